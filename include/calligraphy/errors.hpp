@@ -1,0 +1,68 @@
+#pragma once
+/// \file errors.hpp
+/// The library's exception hierarchy. Every error message names the thing at fault
+/// (file, character, stroke, position). Bad input throws `DataError` or `InvalidArgument`;
+/// device faults throw `DeviceError` subclasses. Nothing in the servo path throws past the loop.
+
+#include <stdexcept>
+#include <string>
+
+namespace calligraphy {
+
+/// Base of every exception thrown by the library.
+class Error : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// A caller passed a value outside a documented precondition (NaN, negative stiffness, ...).
+class InvalidArgument : public Error {
+ public:
+  using Error::Error;
+};
+
+/// Character data could not be read: missing folder or file, malformed JSON, impossible geometry.
+/// The message names the path, the character and the position (line:column or JSON pointer).
+class DataError : public Error {
+ public:
+  using Error::Error;
+};
+
+/// A character is not in the library that was asked for it. The message names the character
+/// (glyph and U+ code point) and where the library looked.
+class CharacterNotFound : public DataError {
+ public:
+  using DataError::DataError;
+};
+
+/// Base of haptic-device faults.
+class DeviceError : public Error {
+ public:
+  using Error::Error;
+};
+
+/// No device of the requested name or id is attached.
+class DeviceNotFound : public DeviceError {
+ public:
+  using DeviceError::DeviceError;
+};
+
+/// The transport to the device failed: timeout, unplug, malformed packet stream.
+class CommunicationError : public DeviceError {
+ public:
+  using DeviceError::DeviceError;
+};
+
+/// A safety limit tripped (force, velocity, watchdog, NaN command); forces were turned off.
+class SafetyFault : public DeviceError {
+ public:
+  using DeviceError::DeviceError;
+};
+
+/// The device must be calibrated (for a Phantom: put the stylus in the inkwell) before use.
+class CalibrationNeeded : public DeviceError {
+ public:
+  using DeviceError::DeviceError;
+};
+
+}  // namespace calligraphy

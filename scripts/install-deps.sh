@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Installs every build, test and data dependency from Debian 12 packages (run as root).
+# Idempotent: packages already present are skipped by apt-get; `apt-get update` runs only
+# when the package lists are missing or older than a day.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build git ca-certificates
+  clang libclang-rt-14-dev            # sanitizer and fuzzer builds
+  libeigen3-dev libspdlog-dev catch2 nlohmann-json3-dev libbenchmark-dev
+  libusb-1.0-0-dev libhidapi-dev     # Phantom backend (optional at configure time)
+  pybind11-dev python3-dev python3-numpy python3-pytest
+  nodejs npm                          # npm pack for hanzi-writer-data
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+# npm may come from another installation (nvm, a distribution image); don't fight it.
+if command -v npm >/dev/null 2>&1; then
+  missing=("${missing[@]/npm}"); missing=("${missing[@]/nodejs}")
+fi
+filtered=()
+for p in "${missing[@]}"; do [ -n "$p" ] && filtered+=("$p"); done
+
+if [ "${#filtered[@]}" -eq 0 ]; then
+  echo "install-deps: all packages present"
+  exit 0
+fi
+
+export DEBIAN_FRONTEND=noninteractive
+lists=/var/lib/apt/lists
+if [ -z "$(find "$lists" -maxdepth 1 -name '*Packages*' -mtime -1 2>/dev/null | head -n 1)" ]; then
+  apt-get update -qq
+fi
+echo "install-deps: installing ${filtered[*]}"
+apt-get install -y -qq --no-install-recommends "${filtered[@]}" >/dev/null
+echo "install-deps: done"
