@@ -26,7 +26,9 @@ inline constexpr int kMaxElementDegree = 4;
 struct StrokeElement {
   ElementKind kind = ElementKind::line;
   int degree = 1;                                       ///< 1 for an LSE, 2..4 for a CSE
-  std::array<Vec2, kMaxElementDegree + 1> control{};    ///< first degree+1 entries used
+  /// First degree+1 entries used; the rest stay zero (Eigen does not zero-initialise by itself).
+  std::array<Vec2, kMaxElementDegree + 1> control{Vec2::Zero(), Vec2::Zero(), Vec2::Zero(), Vec2::Zero(),
+                                                  Vec2::Zero()};
 
   /// An LSE from `a` to `b`.
   static StrokeElement line(const Vec2& a, const Vec2& b);

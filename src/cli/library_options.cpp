@@ -1,0 +1,24 @@
+#include "cli/library_options.hpp"
+
+#include "calligraphy/errors.hpp"
+#include "calligraphy/unicode.hpp"
+
+namespace calligraphy::cli {
+
+CharacterLibrary library_from(const Arguments& arguments) {
+  if (const auto folder = arguments.option("data")) return CharacterLibrary::from_directory(*folder);
+  return CharacterLibrary::embedded();
+}
+
+std::u32string characters_from(const std::string& text) {
+  std::u32string chars;
+  try {
+    chars = decode_utf8(text);
+  } catch (const InvalidArgument& e) {
+    throw UsageError(std::string("characters: ") + e.what());
+  }
+  if (chars.empty()) throw UsageError("no character given");
+  return chars;
+}
+
+}  // namespace calligraphy::cli

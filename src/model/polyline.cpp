@@ -1,0 +1,92 @@
+#include "model/polyline.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "calligraphy/nearest_point.hpp"
+
+namespace calligraphy {
+
+double direction_deg(const Vec2& v) { return std::atan2(v.y(), v.x()) * 180.0 / std::numbers::pi; }
+
+double wrap_deg(double a) {
+  a = std::fmod(a, 360.0);
+  if (a > 180.0) a -= 360.0;
+  if (a <= -180.0) a += 360.0;
+  return a;
+}
+
+double turn_deg(const Vec2& a, const Vec2& b) { return wrap_deg(direction_deg(b) - direction_deg(a)); }
+
+std::vector<Vec2> without_repeats(std::span<const Vec2> pts) {
+  std::vector<Vec2> out;
+  for (const Vec2& p : pts) {
+    if (out.empty() || p != out.back()) out.push_back(p);
+  }
+  return out;
+}
+
+double polyline_length(std::span<const Vec2> pts) {
+  double length = 0.0;
+  for (std::size_t i = 1; i < pts.size(); ++i) length += (pts[i] - pts[i - 1]).norm();
+  return length;
+}
+
+std::vector<Vec2> resample(std::span<const Vec2> pts, double step) {
+  std::vector<Vec2> out;
+  if (pts.empty()) return out;
+  out.push_back(pts.front());
+  double carried = 0.0;  // distance walked since the last emitted point
+  for (std::size_t i = 1; i < pts.size(); ++i) {
+    const Vec2 a = pts[i - 1];
+    const Vec2 d = pts[i] - a;
+    const double len = d.norm();
+    double s = step - carried;
+    while (s < len) {
+      out.push_back(a + d * (s / len));
+      s += step;
+    }
+    carried = len - (s - step);
+  }
+  if ((out.back() - pts.back()).norm() > 1e-9 * step) out.push_back(pts.back());
+  return out;
+}
+
+double max_chord_deviation(std::span<const Vec2> pts) {
+  double worst = 0.0;
+  for (const Vec2& p : pts) worst = std::max(worst, nearest_point_on_segment(pts.front(), pts.back(), p).distance);
+  return worst;
+}
+
+std::size_t farthest_from_chord(std::span<const Vec2> pts) {
+  std::size_t best = 1;
+  double worst = -1.0;
+  for (std::size_t i = 1; i + 1 < pts.size(); ++i) {
+    const double d = nearest_point_on_segment(pts.front(), pts.back(), pts[i]).distance;
+    if (d > worst) {
+      worst = d;
+      best = i;
+    }
+  }
+  return best;
+}
+
+std::vector<Vec2> sample_element(const StrokeElement& element, int segments) {
+  std::vector<Vec2> out;
+  out.reserve(static_cast<std::size_t>(segments) + 1);
+  for (int i = 0; i <= segments; ++i) out.push_back(element.point(static_cast<double>(i) / segments));
+  return out;
+}
+
+double distance_to_polyline(const Vec2& p, std::span<const Vec2> pts) {
+  if (pts.size() == 1) return (p - pts[0]).norm();
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 1; i < pts.size(); ++i) {
+    best = std::min(best, nearest_point_on_segment(pts[i - 1], pts[i], p).distance);
+  }
+  return best;
+}
+
+}  // namespace calligraphy

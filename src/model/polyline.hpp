@@ -1,0 +1,30 @@
+#pragma once
+// Small polyline and angle helpers shared by fitting, metrics and drawing. Internal.
+#include <span>
+#include <vector>
+
+#include "calligraphy/element.hpp"
+
+namespace calligraphy {
+
+/// Direction of v in degrees, (-180, 180], y up.
+double direction_deg(const Vec2& v);
+/// a wrapped into (-180, 180].
+double wrap_deg(double a);
+/// Signed turn from direction a to direction b, degrees, counter-clockwise positive.
+double turn_deg(const Vec2& a, const Vec2& b);
+
+std::vector<Vec2> without_repeats(std::span<const Vec2> pts);
+double polyline_length(std::span<const Vec2> pts);
+/// Points every `step` along the polyline, both ends included.
+std::vector<Vec2> resample(std::span<const Vec2> pts, double step);
+/// Max distance of the points from the chord front-back.
+double max_chord_deviation(std::span<const Vec2> pts);
+/// Index of the interior point farthest from the chord (1 when there is none farther).
+std::size_t farthest_from_chord(std::span<const Vec2> pts);
+/// `segments` + 1 points along the element at equal parameter steps.
+std::vector<Vec2> sample_element(const StrokeElement& element, int segments);
+/// Distance from p to the polyline.
+double distance_to_polyline(const Vec2& p, std::span<const Vec2> pts);
+
+}  // namespace calligraphy
