@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   const std::string command = argv[1];
   const Args args(argv + 2, argv + argc);
   try {
+    if (command == "trial") return command_trial(args);
     if (command == "model") return command_model(args);
     std::fprintf(stderr, "calligraphy: error: unknown command '%s'\n%s", command.c_str(), kUsage);
     return 2;

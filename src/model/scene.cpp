@@ -1,0 +1,61 @@
+#include "calligraphy/scene.hpp"
+
+#include <string>
+
+#include "calligraphy/errors.hpp"
+
+namespace calligraphy {
+
+double PlacedStroke::length_m() const {
+  double length = 0.0;
+  for (const auto& e : elements) length += e.arc_length();
+  return length;
+}
+
+std::size_t Scene::stroke_count() const {
+  std::size_t n = 0;
+  for (const auto& c : characters) n += c.strokes.size();
+  return n;
+}
+
+Scene Scene::lay_out(const std::vector<Character>& characters, const SceneLayout& layout) {
+  if (!(layout.character_size_m > 0.0) || !(layout.spacing_m > 0.0) || !(layout.start_radius_m > 0.0) ||
+      !(layout.box_margin_m >= 0.0) || !layout.centre_m.allFinite() || !std::isfinite(layout.paper_z_m)) {
+    throw InvalidArgument("SceneLayout out of range: character size " + std::to_string(layout.character_size_m) +
+                          " m, spacing " + std::to_string(layout.spacing_m) + " m, start radius " +
+                          std::to_string(layout.start_radius_m) + " m");
+  }
+  Scene scene;
+  scene.layout = layout;
+  const double n = static_cast<double>(characters.size());
+  for (std::size_t k = 0; k < characters.size(); ++k) {
+    const Character& character = characters[k];
+    PlacedCharacter placed;
+    placed.code_point = character.code_point;
+    placed.placement.metres_per_unit = layout.character_size_m / kDataBoxSize;
+    const Vec2 box_centre_data(kDataBoxSize / 2.0, (kDataBoxTop + kDataBoxBottom) / 2.0);
+    const Vec2 centre = layout.centre_m + Vec2((static_cast<double>(k) - (n - 1.0) / 2.0) * layout.spacing_m, 0.0);
+    placed.placement.origin_m = centre - placed.placement.metres_per_unit * box_centre_data;
+    for (const Stroke& stroke : character.strokes) {
+      PlacedStroke ps;
+      ps.typical_id = stroke.typical_id;
+      ps.attraction_factors = stroke.attraction_factors;
+      for (StrokeElement e : stroke.elements) {
+        for (int i = 0; i <= e.degree; ++i) {
+          auto& c = e.control[static_cast<std::size_t>(i)];
+          c = placed.placement.to_paper(c);
+          placed.bounding_box.extend(c);
+        }
+        ps.elements.push_back(e);
+      }
+      for (const Vec2& p : stroke.median) ps.median_m.push_back(placed.placement.to_paper(p));
+      placed.strokes.push_back(std::move(ps));
+    }
+    placed.bounding_box.min().array() -= layout.box_margin_m;
+    placed.bounding_box.max().array() += layout.box_margin_m;
+    scene.characters.push_back(std::move(placed));
+  }
+  return scene;
+}
+
+}  // namespace calligraphy
