@@ -1,0 +1,54 @@
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <limits>
+
+#include "calligraphy/errors.hpp"
+#include "calligraphy/force_law.hpp"
+
+using namespace calligraphy;
+
+TEST_CASE("Eq. (9): the paper pushes a penetrating tip out with K_en times the depth", "[force]") {
+  const Vec3 f = paper_force(-0.002, 0.0, 800.0);  // 2 mm below the paper
+  CHECK(f.x() == 0.0);
+  CHECK(f.y() == 0.0);
+  CHECK(f.z() == Approx(1.6));                      // 800 N/m * 2 mm, out of the paper (+z)
+  CHECK(paper_force(0.001, 0.0, 800.0).isZero());   // above the paper: nothing
+  CHECK(paper_force(0.0105, 0.01, 1000.0).isZero());
+  CHECK(paper_force(0.0095, 0.01, 1000.0).z() == Approx(0.5));  // z0 = 10 mm
+}
+
+TEST_CASE("Eq. (8): the attraction pulls the tip towards X_S, scaled by the attraction factor", "[force]") {
+  const Vec2 tip(0.010, 0.003);
+  const Vec2 foot(0.010, 0.0);
+  const Vec2 f = attraction_force(tip, foot, 400.0, 1.5);
+  CHECK(f.x() == Approx(0.0).margin(1e-15));
+  CHECK(f.y() == Approx(-1.8));  // 400 N/m * 1.5 * 3 mm, towards the stroke
+  CHECK(attraction_force(foot, foot, 400.0, 1.0).isZero());
+}
+
+TEST_CASE("Resistance opposes only backward motion along the element (Fig. 4)", "[force]") {
+  const Vec2 t(1.0, 0.0);
+  CHECK(resistance_force(Vec2(0.02, 0.01), t, 15.0).isZero());  // forward: free
+  const Vec2 back = resistance_force(Vec2(-0.02, 0.01), t, 15.0);
+  CHECK(back.x() == Approx(0.3));  // 15 N s/m * 20 mm/s, pushing forward
+  CHECK(back.y() == 0.0);
+}
+
+TEST_CASE("Clamping keeps the direction and removes non-finite forces", "[force]") {
+  const Vec3 f = clamp_force(Vec3(6.0, 8.0, 0.0), 5.0);
+  CHECK(f.norm() == Approx(5.0));
+  CHECK(f.x() / f.y() == Approx(0.75));
+  CHECK(clamp_force(Vec3(1.0, 0.0, 0.0), 5.0) == Vec3(1.0, 0.0, 0.0));
+  CHECK(clamp_force(Vec3(std::numeric_limits<double>::quiet_NaN(), 0.0, 0.0), 5.0).isZero());
+  CHECK(clamp_force(Vec3(std::numeric_limits<double>::infinity(), 0.0, 0.0), 5.0).isZero());
+}
+
+TEST_CASE("Force-law parameters are validated", "[force]") {
+  ForceLawParameters p;
+  CHECK_NOTHROW(p.validate());
+  p.constraint_radius_m = 0.0;
+  CHECK_THROWS_AS(p.validate(), InvalidArgument);
+  p = {};
+  p.guidance_stiffness_n_per_m = -1.0;
+  CHECK_THROWS_WITH(p.validate(), Catch::Contains("guidance_stiffness_n_per_m"));
+}

@@ -1,0 +1,128 @@
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+
+#include "calligraphy/character_library.hpp"
+#include "calligraphy/errors.hpp"
+#include "calligraphy/fitting.hpp"
+#include "calligraphy/typical_strokes.hpp"
+#include "calligraphy/unicode.hpp"
+
+using namespace calligraphy;
+
+TEST_CASE("39 typical strokes with stable IDs", "[model]") {
+  REQUIRE(typical_strokes().size() == 39);
+  for (std::size_t i = 0; i < 39; ++i) CHECK(typical_strokes()[i].id == static_cast<int>(i) + 1);
+  CHECK(typical_stroke(10).acronym == "HZG");
+  CHECK(typical_stroke(10).unicode == U'\u31C6');
+  CHECK(typical_stroke_id("XG") == 30);
+  CHECK_THROWS_AS(typical_stroke(40), InvalidArgument);
+}
+
+TEST_CASE("Fitting: a straight median is one LSE, a corner makes a feature point", "[model]") {
+  const std::vector<Vec2> straight = {{100, 500}, {300, 502}, {600, 500}};
+  auto f = fit_stroke(straight);
+  REQUIRE(f.stroke.elements.size() == 1);
+  CHECK(f.stroke.elements[0].kind == ElementKind::line);
+  CHECK(f.stroke.typical_id == typical_stroke_id("H"));
+
+  const std::vector<Vec2> corner = {{100, 600}, {400, 610}, {700, 620}, {700, 300}, {700, 100}};
+  f = fit_stroke(corner);
+  REQUIRE(f.stroke.elements.size() == 2);
+  CHECK(f.stroke.feature_point(1).isApprox(Vec2(700, 620)));
+  CHECK(f.stroke.typical_id == typical_stroke_id("HZ"));
+  CHECK(f.stroke.attraction_factors.size() == 3);
+
+  const std::vector<Vec2> bend = {{300, 700}, {300, 400}, {320, 300}, {380, 230}, {500, 200}, {700, 200}};
+  f = fit_stroke(bend);
+  CHECK(f.max_deviation <= FitOptions{}.tolerance + 1e-9);
+  bool has_curve = false;
+  for (const auto& e : f.stroke.elements) has_curve |= e.kind == ElementKind::bezier;
+  CHECK(has_curve);
+
+  const std::vector<Vec2> dot = {{500, 500}};
+  f = fit_stroke(dot);
+  REQUIRE(f.stroke.elements.size() == 1);
+  CHECK(f.stroke.elements[0].start() == f.stroke.elements[0].end());  // rule (d)
+}
+
+TEST_CASE("永 is modelled as 5 typical strokes: D HZG HP P N", "[model]") {
+  const Character c = CharacterLibrary::embedded().load(U'永');
+  REQUIRE(c.strokes.size() == 5);
+  std::vector<std::string_view> acronyms;
+  for (const auto& s : c.strokes) acronyms.push_back(typical_stroke(s.typical_id).acronym);
+  CHECK(acronyms == std::vector<std::string_view>{"D", "HZG", "HP", "P", "N"});
+  const CharacterTable table = character_table(c);
+  std::size_t elements = 0;
+  for (const auto& s : c.strokes) elements += s.elements.size();
+  CHECK(table.feature_point_count() == elements + c.strokes.size());
+  for (std::size_t s = 0; s < c.strokes.size(); ++s) {  // feature points index the control points
+    for (std::size_t k = 0; k < table.feature_point_indices[s].size(); ++k) {
+      const int i = table.feature_point_indices[s][k];
+      CHECK(table.control_points[static_cast<std::size_t>(i)] == c.strokes[s].feature_point(k));
+    }
+  }
+}
+
+TEST_CASE("Every embedded character loads and fits within tolerance", "[model]") {
+  const auto library = CharacterLibrary::embedded();
+  const auto chars = library.characters();
+  CHECK(chars.size() >= 40);
+  for (char32_t cp : chars) {
+    const auto data = library.load_data(cp);
+    for (const auto& median : data.medians) {
+      const auto fitted = fit_stroke(median);
+      INFO(describe_character(cp));
+      CHECK(fitted.max_deviation <= 2.0 * FitOptions{}.tolerance);
+    }
+  }
+}
+
+namespace {
+std::filesystem::path scratch_folder(const std::string& name) {
+  auto dir = std::filesystem::temp_directory_path() / ("calligraphy-test-" + name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+void write(const std::filesystem::path& p, const std::string& text) { std::ofstream(p) << text; }
+}  // namespace
+
+TEST_CASE("Bad data gives errors that name the character, the path and the position", "[model][errors]") {
+  CHECK_THROWS_AS(CharacterLibrary::from_directory("/nonexistent/hanzi"), DataError);
+  CHECK_THROWS_WITH(CharacterLibrary::from_directory("/nonexistent/hanzi"), Catch::Contains("/nonexistent/hanzi"));
+
+  CHECK_THROWS_AS(CharacterLibrary::embedded().load(U'龘'), CharacterNotFound);
+  CHECK_THROWS_WITH(CharacterLibrary::embedded().load(U'龘'), Catch::Contains("U+9F98"));
+
+  const auto dir = scratch_folder("bad");
+  write(dir / "一.json", "{\"medians\": [[[1, 2], [3, 4]],\n  [[5, 6], [7,]]]}");
+  CHECK_THROWS_AS(CharacterLibrary::from_directory(dir).load(U'一'), DataError);
+  CHECK_THROWS_WITH(CharacterLibrary::from_directory(dir).load(U'一'),
+                    Catch::Contains("一.json") && Catch::Contains("U+4E00") && Catch::Contains("2:"));
+  write(dir / "二.json", "{\"medians\": [[[1, 2], [3, \"x\"]]]}");
+  CHECK_THROWS_WITH(CharacterLibrary::from_directory(dir).load(U'二'), Catch::Contains("/medians/0/1"));
+  write(dir / "三.json", "{\"strokes\": []}");
+  CHECK_THROWS_WITH(CharacterLibrary::from_directory(dir).load(U'三'), Catch::Contains("/medians"));
+  write(dir / "四.json", "");
+  CHECK_THROWS_AS(CharacterLibrary::from_directory(dir).load(U'四'), DataError);
+  CHECK_THROWS_AS(CharacterLibrary::from_directory(dir).load(U'五'), CharacterNotFound);
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("The loader reads a hanzi-writer-data folder the same as the embedded set", "[model]") {
+  const auto dir = scratch_folder("copy");
+  std::filesystem::copy_file(std::filesystem::path(CALLIGRAPHY_SOURCE_DIR) / "data/hanzi-writer-data/永.json",
+                             dir / "永.json");
+  const auto from_folder = CharacterLibrary::from_directory(dir).load_data(U'永');
+  const auto embedded = CharacterLibrary::embedded().load_data(U'永');
+  CHECK(from_folder.medians == embedded.medians);
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("UTF-8 round trip and malformed input", "[model]") {
+  CHECK(decode_utf8("永我") == U"永我");
+  CHECK(encode_utf8(U'永') == "永");
+  CHECK_THROWS_AS(decode_utf8("\xE6\xB0"), InvalidArgument);
+  CHECK_THROWS_AS(decode_utf8("\xC0\x80"), InvalidArgument);
+}

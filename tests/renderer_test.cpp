@@ -1,0 +1,127 @@
+#include <catch2/catch.hpp>
+
+#include "calligraphy/renderer.hpp"
+#include "calligraphy/simulated_device.hpp"
+
+using namespace calligraphy;
+
+namespace {
+
+// One character: stroke 0 is a 横折 (right, then down), stroke 1 a 横 lower down. Data units.
+Scene two_stroke_scene() {
+  Character c;
+  c.code_point = U'口';
+  Stroke hz;
+  hz.typical_id = 7;
+  hz.elements = {StrokeElement::line({200, 600}, {800, 600}), StrokeElement::line({800, 600}, {800, 100})};
+  hz.attraction_factors = {1.0, 2.0, 2.0};
+  Stroke h;
+  h.typical_id = 1;
+  h.elements = {StrokeElement::line({200, 300}, {700, 300})};
+  h.attraction_factors = {1.0, 1.0};
+  c.strokes = {hz, h};
+  return Scene::lay_out({c});
+}
+
+DeviceState at(const Scene& scene, const Vec2& data, double z, const Vec2& velocity = Vec2::Zero()) {
+  DeviceState s;
+  const Vec2 p = scene.characters[0].placement.to_paper(data);
+  s.position_m = Vec3(p.x(), p.y(), z);
+  s.velocity_m_s = Vec3(velocity.x(), velocity.y(), 0.0);
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("Renderer: states, plane popping, completion and per-state forces", "[renderer]") {
+  const Scene scene = two_stroke_scene();
+  Renderer r(scene, ForceLawParameters{}, phantom_desktop_info());
+  const double below = -0.001;  // 1 mm into the paper
+
+  // SS above the paper: zero force.
+  auto out = r.tick(at(scene, {500, 500}, 0.01));
+  CHECK(out.state == InteractionState::separation);
+  CHECK(out.force_n.isZero());
+  // AS: touching outside the bounding box: zero force (Table 2).
+  out = r.tick(at(scene, {1000, -100}, below));
+  CHECK(out.state == InteractionState::adjusting);
+  CHECK(out.force_n.isZero());
+  // CS: inside the box, away from the start: only the normal force.
+  out = r.tick(at(scene, {500, 450}, below));
+  CHECK(out.state == InteractionState::calibration);
+  CHECK(out.force_n.head<2>().isZero());
+  CHECK(out.force_n.z() == Approx(0.8));  // 800 N/m * 1 mm
+  // WS: at the start point.
+  out = r.tick(at(scene, {210, 600}, below));
+  CHECK(out.state == InteractionState::writing);
+  CHECK(out.element == 0);
+  // Off the stroke by 40 data units (2.34 mm): attraction back towards it, in -y.
+  out = r.tick(at(scene, {500, 640}, below));
+  CHECK(out.in_constraint_space);
+  const double offset_m = 40 * 0.06 / 1024;
+  // Halfway along the element the attraction factor is 1.5, between its feature points' 1 and 2.
+  CHECK(out.force_n.y() == Approx(-400.0 * 1.5 * offset_m).epsilon(1e-9));
+  CHECK(out.force_n.x() == Approx(0.0).margin(1e-12));
+  // Moving backwards along the element: resistance pushes forward (+x).
+  out = r.tick(at(scene, {500, 600}, below, Vec2(-0.02, 0.0)));
+  CHECK(out.force_n.x() == Approx(15.0 * 0.02));
+  // Crossing the feature plane at x = 800 pops to the vertical element.
+  out = r.tick(at(scene, {805, 590}, below));
+  CHECK(out.element == 1);
+  CHECK(out.stroke == 0);
+  // Lifting mid-stroke abandons it: the feature points are reloaded.
+  out = r.tick(at(scene, {805, 400}, 0.01));
+  CHECK(out.state == InteractionState::separation);
+  CHECK(out.stroke_abandoned);
+  CHECK(r.active().element_index() == 0);
+  CHECK(r.active().stroke_index() == 0);
+  // Write it again, all the way through the last plane: the stroke completes, the next is active.
+  r.tick(at(scene, {200, 600}, below));
+  r.tick(at(scene, {810, 600}, below));
+  out = r.tick(at(scene, {800, 90}, below));
+  CHECK(out.stroke_completed);
+  CHECK(out.state == InteractionState::calibration);
+  CHECK(out.stroke == 1);
+  CHECK(r.active().strokes_written() == 1);
+  // The written stroke is not written again: touching its start now is plain CS.
+  out = r.tick(at(scene, {200, 600}, 0.01));
+  out = r.tick(at(scene, {200, 600}, below));
+  CHECK(out.state == InteractionState::calibration);
+  // The next stroke starts at its own neighbourhood.
+  out = r.tick(at(scene, {200, 300}, below));
+  CHECK(out.state == InteractionState::writing);
+  out = r.tick(at(scene, {720, 300}, below));
+  CHECK(out.stroke_completed);
+  CHECK(out.finished);
+}
+
+TEST_CASE("Renderer: non-finite input gives zero force, never NaN", "[renderer]") {
+  const Scene scene = two_stroke_scene();
+  Renderer r(scene, ForceLawParameters{}, phantom_desktop_info());
+  DeviceState s = at(scene, {210, 600}, -0.001);
+  s.position_m.x() = std::numeric_limits<double>::quiet_NaN();
+  const auto out = r.tick(s);
+  CHECK(out.input_rejected);
+  CHECK(out.force_n.isZero());
+}
+
+TEST_CASE("Renderer: guidance off keeps the paper and the tracking but no in-plane force", "[renderer]") {
+  const Scene scene = two_stroke_scene();
+  ForceLawParameters p;
+  p.guidance = false;
+  Renderer r(scene, p, phantom_desktop_info());
+  r.tick(at(scene, {210, 600}, -0.001));
+  const auto out = r.tick(at(scene, {500, 640}, -0.001));
+  CHECK(out.state == InteractionState::writing);
+  CHECK(out.force_n.head<2>().isZero());
+  CHECK(out.force_n.z() > 0.0);
+}
+
+TEST_CASE("Renderer: the force never exceeds the device maximum", "[renderer]") {
+  const Scene scene = two_stroke_scene();
+  DeviceInfo weak = phantom_desktop_info();
+  weak.max_force_n = 0.5;
+  Renderer r(scene, ForceLawParameters{}, weak);
+  const auto out = r.tick(at(scene, {300, 500}, -0.01));  // 10 mm deep: 8 N asked
+  CHECK(out.force_n.norm() == Approx(0.5));
+}
