@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Runs every test: installs dependencies, builds with warnings as errors and runs the Catch2 and
+# pytest suites through CTest, then again under AddressSanitizer + UndefinedBehaviorSanitizer, then
+# installs the library and builds a separate project against it with find_package(calligraphy).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/install-deps.sh
+jobs=$(nproc)
+
+echo "== Release build, warnings as errors"
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON >/dev/null
+cmake --build build -j "$jobs"
+ctest --test-dir build --output-on-failure -j "$jobs"
+
+echo "== AddressSanitizer + UndefinedBehaviorSanitizer"
+cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCALLIGRAPHY_SANITIZE=address,undefined \
+  -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_BENCH=OFF -DCALLIGRAPHY_BUILD_PYTHON=OFF >/dev/null
+cmake --build build-asan -j "$jobs"
+ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 ctest --test-dir build-asan --output-on-failure -j "$jobs"
+
+echo "== install + find_package(calligraphy) from another project"
+rm -rf build/stage build/consumer
+cmake --install build --prefix build/stage >/dev/null
+cmake -S tests/consumer -B build/consumer -G Ninja -DCMAKE_PREFIX_PATH="$PWD/build/stage" >/dev/null
+cmake --build build/consumer
+build/consumer/consumer
+echo "== all tests passed"
