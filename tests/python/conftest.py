@@ -1,0 +1,38 @@
+"""pytest configuration of the Python binding tests.
+
+Run from CTest (``ctest -R python``) with PYTHONPATH set to the build's ``python`` folder and
+CALLIGRAPHY_CLI to the ``calligraphy`` program. A run that collects fewer tests than expected fails,
+so that a broken import or a renamed file cannot pass as "no tests ran".
+"""
+
+import os
+
+import pytest
+
+# The suite has more tests than this; collecting fewer means files were lost or skipped wholesale.
+MINIMUM_TESTS = 20
+
+
+def pytest_collection_finish(session):
+    whole_suite = not session.config.option.keyword and all(os.path.isdir(a) for a in session.config.args)
+    if whole_suite and len(session.items) < MINIMUM_TESTS:
+        raise pytest.UsageError(
+            f"only {len(session.items)} tests collected, expected at least {MINIMUM_TESTS}"
+        )
+
+
+@pytest.fixture(scope="session")
+def cli():
+    path = os.environ.get("CALLIGRAPHY_CLI")
+    if not path:
+        pytest.fail("CALLIGRAPHY_CLI is not set: run these tests through ctest")
+    if not os.path.exists(path):
+        pytest.fail(f"CALLIGRAPHY_CLI={path} does not exist")
+    return path
+
+
+@pytest.fixture(scope="session")
+def library():
+    import calligraphy
+
+    return calligraphy.CharacterLibrary.default()

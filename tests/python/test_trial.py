@@ -1,0 +1,94 @@
+"""Simulated trials from Python: the trace arrays and the metrics, against `calligraphy trial --json`."""
+
+import json
+import subprocess
+
+import numpy as np
+import pytest
+
+import calligraphy
+
+CLI_KEYS = {
+    "character", "guidance", "writer", "seed", "rate_hz", "strokes_total", "strokes_completed",
+    "completed_in_order", "time_s", "mean_deviation_mm", "max_deviation_mm", "max_force_n",
+    "max_force_step_n", "state_transitions", "per_stroke",
+}
+STROKE_KEYS = {"index", "typical_id", "mean_deviation_mm", "max_deviation_mm", "time_s", "completed", "attempts"}
+
+
+@pytest.fixture(scope="module")
+def yong_seed3():
+    return calligraphy.simulate_trial("永", seed=3)
+
+
+def run_cli(cli, tmp_path, *args):
+    out = tmp_path / "trial.json"
+    subprocess.run([cli, "trial", *args, "--json", str(out)], check=True, capture_output=True)
+    return json.loads(out.read_text(encoding="utf-8"))
+
+
+def test_metrics_equal_the_cli(cli, tmp_path, yong_seed3):
+    expected = run_cli(cli, tmp_path, "永", "--seed", "3")
+    assert set(yong_seed3.metrics) == CLI_KEYS
+    assert all(set(s) == STROKE_KEYS for s in yong_seed3.metrics["per_stroke"])
+    assert yong_seed3.metrics == expected
+
+
+def test_metrics_equal_the_cli_skilled_unguided(cli, tmp_path):
+    expected = run_cli(cli, tmp_path, "九", "--seed", "11", "--writer", "skilled", "--guidance", "off")
+    result = calligraphy.simulate_trial("九", writer="skilled", guidance=False, seed=11, keep_trace=False)
+    assert result.metrics == expected
+    assert result.t.shape == (0,)
+
+
+def test_trace_arrays(yong_seed3):
+    r = yong_seed3
+    n = r.t.shape[0]
+    assert n > 1000
+    assert r.position.shape == (n, 3) and r.force.shape == (n, 3)
+    assert r.state.shape == (n,) and r.active_stroke.shape == (n,) and r.active_element.shape == (n,)
+    np.testing.assert_allclose(np.diff(r.t), 1e-3, rtol=1e-6)
+    assert set(np.unique(r.state)) <= {0, 1, 2, 3}
+    assert calligraphy.STATE_NAMES[calligraphy.WRITING] == "WS"
+    # Writing happened, and forces are zero in SS and AS (Table 2).
+    assert np.any(r.state == calligraphy.WRITING)
+    free = (r.state == calligraphy.SEPARATION) | (r.state == calligraphy.ADJUSTING)
+    assert np.all(r.force[free] == 0.0)
+    m = r.metrics
+    assert np.max(np.linalg.norm(r.force, axis=1)) == pytest.approx(m["max_force_n"], rel=1e-12)
+    assert np.max(np.linalg.norm(np.diff(r.force, axis=0), axis=1)) == pytest.approx(m["max_force_step_n"], rel=1e-9)
+    assert np.count_nonzero(np.diff(r.state.astype(int))) == m["state_transitions"]
+    assert r.active_stroke.min() == 0 and r.active_stroke.max() <= m["strokes_total"] - 1
+    assert np.all(np.diff(r.active_stroke) >= 0)
+
+
+def test_characters_can_be_given_as_objects(library, yong_seed3):
+    by_object = calligraphy.simulate_trial(library.load("永"), seed=3, keep_trace=False)
+    assert by_object.metrics == yong_seed3.metrics
+    group = calligraphy.simulate_trial([library.load("九"), library.load("心")], seed=2, keep_trace=False)
+    assert group.metrics["character"] == "九心"
+    assert group.metrics["strokes_total"] == len(library.load("九")) + len(library.load("心"))
+
+
+def test_deterministic_for_a_seed_and_seed_matters():
+    a = calligraphy.simulate_trial("心", seed=5, keep_trace=False).metrics
+    b = calligraphy.simulate_trial("心", seed=5, keep_trace=False).metrics
+    c = calligraphy.simulate_trial("心", seed=6, keep_trace=False).metrics
+    assert a == b
+    assert a["mean_deviation_mm"] != c["mean_deviation_mm"]
+
+
+def test_simulated_device_moves_with_the_force():
+    device = calligraphy.SimulatedDevice(initial_position_m=(0.0, 0.0, 0.02))
+    start = device.read_state().position
+    np.testing.assert_allclose(start, [0.0, 0.0, 0.02], atol=3e-5)
+    device.write_force([1.0, 0.0, 0.0])
+    for _ in range(100):
+        device.advance(1e-3)
+    state = device.read_state()
+    assert state.time_s == pytest.approx(0.1)
+    assert state.position[0] > 0.01  # x = F t^2 / 2m ~ 0.025 m, less damping
+    assert abs(state.position[1]) < 1e-4
+    assert device.true_velocity[0] > 0
+    device.write_force([100.0, 0.0, 0.0])
+    assert np.linalg.norm(device.applied_force) == pytest.approx(device.max_force_n)
