@@ -8,7 +8,8 @@ bash scripts/install-deps.sh
 jobs=$(nproc)
 
 echo "== Release build, warnings as errors"
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON >/dev/null
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON \
+  -DCALLIGRAPHY_BUILD_PYTHON=ON -DCALLIGRAPHY_BUILD_TESTS=ON >/dev/null
 cmake --build build -j "$jobs"
 ctest --test-dir build --output-on-failure -j "$jobs"
 
