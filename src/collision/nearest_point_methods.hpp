@@ -1,12 +1,16 @@
 #pragma once
 // The nearest-point methods on a curve already in its local frame. No validation, no exceptions:
 // `nearest_point` validates, and the tracker calls these on the servo path.
+#include <algorithm>
+#include <limits>
+
 #include "calligraphy/nearest_point.hpp"
 #include "collision/local_curve.hpp"
 
 namespace calligraphy::detail {
 
-/// Keeps the nearest of the candidate parameters offered; among equally near ones the smallest t.
+/// Keeps the nearest of the candidate parameters offered; among equally near ones (within the
+/// rounding of the squared distance) the smallest t, so that ties do not depend on rounding.
 struct NearestCandidate {
   double t = 0.0;
   double squared_distance = 0.0;  ///< local units
@@ -15,7 +19,8 @@ struct NearestCandidate {
       : t(first_t), squared_distance(local_squared_distance(curve, first_t)) {}
   void offer(const LocalCurve& curve, double candidate_t) noexcept {
     const double d2 = local_squared_distance(curve, candidate_t);
-    if (d2 < squared_distance || (d2 == squared_distance && candidate_t < t)) {
+    const double tie = 8.0 * std::numeric_limits<double>::epsilon() * std::max(d2, squared_distance);
+    if (d2 < squared_distance - tie || (d2 <= squared_distance + tie && candidate_t < t)) {
       squared_distance = d2;
       t = candidate_t;
     }
