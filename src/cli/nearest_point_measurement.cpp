@@ -76,8 +76,12 @@ NearestPointRow measure_method(NearestPointMethod method, int degree, const std:
   return row;
 }
 
+// Through volatile floats: GCC 12 at -O2 dropped the plain double -> float -> double round trip in
+// this file (it includes the __float128 reference), which made float look as precise as double.
 Vec2 round_to_float(const Vec2& v) {
-  return {static_cast<double>(static_cast<float>(v.x())), static_cast<double>(static_cast<float>(v.y()))};
+  const volatile float x = static_cast<float>(v.x());
+  const volatile float y = static_cast<float>(v.y());
+  return {static_cast<double>(x), static_cast<double>(y)};
 }
 
 // Max error of the exact method when the input passes through float first.

@@ -42,9 +42,9 @@ struct NearestPointMeasurement {
 };
 
 struct MeasurementSettings {
-  int queries = 1000;      ///< queries per scenario and degree
-  std::uint64_t seed = 1;  ///< seed of the random scenarios
-  int timing_repeats = 8;  ///< calls per query timed together (the clock's overhead is shared)
+  int queries = 1000;       ///< queries per scenario and degree
+  std::uint64_t seed = 1;   ///< seed of the random scenarios
+  int timing_repeats = 16;  ///< calls per query timed together (the clock's overhead is shared)
 };
 
 /// The method names used in the table: "exact", "newton", "subdivision".
