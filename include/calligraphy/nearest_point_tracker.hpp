@@ -1,7 +1,7 @@
 #pragma once
 /// \file nearest_point_tracker.hpp
 /// Following the nearest point on one stroke element from servo tick to tick (1 kHz). Each tick
-/// refines the previous foot point with a few damped Newton steps (a local search: about 0.1 us);
+/// refines the previous foot point with a few damped Newton steps (a local search);
 /// every `global_check_period` ticks the exact global search runs as well, and the tracker moves
 /// to the global minimum only when it is nearer than the tracked one by more than
 /// `switch_hysteresis_m`. So the foot point does not flip between near-equal minima (a pen on the
