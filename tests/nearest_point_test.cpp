@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <random>
 #include <string>
 #include <type_traits>
@@ -70,7 +71,7 @@ std::vector<Case> extreme_cases(int degree) {
     return make(points);
   };
   auto around = [&](const Vec2& centre, double radius) {
-    const double angle = 2 * M_PI * unit(random);
+    const double angle = 2 * std::numbers::pi * unit(random);
     return Vec2(centre + radius * unit(random) * Vec2(std::cos(angle), std::sin(angle)));
   };
   std::vector<Case> cases;
