@@ -1,50 +1,96 @@
-// PROVISIONAL until the nearest-point module of issue 4 is merged: segment projection, and for Bezier
-// elements dense sampling followed by Newton refinement. Replaced wholesale by that module.
+// Validation and dispatch of `nearest_point`, and the servo-path segment projection.
 #include "calligraphy/nearest_point.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 #include "calligraphy/errors.hpp"
+#include "collision/local_curve.hpp"
+#include "collision/nearest_point_methods.hpp"
 
 namespace calligraphy {
 
-NearestPoint nearest_point_on_segment(const Vec2& a, const Vec2& b, const Vec2& p) noexcept {
-  const Vec2 edge = b - a;
-  const double length_sq = edge.squaredNorm();
-  double t = length_sq > 0.0 ? std::clamp((p - a).dot(edge) / length_sq, 0.0, 1.0) : 0.0;
-  const Vec2 foot = a + t * edge;
-  return {t, foot, (p - foot).norm()};
+namespace {
+
+// Above this magnitude squared distances could overflow a double.
+constexpr double kMaxCoordinate = 1e150;
+
+std::string format_number(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.17g", value);
+  return buffer;
 }
 
+std::string format_point(const Vec2& v) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "(%.17g, %.17g)", v.x(), v.y());
+  return buffer;
+}
+
+bool usable_point(const Vec2& v) {
+  return std::isfinite(v.x()) && std::isfinite(v.y()) && std::abs(v.x()) <= kMaxCoordinate &&
+         std::abs(v.y()) <= kMaxCoordinate;
+}
+
+// Messages are built only on failure: the success path must not allocate.
+[[noreturn]] void reject_point(const char* what, const Vec2& v) {
+  throw InvalidArgument(std::string("nearest_point: ") + what + " = " + format_point(v) +
+                        " is not finite or exceeds 1e150 in magnitude");
+}
+
+void validate(const StrokeElement& element, const Vec2& p, const NearestPointOptions& options) {
+  if (element.degree < 1 || element.degree > kMaxElementDegree) {
+    throw InvalidArgument("nearest_point: element degree " + std::to_string(element.degree) +
+                          " is not in 1.." + std::to_string(kMaxElementDegree));
+  }
+  if (!usable_point(p)) reject_point("query point p", p);
+  for (int i = 0; i <= element.degree; ++i) {
+    const Vec2& control = element.control[static_cast<std::size_t>(i)];
+    if (!usable_point(control)) reject_point(("control point " + std::to_string(i)).c_str(), control);
+  }
+  if (!(options.tolerance > 0.0) || !std::isfinite(options.tolerance)) {
+    throw InvalidArgument("nearest_point: options.tolerance = " + format_number(options.tolerance) +
+                          " must be finite and > 0");
+  }
+  if (options.newton_starts < 1) {
+    throw InvalidArgument("nearest_point: options.newton_starts = " + std::to_string(options.newton_starts) +
+                          " must be >= 1");
+  }
+  if (options.newton_iterations < 1) {
+    throw InvalidArgument("nearest_point: options.newton_iterations = " +
+                          std::to_string(options.newton_iterations) + " must be >= 1");
+  }
+}
+
+}  // namespace
+
 NearestPoint nearest_point(const StrokeElement& element, const Vec2& p, const NearestPointOptions& options) {
-  if (!p.allFinite()) throw InvalidArgument("nearest_point: query point is not finite");
-  if (!(options.tolerance > 0.0)) throw InvalidArgument("nearest_point: tolerance must be > 0");
-  if (element.degree == 1) return nearest_point_on_segment(element.start(), element.end(), p);
-  constexpr int kSamples = 64;
-  NearestPoint best{0.0, element.start(), (p - element.start()).norm()};
-  for (int i = 1; i <= kSamples; ++i) {
-    const double t = static_cast<double>(i) / kSamples;
-    const Vec2 q = element.point(t);
-    const double d = (p - q).norm();
-    if (d < best.distance) best = {t, q, d};
+  validate(element, p, options);
+  const detail::LocalCurve curve = detail::to_local(element, p);
+  switch (options.method) {
+    case NearestPointMethod::newton:
+      return detail::nearest_point_newton(curve, options.newton_starts, options.newton_iterations);
+    case NearestPointMethod::subdivision:
+      return detail::nearest_point_subdivision(curve, options.tolerance);
+    case NearestPointMethod::exact:
+      break;
   }
-  double t = best.t;
-  for (int iteration = 0; iteration < 20; ++iteration) {
-    const Vec2 d = element.point(t) - p;
-    const Vec2 d1 = element.derivative(t);
-    const double h = 1e-7;
-    const Vec2 d2 = (element.derivative(std::min(1.0, t + h)) - element.derivative(std::max(0.0, t - h))) / (2 * h);
-    const double denom = d1.squaredNorm() + d.dot(d2);
-    if (!(denom > 0.0)) break;
-    const double next = std::clamp(t - d.dot(d1) / denom, 0.0, 1.0);
-    if (std::abs(next - t) < 1e-14) break;
-    t = next;
-  }
-  const Vec2 q = element.point(t);
-  const double d = (p - q).norm();
-  if (d < best.distance) best = {t, q, d};
-  return best;
+  return detail::nearest_point_exact(curve, options.tolerance);
+}
+
+NearestPoint nearest_point_on_segment(const Vec2& a, const Vec2& b, const Vec2& p) noexcept {
+  const Vec2 edge = b - a;
+  const Vec2 offset = p - a;
+  const double length_squared = edge.squaredNorm();
+  double t = 0.0;
+  if (length_squared > 0.0) t = std::clamp(offset.dot(edge) / length_squared, 0.0, 1.0);
+  NearestPoint result;
+  result.t = t;
+  result.foot = a + t * edge;
+  result.distance = (offset - t * edge).norm();
+  return result;
 }
 
 }  // namespace calligraphy
