@@ -62,9 +62,10 @@ PhantomDevice::~PhantomDevice() { close(); }
 void PhantomDevice::log_start_up() const {
   spdlog::info("Phantom: opening {} on {}", config_.info.model, transport_->description());
   spdlog::info(
-      "Phantom: verified: packet codec against the published FireWire Omni field list (raw_omni, "
-      "phantom-drivers; field order and byte order are this library's choice, see docs/devices.md); "
-      "kinematics against Cavusoglu et al.'s Phantom 1.5 model (l1 = {} m, l2 = {} m here)",
+      "Phantom: verified (by tests, against published sources): the packet codec against the FireWire Omni "
+      "field list of raw_omni / phantom-drivers (field order and byte order are this library's choice, see "
+      "docs/devices.md); the kinematics against Cavusoglu et al.'s Phantom 1.5 model (here l1 = {} m, "
+      "l2 = {} m)",
       config_.geometry.first_link_m, config_.geometry.second_link_m);
   spdlog::warn(
       "Phantom: NOT verified: nothing was run on hardware; the USB Touch's packet framing is not public; "
