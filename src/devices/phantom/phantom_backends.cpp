@@ -19,7 +19,7 @@
 namespace calligraphy::phantom {
 namespace {
 
-constexpr const char* kUsbCaveat =
+[[maybe_unused]] constexpr const char* kUsbCaveat =
     "UNVERIFIED: USB id reported by users, not confirmed; the packet codec is the FireWire Omni's, the USB "
     "Touch's framing is not public; never run on hardware";
 
@@ -39,7 +39,7 @@ std::unique_ptr<HapticDevice> make_registry_emulated_phantom() {
   return std::move(make_emulated_phantom(std::move(config), parameters).device);
 }
 
-DeviceInfo usb_touch_info(std::uint16_t vendor, std::uint16_t product) {
+[[maybe_unused]] DeviceInfo usb_touch_info(std::uint16_t vendor, std::uint16_t product) {
   DeviceInfo info = touch_info();
   char ids[48];
   std::snprintf(ids, sizeof ids, " (USB %04x:%04x, unconfirmed)", vendor, product);
