@@ -54,6 +54,10 @@ class HapticDevice {
   /// Homes the encoders. Devices that need no calibration do nothing. Throws CalibrationNeeded when
   /// the device cannot calibrate itself now (e.g. a Phantom whose stylus is not in the inkwell).
   virtual void calibrate() {}
+  /// False while positions are not meaningful and forces cannot be enabled until `calibrate()`
+  /// succeeds (e.g. a Phantom whose encoders were not homed in the inkwell). Devices that need no
+  /// calibration return true. Any thread.
+  [[nodiscard]] virtual bool is_calibrated() const { return true; }
 
   /// Enables or disables force output. Disabled devices ignore `write_force`.
   virtual void enable_forces(bool enabled) = 0;

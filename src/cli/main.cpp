@@ -15,6 +15,7 @@ constexpr const char* kUsage =
     "                       run a guided writing trial at 1 kHz on the simulated device\n"
     "  model CHAR [--json] [--data DIR]\n"
     "                       print the character's model (paper Table 3)\n"
+    "  devices              list the haptic devices found (simulated, Phantoms, OpenHaptics)\n"
     "  bench nearest [--json] [--markdown FILE] [--queries N] [--seed S]\n"
     "                       accuracy and speed of the nearest-point methods\n";
 
@@ -31,6 +32,7 @@ int main(int argc, char** argv) {
   try {
     if (command == "trial") return command_trial(args);
     if (command == "model") return command_model(args);
+    if (command == "devices") return command_devices(args);
     if (command == "bench" && !args.empty() && args[0] == "nearest") return command_bench_nearest(args);
     std::fprintf(stderr, "calligraphy: error: unknown command '%s'\n%s", command.c_str(), kUsage);
     return 2;

@@ -1,0 +1,84 @@
+#include "devices/openhaptics/hd_library.hpp"
+
+#include <dlfcn.h>
+
+#include <cstdlib>
+
+#include "calligraphy/errors.hpp"
+
+namespace calligraphy::openhaptics {
+namespace {
+
+// dlsym returns void*; converting it to a function pointer is conditionally supported and is what
+// POSIX guarantees to work.
+template <typename Function>
+bool bind(void* handle, const char* name, Function& out, std::string& missing) {
+  void* symbol = dlsym(handle, name);
+  if (symbol == nullptr) {
+    missing += missing.empty() ? name : std::string(", ") + name;
+    return false;
+  }
+  out = reinterpret_cast<Function>(symbol);
+  return true;
+}
+
+}  // namespace
+
+std::vector<std::string> HdLibrary::candidate_paths() {
+  std::vector<std::string> paths;
+  if (const char* explicit_path = std::getenv("CALLIGRAPHY_LIBHD");
+      explicit_path != nullptr && *explicit_path) {
+    paths.emplace_back(explicit_path);
+  }
+  // The bare names go through the dynamic loader's search path (LD_LIBRARY_PATH, ld.so.cache).
+  for (const char* path :
+       {"libHD.so", "libHD.so.3.4", "libHD.so.3", "/usr/lib/libHD.so", "/usr/lib64/libHD.so",
+        "/usr/local/lib/libHD.so", "/opt/OpenHaptics/Developer/lib/libHD.so"}) {
+    paths.emplace_back(path);
+  }
+  return paths;
+}
+
+std::shared_ptr<const HdLibrary> HdLibrary::load() {
+  std::string tried;
+  for (const auto& path : candidate_paths()) {
+    void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (handle == nullptr) {
+      const char* why = dlerror();
+      tried += "\n  " + path + ": " + (why != nullptr ? why : "not loadable");
+      continue;
+    }
+    std::shared_ptr<HdLibrary> library(new HdLibrary);
+    library->handle_ = handle;
+    library->path = path;
+    std::string missing;
+    bind(handle, "hdInitDevice", library->init_device, missing);
+    bind(handle, "hdDisableDevice", library->disable_device, missing);
+    bind(handle, "hdMakeCurrentDevice", library->make_current_device, missing);
+    bind(handle, "hdBeginFrame", library->begin_frame, missing);
+    bind(handle, "hdEndFrame", library->end_frame, missing);
+    bind(handle, "hdGetDoublev", library->get_doublev, missing);
+    bind(handle, "hdGetIntegerv", library->get_integerv, missing);
+    bind(handle, "hdSetDoublev", library->set_doublev, missing);
+    bind(handle, "hdGetString", library->get_string, missing);
+    bind(handle, "hdEnable", library->enable, missing);
+    bind(handle, "hdGetError", library->get_error, missing);
+    bind(handle, "hdScheduleAsynchronous", library->schedule_asynchronous, missing);
+    bind(handle, "hdScheduleSynchronous", library->schedule_synchronous, missing);
+    bind(handle, "hdUnschedule", library->unschedule, missing);
+    bind(handle, "hdStartScheduler", library->start_scheduler, missing);
+    bind(handle, "hdStopScheduler", library->stop_scheduler, missing);
+    bind(handle, "hdCheckCalibration", library->check_calibration, missing);
+    bind(handle, "hdUpdateCalibration", library->update_calibration, missing);
+    if (missing.empty()) return library;
+    tried += "\n  " + path + ": loaded, but lacks " + missing;
+  }
+  throw DeviceNotFound("OpenHaptics not found: libHD.so could not be loaded; tried:" + tried +
+                       "\n(set CALLIGRAPHY_LIBHD to the full path of libHD.so)");
+}
+
+HdLibrary::~HdLibrary() {
+  if (handle_ != nullptr) dlclose(handle_);
+}
+
+}  // namespace calligraphy::openhaptics

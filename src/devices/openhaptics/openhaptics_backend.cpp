@@ -1,0 +1,46 @@
+// Registers "openhaptics": listed when libHD.so loads and the default device initialises.
+#include <memory>
+
+#include "calligraphy/errors.hpp"
+#include "devices/builtin_backends.hpp"
+#include "devices/openhaptics/hd_errors.hpp"
+#include "devices/openhaptics/hd_library.hpp"
+#include "devices/openhaptics/openhaptics_device.hpp"
+
+namespace calligraphy::openhaptics {
+namespace {
+
+DeviceSurvey scan() {
+  std::shared_ptr<const HdLibrary> library;
+  try {
+    library = HdLibrary::load();
+  } catch (const DeviceNotFound& e) {
+    return DeviceSurvey{{}, {std::string("openhaptics: ") + e.what()}};
+  }
+  // Like CHAI3D: initialise the default device to learn whether one is there and what it can do.
+  const hd::HHD handle = library->init_device(nullptr);
+  if (const hd::HDErrorInfo error = library->get_error(); error.errorCode != hd::HD_SUCCESS) {
+    return DeviceSurvey{
+        {},
+        {"openhaptics: " + library->path + " loaded, but no device: hdInitDevice failed with " +
+         hd_error_name(error.errorCode)}};
+  }
+  library->disable_device(handle);
+  DeviceListing listing;
+  listing.name = "openhaptics";
+  listing.hardware = true;
+  listing.info.model = "OpenHaptics default device";
+  listing.info.manufacturer = "see info() after open()";
+  listing.details =
+      "via " + library->path + "; limits are read at open(); this backend is untested (no libHD here)";
+  return DeviceSurvey{{listing}, {}};
+}
+
+}  // namespace
+
+void register_backend(DeviceRegistry& registry) {
+  registry.register_backend(
+      {"openhaptics", scan, [](const DeviceListing&) { return std::make_unique<OpenHapticsDevice>(); }});
+}
+
+}  // namespace calligraphy::openhaptics

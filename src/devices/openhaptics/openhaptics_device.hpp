@@ -1,0 +1,71 @@
+#pragma once
+// HapticDevice over OpenHaptics' HDAPI, loaded at run time (hd_library.hpp). UNTESTED here: no libHD
+// was available on the build machine; only the error mapping, unit conversions and the "not found"
+// path are covered by tests.
+//
+// OpenHaptics owns the 1 kHz loop: an asynchronous scheduler callback reads position (mm), velocity
+// (mm/s) and buttons and writes the latest commanded force (N) inside hdBeginFrame/hdEndFrame. The
+// servo thread exchanges data with it through sequence locks (no locks, no allocation).
+#include <atomic>
+#include <memory>
+#include <string>
+
+#include "calligraphy/haptic_device.hpp"
+#include "devices/openhaptics/hd_library.hpp"
+#include "devices/openhaptics/seqlock.hpp"
+
+namespace calligraphy::openhaptics {
+
+class OpenHapticsDevice final : public HapticDevice {
+ public:
+  /// `configuration_name`: an OpenHaptics device configuration name; empty for HD_DEFAULT_DEVICE.
+  /// `watchdog_timeout_s` [s]: no write_force for this long turns forces off.
+  explicit OpenHapticsDevice(std::string configuration_name = {}, double watchdog_timeout_s = 0.05);
+  ~OpenHapticsDevice() override;
+
+  /// Valid after open(); before, a placeholder with zero limits.
+  [[nodiscard]] const DeviceInfo& info() const override { return info_; }
+  /// Loads libHD, initialises the device, reads its nominal limits, starts the scheduler. Throws
+  /// DeviceNotFound ("OpenHaptics not found" with the paths tried, or hdInitDevice failed) or the
+  /// mapped HD error (CommunicationError, SafetyFault, DeviceError).
+  void open() override;
+  void close() noexcept override;
+  [[nodiscard]] bool is_open() const override { return open_; }
+  /// hdCheckCalibration, then hdUpdateCalibration with the device's automatic style when an update is
+  /// needed. Throws CalibrationNeeded when the device needs manual input (inkwell: dock the stylus).
+  void calibrate() override;
+  [[nodiscard]] bool is_calibrated() const override { return calibrated_.load(std::memory_order_acquire); }
+  /// Throws CalibrationNeeded when enabling an uncalibrated device, DeviceError when not open.
+  void enable_forces(bool enabled) override;
+  [[nodiscard]] bool forces_enabled() const override {
+    return forces_enabled_.load(std::memory_order_acquire);
+  }
+  /// Servo path. Throws CommunicationError (link errors and any non-safety HD error from the scheduler)
+  /// or SafetyFault (HD force/velocity/temperature errors, or the watchdog); forces are then off.
+  DeviceState read_state() override;
+  /// Servo path. Clamps to info().max_force_n keeping the direction. Throws SafetyFault on a NaN or
+  /// infinite component (zero force, forces off) and CommunicationError when not open.
+  void write_force(const Vec3& force_n) override;
+
+ private:
+  static hd::HDCallbackCode servo_tick(void* self) noexcept;
+  static hd::HDCallbackCode calibration_check(void* self) noexcept;
+  void read_info();
+
+  std::string configuration_name_;
+  double watchdog_timeout_s_;
+  std::shared_ptr<const HdLibrary> library_;
+  hd::HHD handle_ = hd::HD_INVALID_HANDLE;
+  hd::HDSchedulerHandle servo_callback_ = 0;
+  DeviceInfo info_;
+  bool open_ = false;
+  std::atomic<bool> forces_enabled_{false};
+  std::atomic<bool> calibrated_{false};
+  std::atomic<hd::HDerror> scheduler_error_{hd::HD_SUCCESS};  // first error seen by the callback
+  std::atomic<bool> watchdog_tripped_{false};
+  hd::HDenum calibration_result_ = hd::HD_CALIBRATION_OK;  // written by the synchronous calibration call
+  SeqLocked<8> state_;    // position m (3), velocity m/s (3), buttons, time s
+  SeqLocked<4> command_;  // force N in device frame (3), time s of the write
+};
+
+}  // namespace calligraphy::openhaptics

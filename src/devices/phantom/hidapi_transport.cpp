@@ -1,0 +1,99 @@
+#include "devices/phantom/hidapi_transport.hpp"
+
+#include <hidapi.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cwchar>
+#include <utility>
+
+#include "calligraphy/errors.hpp"
+#include "devices/phantom/usb_ids.hpp"
+
+namespace calligraphy::phantom {
+namespace {
+
+// hidapi reports strings as wchar_t; the ASCII part is all a log line needs.
+std::string narrow(const wchar_t* text) {
+  std::string out;
+  if (text == nullptr) return out;
+  for (; *text != L'\0'; ++text) out.push_back(*text < 128 ? static_cast<char>(*text) : '?');
+  return out;
+}
+
+std::string last_error(hid_device* device) {
+  const std::string text = narrow(hid_error(device));
+  return text.empty() ? "unknown hidapi error" : text;
+}
+
+int to_milliseconds(std::chrono::microseconds timeout) {
+  return static_cast<int>(std::max<std::int64_t>(1, (timeout.count() + 999) / 1000));
+}
+
+std::string hex_id(std::uint16_t vendor, std::uint16_t product) {
+  char buffer[16];
+  std::snprintf(buffer, sizeof buffer, "%04x:%04x", vendor, product);
+  return buffer;
+}
+
+}  // namespace
+
+std::vector<HidDeviceEntry> find_hid_phantoms() {
+  if (hid_init() != 0) throw CommunicationError("hidapi: hid_init failed");
+  std::vector<HidDeviceEntry> found;
+  hid_device_info* list = hid_enumerate(kTouchUsbVendorId, 0);
+  for (const hid_device_info* info = list; info != nullptr; info = info->next) {
+    if (!is_reported_touch_id(info->vendor_id, info->product_id)) continue;
+    found.push_back({info->path != nullptr ? info->path : "", info->vendor_id, info->product_id,
+                     narrow(info->product_string), narrow(info->serial_number)});
+  }
+  hid_free_enumeration(list);
+  return found;
+}
+
+HidapiTransport::HidapiTransport(HidDeviceEntry entry) : entry_(std::move(entry)) {}
+
+HidapiTransport::~HidapiTransport() { close(); }
+
+void HidapiTransport::open() {
+  if (device_ != nullptr) return;
+  if (hid_init() != 0) throw CommunicationError("hidapi: hid_init failed");
+  device_ = hid_open_path(entry_.path.c_str());
+  if (device_ == nullptr) {
+    throw DeviceNotFound("hidapi: cannot open " + entry_.path + " (" +
+                         hex_id(entry_.vendor_id, entry_.product_id) +
+                         "): unplugged, or no permission (a udev rule granting access to hidraw is needed)");
+  }
+}
+
+void HidapiTransport::close() noexcept {
+  if (device_ != nullptr) hid_close(device_);
+  device_ = nullptr;
+}
+
+void HidapiTransport::write(std::span<const std::uint8_t> packet, std::chrono::microseconds /*timeout*/) {
+  if (device_ == nullptr) throw CommunicationError("hidapi: write on a closed device " + entry_.path);
+  if (packet.size() + 1 > report_.size()) throw CommunicationError("hidapi: packet longer than 64 bytes");
+  report_[0] = 0;  // report id 0: the device uses unnumbered reports (assumption, unverified)
+  std::copy(packet.begin(), packet.end(), report_.begin() + 1);
+  if (hid_write(device_, report_.data(), packet.size() + 1) < 0) {
+    throw CommunicationError("hidapi: write to " + entry_.path +
+                             " failed (unplugged?): " + last_error(device_));
+  }
+}
+
+std::size_t HidapiTransport::read(std::span<std::uint8_t> buffer, std::chrono::microseconds timeout) {
+  if (device_ == nullptr) throw CommunicationError("hidapi: read on a closed device " + entry_.path);
+  const int received = hid_read_timeout(device_, buffer.data(), buffer.size(), to_milliseconds(timeout));
+  if (received < 0) {
+    throw CommunicationError("hidapi: read from " + entry_.path +
+                             " failed (unplugged?): " + last_error(device_));
+  }
+  return static_cast<std::size_t>(received);
+}
+
+std::string HidapiTransport::description() const {
+  return "hidapi " + entry_.path + " (" + hex_id(entry_.vendor_id, entry_.product_id) + ")";
+}
+
+}  // namespace calligraphy::phantom

@@ -1,0 +1,139 @@
+#include "calligraphy/device_registry.hpp"
+
+#include <catch2/catch.hpp>
+#include <memory>
+#include <sstream>
+
+#include "calligraphy/devices/phantom.hpp"
+#include "calligraphy/errors.hpp"
+
+using calligraphy::DeviceBackend;
+using calligraphy::DeviceInfo;
+using calligraphy::DeviceListing;
+using calligraphy::DeviceRegistry;
+using calligraphy::DeviceSurvey;
+using calligraphy::HapticDevice;
+using calligraphy::Vec3;
+
+namespace {
+
+// A trivial device standing in for the lead's SimulatedDevice.
+class FixedDevice final : public HapticDevice {
+ public:
+  explicit FixedDevice(DeviceInfo info) : info_(std::move(info)) {}
+  const DeviceInfo& info() const override { return info_; }
+  void open() override { open_ = true; }
+  void close() noexcept override { open_ = false; }
+  bool is_open() const override { return open_; }
+  void enable_forces(bool enabled) override { enabled_ = enabled; }
+  bool forces_enabled() const override { return enabled_; }
+  calligraphy::DeviceState read_state() override { return {}; }
+  void write_force(const Vec3&) override {}
+
+ private:
+  DeviceInfo info_;
+  bool open_ = false;
+  bool enabled_ = false;
+};
+
+DeviceInfo info_named(const char* model) {
+  DeviceInfo info;
+  info.model = model;
+  info.max_force_n = 2.0;
+  return info;
+}
+
+}  // namespace
+
+TEST_CASE("Backends register factories; devices are listed and created by name", "[registry]") {
+  DeviceRegistry registry;
+  registry.register_device("simulated", info_named("Sim"),
+                           [] { return std::make_unique<FixedDevice>(info_named("Sim")); });
+  DeviceBackend pair;
+  pair.name = "pair";
+  pair.scan = [] {
+    return DeviceSurvey{
+        {{"pair:a", "", info_named("A"), true, ""}, {"pair:b", "", info_named("B"), true, ""}},
+        {"pair: scanned two"}};
+  };
+  pair.create = [](const DeviceListing& listing) { return std::make_unique<FixedDevice>(listing.info); };
+  registry.register_backend(pair);
+
+  const auto survey = registry.survey();
+  REQUIRE(survey.devices.size() == 3);
+  CHECK(survey.devices[0].name == "simulated");
+  CHECK(survey.devices[2].name == "pair:b");
+  CHECK(survey.devices[2].backend == "pair");
+  CHECK(survey.any_hardware());
+  CHECK(survey.notes == std::vector<std::string>{"pair: scanned two"});
+
+  auto device = registry.open("pair:b");
+  CHECK(device->is_open());
+  CHECK(device->info().model == "B");
+  CHECK_FALSE(registry.create("simulated")->is_open());
+
+  try {
+    (void)registry.create("nope");
+    FAIL("expected DeviceNotFound");
+  } catch (const calligraphy::DeviceNotFound& e) {
+    CHECK(std::string(e.what()).find("simulated, pair:a, pair:b") != std::string::npos);
+  }
+  CHECK_THROWS_AS(registry.register_backend(pair), calligraphy::InvalidArgument);  // duplicate name
+  CHECK_THROWS_AS(registry.register_backend(DeviceBackend{"empty", {}, {}}), calligraphy::InvalidArgument);
+  CHECK(registry.unregister_backend("pair"));
+  CHECK_FALSE(registry.unregister_backend("pair"));
+  CHECK(registry.backend_names() == std::vector<std::string>{"simulated"});
+}
+
+TEST_CASE("A backend that fails to scan becomes a note, not a failure", "[registry]") {
+  DeviceRegistry registry;
+  registry.register_backend({"broken",
+                             []() -> DeviceSurvey { throw calligraphy::CommunicationError("bus on fire"); },
+                             [](const DeviceListing&) -> std::unique_ptr<HapticDevice> { return nullptr; }});
+  const auto survey = registry.survey();
+  CHECK(survey.devices.empty());
+  REQUIRE(survey.notes.size() == 1);
+  CHECK(survey.notes[0] == "broken: bus on fire");
+  std::ostringstream out;
+  calligraphy::print_device_survey(out, survey);
+  CHECK(out.str().find("No haptic hardware attached. No devices available at all.") != std::string::npos);
+  CHECK(out.str().find("note: broken: bus on fire") != std::string::npos);
+}
+
+TEST_CASE("The process registry offers the emulated Phantom and runs a servo loop through it",
+          "[registry][phantom]") {
+  auto& registry = calligraphy::device_registry();
+  const auto names = registry.backend_names();
+  CHECK(std::find(names.begin(), names.end(), "emulated-phantom") != names.end());
+  CHECK(std::find(names.begin(), names.end(), "phantom-hid") != names.end());
+  CHECK(std::find(names.begin(), names.end(), "phantom-usb") != names.end());
+
+  const auto survey = registry.survey();
+  const auto emulated = std::find_if(survey.devices.begin(), survey.devices.end(),
+                                     [](const DeviceListing& d) { return d.name == "emulated-phantom"; });
+  REQUIRE(emulated != survey.devices.end());
+  CHECK_FALSE(emulated->hardware);
+  CHECK(emulated->info.max_force_n == 3.3);
+  CHECK(emulated->info.max_continuous_force_n == 0.88);
+  CHECK(emulated->info.max_stiffness_n_per_m == 700.0);
+  std::ostringstream printed;
+  calligraphy::print_device_survey(printed, survey);
+  CHECK(printed.str().find("emulated-phantom  (not hardware)") != std::string::npos);
+  CHECK(printed.str().find("max force:          3.3 N (continuous 0.88 N)") != std::string::npos);
+
+  auto device = registry.open("emulated-phantom");
+  REQUIRE(device->is_calibrated());  // powered on in the inkwell
+  device->enable_forces(true);
+  // 200 ticks of a spring towards a point 2 cm above the start, as a trial would do.
+  const Vec3 start = device->read_state().position_m;
+  const Vec3 target = start + Vec3(0, 0, 0.02);
+  calligraphy::DeviceState state;
+  for (int tick = 0; tick < 200; ++tick) {
+    state = device->read_state();
+    device->write_force(200.0 * (target - state.position_m) - 2.0 * state.velocity_m_s);
+  }
+  CHECK(state.position_m.z() > start.z() + 0.005);  // left the inkwell after 50 ms and rose
+  CHECK(state.time_s == Approx(0.202).margin(0.0015));
+  device->close();
+  CHECK_FALSE(device->is_open());
+}
