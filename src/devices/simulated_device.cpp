@@ -4,21 +4,16 @@
 #include <numbers>
 #include <string>
 
+#include "calligraphy/devices/phantom_models.hpp"
 #include "calligraphy/errors.hpp"
 #include "calligraphy/force_law.hpp"
 
 namespace calligraphy {
 
 DeviceInfo phantom_desktop_info() {
-  DeviceInfo info;
-  info.model = "Phantom Desktop (simulated)";
+  DeviceInfo info = phantom::phantom_desktop_info();  // the one table of Phantom figures
+  info.model += " (simulated)";
   info.manufacturer = "calligraphy";
-  info.max_force_n = 7.9;
-  info.max_continuous_force_n = 1.75;
-  info.max_stiffness_n_per_m = 1000.0;
-  info.max_damping_n_s_per_m = 5.0;
-  info.workspace_radius_m = 0.10;
-  info.workspace_size_m = Vec3(0.16, 0.12, 0.12);
   return info;
 }
 
