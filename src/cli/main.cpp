@@ -10,9 +10,9 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: calligraphy <command> [options]\n"
-    "  trial CHARS [--guidance on|off] [--writer novice|skilled] [--seed N] [--data DIR]\n"
-    "              [--json FILE] [--svg FILE] [--csv FILE]\n"
-    "                       run a guided writing trial at 1 kHz on the simulated device\n"
+    "  trial CHARS [--device NAME] [--guidance on|off] [--writer novice|skilled] [--seed N]\n"
+    "              [--data DIR] [--json FILE] [--svg FILE] [--csv FILE]\n"
+    "                       run a guided writing trial at 1 kHz on a device (default: simulated)\n"
     "  model CHAR [--json] [--data DIR]\n"
     "                       print the character's model (paper Table 3)\n"
     "  devices              list the haptic devices found (simulated, Phantoms, OpenHaptics)\n"
