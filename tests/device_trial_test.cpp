@@ -2,6 +2,7 @@
 // safety fault in the middle of a trial, wall-clock pacing for devices without a hand port.
 #include "calligraphy/device_trial.hpp"
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <string>
@@ -9,6 +10,7 @@
 #include "calligraphy/character_library.hpp"
 #include "calligraphy/devices/phantom_emulator.hpp"
 #include "calligraphy/errors.hpp"
+#include "cli/trial_report.hpp"
 
 using namespace calligraphy;
 using phantom::EmulatedPhantomDevice;
@@ -193,6 +195,24 @@ TEST_CASE("A disconnect mid-trial aborts it with forces zeroed and the recording
   CHECK_FALSE(device.is_open());
   CHECK_FALSE(device.inner().emulator().forces_active());
   CHECK(device.inner().emulator().motor_torques().isZero());
+}
+
+TEST_CASE("The reports of an aborted trial say so and keep what was recorded", "[device-trial][phantom]") {
+  const Scene scene = scene_of(U"口");
+  UnpluggedPhantom device(1500);
+  DeviceTrialOptions options;
+  const TrialResult result = run_device_trial(device, scene, options);
+  REQUIRE(result.aborted);
+  const cli::TrialDescription description{
+      "口", true, "novice", 0, 1000.0, "emulated-phantom", device.info().model};
+  const std::string json = cli::trial_json(description, result);
+  CHECK(json.find("\"aborted\": true") != std::string::npos);
+  CHECK(json.find("unplugged") != std::string::npos);
+  CHECK(json.find("\"device\": \"emulated-phantom\"") != std::string::npos);
+  const std::string csv = cli::trial_csv(result.trace);
+  CHECK(static_cast<std::size_t>(std::count(csv.begin(), csv.end(), '\n')) ==
+        result.trace.size() + 1);  // + header
+  CHECK(cli::trial_svg(scene, result).find("</svg>") != std::string::npos);
 }
 
 TEST_CASE("A safety fault aborts a wall-clock paced trial; ticks are paced by absolute deadlines",
