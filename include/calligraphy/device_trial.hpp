@@ -12,9 +12,10 @@
 /// starts at start + k / rate_hz (`std::this_thread::sleep_until` on absolute deadlines, so lateness
 /// does not accumulate).
 ///
-/// Faults: a `CommunicationError` or `SafetyFault` from `read_state`/`write_force` ends the trial;
-/// forces are disabled (best effort), the device is closed, and the result keeps every tick recorded
-/// before the fault, with `aborted` set and `abort_reason` the device's message.
+/// Faults: a `CommunicationError`, `SafetyFault` (or any other `DeviceError`) from `read_state` or
+/// `write_force` ends the trial; forces are disabled (best effort), the device is closed, and the result
+/// keeps every tick recorded before the fault, with `aborted` set and `abort_reason` the device's
+/// message. Any other exception also turns forces off and closes the device, then propagates.
 #include <cstdint>
 #include <string_view>
 

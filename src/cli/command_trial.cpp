@@ -54,9 +54,14 @@ int command_trial(const Args& args) {
   options.keep_trace = arguments.option("svg") || arguments.option("csv");
 
   const TrialResult result = run_device_trial(device_name, scene, options);
-  const TrialDescription description{
-      arguments.positionals()[0], options.force.guidance, writer, options.seed, options.rate_hz, device.name,
-      device.info.model};
+  // On hardware a person writes; the simulated writer only moves simulated and emulated devices.
+  const TrialDescription description{arguments.positionals()[0],
+                                     options.force.guidance,
+                                     device.hardware ? "human" : writer,
+                                     options.seed,
+                                     options.rate_hz,
+                                     device.name,
+                                     device.info.model};
   print_trial_table(description, scene, result);
   // The outputs are written for an aborted trial too: they hold what was recorded before the fault.
   if (const auto path = arguments.option("json")) write_file(*path, trial_json(description, result));

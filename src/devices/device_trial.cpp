@@ -104,12 +104,15 @@ TrialResult run_device_trial(HapticDevice& device, const Scene& scene, const Dev
       // The time budget ran out after this tick: the trial lasted until the next tick would start.
       if (k + 1 == ticks) end_time = state.time_s + dt;
     }
-  } catch (const CommunicationError& e) {
+  } catch (const DeviceError& e) {
+    // CommunicationError (link lost), SafetyFault, or another device fault of an application's device.
     result.aborted = true;
     result.abort_reason = e.what();
-  } catch (const SafetyFault& e) {
-    result.aborted = true;
-    result.abort_reason = e.what();
+  } catch (...) {
+    // Not a device fault (a bug, std::bad_alloc): forces off before it propagates.
+    if (hand_port != nullptr) hand_port->attach_hand(nullptr);
+    stop_device(device);
+    throw;
   }
   if (hand_port != nullptr) hand_port->attach_hand(nullptr);
   stop_device(device);
