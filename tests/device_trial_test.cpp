@@ -63,7 +63,9 @@ class UnpluggedPhantom final : public HapticDevice, public HandPort {
 // its `fault_at`-th state. It records how the runner drove it.
 class FaultingDevice final : public HapticDevice {
  public:
-  explicit FaultingDevice(int fault_at) : fault_at_(fault_at) { info_.max_force_n = 3.0; }
+  explicit FaultingDevice(int fault_at, double max_force_n = 3.0) : fault_at_(fault_at) {
+    info_.max_force_n = max_force_n;
+  }
   const DeviceInfo& info() const override { return info_; }
   void open() override { open_ = true; }
   void close() noexcept override {
@@ -241,4 +243,13 @@ TEST_CASE("A device that cannot calibrate refuses the trial and is closed", "[de
   CHECK_THROWS_AS(run_device_trial(device, scene_of(U"口"), DeviceTrialOptions{}), CalibrationNeeded);
   CHECK_FALSE(device.is_open());
   CHECK_FALSE(device.emulator().forces_active());
+}
+
+TEST_CASE("A device without a usable force limit is refused after open() and closed again",
+          "[device-trial]") {
+  FaultingDevice device(1000, 0.0);
+  CHECK_THROWS_AS(run_device_trial(device, scene_of(U"口"), DeviceTrialOptions{}), InvalidArgument);
+  CHECK(device.reads == 0);
+  CHECK(device.closes == 1);
+  CHECK_FALSE(device.is_open());
 }

@@ -40,7 +40,8 @@ struct DeviceTrialOptions {
 
 /// Runs one trial of `scene` on `device` (opened here if it is not open yet, closed at the end).
 /// Returns the metrics and, when `keep_trace`, the trace; `aborted` when the device failed mid-trial.
-/// Throws InvalidArgument for bad options or a device whose info is unusable (max force <= 0), and
+/// The renderer takes the device's limits from `info()` after `open()`. Throws InvalidArgument for bad
+/// options or a device whose info is unusable (max force <= 0; the device is closed again), and
 /// what `open()`, `calibrate()` or `enable_forces(true)` throw (DeviceNotFound, CommunicationError,
 /// CalibrationNeeded): no tick was recorded then, and the device is closed.
 TrialResult run_device_trial(HapticDevice& device, const Scene& scene, const DeviceTrialOptions& options);

@@ -60,7 +60,6 @@ void DeviceTrialOptions::validate() const {
 
 TrialResult run_device_trial(HapticDevice& device, const Scene& scene, const DeviceTrialOptions& options) {
   options.validate();
-  Renderer renderer(scene, options.force, device.info());
   TrialRecorder recorder(scene, options.keep_trace);
   const double dt = 1.0 / options.rate_hz;
   const auto ticks = static_cast<std::size_t>(std::ceil(options.max_duration_s * options.rate_hz));
@@ -73,9 +72,12 @@ TrialResult run_device_trial(HapticDevice& device, const Scene& scene, const Dev
     hand_port->attach_hand(&*writer);
   }
 
+  std::optional<Renderer> renderer;
   try {
     if (!device.is_open()) device.open();
     if (!device.is_calibrated()) device.calibrate();
+    // After open(): some devices know their limits only then (OpenHaptics reads them from the driver).
+    renderer.emplace(scene, options.force, device.info());
     device.enable_forces(true);
   } catch (...) {
     if (hand_port != nullptr) hand_port->attach_hand(nullptr);
@@ -91,7 +93,7 @@ TrialResult run_device_trial(HapticDevice& device, const Scene& scene, const Dev
     for (std::size_t k = 0; k < ticks; ++k) {
       if (pacer) pacer->wait_for_tick(k);
       const DeviceState state = device.read_state();
-      const RenderOutput out = renderer.tick(state);
+      const RenderOutput out = renderer->tick(state);
       device.write_force(out.force_n);
       recorder.record(state, out);
       end_time = state.time_s;
