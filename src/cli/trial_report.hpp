@@ -12,7 +12,7 @@ struct TrialDescription {
   std::string writer;
   std::uint64_t seed = 0;
   double rate_hz = 1000.0;
-  std::string device = "simulated";            // registry name
+  std::string device = "simulated";  // registry name
   std::string device_model = "Phantom Desktop (simulated)";
 };
 
