@@ -1,6 +1,7 @@
 // Time per nearest-point query, per method and degree, on random curves in a 50 mm box with the
-// query within 5 mm (scenario random_near of `calligraphy bench nearest`), and per tracker update on
-// a point moving along a curve. Run a Release build: build/bin/nearest_point_bench
+// query within 5 mm (scenario random_near of `calligraphy bench nearest`) and on the real strokes of
+// the embedded characters (scenario corpus, degrees 1-3), and per tracker update on a point moving
+// along a curve. Run a Release build: build/bin/nearest_point_bench
 #include <benchmark/benchmark.h>
 
 #include <random>
@@ -24,6 +25,28 @@ std::vector<calligraphy::cli::NearestPointQuery> near_queries(int degree) {
 
 void nearest_point_method(benchmark::State& state, NearestPointMethod method) {
   const auto queries = near_queries(static_cast<int>(state.range(0)));
+  calligraphy::NearestPointOptions options;
+  options.method = method;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const auto& query = queries[i];
+    benchmark::DoNotOptimize(calligraphy::nearest_point(query.element, query.point, options));
+    i = (i + 1) % queries.size();
+  }
+}
+
+// Scenario `corpus`: every fitted element of the embedded characters, P within 5 mm.
+void nearest_point_corpus(benchmark::State& state, NearestPointMethod method) {
+  std::vector<calligraphy::cli::NearestPointQuery> queries;
+  for (const auto& scenario : calligraphy::cli::nearest_point_scenarios()) {
+    std::mt19937_64 random(static_cast<std::uint64_t>(state.range(0)));
+    if (scenario.name == "corpus")
+      queries = scenario.make(static_cast<int>(state.range(0)), kQueries, random);
+  }
+  if (queries.empty()) {
+    state.SkipWithError("no corpus element of this degree");
+    return;
+  }
   calligraphy::NearestPointOptions options;
   options.method = method;
   std::size_t i = 0;
@@ -68,6 +91,9 @@ void tracker_update(benchmark::State& state) {
 BENCHMARK_CAPTURE(nearest_point_method, exact, NearestPointMethod::exact)->DenseRange(1, 4);
 BENCHMARK_CAPTURE(nearest_point_method, newton, NearestPointMethod::newton)->DenseRange(1, 4);
 BENCHMARK_CAPTURE(nearest_point_method, subdivision, NearestPointMethod::subdivision)->DenseRange(1, 4);
+BENCHMARK_CAPTURE(nearest_point_corpus, exact, NearestPointMethod::exact)->DenseRange(1, 3);
+BENCHMARK_CAPTURE(nearest_point_corpus, newton, NearestPointMethod::newton)->DenseRange(1, 3);
+BENCHMARK_CAPTURE(nearest_point_corpus, subdivision, NearestPointMethod::subdivision)->DenseRange(1, 3);
 BENCHMARK(segment);
 BENCHMARK(tracker_update);
 

@@ -25,11 +25,9 @@ EmulatedPhantom make_undocked(const JointAngles& pose) {
   return emulated;
 }
 
-// Enables forces and sends the two packets of the 0 -> 1 enable toggle.
+// Enables forces (the bit-0 packet) and commands one force (the bit-1 packet): the 0 -> 1 toggle.
 void enable_and_toggle(PhantomDevice& device, const Vec3& force) {
   device.enable_forces(true);
-  (void)device.read_state();
-  device.write_force(force);
   (void)device.read_state();
   device.write_force(force);
 }
@@ -88,14 +86,17 @@ TEST_CASE("Forces need the enable-bit toggle; the arm is pushed along the comman
   emulator->set_joint_angles(JointAngles(0.2, 0.3, 0.4));
   const Vec3 force(0.5, -0.3, 0.8);  // [N], below the Omni's 3.3 N
 
+  const auto commands_before = emulator->commands_received();
   device->enable_forces(true);
-  (void)device->read_state();
-  device->write_force(force);
-  CHECK_FALSE(emulator->last_command().force_enable);  // first half of the toggle: bit 0, zero force
+  // enable_forces sends the first half of the toggle at once: bit 0, zero force.
+  CHECK(emulator->commands_received() == commands_before + 1);
+  CHECK_FALSE(emulator->last_command().force_enable);
+  CHECK(emulator->last_command().dac_counts == std::array<std::int16_t, 3>{0, 0, 0});
   CHECK(emulator->motor_torques().isZero());
   const auto before = device->read_state();
-  device->write_force(force);
+  device->write_force(force);  // the first force after enabling is applied, not skipped
   REQUIRE(emulator->forces_active());
+  CHECK(emulator->last_command().force_enable);
   // The motors apply J^T F, up to one DAC count.
   const PhantomArm arm(ArmGeometry::omni());
   const JointTorques expected = arm.joint_torques(device->joint_angles(), force);

@@ -193,7 +193,8 @@ struct PyTrialResult {
 };
 
 py::dict metrics_dict(const std::string& characters, bool guidance, const std::string& writer,
-                      std::uint64_t seed, double rate_hz, const TrialMetrics& m) {
+                      std::uint64_t seed, double rate_hz, const TrialResult& result) {
+  const TrialMetrics& m = result.metrics;
   py::list per_stroke;
   for (const StrokeMetrics& s : m.per_stroke) {
     py::dict d;
@@ -212,6 +213,9 @@ py::dict metrics_dict(const std::string& characters, bool guidance, const std::s
   d["writer"] = writer;
   d["seed"] = seed;
   d["rate_hz"] = rate_hz;
+  d["device"] = "simulated";  // as `calligraphy trial --device simulated`
+  d["aborted"] = result.aborted;
+  d["abort_reason"] = result.abort_reason;
   d["strokes_total"] = m.strokes_total;
   d["strokes_completed"] = m.strokes_completed;
   d["completed_in_order"] = m.completed_in_order;
@@ -307,7 +311,7 @@ PyTrialResult simulate_trial_py(const py::object& characters_object, const std::
                        state,
                        active_stroke,
                        active_element,
-                       metrics_dict(label, guidance, writer, seed, rate_hz, result.metrics)};
+                       metrics_dict(label, guidance, writer, seed, rate_hz, result)};
 }
 
 // ---- exceptions --------------------------------------------------------------------------------

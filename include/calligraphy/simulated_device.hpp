@@ -6,16 +6,10 @@
 /// reported position is quantised to the encoder resolution and the velocity is a low-passed
 /// difference of reported positions, as on a real device. Deterministic; no wall clock.
 /// Model: m x'' = F_hand + F_device - b x' (REFERENCE.md section 8).
+#include "calligraphy/hand_port.hpp"
 #include "calligraphy/haptic_device.hpp"
 
 namespace calligraphy {
-
-/// The hand holding the stylus: the force it applies [N] given time [s], position [m], velocity [m/s].
-class HandModel {
- public:
-  virtual ~HandModel() = default;
-  virtual Vec3 hand_force(double time_s, const Vec3& position_m, const Vec3& velocity_m_s) = 0;
-};
 
 /// CHAI3D's figures for the Phantom Desktop (max 7.9 N, 1000 N/m, 5 N s/m, 0.10 m) and the datasheet's
 /// continuous force 1.75 N and workspace 160 x 120 x 120 mm (REFERENCE.md section 7).
@@ -34,14 +28,14 @@ struct SimulatedDeviceParameters {
   void validate() const;
 };
 
-class SimulatedDevice final : public HapticDevice {
+class SimulatedDevice final : public HapticDevice, public HandPort {
  public:
   explicit SimulatedDevice(const SimulatedDeviceParameters& parameters = {});
 
   /// The hand moving the stylus (not owned; nullptr for a free device).
-  void attach_hand(HandModel* hand) noexcept { hand_ = hand; }
+  void attach_hand(HandModel* hand) noexcept override { hand_ = hand; }
   /// Integrates the physics over `dt_s` seconds with the force held since the last `write_force`.
-  void advance(double dt_s) noexcept;
+  void advance(double dt_s) noexcept override;
 
   [[nodiscard]] const DeviceInfo& info() const override { return parameters_.info; }
   void open() override { open_ = true; }

@@ -100,14 +100,18 @@ struct TrialOptions {
   void validate() const;
 };
 
-/// Result of a trial: metrics, and the trace when kept.
+/// Result of a trial: metrics, and the trace when kept. A trial the device stopped (link lost, safety
+/// fault) is `aborted`: the metrics and trace hold every tick recorded up to the fault.
 struct TrialResult {
   TrialMetrics metrics;
   std::vector<TrialSample> trace;
+  bool aborted = false;
+  std::string abort_reason;  ///< the device's error message when aborted, else empty
 };
 
 /// Runs a whole trial lock-step: each tick reads the simulated device, renders, commands the force,
 /// lets the writer see the display, and advances the physics by 1 / rate_hz. Deterministic for a seed.
+/// The same loop as any device: `run_device_trial` (device_trial.hpp) on a `SimulatedDevice`.
 /// Throws InvalidArgument for bad options.
 TrialResult run_simulated_trial(const Scene& scene, const TrialOptions& options);
 

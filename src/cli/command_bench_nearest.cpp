@@ -1,5 +1,7 @@
 // `calligraphy bench nearest [--json] [--markdown FILE] [--queries N] [--seed S]`: accuracy and speed
-// of the nearest-point methods on every scenario (docs/nearest-point.md).
+// of the nearest-point methods on every scenario, and `calligraphy bench jumps [--json] [--markdown FILE]
+// [--seeds N] [--chars CHARS]`: foot-point jumps on real characters, by method (docs/nearest-point.md).
+// `bench nearest --markdown` regenerates both sections of the document.
 #include <charconv>
 #include <fstream>
 #include <iostream>
@@ -7,6 +9,8 @@
 
 #include "calligraphy/errors.hpp"
 #include "cli/commands.hpp"
+#include "cli/library_options.hpp"
+#include "cli/nearest_point_jumps.hpp"
 #include "cli/nearest_point_measurement.hpp"
 #include "cli/nearest_point_report.hpp"
 
@@ -34,6 +38,20 @@ std::string read_file(const std::string& path) {
   std::ostringstream content;
   content << in.rdbuf();
   return content.str();
+}
+
+void write_document(const std::string& path, const std::string& document) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out || !(out << document) || !out.flush()) {
+    throw Error("bench: cannot write the Markdown file '" + path + "'");
+  }
+}
+
+// The jump measurement of `bench nearest`: seeds S, S + 1, S + 2 on every embedded character.
+JumpSettings jump_settings_for_seed(std::uint64_t seed) {
+  JumpSettings settings;
+  settings.seeds = {seed, seed + 1, seed + 2};
+  return settings;
 }
 
 }  // namespace
@@ -71,14 +89,65 @@ int command_bench_nearest(const Args& args) {
   const std::string section = nearest_point_markdown(measurement, scenarios, command);
 
   if (!markdown_path.empty()) {
-    const std::string document = replace_generated_section(read_file(markdown_path), section);
-    std::ofstream out(markdown_path, std::ios::binary | std::ios::trunc);
-    if (!out || !(out << document) || !out.flush()) {
-      throw Error("bench nearest: cannot write the Markdown file '" + markdown_path + "'");
-    }
+    const JumpMeasurement jumps = measure_foot_jumps(jump_settings_for_seed(settings.seed));
+    std::string document = replace_generated_section(read_file(markdown_path), section);
+    document = replace_generated_section(document, foot_jumps_markdown(jumps, command), kJumpsGeneratedBegin);
+    write_document(markdown_path, document);
   }
   if (json) {
     std::cout << nearest_point_json(measurement);
+  } else if (markdown_path.empty()) {
+    std::cout << section;
+  } else {
+    std::cout << "wrote the table to " << markdown_path << "\n";
+  }
+  return 0;
+}
+
+int command_bench_jumps(const Args& args) {
+  constexpr const char* kJumpsUsage =
+      "usage: calligraphy bench jumps [--json] [--markdown FILE] [--seeds N] [--chars CHARS]";
+  bool json = false;
+  std::string markdown_path;
+  std::string chars;
+  int seed_count = 3;
+  std::size_t i = 0;
+  if (!args.empty() && args[0] == "jumps") i = 1;
+  for (; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    auto value = [&]() -> const std::string& {
+      if (i + 1 >= args.size()) throw UsageError(arg + " expects a value\n" + kJumpsUsage);
+      return args[++i];
+    };
+    if (arg == "--json") {
+      json = true;
+    } else if (arg == "--markdown") {
+      markdown_path = value();
+    } else if (arg == "--seeds") {
+      seed_count = parse_integer<int>(arg, value(), 1);
+    } else if (arg == "--chars") {
+      chars = value();
+    } else {
+      throw UsageError("unknown argument '" + arg + "'\n" + kJumpsUsage);
+    }
+  }
+  JumpSettings settings;
+  settings.seeds.clear();
+  for (int seed = 1; seed <= seed_count; ++seed) settings.seeds.push_back(static_cast<std::uint64_t>(seed));
+  if (!chars.empty()) settings.characters = characters_from(chars);
+  const JumpMeasurement measurement = measure_foot_jumps(settings);
+
+  std::string command = "calligraphy bench jumps";
+  if (!markdown_path.empty()) command += " --markdown " + markdown_path;
+  command += " --seeds " + std::to_string(seed_count);
+  if (!chars.empty()) command += " --chars " + chars;
+  const std::string section = foot_jumps_markdown(measurement, command);
+  if (!markdown_path.empty()) {
+    write_document(markdown_path,
+                   replace_generated_section(read_file(markdown_path), section, kJumpsGeneratedBegin));
+  }
+  if (json) {
+    std::cout << foot_jumps_json(measurement);
   } else if (markdown_path.empty()) {
     std::cout << section;
   } else {

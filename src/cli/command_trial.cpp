@@ -1,26 +1,47 @@
-// `calligraphy trial CHARS ...`: a whole guided writing trial at 1 kHz on the simulated device.
+// `calligraphy trial CHARS ...`: a whole guided writing trial at 1 kHz on any registered device
+// (the simulated one by default), through run_device_trial.
+#include <algorithm>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 #include "calligraphy/character_library.hpp"
+#include "calligraphy/device_registry.hpp"
+#include "calligraphy/device_trial.hpp"
 #include "calligraphy/scene.hpp"
-#include "calligraphy/trial.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 #include "cli/trial_report.hpp"
 
 namespace calligraphy::cli {
+namespace {
+
+// The listing of `name`, or a UsageError (exit 2) naming every device that can be opened.
+DeviceListing find_device(const std::string& name) {
+  const DeviceSurvey survey = device_registry().survey();
+  const auto found = std::find_if(survey.devices.begin(), survey.devices.end(),
+                                  [&](const DeviceListing& listing) { return listing.name == name; });
+  if (found != survey.devices.end()) return *found;
+  std::string names;
+  for (const DeviceListing& listing : survey.devices) names += (names.empty() ? "" : ", ") + listing.name;
+  throw UsageError("unknown device '" + name + "'; registered devices: " + (names.empty() ? "none" : names));
+}
+
+}  // namespace
 
 int command_trial(const Args& args) {
-  const Arguments arguments(args, {"guidance", "writer", "seed", "data", "json", "svg", "csv", "rate"}, {});
+  const Arguments arguments(
+      args, {"guidance", "writer", "seed", "data", "json", "svg", "csv", "rate", "device"}, {});
   if (arguments.positionals().size() != 1) throw UsageError("trial takes one CHARS argument, e.g. trial 永");
   const std::u32string chars = characters_from(arguments.positionals()[0]);
+  const std::string device_name = arguments.option_or("device", "simulated");
+  const DeviceListing device = find_device(device_name);
   const CharacterLibrary library = library_from(arguments);
   std::vector<Character> characters;
   for (char32_t c : chars) characters.push_back(library.load(c));
   const Scene scene = Scene::lay_out(characters);
 
-  TrialOptions options;
+  DeviceTrialOptions options;
   options.force.guidance = arguments.choice_or("guidance", {"on", "off"}, "on") == "on";
   const std::string writer = arguments.choice_or("writer", {"novice", "skilled"}, "novice");
   options.writer = writer == "novice" ? WriterProfile::novice() : WriterProfile::skilled();
@@ -32,13 +53,25 @@ int command_trial(const Args& args) {
   options.rate_hz = arguments.number_or("rate", 1000.0);
   options.keep_trace = arguments.option("svg") || arguments.option("csv");
 
-  const TrialResult result = run_simulated_trial(scene, options);
-  const TrialDescription description{arguments.positionals()[0], options.force.guidance, writer, options.seed,
-                                     options.rate_hz};
-  print_trial_table(description, scene, result.metrics);
-  if (const auto path = arguments.option("json")) write_file(*path, trial_json(description, result.metrics));
+  const TrialResult result = run_device_trial(device_name, scene, options);
+  // On hardware a person writes; the simulated writer only moves simulated and emulated devices.
+  const TrialDescription description{arguments.positionals()[0],
+                                     options.force.guidance,
+                                     device.hardware ? "human" : writer,
+                                     options.seed,
+                                     options.rate_hz,
+                                     device.name,
+                                     device.info.model};
+  print_trial_table(description, scene, result);
+  // The outputs are written for an aborted trial too: they hold what was recorded before the fault.
+  if (const auto path = arguments.option("json")) write_file(*path, trial_json(description, result));
   if (const auto path = arguments.option("svg")) write_file(*path, trial_svg(scene, result));
   if (const auto path = arguments.option("csv")) write_file(*path, trial_csv(result.trace));
+  if (result.aborted) {
+    std::fprintf(stderr, "calligraphy trial: error: the trial was aborted: %s\n",
+                 result.abort_reason.c_str());
+    return 1;
+  }
   return 0;
 }
 

@@ -10,14 +10,16 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: calligraphy <command> [options]\n"
-    "  trial CHARS [--guidance on|off] [--writer novice|skilled] [--seed N] [--data DIR]\n"
-    "              [--json FILE] [--svg FILE] [--csv FILE]\n"
-    "                       run a guided writing trial at 1 kHz on the simulated device\n"
+    "  trial CHARS [--device NAME] [--guidance on|off] [--writer novice|skilled] [--seed N]\n"
+    "              [--data DIR] [--json FILE] [--svg FILE] [--csv FILE]\n"
+    "                       run a guided writing trial at 1 kHz on a device (default: simulated)\n"
     "  model CHAR [--json] [--data DIR]\n"
     "                       print the character's model (paper Table 3)\n"
     "  devices              list the haptic devices found (simulated, Phantoms, OpenHaptics)\n"
     "  bench nearest [--json] [--markdown FILE] [--queries N] [--seed S]\n"
-    "                       accuracy and speed of the nearest-point methods\n";
+    "                       accuracy and speed of the nearest-point methods\n"
+    "  bench jumps [--json] [--markdown FILE] [--seeds N] [--chars CHARS]\n"
+    "                       foot-point jumps > 1 mm per stroke on real characters, by method\n";
 
 }  // namespace
 
@@ -34,6 +36,7 @@ int main(int argc, char** argv) {
     if (command == "model") return command_model(args);
     if (command == "devices") return command_devices(args);
     if (command == "bench" && !args.empty() && args[0] == "nearest") return command_bench_nearest(args);
+    if (command == "bench" && !args.empty() && args[0] == "jumps") return command_bench_jumps(args);
     std::fprintf(stderr, "calligraphy: error: unknown command '%s'\n%s", command.c_str(), kUsage);
     return 2;
   } catch (const UsageError& e) {

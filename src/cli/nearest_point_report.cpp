@@ -97,8 +97,9 @@ std::string nearest_point_markdown(const NearestPointMeasurement& measurement,
   return out.str();
 }
 
-std::string replace_generated_section(const std::string& document, const std::string& section) {
-  const auto begin = document.find(kGeneratedBegin);
+std::string replace_generated_section(const std::string& document, const std::string& section,
+                                      const char* begin_marker) {
+  const auto begin = document.find(begin_marker);
   const auto end = begin == std::string::npos ? std::string::npos : document.find(kGeneratedEnd, begin);
   if (end == std::string::npos) {
     return document + (document.empty() || document.back() == '\n' ? "" : "\n") + section;

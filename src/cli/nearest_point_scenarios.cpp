@@ -2,6 +2,9 @@
 
 #include <cmath>
 
+#include "calligraphy/character_library.hpp"
+#include "calligraphy/scene.hpp"
+
 namespace calligraphy::cli {
 
 namespace {
@@ -179,6 +182,24 @@ std::vector<NearestPointQuery> centre_of_curvature_queries(int degree, int count
   return queries;
 }
 
+// Queries near the real strokes: a random element of the degree from the corpus, P within 5 mm of a
+// random point on it (where a pen is while it writes or approaches a stroke).
+std::vector<NearestPointQuery> corpus_queries(int degree, int count, std::mt19937_64& random) {
+  static const std::vector<StrokeElement> elements = corpus_elements();
+  std::vector<const StrokeElement*> of_degree;
+  for (const StrokeElement& element : elements) {
+    if (element.degree == degree) of_degree.push_back(&element);
+  }
+  std::vector<NearestPointQuery> queries;
+  if (of_degree.empty()) return queries;
+  std::uniform_int_distribution<std::size_t> pick(0, of_degree.size() - 1);
+  for (int i = 0; i < count; ++i) {
+    const StrokeElement& element = *of_degree[pick(random)];
+    queries.push_back({element, point_near(element, random, 0.0, 5 * kMillimetre)});
+  }
+  return queries;
+}
+
 std::function<std::vector<NearestPointQuery>(int, int, std::mt19937_64&)> random_scenario(double box,
                                                                                           const Vec2& corner,
                                                                                           double min_offset,
@@ -189,6 +210,18 @@ std::function<std::vector<NearestPointQuery>(int, int, std::mt19937_64&)> random
 }
 
 }  // namespace
+
+std::vector<StrokeElement> corpus_elements() {
+  const CharacterLibrary library = CharacterLibrary::embedded();
+  std::vector<StrokeElement> elements;
+  for (const char32_t code_point : library.characters()) {
+    const Scene scene = Scene::lay_out({library.load(code_point)});
+    for (const PlacedStroke& stroke : scene.characters.front().strokes) {
+      elements.insert(elements.end(), stroke.elements.begin(), stroke.elements.end());
+    }
+  }
+  return elements;
+}
 
 std::vector<NearestPointQuery> random_curve_queries(int degree, int count, std::mt19937_64& random,
                                                     double box_m, const Vec2& corner_m, double min_offset_m,
@@ -205,6 +238,11 @@ std::vector<NearestPointScenario> nearest_point_scenarios() {
   const double mm = kMillimetre;
   const Vec2 far_corner(100.0, 100.0);
   return {
+      {"corpus",
+       "fitted elements of the " + std::to_string(CharacterLibrary::embedded().characters().size()) +
+           " embedded characters, each character placed alone in the default 60 mm box; P within 5 mm of a "
+           "random point of a random element",
+       corpus_queries},
       {"random_near", "random curves in a 50 mm box, P within 5 mm of a random curve point",
        random_scenario(50 * mm, Vec2::Zero(), 0.0, 5 * mm)},
       {"random_out", "random curves in a 50 mm box, P 5 to 50 mm from a random curve point",

@@ -1,8 +1,8 @@
 #pragma once
 // Query sets for measuring the nearest-point methods (`calligraphy bench nearest`, bench/).
 // A scenario is a name, a one-line description and a function producing queries (an element and a
-// point) for one degree. Adding one, e.g. real strokes from the corpus, is one more entry in the list
-// returned by `nearest_point_scenarios()`.
+// point) for one degree. Adding one is one more entry in the list returned by
+// `nearest_point_scenarios()`.
 #include <functional>
 #include <random>
 #include <string>
@@ -26,8 +26,13 @@ struct NearestPointScenario {
   std::function<std::vector<NearestPointQuery>(int degree, int count, std::mt19937_64& random)> make;
 };
 
-/// The built-in scenarios: random curves in a 50 mm box (near and far queries) and the extremes.
+/// The built-in scenarios: real strokes of the embedded characters, random curves in a 50 mm box (near
+/// and far queries) and the extremes.
 std::vector<NearestPointScenario> nearest_point_scenarios();
+
+/// Every fitted element of every embedded character, each character laid out alone with the default
+/// SceneLayout (60 mm box centred at the origin of the paper), control points in m.
+std::vector<StrokeElement> corpus_elements();
 
 /// Random queries within `max_offset_m` of random curves in a box of side `box_m` whose lower corner
 /// is at `corner_m`; shared by the scenarios and the Google Benchmark program.

@@ -12,10 +12,11 @@
 
 namespace calligraphy::cli {
 
-void print_trial_table(const TrialDescription& d, const Scene& scene, const TrialMetrics& m) {
-  std::printf("Trial %s: guidance %s, %s writer, seed %llu, %.0f Hz, simulated %s\n", d.characters.c_str(),
+void print_trial_table(const TrialDescription& d, const Scene& scene, const TrialResult& result) {
+  const TrialMetrics& m = result.metrics;
+  std::printf("Trial %s: guidance %s, %s writer, seed %llu, %.0f Hz, device %s (%s)\n", d.characters.c_str(),
               d.guidance ? "on" : "off", d.writer.c_str(), static_cast<unsigned long long>(d.seed), d.rate_hz,
-              "Phantom Desktop");
+              d.device.c_str(), d.device_model.c_str());
   std::printf("\n  %-6s %-5s %-6s %-4s %9s %9s %9s %8s %9s\n", "stroke", "char", "type", "ID", "mean[mm]", "max[mm]",
               "time[s]", "attempts", "completed");
   for (const StrokeMetrics& s : m.per_stroke) {
@@ -33,9 +34,11 @@ void print_trial_table(const TrialDescription& d, const Scene& scene, const Tria
   std::printf("  state transitions          %zu\n", m.state_transitions);
   std::printf("  max |F|                    %.3f N\n", m.max_force_n);
   std::printf("  max per-tick |dF|          %.3f N\n", m.max_force_step_n);
+  if (result.aborted) std::printf("\n  ABORTED after %.3f s: %s\n", m.time_s, result.abort_reason.c_str());
 }
 
-std::string trial_json(const TrialDescription& d, const TrialMetrics& m) {
+std::string trial_json(const TrialDescription& d, const TrialResult& result) {
+  const TrialMetrics& m = result.metrics;
   nlohmann::json per_stroke = nlohmann::json::array();
   for (const StrokeMetrics& s : m.per_stroke) {
     per_stroke.push_back({{"index", s.index + 1},
@@ -51,6 +54,9 @@ std::string trial_json(const TrialDescription& d, const TrialMetrics& m) {
                               {"writer", d.writer},
                               {"seed", d.seed},
                               {"rate_hz", d.rate_hz},
+                              {"device", d.device},
+                              {"aborted", result.aborted},
+                              {"abort_reason", result.abort_reason},
                               {"strokes_total", m.strokes_total},
                               {"strokes_completed", m.strokes_completed},
                               {"completed_in_order", m.completed_in_order},

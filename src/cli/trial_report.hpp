@@ -12,10 +12,14 @@ struct TrialDescription {
   std::string writer;
   std::uint64_t seed = 0;
   double rate_hz = 1000.0;
+  std::string device = "simulated";  // registry name
+  std::string device_model = "Phantom Desktop (simulated)";
 };
 
-void print_trial_table(const TrialDescription& d, const Scene& scene, const TrialMetrics& m);
-std::string trial_json(const TrialDescription& d, const TrialMetrics& m);
+/// The table of the metrics, and a line saying why when the trial was aborted.
+void print_trial_table(const TrialDescription& d, const Scene& scene, const TrialResult& result);
+/// The metrics as JSON, with `device`, `aborted` and `abort_reason`.
+std::string trial_json(const TrialDescription& d, const TrialResult& result);
 /// Reference in blue, pen trace in green, each stroke's start hint as a red ellipse (paper Figs. 30-31).
 std::string trial_svg(const Scene& scene, const TrialResult& result);
 /// The 1 kHz trace: t,x,y,z,fx,fy,fz,state,stroke,element (SI units).

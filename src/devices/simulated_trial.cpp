@@ -1,6 +1,7 @@
 #include <cmath>
 #include <string>
 
+#include "calligraphy/device_trial.hpp"
 #include "calligraphy/errors.hpp"
 #include "calligraphy/trial.hpp"
 
@@ -8,7 +9,8 @@ namespace calligraphy {
 
 void TrialOptions::validate() const {
   if (!(rate_hz >= 100.0 && rate_hz <= 100000.0)) {
-    throw InvalidArgument("TrialOptions.rate_hz = " + std::to_string(rate_hz) + " must be in [100, 100000] Hz");
+    throw InvalidArgument("TrialOptions.rate_hz = " + std::to_string(rate_hz) +
+                          " must be in [100, 100000] Hz");
   }
   if (!(max_duration_s > 0.0) || !std::isfinite(max_duration_s)) {
     throw InvalidArgument("TrialOptions.max_duration_s = " + std::to_string(max_duration_s) + " must be > 0");
@@ -21,27 +23,14 @@ void TrialOptions::validate() const {
 TrialResult run_simulated_trial(const Scene& scene, const TrialOptions& options) {
   options.validate();
   SimulatedDevice device(options.device);
-  SimulatedWriter writer(scene, options.writer, options.seed);
-  Renderer renderer(scene, options.force, device.info());
-  TrialRecorder recorder(scene, options.keep_trace);
-  device.attach_hand(&writer);
-  device.open();
-
-  const double dt = 1.0 / options.rate_hz;
-  const auto ticks = static_cast<std::size_t>(std::ceil(options.max_duration_s * options.rate_hz));
-  for (std::size_t k = 0; k < ticks; ++k) {
-    const DeviceState state = device.read_state();
-    const RenderOutput out = renderer.tick(state);
-    device.write_force(out.force_n);
-    recorder.record(state, out);
-    if (out.finished) break;
-    writer.observe(out, state);
-    if (writer.done()) break;
-    device.advance(dt);
-  }
-  device.close();
-  recorder.finish(device.time());
-  return {recorder.metrics(), recorder.trace()};
+  DeviceTrialOptions device_options;
+  device_options.force = options.force;
+  device_options.writer = options.writer;
+  device_options.rate_hz = options.rate_hz;
+  device_options.seed = options.seed;
+  device_options.max_duration_s = options.max_duration_s;
+  device_options.keep_trace = options.keep_trace;
+  return run_device_trial(device, scene, device_options);
 }
 
 }  // namespace calligraphy

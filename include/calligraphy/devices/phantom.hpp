@@ -86,10 +86,11 @@ class PhantomDevice final : public HapticDevice {
   /// True once the encoders were homed (by calibrate(), or by the first docked packet after open()).
   [[nodiscard]] bool is_calibrated() const override { return calibrated_.load(std::memory_order_acquire); }
 
-  /// Enabling takes effect with the next two write_force calls: the first sends the force-enable bit 0
-  /// (and zero force), the second sets it to 1, the toggle the Omni needs. Throws CalibrationNeeded when
-  /// enabling an uncalibrated arm (the Jacobian would push in wrong directions) and DeviceError when
-  /// not open. Disabling never throws.
+  /// Enabling sends a packet with the force-enable bit 0 (zero force) at once; the next write_force sets
+  /// the bit to 1 with its force: the 0 -> 1 toggle the Omni needs, and no commanded force is skipped.
+  /// Throws CalibrationNeeded when enabling an uncalibrated arm (the Jacobian would push in wrong
+  /// directions), DeviceError when not open, CommunicationError when that packet cannot be sent (link
+  /// lost). Disabling never throws.
   void enable_forces(bool enabled) override;
   [[nodiscard]] bool forces_enabled() const override {
     return forces_requested_.load(std::memory_order_acquire);

@@ -17,6 +17,7 @@
 #include "calligraphy/devices/phantom.hpp"
 #include "calligraphy/devices/phantom_arm.hpp"
 #include "calligraphy/devices/phantom_codec.hpp"
+#include "calligraphy/hand_port.hpp"
 
 namespace calligraphy::phantom {
 
@@ -62,6 +63,10 @@ class PhantomEmulator final : public devices::InMemoryPeer {
   void set_joint_angles(const JointAngles& q) noexcept;
   /// Torque of the writer's hand on the joints [N m], held until changed.
   void set_external_torque(const JointTorques& tau) noexcept { external_torque_ = tau; }
+  /// Emulated time per status packet [s], e.g. 1 / servo rate. Ignored unless finite and > 0.
+  void set_tick(double tick_s) noexcept {
+    if (tick_s > 0.0 && tick_s < 1.0) parameters_.tick_s = tick_s;
+  }
   /// Bit i set: button i+1 pressed.
   void set_buttons(std::uint32_t pressed) noexcept { buttons_ = pressed; }
   /// The next `count` status packets have a potentiometer pair of zeros (malformed).
@@ -124,5 +129,44 @@ struct EmulatedPhantom {
 [[nodiscard]] EmulatedPhantom make_emulated_phantom(PhantomDeviceConfig config = phantom_omni_config());
 [[nodiscard]] EmulatedPhantom make_emulated_phantom(PhantomDeviceConfig config,
                                                     EmulatorParameters parameters);
+
+/// The emulated Phantom as one device that a simulated hand can move. Every `HapticDevice` call goes to
+/// the `PhantomDevice` (the real code path: codec, arm model, watchdog, over the in-memory link); the
+/// `HandPort` turns the hand's tip force into joint torques by the Jacobian transpose of the emulated
+/// arm, tau = J(q)^T F, evaluated from the arm's true joint angles and velocities once per tick and held
+/// over the tick (`PhantomEmulator::set_external_torque`). The emulator integrates a tick each time
+/// the host reads a status packet, so `advance(dt)` sets the tick length and the hand torque, and the
+/// next `read_state` moves the arm.
+class EmulatedPhantomDevice final : public HapticDevice, public HandPort {
+ public:
+  /// `parameters` default to emulator_matching(config). Throws InvalidArgument like PhantomDevice.
+  explicit EmulatedPhantomDevice(PhantomDeviceConfig config = phantom_omni_config());
+  EmulatedPhantomDevice(PhantomDeviceConfig config, EmulatorParameters parameters);
+
+  [[nodiscard]] const DeviceInfo& info() const override { return device_->info(); }
+  void open() override { device_->open(); }
+  void close() noexcept override { device_->close(); }
+  [[nodiscard]] bool is_open() const override { return device_->is_open(); }
+  void calibrate() override { device_->calibrate(); }
+  [[nodiscard]] bool is_calibrated() const override { return device_->is_calibrated(); }
+  void enable_forces(bool enabled) override { device_->enable_forces(enabled); }
+  [[nodiscard]] bool forces_enabled() const override { return device_->forces_enabled(); }
+  DeviceState read_state() override { return device_->read_state(); }
+  void write_force(const Vec3& force_n) override { device_->write_force(force_n); }
+
+  void attach_hand(HandModel* hand) noexcept override;
+  void advance(double dt_s) noexcept override;
+
+  /// The device side, for tests (unplug it, dock it, push it).
+  [[nodiscard]] PhantomEmulator& emulator() noexcept { return *emulator_; }
+  /// The host side.
+  [[nodiscard]] PhantomDevice& phantom() noexcept { return *device_; }
+
+ private:
+  std::unique_ptr<PhantomDevice> device_;
+  std::shared_ptr<PhantomEmulator> emulator_;
+  PhantomArm arm_;  // the emulated arm's true geometry, in the device's frame
+  HandModel* hand_ = nullptr;
+};
 
 }  // namespace calligraphy::phantom

@@ -36,7 +36,7 @@ std::unique_ptr<HapticDevice> make_registry_emulated_phantom() {
   auto parameters = emulator_matching(config);
   // Powers on docked, so open() homes the encoders; 50 ms later the writer lifts the stylus out.
   parameters.undock_after_s = 0.05;
-  return std::move(make_emulated_phantom(std::move(config), parameters).device);
+  return std::make_unique<EmulatedPhantomDevice>(std::move(config), parameters);
 }
 
 [[maybe_unused]] DeviceInfo usb_touch_info(std::uint16_t vendor, std::uint16_t product) {

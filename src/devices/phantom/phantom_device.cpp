@@ -146,6 +146,12 @@ void PhantomDevice::enable_forces(bool enabled) {
                               "calibrate()");
     }
   }
+  if (enabled && !forces_requested_.load(std::memory_order_acquire)) {
+    // First half of the Omni's 0 -> 1 force-enable toggle, sent now so that the first write_force
+    // already carries its force. The watchdog is armed by that first write_force.
+    send_command(CommandPacket{});
+    enable_bit_zero_sent_ = true;
+  }
   forces_requested_.store(enabled, std::memory_order_release);
 }
 
@@ -178,7 +184,8 @@ void PhantomDevice::write_force(const Vec3& force_n) {
     enable_bit_zero_sent_ = false;
     watchdog_.disarm();
   } else if (!enable_bit_zero_sent_) {
-    // First half of the toggle: enable bit 0 with zero force; the next packet sets it to 1.
+    // Forces were turned off and on again without a bit-0 packet in between (enable_forces(false)
+    // from another thread): first half of the toggle now, with zero force; the next packet sets it to 1.
     enable_bit_zero_sent_ = true;
     watchdog_.kick(now);
   } else {

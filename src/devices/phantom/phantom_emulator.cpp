@@ -146,4 +146,29 @@ EmulatedPhantom make_emulated_phantom(PhantomDeviceConfig config, EmulatorParame
   return {std::move(device), std::move(emulator)};
 }
 
+EmulatedPhantomDevice::EmulatedPhantomDevice(PhantomDeviceConfig config)
+    : EmulatedPhantomDevice(config, emulator_matching(config)) {}
+
+EmulatedPhantomDevice::EmulatedPhantomDevice(PhantomDeviceConfig config, EmulatorParameters parameters)
+    : arm_(parameters.geometry, config.workspace_centre_rad) {
+  auto emulated = make_emulated_phantom(std::move(config), std::move(parameters));
+  device_ = std::move(emulated.device);
+  emulator_ = std::move(emulated.emulator);
+}
+
+void EmulatedPhantomDevice::attach_hand(HandModel* hand) noexcept {
+  hand_ = hand;
+  if (hand == nullptr) emulator_->set_external_torque(JointTorques::Zero());
+}
+
+void EmulatedPhantomDevice::advance(double dt_s) noexcept {
+  emulator_->set_tick(dt_s);
+  if (hand_ == nullptr) return;
+  const JointAngles& q = emulator_->joint_angles();
+  const Eigen::Matrix3d jacobian = arm_.jacobian(q);
+  const Vec3 tip_velocity = jacobian * emulator_->joint_velocities();
+  const Vec3 force = hand_->hand_force(emulator_->time_s(), arm_.tip_position(q), tip_velocity);
+  emulator_->set_external_torque(jacobian.transpose() * force);
+}
+
 }  // namespace calligraphy::phantom
