@@ -47,8 +47,12 @@ struct FittedStroke {
 /// Throws InvalidArgument for non-finite points or options out of range.
 FittedStroke fit_stroke(std::span<const Vec2> median, const FitOptions& options = {});
 
-/// Provisional typical-stroke classification of fitted pieces by template matching (directions
-/// within `kTypicalStrokeDirectionToleranceDeg`, piece counts, hook lengths). Returns an ID 1-39.
+/// Typical-stroke classification of fitted pieces by template matching: the least cost over the 39
+/// templates of typical_strokes.hpp and a few observed forms of them, the cost being the squared
+/// direction errors in units of the templates' tolerances plus soft penalties for piece counts, hook
+/// fractions and lengths. A short down-right first piece is ignored as the brush's entry. Validated
+/// against cnchar-order (docs/classification.md). Returns an ID 1-39; throws InvalidArgument when
+/// `pieces` is empty.
 int classify_pieces(std::span<const StrokePiece> pieces);
 
 /// Fits every median of a character, in stroke order.

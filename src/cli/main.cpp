@@ -15,6 +15,10 @@ constexpr const char* kUsage =
     "                       run a guided writing trial at 1 kHz on the simulated device\n"
     "  model CHAR [--json] [--data DIR]\n"
     "                       print the character's model (paper Table 3)\n"
+    "  strokes [--markdown FILE] [--json]\n"
+    "                       the table of the 39 typical strokes\n"
+    "  corpus validate --data DIR --cnchar FILE [--markdown FILE] [--json]\n"
+    "                       per-stroke agreement of the classification with cnchar-order\n"
     "  devices              list the haptic devices found (simulated, Phantoms, OpenHaptics)\n"
     "  bench nearest [--json] [--markdown FILE] [--queries N] [--seed S]\n"
     "                       accuracy and speed of the nearest-point methods\n";
@@ -33,6 +37,8 @@ int main(int argc, char** argv) {
     if (command == "trial") return command_trial(args);
     if (command == "model") return command_model(args);
     if (command == "devices") return command_devices(args);
+    if (command == "strokes") return command_strokes(args);
+    if (command == "corpus" && !args.empty() && args[0] == "validate") return command_corpus_validate(args);
     if (command == "bench" && !args.empty() && args[0] == "nearest") return command_bench_nearest(args);
     std::fprintf(stderr, "calligraphy: error: unknown command '%s'\n%s", command.c_str(), kUsage);
     return 2;

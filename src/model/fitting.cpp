@@ -5,6 +5,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -64,7 +65,10 @@ std::vector<std::size_t> find_corners(std::vector<Vec2>& pts, const FitOptions& 
       }
     }
     if (first > last) continue;
-    if (!clusters.empty() && first <= clusters.back().second + 1 && turn[first] * turn[clusters.back().first] > 0.0) {
+    // Adjacent windows extend one corner; two corners joined by a long straight segment (a vertical
+    // and its hook) stay apart even when no vertex lies between them.
+    if (!clusters.empty() && first <= clusters.back().second + 1 && turn[first] * turn[clusters.back().first] > 0.0 &&
+        arc[first] - arc[clusters.back().second] <= options.corner_window) {
       clusters.back().second = std::max(clusters.back().second, last);
     } else if (clusters.empty() || first > clusters.back().second) {
       clusters.emplace_back(first, last);
@@ -249,41 +253,114 @@ FittedStroke fit_stroke(std::span<const Vec2> median, const FitOptions& options)
   for (const Vec2& p : pts) fitted.max_deviation = std::max(fitted.max_deviation, distance_to_polyline(p, curve));
 
   fitted.stroke.typical_id = classify_pieces(fitted.pieces);
-  fitted.stroke.attraction_factors.assign(fitted.stroke.feature_point_count(),
-                                          typical_stroke(fitted.stroke.typical_id).default_attraction);
+  // Paper eq. 8: an attraction factor per feature point; corners (piece joints) pull harder so that the
+  // writer is guided through the turn.
+  const TypicalStroke& type = typical_stroke(fitted.stroke.typical_id);
+  fitted.stroke.attraction_factors.assign(fitted.stroke.feature_point_count(), type.default_attraction);
+  for (std::size_t k = 1; k < fitted.pieces.size(); ++k) {
+    fitted.stroke.attraction_factors[fitted.pieces[k].first_element] = type.corner_attraction;
+  }
   return fitted;
 }
 
+namespace {
+
+// Forms in which hanzi-writer-data's medians show some typical strokes besides their canonical
+// template, found by comparing with cnchar-order's labels (docs/classification.md): a corner rounded
+// so widely that it is fitted as one bent piece, a zig-zag that is too small to make corners.
+struct ObservedForm {
+  int id;
+  std::array<StrokePieceTemplate, 3> pieces;
+  std::size_t count;
+  double extra_cost;  // prior against the form (units of the template cost)
+};
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr StrokePieceTemplate form_piece(double start, double end, double start_tol, double end_tol,
+                                         bool hook = false, double min_length = 0.0, double max_length = kInf) {
+  return {start == end ? ElementKind::line : ElementKind::bezier, start, end, start_tol, end_tol, hook, min_length,
+          max_length};
+}
+constexpr StrokePieceTemplate kFormHookLeft = form_piece(150, 150, 25, 25, true);
+constexpr StrokePieceTemplate kNone{};
+constexpr ObservedForm kObservedForms[] = {
+    // 提 starting flat and rising at its end (乖 6, 些 4).
+    {6, {form_piece(0, 27, 12, 6), kNone, kNone}, 1, 0.0},
+    // Short vertical leaning right, as the left side of a small 口 (串 1, 京 3).
+    {2, {form_piece(-58, -80, 14, 5, false, 120, 320), kNone, kNone}, 1, 0.0},
+    // 横撇弯钩 (阝) whose 撇 and 弯 merge into one bent piece (哪 8, 啊 4).
+    {16, {form_piece(10, 10, 20, 20), form_piece(-110, -73, 15, 10), form_piece(160, 160, 25, 25, true)}, 3, 0.0},
+    // 横折折撇 (辶 2) whose small zig-zag makes no corners: down-left turning down-right.
+    {17, {form_piece(10, 10, 20, 20), form_piece(-110, -75, 20, 20), kNone}, 2, 1.0},
+    // 竖弯钩 whose bend is a corner.
+    {24, {form_piece(-95, -95, 20, 20), form_piece(0, 0, 25, 25), form_piece(90, 90, 25, 25, true)}, 3, 0.0},
+    // 竖折折钩 whose second corner is rounded into the bend.
+    {27, {form_piece(-95, -95, 20, 20), form_piece(15, -80, 25, 25), kFormHookLeft}, 3, 0.0},
+};
+
+// Extra costs of the variants without a cnchar letter of their own, so that they win only clearly.
+double prior_cost(int id) {
+  switch (id) {
+    case 34: return 0.3;  // 长点
+    case 37: return 0.5;  // 提捺
+    default: return 0.0;
+  }
+}
+
+// A hook or tick is at most this fraction of its stroke's (entry-trimmed) length.
+constexpr double kHookFraction = 0.35;
+
+// Template cost (paper section 3.1, classification by template matching): squared direction errors
+// in units of the tolerances, plus soft penalties for lengths and piece counts.
+double template_cost(std::span<const StrokePiece> pieces, double total, std::span<const StrokePieceTemplate> t) {
+  constexpr double kPieceCountCost = 4.0;
+  constexpr double kLengthScale = 40.0;    // data units per unit of cost (squared)
+  constexpr double kFractionScale = 0.1;
+  const std::size_t common = std::min(pieces.size(), t.size());
+  double cost = kPieceCountCost * static_cast<double>(std::max(pieces.size(), t.size()) - common);
+  for (std::size_t k = 0; k < common; ++k) {
+    const StrokePiece& p = pieces[k];
+    const StrokePieceTemplate& q = t[k];
+    const double ds = wrap_deg(p.start_direction_deg - q.start_direction_deg) / q.start_tolerance_deg;
+    const double de = wrap_deg(p.end_direction_deg - q.end_direction_deg) / q.end_tolerance_deg;
+    cost += 0.5 * (ds * ds + de * de);
+    const double fraction = total > 0.0 ? p.length / total : 0.0;
+    if (q.hook && fraction > kHookFraction) cost += std::pow((fraction - kHookFraction) / kFractionScale, 2);
+    if (p.length < q.min_length) cost += std::pow((q.min_length - p.length) / kLengthScale, 2);
+    if (p.length > q.max_length) cost += std::pow((p.length - q.max_length) / kLengthScale, 2);
+  }
+  return cost;
+}
+
+}  // namespace
+
 int classify_pieces(std::span<const StrokePiece> all_pieces) {
-  // No typical stroke starts with a short piece: a short first piece is the brush's entry.
+  if (all_pieces.empty()) throw InvalidArgument("classify_pieces: no pieces");
+  // No typical stroke starts with a short piece going down-right before turning: that is the brush's
+  // entry (the press before a 撇 or a vertical), not part of the stroke's shape.
   std::span<const StrokePiece> pieces = all_pieces;
   double whole = 0.0;
   for (const auto& p : all_pieces) whole += p.length;
-  if (pieces.size() > 1 && pieces.front().length < 0.2 * whole) pieces = pieces.subspan(1);
+  const StrokePiece& first = all_pieces.front();
+  constexpr double kEntryFraction = 0.35;
+  constexpr double kEntryLength = 120.0;
+  if (pieces.size() > 1 && first.length < kEntryFraction * whole && first.length < kEntryLength &&
+      first.start_direction_deg > -85.0 && first.start_direction_deg < -5.0) {
+    pieces = pieces.subspan(1);
+  }
   double total = 0.0;
   for (const auto& p : pieces) total += p.length;
-  // Dots are short strokes; hooks and ticks are short relative to their stroke (data units).
-  constexpr double kDotLength = 230.0;
-  constexpr double kShortFraction = 0.3;
-  constexpr double kShortMismatchCost = 40.0;
+
   int best_id = 1;
   double best_cost = std::numeric_limits<double>::infinity();
-  for (const TypicalStroke& t : typical_strokes()) {
-    const std::size_t count = std::min(t.pieces.size(), pieces.size());
-    double cost = 90.0 * static_cast<double>(std::max(t.pieces.size(), pieces.size()) - count);
-    for (std::size_t k = 0; k < count; ++k) {
-      const StrokePiece& p = pieces[k];
-      const StrokePieceTemplate& q = t.pieces[k];
-      cost += std::abs(wrap_deg(p.start_direction_deg - q.start_direction_deg));
-      cost += std::abs(wrap_deg(p.end_direction_deg - q.end_direction_deg));
-      const bool is_short = pieces.size() == 1 ? p.length < kDotLength : p.length < kShortFraction * total;
-      if (is_short != q.short_piece) cost += kShortMismatchCost;
-    }
+  const auto consider = [&](int id, std::span<const StrokePieceTemplate> t, double extra) {
+    const double cost = extra + prior_cost(id) + template_cost(pieces, total, t);
     if (cost < best_cost) {
       best_cost = cost;
-      best_id = t.id;
+      best_id = id;
     }
-  }
+  };
+  for (const TypicalStroke& t : typical_strokes()) consider(t.id, t.pieces, 0.0);
+  for (const ObservedForm& f : kObservedForms) consider(f.id, std::span(f.pieces.data(), f.count), f.extra_cost);
   return best_id;
 }
 
