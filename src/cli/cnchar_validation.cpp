@@ -100,30 +100,35 @@ std::string_view cnchar_letter_name(char letter) {
 }
 
 std::map<char32_t, std::string> parse_cnchar_orders(std::string_view text, const std::string& source) {
-  // Pairs "X":"letters" with X one UTF-8 character and letters in a-z (the map in cnchar.order.min.js).
+  // Pairs "X":"letters" with X one UTF-8 character and letters in a-z (the map in cnchar.order.min.js;
+  // spaces around the colon are allowed, so a JSON object of the same pairs reads too).
   std::map<char32_t, std::string> orders;
+  const auto skip_spaces = [&text](std::size_t k) {
+    while (k < text.size() && (text[k] == ' ' || text[k] == '\n' || text[k] == '\r' || text[k] == '\t')) ++k;
+    return k;
+  };
   std::size_t i = 0;
   while ((i = text.find('"', i)) != std::string_view::npos) {
     const std::size_t start = i + 1;
+    i = start;
     if (start >= text.size()) break;
     const auto lead = static_cast<unsigned char>(text[start]);
-    const std::size_t width = lead < 0x80 ? 1 : lead >= 0xF0 ? 4 : lead >= 0xE0 ? 3 : lead >= 0xC0 ? 2 : 0;
-    const std::size_t after = start + width;
-    if (width >= 2 && after + 3 < text.size() && text.substr(after, 3) == "\":\"") {
-      std::size_t end = after + 3;
-      while (end < text.size() && text[end] >= 'a' && text[end] <= 'z') ++end;
-      if (end > after + 3 && end < text.size() && text[end] == '"') {
-        try {
-          const std::u32string cp = decode_utf8(text.substr(start, width));
-          if (cp.size() == 1) orders[cp[0]] = std::string(text.substr(after + 3, end - after - 3));
-        } catch (const InvalidArgument&) {
-          // Not a character key; keep scanning.
-        }
-        i = end + 1;
-        continue;
-      }
+    const std::size_t width = lead >= 0xF0 ? 4 : lead >= 0xE0 ? 3 : lead >= 0xC0 ? 2 : 0;
+    if (width == 0 || start + width >= text.size() || text[start + width] != '"') continue;
+    std::size_t k = skip_spaces(start + width + 1);
+    if (k >= text.size() || text[k] != ':') continue;
+    k = skip_spaces(k + 1);
+    if (k >= text.size() || text[k] != '"') continue;
+    std::size_t end = k + 1;
+    while (end < text.size() && text[end] >= 'a' && text[end] <= 'z') ++end;
+    if (end == k + 1 || end >= text.size() || text[end] != '"') continue;
+    try {
+      const std::u32string cp = decode_utf8(text.substr(start, width));
+      if (cp.size() == 1) orders[cp[0]] = std::string(text.substr(k + 1, end - k - 1));
+    } catch (const InvalidArgument&) {
+      continue;  // not a character key
     }
-    i = start;
+    i = end + 1;
   }
   if (orders.empty())
     throw DataError(source + ": no \"char\":\"letters\" stroke map found (is it cnchar.order.min.js?)");

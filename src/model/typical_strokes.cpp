@@ -4,6 +4,7 @@
 #include "calligraphy/typical_strokes.hpp"
 
 #include <array>
+#include <cmath>
 #include <limits>
 #include <string>
 
@@ -15,10 +16,12 @@ namespace {
 using P = StrokePieceTemplate;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// A piece: straight (an LSE) when its nominal start and end directions agree, else bent (a CSE).
+// A piece is straight (an LSE) when its nominal start and end directions differ by less than this,
+// else bent (a CSE): the paper's line segment and curve segment strokes (section 3.2).
+constexpr double kBentDeg = 15.0;
 constexpr P piece(double start, double end, double start_tol, double end_tol, bool hook = false,
                   double min_length = 0.0, double max_length = kInf) {
-  return {start == end ? ElementKind::line : ElementKind::bezier,
+  return {(end - start < kBentDeg && start - end < kBentDeg) ? ElementKind::line : ElementKind::bezier,
           start,
           end,
           start_tol,
