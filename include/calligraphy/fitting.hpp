@@ -32,6 +32,9 @@ struct StrokePiece {
   double start_direction_deg = 0.0;  ///< direction of motion at the piece's start, y-up degrees
   double end_direction_deg = 0.0;
   double length = 0.0;               ///< data units
+  /// Turn of the last fifth of the piece against the fifth to third before it (degrees, counter-
+  /// clockwise positive): the curl back toward the vertical that ends a 左点.
+  double exit_turn_deg = 0.0;
   std::size_t first_element = 0;     ///< elements [first_element, end_element) form the piece
   std::size_t end_element = 0;
 };

@@ -241,6 +241,7 @@ FittedStroke fit_stroke(std::span<const Vec2> median, const FitOptions& options)
       info.start_direction_deg = chord_direction(piece, 0.1, 0.4);
       info.end_direction_deg = chord_direction(piece, 0.6, 0.95);
       info.length = polyline_length(piece);
+      info.exit_turn_deg = wrap_deg(chord_direction(piece, 0.8, 1.0) - chord_direction(piece, 0.5, 0.8));
       fitted.pieces.push_back(info);
     }
   }
@@ -292,6 +293,10 @@ constexpr ObservedForm kObservedForms[] = {
     {16, {form_piece(10, 10, 20, 20), form_piece(-110, -73, 15, 10), form_piece(160, 160, 25, 25, true)}, 3, 0.0},
     // 横折折撇 (辶 2) whose small zig-zag makes no corners: down-left turning down-right.
     {17, {form_piece(10, 10, 20, 20), form_piece(-110, -75, 20, 20), kNone}, 2, 1.0},
+    // 竖弯钩 whose hook the median lacks (七 2, 他 5): a single bend from down to right.
+    {24, {form_piece(-95, 0, 25, 25), kNone, kNone}, 1, 0.0},
+    // 横折 ending with a brush tick too short for a hook (亩 4, 佃 4).
+    {7, {form_piece(10, 10, 20, 20), form_piece(-95, -95, 20, 20), form_piece(150, 150, 25, 25, true, 0, 60)}, 3, 0.0},
     // 竖弯钩 whose bend is a corner.
     {24, {form_piece(-95, -95, 20, 20), form_piece(0, 0, 25, 25), form_piece(90, 90, 25, 25, true)}, 3, 0.0},
     // 竖折折钩 whose second corner is rounded into the bend.
@@ -303,6 +308,7 @@ double prior_cost(int id) {
   switch (id) {
     case 34: return 0.3;  // 长点
     case 37: return 0.5;  // 提捺
+    case 23: return 0.5;  // 竖弯: in the data mostly a 竖弯钩 whose hook the median lacks
     default: return 0.0;
   }
 }
@@ -330,6 +336,26 @@ double template_cost(std::span<const StrokePiece> pieces, double total, std::spa
     if (p.length > q.max_length) cost += std::pow((p.length - q.max_length) / kLengthScale, 2);
   }
   return cost;
+}
+
+}  // namespace
+
+namespace {
+
+// A short stroke falling slightly to the left is a 左点 (点2: 冖 1, 宀 2, 心 1, 忄 1), a short vertical
+// (艹) or a short 撇; their directions overlap. The 左点 ends curling back toward the vertical, the
+// others do not; of those, a stroke ending steeper than -112 degrees is a vertical. Measured over
+// the corpus (docs/classification.md).
+int resolve_short_vertical(const StrokePiece& p, int best_id) {
+  constexpr int kS = 2, kP = 3, kD2 = 33;
+  const bool in_zone = p.start_direction_deg > -118.0 && p.start_direction_deg < -85.0 && p.length < 280.0 &&
+                       p.end_direction_deg > -125.0 && p.end_direction_deg < -95.0;
+  if (!in_zone) return best_id;
+  constexpr double kCurlDeg = 8.0;
+  constexpr double kVerticalEndDeg = -112.0;
+  if (p.exit_turn_deg >= kCurlDeg) return kD2;
+  if (p.end_direction_deg > kVerticalEndDeg) return kS;
+  return best_id == kD2 ? kP : best_id;
 }
 
 }  // namespace
@@ -362,7 +388,7 @@ int classify_pieces(std::span<const StrokePiece> all_pieces) {
   };
   for (const TypicalStroke& t : typical_strokes()) consider(t.id, t.pieces, 0.0);
   for (const ObservedForm& f : kObservedForms) consider(f.id, std::span(f.pieces.data(), f.count), f.extra_cost);
-  return best_id;
+  return pieces.size() == 1 ? resolve_short_vertical(pieces.front(), best_id) : best_id;
 }
 
 Character fit_character(char32_t code_point, const std::vector<std::vector<Vec2>>& medians, std::string source,
