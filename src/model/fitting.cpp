@@ -278,8 +278,15 @@ struct ObservedForm {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kBentDeg = 15.0;  // as in typical_strokes.cpp
 constexpr StrokePieceTemplate form_piece(double start, double end, double start_tol, double end_tol,
-                                         bool hook = false, double min_length = 0.0, double max_length = kInf) {
-  return {(end - start < kBentDeg && start - end < kBentDeg) ? ElementKind::line : ElementKind::bezier, start, end, start_tol, end_tol, hook, min_length,
+                                         bool hook = false, double min_length = 0.0,
+                                         double max_length = kInf) {
+  return {(end - start < kBentDeg && start - end < kBentDeg) ? ElementKind::line : ElementKind::bezier,
+          start,
+          end,
+          start_tol,
+          end_tol,
+          hook,
+          min_length,
           max_length};
 }
 constexpr StrokePieceTemplate kFormHookLeft = form_piece(150, 150, 25, 25, true);
@@ -288,15 +295,21 @@ constexpr ObservedForm kObservedForms[] = {
     // 提 starting flat and rising at its end (乖 6, 些 4).
     {6, {form_piece(0, 27, 12, 6), kNone, kNone}, 1, 0.0},
     // Short vertical leaning right, as the left side of a small 口 (串 1, 京 3).
-    {2, {form_piece(-58, -80, 14, 5, false, 120, 320), kNone, kNone}, 1, 0.0},
+    {2, {form_piece(-58, -80, 14, 5, false, 150, 320), kNone, kNone}, 1, 0.0},
     // 横撇弯钩 (阝) whose 撇 and 弯 merge into one bent piece (哪 8, 啊 4).
-    {16, {form_piece(10, 10, 20, 20), form_piece(-110, -73, 15, 10), form_piece(160, 160, 25, 25, true)}, 3, 0.0},
+    {16,
+     {form_piece(10, 10, 20, 20), form_piece(-110, -73, 15, 10), form_piece(160, 160, 25, 25, true)},
+     3,
+     0.0},
     // 横折折撇 (辶 2) whose small zig-zag makes no corners: down-left turning down-right.
     {17, {form_piece(10, 10, 20, 20), form_piece(-110, -75, 20, 20), kNone}, 2, 1.0},
     // 竖弯钩 whose hook the median lacks (七 2, 他 5): a single bend from down to right.
     {24, {form_piece(-95, 0, 25, 25), kNone, kNone}, 1, 0.0},
     // 横折 ending with a brush tick too short for a hook (亩 4, 佃 4).
-    {7, {form_piece(10, 10, 20, 20), form_piece(-95, -95, 20, 20), form_piece(150, 150, 25, 25, true, 0, 60)}, 3, 0.0},
+    {7,
+     {form_piece(10, 10, 20, 20), form_piece(-95, -95, 20, 20), form_piece(150, 150, 25, 25, true, 0, 75)},
+     3,
+     0.0},
     // 竖弯钩 whose bend is a corner.
     {24, {form_piece(-95, -95, 20, 20), form_piece(0, 0, 25, 25), form_piece(90, 90, 25, 25, true)}, 3, 0.0},
     // 竖折折钩 whose second corner is rounded into the bend.
@@ -306,10 +319,14 @@ constexpr ObservedForm kObservedForms[] = {
 // Extra costs of the variants without a cnchar letter of their own, so that they win only clearly.
 double prior_cost(int id) {
   switch (id) {
-    case 34: return 0.3;  // 长点
-    case 37: return 0.5;  // 提捺
-    case 23: return 0.5;  // 竖弯: in the data mostly a 竖弯钩 whose hook the median lacks
-    default: return 0.0;
+    case 34:
+      return 0.3;  // 长点
+    case 37:
+      return 0.5;  // 提捺
+    case 23:
+      return 0.5;  // 竖弯: in the data mostly a 竖弯钩 whose hook the median lacks
+    default:
+      return 0.0;
   }
 }
 
@@ -318,9 +335,10 @@ constexpr double kHookFraction = 0.35;
 
 // Template cost (paper section 3.1, classification by template matching): squared direction errors
 // in units of the tolerances, plus soft penalties for lengths and piece counts.
-double template_cost(std::span<const StrokePiece> pieces, double total, std::span<const StrokePieceTemplate> t) {
+double template_cost(std::span<const StrokePiece> pieces, double total,
+                     std::span<const StrokePieceTemplate> t) {
   constexpr double kPieceCountCost = 4.0;
-  constexpr double kLengthScale = 40.0;    // data units per unit of cost (squared)
+  constexpr double kLengthScale = 40.0;  // data units per unit of cost (squared)
   constexpr double kFractionScale = 0.1;
   const std::size_t common = std::min(pieces.size(), t.size());
   double cost = kPieceCountCost * static_cast<double>(std::max(pieces.size(), t.size()) - common);
@@ -387,12 +405,13 @@ int classify_pieces(std::span<const StrokePiece> all_pieces) {
     }
   };
   for (const TypicalStroke& t : typical_strokes()) consider(t.id, t.pieces, 0.0);
-  for (const ObservedForm& f : kObservedForms) consider(f.id, std::span(f.pieces.data(), f.count), f.extra_cost);
+  for (const ObservedForm& f : kObservedForms)
+    consider(f.id, std::span(f.pieces.data(), f.count), f.extra_cost);
   return pieces.size() == 1 ? resolve_short_vertical(pieces.front(), best_id) : best_id;
 }
 
-Character fit_character(char32_t code_point, const std::vector<std::vector<Vec2>>& medians, std::string source,
-                        const FitOptions& options) {
+Character fit_character(char32_t code_point, const std::vector<std::vector<Vec2>>& medians,
+                        std::string source, const FitOptions& options) {
   Character character;
   character.code_point = code_point;
   character.source = std::move(source);
