@@ -304,7 +304,9 @@ constexpr ObservedForm kObservedForms[] = {
     // 横折折撇 (辶 2) whose small zig-zag makes no corners: down-left turning down-right.
     {17, {form_piece(10, 10, 20, 20), form_piece(-110, -75, 20, 20), kNone}, 2, 1.0},
     // 竖弯钩 whose hook the median lacks (七 2, 他 5): a single bend from down to right.
-    {24, {form_piece(-95, 0, 25, 25), kNone, kNone}, 1, 0.0},
+    {24, {form_piece(-85, 35, 20, 20), kNone, kNone}, 1, 0.0},
+    // 撇点 of 女 as a left part (妣 1, 姥 1): one bend from down-left to down-right.
+    {28, {form_piece(-100, -50, 10, 10), kNone, kNone}, 1, 0.0},
     // 横折 ending with a brush tick too short for a hook (亩 4, 佃 4).
     {7,
      {form_piece(10, 10, 20, 20), form_piece(-95, -95, 20, 20), form_piece(150, 150, 25, 25, true, 0, 75)},
@@ -325,6 +327,8 @@ double prior_cost(int id) {
       return 0.5;  // 提捺
     case 23:
       return 0.5;  // 竖弯: in the data mostly a 竖弯钩 whose hook the median lacks
+    case 39:
+      return 1.0;  // 竖弯左: rare; a curved 撇 must not fall into it
     default:
       return 0.0;
   }
