@@ -190,7 +190,7 @@ CncharValidation validate_against_cnchar(const CharacterLibrary& library,
       if (features) {
         *features << encode_utf8(cp) << ' ' << s << ' ' << letters[s] << ' ' << o.ids[s];
         for (const auto& p : o.pieces[s])
-          *features << ' ' << p.start_direction_deg << ' ' << p.end_direction_deg << ' ' << p.length;
+          *features << ' ' << p.start_direction_deg << ' ' << p.end_direction_deg << ' ' << p.length << ' ' << p.exit_turn_deg;
         *features << '\n';
       }
       if (cnchar_letter(o.ids[s]) == letters[s]) {

@@ -52,7 +52,7 @@ struct CncharValidation {
 /// Fits every character of `labels` found in `library` (with `options`) on `threads` threads and
 /// compares stroke by stroke. Deterministic: the result does not depend on `threads`. When `features` is
 /// given, writes one line per compared stroke: character, stroke index, cnchar letter, typical ID, then
-/// start direction, end direction and length of each piece (for studying the classifier).
+/// start direction, end direction, length and exit turn of each piece (for studying the classifier).
 CncharValidation validate_against_cnchar(const CharacterLibrary& library,
                                          const std::map<char32_t, std::string>& labels,
                                          const FitOptions& options, unsigned threads,

@@ -380,6 +380,20 @@ int resolve_short_vertical(const StrokePiece& p, int best_id) {
   return best_id == kD2 ? kP : best_id;
 }
 
+// A Kai 横 ends with a press that bends its end down; a 提 flicks up straight. Where their directions
+// overlap (a 横 rising steeply, a 提 starting flat), the turn at the end decides. Measured over the
+// corpus (docs/classification.md).
+int resolve_horizontal_or_tick(const StrokePiece& p, int best_id) {
+  constexpr int kH = 1, kT = 6;
+  if (p.start_direction_deg <= -10.0 || p.start_direction_deg >= 45.0) return best_id;
+  constexpr double kPressDeg = -8.0;
+  constexpr double kStraightDeg = 5.0;
+  constexpr double kRisingEndDeg = 17.0;
+  if (best_id == kT && p.exit_turn_deg <= kPressDeg) return kH;
+  if (best_id == kH && std::abs(p.exit_turn_deg) < kStraightDeg && p.end_direction_deg >= kRisingEndDeg) return kT;
+  return best_id;
+}
+
 }  // namespace
 
 int classify_pieces(std::span<const StrokePiece> all_pieces) {
@@ -411,7 +425,8 @@ int classify_pieces(std::span<const StrokePiece> all_pieces) {
   for (const TypicalStroke& t : typical_strokes()) consider(t.id, t.pieces, 0.0);
   for (const ObservedForm& f : kObservedForms)
     consider(f.id, std::span(f.pieces.data(), f.count), f.extra_cost);
-  return pieces.size() == 1 ? resolve_short_vertical(pieces.front(), best_id) : best_id;
+  if (pieces.size() != 1) return best_id;
+  return resolve_horizontal_or_tick(pieces.front(), resolve_short_vertical(pieces.front(), best_id));
 }
 
 Character fit_character(char32_t code_point, const std::vector<std::vector<Vec2>>& medians,
