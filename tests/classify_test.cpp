@@ -127,7 +127,7 @@ TEST_CASE("Classification agrees with cnchar-order on fixed labelled samples", "
   const auto embedded = cli::validate_against_cnchar(CharacterLibrary::embedded(), embedded_labels, {}, 1);
   CHECK(embedded.compared == embedded_labels.size());
   CHECK(embedded.strokes >= 250);
-  CHECK(embedded.agreement() >= 0.95);
+  CHECK(embedded.agreement() >= 0.96);
   // 121 real characters (every 56th of those both sources cover), copied verbatim from the full data.
   const auto sample_labels = cli::parse_cnchar_orders(read_text(data / "cnchar_sample_large_labels.json"),
                                                       "cnchar_sample_large_labels.json");
@@ -136,7 +136,7 @@ TEST_CASE("Classification agrees with cnchar-order on fixed labelled samples", "
   CHECK(sample.compared == 121);
   CHECK(sample.count_mismatch.empty());
   CHECK(sample.strokes >= 1300);
-  CHECK(sample.agreement() >= 0.94);
+  CHECK(sample.agreement() >= 0.965);  // 96.98 % measured; the whole corpus gives 97.0 %
   // Deterministic whatever the thread count.
   CHECK(cli::validate_against_cnchar(sample_library, sample_labels, {}, 1).agreeing == sample.agreeing);
   // The report names the figures.
@@ -163,6 +163,23 @@ TEST_CASE("classify_pieces recognises canonical pieces and rejects an empty stro
   // A short down-right first piece is the brush's entry, not part of the shape: still a 撇.
   CHECK(classify_pieces(std::vector{piece(-45, -45, 50), piece(-125, -140, 400)}) == typical("P"));
   CHECK_THROWS_AS(classify_pieces(std::vector<StrokePiece>{}), InvalidArgument);
+}
+
+TEST_CASE("classify_pieces: the end's turn settles 左点 vs 竖, 横 vs 提, 横 vs flat 捺", "[classify]") {
+  const auto piece = [](double start, double end, double length, double exit_turn) {
+    StrokePiece p;
+    p.start_direction_deg = start;
+    p.end_direction_deg = end;
+    p.length = length;
+    p.exit_turn_deg = exit_turn;
+    return std::vector{p};
+  };
+  CHECK(classify_pieces(piece(-95, -105, 180, 12)) == typical("D2"));  // curls back: 冖's left dot
+  CHECK(classify_pieces(piece(-95, -105, 180, -3)) == typical("S"));   // no curl: 艹's short vertical
+  CHECK(classify_pieces(piece(5, 20, 300, 0)) == typical("T"));        // straight flick
+  CHECK(classify_pieces(piece(5, 20, 300, -15)) == typical("H"));      // the 横's press at its end
+  CHECK(classify_pieces(piece(-3, -3, 800, 15)) == typical("TN"));     // flat 捺: the end turns up
+  CHECK(classify_pieces(piece(-3, -3, 800, -15)) == typical("H"));
 }
 
 TEST_CASE("Fitting: brush entry and exit hooks are trimmed", "[fitting]") {

@@ -380,9 +380,9 @@ int resolve_short_vertical(const StrokePiece& p, int best_id) {
   return best_id == kD2 ? kP : best_id;
 }
 
-// A Kai 横 ends with a press that bends its end down; a 提 flicks up straight; a flat 捺 turns up. Where their directions
-// overlap (a 横 rising steeply, a 提 starting flat), the turn at the end decides. Measured over the
-// corpus (docs/classification.md).
+// A Kai 横 ends with a press that bends its end down; a 提 flicks up straight; a flat 捺 turns up. Where
+// their directions overlap (a 横 rising steeply, a 提 starting flat), the turn at the end decides. Measured
+// over the corpus (docs/classification.md).
 int resolve_horizontal_or_tick(const StrokePiece& p, int best_id) {
   constexpr int kH = 1, kT = 6;
   if (p.start_direction_deg <= -10.0 || p.start_direction_deg >= 45.0) return best_id;
@@ -390,7 +390,8 @@ int resolve_horizontal_or_tick(const StrokePiece& p, int best_id) {
   constexpr double kStraightDeg = 5.0;
   constexpr double kRisingEndDeg = 17.0;
   if (best_id == kT && p.exit_turn_deg <= kPressDeg) return kH;
-  if (best_id == kH && std::abs(p.exit_turn_deg) < kStraightDeg && p.end_direction_deg >= kRisingEndDeg) return kT;
+  if (best_id == kH && std::abs(p.exit_turn_deg) < kStraightDeg && p.end_direction_deg >= kRisingEndDeg)
+    return kT;
   // A long flat stroke whose end turns up is the flat 捺 (平捺, 之 3, 辶's last): the 横's end turns down.
   constexpr int kTN = 37;
   constexpr double kFlatNaLength = 500.0;

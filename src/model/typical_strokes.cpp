@@ -50,7 +50,8 @@ constexpr P kT[] = {piece(35, 35, 25)};
 constexpr P kHZ[] = {piece(E, E), piece(-105, -105, 12, 15)};
 constexpr P kHP[] = {piece(E, E), piece(-125, -140, 15, 20, false, 300)};
 constexpr P kHG[] = {piece(E, E), piece(-130, -133, 8, 15, false, 0, 250)};
-constexpr P kHZG[] = {piece(E, E), piece(S, S), piece(150, 150, 25, 25, true, 80)};  // hook ≥ 80: shorter is a tick
+constexpr P kHZG[] = {piece(E, E), piece(S, S),
+                      piece(150, 150, 25, 25, true, 80)};  // hook ≥ 80: shorter is a tick
 constexpr P kHZT[] = {piece(E, E), piece(S, S), hook_piece(45)};
 constexpr P kHZW[] = {piece(E, E), piece(S, 0, 25)};
 constexpr P kHZZ[] = {piece(E, E), piece(S, S, 20, 20, true), piece(E, E)};
