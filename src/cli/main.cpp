@@ -17,7 +17,7 @@ constexpr const char* kUsage =
     "                       print the character's model (paper Table 3); --svg draws it (Fig. 13)\n"
     "  strokes [--markdown FILE] [--json]\n"
     "                       the table of the 39 typical strokes\n"
-    "  corpus validate --data DIR --cnchar FILE [--markdown FILE] [--json]\n"
+    "  corpus validate --data DIR --cnchar FILE [--markdown FILE] [--json] [--threads N] [--features FILE]\n"
     "                       per-stroke agreement of the classification with cnchar-order\n"
     "  devices              list the haptic devices found (simulated, Phantoms, OpenHaptics)\n"
     "  bench nearest [--json] [--markdown FILE] [--queries N] [--seed S]\n"

@@ -318,7 +318,8 @@ constexpr ObservedForm kObservedForms[] = {
     {27, {form_piece(-95, -95, 20, 20), form_piece(15, -80, 25, 25), kFormHookLeft}, 3, 0.0},
 };
 
-// Extra costs of the variants without a cnchar letter of their own, so that they win only clearly.
+// Extra costs of typical strokes that are rare in the data or that the medians mimic, so that they win
+// only clearly.
 double prior_cost(int id) {
   switch (id) {
     case 34:
@@ -359,10 +360,6 @@ double template_cost(std::span<const StrokePiece> pieces, double total,
   }
   return cost;
 }
-
-}  // namespace
-
-namespace {
 
 // A short stroke falling slightly to the left is a 左点 (点2: 冖 1, 宀 2, 心 1, 忄 1), a short vertical
 // (艹) or a short 撇; their directions overlap. The 左点 ends curling back toward the vertical, the
@@ -435,8 +432,8 @@ int classify_pieces(std::span<const StrokePiece> all_pieces) {
   return resolve_horizontal_or_tick(pieces.front(), resolve_short_vertical(pieces.front(), best_id));
 }
 
-Character fit_character(char32_t code_point, const std::vector<std::vector<Vec2>>& medians,
-                        std::string source, const FitOptions& options) {
+Character fit_character(char32_t code_point, const std::vector<std::vector<Vec2>>& medians, std::string source,
+                        const FitOptions& options) {
   Character character;
   character.code_point = code_point;
   character.source = std::move(source);
