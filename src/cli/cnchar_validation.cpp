@@ -76,6 +76,25 @@ constexpr LetterName kLetterNames[] = {
     {'t', "弯钩"},     {'y', "斜钩|卧钩"},
 };
 
+// How classify_pieces decides (docs/classification.md, section 2).
+constexpr const char* kMethod = R"(## How strokes are classified
+
+`classify_pieces` (src/model/fitting.cpp) takes the corner-to-corner pieces of a fitted stroke (start
+and end directions on the piece's interior, length, turn of its last fifth). It ignores a short
+down-right first piece (the brush's entry), then picks the least cost over the 39 templates of
+docs/typical-strokes.md and a few observed forms of them (a corner rounded into a bend, a hook the
+median lacks, a 横折 ending with a brush tick): squared direction errors in units of the templates'
+tolerances plus soft penalties for piece counts, hook fractions and lengths. Four rules settle
+single-piece strokes whose directions overlap, each measured over this corpus: a short stroke falling
+slightly left is a 左点 when its end curls back toward the vertical, else a 竖 when it ends steeper
+than -112 degrees; a short stroke falling steeply right is a 点 when its end turns clockwise, else a
+竖; a 横 ends with a press (its end turns down), a 提 flicks up straight; a long flat stroke whose end
+turns up is the flat 捺. The templates and rules were tuned on the whole corpus; the tests assert the
+agreement on a fixed sample of 121 characters (tests/data/hanzi-writer-sample). The figures after each
+change are in docs/classification-log.md.
+
+)";
+
 std::string percent(std::size_t part, std::size_t whole) {
   char text[32];
   std::snprintf(text, sizeof text, "%.2f %%",
@@ -270,29 +289,7 @@ std::string cnchar_validation_markdown(const CncharValidation& r, const std::str
   line("calligraphy corpus validate --data DIR --cnchar FILE --markdown docs/classification.md");
   line("```");
   line("");
-  line("## How strokes are classified");
-  line("");
-  line(
-      "`classify_pieces` (src/model/fitting.cpp) takes the corner-to-corner pieces of a fitted stroke (start "
-      "and");
-  line(
-      "end directions on the piece's interior, length, turn of its last fifth). It ignores a short "
-      "down-right");
-  line("first piece (the brush's entry), then picks the least cost over the 39 templates of");
-  line("docs/typical-strokes.md and a few observed forms of them (a corner rounded into a bend, a hook the");
-  line("median lacks, a 横折 ending with a brush tick): squared direction errors in units of the templates'");
-  line("tolerances plus soft penalties for piece counts, hook fractions and lengths. Three rules settle");
-  line(
-      "single-piece strokes whose directions overlap, each measured over this corpus: a short stroke "
-      "falling");
-  line("slightly left is a 左点 when its end curls back toward the vertical, else a 竖 when it ends steeper");
-  line(
-      "than -112 degrees; a 横 ends with a press (its end turns down), a 提 flicks up straight; a long flat");
-  line(
-      "stroke whose end turns up is the flat 捺. The templates and rules were tuned on the whole corpus; "
-      "the");
-  line("tests assert the agreement on a fixed sample of 121 characters (tests/data/hanzi-writer-sample).");
-  line("");
+  md += kMethod;
   line("## Figures");
   line("");
   line("| | |");

@@ -377,6 +377,16 @@ int resolve_short_vertical(const StrokePiece& p, int best_id) {
   return best_id == kD2 ? kP : best_id;
 }
 
+// A short stroke falling steeply to the right is a short vertical (the left side of a small 口) or a
+// 点; a 点's end turns clockwise, the vertical stays straight. Measured over the corpus.
+int resolve_dot_or_short_vertical(const StrokePiece& p, int best_id) {
+  constexpr int kS = 2, kD = 4;
+  const bool in_zone = best_id == kS && p.start_direction_deg > -65.0 && p.start_direction_deg < -45.0 &&
+                       p.end_direction_deg > -85.0 && p.end_direction_deg < -65.0 && p.length < 300.0;
+  constexpr double kDotTurnDeg = -8.0;
+  return in_zone && p.exit_turn_deg <= kDotTurnDeg ? kD : best_id;
+}
+
 // A Kai 横 ends with a press that bends its end down; a 提 flicks up straight; a flat 捺 turns up. Where
 // their directions overlap (a 横 rising steeply, a 提 starting flat), the turn at the end decides. Measured
 // over the corpus (docs/classification.md).
@@ -429,7 +439,9 @@ int classify_pieces(std::span<const StrokePiece> all_pieces) {
   for (const ObservedForm& f : kObservedForms)
     consider(f.id, std::span(f.pieces.data(), f.count), f.extra_cost);
   if (pieces.size() != 1) return best_id;
-  return resolve_horizontal_or_tick(pieces.front(), resolve_short_vertical(pieces.front(), best_id));
+  const StrokePiece& only = pieces.front();
+  return resolve_horizontal_or_tick(
+      only, resolve_dot_or_short_vertical(only, resolve_short_vertical(only, best_id)));
 }
 
 Character fit_character(char32_t code_point, const std::vector<std::vector<Vec2>>& medians, std::string source,
