@@ -378,6 +378,7 @@ PYBIND11_MODULE(_calligraphy, m) {
     d["unicode"] = s.unicode != 0 ? py::object(py::str(encode_utf8(s.unicode))) : py::object(py::none());
     d["compound"] = s.compound;
     d["default_attraction"] = s.default_attraction;
+    d["corner_attraction"] = s.corner_attraction;
     typical.append(d);
   }
   m.attr("TYPICAL_STROKES") = typical;

@@ -32,6 +32,9 @@ struct StrokePiece {
   double start_direction_deg = 0.0;  ///< direction of motion at the piece's start, y-up degrees
   double end_direction_deg = 0.0;
   double length = 0.0;               ///< data units
+  /// Turn of the last fifth of the piece against the fifth to third before it (degrees, counter-
+  /// clockwise positive): the curl back toward the vertical that ends a 左点.
+  double exit_turn_deg = 0.0;
   std::size_t first_element = 0;     ///< elements [first_element, end_element) form the piece
   std::size_t end_element = 0;
 };
@@ -47,8 +50,12 @@ struct FittedStroke {
 /// Throws InvalidArgument for non-finite points or options out of range.
 FittedStroke fit_stroke(std::span<const Vec2> median, const FitOptions& options = {});
 
-/// Provisional typical-stroke classification of fitted pieces by template matching (directions
-/// within `kTypicalStrokeDirectionToleranceDeg`, piece counts, hook lengths). Returns an ID 1-39.
+/// Typical-stroke classification of fitted pieces by template matching: the least cost over the 39
+/// templates of typical_strokes.hpp and a few observed forms of them, the cost being the squared
+/// direction errors in units of the templates' tolerances plus soft penalties for piece counts, hook
+/// fractions and lengths. A short down-right first piece is ignored as the brush's entry. Validated
+/// against cnchar-order (docs/classification.md). Returns an ID 1-39; throws InvalidArgument when
+/// `pieces` is empty.
 int classify_pieces(std::span<const StrokePiece> pieces);
 
 /// Fits every median of a character, in stroke order.

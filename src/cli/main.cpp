@@ -10,11 +10,24 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: calligraphy <command> [options]\n"
-    "  trial CHARS [--device NAME] [--guidance on|off] [--writer novice|skilled] [--seed N]\n"
-    "              [--data DIR] [--json FILE] [--svg FILE] [--csv FILE]\n"
-    "                       run a guided writing trial at 1 kHz on a device (default: simulated)\n"
-    "  model CHAR [--json] [--data DIR]\n"
-    "                       print the character's model (paper Table 3)\n"
+    "  trial CHARS [--device NAME] [--guidance on|off] [--writer novice|skilled] [--seed N]
+"
+    "              [--data DIR] [--json FILE] [--svg FILE] [--csv FILE]
+"
+    "                       run a guided writing trial at 1 kHz on a device (default: simulated)
+"
+    "  model CHAR [--json] [--svg FILE] [--data DIR]
+"
+    "                       print the character's model (paper Table 3); --svg draws it (Fig. 13)
+"
+    "  strokes [--markdown FILE] [--json]
+"
+    "                       the table of the 39 typical strokes
+"
+    "  corpus validate --data DIR --cnchar FILE [--markdown FILE] [--json] [--threads N] [--features FILE]
+"
+    "                       per-stroke agreement of the classification with cnchar-order
+"
     "  devices              list the haptic devices found (simulated, Phantoms, OpenHaptics)\n"
     "  bench nearest [--json] [--markdown FILE] [--queries N] [--seed S]\n"
     "                       accuracy and speed of the nearest-point methods\n"
@@ -35,6 +48,8 @@ int main(int argc, char** argv) {
     if (command == "trial") return command_trial(args);
     if (command == "model") return command_model(args);
     if (command == "devices") return command_devices(args);
+    if (command == "strokes") return command_strokes(args);
+    if (command == "corpus" && !args.empty() && args[0] == "validate") return command_corpus_validate(args);
     if (command == "bench" && !args.empty() && args[0] == "nearest") return command_bench_nearest(args);
     if (command == "bench" && !args.empty() && args[0] == "jumps") return command_bench_jumps(args);
     std::fprintf(stderr, "calligraphy: error: unknown command '%s'\n%s", command.c_str(), kUsage);

@@ -5,6 +5,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -64,7 +65,10 @@ std::vector<std::size_t> find_corners(std::vector<Vec2>& pts, const FitOptions& 
       }
     }
     if (first > last) continue;
-    if (!clusters.empty() && first <= clusters.back().second + 1 && turn[first] * turn[clusters.back().first] > 0.0) {
+    // Adjacent windows extend one corner; two corners joined by a long straight segment (a vertical
+    // and its hook) stay apart even when no vertex lies between them.
+    if (!clusters.empty() && first <= clusters.back().second + 1 && turn[first] * turn[clusters.back().first] > 0.0 &&
+        arc[first] - arc[clusters.back().second] <= options.corner_window) {
       clusters.back().second = std::max(clusters.back().second, last);
     } else if (clusters.empty() || first > clusters.back().second) {
       clusters.emplace_back(first, last);
@@ -237,6 +241,7 @@ FittedStroke fit_stroke(std::span<const Vec2> median, const FitOptions& options)
       info.start_direction_deg = chord_direction(piece, 0.1, 0.4);
       info.end_direction_deg = chord_direction(piece, 0.6, 0.95);
       info.length = polyline_length(piece);
+      info.exit_turn_deg = wrap_deg(chord_direction(piece, 0.8, 1.0) - chord_direction(piece, 0.5, 0.8));
       fitted.pieces.push_back(info);
     }
   }
@@ -249,42 +254,194 @@ FittedStroke fit_stroke(std::span<const Vec2> median, const FitOptions& options)
   for (const Vec2& p : pts) fitted.max_deviation = std::max(fitted.max_deviation, distance_to_polyline(p, curve));
 
   fitted.stroke.typical_id = classify_pieces(fitted.pieces);
-  fitted.stroke.attraction_factors.assign(fitted.stroke.feature_point_count(),
-                                          typical_stroke(fitted.stroke.typical_id).default_attraction);
+  // Paper eq. 8: an attraction factor per feature point; corners (piece joints) pull harder so that the
+  // writer is guided through the turn.
+  const TypicalStroke& type = typical_stroke(fitted.stroke.typical_id);
+  fitted.stroke.attraction_factors.assign(fitted.stroke.feature_point_count(), type.default_attraction);
+  for (std::size_t k = 1; k < fitted.pieces.size(); ++k) {
+    fitted.stroke.attraction_factors[fitted.pieces[k].first_element] = type.corner_attraction;
+  }
   return fitted;
 }
 
+namespace {
+
+// Forms in which hanzi-writer-data's medians show some typical strokes besides their canonical
+// template, found by comparing with cnchar-order's labels (docs/classification.md): a corner rounded
+// so widely that it is fitted as one bent piece, a zig-zag that is too small to make corners.
+struct ObservedForm {
+  int id;
+  std::array<StrokePieceTemplate, 3> pieces;
+  std::size_t count;
+  double extra_cost;  // prior against the form (units of the template cost)
+};
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kBentDeg = 15.0;  // as in typical_strokes.cpp
+constexpr StrokePieceTemplate form_piece(double start, double end, double start_tol, double end_tol,
+                                         bool hook = false, double min_length = 0.0,
+                                         double max_length = kInf) {
+  return {(end - start < kBentDeg && start - end < kBentDeg) ? ElementKind::line : ElementKind::bezier,
+          start,
+          end,
+          start_tol,
+          end_tol,
+          hook,
+          min_length,
+          max_length};
+}
+constexpr StrokePieceTemplate kFormHookLeft = form_piece(150, 150, 25, 25, true);
+constexpr StrokePieceTemplate kNone{};
+constexpr ObservedForm kObservedForms[] = {
+    // 提 starting flat and rising at its end (乖 6, 些 4).
+    {6, {form_piece(0, 27, 12, 6), kNone, kNone}, 1, 0.0},
+    // Short vertical leaning right, as the left side of a small 口 (串 1, 京 3).
+    {2, {form_piece(-58, -80, 14, 5, false, 150, 320), kNone, kNone}, 1, 0.0},
+    // 横撇弯钩 (阝) whose 撇 and 弯 merge into one bent piece (哪 8, 啊 4).
+    {16,
+     {form_piece(10, 10, 20, 20), form_piece(-110, -73, 15, 10), form_piece(160, 160, 25, 25, true)},
+     3,
+     0.0},
+    // 横折折撇 (辶 2) whose small zig-zag makes no corners: down-left turning down-right.
+    {17, {form_piece(10, 10, 20, 20), form_piece(-110, -75, 20, 20), kNone}, 2, 1.0},
+    // 竖弯钩 whose hook the median lacks (七 2, 他 5): a single bend from down to right.
+    {24, {form_piece(-85, 35, 20, 20), kNone, kNone}, 1, 0.0},
+    // 撇点 of 女 as a left part (妣 1, 姥 1): one bend from down-left to down-right.
+    {28, {form_piece(-100, -50, 10, 10), kNone, kNone}, 1, 0.0},
+    // 横折 ending with a brush tick too short for a hook (亩 4, 佃 4).
+    {7,
+     {form_piece(10, 10, 20, 20), form_piece(-95, -95, 20, 20), form_piece(150, 150, 25, 25, true, 0, 75)},
+     3,
+     0.0},
+    // 竖弯钩 whose bend is a corner.
+    {24, {form_piece(-95, -95, 20, 20), form_piece(0, 0, 25, 25), form_piece(90, 90, 25, 25, true)}, 3, 0.0},
+    // 竖折折钩 whose second corner is rounded into the bend.
+    {27, {form_piece(-95, -95, 20, 20), form_piece(15, -80, 25, 25), kFormHookLeft}, 3, 0.0},
+};
+
+// Extra costs of typical strokes that are rare in the data or that the medians mimic, so that they win
+// only clearly.
+double prior_cost(int id) {
+  switch (id) {
+    case 34:
+      return 0.3;  // 长点
+    case 37:
+      return 0.5;  // 提捺
+    case 23:
+      return 0.5;  // 竖弯: in the data mostly a 竖弯钩 whose hook the median lacks
+    case 39:
+      return 1.0;  // 竖弯左: rare; a curved 撇 must not fall into it
+    default:
+      return 0.0;
+  }
+}
+
+// A hook or tick is at most this fraction of its stroke's (entry-trimmed) length.
+constexpr double kHookFraction = 0.35;
+
+// Template cost (paper section 3.1, classification by template matching): squared direction errors
+// in units of the tolerances, plus soft penalties for lengths and piece counts.
+double template_cost(std::span<const StrokePiece> pieces, double total,
+                     std::span<const StrokePieceTemplate> t) {
+  constexpr double kPieceCountCost = 4.0;
+  constexpr double kLengthScale = 40.0;  // data units per unit of cost (squared)
+  constexpr double kFractionScale = 0.1;
+  const std::size_t common = std::min(pieces.size(), t.size());
+  double cost = kPieceCountCost * static_cast<double>(std::max(pieces.size(), t.size()) - common);
+  for (std::size_t k = 0; k < common; ++k) {
+    const StrokePiece& p = pieces[k];
+    const StrokePieceTemplate& q = t[k];
+    const double ds = wrap_deg(p.start_direction_deg - q.start_direction_deg) / q.start_tolerance_deg;
+    const double de = wrap_deg(p.end_direction_deg - q.end_direction_deg) / q.end_tolerance_deg;
+    cost += 0.5 * (ds * ds + de * de);
+    const double fraction = total > 0.0 ? p.length / total : 0.0;
+    if (q.hook && fraction > kHookFraction) cost += std::pow((fraction - kHookFraction) / kFractionScale, 2);
+    if (p.length < q.min_length) cost += std::pow((q.min_length - p.length) / kLengthScale, 2);
+    if (p.length > q.max_length) cost += std::pow((p.length - q.max_length) / kLengthScale, 2);
+  }
+  return cost;
+}
+
+// A short stroke falling slightly to the left is a 左点 (点2: 冖 1, 宀 2, 心 1, 忄 1), a short vertical
+// (艹) or a short 撇; their directions overlap. The 左点 ends curling back toward the vertical, the
+// others do not; of those, a stroke ending steeper than -112 degrees is a vertical. Measured over
+// the corpus (docs/classification.md).
+int resolve_short_vertical(const StrokePiece& p, int best_id) {
+  constexpr int kS = 2, kP = 3, kD2 = 33;
+  const bool in_zone = p.start_direction_deg > -118.0 && p.start_direction_deg < -85.0 && p.length < 280.0 &&
+                       p.end_direction_deg > -125.0 && p.end_direction_deg < -95.0;
+  if (!in_zone) return best_id;
+  constexpr double kCurlDeg = 8.0;
+  constexpr double kVerticalEndDeg = -112.0;
+  if (p.exit_turn_deg >= kCurlDeg) return kD2;
+  if (p.end_direction_deg > kVerticalEndDeg) return kS;
+  return best_id == kD2 ? kP : best_id;
+}
+
+// A short stroke falling steeply to the right is a short vertical (the left side of a small 口) or a
+// 点; a 点's end turns clockwise, the vertical stays straight. Measured over the corpus.
+int resolve_dot_or_short_vertical(const StrokePiece& p, int best_id) {
+  constexpr int kS = 2, kD = 4;
+  const bool in_zone = best_id == kS && p.start_direction_deg > -65.0 && p.start_direction_deg < -45.0 &&
+                       p.end_direction_deg > -85.0 && p.end_direction_deg < -65.0 && p.length < 300.0;
+  constexpr double kDotTurnDeg = -8.0;
+  return in_zone && p.exit_turn_deg <= kDotTurnDeg ? kD : best_id;
+}
+
+// A Kai 横 ends with a press that bends its end down; a 提 flicks up straight; a flat 捺 turns up. Where
+// their directions overlap (a 横 rising steeply, a 提 starting flat), the turn at the end decides. Measured
+// over the corpus (docs/classification.md).
+int resolve_horizontal_or_tick(const StrokePiece& p, int best_id) {
+  constexpr int kH = 1, kT = 6;
+  if (p.start_direction_deg <= -10.0 || p.start_direction_deg >= 45.0) return best_id;
+  constexpr double kPressDeg = -8.0;
+  constexpr double kStraightDeg = 5.0;
+  constexpr double kRisingEndDeg = 17.0;
+  if (best_id == kT && p.exit_turn_deg <= kPressDeg) return kH;
+  if (best_id == kH && std::abs(p.exit_turn_deg) < kStraightDeg && p.end_direction_deg >= kRisingEndDeg)
+    return kT;
+  // A long flat stroke whose end turns up is the flat 捺 (平捺, 之 3, 辶's last): the 横's end turns down.
+  constexpr int kTN = 37;
+  constexpr double kFlatNaLength = 500.0;
+  constexpr double kFlatNaTurnDeg = 10.0;
+  if (best_id == kH && p.length >= kFlatNaLength && p.exit_turn_deg >= kFlatNaTurnDeg) return kTN;
+  return best_id;
+}
+
+}  // namespace
+
 int classify_pieces(std::span<const StrokePiece> all_pieces) {
-  // No typical stroke starts with a short piece: a short first piece is the brush's entry.
+  if (all_pieces.empty()) throw InvalidArgument("classify_pieces: no pieces");
+  // No typical stroke starts with a short piece going down-right before turning: that is the brush's
+  // entry (the press before a 撇 or a vertical), not part of the stroke's shape.
   std::span<const StrokePiece> pieces = all_pieces;
   double whole = 0.0;
   for (const auto& p : all_pieces) whole += p.length;
-  if (pieces.size() > 1 && pieces.front().length < 0.2 * whole) pieces = pieces.subspan(1);
+  const StrokePiece& first = all_pieces.front();
+  constexpr double kEntryFraction = 0.35;
+  constexpr double kEntryLength = 120.0;
+  if (pieces.size() > 1 && first.length < kEntryFraction * whole && first.length < kEntryLength &&
+      first.start_direction_deg > -85.0 && first.start_direction_deg < -5.0) {
+    pieces = pieces.subspan(1);
+  }
   double total = 0.0;
   for (const auto& p : pieces) total += p.length;
-  // Dots are short strokes; hooks and ticks are short relative to their stroke (data units).
-  constexpr double kDotLength = 230.0;
-  constexpr double kShortFraction = 0.3;
-  constexpr double kShortMismatchCost = 40.0;
+
   int best_id = 1;
   double best_cost = std::numeric_limits<double>::infinity();
-  for (const TypicalStroke& t : typical_strokes()) {
-    const std::size_t count = std::min(t.pieces.size(), pieces.size());
-    double cost = 90.0 * static_cast<double>(std::max(t.pieces.size(), pieces.size()) - count);
-    for (std::size_t k = 0; k < count; ++k) {
-      const StrokePiece& p = pieces[k];
-      const StrokePieceTemplate& q = t.pieces[k];
-      cost += std::abs(wrap_deg(p.start_direction_deg - q.start_direction_deg));
-      cost += std::abs(wrap_deg(p.end_direction_deg - q.end_direction_deg));
-      const bool is_short = pieces.size() == 1 ? p.length < kDotLength : p.length < kShortFraction * total;
-      if (is_short != q.short_piece) cost += kShortMismatchCost;
-    }
+  const auto consider = [&](int id, std::span<const StrokePieceTemplate> t, double extra) {
+    const double cost = extra + prior_cost(id) + template_cost(pieces, total, t);
     if (cost < best_cost) {
       best_cost = cost;
-      best_id = t.id;
+      best_id = id;
     }
-  }
-  return best_id;
+  };
+  for (const TypicalStroke& t : typical_strokes()) consider(t.id, t.pieces, 0.0);
+  for (const ObservedForm& f : kObservedForms)
+    consider(f.id, std::span(f.pieces.data(), f.count), f.extra_cost);
+  if (pieces.size() != 1) return best_id;
+  const StrokePiece& only = pieces.front();
+  return resolve_horizontal_or_tick(
+      only, resolve_dot_or_short_vertical(only, resolve_short_vertical(only, best_id)));
 }
 
 Character fit_character(char32_t code_point, const std::vector<std::vector<Vec2>>& medians, std::string source,
