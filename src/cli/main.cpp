@@ -10,24 +10,15 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: calligraphy <command> [options]\n"
-    "  trial CHARS [--device NAME] [--guidance on|off] [--writer novice|skilled] [--seed N]
-"
-    "              [--data DIR] [--json FILE] [--svg FILE] [--csv FILE]
-"
-    "                       run a guided writing trial at 1 kHz on a device (default: simulated)
-"
-    "  model CHAR [--json] [--svg FILE] [--data DIR]
-"
-    "                       print the character's model (paper Table 3); --svg draws it (Fig. 13)
-"
-    "  strokes [--markdown FILE] [--json]
-"
-    "                       the table of the 39 typical strokes
-"
-    "  corpus validate --data DIR --cnchar FILE [--markdown FILE] [--json] [--threads N] [--features FILE]
-"
-    "                       per-stroke agreement of the classification with cnchar-order
-"
+    "  trial CHARS [--device NAME] [--guidance on|off] [--writer novice|skilled] [--seed N]\n"
+    "              [--data DIR] [--json FILE] [--svg FILE] [--csv FILE]\n"
+    "                       run a guided writing trial at 1 kHz on a device (default: simulated)\n"
+    "  model CHAR [--json] [--svg FILE] [--data DIR]\n"
+    "                       print the character's model (paper Table 3); --svg draws it (Fig. 13)\n"
+    "  strokes [--markdown FILE] [--json]\n"
+    "                       the table of the 39 typical strokes\n"
+    "  corpus validate --data DIR --cnchar FILE [--markdown FILE] [--json] [--threads N] [--features FILE]\n"
+    "                       per-stroke agreement of the classification with cnchar-order\n"
     "  devices              list the haptic devices found (simulated, Phantoms, OpenHaptics)\n"
     "  bench nearest [--json] [--markdown FILE] [--queries N] [--seed S]\n"
     "                       accuracy and speed of the nearest-point methods\n"
