@@ -15,6 +15,12 @@ constexpr const char* kUsage =
     "                       run a guided writing trial at 1 kHz on the simulated device\n"
     "  model CHAR [--json] [--data DIR]\n"
     "                       print the character's model (paper Table 3)\n"
+    "  corpus build [--data DIR] --out FILE [--tolerance UNITS] [--steps 1|2|4|8|16] [--threads N]\n"
+    "                       model every character of hanzi-writer-data into a compact store\n"
+    "  corpus stats FILE [--json]\n"
+    "                       characters, strokes, elements, bytes, typical-stroke histogram, checksums\n"
+    "  corpus fidelity [--data DIR] [--tolerances 2,5,10,20] [--markdown FILE]\n"
+    "                       elements, bytes and deviation from the medians per fitting tolerance\n"
     "  devices              list the haptic devices found (simulated, Phantoms, OpenHaptics)\n"
     "  bench nearest [--json] [--markdown FILE] [--queries N] [--seed S]\n"
     "                       accuracy and speed of the nearest-point methods\n";
@@ -33,6 +39,7 @@ int main(int argc, char** argv) {
     if (command == "trial") return command_trial(args);
     if (command == "model") return command_model(args);
     if (command == "devices") return command_devices(args);
+    if (command == "corpus") return command_corpus(args);
     if (command == "bench" && !args.empty() && args[0] == "nearest") return command_bench_nearest(args);
     std::fprintf(stderr, "calligraphy: error: unknown command '%s'\n%s", command.c_str(), kUsage);
     return 2;
