@@ -12,12 +12,12 @@
 namespace calligraphy::cli {
 
 int command_trial(const Args& args) {
-  const Arguments arguments(args, {"guidance", "writer", "seed", "data", "json", "svg", "csv", "rate"}, {});
+  const Arguments arguments(args, {"guidance", "writer", "seed", "data", "store", "json", "svg", "csv", "rate"}, {});
   if (arguments.positionals().size() != 1) throw UsageError("trial takes one CHARS argument, e.g. trial 永");
   const std::u32string chars = characters_from(arguments.positionals()[0]);
-  const CharacterLibrary library = library_from(arguments);
+  const CharacterSource source(arguments);  // only these characters are read (on demand from a store)
   std::vector<Character> characters;
-  for (char32_t c : chars) characters.push_back(library.load(c));
+  for (char32_t c : chars) characters.push_back(source.load(c));
   const Scene scene = Scene::lay_out(characters);
 
   TrialOptions options;

@@ -10,10 +10,10 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: calligraphy <command> [options]\n"
-    "  trial CHARS [--guidance on|off] [--writer novice|skilled] [--seed N] [--data DIR]\n"
+    "  trial CHARS [--guidance on|off] [--writer novice|skilled] [--seed N] [--data DIR] [--store FILE]\n"
     "              [--json FILE] [--svg FILE] [--csv FILE]\n"
     "                       run a guided writing trial at 1 kHz on the simulated device\n"
-    "  model CHAR [--json] [--data DIR]\n"
+    "  model CHAR [--json] [--data DIR] [--store FILE]\n"
     "                       print the character's model (paper Table 3)\n"
     "  corpus build [--data DIR] --out FILE [--tolerance UNITS] [--steps 1|2|4|8|16] [--threads N]\n"
     "                       model every character of hanzi-writer-data into a compact store\n"
