@@ -204,6 +204,10 @@ struct FidelityRow {
   std::size_t bytes = 0;
   double max_before = 0.0;  // unquantised
   Deviation after;          // quantised, as loaded from the store
+  std::size_t strokes = 0;
+  std::size_t strokes_beyond = 0;  // max deviation above tolerance + quantisation error
+  char32_t worst_character = 0;
+  std::size_t worst_stroke = 0;
   double fit_wall_s = 0.0;
   double fit_cpu_s = 0.0;
   unsigned threads = 0;
@@ -255,9 +259,20 @@ int corpus_fidelity(const Args& args) {
         Deviation before;
         measure_stroke(c.strokes[s], c.strokes[s], before);
         row.max_before = std::max(row.max_before, before.max_kept);
-        measure_stroke(c.strokes[s], stored.strokes[s], row.after);
+        Deviation after;
+        measure_stroke(c.strokes[s], stored.strokes[s], after);
+        if (after.max_kept > tolerance + store.info().max_quantisation_error()) ++row.strokes_beyond;
+        if (after.max_kept > row.after.max_kept) {
+          row.worst_character = c.code_point;
+          row.worst_stroke = s + 1;
+        }
+        row.after.max_kept = std::max(row.after.max_kept, after.max_kept);
+        row.after.max_all = std::max(row.after.max_all, after.max_all);
+        row.after.sum_kept += after.sum_kept;
+        row.after.samples_kept += after.samples_kept;
       }
     }
+    row.strokes = strokes;
     row.elements_per_stroke = strokes ? static_cast<double>(elements) / static_cast<double>(strokes) : 0.0;
     rows.push_back(row);
   }
@@ -266,8 +281,8 @@ int corpus_fidelity(const Args& args) {
   md << "| tolerance (units) | elements/stroke | store bytes | bytes/char | max dev (units) | max dev (mm) | "
         "mean dev (units) | mean dev (mm) | max dev before quantisation (units) | max dev incl. hooks "
         "(units) | "
-        "fit time (s wall, threads) | fit CPU (s) |\n";
-  md << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "strokes beyond tolerance | worst stroke | fit time (s wall, threads) | fit thread-s |\n";
+  md << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& r : rows) {
     const double mean =
         r.after.samples_kept ? r.after.sum_kept / static_cast<double>(r.after.samples_kept) : 0.0;

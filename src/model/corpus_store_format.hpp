@@ -1,5 +1,6 @@
 #pragma once
 // Internal: constants, CRC-32 and bit streams of the corpus store format (docs/corpus.md).
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <cstring>
@@ -112,9 +113,13 @@ class BitReader {
   [[nodiscard]] bool get(int bits, std::uint64_t& value) {
     if (bits < 0 || bits > 64 || static_cast<std::uint64_t>(bits) > remaining()) return false;
     value = 0;
-    for (int i = 0; i < bits; ++i, ++position_) {
-      const std::uint64_t bit = (bytes_[position_ >> 3] >> (position_ & 7)) & 1u;
-      value |= bit << i;
+    for (int got = 0; got < bits;) {  // whole bytes at a time
+      const int offset = static_cast<int>(position_ & 7);
+      const int take = std::min(8 - offset, bits - got);
+      const std::uint64_t chunk = (bytes_[position_ >> 3] >> offset) & ((1u << take) - 1u);
+      value |= chunk << got;
+      got += take;
+      position_ += static_cast<std::size_t>(take);
     }
     return true;
   }
