@@ -203,6 +203,8 @@ struct FidelityRow {
   double elements_per_stroke = 0.0;
   std::size_t bytes = 0;
   double max_before = 0.0;  // unquantised
+  double fitter_max = 0.0;  // FittedStroke::max_deviation
+  std::size_t fitter_beyond = 0;
   Deviation after;          // quantised, as loaded from the store
   std::size_t strokes = 0;
   std::size_t strokes_beyond = 0;  // max deviation above tolerance + quantisation error
@@ -251,10 +253,14 @@ int corpus_fidelity(const Args& args) {
     row.threads = fit.threads;
     std::size_t strokes = 0;
     std::size_t elements = 0;
-    for (const Character& c : fit.characters) {
+    for (std::size_t ci = 0; ci < fit.characters.size(); ++ci) {
+      const Character& c = fit.characters[ci];
       const Character stored = store.load(c.code_point);
       for (std::size_t s = 0; s < c.strokes.size(); ++s) {
         ++strokes;
+        const double fitter = fit.fitter_deviation[ci][s];
+        row.fitter_max = std::max(row.fitter_max, fitter);
+        if (fitter > tolerance) ++row.fitter_beyond;
         elements += c.strokes[s].elements.size();
         Deviation before;
         measure_stroke(c.strokes[s], c.strokes[s], before);
@@ -281,8 +287,8 @@ int corpus_fidelity(const Args& args) {
   md << "| tolerance (units) | elements/stroke | store bytes | bytes/char | max dev (units) | max dev (mm) | "
         "mean dev (units) | mean dev (mm) | max dev before quantisation (units) | max dev incl. hooks "
         "(units) | "
-        "strokes beyond tolerance | worst stroke | fit time (s wall, threads) | fit thread-s |\n";
-  md << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "strokes beyond tolerance | worst stroke | fitter's max dev (units) | strokes beyond, fitter's measure | fit time (s wall, threads) | fit thread-s |\n";
+  md << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& r : rows) {
     const double mean =
         r.after.samples_kept ? r.after.sum_kept / static_cast<double>(r.after.samples_kept) : 0.0;
@@ -293,6 +299,14 @@ int corpus_fidelity(const Args& args) {
        << " | " << format("%.2f", r.after.max_kept) << " | " << format("%.3f", r.after.max_kept * mm_per_unit)
        << " | " << format("%.2f", mean) << " | " << format("%.3f", mean * mm_per_unit) << " | "
        << format("%.2f", r.max_before) << " | " << format("%.1f", r.after.max_all) << " | "
+       << r.strokes_beyond << " ("
+       << format("%.2f", 100.0 * static_cast<double>(r.strokes_beyond) /
+                             static_cast<double>(std::max<std::size_t>(1, r.strokes)))
+       << " %) | " << encode_utf8(r.worst_character) << " stroke " << r.worst_stroke << " | "
+       << format("%.2f", r.fitter_max) << " | " << r.fitter_beyond << " ("
+       << format("%.2f", 100.0 * static_cast<double>(r.fitter_beyond) /
+                             static_cast<double>(std::max<std::size_t>(1, r.strokes)))
+       << " %) | "
        << format("%.2f", r.fit_wall_s) << " (" << r.threads << ") | " << format("%.2f", r.fit_cpu_s)
        << " |\n";
   }

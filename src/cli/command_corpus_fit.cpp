@@ -84,6 +84,7 @@ CorpusFit fit_corpus(const CharacterLibrary& library, const FitOptions& options,
   const auto start = Clock::now();
   const std::vector<char32_t> code_points = library.characters();
   std::vector<Character> fitted(code_points.size());
+  std::vector<std::vector<double>> deviations(code_points.size());
   std::vector<std::string> errors(code_points.size());
   std::atomic<std::size_t> next{0};
   std::atomic<std::size_t> done{0};
@@ -99,7 +100,15 @@ CorpusFit fit_corpus(const CharacterLibrary& library, const FitOptions& options,
         const auto t0 = Clock::now();
         const CharacterData data = library.load_data(code_points[k]);
         const auto t1 = Clock::now();
-        fitted[k] = fit_character(code_points[k], data.medians, data.source, options);
+        // As fit_character, keeping each stroke's max deviation.
+        Character& character = fitted[k];
+        character.code_point = code_points[k];
+        character.source = data.source;
+        for (const auto& median : data.medians) {
+          FittedStroke stroke = fit_stroke(median, options);
+          deviations[k].push_back(stroke.max_deviation);
+          character.strokes.push_back(std::move(stroke.stroke));
+        }
         my_fit += seconds_since(t1);
         my_read += std::chrono::duration<double>(t1 - t0).count();
       } catch (const std::exception& e) {  // reported per character below, never fatal for the run
@@ -126,6 +135,7 @@ CorpusFit fit_corpus(const CharacterLibrary& library, const FitOptions& options,
   for (std::size_t k = 0; k < code_points.size(); ++k) {
     if (errors[k].empty()) {
       result.characters.push_back(std::move(fitted[k]));
+      result.fitter_deviation.push_back(std::move(deviations[k]));
     } else {
       result.failures.push_back({code_points[k], errors[k]});
     }

@@ -17,6 +17,9 @@ struct CorpusFitFailure {
 
 struct CorpusFit {
   std::vector<Character> characters;  ///< sorted by code point; medians kept in each stroke
+  /// Per character, per stroke: `FittedStroke::max_deviation`, the fitter's own measure (from the median
+  /// after brush hooks are trimmed and rounded corners snapped to their lines' intersection).
+  std::vector<std::vector<double>> fitter_deviation;
   std::vector<CorpusFitFailure> failures;
   unsigned threads = 0;
   double wall_s = 0.0;            ///< reading, parsing and fitting, wall clock
