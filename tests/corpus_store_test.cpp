@@ -1,10 +1,12 @@
+#include "calligraphy/corpus_store.hpp"
+
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 
 #include "calligraphy/character_library.hpp"
-#include "calligraphy/corpus_store.hpp"
 #include "calligraphy/errors.hpp"
 #include "calligraphy/scene.hpp"
 #include "calligraphy/typical_strokes.hpp"
@@ -124,20 +126,24 @@ TEST_CASE("Store writer rejects what it cannot encode", "[store]") {
   CHECK_THROWS_AS(encode_corpus_store(std::vector{bad}, {}), InvalidArgument);
 }
 
-TEST_CASE("Store: missing, empty, foreign and newer-version files are DataErrors naming the file", "[store]") {
+TEST_CASE("Store: missing, empty, foreign and newer-version files are DataErrors naming the file",
+          "[store]") {
   CHECK_THROWS_AS(CorpusStore::open(temp_path("does_not_exist.clg")), DataError);
   const auto empty = temp_path("empty.clg");
   std::ofstream(empty).close();
-  CHECK_THROWS_WITH(CorpusStore::open(empty), Catch::Contains(empty.string()) && Catch::Contains("too short"));
+  CHECK_THROWS_WITH(CorpusStore::open(empty),
+                    Catch::Contains(empty.string()) && Catch::Contains("too short"));
   std::filesystem::remove(empty);
   const std::string json = R"({"strokes": [], "medians": []})";
   std::vector<std::uint8_t> foreign(json.begin(), json.end());
   foreign.resize(600, ' ');
-  CHECK_THROWS_WITH(CorpusStore::from_bytes(foreign, "x.json"), Catch::Contains("x.json") && Catch::Contains("magic"));
+  CHECK_THROWS_WITH(CorpusStore::from_bytes(foreign, "x.json"),
+                    Catch::Contains("x.json") && Catch::Contains("magic"));
 
   auto bytes = encode_corpus_store(small_set());
   store::put_u16(bytes.data() + store::kOffVersionMajor, 2);  // a future format, header CRC fixed up
-  store::put_u32(bytes.data() + store::kOffHeaderCrc, store::crc32(std::span(bytes).first(store::kOffHeaderCrc)));
+  store::put_u32(bytes.data() + store::kOffHeaderCrc,
+                 store::crc32(std::span(bytes).first(store::kOffHeaderCrc)));
   CHECK_THROWS_WITH(CorpusStore::from_bytes(bytes, "v2"), Catch::Contains("version 2.0 is not supported"));
 }
 
@@ -169,7 +175,8 @@ TEST_CASE("Store regressions from fuzzing are DataErrors, not crashes", "[store]
   for (const auto& entry : std::filesystem::directory_iterator(folder)) {
     if (!entry.is_regular_file() || entry.path().extension() == ".md") continue;
     std::ifstream in(entry.path(), std::ios::binary);
-    const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)),
+                                          std::istreambuf_iterator<char>());
     INFO(entry.path().string());
     CHECK_THROWS_AS(open_and_load_all(bytes), DataError);
     ++files;
@@ -190,7 +197,35 @@ TEST_CASE("A scene laid out from a store matches one from the fitted characters"
       const auto& b = from_store.characters[c].strokes[s];
       CHECK(a.typical_id == b.typical_id);
       CHECK(b.length_m() == Approx(a.length_m()).epsilon(1e-3));
-      CHECK((a.start() - b.start()).norm() <= store.info().max_quantisation_error() * metres_per_unit + 1e-15);
+      CHECK((a.start() - b.start()).norm() <=
+            store.info().max_quantisation_error() * metres_per_unit + 1e-15);
     }
   }
+}
+
+TEST_CASE("Store statistics count what was written and report bad records", "[store]") {
+  const auto characters = embedded_characters();
+  auto bytes = encode_corpus_store(characters);
+  std::size_t strokes = 0;
+  std::size_t elements = 0;
+  std::map<int, std::size_t> by_id;
+  for (const auto& c : characters) {
+    strokes += c.strokes.size();
+    for (const auto& s : c.strokes) {
+      elements += s.elements.size();
+      ++by_id[s.typical_id];
+    }
+  }
+  const CorpusStoreStats stats = corpus_store_stats(CorpusStore::from_bytes(bytes, "memory"));
+  CHECK(stats.characters == characters.size());
+  CHECK(stats.strokes == strokes);
+  CHECK(stats.elements == elements);
+  CHECK(stats.strokes_by_typical_id == by_id);
+  CHECK(stats.errors.empty());
+
+  bytes.back() ^= 0x10;  // the last record: its CRC no longer matches, the others still load
+  const CorpusStoreStats bad = corpus_store_stats(CorpusStore::from_bytes(bytes, "memory"));
+  CHECK(bad.characters == characters.size() - 1);
+  REQUIRE(bad.errors.size() == 1);
+  CHECK_THAT(bad.errors[0], Catch::Contains("checksum mismatch"));
 }

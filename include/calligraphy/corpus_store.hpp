@@ -13,6 +13,7 @@
 /// when the store is built (`calligraphy corpus fidelity`, docs/corpus.md).
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <span>
 #include <string>
@@ -90,5 +91,17 @@ class CorpusStore {
   explicit CorpusStore(std::shared_ptr<const Data> data) : data_(std::move(data)) {}
   std::shared_ptr<const Data> data_;
 };
+
+/// Totals over a whole store, every record loaded (so every record checksum verified).
+struct CorpusStoreStats {
+  std::size_t characters = 0;  ///< characters that loaded
+  std::size_t strokes = 0;
+  std::size_t elements = 0;
+  std::map<int, std::size_t> strokes_by_typical_id;  ///< typical ID 1-39 -> strokes
+  std::vector<std::string> errors;                   ///< one DataError message per record that failed
+};
+
+/// Loads every character of the store and counts. Bad records are listed in `errors`, not thrown.
+CorpusStoreStats corpus_store_stats(const CorpusStore& store);
 
 }  // namespace calligraphy

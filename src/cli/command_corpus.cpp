@@ -85,38 +85,12 @@ int corpus_build(const Args& args) {
   return fit.failures.empty() ? 0 : 1;
 }
 
-struct StoreStats {
-  std::size_t characters = 0;
-  std::size_t strokes = 0;
-  std::size_t elements = 0;
-  std::map<int, std::size_t> histogram;  // typical ID -> strokes
-  std::vector<std::string> errors;
-};
-
-StoreStats gather_stats(const CorpusStore& store) {
-  StoreStats stats;
-  for (char32_t cp : store.characters()) {
-    try {
-      const Character c = store.load(cp);
-      ++stats.characters;
-      stats.strokes += c.strokes.size();
-      for (const Stroke& s : c.strokes) {
-        stats.elements += s.elements.size();
-        ++stats.histogram[s.typical_id];
-      }
-    } catch (const DataError& e) {
-      stats.errors.push_back(e.what());
-    }
-  }
-  return stats;
-}
-
 int corpus_stats(const Args& args) {
   const Arguments arguments(args, {}, {"json"});
   if (arguments.positionals().size() != 2) throw UsageError("corpus stats takes one FILE");
   const CorpusStore store = CorpusStore::open(arguments.positionals()[1]);
   const CorpusStoreInfo& info = store.info();
-  const StoreStats stats = gather_stats(store);
+  const CorpusStoreStats stats = corpus_store_stats(store);
   const double per_char =
       info.character_count ? static_cast<double>(info.file_bytes) / static_cast<double>(info.character_count)
                            : 0.0;
@@ -124,7 +98,7 @@ int corpus_stats(const Args& args) {
                                                      : std::to_string(stats.errors.size()) + " bad records";
   if (arguments.flag("json")) {
     nlohmann::json histogram = nlohmann::json::array();
-    for (const auto& [id, count] : stats.histogram) {
+    for (const auto& [id, count] : stats.strokes_by_typical_id) {
       histogram.push_back(
           {{"id", id}, {"acronym", std::string(typical_stroke(id).acronym)}, {"strokes", count}});
     }
@@ -157,7 +131,7 @@ int corpus_stats(const Args& args) {
     std::printf("  checksums           %s\n", checksums.c_str());
     for (const auto& e : stats.errors) std::printf("    %s\n", e.c_str());
     std::printf("  typical strokes:\n");
-    for (const auto& [id, count] : stats.histogram) {
+    for (const auto& [id, count] : stats.strokes_by_typical_id) {
       std::printf(
           "    %2d %-6s %-8s %7zu  %5.2f %%\n", id, std::string(typical_stroke(id).acronym).c_str(),
           std::string(typical_stroke(id).name_zh).c_str(), count,
@@ -205,7 +179,7 @@ struct FidelityRow {
   double max_before = 0.0;  // unquantised
   double fitter_max = 0.0;  // FittedStroke::max_deviation
   std::size_t fitter_beyond = 0;
-  Deviation after;          // quantised, as loaded from the store
+  Deviation after;  // quantised, as loaded from the store
   std::size_t strokes = 0;
   std::size_t strokes_beyond = 0;  // max deviation above tolerance + quantisation error
   char32_t worst_character = 0;
@@ -287,7 +261,8 @@ int corpus_fidelity(const Args& args) {
   md << "| tolerance (units) | elements/stroke | store bytes | bytes/char | max dev (units) | max dev (mm) | "
         "mean dev (units) | mean dev (mm) | max dev before quantisation (units) | max dev incl. hooks "
         "(units) | "
-        "strokes beyond tolerance | worst stroke | fitter's max dev (units) | strokes beyond, fitter's measure | fit time (s wall, threads) | fit thread-s |\n";
+        "strokes beyond tolerance | worst stroke | fitter's max dev (units) | strokes beyond, fitter's "
+        "measure | fit time (s wall, threads) | fit thread-s |\n";
   md << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& r : rows) {
     const double mean =
@@ -306,9 +281,8 @@ int corpus_fidelity(const Args& args) {
        << format("%.2f", r.fitter_max) << " | " << r.fitter_beyond << " ("
        << format("%.2f", 100.0 * static_cast<double>(r.fitter_beyond) /
                              static_cast<double>(std::max<std::size_t>(1, r.strokes)))
-       << " %) | "
-       << format("%.2f", r.fit_wall_s) << " (" << r.threads << ") | " << format("%.2f", r.fit_cpu_s)
-       << " |\n";
+       << " %) | " << format("%.2f", r.fit_wall_s) << " (" << r.threads << ") | "
+       << format("%.2f", r.fit_cpu_s) << " |\n";
   }
   md << "\n"
      << rows.front().characters << " characters (" << rows.front().failures

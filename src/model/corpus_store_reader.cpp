@@ -276,4 +276,22 @@ Character CorpusStore::load(char32_t cp) const {
   return data_->decode(k);
 }
 
+CorpusStoreStats corpus_store_stats(const CorpusStore& store) {
+  CorpusStoreStats stats;
+  for (char32_t cp : store.characters()) {
+    try {
+      const Character c = store.load(cp);
+      ++stats.characters;
+      stats.strokes += c.strokes.size();
+      for (const Stroke& s : c.strokes) {
+        stats.elements += s.elements.size();
+        ++stats.strokes_by_typical_id[s.typical_id];
+      }
+    } catch (const DataError& e) {
+      stats.errors.push_back(e.what());
+    }
+  }
+  return stats;
+}
+
 }  // namespace calligraphy
