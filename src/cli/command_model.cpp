@@ -28,30 +28,30 @@ nlohmann::json model_json(const Character& character, const CharacterTable& tabl
     for (const StrokeElement& e : stroke.elements) {
       nlohmann::json points = nlohmann::json::array();
       for (int i = 0; i <= e.degree; ++i) {
-        points.push_back(
-            {e.control[static_cast<std::size_t>(i)].x(), e.control[static_cast<std::size_t>(i)].y()});
+        points.push_back({e.control[static_cast<std::size_t>(i)].x(), e.control[static_cast<std::size_t>(i)].y()});
       }
       elements.push_back({{"kind", e.kind == ElementKind::line ? "line" : "bezier"},
                           {"degree", e.degree},
                           {"control_points", points}});
     }
-    strokes.push_back(
-        {{"typical_id", stroke.typical_id},
-         {"acronym", std::string(type.acronym)},
-         {"name", std::string(type.name_zh)},
-         {"unicode", type.unicode ? nlohmann::json(unicode_name(type.unicode)) : nlohmann::json(nullptr)},
-         {"elements", elements},
-         {"feature_point_indices", table.feature_point_indices[s]},
-         {"attraction_factors", stroke.attraction_factors}});
+    strokes.push_back({{"typical_id", stroke.typical_id},
+                       {"acronym", std::string(type.acronym)},
+                       {"name", std::string(type.name_zh)},
+                       {"unicode", type.unicode ? nlohmann::json(unicode_name(type.unicode)) : nlohmann::json(nullptr)},
+                       {"elements", elements},
+                       {"feature_point_indices", table.feature_point_indices[s]},
+                       {"attraction_factors", stroke.attraction_factors}});
   }
-  return {{"character", encode_utf8(character.code_point)}, {"typical_strokes", character.strokes.size()},
-          {"typical_stroke_ids", table.typical_stroke_ids}, {"control_points", table.control_points.size()},
-          {"feature_points", table.feature_point_count()},  {"strokes", strokes}};
+  return {{"character", encode_utf8(character.code_point)},
+          {"typical_strokes", character.strokes.size()},
+          {"typical_stroke_ids", table.typical_stroke_ids},
+          {"control_points", table.control_points.size()},
+          {"feature_points", table.feature_point_count()},
+          {"strokes", strokes}};
 }
 
 void print_model(const Character& character, const CharacterTable& table) {
-  std::printf("Character %s, from %s\n", describe_character(character.code_point).c_str(),
-              character.source.c_str());
+  std::printf("Character %s, from %s\n", describe_character(character.code_point).c_str(), character.source.c_str());
   std::printf("  Number of typical strokes  %zu\n", character.strokes.size());
   std::printf("  ID array of typical strokes");
   for (int id : table.typical_stroke_ids) std::printf(" %d", id);
@@ -60,9 +60,8 @@ void print_model(const Character& character, const CharacterTable& table) {
   for (std::size_t s = 0; s < character.strokes.size(); ++s) {
     const Stroke& stroke = character.strokes[s];
     const TypicalStroke& type = typical_stroke(stroke.typical_id);
-    std::printf("  stroke %zu: ID %d %s %s %s  feature points [", s + 1, type.id,
-                std::string(type.acronym).c_str(), std::string(type.name_zh).c_str(),
-                type.unicode ? unicode_name(type.unicode).c_str() : "-");
+    std::printf("  stroke %zu: ID %d %s %s %s  feature points [", s + 1, type.id, std::string(type.acronym).c_str(),
+                std::string(type.name_zh).c_str(), type.unicode ? unicode_name(type.unicode).c_str() : "-");
     for (std::size_t k = 0; k < table.feature_point_indices[s].size(); ++k) {
       std::printf("%s%d", k ? " " : "", table.feature_point_indices[s][k]);
     }
@@ -74,8 +73,7 @@ void print_model(const Character& character, const CharacterTable& table) {
     for (const StrokeElement& e : stroke.elements) {
       std::printf("    %s degree %d:", e.kind == ElementKind::line ? "LSE" : "CSE", e.degree);
       for (int i = 0; i <= e.degree; ++i) {
-        std::printf(" (%.1f, %.1f)", e.control[static_cast<std::size_t>(i)].x(),
-                    e.control[static_cast<std::size_t>(i)].y());
+        std::printf(" (%.1f, %.1f)", e.control[static_cast<std::size_t>(i)].x(), e.control[static_cast<std::size_t>(i)].y());
       }
       std::printf("\n");
     }
@@ -88,8 +86,7 @@ int command_model(const Args& args) {
   const Arguments arguments(args, {"data", "store"}, {"json"});
   if (arguments.positionals().size() != 1) throw UsageError("model takes exactly one character");
   const std::u32string chars = characters_from(arguments.positionals()[0]);
-  if (chars.size() != 1)
-    throw UsageError("model takes exactly one character, got " + std::to_string(chars.size()));
+  if (chars.size() != 1) throw UsageError("model takes exactly one character, got " + std::to_string(chars.size()));
   const Character character = CharacterSource(arguments).load(chars[0]);
   const CharacterTable table = character_table(character);
   if (arguments.flag("json")) {

@@ -12,8 +12,7 @@
 namespace calligraphy::cli {
 
 int command_trial(const Args& args) {
-  const Arguments arguments(
-      args, {"guidance", "writer", "seed", "data", "store", "json", "svg", "csv", "rate"}, {});
+  const Arguments arguments(args, {"guidance", "writer", "seed", "data", "store", "json", "svg", "csv", "rate"}, {});
   if (arguments.positionals().size() != 1) throw UsageError("trial takes one CHARS argument, e.g. trial 永");
   const std::u32string chars = characters_from(arguments.positionals()[0]);
   const CharacterSource source(arguments);  // only these characters are read (on demand from a store)
