@@ -72,6 +72,15 @@ void json_load_one(benchmark::State& state) {  // the embedded JSON, parsed and 
   }
 }
 
+// Resident set size from /proc/self/statm [bytes]; 0 where unavailable.
+std::size_t resident_bytes() {
+  std::ifstream statm("/proc/self/statm");
+  std::size_t pages = 0;
+  std::size_t resident = 0;
+  statm >> pages >> resident;
+  return resident * 4096;
+}
+
 template <typename T>
 std::size_t vector_bytes(const std::vector<T>& v) {
   return v.capacity() * sizeof(T);
@@ -93,6 +102,14 @@ void scene_of_four_from_store(benchmark::State& state) {
   const std::vector<char32_t> text = {U'永', U'字', U'八', U'法'};
   std::vector<char32_t> wanted;
   for (char32_t c : text) wanted.push_back(store().contains(c) ? c : sample_characters(4)[wanted.size()]);
+  // RSS growth of a fresh open + 4 loads + lay_out, once, outside the timing (page granularity).
+  const std::size_t rss_before = resident_bytes();
+  const CorpusStore fresh = CorpusStore::open(store_path());
+  std::vector<Character> once;
+  for (char32_t c : wanted) once.push_back(fresh.load(c));
+  const Scene first = Scene::lay_out(once);
+  state.counters["rss_delta_bytes"] = static_cast<double>(resident_bytes() - std::min(rss_before, resident_bytes()));
+  benchmark::DoNotOptimize(first);
   std::size_t bytes = 0;
   for (auto _ : state) {
     std::vector<Character> characters;
