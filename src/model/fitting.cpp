@@ -169,9 +169,7 @@ StrokeElement fit_bezier(const std::vector<Vec2>& samples, int degree) {
 
 double max_deviation(const std::vector<Vec2>& samples, const StrokeElement& element) {
   const auto curve = sample_element(element, 64);
-  double worst = 0.0;
-  for (const Vec2& p : samples) worst = std::max(worst, distance_to_polyline(p, curve));
-  return worst;
+  return max_distance_to_polyline(samples, curve);
 }
 
 void fit_piece(std::span<const Vec2> pts, const FitOptions& options, int depth, std::vector<StrokeElement>& out) {
@@ -246,7 +244,7 @@ FittedStroke fit_stroke(std::span<const Vec2> median, const FitOptions& options)
     const auto s = sample_element(e, 64);
     curve.insert(curve.end(), s.begin(), s.end());
   }
-  for (const Vec2& p : pts) fitted.max_deviation = std::max(fitted.max_deviation, distance_to_polyline(p, curve));
+  fitted.max_deviation = max_distance_to_polyline(pts, curve);
 
   fitted.stroke.typical_id = classify_pieces(fitted.pieces);
   fitted.stroke.attraction_factors.assign(fitted.stroke.feature_point_count(),
