@@ -122,7 +122,11 @@ double chord_direction(std::span<const Vec2> pts, double from, double to) {
 double bernstein(int n, int i, double t) {
   double binom = 1.0;
   for (int k = 1; k <= i; ++k) binom = binom * (n - k + 1) / k;
-  return binom * std::pow(t, i) * std::pow(1.0 - t, n - i);
+  // x^0, x^1 and x^2 multiplied out (one rounding, as pow's correctly rounded result); pow above.
+  const auto power = [](double x, int e) {
+    return e == 0 ? 1.0 : e == 1 ? x : e == 2 ? x * x : std::pow(x, e);
+  };
+  return binom * power(t, i) * power(1.0 - t, n - i);
 }
 
 // Least-squares Bezier of `degree` with fixed endpoints through `samples` at chord-length parameters,
