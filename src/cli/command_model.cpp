@@ -99,12 +99,12 @@ void print_model(const Character& character, const CharacterTable& table) {
 }  // namespace
 
 int command_model(const Args& args) {
-  const Arguments arguments(args, {"data", "svg"}, {"json"});
+  const Arguments arguments(args, {"data", "store", "svg"}, {"json"});
   if (arguments.positionals().size() != 1) throw UsageError("model takes exactly one character");
   const std::u32string chars = characters_from(arguments.positionals()[0]);
   if (chars.size() != 1)
     throw UsageError("model takes exactly one character, got " + std::to_string(chars.size()));
-  const Character character = library_from(arguments).load(chars[0]);
+  const Character character = CharacterSource(arguments).load(chars[0]);
   const CharacterTable table = character_table(character);
   if (const auto path = arguments.option("svg")) write_file(*path, model_svg(character));
   if (arguments.flag("json")) {

@@ -31,14 +31,14 @@ DeviceListing find_device(const std::string& name) {
 
 int command_trial(const Args& args) {
   const Arguments arguments(
-      args, {"guidance", "writer", "seed", "data", "json", "svg", "csv", "rate", "device"}, {});
+      args, {"guidance", "writer", "seed", "data", "store", "json", "svg", "csv", "rate", "device"}, {});
   if (arguments.positionals().size() != 1) throw UsageError("trial takes one CHARS argument, e.g. trial 永");
   const std::u32string chars = characters_from(arguments.positionals()[0]);
   const std::string device_name = arguments.option_or("device", "simulated");
   const DeviceListing device = find_device(device_name);
-  const CharacterLibrary library = library_from(arguments);
+  const CharacterSource source(arguments);  // only these characters are read (on demand from a store)
   std::vector<Character> characters;
-  for (char32_t c : chars) characters.push_back(library.load(c));
+  for (char32_t c : chars) characters.push_back(source.load(c));
   const Scene scene = Scene::lay_out(characters);
 
   DeviceTrialOptions options;

@@ -10,6 +10,18 @@ CharacterLibrary library_from(const Arguments& arguments) {
   return CharacterLibrary::embedded();
 }
 
+CharacterSource::CharacterSource(const Arguments& arguments) : library_(CharacterLibrary::embedded()) {
+  if (const auto path = arguments.option("store")) {
+    store_ = CorpusStore::open(*path);
+  } else {
+    library_ = library_from(arguments);
+  }
+}
+
+Character CharacterSource::load(char32_t code_point) const {
+  return store_ ? store_->load(code_point) : library_.load(code_point);
+}
+
 std::u32string characters_from(const std::string& text) {
   std::u32string chars;
   try {

@@ -11,12 +11,18 @@ namespace {
 constexpr const char* kUsage =
     "usage: calligraphy <command> [options]\n"
     "  trial CHARS [--device NAME] [--guidance on|off] [--writer novice|skilled] [--seed N]\n"
-    "              [--data DIR] [--json FILE] [--svg FILE] [--csv FILE]\n"
+    "              [--data DIR] [--store FILE] [--json FILE] [--svg FILE] [--csv FILE]\n"
     "                       run a guided writing trial at 1 kHz on a device (default: simulated)\n"
-    "  model CHAR [--json] [--svg FILE] [--data DIR]\n"
+    "  model CHAR [--json] [--svg FILE] [--data DIR] [--store FILE]\n"
     "                       print the character's model (paper Table 3); --svg draws it (Fig. 13)\n"
     "  strokes [--markdown FILE] [--json]\n"
     "                       the table of the 39 typical strokes\n"
+    "  corpus build [--data DIR] --out FILE [--tolerance UNITS] [--steps 1|2|4|8|16] [--threads N]\n"
+    "                       model every character of hanzi-writer-data into a compact store\n"
+    "  corpus stats FILE [--json]\n"
+    "                       characters, strokes, elements, bytes, typical-stroke histogram, checksums\n"
+    "  corpus fidelity [--data DIR] [--tolerances 2,5,10,20] [--markdown FILE]\n"
+    "                       elements, bytes and deviation from the medians per fitting tolerance\n"
     "  corpus validate --data DIR --cnchar FILE [--markdown FILE] [--json] [--threads N] [--features FILE]\n"
     "                       per-stroke agreement of the classification with cnchar-order\n"
     "  devices              list the haptic devices found (simulated, Phantoms, OpenHaptics)\n"
@@ -41,6 +47,7 @@ int main(int argc, char** argv) {
     if (command == "devices") return command_devices(args);
     if (command == "strokes") return command_strokes(args);
     if (command == "corpus" && !args.empty() && args[0] == "validate") return command_corpus_validate(args);
+    if (command == "corpus") return command_corpus(args);
     if (command == "bench" && !args.empty() && args[0] == "nearest") return command_bench_nearest(args);
     if (command == "bench" && !args.empty() && args[0] == "jumps") return command_bench_jumps(args);
     std::fprintf(stderr, "calligraphy: error: unknown command '%s'\n%s", command.c_str(), kUsage);

@@ -126,7 +126,11 @@ double chord_direction(std::span<const Vec2> pts, double from, double to) {
 double bernstein(int n, int i, double t) {
   double binom = 1.0;
   for (int k = 1; k <= i; ++k) binom = binom * (n - k + 1) / k;
-  return binom * std::pow(t, i) * std::pow(1.0 - t, n - i);
+  // x^0, x^1 and x^2 multiplied out (one rounding, as pow's correctly rounded result); pow above.
+  const auto power = [](double x, int e) {
+    return e == 0 ? 1.0 : e == 1 ? x : e == 2 ? x * x : std::pow(x, e);
+  };
+  return binom * power(t, i) * power(1.0 - t, n - i);
 }
 
 // Least-squares Bezier of `degree` with fixed endpoints through `samples` at chord-length parameters,
@@ -173,9 +177,7 @@ StrokeElement fit_bezier(const std::vector<Vec2>& samples, int degree) {
 
 double max_deviation(const std::vector<Vec2>& samples, const StrokeElement& element) {
   const auto curve = sample_element(element, 64);
-  double worst = 0.0;
-  for (const Vec2& p : samples) worst = std::max(worst, distance_to_polyline(p, curve));
-  return worst;
+  return max_distance_to_polyline(samples, curve);
 }
 
 void fit_piece(std::span<const Vec2> pts, const FitOptions& options, int depth, std::vector<StrokeElement>& out) {
@@ -251,7 +253,7 @@ FittedStroke fit_stroke(std::span<const Vec2> median, const FitOptions& options)
     const auto s = sample_element(e, 64);
     curve.insert(curve.end(), s.begin(), s.end());
   }
-  for (const Vec2& p : pts) fitted.max_deviation = std::max(fitted.max_deviation, distance_to_polyline(p, curve));
+  fitted.max_deviation = max_distance_to_polyline(pts, curve);
 
   fitted.stroke.typical_id = classify_pieces(fitted.pieces);
   // Paper eq. 8: an attraction factor per feature point; corners (piece joints) pull harder so that the

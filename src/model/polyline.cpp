@@ -89,4 +89,35 @@ double distance_to_polyline(const Vec2& p, std::span<const Vec2> pts) {
   return best;
 }
 
+double max_distance_to_polyline(std::span<const Vec2> points, std::span<const Vec2> pts) {
+  if (pts.empty()) return points.empty() ? 0.0 : std::numeric_limits<double>::infinity();
+  if (pts.size() == 1) {
+    double worst = 0.0;
+    for (const Vec2& p : points) worst = std::max(worst, (p - pts[0]).norm());
+    return worst;
+  }
+  // Same value as the max of distance_to_polyline: a point's scan stops once some segment is no
+  // farther than the worst so far (it cannot raise the max), and starts at the previous point's
+  // nearest segment, where consecutive points usually find theirs.
+  const std::size_t segments = pts.size() - 1;
+  double worst = 0.0;
+  std::size_t start = 0;
+  for (const Vec2& p : points) {
+    double best = std::numeric_limits<double>::infinity();
+    std::size_t best_segment = start;
+    for (std::size_t k = 0; k < segments; ++k) {
+      const std::size_t i = (start + k) % segments;
+      const double d = nearest_point_on_segment(pts[i], pts[i + 1], p).distance;
+      if (d < best) {
+        best = d;
+        best_segment = i;
+      }
+      if (best <= worst) break;
+    }
+    worst = std::max(worst, best);
+    start = best_segment;
+  }
+  return worst;
+}
+
 }  // namespace calligraphy

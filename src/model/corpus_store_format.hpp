@@ -1,0 +1,134 @@
+#pragma once
+// Internal: constants, CRC-32 and bit streams of the corpus store format (docs/corpus.md).
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <cstring>
+#include <span>
+#include <vector>
+
+namespace calligraphy::store {
+
+inline constexpr std::array<std::uint8_t, 8> kMagic = {'C', 'L', 'G', 'S', 'T', 'O', 'R', 'E'};
+inline constexpr std::uint16_t kVersionMajor = 1;  // readers reject another major version
+inline constexpr std::uint16_t kVersionMinor = 0;  // added fields only; readers accept any minor
+inline constexpr std::size_t kHeaderBytes = 64;
+inline constexpr std::size_t kTypicalStrokeCount = 39;
+inline constexpr std::size_t kDefaultsBytes = 8 * kTypicalStrokeCount;  // float64 per typical ID
+inline constexpr std::size_t kIndexEntryBytes = 12;                     // code point, offset, CRC
+inline constexpr std::int64_t kMaxCoordinate = std::int64_t{1} << 23;   // quantised |x|
+
+// Header field offsets.
+inline constexpr std::size_t kOffVersionMajor = 8, kOffVersionMinor = 10, kOffHeaderSize = 12, kOffCount = 16,
+                             kOffSteps = 20, kOffTolerance = 24, kOffFlags = 28, kOffIndex = 32,
+                             kOffRecords = 40, kOffRecordsSize = 48, kOffTablesCrc = 56, kOffHeaderCrc = 60;
+
+// Per-stroke flags.
+inline constexpr unsigned kExplicitFactors =
+    1;  // factors stored as float64, else the file's default for the ID
+inline constexpr unsigned kDetachedElements = 2;  // some element does not start where the previous ended
+
+/// CRC-32 (IEEE 802.3, reflected polynomial 0xEDB88320, as zlib and PNG), slicing by one byte.
+std::uint32_t crc32(std::span<const std::uint8_t> bytes);
+
+inline std::uint32_t get_u32(const std::uint8_t* p) {
+  return std::uint32_t{p[0]} | std::uint32_t{p[1]} << 8 | std::uint32_t{p[2]} << 16 |
+         std::uint32_t{p[3]} << 24;
+}
+inline std::uint16_t get_u16(const std::uint8_t* p) { return static_cast<std::uint16_t>(p[0] | p[1] << 8); }
+inline std::uint64_t get_u64(const std::uint8_t* p) {
+  return get_u32(p) | std::uint64_t{get_u32(p + 4)} << 32;
+}
+inline float get_f32(const std::uint8_t* p) {
+  const std::uint32_t bits = get_u32(p);
+  float f = 0.0f;
+  std::memcpy(&f, &bits, sizeof f);
+  return f;
+}
+inline void put_u16(std::uint8_t* p, std::uint16_t v) {
+  p[0] = static_cast<std::uint8_t>(v);
+  p[1] = static_cast<std::uint8_t>(v >> 8);
+}
+inline void put_u32(std::uint8_t* p, std::uint32_t v) {
+  for (int i = 0; i < 4; ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
+}
+inline void put_u64(std::uint8_t* p, std::uint64_t v) {
+  put_u32(p, static_cast<std::uint32_t>(v));
+  put_u32(p + 4, static_cast<std::uint32_t>(v >> 32));
+}
+inline std::uint64_t double_bits(double d) {
+  std::uint64_t bits = 0;
+  std::memcpy(&bits, &d, sizeof bits);
+  return bits;
+}
+inline double get_f64(const std::uint8_t* p) {
+  const std::uint64_t bits = get_u64(p);
+  double d = 0.0;
+  std::memcpy(&d, &bits, sizeof d);
+  return d;
+}
+inline std::uint32_t float_bits(float f) {
+  std::uint32_t bits = 0;
+  std::memcpy(&bits, &f, sizeof bits);
+  return bits;
+}
+
+inline std::uint64_t zigzag(std::int64_t v) {
+  return v >= 0 ? static_cast<std::uint64_t>(v) << 1 : (static_cast<std::uint64_t>(-(v + 1)) << 1) | 1u;
+}
+inline std::int64_t unzigzag(std::uint64_t u) {
+  return (u & 1u) ? -static_cast<std::int64_t>(u >> 1) - 1 : static_cast<std::int64_t>(u >> 1);
+}
+/// Bits needed to hold u (0 for 0).
+inline int bit_width(std::uint64_t u) {
+  int n = 0;
+  while (u != 0) {
+    ++n;
+    u >>= 1;
+  }
+  return n;
+}
+
+/// Appends bit fields, least significant bit first.
+class BitWriter {
+ public:
+  void put(std::uint64_t value, int bits) {
+    for (int i = 0; i < bits; ++i) {
+      if (used_ == 0) bytes_.push_back(0);
+      if ((value >> i) & 1u) bytes_.back() = static_cast<std::uint8_t>(bytes_.back() | (1u << used_));
+      used_ = (used_ + 1) & 7;
+    }
+  }
+  [[nodiscard]] std::vector<std::uint8_t> take() { return std::move(bytes_); }
+
+ private:
+  std::vector<std::uint8_t> bytes_;
+  int used_ = 0;
+};
+
+/// Reads bit fields; `get` returns false instead of reading past the end.
+class BitReader {
+ public:
+  explicit BitReader(std::span<const std::uint8_t> bytes) : bytes_(bytes) {}
+  [[nodiscard]] bool get(int bits, std::uint64_t& value) {
+    if (bits < 0 || bits > 64 || static_cast<std::uint64_t>(bits) > remaining()) return false;
+    value = 0;
+    for (int got = 0; got < bits;) {  // whole bytes at a time
+      const int offset = static_cast<int>(position_ & 7);
+      const int take = std::min(8 - offset, bits - got);
+      const std::uint64_t chunk = (bytes_[position_ >> 3] >> offset) & ((1u << take) - 1u);
+      value |= chunk << got;
+      got += take;
+      position_ += static_cast<std::size_t>(take);
+    }
+    return true;
+  }
+  [[nodiscard]] std::uint64_t remaining() const { return bytes_.size() * 8 - position_; }
+  [[nodiscard]] std::size_t bit_position() const { return position_; }
+
+ private:
+  std::span<const std::uint8_t> bytes_;
+  std::size_t position_ = 0;
+};
+
+}  // namespace calligraphy::store

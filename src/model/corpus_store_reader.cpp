@@ -1,0 +1,297 @@
+// Reads the corpus store (docs/corpus.md) through a read-only memory mapping. Every offset and size is
+// checked against the file before it is used; every failure is a DataError naming the file and offset.
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+#include "calligraphy/corpus_store.hpp"
+#include "calligraphy/errors.hpp"
+#include "calligraphy/unicode.hpp"
+#include "model/corpus_store_format.hpp"
+
+namespace calligraphy {
+
+using namespace store;
+
+struct CorpusStore::Data {
+  std::string name;
+  const std::uint8_t* bytes = nullptr;
+  std::size_t size = 0;
+  void* mapping = nullptr;          // from mmap, unmapped on destruction
+  std::vector<std::uint8_t> owned;  // from_bytes
+  CorpusStoreInfo info;
+  const std::uint8_t* index = nullptr;
+  const std::uint8_t* records = nullptr;
+  std::array<double, kTypicalStrokeCount> default_factors{};
+
+  Data() = default;
+  Data(const Data&) = delete;
+  Data& operator=(const Data&) = delete;
+  ~Data() {
+    if (mapping != nullptr) munmap(mapping, size);
+  }
+
+  [[noreturn]] void fail(std::size_t offset, const std::string& what) const {
+    throw DataError(name + ": offset " + std::to_string(offset) + ": " + what);
+  }
+
+  [[nodiscard]] std::uint32_t code_point_at(std::size_t k) const {
+    return get_u32(index + kIndexEntryBytes * k);
+  }
+  [[nodiscard]] std::size_t record_begin(std::size_t k) const {
+    return get_u32(index + kIndexEntryBytes * k + 4);
+  }
+  [[nodiscard]] std::size_t record_end(std::size_t k) const {
+    return k + 1 < info.character_count ? record_begin(k + 1) : info.record_bytes;
+  }
+  /// Index of the entry for cp, or character_count when absent.
+  [[nodiscard]] std::size_t find(char32_t cp) const {
+    std::size_t lo = 0;
+    std::size_t hi = info.character_count;
+    while (lo < hi) {
+      const std::size_t mid = lo + (hi - lo) / 2;
+      if (code_point_at(mid) < cp) {
+        lo = mid + 1;
+      } else {
+        hi = mid;
+      }
+    }
+    return lo < info.character_count && code_point_at(lo) == cp ? lo : info.character_count;
+  }
+
+  void validate();
+  [[nodiscard]] Character decode(std::size_t k) const;
+};
+
+void CorpusStore::Data::validate() {
+  if (size < kHeaderBytes)
+    fail(size, "file too short for a corpus store header (" + std::to_string(size) + " bytes)");
+  if (!std::equal(kMagic.begin(), kMagic.end(), bytes)) fail(0, "not a calligraphy corpus store (bad magic)");
+  if (get_u32(bytes + kOffHeaderCrc) != crc32(std::span(bytes, kOffHeaderCrc)))
+    fail(0, "header checksum mismatch");
+  info.version_major = get_u16(bytes + kOffVersionMajor);
+  info.version_minor = get_u16(bytes + kOffVersionMinor);
+  if (info.version_major != kVersionMajor) {
+    fail(kOffVersionMajor, "format version " + std::to_string(info.version_major) + "." +
+                               std::to_string(info.version_minor) + " is not supported (this reader reads " +
+                               std::to_string(kVersionMajor) + ".x)");
+  }
+  if (get_u32(bytes + kOffHeaderSize) != kHeaderBytes) fail(kOffHeaderSize, "unexpected header size");
+  if (get_u32(bytes + kOffFlags) != 0) fail(kOffFlags, "unknown flags");
+  info.character_count = get_u32(bytes + kOffCount);
+  info.steps_per_unit = static_cast<int>(get_u32(bytes + kOffSteps));
+  const int s = info.steps_per_unit;
+  if (s != 1 && s != 2 && s != 4 && s != 8 && s != 16)
+    fail(kOffSteps, "quantisation steps per unit out of range");
+  info.fit_tolerance = get_f32(bytes + kOffTolerance);
+  const std::uint64_t index_offset = get_u64(bytes + kOffIndex);
+  const std::uint64_t records_offset = get_u64(bytes + kOffRecords);
+  const std::uint64_t records_size = get_u64(bytes + kOffRecordsSize);
+  if (index_offset != kHeaderBytes + kDefaultsBytes) fail(kOffIndex, "unexpected index offset");
+  if (records_offset != index_offset + kIndexEntryBytes * std::uint64_t{info.character_count}) {
+    fail(kOffRecords,
+         "records offset does not follow the index of " + std::to_string(info.character_count) + " entries");
+  }
+  if (records_offset > size || records_size != size - records_offset) {
+    fail(kOffRecordsSize, "file is " + std::to_string(size) + " bytes, header says " +
+                              std::to_string(records_offset) + " + " + std::to_string(records_size) +
+                              " (truncated or extended)");
+  }
+  info.file_bytes = size;
+  info.header_bytes = index_offset;
+  info.index_bytes = records_offset - index_offset;
+  info.record_bytes = records_size;
+  if (get_u32(bytes + kOffTablesCrc) !=
+      crc32(std::span(bytes + kHeaderBytes, records_offset - kHeaderBytes))) {
+    fail(kHeaderBytes, "checksum mismatch in the default-factor table or the index");
+  }
+  index = bytes + index_offset;
+  records = bytes + records_offset;
+  for (std::size_t id = 0; id < kTypicalStrokeCount; ++id) {
+    default_factors[id] = get_f64(bytes + kHeaderBytes + 8 * id);
+    if (!std::isfinite(default_factors[id]))
+      fail(kHeaderBytes + 8 * id, "default attraction factor not finite");
+  }
+  for (std::size_t k = 0; k < info.character_count; ++k) {
+    const std::size_t at = index_offset + kIndexEntryBytes * k;
+    if (code_point_at(k) > 0x10FFFF || (k > 0 && code_point_at(k) <= code_point_at(k - 1))) {
+      fail(at, "index entry " + std::to_string(k) + ": code points not strictly increasing Unicode scalars");
+    }
+    if ((k == 0 && record_begin(k) != 0) || record_begin(k) >= record_end(k) ||
+        record_end(k) > records_size) {
+      fail(at + 4, "index entry " + std::to_string(k) + ": record offsets out of order or out of the file");
+    }
+  }
+}
+
+Character CorpusStore::Data::decode(std::size_t k) const {
+  const char32_t cp = code_point_at(k);
+  const std::size_t begin = record_begin(k);
+  const std::span<const std::uint8_t> record(records + begin, record_end(k) - begin);
+  const std::size_t file_offset = static_cast<std::size_t>(records - bytes) + begin;
+  const auto bad = [&](const std::string& what) {
+    fail(file_offset, "record of character " + describe_character(cp) + ": " + what);
+  };
+  if (get_u32(index + kIndexEntryBytes * k + 8) != crc32(record)) bad("checksum mismatch");
+
+  BitReader in(record);
+  const auto get = [&](int bits) {
+    std::uint64_t v = 0;
+    if (!in.get(bits, v)) bad("ends early at bit " + std::to_string(in.bit_position()));
+    return v;
+  };
+  const double scale = 1.0 / info.steps_per_unit;
+  Character character;
+  character.code_point = cp;
+  character.source = name + "#" + describe_character(cp);
+  const std::size_t stroke_count = get(8);
+  if (stroke_count == 0) bad("no strokes");
+  character.strokes.resize(stroke_count);
+  std::int64_t x = 0;
+  std::int64_t y = 0;
+  for (std::size_t s = 0; s < stroke_count; ++s) {
+    Stroke& stroke = character.strokes[s];
+    stroke.typical_id = static_cast<int>(get(6));
+    if (stroke.typical_id < 1 || stroke.typical_id > 39)
+      bad("stroke " + std::to_string(s + 1) + ": typical ID out of range");
+    std::size_t n = get(4) + 1;
+    if (n == 16) n += get(8);
+    const unsigned flags = static_cast<unsigned>(get(2));
+    std::array<int, 15 + 256> degrees{};
+    for (std::size_t e = 0; e < n; ++e) degrees[e] = static_cast<int>(get(2)) + 1;
+    std::array<bool, 15 + 256> detached{};
+    if (flags & kDetachedElements) {
+      for (std::size_t e = 1; e < n; ++e) detached[e] = get(1) != 0;
+    }
+    const auto next_point = [&](int width) {
+      x += unzigzag(get(width));
+      y += unzigzag(get(width));
+      return Vec2(static_cast<double>(x) * scale, static_cast<double>(y) * scale);
+    };
+    const int start_width = static_cast<int>(get(5));
+    Vec2 previous = next_point(start_width);
+    const int width = static_cast<int>(get(5));
+    stroke.elements.resize(n);
+    for (std::size_t e = 0; e < n; ++e) {
+      StrokeElement& element = stroke.elements[e];
+      element.degree = degrees[e];
+      element.kind = element.degree == 1 ? ElementKind::line : ElementKind::bezier;
+      element.control[0] = detached[e] ? next_point(width) : previous;
+      for (int i = 1; i <= element.degree; ++i)
+        element.control[static_cast<std::size_t>(i)] = next_point(width);
+      previous = element.end();
+    }
+    if (flags & kExplicitFactors) {
+      stroke.attraction_factors.resize(n + 1);
+      for (double& f : stroke.attraction_factors) {
+        const std::uint64_t bits = get(64);
+        std::memcpy(&f, &bits, sizeof f);
+        if (!std::isfinite(f)) bad("stroke " + std::to_string(s + 1) + ": attraction factor not finite");
+      }
+    } else {
+      stroke.attraction_factors.assign(n + 1,
+                                       default_factors[static_cast<std::size_t>(stroke.typical_id - 1)]);
+    }
+  }
+  // The writer pads the last byte with zero bits and writes nothing after.
+  std::uint64_t padding = 0;
+  if (in.remaining() >= 8 || !in.get(static_cast<int>(in.remaining()), padding) || padding != 0) {
+    bad("unexpected bytes after the last stroke");
+  }
+  return character;
+}
+
+double CorpusStoreInfo::max_quantisation_error() const {
+  return steps_per_unit > 0 ? std::sqrt(2.0) / (2.0 * steps_per_unit) : 0.0;
+}
+
+CorpusStore CorpusStore::open(const std::filesystem::path& path) {
+  auto data = std::make_shared<Data>();
+  data->name = path.string();
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw DataError(data->name + ": cannot open the corpus store (" + std::strerror(errno) + ")");
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    throw DataError(data->name + ": not a regular file");
+  }
+  data->size = static_cast<std::size_t>(st.st_size);
+  if (data->size > 0) {
+    void* m = ::mmap(nullptr, data->size, PROT_READ, MAP_PRIVATE, fd, 0);
+    if (m == MAP_FAILED) {
+      ::close(fd);
+      throw DataError(data->name + ": cannot map the corpus store (" + std::strerror(errno) + ")");
+    }
+    data->mapping = m;
+    data->bytes = static_cast<const std::uint8_t*>(m);
+  }
+  ::close(fd);
+  data->validate();
+  return CorpusStore(std::move(data));
+}
+
+CorpusStore CorpusStore::from_bytes(std::span<const std::uint8_t> bytes, const std::string& name) {
+  auto data = std::make_shared<Data>();
+  data->name = name;
+  data->owned.assign(bytes.begin(), bytes.end());
+  data->bytes = data->owned.data();
+  data->size = data->owned.size();
+  data->validate();
+  return CorpusStore(std::move(data));
+}
+
+const CorpusStoreInfo& CorpusStore::info() const { return data_->info; }
+const std::string& CorpusStore::name() const { return data_->name; }
+
+bool CorpusStore::contains(char32_t cp) const { return data_->find(cp) < data_->info.character_count; }
+
+std::vector<char32_t> CorpusStore::characters() const {
+  std::vector<char32_t> out(data_->info.character_count);
+  for (std::size_t k = 0; k < out.size(); ++k) out[k] = data_->code_point_at(k);
+  return out;
+}
+
+namespace {
+[[noreturn]] void not_found(const std::string& name, char32_t cp, std::size_t count) {
+  throw CharacterNotFound("character " + describe_character(cp) + " is not in the corpus store " + name +
+                          " (" + std::to_string(count) + " characters)");
+}
+}  // namespace
+
+std::size_t CorpusStore::record_bytes(char32_t cp) const {
+  const std::size_t k = data_->find(cp);
+  if (k == data_->info.character_count) not_found(data_->name, cp, k);
+  return data_->record_end(k) - data_->record_begin(k);
+}
+
+Character CorpusStore::load(char32_t cp) const {
+  const std::size_t k = data_->find(cp);
+  if (k == data_->info.character_count) not_found(data_->name, cp, k);
+  return data_->decode(k);
+}
+
+CorpusStoreStats corpus_store_stats(const CorpusStore& store) {
+  CorpusStoreStats stats;
+  for (char32_t cp : store.characters()) {
+    try {
+      const Character c = store.load(cp);
+      ++stats.characters;
+      stats.strokes += c.strokes.size();
+      for (const Stroke& s : c.strokes) {
+        stats.elements += s.elements.size();
+        ++stats.strokes_by_typical_id[s.typical_id];
+      }
+    } catch (const DataError& e) {
+      stats.errors.push_back(e.what());
+    }
+  }
+  return stats;
+}
+
+}  // namespace calligraphy

@@ -1,0 +1,203 @@
+// Writes the corpus store (docs/corpus.md): header, table of default attraction factors, sorted index,
+// bit-packed records of quantised, delta-coded control points with shared joints.
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <string>
+
+#include "calligraphy/corpus_store.hpp"
+#include "calligraphy/errors.hpp"
+#include "calligraphy/typical_strokes.hpp"
+#include "calligraphy/unicode.hpp"
+#include "model/corpus_store_format.hpp"
+
+namespace calligraphy {
+namespace {
+
+using namespace store;
+
+struct QPoint {
+  std::int64_t x = 0;
+  std::int64_t y = 0;
+  bool operator==(const QPoint&) const = default;
+};
+
+class RecordEncoder {
+ public:
+  RecordEncoder(const Character& character, int steps) : character_(character), steps_(steps) {}
+
+  std::vector<std::uint8_t> encode() {
+    const auto& strokes = character_.strokes;
+    if (strokes.empty() || strokes.size() > 255)
+      fail("has " + std::to_string(strokes.size()) + " strokes (1-255)");
+    out_.put(strokes.size(), 8);
+    for (std::size_t s = 0; s < strokes.size(); ++s) encode_stroke(s);
+    return out_.take();
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& what) const {
+    throw InvalidArgument("corpus store: character " + describe_character(character_.code_point) + " " +
+                          what);
+  }
+
+  QPoint quantise(const Vec2& p, std::size_t stroke) const {
+    const auto q = [&](double v) {
+      const double scaled = std::round(v * steps_);
+      if (!std::isfinite(scaled) || std::abs(scaled) > static_cast<double>(kMaxCoordinate)) {
+        fail("stroke " + std::to_string(stroke + 1) + ": coordinate " + std::to_string(v) + " out of range");
+      }
+      return static_cast<std::int64_t>(scaled);
+    };
+    return {q(p.x()), q(p.y())};
+  }
+
+  void encode_stroke(std::size_t s) {
+    const Stroke& stroke = character_.strokes[s];
+    const std::string where = "stroke " + std::to_string(s + 1);
+    if (stroke.typical_id < 1 || stroke.typical_id > 39) fail(where + ": typical ID out of range 1-39");
+    const std::size_t n = stroke.elements.size();
+    if (n == 0 || n > 15 + 255) fail(where + ": " + std::to_string(n) + " elements (1-270)");
+    if (stroke.attraction_factors.size() != n + 1)
+      fail(where + ": needs one attraction factor per feature point");
+
+    // Control points in writing order; an element starting where the last ended shares that joint.
+    std::vector<QPoint> points;
+    std::vector<bool> detached(n, false);
+    for (std::size_t k = 0; k < n; ++k) {
+      const StrokeElement& e = stroke.elements[k];
+      if (e.degree < 1 || e.degree > kMaxElementDegree || (e.degree == 1) != (e.kind == ElementKind::line)) {
+        fail(where + ": element " + std::to_string(k + 1) + " has kind/degree out of range");
+      }
+      const QPoint start = quantise(e.start(), s);
+      if (k == 0 || !(start == points.back())) {
+        detached[k] = k > 0;
+        points.push_back(start);
+      }
+      for (int i = 1; i <= e.degree; ++i)
+        points.push_back(quantise(e.control[static_cast<std::size_t>(i)], s));
+    }
+    const bool any_detached = std::find(detached.begin(), detached.end(), true) != detached.end();
+    const double default_factor = typical_stroke(stroke.typical_id).default_attraction;
+    bool explicit_factors = false;
+    for (double f : stroke.attraction_factors) {
+      if (!std::isfinite(f)) fail(where + ": attraction factor is not finite");
+      explicit_factors |= f != default_factor;
+    }
+
+    out_.put(static_cast<std::uint64_t>(stroke.typical_id), 6);
+    if (n - 1 < 15) {
+      out_.put(n - 1, 4);
+    } else {
+      out_.put(15, 4);
+      out_.put(n - 16, 8);
+    }
+    out_.put((explicit_factors ? kExplicitFactors : 0u) | (any_detached ? kDetachedElements : 0u), 2);
+    for (const StrokeElement& e : stroke.elements) out_.put(static_cast<std::uint64_t>(e.degree - 1), 2);
+    if (any_detached) {
+      for (std::size_t k = 1; k < n; ++k) out_.put(detached[k] ? 1 : 0, 1);
+    }
+    // The start relative to the previous stroke's end, with its own width: strokes jump further than
+    // control points within a stroke move.
+    const auto put_delta = [&](const QPoint& from, const QPoint& to, int width) {
+      out_.put(zigzag(to.x - from.x), width);
+      out_.put(zigzag(to.y - from.y), width);
+    };
+    const int start_width =
+        std::max(bit_width(zigzag(points[0].x - previous_.x)), bit_width(zigzag(points[0].y - previous_.y)));
+    out_.put(static_cast<std::uint64_t>(start_width), 5);
+    put_delta(previous_, points[0], start_width);
+    int width = 0;
+    for (std::size_t i = 1; i < points.size(); ++i) {
+      width = std::max({width, bit_width(zigzag(points[i].x - points[i - 1].x)),
+                        bit_width(zigzag(points[i].y - points[i - 1].y))});
+    }
+    out_.put(static_cast<std::uint64_t>(width), 5);
+    for (std::size_t i = 1; i < points.size(); ++i) put_delta(points[i - 1], points[i], width);
+    if (explicit_factors) {
+      for (double f : stroke.attraction_factors) out_.put(double_bits(f), 64);
+    }
+    previous_ = points.back();
+  }
+
+  const Character& character_;
+  int steps_;
+  BitWriter out_;
+  QPoint previous_;
+};
+
+}  // namespace
+
+std::vector<std::uint8_t> encode_corpus_store(std::span<const Character> characters,
+                                              const CorpusStoreOptions& options) {
+  const int steps = options.steps_per_unit;
+  if (steps != 1 && steps != 2 && steps != 4 && steps != 8 && steps != 16) {
+    throw InvalidArgument("corpus store: steps_per_unit must be 1, 2, 4, 8 or 16, got " +
+                          std::to_string(steps));
+  }
+  if (!(options.fit_tolerance >= 0.0) || !std::isfinite(options.fit_tolerance)) {
+    throw InvalidArgument("corpus store: fit_tolerance must be finite and >= 0");
+  }
+  std::vector<const Character*> sorted;
+  for (const Character& c : characters) sorted.push_back(&c);
+  std::sort(sorted.begin(), sorted.end(), [](auto* a, auto* b) { return a->code_point < b->code_point; });
+  for (std::size_t i = 1; i < sorted.size(); ++i) {
+    if (sorted[i]->code_point == sorted[i - 1]->code_point) {
+      throw InvalidArgument("corpus store: character " + describe_character(sorted[i]->code_point) +
+                            " given twice");
+    }
+  }
+
+  const std::size_t index_offset = kHeaderBytes + kDefaultsBytes;
+  const std::size_t records_offset = index_offset + kIndexEntryBytes * sorted.size();
+  std::vector<std::uint8_t> file(records_offset, 0);
+  for (std::size_t k = 0; k < sorted.size(); ++k) {
+    const Character* c = sorted[k];
+    if (c->code_point > 0x10FFFF) throw InvalidArgument("corpus store: code point out of Unicode range");
+    const std::size_t offset = file.size() - records_offset;
+    if (offset > 0xFFFFFFFFu) throw InvalidArgument("corpus store: records exceed 4 GiB");
+    const std::vector<std::uint8_t> record = RecordEncoder(*c, steps).encode();
+    file.insert(file.end(), record.begin(), record.end());
+    std::uint8_t* entry = file.data() + index_offset + kIndexEntryBytes * k;
+    put_u32(entry, static_cast<std::uint32_t>(c->code_point));
+    put_u32(entry + 4, static_cast<std::uint32_t>(offset));
+    put_u32(entry + 8, crc32(record));
+  }
+
+  std::uint8_t* h = file.data();
+  std::copy(kMagic.begin(), kMagic.end(), h);
+  put_u16(h + kOffVersionMajor, kVersionMajor);
+  put_u16(h + kOffVersionMinor, kVersionMinor);
+  put_u32(h + kOffHeaderSize, static_cast<std::uint32_t>(kHeaderBytes));
+  put_u32(h + kOffCount, static_cast<std::uint32_t>(sorted.size()));
+  put_u32(h + kOffSteps, static_cast<std::uint32_t>(steps));
+  put_u32(h + kOffTolerance, float_bits(static_cast<float>(options.fit_tolerance)));
+  put_u32(h + kOffFlags, 0);
+  put_u64(h + kOffIndex, index_offset);
+  put_u64(h + kOffRecords, records_offset);
+  put_u64(h + kOffRecordsSize, file.size() - records_offset);
+  for (std::size_t id = 1; id <= kTypicalStrokeCount; ++id) {
+    put_u64(h + kHeaderBytes + 8 * (id - 1),
+            double_bits(typical_stroke(static_cast<int>(id)).default_attraction));
+  }
+  put_u32(h + kOffTablesCrc, crc32(std::span(file).subspan(kHeaderBytes, records_offset - kHeaderBytes)));
+  put_u32(h + kOffHeaderCrc, crc32(std::span(file).first(kOffHeaderCrc)));
+  return file;
+}
+
+void write_corpus_store(const std::filesystem::path& path, std::span<const Character> characters,
+                        const CorpusStoreOptions& options) {
+  const std::vector<std::uint8_t> bytes = encode_corpus_store(characters, options);
+  std::filesystem::path temporary = path;
+  temporary += ".tmp";
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    if (!out) throw DataError(temporary.string() + ": cannot write the corpus store");
+  }
+  std::error_code ec;
+  std::filesystem::rename(temporary, path, ec);
+  if (ec) throw DataError(path.string() + ": cannot write the corpus store (" + ec.message() + ")");
+}
+
+}  // namespace calligraphy

@@ -1,0 +1,231 @@
+#include "calligraphy/corpus_store.hpp"
+
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include "calligraphy/character_library.hpp"
+#include "calligraphy/errors.hpp"
+#include "calligraphy/scene.hpp"
+#include "calligraphy/typical_strokes.hpp"
+#include "model/corpus_store_format.hpp"
+
+using namespace calligraphy;
+
+namespace {
+
+std::vector<Character> embedded_characters() {
+  const CharacterLibrary library = CharacterLibrary::embedded();
+  std::vector<Character> out;
+  for (char32_t c : library.characters()) out.push_back(library.load(c));
+  return out;
+}
+
+std::vector<Character> small_set() {
+  const CharacterLibrary library = CharacterLibrary::embedded();
+  return {library.load(U'永'), library.load(U'十')};
+}
+
+std::filesystem::path temp_path(const std::string& name) {
+  return std::filesystem::temp_directory_path() / ("calligraphy_store_test_" + name);
+}
+
+// Every load of every character either succeeds or throws DataError; nothing else escapes.
+void open_and_load_all(std::span<const std::uint8_t> bytes) {
+  const CorpusStore store = CorpusStore::from_bytes(bytes, "test");
+  for (char32_t cp : store.characters()) (void)store.load(cp);
+}
+
+}  // namespace
+
+TEST_CASE("CRC-32 matches the IEEE check value", "[store]") {
+  const std::string text = "123456789";
+  CHECK(store::crc32({reinterpret_cast<const std::uint8_t*>(text.data()), text.size()}) == 0xCBF43926u);
+}
+
+TEST_CASE("Store round trip of the embedded characters", "[store]") {
+  const auto characters = embedded_characters();
+  REQUIRE(characters.size() > 50);
+  for (int steps : {1, 2, 16}) {
+    CorpusStoreOptions options;
+    options.steps_per_unit = steps;
+    const auto bytes = encode_corpus_store(characters, options);
+    const CorpusStore store = CorpusStore::from_bytes(bytes, "memory");
+    REQUIRE(store.size() == characters.size());
+    CHECK(store.info().steps_per_unit == steps);
+    const double q = store.info().max_quantisation_error();
+    CHECK(q == Approx(std::sqrt(2.0) / (2.0 * steps)));
+    for (const Character& original : characters) {
+      const Character loaded = store.load(original.code_point);
+      REQUIRE(loaded.strokes.size() == original.strokes.size());
+      for (std::size_t s = 0; s < original.strokes.size(); ++s) {
+        const Stroke& a = original.strokes[s];
+        const Stroke& b = loaded.strokes[s];
+        CHECK(b.typical_id == a.typical_id);
+        CHECK(b.attraction_factors == a.attraction_factors);
+        CHECK(b.median.empty());
+        REQUIRE(b.elements.size() == a.elements.size());
+        for (std::size_t e = 0; e < a.elements.size(); ++e) {
+          CHECK(b.elements[e].kind == a.elements[e].kind);
+          REQUIRE(b.elements[e].degree == a.elements[e].degree);
+          for (int i = 0; i <= a.elements[e].degree; ++i) {
+            const auto k = static_cast<std::size_t>(i);
+            CHECK((b.elements[e].control[k] - a.elements[e].control[k]).norm() <= q + 1e-12);
+          }
+          if (e > 0) CHECK(b.elements[e].start() == b.elements[e - 1].end());  // joints shared
+        }
+      }
+    }
+  }
+}
+
+TEST_CASE("Store keeps explicit attraction factors and detached elements exactly", "[store]") {
+  Character c = CharacterLibrary::embedded().load(U'永');
+  c.strokes[1].attraction_factors[1] = 0.123456789;
+  c.strokes[2].elements[1].control[0] += Vec2(3.0, -4.0);  // an element that does not start at the joint
+  if (c.strokes[2].elements[1].degree == 1) c.strokes[2].elements[1].kind = ElementKind::line;
+  const std::vector<Character> one{c};
+  const auto bytes = encode_corpus_store(one, {16, 10.0});
+  const Character loaded = CorpusStore::from_bytes(bytes, "memory").load(U'永');
+  CHECK(loaded.strokes[1].attraction_factors == c.strokes[1].attraction_factors);
+  CHECK((loaded.strokes[2].elements[1].start() - c.strokes[2].elements[1].start()).norm() <= 1.0 / 16);
+  CHECK((loaded.strokes[2].elements[0].end() - c.strokes[2].elements[0].end()).norm() <= 1.0 / 16);
+}
+
+TEST_CASE("Store lookup of present and absent characters", "[store]") {
+  const auto path = temp_path("lookup.clg");
+  write_corpus_store(path, small_set());
+  const CorpusStore store = CorpusStore::open(path);
+  CHECK(store.characters() == std::vector<char32_t>{U'十', U'永'});
+  CHECK(store.contains(U'永'));
+  CHECK_FALSE(store.contains(U'二'));
+  CHECK(store.load(U'十').strokes.size() == 2);
+  CHECK(store.load(U'永').source.find(path.string()) == 0);
+  CHECK_THROWS_AS(store.load(U'二'), CharacterNotFound);
+  CHECK_THROWS_WITH(store.load(U'二'), Catch::Contains("U+4E8C") && Catch::Contains(path.string()));
+  CHECK_THROWS_AS(store.record_bytes(U'二'), CharacterNotFound);
+  CHECK(store.record_bytes(U'永') > 10);
+  std::filesystem::remove(path);
+}
+
+TEST_CASE("Store writer rejects what it cannot encode", "[store]") {
+  const auto set = small_set();
+  CHECK_THROWS_AS(encode_corpus_store(set, {3, 10.0}), InvalidArgument);
+  std::vector<Character> twice{set[0], set[0]};
+  CHECK_THROWS_AS(encode_corpus_store(twice, {}), InvalidArgument);
+  Character bad = set[0];
+  bad.strokes[0].typical_id = 40;
+  CHECK_THROWS_AS(encode_corpus_store(std::vector{bad}, {}), InvalidArgument);
+  bad = set[0];
+  bad.strokes[0].elements[0].control[0].x() = std::nan("");
+  CHECK_THROWS_AS(encode_corpus_store(std::vector{bad}, {}), InvalidArgument);
+  bad = set[0];
+  bad.strokes[0].attraction_factors.pop_back();
+  CHECK_THROWS_AS(encode_corpus_store(std::vector{bad}, {}), InvalidArgument);
+}
+
+TEST_CASE("Store: missing, empty, foreign and newer-version files are DataErrors naming the file",
+          "[store]") {
+  CHECK_THROWS_AS(CorpusStore::open(temp_path("does_not_exist.clg")), DataError);
+  const auto empty = temp_path("empty.clg");
+  std::ofstream(empty).close();
+  CHECK_THROWS_WITH(CorpusStore::open(empty),
+                    Catch::Contains(empty.string()) && Catch::Contains("too short"));
+  std::filesystem::remove(empty);
+  const std::string json = R"({"strokes": [], "medians": []})";
+  std::vector<std::uint8_t> foreign(json.begin(), json.end());
+  foreign.resize(600, ' ');
+  CHECK_THROWS_WITH(CorpusStore::from_bytes(foreign, "x.json"),
+                    Catch::Contains("x.json") && Catch::Contains("magic"));
+
+  auto bytes = encode_corpus_store(small_set());
+  store::put_u16(bytes.data() + store::kOffVersionMajor, 2);  // a future format, header CRC fixed up
+  store::put_u32(bytes.data() + store::kOffHeaderCrc,
+                 store::crc32(std::span(bytes).first(store::kOffHeaderCrc)));
+  CHECK_THROWS_WITH(CorpusStore::from_bytes(bytes, "v2"), Catch::Contains("version 2.0 is not supported"));
+}
+
+TEST_CASE("Store truncated at every byte offset is a DataError", "[store]") {
+  const auto bytes = encode_corpus_store(small_set());
+  for (std::size_t n = 0; n < bytes.size(); ++n) {
+    INFO("truncated to " << n << " of " << bytes.size() << " bytes");
+    CHECK_THROWS_AS(open_and_load_all(std::span(bytes).first(n)), DataError);
+  }
+  CHECK_NOTHROW(open_and_load_all(bytes));
+}
+
+TEST_CASE("Store with any single byte corrupted is a DataError", "[store]") {
+  const auto bytes = encode_corpus_store(small_set());
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    for (std::uint8_t flip : {std::uint8_t{0x01}, std::uint8_t{0x80}, std::uint8_t{0xFF}}) {
+      auto corrupted = bytes;
+      corrupted[i] ^= flip;
+      INFO("byte " << i << " xor " << int{flip});
+      // CRC-32 detects every error burst of up to 32 bits, so each such change is caught.
+      CHECK_THROWS_AS(open_and_load_all(corrupted), DataError);
+    }
+  }
+}
+
+TEST_CASE("Store regressions from fuzzing are DataErrors, not crashes", "[store]") {
+  const std::filesystem::path folder = std::filesystem::path(CALLIGRAPHY_TEST_DATA_DIR) / "store_regressions";
+  std::size_t files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+    if (!entry.is_regular_file() || entry.path().extension() == ".md") continue;
+    std::ifstream in(entry.path(), std::ios::binary);
+    const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)),
+                                          std::istreambuf_iterator<char>());
+    INFO(entry.path().string());
+    CHECK_THROWS_AS(open_and_load_all(bytes), DataError);
+    ++files;
+  }
+  CHECK(files > 0);
+}
+
+TEST_CASE("A scene laid out from a store matches one from the fitted characters", "[store]") {
+  const auto set = small_set();
+  const CorpusStore store = CorpusStore::from_bytes(encode_corpus_store(set, {16, 10.0}), "memory");
+  const Scene from_json = Scene::lay_out(set);
+  const Scene from_store = Scene::lay_out({store.load(U'永'), store.load(U'十')});
+  REQUIRE(from_store.stroke_count() == from_json.stroke_count());
+  const double metres_per_unit = SceneLayout{}.character_size_m / kDataBoxSize;
+  for (std::size_t c = 0; c < 2; ++c) {
+    for (std::size_t s = 0; s < from_json.characters[c].strokes.size(); ++s) {
+      const auto& a = from_json.characters[c].strokes[s];
+      const auto& b = from_store.characters[c].strokes[s];
+      CHECK(a.typical_id == b.typical_id);
+      CHECK(b.length_m() == Approx(a.length_m()).epsilon(1e-3));
+      CHECK((a.start() - b.start()).norm() <=
+            store.info().max_quantisation_error() * metres_per_unit + 1e-15);
+    }
+  }
+}
+
+TEST_CASE("Store statistics count what was written and report bad records", "[store]") {
+  const auto characters = embedded_characters();
+  auto bytes = encode_corpus_store(characters);
+  std::size_t strokes = 0;
+  std::size_t elements = 0;
+  std::map<int, std::size_t> by_id;
+  for (const auto& c : characters) {
+    strokes += c.strokes.size();
+    for (const auto& s : c.strokes) {
+      elements += s.elements.size();
+      ++by_id[s.typical_id];
+    }
+  }
+  const CorpusStoreStats stats = corpus_store_stats(CorpusStore::from_bytes(bytes, "memory"));
+  CHECK(stats.characters == characters.size());
+  CHECK(stats.strokes == strokes);
+  CHECK(stats.elements == elements);
+  CHECK(stats.strokes_by_typical_id == by_id);
+  CHECK(stats.errors.empty());
+
+  bytes.back() ^= 0x10;  // the last record: its CRC no longer matches, the others still load
+  const CorpusStoreStats bad = corpus_store_stats(CorpusStore::from_bytes(bytes, "memory"));
+  CHECK(bad.characters == characters.size() - 1);
+  REQUIRE(bad.errors.size() == 1);
+  CHECK_THAT(bad.errors[0], Catch::Contains("checksum mismatch"));
+}
