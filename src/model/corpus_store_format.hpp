@@ -14,7 +14,8 @@ inline constexpr std::uint16_t kVersionMajor = 1;  // readers reject another maj
 inline constexpr std::uint16_t kVersionMinor = 0;  // added fields only; readers accept any minor
 inline constexpr std::size_t kHeaderBytes = 64;
 inline constexpr std::size_t kTypicalStrokeCount = 39;
-inline constexpr std::size_t kDefaultsBytes = 8 * kTypicalStrokeCount;  // float64 per typical ID
+// Two float64 per typical ID: the default attraction factor, then the corner attraction factor.
+inline constexpr std::size_t kDefaultsBytes = 16 * kTypicalStrokeCount;
 inline constexpr std::size_t kIndexEntryBytes = 12;                     // code point, offset, CRC
 inline constexpr std::int64_t kMaxCoordinate = std::int64_t{1} << 23;   // quantised |x|
 
@@ -24,8 +25,9 @@ inline constexpr std::size_t kOffVersionMajor = 8, kOffVersionMinor = 10, kOffHe
                              kOffRecords = 40, kOffRecordsSize = 48, kOffTablesCrc = 56, kOffHeaderCrc = 60;
 
 // Per-stroke flags.
-inline constexpr unsigned kExplicitFactors =
-    1;  // factors stored as float64, else the file's default for the ID
+// Not every factor is the file's default for the ID: a 1-bit mode follows. Mode 1 (palette): one bit per
+// feature point choosing the ID's default (0) or corner (1) factor. Mode 0: one float64 per feature point.
+inline constexpr unsigned kExplicitFactors = 1;
 inline constexpr unsigned kDetachedElements = 2;  // some element does not start where the previous ended
 
 /// CRC-32 (IEEE 802.3, reflected polynomial 0xEDB88320, as zlib and PNG), slicing by one byte.

@@ -29,6 +29,7 @@ struct CorpusStore::Data {
   const std::uint8_t* index = nullptr;
   const std::uint8_t* records = nullptr;
   std::array<double, kTypicalStrokeCount> default_factors{};
+  std::array<double, kTypicalStrokeCount> corner_factors{};
 
   Data() = default;
   Data(const Data&) = delete;
@@ -114,9 +115,10 @@ void CorpusStore::Data::validate() {
   index = bytes + index_offset;
   records = bytes + records_offset;
   for (std::size_t id = 0; id < kTypicalStrokeCount; ++id) {
-    default_factors[id] = get_f64(bytes + kHeaderBytes + 8 * id);
-    if (!std::isfinite(default_factors[id]))
-      fail(kHeaderBytes + 8 * id, "default attraction factor not finite");
+    default_factors[id] = get_f64(bytes + kHeaderBytes + 16 * id);
+    corner_factors[id] = get_f64(bytes + kHeaderBytes + 16 * id + 8);
+    if (!std::isfinite(default_factors[id]) || !std::isfinite(corner_factors[id]))
+      fail(kHeaderBytes + 16 * id, "default or corner attraction factor not finite");
   }
   for (std::size_t k = 0; k < info.character_count; ++k) {
     const std::size_t at = index_offset + kIndexEntryBytes * k;
@@ -188,8 +190,14 @@ Character CorpusStore::Data::decode(std::size_t k) const {
       previous = element.end();
     }
     if (flags & kExplicitFactors) {
+      const auto id = static_cast<std::size_t>(stroke.typical_id - 1);
+      const bool palette = get(1) == 1;
       stroke.attraction_factors.resize(n + 1);
       for (double& f : stroke.attraction_factors) {
+        if (palette) {
+          f = get(1) == 1 ? corner_factors[id] : default_factors[id];
+          continue;
+        }
         const std::uint64_t bits = get(64);
         std::memcpy(&f, &bits, sizeof f);
         if (!std::isfinite(f)) bad("stroke " + std::to_string(s + 1) + ": attraction factor not finite");

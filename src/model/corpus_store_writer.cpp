@@ -78,11 +78,13 @@ class RecordEncoder {
         points.push_back(quantise(e.control[static_cast<std::size_t>(i)], s));
     }
     const bool any_detached = std::find(detached.begin(), detached.end(), true) != detached.end();
-    const double default_factor = typical_stroke(stroke.typical_id).default_attraction;
-    bool explicit_factors = false;
+    const TypicalStroke& type = typical_stroke(stroke.typical_id);
+    bool explicit_factors = false;  // some factor is not the ID's default
+    bool palette = true;            // every factor is the ID's default or corner factor
     for (double f : stroke.attraction_factors) {
       if (!std::isfinite(f)) fail(where + ": attraction factor is not finite");
-      explicit_factors |= f != default_factor;
+      explicit_factors |= f != type.default_attraction;
+      palette &= f == type.default_attraction || f == type.corner_attraction;
     }
 
     out_.put(static_cast<std::uint64_t>(stroke.typical_id), 6);
@@ -115,7 +117,14 @@ class RecordEncoder {
     out_.put(static_cast<std::uint64_t>(width), 5);
     for (std::size_t i = 1; i < points.size(); ++i) put_delta(points[i - 1], points[i], width);
     if (explicit_factors) {
-      for (double f : stroke.attraction_factors) out_.put(double_bits(f), 64);
+      out_.put(palette ? 1 : 0, 1);
+      for (double f : stroke.attraction_factors) {
+        if (palette) {
+          out_.put(f == type.default_attraction ? 0 : 1, 1);
+        } else {
+          out_.put(double_bits(f), 64);
+        }
+      }
     }
     previous_ = points.back();
   }
@@ -177,8 +186,9 @@ std::vector<std::uint8_t> encode_corpus_store(std::span<const Character> charact
   put_u64(h + kOffRecords, records_offset);
   put_u64(h + kOffRecordsSize, file.size() - records_offset);
   for (std::size_t id = 1; id <= kTypicalStrokeCount; ++id) {
-    put_u64(h + kHeaderBytes + 8 * (id - 1),
-            double_bits(typical_stroke(static_cast<int>(id)).default_attraction));
+    const TypicalStroke& type = typical_stroke(static_cast<int>(id));
+    put_u64(h + kHeaderBytes + 16 * (id - 1), double_bits(type.default_attraction));
+    put_u64(h + kHeaderBytes + 16 * (id - 1) + 8, double_bits(type.corner_attraction));
   }
   put_u32(h + kOffTablesCrc, crc32(std::span(file).subspan(kHeaderBytes, records_offset - kHeaderBytes)));
   put_u32(h + kOffHeaderCrc, crc32(std::span(file).first(kOffHeaderCrc)));
