@@ -20,5 +20,6 @@ int command_trial(const Args& args);          // calligraphy trial CHARS [...]
 int command_model(const Args& args);          // calligraphy model CHAR [...]
 int command_bench_nearest(const Args& args);  // calligraphy bench nearest [--json] [...]
 int command_devices(const Args& args);        // calligraphy devices
+int command_bench_loop(const Args& args);     // calligraphy bench loop [--rate HZ] [--seconds S] [...]
 
 }  // namespace calligraphy::cli
