@@ -383,3 +383,36 @@ TEST_CASE("A device fault during a real-time trial keeps the recording and repor
   CHECK(result.trial.trace.back().time_s > result.trial.trace.front().time_s);
   CHECK_FALSE(device.forces_enabled());
 }
+
+TEST_CASE("Start, stop and restart under a running trial leave no thread behind", "[servo]") {
+  const Scene scene = scene_of(U"口");
+  SimulatedDevice device;
+  SimulatedWriter writer(scene, WriterProfile::skilled(), 0);
+  Renderer renderer(scene, ForceLawParameters{}, device.info());
+  TrialRecorder recorder(scene, /*keep_trace=*/false);
+  device.attach_hand(&writer);
+  device.open();
+  const double period_s = 1e-3;
+  ServoLoop loop(
+      device,
+      [&](const DeviceState& state, double) {
+        const RenderOutput out = renderer.tick(state);
+        recorder.record(state, out);
+        device.write_force(out.force_n);
+        writer.observe(out, state);
+        device.advance(period_s);
+        return ServoCommand{out.force_n, out.finished};
+      },
+      test_options());
+  const std::size_t threads_before = thread_count();
+  double last_time_s = 0.0;
+  for (int run = 0; run < 3; ++run) {
+    loop.start();
+    std::this_thread::sleep_for(std::chrono::milliseconds(60));
+    CHECK_FALSE(loop.stop());
+    CHECK(settled_thread_count(threads_before) == threads_before);
+    CHECK_FALSE(device.forces_enabled());
+    CHECK(device.time() > last_time_s);  // the trial went on in each run
+    last_time_s = device.time();
+  }
+}
