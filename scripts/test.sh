@@ -21,9 +21,11 @@ cmake --build build-asan -j "$jobs"
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 ctest --test-dir build-asan --output-on-failure -j "$jobs"
 
 echo "== ThreadSanitizer: the servo loop and its log queue"
+# -Wno-tsan: GCC warns that TSan does not model atomic_thread_fence (the OpenHaptics seqlock uses it);
+# those tests are not run here.
 cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCALLIGRAPHY_SANITIZE=thread \
-  -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_TOOLS=OFF -DCALLIGRAPHY_BUILD_BENCH=OFF \
-  -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_EXAMPLES=OFF >/dev/null
+  -DCMAKE_CXX_FLAGS=-Wno-tsan -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_TOOLS=OFF \
+  -DCALLIGRAPHY_BUILD_BENCH=OFF -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_EXAMPLES=OFF >/dev/null
 cmake --build build-tsan -j "$jobs" --target calligraphy_tests
 TSAN_OPTIONS=halt_on_error=1 build-tsan/tests/calligraphy_tests "[servo],[log_queue]"
 

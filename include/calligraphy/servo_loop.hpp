@@ -143,7 +143,8 @@ class ServoLoop {
   void start();
   /// Asks the loop to stop, waits for the thread to end and returns the fault that ended the run, if
   /// any (none when it was stopped or ended by its callback). Forces are zero and disabled on return.
-  /// Never throws; does nothing when not started.
+  /// Never throws; does nothing when not started. Called from the callback it only requests the stop (the
+  /// callback should return `ServoCommand::stop` instead).
   LoopFault stop() noexcept;
   /// Waits until the loop ends by itself (its callback asked to stop, or a fault) and joins it; then
   /// rethrows the fault: the device's or the callback's own exception, or a SafetyFault for the
@@ -151,7 +152,8 @@ class ServoLoop {
   void wait();
   /// True from `start()` until the loop thread has left its loop. Any thread.
   [[nodiscard]] bool running() const noexcept;
-  /// A snapshot of the statistics; lock-free, any thread, any time (also after the run).
+  /// A snapshot of the statistics; lock-free, from any thread while the loop runs or after it ended (not
+  /// concurrently with `start()`, which resets them).
   [[nodiscard]] ServoLoopStats stats() const;
   [[nodiscard]] const ServoLoopOptions& options() const noexcept;
 
