@@ -27,7 +27,7 @@ cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCALLIGRAPH
   -DCMAKE_CXX_FLAGS=-Wno-tsan -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_TOOLS=OFF \
   -DCALLIGRAPHY_BUILD_BENCH=OFF -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_EXAMPLES=OFF >/dev/null
 cmake --build build-tsan -j "$jobs" --target calligraphy_tests
-TSAN_OPTIONS=halt_on_error=1 build-tsan/tests/calligraphy_tests "[servo],[log_queue]"
+TSAN_OPTIONS=halt_on_error=1 build-tsan/bin/calligraphy_tests "[servo],[log_queue]"
 
 echo "== install + find_package(calligraphy) from another project"
 rm -rf build/stage build/consumer
