@@ -54,13 +54,23 @@ std::string describe_errno(int error) {
   return std::string(text) + " (" + (name != nullptr ? name : "errno " + std::to_string(error)) + ")";
 }
 
+namespace {
+
+void append_problem(std::string& problems, const std::string& problem) {
+  if (!problems.empty()) problems += "; ";
+  problems += problem;
+}
+
+}  // namespace
+
 bool lock_process_memory(std::string& problems) {
   if (built_with_sanitizer()) {
-    problems += "mlockall: not available in a sanitizer build; ";
+    append_problem(problems, "mlockall: not available in a sanitizer build");
     return false;
   }
   if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
-    problems += "mlockall(MCL_CURRENT | MCL_FUTURE): " + describe_errno(errno) + "; ";
+    const int error = errno;  // read before anything else can change it
+    append_problem(problems, "mlockall(MCL_CURRENT | MCL_FUTURE): " + describe_errno(error));
     return false;
   }
   return true;
@@ -76,8 +86,8 @@ void apply_thread_realtime(const ServoLoopOptions& options, RealtimeStatus& stat
       status.fifo_scheduling = true;
       status.priority = options.priority;
     } else {
-      status.problems +=
-          "SCHED_FIFO priority " + std::to_string(options.priority) + ": " + describe_errno(error) + "; ";
+      append_problem(status.problems, "SCHED_FIFO priority " + std::to_string(options.priority) + ": " +
+                                          describe_errno(error));
     }
   }
   if (options.cpu >= 0) {
@@ -88,8 +98,8 @@ void apply_thread_realtime(const ServoLoopOptions& options, RealtimeStatus& stat
     if (error == 0) {
       status.cpu = options.cpu;
     } else {
-      status.problems +=
-          "pinning to CPU " + std::to_string(options.cpu) + ": " + describe_errno(error) + "; ";
+      append_problem(status.problems,
+                     "pinning to CPU " + std::to_string(options.cpu) + ": " + describe_errno(error));
     }
   }
 }
