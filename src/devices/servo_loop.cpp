@@ -321,6 +321,8 @@ void ServoLoop::start() {
 
   m.stop_requested.store(false, std::memory_order_relaxed);
   m.running.store(true, std::memory_order_release);
+  // spdlog creates its default logger lazily; create it here, before the drain thread can race to it.
+  static_cast<void>(spdlog::default_logger_raw());
   m.log_drain.start(m.log_queue, log_sink);
   m.thread = std::thread([&m] {
     devices::apply_thread_realtime(m.options, m.realtime);
