@@ -24,5 +24,6 @@ int command_devices(const Args& args);        // calligraphy devices
 int command_corpus(const Args& args);           // calligraphy corpus build|stats|fidelity [...]
 int command_corpus_validate(const Args& args);  // calligraphy corpus validate --data DIR --cnchar FILE [...]
 int command_strokes(const Args& args);          // calligraphy strokes [--markdown FILE] [--json]
+int command_bench_loop(const Args& args);     // calligraphy bench loop [--rate HZ] [--seconds S] [...]
 
 }  // namespace calligraphy::cli

@@ -29,7 +29,9 @@ constexpr const char* kUsage =
     "  bench nearest [--json] [--markdown FILE] [--queries N] [--seed S]\n"
     "                       accuracy and speed of the nearest-point methods\n"
     "  bench jumps [--json] [--markdown FILE] [--seeds N] [--chars CHARS]\n"
-    "                       foot-point jumps > 1 mm per stroke on real characters, by method\n";
+    "                       foot-point jumps > 1 mm per stroke on real characters, by method\n"
+    "  bench loop [--rate HZ] [--seconds S] [--realtime enforce|ignore|off] [--trial CHARS] [--json]\n"
+    "                       period jitter and missed deadlines of the real-time servo loop\n";
 
 }  // namespace
 
@@ -50,6 +52,7 @@ int main(int argc, char** argv) {
     if (command == "corpus") return command_corpus(args);
     if (command == "bench" && !args.empty() && args[0] == "nearest") return command_bench_nearest(args);
     if (command == "bench" && !args.empty() && args[0] == "jumps") return command_bench_jumps(args);
+    if (command == "bench" && !args.empty() && args[0] == "loop") return command_bench_loop(args);
     std::fprintf(stderr, "calligraphy: error: unknown command '%s'\n%s", command.c_str(), kUsage);
     return 2;
   } catch (const UsageError& e) {

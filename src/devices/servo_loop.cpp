@@ -1,0 +1,411 @@
+#include "calligraphy/servo_loop.hpp"
+
+#include <sched.h>
+#include <spdlog/spdlog.h>
+#include <time.h>
+
+#include <array>
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <thread>
+
+#include "devices/latency_histogram.hpp"
+#include "devices/log_queue.hpp"
+#include "devices/servo_loop_realtime.hpp"
+
+namespace calligraphy {
+
+using devices::LatencyHistogram;
+using devices::LogLevel;
+using devices::LogRecord;
+
+namespace {
+
+constexpr double kMinRateHz = 100.0;
+constexpr double kMaxRateHz = 10000.0;
+
+std::int64_t monotonic_ns() noexcept {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+// Sleeps until the absolute CLOCK_MONOTONIC time `deadline_ns` (a signal does not shorten the sleep).
+void sleep_until(std::int64_t deadline_ns) noexcept {
+  timespec ts{};
+  ts.tv_sec = static_cast<time_t>(deadline_ns / 1'000'000'000);
+  ts.tv_nsec = static_cast<long>(deadline_ns % 1'000'000'000);
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+  }
+}
+
+// What the loop thread logs; worded by `log_sink` on the drain thread.
+enum LogCode : std::uint16_t { kDeadlineMissed = 1, kWatchdog, kFault, kStopped };
+
+void log_sink(const LogRecord& r) {
+  switch (r.code) {
+    case kDeadlineMissed:
+      spdlog::warn("servo loop: tick {} missed its deadline by {:.1f} us ({} missed so far)", r.count,
+                   r.values[0], static_cast<std::uint64_t>(r.values[1]));
+      break;
+    case kWatchdog:
+      spdlog::error("servo loop: watchdog: {}", r.text.data());
+      break;
+    case kFault:
+      spdlog::error("servo loop: fault at tick {}: {}", r.count, r.text.data());
+      break;
+    case kStopped:
+      spdlog::info("servo loop: stopped after {} ticks, {} missed deadlines", r.count,
+                   static_cast<std::uint64_t>(r.values[0]));
+      break;
+    default:
+      spdlog::debug("servo loop: log record {}", r.code);
+  }
+}
+
+constexpr std::size_t kFaultMessageBytes = 128;
+
+}  // namespace
+
+const char* to_string(LoopFaultKind kind) noexcept {
+  switch (kind) {
+    case LoopFaultKind::none:
+      return "none";
+    case LoopFaultKind::watchdog:
+      return "watchdog";
+    case LoopFaultKind::communication:
+      return "communication";
+    case LoopFaultKind::safety:
+      return "safety";
+    case LoopFaultKind::device:
+      return "device";
+    case LoopFaultKind::callback:
+      return "callback";
+  }
+  return "unknown";
+}
+
+void ServoLoopOptions::validate() const {
+  if (!(rate_hz >= kMinRateHz && rate_hz <= kMaxRateHz)) {
+    throw InvalidArgument("ServoLoopOptions.rate_hz = " + std::to_string(rate_hz) +
+                          " must be in [100, 10000] Hz");
+  }
+  if (priority < 0 || priority > 99) {
+    throw InvalidArgument("ServoLoopOptions.priority = " + std::to_string(priority) + " must be in [0, 99]");
+  }
+  if (realtime == RealtimeMode::enforce && priority == 0) {
+    throw InvalidArgument("ServoLoopOptions.priority must be in [1, 99] with RealtimeMode::enforce");
+  }
+  if (cpu < -1 || cpu >= CPU_SETSIZE) {
+    throw InvalidArgument("ServoLoopOptions.cpu = " + std::to_string(cpu) +
+                          " must be -1 or a CPU index below " + std::to_string(CPU_SETSIZE));
+  }
+  if (watchdog_periods < 0) {
+    throw InvalidArgument("ServoLoopOptions.watchdog_periods = " + std::to_string(watchdog_periods) +
+                          " must be >= 0");
+  }
+}
+
+std::int64_t ServoLoopOptions::period_ns() const { return std::llround(1e9 / rate_hz); }
+
+struct ServoLoop::Impl {
+  Impl(HapticDevice& d, ServoCallback c, const ServoLoopOptions& o)
+      : device(d), callback(std::move(c)), options(o) {}
+
+  void run() noexcept;
+  void record_fault(LoopFaultKind kind, const char* message, std::uint64_t tick) noexcept;
+  void log(LogLevel level, std::uint16_t code, std::uint64_t count, double a = 0.0, double b = 0.0,
+           const char* text = nullptr) noexcept {
+    LogRecord r;
+    r.level = level;
+    r.code = code;
+    r.time_ns = monotonic_ns();
+    r.count = count;
+    r.values = {a, b, 0.0};
+    if (text != nullptr) r.set_text(text);
+    log_queue.try_push(r);  // a full queue drops the record and counts it; the loop never waits
+  }
+  void reset_stats() noexcept;
+  [[nodiscard]] LoopFault fault() const;
+
+  HapticDevice& device;
+  ServoCallback callback;
+  ServoLoopOptions options;
+  std::thread thread;
+  devices::LogQueue log_queue;
+  devices::LogDrain log_drain;
+
+  std::atomic<bool> stop_requested{false};
+  std::atomic<bool> running{false};
+  // Start-up handshake: 0 pending, 1 the loop runs, 2 the realtime settings failed under `enforce`.
+  std::atomic<int> startup{0};
+  RealtimeStatus realtime;  // written before the handshake / by start(), read after it: ordered by `startup`
+
+  // Statistics: single writer (the loop thread), relaxed atomics for the readers.
+  std::atomic<std::uint64_t> ticks{0};
+  std::atomic<std::uint64_t> missed{0};
+  std::atomic<std::uint64_t> skipped{0};
+  std::atomic<std::uint64_t> wake_latency_max_ns{0};
+  LatencyHistogram jitter{1000};        // 1 us bins
+  LatencyHistogram callback_time{100};  // 0.1 us bins
+  // The fault: message characters first, then the kind with release; readers acquire the kind.
+  std::atomic<int> fault_kind{0};
+  std::array<std::atomic<char>, kFaultMessageBytes> fault_message{};
+  std::exception_ptr fault_exception;  // set by the loop thread, read after join
+};
+
+void ServoLoop::Impl::reset_stats() noexcept {
+  ticks.store(0, std::memory_order_relaxed);
+  missed.store(0, std::memory_order_relaxed);
+  skipped.store(0, std::memory_order_relaxed);
+  wake_latency_max_ns.store(0, std::memory_order_relaxed);
+  jitter.clear();
+  callback_time.clear();
+  fault_kind.store(0, std::memory_order_release);
+  for (auto& c : fault_message) c.store('\0', std::memory_order_relaxed);
+  fault_exception = nullptr;
+}
+
+void ServoLoop::Impl::record_fault(LoopFaultKind kind, const char* message, std::uint64_t tick) noexcept {
+  std::size_t i = 0;
+  if (message != nullptr) {
+    for (; i + 1 < kFaultMessageBytes && message[i] != '\0'; ++i)
+      fault_message[i].store(message[i], std::memory_order_relaxed);
+  }
+  fault_message[i].store('\0', std::memory_order_relaxed);
+  fault_kind.store(static_cast<int>(kind), std::memory_order_release);
+  log(LogLevel::error, kind == LoopFaultKind::watchdog ? kWatchdog : kFault, tick, 0.0, 0.0, message);
+}
+
+LoopFault ServoLoop::Impl::fault() const {
+  LoopFault f;
+  f.kind = static_cast<LoopFaultKind>(fault_kind.load(std::memory_order_acquire));
+  if (f.kind == LoopFaultKind::none) return f;
+  for (const auto& c : fault_message) {
+    const char ch = c.load(std::memory_order_relaxed);
+    if (ch == '\0') break;
+    f.message.push_back(ch);
+  }
+  return f;
+}
+
+// The loop body (issue 5, Deliver 1). Deadlines are absolute, on a grid of whole periods from the start:
+// a late tick does not shift later ones. When a tick ends past the next deadline, the missed deadlines
+// are skipped (never run back to back), so the callback always sees dt close to a whole number of periods.
+void ServoLoop::Impl::run() noexcept {
+  const std::int64_t period = options.period_ns();
+  const double period_s = static_cast<double>(period) * 1e-9;
+  const std::int64_t watchdog_ns = static_cast<std::int64_t>(options.watchdog_periods) * period;
+  std::int64_t next = monotonic_ns() + period;
+  std::int64_t previous_wake = 0;
+  std::uint64_t tick = 0;
+  std::uint64_t missed_count = 0;
+  std::array<char, kFaultMessageBytes> reason{};
+
+  while (!stop_requested.load(std::memory_order_acquire)) {
+    sleep_until(next);
+    const std::int64_t wake = monotonic_ns();
+    const std::int64_t deadline = next + period;  // the force must be out before the next tick starts
+    if (wake - next > static_cast<std::int64_t>(wake_latency_max_ns.load(std::memory_order_relaxed))) {
+      wake_latency_max_ns.store(static_cast<std::uint64_t>(wake - next), std::memory_order_relaxed);
+    }
+    double dt_s = period_s;
+    if (tick > 0) {
+      jitter.add(std::llabs((wake - previous_wake) - period));
+      dt_s = static_cast<double>(wake - previous_wake) * 1e-9;
+    }
+    previous_wake = wake;
+
+    bool stop_after = false;
+    try {
+      const DeviceState state = device.read_state();
+      const std::int64_t call = monotonic_ns();
+      const ServoCommand command = callback(state, dt_s);
+      const std::int64_t returned = monotonic_ns();
+      callback_time.add(returned - call);
+      if (watchdog_ns > 0 && returned - deadline > watchdog_ns) {
+        // The device has held the previous force for too long; the late command is not written.
+        std::snprintf(
+            reason.data(), reason.size(), "tick %llu ended %.1f periods after its deadline (limit %d)",
+            static_cast<unsigned long long>(tick),
+            static_cast<double>(returned - deadline) / static_cast<double>(period), options.watchdog_periods);
+        record_fault(LoopFaultKind::watchdog, reason.data(), tick);
+        break;
+      }
+      device.write_force(command.force_n);
+      stop_after = command.stop;
+    } catch (const CommunicationError& e) {
+      fault_exception = std::current_exception();
+      record_fault(LoopFaultKind::communication, e.what(), tick);
+      break;
+    } catch (const SafetyFault& e) {
+      fault_exception = std::current_exception();
+      record_fault(LoopFaultKind::safety, e.what(), tick);
+      break;
+    } catch (const DeviceError& e) {
+      fault_exception = std::current_exception();
+      record_fault(LoopFaultKind::device, e.what(), tick);
+      break;
+    } catch (const std::exception& e) {
+      fault_exception = std::current_exception();
+      record_fault(LoopFaultKind::callback, e.what(), tick);
+      break;
+    } catch (...) {
+      fault_exception = std::current_exception();
+      record_fault(LoopFaultKind::callback, "unknown exception from the servo callback", tick);
+      break;
+    }
+    const std::int64_t written = monotonic_ns();
+    ticks.store(++tick, std::memory_order_relaxed);
+    if (written > deadline) {
+      missed.store(++missed_count, std::memory_order_relaxed);
+      // Logged at the 1st, 2nd, 4th, 8th ... miss, so a bad run cannot flood the queue or the log.
+      if ((missed_count & (missed_count - 1)) == 0) {
+        log(LogLevel::warn, kDeadlineMissed, tick, static_cast<double>(written - deadline) * 1e-3,
+            static_cast<double>(missed_count));
+      }
+    }
+    if (stop_after) break;
+    next += period;
+    if (written >= next) {  // behind: skip to the first deadline still ahead
+      const std::int64_t behind = (written - next) / period + 1;
+      next += behind * period;
+      skipped.store(skipped.load(std::memory_order_relaxed) + static_cast<std::uint64_t>(behind),
+                    std::memory_order_relaxed);
+    }
+  }
+
+  // Whatever ended the run, the device is left with zero force and forces off.
+  try {
+    device.write_force(Vec3::Zero());
+  } catch (...) {  // the transport may be gone; disabling below is the next line of defence
+  }
+  try {
+    device.enable_forces(false);
+  } catch (...) {
+  }
+  log(LogLevel::info, kStopped, tick, static_cast<double>(missed_count));
+  running.store(false, std::memory_order_release);
+}
+
+ServoLoop::ServoLoop(HapticDevice& device, ServoCallback callback, const ServoLoopOptions& options) {
+  options.validate();
+  if (!callback) throw InvalidArgument("ServoLoop: the callback is empty");
+  impl_ = std::make_unique<Impl>(device, std::move(callback), options);
+}
+
+ServoLoop::~ServoLoop() { stop(); }
+
+void ServoLoop::start() {
+  Impl& m = *impl_;
+  if (m.running.load(std::memory_order_acquire)) throw Error("ServoLoop::start: the loop is already running");
+  if (m.thread.joinable()) m.thread.join();  // the previous run ended by itself
+  m.log_drain.stop();
+  if (!m.device.is_open())
+    throw DeviceError("ServoLoop::start: the device '" + m.device.info().model + "' is not open");
+
+  m.startup.store(0, std::memory_order_release);  // readers stop copying the previous run's realtime status
+  m.reset_stats();
+  m.realtime = RealtimeStatus{};
+  if (m.options.lock_memory) {
+    m.realtime.memory_locked = devices::lock_process_memory(m.realtime.problems);
+    if (!m.realtime.memory_locked && m.options.realtime == RealtimeMode::enforce) {
+      throw RealtimeError("ServoLoop::start: realtime required but " + m.realtime.problems);
+    }
+  }
+  if (m.options.enable_forces_on_start) m.device.enable_forces(true);
+
+  m.stop_requested.store(false, std::memory_order_relaxed);
+  m.running.store(true, std::memory_order_release);
+  // spdlog creates its default logger lazily; create it here, before the drain thread can race to it.
+  static_cast<void>(spdlog::default_logger_raw());
+  m.log_drain.start(m.log_queue, log_sink);
+  m.thread = std::thread([&m] {
+    devices::apply_thread_realtime(m.options, m.realtime);
+    const bool failed = m.options.realtime == RealtimeMode::enforce && !m.realtime.problems.empty();
+    if (failed) {
+      m.running.store(false, std::memory_order_release);
+      m.startup.store(2, std::memory_order_release);
+      m.startup.notify_one();
+      return;
+    }
+    devices::prefault_stack();
+    m.startup.store(1, std::memory_order_release);
+    m.startup.notify_one();
+    m.run();
+  });
+  m.startup.wait(0, std::memory_order_acquire);
+  if (m.startup.load(std::memory_order_acquire) == 2) {
+    m.thread.join();
+    m.log_drain.stop();
+    try {
+      m.device.enable_forces(false);
+    } catch (...) {
+    }
+    throw RealtimeError("ServoLoop::start: realtime required but " + m.realtime.problems);
+  }
+  spdlog::info("servo loop: started at {} Hz; SCHED_FIFO {}, CPU {}, memory locked {}{}{}", m.options.rate_hz,
+               m.realtime.fifo_scheduling ? std::to_string(m.realtime.priority) : "no",
+               m.realtime.cpu >= 0 ? std::to_string(m.realtime.cpu) : "not pinned",
+               m.realtime.memory_locked ? "yes" : "no",
+               m.realtime.problems.empty() ? "" : "; not obtained: ", m.realtime.problems);
+}
+
+LoopFault ServoLoop::stop() noexcept {
+  Impl& m = *impl_;
+  m.stop_requested.store(true, std::memory_order_release);
+  if (m.thread.get_id() == std::this_thread::get_id())
+    return {};  // called from the callback: stops after this tick
+  if (m.thread.joinable()) m.thread.join();
+  m.log_drain.stop();
+  try {
+    return m.fault();
+  } catch (...) {  // out of memory copying the message
+    return LoopFault{static_cast<LoopFaultKind>(m.fault_kind.load(std::memory_order_acquire)), {}};
+  }
+}
+
+void ServoLoop::wait() {
+  Impl& m = *impl_;
+  if (m.thread.joinable()) m.thread.join();
+  m.log_drain.stop();
+  const LoopFault f = m.fault();
+  if (!f) return;
+  if (m.fault_exception) std::rethrow_exception(m.fault_exception);
+  throw SafetyFault("servo loop watchdog: " + f.message);
+}
+
+bool ServoLoop::running() const noexcept { return impl_->running.load(std::memory_order_acquire); }
+
+const ServoLoopOptions& ServoLoop::options() const noexcept { return impl_->options; }
+
+ServoLoopStats ServoLoop::stats() const {
+  const Impl& m = *impl_;
+  ServoLoopStats s;
+  s.running = m.running.load(std::memory_order_acquire);
+  s.rate_hz = m.options.rate_hz;
+  s.ticks = m.ticks.load(std::memory_order_relaxed);
+  s.missed_deadlines = m.missed.load(std::memory_order_relaxed);
+  s.skipped_periods = m.skipped.load(std::memory_order_relaxed);
+  s.period_jitter_us_p50 = m.jitter.quantile_ns(0.50) * 1e-3;
+  s.period_jitter_us_p99 = m.jitter.quantile_ns(0.99) * 1e-3;
+  s.period_jitter_us_max = static_cast<double>(m.jitter.max_ns()) * 1e-3;
+  s.wake_latency_us_max = static_cast<double>(m.wake_latency_max_ns.load(std::memory_order_relaxed)) * 1e-3;
+  s.callback_us_mean = m.callback_time.mean_ns() * 1e-3;
+  s.callback_us_p99 = m.callback_time.quantile_ns(0.99) * 1e-3;
+  s.callback_us_max = static_cast<double>(m.callback_time.max_ns()) * 1e-3;
+  for (std::size_t i = 0; i < LatencyHistogram::kBins; ++i) {
+    if (const std::uint64_t n = m.jitter.bin_count(i); n > 0) {
+      s.period_jitter_histogram.push_back({static_cast<double>(m.jitter.upper_ns(i)) * 1e-3, n});
+    }
+  }
+  if (m.startup.load(std::memory_order_acquire) != 0) s.realtime = m.realtime;
+  s.fault = m.fault();
+  return s;
+}
+
+}  // namespace calligraphy

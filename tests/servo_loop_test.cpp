@@ -1,0 +1,418 @@
+// The real-time servo loop (issue 5, Deliver 1): rate, start/stop/restart, fault containment, watchdog,
+// concurrent statistics, and a real-time trial on the simulated device. Timing is asserted only as loose
+// properties (tick counts within 20 %), never as benchmarks; `calligraphy bench loop` measures jitter.
+#include "calligraphy/servo_loop.hpp"
+
+#include <dirent.h>
+
+#include <atomic>
+#include <catch2/catch.hpp>
+#include <chrono>
+#include <stdexcept>
+#include <thread>
+
+#include "calligraphy/character_library.hpp"
+#include "calligraphy/realtime_trial.hpp"
+#include "calligraphy/simulated_device.hpp"
+#include "devices/latency_histogram.hpp"
+
+using namespace calligraphy;
+
+namespace {
+
+// Options for tests: best effort realtime (SCHED_FIFO when permitted keeps the counts steady on a busy
+// machine), no process-wide memory locking, a watchdog loose enough for a loaded or sanitized build.
+ServoLoopOptions test_options(double rate_hz = 1000.0) {
+  ServoLoopOptions o;
+  o.rate_hz = rate_hz;
+  o.realtime = RealtimeMode::ignore;
+  o.lock_memory = false;
+  o.watchdog_periods = 0;
+  return o;
+}
+
+std::size_t thread_count() {
+  std::size_t n = 0;
+  if (DIR* dir = opendir("/proc/self/task")) {
+    while (const dirent* entry = readdir(dir)) {
+      if (entry->d_name[0] != '.') ++n;
+    }
+    closedir(dir);
+  }
+  return n;
+}
+
+// The thread count once exited threads are gone: a joined thread can stay listed in /proc for a moment
+// after pthread_join returns (the kernel wakes the joiner before it unlists the task).
+std::size_t settled_thread_count(std::size_t expected) {
+  for (int i = 0; i < 100 && thread_count() != expected; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  return thread_count();
+}
+
+// A simulated device that counts writes of a marker force and can throw CommunicationError on a given read.
+class ProbeDevice final : public HapticDevice {
+ public:
+  explicit ProbeDevice(long fail_on_read = -1) : fail_on_read_(fail_on_read) { inner_.open(); }
+  const DeviceInfo& info() const override { return inner_.info(); }
+  void open() override { inner_.open(); }
+  void close() noexcept override { inner_.close(); }
+  bool is_open() const override { return inner_.is_open(); }
+  void enable_forces(bool enabled) override { inner_.enable_forces(enabled); }
+  bool forces_enabled() const override { return inner_.forces_enabled(); }
+  DeviceState read_state() override {
+    if (reads_++ == fail_on_read_)
+      throw CommunicationError("probe device: USB transfer timed out on read " +
+                               std::to_string(fail_on_read_));
+    return inner_.read_state();
+  }
+  void write_force(const Vec3& force_n) override {
+    if (force_n.x() == kMarker) ++marker_writes_;
+    inner_.write_force(force_n);
+  }
+  static constexpr double kMarker = 1.25;  // [N]
+  SimulatedDevice inner_;
+  long reads_ = 0;
+  long fail_on_read_;
+  int marker_writes_ = 0;
+};
+
+Scene scene_of(const std::u32string& chars) {
+  std::vector<Character> characters;
+  for (char32_t c : chars) characters.push_back(CharacterLibrary::embedded().load(c));
+  return Scene::lay_out(characters);
+}
+
+}  // namespace
+
+TEST_CASE("The servo loop accepts rates from 100 Hz to 10 kHz and nothing else", "[servo]") {
+  SimulatedDevice device;
+  const auto callback = [](const DeviceState&, double) { return ServoCommand{}; };
+  for (double rate : {99.9, 10000.1, 0.0, -1000.0, std::nan("")}) {
+    ServoLoopOptions o = test_options(rate);
+    CHECK_THROWS_AS(ServoLoop(device, callback, o), InvalidArgument);
+  }
+  for (double rate : {100.0, 1000.0, 10000.0}) CHECK_NOTHROW(ServoLoop(device, callback, test_options(rate)));
+  ServoLoopOptions o = test_options();
+  o.realtime = RealtimeMode::enforce;
+  o.priority = 0;
+  CHECK_THROWS_AS(ServoLoop(device, callback, o), InvalidArgument);
+  o = test_options();
+  o.watchdog_periods = -1;
+  CHECK_THROWS_AS(ServoLoop(device, callback, o), InvalidArgument);
+  CHECK_THROWS_AS(ServoLoop(device, ServoCallback{}, test_options()), InvalidArgument);
+}
+
+TEST_CASE("The latency histogram's quantiles are bin upper edges capped at the maximum", "[servo]") {
+  devices::LatencyHistogram h(1000);  // 1 us bins
+  CHECK(h.quantile_ns(0.5) == 0.0);
+  for (int i = 0; i < 98; ++i) h.add(2500);  // bin [2, 3) us
+  h.add(40'000);                             // bin [40, 41) us
+  h.add(5'000'000);                          // 5 ms: a coarse bin (100 us wide)
+  CHECK(h.count() == 100);
+  CHECK(h.quantile_ns(0.50) == 3000.0);
+  CHECK(h.quantile_ns(0.99) == 41000.0);
+  CHECK(h.quantile_ns(1.0) == 5'000'000.0);  // the coarse bin's edge 5.1 ms, capped at the exact max
+  CHECK(h.max_ns() == 5'000'000);
+  CHECK(h.mean_ns() == Approx((98 * 2500.0 + 40'000 + 5'000'000) / 100));
+  h.add(-5);  // clock oddities count as zero
+  CHECK(h.bin_count(0) == 1);
+}
+
+TEST_CASE("The servo loop ticks at its rate", "[servo]") {
+  for (double rate : {1000.0, 5000.0}) {
+    SimulatedDevice device;
+    device.open();
+    std::atomic<std::uint64_t> calls{0};
+    double dt_sum = 0.0;
+    ServoLoop loop(
+        device,
+        [&](const DeviceState&, double dt_s) {
+          dt_sum += dt_s;
+          calls.fetch_add(1, std::memory_order_relaxed);
+          return ServoCommand{};
+        },
+        test_options(rate));
+    const auto t0 = std::chrono::steady_clock::now();
+    loop.start();
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    loop.stop();
+    const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const ServoLoopStats s = loop.stats();
+    INFO("rate " << rate << " Hz, elapsed " << elapsed_s << " s, ticks " << s.ticks << ", skipped "
+                 << s.skipped_periods);
+    CHECK(s.ticks == calls.load());
+    // Every period of the run is either a tick or a period skipped after a late tick.
+    const double periods = static_cast<double>(s.ticks + s.skipped_periods);
+    CHECK(periods == Approx(elapsed_s * rate).epsilon(0.2));
+    // The callback's dt adds up to the time between the first and the last tick.
+    CHECK(dt_sum == Approx(static_cast<double>(s.ticks + s.skipped_periods) / rate).epsilon(0.2));
+    CHECK(s.period_jitter_us_p50 <= s.period_jitter_us_p99);
+    CHECK(s.period_jitter_us_p99 <= s.period_jitter_us_max);
+    CHECK(s.callback_us_mean <= s.callback_us_max);
+    CHECK_FALSE(s.fault);
+  }
+}
+
+TEST_CASE("Start, stop and restart leave no thread behind and the forces off", "[servo]") {
+  SimulatedDevice device;
+  const auto callback = [](const DeviceState&, double) { return ServoCommand{Vec3(0.5, 0.0, 0.0), false}; };
+  ServoLoop loop(device, callback, test_options());
+  CHECK_THROWS_AS(loop.start(), DeviceError);  // the device is not open
+  device.open();
+  const std::size_t threads_before = thread_count();
+  for (int run = 0; run < 3; ++run) {
+    loop.start();
+    CHECK(loop.running());
+    CHECK(device.forces_enabled());
+    CHECK_THROWS_AS(loop.start(), Error);  // already running
+    std::this_thread::sleep_for(std::chrono::milliseconds(30));
+    const LoopFault fault = loop.stop();
+    CHECK_FALSE(fault);
+    CHECK_FALSE(loop.running());
+    CHECK_FALSE(device.forces_enabled());
+    CHECK(device.applied_force() == Vec3::Zero());
+    CHECK(loop.stats().ticks > 5);
+    CHECK(settled_thread_count(threads_before) == threads_before);
+  }
+  loop.stop();  // again: harmless
+  {
+    ServoLoop scoped(device, callback, test_options());
+    scoped.start();
+  }  // the destructor stops it
+  CHECK(settled_thread_count(threads_before) == threads_before);
+  CHECK_FALSE(device.forces_enabled());
+}
+
+TEST_CASE("The callback stops the loop through its return value", "[servo]") {
+  SimulatedDevice device;
+  device.open();
+  std::uint64_t n = 0;
+  ServoLoop loop(
+      device,
+      [&](const DeviceState&, double) {
+        return ServoCommand{Vec3(0.3, 0, 0), ++n % 40 == 0};
+      },
+      test_options(2000.0));
+  loop.start();
+  loop.wait();
+  CHECK(loop.stats().ticks == 40);
+  CHECK_FALSE(loop.running());
+  CHECK_FALSE(device.forces_enabled());
+  loop.start();  // restart after a stop from the callback
+  loop.wait();
+  CHECK(n == 80);
+}
+
+TEST_CASE("An exception from the callback is contained: force zeroed, fault reported, loop stopped",
+          "[servo]") {
+  SimulatedDevice device;
+  device.open();
+  std::uint64_t n = 0;
+  ServoLoop loop(
+      device,
+      [&](const DeviceState&, double) {
+        if (++n == 50) throw std::runtime_error("renderer: something went wrong at tick 50");
+        return ServoCommand{Vec3(0.0, 0.7, 0.0), false};
+      },
+      test_options());
+  loop.start();
+  CHECK_THROWS_WITH(loop.wait(), "renderer: something went wrong at tick 50");
+  const ServoLoopStats s = loop.stats();
+  CHECK(s.ticks == 49);
+  CHECK(s.fault.kind == LoopFaultKind::callback);
+  CHECK(s.fault.message == "renderer: something went wrong at tick 50");
+  CHECK_FALSE(s.running);
+  CHECK(device.applied_force() == Vec3::Zero());
+  CHECK_FALSE(device.forces_enabled());
+  CHECK(loop.stop().kind == LoopFaultKind::callback);  // stop() reports the same fault without throwing
+}
+
+TEST_CASE("A CommunicationError from the device mid-run is contained and rethrown on the caller's thread",
+          "[servo]") {
+  ProbeDevice device(/*fail_on_read=*/30);
+  ServoLoop loop(
+      device,
+      [](const DeviceState&, double) {
+        return ServoCommand{Vec3(ProbeDevice::kMarker, 0, 0), false};
+      },
+      test_options());
+  loop.start();
+  CHECK_THROWS_AS(loop.wait(), CommunicationError);
+  const ServoLoopStats s = loop.stats();
+  CHECK(s.ticks == 30);
+  CHECK(s.fault.kind == LoopFaultKind::communication);
+  CHECK(s.fault.message.find("USB transfer timed out") != std::string::npos);
+  CHECK(device.inner_.applied_force() == Vec3::Zero());
+  CHECK_FALSE(device.forces_enabled());
+}
+
+TEST_CASE("The watchdog stops the loop with zero force when a tick overruns by more than N periods",
+          "[servo]") {
+  for (const int watchdog : {3, 0}) {
+    ProbeDevice device;
+    std::uint64_t n = 0;
+    ServoLoopOptions o = test_options();
+    o.watchdog_periods = watchdog;
+    ServoLoop loop(
+        device,
+        [&](const DeviceState&, double) {
+          if (++n == 20) {  // 10 periods late, then asks for the marker force
+            std::this_thread::sleep_for(std::chrono::milliseconds(10));
+            return ServoCommand{Vec3(ProbeDevice::kMarker, 0, 0), false};
+          }
+          return ServoCommand{Vec3(0.1, 0, 0), n >= 40};
+        },
+        o);
+    loop.start();
+    if (watchdog > 0) {
+      CHECK_THROWS_AS(loop.wait(), SafetyFault);
+      const ServoLoopStats s = loop.stats();
+      CHECK(s.fault.kind == LoopFaultKind::watchdog);
+      CHECK(s.fault.message.find("periods after its deadline") != std::string::npos);
+      CHECK(device.marker_writes_ == 0);  // the late command never reached the device
+      CHECK(s.ticks == 19);
+      CHECK(device.inner_.applied_force() == Vec3::Zero());
+      CHECK_FALSE(device.forces_enabled());
+    } else {  // watchdog off: the late tick is written and counted as a missed deadline
+      loop.wait();
+      const ServoLoopStats s = loop.stats();
+      CHECK_FALSE(s.fault);
+      CHECK(device.marker_writes_ == 1);
+      CHECK(s.missed_deadlines >= 1);
+      CHECK(s.skipped_periods >= 8);
+      CHECK(s.period_jitter_us_max >= 8000.0);
+    }
+  }
+}
+
+TEST_CASE("The statistics are readable from another thread while the loop runs", "[servo]") {
+  SimulatedDevice device;
+  device.open();
+  ServoLoop loop(
+      device,
+      [&](const DeviceState&, double dt) {
+        device.advance(dt);
+        return ServoCommand{};
+      },
+      test_options(4000.0));
+  loop.start();
+  std::uint64_t last = 0;
+  bool monotonic = true;
+  int snapshots = 0;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(200);
+  while (std::chrono::steady_clock::now() < until) {
+    const ServoLoopStats s = loop.stats();
+    monotonic = monotonic && s.ticks >= last && s.running;
+    last = s.ticks;
+    ++snapshots;
+  }
+  loop.stop();
+  CHECK(monotonic);
+  CHECK(snapshots > 10);
+  CHECK(loop.stats().ticks >= last);
+  CHECK(last > 100);
+}
+
+TEST_CASE("Enforced realtime that cannot be had fails at start with the reason", "[servo]") {
+  SimulatedDevice device;
+  device.open();
+  ServoLoopOptions o = test_options();
+  o.realtime = RealtimeMode::enforce;
+  o.cpu = 1023;  // no such CPU here: EINVAL (or EPERM for the priority when not privileged)
+  const std::size_t threads_before = thread_count();
+  ServoLoop loop(
+      device, [](const DeviceState&, double) { return ServoCommand{}; }, o);
+  try {
+    loop.start();
+    FAIL("start() did not throw");
+  } catch (const RealtimeError& e) {
+    const std::string message = e.what();
+    CHECK((message.find("EINVAL") != std::string::npos || message.find("EPERM") != std::string::npos));
+  }
+  CHECK_FALSE(loop.running());
+  CHECK_FALSE(device.forces_enabled());
+  CHECK(settled_thread_count(threads_before) == threads_before);
+}
+
+TEST_CASE("A real-time trial on the simulated device records the lock-step trial's trace", "[servo]") {
+  const Scene scene = scene_of(U"口");
+  TrialOptions trial;
+  trial.writer = WriterProfile::skilled();
+  trial.max_duration_s = 2.5;  // about the first stroke of 口 (a whole trial would take 6 s of wall clock)
+  ServoLoopOptions loop = test_options();
+  loop.watchdog_periods = 200;
+  const RealtimeTrialResult realtime = run_realtime_simulated_trial(scene, trial, loop);
+  const TrialResult lockstep = run_simulated_trial(scene, trial);
+
+  CHECK(realtime.end == TrialEnd::max_duration);
+  CHECK_FALSE(realtime.fault);
+  CHECK(realtime.loop.ticks == 2500);
+  REQUIRE(realtime.trial.trace.size() == 2500);
+  REQUIRE(lockstep.trace.size() >= realtime.trial.trace.size());
+  CHECK(realtime.trial.metrics.strokes_completed >= 1);
+  bool same = true;
+  for (std::size_t i = 0; i < realtime.trial.trace.size(); ++i) {
+    const TrialSample& a = realtime.trial.trace[i];
+    const TrialSample& b = lockstep.trace[i];
+    same = same && a.time_s == b.time_s && a.position_m == b.position_m && a.force_n == b.force_n &&
+           a.state == b.state && a.stroke == b.stroke && a.element == b.element;
+  }
+  CHECK(same);
+  const StrokeMetrics& first = realtime.trial.metrics.per_stroke[0];
+  CHECK(first.completed);
+  CHECK(first.trace_begin == lockstep.metrics.per_stroke[0].trace_begin);
+  CHECK(first.trace_end == lockstep.metrics.per_stroke[0].trace_end);
+  CHECK(first.mean_deviation_m == lockstep.metrics.per_stroke[0].mean_deviation_m);
+}
+
+TEST_CASE("A device fault during a real-time trial keeps the recording and reports the fault", "[servo]") {
+  const Scene scene = scene_of(U"口");
+  ProbeDevice device(/*fail_on_read=*/300);
+  RealtimeTrialOptions options;
+  options.loop = test_options();
+  options.max_duration_s = 2.0;
+  options.after_tick = [&](const DeviceState&, const RenderOutput&, double period_s) {
+    device.inner_.advance(period_s);
+    return true;
+  };
+  const RealtimeTrialResult result = run_realtime_trial(device, scene, options);
+  CHECK(result.end == TrialEnd::fault);
+  CHECK(result.fault.kind == LoopFaultKind::communication);
+  CHECK(result.trial.trace.size() == 300);
+  CHECK(result.trial.trace.back().time_s > result.trial.trace.front().time_s);
+  CHECK_FALSE(device.forces_enabled());
+}
+
+TEST_CASE("Start, stop and restart under a running trial leave no thread behind", "[servo]") {
+  const Scene scene = scene_of(U"口");
+  SimulatedDevice device;
+  SimulatedWriter writer(scene, WriterProfile::skilled(), 0);
+  Renderer renderer(scene, ForceLawParameters{}, device.info());
+  TrialRecorder recorder(scene, /*keep_trace=*/false);
+  device.attach_hand(&writer);
+  device.open();
+  const double period_s = 1e-3;
+  ServoLoop loop(
+      device,
+      [&](const DeviceState& state, double) {
+        const RenderOutput out = renderer.tick(state);
+        recorder.record(state, out);
+        device.write_force(out.force_n);
+        writer.observe(out, state);
+        device.advance(period_s);
+        return ServoCommand{out.force_n, out.finished};
+      },
+      test_options());
+  const std::size_t threads_before = thread_count();
+  double last_time_s = 0.0;
+  for (int run = 0; run < 3; ++run) {
+    loop.start();
+    std::this_thread::sleep_for(std::chrono::milliseconds(60));
+    CHECK_FALSE(loop.stop());
+    CHECK(settled_thread_count(threads_before) == threads_before);
+    CHECK_FALSE(device.forces_enabled());
+    CHECK(device.time() > last_time_s);  // the trial went on in each run
+    last_time_s = device.time();
+  }
+}
