@@ -1,8 +1,6 @@
 // `calligraphy bench loop --rate HZ --seconds S [--realtime enforce|ignore|off] [--json] ...`: runs the
 // real-time servo loop against the simulated device and prints its period jitter, missed deadlines and
 // callback time (issue 5, Deliver 6; docs/servo-loop.md).
-#include <spdlog/sinks/stdout_color_sinks.h>
-#include <spdlog/spdlog.h>
 
 #include <chrono>
 #include <cstdio>
@@ -115,8 +113,6 @@ int command_bench_loop(const Args& args) {
   if (arguments.positionals().size() != 1 || arguments.positionals()[0] != "loop") {
     throw UsageError(std::string("unexpected arguments\n") + kUsage);
   }
-  // The loop's log (settings obtained, missed deadlines) goes to stderr; stdout carries the report only.
-  spdlog::set_default_logger(spdlog::stderr_color_mt("bench-loop"));
   ServoLoopOptions options;
   options.rate_hz = arguments.number_or("rate", 1000.0);
   const double seconds = arguments.number_or("seconds", 10.0);

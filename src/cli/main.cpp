@@ -1,4 +1,7 @@
-// The `calligraphy` program: runs guided writing trials on the simulated device and prints models.
+// The `calligraphy` program: guided writing trials on any device, models, the corpus store, benchmarks.
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -43,6 +46,8 @@ int main(int argc, char** argv) {
   }
   const std::string command = argv[1];
   const Args args(argv + 2, argv + argc);
+  // The library's log (device start-up, warnings) goes to stderr: stdout carries reports (--json) only.
+  spdlog::set_default_logger(spdlog::stderr_color_mt("calligraphy"));
   try {
     if (command == "trial") return command_trial(args);
     if (command == "model") return command_model(args);
