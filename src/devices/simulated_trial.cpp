@@ -8,7 +8,8 @@ namespace calligraphy {
 
 void TrialOptions::validate() const {
   if (!(rate_hz >= 100.0 && rate_hz <= 100000.0)) {
-    throw InvalidArgument("TrialOptions.rate_hz = " + std::to_string(rate_hz) + " must be in [100, 100000] Hz");
+    throw InvalidArgument("TrialOptions.rate_hz = " + std::to_string(rate_hz) +
+                          " must be in [100, 100000] Hz");
   }
   if (!(max_duration_s > 0.0) || !std::isfinite(max_duration_s)) {
     throw InvalidArgument("TrialOptions.max_duration_s = " + std::to_string(max_duration_s) + " must be > 0");
@@ -22,7 +23,10 @@ TrialResult run_simulated_trial(const Scene& scene, const TrialOptions& options)
   options.validate();
   SimulatedDevice device(options.device);
   SimulatedWriter writer(scene, options.writer, options.seed);
-  Renderer renderer(scene, options.force, device.info());
+  RendererOptions render_options;
+  render_options.rate_hz = options.rate_hz;
+  render_options.device_damping_n_s_per_m = options.device.damping_n_s_per_m;
+  Renderer renderer(scene, options.force, device.info(), render_options);
   TrialRecorder recorder(scene, options.keep_trace);
   device.attach_hand(&writer);
   device.open();
