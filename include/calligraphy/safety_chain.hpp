@@ -28,7 +28,7 @@ struct SafetyChainParameters {
   double max_continuous_force_n = 0.0;        ///< continuous-force limit [N], 0 = off
   double continuous_time_constant_s = 10.0;   ///< tau of the RMS (thermal) estimate [s], > 0
   double start_ramp_n_per_s = 20.0;           ///< force ramp after start or reset [N/s], 0 = off
-  double max_force_change_n_per_tick = 0.05;  ///< per-tick change limit [N per tick], 0 = off
+  double max_force_change_n_per_tick = 0.25;  ///< per-tick change limit [N per tick], 0 = off
   double low_pass_cutoff_hz = 0.0;            ///< first-order low-pass cutoff [Hz], 0 = off
 
   /// Throws InvalidArgument naming the field when a value is negative or not finite, when

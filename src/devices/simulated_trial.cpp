@@ -26,6 +26,8 @@ TrialResult run_simulated_trial(const Scene& scene, const TrialOptions& options)
   RendererOptions render_options;
   render_options.rate_hz = options.rate_hz;
   render_options.device_damping_n_s_per_m = options.device.damping_n_s_per_m;
+  render_options.safety = options.safety;
+  render_options.passivity = options.passivity;
   Renderer renderer(scene, options.force, device.info(), render_options);
   TrialRecorder recorder(scene, options.keep_trace);
   device.attach_hand(&writer);
