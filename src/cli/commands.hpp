@@ -19,6 +19,7 @@ class UsageError : public std::runtime_error {
 int command_trial(const Args& args);          // calligraphy trial CHARS [...]
 int command_model(const Args& args);          // calligraphy model CHAR [...]
 int command_bench_nearest(const Args& args);  // calligraphy bench nearest [--json] [...]
+int command_bench_tick(const Args& args);     // calligraphy bench tick [--json] [...]
 int command_devices(const Args& args);        // calligraphy devices
 
 }  // namespace calligraphy::cli

@@ -17,7 +17,9 @@ constexpr const char* kUsage =
     "                       print the character's model (paper Table 3)\n"
     "  devices              list the haptic devices found (simulated, Phantoms, OpenHaptics)\n"
     "  bench nearest [--json] [--markdown FILE] [--queries N] [--seed S]\n"
-    "                       accuracy and speed of the nearest-point methods\n";
+    "                       accuracy and speed of the nearest-point methods\n"
+    "  bench tick [--json] [--chars CHARS] [--passes N] [--rate HZ]\n"
+    "                       cost of one servo tick (renderer and safety chain) over real trials\n";
 
 }  // namespace
 
@@ -34,6 +36,7 @@ int main(int argc, char** argv) {
     if (command == "model") return command_model(args);
     if (command == "devices") return command_devices(args);
     if (command == "bench" && !args.empty() && args[0] == "nearest") return command_bench_nearest(args);
+    if (command == "bench" && !args.empty() && args[0] == "tick") return command_bench_tick(args);
     std::fprintf(stderr, "calligraphy: error: unknown command '%s'\n%s", command.c_str(), kUsage);
     return 2;
   } catch (const UsageError& e) {
