@@ -1,7 +1,6 @@
-#include "calligraphy/renderer.hpp"
-
 #include <catch2/catch.hpp>
 
+#include "calligraphy/renderer.hpp"
 #include "calligraphy/simulated_device.hpp"
 
 using namespace calligraphy;
@@ -33,7 +32,7 @@ DeviceState at(const Scene& scene, const Vec2& data, double z, const Vec2& veloc
 }
 
 // The paper's force law without the smoothing of section 6 and without the safety chain's ramp and
-// rate limit, so that single ticks show eqs. (7)-(9) exactly (the smoothing is tested in safety_test).
+// rate limit, so that single ticks show eqs. (7)-(9) exactly (the smoothing is tested in smoothness_test.cpp).
 ForceLawParameters unsmoothed() {
   ForceLawParameters p;
   p.constraint_taper_m = 0.0;

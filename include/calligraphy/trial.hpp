@@ -19,23 +19,23 @@ struct TrialSample {
   Vec3 position_m = Vec3::Zero();  ///< HIP as read from the device [m]
   Vec3 force_n = Vec3::Zero();     ///< commanded force [N]
   InteractionState state = InteractionState::separation;
-  std::size_t stroke = 0;   ///< active stroke, counted over the whole scene (0-based)
-  std::size_t element = 0;  ///< active element within it
+  std::size_t stroke = 0;          ///< active stroke, counted over the whole scene (0-based)
+  std::size_t element = 0;         ///< active element within it
 };
 
 /// Metrics of one stroke. Deviations are distances in the paper plane from the pen tip to the stroke's
 /// reference elements, over the WS ticks of the stroke's last attempt (an abandoned attempt is cleared,
 /// as its trace is on screen, section 4.3.3).
 struct StrokeMetrics {
-  std::size_t index = 0;  ///< over the whole scene, 0-based
+  std::size_t index = 0;           ///< over the whole scene, 0-based
   std::size_t character = 0;
   int typical_id = 0;
   bool completed = false;
-  int attempts = 0;  ///< times WS was entered on this stroke
+  int attempts = 0;                ///< times WS was entered on this stroke
   double mean_deviation_m = 0.0;
   double max_deviation_m = 0.0;
-  double time_s = 0.0;          ///< from entering WS to writing the last feature point, last attempt
-  std::size_t trace_begin = 0;  ///< the last attempt's samples in the trace: [trace_begin, trace_end)
+  double time_s = 0.0;             ///< from entering WS to writing the last feature point, last attempt
+  std::size_t trace_begin = 0;     ///< the last attempt's samples in the trace: [trace_begin, trace_end)
   std::size_t trace_end = 0;
 };
 
@@ -43,12 +43,12 @@ struct StrokeMetrics {
 struct TrialMetrics {
   std::size_t strokes_total = 0;
   std::size_t strokes_completed = 0;
-  bool completed_in_order = false;  ///< every stroke written, each in its turn
-  double time_s = 0.0;              ///< from the start to the last stroke written (or the end of the trial)
-  double mean_deviation_m = 0.0;    ///< over all WS ticks of the strokes' last attempts
+  bool completed_in_order = false;   ///< every stroke written, each in its turn
+  double time_s = 0.0;               ///< from the start to the last stroke written (or the end of the trial)
+  double mean_deviation_m = 0.0;     ///< over all WS ticks of the strokes' last attempts
   double max_deviation_m = 0.0;
-  double max_force_n = 0.0;       ///< max |F| commanded
-  double max_force_step_n = 0.0;  ///< max |F(k) - F(k-1)| between consecutive ticks
+  double max_force_n = 0.0;          ///< max |F| commanded
+  double max_force_step_n = 0.0;     ///< max |F(k) - F(k-1)| between consecutive ticks
   std::size_t state_transitions = 0;
   std::vector<StrokeMetrics> per_stroke;
 };
@@ -77,7 +77,7 @@ class TrialRecorder {
   std::vector<TrialSample> trace_;
   TrialMetrics metrics_;
   std::vector<std::pair<std::size_t, std::size_t>> stroke_location_;  // global index -> (character, stroke)
-  std::size_t current_ = 0;                                           // stroke being written (global index)
+  std::size_t current_ = 0;  // stroke being written (global index)
   Attempt attempt_;
   Vec3 last_force_ = Vec3::Zero();
   bool first_ = true;
@@ -89,14 +89,14 @@ class TrialRecorder {
 
 /// Options of a simulated trial.
 struct TrialOptions {
-  ForceLawParameters force{};  ///< `force.guidance` switches guidance on or off
+  ForceLawParameters force{};                 ///< `force.guidance` switches guidance on or off
   WriterProfile writer = WriterProfile::novice();
   SimulatedDeviceParameters device{};
-  double rate_hz = 1000.0;          ///< servo rate [Hz]
-  SafetyChainParameters safety{};   ///< the renderer's safety chain (renderer.hpp)
-  PassivityParameters passivity{};  ///< the renderer's passivity controller (off by default)
-  std::uint64_t seed = 0;           ///< seeds the writer's bias, noise and tremor
-  double max_duration_s = 300.0;    ///< stop after this much simulated time [s]
+  double rate_hz = 1000.0;                    ///< servo rate [Hz]
+  SafetyChainParameters safety{};             ///< the renderer's safety chain (renderer.hpp)
+  PassivityParameters passivity{};            ///< the renderer's passivity controller (off by default)
+  std::uint64_t seed = 0;                     ///< seeds the writer's bias, noise and tremor
+  double max_duration_s = 300.0;              ///< stop after this much simulated time [s]
   bool keep_trace = true;
   /// Throws InvalidArgument when the rate is not in [100, 100000] Hz or the duration is not positive.
   void validate() const;

@@ -8,8 +8,7 @@ namespace calligraphy {
 
 void TrialOptions::validate() const {
   if (!(rate_hz >= 100.0 && rate_hz <= 100000.0)) {
-    throw InvalidArgument("TrialOptions.rate_hz = " + std::to_string(rate_hz) +
-                          " must be in [100, 100000] Hz");
+    throw InvalidArgument("TrialOptions.rate_hz = " + std::to_string(rate_hz) + " must be in [100, 100000] Hz");
   }
   if (!(max_duration_s > 0.0) || !std::isfinite(max_duration_s)) {
     throw InvalidArgument("TrialOptions.max_duration_s = " + std::to_string(max_duration_s) + " must be > 0");
