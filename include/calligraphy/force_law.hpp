@@ -47,7 +47,7 @@ struct ForceLawParameters {
   double friction_coefficient = 0.15;
   /// Stick band [m/s] > 0: below this in-plane speed friction is viscous, mu N v / v_band, which
   /// avoids the chatter of a sign function at rest.
-  double friction_stick_speed_m_s = 0.01;
+  double friction_stick_speed_m_s = 0.02;
   /// How the foot point X_S on curve elements is found.
   NearestPointOptions nearest{};
 
