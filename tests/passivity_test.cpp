@@ -3,10 +3,14 @@
 // 2 b / T, grows above it, and the Hannaford-Ryu controller stops the growth.
 #include "calligraphy/passivity.hpp"
 
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 
 #include "calligraphy/character_library.hpp"
 #include "calligraphy/errors.hpp"
@@ -76,8 +80,9 @@ ContactRun run_contact(Hand hand, double rate_hz, double stiffness_n_per_m, bool
     energy += applied.dot(device.true_position() - before);  // work of the device on the stylus [J]
     const double t = static_cast<double>(k + 1) * dt;
     run.max_energy_j = std::max(run.max_energy_j, energy);
-    if (t <= 10.0) run.max_energy_first_10s_j = std::max(run.max_energy_first_10s_j, energy);
-    if (t >= seconds - 10.0) run.max_energy_last_10s_j = std::max(run.max_energy_last_10s_j, energy);
+    const double window = seconds / 6.0;  // 10 s of a 60 s run
+    if (t <= window) run.max_energy_first_10s_j = std::max(run.max_energy_first_10s_j, energy);
+    if (t >= seconds - window) run.max_energy_last_10s_j = std::max(run.max_energy_last_10s_j, energy);
     run.max_depth_m = std::max(run.max_depth_m, paper_z - device.true_position().z());
     run.max_force_n = std::max(run.max_force_n, out.force_n.norm());
     if (out.state == InteractionState::calibration) touched = true;
@@ -96,7 +101,13 @@ constexpr double kDeviceDamping = 0.5;  // SimulatedDeviceParameters' default b 
 // docs/force-rendering.md); a bounded contact stays within a few mJ in total.
 constexpr double kGrowthTolerance = 5e-4;
 constexpr double kBoundedEnergy = 0.01;
+// 60 s of contact (issue 5). The sanitizer builds run 20 s: a Debug ASan build is about 100 times
+// slower and the 60 s runs took over 10 minutes there; the Release build runs the full 60 s.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+constexpr double kContactSeconds = 20.0;
+#else
 constexpr double kContactSeconds = 60.0;
+#endif
 
 bool grows(const ContactRun& run) {
   return run.max_energy_last_10s_j > std::max(run.max_energy_first_10s_j, 0.0) + kGrowthTolerance;
@@ -112,6 +123,27 @@ TEST_CASE("Colgate's bound is 2 (b - B) / T and validates its input", "[passivit
   CHECK_THROWS_AS(colgate_stiffness_bound(-1.0, 1000.0), InvalidArgument);
   CHECK_THROWS_AS(colgate_stiffness_bound(0.5, 0.0), InvalidArgument);
   CHECK_THROWS_AS(colgate_stiffness_bound(0.5, 1000.0, std::nan("")), InvalidArgument);
+}
+
+TEST_CASE("The renderer warns at construction when a stiffness exceeds the bound", "[passivity]") {
+  const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'口')});
+  std::ostringstream log;
+  const auto previous = spdlog::default_logger();
+  spdlog::set_default_logger(
+      std::make_shared<spdlog::logger>("capture", std::make_shared<spdlog::sinks::ostream_sink_mt>(log)));
+  RendererOptions options;
+  options.rate_hz = 1000.0;
+  options.device_damping_n_s_per_m = kDeviceDamping;  // bound 1000 N/m
+  ForceLawParameters force;
+  force.paper_stiffness_n_per_m = 900.0;
+  { const Renderer below(scene, force, phantom_desktop_info(), options); }
+  const std::string quiet = log.str();
+  force.paper_stiffness_n_per_m = 1500.0;
+  { const Renderer above(scene, force, phantom_desktop_info(), options); }
+  const std::string warned = log.str();
+  spdlog::set_default_logger(previous);
+  CHECK(quiet.find("passivity bound") == std::string::npos);
+  CHECK(warned.find("passivity bound") != std::string::npos);
 }
 
 TEST_CASE("Up to Colgate's bound the energy supplied by the device does not grow over 60 s of contact",
