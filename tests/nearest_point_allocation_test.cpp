@@ -5,9 +5,9 @@
 #include <cstdlib>
 #include <new>
 
+#include "calligraphy/character_library.hpp"
 #include "calligraphy/nearest_point.hpp"
 #include "calligraphy/nearest_point_tracker.hpp"
-#include "calligraphy/character_library.hpp"
 #include "calligraphy/renderer.hpp"
 #include "calligraphy/simulated_device.hpp"
 #include "calligraphy/trial.hpp"
