@@ -5,8 +5,12 @@
 #include <cstdlib>
 #include <new>
 
+#include "calligraphy/character_library.hpp"
 #include "calligraphy/nearest_point.hpp"
 #include "calligraphy/nearest_point_tracker.hpp"
+#include "calligraphy/renderer.hpp"
+#include "calligraphy/simulated_device.hpp"
+#include "calligraphy/trial.hpp"
 
 // AddressSanitizer owns operator new/delete; replacing them there mixes its allocator with ours
 // (alloc-dealloc-mismatch at exit). The Release build runs this test; the ASan build leaves it out.
@@ -44,6 +48,28 @@ TEST_CASE("Nearest-point queries and tracker updates do not allocate", "[nearest
     for (int i = 0; i < 50; ++i) sum += tracker.update(element, Vec2(0.001 * i, 0.01)).distance;
   }
   sum += calligraphy::nearest_point_on_segment(points[0], points[1], points[2]).distance;
+  CHECK(allocations.load() == before);
+  CHECK(sum > 0.0);
+}
+TEST_CASE("Renderer ticks (smoothing, passivity controller, safety chain) do not allocate", "[safety]") {
+  using namespace calligraphy;
+  const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'永')});
+  TrialOptions trial;
+  trial.seed = 1;
+  const TrialResult recorded = run_simulated_trial(scene, trial);  // positions of a real trial
+  REQUIRE(recorded.trace.size() > 1000);
+  RendererOptions options;
+  options.passivity.enabled = true;
+  options.safety.low_pass_cutoff_hz = 100.0;
+  Renderer renderer(scene, ForceLawParameters{}, phantom_desktop_info(), options);
+  const long before = allocations.load();
+  double sum = 0.0;
+  for (std::size_t k = 1; k < recorded.trace.size(); ++k) {
+    DeviceState state;
+    state.position_m = recorded.trace[k].position_m;
+    state.velocity_m_s = (recorded.trace[k].position_m - recorded.trace[k - 1].position_m) * 1000.0;
+    sum += renderer.tick(state).force_n.norm();
+  }
   CHECK(allocations.load() == before);
   CHECK(sum > 0.0);
 }

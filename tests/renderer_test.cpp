@@ -31,11 +31,30 @@ DeviceState at(const Scene& scene, const Vec2& data, double z, const Vec2& veloc
   return s;
 }
 
+// The paper's force law without the smoothing of section 6 and without the safety chain's ramp and
+// rate limit, so that single ticks show eqs. (7)-(9) exactly (the smoothing is tested in smoothness_test.cpp).
+ForceLawParameters unsmoothed() {
+  ForceLawParameters p;
+  p.constraint_taper_m = 0.0;
+  p.crossfade_s = 0.0;
+  p.paper_fade_s = 0.0;
+  p.friction_coefficient = 0.0;
+  p.max_foot_speed_m_s = 1e6;
+  return p;
+}
+
+RendererOptions no_ramp_no_rate_limit() {
+  RendererOptions o;
+  o.safety.start_ramp_n_per_s = 0.0;
+  o.safety.max_force_change_n_per_tick = 0.0;
+  return o;
+}
+
 }  // namespace
 
 TEST_CASE("Renderer: states, plane popping, completion and per-state forces", "[renderer]") {
   const Scene scene = two_stroke_scene();
-  Renderer r(scene, ForceLawParameters{}, phantom_desktop_info());
+  Renderer r(scene, unsmoothed(), phantom_desktop_info(), no_ramp_no_rate_limit());
   const double below = -0.001;  // 1 mm into the paper
 
   // SS above the paper: zero force.
@@ -121,7 +140,7 @@ TEST_CASE("Renderer: the force never exceeds the device maximum", "[renderer]") 
   const Scene scene = two_stroke_scene();
   DeviceInfo weak = phantom_desktop_info();
   weak.max_force_n = 0.5;
-  Renderer r(scene, ForceLawParameters{}, weak);
+  Renderer r(scene, unsmoothed(), weak, no_ramp_no_rate_limit());
   const auto out = r.tick(at(scene, {300, 500}, -0.01));  // 10 mm deep: 8 N asked
   CHECK(out.force_n.norm() == Approx(0.5));
 }

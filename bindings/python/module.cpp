@@ -535,7 +535,9 @@ Raises InvalidArgumentError (ValueError) for a non-finite point, bad shapes or o
       "The force model of paper section 5 (F_e = F_en + F_et, eq. 7), SI units. The "
       "paper plane is z = paper_z_m, +z out of the paper.")
       .def(py::init([](double guidance_stiffness, double paper_stiffness, double radius, double damping,
-                       double hysteresis, bool guidance) {
+                       double hysteresis, bool guidance, double taper, double crossfade, double paper_fade,
+                       double plane_margin, double paper_damping, double foot_speed, double friction,
+                       double stick_speed) {
              ForceLawParameters p;
              p.guidance_stiffness_n_per_m = guidance_stiffness;
              p.paper_stiffness_n_per_m = paper_stiffness;
@@ -543,6 +545,14 @@ Raises InvalidArgumentError (ValueError) for a non-finite point, bad shapes or o
              p.resistance_damping_n_s_per_m = damping;
              p.contact_hysteresis_m = hysteresis;
              p.guidance = guidance;
+             p.constraint_taper_m = taper;
+             p.crossfade_s = crossfade;
+             p.paper_fade_s = paper_fade;
+             p.feature_plane_margin_m = plane_margin;
+             p.paper_damping_n_s_per_m = paper_damping;
+             p.max_foot_speed_m_s = foot_speed;
+             p.friction_coefficient = friction;
+             p.friction_stick_speed_m_s = stick_speed;
              p.validate();
              return p;
            }),
@@ -552,9 +562,17 @@ Raises InvalidArgumentError (ValueError) for a non-finite point, bad shapes or o
            py::arg("resistance_damping_n_s_per_m") = ForceLawParameters{}.resistance_damping_n_s_per_m,
            py::arg("contact_hysteresis_m") = ForceLawParameters{}.contact_hysteresis_m,
            py::arg("guidance") = true,
+           py::arg("constraint_taper_m") = ForceLawParameters{}.constraint_taper_m,
+           py::arg("crossfade_s") = ForceLawParameters{}.crossfade_s,
+           py::arg("paper_fade_s") = ForceLawParameters{}.paper_fade_s,
+           py::arg("feature_plane_margin_m") = ForceLawParameters{}.feature_plane_margin_m,
+           py::arg("paper_damping_n_s_per_m") = ForceLawParameters{}.paper_damping_n_s_per_m,
+           py::arg("max_foot_speed_m_s") = ForceLawParameters{}.max_foot_speed_m_s,
+           py::arg("friction_coefficient") = ForceLawParameters{}.friction_coefficient,
+           py::arg("friction_stick_speed_m_s") = ForceLawParameters{}.friction_stick_speed_m_s,
            "Raises InvalidArgumentError (a ValueError) naming the field when a value is negative or not "
-           "finite, or "
-           "the radius is not positive.")
+           "finite, the radius or the stick speed is not positive, or the taper is wider than the radius. "
+           "The smoothing fields (section 6) and friction: docs/force-rendering.md.")
       .def_readonly("guidance_stiffness_n_per_m", &ForceLawParameters::guidance_stiffness_n_per_m,
                     "K_et [N/m]")
       .def_readonly("paper_stiffness_n_per_m", &ForceLawParameters::paper_stiffness_n_per_m, "K_en [N/m]")
@@ -563,6 +581,20 @@ Raises InvalidArgumentError (ValueError) for a non-finite point, bad shapes or o
                     "[N s/m]")
       .def_readonly("contact_hysteresis_m", &ForceLawParameters::contact_hysteresis_m, "[m]")
       .def_readonly("guidance", &ForceLawParameters::guidance)
+      .def_readonly("constraint_taper_m", &ForceLawParameters::constraint_taper_m,
+                    "band at R_res over which F_et tapers to zero [m]")
+      .def_readonly("crossfade_s", &ForceLawParameters::crossfade_s, "in-plane cross-fade time [s]")
+      .def_readonly("paper_fade_s", &ForceLawParameters::paper_fade_s,
+                    "paper-force fade time (AS <-> CS) [s]")
+      .def_readonly("feature_plane_margin_m", &ForceLawParameters::feature_plane_margin_m,
+                    "feature-plane hysteresis [m]")
+      .def_readonly("paper_damping_n_s_per_m", &ForceLawParameters::paper_damping_n_s_per_m,
+                    "paper damping on inward motion [N s/m]")
+      .def_readonly("max_foot_speed_m_s", &ForceLawParameters::max_foot_speed_m_s,
+                    "highest speed of the attraction target X_S [m/s]")
+      .def_readonly("friction_coefficient", &ForceLawParameters::friction_coefficient, "Coulomb mu")
+      .def_readonly("friction_stick_speed_m_s", &ForceLawParameters::friction_stick_speed_m_s,
+                    "stick band of the friction [m/s]")
       .def(
           "paper_force",
           [](const ForceLawParameters& p, const py::object& z_object, double paper_z) -> py::object {

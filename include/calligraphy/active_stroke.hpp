@@ -12,8 +12,8 @@ namespace calligraphy {
 
 /// What `ActiveStroke::advance` did this tick.
 struct StrokeProgress {
-  int planes_passed = 0;         ///< feature planes popped this tick
-  bool stroke_completed = false; ///< the last plane of the stroke popped; the next stroke is now active
+  int planes_passed = 0;          ///< feature planes popped this tick
+  bool stroke_completed = false;  ///< the last plane of the stroke popped; the next stroke is now active
 };
 
 class ActiveStroke {
@@ -24,8 +24,9 @@ class ActiveStroke {
   /// Back to the first stroke, nothing written.
   void reset() noexcept;
   /// Pops every feature plane the tip has crossed (eq. 6), possibly several in one tick, and
-  /// completes the stroke when its last plane pops. Tip on the paper plane [m].
-  StrokeProgress advance(const Vec2& tip_m) noexcept;
+  /// completes the stroke when its last plane pops. Tip on the paper plane [m]; `plane_margin_m` is
+  /// the feature-plane hysteresis of `feature_plane_passed` [m].
+  StrokeProgress advance(const Vec2& tip_m, double plane_margin_m = 0.0) noexcept;
   /// Pen lifted in WS: the active stroke's feature points are loaded again (section 4.3.3).
   void reload() noexcept;
 

@@ -9,8 +9,8 @@ namespace calligraphy {
 
 /// Where the tip is relative to an element (paper section 4.3.1, Fig. 19; extended to CSEs).
 struct ElementContact {
-  NearestPoint nearest;       ///< foot point X_S on the element
-  bool inside = false;        ///< inside the constraint space R_res
+  NearestPoint nearest;  ///< foot point X_S on the element
+  bool inside = false;   ///< inside the constraint space R_res
 };
 
 /// LSE rules (a)-(d) of section 4.3.1 with P1 = tip - start, PEdge = end - start:
@@ -25,8 +25,14 @@ struct ElementContact {
 [[nodiscard]] ElementContact element_contact(const StrokeElement& element, const Vec2& tip, double radius_m,
                                              const NearestPointOptions& options) noexcept;
 
+/// The same with the foot point already found (e.g. by a NearestPointTracker): the inside rules only.
+[[nodiscard]] ElementContact element_contact_at(const StrokeElement& element, const Vec2& tip,
+                                                const NearestPoint& nearest, double radius_m) noexcept;
+
 /// Eq. (6): the feature point at the end of `element` has been written (phi > 0) when
-/// V_t . V_f > 0, V_t the element's tangent at its end and V_f the vector from that point to the tip.
-[[nodiscard]] bool feature_plane_passed(const StrokeElement& element, const Vec2& tip) noexcept;
+/// V_t . V_f > margin, V_t the element's unit tangent at its end and V_f the vector from that point to
+/// the tip. `margin_m` >= 0 [m] is a hysteresis band (section 6): 0 is the paper's rule.
+[[nodiscard]] bool feature_plane_passed(const StrokeElement& element, const Vec2& tip,
+                                        double margin_m = 0.0) noexcept;
 
 }  // namespace calligraphy

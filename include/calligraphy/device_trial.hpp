@@ -5,12 +5,14 @@
 /// `read_state()` -> `Renderer::tick` -> `write_force()` -> `TrialRecorder::record`, and
 /// `enable_forces(false)`, `close()` at the end.
 ///
-/// Pacing: a device with a `HandPort` (hand_port.hpp; the simulated device, the emulated Phantom) is
-/// moved by a `SimulatedWriter` and runs lock-step: after each tick the writer sees the display and the
-/// device advances by 1 / rate_hz of its own time, no wall clock, deterministic for a seed. Any other
-/// device (a real Phantom, OpenHaptics) is moved by a person and paced by the wall clock: tick k
-/// starts at start + k / rate_hz (`std::this_thread::sleep_until` on absolute deadlines, so lateness
-/// does not accumulate).
+/// Pacing (`TrialPacing`): a device with a `HandPort` (hand_port.hpp; the simulated device, the emulated
+/// Phantom) is moved by a `SimulatedWriter` and by default runs lock-step: after each tick the writer
+/// sees the display and the device advances by 1 / rate_hz of its own time, no wall clock, deterministic
+/// for a seed. Any other device (a real Phantom, OpenHaptics) is moved by a person and runs in real time
+/// on the `ServoLoop` (servo_loop.hpp: its own thread, absolute deadlines, watchdog); a hand-port device
+/// runs there too when `pacing` is `real_time` (the writer and the device's physics then step inside the
+/// loop, after each tick). In real time, a fault of the loop (device error, watchdog) aborts the trial
+/// like a device fault below.
 ///
 /// Faults: a `CommunicationError`, `SafetyFault` (or any other `DeviceError`) from `read_state` or
 /// `write_force` ends the trial; forces are disabled (best effort), the device is closed, and the result
@@ -21,9 +23,17 @@
 
 #include "calligraphy/haptic_device.hpp"
 #include "calligraphy/scene.hpp"
+#include "calligraphy/servo_loop.hpp"
 #include "calligraphy/trial.hpp"
 
 namespace calligraphy {
+
+/// How a trial's ticks are paced (see the file comment).
+enum class TrialPacing {
+  automatic,  ///< lock-step for a device with a hand port, real time on the ServoLoop for any other
+  lock_step,  ///< no wall clock; only for a device with a hand port (else InvalidArgument)
+  real_time,  ///< the ServoLoop at `rate_hz`, with `loop`'s realtime settings and watchdog
+};
 
 /// Options of a trial on a device. The device's own parameters are the device's business.
 struct DeviceTrialOptions {
@@ -33,8 +43,15 @@ struct DeviceTrialOptions {
   std::uint64_t seed = 0;                          ///< seeds the simulated writer
   double max_duration_s = 300.0;                   ///< stop after this much device time [s]
   bool keep_trace = true;
-  /// Throws InvalidArgument when the rate is not in [100, 100000] Hz, the duration is not positive,
-  /// or the force law or writer is out of range.
+  SafetyChainParameters safety{};     ///< the renderer's safety chain (renderer.hpp)
+  PassivityParameters passivity{};    ///< the renderer's passivity controller (off by default)
+  /// Physical damping of the device [N s/m] for the renderer's stiffness bound; 0 = unknown.
+  double device_damping_n_s_per_m = 0.0;
+  TrialPacing pacing = TrialPacing::automatic;
+  /// Real-time pacing only: realtime mode, priority, CPU, watchdog. Its rate is replaced by `rate_hz`.
+  ServoLoopOptions loop{};
+  /// Throws InvalidArgument when the rate is not in [100, 100000] Hz (lock-step) or [100, 10000] Hz
+  /// (real time), the duration is not positive, or the force law or writer is out of range.
   void validate() const;
 };
 

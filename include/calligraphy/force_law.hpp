@@ -22,10 +22,37 @@ struct ForceLawParameters {
   double contact_hysteresis_m = 0.0005;
   /// In-plane guidance on (F_et and the resistance force); the paper force is always rendered.
   bool guidance = true;
+
+  // Smoothness (paper section 6, sources of instability; docs/force-rendering.md).
+  /// Band at the edge of the constraint space over which F_et tapers to zero [m], in [0, R_res]: F_et
+  /// is scaled by a smoothstep of (R_res - d) / band, so it is continuous at R_res instead of stepping
+  /// by K_et a R_res. 0 = the paper's step.
+  double constraint_taper_m = 0.002;
+  /// Cross-fade time [s] of the in-plane force when the active element, stroke or character changes,
+  /// when WS is entered or left, or when the tip enters or leaves the constraint space. 0 = off.
+  double crossfade_s = 0.05;
+  /// Time [s] over which the paper force fades in when the paper starts to push (AS/SS -> CS/WS) and
+  /// out when it stops (CS -> AS). 0 = off.
+  double paper_fade_s = 0.2;
+  /// Hysteresis of the feature planes (eq. 6) [m]: a plane counts as passed when the tip is this far
+  /// past it, so that encoder noise at the plane does not switch the active element early.
+  double feature_plane_margin_m = 0.0002;
+  /// Damping of the paper on inward motion only (v_z < 0, below the paper) [N s/m]. Colgate's bound
+  /// shrinks by it: K <= 2 (b - B) / T. 0 = off.
+  double paper_damping_n_s_per_m = 0.0;
+  /// Highest speed of the rendered foot point X_S [m/s]: the attraction target moves towards the
+  /// tracked foot point at most this fast, so a jump of the nearest point does not step the force.
+  double max_foot_speed_m_s = 0.3;
+  /// Coulomb friction coefficient mu of the paper (not in the paper), dimensionless: |F_f| = mu N.
+  double friction_coefficient = 0.15;
+  /// Stick band [m/s] > 0: below this in-plane speed friction is viscous, mu N v / v_band, which
+  /// avoids the chatter of a sign function at rest.
+  double friction_stick_speed_m_s = 0.02;
   /// How the foot point X_S on curve elements is found.
   NearestPointOptions nearest{};
 
-  /// Throws InvalidArgument when a value is negative, not finite, or the radius is not positive.
+  /// Throws InvalidArgument when a value is negative, not finite, the radius or the stick speed is not
+  /// positive, or the taper band is wider than the radius.
   void validate() const;
 };
 
@@ -40,7 +67,17 @@ struct ForceLawParameters {
 
 /// Resistance against writing backwards (section 2.2, Fig. 4): -b (v . t) t when v . t < 0, else zero
 /// [N]; `tangent` is the unit writing direction of the active element at the foot point.
-[[nodiscard]] Vec2 resistance_force(const Vec2& velocity_m_s, const Vec2& tangent, double damping_n_s_per_m) noexcept;
+[[nodiscard]] Vec2 resistance_force(const Vec2& velocity_m_s, const Vec2& tangent,
+                                    double damping_n_s_per_m) noexcept;
+
+/// Paper friction (Coulomb with a stick band): -mu N v / |v| when |v| > v_band, else -mu N v / v_band
+/// [N], in the paper plane; `normal_force_n` N >= 0 [N], in-plane velocity [m/s].
+[[nodiscard]] Vec2 friction_force(const Vec2& velocity_m_s, double normal_force_n, double coefficient,
+                                  double stick_speed_m_s) noexcept;
+
+/// Taper of F_et at the constraint-space edge, in [0, 1]: 1 when distance <= R - band, 0 when
+/// distance >= R, a smoothstep between; band 0 gives the step 1 -> 0 at R. Lengths [m].
+[[nodiscard]] double constraint_taper(double distance_m, double radius_m, double band_m) noexcept;
 
 /// Scales `force` down to at most `max_force_n`, keeping its direction; a non-finite force gives zero.
 [[nodiscard]] Vec3 clamp_force(const Vec3& force_n, double max_force_n) noexcept;

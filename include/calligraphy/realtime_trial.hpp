@@ -19,6 +19,10 @@ namespace calligraphy {
 /// Options of a real-time trial.
 struct RealtimeTrialOptions {
   ForceLawParameters force{};     ///< `force.guidance` switches guidance on or off
+  SafetyChainParameters safety{};  ///< the renderer's safety chain (renderer.hpp)
+  PassivityParameters passivity{};  ///< the renderer's passivity controller (off by default)
+  /// Physical damping of the device [N s/m] for the renderer's stiffness bound; 0 = unknown.
+  double device_damping_n_s_per_m = 0.0;
   ServoLoopOptions loop{};        ///< rate, realtime mode, watchdog
   double max_duration_s = 300.0;  ///< the trial ends after max_duration_s x rate_hz ticks [s]
   bool keep_trace = true;

@@ -93,6 +93,8 @@ struct TrialOptions {
   WriterProfile writer = WriterProfile::novice();
   SimulatedDeviceParameters device{};
   double rate_hz = 1000.0;                    ///< servo rate [Hz]
+  SafetyChainParameters safety{};             ///< the renderer's safety chain (renderer.hpp)
+  PassivityParameters passivity{};            ///< the renderer's passivity controller (off by default)
   std::uint64_t seed = 0;                     ///< seeds the writer's bias, noise and tremor
   double max_duration_s = 300.0;              ///< stop after this much simulated time [s]
   bool keep_trace = true;

@@ -1,5 +1,6 @@
 // `calligraphy trial CHARS ...`: a whole guided writing trial at 1 kHz on any registered device
-// (the simulated one by default), through run_device_trial.
+// (the simulated one by default), through run_device_trial: lock-step for devices a simulated writer
+// moves, on the real-time ServoLoop otherwise or with --pacing real-time.
 #include <algorithm>
 #include <cstdio>
 #include <string>
@@ -9,6 +10,7 @@
 #include "calligraphy/device_registry.hpp"
 #include "calligraphy/device_trial.hpp"
 #include "calligraphy/scene.hpp"
+#include "calligraphy/simulated_device.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 #include "cli/trial_report.hpp"
@@ -31,7 +33,8 @@ DeviceListing find_device(const std::string& name) {
 
 int command_trial(const Args& args) {
   const Arguments arguments(
-      args, {"guidance", "writer", "seed", "data", "store", "json", "svg", "csv", "rate", "device"}, {});
+      args, {"guidance", "writer", "seed", "data", "store", "json", "svg", "csv", "rate", "device", "pacing",
+             "realtime"}, {});
   if (arguments.positionals().size() != 1) throw UsageError("trial takes one CHARS argument, e.g. trial 永");
   const std::u32string chars = characters_from(arguments.positionals()[0]);
   const std::string device_name = arguments.option_or("device", "simulated");
@@ -52,6 +55,15 @@ int command_trial(const Args& args) {
   options.seed = static_cast<std::uint64_t>(seed);
   options.rate_hz = arguments.number_or("rate", 1000.0);
   options.keep_trace = arguments.option("svg") || arguments.option("csv");
+  const std::string pacing = arguments.choice_or("pacing", {"auto", "lock-step", "real-time"}, "auto");
+  options.pacing = pacing == "lock-step"   ? TrialPacing::lock_step
+                   : pacing == "real-time" ? TrialPacing::real_time
+                                           : TrialPacing::automatic;
+  options.loop.realtime = arguments.choice_or("realtime", {"enforce", "ignore"}, "ignore") == "enforce"
+                              ? RealtimeMode::enforce
+                              : RealtimeMode::ignore;
+  // The simulated device's physical damping is known: it sets the renderer's stiffness bound.
+  if (device_name == "simulated") options.device_damping_n_s_per_m = SimulatedDeviceParameters{}.damping_n_s_per_m;
 
   const TrialResult result = run_device_trial(device_name, scene, options);
   // On hardware a person writes; the simulated writer only moves simulated and emulated devices.

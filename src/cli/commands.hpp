@@ -20,6 +20,7 @@ int command_trial(const Args& args);          // calligraphy trial CHARS [...]
 int command_model(const Args& args);          // calligraphy model CHAR [...]
 int command_bench_nearest(const Args& args);  // calligraphy bench nearest [--json] [...]
 int command_bench_jumps(const Args& args);    // calligraphy bench jumps [--json] [...]
+int command_bench_tick(const Args& args);     // calligraphy bench tick [--json] [...]
 int command_devices(const Args& args);        // calligraphy devices
 int command_corpus(const Args& args);           // calligraphy corpus build|stats|fidelity [...]
 int command_corpus_validate(const Args& args);  // calligraphy corpus validate --data DIR --cnchar FILE [...]

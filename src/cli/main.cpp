@@ -15,6 +15,7 @@ constexpr const char* kUsage =
     "usage: calligraphy <command> [options]\n"
     "  trial CHARS [--device NAME] [--guidance on|off] [--writer novice|skilled] [--seed N]\n"
     "              [--data DIR] [--store FILE] [--json FILE] [--svg FILE] [--csv FILE]\n"
+    "              [--pacing auto|lock-step|real-time] [--realtime enforce|ignore]\n"
     "                       run a guided writing trial at 1 kHz on a device (default: simulated)\n"
     "  model CHAR [--json] [--svg FILE] [--data DIR] [--store FILE]\n"
     "                       print the character's model (paper Table 3); --svg draws it (Fig. 13)\n"
@@ -34,7 +35,9 @@ constexpr const char* kUsage =
     "  bench jumps [--json] [--markdown FILE] [--seeds N] [--chars CHARS]\n"
     "                       foot-point jumps > 1 mm per stroke on real characters, by method\n"
     "  bench loop [--rate HZ] [--seconds S] [--realtime enforce|ignore|off] [--trial CHARS] [--json]\n"
-    "                       period jitter and missed deadlines of the real-time servo loop\n";
+    "                       period jitter and missed deadlines of the real-time servo loop\n"
+    "  bench tick [--json] [--chars CHARS] [--passes N] [--rate HZ]\n"
+    "                       cost of one servo tick (renderer and safety chain) over real trials\n";
 
 }  // namespace
 
@@ -58,6 +61,7 @@ int main(int argc, char** argv) {
     if (command == "bench" && !args.empty() && args[0] == "nearest") return command_bench_nearest(args);
     if (command == "bench" && !args.empty() && args[0] == "jumps") return command_bench_jumps(args);
     if (command == "bench" && !args.empty() && args[0] == "loop") return command_bench_loop(args);
+    if (command == "bench" && !args.empty() && args[0] == "tick") return command_bench_tick(args);
     std::fprintf(stderr, "calligraphy: error: unknown command '%s'\n%s", command.c_str(), kUsage);
     return 2;
   } catch (const UsageError& e) {

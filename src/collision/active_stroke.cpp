@@ -12,7 +12,8 @@ void ActiveStroke::reset() noexcept {
   element_ = 0;
   written_ = 0;
   // Skip characters without strokes so that the active stroke always exists until finished.
-  while (character_ < scene_->characters.size() && scene_->characters[character_].strokes.empty()) ++character_;
+  while (character_ < scene_->characters.size() && scene_->characters[character_].strokes.empty())
+    ++character_;
 }
 
 void ActiveStroke::next_stroke() noexcept {
@@ -25,11 +26,12 @@ void ActiveStroke::next_stroke() noexcept {
   }
 }
 
-StrokeProgress ActiveStroke::advance(const Vec2& tip_m) noexcept {
+StrokeProgress ActiveStroke::advance(const Vec2& tip_m, double plane_margin_m) noexcept {
   StrokeProgress progress;
   const PlacedStroke* s = stroke();
   if (s == nullptr) return progress;
-  while (element_ < s->elements.size() && feature_plane_passed(s->elements[element_], tip_m)) {
+  while (element_ < s->elements.size() &&
+         feature_plane_passed(s->elements[element_], tip_m, plane_margin_m)) {
     ++element_;
     ++progress.planes_passed;
   }

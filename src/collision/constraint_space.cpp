@@ -3,7 +3,7 @@
 namespace calligraphy {
 
 bool lse_rules_inside(const Vec2& start, const Vec2& end, const Vec2& tip) noexcept {
-  const Vec2 edge = end - start;  // PEdge
+  const Vec2 edge = end - start;               // PEdge
   if (edge.squaredNorm() == 0.0) return true;  // rule (d)
   const Vec2 p1 = tip - start;
   const double along = p1.dot(edge);
@@ -19,7 +19,8 @@ ElementContact element_contact(const StrokeElement& element, const Vec2& tip, do
   ElementContact contact;
   if (element.degree == 1) {
     contact.nearest = nearest_point_on_segment(element.start(), element.end(), tip);
-    contact.inside = lse_rules_inside(element.start(), element.end(), tip) && contact.nearest.distance <= radius_m;
+    contact.inside =
+        lse_rules_inside(element.start(), element.end(), tip) && contact.nearest.distance <= radius_m;
     return contact;
   }
   try {
@@ -27,6 +28,17 @@ ElementContact element_contact(const StrokeElement& element, const Vec2& tip, do
   } catch (...) {
     // Only non-finite input throws; the renderer rejects that before collision detection.
     contact.nearest = {0.0, element.start(), 0.0};
+    return contact;
+  }
+  return element_contact_at(element, tip, contact.nearest, radius_m);
+}
+
+ElementContact element_contact_at(const StrokeElement& element, const Vec2& tip, const NearestPoint& nearest,
+                                  double radius_m) noexcept {
+  ElementContact contact;
+  contact.nearest = nearest;
+  if (element.degree == 1) {
+    contact.inside = lse_rules_inside(element.start(), element.end(), tip) && nearest.distance <= radius_m;
     return contact;
   }
   const Vec2 start_tangent = element.unit_tangent(0.0);
@@ -37,8 +49,8 @@ ElementContact element_contact(const StrokeElement& element, const Vec2& tip, do
   return contact;
 }
 
-bool feature_plane_passed(const StrokeElement& element, const Vec2& tip) noexcept {
-  return element.unit_tangent(1.0).dot(tip - element.end()) > 0.0;
+bool feature_plane_passed(const StrokeElement& element, const Vec2& tip, double margin_m) noexcept {
+  return element.unit_tangent(1.0).dot(tip - element.end()) > margin_m;
 }
 
 }  // namespace calligraphy

@@ -1,37 +1,18 @@
 // The trial loop shared by every device (device_trial.hpp).
 #include "calligraphy/device_trial.hpp"
 
-#include <chrono>
 #include <cmath>
 #include <optional>
 #include <string>
-#include <thread>
 
 #include "calligraphy/device_registry.hpp"
 #include "calligraphy/errors.hpp"
 #include "calligraphy/hand_port.hpp"
+#include "calligraphy/realtime_trial.hpp"
 #include "calligraphy/simulated_writer.hpp"
 
 namespace calligraphy {
 namespace {
-
-// Wall-clock pacing for devices moved by a person: tick k starts at start + k * period. Absolute
-// deadlines keep a late tick from delaying every later one. One small function so that a real-time
-// servo loop can replace it.
-class WallClockPacer {
- public:
-  explicit WallClockPacer(double rate_hz)
-      : period_(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-            std::chrono::duration<double>(1.0 / rate_hz))),
-        start_(std::chrono::steady_clock::now()) {}
-  void wait_for_tick(std::size_t tick) const {
-    std::this_thread::sleep_until(start_ + static_cast<std::chrono::steady_clock::rep>(tick) * period_);
-  }
-
- private:
-  std::chrono::steady_clock::duration period_;
-  std::chrono::steady_clock::time_point start_;
-};
 
 // Forces off and link closed after a fault or at the end; never throws (the link may be gone).
 void stop_device(HapticDevice& device) noexcept {
@@ -56,7 +37,55 @@ void DeviceTrialOptions::validate() const {
   }
   force.validate();
   writer.validate();
+  if (pacing == TrialPacing::real_time && rate_hz > 10000.0) {
+    throw InvalidArgument("DeviceTrialOptions.rate_hz = " + std::to_string(rate_hz) +
+                          " must be at most 10000 Hz in real time (the ServoLoop's range)");
+  }
 }
+
+namespace {
+
+RendererOptions renderer_options(const DeviceTrialOptions& options) {
+  RendererOptions render;
+  render.rate_hz = options.rate_hz;
+  render.safety = options.safety;
+  render.passivity = options.passivity;
+  render.device_damping_n_s_per_m = options.device_damping_n_s_per_m;
+  return render;
+}
+
+// Real-time pacing on the ServoLoop (the device is open and calibrated; the loop enables and disables
+// forces). A hand-port device's writer and physics step inside the loop after each tick.
+TrialResult run_on_servo_loop(HapticDevice& device, const Scene& scene, const DeviceTrialOptions& options,
+                              HandPort* hand_port, SimulatedWriter* writer) {
+  RealtimeTrialOptions realtime;
+  realtime.force = options.force;
+  realtime.safety = options.safety;
+  realtime.passivity = options.passivity;
+  realtime.device_damping_n_s_per_m = options.device_damping_n_s_per_m;
+  realtime.loop = options.loop;
+  realtime.loop.rate_hz = options.rate_hz;
+  realtime.max_duration_s = options.max_duration_s;
+  realtime.keep_trace = options.keep_trace;
+  if (hand_port != nullptr) {
+    realtime.after_tick = [&](const DeviceState& state, const RenderOutput& out, double period_s) {
+      device.write_force(out.force_n);  // as lock-step: the force acts during the physics step
+      writer->observe(out, state);
+      if (writer->done()) return false;
+      hand_port->advance(period_s);
+      return true;
+    };
+  }
+  RealtimeTrialResult outcome = run_realtime_trial(device, scene, realtime);
+  TrialResult result = std::move(outcome.trial);
+  if (outcome.fault) {
+    result.aborted = true;
+    result.abort_reason = std::string(to_string(outcome.fault.kind)) + ": " + outcome.fault.message;
+  }
+  return result;
+}
+
+}  // namespace
 
 TrialResult run_device_trial(HapticDevice& device, const Scene& scene, const DeviceTrialOptions& options) {
   options.validate();
@@ -72,12 +101,24 @@ TrialResult run_device_trial(HapticDevice& device, const Scene& scene, const Dev
     hand_port->attach_hand(&*writer);
   }
 
+  if (hand_port == nullptr && options.pacing == TrialPacing::lock_step) {
+    throw InvalidArgument("lock-step pacing needs a device a simulated writer can move (a HandPort); '" +
+                          device.info().model + "' is moved by a person: use real-time pacing");
+  }
+  const bool real_time = hand_port == nullptr || options.pacing == TrialPacing::real_time;
+
   std::optional<Renderer> renderer;
   try {
     if (!device.is_open()) device.open();
     if (!device.is_calibrated()) device.calibrate();
     // After open(): some devices know their limits only then (OpenHaptics reads them from the driver).
-    renderer.emplace(scene, options.force, device.info());
+    if (real_time) {
+      TrialResult result = run_on_servo_loop(device, scene, options, hand_port, writer ? &*writer : nullptr);
+      if (hand_port != nullptr) hand_port->attach_hand(nullptr);
+      stop_device(device);
+      return result;
+    }
+    renderer.emplace(scene, options.force, device.info(), renderer_options(options));
     device.enable_forces(true);
   } catch (...) {
     if (hand_port != nullptr) hand_port->attach_hand(nullptr);
@@ -87,22 +128,17 @@ TrialResult run_device_trial(HapticDevice& device, const Scene& scene, const Dev
 
   TrialResult result;
   double end_time = 0.0;
-  std::optional<WallClockPacer> pacer;
-  if (hand_port == nullptr) pacer.emplace(options.rate_hz);
   try {
     for (std::size_t k = 0; k < ticks; ++k) {
-      if (pacer) pacer->wait_for_tick(k);
       const DeviceState state = device.read_state();
       const RenderOutput out = renderer->tick(state);
       device.write_force(out.force_n);
       recorder.record(state, out);
       end_time = state.time_s;
       if (out.finished) break;
-      if (writer) {
-        writer->observe(out, state);
-        if (writer->done()) break;
-        hand_port->advance(dt);
-      }
+      writer->observe(out, state);
+      if (writer->done()) break;
+      hand_port->advance(dt);
       // The time budget ran out after this tick: the trial lasted until the next tick would start.
       if (k + 1 == ticks) end_time = state.time_s + dt;
     }

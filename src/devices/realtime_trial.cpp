@@ -44,7 +44,12 @@ void RealtimeTrialOptions::validate() const {
 RealtimeTrialResult run_realtime_trial(HapticDevice& device, const Scene& scene,
                                        const RealtimeTrialOptions& options) {
   options.validate();
-  Renderer renderer(scene, options.force, device.info());
+  RendererOptions render_options;
+  render_options.rate_hz = options.loop.rate_hz;
+  render_options.safety = options.safety;
+  render_options.passivity = options.passivity;
+  render_options.device_damping_n_s_per_m = options.device_damping_n_s_per_m;
+  Renderer renderer(scene, options.force, device.info(), render_options);
   TrialRecorder recorder(scene, /*keep_trace=*/false);
   const double period_s = 1.0 / options.loop.rate_hz;
   const auto max_ticks = static_cast<std::size_t>(std::ceil(options.max_duration_s * options.loop.rate_hz));
@@ -122,6 +127,9 @@ RealtimeTrialResult run_realtime_simulated_trial(const Scene& scene, const Trial
 
   RealtimeTrialOptions options;
   options.force = trial.force;
+  options.safety = trial.safety;
+  options.passivity = trial.passivity;
+  options.device_damping_n_s_per_m = trial.device.damping_n_s_per_m;
   options.loop = loop;
   options.max_duration_s = trial.max_duration_s;
   options.keep_trace = trial.keep_trace;

@@ -30,6 +30,9 @@ TrialResult run_simulated_trial(const Scene& scene, const TrialOptions& options)
   device_options.seed = options.seed;
   device_options.max_duration_s = options.max_duration_s;
   device_options.keep_trace = options.keep_trace;
+  device_options.safety = options.safety;
+  device_options.passivity = options.passivity;
+  device_options.device_damping_n_s_per_m = options.device.damping_n_s_per_m;
   return run_device_trial(device, scene, device_options);
 }
 

@@ -1,5 +1,6 @@
 #include "calligraphy/force_law.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -19,6 +20,18 @@ void ForceLawParameters::validate() const {
   check(constraint_radius_m, "constraint_radius_m", true);
   check(resistance_damping_n_s_per_m, "resistance_damping_n_s_per_m", false);
   check(contact_hysteresis_m, "contact_hysteresis_m", false);
+  check(constraint_taper_m, "constraint_taper_m", false);
+  check(crossfade_s, "crossfade_s", false);
+  check(paper_fade_s, "paper_fade_s", false);
+  check(feature_plane_margin_m, "feature_plane_margin_m", false);
+  check(paper_damping_n_s_per_m, "paper_damping_n_s_per_m", false);
+  check(max_foot_speed_m_s, "max_foot_speed_m_s", true);
+  check(friction_coefficient, "friction_coefficient", false);
+  check(friction_stick_speed_m_s, "friction_stick_speed_m_s", true);
+  if (constraint_taper_m > constraint_radius_m) {
+    throw InvalidArgument("ForceLawParameters.constraint_taper_m = " + std::to_string(constraint_taper_m) +
+                          " must not exceed constraint_radius_m = " + std::to_string(constraint_radius_m));
+  }
 }
 
 Vec3 paper_force(double tip_z_m, double paper_z_m, double stiffness_n_per_m) noexcept {
@@ -34,6 +47,22 @@ Vec2 attraction_force(const Vec2& tip_m, const Vec2& foot_m, double stiffness_n_
 Vec2 resistance_force(const Vec2& velocity_m_s, const Vec2& tangent, double damping_n_s_per_m) noexcept {
   const double along = velocity_m_s.dot(tangent);
   return along < 0.0 ? Vec2(-damping_n_s_per_m * along * tangent) : Vec2(Vec2::Zero());
+}
+
+Vec2 friction_force(const Vec2& velocity_m_s, double normal_force_n, double coefficient,
+                    double stick_speed_m_s) noexcept {
+  const double speed = velocity_m_s.norm();
+  const double limit = coefficient * std::max(normal_force_n, 0.0);
+  if (!(stick_speed_m_s > 0.0) || speed == 0.0) return Vec2::Zero();
+  return speed > stick_speed_m_s ? Vec2(-limit / speed * velocity_m_s)
+                                 : Vec2(-limit / stick_speed_m_s * velocity_m_s);
+}
+
+double constraint_taper(double distance_m, double radius_m, double band_m) noexcept {
+  if (distance_m >= radius_m) return 0.0;
+  if (band_m <= 0.0 || distance_m <= radius_m - band_m) return 1.0;
+  const double u = (radius_m - distance_m) / band_m;  // 0 at the edge, 1 at the inner side of the band
+  return u * u * (3.0 - 2.0 * u);
 }
 
 Vec3 clamp_force(const Vec3& force_n, double max_force_n) noexcept {

@@ -2,42 +2,166 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <string>
 
 #include "calligraphy/constraint_space.hpp"
 #include "calligraphy/errors.hpp"
 
 namespace calligraphy {
+namespace {
 
-Renderer::Renderer(const Scene& scene, const ForceLawParameters& parameters, const DeviceInfo& device)
-    : scene_(&scene), parameters_(parameters), max_force_n_(device.max_force_n), active_(scene) {
-  parameters_.validate();
-  if (!(max_force_n_ > 0.0)) {
-    throw InvalidArgument("Renderer: device '" + device.model + "' max_force_n = " + std::to_string(max_force_n_) +
-                          " must be > 0");
+double smoothstep(double u) noexcept {
+  u = std::clamp(u, 0.0, 1.0);
+  return u * u * (3.0 - 2.0 * u);
+}
+
+// The safety chain's parameters with the device's peak and continuous force filled in.
+SafetyChainParameters chain_parameters(const RendererOptions& options, const DeviceInfo& device) {
+  SafetyChainParameters p = options.safety;
+  if (p.max_force_n == 0.0) p.max_force_n = device.max_force_n;
+  if (p.max_continuous_force_n == 0.0)
+    p.max_continuous_force_n = std::min(device.max_continuous_force_n, p.max_force_n);
+  return p;
+}
+
+const DeviceInfo& checked(const DeviceInfo& device) {
+  if (!(device.max_force_n > 0.0) || !std::isfinite(device.max_force_n)) {
+    throw InvalidArgument("Renderer: device '" + device.model + "' max_force_n = " +
+                          std::to_string(device.max_force_n) + " must be finite and > 0");
   }
+  return device;
+}
+
+const RendererOptions& checked(const RendererOptions& options) {
+  options.validate();
+  return options;
+}
+
+}  // namespace
+
+void RendererOptions::validate() const {
+  if (!(rate_hz >= 100.0 && rate_hz <= 100000.0)) {
+    throw InvalidArgument("RendererOptions.rate_hz = " + std::to_string(rate_hz) +
+                          " must be in [100, 100000] Hz");
+  }
+  if (!std::isfinite(device_damping_n_s_per_m) || device_damping_n_s_per_m < 0.0) {
+    throw InvalidArgument("RendererOptions.device_damping_n_s_per_m = " +
+                          std::to_string(device_damping_n_s_per_m) + " must be finite and >= 0");
+  }
+  passivity.validate();
+}
+
+Renderer::Renderer(const Scene& scene, const ForceLawParameters& parameters, const DeviceInfo& device,
+                   const RendererOptions& options)
+    : scene_(&scene),
+      parameters_(parameters),
+      options_(checked(options)),
+      period_s_(1.0 / options.rate_hz),
+      active_(scene),
+      chain_(chain_parameters(options, checked(device)), options.rate_hz),
+      passivity_(options.passivity, options.rate_hz) {
+  parameters_.validate();
+  const double k_paper = parameters_.paper_stiffness_n_per_m;
+  const double k_guidance = parameters_.guidance_stiffness_n_per_m;
   const double k_max = device.max_stiffness_n_per_m;
-  if (k_max > 0.0 && (parameters_.paper_stiffness_n_per_m > k_max || parameters_.guidance_stiffness_n_per_m > k_max)) {
-    spdlog::warn("stiffness above the device's stable maximum of {} N/m ({}): paper {} N/m, guidance {} N/m", k_max,
-                 device.model, parameters_.paper_stiffness_n_per_m, parameters_.guidance_stiffness_n_per_m);
+  if (k_max > 0.0 && (k_paper > k_max || k_guidance > k_max)) {
+    spdlog::warn("stiffness above the device's stable maximum of {} N/m ({}): paper {} N/m, guidance {} N/m",
+                 k_max, device.model, k_paper, k_guidance);
+  }
+  if (options_.device_damping_n_s_per_m > 0.0) {
+    // Colgate & Schenkel 1997: K < 2 (b - B) / T. The paper has the virtual damper B; the guidance
+    // stiffness is scaled by the attraction factor (eq. 8) on top.
+    const double paper_bound = colgate_stiffness_bound(options_.device_damping_n_s_per_m, options_.rate_hz,
+                                                       parameters_.paper_damping_n_s_per_m);
+    const double guidance_bound =
+        colgate_stiffness_bound(options_.device_damping_n_s_per_m, options_.rate_hz);
+    if (k_paper > paper_bound) {
+      spdlog::warn(
+          "paper stiffness {} N/m above the passivity bound 2 (b - B) / T = {} N/m (b = {} N s/m, B = {} "
+          "N s/m, {} Hz): the contact may be unstable without a hand or the passivity controller",
+          k_paper, paper_bound, options_.device_damping_n_s_per_m, parameters_.paper_damping_n_s_per_m,
+          options_.rate_hz);
+    }
+    if (parameters_.guidance && k_guidance > guidance_bound) {
+      spdlog::warn(
+          "guidance stiffness {} N/m above the passivity bound 2 b / T = {} N/m (b = {} N s/m, {} Hz)",
+          k_guidance, guidance_bound, options_.device_damping_n_s_per_m, options_.rate_hz);
+    }
   }
 }
 
 void Renderer::reset() noexcept {
   active_.reset();
   state_ = InteractionState::separation;
+  chain_.reset();
+  passivity_.reset();
+  tracker_.reset();
+  foot_valid_ = false;
+  paper_weight_ = 0.0;
+  guidance_ = fade_from_ = Vec2::Zero();
+  fade_elapsed_s_ = 0.0;
+  was_inside_ = false;
+  last_force_ = Vec3::Zero();
+}
+
+// F_et (eq. 8) with the taper at R_res and a rate-limited foot point, plus the resistance force, for
+// the active element; zero outside the constraint space. Fills the contact fields of `out`.
+Vec2 Renderer::guidance_force(const DeviceState& device, RenderOutput& out, bool element_changed) noexcept {
+  const StrokeElement& element = *active_.element();
+  const Vec2 tip = device.position_m.head<2>();
+  if (element_changed) tracker_.reset();
+  // An LSE's foot point is exact and cheap; a CSE's is tracked from tick to tick (nearest_point_tracker.hpp).
+  const NearestPoint nearest = element.degree == 1
+                                   ? nearest_point_on_segment(element.start(), element.end(), tip)
+                                   : tracker_.update(element, tip);
+  const ElementContact contact = element_contact_at(element, tip, nearest, parameters_.constraint_radius_m);
+  out.in_constraint_space = contact.inside;
+  out.foot_m = nearest.foot;
+  // Foot-point jumps (a new element, a jump of the tracker to another minimum) move the attraction
+  // target at a bounded speed instead of stepping the force.
+  const double max_move = parameters_.max_foot_speed_m_s * period_s_;
+  const Vec2 move = nearest.foot - rendered_foot_;
+  if (!foot_valid_ || element_changed) {
+    rendered_foot_ = nearest.foot;
+  } else if (move.norm() > max_move) {
+    rendered_foot_ += move * (max_move / move.norm());
+  } else {
+    rendered_foot_ = nearest.foot;
+  }
+  foot_valid_ = true;
+  if (!parameters_.guidance || !contact.inside) return Vec2::Zero();
+  const double taper =
+      constraint_taper(nearest.distance, parameters_.constraint_radius_m, parameters_.constraint_taper_m);
+  const Vec2 tangent = element.unit_tangent(nearest.t);
+  return taper * attraction_force(tip, rendered_foot_, parameters_.guidance_stiffness_n_per_m,
+                                  active_.attraction(nearest.t)) +
+         resistance_force(device.velocity_m_s.head<2>(), tangent, parameters_.resistance_damping_n_s_per_m);
 }
 
 RenderOutput Renderer::tick(const DeviceState& device) noexcept {
   RenderOutput out;
   if (!device.position_m.allFinite() || !device.velocity_m_s.allFinite()) {
     out.input_rejected = true;
+    const SafetyResult safe = chain_.apply(Vec3::Constant(std::numeric_limits<double>::quiet_NaN()));
+    out.force_n = safe.force_n;
+    out.limits = safe.limits;
+    last_force_ = out.force_n;
     out.state = state_;
     out.finished = active_.finished();
+    out.character = active_.character_index();
+    out.stroke = active_.stroke_index();
+    out.element = active_.element_index();
     return out;
   }
   const Vec2 tip = device.position_m.head<2>();
   const double paper_z = scene_->layout.paper_z_m;
+  const std::size_t character_before = active_.character_index();
+  const std::size_t stroke_before = active_.stroke_index();
+  const std::size_t element_before = active_.element_index();
+  const InteractionState state_before = state_;
 
   StateInputs inputs;
   const double release_z =
@@ -53,34 +177,65 @@ RenderOutput Renderer::tick(const DeviceState& device) noexcept {
     out.stroke_abandoned = true;
   }
   if (next == InteractionState::writing) {
-    if (active_.advance(tip).stroke_completed) {
+    if (active_.advance(tip, parameters_.feature_plane_margin_m).stroke_completed) {
       out.stroke_completed = true;
       next = InteractionState::calibration;  // written; the next stroke starts at its own neighbourhood
     }
   }
   out.state_changed = next != state_;
   state_ = next;
+  const bool writing = state_ == InteractionState::writing && !active_.finished();
+  const bool element_changed =
+      active_.character_index() != character_before || active_.stroke_index() != stroke_before ||
+      active_.element_index() != element_before ||
+      (state_ == InteractionState::writing) != (state_before == InteractionState::writing);
 
-  Vec3 force = Vec3::Zero();
-  if (state_ == InteractionState::calibration || state_ == InteractionState::writing) {
-    force += paper_force(device.position_m.z(), paper_z, parameters_.paper_stiffness_n_per_m);
+  // Paper force, eq. (9), with inward-only damping; faded in when the paper starts pushing on a tip
+  // that is already below it (AS -> CS) and out when it stops (CS -> AS), section 6.
+  const bool paper_on = state_ == InteractionState::calibration || state_ == InteractionState::writing;
+  if (state_before == InteractionState::separation || parameters_.paper_fade_s <= 0.0) {
+    paper_weight_ = paper_on ? 1.0 : 0.0;  // a touch-down starts at zero depth: no step to smooth
+  } else {
+    const double step = period_s_ / parameters_.paper_fade_s;
+    paper_weight_ = paper_on ? std::min(1.0, paper_weight_ + step) : std::max(0.0, paper_weight_ - step);
   }
-  if (state_ == InteractionState::writing && !active_.finished()) {
-    const StrokeElement& element = *active_.element();
-    const ElementContact contact =
-        element_contact(element, tip, parameters_.constraint_radius_m, parameters_.nearest);
-    out.in_constraint_space = contact.inside;
-    out.foot_m = contact.nearest.foot;
-    if (parameters_.guidance && contact.inside) {
-      const Vec2 tangent = element.unit_tangent(contact.nearest.t);
-      const Vec2 in_plane = attraction_force(tip, contact.nearest.foot, parameters_.guidance_stiffness_n_per_m,
-                                             active_.attraction(contact.nearest.t)) +
-                            resistance_force(device.velocity_m_s.head<2>(), tangent,
-                                             parameters_.resistance_damping_n_s_per_m);
-      force.head<2>() += in_plane;
-    }
+  Vec3 force = paper_force(device.position_m.z(), paper_z, parameters_.paper_stiffness_n_per_m);
+  if (force.z() > 0.0 && device.velocity_m_s.z() < 0.0) {
+    force.z() -= parameters_.paper_damping_n_s_per_m * device.velocity_m_s.z();
   }
-  out.force_n = clamp_force(force, max_force_n_);
+  force *= paper_weight_;
+
+  // In-plane guidance, cross-faded when its source changes (element, stroke, character, WS, inside).
+  Vec2 target = Vec2::Zero();
+  if (writing) {
+    target = guidance_force(device, out, element_changed);
+  } else {
+    foot_valid_ = false;
+  }
+  if (element_changed || out.in_constraint_space != was_inside_) {
+    fade_from_ = guidance_;
+    fade_elapsed_s_ = 0.0;
+  }
+  was_inside_ = out.in_constraint_space;
+  fade_elapsed_s_ += period_s_;
+  const double blend =
+      parameters_.crossfade_s > 0.0 ? smoothstep(fade_elapsed_s_ / parameters_.crossfade_s) : 1.0;
+  guidance_ = fade_from_ + blend * (target - fade_from_);
+  force.head<2>() += guidance_;
+
+  // Paper friction (Coulomb with a stick band), against the in-plane velocity.
+  force.head<2>() += friction_force(device.velocity_m_s.head<2>(), force.z(),
+                                    parameters_.friction_coefficient, parameters_.friction_stick_speed_m_s);
+
+  if (options_.passivity.enabled) {
+    force = passivity_.apply(device.position_m, device.velocity_m_s, last_force_, force);
+    out.passivity_damping_n_s_per_m = passivity_.damping_n_s_per_m();
+  }
+  out.force_error = !force.allFinite();
+  const SafetyResult safe = chain_.apply(force);
+  out.force_n = safe.force_n;
+  out.limits = safe.limits;
+  last_force_ = out.force_n;
   out.state = state_;
   out.finished = active_.finished();
   out.character = active_.character_index();

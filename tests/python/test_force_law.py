@@ -65,3 +65,15 @@ def test_clamp_keeps_direction_and_zeroes_non_finite():
     np.testing.assert_array_equal(calligraphy.ForceLaw.clamp([0.1, 0.2, 0.3], 2.5), [0.1, 0.2, 0.3])
     many = calligraphy.ForceLaw.clamp(np.array([[10.0, 0.0, 0.0], [np.nan, 0.0, 1.0], [0.0, 0.0, -1.0]]), 2.0)
     np.testing.assert_allclose(many, [[2.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
+
+
+def test_smoothing_and_friction_parameters_are_exposed():
+    law = calligraphy.ForceLaw(friction_coefficient=0.3, crossfade_s=0.1, constraint_taper_m=0.001)
+    assert law.friction_coefficient == 0.3
+    assert law.crossfade_s == 0.1
+    assert law.constraint_taper_m == 0.001
+    assert calligraphy.ForceLaw().friction_stick_speed_m_s > 0.0
+    with pytest.raises(ValueError, match="constraint_taper_m"):
+        calligraphy.ForceLaw(constraint_radius_m=0.002, constraint_taper_m=0.003)
+    with pytest.raises(ValueError, match="friction_coefficient"):
+        calligraphy.ForceLaw(friction_coefficient=-0.1)
