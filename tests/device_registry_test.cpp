@@ -45,7 +45,7 @@ DeviceInfo info_named(const char* model) {
 
 }  // namespace
 
-TEST_CASE("Backends register factories; devices are listed and created by name", "[registry]") {
+TEST_CASE("Backends register factories, devices are listed and created by name", "[registry]") {
   DeviceRegistry registry;
   registry.register_device("simulated", info_named("Sim"),
                            [] { return std::make_unique<FixedDevice>(info_named("Sim")); });

@@ -1,5 +1,5 @@
 // Trials on any device through run_device_trial: the emulated Phantom end to end, a disconnect and a
-// safety fault in the middle of a trial, wall-clock pacing for devices without a hand port.
+// safety fault in the middle of a trial, real-time pacing on the ServoLoop for devices without a hand port.
 #include "calligraphy/device_trial.hpp"
 
 #include <algorithm>
@@ -82,10 +82,14 @@ class FaultingDevice final : public HapticDevice {
     state.time_s = 0.001 * reads;
     return state;
   }
-  void write_force(const Vec3&) override { ++writes; }
+  void write_force(const Vec3& force_n) override {
+    ++writes;
+    last_force = force_n;
+  }
   int reads = 0;
   int writes = 0;
   int closes = 0;
+  Vec3 last_force = Vec3::Constant(1.0);
 
  private:
   DeviceInfo info_;
@@ -136,7 +140,7 @@ TEST_CASE("Lock-step trials on the emulated Phantom are deterministic for a seed
   CHECK(first.metrics.time_s == again.metrics.time_s);
 }
 
-TEST_CASE("The CLI's runner takes a registry name; an unknown name lists the devices",
+TEST_CASE("The CLI's runner takes a registry name, an unknown name lists the devices",
           "[device-trial][registry]") {
   const Scene scene = scene_of(U"口");
   DeviceTrialOptions options;
@@ -217,7 +221,7 @@ TEST_CASE("The reports of an aborted trial say so and keep what was recorded", "
   CHECK(cli::trial_svg(scene, result).find("</svg>") != std::string::npos);
 }
 
-TEST_CASE("A safety fault aborts a wall-clock paced trial; ticks are paced by absolute deadlines",
+TEST_CASE("A safety fault aborts a trial on the servo loop, ticks are paced by absolute deadlines",
           "[device-trial]") {
   const Scene scene = scene_of(U"口");
   FaultingDevice device(40);
@@ -228,10 +232,13 @@ TEST_CASE("A safety fault aborts a wall-clock paced trial; ticks are paced by ab
   REQUIRE(result.aborted);
   CHECK(result.abort_reason == "test: force limit tripped");
   CHECK(result.trace.size() == 39);
-  CHECK(device.writes == 39);
+  // No hand port: the trial runs on the ServoLoop, which writes the 39 ticks' forces, then zero force
+  // when the fault stops it.
+  CHECK(device.writes == 40);
+  CHECK(device.last_force == Vec3::Zero());
   CHECK(device.closes >= 1);
   CHECK_FALSE(device.forces_enabled());
-  // No hand port: tick 39 (0-based) may not start before 39 ms (sleep_until never wakes early).
+  // Tick 39 (0-based) may not start before 39 ms: absolute deadlines never wake early.
   CHECK(elapsed_s >= 0.039);
 }
 

@@ -94,7 +94,7 @@ TEST_CASE("The tracker follows a point moving along a curve", "[nearest_point][t
   CHECK(mismatches == 0);
 }
 
-TEST_CASE("reset() makes the next update search globally; bad input leaves the state alone",
+TEST_CASE("reset() makes the next update search globally, bad input leaves the state alone",
           "[nearest_point][tracker]") {
   const StrokeElement arc = symmetric_arc();
   NearestPointTracker tracker;

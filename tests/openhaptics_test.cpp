@@ -75,7 +75,7 @@ TEST_CASE("HD error codes map onto the exception hierarchy", "[openhaptics]") {
   CHECK_THROWS_AS(throw_hd_servo_error(HD_INVALID_LICENSE), calligraphy::CommunicationError);
 }
 
-TEST_CASE("HD millimetres and axes convert to device metres; forces map back power-consistently",
+TEST_CASE("HD millimetres and axes convert to device metres, forces map back power-consistently",
           "[openhaptics]") {
   CHECK((hd_mm_to_device_m({10.0, 20.0, 30.0}) - Vec3(0.010, -0.030, 0.020)).norm() < 1e-15);
   // Power is frame-independent: F.v in device axes equals F.v in HD axes.

@@ -101,7 +101,7 @@ TEST_CASE("Encoder counts to joint angles and back", "[phantom][arm]") {
   CHECK_THROWS_AS(JointEncoders(15000, {1, 2, 1}), calligraphy::InvalidArgument);
 }
 
-TEST_CASE("Joint torques to DAC counts and back; saturation keeps the direction", "[phantom][arm]") {
+TEST_CASE("Joint torques to DAC counts and back, saturation keeps the direction", "[phantom][arm]") {
   MotorModel motors;
   motors.direction = {1, -1, 1};
   const double per_count = motors.newton_metres_per_count(0);
@@ -124,7 +124,7 @@ TEST_CASE("Joint torques to DAC counts and back; saturation keeps the direction"
   CHECK(torques_to_dac(motors, nan) == std::array<std::int16_t, 3>{0, 0, 0});
 }
 
-TEST_CASE("Force clamp keeps the direction; non-finite force gives zero", "[devices][safety]") {
+TEST_CASE("Force clamp keeps the direction, non-finite force gives zero", "[devices][safety]") {
   using calligraphy::devices::clamp_force_magnitude;
   const Vec3 f(3.0, 4.0, 0.0);
   CHECK(clamp_force_magnitude(f, 10.0) == f);

@@ -49,7 +49,7 @@ TEST_CASE("Command DAC counts saturate at the 12-bit range", "[phantom][codec]")
   CHECK(decode_command(bytes, decoded) == PacketError::bad_dac_value);
 }
 
-TEST_CASE("Status packets round-trip; buttons are active-low on the wire", "[phantom][codec]") {
+TEST_CASE("Status packets round-trip, buttons are active-low on the wire", "[phantom][codec]") {
   StatusPacket status;
   status.encoder_counts = {-32768, 12345, -1};
   status.potentiometer_pairs = {{{0x8000, 0x4000}, {0x0020, 0xFFE0}, {0x1234, 0x5678}}};

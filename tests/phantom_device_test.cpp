@@ -77,7 +77,7 @@ TEST_CASE("Used uncalibrated: CalibrationNeeded until the stylus is docked", "[p
   CHECK_NOTHROW(device->enable_forces(true));
 }
 
-TEST_CASE("Forces need the enable-bit toggle; the arm is pushed along the commanded force",
+TEST_CASE("Forces need the enable-bit toggle, the arm is pushed along the commanded force",
           "[phantom][device]") {
   auto [device, emulator] = make_undocked(JointAngles(0.2, 0.3, 0.4));
   emulator->set_docked(true);
@@ -186,7 +186,7 @@ TEST_CASE("A stream of bad packets becomes a CommunicationError after the limit,
   CHECK(device->packet_errors().malformed == 10);
 }
 
-TEST_CASE("Malformed, short and long packets are counted and reported; the last good state is kept",
+TEST_CASE("Malformed, short and long packets are counted and reported, the last good state is kept",
           "[phantom][device]") {
   auto [device, emulator] = make_emulated_phantom();
   device->open();

@@ -124,7 +124,7 @@ TEST_CASE("Safety chain: parameters are validated", "[safety]") {
   CHECK_THROWS_AS(SafetyChain(p, 1000.0), InvalidArgument);
 }
 
-TEST_CASE("Renderer: NaN input gives zero force and the safety flag; the chain's limits hold", "[safety]") {
+TEST_CASE("Renderer: NaN input gives zero force and the safety flag, the chain's limits hold", "[safety]") {
   const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'口')});
   Renderer r(scene, ForceLawParameters{}, phantom_desktop_info());
   const Vec2 centre = scene.characters[0].bounding_box.center();

@@ -80,7 +80,7 @@ TrialResult run_on_servo_loop(HapticDevice& device, const Scene& scene, const De
   TrialResult result = std::move(outcome.trial);
   if (outcome.fault) {
     result.aborted = true;
-    result.abort_reason = std::string(to_string(outcome.fault.kind)) + ": " + outcome.fault.message;
+    result.abort_reason = outcome.fault.message;  // the device's message, or the watchdog's reason
   }
   return result;
 }
