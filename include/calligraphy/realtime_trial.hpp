@@ -4,10 +4,9 @@
 /// callback at the loop's rate against any `HapticDevice` (issue 5, Deliver 1: "the trial runner gains
 /// a real-time mode on the loop beside the lock-step mode" of `run_simulated_trial`).
 ///
-/// The loop never allocates for the trace: the trace is allocated and touched up front for
-/// max_duration_s x rate_hz ticks (memory: about 80 bytes per tick, 24 MB for 300 s at 1 kHz), and the
-/// trial ends when it is full. The metrics come from `TrialRecorder` run without its own trace (it has
-/// no reserve), with each stroke's `trace_begin`/`trace_end` filled in from the trace kept here.
+/// The loop never allocates for the trace: the recorder's trace is reserved (and touched) up front for
+/// max_duration_s x rate_hz ticks (`TrialRecorder::reserve`; memory: about 80 bytes per tick, 24 MB for
+/// 300 s at 1 kHz), and the trial ends when it is full.
 #include <functional>
 
 #include "calligraphy/renderer.hpp"

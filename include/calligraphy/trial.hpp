@@ -53,7 +53,7 @@ struct TrialMetrics {
   std::vector<StrokeMetrics> per_stroke;
 };
 
-/// Records ticks into a trace and metrics. Allocates only when the trace grows (reserve it for real time).
+/// Records ticks into a trace and metrics. Allocates only when the trace grows beyond `reserve`.
 class TrialRecorder {
  public:
   /// `scene` must outlive the recorder.
@@ -62,6 +62,9 @@ class TrialRecorder {
   void record(const DeviceState& state, const RenderOutput& output);
   [[nodiscard]] const TrialMetrics& metrics() const noexcept { return metrics_; }
   [[nodiscard]] const std::vector<TrialSample>& trace() const noexcept { return trace_; }
+  /// Allocates (and touches) room for `ticks` samples of the trace, so that the next `ticks` calls of
+  /// `record` never allocate: for a real-time loop. Nothing when the trace is not kept.
+  void reserve(std::size_t ticks);
   /// Closes the metrics at `end_time_s` (time_s of an unfinished trial).
   void finish(double end_time_s);
 
@@ -78,6 +81,7 @@ class TrialRecorder {
   TrialMetrics metrics_;
   std::vector<std::pair<std::size_t, std::size_t>> stroke_location_;  // global index -> (character, stroke)
   std::size_t current_ = 0;  // stroke being written (global index)
+  std::size_t ticks_ = 0;    // ticks recorded: the next sample's index in the trace
   Attempt attempt_;
   Vec3 last_force_ = Vec3::Zero();
   bool first_ = true;

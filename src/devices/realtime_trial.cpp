@@ -7,17 +7,6 @@
 
 namespace calligraphy {
 
-namespace {
-
-// Where each stroke's last attempt lies in the trace, tracked as `TrialRecorder::record` does, because a
-// recorder without its own trace cannot know trace indices.
-struct StrokeSpan {
-  std::size_t begin = 0;
-  std::size_t end = 0;
-};
-
-}  // namespace
-
 const char* to_string(TrialEnd end) noexcept {
   switch (end) {
     case TrialEnd::finished:
@@ -50,13 +39,11 @@ RealtimeTrialResult run_realtime_trial(HapticDevice& device, const Scene& scene,
   render_options.passivity = options.passivity;
   render_options.device_damping_n_s_per_m = options.device_damping_n_s_per_m;
   Renderer renderer(scene, options.force, device.info(), render_options);
-  TrialRecorder recorder(scene, /*keep_trace=*/false);
+  TrialRecorder recorder(scene, options.keep_trace);
   const double period_s = 1.0 / options.loop.rate_hz;
   const auto max_ticks = static_cast<std::size_t>(std::ceil(options.max_duration_s * options.loop.rate_hz));
 
-  // Allocated and value-initialised (so touched) here, written by index in the loop.
-  std::vector<TrialSample> trace(options.keep_trace ? max_ticks : 0);
-  std::vector<StrokeSpan> spans(recorder.metrics().per_stroke.size());
+  recorder.reserve(max_ticks);  // allocated and touched here: the loop never allocates for the trace
   std::size_t count = 0;
   double last_time_s = 0.0;
   TrialEnd end = TrialEnd::max_duration;
@@ -65,16 +52,7 @@ RealtimeTrialResult run_realtime_trial(HapticDevice& device, const Scene& scene,
       device,
       [&](const DeviceState& state, double /*dt_s*/) -> ServoCommand {
         const RenderOutput out = renderer.tick(state);
-        const std::size_t stroke = recorder.metrics().strokes_completed;  // the recorder's current stroke
         recorder.record(state, out);
-        if (stroke < spans.size()) {
-          StrokeSpan& span = spans[stroke];
-          if (out.state_changed && out.state == InteractionState::writing) span.begin = count;
-          if (out.state == InteractionState::writing || out.stroke_completed) span.end = count + 1;
-          if (out.stroke_abandoned) span.end = span.begin;
-        }
-        if (options.keep_trace)
-          trace[count] = {state.time_s, state.position_m, out.force_n, out.state, stroke, out.element};
         ++count;
         last_time_s = state.time_s;
         ServoCommand command{out.force_n, false};
@@ -106,14 +84,7 @@ RealtimeTrialResult run_realtime_trial(HapticDevice& device, const Scene& scene,
 
   recorder.finish(last_time_s);
   result.trial.metrics = recorder.metrics();
-  if (options.keep_trace) {
-    for (std::size_t i = 0; i < spans.size(); ++i) {
-      result.trial.metrics.per_stroke[i].trace_begin = spans[i].begin;
-      result.trial.metrics.per_stroke[i].trace_end = spans[i].end;
-    }
-    trace.resize(count);
-    result.trial.trace = std::move(trace);
-  }
+  result.trial.trace = recorder.trace();
   return result;
 }
 

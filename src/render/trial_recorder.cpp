@@ -41,7 +41,7 @@ void TrialRecorder::record(const DeviceState& state, const RenderOutput& out) {
   last_force_ = out.force_n;
   last_state_ = out.state;
 
-  const std::size_t index = trace_.size();
+  const std::size_t index = ticks_++;
   if (keep_trace_) {
     trace_.push_back({state.time_s, state.position_m, out.force_n, out.state, current_, out.element});
   }
@@ -77,6 +77,13 @@ void TrialRecorder::record(const DeviceState& state, const RenderOutput& out) {
     attempt_ = {};
     ++current_;
   }
+}
+
+void TrialRecorder::reserve(std::size_t ticks) {
+  if (!keep_trace_ || ticks <= trace_.capacity()) return;
+  const std::size_t size = trace_.size();
+  trace_.resize(ticks);  // value-initialises, so the pages are touched now, not in the loop
+  trace_.resize(size);
 }
 
 void TrialRecorder::finish(double end_time_s) {
