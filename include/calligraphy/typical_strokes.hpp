@@ -30,6 +30,25 @@ struct StrokePieceTemplate {
   double max_length = std::numeric_limits<double>::infinity();
 };
 
+/// A piece template from nominal directions [deg] and their tolerances [deg]: a line (LSE) when the
+/// start and end directions differ by less than 15 degrees, else a Bezier curve (CSE), after the paper's
+/// line segment and curve segment strokes (section 3.2). Lengths in data units (1024 box).
+constexpr StrokePieceTemplate piece_template(double start_deg, double end_deg, double start_tolerance_deg,
+                                             double end_tolerance_deg, bool hook = false,
+                                             double min_length = 0.0,
+                                             double max_length = std::numeric_limits<double>::infinity()) {
+  constexpr double kBentDeg = 15.0;
+  const bool straight = end_deg - start_deg < kBentDeg && start_deg - end_deg < kBentDeg;
+  return {straight ? ElementKind::line : ElementKind::bezier,
+          start_deg,
+          end_deg,
+          start_tolerance_deg,
+          end_tolerance_deg,
+          hook,
+          min_length,
+          max_length};
+}
+
 /// A typical stroke. `id` is 1-39, constant forever.
 struct TypicalStroke {
   int id;

@@ -278,18 +278,10 @@ struct ObservedForm {
   double extra_cost;  // prior against the form (units of the template cost)
 };
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kBentDeg = 15.0;  // as in typical_strokes.cpp
 constexpr StrokePieceTemplate form_piece(double start, double end, double start_tol, double end_tol,
                                          bool hook = false, double min_length = 0.0,
                                          double max_length = kInf) {
-  return {(end - start < kBentDeg && start - end < kBentDeg) ? ElementKind::line : ElementKind::bezier,
-          start,
-          end,
-          start_tol,
-          end_tol,
-          hook,
-          min_length,
-          max_length};
+  return piece_template(start, end, start_tol, end_tol, hook, min_length, max_length);
 }
 constexpr StrokePieceTemplate kFormHookLeft = form_piece(150, 150, 25, 25, true);
 constexpr StrokePieceTemplate kNone{};

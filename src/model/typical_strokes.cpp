@@ -16,19 +16,9 @@ namespace {
 using P = StrokePieceTemplate;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// A piece is straight (an LSE) when its nominal start and end directions differ by less than this,
-// else bent (a CSE): the paper's line segment and curve segment strokes (section 3.2).
-constexpr double kBentDeg = 15.0;
 constexpr P piece(double start, double end, double start_tol, double end_tol, bool hook = false,
                   double min_length = 0.0, double max_length = kInf) {
-  return {(end - start < kBentDeg && start - end < kBentDeg) ? ElementKind::line : ElementKind::bezier,
-          start,
-          end,
-          start_tol,
-          end_tol,
-          hook,
-          min_length,
-          max_length};
+  return piece_template(start, end, start_tol, end_tol, hook, min_length, max_length);
 }
 constexpr P piece(double start, double end, double tol = 20.0) { return piece(start, end, tol, tol); }
 constexpr P hook_piece(double direction, double tol = 25.0) {
