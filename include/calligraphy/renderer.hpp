@@ -74,6 +74,7 @@ class Renderer {
 
  private:
   Vec2 guidance_force(const DeviceState& device, RenderOutput& out, bool element_changed) noexcept;
+  void command(const Vec3& force, RenderOutput& out) noexcept;
 
   const Scene* scene_;
   ForceLawParameters parameters_;
@@ -92,7 +93,6 @@ class Renderer {
   Vec2 fade_from_ = Vec2::Zero();  // guidance force at the start of the running cross-fade
   double fade_elapsed_s_ = 0.0;
   bool was_inside_ = false;
-  Vec3 last_force_ = Vec3::Zero();  // last command, for the passivity observer
 };
 
 }  // namespace calligraphy

@@ -104,7 +104,6 @@ void Renderer::reset() noexcept {
   guidance_ = fade_from_ = Vec2::Zero();
   fade_elapsed_s_ = 0.0;
   was_inside_ = false;
-  last_force_ = Vec3::Zero();
 }
 
 // F_et (eq. 8) with the taper at R_res and a rate-limited foot point, plus the resistance force, for
@@ -145,15 +144,7 @@ RenderOutput Renderer::tick(const DeviceState& device) noexcept {
   RenderOutput out;
   if (!device.position_m.allFinite() || !device.velocity_m_s.allFinite()) {
     out.input_rejected = true;
-    const SafetyResult safe = chain_.apply(Vec3::Constant(std::numeric_limits<double>::quiet_NaN()));
-    out.force_n = safe.force_n;
-    out.limits = safe.limits;
-    last_force_ = out.force_n;
-    out.state = state_;
-    out.finished = active_.finished();
-    out.character = active_.character_index();
-    out.stroke = active_.stroke_index();
-    out.element = active_.element_index();
+    command(Vec3::Constant(std::numeric_limits<double>::quiet_NaN()), out);
     return out;
   }
   const Vec2 tip = device.position_m.head<2>();
@@ -228,20 +219,24 @@ RenderOutput Renderer::tick(const DeviceState& device) noexcept {
                                     parameters_.friction_coefficient, parameters_.friction_stick_speed_m_s);
 
   if (options_.passivity.enabled) {
-    force = passivity_.apply(device.position_m, device.velocity_m_s, last_force_, force);
+    force = passivity_.apply(device.position_m, device.velocity_m_s, chain_.last_output(), force);
     out.passivity_damping_n_s_per_m = passivity_.damping_n_s_per_m();
   }
   out.force_error = !force.allFinite();
+  command(force, out);
+  return out;
+}
+
+// The force law's force through the safety chain into `out`, with where the renderer now stands.
+void Renderer::command(const Vec3& force, RenderOutput& out) noexcept {
   const SafetyResult safe = chain_.apply(force);
   out.force_n = safe.force_n;
   out.limits = safe.limits;
-  last_force_ = out.force_n;
   out.state = state_;
   out.finished = active_.finished();
   out.character = active_.character_index();
   out.stroke = active_.stroke_index();
   out.element = active_.element_index();
-  return out;
 }
 
 }  // namespace calligraphy
