@@ -89,10 +89,6 @@ TrialResult run_on_servo_loop(HapticDevice& device, const Scene& scene, const De
 
 TrialResult run_device_trial(HapticDevice& device, const Scene& scene, const DeviceTrialOptions& options) {
   options.validate();
-  TrialRecorder recorder(scene, options.keep_trace);
-  const double dt = 1.0 / options.rate_hz;
-  const auto ticks = static_cast<std::size_t>(std::ceil(options.max_duration_s * options.rate_hz));
-
   // Discovered once: the loop below never asks again.
   HandPort* const hand_port = dynamic_cast<HandPort*>(&device);
   std::optional<SimulatedWriter> writer;
@@ -126,6 +122,10 @@ TrialResult run_device_trial(HapticDevice& device, const Scene& scene, const Dev
     throw;
   }
 
+  // Lock-step from here on (the real-time branch returned above).
+  TrialRecorder recorder(scene, options.keep_trace);
+  const double dt = 1.0 / options.rate_hz;
+  const auto ticks = static_cast<std::size_t>(std::ceil(options.max_duration_s * options.rate_hz));
   TrialResult result;
   double end_time = 0.0;
   try {
