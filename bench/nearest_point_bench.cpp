@@ -7,9 +7,9 @@
 #include <random>
 #include <vector>
 
-#include "calligraphy/nearest_point.hpp"
-#include "calligraphy/nearest_point_tracker.hpp"
-#include "cli/nearest_point_scenarios.hpp"
+#include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/collision/nearest_point_tracker.hpp"
+#include "eval/nearest_point_scenarios.hpp"
 
 namespace {
 

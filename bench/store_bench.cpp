@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "calligraphy/character_library.hpp"
-#include "calligraphy/corpus_store.hpp"
-#include "calligraphy/scene.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/model/corpus_store.hpp"
+#include "calligraphy/model/scene.hpp"
 
 namespace {
 
@@ -108,7 +108,8 @@ void scene_of_four_from_store(benchmark::State& state) {
   std::vector<Character> once;
   for (char32_t c : wanted) once.push_back(fresh.load(c));
   const Scene first = Scene::lay_out(once);
-  state.counters["rss_delta_bytes"] = static_cast<double>(resident_bytes() - std::min(rss_before, resident_bytes()));
+  state.counters["rss_delta_bytes"] =
+      static_cast<double>(resident_bytes() - std::min(rss_before, resident_bytes()));
   benchmark::DoNotOptimize(first);
   std::size_t bytes = 0;
   for (auto _ : state) {

@@ -7,11 +7,11 @@
 // library's simulated writer can hold it and the trial runs lock-step (deterministic, much faster than
 // real time). A real device would implement HapticDevice only: run_device_trial then paces the ticks
 // by the wall clock and the person holding the device writes.
-#include <calligraphy/character_library.hpp>
-#include <calligraphy/device_registry.hpp>
-#include <calligraphy/device_trial.hpp>
-#include <calligraphy/errors.hpp>
-#include <calligraphy/hand_port.hpp>
+#include <calligraphy/core/errors.hpp>
+#include <calligraphy/devices/device_registry.hpp>
+#include <calligraphy/model/character_library.hpp>
+#include <calligraphy/sim/hand_port.hpp>
+#include <calligraphy/trial/device_trial.hpp>
 #include <cmath>
 #include <cstdio>
 #include <memory>

@@ -1,8 +1,8 @@
 // The README's usage example: model a character, lay it out on the paper, run a guided trial on the
 // simulated device, and print the metrics.
-#include <calligraphy/character_library.hpp>
-#include <calligraphy/scene.hpp>
-#include <calligraphy/trial.hpp>
+#include <calligraphy/model/character_library.hpp>
+#include <calligraphy/model/scene.hpp>
+#include <calligraphy/trial/trial.hpp>
 #include <cstdio>
 
 int main() {
@@ -10,7 +10,7 @@ int main() {
   const Character yong = CharacterLibrary::embedded().load(U'永');  // hanzi-writer-data medians, fitted
   const Scene scene = Scene::lay_out({yong});                       // 60 mm box on the paper z = 0
 
-  TrialOptions options;                      // 1 kHz, simulated Phantom Desktop, novice writer
+  TrialOptions options;                              // 1 kHz, simulated Phantom Desktop, novice writer
   options.force.guidance_stiffness_n_per_m = 400.0;  // K_et [N/m], eq. (8)
   options.seed = 1;
   const TrialResult result = run_simulated_trial(scene, options);

@@ -9,8 +9,8 @@
 #include <span>
 #include <vector>
 
-#include "calligraphy/corpus_store.hpp"
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/corpus_store.hpp"
 #include "model/corpus_store_format.hpp"
 
 namespace {

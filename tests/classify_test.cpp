@@ -9,13 +9,13 @@
 #include <string>
 #include <vector>
 
-#include "calligraphy/character_library.hpp"
-#include "calligraphy/errors.hpp"
-#include "calligraphy/fitting.hpp"
-#include "calligraphy/typical_strokes.hpp"
-#include "cli/cnchar_validation.hpp"
-#include "cli/model_svg.hpp"
-#include "cli/typical_strokes_report.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/model/fitting.hpp"
+#include "calligraphy/model/typical_strokes.hpp"
+#include "calligraphy/report/model_svg.hpp"
+#include "eval/cnchar_validation.hpp"
+#include "report/typical_strokes_report.hpp"
 
 using namespace calligraphy;
 

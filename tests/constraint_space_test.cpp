@@ -1,6 +1,6 @@
-#include <catch2/catch.hpp>
+#include "calligraphy/collision/constraint_space.hpp"
 
-#include "calligraphy/constraint_space.hpp"
+#include <catch2/catch.hpp>
 
 using namespace calligraphy;
 

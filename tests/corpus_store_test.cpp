@@ -1,4 +1,4 @@
-#include "calligraphy/corpus_store.hpp"
+#include "calligraphy/model/corpus_store.hpp"
 
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -6,10 +6,10 @@
 #include <fstream>
 #include <map>
 
-#include "calligraphy/character_library.hpp"
-#include "calligraphy/errors.hpp"
-#include "calligraphy/scene.hpp"
-#include "calligraphy/typical_strokes.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/model/typical_strokes.hpp"
 #include "model/corpus_store_format.hpp"
 
 using namespace calligraphy;

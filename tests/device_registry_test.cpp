@@ -1,11 +1,12 @@
-#include "calligraphy/device_registry.hpp"
+#include "calligraphy/devices/device_registry.hpp"
 
 #include <catch2/catch.hpp>
 #include <memory>
 #include <sstream>
 
-#include "calligraphy/devices/phantom.hpp"
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/testing/emulated_phantom.hpp"
+#include "devices/phantom/phantom_device.hpp"
 
 using calligraphy::DeviceBackend;
 using calligraphy::DeviceInfo;
@@ -103,6 +104,7 @@ TEST_CASE("A backend that fails to scan becomes a note, not a failure", "[regist
 TEST_CASE("The process registry offers the emulated Phantom and runs a servo loop through it",
           "[registry][phantom]") {
   auto& registry = calligraphy::device_registry();
+  calligraphy::testing::register_emulated_phantom(registry);
   const auto names = registry.backend_names();
   CHECK(std::find(names.begin(), names.end(), "emulated-phantom") != names.end());
   CHECK(std::find(names.begin(), names.end(), "phantom-hid") != names.end());

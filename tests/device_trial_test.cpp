@@ -1,16 +1,17 @@
 // Trials on any device through run_device_trial: the emulated Phantom end to end, a disconnect and a
 // safety fault in the middle of a trial, real-time pacing on the ServoLoop for devices without a hand port.
-#include "calligraphy/device_trial.hpp"
+#include "calligraphy/trial/device_trial.hpp"
 
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <string>
 
-#include "calligraphy/character_library.hpp"
-#include "calligraphy/devices/phantom_emulator.hpp"
-#include "calligraphy/errors.hpp"
-#include "cli/trial_report.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/report/trial_report.hpp"
+#include "calligraphy/testing/emulated_phantom.hpp"
+#include "sim/testing/phantom_emulator.hpp"
 
 using namespace calligraphy;
 using phantom::EmulatedPhantomDevice;
@@ -129,6 +130,7 @@ TEST_CASE("A trial of 永 runs end to end on the emulated Phantom through the Ph
 
 TEST_CASE("Lock-step trials on the emulated Phantom are deterministic for a seed",
           "[device-trial][phantom]") {
+  calligraphy::testing::register_emulated_phantom(calligraphy::device_registry());
   const Scene scene = scene_of(U"口");
   DeviceTrialOptions options;
   options.seed = 5;
@@ -142,6 +144,7 @@ TEST_CASE("Lock-step trials on the emulated Phantom are deterministic for a seed
 
 TEST_CASE("The CLI's runner takes a registry name, an unknown name lists the devices",
           "[device-trial][registry]") {
+  calligraphy::testing::register_emulated_phantom(calligraphy::device_registry());
   const Scene scene = scene_of(U"口");
   DeviceTrialOptions options;
   options.keep_trace = false;

@@ -1,7 +1,8 @@
+#include "calligraphy/model/element.hpp"
+
 #include <catch2/catch.hpp>
 
-#include "calligraphy/element.hpp"
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
 
 using calligraphy::StrokeElement;
 using calligraphy::Vec2;

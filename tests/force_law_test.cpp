@@ -1,9 +1,10 @@
+#include "calligraphy/render/force_law.hpp"
+
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
 
-#include "calligraphy/errors.hpp"
-#include "calligraphy/force_law.hpp"
+#include "calligraphy/core/errors.hpp"
 
 using namespace calligraphy;
 
@@ -11,8 +12,8 @@ TEST_CASE("Eq. (9): the paper pushes a penetrating tip out with K_en times the d
   const Vec3 f = paper_force(-0.002, 0.0, 800.0);  // 2 mm below the paper
   CHECK(f.x() == 0.0);
   CHECK(f.y() == 0.0);
-  CHECK(f.z() == Approx(1.6));                      // 800 N/m * 2 mm, out of the paper (+z)
-  CHECK(paper_force(0.001, 0.0, 800.0).isZero());   // above the paper: nothing
+  CHECK(f.z() == Approx(1.6));                     // 800 N/m * 2 mm, out of the paper (+z)
+  CHECK(paper_force(0.001, 0.0, 800.0).isZero());  // above the paper: nothing
   CHECK(paper_force(0.0105, 0.01, 1000.0).isZero());
   CHECK(paper_force(0.0095, 0.01, 1000.0).z() == Approx(0.5));  // z0 = 10 mm
 }

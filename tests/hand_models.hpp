@@ -2,7 +2,7 @@
 // Hand models for the stability tests (issue 5): the hand holding the simulated device's stylus.
 // Figures of the relaxed and stiff hands: REFERENCE.md section 8 (a relaxed grip 150 N/m, 3 N s/m; a
 // stiff grip 600 N/m, 8 N s/m). Test helpers, not library API.
-#include "calligraphy/simulated_device.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
 
 namespace calligraphy::testing {
 

@@ -2,11 +2,11 @@
 #include <filesystem>
 #include <fstream>
 
-#include "calligraphy/character_library.hpp"
-#include "calligraphy/errors.hpp"
-#include "calligraphy/fitting.hpp"
-#include "calligraphy/typical_strokes.hpp"
-#include "calligraphy/unicode.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/model/fitting.hpp"
+#include "calligraphy/model/typical_strokes.hpp"
+#include "core/unicode.hpp"
 
 using namespace calligraphy;
 
@@ -90,7 +90,8 @@ void write(const std::filesystem::path& p, const std::string& text) { std::ofstr
 
 TEST_CASE("Bad data gives errors that name the character, the path and the position", "[model][errors]") {
   CHECK_THROWS_AS(CharacterLibrary::from_directory("/nonexistent/hanzi"), DataError);
-  CHECK_THROWS_WITH(CharacterLibrary::from_directory("/nonexistent/hanzi"), Catch::Contains("/nonexistent/hanzi"));
+  CHECK_THROWS_WITH(CharacterLibrary::from_directory("/nonexistent/hanzi"),
+                    Catch::Contains("/nonexistent/hanzi"));
 
   CHECK_THROWS_AS(CharacterLibrary::embedded().load(U'龘'), CharacterNotFound);
   CHECK_THROWS_WITH(CharacterLibrary::embedded().load(U'龘'), Catch::Contains("U+9F98"));

@@ -5,12 +5,12 @@
 #include <cstdlib>
 #include <new>
 
-#include "calligraphy/character_library.hpp"
-#include "calligraphy/nearest_point.hpp"
-#include "calligraphy/nearest_point_tracker.hpp"
-#include "calligraphy/renderer.hpp"
-#include "calligraphy/simulated_device.hpp"
-#include "calligraphy/trial.hpp"
+#include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/collision/nearest_point_tracker.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/render/renderer.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/trial/trial.hpp"
 
 // AddressSanitizer owns operator new/delete; replacing them there mixes its allocator with ours
 // (alloc-dealloc-mismatch at exit). The Release build runs this test; the ASan build leaves it out.
@@ -61,7 +61,7 @@ TEST_CASE("Renderer ticks (smoothing, passivity controller, safety chain) do not
   RendererOptions options;
   options.passivity.enabled = true;
   options.safety.low_pass_cutoff_hz = 100.0;
-  Renderer renderer(scene, ForceLawParameters{}, phantom_desktop_info(), options);
+  Renderer renderer(scene, ForceLawParameters{}, simulated_phantom_desktop_info(), options);
   const long before = allocations.load();
   double sum = 0.0;
   for (std::size_t k = 1; k < recorded.trace.size(); ++k) {

@@ -5,11 +5,11 @@
 #include <numbers>
 #include <random>
 
-#include "calligraphy/character_library.hpp"
-#include "calligraphy/nearest_point.hpp"
-#include "calligraphy/nearest_point_tracker.hpp"
-#include "calligraphy/scene.hpp"
-#include "cli/nearest_point_reference.hpp"
+#include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/collision/nearest_point_tracker.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "eval/nearest_point_reference.hpp"
 
 using namespace calligraphy;
 

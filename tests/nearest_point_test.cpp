@@ -1,6 +1,6 @@
 // Nearest point on a stroke element: every method on every extreme case of REFERENCE.md section 5,
 // against the independent high-precision reference of src/cli/nearest_point_reference.hpp.
-#include "calligraphy/nearest_point.hpp"
+#include "calligraphy/collision/nearest_point.hpp"
 
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -12,8 +12,8 @@
 #include <utility>
 #include <vector>
 
-#include "calligraphy/errors.hpp"
-#include "cli/nearest_point_reference.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "eval/nearest_point_reference.hpp"
 
 using calligraphy::InvalidArgument;
 using calligraphy::NearestPoint;

@@ -1,13 +1,13 @@
 // NearestPointTracker: hysteresis between equal minima, following a moving point, reset, bad input.
-#include "calligraphy/nearest_point_tracker.hpp"
+#include "calligraphy/collision/nearest_point_tracker.hpp"
 
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
 #include <utility>
 
-#include "calligraphy/errors.hpp"
-#include "calligraphy/nearest_point.hpp"
+#include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/core/errors.hpp"
 
 using calligraphy::NearestPoint;
 using calligraphy::NearestPointTracker;

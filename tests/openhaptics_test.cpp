@@ -5,8 +5,8 @@
 #include <optional>
 #include <string>
 
-#include "calligraphy/device_registry.hpp"
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/devices/device_registry.hpp"
 #include "devices/openhaptics/hd_conversions.hpp"
 #include "devices/openhaptics/hd_errors.hpp"
 #include "devices/openhaptics/hd_library.hpp"

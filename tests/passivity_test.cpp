@@ -1,7 +1,7 @@
 // Passivity of the paper contact on the simulated device (issue 5): the energy the device supplies,
 // integral of F . v dt from the device's side, stays bounded for stiffness up to Colgate's bound
 // 2 b / T, grows above it, and the Hannaford-Ryu controller stops the growth.
-#include "calligraphy/passivity.hpp"
+#include "calligraphy/render/passivity.hpp"
 
 #include <spdlog/sinks/ostream_sink.h>
 #include <spdlog/spdlog.h>
@@ -12,10 +12,10 @@
 #include <cstdio>
 #include <sstream>
 
-#include "calligraphy/character_library.hpp"
-#include "calligraphy/errors.hpp"
-#include "calligraphy/renderer.hpp"
-#include "calligraphy/simulated_device.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/render/renderer.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
 #include "hand_models.hpp"
 
 using namespace calligraphy;
@@ -138,10 +138,10 @@ TEST_CASE("The renderer warns at construction when a stiffness exceeds the bound
   options.device_damping_n_s_per_m = kDeviceDamping;  // bound 1000 N/m
   ForceLawParameters force;
   force.paper_stiffness_n_per_m = 900.0;
-  { const Renderer below(scene, force, phantom_desktop_info(), options); }
+  { const Renderer below(scene, force, simulated_phantom_desktop_info(), options); }
   const std::string quiet = log.str();
   force.paper_stiffness_n_per_m = 1500.0;
-  { const Renderer above(scene, force, phantom_desktop_info(), options); }
+  { const Renderer above(scene, force, simulated_phantom_desktop_info(), options); }
   const std::string warned = log.str();
   spdlog::set_default_logger(previous);
   CHECK(quiet.find("passivity bound") == std::string::npos);

@@ -1,12 +1,12 @@
-#include "calligraphy/devices/phantom_arm.hpp"
+#include "devices/phantom/phantom_arm.hpp"
 
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <numbers>
 
-#include "calligraphy/devices/force_limits.hpp"
-#include "calligraphy/devices/velocity_filter.hpp"
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/force_limits.hpp"
+#include "devices/phantom/velocity_filter.hpp"
 
 using namespace calligraphy::phantom;
 using calligraphy::Vec3;

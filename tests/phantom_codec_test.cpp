@@ -1,4 +1,4 @@
-#include "calligraphy/devices/phantom_codec.hpp"
+#include "devices/phantom/phantom_codec.hpp"
 
 #include <array>
 #include <catch2/catch.hpp>

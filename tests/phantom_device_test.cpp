@@ -1,12 +1,13 @@
 // PhantomDevice against the emulated Phantom: the real device code path over the in-memory transport.
+#include "devices/phantom/phantom_device.hpp"
+
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
 
-#include "calligraphy/devices/in_memory_transport.hpp"
-#include "calligraphy/devices/phantom.hpp"
-#include "calligraphy/devices/phantom_emulator.hpp"
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "sim/testing/in_memory_transport.hpp"
+#include "sim/testing/phantom_emulator.hpp"
 
 using namespace calligraphy::phantom;
 using calligraphy::CalibrationNeeded;

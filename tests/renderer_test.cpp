@@ -1,7 +1,8 @@
+#include "calligraphy/render/renderer.hpp"
+
 #include <catch2/catch.hpp>
 
-#include "calligraphy/renderer.hpp"
-#include "calligraphy/simulated_device.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
 
 using namespace calligraphy;
 
@@ -32,7 +33,8 @@ DeviceState at(const Scene& scene, const Vec2& data, double z, const Vec2& veloc
 }
 
 // The paper's force law without the smoothing of section 6 and without the safety chain's ramp and
-// rate limit, so that single ticks show eqs. (7)-(9) exactly (the smoothing is tested in smoothness_test.cpp).
+// rate limit, so that single ticks show eqs. (7)-(9) exactly (the smoothing is tested in
+// smoothness_test.cpp).
 ForceLawParameters unsmoothed() {
   ForceLawParameters p;
   p.constraint_taper_m = 0.0;
@@ -54,7 +56,7 @@ RendererOptions no_ramp_no_rate_limit() {
 
 TEST_CASE("Renderer: states, plane popping, completion and per-state forces", "[renderer]") {
   const Scene scene = two_stroke_scene();
-  Renderer r(scene, unsmoothed(), phantom_desktop_info(), no_ramp_no_rate_limit());
+  Renderer r(scene, unsmoothed(), simulated_phantom_desktop_info(), no_ramp_no_rate_limit());
   const double below = -0.001;  // 1 mm into the paper
 
   // SS above the paper: zero force.
@@ -116,7 +118,7 @@ TEST_CASE("Renderer: states, plane popping, completion and per-state forces", "[
 
 TEST_CASE("Renderer: non-finite input gives zero force, never NaN", "[renderer]") {
   const Scene scene = two_stroke_scene();
-  Renderer r(scene, ForceLawParameters{}, phantom_desktop_info());
+  Renderer r(scene, ForceLawParameters{}, simulated_phantom_desktop_info());
   DeviceState s = at(scene, {210, 600}, -0.001);
   s.position_m.x() = std::numeric_limits<double>::quiet_NaN();
   const auto out = r.tick(s);
@@ -128,7 +130,7 @@ TEST_CASE("Renderer: guidance off keeps the paper and the tracking but no in-pla
   const Scene scene = two_stroke_scene();
   ForceLawParameters p;
   p.guidance = false;
-  Renderer r(scene, p, phantom_desktop_info());
+  Renderer r(scene, p, simulated_phantom_desktop_info());
   r.tick(at(scene, {210, 600}, -0.001));
   const auto out = r.tick(at(scene, {500, 640}, -0.001));
   CHECK(out.state == InteractionState::writing);
@@ -138,7 +140,7 @@ TEST_CASE("Renderer: guidance off keeps the paper and the tracking but no in-pla
 
 TEST_CASE("Renderer: the force never exceeds the device maximum", "[renderer]") {
   const Scene scene = two_stroke_scene();
-  DeviceInfo weak = phantom_desktop_info();
+  DeviceInfo weak = simulated_phantom_desktop_info();
   weak.max_force_n = 0.5;
   Renderer r(scene, unsmoothed(), weak, no_ramp_no_rate_limit());
   const auto out = r.tick(at(scene, {300, 500}, -0.01));  // 10 mm deep: 8 N asked

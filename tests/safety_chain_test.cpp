@@ -1,15 +1,15 @@
 // The safety chain (issue 5): each stage on its own, and the renderer's use of it.
-#include "calligraphy/safety_chain.hpp"
+#include "calligraphy/render/safety_chain.hpp"
 
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
 #include <numbers>
 
-#include "calligraphy/character_library.hpp"
-#include "calligraphy/errors.hpp"
-#include "calligraphy/renderer.hpp"
-#include "calligraphy/simulated_device.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/render/renderer.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
 
 using namespace calligraphy;
 
@@ -126,7 +126,7 @@ TEST_CASE("Safety chain: parameters are validated", "[safety]") {
 
 TEST_CASE("Renderer: NaN input gives zero force and the safety flag, the chain's limits hold", "[safety]") {
   const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'口')});
-  Renderer r(scene, ForceLawParameters{}, phantom_desktop_info());
+  Renderer r(scene, ForceLawParameters{}, simulated_phantom_desktop_info());
   const Vec2 centre = scene.characters[0].bounding_box.center();
   DeviceState s;
   s.position_m = Vec3(centre.x(), centre.y(), scene.layout.paper_z_m - 0.004);

@@ -13,11 +13,11 @@
 #include <thread>
 #include <vector>
 
-#include "calligraphy/character_library.hpp"
-#include "calligraphy/renderer.hpp"
-#include "calligraphy/servo_loop.hpp"
-#include "calligraphy/simulated_device.hpp"
-#include "calligraphy/trial.hpp"
+#include "calligraphy/devices/servo_loop.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/render/renderer.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/trial/trial.hpp"
 
 namespace {
 thread_local bool watched = false;  // set by a thread to have its own allocations counted

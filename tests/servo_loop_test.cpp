@@ -1,7 +1,7 @@
 // The real-time servo loop (issue 5, Deliver 1): rate, start/stop/restart, fault containment, watchdog,
 // concurrent statistics, and a real-time trial on the simulated device. Timing is asserted only as loose
 // properties (tick counts within 20 %), never as benchmarks; `calligraphy bench loop` measures jitter.
-#include "calligraphy/servo_loop.hpp"
+#include "calligraphy/devices/servo_loop.hpp"
 
 #include <dirent.h>
 
@@ -11,9 +11,9 @@
 #include <stdexcept>
 #include <thread>
 
-#include "calligraphy/character_library.hpp"
-#include "calligraphy/realtime_trial.hpp"
-#include "calligraphy/simulated_device.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/trial/realtime_trial.hpp"
 #include "devices/latency_histogram.hpp"
 
 using namespace calligraphy;

@@ -1,7 +1,8 @@
+#include "calligraphy/sim/simulated_device.hpp"
+
 #include <catch2/catch.hpp>
 
-#include "calligraphy/errors.hpp"
-#include "calligraphy/simulated_device.hpp"
+#include "calligraphy/core/errors.hpp"
 
 using namespace calligraphy;
 
@@ -21,7 +22,7 @@ TEST_CASE("A free simulated device accelerates as F = m a under a held force", "
 TEST_CASE("The simulated device saturates and quantises like a real one", "[device]") {
   SimulatedDevice d;
   d.write_force(Vec3(0.0, 30.0, 40.0));
-  CHECK(d.applied_force().norm() == Approx(phantom_desktop_info().max_force_n));
+  CHECK(d.applied_force().norm() == Approx(simulated_phantom_desktop_info().max_force_n));
   d.enable_forces(false);
   d.write_force(Vec3(1.0, 0.0, 0.0));
   CHECK(d.applied_force().isZero());

@@ -7,11 +7,12 @@
 #include <string>
 #include <vector>
 
-#include "calligraphy/character_library.hpp"
-#include "calligraphy/constraint_space.hpp"
-#include "calligraphy/force_law.hpp"
-#include "calligraphy/renderer.hpp"
-#include "calligraphy/trial.hpp"
+#include "calligraphy//model/character_library.hpp"
+#include "calligraphy/collision/constraint_space.hpp"
+#include "calligraphy/render/force_law.hpp"
+#include "calligraphy/render/renderer.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/trial/trial.hpp"
 
 using namespace calligraphy;
 
@@ -105,7 +106,7 @@ RendererOptions without_rate_limit() {
 // element past x = 800 (the plane pops, X_S jumps to the vertical element), then down.
 double corner_max_step(const ForceLawParameters& force) {
   const Scene scene = corner_scene();
-  Renderer r(scene, force, phantom_desktop_info(), without_rate_limit());
+  Renderer r(scene, force, simulated_phantom_desktop_info(), without_rate_limit());
   const double z = scene.layout.paper_z_m - 0.0005;
   r.tick(at_data(scene, {205, 600}, z));  // WS at the start
   Vec3 previous = Vec3::Zero();
@@ -185,7 +186,7 @@ TEST_CASE("F_et tapers to zero at the constraint-space edge", "[smoothness]") {
   ForceLawParameters p = unsmoothed();
   p.constraint_taper_m = band;
   p.resistance_damping_n_s_per_m = 0.0;
-  Renderer renderer(scene, p, phantom_desktop_info(), without_rate_limit());
+  Renderer renderer(scene, p, simulated_phantom_desktop_info(), without_rate_limit());
   const double z = scene.layout.paper_z_m;
   renderer.tick(at_data(scene, {205, 600}, z));
   const double units_per_m = 1024.0 / 0.06;
@@ -206,7 +207,7 @@ TEST_CASE("The paper force fades in when CS is entered from AS below the paper",
   const Scene scene = corner_scene();
   ForceLawParameters p;
   p.friction_coefficient = 0.0;
-  Renderer r(scene, p, phantom_desktop_info(), without_rate_limit());
+  Renderer r(scene, p, simulated_phantom_desktop_info(), without_rate_limit());
   const double z = scene.layout.paper_z_m - 0.004;  // 4 mm deep: 3.2 N at full weight
   const Vec2 outside = scene.characters[0].bounding_box.max() + Vec2(0.01, 0.01);
   DeviceState s;
@@ -230,7 +231,7 @@ TEST_CASE("Paper damping acts on inward motion only", "[smoothness]") {
   const Scene scene = corner_scene();
   ForceLawParameters p = unsmoothed();
   p.paper_damping_n_s_per_m = 0.4;
-  Renderer r(scene, p, phantom_desktop_info(), without_rate_limit());
+  Renderer r(scene, p, simulated_phantom_desktop_info(), without_rate_limit());
   DeviceState s = at_data(scene, {500, 300}, scene.layout.paper_z_m - 0.001);
   s.velocity_m_s.z() = -0.05;
   CHECK(r.tick(s).force_n.z() == Approx(0.8 + 0.4 * 0.05));

@@ -1,6 +1,6 @@
 #include <catch2/catch.hpp>
 
-#include "calligraphy/interaction_state.hpp"
+#include "calligraphy/render/interaction_state.hpp"
 
 using namespace calligraphy;
 using S = InteractionState;

@@ -1,8 +1,9 @@
+#include "calligraphy/trial/trial.hpp"
+
 #include <catch2/catch.hpp>
 
-#include "calligraphy/character_library.hpp"
-#include "calligraphy/simulated_device.hpp"
-#include "calligraphy/trial.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
 
 using namespace calligraphy;
 
@@ -21,7 +22,7 @@ TEST_CASE("A guided trial on 永 completes every stroke in order", "[trial]") {
   CHECK(result.metrics.strokes_total == 5);
   CHECK(result.metrics.strokes_completed == 5);
   CHECK(result.metrics.completed_in_order);
-  CHECK(result.metrics.max_force_n <= phantom_desktop_info().max_force_n);
+  CHECK(result.metrics.max_force_n <= simulated_phantom_desktop_info().max_force_n);
   for (const auto& s : result.trace) REQUIRE(s.force_n.allFinite());
 }
 
@@ -66,7 +67,8 @@ TEST_CASE("A character group is written one character after another", "[trial]")
   double second_started = 1e9;
   for (const auto& s : result.trace) {
     if (s.stroke == 2 && s.state == InteractionState::writing) first_done = std::max(first_done, s.time_s);
-    if (s.stroke == 3 && s.state == InteractionState::writing) second_started = std::min(second_started, s.time_s);
+    if (s.stroke == 3 && s.state == InteractionState::writing)
+      second_started = std::min(second_started, s.time_s);
   }
   CHECK(first_done < second_started);
 }

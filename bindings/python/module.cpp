@@ -9,15 +9,15 @@
 #include <string>
 #include <vector>
 
-#include "calligraphy/character_library.hpp"
-#include "calligraphy/errors.hpp"
-#include "calligraphy/force_law.hpp"
-#include "calligraphy/nearest_point.hpp"
-#include "calligraphy/scene.hpp"
-#include "calligraphy/simulated_device.hpp"
-#include "calligraphy/trial.hpp"
-#include "calligraphy/typical_strokes.hpp"
-#include "calligraphy/unicode.hpp"
+#include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/model/typical_strokes.hpp"
+#include "calligraphy/render/force_law.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/trial/trial.hpp"
+#include "core/unicode.hpp"
 
 namespace py = pybind11;
 using namespace calligraphy;

@@ -8,11 +8,11 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
-#include "calligraphy/character_library.hpp"
-#include "calligraphy/realtime_trial.hpp"
-#include "calligraphy/scene.hpp"
-#include "calligraphy/servo_loop.hpp"
-#include "calligraphy/simulated_device.hpp"
+#include "calligraphy/devices/servo_loop.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/trial/realtime_trial.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 

@@ -7,12 +7,12 @@
 #include <iostream>
 #include <sstream>
 
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
-#include "cli/nearest_point_jumps.hpp"
-#include "cli/nearest_point_measurement.hpp"
-#include "cli/nearest_point_report.hpp"
+#include "eval/nearest_point_jumps.hpp"
+#include "eval/nearest_point_measurement.hpp"
+#include "eval/nearest_point_report.hpp"
 
 namespace calligraphy::cli {
 

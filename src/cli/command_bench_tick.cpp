@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "calligraphy/renderer.hpp"
-#include "calligraphy/scene.hpp"
-#include "calligraphy/simulated_device.hpp"
-#include "calligraphy/simulated_writer.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/render/renderer.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/sim/simulated_writer.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 
@@ -76,7 +76,7 @@ int command_bench_tick(const Args& args) {
     const std::vector<DeviceState> states = record_states(scene, rate_hz, 300.0);
     RendererOptions options;
     options.rate_hz = rate_hz;
-    Renderer renderer(scene, ForceLawParameters{}, phantom_desktop_info(), options);
+    Renderer renderer(scene, ForceLawParameters{}, simulated_phantom_desktop_info(), options);
     for (int pass = 0; pass < passes; ++pass) {
       renderer.reset();
       for (const DeviceState& state : states) {

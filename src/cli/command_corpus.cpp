@@ -8,13 +8,13 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "calligraphy/corpus_store.hpp"
-#include "calligraphy/errors.hpp"
-#include "calligraphy/scene.hpp"
-#include "calligraphy/typical_strokes.hpp"
-#include "calligraphy/unicode.hpp"
-#include "cli/command_corpus_fit.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/corpus_store.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/model/typical_strokes.hpp"
 #include "cli/commands.hpp"
+#include "core/unicode.hpp"
+#include "eval/corpus_fit.hpp"
 #include "model/polyline.hpp"
 
 namespace calligraphy::cli {

@@ -9,13 +9,13 @@
 #include <sstream>
 #include <thread>
 
-#include "calligraphy/errors.hpp"
-#include "calligraphy/unicode.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/report/trial_report.hpp"
 #include "cli/arguments.hpp"
-#include "cli/cnchar_validation.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
-#include "cli/trial_report.hpp"
+#include "core/unicode.hpp"
+#include "eval/cnchar_validation.hpp"
 
 namespace calligraphy::cli {
 

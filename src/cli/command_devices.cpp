@@ -1,7 +1,8 @@
 // `calligraphy devices`: lists every haptic device the registered backends find, with its DeviceInfo.
 #include <iostream>
 
-#include "calligraphy/device_registry.hpp"
+#include "calligraphy/devices/device_registry.hpp"
+#include "cli/cli_devices.hpp"
 #include "cli/commands.hpp"
 
 namespace calligraphy::cli {
@@ -15,7 +16,7 @@ int command_devices(const Args& args) {
     }
     throw UsageError("devices: unexpected argument '" + arg + "' (usage: calligraphy devices)");
   }
-  print_device_survey(std::cout, device_registry().survey());
+  print_device_survey(std::cout, cli_device_registry().survey());
   return 0;
 }
 

@@ -5,13 +5,13 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "calligraphy/character_library.hpp"
-#include "calligraphy/typical_strokes.hpp"
-#include "calligraphy/unicode.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/model/typical_strokes.hpp"
+#include "calligraphy/report/model_svg.hpp"
+#include "calligraphy/report/trial_report.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
-#include "cli/model_svg.hpp"
-#include "cli/trial_report.hpp"
+#include "core/unicode.hpp"
 
 namespace calligraphy::cli {
 namespace {

@@ -2,10 +2,10 @@
 // docs/typical-strokes.md is its --markdown output.
 #include <iostream>
 
+#include "calligraphy/report/trial_report.hpp"
 #include "cli/arguments.hpp"
 #include "cli/commands.hpp"
-#include "cli/trial_report.hpp"
-#include "cli/typical_strokes_report.hpp"
+#include "report/typical_strokes_report.hpp"
 
 namespace calligraphy::cli {
 

@@ -6,21 +6,22 @@
 #include <string>
 #include <vector>
 
-#include "calligraphy/character_library.hpp"
-#include "calligraphy/device_registry.hpp"
-#include "calligraphy/device_trial.hpp"
-#include "calligraphy/scene.hpp"
-#include "calligraphy/simulated_device.hpp"
+#include "calligraphy/devices/device_registry.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/report/trial_report.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/trial/device_trial.hpp"
+#include "cli/cli_devices.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
-#include "cli/trial_report.hpp"
 
 namespace calligraphy::cli {
 namespace {
 
 // The listing of `name`, or a UsageError (exit 2) naming every device that can be opened.
 DeviceListing find_device(const std::string& name) {
-  const DeviceSurvey survey = device_registry().survey();
+  const DeviceSurvey survey = cli_device_registry().survey();
   const auto found = std::find_if(survey.devices.begin(), survey.devices.end(),
                                   [&](const DeviceListing& listing) { return listing.name == name; });
   if (found != survey.devices.end()) return *found;
@@ -32,9 +33,10 @@ DeviceListing find_device(const std::string& name) {
 }  // namespace
 
 int command_trial(const Args& args) {
-  const Arguments arguments(
-      args, {"guidance", "writer", "seed", "data", "store", "json", "svg", "csv", "rate", "device", "pacing",
-             "realtime"}, {});
+  const Arguments arguments(args,
+                            {"guidance", "writer", "seed", "data", "store", "json", "svg", "csv", "rate",
+                             "device", "pacing", "realtime"},
+                            {});
   if (arguments.positionals().size() != 1) throw UsageError("trial takes one CHARS argument, e.g. trial 永");
   const std::u32string chars = characters_from(arguments.positionals()[0]);
   const std::string device_name = arguments.option_or("device", "simulated");
@@ -63,7 +65,8 @@ int command_trial(const Args& args) {
                               ? RealtimeMode::enforce
                               : RealtimeMode::ignore;
   // The simulated device's physical damping is known: it sets the renderer's stiffness bound.
-  if (device_name == "simulated") options.device_damping_n_s_per_m = SimulatedDeviceParameters{}.damping_n_s_per_m;
+  if (device_name == "simulated")
+    options.device_damping_n_s_per_m = SimulatedDeviceParameters{}.damping_n_s_per_m;
 
   const TrialResult result = run_device_trial(device_name, scene, options);
   // On hardware a person writes; the simulated writer only moves simulated and emulated devices.

@@ -1,7 +1,7 @@
 #include "cli/library_options.hpp"
 
-#include "calligraphy/errors.hpp"
-#include "calligraphy/unicode.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "core/unicode.hpp"
 
 namespace calligraphy::cli {
 

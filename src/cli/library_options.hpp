@@ -4,8 +4,8 @@
 #include <optional>
 #include <string>
 
-#include "calligraphy/character_library.hpp"
-#include "calligraphy/corpus_store.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/model/corpus_store.hpp"
 #include "cli/arguments.hpp"
 
 namespace calligraphy::cli {

@@ -6,7 +6,7 @@
 #include <exception>
 #include <string>
 
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
 #include "cli/commands.hpp"
 
 namespace {

@@ -1,6 +1,6 @@
-#include "calligraphy/active_stroke.hpp"
+#include "calligraphy/collision/active_stroke.hpp"
 
-#include "calligraphy/constraint_space.hpp"
+#include "calligraphy/collision/constraint_space.hpp"
 
 namespace calligraphy {
 

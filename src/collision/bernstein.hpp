@@ -7,7 +7,7 @@
 #include <array>
 #include <cmath>
 
-#include "calligraphy/element.hpp"
+#include "calligraphy/model/element.hpp"
 
 namespace calligraphy::detail {
 

@@ -1,4 +1,4 @@
-#include "calligraphy/constraint_space.hpp"
+#include "calligraphy/collision/constraint_space.hpp"
 
 namespace calligraphy {
 

@@ -6,8 +6,8 @@
 // global coordinates.
 #include <array>
 
-#include "calligraphy/element.hpp"
-#include "calligraphy/nearest_point.hpp"
+#include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/model/element.hpp"
 
 namespace calligraphy::detail {
 

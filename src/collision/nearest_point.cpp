@@ -1,12 +1,12 @@
 // Validation and dispatch of `nearest_point`, and the servo-path segment projection.
-#include "calligraphy/nearest_point.hpp"
+#include "calligraphy/collision/nearest_point.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
 
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
 #include "collision/local_curve.hpp"
 #include "collision/nearest_point_methods.hpp"
 
@@ -81,15 +81,10 @@ NearestPoint nearest_point(const StrokeElement& element, const Vec2& p, const Ne
 }
 
 NearestPoint nearest_point_on_segment(const Vec2& a, const Vec2& b, const Vec2& p) noexcept {
-  const Vec2 edge = b - a;
-  const Vec2 offset = p - a;
-  const double length_squared = edge.squaredNorm();
-  double t = 0.0;
-  if (length_squared > 0.0) t = std::clamp(offset.dot(edge) / length_squared, 0.0, 1.0);
   NearestPoint result;
-  result.t = t;
-  result.foot = a + t * edge;
-  result.distance = (offset - t * edge).norm();
+  result.t = segment_parameter(a, b, p);
+  result.foot = a + result.t * (b - a);
+  result.distance = ((p - a) - result.t * (b - a)).norm();
   return result;
 }
 

@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <limits>
 
-#include "calligraphy/nearest_point.hpp"
+#include "calligraphy/collision/nearest_point.hpp"
 #include "collision/local_curve.hpp"
 
 namespace calligraphy::detail {

@@ -1,11 +1,11 @@
-#include "calligraphy/nearest_point_tracker.hpp"
+#include "calligraphy/collision/nearest_point_tracker.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
 
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
 #include "collision/local_curve.hpp"
 #include "collision/nearest_point_methods.hpp"
 

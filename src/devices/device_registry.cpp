@@ -1,10 +1,10 @@
-#include "calligraphy/device_registry.hpp"
+#include "calligraphy/devices/device_registry.hpp"
 
 #include <algorithm>
 #include <ostream>
 #include <utility>
 
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
 #include "devices/builtin_backends.hpp"
 
 namespace calligraphy {

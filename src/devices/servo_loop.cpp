@@ -1,4 +1,4 @@
-#include "calligraphy/servo_loop.hpp"
+#include "calligraphy/devices/servo_loop.hpp"
 
 #include <sched.h>
 #include <spdlog/spdlog.h>

@@ -3,7 +3,7 @@
 // failed. Called at start, never from the loop body.
 #include <string>
 
-#include "calligraphy/servo_loop.hpp"
+#include "calligraphy/devices/servo_loop.hpp"
 
 namespace calligraphy::devices {
 

@@ -1,12 +1,12 @@
-#include "calligraphy/character_library.hpp"
+#include "calligraphy/model/character_library.hpp"
 
 #include <algorithm>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "calligraphy/errors.hpp"
-#include "calligraphy/unicode.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "core/unicode.hpp"
 #include "model/embedded_characters.hpp"
 
 namespace calligraphy {
@@ -26,7 +26,8 @@ std::string line_column(std::string_view text, std::size_t byte) {
   return std::to_string(line) + ":" + std::to_string(column);
 }
 
-[[noreturn]] void fail(const std::string& source, char32_t cp, const std::string& where, const std::string& what) {
+[[noreturn]] void fail(const std::string& source, char32_t cp, const std::string& where,
+                       const std::string& what) {
   throw DataError(source + ": character " + describe_character(cp) + ": " + where + ": " + what);
 }
 
@@ -46,7 +47,8 @@ CharacterData parse_hanzi_writer_json(std::string_view json, char32_t cp, const 
     doc = nlohmann::json::parse(json.begin(), json.end());
   } catch (const nlohmann::json::parse_error& e) {
     const std::size_t byte = e.byte > 0 ? e.byte - 1 : 0;
-    fail(source, cp, "line:column " + line_column(json, byte), "malformed JSON (" + std::string(e.what()) + ")");
+    fail(source, cp, "line:column " + line_column(json, byte),
+         "malformed JSON (" + std::string(e.what()) + ")");
   }
   if (!doc.is_object()) fail(source, cp, "/", "expected a JSON object");
   const auto medians = doc.find("medians");
@@ -58,7 +60,8 @@ CharacterData parse_hanzi_writer_json(std::string_view json, char32_t cp, const 
   for (std::size_t s = 0; s < medians->size(); ++s) {
     const auto& median = (*medians)[s];
     const std::string stroke_path = "/medians/" + std::to_string(s);
-    if (!median.is_array() || median.empty()) fail(source, cp, stroke_path, "expected a non-empty array of points");
+    if (!median.is_array() || median.empty())
+      fail(source, cp, stroke_path, "expected a non-empty array of points");
     std::vector<Vec2> points;
     for (std::size_t i = 0; i < median.size(); ++i) {
       const auto& point = median[i];
@@ -80,7 +83,8 @@ CharacterLibrary CharacterLibrary::embedded() { return CharacterLibrary{}; }
 CharacterLibrary CharacterLibrary::from_directory(const std::filesystem::path& folder) {
   std::error_code ec;
   if (!std::filesystem::is_directory(folder, ec)) {
-    throw DataError(folder.string() + ": character data folder does not exist (fetch it with "
+    throw DataError(folder.string() +
+                    ": character data folder does not exist (fetch it with "
                     "scripts/fetch-hanzi-writer-data.sh)");
   }
   CharacterLibrary library;
@@ -98,7 +102,8 @@ CharacterData CharacterLibrary::load_data(char32_t cp) const {
   if (folder_.empty()) {
     const auto* e = find_embedded(cp);
     if (e == nullptr) {
-      throw CharacterNotFound("character " + describe_character(cp) + " is not in the embedded default set (" +
+      throw CharacterNotFound("character " + describe_character(cp) +
+                              " is not in the embedded default set (" +
                               std::to_string(detail::embedded_characters().size()) +
                               " characters); pass --data with the full hanzi-writer-data folder");
     }
@@ -106,7 +111,8 @@ CharacterData CharacterLibrary::load_data(char32_t cp) const {
   }
   const auto path = folder_ / (encode_utf8(cp) + ".json");
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw CharacterNotFound("character " + describe_character(cp) + " not found: no file " + path.string());
+  if (!in)
+    throw CharacterNotFound("character " + describe_character(cp) + " not found: no file " + path.string());
   std::ostringstream text;
   text << in.rdbuf();
   return parse_hanzi_writer_json(text.str(), cp, path.string());

@@ -1,4 +1,4 @@
-#include "calligraphy/character.hpp"
+#include "calligraphy/model/character.hpp"
 
 namespace calligraphy {
 

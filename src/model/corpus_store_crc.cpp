@@ -1,30 +1,26 @@
-// CRC-32 of the corpus store: IEEE 802.3 polynomial, reflected (0xEDB88320), initial value and final
-// XOR 0xFFFFFFFF, so it equals zlib's crc32() and `python3 -c "import zlib; zlib.crc32(...)"`.
-#include <array>
+// CRC-32 of the corpus store: zlib's crc32() (IEEE 802.3 polynomial, reflected), so a store can be
+// checked with `python3 -c "import zlib; zlib.crc32(...)"`.
+#include <zlib.h>
+
+#include <algorithm>
+#include <limits>
 
 #include "model/corpus_store_format.hpp"
 
 namespace calligraphy::store {
-namespace {
-
-constexpr std::array<std::uint32_t, 256> make_table() {
-  std::array<std::uint32_t, 256> table{};
-  for (std::uint32_t i = 0; i < 256; ++i) {
-    std::uint32_t c = i;
-    for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-    table[i] = c;
-  }
-  return table;
-}
-
-constexpr auto kTable = make_table();
-
-}  // namespace
 
 std::uint32_t crc32(std::span<const std::uint8_t> bytes) {
-  std::uint32_t c = 0xFFFFFFFFu;
-  for (std::uint8_t b : bytes) c = kTable[(c ^ b) & 0xFFu] ^ (c >> 8);
-  return c ^ 0xFFFFFFFFu;
+  // zlib takes a uInt length: feed stores larger than 4 GiB in chunks.
+  uLong crc = ::crc32(0L, Z_NULL, 0);
+  const std::uint8_t* data = bytes.data();
+  std::size_t left = bytes.size();
+  while (left > 0) {
+    const auto chunk = static_cast<uInt>(std::min<std::size_t>(left, std::numeric_limits<uInt>::max()));
+    crc = ::crc32(crc, data, chunk);
+    data += chunk;
+    left -= chunk;
+  }
+  return static_cast<std::uint32_t>(crc);
 }
 
 }  // namespace calligraphy::store

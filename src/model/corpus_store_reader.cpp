@@ -10,9 +10,9 @@
 #include <cstdio>
 #include <cstring>
 
-#include "calligraphy/corpus_store.hpp"
-#include "calligraphy/errors.hpp"
-#include "calligraphy/unicode.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/corpus_store.hpp"
+#include "core/unicode.hpp"
 #include "model/corpus_store_format.hpp"
 
 namespace calligraphy {

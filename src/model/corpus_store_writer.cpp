@@ -5,10 +5,10 @@
 #include <fstream>
 #include <string>
 
-#include "calligraphy/corpus_store.hpp"
-#include "calligraphy/errors.hpp"
-#include "calligraphy/typical_strokes.hpp"
-#include "calligraphy/unicode.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/corpus_store.hpp"
+#include "calligraphy/model/typical_strokes.hpp"
+#include "core/unicode.hpp"
 #include "model/corpus_store_format.hpp"
 
 namespace calligraphy {

@@ -1,9 +1,9 @@
-#include "calligraphy/element.hpp"
+#include "calligraphy/model/element.hpp"
 
 #include <cmath>
 #include <string>
 
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
 
@@ -32,7 +32,8 @@ Vec2 StrokeElement::point(double t) const {
   std::array<Vec2, kMaxElementDegree + 1> p = control;
   for (int r = 1; r <= degree; ++r) {
     for (int i = 0; i <= degree - r; ++i) {
-      p[static_cast<std::size_t>(i)] = (1.0 - t) * p[static_cast<std::size_t>(i)] + t * p[static_cast<std::size_t>(i + 1)];
+      p[static_cast<std::size_t>(i)] =
+          (1.0 - t) * p[static_cast<std::size_t>(i)] + t * p[static_cast<std::size_t>(i + 1)];
     }
   }
   return p[0];
@@ -42,11 +43,13 @@ Vec2 StrokeElement::derivative(double t) const {
   // B'(t) = n * sum (P_{i+1} - P_i) B_{i,n-1}(t), evaluated by de Casteljau on the hodograph.
   std::array<Vec2, kMaxElementDegree> d{};
   for (int i = 0; i < degree; ++i) {
-    d[static_cast<std::size_t>(i)] = control[static_cast<std::size_t>(i + 1)] - control[static_cast<std::size_t>(i)];
+    d[static_cast<std::size_t>(i)] =
+        control[static_cast<std::size_t>(i + 1)] - control[static_cast<std::size_t>(i)];
   }
   for (int r = 1; r < degree; ++r) {
     for (int i = 0; i < degree - r; ++i) {
-      d[static_cast<std::size_t>(i)] = (1.0 - t) * d[static_cast<std::size_t>(i)] + t * d[static_cast<std::size_t>(i + 1)];
+      d[static_cast<std::size_t>(i)] =
+          (1.0 - t) * d[static_cast<std::size_t>(i)] + t * d[static_cast<std::size_t>(i + 1)];
     }
   }
   return static_cast<double>(degree) * d[0];
@@ -85,7 +88,8 @@ double gauss5(const StrokeElement& e, double a, double b) {
   return sum * half;
 }
 
-double adaptive_length(const StrokeElement& e, double a, double b, double whole, double tolerance, int depth) {
+double adaptive_length(const StrokeElement& e, double a, double b, double whole, double tolerance,
+                       int depth) {
   const double mid = 0.5 * (a + b);
   const double left = gauss5(e, a, mid);
   const double right = gauss5(e, mid, b);

@@ -1,7 +1,7 @@
 // Median polyline -> stroke elements (paper sections 3.3-3.4). First version: corners found by summed
 // turning over a window (REFERENCE.md section 2), straight pieces as LSEs, bent pieces as least-squares
 // Bezier CSEs, split at the worst point until within tolerance.
-#include "calligraphy/fitting.hpp"
+#include "calligraphy/model/fitting.hpp"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -11,8 +11,8 @@
 #include <numbers>
 #include <string>
 
-#include "calligraphy/errors.hpp"
-#include "calligraphy/typical_strokes.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/typical_strokes.hpp"
 #include "model/polyline.hpp"
 
 namespace calligraphy {
@@ -67,7 +67,8 @@ std::vector<std::size_t> find_corners(std::vector<Vec2>& pts, const FitOptions& 
     if (first > last) continue;
     // Adjacent windows extend one corner; two corners joined by a long straight segment (a vertical
     // and its hook) stay apart even when no vertex lies between them.
-    if (!clusters.empty() && first <= clusters.back().second + 1 && turn[first] * turn[clusters.back().first] > 0.0 &&
+    if (!clusters.empty() && first <= clusters.back().second + 1 &&
+        turn[first] * turn[clusters.back().first] > 0.0 &&
         arc[first] - arc[clusters.back().second] <= options.corner_window) {
       clusters.back().second = std::max(clusters.back().second, last);
     } else if (clusters.empty() || first > clusters.back().second) {
@@ -115,7 +116,8 @@ double chord_direction(std::span<const Vec2> pts, double from, double to) {
     double remaining = fraction * length;
     for (std::size_t i = 1; i < pts.size(); ++i) {
       const double segment = (pts[i] - pts[i - 1]).norm();
-      if (remaining <= segment && segment > 0.0) return Vec2(pts[i - 1] + (pts[i] - pts[i - 1]) * (remaining / segment));
+      if (remaining <= segment && segment > 0.0)
+        return Vec2(pts[i - 1] + (pts[i] - pts[i - 1]) * (remaining / segment));
       remaining -= segment;
     }
     return Vec2(pts.back());
@@ -160,14 +162,16 @@ StrokeElement fit_bezier(const std::vector<Vec2>& samples, int degree) {
       rhs(row, 1) = r.y();
     }
     const Eigen::MatrixXd inner = a.colPivHouseholderQr().solve(rhs);
-    for (int i = 1; i < degree; ++i) ctrl[static_cast<std::size_t>(i)] = Vec2(inner(i - 1, 0), inner(i - 1, 1));
+    for (int i = 1; i < degree; ++i)
+      ctrl[static_cast<std::size_t>(i)] = Vec2(inner(i - 1, 0), inner(i - 1, 1));
     element = StrokeElement::bezier(ctrl.data(), degree + 1);
     for (std::size_t k = 1; k + 1 < m; ++k) {  // Newton step on |B(t)-p|^2
       const Vec2 d = element.point(t[k]) - samples[k];
       const Vec2 d1 = element.derivative(t[k]);
       const double h = 1e-6;
-      const Vec2 d2 = (element.derivative(std::min(1.0, t[k] + h)) - element.derivative(std::max(0.0, t[k] - h))) /
-                      (std::min(1.0, t[k] + h) - std::max(0.0, t[k] - h));
+      const Vec2 d2 =
+          (element.derivative(std::min(1.0, t[k] + h)) - element.derivative(std::max(0.0, t[k] - h))) /
+          (std::min(1.0, t[k] + h) - std::max(0.0, t[k] - h));
       const double denom = d1.squaredNorm() + d.dot(d2);
       if (denom > 0.0) t[k] = std::clamp(t[k] - d.dot(d1) / denom, 0.0, 1.0);
     }
@@ -180,7 +184,8 @@ double max_deviation(const std::vector<Vec2>& samples, const StrokeElement& elem
   return max_distance_to_polyline(samples, curve);
 }
 
-void fit_piece(std::span<const Vec2> pts, const FitOptions& options, int depth, std::vector<StrokeElement>& out) {
+void fit_piece(std::span<const Vec2> pts, const FitOptions& options, int depth,
+               std::vector<StrokeElement>& out) {
   if (pts.size() <= 2 || max_chord_deviation(pts) <= options.tolerance) {
     out.push_back(StrokeElement::line(pts.front(), pts.back()));
     return;
@@ -209,9 +214,10 @@ void fit_piece(std::span<const Vec2> pts, const FitOptions& options, int depth, 
 void check_options(const FitOptions& o) {
   if (!(o.tolerance > 0.0) || !(o.corner_angle_deg > 0.0) || !(o.corner_window > 0.0) ||
       !(o.hook_trim_length >= 0.0) || o.max_degree < 2 || o.max_degree > kMaxElementDegree) {
-    throw InvalidArgument("FitOptions out of range: tolerance " + std::to_string(o.tolerance) + ", corner angle " +
-                          std::to_string(o.corner_angle_deg) + ", window " + std::to_string(o.corner_window) +
-                          ", max degree " + std::to_string(o.max_degree) + " (2-4)");
+    throw InvalidArgument("FitOptions out of range: tolerance " + std::to_string(o.tolerance) +
+                          ", corner angle " + std::to_string(o.corner_angle_deg) + ", window " +
+                          std::to_string(o.corner_window) + ", max degree " + std::to_string(o.max_degree) +
+                          " (2-4)");
   }
 }
 
@@ -221,7 +227,8 @@ FittedStroke fit_stroke(std::span<const Vec2> median, const FitOptions& options)
   check_options(options);
   if (median.empty()) throw InvalidArgument("fit_stroke: empty median");
   for (std::size_t i = 0; i < median.size(); ++i) {
-    if (!median[i].allFinite()) throw InvalidArgument("fit_stroke: median point " + std::to_string(i) + " is not finite");
+    if (!median[i].allFinite())
+      throw InvalidArgument("fit_stroke: median point " + std::to_string(i) + " is not finite");
   }
   FittedStroke fitted;
   fitted.stroke.median.assign(median.begin(), median.end());
@@ -438,8 +445,8 @@ int classify_pieces(std::span<const StrokePiece> all_pieces) {
       only, resolve_dot_or_short_vertical(only, resolve_short_vertical(only, best_id)));
 }
 
-Character fit_character(char32_t code_point, const std::vector<std::vector<Vec2>>& medians, std::string source,
-                        const FitOptions& options) {
+Character fit_character(char32_t code_point, const std::vector<std::vector<Vec2>>& medians,
+                        std::string source, const FitOptions& options) {
   Character character;
   character.code_point = code_point;
   character.source = std::move(source);

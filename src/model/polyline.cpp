@@ -5,8 +5,6 @@
 #include <limits>
 #include <numbers>
 
-#include "calligraphy/nearest_point.hpp"
-
 namespace calligraphy {
 
 double direction_deg(const Vec2& v) { return std::atan2(v.y(), v.x()) * 180.0 / std::numbers::pi; }
@@ -56,7 +54,7 @@ std::vector<Vec2> resample(std::span<const Vec2> pts, double step) {
 
 double max_chord_deviation(std::span<const Vec2> pts) {
   double worst = 0.0;
-  for (const Vec2& p : pts) worst = std::max(worst, nearest_point_on_segment(pts.front(), pts.back(), p).distance);
+  for (const Vec2& p : pts) worst = std::max(worst, distance_to_segment(pts.front(), pts.back(), p));
   return worst;
 }
 
@@ -64,7 +62,7 @@ std::size_t farthest_from_chord(std::span<const Vec2> pts) {
   std::size_t best = 1;
   double worst = -1.0;
   for (std::size_t i = 1; i + 1 < pts.size(); ++i) {
-    const double d = nearest_point_on_segment(pts.front(), pts.back(), pts[i]).distance;
+    const double d = distance_to_segment(pts.front(), pts.back(), pts[i]);
     if (d > worst) {
       worst = d;
       best = i;
@@ -84,7 +82,7 @@ double distance_to_polyline(const Vec2& p, std::span<const Vec2> pts) {
   if (pts.size() == 1) return (p - pts[0]).norm();
   double best = std::numeric_limits<double>::infinity();
   for (std::size_t i = 1; i < pts.size(); ++i) {
-    best = std::min(best, nearest_point_on_segment(pts[i - 1], pts[i], p).distance);
+    best = std::min(best, distance_to_segment(pts[i - 1], pts[i], p));
   }
   return best;
 }
@@ -107,7 +105,7 @@ double max_distance_to_polyline(std::span<const Vec2> points, std::span<const Ve
     std::size_t best_segment = start;
     for (std::size_t k = 0; k < segments; ++k) {
       const std::size_t i = (start + k) % segments;
-      const double d = nearest_point_on_segment(pts[i], pts[i + 1], p).distance;
+      const double d = distance_to_segment(pts[i], pts[i + 1], p);
       if (d < best) {
         best = d;
         best_segment = i;

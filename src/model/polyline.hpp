@@ -3,7 +3,7 @@
 #include <span>
 #include <vector>
 
-#include "calligraphy/element.hpp"
+#include "calligraphy/model/element.hpp"
 
 namespace calligraphy {
 
@@ -26,7 +26,8 @@ std::size_t farthest_from_chord(std::span<const Vec2> pts);
 std::vector<Vec2> sample_element(const StrokeElement& element, int segments);
 /// Distance from p to the polyline.
 double distance_to_polyline(const Vec2& p, std::span<const Vec2> pts);
-/// Max over `points` of distance_to_polyline(point, pts), exactly, with early exits. 0 when `points` is empty.
+/// Max over `points` of distance_to_polyline(point, pts), exactly, with early exits. 0 when `points` is
+/// empty.
 double max_distance_to_polyline(std::span<const Vec2> points, std::span<const Vec2> pts);
 
 }  // namespace calligraphy

@@ -1,8 +1,8 @@
-#include "calligraphy/scene.hpp"
+#include "calligraphy/model/scene.hpp"
 
 #include <string>
 
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
 
@@ -21,8 +21,9 @@ std::size_t Scene::stroke_count() const {
 Scene Scene::lay_out(const std::vector<Character>& characters, const SceneLayout& layout) {
   if (!(layout.character_size_m > 0.0) || !(layout.spacing_m > 0.0) || !(layout.start_radius_m > 0.0) ||
       !(layout.box_margin_m >= 0.0) || !layout.centre_m.allFinite() || !std::isfinite(layout.paper_z_m)) {
-    throw InvalidArgument("SceneLayout out of range: character size " + std::to_string(layout.character_size_m) +
-                          " m, spacing " + std::to_string(layout.spacing_m) + " m, start radius " +
+    throw InvalidArgument("SceneLayout out of range: character size " +
+                          std::to_string(layout.character_size_m) + " m, spacing " +
+                          std::to_string(layout.spacing_m) + " m, start radius " +
                           std::to_string(layout.start_radius_m) + " m");
   }
   Scene scene;
@@ -34,7 +35,8 @@ Scene Scene::lay_out(const std::vector<Character>& characters, const SceneLayout
     placed.code_point = character.code_point;
     placed.placement.metres_per_unit = layout.character_size_m / kDataBoxSize;
     const Vec2 box_centre_data(kDataBoxSize / 2.0, (kDataBoxTop + kDataBoxBottom) / 2.0);
-    const Vec2 centre = layout.centre_m + Vec2((static_cast<double>(k) - (n - 1.0) / 2.0) * layout.spacing_m, 0.0);
+    const Vec2 centre =
+        layout.centre_m + Vec2((static_cast<double>(k) - (n - 1.0) / 2.0) * layout.spacing_m, 0.0);
     placed.placement.origin_m = centre - placed.placement.metres_per_unit * box_centre_data;
     for (const Stroke& stroke : character.strokes) {
       PlacedStroke ps;

@@ -1,14 +1,14 @@
 // The table of the 39 typical strokes. IDs are part of the data format: never renumber.
 // Sources: GF 2001-2001 (25 turning strokes), the 6 flat strokes, Unicode CJK Strokes block,
 // REFERENCE.md section 3. Directions are degrees in the y-up data frame.
-#include "calligraphy/typical_strokes.hpp"
+#include "calligraphy/model/typical_strokes.hpp"
 
 #include <array>
 #include <cmath>
 #include <limits>
 #include <string>
 
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
 namespace {

@@ -1,10 +1,10 @@
-#include "calligraphy/force_law.hpp"
+#include "calligraphy/render/force_law.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <string>
 
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
 

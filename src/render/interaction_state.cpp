@@ -1,4 +1,4 @@
-#include "calligraphy/interaction_state.hpp"
+#include "calligraphy/render/interaction_state.hpp"
 
 namespace calligraphy {
 

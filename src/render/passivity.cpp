@@ -1,10 +1,10 @@
-#include "calligraphy/passivity.hpp"
+#include "calligraphy/render/passivity.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <string>
 
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
 

@@ -1,4 +1,4 @@
-#include "calligraphy/renderer.hpp"
+#include "calligraphy/render/renderer.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -7,8 +7,8 @@
 #include <limits>
 #include <string>
 
-#include "calligraphy/constraint_space.hpp"
-#include "calligraphy/errors.hpp"
+#include "calligraphy/collision/constraint_space.hpp"
+#include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
 namespace {

@@ -1,11 +1,11 @@
-#include "calligraphy/safety_chain.hpp"
+#include "calligraphy/render/safety_chain.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
 
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
 namespace {

@@ -5,9 +5,9 @@
 /// Continuous force and workspace box: vendor datasheets as quoted in REFERENCE.md section 7 (not
 /// re-checked against the datasheets here).
 
-#include "calligraphy/haptic_device.hpp"
+#include "calligraphy/devices/haptic_device.hpp"
 
-namespace calligraphy::phantom {
+namespace calligraphy {
 
 /// Phantom Omni: 3.3 N, 0.88 N continuous, 700 N/m, 5 N s/m, 0.10 m radius, 0.16 x 0.12 x 0.07 m.
 [[nodiscard]] DeviceInfo phantom_omni_info();
@@ -17,4 +17,4 @@ namespace calligraphy::phantom {
 /// 0.16 x 0.12 x 0.07 m.
 [[nodiscard]] DeviceInfo touch_info();
 
-}  // namespace calligraphy::phantom
+}  // namespace calligraphy

@@ -4,8 +4,8 @@
 // z up. So device = (x, -z, y) / 1000 for positions and velocities; forces go the other way in newtons.
 #include <array>
 
-#include "calligraphy/geometry.hpp"
-#include "calligraphy/haptic_device.hpp"
+#include "calligraphy/core/geometry.hpp"
+#include "calligraphy/devices/haptic_device.hpp"
 
 namespace calligraphy::openhaptics {
 

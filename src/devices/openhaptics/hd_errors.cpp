@@ -2,7 +2,7 @@
 
 #include <string>
 
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
 
 namespace calligraphy::openhaptics {
 

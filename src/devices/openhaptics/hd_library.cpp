@@ -4,7 +4,7 @@
 
 #include <cstdlib>
 
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
 
 namespace calligraphy::openhaptics {
 namespace {

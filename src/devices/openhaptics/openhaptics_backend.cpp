@@ -1,7 +1,7 @@
 // Registers "openhaptics": listed when libHD.so loads and the default device initialises.
 #include <memory>
 
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
 #include "devices/builtin_backends.hpp"
 #include "devices/openhaptics/hd_errors.hpp"
 #include "devices/openhaptics/hd_library.hpp"

@@ -5,8 +5,8 @@
 #include <chrono>
 #include <utility>
 
-#include "calligraphy/devices/force_limits.hpp"
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/force_limits.hpp"
 #include "devices/openhaptics/hd_conversions.hpp"
 #include "devices/openhaptics/hd_errors.hpp"
 

@@ -10,7 +10,7 @@
 #include <memory>
 #include <string>
 
-#include "calligraphy/haptic_device.hpp"
+#include "calligraphy/devices/haptic_device.hpp"
 #include "devices/openhaptics/hd_library.hpp"
 #include "devices/openhaptics/seqlock.hpp"
 

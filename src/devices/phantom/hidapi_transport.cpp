@@ -7,7 +7,7 @@
 #include <cwchar>
 #include <utility>
 
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
 #include "devices/phantom/usb_ids.hpp"
 
 namespace calligraphy::phantom {

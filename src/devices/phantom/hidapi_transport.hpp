@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "calligraphy/devices/byte_transport.hpp"
+#include "devices/byte_transport.hpp"
 
 struct hid_device_;
 

@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <utility>
 
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
 #include "devices/phantom/usb_ids.hpp"
 
 namespace calligraphy::phantom {

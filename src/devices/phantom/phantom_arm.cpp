@@ -1,10 +1,10 @@
-#include "calligraphy/devices/phantom_arm.hpp"
+#include "devices/phantom/phantom_arm.hpp"
 
 #include <cmath>
 #include <numbers>
 
-#include "calligraphy/devices/phantom_codec.hpp"
-#include "calligraphy/errors.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "devices/phantom/phantom_codec.hpp"
 
 namespace calligraphy::phantom {
 namespace {

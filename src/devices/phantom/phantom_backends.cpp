@@ -1,13 +1,13 @@
-// Registers the Phantom backends: the emulator (always), and the USB transports that were built.
+// Registers the Phantom backends: the USB transports that were built (the emulator registers itself
+// from the testing target, calligraphy/testing/emulated_phantom.hpp).
 #include <cstdio>
 #include <memory>
 #include <string>
 
-#include "calligraphy/devices/phantom.hpp"
-#include "calligraphy/devices/phantom_emulator.hpp"
+#include "calligraphy/core/errors.hpp"
 #include "calligraphy/devices/phantom_models.hpp"
-#include "calligraphy/errors.hpp"
 #include "devices/builtin_backends.hpp"
+#include "devices/phantom/phantom_device.hpp"
 #include "devices/phantom/usb_ids.hpp"
 #if defined(CALLIGRAPHY_WITH_HIDAPI)
 #include "devices/phantom/hidapi_transport.hpp"
@@ -22,22 +22,6 @@ namespace {
 [[maybe_unused]] constexpr const char* kUsbCaveat =
     "UNVERIFIED: USB id reported by users, not confirmed; the packet codec is the FireWire Omni's, the USB "
     "Touch's framing is not public; never run on hardware";
-
-DeviceInfo emulated_info() {
-  DeviceInfo info = phantom_omni_info();
-  info.model = "Phantom Omni (emulated)";
-  info.manufacturer = "calligraphy";
-  return info;
-}
-
-std::unique_ptr<HapticDevice> make_registry_emulated_phantom() {
-  auto config = phantom_omni_config();
-  config.info = emulated_info();
-  auto parameters = emulator_matching(config);
-  // Powers on docked, so open() homes the encoders; 50 ms later the writer lifts the stylus out.
-  parameters.undock_after_s = 0.05;
-  return std::make_unique<EmulatedPhantomDevice>(std::move(config), parameters);
-}
 
 [[maybe_unused]] DeviceInfo usb_touch_info(std::uint16_t vendor, std::uint16_t product) {
   DeviceInfo info = touch_info();
@@ -112,10 +96,6 @@ std::unique_ptr<HapticDevice> create_usb(const DeviceListing& listing) {
 }  // namespace
 
 void register_backends(DeviceRegistry& registry) {
-  registry.register_device(
-      "emulated-phantom", emulated_info(), make_registry_emulated_phantom, false,
-      "PhantomEmulator over an in-memory link, through the real PhantomDevice code path; "
-      "starts docked, leaves the inkwell after 50 ms of emulated time");
 #if defined(CALLIGRAPHY_WITH_HIDAPI)
   registry.register_backend({"phantom-hid", scan_hid, create_hid});
 #else

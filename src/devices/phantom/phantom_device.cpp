@@ -1,12 +1,13 @@
+#include "devices/phantom/phantom_device.hpp"
+
 #include <spdlog/spdlog.h>
 
 #include <string>
 #include <utility>
 
-#include "calligraphy/devices/force_limits.hpp"
-#include "calligraphy/devices/phantom.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/force_limits.hpp"
 #include "calligraphy/devices/phantom_models.hpp"
-#include "calligraphy/errors.hpp"
 
 namespace calligraphy::phantom {
 namespace {

@@ -1,0 +1,39 @@
+# calligraphy_module(NAME [DEPENDS module...] [SOURCE_DIR dir] [SOURCES extra...] [NOT_INSTALLED])
+#
+# Declares the static library calligraphy_NAME from src/<SOURCE_DIR or NAME>/*.cpp. Its public headers
+# are include/calligraphy/NAME/; the target sees them through a folder of its own in the build tree
+# (module-include/NAME/calligraphy/NAME -> include/calligraphy/NAME), and a module sees another's
+# public headers only by linking it. So a file that includes a module above its own does not compile.
+# Private headers stay under src/ (PRIVATE include path); scripts/check-layering.py checks their
+# include lines too.
+set(CALLIGRAPHY_INSTALLED_MODULES "" CACHE INTERNAL "")
+
+function(calligraphy_module name)
+  cmake_parse_arguments(module "NOT_INSTALLED" "SOURCE_DIR" "DEPENDS;SOURCES" ${ARGN})
+  if(NOT module_SOURCE_DIR)
+    set(module_SOURCE_DIR ${name})
+  endif()
+  file(GLOB sources CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/src/${module_SOURCE_DIR}/*.cpp)
+  set(target calligraphy_${name})
+  add_library(${target} STATIC ${sources} ${module_SOURCES})
+  set(staged ${PROJECT_BINARY_DIR}/module-include/${name})
+  if(EXISTS ${PROJECT_SOURCE_DIR}/include/calligraphy/${name})
+    file(MAKE_DIRECTORY ${staged}/calligraphy)
+    if(NOT EXISTS ${staged}/calligraphy/${name})
+      file(CREATE_LINK ${PROJECT_SOURCE_DIR}/include/calligraphy/${name} ${staged}/calligraphy/${name} SYMBOLIC)
+    endif()
+    target_include_directories(${target} PUBLIC $<BUILD_INTERFACE:${staged}>)
+  endif()
+  target_include_directories(${target}
+    PUBLIC $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>
+    PRIVATE ${PROJECT_SOURCE_DIR}/src)
+  foreach(dependency IN LISTS module_DEPENDS)
+    target_link_libraries(${target} PUBLIC calligraphy_${dependency})
+  endforeach()
+  target_link_libraries(${target} PRIVATE $<BUILD_INTERFACE:calligraphy_warnings>)
+  target_compile_features(${target} PUBLIC cxx_std_20)
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${name})
+  if(NOT module_NOT_INSTALLED)
+    set(CALLIGRAPHY_INSTALLED_MODULES ${CALLIGRAPHY_INSTALLED_MODULES} ${target} CACHE INTERNAL "")
+  endif()
+endfunction()

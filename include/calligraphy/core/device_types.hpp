@@ -1,0 +1,34 @@
+#pragma once
+/// \file device_types.hpp
+/// The value types a haptic device and the renderer exchange, in SI units: positions in m, velocities
+/// in m/s, forces in N, stiffness in N/m, damping in N s/m, time in s. Device coordinates: x right,
+/// y away from the writer, z up out of the paper. They live in `core` because the renderer (below the
+/// device layer) reads a `DeviceState` and sizes its forces from a `DeviceInfo`.
+#include <cstdint>
+#include <string>
+
+#include "calligraphy/core/geometry.hpp"
+
+namespace calligraphy {
+
+/// What a device can do, in SI units (after CHAI3D's cHapticDeviceInfo).
+struct DeviceInfo {
+  std::string model;                     ///< e.g. "Phantom Desktop (simulated)"
+  std::string manufacturer;              ///< e.g. "calligraphy"
+  double max_force_n = 0.0;              ///< peak force [N]
+  double max_continuous_force_n = 0.0;   ///< force sustainable for minutes [N]
+  double max_stiffness_n_per_m = 0.0;    ///< highest stable stiffness at 1 kHz [N/m]
+  double max_damping_n_s_per_m = 0.0;    ///< highest stable damping [N s/m]
+  double workspace_radius_m = 0.0;       ///< radius of a sphere inside the workspace [m]
+  Vec3 workspace_size_m = Vec3::Zero();  ///< box of the usable workspace, x y z [m]
+};
+
+/// A snapshot of the device, as read once per servo tick.
+struct DeviceState {
+  Vec3 position_m = Vec3::Zero();    ///< tip (HIP) position [m]
+  Vec3 velocity_m_s = Vec3::Zero();  ///< tip velocity [m/s]
+  std::uint32_t buttons = 0;         ///< bit i set when button i is pressed
+  double time_s = 0.0;               ///< device time stamp [s], monotonic
+};
+
+}  // namespace calligraphy

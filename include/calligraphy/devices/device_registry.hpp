@@ -1,0 +1,89 @@
+#pragma once
+/// \file device_registry.hpp
+/// Discovery of haptic devices: backends register factories; the registry lists every device they find
+/// (name and DeviceInfo) and creates one by name.
+///
+/// Built-in backends (registered on first use of `device_registry()`, see src/devices/builtin_backends.cpp):
+///   "emulated-phantom"   the Phantom emulator behind the real PhantomDevice code path (always present)
+///   "phantom-hid:<path>" each HID device with the Touch's reported USB ids (when built with hidapi)
+///   "phantom-usb:<bus>-<address>" each such USB device over libusb bulk transfers (when built with libusb)
+///   "openhaptics"        the default OpenHaptics device when libHD.so loads at run time
+/// The simulated device registers itself the same way (`register_device`, name "simulated").
+/// Nothing here is on the servo path.
+
+#include <functional>
+#include <iosfwd>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "calligraphy/devices/haptic_device.hpp"
+
+namespace calligraphy {
+
+/// One device a backend can create.
+struct DeviceListing {
+  std::string name;       ///< unique, what `create` takes, e.g. "phantom-hid:/dev/hidraw3"
+  std::string backend;    ///< the backend that found it
+  DeviceInfo info;        ///< SI units
+  bool hardware = false;  ///< a physical device (false for simulated and emulated ones)
+  std::string details;    ///< free text for people: transport, caveats
+};
+
+/// What a scan of the backends found, plus notes on what was checked and not found.
+struct DeviceSurvey {
+  std::vector<DeviceListing> devices;
+  std::vector<std::string> notes;  ///< e.g. "openhaptics: OpenHaptics not found (tried ...)"
+  [[nodiscard]] bool any_hardware() const;
+};
+
+/// A source of devices. `scan` may be slow (USB enumeration, dlopen) and may throw DeviceError, which
+/// the registry turns into a note. `create` gets a listing that `scan` returned and returns an unopened
+/// device; it throws DeviceError subclasses.
+struct DeviceBackend {
+  std::string name;
+  std::function<DeviceSurvey()> scan;
+  std::function<std::unique_ptr<HapticDevice>(const DeviceListing&)> create;
+};
+
+/// Thread-safe list of backends.
+class DeviceRegistry {
+ public:
+  /// Adds a backend. Throws InvalidArgument when the name is empty or taken, or a function is empty.
+  void register_backend(DeviceBackend backend);
+  /// Adds a backend with exactly one always-present device of the same name (e.g. "simulated").
+  /// Throws InvalidArgument like register_backend.
+  void register_device(std::string name, DeviceInfo info,
+                       std::function<std::unique_ptr<HapticDevice>()> factory, bool hardware = false,
+                       std::string details = {});
+  /// Removes a backend; returns false when there was none of that name.
+  bool unregister_backend(std::string_view name);
+  [[nodiscard]] std::vector<std::string> backend_names() const;
+
+  /// Scans every backend. A backend that throws adds a note instead of failing the survey.
+  [[nodiscard]] DeviceSurvey survey() const;
+  /// Creates (does not open) the device called `name`. Throws DeviceNotFound naming the devices that
+  /// exist, or what the backend's factory throws.
+  [[nodiscard]] std::unique_ptr<HapticDevice> create(std::string_view name) const;
+  /// create(name), then open(). Throws what either throws.
+  [[nodiscard]] std::unique_ptr<HapticDevice> open(std::string_view name) const;
+
+ private:
+  [[nodiscard]] std::vector<DeviceBackend> snapshot() const;
+
+  mutable std::mutex mutex_;
+  std::vector<DeviceBackend> backends_;
+};
+
+/// The process-wide registry, with the built-in backends registered on first use.
+[[nodiscard]] DeviceRegistry& device_registry();
+/// device_registry().register_backend(backend).
+void register_device_backend(DeviceBackend backend);
+
+/// Prints a survey for people: one block per device with its DeviceInfo in SI units, then the notes;
+/// says plainly when no hardware is attached.
+void print_device_survey(std::ostream& out, const DeviceSurvey& survey);
+
+}  // namespace calligraphy

@@ -1,0 +1,50 @@
+#pragma once
+/// \file haptic_device.hpp
+/// The abstract haptic device (paper section 2.4, "device level"). All quantities are SI:
+/// positions in m, velocities in m/s, forces in N, stiffness in N/m, damping in N s/m, time in s.
+/// Device coordinates: x right, y away from the writer, z up out of the paper.
+
+#include "calligraphy/core/device_types.hpp"
+
+namespace calligraphy {
+
+/// Abstract haptic device. Implementations: `SimulatedDevice`, the Phantom backends.
+/// `read_state` and `write_force` are called from the servo thread at up to 10 kHz: implementations
+/// must not allocate, lock or log there; a transport fault throws `CommunicationError` (the servo
+/// loop catches it, zeroes forces and stops).
+class HapticDevice {
+ public:
+  virtual ~HapticDevice() = default;
+  HapticDevice() = default;
+  HapticDevice(const HapticDevice&) = delete;
+  HapticDevice& operator=(const HapticDevice&) = delete;
+
+  /// Static facts of the device, SI units.
+  [[nodiscard]] virtual const DeviceInfo& info() const = 0;
+
+  /// Opens the connection. Throws DeviceNotFound or CommunicationError.
+  virtual void open() = 0;
+  /// Turns forces off and closes the connection. Never throws.
+  virtual void close() noexcept = 0;
+  [[nodiscard]] virtual bool is_open() const = 0;
+
+  /// Homes the encoders. Devices that need no calibration do nothing. Throws CalibrationNeeded when
+  /// the device cannot calibrate itself now (e.g. a Phantom whose stylus is not in the inkwell).
+  virtual void calibrate() {}
+  /// False while positions are not meaningful and forces cannot be enabled until `calibrate()`
+  /// succeeds (e.g. a Phantom whose encoders were not homed in the inkwell). Devices that need no
+  /// calibration return true. Any thread.
+  [[nodiscard]] virtual bool is_calibrated() const { return true; }
+
+  /// Enables or disables force output. Disabled devices ignore `write_force`.
+  virtual void enable_forces(bool enabled) = 0;
+  [[nodiscard]] virtual bool forces_enabled() const = 0;
+
+  /// Reads the current state. Servo path.
+  virtual DeviceState read_state() = 0;
+  /// Commands a force [N] to be held until the next command (zero-order hold). Servo path.
+  /// Implementations clamp to `info().max_force_n` preserving direction.
+  virtual void write_force(const Vec3& force_n) = 0;
+};
+
+}  // namespace calligraphy

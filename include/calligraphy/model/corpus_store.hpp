@@ -1,0 +1,107 @@
+#pragma once
+/// \file corpus_store.hpp
+/// A compact binary store of fitted characters (paper section 3.5: a large number of characters stored
+/// compactly as typical-stroke IDs, control points and feature points). The file is read by memory
+/// mapping; `CorpusStore::load` materialises one character without parsing the rest. Format (fixed
+/// little-endian, CRC-32 checksums, versioned header, sorted index): docs/corpus.md.
+///
+/// What a stored character holds: per stroke the typical-stroke ID, the elements (kind, degree, control
+/// points quantised to 1/steps_per_unit data units, joints shared) and the attraction factors at the
+/// feature points (exact float64; a stroke whose factors all equal its typical stroke's default
+/// stores none). It does not hold the source medians: a loaded `Stroke::median` is
+/// empty, and `Character::source` is "<store path>#U+XXXX". Fidelity against the medians is measured
+/// when the store is built (`calligraphy corpus fidelity`, docs/corpus.md).
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "calligraphy/model/character.hpp"
+
+namespace calligraphy {
+
+/// How `write_corpus_store` encodes characters.
+struct CorpusStoreOptions {
+  /// Quantisation of control points: coordinates are stored as round(x * steps_per_unit), so a control
+  /// point moves by at most sqrt(2) / (2 * steps_per_unit) data units, and so does every point of an
+  /// element (a Bezier curve is an affine combination of its control points). One of 1, 2, 4, 8, 16.
+  int steps_per_unit = 2;
+  /// The fitting tolerance the characters were fitted with [data units]; recorded in the header only.
+  double fit_tolerance = 10.0;
+};
+
+/// What a store's header says, plus sizes.
+struct CorpusStoreInfo {
+  int version_major = 0;
+  int version_minor = 0;
+  std::size_t character_count = 0;
+  int steps_per_unit = 0;
+  double fit_tolerance = 0.0;  ///< data units, as recorded by the writer
+  std::size_t file_bytes = 0;
+  std::size_t header_bytes = 0;  ///< header and the table of default attraction factors
+  std::size_t index_bytes = 0;
+  std::size_t record_bytes = 0;
+  /// Largest distance a stored control point can be from the one written [data units].
+  [[nodiscard]] double max_quantisation_error() const;
+};
+
+/// Encodes characters into the store format in memory. Characters are sorted by code point.
+/// Throws InvalidArgument for duplicate code points, an empty character, more than 255 strokes, a stroke
+/// without elements, a typical ID outside 1-39, degrees outside 1-4, attraction factors not one per
+/// feature point, non-finite or out-of-range coordinates (|x| * steps_per_unit > 2^23), or bad options.
+std::vector<std::uint8_t> encode_corpus_store(std::span<const Character> characters,
+                                              const CorpusStoreOptions& options = {});
+
+/// Writes `encode_corpus_store(characters, options)` to `path` (via a temporary file renamed into
+/// place). Throws as `encode_corpus_store`, and DataError naming the path when it cannot be written.
+void write_corpus_store(const std::filesystem::path& path, std::span<const Character> characters,
+                        const CorpusStoreOptions& options = {});
+
+/// A read-only store. Cheap to copy (the mapping is shared); thread-safe for concurrent `load`s.
+class CorpusStore {
+ public:
+  /// Memory-maps the file (POSIX mmap) and validates the header, the sizes, the index and its checksum.
+  /// Records are checked when loaded. Throws DataError naming the file and the offset at fault for a
+  /// missing, truncated, corrupted or foreign file. Do not modify the file while it is open: a file
+  /// truncated under a live mapping raises SIGBUS on access, which no reader can prevent.
+  static CorpusStore open(const std::filesystem::path& path);
+  /// The same over a copy of `bytes` (tests, fuzzing); `name` stands for the file in errors.
+  static CorpusStore from_bytes(std::span<const std::uint8_t> bytes, const std::string& name);
+
+  [[nodiscard]] const CorpusStoreInfo& info() const;
+  [[nodiscard]] std::size_t size() const { return info().character_count; }
+  /// True when the store holds the character. O(log n).
+  [[nodiscard]] bool contains(char32_t code_point) const;
+  /// Every stored character, sorted by code point.
+  [[nodiscard]] std::vector<char32_t> characters() const;
+  /// Bytes of the character's record (without its index entry). Throws CharacterNotFound.
+  [[nodiscard]] std::size_t record_bytes(char32_t code_point) const;
+  /// Materialises one character: binary search in the index, CRC-32 of its record, decoding with every
+  /// read bounds-checked. Throws CharacterNotFound (naming the character and the file) or DataError
+  /// (naming the file, the character, the record's offset and what is wrong).
+  [[nodiscard]] Character load(char32_t code_point) const;
+  /// The file's name as used in messages.
+  [[nodiscard]] const std::string& name() const;
+
+ private:
+  struct Data;
+  explicit CorpusStore(std::shared_ptr<const Data> data) : data_(std::move(data)) {}
+  std::shared_ptr<const Data> data_;
+};
+
+/// Totals over a whole store, every record loaded (so every record checksum verified).
+struct CorpusStoreStats {
+  std::size_t characters = 0;  ///< characters that loaded
+  std::size_t strokes = 0;
+  std::size_t elements = 0;
+  std::map<int, std::size_t> strokes_by_typical_id;  ///< typical ID 1-39 -> strokes
+  std::vector<std::string> errors;                   ///< one DataError message per record that failed
+};
+
+/// Loads every character of the store and counts. Bad records are listed in `errors`, not thrown.
+CorpusStoreStats corpus_store_stats(const CorpusStore& store);
+
+}  // namespace calligraphy

@@ -1,0 +1,63 @@
+#pragma once
+/// \file scene.hpp
+/// A scene places characters on the paper plane in metres: the data box of each character (y up)
+/// maps to the plane z = z0 of device space, x right, y away from the writer, +z out of the paper.
+/// Several characters lie in a row, the paper's character group (Fig. 30). A scene holds only the
+/// characters it is given.
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+#include "calligraphy/model/character.hpp"
+
+namespace calligraphy {
+
+/// Maps a character's data box to metres on the paper: p_m = origin_m + metres_per_unit * p_data.
+struct Placement {
+  Vec2 origin_m = Vec2::Zero();                  ///< where the data point (0, 0) lands [m]
+  double metres_per_unit = 0.06 / kDataBoxSize;  ///< scale [m per data unit]
+
+  [[nodiscard]] Vec2 to_paper(const Vec2& data) const { return origin_m + metres_per_unit * data; }
+  [[nodiscard]] Vec2 to_data(const Vec2& paper_m) const { return (paper_m - origin_m) / metres_per_unit; }
+};
+
+/// How a scene lays characters out.
+struct SceneLayout {
+  double character_size_m = 0.06;  ///< side of each character's data box on paper [m]
+  double spacing_m = 0.066;        ///< centre-to-centre distance in the row [m]
+  Vec2 centre_m = Vec2::Zero();    ///< centre of the row on the paper [m]
+  double paper_z_m = 0.0;          ///< z0, height of the paper plane in device space [m]
+  double box_margin_m = 0.005;     ///< bounding box margin around the strokes (paper Fig. 5) [m]
+  double start_radius_m = 0.005;   ///< radius of the start-point neighbourhood (paper Fig. 5, Table 1) [m]
+};
+
+/// A stroke in metres.
+struct PlacedStroke {
+  int typical_id = 0;
+  std::vector<StrokeElement> elements;     ///< control points in metres on the paper
+  std::vector<double> attraction_factors;  ///< one per feature point, dimensionless
+  std::vector<Vec2> median_m;              ///< the source median in metres, for drawing
+  [[nodiscard]] const Vec2& start() const { return elements.front().start(); }
+  [[nodiscard]] const Vec2& end() const { return elements.back().end(); }
+  [[nodiscard]] double length_m() const;
+};
+
+/// A character placed on the paper.
+struct PlacedCharacter {
+  char32_t code_point = 0;
+  Placement placement;
+  std::vector<PlacedStroke> strokes;
+  Eigen::AlignedBox2d bounding_box;  ///< strokes' box plus the margin [m]
+};
+
+/// Characters placed in a row, written left to right.
+struct Scene {
+  std::vector<PlacedCharacter> characters;
+  SceneLayout layout;
+
+  [[nodiscard]] std::size_t stroke_count() const;
+  /// Scene for the given characters. Throws InvalidArgument for a non-positive size, radius or spacing.
+  static Scene lay_out(const std::vector<Character>& characters, const SceneLayout& layout = {});
+};
+
+}  // namespace calligraphy

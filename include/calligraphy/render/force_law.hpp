@@ -1,0 +1,85 @@
+#pragma once
+/// \file force_law.hpp
+/// The force model of paper section 5: F_e = F_en + F_et (eq. 7). Free functions, SI units, servo path
+/// (noexcept, no allocation). Device frame: the paper is z = z0, +z out of the paper.
+#include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/core/geometry.hpp"
+
+namespace calligraphy {
+
+/// Parameters of the force law. Validated by `validate` (throws InvalidArgument naming the field).
+struct ForceLawParameters {
+  /// K_et per unit attraction factor (eq. 8) [N/m]: the guidance stiffness of the virtual fixture.
+  double guidance_stiffness_n_per_m = 400.0;
+  /// K_en, stiffness of the virtual paper (eq. 9) [N/m].
+  double paper_stiffness_n_per_m = 800.0;
+  /// Radius of the constraint space R_res around the active element [m] (section 4.3).
+  double constraint_radius_m = 0.006;
+  /// Damping against moving backwards along the active element (internal sequence, Fig. 4) [N s/m].
+  double resistance_damping_n_s_per_m = 15.0;
+  /// Contact hysteresis [m]: once touching, the tip counts as lifted only when it is this far above the
+  /// paper, so that the bounce of a touch-down does not chatter between SS and WS (section 6).
+  double contact_hysteresis_m = 0.0005;
+  /// In-plane guidance on (F_et and the resistance force); the paper force is always rendered.
+  bool guidance = true;
+
+  // Smoothness (paper section 6, sources of instability; docs/force-rendering.md).
+  /// Band at the edge of the constraint space over which F_et tapers to zero [m], in [0, R_res]: F_et
+  /// is scaled by a smoothstep of (R_res - d) / band, so it is continuous at R_res instead of stepping
+  /// by K_et a R_res. 0 = the paper's step.
+  double constraint_taper_m = 0.002;
+  /// Cross-fade time [s] of the in-plane force when the active element, stroke or character changes,
+  /// when WS is entered or left, or when the tip enters or leaves the constraint space. 0 = off.
+  double crossfade_s = 0.05;
+  /// Time [s] over which the paper force fades in when the paper starts to push (AS/SS -> CS/WS) and
+  /// out when it stops (CS -> AS). 0 = off.
+  double paper_fade_s = 0.2;
+  /// Hysteresis of the feature planes (eq. 6) [m]: a plane counts as passed when the tip is this far
+  /// past it, so that encoder noise at the plane does not switch the active element early.
+  double feature_plane_margin_m = 0.0002;
+  /// Damping of the paper on inward motion only (v_z < 0, below the paper) [N s/m]. Colgate's bound
+  /// shrinks by it: K <= 2 (b - B) / T. 0 = off.
+  double paper_damping_n_s_per_m = 0.0;
+  /// Highest speed of the rendered foot point X_S [m/s]: the attraction target moves towards the
+  /// tracked foot point at most this fast, so a jump of the nearest point does not step the force.
+  double max_foot_speed_m_s = 0.3;
+  /// Coulomb friction coefficient mu of the paper (not in the paper), dimensionless: |F_f| = mu N.
+  double friction_coefficient = 0.15;
+  /// Stick band [m/s] > 0: below this in-plane speed friction is viscous, mu N v / v_band, which
+  /// avoids the chatter of a sign function at rest.
+  double friction_stick_speed_m_s = 0.02;
+  /// How the foot point X_S on curve elements is found.
+  NearestPointOptions nearest{};
+
+  /// Throws InvalidArgument when a value is negative, not finite, the radius or the stick speed is not
+  /// positive, or the taper band is wider than the radius.
+  void validate() const;
+};
+
+/// Eq. (9), written to push out of the paper: K_en (z0 - z) e_z when the tip is below the paper
+/// (z < z0), else zero [N].
+[[nodiscard]] Vec3 paper_force(double tip_z_m, double paper_z_m, double stiffness_n_per_m) noexcept;
+
+/// Eq. (8) with the attracting sign: K_et a (X_S - X_p) [N], in the paper plane. As printed the paper's
+/// K_et (X_p - X_S) would push the tip away from the stroke (REFERENCE.md section 1).
+[[nodiscard]] Vec2 attraction_force(const Vec2& tip_m, const Vec2& foot_m, double stiffness_n_per_m,
+                                    double attraction_factor) noexcept;
+
+/// Resistance against writing backwards (section 2.2, Fig. 4): -b (v . t) t when v . t < 0, else zero
+/// [N]; `tangent` is the unit writing direction of the active element at the foot point.
+[[nodiscard]] Vec2 resistance_force(const Vec2& velocity_m_s, const Vec2& tangent,
+                                    double damping_n_s_per_m) noexcept;
+
+/// Paper friction (Coulomb with a stick band): -mu N v / |v| when |v| > v_band, else -mu N v / v_band
+/// [N], in the paper plane; `normal_force_n` N >= 0 [N], in-plane velocity [m/s].
+[[nodiscard]] Vec2 friction_force(const Vec2& velocity_m_s, double normal_force_n, double coefficient,
+                                  double stick_speed_m_s) noexcept;
+
+/// Taper of F_et at the constraint-space edge, in [0, 1]: 1 when distance <= R - band, 0 when
+/// distance >= R, a smoothstep between; band 0 gives the step 1 -> 0 at R. Lengths [m].
+[[nodiscard]] double constraint_taper(double distance_m, double radius_m, double band_m) noexcept;
+
+/// Scales `force` down to at most `max_force_n`, keeping its direction; a non-finite force gives zero.
+[[nodiscard]] Vec3 clamp_force(const Vec3& force_n, double max_force_n) noexcept;
+
+}  // namespace calligraphy

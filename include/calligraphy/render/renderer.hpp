@@ -1,0 +1,98 @@
+#pragma once
+/// \file renderer.hpp
+/// The per-tick haptic renderer (paper section 4, Fig. 15): device state in, force out. Usable on its
+/// own from an application's servo loop (an OpenHaptics scheduler callback, a CHAI3D haptics thread):
+/// call `tick` once per servo tick at the rate given in `RendererOptions`. `tick` is noexcept and never
+/// allocates. Pipeline per tick: state machine (Fig. 6) -> collision with the active element (section
+/// 4.3) -> force law (eqs. 7-9) with the smoothing of section 6 and paper friction -> optional
+/// passivity controller -> safety chain. Details and measurements: docs/force-rendering.md.
+#include <cstdint>
+
+#include "calligraphy/collision/active_stroke.hpp"
+#include "calligraphy/collision/nearest_point_tracker.hpp"
+#include "calligraphy/core/device_types.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/render/force_law.hpp"
+#include "calligraphy/render/interaction_state.hpp"
+#include "calligraphy/render/passivity.hpp"
+#include "calligraphy/render/safety_chain.hpp"
+
+namespace calligraphy {
+
+/// How the renderer is run: the servo rate and the stages after the force law.
+struct RendererOptions {
+  double rate_hz = 1000.0;  ///< servo rate [Hz], in [100, 100000]
+  /// Safety chain. `max_force_n` and `max_continuous_force_n` left at 0 take the device's figures.
+  SafetyChainParameters safety{};
+  PassivityParameters passivity{};  ///< Hannaford-Ryu observer and controller (off by default)
+  /// Physical damping b of the device [N s/m] for Colgate's bound K <= 2 (b - B) / T; 0 = unknown,
+  /// then only `DeviceInfo::max_stiffness_n_per_m` is checked.
+  double device_damping_n_s_per_m = 0.0;
+  /// Throws InvalidArgument naming the field when a value is out of range.
+  void validate() const;
+};
+
+/// Everything one tick decided.
+struct RenderOutput {
+  Vec3 force_n = Vec3::Zero();  ///< command for the device [N], finite, within the safety chain's limits
+  InteractionState state = InteractionState::separation;
+  bool state_changed = false;
+  std::size_t character = 0;                 ///< active character index (valid unless `finished`)
+  std::size_t stroke = 0;                    ///< active stroke index within the character
+  std::size_t element = 0;                   ///< active element index within the stroke
+  bool finished = false;                     ///< every stroke of the scene has been written
+  bool in_constraint_space = false;          ///< the tip is inside R_res of the active element
+  Vec2 foot_m = Vec2::Zero();                ///< X_S on the active element (WS only) [m]
+  bool stroke_completed = false;             ///< this tick wrote the last feature point of a stroke
+  bool stroke_abandoned = false;             ///< the pen was lifted in WS: the stroke was reloaded
+  bool input_rejected = false;               ///< the device state was not finite: zero force
+  bool force_error = false;                  ///< the force law gave a non-finite force: zero force
+  std::uint8_t limits = safety_none;         ///< SafetyLimit bits: which safety stages acted
+  double passivity_damping_n_s_per_m = 0.0;  ///< damper added by the passivity controller [N s/m]
+};
+
+class Renderer {
+ public:
+  /// `scene` must outlive the renderer. Throws InvalidArgument when the parameters or options are out
+  /// of range or `device.max_force_n` is not positive. Logs a warning (here, never per tick) when a
+  /// stiffness exceeds the device's stable maximum or Colgate's bound 2 (b - B) rate.
+  Renderer(const Scene& scene, const ForceLawParameters& parameters, const DeviceInfo& device,
+           const RendererOptions& options = {});
+
+  /// One servo tick. Never throws, never allocates.
+  RenderOutput tick(const DeviceState& state) noexcept;
+  /// Back to the first stroke, state SS; the safety chain's ramp restarts.
+  void reset() noexcept;
+
+  [[nodiscard]] const ActiveStroke& active() const noexcept { return active_; }
+  [[nodiscard]] InteractionState state() const noexcept { return state_; }
+  [[nodiscard]] const ForceLawParameters& parameters() const noexcept { return parameters_; }
+  [[nodiscard]] const RendererOptions& options() const noexcept { return options_; }
+  [[nodiscard]] const Scene& scene() const noexcept { return *scene_; }
+  [[nodiscard]] const SafetyChain& safety_chain() const noexcept { return chain_; }
+  [[nodiscard]] const PassivityController& passivity() const noexcept { return passivity_; }
+
+ private:
+  Vec2 guidance_force(const DeviceState& device, RenderOutput& out, bool element_changed) noexcept;
+  void command(const Vec3& force, RenderOutput& out) noexcept;
+
+  const Scene* scene_;
+  ForceLawParameters parameters_;
+  RendererOptions options_;
+  double period_s_;
+  ActiveStroke active_;
+  InteractionState state_ = InteractionState::separation;
+  SafetyChain chain_;
+  PassivityController passivity_;
+  NearestPointTracker tracker_;
+  // Smoothing state.
+  Vec2 rendered_foot_ = Vec2::Zero();  // attraction target, rate-limited towards the tracked foot
+  bool foot_valid_ = false;
+  double paper_weight_ = 0.0;      // fade of the paper force, 0..1
+  Vec2 guidance_ = Vec2::Zero();   // last in-plane guidance force after the cross-fade
+  Vec2 fade_from_ = Vec2::Zero();  // guidance force at the start of the running cross-fade
+  double fade_elapsed_s_ = 0.0;
+  bool was_inside_ = false;
+};
+
+}  // namespace calligraphy

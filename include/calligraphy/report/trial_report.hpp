@@ -1,0 +1,30 @@
+#pragma once
+// Reports of a trial: the printed table, JSON (keys fixed by the CLI's contract), SVG and CSV.
+#include <string>
+
+#include "calligraphy/trial/trial.hpp"
+
+namespace calligraphy::cli {
+
+struct TrialDescription {
+  std::string characters;  // UTF-8
+  bool guidance = true;
+  std::string writer;
+  std::uint64_t seed = 0;
+  double rate_hz = 1000.0;
+  std::string device = "simulated";  // registry name
+  std::string device_model = "Phantom Desktop (simulated)";
+};
+
+/// The table of the metrics, and a line saying why when the trial was aborted.
+void print_trial_table(const TrialDescription& d, const Scene& scene, const TrialResult& result);
+/// The metrics as JSON, with `device`, `aborted` and `abort_reason`.
+std::string trial_json(const TrialDescription& d, const TrialResult& result);
+/// Reference in blue, pen trace in green, each stroke's start hint as a red ellipse (paper Figs. 30-31).
+std::string trial_svg(const Scene& scene, const TrialResult& result);
+/// The 1 kHz trace: t,x,y,z,fx,fy,fz,state,stroke,element (SI units).
+std::string trial_csv(const std::vector<TrialSample>& trace);
+/// Writes text to a file; throws DataError naming the path when it cannot.
+void write_file(const std::string& path, const std::string& text);
+
+}  // namespace calligraphy::cli

@@ -1,0 +1,149 @@
+#include "eval/corpus_fit.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <mutex>
+#include <thread>
+
+#include "calligraphy/core/errors.hpp"
+#include "cli/commands.hpp"
+#include "core/unicode.hpp"
+
+namespace calligraphy::cli {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// A bar redrawn in place on a terminal; elsewhere (a log, CI) one line per 10 %.
+class ProgressBar {
+ public:
+  ProgressBar(std::string label, std::size_t total)
+      : label_(std::move(label)), total_(total), tty_(::isatty(STDERR_FILENO) != 0) {}
+  void show(std::size_t done) {
+    if (tty_) {
+      constexpr int kWidth = 40;
+      const int filled = total_ ? static_cast<int>(kWidth * done / total_) : kWidth;
+      std::fprintf(stderr, "\r%s [%.*s%*s] %zu/%zu", label_.c_str(), filled,
+                   "########################################", kWidth - filled, "", done, total_);
+      if (done == total_) std::fputc('\n', stderr);
+    } else {
+      const std::size_t tenth = total_ ? 10 * done / total_ : 10;
+      if (tenth > last_tenth_ || (done == total_ && !finished_)) {
+        std::fprintf(stderr, "%s: %zu/%zu\n", label_.c_str(), done, total_);
+        last_tenth_ = tenth;
+      }
+      finished_ = done == total_;
+    }
+  }
+
+ private:
+  std::string label_;
+  std::size_t total_;
+  bool tty_;
+  std::size_t last_tenth_ = 0;
+  bool finished_ = false;
+};
+
+}  // namespace
+
+std::filesystem::path corpus_folder(const Arguments& arguments) {
+  if (const auto folder = arguments.option("data")) return *folder;
+  const char* xdg = std::getenv("XDG_CACHE_HOME");
+  const char* home = std::getenv("HOME");
+  std::filesystem::path cache;
+  if (xdg != nullptr && *xdg != '\0') {
+    cache = xdg;
+  } else if (home != nullptr) {
+    cache = std::filesystem::path(home) / ".cache";
+  }
+  const auto fetched = cache / "calligraphy" / "hanzi-writer-data-2.0.1";
+  std::error_code ec;
+  if (!cache.empty() && std::filesystem::exists(fetched / ".complete", ec)) return fetched;
+  throw UsageError("no hanzi-writer-data folder: run scripts/fetch-hanzi-writer-data.sh (it fills " +
+                   fetched.string() + ") or pass --data DIR");
+}
+
+unsigned corpus_threads(const Arguments& arguments) {
+  const double n = arguments.number_or("threads", std::max(1u, std::thread::hardware_concurrency()));
+  if (n < 1 || n > 256 || n != static_cast<double>(static_cast<unsigned>(n))) {
+    throw UsageError("--threads expects an integer 1-256");
+  }
+  return static_cast<unsigned>(n);
+}
+
+CorpusFit fit_corpus(const CharacterLibrary& library, const FitOptions& options, unsigned threads,
+                     const std::string& label) {
+  const auto start = Clock::now();
+  const std::vector<char32_t> code_points = library.characters();
+  std::vector<Character> fitted(code_points.size());
+  std::vector<std::vector<double>> deviations(code_points.size());
+  std::vector<std::string> errors(code_points.size());
+  std::atomic<std::size_t> next{0};
+  std::atomic<std::size_t> done{0};
+  std::mutex timing_mutex;
+  double read_parse = 0.0;
+  double fit = 0.0;
+
+  const auto work = [&] {
+    double my_read = 0.0;
+    double my_fit = 0.0;
+    for (std::size_t k = next++; k < code_points.size(); k = next++) {
+      try {
+        const auto t0 = Clock::now();
+        const CharacterData data = library.load_data(code_points[k]);
+        const auto t1 = Clock::now();
+        // As fit_character, keeping each stroke's max deviation.
+        Character& character = fitted[k];
+        character.code_point = code_points[k];
+        character.source = data.source;
+        for (const auto& median : data.medians) {
+          FittedStroke stroke = fit_stroke(median, options);
+          deviations[k].push_back(stroke.max_deviation);
+          character.strokes.push_back(std::move(stroke.stroke));
+        }
+        my_fit += seconds_since(t1);
+        my_read += std::chrono::duration<double>(t1 - t0).count();
+      } catch (const std::exception& e) {  // reported per character below, never fatal for the run
+        errors[k] = e.what();
+      }
+      ++done;
+    }
+    const std::lock_guard lock(timing_mutex);
+    read_parse += my_read;
+    fit += my_fit;
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 0; t < threads; ++t) pool.emplace_back(work);
+  ProgressBar bar(label, code_points.size());
+  while (done < code_points.size()) {
+    bar.show(done);
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  for (auto& t : pool) t.join();
+  bar.show(code_points.size());
+
+  CorpusFit result;
+  result.threads = threads;
+  for (std::size_t k = 0; k < code_points.size(); ++k) {
+    if (errors[k].empty()) {
+      result.characters.push_back(std::move(fitted[k]));
+      result.fitter_deviation.push_back(std::move(deviations[k]));
+    } else {
+      result.failures.push_back({code_points[k], errors[k]});
+    }
+  }
+  result.wall_s = seconds_since(start);
+  result.read_parse_cpu_s = read_parse;
+  result.fit_cpu_s = fit;
+  return result;
+}
+
+}  // namespace calligraphy::cli

@@ -1,0 +1,38 @@
+#pragma once
+// Fits a whole folder of hanzi-writer-data characters on a pool of threads, with a progress bar on
+// stderr and timings split into read+parse and fit (shared by `corpus build` and `corpus fidelity`).
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "calligraphy/model/character_library.hpp"
+#include "cli/arguments.hpp"
+
+namespace calligraphy::cli {
+
+struct CorpusFitFailure {
+  char32_t code_point = 0;
+  std::string reason;
+};
+
+struct CorpusFit {
+  std::vector<Character> characters;  ///< sorted by code point; medians kept in each stroke
+  /// Per character, per stroke: `FittedStroke::max_deviation`, the fitter's own measure (from the median
+  /// after brush hooks are trimmed and rounded corners snapped to their lines' intersection).
+  std::vector<std::vector<double>> fitter_deviation;
+  std::vector<CorpusFitFailure> failures;
+  unsigned threads = 0;
+  double wall_s = 0.0;            ///< reading, parsing and fitting, wall clock
+  double read_parse_cpu_s = 0.0;  ///< summed over threads
+  double fit_cpu_s = 0.0;         ///< summed over threads
+};
+
+/// --data DIR, else the folder scripts/fetch-hanzi-writer-data.sh fills; UsageError saying how to fetch.
+std::filesystem::path corpus_folder(const Arguments& arguments);
+/// --threads N, else std::thread::hardware_concurrency().
+unsigned corpus_threads(const Arguments& arguments);
+/// Fits every character of the folder. `label` prefixes the progress bar.
+CorpusFit fit_corpus(const CharacterLibrary& library, const FitOptions& options, unsigned threads,
+                     const std::string& label);
+
+}  // namespace calligraphy::cli

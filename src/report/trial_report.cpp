@@ -1,0 +1,141 @@
+#include "calligraphy/report/trial_report.hpp"
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/typical_strokes.hpp"
+#include "core/unicode.hpp"
+#include "model/polyline.hpp"
+
+namespace calligraphy::cli {
+
+void print_trial_table(const TrialDescription& d, const Scene& scene, const TrialResult& result) {
+  const TrialMetrics& m = result.metrics;
+  std::printf("Trial %s: guidance %s, %s writer, seed %llu, %.0f Hz, device %s (%s)\n", d.characters.c_str(),
+              d.guidance ? "on" : "off", d.writer.c_str(), static_cast<unsigned long long>(d.seed), d.rate_hz,
+              d.device.c_str(), d.device_model.c_str());
+  std::printf("\n  %-6s %-5s %-6s %-4s %9s %9s %9s %8s %9s\n", "stroke", "char", "type", "ID", "mean[mm]",
+              "max[mm]", "time[s]", "attempts", "completed");
+  for (const StrokeMetrics& s : m.per_stroke) {
+    const TypicalStroke& type = typical_stroke(s.typical_id);
+    std::printf("  %-6zu %-5s %-6s %-4d %9.2f %9.2f %9.2f %8d %9s\n", s.index + 1,
+                encode_utf8(scene.characters[s.character].code_point).c_str(),
+                std::string(type.acronym).c_str(), s.typical_id, s.mean_deviation_m * 1e3,
+                s.max_deviation_m * 1e3, s.time_s, s.attempts, s.completed ? "yes" : "no");
+  }
+  std::printf("\n  strokes completed in order  %zu / %zu%s\n", m.strokes_completed, m.strokes_total,
+              m.completed_in_order ? "" : "  (incomplete)");
+  std::printf("  mean deviation             %.3f mm\n", m.mean_deviation_m * 1e3);
+  std::printf("  max deviation              %.3f mm\n", m.max_deviation_m * 1e3);
+  std::printf("  writing time               %.2f s\n", m.time_s);
+  std::printf("  state transitions          %zu\n", m.state_transitions);
+  std::printf("  max |F|                    %.3f N\n", m.max_force_n);
+  std::printf("  max per-tick |dF|          %.3f N\n", m.max_force_step_n);
+  if (result.aborted) std::printf("\n  ABORTED after %.3f s: %s\n", m.time_s, result.abort_reason.c_str());
+}
+
+std::string trial_json(const TrialDescription& d, const TrialResult& result) {
+  const TrialMetrics& m = result.metrics;
+  nlohmann::json per_stroke = nlohmann::json::array();
+  for (const StrokeMetrics& s : m.per_stroke) {
+    per_stroke.push_back({{"index", s.index + 1},
+                          {"typical_id", s.typical_id},
+                          {"mean_deviation_mm", s.mean_deviation_m * 1e3},
+                          {"max_deviation_mm", s.max_deviation_m * 1e3},
+                          {"time_s", s.time_s},
+                          {"completed", s.completed},
+                          {"attempts", s.attempts}});
+  }
+  const nlohmann::json doc = {{"character", d.characters},
+                              {"guidance", d.guidance},
+                              {"writer", d.writer},
+                              {"seed", d.seed},
+                              {"rate_hz", d.rate_hz},
+                              {"device", d.device},
+                              {"aborted", result.aborted},
+                              {"abort_reason", result.abort_reason},
+                              {"strokes_total", m.strokes_total},
+                              {"strokes_completed", m.strokes_completed},
+                              {"completed_in_order", m.completed_in_order},
+                              {"time_s", m.time_s},
+                              {"mean_deviation_mm", m.mean_deviation_m * 1e3},
+                              {"max_deviation_mm", m.max_deviation_m * 1e3},
+                              {"max_force_n", m.max_force_n},
+                              {"max_force_step_n", m.max_force_step_n},
+                              {"state_transitions", m.state_transitions},
+                              {"per_stroke", per_stroke}};
+  return doc.dump(2) + "\n";
+}
+
+std::string trial_svg(const Scene& scene, const TrialResult& result) {
+  // Paper metres -> SVG pixels, y flipped (SVG y grows downwards).
+  Eigen::AlignedBox2d box;
+  for (const auto& c : scene.characters) box.extend(c.bounding_box);
+  constexpr double kPixelsPerMetre = 8000.0;  // 60 mm -> 480 px
+  const double margin = 0.01;
+  const Vec2 lo = box.min() - Vec2(margin, margin);
+  const Vec2 size = box.sizes() + Vec2(2 * margin, 2 * margin);
+  const auto px = [&](const Vec2& p) {
+    return Vec2((p.x() - lo.x()) * kPixelsPerMetre, (lo.y() + size.y() - p.y()) * kPixelsPerMetre);
+  };
+  std::ostringstream svg;
+  svg.precision(2);
+  svg << std::fixed;
+  svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << size.x() * kPixelsPerMetre << "\" height=\""
+      << size.y() * kPixelsPerMetre << "\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  for (const auto& c : scene.characters) {  // reference strokes in blue
+    for (const auto& s : c.strokes) {
+      svg << "<polyline fill=\"none\" stroke=\"blue\" stroke-width=\"3\" stroke-linecap=\"round\" points=\"";
+      for (const auto& e : s.elements) {
+        for (const Vec2& p : sample_element(e, e.degree == 1 ? 1 : 24))
+          svg << px(p).x() << "," << px(p).y() << " ";
+      }
+      svg << "\"/>\n";
+    }
+  }
+  const auto& trace = result.trace;
+  for (const StrokeMetrics& m :
+       result.metrics.per_stroke) {  // pen trace in green, last attempt of each stroke
+    if (m.trace_end <= m.trace_begin || m.trace_end > trace.size()) continue;
+    svg << "<polyline fill=\"none\" stroke=\"limegreen\" stroke-width=\"1.5\" points=\"";
+    for (std::size_t i = m.trace_begin; i < m.trace_end; i += 5) {
+      const Vec2 p = px(trace[i].position_m.head<2>());
+      svg << p.x() << "," << p.y() << " ";
+    }
+    svg << "\"/>\n";
+  }
+  for (const auto& c : scene.characters) {  // start hints as red ellipses
+    for (const auto& s : c.strokes) {
+      const Vec2 p = px(s.start());
+      const double r = scene.layout.start_radius_m * kPixelsPerMetre;
+      svg << "<ellipse cx=\"" << p.x() << "\" cy=\"" << p.y() << "\" rx=\"" << r << "\" ry=\"" << 0.7 * r
+          << "\" fill=\"none\" stroke=\"red\" stroke-width=\"1.5\"/>\n";
+    }
+  }
+  svg << "</svg>\n";
+  return svg.str();
+}
+
+std::string trial_csv(const std::vector<TrialSample>& trace) {
+  std::ostringstream csv;
+  csv << "t,x,y,z,fx,fy,fz,state,stroke,element\n";
+  char line[256];
+  for (const TrialSample& s : trace) {
+    std::snprintf(line, sizeof line, "%.4f,%.7f,%.7f,%.7f,%.5f,%.5f,%.5f,%s,%zu,%zu\n", s.time_s,
+                  s.position_m.x(), s.position_m.y(), s.position_m.z(), s.force_n.x(), s.force_n.y(),
+                  s.force_n.z(), to_string(s.state), s.stroke, s.element);
+    csv << line;
+  }
+  return csv.str();
+}
+
+void write_file(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  if (!out) throw DataError(path + ": cannot write file");
+}
+
+}  // namespace calligraphy::cli

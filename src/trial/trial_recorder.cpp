@@ -1,0 +1,95 @@
+#include <algorithm>
+#include <limits>
+
+#include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/trial/trial.hpp"
+
+namespace calligraphy {
+namespace {
+
+// Distance from the tip to the nearest element of the stroke (the whole reference, not only the active
+// element).
+double distance_to_stroke(const PlacedStroke& stroke, const Vec2& tip) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const StrokeElement& e : stroke.elements) best = std::min(best, nearest_point(e, tip).distance);
+  return best;
+}
+
+}  // namespace
+
+TrialRecorder::TrialRecorder(const Scene& scene, bool keep_trace) : scene_(&scene), keep_trace_(keep_trace) {
+  for (std::size_t c = 0; c < scene.characters.size(); ++c) {
+    for (std::size_t s = 0; s < scene.characters[c].strokes.size(); ++s) {
+      StrokeMetrics m;
+      m.index = stroke_location_.size();
+      m.character = c;
+      m.typical_id = scene.characters[c].strokes[s].typical_id;
+      metrics_.per_stroke.push_back(m);
+      stroke_location_.emplace_back(c, s);
+    }
+  }
+  metrics_.strokes_total = stroke_location_.size();
+}
+
+void TrialRecorder::record(const DeviceState& state, const RenderOutput& out) {
+  last_time_ = state.time_s;
+  const double force_step = first_ ? 0.0 : (out.force_n - last_force_).norm();
+  metrics_.max_force_step_n = std::max(metrics_.max_force_step_n, force_step);
+  metrics_.max_force_n = std::max(metrics_.max_force_n, out.force_n.norm());
+  if (!first_ && out.state != last_state_) ++metrics_.state_transitions;
+  first_ = false;
+  last_force_ = out.force_n;
+  last_state_ = out.state;
+
+  const std::size_t index = ticks_++;
+  if (keep_trace_) {
+    trace_.push_back({state.time_s, state.position_m, out.force_n, out.state, current_, out.element});
+  }
+  if (current_ >= metrics_.per_stroke.size()) return;
+  StrokeMetrics& m = metrics_.per_stroke[current_];
+  const bool writing_this = out.state == InteractionState::writing || out.stroke_completed;
+  if (out.state_changed && out.state == InteractionState::writing) {  // a new attempt starts
+    attempt_ = {};
+    attempt_.start_time = state.time_s;
+    ++m.attempts;
+    m.trace_begin = index;
+  }
+  if (writing_this) {
+    const auto [c, s] = stroke_location_[current_];
+    const double d = distance_to_stroke(scene_->characters[c].strokes[s], state.position_m.head<2>());
+    attempt_.sum += d;
+    ++attempt_.count;
+    attempt_.max = std::max(attempt_.max, d);
+    m.trace_end = index + 1;
+  }
+  if (out.stroke_abandoned) m.trace_end = m.trace_begin;  // the trace of an abandoned attempt is cleared
+  if (out.stroke_completed) {
+    m.completed = true;
+    m.time_s = state.time_s - attempt_.start_time;
+    m.mean_deviation_m = attempt_.count ? attempt_.sum / static_cast<double>(attempt_.count) : 0.0;
+    m.max_deviation_m = attempt_.max;
+    pooled_sum_ += attempt_.sum;
+    pooled_count_ += attempt_.count;
+    ++metrics_.strokes_completed;
+    metrics_.max_deviation_m = std::max(metrics_.max_deviation_m, attempt_.max);
+    metrics_.mean_deviation_m = pooled_count_ ? pooled_sum_ / static_cast<double>(pooled_count_) : 0.0;
+    metrics_.time_s = state.time_s;
+    attempt_ = {};
+    ++current_;
+  }
+}
+
+void TrialRecorder::reserve(std::size_t ticks) {
+  if (!keep_trace_ || ticks <= trace_.capacity()) return;
+  const std::size_t size = trace_.size();
+  trace_.resize(ticks);  // value-initialises, so the pages are touched now, not in the loop
+  trace_.resize(size);
+}
+
+void TrialRecorder::finish(double end_time_s) {
+  metrics_.completed_in_order =
+      metrics_.strokes_total > 0 && metrics_.strokes_completed == metrics_.strokes_total;
+  if (!metrics_.completed_in_order) metrics_.time_s = std::max(end_time_s, last_time_);
+}
+
+}  // namespace calligraphy
