@@ -1,4 +1,4 @@
-// Corpus store timings (issue 3, item 5): open, load one character on demand, a scene of 4 characters,
+// Corpus store timings: open, load one character on demand, a scene of 4 characters,
 // and for comparison the same character parsed from JSON and fitted. Uses the store named by the
 // environment variable CALLIGRAPHY_STORE (e.g. from `calligraphy corpus build --out FILE`), else a
 // store of the embedded default characters written to a temporary file.

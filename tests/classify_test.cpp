@@ -1,5 +1,5 @@
 // The 39 typical strokes, their classification against cnchar-order's labels, the robustness of the
-// fitting to the data's quirks (REFERENCE.md section 2), and the Fig. 13 drawing of a model.
+// fitting to hanzi-writer-data's quirks (brush hooks, rounded corners), and the Fig. 13 drawing of a model.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
@@ -63,7 +63,7 @@ TEST_CASE("Typical strokes: unique acronyms and code points, Unicode block facts
     CHECK(t.default_attraction > 0.0);
     CHECK(t.corner_attraction > 0.0);
   }
-  // REFERENCE.md section 3 (Unicode CJK Strokes, including U+31E4 and U+31E5 of Unicode 16).
+  // The Unicode CJK Strokes block (U+31C0-U+31E3, plus U+31E4 and U+31E5 added in Unicode 16).
   const std::pair<const char*, char32_t> block[] = {
       {"T", U'\u31C0'},   {"WG", U'\u31C1'},   {"XG", U'\u31C2'},    {"BXG", U'\u31C3'},  {"SW", U'\u31C4'},
       {"HZZ", U'\u31C5'}, {"HZG", U'\u31C6'},  {"HP", U'\u31C7'},    {"HZWG", U'\u31C8'}, {"SZWG", U'\u31C9'},

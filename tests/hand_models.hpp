@@ -1,7 +1,7 @@
 #pragma once
-// Hand models for the stability tests (issue 5): the hand holding the simulated device's stylus.
-// Figures of the relaxed and stiff hands: REFERENCE.md section 8 (a relaxed grip 150 N/m, 3 N s/m; a
-// stiff grip 600 N/m, 8 N s/m). Test helpers, not library API.
+// Hand models for the stability tests: the hand holding the simulated device's stylus. The relaxed
+// and stiff hands (a relaxed grip 150 N/m, 3 N s/m; a stiff grip 600 N/m, 8 N s/m) are assumed,
+// order-of-magnitude figures, not measured on people. Test helpers, not library API.
 #include "calligraphy/sim/simulated_device.hpp"
 
 namespace calligraphy::testing {

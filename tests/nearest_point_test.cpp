@@ -1,4 +1,4 @@
-// Nearest point on a stroke element: every method on every extreme case of REFERENCE.md section 5,
+// Nearest point on a stroke element: every method on every extreme case (see extreme_cases below),
 // against the independent high-precision reference of src/cli/nearest_point_reference.hpp.
 #include "calligraphy/collision/nearest_point.hpp"
 
@@ -61,7 +61,9 @@ StrokeElement transformed(const StrokeElement& e, double scale, const Vec2& offs
   return result;
 }
 
-// The extreme cases of REFERENCE.md section 5 plus random curves, for one degree.
+// The extreme cases (the point on the curve, at an endpoint, on an end tangent's extension, at a
+// centre of curvature; cusps, loops, coincident control points, far offsets, tiny scales) plus random
+// curves, for one degree.
 std::vector<Case> extreme_cases(int degree) {
   std::mt19937_64 random(static_cast<std::uint64_t>(100 + degree));
   std::uniform_real_distribution<double> unit(0.0, 1.0);

@@ -1,4 +1,4 @@
-// Passivity of the paper contact on the simulated device (issue 5): the energy the device supplies,
+// Passivity of the paper contact on the simulated device: the energy the device supplies,
 // integral of F . v dt from the device's side, stays bounded for stiffness up to Colgate's bound
 // 2 b / T, grows above it, and the Hannaford-Ryu controller stops the growth.
 #include "calligraphy/render/passivity.hpp"
@@ -101,8 +101,9 @@ constexpr double kDeviceDamping = 0.5;  // SimulatedDeviceParameters' default b 
 // docs/force-rendering.md); a bounded contact stays within a few mJ in total.
 constexpr double kGrowthTolerance = 5e-4;
 constexpr double kBoundedEnergy = 0.01;
-// 60 s of contact (issue 5). The sanitizer builds run 20 s: a Debug ASan build is about 100 times
-// slower and the 60 s runs took over 10 minutes there; the Release build runs the full 60 s.
+// 60 s of contact, so that slow energy growth shows. The sanitizer builds run 20 s: a Debug ASan build
+// is about 100 times slower and the 60 s runs took over 10 minutes there; the Release build runs the
+// full 60 s.
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 constexpr double kContactSeconds = 20.0;
 #else

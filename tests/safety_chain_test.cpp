@@ -1,4 +1,4 @@
-// The safety chain (issue 5): each stage on its own, and the renderer's use of it.
+// The safety chain: each stage on its own, and the renderer's use of it.
 #include "calligraphy/render/safety_chain.hpp"
 
 #include <catch2/catch.hpp>

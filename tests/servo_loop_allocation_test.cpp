@@ -1,7 +1,8 @@
-// The servo loop thread must not allocate while it runs a renderer (issue 5, Deliver 1). Counts calls of
-// malloc made by a thread that has asked to be watched: malloc is interposed for this test binary and
-// forwards to glibc's __libc_malloc (operator new, replaced in nearest_point_allocation_test.cpp, calls
-// malloc). Sanitizers own malloc, so their builds leave this test out.
+// The servo loop thread must not allocate while it runs a renderer (an allocation can block for longer
+// than a servo period). Counts calls of malloc made by a thread that has asked to be watched: malloc
+// is interposed for this test binary and forwards to glibc's __libc_malloc (operator new, replaced in
+// nearest_point_allocation_test.cpp, calls malloc). Sanitizers own malloc, so their builds leave this
+// test out.
 #include <catch2/catch.hpp>
 
 #if !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__) && defined(__GLIBC__)

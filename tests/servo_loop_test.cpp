@@ -1,4 +1,4 @@
-// The real-time servo loop (issue 5, Deliver 1): rate, start/stop/restart, fault containment, watchdog,
+// The real-time servo loop: rate, start/stop/restart, fault containment, watchdog,
 // concurrent statistics, and a real-time trial on the simulated device. Timing is asserted only as loose
 // properties (tick counts within 20 %), never as benchmarks; `calligraphy bench loop` measures jitter.
 #include "calligraphy/devices/servo_loop.hpp"

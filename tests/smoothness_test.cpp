@@ -1,4 +1,4 @@
-// Smoothness of the rendered force (issue 5, paper section 6): full simulated trials on real
+// Smoothness of the rendered force (Wang, Zhang & Yao 2006, section 6): full simulated trials on real
 // characters with corners, hooks and crossing strokes, and the single smoothing stages.
 #include <algorithm>
 #include <catch2/catch.hpp>

@@ -1,6 +1,6 @@
 // `calligraphy bench loop --rate HZ --seconds S [--realtime enforce|ignore|off] [--json] ...`: runs the
 // real-time servo loop against the simulated device and prints its period jitter, missed deadlines and
-// callback time (issue 5, Deliver 6; docs/servo-loop.md).
+// callback time (docs/servo-loop.md).
 
 #include <chrono>
 #include <cstdio>

@@ -1,6 +1,6 @@
 // `calligraphy corpus validate --data DIR --cnchar FILE [--markdown FILE] [--json] [--threads N]`:
 // per-stroke agreement of the typical-stroke classification with cnchar-order's letters
-// (issue 3 item 3; docs/classification.md is this command's --markdown output).
+// (docs/classification.md is this command's --markdown output).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>

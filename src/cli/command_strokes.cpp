@@ -1,4 +1,4 @@
-// `calligraphy strokes [--markdown FILE] [--json]`: the table of the 39 typical strokes (issue 3 item 1);
+// `calligraphy strokes [--markdown FILE] [--json]`: the table of the 39 typical strokes;
 // docs/typical-strokes.md is its --markdown output.
 #include <iostream>
 

@@ -1,4 +1,4 @@
-// The multi-start Newton method (as in msdfgen's curve distance, REFERENCE.md section 5).
+// The multi-start Newton method (as msdfgen, Chlumsky's signed distance field generator, does for curves).
 #include <algorithm>
 
 #include "collision/nearest_point_methods.hpp"

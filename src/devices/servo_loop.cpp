@@ -193,7 +193,7 @@ LoopFault ServoLoop::Impl::fault() const {
   return f;
 }
 
-// The loop body (issue 5, Deliver 1). Deadlines are absolute, on a grid of whole periods from the start:
+// The loop body. Deadlines are absolute, on a grid of whole periods from the start:
 // a late tick does not shift later ones. When a tick ends past the next deadline, the missed deadlines
 // are skipped (never run back to back), so the callback always sees dt close to a whole number of periods.
 void ServoLoop::Impl::run() noexcept {

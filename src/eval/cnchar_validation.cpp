@@ -13,7 +13,7 @@
 namespace calligraphy::cli {
 namespace {
 
-// cnchar letter per typical ID (index ID - 1). From cnchar's stroke table (REFERENCE.md section 2):
+// cnchar letter per typical ID (index ID - 1). From cnchar's stroke table (theajack/cnchar):
 // cnchar merges 横撇/横钩 (e), 横折折/横折弯 (v), 横折折折钩/横撇弯钩 (w), 横斜钩/横折弯钩 (o),
 // 竖弯/竖折 (b), 竖折撇/竖折折 (x), 斜钩/卧钩 (y), and writes 竖撇 as 撇 (s). It has no letter for
 // the variants 长点, 平撇, 提捺, 撇钩 and 竖弯左; they map to the flat stroke they vary.

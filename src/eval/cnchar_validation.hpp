@@ -1,6 +1,6 @@
 #pragma once
 // Validation of the typical-stroke classification against the per-stroke letters of npm
-// `cnchar-order` 3.2.6 (MIT, theajack/cnchar; letter meanings in REFERENCE.md section 2). cnchar's
+// `cnchar-order` 3.2.6 (MIT, theajack/cnchar; letter meanings in its stroke table). cnchar's
 // letters are coarser than the 39 typical strokes (e.g. `e` is both 横撇 HP and 横钩 HG), so each ID
 // maps to one letter and agreement is counted at the letter's granularity.
 #include <iosfwd>

@@ -1,5 +1,5 @@
 #pragma once
-// Foot-point jumps on real characters (issue 4): simulated trials of embedded characters (lock-step,
+// Foot-point jumps on real characters: simulated trials of embedded characters (lock-step,
 // novice writer, several seeds) are recorded, and each trace's WS ticks are replayed through each
 // nearest-point method; a jump is a tick where the foot point on the active element moves more than
 // a threshold (1 mm) from the previous WS tick of the same stroke. Used by `calligraphy bench jumps`

@@ -77,7 +77,7 @@ std::vector<NearestPointQuery> queries_on(const StrokeElement& element, const Ve
 std::vector<NearestPointQuery> cusp_queries(int degree, int count, std::mt19937_64& random) {
   if (degree < 2) return {};
   // A quadratic whose middle control point is passed twice turns back at t = 0.5; the cubic
-  // (0,0),(30,30),(0,30),(30,0) mm has its cusp at t = 0.5 (REFERENCE.md section 5).
+  // (0,0),(30,30),(0,30),(30,0) mm has its cusp at t = 0.5 (B'(0.5) = 0).
   StrokeElement element = degree == 2 ? element_from(millimetres({{0, 0}, {30, 30}, {0, 0}}))
                                       : element_from(millimetres({{0, 0}, {30, 30}, {0, 30}, {30, 0}}));
   if (degree == 4) element = elevate(element);

@@ -1,6 +1,6 @@
 // Median polyline -> stroke elements (paper sections 3.3-3.4). First version: corners found by summed
-// turning over a window (REFERENCE.md section 2), straight pieces as LSEs, bent pieces as least-squares
-// Bezier CSEs, split at the worst point until within tolerance.
+// turning over a window (hanzi-writer-data rounds corners over 2-3 vertices), straight pieces as
+// LSEs, bent pieces as least-squares Bezier CSEs, split at the worst point until within tolerance.
 #include "calligraphy/model/fitting.hpp"
 
 #include <Eigen/Dense>

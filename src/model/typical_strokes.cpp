@@ -1,6 +1,7 @@
 // The table of the 39 typical strokes. IDs are part of the data format: never renumber.
-// Sources: GF 2001-2001 (25 turning strokes), the 6 flat strokes, Unicode CJK Strokes block,
-// REFERENCE.md section 3. Directions are degrees in the y-up data frame.
+// Sources: GF 2001-2001 (25 turning strokes), the 6 flat strokes, 8 common variants, and the Unicode
+// CJK Strokes block (U+31C0-U+31E5, Unicode 16) for acronyms and code points. Directions are degrees
+// in the y-up data frame.
 #include "calligraphy/model/typical_strokes.hpp"
 
 #include <array>

@@ -6,7 +6,7 @@
 /// to the global minimum only when it is nearer than the tracked one by more than
 /// `switch_hysteresis_m`. So the foot point does not flip between near-equal minima (a pen on the
 /// axis of a symmetric arc, near a self-crossing); it still jumps when another part of the curve
-/// becomes clearly nearer, which the force path must smooth (REFERENCE.md section 5).
+/// becomes clearly nearer (the pen crossed the curve's medial axis), which the force path must smooth.
 /// Behaviour and measurements: docs/nearest-point.md.
 
 #include "calligraphy/collision/nearest_point.hpp"

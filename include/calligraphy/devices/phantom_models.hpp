@@ -2,8 +2,8 @@
 /// \file phantom_models.hpp
 /// DeviceInfo of the Phantom family, SI units.
 /// Peak force, stiffness, damping and workspace radius: CHAI3D's per-model values (CPhantomDevices.cpp).
-/// Continuous force and workspace box: vendor datasheets as quoted in REFERENCE.md section 7 (not
-/// re-checked against the datasheets here).
+/// Continuous force and workspace box: the vendor's Phantom Omni and Desktop datasheets, as recalled
+/// (not re-checked against the datasheets here).
 
 #include "calligraphy/devices/haptic_device.hpp"
 

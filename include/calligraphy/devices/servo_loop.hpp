@@ -1,9 +1,9 @@
 #pragma once
 /// \file servo_loop.hpp
-/// The real-time servo loop (issue 5): a dedicated thread that, at a fixed rate with absolute deadlines,
+/// The real-time servo loop: a dedicated thread that, at a fixed rate with absolute deadlines,
 /// reads the device state, calls a callback that returns a force command, and writes the force
-/// (the paper runs its haptic loop at 1 kHz, section 6). The loop's structure follows libfranka's
-/// `Robot::control` callback loop and its `RealtimeConfig` {enforce, ignore} (REFERENCE.md section 7).
+/// (the paper runs its haptic loop at 1 kHz, sections 1 and 7). The loop's structure follows libfranka's
+/// `Robot::control` callback loop and its `RealtimeConfig` {enforce, ignore} (Franka Robotics' C++ client).
 ///
 /// Inside the loop nothing allocates, locks, logs synchronously or lets an exception escape: device
 /// faults and callback exceptions are caught on the loop thread, the force is zeroed, forces are

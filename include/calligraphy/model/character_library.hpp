@@ -1,7 +1,7 @@
 #pragma once
 /// \file character_library.hpp
 /// Loads hanzi-writer-data 2.0.1 characters (one `<char>.json` per character, `medians` in a 1024 box,
-/// y up; REFERENCE.md section 2) from the embedded default set or from a folder, such as the one
+/// y up, as documented by Make Me a Hanzi) from the embedded default set or from a folder, such as the one
 /// `scripts/fetch-hanzi-writer-data.sh` unpacks. Errors name the character, the path and the position.
 #include <filesystem>
 #include <memory>

@@ -18,10 +18,12 @@ struct FitOptions {
   /// A corner is a turn of at least this many degrees within `corner_window` along the median.
   double corner_angle_deg = 70.0;
   /// Arc length (data units) over which turning is summed when looking for corners; wider bends are
-  /// fitted as curves (REFERENCE.md section 2: resample, sum turning over +-48 units).
+  /// fitted as curves. Summed over a window because hanzi-writer-data rounds corners over 2-3 median
+  /// vertices; +-48 units worked in an experiment with scratch code outside this project.
   double corner_window = 48.0;
   /// Entry and exit brush hooks: an end segment shorter than this that turns more than 30 degrees is
-  /// trimmed (REFERENCE.md section 2: 16-32 units works).
+  /// trimmed (hanzi-writer-data medians keep the brush's entry and exit hooks; 16-32 units worked in
+  /// an experiment with scratch code outside this project).
   double hook_trim_length = 32.0;
   /// Highest Bezier degree used (2-4).
   int max_degree = 3;

@@ -2,9 +2,9 @@
 /// \file typical_strokes.hpp
 /// The 39 typical strokes (paper section 3.1, Fig. 7): every character is a sequence of these, each
 /// with an ID that never changes. The set is the 6 flat strokes and the 25 turning strokes of
-/// GF 2001-2001, plus 8 common variants (REFERENCE.md section 3). Acronyms and code points follow the
-/// Unicode CJK Strokes block (U+31C0-U+31E5) where one exists. `docs/typical-strokes.md` is generated
-/// from this table (`calligraphy strokes --markdown`).
+/// GF 2001-2001, plus 8 common variants (竖撇, 左点, 长点, 卧钩, 平撇, 提捺, 撇钩, 竖弯左).
+/// Acronyms and code points follow the Unicode CJK Strokes block (U+31C0-U+31E5) where one exists.
+/// `docs/typical-strokes.md` is generated from this table (`calligraphy strokes --markdown`).
 #include <limits>
 #include <optional>
 #include <span>
@@ -18,7 +18,7 @@ namespace calligraphy {
 /// Directions are the pen's direction of motion in degrees in the data's y-up frame (0 = right,
 /// 90 = up, -90 = down), measured on the piece's interior (10-40 % and 60-95 % of its length) so
 /// that brush entries and exits do not count. The nominal values are those of Kai-style medians:
-/// horizontals rise about 10 degrees, verticals lean (REFERENCE.md section 2).
+/// horizontals rise about 10 degrees, verticals lean (as in hanzi-writer-data's medians).
 struct StrokePieceTemplate {
   ElementKind kind;            ///< line where straight (start = end direction), bezier where bent
   double start_direction_deg;  ///< nominal direction at the piece's start

@@ -61,7 +61,7 @@ struct ForceLawParameters {
 [[nodiscard]] Vec3 paper_force(double tip_z_m, double paper_z_m, double stiffness_n_per_m) noexcept;
 
 /// Eq. (8) with the attracting sign: K_et a (X_S - X_p) [N], in the paper plane. As printed the paper's
-/// K_et (X_p - X_S) would push the tip away from the stroke (REFERENCE.md section 1).
+/// K_et (X_p - X_S) would push the tip away from the stroke (Wang, Zhang & Yao 2006, section 5).
 [[nodiscard]] Vec2 attraction_force(const Vec2& tip_m, const Vec2& foot_m, double stiffness_n_per_m,
                                     double attraction_factor) noexcept;
 

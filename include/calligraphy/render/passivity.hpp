@@ -1,6 +1,6 @@
 #pragma once
 /// \file passivity.hpp
-/// Passivity of the rendered force (issue 5; REFERENCE.md, stability section).
+/// Passivity of the rendered force: bounds and an energy check that keep the contact from injecting energy.
 ///  - `colgate_stiffness_bound`: a sampled virtual wall K with virtual damping B on a device with
 ///    physical damping b, held by a zero-order hold at period T, is passive when b > K T / 2 + |B|
 ///    (Colgate & Schenkel 1997), i.e. K < 2 (b - |B|) / T.

@@ -1,6 +1,6 @@
 #pragma once
 /// \file safety_chain.hpp
-/// The safety chain between the force law and the device (issue 5; paper section 6 names force steps
+/// The safety chain between the force law and the device (Wang, Zhang & Yao 2006, section 6, name force steps
 /// as a source of instability). A value type applied once per servo tick, in this order:
 ///   1. non-finite check: a NaN/Inf force gives zero force at once, sets `SafetyLimit::non_finite`
 ///      and is counted (the only stage allowed to step the force: an invalid force is never smoothed);

@@ -5,7 +5,7 @@
 /// and saturated at the device's maximum. Physics runs in substeps finer than the servo tick; the
 /// reported position is quantised to the encoder resolution and the velocity is a low-passed
 /// difference of reported positions, as on a real device. Deterministic; no wall clock.
-/// Model: m x'' = F_hand + F_device - b x' (REFERENCE.md section 8).
+/// Model: m x'' = F_hand + F_device - b x', a point mass with viscous damping.
 #include "calligraphy/devices/device_registry.hpp"
 #include "calligraphy/devices/haptic_device.hpp"
 #include "calligraphy/sim/hand_port.hpp"
@@ -13,7 +13,7 @@
 namespace calligraphy {
 
 /// CHAI3D's figures for the Phantom Desktop (max 7.9 N, 1000 N/m, 5 N s/m, 0.10 m) and the datasheet's
-/// continuous force 1.75 N and workspace 160 x 120 x 120 mm (REFERENCE.md section 7).
+/// continuous force 1.75 N and workspace 160 x 120 x 120 mm (the vendor's datasheet, as recalled).
 [[nodiscard]] DeviceInfo simulated_phantom_desktop_info();
 
 struct SimulatedDeviceParameters {

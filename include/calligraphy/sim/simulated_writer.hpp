@@ -1,12 +1,13 @@
 #pragma once
 /// \file simulated_writer.hpp
-/// A simulated writer for tests and experiments (REFERENCE.md section 8). It holds the stylus through
-/// a hand impedance F = k (x_d - x) + b (x_d' - x') + noise + tremor and moves x_d along its own copy of
-/// the reference strokes: minimum-jerk motion (Flash & Hogan 1985) per stroke element, pen lifts
-/// between strokes, pressing into the paper while writing. Its copy carries a systematic bias (an
-/// offset and a mis-scale of the character) so that guidance has work to do. It follows the display:
-/// it writes the stroke whose start is hinted (the active stroke), and when a stroke was not accepted
-/// it re-aims at the hint with less bias, up to a number of attempts. All randomness is seeded.
+/// A simulated writer for tests and experiments. It holds the stylus through a hand impedance
+/// F = k (x_d - x) + b (x_d' - x') + noise + tremor (the noise grows with the force, after Harris &
+/// Wolpert 1998) and moves x_d along its own copy of the reference strokes: minimum-jerk motion
+/// (Flash & Hogan 1985) per stroke element, pen lifts between strokes, pressing into the paper while
+/// writing. Its copy carries a systematic bias (an offset and a mis-scale of the character) so that
+/// guidance has work to do. It follows the display: it writes the stroke whose start is hinted (the
+/// active stroke), and when a stroke was not accepted it re-aims at the hint with less bias, up to a
+/// number of attempts. All randomness is seeded.
 #include <cstdint>
 #include <random>
 #include <string>
@@ -37,7 +38,7 @@ struct WriterProfile {
   double correction_per_attempt = 0.5;    ///< share of the bias removed on each re-aim after a miss
   int max_attempts_per_stroke = 3;
 
-  /// A relaxed learner with a visible bias (REFERENCE.md section 8: 150 N/m, 3 N s/m).
+  /// A relaxed learner with a visible bias (150 N/m, 3 N s/m: assumed grip figures, not measured).
   static WriterProfile novice();
   /// A stiffer, faster, nearly unbiased writer (600 N/m, 8 N s/m).
   static WriterProfile skilled();

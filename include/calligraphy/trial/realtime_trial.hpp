@@ -1,8 +1,8 @@
 #pragma once
 /// \file realtime_trial.hpp
 /// A guided writing trial in real time: the `Renderer` and a trial recorder run inside the `ServoLoop`
-/// callback at the loop's rate against any `HapticDevice` (issue 5, Deliver 1: "the trial runner gains
-/// a real-time mode on the loop beside the lock-step mode" of `run_simulated_trial`).
+/// callback at the loop's rate against any `HapticDevice`: the real-time counterpart of the lock-step
+/// `run_simulated_trial`, for a device that moves on its own clock.
 ///
 /// The loop never allocates for the trace: the recorder's trace is reserved (and touched) up front for
 /// max_duration_s x rate_hz ticks (`TrialRecorder::reserve`; memory: about 80 bytes per tick, 24 MB for

@@ -3,7 +3,7 @@
 /// Encoding of the Phantom Omni (FireWire) command and status packets.
 ///
 /// Source of the field list: the reverse-engineered protocol published by ytsutano/raw_omni (ISC) and
-/// scottsharris/phantom-drivers (LGPL-3), as summarised in REFERENCE.md section 7. That description
+/// scottsharris/phantom-drivers (LGPL-3), as described in those projects. That description
 /// names the fields and their sizes; it does not pin their order inside the status packet nor the byte
 /// order. The offsets and the byte order below are THIS LIBRARY'S CHOICE where the description is
 /// silent (marked "choice"); docs/devices.md lists them. Nothing here was checked against hardware.

@@ -1,6 +1,6 @@
 #pragma once
 // USB ids reported for the 3D Systems (Geomagic) Touch. UNCONFIRMED: they come from user reports
-// quoted in REFERENCE.md section 7, not from a vendor document or a device on this bench.
+// on public forums, not from a vendor document or a device on this bench.
 #include <array>
 #include <cstdint>
 
