@@ -64,7 +64,7 @@ TEST_CASE("The servo loop thread does not allocate while it renders and records"
   std::size_t transitions = 0;
   ServoLoopOptions options;
   options.lock_memory = false;
-  options.watchdog_periods = 0;
+  options.stall_timeout_s = 0.0;
   ServoLoop loop(
       device,
       [&](const DeviceState& state, double) {

@@ -66,6 +66,9 @@ nlohmann::json stats_json(const ServoLoopStats& s) {
           {"ticks", s.ticks},
           {"missed_deadlines", s.missed_deadlines},
           {"skipped_periods", s.skipped_periods},
+          {"forces_withheld", s.forces_withheld},
+          {"longest_stall_ms", s.longest_stall_s * 1e3},
+          {"deadline_reanchors", s.deadline_reanchors},
           {"period_jitter_us_p50", s.period_jitter_us_p50},
           {"period_jitter_us_p99", s.period_jitter_us_p99},
           {"period_jitter_us_max", s.period_jitter_us_max},
@@ -89,6 +92,9 @@ void print_stats(const ServoLoopStats& s, double seconds) {
   std::printf("  missed_deadlines       %llu (skipped periods %llu)\n",
               static_cast<unsigned long long>(s.missed_deadlines),
               static_cast<unsigned long long>(s.skipped_periods));
+  std::printf("  longest_stall_ms       %.3f (forces withheld %llu, deadlines re-anchored %llu)\n",
+              s.longest_stall_s * 1e3, static_cast<unsigned long long>(s.forces_withheld),
+              static_cast<unsigned long long>(s.deadline_reanchors));
   std::printf("  period_jitter_us_p50   %.1f\n", s.period_jitter_us_p50);
   std::printf("  period_jitter_us_p99   %.1f\n", s.period_jitter_us_p99);
   std::printf("  period_jitter_us_max   %.1f\n", s.period_jitter_us_max);
@@ -127,8 +133,9 @@ int command_bench_loop(const Args& args) {
     options.cpu = -1;
     options.lock_memory = false;
   }
-  // Off by default so that the whole run is measured; the worst lateness shows in wake_latency_us_max.
-  options.watchdog_periods = integer_option(arguments, "watchdog-periods", 0, 0, 1000000);
+  // The stall bound in periods; off by default so that the whole run is measured (the worst lateness
+  // shows in wake_latency_us_max and longest_stall).
+  options.stall_timeout_s = integer_option(arguments, "watchdog-periods", 0, 0, 1000000) / options.rate_hz;
 
   ServoLoopStats stats;
   nlohmann::json trial_json;

@@ -8,7 +8,6 @@
 #include <atomic>
 #include <cerrno>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <exception>
 #include <thread>
@@ -44,28 +43,53 @@ void sleep_until(std::int64_t deadline_ns) noexcept {
 }
 
 // What the loop thread logs; worded by `log_sink` on the drain thread.
-enum LogCode : std::uint16_t { kDeadlineMissed = 1, kWatchdog, kFault, kStopped };
+enum LogCode : std::uint16_t {
+  kDeadlineMissed = 1,
+  kWatchdog,
+  kFault,
+  kStopped,
+  kForceWithheld,
+  kStoppedGrid
+};
 
 void log_sink(const LogRecord& r) {
   switch (r.code) {
     case kDeadlineMissed:
-      spdlog::warn("servo loop: tick {} missed its deadline by {:.1f} us ({} missed so far)", r.count,
+      spdlog::warn("servo loop: tick {} missed its deadline by {:.1f} us ({} late so far)", r.count,
                    r.values[0], static_cast<std::uint64_t>(r.values[1]));
       break;
+    case kForceWithheld:
+      spdlog::warn("servo loop: tick {} withheld a force computed from a state {:.1f} us old ({} so far)",
+                   r.count, r.values[0], static_cast<std::uint64_t>(r.values[1]));
+      break;
     case kWatchdog:
-      spdlog::error("servo loop: watchdog: {}", r.text.data());
+      spdlog::error("servo loop: watchdog at tick {}: stall of {:.1f} ms: {}", r.count, r.values[0],
+                    r.text.data());
       break;
     case kFault:
       spdlog::error("servo loop: fault at tick {}: {}", r.count, r.text.data());
       break;
     case kStopped:
-      spdlog::info("servo loop: stopped after {} ticks, {} missed deadlines", r.count,
+      spdlog::info(
+          "servo loop: stopped after {} ticks: {} late ticks, longest stall {:.3f} ms, {} forces withheld",
+          r.count, static_cast<std::uint64_t>(r.values[0]), r.values[1],
+          static_cast<std::uint64_t>(r.values[2]));
+      break;
+    case kStoppedGrid:
+      spdlog::info("servo loop: deadlines re-anchored {} times, {} deadlines skipped", r.count,
                    static_cast<std::uint64_t>(r.values[0]));
       break;
     default:
       spdlog::debug("servo loop: log record {}", r.code);
   }
 }
+
+// True at the 1st, 2nd, 4th, 8th ... event: how often a recurring event is logged, so that a bad run
+// cannot flood the queue or the log.
+bool worth_logging(std::uint64_t count) noexcept { return (count & (count - 1)) == 0; }
+
+constexpr double kMaxForceAgeLimitS = 1.0;
+constexpr double kMaxStallTimeoutS = 60.0;
 
 constexpr std::size_t kFaultMessageBytes = 128;
 
@@ -104,9 +128,13 @@ void ServoLoopOptions::validate() const {
     throw InvalidArgument("ServoLoopOptions.cpu = " + std::to_string(cpu) +
                           " must be -1 or a CPU index below " + std::to_string(CPU_SETSIZE));
   }
-  if (watchdog_periods < 0) {
-    throw InvalidArgument("ServoLoopOptions.watchdog_periods = " + std::to_string(watchdog_periods) +
-                          " must be >= 0");
+  if (!(max_force_age_s > 0.0 && max_force_age_s <= kMaxForceAgeLimitS)) {
+    throw InvalidArgument("ServoLoopOptions.max_force_age_s = " + std::to_string(max_force_age_s) +
+                          " must be in (0, 1] s");
+  }
+  if (!(stall_timeout_s >= 0.0 && stall_timeout_s <= kMaxStallTimeoutS)) {
+    throw InvalidArgument("ServoLoopOptions.stall_timeout_s = " + std::to_string(stall_timeout_s) +
+                          " must be in [0, 60] s (0: no stall bound)");
   }
 }
 
@@ -117,15 +145,16 @@ struct ServoLoop::Impl {
       : device(d), callback(std::move(c)), options(o) {}
 
   void run() noexcept;
-  void record_fault(LoopFaultKind kind, const char* message, std::uint64_t tick) noexcept;
+  void record_fault(LoopFaultKind kind, const char* message, std::uint64_t tick,
+                    double stall_ms = 0.0) noexcept;
   void log(LogLevel level, std::uint16_t code, std::uint64_t count, double a = 0.0, double b = 0.0,
-           const char* text = nullptr) noexcept {
+           const char* text = nullptr, double c = 0.0) noexcept {
     LogRecord r;
     r.level = level;
     r.code = code;
     r.time_ns = monotonic_ns();
     r.count = count;
-    r.values = {a, b, 0.0};
+    r.values = {a, b, c};
     if (text != nullptr) r.set_text(text);
     log_queue.try_push(r);  // a full queue drops the record and counts it; the loop never waits
   }
@@ -147,7 +176,10 @@ struct ServoLoop::Impl {
 
   // Statistics: single writer (the loop thread), relaxed atomics for the readers.
   std::atomic<std::uint64_t> ticks{0};
-  std::atomic<std::uint64_t> missed{0};
+  std::atomic<std::uint64_t> late{0};
+  std::atomic<std::uint64_t> withheld{0};
+  std::atomic<std::int64_t> longest_stall_ns{0};
+  std::atomic<std::uint64_t> reanchors{0};
   std::atomic<std::uint64_t> skipped{0};
   std::atomic<std::uint64_t> wake_latency_max_ns{0};
   LatencyHistogram jitter{1000};        // 1 us bins
@@ -160,7 +192,10 @@ struct ServoLoop::Impl {
 
 void ServoLoop::Impl::reset_stats() noexcept {
   ticks.store(0, std::memory_order_relaxed);
-  missed.store(0, std::memory_order_relaxed);
+  late.store(0, std::memory_order_relaxed);
+  withheld.store(0, std::memory_order_relaxed);
+  longest_stall_ns.store(0, std::memory_order_relaxed);
+  reanchors.store(0, std::memory_order_relaxed);
   skipped.store(0, std::memory_order_relaxed);
   wake_latency_max_ns.store(0, std::memory_order_relaxed);
   jitter.clear();
@@ -170,7 +205,8 @@ void ServoLoop::Impl::reset_stats() noexcept {
   fault_exception = nullptr;
 }
 
-void ServoLoop::Impl::record_fault(LoopFaultKind kind, const char* message, std::uint64_t tick) noexcept {
+void ServoLoop::Impl::record_fault(LoopFaultKind kind, const char* message, std::uint64_t tick,
+                                   double stall_ms) noexcept {
   std::size_t i = 0;
   if (message != nullptr) {
     for (; i + 1 < kFaultMessageBytes && message[i] != '\0'; ++i)
@@ -178,7 +214,7 @@ void ServoLoop::Impl::record_fault(LoopFaultKind kind, const char* message, std:
   }
   fault_message[i].store('\0', std::memory_order_relaxed);
   fault_kind.store(static_cast<int>(kind), std::memory_order_release);
-  log(LogLevel::error, kind == LoopFaultKind::watchdog ? kWatchdog : kFault, tick, 0.0, 0.0, message);
+  log(LogLevel::error, kind == LoopFaultKind::watchdog ? kWatchdog : kFault, tick, stall_ms, 0.0, message);
 }
 
 LoopFault ServoLoop::Impl::fault() const {
@@ -193,18 +229,23 @@ LoopFault ServoLoop::Impl::fault() const {
   return f;
 }
 
-// The loop body. Deadlines are absolute, on a grid of whole periods from the start:
-// a late tick does not shift later ones. When a tick ends past the next deadline, the missed deadlines
-// are skipped (never run back to back), so the callback always sees dt close to a whole number of periods.
+// The loop body. Deadlines are absolute, on a grid of whole periods: a tick that is a little late does
+// not shift later ones. A tick that ends past the next deadline re-anchors the grid one period after
+// its own end, so missed ticks are never run back to back and the callback's dt stays about a period
+// after the first tick behind a stall. What a late tick writes: see ServoLoopOptions.
 void ServoLoop::Impl::run() noexcept {
   const std::int64_t period = options.period_ns();
   const double period_s = static_cast<double>(period) * 1e-9;
-  const std::int64_t watchdog_ns = static_cast<std::int64_t>(options.watchdog_periods) * period;
-  std::int64_t next = monotonic_ns() + period;
+  const std::int64_t max_force_age_ns = std::llround(options.max_force_age_s * 1e9);
+  const std::int64_t stall_limit_ns = std::llround(options.stall_timeout_s * 1e9);  // 0: no bound
+  const std::int64_t start = monotonic_ns();
+  std::int64_t next = start + period;
+  std::int64_t last_update = start;  // the last force update the device got (start: forces just enabled)
   std::int64_t previous_wake = 0;
   std::uint64_t tick = 0;
-  std::uint64_t missed_count = 0;
-  std::array<char, kFaultMessageBytes> reason{};
+  std::uint64_t late_count = 0;
+  std::uint64_t withheld_count = 0;
+  std::int64_t longest_stall = 0;
 
   while (!stop_requested.load(std::memory_order_acquire)) {
     sleep_until(next);
@@ -221,22 +262,31 @@ void ServoLoop::Impl::run() noexcept {
     previous_wake = wake;
 
     bool stop_after = false;
+    bool stalled = false;
+    std::int64_t stall = 0;
+    std::int64_t force_age = 0;
     try {
-      const DeviceState state = device.read_state();
+      const DeviceState state =
+          device.read_state();  // read at `wake`: the age of the state counts from there
       const std::int64_t call = monotonic_ns();
       const ServoCommand command = callback(state, dt_s);
       const std::int64_t returned = monotonic_ns();
       callback_time.add(returned - call);
-      if (watchdog_ns > 0 && returned - deadline > watchdog_ns) {
-        // The device has held the previous force for too long; the late command is not written.
-        std::snprintf(
-            reason.data(), reason.size(), "tick %llu ended %.1f periods after its deadline (limit %d)",
-            static_cast<unsigned long long>(tick),
-            static_cast<double>(returned - deadline) / static_cast<double>(period), options.watchdog_periods);
-        record_fault(LoopFaultKind::watchdog, reason.data(), tick);
-        break;
+      stall = returned - last_update - period;
+      force_age = returned - wake;
+      stalled = stall_limit_ns > 0 && stall > stall_limit_ns;
+      if (stalled || force_age > max_force_age_ns) {
+        // Zero force is passive whatever the state; a force computed from an old state on a stiff fixture
+        // is not (Colgate & Schenkel 1997).
+        device.write_force(Vec3::Zero());
+        withheld.store(++withheld_count, std::memory_order_relaxed);
+        if (!stalled && worth_logging(withheld_count)) {
+          log(LogLevel::warn, kForceWithheld, tick + 1, static_cast<double>(force_age) * 1e-3,
+              static_cast<double>(withheld_count));
+        }
+      } else {
+        device.write_force(command.force_n);
       }
-      device.write_force(command.force_n);
       stop_after = command.stop;
     } catch (const CommunicationError& e) {
       fault_exception = std::current_exception();
@@ -260,22 +310,31 @@ void ServoLoop::Impl::run() noexcept {
       break;
     }
     const std::int64_t written = monotonic_ns();
+    last_update = written;
     ticks.store(++tick, std::memory_order_relaxed);
+    if (stall > longest_stall) {
+      longest_stall = stall;
+      longest_stall_ns.store(stall, std::memory_order_relaxed);
+    }
     if (written > deadline) {
-      missed.store(++missed_count, std::memory_order_relaxed);
-      // Logged at the 1st, 2nd, 4th, 8th ... miss, so a bad run cannot flood the queue or the log.
-      if ((missed_count & (missed_count - 1)) == 0) {
+      late.store(++late_count, std::memory_order_relaxed);
+      if (worth_logging(late_count)) {
         log(LogLevel::warn, kDeadlineMissed, tick, static_cast<double>(written - deadline) * 1e-3,
-            static_cast<double>(missed_count));
+            static_cast<double>(late_count));
       }
+    }
+    if (stalled) {  // counted above like any tick; the run ends here with zero force written
+      record_fault(LoopFaultKind::watchdog, kStallFaultMessage, tick, static_cast<double>(stall) * 1e-6);
+      break;
     }
     if (stop_after) break;
     next += period;
-    if (written >= next) {  // behind: skip to the first deadline still ahead
-      const std::int64_t behind = (written - next) / period + 1;
-      next += behind * period;
-      skipped.store(skipped.load(std::memory_order_relaxed) + static_cast<std::uint64_t>(behind),
+    if (written >= next) {  // behind: the deadlines that passed are dropped and the grid restarts from now
+      const std::int64_t passed = (written - next) / period + 1;
+      next = written + period;
+      skipped.store(skipped.load(std::memory_order_relaxed) + static_cast<std::uint64_t>(passed),
                     std::memory_order_relaxed);
+      reanchors.store(reanchors.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
     }
   }
 
@@ -288,7 +347,10 @@ void ServoLoop::Impl::run() noexcept {
     device.enable_forces(false);
   } catch (...) {
   }
-  log(LogLevel::info, kStopped, tick, static_cast<double>(missed_count));
+  log(LogLevel::info, kStopped, tick, static_cast<double>(late_count),
+      static_cast<double>(longest_stall) * 1e-6, nullptr, static_cast<double>(withheld_count));
+  log(LogLevel::info, kStoppedGrid, reanchors.load(std::memory_order_relaxed),
+      static_cast<double>(skipped.load(std::memory_order_relaxed)));
   running.store(false, std::memory_order_release);
 }
 
@@ -376,7 +438,7 @@ void ServoLoop::wait() {
   const LoopFault f = m.fault();
   if (!f) return;
   if (m.fault_exception) std::rethrow_exception(m.fault_exception);
-  throw SafetyFault("servo loop watchdog: " + f.message);
+  throw SafetyFault(f.message);
 }
 
 bool ServoLoop::running() const noexcept { return impl_->running.load(std::memory_order_acquire); }
@@ -389,7 +451,11 @@ ServoLoopStats ServoLoop::stats() const {
   s.running = m.running.load(std::memory_order_acquire);
   s.rate_hz = m.options.rate_hz;
   s.ticks = m.ticks.load(std::memory_order_relaxed);
-  s.missed_deadlines = m.missed.load(std::memory_order_relaxed);
+  s.late_ticks = m.late.load(std::memory_order_relaxed);
+  s.missed_deadlines = s.late_ticks;
+  s.forces_withheld = m.withheld.load(std::memory_order_relaxed);
+  s.longest_stall_s = static_cast<double>(m.longest_stall_ns.load(std::memory_order_relaxed)) * 1e-9;
+  s.deadline_reanchors = m.reanchors.load(std::memory_order_relaxed);
   s.skipped_periods = m.skipped.load(std::memory_order_relaxed);
   s.period_jitter_us_p50 = m.jitter.quantile_ns(0.50) * 1e-3;
   s.period_jitter_us_p99 = m.jitter.quantile_ns(0.99) * 1e-3;

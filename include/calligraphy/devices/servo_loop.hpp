@@ -3,13 +3,18 @@
 /// The real-time servo loop: a dedicated thread that, at a fixed rate with absolute deadlines,
 /// reads the device state, calls a callback that returns a force command, and writes the force
 /// (the paper runs its haptic loop at 1 kHz, sections 1 and 7). The loop's structure follows libfranka's
-/// `Robot::control` callback loop and its `RealtimeConfig` {enforce, ignore} (Franka Robotics' C++ client).
+/// `Robot::control` callback loop and its `RealtimeConfig` {enforce, ignore}.
 ///
-/// Inside the loop nothing allocates, locks, logs synchronously or lets an exception escape: device
-/// faults and callback exceptions are caught on the loop thread, the force is zeroed, forces are
-/// disabled, the fault is recorded, the loop stops, and `wait()` rethrows it on the caller's thread.
-/// Statistics are atomics, readable from any thread while the loop runs. Log records go through a
-/// lock-free queue to a normal thread that calls spdlog. Linux only (clock_nanosleep, SCHED_FIFO).
+/// Late ticks do not end the loop: a force computed from a state older than `max_force_age_s` is
+/// replaced by zero force (a stale force on a stiff virtual fixture is what makes a sampled haptic loop
+/// active: Colgate & Schenkel 1997), and after a stall the deadlines are re-anchored to the present
+/// instead of being caught up. Only a stall longer than `stall_timeout_s` ends the run, safely.
+///
+/// Inside the loop nothing allocates, locks, logs synchronously, builds a string or lets an exception
+/// escape: device faults and callback exceptions are caught on the loop thread, the force is zeroed,
+/// forces are disabled, the fault is recorded, the loop stops, and `wait()` rethrows it on the caller's
+/// thread. Statistics are atomics, readable from any thread while the loop runs. Log records go through
+/// a lock-free queue to a normal thread that calls spdlog. Linux only (clock_nanosleep, SCHED_FIFO).
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -45,13 +50,21 @@ struct ServoLoopOptions {
   /// and not undone at stop. Unavailable in sanitizer builds (their shadow memory cannot be locked):
   /// there `enforce` throws and `ignore` records it as not obtained.
   bool lock_memory = true;
-  /// Watchdog: a tick whose force would be written more than this many periods after its deadline is
-  /// not written; zero force is commanded, forces are disabled, a `watchdog` fault is recorded and the
-  /// loop stops. 0 turns the watchdog off.
-  int watchdog_periods = 3;
+  /// Stale-force guard [s], in (0, 1]: the longest time from the start of a tick's `read_state` to the
+  /// return of its callback for which the callback's force is still written. A later tick (the thread
+  /// lost the CPU inside the tick) commands zero force instead, counts it in `forces_withheld`, and the
+  /// loop goes on. Default 2 ms, 2 periods at the default 1 kHz (docs/servo-loop.md gives the reasoning).
+  double max_force_age_s = 0.002;
+  /// Stall bound [s], in [0, 60]; 0 turns it off. A stall is the time the device held one force command
+  /// beyond one period (the gap between two successive force updates, less a period). A tick that ends a
+  /// stall longer than this ends the run: zero force, forces disabled, a `watchdog` fault with a fixed
+  /// message; the tick is counted. Checked when the loop thread runs again: a thread that never resumes
+  /// is a case for the device's own command watchdog. Default 50 ms, the Phantom backend's own command
+  /// watchdog. (The command line's `--watchdog-ms N` sets this to N / 1000.)
+  double stall_timeout_s = 0.050;
   bool enable_forces_on_start = true;  ///< `start()` calls `device.enable_forces(true)`
 
-  /// Throws InvalidArgument naming the field when a value is out of range.
+  /// Throws InvalidArgument naming the field, its value and its range when a value is out of range.
   void validate() const;
   [[nodiscard]] std::int64_t period_ns() const;
 };
@@ -70,7 +83,7 @@ using ServoCallback = std::function<ServoCommand(const DeviceState& state, doubl
 
 enum class LoopFaultKind {
   none,
-  watchdog,       ///< a tick overran by more than `watchdog_periods` periods
+  watchdog,       ///< a stall longer than `stall_timeout_s`
   communication,  ///< CommunicationError from the device
   safety,         ///< SafetyFault from the device or the callback
   device,         ///< another DeviceError
@@ -78,9 +91,14 @@ enum class LoopFaultKind {
 };
 [[nodiscard]] const char* to_string(LoopFaultKind kind) noexcept;
 
+/// The message of a `watchdog` fault (fixed: the loop builds no string; the numbers are in the statistics).
+inline constexpr const char* kStallFaultMessage =
+    "the servo loop stalled longer than stall_timeout_s; zero force commanded and forces disabled";
+
 struct LoopFault {
   LoopFaultKind kind = LoopFaultKind::none;
-  std::string message;  ///< the exception's what() (truncated to 127 bytes) or the watchdog's reason
+  /// The exception's what() (truncated to 127 bytes), or `kStallFaultMessage` for the watchdog.
+  std::string message;
   [[nodiscard]] explicit operator bool() const noexcept { return kind != LoopFaultKind::none; }
 };
 
@@ -106,9 +124,18 @@ struct HistogramBin {
 struct ServoLoopStats {
   bool running = false;
   double rate_hz = 0.0;
-  std::uint64_t ticks = 0;             ///< callbacks completed
-  std::uint64_t missed_deadlines = 0;  ///< ticks whose force was written after the next tick's start time
-  std::uint64_t skipped_periods = 0;   ///< periods left out to get back on the deadline grid
+  std::uint64_t ticks = 0;  ///< callbacks completed (the tick that tripped the stall bound included)
+  /// Ticks whose force update (the callback's force, or the zero force that replaced it) reached the
+  /// device after the next tick's start time; the tick that tripped the stall bound included.
+  std::uint64_t late_ticks = 0;
+  std::uint64_t missed_deadlines = 0;  ///< the same count as `late_ticks`, under its earlier name
+  std::uint64_t forces_withheld = 0;   ///< ticks that commanded zero force instead of a stale force
+  /// The longest time the device held one force command beyond one period [s] (see `stall_timeout_s`).
+  double longest_stall_s = 0.0;
+  /// Times the deadline grid was re-anchored to the present after a tick ended past the next deadline
+  /// (instead of running the missed ticks back to back).
+  std::uint64_t deadline_reanchors = 0;
+  std::uint64_t skipped_periods = 0;  ///< deadlines that passed without a tick
   /// Period jitter: |time between successive wake-ups - period| [us].
   double period_jitter_us_p50 = 0.0;
   double period_jitter_us_p99 = 0.0;
@@ -147,8 +174,9 @@ class ServoLoop {
   /// callback should return `ServoCommand::stop` instead).
   LoopFault stop() noexcept;
   /// Waits until the loop ends by itself (its callback asked to stop, or a fault) and joins it; then
-  /// rethrows the fault: the device's or the callback's own exception, or a SafetyFault for the
-  /// watchdog. Returns normally when the run ended without a fault. Blocks forever if nothing ends it.
+  /// rethrows the fault: the device's or the callback's own exception, or a SafetyFault for a stall
+  /// (`kStallFaultMessage`). Returns normally when the run ended without a fault. Blocks forever if
+  /// nothing ends it.
   void wait();
   /// True from `start()` until the loop thread has left its loop. Any thread.
   [[nodiscard]] bool running() const noexcept;

@@ -25,8 +25,9 @@ class HandPort {
   /// The hand holding the stylus (not owned; nullptr: nobody holds it).
   virtual void attach_hand(HandModel* hand) noexcept = 0;
   /// Lets `dt_s` seconds of device time pass [s] under the force held since the last `write_force`
-  /// and the hand's force. The next `read_state` reports the state after them.
-  virtual void advance(double dt_s) noexcept = 0;
+  /// and the hand's force. The next `read_state` reports the state after them. An implementation may
+  /// throw InvalidArgument for a negative or non-finite dt_s (the simulated device does).
+  virtual void advance(double dt_s) = 0;
 };
 
 }  // namespace calligraphy

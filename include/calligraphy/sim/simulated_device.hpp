@@ -5,7 +5,17 @@
 /// and saturated at the device's maximum. Physics runs in substeps finer than the servo tick; the
 /// reported position is quantised to the encoder resolution and the velocity is a low-passed
 /// difference of reported positions, as on a real device. Deterministic; no wall clock.
-/// Model: m x'' = F_hand + F_device - b x', a point mass with viscous damping.
+/// Model: m x'' = F_hand + F_device - b x' (a point-mass device with viscous damping, as in Colgate &
+/// Schenkel, "Passivity of a class of sampled-data systems: application to haptic interfaces", 1997).
+///
+/// Stability for any step: `advance(dt)` never takes a substep longer than
+/// min(1 / physics_rate_hz, m / b). Semi-implicit Euler on m v' = F - b v is stable for h b / m < 2, and
+/// at h <= m / b it is also monotone (no overshoot of the terminal velocity F / b). The hand is a black
+/// box to the device: its spring k_h and damper b_h need h < 2 sqrt(m / k_h) and h < 2 m / b_h, which the
+/// default 10 kHz physics rate gives for the simulated writers (k_h <= 600 N/m, b_h <= 8 N s/m) on any
+/// mass above 0.5 g; raise `physics_rate_hz` for a lighter device or a stiffer hand. At most
+/// `kMaxSubstepsPerAdvance` substeps are taken per call; the time left after them is integrated with the
+/// exact solution of the damped mass under the force held constant (see `advance`).
 #include "calligraphy/devices/device_registry.hpp"
 #include "calligraphy/devices/haptic_device.hpp"
 #include "calligraphy/sim/hand_port.hpp"
@@ -16,16 +26,25 @@ namespace calligraphy {
 /// continuous force 1.75 N and workspace 160 x 120 x 120 mm (the vendor's datasheet, as recalled).
 [[nodiscard]] DeviceInfo simulated_phantom_desktop_info();
 
+/// The simulated device's physics. Ranges are physical (a stylus, linkage and hand, not a crane or a
+/// dust grain) and checked by `validate()`.
 struct SimulatedDeviceParameters {
-  double moving_mass_kg = 0.2;                       ///< stylus, linkage and hand together [kg]
-  double damping_n_s_per_m = 0.5;                    ///< device viscous damping b [N s/m]
-  double encoder_resolution_m = 2.3e-5;              ///< position quantum (Desktop nominal 0.023 mm) [m]
-  double velocity_cutoff_hz = 50.0;                  ///< low-pass on the differenced velocity [Hz]
-  int physics_substeps = 10;                         ///< integration steps per `advance` call
+  double moving_mass_kg = 0.2;     ///< stylus, linkage and hand together [kg], in [1e-4, 1e3]
+  double damping_n_s_per_m = 0.5;  ///< device viscous damping b [N s/m], in [0, 1e4]
+  double encoder_resolution_m =
+      2.3e-5;                        ///< position quantum (Desktop nominal 0.023 mm) [m]; 0 or [1e-9, 1e-3]
+  double velocity_cutoff_hz = 50.0;  ///< low-pass on the differenced velocity [Hz], in (0, 1e6]
+  /// Least number of integration steps per `advance` call, in [1, 10000]. With the default 10 and a 1 kHz
+  /// servo tick the substep is 0.1 ms, exactly as before `physics_rate_hz` existed.
+  int physics_substeps = 10;
+  /// Least physics rate [Hz], in [1e3, 1e8]: no substep is longer than 1 / physics_rate_hz. 10 kHz is
+  /// the rate the simulated writer's hand spring was tuned at ("physics at >= 10 kHz").
+  double physics_rate_hz = 10000.0;
   Vec3 initial_position_m = Vec3(0.0, -0.05, 0.02);  ///< where the stylus starts [m]
   DeviceInfo info = simulated_phantom_desktop_info();
 
-  /// Throws InvalidArgument when a value is out of range.
+  /// Throws InvalidArgument naming the parameter, its value and its range when a value is out of range
+  /// or not finite.
   void validate() const;
 };
 
@@ -35,8 +54,18 @@ class SimulatedDevice final : public HapticDevice, public HandPort {
 
   /// The hand moving the stylus (not owned; nullptr for a free device).
   void attach_hand(HandModel* hand) noexcept override { hand_ = hand; }
-  /// Integrates the physics over `dt_s` seconds with the force held since the last `write_force`.
-  void advance(double dt_s) noexcept override;
+  /// Integrates the physics over `dt_s` seconds [s] with the force held since the last `write_force`.
+  /// Any finite dt_s >= 0 is integrated stably: n = max(physics_substeps, ceil(dt_s / h_max)) semi-implicit
+  /// Euler substeps of dt_s / n, h_max = min(1 / physics_rate_hz, m / b), at most
+  /// `kMaxSubstepsPerAdvance` of them; the time left after those (only when dt_s exceeds
+  /// kMaxSubstepsPerAdvance x h_max, e.g. 20 s at the defaults) follows the exact solution of
+  /// m x'' = F - b x' with F the commanded force plus the hand's force at the start of that interval,
+  /// held constant. Throws InvalidArgument when dt_s is negative or not finite (the state is unchanged),
+  /// or when the exact interval would take the state out of the range of a double (the state is then
+  /// left after the substeps already taken).
+  void advance(double dt_s) override;
+  /// The most substeps one `advance` call takes (bounds its cost: about 10 ms of CPU without a hand).
+  static constexpr long kMaxSubstepsPerAdvance = 200'000;
 
   [[nodiscard]] const DeviceInfo& info() const override { return parameters_.info; }
   void open() override { open_ = true; }
@@ -67,6 +96,8 @@ class SimulatedDevice final : public HapticDevice, public HandPort {
   Vec3 reported_velocity_ = Vec3::Zero();
   double last_read_time_ = 0.0;
   bool read_before_ = false;
+
+  void integrate_exactly(double duration_s);
 };
 
 /// Registers a `SimulatedDevice` with default parameters as "simulated" in `registry`; nothing when a
