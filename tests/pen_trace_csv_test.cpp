@@ -93,6 +93,9 @@ TEST_CASE("Malformed traces name the source, line and column", "[pen_trace_csv]"
   CHECK_THROWS_WITH(
       parse_pen_trace_csv("t,x,y,pen\n0,0,0,1\n0.1,0,nan,1\n", "a.csv", p),
       Catch::Contains("a.csv:3") && Catch::Contains("column 3 (y)") && Catch::Contains("finite"));
+  CHECK_THROWS_WITH(
+      parse_pen_trace_csv("t,x,y,pen\n0,1e400,0,1\n", "a.csv", p),
+      Catch::Contains("a.csv:2") && Catch::Contains("column 2 (x)") && Catch::Contains("range"));
   CHECK_THROWS_WITH(parse_pen_trace_csv("t,x,y,pen\n0,0,0,2\n", "a.csv", p),
                     Catch::Contains("a.csv:2") && Catch::Contains("column 4 (pen)"));
   CHECK_THROWS_WITH(

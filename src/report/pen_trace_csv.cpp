@@ -112,8 +112,10 @@ class Reader {
     const std::string_view field = fields[column];
     double value = 0.0;
     const auto [end, error] = std::from_chars(field.data(), field.data() + field.size(), value);
-    if (field.empty() || error != std::errc() || end != field.data() + field.size())
+    if (error == std::errc::result_out_of_range) fail(column, field, "out of the range of a double");
+    if (field.empty() || error != std::errc() || end != field.data() + field.size()) {
       fail(column, field, "not a number");
+    }
     if (!std::isfinite(value)) fail(column, field, "not a finite number");
     return value;
   }
