@@ -179,6 +179,24 @@ TEST_CASE("Two minimum-jerk movements one after the other have two velocity peak
   CHECK(stroke_kinematics(t_slow, p_slow).velocity_peaks == 2);
 }
 
+TEST_CASE("Kinematics stay bounded for extreme timestamps", "[metrics]") {
+  // 100,000 samples 1000 s apart, and 100,000 samples within 1 us: the grid is bounded by the sample count
+  // and the filter's resolution, so both return finite values.
+  std::vector<double> t;
+  std::vector<Vec2> p;
+  for (int i = 0; i < 100'000; ++i) {
+    t.push_back(1000.0 * i);
+    p.emplace_back(1e-4 * std::sin(0.001 * i), 1e-4 * i);
+  }
+  const StrokeKinematics slow = stroke_kinematics(t, p);
+  CHECK(std::isfinite(slow.normalised_jerk));
+  CHECK(slow.velocity_peaks >= 1);
+  for (std::size_t i = 0; i < t.size(); ++i) t[i] = 1e-11 * static_cast<double>(i);
+  const StrokeKinematics fast = stroke_kinematics(t, p);
+  CHECK(std::isfinite(fast.normalised_jerk));
+  CHECK(fast.velocity_peaks == 1);  // the whole movement lies within one filter width: one bump
+}
+
 TEST_CASE("Kinematics reject bad samples, naming the index", "[metrics]") {
   std::vector<double> t{0.0, 0.1, 0.05};
   std::vector<Vec2> p{{0.0, 0.0}, {0.01, 0.0}, {0.02, 0.0}};

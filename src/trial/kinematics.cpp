@@ -11,6 +11,8 @@
 namespace calligraphy {
 namespace {
 
+constexpr double kGridPointsPerInterval = 16.0;
+
 void check_samples(std::span<const double> times_s, std::span<const Vec2> positions_m) {
   if (times_s.size() != positions_m.size()) {
     throw InvalidArgument("stroke_kinematics: " + std::to_string(times_s.size()) + " times but " +
@@ -122,13 +124,19 @@ StrokeKinematics stroke_kinematics(std::span<const double> times_s, std::span<co
 
   const bool filtered = options.low_pass_cutoff_hz > 0.0;
   const double sigma_s = filtered ? gaussian_sigma_s(options.low_pass_cutoff_hz) : 0.0;
-  // The mean sampling interval, at most sigma / 4 so that the kernel is resolved.
-  double step_s = k.writing_time_s / static_cast<double>(times_s.size() - 1);
-  if (filtered) step_s = std::min(step_s, sigma_s / 4.0);
-  const double intervals =
-      std::min(std::ceil(k.writing_time_s / step_s), static_cast<double>(options.max_grid_points - 1));
+  // The grid step: the mean sampling interval, kept within [sigma / 16, sigma / 4] when filtering so that
+  // the kernel is resolved by 9 to 129 taps. The grid is capped at kGridPointsPerInterval points per
+  // sampling interval and at max_grid_points (the step grows instead), which bounds the work by the
+  // number of samples whatever the timestamps.
+  const double sample_count = static_cast<double>(times_s.size());
+  double step_s = k.writing_time_s / (sample_count - 1.0);
+  if (filtered) step_s = std::clamp(step_s, sigma_s / 16.0, sigma_s / 4.0);
+  const double needed = std::max(1.0, std::ceil(k.writing_time_s / step_s));
+  const double intervals = std::min({needed, static_cast<double>(options.max_grid_points - 1),
+                                     kGridPointsPerInterval * (sample_count - 1.0)});
+  if (intervals < needed) step_s = k.writing_time_s / intervals;
+  // The grid covers [t0, t0 + intervals * step], at least the samples' span; later points hold the end.
   const auto count = static_cast<std::size_t>(intervals) + 1;
-  step_s = k.writing_time_s / intervals;
   // Rest before and after: as far as the kernel spreads the movement, plus the stencils' reach.
   const std::size_t padding =
       (filtered ? static_cast<std::size_t>(std::ceil(4.0 * sigma_s / step_s)) : 0) + 3;

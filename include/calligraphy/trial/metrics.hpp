@@ -147,7 +147,8 @@ struct StrokeKinematics {
 };
 
 /// Kinematics of a stroke from its samples. The samples are linearly interpolated on a uniform time grid
-/// (the mean sampling interval, finer when needed to resolve the filter, at most max_grid_points points),
+/// (step: the mean sampling interval, kept within [sigma / 16, sigma / 4] of the filter; at most 16 grid
+/// points per sampling interval and max_grid_points in all, so the work is bounded by the sample count),
 /// extended at both ends by the pen resting at its first and last position, low-pass filtered, and
 /// differentiated by central differences (speed: first, jerk: third); the jerk integral runs over the
 /// extended grid. Throws InvalidArgument when the spans differ in size, hold fewer than 2 samples, hold a
