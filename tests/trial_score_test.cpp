@@ -238,9 +238,28 @@ TEST_CASE("A bad trace is refused, naming the sample", "[score]") {
   std::vector<PenSample> not_finite = trace.samples;
   not_finite[3].position_m.y() = NAN;
   CHECK_THROWS_WITH(score_trace(yong, not_finite), Catch::Contains("sample 3"));
+  std::vector<PenSample> far = trace.samples;
+  far[4].position_m.x() = 1e305;  // finite in metres, not in data units
+  CHECK_THROWS_WITH(score_trace(yong, far), Catch::Contains("sample 4"));
   ScoreOptions options;
   options.leniency = 0.0;
   CHECK_THROWS_AS(score_trace(yong, trace.samples, options), InvalidArgument);
+  PlacedCharacter hollow = yong;
+  hollow.strokes[2].elements.clear();
+  CHECK_THROWS_WITH(score_trace(hollow, trace.samples), Catch::Contains("stroke 2"));
+}
+
+TEST_CASE("A pen held still is ignored, even without a minimum length", "[score]") {
+  const PlacedCharacter& yong = scene_of(U'永').characters.front();
+  TraceBuilder trace;
+  for (int i = 0; i < 50; ++i) trace.add(yong.strokes[0].start(), true);
+  ScoreOptions options;
+  options.min_segment_length_m = 0.0;
+  const CharacterScore score = score_trace(yong, trace.samples, options);
+  CHECK(score.ignored_segments == 1);
+  CHECK(score.strokes_written == 0);
+  CHECK(score.totals.writing_time_s == Approx(0.049));
+  CHECK_FALSE(score.totals.normalised_jerk);
 }
 
 TEST_CASE("Leniency scales how far a stroke may stray", "[score]") {

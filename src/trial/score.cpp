@@ -105,6 +105,18 @@ CharacterScore score_trace(const PlacedCharacter& character, std::span<const Pen
     throw InvalidArgument("score_trace: character " + character_name(character.code_point) +
                           " has no stroke");
   }
+  const Placement& placement = character.placement;
+  if (!placement.origin_m.allFinite() || !std::isfinite(placement.metres_per_unit) ||
+      !(placement.metres_per_unit > 0.0)) {
+    throw InvalidArgument("score_trace: character " + character_name(character.code_point) +
+                          " has a placement that is not finite with a positive scale");
+  }
+  for (std::size_t r = 0; r < character.strokes.size(); ++r) {
+    if (character.strokes[r].elements.empty()) {
+      throw InvalidArgument("score_trace: stroke " + std::to_string(r) + " of character " +
+                            character_name(character.code_point) + " has no element");
+    }
+  }
   validate_pen_trace(trace);
 
   CharacterScore score;
@@ -135,7 +147,11 @@ CharacterScore score_trace(const PlacedCharacter& character, std::span<const Pen
     for (std::size_t i = segment.begin; i < segment.end; ++i) {
       t.push_back(trace[i].time_s);
       p.push_back(trace[i].position_m);
-      data.push_back(character.placement.to_data(trace[i].position_m));
+      data.push_back(placement.to_data(trace[i].position_m));
+      if (!data.back().allFinite()) {
+        throw InvalidArgument("score_trace: sample " + std::to_string(i) +
+                              " is too far away to convert to data units");
+      }
     }
     segment.kinematics = stroke_kinematics(t, p, options.metrics.kinematics);
     scored.push_back(k);

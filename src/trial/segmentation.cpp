@@ -39,7 +39,8 @@ std::vector<WrittenSegment> pen_down_segments(std::span<const PenSample> trace, 
       length += (trace[i].position_m - trace[i - 1].position_m).norm();
     segment.end = i;
     const bool spans_time = trace[segment.end - 1].time_s > trace[segment.begin].time_s;
-    segment.ignored = segment.end - segment.begin < min_samples || length < min_length_m || !spans_time;
+    const bool moves = length > 0.0 && length >= min_length_m;
+    segment.ignored = segment.end - segment.begin < min_samples || !moves || !spans_time;
     segments.push_back(segment);
   }
   return segments;

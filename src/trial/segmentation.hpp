@@ -8,7 +8,8 @@
 namespace calligraphy::trial_detail {
 
 /// Every maximal run of pen-down samples, in order, with `ignored` set for runs with fewer than
-/// `min_samples` samples, a path shorter than `min_length_m` or no time span. Other fields left empty.
+/// `min_samples` samples, a path shorter than `min_length_m` (or of
+/// zero length) or no time span. Other fields left empty.
 std::vector<WrittenSegment> pen_down_segments(std::span<const PenSample> trace, std::size_t min_samples,
                                               double min_length_m);
 

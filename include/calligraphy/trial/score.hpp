@@ -30,7 +30,7 @@ struct WrittenSegment {
   std::size_t begin = 0;  ///< first sample index in the trace
   std::size_t end = 0;    ///< one past the last
   /// Too short to be a stroke (fewer than ScoreOptions::min_segment_samples samples, a path shorter than
-  /// min_segment_length_m, or no time span): counted, but neither matched nor scored.
+  /// min_segment_length_m or of zero length, or no time span): counted, but neither matched nor scored.
   bool ignored = false;
   std::optional<std::size_t> matched_stroke;   ///< reference stroke index, when matched
   bool backwards = false;                      ///< matched with its samples reversed
@@ -81,8 +81,9 @@ struct CharacterScore {
 /// Scores `trace` against `character`. Segments are matched one to one to reference strokes: among the
 /// pairs that pass the Hanzi Writer tests (forwards, else backwards), as many pairs as possible, and
 /// among those the least sum of mean distances (an optimal assignment, Kuhn 1955 / Munkres 1957). Throws
-/// InvalidArgument for a bad trace (see validate_pen_trace), a character without strokes or options out
-/// of range.
+/// InvalidArgument for a bad trace (see validate_pen_trace, and positions too large to convert to data
+/// units), a character without strokes, a stroke without elements, a placement that is not finite with a
+/// positive scale, or options out of range.
 CharacterScore score_trace(const PlacedCharacter& character, std::span<const PenSample> trace,
                            const ScoreOptions& options = {});
 
