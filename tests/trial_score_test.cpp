@@ -195,7 +195,6 @@ TEST_CASE("Strokes of another character are not matched", "[score]") {
   REQUIRE(kou.placement.origin_m == yong.placement.origin_m);  // same box on the paper
   const TraceBuilder trace = written_in_order(kou, {0, 1, 2}, 0.05e-3);
   const CharacterScore score = score_trace(yong, trace.samples);
-  WARN("matched " << score.strokes_written << " unmatched " << score.unmatched_strokes);
   CHECK(score.unmatched_strokes + score.strokes_written == 3);
   CHECK(score.unmatched_strokes > 0);
   CHECK(score.missing_strokes.size() == 5 - score.strokes_written);
