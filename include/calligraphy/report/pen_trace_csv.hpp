@@ -1,0 +1,52 @@
+#pragma once
+/// \file pen_trace_csv.hpp
+/// Reading a pen trace from CSV for `score_trace` (trial/score.hpp).
+///
+/// Format: comma-separated, one header line naming the columns, then one sample a line. Columns are found
+/// by header name (others are ignored, order is free): `t` time [s], `x` and `y` the pen tip, and either
+/// `pen` (1 = touching the paper, 0 = lifted) or `z`, the height of the tip above the paper [m] (the pen
+/// touches when z <= the contact threshold). Blank lines and lines starting with `#` are skipped; a line
+/// may end in CR LF; fields may be padded with spaces; no quoting. Times must not decrease.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/trial/score.hpp"
+
+namespace calligraphy {
+
+/// Units of the x and y columns.
+enum class TraceUnits {
+  metres,  ///< the paper plane of the character's placement [m], as a Scene places it
+  data,    ///< the character's 1024-unit data box, y up; converted with its Placement
+};
+
+/// Parses "metres" or "data". Throws InvalidArgument naming the value otherwise.
+TraceUnits parse_trace_units(std::string_view name);
+
+/// Options of the reader.
+struct PenTraceCsvOptions {
+  TraceUnits units = TraceUnits::metres;
+  /// With a `z` column: the pen touches the paper when z <= this [m]. 0.5 mm allows for the tracking noise
+  /// of a desktop haptic device above a virtual paper plane (a choice). Finite.
+  double contact_threshold_m = 0.5e-3;
+  std::uintmax_t max_file_bytes = std::uintmax_t{256} << 20;  ///< larger files are refused (256 MiB)
+};
+
+/// Parses CSV text. `source` names the text in errors; `placement` converts data units to metres. Throws
+/// DataError naming source:line, the column (number and name) and the value for a missing or duplicate
+/// column, a row with the wrong number of fields, a value that is not a finite number (or not 0/1 for
+/// `pen`), or a time below the previous one; InvalidArgument for bad options.
+std::vector<PenSample> parse_pen_trace_csv(std::string_view text, const std::string& source,
+                                           const Placement& placement,
+                                           const PenTraceCsvOptions& options = {});
+
+/// Reads and parses a CSV file. Throws DataError naming the file when it does not exist, is not a regular
+/// file, is larger than options.max_file_bytes or cannot be read, and as `parse_pen_trace_csv`.
+std::vector<PenSample> read_pen_trace_csv(const std::filesystem::path& file, const Placement& placement,
+                                          const PenTraceCsvOptions& options = {});
+
+}  // namespace calligraphy

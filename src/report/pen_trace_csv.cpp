@@ -1,0 +1,199 @@
+#include "calligraphy/report/pen_trace_csv.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <optional>
+#include <system_error>
+
+#include "calligraphy/core/errors.hpp"
+
+namespace calligraphy {
+namespace {
+
+std::string_view trimmed(std::string_view s) {
+  const auto first = s.find_first_not_of(" \t");
+  if (first == std::string_view::npos) return {};
+  const auto last = s.find_last_not_of(" \t");
+  return s.substr(first, last - first + 1);
+}
+
+std::vector<std::string_view> fields_of(std::string_view line) {
+  std::vector<std::string_view> fields;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = line.find(',', start);
+    fields.push_back(trimmed(
+        line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start)));
+    if (comma == std::string_view::npos) return fields;
+    start = comma + 1;
+  }
+}
+
+// Where the columns are (0-based field numbers).
+struct Columns {
+  std::size_t count = 0;
+  std::size_t t = 0, x = 0, y = 0;
+  std::optional<std::size_t> pen;
+  std::optional<std::size_t> z;
+};
+
+class Reader {
+ public:
+  Reader(const std::string& source, const Placement& placement, const PenTraceCsvOptions& options)
+      : source_(source), placement_(placement), options_(options) {}
+
+  std::vector<PenSample> parse(std::string_view text) {
+    std::vector<PenSample> samples;
+    std::optional<Columns> columns;
+    std::size_t line_start = 0;
+    while (line_start < text.size()) {
+      const std::size_t newline = text.find('\n', line_start);
+      std::string_view line = text.substr(
+          line_start, newline == std::string_view::npos ? std::string_view::npos : newline - line_start);
+      line_start = newline == std::string_view::npos ? text.size() : newline + 1;
+      ++line_number_;
+      if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+      if (trimmed(line).empty() || trimmed(line).front() == '#') continue;
+      const std::vector<std::string_view> fields = fields_of(line);
+      if (!columns) {
+        columns = header(fields);
+        header_ = fields;
+        continue;
+      }
+      samples.push_back(row(fields, *columns));
+      if (samples.size() > 1 && samples.back().time_s < samples[samples.size() - 2].time_s) {
+        fail(columns->t, fields[columns->t],
+             "time goes backwards (previous sample at " + std::to_string(samples[samples.size() - 2].time_s) +
+                 " s)");
+      }
+    }
+    if (!columns) throw DataError(source_ + ": no header line (expected columns t, x, y and pen or z)");
+    return samples;
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& what) const {
+    throw DataError(source_ + ":" + std::to_string(line_number_) + ": " + what);
+  }
+  [[noreturn]] void fail(std::size_t column, std::string_view value, const std::string& what) const {
+    fail("column " + std::to_string(column + 1) + " (" + std::string(header_[column]) + "), value '" +
+         std::string(value) + "': " + what);
+  }
+
+  Columns header(const std::vector<std::string_view>& names) {
+    Columns c;
+    c.count = names.size();
+    std::optional<std::size_t> t, x, y;
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      for (std::size_t j = 0; j < i; ++j) {
+        if (!names[i].empty() && names[i] == names[j])
+          fail("column name '" + std::string(names[i]) + "' appears twice");
+      }
+      if (names[i] == "t") t = i;
+      if (names[i] == "x") x = i;
+      if (names[i] == "y") y = i;
+      if (names[i] == "pen") c.pen = i;
+      if (names[i] == "z") c.z = i;
+    }
+    for (const auto& [column, name] : {std::pair{t, "t"}, std::pair{x, "x"}, std::pair{y, "y"}}) {
+      if (!column) fail(std::string("header has no column '") + name + "' (expected t, x, y and pen or z)");
+    }
+    if (!c.pen && !c.z) fail("header has neither a 'pen' nor a 'z' column");
+    if (c.pen && c.z)
+      fail("header has both 'pen' and 'z' columns; give one, so that pen contact is unambiguous");
+    c.t = *t;
+    c.x = *x;
+    c.y = *y;
+    return c;
+  }
+
+  double number(const std::vector<std::string_view>& fields, std::size_t column) const {
+    const std::string_view field = fields[column];
+    double value = 0.0;
+    const auto [end, error] = std::from_chars(field.data(), field.data() + field.size(), value);
+    if (error == std::errc::result_out_of_range) fail(column, field, "out of the range of a double");
+    if (field.empty() || error != std::errc() || end != field.data() + field.size()) {
+      fail(column, field, "not a number");
+    }
+    if (!std::isfinite(value)) fail(column, field, "not a finite number");
+    return value;
+  }
+
+  PenSample row(const std::vector<std::string_view>& fields, const Columns& c) const {
+    if (fields.size() != c.count) {
+      fail(std::to_string(fields.size()) + " fields, the header has " + std::to_string(c.count));
+    }
+    PenSample s;
+    s.time_s = number(fields, c.t);
+    const Vec2 xy(number(fields, c.x), number(fields, c.y));
+    s.position_m = options_.units == TraceUnits::data ? placement_.to_paper(xy) : xy;
+    if (!s.position_m.allFinite()) fail(c.x, fields[c.x], "not finite once converted to metres");
+    if (c.pen) {
+      const std::string_view pen = fields[*c.pen];
+      if (pen != "0" && pen != "1") fail(*c.pen, pen, "pen must be 1 (down) or 0 (up)");
+      s.pen_down = pen == "1";
+    } else {
+      s.pen_down = number(fields, *c.z) <= options_.contact_threshold_m;
+    }
+    return s;
+  }
+
+  const std::string& source_;
+  const Placement& placement_;
+  const PenTraceCsvOptions& options_;
+  std::size_t line_number_ = 0;
+  std::vector<std::string_view> header_;
+};
+
+void check_options(const PenTraceCsvOptions& options, const Placement& placement) {
+  if (!std::isfinite(options.contact_threshold_m)) {
+    throw InvalidArgument("PenTraceCsvOptions: contact threshold " +
+                          std::to_string(options.contact_threshold_m) + " m is not finite");
+  }
+  if (options.max_file_bytes == 0) throw InvalidArgument("PenTraceCsvOptions: max_file_bytes is 0");
+  if (options.units == TraceUnits::data &&
+      (!placement.origin_m.allFinite() || !std::isfinite(placement.metres_per_unit) ||
+       !(placement.metres_per_unit > 0.0))) {
+    throw InvalidArgument("parse_pen_trace_csv: the placement (" + std::to_string(placement.metres_per_unit) +
+                          " m per unit) cannot convert data units to metres");
+  }
+}
+
+}  // namespace
+
+TraceUnits parse_trace_units(std::string_view name) {
+  if (name == "metres") return TraceUnits::metres;
+  if (name == "data") return TraceUnits::data;
+  throw InvalidArgument("trace units '" + std::string(name) + "' are neither 'metres' nor 'data'");
+}
+
+std::vector<PenSample> parse_pen_trace_csv(std::string_view text, const std::string& source,
+                                           const Placement& placement, const PenTraceCsvOptions& options) {
+  check_options(options, placement);
+  return Reader(source, placement, options).parse(text);
+}
+
+std::vector<PenSample> read_pen_trace_csv(const std::filesystem::path& file, const Placement& placement,
+                                          const PenTraceCsvOptions& options) {
+  check_options(options, placement);
+  const std::string name = file.string();
+  std::error_code error;
+  const auto status = std::filesystem::status(file, error);
+  if (error || !std::filesystem::exists(status)) throw DataError(name + ": no such file");
+  if (!std::filesystem::is_regular_file(status)) throw DataError(name + ": not a regular file");
+  const std::uintmax_t size = std::filesystem::file_size(file, error);
+  if (error) throw DataError(name + ": cannot read its size (" + error.message() + ")");
+  if (size > options.max_file_bytes) {
+    throw DataError(name + ": " + std::to_string(size) + " bytes, more than the limit of " +
+                    std::to_string(options.max_file_bytes));
+  }
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw DataError(name + ": cannot be opened");
+  std::string text(static_cast<std::size_t>(size), '\0');
+  in.read(text.data(), static_cast<std::streamsize>(size));
+  if (static_cast<std::uintmax_t>(in.gcount()) != size) throw DataError(name + ": could not be read whole");
+  return Reader(name, placement, options).parse(text);
+}
+
+}  // namespace calligraphy

@@ -1,0 +1,65 @@
+#include "trial/input_checks.hpp"
+
+#include <cmath>
+#include <string>
+
+#include "calligraphy/core/errors.hpp"
+
+namespace calligraphy::trial_detail {
+
+void require_finite_points(std::span<const Vec2> points, const char* function, const char* argument) {
+  if (points.empty()) throw InvalidArgument(std::string(function) + ": " + argument + " has no point");
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!points[i].allFinite()) {
+      throw InvalidArgument(std::string(function) + ": point " + std::to_string(i) + " of " + argument +
+                            " is not finite");
+    }
+  }
+}
+
+void require_bounded_cells(std::size_t rows, std::size_t columns, const char* function) {
+  // rows > kMaxCurveCells / columns avoids the overflow of rows * columns.
+  if (columns != 0 && rows > kMaxCurveCells / columns) {
+    throw InvalidArgument(std::string(function) + ": " + std::to_string(rows) + " x " +
+                          std::to_string(columns) + " points exceed the bound of " +
+                          std::to_string(kMaxCurveCells) +
+                          " cells; resample the curves first (compare_curves does)");
+  }
+}
+
+void require_valid_options(const KinematicsOptions& options) {
+  if (!std::isfinite(options.low_pass_cutoff_hz) || options.low_pass_cutoff_hz < 0.0) {
+    throw InvalidArgument("KinematicsOptions: low-pass cut-off " +
+                          std::to_string(options.low_pass_cutoff_hz) + " Hz is not finite and >= 0");
+  }
+  if (!(options.peak_prominence > 0.0 && options.peak_prominence < 1.0)) {
+    throw InvalidArgument("KinematicsOptions: peak prominence " + std::to_string(options.peak_prominence) +
+                          " is outside (0, 1)");
+  }
+  if (options.max_grid_points < 16) {
+    throw InvalidArgument("KinematicsOptions: max_grid_points " + std::to_string(options.max_grid_points) +
+                          " is below 16");
+  }
+}
+
+void require_valid_options(const CurveComparisonOptions& options) {
+  if (!std::isfinite(options.reference_step_m) || options.reference_step_m <= 0.0) {
+    throw InvalidArgument("CurveComparisonOptions: reference step " +
+                          std::to_string(options.reference_step_m) + " m is not a finite length > 0");
+  }
+  if (options.max_points < 2 || options.max_points > 4096) {
+    throw InvalidArgument("CurveComparisonOptions: max_points " + std::to_string(options.max_points) +
+                          " is outside 2..4096");
+  }
+}
+
+void require_valid_options(const MetricsOptions& options) {
+  if (!std::isfinite(options.tube_radius_m) || options.tube_radius_m < 0.0) {
+    throw InvalidArgument("MetricsOptions: tube radius " + std::to_string(options.tube_radius_m) +
+                          " m is not a finite length >= 0");
+  }
+  require_valid_options(options.curves);
+  require_valid_options(options.kinematics);
+}
+
+}  // namespace calligraphy::trial_detail

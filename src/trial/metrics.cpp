@@ -1,0 +1,24 @@
+#include "calligraphy/trial/metrics.hpp"
+
+#include <string>
+
+#include "calligraphy/core/errors.hpp"
+
+namespace calligraphy {
+
+StrokeWritingMetrics stroke_writing_metrics(std::span<const double> times_s,
+                                            std::span<const Vec2> positions_m,
+                                            std::span<const StrokeElement> reference_m,
+                                            const MetricsOptions& options, bool reference_reversed) {
+  if (times_s.size() != positions_m.size()) {
+    throw InvalidArgument("stroke_writing_metrics: " + std::to_string(times_s.size()) + " times but " +
+                          std::to_string(positions_m.size()) + " positions");
+  }
+  StrokeWritingMetrics m;
+  m.kinematics = stroke_kinematics(times_s, positions_m, options.kinematics);
+  m.deviation = deviation_summary(positions_m, reference_m, options.tube_radius_m);
+  m.curves = compare_curves(positions_m, reference_m, options.curves, reference_reversed);
+  return m;
+}
+
+}  // namespace calligraphy

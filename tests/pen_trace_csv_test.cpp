@@ -1,0 +1,132 @@
+#include "calligraphy/report/pen_trace_csv.hpp"
+
+#include <unistd.h>
+
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "calligraphy/core/errors.hpp"
+
+using namespace calligraphy;
+
+namespace {
+
+Placement test_placement() {
+  Placement p;
+  p.origin_m = Vec2(-0.03, -0.0225);
+  p.metres_per_unit = 0.06 / 1024.0;
+  return p;
+}
+
+// A file in a folder of its own under the temporary directory, removed with the folder.
+struct TemporaryFile {
+  std::filesystem::path folder;
+  std::filesystem::path path;
+  explicit TemporaryFile(const std::string& text, const std::string& name = "trace.csv") {
+    static int made = 0;  // unique within the process; the process id makes it unique across processes
+    folder = std::filesystem::temp_directory_path() /
+             ("calligraphy_pen_trace_csv_" + std::to_string(::getpid()) + "_" + std::to_string(made++));
+    std::filesystem::create_directories(folder);
+    path = folder / name;
+    std::ofstream(path, std::ios::binary) << text;
+  }
+  ~TemporaryFile() {
+    std::error_code ignored;
+    std::filesystem::remove_all(folder, ignored);
+  }
+};
+
+}  // namespace
+
+TEST_CASE("A metres trace with a pen column is read by header name", "[pen_trace_csv]") {
+  const std::string text =
+      "# recorded at 1 kHz\r\n"
+      "y, t ,pen,x,force\r\n"
+      "0.002,0.000,0,0.001,9\r\n"
+      "\r\n"
+      "0.003,0.001,1,0.0015,9\r\n"
+      "0.004,0.001,1,0.002,9\r\n";
+  const auto samples = parse_pen_trace_csv(text, "inline", test_placement());
+  REQUIRE(samples.size() == 3);
+  CHECK(samples[0].time_s == 0.0);
+  CHECK(samples[0].position_m == Vec2(0.001, 0.002));
+  CHECK_FALSE(samples[0].pen_down);
+  CHECK(samples[1].pen_down);
+  CHECK(samples[2].time_s == 0.001);  // equal times are allowed
+  CHECK(samples[2].position_m == Vec2(0.002, 0.004));
+}
+
+TEST_CASE("A z column sets pen contact by the threshold", "[pen_trace_csv]") {
+  const std::string text = "t,x,y,z\n0,0,0,0.0004\n0.001,0,0,0.0005\n0.002,0,0,0.0006\n0.003,0,0,-0.001\n";
+  const auto samples = parse_pen_trace_csv(text, "inline", test_placement());
+  REQUIRE(samples.size() == 4);
+  CHECK(samples[0].pen_down);
+  CHECK(samples[1].pen_down);  // z <= 0.5 mm
+  CHECK_FALSE(samples[2].pen_down);
+  CHECK(samples[3].pen_down);  // below the paper plane: pressing
+  PenTraceCsvOptions strict;
+  strict.contact_threshold_m = 0.0;
+  CHECK_FALSE(parse_pen_trace_csv(text, "inline", test_placement(), strict)[0].pen_down);
+}
+
+TEST_CASE("Data units are converted with the placement", "[pen_trace_csv]") {
+  PenTraceCsvOptions options;
+  options.units = TraceUnits::data;
+  const Placement placement = test_placement();
+  const auto samples =
+      parse_pen_trace_csv("t,x,y,pen\n0,512,388,1\n0.1,0,900,1\n", "inline", placement, options);
+  REQUIRE(samples.size() == 2);
+  CHECK(samples[0].position_m.isApprox(placement.to_paper(Vec2(512.0, 388.0))));
+  CHECK(samples[1].position_m.isApprox(placement.origin_m + Vec2(0.0, 900.0 * 0.06 / 1024.0)));
+  CHECK(parse_trace_units("data") == TraceUnits::data);
+  CHECK(parse_trace_units("metres") == TraceUnits::metres);
+  CHECK_THROWS_WITH(parse_trace_units("mm"), Catch::Contains("'mm'"));
+}
+
+TEST_CASE("Malformed traces name the source, line and column", "[pen_trace_csv]") {
+  const Placement p = test_placement();
+  CHECK_THROWS_WITH(
+      parse_pen_trace_csv("t,x,y,pen\n0,0,0,1\n0.1,abc,0,1\n", "a.csv", p),
+      Catch::Contains("a.csv:3") && Catch::Contains("column 2 (x)") && Catch::Contains("'abc'"));
+  CHECK_THROWS_WITH(
+      parse_pen_trace_csv("t,x,y,pen\n0,0,0,1\n0.1,0,nan,1\n", "a.csv", p),
+      Catch::Contains("a.csv:3") && Catch::Contains("column 3 (y)") && Catch::Contains("finite"));
+  CHECK_THROWS_WITH(
+      parse_pen_trace_csv("t,x,y,pen\n0,1e400,0,1\n", "a.csv", p),
+      Catch::Contains("a.csv:2") && Catch::Contains("column 2 (x)") && Catch::Contains("range"));
+  CHECK_THROWS_WITH(parse_pen_trace_csv("t,x,y,pen\n0,0,0,2\n", "a.csv", p),
+                    Catch::Contains("a.csv:2") && Catch::Contains("column 4 (pen)"));
+  CHECK_THROWS_WITH(
+      parse_pen_trace_csv("t,x,y,pen\n0.2,0,0,1\n0.1,0,0,1\n", "a.csv", p),
+      Catch::Contains("a.csv:3") && Catch::Contains("column 1 (t)") && Catch::Contains("backwards"));
+  CHECK_THROWS_WITH(parse_pen_trace_csv("t,x,y,pen\n0,0,0\n", "a.csv", p),
+                    Catch::Contains("a.csv:2") && Catch::Contains("3 fields"));
+  CHECK_THROWS_WITH(parse_pen_trace_csv("t,x,pen\n0,0,1\n", "a.csv", p), Catch::Contains("'y'"));
+  CHECK_THROWS_WITH(parse_pen_trace_csv("t,x,y\n0,0,0\n", "a.csv", p), Catch::Contains("neither"));
+  CHECK_THROWS_WITH(parse_pen_trace_csv("t,x,y,pen,z\n", "a.csv", p), Catch::Contains("both"));
+  CHECK_THROWS_WITH(parse_pen_trace_csv("t,x,x,y,pen\n", "a.csv", p), Catch::Contains("twice"));
+  CHECK_THROWS_WITH(parse_pen_trace_csv("# only a comment\n", "a.csv", p), Catch::Contains("no header"));
+  CHECK_THROWS_AS(parse_pen_trace_csv("t,x,y,pen\n0,\"1\",0,1\n", "a.csv", p), DataError);
+  // Header only: an empty trace.
+  CHECK(parse_pen_trace_csv("t,x,y,pen\n", "a.csv", p).empty());
+}
+
+TEST_CASE("Files are read whole, regular and bounded in size", "[pen_trace_csv]") {
+  const std::string text = "t,x,y,pen\n0,0.001,0.002,1\n0.001,0.002,0.002,1\n";
+  const TemporaryFile file(text);
+  const auto samples = read_pen_trace_csv(file.path, test_placement());
+  REQUIRE(samples.size() == 2);
+  CHECK(samples[1].position_m == Vec2(0.002, 0.002));
+  PenTraceCsvOptions small;
+  small.max_file_bytes = text.size() - 1;
+  CHECK_THROWS_WITH(read_pen_trace_csv(file.path, test_placement(), small),
+                    Catch::Contains(file.path.string()) && Catch::Contains("limit"));
+  CHECK_THROWS_WITH(read_pen_trace_csv(file.folder, test_placement()), Catch::Contains("not a regular file"));
+  CHECK_THROWS_WITH(read_pen_trace_csv(file.folder / "missing.csv", test_placement()),
+                    Catch::Contains("missing.csv") && Catch::Contains("no such file"));
+  const TemporaryFile bad("t,x,y,pen\n0,0,0,1\n0.1,0,0,yes\n", "bad.csv");
+  CHECK_THROWS_WITH(read_pen_trace_csv(bad.path, test_placement()),
+                    Catch::Contains("bad.csv:3") && Catch::Contains("column 4 (pen)"));
+}

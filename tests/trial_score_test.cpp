@@ -1,0 +1,289 @@
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <vector>
+
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/trial/score.hpp"
+
+using namespace calligraphy;
+
+namespace {
+
+const Scene& scene_of(char32_t c) {
+  static std::map<char32_t, Scene> scenes;
+  auto it = scenes.find(c);
+  if (it == scenes.end())
+    it = scenes.emplace(c, Scene::lay_out({CharacterLibrary::embedded().load(c)})).first;
+  return it->second;
+}
+
+// The stroke as points `spacing_m` apart along its elements, each moved `offset_m` along the left normal
+// of the polyline (the direction 90 degrees counter-clockwise from the writing direction).
+std::vector<Vec2> stroke_points(const PlacedStroke& stroke, double spacing_m, double offset_m = 0.0) {
+  std::vector<Vec2> points = reference_polyline_m(stroke.elements, spacing_m, 4096);
+  const double length = stroke.length_m();
+  if (length / spacing_m > 4095.0) {
+    points = resample_by_arc_length(points, static_cast<std::size_t>(std::ceil(length / spacing_m)) + 1);
+  }
+  if (offset_m == 0.0) return points;
+  std::vector<Vec2> moved(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Vec2 tangent =
+        (points[std::min(i + 1, points.size() - 1)] - points[i == 0 ? 0 : i - 1]).normalized();
+    moved[i] = points[i] + offset_m * Vec2(-tangent.y(), tangent.x());
+  }
+  return moved;
+}
+
+// A trace at 1 kHz: strokes written with the pen down, pen-up travel between them.
+struct TraceBuilder {
+  std::vector<PenSample> samples;
+  double time_s = 0.0;
+
+  void add(const Vec2& p, bool down) {
+    samples.push_back({time_s, p, down});
+    time_s += 1e-3;
+  }
+  void write(const std::vector<Vec2>& points) {
+    if (!samples.empty()) travel_to(points.front());
+    for (const Vec2& p : points) add(p, true);
+  }
+  void travel_to(const Vec2& to, std::size_t steps = 200) {
+    const Vec2 from = samples.back().position_m;
+    for (std::size_t k = 1; k <= steps; ++k)
+      add(from + (to - from) * (static_cast<double>(k) / (static_cast<double>(steps) + 1.0)), false);
+  }
+};
+
+TraceBuilder written_in_order(const PlacedCharacter& c, const std::vector<std::size_t>& order,
+                              double spacing_m, double offset_m = 0.0) {
+  TraceBuilder trace;
+  for (const std::size_t s : order) trace.write(stroke_points(c.strokes[s], spacing_m, offset_m));
+  return trace;
+}
+
+const std::vector<std::size_t> kYongOrder{0, 1, 2, 3, 4};
+
+}  // namespace
+
+TEST_CASE("The reference itself, densely sampled, scores as perfect", "[score]") {
+  const PlacedCharacter& yong = scene_of(U'永').characters.front();
+  REQUIRE(yong.strokes.size() == 5);
+  const TraceBuilder trace = written_in_order(yong, kYongOrder, 0.02e-3);
+  const CharacterScore score = score_trace(yong, trace.samples);
+  CHECK(score.strokes_written == 5);
+  CHECK(score.missing_strokes.empty());
+  CHECK(score.unmatched_strokes == 0);
+  CHECK(score.order_errors == 0);
+  CHECK(score.backwards_strokes == 0);
+  CHECK(score.strokes_in_order);
+  CHECK(score.completed_in_order);
+  CHECK(score.totals.pen_lifts == 4);
+  const double step = ScoreOptions{}.metrics.curves.reference_step_m;
+  for (const StrokeScore& s : score.strokes) {
+    INFO("stroke " << s.index);
+    REQUIRE(s.metrics);
+    CHECK(s.segment == s.index);
+    CHECK(s.metrics->deviation.max_m < 5e-6);  // the chords of the dense polyline: below 5 um
+    // Discrete Frechet: a written point between two reference points is up to half a step from both.
+    CHECK(s.metrics->curves.frechet_m <= step / 2 + 5e-6);
+    CHECK(s.metrics->curves.dtw_m <= s.metrics->curves.frechet_m);
+    CHECK(s.metrics->kinematics.mean_speed_m_per_s == Approx(0.02).epsilon(0.01));  // 0.02 mm per ms
+  }
+  REQUIRE(score.totals.deviation);
+  CHECK(score.totals.deviation->mean_m < 5e-6);
+  CHECK(score.totals.deviation->outside_tube_share == 0.0);
+}
+
+TEST_CASE("The reference moved 1 mm sideways deviates by 1 mm", "[score]") {
+  const PlacedCharacter& yong = scene_of(U'永').characters.front();
+  const double offset = 1e-3;
+  for (const double side : {1.0, -1.0}) {
+    const TraceBuilder trace = written_in_order(yong, kYongOrder, 0.02e-3, side * offset);
+    const CharacterScore score = score_trace(yong, trace.samples);
+    INFO("side " << side);
+    CHECK(score.strokes_written == 5);
+    CHECK(score.completed_in_order);
+    const double step = ScoreOptions{}.metrics.curves.reference_step_m;
+    for (const StrokeScore& s : score.strokes) {
+      INFO("stroke " << s.index);
+      REQUIRE(s.metrics);
+      // Every point is 1 mm from its foot, so no deviation exceeds 1 mm (to the chord error of the
+      // sampled reference, below 5 um). Inside a corner or a hook the other leg is nearer: that lowers the
+      // mean, by up to 6 % for the hook of stroke 1, so the mean is checked within 10 % below.
+      CHECK(s.metrics->deviation.max_m <= offset + 5e-6);
+      CHECK(s.metrics->deviation.mean_m <= offset + 5e-6);
+      CHECK(s.metrics->deviation.mean_m >= 0.9 * offset);
+      // Frechet: the first points are coupled (1 mm apart); coupling every written point with the reference
+      // point nearest its foot along the stroke (at most step / 2 from the foot) gives <= 1 mm + step / 2.
+      CHECK(s.metrics->curves.frechet_m >= offset * (1 - 1e-6));
+      CHECK(s.metrics->curves.frechet_m <= offset + step / 2 + 5e-6);
+      CHECK(s.metrics->curves.dtw_m <= offset + step / 2 + 5e-6);
+    }
+    REQUIRE(score.totals.deviation);
+    CHECK(score.totals.deviation->mean_m <= offset + 5e-6);
+    CHECK(score.totals.deviation->mean_m >= 0.9 * offset);
+    CHECK(*score.totals.frechet_m >= offset * (1 - 1e-6));
+  }
+}
+
+TEST_CASE("A stroke written from its end is matched backwards", "[score]") {
+  const PlacedCharacter& yong = scene_of(U'永').characters.front();
+  TraceBuilder trace;
+  for (const std::size_t s : kYongOrder) {
+    std::vector<Vec2> points = stroke_points(yong.strokes[s], 0.05e-3);
+    if (s == 3) std::reverse(points.begin(), points.end());
+    trace.write(points);
+  }
+  const CharacterScore score = score_trace(yong, trace.samples);
+  CHECK(score.strokes_written == 5);
+  CHECK(score.backwards_strokes == 1);
+  CHECK(score.strokes[3].backwards);
+  CHECK(score.segments[3].backwards);
+  CHECK(score.order_errors == 0);
+  // Shape is measured against the stroke traversed the way it was written.
+  REQUIRE(score.strokes[3].metrics);
+  CHECK(score.strokes[3].metrics->curves.frechet_m < 0.1e-3);
+}
+
+TEST_CASE("Two swapped strokes make one order error", "[score]") {
+  const PlacedCharacter& yong = scene_of(U'永').characters.front();
+  const TraceBuilder trace = written_in_order(yong, {0, 2, 1, 3, 4}, 0.05e-3);
+  const CharacterScore score = score_trace(yong, trace.samples);
+  CHECK(score.strokes_written == 5);
+  CHECK(score.order_errors == 1);
+  CHECK_FALSE(score.strokes_in_order);
+  CHECK_FALSE(score.completed_in_order);
+  CHECK(score.strokes[1].segment == 2u);
+  CHECK(score.strokes[2].segment == 1u);
+  // Written last to first: every pair inverted, 5 * 4 / 2.
+  CHECK(score_trace(yong, written_in_order(yong, {4, 3, 2, 1, 0}, 0.05e-3).samples).order_errors == 10);
+}
+
+TEST_CASE("A lifted pen is counted, with its time in the air", "[score]") {
+  const PlacedCharacter& yong = scene_of(U'永').characters.front();
+  TraceBuilder trace;
+  for (const std::size_t s : kYongOrder) {
+    const std::vector<Vec2> points = stroke_points(yong.strokes[s], 0.05e-3);
+    if (s != 1) {
+      trace.write(points);
+      continue;
+    }
+    // Stroke 1 with the pen lifted for 100 samples at 80 % of its points (moving on in the air).
+    const std::size_t lift = points.size() * 8 / 10;
+    trace.write(std::vector<Vec2>(points.begin(), points.begin() + static_cast<std::ptrdiff_t>(lift)));
+    for (std::size_t i = lift; i < lift + 100; ++i) trace.add(points[i], false);
+    for (std::size_t i = lift + 100; i < points.size(); ++i) trace.add(points[i], true);
+  }
+  const CharacterScore score = score_trace(yong, trace.samples);
+  const CharacterScore clean = score_trace(yong, written_in_order(yong, kYongOrder, 0.05e-3).samples);
+  CHECK(score.segments.size() == 6);
+  CHECK(score.totals.pen_lifts == clean.totals.pen_lifts + 1);
+  // 100 samples up: the gap from the last sample down to the next down is 101 ms.
+  CHECK(score.totals.in_air_time_s - clean.totals.in_air_time_s == Approx(0.101).margin(1e-9));
+  CHECK(score.totals.total_time_s == Approx(score.totals.writing_time_s + score.totals.in_air_time_s));
+  CHECK(score.strokes_written + score.missing_strokes.size() == 5);
+}
+
+TEST_CASE("Strokes of another character are not matched", "[score]") {
+  const PlacedCharacter& yong = scene_of(U'永').characters.front();
+  const PlacedCharacter& kou = scene_of(U'口').characters.front();
+  REQUIRE(kou.placement.origin_m == yong.placement.origin_m);  // same box on the paper
+  const TraceBuilder trace = written_in_order(kou, {0, 1, 2}, 0.05e-3);
+  const CharacterScore score = score_trace(yong, trace.samples);
+  CHECK(score.unmatched_strokes + score.strokes_written == 3);
+  CHECK(score.unmatched_strokes > 0);
+  CHECK(score.missing_strokes.size() == 5 - score.strokes_written);
+  CHECK_FALSE(score.completed_in_order);
+  for (const std::size_t missing : score.missing_strokes) {
+    CHECK_FALSE(score.strokes[missing].written);
+    CHECK_FALSE(score.strokes[missing].metrics);  // absent, not 0
+  }
+}
+
+TEST_CASE("Unwritten strokes are missing and short taps are ignored", "[score]") {
+  const PlacedCharacter& yong = scene_of(U'永').characters.front();
+  TraceBuilder trace = written_in_order(yong, {0, 1}, 0.05e-3);
+  trace.travel_to({0.0, 0.0});
+  trace.add({0.0, 0.0}, true);  // a tap of 2 samples
+  trace.add({0.0, 0.0001}, true);
+  const CharacterScore score = score_trace(yong, trace.samples);
+  CHECK(score.strokes_written == 2);
+  CHECK(score.missing_strokes == std::vector<std::size_t>{2, 3, 4});
+  CHECK(score.ignored_segments == 1);
+  CHECK(score.unmatched_strokes == 0);
+  CHECK(score.totals.pen_lifts == 2);
+  CHECK(score.strokes_in_order);
+  CHECK_FALSE(score.completed_in_order);
+  CHECK_FALSE(score.strokes[4].metrics);
+  // Nothing written: no spatial totals at all.
+  const CharacterScore empty = score_trace(yong, {});
+  CHECK(empty.missing_strokes.size() == 5);
+  CHECK_FALSE(empty.totals.deviation);
+  CHECK_FALSE(empty.totals.frechet_m);
+  CHECK_FALSE(empty.strokes_in_order);
+}
+
+TEST_CASE("A bad trace is refused, naming the sample", "[score]") {
+  const PlacedCharacter& yong = scene_of(U'永').characters.front();
+  TraceBuilder trace = written_in_order(yong, {0}, 0.05e-3);
+  std::vector<PenSample> backwards = trace.samples;
+  backwards[7].time_s = backwards[5].time_s - 1e-3;
+  CHECK_THROWS_WITH(score_trace(yong, backwards), Catch::Contains("sample 7"));
+  std::vector<PenSample> not_finite = trace.samples;
+  not_finite[3].position_m.y() = NAN;
+  CHECK_THROWS_WITH(score_trace(yong, not_finite), Catch::Contains("sample 3"));
+  std::vector<PenSample> far = trace.samples;
+  far[4].position_m.x() = 1e305;  // finite in metres, not in data units
+  CHECK_THROWS_WITH(score_trace(yong, far), Catch::Contains("sample 4"));
+  ScoreOptions options;
+  options.leniency = 0.0;
+  CHECK_THROWS_AS(score_trace(yong, trace.samples, options), InvalidArgument);
+  PlacedCharacter hollow = yong;
+  hollow.strokes[2].elements.clear();
+  CHECK_THROWS_WITH(score_trace(hollow, trace.samples), Catch::Contains("stroke 2"));
+}
+
+TEST_CASE("A pen held still is ignored, even without a minimum length", "[score]") {
+  const PlacedCharacter& yong = scene_of(U'永').characters.front();
+  TraceBuilder trace;
+  for (int i = 0; i < 50; ++i) trace.add(yong.strokes[0].start(), true);
+  ScoreOptions options;
+  options.min_segment_length_m = 0.0;
+  const CharacterScore score = score_trace(yong, trace.samples, options);
+  CHECK(score.ignored_segments == 1);
+  CHECK(score.strokes_written == 0);
+  CHECK(score.totals.writing_time_s == Approx(0.049));
+  CHECK_FALSE(score.totals.normalised_jerk);
+}
+
+TEST_CASE("Leniency scales how far a stroke may stray", "[score]") {
+  const PlacedCharacter& yong = scene_of(U'永').characters.front();
+  // 8 mm beside the model: 137 data units, within Hanzi Writer's mean distance of 175 at leniency 1, not
+  // within 175 x 0.5.
+  const TraceBuilder trace = written_in_order(yong, {3}, 0.05e-3, 8e-3);
+  ScoreOptions strict;
+  strict.leniency = 0.5;
+  CHECK(score_trace(yong, trace.samples, strict).strokes_written == 0);
+  CHECK(score_trace(yong, trace.samples).strokes[3].written);
+}
+
+TEST_CASE("Scoring a 5-stroke trace of about 15,000 samples (timing printed)", "[.][score_timing]") {
+  const PlacedCharacter& yong = scene_of(U'永').characters.front();
+  // 0.01 mm apart at 1 kHz (10 mm/s, slow brush writing), 0.3 mm beside the model; then 1.5 um apart
+  // (about 100,000 samples).
+  for (const double spacing : {0.01e-3, 0.0015e-3}) {
+    const TraceBuilder trace = written_in_order(yong, kYongOrder, spacing, 0.3e-3);
+    for (int run = 0; run < 3; ++run) {
+      const auto start = std::chrono::steady_clock::now();
+      const CharacterScore score = score_trace(yong, trace.samples);
+      const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
+      WARN(trace.samples.size() << " samples scored in " << took.count() * 1e3 << " ms");
+      CHECK(score.strokes_written == 5);
+    }
+  }
+}
