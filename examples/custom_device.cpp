@@ -1,17 +1,17 @@
 // How an application plugs in its own haptic device: implement calligraphy::HapticDevice (SI units,
 // device frame x right, y away from the writer, z up), optionally register it by name, and run a
-// guided trial on it with run_device_trial, the same loop the Phantom backends use.
+// guided trial on it with run_trial, the same loop the Phantom backends use.
 //
 // The device here is a toy: a 0.1 kg puck on a voice-coil stage with viscous friction, 0.05 mm
 // encoders and a 2 N amplifier. Because it is simulated, it also implements HandPort, so the
 // library's simulated writer can hold it and the trial runs lock-step (deterministic, much faster than
-// real time). A real device would implement HapticDevice only: run_device_trial then paces the ticks
+// real time). A real device would implement HapticDevice only: run_trial then paces the ticks
 // by the wall clock and the person holding the device writes.
 #include <calligraphy/core/errors.hpp>
 #include <calligraphy/devices/device_registry.hpp>
 #include <calligraphy/model/character_library.hpp>
 #include <calligraphy/sim/hand_port.hpp>
-#include <calligraphy/trial/device_trial.hpp>
+#include <calligraphy/trial/trial.hpp>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -94,15 +94,15 @@ class VoiceCoilPuck final : public calligraphy::HapticDevice, public calligraphy
 
 int main() {
   using namespace calligraphy;
-  // Registering is optional (run_device_trial also takes the device itself); a registered device is
+  // Registering is optional (run_trial also takes the device itself); a registered device is
   // listed by `device_registry().survey()` and opened by name, like the built-in ones.
   device_registry().register_device("voice-coil-puck", VoiceCoilPuck{}.info(),
                                     [] { return std::make_unique<VoiceCoilPuck>(); });
 
   const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'口')});
-  DeviceTrialOptions options;  // 1 kHz, novice writer, guidance on
-  options.seed = 1;
-  const TrialResult result = run_device_trial("voice-coil-puck", scene, options);
+  TrialOptions options;  // 1 kHz, novice writer, guidance on
+  options.simulation.seed = 1;
+  const TrialResult result = run_trial("voice-coil-puck", scene, options);
 
   const TrialMetrics& m = result.metrics;
   std::printf(

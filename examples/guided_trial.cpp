@@ -12,7 +12,7 @@ int main() {
 
   TrialOptions options;                              // 1 kHz, simulated Phantom Desktop, novice writer
   options.force.guidance_stiffness_n_per_m = 400.0;  // K_et [N/m], eq. (8)
-  options.seed = 1;
+  options.simulation.seed = 1;
   const TrialResult result = run_simulated_trial(scene, options);
 
   const TrialMetrics& m = result.metrics;

@@ -1,7 +1,5 @@
-// Trials on any device through run_device_trial: the emulated Phantom end to end, a disconnect and a
+// Trials on any device through run_trial: the emulated Phantom end to end, a disconnect and a
 // safety fault in the middle of a trial, real-time pacing on the ServoLoop for devices without a hand port.
-#include "calligraphy/trial/device_trial.hpp"
-
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <chrono>
@@ -11,6 +9,7 @@
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/report/trial_report.hpp"
 #include "calligraphy/testing/emulated_phantom.hpp"
+#include "calligraphy/trial/trial.hpp"
 #include "sim/testing/phantom_emulator.hpp"
 
 using namespace calligraphy;
@@ -106,7 +105,7 @@ TEST_CASE("A trial of 永 runs end to end on the emulated Phantom through the Ph
   const Scene scene = scene_of(U"永");
   EmulatedPhantomDevice device(phantom::phantom_omni_config(),
                                undocking_emulator(phantom::phantom_omni_config()));
-  const TrialResult result = run_device_trial(device, scene, DeviceTrialOptions{});
+  const TrialResult result = run_trial(device, scene, TrialOptions{});
   CHECK_FALSE(result.aborted);
   CHECK(result.abort_reason.empty());
   CHECK(result.metrics.strokes_total == 5);
@@ -132,11 +131,11 @@ TEST_CASE("Lock-step trials on the emulated Phantom are deterministic for a seed
           "[device-trial][phantom]") {
   calligraphy::testing::register_emulated_phantom(calligraphy::device_registry());
   const Scene scene = scene_of(U"口");
-  DeviceTrialOptions options;
-  options.seed = 5;
+  TrialOptions options;
+  options.simulation.seed = 5;
   options.keep_trace = false;
-  const auto first = run_device_trial("emulated-phantom", scene, options);
-  const auto again = run_device_trial("emulated-phantom", scene, options);
+  const auto first = run_trial("emulated-phantom", scene, options);
+  const auto again = run_trial("emulated-phantom", scene, options);
   CHECK(first.metrics.strokes_completed == first.metrics.strokes_total);
   CHECK(first.metrics.mean_deviation_m == again.metrics.mean_deviation_m);
   CHECK(first.metrics.time_s == again.metrics.time_s);
@@ -146,13 +145,13 @@ TEST_CASE("The CLI's runner takes a registry name, an unknown name lists the dev
           "[device-trial][registry]") {
   calligraphy::testing::register_emulated_phantom(calligraphy::device_registry());
   const Scene scene = scene_of(U"口");
-  DeviceTrialOptions options;
+  TrialOptions options;
   options.keep_trace = false;
-  const TrialResult result = run_device_trial("emulated-phantom", scene, options);
+  const TrialResult result = run_trial("emulated-phantom", scene, options);
   CHECK_FALSE(result.aborted);
   CHECK(result.metrics.strokes_completed == 3);
   try {
-    (void)run_device_trial("no-such-device", scene, options);
+    (void)run_trial("no-such-device", scene, options);
     FAIL("expected DeviceNotFound");
   } catch (const DeviceNotFound& e) {
     const std::string message = e.what();
@@ -165,12 +164,12 @@ TEST_CASE("The CLI's runner takes a registry name, an unknown name lists the dev
 TEST_CASE("The simulated device runs the same loop as run_simulated_trial", "[device-trial]") {
   const Scene scene = scene_of(U"九");
   TrialOptions simulated;
-  simulated.seed = 2;
-  DeviceTrialOptions on_device;
-  on_device.seed = 2;
-  SimulatedDevice device(simulated.device);
+  simulated.simulation.seed = 2;
+  TrialOptions on_device;
+  on_device.simulation.seed = 2;
+  SimulatedDevice device(simulated.simulation.device);
   const auto a = run_simulated_trial(scene, simulated);
-  const auto b = run_device_trial(device, scene, on_device);
+  const auto b = run_trial(device, scene, on_device);
   CHECK(a.metrics.mean_deviation_m == b.metrics.mean_deviation_m);
   CHECK(a.metrics.time_s == b.metrics.time_s);
   CHECK(a.trace.size() == b.trace.size());
@@ -182,7 +181,7 @@ TEST_CASE("A disconnect mid-trial aborts it with forces zeroed and the recording
   const Scene scene = scene_of(U"永");
   constexpr int kUnplugAt = 3000;  // 3 s in: the first stroke is being written
   UnpluggedPhantom device(kUnplugAt);
-  const TrialResult result = run_device_trial(device, scene, DeviceTrialOptions{});
+  const TrialResult result = run_trial(device, scene, TrialOptions{});
   REQUIRE(result.aborted);
   INFO(result.abort_reason);
   CHECK(result.abort_reason.find("unplugged") != std::string::npos);
@@ -209,8 +208,8 @@ TEST_CASE("A disconnect mid-trial aborts it with forces zeroed and the recording
 TEST_CASE("The reports of an aborted trial say so and keep what was recorded", "[device-trial][phantom]") {
   const Scene scene = scene_of(U"口");
   UnpluggedPhantom device(1500);
-  DeviceTrialOptions options;
-  const TrialResult result = run_device_trial(device, scene, options);
+  TrialOptions options;
+  const TrialResult result = run_trial(device, scene, options);
   REQUIRE(result.aborted);
   const cli::TrialDescription description{
       "口", true, "novice", 0, 1000.0, "emulated-phantom", device.info().model};
@@ -228,9 +227,9 @@ TEST_CASE("A safety fault aborts a trial on the servo loop, ticks are paced by a
           "[device-trial]") {
   const Scene scene = scene_of(U"口");
   FaultingDevice device(40);
-  DeviceTrialOptions options;
+  TrialOptions options;
   const auto start = std::chrono::steady_clock::now();
-  const TrialResult result = run_device_trial(device, scene, options);
+  const TrialResult result = run_trial(device, scene, options);
   const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   REQUIRE(result.aborted);
   CHECK(result.abort_reason == "test: force limit tripped");
@@ -250,7 +249,7 @@ TEST_CASE("A device that cannot calibrate refuses the trial and is closed", "[de
   auto parameters = phantom::emulator_matching(config);
   parameters.start_docked = false;  // never in the inkwell: encoders cannot be homed
   EmulatedPhantomDevice device(config, parameters);
-  CHECK_THROWS_AS(run_device_trial(device, scene_of(U"口"), DeviceTrialOptions{}), CalibrationNeeded);
+  CHECK_THROWS_AS(run_trial(device, scene_of(U"口"), TrialOptions{}), CalibrationNeeded);
   CHECK_FALSE(device.is_open());
   CHECK_FALSE(device.emulator().forces_active());
 }
@@ -258,7 +257,7 @@ TEST_CASE("A device that cannot calibrate refuses the trial and is closed", "[de
 TEST_CASE("A device without a usable force limit is refused after open() and closed again",
           "[device-trial]") {
   FaultingDevice device(1000, 0.0);
-  CHECK_THROWS_AS(run_device_trial(device, scene_of(U"口"), DeviceTrialOptions{}), InvalidArgument);
+  CHECK_THROWS_AS(run_trial(device, scene_of(U"口"), TrialOptions{}), InvalidArgument);
   CHECK(device.reads == 0);
   CHECK(device.closes == 1);
   CHECK_FALSE(device.is_open());

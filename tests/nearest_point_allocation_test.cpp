@@ -55,7 +55,7 @@ TEST_CASE("Renderer ticks (smoothing, passivity controller, safety chain) do not
   using namespace calligraphy;
   const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'永')});
   TrialOptions trial;
-  trial.seed = 1;
+  trial.simulation.seed = 1;
   const TrialResult recorded = run_simulated_trial(scene, trial);  // positions of a real trial
   REQUIRE(recorded.trace.size() > 1000);
   RendererOptions options;

@@ -61,7 +61,6 @@ ContactRun run_contact(Hand hand, double rate_hz, double stiffness_n_per_m, bool
   force.paper_stiffness_n_per_m = stiffness_n_per_m;
   RendererOptions options;
   options.rate_hz = rate_hz;
-  options.device_damping_n_s_per_m = device_parameters.damping_n_s_per_m;
   options.passivity.enabled = observer;
   options.safety = safety;
   Renderer renderer(scene, force, device.info(), options);
@@ -136,13 +135,14 @@ TEST_CASE("The renderer warns at construction when a stiffness exceeds the bound
   spdlog::set_default_logger(capture);
   RendererOptions options;
   options.rate_hz = 1000.0;
-  options.device_damping_n_s_per_m = kDeviceDamping;  // bound 1000 N/m
+  DeviceInfo device = simulated_phantom_desktop_info();
+  device.intrinsic_damping_n_s_per_m = kDeviceDamping;  // bound 1000 N/m
   ForceLawParameters force;
   force.paper_stiffness_n_per_m = 900.0;
-  { const Renderer below(scene, force, simulated_phantom_desktop_info(), options); }
+  { const Renderer below(scene, force, device, options); }
   const std::string quiet = log.str();
   force.paper_stiffness_n_per_m = 1500.0;
-  { const Renderer above(scene, force, simulated_phantom_desktop_info(), options); }
+  { const Renderer above(scene, force, device, options); }
   const std::string warned = log.str();
   spdlog::set_default_logger(previous);
   CHECK(quiet.find("passivity bound") == std::string::npos);

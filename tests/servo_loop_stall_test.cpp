@@ -9,10 +9,10 @@
 #include <limits>
 #include <thread>
 
-#include "calligraphy/model/character_library.hpp"
-#include "calligraphy/trial/realtime_trial.hpp"
 #include "calligraphy/devices/servo_loop.hpp"
+#include "calligraphy/model/character_library.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/trial/trial.hpp"
 
 using namespace calligraphy;
 using Catch::Matchers::Contains;
@@ -28,7 +28,7 @@ ServoLoopOptions stall_test_options() {
 }
 
 // A simulated device that counts how often a marker force reaches it.
-class MarkerDevice final : public HapticDevice {
+class MarkerDevice final : public HapticDevice, public HandPort {
  public:
   MarkerDevice() { inner_.open(); }
   const DeviceInfo& info() const override { return inner_.info(); }
@@ -42,9 +42,20 @@ class MarkerDevice final : public HapticDevice {
     if (force_n.x() == kMarker) ++marker_writes_;
     inner_.write_force(force_n);
   }
+  // The hand port, so a real-time trial steps the physics after each force write; the advance after
+  // tick `stall_after_` sleeps for `stall_ms_` (a stall on the loop thread).
+  void attach_hand(HandModel* hand) noexcept override { inner_.attach_hand(hand); }
+  void advance(double dt_s) override {
+    if (++advances_ == stall_after_) sleep_ms(stall_ms_);
+    inner_.advance(dt_s);
+  }
+  static void sleep_ms(int ms) { std::this_thread::sleep_for(std::chrono::milliseconds(ms)); }
   static constexpr double kMarker = 1.25;  // [N]
   SimulatedDevice inner_;
   int marker_writes_ = 0;
+  long advances_ = 0;
+  long stall_after_ = -1;
+  int stall_ms_ = 0;
 };
 
 void sleep_ms(int ms) { std::this_thread::sleep_for(std::chrono::milliseconds(ms)); }
@@ -166,22 +177,21 @@ TEST_CASE("A real-time trial ended by a stall keeps every tick recorded, the tri
           "[servo]") {
   const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'口')});
   MarkerDevice device;
-  RealtimeTrialOptions options;
+  device.stall_after_ = 100;  // the physics step after tick 100 takes 250 ms
+  device.stall_ms_ = 250;
+  TrialOptions options;
+  options.pacing = TrialPacing::real_time;
   options.loop = stall_test_options();
   options.loop.stall_timeout_s = 0.1;
   options.max_duration_s = 2.0;
-  std::size_t ticks = 0;
-  options.after_tick = [&](const DeviceState&, const RenderOutput&, double period_s) {
-    if (++ticks == 100) sleep_ms(250);
-    device.inner_.advance(period_s);
-    return true;
-  };
-  const RealtimeTrialResult result = run_realtime_trial(device, scene, options);
-  CHECK(result.end == TrialEnd::fault);
-  CHECK(result.fault.kind == LoopFaultKind::watchdog);
-  CHECK(ticks == 100);
-  CHECK(result.trial.trace.size() == 100);
-  CHECK(result.loop.ticks == result.trial.trace.size());
-  CHECK(result.loop.longest_stall_s >= 0.249);
+  const TrialResult result = run_trial(device, scene, options);
+  CHECK(result.end == TrialEnd::watchdog);
+  CHECK(result.aborted);
+  CHECK(device.advances_ == 100);
+  REQUIRE(result.loop.has_value());
+  CHECK(result.loop->fault.kind == LoopFaultKind::watchdog);
+  CHECK(result.trace.size() == 101);  // the tick after the stall tripped the bound and was recorded
+  CHECK(result.loop->ticks == result.trace.size());
+  CHECK(result.loop->longest_stall_s >= 0.249);
   CHECK_FALSE(device.forces_enabled());
 }

@@ -14,7 +14,7 @@
 
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
-#include "calligraphy/trial/realtime_trial.hpp"
+#include "calligraphy/trial/trial.hpp"
 #include "devices/latency_histogram.hpp"
 
 using namespace calligraphy;
@@ -54,7 +54,7 @@ std::size_t settled_thread_count(std::size_t expected) {
 }
 
 // A simulated device that counts writes of a marker force and can throw CommunicationError on a given read.
-class ProbeDevice final : public HapticDevice {
+class ProbeDevice final : public HapticDevice, public HandPort {
  public:
   explicit ProbeDevice(long fail_on_read = -1) : fail_on_read_(fail_on_read) { inner_.open(); }
   const DeviceInfo& info() const override { return inner_.info(); }
@@ -73,6 +73,9 @@ class ProbeDevice final : public HapticDevice {
     if (force_n.x() == kMarker) ++marker_writes_;
     inner_.write_force(force_n);
   }
+  // The hand port, so that a real-time trial steps the physics after each force write.
+  void attach_hand(HandModel* hand) noexcept override { inner_.attach_hand(hand); }
+  void advance(double dt_s) override { inner_.advance(dt_s); }
   static constexpr double kMarker = 1.25;  // [N]
   SimulatedDevice inner_;
   long reads_ = 0;
@@ -299,27 +302,29 @@ TEST_CASE("Enforced realtime that cannot be had fails at start with the reason",
 TEST_CASE("A real-time trial on the simulated device records the lock-step trial's trace", "[servo]") {
   const Scene scene = scene_of(U"口");
   TrialOptions trial;
-  trial.writer = WriterProfile::skilled();
+  trial.simulation.writer = WriterProfile::skilled();
   trial.max_duration_s = 2.5;  // about the first stroke of 口 (a whole trial would take 6 s of wall clock)
-  const ServoLoopOptions loop = test_options();
-  const RealtimeTrialResult realtime = run_realtime_simulated_trial(scene, trial, loop);
   const TrialResult lockstep = run_simulated_trial(scene, trial);
+  trial.pacing = TrialPacing::real_time;
+  trial.loop = test_options();
+  const TrialResult realtime = run_simulated_trial(scene, trial);
 
-  CHECK(realtime.end == TrialEnd::max_duration);
-  CHECK_FALSE(realtime.fault);
-  CHECK(realtime.loop.ticks == 2500);
-  REQUIRE(realtime.trial.trace.size() == 2500);
-  REQUIRE(lockstep.trace.size() >= realtime.trial.trace.size());
-  CHECK(realtime.trial.metrics.strokes_completed >= 1);
+  CHECK(realtime.end == TrialEnd::time_limit);
+  REQUIRE(realtime.loop.has_value());
+  CHECK_FALSE(realtime.loop->fault);
+  CHECK(realtime.loop->ticks == 2500);
+  REQUIRE(realtime.trace.size() == 2500);
+  REQUIRE(lockstep.trace.size() >= realtime.trace.size());
+  CHECK(realtime.metrics.strokes_completed >= 1);
   bool same = true;
-  for (std::size_t i = 0; i < realtime.trial.trace.size(); ++i) {
-    const TrialSample& a = realtime.trial.trace[i];
+  for (std::size_t i = 0; i < realtime.trace.size(); ++i) {
+    const TrialSample& a = realtime.trace[i];
     const TrialSample& b = lockstep.trace[i];
     same = same && a.time_s == b.time_s && a.position_m == b.position_m && a.force_n == b.force_n &&
            a.state == b.state && a.stroke == b.stroke && a.element == b.element;
   }
   CHECK(same);
-  const StrokeMetrics& first = realtime.trial.metrics.per_stroke[0];
+  const StrokeMetrics& first = realtime.metrics.per_stroke[0];
   CHECK(first.completed);
   CHECK(first.trace_begin == lockstep.metrics.per_stroke[0].trace_begin);
   CHECK(first.trace_end == lockstep.metrics.per_stroke[0].trace_end);
@@ -329,18 +334,18 @@ TEST_CASE("A real-time trial on the simulated device records the lock-step trial
 TEST_CASE("A device fault during a real-time trial keeps the recording and reports the fault", "[servo]") {
   const Scene scene = scene_of(U"口");
   ProbeDevice device(/*fail_on_read=*/300);
-  RealtimeTrialOptions options;
+  TrialOptions options;
+  options.pacing = TrialPacing::real_time;
   options.loop = test_options();
   options.max_duration_s = 2.0;
-  options.after_tick = [&](const DeviceState&, const RenderOutput&, double period_s) {
-    device.inner_.advance(period_s);
-    return true;
-  };
-  const RealtimeTrialResult result = run_realtime_trial(device, scene, options);
-  CHECK(result.end == TrialEnd::fault);
-  CHECK(result.fault.kind == LoopFaultKind::communication);
-  CHECK(result.trial.trace.size() == 300);
-  CHECK(result.trial.trace.back().time_s > result.trial.trace.front().time_s);
+  const TrialResult result = run_trial(device, scene, options);
+  CHECK(result.end == TrialEnd::device_fault);
+  CHECK(result.aborted);
+  CHECK(result.abort_reason.find("timed out on read 300") != std::string::npos);
+  REQUIRE(result.loop.has_value());
+  CHECK(result.loop->fault.kind == LoopFaultKind::communication);
+  CHECK(result.trace.size() == 300);
+  CHECK(result.trace.back().time_s > result.trace.front().time_s);
   CHECK_FALSE(device.forces_enabled());
 }
 

@@ -58,9 +58,9 @@ StepFigures trial_steps(char32_t c, const TrialOptions& options) {
 
 TrialOptions guided_novice(std::uint64_t seed) {
   TrialOptions options;
-  options.seed = seed;
+  options.simulation.seed = seed;
   options.force.guidance = true;
-  options.writer = WriterProfile::novice();
+  options.simulation.writer = WriterProfile::novice();
   return options;
 }
 

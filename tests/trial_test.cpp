@@ -31,7 +31,7 @@ TEST_CASE("For the same seeded novice, guidance lowers the mean deviation", "[tr
     const Scene scene = scene_of(std::u32string(1, c));
     for (std::uint64_t seed : {0u, 7u}) {
       TrialOptions on;
-      on.seed = seed;
+      on.simulation.seed = seed;
       on.keep_trace = false;
       TrialOptions off = on;
       off.force.guidance = false;
@@ -47,12 +47,12 @@ TEST_CASE("For the same seeded novice, guidance lowers the mean deviation", "[tr
 TEST_CASE("Trials are deterministic for a seed and differ across seeds", "[trial]") {
   const Scene scene = scene_of(U"口");
   TrialOptions a;
-  a.seed = 3;
+  a.simulation.seed = 3;
   const auto first = run_simulated_trial(scene, a).metrics;
   const auto again = run_simulated_trial(scene, a).metrics;
   CHECK(first.mean_deviation_m == again.mean_deviation_m);
   CHECK(first.time_s == again.time_s);
-  a.seed = 4;
+  a.simulation.seed = 4;
   CHECK(run_simulated_trial(scene, a).metrics.mean_deviation_m != first.mean_deviation_m);
 }
 

@@ -261,14 +261,14 @@ PyTrialResult simulate_trial_py(const py::object& characters_object, const std::
   if (!force_law_object.is_none()) options.force = force_law_object.cast<ForceLawParameters>();
   options.force.guidance = guidance;
   if (writer == "novice") {
-    options.writer = WriterProfile::novice();
+    options.simulation.writer = WriterProfile::novice();
   } else if (writer == "skilled") {
-    options.writer = WriterProfile::skilled();
+    options.simulation.writer = WriterProfile::skilled();
   } else {
     throw InvalidArgument("writer: expected 'novice' or 'skilled', got '" + writer + "'");
   }
   options.rate_hz = rate_hz;
-  options.seed = seed;
+  options.simulation.seed = seed;
   options.max_duration_s = max_duration_s;
   options.keep_trace = keep_trace;
 

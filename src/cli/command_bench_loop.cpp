@@ -12,7 +12,7 @@
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
-#include "calligraphy/trial/realtime_trial.hpp"
+#include "calligraphy/trial/trial.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 
@@ -147,13 +147,16 @@ int command_bench_loop(const Args& args) {
     TrialOptions trial;
     trial.max_duration_s = seconds;
     trial.keep_trace = false;
-    const RealtimeTrialResult result = run_realtime_simulated_trial(scene, trial, options);
-    stats = result.loop;
+    trial.pacing = TrialPacing::real_time;
+    trial.rate_hz = options.rate_hz;
+    trial.loop = options;
+    const TrialResult result = run_simulated_trial(scene, trial);
+    stats = result.loop.value_or(ServoLoopStats{});
     trial_json = {{"characters", *chars},
                   {"end", to_string(result.end)},
-                  {"strokes_completed", result.trial.metrics.strokes_completed},
-                  {"strokes_total", result.trial.metrics.strokes_total},
-                  {"time_s", result.trial.metrics.time_s}};
+                  {"strokes_completed", result.metrics.strokes_completed},
+                  {"strokes_total", result.metrics.strokes_total},
+                  {"time_s", result.metrics.time_s}};
   } else {
     stats = run_free_loop(options, seconds);
   }

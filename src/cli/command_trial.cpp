@@ -1,5 +1,5 @@
 // `calligraphy trial CHARS ...`: a whole guided writing trial at 1 kHz on any registered device
-// (the simulated one by default), through run_device_trial: lock-step for devices a simulated writer
+// (the simulated one by default), through run_trial: lock-step for devices a simulated writer
 // moves, on the real-time ServoLoop otherwise or with --pacing real-time.
 #include <algorithm>
 #include <cstdio>
@@ -11,7 +11,7 @@
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/report/trial_report.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
-#include "calligraphy/trial/device_trial.hpp"
+#include "calligraphy/trial/trial.hpp"
 #include "cli/cli_devices.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
@@ -46,15 +46,15 @@ int command_trial(const Args& args) {
   for (char32_t c : chars) characters.push_back(source.load(c));
   const Scene scene = Scene::lay_out(characters);
 
-  DeviceTrialOptions options;
+  TrialOptions options;
   options.force.guidance = arguments.choice_or("guidance", {"on", "off"}, "on") == "on";
   const std::string writer = arguments.choice_or("writer", {"novice", "skilled"}, "novice");
-  options.writer = writer == "novice" ? WriterProfile::novice() : WriterProfile::skilled();
+  options.simulation.writer = writer == "novice" ? WriterProfile::novice() : WriterProfile::skilled();
   const double seed = arguments.number_or("seed", 0);
   if (seed < 0 || seed != static_cast<double>(static_cast<std::uint64_t>(seed))) {
     throw UsageError("--seed expects a non-negative integer");
   }
-  options.seed = static_cast<std::uint64_t>(seed);
+  options.simulation.seed = static_cast<std::uint64_t>(seed);
   options.rate_hz = arguments.number_or("rate", 1000.0);
   options.keep_trace = arguments.option("svg") || arguments.option("csv");
   const std::string pacing = arguments.choice_or("pacing", {"auto", "lock-step", "real-time"}, "auto");
@@ -64,27 +64,21 @@ int command_trial(const Args& args) {
   options.loop.realtime = arguments.choice_or("realtime", {"enforce", "ignore"}, "ignore") == "enforce"
                               ? RealtimeMode::enforce
                               : RealtimeMode::ignore;
-  // The simulated device's physical damping is known: it sets the renderer's stiffness bound.
-  if (device_name == "simulated")
-    options.device_damping_n_s_per_m = SimulatedDeviceParameters{}.damping_n_s_per_m;
 
-  const TrialResult result = run_device_trial(device_name, scene, options);
+  const TrialResult result = run_trial(device_name, scene, options);
   // On hardware a person writes; the simulated writer only moves simulated and emulated devices.
-  const TrialDescription description{arguments.positionals()[0],
-                                     options.force.guidance,
-                                     device.hardware ? "human" : writer,
-                                     options.seed,
-                                     options.rate_hz,
-                                     device.name,
-                                     device.info.model};
+  const TrialDescription description{
+      arguments.positionals()[0], options.force.guidance, device.hardware ? "human" : writer,
+      options.simulation.seed,    options.rate_hz,        device.name,
+      device.info.model};
   print_trial_table(description, scene, result);
   // The outputs are written for an aborted trial too: they hold what was recorded before the fault.
   if (const auto path = arguments.option("json")) write_file(*path, trial_json(description, result));
   if (const auto path = arguments.option("svg")) write_file(*path, trial_svg(scene, result));
   if (const auto path = arguments.option("csv")) write_file(*path, trial_csv(result.trace));
   if (result.aborted) {
-    std::fprintf(stderr, "calligraphy trial: error: the trial was aborted: %s\n",
-                 result.abort_reason.c_str());
+    std::fprintf(stderr, "calligraphy trial: error: the trial ended early (%s)%s%s\n", to_string(result.end),
+                 result.abort_reason.empty() ? "" : ": ", result.abort_reason.c_str());
     return 1;
   }
   return 0;

@@ -163,6 +163,7 @@ struct ServoLoop::Impl {
 
   HapticDevice& device;
   ServoCallback callback;
+  std::function<void()> after_write;  // optional, on the loop thread after each tick's force write
   ServoLoopOptions options;
   std::thread thread;
   devices::LogQueue log_queue;
@@ -263,6 +264,7 @@ void ServoLoop::Impl::run() noexcept {
 
     bool stop_after = false;
     bool stalled = false;
+    std::int64_t written = 0;
     std::int64_t stall = 0;
     std::int64_t force_age = 0;
     try {
@@ -287,6 +289,8 @@ void ServoLoop::Impl::run() noexcept {
       } else {
         device.write_force(command.force_n);
       }
+      written = monotonic_ns();  // the device holds this force from here: stalls count from the write
+      if (after_write && !command.stop && !stalled) after_write();
       stop_after = command.stop;
     } catch (const CommunicationError& e) {
       fault_exception = std::current_exception();
@@ -309,7 +313,6 @@ void ServoLoop::Impl::run() noexcept {
       record_fault(LoopFaultKind::callback, "unknown exception from the servo callback", tick);
       break;
     }
-    const std::int64_t written = monotonic_ns();
     last_update = written;
     ticks.store(++tick, std::memory_order_relaxed);
     if (stall > longest_stall) {
@@ -364,7 +367,8 @@ ServoLoop::~ServoLoop() { stop(); }
 
 void ServoLoop::start() {
   Impl& m = *impl_;
-  if (m.running.load(std::memory_order_acquire)) throw Error("ServoLoop::start: the loop is already running");
+  if (m.running.load(std::memory_order_acquire))
+    throw StateError("ServoLoop::start: the loop is already running");
   if (m.thread.joinable()) m.thread.join();  // the previous run ended by itself
   m.log_drain.stop();
   if (!m.device.is_open())
@@ -444,6 +448,13 @@ void ServoLoop::wait() {
 bool ServoLoop::running() const noexcept { return impl_->running.load(std::memory_order_acquire); }
 
 const ServoLoopOptions& ServoLoop::options() const noexcept { return impl_->options; }
+
+void ServoLoop::set_after_write(std::function<void()> hook) {
+  if (impl_->running.load(std::memory_order_acquire)) {
+    throw StateError("ServoLoop::set_after_write: the loop is running");
+  }
+  impl_->after_write = std::move(hook);
+}
 
 ServoLoopStats ServoLoop::stats() const {
   const Impl& m = *impl_;

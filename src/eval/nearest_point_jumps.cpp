@@ -128,7 +128,7 @@ JumpMeasurement measure_foot_jumps(const JumpSettings& settings) {
     for (const Scene& scene : scenes) {
       for (const std::uint64_t seed : settings.seeds) {
         TrialOptions options;  // 1 kHz, simulated Phantom Desktop, novice writer; the renderer uses exact
-        options.seed = seed;
+        options.simulation.seed = seed;
         options.force.guidance = guidance;
         const TrialResult trial = run_simulated_trial(scene, options);
         ++measurement.trials;

@@ -47,10 +47,6 @@ void RendererOptions::validate() const {
     throw InvalidArgument("RendererOptions.rate_hz = " + std::to_string(rate_hz) +
                           " must be in [100, 100000] Hz");
   }
-  if (!std::isfinite(device_damping_n_s_per_m) || device_damping_n_s_per_m < 0.0) {
-    throw InvalidArgument("RendererOptions.device_damping_n_s_per_m = " +
-                          std::to_string(device_damping_n_s_per_m) + " must be finite and >= 0");
-  }
   passivity.validate();
 }
 
@@ -71,24 +67,27 @@ Renderer::Renderer(const Scene& scene, const ForceLawParameters& parameters, con
     spdlog::warn("stiffness above the device's stable maximum of {} N/m ({}): paper {} N/m, guidance {} N/m",
                  k_max, device.model, k_paper, k_guidance);
   }
-  if (options_.device_damping_n_s_per_m > 0.0) {
+  const double b_device = device.intrinsic_damping_n_s_per_m;
+  if (!std::isfinite(b_device) || b_device < 0.0) {
+    throw InvalidArgument("DeviceInfo.intrinsic_damping_n_s_per_m = " + std::to_string(b_device) +
+                          " must be finite and >= 0");
+  }
+  if (b_device > 0.0) {
     // Colgate & Schenkel 1997: K < 2 (b - B) / T. The paper has the virtual damper B; the guidance
     // stiffness is scaled by the attraction factor (eq. 8) on top.
-    const double paper_bound = colgate_stiffness_bound(options_.device_damping_n_s_per_m, options_.rate_hz,
-                                                       parameters_.paper_damping_n_s_per_m);
-    const double guidance_bound =
-        colgate_stiffness_bound(options_.device_damping_n_s_per_m, options_.rate_hz);
+    const double paper_bound =
+        colgate_stiffness_bound(b_device, options_.rate_hz, parameters_.paper_damping_n_s_per_m);
+    const double guidance_bound = colgate_stiffness_bound(b_device, options_.rate_hz);
     if (k_paper > paper_bound) {
       spdlog::warn(
           "paper stiffness {} N/m above the passivity bound 2 (b - B) / T = {} N/m (b = {} N s/m, B = {} "
           "N s/m, {} Hz): the contact may be unstable without a hand or the passivity controller",
-          k_paper, paper_bound, options_.device_damping_n_s_per_m, parameters_.paper_damping_n_s_per_m,
-          options_.rate_hz);
+          k_paper, paper_bound, b_device, parameters_.paper_damping_n_s_per_m, options_.rate_hz);
     }
     if (parameters_.guidance && k_guidance > guidance_bound) {
       spdlog::warn(
           "guidance stiffness {} N/m above the passivity bound 2 b / T = {} N/m (b = {} N s/m, {} Hz)",
-          k_guidance, guidance_bound, options_.device_damping_n_s_per_m, options_.rate_hz);
+          k_guidance, guidance_bound, b_device, options_.rate_hz);
     }
   }
 }

@@ -56,6 +56,7 @@ std::string trial_json(const TrialDescription& d, const TrialResult& result) {
                               {"rate_hz", d.rate_hz},
                               {"device", d.device},
                               {"aborted", result.aborted},
+                              {"end_reason", to_string(result.end)},
                               {"abort_reason", result.abort_reason},
                               {"strokes_total", m.strokes_total},
                               {"strokes_completed", m.strokes_completed},

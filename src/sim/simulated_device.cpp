@@ -59,6 +59,7 @@ SimulatedDevice::SimulatedDevice(const SimulatedDeviceParameters& parameters)
       position_(parameters.initial_position_m),
       reported_position_(parameters.initial_position_m) {
   parameters_.validate();
+  parameters_.info.intrinsic_damping_n_s_per_m = parameters_.damping_n_s_per_m;  // the simulation's truth
 }
 
 void SimulatedDevice::close() noexcept {
@@ -178,7 +179,7 @@ void register_simulated_device(DeviceRegistry& registry) {
   };
   if (present()) return;
   try {
-    registry.register_device("simulated", simulated_phantom_desktop_info(),
+    registry.register_device("simulated", SimulatedDevice{}.info(),
                              [] { return std::make_unique<SimulatedDevice>(); });
   } catch (const InvalidArgument&) {
     if (!present()) throw;  // another thread registered it between the check and here

@@ -13,12 +13,15 @@ namespace calligraphy {
 
 /// What a device can do, in SI units (after CHAI3D's cHapticDeviceInfo).
 struct DeviceInfo {
-  std::string model;                     ///< e.g. "Phantom Desktop (simulated)"
-  std::string manufacturer;              ///< e.g. "calligraphy"
-  double max_force_n = 0.0;              ///< peak force [N]
-  double max_continuous_force_n = 0.0;   ///< force sustainable for minutes [N]
-  double max_stiffness_n_per_m = 0.0;    ///< highest stable stiffness at 1 kHz [N/m]
-  double max_damping_n_s_per_m = 0.0;    ///< highest stable damping [N s/m]
+  std::string model;                    ///< e.g. "Phantom Desktop (simulated)"
+  std::string manufacturer;             ///< e.g. "calligraphy"
+  double max_force_n = 0.0;             ///< peak force [N]
+  double max_continuous_force_n = 0.0;  ///< force sustainable for minutes [N]
+  double max_stiffness_n_per_m = 0.0;   ///< highest stable stiffness at 1 kHz [N/m]
+  double max_damping_n_s_per_m = 0.0;   ///< highest stable damping [N s/m]
+  /// The device's own physical damping [N s/m], which raises the stiffness a sampled loop can render
+  /// passively (Colgate & Schenkel 1997: b > K T / 2 + |B|); 0 when unknown.
+  double intrinsic_damping_n_s_per_m = 0.0;
   double workspace_radius_m = 0.0;       ///< radius of a sphere inside the workspace [m]
   Vec3 workspace_size_m = Vec3::Zero();  ///< box of the usable workspace, x y z [m]
 };

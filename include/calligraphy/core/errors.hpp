@@ -65,4 +65,18 @@ class CalibrationNeeded : public DeviceError {
   using DeviceError::DeviceError;
 };
 
+/// The realtime settings were required (`RealtimeMode::enforce`) and could not be applied; the message
+/// names the setting and the system's reason (e.g. "SCHED_FIFO priority 80: Operation not permitted
+/// (EPERM)"). Thrown by `ServoLoop::start`.
+class RealtimeError : public DeviceError {
+ public:
+  using DeviceError::DeviceError;
+};
+
+/// A call in the wrong state, e.g. starting a servo loop that is already running.
+class StateError : public Error {
+ public:
+  using Error::Error;
+};
+
 }  // namespace calligraphy

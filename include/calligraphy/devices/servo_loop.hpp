@@ -26,14 +26,6 @@
 
 namespace calligraphy {
 
-/// The realtime settings were required (`RealtimeMode::enforce`) and could not be applied; the message
-/// names the setting and the system's reason (e.g. "SCHED_FIFO priority 80: Operation not permitted
-/// (EPERM)"). Thrown by `ServoLoop::start`.
-class RealtimeError : public DeviceError {
- public:
-  using DeviceError::DeviceError;
-};
-
 /// As libfranka's RealtimeConfig: `enforce` makes `start()` throw RealtimeError unless every requested
 /// setting (SCHED_FIFO priority, CPU pinning, locked memory) was applied; `ignore` tries the requested
 /// settings, runs anyway, and records what was obtained in `ServoLoopStats::realtime`.
@@ -165,9 +157,15 @@ class ServoLoop {
   /// Starts the loop thread: clears the statistics, locks memory when asked, enables forces when asked,
   /// applies the realtime settings on the new thread and returns once they are applied. Throws
   /// RealtimeError (mode `enforce`, with the reason), DeviceError (the device is not open, or from
-  /// `enable_forces`), or Error when the loop is already running. A loop that ended (stopped by its
+  /// `enable_forces`), or StateError when the loop is already running. A loop that ended (stopped by its
   /// callback, by `stop()` or by a fault) can be started again.
   void start();
+  /// Optional: called on the loop thread right after each tick's force write (the callback's force or
+  /// the zero force that replaced it), except after a tick that asked to stop or ended the run. A
+  /// simulation steps its world here, so the force acts during the step; its time counts towards the
+  /// stall bound. Same rules as the callback; its exceptions are contained like the callback's.
+  /// Throws StateError while the loop runs.
+  void set_after_write(std::function<void()> hook);
   /// Asks the loop to stop, waits for the thread to end and returns the fault that ended the run, if
   /// any (none when it was stopped or ended by its callback). Forces are zero and disabled on return.
   /// Never throws; does nothing when not started. Called from the callback it only requests the stop (the

@@ -25,9 +25,6 @@ struct RendererOptions {
   /// Safety chain. `max_force_n` and `max_continuous_force_n` left at 0 take the device's figures.
   SafetyChainParameters safety{};
   PassivityParameters passivity{};  ///< Hannaford-Ryu observer and controller (off by default)
-  /// Physical damping b of the device [N s/m] for Colgate's bound K <= 2 (b - B) / T; 0 = unknown,
-  /// then only `DeviceInfo::max_stiffness_n_per_m` is checked.
-  double device_damping_n_s_per_m = 0.0;
   /// Throws InvalidArgument naming the field when a value is out of range.
   void validate() const;
 };

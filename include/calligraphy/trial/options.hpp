@@ -1,0 +1,54 @@
+#pragma once
+/// \file options.hpp
+/// The options of a guided writing trial, one struct for every device and pacing (validated once, in
+/// `TrialOptions::validate`).
+#include <cstdint>
+#include <functional>
+
+#include "calligraphy/devices/servo_loop.hpp"
+#include "calligraphy/render/force_law.hpp"
+#include "calligraphy/render/renderer.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/sim/simulated_writer.hpp"
+
+namespace calligraphy {
+
+/// How a trial's ticks are paced.
+enum class TrialPacing {
+  automatic,  ///< lock-step for a device a simulated writer moves (a `HandPort`), real time otherwise
+  lock_step,  ///< no wall clock: only for a device with a hand port (else InvalidArgument)
+  real_time,  ///< the `ServoLoop` at `rate_hz` on its own thread, with `loop`'s realtime settings
+};
+
+/// The simulated part of a trial: who moves a device that has a hand port, and the simulated device
+/// `run_simulated_trial` creates. Unused on a device a person moves.
+struct SimulationOptions {
+  WriterProfile writer = WriterProfile::novice();  ///< the simulated writer
+  SimulatedDeviceParameters device{};              ///< the device `run_simulated_trial` creates
+  std::uint64_t seed = 0;                          ///< seeds the writer's bias, noise and tremor
+};
+
+/// Options of a trial on any device.
+struct TrialOptions {
+  ForceLawParameters force{};       ///< the force law; `force.guidance` switches guidance on or off
+  SafetyChainParameters safety{};   ///< the renderer's safety chain (renderer.hpp)
+  PassivityParameters passivity{};  ///< the renderer's passivity controller (off by default)
+  double rate_hz = 1000.0;          ///< servo rate [Hz]: [100, 100000] lock-step, [100, 10000] real time
+  TrialPacing pacing = TrialPacing::automatic;
+  /// Real-time pacing: realtime mode, priority, CPU, stale-force and stall bounds. Its `rate_hz` is
+  /// ignored: the trial's `rate_hz` is used.
+  ServoLoopOptions loop{};
+  double max_duration_s = 300.0;  ///< the trial ends after this much device time [s]
+  bool keep_trace = true;         ///< keep one `TrialSample` per tick in the result
+  SimulationOptions simulation{};
+  /// Polled by the thread that runs the trial (never the servo thread): once per tick in lock-step,
+  /// every millisecond in real time. Returning true ends the trial at the next tick with
+  /// `TrialEnd::interrupted` (zero force, forces disabled, every recorded tick kept). May be empty.
+  std::function<bool()> should_stop;
+
+  /// Throws InvalidArgument naming the field when a value is out of range (the rate for the pacing
+  /// `pacing`, or either range for `automatic`, which is checked again once the device is known).
+  void validate() const;
+};
+
+}  // namespace calligraphy

@@ -1,0 +1,92 @@
+#pragma once
+/// \file recorder.hpp
+/// The trial recorder: turns each servo tick (the state read and what the renderer made of it) into a
+/// trace sample and the trial's metrics. Usable from any loop, lock-step or real time.
+#include <cstdint>
+#include <vector>
+
+#include "calligraphy/core/device_types.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/render/renderer.hpp"
+
+namespace calligraphy {
+
+/// One servo tick of the trace.
+struct TrialSample {
+  double time_s = 0.0;
+  Vec3 position_m = Vec3::Zero();  ///< HIP as read from the device [m]
+  Vec3 force_n = Vec3::Zero();     ///< commanded force [N]
+  InteractionState state = InteractionState::separation;
+  std::size_t stroke = 0;   ///< active stroke, counted over the whole scene (0-based)
+  std::size_t element = 0;  ///< active element within it
+};
+
+/// Metrics of one stroke. Deviations are distances in the paper plane from the pen tip to the stroke's
+/// reference elements, over the WS ticks of the stroke's last attempt (an abandoned attempt is cleared,
+/// as its trace is on screen, section 4.3.3).
+struct StrokeMetrics {
+  std::size_t index = 0;  ///< over the whole scene, 0-based
+  std::size_t character = 0;
+  int typical_id = 0;
+  bool completed = false;
+  int attempts = 0;  ///< times WS was entered on this stroke
+  double mean_deviation_m = 0.0;
+  double max_deviation_m = 0.0;
+  double time_s = 0.0;          ///< from entering WS to writing the last feature point, last attempt
+  std::size_t trace_begin = 0;  ///< the last attempt's samples in the trace: [trace_begin, trace_end)
+  std::size_t trace_end = 0;
+};
+
+/// Metrics of a whole trial.
+struct TrialMetrics {
+  std::size_t strokes_total = 0;
+  std::size_t strokes_completed = 0;
+  bool completed_in_order = false;  ///< every stroke written, each in its turn
+  double time_s = 0.0;              ///< from the start to the last stroke written (or the end of the trial)
+  double mean_deviation_m = 0.0;    ///< over all WS ticks of the strokes' last attempts
+  double max_deviation_m = 0.0;
+  double max_force_n = 0.0;       ///< max |F| commanded
+  double max_force_step_n = 0.0;  ///< max |F(k) - F(k-1)| between consecutive ticks
+  std::size_t state_transitions = 0;
+  std::vector<StrokeMetrics> per_stroke;
+};
+
+/// Records ticks into a trace and metrics. Allocates only when the trace grows beyond `reserve`.
+class TrialRecorder {
+ public:
+  /// `scene` must outlive the recorder.
+  explicit TrialRecorder(const Scene& scene, bool keep_trace = true);
+  /// Record one tick: the state read from the device and what the renderer made of it.
+  void record(const DeviceState& state, const RenderOutput& output);
+  [[nodiscard]] const TrialMetrics& metrics() const noexcept { return metrics_; }
+  [[nodiscard]] const std::vector<TrialSample>& trace() const noexcept { return trace_; }
+  /// Allocates (and touches) room for `ticks` samples of the trace, so that the next `ticks` calls of
+  /// `record` never allocate: for a real-time loop. Nothing when the trace is not kept.
+  void reserve(std::size_t ticks);
+  /// Closes the metrics at `end_time_s` (time_s of an unfinished trial).
+  void finish(double end_time_s);
+
+ private:
+  struct Attempt {
+    double sum = 0.0;
+    std::size_t count = 0;
+    double max = 0.0;
+    double start_time = 0.0;
+  };
+  const Scene* scene_;
+  bool keep_trace_;
+  std::vector<TrialSample> trace_;
+  TrialMetrics metrics_;
+  std::vector<std::pair<std::size_t, std::size_t>> stroke_location_;  // global index -> (character, stroke)
+  std::size_t current_ = 0;                                           // stroke being written (global index)
+  std::size_t ticks_ = 0;  // ticks recorded: the next sample's index in the trace
+  Attempt attempt_;
+  Vec3 last_force_ = Vec3::Zero();
+  bool first_ = true;
+  InteractionState last_state_ = InteractionState::separation;
+  double pooled_sum_ = 0.0;
+  std::size_t pooled_count_ = 0;
+  double last_time_ = 0.0;
+};
+
+}  // namespace calligraphy

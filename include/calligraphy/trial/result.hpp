@@ -1,0 +1,37 @@
+#pragma once
+/// \file result.hpp
+/// What a trial returns: the metrics, the trace, how it ended, and the servo loop's statistics when it
+/// ran in real time.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "calligraphy/devices/servo_loop.hpp"
+#include "calligraphy/trial/recorder.hpp"
+
+namespace calligraphy {
+
+/// How a trial ended.
+enum class TrialEnd {
+  completed,       ///< every stroke written, each in its turn
+  time_limit,      ///< `max_duration_s` ran out first
+  device_fault,    ///< the device failed (link lost, safety fault, another DeviceError)
+  watchdog,        ///< the servo loop stalled longer than its bound
+  interrupted,     ///< `TrialOptions::should_stop` (e.g. SIGINT or SIGTERM, a closed window)
+  writer_gave_up,  ///< the simulated writer stopped before every stroke was written
+};
+
+/// "completed", "time_limit", "device_fault", "watchdog", "interrupted", "writer_gave_up".
+[[nodiscard]] const char* to_string(TrialEnd end) noexcept;
+
+/// The outcome of a trial. The metrics and trace hold every tick recorded, whatever ended the trial.
+struct TrialResult {
+  TrialMetrics metrics;
+  std::vector<TrialSample> trace;  ///< one sample per tick, when `keep_trace`
+  TrialEnd end = TrialEnd::completed;
+  bool aborted = false;      ///< every end but `completed`
+  std::string abort_reason;  ///< the device's or the loop's message for a fault, else a short reason or empty
+  std::optional<ServoLoopStats> loop;  ///< the servo loop's statistics, for a real-time trial
+};
+
+}  // namespace calligraphy

@@ -1,0 +1,72 @@
+#pragma once
+/// \file session.hpp
+/// One guided writing trial, stepped one servo tick at a time from any loop: the renderer (paper
+/// sections 4-6) and the recorder of a scene. `step` is the whole servo path of a trial: call it with the
+/// state read from the device and write the force it returns. It is what `run_trial` calls, in lock-step
+/// and on the `ServoLoop` alike, and what an application with its own servo loop calls:
+///
+///     TrialSession session(scene, device.info(), options);
+///     session.reserve_trace();                              // before a real-time loop
+///     while (running) {                                    // the application's 1 kHz loop
+///       const ServoCommand command = session.step(device.read_state());
+///       device.write_force(command.force_n);
+///       if (command.stop) break;
+///     }
+///     TrialResult result = session.finish(TrialEnd::completed);
+///
+/// `step` never locks, logs or throws, and after `reserve_trace()` it never allocates; it asks to stop
+/// when every stroke is written or `max_duration_s` x `rate_hz` ticks were stepped.
+#include <cstddef>
+
+#include "calligraphy/core/device_types.hpp"
+#include "calligraphy/devices/servo_loop.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/render/renderer.hpp"
+#include "calligraphy/trial/options.hpp"
+#include "calligraphy/trial/recorder.hpp"
+#include "calligraphy/trial/result.hpp"
+
+namespace calligraphy {
+
+class TrialSession {
+ public:
+  /// `scene` must outlive the session. The renderer takes the device's limits and its intrinsic damping
+  /// (`DeviceInfo::damping_n_s_per_m`, for the stiffness bound) from `device`. Throws InvalidArgument for
+  /// bad options or a device whose info is unusable (max force <= 0).
+  TrialSession(const Scene& scene, const DeviceInfo& device, const TrialOptions& options);
+
+  /// Allocates (and touches) the trace for `max_duration_s` x `rate_hz` ticks, about 80 bytes a tick,
+  /// so that `step` never allocates: for a real-time loop. Nothing when the trace is not kept.
+  void reserve_trace();
+
+  /// One servo tick: renders the force for `state` and records the tick. `stop` is set when every
+  /// stroke is written or the time limit is reached. Servo path: no lock, log or exception, and no
+  /// allocation after `reserve_trace()`.
+  ServoCommand step(const DeviceState& state) noexcept;
+
+  /// What the renderer made of the last step (state, active stroke, hint, force, events).
+  [[nodiscard]] const RenderOutput& last_output() const noexcept { return last_output_; }
+  /// Ticks stepped so far.
+  [[nodiscard]] std::size_t ticks() const noexcept { return ticks_; }
+  /// True once every stroke of the scene is written.
+  [[nodiscard]] bool finished() const noexcept { return last_output_.finished; }
+  /// True once the ticks reach `max_duration_s` x `rate_hz`.
+  [[nodiscard]] bool out_of_time() const noexcept { return ticks_ >= max_ticks_; }
+  [[nodiscard]] const TrialOptions& options() const noexcept { return options_; }
+
+  /// Closes the metrics at `end_time_s` (the device time the trial ended; the last tick's time when
+  /// negative) and returns the recording with how it ended. `reason` is kept as `abort_reason`.
+  /// Call once; the session is spent after it.
+  [[nodiscard]] TrialResult finish(TrialEnd end, std::string reason = {}, double end_time_s = -1.0);
+
+ private:
+  TrialOptions options_;
+  Renderer renderer_;
+  TrialRecorder recorder_;
+  RenderOutput last_output_{};
+  std::size_t ticks_ = 0;
+  std::size_t max_ticks_ = 0;
+  double last_time_s_ = 0.0;
+};
+
+}  // namespace calligraphy

@@ -1,0 +1,32 @@
+#include "calligraphy/trial/options.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "calligraphy/core/errors.hpp"
+
+namespace calligraphy {
+
+void TrialOptions::validate() const {
+  // Lock-step has no wall clock, so it may run faster than any loop thread; real time is the ServoLoop's
+  // range.
+  const double max_rate_hz = pacing == TrialPacing::real_time ? 10000.0 : 100000.0;
+  if (!(rate_hz >= 100.0 && rate_hz <= max_rate_hz)) {
+    throw InvalidArgument("TrialOptions.rate_hz = " + std::to_string(rate_hz) + " must be in [100, " +
+                          std::to_string(static_cast<int>(max_rate_hz)) + "] Hz" +
+                          (pacing == TrialPacing::real_time ? " in real time" : ""));
+  }
+  if (!(max_duration_s > 0.0) || !std::isfinite(max_duration_s)) {
+    throw InvalidArgument("TrialOptions.max_duration_s = " + std::to_string(max_duration_s) + " must be > 0");
+  }
+  force.validate();
+  passivity.validate();
+  simulation.writer.validate();
+  simulation.device.validate();
+  ServoLoopOptions paced = loop;
+  paced.rate_hz = std::min(rate_hz, 10000.0);  // the loop's other fields; its rate is the trial's
+  paced.validate();
+}
+
+}  // namespace calligraphy

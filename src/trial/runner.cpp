@@ -1,0 +1,171 @@
+// The one trial runner for every device and pacing (runner.hpp).
+#include "calligraphy/trial/runner.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/devices/device_registry.hpp"
+#include "calligraphy/sim/hand_port.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/sim/simulated_writer.hpp"
+#include "calligraphy/trial/session.hpp"
+
+namespace calligraphy {
+namespace {
+
+// Forces off, the hand let go and the link closed on every way out of a trial; never throws (the link
+// may be gone).
+class DeviceShutdown {
+ public:
+  DeviceShutdown(HapticDevice& device, HandPort* hand) : device_(device), hand_(hand) {}
+  DeviceShutdown(const DeviceShutdown&) = delete;
+  DeviceShutdown& operator=(const DeviceShutdown&) = delete;
+  ~DeviceShutdown() {
+    try {
+      device_.enable_forces(false);
+    } catch (...) {
+      // Disabling is documented not to throw; a broken backend must still get close().
+    }
+    if (hand_ != nullptr) hand_->attach_hand(nullptr);
+    device_.close();
+  }
+
+ private:
+  HapticDevice& device_;
+  HandPort* hand_;
+};
+
+// Lock-step: each tick reads the device, steps the session, commands the force, lets the writer see the
+// display and advances the device's time by one period. No wall clock.
+TrialResult run_lock_step(HapticDevice& device, HandPort& hand, SimulatedWriter& writer,
+                          TrialSession& session, const TrialOptions& options) {
+  const double period_s = 1.0 / options.rate_hz;
+  double end_time_s = -1.0;
+  TrialEnd end = TrialEnd::time_limit;
+  std::string reason;
+  try {
+    while (true) {
+      if (options.should_stop && options.should_stop()) {
+        end = TrialEnd::interrupted;
+        break;
+      }
+      const DeviceState state = device.read_state();
+      const ServoCommand command = session.step(state);
+      device.write_force(command.force_n);
+      end_time_s = state.time_s;
+      if (session.finished()) {
+        end = TrialEnd::completed;
+        break;
+      }
+      writer.observe(session.last_output(), state);
+      if (writer.done()) {
+        end = TrialEnd::writer_gave_up;
+        break;
+      }
+      if (command.stop) {  // out of time after this tick: the trial lasted until the next would start
+        end_time_s = state.time_s + period_s;
+        break;
+      }
+      hand.advance(period_s);
+    }
+  } catch (const DeviceError& e) {  // link lost, safety fault, or another device's fault
+    end = TrialEnd::device_fault;
+    reason = e.what();
+  }
+  return session.finish(end, std::move(reason), end_time_s);
+}
+
+// Real time on the ServoLoop: the loop thread steps the session (and a simulated writer and the device's
+// physics right after the force write); this thread polls `should_stop`.
+TrialResult run_real_time(HapticDevice& device, HandPort* hand, SimulatedWriter* writer,
+                          TrialSession& session, const TrialOptions& options) {
+  ServoLoopOptions loop_options = options.loop;
+  loop_options.rate_hz = options.rate_hz;
+  const double period_s = 1.0 / options.rate_hz;
+  std::atomic<bool> writer_gave_up{false};
+  session.reserve_trace();
+  ServoLoop loop(
+      device,
+      [&](const DeviceState& state, double /*dt_s*/) -> ServoCommand {
+        ServoCommand command = session.step(state);
+        if (writer != nullptr && !command.stop) {
+          writer->observe(session.last_output(), state);
+          if (writer->done()) {
+            writer_gave_up.store(true, std::memory_order_relaxed);
+            command.stop = true;
+          }
+        }
+        return command;
+      },
+      loop_options);
+  if (hand != nullptr) loop.set_after_write([hand, period_s] { hand->advance(period_s); });
+
+  loop.start();
+  bool interrupted = false;
+  while (loop.running()) {
+    if (options.should_stop && options.should_stop()) {
+      interrupted = true;
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  const LoopFault fault = loop.stop();  // joined; forces are zero and disabled
+  TrialEnd end = TrialEnd::interrupted;
+  if (fault) {
+    end = fault.kind == LoopFaultKind::watchdog ? TrialEnd::watchdog : TrialEnd::device_fault;
+  } else if (session.finished()) {
+    end = TrialEnd::completed;
+  } else if (writer_gave_up.load(std::memory_order_relaxed)) {
+    end = TrialEnd::writer_gave_up;
+  } else if (!interrupted && session.out_of_time()) {
+    end = TrialEnd::time_limit;
+  }
+  TrialResult result = session.finish(end, fault ? fault.message : std::string());
+  result.loop = loop.stats();
+  return result;
+}
+
+}  // namespace
+
+TrialResult run_trial(HapticDevice& device, const Scene& scene, const TrialOptions& options) {
+  options.validate();
+  // Discovered once: the loops never ask again.
+  HandPort* const hand = dynamic_cast<HandPort*>(&device);
+  if (hand == nullptr && options.pacing == TrialPacing::lock_step) {
+    throw InvalidArgument("lock-step pacing needs a device a simulated writer can move (a HandPort); '" +
+                          device.info().model + "' is moved by a person: use real-time pacing");
+  }
+  const bool real_time = hand == nullptr || options.pacing == TrialPacing::real_time;
+  std::optional<SimulatedWriter> writer;
+  if (hand != nullptr) {
+    writer.emplace(scene, options.simulation.writer, options.simulation.seed);
+    hand->attach_hand(&*writer);
+  }
+  const DeviceShutdown shutdown(device, hand);
+  if (!device.is_open()) device.open();
+  if (!device.is_calibrated()) device.calibrate();
+  // After open(): some devices know their limits only then (OpenHaptics reads them from the driver).
+  TrialSession session(scene, device.info(), options);
+  if (real_time) return run_real_time(device, hand, writer ? &*writer : nullptr, session, options);
+  device.enable_forces(true);
+  return run_lock_step(device, *hand, *writer, session, options);
+}
+
+TrialResult run_trial(std::string_view device_name, const Scene& scene, const TrialOptions& options) {
+  options.validate();  // before a device is created (and possibly opened by its backend)
+  const std::unique_ptr<HapticDevice> device = device_registry_with_simulation().create(device_name);
+  return run_trial(*device, scene, options);
+}
+
+TrialResult run_simulated_trial(const Scene& scene, const TrialOptions& options) {
+  options.validate();
+  SimulatedDevice device(options.simulation.device);
+  return run_trial(device, scene, options);
+}
+
+}  // namespace calligraphy

@@ -1,0 +1,46 @@
+#include "calligraphy/trial/session.hpp"
+
+#include <cmath>
+#include <utility>
+
+namespace calligraphy {
+namespace {
+
+RendererOptions renderer_options(const TrialOptions& options) {
+  RendererOptions render;
+  render.rate_hz = options.rate_hz;
+  render.safety = options.safety;
+  render.passivity = options.passivity;
+  return render;
+}
+
+}  // namespace
+
+TrialSession::TrialSession(const Scene& scene, const DeviceInfo& device, const TrialOptions& options)
+    : options_((options.validate(), options)),
+      renderer_(scene, options.force, device, renderer_options(options)),
+      recorder_(scene, options.keep_trace),
+      max_ticks_(static_cast<std::size_t>(std::ceil(options.max_duration_s * options.rate_hz))) {}
+
+void TrialSession::reserve_trace() { recorder_.reserve(max_ticks_); }
+
+ServoCommand TrialSession::step(const DeviceState& state) noexcept {
+  last_output_ = renderer_.tick(state);
+  recorder_.record(state, last_output_);
+  ++ticks_;
+  last_time_s_ = state.time_s;
+  return ServoCommand{last_output_.force_n, last_output_.finished || ticks_ >= max_ticks_};
+}
+
+TrialResult TrialSession::finish(TrialEnd end, std::string reason, double end_time_s) {
+  recorder_.finish(end_time_s < 0.0 ? last_time_s_ : end_time_s);
+  TrialResult result;
+  result.metrics = recorder_.metrics();
+  result.trace = recorder_.trace();
+  result.end = end;
+  result.aborted = end != TrialEnd::completed;
+  result.abort_reason = std::move(reason);
+  return result;
+}
+
+}  // namespace calligraphy

@@ -1,0 +1,140 @@
+// TrialSession from an application's own loop, and the runner's endings: one force write per tick,
+// the loop statistics kept, an interrupt, the time limit, a writer that gives up.
+#include <catch2/catch.hpp>
+
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/sim/simulated_writer.hpp"
+#include "calligraphy/trial/trial.hpp"
+
+using namespace calligraphy;
+
+namespace {
+
+Scene scene_of(std::u32string chars) {
+  std::vector<Character> characters;
+  for (char32_t c : chars) characters.push_back(CharacterLibrary::embedded().load(c));
+  return Scene::lay_out(characters);
+}
+
+// A simulated device that counts force writes and hand-port steps.
+class CountingDevice final : public HapticDevice, public HandPort {
+ public:
+  const DeviceInfo& info() const override { return inner_.info(); }
+  void open() override { inner_.open(); }
+  void close() noexcept override { inner_.close(); }
+  bool is_open() const override { return inner_.is_open(); }
+  void enable_forces(bool enabled) override { inner_.enable_forces(enabled); }
+  bool forces_enabled() const override { return inner_.forces_enabled(); }
+  DeviceState read_state() override {
+    ++reads_;
+    return inner_.read_state();
+  }
+  void write_force(const Vec3& force_n) override {
+    ++writes_;
+    inner_.write_force(force_n);
+  }
+  void attach_hand(HandModel* hand) noexcept override { inner_.attach_hand(hand); }
+  void advance(double dt_s) override { inner_.advance(dt_s); }
+  SimulatedDevice inner_;
+  long reads_ = 0;
+  long writes_ = 0;
+};
+
+}  // namespace
+
+TEST_CASE("A session stepped from the application's own loop records the runner's trial", "[trial]") {
+  const Scene scene = scene_of(U"九");
+  TrialOptions options;
+  options.simulation.seed = 3;
+  const TrialResult by_runner = run_simulated_trial(scene, options);
+
+  SimulatedDevice device(options.simulation.device);
+  SimulatedWriter writer(scene, options.simulation.writer, options.simulation.seed);
+  device.attach_hand(&writer);
+  device.open();
+  device.enable_forces(true);
+  TrialSession session(scene, device.info(), options);
+  session.reserve_trace();
+  while (true) {
+    const DeviceState state = device.read_state();
+    const ServoCommand command = session.step(state);
+    device.write_force(command.force_n);
+    if (command.stop) break;
+    writer.observe(session.last_output(), state);
+    if (writer.done()) break;
+    device.advance(1.0 / options.rate_hz);
+  }
+  const TrialResult by_hand = session.finish(session.finished() ? TrialEnd::completed : TrialEnd::time_limit);
+  CHECK(by_hand.end == TrialEnd::completed);
+  CHECK_FALSE(by_hand.aborted);
+  CHECK(by_hand.trace.size() == by_runner.trace.size());
+  CHECK(by_hand.metrics.mean_deviation_m == by_runner.metrics.mean_deviation_m);
+  CHECK(by_hand.metrics.time_s == by_runner.metrics.time_s);
+  CHECK(by_hand.metrics.completed_in_order);
+}
+
+TEST_CASE("Every tick writes the force once, lock-step and in real time", "[trial][servo]") {
+  const Scene scene = scene_of(U"乙");
+  for (const TrialPacing pacing : {TrialPacing::lock_step, TrialPacing::real_time}) {
+    CountingDevice device;
+    TrialOptions options;
+    options.pacing = pacing;
+    options.max_duration_s = 0.3;  // a short stretch of the trial is enough
+    options.loop.realtime = RealtimeMode::ignore;
+    options.loop.priority = 0;
+    options.loop.lock_memory = false;
+    const TrialResult result = run_trial(device, scene, options);
+    INFO("pacing " << static_cast<int>(pacing));
+    CHECK(result.end == TrialEnd::time_limit);
+    CHECK(result.aborted);
+    CHECK(static_cast<long>(result.trace.size()) == device.reads_);
+    // The runner writes once per tick; the loop adds one zero-force write at its end.
+    CHECK(device.writes_ == device.reads_ + (pacing == TrialPacing::real_time ? 1 : 0));
+    CHECK(result.loop.has_value() == (pacing == TrialPacing::real_time));
+    if (result.loop) CHECK(result.loop->ticks == result.trace.size());
+    CHECK_FALSE(device.is_open());
+  }
+}
+
+TEST_CASE("should_stop ends a trial as interrupted with the ticks kept", "[trial][servo]") {
+  const Scene scene = scene_of(U"永");
+  for (const TrialPacing pacing : {TrialPacing::lock_step, TrialPacing::real_time}) {
+    TrialOptions options;
+    options.pacing = pacing;
+    options.loop.realtime = RealtimeMode::ignore;
+    options.loop.priority = 0;
+    options.loop.lock_memory = false;
+    long polls = 0;
+    options.should_stop = [&polls] { return ++polls > 200; };
+    const TrialResult result = run_simulated_trial(scene, options);
+    INFO("pacing " << static_cast<int>(pacing));
+    CHECK(result.end == TrialEnd::interrupted);
+    CHECK(result.aborted);
+    CHECK_FALSE(result.trace.empty());
+    CHECK(result.metrics.strokes_completed < result.metrics.strokes_total);
+    if (pacing == TrialPacing::lock_step) CHECK(result.trace.size() == 200);
+  }
+}
+
+TEST_CASE("A writer that stops early ends the trial as writer_gave_up", "[trial]") {
+  const Scene scene = scene_of(U"口");
+  TrialOptions options;
+  options.rate_hz = 100.0;  // too coarse a tick for this writer: it misses every stroke and gives up
+  const TrialResult result = run_simulated_trial(scene, options);
+  CHECK(result.metrics.strokes_completed == 0);
+  CHECK(result.end == TrialEnd::writer_gave_up);
+  CHECK(std::string(to_string(result.end)) == "writer_gave_up");
+  CHECK(result.aborted);
+}
+
+TEST_CASE("The rate is checked against the pacing", "[trial]") {
+  TrialOptions options;
+  options.pacing = TrialPacing::real_time;
+  options.rate_hz = 20000.0;
+  CHECK_THROWS_AS(options.validate(), InvalidArgument);
+  options.pacing = TrialPacing::lock_step;
+  CHECK_NOTHROW(options.validate());
+  options.rate_hz = 50.0;
+  CHECK_THROWS_WITH(options.validate(), Catch::Contains("TrialOptions.rate_hz"));
+}
