@@ -216,6 +216,7 @@ py::dict metrics_dict(const std::string& characters, bool guidance, const std::s
   d["device"] = "simulated";  // as `calligraphy trial --device simulated`
   d["aborted"] = result.aborted;
   d["abort_reason"] = result.abort_reason;
+  d["end_reason"] = to_string(result.end);
   d["strokes_total"] = m.strokes_total;
   d["strokes_completed"] = m.strokes_completed;
   d["completed_in_order"] = m.completed_in_order;

@@ -9,7 +9,7 @@ import pytest
 import calligraphy
 
 CLI_KEYS = {
-    "character", "guidance", "writer", "seed", "rate_hz", "device", "aborted", "abort_reason",
+    "character", "guidance", "writer", "seed", "rate_hz", "device", "aborted", "abort_reason", "end_reason",
     "strokes_total", "strokes_completed",
     "completed_in_order", "time_s", "mean_deviation_mm", "max_deviation_mm", "max_force_n",
     "max_force_step_n", "state_transitions", "per_stroke",
