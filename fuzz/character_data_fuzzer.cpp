@@ -54,7 +54,8 @@ void check_fitted(const Character& character, std::size_t strokes) {
     require(stroke.typical_id >= 1 && stroke.typical_id <= 39);
     require(stroke.attraction_factors.size() == stroke.feature_point_count());
     for (const StrokeElement& element : stroke.elements) {
-      for (int i = 0; i <= element.degree; ++i) require(element.control[static_cast<std::size_t>(i)].allFinite());
+      for (int i = 0; i <= element.degree; ++i)
+        require(element.control[static_cast<std::size_t>(i)].allFinite());
       // The nearest point to a control point and to a point off the element: work bounded whatever the
       // element's shape (a throw here is a finding: the elements are finite and within 1e150).
       for (const Vec2& p : {element.control[1], Vec2(element.start() + Vec2(3.0, -7.0))}) {
