@@ -1,33 +1,18 @@
 #include "calligraphy/model/character_library.hpp"
 
 #include <algorithm>
-#include <fstream>
-#include <nlohmann/json.hpp>
-#include <sstream>
+#include <system_error>
 
 #include "calligraphy/core/errors.hpp"
 #include "core/unicode.hpp"
+#include "model/character_file.hpp"
 #include "model/embedded_characters.hpp"
+#include "model/median_json_reader.hpp"
 
 namespace calligraphy {
 namespace {
 
-std::string line_column(std::string_view text, std::size_t byte) {
-  std::size_t line = 1;
-  std::size_t column = 1;
-  for (std::size_t i = 0; i < std::min(byte, text.size()); ++i) {
-    if (text[i] == '\n') {
-      ++line;
-      column = 1;
-    } else {
-      ++column;
-    }
-  }
-  return std::to_string(line) + ":" + std::to_string(column);
-}
-
-[[noreturn]] void fail(const std::string& source, char32_t cp, const std::string& where,
-                       const std::string& what) {
+[[noreturn]] void fail(const std::string& source, char32_t cp, const std::string& where, const std::string& what) {
   throw DataError(source + ": character " + describe_character(cp) + ": " + where + ": " + what);
 }
 
@@ -42,39 +27,17 @@ const detail::EmbeddedCharacter* find_embedded(char32_t cp) {
 }  // namespace
 
 CharacterData parse_hanzi_writer_json(std::string_view json, char32_t cp, const std::string& source) {
-  nlohmann::json doc;
-  try {
-    doc = nlohmann::json::parse(json.begin(), json.end());
-  } catch (const nlohmann::json::parse_error& e) {
-    const std::size_t byte = e.byte > 0 ? e.byte - 1 : 0;
-    fail(source, cp, "line:column " + line_column(json, byte),
-         "malformed JSON (" + std::string(e.what()) + ")");
+  if (json.size() > kMaxCharacterFileBytes) {
+    fail(source, cp, "/",
+         "document of " + std::to_string(json.size()) + " bytes, more than the " +
+             std::to_string(kMaxCharacterFileBytes) + " a character file may have");
   }
-  if (!doc.is_object()) fail(source, cp, "/", "expected a JSON object");
-  const auto medians = doc.find("medians");
-  if (medians == doc.end()) fail(source, cp, "/medians", "missing");
-  if (!medians->is_array() || medians->empty()) fail(source, cp, "/medians", "expected a non-empty array");
+  detail::MedianJsonResult read = detail::read_medians_json(json);
+  if (!read.ok) fail(source, cp, read.where, read.what);
   CharacterData data;
   data.code_point = cp;
   data.source = source;
-  for (std::size_t s = 0; s < medians->size(); ++s) {
-    const auto& median = (*medians)[s];
-    const std::string stroke_path = "/medians/" + std::to_string(s);
-    if (!median.is_array() || median.empty())
-      fail(source, cp, stroke_path, "expected a non-empty array of points");
-    std::vector<Vec2> points;
-    for (std::size_t i = 0; i < median.size(); ++i) {
-      const auto& point = median[i];
-      const std::string path = stroke_path + "/" + std::to_string(i);
-      if (!point.is_array() || point.size() != 2 || !point[0].is_number() || !point[1].is_number()) {
-        fail(source, cp, path, "expected a point [x, y] of two numbers, got " + point.dump());
-      }
-      const Vec2 p(point[0].get<double>(), point[1].get<double>());
-      if (!p.allFinite()) fail(source, cp, path, "point is not finite");
-      points.push_back(p);
-    }
-    data.medians.push_back(std::move(points));
-  }
+  data.medians = std::move(read.medians);
   return data;
 }
 
@@ -110,12 +73,8 @@ CharacterData CharacterLibrary::load_data(char32_t cp) const {
     return parse_hanzi_writer_json(e->json, cp, "embedded:" + encode_utf8(cp) + ".json");
   }
   const auto path = folder_ / (encode_utf8(cp) + ".json");
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    throw CharacterNotFound("character " + describe_character(cp) + " not found: no file " + path.string());
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_hanzi_writer_json(text.str(), cp, path.string());
+  return parse_hanzi_writer_json(detail::read_character_file(path, cp, kMaxCharacterFileBytes), cp,
+                                 path.string());
 }
 
 Character CharacterLibrary::load(char32_t cp, const FitOptions& options) const {
@@ -132,14 +91,24 @@ std::vector<char32_t> CharacterLibrary::characters() const {
   if (folder_.empty()) {
     for (const auto& e : detail::embedded_characters()) out.push_back(decode_utf8(e.name).at(0));
   } else {
-    for (const auto& entry : std::filesystem::directory_iterator(folder_)) {
-      if (entry.path().extension() != ".json") continue;
+    std::error_code ec;
+    std::filesystem::directory_iterator entries(folder_, ec);
+    for (; !ec && entries != std::filesystem::directory_iterator(); entries.increment(ec)) {
+      const auto& path = entries->path();
+      if (path.extension() != ".json") continue;
       try {
-        const std::u32string name = decode_utf8(entry.path().stem().string());
+        const std::u32string name = decode_utf8(path.stem().string());
         if (name.size() == 1) out.push_back(name[0]);
       } catch (const InvalidArgument&) {
         // Not a character file (package.json, an odd name): skip.
       }
+    }
+    if (ec)
+      throw DataError(folder_.string() + ": cannot list the character data folder (" + ec.message() + ")");
+    if (out.empty()) {
+      throw DataError(folder_.string() +
+                      ": no character files (<character>.json) in the character data folder "
+                      "(fetch hanzi-writer-data with scripts/fetch-hanzi-writer-data.sh)");
     }
   }
   std::sort(out.begin(), out.end());

@@ -1,4 +1,7 @@
+#include <string>
+
 #include "calligraphy/model/character.hpp"
+#include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
 
@@ -16,6 +19,11 @@ CharacterTable character_table(const Character& character) {
     std::vector<int> features;
     int joint = -1;  // index of the previous element's end, shared with the next element's start
     for (const StrokeElement& element : stroke.elements) {
+      if (element.degree < 1 || element.degree > kMaxElementDegree) {  // control[] holds degree + 1 points
+        throw InvalidArgument("character_table: stroke " + std::to_string(table.typical_stroke_ids.size()) +
+                              " element " + std::to_string(elements.size() + 1) + ": degree " +
+                              std::to_string(element.degree) + " outside 1-4");
+      }
       std::vector<int> indices;
       for (int i = 0; i <= element.degree; ++i) {
         if (i == 0 && joint >= 0) {

@@ -6,8 +6,19 @@
 #include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
+namespace {
+
+// A fixed message per point (no formatting): cheap enough for any caller, and it names the point.
+[[noreturn]] void throw_not_finite(const char* function, int index) {
+  static constexpr const char* kPoint[] = {"0", "1", "2", "3", "4"};
+  throw InvalidArgument(std::string(function) + ": control point " + kPoint[index] + " is not finite");
+}
+
+}  // namespace
 
 StrokeElement StrokeElement::line(const Vec2& a, const Vec2& b) {
+  if (!a.allFinite()) throw_not_finite("StrokeElement::line", 0);
+  if (!b.allFinite()) throw_not_finite("StrokeElement::line", 1);
   StrokeElement e;
   e.kind = ElementKind::line;
   e.degree = 1;
@@ -20,6 +31,9 @@ StrokeElement StrokeElement::bezier(const Vec2* points, int count) {
   if (count < 3 || count > kMaxElementDegree + 1) {
     throw InvalidArgument("StrokeElement::bezier: " + std::to_string(count) +
                           " control points given, a CSE takes 3 to 5");
+  }
+  for (int i = 0; i < count; ++i) {
+    if (!points[i].allFinite()) throw_not_finite("StrokeElement::bezier", i);
   }
   StrokeElement e;
   e.kind = ElementKind::bezier;

@@ -1,6 +1,6 @@
-// Median polyline -> stroke elements (paper sections 3.3-3.4). First version: corners found by summed
-// turning over a window (hanzi-writer-data rounds corners over 2-3 vertices), straight pieces as
-// LSEs, bent pieces as least-squares Bezier CSEs, split at the worst point until within tolerance.
+// Median polyline -> stroke elements (paper sections 3.3-3.4). Corners found by summed turning over a
+// window (model/corner_search.cpp), straight pieces as LSEs, bent pieces as least-squares Bezier CSEs,
+// split at the worst point until within tolerance. Every loop is bounded by the number of points.
 #include "calligraphy/model/fitting.hpp"
 
 #include <Eigen/Dense>
@@ -13,13 +13,13 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
+#include "model/corner_search.hpp"
 #include "model/polyline.hpp"
 
 namespace calligraphy {
 namespace {
 
 constexpr double kBrushHookTurnDeg = 30.0;
-constexpr double kClusterTurnDeg = 10.0;
 constexpr int kMaxSplitDepth = 6;
 
 std::vector<Vec2> trim_brush_hooks(std::vector<Vec2> pts, const FitOptions& options) {
@@ -33,80 +33,6 @@ std::vector<Vec2> trim_brush_hooks(std::vector<Vec2> pts, const FitOptions& opti
   const std::size_t n = pts.size();
   if (n >= 3 && is_hook(pts[n - 1], pts[n - 2], pts[n - 3])) pts.pop_back();
   return pts;
-}
-
-// Indices of corner vertices, after replacing rounded corners (a run of vertices turning the same way)
-// by the intersection of the lines that enter and leave them. The window slides along the arc every
-// few units, so a corner rounded over several vertices is summed whole wherever its centre lies.
-std::vector<std::size_t> find_corners(std::vector<Vec2>& pts, const FitOptions& options) {
-  const std::size_t n = pts.size();
-  if (n < 3) return {};
-  std::vector<double> turn(n, 0.0);
-  std::vector<double> arc(n, 0.0);
-  for (std::size_t i = 1; i < n; ++i) arc[i] = arc[i - 1] + (pts[i] - pts[i - 1]).norm();
-  for (std::size_t i = 1; i + 1 < n; ++i) turn[i] = turn_deg(pts[i] - pts[i - 1], pts[i + 1] - pts[i]);
-
-  // Clusters [first, last] of interior vertices forming one corner each.
-  std::vector<std::pair<std::size_t, std::size_t>> clusters;
-  const double step = std::max(1.0, options.corner_window / 12.0);
-  for (double centre = 0.0; centre <= arc[n - 1]; centre += step) {
-    double windowed = 0.0;
-    for (std::size_t j = 1; j + 1 < n; ++j) {
-      if (std::abs(arc[j] - centre) <= options.corner_window) windowed += turn[j];
-    }
-    if (std::abs(windowed) < options.corner_angle_deg) continue;
-    std::size_t first = n;
-    std::size_t last = 0;
-    for (std::size_t j = 1; j + 1 < n; ++j) {
-      if (std::abs(arc[j] - centre) <= options.corner_window && turn[j] * windowed > 0.0 &&
-          std::abs(turn[j]) > kClusterTurnDeg) {
-        first = std::min(first, j);
-        last = std::max(last, j);
-      }
-    }
-    if (first > last) continue;
-    // Adjacent windows extend one corner; two corners joined by a long straight segment (a vertical
-    // and its hook) stay apart even when no vertex lies between them.
-    if (!clusters.empty() && first <= clusters.back().second + 1 &&
-        turn[first] * turn[clusters.back().first] > 0.0 &&
-        arc[first] - arc[clusters.back().second] <= options.corner_window) {
-      clusters.back().second = std::max(clusters.back().second, last);
-    } else if (clusters.empty() || first > clusters.back().second) {
-      clusters.emplace_back(first, last);
-    }
-  }
-
-  // Snap each cluster to one vertex, from the last so that earlier indices stay valid.
-  std::vector<std::size_t> corners;
-  for (auto it = clusters.rbegin(); it != clusters.rend(); ++it) {
-    auto [first, last] = *it;
-    std::size_t sharpest = first;
-    for (std::size_t j = first; j <= last; ++j) {
-      if (std::abs(turn[j]) > std::abs(turn[sharpest])) sharpest = j;
-    }
-    std::size_t corner = sharpest;
-    if (first != last) {
-      const Vec2 a = pts[first - 1];
-      const Vec2 da = pts[first] - a;
-      const Vec2 b = pts[last + 1];
-      const Vec2 db = pts[last] - b;
-      const double denom = da.x() * db.y() - da.y() * db.x();
-      if (std::abs(denom) > 1e-9 * da.norm() * db.norm()) {
-        const double s = ((b - a).x() * db.y() - (b - a).y() * db.x()) / denom;
-        const Vec2 x = a + s * da;
-        if (s > 0.0 && (x - pts[sharpest]).norm() <= options.corner_window) {
-          pts.erase(pts.begin() + static_cast<std::ptrdiff_t>(first + 1),
-                    pts.begin() + static_cast<std::ptrdiff_t>(last + 1));
-          pts[first] = x;
-          for (auto& c : corners) c -= last - first;
-          corner = first;
-        }
-      }
-    }
-    corners.push_back(corner);
-  }
-  std::reverse(corners.begin(), corners.end());
-  return corners;
 }
 
 // Direction of motion of a polyline between two fractions of its arc length, y-up degrees.
@@ -179,9 +105,10 @@ StrokeElement fit_bezier(const std::vector<Vec2>& samples, int degree) {
   return element;
 }
 
-double max_deviation(const std::vector<Vec2>& samples, const StrokeElement& element) {
+// The max distance of the samples from the element; any value above `stop_above` once it is exceeded.
+double max_deviation(const std::vector<Vec2>& samples, const StrokeElement& element, double stop_above) {
   const auto curve = sample_element(element, 64);
-  return max_distance_to_polyline(samples, curve);
+  return max_distance_to_polyline(samples, curve, stop_above);
 }
 
 void fit_piece(std::span<const Vec2> pts, const FitOptions& options, int depth,
@@ -190,12 +117,21 @@ void fit_piece(std::span<const Vec2> pts, const FitOptions& options, int depth,
     out.push_back(StrokeElement::line(pts.front(), pts.back()));
     return;
   }
-  const auto samples = resample(pts, std::max(2.0, options.tolerance * 0.5));
+  // Samples every half tolerance, but no more than a number tied to the piece's points, so that far-flung
+  // points (a hostile median) cost no more than near ones. It binds only on pieces longer than
+  // 2 * (1024 + 8 n) data units, two box widths, so never on the 1024-box data (same samples as before).
+  const double max_samples = 1024.0 + 8.0 * static_cast<double>(pts.size());
+  const double spacing = std::max({2.0, options.tolerance * 0.5, polyline_length(pts) / max_samples});
+  const auto samples = resample(pts, spacing);
   StrokeElement best;
   double best_deviation = std::numeric_limits<double>::infinity();
+  // Before the depth limit a piece that no degree fits within tolerance is split, so a candidate's
+  // deviation is needed only up to the tolerance; at the limit the least deviation picks the element.
+  const double needed_up_to =
+      depth >= kMaxSplitDepth ? std::numeric_limits<double>::infinity() : options.tolerance;
   for (int degree = 2; degree <= options.max_degree; ++degree) {
     const StrokeElement candidate = fit_bezier(samples, degree);
-    const double deviation = max_deviation(samples, candidate);
+    const double deviation = max_deviation(samples, candidate, needed_up_to);
     if (deviation < best_deviation) {
       best = candidate;
       best_deviation = deviation;
@@ -209,6 +145,38 @@ void fit_piece(std::span<const Vec2> pts, const FitOptions& options, int depth,
   const std::size_t split = farthest_from_chord(pts);
   fit_piece(pts.subspan(0, split + 1), options, depth + 1, out);
   fit_piece(pts.subspan(split), options, depth + 1, out);
+}
+
+std::vector<Vec2> sample_elements(std::span<const StrokeElement> elements) {
+  std::vector<Vec2> curve;
+  for (const auto& e : elements) {
+    const auto s = sample_element(e, 64);
+    curve.insert(curve.end(), s.begin(), s.end());
+  }
+  return curve;
+}
+
+// Max deviation of the kept median points from the whole fitted stroke. Exact when it takes at most 64
+// point-segment distances per point and curve sample, which a median of up to 64 points never exceeds;
+// otherwise (a long median overlapping itself many times) the max distance of each piece's points to
+// the piece's own elements, an upper bound, so that the work stays bounded by the number of points.
+double stroke_deviation(std::span<const Vec2> pts, std::span<const std::size_t> cuts,
+                        const FittedStroke& fitted) {
+  const std::vector<Vec2> curve = sample_elements(fitted.stroke.elements);
+  constexpr std::size_t kEvaluationsPerPoint = 64;
+  if (const auto exact =
+          max_distance_to_polyline_within(pts, curve, kEvaluationsPerPoint * (pts.size() + curve.size()))) {
+    return *exact;
+  }
+  double bound = 0.0;
+  for (std::size_t k = 0; k < fitted.pieces.size(); ++k) {
+    const StrokePiece& piece = fitted.pieces[k];
+    const auto own = std::span(fitted.stroke.elements)
+                         .subspan(piece.first_element, piece.end_element - piece.first_element);
+    bound = std::max(bound, max_distance_to_polyline(pts.subspan(cuts[k], cuts[k + 1] - cuts[k] + 1),
+                                                     sample_elements(own)));
+  }
+  return bound;
 }
 
 void check_options(const FitOptions& o) {
@@ -227,17 +195,21 @@ FittedStroke fit_stroke(std::span<const Vec2> median, const FitOptions& options)
   check_options(options);
   if (median.empty()) throw InvalidArgument("fit_stroke: empty median");
   for (std::size_t i = 0; i < median.size(); ++i) {
-    if (!median[i].allFinite())
-      throw InvalidArgument("fit_stroke: median point " + std::to_string(i) + " is not finite");
+    if (!median[i].allFinite()) throw InvalidArgument("fit_stroke: median point " + std::to_string(i) + " is not finite");
+    if (median[i].cwiseAbs().maxCoeff() > kMaxFitCoordinate) {
+      throw InvalidArgument("fit_stroke: median point " + std::to_string(i) +
+                            " is beyond +-1e150 (lengths would overflow)");
+    }
   }
   FittedStroke fitted;
   fitted.stroke.median.assign(median.begin(), median.end());
   std::vector<Vec2> pts = trim_brush_hooks(without_repeats(median), options);
+  std::vector<std::size_t> cuts{0, 0};  // piece k spans pts[cuts[k]] to pts[cuts[k + 1]]
   if (pts.size() == 1) {  // a single point: a zero-length LSE, always inside its constraint space (rule d)
     fitted.stroke.elements.push_back(StrokeElement::line(pts[0], pts[0]));
     fitted.pieces.push_back({0.0, 0.0, 0.0, 0, 1});
   } else {
-    std::vector<std::size_t> cuts = find_corners(pts, options);
+    cuts = detail::find_corners(pts, options);
     cuts.insert(cuts.begin(), 0);
     cuts.push_back(pts.size() - 1);
     for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
@@ -254,13 +226,7 @@ FittedStroke fit_stroke(std::span<const Vec2> median, const FitOptions& options)
       fitted.pieces.push_back(info);
     }
   }
-  // Max deviation of the kept median points from the whole fitted stroke.
-  std::vector<Vec2> curve;
-  for (const auto& e : fitted.stroke.elements) {
-    const auto s = sample_element(e, 64);
-    curve.insert(curve.end(), s.begin(), s.end());
-  }
-  fitted.max_deviation = max_distance_to_polyline(pts, curve);
+  fitted.max_deviation = stroke_deviation(pts, cuts, fitted);
 
   fitted.stroke.typical_id = classify_pieces(fitted.pieces);
   // Paper eq. 8: an attraction factor per feature point; corners (piece joints) pull harder so that the

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 
 namespace calligraphy {
 
@@ -34,7 +35,7 @@ double polyline_length(std::span<const Vec2> pts) {
 
 std::vector<Vec2> resample(std::span<const Vec2> pts, double step) {
   std::vector<Vec2> out;
-  if (pts.empty()) return out;
+  if (pts.empty() || !(step > 0.0)) return out;
   out.push_back(pts.front());
   double carried = 0.0;  // distance walked since the last emitted point
   for (std::size_t i = 1; i < pts.size(); ++i) {
@@ -44,6 +45,7 @@ std::vector<Vec2> resample(std::span<const Vec2> pts, double step) {
     double s = step - carried;
     while (s < len) {
       out.push_back(a + d * (s / len));
+      if (!(s + step > s)) break;  // a step below the rounding of s would never reach len
       s += step;
     }
     carried = len - (s - step);
@@ -87,7 +89,12 @@ double distance_to_polyline(const Vec2& p, std::span<const Vec2> pts) {
   return best;
 }
 
-double max_distance_to_polyline(std::span<const Vec2> points, std::span<const Vec2> pts) {
+namespace {
+
+// max_distance_to_polyline, giving up (nullopt) when it would take more than `max_evaluations` segment
+// distances.
+std::optional<double> bounded_max_distance(std::span<const Vec2> points, std::span<const Vec2> pts,
+                                           double stop_above, std::size_t max_evaluations) {
   if (pts.empty()) return points.empty() ? 0.0 : std::numeric_limits<double>::infinity();
   if (pts.size() == 1) {
     double worst = 0.0;
@@ -98,12 +105,14 @@ double max_distance_to_polyline(std::span<const Vec2> points, std::span<const Ve
   // farther than the worst so far (it cannot raise the max), and starts at the previous point's
   // nearest segment, where consecutive points usually find theirs.
   const std::size_t segments = pts.size() - 1;
+  std::size_t evaluations = 0;
   double worst = 0.0;
   std::size_t start = 0;
   for (const Vec2& p : points) {
     double best = std::numeric_limits<double>::infinity();
     std::size_t best_segment = start;
     for (std::size_t k = 0; k < segments; ++k) {
+      if (++evaluations > max_evaluations) return std::nullopt;
       const std::size_t i = (start + k) % segments;
       const double d = distance_to_segment(pts[i], pts[i + 1], p);
       if (d < best) {
@@ -113,9 +122,21 @@ double max_distance_to_polyline(std::span<const Vec2> points, std::span<const Ve
       if (best <= worst) break;
     }
     worst = std::max(worst, best);
+    if (worst > stop_above) return worst;
     start = best_segment;
   }
   return worst;
+}
+
+}  // namespace
+
+double max_distance_to_polyline(std::span<const Vec2> points, std::span<const Vec2> pts, double stop_above) {
+  return *bounded_max_distance(points, pts, stop_above, std::numeric_limits<std::size_t>::max());
+}
+
+std::optional<double> max_distance_to_polyline_within(std::span<const Vec2> points, std::span<const Vec2> pts,
+                                                      std::size_t max_evaluations) {
+  return bounded_max_distance(points, pts, std::numeric_limits<double>::infinity(), max_evaluations);
 }
 
 }  // namespace calligraphy

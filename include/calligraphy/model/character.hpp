@@ -51,7 +51,8 @@ struct CharacterTable {
   [[nodiscard]] std::size_t feature_point_count() const;
 };
 
-/// Builds the Table-3 view of a character.
+/// Builds the Table-3 view of a character. Throws InvalidArgument naming the stroke and element (from 1)
+/// when an element's degree is outside 1-4.
 CharacterTable character_table(const Character& character);
 
 }  // namespace calligraphy

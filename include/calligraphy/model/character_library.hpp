@@ -3,6 +3,7 @@
 /// Loads hanzi-writer-data 2.0.1 characters (one `<char>.json` per character, `medians` in a 1024 box,
 /// y up, as documented by Make Me a Hanzi) from the embedded default set or from a folder, such as the one
 /// `scripts/fetch-hanzi-writer-data.sh` unpacks. Errors name the character, the path and the position.
+#include <cstddef>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -14,6 +15,24 @@
 
 namespace calligraphy {
 
+/// Bounds on character data. hanzi-writer-data 2.0.1 has 2 to 38 integer points per median inside the
+/// 1024 box (y from -124 to 900); these bounds are far above that and keep loading and fitting of hostile
+/// files fast (the work is bounded by the file's size, never by its coordinate values).
+/// Largest character file read, bytes (hanzi-writer-data files average 5 kB: 47 MB for 9,574).
+inline constexpr std::size_t kMaxCharacterFileBytes = std::size_t{16} << 20;
+/// Largest |x| or |y| of a median point, data units (about 100 character boxes around the origin).
+inline constexpr double kMaxDataCoordinate = 1e5;
+/// Most points in one median.
+inline constexpr std::size_t kMaxMedianPoints = 10'000;
+/// Most strokes (medians) in one character (the most complex encoded CJK characters have about 64).
+inline constexpr std::size_t kMaxCharacterStrokes = 128;
+/// Most points in all medians of one character together: fitting took up to about 0.15 ms per point on
+/// the costliest hostile shapes measured, so this keeps one character's fitting within a few seconds.
+inline constexpr std::size_t kMaxCharacterPoints = 20'000;
+/// Deepest nesting of JSON arrays and objects (hanzi-writer-data nests 4 deep: object, medians,
+/// median, point).
+inline constexpr std::size_t kMaxJsonDepth = 16;
+
 /// A character's raw data: one median polyline per stroke, in stroke order, data units.
 struct CharacterData {
   char32_t code_point = 0;
@@ -21,9 +40,14 @@ struct CharacterData {
   std::vector<std::vector<Vec2>> medians;
 };
 
-/// Parses one hanzi-writer-data JSON document. `source` names it in errors. Throws DataError naming
-/// the source, the character and the position (line:column for syntax errors, a JSON pointer such as
-/// /medians/2/1 for structural ones).
+/// Parses one hanzi-writer-data JSON document: an object whose `medians` is a non-empty array of at
+/// most kMaxCharacterStrokes medians, each an array of 2 to kMaxMedianPoints points [x, y] with at least
+/// two distinct points and |x|, |y| <= kMaxDataCoordinate, kMaxCharacterPoints points in all, the text
+/// at most kMaxCharacterFileBytes; other keys are skipped. `source` names it in errors. Throws DataError
+/// naming the source, the character and the position: line:column and the JSON pointer being read for
+/// syntax errors, the JSON pointer (such as /medians/2/1/0) for everything else, including numbers out
+/// of range (1e400), values of the wrong type, nesting deeper than kMaxJsonDepth and the bounds above.
+/// Never recurses on the input's nesting.
 CharacterData parse_hanzi_writer_json(std::string_view json, char32_t code_point, const std::string& source);
 
 /// A set of characters to load from. Cheap to copy; loading parses only the character asked for.
@@ -32,7 +56,9 @@ class CharacterLibrary {
   /// The embedded default set: a verbatim subset of hanzi-writer-data 2.0.1 compiled into the library
   /// (data/hanzi-writer-data, Arphic Public License).
   static CharacterLibrary embedded();
-  /// A folder of `<char>.json` files. Throws DataError when the folder does not exist.
+  /// A folder of `<char>.json` files. Throws DataError when the folder does not exist. Only regular
+  /// files of at most kMaxCharacterFileBytes are read (a FIFO or a device named like a character file
+  /// is refused without blocking: DataError naming the file).
   static CharacterLibrary from_directory(const std::filesystem::path& folder);
 
   /// True when the character is available.
@@ -41,7 +67,8 @@ class CharacterLibrary {
   [[nodiscard]] CharacterData load_data(char32_t code_point) const;
   /// The fitted model (elements, feature points, typical IDs). Throws as `load_data`.
   [[nodiscard]] Character load(char32_t code_point, const FitOptions& options = {}) const;
-  /// Every available character, sorted by code point.
+  /// Every available character, sorted by code point. Throws DataError naming the folder when a folder
+  /// holds no `<char>.json` file or cannot be listed.
   [[nodiscard]] std::vector<char32_t> characters() const;
   /// "embedded default (58 characters)" or the folder's path.
   [[nodiscard]] std::string description() const;

@@ -30,9 +30,12 @@ struct StrokeElement {
   std::array<Vec2, kMaxElementDegree + 1> control{Vec2::Zero(), Vec2::Zero(), Vec2::Zero(), Vec2::Zero(),
                                                   Vec2::Zero()};
 
-  /// An LSE from `a` to `b`.
+  /// An LSE from `a` to `b` (equal points give a zero-length LSE, paper section 4.3.1 rule (d)).
+  /// Throws InvalidArgument "StrokeElement::line: control point <i> is not finite" for a NaN or
+  /// infinite coordinate.
   static StrokeElement line(const Vec2& a, const Vec2& b);
-  /// A CSE from 3 to 5 control points (degree 2 to 4). Throws InvalidArgument otherwise.
+  /// A CSE from 3 to 5 control points (degree 2 to 4). Throws InvalidArgument for another count, or
+  /// "StrokeElement::bezier: control point <i> is not finite" for a NaN or infinite coordinate.
   static StrokeElement bezier(const Vec2* points, int count);
 
   [[nodiscard]] int point_count() const { return degree + 1; }

@@ -43,13 +43,22 @@ struct StrokePiece {
 
 /// Result of fitting one median.
 struct FittedStroke {
-  Stroke stroke;                    ///< elements, attraction factors, typical ID, median
-  std::vector<StrokePiece> pieces;  ///< corner-to-corner pieces
-  double max_deviation = 0.0;       ///< max distance from the median's points to the elements [data units]
+  Stroke stroke;                     ///< elements, attraction factors, typical ID, median
+  std::vector<StrokePiece> pieces;   ///< corner-to-corner pieces
+  /// Max distance from the (trimmed) median's points to the elements [data units]. Exact for medians of
+  /// up to 64 points (all of hanzi-writer-data); for longer ones, when the exact value would cost more
+  /// than 64 point-segment distances per point and curve sample (a median overlapping itself many
+  /// times), the max distance of each piece's points to the piece's own elements, an upper bound.
+  double max_deviation = 0.0;
 };
 
+/// Largest |x| or |y| of a median point that `fit_stroke` accepts: squared distances between such
+/// points stay finite. (Character files are held to the far smaller kMaxDataCoordinate.)
+inline constexpr double kMaxFitCoordinate = 1e150;
+
 /// Fits one median (at least one point; a single point gives a zero-length LSE, paper rule (d)).
-/// Throws InvalidArgument for non-finite points or options out of range.
+/// The work is bounded by the number of points (about linear in it), whatever the coordinates.
+/// Throws InvalidArgument for non-finite points, points beyond kMaxFitCoordinate or options out of range.
 FittedStroke fit_stroke(std::span<const Vec2> median, const FitOptions& options = {});
 
 /// Typical-stroke classification of fitted pieces by template matching: the least cost over the 39
