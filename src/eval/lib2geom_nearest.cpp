@@ -13,6 +13,7 @@
 #include <2geom/exception.h>
 #include <2geom/point.h>
 
+#include <array>
 #include <vector>
 #endif
 
@@ -48,6 +49,23 @@ struct Lib2geomCurve::Curve {
   Geom::BezierCurve bezier;
 };
 
+namespace {
+
+// |B(t) - P| from the control points taken relative to P, as lib2geom compares its candidates (it
+// subtracts P from the curve first): the distance then carries no rounding of global coordinates, and
+// the error measured is that of lib2geom's t. De Casteljau on at most five points, no allocation.
+double distance_at(const Geom::BezierCurve& curve, const Geom::Point& p, double t) {
+  std::array<Geom::Point, kMaxElementDegree + 1> relative;
+  const unsigned order = curve.order();
+  for (unsigned i = 0; i <= order; ++i) relative[i] = curve.controlPoint(i) - p;
+  for (unsigned level = 1; level <= order; ++level) {
+    for (unsigned i = 0; i + level <= order; ++i) relative[i] = (1.0 - t) * relative[i] + t * relative[i + 1];
+  }
+  return Geom::L2(relative[0]);
+}
+
+}  // namespace
+
 bool lib2geom_built() { return true; }
 
 Lib2geomCurve::Lib2geomCurve(const StrokeElement& element) {
@@ -75,7 +93,7 @@ NearestPoint Lib2geomCurve::nearest(const Vec2& p) const {
   }
   const Geom::Point foot = curve_->bezier.pointAt(result.t);
   result.foot = Vec2(foot.x(), foot.y());
-  result.distance = Geom::distance(foot, query);
+  result.distance = distance_at(curve_->bezier, query, result.t);
   return result;
 }
 

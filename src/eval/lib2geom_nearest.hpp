@@ -28,7 +28,8 @@ class Lib2geomCurve {
   Lib2geomCurve& operator=(const Lib2geomCurve&) = delete;
 
   /// t = Geom::nearest_time(p, curve); foot = the curve's point at t (lib2geom's evaluation);
-  /// distance = |foot - p| (element units). Throws InvalidArgument for a non-finite `p`, Error when
+  /// distance = |B(t) - p| evaluated on the control points relative to p, as lib2geom compares its
+  /// candidates (element units). Throws InvalidArgument for a non-finite `p`, Error when
   /// lib2geom throws. Not on a moved-from curve.
   [[nodiscard]] NearestPoint nearest(const Vec2& p) const;
 
