@@ -10,6 +10,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
+#include "eval/generated_document.hpp"
 #include "eval/nearest_point_jumps.hpp"
 #include "eval/nearest_point_measurement.hpp"
 #include "eval/nearest_point_report.hpp"
@@ -30,14 +31,6 @@ Integer parse_integer(const std::string& option, const std::string& text, Intege
                      kUsage);
   }
   return value;
-}
-
-std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return {};
-  std::ostringstream content;
-  content << in.rdbuf();
-  return content.str();
 }
 
 void write_document(const std::string& path, const std::string& document) {
@@ -81,6 +74,8 @@ int command_bench_nearest(const Args& args) {
     }
   }
 
+  // Checked before the minutes of measuring.
+  const std::string document = markdown_path.empty() ? std::string() : read_generated_document(markdown_path);
   const std::vector<NearestPointScenario> scenarios = nearest_point_scenarios();
   const NearestPointMeasurement measurement = measure_nearest_point(scenarios, settings);
   std::string command = "calligraphy bench nearest";
@@ -90,9 +85,9 @@ int command_bench_nearest(const Args& args) {
 
   if (!markdown_path.empty()) {
     const JumpMeasurement jumps = measure_foot_jumps(jump_settings_for_seed(settings.seed));
-    std::string document = replace_generated_section(read_file(markdown_path), section);
-    document = replace_generated_section(document, foot_jumps_markdown(jumps, command), kJumpsGeneratedBegin);
-    write_document(markdown_path, document);
+    std::string updated = replace_generated_section(document, section);
+    updated = replace_generated_section(updated, foot_jumps_markdown(jumps, command), kJumpsGeneratedBegin);
+    write_document(markdown_path, updated);
   }
   if (json) {
     std::cout << nearest_point_json(measurement);
@@ -131,6 +126,7 @@ int command_bench_jumps(const Args& args) {
       throw UsageError("unknown argument '" + arg + "'\n" + kJumpsUsage);
     }
   }
+  const std::string document = markdown_path.empty() ? std::string() : read_generated_document(markdown_path);
   JumpSettings settings;
   settings.seeds.clear();
   for (int seed = 1; seed <= seed_count; ++seed) settings.seeds.push_back(static_cast<std::uint64_t>(seed));
@@ -143,8 +139,7 @@ int command_bench_jumps(const Args& args) {
   if (!chars.empty()) command += " --chars " + chars;
   const std::string section = foot_jumps_markdown(measurement, command);
   if (!markdown_path.empty()) {
-    write_document(markdown_path,
-                   replace_generated_section(read_file(markdown_path), section, kJumpsGeneratedBegin));
+    write_document(markdown_path, replace_generated_section(document, section, kJumpsGeneratedBegin));
   }
   if (json) {
     std::cout << foot_jumps_json(measurement);

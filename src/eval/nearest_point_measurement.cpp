@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <utility>
 
+#include "calligraphy/core/errors.hpp"
+#include "eval/lib2geom_nearest.hpp"
 #include "eval/nearest_point_reference.hpp"
 
 namespace calligraphy::cli {
@@ -31,30 +35,35 @@ double percentile(std::vector<double> values, double fraction) {
   return values[std::clamp<std::size_t>(rank, 1, values.size()) - 1];
 }
 
-// Time per call of one query, `repeats` calls timed together.
-double time_query(const NearestPointQuery& query, const NearestPointOptions& options, int repeats,
-                  volatile double& sink) {
+// Time per call of `distance_of(i)`, `repeats` calls timed together.
+template <typename DistanceOf>
+double time_query(const DistanceOf& distance_of, std::size_t i, int repeats, volatile double& sink) {
   const auto start = std::chrono::steady_clock::now();
-  for (int i = 0; i < repeats; ++i) sink = sink + nearest_point(query.element, query.point, options).distance;
+  for (int r = 0; r < repeats; ++r) sink = sink + distance_of(i);
   const auto stop = std::chrono::steady_clock::now();
   return std::chrono::duration<double, std::nano>(stop - start).count() / repeats;
 }
 
-NearestPointRow measure_method(NearestPointMethod method, int degree, const std::string& scenario,
-                               const std::vector<NearestPointQuery>& queries,
-                               const std::vector<ReferenceNearest>& references, int repeats) {
-  NearestPointRow row;
-  row.method = method_name(method);
-  row.degree = degree;
-  row.scenario = scenario;
+// Errors and times of one solver, `distance_of(i)` being its distance for query i. Every solver sees
+// the same queries in the same order; a query it throws on (std::nullopt from `checked_distance_of`)
+// counts as an infinite error and is not timed.
+template <typename DistanceOf, typename CheckedDistanceOf>
+NearestPointRow measure_solver(NearestPointRow row, const std::vector<NearestPointQuery>& queries,
+                               const std::vector<ReferenceNearest>& references, int repeats,
+                               const DistanceOf& distance_of, const CheckedDistanceOf& checked_distance_of) {
   row.queries = static_cast<int>(queries.size());
   double error_sum = 0.0;
   int off = 0;
+  std::vector<bool> failed(queries.size(), false);
   for (std::size_t i = 0; i < queries.size(); ++i) {
-    const NearestPointOptions options = options_for(method, queries[i].element);
-    const NearestPoint result = nearest_point(queries[i].element, queries[i].point, options);
-    const auto error =
-        static_cast<double>(std::abs(static_cast<long double>(result.distance) - references[i].distance));
+    const std::optional<double> distance = checked_distance_of(i);
+    double error = std::numeric_limits<double>::infinity();
+    if (distance) {
+      error = static_cast<double>(std::abs(static_cast<long double>(*distance) - references[i].distance));
+    } else {
+      failed[i] = true;
+      ++row.failed_queries;
+    }
     row.max_error_m = std::max(row.max_error_m, error);
     error_sum += error;
     if (error > kOffThreshold) ++off;
@@ -68,12 +77,61 @@ NearestPointRow measure_method(NearestPointMethod method, int degree, const std:
   volatile double sink = 0.0;
   std::vector<double> times;
   times.reserve(queries.size());
-  for (const NearestPointQuery& query : queries) {
-    times.push_back(time_query(query, options_for(method, query.element), repeats, sink));
+  for (std::size_t i = 0; i < queries.size(); ++i) {
+    if (!failed[i]) times.push_back(time_query(distance_of, i, repeats, sink));
   }
-  row.ns_median = percentile(times, 0.5);
-  row.ns_p99 = percentile(times, 0.99);
+  if (!times.empty()) {
+    row.ns_median = percentile(times, 0.5);
+    row.ns_p99 = percentile(times, 0.99);
+  }
   return row;
+}
+
+NearestPointRow row_header(const char* method, int degree, const std::string& scenario) {
+  NearestPointRow row;
+  row.method = method;
+  row.degree = degree;
+  row.scenario = scenario;
+  return row;
+}
+
+NearestPointRow measure_method(NearestPointMethod method, int degree, const std::string& scenario,
+                               const std::vector<NearestPointQuery>& queries,
+                               const std::vector<ReferenceNearest>& references, int repeats) {
+  std::vector<NearestPointOptions> options;
+  options.reserve(queries.size());
+  for (const NearestPointQuery& query : queries) options.push_back(options_for(method, query.element));
+  const auto distance_of = [&](std::size_t i) {
+    return nearest_point(queries[i].element, queries[i].point, options[i]).distance;
+  };
+  const auto checked = [&](std::size_t i) { return std::optional<double>(distance_of(i)); };
+  return measure_solver(row_header(method_name(method), degree, scenario), queries, references, repeats,
+                        distance_of, checked);
+}
+
+// lib2geom's Geom::nearest_time on curves converted before the timing (as a caller would keep them
+// for a stroke); the time includes evaluating the foot point and the distance.
+NearestPointRow measure_lib2geom(int degree, const std::string& scenario,
+                                 const std::vector<NearestPointQuery>& queries,
+                                 const std::vector<ReferenceNearest>& references, int repeats) {
+  NearestPointRow row = row_header(kLib2geomMethod, degree, scenario);
+  if (!lib2geom_built()) {
+    row.built = false;
+    row.queries = static_cast<int>(queries.size());
+    return row;
+  }
+  std::vector<Lib2geomCurve> curves;
+  curves.reserve(queries.size());
+  for (const NearestPointQuery& query : queries) curves.emplace_back(query.element);
+  const auto distance_of = [&](std::size_t i) { return curves[i].nearest(queries[i].point).distance; };
+  const auto checked = [&](std::size_t i) -> std::optional<double> {
+    try {
+      return distance_of(i);
+    } catch (const Error&) {
+      return std::nullopt;
+    }
+  };
+  return measure_solver(std::move(row), queries, references, repeats, distance_of, checked);
 }
 
 // Through volatile floats: GCC 12 at -O2 dropped the plain double -> float -> double round trip in
@@ -146,6 +204,8 @@ NearestPointMeasurement measure_nearest_point(const std::vector<NearestPointScen
         measurement.rows.push_back(
             measure_method(method, degree, scenarios[s].name, queries, references, settings.timing_repeats));
       }
+      measurement.rows.push_back(
+          measure_lib2geom(degree, scenarios[s].name, queries, references, settings.timing_repeats));
       if (scenarios[s].name == measurement.precision_scenario) {
         for (PrecisionRow& row : measure_precision(queries, references, degree))
           measurement.precision.push_back(row);

@@ -14,6 +14,8 @@ namespace calligraphy::cli {
 /// One row of the table: one method on one degree of one scenario.
 struct NearestPointRow {
   std::string method;
+  /// false for the lib2geom method in a build without lib2geom: nothing was measured.
+  bool built = true;
   int degree = 0;
   std::string scenario;
   int queries = 0;
@@ -25,6 +27,9 @@ struct NearestPointRow {
   /// max of error / control-polygon length over the queries with a non-zero length (dimensionless);
   /// empty when every element has zero length.
   std::optional<double> max_error_over_length;
+  /// Queries the method threw on (only lib2geom can); counted with an infinite error and left out of
+  /// the times.
+  int failed_queries = 0;
 };
 
 /// The float-versus-double comparison: max distance error of the exact method when the input is
@@ -50,7 +55,11 @@ struct MeasurementSettings {
 /// The method names used in the table: "exact", "newton", "subdivision".
 const char* method_name(NearestPointMethod method);
 
-/// Measures every method on every degree of every scenario with queries.
+/// The name of lib2geom's Geom::nearest_time in the table (src/eval/lib2geom_nearest.hpp).
+inline constexpr const char* kLib2geomMethod = "lib2geom";
+
+/// Measures every method, and lib2geom's Geom::nearest_time (a row that is not `built` when this
+/// build has no lib2geom), on every degree of every scenario with queries.
 NearestPointMeasurement measure_nearest_point(const std::vector<NearestPointScenario>& scenarios,
                                               const MeasurementSettings& settings);
 

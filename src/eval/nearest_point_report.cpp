@@ -1,5 +1,6 @@
 #include "eval/nearest_point_report.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -40,11 +41,61 @@ std::string build_description() {
 #endif
 }
 
+const NearestPointRow* find_row(const NearestPointMeasurement& measurement, const std::string& method,
+                                int degree, const std::string& scenario) {
+  for (const NearestPointRow& row : measurement.rows) {
+    if (row.method == method && row.degree == degree && row.scenario == scenario) return &row;
+  }
+  return nullptr;
+}
+
+// lib2geom against `exact` on the same queries of the same run: time ratio and both errors.
+std::string lib2geom_comparison(const NearestPointMeasurement& measurement) {
+  std::ostringstream out;
+  out << "\n`" << kLib2geomMethod << "` versus `exact` on the same queries (time ratio = " << kLib2geomMethod
+      << " median / exact median; error ratio = " << kLib2geomMethod
+      << " max error / exact max error, \"-\" when exact's is 0):\n\n";
+  std::vector<double> time_ratios;
+  int failed = 0;
+  std::ostringstream table;
+  table << "| degree | scenario | exact ns | " << kLib2geomMethod
+        << " ns | time ratio | exact max error (m) | " << kLib2geomMethod << " max error (m) | error ratio | "
+        << kLib2geomMethod << " > 0.1 mm |\n";
+  table << "|---:|---|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const NearestPointRow& row : measurement.rows) {
+    if (row.method != kLib2geomMethod) continue;
+    if (!row.built)
+      return out.str() + kLib2geomMethod + std::string(": not built (this build has no lib2geom)\n");
+    const NearestPointRow* exact = find_row(measurement, "exact", row.degree, row.scenario);
+    if (exact == nullptr) continue;
+    failed += row.failed_queries;
+    const double time_ratio = row.ns_median / exact->ns_median;
+    time_ratios.push_back(time_ratio);
+    table << "| " << row.degree << " | " << row.scenario << " | " << format("%.0f", exact->ns_median) << " | "
+          << format("%.0f", row.ns_median) << " | " << format("%.2f", time_ratio) << " | "
+          << format("%.3g", exact->max_error_m) << " | " << format("%.3g", row.max_error_m) << " | "
+          << (exact->max_error_m > 0.0 ? format("%.3g", row.max_error_m / exact->max_error_m)
+                                       : std::string("-"))
+          << " | " << format("%.2f %%", 100.0 * row.frac_off_0p1mm) << " |\n";
+  }
+  if (time_ratios.empty()) return {};
+  std::sort(time_ratios.begin(), time_ratios.end());
+  out << table.str() << "\nTime ratio over the " << time_ratios.size()
+      << " scenario and degree pairs: median " << format("%.2f", time_ratios[time_ratios.size() / 2])
+      << ", from " << format("%.2f", time_ratios.front()) << " to " << format("%.2f", time_ratios.back())
+      << ".";
+  if (failed > 0)
+    out << " " << kLib2geomMethod << " threw on " << failed << " queries (counted as infinite errors).";
+  out << "\n";
+  return out.str();
+}
+
 }  // namespace
 
 std::string nearest_point_json(const NearestPointMeasurement& measurement) {
   nlohmann::json rows = nlohmann::json::array();
   for (const NearestPointRow& row : measurement.rows) {
+    if (!row.built) continue;
     rows.push_back({{"method", row.method},
                     {"degree", row.degree},
                     {"scenario", row.scenario},
@@ -68,9 +119,13 @@ std::string nearest_point_markdown(const NearestPointMeasurement& measurement,
     out << "- `" << scenario.name << "`: " << scenario.description << "\n";
   }
   out << "\nTimes are per query (`nearest_point` including validation), median and 99th percentile over the "
-         "queries. Errors are |distance - reference distance| in m; the reference is sampling in long double "
+         "queries. `"
+      << kLib2geomMethod
+      << "` is lib2geom's `Geom::nearest_time` on a `Geom::BezierCurve` with the element's control points, "
+         "converted before the timing; its time includes evaluating the foot point and the distance. "
+         "Errors are |distance - reference distance| in m; the reference is sampling in long double "
          "refined to 1e-15 in t, with the final distances in __float128 "
-         "(src/cli/nearest_point_reference.hpp). "
+         "(src/eval/nearest_point_reference.hpp). "
          "\"> 0.1 mm\" is the share of queries off by more than 1e-4 m; \"max err / L\" is the largest error "
          "divided by the element's control-polygon length (\"-\" when every element has zero length).\n\n";
   out << "| method | degree | scenario | queries | ns median | ns p99 | max error (m) | mean error (m) | > "
@@ -78,6 +133,11 @@ std::string nearest_point_markdown(const NearestPointMeasurement& measurement,
          "max err / L |\n";
   out << "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const NearestPointRow& row : measurement.rows) {
+    if (!row.built) {
+      out << "| " << row.method << " | " << row.degree << " | " << row.scenario << " | " << row.queries
+          << " | not built | not built | not built | not built | not built | not built |\n";
+      continue;
+    }
     out << "| " << row.method << " | " << row.degree << " | " << row.scenario << " | " << row.queries << " | "
         << format("%.0f", row.ns_median) << " | " << format("%.0f", row.ns_p99) << " | "
         << format("%.3g", row.max_error_m) << " | " << format("%.3g", row.mean_error_m) << " | "
@@ -85,6 +145,7 @@ std::string nearest_point_markdown(const NearestPointMeasurement& measurement,
         << (row.max_error_over_length ? format("%.3g", *row.max_error_over_length) : std::string("-"))
         << " |\n";
   }
+  out << lib2geom_comparison(measurement);
   if (!measurement.precision.empty()) {
     out << "\nFloat versus double (exact method, scenario `" << measurement.precision_scenario
         << "`: the input rounded to float first, max distance error in m):\n\n";

@@ -9,11 +9,12 @@
 namespace calligraphy::cli {
 
 /// A JSON array of objects with exactly the keys method, degree, scenario, ns_median, ns_p99,
-/// max_error_m, mean_error_m, frac_off_0p1mm.
+/// max_error_m, mean_error_m, frac_off_0p1mm; rows that were not built (lib2geom missing) are left out.
 std::string nearest_point_json(const NearestPointMeasurement& measurement);
 
-/// The generated Markdown section (between the markers below): settings, scenarios, the table and
-/// the float-versus-double comparison. `command` is the command line that regenerates it.
+/// The generated Markdown section (between the markers below): settings, scenarios, the table,
+/// lib2geom versus exact and the float-versus-double comparison. `command` is the command line that
+/// regenerates it.
 std::string nearest_point_markdown(const NearestPointMeasurement& measurement,
                                    const std::vector<NearestPointScenario>& scenarios,
                                    const std::string& command);
