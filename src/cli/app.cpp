@@ -219,7 +219,10 @@ CLI::Option* add_output_path(CLI::App& app, const std::string& name, std::string
 
 CLI::Option* required(CLI::Option* option) {
   option->required();
-  option->description(option->get_description() + " (required)");
+  std::string description = option->get_description();
+  const auto default_start = description.rfind(" (default: ");
+  if (default_start != std::string::npos) description.erase(default_start);  // a required option has none
+  option->description(description + " (required)");
   return option;
 }
 

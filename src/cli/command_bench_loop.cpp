@@ -71,7 +71,7 @@ void add_bench_loop_command(CLI::App& bench, Commands& commands) {
   add_integer(*app, "--watchdog-periods", command->watchdog_periods, "N",
               "end the run when the device holds one force longer than N periods; 0: off", 0, 1000000);
   add_text(*app, "--trial", command->trial, "CHARS", "run a real-time simulated trial of these characters",
-           "none: the free loop (the simulated device held by a spring)");
+           "none: the free loop, the simulated device held by a spring");
   add_library_options(*app, command->library, false);
   add_flag(*app, "--json", command->json, "print the statistics as JSON");
 }

@@ -88,7 +88,8 @@ void add_corpus_validate_command(CLI::App& corpus, Commands& commands) {
   add_output_path(*app, "--markdown", command->markdown,
                   "write the report as Markdown (docs/classification.md)", StandardOutput::allowed);
   add_flag(*app, "--json", command->json, "print the result as JSON");
-  add_integer(*app, "--threads", command->threads, "N", "threads that fit and classify", 1, 64);
+  add_integer(*app, "--threads", command->threads, "N", "threads that fit and classify", 1, 64,
+              "one per CPU, at most 2; " + std::to_string(command->threads) + " here");
   add_output_path(*app, "--features", command->features, "write each stroke's classification features (CSV)",
                   StandardOutput::refused);
 }
