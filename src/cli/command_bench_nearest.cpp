@@ -1,154 +1,128 @@
-// `calligraphy bench nearest [--json] [--markdown FILE] [--queries N] [--seed S]`: accuracy and speed
-// of the nearest-point methods on every scenario, and `calligraphy bench jumps [--json] [--markdown FILE]
-// [--seeds N] [--chars CHARS]`: foot-point jumps on real characters, by method (docs/nearest-point.md).
-// `bench nearest --markdown` regenerates both sections of the document.
-#include <charconv>
-#include <fstream>
-#include <iostream>
-#include <sstream>
+// `calligraphy bench nearest`: accuracy and speed of the nearest-point methods on every scenario, and
+// `calligraphy bench jumps`: foot-point jumps on real characters, by method (docs/nearest-point.md).
+// With --markdown FILE the generated sections of that document are replaced (both, for `bench nearest`);
+// the rest of the document is kept. Only a regular file is read for that; any other target (a device,
+// '-') gets the generated sections alone.
+#include <memory>
+#include <string>
 
-#include "calligraphy/core/errors.hpp"
+#include "calligraphy/report/atomic_file.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
-#include "eval/generated_document.hpp"
+#include "cli/output.hpp"
 #include "eval/nearest_point_jumps.hpp"
 #include "eval/nearest_point_measurement.hpp"
 #include "eval/nearest_point_report.hpp"
 
 namespace calligraphy::cli {
-
 namespace {
 
-constexpr const char* kUsage =
-    "usage: calligraphy bench nearest [--json] [--markdown FILE] [--queries N] [--seed S]";
-
-template <typename Integer>
-Integer parse_integer(const std::string& option, const std::string& text, Integer minimum) {
-  Integer value{};
-  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (error != std::errc() || end != text.data() + text.size() || value < minimum) {
-    throw UsageError(option + " expects an integer >= " + std::to_string(minimum) + ", got '" + text + "'\n" +
-                     kUsage);
-  }
-  return value;
+// The document at `path` with its generated sections replaced, or the sections alone.
+std::string updated_document(const std::string& path, const std::string& section, const char* marker,
+                             const std::string& jumps_section = {}) {
+  std::string document = path == "-" ? std::string() : read_file_for_update(path).value_or(std::string());
+  document = replace_generated_section(document, section, marker);
+  if (!jumps_section.empty())
+    document = replace_generated_section(document, jumps_section, kJumpsGeneratedBegin);
+  return document;
 }
 
-void write_document(const std::string& path, const std::string& document) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out || !(out << document) || !out.flush()) {
-    throw Error("bench: cannot write the Markdown file '" + path + "'");
+// Standard output: the JSON, else the section unless it went to a document (then where it went).
+void print_report(bool json, const std::string& json_text, const std::string& markdown,
+                  const std::string& section) {
+  if (json) {
+    write_standard_output(json_text);
+  } else if (markdown.empty()) {
+    write_standard_output(section);
+  } else if (markdown != "-") {
+    write_standard_output("wrote the table to " + markdown + "\n");
   }
 }
 
-// The jump measurement of `bench nearest`: seeds S, S + 1, S + 2 on every embedded character.
-JumpSettings jump_settings_for_seed(std::uint64_t seed) {
+struct NearestCommand {
+  bool json = false;
+  std::string markdown;
+  std::int64_t queries = MeasurementSettings{}.queries;
+  std::uint64_t seed = MeasurementSettings{}.seed;
+};
+
+int run_nearest(const NearestCommand& command) {
+  require_one_standard_output({{"--json", command.json}, {"--markdown -", command.markdown == "-"}});
+  MeasurementSettings settings;
+  settings.queries = static_cast<int>(command.queries);
+  settings.seed = command.seed;
+  const std::vector<NearestPointScenario> scenarios = nearest_point_scenarios();
+  const NearestPointMeasurement measurement = measure_nearest_point(scenarios, settings);
+  std::string invocation = "calligraphy bench nearest";
+  if (!command.markdown.empty()) invocation += " --markdown " + command.markdown;
+  invocation += " --queries " + std::to_string(settings.queries) + " --seed " + std::to_string(settings.seed);
+  const std::string section = nearest_point_markdown(measurement, scenarios, invocation);
+
+  if (!command.markdown.empty()) {
+    // The jump measurement of `bench nearest`: seeds S, S + 1, S + 2 on every embedded character.
+    JumpSettings jump_settings;
+    jump_settings.seeds = {settings.seed, settings.seed + 1, settings.seed + 2};
+    const JumpMeasurement jumps = measure_foot_jumps(jump_settings);
+    write_output(command.markdown, updated_document(command.markdown, section, kGeneratedBegin,
+                                                    foot_jumps_markdown(jumps, invocation)));
+  }
+  print_report(command.json, nearest_point_json(measurement), command.markdown, section);
+  return 0;
+}
+
+struct JumpsCommand {
+  bool json = false;
+  std::string markdown;
+  std::int64_t seeds = 3;
+  std::string chars;
+};
+
+int run_jumps(const JumpsCommand& command) {
+  require_one_standard_output({{"--json", command.json}, {"--markdown -", command.markdown == "-"}});
   JumpSettings settings;
-  settings.seeds = {seed, seed + 1, seed + 2};
-  return settings;
+  settings.seeds.clear();
+  for (std::int64_t seed = 1; seed <= command.seeds; ++seed)
+    settings.seeds.push_back(static_cast<std::uint64_t>(seed));
+  if (!command.chars.empty()) settings.characters = characters_from(command.chars, "--chars");
+  const JumpMeasurement measurement = measure_foot_jumps(settings);
+
+  std::string invocation = "calligraphy bench jumps";
+  if (!command.markdown.empty()) invocation += " --markdown " + command.markdown;
+  invocation += " --seeds " + std::to_string(command.seeds);
+  if (!command.chars.empty()) invocation += " --chars " + command.chars;
+  const std::string section = foot_jumps_markdown(measurement, invocation);
+  if (!command.markdown.empty()) {
+    write_output(command.markdown, updated_document(command.markdown, section, kJumpsGeneratedBegin));
+  }
+  print_report(command.json, foot_jumps_json(measurement), command.markdown, section);
+  return 0;
 }
 
 }  // namespace
 
-int command_bench_nearest(const Args& args) {
-  bool json = false;
-  std::string markdown_path;
-  MeasurementSettings settings;
-  std::size_t i = 0;
-  if (!args.empty() && args[0] == "nearest") i = 1;  // accept the arguments with or without the sub-command
-  for (; i < args.size(); ++i) {
-    const std::string& arg = args[i];
-    auto value = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) throw UsageError(arg + " expects a value\n" + kUsage);
-      return args[++i];
-    };
-    if (arg == "--json") {
-      json = true;
-    } else if (arg == "--markdown") {
-      markdown_path = value();
-    } else if (arg == "--queries") {
-      settings.queries = parse_integer<int>(arg, value(), 1);
-    } else if (arg == "--seed") {
-      settings.seed = parse_integer<std::uint64_t>(arg, value(), 0);
-    } else {
-      throw UsageError("unknown argument '" + arg + "'\n" + kUsage);
-    }
-  }
-
-  // Checked before the minutes of measuring.
-  const std::string document = markdown_path.empty() ? std::string() : read_generated_document(markdown_path);
-  const std::vector<NearestPointScenario> scenarios = nearest_point_scenarios();
-  const NearestPointMeasurement measurement = measure_nearest_point(scenarios, settings);
-  std::string command = "calligraphy bench nearest";
-  if (!markdown_path.empty()) command += " --markdown " + markdown_path;
-  command += " --queries " + std::to_string(settings.queries) + " --seed " + std::to_string(settings.seed);
-  const std::string section = nearest_point_markdown(measurement, scenarios, command);
-
-  if (!markdown_path.empty()) {
-    const JumpMeasurement jumps = measure_foot_jumps(jump_settings_for_seed(settings.seed));
-    std::string updated = replace_generated_section(document, section);
-    updated = replace_generated_section(updated, foot_jumps_markdown(jumps, command), kJumpsGeneratedBegin);
-    write_document(markdown_path, updated);
-  }
-  if (json) {
-    std::cout << nearest_point_json(measurement);
-  } else if (markdown_path.empty()) {
-    std::cout << section;
-  } else {
-    std::cout << "wrote the table to " << markdown_path << "\n";
-  }
-  return 0;
+void add_bench_nearest_command(CLI::App& bench, Commands& commands) {
+  auto command = std::make_shared<NearestCommand>();
+  CLI::App* app = commands.add(bench, "nearest", "Accuracy and speed of the nearest-point methods",
+                               [command] { return run_nearest(*command); });
+  add_flag(*app, "--json", command->json, "print the rows as JSON");
+  add_output_path(*app, "--markdown", command->markdown,
+                  "replace the generated sections (nearest point and jumps) of this Markdown document",
+                  StandardOutput::allowed);
+  add_integer(*app, "--queries", command->queries, "N", "queries per scenario and degree", 1, 100000000);
+  add_unsigned(*app, "--seed", command->seed, "S", "seed of the random scenarios (a 64-bit integer)");
 }
 
-int command_bench_jumps(const Args& args) {
-  constexpr const char* kJumpsUsage =
-      "usage: calligraphy bench jumps [--json] [--markdown FILE] [--seeds N] [--chars CHARS]";
-  bool json = false;
-  std::string markdown_path;
-  std::string chars;
-  int seed_count = 3;
-  std::size_t i = 0;
-  if (!args.empty() && args[0] == "jumps") i = 1;
-  for (; i < args.size(); ++i) {
-    const std::string& arg = args[i];
-    auto value = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) throw UsageError(arg + " expects a value\n" + kJumpsUsage);
-      return args[++i];
-    };
-    if (arg == "--json") {
-      json = true;
-    } else if (arg == "--markdown") {
-      markdown_path = value();
-    } else if (arg == "--seeds") {
-      seed_count = parse_integer<int>(arg, value(), 1);
-    } else if (arg == "--chars") {
-      chars = value();
-    } else {
-      throw UsageError("unknown argument '" + arg + "'\n" + kJumpsUsage);
-    }
-  }
-  const std::string document = markdown_path.empty() ? std::string() : read_generated_document(markdown_path);
-  JumpSettings settings;
-  settings.seeds.clear();
-  for (int seed = 1; seed <= seed_count; ++seed) settings.seeds.push_back(static_cast<std::uint64_t>(seed));
-  if (!chars.empty()) settings.characters = characters_from(chars);
-  const JumpMeasurement measurement = measure_foot_jumps(settings);
-
-  std::string command = "calligraphy bench jumps";
-  if (!markdown_path.empty()) command += " --markdown " + markdown_path;
-  command += " --seeds " + std::to_string(seed_count);
-  if (!chars.empty()) command += " --chars " + chars;
-  const std::string section = foot_jumps_markdown(measurement, command);
-  if (!markdown_path.empty()) {
-    write_document(markdown_path, replace_generated_section(document, section, kJumpsGeneratedBegin));
-  }
-  if (json) {
-    std::cout << foot_jumps_json(measurement);
-  } else if (markdown_path.empty()) {
-    std::cout << section;
-  } else {
-    std::cout << "wrote the table to " << markdown_path << "\n";
-  }
-  return 0;
+void add_bench_jumps_command(CLI::App& bench, Commands& commands) {
+  auto command = std::make_shared<JumpsCommand>();
+  CLI::App* app =
+      commands.add(bench, "jumps", "Foot-point jumps > 1 mm per stroke on real characters, by method",
+                   [command] { return run_jumps(*command); });
+  add_flag(*app, "--json", command->json, "print the rows as JSON");
+  add_output_path(*app, "--markdown", command->markdown,
+                  "replace the generated jumps section of this Markdown document", StandardOutput::allowed);
+  add_integer(*app, "--seeds", command->seeds, "N", "trials per character, seeds 1..N", 1, 1000000);
+  add_text(*app, "--chars", command->chars, "CHARS", "the characters to write (UTF-8)",
+           "every embedded character");
 }
 
 }  // namespace calligraphy::cli

@@ -1,13 +1,14 @@
-// `calligraphy trial CHARS ...`: a whole guided writing trial at 1 kHz on any registered device
-// (the simulated one by default), through run_trial: lock-step for devices a simulated writer
-// moves, on the real-time ServoLoop otherwise or with --pacing real-time.
+// `calligraphy trial CHARS ...`: a whole guided writing trial on any registered device (the simulated one
+// by default), through run_trial: lock-step for devices a simulated writer moves, on the real-time
+// ServoLoop otherwise or with --pacing real-time.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "calligraphy/devices/device_registry.hpp"
-#include "calligraphy/model/character_library.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/report/trial_report.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
@@ -15,9 +16,25 @@
 #include "cli/cli_devices.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
+#include "cli/output.hpp"
 
 namespace calligraphy::cli {
 namespace {
+
+struct TrialCommand {
+  std::string characters;
+  std::string device = "simulated";
+  std::string guidance = "on";
+  std::string writer = "novice";
+  std::uint64_t seed = 0;
+  double rate_hz = TrialOptions{}.rate_hz;
+  std::string pacing = "auto";
+  std::string realtime = "ignore";
+  std::int64_t watchdog_ms = std::llround(ServoLoopOptions{}.stall_timeout_s * 1000.0);
+  const CLI::Option* watchdog_option = nullptr;  // given on the command line when its count() > 0
+  LibraryOptions library;
+  std::string json, svg, csv;
+};
 
 // The listing of `name`, or a UsageError (exit 2) naming every device that can be opened.
 DeviceListing find_device(const std::string& name) {
@@ -27,61 +44,95 @@ DeviceListing find_device(const std::string& name) {
   if (found != survey.devices.end()) return *found;
   std::string names;
   for (const DeviceListing& listing : survey.devices) names += (names.empty() ? "" : ", ") + listing.name;
-  throw UsageError("unknown device '" + name + "'; registered devices: " + (names.empty() ? "none" : names));
+  throw UsageError("--device: unknown device '" + name +
+                   "'; registered devices: " + (names.empty() ? "none" : names));
 }
 
-}  // namespace
+// Every use of the trial runner's options and run_trial is here, in one place.
+TrialResult run_trial_on_device(const TrialCommand& command, const DeviceListing& device, const Scene& scene,
+                                TrialDescription& description) {
+  TrialOptions options;
+  options.force.guidance = command.guidance == "on";
+  options.simulation.writer = command.writer == "novice" ? WriterProfile::novice() : WriterProfile::skilled();
+  options.simulation.seed = command.seed;
+  options.rate_hz = command.rate_hz;
+  options.keep_trace = !command.svg.empty() || !command.csv.empty();
+  options.pacing = command.pacing == "lock-step"   ? TrialPacing::lock_step
+                   : command.pacing == "real-time" ? TrialPacing::real_time
+                                                   : TrialPacing::automatic;
+  options.loop.realtime = command.realtime == "enforce" ? RealtimeMode::enforce : RealtimeMode::ignore;
+  options.loop.stall_timeout_s = static_cast<double>(command.watchdog_ms) / 1000.0;
+  // On hardware a person writes; the simulated writer only moves simulated and emulated devices.
+  description =
+      TrialDescription{command.characters, options.force.guidance, device.hardware ? "human" : command.writer,
+                       options.simulation.seed, options.rate_hz,        device.name,
+                       device.info.model};
+  return calligraphy::run_trial(device.name, scene, options);
+}
 
-int command_trial(const Args& args) {
-  const Arguments arguments(args,
-                            {"guidance", "writer", "seed", "data", "store", "json", "svg", "csv", "rate",
-                             "device", "pacing", "realtime"},
-                            {});
-  if (arguments.positionals().size() != 1) throw UsageError("trial takes one CHARS argument, e.g. trial 永");
-  const std::u32string chars = characters_from(arguments.positionals()[0]);
-  const std::string device_name = arguments.option_or("device", "simulated");
-  const DeviceListing device = find_device(device_name);
-  const CharacterSource source(arguments);  // only these characters are read (on demand from a store)
+int run_trial(const TrialCommand& command) {
+  require_one_standard_output(
+      {{"--json", command.json == "-"}, {"--svg", command.svg == "-"}, {"--csv", command.csv == "-"}});
+  const std::u32string chars = characters_from(command.characters, "CHARS");
+  const DeviceListing device = find_device(command.device);
+  // Lock-step pacing has no wall clock, so no stall can be bounded: the option would be ignored.
+  const bool real_time = command.pacing == "real-time" || (command.pacing == "auto" && device.hardware);
+  if (command.watchdog_option->count() > 0 && !real_time) {
+    throw UsageError(
+        "--watchdog-ms applies to real-time pacing only (--pacing real-time, or a hardware device)");
+  }
+  const CharacterSource source(command.library);  // only these characters are read (on demand from a store)
   std::vector<Character> characters;
   for (char32_t c : chars) characters.push_back(source.load(c));
   const Scene scene = Scene::lay_out(characters);
 
-  TrialOptions options;
-  options.force.guidance = arguments.choice_or("guidance", {"on", "off"}, "on") == "on";
-  const std::string writer = arguments.choice_or("writer", {"novice", "skilled"}, "novice");
-  options.simulation.writer = writer == "novice" ? WriterProfile::novice() : WriterProfile::skilled();
-  const double seed = arguments.number_or("seed", 0);
-  if (seed < 0 || seed != static_cast<double>(static_cast<std::uint64_t>(seed))) {
-    throw UsageError("--seed expects a non-negative integer");
-  }
-  options.simulation.seed = static_cast<std::uint64_t>(seed);
-  options.rate_hz = arguments.number_or("rate", 1000.0);
-  options.keep_trace = arguments.option("svg") || arguments.option("csv");
-  const std::string pacing = arguments.choice_or("pacing", {"auto", "lock-step", "real-time"}, "auto");
-  options.pacing = pacing == "lock-step"   ? TrialPacing::lock_step
-                   : pacing == "real-time" ? TrialPacing::real_time
-                                           : TrialPacing::automatic;
-  options.loop.realtime = arguments.choice_or("realtime", {"enforce", "ignore"}, "ignore") == "enforce"
-                              ? RealtimeMode::enforce
-                              : RealtimeMode::ignore;
-
-  const TrialResult result = run_trial(device_name, scene, options);
-  // On hardware a person writes; the simulated writer only moves simulated and emulated devices.
-  const TrialDescription description{
-      arguments.positionals()[0], options.force.guidance, device.hardware ? "human" : writer,
-      options.simulation.seed,    options.rate_hz,        device.name,
-      device.info.model};
-  print_trial_table(description, scene, result);
+  TrialDescription description;
+  const TrialResult result = run_trial_on_device(command, device, scene, description);
+  // Standard output carries one document: the table, or the output given as '-'.
+  if (command.json != "-" && command.svg != "-" && command.csv != "-")
+    print_trial_table(description, scene, result);
   // The outputs are written for an aborted trial too: they hold what was recorded before the fault.
-  if (const auto path = arguments.option("json")) write_file(*path, trial_json(description, result));
-  if (const auto path = arguments.option("svg")) write_file(*path, trial_svg(scene, result));
-  if (const auto path = arguments.option("csv")) write_file(*path, trial_csv(result.trace));
+  if (!command.json.empty()) write_output(command.json, trial_json(description, result));
+  if (!command.svg.empty()) write_output(command.svg, trial_svg(scene, result));
+  if (!command.csv.empty()) write_output(command.csv, trial_csv(result.trace));
   if (result.aborted) {
     std::fprintf(stderr, "calligraphy trial: error: the trial ended early (%s)%s%s\n", to_string(result.end),
                  result.abort_reason.empty() ? "" : ": ", result.abort_reason.c_str());
     return 1;
   }
   return 0;
+}
+
+}  // namespace
+
+void add_trial_command(CLI::App& root, Commands& commands) {
+  auto command = std::make_shared<TrialCommand>();
+  CLI::App* app = commands.add(root, "trial", "Run a guided writing trial of CHARS on a haptic device",
+                               [command] { return run_trial(*command); });
+  add_positional(*app, "CHARS", command->characters, "the characters to write, left to right (UTF-8)");
+  add_text(*app, "--device", command->device, "NAME", "the device, by its name in `calligraphy devices`");
+  add_choice(*app, "--guidance", command->guidance, {"on", "off"}, "guiding force towards the stroke");
+  add_choice(*app, "--writer", command->writer, {"novice", "skilled"},
+             "the simulated writer's profile (simulated and emulated devices)");
+  add_unsigned(*app, "--seed", command->seed, "N", "seed of the simulated writer (a 64-bit integer)");
+  add_number(*app, "--rate", command->rate_hz, "HZ", "servo rate [Hz]", "a number of Hz in [100, 100000]",
+             [](double hz) { return hz >= 100.0 && hz <= 100000.0; });
+  add_choice(*app, "--pacing", command->pacing, {"auto", "lock-step", "real-time"},
+             "auto: lock-step for devices a simulated writer moves, real time for any other");
+  add_choice(
+      *app, "--realtime", command->realtime, {"enforce", "ignore"},
+      "real-time pacing: fail unless SCHED_FIFO, CPU pinning and locked memory are obtained (enforce)");
+  command->watchdog_option = add_integer(
+      *app, "--watchdog-ms", command->watchdog_ms, "MS",
+      "real-time pacing: end the trial when the device holds one force longer than this [ms]; 0: off", 0,
+      60000);
+  add_library_options(*app, command->library, true);
+  add_output_path(*app, "--json", command->json, "write the metrics as JSON", StandardOutput::allowed);
+  add_output_path(*app, "--svg", command->svg, "draw the reference and the pen trace as SVG",
+                  StandardOutput::allowed);
+  add_output_path(*app, "--csv", command->csv,
+                  "write the trace (t,x,y,z,fx,fy,fz,state,stroke,element; s, m, N) as CSV",
+                  StandardOutput::allowed);
 }
 
 }  // namespace calligraphy::cli

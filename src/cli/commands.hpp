@@ -1,30 +1,27 @@
 #pragma once
-// Sub-commands of the `calligraphy` program. Each takes the arguments after its name, writes its
-// report to stdout, and returns the process exit status. Errors are thrown (calligraphy::Error or
-// cli::UsageError) and turned into a one-line message with a non-zero status by main().
-#include <stdexcept>
-#include <string>
-#include <vector>
+// The commands of the `calligraphy` program. Each adds its subcommand (options, help) to the root and
+// registers what runs it; the run writes its report to stdout or to files and returns the exit status.
+// Errors are thrown (calligraphy::Error, UsageError) and turned into one line and a status by main().
+#include "cli/app.hpp"
 
 namespace calligraphy::cli {
 
-using Args = std::vector<std::string>;
+void add_trial_command(CLI::App& root, Commands& commands);    // trial CHARS [...]
+void add_score_command(CLI::App& root, Commands& commands);    // score TRACE.csv --character C [...]
+void add_model_command(CLI::App& root, Commands& commands);    // model CHAR [...]
+void add_strokes_command(CLI::App& root, Commands& commands);  // strokes [--markdown FILE] [--json]
+void add_devices_command(CLI::App& root, Commands& commands);  // devices [--json]
+void add_corpus_commands(CLI::App& root, Commands& commands);  // corpus build|stats|fidelity|validate
+void add_bench_commands(CLI::App& root, Commands& commands);   // bench nearest|jumps|tick|loop
 
-/// Wrong command-line usage; main() prints the message and exits with status 2.
-class UsageError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-int command_trial(const Args& args);          // calligraphy trial CHARS [...]
-int command_model(const Args& args);          // calligraphy model CHAR [...]
-int command_bench_nearest(const Args& args);  // calligraphy bench nearest [--json] [...]
-int command_bench_jumps(const Args& args);    // calligraphy bench jumps [--json] [...]
-int command_bench_tick(const Args& args);     // calligraphy bench tick [--json] [...]
-int command_devices(const Args& args);        // calligraphy devices
-int command_corpus(const Args& args);           // calligraphy corpus build|stats|fidelity [...]
-int command_corpus_validate(const Args& args);  // calligraphy corpus validate --data DIR --cnchar FILE [...]
-int command_strokes(const Args& args);          // calligraphy strokes [--markdown FILE] [--json]
-int command_bench_loop(const Args& args);     // calligraphy bench loop [--rate HZ] [--seconds S] [...]
+// The subcommands of the groups, one file each.
+void add_corpus_build_command(CLI::App& corpus, Commands& commands);
+void add_corpus_stats_command(CLI::App& corpus, Commands& commands);
+void add_corpus_fidelity_command(CLI::App& corpus, Commands& commands);
+void add_corpus_validate_command(CLI::App& corpus, Commands& commands);
+void add_bench_nearest_command(CLI::App& bench, Commands& commands);
+void add_bench_jumps_command(CLI::App& bench, Commands& commands);
+void add_bench_tick_command(CLI::App& bench, Commands& commands);
+void add_bench_loop_command(CLI::App& bench, Commands& commands);
 
 }  // namespace calligraphy::cli

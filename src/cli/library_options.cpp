@@ -5,16 +5,28 @@
 
 namespace calligraphy::cli {
 
-CharacterLibrary library_from(const Arguments& arguments) {
-  if (const auto folder = arguments.option("data")) return CharacterLibrary::from_directory(*folder);
+void add_library_options(CLI::App& app, LibraryOptions& options, bool with_store) {
+  CLI::Option* data = add_input_path(
+      app, "--data", options.data_folder, "DIR",
+      "read characters from this hanzi-writer-data folder (one JSON file each)", "the embedded characters");
+  if (with_store) {
+    CLI::Option* store =
+        add_input_path(app, "--store", options.store_file, "FILE",
+                       "read fitted characters from this corpus store (corpus build)", "none");
+    store->excludes(data);
+  }
+}
+
+CharacterLibrary library_from(const LibraryOptions& options) {
+  if (!options.data_folder.empty()) return CharacterLibrary::from_directory(options.data_folder);
   return CharacterLibrary::embedded();
 }
 
-CharacterSource::CharacterSource(const Arguments& arguments) : library_(CharacterLibrary::embedded()) {
-  if (const auto path = arguments.option("store")) {
-    store_ = CorpusStore::open(*path);
+CharacterSource::CharacterSource(const LibraryOptions& options) : library_(CharacterLibrary::embedded()) {
+  if (!options.store_file.empty()) {
+    store_ = CorpusStore::open(options.store_file);
   } else {
-    library_ = library_from(arguments);
+    library_ = library_from(options);
   }
 }
 
@@ -22,14 +34,14 @@ Character CharacterSource::load(char32_t code_point) const {
   return store_ ? store_->load(code_point) : library_.load(code_point);
 }
 
-std::u32string characters_from(const std::string& text) {
+std::u32string characters_from(const std::string& text, const std::string& what) {
   std::u32string chars;
   try {
     chars = decode_utf8(text);
   } catch (const InvalidArgument& e) {
-    throw UsageError(std::string("characters: ") + e.what());
+    throw UsageError(what + ": " + e.what());
   }
-  if (chars.empty()) throw UsageError("no character given");
+  if (chars.empty()) throw UsageError(what + ": no character given");
   return chars;
 }
 

@@ -1,22 +1,31 @@
 #pragma once
-// Shared option handling: which character library to read (--store FILE, else --data DIR, else the
-// embedded default) and which characters were asked for.
+// Shared options: which character library to read (--store FILE, else --data DIR, else the embedded
+// default) and which characters were asked for.
 #include <optional>
 #include <string>
 
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/model/corpus_store.hpp"
-#include "cli/arguments.hpp"
+#include "cli/app.hpp"
 
 namespace calligraphy::cli {
 
-CharacterLibrary library_from(const Arguments& arguments);
+struct LibraryOptions {
+  std::string data_folder;  ///< --data DIR; empty: the embedded characters
+  std::string store_file;   ///< --store FILE; empty: none
+};
+
+/// Adds --data DIR and, when `with_store`, --store FILE (the two exclude each other).
+void add_library_options(CLI::App& app, LibraryOptions& options, bool with_store);
+
+/// --data DIR, else the embedded characters.
+CharacterLibrary library_from(const LibraryOptions& options);
 
 /// Characters from a corpus store (--store FILE: fitted models, each materialised on demand) or else
 /// fitted from the library of `library_from`.
 class CharacterSource {
  public:
-  explicit CharacterSource(const Arguments& arguments);
+  explicit CharacterSource(const LibraryOptions& options);
   /// The character's model; throws CharacterNotFound or DataError.
   [[nodiscard]] Character load(char32_t code_point) const;
 
@@ -24,7 +33,9 @@ class CharacterSource {
   std::optional<CorpusStore> store_;
   CharacterLibrary library_;
 };
-/// The code points of a CHARS argument; throws UsageError when empty or not UTF-8.
-std::u32string characters_from(const std::string& text);
+
+/// The code points of a CHARS argument; throws UsageError naming `what` (e.g. "--chars") when it is
+/// empty or not UTF-8.
+std::u32string characters_from(const std::string& text, const std::string& what);
 
 }  // namespace calligraphy::cli

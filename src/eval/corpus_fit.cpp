@@ -10,7 +10,6 @@
 #include <thread>
 
 #include "calligraphy/core/errors.hpp"
-#include "cli/commands.hpp"
 #include "core/unicode.hpp"
 
 namespace calligraphy::cli {
@@ -54,8 +53,7 @@ class ProgressBar {
 
 }  // namespace
 
-std::filesystem::path corpus_folder(const Arguments& arguments) {
-  if (const auto folder = arguments.option("data")) return *folder;
+std::filesystem::path fetched_corpus_folder() {
   const char* xdg = std::getenv("XDG_CACHE_HOME");
   const char* home = std::getenv("HOME");
   std::filesystem::path cache;
@@ -64,20 +62,19 @@ std::filesystem::path corpus_folder(const Arguments& arguments) {
   } else if (home != nullptr) {
     cache = std::filesystem::path(home) / ".cache";
   }
-  const auto fetched = cache / "calligraphy" / "hanzi-writer-data-2.0.1";
-  std::error_code ec;
-  if (!cache.empty() && std::filesystem::exists(fetched / ".complete", ec)) return fetched;
-  throw UsageError("no hanzi-writer-data folder: run scripts/fetch-hanzi-writer-data.sh (it fills " +
-                   fetched.string() + ") or pass --data DIR");
+  return cache / "calligraphy" / "hanzi-writer-data-2.0.1";
 }
 
-unsigned corpus_threads(const Arguments& arguments) {
-  const double n = arguments.number_or("threads", std::max(1u, std::thread::hardware_concurrency()));
-  if (n < 1 || n > 256 || n != static_cast<double>(static_cast<unsigned>(n))) {
-    throw UsageError("--threads expects an integer 1-256");
-  }
-  return static_cast<unsigned>(n);
+std::optional<std::filesystem::path> complete_fetched_corpus_folder() {
+  const auto fetched = fetched_corpus_folder();
+  std::error_code ec;
+  // Without a cache folder the path is relative to the working directory: not the fetched data.
+  if (fetched.parent_path() == "calligraphy") return std::nullopt;
+  if (std::filesystem::exists(fetched / ".complete", ec)) return fetched;
+  return std::nullopt;
 }
+
+unsigned default_corpus_threads() { return std::max(1u, std::thread::hardware_concurrency()); }
 
 CorpusFit fit_corpus(const CharacterLibrary& library, const FitOptions& options, unsigned threads,
                      const std::string& label) {

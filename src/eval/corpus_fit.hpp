@@ -2,11 +2,11 @@
 // Fits a whole folder of hanzi-writer-data characters on a pool of threads, with a progress bar on
 // stderr and timings split into read+parse and fit (shared by `corpus build` and `corpus fidelity`).
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "calligraphy/model/character_library.hpp"
-#include "cli/arguments.hpp"
 
 namespace calligraphy::cli {
 
@@ -27,10 +27,13 @@ struct CorpusFit {
   double fit_cpu_s = 0.0;         ///< summed over threads
 };
 
-/// --data DIR, else the folder scripts/fetch-hanzi-writer-data.sh fills; UsageError saying how to fetch.
-std::filesystem::path corpus_folder(const Arguments& arguments);
-/// --threads N, else std::thread::hardware_concurrency().
-unsigned corpus_threads(const Arguments& arguments);
+/// The folder scripts/fetch-hanzi-writer-data.sh fills ($XDG_CACHE_HOME, else ~/.cache, then
+/// calligraphy/hanzi-writer-data-2.0.1), whether or not it has been filled.
+std::filesystem::path fetched_corpus_folder();
+/// `fetched_corpus_folder()` when the fetch completed (its `.complete` marker exists), else nullopt.
+std::optional<std::filesystem::path> complete_fetched_corpus_folder();
+/// std::thread::hardware_concurrency(), at least 1.
+unsigned default_corpus_threads();
 /// Fits every character of the folder. `label` prefixes the progress bar.
 CorpusFit fit_corpus(const CharacterLibrary& library, const FitOptions& options, unsigned threads,
                      const std::string& label);

@@ -1,12 +1,12 @@
 #include "calligraphy/report/trial_report.hpp"
 
 #include <cstdio>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
+#include "calligraphy/report/atomic_file.hpp"
 #include "core/unicode.hpp"
 #include "model/polyline.hpp"
 
@@ -133,10 +133,6 @@ std::string trial_csv(const std::vector<TrialSample>& trace) {
   return csv.str();
 }
 
-void write_file(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  if (!out) throw DataError(path + ": cannot write file");
-}
+void write_file(const std::string& path, const std::string& text) { write_file_atomically(path, text); }
 
 }  // namespace calligraphy::cli

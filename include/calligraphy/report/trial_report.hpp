@@ -24,7 +24,8 @@ std::string trial_json(const TrialDescription& d, const TrialResult& result);
 std::string trial_svg(const Scene& scene, const TrialResult& result);
 /// The 1 kHz trace: t,x,y,z,fx,fy,fz,state,stroke,element (SI units).
 std::string trial_csv(const std::vector<TrialSample>& trace);
-/// Writes text to a file; throws DataError naming the path when it cannot.
+/// Writes text to a file, whole or not at all (`write_file_atomically`, atomic_file.hpp); throws DataError
+/// naming the path when it cannot.
 void write_file(const std::string& path, const std::string& text);
 
 }  // namespace calligraphy::cli

@@ -1,0 +1,249 @@
+#include "cli/app.hpp"
+
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <memory>
+#include <system_error>
+
+namespace calligraphy::cli {
+namespace {
+
+#ifndef CALLIGRAPHY_VERSION
+#error "CALLIGRAPHY_VERSION must be defined (from PROJECT_VERSION)"
+#endif
+constexpr const char* kVersion = "calligraphy " CALLIGRAPHY_VERSION;
+
+[[noreturn]] void invalid(const std::string& name, const std::string& expectation, const std::string& value) {
+  std::string message = "expects " + expectation + ", got '" + value + "'";
+  if (value.rfind("-", 0) == 0 && value.size() > 1 && !std::isdigit(static_cast<unsigned char>(value[1]))) {
+    message += " (an option where a value belongs?)";
+  }
+  throw CLI::ValidationError(name, message);
+}
+
+template <typename Integer>
+bool parse_integer(const std::string& text, Integer& value) {
+  const char* end = text.data() + text.size();
+  const auto [stop, error] = std::from_chars(text.data(), end, value, 10);
+  return error == std::errc() && stop == end && !text.empty();
+}
+
+bool parse_number(const std::string& text, double& value) {
+  const char* end = text.data() + text.size();
+  const auto [stop, error] = std::from_chars(text.data(), end, value, std::chars_format::general);
+  return error == std::errc() && stop == end && !text.empty() && std::isfinite(value);
+}
+
+std::string shortest(double value) {
+  char text[32];
+  const auto result = std::to_chars(text, text + sizeof text, value);
+  return std::string(text, result.ptr);
+}
+
+// An option taking exactly one value, handed to `parse` (which stores it or throws ValidationError).
+CLI::Option* add_single(CLI::App& app, const std::string& name, const std::string& value_name,
+                        const std::string& description, const std::string& default_text,
+                        std::function<void(const std::string&)> parse) {
+  CLI::Option* option = app.add_option(
+      name,
+      [parse, name](const CLI::results_t& results) {
+        if (results.size() > 1) {
+          throw CLI::ValidationError(name,
+                                     "given " + std::to_string(results.size()) + " times; give it once");
+        }
+        parse(results.front());
+        return true;
+      },
+      description + (default_text.empty() ? "" : " (default: " + default_text + ")"));
+  option->type_size(1);
+  option->expected(1);
+  option->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);  // so that a repeat is seen, and refused
+  option->option_text(value_name);
+  return option;
+}
+
+// Text that starts with '-' is an option that took the place of a value (CLI11 hands it over).
+void require_not_option_like(const std::string& name, const std::string& value, const std::string& what) {
+  if (value.empty()) throw CLI::ValidationError(name, "expects " + what + ", got an empty value");
+  if (value.front() == '-') invalid(name, what, value);
+}
+
+}  // namespace
+
+CLI::App* Commands::add(CLI::App& parent, const std::string& name, const std::string& description,
+                        std::function<int()> run) {
+  CLI::App* app = parent.add_subcommand(name, description);
+  app->set_version_flag("--version", kVersion, "Print the program's version and exit");
+  commands_.emplace_back(app, std::move(run));
+  return app;
+}
+
+CLI::App* Commands::add_group(CLI::App& parent, const std::string& name, const std::string& description) {
+  CLI::App* app = parent.add_subcommand(name, description);
+  app->set_version_flag("--version", kVersion, "Print the program's version and exit");
+  app->require_subcommand(1);
+  return app;
+}
+
+int Commands::run_selected() const {
+  for (const auto& [app, run] : commands_) {
+    if (app->parsed()) return run();
+  }
+  throw UsageError("no command given");
+}
+
+void configure_root(CLI::App& root) {
+  root.set_version_flag("--version", kVersion, "Print the program's version and exit");
+  root.require_subcommand(1);
+  auto formatter = std::make_shared<CLI::Formatter>();
+  formatter->column_width(40);
+  root.formatter(formatter);
+  root.footer(
+      "Exit status: 0 success; 1 a library or I/O error, an aborted trial, or a failed check; 2 wrong usage; "
+      "3 an internal error. Every output file is written whole or not at all; '-' as an output file means "
+      "standard output. docs/cli.md describes every command.");
+}
+
+CLI::Option* add_flag(CLI::App& app, const std::string& name, bool& target, const std::string& description) {
+  CLI::Option* option = app.add_flag(name, target, description);
+  return option;
+}
+
+CLI::Option* add_integer(CLI::App& app, const std::string& name, std::int64_t& target,
+                         const std::string& value_name, const std::string& description, std::int64_t minimum,
+                         std::int64_t maximum, const std::string& default_text) {
+  const std::string expectation =
+      "an integer in [" + std::to_string(minimum) + ", " + std::to_string(maximum) + "]";
+  const std::string shown = default_text.empty() ? std::to_string(target) : default_text;
+  return add_single(app, name, value_name, description, shown, [=, &target](const std::string& text) {
+    std::int64_t value = 0;
+    if (!parse_integer(text, value) || value < minimum || value > maximum) invalid(name, expectation, text);
+    target = value;
+  });
+}
+
+CLI::Option* add_unsigned(CLI::App& app, const std::string& name, std::uint64_t& target,
+                          const std::string& value_name, const std::string& description) {
+  return add_single(app, name, value_name, description, std::to_string(target),
+                    [=, &target](const std::string& text) {
+                      std::uint64_t value = 0;
+                      if (!parse_integer(text, value))
+                        invalid(name, "an integer in [0, 18446744073709551615]", text);
+                      target = value;
+                    });
+}
+
+CLI::Option* add_number(CLI::App& app, const std::string& name, double& target, const std::string& value_name,
+                        const std::string& description, const std::string& expectation,
+                        std::function<bool(double)> valid) {
+  return add_single(app, name, value_name, description, shortest(target),
+                    [=, &target](const std::string& text) {
+                      double value = 0.0;
+                      if (!parse_number(text, value) || !valid(value)) invalid(name, expectation, text);
+                      target = value;
+                    });
+}
+
+CLI::Option* add_number_list(CLI::App& app, const std::string& name, std::vector<double>& target,
+                             const std::string& value_name, const std::string& description,
+                             const std::string& expectation, std::function<bool(double)> valid) {
+  std::string default_text;
+  for (double value : target) default_text += (default_text.empty() ? "" : ",") + shortest(value);
+  return add_single(app, name, value_name, description, default_text, [=, &target](const std::string& text) {
+    std::vector<double> values;
+    std::size_t start = 0;
+    while (true) {
+      const std::size_t comma = text.find(',', start);
+      const std::string item =
+          text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+      double value = 0.0;
+      if (!parse_number(item, value) || !valid(value)) {
+        invalid(name, "a comma-separated list of " + expectation, text);
+      }
+      values.push_back(value);
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
+    target = values;
+  });
+}
+
+CLI::Option* add_choice(CLI::App& app, const std::string& name, std::string& target,
+                        const std::vector<std::string>& choices, const std::string& description) {
+  std::string list;
+  for (const auto& choice : choices) list += (list.empty() ? "" : "|") + choice;
+  return add_single(app, name, list, description, target, [=, &target](const std::string& text) {
+    for (const auto& choice : choices) {
+      if (choice == text) {
+        target = text;
+        return;
+      }
+    }
+    invalid(name, list, text);
+  });
+}
+
+CLI::Option* add_text(CLI::App& app, const std::string& name, std::string& target,
+                      const std::string& value_name, const std::string& description,
+                      const std::string& default_text) {
+  const std::string shown = target.empty() ? default_text : target;
+  return add_single(app, name, value_name, description, shown, [=, &target](const std::string& text) {
+    require_not_option_like(name, text, value_name);
+    target = text;
+  });
+}
+
+CLI::Option* add_input_path(CLI::App& app, const std::string& name, std::string& target,
+                            const std::string& value_name, const std::string& description,
+                            const std::string& default_text) {
+  return add_single(app, name, value_name, description, default_text, [=, &target](const std::string& text) {
+    require_not_option_like(name, text, "a " + value_name + " name");
+    target = text;
+  });
+}
+
+CLI::Option* add_output_path(CLI::App& app, const std::string& name, std::string& target,
+                             const std::string& description, StandardOutput standard_output) {
+  const bool allowed = standard_output == StandardOutput::allowed;
+  const std::string full = description + (allowed ? "; '-' writes it to standard output" : "");
+  return add_single(
+      app, name, allowed ? "FILE|-" : "FILE", full, "not written", [=, &target](const std::string& text) {
+        if (text == "-" && !allowed) {
+          throw CLI::ValidationError(name, "cannot write to standard output ('-'): give a file name");
+        }
+        if (text != "-") require_not_option_like(name, text, "a file name");
+        target = text;
+      });
+}
+
+CLI::Option* required(CLI::Option* option) {
+  option->required();
+  std::string description = option->get_description();
+  const auto default_start = description.rfind(" (default: ");
+  if (default_start != std::string::npos) description.erase(default_start);  // a required option has none
+  option->description(description + " (required)");
+  return option;
+}
+
+CLI::Option* add_positional(CLI::App& app, const std::string& name, std::string& target,
+                            const std::string& description) {
+  CLI::Option* option = app.add_option(name, target, description);
+  option->required();
+  return option;
+}
+
+void require_one_standard_output(const std::vector<std::pair<std::string, bool>>& uses) {
+  std::string names;
+  int count = 0;
+  for (const auto& [name, writes] : uses) {
+    if (!writes) continue;
+    names += (names.empty() ? "" : " and ") + name;
+    ++count;
+  }
+  if (count > 1) {
+    throw UsageError(names + " would all write standard output; give all but one of them a file name");
+  }
+}
+
+}  // namespace calligraphy::cli

@@ -1,0 +1,93 @@
+#pragma once
+// The command-line framework of `calligraphy`, on CLI11: commands register a subcommand and the function
+// that runs it; options are parsed strictly (the whole value, integers exactly, within a range), reject
+// values that look like options, and show their unit and default in --help. A parse error is a
+// CLI::ParseError naming the option; main() prints it on one line and exits with status 2.
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace calligraphy::cli {
+
+/// Wrong usage found after parsing (a device no backend knows, options that cannot go together):
+/// main() prints the message and exits with status 2.
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// The subcommands and what runs each. The function returns the process exit status.
+class Commands {
+ public:
+  /// A subcommand of `parent` with -h/--help and --version, run by `run` when it is the one given.
+  CLI::App* add(CLI::App& parent, const std::string& name, const std::string& description,
+                std::function<int()> run);
+  /// A subcommand that only groups others (corpus, bench): one of them is required.
+  CLI::App* add_group(CLI::App& parent, const std::string& name, const std::string& description);
+  /// Runs the subcommand given on the command line; throws UsageError when there is none.
+  [[nodiscard]] int run_selected() const;
+
+ private:
+  std::vector<std::pair<CLI::App*, std::function<int()>>> commands_;
+};
+
+/// Sets up the program's root: version flag, help layout, one subcommand required.
+void configure_root(CLI::App& root);
+
+// ---- Options -----------------------------------------------------------------------------------
+// `value_name` is what --help shows after the option (e.g. "HZ", "FILE"); `description` should give the
+// unit in brackets; the default is appended as "(default: ...)".
+
+/// A flag (no value).
+CLI::Option* add_flag(CLI::App& app, const std::string& name, bool& target, const std::string& description);
+
+/// An integer in [minimum, maximum], decimal digits only (a leading '-' for a negative one). The default
+/// shown is `target`, or `default_text` when given.
+CLI::Option* add_integer(CLI::App& app, const std::string& name, std::int64_t& target,
+                         const std::string& value_name, const std::string& description, std::int64_t minimum,
+                         std::int64_t maximum, const std::string& default_text = "");
+/// An unsigned 64-bit integer, parsed exactly (e.g. a seed up to 18446744073709551615).
+CLI::Option* add_unsigned(CLI::App& app, const std::string& name, std::uint64_t& target,
+                          const std::string& value_name, const std::string& description);
+/// A finite decimal number for which `valid` holds; `expectation` says what is valid ("a number > 0").
+CLI::Option* add_number(CLI::App& app, const std::string& name, double& target, const std::string& value_name,
+                        const std::string& description, const std::string& expectation,
+                        std::function<bool(double)> valid);
+/// A comma-separated list of finite numbers for which `valid` holds.
+CLI::Option* add_number_list(CLI::App& app, const std::string& name, std::vector<double>& target,
+                             const std::string& value_name, const std::string& description,
+                             const std::string& expectation, std::function<bool(double)> valid);
+/// One of `choices`.
+CLI::Option* add_choice(CLI::App& app, const std::string& name, std::string& target,
+                        const std::vector<std::string>& choices, const std::string& description);
+/// Free text (characters, a device name). `default_text` describes the default when `target` is empty.
+CLI::Option* add_text(CLI::App& app, const std::string& name, std::string& target,
+                      const std::string& value_name, const std::string& description,
+                      const std::string& default_text = "");
+/// A file or folder that is read.
+CLI::Option* add_input_path(CLI::App& app, const std::string& name, std::string& target,
+                            const std::string& value_name, const std::string& description,
+                            const std::string& default_text);
+
+/// Whether an output may be standard output.
+enum class StandardOutput { allowed, refused };
+/// A file that is written (`write_output`); "-" means standard output when allowed.
+CLI::Option* add_output_path(CLI::App& app, const std::string& name, std::string& target,
+                             const std::string& description, StandardOutput standard_output);
+
+/// Makes an option required and says so in --help.
+CLI::Option* required(CLI::Option* option);
+
+/// A required positional argument.
+CLI::Option* add_positional(CLI::App& app, const std::string& name, std::string& target,
+                            const std::string& description);
+
+/// Throws UsageError when more than one of `uses` (option name, writes standard output) is true:
+/// standard output carries one document at a time.
+void require_one_standard_output(const std::vector<std::pair<std::string, bool>>& uses);
+
+}  // namespace calligraphy::cli

@@ -1,0 +1,187 @@
+#include "calligraphy/report/atomic_file.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <system_error>
+
+#include "calligraphy/core/errors.hpp"
+
+namespace calligraphy {
+namespace {
+
+namespace fs = std::filesystem;
+
+[[noreturn]] void fail(const fs::path& path, const std::string& what, int error) {
+  throw DataError(path.string() + ": " + what + ": " + std::generic_category().message(error));
+}
+
+// Writes all of `content`, resuming after EINTR and short writes. Returns 0 or the errno of the failure.
+int write_all(int fd, std::string_view content) {
+  while (!content.empty()) {
+    const ssize_t written = ::write(fd, content.data(), content.size());
+    if (written < 0) {
+      if (errno == EINTR) continue;
+      return errno;
+    }
+    if (written == 0) return EIO;  // no progress and no error: give up rather than spin
+    content.remove_prefix(static_cast<std::size_t>(written));
+  }
+  return 0;
+}
+
+// close(2) once; EINTR is not retried (Linux releases the descriptor anyway).
+int close_checked(int& fd) {
+  const int result = ::close(fd);
+  fd = -1;
+  return result == 0 || errno == EINTR ? 0 : errno;
+}
+
+// A device, FIFO or terminal: written as it is; there is no file to replace.
+void write_in_place(const fs::path& path, std::string_view content) {
+  int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) fail(path, "cannot open for writing", errno);
+  const int write_error = write_all(fd, content);
+  const int close_error = close_checked(fd);
+  if (write_error != 0) fail(path, "cannot write", write_error);
+  if (close_error != 0) fail(path, "cannot write (on close)", close_error);
+}
+
+// The temporary file beside the target, removed on destruction unless committed.
+class TemporaryFile {
+ public:
+  TemporaryFile(const fs::path& target, const fs::path& reported, mode_t mode, bool set_mode)
+      : reported_(reported) {
+    static std::atomic<unsigned> counter{0};
+    const fs::path folder = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+    for (int attempt = 0; attempt < 100; ++attempt) {
+      std::string name(1, '.');  // hidden, beside the target; built by appends (GCC 12 warns on a + chain)
+      name.append(target.filename().string()).append(".tmp-").append(std::to_string(::getpid()));
+      name.append("-").append(std::to_string(counter.fetch_add(1)));
+      path_ = folder / name;
+      fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, set_mode ? 0600 : 0666);
+      if (fd_ >= 0 || errno != EEXIST) break;
+    }
+    if (fd_ < 0) fail(reported_, "cannot create a temporary file in " + folder.string(), errno);
+    if (set_mode && ::fchmod(fd_, mode) != 0) fail_and_remove("cannot set the permissions", errno);
+  }
+  TemporaryFile(const TemporaryFile&) = delete;
+  TemporaryFile& operator=(const TemporaryFile&) = delete;
+  ~TemporaryFile() { remove(); }
+
+  void write(std::string_view content) {
+    if (const int error = write_all(fd_, content)) fail_and_remove("cannot write", error);
+    if (::fsync(fd_) != 0) fail_and_remove("cannot write (fsync)", errno);
+    if (const int error = close_checked(fd_)) fail_and_remove("cannot write (on close)", error);
+  }
+
+  void rename_to(const fs::path& target) {
+    if (::rename(path_.c_str(), target.c_str()) != 0) fail_and_remove("cannot replace the file", errno);
+    committed_ = true;
+  }
+
+ private:
+  void remove() noexcept {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = -1;
+    if (!committed_) ::unlink(path_.c_str());
+    committed_ = true;
+  }
+  [[noreturn]] void fail_and_remove(const std::string& what, int error) {
+    remove();
+    fail(reported_, what, error);
+  }
+
+  fs::path reported_;
+  fs::path path_;
+  int fd_ = -1;
+  bool committed_ = false;
+};
+
+// The folder holds the new directory entry only once it is synced; a folder that cannot be opened or
+// synced (some file systems refuse fsync on directories: EINVAL) leaves the file written but the rename
+// possibly not yet durable, which is reported unless the file system does not support it.
+void sync_folder(const fs::path& target, const fs::path& reported) {
+  const fs::path folder = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+  const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;  // written and renamed; only the durability of the rename is not confirmed
+  const int result = ::fsync(fd);
+  const int error = errno;
+  ::close(fd);
+  if (result != 0 && error != EINVAL && error != EROFS) {
+    fail(reported, "written, but its folder could not be synced", error);
+  }
+}
+
+}  // namespace
+
+void write_file_atomically(const fs::path& path, std::string_view content) {
+  if (path.empty()) throw DataError("cannot write a file with an empty name");
+  struct stat status {};
+  fs::path target = path;
+  bool exists = false;
+  if (::stat(path.c_str(), &status) == 0) {
+    if (!S_ISREG(status.st_mode)) return write_in_place(path, content);
+    // A read-only file stays as it is, as it would were it overwritten in place (the rename alone needs
+    // only the folder's permission).
+    if (::access(path.c_str(), W_OK) != 0) fail(path, "cannot write", errno);
+    exists = true;
+    struct stat link_status {};
+    if (::lstat(path.c_str(), &link_status) == 0 && S_ISLNK(link_status.st_mode)) {
+      std::error_code error;
+      target = fs::canonical(path, error);  // replace the file the link points to, keep the link
+      if (error) fail(path, "cannot resolve the symbolic link", error.value());
+    }
+  } else if (errno != ENOENT) {
+    fail(path, "cannot write", errno);
+  }
+  TemporaryFile temporary(target, path, status.st_mode & 07777, exists);
+  temporary.write(content);
+  temporary.rename_to(target);
+  sync_folder(target, path);
+}
+
+void write_file_atomically(const fs::path& path, std::span<const std::uint8_t> content) {
+  write_file_atomically(path,
+                        std::string_view(reinterpret_cast<const char*>(content.data()), content.size()));
+}
+
+std::optional<std::string> read_file_for_update(const fs::path& path, std::uintmax_t max_bytes) {
+  struct stat status {};
+  if (::stat(path.c_str(), &status) != 0) {
+    if (errno == ENOENT) return std::nullopt;
+    fail(path, "cannot read", errno);
+  }
+  if (!S_ISREG(status.st_mode)) return std::nullopt;
+  const auto size = static_cast<std::uintmax_t>(status.st_size);
+  if (size > max_bytes) {
+    throw DataError(path.string() + ": " + std::to_string(size) + " bytes, more than the limit of " +
+                    std::to_string(max_bytes) + " for a file that is updated in place");
+  }
+  int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) fail(path, "cannot open for reading", errno);
+  std::string text;
+  char buffer[65536];
+  while (true) {
+    const ssize_t got = ::read(fd, buffer, sizeof buffer);
+    if (got < 0 && errno == EINTR) continue;
+    if (got < 0) {
+      const int error = errno;
+      close_checked(fd);
+      fail(path, "cannot read", error);
+    }
+    if (got == 0) break;
+    text.append(buffer, static_cast<std::size_t>(got));
+    if (text.size() > max_bytes) {  // the file grew while it was read
+      close_checked(fd);
+      throw DataError(path.string() + ": more than " + std::to_string(max_bytes) + " bytes");
+    }
+  }
+  close_checked(fd);
+  return text;
+}
+
+}  // namespace calligraphy

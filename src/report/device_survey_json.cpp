@@ -1,0 +1,32 @@
+#include "calligraphy/report/device_survey_json.hpp"
+
+#include <nlohmann/json.hpp>
+
+namespace calligraphy {
+
+std::string device_survey_json(const DeviceSurvey& survey) {
+  nlohmann::json devices = nlohmann::json::array();
+  for (const DeviceListing& listing : survey.devices) {
+    const DeviceInfo& info = listing.info;
+    devices.push_back(
+        {{"name", listing.name},
+         {"backend", listing.backend},
+         {"hardware", listing.hardware},
+         {"details", listing.details},
+         {"info",
+          {{"model", info.model},
+           {"manufacturer", info.manufacturer},
+           {"max_force_n", info.max_force_n},
+           {"max_continuous_force_n", info.max_continuous_force_n},
+           {"max_stiffness_n_per_m", info.max_stiffness_n_per_m},
+           {"max_damping_n_s_per_m", info.max_damping_n_s_per_m},
+           {"workspace_radius_m", info.workspace_radius_m},
+           {"workspace_size_m",
+            {info.workspace_size_m.x(), info.workspace_size_m.y(), info.workspace_size_m.z()}}}}});
+  }
+  const nlohmann::json doc = {
+      {"devices", devices}, {"notes", survey.notes}, {"any_hardware", survey.any_hardware()}};
+  return doc.dump(2) + "\n";
+}
+
+}  // namespace calligraphy

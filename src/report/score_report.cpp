@@ -1,0 +1,133 @@
+#include "calligraphy/report/score_report.hpp"
+
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "calligraphy/model/typical_strokes.hpp"
+#include "report/appendf.hpp"
+
+namespace calligraphy {
+namespace {
+
+nlohmann::json value_or_null(const std::optional<double>& value, double scale = 1.0) {
+  return value ? nlohmann::json(*value * scale) : nlohmann::json(nullptr);
+}
+
+std::string fixed(const std::optional<double>& value, double scale, const char* pattern) {
+  if (!value) return "-";
+  char text[64];
+  std::snprintf(text, sizeof text, pattern, *value * scale);
+  return text;
+}
+
+nlohmann::json stroke_json(const StrokeScore& stroke) {
+  const auto& m = stroke.metrics;
+  const auto get = [&](auto member) -> std::optional<double> {
+    if (!m) return std::nullopt;
+    return static_cast<double>(member(*m));
+  };
+  return {{"index", stroke.index + 1},
+          {"typical_id", stroke.typical_id},
+          {"written", stroke.written},
+          {"backwards", stroke.backwards},
+          {"mean_deviation_mm", value_or_null(get([](auto& x) { return x.deviation.mean_m; }), 1e3)},
+          {"max_deviation_mm", value_or_null(get([](auto& x) { return x.deviation.max_m; }), 1e3)},
+          {"rms_deviation_mm", value_or_null(get([](auto& x) { return x.deviation.rms_m; }), 1e3)},
+          {"outside_tube_share", value_or_null(get([](auto& x) { return x.deviation.outside_tube_share; }))},
+          {"frechet_mm", value_or_null(get([](auto& x) { return x.curves.frechet_m; }), 1e3)},
+          {"dtw_mm", value_or_null(get([](auto& x) { return x.curves.dtw_m; }), 1e3)},
+          {"time_s", value_or_null(get([](auto& x) { return x.kinematics.writing_time_s; }))},
+          {"path_length_mm", value_or_null(get([](auto& x) { return x.kinematics.path_length_m; }), 1e3)},
+          {"mean_speed_m_s", value_or_null(get([](auto& x) { return x.kinematics.mean_speed_m_per_s; }))},
+          {"velocity_peaks", m ? nlohmann::json(m->kinematics.velocity_peaks) : nlohmann::json(nullptr)},
+          {"normalised_jerk", value_or_null(get([](auto& x) { return x.kinematics.normalised_jerk; }))}};
+}
+
+}  // namespace
+
+std::string score_table(const ScoreDescription& d, const CharacterScore& score) {
+  const CharacterWritingMetrics& t = score.totals;
+  std::string out;
+  appendf(out, "Score of %s against %s (%zu samples, x and y in %s)\n", d.trace.c_str(), d.character.c_str(),
+          d.samples, d.units.c_str());
+  appendf(out, "\n  %-6s %-6s %-4s %-7s %-9s %9s %9s %11s %9s %9s\n", "stroke", "type", "ID", "written",
+          "backwards", "mean[mm]", "max[mm]", "Frechet[mm]", "DTW[mm]", "time[s]");
+  for (const StrokeScore& s : score.strokes) {
+    const auto& m = s.metrics;
+    const auto mm = [&](auto member) { return m ? std::optional<double>(member(*m)) : std::nullopt; };
+    appendf(out, "  %-6zu %-6s %-4d %-7s %-9s %9s %9s %11s %9s %9s\n", s.index + 1,
+            std::string(typical_stroke(s.typical_id).acronym).c_str(), s.typical_id, s.written ? "yes" : "no",
+            s.backwards ? "yes" : "no",
+            fixed(mm([](auto& x) { return x.deviation.mean_m; }), 1e3, "%.2f").c_str(),
+            fixed(mm([](auto& x) { return x.deviation.max_m; }), 1e3, "%.2f").c_str(),
+            fixed(mm([](auto& x) { return x.curves.frechet_m; }), 1e3, "%.2f").c_str(),
+            fixed(mm([](auto& x) { return x.curves.dtw_m; }), 1e3, "%.2f").c_str(),
+            fixed(mm([](auto& x) { return x.kinematics.writing_time_s; }), 1.0, "%.2f").c_str());
+  }
+  const auto deviation = [&](double DeviationSummary::*member) {
+    return t.deviation ? std::optional<double>((*t.deviation).*member) : std::nullopt;
+  };
+  appendf(out, "\n  strokes written            %zu / %zu%s\n", score.strokes_written, score.strokes.size(),
+          score.completed_in_order ? "  (complete, in order)" : "");
+  appendf(out, "  order errors               %zu\n", score.order_errors);
+  appendf(out, "  backwards strokes          %zu\n", score.backwards_strokes);
+  appendf(out, "  unmatched / ignored        %zu / %zu segments\n", score.unmatched_strokes,
+          score.ignored_segments);
+  appendf(out, "  mean deviation             %s mm\n",
+          fixed(deviation(&DeviationSummary::mean_m), 1e3, "%.3f").c_str());
+  appendf(out, "  max deviation              %s mm\n",
+          fixed(deviation(&DeviationSummary::max_m), 1e3, "%.3f").c_str());
+  appendf(out, "  RMS deviation              %s mm\n",
+          fixed(deviation(&DeviationSummary::rms_m), 1e3, "%.3f").c_str());
+  appendf(out, "  Frechet (worst stroke)     %s mm\n", fixed(t.frechet_m, 1e3, "%.3f").c_str());
+  appendf(out, "  DTW (mean)                 %s mm\n", fixed(t.dtw_m, 1e3, "%.3f").c_str());
+  appendf(out, "  pen lifts                  %zu\n", t.pen_lifts);
+  appendf(out, "  time                       %.2f s (writing %.2f s, in the air %.2f s)\n", t.total_time_s,
+          t.writing_time_s, t.in_air_time_s);
+  appendf(out, "  mean speed                 %s m/s\n", fixed(t.mean_speed_m_per_s, 1.0, "%.4f").c_str());
+  appendf(out, "  velocity peaks             %d\n", t.velocity_peaks);
+  appendf(out, "  normalised jerk            %s\n", fixed(t.normalised_jerk, 1.0, "%.1f").c_str());
+  return out;
+}
+
+std::string score_json(const ScoreDescription& d, const CharacterScore& score) {
+  const CharacterWritingMetrics& t = score.totals;
+  nlohmann::json per_stroke = nlohmann::json::array();
+  for (const StrokeScore& s : score.strokes) per_stroke.push_back(stroke_json(s));
+  nlohmann::json missing = nlohmann::json::array();
+  for (std::size_t index : score.missing_strokes) missing.push_back(index + 1);
+  const auto deviation = [&](double DeviationSummary::*member) {
+    return value_or_null(t.deviation ? std::optional<double>((*t.deviation).*member) : std::nullopt, 1e3);
+  };
+  const nlohmann::json doc = {{"character", d.character},
+                              {"trace", d.trace},
+                              {"units", d.units},
+                              {"samples", d.samples},
+                              {"strokes_total", score.strokes.size()},
+                              {"strokes_written", score.strokes_written},
+                              {"completed_in_order", score.completed_in_order},
+                              {"strokes_in_order", score.strokes_in_order},
+                              {"order_errors", score.order_errors},
+                              {"backwards_strokes", score.backwards_strokes},
+                              {"missing_strokes", missing},
+                              {"unmatched_strokes", score.unmatched_strokes},
+                              {"ignored_segments", score.ignored_segments},
+                              {"pen_lifts", t.pen_lifts},
+                              {"time_s", t.total_time_s},
+                              {"writing_time_s", t.writing_time_s},
+                              {"in_air_time_s", t.in_air_time_s},
+                              {"mean_deviation_mm", deviation(&DeviationSummary::mean_m)},
+                              {"max_deviation_mm", deviation(&DeviationSummary::max_m)},
+                              {"rms_deviation_mm", deviation(&DeviationSummary::rms_m)},
+                              {"frechet_mm", value_or_null(t.frechet_m, 1e3)},
+                              {"dtw_mm", value_or_null(t.dtw_m, 1e3)},
+                              {"path_length_mm", t.path_length_m * 1e3},
+                              {"mean_speed_m_s", value_or_null(t.mean_speed_m_per_s)},
+                              {"velocity_peaks", t.velocity_peaks},
+                              {"normalised_jerk", value_or_null(t.normalised_jerk)},
+                              {"per_stroke", per_stroke}};
+  return doc.dump(2) + "\n";
+}
+
+}  // namespace calligraphy

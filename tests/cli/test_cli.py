@@ -1,0 +1,418 @@
+#!/usr/bin/env python3
+"""End-to-end tests of the `calligraphy` program (docs/cli.md), run by CTest as `cli_tests`.
+
+CALLIGRAPHY_CLI names the program and CALLIGRAPHY_SOURCE_DIR the source tree. Standard library only
+(unittest), so that no package has to be installed. Each case runs the program in a fresh temporary
+folder, so that a stray output file (one named `-` or `--seed`) would show.
+"""
+import json
+import os
+import re
+import resource
+import signal
+import stat
+import subprocess
+import sys
+import tempfile
+import threading
+import unittest
+from pathlib import Path
+
+CLI = os.environ.get("CALLIGRAPHY_CLI", "")
+SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
+DATA = SOURCE / "data" / "hanzi-writer-data"
+
+COMMANDS = [
+    [], ["trial"], ["score"], ["model"], ["strokes"], ["devices"],
+    ["corpus"], ["corpus", "build"], ["corpus", "stats"], ["corpus", "fidelity"], ["corpus", "validate"],
+    ["bench"], ["bench", "nearest"], ["bench", "jumps"], ["bench", "tick"], ["bench", "loop"],
+]
+
+
+def project_version():
+    text = (SOURCE / "CMakeLists.txt").read_text(encoding="utf-8")
+    return re.search(r"project\(calligraphy VERSION ([0-9.]+)", text).group(1)
+
+
+class CliTestCase(unittest.TestCase):
+    def setUp(self):
+        if not CLI or not Path(CLI).exists():
+            self.fail(f"CALLIGRAPHY_CLI={CLI!r} is not the calligraphy program: run these tests through ctest")
+        self.folder = tempfile.TemporaryDirectory(prefix="calligraphy-cli-")
+        self.cwd = Path(self.folder.name)
+
+    def tearDown(self):
+        self.folder.cleanup()
+
+    def run_cli(self, *args, stdout=subprocess.PIPE, limit_file_bytes=None, timeout=120):
+        def limit():
+            if limit_file_bytes is not None:  # writes beyond this many bytes fail with EFBIG
+                signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+                resource.setrlimit(resource.RLIMIT_FSIZE, (limit_file_bytes, limit_file_bytes))
+
+        return subprocess.run([CLI, *map(str, args)], cwd=self.cwd, stdout=stdout, stderr=subprocess.PIPE,
+                              timeout=timeout, preexec_fn=limit)
+
+    def assert_usage_error(self, args, option):
+        """Exit status 2 and one line on stderr naming `option`."""
+        result = self.run_cli(*args)
+        message = result.stderr.decode()
+        self.assertEqual(result.returncode, 2, f"{args}: {message}")
+        self.assertEqual(len(message.splitlines()), 1, f"{args}: not one line: {message!r}")
+        self.assertIn(option, message, f"{args}: the message does not name {option}")
+        return message
+
+    def trial_json(self, *args):
+        result = self.run_cli("trial", *args, "--json", "-")
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
+        return json.loads(result.stdout)
+
+    def files_here(self):
+        return sorted(p.name for p in self.cwd.iterdir())
+
+
+class HelpAndVersion(CliTestCase):
+    def test_help_of_every_command_lists_each_option_with_default(self):
+        for command in COMMANDS:
+            for flag in ("--help", "-h"):
+                result = self.run_cli(*command, flag)
+                self.assertEqual(result.returncode, 0, f"{command} {flag}: {result.stderr.decode()}")
+                text = result.stdout.decode()
+                self.assertIn("Usage: " + " ".join(["calligraphy", *command]), text)
+                # One entry per option: its line and any continuation lines (indented further).
+                entries = re.findall(r"^  (--[a-z-]+.*(?:\n {10,}.*)*)", text, flags=re.M)
+                self.assertTrue(entries or command in ([], ["corpus"], ["bench"]), command)
+                for entry in entries:
+                    # An option taking a value ("--seed N ...") shows its default or that it is required.
+                    if re.match(r"--[a-z-]+ [A-Z]", entry):
+                        self.assertRegex(entry, r"\((default: .+|required)\)", f"{command}: {entry}")
+
+    def test_version_of_every_command(self):
+        expected = f"calligraphy {project_version()}\n"
+        for command in COMMANDS:
+            result = self.run_cli(*command, "--version")
+            self.assertEqual(result.returncode, 0, f"{command}: {result.stderr.decode()}")
+            self.assertEqual(result.stdout.decode(), expected)
+
+    def test_trial_help_is_help_not_a_character(self):
+        result = self.run_cli("trial", "-h")
+        self.assertEqual(result.returncode, 0)
+        self.assertIn("--watchdog-ms", result.stdout.decode())
+        self.assertIn("--rate HZ", result.stdout.decode())  # the servo rate is documented, with its unit
+        self.assertIn("[Hz]", result.stdout.decode())
+
+    def test_group_without_subcommand_prints_its_help_and_fails(self):
+        for group, subcommands in (("bench", ["nearest", "jumps", "tick", "loop"]),
+                                   ("corpus", ["build", "stats", "fidelity", "validate"])):
+            result = self.run_cli(group)
+            self.assertEqual(result.returncode, 2)
+            message = result.stderr.decode()
+            for subcommand in subcommands:
+                self.assertIn(subcommand, message)
+            self.assertTrue(message.splitlines()[-1].startswith(f"calligraphy {group}: error:"))
+        self.assertEqual(self.run_cli().returncode, 2)
+        self.assertIn("unknown command 'nonsense'", self.run_cli("nonsense").stderr.decode())
+
+
+class StrictOptions(CliTestCase):
+    def test_equals_form_is_the_same_option(self):
+        self.assertEqual(self.trial_json("乙", "--seed=3"), self.trial_json("乙", "--seed", "3"))
+
+    def test_option_taking_an_option_as_its_value_is_an_error(self):
+        self.assert_usage_error(["trial", "乙", "--json", "--seed", "3"], "--json")
+        self.assert_usage_error(["trial", "乙", "--json=--seed"], "--json")
+        self.assert_usage_error(["trial", "乙", "--device", "--json", "x.json"], "--device")
+        self.assertEqual(self.files_here(), [], "an output file was written after a usage error")
+
+    def test_repeated_option_is_an_error(self):
+        self.assert_usage_error(["trial", "乙", "--seed", "3", "--seed", "4"], "--seed")
+        self.assert_usage_error(["trial", "乙", "--guidance", "on", "--guidance", "off"], "--guidance")
+        self.assert_usage_error(["trial", "乙", "--json", "a.json", "--json", "b.json"], "--json")
+
+    def test_numbers_are_parsed_whole_and_by_kind(self):
+        self.assert_usage_error(["corpus", "fidelity", "--tolerances", "2x"], "--tolerances")
+        self.assert_usage_error(["corpus", "fidelity", "--tolerances", "2,,5"], "--tolerances")
+        self.assert_usage_error(["corpus", "build", "--out", "s.clg", "--threads", "1.5"], "--threads")
+        self.assert_usage_error(["bench", "tick", "--passes", "2x"], "--passes")
+        self.assert_usage_error(["bench", "tick", "--passes", "0x10"], "--passes")
+        self.assert_usage_error(["bench", "tick", "--passes", "0"], "--passes")
+        self.assert_usage_error(["trial", "乙", "--seed", "-1"], "--seed")
+        self.assert_usage_error(["trial", "乙", "--seed", "18446744073709551616"], "--seed")
+        self.assert_usage_error(["trial", "乙", "--rate", "nan"], "--rate")
+        self.assert_usage_error(["trial", "乙", "--pacing", "real-time", "--watchdog-ms", "1.5"], "--watchdog-ms")
+        self.assert_usage_error(["bench", "loop", "--cpu", "-2"], "--cpu")
+
+    def test_negative_integer_where_allowed(self):
+        result = self.run_cli("bench", "loop", "--seconds", "0.05", "--cpu", "-1", "--realtime", "off", "--json")
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
+        self.assertEqual(json.loads(result.stdout)["realtime"]["cpu"], -1)
+
+    def test_64_bit_seed_is_exact(self):
+        seed = 9007199254740993  # 2^53 + 1: a double would round it to 2^53
+        exact = self.trial_json("乙", "--seed", seed)
+        rounded = self.trial_json("乙", "--seed", seed - 1)
+        self.assertEqual(exact["seed"], seed)
+        self.assertEqual(rounded["seed"], seed - 1)
+        self.assertNotEqual(exact["mean_deviation_mm"], rounded["mean_deviation_mm"],
+                            "neighbouring seeds gave the same trial")
+
+    def test_watchdog_only_with_real_time_pacing(self):
+        self.assert_usage_error(["trial", "乙", "--watchdog-ms", "10"], "--watchdog-ms")
+        self.assert_usage_error(["trial", "乙", "--pacing", "lock-step", "--watchdog-ms", "10"], "--watchdog-ms")
+
+    def test_data_and_store_exclude_each_other(self):
+        self.assert_usage_error(["trial", "乙", "--data", "x", "--store", "y"], "--store")
+
+    def test_unknown_device_is_a_usage_error(self):
+        self.assert_usage_error(["trial", "乙", "--device", "nope"], "--device")
+
+    def test_library_errors_exit_1_with_one_line(self):
+        for args in (["trial", "乙", "--data", self.cwd / "missing"], ["score", "missing.csv", "--character", "乙"],
+                     ["corpus", "stats", "missing.clg"], ["model", "永", "--store", "missing.clg"]):
+            result = self.run_cli(*args)
+            self.assertEqual(result.returncode, 1, f"{args}: {result.stderr.decode()}")
+            self.assertEqual(len(result.stderr.decode().splitlines()), 1, f"{args}: {result.stderr.decode()}")
+            self.assertIn("missing", result.stderr.decode())
+
+
+class StandardOutput(CliTestCase):
+    def test_dash_writes_to_standard_output_not_to_a_file(self):
+        result = self.run_cli("trial", "乙", "--svg", "-")
+        self.assertEqual(result.returncode, 0)
+        self.assertTrue(result.stdout.startswith(b"<svg"), result.stdout[:80])
+        self.assertEqual(self.files_here(), [])
+        self.assertEqual(self.run_cli("model", "永", "--svg", "-").stdout,
+                         self.run_cli("model", "永", "--svg", "m.svg").returncode == 0
+                         and (self.cwd / "m.svg").read_bytes())
+        markdown = self.run_cli("strokes", "--markdown", "-")
+        self.assertEqual(markdown.returncode, 0)
+        self.assertIn(b"| ID |", markdown.stdout[:2000])
+
+    def test_trial_csv_to_standard_output_is_the_file(self):
+        to_stdout = self.run_cli("trial", "乙", "--seed", "2", "--csv", "-")
+        self.assertEqual(self.run_cli("trial", "乙", "--seed", "2", "--csv", "t.csv").returncode, 0)
+        self.assertEqual(to_stdout.stdout, (self.cwd / "t.csv").read_bytes())
+
+    def test_two_outputs_cannot_share_standard_output(self):
+        self.assert_usage_error(["trial", "乙", "--json", "-", "--csv", "-"], "--json")
+        self.assert_usage_error(["model", "永", "--json", "--svg", "-"], "--svg")
+
+    def test_dash_refused_where_it_makes_no_sense(self):
+        self.assert_usage_error(["corpus", "build", "--out", "-"], "--out")
+        self.assertEqual(self.files_here(), [])
+
+    def test_devices_json(self):
+        result = self.run_cli("devices", "--json")
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
+        survey = json.loads(result.stdout)
+        names = [d["name"] for d in survey["devices"]]
+        self.assertIn("simulated", names)
+        for device in survey["devices"]:
+            self.assertGreater(device["info"]["max_force_n"], 0.0)
+            self.assertEqual(len(device["info"]["workspace_size_m"]), 3)
+            self.assertLess(max(device["info"]["workspace_size_m"]), 10.0)  # metres, not mm
+        self.assertTrue(all(isinstance(note, str) for note in survey["notes"]))
+        self.assertEqual(survey["any_hardware"], any(d["hardware"] for d in survey["devices"]))
+
+
+class NothingLost(CliTestCase):
+    def assert_fails_loudly(self, result, what):
+        self.assertNotEqual(result.returncode, 0, f"{what}: exit 0")
+        self.assertIn(what, result.stderr.decode())
+
+    def test_full_standard_output_fails(self):
+        with open("/dev/full", "wb") as full:
+            for args in (["trial", "乙"], ["model", "永", "--json"], ["model", "永"], ["devices", "--json"],
+                         ["strokes"], ["--help"], ["--version"], ["trial", "乙", "--json", "-"]):
+                result = self.run_cli(*args, stdout=full)
+                self.assert_fails_loudly(result, "standard output")
+
+    def test_full_device_as_output_file_fails(self):
+        for args in (["trial", "乙", "--json", "/dev/full"], ["trial", "乙", "--csv", "/dev/full"],
+                     ["model", "永", "--svg", "/dev/full"], ["strokes", "--markdown", "/dev/full"]):
+            result = self.run_cli(*args)
+            self.assertEqual(result.returncode, 1, args)
+            self.assertIn("/dev/full", result.stderr.decode())
+            self.assertIn("No space left on device", result.stderr.decode())
+
+    def test_failed_write_keeps_the_earlier_file(self):
+        earlier = self.cwd / "out.json"
+        earlier.write_text("earlier\n")
+        # The file size limit makes every write past 64 bytes fail (EFBIG), like a full disk.
+        result = self.run_cli("trial", "乙", "--json", earlier, limit_file_bytes=64)
+        self.assertEqual(result.returncode, 1, result.stderr.decode())
+        self.assertIn(str(earlier), result.stderr.decode())
+        self.assertEqual(earlier.read_text(), "earlier\n")
+        self.assertEqual(self.files_here(), ["out.json"], "a temporary file was left behind")
+
+    def test_failed_corpus_build_keeps_the_earlier_store(self):
+        store = self.cwd / "corpus.clg"
+        first = self.run_cli("corpus", "build", "--data", DATA, "--out", store, "--threads", "1")
+        self.assertEqual(first.returncode, 0, first.stderr.decode())
+        good = store.read_bytes()
+        # A different store (another tolerance) that cannot be written whole.
+        second = self.run_cli("corpus", "build", "--data", DATA, "--out", store, "--threads", "1",
+                              "--tolerance", "2", limit_file_bytes=len(good) // 2)
+        self.assertEqual(second.returncode, 1)
+        self.assertIn(str(store), second.stderr.decode())
+        self.assertEqual(store.read_bytes(), good)
+        self.assertEqual(self.files_here(), ["corpus.clg"])
+        self.assertEqual(self.run_cli("corpus", "stats", store).returncode, 0)
+
+    def test_full_disk_keeps_the_earlier_store(self):
+        mount_point = self.cwd / "tiny"
+        mount_point.mkdir()
+        mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(mount_point)],
+                                 stderr=subprocess.PIPE, stdout=subprocess.PIPE)
+        if mounted.returncode != 0:
+            self.skipTest("cannot mount a small tmpfs here (needs privileges): " + mounted.stderr.decode().strip())
+        try:
+            store = mount_point / "corpus.clg"
+            self.assertEqual(self.run_cli("corpus", "build", "--data", DATA, "--out", store).returncode, 0)
+            good = store.read_bytes()
+            filler = mount_point / "filler"
+            descriptor = os.open(filler, os.O_WRONLY | os.O_CREAT)
+            try:  # fill the file system
+                while os.write(descriptor, b"\0" * 4096) > 0:
+                    pass
+            except OSError:
+                pass
+            finally:
+                os.close(descriptor)
+            result = self.run_cli("corpus", "build", "--data", DATA, "--out", store, "--tolerance", "2")
+            self.assertEqual(result.returncode, 1)
+            self.assertIn("No space left on device", result.stderr.decode())
+            self.assertEqual(store.read_bytes(), good)
+            self.assertEqual(sorted(p.name for p in mount_point.iterdir()), ["corpus.clg", "filler"])
+        finally:
+            subprocess.run(["umount", str(mount_point)], check=True)
+
+    def test_output_to_a_fifo(self):
+        fifo = self.cwd / "pipe"
+        os.mkfifo(fifo)
+        received = []
+        reader = threading.Thread(target=lambda: received.append(fifo.read_bytes()))
+        reader.start()
+        result = self.run_cli("model", "永", "--svg", fifo)
+        reader.join(timeout=60)
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
+        self.assertEqual(received, [self.run_cli("model", "永", "--svg", "-").stdout])
+
+    def test_replaced_file_keeps_its_permissions_and_links(self):
+        target = self.cwd / "real.json"
+        target.write_text("old")
+        os.chmod(target, 0o640)
+        link = self.cwd / "link.json"
+        link.symlink_to(target)
+        self.assertEqual(self.run_cli("trial", "乙", "--json", link).returncode, 0)
+        self.assertTrue(link.is_symlink())
+        self.assertEqual(stat.S_IMODE(target.stat().st_mode), 0o640)
+        self.assertEqual(json.loads(target.read_text())["character"], "乙")
+
+    def test_markdown_into_a_device_does_not_read_it(self):
+        # /dev/zero never ends: the command must only write there.
+        result = self.run_cli("bench", "nearest", "--queries", "2", "--markdown", "/dev/zero", timeout=120)
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
+
+    def test_markdown_document_keeps_its_text(self):
+        document = self.cwd / "doc.md"
+        document.write_text("# Heading\n\nHand-written text.\n")
+        result = self.run_cli("bench", "jumps", "--seeds", "1", "--chars", "乙", "--markdown", document)
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
+        text = document.read_text()
+        self.assertTrue(text.startswith("# Heading\n\nHand-written text.\n"))
+        self.assertEqual(text.count("<!-- BEGIN generated by `calligraphy bench jumps` -->"), 1)
+        again = self.run_cli("bench", "jumps", "--seeds", "1", "--chars", "乙", "--markdown", document)
+        self.assertEqual(again.returncode, 0)
+        self.assertEqual(document.read_text().count("<!-- BEGIN generated"), 1)  # replaced, not appended
+
+
+def model_trace(model, order=None, reverse=()):
+    """A CSV pen trace in data units drawing the model's elements: pen down along each stroke (sampled every
+    ~4 data units at 100 Hz-like steps), one lifted sample between strokes."""
+
+    def point(control, s):
+        points = [tuple(p) for p in control]
+        while len(points) > 1:  # de Casteljau
+            points = [((1 - s) * a[0] + s * b[0], (1 - s) * a[1] + s * b[1]) for a, b in zip(points, points[1:])]
+        return points[0]
+
+    rows, t = ["t,x,y,pen"], 0.0
+    for index in order or range(len(model["strokes"])):
+        samples = []
+        for element in model["strokes"][index]["elements"]:
+            samples += [point(element["control_points"], k / 40) for k in range(41)]
+        if index in reverse:
+            samples.reverse()
+        for x, y in samples:
+            rows.append(f"{t:.3f},{x:.4f},{y:.4f},1")
+            t += 0.01
+        rows.append(f"{t:.3f},{samples[-1][0]:.4f},{samples[-1][1]:.4f},0")
+        t += 0.2
+    return "\n".join(rows) + "\n"
+
+
+class Score(CliTestCase):
+    def score(self, trace_text, character, *args):
+        (self.cwd / "trace.csv").write_text(trace_text)
+        result = self.run_cli("score", "trace.csv", "--character", character, *args, "--json", "-")
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
+        return json.loads(result.stdout)
+
+    def test_trace_of_a_lock_step_trial_scores_complete(self):
+        trial = self.run_cli("trial", "永", "--seed", "7", "--csv", "t.csv", "--json", "t.json")
+        self.assertEqual(trial.returncode, 0, trial.stderr.decode())
+        metrics = json.loads((self.cwd / "t.json").read_text())
+        result = self.run_cli("score", "t.csv", "--character", "永", "--json", "s.json")
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
+        self.assertIn("strokes written", result.stdout.decode())  # the table
+        score = json.loads((self.cwd / "s.json").read_text())
+        self.assertEqual(score["strokes_total"], metrics["strokes_total"])
+        self.assertEqual(score["strokes_written"], metrics["strokes_total"])
+        self.assertTrue(score["completed_in_order"])
+        self.assertEqual(score["order_errors"], 0)
+        self.assertEqual(score["backwards_strokes"], 0)
+        self.assertEqual([s["typical_id"] for s in score["per_stroke"]],
+                         [s["typical_id"] for s in metrics["per_stroke"]])
+        for key in ("mean_deviation_mm", "max_deviation_mm", "per_stroke", "completed_in_order", "time_s",
+                    "frechet_mm", "dtw_mm", "rms_deviation_mm", "order_errors", "backwards_strokes", "pen_lifts",
+                    "in_air_time_s", "velocity_peaks", "normalised_jerk", "mean_speed_m_s"):
+            self.assertIn(key, score)
+        self.assertLessEqual(score["mean_deviation_mm"], score["max_deviation_mm"])
+
+    def test_the_reference_itself_scores_near_zero(self):
+        model = json.loads(self.run_cli("model", "永", "--json").stdout)
+        score = self.score(model_trace(model), "永", "--units", "data")
+        self.assertEqual(score["strokes_written"], len(model["strokes"]))
+        self.assertTrue(score["completed_in_order"])
+        # Samples on the elements themselves: only rounding to 1e-4 data units (6e-6 mm) remains.
+        self.assertLess(score["max_deviation_mm"], 1e-3)
+        self.assertEqual(score["pen_lifts"], len(model["strokes"]) - 1)
+
+    def test_order_and_direction_errors_are_counted(self):
+        model = json.loads(self.run_cli("model", "永", "--json").stdout)
+        n = len(model["strokes"])
+        reversed_order = self.score(model_trace(model, order=list(reversed(range(n)))), "永", "--units", "data")
+        self.assertEqual(reversed_order["order_errors"], n * (n - 1) // 2)
+        self.assertFalse(reversed_order["completed_in_order"])
+        backwards = self.score(model_trace(model, reverse={0}), "永", "--units", "data")
+        self.assertEqual(backwards["backwards_strokes"], 1)
+        self.assertTrue(backwards["per_stroke"][0]["backwards"])
+
+    def test_usage(self):
+        self.assert_usage_error(["score", "t.csv", "--character", "永我"], "--character")
+        self.assert_usage_error(["score", "t.csv"], "--character")
+        self.assert_usage_error(["score", "t.csv", "--character", "永", "--units", "metres"], "--units")
+
+
+class Determinism(CliTestCase):
+    def test_lock_step_trial_json_is_reproducible(self):
+        for name in ("a.json", "b.json"):
+            self.assertEqual(self.run_cli("trial", "永", "--seed", "7", "--json", name).returncode, 0)
+        self.assertEqual((self.cwd / "a.json").read_bytes(), (self.cwd / "b.json").read_bytes())
+
+
+if __name__ == "__main__":
+    program = unittest.main(exit=False, verbosity=2)
+    result = program.result
+    sys.exit(0 if result.wasSuccessful() and result.testsRun > 0 else 1)

@@ -1,0 +1,144 @@
+// write_file_atomically and read_file_for_update (calligraphy/report/atomic_file.hpp), the one way the
+// command line writes files. Write failures are made with RLIMIT_FSIZE (writes past the limit fail with
+// EFBIG, whoever runs the test, root included) and with /dev/full (ENOSPC).
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/report/atomic_file.hpp"
+
+using namespace calligraphy;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A folder of its own under the temporary directory, removed with everything in it.
+struct TemporaryFolder {
+  fs::path path;
+  TemporaryFolder() {
+    static int made = 0;
+    path = fs::temp_directory_path() /
+           ("calligraphy_atomic_file_" + std::to_string(::getpid()) + "_" + std::to_string(made++));
+    fs::create_directories(path);
+  }
+  ~TemporaryFolder() {
+    std::error_code ignored;
+    fs::remove_all(path, ignored);
+  }
+  [[nodiscard]] std::vector<std::string> names() const {
+    std::vector<std::string> out;
+    for (const auto& entry : fs::directory_iterator(path)) out.push_back(entry.path().filename().string());
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+};
+
+std::string contents(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Writes past `bytes` fail with EFBIG while this lives (SIGXFSZ ignored so that the write returns).
+class FileSizeLimit {
+ public:
+  explicit FileSizeLimit(rlim_t bytes) {
+    ::getrlimit(RLIMIT_FSIZE, &saved_);
+    previous_handler_ = std::signal(SIGXFSZ, SIG_IGN);
+    rlimit limit = saved_;
+    limit.rlim_cur = bytes;
+    ::setrlimit(RLIMIT_FSIZE, &limit);
+  }
+  FileSizeLimit(const FileSizeLimit&) = delete;
+  FileSizeLimit& operator=(const FileSizeLimit&) = delete;
+  ~FileSizeLimit() {
+    ::setrlimit(RLIMIT_FSIZE, &saved_);
+    std::signal(SIGXFSZ, previous_handler_);
+  }
+
+ private:
+  rlimit saved_{};
+  void (*previous_handler_)(int) = nullptr;
+};
+
+}  // namespace
+
+TEST_CASE("write_file_atomically creates and replaces a file, leaving nothing else", "[atomic_file]") {
+  TemporaryFolder folder;
+  const fs::path target = folder.path / "report.json";
+  write_file_atomically(target, std::string_view("first\n"));
+  CHECK(contents(target) == "first\n");
+  write_file_atomically(target, std::string_view("second, longer\n"));
+  CHECK(contents(target) == "second, longer\n");
+  write_file_atomically(target, std::string_view(""));
+  CHECK(contents(target).empty());
+  const std::vector<std::uint8_t> bytes{0, 1, 2, 255};
+  write_file_atomically(target, bytes);
+  CHECK(contents(target) == std::string("\0\1\2\xff", 4));
+  CHECK(folder.names() == std::vector<std::string>{"report.json"});
+}
+
+TEST_CASE("write_file_atomically keeps permission bits and symbolic links", "[atomic_file]") {
+  TemporaryFolder folder;
+  const fs::path target = folder.path / "real.txt";
+  const fs::path link = folder.path / "link.txt";
+  write_file_atomically(target, std::string_view("old"));
+  ::chmod(target.c_str(), 0640);
+  fs::create_symlink(target, link);
+  write_file_atomically(link, std::string_view("new"));
+  CHECK(fs::is_symlink(link));
+  CHECK(contents(target) == "new");
+  struct stat status {};
+  REQUIRE(::stat(target.c_str(), &status) == 0);
+  CHECK((status.st_mode & 07777) == 0640);
+}
+
+TEST_CASE("a failed write throws naming the file and keeps the earlier one", "[atomic_file]") {
+  TemporaryFolder folder;
+  const fs::path target = folder.path / "store.bin";
+  write_file_atomically(target, std::string_view("earlier"));
+  const std::string large(1 << 16, 'x');
+  {
+    FileSizeLimit limit(1024);
+    CHECK_THROWS_AS(write_file_atomically(target, large), DataError);
+    try {
+      write_file_atomically(target, large);
+    } catch (const DataError& e) {
+      CHECK_THAT(e.what(), Catch::Contains(target.string()) && Catch::Contains("too large"));
+    }
+  }
+  CHECK(contents(target) == "earlier");
+  CHECK(folder.names() == std::vector<std::string>{"store.bin"});  // the temporary was removed
+}
+
+TEST_CASE("a target that is not a regular file is written in place and checked", "[atomic_file]") {
+  CHECK_NOTHROW(write_file_atomically("/dev/null", std::string_view("discarded")));
+  CHECK_THROWS_WITH(write_file_atomically("/dev/full", std::string_view("lost")),
+                    Catch::Contains("/dev/full") && Catch::Contains("No space left on device"));
+  TemporaryFolder folder;
+  CHECK_THROWS_WITH(write_file_atomically(folder.path, std::string_view("x")),
+                    Catch::Contains(folder.path.string()));
+  CHECK_THROWS_AS(write_file_atomically(folder.path / "missing" / "file", std::string_view("x")), DataError);
+  CHECK(folder.names().empty());
+}
+
+TEST_CASE("read_file_for_update reads regular files only, within a bound", "[atomic_file]") {
+  TemporaryFolder folder;
+  const fs::path document = folder.path / "doc.md";
+  CHECK_FALSE(read_file_for_update(document).has_value());  // does not exist
+  write_file_atomically(document, std::string_view("# Title\n"));
+  CHECK(read_file_for_update(document) == std::optional<std::string>("# Title\n"));
+  CHECK_FALSE(read_file_for_update("/dev/zero").has_value());  // never read: it would not end
+  CHECK_THROWS_WITH(read_file_for_update(document, 4), Catch::Contains(document.string()));
+}
