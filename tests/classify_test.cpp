@@ -283,7 +283,7 @@ TEST_CASE("Model SVG (paper Fig. 13): well-formed, one path per element, one red
   const auto library = CharacterLibrary::embedded();
   for (char32_t cp : {U'永', U'我', U'鼎'}) {
     const Character c = library.load(cp);
-    const std::string svg = cli::model_svg(c);
+    const std::string svg = model_svg(c);
     CHECK(well_formed_xml(svg));
     std::size_t elements = 0;
     std::size_t features = 0;

@@ -211,16 +211,16 @@ TEST_CASE("The reports of an aborted trial say so and keep what was recorded", "
   TrialOptions options;
   const TrialResult result = run_trial(device, scene, options);
   REQUIRE(result.aborted);
-  const cli::TrialDescription description{
+  const TrialDescription description{
       "口", true, "novice", 0, 1000.0, "emulated-phantom", device.info().model};
-  const std::string json = cli::trial_json(description, result);
+  const std::string json = trial_json(description, result);
   CHECK(json.find("\"aborted\": true") != std::string::npos);
   CHECK(json.find("unplugged") != std::string::npos);
   CHECK(json.find("\"device\": \"emulated-phantom\"") != std::string::npos);
-  const std::string csv = cli::trial_csv(result.trace);
+  const std::string csv = trial_csv(result.trace);
   CHECK(static_cast<std::size_t>(std::count(csv.begin(), csv.end(), '\n')) ==
         result.trace.size() + 1);  // + header
-  CHECK(cli::trial_svg(scene, result).find("</svg>") != std::string::npos);
+  CHECK(trial_svg(scene, result).find("</svg>") != std::string::npos);
 }
 
 TEST_CASE("A safety fault aborts a trial on the servo loop, ticks are paced by absolute deadlines",

@@ -125,7 +125,7 @@ TEST_CASE("Joint torques to DAC counts and back, saturation keeps the direction"
 }
 
 TEST_CASE("Force clamp keeps the direction, non-finite force gives zero", "[devices][safety]") {
-  using calligraphy::devices::clamp_force_magnitude;
+  using calligraphy::clamp_force_magnitude;
   const Vec3 f(3.0, 4.0, 0.0);
   CHECK(clamp_force_magnitude(f, 10.0) == f);
   const Vec3 clamped = clamp_force_magnitude(f, 2.5);

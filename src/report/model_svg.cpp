@@ -4,7 +4,7 @@
 
 #include "core/unicode.hpp"
 
-namespace calligraphy::cli {
+namespace calligraphy {
 namespace {
 
 // SVG coordinates of a model point (data units, y up).
@@ -98,4 +98,4 @@ std::string model_svg(const Character& character) {
   return svg;
 }
 
-}  // namespace calligraphy::cli
+}  // namespace calligraphy

@@ -10,7 +10,7 @@
 #include "core/unicode.hpp"
 #include "model/polyline.hpp"
 
-namespace calligraphy::cli {
+namespace calligraphy {
 
 void print_trial_table(const TrialDescription& d, const Scene& scene, const TrialResult& result) {
   const TrialMetrics& m = result.metrics;
@@ -135,4 +135,4 @@ std::string trial_csv(const std::vector<TrialSample>& trace) {
 
 void write_file(const std::string& path, const std::string& text) { write_file_atomically(path, text); }
 
-}  // namespace calligraphy::cli
+}  // namespace calligraphy

@@ -4,7 +4,7 @@
 
 #include "calligraphy/core/geometry.hpp"
 
-namespace calligraphy::devices {
+namespace calligraphy {
 
 /// `force_n` [N] scaled down to at most `max_force_n` [N] in magnitude, direction preserved.
 /// A non-finite force or a non-positive limit gives zero force.
@@ -15,4 +15,4 @@ namespace calligraphy::devices {
   return force_n * (max_force_n / magnitude);
 }
 
-}  // namespace calligraphy::devices
+}  // namespace calligraphy

@@ -7,11 +7,11 @@
 
 #include "calligraphy/model/character.hpp"
 
-namespace calligraphy::cli {
+namespace calligraphy {
 
 /// A standalone SVG document (UTF-8). Element tags carry class="element", feature points
 /// class="feature-point", other control points class="control-point", control polygons
 /// class="control-polygon", stroke numbers class="stroke-number", the medians class="median".
 std::string model_svg(const Character& character);
 
-}  // namespace calligraphy::cli
+}  // namespace calligraphy

@@ -4,7 +4,7 @@
 
 #include "calligraphy/trial/trial.hpp"
 
-namespace calligraphy::cli {
+namespace calligraphy {
 
 struct TrialDescription {
   std::string characters;  // UTF-8
@@ -28,4 +28,4 @@ std::string trial_csv(const std::vector<TrialSample>& trace);
 /// naming the path when it cannot.
 void write_file(const std::string& path, const std::string& text);
 
-}  // namespace calligraphy::cli
+}  // namespace calligraphy

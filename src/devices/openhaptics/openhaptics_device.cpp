@@ -189,8 +189,8 @@ DeviceState OpenHapticsDevice::read_state() {
     throw_hd_servo_error(error);
   }
   if (watchdog_tripped_.exchange(false)) {
-    throw SafetyFault("OpenHaptics: watchdog: no force command for more than " +
-                      std::to_string(watchdog_timeout_s_) + " s; forces turned off");
+    // A fixed message: the servo path builds no strings, also when it fails.
+    throw SafetyFault("OpenHaptics: watchdog: no force command within its timeout; forces turned off");
   }
   const auto values = state_.load();
   DeviceState state;
@@ -210,7 +210,7 @@ void OpenHapticsDevice::write_force(const Vec3& force_n) {
     throw SafetyFault(
         "OpenHaptics: non-finite force command (NaN or infinity); zero force, forces turned off");
   }
-  const Vec3 limited = devices::clamp_force_magnitude(force_n, info_.max_force_n);
+  const Vec3 limited = clamp_force_magnitude(force_n, info_.max_force_n);
   command_.store({limited.x(), limited.y(), limited.z(), now});
 }
 

@@ -21,11 +21,6 @@ std::string narrow(const wchar_t* text) {
   return out;
 }
 
-std::string last_error(hid_device* device) {
-  const std::string text = narrow(hid_error(device));
-  return text.empty() ? "unknown hidapi error" : text;
-}
-
 int to_milliseconds(std::chrono::microseconds timeout) {
   return static_cast<int>(std::max<std::int64_t>(1, (timeout.count() + 999) / 1000));
 }
@@ -72,22 +67,20 @@ void HidapiTransport::close() noexcept {
 }
 
 void HidapiTransport::write(std::span<const std::uint8_t> packet, std::chrono::microseconds /*timeout*/) {
-  if (device_ == nullptr) throw CommunicationError("hidapi: write on a closed device " + entry_.path);
+  if (device_ == nullptr) throw CommunicationError("hidapi: write on a closed device");
   if (packet.size() + 1 > report_.size()) throw CommunicationError("hidapi: packet longer than 64 bytes");
   report_[0] = 0;  // report id 0: the device uses unnumbered reports (assumption, unverified)
   std::copy(packet.begin(), packet.end(), report_.begin() + 1);
   if (hid_write(device_, report_.data(), packet.size() + 1) < 0) {
-    throw CommunicationError("hidapi: write to " + entry_.path +
-                             " failed (unplugged?): " + last_error(device_));
+    throw CommunicationError("hidapi: write failed (unplugged?)");  // fixed: servo path
   }
 }
 
 std::size_t HidapiTransport::read(std::span<std::uint8_t> buffer, std::chrono::microseconds timeout) {
-  if (device_ == nullptr) throw CommunicationError("hidapi: read on a closed device " + entry_.path);
+  if (device_ == nullptr) throw CommunicationError("hidapi: read on a closed device");
   const int received = hid_read_timeout(device_, buffer.data(), buffer.size(), to_milliseconds(timeout));
   if (received < 0) {
-    throw CommunicationError("hidapi: read from " + entry_.path +
-                             " failed (unplugged?): " + last_error(device_));
+    throw CommunicationError("hidapi: read failed (unplugged?)");  // fixed: servo path
   }
   return static_cast<std::size_t>(received);
 }

@@ -136,27 +136,27 @@ void LibusbTransport::close() noexcept {
 }
 
 void LibusbTransport::write(std::span<const std::uint8_t> packet, std::chrono::microseconds timeout) {
-  if (handle_ == nullptr) throw CommunicationError(description() + ": write on a closed device");
-  if (packet.size() > out_buffer_.size())
-    throw CommunicationError(description() + ": packet longer than 64 bytes");
+  // Fixed messages below: the servo path builds no strings, also when it fails.
+  if (handle_ == nullptr) throw CommunicationError("libusb: write on a closed device");
+  if (packet.size() > out_buffer_.size()) throw CommunicationError("libusb: packet longer than 64 bytes");
   std::copy(packet.begin(), packet.end(), out_buffer_.begin());
   int sent = 0;
   const int rc = libusb_bulk_transfer(handle_, endpoint_out_, out_buffer_.data(),
                                       static_cast<int>(packet.size()), &sent, to_milliseconds(timeout));
-  if (rc == LIBUSB_ERROR_NO_DEVICE) throw CommunicationError(description() + ": unplugged");
-  if (rc != 0) throw CommunicationError(description() + ": bulk write failed: " + error_text(rc));
-  if (sent != static_cast<int>(packet.size())) throw CommunicationError(description() + ": short bulk write");
+  if (rc == LIBUSB_ERROR_NO_DEVICE) throw CommunicationError("libusb: device unplugged");
+  if (rc != 0) throw CommunicationError("libusb: bulk write failed");
+  if (sent != static_cast<int>(packet.size())) throw CommunicationError("libusb: short bulk write");
 }
 
 std::size_t LibusbTransport::read(std::span<std::uint8_t> buffer, std::chrono::microseconds timeout) {
-  if (handle_ == nullptr) throw CommunicationError(description() + ": read on a closed device");
+  if (handle_ == nullptr) throw CommunicationError("libusb: read on a closed device");
   int received = 0;
   const int rc = libusb_bulk_transfer(handle_, endpoint_in_, buffer.data(), static_cast<int>(buffer.size()),
                                       &received, to_milliseconds(timeout));
   if (rc == 0 || rc == LIBUSB_ERROR_TIMEOUT) return static_cast<std::size_t>(received);
   if (rc == LIBUSB_ERROR_OVERFLOW) return buffer.size();  // longer than the buffer: the caller rejects it
-  if (rc == LIBUSB_ERROR_NO_DEVICE) throw CommunicationError(description() + ": unplugged");
-  throw CommunicationError(description() + ": bulk read failed: " + error_text(rc));
+  if (rc == LIBUSB_ERROR_NO_DEVICE) throw CommunicationError("libusb: device unplugged");
+  throw CommunicationError("libusb: bulk read failed");
 }
 
 std::string LibusbTransport::description() const {

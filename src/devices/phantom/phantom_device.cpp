@@ -163,8 +163,8 @@ DeviceState PhantomDevice::read_state() {
     turn_forces_off_locally();
     counters_.watchdog_trips.fetch_add(1, std::memory_order_relaxed);
     send_command(CommandPacket{});  // CommunicationError here means the link is gone as well
-    throw SafetyFault("Phantom: watchdog: no force command for more than " +
-                      std::to_string(watchdog_.timeout_s()) + " s; forces turned off");
+    // A fixed message: the servo path builds no strings, also when it fails.
+    throw SafetyFault("Phantom: watchdog: no force command within its timeout; forces turned off");
   }
   receive_status(now);
   return state_;
@@ -190,7 +190,7 @@ void PhantomDevice::write_force(const Vec3& force_n) {
     enable_bit_zero_sent_ = true;
     watchdog_.kick(now);
   } else {
-    const Vec3 limited = devices::clamp_force_magnitude(force_n, config_.info.max_force_n);
+    const Vec3 limited = clamp_force_magnitude(force_n, config_.info.max_force_n);
     if (limited != force_n) counters_.clamped_commands.fetch_add(1, std::memory_order_relaxed);
     command.dac_counts = torques_to_dac(config_.motors, arm_.joint_torques(joint_angles_, limited));
     command.force_enable = true;

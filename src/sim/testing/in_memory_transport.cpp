@@ -19,13 +19,11 @@ void InMemoryTransport::close() noexcept { open_ = false; }
 
 bool InMemoryTransport::is_open() const noexcept { return open_; }
 
-void InMemoryTransport::throw_if_unusable(const char* operation) const {
+void InMemoryTransport::throw_if_unusable(const char* /*operation*/) const {
   // Unplug is checked first: that is the fault a caller needs to see after a mid-stream disconnect.
-  if (!peer_->connected()) {
-    throw CommunicationError(std::string("in-memory transport: ") + operation + " failed: device unplugged");
-  }
-  if (!open_)
-    throw CommunicationError(std::string("in-memory transport: ") + operation + " on a closed link");
+  // Fixed messages: the servo path builds no strings, also when it fails.
+  if (!peer_->connected()) throw CommunicationError("in-memory transport: device unplugged");
+  if (!open_) throw CommunicationError("in-memory transport: closed link");
 }
 
 void InMemoryTransport::write(std::span<const std::uint8_t> packet, std::chrono::microseconds /*timeout*/) {
