@@ -78,7 +78,7 @@ def measure_speed(char="家", repeats=3):
         start = time.perf_counter()
         result = calligraphy.simulate_trial(char, seed=0, rate_hz=1000.0)
         wall = time.perf_counter() - start
-        simulated = result.t.size * 1e-3  # one sample per 1 ms servo tick
+        simulated = result.time_s.size * 1e-3  # one sample per 1 ms servo tick
         runs.append((simulated / wall, simulated, wall))
     best = max(runs)
     factor, simulated, wall = best
@@ -103,7 +103,7 @@ def save_plots(folder):
         fig, axes = plt.subplots(2, 1, sharex=True, figsize=(8, 5))
         for ax, guidance in zip(axes, (False, True)):
             r = calligraphy.simulate_trial(char, guidance=guidance, seed=0)
-            ax.plot(r.t, np.linalg.norm(r.force, axis=1), lw=0.6)
+            ax.plot(r.time_s, np.linalg.norm(r.force_n, axis=1), lw=0.6)
             ax.set_ylabel("|F| [N]")
             ax.set_title(f"{char}, guidance {'on' if guidance else 'off'}")
         axes[-1].set_xlabel("t [s]")

@@ -17,12 +17,14 @@ CharacterLibrary library_from(const Arguments& arguments);
 class CharacterSource {
  public:
   explicit CharacterSource(const Arguments& arguments);
-  /// The character's model; throws CharacterNotFound or DataError.
+  /// The character's model; throws CharacterNotFound (for the embedded set naming --data and --store)
+  /// or DataError.
   [[nodiscard]] Character load(char32_t code_point) const;
 
  private:
   std::optional<CorpusStore> store_;
   CharacterLibrary library_;
+  bool embedded_ = false;  // the embedded default set: a missing character gets the --data hint
 };
 /// The code points of a CHARS argument; throws UsageError when empty or not UTF-8.
 std::u32string characters_from(const std::string& text);

@@ -7,60 +7,92 @@ in hanzi-writer-data's 1024 box, y up.
 Main entry points:
 
 * ``CharacterLibrary.default()`` / ``CharacterLibrary.from_hanzi_writer(path)`` and ``.load(char)``
-* ``TYPICAL_STROKES``: the 39 typical strokes (dicts: id, acronym, name, pinyin, unicode, ...)
+* ``TYPICAL_STROKES``: the 39 typical strokes
 * ``nearest_point(element, point, method="exact")``: one point (2,) or many (N, 2)
-* ``ForceLaw(...)``: paper_force, attraction_force, resistance_force, clamp
+* ``ForceLawParameters(...)`` and the force law: ``paper_force``, ``attraction_force``,
+  ``resistance_force``, ``friction_force``, ``constraint_taper``, ``clamp_force``
 * ``simulate_trial(chars, writer="novice", guidance=True, rate_hz=1000, seed=0)`` -> ``TrialResult``
-* ``SimulatedDevice``: read_state, write_force, advance
+* ``SimulatedDevice(SimulatedDeviceParameters(...))``: read_state, write_force, advance
+* ``list_devices()``: the device registry
 
-Errors: ``CharacterNotFoundError`` (a KeyError), ``InvalidArgumentError`` (a ValueError),
-``DataError`` and ``DeviceError`` (RuntimeErrors), all subclasses of ``CalligraphyError``.
+Errors carry the C++ class names: ``Error`` (the base), ``InvalidArgument`` (a ValueError),
+``DataError`` (a RuntimeError), ``CharacterNotFound`` (a KeyError and a DataError), ``DeviceError``
+(a RuntimeError) with ``DeviceNotFound`` (a LookupError), ``CommunicationError`` (a ConnectionError),
+``SafetyFault`` and ``CalibrationNeeded``.
 """
 
 from ._calligraphy import (  # noqa: F401
-    ADJUSTING,
-    CALIBRATION,
-    SEPARATION,
-    STATE_NAMES,
     TYPICAL_STROKES,
-    WRITING,
-    CalligraphyError,
+    CalibrationNeeded,
     Character,
     CharacterLibrary,
-    CharacterNotFoundError,
+    CharacterNotFound,
+    CommunicationError,
     DataError,
     DeviceError,
+    DeviceInfo,
+    DeviceListing,
+    DeviceNotFound,
     DeviceState,
-    ForceLaw,
-    InvalidArgumentError,
+    DeviceSurvey,
+    Error,
+    ForceLawParameters,
+    InteractionState,
+    InvalidArgument,
+    NearestPointMethod,
+    NearestPointOptions,
+    SafetyFault,
     SimulatedDevice,
+    SimulatedDeviceParameters,
     Stroke,
     StrokeElement,
     TrialResult,
+    WriterProfile,
+    attraction_force,
+    clamp_force,
+    constraint_taper,
+    friction_force,
+    list_devices,
     nearest_point,
+    paper_force,
+    resistance_force,
     simulate_trial,
 )
 
 __all__ = [
-    "ADJUSTING",
-    "CALIBRATION",
-    "SEPARATION",
-    "STATE_NAMES",
     "TYPICAL_STROKES",
-    "WRITING",
-    "CalligraphyError",
+    "CalibrationNeeded",
     "Character",
     "CharacterLibrary",
-    "CharacterNotFoundError",
+    "CharacterNotFound",
+    "CommunicationError",
     "DataError",
     "DeviceError",
+    "DeviceInfo",
+    "DeviceListing",
+    "DeviceNotFound",
     "DeviceState",
-    "ForceLaw",
-    "InvalidArgumentError",
+    "DeviceSurvey",
+    "Error",
+    "ForceLawParameters",
+    "InteractionState",
+    "InvalidArgument",
+    "NearestPointMethod",
+    "NearestPointOptions",
+    "SafetyFault",
     "SimulatedDevice",
+    "SimulatedDeviceParameters",
     "Stroke",
     "StrokeElement",
     "TrialResult",
+    "WriterProfile",
+    "attraction_force",
+    "clamp_force",
+    "constraint_taper",
+    "friction_force",
+    "list_devices",
     "nearest_point",
+    "paper_force",
+    "resistance_force",
     "simulate_trial",
 ]
