@@ -42,6 +42,12 @@ struct ElementLikeTag {
 /// A stroke element: a StrokeElement or its control points (n, 2).
 using ElementLike = Annotated<ElementLikeTag>;
 
+struct CharactersTag {
+  static constexpr auto name = py::detail::const_name("str | Character | Sequence[Character]");
+};
+/// Characters: a str of one or more, a Character or a sequence of Characters.
+using CharactersLike = Annotated<CharactersTag>;
+
 /// `repr(value)`, shortened to at most 60 characters, for messages.
 std::string short_repr(py::handle value);
 

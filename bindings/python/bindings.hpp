@@ -8,6 +8,7 @@ namespace calligraphy::python {
 namespace py = pybind11;
 
 void bind_core(py::module_& m);       // exceptions, __version__, DeviceState, DeviceInfo
+void bind_logging(py::module_& m);    // spdlog -> Python logging (log_forwarding.hpp)
 void bind_model(py::module_& m);      // elements, characters, libraries, typical strokes, scenes
 void bind_collision(py::module_& m);  // nearest_point
 void bind_render(py::module_& m);     // force law, interaction states, renderer

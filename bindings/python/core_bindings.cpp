@@ -115,6 +115,8 @@ void check_device_info(const DeviceInfo& info) {
 
 void bind_core(py::module_& m) {
   bind_exceptions(m);
+  // The project's version (CMake's PROJECT_VERSION), as the C++ library it was built from.
+  m.attr("__version__") = CALLIGRAPHY_VERSION;
 
   ParameterClass<DeviceInfo>(m, "DeviceInfo",
                              "What a haptic device can do, in SI units (after CHAI3D's cHapticDeviceInfo). "

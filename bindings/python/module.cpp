@@ -8,6 +8,7 @@ PYBIND11_MODULE(_calligraphy, m) {
   m.doc() = "Haptic training of Chinese handwriting (Wang, Zhang & Yao 2006), SI units throughout.";
   using namespace calligraphy::python;
   bind_core(m);
+  bind_logging(m);
   bind_model(m);
   bind_collision(m);
   bind_render(m);

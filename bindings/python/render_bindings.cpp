@@ -2,13 +2,20 @@
 // interaction states (interaction_state.hpp, paper section 2.3).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 
+#include <algorithm>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "bindings.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/render/force_law.hpp"
 #include "calligraphy/render/interaction_state.hpp"
+#include "calligraphy/render/renderer.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
+#include "log_forwarding.hpp"
 #include "numpy_arrays.hpp"
 #include "parameter_class.hpp"
 
@@ -198,12 +205,155 @@ void bind_interaction_state(py::module_& m) {
       .def("__hash__", [](InteractionState a) { return static_cast<int>(a); });
 }
 
+void check_safety(const SafetyChainParameters& p) {
+  // max_force_n = 0 means "the device's figure" in a RendererOptions or a trial; check the rest.
+  SafetyChainParameters copy = p;
+  if (copy.max_force_n == 0.0) copy.max_force_n = std::max(copy.max_continuous_force_n, 1.0);
+  copy.validate();
+}
+
+std::vector<std::string> limit_names(std::uint8_t limits) {
+  static const std::pair<std::uint8_t, const char*> names[] = {
+      {safety_non_finite, "non_finite"}, {safety_low_pass, "low_pass"},
+      {safety_continuous, "continuous"}, {safety_peak, "peak"},
+      {safety_start_ramp, "start_ramp"}, {safety_rate, "rate"}};
+  std::vector<std::string> out;
+  for (const auto& [bit, name] : names) {
+    if ((limits & bit) != 0) out.emplace_back(name);
+  }
+  return out;
+}
+
+void bind_renderer(py::module_& m) {
+  ParameterClass<SafetyChainParameters>(
+      m, "SafetyChainParameters",
+      "The safety chain between the force law and the device (paper section 6: force steps as a source of "
+      "instability), applied each tick: non-finite check, low-pass, continuous-force limit, peak clamp, "
+      "start ramp, per-tick change limit (include/calligraphy/render/safety_chain.hpp). A stage set to 0 is "
+      "off; max_force_n and max_continuous_force_n left at 0 take the device's figures.",
+      check_safety)
+      .field("max_force_n", &SafetyChainParameters::max_force_n, "peak clamp [N]; 0 = the device's max force")
+      .field("max_continuous_force_n", &SafetyChainParameters::max_continuous_force_n,
+             "continuous-force limit [N]; 0 = the device's figure (renderer) or off")
+      .field("continuous_time_constant_s", &SafetyChainParameters::continuous_time_constant_s,
+             "tau of the RMS (thermal) force estimate [s], > 0")
+      .field("start_ramp_n_per_s", &SafetyChainParameters::start_ramp_n_per_s,
+             "force ramp after start or reset [N/s]; 0 = off")
+      .field("max_force_change_n_per_tick", &SafetyChainParameters::max_force_change_n_per_tick,
+             "per-tick change limit [N per tick]; 0 = off")
+      .field("low_pass_cutoff_hz", &SafetyChainParameters::low_pass_cutoff_hz,
+             "first-order low-pass cutoff [Hz]; 0 = off")
+      .finish();
+
+  ParameterClass<PassivityParameters>(
+      m, "PassivityParameters",
+      "The time-domain passivity observer and controller of Hannaford & Ryu (2002): a variable damper "
+      "dissipates the energy the rendered force has produced (include/calligraphy/render/passivity.hpp).",
+      [](const PassivityParameters& p) { p.validate(); })
+      .field("enabled", &PassivityParameters::enabled, "observer and controller on")
+      .field("max_damping_n_s_per_m", &PassivityParameters::max_damping_n_s_per_m,
+             "cap on the variable damper alpha [N s/m], > 0")
+      .field("min_speed_m_s", &PassivityParameters::min_speed_m_s,
+             "below this speed no damping is added [m/s], > 0")
+      .finish();
+
+  ParameterClass<RendererOptions>(m, "RendererOptions",
+                                  "How a Renderer is run: the servo rate and the stages after the force law "
+                                  "(include/calligraphy/render/renderer.hpp).",
+                                  [](const RendererOptions& o) {
+                                    o.validate();
+                                    check_safety(o.safety);
+                                  })
+      .field("rate_hz", &RendererOptions::rate_hz, "servo rate [Hz], in [100, 100000]")
+      .field("safety", &RendererOptions::safety, "SafetyChainParameters")
+      .field("passivity", &RendererOptions::passivity, "PassivityParameters (off by default)")
+      .field("device_damping_n_s_per_m", &RendererOptions::device_damping_n_s_per_m,
+             "physical damping b of the device for Colgate's bound K <= 2 (b - B) / T [N s/m]; 0 = unknown")
+      .finish();
+
+  py::class_<RenderOutput>(m, "RenderOutput", "Everything one Renderer.tick decided.")
+      .def_property_readonly(
+          "force_n", [](const RenderOutput& o) { return to_array(o.force_n); },
+          "(3,) float64, the command for the device [N]: finite, within the safety chain's limits")
+      .def_readonly("state", &RenderOutput::state, "the InteractionState after this tick")
+      .def_readonly("state_changed", &RenderOutput::state_changed, "the state changed this tick")
+      .def_readonly("character", &RenderOutput::character, "active character index (valid unless finished)")
+      .def_readonly("stroke", &RenderOutput::stroke, "active stroke index within the character")
+      .def_readonly("element", &RenderOutput::element, "active element index within the stroke")
+      .def_readonly("finished", &RenderOutput::finished, "every stroke of the scene has been written")
+      .def_readonly("in_constraint_space", &RenderOutput::in_constraint_space,
+                    "the tip is inside R_res of the active element")
+      .def_property_readonly(
+          "foot_m", [](const RenderOutput& o) { return to_array(o.foot_m); },
+          "(2,) float64, the foot point X_S on the active element (WS only) [m]")
+      .def_readonly("stroke_completed", &RenderOutput::stroke_completed,
+                    "this tick wrote the last feature point of a stroke")
+      .def_readonly("stroke_abandoned", &RenderOutput::stroke_abandoned,
+                    "the pen was lifted in WS: the stroke was reloaded")
+      .def_readonly("input_rejected", &RenderOutput::input_rejected,
+                    "the device state was not finite: zero force")
+      .def_readonly("force_error", &RenderOutput::force_error,
+                    "the force law gave a non-finite force: zero force")
+      .def_readonly("limits", &RenderOutput::limits, "bits of the safety stages that acted (see limit_names)")
+      .def_property_readonly(
+          "limit_names", [](const RenderOutput& o) { return limit_names(o.limits); },
+          "list of str: the safety stages that acted, of 'non_finite', 'low_pass', 'continuous', 'peak', "
+          "'start_ramp', 'rate'")
+      .def_readonly("passivity_damping_n_s_per_m", &RenderOutput::passivity_damping_n_s_per_m,
+                    "damper added by the passivity controller [N s/m]")
+      .def("__repr__", [](const RenderOutput& o) {
+        return std::string("<RenderOutput ") + to_string(o.state) +
+               " |F| = " + std::to_string(o.force_n.norm()) + " N, stroke " + std::to_string(o.stroke) +
+               " element " + std::to_string(o.element) + ">";
+      });
+
+  py::class_<Renderer>(
+      m, "Renderer",
+      "The per-tick haptic renderer (paper section 4, Fig. 15): a DeviceState in, a force out. Call tick "
+      "once per servo tick at options.rate_hz from your own loop. Pipeline per tick: state machine "
+      "(Fig. 6) -> collision with the active element (section 4.3) -> force law (eqs. 7-9) with the "
+      "smoothing of section 6 and paper friction -> optional passivity controller -> safety chain. Not "
+      "thread-safe; keeps its Scene alive.")
+      .def(
+          py::init([](const Checked<Scene>& scene,
+                      const std::optional<Checked<ForceLawParameters>>& force_law,
+                      const std::optional<Checked<DeviceInfo>>& device,
+                      const std::optional<Checked<RendererOptions>>& options) {
+            if (!py::isinstance<Scene>(scene.object)) throw_type_error("scene", "Scene", scene.object);
+            return std::make_unique<Renderer>(
+                scene.object.cast<const Scene&>(),
+                force_law ? take(*force_law, "force_law") : ForceLawParameters{},
+                device ? take(*device, "device") : simulated_phantom_desktop_info(),
+                options ? take(*options, "options") : RendererOptions{});
+          }),
+          py::arg("scene"), py::arg("force_law") = py::none(), py::arg("device") = py::none(),
+          py::arg("options") = py::none(), py::keep_alive<1, 2>(), py::call_guard<ForwardLog>(),
+          "scene: the Scene to render. force_law: ForceLawParameters (default the C++ defaults). device: the "
+          "DeviceInfo whose limits the safety chain takes (default the simulated Phantom Desktop's). "
+          "options: "
+          "RendererOptions. Raises InvalidArgument (a ValueError) for values out of range or a device with "
+          "max_force_n <= 0; logs a warning when a stiffness exceeds the device's stable maximum.")
+      .def(
+          "tick", [](Renderer& r, const Checked<DeviceState>& state) { return r.tick(take(state, "state")); },
+          py::arg("state"),
+          "One servo tick: the DeviceState read from the device (SI units) -> RenderOutput. Never raises "
+          "for any state values: a non-finite state gives zero force (input_rejected).")
+      .def("reset", &Renderer::reset, "Back to the first stroke, state SS; the safety chain's ramp restarts.")
+      .def_property_readonly("state", &Renderer::state, "the current InteractionState")
+      .def_property_readonly("parameters", &Renderer::parameters, "its ForceLawParameters (a copy)")
+      .def_property_readonly("options", &Renderer::options, "its RendererOptions (a copy)")
+      .def_property_readonly(
+          "scene", [](const Renderer& r) -> const Scene& { return r.scene(); },
+          py::return_value_policy::reference_internal, "the Scene it renders");
+}
+
 }  // namespace
 
 void bind_render(py::module_& m) {
   bind_force_law_parameters(m);
   bind_force_functions(m);
   bind_interaction_state(m);
+  bind_renderer(m);
 }
 
 }  // namespace calligraphy::python

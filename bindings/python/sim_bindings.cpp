@@ -13,6 +13,7 @@
 #include "calligraphy/devices/device_registry.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
 #include "calligraphy/sim/simulated_writer.hpp"
+#include "log_forwarding.hpp"
 #include "numpy_arrays.hpp"
 #include "parameter_class.hpp"
 
@@ -184,6 +185,7 @@ void bind_registry(py::module_& m) {
         py::gil_scoped_release release;  // a scan may enumerate USB devices and load OpenHaptics
         return device_registry_with_simulation().survey();
       },
+      py::call_guard<ForwardLog>(),
       "Scans every registered backend (the simulated device, Phantoms over HID or USB, OpenHaptics) as "
       "`calligraphy devices` does (which also lists its Phantom emulator). Returns a DeviceSurvey; a backend "
       "that fails adds "

@@ -11,48 +11,39 @@
 #include "bindings.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/scene.hpp"
+#include "calligraphy/render/passivity.hpp"
+#include "calligraphy/render/safety_chain.hpp"
 #include "calligraphy/trial/trial.hpp"
 #include "character_source.hpp"
 #include "core/unicode.hpp"
+#include "log_forwarding.hpp"
+#include "model_bindings.hpp"
 #include "numpy_arrays.hpp"
 #include "report_bindings.hpp"
 
 namespace calligraphy::python {
 namespace {
 
-struct CharactersTag {
-  static constexpr auto name = py::detail::const_name("str | Character | Sequence[Character]");
+struct TrialCharactersTag {
+  static constexpr auto name = py::detail::const_name("str | Character | Sequence[Character] | Scene");
+};
+struct SceneTag {
+  static constexpr auto name = py::detail::const_name("Scene");
 };
 struct WriterTag {
   static constexpr auto name = py::detail::const_name("str | WriterProfile");
 };
 
-// A trial's trace as numpy arrays (one row per servo tick) and its metrics.
+// A trial's trace as numpy arrays (one row per servo tick), its metrics and the scene it was written on.
 struct PyTrialResult {
   py::array time_s, position_m, force_n, state, stroke, element;
   py::dict metrics;
+  py::object scene;
 };
 
-// Characters: a str of one or more characters (loaded from `library`), a Character, or a sequence of them.
-std::vector<Character> characters_from(const py::object& object, const CharacterSource& library) {
-  std::vector<Character> characters;
-  if (py::isinstance<py::str>(object)) {
-    for (char32_t c : decode_utf8(object.cast<std::string>())) characters.push_back(library.load(c));
-  } else if (py::isinstance<Character>(object)) {
-    characters.push_back(object.cast<Character>());
-  } else if (py::isinstance<py::sequence>(object) && !py::isinstance<py::bytes>(object)) {
-    for (const py::handle item : object) {
-      if (!py::isinstance<Character>(item)) {
-        throw_type_error("characters", "a str, a Character or a sequence of Characters", item);
-      }
-      characters.push_back(item.cast<Character>());
-    }
-  } else {
-    throw_type_error("characters", "a str, a Character or a sequence of Characters", object);
-  }
-  if (characters.empty()) throw InvalidArgument("characters: no character given");
-  return characters;
-}
+// The most servo ticks one call may simulate (rate_hz * max_duration_s): 10^7 ticks keep about 0.8 GB of
+// trace, about 3 hours at 1 kHz; the default 300 s at 1 kHz is 3 * 10^5.
+constexpr double kMaxTicks = 1e7;
 
 WriterProfile writer_from(const py::object& object) {
   if (py::isinstance<WriterProfile>(object)) return object.cast<WriterProfile>();
@@ -64,7 +55,7 @@ WriterProfile writer_from(const py::object& object) {
   throw InvalidArgument("writer: expected 'novice', 'skilled' or a WriterProfile, got '" + name + "'");
 }
 
-PyTrialResult to_python(const TrialResult& result, py::dict metrics) {
+PyTrialResult to_python(const TrialResult& result, py::dict metrics, py::object scene) {
   const auto n = static_cast<py::ssize_t>(result.trace.size());
   auto time = new_array({n});
   auto position = new_array({n, 3});
@@ -89,32 +80,49 @@ PyTrialResult to_python(const TrialResult& result, py::dict metrics) {
     aw(i) = static_cast<std::int64_t>(s.stroke);
     ew(i) = static_cast<std::int64_t>(s.element);
   }
-  return PyTrialResult{time, position, force, state, stroke, element, std::move(metrics)};
+  return PyTrialResult{time, position, force, state, stroke, element, std::move(metrics), std::move(scene)};
 }
 
-PyTrialResult simulate_trial_py(const Annotated<CharactersTag>& characters_object,
-                                const Annotated<WriterTag>& writer_object, const Checked<bool>& guidance,
+PyTrialResult simulate_trial_py(const Annotated<TrialCharactersTag>& characters,
+                                const Annotated<WriterTag>& writer, const Checked<bool>& guidance,
                                 const Checked<double>& rate_hz, const Checked<std::uint64_t>& seed,
                                 const std::optional<Checked<CharacterSource>>& library,
                                 const std::optional<Checked<ForceLawParameters>>& force_law,
-                                const Checked<double>& max_duration_s, const Checked<bool>& keep_trace) {
+                                const Checked<double>& max_duration_s, const Checked<bool>& keep_trace,
+                                const std::optional<Checked<SimulatedDeviceParameters>>& device,
+                                const std::optional<Checked<SafetyChainParameters>>& safety,
+                                const std::optional<Checked<PassivityParameters>>& passivity) {
   TrialOptions options;
   if (force_law) options.force = take(*force_law, "force_law");
   options.force.guidance = take(guidance, "guidance");
-  options.writer = writer_from(writer_object.object);
+  options.writer = writer_from(writer.object);
   options.rate_hz = take(rate_hz, "rate_hz");
   options.seed = take(seed, "seed");
   options.max_duration_s = take(max_duration_s, "max_duration_s");
   options.keep_trace = take(keep_trace, "keep_trace");
-  const CharacterSource source = library ? take(*library, "library") : CharacterSource::embedded();
-  const std::vector<Character> characters = characters_from(characters_object.object, source);
+  if (device) options.device = take(*device, "device");
+  if (safety) options.safety = take(*safety, "safety");
+  if (passivity) options.passivity = take(*passivity, "passivity");
+  options.validate();
+  if (!(options.rate_hz * options.max_duration_s <= kMaxTicks)) {
+    throw InvalidArgument("max_duration_s: " + std::to_string(options.max_duration_s) + " s at " +
+                          std::to_string(options.rate_hz) + " Hz is more than 10^7 servo ticks");
+  }
+
+  py::object scene_object;
+  if (py::isinstance<Scene>(characters.object)) {
+    scene_object = characters.object;
+  } else {
+    const CharacterSource source = library ? take(*library, "library") : CharacterSource::embedded();
+    scene_object = py::cast(Scene::lay_out(characters_from(characters.object, source, "characters")));
+  }
+  const Scene& scene = scene_object.cast<const Scene&>();
   std::string label;
-  for (const Character& c : characters) label += encode_utf8(c.code_point);
+  for (const PlacedCharacter& c : scene.characters) label += encode_utf8(c.code_point);
 
   TrialResult result;
   {
     py::gil_scoped_release release;
-    const Scene scene = Scene::lay_out(characters);
     result = run_simulated_trial(scene, options);
   }
   cli::TrialDescription description;
@@ -123,7 +131,7 @@ PyTrialResult simulate_trial_py(const Annotated<CharactersTag>& characters_objec
   description.writer = options.writer.name.empty() ? "custom" : options.writer.name;
   description.seed = options.seed;
   description.rate_hz = options.rate_hz;
-  return to_python(result, trial_metrics(description, result));
+  return to_python(result, trial_metrics(description, result), scene_object);
 }
 
 }  // namespace
@@ -140,23 +148,31 @@ void bind_trial(py::module_& m) {
       .def_readonly("stroke", &PyTrialResult::stroke, "(N,) int64, active stroke over the scene, 0-based")
       .def_readonly("element", &PyTrialResult::element,
                     "(N,) int64, active element within the stroke, 0-based")
-      .def_readonly("metrics", &PyTrialResult::metrics,
-                    "dict with exactly the keys of `calligraphy trial --json` (deviations in mm, times in s, "
-                    "forces in N)");
+      .def_readonly(
+          "metrics", &PyTrialResult::metrics,
+          "dict with exactly the keys of `calligraphy trial --json`, from the same code (deviations "
+          "in mm, times in s, forces in N; 'per_stroke' a list of dicts)")
+      .def_property_readonly(
+          "scene", [](const PyTrialResult& r) { return Annotated<SceneTag>{r.scene}; },
+          "the Scene the trial was written on (metres)");
 
   m.def("simulate_trial", &simulate_trial_py, py::arg("characters"), py::arg("writer") = "novice",
         py::arg("guidance") = true, py::arg("rate_hz") = 1000.0, py::arg("seed") = 0,
         py::arg("library") = py::none(), py::arg("force_law") = py::none(), py::arg("max_duration_s") = 300.0,
-        py::arg("keep_trace") = true,
+        py::arg("keep_trace") = true, py::arg("device") = py::none(), py::arg("safety") = py::none(),
+        py::arg("passivity") = py::none(), py::call_guard<ForwardLog>(),
         R"(Runs a whole guided writing trial lock-step on the simulated device with a simulated writer,
-as `calligraphy trial` does. Deterministic for a seed; the GIL is released while it runs.
+as `calligraphy trial` does (run_simulated_trial, include/calligraphy/trial/trial.hpp).
+Deterministic for a seed; the GIL is released while it runs.
 
 characters: a str of one or more characters (loaded from `library`, default the embedded set),
-            a Character, or a sequence of Characters (written left to right).
+            a Character, a sequence of Characters (written left to right), or a Scene.
 writer: 'novice', 'skilled' or a WriterProfile. guidance: in-plane guidance on or off (the paper
 force stays). rate_hz: servo rate [Hz], 100..100000. seed: int >= 0. max_duration_s: simulated
-time limit [s]. force_law: ForceLawParameters (its `guidance` is replaced by `guidance`).
-keep_trace: False leaves the arrays empty (faster, metrics only).
+time limit [s], > 0, at most 10^7 ticks (rate_hz * max_duration_s).
+force_law: ForceLawParameters (its `guidance` is replaced by `guidance`). device:
+SimulatedDeviceParameters. safety: SafetyChainParameters (0 forces take the device's figures).
+passivity: PassivityParameters. keep_trace: False leaves the arrays empty (faster, metrics only).
 Returns a TrialResult. Raises CharacterNotFound (a KeyError), InvalidArgument (a ValueError) for
 values out of range, TypeError naming the argument for a value of the wrong type.)");
 }
