@@ -10,6 +10,9 @@ packages=(
   libeigen3-dev libspdlog-dev catch2 nlohmann-json3-dev libbenchmark-dev
   libusb-1.0-0-dev libhidapi-dev     # Phantom backend (optional at configure time)
   pybind11-dev python3-dev python3-numpy python3-pytest
+  python3-pandas python3-matplotlib python3-tqdm python3-mypy   # Python tables, figures, stubgen
+  python3-dask python3-distributed    # parallel experiments from Python
+  fonts-arphic-ukai                   # a CJK font for calligraphy.plot
   nodejs npm                          # npm pack for hanzi-writer-data
 )
 

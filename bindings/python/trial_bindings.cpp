@@ -30,13 +30,16 @@ struct TrialCharactersTag {
 struct SceneTag {
   static constexpr auto name = py::detail::const_name("Scene");
 };
+struct DataFrameTag {
+  static constexpr auto name = py::detail::const_name("pandas.DataFrame");
+};
 struct WriterTag {
   static constexpr auto name = py::detail::const_name("str | WriterProfile");
 };
 
 // A trial's trace as numpy arrays (one row per servo tick), its metrics and the scene it was written on.
 struct PyTrialResult {
-  py::array time_s, position_m, force_n, state, stroke, element;
+  py::array time_s, position_m, force_n, state, stroke, element, stroke_trace_range;
   py::dict metrics;
   py::object scene;
 };
@@ -80,7 +83,17 @@ PyTrialResult to_python(const TrialResult& result, py::dict metrics, py::object 
     aw(i) = static_cast<std::int64_t>(s.stroke);
     ew(i) = static_cast<std::int64_t>(s.element);
   }
-  return PyTrialResult{time, position, force, state, stroke, element, std::move(metrics), std::move(scene)};
+  const auto strokes = static_cast<py::ssize_t>(result.metrics.per_stroke.size());
+  py::array_t<std::int64_t> ranges({strokes, py::ssize_t{2}});
+  auto rw = ranges.mutable_unchecked<2>();
+  for (py::ssize_t i = 0; i < strokes; ++i) {
+    const StrokeMetrics& m = result.metrics.per_stroke[static_cast<std::size_t>(i)];
+    // Without a trace there is nothing to index: empty ranges.
+    rw(i, 0) = n > 0 ? static_cast<std::int64_t>(m.trace_begin) : 0;
+    rw(i, 1) = n > 0 ? static_cast<std::int64_t>(m.trace_end) : 0;
+  }
+  return PyTrialResult{time,   position,           force,           state, stroke, element,
+                       ranges, std::move(metrics), std::move(scene)};
 }
 
 PyTrialResult simulate_trial_py(const Annotated<TrialCharactersTag>& characters,
@@ -148,13 +161,35 @@ void bind_trial(py::module_& m) {
       .def_readonly("stroke", &PyTrialResult::stroke, "(N,) int64, active stroke over the scene, 0-based")
       .def_readonly("element", &PyTrialResult::element,
                     "(N,) int64, active element within the stroke, 0-based")
+      .def_readonly("stroke_trace_range", &PyTrialResult::stroke_trace_range,
+                    "(S, 2) int64, one row per stroke of the scene: [begin, end) of its last attempt in the "
+                    "trace, the ticks its deviations are measured over (empty when not written or no trace)")
       .def_readonly(
           "metrics", &PyTrialResult::metrics,
           "dict with exactly the keys of `calligraphy trial --json`, from the same code (deviations "
           "in mm, times in s, forces in N; 'per_stroke' a list of dicts)")
       .def_property_readonly(
           "scene", [](const PyTrialResult& r) { return Annotated<SceneTag>{r.scene}; },
-          "the Scene the trial was written on (metres)");
+          "the Scene the trial was written on (metres)")
+      // The tables are made in Python (calligraphy/frames.py), where pandas is an optional import.
+      .def(
+          "to_dataframe",
+          [](const py::object& self) {
+            return Annotated<DataFrameTag>{
+                py::module_::import("calligraphy.frames").attr("trial_dataframe")(self)};
+          },
+          "A pandas.DataFrame with one row per servo tick: time_s [s], x_m, y_m, z_m [m], fx_n, fy_n, fz_n "
+          "[N], state (categorical 'SS', 'AS', 'CS', 'WS'), stroke, element (0-based). Raises ImportError "
+          "without pandas.")
+      .def(
+          "per_stroke_dataframe",
+          [](const py::object& self) {
+            return Annotated<DataFrameTag>{
+                py::module_::import("calligraphy.frames").attr("per_stroke_dataframe")(self)};
+          },
+          "A pandas.DataFrame with one row per stroke, indexed by the stroke over the scene (0-based): "
+          "character, acronym, typical_id, completed, attempts, mean_deviation_mm, max_deviation_mm [mm], "
+          "time_s [s]. Raises ImportError without pandas.");
 
   m.def("simulate_trial", &simulate_trial_py, py::arg("characters"), py::arg("writer") = "novice",
         py::arg("guidance") = true, py::arg("rate_hz") = 1000.0, py::arg("seed") = 0,
