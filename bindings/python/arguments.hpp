@@ -37,16 +37,28 @@ struct ArrayLikeTag {
 using ArrayLike = Annotated<ArrayLikeTag>;
 
 struct ElementLikeTag {
-  static constexpr auto name = py::detail::const_name("StrokeElement | numpy.typing.ArrayLike");
+  static constexpr auto name = py::detail::const_name("Union[StrokeElement, numpy.typing.ArrayLike]");
 };
 /// A stroke element: a StrokeElement or its control points (n, 2).
 using ElementLike = Annotated<ElementLikeTag>;
 
+struct PathTag {
+  static constexpr auto name = py::detail::const_name("Union[str, os.PathLike]");
+};
+/// A file or folder: a str or a path-like object, converted with convert_named<std::filesystem::path>.
+using PathLike = Annotated<PathTag>;
+
 struct CharactersTag {
-  static constexpr auto name = py::detail::const_name("str | Character | Sequence[Character]");
+  static constexpr auto name = py::detail::const_name("Union[str, Character, Sequence[Character]]");
 };
 /// Characters: a str of one or more, a Character or a sequence of Characters.
 using CharactersLike = Annotated<CharactersTag>;
+
+struct ComparisonTag {
+  static constexpr auto name = py::detail::const_name("bool");
+};
+/// The result of __eq__ / __ne__: a bool, or NotImplemented for another type (shown as bool).
+using Comparison = Annotated<ComparisonTag>;
 
 /// `repr(value)`, shortened to at most 60 characters, for messages.
 std::string short_repr(py::handle value);

@@ -89,7 +89,7 @@ spdlog::level::level_enum spdlog_level(int python_level) {
 }
 
 struct LogLevelTag {
-  static constexpr auto name = py::detail::const_name("int | str");
+  static constexpr auto name = py::detail::const_name("Union[int, str]");
 };
 
 void set_log_level(const Annotated<LogLevelTag>& level) {

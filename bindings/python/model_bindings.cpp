@@ -82,7 +82,7 @@ void bind_element(py::module_& m) {
           "(degree + 1, 2) float64, in the element's units")
       .def(
           "point",
-          [](const StrokeElement& e, const ArrayLike& t_object) -> py::object {
+          [](const StrokeElement& e, const ArrayLike& t_object) -> py::array_t<double> {
             const Scalars t = as_scalars(t_object.object, "t");
             if (t.single) return to_array(e.point(*t.array.data()));
             auto out = new_array({t.count, 2});
@@ -125,8 +125,12 @@ const TypicalStroke& typical_stroke_by_key(py::handle key) {
   throw_type_error("key", "a typical-stroke ID (int) or acronym (str)", key);
 }
 
+struct OptionalDictTag {
+  static constexpr auto name = py::detail::const_name("Optional[dict]");
+};
+
 struct TypicalStrokeKeyTag {
-  static constexpr auto name = py::detail::const_name("int | str");
+  static constexpr auto name = py::detail::const_name("Union[int, str]");
 };
 
 void bind_typical_strokes(py::module_& m) {
@@ -275,16 +279,17 @@ void bind_library(py::module_& m) {
                   "The embedded default set: a subset of hanzi-writer-data 2.0.1 compiled into the library.")
       .def_static(
           "from_hanzi_writer",
-          [](const Checked<std::filesystem::path>& folder) {
-            return CharacterSource::hanzi_writer_folder(take(folder, "path"));
+          [](const PathLike& folder) {
+            return CharacterSource::hanzi_writer_folder(
+                convert_named<std::filesystem::path>(folder.object, "path"));
           },
           py::arg("path"),
           "A folder of hanzi-writer-data '<char>.json' files (fitted when loaded). Raises DataError (a "
           "RuntimeError) when it does not exist.")
       .def_static(
           "from_store",
-          [](const Checked<std::filesystem::path>& path) {
-            return CharacterSource::store(take(path, "path"));
+          [](const PathLike& path) {
+            return CharacterSource::store(convert_named<std::filesystem::path>(path.object, "path"));
           },
           py::arg("path"),
           "A binary corpus store of fitted characters (include/calligraphy/model/corpus_store.hpp, "
@@ -318,8 +323,8 @@ void bind_library(py::module_& m) {
       .def_property_readonly("description", &CharacterSource::description, "what the library reads")
       .def_property_readonly(
           "store_info",
-          [](const CharacterSource& lib) -> py::object {
-            if (!lib.corpus_store()) return py::none();
+          [](const CharacterSource& lib) -> Annotated<OptionalDictTag> {
+            if (!lib.corpus_store()) return {py::none()};
             const CorpusStoreInfo& i = lib.corpus_store()->info();
             py::dict d;
             d["version"] = std::to_string(i.version_major) + "." + std::to_string(i.version_minor);
@@ -328,7 +333,7 @@ void bind_library(py::module_& m) {
             d["fit_tolerance"] = i.fit_tolerance;
             d["max_quantisation_error"] = i.max_quantisation_error();
             d["file_bytes"] = i.file_bytes;
-            return d;
+            return {d};
           },
           "For a corpus store, its header as a dict (version, character_count, steps_per_unit, "
           "fit_tolerance and max_quantisation_error in data units, file_bytes); else None.")
@@ -449,10 +454,16 @@ void bind_scene(py::module_& m) {
                " strokes>";
       });
 
-  py::class_<Scene>(m, "Scene",
-                    "Characters placed in a row on the paper plane, in metres, written left to right "
-                    "(include/calligraphy/model/scene.hpp; the paper's character group, Fig. 30). Immutable: "
-                    "a Renderer keeps a reference to it.")
+  py::class_<Scene>(
+      m, "Scene",
+      "Characters placed in a row on the paper plane z = layout.paper_z_m, in metres (x right, y away from "
+      "the writer), written left to right: the paper's character group (Fig. 30; "
+      "include/calligraphy/model/scene.hpp).\n\n"
+      "Each PlacedCharacter has a placement mapping its data box (1024 units, y up) to metres "
+      "(Placement.to_paper / to_data on shape (2,) or (N, 2) arrays), its strokes with elements whose "
+      "control points are in m, and bounding_box_m, shape (2, 2) [m]. strokes lists every PlacedStroke in "
+      "writing order (median_m (M, 2) [m], start_m and end_m (2,) [m], length_m [m]). Immutable: a "
+      "Renderer keeps a reference to it.")
       .def(py::init([](const Annotated<CharactersTag>& characters,
                        const std::optional<Checked<SceneLayout>>& layout,
                        const std::optional<Checked<CharacterSource>>& library) {

@@ -168,13 +168,13 @@ class ParameterClass {
     });
     cls_.def(
         "__eq__",
-        [shared](const S& self, py::object other) -> py::object {
-          if (!py::isinstance<S>(other)) return py::reinterpret_borrow<py::object>(Py_NotImplemented);
+        [shared](const S& self, const py::object& other) -> Comparison {
+          if (!py::isinstance<S>(other)) return {py::reinterpret_borrow<py::object>(Py_NotImplemented)};
           const S& o = other.cast<const S&>();
           for (const Field& f : shared->fields) {
-            if (!f.equal(self, o)) return py::bool_(false);
+            if (!f.equal(self, o)) return {py::bool_(false)};
           }
-          return py::bool_(true);
+          return {py::bool_(true)};
         },
         py::is_operator());
     cls_.attr("__hash__") = py::none();  // mutable: not hashable

@@ -64,6 +64,10 @@ void bind_force_law_parameters(py::module_& m) {
 
 double number(const Checked<double>& value, const char* name) { return take(value, name); }
 
+struct FloatOrArrayTag {
+  static constexpr auto name = py::detail::const_name("Union[float, numpy.ndarray[numpy.float64]]");
+};
+
 void bind_force_functions(py::module_& m) {
   m.def(
       "paper_force",
@@ -137,15 +141,15 @@ void bind_force_functions(py::module_& m) {
   m.def(
       "constraint_taper",
       [](const ArrayLike& d_object, const Checked<double>& radius,
-         const Checked<double>& band) -> py::object {
+         const Checked<double>& band) -> Annotated<FloatOrArrayTag> {
         const Scalars d = as_scalars(d_object.object, "distance_m");
         const double r = number(radius, "radius_m");
         const double w = number(band, "band_m");
-        if (d.single) return py::float_(constraint_taper(*d.array.data(), r, w));
+        if (d.single) return {py::float_(constraint_taper(*d.array.data(), r, w))};
         auto out = new_array({d.count});
         for (py::ssize_t i = 0; i < d.count; ++i)
           out.mutable_at(i) = constraint_taper(d.array.data()[i], r, w);
-        return out;
+        return {out};
       },
       py::arg("distance_m"), py::arg("radius_m"), py::arg("band_m"),
       "Taper of F_et at the constraint-space edge, in [0, 1]: 1 up to radius_m - band_m, 0 from radius_m, "
@@ -192,14 +196,14 @@ void bind_interaction_state(py::module_& m) {
       // Equal to its int value too, so that `result.state == InteractionState.writing` compares a numpy
       // array elementwise (a scoped enum's binding compares equal only to its own type).
       .def(
-          "__eq__", [](InteractionState a, const py::object& b) { return state_equals(a, b); },
+          "__eq__", [](InteractionState a, const py::object& b) { return Comparison{state_equals(a, b)}; },
           py::is_operator())
       .def(
           "__ne__",
-          [](InteractionState a, const py::object& b) -> py::object {
+          [](InteractionState a, const py::object& b) -> Comparison {
             const py::object equal = state_equals(a, b);
-            if (equal.is(py::reinterpret_borrow<py::object>(Py_NotImplemented))) return equal;
-            return py::bool_(!equal.cast<bool>());
+            if (equal.is(py::reinterpret_borrow<py::object>(Py_NotImplemented))) return {equal};
+            return {py::bool_(!equal.cast<bool>())};
           },
           py::is_operator())
       .def("__hash__", [](InteractionState a) { return static_cast<int>(a); });

@@ -25,7 +25,7 @@ namespace calligraphy::python {
 namespace {
 
 struct TrialCharactersTag {
-  static constexpr auto name = py::detail::const_name("str | Character | Sequence[Character] | Scene");
+  static constexpr auto name = py::detail::const_name("Union[str, Character, Sequence[Character], Scene]");
 };
 struct SceneTag {
   static constexpr auto name = py::detail::const_name("Scene");
@@ -34,12 +34,14 @@ struct DataFrameTag {
   static constexpr auto name = py::detail::const_name("pandas.DataFrame");
 };
 struct WriterTag {
-  static constexpr auto name = py::detail::const_name("str | WriterProfile");
+  static constexpr auto name = py::detail::const_name("Union[str, WriterProfile]");
 };
 
 // A trial's trace as numpy arrays (one row per servo tick), its metrics and the scene it was written on.
 struct PyTrialResult {
-  py::array time_s, position_m, force_n, state, stroke, element, stroke_trace_range;
+  py::array_t<double> time_s, position_m, force_n;
+  py::array_t<std::uint8_t> state;
+  py::array_t<std::int64_t> stroke, element, stroke_trace_range;
   py::dict metrics;
   py::object scene;
 };

@@ -91,7 +91,9 @@ def _axes(ax, figsize):
 
 def _runs(mask: np.ndarray):
     """[start, end) index ranges where mask is True."""
-    edges = np.flatnonzero(np.diff(np.concatenate(([0], mask.astype(np.int8), [0]))))
+    padded = np.zeros(mask.size + 2, dtype=np.int8)
+    padded[1:-1] = mask
+    edges = np.flatnonzero(np.diff(padded))
     return list(zip(edges[::2], edges[1::2]))
 
 
@@ -189,8 +191,8 @@ def forces(result: TrialResult, ax: matplotlib.axes.Axes | None = None, *, compo
         ax.axvline(time[i], color="grey", ls="--", lw=0.7, gid="calligraphy-stroke-boundary")
     if stroke_labels:
         names = [f"{placed.char} {s.acronym}" for placed in result.scene.characters for s in placed.strokes]
-        starts = np.concatenate(([0], changes))
-        ends = np.concatenate((changes, [time.size]))
+        starts = np.insert(changes, 0, 0)
+        ends = np.append(changes, time.size)
         for a, b in zip(starts, ends):
             name = names[stroke[a]] if stroke[a] < len(names) else ""
             ax.text((time[a] + time[b - 1]) / 2, 1.01, name, transform=ax.get_xaxis_transform(), ha="center",
