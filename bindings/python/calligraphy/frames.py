@@ -15,8 +15,14 @@ if typing.TYPE_CHECKING:  # pragma: no cover
 
     from ._calligraphy import TrialResult
 
-#: The state column's categories, in the order of InteractionState's values (paper section 2.3).
-STATE_NAMES = ("SS", "AS", "CS", "WS")
+
+def _state_names():
+    """The state column's categories, 'SS', 'AS', 'CS', 'WS', in the order of InteractionState's values."""
+    from ._calligraphy import InteractionState
+
+    states = sorted(InteractionState.__members__.values(), key=int)
+    assert [int(s) for s in states] == list(range(len(states)))
+    return [s.short_name for s in states]
 
 
 def _pandas():
@@ -41,7 +47,7 @@ def trial_dataframe(result: TrialResult) -> pandas.DataFrame:
     pandas = _pandas()
     position = np.asarray(result.position_m)
     force = np.asarray(result.force_n)
-    state = pandas.Categorical.from_codes(np.asarray(result.state, dtype=np.int8), categories=list(STATE_NAMES))
+    state = pandas.Categorical.from_codes(np.asarray(result.state, dtype=np.int8), categories=_state_names())
     return pandas.DataFrame(
         {
             "time_s": np.asarray(result.time_s),
