@@ -12,15 +12,14 @@ simulated seconds per wall-clock second.
 Run from a build tree:
     PYTHONPATH=build/python /usr/bin/python3 examples/python/table5.py [--seeds 8] [--plots DIR]
 
-Force plots (one trial per character, |F| against time) are written only when matplotlib imports.
+Force plots (one trial per character with guidance off and on, the in-plane force against time with
+the stroke boundaries, calligraphy.plot.forces) are written only when matplotlib imports.
 """
 
 import argparse
 import statistics
 import sys
 import time
-
-import numpy as np
 
 import calligraphy
 
@@ -78,7 +77,7 @@ def measure_speed(char="家", repeats=3):
         start = time.perf_counter()
         result = calligraphy.simulate_trial(char, seed=0, rate_hz=1000.0)
         wall = time.perf_counter() - start
-        simulated = result.t.size * 1e-3  # one sample per 1 ms servo tick
+        simulated = result.time_s.size * 1e-3  # one sample per 1 ms servo tick
         runs.append((simulated / wall, simulated, wall))
     best = max(runs)
     factor, simulated, wall = best
@@ -93,6 +92,8 @@ def save_plots(folder):
 
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
+
+        import calligraphy.plot
     except ImportError:
         print("matplotlib is not installed: no force plots")
         return
@@ -100,13 +101,12 @@ def save_plots(folder):
 
     os.makedirs(folder, exist_ok=True)
     for char in CHARACTERS:
-        fig, axes = plt.subplots(2, 1, sharex=True, figsize=(8, 5))
+        fig, axes = plt.subplots(2, 1, sharex=True, figsize=(9, 6))
         for ax, guidance in zip(axes, (False, True)):
             r = calligraphy.simulate_trial(char, guidance=guidance, seed=0)
-            ax.plot(r.t, np.linalg.norm(r.force, axis=1), lw=0.6)
-            ax.set_ylabel("|F| [N]")
-            ax.set_title(f"{char}, guidance {'on' if guidance else 'off'}")
-        axes[-1].set_xlabel("t [s]")
+            calligraphy.plot.forces(r, ax=ax)
+            ax.text(0.01, 0.96, f"guidance {'on' if guidance else 'off'}", transform=ax.transAxes, va="top",
+                    fontsize=9)
         path = os.path.join(folder, f"force_{ord(char):04X}.png")
         fig.tight_layout()
         fig.savefig(path, dpi=120)

@@ -27,11 +27,18 @@ CharacterSource::CharacterSource(const LibraryOptions& options) : library_(Chara
     store_ = CorpusStore::open(options.store_file);
   } else {
     library_ = library_from(options);
+    embedded_ = options.data_folder.empty();
   }
 }
 
 Character CharacterSource::load(char32_t code_point) const {
-  return store_ ? store_->load(code_point) : library_.load(code_point);
+  if (store_) return store_->load(code_point);
+  if (!embedded_) return library_.load(code_point);
+  try {
+    return library_.load(code_point);
+  } catch (const CharacterNotFound& e) {  // the library's message is neutral; the flags are ours
+    throw CharacterNotFound(std::string(e.what()) + ": pass --data DIR or --store FILE");
+  }
 }
 
 std::u32string characters_from(const std::string& text, const std::string& what) {

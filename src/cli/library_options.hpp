@@ -26,12 +26,14 @@ CharacterLibrary library_from(const LibraryOptions& options);
 class CharacterSource {
  public:
   explicit CharacterSource(const LibraryOptions& options);
-  /// The character's model; throws CharacterNotFound or DataError.
+  /// The character's model; throws CharacterNotFound (for the embedded set naming --data and --store)
+  /// or DataError.
   [[nodiscard]] Character load(char32_t code_point) const;
 
  private:
   std::optional<CorpusStore> store_;
   CharacterLibrary library_;
+  bool embedded_ = false;  // the embedded default set: a missing character gets the --data hint
 };
 
 /// The code points of a CHARS argument; throws UsageError naming `what` (e.g. "--chars") when it is

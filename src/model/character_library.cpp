@@ -68,7 +68,8 @@ CharacterData CharacterLibrary::load_data(char32_t cp) const {
       throw CharacterNotFound("character " + describe_character(cp) +
                               " is not in the embedded default set (" +
                               std::to_string(detail::embedded_characters().size()) +
-                              " characters); pass --data with the full hanzi-writer-data folder");
+                              " characters); load it from the full hanzi-writer-data package (a folder "
+                              "of <char>.json files) or from a corpus store");
     }
     return parse_hanzi_writer_json(e->json, cp, "embedded:" + encode_utf8(cp) + ".json");
   }

@@ -1,5 +1,7 @@
 """Bad input raises Python exceptions carrying the C++ message."""
 
+import subprocess
+
 import numpy as np
 import pytest
 
@@ -7,20 +9,29 @@ import calligraphy
 
 
 def test_exception_hierarchy():
-    assert issubclass(calligraphy.CharacterNotFoundError, KeyError)
-    assert issubclass(calligraphy.CharacterNotFoundError, calligraphy.DataError)
-    assert issubclass(calligraphy.InvalidArgumentError, ValueError)
+    assert issubclass(calligraphy.CharacterNotFound, KeyError)
+    assert issubclass(calligraphy.CharacterNotFound, calligraphy.DataError)
+    assert issubclass(calligraphy.InvalidArgument, ValueError)
     assert issubclass(calligraphy.DataError, RuntimeError)
     assert issubclass(calligraphy.DeviceError, RuntimeError)
-    for cls in (calligraphy.InvalidArgumentError, calligraphy.DataError, calligraphy.DeviceError):
-        assert issubclass(cls, calligraphy.CalligraphyError)
+    assert issubclass(calligraphy.DeviceNotFound, LookupError)
+    assert issubclass(calligraphy.CommunicationError, ConnectionError)
+    for cls in (calligraphy.DeviceNotFound, calligraphy.CommunicationError, calligraphy.SafetyFault,
+                calligraphy.CalibrationNeeded):
+        assert issubclass(cls, calligraphy.DeviceError)
+    for cls in (calligraphy.InvalidArgument, calligraphy.DataError, calligraphy.DeviceError):
+        assert issubclass(cls, calligraphy.Error)
 
 
 def test_missing_character_is_key_error(library):
     with pytest.raises(KeyError) as info:
         library.load("龘")
-    assert isinstance(info.value, calligraphy.CharacterNotFoundError)
-    assert "U+9F98" in str(info.value)
+    assert isinstance(info.value, calligraphy.CharacterNotFound)
+    message = str(info.value)
+    assert "U+9F98" in message
+    # The message speaks Python: how to load more characters, no command-line flag.
+    assert "CharacterLibrary.from_hanzi_writer" in message and "CharacterLibrary.from_store" in message
+    assert "--" not in message
 
 
 def test_not_one_character_is_value_error(library):
@@ -63,11 +74,11 @@ def test_nearest_point_bad_input():
 
 def test_force_law_rejects_bad_parameters():
     with pytest.raises(ValueError, match="paper_stiffness"):
-        calligraphy.ForceLaw(paper_stiffness_n_per_m=-1.0)
+        calligraphy.ForceLawParameters(paper_stiffness_n_per_m=-1.0)
     with pytest.raises(ValueError):
-        calligraphy.ForceLaw(constraint_radius_m=0.0)
+        calligraphy.ForceLawParameters(constraint_radius_m=0.0)
     with pytest.raises(ValueError):
-        calligraphy.ForceLaw(guidance_stiffness_n_per_m=float("nan"))
+        calligraphy.ForceLawParameters(guidance_stiffness_n_per_m=float("nan"))
 
 
 def test_simulate_trial_bad_input():
@@ -79,15 +90,58 @@ def test_simulate_trial_bad_input():
         calligraphy.simulate_trial("龘")
     with pytest.raises(ValueError):
         calligraphy.simulate_trial("")
-    with pytest.raises(ValueError):
+    with pytest.raises(TypeError, match="characters"):
         calligraphy.simulate_trial([1, 2])
 
 
 def test_simulated_device_bad_input():
-    with pytest.raises(ValueError):
-        calligraphy.SimulatedDevice(moving_mass_kg=0.0)
+    with pytest.raises(ValueError, match="moving_mass_kg"):
+        calligraphy.SimulatedDeviceParameters(moving_mass_kg=0.0)
     device = calligraphy.SimulatedDevice()
     with pytest.raises(ValueError):
         device.write_force([1.0, 0.0])
     with pytest.raises(ValueError):
         device.advance(-1e-3)
+
+
+def test_cli_adds_its_own_flag_hint(cli):
+    # The library's message is neutral; the command line names its options.
+    run = subprocess.run([cli, "model", "龘"], capture_output=True, text=True)
+    assert run.returncode == 1
+    assert "U+9F98" in run.stderr and "--data" in run.stderr and "CharacterLibrary" not in run.stderr
+
+
+@pytest.mark.parametrize(
+    "call, name",
+    [
+        (lambda: calligraphy.simulate_trial("永", rate_hz="fast"), "rate_hz"),
+        (lambda: calligraphy.simulate_trial("永", seed=1.5), "seed"),
+        (lambda: calligraphy.simulate_trial("永", guidance=None), "guidance"),
+        (lambda: calligraphy.simulate_trial("永", writer=3), "writer"),
+        (lambda: calligraphy.simulate_trial("永", library="embedded"), "library"),
+        (lambda: calligraphy.simulate_trial("永", force_law={"guidance": True}), "force_law"),
+        (lambda: calligraphy.simulate_trial(42), "characters"),
+        (lambda: calligraphy.nearest_point([[0, 0], [1, 0]], "here"), "point"),
+        (lambda: calligraphy.nearest_point([[0, 0], [1, 0]], [0, 1], newton_starts=2.5), "newton_starts"),
+        (lambda: calligraphy.nearest_point([[0, 0], [1, 0]], [0, 1], tolerance="small"), "tolerance"),
+        (lambda: calligraphy.CharacterLibrary.default().load(0x6C38), "char"),
+        (lambda: calligraphy.CharacterLibrary.from_hanzi_writer(3), "path"),
+        (lambda: calligraphy.paper_force(-0.001, 0.0, stiffness_n_per_m=None), "stiffness_n_per_m"),
+        (lambda: calligraphy.SimulatedDevice().advance("1 ms"), "dt_s"),
+        (lambda: calligraphy.SimulatedDevice(parameters=1), "parameters"),
+        (lambda: calligraphy.ForceLawParameters(guidance_stiffness_n_per_m="400"), "guidance_stiffness_n_per_m"),
+    ],
+)
+def test_wrong_type_names_the_argument(call, name):
+    with pytest.raises(TypeError) as info:
+        call()
+    message = str(info.value)
+    assert name in message
+    assert "Unable to cast" not in message and "incompatible function arguments" not in message
+
+
+def test_out_of_range_integer_is_value_error():
+    with pytest.raises(ValueError, match="seed"):
+        calligraphy.simulate_trial("永", seed=-1)
+    with pytest.raises(ValueError, match="newton_starts"):
+        calligraphy.nearest_point([[0, 0], [1, 0]], [0, 1], newton_starts=2**40)

@@ -1,6 +1,8 @@
 """Loading characters, the typical strokes and the element data from Python."""
 
 import json
+import pathlib
+import subprocess
 
 import numpy as np
 import pytest
@@ -24,7 +26,7 @@ def test_strokes_and_elements_are_consistent(library):
         character = library.load(ch)
         for stroke in character.strokes:
             assert 1 <= stroke.typical_id <= 39
-            assert stroke.acronym == calligraphy.TYPICAL_STROKES[stroke.typical_id - 1]["acronym"]
+            assert stroke.acronym == calligraphy.TYPICAL_STROKES[stroke.typical_id - 1].acronym
             elements = stroke.elements
             assert elements
             fp = stroke.feature_points
@@ -58,13 +60,33 @@ def test_element_point_matches_bernstein_form(library):
 def test_typical_strokes_table():
     strokes = calligraphy.TYPICAL_STROKES
     assert len(strokes) == 39
-    assert [s["id"] for s in strokes] == list(range(1, 40))
-    acronyms = [s["acronym"] for s in strokes]
+    assert [s.id for s in strokes] == list(range(1, 40))
+    acronyms = [s.acronym for s in strokes]
     assert len(set(acronyms)) == 39
     assert {"H", "S", "P", "D", "HZG"} <= set(acronyms)
     for s in strokes:
-        assert s["name"] and s["pinyin"]
-        assert s["unicode"] is None or 0x31C0 <= ord(s["unicode"]) <= 0x31E5
+        assert s.name_zh and s.pinyin
+        assert s.unicode is None or 0x31C0 <= ord(s.unicode) <= 0x31E5
+        assert len(s.pieces) >= 1 and (s.compound or len(s.pieces) == 1)
+        for piece in s.pieces:
+            assert piece.kind in ("line", "bezier")
+            assert piece.min_length <= piece.max_length
+
+
+def test_typical_stroke_by_acronym_and_id():
+    hzg = calligraphy.typical_stroke("HZG")
+    assert hzg.acronym == "HZG" and hzg.name_zh == "横折钩"
+    assert calligraphy.typical_stroke(hzg.id).acronym == "HZG"
+    for s in calligraphy.TYPICAL_STROKES:
+        assert calligraphy.typical_stroke(s.acronym).id == s.id
+        assert calligraphy.typical_stroke(s.id).acronym == s.acronym
+    assert calligraphy.typical_stroke(np.int64(1)).acronym == calligraphy.TYPICAL_STROKES[0].acronym
+    with pytest.raises(ValueError, match="XYZ"):
+        calligraphy.typical_stroke("XYZ")
+    with pytest.raises(ValueError, match="40"):
+        calligraphy.typical_stroke(40)
+    with pytest.raises(TypeError, match="key"):
+        calligraphy.typical_stroke(1.5)
 
 
 def test_from_hanzi_writer_folder(tmp_path):
@@ -78,3 +100,45 @@ def test_from_hanzi_writer_folder(tmp_path):
     assert one.strokes[0].acronym == "H"
     np.testing.assert_allclose(one.strokes[0].feature_points[0], [100, 400], atol=1e-9)
     np.testing.assert_allclose(one.strokes[0].feature_points[-1], [900, 420], atol=1e-9)
+
+
+@pytest.fixture(scope="module")
+def store_path(cli, tmp_path_factory):
+    """A corpus store of the embedded set, built by `calligraphy corpus build`."""
+    data = pathlib.Path(__file__).resolve().parents[2] / "data" / "hanzi-writer-data"
+    path = tmp_path_factory.mktemp("store") / "embedded.store"
+    subprocess.run([cli, "corpus", "build", "--data", str(data), "--out", str(path), "--threads", "1"],
+                   check=True, capture_output=True)
+    return path
+
+
+def test_from_store_matches_the_fitted_characters(store_path, library):
+    store = calligraphy.CharacterLibrary.from_store(store_path)
+    assert store.characters() == library.characters()
+    assert len(store) == len(library)
+    info = store.store_info
+    assert info["character_count"] == len(library)
+    assert library.store_info is None
+    for ch in ("永", "我"):
+        stored, fitted = store.load(ch), library.load(ch)
+        assert stored.typical_stroke_ids == fitted.typical_stroke_ids
+        for s_stored, s_fitted in zip(stored.strokes, fitted.strokes):
+            assert s_stored.median.shape == (0, 2)  # a store keeps no medians
+            np.testing.assert_allclose(s_stored.attraction_factors, s_fitted.attraction_factors)
+            # Control points are quantised to 1 / steps_per_unit data units.
+            error = np.abs(s_stored.feature_points - s_fitted.feature_points).max()
+            assert error <= info["max_quantisation_error"] + 1e-9
+    with pytest.raises(calligraphy.CharacterNotFound, match=r"U\+9F98"):
+        store.load("龘")
+    # A store's character trains like a fitted one.
+    result = calligraphy.simulate_trial("永", library=store, seed=3, keep_trace=False)
+    assert result.metrics["strokes_total"] == 5
+
+
+def test_from_store_rejects_a_bad_file(tmp_path):
+    with pytest.raises(calligraphy.DataError, match="missing.store"):
+        calligraphy.CharacterLibrary.from_store(tmp_path / "missing.store")
+    junk = tmp_path / "junk.store"
+    junk.write_bytes(b"not a corpus store" * 10)
+    with pytest.raises(calligraphy.DataError, match="junk.store"):
+        calligraphy.CharacterLibrary.from_store(str(junk))

@@ -1,66 +1,134 @@
 """calligraphy: haptic training of Chinese handwriting (Wang, Zhang & Yao, Virtual Reality 2006).
 
-Python bindings of the C++20 library. Units are SI everywhere: lengths in m, forces in N, time in s,
-stiffness in N/m, damping in N s/m. Character data (control points of a Character's elements) stays
-in hanzi-writer-data's 1024 box, y up.
+Python bindings of the C++20 library, its types bound directly. Units are SI everywhere and named in
+every field and argument: lengths in m, forces in N, time in s, stiffness in N/m, damping in N s/m.
+Character data (control points of a Character's elements) stays in hanzi-writer-data's 1024 box, y up.
 
 Main entry points:
 
-* ``CharacterLibrary.default()`` / ``CharacterLibrary.from_hanzi_writer(path)`` and ``.load(char)``
-* ``TYPICAL_STROKES``: the 39 typical strokes (dicts: id, acronym, name, pinyin, unicode, ...)
+* ``CharacterLibrary.default()``, ``.from_hanzi_writer(folder)``, ``.from_store(path)``; ``.load(char)``
+* ``typical_stroke("HZG")`` / ``typical_stroke(10)`` and ``TYPICAL_STROKES``: the 39 typical strokes
+* ``Scene(chars)``: characters placed on the paper in metres; ``Placement.to_paper`` / ``to_data``
 * ``nearest_point(element, point, method="exact")``: one point (2,) or many (N, 2)
-* ``ForceLaw(...)``: paper_force, attraction_force, resistance_force, clamp
+* ``ForceLawParameters(...)`` and the force law: ``paper_force``, ``attraction_force``,
+  ``resistance_force``, ``friction_force``, ``constraint_taper``, ``clamp_force``
+* ``Renderer(scene, force_law).tick(DeviceState(...))`` -> ``RenderOutput``
 * ``simulate_trial(chars, writer="novice", guidance=True, rate_hz=1000, seed=0)`` -> ``TrialResult``
-* ``SimulatedDevice``: read_state, write_force, advance
+  (``.to_dataframe()``, ``.per_stroke_dataframe()`` with pandas; ``calligraphy.plot`` with matplotlib)
+* ``SimulatedDevice(SimulatedDeviceParameters(...))``, ``WriterProfile``, ``list_devices()``
+* ``set_log_level(level)``: the C++ log goes to ``logging.getLogger("calligraphy")``
 
-Errors: ``CharacterNotFoundError`` (a KeyError), ``InvalidArgumentError`` (a ValueError),
-``DataError`` and ``DeviceError`` (RuntimeErrors), all subclasses of ``CalligraphyError``.
+Errors carry the C++ class names: ``Error`` (the base), ``InvalidArgument`` (a ValueError),
+``DataError`` (a RuntimeError), ``CharacterNotFound`` (a KeyError and a DataError), ``DeviceError``
+(a RuntimeError) with ``DeviceNotFound`` (a LookupError), ``CommunicationError`` (a ConnectionError),
+``SafetyFault`` and ``CalibrationNeeded``. An argument of the wrong type raises TypeError naming it.
+See docs/python.md.
 """
 
 from ._calligraphy import (  # noqa: F401
-    ADJUSTING,
-    CALIBRATION,
-    SEPARATION,
-    STATE_NAMES,
+    __version__,
     TYPICAL_STROKES,
-    WRITING,
-    CalligraphyError,
+    CalibrationNeeded,
     Character,
     CharacterLibrary,
-    CharacterNotFoundError,
+    CharacterNotFound,
+    CommunicationError,
     DataError,
     DeviceError,
+    DeviceInfo,
+    DeviceListing,
+    DeviceNotFound,
     DeviceState,
-    ForceLaw,
-    InvalidArgumentError,
+    DeviceSurvey,
+    Error,
+    ForceLawParameters,
+    InteractionState,
+    InvalidArgument,
+    NearestPointMethod,
+    NearestPointOptions,
+    PassivityParameters,
+    PlacedCharacter,
+    PlacedStroke,
+    Placement,
+    RenderOutput,
+    Renderer,
+    RendererOptions,
+    SafetyChainParameters,
+    SafetyFault,
+    Scene,
+    SceneLayout,
     SimulatedDevice,
+    SimulatedDeviceParameters,
     Stroke,
     StrokeElement,
+    StrokePieceTemplate,
     TrialResult,
+    TypicalStroke,
+    WriterProfile,
+    attraction_force,
+    clamp_force,
+    constraint_taper,
+    flush_log,
+    friction_force,
+    list_devices,
     nearest_point,
+    paper_force,
+    resistance_force,
+    set_log_level,
     simulate_trial,
+    typical_stroke,
 )
 
 __all__ = [
-    "ADJUSTING",
-    "CALIBRATION",
-    "SEPARATION",
-    "STATE_NAMES",
+    "__version__",
     "TYPICAL_STROKES",
-    "WRITING",
-    "CalligraphyError",
+    "CalibrationNeeded",
     "Character",
     "CharacterLibrary",
-    "CharacterNotFoundError",
+    "CharacterNotFound",
+    "CommunicationError",
     "DataError",
     "DeviceError",
+    "DeviceInfo",
+    "DeviceListing",
+    "DeviceNotFound",
     "DeviceState",
-    "ForceLaw",
-    "InvalidArgumentError",
+    "DeviceSurvey",
+    "Error",
+    "ForceLawParameters",
+    "InteractionState",
+    "InvalidArgument",
+    "NearestPointMethod",
+    "NearestPointOptions",
+    "PassivityParameters",
+    "PlacedCharacter",
+    "PlacedStroke",
+    "Placement",
+    "RenderOutput",
+    "Renderer",
+    "RendererOptions",
+    "SafetyChainParameters",
+    "SafetyFault",
+    "Scene",
+    "SceneLayout",
     "SimulatedDevice",
+    "SimulatedDeviceParameters",
     "Stroke",
     "StrokeElement",
+    "StrokePieceTemplate",
     "TrialResult",
+    "TypicalStroke",
+    "WriterProfile",
+    "attraction_force",
+    "clamp_force",
+    "constraint_taper",
+    "flush_log",
+    "friction_force",
+    "list_devices",
     "nearest_point",
+    "paper_force",
+    "resistance_force",
+    "set_log_level",
     "simulate_trial",
+    "typical_stroke",
 ]

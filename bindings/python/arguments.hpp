@@ -1,0 +1,150 @@
+#pragma once
+// Argument conversion for the bindings: Python values of the wrong type raise TypeError (out-of-range
+// integers and unknown enum names InvalidArgument, a ValueError) naming the argument, instead of pybind11's
+// "incompatible function arguments" or "Unable to cast Python instance to C++ type".
+//
+// `Checked<T>` accepts any Python object at call time and shows T's Python type in signatures and
+// stubs ("rate_hz: float = 1000.0"); `take(arg, "rate_hz")` converts it. `Annotated<Tag>` takes any object
+// for arguments of several types (ArrayLike: numpy-convertible, shown as numpy.typing.ArrayLike).
+#include <pybind11/pybind11.h>
+
+#include <string>
+#include <type_traits>
+
+#include "calligraphy/core/errors.hpp"
+
+namespace calligraphy::python {
+
+namespace py = pybind11;
+
+/// An argument converted to T in the function body by `take`, so that errors can name it.
+template <typename T>
+struct Checked {
+  py::object object;
+};
+
+/// Any Python object, shown in signatures and stubs as `Tag::name` (a pybind11 const_name): for
+/// arguments that take several types, converted in the function body.
+template <typename Tag>
+struct Annotated {
+  py::object object;
+};
+
+struct ArrayLikeTag {
+  static constexpr auto name = py::detail::const_name("numpy.typing.ArrayLike");
+};
+/// An array-like argument (list, tuple, numpy array); shapes are checked where it is used.
+using ArrayLike = Annotated<ArrayLikeTag>;
+
+struct ElementLikeTag {
+  static constexpr auto name = py::detail::const_name("Union[StrokeElement, numpy.typing.ArrayLike]");
+};
+/// A stroke element: a StrokeElement or its control points (n, 2).
+using ElementLike = Annotated<ElementLikeTag>;
+
+struct PathTag {
+  static constexpr auto name = py::detail::const_name("Union[str, os.PathLike]");
+};
+/// A file or folder: a str or a path-like object, converted with convert_named<std::filesystem::path>.
+using PathLike = Annotated<PathTag>;
+
+struct CharactersTag {
+  static constexpr auto name = py::detail::const_name("Union[str, Character, Sequence[Character]]");
+};
+/// Characters: a str of one or more, a Character or a sequence of Characters.
+using CharactersLike = Annotated<CharactersTag>;
+
+struct ComparisonTag {
+  static constexpr auto name = py::detail::const_name("bool");
+};
+/// The result of __eq__ / __ne__: a bool, or NotImplemented for another type (shown as bool).
+using Comparison = Annotated<ComparisonTag>;
+
+/// `repr(value)`, shortened to at most 60 characters, for messages.
+std::string short_repr(py::handle value);
+
+/// TypeError "<name>: expected <expected>, got <type> <repr>".
+[[noreturn]] void throw_type_error(const std::string& name, const std::string& expected, py::handle value);
+
+/// The Python name of T: "float", "int", "str", "bool", or a bound class's name.
+template <typename T>
+std::string python_type_name() {
+  if constexpr (std::is_base_of_v<py::detail::type_caster_generic, py::detail::make_caster<T>>) {
+    return py::str(py::type::of<T>().attr("__name__"));
+  } else {
+    return py::detail::make_caster<T>::name.text;
+  }
+}
+
+/// Converts `value` to T, naming `name` in the TypeError (or, for an int out of T's range, ValueError).
+/// Numbers: int or float (not bool) for double, int for integers; an enum takes a member or its name;
+/// None is refused for every T.
+template <typename T>
+T convert_named(py::handle value, const std::string& name) {
+  if (value.is_none()) throw_type_error(name, python_type_name<T>(), value);
+  if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>) {
+    if (PyBool_Check(value.ptr())) throw_type_error(name, python_type_name<T>(), value);
+  }
+  if constexpr (std::is_enum_v<T>) {
+    // An enum also takes its member's name: "newton" for NearestPointMethod.newton.
+    if (py::isinstance<py::str>(value)) {
+      const py::dict members = py::type::of<T>().attr("__members__");
+      if (!members.contains(value)) {
+        std::string known;
+        for (const auto& item : members)
+          known += (known.empty() ? "'" : ", '") + std::string(py::str(item.first)) + "'";
+        throw InvalidArgument(name + ": expected one of " + known + ", got " + short_repr(value));
+      }
+      return members[value].template cast<T>();
+    }
+  }
+  try {
+    return value.cast<T>();
+  } catch (const py::cast_error&) {
+    if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
+      if (PyLong_Check(value.ptr())) {
+        throw InvalidArgument(name + ": " + short_repr(value) + " is out of range for this argument");
+      }
+    }
+    throw_type_error(name, python_type_name<T>(), value);
+  }
+}
+
+template <typename T>
+T take(const Checked<T>& argument, const std::string& name) {
+  return convert_named<T>(argument.object, name);
+}
+
+}  // namespace calligraphy::python
+
+namespace pybind11::detail {
+
+template <typename T>
+struct type_caster<calligraphy::python::Checked<T>> {
+  using Value = calligraphy::python::Checked<T>;
+  PYBIND11_TYPE_CASTER(Value, make_caster<T>::name);
+  bool load(handle source, bool /*convert*/) {
+    if (!source) return false;
+    value.object = reinterpret_borrow<object>(source);
+    return true;
+  }
+  static handle cast(const Value& v, return_value_policy /*policy*/, handle /*parent*/) {
+    return v.object.inc_ref();
+  }
+};
+
+template <typename Tag>
+struct type_caster<calligraphy::python::Annotated<Tag>> {
+  using Value = calligraphy::python::Annotated<Tag>;
+  PYBIND11_TYPE_CASTER(Value, Tag::name);
+  bool load(handle source, bool /*convert*/) {
+    if (!source) return false;
+    value.object = reinterpret_borrow<object>(source);
+    return true;
+  }
+  static handle cast(const Value& v, return_value_policy /*policy*/, handle /*parent*/) {
+    return v.object.inc_ref();
+  }
+};
+
+}  // namespace pybind11::detail

@@ -1,0 +1,361 @@
+// render: the force law (include/calligraphy/render/force_law.hpp, paper section 5, eqs. 7-9) and the
+// interaction states (interaction_state.hpp, paper section 2.3).
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bindings.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/render/force_law.hpp"
+#include "calligraphy/render/interaction_state.hpp"
+#include "calligraphy/render/renderer.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
+#include "log_forwarding.hpp"
+#include "numpy_arrays.hpp"
+#include "parameter_class.hpp"
+
+namespace calligraphy::python {
+namespace {
+
+void bind_force_law_parameters(py::module_& m) {
+  ParameterClass<ForceLawParameters>(
+      m, "ForceLawParameters",
+      "Parameters of the force model of paper section 5 (F_e = F_en + F_et, eq. 7), SI units as named. "
+      "The paper plane is z = paper_z_m, +z out of the paper. The smoothing fields (section 6) and "
+      "friction are described in docs/force-rendering.md.",
+      [](const ForceLawParameters& p) { p.validate(); })
+      .field("guidance_stiffness_n_per_m", &ForceLawParameters::guidance_stiffness_n_per_m,
+             "K_et per unit attraction factor (eq. 8) [N/m]")
+      .field("paper_stiffness_n_per_m", &ForceLawParameters::paper_stiffness_n_per_m,
+             "K_en, stiffness of the virtual paper (eq. 9) [N/m]")
+      .field("constraint_radius_m", &ForceLawParameters::constraint_radius_m,
+             "R_res, radius of the constraint space around the active element (section 4.3) [m], > 0")
+      .field("resistance_damping_n_s_per_m", &ForceLawParameters::resistance_damping_n_s_per_m,
+             "damping against writing backwards along the active element (Fig. 4) [N s/m]")
+      .field("contact_hysteresis_m", &ForceLawParameters::contact_hysteresis_m,
+             "height above the paper at which a touching tip counts as lifted (section 6) [m]")
+      .field("guidance", &ForceLawParameters::guidance,
+             "in-plane guidance on (F_et and the resistance force); the paper force is always rendered")
+      .field("constraint_taper_m", &ForceLawParameters::constraint_taper_m,
+             "band at R_res over which F_et tapers to zero [m], in [0, R_res]; 0 = the paper's step")
+      .field("crossfade_s", &ForceLawParameters::crossfade_s,
+             "cross-fade time of the in-plane force when the active element or state changes [s]; 0 = off")
+      .field("paper_fade_s", &ForceLawParameters::paper_fade_s,
+             "fade time of the paper force when it starts or stops pushing (AS <-> CS) [s]; 0 = off")
+      .field("feature_plane_margin_m", &ForceLawParameters::feature_plane_margin_m,
+             "hysteresis of the feature planes (eq. 6) [m]")
+      .field("paper_damping_n_s_per_m", &ForceLawParameters::paper_damping_n_s_per_m,
+             "damping of the paper on inward motion only [N s/m]; 0 = off")
+      .field("max_foot_speed_m_s", &ForceLawParameters::max_foot_speed_m_s,
+             "highest speed of the rendered attraction target X_S [m/s]")
+      .field("friction_coefficient", &ForceLawParameters::friction_coefficient,
+             "Coulomb friction coefficient mu of the paper (not in the paper), dimensionless")
+      .field("friction_stick_speed_m_s", &ForceLawParameters::friction_stick_speed_m_s,
+             "stick band of the friction [m/s], > 0: viscous below it")
+      .field("nearest", &ForceLawParameters::nearest,
+             "NearestPointOptions: how the foot point X_S on curve elements is found")
+      .finish();
+}
+
+double number(const Checked<double>& value, const char* name) { return take(value, name); }
+
+struct FloatOrArrayTag {
+  static constexpr auto name = py::detail::const_name("Union[float, numpy.ndarray[numpy.float64]]");
+};
+
+void bind_force_functions(py::module_& m) {
+  m.def(
+      "paper_force",
+      [](const ArrayLike& z_object, const Checked<double>& paper_z, const Checked<double>& stiffness) {
+        const Scalars z = as_scalars(z_object.object, "tip_z_m");
+        const double z0 = number(paper_z, "paper_z_m");
+        const double k = number(stiffness, "stiffness_n_per_m");
+        auto out = z.single ? new_array({3}) : new_array({z.count, 3});
+        double* o = out.mutable_data();
+        for (py::ssize_t i = 0; i < z.count; ++i) {
+          const Vec3 f = paper_force(z.array.data()[i], z0, k);
+          for (int c = 0; c < 3; ++c) o[i * 3 + c] = f[c];
+        }
+        return out;
+      },
+      py::arg("tip_z_m"), py::arg("paper_z_m"), py::arg("stiffness_n_per_m"),
+      "Eq. (9), pushing out of the paper: K_en (z0 - z) e_z when the tip is below the paper plane z0, "
+      "else 0 [N]. tip_z_m: a number -> (3,), shape (N,) -> (N, 3), float64 [m]; paper_z_m z0 [m]; "
+      "stiffness_n_per_m K_en [N/m].");
+  m.def(
+      "attraction_force",
+      [](const ArrayLike& tip_object, const ArrayLike& foot_object, const Checked<double>& stiffness,
+         const Checked<double>& factor) {
+        const Vectors tip = as_vectors(tip_object.object, 2, "tip_m");
+        const Vectors foot = as_vectors(foot_object.object, 2, "foot_m");
+        check_broadcast(tip, foot, "tip_m", "foot_m");
+        const double k = number(stiffness, "stiffness_n_per_m");
+        const double a = number(factor, "attraction_factor");
+        return map_rows<2>(tip, [&](py::ssize_t i) {
+          return attraction_force(tip.vec2(i), foot.vec2(foot.single ? 0 : i), k, a);
+        });
+      },
+      py::arg("tip_m"), py::arg("foot_m"), py::arg("stiffness_n_per_m"), py::arg("attraction_factor") = 1.0,
+      "Eq. (8) with the attracting sign: K_et a (X_S - X_p) [N], in the paper plane. tip_m (2,) or (N, 2) "
+      "[m]; foot_m, the foot point X_S, the same shape or (2,) [m]; returns the tip's shape, float64.");
+  m.def(
+      "resistance_force",
+      [](const ArrayLike& v_object, const ArrayLike& tangent_object, const Checked<double>& damping) {
+        const Vectors v = as_vectors(v_object.object, 2, "velocity_m_s");
+        const Vectors tangent = as_vectors(tangent_object.object, 2, "tangent");
+        check_broadcast(v, tangent, "velocity_m_s", "tangent");
+        const double b = number(damping, "damping_n_s_per_m");
+        return map_rows<2>(v, [&](py::ssize_t i) {
+          return resistance_force(v.vec2(i), tangent.vec2(tangent.single ? 0 : i), b);
+        });
+      },
+      py::arg("velocity_m_s"), py::arg("tangent"), py::arg("damping_n_s_per_m"),
+      "Resistance against writing backwards (section 2.2, Fig. 4): -b (v.t) t when v.t < 0, else 0 [N]. "
+      "velocity_m_s (2,) or (N, 2) [m/s]; tangent the unit writing direction, the same shape or (2,); "
+      "returns the velocity's shape, float64.");
+  m.def(
+      "friction_force",
+      [](const ArrayLike& v_object, const ArrayLike& normal_object, const Checked<double>& coefficient,
+         const Checked<double>& stick_speed) {
+        const Vectors v = as_vectors(v_object.object, 2, "velocity_m_s");
+        const Scalars normal = as_scalars(normal_object.object, "normal_force_n");
+        if (!normal.single && normal.count != v.count) {
+          throw InvalidArgument("normal_force_n: expected a number or as many as velocity_m_s (" +
+                                std::to_string(v.count) + "), got " + std::to_string(normal.count));
+        }
+        const double mu = number(coefficient, "coefficient");
+        const double band = number(stick_speed, "stick_speed_m_s");
+        return map_rows<2>(v, [&](py::ssize_t i) {
+          return friction_force(v.vec2(i), normal.array.data()[normal.single ? 0 : i], mu, band);
+        });
+      },
+      py::arg("velocity_m_s"), py::arg("normal_force_n"), py::arg("coefficient"), py::arg("stick_speed_m_s"),
+      "Paper friction, Coulomb with a stick band: -mu N v / |v| when |v| > v_band, else -mu N v / v_band "
+      "[N], in the paper plane. velocity_m_s (2,) or (N, 2) [m/s]; normal_force_n N >= 0, a number or "
+      "(N,) [N]; returns the velocity's shape, float64.");
+  m.def(
+      "constraint_taper",
+      [](const ArrayLike& d_object, const Checked<double>& radius,
+         const Checked<double>& band) -> Annotated<FloatOrArrayTag> {
+        const Scalars d = as_scalars(d_object.object, "distance_m");
+        const double r = number(radius, "radius_m");
+        const double w = number(band, "band_m");
+        if (d.single) return {py::float_(constraint_taper(*d.array.data(), r, w))};
+        auto out = new_array({d.count});
+        for (py::ssize_t i = 0; i < d.count; ++i)
+          out.mutable_at(i) = constraint_taper(d.array.data()[i], r, w);
+        return {out};
+      },
+      py::arg("distance_m"), py::arg("radius_m"), py::arg("band_m"),
+      "Taper of F_et at the constraint-space edge, in [0, 1]: 1 up to radius_m - band_m, 0 from radius_m, "
+      "a smoothstep between (lengths [m]). distance_m: a number -> float, (N,) -> (N,) float64.");
+  m.def(
+      "clamp_force",
+      [](const ArrayLike& force_object, const Checked<double>& max_force) {
+        const Vectors f = as_vectors(force_object.object, 3, "force_n");
+        const double limit = number(max_force, "max_force_n");
+        return map_rows<3>(f, [&](py::ssize_t i) { return clamp_force(f.vec3(i), limit); });
+      },
+      py::arg("force_n"), py::arg("max_force_n"),
+      "Scales each force (3,) or (N, 3) [N] down to at most max_force_n [N], keeping its direction; a "
+      "non-finite force gives zero. Returns the input's shape, float64.");
+}
+
+py::object state_equals(InteractionState a, const py::object& b) {
+  if (py::isinstance<InteractionState>(b)) return py::bool_(a == b.cast<InteractionState>());
+  if (PyIndex_Check(b.ptr()) && !PyBool_Check(b.ptr())) {
+    return py::int_(static_cast<int>(a))
+        .attr("__eq__")(py::reinterpret_steal<py::object>(PyNumber_Index(b.ptr())));
+  }
+  return py::reinterpret_borrow<py::object>(Py_NotImplemented);
+}
+
+void bind_interaction_state(py::module_& m) {
+  py::enum_<InteractionState> states(
+      m, "InteractionState", py::arithmetic(),
+      "Interaction state of the virtual pen tip and the paper (paper section 2.3, "
+      "Tables 1-2, Fig. 6). Its int value is what TrialResult.state stores.");
+  states.value("separation", InteractionState::separation, "SS: not touching the paper; zero force")
+      .value("adjusting", InteractionState::adjusting,
+             "AS: touching, outside the active character's bounding box; zero force")
+      .value("calibration", InteractionState::calibration,
+             "CS: touching, inside the box, not at the active stroke's start; normal force only")
+      .value("writing", InteractionState::writing,
+             "WS: touching, entered at the start neighbourhood, writing; normal and in-plane forces")
+      .def_property_readonly(
+          "short_name", [](InteractionState s) { return std::string(to_string(s)); },
+          "the paper's abbreviation: 'SS', 'AS', 'CS' or 'WS'");
+  // Replaced, not overloaded: pybind11's own comparisons would answer first.
+  for (const char* name : {"__eq__", "__ne__", "__hash__"}) py::delattr(states, name);
+  states
+      // Equal to its int value too, so that `result.state == InteractionState.writing` compares a numpy
+      // array elementwise (a scoped enum's binding compares equal only to its own type).
+      .def(
+          "__eq__", [](InteractionState a, const py::object& b) { return Comparison{state_equals(a, b)}; },
+          py::is_operator())
+      .def(
+          "__ne__",
+          [](InteractionState a, const py::object& b) -> Comparison {
+            const py::object equal = state_equals(a, b);
+            if (equal.is(py::reinterpret_borrow<py::object>(Py_NotImplemented))) return {equal};
+            return {py::bool_(!equal.cast<bool>())};
+          },
+          py::is_operator())
+      .def("__hash__", [](InteractionState a) { return static_cast<int>(a); });
+}
+
+void check_safety(const SafetyChainParameters& p) {
+  // max_force_n = 0 means "the device's figure" in a RendererOptions or a trial; check the rest.
+  SafetyChainParameters copy = p;
+  if (copy.max_force_n == 0.0) copy.max_force_n = std::max(copy.max_continuous_force_n, 1.0);
+  copy.validate();
+}
+
+std::vector<std::string> limit_names(std::uint8_t limits) {
+  static const std::pair<std::uint8_t, const char*> names[] = {
+      {safety_non_finite, "non_finite"}, {safety_low_pass, "low_pass"},
+      {safety_continuous, "continuous"}, {safety_peak, "peak"},
+      {safety_start_ramp, "start_ramp"}, {safety_rate, "rate"}};
+  std::vector<std::string> out;
+  for (const auto& [bit, name] : names) {
+    if ((limits & bit) != 0) out.emplace_back(name);
+  }
+  return out;
+}
+
+void bind_renderer(py::module_& m) {
+  ParameterClass<SafetyChainParameters>(
+      m, "SafetyChainParameters",
+      "The safety chain between the force law and the device (paper section 6: force steps as a source of "
+      "instability), applied each tick: non-finite check, low-pass, continuous-force limit, peak clamp, "
+      "start ramp, per-tick change limit (include/calligraphy/render/safety_chain.hpp). A stage set to 0 is "
+      "off; max_force_n and max_continuous_force_n left at 0 take the device's figures.",
+      check_safety)
+      .field("max_force_n", &SafetyChainParameters::max_force_n, "peak clamp [N]; 0 = the device's max force")
+      .field("max_continuous_force_n", &SafetyChainParameters::max_continuous_force_n,
+             "continuous-force limit [N]; 0 = the device's figure (renderer) or off")
+      .field("continuous_time_constant_s", &SafetyChainParameters::continuous_time_constant_s,
+             "tau of the RMS (thermal) force estimate [s], > 0")
+      .field("start_ramp_n_per_s", &SafetyChainParameters::start_ramp_n_per_s,
+             "force ramp after start or reset [N/s]; 0 = off")
+      .field("max_force_change_n_per_tick", &SafetyChainParameters::max_force_change_n_per_tick,
+             "per-tick change limit [N per tick]; 0 = off")
+      .field("low_pass_cutoff_hz", &SafetyChainParameters::low_pass_cutoff_hz,
+             "first-order low-pass cutoff [Hz]; 0 = off")
+      .finish();
+
+  ParameterClass<PassivityParameters>(
+      m, "PassivityParameters",
+      "The time-domain passivity observer and controller of Hannaford & Ryu (2002): a variable damper "
+      "dissipates the energy the rendered force has produced (include/calligraphy/render/passivity.hpp).",
+      [](const PassivityParameters& p) { p.validate(); })
+      .field("enabled", &PassivityParameters::enabled, "observer and controller on")
+      .field("max_damping_n_s_per_m", &PassivityParameters::max_damping_n_s_per_m,
+             "cap on the variable damper alpha [N s/m], > 0")
+      .field("min_speed_m_s", &PassivityParameters::min_speed_m_s,
+             "below this speed no damping is added [m/s], > 0")
+      .finish();
+
+  ParameterClass<RendererOptions>(m, "RendererOptions",
+                                  "How a Renderer is run: the servo rate and the stages after the force law "
+                                  "(include/calligraphy/render/renderer.hpp).",
+                                  [](const RendererOptions& o) {
+                                    o.validate();
+                                    check_safety(o.safety);
+                                  })
+      .field("rate_hz", &RendererOptions::rate_hz, "servo rate [Hz], in [100, 100000]")
+      .field("safety", &RendererOptions::safety, "SafetyChainParameters")
+      .field("passivity", &RendererOptions::passivity, "PassivityParameters (off by default)")
+      .finish();
+
+  py::class_<RenderOutput>(m, "RenderOutput", "Everything one Renderer.tick decided.")
+      .def_property_readonly(
+          "force_n", [](const RenderOutput& o) { return to_array(o.force_n); },
+          "(3,) float64, the command for the device [N]: finite, within the safety chain's limits")
+      .def_readonly("state", &RenderOutput::state, "the InteractionState after this tick")
+      .def_readonly("state_changed", &RenderOutput::state_changed, "the state changed this tick")
+      .def_readonly("character", &RenderOutput::character, "active character index (valid unless finished)")
+      .def_readonly("stroke", &RenderOutput::stroke, "active stroke index within the character")
+      .def_readonly("element", &RenderOutput::element, "active element index within the stroke")
+      .def_readonly("finished", &RenderOutput::finished, "every stroke of the scene has been written")
+      .def_readonly("in_constraint_space", &RenderOutput::in_constraint_space,
+                    "the tip is inside R_res of the active element")
+      .def_property_readonly(
+          "foot_m", [](const RenderOutput& o) { return to_array(o.foot_m); },
+          "(2,) float64, the foot point X_S on the active element (WS only) [m]")
+      .def_readonly("stroke_completed", &RenderOutput::stroke_completed,
+                    "this tick wrote the last feature point of a stroke")
+      .def_readonly("stroke_abandoned", &RenderOutput::stroke_abandoned,
+                    "the pen was lifted in WS: the stroke was reloaded")
+      .def_readonly("input_rejected", &RenderOutput::input_rejected,
+                    "the device state was not finite: zero force")
+      .def_readonly("force_error", &RenderOutput::force_error,
+                    "the force law gave a non-finite force: zero force")
+      .def_readonly("limits", &RenderOutput::limits, "bits of the safety stages that acted (see limit_names)")
+      .def_property_readonly(
+          "limit_names", [](const RenderOutput& o) { return limit_names(o.limits); },
+          "list of str: the safety stages that acted, of 'non_finite', 'low_pass', 'continuous', 'peak', "
+          "'start_ramp', 'rate'")
+      .def_readonly("passivity_damping_n_s_per_m", &RenderOutput::passivity_damping_n_s_per_m,
+                    "damper added by the passivity controller [N s/m]")
+      .def("__repr__", [](const RenderOutput& o) {
+        return std::string("<RenderOutput ") + to_string(o.state) +
+               " |F| = " + std::to_string(o.force_n.norm()) + " N, stroke " + std::to_string(o.stroke) +
+               " element " + std::to_string(o.element) + ">";
+      });
+
+  py::class_<Renderer>(
+      m, "Renderer",
+      "The per-tick haptic renderer (paper section 4, Fig. 15): a DeviceState in, a force out. Call tick "
+      "once per servo tick at options.rate_hz from your own loop. Pipeline per tick: state machine "
+      "(Fig. 6) -> collision with the active element (section 4.3) -> force law (eqs. 7-9) with the "
+      "smoothing of section 6 and paper friction -> optional passivity controller -> safety chain. Not "
+      "thread-safe; keeps its Scene alive.")
+      .def(
+          py::init([](const Checked<Scene>& scene,
+                      const std::optional<Checked<ForceLawParameters>>& force_law,
+                      const std::optional<Checked<DeviceInfo>>& device,
+                      const std::optional<Checked<RendererOptions>>& options) {
+            if (!py::isinstance<Scene>(scene.object)) throw_type_error("scene", "Scene", scene.object);
+            return std::make_unique<Renderer>(
+                scene.object.cast<const Scene&>(),
+                force_law ? take(*force_law, "force_law") : ForceLawParameters{},
+                device ? take(*device, "device") : simulated_phantom_desktop_info(),
+                options ? take(*options, "options") : RendererOptions{});
+          }),
+          py::arg("scene"), py::arg("force_law") = py::none(), py::arg("device") = py::none(),
+          py::arg("options") = py::none(), py::keep_alive<1, 2>(), py::call_guard<ForwardLog>(),
+          "scene: the Scene to render. force_law: ForceLawParameters (default the C++ defaults). device: the "
+          "DeviceInfo whose limits the safety chain takes (default the simulated Phantom Desktop's). "
+          "options: "
+          "RendererOptions. Raises InvalidArgument (a ValueError) for values out of range or a device with "
+          "max_force_n <= 0; logs a warning when a stiffness exceeds the device's stable maximum.")
+      .def(
+          "tick", [](Renderer& r, const Checked<DeviceState>& state) { return r.tick(take(state, "state")); },
+          py::arg("state"),
+          "One servo tick: the DeviceState read from the device (SI units) -> RenderOutput. Never raises "
+          "for any state values: a non-finite state gives zero force (input_rejected).")
+      .def("reset", &Renderer::reset, "Back to the first stroke, state SS; the safety chain's ramp restarts.")
+      .def_property_readonly("state", &Renderer::state, "the current InteractionState")
+      .def_property_readonly("parameters", &Renderer::parameters, "its ForceLawParameters (a copy)")
+      .def_property_readonly("options", &Renderer::options, "its RendererOptions (a copy)")
+      .def_property_readonly(
+          "scene", [](const Renderer& r) -> const Scene& { return r.scene(); },
+          py::return_value_policy::reference_internal, "the Scene it renders");
+}
+
+}  // namespace
+
+void bind_render(py::module_& m) {
+  bind_force_law_parameters(m);
+  bind_force_functions(m);
+  bind_interaction_state(m);
+  bind_renderer(m);
+}
+
+}  // namespace calligraphy::python

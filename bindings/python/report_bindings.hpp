@@ -1,0 +1,14 @@
+#pragma once
+// The report functions other binding files use.
+#include <pybind11/pybind11.h>
+
+#include "calligraphy/report/trial_report.hpp"
+
+namespace calligraphy::python {
+
+namespace py = pybind11;
+
+/// The trial's metrics as a dict with the keys of `calligraphy trial --json`.
+py::dict trial_metrics(const TrialDescription& description, const TrialResult& result);
+
+}  // namespace calligraphy::python

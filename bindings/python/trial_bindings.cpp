@@ -1,0 +1,251 @@
+// trial: a whole simulated trial (include/calligraphy/trial/trial.hpp, run_simulated_trial) and its
+// result. Every binding of the trial runner is in this file.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <chrono>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "arguments.hpp"
+#include "bindings.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/render/passivity.hpp"
+#include "calligraphy/render/safety_chain.hpp"
+#include "calligraphy/trial/trial.hpp"
+#include "character_source.hpp"
+#include "core/unicode.hpp"
+#include "log_forwarding.hpp"
+#include "model_bindings.hpp"
+#include "numpy_arrays.hpp"
+#include "report_bindings.hpp"
+
+namespace calligraphy::python {
+namespace {
+
+struct TrialCharactersTag {
+  static constexpr auto name = py::detail::const_name("Union[str, Character, Sequence[Character], Scene]");
+};
+struct SceneTag {
+  static constexpr auto name = py::detail::const_name("Scene");
+};
+struct DataFrameTag {
+  static constexpr auto name = py::detail::const_name("pandas.DataFrame");
+};
+struct WriterTag {
+  static constexpr auto name = py::detail::const_name("Union[str, WriterProfile]");
+};
+
+// A trial's trace as numpy arrays (one row per servo tick), its metrics and the scene it was written on.
+struct PyTrialResult {
+  py::array_t<double> time_s, position_m, force_n;
+  py::array_t<std::uint8_t> state;
+  py::array_t<std::int64_t> stroke, element, stroke_trace_range;
+  py::dict metrics;
+  py::object scene;
+};
+
+// The most servo ticks one call may simulate (rate_hz * max_duration_s): 10^7 ticks keep about 0.8 GB of
+// trace, about 3 hours at 1 kHz; the default 300 s at 1 kHz is 3 * 10^5.
+constexpr double kMaxTicks = 1e7;
+
+WriterProfile writer_from(const py::object& object) {
+  if (py::isinstance<WriterProfile>(object)) return object.cast<WriterProfile>();
+  if (!py::isinstance<py::str>(object))
+    throw_type_error("writer", "'novice', 'skilled' or a WriterProfile", object);
+  const std::string name = object.cast<std::string>();
+  if (name == "novice") return WriterProfile::novice();
+  if (name == "skilled") return WriterProfile::skilled();
+  throw InvalidArgument("writer: expected 'novice', 'skilled' or a WriterProfile, got '" + name + "'");
+}
+
+PyTrialResult to_python(const TrialResult& result, py::dict metrics, py::object scene) {
+  const auto n = static_cast<py::ssize_t>(result.trace.size());
+  auto time = new_array({n});
+  auto position = new_array({n, 3});
+  auto force = new_array({n, 3});
+  py::array_t<std::uint8_t> state({n});
+  py::array_t<std::int64_t> stroke({n});
+  py::array_t<std::int64_t> element({n});
+  auto tw = time.mutable_unchecked<1>();
+  auto pw = position.mutable_unchecked<2>();
+  auto fw = force.mutable_unchecked<2>();
+  auto sw = state.mutable_unchecked<1>();
+  auto aw = stroke.mutable_unchecked<1>();
+  auto ew = element.mutable_unchecked<1>();
+  for (py::ssize_t i = 0; i < n; ++i) {
+    const TrialSample& s = result.trace[static_cast<std::size_t>(i)];
+    tw(i) = s.time_s;
+    for (py::ssize_t k = 0; k < 3; ++k) {
+      pw(i, k) = s.position_m[static_cast<Eigen::Index>(k)];
+      fw(i, k) = s.force_n[static_cast<Eigen::Index>(k)];
+    }
+    sw(i) = static_cast<std::uint8_t>(s.state);
+    aw(i) = static_cast<std::int64_t>(s.stroke);
+    ew(i) = static_cast<std::int64_t>(s.element);
+  }
+  const auto strokes = static_cast<py::ssize_t>(result.metrics.per_stroke.size());
+  py::array_t<std::int64_t> ranges({strokes, py::ssize_t{2}});
+  auto rw = ranges.mutable_unchecked<2>();
+  for (py::ssize_t i = 0; i < strokes; ++i) {
+    const StrokeMetrics& m = result.metrics.per_stroke[static_cast<std::size_t>(i)];
+    // Without a trace there is nothing to index: empty ranges.
+    rw(i, 0) = n > 0 ? static_cast<std::int64_t>(m.trace_begin) : 0;
+    rw(i, 1) = n > 0 ? static_cast<std::int64_t>(m.trace_end) : 0;
+  }
+  return PyTrialResult{time,   position,           force,           state, stroke, element,
+                       ranges, std::move(metrics), std::move(scene)};
+}
+
+// Polls Python's signal handlers from a thread that does not hold the GIL, at most every 50 ms.
+class SignalPoll {
+ public:
+  bool interrupted() {
+    if (interrupted_) return true;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_ < std::chrono::milliseconds(50)) return false;
+    last_ = now;
+    py::gil_scoped_acquire acquire;
+    if (PyErr_CheckSignals() != 0) {
+      error_ = std::make_unique<py::error_already_set>();  // keeps the exception until it is raised
+      interrupted_ = true;
+    }
+    return interrupted_;
+  }
+  // With the GIL held: raises what a signal handler raised during the trial.
+  void raise_if_interrupted() {
+    if (error_) throw std::move(*error_);
+  }
+
+ private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+  bool interrupted_ = false;
+  std::unique_ptr<py::error_already_set> error_;
+};
+
+PyTrialResult simulate_trial_py(const Annotated<TrialCharactersTag>& characters,
+                                const Annotated<WriterTag>& writer, const Checked<bool>& guidance,
+                                const Checked<double>& rate_hz, const Checked<std::uint64_t>& seed,
+                                const std::optional<Checked<CharacterSource>>& library,
+                                const std::optional<Checked<ForceLawParameters>>& force_law,
+                                const Checked<double>& max_duration_s, const Checked<bool>& keep_trace,
+                                const std::optional<Checked<SimulatedDeviceParameters>>& device,
+                                const std::optional<Checked<SafetyChainParameters>>& safety,
+                                const std::optional<Checked<PassivityParameters>>& passivity) {
+  TrialOptions options;
+  if (force_law) options.force = take(*force_law, "force_law");
+  options.force.guidance = take(guidance, "guidance");
+  options.simulation.writer = writer_from(writer.object);
+  options.rate_hz = take(rate_hz, "rate_hz");
+  options.simulation.seed = take(seed, "seed");
+  options.max_duration_s = take(max_duration_s, "max_duration_s");
+  options.keep_trace = take(keep_trace, "keep_trace");
+  if (device) options.simulation.device = take(*device, "device");
+  if (safety) options.safety = take(*safety, "safety");
+  if (passivity) options.passivity = take(*passivity, "passivity");
+  options.validate();
+  if (!(options.rate_hz * options.max_duration_s <= kMaxTicks)) {
+    throw InvalidArgument("max_duration_s: " + std::to_string(options.max_duration_s) + " s at " +
+                          std::to_string(options.rate_hz) + " Hz is more than 10^7 servo ticks");
+  }
+
+  py::object scene_object;
+  if (py::isinstance<Scene>(characters.object)) {
+    scene_object = characters.object;
+  } else {
+    const CharacterSource source = library ? take(*library, "library") : CharacterSource::embedded();
+    scene_object = py::cast(Scene::lay_out(characters_from(characters.object, source, "characters")));
+  }
+  const Scene& scene = scene_object.cast<const Scene&>();
+  std::string label;
+  for (const PlacedCharacter& c : scene.characters) label += encode_utf8(c.code_point);
+
+  // Ctrl-C: the trial runs without the GIL; every 50 ms of wall clock the runner's thread takes the GIL
+  // and lets Python run its signal handlers. A KeyboardInterrupt (or any exception a handler raises)
+  // ends the trial at the next tick and is raised once the device is shut down.
+  SignalPoll poll;
+  options.should_stop = [&poll] { return poll.interrupted(); };
+  TrialResult result;
+  {
+    py::gil_scoped_release release;
+    result = run_simulated_trial(scene, options);
+  }
+  poll.raise_if_interrupted();
+  TrialDescription description;
+  description.characters = label;
+  description.guidance = options.force.guidance;
+  description.writer = options.simulation.writer.name.empty() ? "custom" : options.simulation.writer.name;
+  description.seed = options.simulation.seed;
+  description.rate_hz = options.rate_hz;
+  return to_python(result, trial_metrics(description, result), scene_object);
+}
+
+}  // namespace
+
+void bind_trial(py::module_& m) {
+  py::class_<PyTrialResult>(m, "TrialResult",
+                            "A simulated trial: the trace, one row per servo tick (N ticks, empty when "
+                            "keep_trace=False), and the metrics.")
+      .def_readonly("time_s", &PyTrialResult::time_s, "(N,) float64, time [s]")
+      .def_readonly("position_m", &PyTrialResult::position_m,
+                    "(N, 3) float64, pen tip as read from the device [m]")
+      .def_readonly("force_n", &PyTrialResult::force_n, "(N, 3) float64, commanded force [N]")
+      .def_readonly("state", &PyTrialResult::state, "(N,) uint8, the InteractionState's int value")
+      .def_readonly("stroke", &PyTrialResult::stroke, "(N,) int64, active stroke over the scene, 0-based")
+      .def_readonly("element", &PyTrialResult::element,
+                    "(N,) int64, active element within the stroke, 0-based")
+      .def_readonly("stroke_trace_range", &PyTrialResult::stroke_trace_range,
+                    "(S, 2) int64, one row per stroke of the scene: [begin, end) of its last attempt in the "
+                    "trace, the ticks its deviations are measured over (empty when not written or no trace)")
+      .def_readonly(
+          "metrics", &PyTrialResult::metrics,
+          "dict with exactly the keys of `calligraphy trial --json`, from the same code (deviations "
+          "in mm, times in s, forces in N; 'per_stroke' a list of dicts)")
+      .def_property_readonly(
+          "scene", [](const PyTrialResult& r) { return Annotated<SceneTag>{r.scene}; },
+          "the Scene the trial was written on (metres)")
+      // The tables are made in Python (calligraphy/frames.py), where pandas is an optional import.
+      .def(
+          "to_dataframe",
+          [](const py::object& self) {
+            return Annotated<DataFrameTag>{
+                py::module_::import("calligraphy.frames").attr("trial_dataframe")(self)};
+          },
+          "A pandas.DataFrame with one row per servo tick: time_s [s], x_m, y_m, z_m [m], fx_n, fy_n, fz_n "
+          "[N], state (categorical 'SS', 'AS', 'CS', 'WS'), stroke, element (0-based). Raises ImportError "
+          "without pandas.")
+      .def(
+          "per_stroke_dataframe",
+          [](const py::object& self) {
+            return Annotated<DataFrameTag>{
+                py::module_::import("calligraphy.frames").attr("per_stroke_dataframe")(self)};
+          },
+          "A pandas.DataFrame with one row per stroke, indexed by the stroke over the scene (0-based): "
+          "character, acronym, typical_id, completed, attempts, mean_deviation_mm, max_deviation_mm [mm], "
+          "time_s [s]. Raises ImportError without pandas.");
+
+  m.def("simulate_trial", &simulate_trial_py, py::arg("characters"), py::arg("writer") = "novice",
+        py::arg("guidance") = true, py::arg("rate_hz") = 1000.0, py::arg("seed") = 0,
+        py::arg("library") = py::none(), py::arg("force_law") = py::none(), py::arg("max_duration_s") = 300.0,
+        py::arg("keep_trace") = true, py::arg("device") = py::none(), py::arg("safety") = py::none(),
+        py::arg("passivity") = py::none(), py::call_guard<ForwardLog>(),
+        R"(Runs a whole guided writing trial lock-step on the simulated device with a simulated writer,
+as `calligraphy trial` does (run_simulated_trial, include/calligraphy/trial/trial.hpp).
+Deterministic for a seed; the GIL is released while it runs.
+
+characters: a str of one or more characters (loaded from `library`, default the embedded set),
+            a Character, a sequence of Characters (written left to right), or a Scene.
+writer: 'novice', 'skilled' or a WriterProfile. guidance: in-plane guidance on or off (the paper
+force stays). rate_hz: servo rate [Hz], 100..100000. seed: int >= 0. max_duration_s: simulated
+time limit [s], > 0, at most 10^7 ticks (rate_hz * max_duration_s).
+force_law: ForceLawParameters (its `guidance` is replaced by `guidance`). device:
+SimulatedDeviceParameters. safety: SafetyChainParameters (0 forces take the device's figures).
+passivity: PassivityParameters. keep_trace: False leaves the arrays empty (faster, metrics only).
+Returns a TrialResult. Raises CharacterNotFound (a KeyError), InvalidArgument (a ValueError) for
+values out of range, TypeError naming the argument for a value of the wrong type.)");
+}
+
+}  // namespace calligraphy::python

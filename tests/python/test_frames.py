@@ -1,0 +1,71 @@
+"""pandas tables of a trial: one row per tick, one row per stroke; pandas is optional."""
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import calligraphy
+
+pandas = pytest.importorskip("pandas")
+
+
+@pytest.fixture(scope="module")
+def result():
+    return calligraphy.simulate_trial("九心", seed=2)
+
+
+def test_one_row_per_tick_with_units_in_the_column_names(result):
+    frame = result.to_dataframe()
+    assert list(frame.columns) == ["time_s", "x_m", "y_m", "z_m", "fx_n", "fy_n", "fz_n", "state", "stroke",
+                                   "element"]
+    assert len(frame) == result.time_s.size
+    np.testing.assert_array_equal(frame["time_s"], result.time_s)
+    np.testing.assert_array_equal(frame[["x_m", "y_m", "z_m"]].to_numpy(), result.position_m)
+    np.testing.assert_array_equal(frame[["fx_n", "fy_n", "fz_n"]].to_numpy(), result.force_n)
+    np.testing.assert_array_equal(frame["stroke"], result.stroke)
+    # The state column names the states as the paper does, in InteractionState's order.
+    names = [s.short_name for s in calligraphy.InteractionState.__members__.values()]
+    assert list(frame["state"].cat.categories) == names
+    np.testing.assert_array_equal(frame["state"].to_numpy(), np.array(names)[result.state])
+    # The metrics agree with the table.
+    assert np.hypot(frame.fx_n, np.hypot(frame.fy_n, frame.fz_n)).max() == pytest.approx(result.metrics["max_force_n"])
+
+
+def test_one_row_per_stroke(result):
+    frame = result.per_stroke_dataframe()
+    scene = result.scene
+    assert list(frame.index) == list(range(scene.stroke_count))
+    assert frame.index.name == "stroke"
+    assert list(frame["character"]) == ["九"] * 2 + ["心"] * 4
+    assert list(frame["acronym"]) == [s.acronym for s in scene.strokes]
+    for stroke, entry in zip(frame.itertuples(), result.metrics["per_stroke"]):
+        assert stroke.mean_deviation_mm == entry["mean_deviation_mm"]
+        assert stroke.completed == entry["completed"] and stroke.attempts == entry["attempts"]
+    # The per-stroke deviation is measured over the stroke's last attempt, which stroke_trace_range
+    # locates in the trace: its ticks are all of that stroke.
+    for k, (begin, end) in enumerate(result.stroke_trace_range):
+        assert end > begin
+        assert np.all(result.stroke[begin:end] == k)
+
+
+def test_without_a_trace_the_table_is_empty():
+    result = calligraphy.simulate_trial("九", seed=1, keep_trace=False)
+    assert len(result.to_dataframe()) == 0
+    assert len(result.per_stroke_dataframe()) == 2
+
+
+def test_import_does_not_load_pandas_or_matplotlib_and_says_what_is_missing():
+    code = (
+        "import sys; sys.modules['pandas'] = None\n"  # pandas made unimportable
+        "import calligraphy\n"
+        "assert 'matplotlib' not in sys.modules\n"
+        "r = calligraphy.simulate_trial('九', keep_trace=False)\n"
+        "try:\n"
+        "    r.to_dataframe()\n"
+        "except ImportError as e:\n"
+        "    print(e)\n"
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert "pandas" in run.stdout and "python3-pandas" in run.stdout
