@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/model/corpus_store.hpp"
-#include "calligraphy/report/atomic_file.hpp"
 #include "cli/commands.hpp"
 #include "cli/output.hpp"
 #include "eval/corpus_fidelity.hpp"

@@ -4,9 +4,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
-#include "calligraphy/report/atomic_file.hpp"
 #include "core/unicode.hpp"
 #include "model/polyline.hpp"
 
