@@ -27,7 +27,8 @@ class DeviceShutdown {
   DeviceShutdown& operator=(const DeviceShutdown&) = delete;
   ~DeviceShutdown() {
     try {
-      if (device_.is_open()) device_.write_force(Vec3::Zero());  // the last tick's force must not outlive it
+      // The last tick's force must not outlive the trial (the real-time loop has zeroed and disabled it).
+      if (device_.is_open() && device_.forces_enabled()) device_.write_force(Vec3::Zero());
     } catch (...) {
       // The link may be gone (the trial may be ending because of it); disabling and closing still follow.
     }
