@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -81,8 +82,11 @@ bool write_trial_outputs(const TrialCommand& command, const TrialDescription& de
     if (path.empty()) return;
     try {
       write_output(path, text());
-    } catch (const Error& e) {
+    } catch (const Error& e) {  // DataError naming the path and the reason
       std::fprintf(stderr, "calligraphy trial: error: %s\n", e.what());
+      all_written = false;
+    } catch (const std::bad_alloc&) {  // a trace too large to format in memory
+      std::fprintf(stderr, "calligraphy trial: error: %s: cannot write: out of memory\n", path.c_str());
       all_written = false;
     }
   };
@@ -109,8 +113,8 @@ int run_trial(const TrialCommand& command) {
   std::vector<Character> characters;
   for (char32_t c : chars) characters.push_back(source.load(c));
   const Scene scene = Scene::lay_out(characters);
-  if (const int signal =
-          StopSignals::received()) {  // nothing recorded yet: no device opened, no file written
+  // A signal while the characters were read: nothing recorded yet, no device opened, no file written.
+  if (const int signal = StopSignals::received()) {
     std::fprintf(stderr, "calligraphy trial: stopped by %s before the trial started; nothing written\n",
                  signal_name(signal));
     return exit_status_after(signal);
