@@ -107,7 +107,7 @@ int main() {
   const TrialMetrics& m = result.metrics;
   std::printf(
       "口 on the voice-coil puck: %zu/%zu strokes in %.1f s, mean deviation %.2f mm, max |F| %.2f N%s\n",
-      m.strokes_completed, m.strokes_total, m.time_s, m.mean_deviation_m * 1e3, m.max_force_n,
-      result.aborted ? " (aborted)" : "");
+      m.strokes_completed, m.strokes_total, m.time_s, m.mean_deviation_m.value_or(std::nan("")) * 1e3,
+      m.max_force_n, result.aborted ? " (aborted)" : "");
   return !result.aborted && m.completed_in_order ? 0 : 1;
 }

@@ -3,6 +3,7 @@
 #include <calligraphy/model/character_library.hpp>
 #include <calligraphy/model/scene.hpp>
 #include <calligraphy/trial/trial.hpp>
+#include <cmath>
 #include <cstdio>
 
 int main() {
@@ -17,6 +18,6 @@ int main() {
 
   const TrialMetrics& m = result.metrics;
   std::printf("%zu/%zu strokes, mean deviation %.2f mm, max |F| %.2f N\n", m.strokes_completed,
-              m.strokes_total, m.mean_deviation_m * 1e3, m.max_force_n);
+              m.strokes_total, m.mean_deviation_m.value_or(std::nan("")) * 1e3, m.max_force_n);
   return m.completed_in_order ? 0 : 1;
 }

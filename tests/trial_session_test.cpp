@@ -32,6 +32,7 @@ class CountingDevice final : public HapticDevice, public HandPort {
   }
   void write_force(const Vec3& force_n) override {
     ++writes_;
+    last_force_ = force_n;
     inner_.write_force(force_n);
   }
   void attach_hand(HandModel* hand) noexcept override { inner_.attach_hand(hand); }
@@ -39,6 +40,7 @@ class CountingDevice final : public HapticDevice, public HandPort {
   SimulatedDevice inner_;
   long reads_ = 0;
   long writes_ = 0;
+  Vec3 last_force_ = Vec3::Constant(1.0);  // the last force commanded [N]
 };
 
 }  // namespace
@@ -89,8 +91,10 @@ TEST_CASE("Every tick writes the force once, lock-step and in real time", "[tria
     CHECK(result.end == TrialEnd::time_limit);
     CHECK(result.aborted);
     CHECK(static_cast<long>(result.trace.size()) == device.reads_);
-    // The runner writes once per tick; the loop adds one zero-force write at its end.
-    CHECK(device.writes_ == device.reads_ + (pacing == TrialPacing::real_time ? 1 : 0));
+    // The runner writes once per tick and one zero force at the end (in real time the loop writes it).
+    CHECK(device.writes_ == device.reads_ + 1);
+    CHECK(device.last_force_.isZero());
+    CHECK_FALSE(device.forces_enabled());
     CHECK(result.loop.has_value() == (pacing == TrialPacing::real_time));
     if (result.loop) CHECK(result.loop->ticks == result.trace.size());
     CHECK_FALSE(device.is_open());
@@ -105,15 +109,26 @@ TEST_CASE("should_stop ends a trial as interrupted with the ticks kept", "[trial
     options.loop.realtime = RealtimeMode::ignore;
     options.loop.priority = 0;
     options.loop.lock_memory = false;
+    // Lock-step: stopped 3 s in, while the writer presses on stroke 2 (the force is not zero); real
+    // time: 0.2 s of polls.
+    const long stop_after = pacing == TrialPacing::lock_step ? 3000 : 200;
     long polls = 0;
-    options.should_stop = [&polls] { return ++polls > 200; };
-    const TrialResult result = run_simulated_trial(scene, options);
+    options.should_stop = [&polls, stop_after] { return ++polls > stop_after; };
+    CountingDevice device;
+    const TrialResult result = run_trial(device, scene, options);
     INFO("pacing " << static_cast<int>(pacing));
     CHECK(result.end == TrialEnd::interrupted);
+    // Zero force commanded, forces disabled and the device closed before the result is returned.
+    CHECK(device.last_force_.isZero());
+    CHECK_FALSE(device.forces_enabled());
+    CHECK_FALSE(device.is_open());
     CHECK(result.aborted);
     CHECK_FALSE(result.trace.empty());
     CHECK(result.metrics.strokes_completed < result.metrics.strokes_total);
-    if (pacing == TrialPacing::lock_step) CHECK(result.trace.size() == 200);
+    if (pacing == TrialPacing::lock_step) {
+      REQUIRE(result.trace.size() == 3000);
+      CHECK_FALSE(result.trace.back().force_n.isZero());  // the force the shutdown had to zero
+    }
   }
 }
 

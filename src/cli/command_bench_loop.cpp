@@ -1,12 +1,14 @@
 // `calligraphy bench loop [--rate HZ] [--seconds S] [--realtime enforce|ignore|off] [--json] ...`: the
 // real-time servo loop's period jitter, missed deadlines and callback time (eval/servo_loop_bench.hpp,
 // docs/servo-loop.md).
+#include <cstdio>
 #include <memory>
 #include <string>
 
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 #include "cli/output.hpp"
+#include "cli/signals.hpp"
 #include "eval/servo_loop_bench.hpp"
 
 namespace calligraphy::cli {
@@ -46,8 +48,16 @@ int run_loop(const LoopCommand& command) {
   // in wake_latency_us_max and longest_stall).
   loop.stall_timeout_s = static_cast<double>(command.watchdog_periods) / loop.rate_hz;
   if (!command.trial.empty()) settings.trial_characters = characters_from(command.trial, "--trial");
+  // A stop signal ends the run early; its statistics are still printed.
+  const StopSignals stop_signals;
+  settings.should_stop = StopSignals::stop_requested();
   const LoopBenchResult result = run_loop_bench(library_from(command.library), settings);
   write_standard_output(command.json ? loop_bench_json(result, settings) : loop_bench_text(result, settings));
+  if (const int signal = StopSignals::received()) {
+    std::fprintf(stderr, "calligraphy bench loop: stopped by %s; the statistics cover the run until then\n",
+                 signal_name(signal));
+    return exit_status_after(signal);
+  }
   return result.stats.fault ? 1 : 0;
 }
 

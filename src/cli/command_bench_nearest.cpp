@@ -6,7 +6,7 @@
 #include <memory>
 #include <string>
 
-#include "calligraphy/report/atomic_file.hpp"
+#include "calligraphy/core/atomic_file.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 #include "cli/output.hpp"

@@ -5,8 +5,9 @@
 #include <string>
 #include <vector>
 
+#include "calligraphy/core/atomic_file.hpp"
+#include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/corpus_store.hpp"
-#include "calligraphy/report/atomic_file.hpp"
 #include "cli/commands.hpp"
 #include "cli/output.hpp"
 #include "eval/corpus_fidelity.hpp"
@@ -52,7 +53,8 @@ struct BuildCommand {
 };
 
 int run_build(const BuildCommand& command) {
-  const CharacterLibrary library = CharacterLibrary::from_directory(corpus_folder(command.fit));
+  const std::filesystem::path folder = corpus_folder(command.fit);
+  const CharacterLibrary library = CharacterLibrary::from_directory(folder);
   FitOptions fit_options;
   fit_options.tolerance = command.tolerance;
   CorpusStoreOptions store_options;
@@ -62,6 +64,11 @@ int run_build(const BuildCommand& command) {
   const auto start = Clock::now();
   const CorpusFit fit =
       fit_corpus(library, fit_options, static_cast<unsigned>(command.fit.threads), "fitting");
+  if (fit.characters.empty()) {  // a store of nothing would replace an earlier store with nothing
+    throw DataError(folder.string() + ": none of its " + std::to_string(fit.failures.size()) +
+                    " character files could be modelled, so " + command.out + " is not written; the first: " +
+                    (fit.failures.empty() ? std::string("none") : fit.failures.front().reason));
+  }
   const auto write_start = Clock::now();
   // Encoded in memory and then written whole: an earlier store survives any failure to write this one.
   const std::vector<std::uint8_t> bytes = encode_corpus_store(fit.characters, store_options);

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <thread>
 
+#include "calligraphy/core/errors.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 #include "cli/output.hpp"
@@ -48,18 +49,24 @@ int run_validate(const ValidateCommand& command) {
   const auto labels = parse_cnchar_orders(
       read_input_file(command.cnchar, "cnchar-order's cnchar.order.min.js"), command.cnchar);
   const CharacterLibrary library = library_from(command.library);
+  // Listing the folder first: one without character files is an error naming it (DataError).
+  const std::string data_description =
+      command.library.data_folder.empty()
+          ? library.description()
+          : "hanzi-writer-data 2.0.1 (" + std::to_string(library.characters().size()) + " characters)";
   const auto threads = static_cast<unsigned>(command.threads);
   const auto start = std::chrono::steady_clock::now();
   std::ostringstream features;
   const CncharValidation result = validate_against_cnchar(library, labels, FitOptions{}, threads,
                                                           command.features.empty() ? nullptr : &features);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (result.compared == 0) {  // an agreement over nothing is no result
+    throw DataError("nothing to compare: of the " + std::to_string(result.labelled) + " characters " +
+                    command.cnchar + " labels, " + std::to_string(result.missing) + " are not in the data (" +
+                    library.description() + ") and " + std::to_string(result.count_mismatch.size()) +
+                    " have other stroke counts there");
+  }
   if (!command.features.empty()) write_output(command.features, features.str());
-
-  const std::string data_description =
-      command.library.data_folder.empty()
-          ? library.description()
-          : "hanzi-writer-data 2.0.1 (" + std::to_string(library.characters().size()) + " characters)";
   if (!command.markdown.empty()) {
     write_output(
         command.markdown,

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,7 @@
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 #include "cli/output.hpp"
+#include "cli/signals.hpp"
 
 namespace calligraphy::cli {
 namespace {
@@ -62,12 +64,36 @@ TrialResult run_trial_on_device(const TrialCommand& command, const DeviceListing
                                                    : TrialPacing::automatic;
   options.loop.realtime = command.realtime == "enforce" ? RealtimeMode::enforce : RealtimeMode::ignore;
   options.loop.stall_timeout_s = static_cast<double>(command.watchdog_ms) / 1000.0;
+  options.should_stop = StopSignals::stop_requested();
   // On hardware a person writes; the simulated writer only moves simulated and emulated devices.
-  description =
-      TrialDescription{command.characters, options.force.guidance, device.hardware ? "human" : command.writer,
-                       options.simulation.seed, options.rate_hz,        device.name,
-                       device.info.model};
+  description = TrialDescription{
+      command.characters,      options.force.guidance, device.hardware ? "human" : command.writer,
+      options.simulation.seed, options.rate_hz,        device.name,
+      device.info.model};
   return calligraphy::run_trial(device.name, scene, options);
+}
+
+// Writes each output given; one that fails is reported on stderr and does not keep the others from being
+// written. Returns whether all were written.
+bool write_trial_outputs(const TrialCommand& command, const TrialDescription& description, const Scene& scene,
+                         const TrialResult& result) {
+  bool all_written = true;
+  const auto write = [&](const std::string& path, const auto& text) {
+    if (path.empty()) return;
+    try {
+      write_output(path, text());
+    } catch (const Error& e) {  // DataError naming the path and the reason
+      std::fprintf(stderr, "calligraphy trial: error: %s\n", e.what());
+      all_written = false;
+    } catch (const std::bad_alloc&) {  // a trace too large to format in memory
+      std::fprintf(stderr, "calligraphy trial: error: %s: cannot write: out of memory\n", path.c_str());
+      all_written = false;
+    }
+  };
+  write(command.json, [&] { return trial_json(description, result); });
+  write(command.csv, [&] { return trial_csv(result.trace); });
+  write(command.svg, [&] { return trial_svg(scene, result); });
+  return all_written;
 }
 
 int run_trial(const TrialCommand& command) {
@@ -81,20 +107,38 @@ int run_trial(const TrialCommand& command) {
     throw UsageError(
         "--watchdog-ms applies to real-time pacing only (--pacing real-time, or a hardware device)");
   }
+  // From here a stop signal ends the trial at its next tick and the outputs are still written.
+  const StopSignals stop_signals;
   const CharacterSource source(command.library);  // only these characters are read (on demand from a store)
   std::vector<Character> characters;
   for (char32_t c : chars) characters.push_back(source.load(c));
   const Scene scene = Scene::lay_out(characters);
+  // A signal while the characters were read: nothing recorded yet, no device opened, no file written.
+  if (const int signal = StopSignals::received()) {
+    std::fprintf(stderr, "calligraphy trial: stopped by %s before the trial started; nothing written\n",
+                 signal_name(signal));
+    return exit_status_after(signal);
+  }
 
   TrialDescription description;
-  const TrialResult result = run_trial_on_device(command, device, scene, description);
+  TrialResult result = run_trial_on_device(command, device, scene, description);
+  const int signal = StopSignals::received();
+  if (result.end == TrialEnd::interrupted && result.abort_reason.empty() && signal != 0) {
+    result.abort_reason = std::string("stopped by ") + signal_name(signal);
+  }
+  // The recording first (it cannot be repeated), then the table. Outputs are written for a trial that
+  // ended early too: they hold every tick recorded.
+  const bool written = write_trial_outputs(command, description, scene, result);
   // Standard output carries one document: the table, or the output given as '-'.
   if (command.json != "-" && command.svg != "-" && command.csv != "-")
     print_trial_table(description, scene, result);
-  // The outputs are written for an aborted trial too: they hold what was recorded before the fault.
-  if (!command.json.empty()) write_output(command.json, trial_json(description, result));
-  if (!command.svg.empty()) write_output(command.svg, trial_svg(scene, result));
-  if (!command.csv.empty()) write_output(command.csv, trial_csv(result.trace));
+  if (signal != 0) {
+    std::fprintf(stderr, "calligraphy trial: stopped by %s after %.3f s (%s); %s\n", signal_name(signal),
+                 result.metrics.time_s, to_string(result.end),
+                 written ? "every recorded tick was written" : "an output could not be written");
+    return written ? exit_status_after(signal) : 1;
+  }
+  if (!written) return 1;
   if (result.aborted) {
     std::fprintf(stderr, "calligraphy trial: error: the trial ended early (%s)%s%s\n", to_string(result.end),
                  result.abort_reason.empty() ? "" : ": ", result.abort_reason.c_str());

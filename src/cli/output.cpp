@@ -5,8 +5,8 @@
 #include <cstring>
 #include <iostream>
 
+#include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/report/atomic_file.hpp"
 
 namespace calligraphy::cli {
 

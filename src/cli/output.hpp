@@ -10,7 +10,7 @@ namespace calligraphy::cli {
 /// write or the flush fails (a full disk, a closed pipe).
 void write_standard_output(std::string_view text);
 
-/// Writes `text` to the file `path` (atomically, see calligraphy/report/atomic_file.hpp) or, when `path` is
+/// Writes `text` to the file `path` (atomically, see calligraphy/core/atomic_file.hpp) or, when `path` is
 /// "-", to standard output. Throws DataError naming the path when it cannot.
 void write_output(const std::string& path, std::string_view text);
 

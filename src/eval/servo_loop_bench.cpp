@@ -16,7 +16,8 @@ namespace calligraphy::cli {
 namespace {
 
 // The free loop: stepped by one period per tick inside the callback (lock-step physics paced by the loop).
-ServoLoopStats run_free_loop(const ServoLoopOptions& options, double seconds) {
+ServoLoopStats run_free_loop(const ServoLoopOptions& options, double seconds,
+                             const std::function<bool()>& should_stop) {
   SimulatedDevice device;
   device.open();
   const Vec3 home = SimulatedDeviceParameters{}.initial_position_m;
@@ -32,8 +33,8 @@ ServoLoopStats run_free_loop(const ServoLoopOptions& options, double seconds) {
       options);
   loop.start();
   const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (loop.running() && std::chrono::steady_clock::now() < until) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  while (loop.running() && std::chrono::steady_clock::now() < until && !(should_stop && should_stop())) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   loop.stop();
   return loop.stats();
@@ -44,7 +45,7 @@ ServoLoopStats run_free_loop(const ServoLoopOptions& options, double seconds) {
 LoopBenchResult run_loop_bench(const CharacterLibrary& library, const LoopBenchSettings& settings) {
   LoopBenchResult result;
   if (settings.trial_characters.empty()) {
-    result.stats = run_free_loop(settings.loop, settings.seconds);
+    result.stats = run_free_loop(settings.loop, settings.seconds, settings.should_stop);
     return result;
   }
   std::vector<Character> characters;
@@ -56,6 +57,7 @@ LoopBenchResult run_loop_bench(const CharacterLibrary& library, const LoopBenchS
   trial.pacing = TrialPacing::real_time;
   trial.rate_hz = settings.loop.rate_hz;
   trial.loop = settings.loop;
+  trial.should_stop = settings.should_stop;
   const TrialResult run = run_simulated_trial(scene, trial);
   result.stats = run.loop.value_or(ServoLoopStats{});
   LoopBenchTrial summary;

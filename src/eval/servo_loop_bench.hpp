@@ -2,6 +2,7 @@
 // `calligraphy bench loop`: the real-time ServoLoop run for a while, either free (the simulated device
 // with no hand, held near its start by a weak virtual spring) or through a whole real-time simulated
 // trial, and its statistics: period jitter, missed deadlines, stalls, callback time (docs/servo-loop.md).
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -15,6 +16,8 @@ struct LoopBenchSettings {
   double seconds = 10.0;                 ///< how long the free loop runs; the trial's time limit [s]
   std::string realtime_mode = "ignore";  ///< enforce|ignore|off, as given; reported only
   std::u32string trial_characters;       ///< empty: the free loop; else a real-time trial of these
+  /// Polled every few milliseconds: true ends the run early (the trial ends `interrupted`). May be empty.
+  std::function<bool()> should_stop;
 };
 
 /// What the trial of a loop bench did.

@@ -12,7 +12,8 @@
 namespace calligraphy {
 namespace {
 
-[[noreturn]] void fail(const std::string& source, char32_t cp, const std::string& where, const std::string& what) {
+[[noreturn]] void fail(const std::string& source, char32_t cp, const std::string& where,
+                       const std::string& what) {
   throw DataError(source + ": character " + describe_character(cp) + ": " + where + ": " + what);
 }
 
@@ -46,9 +47,13 @@ CharacterLibrary CharacterLibrary::embedded() { return CharacterLibrary{}; }
 CharacterLibrary CharacterLibrary::from_directory(const std::filesystem::path& folder) {
   std::error_code ec;
   if (!std::filesystem::is_directory(folder, ec)) {
+    // Something else by that name (a file, /dev/null) is not a missing folder: say which.
+    const bool exists = std::filesystem::exists(folder, ec);
     throw DataError(folder.string() +
-                    ": character data folder does not exist (fetch it with "
-                    "scripts/fetch-hanzi-writer-data.sh)");
+                    (exists ? ": not a folder (expected the character data folder, one <character>.json per "
+                              "character)"
+                            : ": character data folder does not exist (fetch it with "
+                              "scripts/fetch-hanzi-writer-data.sh)"));
   }
   CharacterLibrary library;
   library.folder_ = folder;

@@ -222,7 +222,8 @@ double CorpusStoreInfo::max_quantisation_error() const {
 CorpusStore CorpusStore::open(const std::filesystem::path& path) {
   auto data = std::make_shared<Data>();
   data->name = path.string();
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  // O_NONBLOCK: opening a FIFO for reading would otherwise wait for a writer (it is then refused below).
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
   if (fd < 0) throw DataError(data->name + ": cannot open the corpus store (" + std::strerror(errno) + ")");
   struct stat st {};
   if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {

@@ -2,9 +2,9 @@
 // bit-packed records of quantised, delta-coded control points with shared joints.
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <string>
 
+#include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/corpus_store.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
@@ -197,17 +197,9 @@ std::vector<std::uint8_t> encode_corpus_store(std::span<const Character> charact
 
 void write_corpus_store(const std::filesystem::path& path, std::span<const Character> characters,
                         const CorpusStoreOptions& options) {
-  const std::vector<std::uint8_t> bytes = encode_corpus_store(characters, options);
-  std::filesystem::path temporary = path;
-  temporary += ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    if (!out) throw DataError(temporary.string() + ": cannot write the corpus store");
-  }
-  std::error_code ec;
-  std::filesystem::rename(temporary, path, ec);
-  if (ec) throw DataError(path.string() + ": cannot write the corpus store (" + ec.message() + ")");
+  // Encoded whole before the file is touched, then written as every output is: an earlier store survives
+  // any failure, and no temporary file is left behind.
+  write_file_atomically(path, encode_corpus_store(characters, options));
 }
 
 }  // namespace calligraphy

@@ -2,15 +2,58 @@
 
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
+#include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
-#include "calligraphy/report/atomic_file.hpp"
 #include "core/unicode.hpp"
 #include "model/polyline.hpp"
 
 namespace calligraphy {
+namespace {
+
+// A length [m] in millimetres with `decimals` digits, or "-" when there is none.
+std::string millimetres(const std::optional<double>& metres, int decimals) {
+  if (!metres) return "-";
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*f", decimals, *metres * 1e3);
+  return text;
+}
+
+// A length [m] as JSON millimetres, or null when there is none.
+nlohmann::json millimetres_json(const std::optional<double>& metres) {
+  return metres ? nlohmann::json(*metres * 1e3) : nlohmann::json(nullptr);
+}
+
+// A stroke's writing time exists only once it is written.
+std::optional<double> stroke_time_s(const StrokeMetrics& stroke) {
+  return stroke.completed ? std::optional<double>(stroke.time_s) : std::nullopt;
+}
+
+void print_loop_statistics(const ServoLoopStats& loop) {
+  std::printf("  servo loop                 %llu ticks, %llu late, %llu forces withheld\n",
+              static_cast<unsigned long long>(loop.ticks), static_cast<unsigned long long>(loop.late_ticks),
+              static_cast<unsigned long long>(loop.forces_withheld));
+  std::printf("  longest stall              %.3f ms\n", loop.longest_stall_s * 1e3);
+  std::printf("  period jitter p99 / max    %.0f / %.0f us (%s)\n", loop.period_jitter_us_p99,
+              loop.period_jitter_us_max,
+              loop.realtime.fifo_scheduling ? "SCHED_FIFO" : "normal scheduling, not SCHED_FIFO");
+}
+
+nlohmann::json loop_json(const ServoLoopStats& loop) {
+  return {{"ticks", loop.ticks},
+          {"late_ticks", loop.late_ticks},
+          {"forces_withheld", loop.forces_withheld},
+          {"longest_stall_ms", loop.longest_stall_s * 1e3},
+          {"deadline_reanchors", loop.deadline_reanchors},
+          {"period_jitter_us_p99", loop.period_jitter_us_p99},
+          {"period_jitter_us_max", loop.period_jitter_us_max},
+          {"fifo_scheduling", loop.realtime.fifo_scheduling}};
+}
+
+}  // namespace
 
 void print_trial_table(const TrialDescription& d, const Scene& scene, const TrialResult& result) {
   const TrialMetrics& m = result.metrics;
@@ -21,20 +64,30 @@ void print_trial_table(const TrialDescription& d, const Scene& scene, const Tria
               "max[mm]", "time[s]", "attempts", "completed");
   for (const StrokeMetrics& s : m.per_stroke) {
     const TypicalStroke& type = typical_stroke(s.typical_id);
-    std::printf("  %-6zu %-5s %-6s %-4d %9.2f %9.2f %9.2f %8d %9s\n", s.index + 1,
+    const std::optional<double> time_s = stroke_time_s(s);
+    char time_text[32] = "-";
+    if (time_s) std::snprintf(time_text, sizeof time_text, "%.2f", *time_s);
+    std::printf("  %-6zu %-5s %-6s %-4d %9s %9s %9s %8d %9s\n", s.index + 1,
                 encode_utf8(scene.characters[s.character].code_point).c_str(),
-                std::string(type.acronym).c_str(), s.typical_id, s.mean_deviation_m * 1e3,
-                s.max_deviation_m * 1e3, s.time_s, s.attempts, s.completed ? "yes" : "no");
+                std::string(type.acronym).c_str(), s.typical_id, millimetres(s.mean_deviation_m, 2).c_str(),
+                millimetres(s.max_deviation_m, 2).c_str(), time_text, s.attempts, s.completed ? "yes" : "no");
   }
   std::printf("\n  strokes completed in order  %zu / %zu%s\n", m.strokes_completed, m.strokes_total,
               m.completed_in_order ? "" : "  (incomplete)");
-  std::printf("  mean deviation             %.3f mm\n", m.mean_deviation_m * 1e3);
-  std::printf("  max deviation              %.3f mm\n", m.max_deviation_m * 1e3);
+  // "-" without a unit: nothing was written, so there is no deviation to give.
+  std::printf("  mean deviation             %s%s\n", millimetres(m.mean_deviation_m, 3).c_str(),
+              m.mean_deviation_m ? " mm" : "");
+  std::printf("  max deviation              %s%s\n", millimetres(m.max_deviation_m, 3).c_str(),
+              m.max_deviation_m ? " mm" : "");
   std::printf("  writing time               %.2f s\n", m.time_s);
   std::printf("  state transitions          %zu\n", m.state_transitions);
   std::printf("  max |F|                    %.3f N\n", m.max_force_n);
   std::printf("  max per-tick |dF|          %.3f N\n", m.max_force_step_n);
-  if (result.aborted) std::printf("\n  ABORTED after %.3f s: %s\n", m.time_s, result.abort_reason.c_str());
+  if (result.loop) print_loop_statistics(*result.loop);
+  if (result.aborted) {
+    std::printf("\n  ABORTED after %.3f s (%s)%s%s\n", m.time_s, to_string(result.end),
+                result.abort_reason.empty() ? "" : ": ", result.abort_reason.c_str());
+  }
 }
 
 std::string trial_json(const TrialDescription& d, const TrialResult& result) {
@@ -43,31 +96,32 @@ std::string trial_json(const TrialDescription& d, const TrialResult& result) {
   for (const StrokeMetrics& s : m.per_stroke) {
     per_stroke.push_back({{"index", s.index + 1},
                           {"typical_id", s.typical_id},
-                          {"mean_deviation_mm", s.mean_deviation_m * 1e3},
-                          {"max_deviation_mm", s.max_deviation_m * 1e3},
-                          {"time_s", s.time_s},
+                          {"mean_deviation_mm", millimetres_json(s.mean_deviation_m)},
+                          {"max_deviation_mm", millimetres_json(s.max_deviation_m)},
+                          {"time_s", stroke_time_s(s) ? nlohmann::json(s.time_s) : nlohmann::json(nullptr)},
                           {"completed", s.completed},
                           {"attempts", s.attempts}});
   }
-  const nlohmann::json doc = {{"character", d.characters},
-                              {"guidance", d.guidance},
-                              {"writer", d.writer},
-                              {"seed", d.seed},
-                              {"rate_hz", d.rate_hz},
-                              {"device", d.device},
-                              {"aborted", result.aborted},
-                              {"end_reason", to_string(result.end)},
-                              {"abort_reason", result.abort_reason},
-                              {"strokes_total", m.strokes_total},
-                              {"strokes_completed", m.strokes_completed},
-                              {"completed_in_order", m.completed_in_order},
-                              {"time_s", m.time_s},
-                              {"mean_deviation_mm", m.mean_deviation_m * 1e3},
-                              {"max_deviation_mm", m.max_deviation_m * 1e3},
-                              {"max_force_n", m.max_force_n},
-                              {"max_force_step_n", m.max_force_step_n},
-                              {"state_transitions", m.state_transitions},
-                              {"per_stroke", per_stroke}};
+  nlohmann::json doc = {{"character", d.characters},
+                        {"guidance", d.guidance},
+                        {"writer", d.writer},
+                        {"seed", d.seed},
+                        {"rate_hz", d.rate_hz},
+                        {"device", d.device},
+                        {"aborted", result.aborted},
+                        {"end_reason", to_string(result.end)},
+                        {"abort_reason", result.abort_reason},
+                        {"strokes_total", m.strokes_total},
+                        {"strokes_completed", m.strokes_completed},
+                        {"completed_in_order", m.completed_in_order},
+                        {"time_s", m.time_s},
+                        {"mean_deviation_mm", millimetres_json(m.mean_deviation_m)},
+                        {"max_deviation_mm", millimetres_json(m.max_deviation_m)},
+                        {"max_force_n", m.max_force_n},
+                        {"max_force_step_n", m.max_force_step_n},
+                        {"state_transitions", m.state_transitions},
+                        {"per_stroke", per_stroke}};
+  if (result.loop) doc["loop"] = loop_json(*result.loop);  // real-time trials only
   return doc.dump(2) + "\n";
 }
 

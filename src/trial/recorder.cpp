@@ -62,21 +62,29 @@ void TrialRecorder::record(const DeviceState& state, const RenderOutput& out) {
     attempt_.max = std::max(attempt_.max, d);
     m.trace_end = index + 1;
   }
-  if (out.stroke_abandoned) m.trace_end = m.trace_begin;  // the trace of an abandoned attempt is cleared
+  if (out.stroke_abandoned) {  // the trace of an abandoned attempt is cleared, and so are its deviations
+    m.trace_end = m.trace_begin;
+    attempt_ = {};
+  }
   if (out.stroke_completed) {
     m.completed = true;
     m.time_s = state.time_s - attempt_.start_time;
-    m.mean_deviation_m = attempt_.count ? attempt_.sum / static_cast<double>(attempt_.count) : 0.0;
-    m.max_deviation_m = attempt_.max;
-    pooled_sum_ += attempt_.sum;
-    pooled_count_ += attempt_.count;
+    close_attempt(m);
     ++metrics_.strokes_completed;
-    metrics_.max_deviation_m = std::max(metrics_.max_deviation_m, attempt_.max);
-    metrics_.mean_deviation_m = pooled_count_ ? pooled_sum_ / static_cast<double>(pooled_count_) : 0.0;
     metrics_.time_s = state.time_s;
     attempt_ = {};
     ++current_;
   }
+}
+
+void TrialRecorder::close_attempt(StrokeMetrics& stroke) {
+  if (attempt_.count == 0) return;  // no WS tick: no deviation to report
+  stroke.mean_deviation_m = attempt_.sum / static_cast<double>(attempt_.count);
+  stroke.max_deviation_m = attempt_.max;
+  pooled_sum_ += attempt_.sum;
+  pooled_count_ += attempt_.count;
+  metrics_.mean_deviation_m = pooled_sum_ / static_cast<double>(pooled_count_);
+  metrics_.max_deviation_m = std::max(metrics_.max_deviation_m.value_or(0.0), attempt_.max);
 }
 
 void TrialRecorder::reserve(std::size_t ticks) {
@@ -87,6 +95,10 @@ void TrialRecorder::reserve(std::size_t ticks) {
 }
 
 void TrialRecorder::finish(double end_time_s) {
+  if (current_ < metrics_.per_stroke.size()) {  // the stroke under way when the trial ended
+    close_attempt(metrics_.per_stroke[current_]);
+    attempt_ = {};
+  }
   metrics_.completed_in_order =
       metrics_.strokes_total > 0 && metrics_.strokes_completed == metrics_.strokes_total;
   if (!metrics_.completed_in_order) metrics_.time_s = std::max(end_time_s, last_time_);

@@ -18,14 +18,20 @@
 namespace calligraphy {
 namespace {
 
-// Forces off, the hand let go and the link closed on every way out of a trial; never throws (the link
-// may be gone).
+// Zero force, forces off, the hand let go and the link closed on every way out of a trial; never throws
+// (the link may be gone).
 class DeviceShutdown {
  public:
   DeviceShutdown(HapticDevice& device, HandPort* hand) : device_(device), hand_(hand) {}
   DeviceShutdown(const DeviceShutdown&) = delete;
   DeviceShutdown& operator=(const DeviceShutdown&) = delete;
   ~DeviceShutdown() {
+    try {
+      // The last tick's force must not outlive the trial (the real-time loop has zeroed and disabled it).
+      if (device_.is_open() && device_.forces_enabled()) device_.write_force(Vec3::Zero());
+    } catch (...) {
+      // The link may be gone (the trial may be ending because of it); disabling and closing still follow.
+    }
     try {
       device_.enable_forces(false);
     } catch (...) {

@@ -55,8 +55,10 @@ struct CorpusStoreInfo {
 std::vector<std::uint8_t> encode_corpus_store(std::span<const Character> characters,
                                               const CorpusStoreOptions& options = {});
 
-/// Writes `encode_corpus_store(characters, options)` to `path` (via a temporary file renamed into
-/// place). Throws as `encode_corpus_store`, and DataError naming the path when it cannot be written.
+/// Writes `encode_corpus_store(characters, options)` to `path` with `write_file_atomically`
+/// (calligraphy/core/atomic_file.hpp): a temporary file in the same folder, fsync'ed and renamed into
+/// place, so that an earlier store is either kept whole or replaced whole and no temporary is left behind.
+/// Throws as `encode_corpus_store`, and DataError naming the path when it cannot be written.
 void write_corpus_store(const std::filesystem::path& path, std::span<const Character> characters,
                         const CorpusStoreOptions& options = {});
 

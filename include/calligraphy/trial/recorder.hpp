@@ -3,6 +3,7 @@
 /// The trial recorder: turns each servo tick (the state read and what the renderer made of it) into a
 /// trace sample and the trial's metrics. Usable from any loop, lock-step or real time.
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "calligraphy/core/device_types.hpp"
@@ -22,16 +23,18 @@ struct TrialSample {
 };
 
 /// Metrics of one stroke. Deviations are distances in the paper plane from the pen tip to the stroke's
-/// reference elements, over the WS ticks of the stroke's last attempt (an abandoned attempt is cleared,
-/// as its trace is on screen, section 4.3.3).
+/// reference elements [m], over the WS ticks of the stroke's last attempt (an abandoned attempt is
+/// cleared, as its trace is on screen, section 4.3.3; the attempt under way when the trial ends counts up
+/// to its end). They are absent (nullopt) when that attempt has no WS tick: a stroke never written, or one
+/// whose last attempt was abandoned; never a 0 that would read as a perfect stroke.
 struct StrokeMetrics {
   std::size_t index = 0;  ///< over the whole scene, 0-based
   std::size_t character = 0;
   int typical_id = 0;
   bool completed = false;
-  int attempts = 0;  ///< times WS was entered on this stroke
-  double mean_deviation_m = 0.0;
-  double max_deviation_m = 0.0;
+  int attempts = 0;                        ///< times WS was entered on this stroke
+  std::optional<double> mean_deviation_m;  ///< [m]; nullopt without a WS tick (see above)
+  std::optional<double> max_deviation_m;   ///< [m]; nullopt without a WS tick
   double time_s = 0.0;          ///< from entering WS to writing the last feature point, last attempt
   std::size_t trace_begin = 0;  ///< the last attempt's samples in the trace: [trace_begin, trace_end)
   std::size_t trace_end = 0;
@@ -43,10 +46,12 @@ struct TrialMetrics {
   std::size_t strokes_completed = 0;
   bool completed_in_order = false;  ///< every stroke written, each in its turn
   double time_s = 0.0;              ///< from the start to the last stroke written (or the end of the trial)
-  double mean_deviation_m = 0.0;    ///< over all WS ticks of the strokes' last attempts
-  double max_deviation_m = 0.0;
-  double max_force_n = 0.0;       ///< max |F| commanded
-  double max_force_step_n = 0.0;  ///< max |F(k) - F(k-1)| between consecutive ticks
+  /// Over all WS ticks of the strokes' last attempts [m]; nullopt when no stroke has one (nothing was
+  /// written).
+  std::optional<double> mean_deviation_m;
+  std::optional<double> max_deviation_m;  ///< [m]; nullopt when no stroke has a WS tick
+  double max_force_n = 0.0;               ///< max |F| commanded
+  double max_force_step_n = 0.0;          ///< max |F(k) - F(k-1)| between consecutive ticks
   std::size_t state_transitions = 0;
   std::vector<StrokeMetrics> per_stroke;
 };
@@ -63,11 +68,12 @@ class TrialRecorder {
   /// Allocates (and touches) room for `ticks` samples of the trace, so that the next `ticks` calls of
   /// `record` never allocate: for a real-time loop. Nothing when the trace is not kept.
   void reserve(std::size_t ticks);
-  /// Closes the metrics at `end_time_s` (time_s of an unfinished trial).
+  /// Closes the metrics at `end_time_s` (time_s of an unfinished trial); the deviations of the attempt
+  /// under way, if it has WS ticks, are added to its stroke and to the totals.
   void finish(double end_time_s);
 
  private:
-  struct Attempt {
+  struct Attempt {  // the WS ticks of the current stroke's attempt under way
     double sum = 0.0;
     std::size_t count = 0;
     double max = 0.0;
@@ -87,6 +93,7 @@ class TrialRecorder {
   double pooled_sum_ = 0.0;
   std::size_t pooled_count_ = 0;
   double last_time_ = 0.0;
+  void close_attempt(StrokeMetrics& stroke);  // the attempt's deviations to `stroke` and the totals
 };
 
 }  // namespace calligraphy

@@ -1,4 +1,4 @@
-#include "calligraphy/report/atomic_file.hpp"
+#include "calligraphy/core/atomic_file.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>

@@ -1,78 +1,21 @@
-// write_file_atomically and read_file_for_update (calligraphy/report/atomic_file.hpp), the one way the
-// command line writes files. Write failures are made with RLIMIT_FSIZE (writes past the limit fail with
-// EFBIG, whoever runs the test, root included) and with /dev/full (ENOSPC).
-#include <sys/resource.h>
-#include <sys/stat.h>
-#include <unistd.h>
+// write_file_atomically and read_file_for_update (calligraphy/core/atomic_file.hpp), the one way the
+// library and the command line write files. Write failures are made with RLIMIT_FSIZE (writes past the
+// limit fail with EFBIG, whoever runs the test, root included) and with /dev/full (ENOSPC).
+#include "calligraphy/core/atomic_file.hpp"
 
-#include <algorithm>
+#include <sys/stat.h>
+
 #include <catch2/catch.hpp>
-#include <csignal>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/report/atomic_file.hpp"
+#include "temporary_files.hpp"
 
 using namespace calligraphy;
+using namespace calligraphy::testing_files;
 namespace fs = std::filesystem;
-
-namespace {
-
-// A folder of its own under the temporary directory, removed with everything in it.
-struct TemporaryFolder {
-  fs::path path;
-  TemporaryFolder() {
-    static int made = 0;
-    path = fs::temp_directory_path() /
-           ("calligraphy_atomic_file_" + std::to_string(::getpid()) + "_" + std::to_string(made++));
-    fs::create_directories(path);
-  }
-  ~TemporaryFolder() {
-    std::error_code ignored;
-    fs::remove_all(path, ignored);
-  }
-  [[nodiscard]] std::vector<std::string> names() const {
-    std::vector<std::string> out;
-    for (const auto& entry : fs::directory_iterator(path)) out.push_back(entry.path().filename().string());
-    std::sort(out.begin(), out.end());
-    return out;
-  }
-};
-
-std::string contents(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-// Writes past `bytes` fail with EFBIG while this lives (SIGXFSZ ignored so that the write returns).
-class FileSizeLimit {
- public:
-  explicit FileSizeLimit(rlim_t bytes) {
-    ::getrlimit(RLIMIT_FSIZE, &saved_);
-    previous_handler_ = std::signal(SIGXFSZ, SIG_IGN);
-    rlimit limit = saved_;
-    limit.rlim_cur = bytes;
-    ::setrlimit(RLIMIT_FSIZE, &limit);
-  }
-  FileSizeLimit(const FileSizeLimit&) = delete;
-  FileSizeLimit& operator=(const FileSizeLimit&) = delete;
-  ~FileSizeLimit() {
-    ::setrlimit(RLIMIT_FSIZE, &saved_);
-    std::signal(SIGXFSZ, previous_handler_);
-  }
-
- private:
-  rlimit saved_{};
-  void (*previous_handler_)(int) = nullptr;
-};
-
-}  // namespace
 
 TEST_CASE("write_file_atomically creates and replaces a file, leaving nothing else", "[atomic_file]") {
   TemporaryFolder folder;

@@ -1,0 +1,74 @@
+#include "cli/signals.hpp"
+
+#include <atomic>
+#include <csignal>
+
+#include "calligraphy/core/errors.hpp"
+
+namespace calligraphy::cli {
+namespace {
+
+// Written by the handler, read by the command's thread: it must be lock-free to be async-signal-safe
+// (C++20 [support.signal]).
+std::atomic<int> received_signal{0};
+static_assert(std::atomic<int>::is_always_lock_free);
+
+constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
+
+extern "C" void record_stop_signal(int signal) {
+  int none = 0;
+  received_signal.compare_exchange_strong(none, signal);  // keep the first
+}
+
+struct SavedDispositions {
+  struct sigaction stop[std::size(kStopSignals)];
+  struct sigaction pipe;
+};
+SavedDispositions saved;
+std::atomic<bool> installed{false};
+
+}  // namespace
+
+StopSignals::StopSignals() {
+  if (installed.exchange(true)) throw StateError("stop signal handlers are installed already");
+  received_signal.store(0);
+  struct sigaction action {};
+  action.sa_handler = record_stop_signal;
+  sigemptyset(&action.sa_mask);
+  for (int signal : kStopSignals) sigaddset(&action.sa_mask, signal);  // one handler at a time
+  action.sa_flags = SA_RESTART;
+  for (std::size_t i = 0; i < std::size(kStopSignals); ++i)
+    sigaction(kStopSignals[i], &action, &saved.stop[i]);
+  struct sigaction ignore {};
+  ignore.sa_handler = SIG_IGN;
+  sigemptyset(&ignore.sa_mask);
+  sigaction(SIGPIPE, &ignore, &saved.pipe);
+}
+
+StopSignals::~StopSignals() {
+  for (std::size_t i = 0; i < std::size(kStopSignals); ++i)
+    sigaction(kStopSignals[i], &saved.stop[i], nullptr);
+  sigaction(SIGPIPE, &saved.pipe, nullptr);
+  installed.store(false);
+}
+
+int StopSignals::received() noexcept { return received_signal.load(std::memory_order_relaxed); }
+
+std::function<bool()> StopSignals::stop_requested() {
+  return [] { return received() != 0; };
+}
+
+const char* signal_name(int signal) noexcept {
+  switch (signal) {
+    case SIGINT:
+      return "SIGINT";
+    case SIGTERM:
+      return "SIGTERM";
+    case SIGHUP:
+      return "SIGHUP";
+    default:
+      return "a signal";
+  }
+}
+
+}  // namespace calligraphy::cli

@@ -1,0 +1,354 @@
+#!/usr/bin/env python3
+"""The `calligraphy` program on hostile inputs and outputs, and stopped by signals (docs/cli.md), run by CTest
+as `cli_hostile_tests`.
+
+Each case runs the built program and asserts the exit status, the message (one line naming the file, folder
+or character at fault) and that no earlier data was lost: an earlier output is byte for byte what it was, no
+temporary file is left beside it, and a trial stopped by SIGINT or SIGTERM has every recorded tick in its
+outputs. Inputs: the character files of tests/data/hostile/ and larger ones generated here (100,000-deep
+nesting, 100,000-point and one-point medians, an oversized file), FIFOs and device files where files are read,
+files where folders are expected, empty folders. Outputs: /dev/full, a file size limit (RLIMIT_FSIZE, which
+applies to root as well).
+
+CALLIGRAPHY_CLI names the program and CALLIGRAPHY_SOURCE_DIR the source tree. Standard library only
+(unittest; pytest runs these cases as well), so that nothing has to be installed.
+"""
+import csv
+import json
+import os
+import resource
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+from pathlib import Path
+
+CLI = os.environ.get("CALLIGRAPHY_CLI", "")
+SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
+DATA = SOURCE / "data" / "hanzi-writer-data"
+HOSTILE = SOURCE / "tests" / "data" / "hostile"
+YONG = "永"  # U+6C38, in the embedded set
+YONG_CODE = "U+6C38"
+TIMEOUT_S = 120  # a hang (reading a FIFO, /dev/zero) fails the case instead of blocking CTest
+
+
+class HostileTestCase(unittest.TestCase):
+    def setUp(self):
+        if not CLI or not Path(CLI).exists():
+            self.fail(f"CALLIGRAPHY_CLI={CLI!r} is not the calligraphy program: run these tests through ctest")
+        self.folder = tempfile.TemporaryDirectory(prefix="calligraphy-hostile-")
+        self.cwd = Path(self.folder.name)
+
+    def tearDown(self):
+        self.folder.cleanup()
+
+    def run_cli(self, *args, limit_file_bytes=None):
+        def limit():
+            if limit_file_bytes is not None:  # writes beyond this many bytes fail with EFBIG
+                signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+                resource.setrlimit(resource.RLIMIT_FSIZE, (limit_file_bytes, limit_file_bytes))
+
+        return subprocess.run([CLI, *map(str, args)], cwd=self.cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                              timeout=TIMEOUT_S, preexec_fn=limit)
+
+    def assert_error(self, result, status, *names):
+        """Exit `status`, and an error line on stderr naming each of `names`."""
+        message = result.stderr.decode(errors="replace")
+        self.assertEqual(result.returncode, status, message)
+        errors = [line for line in message.splitlines() if ": error: " in line]
+        self.assertEqual(len(errors), 1, f"not one error line: {message!r}")
+        for name in names:
+            self.assertIn(str(name), errors[0])
+        return errors[0]
+
+    def folder_with(self, name, files):
+        """A folder `name` in the working folder holding `files` {file name: bytes}."""
+        folder = self.cwd / name
+        folder.mkdir()
+        for file_name, content in files.items():
+            (folder / file_name).write_bytes(content)
+        return folder
+
+    def earlier_files(self, *names):
+        """Earlier outputs with known contents; returns {path: bytes}."""
+        earlier = {}
+        for name in names:
+            path = self.cwd / name
+            path.write_bytes(f"earlier {name}, kept unless replaced whole\n".encode())
+            earlier[path] = path.read_bytes()
+        return earlier
+
+    def assert_kept(self, earlier):
+        """Every earlier file is as it was, and nothing else was left beside them (no temporary)."""
+        for path, content in earlier.items():
+            self.assertEqual(path.read_bytes(), content, f"{path.name} was changed")
+        for path in self.cwd.iterdir():
+            self.assertFalse(path.name.startswith(".") or path.name.endswith(".tmp"), f"left behind: {path.name}")
+
+
+class HostileCharacterFiles(HostileTestCase):
+    def refuse_as_yong(self, content, *expected):
+        """`content` as the character file of 永: model, trial and corpus build refuse it, naming the file and
+        the character; the trial's earlier outputs and the earlier store are kept."""
+        data = self.folder_with(f"data-{len(list(self.cwd.iterdir()))}", {f"{YONG}.json": content})
+        names = (f"{YONG}.json", YONG_CODE, *expected)
+        self.assert_error(self.run_cli("model", YONG, "--data", data), 1, *names)
+        earlier = self.earlier_files("trial.json", "trace.csv", "corpus.clg")
+        trial = self.run_cli("trial", YONG, "--data", data, "--json", "trial.json", "--csv", "trace.csv")
+        self.assert_error(trial, 1, *names)
+        build = self.run_cli("corpus", "build", "--data", data, "--out", "corpus.clg", "--threads", "1")
+        self.assert_error(build, 1, data.name, "none of its 1 character files", "corpus.clg is not written",
+                          *names)
+        self.assert_kept(earlier)
+
+    def test_every_file_of_the_hostile_set_is_refused(self):
+        files = sorted(HOSTILE.glob("*.json"))
+        self.assertGreaterEqual(len(files), 16)
+        for path in files:
+            with self.subTest(file=path.name):
+                self.refuse_as_yong(path.read_bytes())
+
+    def test_deep_nesting(self):
+        depth = 100_000
+        self.refuse_as_yong(b'{"medians": ' + b"[" * depth + b"]" * depth + b"}")
+        # Under a key the loader skips: still bounded, never a stack overflow.
+        self.refuse_as_yong(b'{"strokes": ' + b"[" * depth + b"]" * depth + b', "medians": [[[0, 0], [9, 9]]]}',
+                            "nested deeper than")
+
+    def test_one_point_and_100000_point_medians(self):
+        self.refuse_as_yong(json.dumps({"medians": [[[500, 500]]]}).encode(), "/medians/0", "got 1")
+        many = [[i % 1000, i // 1000] for i in range(100_000)]
+        self.refuse_as_yong(json.dumps({"medians": [many]}).encode(), "/medians/0", "more than")
+
+    def test_far_and_huge_coordinates(self):
+        for value in ("1e17", "-1e17", "1e308", "18446744073709551616", "1e400"):
+            with self.subTest(value=value):
+                self.refuse_as_yong(f'{{"medians": [[[0, 0], [{value}, 5]]]}}'.encode(), "/medians/0/1/0")
+
+    def test_oversized_file(self):
+        self.refuse_as_yong(b" " * (17 << 20) + b'{"medians": []}', "bytes")
+
+
+class NonRegularInputs(HostileTestCase):
+    """FIFOs, devices and folders where files are read: refused unread (a FIFO would block, /dev/zero never
+    ends), with one line naming the path."""
+
+    def test_fifo_and_devices_as_character_files(self):
+        data = self.cwd / "data"
+        data.mkdir()
+        os.mkfifo(data / f"{YONG}.json")
+        for command in (["model", YONG], ["trial", YONG]):
+            with self.subTest(command=command, kind="FIFO"):
+                self.assert_error(self.run_cli(*command, "--data", data), 1, f"{YONG}.json", "FIFO")
+        (data / f"{YONG}.json").unlink()
+        for device in ("/dev/zero", "/dev/null"):
+            os.symlink(device, data / f"{YONG}.json")
+            with self.subTest(device=device):
+                self.assert_error(self.run_cli("model", YONG, "--data", data), 1, f"{YONG}.json",
+                                  "character device")
+            (data / f"{YONG}.json").unlink()
+        (data / f"{YONG}.json").mkdir()
+        self.assert_error(self.run_cli("model", YONG, "--data", data), 1, f"{YONG}.json", "directory")
+
+    def test_fifo_and_devices_as_input_files(self):
+        os.mkfifo(self.cwd / "fifo")
+        (self.cwd / "folder").mkdir()
+        for path in ("fifo", "/dev/zero", "/dev/null", "folder"):
+            for command in (["score", path, "--character", YONG], ["corpus", "stats", path],
+                            ["model", YONG, "--store", path], ["corpus", "validate", "--cnchar", path]):
+                with self.subTest(command=command):
+                    self.assert_error(self.run_cli(*command), 1, path, "not a regular file")
+
+    def test_files_and_devices_as_data_folders(self):
+        (self.cwd / "file.json").write_text("{}")
+        for path in ("/dev/null", "file.json"):
+            for command in (["model", YONG], ["trial", YONG], ["corpus", "build", "--out", "s.clg"]):
+                with self.subTest(command=command, data=path):
+                    self.assert_error(self.run_cli(*command, "--data", path), 1, path, "not a folder")
+        self.assertFalse((self.cwd / "s.clg").exists())
+
+
+class EmptyAndUselessFolders(HostileTestCase):
+    def test_empty_data_folder(self):
+        empty = self.folder_with("empty", {})
+        earlier = self.earlier_files("corpus.clg", "report.md")
+        self.assert_error(self.run_cli("corpus", "build", "--data", empty, "--out", "corpus.clg"), 1, "empty",
+                          "no character files")
+        self.assert_error(self.run_cli("corpus", "fidelity", "--data", empty, "--tolerances", "10"), 1, "empty",
+                          "no character files")
+        cnchar = self.cwd / "cnchar.js"
+        cnchar.write_text(json.dumps({YONG: "dhpn"}, ensure_ascii=False), encoding="utf-8")
+        self.assert_error(self.run_cli("corpus", "validate", "--data", empty, "--cnchar", cnchar,
+                                       "--markdown", "report.md"), 1, "empty", "no character files")
+        self.assert_error(self.run_cli("model", YONG, "--data", empty), 1, YONG_CODE, "empty")
+        self.assert_error(self.run_cli("trial", YONG, "--data", empty), 1, YONG_CODE, "empty")
+        earlier[cnchar] = cnchar.read_bytes()
+        self.assert_kept(earlier)
+
+    def test_validation_that_compares_nothing_is_an_error(self):
+        # 七 is labelled but not in a folder holding only 永: nothing to compare, no agreement of 0 %.
+        data = self.folder_with("data", {f"{YONG}.json": (DATA / f"{YONG}.json").read_bytes()})
+        cnchar = self.cwd / "cnchar.js"
+        cnchar.write_text('{"七":"hs"}', encoding="utf-8")
+        earlier = self.earlier_files("report.md")
+        result = self.run_cli("corpus", "validate", "--data", data, "--cnchar", cnchar, "--markdown", "report.md")
+        self.assert_error(result, 1, "nothing to compare", "cnchar.js")
+        self.assertEqual(result.stdout, b"")
+        earlier[cnchar] = cnchar.read_bytes()
+        earlier[data / f"{YONG}.json"] = (DATA / f"{YONG}.json").read_bytes()
+        self.assert_kept(earlier)
+
+
+class FullAndFailingOutputs(HostileTestCase):
+    def test_dev_full_as_every_kind_of_output(self):
+        for command in (["trial", YONG, "--json", "/dev/full"], ["trial", YONG, "--csv", "/dev/full"],
+                        ["trial", YONG, "--svg", "/dev/full"], ["model", YONG, "--svg", "/dev/full"],
+                        ["strokes", "--markdown", "/dev/full"],
+                        ["corpus", "build", "--data", DATA, "--out", "/dev/full", "--threads", "1"]):
+            with self.subTest(command=command):
+                self.assert_error(self.run_cli(*command), 1, "/dev/full", "No space left on device")
+
+    def test_one_failing_output_does_not_keep_the_others_from_being_written(self):
+        result = self.run_cli("trial", YONG, "--json", "trial.json", "--csv", "/dev/full", "--svg", "trial.svg")
+        self.assert_error(result, 1, "/dev/full")
+        self.assertEqual(json.loads((self.cwd / "trial.json").read_text())["end_reason"], "completed")
+        self.assertTrue((self.cwd / "trial.svg").read_text().rstrip().endswith("</svg>"))
+
+    def test_write_failure_keeps_earlier_outputs_whole(self):
+        earlier = self.earlier_files("trial.json", "trace.csv")
+        # The JSON of a trial is a few kilobytes, its trace far more: the trace fails part-way.
+        result = self.run_cli("trial", YONG, "--json", "trial.json", "--csv", "trace.csv",
+                              limit_file_bytes=64 << 10)
+        self.assert_error(result, 1, "trace.csv", "too large")
+        self.assertEqual(json.loads((self.cwd / "trial.json").read_text())["end_reason"], "completed")
+        del earlier[self.cwd / "trial.json"]  # replaced whole by the new trial: that write succeeded
+        self.assert_kept(earlier)
+
+    def test_failed_store_write_keeps_the_earlier_store(self):
+        store = self.cwd / "corpus.clg"
+        self.assertEqual(self.run_cli("corpus", "build", "--data", DATA, "--out", store, "--steps", "1",
+                                      "--threads", "1").returncode, 0)
+        earlier = {store: store.read_bytes()}
+        result = self.run_cli("corpus", "build", "--data", DATA, "--out", store, "--steps", "16", "--threads", "1",
+                              limit_file_bytes=len(earlier[store]))
+        self.assert_error(result, 1, "corpus.clg")
+        self.assert_kept(earlier)
+
+
+class HonestResults(HostileTestCase):
+    def test_trial_that_writes_nothing_reports_no_deviation(self):
+        # At 100 Hz the simulated writer misses every stroke and gives up: nothing written, nothing measured.
+        result = self.run_cli("trial", YONG, "--rate", "100", "--json", "trial.json")
+        self.assertNotEqual(result.returncode, 0)
+        self.assertIn("writer_gave_up", result.stderr.decode())
+        table = result.stdout.decode()
+        self.assertRegex(table, r"mean deviation +-\n")
+        self.assertRegex(table, r"max deviation +-\n")
+        for line in table.splitlines():
+            if line.strip().startswith(("1 ", "2 ", "3 ", "4 ", "5 ")):
+                self.assertEqual(line.split()[4:6], ["-", "-"], line)
+        doc = json.loads((self.cwd / "trial.json").read_text())
+        self.assertEqual(doc["strokes_completed"], 0)
+        self.assertIsNone(doc["mean_deviation_mm"])
+        self.assertIsNone(doc["max_deviation_mm"])
+        for stroke in doc["per_stroke"]:
+            self.assertIsNone(stroke["mean_deviation_mm"])
+            self.assertIsNone(stroke["time_s"])
+
+
+def read_trace(path):
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    return rows[0], rows[1:]
+
+
+class Signals(HostileTestCase):
+    """A trial stopped by SIGINT or SIGTERM writes every recorded tick, then exits 128 + the signal."""
+
+    def stop_trial(self, args, sig, after_s=1.5, twice=False):
+        process = subprocess.Popen([CLI, "trial", *args], cwd=self.cwd, stdout=subprocess.PIPE,
+                                   stderr=subprocess.PIPE)
+        try:
+            time.sleep(after_s)
+            if process.poll() is not None:
+                self.fail(f"the trial ended (status {process.returncode}) before the signal: "
+                          f"{process.communicate()[1].decode(errors='replace')}")
+            process.send_signal(sig)
+            if twice:  # a second Ctrl-C while the files are written must not lose them
+                time.sleep(0.05)
+                if process.poll() is None:
+                    process.send_signal(sig)
+            stdout, stderr = process.communicate(timeout=TIMEOUT_S)
+        finally:
+            if process.poll() is None:
+                process.kill()
+                process.wait()
+        message = stderr.decode(errors="replace")
+        self.assertEqual(process.returncode, 128 + sig, message)
+        name = signal.Signals(sig).name
+        self.assertIn(f"stopped by {name}", message)
+        self.assertIn("every recorded tick was written", message)
+        table = stdout.decode()
+        self.assertIn("ABORTED", table)
+        self.assertIn("interrupted", table)
+        doc = json.loads((self.cwd / "trial.json").read_text())
+        self.assertEqual(doc["end_reason"], "interrupted")
+        self.assertTrue(doc["aborted"])
+        self.assertIn(name, doc["abort_reason"])
+        self.assertLess(doc["strokes_completed"], doc["strokes_total"])
+        header, rows = read_trace(self.cwd / "trace.csv")
+        self.assertEqual(header[0], "t")
+        self.assertGreater(len(rows), 0)
+        self.assertEqual(rows[-1][0], f"{doc['time_s']:.4f}")  # the last tick recorded is the last row
+        self.assertEqual(sorted(p.name for p in self.cwd.iterdir()), ["trace.csv", "trial.json"])  # no temporary
+        return doc, rows
+
+    def real_time(self, sig):
+        doc, rows = self.stop_trial([YONG, "--pacing", "real-time", "--json", "trial.json", "--csv", "trace.csv"],
+                                    sig)
+        self.assertEqual(len(rows), doc["loop"]["ticks"])  # one row per tick of the servo loop
+        for key in ("late_ticks", "forces_withheld", "longest_stall_ms", "period_jitter_us_p99"):
+            self.assertIn(key, doc["loop"])
+
+    def lock_step(self, sig, twice=False):
+        # Twenty 永 at 10 kHz: 3 million ticks to the time limit, seconds of work, still running when the signal
+        # comes (a lock-step tick costs microseconds).
+        rate_hz = 10000
+        args = [YONG * 20, "--pacing", "lock-step", "--rate", str(rate_hz), "--json", "trial.json", "--csv",
+                "trace.csv"]
+        doc, rows = self.stop_trial(args, sig, twice=twice)
+        self.assertNotIn("loop", doc)
+        # Ticks from t = 0 one period apart, up to the time the JSON gives: none missing.
+        self.assertEqual(len(rows), round(doc["time_s"] * rate_hz) + 1)
+        self.assertEqual(rows[0][0], "0.0000")
+
+    def test_sigint_real_time(self):
+        self.real_time(signal.SIGINT)
+
+    def test_sigterm_real_time(self):
+        self.real_time(signal.SIGTERM)
+
+    def test_sigint_lock_step_twice(self):
+        self.lock_step(signal.SIGINT, twice=True)
+
+    def test_sigterm_lock_step(self):
+        self.lock_step(signal.SIGTERM)
+
+    def test_bench_loop_trial(self):
+        process = subprocess.Popen([CLI, "bench", "loop", "--trial", YONG, "--json"], cwd=self.cwd,
+                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        time.sleep(1.5)
+        self.assertIsNone(process.poll())
+        process.send_signal(signal.SIGINT)
+        stdout, stderr = process.communicate(timeout=TIMEOUT_S)
+        self.assertEqual(process.returncode, 130, stderr.decode())
+        self.assertIn("stopped by SIGINT", stderr.decode())
+        report = json.loads(stdout)
+        self.assertEqual(report["trial"]["end"], "interrupted")
+        self.assertGreater(report["ticks"], 0)
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
