@@ -36,6 +36,11 @@ void ForceLawParameters::validate() const {
                           " must be in [0, 1]");
   }
   if (guidance_mode == GuidanceMode::replay) validate_teacher_trajectory(teacher_trajectory);
+  if (!(replay_max_lead_m > 0.0 && replay_max_lead_m <= constraint_radius_m)) {
+    throw InvalidArgument("ForceLawParameters.replay_max_lead_m = " + std::to_string(replay_max_lead_m) +
+                          " must be in (0, constraint_radius_m = " + std::to_string(constraint_radius_m) +
+                          "]");
+  }
   if (constraint_taper_m > constraint_radius_m) {
     throw InvalidArgument("ForceLawParameters.constraint_taper_m = " + std::to_string(constraint_taper_m) +
                           " must not exceed constraint_radius_m = " + std::to_string(constraint_radius_m));

@@ -129,11 +129,12 @@ Vec2 Renderer::guidance_force(const DeviceState& device, RenderOutput& out, bool
   out.foot_m = nearest.foot;
   // Foot-point jumps (a new element, a jump of the tracker to another minimum) move the attraction
   // target at a bounded speed instead of stepping the force.
-  // In the replay mode the attraction point is the teacher's pen, as many seconds into the stroke as the
-  // pen has been writing it, with the same bounded speed.
+  // In the replay mode the attraction point is where the teacher was, as many seconds into the stroke as
+  // the pen has been writing it, kept on the active element, with the same bounded speed.
   const Vec2 attraction_point =
       parameters_.guidance_mode == GuidanceMode::replay
-          ? replay_.position(active_.strokes_written(), device.time_s - writing_since_s_)
+          ? replay_.attraction_point(active_.strokes_written(), device.time_s - writing_since_s_,
+                                     active_.element_index(), element)
           : nearest.foot;
   const double max_move = parameters_.max_foot_speed_m_s * period_s_;
   const Vec2 move = attraction_point - rendered_foot_;
@@ -153,8 +154,11 @@ Vec2 Renderer::guidance_force(const DeviceState& device, RenderOutput& out, bool
   const double factor = gain * active_.attraction(nearest.t);
   Vec2 attraction = attraction_force(tip, rendered_foot_, parameters_.guidance_stiffness_n_per_m, factor);
   // The replay point may lead or trail the pen along the stroke by more than R_res: the spring is
-  // saturated at its force at R_res, so the force stays bounded (K_et a R_res) and continuous.
-  const double limit = parameters_.guidance_stiffness_n_per_m * factor * parameters_.constraint_radius_m;
+  // saturated at its force at replay_max_lead_m, so the force stays bounded and continuous. (The foot
+  // point of the other modes is never further than R_res.)
+  const double reach = parameters_.guidance_mode == GuidanceMode::replay ? parameters_.replay_max_lead_m
+                                                                         : parameters_.constraint_radius_m;
+  const double limit = parameters_.guidance_stiffness_n_per_m * factor * reach;
   const double magnitude = attraction.norm();
   if (magnitude > limit) attraction *= limit / magnitude;
   return taper * attraction +

@@ -4,17 +4,32 @@
 #include <string>
 
 #include "calligraphy/collision/active_stroke.hpp"
+#include "calligraphy/collision/nearest_point.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/render/force_law.hpp"
 #include "calligraphy/render/interaction_state.hpp"
 
 namespace calligraphy {
+namespace {
+
+// Elements of stroke `scene_stroke` (counted over the scene).
+std::size_t scene_element_count(const Scene& scene, std::size_t scene_stroke) {
+  for (const PlacedCharacter& c : scene.characters) {
+    if (scene_stroke < c.strokes.size()) return c.strokes[scene_stroke].elements.size();
+    scene_stroke -= c.strokes.size();
+  }
+  return 0;
+}
+
+}  // namespace
 
 TeacherReplay::TeacherReplay(const Scene& scene, std::span<const TeacherSample> samples,
                              const ForceLawParameters& force) {
   validate_teacher_trajectory(samples);
   times_s_.reserve(samples.size());
   positions_m_.reserve(samples.size());
+  elements_.assign(samples.size(), 0);
+  parameters_.assign(samples.size(), 0.0);
   for (const TeacherSample& s : samples) {
     times_s_.push_back(s.time_s);
     positions_m_.push_back(s.position_m.head<2>());
@@ -27,7 +42,8 @@ TeacherReplay::TeacherReplay(const Scene& scene, std::span<const TeacherSample> 
   InteractionState state = InteractionState::separation;
   double entered_s = samples.front().time_s;
   const double paper_z = scene.layout.paper_z_m;
-  for (const TeacherSample& s : samples) {
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const TeacherSample& s = samples[i];
     if (active.finished()) break;
     const Vec2 tip = s.position_m.head<2>();
     StateInputs inputs;
@@ -44,6 +60,11 @@ TeacherReplay::TeacherReplay(const Scene& scene, std::span<const TeacherSample> 
       if (active.advance(tip, force.feature_plane_margin_m).stroke_completed) {
         windows[index] = Window{entered_s, s.time_s};
         next = InteractionState::calibration;
+        elements_[i] = scene_element_count(scene, index) - 1;
+        parameters_[i] = 1.0;
+      } else {
+        elements_[i] = active.element_index();
+        parameters_[i] = nearest_point(*active.element(), tip, force.nearest).t;
       }
     }
     state = next;
@@ -77,6 +98,31 @@ Vec2 TeacherReplay::position(std::size_t scene_stroke, double elapsed_s) const n
   const double span = times_s_[i] - times_s_[i - 1];
   const double f = span > 0.0 ? (t - times_s_[i - 1]) / span : 1.0;
   return positions_m_[i - 1] + f * (positions_m_[i] - positions_m_[i - 1]);
+}
+
+}  // namespace calligraphy
+
+namespace calligraphy {
+
+Vec2 TeacherReplay::attraction_point(std::size_t scene_stroke, double elapsed_s, std::size_t element_index,
+                                     const StrokeElement& element) const noexcept {
+  if (scene_stroke >= windows_.size()) return element.start();
+  const Window& w = windows_[scene_stroke];
+  const double t = std::clamp(w.begin_s + std::max(elapsed_s, 0.0), w.begin_s, w.end_s);
+  // The last sample at or before t; within a window every sample has an element and a parameter.
+  auto upper = std::upper_bound(times_s_.begin(), times_s_.end(), t);
+  if (upper == times_s_.begin()) ++upper;
+  const auto i = static_cast<std::size_t>(upper - times_s_.begin()) - 1;
+  const std::size_t teacher_element = elements_[i];
+  if (teacher_element > element_index) return element.end();
+  if (teacher_element < element_index) return element.start();
+  double u = parameters_[i];
+  if (i + 1 < times_s_.size() && times_s_[i + 1] <= w.end_s && elements_[i + 1] == teacher_element &&
+      times_s_[i + 1] > times_s_[i]) {
+    const double f = std::clamp((t - times_s_[i]) / (times_s_[i + 1] - times_s_[i]), 0.0, 1.0);
+    u += f * (parameters_[i + 1] - u);
+  }
+  return element.point(u);
 }
 
 }  // namespace calligraphy

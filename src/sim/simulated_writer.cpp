@@ -79,6 +79,8 @@ struct SimulatedWriter::State {
     Vec2 start_m = Vec2::Zero();  // the true start in the writing direction
     bool mid_lift_reached = false;
     bool ended = true;
+    std::size_t display_at_start = 0;  // the active stroke (scene index) the writer saw when it set off
+    bool accepted = false;             // the writer has seen the display move past this stroke
   };
   enum class Next { plan, hint, redo };
 
@@ -145,6 +147,7 @@ struct SimulatedWriter::State {
   void end_attempt(double time_s, AttemptEnd why);
   void choose_next(double time_s);
   [[nodiscard]] PlannedStroke hinted() const;
+  [[nodiscard]] std::size_t seen_active() const;
   void start_attempt(const PlannedStroke& target, bool follows_hint, double time_s);
   Vec3 add_stray_touch(const PlacedCharacter& character, const Vec3& from);
 };
@@ -280,6 +283,13 @@ void SimulatedWriter::State::look(double time_s) {
   seen_character = seen->character;
   seen_stroke = seen->stroke;
   seen_finished = seen->finished;
+  // The display has moved past the stroke being written: it was accepted, and what the writer feels
+  // now (the paper outside the written stroke) is no refusal.
+  if (!attempt.ended && seen_active() > attempt.target.scene_stroke &&
+      attempt.display_at_start <= attempt.target.scene_stroke) {
+    attempt.accepted = true;
+    written[attempt.target.scene_stroke] = true;
+  }
 
   Vec2 error = Vec2::Zero();
   bool writing = false;
@@ -317,7 +327,7 @@ void SimulatedWriter::State::feel(const RenderOutput& output, double dt, double 
   }
   const Segment& s = program[current];
   const double along = s.length_m() * Segment::minimum_jerk(phase);
-  if (s.kind != SegmentKind::write || along >= s.follow_from_m) {
+  if (s.kind != SegmentKind::write || along >= s.follow_from_m || attempt.accepted) {
     resisted_s = 0.0;
     return;
   }
@@ -359,6 +369,12 @@ void SimulatedWriter::State::break_off(double time_s, AttemptEnd why, Next then)
   next = then;
   redo_target = attempt.target;
   update_rate();
+}
+
+// The active stroke as last seen, counted over the scene (the stroke count once finished).
+std::size_t SimulatedWriter::State::seen_active() const {
+  if (seen_finished || seen_character >= first_scene_stroke.size()) return written.size();
+  return first_scene_stroke[seen_character] + seen_stroke;
 }
 
 PlannedStroke SimulatedWriter::State::hinted() const {
@@ -477,6 +493,7 @@ void SimulatedWriter::State::start_attempt(const PlannedStroke& target, bool fol
   attempt.log_index = log.attempts.size() - 1;
   attempt.ended = false;
   attempt.start_m = reversed ? ref.end() : ref.start();
+  attempt.display_at_start = seen_active();
 
   const std::size_t elements = ref.elements.size();
   const Vec2 centre = character.bounding_box.center();

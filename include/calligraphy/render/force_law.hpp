@@ -37,20 +37,28 @@ struct ForceLawParameters {
   /// recorded trial's trace: `TrialSample::time_s`, `position_m`). Read at renderer construction
   /// (teacher_replay.hpp); ignored in the other modes.
   std::vector<TeacherSample> teacher_trajectory;
+  /// Replay only: the spring towards the teacher's point pulls at most as hard as it does at this
+  /// distance [m], in (0, R_res]: K_et a d_max. The point may lead or trail the pen along the stroke by
+  /// more (a trainee slower than the teacher); the bound keeps the pull moderate and the force step
+  /// small when a pen held back that hard crosses the taper band at the edge of R_res.
+  double replay_max_lead_m = 0.003;
   /// Resistance against writing off the active stroke [N s/m] >= 0: under guidance, a damper
   /// -B v on in-plane motion in CS (touching inside the active character's box but not writing the
   /// active stroke: a stroke out of order, a stroke started from its end, a stroke continued after a
   /// lift). The paper's resistance of Fig. 4 extended from the direction within a stroke to the order of
   /// the strokes (section 2.2; section 6: the active stroke masks the others). 0 = the paper's CS
   /// (normal force only).
-  double off_stroke_damping_n_s_per_m = 40.0;
+  double off_stroke_damping_n_s_per_m = 25.0;
   /// Speed [m/s] > 0 below which the off-stroke resistance is off; it ramps in (smoothstep) up to twice
   /// this speed, so that a pen at rest or creeping in CS feels only the paper.
   double off_stroke_speed_m_s = 0.005;
   /// Cut-off [Hz] > 0 of the first-order low-pass on the velocity the off-stroke resistance acts on, so
   /// that encoder noise in the velocity (one 23 um quantum at 1 kHz is a 23 mm/s spike) does not come
-  /// through a damper this stiff as force steps; a low-passed damper B / (1 + s / w_c) stays passive.
-  double off_stroke_velocity_cutoff_hz = 10.0;
+  /// through the damper as force steps. Not lower: above the cut-off a low-passed damper B / (1 + s /
+  /// w_c) acts like a spring B w_c on the pen's mass (at 10 Hz and 40 N s/m a 2.5 kN/m spring, which
+  /// rang at about 20 Hz on the simulated device); at 30 Hz and 25 N s/m the pen with a relaxed hand
+  /// keeps a damping ratio of about 0.6.
+  double off_stroke_velocity_cutoff_hz = 30.0;
 
   // Smoothness (paper section 6, sources of instability; docs/force-rendering.md).
   /// Band at the edge of the constraint space over which F_et tapers to zero [m], in [0, R_res]: F_et
