@@ -230,13 +230,25 @@ RenderOutput Renderer::tick(const DeviceState& device) noexcept {
   } else {
     foot_valid_ = false;
   }
-  const bool off_stroke = state_ == InteractionState::calibration;
+  // Off-stroke resistance: in CS against any in-plane motion; in WS outside the active element's
+  // constraint space against motion away from the element (a stroke that set off from the active
+  // start in another direction), never against coming back to it.
   off_stroke_velocity_ += off_stroke_alpha_ * (device.velocity_m_s.head<2>() - off_stroke_velocity_);
-  if (off_stroke && parameters_.guidance) {
+  const bool off_in_calibration = state_ == InteractionState::calibration;
+  const bool off_in_writing = writing && !out.in_constraint_space;
+  if (parameters_.guidance && off_in_calibration) {
     target = off_stroke_resistance(off_stroke_velocity_, parameters_.off_stroke_damping_n_s_per_m,
                                    parameters_.off_stroke_speed_m_s);
+  } else if (parameters_.guidance && off_in_writing) {
+    const Vec2 away = tip - out.foot_m;
+    const double distance = away.norm();
+    const double outward = distance > 0.0 ? std::max(0.0, off_stroke_velocity_.dot(away) / distance) : 0.0;
+    if (outward > 0.0) {
+      target = off_stroke_resistance(outward * away / distance, parameters_.off_stroke_damping_n_s_per_m,
+                                     parameters_.off_stroke_speed_m_s);
+    }
   }
-  const bool off_stroke_changed = off_stroke != (state_before == InteractionState::calibration);
+  const bool off_stroke_changed = off_in_calibration != (state_before == InteractionState::calibration);
   if (element_changed || off_stroke_changed || out.in_constraint_space != was_inside_) {
     fade_from_ = guidance_;
     fade_elapsed_s_ = 0.0;

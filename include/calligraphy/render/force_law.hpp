@@ -42,12 +42,14 @@ struct ForceLawParameters {
   /// more (a trainee slower than the teacher); the bound keeps the pull moderate and the force step
   /// small when a pen held back that hard crosses the taper band at the edge of R_res.
   double replay_max_lead_m = 0.003;
-  /// Resistance against writing off the active stroke [N s/m] >= 0: under guidance, a damper
-  /// -B v on in-plane motion in CS (touching inside the active character's box but not writing the
-  /// active stroke: a stroke out of order, a stroke started from its end, a stroke continued after a
-  /// lift). The paper's resistance of Fig. 4 extended from the direction within a stroke to the order of
-  /// the strokes (section 2.2; section 6: the active stroke masks the others). 0 = the paper's CS
-  /// (normal force only).
+  /// Resistance against writing off the active stroke [N s/m] >= 0: under guidance, a damper -B v on
+  /// in-plane motion in CS (touching inside the active character's box but not writing the active
+  /// stroke: a stroke out of order, a stroke started from its end, a stroke continued after a lift),
+  /// and in WS outside the constraint space on the part of the motion that leads away from the active
+  /// element (a stroke that set off from the active start in another direction). The paper's
+  /// resistance of Fig. 4 extended from the direction within a stroke to the order of the strokes
+  /// (section 2.2; section 6: the active stroke masks the others). 0 = the paper's CS (normal force
+  /// only) and no in-plane force outside R_res.
   double off_stroke_damping_n_s_per_m = 25.0;
   /// Speed [m/s] > 0 below which the off-stroke resistance is off; it ramps in (smoothstep) up to twice
   /// this speed, so that a pen at rest or creeping in CS feels only the paper.
