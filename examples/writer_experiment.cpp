@@ -34,7 +34,9 @@ struct Run {
   bool guidance = false;
   std::uint64_t seed = 0;
   double deviation_mm = 0.0;  // pooled over the matched strokes of the trace
-  double time_s = 0.0;        // first to last pen-down sample
+  double renderer_deviation_mm =
+      0.0;              // the trial recorder's: WS ticks of each accepted stroke's last attempt
+  double time_s = 0.0;  // first to last pen-down sample
   std::size_t order_errors = 0;
   std::size_t backwards = 0;
   bool in_order = false;  // the renderer accepted every stroke, each in its turn
@@ -83,6 +85,7 @@ Run run_trial(const Scene& scene, const WriterProfile& profile, bool guidance, s
   run.guidance = guidance;
   run.seed = seed;
   run.deviation_mm = score.totals.deviation ? score.totals.deviation->mean_m * 1e3 : std::nan("");
+  run.renderer_deviation_mm = recorder.metrics().mean_deviation_m * 1e3;
   run.time_s = score.totals.total_time_s;
   run.order_errors = score.order_errors;
   run.backwards = score.backwards_strokes;
@@ -195,21 +198,23 @@ int main(int argc, char** argv) {
     }
     if (!csv.empty()) {
       std::ofstream out(csv);
-      out << "character,code_point,profile,guidance,seed,mean_deviation_mm,writing_time_s,order_errors,"
-             "backwards_strokes,completed_in_order,refusals\n";
+      out << "character,code_point,profile,guidance,seed,mean_deviation_mm,renderer_deviation_mm,writing_"
+             "time_s,"
+             "order_errors,backwards_strokes,completed_in_order,refusals\n";
       for (const Run& r : runs) {
         char line[256];
-        std::snprintf(line, sizeof line, "%s,U+%04X,%s,%d,%llu,%.4f,%.3f,%zu,%zu,%d,%zu\n",
+        std::snprintf(line, sizeof line, "%s,U+%04X,%s,%d,%llu,%.4f,%.4f,%.3f,%zu,%zu,%d,%zu\n",
                       utf8(r.character).c_str(), static_cast<unsigned>(r.character), r.profile.c_str(),
-                      r.guidance ? 1 : 0, static_cast<unsigned long long>(r.seed), r.deviation_mm, r.time_s,
-                      r.order_errors, r.backwards, r.in_order ? 1 : 0, r.refusals);
+                      r.guidance ? 1 : 0, static_cast<unsigned long long>(r.seed), r.deviation_mm,
+                      r.renderer_deviation_mm, r.time_s, r.order_errors, r.backwards, r.in_order ? 1 : 0,
+                      r.refusals);
         out << line;
       }
     }
 
     // Paired comparisons, novice: guidance on against off for the same character and seed.
-    std::vector<double> dev_off, dev_on, time_off, time_on, time_ratio;
-    std::size_t pairs = 0, dev_lower = 0, time_lower = 0;
+    std::vector<double> dev_off, dev_on, rdev_off, rdev_on, time_off, time_on, time_ratio;
+    std::size_t pairs = 0, dev_lower = 0, rdev_lower = 0, time_lower = 0;
     for (const Run& r : runs) {
       if (r.profile != "novice" || r.guidance) continue;
       const Run* on = find(runs, r.character, "novice", true, r.seed);
@@ -217,6 +222,9 @@ int main(int argc, char** argv) {
       ++pairs;
       dev_off.push_back(r.deviation_mm);
       dev_on.push_back(on->deviation_mm);
+      rdev_off.push_back(r.renderer_deviation_mm);
+      rdev_on.push_back(on->renderer_deviation_mm);
+      if (on->renderer_deviation_mm < r.renderer_deviation_mm) ++rdev_lower;
       time_off.push_back(r.time_s);
       time_on.push_back(on->time_s);
       time_ratio.push_back(on->time_s / r.time_s);
@@ -249,13 +257,18 @@ int main(int argc, char** argv) {
                 static_cast<unsigned long long>(seeds), runs.size());
     std::printf("novice, %zu pairs (same character and seed):\n", pairs);
     std::printf(
-        "  guidance lowers the mean deviation in %zu of %zu (%.1f %%)\n", dev_lower, pairs,
+        "  guidance lowers the trace-scored mean deviation in %zu of %zu (%.1f %%)\n", dev_lower, pairs,
         100.0 * static_cast<double>(dev_lower) / static_cast<double>(std::max<std::size_t>(pairs, 1)));
+    std::printf(
+        "  guidance lowers the recorder's mean deviation in %zu of %zu (%.1f %%)\n", rdev_lower, pairs,
+        100.0 * static_cast<double>(rdev_lower) / static_cast<double>(std::max<std::size_t>(pairs, 1)));
     std::printf(
         "  guidance lowers the writing time in %zu of %zu (%.1f %%)\n", time_lower, pairs,
         100.0 * static_cast<double>(time_lower) / static_cast<double>(std::max<std::size_t>(pairs, 1)));
     show("mean deviation off [mm]", spread(dev_off));
     show("mean deviation on [mm]", spread(dev_on));
+    show("recorder's deviation off [mm]", spread(rdev_off));
+    show("recorder's deviation on [mm]", spread(rdev_on));
     show("writing time off [s]", spread(time_off));
     show("writing time on [s]", spread(time_on));
     show("time on / time off", spread(time_ratio));

@@ -215,25 +215,37 @@ TEST_CASE("In the replay mode the attraction point moves at the teacher's pace",
         force.guidance_stiffness_n_per_m * force.replay_max_lead_m * (1.0 + 1e-9));
 }
 
-TEST_CASE("Off-stroke resistance opposes motion in CS under guidance only", "[guidance]") {
+TEST_CASE("Off-stroke resistance: friction in CS, a damper on leaving the element in WS, under guidance only",
+          "[guidance]") {
   const Scene scene = one_stroke_scene();
   const double z = scene.layout.paper_z_m - 0.0005;
-  const Vec2 velocity(0.0, 0.02);  // 20 mm/s across the character, away from the stroke start
+  const double metres_per_unit = scene.characters[0].placement.metres_per_unit;
   ForceLawParameters force = exact();
-  force.off_stroke_velocity_cutoff_hz = 1e4;  // no filter lag, for an exact single tick
   for (const bool guidance : {true, false}) {
     force.guidance = guidance;
     Renderer r(scene, force, simulated_phantom_desktop_info(), exact_options());
-    RenderOutput out;
-    for (int k = 0; k < 5; ++k) out = r.tick(at(scene, {500, 560}, z, 1e-3 * k, velocity));
+    // Touch down in CS, away from the start, and slide +y by 0.25 mm per tick.
+    RenderOutput out = r.tick(at(scene, {500, 560}, z));
+    REQUIRE(out.state == InteractionState::calibration);
+    CHECK(out.force_n.head<2>().norm() < 1e-12);  // held where it touched down
+    out = r.tick(at(scene, {500, 560 + 0.0005 / metres_per_unit}, z, 1e-3));
+    if (guidance) {
+      CHECK(out.force_n.y() == Approx(-0.5 * force.off_stroke_force_n));  // half the travel: half the force
+    }
+    for (int k = 2; k < 10; ++k)
+      out = r.tick(at(scene, {500, 560 + 0.00025 * k / metres_per_unit}, z, 1e-3 * k));
     REQUIRE(out.state == InteractionState::calibration);
     if (guidance) {
-      CHECK(out.force_n.y() == Approx(-force.off_stroke_damping_n_s_per_m * velocity.y()));
+      CHECK(out.force_n.y() == Approx(-force.off_stroke_force_n));  // dragged: the full force, at any speed
       CHECK(std::abs(out.force_n.x()) < 1e-9);
     } else {
       CHECK(out.force_n.head<2>().norm() < 1e-9);
     }
   }
+  Vec2 anchor(0.0, 0.0);
+  CHECK(off_stroke_friction(Vec2(0.0005, 0.0), anchor, 0.5, 0.001).x() == Approx(-0.25));
+  CHECK(off_stroke_friction(Vec2(0.003, 0.0), anchor, 0.5, 0.001).x() == Approx(-0.5));
+  CHECK(anchor.x() == Approx(0.002));
   CHECK(off_stroke_resistance(Vec2(0.004, 0.0), 40.0, 0.005).norm() == 0.0);  // below the threshold speed
   CHECK(off_stroke_resistance(Vec2(0.01, 0.0), 40.0, 0.005).x() == Approx(-0.4));
 }

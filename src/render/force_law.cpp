@@ -28,6 +28,8 @@ void ForceLawParameters::validate() const {
   check(max_foot_speed_m_s, "max_foot_speed_m_s", true);
   check(friction_coefficient, "friction_coefficient", false);
   check(friction_stick_speed_m_s, "friction_stick_speed_m_s", true);
+  check(off_stroke_force_n, "off_stroke_force_n", false);
+  check(off_stroke_travel_m, "off_stroke_travel_m", true);
   check(off_stroke_damping_n_s_per_m, "off_stroke_damping_n_s_per_m", false);
   check(off_stroke_speed_m_s, "off_stroke_speed_m_s", true);
   check(off_stroke_velocity_cutoff_hz, "off_stroke_velocity_cutoff_hz", true);
@@ -76,6 +78,14 @@ double constraint_taper(double distance_m, double radius_m, double band_m) noexc
   if (band_m <= 0.0 || distance_m <= radius_m - band_m) return 1.0;
   const double u = (radius_m - distance_m) / band_m;  // 0 at the edge, 1 at the inner side of the band
   return u * u * (3.0 - 2.0 * u);
+}
+
+Vec2 off_stroke_friction(const Vec2& tip_m, Vec2& anchor_m, double force_n, double travel_m) noexcept {
+  if (!(travel_m > 0.0)) return Vec2::Zero();
+  const Vec2 stretch = tip_m - anchor_m;
+  const double length = stretch.norm();
+  if (length > travel_m) anchor_m = tip_m - stretch * (travel_m / length);  // the pen drags the point along
+  return (force_n / travel_m) * (anchor_m - tip_m);
 }
 
 Vec2 off_stroke_resistance(const Vec2& velocity_m_s, double damping_n_s_per_m,

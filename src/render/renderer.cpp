@@ -112,6 +112,7 @@ void Renderer::reset() noexcept {
   was_inside_ = false;
   writing_since_s_ = 0.0;
   off_stroke_velocity_ = Vec2::Zero();
+  anchor_valid_ = false;
 }
 
 // F_et (eq. 8) with the taper at R_res and a rate-limited foot point, plus the resistance force, for
@@ -230,15 +231,18 @@ RenderOutput Renderer::tick(const DeviceState& device) noexcept {
   } else {
     foot_valid_ = false;
   }
-  // Off-stroke resistance: in CS against any in-plane motion; in WS outside the active element's
-  // constraint space against motion away from the element (a stroke that set off from the active
-  // start in another direction), never against coming back to it.
+  // Off-stroke resistance: in CS a friction against any in-plane motion; in WS outside the active
+  // element's constraint space a damper against motion away from the element (a stroke that set off
+  // from the active start in another direction), never against coming back to it.
   off_stroke_velocity_ += off_stroke_alpha_ * (device.velocity_m_s.head<2>() - off_stroke_velocity_);
   const bool off_in_calibration = state_ == InteractionState::calibration;
   const bool off_in_writing = writing && !out.in_constraint_space;
+  if (!off_in_calibration) anchor_valid_ = false;
   if (parameters_.guidance && off_in_calibration) {
-    target = off_stroke_resistance(off_stroke_velocity_, parameters_.off_stroke_damping_n_s_per_m,
-                                   parameters_.off_stroke_speed_m_s);
+    if (!anchor_valid_) off_stroke_anchor_ = tip;  // adheres where CS was entered
+    anchor_valid_ = true;
+    target = off_stroke_friction(tip, off_stroke_anchor_, parameters_.off_stroke_force_n,
+                                 parameters_.off_stroke_travel_m);
   } else if (parameters_.guidance && off_in_writing) {
     const Vec2 away = tip - out.foot_m;
     const double distance = away.norm();

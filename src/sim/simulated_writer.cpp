@@ -390,9 +390,16 @@ void SimulatedWriter::State::choose_next(double time_s) {
     done = true;
     return;
   }
+  // Once the display has refused a stroke the writer knows it keeps the order, and takes every stroke
+  // before the one it hints as written (also one the display took from a stroke the writer meant as
+  // another: a stroke out of order that passed the active stroke's feature planes).
+  if (log.refusals > 0) {
+    for (std::size_t k = 0; k < seen_active() && k < written.size(); ++k) written[k] = true;
+  }
   PlannedStroke target;
   bool follows_hint = false;
-  if (next == Next::hint) {
+  if (next == Next::hint || (next == Next::plan && log.refusals > 0)) {
+    // After a refusal the writer has learnt that the display leads, and writes what it hints.
     target = hinted();
     follows_hint = true;
   } else if (next == Next::redo) {
@@ -400,16 +407,11 @@ void SimulatedWriter::State::choose_next(double time_s) {
   } else {
     const auto open = std::find_if(plan.begin(), plan.end(),
                                    [&](const PlannedStroke& p) { return !written[p.scene_stroke]; });
-    if (open != plan.end()) {
-      target = *open;
-    } else if (log.refusals > 0) {
-      // The display has refused a stroke before, so the writer trusts its hint until it is finished.
-      target = hinted();
-      follows_hint = true;
-    } else {
+    if (open == plan.end()) {  // its own plan written, and nothing ever refused
       done = true;
       return;
     }
+    target = *open;
   }
   next = Next::plan;
   start_attempt(target, follows_hint, time_s);

@@ -42,24 +42,32 @@ struct ForceLawParameters {
   /// more (a trainee slower than the teacher); the bound keeps the pull moderate and the force step
   /// small when a pen held back that hard crosses the taper band at the edge of R_res.
   double replay_max_lead_m = 0.003;
-  /// Resistance against writing off the active stroke [N s/m] >= 0: under guidance, a damper -B v on
-  /// in-plane motion in CS (touching inside the active character's box but not writing the active
-  /// stroke: a stroke out of order, a stroke started from its end, a stroke continued after a lift),
-  /// and in WS outside the constraint space on the part of the motion that leads away from the active
-  /// element (a stroke that set off from the active start in another direction). The paper's
-  /// resistance of Fig. 4 extended from the direction within a stroke to the order of the strokes
-  /// (section 2.2; section 6: the active stroke masks the others). 0 = the paper's CS (normal force
-  /// only) and no in-plane force outside R_res.
+  // Off-stroke resistance (docs/force-rendering.md): under guidance, writing off the active stroke is
+  // felt. The paper's resistance of Fig. 4 extended from the direction within a stroke to the order of
+  // the strokes (section 2.2; section 6: the active stroke masks the others). Both parts 0 = the
+  // paper (CS: normal force only; WS: no in-plane force outside R_res).
+  /// In CS (touching inside the active character's box, not writing the active stroke: a stroke out
+  /// of order, a stroke started from its end, a stroke continued after a lift), a friction of this
+  /// force [N] >= 0 against in-plane motion, rendered with an adhesion point (Hayward & Armstrong
+  /// 2000): a spring to a point that the pen drags along once it is `off_stroke_travel_m` away, so the
+  /// force is the same at any speed and the pen at rest is simply held.
+  double off_stroke_force_n = 0.5;
+  /// Travel [m] > 0 before the off-stroke friction reaches its force (spring off_stroke_force_n /
+  /// off_stroke_travel_m: 500 N/m by default, below Colgate's bound at 1 kHz and more).
+  double off_stroke_travel_m = 0.001;
+  /// In WS outside the constraint space, a damper [N s/m] >= 0 on the part of the in-plane velocity
+  /// that leads away from the active element (a stroke that set off from the active start in another
+  /// direction), never on coming back to it.
   double off_stroke_damping_n_s_per_m = 25.0;
-  /// Speed [m/s] > 0 below which the off-stroke resistance is off; it ramps in (smoothstep) up to twice
-  /// this speed, so that a pen at rest or creeping in CS feels only the paper.
+  /// Speed [m/s] > 0 below which that damper is off; it ramps in (smoothstep) up to twice this speed,
+  /// so that a pen at rest or creeping feels only the paper.
   double off_stroke_speed_m_s = 0.005;
-  /// Cut-off [Hz] > 0 of the first-order low-pass on the velocity the off-stroke resistance acts on, so
-  /// that encoder noise in the velocity (one 23 um quantum at 1 kHz is a 23 mm/s spike) does not come
-  /// through the damper as force steps. Not lower: above the cut-off a low-passed damper B / (1 + s /
-  /// w_c) acts like a spring B w_c on the pen's mass (at 10 Hz and 40 N s/m a 2.5 kN/m spring, which
-  /// rang at about 20 Hz on the simulated device); at 30 Hz and 25 N s/m the pen with a relaxed hand
-  /// keeps a damping ratio of about 0.6.
+  /// Cut-off [Hz] > 0 of the first-order low-pass on the velocity the damper acts on, so that encoder
+  /// noise in the velocity (one 23 um quantum at 1 kHz is a 23 mm/s spike) does not come through it
+  /// as force steps. Not lower: above the cut-off a low-passed damper B / (1 + s / w_c) acts like a
+  /// spring B w_c on the pen's mass (at 10 Hz and 40 N s/m a 2.5 kN/m spring, which rang at about
+  /// 20 Hz on the simulated device); at 30 Hz and 25 N s/m the pen with a relaxed hand keeps a damping
+  /// ratio of about 0.6.
   double off_stroke_velocity_cutoff_hz = 30.0;
 
   // Smoothness (paper section 6, sources of instability; docs/force-rendering.md).
@@ -119,7 +127,13 @@ struct ForceLawParameters {
 /// distance >= R, a smoothstep between; band 0 gives the step 1 -> 0 at R. Lengths [m].
 [[nodiscard]] double constraint_taper(double distance_m, double radius_m, double band_m) noexcept;
 
-/// Off-stroke resistance: -B v w(|v|) [N] in the paper plane, w a smoothstep from 0 at |v| = v0 to 1 at
+/// Off-stroke friction with an adhesion point (Hayward & Armstrong 2000): moves `anchor_m` towards the
+/// tip until it is at most `travel_m` away, and returns the spring force (force_n / travel_m) (anchor -
+/// tip) [N], at most force_n. Lengths [m], force [N]; travel_m > 0.
+[[nodiscard]] Vec2 off_stroke_friction(const Vec2& tip_m, Vec2& anchor_m, double force_n,
+                                       double travel_m) noexcept;
+
+/// Off-stroke damper: -B v w(|v|) [N] in the paper plane, w a smoothstep from 0 at |v| = v0 to 1 at
 /// 2 v0; in-plane velocity [m/s], B [N s/m], v0 [m/s] > 0.
 [[nodiscard]] Vec2 off_stroke_resistance(const Vec2& velocity_m_s, double damping_n_s_per_m,
                                          double threshold_speed_m_s) noexcept;

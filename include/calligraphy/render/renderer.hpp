@@ -92,8 +92,10 @@ class Renderer {
   NearestPointTracker tracker_;
   TeacherReplay replay_;
   double writing_since_s_ = 0.0;  // device time at which WS was entered on the active stroke (replay clock)
-  Vec2 off_stroke_velocity_ = Vec2::Zero();  // low-passed in-plane velocity for the off-stroke resistance
-  double off_stroke_alpha_ = 1.0;            // its filter coefficient per tick
+  Vec2 off_stroke_velocity_ = Vec2::Zero();  // low-passed in-plane velocity for the off-stroke damper
+  Vec2 off_stroke_anchor_ = Vec2::Zero();    // adhesion point of the off-stroke friction in CS
+  bool anchor_valid_ = false;
+  double off_stroke_alpha_ = 1.0;  // its filter coefficient per tick
   // Smoothing state.
   Vec2 rendered_foot_ = Vec2::Zero();  // attraction target, rate-limited towards the tracked foot
   bool foot_valid_ = false;

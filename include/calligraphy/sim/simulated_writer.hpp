@@ -6,7 +6,7 @@
 ///    force, Harris & Wolpert 1998) holds the stylus; x_d moves in minimum-jerk segments (Flash & Hogan
 ///    1985) along the writer's own, biased copy of each stroke (offset, mis-scale, per-attempt jitter).
 ///  - Vision: the writer sees its pen and the display a visuomotor delay late (about 120 ms; Miall,
-///    Weir, Wolpert & Stein 1993; Saunders & Knill 2003), corrects x_d towards the reference stroke when
+///    Weir, Wolpert & Stein 1993; Saunders & Knill 2005: corrections across the path within 117 ms), corrects x_d towards the reference stroke when
 ///    the seen error exceeds its tolerance, and paces itself by the seen error with the steering law's
 ///    local form v = (W - 2|e|) / tau (Accot & Zhai 1997): a pen that guidance holds on the stroke is
 ///    written faster.

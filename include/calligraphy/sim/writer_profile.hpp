@@ -35,7 +35,7 @@ struct WriterProfile {
 
   // Closed loop: the writer sees its pen and the reference late, corrects, and paces itself.
   double visual_delay_s =
-      0.12;  ///< visuomotor delay [s], in [0, 0.5] (Miall et al. 1993; Saunders & Knill 2003)
+      0.12;  ///< visuomotor delay [s], in [0, 0.5] (Miall et al. 1993; Saunders & Knill 2005)
   double vision_period_s = 0.01;  ///< interval between visual updates [s], in [0.001, 0.1]
   double correction_rate_per_s =
       4.0;  ///< rate at which a seen error beyond the tolerance is removed [1/s], >= 0
