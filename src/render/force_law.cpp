@@ -28,6 +28,21 @@ void ForceLawParameters::validate() const {
   check(max_foot_speed_m_s, "max_foot_speed_m_s", true);
   check(friction_coefficient, "friction_coefficient", false);
   check(friction_stick_speed_m_s, "friction_stick_speed_m_s", true);
+  check(off_stroke_force_n, "off_stroke_force_n", false);
+  check(off_stroke_travel_m, "off_stroke_travel_m", true);
+  check(off_stroke_damping_n_s_per_m, "off_stroke_damping_n_s_per_m", false);
+  check(off_stroke_speed_m_s, "off_stroke_speed_m_s", true);
+  check(off_stroke_velocity_cutoff_hz, "off_stroke_velocity_cutoff_hz", true);
+  if (!(guidance_gain >= 0.0 && guidance_gain <= 1.0)) {
+    throw InvalidArgument("ForceLawParameters.guidance_gain = " + std::to_string(guidance_gain) +
+                          " must be in [0, 1]");
+  }
+  if (guidance_mode == GuidanceMode::replay) validate_teacher_trajectory(teacher_trajectory);
+  if (!(replay_max_lead_m > 0.0 && replay_max_lead_m <= constraint_radius_m)) {
+    throw InvalidArgument("ForceLawParameters.replay_max_lead_m = " + std::to_string(replay_max_lead_m) +
+                          " must be in (0, constraint_radius_m = " + std::to_string(constraint_radius_m) +
+                          "]");
+  }
   if (constraint_taper_m > constraint_radius_m) {
     throw InvalidArgument("ForceLawParameters.constraint_taper_m = " + std::to_string(constraint_taper_m) +
                           " must not exceed constraint_radius_m = " + std::to_string(constraint_radius_m));
@@ -63,6 +78,21 @@ double constraint_taper(double distance_m, double radius_m, double band_m) noexc
   if (band_m <= 0.0 || distance_m <= radius_m - band_m) return 1.0;
   const double u = (radius_m - distance_m) / band_m;  // 0 at the edge, 1 at the inner side of the band
   return u * u * (3.0 - 2.0 * u);
+}
+
+Vec2 off_stroke_friction(const Vec2& tip_m, Vec2& anchor_m, double force_n, double travel_m) noexcept {
+  if (!(travel_m > 0.0)) return Vec2::Zero();
+  const Vec2 stretch = tip_m - anchor_m;
+  const double length = stretch.norm();
+  if (length > travel_m) anchor_m = tip_m - stretch * (travel_m / length);  // the pen drags the point along
+  return (force_n / travel_m) * (anchor_m - tip_m);
+}
+
+Vec2 off_stroke_resistance(const Vec2& velocity_m_s, double damping_n_s_per_m,
+                           double threshold_speed_m_s) noexcept {
+  if (!(threshold_speed_m_s > 0.0)) return Vec2::Zero();
+  const double u = std::clamp(velocity_m_s.norm() / threshold_speed_m_s - 1.0, 0.0, 1.0);
+  return -damping_n_s_per_m * u * u * (3.0 - 2.0 * u) * velocity_m_s;
 }
 
 Vec3 clamp_force(const Vec3& force_n, double max_force_n) noexcept {

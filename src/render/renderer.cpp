@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <string>
 
 #include "calligraphy/collision/constraint_space.hpp"
@@ -60,6 +61,11 @@ Renderer::Renderer(const Scene& scene, const ForceLawParameters& parameters, con
       chain_(chain_parameters(options, checked(device)), options.rate_hz),
       passivity_(options.passivity, options.rate_hz) {
   parameters_.validate();
+  if (parameters_.guidance_mode == GuidanceMode::replay) {
+    replay_ = TeacherReplay(scene, parameters_.teacher_trajectory, parameters_);
+  }
+  off_stroke_alpha_ =
+      1.0 - std::exp(-2.0 * std::numbers::pi * parameters_.off_stroke_velocity_cutoff_hz * period_s_);
   const double k_paper = parameters_.paper_stiffness_n_per_m;
   const double k_guidance = parameters_.guidance_stiffness_n_per_m;
   const double k_max = device.max_stiffness_n_per_m;
@@ -103,6 +109,9 @@ void Renderer::reset() noexcept {
   guidance_ = fade_from_ = Vec2::Zero();
   fade_elapsed_s_ = 0.0;
   was_inside_ = false;
+  writing_since_s_ = 0.0;
+  off_stroke_velocity_ = Vec2::Zero();
+  anchor_valid_ = false;
 }
 
 // F_et (eq. 8) with the taper at R_res and a rate-limited foot point, plus the resistance force, for
@@ -120,22 +129,39 @@ Vec2 Renderer::guidance_force(const DeviceState& device, RenderOutput& out, bool
   out.foot_m = nearest.foot;
   // Foot-point jumps (a new element, a jump of the tracker to another minimum) move the attraction
   // target at a bounded speed instead of stepping the force.
+  // In the replay mode the attraction point is where the teacher was, as many seconds into the stroke as
+  // the pen has been writing it, kept on the active element, with the same bounded speed.
+  const Vec2 attraction_point =
+      parameters_.guidance_mode == GuidanceMode::replay
+          ? replay_.attraction_point(active_.strokes_written(), device.time_s - writing_since_s_,
+                                     active_.element_index(), element)
+          : nearest.foot;
   const double max_move = parameters_.max_foot_speed_m_s * period_s_;
-  const Vec2 move = nearest.foot - rendered_foot_;
+  const Vec2 move = attraction_point - rendered_foot_;
   if (!foot_valid_ || element_changed) {
-    rendered_foot_ = nearest.foot;
+    rendered_foot_ = attraction_point;
   } else if (move.norm() > max_move) {
     rendered_foot_ += move * (max_move / move.norm());
   } else {
-    rendered_foot_ = nearest.foot;
+    rendered_foot_ = attraction_point;
   }
   foot_valid_ = true;
   if (!parameters_.guidance || !contact.inside) return Vec2::Zero();
   const double taper =
       constraint_taper(nearest.distance, parameters_.constraint_radius_m, parameters_.constraint_taper_m);
   const Vec2 tangent = element.unit_tangent(nearest.t);
-  return taper * attraction_force(tip, rendered_foot_, parameters_.guidance_stiffness_n_per_m,
-                                  active_.attraction(nearest.t)) +
+  const double gain = parameters_.guidance_mode == GuidanceMode::fading ? parameters_.guidance_gain : 1.0;
+  const double factor = gain * active_.attraction(nearest.t);
+  Vec2 attraction = attraction_force(tip, rendered_foot_, parameters_.guidance_stiffness_n_per_m, factor);
+  // The replay point may lead or trail the pen along the stroke by more than R_res: the spring is
+  // saturated at its force at replay_max_lead_m, so the force stays bounded and continuous. (The foot
+  // point of the other modes is never further than R_res.)
+  const double reach = parameters_.guidance_mode == GuidanceMode::replay ? parameters_.replay_max_lead_m
+                                                                         : parameters_.constraint_radius_m;
+  const double limit = parameters_.guidance_stiffness_n_per_m * factor * reach;
+  const double magnitude = attraction.norm();
+  if (magnitude > limit) attraction *= limit / magnitude;
+  return taper * attraction +
          resistance_force(device.velocity_m_s.head<2>(), tangent, parameters_.resistance_damping_n_s_per_m);
 }
 
@@ -172,6 +198,8 @@ RenderOutput Renderer::tick(const DeviceState& device) noexcept {
       next = InteractionState::calibration;  // written; the next stroke starts at its own neighbourhood
     }
   }
+  if (next == InteractionState::writing && state_ != InteractionState::writing)
+    writing_since_s_ = device.time_s;
   out.state_changed = next != state_;
   state_ = next;
   const bool writing = state_ == InteractionState::writing && !active_.finished();
@@ -195,14 +223,36 @@ RenderOutput Renderer::tick(const DeviceState& device) noexcept {
   }
   force *= paper_weight_;
 
-  // In-plane guidance, cross-faded when its source changes (element, stroke, character, WS, inside).
+  // In-plane guidance, cross-faded when its source changes (element, stroke, character, WS, CS, inside).
   Vec2 target = Vec2::Zero();
   if (writing) {
     target = guidance_force(device, out, element_changed);
   } else {
     foot_valid_ = false;
   }
-  if (element_changed || out.in_constraint_space != was_inside_) {
+  // Off-stroke resistance: in CS a friction against any in-plane motion; in WS outside the active
+  // element's constraint space a damper against motion away from the element (a stroke that set off
+  // from the active start in another direction), never against coming back to it.
+  off_stroke_velocity_ += off_stroke_alpha_ * (device.velocity_m_s.head<2>() - off_stroke_velocity_);
+  const bool off_in_calibration = state_ == InteractionState::calibration;
+  const bool off_in_writing = writing && !out.in_constraint_space;
+  if (!off_in_calibration) anchor_valid_ = false;
+  if (parameters_.guidance && off_in_calibration) {
+    if (!anchor_valid_) off_stroke_anchor_ = tip;  // adheres where CS was entered
+    anchor_valid_ = true;
+    target = off_stroke_friction(tip, off_stroke_anchor_, parameters_.off_stroke_force_n,
+                                 parameters_.off_stroke_travel_m);
+  } else if (parameters_.guidance && off_in_writing) {
+    const Vec2 away = tip - out.foot_m;
+    const double distance = away.norm();
+    const double outward = distance > 0.0 ? std::max(0.0, off_stroke_velocity_.dot(away) / distance) : 0.0;
+    if (outward > 0.0) {
+      target = off_stroke_resistance(outward * away / distance, parameters_.off_stroke_damping_n_s_per_m,
+                                     parameters_.off_stroke_speed_m_s);
+    }
+  }
+  const bool off_stroke_changed = off_in_calibration != (state_before == InteractionState::calibration);
+  if (element_changed || off_stroke_changed || out.in_constraint_space != was_inside_) {
     fade_from_ = guidance_;
     fade_elapsed_s_ = 0.0;
   }

@@ -2,205 +2,690 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
-#include <string>
+#include <random>
 
-#include "calligraphy/core/errors.hpp"
+#include "sim/writer_program.hpp"
 
 namespace calligraphy {
+
+using writer_detail::make_segment;
+using writer_detail::nearest_on_polyline;
+using writer_detail::Segment;
+using writer_detail::SegmentKind;
+
 namespace {
 
-// Minimum-jerk position profile on [0, 1] (Flash & Hogan 1985).
-double minimum_jerk(double tau) {
-  tau = std::clamp(tau, 0.0, 1.0);
-  return tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau);
-}
+// Motion constants of the plan (docs/writer.md, "Movement"): assumed figures of an unhurried writer.
+constexpr double kHoverHeight_m = 0.002;    // descent ends this far above the paper
+constexpr double kTravelMinimum_s = 0.3;    // shortest pen-up move between strokes
+constexpr double kDescend_s = 0.2;          // quick descent to just above the start
+constexpr double kTouchDown_s = 0.3;        // gentle touch-down onto the paper
+constexpr double kLift_s = 0.2;             // lift at the end of a stroke
+constexpr double kMinimumElement_s = 0.15;  // shortest element
+constexpr int kSamplesPerElement = 48;      // polyline samples of an element
+constexpr double kNoiseUpdate_s = 1e-3;     // the hand's noise is redrawn every millisecond
+constexpr double kVisionSample_s = 1e-3;    // resolution of the seen (delayed) pen and display
+constexpr double kCorrectionDecay_s = 0.3;  // the visual correction fades while travelling pen-up
+constexpr double kMidLiftHeight_m = 0.003;  // a lift in the middle of a stroke: how high,
+constexpr double kMidLift_s = 0.12;         // how long up and down,
+constexpr double kMidLiftHold_s = 0.1;      // and how long the pen stays up
+constexpr double kStrayDistance_m = 0.004;  // a touch outside the box lands this far outside it
+constexpr double kStrayLength_m = 0.004;    // and slides this far along it
+constexpr double kDerivativeStep_s = 1e-4;  // central difference for the hand's target velocity
 
-constexpr double kDescendSeconds = 0.2;
-constexpr double kTouchDownSeconds = 0.3;
-constexpr double kHoverHeight = 0.002;
-constexpr double kLiftSeconds = 0.2;
-constexpr double kMinimumElementSeconds = 0.15;
-constexpr double kNoiseUpdateSeconds = 1e-3;
-constexpr int kSamplesPerElement = 48;
+double uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1p-53; }
 
-}  // namespace
-
-WriterProfile WriterProfile::novice() {
-  WriterProfile p;
-  p.name = "novice";
-  return p;
-}
-
-WriterProfile WriterProfile::skilled() {
-  WriterProfile p;
-  p.name = "skilled";
-  p.hand_stiffness_n_per_m = 600.0;
-  p.hand_damping_n_s_per_m = 8.0;
-  p.writing_speed_m_s = 0.04;
-  p.bias_offset_m = 0.0005;
-  p.scale_error = 0.02;
-  p.stroke_jitter_m = 0.0003;
-  p.noise_fraction = 0.02;
-  p.tremor_amplitude_n = 0.01;
-  return p;
-}
-
-void WriterProfile::validate() const {
-  const auto fail = [](const std::string& what) { throw InvalidArgument("WriterProfile: " + what); };
-  if (!(hand_stiffness_n_per_m > 0.0) || !std::isfinite(hand_stiffness_n_per_m))
-    fail("hand_stiffness_n_per_m must be > 0");
-  if (!(hand_damping_n_s_per_m >= 0.0) || !std::isfinite(hand_damping_n_s_per_m))
-    fail("hand_damping_n_s_per_m must be >= 0");
-  if (!(writing_speed_m_s > 0.0) || !(travel_speed_m_s > 0.0)) fail("speeds must be > 0");
-  if (!(press_depth_m >= 0.0) || !(lift_height_m > 0.0))
-    fail("press_depth_m >= 0 and lift_height_m > 0 required");
-  if (!(bias_offset_m >= 0.0) || !(stroke_jitter_m >= 0.0) || !(noise_fraction >= 0.0) ||
-      !(tremor_amplitude_n >= 0.0) || !(overshoot_m >= 0.0)) {
-    fail("bias, jitter, noise, tremor and overshoot must be >= 0");
-  }
-  if (!(scale_error > -0.5 && scale_error < 0.5)) fail("scale_error must be in (-0.5, 0.5)");
-  if (!(correction_per_attempt >= 0.0 && correction_per_attempt <= 1.0))
-    fail("correction_per_attempt must be in [0, 1]");
-  if (max_attempts_per_stroke < 1) fail("max_attempts_per_stroke must be >= 1");
-}
-
-SimulatedWriter::SimulatedWriter(const Scene& scene, const WriterProfile& profile, std::uint64_t seed)
-    : scene_(&scene), profile_(profile), rng_(seed), rest_(Vec3::Zero()) {
-  profile_.validate();
-  for (std::size_t c = 0; c < scene.characters.size(); ++c) {
-    const double angle = 2.0 * std::numbers::pi * static_cast<double>(rng_() >> 11) * 0x1p-53;
-    character_offset_m_.push_back(profile_.bias_offset_m * Vec2(std::cos(angle), std::sin(angle)));
-  }
-  tremor_phase_x_ = 2.0 * std::numbers::pi * static_cast<double>(rng_() >> 11) * 0x1p-53;
-  tremor_phase_y_ = 2.0 * std::numbers::pi * static_cast<double>(rng_() >> 11) * 0x1p-53;
-}
-
-double SimulatedWriter::gaussian() {
+double gaussian(std::mt19937_64& rng) {
   // Box-Muller on our own uniform draws, so results do not depend on the standard library's distributions.
-  const double u1 = (static_cast<double>(rng_() >> 11) + 0.5) * 0x1p-53;
-  const double u2 = static_cast<double>(rng_() >> 11) * 0x1p-53;
+  const double u1 = (static_cast<double>(rng() >> 11) + 0.5) * 0x1p-53;
+  const double u2 = uniform(rng);
   return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
 }
 
-Vec2 SimulatedWriter::copy_of(const Vec2& reference_m, std::size_t character) const {
-  const Vec2 centre = scene_->characters[character].bounding_box.center();
-  return centre + (1.0 + bias_scale_ * profile_.scale_error) * (reference_m - centre) +
-         bias_scale_ * character_offset_m_[character];
+// SplitMix64 (Steele, Lea & Flood 2014): independent seeds for the plan and the hand's noise.
+std::uint64_t split_seed(std::uint64_t& state) {
+  std::uint64_t z = (state += 0x9E3779B97F4A7C15ULL);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
 }
 
-void SimulatedWriter::add_motion(std::vector<Vec3> path, double speed_m_s, double minimum_s) {
-  // Each motion starts where the previous one ended, so the hand's target never jumps.
-  if (!motions_.empty()) path.insert(path.begin(), motions_.back().path.back());
-  Motion m;
-  m.arc.push_back(0.0);
-  for (std::size_t i = 1; i < path.size(); ++i)
-    m.arc.push_back(m.arc.back() + (path[i] - path[i - 1]).norm());
-  m.path = std::move(path);
-  m.t0 = plan_end_;
-  m.duration = std::max(minimum_s, m.arc.back() / speed_m_s);
-  plan_end_ = m.t0 + m.duration;
-  motions_.push_back(std::move(m));
+Vec3 on_plane(const Vec2& p, double z) { return Vec3(p.x(), p.y(), z); }
+
+// The error vector shortened by the tolerance: no correction within it, continuous at its edge.
+Vec2 beyond_tolerance(const Vec2& error, double tolerance) {
+  const double n = error.norm();
+  return n > tolerance ? Vec2(error * (1.0 - tolerance / n)) : Vec2(Vec2::Zero());
 }
 
-void SimulatedWriter::plan_stroke(std::size_t character, std::size_t stroke, double time_s,
-                                  const Vec3& from) {
-  motions_.clear();
-  plan_end_ = time_s;
-  const PlacedStroke& ref = scene_->characters[character].strokes[stroke];
-  const double z0 = scene_->layout.paper_z_m;
-  const double up = z0 + profile_.lift_height_m;
-  const double down = z0 - profile_.press_depth_m;
-  const Vec2 jitter = bias_scale_ * profile_.stroke_jitter_m * Vec2(gaussian(), gaussian());
-  const auto on_paper = [&](const Vec2& p) {
-    const Vec2 q = copy_of(p, character) + jitter;
-    return Vec3(q.x(), q.y(), down);
+}  // namespace
+
+struct SimulatedWriter::State {
+  struct VisionSample {
+    double time_s = 0.0;
+    Vec2 pen = Vec2::Zero();
+    std::size_t character = 0;
+    std::size_t stroke = 0;
+    bool finished = false;
+    bool abandoned = false;
+    std::uint64_t sequence = 0;
   };
-  const Vec3 start = on_paper(ref.start());
-  // Travel above the paper to the start, then descend onto it.
-  add_motion({from, Vec3(from.x(), from.y(), std::max(from.z(), up)), Vec3(start.x(), start.y(), up)},
-             profile_.travel_speed_m_s, 0.3);
-  // Descend quickly to just above the paper, then touch down gently, as writers do.
-  const Vec3 hover(start.x(), start.y(), z0 + kHoverHeight);
-  add_motion({Vec3(start.x(), start.y(), up), hover}, profile_.travel_speed_m_s, kDescendSeconds);
-  add_motion({hover, start}, profile_.travel_speed_m_s, kTouchDownSeconds);
-  // Write each element with its own minimum-jerk profile: writers pause at the feature points.
-  for (std::size_t e = 0; e < ref.elements.size(); ++e) {
+  struct Attempt {
+    PlannedStroke target;
+    std::size_t log_index = 0;
+    std::vector<Vec2> reference;  // the true stroke as a polyline, for what the writer sees
+    Vec2 start_m = Vec2::Zero();  // the true start in the writing direction
+    bool mid_lift_reached = false;
+    bool ended = true;
+    std::size_t display_at_start = 0;  // the active stroke (scene index) the writer saw when it set off
+    bool accepted = false;             // the writer has seen the display move past this stroke
+  };
+  enum class Next { plan, hint, redo };
+
+  const Scene* scene;
+  WriterProfile profile;
+  std::mt19937_64 plan_rng;
+  std::mt19937_64 noise_rng;
+  std::vector<Vec2> character_offset_m;
+  std::vector<std::size_t> first_scene_stroke;
+  std::vector<PlannedStroke> plan;
+  std::vector<bool> written;
+  WriterLog log;
+
+  // Motion program and its phase.
+  std::vector<Segment> program;
+  std::size_t current = 0;
+  double phase = 0.0;
+  double rate_per_s = 0.0;
+  Vec3 hold = Vec3::Zero();
+  bool started = false;
+  double observed_s = 0.0;
+
+  // Closed loop: visual correction of x_d and pace.
+  Vec2 correction_m = Vec2::Zero();
+  Vec2 correction_rate_m_s = Vec2::Zero();
+  double seen_error_m = 0.0;
+  double speed_factor = 1.0;
+  double next_vision_s = 0.0;
+  double resisted_s = 0.0;
+
+  // What the writer sees, late: a ring of samples every kVisionSample_s.
+  std::vector<VisionSample> ring;
+  std::size_t ring_next = 0;
+  std::size_t ring_count = 0;
+  std::uint64_t sequence = 0;
+  std::uint64_t processed_sequence = 0;
+  double last_stored_s = -std::numeric_limits<double>::infinity();
+  bool pending_abandon = false;
+  std::size_t seen_character = 0;
+  std::size_t seen_stroke = 0;
+  bool seen_finished = false;
+
+  Attempt attempt;
+  Next next = Next::plan;
+  PlannedStroke redo_target;
+  bool done = false;
+
+  Vec3 noise_n = Vec3::Zero();
+  double noise_time_s = -1.0;
+  double tremor_phase_x = 0.0;
+  double tremor_phase_y = 0.0;
+
+  State(const Scene& s, const WriterProfile& p, std::uint64_t seed);
+  [[nodiscard]] Vec3 desired(double time_s) const;
+  [[nodiscard]] Vec3 planned_now() const;
+  void update_rate();
+  void advance(double dt, double time_s);
+  void store_seen(const RenderOutput& output, const DeviceState& pen);
+  [[nodiscard]] const VisionSample* seen_at(double time_s) const;
+  void look(double time_s);
+  void feel(const RenderOutput& output, double dt, double time_s);
+  void pace(double dt);
+  void break_off(double time_s, AttemptEnd why, Next then);
+  void end_attempt(double time_s, AttemptEnd why);
+  void choose_next(double time_s);
+  [[nodiscard]] PlannedStroke hinted() const;
+  [[nodiscard]] std::size_t seen_active() const;
+  void start_attempt(const PlannedStroke& target, bool follows_hint, double time_s);
+  Vec3 add_stray_touch(const PlacedCharacter& character, const Vec3& from);
+};
+
+SimulatedWriter::State::State(const Scene& s, const WriterProfile& p, std::uint64_t seed)
+    : scene(&s), profile(p) {
+  profile.validate();
+  std::uint64_t seeds = seed;
+  plan_rng.seed(split_seed(seeds));
+  noise_rng.seed(split_seed(seeds));
+  std::size_t scene_stroke = 0;
+  for (std::size_t c = 0; c < s.characters.size(); ++c) {
+    const double angle = 2.0 * std::numbers::pi * uniform(plan_rng);
+    character_offset_m.push_back(profile.bias_offset_m * Vec2(std::cos(angle), std::sin(angle)));
+    first_scene_stroke.push_back(scene_stroke);
+    // The writer's own order: each stroke may swap with the next (an order error), and each may be
+    // meant backwards (a direction error).
+    const std::size_t n = s.characters[c].strokes.size();
+    std::vector<std::size_t> order(n);
+    for (std::size_t i = 0; i < n; ++i) order[i] = i;
+    for (std::size_t i = 0; i + 1 < n;) {
+      if (uniform(plan_rng) < profile.order_error_probability) {
+        std::swap(order[i], order[i + 1]);
+        i += 2;
+      } else {
+        i += 1;
+      }
+    }
+    for (const std::size_t k : order) {
+      plan.push_back(
+          PlannedStroke{c, k, scene_stroke + k, uniform(plan_rng) < profile.backwards_probability});
+    }
+    scene_stroke += n;
+  }
+  written.assign(scene_stroke, false);
+  tremor_phase_x = 2.0 * std::numbers::pi * uniform(noise_rng);
+  tremor_phase_y = 2.0 * std::numbers::pi * uniform(noise_rng);
+  ring.resize(static_cast<std::size_t>(std::ceil(profile.visual_delay_s / kVisionSample_s)) + 16);
+}
+
+Vec3 SimulatedWriter::State::planned_now() const {
+  return current < program.size() ? program[current].at_phase(phase) : hold;
+}
+
+Vec3 SimulatedWriter::State::desired(double time_s) const {
+  const double ahead = time_s - observed_s;
+  Vec3 base = hold;
+  if (current < program.size())
+    base = program[current].at_phase(std::clamp(phase + rate_per_s * ahead, 0.0, 1.0));
+  const Vec2 c = correction_m + correction_rate_m_s * ahead;
+  return base + Vec3(c.x(), c.y(), 0.0);
+}
+
+void SimulatedWriter::State::update_rate() {
+  if (current >= program.size()) {
+    rate_per_s = 0.0;
+    return;
+  }
+  const Segment& s = program[current];
+  rate_per_s = (s.steered ? speed_factor : 1.0) / s.duration_s;
+}
+
+void SimulatedWriter::State::advance(double dt, double time_s) {
+  if (program.empty()) return;
+  phase += rate_per_s * dt;
+  while (current < program.size() && phase >= 1.0) {
+    const double beyond_s = rate_per_s > 0.0 ? (phase - 1.0) / rate_per_s : 0.0;
+    hold = program[current].path.back();
+    ++current;
+    phase = 0.0;
+    resisted_s = 0.0;
+    if (current >= program.size()) break;
+    const Segment& s = program[current];
+    if (!attempt.ended) {
+      WriterAttempt& a = log.attempts[attempt.log_index];
+      if (s.kind == SegmentKind::write && a.touch_down_s < 0.0) a.touch_down_s = time_s - beyond_s;
+      if (s.mid_stroke) attempt.mid_lift_reached = true;
+    }
+    update_rate();
+    phase = rate_per_s * beyond_s;
+  }
+  if (current >= program.size()) {
+    program.clear();
+    current = 0;
+    phase = 0.0;
+    if (!attempt.ended) {
+      written[attempt.target.scene_stroke] = true;  // by the writer's own account
+      end_attempt(time_s, AttemptEnd::completed);
+    }
+  }
+}
+
+void SimulatedWriter::State::store_seen(const RenderOutput& output, const DeviceState& pen) {
+  pending_abandon = pending_abandon || output.stroke_abandoned;
+  if (pen.time_s - last_stored_s < kVisionSample_s * (1.0 - 1e-9)) return;
+  VisionSample& v = ring[ring_next];
+  v.time_s = pen.time_s;
+  v.pen = pen.position_m.head<2>();
+  v.character = output.character;
+  v.stroke = output.stroke;
+  v.finished = output.finished;
+  v.abandoned = pending_abandon;
+  v.sequence = ++sequence;
+  pending_abandon = false;
+  last_stored_s = pen.time_s;
+  ring_next = (ring_next + 1) % ring.size();
+  ring_count = std::min(ring_count + 1, ring.size());
+}
+
+const SimulatedWriter::State::VisionSample* SimulatedWriter::State::seen_at(double time_s) const {
+  const VisionSample* oldest = nullptr;
+  for (std::size_t k = 1; k <= ring_count; ++k) {
+    const VisionSample& v = ring[(ring_next + ring.size() - k) % ring.size()];
+    if (v.time_s <= time_s + 1e-12) return &v;
+    oldest = &v;
+  }
+  return oldest;  // nothing that old yet: the earliest the writer has
+}
+
+// Vision, every vision_period_s: the pen and the display as they were visual_delay_s ago.
+void SimulatedWriter::State::look(double time_s) {
+  const VisionSample* seen = seen_at(time_s - profile.visual_delay_s);
+  if (seen == nullptr) return;
+  // A stroke cleared after a lift in the middle of it: write it again.
+  for (std::size_t k = ring_count; k >= 1; --k) {
+    const VisionSample& v = ring[(ring_next + ring.size() - k) % ring.size()];
+    if (v.sequence <= processed_sequence || v.sequence > seen->sequence) continue;
+    if (v.abandoned && !attempt.ended && attempt.mid_lift_reached) {
+      break_off(time_s, AttemptEnd::interrupted, Next::redo);
+    }
+  }
+  processed_sequence = std::max(processed_sequence, seen->sequence);
+  seen_character = seen->character;
+  seen_stroke = seen->stroke;
+  seen_finished = seen->finished;
+  // The display has moved past the stroke being written: it was accepted, and what the writer feels
+  // now (the paper outside the written stroke) is no refusal.
+  if (!attempt.ended && seen_active() > attempt.target.scene_stroke &&
+      attempt.display_at_start <= attempt.target.scene_stroke) {
+    attempt.accepted = true;
+    written[attempt.target.scene_stroke] = true;
+  }
+
+  Vec2 error = Vec2::Zero();
+  bool writing = false;
+  bool travelling = true;
+  if (current < program.size() && !attempt.ended) {
+    const Segment& s = program[current];
+    travelling = s.kind == SegmentKind::travel;
+    if (s.aim_at_start) {
+      error = attempt.start_m - seen->pen;
+    } else if (s.kind == SegmentKind::write) {
+      // Only the error across the stroke: along it the writer is where its pace puts it.
+      const writer_detail::PolylineFoot foot = nearest_on_polyline(attempt.reference, seen->pen);
+      const Vec2 e = foot.foot - seen->pen;
+      error = e - e.dot(foot.direction) * foot.direction;
+      writing = true;
+    }
+  }
+  if (travelling) {
+    correction_rate_m_s = -correction_m / kCorrectionDecay_s;
+  } else {
+    correction_rate_m_s = profile.correction_rate_per_s * beyond_tolerance(error, profile.error_tolerance_m);
+  }
+  if (writing) {
+    const double blend = 1.0 - std::exp(-profile.vision_period_s / profile.error_filter_s);
+    seen_error_m += blend * (error.norm() - seen_error_m);
+  }
+}
+
+// Touch: a force against the intended motion, beyond the paper's usual drag, for the reaction time
+// means the display refuses the stroke (the resistance of Fig. 4, the off-stroke resistance).
+void SimulatedWriter::State::feel(const RenderOutput& output, double dt, double time_s) {
+  if (attempt.ended || current >= program.size()) {
+    resisted_s = 0.0;
+    return;
+  }
+  const Segment& s = program[current];
+  const double along = s.length_m() * Segment::minimum_jerk(phase);
+  if (s.kind != SegmentKind::write || along >= s.follow_from_m || attempt.accepted) {
+    resisted_s = 0.0;
+    return;
+  }
+  const Vec2 intended = s.direction_at_arc(along);
+  const Vec3& f = output.force_n;
+  const double against = -f.head<2>().dot(intended) - profile.expected_drag_ratio * std::max(f.z(), 0.0);
+  resisted_s = (!intended.isZero() && against > profile.resistance_threshold_n) ? resisted_s + dt : 0.0;
+  if (resisted_s >= profile.reaction_time_s) {
+    ++log.refusals;
+    break_off(time_s, AttemptEnd::refused, Next::hint);
+  }
+}
+
+// Steering law, local form v = W_free / tau with W_free = W - 2 |e| (Accot & Zhai 1997), tau = W / v0.
+void SimulatedWriter::State::pace(double dt) {
+  const double target =
+      std::clamp(1.0 - 2.0 * seen_error_m / profile.steering_width_m, profile.min_speed_fraction, 1.0);
+  speed_factor += (1.0 - std::exp(-dt / profile.speed_time_constant_s)) * (target - speed_factor);
+}
+
+void SimulatedWriter::State::end_attempt(double time_s, AttemptEnd why) {
+  WriterAttempt& a = log.attempts[attempt.log_index];
+  a.end = why;
+  a.end_s = time_s;
+  attempt.ended = true;
+}
+
+void SimulatedWriter::State::break_off(double time_s, AttemptEnd why, Next then) {
+  if (attempt.ended) return;
+  end_attempt(time_s, why);
+  const Vec3 here = planned_now();
+  const double up = scene->layout.paper_z_m + profile.lift_height_m;
+  program.clear();
+  program.push_back(make_segment(SegmentKind::lift, {here, Vec3(here.x(), here.y(), std::max(here.z(), up))},
+                                 profile.travel_speed_m_s, kLift_s));
+  current = 0;
+  phase = 0.0;
+  resisted_s = 0.0;
+  next = then;
+  redo_target = attempt.target;
+  update_rate();
+}
+
+// The active stroke as last seen, counted over the scene (the stroke count once finished).
+std::size_t SimulatedWriter::State::seen_active() const {
+  if (seen_finished || seen_character >= first_scene_stroke.size()) return written.size();
+  return first_scene_stroke[seen_character] + seen_stroke;
+}
+
+PlannedStroke SimulatedWriter::State::hinted() const {
+  PlannedStroke p;
+  p.character = std::min(seen_character, scene->characters.size() - 1);
+  p.stroke = std::min(seen_stroke, scene->characters[p.character].strokes.size() - 1);
+  p.scene_stroke = first_scene_stroke[p.character] + p.stroke;
+  return p;
+}
+
+void SimulatedWriter::State::choose_next(double time_s) {
+  if (seen_finished || plan.empty()) {
+    done = true;
+    return;
+  }
+  // Once the display has refused a stroke the writer knows it keeps the order, and takes every stroke
+  // before the one it hints as written (also one the display took from a stroke the writer meant as
+  // another: a stroke out of order that passed the active stroke's feature planes).
+  if (log.refusals > 0) {
+    for (std::size_t k = 0; k < seen_active() && k < written.size(); ++k) written[k] = true;
+  }
+  PlannedStroke target;
+  bool follows_hint = false;
+  if (next == Next::hint || (next == Next::plan && log.refusals > 0)) {
+    // After a refusal the writer has learnt that the display leads, and writes what it hints.
+    target = hinted();
+    follows_hint = true;
+  } else if (next == Next::redo) {
+    target = redo_target;
+  } else {
+    const auto open = std::find_if(plan.begin(), plan.end(),
+                                   [&](const PlannedStroke& p) { return !written[p.scene_stroke]; });
+    if (open == plan.end()) {  // its own plan written, and nothing ever refused
+      done = true;
+      return;
+    }
+    target = *open;
+  }
+  next = Next::plan;
+  start_attempt(target, follows_hint, time_s);
+}
+
+Vec3 SimulatedWriter::State::add_stray_touch(const PlacedCharacter& character, const Vec3& from) {
+  const Eigen::AlignedBox2d& box = character.bounding_box;
+  const Vec2 p = from.head<2>();
+  const Vec2 lo = box.min();
+  const Vec2 hi = box.max();
+  const double y = std::clamp(p.y(), lo.y(), hi.y());
+  const double x = std::clamp(p.x(), lo.x(), hi.x());
+  const Vec2 candidates[4] = {Vec2(lo.x() - kStrayDistance_m, y), Vec2(hi.x() + kStrayDistance_m, y),
+                              Vec2(x, lo.y() - kStrayDistance_m), Vec2(x, hi.y() + kStrayDistance_m)};
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < 4; ++i) {
+    if ((candidates[i] - p).norm() < (candidates[best] - p).norm()) best = i;
+  }
+  const Vec2 touch = candidates[best];
+  const Vec2 centre = box.center();
+  const Vec2 slide = best < 2 ? Vec2(0.0, centre.y() > touch.y() ? 1.0 : -1.0)
+                              : Vec2(centre.x() > touch.x() ? 1.0 : -1.0, 0.0);
+  const Vec2 end = touch + kStrayLength_m * slide;
+  const double z0 = scene->layout.paper_z_m;
+  const double up = z0 + profile.lift_height_m;
+  const double down = z0 - 0.5 * profile.press_depth_m;
+  program.push_back(make_segment(SegmentKind::travel,
+                                 {from, Vec3(p.x(), p.y(), std::max(from.z(), up)), on_plane(touch, up)},
+                                 profile.travel_speed_m_s, kTravelMinimum_s));
+  program.push_back(make_segment(SegmentKind::touch, {on_plane(touch, up), on_plane(touch, down)},
+                                 profile.travel_speed_m_s, kTouchDown_s));
+  program.push_back(make_segment(SegmentKind::stray, {on_plane(touch, down), on_plane(end, down)},
+                                 profile.writing_speed_m_s, kMinimumElement_s));
+  program.push_back(make_segment(SegmentKind::lift, {on_plane(end, down), on_plane(end, up)},
+                                 profile.travel_speed_m_s, kLift_s));
+  return on_plane(end, up);
+}
+
+void SimulatedWriter::State::start_attempt(const PlannedStroke& target, bool follows_hint, double time_s) {
+  int number = 1;
+  for (const WriterAttempt& a : log.attempts) {
+    if (a.scene_stroke == target.scene_stroke) ++number;
+  }
+  if (number > profile.max_attempts_per_stroke) {
+    log.gave_up = true;
+    done = true;
+    return;
+  }
+  // Each re-attempt is more careful: bias and error rates shrink by correction_per_attempt.
+  const double care = std::pow(1.0 - profile.correction_per_attempt, number - 1);
+  const PlacedCharacter& character = scene->characters[target.character];
+  const PlacedStroke& ref = character.strokes[target.stroke];
+  const bool reversed = target.reversed && !follows_hint;
+
+  // Draws in a fixed order, so that the plan does not depend on the servo rate.
+  const bool outside = uniform(plan_rng) < care * profile.outside_touch_probability;
+  const bool hesitate = uniform(plan_rng) < care * profile.hesitation_probability;
+  const double hesitation_where = uniform(plan_rng);
+  const double hesitation_length_s = profile.hesitation_s * (0.5 + uniform(plan_rng));
+  const bool lift = uniform(plan_rng) < care * profile.mid_stroke_lift_probability;
+  const double lift_where = uniform(plan_rng);
+  const double lift_fraction = 0.3 + 0.4 * uniform(plan_rng);
+  const Vec2 jitter = care * profile.stroke_jitter_m * Vec2(gaussian(plan_rng), gaussian(plan_rng));
+
+  WriterAttempt entry;
+  entry.character = target.character;
+  entry.stroke = target.stroke;
+  entry.scene_stroke = target.scene_stroke;
+  entry.reversed = reversed;
+  entry.follows_hint = follows_hint;
+  entry.attempt = number;
+  entry.start_s = time_s;
+  entry.outside_touch = outside;
+  for (std::size_t k = 0; k < target.stroke; ++k) {
+    if (!written[first_scene_stroke[target.character] + k]) entry.out_of_order = true;
+  }
+  log.attempts.push_back(entry);
+  attempt = Attempt{};
+  attempt.target = target;
+  attempt.target.reversed = reversed;
+  attempt.log_index = log.attempts.size() - 1;
+  attempt.ended = false;
+  attempt.start_m = reversed ? ref.end() : ref.start();
+  attempt.display_at_start = seen_active();
+
+  const std::size_t elements = ref.elements.size();
+  const Vec2 centre = character.bounding_box.center();
+  const Vec2 offset = care * character_offset_m[target.character];
+  const double scale = 1.0 + care * profile.scale_error;
+  const auto copy = [&](const Vec2& p) { return Vec2(centre + scale * (p - centre) + offset + jitter); };
+  const double z0 = scene->layout.paper_z_m;
+  const double up = z0 + profile.lift_height_m;
+  const double down = z0 - profile.press_depth_m;
+  for (std::size_t e = 0; e < elements; ++e) {
+    for (int i = (e == 0 ? 0 : 1); i <= kSamplesPerElement; ++i) {
+      attempt.reference.push_back(ref.elements[e].point(static_cast<double>(i) / kSamplesPerElement));
+    }
+  }
+
+  program.clear();
+  current = 0;
+  phase = 0.0;
+  Vec3 from = hold;
+  if (outside) from = add_stray_touch(character, from);
+  const Vec3 start = on_plane(copy(attempt.start_m), down);
+  const Vec3 above(start.x(), start.y(), up);
+  program.push_back(make_segment(SegmentKind::travel,
+                                 {from, Vec3(from.x(), from.y(), std::max(from.z(), up)), above},
+                                 profile.travel_speed_m_s, kTravelMinimum_s));
+  const bool hesitate_before = hesitate && (elements < 2 || hesitation_where < 0.5);
+  const std::size_t hesitate_after =
+      hesitate && !hesitate_before
+          ? std::min(elements - 2, static_cast<std::size_t>(2.0 * (hesitation_where - 0.5) *
+                                                            static_cast<double>(elements - 1)))
+          : elements;
+  if (hesitate_before) {
+    program.push_back(make_segment(SegmentKind::pause, {above}, 1.0, hesitation_length_s));
+    log.attempts.back().hesitation = true;
+  }
+  const Vec3 hover(start.x(), start.y(), z0 + kHoverHeight_m);
+  program.push_back(make_segment(SegmentKind::descend, {above, hover}, profile.travel_speed_m_s, kDescend_s));
+  program.back().aim_at_start = true;
+  program.push_back(make_segment(SegmentKind::touch, {hover, start}, profile.travel_speed_m_s, kTouchDown_s));
+  program.back().aim_at_start = true;
+
+  const std::size_t lifted_element =
+      lift ? std::min(elements - 1, static_cast<std::size_t>(lift_where * static_cast<double>(elements)))
+           : elements;
+  for (std::size_t k = 0; k < elements; ++k) {
+    const std::size_t e = reversed ? elements - 1 - k : k;
     const StrokeElement& element = ref.elements[e];
     std::vector<Vec3> path;
-    for (int i = 0; i <= kSamplesPerElement; ++i)
-      path.push_back(on_paper(element.point(static_cast<double>(i) / kSamplesPerElement)));
-    if (profile_.overshoot_m > 0.0) {  // follow through past the feature point before turning
-      const Vec2 tangent = element.unit_tangent(1.0);
-      const Vec3 last = path.back();
-      path.push_back(last + profile_.overshoot_m * Vec3(tangent.x(), tangent.y(), 0.0));
-      if (e + 1 < ref.elements.size()) path.push_back(last);
+    for (int i = 0; i <= kSamplesPerElement; ++i) {
+      const double u = static_cast<double>(i) / kSamplesPerElement;
+      path.push_back(on_plane(copy(element.point(reversed ? 1.0 - u : u)), down));
     }
-    add_motion(std::move(path), profile_.writing_speed_m_s, kMinimumElementSeconds);
+    const Vec2 tangent = reversed ? Vec2(-element.unit_tangent(0.0)) : element.unit_tangent(1.0);
+    const Vec3 last = path.back();
+    double proper_m = 0.0;
+    for (std::size_t i = 1; i < path.size(); ++i) proper_m += (path[i] - path[i - 1]).norm();
+    if (k + 1 < elements) {
+      if (profile.overshoot_m > 0.0) {  // follow through past the feature point before turning
+        path.push_back(last + profile.overshoot_m * Vec3(tangent.x(), tangent.y(), 0.0));
+        path.push_back(last);
+      }
+    } else {
+      // Past the end the writer sees on the display, whatever its copy says, and follows through.
+      const Vec2 true_end = reversed ? ref.start() : ref.end();
+      const double short_m = std::max(0.0, (true_end - last.head<2>()).dot(tangent));
+      const double beyond_m = profile.overshoot_m + short_m;
+      if (beyond_m > 0.0) path.push_back(last + beyond_m * Vec3(tangent.x(), tangent.y(), 0.0));
+    }
+    if (k == lifted_element) {
+      // Split at lift_fraction of the element: write, lift, hold, touch down again, write on.
+      const double split_m = lift_fraction * proper_m;
+      std::vector<Vec3> first{path.front()};
+      std::vector<Vec3> second;
+      double run_m = 0.0;
+      std::size_t i = 1;
+      for (; i < path.size(); ++i) {
+        const double step = (path[i] - path[i - 1]).norm();
+        if (run_m + step >= split_m && step > 0.0) {
+          const Vec3 split = path[i - 1] + ((split_m - run_m) / step) * (path[i] - path[i - 1]);
+          first.push_back(split);
+          second.push_back(split);
+          break;
+        }
+        run_m += step;
+        first.push_back(path[i]);
+      }
+      for (; i < path.size(); ++i) second.push_back(path[i]);
+      const Vec3 split = first.back();
+      const Vec3 raised(split.x(), split.y(), z0 + kMidLiftHeight_m);
+      Segment a =
+          make_segment(SegmentKind::write, std::move(first), profile.writing_speed_m_s, kMinimumElement_s);
+      a.steered = true;
+      a.element = static_cast<int>(e);
+      program.push_back(std::move(a));
+      program.push_back(
+          make_segment(SegmentKind::lift, {split, raised}, profile.travel_speed_m_s, kMidLift_s));
+      program.back().mid_stroke = true;
+      program.push_back(make_segment(SegmentKind::pause, {raised}, 1.0, kMidLiftHold_s));
+      program.back().mid_stroke = true;
+      program.push_back(
+          make_segment(SegmentKind::touch, {raised, split}, profile.travel_speed_m_s, kMidLift_s));
+      program.back().mid_stroke = true;
+      Segment b =
+          make_segment(SegmentKind::write, std::move(second), profile.writing_speed_m_s, kMinimumElement_s);
+      b.steered = true;
+      b.element = static_cast<int>(e);
+      b.follow_from_m = std::max(0.0, proper_m - split_m);
+      program.push_back(std::move(b));
+      log.attempts.back().mid_stroke_lift = true;
+    } else {
+      Segment w =
+          make_segment(SegmentKind::write, std::move(path), profile.writing_speed_m_s, kMinimumElement_s);
+      w.steered = true;
+      w.element = static_cast<int>(e);
+      w.follow_from_m = proper_m;
+      program.push_back(std::move(w));
+    }
+    if (k == hesitate_after) {
+      program.push_back(
+          make_segment(SegmentKind::pause, {program.back().path.back()}, 1.0, hesitation_length_s));
+      log.attempts.back().hesitation = true;
+    }
   }
-  const Vec3 end = motions_.back().path.back();
-  add_motion({end, Vec3(end.x(), end.y(), up)}, profile_.travel_speed_m_s, kLiftSeconds);
+  const Vec3 end = program.back().path.back();
+  program.push_back(
+      make_segment(SegmentKind::lift, {end, Vec3(end.x(), end.y(), up)}, profile.travel_speed_m_s, kLift_s));
+  update_rate();
+}
+
+SimulatedWriter::SimulatedWriter(const Scene& scene, const WriterProfile& profile, std::uint64_t seed)
+    : state_(std::make_unique<State>(scene, profile, seed)) {}
+SimulatedWriter::~SimulatedWriter() = default;
+SimulatedWriter::SimulatedWriter(SimulatedWriter&&) noexcept = default;
+SimulatedWriter& SimulatedWriter::operator=(SimulatedWriter&&) noexcept = default;
+
+bool SimulatedWriter::done() const noexcept { return state_->done; }
+const WriterLog& SimulatedWriter::log() const noexcept { return state_->log; }
+const std::vector<PlannedStroke>& SimulatedWriter::plan() const noexcept { return state_->plan; }
+const WriterProfile& SimulatedWriter::profile() const noexcept { return state_->profile; }
+
+Vec3 SimulatedWriter::target(double time_s) const {
+  return state_->started ? state_->desired(time_s) : state_->hold;
 }
 
 void SimulatedWriter::observe(const RenderOutput& output, const DeviceState& pen) {
+  State& s = *state_;
   const double time_s = pen.time_s;
-  if (motions_.empty()) last_position_ = pen.position_m;
-  if (done_ || time_s < plan_end_) return;
-  if (output.finished) {
-    done_ = true;
-    return;
+  if (!s.started) {
+    s.started = true;
+    s.observed_s = time_s;
+    s.hold = pen.position_m;
+    s.next_vision_s = time_s;
   }
-  const bool same_stroke =
-      !motions_.empty() && output.character == last_character_ && output.stroke == last_stroke_;
-  if (same_stroke) {
-    if (attempts_ >= profile_.max_attempts_per_stroke) {
-      done_ = true;  // gives up on this stroke
-      return;
-    }
-    ++attempts_;
-    bias_scale_ *= 1.0 - profile_.correction_per_attempt;  // re-aim at the hint
-  } else {
-    attempts_ = 1;
-    bias_scale_ = 1.0;
+  const double dt = std::max(0.0, time_s - s.observed_s);
+  s.correction_m += s.correction_rate_m_s * dt;
+  s.advance(dt, time_s);
+  s.observed_s = time_s;
+  s.store_seen(output, pen);
+  if (s.done) return;
+  s.feel(output, dt, time_s);
+  while (time_s >= s.next_vision_s) {
+    s.look(time_s);
+    s.next_vision_s += s.profile.vision_period_s;
   }
-  last_character_ = output.character;
-  last_stroke_ = output.stroke;
-  const Vec3 from = motions_.empty() ? last_position_ : motions_.back().path.back();
-  plan_stroke(output.character, output.stroke, time_s, from);
-}
-
-Vec3 SimulatedWriter::target(double time_s) const {
-  if (motions_.empty()) return last_position_;
-  const auto it = std::find_if(motions_.begin(), motions_.end(),
-                               [&](const Motion& m) { return time_s < m.t0 + m.duration; });
-  const Motion& m = it == motions_.end() ? motions_.back() : *it;
-  const double s = m.arc.back() * minimum_jerk((time_s - m.t0) / m.duration);
-  const auto upper = std::upper_bound(m.arc.begin(), m.arc.end(), s);
-  if (upper == m.arc.end()) return m.path.back();
-  if (upper == m.arc.begin()) return m.path.front();
-  const std::size_t i = static_cast<std::size_t>(upper - m.arc.begin());
-  const double span = m.arc[i] - m.arc[i - 1];
-  const double f = span > 0.0 ? (s - m.arc[i - 1]) / span : 0.0;
-  return m.path[i - 1] + f * (m.path[i] - m.path[i - 1]);
+  s.pace(dt);
+  if (s.program.empty()) s.choose_next(time_s);
+  s.update_rate();
 }
 
 Vec3 SimulatedWriter::hand_force(double time_s, const Vec3& position_m, const Vec3& velocity_m_s) {
-  if (motions_.empty()) last_position_ = position_m;  // before the first plan the hand holds still
-  constexpr double h = 1e-4;
+  State& s = *state_;
+  const WriterProfile& p = s.profile;
+  if (!s.started) s.hold = position_m;  // before the first observation the hand holds still
   const Vec3 x_d = target(time_s);
-  const Vec3 v_d = (target(time_s + h) - target(time_s - h)) / (2.0 * h);
-  const Vec3 force = profile_.hand_stiffness_n_per_m * (x_d - position_m) +
-                     profile_.hand_damping_n_s_per_m * (v_d - velocity_m_s);
-  if (time_s - noise_time_ >=
-      kNoiseUpdateSeconds) {  // signal-dependent noise (Harris & Wolpert 1998), in plane
-    noise_time_ = time_s;
-    const double sigma = profile_.noise_fraction * force.norm();
-    noise_ = Vec3(sigma * gaussian(), sigma * gaussian(), 0.0);
+  const Vec3 v_d =
+      s.started ? Vec3((s.desired(time_s + kDerivativeStep_s) - s.desired(time_s - kDerivativeStep_s)) /
+                       (2.0 * kDerivativeStep_s))
+                : Vec3(Vec3::Zero());
+  const Vec3 force =
+      p.hand_stiffness_n_per_m * (x_d - position_m) + p.hand_damping_n_s_per_m * (v_d - velocity_m_s);
+  if (time_s - s.noise_time_s >=
+      kNoiseUpdate_s) {  // signal-dependent noise (Harris & Wolpert 1998), in plane
+    s.noise_time_s = time_s;
+    const double sigma = p.noise_fraction * force.norm();
+    s.noise_n = Vec3(sigma * gaussian(s.noise_rng), sigma * gaussian(s.noise_rng), 0.0);
   }
-  const double w = 2.0 * std::numbers::pi * profile_.tremor_frequency_hz * time_s;
+  const double w = 2.0 * std::numbers::pi * p.tremor_frequency_hz * time_s;
   const Vec3 tremor =
-      profile_.tremor_amplitude_n * Vec3(std::sin(w + tremor_phase_x_), std::sin(w + tremor_phase_y_), 0.0);
-  return force + noise_ + tremor;
+      p.tremor_amplitude_n * Vec3(std::sin(w + s.tremor_phase_x), std::sin(w + s.tremor_phase_y), 0.0);
+  return force + s.noise_n + tremor;
 }
 
 }  // namespace calligraphy

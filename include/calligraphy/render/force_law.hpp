@@ -2,8 +2,11 @@
 /// \file force_law.hpp
 /// The force model of paper section 5: F_e = F_en + F_et (eq. 7). Free functions, SI units, servo path
 /// (noexcept, no allocation). Device frame: the paper is z = z0, +z out of the paper.
+#include <vector>
+
 #include "calligraphy/collision/nearest_point.hpp"
 #include "calligraphy/core/geometry.hpp"
+#include "calligraphy/render/guidance_mode.hpp"
 
 namespace calligraphy {
 
@@ -20,8 +23,52 @@ struct ForceLawParameters {
   /// Contact hysteresis [m]: once touching, the tip counts as lifted only when it is this far above the
   /// paper, so that the bounce of a touch-down does not chatter between SS and WS (section 6).
   double contact_hysteresis_m = 0.0005;
-  /// In-plane guidance on (F_et and the resistance force); the paper force is always rendered.
+  /// In-plane guidance on (F_et, the resistance force and the off-stroke resistance); the paper force is
+  /// always rendered.
   bool guidance = true;
+
+  // Guidance modes (guidance_mode.hpp; docs/force-rendering.md, "Guidance modes").
+  /// How F_et attracts: the paper's fixed fixture, faded by `guidance_gain`, or replaying a teacher.
+  GuidanceMode guidance_mode = GuidanceMode::fixed;
+  /// Gain g in [0, 1] on F_et in the `fading` mode (ignored in the others); set it per repetition, or
+  /// from performance with `next_guidance_gain`.
+  double guidance_gain = 1.0;
+  /// The teacher's recorded pen for the `replay` mode, device frame [m], times [s] non-decreasing (a
+  /// recorded trial's trace: `TrialSample::time_s`, `position_m`). Read at renderer construction
+  /// (teacher_replay.hpp); ignored in the other modes.
+  std::vector<TeacherSample> teacher_trajectory;
+  /// Replay only: the spring towards the teacher's point pulls at most as hard as it does at this
+  /// distance [m], in (0, R_res]: K_et a d_max. The point may lead or trail the pen along the stroke by
+  /// more (a trainee slower than the teacher); the bound keeps the pull moderate and the force step
+  /// small when a pen held back that hard crosses the taper band at the edge of R_res.
+  double replay_max_lead_m = 0.003;
+  // Off-stroke resistance (docs/force-rendering.md): under guidance, writing off the active stroke is
+  // felt. The paper's resistance of Fig. 4 extended from the direction within a stroke to the order of
+  // the strokes (section 2.2; section 6: the active stroke masks the others). Both parts 0 = the
+  // paper (CS: normal force only; WS: no in-plane force outside R_res).
+  /// In CS (touching inside the active character's box, not writing the active stroke: a stroke out
+  /// of order, a stroke started from its end, a stroke continued after a lift), a friction of this
+  /// force [N] >= 0 against in-plane motion, rendered with an adhesion point (Hayward & Armstrong
+  /// 2000): a spring to a point that the pen drags along once it is `off_stroke_travel_m` away, so the
+  /// force is the same at any speed and the pen at rest is simply held.
+  double off_stroke_force_n = 0.5;
+  /// Travel [m] > 0 before the off-stroke friction reaches its force (spring off_stroke_force_n /
+  /// off_stroke_travel_m: 500 N/m by default, below Colgate's bound at 1 kHz and more).
+  double off_stroke_travel_m = 0.001;
+  /// In WS outside the constraint space, a damper [N s/m] >= 0 on the part of the in-plane velocity
+  /// that leads away from the active element (a stroke that set off from the active start in another
+  /// direction), never on coming back to it.
+  double off_stroke_damping_n_s_per_m = 25.0;
+  /// Speed [m/s] > 0 below which that damper is off; it ramps in (smoothstep) up to twice this speed,
+  /// so that a pen at rest or creeping feels only the paper.
+  double off_stroke_speed_m_s = 0.005;
+  /// Cut-off [Hz] > 0 of the first-order low-pass on the velocity the damper acts on, so that encoder
+  /// noise in the velocity (one 23 um quantum at 1 kHz is a 23 mm/s spike) does not come through it
+  /// as force steps. Not lower: above the cut-off a low-passed damper B / (1 + s / w_c) acts like a
+  /// spring B w_c on the pen's mass (at 10 Hz and 40 N s/m a 2.5 kN/m spring, which rang at about
+  /// 20 Hz on the simulated device); at 30 Hz and 25 N s/m the pen with a relaxed hand keeps a damping
+  /// ratio of about 0.6.
+  double off_stroke_velocity_cutoff_hz = 30.0;
 
   // Smoothness (paper section 6, sources of instability; docs/force-rendering.md).
   /// Band at the edge of the constraint space over which F_et tapers to zero [m], in [0, R_res]: F_et
@@ -52,7 +99,8 @@ struct ForceLawParameters {
   NearestPointOptions nearest{};
 
   /// Throws InvalidArgument when a value is negative, not finite, the radius or the stick speed is not
-  /// positive, or the taper band is wider than the radius.
+  /// positive, the taper band is wider than the radius, the gain is outside [0, 1], or the mode is
+  /// `replay` and the teacher trajectory is bad (validate_teacher_trajectory).
   void validate() const;
 };
 
@@ -78,6 +126,17 @@ struct ForceLawParameters {
 /// Taper of F_et at the constraint-space edge, in [0, 1]: 1 when distance <= R - band, 0 when
 /// distance >= R, a smoothstep between; band 0 gives the step 1 -> 0 at R. Lengths [m].
 [[nodiscard]] double constraint_taper(double distance_m, double radius_m, double band_m) noexcept;
+
+/// Off-stroke friction with an adhesion point (Hayward & Armstrong 2000): moves `anchor_m` towards the
+/// tip until it is at most `travel_m` away, and returns the spring force (force_n / travel_m) (anchor -
+/// tip) [N], at most force_n. Lengths [m], force [N]; travel_m > 0.
+[[nodiscard]] Vec2 off_stroke_friction(const Vec2& tip_m, Vec2& anchor_m, double force_n,
+                                       double travel_m) noexcept;
+
+/// Off-stroke damper: -B v w(|v|) [N] in the paper plane, w a smoothstep from 0 at |v| = v0 to 1 at
+/// 2 v0; in-plane velocity [m/s], B [N s/m], v0 [m/s] > 0.
+[[nodiscard]] Vec2 off_stroke_resistance(const Vec2& velocity_m_s, double damping_n_s_per_m,
+                                         double threshold_speed_m_s) noexcept;
 
 /// Scales `force` down to at most `max_force_n`, keeping its direction; a non-finite force gives zero.
 [[nodiscard]] Vec3 clamp_force(const Vec3& force_n, double max_force_n) noexcept;

@@ -5,7 +5,8 @@
 /// call `tick` once per servo tick at the rate given in `RendererOptions`. `tick` is noexcept and never
 /// allocates. Pipeline per tick: state machine (Fig. 6) -> collision with the active element (section
 /// 4.3) -> force law (eqs. 7-9) with the smoothing of section 6 and paper friction -> optional
-/// passivity controller -> safety chain. Details and measurements: docs/force-rendering.md.
+/// passivity controller -> safety chain. The in-plane guidance has three modes (guidance_mode.hpp: the
+/// paper's fixed fixture, fading, teacher replay). Details and measurements: docs/force-rendering.md.
 #include <cstdint>
 
 #include "calligraphy/collision/active_stroke.hpp"
@@ -16,6 +17,7 @@
 #include "calligraphy/render/interaction_state.hpp"
 #include "calligraphy/render/passivity.hpp"
 #include "calligraphy/render/safety_chain.hpp"
+#include "calligraphy/render/teacher_replay.hpp"
 
 namespace calligraphy {
 
@@ -51,8 +53,9 @@ struct RenderOutput {
 class Renderer {
  public:
   /// `scene` must outlive the renderer. Throws InvalidArgument when the parameters or options are out
-  /// of range or `device.max_force_n` is not positive. Logs a warning (here, never per tick) when a
-  /// stiffness exceeds the device's stable maximum or Colgate's bound 2 (b - B) rate.
+  /// of range, `device.max_force_n` is not positive, or (replay mode) the teacher trajectory does not
+  /// write every stroke of the scene in order (teacher_replay.hpp). Logs a warning (here, never per tick)
+  /// when a stiffness exceeds the device's stable maximum or Colgate's bound 2 (b - B) rate.
   Renderer(const Scene& scene, const ForceLawParameters& parameters, const DeviceInfo& device,
            const RendererOptions& options = {});
 
@@ -68,6 +71,8 @@ class Renderer {
   [[nodiscard]] const Scene& scene() const noexcept { return *scene_; }
   [[nodiscard]] const SafetyChain& safety_chain() const noexcept { return chain_; }
   [[nodiscard]] const PassivityController& passivity() const noexcept { return passivity_; }
+  /// The teacher's strokes in the replay mode (empty in the others).
+  [[nodiscard]] const TeacherReplay& teacher_replay() const noexcept { return replay_; }
 
  private:
   Vec2 guidance_force(const DeviceState& device, RenderOutput& out, bool element_changed) noexcept;
@@ -82,6 +87,12 @@ class Renderer {
   SafetyChain chain_;
   PassivityController passivity_;
   NearestPointTracker tracker_;
+  TeacherReplay replay_;
+  double writing_since_s_ = 0.0;  // device time at which WS was entered on the active stroke (replay clock)
+  Vec2 off_stroke_velocity_ = Vec2::Zero();  // low-passed in-plane velocity for the off-stroke damper
+  Vec2 off_stroke_anchor_ = Vec2::Zero();    // adhesion point of the off-stroke friction in CS
+  bool anchor_valid_ = false;
+  double off_stroke_alpha_ = 1.0;  // its filter coefficient per tick
   // Smoothing state.
   Vec2 rendered_foot_ = Vec2::Zero();  // attraction target, rate-limited towards the tracked foot
   bool foot_valid_ = false;

@@ -1,0 +1,56 @@
+#pragma once
+// The simulated writer's motion program (private to the sim module): segments of minimum-jerk motion
+// (Flash & Hogan 1985) along polylines, advanced by a phase whose rate the writer sets online, so that
+// a segment keeps its bell-shaped speed profile while its duration follows the writer's pace.
+#include <cstddef>
+#include <limits>
+#include <vector>
+
+#include "calligraphy/core/geometry.hpp"
+
+namespace calligraphy::writer_detail {
+
+enum class SegmentKind {
+  travel,   // pen up, towards the next start
+  descend,  // pen up to hovering above the start
+  touch,    // onto the paper
+  write,    // along a stroke element (steered: speed from the seen error)
+  lift,     // off the paper
+  pause,    // holding still (a hesitation, the top of a mid-stroke lift)
+  stray,    // sliding on the paper outside the character's box
+};
+
+struct Segment {
+  SegmentKind kind = SegmentKind::travel;
+  std::vector<Vec3> path;     // at least one point, device frame [m]
+  std::vector<double> arc;    // cumulative length along path [m]
+  double duration_s = 0.0;    // at speed factor 1
+  bool steered = false;       // write segments: the rate follows the writer's speed factor
+  int element = -1;           // reference element written (index within the stroke), -1 none
+  bool aim_at_start = false;  // the writer corrects towards the stroke's start while on it
+  bool mid_stroke = false;    // part of a lift in the middle of a stroke
+  double follow_from_m = std::numeric_limits<double>::infinity();  // arc beyond which it is follow-through
+
+  [[nodiscard]] double length_m() const { return arc.empty() ? 0.0 : arc.back(); }
+  /// Point at arc length `s` [m], clamped to the path.
+  [[nodiscard]] Vec3 at_arc(double s) const;
+  /// Unit in-plane direction of the path at arc length `s` (zero for a point).
+  [[nodiscard]] Vec2 direction_at_arc(double s) const;
+  /// Point at phase `phase` in [0, 1] of the minimum-jerk profile.
+  [[nodiscard]] Vec3 at_phase(double phase) const { return at_arc(length_m() * minimum_jerk(phase)); }
+  /// Minimum-jerk position profile on [0, 1]: 10 p^3 - 15 p^4 + 6 p^5 (Flash & Hogan 1985).
+  [[nodiscard]] static double minimum_jerk(double phase);
+};
+
+/// A segment through `path` lasting max(minimum_s, length / speed_m_s) at speed factor 1.
+Segment make_segment(SegmentKind kind, std::vector<Vec3> path, double speed_m_s, double minimum_s);
+
+/// Nearest point to `p` on the polyline `points` (at least one point) and the unit direction of the
+/// polyline there (zero for a single point).
+struct PolylineFoot {
+  Vec2 foot = Vec2::Zero();
+  Vec2 direction = Vec2::Zero();
+};
+PolylineFoot nearest_on_polyline(const std::vector<Vec2>& points, const Vec2& p);
+
+}  // namespace calligraphy::writer_detail

@@ -1,0 +1,83 @@
+// Writer profiles: the three named profiles, validation naming the field, and setting fields by name.
+#include "calligraphy/sim/writer_profile.hpp"
+
+#include <catch2/catch.hpp>
+#include <string>
+
+#include "calligraphy/core/errors.hpp"
+
+using namespace calligraphy;
+
+TEST_CASE("The named profiles are valid and differ as described", "[writer]") {
+  const WriterProfile novice = WriterProfile::novice();
+  const WriterProfile skilled = WriterProfile::skilled();
+  const WriterProfile foreign = WriterProfile::foreign();
+  for (const WriterProfile& p : {novice, skilled, foreign}) CHECK_NOTHROW(p.validate());
+  CHECK(novice.name == "novice");
+  CHECK(writer_profile("skilled").name == "skilled");
+  CHECK(writer_profile("foreign").name == "foreign");
+  // The paper's foreign student: larger bias, order and direction errors, slower.
+  CHECK(foreign.bias_offset_m > novice.bias_offset_m);
+  CHECK(foreign.scale_error > novice.scale_error);
+  CHECK(foreign.order_error_probability > 0.0);
+  CHECK(foreign.backwards_probability > 0.0);
+  CHECK(foreign.writing_speed_m_s < novice.writing_speed_m_s);
+  CHECK(novice.order_error_probability == 0.0);
+  CHECK(skilled.writing_speed_m_s > novice.writing_speed_m_s);
+  CHECK(skilled.bias_offset_m < novice.bias_offset_m);
+  CHECK_THROWS_WITH(writer_profile("expert"), Catch::Contains("expert") && Catch::Contains("foreign"));
+}
+
+TEST_CASE("validate names the field that is out of range", "[writer]") {
+  WriterProfile p;
+  p.writing_speed_m_s = -0.01;
+  CHECK_THROWS_WITH(p.validate(), Catch::Contains("writing_speed_m_s"));
+  p = WriterProfile{};
+  p.order_error_probability = 1.5;
+  CHECK_THROWS_WITH(p.validate(), Catch::Contains("order_error_probability"));
+  p = WriterProfile{};
+  p.visual_delay_s = std::nan("");
+  CHECK_THROWS_WITH(p.validate(), Catch::Contains("visual_delay_s"));
+  p = WriterProfile{};
+  p.max_attempts_per_stroke = 0;
+  CHECK_THROWS_WITH(p.validate(), Catch::Contains("max_attempts_per_stroke"));
+}
+
+TEST_CASE("Writer parameters are set by name, and an unknown name is refused naming it", "[writer]") {
+  WriterProfile p;
+  set_writer_parameter(p, "bias_offset_m", 0.004);
+  CHECK(p.bias_offset_m == 0.004);
+  CHECK(writer_parameter(p, "bias_offset_m") == 0.004);
+  set_writer_parameter(p, "max_attempts_per_stroke", 7.0);
+  CHECK(p.max_attempts_per_stroke == 7);
+  CHECK_THROWS_WITH(set_writer_parameter(p, "max_attempts_per_stroke", 2.5), Catch::Contains("whole number"));
+  CHECK_THROWS_WITH(set_writer_parameter(p, "bias_offset", 0.004),
+                    Catch::Contains("'bias_offset'") && Catch::Contains("bias_offset_m"));
+  CHECK_THROWS_WITH(writer_parameter(p, "speed"), Catch::Contains("'speed'"));
+  // A refused value leaves the profile as it was.
+  const WriterProfile before = p;
+  CHECK_THROWS_WITH(set_writer_parameter(p, "hand_stiffness_n_per_m", -5.0),
+                    Catch::Contains("hand_stiffness_n_per_m"));
+  CHECK(p.hand_stiffness_n_per_m == before.hand_stiffness_n_per_m);
+  // Every listed name can be read and written back.
+  for (const std::string& key : writer_parameter_names()) {
+    INFO(key);
+    WriterProfile q = WriterProfile::foreign();
+    const double value = writer_parameter(q, key);
+    CHECK_NOTHROW(set_writer_parameter(q, key, value));
+    CHECK(writer_parameter(q, key) == value);
+  }
+}
+
+TEST_CASE("A key=value setting as given on a command line", "[writer]") {
+  WriterProfile p;
+  apply_writer_setting(p, "order_error_probability=0.3");
+  CHECK(p.order_error_probability == 0.3);
+  apply_writer_setting(p, "visual_delay_s=1.5e-1");
+  CHECK(p.visual_delay_s == 0.15);
+  CHECK_THROWS_WITH(apply_writer_setting(p, "order_error_probability"), Catch::Contains("key=value"));
+  CHECK_THROWS_WITH(apply_writer_setting(p, "visual_delay_s=fast"),
+                    Catch::Contains("'fast' is not a number"));
+  CHECK_THROWS_WITH(apply_writer_setting(p, "visual_delay_s=0.1s"), Catch::Contains("not a number"));
+  CHECK_THROWS_WITH(apply_writer_setting(p, "delay=0.1"), Catch::Contains("'delay'"));
+}
