@@ -43,7 +43,7 @@ struct Run {
   std::size_t refusals = 0;
 };
 
-// One lock-step trial, as run_device_trial runs it on the simulated device, keeping the writer.
+// One lock-step trial, as run_trial runs it on the simulated device, keeping the writer.
 Run run_trial(const Scene& scene, const WriterProfile& profile, bool guidance, std::uint64_t seed) {
   SimulatedDeviceParameters device_parameters;
   SimulatedDevice device(device_parameters);
@@ -53,7 +53,6 @@ Run run_trial(const Scene& scene, const WriterProfile& profile, bool guidance, s
   ForceLawParameters force;
   force.guidance = guidance;
   RendererOptions options;
-  options.device_damping_n_s_per_m = device_parameters.damping_n_s_per_m;
   Renderer renderer(scene, force, device.info(), options);
   device.enable_forces(true);
   TrialRecorder recorder(scene, true);
@@ -85,7 +84,7 @@ Run run_trial(const Scene& scene, const WriterProfile& profile, bool guidance, s
   run.guidance = guidance;
   run.seed = seed;
   run.deviation_mm = score.totals.deviation ? score.totals.deviation->mean_m * 1e3 : std::nan("");
-  run.renderer_deviation_mm = recorder.metrics().mean_deviation_m * 1e3;
+  run.renderer_deviation_mm = recorder.metrics().mean_deviation_m.value_or(std::nan("")) * 1e3;
   run.time_s = score.totals.total_time_s;
   run.order_errors = score.order_errors;
   run.backwards = score.backwards_strokes;

@@ -102,7 +102,7 @@ TEST_CASE("Guidance modes have names", "[guidance]") {
   CHECK_FALSE(guidance_mode_from_string("haptic").has_value());
 }
 
-TEST_CASE("Fading scales F_et by its gain; the fixed mode ignores the gain", "[guidance]") {
+TEST_CASE("Fading scales F_et by its gain and the fixed mode ignores the gain", "[guidance]") {
   ForceLawParameters fixed = exact();
   fixed.resistance_damping_n_s_per_m = 0.0;
   const Vec2 full = guidance_at_offset(fixed);

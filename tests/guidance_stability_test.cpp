@@ -127,7 +127,6 @@ HoldRun hold_in_writing(GuidanceMode mode, Hand hand, double rate_hz, double sti
   }
   RendererOptions options;
   options.rate_hz = rate_hz;
-  options.device_damping_n_s_per_m = device_parameters.damping_n_s_per_m;
   Renderer renderer(scene, force, device.info(), options);
   HoldRun run;
   double energy = 0.0;

@@ -115,7 +115,7 @@ TEST_CASE("A stroke cleared after a lift in its middle is written again, with or
   }
 }
 
-TEST_CASE("Touches outside the box are AS and change nothing else; hesitations take time", "[writer]") {
+TEST_CASE("Touches outside the box are AS and change nothing else and hesitations take time", "[writer]") {
   const Scene scene = scene_of(U'口');
   WriterTrialOptions plain;
   plain.writer = careful_novice();

@@ -41,7 +41,6 @@ inline WriterTrial run_writer_trial(const Scene& scene, const WriterTrialOptions
   RendererOptions render;
   render.rate_hz = options.rate_hz;
   render.safety = options.safety;
-  render.device_damping_n_s_per_m = device_parameters.damping_n_s_per_m;
   Renderer renderer(scene, options.force, device.info(), render);
   device.enable_forces(true);
   TrialRecorder recorder(scene, true);

@@ -12,6 +12,7 @@
 #include "bindings.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/render/force_law.hpp"
+#include "calligraphy/render/guidance_mode.hpp"
 #include "calligraphy/render/interaction_state.hpp"
 #include "calligraphy/render/renderer.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
@@ -21,6 +22,32 @@
 
 namespace calligraphy::python {
 namespace {
+
+void bind_guidance(py::module_& m) {
+  py::enum_<GuidanceMode>(m, "GuidanceMode", "How F_et attracts (docs/force-rendering.md, Guidance modes).")
+      .value("fixed", GuidanceMode::fixed, "eq. (8): the paper's fixed virtual fixture")
+      .value("fading", GuidanceMode::fading,
+             "eq. (8) scaled by guidance_gain (Marchal-Crespo & Reinkensmeyer)")
+      .value(
+          "replay", GuidanceMode::replay,
+          "the attraction point follows a teacher's recording in time (Henmi & Yoshikawa 1998; Feygin et al. "
+          "2002)");
+  py::class_<TeacherSample>(m, "TeacherSample", "One sample of a teacher's recorded pen.")
+      .def(py::init([](double time_s, const py::object& position_m) {
+             return TeacherSample{time_s, as_vec3(position_m, "position_m")};
+           }),
+           py::kw_only(), py::arg("time_s"), py::arg("position_m"),
+           "time_s [s]; position_m, 3 floats, the pen in the device frame [m]")
+      .def_readonly("time_s", &TeacherSample::time_s, "time [s]")
+      .def_property_readonly(
+          "position_m", [](const TeacherSample& t) { return to_array(t.position_m); },
+          "(3,) float64, the pen in the device frame [m]")
+      .def("__repr__", [](const TeacherSample& t) {
+        return "TeacherSample(time_s=" + std::to_string(t.time_s) + ", position_m=[" +
+               std::to_string(t.position_m.x()) + ", " + std::to_string(t.position_m.y()) + ", " +
+               std::to_string(t.position_m.z()) + "])";
+      });
+}
 
 void bind_force_law_parameters(py::module_& m) {
   ParameterClass<ForceLawParameters>(
@@ -41,6 +68,23 @@ void bind_force_law_parameters(py::module_& m) {
              "height above the paper at which a touching tip counts as lifted (section 6) [m]")
       .field("guidance", &ForceLawParameters::guidance,
              "in-plane guidance on (F_et and the resistance force); the paper force is always rendered")
+      .field("guidance_mode", &ForceLawParameters::guidance_mode,
+             "how F_et attracts, a GuidanceMode (fixed as eq. 8, fading by guidance_gain, or replay of a "
+             "teacher)")
+      .field("guidance_gain", &ForceLawParameters::guidance_gain,
+             "scale of F_et in the fading mode, in [0, 1]")
+      .field("replay_max_lead_m", &ForceLawParameters::replay_max_lead_m,
+             "replay: the farthest the attraction point leads the pen [m], in (0, constraint_radius_m]")
+      .field("off_stroke_force_n", &ForceLawParameters::off_stroke_force_n,
+             "friction against writing away from the active stroke in CS [N], >= 0; 0 = the paper's CS")
+      .field("off_stroke_travel_m", &ForceLawParameters::off_stroke_travel_m,
+             "travel before the off-stroke friction reaches its force [m], > 0")
+      .field("off_stroke_damping_n_s_per_m", &ForceLawParameters::off_stroke_damping_n_s_per_m,
+             "damping of motion away from the active element in WS outside R_res [N s/m], >= 0")
+      .field("off_stroke_speed_m_s", &ForceLawParameters::off_stroke_speed_m_s,
+             "speed below which that damping fades out [m/s], > 0")
+      .field("off_stroke_velocity_cutoff_hz", &ForceLawParameters::off_stroke_velocity_cutoff_hz,
+             "low-pass on the velocity the off-stroke damping reads [Hz], > 0")
       .field("constraint_taper_m", &ForceLawParameters::constraint_taper_m,
              "band at R_res over which F_et tapers to zero [m], in [0, R_res]; 0 = the paper's step")
       .field("crossfade_s", &ForceLawParameters::crossfade_s,
@@ -59,7 +103,18 @@ void bind_force_law_parameters(py::module_& m) {
              "stick band of the friction [m/s], > 0: viscous below it")
       .field("nearest", &ForceLawParameters::nearest,
              "NearestPointOptions: how the foot point X_S on curve elements is found")
-      .finish();
+      .finish()
+      // Not a ParameterClass field (a list, not a value): not in to_dict() or the constructor.
+      .def_property(
+          "teacher_trajectory", [](const ForceLawParameters& p) { return p.teacher_trajectory; },
+          [](ForceLawParameters& p, const std::vector<TeacherSample>& samples) {
+            ForceLawParameters copy = p;
+            copy.teacher_trajectory = samples;
+            copy.validate();
+            p = std::move(copy);
+          },
+          "The teacher's recorded pen for the replay mode, a list of TeacherSample in the device frame [m] "
+          "(checked when guidance_mode is replay)");
 }
 
 double number(const Checked<double>& value, const char* name) { return take(value, name); }
@@ -352,6 +407,7 @@ void bind_renderer(py::module_& m) {
 }  // namespace
 
 void bind_render(py::module_& m) {
+  bind_guidance(m);
   bind_force_law_parameters(m);
   bind_force_functions(m);
   bind_interaction_state(m);

@@ -50,43 +50,84 @@ void check_writer(const WriterProfile& w) {
 void bind_writer_profile(py::module_& m) {
   ParameterClass<WriterProfile>(
       m, "WriterProfile",
-      "How a simulated writer writes (include/calligraphy/sim/simulated_writer.hpp): a hand impedance "
+      "How a simulated writer writes (include/calligraphy/sim/writer_profile.hpp, docs/writer.md): a hand "
+      "impedance "
       "F = k (x_d - x) + b (x_d' - x') + noise + tremor holding the stylus, moving x_d with minimum-jerk "
       "timing (Flash & Hogan 1985) along a biased copy of the reference; force noise grows with the force "
-      "(Harris & Wolpert 1998). Units as named. WriterProfile.novice() and .skilled() are the presets.",
+      "(Harris & Wolpert 1998). Units as named. WriterProfile.novice(), .skilled() and .foreign() are the "
+      "presets.",
       check_writer)
       .field("name", &WriterProfile::name, "a label, reported as the trial's 'writer'")
       .field("hand_stiffness_n_per_m", &WriterProfile::hand_stiffness_n_per_m,
-             "k of the hand impedance [N/m], > 0")
-      .field("hand_damping_n_s_per_m", &WriterProfile::hand_damping_n_s_per_m,
-             "b of the hand impedance [N s/m]")
+             "k [N/m], > 0 (a relaxed grip; assumed)")
+      .field("hand_damping_n_s_per_m", &WriterProfile::hand_damping_n_s_per_m, "b [N s/m], >= 0")
+      .field("noise_fraction", &WriterProfile::noise_fraction,
+             "signal-dependent force noise, std dev / |F| (Harris & Wolpert 1998)")
+      .field("tremor_amplitude_n", &WriterProfile::tremor_amplitude_n,
+             "in-plane tremor force amplitude [N], >= 0")
+      .field("tremor_frequency_hz", &WriterProfile::tremor_frequency_hz,
+             "tremor frequency [Hz], > 0 (8-12 Hz physiological)")
       .field("writing_speed_m_s", &WriterProfile::writing_speed_m_s,
-             "mean speed along an element while writing [m/s]")
-      .field("travel_speed_m_s", &WriterProfile::travel_speed_m_s, "mean speed of pen-up moves [m/s]")
+             "mean writing speed with the pen on the stroke [m/s], > 0")
+      .field("travel_speed_m_s", &WriterProfile::travel_speed_m_s, "mean speed of pen-up moves [m/s], > 0")
       .field("press_depth_m", &WriterProfile::press_depth_m,
-             "how far below the paper the hand aims while writing [m]")
+             "how far below the paper the hand aims while writing [m], >= 0")
       .field("lift_height_m", &WriterProfile::lift_height_m, "pen-up height above the paper [m], > 0")
-      .field("bias_offset_m", &WriterProfile::bias_offset_m,
-             "systematic offset of the whole character copy [m]")
+      .field("overshoot_m", &WriterProfile::overshoot_m,
+             "follow-through past turns and the stroke's end [m], >= 0")
+      .field("bias_offset_m", &WriterProfile::bias_offset_m, "offset of the whole copy [m], >= 0")
       .field("scale_error", &WriterProfile::scale_error,
              "relative mis-scale of the copy about the character centre, in (-0.5, 0.5)")
-      .field("stroke_jitter_m", &WriterProfile::stroke_jitter_m, "std dev of a per-stroke random offset [m]")
-      .field("noise_fraction", &WriterProfile::noise_fraction,
-             "signal-dependent force noise, std dev / |F_hand|")
-      .field("tremor_amplitude_n", &WriterProfile::tremor_amplitude_n, "in-plane tremor force amplitude [N]")
-      .field("tremor_frequency_hz", &WriterProfile::tremor_frequency_hz,
-             "tremor frequency [Hz] (8-12 Hz physiological)")
-      .field("overshoot_m", &WriterProfile::overshoot_m, "follow-through past each feature point [m]")
+      .field("stroke_jitter_m", &WriterProfile::stroke_jitter_m,
+             "std dev of a per-attempt random offset [m], >= 0")
+      .field("visual_delay_s", &WriterProfile::visual_delay_s,
+             "visuomotor delay [s], in [0, 0.5] (Miall et al. 1993; Saunders & Knill 2005)")
+      .field("vision_period_s", &WriterProfile::vision_period_s,
+             "interval between visual updates [s], in [0.001, 0.1]")
+      .field("correction_rate_per_s", &WriterProfile::correction_rate_per_s,
+             "rate at which a seen error beyond the tolerance is removed [1/s], >= 0")
+      .field("error_tolerance_m", &WriterProfile::error_tolerance_m,
+             "seen error the writer leaves uncorrected [m], >= 0")
+      .field("steering_width_m", &WriterProfile::steering_width_m,
+             "width W of the tunnel in the steering law v = (W - 2|e|) / tau [m], > 0")
+      .field("min_speed_fraction", &WriterProfile::min_speed_fraction,
+             "least share of `writing_speed_m_s` however large the error, in (0, 1]")
+      .field("error_filter_s", &WriterProfile::error_filter_s,
+             "time constant of the seen error that sets the speed [s], > 0")
+      .field("speed_time_constant_s", &WriterProfile::speed_time_constant_s,
+             "time constant of the speed command [s], > 0")
+      .field("reaction_time_s", &WriterProfile::reaction_time_s,
+             "how long a resistance lasts before the writer reacts [s], > 0")
+      .field("resistance_threshold_n", &WriterProfile::resistance_threshold_n,
+             "in-plane force against the intended motion that counts as resistance [N], > 0")
+      .field("expected_drag_ratio", &WriterProfile::expected_drag_ratio,
+             "paper drag the writer takes as normal, share of the normal force, >= 0")
       .field("correction_per_attempt", &WriterProfile::correction_per_attempt,
-             "share of the bias removed on each re-aim after a missed stroke, in [0, 1]")
+             "share of the bias and error rates removed on each re-attempt, in [0, 1]")
       .field("max_attempts_per_stroke", &WriterProfile::max_attempts_per_stroke,
-             "attempts before giving up, >= 1")
+             "attempts at one stroke before the writer gives up, >= 1")
+      .field("order_error_probability", &WriterProfile::order_error_probability,
+             "a stroke is swapped with the next one in the writer's order")
+      .field("backwards_probability", &WriterProfile::backwards_probability,
+             "a stroke is written from its end to its start")
+      .field("mid_stroke_lift_probability", &WriterProfile::mid_stroke_lift_probability,
+             "the pen is lifted in the middle of a stroke")
+      .field("outside_touch_probability", &WriterProfile::outside_touch_probability,
+             "the pen touches the paper outside the character's box (AS)")
+      .field("hesitation_probability", &WriterProfile::hesitation_probability,
+             "the writer pauses before a stroke or at a feature point")
+      .field("hesitation_s", &WriterProfile::hesitation_s, "mean length of a pause [s], >= 0")
+      .field("learning_rate", &WriterProfile::learning_rate,
+             "lambda of the exponential practice law per repetition, >= 0; 0 = no learning")
       .finish()
       .def_static(
           "novice", &WriterProfile::novice,
           "A relaxed learner with a visible bias (150 N/m, 3 N s/m: assumed grip figures, not measured).")
       .def_static("skilled", &WriterProfile::skilled,
-                  "A stiffer, faster, nearly unbiased writer (600 N/m, 8 N s/m).");
+                  "A stiffer, faster, nearly unbiased writer without errors.")
+      .def_static("foreign", &WriterProfile::foreign,
+                  "The paper's foreign student (section 7): larger bias, strokes out of order and backwards, "
+                  "slower.");
 }
 
 void bind_simulated_device(py::module_& m) {

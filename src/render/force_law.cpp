@@ -38,10 +38,13 @@ void ForceLawParameters::validate() const {
                           " must be in [0, 1]");
   }
   if (guidance_mode == GuidanceMode::replay) validate_teacher_trajectory(teacher_trajectory);
-  if (!(replay_max_lead_m > 0.0 && replay_max_lead_m <= constraint_radius_m)) {
+  // The lead is bounded by the constraint space only where it is used: a replay's attraction point must
+  // stay within R_res of the pen.
+  const double max_lead_m = guidance_mode == GuidanceMode::replay ? constraint_radius_m : 1.0;
+  if (!(replay_max_lead_m > 0.0 && replay_max_lead_m <= max_lead_m)) {
     throw InvalidArgument("ForceLawParameters.replay_max_lead_m = " + std::to_string(replay_max_lead_m) +
-                          " must be in (0, constraint_radius_m = " + std::to_string(constraint_radius_m) +
-                          "]");
+                          " must be in (0, " + std::to_string(max_lead_m) + "] m" +
+                          (guidance_mode == GuidanceMode::replay ? " (constraint_radius_m in replay)" : ""));
   }
   if (constraint_taper_m > constraint_radius_m) {
     throw InvalidArgument("ForceLawParameters.constraint_taper_m = " + std::to_string(constraint_taper_m) +

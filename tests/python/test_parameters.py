@@ -31,7 +31,7 @@ def cpp_fields(header, struct):
     [
         (calligraphy.ForceLawParameters, "render/force_law.hpp", "ForceLawParameters"),
         (calligraphy.NearestPointOptions, "collision/nearest_point.hpp", "NearestPointOptions"),
-        (calligraphy.WriterProfile, "sim/simulated_writer.hpp", "WriterProfile"),
+        (calligraphy.WriterProfile, "sim/writer_profile.hpp", "WriterProfile"),
         (calligraphy.SimulatedDeviceParameters, "sim/simulated_device.hpp", "SimulatedDeviceParameters"),
         (calligraphy.DeviceInfo, "core/device_types.hpp", "DeviceInfo"),
         (calligraphy.DeviceState, "core/device_types.hpp", "DeviceState"),
@@ -40,7 +40,9 @@ def cpp_fields(header, struct):
 def test_every_cpp_field_is_bound(cls, header, struct):
     fields = cpp_fields(header, struct)
     assert len(fields) >= 4
-    assert list(cls().to_dict()) == fields
+    # Lists (a teacher's recording) are properties, not values of to_dict() and the constructor.
+    lists = {"teacher_trajectory"}
+    assert list(cls().to_dict()) == [f for f in fields if f not in lists]
     for name in fields:
         assert getattr(cls, name).__doc__, f"{struct}.{name} has no documentation"
 
