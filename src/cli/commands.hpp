@@ -13,6 +13,8 @@ void add_strokes_command(CLI::App& root, Commands& commands);  // strokes [--mar
 void add_devices_command(CLI::App& root, Commands& commands);  // devices [--json]
 void add_corpus_commands(CLI::App& root, Commands& commands);  // corpus build|stats|fidelity|validate
 void add_bench_commands(CLI::App& root, Commands& commands);   // bench nearest|jumps|tick|loop
+void add_session_commands(CLI::App& root, Commands& commands);  // session run|resume
+void add_report_command(CLI::App& root, Commands& commands);    // report DIR... --out FILE
 
 // The subcommands of the groups, one file each.
 void add_corpus_build_command(CLI::App& corpus, Commands& commands);
