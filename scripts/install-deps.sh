@@ -12,6 +12,7 @@ packages=(
   pkg-config lib2geom-dev            # lib2geom column of `bench nearest` (optional at configure time)
   pybind11-dev python3-dev python3-numpy python3-pytest
   nodejs npm                          # npm pack for hanzi-writer-data
+  chromium                            # the study report loaded headless (tests/study; optional, skipped without)
 )
 
 missing=()

@@ -261,3 +261,46 @@ TEST_CASE("the report page escapes what sessions wrote", "[study][report]") {
   CHECK(page.find("S&lt;1&gt;") != std::string::npos);
   CHECK(page.find("&quot;&amp;&#39;") != std::string::npos);
 }
+
+TEST_CASE("a crash between saving a trial and logging it, or in a log line, is mended on resume",
+          "[study][session]") {
+  TempFolder temp;
+  fs::path folder;
+  {
+    SessionFolder session = SessionFolder::create(temp.path, simulated("S05"), small_protocol());
+    folder = session.path();
+    StopAfter host(1);
+    SessionRunOptions options;
+    options.host = &host;
+    options.should_stop = [&] { return host.ended >= 1; };
+    REQUIRE(run_session(session, options).saved_now == 1);
+  }
+  // As if the process died after the trial's JSON was linked but before its log line, in the middle of a
+  // later line.
+  std::string kept;
+  {
+    std::ifstream log(folder / "log.jsonl");
+    for (std::string line; std::getline(log, line);) {
+      if (nlohmann::json::parse(line).at("event") != "trial_saved") kept += line + "\n";
+    }
+  }
+  std::ofstream(folder / "log.jsonl", std::ios::trunc) << kept << "{\"event\": \"tri";
+  SessionFolder resumed = SessionFolder::open(folder);
+  REQUIRE(run_session(resumed).complete());
+  std::ifstream log(folder / "log.jsonl");
+  std::size_t saved = 0, recovered = 0, torn = 0;
+  for (std::string line; std::getline(log, line);) {
+    if (!nlohmann::json::accept(line)) {
+      ++torn;
+      continue;
+    }
+    const auto event = nlohmann::json::parse(line);
+    if (event.at("event") == "trial_saved") {
+      ++saved;
+      recovered += event.value("recovered", false) ? 1 : 0;
+    }
+  }
+  CHECK(torn == 1);  // the torn line stands alone, every later line is whole
+  CHECK(saved == 3);
+  CHECK(recovered == 1);
+}

@@ -42,8 +42,7 @@ void add_report_command(CLI::App& root, Commands& commands) {
                                [command] { return run_report(*command); });
   app->add_option("DIR", command->folders,
                   "session folders, or folders holding them (e.g. a `session run --out` folder)")
-      ->required()
-      ->type_name("DIR...");
+      ->required();
   required(add_output_path(*app, "--out", command->out, "the HTML page", StandardOutput::allowed));
 }
 

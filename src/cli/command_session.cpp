@@ -29,7 +29,7 @@ struct SessionRunCommand {
   const CLI::Option* subject_number_option = nullptr;
   std::int64_t subjects = 0;
   std::string device = "simulated";
-  std::string writer;
+  std::string writer = "auto";
   std::string writer_profile = "novice";
   std::string pacing = "auto";
   std::string out;
@@ -140,7 +140,7 @@ int run_sessions(const SessionRunCommand& command) {
     throw UsageError("--device: unknown device '" + command.device + "'; registered devices: " + names);
   }
   const std::string writer =
-      command.writer.empty() ? (device->hardware ? "human" : "simulated") : command.writer;
+      command.writer == "auto" ? (device->hardware ? "human" : "simulated") : command.writer;
   if (writer == "simulated" && device->hardware) {
     throw UsageError("--writer simulated: the device '" + command.device + "' is moved by a person");
   }
@@ -223,9 +223,11 @@ void add_session_commands(CLI::App& root, Commands& commands) {
       commands.add_group(root, "session", "Study sessions: run a protocol, resume a stopped session");
 
   auto run = std::make_shared<SessionRunCommand>();
-  CLI::App* app =
-      commands.add(*group, "run", "Run a study protocol for one subject, or for N simulated subjects",
-                   [run] { return run_sessions(*run); });
+  CLI::App* app = commands.add(
+      *group, "run",
+      "Run a study protocol for one subject, or for N simulated subjects; SIGINT or SIGTERM stops it "
+      "after keeping the running trial (exit status 128 + the signal)",
+      [run] { return run_sessions(*run); });
   add_positional(*app, "PROTOCOL", run->protocol, "the study protocol (JSON; docs/experiments.md)");
   add_text(*app, "--subject", run->subject, "ID",
            "the subject's id (letters, digits, '_', '-'); with --subjects, the prefix of the simulated ids",

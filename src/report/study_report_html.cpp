@@ -347,8 +347,9 @@ table.summary td,table.summary th{border:1px solid #ccc;padding:.25em .5em}
 table.summary caption{text-align:left;font-weight:bold;padding:.2em 0}
 td.num{text-align:right;font-variant-numeric:tabular-nums}.n{color:#888;font-size:.85em}
 figure{margin:.3em;display:inline-block;vertical-align:top}figcaption{font-size:.75em;color:#555;max-width:380px}
+figure.trajectory figcaption{max-width:220px}
 .trials{display:flex;flex-wrap:wrap;gap:.6em}
-article.trial{flex:0 0 auto;width:640px;border:1px solid #ddd;border-radius:4px;padding:.3em .6em;background:#fafafa}
+article.trial{flex:0 0 auto;width:620px;border:1px solid #ddd;border-radius:4px;padding:.3em .6em;background:#fafafa}
 article.trial h4{margin:.2em 0}.glyph{font-size:1.3em}p.metrics{font-size:.8em;margin:.2em 0}
 .figures{display:flex;flex-wrap:wrap;align-items:flex-start}
 ul.sessions{font-size:.85em}

@@ -179,8 +179,25 @@ SessionFolder SessionFolder::open(const fs::path& folder) {
   SessionManifest manifest = study_detail::manifest_from_json(text, manifest_path.string());
   manifest.session_id = folder.filename().string();
   if (manifest.session_id.empty()) manifest.session_id = folder.parent_path().filename().string();
-  const int fd = open_locked_log(folder / "log.jsonl");
-  return SessionFolder(folder, std::move(manifest), fd);
+  const fs::path log_path = folder / "log.jsonl";
+  const int fd = open_locked_log(log_path);
+  SessionFolder session(folder, std::move(manifest), fd);
+  // A crash in the middle of a log line leaves it torn: end it, so that the next line stands alone.
+  std::error_code error;
+  const std::uintmax_t size = fs::file_size(log_path, error);
+  if (!error && size > 0) {
+    const int reader = ::open(log_path.c_str(), O_RDONLY | O_CLOEXEC);
+    char last = '\n';
+    if (reader >= 0) {
+      if (::pread(reader, &last, 1, static_cast<off_t>(size - 1)) != 1) last = '\n';
+      ::close(reader);
+    }
+    if (last != '\n') {
+      write_all(fd, "\n", log_path);
+      if (::fsync(fd) != 0) fail_errno(log_path, "cannot sync the session log", errno);
+    }
+  }
+  return session;
 }
 
 std::string SessionFolder::trial_stem(const PlannedTrial& trial) {

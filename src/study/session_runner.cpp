@@ -3,6 +3,7 @@
 #include <chrono>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
@@ -55,6 +56,33 @@ json trial_details(const PlannedTrial& trial) {
   return {{"trial", trial.index + 1},       {"phase", to_string(trial.phase)},
           {"condition", trial.condition},   {"characters", utf8(trial.characters)},
           {"repetition", trial.repetition}, {"file", SessionFolder::trial_stem(trial)}};
+}
+
+// Trials saved by a run that crashed before it could log them get their "trial_saved" line now, marked
+// recovered, so that the log names every saved trial once.
+void log_unlogged_saves(SessionFolder& session) {
+  const std::filesystem::path log_path = session.path() / "log.jsonl";
+  const std::string text = study_detail::read_small_file(log_path, std::uintmax_t{256} << 20, "session log");
+  std::set<std::string> logged;
+  std::size_t begin = 0;
+  while (begin < text.size()) {
+    std::size_t end = text.find('\n', begin);
+    if (end == std::string::npos) end = text.size();
+    try {
+      const json line = json::parse(text.begin() + static_cast<std::ptrdiff_t>(begin),
+                                    text.begin() + static_cast<std::ptrdiff_t>(end));
+      if (line.value("event", "") == "trial_saved") logged.insert(line.value("file", ""));
+    } catch (const json::exception&) {
+      // a line torn by a crash: it names nothing
+    }
+    begin = end + 1;
+  }
+  for (const PlannedTrial& trial : session.plan()) {
+    if (!session.is_saved(trial) || logged.count(SessionFolder::trial_stem(trial)) > 0) continue;
+    json details = trial_details(trial);
+    details["recovered"] = true;
+    session.log("trial_saved", details.dump());
+  }
 }
 
 }  // namespace
@@ -124,6 +152,7 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
   result.planned = session.plan().size();
   result.saved_before = session.saved_count();
   const std::optional<std::size_t> first = session.next_unsaved();
+  if (result.saved_before > 0) log_unlogged_saves(session);
   session.log(result.saved_before == 0 ? "session_started" : "session_resumed",
               json{{"saved_trials", result.saved_before},
                    {"next_trial", first ? json(*first + 1) : json(nullptr)},
