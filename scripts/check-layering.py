@@ -2,7 +2,7 @@
 """Fails when a source file includes a module above its own.
 
 The modules, lowest first (docs/architecture.md): core, model, collision, render, devices, sim (its testing
-part, the emulator, only for eval and programs), trial, report, eval, then the programs (cli, bindings, tests, bench, examples, fuzz),
+part, the emulator, only for eval and programs), trial, report, study, eval, then the programs (cli, bindings, tests, bench, examples, fuzz),
 which may include any module. A file's module is the folder after src/ or include/calligraphy/; an
 include's module is the folder after calligraphy/ (a public header) or the first folder of a private
 header under src/. Usage: check-layering.py [ROOT] -> exit 1 listing each upward include as
@@ -12,7 +12,7 @@ import pathlib
 import re
 import sys
 
-ORDER = ["core", "model", "collision", "render", "devices", "sim", "testing", "trial", "report", "eval"]
+ORDER = ["core", "model", "collision", "render", "devices", "sim", "testing", "trial", "report", "study", "eval"]
 RANK = {name: rank for rank, name in enumerate(ORDER)}
 INCLUDE = re.compile(r'^\s*#\s*include\s*"([^"]+)"')
 

@@ -15,6 +15,7 @@ packages=(
   python3-dask python3-distributed    # parallel experiments from Python
   fonts-arphic-ukai                   # a CJK font for calligraphy.plot
   nodejs npm                          # npm pack for hanzi-writer-data
+  chromium                            # the study report loaded headless (tests/study; optional, skipped without)
 )
 
 missing=()

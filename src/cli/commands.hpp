@@ -6,13 +6,15 @@
 
 namespace calligraphy::cli {
 
-void add_trial_command(CLI::App& root, Commands& commands);    // trial CHARS [...]
-void add_score_command(CLI::App& root, Commands& commands);    // score TRACE.csv --character C [...]
-void add_model_command(CLI::App& root, Commands& commands);    // model CHAR [...]
-void add_strokes_command(CLI::App& root, Commands& commands);  // strokes [--markdown FILE] [--json]
-void add_devices_command(CLI::App& root, Commands& commands);  // devices [--json]
-void add_corpus_commands(CLI::App& root, Commands& commands);  // corpus build|stats|fidelity|validate
-void add_bench_commands(CLI::App& root, Commands& commands);   // bench nearest|jumps|tick|loop
+void add_trial_command(CLI::App& root, Commands& commands);     // trial CHARS [...]
+void add_score_command(CLI::App& root, Commands& commands);     // score TRACE.csv --character C [...]
+void add_model_command(CLI::App& root, Commands& commands);     // model CHAR [...]
+void add_strokes_command(CLI::App& root, Commands& commands);   // strokes [--markdown FILE] [--json]
+void add_devices_command(CLI::App& root, Commands& commands);   // devices [--json]
+void add_corpus_commands(CLI::App& root, Commands& commands);   // corpus build|stats|fidelity|validate
+void add_bench_commands(CLI::App& root, Commands& commands);    // bench nearest|jumps|tick|loop
+void add_session_commands(CLI::App& root, Commands& commands);  // session run|resume
+void add_report_command(CLI::App& root, Commands& commands);    // report DIR... --out FILE
 
 // The subcommands of the groups, one file each.
 void add_corpus_build_command(CLI::App& corpus, Commands& commands);

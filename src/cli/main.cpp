@@ -65,6 +65,8 @@ int main(int argc, char** argv) {
   add_devices_command(root, commands);
   add_corpus_commands(root, commands);
   add_bench_commands(root, commands);
+  add_session_commands(root, commands);
+  add_report_command(root, commands);
 
   int status = 0;
   try {

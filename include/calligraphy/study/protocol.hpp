@@ -1,0 +1,137 @@
+#pragma once
+/// \file protocol.hpp
+/// A study protocol: which characters are practised and tested, under which feedback conditions, how
+/// often, in which order and with which breaks. Read from a JSON file (format: docs/experiments.md;
+/// example: examples/protocols/paper-table5.json, the design of Wang, Zhang & Yao 2006, section 7).
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace calligraphy {
+
+/// What the writer gets in a condition.
+enum class ConditionMode {
+  vision,  ///< vision only: the paper force, no in-plane guidance (the paper's "no force feedback")
+  haptic,  ///< vision and the guiding force of paper section 5 (the paper's "with force feedback")
+  fading,  ///< guidance whose gain fades over repetitions (a renderer mode not in this build yet)
+  replay,  ///< the reference movement played back through the device (not in this build yet)
+  quiz,    ///< vision only, each stroke judged when the pen lifts (quiz.hpp)
+};
+
+/// "vision", "haptic", "fading", "replay", "quiz".
+[[nodiscard]] const char* to_string(ConditionMode mode) noexcept;
+
+/// How a quiz judges strokes (Hanzi Writer's quiz, chanind/hanzi-writer src/Quiz.ts and strokeMatches.ts).
+struct QuizOptions {
+  /// Scales the distance, shape and length thresholds of the stroke tests; bigger is more lenient. > 0.
+  double leniency = 1.0;
+  /// A hint (the expected stroke shown) after this many misses on one stroke, and after each further
+  /// miss; 0: never. Hanzi Writer's default is 3.
+  int hint_after_misses = 3;
+  /// A stroke written from its end to its start is accepted (and still reported as backwards).
+  bool accept_backwards = false;
+  /// Throws InvalidArgument naming the field when a value is out of range.
+  void validate() const;
+};
+
+/// One feedback condition.
+struct StudyCondition {
+  std::string name;  ///< unique label, used in file names and reports: [A-Za-z0-9_-], 1..32 characters
+  ConditionMode mode = ConditionMode::vision;
+  /// Overrides the guidance stiffness K_et (ForceLawParameters, paper eq. 8) [N/m]; haptic modes only.
+  std::optional<double> guidance_stiffness_n_per_m;
+  /// Parameters of the `fading` and `replay` modes, by name, as the protocol gives them: kept for the
+  /// renderer that implements them and recorded with every trial.
+  std::map<std::string, double> guidance_parameters;
+  QuizOptions quiz;  ///< `quiz` mode only
+};
+
+/// How the blocks of conditions are ordered for a subject.
+enum class ConditionOrder {
+  fixed,         ///< as listed, for every subject
+  latin_square,  ///< a balanced Latin square (Williams 1949), row by subject number
+  abba,          ///< conditions forwards then backwards (A B B A), reversed for every second subject
+  random,        ///< shuffled per subject from the protocol's seed and the subject id
+};
+/// How the characters are ordered within each round of a block.
+enum class ItemOrder {
+  fixed,   ///< as listed
+  random,  ///< shuffled per subject, block and round from the protocol's seed
+};
+[[nodiscard]] const char* to_string(ConditionOrder order) noexcept;
+[[nodiscard]] const char* to_string(ItemOrder order) noexcept;
+
+/// The familiarisation phase before the test (paper section 7.1: "participants are allowed to write a
+/// specified character for a few times to get familiar with the system").
+struct PracticePhase {
+  std::vector<std::u32string> items;  ///< each item is written in one trial (one or more characters)
+  std::string condition;              ///< name of one of the protocol's conditions
+  int repetitions = 1;                ///< times each item is written, >= 1
+};
+
+/// Rests between trials [s]. Breaks are taken by a person; a simulated writer only logs them.
+struct BreakRules {
+  double between_blocks_s = 0.0;  ///< before the first trial of every block after the first
+  int every_trials = 0;           ///< a rest of `duration_s` after every this many trials; 0: none
+  double duration_s = 0.0;
+};
+
+/// Settings of every trial of the study.
+struct ProtocolTrialSettings {
+  double max_duration_s = 120.0;  ///< a trial ends after this much device time [s], (0, 3600]
+  double rate_hz = 1000.0;        ///< servo rate [Hz], [100, 10000]
+};
+
+/// A whole protocol.
+struct StudyProtocol {
+  std::string name;  ///< [A-Za-z0-9_-], 1..64 characters; names session folders
+  std::string description;
+  std::vector<StudyCondition> conditions;
+  std::optional<PracticePhase> practice;
+  std::vector<std::u32string> test_items;    ///< each written in one trial (one or more characters)
+  std::vector<std::string> test_conditions;  ///< names of the conditions tested, in listed order
+  int repetitions = 1;                       ///< times each test item is written in each test condition, >= 1
+  ConditionOrder condition_order = ConditionOrder::fixed;
+  ItemOrder item_order = ItemOrder::fixed;
+  std::uint64_t seed = 0;  ///< seeds the random orders
+  BreakRules breaks;
+  ProtocolTrialSettings trial;
+
+  /// The condition called `name`; throws InvalidArgument naming it when there is none.
+  [[nodiscard]] const StudyCondition& condition(std::string_view name) const;
+};
+
+/// Parses a protocol. `source` names the text in errors (a file name). Throws DataError naming the
+/// source and the JSON pointer of the offending value (e.g. "paper.json: /test/repetitions: expected an
+/// integer >= 1, got 0"): malformed JSON (with the byte offset), a missing or unknown key, a value of
+/// the wrong type or out of range, a condition named twice or not defined, a character list that is
+/// empty or not UTF-8, repetitions that `abba` cannot split evenly.
+[[nodiscard]] StudyProtocol parse_study_protocol(std::string_view json_text, const std::string& source);
+
+/// A protocol read from a file, with the exact text and its SHA-256 (so that a trial names the protocol
+/// it ran under and any change to the file is seen).
+struct LoadedProtocol {
+  StudyProtocol protocol;
+  std::string text;    ///< the file's bytes
+  std::string sha256;  ///< lower-case hex SHA-256 of `text` (FIPS 180-4)
+  std::filesystem::path path;
+};
+
+/// Largest protocol file read: 1 MiB.
+inline constexpr std::uintmax_t kMaxProtocolBytes = std::uintmax_t{1} << 20;
+
+/// Reads and parses a protocol file. Throws DataError naming the path when it does not exist, is not a
+/// regular file, is larger than kMaxProtocolBytes or cannot be read, and as `parse_study_protocol`.
+[[nodiscard]] LoadedProtocol load_study_protocol(const std::filesystem::path& path);
+
+/// The protocol from its text (e.g. the copy a session folder keeps): parses it and hashes it.
+[[nodiscard]] LoadedProtocol protocol_from_text(std::string text, const std::filesystem::path& path);
+
+/// Lower-case hex SHA-256 of `bytes` (FIPS 180-4).
+[[nodiscard]] std::string sha256_hex(std::string_view bytes);
+
+}  // namespace calligraphy

@@ -1,0 +1,120 @@
+#pragma once
+/// \file session_folder.hpp
+/// The folder of one subject's session, laid out so that no saved trial is ever lost or overwritten:
+///
+///     ROOT/SUBJECT/PROTOCOL-YYYYMMDD-HHMMSS/
+///       session.json          what the session was started with: subject, device, writer, the protocol's
+///                             text, path and SHA-256, the library build, and the planned trials
+///       log.jsonl             append-only event log, one JSON object a line, fsync'ed line by line
+///       trials/NNN-PHASE-CONDITION-rR-U....json|.csv|.svg    one saved trial (the JSON is written last)
+///       trials/attempts/...   interrupted or failed attempts, numbered, kept for the record
+///
+/// A trial counts as saved when its JSON exists. The JSON is committed with link(2) from a complete,
+/// fsync'ed temporary file, which fails rather than replace an existing file; the CSV and SVG beside it
+/// are written first with `write_file_atomically`. The log is locked (flock) while a process works on the
+/// session, so two runners cannot write one session. Format of every file: docs/experiments.md.
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "calligraphy/study/protocol.hpp"
+#include "calligraphy/study/schedule.hpp"
+
+namespace calligraphy {
+
+/// The library that ran a session: version, build type, compiler and C++ standard.
+struct LibraryBuild {
+  std::string version;       ///< the project's version, e.g. "0.1.0"
+  std::string build_type;    ///< CMake build type, e.g. "Release"
+  std::string compiler;      ///< e.g. "GCC 12.2.0"
+  std::string cxx_standard;  ///< the value of __cplusplus, e.g. "202002"
+};
+[[nodiscard]] LibraryBuild library_build();
+
+/// How a session is run: kept in session.json so that a resumed session runs the same way.
+struct SessionSetup {
+  SubjectAssignment subject;
+  std::string device = "simulated";       ///< the device's name in the device registry
+  std::string writer = "simulated";       ///< "simulated" (a simulated writer moves the device) or "human"
+  std::string writer_profile = "novice";  ///< the simulated writer's profile: "novice" or "skilled"
+  std::uint64_t writer_seed = 0;          ///< the simulated subject's seed (see `subject_seed`)
+  std::string pacing = "auto";            ///< "auto", "lock-step" or "real-time" (TrialPacing)
+};
+
+/// The seed of a simulated subject, derived from its id alone (FNV-1a of the id, mixed by SplitMix64), so
+/// that a subject writes the same way in every session and protocol.
+[[nodiscard]] std::uint64_t subject_seed(std::string_view subject_id);
+
+/// What session.json holds.
+struct SessionManifest {
+  std::string session_id;  ///< the folder's name
+  std::string created_utc;
+  SessionSetup setup;
+  LoadedProtocol protocol;  ///< `text` is the copy kept in session.json; `path` where it was read from
+  LibraryBuild library;     ///< the build that created the session
+  std::vector<PlannedTrial> plan;
+};
+
+/// A session folder, opened by one process at a time. Move-only; the lock is released on destruction.
+class SessionFolder {
+ public:
+  /// Creates ROOT/SUBJECT/PROTOCOL-YYYYMMDD-HHMMSS (a "-2", "-3" ... suffix when it exists), writes
+  /// session.json with the plan of `plan_session` and starts the log ("session_created"). Throws
+  /// InvalidArgument for a bad setup (subject id, writer, profile, pacing), DataError naming the path
+  /// when a folder or file cannot be made.
+  static SessionFolder create(const std::filesystem::path& root, const SessionSetup& setup,
+                              const LoadedProtocol& protocol);
+  /// Opens an existing session: reads session.json (the plan recorded there is the plan), checks the
+  /// protocol copy against its SHA-256 and locks the log. Throws DataError naming the file and JSON
+  /// pointer for a missing or damaged session.json, StateError when another process has the session open.
+  static SessionFolder open(const std::filesystem::path& folder);
+
+  SessionFolder(SessionFolder&& other) noexcept;
+  SessionFolder& operator=(SessionFolder&& other) noexcept;
+  SessionFolder(const SessionFolder&) = delete;
+  SessionFolder& operator=(const SessionFolder&) = delete;
+  ~SessionFolder();
+
+  [[nodiscard]] const std::filesystem::path& path() const noexcept { return path_; }
+  [[nodiscard]] const SessionManifest& manifest() const noexcept { return manifest_; }
+  [[nodiscard]] const std::vector<PlannedTrial>& plan() const noexcept { return manifest_.plan; }
+
+  /// "003-test-vision-r1-U5927": the file name of a trial without extension.
+  [[nodiscard]] static std::string trial_stem(const PlannedTrial& trial);
+  /// trials/STEM.EXTENSION
+  [[nodiscard]] std::filesystem::path trial_file(const PlannedTrial& trial, std::string_view extension) const;
+  /// True when the trial's JSON exists.
+  [[nodiscard]] bool is_saved(const PlannedTrial& trial) const;
+  [[nodiscard]] std::size_t saved_count() const;
+  /// The first planned trial not saved yet, or nullopt when every trial is saved.
+  [[nodiscard]] std::optional<std::size_t> next_unsaved() const;
+
+  /// Saves a finished trial: `csv` and `svg` atomically, then `json` with link(2), so it never replaces a
+  /// file. Throws StateError naming the file when the trial was saved already, DataError when a write fails.
+  void save_trial(const PlannedTrial& trial, std::string_view json, std::string_view csv,
+                  std::string_view svg);
+  /// Keeps an attempt that did not become the saved trial (interrupted, failed) in trials/attempts/ as
+  /// STEM.attempt-K.json and .csv with the first free K. Returns the JSON's path.
+  std::filesystem::path save_attempt(const PlannedTrial& trial, std::string_view json, std::string_view csv);
+
+  /// Appends {"time_utc": ..., "event": EVENT, ...details} as one line to log.jsonl and fsyncs it.
+  /// `details_json` is a JSON object (its members are added) or empty. Throws InvalidArgument when it is
+  /// not an object, DataError naming the log when the write or fsync fails.
+  void log(std::string_view event, std::string_view details_json = {});
+
+ private:
+  SessionFolder(std::filesystem::path path, SessionManifest manifest, int log_fd);
+  std::filesystem::path path_;
+  SessionManifest manifest_;
+  int log_fd_ = -1;
+};
+
+/// The session folders under `root`: `root` itself when it holds a session.json, else every folder below it
+/// (at most 4 levels deep) that does, sorted by path. Throws DataError when `root` is not a folder.
+[[nodiscard]] std::vector<std::filesystem::path> find_session_folders(const std::filesystem::path& root);
+
+}  // namespace calligraphy

@@ -1,0 +1,87 @@
+#pragma once
+/// \file session_runner.hpp
+/// Runs the trials of a session folder that are not saved yet, in the planned order, one `run_trial`
+/// each (trial/runner.hpp): lock-step with a simulated writer on a simulated or emulated device, in real
+/// time on a device a person moves. Each trial is scored (`score_trace` on the recorded pen trace, quiz
+/// conditions also through a `QuizSession`) and saved as it ends (session_folder.hpp); the log records
+/// every step. A trial that ends interrupted or with a device fault is kept as an attempt, never as the
+/// saved trial, so `run_session` on the same folder later resumes with it. A `SessionHost` (a trainer
+/// window, a terminal) is told what comes next and takes the breaks.
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "calligraphy/devices/device_registry.hpp"
+#include "calligraphy/model/character.hpp"
+#include "calligraphy/study/schedule.hpp"
+#include "calligraphy/study/session_folder.hpp"
+#include "calligraphy/trial/options.hpp"
+
+namespace calligraphy {
+
+/// What a saved trial came to, for the host.
+struct TrialOutcome {
+  std::string end_reason;          ///< TrialEnd as text
+  bool saved = false;              ///< saved as the trial (else kept as an attempt)
+  double time_s = 0.0;             ///< writing time [s]
+  double mean_deviation_mm = 0.0;  ///< NaN when no stroke was written
+  std::string json_file;           ///< the saved trial's or the attempt's JSON
+};
+
+/// Who hosts a session: the trainer window, a terminal prompt, or nobody (the default does nothing).
+class SessionHost {
+ public:
+  virtual ~SessionHost() = default;
+  /// Before a trial starts: show what is to be written (`trial.characters`, the condition). `total` is the
+  /// number of planned trials.
+  virtual void before_trial(const PlannedTrial& trial, std::size_t total);
+  /// A rest of `seconds` before `trial`: return when it is over or `should_stop` turns true. Called only
+  /// for a human writer; a simulated writer's breaks are logged, not waited.
+  virtual void rest(double seconds, const PlannedTrial& trial, const std::function<bool()>& should_stop);
+  /// After a trial ended (saved or kept as an attempt).
+  virtual void after_trial(const PlannedTrial& trial, const TrialOutcome& outcome);
+};
+
+/// Options of `run_session`.
+struct SessionRunOptions {
+  /// Where the device named in the session is created; nullptr: `device_registry_with_simulation()`.
+  const DeviceRegistry* registry = nullptr;
+  /// Loads a character's model; empty: the embedded characters (CharacterLibrary::embedded()).
+  std::function<Character(char32_t)> load_character;
+  /// Polled between trials and during each trial (TrialOptions::should_stop); true ends the session after
+  /// keeping the running trial as an attempt.
+  std::function<bool()> should_stop;
+  SessionHost* host = nullptr;  ///< nullptr: nobody is told
+  /// Overrides the session's pacing for this run (e.g. a session begun in real time resumed lock-step);
+  /// nullopt: the pacing in session.json.
+  std::optional<TrialPacing> pacing;
+};
+
+/// What `run_session` did.
+struct SessionRunResult {
+  std::size_t planned = 0;       ///< trials in the plan
+  std::size_t saved_before = 0;  ///< saved when the run began
+  std::size_t saved_now = 0;     ///< saved by this run
+  std::size_t attempts_kept = 0;
+  bool interrupted = false;  ///< should_stop ended the run
+  bool device_failed = false;
+  std::string failure;  ///< the device's message when it failed
+  [[nodiscard]] bool complete() const { return saved_before + saved_now == planned; }
+};
+
+/// The options of the trials of `condition` in `session`, trial `trial`: servo rate and duration from the
+/// protocol, guidance on for `haptic` (with the condition's stiffness), off for `vision` and `quiz`, the
+/// session's pacing, the simulated writer's profile and a seed derived from the subject's seed and the
+/// trial's index. Throws InvalidArgument naming the condition for a mode this build cannot render
+/// (`fading`, `replay`).
+[[nodiscard]] TrialOptions study_trial_options(const SessionManifest& session,
+                                               const StudyCondition& condition, const PlannedTrial& trial);
+
+/// Runs every unsaved trial of `session` (see the file comment). Throws InvalidArgument before any trial
+/// when a planned condition cannot run or a simulated writer is asked to move a device a person holds,
+/// DeviceNotFound when the device is not in the registry, CharacterNotFound for a missing character, and
+/// DataError when a file cannot be saved; what was saved before stays saved.
+SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& options = {});
+
+}  // namespace calligraphy

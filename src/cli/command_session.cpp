@@ -1,0 +1,268 @@
+// `calligraphy session run PROTOCOL ...` and `calligraphy session resume DIR`: a study session (or one per
+// simulated subject) through the study module's runner, which saves every trial as it ends. SIGINT and
+// SIGTERM stop the session after keeping the running trial as an attempt; `resume` goes on from there.
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "calligraphy/study/protocol.hpp"
+#include "calligraphy/study/session_folder.hpp"
+#include "calligraphy/study/session_runner.hpp"
+#include "cli/cli_devices.hpp"
+#include "cli/commands.hpp"
+#include "cli/interrupt.hpp"
+#include "cli/library_options.hpp"
+#include "core/unicode.hpp"
+
+namespace calligraphy::cli {
+namespace {
+
+struct SessionRunCommand {
+  std::string protocol;
+  std::string subject;
+  std::int64_t subject_number = 0;
+  const CLI::Option* subject_number_option = nullptr;
+  std::int64_t subjects = 0;
+  std::string device = "simulated";
+  std::string writer = "auto";
+  std::string writer_profile = "novice";
+  std::string pacing = "auto";
+  std::string out;
+  LibraryOptions library;
+};
+
+struct SessionResumeCommand {
+  std::string folder;
+  std::string pacing;
+  LibraryOptions library;
+};
+
+std::string utf8(const std::u32string& text) {
+  std::string out;
+  for (const char32_t c : text) out += encode_utf8(c);
+  return out;
+}
+
+// Tells the person at the device what to write next (on stderr: stdout carries the summary) and waits for
+// Enter when a terminal is attached; breaks count down.
+class TerminalHost final : public SessionHost {
+ public:
+  void before_trial(const PlannedTrial& trial, std::size_t total) override {
+    std::fprintf(stderr, "trial %zu/%zu (%s, %s, repetition %d): write %s", trial.index + 1, total,
+                 to_string(trial.phase), trial.condition.c_str(), trial.repetition,
+                 utf8(trial.characters).c_str());
+    if (::isatty(STDIN_FILENO)) {
+      std::fprintf(stderr, " -- press Enter to start\n");
+      int c = 0;
+      while ((c = std::getchar()) != '\n' && c != EOF && !stop_requested()) {
+      }
+    } else {
+      std::fprintf(stderr, "\n");
+    }
+  }
+  void rest(double seconds, const PlannedTrial&, const std::function<bool()>& should_stop) override {
+    std::fprintf(stderr, "break: %.0f s\n", seconds);
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (std::chrono::steady_clock::now() < end && !should_stop()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+  }
+  void after_trial(const PlannedTrial& trial, const TrialOutcome& outcome) override {
+    std::fprintf(stderr, "trial %zu: %s, %.1f s, mean deviation %.2f mm%s\n", trial.index + 1,
+                 outcome.end_reason.c_str(), outcome.time_s, outcome.mean_deviation_mm,
+                 outcome.saved ? "" : " (kept as an attempt)");
+  }
+};
+
+SessionRunOptions run_options(const LibraryOptions& library, SessionHost* host,
+                              std::shared_ptr<CharacterSource>& source) {
+  source = std::make_shared<CharacterSource>(library);
+  SessionRunOptions options;
+  options.registry = &cli_device_registry();
+  options.load_character = [source](char32_t c) { return source->load(c); };
+  options.should_stop = [] { return stop_requested(); };
+  options.host = host;
+  return options;
+}
+
+// Prints one line per session; returns the exit status: 0 when complete, 128 + the signal when stopped
+// by one, 1 after a device fault.
+int report_run(const SessionFolder& session, const SessionRunResult& result, double seconds) {
+  std::printf("%s: %zu of %zu trials saved (%zu now, %zu attempts kept) in %s, %.1f s\n",
+              session.manifest().setup.subject.id.c_str(), result.saved_before + result.saved_now,
+              result.planned, result.saved_now, result.attempts_kept, session.path().c_str(), seconds);
+  std::fflush(stdout);
+  if (result.device_failed) {
+    std::fprintf(
+        stderr,
+        "calligraphy session: error: the device failed (%s); resume with: calligraphy session resume %s\n",
+        result.failure.c_str(), session.path().c_str());
+    return 1;
+  }
+  if (!result.complete()) {
+    std::fprintf(stderr, "calligraphy session: stopped; resume with: calligraphy session resume %s\n",
+                 session.path().c_str());
+    return stop_signal() != 0 ? 128 + stop_signal() : 1;
+  }
+  return 0;
+}
+
+std::vector<std::string> split_profiles(const std::string& text) {
+  std::vector<std::string> profiles;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', start);
+    std::string name = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    if (name != "novice" && name != "skilled") {
+      throw UsageError("--writer-profile: expected novice, skilled or a comma-separated list of them, got '" +
+                       text + "'");
+    }
+    profiles.push_back(name);
+    if (comma == std::string::npos) return profiles;
+    start = comma + 1;
+  }
+}
+
+int run_sessions(const SessionRunCommand& command) {
+  const LoadedProtocol protocol = load_study_protocol(command.protocol);
+  const DeviceSurvey survey = cli_device_registry().survey();
+  const DeviceListing* device = nullptr;
+  for (const DeviceListing& listing : survey.devices)
+    device = listing.name == command.device ? &listing : device;
+  if (!device) {
+    std::string names;
+    for (const DeviceListing& listing : survey.devices) names += (names.empty() ? "" : ", ") + listing.name;
+    throw UsageError("--device: unknown device '" + command.device + "'; registered devices: " + names);
+  }
+  const std::string writer =
+      command.writer == "auto" ? (device->hardware ? "human" : "simulated") : command.writer;
+  if (writer == "simulated" && device->hardware) {
+    throw UsageError("--writer simulated: the device '" + command.device + "' is moved by a person");
+  }
+  if (command.subjects > 0 && writer != "simulated") {
+    throw UsageError("--subjects: simulated subjects need --writer simulated");
+  }
+  if (command.subjects == 0 && command.subject.empty()) {
+    throw UsageError("--subject: required (or --subjects N with --writer simulated)");
+  }
+  if (command.subjects > 0 && command.subject_number_option->count() > 0) {
+    throw UsageError("--subject-number: simulated subjects are numbered 1 to N");
+  }
+  const std::vector<std::string> profiles = split_profiles(command.writer_profile);
+
+  std::vector<SubjectAssignment> subjects;
+  if (command.subjects > 0) {
+    const std::string prefix = command.subject.empty() ? "S" : command.subject;
+    for (std::int64_t k = 1; k <= command.subjects; ++k) {
+      char number[32];
+      std::snprintf(number, sizeof number, "%02lld", static_cast<long long>(k));
+      subjects.push_back({prefix + number, static_cast<std::size_t>(k)});
+    }
+  } else {
+    const std::size_t number = command.subject_number_option->count() > 0
+                                   ? static_cast<std::size_t>(command.subject_number)
+                                   : trailing_number(command.subject);
+    subjects.push_back({command.subject, number});
+  }
+
+  install_stop_handlers();
+  TerminalHost host;
+  std::shared_ptr<CharacterSource> source;
+  const SessionRunOptions options = run_options(command.library, writer == "human" ? &host : nullptr, source);
+  for (std::size_t i = 0; i < subjects.size(); ++i) {
+    if (stop_requested()) return 128 + stop_signal();
+    SessionSetup setup;
+    setup.subject = subjects[i];
+    setup.device = command.device;
+    setup.writer = writer;
+    setup.writer_profile = profiles[i % profiles.size()];
+    setup.writer_seed = subject_seed(setup.subject.id);
+    setup.pacing = command.pacing;
+    SessionFolder session = SessionFolder::create(command.out, setup, protocol);
+    const auto start = std::chrono::steady_clock::now();
+    const SessionRunResult result = run_session(session, options);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const int status = report_run(session, result, seconds);
+    if (status != 0) return status;
+  }
+  return 0;
+}
+
+int resume_session(const SessionResumeCommand& command) {
+  SessionFolder session = SessionFolder::open(command.folder);
+  if (!session.next_unsaved()) {
+    std::printf("%s: every trial of %s is saved already\n", session.manifest().setup.subject.id.c_str(),
+                session.path().c_str());
+    return 0;
+  }
+  install_stop_handlers();
+  TerminalHost host;
+  std::shared_ptr<CharacterSource> source;
+  SessionRunOptions options =
+      run_options(command.library, session.manifest().setup.writer == "human" ? &host : nullptr, source);
+  if (!command.pacing.empty()) {
+    options.pacing = command.pacing == "lock-step"   ? TrialPacing::lock_step
+                     : command.pacing == "real-time" ? TrialPacing::real_time
+                                                     : TrialPacing::automatic;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const SessionRunResult result = run_session(session, options);
+  return report_run(session, result,
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+}
+
+}  // namespace
+
+void add_session_commands(CLI::App& root, Commands& commands) {
+  CLI::App* group =
+      commands.add_group(root, "session", "Study sessions: run a protocol, resume a stopped session");
+
+  auto run = std::make_shared<SessionRunCommand>();
+  CLI::App* app = commands.add(
+      *group, "run",
+      "Run a study protocol for one subject, or for N simulated subjects; SIGINT or SIGTERM stops it "
+      "after keeping the running trial (exit status 128 + the signal)",
+      [run] { return run_sessions(*run); });
+  add_positional(*app, "PROTOCOL", run->protocol, "the study protocol (JSON; docs/experiments.md)");
+  add_text(*app, "--subject", run->subject, "ID",
+           "the subject's id (letters, digits, '_', '-'); with --subjects, the prefix of the simulated ids",
+           "required; with --subjects: S");
+  run->subject_number_option =
+      add_integer(*app, "--subject-number", run->subject_number, "N",
+                  "the subject's number for counterbalancing (Latin square row, ABBA direction)", 1,
+                  1000000000, "the digits ending --subject");
+  add_integer(
+      *app, "--subjects", run->subjects, "N",
+      "run N simulated subjects ID01..IDN, numbered 1..N, one session each (needs --writer simulated)", 0,
+      1000, "none");
+  add_text(*app, "--device", run->device, "NAME", "the device, by its name in `calligraphy devices`");
+  add_choice(
+      *app, "--writer", run->writer, {"simulated", "human"},
+      "who writes: a simulated writer (simulated and emulated devices) or a person; default: simulated "
+      "on a simulated or emulated device, human on hardware");
+  add_text(
+      *app, "--writer-profile", run->writer_profile, "PROFILES",
+      "the simulated writer's profile, novice or skilled; a comma-separated list is used by subject in turn");
+  add_choice(*app, "--pacing", run->pacing, {"auto", "lock-step", "real-time"},
+             "auto: lock-step for a simulated writer, real time for a person; real-time paces a simulated "
+             "writer by the wall clock");
+  required(add_text(*app, "--out", run->out, "DIR",
+                    "the study folder: sessions go to DIR/SUBJECT/PROTOCOL-TIME/"));
+  add_library_options(*app, run->library, true);
+
+  auto resume = std::make_shared<SessionResumeCommand>();
+  CLI::App* resume_app =
+      commands.add(*group, "resume", "Go on with a stopped or crashed session from its first unsaved trial",
+                   [resume] { return resume_session(*resume); });
+  add_positional(*resume_app, "DIR", resume->folder, "the session folder (the one holding session.json)");
+  add_choice(*resume_app, "--pacing", resume->pacing, {"auto", "lock-step", "real-time"},
+             "overrides the pacing the session was started with (default: that pacing)");
+  add_library_options(*resume_app, resume->library, true);
+}
+
+}  // namespace calligraphy::cli

@@ -1,0 +1,162 @@
+#include "study/json_reader.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "calligraphy/core/errors.hpp"
+
+namespace calligraphy::study_detail {
+
+void fail(const std::string& source, const std::string& pointer, const std::string& message) {
+  throw DataError(source + ": " + (pointer.empty() ? "/" : pointer) + ": " + message);
+}
+
+nlohmann::json parse_json(std::string_view text, const std::string& source) {
+  try {
+    return nlohmann::json::parse(text.begin(), text.end());
+  } catch (const nlohmann::json::parse_error& e) {
+    throw DataError(source + ": not valid JSON at byte " + std::to_string(e.byte) + ": " + e.what());
+  }
+}
+
+std::string describe(const nlohmann::json& value) {
+  if (value.is_object()) return "an object";
+  if (value.is_array()) return "an array";
+  std::string text = value.dump();
+  if (text.size() > 40) {
+    text.resize(37);
+    text.append("...");
+  }
+  return text;
+}
+
+std::string child_pointer(const std::string& pointer, const std::string& key) {
+  std::string escaped;
+  for (const char c : key) {
+    if (c == '~') {
+      escaped += "~0";
+    } else if (c == '/') {
+      escaped += "~1";
+    } else {
+      escaped += c;
+    }
+  }
+  return pointer + "/" + escaped;
+}
+
+std::string child_pointer(const std::string& pointer, std::size_t index) {
+  return pointer + "/" + std::to_string(index);
+}
+
+std::string as_string(const nlohmann::json& value, const std::string& pointer, const std::string& source) {
+  if (!value.is_string()) fail(source, pointer, "expected a string, got " + describe(value));
+  return value.get<std::string>();
+}
+
+double as_number(const nlohmann::json& value, const std::string& pointer, const std::string& source,
+                 double minimum, double maximum) {
+  if (!value.is_number()) fail(source, pointer, "expected a number, got " + describe(value));
+  const double number = value.get<double>();
+  if (!std::isfinite(number) || number < minimum || number > maximum) {
+    fail(source, pointer,
+         "expected a number in [" + nlohmann::json(minimum).dump() + ", " + nlohmann::json(maximum).dump() +
+             "], got " + describe(value));
+  }
+  return number;
+}
+
+std::int64_t as_integer(const nlohmann::json& value, const std::string& pointer, const std::string& source,
+                        std::int64_t minimum, std::int64_t maximum) {
+  const bool integral =
+      value.is_number_integer() ||
+      (value.is_number_float() && std::isfinite(value.get<double>()) &&
+       std::floor(value.get<double>()) == value.get<double>() && std::fabs(value.get<double>()) < 9.0e15);
+  std::string range = "[";
+  range.append(std::to_string(minimum)).append(", ").append(std::to_string(maximum)).append("]");
+  if (!integral) fail(source, pointer, "expected an integer in " + range + ", got " + describe(value));
+  if (value.is_number_unsigned() &&
+      value.get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())) {
+    fail(source, pointer, "expected an integer in " + range + ", got " + describe(value));
+  }
+  const std::int64_t number =
+      value.is_number_float() ? static_cast<std::int64_t>(value.get<double>()) : value.get<std::int64_t>();
+  if (number < minimum || number > maximum) {
+    fail(source, pointer, "expected an integer in " + range + ", got " + describe(value));
+  }
+  return number;
+}
+
+ObjectReader::ObjectReader(const nlohmann::json& value, std::string pointer, const std::string& source)
+    : value_(value), pointer_(std::move(pointer)), source_(source) {
+  if (!value_.is_object()) fail(source_, pointer_, "expected an object, got " + describe(value_));
+}
+
+bool ObjectReader::has(const std::string& key) const { return value_.contains(key); }
+
+std::string ObjectReader::pointer(const std::string& key) const { return child_pointer(pointer_, key); }
+
+const nlohmann::json& ObjectReader::required(const std::string& key) {
+  const auto found = value_.find(key);
+  if (found == value_.end()) fail(source_, pointer(key), "missing (required)");
+  read_.insert(key);
+  return *found;
+}
+
+const nlohmann::json* ObjectReader::optional(const std::string& key) {
+  const auto found = value_.find(key);
+  if (found == value_.end()) return nullptr;
+  read_.insert(key);
+  return found->is_null() ? nullptr : &*found;
+}
+
+void ObjectReader::finish() const {
+  for (const auto& item : value_.items()) {
+    if (read_.count(item.key()) == 0) fail(source_, pointer(item.key()), "unknown key");
+  }
+}
+
+std::string ObjectReader::string(const std::string& key) {
+  return as_string(required(key), pointer(key), source_);
+}
+
+std::string ObjectReader::string_or(const std::string& key, const std::string& fallback) {
+  const nlohmann::json* value = optional(key);
+  return value ? as_string(*value, pointer(key), source_) : fallback;
+}
+
+double ObjectReader::number(const std::string& key, double minimum, double maximum) {
+  return as_number(required(key), pointer(key), source_, minimum, maximum);
+}
+
+double ObjectReader::number_or(const std::string& key, double fallback, double minimum, double maximum) {
+  const nlohmann::json* value = optional(key);
+  return value ? as_number(*value, pointer(key), source_, minimum, maximum) : fallback;
+}
+
+std::int64_t ObjectReader::integer(const std::string& key, std::int64_t minimum, std::int64_t maximum) {
+  return as_integer(required(key), pointer(key), source_, minimum, maximum);
+}
+
+std::int64_t ObjectReader::integer_or(const std::string& key, std::int64_t fallback, std::int64_t minimum,
+                                      std::int64_t maximum) {
+  const nlohmann::json* value = optional(key);
+  return value ? as_integer(*value, pointer(key), source_, minimum, maximum) : fallback;
+}
+
+std::uint64_t ObjectReader::unsigned_or(const std::string& key, std::uint64_t fallback) {
+  const nlohmann::json* value = optional(key);
+  if (!value) return fallback;
+  if (!value->is_number_unsigned() && !(value->is_number_integer() && value->get<std::int64_t>() >= 0)) {
+    fail(source_, pointer(key), "expected an integer in [0, 18446744073709551615], got " + describe(*value));
+  }
+  return value->get<std::uint64_t>();
+}
+
+bool ObjectReader::boolean_or(const std::string& key, bool fallback) {
+  const nlohmann::json* value = optional(key);
+  if (!value) return fallback;
+  if (!value->is_boolean()) fail(source_, pointer(key), "expected true or false, got " + describe(*value));
+  return value->get<bool>();
+}
+
+}  // namespace calligraphy::study_detail

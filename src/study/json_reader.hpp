@@ -1,0 +1,65 @@
+#pragma once
+// Strict reading of JSON documents for the study files (protocols, session manifests, trial records):
+// every error names the source (a file) and the JSON pointer (RFC 6901) of the value at fault. Internal.
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+#include <string_view>
+
+namespace calligraphy::study_detail {
+
+/// Throws DataError "SOURCE: POINTER: MESSAGE" (the pointer "/" for the document itself).
+[[noreturn]] void fail(const std::string& source, const std::string& pointer, const std::string& message);
+
+/// Parses `text`; throws DataError naming the source and the byte offset of malformed JSON.
+nlohmann::json parse_json(std::string_view text, const std::string& source);
+
+/// A short rendering of a value for messages: "0", "\"latin\"", "an object".
+std::string describe(const nlohmann::json& value);
+
+/// The members of one JSON object, read by key; `finish` refuses keys nobody read (typos).
+class ObjectReader {
+ public:
+  /// Throws DataError when `value` is not an object.
+  ObjectReader(const nlohmann::json& value, std::string pointer, const std::string& source);
+  [[nodiscard]] bool has(const std::string& key) const;
+  /// The member; throws DataError naming the key when it is missing.
+  const nlohmann::json& required(const std::string& key);
+  /// The member, or nullptr when it is missing (or null).
+  const nlohmann::json* optional(const std::string& key);
+  /// The pointer of member `key`.
+  [[nodiscard]] std::string pointer(const std::string& key) const;
+  [[nodiscard]] const std::string& pointer() const { return pointer_; }
+  [[nodiscard]] const std::string& source() const { return source_; }
+  /// Throws DataError naming the first member that was never read.
+  void finish() const;
+
+  std::string string(const std::string& key);
+  std::string string_or(const std::string& key, const std::string& fallback);
+  double number(const std::string& key, double minimum, double maximum);
+  double number_or(const std::string& key, double fallback, double minimum, double maximum);
+  std::int64_t integer(const std::string& key, std::int64_t minimum, std::int64_t maximum);
+  std::int64_t integer_or(const std::string& key, std::int64_t fallback, std::int64_t minimum,
+                          std::int64_t maximum);
+  std::uint64_t unsigned_or(const std::string& key, std::uint64_t fallback);
+  bool boolean_or(const std::string& key, bool fallback);
+
+ private:
+  const nlohmann::json& value_;
+  std::string pointer_;
+  const std::string& source_;
+  std::set<std::string> read_;
+};
+
+/// The value as a string / number in range / integer in range; throws DataError naming `pointer`.
+std::string as_string(const nlohmann::json& value, const std::string& pointer, const std::string& source);
+double as_number(const nlohmann::json& value, const std::string& pointer, const std::string& source,
+                 double minimum, double maximum);
+std::int64_t as_integer(const nlohmann::json& value, const std::string& pointer, const std::string& source,
+                        std::int64_t minimum, std::int64_t maximum);
+/// `pointer` + "/" + `key` with RFC 6901 escapes.
+std::string child_pointer(const std::string& pointer, const std::string& key);
+std::string child_pointer(const std::string& pointer, std::size_t index);
+
+}  // namespace calligraphy::study_detail

@@ -1,0 +1,170 @@
+#include "study/manifest_json.hpp"
+
+#include "calligraphy/core/errors.hpp"
+#include "core/unicode.hpp"
+#include "study/json_reader.hpp"
+
+namespace calligraphy::study_detail {
+namespace {
+
+using nlohmann::json;
+constexpr const char* kFormat = "calligraphy-study-session";
+
+PlannedTrial planned_trial_from(const json& value, const std::string& pointer, const std::string& source,
+                                std::size_t expected_index) {
+  ObjectReader reader(value, pointer, source);
+  PlannedTrial trial;
+  trial.index = static_cast<std::size_t>(reader.integer("index", 1, 1000000)) - 1;
+  if (trial.index != expected_index) {
+    fail(source, reader.pointer("index"),
+         "expected " + std::to_string(expected_index + 1) + " (trials in order)");
+  }
+  const std::string phase = reader.string("phase");
+  if (phase != "practice" && phase != "test")
+    fail(source, reader.pointer("phase"), "expected practice or test");
+  trial.phase = phase == "practice" ? StudyPhase::practice : StudyPhase::test;
+  trial.block = static_cast<std::size_t>(reader.integer("block", 0, 1000000));
+  trial.condition = reader.string("condition");
+  try {
+    trial.characters = decode_utf8(reader.string("characters"));
+  } catch (const InvalidArgument& e) {
+    fail(source, reader.pointer("characters"), std::string("not UTF-8: ") + e.what());
+  }
+  if (trial.characters.empty()) fail(source, reader.pointer("characters"), "empty");
+  trial.item = static_cast<std::size_t>(reader.integer("item", 0, 1000000));
+  trial.repetition = static_cast<int>(reader.integer("repetition", 1, 1000000));
+  trial.break_before_s = reader.number_or("break_before_s", 0.0, 0.0, 86400.0);
+  reader.optional("file");
+  reader.finish();
+  return trial;
+}
+
+}  // namespace
+
+json library_build_json(const LibraryBuild& build) {
+  return {{"version", build.version},
+          {"build_type", build.build_type},
+          {"compiler", build.compiler},
+          {"cxx_standard", build.cxx_standard}};
+}
+
+json planned_trial_json(const PlannedTrial& trial) {
+  std::string characters;
+  for (const char32_t c : trial.characters) characters += encode_utf8(c);
+  return {{"index", trial.index + 1},
+          {"phase", to_string(trial.phase)},
+          {"block", trial.block},
+          {"condition", trial.condition},
+          {"characters", characters},
+          {"item", trial.item},
+          {"repetition", trial.repetition},
+          {"break_before_s", trial.break_before_s},
+          {"file", SessionFolder::trial_stem(trial)}};
+}
+
+std::string manifest_to_json(const SessionManifest& manifest) {
+  json plan = json::array();
+  for (const PlannedTrial& trial : manifest.plan) plan.push_back(planned_trial_json(trial));
+  const SessionSetup& setup = manifest.setup;
+  const json document = {{"format", kFormat},
+                         {"version", 1},
+                         {"created_utc", manifest.created_utc},
+                         {"subject", {{"id", setup.subject.id}, {"number", setup.subject.number}}},
+                         {"device", setup.device},
+                         {"writer", setup.writer},
+                         {"writer_profile", setup.writer_profile},
+                         {"writer_seed", setup.writer_seed},
+                         {"pacing", setup.pacing},
+                         {"library", library_build_json(manifest.library)},
+                         {"protocol",
+                          {{"name", manifest.protocol.protocol.name},
+                           {"path", manifest.protocol.path.string()},
+                           {"sha256", manifest.protocol.sha256},
+                           {"text", manifest.protocol.text}}},
+                         {"plan", plan}};
+  return document.dump(2) + "\n";
+}
+
+SessionManifest manifest_from_json(std::string_view text, const std::string& source) {
+  const json document = parse_json(text, source);
+  ObjectReader root(document, "", source);
+  if (root.string("format") != kFormat) fail(source, "/format", std::string("expected \"") + kFormat + "\"");
+  root.integer("version", 1, 1);
+  SessionManifest manifest;
+  manifest.created_utc = root.string("created_utc");
+  ObjectReader subject(root.required("subject"), "/subject", source);
+  manifest.setup.subject.id = subject.string("id");
+  manifest.setup.subject.number = static_cast<std::size_t>(subject.integer("number", 0, 1000000000));
+  subject.finish();
+  manifest.setup.device = root.string("device");
+  manifest.setup.writer = root.string("writer");
+  manifest.setup.writer_profile = root.string("writer_profile");
+  manifest.setup.writer_seed = root.unsigned_or("writer_seed", 0);
+  manifest.setup.pacing = root.string("pacing");
+  ObjectReader library(root.required("library"), "/library", source);
+  manifest.library = {library.string("version"), library.string("build_type"), library.string("compiler"),
+                      library.string("cxx_standard")};
+  library.finish();
+  ObjectReader protocol(root.required("protocol"), "/protocol", source);
+  const std::string name = protocol.string("name");
+  const std::string path = protocol.string("path");
+  const std::string sha256 = protocol.string("sha256");
+  std::string protocol_text = protocol.string("text");
+  protocol.finish();
+  try {
+    manifest.protocol = protocol_from_text(std::move(protocol_text), path);
+  } catch (const DataError& e) {
+    fail(source, "/protocol/text", std::string("the protocol copy is not valid: ") + e.what());
+  }
+  if (manifest.protocol.sha256 != sha256) {
+    fail(source, "/protocol/text", "the protocol copy does not match its recorded SHA-256 " + sha256);
+  }
+  if (manifest.protocol.protocol.name != name)
+    fail(source, "/protocol/name", "not the name in the protocol copy");
+  const json& plan = root.required("plan");
+  if (!plan.is_array() || plan.empty()) fail(source, "/plan", "expected a list of planned trials");
+  for (std::size_t i = 0; i < plan.size(); ++i) {
+    PlannedTrial trial = planned_trial_from(plan[i], child_pointer("/plan", i), source, i);
+    // Only conditions of the protocol can run.
+    bool known = false;
+    for (const StudyCondition& c : manifest.protocol.protocol.conditions)
+      known = known || c.name == trial.condition;
+    if (!known)
+      fail(source, child_pointer(child_pointer("/plan", i), "condition"), "not a condition of the protocol");
+    manifest.plan.push_back(std::move(trial));
+  }
+  root.finish();
+  return manifest;
+}
+
+std::string session_created_details(const SessionManifest& manifest) {
+  const SessionSetup& setup = manifest.setup;
+  return json{{"subject", setup.subject.id},
+              {"subject_number", setup.subject.number},
+              {"device", setup.device},
+              {"writer", setup.writer},
+              {"writer_profile", setup.writer_profile},
+              {"protocol", manifest.protocol.protocol.name},
+              {"protocol_sha256", manifest.protocol.sha256},
+              {"trials_planned", manifest.plan.size()}}
+      .dump();
+}
+
+std::string log_line(const std::string& time_utc, std::string_view event, std::string_view details_json) {
+  json line = {{"time_utc", time_utc}, {"event", std::string(event)}};
+  if (!details_json.empty()) {
+    json details;
+    try {
+      details = json::parse(details_json.begin(), details_json.end());
+    } catch (const json::parse_error& e) {
+      throw InvalidArgument(std::string("session log details: not JSON: ") + e.what());
+    }
+    if (!details.is_object()) throw InvalidArgument("session log details: expected a JSON object");
+    for (auto& item : details.items()) {
+      if (item.key() != "time_utc" && item.key() != "event") line[item.key()] = item.value();
+    }
+  }
+  return line.dump() + "\n";
+}
+
+}  // namespace calligraphy::study_detail

@@ -1,0 +1,71 @@
+#include "study/names.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/report/atomic_file.hpp"
+
+namespace calligraphy::study_detail {
+
+bool is_label(std::string_view text, std::size_t max_length) {
+  if (text.empty() || text.size() > max_length) return false;
+  for (const char c : text) {
+    const bool ok =
+        (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+    if (!ok) return false;
+  }
+  return true;
+}
+
+std::string read_small_file(const std::filesystem::path& path, std::uintmax_t max_bytes,
+                            const std::string& what) {
+  std::error_code error;
+  const auto status = std::filesystem::status(path, error);
+  if (error || !std::filesystem::exists(status)) {
+    throw DataError(path.string() + ": no such file (expected a " + what + ")");
+  }
+  if (!std::filesystem::is_regular_file(status)) {
+    throw DataError(path.string() + ": not a regular file (expected a " + what + ")");
+  }
+  const std::uintmax_t size = std::filesystem::file_size(path, error);
+  if (!error && size > max_bytes) {
+    throw DataError(path.string() + ": " + std::to_string(size) + " bytes, more than the " +
+                    std::to_string(max_bytes) + " a " + what + " may have");
+  }
+  std::optional<std::string> text = read_file_for_update(path, max_bytes);
+  if (!text) throw DataError(path.string() + ": cannot be read (expected a " + what + ")");
+  return std::move(*text);
+}
+
+std::string utc_now_iso8601() {
+  const auto now = std::chrono::system_clock::now();
+  const std::time_t seconds = std::chrono::system_clock::to_time_t(now);
+  const auto milliseconds =
+      std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
+  std::tm utc{};
+  gmtime_r(&seconds, &utc);
+  char text[96];
+  std::snprintf(text, sizeof text, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", utc.tm_year + 1900, utc.tm_mon + 1,
+                utc.tm_mday, utc.tm_hour, utc.tm_min, utc.tm_sec, static_cast<int>(milliseconds));
+  return text;
+}
+
+std::uint64_t fnv1a_64(std::string_view text) {
+  std::uint64_t hash = 0xcbf29ce484222325ULL;  // offset basis
+  for (const char c : text) {
+    hash ^= static_cast<unsigned char>(c);
+    hash *= 0x100000001b3ULL;  // FNV prime
+  }
+  return hash;
+}
+
+std::uint64_t mix64(std::uint64_t value) {
+  value += 0x9e3779b97f4a7c15ULL;
+  value = (value ^ (value >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  value = (value ^ (value >> 27)) * 0x94d049bb133111ebULL;
+  return value ^ (value >> 31);
+}
+
+}  // namespace calligraphy::study_detail

@@ -1,0 +1,27 @@
+#pragma once
+// Names, files and seeds of the study module. Internal.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+namespace calligraphy::study_detail {
+
+/// True for 1..max_length characters from [A-Za-z0-9_-] (safe in file names on every system).
+bool is_label(std::string_view text, std::size_t max_length);
+
+/// The bytes of a regular file of at most `max_bytes`. Throws DataError naming the path and `what` it
+/// should hold when it does not exist, is not a regular file, is larger or cannot be read.
+std::string read_small_file(const std::filesystem::path& path, std::uintmax_t max_bytes,
+                            const std::string& what);
+
+/// The current time in UTC, ISO 8601 with milliseconds: "2024-05-01T12:34:56.789Z".
+std::string utc_now_iso8601();
+
+/// 64-bit FNV-1a of `text` (Fowler, Noll & Vo; IETF draft-eastlake-fnv): a stable seed from a name.
+std::uint64_t fnv1a_64(std::string_view text);
+/// SplitMix64's finaliser (Steele, Lea & Flood 2014, "Fast splittable pseudorandom number generators",
+/// OOPSLA): mixes a 64-bit value into a well-spread one.
+std::uint64_t mix64(std::uint64_t value);
+
+}  // namespace calligraphy::study_detail

@@ -1,0 +1,316 @@
+// Reading study protocols (format: docs/experiments.md).
+#include "calligraphy/study/protocol.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <sstream>
+
+#include "calligraphy/core/errors.hpp"
+#include "core/unicode.hpp"
+#include "study/json_reader.hpp"
+#include "study/names.hpp"
+
+namespace calligraphy {
+namespace {
+
+using nlohmann::json;
+using study_detail::as_string;
+using study_detail::child_pointer;
+using study_detail::fail;
+using study_detail::ObjectReader;
+
+constexpr const char* kFormat = "calligraphy-study-protocol";
+constexpr std::size_t kMaxItems = 1000;
+constexpr std::size_t kMaxCharactersPerItem = 16;
+constexpr std::int64_t kMaxRepetitions = 1000;
+
+template <typename Enum, std::size_t N>
+Enum choice(ObjectReader& reader, const std::string& key, const std::array<Enum, N>& values, Enum fallback) {
+  const json* value = reader.optional(key);
+  if (!value) return fallback;
+  const std::string text = as_string(*value, reader.pointer(key), reader.source());
+  std::string names;
+  for (const Enum candidate : values) {
+    if (text == to_string(candidate)) return candidate;
+    names += (names.empty() ? "" : ", ") + std::string(to_string(candidate));
+  }
+  fail(reader.source(), reader.pointer(key), "expected one of " + names + "; got \"" + text + "\"");
+}
+
+std::vector<std::u32string> read_items(const json& value, const std::string& pointer,
+                                       const std::string& source) {
+  if (!value.is_array() || value.empty() || value.size() > kMaxItems) {
+    fail(source, pointer,
+         "expected a list of 1 to " + std::to_string(kMaxItems) + " strings of characters, got " +
+             study_detail::describe(value));
+  }
+  std::vector<std::u32string> items;
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    const std::string at = child_pointer(pointer, i);
+    const std::string text = as_string(value[i], at, source);
+    std::u32string characters;
+    try {
+      characters = decode_utf8(text);
+    } catch (const InvalidArgument& e) {
+      fail(source, at, std::string("not UTF-8: ") + e.what());
+    }
+    if (characters.empty() || characters.size() > kMaxCharactersPerItem) {
+      fail(source, at,
+           "expected 1 to " + std::to_string(kMaxCharactersPerItem) + " characters, got " +
+               std::to_string(characters.size()));
+    }
+    for (const char32_t c : characters) {
+      if (c <= U' ' || c == 0x3000) fail(source, at, "a space or control character cannot be written");
+    }
+    items.push_back(characters);
+  }
+  return items;
+}
+
+QuizOptions read_quiz(const json& value, const std::string& pointer, const std::string& source) {
+  ObjectReader reader(value, pointer, source);
+  QuizOptions quiz;
+  quiz.leniency = reader.number_or("leniency", quiz.leniency, 1e-3, 1e3);
+  if (!(quiz.leniency > 0.0)) fail(source, reader.pointer("leniency"), "expected a number > 0");
+  quiz.hint_after_misses =
+      static_cast<int>(reader.integer_or("hint_after_misses", quiz.hint_after_misses, 0, 1000));
+  quiz.accept_backwards = reader.boolean_or("accept_backwards", quiz.accept_backwards);
+  reader.finish();
+  return quiz;
+}
+
+StudyCondition read_condition(const json& value, const std::string& pointer, const std::string& source) {
+  ObjectReader reader(value, pointer, source);
+  StudyCondition condition;
+  condition.name = reader.string("name");
+  if (!study_detail::is_label(condition.name, 32)) {
+    fail(source, reader.pointer("name"),
+         "expected 1 to 32 letters, digits, '_' or '-', got \"" + condition.name + "\"");
+  }
+  constexpr std::array<ConditionMode, 5> kModes{ConditionMode::vision, ConditionMode::haptic,
+                                                ConditionMode::fading, ConditionMode::replay,
+                                                ConditionMode::quiz};
+  if (!reader.has("mode")) fail(source, reader.pointer("mode"), "missing (required)");
+  condition.mode = choice(reader, "mode", kModes, ConditionMode::vision);
+  const bool guided = condition.mode == ConditionMode::haptic || condition.mode == ConditionMode::fading ||
+                      condition.mode == ConditionMode::replay;
+  if (const json* stiffness = reader.optional("guidance_stiffness_n_per_m")) {
+    if (!guided) {
+      fail(source, reader.pointer("guidance_stiffness_n_per_m"),
+           std::string("mode \"") + to_string(condition.mode) + "\" renders no guidance");
+    }
+    condition.guidance_stiffness_n_per_m =
+        study_detail::as_number(*stiffness, reader.pointer("guidance_stiffness_n_per_m"), source, 0.0, 1e5);
+  }
+  if (const json* parameters = reader.optional("parameters")) {
+    const std::string at = reader.pointer("parameters");
+    if (condition.mode != ConditionMode::fading && condition.mode != ConditionMode::replay) {
+      fail(source, at, "only the modes \"fading\" and \"replay\" take parameters");
+    }
+    ObjectReader parameter_reader(*parameters, at, source);
+    for (const auto& item : parameters->items()) {
+      condition.guidance_parameters[item.key()] = parameter_reader.number(
+          item.key(), -std::numeric_limits<double>::max(), std::numeric_limits<double>::max());
+    }
+  }
+  if (const json* quiz = reader.optional("quiz")) {
+    if (condition.mode != ConditionMode::quiz) {
+      fail(source, reader.pointer("quiz"), "only the mode \"quiz\" takes quiz options");
+    }
+    condition.quiz = read_quiz(*quiz, reader.pointer("quiz"), source);
+  }
+  reader.finish();
+  return condition;
+}
+
+// The name of a condition the protocol defines, or an error naming `pointer`.
+std::string condition_name(const json& value, const std::string& pointer, const std::string& source,
+                           const std::vector<StudyCondition>& conditions) {
+  const std::string name = as_string(value, pointer, source);
+  std::string names;
+  for (const StudyCondition& c : conditions) {
+    if (c.name == name) return name;
+    names += (names.empty() ? "" : ", ") + c.name;
+  }
+  fail(source, pointer, "no condition is called \"" + name + "\" (defined: " + names + ")");
+}
+
+void read_order(ObjectReader& reader, StudyProtocol& protocol) {
+  const json* value = reader.optional("order");
+  if (!value) return;
+  ObjectReader order(*value, reader.pointer("order"), reader.source());
+  constexpr std::array<ConditionOrder, 4> kConditionOrders{
+      ConditionOrder::fixed, ConditionOrder::latin_square, ConditionOrder::abba, ConditionOrder::random};
+  constexpr std::array<ItemOrder, 2> kItemOrders{ItemOrder::fixed, ItemOrder::random};
+  protocol.condition_order = choice(order, "conditions", kConditionOrders, ConditionOrder::fixed);
+  protocol.item_order = choice(order, "characters", kItemOrders, ItemOrder::fixed);
+  protocol.seed = order.unsigned_or("seed", 0);
+  order.finish();
+}
+
+void read_breaks(ObjectReader& reader, StudyProtocol& protocol) {
+  const json* value = reader.optional("breaks");
+  if (!value) return;
+  ObjectReader breaks(*value, reader.pointer("breaks"), reader.source());
+  protocol.breaks.between_blocks_s = breaks.number_or("between_blocks_s", 0.0, 0.0, 86400.0);
+  protocol.breaks.every_trials = static_cast<int>(breaks.integer_or("every_trials", 0, 0, 100000));
+  protocol.breaks.duration_s = breaks.number_or("duration_s", 0.0, 0.0, 86400.0);
+  if (protocol.breaks.every_trials > 0 && !breaks.has("duration_s")) {
+    fail(reader.source(), breaks.pointer("duration_s"), "missing: every_trials needs a duration_s");
+  }
+  breaks.finish();
+}
+
+void read_trial_settings(ObjectReader& reader, StudyProtocol& protocol) {
+  const json* value = reader.optional("trial");
+  if (!value) return;
+  ObjectReader trial(*value, reader.pointer("trial"), reader.source());
+  protocol.trial.max_duration_s =
+      trial.number_or("max_duration_s", protocol.trial.max_duration_s, 1e-3, 3600.0);
+  protocol.trial.rate_hz = trial.number_or("rate_hz", protocol.trial.rate_hz, 100.0, 10000.0);
+  trial.finish();
+}
+
+}  // namespace
+
+const char* to_string(ConditionMode mode) noexcept {
+  switch (mode) {
+    case ConditionMode::vision:
+      return "vision";
+    case ConditionMode::haptic:
+      return "haptic";
+    case ConditionMode::fading:
+      return "fading";
+    case ConditionMode::replay:
+      return "replay";
+    case ConditionMode::quiz:
+      return "quiz";
+  }
+  return "unknown";
+}
+
+const char* to_string(ConditionOrder order) noexcept {
+  switch (order) {
+    case ConditionOrder::fixed:
+      return "fixed";
+    case ConditionOrder::latin_square:
+      return "latin_square";
+    case ConditionOrder::abba:
+      return "abba";
+    case ConditionOrder::random:
+      return "random";
+  }
+  return "unknown";
+}
+
+const char* to_string(ItemOrder order) noexcept {
+  return order == ItemOrder::fixed ? "fixed" : order == ItemOrder::random ? "random" : "unknown";
+}
+
+void QuizOptions::validate() const {
+  if (!std::isfinite(leniency) || leniency <= 0.0) {
+    throw InvalidArgument("QuizOptions::leniency must be finite and > 0, got " + std::to_string(leniency));
+  }
+  if (hint_after_misses < 0) {
+    throw InvalidArgument("QuizOptions::hint_after_misses must be >= 0, got " +
+                          std::to_string(hint_after_misses));
+  }
+}
+
+const StudyCondition& StudyProtocol::condition(std::string_view wanted) const {
+  for (const StudyCondition& c : conditions) {
+    if (c.name == wanted) return c;
+  }
+  throw InvalidArgument("protocol '" + name + "' has no condition '" + std::string(wanted) + "'");
+}
+
+StudyProtocol parse_study_protocol(std::string_view json_text, const std::string& source) {
+  const json document = study_detail::parse_json(json_text, source);
+  ObjectReader root(document, "", source);
+  StudyProtocol protocol;
+  const std::string format = root.string_or("format", kFormat);
+  if (format != kFormat) {
+    fail(source, "/format", std::string("expected \"") + kFormat + "\", got \"" + format + "\"");
+  }
+  root.integer_or("version", 1, 1, 1);
+  protocol.name = root.string("name");
+  if (!study_detail::is_label(protocol.name, 64)) {
+    fail(source, "/name", "expected 1 to 64 letters, digits, '_' or '-', got \"" + protocol.name + "\"");
+  }
+  protocol.description = root.string_or("description", "");
+
+  const json& conditions = root.required("conditions");
+  if (!conditions.is_array() || conditions.empty() || conditions.size() > 26) {
+    fail(source, "/conditions",
+         "expected a list of 1 to 26 conditions, got " + study_detail::describe(conditions));
+  }
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < conditions.size(); ++i) {
+    StudyCondition condition = read_condition(conditions[i], child_pointer("/conditions", i), source);
+    if (!names.insert(condition.name).second) {
+      fail(source, child_pointer(child_pointer("/conditions", i), "name"),
+           "the condition \"" + condition.name + "\" is defined twice");
+    }
+    protocol.conditions.push_back(std::move(condition));
+  }
+
+  if (const json* practice = root.optional("practice")) {
+    ObjectReader reader(*practice, "/practice", source);
+    PracticePhase phase;
+    phase.items = read_items(reader.required("characters"), reader.pointer("characters"), source);
+    phase.condition = condition_name(reader.required("condition"), reader.pointer("condition"), source,
+                                     protocol.conditions);
+    phase.repetitions = static_cast<int>(reader.integer_or("repetitions", 1, 1, kMaxRepetitions));
+    reader.finish();
+    protocol.practice = std::move(phase);
+  }
+
+  ObjectReader test(root.required("test"), "/test", source);
+  protocol.test_items = read_items(test.required("characters"), test.pointer("characters"), source);
+  const json& tested = test.required("conditions");
+  if (!tested.is_array() || tested.empty()) {
+    fail(source, "/test/conditions",
+         "expected a list of condition names, got " + study_detail::describe(tested));
+  }
+  for (std::size_t i = 0; i < tested.size(); ++i) {
+    const std::string at = child_pointer("/test/conditions", i);
+    std::string name = condition_name(tested[i], at, source, protocol.conditions);
+    if (std::find(protocol.test_conditions.begin(), protocol.test_conditions.end(), name) !=
+        protocol.test_conditions.end()) {
+      fail(source, at, "the condition \"" + name + "\" is listed twice");
+    }
+    protocol.test_conditions.push_back(std::move(name));
+  }
+  protocol.repetitions = static_cast<int>(test.integer("repetitions", 1, kMaxRepetitions));
+  test.finish();
+
+  read_order(root, protocol);
+  read_breaks(root, protocol);
+  read_trial_settings(root, protocol);
+  root.finish();
+
+  if (protocol.condition_order == ConditionOrder::abba && protocol.repetitions % 2 != 0) {
+    fail(source, "/test/repetitions",
+         "order \"abba\" splits each condition's repetitions over two blocks: expected an even number, got " +
+             std::to_string(protocol.repetitions));
+  }
+  return protocol;
+}
+
+LoadedProtocol protocol_from_text(std::string text, const std::filesystem::path& path) {
+  LoadedProtocol loaded;
+  loaded.protocol = parse_study_protocol(text, path.string());
+  loaded.sha256 = sha256_hex(text);
+  loaded.text = std::move(text);
+  loaded.path = path;
+  return loaded;
+}
+
+LoadedProtocol load_study_protocol(const std::filesystem::path& path) {
+  return protocol_from_text(study_detail::read_small_file(path, kMaxProtocolBytes, "study protocol"), path);
+}
+
+}  // namespace calligraphy

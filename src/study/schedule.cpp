@@ -1,0 +1,161 @@
+#include "calligraphy/study/schedule.hpp"
+
+#include <algorithm>
+#include <map>
+#include <utility>
+
+#include "calligraphy/core/errors.hpp"
+#include "study/names.hpp"
+
+namespace calligraphy {
+namespace {
+
+// A reproducible stream of 64-bit numbers (SplitMix64), the same on every platform (std::shuffle and
+// the standard distributions are not).
+class SeededStream {
+ public:
+  explicit SeededStream(std::uint64_t seed) : state_(seed) {}
+  std::uint64_t next() { return study_detail::mix64(state_++ * 0x9e3779b97f4a7c15ULL); }
+  // Uniform in [0, bound), bound > 0, without modulo bias (rejection).
+  std::size_t below(std::size_t bound) {
+    const std::uint64_t limit = UINT64_MAX - UINT64_MAX % bound;
+    std::uint64_t value = next();
+    while (value >= limit) value = next();
+    return static_cast<std::size_t>(value % bound);
+  }
+
+ private:
+  std::uint64_t state_;
+};
+
+template <typename T>
+void shuffle(std::vector<T>& values, std::uint64_t seed) {
+  SeededStream stream(seed);
+  for (std::size_t i = values.size(); i > 1; --i) std::swap(values[i - 1], values[stream.below(i)]);
+}
+
+// Row `row` of the balanced Latin square of n conditions (Williams 1949): the first row is
+// 0, 1, n-1, 2, n-2, ...; row r adds r mod n; for odd n rows n..2n-1 are rows 0..n-1 reversed.
+std::vector<std::size_t> williams_row(std::size_t n, std::size_t row) {
+  std::vector<std::size_t> first{0};
+  for (std::size_t k = 1, low = 1, high = n - 1; k < n; ++k) first.push_back(k % 2 == 1 ? low++ : high--);
+  std::vector<std::size_t> out(n);
+  for (std::size_t j = 0; j < n; ++j) out[j] = (first[j] + row) % n;
+  if (n % 2 == 1 && (row / n) % 2 == 1) std::reverse(out.begin(), out.end());
+  return out;
+}
+
+std::uint64_t subject_seed(const StudyProtocol& protocol, const SubjectAssignment& subject) {
+  return study_detail::mix64(protocol.seed ^ study_detail::fnv1a_64(subject.id));
+}
+
+void check_subject(const SubjectAssignment& subject) {
+  if (!study_detail::is_label(subject.id, 64)) {
+    throw InvalidArgument("subject id '" + subject.id + "': expected 1 to 64 letters, digits, '_' or '-'");
+  }
+}
+
+}  // namespace
+
+const char* to_string(StudyPhase phase) noexcept {
+  return phase == StudyPhase::practice ? "practice" : "test";
+}
+
+std::size_t trailing_number(std::string_view subject_id) noexcept {
+  std::size_t begin = subject_id.size();
+  while (begin > 0 && subject_id[begin - 1] >= '0' && subject_id[begin - 1] <= '9') --begin;
+  if (begin == subject_id.size() || subject_id.size() - begin > 9) return 0;
+  std::size_t number = 0;
+  for (std::size_t i = begin; i < subject_id.size(); ++i) {
+    number = number * 10 + static_cast<std::size_t>(subject_id[i] - '0');
+  }
+  return number;
+}
+
+std::vector<std::string> test_block_conditions(const StudyProtocol& protocol,
+                                               const SubjectAssignment& subject) {
+  check_subject(subject);
+  const std::vector<std::string>& listed = protocol.test_conditions;
+  const std::size_t n = listed.size();
+  const bool needs_number = protocol.condition_order == ConditionOrder::latin_square ||
+                            protocol.condition_order == ConditionOrder::abba;
+  if (needs_number && subject.number == 0) {
+    throw InvalidArgument("subject '" + subject.id + "': the order '" + to_string(protocol.condition_order) +
+                          "' needs the subject's number (1, 2, ...) to counterbalance");
+  }
+  std::vector<std::string> blocks;
+  switch (protocol.condition_order) {
+    case ConditionOrder::fixed:
+      blocks = listed;
+      break;
+    case ConditionOrder::latin_square: {
+      const std::size_t rows = n % 2 == 0 ? n : 2 * n;
+      for (const std::size_t k : williams_row(n, (subject.number - 1) % rows)) blocks.push_back(listed[k]);
+      break;
+    }
+    case ConditionOrder::abba: {
+      std::vector<std::string> first = listed;
+      if (subject.number % 2 == 0) std::reverse(first.begin(), first.end());
+      blocks = first;
+      blocks.insert(blocks.end(), first.rbegin(), first.rend());
+      break;
+    }
+    case ConditionOrder::random:
+      blocks = listed;
+      shuffle(blocks, subject_seed(protocol, subject));
+      break;
+  }
+  return blocks;
+}
+
+std::vector<PlannedTrial> plan_session(const StudyProtocol& protocol, const SubjectAssignment& subject) {
+  const std::vector<std::string> blocks = test_block_conditions(protocol, subject);
+  std::vector<PlannedTrial> trials;
+  std::map<std::pair<std::string, std::size_t>, int> written;  // (condition, item) -> times planned so far
+  std::size_t block = 0;
+  const auto add_block = [&](StudyPhase phase, const std::string& condition,
+                             const std::vector<std::u32string>& items, int rounds, bool shuffled) {
+    const std::size_t first = trials.size();
+    for (int round = 0; round < rounds; ++round) {
+      std::vector<std::size_t> order(items.size());
+      for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+      if (shuffled) {
+        shuffle(order, study_detail::mix64(
+                           subject_seed(protocol, subject) ^
+                           study_detail::mix64(block * 1000003ULL + static_cast<std::size_t>(round))));
+      }
+      for (const std::size_t item : order) {
+        PlannedTrial trial;
+        trial.index = trials.size();
+        trial.phase = phase;
+        trial.block = block;
+        trial.condition = condition;
+        trial.characters = items[item];
+        trial.item = item;
+        trial.repetition = ++written[{std::string(to_string(phase)) + "/" + condition, item}];
+        trials.push_back(std::move(trial));
+      }
+    }
+    if (block > 0 && first < trials.size()) trials[first].break_before_s = protocol.breaks.between_blocks_s;
+    ++block;
+  };
+  if (protocol.practice) {
+    add_block(StudyPhase::practice, protocol.practice->condition, protocol.practice->items,
+              protocol.practice->repetitions, false);
+  }
+  const int rounds =
+      protocol.condition_order == ConditionOrder::abba ? protocol.repetitions / 2 : protocol.repetitions;
+  for (const std::string& condition : blocks) {
+    add_block(StudyPhase::test, condition, protocol.test_items, rounds,
+              protocol.item_order == ItemOrder::random);
+  }
+  const auto every = static_cast<std::size_t>(protocol.breaks.every_trials);
+  if (every > 0) {
+    for (std::size_t i = every; i < trials.size(); i += every) {
+      trials[i].break_before_s = std::max(trials[i].break_before_s, protocol.breaks.duration_s);
+    }
+  }
+  return trials;
+}
+
+}  // namespace calligraphy

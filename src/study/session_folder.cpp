@@ -1,0 +1,316 @@
+#include "calligraphy/study/session_folder.hpp"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <utility>
+
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/report/atomic_file.hpp"
+#include "core/unicode.hpp"
+#include "study/json_reader.hpp"
+#include "study/manifest_json.hpp"
+#include "study/names.hpp"
+
+namespace calligraphy {
+namespace fs = std::filesystem;
+namespace {
+
+constexpr std::uintmax_t kMaxManifestBytes = std::uintmax_t{16} << 20;
+
+[[noreturn]] void fail_errno(const fs::path& path, const std::string& what, int error) {
+  throw DataError(path.string() + ": " + what + ": " + std::strerror(error));
+}
+
+void make_folder(const fs::path& folder) {
+  std::error_code error;
+  fs::create_directories(folder, error);
+  if (error) throw DataError(folder.string() + ": cannot create the folder: " + error.message());
+}
+
+void fsync_folder(const fs::path& folder) {
+  const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) fail_errno(folder, "cannot open the folder to sync it", errno);
+  const int result = ::fsync(fd);
+  const int error = errno;
+  ::close(fd);
+  if (result != 0 && error != EINVAL) fail_errno(folder, "cannot sync the folder", error);
+}
+
+void write_all(int fd, std::string_view bytes, const fs::path& path) {
+  while (!bytes.empty()) {
+    const ssize_t written = ::write(fd, bytes.data(), bytes.size());
+    if (written < 0 && errno == EINTR) continue;
+    if (written <= 0) fail_errno(path, "write failed", written < 0 ? errno : EIO);
+    bytes.remove_prefix(static_cast<std::size_t>(written));
+  }
+}
+
+// Opens (creating it) the log for appending and takes its exclusive lock.
+int open_locked_log(const fs::path& log_path) {
+  const int fd = ::open(log_path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) fail_errno(log_path, "cannot open the session log", errno);
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    const int error = errno;
+    ::close(fd);
+    if (error == EWOULDBLOCK) {
+      throw StateError(log_path.parent_path().string() +
+                       ": the session is open in another process (its log is locked)");
+    }
+    fail_errno(log_path, "cannot lock the session log", error);
+  }
+  return fd;
+}
+
+std::string folder_timestamp() {
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y%m%d-%H%M%S", &utc);
+  return text;
+}
+
+void check_setup(const SessionSetup& setup) {
+  if (!study_detail::is_label(setup.subject.id, 64)) {
+    throw InvalidArgument("subject id '" + setup.subject.id +
+                          "': expected 1 to 64 letters, digits, '_' or '-'");
+  }
+  if (setup.writer != "simulated" && setup.writer != "human") {
+    throw InvalidArgument("writer '" + setup.writer + "': expected 'simulated' or 'human'");
+  }
+  if (setup.writer_profile != "novice" && setup.writer_profile != "skilled") {
+    throw InvalidArgument("writer profile '" + setup.writer_profile + "': expected 'novice' or 'skilled'");
+  }
+  if (setup.pacing != "auto" && setup.pacing != "lock-step" && setup.pacing != "real-time") {
+    throw InvalidArgument("pacing '" + setup.pacing + "': expected 'auto', 'lock-step' or 'real-time'");
+  }
+  if (setup.device.empty()) throw InvalidArgument("session setup: the device name is empty");
+}
+
+}  // namespace
+
+std::uint64_t subject_seed(std::string_view subject_id) {
+  return study_detail::mix64(study_detail::fnv1a_64(subject_id));
+}
+
+LibraryBuild library_build() {
+  LibraryBuild build;
+  build.version = CALLIGRAPHY_VERSION;
+  build.build_type = CALLIGRAPHY_BUILD_TYPE;
+#if defined(__clang__)
+  build.compiler = "Clang " __clang_version__;
+#elif defined(__GNUC__)
+  build.compiler = "GCC " __VERSION__;
+#else
+  build.compiler = "unknown";
+#endif
+  build.cxx_standard = std::to_string(__cplusplus) + "L";
+  build.cxx_standard.pop_back();
+  return build;
+}
+
+SessionFolder::SessionFolder(fs::path path, SessionManifest manifest, int log_fd)
+    : path_(std::move(path)), manifest_(std::move(manifest)), log_fd_(log_fd) {}
+
+SessionFolder::SessionFolder(SessionFolder&& other) noexcept
+    : path_(std::move(other.path_)),
+      manifest_(std::move(other.manifest_)),
+      log_fd_(std::exchange(other.log_fd_, -1)) {}
+
+SessionFolder& SessionFolder::operator=(SessionFolder&& other) noexcept {
+  if (this != &other) {
+    if (log_fd_ >= 0) ::close(log_fd_);
+    path_ = std::move(other.path_);
+    manifest_ = std::move(other.manifest_);
+    log_fd_ = std::exchange(other.log_fd_, -1);
+  }
+  return *this;
+}
+
+SessionFolder::~SessionFolder() {
+  if (log_fd_ >= 0) ::close(log_fd_);  // releases the flock
+}
+
+SessionFolder SessionFolder::create(const fs::path& root, const SessionSetup& setup,
+                                    const LoadedProtocol& protocol) {
+  check_setup(setup);
+  SessionManifest manifest;
+  manifest.setup = setup;
+  manifest.protocol = protocol;
+  manifest.library = library_build();
+  manifest.created_utc = study_detail::utc_now_iso8601();
+  manifest.plan = plan_session(protocol.protocol, setup.subject);
+
+  const fs::path subject_folder = root / setup.subject.id;
+  make_folder(subject_folder);
+  const std::string base = protocol.protocol.name + "-" + folder_timestamp();
+  fs::path folder;
+  for (int suffix = 1;; ++suffix) {
+    const std::string name = suffix == 1 ? base : base + "-" + std::to_string(suffix);
+    folder = subject_folder / name;
+    // mkdir fails when the folder exists: two runners never share a folder.
+    if (::mkdir(folder.c_str(), 0755) == 0) {
+      manifest.session_id = name;
+      break;
+    }
+    if (errno != EEXIST || suffix > 1000) fail_errno(folder, "cannot create the session folder", errno);
+  }
+  make_folder(folder / "trials");
+  const int fd = open_locked_log(folder / "log.jsonl");
+  SessionFolder session(folder, std::move(manifest), fd);
+  write_file_atomically(folder / "session.json", study_detail::manifest_to_json(session.manifest_));
+  fsync_folder(subject_folder);
+  session.log("session_created", study_detail::session_created_details(session.manifest_));
+  return session;
+}
+
+SessionFolder SessionFolder::open(const fs::path& folder) {
+  const fs::path manifest_path = folder / "session.json";
+  const std::string text =
+      study_detail::read_small_file(manifest_path, kMaxManifestBytes, "session manifest");
+  SessionManifest manifest = study_detail::manifest_from_json(text, manifest_path.string());
+  manifest.session_id = folder.filename().string();
+  if (manifest.session_id.empty()) manifest.session_id = folder.parent_path().filename().string();
+  const fs::path log_path = folder / "log.jsonl";
+  const int fd = open_locked_log(log_path);
+  SessionFolder session(folder, std::move(manifest), fd);
+  // A crash in the middle of a log line leaves it torn: end it, so that the next line stands alone.
+  std::error_code error;
+  const std::uintmax_t size = fs::file_size(log_path, error);
+  if (!error && size > 0) {
+    const int reader = ::open(log_path.c_str(), O_RDONLY | O_CLOEXEC);
+    char last = '\n';
+    if (reader >= 0) {
+      if (::pread(reader, &last, 1, static_cast<off_t>(size - 1)) != 1) last = '\n';
+      ::close(reader);
+    }
+    if (last != '\n') {
+      write_all(fd, "\n", log_path);
+      if (::fsync(fd) != 0) fail_errno(log_path, "cannot sync the session log", errno);
+    }
+  }
+  return session;
+}
+
+std::string SessionFolder::trial_stem(const PlannedTrial& trial) {
+  char number[16];
+  std::snprintf(number, sizeof number, "%03zu", trial.index + 1);
+  std::string stem = std::string(number) + "-" + to_string(trial.phase) + "-" + trial.condition + "-r" +
+                     std::to_string(trial.repetition) + "-";
+  for (std::size_t i = 0; i < trial.characters.size(); ++i) {
+    char code[16];
+    std::snprintf(code, sizeof code, "%sU%04X", i == 0 ? "" : "_",
+                  static_cast<unsigned>(trial.characters[i]));
+    stem += code;
+  }
+  return stem;
+}
+
+fs::path SessionFolder::trial_file(const PlannedTrial& trial, std::string_view extension) const {
+  return path_ / "trials" / (trial_stem(trial) + "." + std::string(extension));
+}
+
+bool SessionFolder::is_saved(const PlannedTrial& trial) const {
+  std::error_code error;
+  return fs::exists(trial_file(trial, "json"), error);
+}
+
+std::size_t SessionFolder::saved_count() const {
+  return static_cast<std::size_t>(
+      std::count_if(plan().begin(), plan().end(), [this](const PlannedTrial& t) { return is_saved(t); }));
+}
+
+std::optional<std::size_t> SessionFolder::next_unsaved() const {
+  for (const PlannedTrial& trial : plan()) {
+    if (!is_saved(trial)) return trial.index;
+  }
+  return std::nullopt;
+}
+
+void SessionFolder::save_trial(const PlannedTrial& trial, std::string_view json, std::string_view csv,
+                               std::string_view svg) {
+  const fs::path target = trial_file(trial, "json");
+  if (is_saved(trial))
+    throw StateError(target.string() + ": the trial is saved already; it is never overwritten");
+  write_file_atomically(trial_file(trial, "csv"), csv);
+  write_file_atomically(trial_file(trial, "svg"), svg);
+  // The JSON marks the trial saved: written whole to a temporary, then linked to its name, which fails
+  // (EEXIST) instead of replacing a file that appeared meanwhile.
+  const fs::path temporary = target.string() + ".part";
+  write_file_atomically(temporary, json);
+  if (::link(temporary.c_str(), target.c_str()) != 0) {
+    const int error = errno;
+    ::unlink(temporary.c_str());
+    if (error == EEXIST)
+      throw StateError(target.string() + ": the trial is saved already; it is never overwritten");
+    fail_errno(target, "cannot save the trial", error);
+  }
+  ::unlink(temporary.c_str());
+  fsync_folder(target.parent_path());
+}
+
+fs::path SessionFolder::save_attempt(const PlannedTrial& trial, std::string_view json, std::string_view csv) {
+  const fs::path folder = path_ / "trials" / "attempts";
+  make_folder(folder);
+  for (int k = 1; k < 100000; ++k) {
+    const std::string stem = trial_stem(trial) + ".attempt-" + std::to_string(k);
+    const fs::path json_path = folder / (stem + ".json");
+    const fs::path temporary = json_path.string() + ".part";
+    std::error_code error;
+    if (fs::exists(json_path, error)) continue;
+    write_file_atomically(folder / (stem + ".csv"), csv);
+    write_file_atomically(temporary, json);
+    const int linked = ::link(temporary.c_str(), json_path.c_str());
+    const int link_error = errno;
+    ::unlink(temporary.c_str());
+    if (linked == 0) {
+      fsync_folder(folder);
+      return json_path;
+    }
+    if (link_error != EEXIST) fail_errno(json_path, "cannot keep the attempt", link_error);
+  }
+  throw DataError(folder.string() + ": too many attempts of trial " + trial_stem(trial));
+}
+
+void SessionFolder::log(std::string_view event, std::string_view details_json) {
+  const std::string line = study_detail::log_line(study_detail::utc_now_iso8601(), event, details_json);
+  const fs::path log_path = path_ / "log.jsonl";
+  write_all(log_fd_, line, log_path);
+  if (::fsync(log_fd_) != 0) fail_errno(log_path, "cannot sync the session log", errno);
+}
+
+std::vector<fs::path> find_session_folders(const fs::path& root) {
+  std::error_code error;
+  if (!fs::is_directory(root, error))
+    throw DataError(root.string() + ": not a folder (expected session folders)");
+  if (fs::is_regular_file(root / "session.json", error)) return {root};
+  std::vector<fs::path> found;
+  fs::recursive_directory_iterator it(root, fs::directory_options::skip_permission_denied, error);
+  if (error) throw DataError(root.string() + ": cannot list the folder: " + error.message());
+  for (; it != fs::recursive_directory_iterator(); it.increment(error)) {
+    if (error) throw DataError(root.string() + ": cannot list the folder: " + error.message());
+    if (it->is_symlink(error)) {
+      it.disable_recursion_pending();
+      continue;
+    }
+    if (!it->is_directory(error)) continue;
+    if (fs::is_regular_file(it->path() / "session.json", error)) {
+      found.push_back(it->path());
+      it.disable_recursion_pending();
+    } else if (it.depth() >= 3) {
+      it.disable_recursion_pending();
+    }
+  }
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
+}  // namespace calligraphy

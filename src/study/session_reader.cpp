@@ -1,0 +1,231 @@
+#include "calligraphy/study/session_reader.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <set>
+#include <string>
+
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/report/pen_trace_csv.hpp"
+#include "core/unicode.hpp"
+#include "study/json_reader.hpp"
+#include "study/manifest_json.hpp"
+#include "study/names.hpp"
+
+namespace calligraphy {
+namespace fs = std::filesystem;
+namespace {
+
+using nlohmann::json;
+using study_detail::fail;
+using study_detail::ObjectReader;
+
+constexpr std::uintmax_t kMaxRecordBytes = std::uintmax_t{64} << 20;
+
+Vec2 vec2(const json& value, const std::string& pointer, const std::string& source) {
+  if (!value.is_array() || value.size() < 2) fail(source, pointer, "expected [x, y]");
+  return {study_detail::as_number(value[0], pointer + "/0", source, -1e6, 1e6),
+          study_detail::as_number(value[1], pointer + "/1", source, -1e6, 1e6)};
+}
+
+std::optional<double> optional_number(const json& record, const char* key, const std::string& source) {
+  const auto found = record.find(key);
+  if (found == record.end() || found->is_null()) return std::nullopt;
+  return study_detail::as_number(*found, std::string("/") + key, source, -1e12, 1e12);
+}
+
+double number(const json& record, const char* key, const std::string& source) {
+  const auto found = record.find(key);
+  if (found == record.end()) fail(source, std::string("/") + key, "missing (required)");
+  return study_detail::as_number(*found, std::string("/") + key, source, -1e12, 1e12);
+}
+
+// The reference strokes and start points from the record's scene.
+void read_scene(const json& record, const std::string& source, ReportTrial& trial) {
+  const auto scene = record.find("scene");
+  if (scene == record.end() || !scene->contains("characters")) fail(source, "/scene", "missing (required)");
+  const json& characters = (*scene)["characters"];
+  for (std::size_t c = 0; c < characters.size(); ++c) {
+    const std::string at = "/scene/characters/" + std::to_string(c) + "/strokes";
+    const json& strokes = characters[c].value("strokes", json::array());
+    for (std::size_t s = 0; s < strokes.size(); ++s) {
+      const std::string stroke_at = at + "/" + std::to_string(s);
+      std::vector<Vec2> polyline;
+      const json& points = strokes[s].value("polyline_m", json::array());
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        polyline.push_back(vec2(points[i], stroke_at + "/polyline_m/" + std::to_string(i), source));
+      }
+      trial.reference_m.push_back(std::move(polyline));
+      trial.stroke_starts_m.push_back(
+          vec2(strokes[s].value("start_m", json()), stroke_at + "/start_m", source));
+    }
+  }
+}
+
+double parse_field(std::string_view field, const std::string& source, std::size_t line, const char* column) {
+  double value = 0.0;
+  const auto [end, error] = std::from_chars(field.data(), field.data() + field.size(), value);
+  if (error != std::errc() || end != field.data() + field.size() || !std::isfinite(value)) {
+    throw DataError(source + ":" + std::to_string(line) + ": column " + column + ": not a finite number: '" +
+                    std::string(field) + "'");
+  }
+  return value;
+}
+
+// The trial CSV (t,x,y,z,fx,fy,fz,state,stroke,element): times, positions, pen down, in-plane force.
+void read_trace(const fs::path& file, double paper_z_m, ReportTrial& trial) {
+  const std::string text = study_detail::read_small_file(file, kMaxTrialCsvBytes, "trial trace (CSV)");
+  const std::string source = file.string();
+  const double contact_m = PenTraceCsvOptions{}.contact_threshold_m;
+  std::size_t line_number = 0, begin = 0;
+  constexpr const char* kHeader = "t,x,y,z,fx,fy,fz,state,stroke,element";
+  while (begin < text.size()) {
+    std::size_t end = text.find('\n', begin);
+    if (end == std::string::npos) end = text.size();
+    std::string_view line(text.data() + begin, end - begin);
+    begin = end + 1;
+    ++line_number;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    if (line_number == 1) {
+      if (line != kHeader) throw DataError(source + ":1: expected the header '" + std::string(kHeader) + "'");
+      continue;
+    }
+    if (line.empty()) continue;
+    std::array<std::string_view, 10> fields;
+    std::size_t count = 0, start = 0;
+    while (count < fields.size()) {
+      const std::size_t comma = line.find(',', start);
+      fields[count++] =
+          line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
+      if (comma == std::string_view::npos) break;
+      start = comma + 1;
+    }
+    if (count != 10) {
+      throw DataError(source + ":" + std::to_string(line_number) + ": expected 10 fields, got " +
+                      std::to_string(count));
+    }
+    const double t = parse_field(fields[0], source, line_number, "t");
+    if (!trial.time_s.empty() && t < trial.time_s.back()) {
+      throw DataError(source + ":" + std::to_string(line_number) + ": time goes backwards");
+    }
+    const Vec2 position(parse_field(fields[1], source, line_number, "x"),
+                        parse_field(fields[2], source, line_number, "y"));
+    const double z = parse_field(fields[3], source, line_number, "z");
+    const Vec2 force(parse_field(fields[4], source, line_number, "fx"),
+                     parse_field(fields[5], source, line_number, "fy"));
+    trial.time_s.push_back(t);
+    trial.position_m.push_back(position);
+    trial.pen_down.push_back(z - paper_z_m <= contact_m);
+    trial.in_plane_force_n.push_back(force.norm());
+  }
+}
+
+ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifest, const PlannedTrial& plan) {
+  const std::string source = json_file.string();
+  const json record = study_detail::parse_json(
+      study_detail::read_small_file(json_file, kMaxRecordBytes, "trial record (JSON)"), source);
+  if (!record.is_object() || record.value("format", "") != "calligraphy-study-trial") {
+    fail(source, "/format", "expected \"calligraphy-study-trial\"");
+  }
+  ReportTrial trial;
+  trial.subject = manifest.setup.subject.id;
+  trial.session = manifest.session_id;
+  trial.phase = to_string(plan.phase);
+  trial.condition = plan.condition;
+  trial.mode = record.value("mode", "");
+  for (const char32_t c : plan.characters) trial.characters += encode_utf8(c);
+  trial.end_reason = record.value("end_reason", "");
+  trial.index = plan.index + 1;
+  trial.item = plan.item;
+  trial.repetition = plan.repetition;
+  trial.time_total_s = number(record, "time_s", source);
+  trial.mean_deviation_mm = number(record, "mean_deviation_mm", source);
+  trial.frechet_mm = optional_number(record, "frechet_mm", source);
+  trial.dtw_mm = optional_number(record, "dtw_mm", source);
+  trial.order_errors = static_cast<std::size_t>(number(record, "order_errors", source));
+  trial.backwards_strokes = static_cast<std::size_t>(number(record, "backwards_strokes", source));
+  trial.completed = record.value("end_reason", "") == "completed";
+  if (record.contains("quiz")) trial.quiz_misses = record["quiz"].value("misses", 0);
+  read_scene(record, source, trial);
+  const json& per_stroke = record.value("per_stroke", json::array());
+  for (std::size_t i = 0; i < per_stroke.size(); ++i) {
+    const json& s = per_stroke[i];
+    if (!s.value("start_s", json()).is_number() || !s.value("end_s", json()).is_number()) continue;
+    trial.strokes.push_back(
+        {i, s["start_s"].get<double>(), s["end_s"].get<double>(), s.value("completed", false)});
+  }
+  const double paper_z = record["scene"].value("layout", json::object()).value("paper_z_m", 0.0);
+  const std::string csv = record.value("files", json::object()).value("csv", "");
+  if (csv.empty() || csv.find('/') != std::string::npos) fail(source, "/files/csv", "expected a file name");
+  read_trace(json_file.parent_path() / csv, paper_z, trial);
+  return trial;
+}
+
+std::string session_line(const SessionManifest& m, const fs::path& folder, std::size_t saved) {
+  std::string writer =
+      m.setup.writer == "simulated" ? "simulated writer (" + m.setup.writer_profile + ")" : "human";
+  return "Subject " + m.setup.subject.id + ": " + folder.string() + ", protocol " + m.protocol.protocol.name +
+         " (sha256 " + m.protocol.sha256.substr(0, 12) + "), device " + m.setup.device + ", " + writer +
+         ", " + std::to_string(saved) + " of " + std::to_string(m.plan.size()) + " trials saved, library " +
+         m.library.version + " " + m.library.build_type;
+}
+
+}  // namespace
+
+StudyReport read_study_report(const std::vector<fs::path>& roots) {
+  std::vector<fs::path> folders;
+  for (const fs::path& root : roots) {
+    for (fs::path& folder : find_session_folders(root)) folders.push_back(std::move(folder));
+  }
+  if (folders.empty()) {
+    std::string names;
+    for (const fs::path& root : roots) names += (names.empty() ? "" : ", ") + root.string();
+    throw DataError(names + ": no session folder (one holding a session.json) found");
+  }
+  StudyReport report;
+  std::set<std::string> protocols;
+  bool simulated = false;
+  for (const fs::path& folder : folders) {
+    const fs::path manifest_path = folder / "session.json";
+    SessionManifest manifest = study_detail::manifest_from_json(
+        study_detail::read_small_file(manifest_path, kMaxRecordBytes, "session manifest"),
+        manifest_path.string());
+    manifest.session_id = folder.filename().string();
+    if (report.title.empty()) {
+      const StudyProtocol& p = manifest.protocol.protocol;
+      report.title = "Study report: " + p.name;
+      report.conditions = p.test_conditions;
+      for (const std::u32string& item : p.test_items) {
+        std::string text;
+        for (const char32_t c : item) text += encode_utf8(c);
+        report.items.push_back(text);
+      }
+    }
+    protocols.insert(manifest.protocol.sha256);
+    simulated = simulated || manifest.setup.writer == "simulated";
+    std::size_t saved = 0;
+    for (const PlannedTrial& plan : manifest.plan) {
+      const fs::path json_file = folder / "trials" / (SessionFolder::trial_stem(plan) + ".json");
+      std::error_code error;
+      if (!fs::exists(json_file, error)) continue;
+      report.trials.push_back(read_trial(json_file, manifest, plan));
+      ++saved;
+    }
+    report.sessions.push_back(session_line(manifest, folder, saved));
+  }
+  if (protocols.size() > 1) {
+    report.notes.push_back("The sessions ran under " + std::to_string(protocols.size()) +
+                           " different protocol files; the tables use the first session's conditions and "
+                           "characters.");
+  }
+  if (simulated) {
+    report.notes.push_back(
+        "Simulated subjects: a simulated writer (hand impedance, minimum-jerk strokes, a "
+        "seeded bias and tremor) moves a simulated device. It does not learn: its "
+        "repetitions differ only by their seeds, so its learning curves are flat by "
+        "construction.");
+  }
+  return report;
+}
+
+}  // namespace calligraphy

@@ -1,0 +1,274 @@
+#include "calligraphy/study/session_runner.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/report/trial_report.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/trial/runner.hpp"
+#include "core/unicode.hpp"
+#include "study/names.hpp"
+#include "study/trial_record.hpp"
+
+namespace calligraphy {
+namespace {
+
+using nlohmann::json;
+
+bool stop_requested(const SessionRunOptions& options) { return options.should_stop && options.should_stop(); }
+
+std::string utf8(const std::u32string& text) {
+  std::string out;
+  for (const char32_t c : text) out += encode_utf8(c);
+  return out;
+}
+
+// The registry's listing of the session's device (whether a person moves it, what it can do).
+DeviceListing find_listing(const DeviceRegistry& registry, const std::string& name) {
+  DeviceSurvey survey = registry.survey();
+  for (DeviceListing& listing : survey.devices) {
+    if (listing.name == name) return std::move(listing);
+  }
+  std::string names;
+  for (const DeviceListing& listing : survey.devices) names += (names.empty() ? "" : ", ") + listing.name;
+  throw DeviceNotFound("device '" + name + "' is not attached; devices: " + (names.empty() ? "none" : names));
+}
+
+// Refuses, before any trial runs, a plan this build or this device cannot carry out.
+void check_plan(const SessionManifest& session, const DeviceListing& device) {
+  for (const PlannedTrial& trial : session.plan) {
+    const StudyCondition& condition = session.protocol.protocol.condition(trial.condition);
+    (void)study_trial_options(session, condition, trial);
+  }
+  if (session.setup.writer == "simulated" && device.hardware) {
+    throw InvalidArgument("device '" + device.name +
+                          "' is moved by a person: a simulated writer cannot write on it (writer 'human')");
+  }
+}
+
+json trial_details(const PlannedTrial& trial) {
+  return {{"trial", trial.index + 1},       {"phase", to_string(trial.phase)},
+          {"condition", trial.condition},   {"characters", utf8(trial.characters)},
+          {"repetition", trial.repetition}, {"file", SessionFolder::trial_stem(trial)}};
+}
+
+// Trials saved by a run that crashed before it could log them get their "trial_saved" line now, marked
+// recovered, so that the log names every saved trial once.
+void log_unlogged_saves(SessionFolder& session) {
+  const std::filesystem::path log_path = session.path() / "log.jsonl";
+  const std::string text = study_detail::read_small_file(log_path, std::uintmax_t{256} << 20, "session log");
+  std::set<std::string> logged;
+  std::size_t begin = 0;
+  while (begin < text.size()) {
+    std::size_t end = text.find('\n', begin);
+    if (end == std::string::npos) end = text.size();
+    try {
+      const json line = json::parse(text.begin() + static_cast<std::ptrdiff_t>(begin),
+                                    text.begin() + static_cast<std::ptrdiff_t>(end));
+      if (line.value("event", "") == "trial_saved") logged.insert(line.value("file", ""));
+    } catch (const json::exception&) {
+      // a line torn by a crash: it names nothing
+    }
+    begin = end + 1;
+  }
+  for (const PlannedTrial& trial : session.plan()) {
+    if (!session.is_saved(trial) || logged.count(SessionFolder::trial_stem(trial)) > 0) continue;
+    json details = trial_details(trial);
+    details["recovered"] = true;
+    session.log("trial_saved", details.dump());
+  }
+}
+
+}  // namespace
+
+void SessionHost::before_trial(const PlannedTrial&, std::size_t) {}
+void SessionHost::rest(double, const PlannedTrial&, const std::function<bool()>&) {}
+void SessionHost::after_trial(const PlannedTrial&, const TrialOutcome&) {}
+
+TrialOptions study_trial_options(const SessionManifest& session, const StudyCondition& condition,
+                                 const PlannedTrial& trial) {
+  TrialOptions options;
+  switch (condition.mode) {
+    case ConditionMode::vision:
+    case ConditionMode::quiz:
+      options.force.guidance = false;
+      break;
+    case ConditionMode::haptic:
+      options.force.guidance = true;
+      if (condition.guidance_stiffness_n_per_m) {
+        options.force.guidance_stiffness_n_per_m = *condition.guidance_stiffness_n_per_m;
+      }
+      break;
+    case ConditionMode::fading:
+    case ConditionMode::replay:
+      throw InvalidArgument(
+          "condition '" + condition.name + "': the guidance mode '" + to_string(condition.mode) +
+          "' is not rendered by this build; the protocol keeps its parameters for a renderer "
+          "that does");
+  }
+  const StudyProtocol& protocol = session.protocol.protocol;
+  options.rate_hz = protocol.trial.rate_hz;
+  options.max_duration_s = protocol.trial.max_duration_s;
+  options.keep_trace = true;
+  const std::string& pacing = session.setup.pacing;
+  options.pacing = pacing == "lock-step"   ? TrialPacing::lock_step
+                   : pacing == "real-time" ? TrialPacing::real_time
+                                           : TrialPacing::automatic;
+  options.simulation.writer =
+      session.setup.writer_profile == "skilled" ? WriterProfile::skilled() : WriterProfile::novice();
+  options.simulation.seed =
+      study_detail::mix64(session.setup.writer_seed ^ study_detail::mix64(trial.index + 1));
+  options.validate();
+  return options;
+}
+
+SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& run_options) {
+  const SessionManifest& manifest = session.manifest();
+  const DeviceRegistry& registry =
+      run_options.registry ? *run_options.registry : device_registry_with_simulation();
+  const DeviceListing listing = find_listing(registry, manifest.setup.device);
+  check_plan(manifest, listing);
+  const bool simulated_writer = manifest.setup.writer == "simulated";
+
+  CharacterLibrary embedded = CharacterLibrary::embedded();
+  std::map<char32_t, Character> characters;  // fitted once per session run
+  const auto character = [&](char32_t code_point) -> const Character& {
+    auto found = characters.find(code_point);
+    if (found == characters.end()) {
+      Character model =
+          run_options.load_character ? run_options.load_character(code_point) : embedded.load(code_point);
+      found = characters.emplace(code_point, std::move(model)).first;
+    }
+    return found->second;
+  };
+
+  SessionRunResult result;
+  result.planned = session.plan().size();
+  result.saved_before = session.saved_count();
+  const std::optional<std::size_t> first = session.next_unsaved();
+  if (result.saved_before > 0) log_unlogged_saves(session);
+  session.log(result.saved_before == 0 ? "session_started" : "session_resumed",
+              json{{"saved_trials", result.saved_before},
+                   {"next_trial", first ? json(*first + 1) : json(nullptr)},
+                   {"library", library_build().version}}
+                  .dump());
+  bool ran_one = false;
+  for (const PlannedTrial& trial : session.plan()) {
+    if (session.is_saved(trial)) continue;
+    if (stop_requested(run_options)) {
+      result.interrupted = true;
+      break;
+    }
+    if (trial.break_before_s > 0.0 && ran_one) {
+      session.log("break", json{{"before_trial", trial.index + 1},
+                                {"duration_s", trial.break_before_s},
+                                {"waited", !simulated_writer}}
+                               .dump());
+      if (!simulated_writer && run_options.host) {
+        run_options.host->rest(trial.break_before_s, trial,
+                               [&run_options] { return stop_requested(run_options); });
+      }
+      if (stop_requested(run_options)) {
+        result.interrupted = true;
+        break;
+      }
+    }
+    if (run_options.host) run_options.host->before_trial(trial, result.planned);
+
+    const StudyCondition& condition = manifest.protocol.protocol.condition(trial.condition);
+    TrialOptions options = study_trial_options(manifest, condition, trial);
+    options.should_stop = run_options.should_stop;
+    if (run_options.pacing) options.pacing = *run_options.pacing;
+    std::vector<Character> models;
+    for (const char32_t c : trial.characters) models.push_back(character(c));
+    const Scene scene = Scene::lay_out(models);
+
+    std::unique_ptr<HapticDevice> device = registry.create(manifest.setup.device);
+    const DeviceInfo device_info = device->info();
+    session.log("trial_started", trial_details(trial).dump());
+    study_detail::TrialRecordContext context;
+    context.session = &manifest;
+    context.trial = &trial;
+    context.condition = &condition;
+    context.options = &options;
+    context.device_name = manifest.setup.device;
+    context.device_info = device_info;
+    context.hardware = listing.hardware;
+    context.simulated_writer = simulated_writer;
+    context.start_utc = study_detail::utc_now_iso8601();
+    const auto wall_start = std::chrono::steady_clock::now();
+    const TrialResult trial_result = run_trial(*device, scene, options);
+    context.wall_time_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    context.end_utc = study_detail::utc_now_iso8601();
+    device.reset();
+    ran_one = true;
+
+    const std::string stem = SessionFolder::trial_stem(trial);
+    context.csv_file = stem + ".csv";
+    context.svg_file = stem + ".svg";
+    const std::vector<CharacterScore> scores = study_detail::score_characters(scene, trial_result.trace);
+    std::vector<std::vector<QuizEvent>> quiz;
+    if (condition.mode == ConditionMode::quiz) {
+      quiz = study_detail::quiz_characters(scene, trial_result.trace, condition.quiz);
+    }
+    const bool keep_as_trial = trial_result.end == TrialEnd::completed ||
+                               trial_result.end == TrialEnd::time_limit ||
+                               trial_result.end == TrialEnd::writer_gave_up;
+    TrialOutcome outcome;
+    outcome.end_reason = to_string(trial_result.end);
+    outcome.time_s = trial_result.metrics.time_s;
+    outcome.mean_deviation_mm = trial_result.metrics.mean_deviation_m.value_or(std::nan("")) * 1e3;
+    json details = trial_details(trial);
+    details["end_reason"] = outcome.end_reason;
+    if (keep_as_trial) {
+      const std::string record = study_detail::trial_record_json(context, scene, trial_result, scores,
+                                                                 quiz.empty() ? nullptr : &quiz);
+      session.save_trial(trial, record, trial_csv(trial_result.trace), trial_svg(scene, trial_result));
+      outcome.saved = true;
+      outcome.json_file = session.trial_file(trial, "json").string();
+      details["time_s"] = outcome.time_s;
+      session.log("trial_saved", details.dump());
+      ++result.saved_now;
+    } else {
+      context.svg_file.clear();
+      const std::string record = study_detail::trial_record_json(context, scene, trial_result, scores,
+                                                                 quiz.empty() ? nullptr : &quiz);
+      const auto kept = session.save_attempt(trial, record, trial_csv(trial_result.trace));
+      outcome.json_file = kept.string();
+      details["attempt"] = kept.filename().string();
+      details["abort_reason"] = trial_result.abort_reason;
+      ++result.attempts_kept;
+      if (trial_result.end == TrialEnd::interrupted) {
+        session.log("trial_interrupted", details.dump());
+        result.interrupted = true;
+      } else {
+        session.log("trial_failed", details.dump());
+        result.device_failed = true;
+        result.failure = trial_result.abort_reason;
+      }
+    }
+    if (run_options.host) run_options.host->after_trial(trial, outcome);
+    if (result.interrupted || result.device_failed) break;
+  }
+  if (result.complete()) {
+    session.log("session_completed", json{{"trials", result.planned}}.dump());
+  } else {
+    session.log("session_stopped", json{{"saved_trials", result.saved_before + result.saved_now},
+                                        {"planned", result.planned},
+                                        {"reason", result.interrupted     ? "interrupted"
+                                                   : result.device_failed ? "device_fault"
+                                                                          : "unknown"}}
+                                       .dump());
+  }
+  return result;
+}
+
+}  // namespace calligraphy

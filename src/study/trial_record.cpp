@@ -1,0 +1,355 @@
+#include "study/trial_record.hpp"
+
+#include <algorithm>
+#include <nlohmann/json.hpp>
+
+#include "calligraphy/model/typical_strokes.hpp"
+#include "calligraphy/report/pen_trace_csv.hpp"
+#include "calligraphy/report/score_report.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
+#include "core/unicode.hpp"
+#include "model/polyline.hpp"
+#include "study/manifest_json.hpp"
+
+namespace calligraphy::study_detail {
+namespace {
+
+using nlohmann::json;
+
+constexpr const char* kFormat = "calligraphy-study-trial";
+
+json vec(const Vec2& v) { return json::array({v.x(), v.y()}); }
+json vec(const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
+
+std::string utf8(const std::u32string& text) {
+  std::string out;
+  for (const char32_t c : text) out += encode_utf8(c);
+  return out;
+}
+
+const char* method_name(NearestPointMethod method) {
+  switch (method) {
+    case NearestPointMethod::exact:
+      return "exact";
+    case NearestPointMethod::newton:
+      return "newton";
+    case NearestPointMethod::subdivision:
+      return "subdivision";
+  }
+  return "unknown";
+}
+
+const char* pacing_name(TrialPacing pacing) {
+  return pacing == TrialPacing::lock_step   ? "lock-step"
+         : pacing == TrialPacing::real_time ? "real-time"
+                                            : "auto";
+}
+
+json force_law_json(const ForceLawParameters& f) {
+  return {{"guidance", f.guidance},
+          {"guidance_stiffness_n_per_m", f.guidance_stiffness_n_per_m},
+          {"paper_stiffness_n_per_m", f.paper_stiffness_n_per_m},
+          {"constraint_radius_m", f.constraint_radius_m},
+          {"resistance_damping_n_s_per_m", f.resistance_damping_n_s_per_m},
+          {"contact_hysteresis_m", f.contact_hysteresis_m},
+          {"constraint_taper_m", f.constraint_taper_m},
+          {"crossfade_s", f.crossfade_s},
+          {"paper_fade_s", f.paper_fade_s},
+          {"feature_plane_margin_m", f.feature_plane_margin_m},
+          {"paper_damping_n_s_per_m", f.paper_damping_n_s_per_m},
+          {"max_foot_speed_m_s", f.max_foot_speed_m_s},
+          {"friction_coefficient", f.friction_coefficient},
+          {"friction_stick_speed_m_s", f.friction_stick_speed_m_s},
+          {"nearest",
+           {{"method", method_name(f.nearest.method)},
+            {"tolerance", f.nearest.tolerance},
+            {"newton_starts", f.nearest.newton_starts},
+            {"newton_iterations", f.nearest.newton_iterations}}}};
+}
+
+json renderer_json(const TrialOptions& o) {
+  const SafetyChainParameters& s = o.safety;
+  return {{"rate_hz", o.rate_hz},
+          {"pacing", pacing_name(o.pacing)},
+          {"max_duration_s", o.max_duration_s},
+          {"safety",
+           {{"max_force_n", s.max_force_n},
+            {"max_continuous_force_n", s.max_continuous_force_n},
+            {"continuous_time_constant_s", s.continuous_time_constant_s},
+            {"start_ramp_n_per_s", s.start_ramp_n_per_s},
+            {"max_force_change_n_per_tick", s.max_force_change_n_per_tick},
+            {"low_pass_cutoff_hz", s.low_pass_cutoff_hz}}},
+          {"passivity",
+           {{"enabled", o.passivity.enabled},
+            {"max_damping_n_s_per_m", o.passivity.max_damping_n_s_per_m},
+            {"min_speed_m_s", o.passivity.min_speed_m_s}}},
+          {"loop",
+           {{"realtime", o.loop.realtime == RealtimeMode::enforce ? "enforce" : "ignore"},
+            {"priority", o.loop.priority},
+            {"cpu", o.loop.cpu},
+            {"lock_memory", o.loop.lock_memory},
+            {"max_force_age_s", o.loop.max_force_age_s},
+            {"stall_timeout_s", o.loop.stall_timeout_s}}}};
+}
+
+json device_info_json(const DeviceInfo& d) {
+  return {{"model", d.model},
+          {"manufacturer", d.manufacturer},
+          {"max_force_n", d.max_force_n},
+          {"max_continuous_force_n", d.max_continuous_force_n},
+          {"max_stiffness_n_per_m", d.max_stiffness_n_per_m},
+          {"max_damping_n_s_per_m", d.max_damping_n_s_per_m},
+          {"intrinsic_damping_n_s_per_m", d.intrinsic_damping_n_s_per_m},
+          {"workspace_radius_m", d.workspace_radius_m},
+          {"workspace_size_m", vec(d.workspace_size_m)}};
+}
+
+json writer_json(const TrialRecordContext& c) {
+  if (!c.simulated_writer) return {{"kind", "human"}, {"subject", c.session->setup.subject.id}};
+  const WriterProfile& w = c.options->simulation.writer;
+  return {{"kind", "simulated"},
+          {"seed", c.options->simulation.seed},
+          {"subject_seed", c.session->setup.writer_seed},
+          {"profile",
+           {{"name", w.name},
+            {"hand_stiffness_n_per_m", w.hand_stiffness_n_per_m},
+            {"hand_damping_n_s_per_m", w.hand_damping_n_s_per_m},
+            {"writing_speed_m_s", w.writing_speed_m_s},
+            {"travel_speed_m_s", w.travel_speed_m_s},
+            {"press_depth_m", w.press_depth_m},
+            {"lift_height_m", w.lift_height_m},
+            {"bias_offset_m", w.bias_offset_m},
+            {"scale_error", w.scale_error},
+            {"stroke_jitter_m", w.stroke_jitter_m},
+            {"noise_fraction", w.noise_fraction},
+            {"tremor_amplitude_n", w.tremor_amplitude_n},
+            {"tremor_frequency_hz", w.tremor_frequency_hz},
+            {"overshoot_m", w.overshoot_m},
+            {"correction_per_attempt", w.correction_per_attempt},
+            {"max_attempts_per_stroke", w.max_attempts_per_stroke}}}};
+}
+
+json simulated_device_json() {
+  const SimulatedDeviceParameters p{};  // the registry's "simulated" device is made with the defaults
+  return {{"moving_mass_kg", p.moving_mass_kg},
+          {"damping_n_s_per_m", p.damping_n_s_per_m},
+          {"encoder_resolution_m", p.encoder_resolution_m},
+          {"velocity_cutoff_hz", p.velocity_cutoff_hz},
+          {"physics_substeps", p.physics_substeps},
+          {"physics_rate_hz", p.physics_rate_hz},
+          {"initial_position_m", vec(p.initial_position_m)}};
+}
+
+json scene_json(const Scene& scene) {
+  json characters = json::array();
+  for (const PlacedCharacter& c : scene.characters) {
+    json strokes = json::array();
+    for (const PlacedStroke& s : c.strokes) {
+      json polyline = json::array();
+      for (const StrokeElement& e : s.elements) {
+        const auto points = sample_element(e, e.degree == 1 ? 1 : 16);
+        for (std::size_t i = polyline.empty() ? 0 : 1; i < points.size(); ++i)
+          polyline.push_back(vec(points[i]));
+      }
+      strokes.push_back({{"typical_id", s.typical_id},
+                         {"acronym", std::string(typical_stroke(s.typical_id).acronym)},
+                         {"start_m", vec(s.start())},
+                         {"polyline_m", polyline}});
+    }
+    characters.push_back(
+        {{"character", encode_utf8(c.code_point)},
+         {"code_point", describe_character(c.code_point)},
+         {"placement",
+          {{"origin_m", vec(c.placement.origin_m)}, {"metres_per_unit", c.placement.metres_per_unit}}},
+         {"strokes", strokes}});
+  }
+  const SceneLayout& l = scene.layout;
+  return {{"layout",
+           {{"character_size_m", l.character_size_m},
+            {"spacing_m", l.spacing_m},
+            {"centre_m", vec(l.centre_m)},
+            {"paper_z_m", l.paper_z_m},
+            {"box_margin_m", l.box_margin_m},
+            {"start_radius_m", l.start_radius_m}}},
+          {"characters", characters}};
+}
+
+json loop_json(const ServoLoopStats& s) {
+  return {{"rate_hz", s.rate_hz},
+          {"ticks", s.ticks},
+          {"late_ticks", s.late_ticks},
+          {"forces_withheld", s.forces_withheld},
+          {"longest_stall_s", s.longest_stall_s},
+          {"period_jitter_us_p99", s.period_jitter_us_p99},
+          {"period_jitter_us_max", s.period_jitter_us_max},
+          {"callback_us_max", s.callback_us_max}};
+}
+
+json nullable(const std::optional<double>& value, double scale) {
+  return value ? json(*value * scale) : json(nullptr);
+}
+
+}  // namespace
+
+std::vector<PenSample> pen_samples_of_character(const Scene& scene, const std::vector<TrialSample>& trace,
+                                                std::size_t character) {
+  std::size_t first = 0;
+  for (std::size_t c = 0; c < character; ++c) first += scene.characters[c].strokes.size();
+  const std::size_t last = first + scene.characters[character].strokes.size();  // one past
+  const double contact_m = PenTraceCsvOptions{}.contact_threshold_m;
+  std::vector<PenSample> samples;
+  for (const TrialSample& s : trace) {
+    const bool active = s.stroke >= first && (s.stroke < last || character + 1 == scene.characters.size());
+    if (!active) continue;
+    samples.push_back(
+        {s.time_s, s.position_m.head<2>(), s.position_m.z() - scene.layout.paper_z_m <= contact_m});
+  }
+  return samples;
+}
+
+std::vector<CharacterScore> score_characters(const Scene& scene, const std::vector<TrialSample>& trace) {
+  std::vector<CharacterScore> scores;
+  for (std::size_t c = 0; c < scene.characters.size(); ++c) {
+    scores.push_back(score_trace(scene.characters[c], pen_samples_of_character(scene, trace, c)));
+  }
+  return scores;
+}
+
+std::vector<std::vector<QuizEvent>> quiz_characters(const Scene& scene, const std::vector<TrialSample>& trace,
+                                                    const QuizOptions& options) {
+  std::vector<std::vector<QuizEvent>> events;
+  for (std::size_t c = 0; c < scene.characters.size(); ++c) {
+    QuizSession quiz(scene.characters[c], options);
+    for (const PenSample& s : pen_samples_of_character(scene, trace, c)) quiz.feed(s);
+    quiz.finish();
+    events.push_back(quiz.events());
+  }
+  return events;
+}
+
+std::string trial_record_json(const TrialRecordContext& c, const Scene& scene, const TrialResult& result,
+                              const std::vector<CharacterScore>& scores,
+                              const std::vector<std::vector<QuizEvent>>* quiz) {
+  const TrialMetrics& m = result.metrics;
+  json per_stroke = json::array();
+  for (const StrokeMetrics& s : m.per_stroke) {
+    const bool has_trace = s.trace_end > s.trace_begin && s.trace_end <= result.trace.size();
+    per_stroke.push_back({{"index", s.index + 1},
+                          {"character", s.character + 1},
+                          {"typical_id", s.typical_id},
+                          {"completed", s.completed},
+                          {"attempts", s.attempts},
+                          {"mean_deviation_mm", nullable(s.mean_deviation_m, 1e3)},
+                          {"max_deviation_mm", nullable(s.max_deviation_m, 1e3)},
+                          {"time_s", s.time_s},
+                          {"start_s", has_trace ? json(result.trace[s.trace_begin].time_s) : json(nullptr)},
+                          {"end_s", has_trace ? json(result.trace[s.trace_end - 1].time_s) : json(nullptr)}});
+  }
+  // Scores over the trial's characters: the worst Frechet, DTW weighted by the strokes written, sums.
+  std::optional<double> frechet_m, dtw_m;
+  double dtw_weighted = 0.0;
+  std::size_t dtw_weight = 0, order_errors = 0, backwards = 0;
+  json score_documents = json::array();
+  for (std::size_t i = 0; i < scores.size(); ++i) {
+    const CharacterScore& s = scores[i];
+    if (s.totals.frechet_m) frechet_m = std::max(frechet_m.value_or(0.0), *s.totals.frechet_m);
+    if (s.totals.dtw_m) {
+      dtw_weighted += *s.totals.dtw_m * static_cast<double>(s.strokes_written);
+      dtw_weight += s.strokes_written;
+    }
+    order_errors += s.order_errors;
+    backwards += s.backwards_strokes;
+    const ScoreDescription description{encode_utf8(s.code_point), c.csv_file, "m", 0};
+    score_documents.push_back(json::parse(score_json(description, s)));
+  }
+  if (dtw_weight > 0) dtw_m = dtw_weighted / static_cast<double>(dtw_weight);
+
+  const PlannedTrial& t = *c.trial;
+  json document = {
+      {"format", kFormat},
+      {"version", 1},
+      {"subject", c.session->setup.subject.id},
+      {"subject_number", c.session->setup.subject.number},
+      {"session", c.session->session_id},
+      {"trial", planned_trial_json(t)},
+      {"phase", to_string(t.phase)},
+      {"condition", t.condition},
+      {"mode", to_string(c.condition->mode)},
+      {"characters", utf8(t.characters)},
+      {"repetition", t.repetition},
+      {"start_time_utc", c.start_utc},
+      {"end_time_utc", c.end_utc},
+      {"wall_time_s", c.wall_time_s},
+      {"protocol",
+       {{"name", c.session->protocol.protocol.name},
+        {"path", c.session->protocol.path.string()},
+        {"sha256", c.session->protocol.sha256}}},
+      {"library", library_build_json(library_build())},
+      {"session_library", library_build_json(c.session->library)},
+      {"device",
+       {{"name", c.device_name}, {"hardware", c.hardware}, {"info", device_info_json(c.device_info)}}},
+      {"writer", writer_json(c)},
+      {"force_law", force_law_json(c.options->force)},
+      {"renderer", renderer_json(*c.options)},
+      {"scene", scene_json(scene)},
+      {"end_reason", to_string(result.end)},
+      {"aborted", result.aborted},
+      {"abort_reason", result.abort_reason},
+      {"strokes_total", m.strokes_total},
+      {"strokes_completed", m.strokes_completed},
+      {"completed_in_order", m.completed_in_order},
+      {"time_s", m.time_s},
+      {"mean_deviation_mm", nullable(m.mean_deviation_m, 1e3)},
+      {"max_deviation_mm", nullable(m.max_deviation_m, 1e3)},
+      {"max_force_n", m.max_force_n},
+      {"max_force_step_n", m.max_force_step_n},
+      {"state_transitions", m.state_transitions},
+      {"frechet_mm", nullable(frechet_m, 1e3)},
+      {"dtw_mm", nullable(dtw_m, 1e3)},
+      {"order_errors", order_errors},
+      {"backwards_strokes", backwards},
+      {"per_stroke", per_stroke},
+      {"score", score_documents},
+      {"samples", result.trace.size()},
+      {"files", {{"csv", c.csv_file}, {"svg", c.svg_file}}}};
+  if (c.device_name == "simulated") document["device"]["simulated_device"] = simulated_device_json();
+  if (!c.condition->guidance_parameters.empty())
+    document["guidance_parameters"] = c.condition->guidance_parameters;
+  if (result.loop) document["loop"] = loop_json(*result.loop);
+  if (quiz) {
+    json characters = json::array();
+    int misses = 0;
+    std::size_t accepted = 0, hints = 0, quiz_backwards = 0;
+    for (std::size_t i = 0; i < quiz->size(); ++i) {
+      json events = json::array();
+      for (const QuizEvent& e : (*quiz)[i]) {
+        json event = {{"kind", to_string(e.kind)},
+                      {"stroke", e.stroke + 1},
+                      {"backwards", e.backwards},
+                      {"misses_on_stroke", e.misses_on_stroke},
+                      {"total_misses", e.total_misses},
+                      {"time_s", e.time_s},
+                      {"samples", e.samples}};
+        if (e.closer_later_stroke) event["closer_later_stroke"] = *e.closer_later_stroke + 1;
+        events.push_back(event);
+        accepted += e.kind == QuizEvent::Kind::stroke_accepted ? 1 : 0;
+        hints += e.kind == QuizEvent::Kind::hint ? 1 : 0;
+        quiz_backwards += e.backwards ? 1 : 0;
+        misses += e.kind == QuizEvent::Kind::stroke_missed ? 1 : 0;
+      }
+      characters.push_back({{"character", encode_utf8(scene.characters[i].code_point)}, {"events", events}});
+    }
+    const QuizOptions& q = c.condition->quiz;
+    document["quiz"] = {{"leniency", q.leniency},
+                        {"hint_after_misses", q.hint_after_misses},
+                        {"accept_backwards", q.accept_backwards},
+                        {"strokes_accepted", accepted},
+                        {"misses", misses},
+                        {"hints", hints},
+                        {"backwards", quiz_backwards},
+                        {"characters", characters}};
+  }
+  return document.dump(2) + "\n";
+}
+
+}  // namespace calligraphy::study_detail

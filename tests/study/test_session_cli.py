@@ -1,0 +1,181 @@
+#!/usr/bin/env python3
+"""`calligraphy session run|resume` and `calligraphy report` end to end (docs/experiments.md), run by CTest as
+`study_session_cli`: a session stopped by SIGINT, SIGTERM or SIGKILL resumes without losing or changing a
+saved trial; protocol errors name the file and the JSON pointer; the report of the sessions has a trajectory
+and a force figure per trial.
+
+CALLIGRAPHY_CLI names the program, CALLIGRAPHY_SOURCE_DIR the source tree. Standard library only.
+"""
+import hashlib
+import json
+import os
+import re
+import signal
+import subprocess
+import tempfile
+import time
+import unittest
+from pathlib import Path
+
+CLI = os.environ.get("CALLIGRAPHY_CLI", "")
+SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
+
+# Many short trials, so that a signal sent after the first saved trials arrives while the session runs.
+LONG_PROTOCOL = {
+    "name": "long",
+    "conditions": [{"name": "vision", "mode": "vision"}, {"name": "haptic", "mode": "haptic"}],
+    "test": {"characters": ["十", "人"], "conditions": ["vision", "haptic"], "repetitions": 12},
+    "order": {"conditions": "abba"},
+    "trial": {"max_duration_s": 30},
+}
+
+
+def digest(path):
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+class SessionCliTest(unittest.TestCase):
+    def setUp(self):
+        if not CLI or not Path(CLI).exists():
+            self.fail(f"CALLIGRAPHY_CLI={CLI!r} is not the calligraphy program: run these tests through ctest")
+        self.folder = tempfile.TemporaryDirectory(prefix="calligraphy-study-")
+        self.cwd = Path(self.folder.name)
+
+    def tearDown(self):
+        self.folder.cleanup()
+
+    def run_cli(self, *args, timeout=600):
+        return subprocess.run([CLI, *map(str, args)], cwd=self.cwd, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, timeout=timeout)
+
+    def write_protocol(self, protocol, name="p.json"):
+        path = self.cwd / name
+        path.write_text(json.dumps(protocol, ensure_ascii=False), encoding="utf-8")
+        return path
+
+    def saved(self, session):
+        return sorted((session / "trials").glob("*.json"))
+
+    def interrupt_and_resume(self, signal_number, expected_status):
+        protocol = self.write_protocol(LONG_PROTOCOL)
+        process = subprocess.Popen([CLI, "session", "run", protocol, "--subject", "P1", "--out", "out"],
+                                   cwd=self.cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        deadline = time.monotonic() + 300
+        session = None
+        while time.monotonic() < deadline and process.poll() is None:
+            found = list((self.cwd / "out" / "P1").glob("long-*"))
+            if found and len(self.saved(found[0])) >= 2:
+                session = found[0]
+                break
+            time.sleep(0.01)
+        self.assertIsNotNone(session, "the session ended or saved nothing before the signal")
+        process.send_signal(signal_number)
+        _, stderr = process.communicate(timeout=300)
+        self.assertEqual(process.returncode, expected_status, stderr.decode())
+        planned = json.loads((session / "session.json").read_text(encoding="utf-8"))["plan"]
+        before = {path.name: digest(path) for path in (session / "trials").glob("*.*") if
+                  path.with_suffix(".json").exists() and not path.name.endswith(".part")}
+        self.assertLess(len(self.saved(session)), len(planned), "the signal came after the last trial")
+        if signal_number != signal.SIGKILL:
+            self.assertIn("resume with: calligraphy session resume", stderr.decode())
+
+        resumed = self.run_cli("session", "resume", session)
+        self.assertEqual(resumed.returncode, 0, resumed.stderr.decode())
+        self.assertEqual(len(self.saved(session)), len(planned))
+        for name, value in before.items():  # every trial saved before the signal is unchanged
+            self.assertEqual(digest(session / "trials" / name), value, name)
+        for trial in planned:  # every planned trial has its JSON, CSV and SVG
+            for extension in ("json", "csv", "svg"):
+                self.assertTrue((session / "trials" / f"{trial['file']}.{extension}").is_file(), trial["file"])
+        events, torn = [], 0
+        for line in (session / "log.jsonl").read_text(encoding="utf-8").splitlines():
+            try:
+                events.append(json.loads(line)["event"])
+            except json.JSONDecodeError:  # a line SIGKILL tore; resume ends it so the next line stands alone
+                torn += 1
+        self.assertLessEqual(torn, 1 if signal_number == signal.SIGKILL else 0)
+        self.assertEqual(events.count("session_resumed"), 1)
+        self.assertEqual(events[-1], "session_completed")
+        self.assertEqual(events.count("trial_saved"), len(planned))
+        again = self.run_cli("session", "resume", session)
+        self.assertEqual(again.returncode, 0)
+        self.assertIn("saved already", again.stdout.decode())
+        return session, events
+
+    def test_sigint_stops_and_resume_completes(self):
+        _, events = self.interrupt_and_resume(signal.SIGINT, 128 + signal.SIGINT)
+        self.assertIn("session_stopped", events)
+
+    def test_sigterm_stops_and_resume_completes(self):
+        self.interrupt_and_resume(signal.SIGTERM, 128 + signal.SIGTERM)
+
+    def test_sigkill_crash_resumes(self):
+        self.interrupt_and_resume(signal.SIGKILL, -signal.SIGKILL)
+
+    def test_protocol_errors_name_file_and_pointer(self):
+        bad = dict(LONG_PROTOCOL, order={"conditions": "latin"})
+        result = self.run_cli("session", "run", self.write_protocol(bad), "--subject", "P1", "--out", "out")
+        self.assertEqual(result.returncode, 1)
+        self.assertRegex(result.stderr.decode(), r"p\.json: /order/conditions: expected one of fixed, latin_square")
+        self.assertFalse((self.cwd / "out").exists())
+        fading = dict(LONG_PROTOCOL, conditions=[{"name": "vision", "mode": "vision"},
+                                                 {"name": "haptic", "mode": "fading"}])
+        result = self.run_cli("session", "run", self.write_protocol(fading), "--subject", "P1", "--out", "out")
+        self.assertEqual(result.returncode, 1)
+        self.assertIn("condition 'haptic': the guidance mode 'fading'", result.stderr.decode())
+
+    def test_usage(self):
+        protocol = self.write_protocol(LONG_PROTOCOL)
+        for args, words in [
+            (["--out", "o"], "--subject"),
+            (["--subjects", "2", "--writer", "human", "--out", "o"], "--subjects"),
+            (["--subjects", "2", "--subject-number", "3", "--out", "o"], "--subject-number"),
+            (["--subject", "P1", "--writer-profile", "expert", "--out", "o"], "--writer-profile"),
+            (["--subject", "P1", "--device", "nothing", "--out", "o"], "--device"),
+        ]:
+            result = self.run_cli("session", "run", protocol, *args)
+            self.assertEqual(result.returncode, 2, f"{args}: {result.stderr.decode()}")
+            self.assertIn(words, result.stderr.decode())
+        result = self.run_cli("session", "resume", self.cwd)
+        self.assertEqual(result.returncode, 1)
+        self.assertIn("session.json", result.stderr.decode())
+        result = self.run_cli("report", self.cwd, "--out", "r.html")
+        self.assertEqual(result.returncode, 1)
+        self.assertIn("no session folder", result.stderr.decode())
+
+    def test_help_lists_each_option_with_default(self):
+        for command in (["session", "run"], ["session", "resume"], ["report"]):
+            result = self.run_cli(*command, "--help")
+            self.assertEqual(result.returncode, 0)
+            for entry in re.findall(r"^  (--[a-z-]+.*(?:\n {10,}.*)*)", result.stdout.decode(), flags=re.M):
+                if re.match(r"--[a-z-]+ [A-Z]", entry):
+                    self.assertRegex(entry, r"\((default: .+|required)\)", f"{command}: {entry}")
+
+    def test_simulated_subjects_and_their_report(self):
+        protocol = dict(LONG_PROTOCOL, test=dict(LONG_PROTOCOL["test"], repetitions=2),
+                        order={"conditions": "latin_square"})
+        path = self.write_protocol(protocol)
+        result = self.run_cli("session", "run", path, "--subjects", "3", "--writer-profile", "novice,skilled",
+                              "--out", "study")
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
+        sessions = sorted((self.cwd / "study").glob("S0*/long-*"))
+        self.assertEqual([s.parent.name for s in sessions], ["S01", "S02", "S03"])
+        manifests = [json.loads((s / "session.json").read_text()) for s in sessions]
+        self.assertEqual([m["writer_profile"] for m in manifests], ["novice", "skilled", "novice"])
+        self.assertEqual([m["subject"]["number"] for m in manifests], [1, 2, 3])
+        # The Latin square alternates the first condition between subjects.
+        self.assertEqual([m["plan"][0]["condition"] for m in manifests], ["vision", "haptic", "vision"])
+        trials = sum(len(m["plan"]) for m in manifests)
+        report = self.run_cli("report", "study", "--out", "study/report.html")
+        self.assertEqual(report.returncode, 0, report.stderr.decode())
+        page = (self.cwd / "study" / "report.html").read_text(encoding="utf-8")
+        self.assertEqual(page.count('<figure class="trajectory"'), trials)
+        self.assertEqual(page.count('<figure class="force"'), trials)
+        self.assertEqual(page.count('<table class="summary"'), 4)
+        record = json.loads(self.saved(sessions[0])[0].read_text(encoding="utf-8"))
+        for key in ("frechet_mm", "dtw_mm", "order_errors", "backwards_strokes"):
+            self.assertIn(key, record)
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)

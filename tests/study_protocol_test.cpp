@@ -1,0 +1,183 @@
+// Study protocols: parsing, errors naming the file and JSON pointer, SHA-256, schedules.
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <map>
+#include <set>
+#include <string>
+
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/study/protocol.hpp"
+#include "calligraphy/study/schedule.hpp"
+
+using namespace calligraphy;
+
+namespace {
+
+std::string protocol_text(const std::string& order = "fixed", int repetitions = 2,
+                          const std::string& extra = "") {
+  return R"({"name": "t", "conditions": [{"name": "A", "mode": "vision"}, {"name": "B", "mode": "haptic"},
+             {"name": "C", "mode": "quiz", "quiz": {"leniency": 1.5, "hint_after_misses": 2}}],
+    "practice": {"characters": ["永"], "condition": "B", "repetitions": 2},
+    "test": {"characters": ["大", "山", "木"], "conditions": ["A", "B", "C"], "repetitions": )" +
+         std::to_string(repetitions) + R"(},
+    "order": {"conditions": ")" +
+         order + R"(", "characters": "random", "seed": 5},
+    "breaks": {"between_blocks_s": 30, "every_trials": 4, "duration_s": 10})" +
+         extra + "}";
+}
+
+void check_error(const std::string& text, const std::string& pointer, const std::string& words) {
+  try {
+    (void)parse_study_protocol(text, "p.json");
+    FAIL("no error for " << text);
+  } catch (const DataError& e) {
+    const std::string message = e.what();
+    CHECK_THAT(message, Catch::StartsWith("p.json: " + pointer + ": "));
+    CHECK_THAT(message, Catch::Contains(words));
+  }
+}
+
+// "S" followed by the number (appended: GCC 12 warns wrongly about `"S" + std::to_string(n)` at -O3).
+std::string subject_id(std::size_t number) {
+  std::string id = "S";
+  id.append(std::to_string(number));
+  return id;
+}
+
+}  // namespace
+
+TEST_CASE("SHA-256 of the FIPS 180-4 examples", "[study][protocol]") {
+  CHECK(sha256_hex("") == "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  CHECK(sha256_hex("abc") == "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  CHECK(sha256_hex("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq") ==
+        "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
+  CHECK(sha256_hex(std::string(1000000, 'a')) ==
+        "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+}
+
+TEST_CASE("a protocol is read with every field", "[study][protocol]") {
+  const StudyProtocol p = parse_study_protocol(protocol_text(), "p.json");
+  CHECK(p.name == "t");
+  REQUIRE(p.conditions.size() == 3);
+  CHECK(p.conditions[2].mode == ConditionMode::quiz);
+  CHECK(p.conditions[2].quiz.leniency == 1.5);
+  CHECK(p.conditions[2].quiz.hint_after_misses == 2);
+  REQUIRE(p.practice);
+  CHECK(p.practice->items == std::vector<std::u32string>{U"永"});
+  CHECK(p.test_items == std::vector<std::u32string>{U"大", U"山", U"木"});
+  CHECK(p.item_order == ItemOrder::random);
+  CHECK(p.seed == 5);
+  CHECK(p.breaks.every_trials == 4);
+  CHECK(p.condition("B").mode == ConditionMode::haptic);
+  CHECK_THROWS_AS(p.condition("D"), InvalidArgument);
+}
+
+TEST_CASE("the shipped paper-table5 protocol is valid", "[study][protocol]") {
+  const LoadedProtocol loaded =
+      load_study_protocol(std::string(CALLIGRAPHY_SOURCE_DIR) + "/examples/protocols/paper-table5.json");
+  CHECK(loaded.protocol.test_items.size() == 4);
+  CHECK(loaded.protocol.test_conditions == std::vector<std::string>{"vision", "haptic"});
+  CHECK(loaded.sha256 == sha256_hex(loaded.text));
+}
+
+TEST_CASE("protocol errors name the file and the JSON pointer", "[study][protocol]") {
+  CHECK_THROWS_WITH(parse_study_protocol("{", "p.json"),
+                    Catch::StartsWith("p.json: not valid JSON at byte "));
+  check_error(protocol_text("latin"), "/order/conditions", "latin_square");
+  check_error(protocol_text("abba", 3), "/test/repetitions", "even");
+  check_error(protocol_text("fixed", 0), "/test/repetitions", "got 0");
+  check_error(protocol_text("fixed", 2, R"(, "colour": 1)"), "/colour", "unknown key");
+  check_error(R"({"name": "t", "conditions": [{"name": "A", "mode": "smell"}], "test": {}})",
+              "/conditions/0/mode", "vision");
+  check_error(R"({"name": "t", "conditions": [{"name": "A", "mode": "vision"}],
+                 "test": {"characters": ["大"], "conditions": ["Z"], "repetitions": 1}})",
+              "/test/conditions/0", "no condition is called \"Z\"");
+  check_error(
+      R"({"name": "t", "conditions": [{"name": "A", "mode": "vision"}, {"name": "A", "mode": "haptic"}],
+                 "test": {"characters": ["大"], "conditions": ["A"], "repetitions": 1}})",
+      "/conditions/1/name", "twice");
+  check_error(R"({"name": "t", "conditions": [{"name": "A", "mode": "vision"}],
+                 "test": {"characters": [""], "conditions": ["A"], "repetitions": 1}})",
+              "/test/characters/0", "1 to 16 characters");
+  check_error(
+      R"({"name": "t", "conditions": [{"name": "A", "mode": "vision", "guidance_stiffness_n_per_m": 100}],
+                 "test": {"characters": ["大"], "conditions": ["A"], "repetitions": 1}})",
+      "/conditions/0/guidance_stiffness_n_per_m", "no guidance");
+  check_error(R"({"conditions": []})", "/name", "missing");
+  CHECK_THROWS_WITH(load_study_protocol("/nonexistent/p.json"), Catch::Contains("/nonexistent/p.json"));
+}
+
+TEST_CASE("fading and replay conditions are read with their parameters", "[study][protocol]") {
+  const StudyProtocol p = parse_study_protocol(
+      R"({"name": "f", "conditions": [{"name": "fade", "mode": "fading", "parameters": {"start_gain": 1, "end_gain": 0}}],
+          "test": {"characters": ["大"], "conditions": ["fade"], "repetitions": 1}})",
+      "f.json");
+  CHECK(p.conditions[0].mode == ConditionMode::fading);
+  CHECK(p.conditions[0].guidance_parameters.at("end_gain") == 0.0);
+}
+
+TEST_CASE("a balanced Latin square: each condition once per row, every ordered pair equally often",
+          "[study][schedule]") {
+  for (const int n : {2, 3, 4, 5}) {
+    StudyProtocol p;
+    p.name = "l";
+    for (int k = 0; k < n; ++k) {
+      p.conditions.push_back({std::string(1, static_cast<char>('A' + k)), ConditionMode::vision, {}, {}, {}});
+      p.test_conditions.push_back(p.conditions.back().name);
+    }
+    p.test_items = {U"大"};
+    p.condition_order = ConditionOrder::latin_square;
+    const std::size_t rows = n % 2 == 0 ? static_cast<std::size_t>(n) : static_cast<std::size_t>(2 * n);
+    std::map<std::pair<std::string, std::string>, int> pairs;
+    std::map<std::pair<std::string, std::size_t>, int> positions;
+    for (std::size_t subject = 1; subject <= rows; ++subject) {
+      const auto blocks = test_block_conditions(p, {subject_id(subject), subject});
+      REQUIRE(blocks.size() == static_cast<std::size_t>(n));
+      CHECK(std::set<std::string>(blocks.begin(), blocks.end()).size() == static_cast<std::size_t>(n));
+      for (std::size_t j = 0; j < blocks.size(); ++j) ++positions[{blocks[j], j}];
+      for (std::size_t j = 1; j < blocks.size(); ++j) ++pairs[{blocks[j - 1], blocks[j]}];
+      // The next cycle of subjects repeats the rows.
+      CHECK(test_block_conditions(p, {"T", subject + rows}) == blocks);
+    }
+    CHECK(pairs.size() == static_cast<std::size_t>(n * (n - 1)));
+    for (const auto& [pair, count] : pairs) CHECK(count == pairs.begin()->second);
+    for (const auto& [position, count] : positions) CHECK(count == positions.begin()->second);
+  }
+}
+
+TEST_CASE("a session plan: practice, blocks, repetitions, ABBA and breaks", "[study][schedule]") {
+  const StudyProtocol abba = parse_study_protocol(protocol_text("abba", 4), "p.json");
+  const auto odd = test_block_conditions(abba, {"S1", 1});
+  const auto even = test_block_conditions(abba, {"S2", 2});
+  CHECK(odd == std::vector<std::string>{"A", "B", "C", "C", "B", "A"});
+  CHECK(even == std::vector<std::string>{"C", "B", "A", "A", "B", "C"});
+  CHECK_THROWS_AS(test_block_conditions(abba, {"anonymous", 0}), InvalidArgument);
+
+  const std::vector<PlannedTrial> plan = plan_session(abba, {"S1", 1});
+  REQUIRE(plan.size() == 2 + 3 * 3 * 4);
+  CHECK(plan[0].phase == StudyPhase::practice);
+  CHECK(plan[1].repetition == 2);
+  std::map<std::pair<std::string, std::size_t>, std::vector<int>> repetitions;
+  for (std::size_t i = 0; i < plan.size(); ++i) {
+    CHECK(plan[i].index == i);
+    if (plan[i].phase == StudyPhase::test)
+      repetitions[{plan[i].condition, plan[i].item}].push_back(plan[i].repetition);
+    const bool block_start = i > 0 && plan[i].block != plan[i - 1].block;
+    const bool every = i > 0 && i % 4 == 0;
+    CHECK(plan[i].break_before_s == (block_start ? 30.0 : every ? 10.0 : 0.0));
+  }
+  for (const auto& [key, seen] : repetitions) CHECK(seen == std::vector<int>{1, 2, 3, 4});
+
+  // Random orders are reproducible per subject and differ between subjects.
+  const StudyProtocol random = parse_study_protocol(protocol_text("random", 2), "p.json");
+  const auto a = plan_session(random, {"S1", 1});
+  CHECK(plan_session(random, {"S1", 0}).size() == a.size());
+  std::set<std::vector<std::string>> orders;
+  for (int s = 1; s <= 12; ++s)
+    orders.insert(test_block_conditions(random, {subject_id(static_cast<std::size_t>(s)), 0}));
+  CHECK(orders.size() > 1);
+  CHECK(test_block_conditions(random, {"S1", 0}) == test_block_conditions(random, {"S1", 9}));
+  CHECK(trailing_number("S07") == 7);
+  CHECK(trailing_number("anna") == 0);
+  CHECK_THROWS_AS(plan_session(random, {"bad id", 1}), InvalidArgument);
+}

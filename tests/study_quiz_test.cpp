@@ -1,0 +1,166 @@
+// QuizSession on hand-made pen traces over 十 (horizontal, then vertical) and 口.
+#include <catch2/catch.hpp>
+#include <map>
+#include <vector>
+
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/study/quiz.hpp"
+#include "calligraphy/trial/metrics.hpp"
+
+using namespace calligraphy;
+
+namespace {
+
+const PlacedCharacter& character_of(char32_t c) {
+  static std::map<char32_t, Scene> scenes;
+  auto it = scenes.find(c);
+  if (it == scenes.end())
+    it = scenes.emplace(c, Scene::lay_out({CharacterLibrary::embedded().load(c)})).first;
+  return it->second.characters.front();
+}
+
+// The reference stroke as points 0.5 mm apart, shifted by `offset_m`, optionally reversed.
+std::vector<Vec2> stroke_points(const PlacedStroke& stroke, const Vec2& offset_m = Vec2::Zero(),
+                                bool reversed = false) {
+  std::vector<Vec2> points = reference_polyline_m(stroke.elements, 0.5e-3, 4096);
+  for (Vec2& p : points) p += offset_m;
+  if (reversed) std::reverse(points.begin(), points.end());
+  return points;
+}
+
+// Feeds a pen-down run of `points` at 1 kHz and one pen-up sample; returns the events of the lift.
+struct Writer {
+  QuizSession quiz;
+  double time_s = 0.0;
+  std::vector<QuizEvent> write(const std::vector<Vec2>& points) {
+    for (const Vec2& p : points) {
+      REQUIRE(quiz.feed({time_s, p, true}).empty());
+      time_s += 1e-3;
+    }
+    const std::vector<QuizEvent> events = quiz.feed({time_s, points.back(), false});
+    time_s += 0.2;
+    return events;
+  }
+};
+
+bool has(const std::vector<QuizEvent>& events, QuizEvent::Kind kind) {
+  return std::any_of(events.begin(), events.end(), [kind](const QuizEvent& e) { return e.kind == kind; });
+}
+
+}  // namespace
+
+TEST_CASE("quiz accepts the strokes written in order and completes the character", "[study][quiz]") {
+  const PlacedCharacter& shi = character_of(U'十');
+  REQUIRE(shi.strokes.size() == 2);
+  Writer writer{QuizSession(shi)};
+  const auto first = writer.write(stroke_points(shi.strokes[0]));
+  REQUIRE(first.size() == 1);
+  CHECK(first[0].kind == QuizEvent::Kind::stroke_accepted);
+  CHECK(first[0].stroke == 0);
+  CHECK_FALSE(first[0].backwards);
+  CHECK(writer.quiz.current_stroke() == 1);
+  const auto second = writer.write(stroke_points(shi.strokes[1]));
+  CHECK(has(second, QuizEvent::Kind::stroke_accepted));
+  CHECK(has(second, QuizEvent::Kind::character_completed));
+  CHECK(writer.quiz.complete());
+  CHECK(writer.quiz.total_misses() == 0);
+  // Samples after completion change nothing.
+  CHECK(writer.write(stroke_points(shi.strokes[1])).empty());
+}
+
+TEST_CASE("quiz misses a stroke written out of order and hints after the set number of misses",
+          "[study][quiz]") {
+  const PlacedCharacter& shi = character_of(U'十');
+  QuizOptions options;
+  options.hint_after_misses = 2;
+  Writer writer{QuizSession(shi, options)};
+  const auto first = writer.write(stroke_points(shi.strokes[1]));  // the vertical before the horizontal
+  REQUIRE(first.size() == 1);
+  CHECK(first[0].kind == QuizEvent::Kind::stroke_missed);
+  CHECK(first[0].stroke == 0);
+  CHECK(first[0].misses_on_stroke == 1);
+  const auto second = writer.write(stroke_points(shi.strokes[1]));
+  CHECK(has(second, QuizEvent::Kind::stroke_missed));
+  CHECK(has(second, QuizEvent::Kind::hint));
+  const auto third = writer.write(stroke_points(shi.strokes[1]));
+  CHECK(has(third, QuizEvent::Kind::hint));  // after each further miss too
+  CHECK(writer.quiz.total_misses() == 3);
+  // The right stroke is then accepted and the count of misses on the stroke starts again.
+  const auto right = writer.write(stroke_points(shi.strokes[0]));
+  CHECK(has(right, QuizEvent::Kind::stroke_accepted));
+  CHECK(writer.quiz.misses_on_stroke() == 0);
+  CHECK(writer.quiz.total_misses() == 3);
+}
+
+TEST_CASE("quiz reports a stroke written backwards and accepts it only when asked to", "[study][quiz]") {
+  const PlacedCharacter& shi = character_of(U'十');
+  Writer strict{QuizSession(shi)};
+  const auto events = strict.write(stroke_points(shi.strokes[0], Vec2::Zero(), true));
+  REQUIRE_FALSE(events.empty());
+  CHECK(events[0].kind == QuizEvent::Kind::stroke_missed);
+  CHECK(events[0].backwards);
+  CHECK(strict.quiz.current_stroke() == 0);
+
+  QuizOptions lenient;
+  lenient.accept_backwards = true;
+  Writer accepting{QuizSession(shi, lenient)};
+  const auto accepted = accepting.write(stroke_points(shi.strokes[0], Vec2::Zero(), true));
+  REQUIRE_FALSE(accepted.empty());
+  CHECK(accepted[0].kind == QuizEvent::Kind::stroke_accepted);
+  CHECK(accepted[0].backwards);
+}
+
+TEST_CASE("quiz leniency decides a stroke written off its place", "[study][quiz]") {
+  const PlacedCharacter& shi = character_of(U'十');
+  // Shifted across the stroke by 9 mm (150 data units of the 6 cm box): beyond the strict thresholds,
+  // within lenient ones.
+  const Vec2 shift(0.0, 0.009);
+  QuizOptions strict;
+  strict.leniency = 0.5;
+  Writer strict_writer{QuizSession(shi, strict)};
+  CHECK(has(strict_writer.write(stroke_points(shi.strokes[0], shift)), QuizEvent::Kind::stroke_missed));
+  QuizOptions lenient;
+  lenient.leniency = 2.0;
+  Writer lenient_writer{QuizSession(shi, lenient)};
+  CHECK(has(lenient_writer.write(stroke_points(shi.strokes[0], shift)), QuizEvent::Kind::stroke_accepted));
+}
+
+TEST_CASE("quiz neither accepts nor counts a touch too short to judge", "[study][quiz]") {
+  const PlacedCharacter& shi = character_of(U'十');
+  Writer writer{QuizSession(shi)};
+  const Vec2 start = shi.strokes[0].start();
+  const auto events = writer.write({start, start + Vec2(1e-4, 0.0)});
+  REQUIRE(events.size() == 1);
+  CHECK(events[0].kind == QuizEvent::Kind::too_short);
+  CHECK(writer.quiz.total_misses() == 0);
+  CHECK(writer.quiz.current_stroke() == 0);
+}
+
+TEST_CASE("quiz judges a run still open when the input ends", "[study][quiz]") {
+  const PlacedCharacter& shi = character_of(U'十');
+  QuizSession quiz(shi);
+  double t = 0.0;
+  for (const Vec2& p : stroke_points(shi.strokes[0])) {
+    quiz.feed({t, p, true});
+    t += 1e-3;
+  }
+  const auto events = quiz.finish();
+  REQUIRE(events.size() == 1);
+  CHECK(events[0].kind == QuizEvent::Kind::stroke_accepted);
+  CHECK(quiz.events().size() == 1);
+}
+
+TEST_CASE("quiz refuses samples going back in time or not finite, naming the sample", "[study][quiz]") {
+  const PlacedCharacter& shi = character_of(U'十');
+  QuizSession quiz(shi);
+  quiz.feed({1.0, Vec2::Zero(), false});
+  CHECK_THROWS_WITH(quiz.feed({0.5, Vec2::Zero(), false}), Catch::Contains("sample 1"));
+  CHECK_THROWS_AS(quiz.feed({2.0, Vec2(std::nan(""), 0.0), true}), InvalidArgument);
+  QuizOptions bad;
+  bad.leniency = 0.0;
+  CHECK_THROWS_AS(QuizSession(shi, bad), InvalidArgument);
+  PlacedCharacter empty = shi;
+  empty.strokes.clear();
+  CHECK_THROWS_AS(QuizSession(empty), InvalidArgument);
+}

@@ -1,0 +1,306 @@
+// Study sessions end to end in the library: folders, the runner with a simulated writer, interruption and
+// resumption without losing or overwriting a saved trial, the records, the report read back.
+#include <unistd.h>
+
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/report/study_report_html.hpp"
+#include "calligraphy/study/session_reader.hpp"
+#include "calligraphy/study/session_runner.hpp"
+
+using namespace calligraphy;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct TempFolder {
+  fs::path path;
+  TempFolder() {
+    std::string pattern = (fs::temp_directory_path() / "calligraphy-study-XXXXXX").string();
+    REQUIRE(::mkdtemp(pattern.data()) != nullptr);
+    path = pattern;
+  }
+  ~TempFolder() {
+    std::error_code ignored;
+    fs::remove_all(path, ignored);
+  }
+};
+
+std::string read(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+LoadedProtocol small_protocol(const std::string& extra_condition = "") {
+  return protocol_from_text(
+      R"({"name": "small", "conditions": [{"name": "vision", "mode": "vision"}, {"name": "haptic", "mode": "haptic"},
+          {"name": "quiz", "mode": "quiz"})" +
+          extra_condition + R"(],
+          "test": {"characters": ["十"], "conditions": ["vision", "haptic", "quiz"], "repetitions": 1},
+          "trial": {"max_duration_s": 40}})",
+      "small.json");
+}
+
+SessionSetup simulated(const std::string& id) {
+  SessionSetup setup;
+  setup.subject = {id, 1};
+  setup.writer_seed = subject_seed(id);
+  return setup;
+}
+
+// Stops once `after` trials ended (between trials).
+struct StopAfter final : SessionHost {
+  std::size_t after;
+  std::size_t ended = 0;
+  explicit StopAfter(std::size_t n) : after(n) {}
+  void after_trial(const PlannedTrial&, const TrialOutcome&) override { ++ended; }
+};
+
+}  // namespace
+
+TEST_CASE("a session stopped mid-trial resumes without losing or overwriting a saved trial",
+          "[study][session]") {
+  TempFolder temp;
+  const LoadedProtocol protocol = small_protocol();
+  fs::path folder;
+  std::string first_json, first_csv;
+  {
+    SessionFolder session = SessionFolder::create(temp.path, simulated("S01"), protocol);
+    folder = session.path();
+    CHECK(folder.parent_path() == temp.path / "S01");
+    REQUIRE(session.plan().size() == 3);
+    // Another process (here: another open) cannot work on the session at the same time.
+    CHECK_THROWS_AS(SessionFolder::open(folder), StateError);
+
+    // Stop 2000 ticks into the second trial.
+    StopAfter host(1);
+    std::size_t polls = 0;
+    SessionRunOptions options;
+    options.host = &host;
+    options.should_stop = [&] { return host.ended >= 1 && ++polls > 2000; };
+    const SessionRunResult result = run_session(session, options);
+    CHECK(result.interrupted);
+    CHECK(result.saved_now == 1);
+    CHECK(result.attempts_kept == 1);
+    CHECK_FALSE(result.complete());
+    const PlannedTrial& first = session.plan()[0];
+    REQUIRE(session.is_saved(first));
+    CHECK_FALSE(session.is_saved(session.plan()[1]));
+    first_json = read(session.trial_file(first, "json"));
+    first_csv = read(session.trial_file(first, "csv"));
+    // A saved trial is never overwritten.
+    CHECK_THROWS_AS(session.save_trial(first, "{}", "", ""), StateError);
+    CHECK(read(session.trial_file(first, "json")) == first_json);
+    CHECK(fs::exists(folder / "trials" / "attempts" /
+                     (SessionFolder::trial_stem(session.plan()[1]) + ".attempt-1.json")));
+  }
+  SessionFolder resumed = SessionFolder::open(folder);
+  CHECK(resumed.next_unsaved() == std::optional<std::size_t>(1));
+  const SessionRunResult result = run_session(resumed);
+  CHECK(result.complete());
+  CHECK(result.saved_before == 1);
+  CHECK(result.saved_now == 2);
+  CHECK(read(resumed.trial_file(resumed.plan()[0], "json")) == first_json);
+  CHECK(read(resumed.trial_file(resumed.plan()[0], "csv")) == first_csv);
+
+  // The log: created, started, the interruption, resumed, completed; every line a JSON object.
+  std::ifstream log(folder / "log.jsonl");
+  std::vector<std::string> events;
+  for (std::string line; std::getline(log, line);) events.push_back(nlohmann::json::parse(line).at("event"));
+  CHECK(events.front() == "session_created");
+  CHECK(std::count(events.begin(), events.end(), "trial_interrupted") == 1);
+  CHECK(std::count(events.begin(), events.end(), "session_resumed") == 1);
+  CHECK(std::count(events.begin(), events.end(), "trial_saved") == 3);
+  CHECK(events.back() == "session_completed");
+
+  // Every trial record carries the scores and the provenance.
+  for (const PlannedTrial& trial : resumed.plan()) {
+    const auto record = nlohmann::json::parse(read(resumed.trial_file(trial, "json")));
+    for (const char* key :
+         {"frechet_mm", "dtw_mm", "order_errors", "backwards_strokes", "time_s", "mean_deviation_mm",
+          "start_time_utc", "force_law", "renderer", "scene", "writer"}) {
+      CHECK(record.contains(key));
+    }
+    CHECK(record["frechet_mm"].is_number());
+    CHECK(record["protocol"]["sha256"] == protocol.sha256);
+    CHECK(record["device"]["info"]["max_force_n"].get<double>() > 0.0);
+    CHECK(record["force_law"]["guidance"] == (trial.condition == "haptic"));
+    CHECK(record["writer"]["kind"] == "simulated");
+    CHECK(record["scene"]["characters"][0]["placement"]["metres_per_unit"].get<double>() > 0.0);
+    CHECK(record["library"]["version"].is_string());
+    CHECK(record.contains("quiz") == (trial.condition == "quiz"));
+  }
+}
+
+TEST_CASE("a session stopped between trials starts no further trial", "[study][session]") {
+  TempFolder temp;
+  SessionFolder session = SessionFolder::create(temp.path, simulated("S02"), small_protocol());
+  StopAfter host(1);
+  SessionRunOptions options;
+  options.host = &host;
+  options.should_stop = [&] { return host.ended >= 1; };
+  const SessionRunResult result = run_session(session, options);
+  CHECK(result.interrupted);
+  CHECK(result.saved_now == 1);
+  CHECK(result.attempts_kept == 0);
+}
+
+TEST_CASE("a simulated subject writes the same for the same id and differently for another",
+          "[study][session]") {
+  TempFolder temp;
+  const LoadedProtocol protocol = small_protocol();
+  std::vector<std::string> times;
+  for (const char* id : {"A1", "A1", "B1"}) {
+    SessionFolder session = SessionFolder::create(temp.path, simulated(id), protocol);
+    run_session(session);
+    const auto record = nlohmann::json::parse(read(session.trial_file(session.plan()[0], "json")));
+    times.push_back(record["per_stroke"].dump() + record["time_s"].dump());
+  }
+  CHECK(times[0] == times[1]);
+  CHECK(times[0] != times[2]);
+}
+
+TEST_CASE("a condition this build cannot render is refused before any trial runs", "[study][session]") {
+  TempFolder temp;
+  const LoadedProtocol protocol = protocol_from_text(
+      R"({"name": "f", "conditions": [{"name": "vision", "mode": "vision"}, {"name": "fade", "mode": "fading"}],
+          "test": {"characters": ["十"], "conditions": ["vision", "fade"], "repetitions": 1}})",
+      "f.json");
+  SessionFolder session = SessionFolder::create(temp.path, simulated("S03"), protocol);
+  CHECK_THROWS_WITH(run_session(session), Catch::Contains("condition 'fade'"));
+  CHECK(session.saved_count() == 0);
+}
+
+TEST_CASE("a damaged session.json is refused naming the file and the JSON pointer", "[study][session]") {
+  TempFolder temp;
+  fs::path folder;
+  {
+    SessionFolder session = SessionFolder::create(temp.path, simulated("S04"), small_protocol());
+    folder = session.path();
+  }
+  auto manifest = nlohmann::json::parse(read(folder / "session.json"));
+  manifest["protocol"]["text"] = manifest["protocol"]["text"].get<std::string>() + " ";
+  std::ofstream(folder / "session.json") << manifest.dump();
+  CHECK_THROWS_WITH(SessionFolder::open(folder),
+                    Catch::Contains("session.json: /protocol/text") && Catch::Contains("SHA-256"));
+  std::ofstream(folder / "session.json") << "{\"format\": \"calligraphy-study-session\"}";
+  CHECK_THROWS_WITH(SessionFolder::open(folder), Catch::Contains("session.json: /version"));
+  CHECK_THROWS_AS(SessionFolder::create(temp.path, simulated("no/slash"), small_protocol()), InvalidArgument);
+}
+
+TEST_CASE("the report of saved sessions has a trajectory and a force figure per trial", "[study][report]") {
+  TempFolder temp;
+  const LoadedProtocol protocol = small_protocol();
+  for (const char* id : {"S01", "S02"}) {
+    SessionFolder session = SessionFolder::create(temp.path / "study", simulated(id), protocol);
+    run_session(session);
+  }
+  const StudyReport report = read_study_report({temp.path / "study"});
+  REQUIRE(report.trials.size() == 6);
+  CHECK(report.sessions.size() == 2);
+  CHECK(report.conditions == std::vector<std::string>{"vision", "haptic", "quiz"});
+  for (const ReportTrial& trial : report.trials) {
+    CHECK(trial.time_s.size() == trial.position_m.size());
+    CHECK_FALSE(trial.time_s.empty());
+    CHECK(trial.reference_m.size() == 2);
+    CHECK(trial.strokes.size() == 2);
+  }
+  const std::vector<double> times = measure_values(report, ReportMeasure::time_s, "vision");
+  REQUIRE(times.size() == 2);
+  const MeanSd summary = mean_and_sd(times);
+  CHECK(summary.mean == Approx((times[0] + times[1]) / 2));
+  const std::string page = study_report_html(report);
+  const auto count = [&](const std::string& needle) {
+    std::size_t n = 0;
+    for (std::size_t at = page.find(needle); at != std::string::npos; at = page.find(needle, at + 1)) ++n;
+    return n;
+  };
+  CHECK(count("<figure class=\"trajectory\"") == 6);
+  CHECK(count("<figure class=\"force\"") == 6);
+  CHECK(count("<table class=\"summary\"") == 4);
+  CHECK(page.find("http") ==
+        page.find("http://www.w3.org/2000/svg"));  // only the SVG namespace, nothing loaded
+  CHECK_THROWS_AS(read_study_report({temp.path / "nothing-here"}), DataError);
+}
+
+TEST_CASE("mean and sample standard deviation", "[study][report]") {
+  const std::vector<double> values{2.0, 4.0, 4.0, 4.0, 5.0, 5.0, 7.0, 9.0};
+  const MeanSd s = mean_and_sd(values);
+  CHECK(s.n == 8);
+  CHECK(s.mean == Approx(5.0));
+  CHECK(s.sd == Approx(std::sqrt(32.0 / 7.0)));
+  CHECK(std::isnan(mean_and_sd(std::vector<double>{1.0}).sd));
+  CHECK(mean_and_sd(std::vector<double>{}).n == 0);
+}
+
+TEST_CASE("the report page escapes what sessions wrote", "[study][report]") {
+  StudyReport report;
+  report.title = "<script>alert(1)</script>";
+  report.conditions = {"a"};
+  ReportTrial trial;
+  trial.subject = "S<1>";
+  trial.condition = "a";
+  trial.phase = "test";
+  trial.characters = "\"&'";
+  trial.time_s = {0.0, 1.0};
+  trial.position_m = {Vec2::Zero(), Vec2(0.01, 0.0)};
+  trial.pen_down = {true, true};
+  trial.in_plane_force_n = {0.0, 1.0};
+  report.trials = {trial};
+  const std::string page = study_report_html(report);
+  CHECK(page.find("<script>") == std::string::npos);
+  CHECK(page.find("&lt;script&gt;") != std::string::npos);
+  CHECK(page.find("S&lt;1&gt;") != std::string::npos);
+  CHECK(page.find("&quot;&amp;&#39;") != std::string::npos);
+}
+
+TEST_CASE("a crash between saving a trial and logging it, or in a log line, is mended on resume",
+          "[study][session]") {
+  TempFolder temp;
+  fs::path folder;
+  {
+    SessionFolder session = SessionFolder::create(temp.path, simulated("S05"), small_protocol());
+    folder = session.path();
+    StopAfter host(1);
+    SessionRunOptions options;
+    options.host = &host;
+    options.should_stop = [&] { return host.ended >= 1; };
+    REQUIRE(run_session(session, options).saved_now == 1);
+  }
+  // As if the process died after the trial's JSON was linked but before its log line, in the middle of a
+  // later line.
+  std::string kept;
+  {
+    std::ifstream log(folder / "log.jsonl");
+    for (std::string line; std::getline(log, line);) {
+      if (nlohmann::json::parse(line).at("event") != "trial_saved") kept += line + "\n";
+    }
+  }
+  std::ofstream(folder / "log.jsonl", std::ios::trunc) << kept << "{\"event\": \"tri";
+  SessionFolder resumed = SessionFolder::open(folder);
+  REQUIRE(run_session(resumed).complete());
+  std::ifstream log(folder / "log.jsonl");
+  std::size_t saved = 0, recovered = 0, torn = 0;
+  for (std::string line; std::getline(log, line);) {
+    if (!nlohmann::json::accept(line)) {
+      ++torn;
+      continue;
+    }
+    const auto event = nlohmann::json::parse(line);
+    if (event.at("event") == "trial_saved") {
+      ++saved;
+      recovered += event.value("recovered", false) ? 1 : 0;
+    }
+  }
+  CHECK(torn == 1);  // the torn line stands alone, every later line is whole
+  CHECK(saved == 3);
+  CHECK(recovered == 1);
+}
