@@ -8,6 +8,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/devices/device_registry.hpp"
+#include "calligraphy/sim/hand_port.hpp"
 #include "cli/cli_devices.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
@@ -71,6 +72,21 @@ int run_train(const TrainCommand& command) {
                    : options.simulated_writer ? "simulated"
                                               : "mouse-hand";
   require_device(options.device);
+  {  // a simulated writer moves only a device with a hand port; a person moves any other
+    const bool hand_port =
+        dynamic_cast<HandPort*>(cli_device_registry().create(options.device).get()) != nullptr;
+    if (options.simulated_writer && !hand_port) {
+      throw UsageError(
+          "--writer simulated needs a device a simulated writer can move (simulated, "
+          "emulated-phantom), not '" +
+          options.device + "'");
+    }
+    if (!options.simulated_writer && hand_port) {
+      throw UsageError(
+          "--device " + options.device +
+          " is moved by the simulated writer: add --writer simulated, or use mouse or mouse-hand");
+    }
+  }
   options.guidance = command.guidance == "on";
   options.seed = command.seed;
   options.session_dir = command.session;
