@@ -224,6 +224,47 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual(record["end_reason"], "completed")
         self.assertLess(record["per_stroke"][0]["mean_deviation_mm"], 1.5)
 
+    def write_yi_beside_the_stroke(self, guidance, offset):
+        """On mouse-hand, presses at the start of 一, then moves the pointer `offset` data units below the
+        stroke to its end; returns the saved record."""
+        folder = pathlib.Path(self.folder) / guidance
+        folder.mkdir()
+        trainer = Trainer("一", "--device", "mouse-hand", "--guidance", guidance, "--data", SAMPLE, "--session",
+                          "out", "--exit-after", "60", folder=folder)
+        try:
+            (box,) = trainer.boxes()
+            window = trainer.window()
+            median = medians("一", SAMPLE)[0]
+            below = [box.data_to_px((x, y - offset)) for x, y in along(median, [i / 24 for i in range(1, 25)])]
+            below.append(box.data_to_px((median[-1][0] + 30, median[-1][1] - offset)))
+            start = box.data_to_px(median[0])
+            time.sleep(0.5)
+            xdotool("mousemove", "--window", window, round(start[0]), round(start[1]))
+            time.sleep(0.8)  # the hand carries the stylus over the start
+            xdotool("mousedown", 1)
+            time.sleep(0.8)
+            for x, y in below:
+                xdotool("mousemove", "--window", window, round(x), round(y))
+                time.sleep(0.1)
+            time.sleep(0.8)
+            xdotool("mouseup", 1)
+            self.assertEqual(trainer.wait(), 0, trainer.errors())
+        finally:
+            trainer.close()
+        (record_path,) = saved_trials(folder / "out")
+        return json.loads(record_path.read_text(encoding="utf-8"))
+
+    def test_guidance_pulls_the_mouse_hand_pen_towards_the_stroke(self):
+        offset = 40  # data units, 2.3 mm on paper
+        guided = self.write_yi_beside_the_stroke("on", offset)
+        free = self.write_yi_beside_the_stroke("off", offset)
+        for record in (guided, free):
+            self.assertEqual(record["device"], "mouse-hand")
+            self.assertEqual(record["strokes_completed"], 1, record)
+        self.assertEqual(guided["condition"], "vision+haptic")
+        self.assertEqual(free["condition"], "vision")
+        self.assertLess(guided["mean_deviation_mm"], 0.7 * free["mean_deviation_mm"])
+
     def ended_mid_trial(self, end):
         """Starts 永 with the simulated writer (no time limit of its own), lets it write a while, then calls
         `end`, and checks the trial was saved whole as interrupted."""
