@@ -12,6 +12,9 @@ packages=(
   pkg-config lib2geom-dev            # lib2geom column of `bench nearest` (optional at configure time)
   pybind11-dev python3-dev python3-numpy python3-pytest
   nodejs npm                          # npm pack for hanzi-writer-data
+  libglfw3-dev libimgui-dev libstb-dev libgl-dev libx11-dev  # the trainer window (optional at configure time)
+  libgl1-mesa-dri fonts-arphic-ukai   # OpenGL without a GPU (llvmpipe), the Chinese font it shows
+  xvfb xauth xdotool                  # the trainer's tests on a virtual X server
 )
 
 missing=()

@@ -160,7 +160,8 @@ void draw_scene(ImDrawList& draw, const WindowLayout& layout, const std::vector<
   }
   if (s.tick == 0) return;
   const Vec2 tip = layout.to_screen(c, Vec2(s.hip_m.x, s.hip_m.y));
-  const Vec2 in_plane_px = Vec2(s.force_n.x, -s.force_n.y) * 60.0;  // 60 px per newton
+  Vec2 in_plane_px = Vec2(s.force_n.x, -s.force_n.y) * 150.0;  // 150 px per newton, at most 220 px
+  if (in_plane_px.norm() > 220.0) in_plane_px *= 220.0 / in_plane_px.norm();
   draw_arrow(draw, tip, tip + in_plane_px, kForce);
   if (s.pen_height_m <= 0.0) {
     draw.AddCircleFilled(im(tip), 6.0f, kPen);

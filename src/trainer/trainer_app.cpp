@@ -297,6 +297,10 @@ class TrainerApp {
       if (closed || received_signal.load() != 0) quit_ = true;
       if (unattended() && seconds_since_start() >= options_.exit_after_s) quit_ = true;
       handle_keys();
+      if (quit_ && !quit_seen_) {  // the picture at exit shows the window as it was when the exit came
+        if (!options_.screenshot.empty() && !screenshot_taken_ && !x11_error_seen() && view_) render(true);
+        quit_seen_ = true;
+      }
       if (quit_ && worker_.active() && !worker_.done()) worker_.request_stop();
       if (pending_ != NextAction::none && worker_.active() && !worker_.done()) worker_.request_stop();
       if (view_ && worker_.active()) view_->consume(*channel_, typical_ids_[view_->character]);
@@ -316,8 +320,6 @@ class TrainerApp {
       if (next_frame < Clock::now()) next_frame = Clock::now();
       std::this_thread::sleep_until(next_frame);
     }
-    // The last picture, when none was taken: the window as it was when the run ended.
-    if (!options_.screenshot.empty() && !screenshot_taken_ && !x11_error_seen() && view_) render(true);
   }
 
   double seconds_since_start() const {
@@ -374,7 +376,7 @@ class TrainerApp {
     panel.unattended = unattended();
     panel.frame_rate_hz = ImGui::GetIO().Framerate;
     panel.large_font = large_font_;
-    if (quit_ && worker_.active() && !worker_.done()) panel.status = "ending the trial...";
+    if (quit_seen_ && worker_.active() && !worker_.done()) panel.status = "ending the trial...";
     draw_panel(*layout_, kPanelWidthPx, panel);
     ImGui::Render();
     int width = 0;
@@ -431,6 +433,7 @@ class TrainerApp {
   bool guidance_ = true;
   bool condition_outputs_force_ = true;
   bool quit_ = false;
+  bool quit_seen_ = false;
   NextAction pending_ = NextAction::none;
   std::optional<Clock::time_point> advance_at_;
   bool screenshot_due_ = false;
