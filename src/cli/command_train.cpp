@@ -35,6 +35,7 @@ struct TrainCommand {
   double exit_after_s = 0.0;
 };
 
+#ifdef CALLIGRAPHY_WITH_TRAINER
 // "WxH" in pixels, each in [min, 8192].
 std::pair<int, int> window_size(const std::string& text) {
   const auto x = text.find('x');
@@ -63,7 +64,6 @@ void require_device(const std::string& name) {
 }
 
 int run_train(const TrainCommand& command) {
-#ifdef CALLIGRAPHY_WITH_TRAINER
   trainer::register_trainer_devices();
   const std::u32string chars = characters_from(command.characters, "CHARS");
   trainer::TrainerOptions options;
@@ -115,13 +115,14 @@ int run_train(const TrainCommand& command) {
     options.characters.push_back(std::move(character));
   }
   return trainer::run_trainer(options);
+}
 #else
-  (void)command;
+int run_train(const TrainCommand& /*command*/) {
   throw Error(
       "this calligraphy was built without the trainer window (CALLIGRAPHY_BUILD_TRAINER=OFF; it needs GLFW 3 "
       "and Dear ImGui: libglfw3-dev libimgui-dev)");
-#endif
 }
+#endif
 
 }  // namespace
 

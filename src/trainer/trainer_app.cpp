@@ -320,6 +320,8 @@ class TrainerApp {
       if (next_frame < Clock::now()) next_frame = Clock::now();
       std::this_thread::sleep_until(next_frame);
     }
+    // The last character's trial ended in this very iteration: its summary, after the last stroke.
+    if (!options_.screenshot.empty() && !screenshot_taken_ && !x11_error_seen() && view_) render(true);
   }
 
   double seconds_since_start() const {
