@@ -16,6 +16,9 @@ packages=(
   fonts-arphic-ukai                   # a CJK font for calligraphy.plot
   nodejs npm                          # npm pack for hanzi-writer-data
   chromium                            # the study report loaded headless (tests/study; optional, skipped without)
+  libglfw3-dev libimgui-dev libstb-dev libgl-dev libx11-dev  # the trainer window (optional at configure time)
+  libgl1-mesa-dri fonts-arphic-ukai   # OpenGL without a GPU (llvmpipe), the Chinese font it shows
+  xvfb xauth xdotool                  # the trainer's tests on a virtual X server
 )
 
 missing=()

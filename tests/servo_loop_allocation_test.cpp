@@ -86,4 +86,41 @@ TEST_CASE("The servo loop thread does not allocate while it renders and records"
   CHECK(transitions > 0);
   CHECK(watched_allocations.load() == before);
 }
+
+TEST_CASE("A trial session publishing to a display does not allocate on the servo thread",
+          "[servo][display]") {
+  using namespace calligraphy;
+  const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'口')});
+  SimulatedDevice device;
+  SweepingHand hand;
+  device.attach_hand(&hand);
+  device.open();
+  DisplayChannel channel;
+  TrialOptions trial_options;
+  trial_options.max_duration_s = 2.0;
+  trial_options.display = &channel;
+  TrialSession session(scene, device.info(), trial_options);
+  session.reserve_trace();
+  ServoLoopOptions options;
+  options.lock_memory = false;
+  options.stall_timeout_s = 0.0;
+  ServoLoop loop(
+      device,
+      [&](const DeviceState& state, double) {
+        watched = true;
+        const ServoCommand command = session.step(state);
+        device.write_force(command.force_n);
+        device.advance(1e-3);
+        return command;
+      },
+      options);
+  const long before = watched_allocations.load();
+  loop.start();
+  std::this_thread::sleep_for(std::chrono::milliseconds(400));
+  loop.stop();
+  INFO("ticks " << loop.stats().ticks);
+  CHECK(loop.stats().ticks > 200);
+  CHECK(channel.latest().tick == session.ticks());
+  CHECK(watched_allocations.load() == before);
+}
 #endif

@@ -7,6 +7,7 @@
 namespace calligraphy::cli {
 
 void add_trial_command(CLI::App& root, Commands& commands);     // trial CHARS [...]
+void add_train_command(CLI::App& root, Commands& commands);     // train CHARS [...] (the trainer window)
 void add_score_command(CLI::App& root, Commands& commands);     // score TRACE.csv --character C [...]
 void add_model_command(CLI::App& root, Commands& commands);     // model CHAR [...]
 void add_strokes_command(CLI::App& root, Commands& commands);   // strokes [--markdown FILE] [--json]

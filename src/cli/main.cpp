@@ -59,6 +59,7 @@ int main(int argc, char** argv) {
   configure_root(root);
   Commands commands;
   add_trial_command(root, commands);
+  add_train_command(root, commands);
   add_score_command(root, commands);
   add_model_command(root, commands);
   add_strokes_command(root, commands);

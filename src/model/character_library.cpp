@@ -8,6 +8,7 @@
 #include "model/character_file.hpp"
 #include "model/embedded_characters.hpp"
 #include "model/median_json_reader.hpp"
+#include "model/outline_json_reader.hpp"
 
 namespace calligraphy {
 namespace {
@@ -23,6 +24,28 @@ const detail::EmbeddedCharacter* find_embedded(char32_t cp) {
     if (name == e.name) return &e;
   }
   return nullptr;
+}
+
+struct Document {
+  std::string text;
+  std::string source;
+};
+
+// The JSON text of the character's file: embedded (folder empty) or from the folder.
+Document read_document(const std::filesystem::path& folder, char32_t cp) {
+  if (folder.empty()) {
+    const auto* e = find_embedded(cp);
+    if (e == nullptr) {
+      throw CharacterNotFound("character " + describe_character(cp) +
+                              " is not in the embedded default set (" +
+                              std::to_string(detail::embedded_characters().size()) +
+                              " characters); load it from the full hanzi-writer-data package (a folder "
+                              "of <char>.json files) or from a corpus store");
+    }
+    return {e->json, "embedded:" + encode_utf8(cp) + ".json"};
+  }
+  const auto path = folder / (encode_utf8(cp) + ".json");
+  return {detail::read_character_file(path, cp, kMaxCharacterFileBytes), path.string()};
 }
 
 }  // namespace
@@ -67,20 +90,38 @@ bool CharacterLibrary::contains(char32_t cp) const {
 }
 
 CharacterData CharacterLibrary::load_data(char32_t cp) const {
-  if (folder_.empty()) {
-    const auto* e = find_embedded(cp);
-    if (e == nullptr) {
-      throw CharacterNotFound("character " + describe_character(cp) +
-                              " is not in the embedded default set (" +
-                              std::to_string(detail::embedded_characters().size()) +
-                              " characters); load it from the full hanzi-writer-data package (a folder "
-                              "of <char>.json files) or from a corpus store");
-    }
-    return parse_hanzi_writer_json(e->json, cp, "embedded:" + encode_utf8(cp) + ".json");
+  const Document document = read_document(folder_, cp);
+  return parse_hanzi_writer_json(document.text, cp, document.source);
+}
+
+CharacterOutlines CharacterLibrary::load_outlines(char32_t cp, double tolerance) const {
+  if (!(tolerance > 0.0)) {
+    throw InvalidArgument("load_outlines: tolerance " + std::to_string(tolerance) +
+                          " must be > 0 data units");
   }
-  const auto path = folder_ / (encode_utf8(cp) + ".json");
-  return parse_hanzi_writer_json(detail::read_character_file(path, cp, kMaxCharacterFileBytes), cp,
-                                 path.string());
+  const Document document = read_document(folder_, cp);
+  if (document.text.size() > kMaxCharacterFileBytes) {
+    fail(document.source, cp, "/", "document larger than a character file may be");
+  }
+  const detail::OutlineJsonResult read = detail::read_outlines_json(document.text);
+  if (!read.ok) fail(document.source, cp, read.where, read.what);
+  CharacterOutlines outlines;
+  outlines.code_point = cp;
+  outlines.source = document.source;
+  std::size_t vertices = 0;
+  for (std::size_t i = 0; i < read.paths.size(); ++i) {
+    try {
+      outlines.strokes.push_back(parse_svg_path(read.paths[i], tolerance));
+    } catch (const DataError& e) {
+      fail(document.source, cp, "/strokes/" + std::to_string(i), e.what());
+    }
+    for (const OutlinePolygon& polygon : outlines.strokes.back()) vertices += polygon.size();
+    if (vertices > kMaxOutlineVertices) {
+      fail(document.source, cp, "/strokes/" + std::to_string(i),
+           "more than " + std::to_string(kMaxOutlineVertices) + " outline vertices in all strokes");
+    }
+  }
+  return outlines;
 }
 
 Character CharacterLibrary::load(char32_t cp, const FitOptions& options) const {

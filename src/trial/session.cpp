@@ -20,7 +20,17 @@ TrialSession::TrialSession(const Scene& scene, const DeviceInfo& device, const T
     : options_((options.validate(), options)),
       renderer_(scene, options.force, device, renderer_options(options)),
       recorder_(scene, options.keep_trace),
-      max_ticks_(static_cast<std::size_t>(std::ceil(options.max_duration_s * options.rate_hz))) {}
+      max_ticks_(static_cast<std::size_t>(std::ceil(options.max_duration_s * options.rate_hz))) {
+  attach_display(options.display);
+}
+
+void TrialSession::attach_display(DisplayChannel* channel) {
+  if (channel == nullptr) {
+    display_.reset();
+  } else {
+    display_.emplace(renderer_.scene(), *channel);
+  }
+}
 
 void TrialSession::reserve_trace() { recorder_.reserve(max_ticks_); }
 
@@ -28,12 +38,14 @@ ServoCommand TrialSession::step(const DeviceState& state) noexcept {
   last_output_ = renderer_.tick(state);
   recorder_.record(state, last_output_);
   ++ticks_;
+  if (display_) display_->publish_tick(ticks_, state, last_output_, recorder_.metrics());
   last_time_s_ = state.time_s;
   return ServoCommand{last_output_.force_n, last_output_.finished || ticks_ >= max_ticks_};
 }
 
 TrialResult TrialSession::finish(TrialEnd end, std::string reason, double end_time_s) {
   recorder_.finish(end_time_s < 0.0 ? last_time_s_ : end_time_s);
+  if (display_) display_->publish_end(end, end_time_s < 0.0 ? last_time_s_ : end_time_s);
   TrialResult result;
   result.metrics = recorder_.metrics();
   result.trace = recorder_.trace();

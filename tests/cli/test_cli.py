@@ -23,7 +23,7 @@ SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().
 DATA = SOURCE / "data" / "hanzi-writer-data"
 
 COMMANDS = [
-    [], ["trial"], ["score"], ["model"], ["strokes"], ["devices"],
+    [], ["trial"], ["train"], ["score"], ["model"], ["strokes"], ["devices"],
     ["corpus"], ["corpus", "build"], ["corpus", "stats"], ["corpus", "fidelity"], ["corpus", "validate"],
     ["bench"], ["bench", "nearest"], ["bench", "jumps"], ["bench", "tick"], ["bench", "loop"],
 ]
@@ -93,6 +93,19 @@ class HelpAndVersion(CliTestCase):
             result = self.run_cli(*command, "--version")
             self.assertEqual(result.returncode, 0, f"{command}: {result.stderr.decode()}")
             self.assertEqual(result.stdout.decode(), expected)
+
+    def test_train_refuses_bad_options_before_opening_a_window(self):
+        probe = self.run_cli("train", "永", "--window", "10x10")
+        if probe.returncode == 1 and b"without the trainer" in probe.stderr:
+            self.skipTest("built without the trainer window")
+        self.assert_usage_error(["train", "永", "--window", "10x10"], "--window")
+        self.assert_usage_error(["train", "永", "--window", "1280"], "--window")
+        self.assert_usage_error(["train", "永", "--subject", "../x"], "--subject")
+        self.assert_usage_error(["train", "永", "--device", "nope"], "--device")
+        self.assert_usage_error(["train", "永", "--writer", "simulated", "--device", "mouse"], "--writer")
+        self.assert_usage_error(["train", "永", "--device", "simulated"], "--device")
+        self.assert_usage_error(["train", "永", "--exit-after", "0"], "--exit-after")
+        self.assert_usage_error(["train", "永", "--screenshot", "-"], "--screenshot")
 
     def test_trial_help_is_help_not_a_character(self):
         result = self.run_cli("trial", "-h")

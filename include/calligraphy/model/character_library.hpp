@@ -12,6 +12,7 @@
 
 #include "calligraphy/model/character.hpp"
 #include "calligraphy/model/fitting.hpp"
+#include "calligraphy/model/stroke_outline.hpp"
 
 namespace calligraphy {
 
@@ -67,6 +68,11 @@ class CharacterLibrary {
   [[nodiscard]] CharacterData load_data(char32_t code_point) const;
   /// The fitted model (elements, feature points, typical IDs). Throws as `load_data`.
   [[nodiscard]] Character load(char32_t code_point, const FitOptions& options = {}) const;
+  /// The filled outlines of the character's strokes, in stroke order: hanzi-writer-data's `strokes` SVG
+  /// paths flattened within `tolerance` data units (stroke_outline.hpp), for drawing. Throws as
+  /// `load_data`, DataError naming the source, the character and the JSON pointer (/strokes/2) when the
+  /// file has no such array or a path does not parse, and InvalidArgument when tolerance is not > 0.
+  [[nodiscard]] CharacterOutlines load_outlines(char32_t code_point, double tolerance = 1.0) const;
   /// Every available character, sorted by code point. Throws DataError naming the folder when a folder
   /// holds no `<char>.json` file or cannot be listed.
   [[nodiscard]] std::vector<char32_t> characters() const;

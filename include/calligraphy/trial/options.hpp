@@ -10,6 +10,7 @@
 #include "calligraphy/render/renderer.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
 #include "calligraphy/sim/simulated_writer.hpp"
+#include "calligraphy/trial/display.hpp"
 
 namespace calligraphy {
 
@@ -45,6 +46,9 @@ struct TrialOptions {
   /// every millisecond in real time. Returning true ends the trial at the next tick with
   /// `TrialEnd::interrupted` (zero force, forces disabled, every recorded tick kept). May be empty.
   std::function<bool()> should_stop;
+  /// Where the session publishes what the display shows after every tick (display.hpp); not owned,
+  /// must outlive the trial. nullptr: nothing is published.
+  DisplayChannel* display = nullptr;
 
   /// Throws InvalidArgument naming the field when a value is out of range (the rate for the pacing
   /// `pacing`, or either range for `automatic`, which is checked again once the device is known).

@@ -15,13 +15,18 @@
 ///     TrialResult result = session.finish(TrialEnd::completed);
 ///
 /// `step` never locks, logs or throws, and after `reserve_trace()` it never allocates; it asks to stop
-/// when every stroke is written or `max_duration_s` x `rate_hz` ticks were stepped.
+/// when every stroke is written or `max_duration_s` x `rate_hz` ticks were stepped. With a display
+/// channel attached (`attach_display`, or `TrialOptions::display`), `step` also publishes the tick for an
+/// application's display thread (display.hpp), still without allocation, lock or wait, and `finish`
+/// pushes the trial's end.
 #include <cstddef>
+#include <optional>
 
 #include "calligraphy/core/device_types.hpp"
 #include "calligraphy/devices/servo_loop.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/render/renderer.hpp"
+#include "calligraphy/trial/display.hpp"
 #include "calligraphy/trial/options.hpp"
 #include "calligraphy/trial/recorder.hpp"
 #include "calligraphy/trial/result.hpp"
@@ -38,6 +43,11 @@ class TrialSession {
   /// Allocates (and touches) the trace for `max_duration_s` x `rate_hz` ticks, about 80 bytes a tick,
   /// so that `step` never allocates: for a real-time loop. Nothing when the trace is not kept.
   void reserve_trace();
+
+  /// Publishes every later tick into `channel` (not owned; it must outlive the session), or stops
+  /// publishing for nullptr. Allocates: call it before the servo loop starts, not while it runs.
+  /// The constructor attaches `options.display`.
+  void attach_display(DisplayChannel* channel);
 
   /// One servo tick: renders the force for `state` and records the tick. `stop` is set when every
   /// stroke is written or the time limit is reached. Servo path: no lock, log or exception, and no
@@ -56,7 +66,8 @@ class TrialSession {
 
   /// Closes the metrics at `end_time_s` (the device time the trial ended; the last tick's time when
   /// negative) and returns the recording with how it ended. `reason` is kept as `abort_reason`.
-  /// Call once; the session is spent after it.
+  /// Call once, after the loop stopped stepping; the session is spent after it. With a display
+  /// attached it pushes the `trial_ended` event.
   [[nodiscard]] TrialResult finish(TrialEnd end, std::string reason = {}, double end_time_s = -1.0);
 
  private:
@@ -64,6 +75,7 @@ class TrialSession {
   Renderer renderer_;
   TrialRecorder recorder_;
   RenderOutput last_output_{};
+  std::optional<DisplayPublisher> display_;
   std::size_t ticks_ = 0;
   std::size_t max_ticks_ = 0;
   double last_time_s_ = 0.0;

@@ -1,0 +1,158 @@
+// `calligraphy train CHARS ...`: the trainer window (src/trainer, docs/trainer.md): a live guided trial in
+// real time, drawn at the display rate, with the mouse, a simulated hand on the mouse, a simulated writer
+// or a haptic device. Built only with CALLIGRAPHY_BUILD_TRAINER; otherwise the command says so.
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/devices/device_registry.hpp"
+#include "calligraphy/sim/hand_port.hpp"
+#include "cli/cli_devices.hpp"
+#include "cli/commands.hpp"
+#include "cli/library_options.hpp"
+#include "core/unicode.hpp"
+#ifdef CALLIGRAPHY_WITH_TRAINER
+#include "trainer/session_files.hpp"
+#include "trainer/trainer.hpp"
+#endif
+
+namespace calligraphy::cli {
+namespace {
+
+struct TrainCommand {
+  std::string characters;
+  std::string device;  // empty: mouse-hand, or simulated with --writer simulated
+  std::string writer = "person";
+  std::string guidance = "on";
+  std::uint64_t seed = 0;
+  LibraryOptions library;
+  std::string session;
+  std::string subject = "anonymous";
+  std::string window = "1280x800";
+  std::string screenshot;
+  double exit_after_s = 0.0;
+};
+
+#ifdef CALLIGRAPHY_WITH_TRAINER
+// "WxH" in pixels, each in [min, 8192].
+std::pair<int, int> window_size(const std::string& text) {
+  const auto x = text.find('x');
+  const auto number = [&](const std::string& part, int minimum) {
+    if (part.empty() || part.size() > 5 || !std::all_of(part.begin(), part.end(), ::isdigit)) return -1;
+    const int value = std::stoi(part);
+    return value >= minimum && value <= 8192 ? value : -1;
+  };
+  const int width = x == std::string::npos ? -1 : number(text.substr(0, x), 800);
+  const int height = x == std::string::npos ? -1 : number(text.substr(x + 1), 480);
+  if (width < 0 || height < 0) {
+    throw UsageError("--window: '" + text +
+                     "' is not WIDTHxHEIGHT in pixels (width 800-8192, height 480-8192)");
+  }
+  return {width, height};
+}
+
+void require_device(const std::string& name) {
+  const DeviceSurvey survey = cli_device_registry().survey();
+  for (const DeviceListing& listing : survey.devices) {
+    if (listing.name == name) return;
+  }
+  std::string names;
+  for (const DeviceListing& listing : survey.devices) names += (names.empty() ? "" : ", ") + listing.name;
+  throw UsageError("--device: unknown device '" + name + "'; registered devices: " + names);
+}
+
+int run_train(const TrainCommand& command) {
+  trainer::register_trainer_devices();
+  const std::u32string chars = characters_from(command.characters, "CHARS");
+  trainer::TrainerOptions options;
+  options.simulated_writer = command.writer == "simulated";
+  options.device = !command.device.empty()    ? command.device
+                   : options.simulated_writer ? "simulated"
+                                              : "mouse-hand";
+  require_device(options.device);
+  {  // a simulated writer moves only a device with a hand port; a person moves any other
+    const bool hand_port =
+        dynamic_cast<HandPort*>(cli_device_registry().create(options.device).get()) != nullptr;
+    if (options.simulated_writer && !hand_port) {
+      throw UsageError(
+          "--writer simulated needs a device a simulated writer can move (simulated, "
+          "emulated-phantom), not '" +
+          options.device + "'");
+    }
+    if (!options.simulated_writer && hand_port) {
+      throw UsageError(
+          "--device " + options.device +
+          " is moved by the simulated writer: add --writer simulated, or use mouse or mouse-hand");
+    }
+  }
+  options.guidance = command.guidance == "on";
+  options.seed = command.seed;
+  options.session_dir = command.session;
+  options.subject = command.subject;
+  try {
+    trainer::check_subject_id(command.subject);
+  } catch (const InvalidArgument& e) {
+    throw UsageError(std::string("--subject: ") + e.what());
+  }
+  std::tie(options.width_px, options.height_px) = window_size(command.window);
+  options.screenshot = command.screenshot;
+  options.exit_after_s = command.exit_after_s;
+  options.library_version = CALLIGRAPHY_VERSION;
+  const CharacterSource source(command.library);
+  const CharacterLibrary outlines = library_from(command.library);
+  for (const char32_t c : chars) {
+    trainer::TrainerCharacter character;
+    character.model = source.load(c);
+    character.utf8 = encode_utf8(c);
+    try {
+      character.outlines = outlines.load_outlines(c);
+    } catch (const DataError& e) {  // e.g. a store without the data folder: drawn without outlines
+      std::fprintf(stderr, "calligraphy train: warning: no stroke outlines for %s: %s\n",
+                   character.utf8.c_str(), e.what());
+    }
+    options.characters.push_back(std::move(character));
+  }
+  return trainer::run_trainer(options);
+}
+#else
+int run_train(const TrainCommand& /*command*/) {
+  throw Error(
+      "this calligraphy was built without the trainer window (CALLIGRAPHY_BUILD_TRAINER=OFF; it needs GLFW 3 "
+      "and Dear ImGui: libglfw3-dev libimgui-dev)");
+}
+#endif
+
+}  // namespace
+
+void add_train_command(CLI::App& root, Commands& commands) {
+  auto command = std::make_shared<TrainCommand>();
+  CLI::App* app = commands.add(root, "train", "Practise CHARS in a window: a live guided trial in real time",
+                               [command] { return run_train(*command); });
+  add_positional(*app, "CHARS", command->characters, "the characters to practise, left to right (UTF-8)");
+  add_text(*app, "--device", command->device, "NAME",
+           "the device: mouse, mouse-hand (docs/devices.md), a haptic device, or simulated with --writer "
+           "simulated",
+           "mouse-hand; simulated with --writer simulated");
+  add_choice(*app, "--writer", command->writer, {"person", "simulated"},
+             "who writes: a person, or the simulated writer live on the simulated device (a demonstration)");
+  add_choice(*app, "--guidance", command->guidance, {"on", "off"},
+             "guiding force towards the stroke (G toggles)");
+  add_unsigned(*app, "--seed", command->seed, "N", "seed of the simulated writer (a 64-bit integer)");
+  add_library_options(*app, command->library, true);
+  add_output_path(*app, "--session", command->session,
+                  "save each trial as it ends into this folder (JSON, CSV, SVG; never overwriting)",
+                  StandardOutput::refused);
+  add_text(*app, "--subject", command->subject, "ID",
+           "the subject's id in the saved trials (A-Z a-z 0-9 . _ -)");
+  add_text(*app, "--window", command->window, "WxH", "window size [px]");
+  add_output_path(*app, "--screenshot", command->screenshot,
+                  "write the window as PNG after the last character's trial, or at exit",
+                  StandardOutput::refused);
+  add_number(*app, "--exit-after", command->exit_after_s, "SECONDS",
+             "unattended: quit after this long [s], or once every character had its trial",
+             "a number of seconds > 0", [](double s) { return s > 0.0 && s <= 86400.0; });
+}
+
+}  // namespace calligraphy::cli

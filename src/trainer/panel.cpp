@@ -1,0 +1,156 @@
+#include "trainer/panel.hpp"
+
+#include <imgui.h>
+
+#include <cmath>
+#include <exception>
+#include <string>
+#include <string_view>
+
+#include "calligraphy/model/typical_strokes.hpp"
+
+namespace calligraphy::trainer {
+namespace {
+
+const char* state_meaning(InteractionState state) {
+  switch (state) {
+    case InteractionState::separation:
+      return "pen off the paper";
+    case InteractionState::adjusting:
+      return "on the paper, outside the character";
+    case InteractionState::calibration:
+      return "in the character: go to the red hint";
+    case InteractionState::writing:
+      return "writing the stroke";
+  }
+  return "";
+}
+
+ImVec4 state_colour(InteractionState state) {
+  switch (state) {
+    case InteractionState::separation:
+      return ImVec4(0.45f, 0.45f, 0.45f, 1.0f);
+    case InteractionState::adjusting:
+      return ImVec4(0.75f, 0.45f, 0.0f, 1.0f);
+    case InteractionState::calibration:
+      return ImVec4(0.1f, 0.35f, 0.8f, 1.0f);
+    case InteractionState::writing:
+      return ImVec4(0.1f, 0.55f, 0.15f, 1.0f);
+  }
+  return ImVec4(0, 0, 0, 1);
+}
+
+void results_table(const TrialView& view) {
+  if (view.results.empty()) {
+    ImGui::TextDisabled("no stroke written yet");
+    return;
+  }
+  if (ImGui::BeginTable("strokes", 5, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerH)) {
+    ImGui::TableSetupColumn("stroke");
+    ImGui::TableSetupColumn("mean mm");
+    ImGui::TableSetupColumn("max mm");
+    ImGui::TableSetupColumn("time s");
+    ImGui::TableSetupColumn("tries");
+    ImGui::TableHeadersRow();
+    for (const StrokeResult& r : view.results) {
+      ImGui::TableNextRow();
+      ImGui::TableNextColumn();
+      std::string_view type = "?";  // an id outside the typical strokes' table shows as '?'
+      try {
+        type = typical_stroke(r.typical_id).acronym;
+      } catch (const std::exception&) {
+      }
+      ImGui::Text("%u %.*s", r.stroke + 1, static_cast<int>(type.size()), type.data());
+      ImGui::TableNextColumn();
+      ImGui::Text("%.2f", r.mean_deviation_m * 1e3);
+      ImGui::TableNextColumn();
+      ImGui::Text("%.2f", r.max_deviation_m * 1e3);
+      ImGui::TableNextColumn();
+      ImGui::Text("%.2f", r.time_s);
+      ImGui::TableNextColumn();
+      ImGui::Text("%d", r.attempts);
+    }
+    ImGui::EndTable();
+  }
+}
+
+void summary(const TrialView& view, const PanelInput& input) {
+  ImGui::Separator();
+  const TrialMetrics& m = view.metrics;
+  const bool complete = view.end == TrialEnd::completed;
+  ImGui::TextColored(complete ? ImVec4(0.1f, 0.55f, 0.15f, 1) : ImVec4(0.8f, 0.2f, 0.1f, 1), "Trial %s: %s",
+                     complete ? "complete" : "ended", to_string(view.end));
+  if (!view.end_reason.empty()) ImGui::TextWrapped("%s", view.end_reason.c_str());
+  ImGui::Text("strokes in order   %zu / %zu", m.strokes_completed, m.strokes_total);
+  if (m.mean_deviation_m && m.max_deviation_m) {
+    ImGui::Text("mean deviation     %.2f mm", *m.mean_deviation_m * 1e3);
+    ImGui::Text("max deviation      %.2f mm", *m.max_deviation_m * 1e3);
+  } else {
+    ImGui::Text("deviation          - (nothing written)");
+  }
+  ImGui::Text("time               %.1f s", m.time_s);
+  ImGui::Text("strokes abandoned  %zu", view.abandoned);
+  if (!view.saved_as.empty()) ImGui::TextWrapped("saved %s", view.saved_as.c_str());
+  if (!view.save_error.empty())
+    ImGui::TextColored(ImVec4(0.8f, 0.1f, 0.1f, 1), "%s", view.save_error.c_str());
+  ImGui::Spacing();
+  if (input.unattended) {
+    ImGui::TextDisabled("unattended run (--exit-after)");
+  } else {
+    ImGui::Text("R  repeat   N  next character");
+    ImGui::Text("G  guidance (next trial: %s)", input.next_guidance ? "on" : "off");
+    ImGui::Text("Q / Esc  quit");
+  }
+}
+
+}  // namespace
+
+void draw_panel(const WindowLayout& layout, double panel_width_px, const PanelInput& input) {
+  ImGui::SetNextWindowPos(ImVec2(static_cast<float>(layout.area_width_px()), 0));
+  ImGui::SetNextWindowSize(
+      ImVec2(static_cast<float>(panel_width_px), static_cast<float>(layout.height_px())));
+  ImGui::Begin("trainer", nullptr,
+               ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
+                   ImGuiWindowFlags_NoBringToFrontOnFocus);
+  const TrialView* view = input.view;
+  if (view == nullptr) {
+    ImGui::TextWrapped("%s", input.status.c_str());
+    ImGui::End();
+    return;
+  }
+  const DisplaySnapshot& s = view->snapshot;
+  ImGui::Text("Trial %zu: %s  (%zu of %zu)", view->number, input.character.c_str(), view->character + 1,
+              input.characters);
+  ImGui::Text("device %s", input.device.c_str());
+  ImGui::Text("%s, guidance %s", view->condition.c_str(), view->guidance ? "on" : "off");
+  ImGui::Separator();
+  if (input.large_font != nullptr) ImGui::PushFont(input.large_font);
+  ImGui::TextColored(state_colour(s.state), "%s", to_string(s.state));
+  if (input.large_font != nullptr) ImGui::PopFont();
+  ImGui::SameLine();
+  ImGui::TextColored(state_colour(s.state), "%s", state_meaning(s.state));
+  const std::uint32_t shown_stroke = s.finished ? s.strokes_total : s.stroke_index + 1;
+  if (s.finished) {
+    ImGui::Text("stroke %u / %u   every stroke written", shown_stroke, s.strokes_total);
+  } else {
+    ImGui::Text("stroke %u / %u   element %u", shown_stroke, s.strokes_total, s.element + 1);
+  }
+  ImGui::Text("written %u   time %.1f s   tick %llu", s.strokes_completed, s.time_s,
+              static_cast<unsigned long long>(s.tick));
+  ImGui::Text("pen height %+.1f mm", s.pen_height_m * 1e3);
+  ImGui::Text("force in plane %.2f N, normal %.2f N", std::hypot(s.force_n.x, s.force_n.y), s.force_n.z);
+  ImGui::Separator();
+  results_table(*view);
+  if (view->have_result) {
+    summary(*view, input);
+  } else if (!input.unattended) {
+    ImGui::Spacing();
+    ImGui::TextDisabled("R repeat  N next  G guidance  Q quit");
+  }
+  if (!input.status.empty()) ImGui::TextWrapped("%s", input.status.c_str());
+  ImGui::SetCursorPosY(static_cast<float>(layout.height_px()) - 30.0f);
+  ImGui::TextDisabled("%.0f frames/s", input.frame_rate_hz);
+  ImGui::End();
+}
+
+}  // namespace calligraphy::trainer

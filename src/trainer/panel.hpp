@@ -1,0 +1,27 @@
+#pragma once
+// The panel on the right of the trainer's window: the trial, the interaction state (SS/AS/CS/WS, paper
+// Table 1), the pen, the per-stroke results as strokes finish, and the summary with the keys at the end.
+#include <string>
+
+#include "trainer/layout.hpp"
+#include "trainer/trial_view.hpp"
+
+struct ImFont;
+
+namespace calligraphy::trainer {
+
+struct PanelInput {
+  const TrialView* view = nullptr;  ///< null before the first trial
+  std::string character;            ///< UTF-8
+  std::string device;
+  std::size_t characters = 1;  ///< in the row
+  bool next_guidance = true;   ///< what G has set for the next trial
+  bool unattended = false;
+  std::string status;  ///< a line for errors or notices
+  double frame_rate_hz = 0.0;
+  ImFont* large_font = nullptr;
+};
+
+void draw_panel(const WindowLayout& layout, double panel_width_px, const PanelInput& input);
+
+}  // namespace calligraphy::trainer

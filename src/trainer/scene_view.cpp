@@ -1,0 +1,179 @@
+#include "trainer/scene_view.hpp"
+
+#include <imgui.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "model/polyline.hpp"
+#include "trainer/triangulate.hpp"
+
+namespace calligraphy::trainer {
+namespace {
+
+// Colours (RGBA): the paper's blue reference, yellow active character, light green trajectory, red hint.
+constexpr ImU32 kPaper = IM_COL32(255, 255, 255, 255);
+constexpr ImU32 kGrid = IM_COL32(225, 225, 225, 255);
+constexpr ImU32 kOutline = IM_COL32(214, 214, 214, 255);
+constexpr ImU32 kActive = IM_COL32(255, 214, 0, 255);
+constexpr ImU32 kReference = IM_COL32(0, 60, 255, 255);
+constexpr ImU32 kTrace = IM_COL32(110, 230, 110, 255);
+constexpr ImU32 kHint = IM_COL32(235, 0, 0, 255);
+constexpr ImU32 kPen = IM_COL32(40, 40, 40, 255);
+constexpr ImU32 kVirtualTip = IM_COL32(255, 120, 0, 255);
+constexpr ImU32 kForce = IM_COL32(150, 0, 200, 255);
+
+ImVec2 im(const Vec2& v) { return ImVec2(static_cast<float>(v.x()), static_cast<float>(v.y())); }
+
+void fill_polygon(ImDrawList& draw, const std::vector<ImVec2>& points,
+                  const std::vector<std::array<int, 3>>& triangles, ImU32 colour) {
+  for (const auto& t : triangles) {
+    draw.AddTriangleFilled(points[static_cast<std::size_t>(t[0])], points[static_cast<std::size_t>(t[1])],
+                           points[static_cast<std::size_t>(t[2])], colour);
+  }
+}
+
+void draw_ellipse(ImDrawList& draw, const Vec2& centre, double rx, double ry, ImU32 colour, float thickness) {
+  constexpr int kSegments = 48;
+  for (int i = 0; i < kSegments; ++i) {
+    const double a = 2.0 * 3.14159265358979 * i / kSegments;
+    draw.PathLineTo(ImVec2(static_cast<float>(centre.x() + rx * std::cos(a)),
+                           static_cast<float>(centre.y() + ry * std::sin(a))));
+  }
+  draw.PathStroke(colour, ImDrawFlags_Closed, thickness);
+}
+
+void draw_arrow(ImDrawList& draw, const Vec2& from, const Vec2& to, ImU32 colour) {
+  const Vec2 d = to - from;
+  const double length = d.norm();
+  if (length < 3.0) return;
+  const Vec2 u = d / length;
+  const Vec2 n(-u.y(), u.x());
+  const double head = std::min(12.0, 0.5 * length);
+  draw.AddLine(im(from), im(to - head * u), colour, 3.0f);
+  draw.AddTriangleFilled(im(to), im(to - head * u + 0.45 * head * n), im(to - head * u - 0.45 * head * n),
+                         colour);
+}
+
+// The pen's height on a vertical gauge at the right edge of the drawing area: the paper at 0, +20 mm
+// above, -10 mm below; the HIP as a dark bar, the VTP (on the paper when the HIP is below) as an orange
+// ring.
+void draw_height_gauge(ImDrawList& draw, const WindowLayout& layout, const DisplaySnapshot& s) {
+  const float x = static_cast<float>(layout.area_width_px() - 48.0);
+  const float top = 60.0f;
+  const float bottom = static_cast<float>(layout.height_px() - 60.0);
+  constexpr double kAboveM = 0.02;
+  constexpr double kBelowM = 0.01;
+  const auto y_of = [&](double height_m) {
+    const double f = (kAboveM - std::clamp(height_m, -kBelowM, kAboveM)) / (kAboveM + kBelowM);
+    return top + static_cast<float>(f) * (bottom - top);
+  };
+  draw.AddRectFilled(ImVec2(x - 6, top), ImVec2(x + 6, bottom), IM_COL32(240, 240, 240, 255), 3.0f);
+  draw.AddLine(ImVec2(x - 14, y_of(0.0)), ImVec2(x + 14, y_of(0.0)), IM_COL32(120, 120, 120, 255), 2.0f);
+  draw.AddText(ImVec2(x - 70, y_of(0.0) - 10), IM_COL32(90, 90, 90, 255), "paper");
+  const float hip = y_of(s.pen_height_m);
+  draw.AddRectFilled(ImVec2(x - 10, hip - 2), ImVec2(x + 10, hip + 2), kPen);
+  if (s.hip_m.z != s.vtp_m.z) draw.AddCircle(ImVec2(x, y_of(0.0)), 7.0f, kVirtualTip, 16, 2.5f);
+  char text[32];
+  std::snprintf(text, sizeof text, "%+.1f mm", s.pen_height_m * 1e3);
+  draw.AddText(ImVec2(x - 40, bottom + 6), IM_COL32(60, 60, 60, 255), text);
+}
+
+}  // namespace
+
+CharacterArt prepare_art(const TrainerCharacter& character) {
+  CharacterArt art;
+  for (std::size_t s = 0; s < character.outlines.strokes.size(); ++s) {
+    for (const OutlinePolygon& polygon : character.outlines.strokes[s]) {
+      art.polygons.push_back(polygon);
+      art.triangles.push_back(triangulate(polygon));
+      art.polygon_stroke.push_back(s);
+    }
+  }
+  for (const Stroke& stroke : character.model.strokes) {
+    std::vector<Vec2> points;
+    for (const StrokeElement& e : stroke.elements) {
+      for (const Vec2& p : sample_element(e, e.degree == 1 ? 1 : 24)) {
+        if (points.empty() || points.back() != p) points.push_back(p);
+      }
+    }
+    art.reference.push_back(std::move(points));
+  }
+  return art;
+}
+
+void draw_scene(ImDrawList& draw, const WindowLayout& layout, const std::vector<CharacterArt>& art,
+                const Scene& trial_scene, const TrialView* view) {
+  draw.AddRectFilled(
+      ImVec2(0, 0),
+      ImVec2(static_cast<float>(layout.area_width_px()), static_cast<float>(layout.height_px())), kPaper);
+  const ImDrawListFlags flags = draw.Flags;
+  for (std::size_t c = 0; c < art.size(); ++c) {
+    const ScreenBox& box = layout.box(c);
+    const ImVec2 corner(static_cast<float>(box.x_px), static_cast<float>(box.y_px));
+    const float side = static_cast<float>(box.size_px);
+    // The practice grid (a square with its middle lines, as a 田字格 practice sheet).
+    draw.AddRect(corner, ImVec2(corner.x + side, corner.y + side), kGrid, 0.0f, 0, 2.0f);
+    draw.AddLine(ImVec2(corner.x + side / 2, corner.y), ImVec2(corner.x + side / 2, corner.y + side), kGrid,
+                 1.0f);
+    draw.AddLine(ImVec2(corner.x, corner.y + side / 2), ImVec2(corner.x + side, corner.y + side / 2), kGrid,
+                 1.0f);
+    const bool active = view != nullptr && view->character == c;
+    // Adjacent triangles must not show anti-aliasing seams.
+    draw.Flags &= ~ImDrawListFlags_AntiAliasedFill;
+    for (std::size_t p = 0; p < art[c].polygons.size(); ++p) {
+      std::vector<ImVec2> points;
+      for (const Vec2& v : art[c].polygons[p]) points.push_back(im(layout.data_to_screen(c, v)));
+      fill_polygon(draw, points, art[c].triangles[p], active ? kActive : kOutline);
+    }
+    draw.Flags = flags;
+  }
+  if (view != nullptr) {  // the trace under the reference, so that both stay visible where they overlap
+    const std::size_t c = view->character;
+    for (const TraceSegment& segment : view->segments) {
+      std::vector<ImVec2> points;
+      for (const Vec2& p : segment.points_m) points.push_back(im(layout.to_screen(c, p)));
+      if (points.size() == 1) draw.AddCircleFilled(points[0], 2.5f, kTrace);
+      if (points.size() > 1)
+        draw.AddPolyline(points.data(), static_cast<int>(points.size()), kTrace, 0, 5.0f);
+    }
+  }
+  for (std::size_t c = 0; c < art.size(); ++c) {
+    for (const std::vector<Vec2>& stroke : art[c].reference) {
+      std::vector<ImVec2> points;
+      for (const Vec2& p : stroke) points.push_back(im(layout.data_to_screen(c, p)));
+      draw.AddPolyline(points.data(), static_cast<int>(points.size()), kReference, 0, 2.5f);
+    }
+  }
+  if (view == nullptr) return;
+  const std::size_t c = view->character;
+  const DisplaySnapshot& s = view->snapshot;
+  const double r = trial_scene.layout.start_radius_m * layout.scale_px_per_m();
+  if (view->ended || s.finished) {  // the writing result: every stroke's start (Fig. 31)
+    for (const PlacedCharacter& placed : trial_scene.characters) {
+      for (const PlacedStroke& stroke : placed.strokes)
+        draw_ellipse(draw, layout.to_screen(c, stroke.start()), r, 0.7 * r, kHint, 2.5f);
+    }
+  } else {
+    draw_ellipse(draw, layout.to_screen(c, Vec2(s.hint_m.x, s.hint_m.y)), r, 0.7 * r, kHint, 3.0f);
+  }
+  if (s.tick == 0) return;
+  const Vec2 tip = layout.to_screen(c, Vec2(s.hip_m.x, s.hip_m.y));
+  Vec2 in_plane_px = Vec2(s.force_n.x, -s.force_n.y) * 150.0;  // 150 px per newton, at most 220 px
+  if (in_plane_px.norm() > 220.0) in_plane_px *= 220.0 / in_plane_px.norm();
+  draw_arrow(draw, tip, tip + in_plane_px, kForce);
+  if (s.pen_height_m <= 0.0) {
+    draw.AddCircleFilled(im(tip), 6.0f, kPen);
+    if (s.hip_m.z != s.vtp_m.z)
+      draw.AddCircle(im(tip), 10.0f, kVirtualTip, 24, 2.0f);  // the VTP on the paper
+  } else {
+    const float radius =
+        6.0f + static_cast<float>(std::min(0.02, s.pen_height_m) * 600.0);  // bigger when higher
+    draw.AddCircle(im(tip), radius, kPen, 24, 2.0f);
+    draw.AddCircleFilled(im(tip), 2.0f, kPen);
+  }
+  draw_height_gauge(draw, layout, s);
+}
+
+}  // namespace calligraphy::trainer

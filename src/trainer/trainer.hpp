@@ -1,0 +1,47 @@
+#pragma once
+// `calligraphy train`: a window (GLFW 3, OpenGL 3.3 core, Dear ImGui) showing a live guided trial, the
+// servo loop on its own thread. See docs/trainer.md.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "calligraphy/model/character.hpp"
+#include "calligraphy/model/stroke_outline.hpp"
+
+namespace calligraphy::trainer {
+
+/// One character to practise: its model (the haptic reference) and its outlines (for drawing).
+struct TrainerCharacter {
+  Character model;
+  CharacterOutlines outlines;
+  std::string utf8;
+};
+
+struct TrainerOptions {
+  std::vector<TrainerCharacter> characters;  ///< the row, practised left to right
+  std::string device = "mouse-hand";         ///< a name in the device registry
+  bool simulated_writer = false;             ///< the simulated writer writes (device with a hand port)
+  std::string writer_profile = "novice";     ///< novice or skilled
+  std::uint64_t seed = 0;
+  bool guidance = true;
+  std::string session_dir;  ///< empty: trials are not saved
+  std::string subject = "anonymous";
+  int width_px = 1280;
+  int height_px = 800;
+  std::string screenshot;     ///< PNG written after the last character's trial, or at exit
+  double exit_after_s = 0.0;  ///< > 0: unattended; quit after this long or once every character had its trial
+  std::string library_version;
+};
+
+/// Runs the trainer until the window is closed, Q or Esc is pressed, SIGINT or SIGTERM arrives, or (with
+/// exit_after_s) the time runs out or every character had its trial. Prints the character boxes to
+/// stdout first, a measurement summary to stderr last. Returns 0, or 1 when a trial ended with a device
+/// fault or could not be saved. Throws Error (InvalidArgument, DeviceNotFound, ...) when it cannot start
+/// (no display, a bad option).
+int run_trainer(const TrainerOptions& options);
+
+/// Registers the trainer's pointer devices ("mouse", "mouse-hand") in the process registry the
+/// command line uses.
+void register_trainer_devices();
+
+}  // namespace calligraphy::trainer

@@ -1,0 +1,478 @@
+// The trainer's window loop (trainer.hpp): the window thread draws at the display rate from the
+// display channel's snapshot and queues, never waiting on the servo thread; each trial runs on a worker
+// thread through run_trial with real-time pacing, the ServoLoop on its own thread.
+#define GLFW_INCLUDE_NONE
+#include <GL/gl.h>
+#include <GLFW/glfw3.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
+#include <signal.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/devices/device_registry.hpp"
+#include "calligraphy/sim/hand_port.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/trial/trial.hpp"
+#include "trainer/layout.hpp"
+#include "trainer/panel.hpp"
+#include "trainer/pointer_devices.hpp"
+#include "trainer/scene_view.hpp"
+#include "trainer/screenshot.hpp"
+#include "trainer/session_files.hpp"
+#include "trainer/trainer.hpp"
+#include "trainer/trial_view.hpp"
+#include "trainer/trial_worker.hpp"
+#include "trainer/x11_errors.hpp"
+
+namespace calligraphy::trainer {
+namespace {
+
+constexpr double kPanelWidthPx = 400.0;
+constexpr double kFramePeriodS = 1.0 / 60.0;
+constexpr double kAdvanceDelayS = 1.0;  // unattended: pause on a trial's summary before the next
+constexpr const char* kChineseFont = "/usr/share/fonts/truetype/arphic/ukai.ttc";
+
+using Clock = std::chrono::steady_clock;
+
+std::atomic<int> received_signal{0};
+extern "C" void trainer_record_signal(int number) {
+  received_signal.store(number, std::memory_order_relaxed);
+}
+
+// SIGINT and SIGTERM only set a flag; the window loop ends the trial safely. Restored at the end.
+class SignalHandlers {
+ public:
+  SignalHandlers() {
+    struct sigaction action {};
+    action.sa_handler = trainer_record_signal;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGINT, &action, &previous_int_);
+    sigaction(SIGTERM, &action, &previous_term_);
+  }
+  SignalHandlers(const SignalHandlers&) = delete;
+  SignalHandlers& operator=(const SignalHandlers&) = delete;
+  ~SignalHandlers() {
+    sigaction(SIGINT, &previous_int_, nullptr);
+    sigaction(SIGTERM, &previous_term_, nullptr);
+  }
+
+ private:
+  struct sigaction previous_int_ {};
+  struct sigaction previous_term_ {};
+};
+
+void print_glfw_error(int code, const char* description) {
+  std::fprintf(stderr, "calligraphy train: GLFW error %d: %s\n", code, description);
+}
+
+std::int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count();
+}
+
+double percentile(std::vector<double> values, double p) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const auto k = static_cast<std::size_t>(std::ceil(p * static_cast<double>(values.size())));
+  return values[std::min(values.size() - 1, k == 0 ? 0 : k - 1)];
+}
+
+// Keys pressed since the last frame (GLFW's key callback, on the window thread).
+std::vector<int>* pending_keys = nullptr;
+void record_key(GLFWwindow* /*window*/, int key, int /*scancode*/, int action, int /*mods*/) {
+  if (action == GLFW_PRESS && pending_keys != nullptr) pending_keys->push_back(key);
+}
+
+enum class NextAction { none, repeat, next, quit };
+
+class TrainerApp {
+ public:
+  TrainerApp(const TrainerOptions& options, std::string device_model)
+      : options_(options), device_model_(std::move(device_model)) {
+    for (const TrainerCharacter& c : options.characters) {
+      art_.push_back(prepare_art(c));
+      std::vector<int> ids;
+      for (const Stroke& s : c.model.strokes) ids.push_back(s.typical_id);
+      typical_ids_.push_back(std::move(ids));
+    }
+    guidance_ = options.guidance;
+    condition_outputs_force_ = options.device != "mouse";
+  }
+
+  int run() {
+    open_window();
+    layout_.emplace(options_.characters.size(), options_.width_px, options_.height_px, kPanelWidthPx);
+    for (std::size_t k = 0; k < layout_->count(); ++k) {
+      const ScreenBox& b = layout_->box(k);
+      std::printf("box %zu %s x=%.0f y=%.0f size=%.0f\n", k, options_.characters[k].utf8.c_str(), b.x_px,
+                  b.y_px, b.size_px);
+    }
+    std::fflush(stdout);
+    started_ = Clock::now();
+    start_trial(0);
+    loop();
+    close_window();
+    print_measurements();
+    return status_;
+  }
+
+ private:
+  void open_window() {
+    glfwSetErrorCallback(print_glfw_error);
+    if (glfwInit() == GLFW_FALSE) {
+      throw Error("cannot open a window: GLFW could not initialise (no X display? DISPLAY is '" +
+                  std::string(std::getenv("DISPLAY") ? std::getenv("DISPLAY") : "") + "'; try xvfb-run)");
+    }
+    install_x11_error_handler();
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+    glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+    glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);
+    std::string title = "calligraphy train";
+    for (const TrainerCharacter& c : options_.characters) title += " " + c.utf8;
+    window_ = glfwCreateWindow(options_.width_px, options_.height_px, title.c_str(), nullptr, nullptr);
+    if (window_ == nullptr) {
+      glfwTerminate();
+      throw Error("cannot open a window of " + std::to_string(options_.width_px) + "x" +
+                  std::to_string(options_.height_px) + " with OpenGL 3.3 core");
+    }
+    glfwMakeContextCurrent(window_);
+    glfwSwapInterval(1);
+    pending_keys = &keys_;
+    glfwSetKeyCallback(window_, record_key);  // before ImGui's, which calls it in turn
+    IMGUI_CHECKVERSION();
+    ImGui::CreateContext();
+    ImGuiIO& io = ImGui::GetIO();
+    io.IniFilename = nullptr;
+    ImGui::StyleColorsLight();
+    load_fonts();
+    ImGui_ImplGlfw_InitForOpenGL(window_, true);
+    ImGui_ImplOpenGL3_Init("#version 330 core");
+  }
+
+  void load_fonts() {
+    ImGuiIO& io = ImGui::GetIO();
+    if (!std::filesystem::exists(kChineseFont)) {
+      std::fprintf(stderr,
+                   "calligraphy train: %s not found (Debian fonts-arphic-ukai): characters show as '?'\n",
+                   kChineseFont);
+      return;
+    }
+    ImFontGlyphRangesBuilder builder;
+    builder.AddRanges(io.Fonts->GetGlyphRangesDefault());
+    for (const TrainerCharacter& c : options_.characters) builder.AddText(c.utf8.c_str());
+    builder.BuildRanges(&glyph_ranges_);
+    ImFontConfig config;
+    config.FontNo = 0;
+    io.Fonts->AddFontFromFileTTF(kChineseFont, 20.0f, &config, glyph_ranges_.Data);
+    large_font_ = io.Fonts->AddFontFromFileTTF(kChineseFont, 34.0f, &config, glyph_ranges_.Data);
+  }
+
+  void close_window() {
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+    if (!x11_error_seen()) glfwDestroyWindow(window_);
+    glfwTerminate();
+    pending_keys = nullptr;
+  }
+
+  // ---- Trials.
+  void start_trial(std::size_t character) {
+    std::vector<Character> one{options_.characters[character].model};
+    Scene scene = Scene::lay_out(one);  // at the device's centre; the row shows it at its place
+    channel_ = std::make_unique<DisplayChannel>();
+    view_.emplace();
+    view_->character = character;
+    view_->number = ++trials_started_;
+    view_->guidance = guidance_;
+    view_->condition = guidance_ && condition_outputs_force_ ? "vision+haptic" : "vision";
+    TrialOptions trial;
+    trial.force.guidance = guidance_;
+    trial.pacing = TrialPacing::real_time;
+    // A window process maps memory all the time (the GL driver): mlockall(MCL_FUTURE) would lock all of
+    // it, or make its allocations fail under a memory-lock limit. The trace is touched in advance instead.
+    trial.loop.lock_memory = false;
+    trial.keep_trace = true;
+    trial.simulation.writer =
+        options_.writer_profile == "skilled" ? WriterProfile::skilled() : WriterProfile::novice();
+    trial.simulation.seed = options_.seed + trials_started_ - 1;
+    trial.display = channel_.get();
+    trial_start_utc_ = utc_now_iso8601();
+    trial_seed_ = trial.simulation.seed;
+    worker_.start(std::move(scene), options_.device, std::move(trial));
+    advance_at_.reset();
+  }
+
+  // The worker is done: takes its result, saves it, and shows the summary.
+  void finish_trial() {
+    TrialView& view = *view_;
+    TrialResult result;
+    try {
+      result = worker_.take();
+    } catch (const std::exception& e) {
+      view.have_result = true;
+      view.ended = true;
+      view.end = TrialEnd::device_fault;
+      view.end_reason = e.what();
+      std::fprintf(stderr, "calligraphy train: the trial could not run: %s\n", e.what());
+      status_ = 1;
+      quit_ = true;  // nothing to retry with the same device
+      return;
+    }
+    view.consume(*channel_, typical_ids_[view.character]);
+    view.have_result = true;
+    view.ended = true;
+    view.end = result.end;
+    view.metrics = result.metrics;
+    view.end_reason = result.abort_reason;
+    if (result.end == TrialEnd::device_fault || result.end == TrialEnd::watchdog) status_ = 1;
+    const std::string& utf8 = options_.characters[view.character].utf8;
+    std::fprintf(stderr,
+                 "calligraphy train: trial %zu %s: %s, %zu/%zu strokes in order, mean %.2f mm, %.1f s\n",
+                 view.number, utf8.c_str(), to_string(result.end), result.metrics.strokes_completed,
+                 result.metrics.strokes_total, result.metrics.mean_deviation_m.value_or(std::nan("")) * 1e3,
+                 result.metrics.time_s);
+    if (result.loop) {
+      const ServoLoopStats& loop = *result.loop;
+      std::fprintf(
+          stderr,
+          "calligraphy train: servo loop: %llu ticks, %llu late, %llu forces withheld, period jitter "
+          "p50 %.1f us, p99 %.1f us, max %.1f us, longest stall %.2f ms\n",
+          static_cast<unsigned long long>(loop.ticks), static_cast<unsigned long long>(loop.late_ticks),
+          static_cast<unsigned long long>(loop.forces_withheld), loop.period_jitter_us_p50,
+          loop.period_jitter_us_p99, loop.period_jitter_us_max, loop.longest_stall_s * 1e3);
+    }
+    if (!options_.session_dir.empty()) {
+      TrialRecordInfo info;
+      info.description = TrialDescription{
+          utf8,         view.guidance,          options_.simulated_writer ? options_.writer_profile : "human",
+          trial_seed_,  TrialOptions{}.rate_hz, options_.device,
+          device_model_};
+      info.subject = options_.subject;
+      info.condition = view.condition;
+      info.start_time_utc = trial_start_utc_;
+      info.library_version = options_.library_version;
+      try {
+        const SavedTrial saved = save_trial(options_.session_dir, info, worker_.scene(), result);
+        view.saved_as = saved.json.filename().string();
+        std::fprintf(stderr, "calligraphy train: saved %s (.csv, .svg)\n", saved.json.string().c_str());
+      } catch (const std::exception& e) {
+        view.save_error = std::string("not saved: ") + e.what();
+        std::fprintf(stderr, "calligraphy train: error: the trial was not saved: %s\n", e.what());
+        status_ = 1;
+      }
+    }
+    const bool last = view.character + 1 == options_.characters.size();
+    if (last) screenshot_due_ = true;  // after the last character's last stroke
+    if (unattended()) {
+      if (last) {
+        quit_ = true;
+      } else {
+        advance_at_ = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                         std::chrono::duration<double>(kAdvanceDelayS));
+      }
+    }
+  }
+
+  [[nodiscard]] bool unattended() const { return options_.exit_after_s > 0.0; }
+
+  // ---- The loop.
+  void loop() {
+    auto next_frame = Clock::now();
+    while (true) {
+      glfwPollEvents();
+      const bool closed = glfwWindowShouldClose(window_) != 0 || x11_error_seen();
+      if (closed || received_signal.load() != 0) quit_ = true;
+      if (unattended() && seconds_since_start() >= options_.exit_after_s) quit_ = true;
+      handle_keys();
+      if (quit_ && !quit_seen_) {  // the picture at exit shows the window as it was when the exit came
+        if (!options_.screenshot.empty() && !screenshot_taken_ && !x11_error_seen() && view_) render(true);
+        quit_seen_ = true;
+      }
+      if (quit_ && worker_.active() && !worker_.done()) worker_.request_stop();
+      if (pending_ != NextAction::none && worker_.active() && !worker_.done()) worker_.request_stop();
+      if (view_ && worker_.active()) view_->consume(*channel_, typical_ids_[view_->character]);
+      if (worker_.active() && worker_.done()) finish_trial();
+      if (!worker_.active()) {
+        if (quit_) break;
+        if (pending_ == NextAction::repeat) start_trial(view_->character);
+        if (pending_ == NextAction::next) start_trial((view_->character + 1) % options_.characters.size());
+        pending_ = NextAction::none;
+        if (advance_at_ && Clock::now() >= *advance_at_) start_trial(view_->character + 1);
+      }
+      update_pointer();
+      if (x11_error_seen()) continue;  // the window is gone: no drawing, only the ending above
+      const bool take_screenshot = !options_.screenshot.empty() && !screenshot_taken_ && screenshot_due_;
+      render(take_screenshot);
+      next_frame += std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kFramePeriodS));
+      if (next_frame < Clock::now()) next_frame = Clock::now();
+      std::this_thread::sleep_until(next_frame);
+    }
+    // The last character's trial ended in this very iteration: its summary, after the last stroke.
+    if (!options_.screenshot.empty() && !screenshot_taken_ && !x11_error_seen() && view_) render(true);
+  }
+
+  double seconds_since_start() const {
+    return std::chrono::duration<double>(Clock::now() - started_).count();
+  }
+
+  void handle_keys() {
+    for (const int key : keys_) {
+      switch (key) {
+        case GLFW_KEY_Q:
+        case GLFW_KEY_ESCAPE:
+          quit_ = true;
+          break;
+        case GLFW_KEY_R:
+          pending_ = NextAction::repeat;
+          break;
+        case GLFW_KEY_N:
+          pending_ = NextAction::next;
+          break;
+        case GLFW_KEY_G:
+          guidance_ = !guidance_;
+          break;
+        default:
+          break;
+      }
+    }
+    keys_.clear();
+  }
+
+  // The pointer in the running trial's metres, for the mouse devices (lock-free; read by the servo thread).
+  void update_pointer() {
+    if (!view_ || !layout_) return;
+    double x = 0.0;
+    double y = 0.0;
+    glfwGetCursorPos(window_, &x, &y);
+    const bool in_area = x >= 0.0 && x < layout_->area_width_px() && y >= 0.0 && y < layout_->height_px();
+    const bool pressed = in_area && glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
+    const Vec2 trial_m = layout_->to_trial(view_->character, Vec2(x, y));
+    pointer_input().set(trial_m.x(), trial_m.y(), pressed);
+  }
+
+  void render(bool take_screenshot) {
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+    const Scene& scene = worker_.scene();
+    draw_scene(*ImGui::GetBackgroundDrawList(), *layout_, art_, scene, view_ ? &*view_ : nullptr);
+    PanelInput panel;
+    panel.view = view_ ? &*view_ : nullptr;
+    if (view_) panel.character = options_.characters[view_->character].utf8;
+    panel.device = options_.device;
+    panel.characters = options_.characters.size();
+    panel.next_guidance = guidance_;
+    panel.unattended = unattended();
+    panel.frame_rate_hz = ImGui::GetIO().Framerate;
+    panel.large_font = large_font_;
+    if (quit_seen_ && worker_.active() && !worker_.done()) panel.status = "ending the trial...";
+    draw_panel(*layout_, kPanelWidthPx, panel);
+    ImGui::Render();
+    int width = 0;
+    int height = 0;
+    glfwGetFramebufferSize(window_, &width, &height);
+    glViewport(0, 0, width, height);
+    glClearColor(1.0f, 1.0f, 1.0f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT);
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    if (take_screenshot) {
+      try {
+        write_framebuffer_png(options_.screenshot, width, height);
+        std::fprintf(stderr, "calligraphy train: screenshot %s\n", options_.screenshot.c_str());
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "calligraphy train: error: %s\n", e.what());
+        status_ = 1;
+      }
+      screenshot_taken_ = true;
+    }
+    glfwSwapBuffers(window_);
+    ++frames_;
+    // Display latency: from the servo tick that published the snapshot to the frame that shows it.
+    if (view_ && worker_.active() && !worker_.done() && view_->snapshot.tick > 0) {
+      latencies_ms_.push_back(static_cast<double>(steady_ns() - view_->snapshot.published_ns) * 1e-6);
+    }
+  }
+
+  void print_measurements() const {
+    const double seconds = seconds_since_start();
+    std::fprintf(
+        stderr,
+        "calligraphy train: %zu frames in %.1f s (%.1f frames/s); display latency, servo tick to frame "
+        "shown: p50 %.2f ms, p99 %.2f ms, max %.2f ms over %zu frames\n",
+        frames_, seconds, static_cast<double>(frames_) / std::max(seconds, 1e-9),
+        percentile(latencies_ms_, 0.5), percentile(latencies_ms_, 0.99), percentile(latencies_ms_, 1.0),
+        latencies_ms_.size());
+  }
+
+  TrainerOptions options_;
+  std::string device_model_;
+  std::vector<CharacterArt> art_;
+  std::vector<std::vector<int>> typical_ids_;
+  GLFWwindow* window_ = nullptr;
+  ImFont* large_font_ = nullptr;
+  ImVector<ImWchar> glyph_ranges_;
+  std::optional<WindowLayout> layout_;
+  std::vector<int> keys_;
+  TrialWorker worker_;
+  std::unique_ptr<DisplayChannel> channel_;
+  std::optional<TrialView> view_;
+  std::size_t trials_started_ = 0;
+  std::uint64_t trial_seed_ = 0;
+  std::string trial_start_utc_;
+  bool guidance_ = true;
+  bool condition_outputs_force_ = true;
+  bool quit_ = false;
+  bool quit_seen_ = false;
+  NextAction pending_ = NextAction::none;
+  std::optional<Clock::time_point> advance_at_;
+  bool screenshot_due_ = false;
+  bool screenshot_taken_ = false;
+  Clock::time_point started_;
+  std::size_t frames_ = 0;
+  std::vector<double> latencies_ms_;
+  int status_ = 0;
+};
+
+}  // namespace
+
+int run_trainer(const TrainerOptions& options) {
+  if (options.characters.empty()) throw InvalidArgument("calligraphy train: no characters to practise");
+  // The device must exist, and a simulated writer can move only a device with a hand port.
+  const std::unique_ptr<HapticDevice> probe = device_registry_with_simulation().create(options.device);
+  const bool hand_port = dynamic_cast<HandPort*>(probe.get()) != nullptr;
+  if (options.simulated_writer && !hand_port) {
+    throw InvalidArgument(
+        "--writer simulated needs a device a simulated writer can move (simulated, "
+        "emulated-phantom); '" +
+        options.device + "' is moved by a person");
+  }
+  if (!options.simulated_writer && hand_port) {
+    throw InvalidArgument("device '" + options.device +
+                          "' is moved by the simulated writer: pass --writer simulated, or use mouse, "
+                          "mouse-hand or a haptic device");
+  }
+  received_signal.store(0);
+  const SignalHandlers handlers;
+  TrainerApp app(options, probe->info().model);
+  return app.run();
+}
+
+void register_trainer_devices() { register_pointer_devices(device_registry_with_simulation()); }
+
+}  // namespace calligraphy::trainer

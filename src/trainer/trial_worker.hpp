@@ -1,0 +1,44 @@
+#pragma once
+// One trial on its own thread: run_trial with real-time pacing (the ServoLoop on yet another thread),
+// stopped through TrialOptions::should_stop. The window thread starts it, polls `done()` once a frame
+// and takes the result only once it is done, so it never waits on the servo side (except when quitting).
+#include <atomic>
+#include <exception>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/trial/trial.hpp"
+
+namespace calligraphy::trainer {
+
+class TrialWorker {
+ public:
+  TrialWorker() = default;
+  TrialWorker(const TrialWorker&) = delete;
+  TrialWorker& operator=(const TrialWorker&) = delete;
+  ~TrialWorker();
+
+  /// Starts the trial of `scene` (kept here) on the device called `device`. `options.should_stop` is
+  /// replaced by this worker's stop flag.
+  void start(Scene scene, std::string device, TrialOptions options);
+  [[nodiscard]] bool active() const noexcept { return thread_.joinable(); }
+  /// True once the trial thread has finished (its result is ready).
+  [[nodiscard]] bool done() const noexcept { return done_.load(std::memory_order_acquire); }
+  /// Asks the trial to end (TrialEnd::interrupted, zero force, forces off, every tick kept).
+  void request_stop() noexcept { stop_.store(true, std::memory_order_relaxed); }
+  /// Joins the thread and returns the result; rethrows what run_trial threw.
+  TrialResult take();
+  [[nodiscard]] const Scene& scene() const noexcept { return scene_; }
+
+ private:
+  Scene scene_;
+  std::thread thread_;
+  std::atomic<bool> stop_{false};
+  std::atomic<bool> done_{false};
+  std::optional<TrialResult> result_;
+  std::exception_ptr failure_;
+};
+
+}  // namespace calligraphy::trainer

@@ -1,0 +1,325 @@
+"""The trainer's window end to end on a virtual X server (run by run_under_xvfb.sh): the simulated writer
+writes 永 live and the screenshot shows the reference, the trace, the active character and the hints
+where the printed layout puts them; the real pointer, driven with xdotool, writes 一 on --device mouse;
+closing the window, pressing Q or sending SIGTERM mid-trial ends it safely with every tick kept.
+
+Environment: CALLIGRAPHY_CLI (the program), CALLIGRAPHY_SOURCE_DIR (the source tree)."""
+import csv
+import json
+import math
+import os
+import pathlib
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from png import read_png  # noqa: E402
+
+CLI = os.environ.get("CALLIGRAPHY_CLI", "calligraphy")
+SOURCE = pathlib.Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", pathlib.Path(__file__).resolve().parents[2]))
+EMBEDDED = SOURCE / "data" / "hanzi-writer-data"
+SAMPLE = SOURCE / "tests" / "data" / "hanzi-writer-sample"
+CHARACTER_SIZE_M = 0.06  # SceneLayout's default side of a character box on paper
+START_RADIUS_M = 0.005   # SceneLayout's default start neighbourhood
+
+
+def xdotool(*args):
+    return subprocess.run(["xdotool", *map(str, args)], check=True, capture_output=True, text=True).stdout
+
+
+class Box:
+    """A `box <index> <char> x= y= size=` line: the data box in window pixels, y down."""
+
+    def __init__(self, line):
+        parts = line.split()
+        self.index, self.char = int(parts[1]), parts[2]
+        values = dict(p.split("=") for p in parts[3:])
+        self.x, self.y, self.size = float(values["x"]), float(values["y"]), float(values["size"])
+
+    def data_to_px(self, point):
+        return (self.x + point[0] / 1024 * self.size, self.y + (900 - point[1]) / 1024 * self.size)
+
+    def metres_to_px(self, x_m, y_m):
+        # A trial lays its character out centred at the origin (Scene::lay_out): data (512, 388) is (0, 0).
+        units = 1024 / CHARACTER_SIZE_M
+        return self.data_to_px((x_m * units + 512, y_m * units + 388))
+
+
+class Trainer:
+    """`calligraphy train` running in the background."""
+
+    def __init__(self, *args, folder):
+        self.folder = pathlib.Path(folder)
+        self.stdout = open(self.folder / "stdout.txt", "w+")
+        self.stderr = open(self.folder / "stderr.txt", "w+")
+        self.process = subprocess.Popen([CLI, "train", *args], stdout=self.stdout, stderr=self.stderr,
+                                        cwd=self.folder)
+
+    def boxes(self, timeout=30):
+        deadline = time.time() + timeout
+        while time.time() < deadline:
+            lines = [l for l in (self.folder / "stdout.txt").read_text().splitlines() if l.startswith("box ")]
+            if lines:
+                return [Box(l) for l in lines]
+            if self.process.poll() is not None:
+                raise AssertionError("the trainer ended before drawing: " + self.errors())
+            time.sleep(0.1)
+        raise AssertionError("no box line within %s s" % timeout)
+
+    def window(self):
+        return xdotool("search", "--name", "calligraphy train").split()[0]
+
+    def wait(self, timeout=120):
+        return self.process.wait(timeout=timeout)
+
+    def errors(self):
+        return (self.folder / "stderr.txt").read_text()
+
+    def close(self):
+        if self.process.poll() is None:
+            self.process.kill()
+            self.process.wait()
+        self.stdout.close()
+        self.stderr.close()
+
+
+def saved_trials(folder):
+    return sorted(pathlib.Path(folder).glob("*.json"))
+
+
+def medians(char, folder=EMBEDDED):
+    return json.loads((folder / f"{char}.json").read_text(encoding="utf-8"))["medians"]
+
+
+def along(polyline, fractions):
+    """Points at the given fractions of the polyline's length."""
+    lengths = [math.dist(a, b) for a, b in zip(polyline, polyline[1:])]
+    total = sum(lengths)
+    out = []
+    for f in fractions:
+        target, walked = f * total, 0.0
+        for (a, b), length in zip(zip(polyline, polyline[1:]), lengths):
+            if walked + length >= target and length > 0:
+                t = (target - walked) / length
+                out.append((a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])))
+                break
+            walked += length
+    return out
+
+
+def near(image, point, radius, colour):
+    """True when a pixel of `colour` (a predicate on r, g, b) lies within `radius` px of `point`."""
+    cx, cy = round(point[0]), round(point[1])
+    for y in range(max(0, cy - radius), min(image.height, cy + radius + 1)):
+        for x in range(max(0, cx - radius), min(image.width, cx + radius + 1)):
+            if (x - cx) ** 2 + (y - cy) ** 2 <= radius * radius and colour(*image.pixel(x, y)):
+                return True
+    return False
+
+
+def is_blue(r, g, b):
+    return b > 180 and r < 90 and g < 140
+
+
+def is_yellow(r, g, b):
+    return r > 230 and g > 180 and b < 80
+
+
+def is_green(r, g, b):
+    return g > 190 and 60 < r < 180 and 60 < b < 180 and g - r > 50
+
+
+def is_red(r, g, b):
+    return r > 190 and g < 70 and b < 70
+
+
+def fraction(hits):
+    return sum(hits) / len(hits)
+
+
+class TrainerTest(unittest.TestCase):
+    def setUp(self):
+        self.folder = tempfile.mkdtemp(prefix="calligraphy-train-")
+        self.trainer = None
+
+    def tearDown(self):
+        if self.trainer is not None:
+            self.trainer.close()
+        shutil.rmtree(self.folder, ignore_errors=True)
+
+    def start(self, *args):
+        self.trainer = Trainer(*args, folder=self.folder)
+        return self.trainer
+
+    def test_simulated_writer_writes_yong_and_the_screenshot_shows_it(self):
+        trainer = self.start("永", "--writer", "simulated", "--session", "out", "--screenshot", "out/yong.png",
+                             "--exit-after", "60")
+        (box,) = trainer.boxes()
+        self.assertEqual(trainer.wait(), 0, trainer.errors())
+        (record_path,) = saved_trials(pathlib.Path(self.folder) / "out")
+        record = json.loads(record_path.read_text(encoding="utf-8"))
+        self.assertEqual((record["strokes_completed"], record["strokes_total"]), (5, 5))
+        self.assertTrue(record["completed_in_order"])
+        self.assertEqual(record["end_reason"], "completed")
+        self.assertEqual(record["character"], "永")
+        self.assertEqual(record["subject"], "anonymous")
+        self.assertEqual(record["condition"], "vision+haptic")
+        self.assertEqual(record["device"], "simulated")
+        for key in ("start_time", "library_version", "mean_deviation_mm", "per_stroke", "servo_loop"):
+            self.assertIn(key, record)
+        with open(record_path.with_suffix(".csv"), newline="") as f:
+            trace = list(csv.DictReader(f))
+        self.assertEqual(len(trace), record["servo_loop"]["ticks"])  # every tick kept
+        self.assertTrue(record_path.with_suffix(".svg").read_text().startswith("<svg"))
+
+        image = read_png(pathlib.Path(self.folder) / "out" / "yong.png")
+        strokes = medians("永")
+        inner = [i / 20 for i in range(2, 19)]
+        blue = [near(image, box.data_to_px(p), 6, is_blue) for m in strokes for p in along(m, inner)]
+        self.assertGreater(fraction(blue), 0.9, "the reference in blue along the medians")
+        yellow = [near(image, box.data_to_px(p), 15, is_yellow) for m in strokes for p in along(m, inner)]
+        self.assertGreater(fraction(yellow), 0.9, "the active character in yellow around the medians")
+        writing = [row for row in trace if row["state"] == "WS"][::25]
+        green = [near(image, box.metres_to_px(float(r["x"]), float(r["y"])), 5, is_green) for r in writing]
+        self.assertGreater(len(writing), 50)
+        self.assertGreater(fraction(green), 0.8, "the pen's trace in light green where the pen wrote")
+        radius = START_RADIUS_M * box.size / CHARACTER_SIZE_M
+        for m in strokes:  # a red ellipse (rx = r, ry = 0.7 r) at each stroke's start once the trial ended
+            cx, cy = box.data_to_px(m[0])
+            ring = [(cx + radius * math.cos(a), cy + 0.7 * radius * math.sin(a))
+                    for a in (2 * math.pi * k / 24 for k in range(24))]
+            self.assertGreater(fraction([near(image, p, 3, is_red) for p in ring]), 0.6, f"hint at {m[0]}")
+        # Nothing of the scene outside the box: no reference or active character beyond it.
+        outside = [(x, y) for x in range(0, int(box.x) - 2, 4) for y in range(0, image.height, 4)]
+        self.assertFalse(any(is_blue(*image.pixel(x, y)) or is_yellow(*image.pixel(x, y)) for x, y in outside))
+
+    def test_the_real_pointer_writes_yi_on_the_mouse_device(self):
+        trainer = self.start("一", "--device", "mouse", "--data", SAMPLE, "--session", "out", "--exit-after", "60")
+        (box,) = trainer.boxes()
+        window = trainer.window()
+        median = medians("一", SAMPLE)[0]
+        path = [box.data_to_px(p) for p in along(median, [i / 12 for i in range(13)])]
+        end = box.data_to_px((median[-1][0] + 15, median[-1][1]))  # a little past the end
+        time.sleep(0.5)
+        xdotool("mousemove", "--window", window, round(path[0][0]), round(path[0][1]))
+        time.sleep(0.3)
+        xdotool("mousedown", 1)  # the pen on the paper at the start of the stroke
+        time.sleep(0.3)
+        for x, y in path[1:] + [end]:
+            xdotool("mousemove", "--window", window, round(x), round(y))
+            time.sleep(0.12)
+        time.sleep(0.3)
+        xdotool("mouseup", 1)
+        self.assertEqual(trainer.wait(), 0, trainer.errors())
+        (record_path,) = saved_trials(pathlib.Path(self.folder) / "out")
+        record = json.loads(record_path.read_text(encoding="utf-8"))
+        self.assertEqual(record["device"], "mouse")
+        self.assertEqual(record["condition"], "vision")
+        self.assertEqual((record["strokes_completed"], record["strokes_total"]), (1, 1))
+        self.assertEqual(record["end_reason"], "completed")
+        self.assertLess(record["per_stroke"][0]["mean_deviation_mm"], 1.5)
+
+    def write_yi_beside_the_stroke(self, guidance, offset):
+        """On mouse-hand, presses at the start of 一, then moves the pointer `offset` data units below the
+        stroke to its end; returns the saved record."""
+        folder = pathlib.Path(self.folder) / guidance
+        folder.mkdir()
+        trainer = Trainer("一", "--device", "mouse-hand", "--guidance", guidance, "--data", SAMPLE, "--session",
+                          "out", "--exit-after", "60", folder=folder)
+        try:
+            (box,) = trainer.boxes()
+            window = trainer.window()
+            median = medians("一", SAMPLE)[0]
+            below = [box.data_to_px((x, y - offset)) for x, y in along(median, [i / 24 for i in range(1, 25)])]
+            below.append(box.data_to_px((median[-1][0] + 30, median[-1][1] - offset)))
+            start = box.data_to_px(median[0])
+            time.sleep(0.5)
+            xdotool("mousemove", "--window", window, round(start[0]), round(start[1]))
+            time.sleep(0.8)  # the hand carries the stylus over the start
+            xdotool("mousedown", 1)
+            time.sleep(0.8)
+            for x, y in below:
+                try:
+                    xdotool("mousemove", "--window", window, round(x), round(y))
+                except subprocess.CalledProcessError:
+                    # The stroke was written and the trainer is closing its window: nothing left to move.
+                    trainer.process.wait(timeout=30)
+                    break
+                time.sleep(0.1)
+            time.sleep(0.8)
+            if trainer.process.poll() is None:
+                xdotool("mouseup", 1)
+            self.assertEqual(trainer.wait(), 0, trainer.errors())
+        finally:
+            trainer.close()
+        (record_path,) = saved_trials(folder / "out")
+        return json.loads(record_path.read_text(encoding="utf-8"))
+
+    def test_guidance_pulls_the_mouse_hand_pen_towards_the_stroke(self):
+        offset = 40  # data units, 2.3 mm on paper
+        guided = self.write_yi_beside_the_stroke("on", offset)
+        free = self.write_yi_beside_the_stroke("off", offset)
+        for record in (guided, free):
+            self.assertEqual(record["device"], "mouse-hand")
+            self.assertEqual(record["strokes_completed"], 1, record)
+        self.assertEqual(guided["condition"], "vision+haptic")
+        self.assertEqual(free["condition"], "vision")
+        self.assertLess(guided["mean_deviation_mm"], 0.7 * free["mean_deviation_mm"])
+
+    def ended_mid_trial(self, end):
+        """Starts 永 with the simulated writer (no time limit of its own), lets it write a while, then calls
+        `end`, and checks the trial was saved whole as interrupted."""
+        trainer = self.start("永", "--writer", "simulated", "--session", "out", "--subject", "s01")
+        trainer.boxes()
+        time.sleep(4.0)
+        self.assertIsNone(trainer.process.poll(), "the trial should still run: " + trainer.errors())
+        end(trainer)
+        self.assertEqual(trainer.wait(timeout=30), 0, trainer.errors())
+        (record_path,) = saved_trials(pathlib.Path(self.folder) / "out")
+        self.assertTrue(record_path.name.startswith("s01-永-"))
+        record = json.loads(record_path.read_text(encoding="utf-8"))
+        self.assertEqual(record["end_reason"], "interrupted")
+        self.assertTrue(record["aborted"])
+        self.assertLess(record["strokes_completed"], 5)
+        with open(record_path.with_suffix(".csv"), newline="") as f:
+            rows = sum(1 for _ in csv.DictReader(f))
+        self.assertGreater(rows, 3000)  # about 4 s at 1 kHz
+        self.assertEqual(rows, record["servo_loop"]["ticks"])
+        return record
+
+    def test_closing_the_window_mid_trial_keeps_the_data(self):
+        self.ended_mid_trial(lambda trainer: xdotool("windowclose", trainer.window()))
+
+    def test_pressing_q_mid_trial_keeps_the_data(self):
+        def press_q(trainer):
+            window = trainer.window()
+            xdotool("windowfocus", "--sync", window)
+            xdotool("key", "--window", window, "q")
+        self.ended_mid_trial(press_q)
+
+    def test_sigterm_mid_trial_keeps_the_data(self):
+        self.ended_mid_trial(lambda trainer: trainer.process.send_signal(signal.SIGTERM))
+
+    def test_saved_trials_never_overwrite(self):
+        out = pathlib.Path(self.folder) / "out"
+        out.mkdir()
+        (out / "anonymous-一-1.json").write_text("earlier\n")
+        trainer = self.start("一", "--device", "mouse", "--data", SAMPLE, "--session", "out", "--exit-after", "2")
+        self.assertEqual(trainer.wait(), 0, trainer.errors())
+        self.assertEqual((out / "anonymous-一-1.json").read_text(), "earlier\n")
+        record = json.loads((out / "anonymous-一-2.json").read_text(encoding="utf-8"))
+        self.assertEqual(record["end_reason"], "interrupted")
+
+
+if __name__ == "__main__":
+    try:
+        xdotool("getdisplaygeometry")
+    except (OSError, subprocess.CalledProcessError) as e:
+        print(f"trainer tests skipped: no X server ({e})")
+        sys.exit(77)
+    unittest.main(verbosity=2)
