@@ -310,8 +310,9 @@ def sweep(characters: typing.Union[str, typing.Sequence[str], None],
     value out of range, TypeError for a value of the wrong type (both before any trial runs),
     DataError when the store or folder cannot be opened, ImportError without pandas.
     """
-    import pandas
+    from .frames import _pandas
 
+    pandas = _pandas()  # first: an ImportError saying how to install it, before any trial runs
     axes = _resolve(grid)
     source = _source(store, data)
     labels = _character_labels(characters, _library(source))
