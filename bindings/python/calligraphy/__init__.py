@@ -15,6 +15,8 @@ Main entry points:
 * ``Renderer(scene, force_law).tick(DeviceState(...))`` -> ``RenderOutput``
 * ``simulate_trial(chars, writer="novice", guidance=True, rate_hz=1000, seed=0)`` -> ``TrialResult``
   (``.to_dataframe()``, ``.per_stroke_dataframe()`` with pandas; ``calligraphy.plot`` with matplotlib)
+* ``calligraphy.experiments.sweep(chars, grid, seeds)``: one trial per grid combination x character x
+  seed on every core or a Dask cluster -> a pandas DataFrame, one row per trial
 * ``SimulatedDevice(SimulatedDeviceParameters(...))``, ``WriterProfile``, ``list_devices()``
 * ``set_log_level(level)``: the C++ log goes to ``logging.getLogger("calligraphy")``
 
