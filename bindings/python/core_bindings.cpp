@@ -30,7 +30,7 @@ py::object new_exception(py::module_& m, const char* name, const py::tuple& base
 
 struct ExceptionTypes {
   py::object error, invalid_argument, data_error, character_not_found, device_error, device_not_found,
-      communication_error, safety_fault, calibration_needed;
+      communication_error, safety_fault, calibration_needed, realtime_error, state_error;
 };
 
 void bind_exceptions(py::module_& m) {
@@ -68,6 +68,16 @@ void bind_exceptions(py::module_& m) {
       new_exception(m, "CalibrationNeeded", py::make_tuple(types->device_error),
                     "The device must be calibrated before use (C++ calligraphy::CalibrationNeeded).");
 
+  types->realtime_error = new_exception(
+      m, "RealtimeError", py::make_tuple(types->device_error),
+      "Realtime settings (SCHED_FIFO, CPU pinning, locked memory) were required and could not be applied "
+      "(C++ calligraphy::RealtimeError).");
+  types->state_error =
+      new_exception(m, "StateError", py::make_tuple(types->error, builtin(PyExc_RuntimeError)),
+                    "A call in the wrong state, e.g. starting a servo loop that already runs (C++ "
+                    "calligraphy::StateError); "
+                    "a RuntimeError.");
+
   py::register_exception_translator([](std::exception_ptr p) {
     const auto raise = [](const py::object& type, const std::exception& e) {
       PyErr_SetString(type.ptr(), e.what());
@@ -88,6 +98,10 @@ void bind_exceptions(py::module_& m) {
       raise(types->safety_fault, e);
     } catch (const CalibrationNeeded& e) {
       raise(types->calibration_needed, e);
+    } catch (const RealtimeError& e) {
+      raise(types->realtime_error, e);
+    } catch (const StateError& e) {
+      raise(types->state_error, e);
     } catch (const DeviceError& e) {
       raise(types->device_error, e);
     } catch (const Error& e) {

@@ -126,16 +126,20 @@ class SignalPoll {
   std::unique_ptr<py::error_already_set> error_;
 };
 
-PyTrialResult simulate_trial_py(const Annotated<TrialCharactersTag>& characters,
-                                const Annotated<WriterTag>& writer, const Checked<bool>& guidance,
-                                const Checked<double>& rate_hz, const Checked<std::uint64_t>& seed,
-                                const std::optional<Checked<CharacterSource>>& library,
-                                const std::optional<Checked<ForceLawParameters>>& force_law,
-                                const Checked<double>& max_duration_s, const Checked<bool>& keep_trace,
-                                const std::optional<Checked<SimulatedDeviceParameters>>& device,
-                                const std::optional<Checked<SafetyChainParameters>>& safety,
-                                const std::optional<Checked<PassivityParameters>>& passivity) {
+// The trial behind simulate_trial and run_trial: `device_name` empty runs on a SimulatedDevice made from
+// `device`; else on the registry's device of that name, paced by `pacing`.
+PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
+                       const Annotated<TrialCharactersTag>& characters, const Annotated<WriterTag>& writer,
+                       const Checked<bool>& guidance, const Checked<double>& rate_hz,
+                       const Checked<std::uint64_t>& seed,
+                       const std::optional<Checked<CharacterSource>>& library,
+                       const std::optional<Checked<ForceLawParameters>>& force_law,
+                       const Checked<double>& max_duration_s, const Checked<bool>& keep_trace,
+                       const std::optional<Checked<SimulatedDeviceParameters>>& device,
+                       const std::optional<Checked<SafetyChainParameters>>& safety,
+                       const std::optional<Checked<PassivityParameters>>& passivity) {
   TrialOptions options;
+  options.pacing = pacing;
   if (force_law) options.force = take(*force_law, "force_law");
   options.force.guidance = take(guidance, "guidance");
   options.simulation.writer = writer_from(writer.object);
@@ -171,7 +175,8 @@ PyTrialResult simulate_trial_py(const Annotated<TrialCharactersTag>& characters,
   TrialResult result;
   {
     py::gil_scoped_release release;
-    result = run_simulated_trial(scene, options);
+    result =
+        device_name.empty() ? run_simulated_trial(scene, options) : run_trial(device_name, scene, options);
   }
   poll.raise_if_interrupted();
   TrialDescription description;
@@ -180,7 +185,43 @@ PyTrialResult simulate_trial_py(const Annotated<TrialCharactersTag>& characters,
   description.writer = options.simulation.writer.name.empty() ? "custom" : options.simulation.writer.name;
   description.seed = options.simulation.seed;
   description.rate_hz = options.rate_hz;
+  if (!device_name.empty()) description.device = device_name;
   return to_python(result, trial_metrics(description, result), scene_object);
+}
+
+PyTrialResult simulate_trial_py(const Annotated<TrialCharactersTag>& characters,
+                                const Annotated<WriterTag>& writer, const Checked<bool>& guidance,
+                                const Checked<double>& rate_hz, const Checked<std::uint64_t>& seed,
+                                const std::optional<Checked<CharacterSource>>& library,
+                                const std::optional<Checked<ForceLawParameters>>& force_law,
+                                const Checked<double>& max_duration_s, const Checked<bool>& keep_trace,
+                                const std::optional<Checked<SimulatedDeviceParameters>>& device,
+                                const std::optional<Checked<SafetyChainParameters>>& safety,
+                                const std::optional<Checked<PassivityParameters>>& passivity) {
+  return trial_py({}, TrialPacing::lock_step, characters, writer, guidance, rate_hz, seed, library, force_law,
+                  max_duration_s, keep_trace, device, safety, passivity);
+}
+
+PyTrialResult run_trial_py(const Annotated<TrialCharactersTag>& characters,
+                           const Checked<std::string>& device, const Checked<std::string>& pacing,
+                           const Annotated<WriterTag>& writer, const Checked<bool>& guidance,
+                           const Checked<double>& rate_hz, const Checked<std::uint64_t>& seed,
+                           const std::optional<Checked<CharacterSource>>& library,
+                           const std::optional<Checked<ForceLawParameters>>& force_law,
+                           const Checked<double>& max_duration_s, const Checked<bool>& keep_trace) {
+  const std::string name = take(device, "device");
+  if (name.empty()) throw InvalidArgument("device: a device name of list_devices() is needed");
+  const std::string how = take(pacing, "pacing");
+  TrialPacing chosen = TrialPacing::automatic;
+  if (how == "lock_step") {
+    chosen = TrialPacing::lock_step;
+  } else if (how == "real_time") {
+    chosen = TrialPacing::real_time;
+  } else if (how != "auto") {
+    throw InvalidArgument("pacing: expected 'auto', 'lock_step' or 'real_time', got '" + how + "'");
+  }
+  return trial_py(name, chosen, characters, writer, guidance, rate_hz, seed, library, force_law,
+                  max_duration_s, keep_trace, std::nullopt, std::nullopt, std::nullopt);
 }
 
 }  // namespace
@@ -246,6 +287,21 @@ SimulatedDeviceParameters. safety: SafetyChainParameters (0 forces take the devi
 passivity: PassivityParameters. keep_trace: False leaves the arrays empty (faster, metrics only).
 Returns a TrialResult. Raises CharacterNotFound (a KeyError), InvalidArgument (a ValueError) for
 values out of range, TypeError naming the argument for a value of the wrong type.)");
+  m.def("run_trial", &run_trial_py, py::arg("characters"), py::arg("device") = "simulated",
+        py::arg("pacing") = "auto", py::arg("writer") = "novice", py::arg("guidance") = true,
+        py::arg("rate_hz") = 1000.0, py::arg("seed") = 0, py::arg("library") = py::none(),
+        py::arg("force_law") = py::none(), py::arg("max_duration_s") = 300.0, py::arg("keep_trace") = true,
+        py::call_guard<ForwardLog>(),
+        R"(Runs a whole guided writing trial on the device called `device` in list_devices(), as
+`calligraphy trial --device NAME` does (run_trial, include/calligraphy/trial/runner.hpp): 'simulated' and
+'emulated-phantom' are moved by the simulated `writer`; a hardware device is moved by a person and runs in
+real time on the servo loop's own thread. The GIL is released while it runs; Ctrl-C ends the trial at
+the next tick (forces off, the device closed) and raises KeyboardInterrupt.
+
+pacing: 'auto' (lock-step for a device a simulated writer moves, real time otherwise), 'lock_step' or
+'real_time'. rate_hz: servo rate [Hz] (at most 10000 in real time). The other arguments as for
+simulate_trial. Returns a TrialResult whose metrics carry `end_reason`. Raises DeviceNotFound (a
+LookupError) naming the devices there are, InvalidArgument, RealtimeError, CommunicationError.)");
 }
 
 }  // namespace calligraphy::python

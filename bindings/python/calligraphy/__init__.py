@@ -31,6 +31,8 @@ from ._calligraphy import (  # noqa: F401
     __version__,
     TYPICAL_STROKES,
     CalibrationNeeded,
+    RealtimeError,
+    StateError,
     Character,
     CharacterLibrary,
     CharacterNotFound,
@@ -79,6 +81,7 @@ from ._calligraphy import (  # noqa: F401
     paper_force,
     resistance_force,
     set_log_level,
+    run_trial,
     simulate_trial,
     typical_stroke,
 )
@@ -87,6 +90,8 @@ __all__ = [
     "__version__",
     "TYPICAL_STROKES",
     "CalibrationNeeded",
+    "RealtimeError",
+    "StateError",
     "Character",
     "CharacterLibrary",
     "CharacterNotFound",
@@ -135,6 +140,7 @@ __all__ = [
     "paper_force",
     "resistance_force",
     "set_log_level",
+    "run_trial",
     "simulate_trial",
     "typical_stroke",
 ]

@@ -1,0 +1,34 @@
+"""run_trial: a trial on a device of the registry, by name, lock-step or in real time."""
+import pytest
+
+import calligraphy
+
+
+def test_run_trial_on_the_simulated_device_is_simulate_trial():
+    by_name = calligraphy.run_trial("九", device="simulated", seed=2, keep_trace=False)
+    simulated = calligraphy.simulate_trial("九", seed=2, keep_trace=False)
+    for key in ("mean_deviation_mm", "time_s", "strokes_completed", "end_reason"):
+        assert by_name.metrics[key] == simulated.metrics[key]
+    assert by_name.metrics["device"] == "simulated"
+
+
+def test_run_trial_in_real_time_keeps_its_ticks():
+    result = calligraphy.run_trial("永", device="simulated", pacing="real_time", max_duration_s=0.3)
+    assert result.metrics["end_reason"] == "time_limit"
+    assert result.metrics["aborted"]
+    assert len(result.time_s) == 300  # the time limit counts ticks: 0.3 s at 1 kHz
+
+
+def test_run_trial_names_what_is_wrong():
+    with pytest.raises(calligraphy.DeviceNotFound, match="simulated"):
+        calligraphy.run_trial("九", device="no-such-device")
+    with pytest.raises(ValueError, match="pacing"):
+        calligraphy.run_trial("九", pacing="fast")
+    with pytest.raises(TypeError, match="device"):
+        calligraphy.run_trial("九", device=3)
+
+
+def test_every_error_class_of_the_library_is_there():
+    assert issubclass(calligraphy.RealtimeError, calligraphy.DeviceError)
+    assert issubclass(calligraphy.StateError, calligraphy.Error)
+    assert issubclass(calligraphy.StateError, RuntimeError)
