@@ -1,0 +1,158 @@
+#include "calligraphy/report/teacher_recording.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "calligraphy/core/errors.hpp"
+
+namespace calligraphy {
+namespace {
+
+constexpr const char* kFormat = "calligraphy-teacher-recording";
+constexpr int kVersion = 1;
+
+[[noreturn]] void fail(const std::string& source, const std::string& what) {
+  throw DataError(source + ": " + what);
+}
+
+const nlohmann::json& member(const nlohmann::json& object, const char* key, const std::string& source,
+                             const std::string& where) {
+  const auto found = object.find(key);
+  if (found == object.end()) fail(source, "missing key " + where + key);
+  return *found;
+}
+
+std::string text_member(const nlohmann::json& object, const char* key, const std::string& source) {
+  const nlohmann::json& value = member(object, key, source, "/");
+  if (!value.is_string()) fail(source, std::string("/") + key + ": expected a string");
+  return value.get<std::string>();
+}
+
+std::vector<double> number_array(const nlohmann::json& samples, const char* key, const std::string& source) {
+  const nlohmann::json& array = member(samples, key, source, "/samples/");
+  const std::string where = std::string("/samples/") + key;
+  if (!array.is_array()) fail(source, where + ": expected an array of numbers");
+  std::vector<double> values;
+  values.reserve(array.size());
+  for (std::size_t i = 0; i < array.size(); ++i) {
+    const nlohmann::json& value = array[i];
+    if (!value.is_number()) fail(source, where + "/" + std::to_string(i) + ": expected a number");
+    const double number = value.get<double>();
+    if (!std::isfinite(number)) fail(source, where + "/" + std::to_string(i) + ": not a finite number");
+    values.push_back(number);
+  }
+  return values;
+}
+
+}  // namespace
+
+TeacherRecording teacher_recording_from_trace(std::string characters, std::string writer, std::string device,
+                                              double rate_hz, const std::vector<TrialSample>& trace) {
+  if (trace.size() < 2) {
+    throw InvalidArgument("a teacher recording needs the trial's trace (at least 2 samples), got " +
+                          std::to_string(trace.size()) + "; run the trial with keep_trace");
+  }
+  TeacherRecording recording{
+      std::move(characters), std::move(writer), std::move(device), rate_hz, CALLIGRAPHY_VERSION, {}};
+  recording.samples.reserve(trace.size());
+  for (const TrialSample& sample : trace) recording.samples.push_back({sample.time_s, sample.position_m});
+  validate_teacher_trajectory(recording.samples);
+  return recording;
+}
+
+std::string teacher_recording_json(const TeacherRecording& recording) {
+  nlohmann::json t = nlohmann::json::array(), x = nlohmann::json::array(), y = nlohmann::json::array(),
+                 z = nlohmann::json::array();
+  for (const TeacherSample& sample : recording.samples) {
+    t.push_back(sample.time_s);
+    x.push_back(sample.position_m.x());
+    y.push_back(sample.position_m.y());
+    z.push_back(sample.position_m.z());
+  }
+  const nlohmann::json document = {{"format", kFormat},
+                                   {"version", kVersion},
+                                   {"characters", recording.characters},
+                                   {"writer", recording.writer},
+                                   {"device", recording.device},
+                                   {"rate_hz", recording.rate_hz},
+                                   {"library_version", recording.library_version},
+                                   {"samples", {{"t_s", t}, {"x_m", x}, {"y_m", y}, {"z_m", z}}}};
+  return document.dump() + "\n";
+}
+
+TeacherRecording parse_teacher_recording(std::string_view json_text, const std::string& source) {
+  nlohmann::json document;
+  try {
+    document = nlohmann::json::parse(json_text);
+  } catch (const nlohmann::json::parse_error& e) {
+    fail(source, "not JSON (byte " + std::to_string(e.byte) + ")");
+  }
+  if (!document.is_object()) fail(source, "expected a JSON object");
+  const nlohmann::json& format = member(document, "format", source, "/");
+  if (format != kFormat) fail(source, std::string("/format: expected \"") + kFormat + "\"");
+  const nlohmann::json& version = member(document, "version", source, "/");
+  if (version != kVersion) fail(source, "/version: expected " + std::to_string(kVersion));
+
+  TeacherRecording recording;
+  recording.characters = text_member(document, "characters", source);
+  if (recording.characters.empty()) fail(source, "/characters: empty");
+  recording.writer = text_member(document, "writer", source);
+  recording.device = text_member(document, "device", source);
+  recording.library_version = text_member(document, "library_version", source);
+  const nlohmann::json& rate = member(document, "rate_hz", source, "/");
+  if (!rate.is_number() || !(rate.get<double>() > 0.0) || !std::isfinite(rate.get<double>()))
+    fail(source, "/rate_hz: expected a positive number");
+  recording.rate_hz = rate.get<double>();
+
+  const nlohmann::json& samples = member(document, "samples", source, "/");
+  if (!samples.is_object()) fail(source, "/samples: expected an object");
+  const std::vector<double> t = number_array(samples, "t_s", source);
+  const std::vector<double> x = number_array(samples, "x_m", source);
+  const std::vector<double> y = number_array(samples, "y_m", source);
+  const std::vector<double> z = number_array(samples, "z_m", source);
+  if (x.size() != t.size() || y.size() != t.size() || z.size() != t.size()) {
+    fail(source, "/samples: t_s, x_m, y_m and z_m have different lengths (" + std::to_string(t.size()) +
+                     ", " + std::to_string(x.size()) + ", " + std::to_string(y.size()) + ", " +
+                     std::to_string(z.size()) + ")");
+  }
+  if (t.size() < 2) fail(source, "/samples: fewer than 2 samples");
+  recording.samples.reserve(t.size());
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (i > 0 && t[i] < t[i - 1]) {
+      fail(source, "/samples/t_s/" + std::to_string(i) + ": time " + std::to_string(t[i]) +
+                       " s is below the previous one");
+    }
+    recording.samples.push_back({t[i], Vec3(x[i], y[i], z[i])});
+  }
+  return recording;
+}
+
+TeacherRecording read_teacher_recording(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  std::error_code error;
+  const auto status = std::filesystem::status(path, error);
+  if (error || !std::filesystem::exists(status)) throw DataError(name + ": no such file");
+  if (!std::filesystem::is_regular_file(status)) throw DataError(name + ": not a regular file");
+  const std::uintmax_t size = std::filesystem::file_size(path, error);
+  if (error) throw DataError(name + ": cannot read its size (" + error.message() + ")");
+  if (size > kMaxTeacherRecordingBytes) {
+    throw DataError(name + ": " + std::to_string(size) + " bytes, more than the limit of " +
+                    std::to_string(kMaxTeacherRecordingBytes));
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw DataError(name + ": cannot be opened");
+  std::string text(static_cast<std::size_t>(size), '\0');
+  in.read(text.data(), static_cast<std::streamsize>(size));
+  if (static_cast<std::uintmax_t>(in.gcount()) != size) throw DataError(name + ": could not be read whole");
+  return parse_teacher_recording(text, name);
+}
+
+void require_teacher_for(const TeacherRecording& recording, std::string_view characters) {
+  if (recording.characters != characters) {
+    throw InvalidArgument("the teacher's recording is of \"" + recording.characters +
+                          "\" and cannot guide \"" + std::string(characters) + "\"");
+  }
+}
+
+}  // namespace calligraphy
