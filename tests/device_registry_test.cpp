@@ -1,8 +1,10 @@
 #include "calligraphy/devices/device_registry.hpp"
 
+#include <atomic>
 #include <catch2/catch.hpp>
 #include <memory>
 #include <sstream>
+#include <thread>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/testing/emulated_phantom.hpp"
@@ -84,6 +86,30 @@ TEST_CASE("Backends register factories, devices are listed and created by name",
   CHECK(registry.unregister_backend("pair"));
   CHECK_FALSE(registry.unregister_backend("pair"));
   CHECK(registry.backend_names() == std::vector<std::string>{"simulated"});
+}
+
+TEST_CASE("Registering a device if absent keeps the first of a name, also from many threads", "[registry]") {
+  DeviceRegistry registry;
+  CHECK(registry.register_device_if_absent(
+      "sim", info_named("First"), [] { return std::make_unique<FixedDevice>(info_named("First")); }));
+  CHECK_FALSE(registry.register_device_if_absent(
+      "sim", info_named("Second"), [] { return std::make_unique<FixedDevice>(info_named("Second")); }));
+  CHECK(registry.create("sim")->info().model == "First");
+  CHECK_THROWS_AS(registry.register_device_if_absent("other", info_named("X"), {}),
+                  calligraphy::InvalidArgument);
+
+  std::atomic<int> added{0};
+  std::vector<std::thread> threads;
+  for (int i = 0; i < 8; ++i) {
+    threads.emplace_back([&] {
+      if (registry.register_device_if_absent("raced", info_named("R"),
+                                             [] { return std::make_unique<FixedDevice>(info_named("R")); }))
+        ++added;
+    });
+  }
+  for (std::thread& thread : threads) thread.join();
+  CHECK(added == 1);
+  CHECK(registry.backend_names() == std::vector<std::string>{"sim", "raced"});
 }
 
 TEST_CASE("A backend that fails to scan becomes a note, not a failure", "[registry]") {

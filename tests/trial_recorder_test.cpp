@@ -94,3 +94,15 @@ TEST_CASE("A completed stroke on the reference has a deviation of zero, present"
   CHECK(m.per_stroke[0].completed);
   CHECK_FALSE(m.per_stroke[1].mean_deviation_m.has_value());
 }
+
+TEST_CASE("take_trace hands over every recorded tick and leaves the recorder's trace empty", "[recorder]") {
+  const Scene scene = scene_of_shi();
+  Ticks ticks(scene);
+  for (int i = 0; i < 250; ++i) ticks.tick(InteractionState::separation);
+  const std::vector<TrialSample> copy = ticks.recorder().trace();
+  const std::vector<TrialSample> taken = ticks.recorder().take_trace();
+  REQUIRE(taken.size() == 250);
+  CHECK(taken.back().time_s == copy.back().time_s);
+  CHECK(taken[17].position_m == copy[17].position_m);
+  CHECK(ticks.recorder().trace().empty());
+}

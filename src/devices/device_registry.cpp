@@ -13,28 +13,59 @@ bool DeviceSurvey::any_hardware() const {
   return std::any_of(devices.begin(), devices.end(), [](const DeviceListing& d) { return d.hardware; });
 }
 
-void DeviceRegistry::register_backend(DeviceBackend backend) {
+namespace {
+
+void check_backend(const DeviceBackend& backend) {
   if (backend.name.empty()) throw InvalidArgument("device backend: the name must not be empty");
   if (!backend.scan || !backend.create) {
     throw InvalidArgument("device backend '" + backend.name + "': scan and create must both be set");
   }
-  const std::lock_guard lock(mutex_);
-  const bool taken = std::any_of(backends_.begin(), backends_.end(),
-                                 [&](const DeviceBackend& b) { return b.name == backend.name; });
-  if (taken) throw InvalidArgument("device backend '" + backend.name + "' is already registered");
-  backends_.push_back(std::move(backend));
 }
 
-void DeviceRegistry::register_device(std::string name, DeviceInfo info,
-                                     std::function<std::unique_ptr<HapticDevice>()> factory, bool hardware,
-                                     std::string details) {
+// A backend that always lists exactly one device, named as the backend.
+DeviceBackend single_device_backend(std::string name, DeviceInfo info,
+                                    std::function<std::unique_ptr<HapticDevice>()> factory, bool hardware,
+                                    std::string details) {
   if (!factory) throw InvalidArgument("device '" + name + "': the factory must be set");
   DeviceListing listing{name, name, std::move(info), hardware, std::move(details)};
   DeviceBackend backend;
   backend.name = std::move(name);
   backend.scan = [listing] { return DeviceSurvey{{listing}, {}}; };
   backend.create = [factory = std::move(factory)](const DeviceListing&) { return factory(); };
-  register_backend(std::move(backend));
+  return backend;
+}
+
+}  // namespace
+
+bool DeviceRegistry::add_if_absent(DeviceBackend backend) {
+  check_backend(backend);
+  const std::lock_guard lock(mutex_);
+  const bool taken = std::any_of(backends_.begin(), backends_.end(),
+                                 [&](const DeviceBackend& b) { return b.name == backend.name; });
+  if (taken) return false;
+  backends_.push_back(std::move(backend));
+  return true;
+}
+
+void DeviceRegistry::register_backend(DeviceBackend backend) {
+  const std::string name = backend.name;
+  if (!add_if_absent(std::move(backend))) {
+    throw InvalidArgument("device backend '" + name + "' is already registered");
+  }
+}
+
+void DeviceRegistry::register_device(std::string name, DeviceInfo info,
+                                     std::function<std::unique_ptr<HapticDevice>()> factory, bool hardware,
+                                     std::string details) {
+  register_backend(single_device_backend(std::move(name), std::move(info), std::move(factory), hardware,
+                                         std::move(details)));
+}
+
+bool DeviceRegistry::register_device_if_absent(std::string name, DeviceInfo info,
+                                               std::function<std::unique_ptr<HapticDevice>()> factory,
+                                               bool hardware, std::string details) {
+  return add_if_absent(single_device_backend(std::move(name), std::move(info), std::move(factory), hardware,
+                                             std::move(details)));
 }
 
 bool DeviceRegistry::unregister_backend(std::string_view name) {

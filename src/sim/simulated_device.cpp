@@ -173,17 +173,8 @@ DeviceState SimulatedDevice::read_state() {
 }
 
 void register_simulated_device(DeviceRegistry& registry) {
-  const auto present = [&] {
-    const auto names = registry.backend_names();
-    return std::find(names.begin(), names.end(), "simulated") != names.end();
-  };
-  if (present()) return;
-  try {
-    registry.register_device("simulated", SimulatedDevice{}.info(),
-                             [] { return std::make_unique<SimulatedDevice>(); });
-  } catch (const InvalidArgument&) {
-    if (!present()) throw;  // another thread registered it between the check and here
-  }
+  registry.register_device_if_absent("simulated", SimulatedDevice{}.info(),
+                                     [] { return std::make_unique<SimulatedDevice>(); });
 }
 
 DeviceRegistry& device_registry_with_simulation() {

@@ -48,7 +48,7 @@ TrialResult TrialSession::finish(TrialEnd end, std::string reason, double end_ti
   if (display_) display_->publish_end(end, end_time_s < 0.0 ? last_time_s_ : end_time_s);
   TrialResult result;
   result.metrics = recorder_.metrics();
-  result.trace = recorder_.trace();
+  result.trace = recorder_.take_trace();  // the session is spent after finish
   result.end = end;
   result.aborted = end != TrialEnd::completed;
   result.abort_reason = std::move(reason);

@@ -58,6 +58,11 @@ class DeviceRegistry {
   void register_device(std::string name, DeviceInfo info,
                        std::function<std::unique_ptr<HapticDevice>()> factory, bool hardware = false,
                        std::string details = {});
+  /// As register_device, but a device of that name registered before (by another thread, say) is kept
+  /// and false returned; true when this call added it. Throws InvalidArgument for an empty factory.
+  bool register_device_if_absent(std::string name, DeviceInfo info,
+                                 std::function<std::unique_ptr<HapticDevice>()> factory,
+                                 bool hardware = false, std::string details = {});
   /// Removes a backend; returns false when there was none of that name.
   bool unregister_backend(std::string_view name);
   [[nodiscard]] std::vector<std::string> backend_names() const;
@@ -72,6 +77,8 @@ class DeviceRegistry {
 
  private:
   [[nodiscard]] std::vector<DeviceBackend> snapshot() const;
+  // Adds a checked backend under the lock; false when its name is taken.
+  bool add_if_absent(DeviceBackend backend);
 
   mutable std::mutex mutex_;
   std::vector<DeviceBackend> backends_;

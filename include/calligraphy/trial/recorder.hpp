@@ -4,6 +4,7 @@
 /// trace sample and the trial's metrics. Usable from any loop, lock-step or real time.
 #include <cstdint>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "calligraphy/core/device_types.hpp"
@@ -65,6 +66,8 @@ class TrialRecorder {
   void record(const DeviceState& state, const RenderOutput& output);
   [[nodiscard]] const TrialMetrics& metrics() const noexcept { return metrics_; }
   [[nodiscard]] const std::vector<TrialSample>& trace() const noexcept { return trace_; }
+  /// Moves the trace out (a long trial's trace is large: no copy); the recorder's trace is empty after.
+  [[nodiscard]] std::vector<TrialSample> take_trace() noexcept { return std::move(trace_); }
   /// Allocates (and touches) room for `ticks` samples of the trace, so that the next `ticks` calls of
   /// `record` never allocate: for a real-time loop. Nothing when the trace is not kept.
   void reserve(std::size_t ticks);

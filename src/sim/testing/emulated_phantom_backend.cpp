@@ -1,5 +1,4 @@
 // The emulated Phantom in the device registry.
-#include <algorithm>
 #include <memory>
 
 #include "calligraphy/core/errors.hpp"
@@ -29,18 +28,10 @@ std::unique_ptr<HapticDevice> make_emulated_phantom() {
 }
 
 void register_emulated_phantom(DeviceRegistry& registry) {
-  const auto present = [&] {
-    const auto names = registry.backend_names();
-    return std::find(names.begin(), names.end(), "emulated-phantom") != names.end();
-  };
-  if (present()) return;
-  try {
-    registry.register_device("emulated-phantom", emulated_info(), make_emulated_phantom, false,
-                             "PhantomEmulator over an in-memory link, through the real PhantomDevice code "
-                             "path; starts docked, leaves the inkwell after 50 ms of emulated time");
-  } catch (const InvalidArgument&) {
-    if (!present()) throw;  // another thread registered it between the check and here
-  }
+  registry.register_device_if_absent(
+      "emulated-phantom", emulated_info(), make_emulated_phantom, false,
+      "PhantomEmulator over an in-memory link, through the real PhantomDevice "
+      "code path; starts docked, leaves the inkwell after 50 ms of emulated time");
 }
 
 }  // namespace calligraphy::testing
