@@ -13,9 +13,12 @@
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
 #include "calligraphy/trial/trial.hpp"
+#include "probe_device.hpp"
 
 using namespace calligraphy;
 using Catch::Matchers::Contains;
+
+using test::ProbeDevice;
 
 namespace {
 
@@ -26,37 +29,6 @@ ServoLoopOptions stall_test_options() {
   o.lock_memory = false;
   return o;
 }
-
-// A simulated device that counts how often a marker force reaches it.
-class MarkerDevice final : public HapticDevice, public HandPort {
- public:
-  MarkerDevice() { inner_.open(); }
-  const DeviceInfo& info() const override { return inner_.info(); }
-  void open() override { inner_.open(); }
-  void close() noexcept override { inner_.close(); }
-  bool is_open() const override { return inner_.is_open(); }
-  void enable_forces(bool enabled) override { inner_.enable_forces(enabled); }
-  bool forces_enabled() const override { return inner_.forces_enabled(); }
-  DeviceState read_state() override { return inner_.read_state(); }
-  void write_force(const Vec3& force_n) override {
-    if (force_n.x() == kMarker) ++marker_writes_;
-    inner_.write_force(force_n);
-  }
-  // The hand port, so a real-time trial steps the physics after each force write; the advance after
-  // tick `stall_after_` sleeps for `stall_ms_` (a stall on the loop thread).
-  void attach_hand(HandModel* hand) noexcept override { inner_.attach_hand(hand); }
-  void advance(double dt_s) override {
-    if (++advances_ == stall_after_) sleep_ms(stall_ms_);
-    inner_.advance(dt_s);
-  }
-  static void sleep_ms(int ms) { std::this_thread::sleep_for(std::chrono::milliseconds(ms)); }
-  static constexpr double kMarker = 1.25;  // [N]
-  SimulatedDevice inner_;
-  int marker_writes_ = 0;
-  long advances_ = 0;
-  long stall_after_ = -1;
-  int stall_ms_ = 0;
-};
 
 void sleep_ms(int ms) { std::this_thread::sleep_for(std::chrono::milliseconds(ms)); }
 
@@ -88,7 +60,7 @@ TEST_CASE("A tick that overruns keeps the loop running, and its force is written
   constexpr int kOverrunMs = 20;  // 20 periods at 1 kHz, inside the callback of tick 20
   for (const double max_force_age_s : {0.002, 1.0}) {
     INFO("max_force_age_s " << max_force_age_s);
-    MarkerDevice device;
+    ProbeDevice device;
     std::uint64_t n = 0;
     double dt_after_overrun_s = 0.0;
     ServoLoopOptions o = stall_test_options();
@@ -101,7 +73,7 @@ TEST_CASE("A tick that overruns keeps the loop running, and its force is written
           if (n == 21) dt_after_overrun_s = dt_s;
           if (n == 20) {
             sleep_ms(kOverrunMs);
-            return ServoCommand{Vec3(MarkerDevice::kMarker, 0, 0), false};
+            return ServoCommand{Vec3(ProbeDevice::kMarker, 0, 0), false};
           }
           return ServoCommand{Vec3(0.1, 0, 0), n >= 40};
         },
@@ -134,7 +106,7 @@ TEST_CASE("A tick that overruns keeps the loop running, and its force is written
 
 TEST_CASE("A stall longer than stall_timeout_s ends the run safely and the tripping tick is counted",
           "[servo]") {
-  MarkerDevice device;
+  ProbeDevice device;
   std::uint64_t n = 0;
   ServoLoopOptions o = stall_test_options();
   o.stall_timeout_s = 0.080;
@@ -143,7 +115,7 @@ TEST_CASE("A stall longer than stall_timeout_s ends the run safely and the tripp
       [&](const DeviceState&, double) {
         if (++n == 20) {
           sleep_ms(200);
-          return ServoCommand{Vec3(MarkerDevice::kMarker, 0, 0), false};
+          return ServoCommand{Vec3(ProbeDevice::kMarker, 0, 0), false};
         }
         return ServoCommand{Vec3(0.1, 0, 0), n >= 400};
       },
@@ -176,9 +148,8 @@ TEST_CASE("A stall longer than stall_timeout_s ends the run safely and the tripp
 TEST_CASE("A real-time trial ended by a stall keeps every tick recorded, the tripping tick included",
           "[servo]") {
   const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'口')});
-  MarkerDevice device;
-  device.stall_after_ = 100;  // the physics step after tick 100 takes 250 ms
-  device.stall_ms_ = 250;
+  ProbeDevice device;
+  device.stall_at(100, 250);  // the physics step after tick 100 takes 250 ms
   TrialOptions options;
   options.pacing = TrialPacing::real_time;
   options.loop = stall_test_options();

@@ -16,8 +16,11 @@
 #include "calligraphy/sim/simulated_device.hpp"
 #include "calligraphy/trial/trial.hpp"
 #include "devices/latency_histogram.hpp"
+#include "probe_device.hpp"
 
 using namespace calligraphy;
+
+using test::ProbeDevice;
 
 namespace {
 
@@ -52,36 +55,6 @@ std::size_t settled_thread_count(std::size_t expected) {
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   return thread_count();
 }
-
-// A simulated device that counts writes of a marker force and can throw CommunicationError on a given read.
-class ProbeDevice final : public HapticDevice, public HandPort {
- public:
-  explicit ProbeDevice(long fail_on_read = -1) : fail_on_read_(fail_on_read) { inner_.open(); }
-  const DeviceInfo& info() const override { return inner_.info(); }
-  void open() override { inner_.open(); }
-  void close() noexcept override { inner_.close(); }
-  bool is_open() const override { return inner_.is_open(); }
-  void enable_forces(bool enabled) override { inner_.enable_forces(enabled); }
-  bool forces_enabled() const override { return inner_.forces_enabled(); }
-  DeviceState read_state() override {
-    if (reads_++ == fail_on_read_)
-      throw CommunicationError("probe device: USB transfer timed out on read " +
-                               std::to_string(fail_on_read_));
-    return inner_.read_state();
-  }
-  void write_force(const Vec3& force_n) override {
-    if (force_n.x() == kMarker) ++marker_writes_;
-    inner_.write_force(force_n);
-  }
-  // The hand port, so that a real-time trial steps the physics after each force write.
-  void attach_hand(HandModel* hand) noexcept override { inner_.attach_hand(hand); }
-  void advance(double dt_s) override { inner_.advance(dt_s); }
-  static constexpr double kMarker = 1.25;  // [N]
-  SimulatedDevice inner_;
-  long reads_ = 0;
-  long fail_on_read_;
-  int marker_writes_ = 0;
-};
 
 Scene scene_of(const std::u32string& chars) {
   std::vector<Character> characters;

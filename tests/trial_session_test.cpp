@@ -6,8 +6,11 @@
 #include "calligraphy/sim/simulated_device.hpp"
 #include "calligraphy/sim/simulated_writer.hpp"
 #include "calligraphy/trial/trial.hpp"
+#include "probe_device.hpp"
 
 using namespace calligraphy;
+
+using test::ProbeDevice;
 
 namespace {
 
@@ -16,32 +19,6 @@ Scene scene_of(std::u32string chars) {
   for (char32_t c : chars) characters.push_back(CharacterLibrary::embedded().load(c));
   return Scene::lay_out(characters);
 }
-
-// A simulated device that counts force writes and hand-port steps.
-class CountingDevice final : public HapticDevice, public HandPort {
- public:
-  const DeviceInfo& info() const override { return inner_.info(); }
-  void open() override { inner_.open(); }
-  void close() noexcept override { inner_.close(); }
-  bool is_open() const override { return inner_.is_open(); }
-  void enable_forces(bool enabled) override { inner_.enable_forces(enabled); }
-  bool forces_enabled() const override { return inner_.forces_enabled(); }
-  DeviceState read_state() override {
-    ++reads_;
-    return inner_.read_state();
-  }
-  void write_force(const Vec3& force_n) override {
-    ++writes_;
-    last_force_ = force_n;
-    inner_.write_force(force_n);
-  }
-  void attach_hand(HandModel* hand) noexcept override { inner_.attach_hand(hand); }
-  void advance(double dt_s) override { inner_.advance(dt_s); }
-  SimulatedDevice inner_;
-  long reads_ = 0;
-  long writes_ = 0;
-  Vec3 last_force_ = Vec3::Constant(1.0);  // the last force commanded [N]
-};
 
 }  // namespace
 
@@ -79,7 +56,7 @@ TEST_CASE("A session stepped from the application's own loop records the runner'
 TEST_CASE("Every tick writes the force once, lock-step and in real time", "[trial][servo]") {
   const Scene scene = scene_of(U"乙");
   for (const TrialPacing pacing : {TrialPacing::lock_step, TrialPacing::real_time}) {
-    CountingDevice device;
+    ProbeDevice device;
     TrialOptions options;
     options.pacing = pacing;
     options.max_duration_s = 0.3;  // a short stretch of the trial is enough
@@ -114,7 +91,7 @@ TEST_CASE("should_stop ends a trial as interrupted with the ticks kept", "[trial
     const long stop_after = pacing == TrialPacing::lock_step ? 3000 : 200;
     long polls = 0;
     options.should_stop = [&polls, stop_after] { return ++polls > stop_after; };
-    CountingDevice device;
+    ProbeDevice device;
     const TrialResult result = run_trial(device, scene, options);
     INFO("pacing " << static_cast<int>(pacing));
     CHECK(result.end == TrialEnd::interrupted);
