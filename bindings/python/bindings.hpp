@@ -15,5 +15,6 @@ void bind_render(py::module_& m);     // force law, interaction states, renderer
 void bind_sim(py::module_& m);        // simulated device and writer, device registry
 void bind_report(py::module_& m);     // trial reports (JSON metrics)
 void bind_trial(py::module_& m);      // simulated trials
+void bind_score(py::module_& m);      // scoring of any pen trace
 
 }  // namespace calligraphy::python

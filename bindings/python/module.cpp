@@ -15,4 +15,5 @@ PYBIND11_MODULE(_calligraphy, m) {
   bind_sim(m);
   bind_report(m);
   bind_trial(m);
+  bind_score(m);
 }

@@ -82,6 +82,7 @@ from ._calligraphy import (  # noqa: F401
     resistance_force,
     set_log_level,
     run_trial,
+    score,
     simulate_trial,
     typical_stroke,
 )
@@ -141,6 +142,7 @@ __all__ = [
     "resistance_force",
     "set_log_level",
     "run_trial",
+    "score",
     "simulate_trial",
     "typical_stroke",
 ]

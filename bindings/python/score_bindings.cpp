@@ -1,0 +1,144 @@
+// score: a pen trace from any source (a CSV file, or columns from numpy or pandas) scored against a
+// character, as `calligraphy score` does (trial/score.hpp, report/score_report.hpp), with the same JSON keys.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "arguments.hpp"
+#include "bindings.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/report/pen_trace_csv.hpp"
+#include "calligraphy/report/score_report.hpp"
+#include "calligraphy/trial/score.hpp"
+#include "character_source.hpp"
+#include "core/unicode.hpp"
+
+namespace calligraphy::python {
+namespace {
+
+using Column = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// Column `key` of a mapping (dict of arrays, pandas DataFrame) as a 1-D float64 array.
+Column column(const py::object& columns, const char* key) {
+  Column values;
+  try {
+    values = Column::ensure(columns[py::str(key)]);
+  } catch (const py::error_already_set&) {
+    values = Column();
+  }
+  if (!values || values.ndim() != 1) {
+    throw InvalidArgument(std::string("trace: column '") + key + "' is not a 1-D array of numbers");
+  }
+  return values;
+}
+
+bool has_column(const py::object& columns, const char* key) {
+  return py::bool_(columns.attr("__contains__")(py::str(key)));
+}
+
+// The samples of a mapping with columns t, x, y and pen (1/0) or z [m] (pen_trace_csv.hpp's columns).
+std::vector<PenSample> samples_from_columns(const py::object& columns, TraceUnits units,
+                                            const Placement& placement, double contact_threshold_m) {
+  if (!py::hasattr(columns, "__getitem__") || !py::hasattr(columns, "__contains__")) {
+    throw py::type_error(
+        "trace: expected a CSV file's path or a mapping of columns (a dict of arrays, a "
+        "pandas DataFrame) with t, x, y and pen or z");
+  }
+  for (const char* key : {"t", "x", "y"}) {
+    if (!has_column(columns, key)) throw InvalidArgument(std::string("trace: no column '") + key + "'");
+  }
+  const bool pen_column = has_column(columns, "pen");
+  if (!pen_column && !has_column(columns, "z")) throw InvalidArgument("trace: no column 'pen' or 'z'");
+  const Column t = column(columns, "t"), x = column(columns, "x"), y = column(columns, "y");
+  const Column contact = column(columns, pen_column ? "pen" : "z");
+  const py::ssize_t n = t.shape(0);
+  if (x.shape(0) != n || y.shape(0) != n || contact.shape(0) != n) {
+    throw InvalidArgument("trace: the columns have different lengths");
+  }
+  std::vector<PenSample> samples(static_cast<std::size_t>(n));
+  for (py::ssize_t i = 0; i < n; ++i) {
+    const double c = contact.at(i);
+    if (pen_column && c != 0.0 && c != 1.0) {
+      throw InvalidArgument("trace: sample " + std::to_string(i) + ": pen is " + std::to_string(c) +
+                            ", expected 1 (on paper) or 0 (lifted)");
+    }
+    if (!pen_column && !std::isfinite(c)) {
+      throw InvalidArgument("trace: sample " + std::to_string(i) + ": z is not a finite number");
+    }
+    const Vec2 position(x.at(i), y.at(i));
+    PenSample& sample = samples[static_cast<std::size_t>(i)];
+    sample.time_s = t.at(i);
+    sample.position_m = units == TraceUnits::data ? placement.to_paper(position) : position;
+    sample.pen_down = pen_column ? c == 1.0 : c <= contact_threshold_m;
+  }
+  return samples;
+}
+
+py::dict score_py(const py::object& trace, const py::object& character, const std::string& units_name,
+                  const std::optional<Checked<CharacterSource>>& library, double contact_threshold_m,
+                  double leniency) {
+  const TraceUnits units = parse_trace_units(units_name == "m" ? "metres" : units_name);
+  Character model;
+  if (py::isinstance<Character>(character)) {
+    model = character.cast<Character>();
+  } else {
+    const CharacterSource source = library ? take(*library, "library") : CharacterSource::embedded();
+    model = source.load(one_character(convert_named<std::string>(character, "character"), "character"));
+  }
+  const Scene scene = Scene::lay_out({model});
+  const PlacedCharacter& placed = scene.characters.front();
+
+  std::vector<PenSample> samples;
+  std::string trace_name = "<columns>";
+  if (py::isinstance<py::str>(trace) || py::isinstance(trace, py::module_::import("os").attr("PathLike"))) {
+    trace_name = py::str(py::module_::import("os").attr("fspath")(trace));
+    PenTraceCsvOptions options;
+    options.units = units;
+    options.contact_threshold_m = contact_threshold_m;
+    samples = read_pen_trace_csv(trace_name, placed.placement, options);
+  } else {
+    if (!std::isfinite(contact_threshold_m))
+      throw InvalidArgument("contact_threshold_m: not a finite number");
+    samples = samples_from_columns(trace, units, placed.placement, contact_threshold_m);
+  }
+  ScoreOptions options;
+  options.leniency = leniency;
+  const CharacterScore score = score_trace(placed, samples, options);
+  const ScoreDescription description{encode_utf8(placed.code_point), trace_name,
+                                     units == TraceUnits::data ? "data" : "m", samples.size()};
+  return py::module_::import("json").attr("loads")(py::str(score_json(description, score)));
+}
+
+}  // namespace
+
+void bind_score(py::module_& m) {
+  m.def(
+      "score", &score_py, py::arg("trace"), py::arg("character"), py::arg("units") = "m",
+      py::arg("library") = py::none(),
+      py::arg("contact_threshold_m") = PenTraceCsvOptions{}.contact_threshold_m,
+      py::arg("leniency") = ScoreOptions{}.leniency,
+      R"(Scores a pen trace from any source against a character, as `calligraphy score` does (trial/score.hpp;
+metrics defined in docs/metrics.md): strokes segmented at pen lifts and matched to the reference strokes
+with Hanzi Writer's quiz tests, so order and direction errors are found.
+
+trace: the path of a CSV file (header t, x, y and pen or z; other columns ignored: `trial --csv` output
+       reads as it is), or a mapping of columns (a dict of 1-D arrays, a pandas DataFrame) with `t` [s],
+       `x`, `y` and `pen` (1 on paper, 0 lifted) or `z` [m] (on paper when z <= contact_threshold_m).
+character: a str of one character (loaded from `library`, default the embedded set) or a Character,
+           laid out as `simulate_trial` places it.
+units: 'm' (metres on the paper plane of that placement) or 'data' (the 1024-unit box, y up).
+leniency: scales the match tests' thresholds, > 0 (Hanzi Writer's quiz leniency).
+Returns a dict with the keys of `calligraphy score --json` (per_stroke, order_errors, backwards_strokes,
+mean_deviation_mm, frechet_mm, dtw_mm, ...); a value that does not exist is None.
+Raises DataError (file unreadable, bad row: naming line and column), InvalidArgument (a bad column,
+sample or option, naming it), CharacterNotFound, TypeError.)");
+}
+
+}  // namespace calligraphy::python

@@ -1,0 +1,92 @@
+"""calligraphy.score: any pen trace (a CSV file, a dict of columns, a pandas DataFrame) scored as
+`calligraphy score` scores it, with order and direction errors found from the trace."""
+
+import numpy as np
+import pytest
+
+import calligraphy
+
+
+def reference_trace(char, offset_m=0.0, order=None, reverse=()):
+    """A trace along the reference strokes (the placed elements sampled densely), pen lifted between
+    strokes, moved `offset_m` to the left of each stroke (along its normal); strokes in `order`, those in
+    `reverse` written end to start."""
+    strokes = calligraphy.Scene(char).characters[0].strokes
+    order = range(len(strokes)) if order is None else order
+    t, x, y, pen = [], [], [], []
+    now = 0.0
+    for k in order:
+        points = np.vstack([e.point(np.linspace(0.0, 1.0, 50)) for e in strokes[k].elements])
+        tangent = np.gradient(points, axis=0)
+        normal = np.column_stack([-tangent[:, 1], tangent[:, 0]])
+        points = points + offset_m * normal / np.linalg.norm(normal, axis=1, keepdims=True)
+        if k in reverse:
+            points = points[::-1]
+        for p in points:
+            t.append(now)
+            x.append(p[0])
+            y.append(p[1])
+            pen.append(1)
+            now += 0.002
+        t.append(now)  # lifted
+        x.append(points[-1][0])
+        y.append(points[-1][1])
+        pen.append(0)
+        now += 0.2
+    return {"t": np.array(t), "x": np.array(x), "y": np.array(y), "pen": np.array(pen)}
+
+
+def test_reference_scores_complete_in_order_near_zero():
+    result = calligraphy.score(reference_trace("木"), "木")
+    assert result["completed_in_order"] is True
+    assert result["order_errors"] == 0
+    assert result["mean_deviation_mm"] < 0.05
+
+
+def test_offset_of_one_millimetre_is_measured():
+    result = calligraphy.score(reference_trace("木", offset_m=0.001), "木")
+    assert result["mean_deviation_mm"] == pytest.approx(1.0, abs=0.1)
+    assert result["frechet_mm"] == pytest.approx(1.0, abs=0.15)
+
+
+def test_swapped_and_reversed_strokes_are_found():
+    swapped = calligraphy.score(reference_trace("木", order=[1, 0, 2, 3]), "木")
+    assert swapped["order_errors"] == 1
+    reversed_stroke = calligraphy.score(reference_trace("木", reverse=(0,)), "木")
+    assert reversed_stroke["backwards_strokes"] == 1
+
+
+def test_dataframe_and_csv_give_the_dict_result(tmp_path):
+    pandas = pytest.importorskip("pandas")
+    columns = reference_trace("大", offset_m=0.0005)
+    frame = pandas.DataFrame(columns)
+    by_dict = calligraphy.score(columns, "大")
+    by_frame = calligraphy.score(frame, "大")
+    path = tmp_path / "trace.csv"
+    frame.to_csv(path, index=False, float_format="%.17g")
+    by_file = calligraphy.score(path, "大")
+    assert by_frame["mean_deviation_mm"] == by_dict["mean_deviation_mm"]
+    assert by_file["mean_deviation_mm"] == pytest.approx(by_dict["mean_deviation_mm"], rel=1e-12)
+    assert by_file["trace"] == str(path)
+
+
+def test_a_simulated_trials_trace_scores_in_order():
+    trial = calligraphy.simulate_trial("中", seed=2)
+    p = trial.position_m  # (N, 3), the paper at z = 0
+    result = calligraphy.score({"t": trial.time_s, "x": p[:, 0], "y": p[:, 1], "z": p[:, 2]}, "中")
+    assert result["completed_in_order"] == trial.metrics["completed_in_order"]
+
+
+def test_bad_input_names_the_column_or_sample():
+    columns = reference_trace("大")
+    with pytest.raises(calligraphy.InvalidArgument, match="'pen' or 'z'"):
+        calligraphy.score({k: v for k, v in columns.items() if k != "pen"}, "大")
+    bad_pen = dict(columns, pen=np.where(columns["pen"] == 1, 2, 0))
+    with pytest.raises(calligraphy.InvalidArgument, match="sample 0: pen"):
+        calligraphy.score(bad_pen, "大")
+    with pytest.raises(calligraphy.InvalidArgument, match="different lengths"):
+        calligraphy.score(dict(columns, x=columns["x"][:-1]), "大")
+    with pytest.raises(calligraphy.DataError, match="no such file"):
+        calligraphy.score("/nonexistent/trace.csv", "大")
+    with pytest.raises(TypeError):
+        calligraphy.score(42, "大")
