@@ -5,8 +5,8 @@
 #include <map>
 #include <vector>
 
-#include "calligraphy/model/character_library.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/character_library.hpp"
 #include "calligraphy/trial/score.hpp"
 
 using namespace calligraphy;
@@ -284,6 +284,34 @@ TEST_CASE("Scoring a 5-stroke trace of about 15,000 samples (timing printed)", "
       const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
       WARN(trace.samples.size() << " samples scored in " << took.count() * 1e3 << " ms");
       CHECK(score.strokes_written == 5);
+    }
+  }
+}
+
+TEST_CASE("A stroke written twice is not taken for a neighbouring stroke never written", "[score]") {
+  // Hanzi Writer's closer-stroke rule: the repeat matches its own stroke more closely, so it must pass the
+  // tests against the unwritten one at a lower leniency. Every (omitted, repeated) pair of strokes.
+  for (const char32_t c : {U'鼎', U'说', U'电', U'月', U'日'}) {
+    const PlacedCharacter& character = scene_of(c).characters.front();
+    const std::size_t n = character.strokes.size();
+    for (std::size_t omitted = 0; omitted < n; ++omitted) {
+      for (std::size_t repeated = 0; repeated < n; ++repeated) {
+        if (repeated == omitted) continue;
+        std::vector<std::size_t> order;
+        for (std::size_t k = 0; k < n; ++k) {
+          if (k == omitted) continue;
+          order.push_back(k);
+          if (k == repeated) order.push_back(k);
+        }
+        const CharacterScore score =
+            score_trace(character, written_in_order(character, order, 0.1e-3).samples);
+        INFO("character U+" << std::hex << static_cast<unsigned>(c) << std::dec << ", stroke " << omitted
+                            << " omitted, stroke " << repeated << " written twice");
+        CHECK(score.strokes_written == n - 1);
+        CHECK(score.missing_strokes == std::vector<std::size_t>{omitted});
+        CHECK(score.order_errors == 0);
+        CHECK(score.unmatched_strokes == 1);
+      }
     }
   }
 }

@@ -12,9 +12,6 @@ namespace {
 // comparison keeps each judgement within milliseconds.
 constexpr std::size_t kQuizCurvePoints = 64;
 
-// Hanzi Writer lowers the leniency to between 0.3 and 0.6 of itself when a later stroke matches closer.
-constexpr double kLaterStrokeLeniencyFactor = 0.6;
-
 }  // namespace
 
 const char* to_string(QuizEvent::Kind kind) noexcept {
@@ -88,9 +85,8 @@ std::vector<QuizEvent> QuizSession::judge_segment() {
         }
       }
       if (event.closer_later_stroke && verdict.mean_distance_m > 0.0) {
-        const double factor = kLaterStrokeLeniencyFactor * (closest + verdict.mean_distance_m) /
-                              (2.0 * verdict.mean_distance_m);
-        verdict = judge(current_, options_.leniency * factor);
+        verdict = judge(current_,
+                        options_.leniency * closer_stroke_leniency_factor(closest, verdict.mean_distance_m));
       }
     }
     const bool accepted = verdict.matched && (!verdict.backwards || options_.accept_backwards);

@@ -98,6 +98,11 @@ void add_spatial_totals(CharacterScore& score) {
 
 }  // namespace
 
+double closer_stroke_leniency_factor(double closer_distance, double own_distance) noexcept {
+  if (!(own_distance > 0.0)) return 1.0;
+  return 0.6 * (closer_distance + own_distance) / (2.0 * own_distance);
+}
+
 CharacterScore score_trace(const PlacedCharacter& character, std::span<const PenSample> trace,
                            const ScoreOptions& options) {
   check_options(options);
@@ -165,12 +170,29 @@ CharacterScore score_trace(const PlacedCharacter& character, std::span<const Pen
   std::vector<std::vector<std::optional<double>>> costs(strokes,
                                                         std::vector<std::optional<double>>(scored.size()));
   std::vector<std::vector<bool>> reversed(strokes, std::vector<bool>(scored.size(), false));
-  for (std::size_t r = 0; r < strokes; ++r) {
-    const trial_detail::MatchCurve reference = reference_curve(character.strokes[r], character.placement);
-    for (std::size_t w = 0; w < scored.size(); ++w) {
-      const trial_detail::MatchResult match =
-          trial_detail::match_stroke(written[w], reference, options.leniency);
+  std::vector<trial_detail::MatchCurve> references;
+  for (const PlacedStroke& stroke : character.strokes)
+    references.push_back(reference_curve(stroke, placement));
+  std::vector<trial_detail::MatchResult> matches(strokes);
+  for (std::size_t w = 0; w < scored.size(); ++w) {
+    for (std::size_t r = 0; r < strokes; ++r) {
+      matches[r] = trial_detail::match_stroke(written[w], references[r], options.leniency);
+    }
+    for (std::size_t r = 0; r < strokes; ++r) {
+      trial_detail::MatchResult match = matches[r];
       if (match.kind == trial_detail::MatchKind::miss) continue;
+      // Another stroke that this segment matches forwards more closely: probably the one written.
+      double closer = match.mean_distance;
+      for (std::size_t other = 0; other < strokes; ++other) {
+        if (other != r && matches[other].kind == trial_detail::MatchKind::forwards)
+          closer = std::min(closer, matches[other].mean_distance);
+      }
+      if (closer < match.mean_distance) {
+        match = trial_detail::match_stroke(
+            written[w], references[r],
+            options.leniency * closer_stroke_leniency_factor(closer, match.mean_distance));
+        if (match.kind == trial_detail::MatchKind::miss) continue;
+      }
       costs[r][w] = match.mean_distance;
       reversed[r][w] = match.kind == trial_detail::MatchKind::backwards;
     }

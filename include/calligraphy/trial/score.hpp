@@ -78,9 +78,17 @@ struct CharacterScore {
   CharacterWritingMetrics totals;
 };
 
+/// Hanzi Writer's rule (chanind/hanzi-writer, src/strokeMatches.ts) when another stroke matches a written
+/// stroke more closely than the stroke it is tested against: the writer probably wrote that other one,
+/// so the test is repeated with the leniency times 0.6 (closer + own) / (2 own), between 0.3 and 0.6.
+/// `closer_distance` < `own_distance`, both >= 0 (any unit); 1 when own_distance is 0.
+[[nodiscard]] double closer_stroke_leniency_factor(double closer_distance, double own_distance) noexcept;
+
 /// Scores `trace` against `character`. Segments are matched one to one to reference strokes: among the
-/// pairs that pass the Hanzi Writer tests (forwards, else backwards), as many pairs as possible, and
-/// among those the least sum of mean distances (an optimal assignment, Kuhn 1955 / Munkres 1957). Throws
+/// pairs that pass the Hanzi Writer tests (forwards, else backwards; a pair whose segment another stroke
+/// matches forwards more closely must pass them again at the leniency `closer_stroke_leniency_factor`
+/// gives), as many pairs as possible, and among those the least sum of mean distances (an optimal
+/// assignment, Kuhn 1955 / Munkres 1957). Throws
 /// InvalidArgument for a bad trace (see validate_pen_trace, and positions too large to convert to data
 /// units), a character without strokes, a stroke without elements, a placement that is not finite with a
 /// positive scale, or options out of range.
