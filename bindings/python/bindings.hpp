@@ -13,7 +13,8 @@ void bind_model(py::module_& m);      // elements, characters, libraries, typica
 void bind_collision(py::module_& m);  // nearest_point
 void bind_render(py::module_& m);     // force law, interaction states, renderer
 void bind_sim(py::module_& m);        // simulated device and writer, device registry
-void bind_report(py::module_& m);     // trial reports (JSON metrics)
+void bind_writer_learning(py::module_& m);  // writer logs, profiles by name, learning across repetitions
+void bind_report(py::module_& m);     // trial reports (JSON metrics), teacher recordings
 void bind_trial(py::module_& m);      // simulated trials
 void bind_score(py::module_& m);      // scoring of any pen trace
 

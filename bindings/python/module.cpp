@@ -13,6 +13,7 @@ PYBIND11_MODULE(_calligraphy, m) {
   bind_collision(m);
   bind_render(m);
   bind_sim(m);
+  bind_writer_learning(m);
   bind_report(m);
   bind_trial(m);
   bind_score(m);

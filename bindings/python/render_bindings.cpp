@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,30 @@ void bind_guidance(py::module_& m) {
                std::to_string(t.position_m.x()) + ", " + std::to_string(t.position_m.y()) + ", " +
                std::to_string(t.position_m.z()) + "])";
       });
+  ParameterClass<FadingRule>(
+      m, "FadingRule",
+      "The performance-based fading rule g(n+1) = clamp(f g(n) + k e(n), 0, 1) of next_guidance_gain: the "
+      "error-based controller with a forgetting factor of Emken, Benitez & Reinkensmeyer 2007 (J NeuroEng "
+      "Rehabil 4:8), applied once per repetition.",
+      [](const FadingRule& rule) { rule.validate(); })
+      .field("forgetting_factor", &FadingRule::forgetting_factor, "f in [0, 1]")
+      .field("error_gain_per_m", &FadingRule::error_gain_per_m,
+             "k [1/m], >= 0, so that 1 mm of mean deviation adds k / 1000 to the gain")
+      .finish();
+  m.def(
+      "next_guidance_gain",
+      [](const Checked<double>& gain, const Checked<double>& error_m,
+         const std::optional<Checked<FadingRule>>& rule) {
+        return next_guidance_gain(take(gain, "gain"), take(error_m, "error_m"),
+                                  rule ? take(*rule, "rule") : FadingRule{});
+      },
+      py::arg("gain"), py::arg("error_m"), py::arg("rule") = py::none(),
+      R"(The fading guidance gain of the next repetition (include/calligraphy/render/guidance_mode.hpp):
+clamp(f gain + k error_m, 0, 1) with f, k of `rule` (a FadingRule, default f = 0.8, k = 200 1/m; Emken,
+Benitez & Reinkensmeyer 2007). gain: this repetition's gain in [0, 1]; error_m: its error [m] >= 0, for
+example the trial's mean deviation (metrics['mean_deviation_mm'] / 1000). Returns a float in [0, 1].
+Raises InvalidArgument (a ValueError) for a gain outside [0, 1], a negative or non-finite error or a bad
+rule; TypeError naming the argument for a value of the wrong type.)");
 }
 
 void bind_force_law_parameters(py::module_& m) {

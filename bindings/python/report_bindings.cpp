@@ -1,10 +1,19 @@
 // report: the metrics of a trial from the same code as `calligraphy trial --json`
-// (include/calligraphy/report/trial_report.hpp, trial_json), so Python and the CLI have one list of keys.
+// (include/calligraphy/report/trial_report.hpp, trial_json), so Python and the CLI have one list of keys;
+// a teacher's recording for replay guidance (teacher_recording.hpp).
 #include "report_bindings.hpp"
 
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
+#include <filesystem>
+#include <string>
+
+#include "arguments.hpp"
 #include "bindings.hpp"
+#include "calligraphy/core/atomic_file.hpp"
+#include "calligraphy/report/teacher_recording.hpp"
 
 namespace calligraphy::python {
 
@@ -13,6 +22,58 @@ py::dict trial_metrics(const TrialDescription& description, const TrialResult& r
   return py::module_::import("json").attr("loads")(py::str(text));
 }
 
-void bind_report(py::module_& /*m*/) {}
+void write_teacher_recording(const TeacherRecording& recording, const std::filesystem::path& path) {
+  // Atomically: a reader (a running trainer, a protocol) never sees half a recording.
+  write_file_atomically(path, teacher_recording_json(recording));
+}
+
+void bind_report(py::module_& m) {
+  py::class_<TeacherRecording>(
+      m, "TeacherRecording",
+      "A teacher's recorded trial for the replay guidance mode (include/calligraphy/report/"
+      "teacher_recording.hpp; record and replay: Henmi & Yoshikawa 1998, Feygin, Keehner & Tendick 2002). "
+      "Made by calligraphy.record_teacher(result) or `calligraphy trial --record FILE`; pass it as "
+      "simulate_trial(..., teacher=recording). It guides only the characters it was recorded on, laid out "
+      "the same way.")
+      .def_readonly("characters", &TeacherRecording::characters, "the scene's characters, left to right")
+      .def_readonly("writer", &TeacherRecording::writer, "who wrote it, 'human' or the writer's profile")
+      .def_readonly("device", &TeacherRecording::device, "registry name of the device it was written on")
+      .def_readonly("rate_hz", &TeacherRecording::rate_hz, "servo rate it was recorded at [Hz]")
+      .def_readonly("library_version", &TeacherRecording::library_version,
+                    "version of the library that recorded it (empty when unknown)")
+      .def_readonly("samples", &TeacherRecording::samples,
+                    "list of TeacherSample, the pen in the device frame [m] at times [s]")
+      .def("to_json", &teacher_recording_json,
+           "The recording as JSON text (format 'calligraphy-teacher-recording', version 1; numbers read "
+           "back exactly).")
+      .def(
+          "save",
+          [](const TeacherRecording& recording, const PathLike& path) {
+            write_teacher_recording(recording, convert_named<std::filesystem::path>(path.object, "path"));
+          },
+          py::arg("path"),
+          "Writes the JSON to `path` atomically (a temporary file renamed over it). Raises Error naming the "
+          "path when it cannot be written.")
+      .def_static(
+          "load",
+          [](const PathLike& path) {
+            return read_teacher_recording(convert_named<std::filesystem::path>(path.object, "path"));
+          },
+          py::arg("path"),
+          "Reads a recording file. Raises DataError naming the path (and the key, the sample index) for a "
+          "missing, oversized or malformed file.")
+      .def_static(
+          "from_json",
+          [](const std::string& text, const std::string& source) {
+            return parse_teacher_recording(text, source);
+          },
+          py::arg("text"), py::arg("source") = "<text>",
+          "Parses the JSON format; `source` names the text in errors. Raises DataError naming the key.")
+      .def("__len__", [](const TeacherRecording& r) { return r.samples.size(); })
+      .def("__repr__", [](const TeacherRecording& r) {
+        return "TeacherRecording(characters='" + r.characters + "', writer='" + r.writer + "', device='" +
+               r.device + "', samples=" + std::to_string(r.samples.size()) + ")";
+      });
+}
 
 }  // namespace calligraphy::python

@@ -2,6 +2,9 @@
 // The report functions other binding files use.
 #include <pybind11/pybind11.h>
 
+#include <filesystem>
+
+#include "calligraphy/report/teacher_recording.hpp"
 #include "calligraphy/report/trial_report.hpp"
 
 namespace calligraphy::python {
@@ -10,5 +13,8 @@ namespace py = pybind11;
 
 /// The trial's metrics as a dict with the keys of `calligraphy trial --json`.
 py::dict trial_metrics(const TrialDescription& description, const TrialResult& result);
+
+/// Writes `recording` as JSON to `path` atomically (write_file_atomically).
+void write_teacher_recording(const TeacherRecording& recording, const std::filesystem::path& path);
 
 }  // namespace calligraphy::python

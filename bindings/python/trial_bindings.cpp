@@ -3,9 +3,12 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include <chrono>
+#include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,6 +16,7 @@
 #include "bindings.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/scene.hpp"
+#include "calligraphy/render/guidance_mode.hpp"
 #include "calligraphy/render/passivity.hpp"
 #include "calligraphy/render/safety_chain.hpp"
 #include "calligraphy/trial/trial.hpp"
@@ -22,6 +26,7 @@
 #include "model_bindings.hpp"
 #include "numpy_arrays.hpp"
 #include "report_bindings.hpp"
+#include "writer_settings.hpp"
 
 namespace calligraphy::python {
 namespace {
@@ -35,8 +40,8 @@ struct SceneTag {
 struct DataFrameTag {
   static constexpr auto name = py::detail::const_name("pandas.DataFrame");
 };
-struct WriterTag {
-  static constexpr auto name = py::detail::const_name("Union[str, WriterProfile]");
+struct TeacherTag {
+  static constexpr auto name = py::detail::const_name("Union[TeacherRecording, Sequence[TeacherSample]]");
 };
 
 // A trial's trace as numpy arrays (one row per servo tick), its metrics and the scene it was written on.
@@ -46,21 +51,13 @@ struct PyTrialResult {
   py::array_t<std::int64_t> stroke, element, stroke_trace_range;
   py::dict metrics;
   py::object scene;
+  WriterProfile writer;                 // the profile the simulated writer wrote with
+  std::optional<WriterLog> writer_log;  // what it did; empty on a device a person moves
 };
 
 // The most servo ticks one call may simulate (rate_hz * max_duration_s): 10^7 ticks keep about 0.8 GB of
 // trace, about 3 hours at 1 kHz; the default 300 s at 1 kHz is 3 * 10^5.
 constexpr double kMaxTicks = 1e7;
-
-WriterProfile writer_from(const py::object& object) {
-  if (py::isinstance<WriterProfile>(object)) return object.cast<WriterProfile>();
-  if (!py::isinstance<py::str>(object))
-    throw_type_error("writer", "'novice', 'skilled' or a WriterProfile", object);
-  const std::string name = object.cast<std::string>();
-  if (name == "novice") return WriterProfile::novice();
-  if (name == "skilled") return WriterProfile::skilled();
-  throw InvalidArgument("writer: expected 'novice', 'skilled' or a WriterProfile, got '" + name + "'");
-}
 
 PyTrialResult to_python(const TrialResult& result, py::dict metrics, py::object scene) {
   const auto n = static_cast<py::ssize_t>(result.trace.size());
@@ -96,8 +93,9 @@ PyTrialResult to_python(const TrialResult& result, py::dict metrics, py::object 
     rw(i, 0) = n > 0 ? static_cast<std::int64_t>(m.trace_begin) : 0;
     rw(i, 1) = n > 0 ? static_cast<std::int64_t>(m.trace_end) : 0;
   }
-  return PyTrialResult{time,   position,           force,           state, stroke, element,
-                       ranges, std::move(metrics), std::move(scene)};
+  return PyTrialResult{
+      time, position,         force, state, stroke, element, ranges, std::move(metrics), std::move(scene),
+      {},   result.writer_log};
 }
 
 // Polls Python's signal handlers from a thread that does not hold the GIL, at most every 50 ms.
@@ -126,46 +124,110 @@ class SignalPoll {
   std::unique_ptr<py::error_already_set> error_;
 };
 
+// One description of the arguments simulate_trial and run_trial share, in their Python order after each
+// function's own leading arguments: X(C++ type, Python name, default). It makes the TrialArguments
+// fields, the C++ parameters and the py::arg list of both functions.
+#define CALLIGRAPHY_TRIAL_ARGUMENTS(X)                                    \
+  X(Annotated<WriterTag>, writer, "novice")                               \
+  X(Checked<bool>, guidance, true)                                        \
+  X(Checked<double>, rate_hz, 1000.0)                                     \
+  X(Checked<std::uint64_t>, seed, 0)                                      \
+  X(std::optional<Checked<CharacterSource>>, library, py::none())         \
+  X(std::optional<Checked<ForceLawParameters>>, force_law, py::none())    \
+  X(Checked<double>, max_duration_s, 300.0)                               \
+  X(Checked<bool>, keep_trace, true)                                      \
+  X(std::optional<Annotated<WriterParamsTag>>, writer_params, py::none()) \
+  X(std::optional<Checked<GuidanceMode>>, guidance_mode, py::none())      \
+  X(std::optional<Checked<double>>, guidance_gain, py::none())            \
+  X(std::optional<Annotated<TeacherTag>>, teacher, py::none())
+
+#define CALLIGRAPHY_TRIAL_FIELD(type, name, default_value) type name;
+#define CALLIGRAPHY_TRIAL_PARAMETER(type, name, default_value) , const type& name
+#define CALLIGRAPHY_TRIAL_VALUE(type, name, default_value) name,
+#define CALLIGRAPHY_TRIAL_PY_ARG(type, name, default_value) , py::arg(#name) = default_value
+
+struct TrialArguments {
+  CALLIGRAPHY_TRIAL_ARGUMENTS(CALLIGRAPHY_TRIAL_FIELD)
+};
+
+// The teacher's samples for replay guidance: a TeacherRecording made on the scene's characters
+// (`label`), or a list of TeacherSample.
+std::vector<TeacherSample> teacher_samples(const py::object& teacher, const std::string& label) {
+  if (py::isinstance<TeacherRecording>(teacher)) {
+    const TeacherRecording& recording = teacher.cast<const TeacherRecording&>();
+    try {
+      require_teacher_for(recording, label);
+    } catch (const InvalidArgument& e) {
+      throw InvalidArgument(std::string("teacher: ") + e.what());
+    }
+    return recording.samples;
+  }
+  if (py::isinstance<py::str>(teacher) || !py::isinstance<py::sequence>(teacher))
+    throw_type_error("teacher", "a TeacherRecording or a list of TeacherSample", teacher);
+  return convert_named<std::vector<TeacherSample>>(teacher, "teacher");
+}
+
+// Guidance: `guidance_mode` (else replay when a teacher is given, else the force law's mode),
+// `guidance_gain` and the teacher's samples replace the force law's.
+void apply_guidance(const TrialArguments& a, const std::string& label, ForceLawParameters& force) {
+  force.guidance = take(a.guidance, "guidance");
+  if (a.guidance_mode) {
+    force.guidance_mode = take(*a.guidance_mode, "guidance_mode");
+  } else if (a.teacher && !a.teacher->object.is_none()) {
+    force.guidance_mode = GuidanceMode::replay;
+  }
+  if (a.guidance_gain) force.guidance_gain = take(*a.guidance_gain, "guidance_gain");
+  if (a.teacher && !a.teacher->object.is_none()) {
+    if (force.guidance_mode != GuidanceMode::replay) {
+      throw InvalidArgument(std::string("teacher: only the 'replay' guidance mode uses a teacher, got "
+                                        "guidance_mode '") +
+                            to_string(force.guidance_mode) + "'");
+    }
+    force.teacher_trajectory = teacher_samples(a.teacher->object, label);
+  }
+  if (force.guidance_mode == GuidanceMode::replay && force.teacher_trajectory.empty()) {
+    throw InvalidArgument(
+        "guidance_mode 'replay' needs teacher= (a TeacherRecording or a list of TeacherSample)");
+  }
+}
+
 // The trial behind simulate_trial and run_trial: `device_name` empty runs on a SimulatedDevice made from
 // `device`; else on the registry's device of that name, paced by `pacing`.
 PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
-                       const Annotated<TrialCharactersTag>& characters, const Annotated<WriterTag>& writer,
-                       const Checked<bool>& guidance, const Checked<double>& rate_hz,
-                       const Checked<std::uint64_t>& seed,
-                       const std::optional<Checked<CharacterSource>>& library,
-                       const std::optional<Checked<ForceLawParameters>>& force_law,
-                       const Checked<double>& max_duration_s, const Checked<bool>& keep_trace,
+                       const Annotated<TrialCharactersTag>& characters, const TrialArguments& a,
                        const std::optional<Checked<SimulatedDeviceParameters>>& device,
                        const std::optional<Checked<SafetyChainParameters>>& safety,
                        const std::optional<Checked<PassivityParameters>>& passivity) {
   TrialOptions options;
   options.pacing = pacing;
-  if (force_law) options.force = take(*force_law, "force_law");
-  options.force.guidance = take(guidance, "guidance");
-  options.simulation.writer = writer_from(writer.object);
-  options.rate_hz = take(rate_hz, "rate_hz");
-  options.simulation.seed = take(seed, "seed");
-  options.max_duration_s = take(max_duration_s, "max_duration_s");
-  options.keep_trace = take(keep_trace, "keep_trace");
+  if (a.force_law) options.force = take(*a.force_law, "force_law");
+  options.simulation.writer =
+      writer_with_settings(a.writer.object, a.writer_params ? a.writer_params->object : py::none());
+  options.rate_hz = take(a.rate_hz, "rate_hz");
+  options.simulation.seed = take(a.seed, "seed");
+  options.max_duration_s = take(a.max_duration_s, "max_duration_s");
+  options.keep_trace = take(a.keep_trace, "keep_trace");
   if (device) options.simulation.device = take(*device, "device");
   if (safety) options.safety = take(*safety, "safety");
   if (passivity) options.passivity = take(*passivity, "passivity");
-  options.validate();
-  if (!(options.rate_hz * options.max_duration_s <= kMaxTicks)) {
-    throw InvalidArgument("max_duration_s: " + std::to_string(options.max_duration_s) + " s at " +
-                          std::to_string(options.rate_hz) + " Hz is more than 10^7 servo ticks");
-  }
 
   py::object scene_object;
   if (py::isinstance<Scene>(characters.object)) {
     scene_object = characters.object;
   } else {
-    const CharacterSource source = library ? take(*library, "library") : CharacterSource::embedded();
+    const CharacterSource source = a.library ? take(*a.library, "library") : CharacterSource::embedded();
     scene_object = py::cast(Scene::lay_out(characters_from(characters.object, source, "characters")));
   }
   const Scene& scene = scene_object.cast<const Scene&>();
   std::string label;
   for (const PlacedCharacter& c : scene.characters) label += encode_utf8(c.code_point);
+
+  apply_guidance(a, label, options.force);
+  options.validate();
+  if (!(options.rate_hz * options.max_duration_s <= kMaxTicks)) {
+    throw InvalidArgument("max_duration_s: " + std::to_string(options.max_duration_s) + " s at " +
+                          std::to_string(options.rate_hz) + " Hz is more than 10^7 servo ticks");
+  }
 
   // Ctrl-C: the trial runs without the GIL; every 50 ms of wall clock the runner's thread takes the GIL
   // and lets Python run its signal handlers. A KeyboardInterrupt (or any exception a handler raises)
@@ -186,29 +248,24 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   description.seed = options.simulation.seed;
   description.rate_hz = options.rate_hz;
   if (!device_name.empty()) description.device = device_name;
-  return to_python(result, trial_metrics(description, result), scene_object);
+  PyTrialResult out = to_python(result, trial_metrics(description, result), scene_object);
+  out.writer = options.simulation.writer;
+  return out;
 }
 
-PyTrialResult simulate_trial_py(const Annotated<TrialCharactersTag>& characters,
-                                const Annotated<WriterTag>& writer, const Checked<bool>& guidance,
-                                const Checked<double>& rate_hz, const Checked<std::uint64_t>& seed,
-                                const std::optional<Checked<CharacterSource>>& library,
-                                const std::optional<Checked<ForceLawParameters>>& force_law,
-                                const Checked<double>& max_duration_s, const Checked<bool>& keep_trace,
+PyTrialResult simulate_trial_py(const Annotated<TrialCharactersTag>& characters
+                                    CALLIGRAPHY_TRIAL_ARGUMENTS(CALLIGRAPHY_TRIAL_PARAMETER),
                                 const std::optional<Checked<SimulatedDeviceParameters>>& device,
                                 const std::optional<Checked<SafetyChainParameters>>& safety,
                                 const std::optional<Checked<PassivityParameters>>& passivity) {
-  return trial_py({}, TrialPacing::lock_step, characters, writer, guidance, rate_hz, seed, library, force_law,
-                  max_duration_s, keep_trace, device, safety, passivity);
+  const TrialArguments arguments{CALLIGRAPHY_TRIAL_ARGUMENTS(CALLIGRAPHY_TRIAL_VALUE)};
+  return trial_py({}, TrialPacing::lock_step, characters, arguments, device, safety, passivity);
 }
 
-PyTrialResult run_trial_py(const Annotated<TrialCharactersTag>& characters,
-                           const Checked<std::string>& device, const Checked<std::string>& pacing,
-                           const Annotated<WriterTag>& writer, const Checked<bool>& guidance,
-                           const Checked<double>& rate_hz, const Checked<std::uint64_t>& seed,
-                           const std::optional<Checked<CharacterSource>>& library,
-                           const std::optional<Checked<ForceLawParameters>>& force_law,
-                           const Checked<double>& max_duration_s, const Checked<bool>& keep_trace) {
+PyTrialResult run_trial_py(
+    const Annotated<TrialCharactersTag>& characters, const Checked<std::string>& device,
+    const Checked<std::string>& pacing CALLIGRAPHY_TRIAL_ARGUMENTS(CALLIGRAPHY_TRIAL_PARAMETER)) {
+  const TrialArguments arguments{CALLIGRAPHY_TRIAL_ARGUMENTS(CALLIGRAPHY_TRIAL_VALUE)};
   const std::string name = take(device, "device");
   if (name.empty()) throw InvalidArgument("device: a device name of list_devices() is needed");
   const std::string how = take(pacing, "pacing");
@@ -220,8 +277,31 @@ PyTrialResult run_trial_py(const Annotated<TrialCharactersTag>& characters,
   } else if (how != "auto") {
     throw InvalidArgument("pacing: expected 'auto', 'lock_step' or 'real_time', got '" + how + "'");
   }
-  return trial_py(name, chosen, characters, writer, guidance, rate_hz, seed, library, force_law,
-                  max_duration_s, keep_trace, std::nullopt, std::nullopt, std::nullopt);
+  return trial_py(name, chosen, characters, arguments, std::nullopt, std::nullopt, std::nullopt);
+}
+
+// A teacher's recording of a finished trial (teacher_recording_from_trace): its trace's times and pen
+// positions, its characters, writer, device and rate.
+TeacherRecording record_teacher_py(const PyTrialResult& result, const std::optional<PathLike>& path) {
+  const auto time = result.time_s.unchecked<1>();
+  const auto position = result.position_m.unchecked<2>();
+  std::vector<TrialSample> trace(static_cast<std::size_t>(time.shape(0)));
+  for (py::ssize_t i = 0; i < time.shape(0); ++i) {
+    TrialSample& sample = trace[static_cast<std::size_t>(i)];
+    sample.time_s = time(i);
+    sample.position_m = Vec3(position(i, 0), position(i, 1), position(i, 2));
+  }
+  const py::dict& m = result.metrics;
+  TeacherRecording recording;
+  try {
+    recording =
+        teacher_recording_from_trace(m["character"].cast<std::string>(), m["writer"].cast<std::string>(),
+                                     m["device"].cast<std::string>(), m["rate_hz"].cast<double>(), trace);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(std::string("result: ") + e.what());
+  }
+  if (path) write_teacher_recording(recording, convert_named<std::filesystem::path>(path->object, "path"));
+  return recording;
 }
 
 }  // namespace
@@ -248,6 +328,11 @@ void bind_trial(py::module_& m) {
       .def_property_readonly(
           "scene", [](const PyTrialResult& r) { return Annotated<SceneTag>{r.scene}; },
           "the Scene the trial was written on (metres)")
+      .def_readonly("writer", &PyTrialResult::writer,
+                    "the WriterProfile the simulated writer wrote with (after writer_params)")
+      .def_readonly("writer_log", &PyTrialResult::writer_log,
+                    "the simulated writer's WriterLog (attempts, order and direction errors, refusals), for "
+                    "RepetitionOutcome.from_log; None on a device a person moves")
       // The tables are made in Python (calligraphy/frames.py), where pandas is an optional import.
       .def(
           "to_dataframe",
@@ -268,29 +353,32 @@ void bind_trial(py::module_& m) {
           "character, acronym, typical_id, completed, attempts, mean_deviation_mm, max_deviation_mm [mm], "
           "time_s [s]. Raises ImportError without pandas.");
 
-  m.def("simulate_trial", &simulate_trial_py, py::arg("characters"), py::arg("writer") = "novice",
-        py::arg("guidance") = true, py::arg("rate_hz") = 1000.0, py::arg("seed") = 0,
-        py::arg("library") = py::none(), py::arg("force_law") = py::none(), py::arg("max_duration_s") = 300.0,
-        py::arg("keep_trace") = true, py::arg("device") = py::none(), py::arg("safety") = py::none(),
-        py::arg("passivity") = py::none(), py::call_guard<ForwardLog>(),
+  m.def("simulate_trial", &simulate_trial_py,
+        py::arg("characters") CALLIGRAPHY_TRIAL_ARGUMENTS(CALLIGRAPHY_TRIAL_PY_ARG),
+        py::arg("device") = py::none(), py::arg("safety") = py::none(), py::arg("passivity") = py::none(),
+        py::call_guard<ForwardLog>(),
         R"(Runs a whole guided writing trial lock-step on the simulated device with a simulated writer,
 as `calligraphy trial` does (run_simulated_trial, include/calligraphy/trial/trial.hpp).
 Deterministic for a seed; the GIL is released while it runs.
 
 characters: a str of one or more characters (loaded from `library`, default the embedded set),
             a Character, a sequence of Characters (written left to right), or a Scene.
-writer: 'novice', 'skilled' or a WriterProfile. guidance: in-plane guidance on or off (the paper
-force stays). rate_hz: servo rate [Hz], 100..100000. seed: int >= 0. max_duration_s: simulated
-time limit [s], > 0, at most 10^7 ticks (rate_hz * max_duration_s).
-force_law: ForceLawParameters (its `guidance` is replaced by `guidance`). device:
+writer: 'novice', 'skilled', 'foreign' or a WriterProfile; writer_params: {'key': value} set on it
+by name (writer_parameter_names(), docs/writer.md). guidance: in-plane guidance on or off (the paper
+force stays). guidance_mode: 'fixed' (eq. 8), 'fading' (eq. 8 times guidance_gain in [0, 1]) or
+'replay' (follow `teacher` in time); None keeps force_law's, or 'replay' when a teacher is given.
+teacher: a TeacherRecording of the same characters (record_teacher) or a list of TeacherSample.
+rate_hz: servo rate [Hz], 100..100000. seed: int >= 0. max_duration_s: simulated time limit [s],
+> 0, at most 10^7 ticks (rate_hz * max_duration_s).
+force_law: ForceLawParameters (its guidance fields are replaced by the arguments given). device:
 SimulatedDeviceParameters. safety: SafetyChainParameters (0 forces take the device's figures).
 passivity: PassivityParameters. keep_trace: False leaves the arrays empty (faster, metrics only).
-Returns a TrialResult. Raises CharacterNotFound (a KeyError), InvalidArgument (a ValueError) for
-values out of range, TypeError naming the argument for a value of the wrong type.)");
+Returns a TrialResult (with .writer and .writer_log). Raises CharacterNotFound (a KeyError),
+InvalidArgument (a ValueError) for values out of range, an unknown writer or writer_params key (named),
+a teacher of other characters or replay without a teacher; TypeError naming the argument for a value
+of the wrong type.)");
   m.def("run_trial", &run_trial_py, py::arg("characters"), py::arg("device") = "simulated",
-        py::arg("pacing") = "auto", py::arg("writer") = "novice", py::arg("guidance") = true,
-        py::arg("rate_hz") = 1000.0, py::arg("seed") = 0, py::arg("library") = py::none(),
-        py::arg("force_law") = py::none(), py::arg("max_duration_s") = 300.0, py::arg("keep_trace") = true,
+        py::arg("pacing") = "auto" CALLIGRAPHY_TRIAL_ARGUMENTS(CALLIGRAPHY_TRIAL_PY_ARG),
         py::call_guard<ForwardLog>(),
         R"(Runs a whole guided writing trial on the device called `device` in list_devices(), as
 `calligraphy trial --device NAME` does (run_trial, include/calligraphy/trial/runner.hpp): 'simulated' and
@@ -302,6 +390,18 @@ pacing: 'auto' (lock-step for a device a simulated writer moves, real time other
 'real_time'. rate_hz: servo rate [Hz] (at most 10000 in real time). The other arguments as for
 simulate_trial. Returns a TrialResult whose metrics carry `end_reason`. Raises DeviceNotFound (a
 LookupError) naming the devices there are, InvalidArgument, RealtimeError, CommunicationError.)");
+  m.def("record_teacher", &record_teacher_py, py::arg("result"), py::arg("path") = py::none(),
+        R"(A teacher's recording of a trial (teacher_recording_from_trace,
+include/calligraphy/report/teacher_recording.hpp): the pen's times [s] and positions [m] of every tick,
+its characters, writer, device and rate, for simulate_trial(..., teacher=recording) on the same
+characters. With `path` it is also written there as JSON, atomically. Raises InvalidArgument when the
+trial kept no trace (keep_trace=False), Error naming the path when it cannot be written.)");
 }
+
+#undef CALLIGRAPHY_TRIAL_PY_ARG
+#undef CALLIGRAPHY_TRIAL_VALUE
+#undef CALLIGRAPHY_TRIAL_PARAMETER
+#undef CALLIGRAPHY_TRIAL_FIELD
+#undef CALLIGRAPHY_TRIAL_ARGUMENTS
 
 }  // namespace calligraphy::python

@@ -157,9 +157,16 @@ TrialResult run_trial(HapticDevice& device, const Scene& scene, const TrialOptio
   if (!device.is_calibrated()) device.calibrate();
   // After open(): some devices know their limits only then (OpenHaptics reads them from the driver).
   TrialSession session(scene, device.info(), options);
-  if (real_time) return run_real_time(device, hand, writer ? &*writer : nullptr, session, options);
-  device.enable_forces(true);
-  return run_lock_step(device, *hand, *writer, session, options);
+  TrialResult result;
+  if (real_time) {
+    result = run_real_time(device, hand, writer ? &*writer : nullptr, session, options);
+  } else {
+    device.enable_forces(true);
+    result = run_lock_step(device, *hand, *writer, session, options);
+  }
+  // The loops have stopped: the writer is no longer stepped and its log is final.
+  if (writer) result.writer_log = writer->log();
+  return result;
 }
 
 TrialResult run_trial(std::string_view device_name, const Scene& scene, const TrialOptions& options) {

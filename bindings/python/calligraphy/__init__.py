@@ -18,6 +18,11 @@ Main entry points:
 * ``calligraphy.experiments.sweep(chars, grid, seeds)``: one trial per grid combination x character x
   seed on every core or a Dask cluster -> a pandas DataFrame, one row per trial
 * ``SimulatedDevice(SimulatedDeviceParameters(...))``, ``WriterProfile``, ``list_devices()``
+* guidance modes: ``simulate_trial(..., guidance_mode="fading", guidance_gain=g)``,
+  ``next_guidance_gain(g, error_m)``; ``record_teacher(result)`` -> ``TeacherRecording`` for
+  ``simulate_trial(..., teacher=recording)`` (replay)
+* writers: ``writer="foreign"``, ``writer_params={"key": value}``, ``writer_profile(name, params)``;
+  learning: ``next_repetition_profile(result.writer, RepetitionOutcome.from_log(result.writer_log, share))``
 * ``set_log_level(level)``: the C++ log goes to ``logging.getLogger("calligraphy")``
 
 Errors carry the C++ class names: ``Error`` (the base), ``InvalidArgument`` (a ValueError),
@@ -85,6 +90,17 @@ from ._calligraphy import (  # noqa: F401
     score,
     simulate_trial,
     typical_stroke,
+    AttemptEnd,
+    FadingRule,
+    RepetitionOutcome,
+    TeacherRecording,
+    WriterAttempt,
+    WriterLog,
+    next_guidance_gain,
+    next_repetition_profile,
+    record_teacher,
+    writer_parameter_names,
+    writer_profile,
 )
 
 __all__ = [
@@ -145,4 +161,15 @@ __all__ = [
     "score",
     "simulate_trial",
     "typical_stroke",
+    "AttemptEnd",
+    "FadingRule",
+    "RepetitionOutcome",
+    "TeacherRecording",
+    "WriterAttempt",
+    "WriterLog",
+    "next_guidance_gain",
+    "next_repetition_profile",
+    "record_teacher",
+    "writer_parameter_names",
+    "writer_profile",
 ]

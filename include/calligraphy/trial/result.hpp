@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "calligraphy/devices/servo_loop.hpp"
+#include "calligraphy/sim/writer_log.hpp"
 #include "calligraphy/trial/recorder.hpp"
 
 namespace calligraphy {
@@ -32,6 +33,9 @@ struct TrialResult {
   bool aborted = false;      ///< every end but `completed`
   std::string abort_reason;  ///< the device's or the loop's message for a fault, else a short reason or empty
   std::optional<ServoLoopStats> loop;  ///< the servo loop's statistics, for a real-time trial
+  /// What the simulated writer did, attempt by attempt, when one moved the device (its `log()`); empty on
+  /// a device a person moves. Feeds `RepetitionOutcome::from_log` for learning across repetitions.
+  std::optional<WriterLog> writer_log;
 };
 
 }  // namespace calligraphy
