@@ -13,8 +13,8 @@
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 #include "core/unicode.hpp"
+#include "study/names.hpp"
 #ifdef CALLIGRAPHY_WITH_TRAINER
-#include "trainer/session_files.hpp"
 #include "trainer/trainer.hpp"
 #endif
 
@@ -91,10 +91,9 @@ int run_train(const TrainCommand& command) {
   options.seed = command.seed;
   options.session_dir = command.session;
   options.subject = command.subject;
-  try {
-    trainer::check_subject_id(command.subject);
-  } catch (const InvalidArgument& e) {
-    throw UsageError(std::string("--subject: ") + e.what());
+  if (!study_detail::is_label(command.subject, 64)) {
+    throw UsageError("--subject: '" + command.subject +
+                     "' must be 1-64 characters of A-Z a-z 0-9 _ - (it names the session folder)");
   }
   std::tie(options.width_px, options.height_px) = window_size(command.window);
   options.screenshot = command.screenshot;
@@ -141,11 +140,12 @@ void add_train_command(CLI::App& root, Commands& commands) {
              "guiding force towards the stroke (G toggles)");
   add_unsigned(*app, "--seed", command->seed, "N", "seed of the simulated writer (a 64-bit integer)");
   add_library_options(*app, command->library, true);
-  add_output_path(*app, "--session", command->session,
-                  "save each trial as it ends into this folder (JSON, CSV, SVG; never overwriting)",
-                  StandardOutput::refused);
+  add_output_path(
+      *app, "--session", command->session,
+      "save the trials as they end into a session folder DIR/SUBJECT/train-TIME/ (docs/experiments.md)",
+      StandardOutput::refused);
   add_text(*app, "--subject", command->subject, "ID",
-           "the subject's id in the saved trials (A-Z a-z 0-9 . _ -)");
+           "the subject's id in the saved trials (A-Z a-z 0-9 _ -)");
   add_text(*app, "--window", command->window, "WxH", "window size [px]");
   add_output_path(*app, "--screenshot", command->screenshot,
                   "write the window as PNG after the last character's trial, or at exit",

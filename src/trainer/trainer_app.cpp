@@ -7,7 +7,6 @@
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
-#include <signal.h>
 
 #include <algorithm>
 #include <atomic>
@@ -27,12 +26,14 @@
 #include "calligraphy/sim/hand_port.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
 #include "calligraphy/trial/trial.hpp"
+#include "core/stop_signals.hpp"
+#include "study/names.hpp"
 #include "trainer/layout.hpp"
 #include "trainer/panel.hpp"
 #include "trainer/pointer_devices.hpp"
+#include "trainer/practice_session.hpp"
 #include "trainer/scene_view.hpp"
 #include "trainer/screenshot.hpp"
-#include "trainer/session_files.hpp"
 #include "trainer/trainer.hpp"
 #include "trainer/trial_view.hpp"
 #include "trainer/trial_worker.hpp"
@@ -47,33 +48,6 @@ constexpr double kAdvanceDelayS = 1.0;  // unattended: pause on a trial's summar
 constexpr const char* kChineseFont = "/usr/share/fonts/truetype/arphic/ukai.ttc";
 
 using Clock = std::chrono::steady_clock;
-
-std::atomic<int> received_signal{0};
-extern "C" void trainer_record_signal(int number) {
-  received_signal.store(number, std::memory_order_relaxed);
-}
-
-// SIGINT and SIGTERM only set a flag; the window loop ends the trial safely. Restored at the end.
-class SignalHandlers {
- public:
-  SignalHandlers() {
-    struct sigaction action {};
-    action.sa_handler = trainer_record_signal;
-    sigemptyset(&action.sa_mask);
-    sigaction(SIGINT, &action, &previous_int_);
-    sigaction(SIGTERM, &action, &previous_term_);
-  }
-  SignalHandlers(const SignalHandlers&) = delete;
-  SignalHandlers& operator=(const SignalHandlers&) = delete;
-  ~SignalHandlers() {
-    sigaction(SIGINT, &previous_int_, nullptr);
-    sigaction(SIGTERM, &previous_term_, nullptr);
-  }
-
- private:
-  struct sigaction previous_int_ {};
-  struct sigaction previous_term_ {};
-};
 
 void print_glfw_error(int code, const char* description) {
   std::fprintf(stderr, "calligraphy train: GLFW error %d: %s\n", code, description);
@@ -100,8 +74,8 @@ enum class NextAction { none, repeat, next, quit };
 
 class TrainerApp {
  public:
-  TrainerApp(const TrainerOptions& options, std::string device_model)
-      : options_(options), device_model_(std::move(device_model)) {
+  TrainerApp(const TrainerOptions& options, DeviceInfo device_info, bool hardware)
+      : options_(options), device_info_(std::move(device_info)), hardware_(hardware) {
     for (const TrainerCharacter& c : options.characters) {
       art_.push_back(prepare_art(c));
       std::vector<int> ids;
@@ -113,6 +87,21 @@ class TrainerApp {
   }
 
   int run() {
+    if (!options_.session_dir.empty()) {
+      PracticeSetup setup;
+      setup.root = options_.session_dir;
+      setup.subject = options_.subject;
+      for (const TrainerCharacter& c : options_.characters) setup.characters_utf8 += c.utf8;
+      setup.first_condition = condition_name();
+      setup.device = options_.device;
+      setup.device_info = device_info_;
+      setup.hardware = hardware_;
+      setup.simulated_writer = options_.simulated_writer;
+      setup.writer_profile = options_.writer_profile;
+      setup.writer_seed = options_.seed;
+      practice_.emplace(setup);
+      std::fprintf(stderr, "calligraphy train: saving into %s\n", practice_->path().c_str());
+    }
     open_window();
     layout_.emplace(options_.characters.size(), options_.width_px, options_.height_px, kPanelWidthPx);
     for (std::size_t k = 0; k < layout_->count(); ++k) {
@@ -200,7 +189,7 @@ class TrainerApp {
     view_->character = character;
     view_->number = ++trials_started_;
     view_->guidance = guidance_;
-    view_->condition = guidance_ && condition_outputs_force_ ? "vision+haptic" : "vision";
+    view_->condition = condition_name();
     TrialOptions trial;
     trial.force.guidance = guidance_;
     trial.pacing = TrialPacing::real_time;
@@ -212,8 +201,10 @@ class TrainerApp {
         options_.writer_profile == "skilled" ? WriterProfile::skilled() : WriterProfile::novice();
     trial.simulation.seed = options_.seed + trials_started_ - 1;
     trial.display = channel_.get();
-    trial_start_utc_ = utc_now_iso8601();
-    trial_seed_ = trial.simulation.seed;
+    trial_start_utc_ = study_detail::utc_now_iso8601();
+    trial_wall_start_ = Clock::now();
+    trial_options_ = trial;
+    trial_options_.display = nullptr;
     worker_.start(std::move(scene), options_.device, std::move(trial));
     advance_at_.reset();
   }
@@ -257,20 +248,21 @@ class TrainerApp {
           static_cast<unsigned long long>(loop.forces_withheld), loop.period_jitter_us_p50,
           loop.period_jitter_us_p99, loop.period_jitter_us_max, loop.longest_stall_s * 1e3);
     }
-    if (!options_.session_dir.empty()) {
-      TrialRecordInfo info;
-      info.description = TrialDescription{
-          utf8,         view.guidance,          options_.simulated_writer ? options_.writer_profile : "human",
-          trial_seed_,  TrialOptions{}.rate_hz, options_.device,
-          device_model_};
-      info.subject = options_.subject;
-      info.condition = view.condition;
-      info.start_time_utc = trial_start_utc_;
-      info.library_version = options_.library_version;
+    if (practice_) {
+      PracticeTrial trial;
+      trial.item = view.character;
+      trial.character = options_.characters[view.character].model.code_point;
+      trial.condition = view.condition;
+      trial.scene = &worker_.scene();
+      trial.options = &trial_options_;
+      trial.start_utc = trial_start_utc_;
+      trial.end_utc = study_detail::utc_now_iso8601();
+      trial.wall_time_s = std::chrono::duration<double>(Clock::now() - trial_wall_start_).count();
       try {
-        const SavedTrial saved = save_trial(options_.session_dir, info, worker_.scene(), result);
-        view.saved_as = saved.json.filename().string();
-        std::fprintf(stderr, "calligraphy train: saved %s (.csv, .svg)\n", saved.json.string().c_str());
+        const auto [path, as_trial] = practice_->save(trial, result);
+        view.saved_as = (as_trial ? "" : "attempts/") + path.filename().string();
+        std::fprintf(stderr, "calligraphy train: saved %s (%s)\n", path.c_str(),
+                     as_trial ? "the trial, .csv, .svg" : "an attempt, .csv");
       } catch (const std::exception& e) {
         view.save_error = std::string("not saved: ") + e.what();
         std::fprintf(stderr, "calligraphy train: error: the trial was not saved: %s\n", e.what());
@@ -289,6 +281,11 @@ class TrainerApp {
     }
   }
 
+  // The condition of the next trial, as the session folder names it.
+  [[nodiscard]] std::string condition_name() const {
+    return guidance_ && condition_outputs_force_ ? kHapticCondition : kVisionCondition;
+  }
+
   [[nodiscard]] bool unattended() const { return options_.exit_after_s > 0.0; }
 
   // ---- The loop.
@@ -297,7 +294,7 @@ class TrainerApp {
     while (true) {
       glfwPollEvents();
       const bool closed = glfwWindowShouldClose(window_) != 0 || x11_error_seen();
-      if (closed || received_signal.load() != 0) quit_ = true;
+      if (closed || StopSignals::received() != 0) quit_ = true;
       if (unattended() && seconds_since_start() >= options_.exit_after_s) quit_ = true;
       handle_keys();
       if (quit_ && !quit_seen_) {  // the picture at exit shows the window as it was when the exit came
@@ -421,7 +418,11 @@ class TrainerApp {
   }
 
   TrainerOptions options_;
-  std::string device_model_;
+  DeviceInfo device_info_;
+  bool hardware_ = false;
+  std::optional<PracticeSession> practice_;
+  TrialOptions trial_options_;
+  Clock::time_point trial_wall_start_;
   std::vector<CharacterArt> art_;
   std::vector<std::vector<int>> typical_ids_;
   GLFWwindow* window_ = nullptr;
@@ -433,7 +434,6 @@ class TrainerApp {
   std::unique_ptr<DisplayChannel> channel_;
   std::optional<TrialView> view_;
   std::size_t trials_started_ = 0;
-  std::uint64_t trial_seed_ = 0;
   std::string trial_start_utc_;
   bool guidance_ = true;
   bool condition_outputs_force_ = true;
@@ -467,9 +467,14 @@ int run_trainer(const TrainerOptions& options) {
                           "' is moved by the simulated writer: pass --writer simulated, or use mouse, "
                           "mouse-hand or a haptic device");
   }
-  received_signal.store(0);
-  const SignalHandlers handlers;
-  TrainerApp app(options, probe->info().model);
+  // SIGINT, SIGTERM and SIGHUP only set a flag; the window loop ends the trial safely. A command that
+  // installed the handlers already (a study session) keeps them.
+  std::optional<StopSignals> signals;
+  if (!StopSignals::installed()) signals.emplace();
+  bool hardware = false;
+  for (const DeviceListing& listing : device_registry_with_simulation().survey().devices)
+    hardware = hardware || (listing.name == options.device && listing.hardware);
+  TrainerApp app(options, probe->info(), hardware);
   return app.run();
 }
 

@@ -88,8 +88,15 @@ class Trainer:
         self.stderr.close()
 
 
-def saved_trials(folder):
-    return sorted(pathlib.Path(folder).glob("*.json"))
+def saved_trials(folder, subject="anonymous"):
+    """The saved trials of the one session folder `train --session FOLDER` made (FOLDER/SUBJECT/train-*)."""
+    (session,) = sorted(pathlib.Path(folder).glob(f"{subject}/train-*"))
+    return sorted((session / "trials").glob("*.json"))
+
+
+def kept_attempts(folder, subject="anonymous"):
+    (session,) = sorted(pathlib.Path(folder).glob(f"{subject}/train-*"))
+    return sorted((session / "trials" / "attempts").glob("*.json"))
 
 
 def medians(char, folder=EMBEDDED):
@@ -166,15 +173,15 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual((record["strokes_completed"], record["strokes_total"]), (5, 5))
         self.assertTrue(record["completed_in_order"])
         self.assertEqual(record["end_reason"], "completed")
-        self.assertEqual(record["character"], "永")
+        self.assertEqual(record["characters"], "永")
         self.assertEqual(record["subject"], "anonymous")
-        self.assertEqual(record["condition"], "vision+haptic")
-        self.assertEqual(record["device"], "simulated")
-        for key in ("start_time", "library_version", "mean_deviation_mm", "per_stroke", "servo_loop"):
+        self.assertEqual(record["condition"], "haptic")
+        self.assertEqual(record["device"]["name"], "simulated")
+        for key in ("start_time_utc", "library", "mean_deviation_mm", "per_stroke", "loop", "score"):
             self.assertIn(key, record)
         with open(record_path.with_suffix(".csv"), newline="") as f:
             trace = list(csv.DictReader(f))
-        self.assertEqual(len(trace), record["servo_loop"]["ticks"])  # every tick kept
+        self.assertEqual(len(trace), record["loop"]["ticks"])  # every tick kept
         self.assertTrue(record_path.with_suffix(".svg").read_text().startswith("<svg"))
 
         image = read_png(pathlib.Path(self.folder) / "out" / "yong.png")
@@ -218,7 +225,7 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual(trainer.wait(), 0, trainer.errors())
         (record_path,) = saved_trials(pathlib.Path(self.folder) / "out")
         record = json.loads(record_path.read_text(encoding="utf-8"))
-        self.assertEqual(record["device"], "mouse")
+        self.assertEqual(record["device"]["name"], "mouse")
         self.assertEqual(record["condition"], "vision")
         self.assertEqual((record["strokes_completed"], record["strokes_total"]), (1, 1))
         self.assertEqual(record["end_reason"], "completed")
@@ -265,23 +272,25 @@ class TrainerTest(unittest.TestCase):
         guided = self.write_yi_beside_the_stroke("on", offset)
         free = self.write_yi_beside_the_stroke("off", offset)
         for record in (guided, free):
-            self.assertEqual(record["device"], "mouse-hand")
+            self.assertEqual(record["device"]["name"], "mouse-hand")
             self.assertEqual(record["strokes_completed"], 1, record)
-        self.assertEqual(guided["condition"], "vision+haptic")
+        self.assertEqual(guided["condition"], "haptic")
         self.assertEqual(free["condition"], "vision")
         self.assertLess(guided["mean_deviation_mm"], 0.7 * free["mean_deviation_mm"])
 
     def ended_mid_trial(self, end):
         """Starts 永 with the simulated writer (no time limit of its own), lets it write a while, then calls
-        `end`, and checks the trial was saved whole as interrupted."""
+        `end`, and checks the trial was kept whole as an interrupted attempt."""
         trainer = self.start("永", "--writer", "simulated", "--session", "out", "--subject", "s01")
         trainer.boxes()
         time.sleep(4.0)
         self.assertIsNone(trainer.process.poll(), "the trial should still run: " + trainer.errors())
         end(trainer)
         self.assertEqual(trainer.wait(timeout=30), 0, trainer.errors())
-        (record_path,) = saved_trials(pathlib.Path(self.folder) / "out")
-        self.assertTrue(record_path.name.startswith("s01-永-"))
+        out = pathlib.Path(self.folder) / "out"
+        self.assertEqual(saved_trials(out, "s01"), [])
+        (record_path,) = kept_attempts(out, "s01")
+        self.assertTrue(record_path.name.startswith("001-test-haptic-r1-U6C38.attempt-1"), record_path.name)
         record = json.loads(record_path.read_text(encoding="utf-8"))
         self.assertEqual(record["end_reason"], "interrupted")
         self.assertTrue(record["aborted"])
@@ -289,7 +298,7 @@ class TrainerTest(unittest.TestCase):
         with open(record_path.with_suffix(".csv"), newline="") as f:
             rows = sum(1 for _ in csv.DictReader(f))
         self.assertGreater(rows, 3000)  # about 4 s at 1 kHz
-        self.assertEqual(rows, record["servo_loop"]["ticks"])
+        self.assertEqual(rows, record["loop"]["ticks"])
         return record
 
     def test_closing_the_window_mid_trial_keeps_the_data(self):
@@ -305,16 +314,20 @@ class TrainerTest(unittest.TestCase):
     def test_sigterm_mid_trial_keeps_the_data(self):
         self.ended_mid_trial(lambda trainer: trainer.process.send_signal(signal.SIGTERM))
 
-    def test_saved_trials_never_overwrite(self):
+    def test_each_run_saves_into_a_new_session_folder(self):
         out = pathlib.Path(self.folder) / "out"
-        out.mkdir()
-        (out / "anonymous-一-1.json").write_text("earlier\n")
-        trainer = self.start("一", "--device", "mouse", "--data", SAMPLE, "--session", "out", "--exit-after", "2")
-        self.assertEqual(trainer.wait(), 0, trainer.errors())
-        self.assertEqual((out / "anonymous-一-1.json").read_text(), "earlier\n")
-        record = json.loads((out / "anonymous-一-2.json").read_text(encoding="utf-8"))
+        first = self.start("一", "--device", "mouse", "--data", SAMPLE, "--session", "out", "--exit-after", "2")
+        self.assertEqual(first.wait(), 0, first.errors())
+        first.close()
+        (session,) = out.glob("anonymous/train-*")
+        before = {p: p.read_bytes() for p in session.rglob("*") if p.is_file() and p.name != "log.jsonl"}
+        self.assertTrue(any(p.name.endswith(".attempt-1.json") for p in before), sorted(before))
+        second = self.start("一", "--device", "mouse", "--data", SAMPLE, "--session", "out", "--exit-after", "2")
+        self.assertEqual(second.wait(), 0, second.errors())
+        self.assertEqual(len(list(out.glob("anonymous/train-*"))), 2)
+        self.assertEqual({p: p.read_bytes() for p in before}, before)  # nothing of the first run changed
+        record = json.loads(next(p for p in before if p.suffix == ".json" and "attempt" in p.name).read_text())
         self.assertEqual(record["end_reason"], "interrupted")
-
 
 if __name__ == "__main__":
     try:
