@@ -96,6 +96,8 @@ void summary(const TrialView& view, const PanelInput& input) {
   ImGui::Spacing();
   if (input.unattended) {
     ImGui::TextDisabled("unattended run (--exit-after)");
+  } else if (!input.session.empty()) {
+    ImGui::Text("Space  start the next trial   Esc  end the session");
   } else {
     ImGui::Text("R  repeat   N  next character");
     ImGui::Text("G  guidance (next trial: %s)", input.next_guidance ? "on" : "off");
@@ -112,6 +114,15 @@ void draw_panel(const WindowLayout& layout, double panel_width_px, const PanelIn
   ImGui::Begin("trainer", nullptr,
                ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
                    ImGuiWindowFlags_NoBringToFrontOnFocus);
+  if (!input.session.empty()) {
+    ImGui::TextWrapped("%s", input.session.c_str());
+    if (!input.prompt.empty()) {
+      if (input.large_font != nullptr) ImGui::PushFont(input.large_font);
+      ImGui::TextColored(ImVec4(0.1f, 0.35f, 0.8f, 1.0f), "%s", input.prompt.c_str());
+      if (input.large_font != nullptr) ImGui::PopFont();
+    }
+    ImGui::Separator();
+  }
   const TrialView* view = input.view;
   if (view == nullptr) {
     ImGui::TextWrapped("%s", input.status.c_str());
@@ -143,7 +154,7 @@ void draw_panel(const WindowLayout& layout, double panel_width_px, const PanelIn
   results_table(*view);
   if (view->have_result) {
     summary(*view, input);
-  } else if (!input.unattended) {
+  } else if (!input.unattended && input.session.empty()) {
     ImGui::Spacing();
     ImGui::TextDisabled("R repeat  N next  G guidance  Q quit");
   }

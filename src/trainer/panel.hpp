@@ -17,7 +17,9 @@ struct PanelInput {
   std::size_t characters = 1;  ///< in the row
   bool next_guidance = true;   ///< what G has set for the next trial
   bool unattended = false;
-  std::string status;  ///< a line for errors or notices
+  std::string status;   ///< a line for errors or notices
+  std::string session;  ///< a study session: subject, trial i of n, phase, condition; empty otherwise
+  std::string prompt;   ///< what the person is asked to do now (start, rest), shown large; may be empty
   double frame_rate_hz = 0.0;
   ImFont* large_font = nullptr;
 };

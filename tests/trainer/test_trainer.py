@@ -329,6 +329,110 @@ class TrainerTest(unittest.TestCase):
         record = json.loads(next(p for p in before if p.suffix == ".json" and "attempt" in p.name).read_text())
         self.assertEqual(record["end_reason"], "interrupted")
 
+TINY_PROTOCOL = {
+    "format": "calligraphy-study-protocol", "version": 1, "name": "tiny",
+    "description": "two trials of one character: vision only, then with the guiding force",
+    "conditions": [{"name": "vision", "mode": "vision"}, {"name": "haptic", "mode": "haptic"}],
+    "test": {"characters": ["一"], "conditions": ["vision", "haptic"], "repetitions": 1},
+    "breaks": {"between_blocks_s": 2},
+    "trial": {"max_duration_s": 8, "rate_hz": 1000},
+}
+
+
+class SessionWindowTest(unittest.TestCase):
+    """`calligraphy session run` with a device a person moves runs the session in the trainer window."""
+
+    def setUp(self):
+        self.folder = pathlib.Path(tempfile.mkdtemp(prefix="calligraphy-session-"))
+        (self.folder / "tiny.json").write_text(json.dumps(TINY_PROTOCOL, ensure_ascii=False), encoding="utf-8")
+        self.stdout = open(self.folder / "stdout.txt", "w+")
+        self.stderr = open(self.folder / "stderr.txt", "w+")
+        self.process = None
+
+    def tearDown(self):
+        if self.process is not None and self.process.poll() is None:
+            self.process.kill()
+            self.process.wait()
+        self.stdout.close()
+        self.stderr.close()
+        shutil.rmtree(self.folder, ignore_errors=True)
+
+    def run_session(self, *extra):
+        self.process = subprocess.Popen(
+            [CLI, "session", "run", "tiny.json", "--subject", "S01", "--device", "mouse-hand", "--writer", "human",
+             "--out", "out", "--data", SAMPLE, *extra], stdout=self.stdout, stderr=self.stderr, cwd=self.folder)
+
+    def errors(self):
+        return (self.folder / "stderr.txt").read_text()
+
+    def first_box(self, timeout=30):
+        deadline = time.time() + timeout
+        while time.time() < deadline:
+            lines = [l for l in (self.folder / "stdout.txt").read_text().splitlines() if l.startswith("box ")]
+            if lines:
+                return Box(lines[0])
+            self.assertIsNone(self.process.poll(), "the session ended before its window showed: " + self.errors())
+            time.sleep(0.1)
+        raise AssertionError("no box line within %s s" % timeout)
+
+    def session_folder(self):
+        (session,) = (self.folder / "out" / "S01").glob("tiny-*")
+        return session
+
+    def test_a_person_writes_the_session_in_the_window_and_every_trial_is_saved(self):
+        self.run_session("--exit-after", "90", "--screenshot", "shot.png")
+        box = self.first_box()
+        window = xdotool("search", "--name", "calligraphy train").split()[0]
+        median = medians("一", SAMPLE)[0]
+        path = [box.data_to_px(p) for p in along(median, [i / 16 for i in range(17)])]
+        path.append(box.data_to_px((median[-1][0] + 30, median[-1][1])))
+        time.sleep(1.5)  # unattended: the trial starts a second after it is announced
+        xdotool("mousemove", "--window", window, round(path[0][0]), round(path[0][1]))
+        time.sleep(0.8)  # the hand carries the stylus over the start
+        xdotool("mousedown", 1)
+        time.sleep(0.8)
+        for x, y in path[1:]:
+            xdotool("mousemove", "--window", window, round(x), round(y))
+            time.sleep(0.1)
+        time.sleep(0.5)
+        xdotool("mouseup", 1)
+        self.assertEqual(self.process.wait(timeout=120), 0, self.errors())
+        trials = sorted((self.session_folder() / "trials").glob("*.json"))
+        self.assertEqual([t.name for t in trials], ["001-test-vision-r1-U4E00.json", "002-test-haptic-r1-U4E00.json"])
+        first, second = (json.loads(t.read_text(encoding="utf-8")) for t in trials)
+        self.assertEqual((first["condition"], first["end_reason"], first["strokes_completed"]), ("vision", "completed", 1))
+        self.assertFalse(first["force_law"]["guidance"])
+        self.assertEqual((second["condition"], second["end_reason"]), ("haptic", "time_limit"))
+        self.assertTrue(second["force_law"]["guidance"])
+        for record in (first, second):
+            self.assertEqual(record["device"]["name"], "mouse-hand")
+            self.assertEqual(record["writer"]["kind"], "human")
+        log = [json.loads(l) for l in (self.session_folder() / "log.jsonl").read_text().splitlines()]
+        self.assertIn("session_completed", [e["event"] for e in log])
+        image = read_png(self.folder / "shot.png")
+        inner = along(median, [i / 20 for i in range(2, 19)])
+        self.assertGreater(fraction([near(image, box.data_to_px(p), 6, is_blue) for p in inner]), 0.9)
+        self.assertGreater(fraction([near(image, box.data_to_px(p), 15, is_yellow) for p in inner]), 0.9)
+
+    def test_sigint_ends_the_session_keeping_the_running_trial_as_an_attempt(self):
+        self.run_session()  # attended: the first trial waits for Space
+        self.first_box()
+        window = xdotool("search", "--name", "calligraphy train").split()[0]
+        time.sleep(0.5)
+        xdotool("windowfocus", "--sync", window)
+        xdotool("key", "--window", window, "space")
+        time.sleep(2.5)
+        self.assertIsNone(self.process.poll(), self.errors())
+        self.process.send_signal(signal.SIGINT)
+        self.assertEqual(self.process.wait(timeout=60), 130, self.errors())
+        session = self.session_folder()
+        self.assertEqual(list((session / "trials").glob("*.json")), [])
+        (attempt,) = (session / "trials" / "attempts").glob("*.json")
+        record = json.loads(attempt.read_text(encoding="utf-8"))
+        self.assertEqual(record["end_reason"], "interrupted")
+        self.assertIn("session resume", self.errors())
+
+
 if __name__ == "__main__":
     try:
         xdotool("getdisplaygeometry")
