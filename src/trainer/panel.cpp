@@ -101,6 +101,7 @@ void summary(const TrialView& view, const PanelInput& input) {
   } else {
     ImGui::Text("R  repeat   N  next character");
     ImGui::Text("G  guidance (next trial: %s)", input.next_guidance ? "on" : "off");
+    ImGui::Text("M  guidance mode (next trial: %s, gain %.2f)", input.next_mode.c_str(), input.next_gain);
     ImGui::Text("Q / Esc  quit");
   }
 }
@@ -134,6 +135,9 @@ void draw_panel(const WindowLayout& layout, double panel_width_px, const PanelIn
               input.characters);
   ImGui::Text("device %s", input.device.c_str());
   ImGui::Text("%s, guidance %s", view->condition.c_str(), view->guidance ? "on" : "off");
+  if (input.session.empty())
+    ImGui::Text("next: guidance %s, mode %s, gain %.2f", input.next_guidance ? "on" : "off",
+                input.next_mode.c_str(), input.next_gain);
   ImGui::Separator();
   if (input.large_font != nullptr) ImGui::PushFont(input.large_font);
   ImGui::TextColored(state_colour(s.state), "%s", to_string(s.state));

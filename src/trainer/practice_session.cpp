@@ -23,7 +23,9 @@ LoadedProtocol practice_protocol(const PracticeSetup& setup) {
       {"conditions",
        {{{"name", kHapticCondition}, {"mode", "haptic"}},
         {{"name", kVisionCondition}, {"mode", "vision"}},
-        {{"name", kQuizCondition}, {"mode", "quiz"}}}},
+        {{"name", kQuizCondition}, {"mode", "quiz"}},
+        {{"name", kFadingCondition}, {"mode", "fading"}},
+        {{"name", kReplayCondition}, {"mode", "replay"}}}},
       {"test", {{"characters", items}, {"conditions", {setup.first_condition}}, {"repetitions", 1}}}};
   return protocol_from_text(protocol.dump(2) + "\n", "calligraphy-train");
 }

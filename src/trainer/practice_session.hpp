@@ -23,6 +23,8 @@ namespace calligraphy::trainer {
 inline constexpr const char* kHapticCondition = "haptic";
 inline constexpr const char* kVisionCondition = "vision";
 inline constexpr const char* kQuizCondition = "quiz";
+inline constexpr const char* kFadingCondition = "fading";  ///< guidance faded trial by trial
+inline constexpr const char* kReplayCondition = "replay";  ///< guidance along a teacher's recording
 
 /// What the session folder is created with.
 struct PracticeSetup {

@@ -8,6 +8,7 @@
 
 #include "calligraphy/model/character.hpp"
 #include "calligraphy/model/stroke_outline.hpp"
+#include "calligraphy/render/guidance_mode.hpp"
 #include "calligraphy/study/session_runner.hpp"
 
 namespace calligraphy::trainer {
@@ -26,6 +27,10 @@ struct TrainerOptions {
   std::string writer_profile = "novice";     ///< novice or skilled
   std::uint64_t seed = 0;
   bool guidance = true;
+  GuidanceMode guidance_mode = GuidanceMode::fixed;  ///< how guidance attracts (M cycles it)
+  double guidance_gain = 1.0;          ///< the fading mode's first gain in [0, 1]; faded after each trial
+  std::vector<TeacherSample> teacher;  ///< replay: the teacher's pen (one character, its recording)
+  std::string record;       ///< non-empty: each completed trial is written here as a teacher recording
   std::string session_dir;  ///< empty: trials are not saved
   std::string subject = "anonymous";
   int width_px = 1280;

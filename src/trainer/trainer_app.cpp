@@ -22,8 +22,10 @@
 #include <thread>
 #include <vector>
 
+#include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/devices/device_registry.hpp"
+#include "calligraphy/report/teacher_recording.hpp"
 #include "calligraphy/sim/hand_port.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
 #include "calligraphy/trial/trial.hpp"
@@ -109,6 +111,8 @@ class TrainerApp {
       typical_ids_.push_back(std::move(ids));
     }
     guidance_ = options.guidance;
+    guidance_mode_ = options.guidance_mode;
+    guidance_gain_ = options.guidance_gain;
     condition_outputs_force_ = options.device != "mouse";
     if (session_ != nullptr) {
       all_art_ = art_;
@@ -226,6 +230,9 @@ class TrainerApp {
     view_->condition = condition_name();
     TrialOptions trial;
     trial.force.guidance = guidance_;
+    trial.force.guidance_mode = guidance_mode_;
+    trial.force.guidance_gain = guidance_gain_;
+    if (guidance_mode_ == GuidanceMode::replay) trial.force.teacher_trajectory = options_.teacher;
     trial.pacing = TrialPacing::real_time;
     // A window process maps memory all the time (the GL driver): mlockall(MCL_FUTURE) would lock all of
     // it, or make its allocations fail under a memory-lock limit. The trace is touched in advance instead.
@@ -266,6 +273,12 @@ class TrainerApp {
     view.metrics = result.metrics;
     view.end_reason = result.abort_reason;
     if (result.end == TrialEnd::device_fault || result.end == TrialEnd::watchdog) status_ = 1;
+    if (guidance_ && trial_options_.force.guidance_mode == GuidanceMode::fading &&
+        result.metrics.mean_deviation_m) {  // performance-based fading (Emken et al. 2007)
+      guidance_gain_ = next_guidance_gain(guidance_gain_, *result.metrics.mean_deviation_m);
+      std::fprintf(stderr, "calligraphy train: fading: next trial's guidance gain %.3f\n", guidance_gain_);
+    }
+    if (!options_.record.empty() && result.end == TrialEnd::completed) save_recording(view, result);
     const std::string& utf8 = options_.characters[view.character].utf8;
     std::fprintf(stderr,
                  "calligraphy train: trial %zu %s: %s, %zu/%zu strokes in order, mean %.2f mm, %.1f s\n",
@@ -419,9 +432,35 @@ class TrainerApp {
     panel.characters = s.trial.characters.size();
   }
 
+  // The last completed trial as a teacher's recording (replay guidance), replaced atomically.
+  void save_recording(TrialView& view, const TrialResult& result) {
+    try {
+      const TeacherRecording recording =
+          teacher_recording_from_trace(options_.characters[view.character].utf8,
+                                       options_.simulated_writer ? options_.writer_profile : "human",
+                                       options_.device, trial_options_.rate_hz, result.trace);
+      write_file_atomically(options_.record, teacher_recording_json(recording));
+      std::fprintf(stderr, "calligraphy train: teacher recording %s (%zu samples)\n", options_.record.c_str(),
+                   recording.samples.size());
+    } catch (const std::exception& e) {
+      view.save_error += std::string(" recording not written: ") + e.what();
+      std::fprintf(stderr, "calligraphy train: error: the recording was not written: %s\n", e.what());
+      status_ = 1;
+    }
+  }
+
   // The condition of the next trial, as the session folder names it.
   [[nodiscard]] std::string condition_name() const {
-    return guidance_ && condition_outputs_force_ ? kHapticCondition : kVisionCondition;
+    if (!guidance_ || !condition_outputs_force_) return kVisionCondition;
+    switch (guidance_mode_) {
+      case GuidanceMode::fading:
+        return kFadingCondition;
+      case GuidanceMode::replay:
+        return kReplayCondition;
+      case GuidanceMode::fixed:
+        break;
+    }
+    return kHapticCondition;
   }
 
   [[nodiscard]] bool unattended() const { return options_.exit_after_s > 0.0; }
@@ -490,6 +529,14 @@ class TrainerApp {
         case GLFW_KEY_G:
           if (session_ == nullptr) guidance_ = !guidance_;
           break;
+        case GLFW_KEY_M:  // the guidance mode of the next trial: fixed, fading, replay (with a teacher)
+          if (session_ == nullptr) {
+            guidance_mode_ = guidance_mode_ == GuidanceMode::fixed ? GuidanceMode::fading
+                             : guidance_mode_ == GuidanceMode::fading && !options_.teacher.empty()
+                                 ? GuidanceMode::replay
+                                 : GuidanceMode::fixed;
+          }
+          break;
         default:
           break;
       }
@@ -523,6 +570,8 @@ class TrainerApp {
     panel.device = options_.device;
     panel.characters = options_.characters.size();
     panel.next_guidance = guidance_;
+    panel.next_mode = to_string(guidance_mode_);
+    panel.next_gain = guidance_gain_;
     panel.unattended = unattended();
     panel.frame_rate_hz = ImGui::GetIO().Framerate;
     panel.large_font = large_font_;
@@ -594,6 +643,8 @@ class TrainerApp {
   std::size_t trials_started_ = 0;
   std::string trial_start_utc_;
   bool guidance_ = true;
+  GuidanceMode guidance_mode_ = GuidanceMode::fixed;
+  double guidance_gain_ = 1.0;
   bool condition_outputs_force_ = true;
   bool quit_ = false;
   bool quit_seen_ = false;

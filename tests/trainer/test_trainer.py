@@ -314,6 +314,23 @@ class TrainerTest(unittest.TestCase):
     def test_sigterm_mid_trial_keeps_the_data(self):
         self.ended_mid_trial(lambda trainer: trainer.process.send_signal(signal.SIGTERM))
 
+    def test_record_then_replay_and_fading_name_their_conditions(self):
+        first = self.start("一", "--writer", "simulated", "--data", SAMPLE, "--record", "teacher.json",
+                           "--session", "out", "--exit-after", "30")
+        self.assertEqual(first.wait(), 0, first.errors())
+        first.close()
+        teacher = json.loads((pathlib.Path(self.folder) / "teacher.json").read_text(encoding="utf-8"))
+        self.assertEqual((teacher["format"], teacher["characters"]), ("calligraphy-teacher-recording", "一"))
+        self.assertGreater(len(teacher["samples"]["t_s"]), 1000)
+        for mode, extra in (("replay", ["--teacher", "teacher.json"]), ("fading", ["--guidance-gain", "0.5"])):
+            run = self.start("一", "--writer", "simulated", "--data", SAMPLE, "--guidance-mode", mode, *extra,
+                             "--session", "out", "--exit-after", "30")
+            self.assertEqual(run.wait(), 0, run.errors())
+            run.close()
+        conditions = sorted(json.loads(p.read_text(encoding="utf-8"))["condition"]
+                            for p in (pathlib.Path(self.folder) / "out").glob("anonymous/train-*/trials/*.json"))
+        self.assertEqual(conditions, ["fading", "haptic", "replay"])
+
     def test_each_run_saves_into_a_new_session_folder(self):
         out = pathlib.Path(self.folder) / "out"
         first = self.start("一", "--device", "mouse", "--data", SAMPLE, "--session", "out", "--exit-after", "2")
