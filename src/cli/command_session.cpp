@@ -18,9 +18,19 @@
 #include "cli/interrupt.hpp"
 #include "cli/library_options.hpp"
 #include "core/unicode.hpp"
+#ifdef CALLIGRAPHY_WITH_TRAINER
+#include "trainer/trainer.hpp"
+#endif
 
 namespace calligraphy::cli {
 namespace {
+
+// Where a person's session is shown: the trainer window (when built with it) or the terminal.
+struct SessionDisplay {
+  std::string display = "window";
+  std::string screenshot;
+  double exit_after_s = 0.0;
+};
 
 struct SessionRunCommand {
   std::string protocol;
@@ -34,12 +44,14 @@ struct SessionRunCommand {
   std::string pacing = "auto";
   std::string out;
   LibraryOptions library;
+  SessionDisplay display;
 };
 
 struct SessionResumeCommand {
   std::string folder;
   std::string pacing;
   LibraryOptions library;
+  SessionDisplay display;
 };
 
 std::string utf8(const std::u32string& text) {
@@ -92,6 +104,51 @@ SessionRunOptions run_options(const LibraryOptions& library, SessionHost* host,
 
 // Prints one line per session; returns the exit status: 0 when complete, 128 + the signal when stopped
 // by one, 1 after a device fault.
+bool in_window(const SessionDisplay& display, const std::string& writer) {
+#ifdef CALLIGRAPHY_WITH_TRAINER
+  return writer == "human" && display.display == "window";
+#else
+  (void)display;
+  (void)writer;
+  return false;
+#endif
+}
+
+// Runs the session in the trainer window (a person writes) or headless, with the terminal as host.
+SessionRunResult run_one(SessionFolder& session, const SessionRunOptions& options,
+                         const SessionDisplay& display, const LibraryOptions& library) {
+#ifdef CALLIGRAPHY_WITH_TRAINER
+  if (in_window(display, session.manifest().setup.writer)) {
+    trainer::TrainerSessionOptions window;
+    window.session = &session;
+    window.run = options;
+    window.run.host = nullptr;
+    const auto source = std::make_shared<CharacterSource>(library);
+    const auto outlines = std::make_shared<CharacterLibrary>(library_from(library));
+    window.load_character = [source, outlines](char32_t c) {
+      trainer::TrainerCharacter character;
+      character.model = source->load(c);
+      character.utf8 = encode_utf8(c);
+      try {
+        character.outlines = outlines->load_outlines(c);
+      } catch (const DataError& e) {  // drawn without outlines
+        std::fprintf(stderr, "calligraphy session: warning: no stroke outlines for %s: %s\n",
+                     character.utf8.c_str(), e.what());
+      }
+      return character;
+    };
+    window.screenshot = display.screenshot;
+    window.exit_after_s = display.exit_after_s;
+    window.library_version = CALLIGRAPHY_VERSION;
+    return trainer::run_trainer_session(window);
+  }
+#else
+  (void)display;
+  (void)library;
+#endif
+  return run_session(session, options);
+}
+
 int report_run(const SessionFolder& session, const SessionRunResult& result, double seconds) {
   std::printf("%s: %zu of %zu trials saved (%zu now, %zu attempts kept) in %s, %.1f s\n",
               session.manifest().setup.subject.id.c_str(), result.saved_before + result.saved_now,
@@ -129,6 +186,9 @@ std::vector<std::string> split_profiles(const std::string& text) {
 }
 
 int run_sessions(const SessionRunCommand& command) {
+#ifdef CALLIGRAPHY_WITH_TRAINER
+  if (command.display.display == "window") trainer::register_trainer_devices();  // mouse, mouse-hand
+#endif
   const LoadedProtocol protocol = load_study_protocol(command.protocol);
   const DeviceSurvey survey = cli_device_registry().survey();
   const DeviceListing* device = nullptr;
@@ -185,7 +245,7 @@ int run_sessions(const SessionRunCommand& command) {
     setup.pacing = command.pacing;
     SessionFolder session = SessionFolder::create(command.out, setup, protocol);
     const auto start = std::chrono::steady_clock::now();
-    const SessionRunResult result = run_session(session, options);
+    const SessionRunResult result = run_one(session, options, command.display, command.library);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const int status = report_run(session, result, seconds);
     if (status != 0) return status;
@@ -194,6 +254,9 @@ int run_sessions(const SessionRunCommand& command) {
 }
 
 int resume_session(const SessionResumeCommand& command) {
+#ifdef CALLIGRAPHY_WITH_TRAINER
+  if (command.display.display == "window") trainer::register_trainer_devices();
+#endif
   SessionFolder session = SessionFolder::open(command.folder);
   if (!session.next_unsaved()) {
     std::printf("%s: every trial of %s is saved already\n", session.manifest().setup.subject.id.c_str(),
@@ -211,12 +274,24 @@ int resume_session(const SessionResumeCommand& command) {
                                                      : TrialPacing::automatic;
   }
   const auto start = std::chrono::steady_clock::now();
-  const SessionRunResult result = run_session(session, options);
+  const SessionRunResult result = run_one(session, options, command.display, command.library);
   return report_run(session, result,
                     std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
 }
 
 }  // namespace
+
+void add_display_options(CLI::App& app, SessionDisplay& display) {
+  add_choice(app, "--display", display.display, {"window", "terminal"},
+             "where a person's session is shown: the trainer window (trial by trial, live; needs the "
+             "trainer build, else the terminal) or the terminal");
+  add_output_path(app, "--screenshot", display.screenshot,
+                  "window: write it as PNG after the last planned trial's outcome, or at exit",
+                  StandardOutput::refused);
+  add_number(app, "--exit-after", display.exit_after_s, "SECONDS",
+             "window, unattended: trials start by themselves; quit after this long [s] or at the end",
+             "a number of seconds > 0", [](double s) { return s > 0.0 && s <= 86400.0; });
+}
 
 void add_session_commands(CLI::App& root, Commands& commands) {
   CLI::App* group =
@@ -254,6 +329,7 @@ void add_session_commands(CLI::App& root, Commands& commands) {
   required(add_text(*app, "--out", run->out, "DIR",
                     "the study folder: sessions go to DIR/SUBJECT/PROTOCOL-TIME/"));
   add_library_options(*app, run->library, true);
+  add_display_options(*app, run->display);
 
   auto resume = std::make_shared<SessionResumeCommand>();
   CLI::App* resume_app =
@@ -263,6 +339,7 @@ void add_session_commands(CLI::App& root, Commands& commands) {
   add_choice(*resume_app, "--pacing", resume->pacing, {"auto", "lock-step", "real-time"},
              "overrides the pacing the session was started with (default: that pacing)");
   add_library_options(*resume_app, resume->library, true);
+  add_display_options(*resume_app, resume->display);
 }
 
 }  // namespace calligraphy::cli

@@ -8,13 +8,14 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/devices/device_registry.hpp"
+#include "calligraphy/report/teacher_recording.hpp"
 #include "calligraphy/sim/hand_port.hpp"
 #include "cli/cli_devices.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 #include "core/unicode.hpp"
+#include "study/names.hpp"
 #ifdef CALLIGRAPHY_WITH_TRAINER
-#include "trainer/session_files.hpp"
 #include "trainer/trainer.hpp"
 #endif
 
@@ -26,6 +27,10 @@ struct TrainCommand {
   std::string device;  // empty: mouse-hand, or simulated with --writer simulated
   std::string writer = "person";
   std::string guidance = "on";
+  std::string guidance_mode = "fixed";
+  double guidance_gain = 1.0;
+  std::string teacher;
+  std::string record;
   std::uint64_t seed = 0;
   LibraryOptions library;
   std::string session;
@@ -88,13 +93,27 @@ int run_train(const TrainCommand& command) {
     }
   }
   options.guidance = command.guidance == "on";
+  options.guidance_mode = *guidance_mode_from_string(command.guidance_mode);
+  options.guidance_gain = command.guidance_gain;
+  options.record = command.record;
+  if (options.guidance_mode == GuidanceMode::replay && command.teacher.empty())
+    throw UsageError("--guidance-mode replay: needs --teacher FILE (a recording made with --record)");
+  if (!command.teacher.empty()) {
+    const TeacherRecording teacher = read_teacher_recording(command.teacher);
+    try {
+      require_teacher_for(teacher, command.characters);
+    } catch (const InvalidArgument& e) {
+      throw UsageError(std::string("--teacher: ") + e.what() +
+                       " (a trial is one character: practise that one character alone)");
+    }
+    options.teacher = teacher.samples;
+  }
   options.seed = command.seed;
   options.session_dir = command.session;
   options.subject = command.subject;
-  try {
-    trainer::check_subject_id(command.subject);
-  } catch (const InvalidArgument& e) {
-    throw UsageError(std::string("--subject: ") + e.what());
+  if (!study_detail::is_label(command.subject, 64)) {
+    throw UsageError("--subject: '" + command.subject +
+                     "' must be 1-64 characters of A-Z a-z 0-9 _ - (it names the session folder)");
   }
   std::tie(options.width_px, options.height_px) = window_size(command.window);
   options.screenshot = command.screenshot;
@@ -139,13 +158,25 @@ void add_train_command(CLI::App& root, Commands& commands) {
              "who writes: a person, or the simulated writer live on the simulated device (a demonstration)");
   add_choice(*app, "--guidance", command->guidance, {"on", "off"},
              "guiding force towards the stroke (G toggles)");
+  add_choice(*app, "--guidance-mode", command->guidance_mode, {"fixed", "fading", "replay"},
+             "how guidance attracts (docs/force-rendering.md): the paper's fixed fixture, faded trial by "
+             "trial from the mean deviation, or along a teacher's recording (M cycles it)");
+  add_number(*app, "--guidance-gain", command->guidance_gain, "G",
+             "fading: the first trial's gain, faded after each trial", "a number in [0, 1]",
+             [](double g) { return g >= 0.0 && g <= 1.0; });
+  add_input_path(*app, "--teacher", command->teacher, "FILE",
+                 "replay: the teacher's recording (JSON, from --record)", "none");
+  add_output_path(*app, "--record", command->record,
+                  "write each completed trial here as a teacher's recording (JSON), replacing the last",
+                  StandardOutput::refused);
   add_unsigned(*app, "--seed", command->seed, "N", "seed of the simulated writer (a 64-bit integer)");
   add_library_options(*app, command->library, true);
-  add_output_path(*app, "--session", command->session,
-                  "save each trial as it ends into this folder (JSON, CSV, SVG; never overwriting)",
-                  StandardOutput::refused);
+  add_output_path(
+      *app, "--session", command->session,
+      "save the trials as they end into a session folder DIR/SUBJECT/train-TIME/ (docs/experiments.md)",
+      StandardOutput::refused);
   add_text(*app, "--subject", command->subject, "ID",
-           "the subject's id in the saved trials (A-Z a-z 0-9 . _ -)");
+           "the subject's id in the saved trials (A-Z a-z 0-9 _ -)");
   add_text(*app, "--window", command->window, "WxH", "window size [px]");
   add_output_path(*app, "--screenshot", command->screenshot,
                   "write the window as PNG after the last character's trial, or at exit",

@@ -1,36 +1,12 @@
 #pragma once
-// Stopping a trial or a servo-loop benchmark cleanly when the person at the terminal or the system asks:
-// SIGINT (Ctrl-C), SIGTERM (kill, a service manager) and SIGHUP (the terminal closed) only record the
-// request; the command polls it (TrialOptions::should_stop), stops at the next tick with zero force and
-// forces disabled, writes what was recorded and exits with 128 + the signal's number (130, 143, 129),
-// the shell's convention for a command ended by a signal. A recording that cannot be repeated is thus
-// never lost to a signal: the default action would end the process before any file is written.
-#include <functional>
+// The command line's stop signals: the one implementation the trainer window shares (core/stop_signals.hpp),
+// under the names the commands use.
+#include "core/stop_signals.hpp"
 
 namespace calligraphy::cli {
 
-/// While it lives, SIGINT, SIGTERM and SIGHUP are caught (sigaction with SA_RESTART, so that interrupted
-/// reads and writes resume) and SIGPIPE is ignored (a closed standard output becomes a write error that
-/// is reported, not a death before the files are written). Every later stop signal is recorded as well,
-/// so a second Ctrl-C while the files are written cannot lose them; SIGKILL and SIGQUIT still end the
-/// process. The previous dispositions are restored on destruction. One at a time per process.
-class StopSignals {
- public:
-  StopSignals();
-  ~StopSignals();
-  StopSignals(const StopSignals&) = delete;
-  StopSignals& operator=(const StopSignals&) = delete;
-
-  /// The first stop signal received since construction, or 0. Lock-free; any thread.
-  [[nodiscard]] static int received() noexcept;
-  /// `received() != 0`, as a function for TrialOptions::should_stop.
-  [[nodiscard]] static std::function<bool()> stop_requested();
-};
-
-/// "SIGINT", "SIGTERM", "SIGHUP", or "a signal" for any other.
-[[nodiscard]] const char* signal_name(int signal) noexcept;
-
-/// The exit status of a command ended by `signal`: 128 + its number.
-[[nodiscard]] constexpr int exit_status_after(int signal) noexcept { return 128 + signal; }
+using calligraphy::exit_status_after;
+using calligraphy::signal_name;
+using calligraphy::StopSignals;
 
 }  // namespace calligraphy::cli

@@ -186,6 +186,7 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     TrialOptions options = study_trial_options(manifest, condition, trial);
     options.should_stop = run_options.should_stop;
     if (run_options.pacing) options.pacing = *run_options.pacing;
+    if (run_options.prepare_trial) run_options.prepare_trial(trial, options);
     std::vector<Character> models;
     for (const char32_t c : trial.characters) models.push_back(character(c));
     const Scene scene = Scene::lay_out(models);

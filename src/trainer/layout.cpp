@@ -44,6 +44,14 @@ Vec2 WindowLayout::to_trial(std::size_t character, const Vec2& screen_px) const 
   return row_m - row_centre_m_.at(character);
 }
 
+Vec2 WindowLayout::row_to_screen(const Vec2& row_m) const {
+  return Vec2(row_origin_px_.x() + row_m.x() * scale_, row_origin_px_.y() - row_m.y() * scale_);
+}
+
+Vec2 WindowLayout::screen_to_row(const Vec2& screen_px) const {
+  return Vec2((screen_px.x() - row_origin_px_.x()) / scale_, (row_origin_px_.y() - screen_px.y()) / scale_);
+}
+
 Vec2 WindowLayout::data_to_screen(std::size_t character, const Vec2& data) const {
   const ScreenBox& b = box(character);
   return Vec2(b.x_px + data.x() / kDataBoxSize * b.size_px,

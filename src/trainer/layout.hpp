@@ -31,6 +31,10 @@ class WindowLayout {
   [[nodiscard]] Vec2 to_screen(std::size_t character, const Vec2& trial_m) const;
   /// Trial metres of a window pixel, for the trial of character `character`.
   [[nodiscard]] Vec2 to_trial(std::size_t character, const Vec2& screen_px) const;
+  /// Window pixel of a point of a trial whose scene is the whole row (Scene::lay_out of every character) [m].
+  [[nodiscard]] Vec2 row_to_screen(const Vec2& row_m) const;
+  /// Row metres of a window pixel (the inverse of row_to_screen).
+  [[nodiscard]] Vec2 screen_to_row(const Vec2& screen_px) const;
   /// Window pixel of a point in character data units (the 1024 box, y up).
   [[nodiscard]] Vec2 data_to_screen(std::size_t character, const Vec2& data) const;
   /// The left part of the window the row is drawn in [px].

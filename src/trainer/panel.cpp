@@ -96,9 +96,12 @@ void summary(const TrialView& view, const PanelInput& input) {
   ImGui::Spacing();
   if (input.unattended) {
     ImGui::TextDisabled("unattended run (--exit-after)");
+  } else if (!input.session.empty()) {
+    ImGui::Text("Space  start the next trial   Esc  end the session");
   } else {
     ImGui::Text("R  repeat   N  next character");
     ImGui::Text("G  guidance (next trial: %s)", input.next_guidance ? "on" : "off");
+    ImGui::Text("M  guidance mode (next trial: %s, gain %.2f)", input.next_mode.c_str(), input.next_gain);
     ImGui::Text("Q / Esc  quit");
   }
 }
@@ -112,6 +115,15 @@ void draw_panel(const WindowLayout& layout, double panel_width_px, const PanelIn
   ImGui::Begin("trainer", nullptr,
                ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
                    ImGuiWindowFlags_NoBringToFrontOnFocus);
+  if (!input.session.empty()) {
+    ImGui::TextWrapped("%s", input.session.c_str());
+    if (!input.prompt.empty()) {
+      if (input.large_font != nullptr) ImGui::PushFont(input.large_font);
+      ImGui::TextColored(ImVec4(0.1f, 0.35f, 0.8f, 1.0f), "%s", input.prompt.c_str());
+      if (input.large_font != nullptr) ImGui::PopFont();
+    }
+    ImGui::Separator();
+  }
   const TrialView* view = input.view;
   if (view == nullptr) {
     ImGui::TextWrapped("%s", input.status.c_str());
@@ -123,6 +135,9 @@ void draw_panel(const WindowLayout& layout, double panel_width_px, const PanelIn
               input.characters);
   ImGui::Text("device %s", input.device.c_str());
   ImGui::Text("%s, guidance %s", view->condition.c_str(), view->guidance ? "on" : "off");
+  if (input.session.empty())
+    ImGui::Text("next: guidance %s, mode %s, gain %.2f", input.next_guidance ? "on" : "off",
+                input.next_mode.c_str(), input.next_gain);
   ImGui::Separator();
   if (input.large_font != nullptr) ImGui::PushFont(input.large_font);
   ImGui::TextColored(state_colour(s.state), "%s", to_string(s.state));
@@ -143,7 +158,7 @@ void draw_panel(const WindowLayout& layout, double panel_width_px, const PanelIn
   results_table(*view);
   if (view->have_result) {
     summary(*view, input);
-  } else if (!input.unattended) {
+  } else if (!input.unattended && input.session.empty()) {
     ImGui::Spacing();
     ImGui::TextDisabled("R repeat  N next  G guidance  Q quit");
   }

@@ -14,10 +14,14 @@ struct PanelInput {
   const TrialView* view = nullptr;  ///< null before the first trial
   std::string character;            ///< UTF-8
   std::string device;
-  std::size_t characters = 1;  ///< in the row
-  bool next_guidance = true;   ///< what G has set for the next trial
+  std::size_t characters = 1;       ///< in the row
+  bool next_guidance = true;        ///< what G has set for the next trial
+  std::string next_mode = "fixed";  ///< the next trial's guidance mode (M cycles it)
+  double next_gain = 1.0;           ///< the next trial's fading gain
   bool unattended = false;
-  std::string status;  ///< a line for errors or notices
+  std::string status;   ///< a line for errors or notices
+  std::string session;  ///< a study session: subject, trial i of n, phase, condition; empty otherwise
+  std::string prompt;   ///< what the person is asked to do now (start, rest), shown large; may be empty
   double frame_rate_hz = 0.0;
   ImFont* large_font = nullptr;
 };

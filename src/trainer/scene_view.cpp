@@ -24,6 +24,11 @@ constexpr ImU32 kPen = IM_COL32(40, 40, 40, 255);
 constexpr ImU32 kVirtualTip = IM_COL32(255, 120, 0, 255);
 constexpr ImU32 kForce = IM_COL32(150, 0, 200, 255);
 
+// Window pixel of a point of the view's trial [m].
+Vec2 trial_to_screen(const WindowLayout& layout, const TrialView& view, const Vec2& trial_m) {
+  return view.whole_row ? layout.row_to_screen(trial_m) : layout.to_screen(view.character, trial_m);
+}
+
 ImVec2 im(const Vec2& v) { return ImVec2(static_cast<float>(v.x()), static_cast<float>(v.y())); }
 
 void fill_polygon(ImDrawList& draw, const std::vector<ImVec2>& points,
@@ -119,7 +124,8 @@ void draw_scene(ImDrawList& draw, const WindowLayout& layout, const std::vector<
                  1.0f);
     draw.AddLine(ImVec2(corner.x, corner.y + side / 2), ImVec2(corner.x + side, corner.y + side / 2), kGrid,
                  1.0f);
-    const bool active = view != nullptr && view->character == c;
+    const bool active =
+        view != nullptr && (view->whole_row ? view->snapshot.character == c : view->character == c);
     // Adjacent triangles must not show anti-aliasing seams.
     draw.Flags &= ~ImDrawListFlags_AntiAliasedFill;
     for (std::size_t p = 0; p < art[c].polygons.size(); ++p) {
@@ -130,10 +136,9 @@ void draw_scene(ImDrawList& draw, const WindowLayout& layout, const std::vector<
     draw.Flags = flags;
   }
   if (view != nullptr) {  // the trace under the reference, so that both stay visible where they overlap
-    const std::size_t c = view->character;
     for (const TraceSegment& segment : view->segments) {
       std::vector<ImVec2> points;
-      for (const Vec2& p : segment.points_m) points.push_back(im(layout.to_screen(c, p)));
+      for (const Vec2& p : segment.points_m) points.push_back(im(trial_to_screen(layout, *view, p)));
       if (points.size() == 1) draw.AddCircleFilled(points[0], 2.5f, kTrace);
       if (points.size() > 1)
         draw.AddPolyline(points.data(), static_cast<int>(points.size()), kTrace, 0, 5.0f);
@@ -147,19 +152,18 @@ void draw_scene(ImDrawList& draw, const WindowLayout& layout, const std::vector<
     }
   }
   if (view == nullptr) return;
-  const std::size_t c = view->character;
   const DisplaySnapshot& s = view->snapshot;
   const double r = trial_scene.layout.start_radius_m * layout.scale_px_per_m();
   if (view->ended || s.finished) {  // the writing result: every stroke's start (Fig. 31)
     for (const PlacedCharacter& placed : trial_scene.characters) {
       for (const PlacedStroke& stroke : placed.strokes)
-        draw_ellipse(draw, layout.to_screen(c, stroke.start()), r, 0.7 * r, kHint, 2.5f);
+        draw_ellipse(draw, trial_to_screen(layout, *view, stroke.start()), r, 0.7 * r, kHint, 2.5f);
     }
   } else {
-    draw_ellipse(draw, layout.to_screen(c, Vec2(s.hint_m.x, s.hint_m.y)), r, 0.7 * r, kHint, 3.0f);
+    draw_ellipse(draw, trial_to_screen(layout, *view, Vec2(s.hint_m.x, s.hint_m.y)), r, 0.7 * r, kHint, 3.0f);
   }
   if (s.tick == 0) return;
-  const Vec2 tip = layout.to_screen(c, Vec2(s.hip_m.x, s.hip_m.y));
+  const Vec2 tip = trial_to_screen(layout, *view, Vec2(s.hip_m.x, s.hip_m.y));
   Vec2 in_plane_px = Vec2(s.force_n.x, -s.force_n.y) * 150.0;  // 150 px per newton, at most 220 px
   if (in_plane_px.norm() > 220.0) in_plane_px *= 220.0 / in_plane_px.norm();
   draw_arrow(draw, tip, tip + in_plane_px, kForce);

@@ -2,11 +2,14 @@
 // `calligraphy train`: a window (GLFW 3, OpenGL 3.3 core, Dear ImGui) showing a live guided trial, the
 // servo loop on its own thread. See docs/trainer.md.
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "calligraphy/model/character.hpp"
 #include "calligraphy/model/stroke_outline.hpp"
+#include "calligraphy/render/guidance_mode.hpp"
+#include "calligraphy/study/session_runner.hpp"
 
 namespace calligraphy::trainer {
 
@@ -24,6 +27,10 @@ struct TrainerOptions {
   std::string writer_profile = "novice";     ///< novice or skilled
   std::uint64_t seed = 0;
   bool guidance = true;
+  GuidanceMode guidance_mode = GuidanceMode::fixed;  ///< how guidance attracts (M cycles it)
+  double guidance_gain = 1.0;          ///< the fading mode's first gain in [0, 1]; faded after each trial
+  std::vector<TeacherSample> teacher;  ///< replay: the teacher's pen (one character, its recording)
+  std::string record;       ///< non-empty: each completed trial is written here as a teacher recording
   std::string session_dir;  ///< empty: trials are not saved
   std::string subject = "anonymous";
   int width_px = 1280;
@@ -39,6 +46,29 @@ struct TrainerOptions {
 /// fault or could not be saved. Throws Error (InvalidArgument, DeviceNotFound, ...) when it cannot start
 /// (no display, a bad option).
 int run_trainer(const TrainerOptions& options);
+
+/// A study session in the window: `calligraphy session run` on a device a person moves.
+struct TrainerSessionOptions {
+  SessionFolder* session = nullptr;  ///< the session to run (its unsaved trials)
+  /// registry, load_character, should_stop (e.g. the process's stop signals), pacing; the trainer sets
+  /// host and prepare_trial.
+  SessionRunOptions run;
+  /// A character to draw (its model and outlines), for every character of the plan.
+  std::function<TrainerCharacter(char32_t)> load_character;
+  int width_px = 1280;
+  int height_px = 800;
+  std::string screenshot;     ///< PNG written after the last planned trial's outcome, or at exit
+  double exit_after_s = 0.0;  ///< > 0: unattended (trials start by themselves); quit after this long
+  std::string library_version;
+};
+
+/// Runs `run_session` on a thread of its own while the window shows, trial by trial, the characters and
+/// the condition of the next trial (started with Space, or after a second when unattended), the break
+/// countdowns, each trial live as `run_trainer` does, and each trial's outcome. Esc, Q, closing the
+/// window or a stop signal ends the session: the running trial is kept as an attempt (so `session resume`
+/// goes on with it). Returns what run_session returned; rethrows what it threw. Throws Error when no
+/// window can open.
+SessionRunResult run_trainer_session(const TrainerSessionOptions& options);
 
 /// Registers the trainer's pointer devices ("mouse", "mouse-hand") in the process registry the
 /// command line uses.

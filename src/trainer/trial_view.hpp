@@ -28,6 +28,7 @@ struct TraceSegment {
 
 struct TrialView {
   std::size_t character = 0;  ///< index in the row
+  bool whole_row = false;     ///< the trial's scene is the whole row (a study trial), not one character
   std::size_t number = 0;     ///< trials started so far, this one included
   bool guidance = true;
   std::string condition;  ///< "vision+haptic" or "vision"

@@ -88,8 +88,15 @@ class Trainer:
         self.stderr.close()
 
 
-def saved_trials(folder):
-    return sorted(pathlib.Path(folder).glob("*.json"))
+def saved_trials(folder, subject="anonymous"):
+    """The saved trials of the one session folder `train --session FOLDER` made (FOLDER/SUBJECT/train-*)."""
+    (session,) = sorted(pathlib.Path(folder).glob(f"{subject}/train-*"))
+    return sorted((session / "trials").glob("*.json"))
+
+
+def kept_attempts(folder, subject="anonymous"):
+    (session,) = sorted(pathlib.Path(folder).glob(f"{subject}/train-*"))
+    return sorted((session / "trials" / "attempts").glob("*.json"))
 
 
 def medians(char, folder=EMBEDDED):
@@ -166,15 +173,15 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual((record["strokes_completed"], record["strokes_total"]), (5, 5))
         self.assertTrue(record["completed_in_order"])
         self.assertEqual(record["end_reason"], "completed")
-        self.assertEqual(record["character"], "永")
+        self.assertEqual(record["characters"], "永")
         self.assertEqual(record["subject"], "anonymous")
-        self.assertEqual(record["condition"], "vision+haptic")
-        self.assertEqual(record["device"], "simulated")
-        for key in ("start_time", "library_version", "mean_deviation_mm", "per_stroke", "servo_loop"):
+        self.assertEqual(record["condition"], "haptic")
+        self.assertEqual(record["device"]["name"], "simulated")
+        for key in ("start_time_utc", "library", "mean_deviation_mm", "per_stroke", "loop", "score"):
             self.assertIn(key, record)
         with open(record_path.with_suffix(".csv"), newline="") as f:
             trace = list(csv.DictReader(f))
-        self.assertEqual(len(trace), record["servo_loop"]["ticks"])  # every tick kept
+        self.assertEqual(len(trace), record["loop"]["ticks"])  # every tick kept
         self.assertTrue(record_path.with_suffix(".svg").read_text().startswith("<svg"))
 
         image = read_png(pathlib.Path(self.folder) / "out" / "yong.png")
@@ -218,7 +225,7 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual(trainer.wait(), 0, trainer.errors())
         (record_path,) = saved_trials(pathlib.Path(self.folder) / "out")
         record = json.loads(record_path.read_text(encoding="utf-8"))
-        self.assertEqual(record["device"], "mouse")
+        self.assertEqual(record["device"]["name"], "mouse")
         self.assertEqual(record["condition"], "vision")
         self.assertEqual((record["strokes_completed"], record["strokes_total"]), (1, 1))
         self.assertEqual(record["end_reason"], "completed")
@@ -265,23 +272,25 @@ class TrainerTest(unittest.TestCase):
         guided = self.write_yi_beside_the_stroke("on", offset)
         free = self.write_yi_beside_the_stroke("off", offset)
         for record in (guided, free):
-            self.assertEqual(record["device"], "mouse-hand")
+            self.assertEqual(record["device"]["name"], "mouse-hand")
             self.assertEqual(record["strokes_completed"], 1, record)
-        self.assertEqual(guided["condition"], "vision+haptic")
+        self.assertEqual(guided["condition"], "haptic")
         self.assertEqual(free["condition"], "vision")
         self.assertLess(guided["mean_deviation_mm"], 0.7 * free["mean_deviation_mm"])
 
     def ended_mid_trial(self, end):
         """Starts 永 with the simulated writer (no time limit of its own), lets it write a while, then calls
-        `end`, and checks the trial was saved whole as interrupted."""
+        `end`, and checks the trial was kept whole as an interrupted attempt."""
         trainer = self.start("永", "--writer", "simulated", "--session", "out", "--subject", "s01")
         trainer.boxes()
         time.sleep(4.0)
         self.assertIsNone(trainer.process.poll(), "the trial should still run: " + trainer.errors())
         end(trainer)
         self.assertEqual(trainer.wait(timeout=30), 0, trainer.errors())
-        (record_path,) = saved_trials(pathlib.Path(self.folder) / "out")
-        self.assertTrue(record_path.name.startswith("s01-永-"))
+        out = pathlib.Path(self.folder) / "out"
+        self.assertEqual(saved_trials(out, "s01"), [])
+        (record_path,) = kept_attempts(out, "s01")
+        self.assertTrue(record_path.name.startswith("001-test-haptic-r1-U6C38.attempt-1"), record_path.name)
         record = json.loads(record_path.read_text(encoding="utf-8"))
         self.assertEqual(record["end_reason"], "interrupted")
         self.assertTrue(record["aborted"])
@@ -289,7 +298,7 @@ class TrainerTest(unittest.TestCase):
         with open(record_path.with_suffix(".csv"), newline="") as f:
             rows = sum(1 for _ in csv.DictReader(f))
         self.assertGreater(rows, 3000)  # about 4 s at 1 kHz
-        self.assertEqual(rows, record["servo_loop"]["ticks"])
+        self.assertEqual(rows, record["loop"]["ticks"])
         return record
 
     def test_closing_the_window_mid_trial_keeps_the_data(self):
@@ -305,15 +314,140 @@ class TrainerTest(unittest.TestCase):
     def test_sigterm_mid_trial_keeps_the_data(self):
         self.ended_mid_trial(lambda trainer: trainer.process.send_signal(signal.SIGTERM))
 
-    def test_saved_trials_never_overwrite(self):
+    def test_record_then_replay_and_fading_name_their_conditions(self):
+        first = self.start("一", "--writer", "simulated", "--data", SAMPLE, "--record", "teacher.json",
+                           "--session", "out", "--exit-after", "30")
+        self.assertEqual(first.wait(), 0, first.errors())
+        first.close()
+        teacher = json.loads((pathlib.Path(self.folder) / "teacher.json").read_text(encoding="utf-8"))
+        self.assertEqual((teacher["format"], teacher["characters"]), ("calligraphy-teacher-recording", "一"))
+        self.assertGreater(len(teacher["samples"]["t_s"]), 1000)
+        for mode, extra in (("replay", ["--teacher", "teacher.json"]), ("fading", ["--guidance-gain", "0.5"])):
+            run = self.start("一", "--writer", "simulated", "--data", SAMPLE, "--guidance-mode", mode, *extra,
+                             "--session", "out", "--exit-after", "30")
+            self.assertEqual(run.wait(), 0, run.errors())
+            run.close()
+        conditions = sorted(json.loads(p.read_text(encoding="utf-8"))["condition"]
+                            for p in (pathlib.Path(self.folder) / "out").glob("anonymous/train-*/trials/*.json"))
+        self.assertEqual(conditions, ["fading", "haptic", "replay"])
+
+    def test_each_run_saves_into_a_new_session_folder(self):
         out = pathlib.Path(self.folder) / "out"
-        out.mkdir()
-        (out / "anonymous-一-1.json").write_text("earlier\n")
-        trainer = self.start("一", "--device", "mouse", "--data", SAMPLE, "--session", "out", "--exit-after", "2")
-        self.assertEqual(trainer.wait(), 0, trainer.errors())
-        self.assertEqual((out / "anonymous-一-1.json").read_text(), "earlier\n")
-        record = json.loads((out / "anonymous-一-2.json").read_text(encoding="utf-8"))
+        first = self.start("一", "--device", "mouse", "--data", SAMPLE, "--session", "out", "--exit-after", "2")
+        self.assertEqual(first.wait(), 0, first.errors())
+        first.close()
+        (session,) = out.glob("anonymous/train-*")
+        before = {p: p.read_bytes() for p in session.rglob("*") if p.is_file() and p.name != "log.jsonl"}
+        self.assertTrue(any(p.name.endswith(".attempt-1.json") for p in before), sorted(before))
+        second = self.start("一", "--device", "mouse", "--data", SAMPLE, "--session", "out", "--exit-after", "2")
+        self.assertEqual(second.wait(), 0, second.errors())
+        self.assertEqual(len(list(out.glob("anonymous/train-*"))), 2)
+        self.assertEqual({p: p.read_bytes() for p in before}, before)  # nothing of the first run changed
+        record = json.loads(next(p for p in before if p.suffix == ".json" and "attempt" in p.name).read_text())
         self.assertEqual(record["end_reason"], "interrupted")
+
+TINY_PROTOCOL = {
+    "format": "calligraphy-study-protocol", "version": 1, "name": "tiny",
+    "description": "two trials of one character: vision only, then with the guiding force",
+    "conditions": [{"name": "vision", "mode": "vision"}, {"name": "haptic", "mode": "haptic"}],
+    "test": {"characters": ["一"], "conditions": ["vision", "haptic"], "repetitions": 1},
+    "breaks": {"between_blocks_s": 2},
+    "trial": {"max_duration_s": 8, "rate_hz": 1000},
+}
+
+
+class SessionWindowTest(unittest.TestCase):
+    """`calligraphy session run` with a device a person moves runs the session in the trainer window."""
+
+    def setUp(self):
+        self.folder = pathlib.Path(tempfile.mkdtemp(prefix="calligraphy-session-"))
+        (self.folder / "tiny.json").write_text(json.dumps(TINY_PROTOCOL, ensure_ascii=False), encoding="utf-8")
+        self.stdout = open(self.folder / "stdout.txt", "w+")
+        self.stderr = open(self.folder / "stderr.txt", "w+")
+        self.process = None
+
+    def tearDown(self):
+        if self.process is not None and self.process.poll() is None:
+            self.process.kill()
+            self.process.wait()
+        self.stdout.close()
+        self.stderr.close()
+        shutil.rmtree(self.folder, ignore_errors=True)
+
+    def run_session(self, *extra):
+        self.process = subprocess.Popen(
+            [CLI, "session", "run", "tiny.json", "--subject", "S01", "--device", "mouse-hand", "--writer", "human",
+             "--out", "out", "--data", SAMPLE, *extra], stdout=self.stdout, stderr=self.stderr, cwd=self.folder)
+
+    def errors(self):
+        return (self.folder / "stderr.txt").read_text()
+
+    def first_box(self, timeout=30):
+        deadline = time.time() + timeout
+        while time.time() < deadline:
+            lines = [l for l in (self.folder / "stdout.txt").read_text().splitlines() if l.startswith("box ")]
+            if lines:
+                return Box(lines[0])
+            self.assertIsNone(self.process.poll(), "the session ended before its window showed: " + self.errors())
+            time.sleep(0.1)
+        raise AssertionError("no box line within %s s" % timeout)
+
+    def session_folder(self):
+        (session,) = (self.folder / "out" / "S01").glob("tiny-*")
+        return session
+
+    def test_a_person_writes_the_session_in_the_window_and_every_trial_is_saved(self):
+        self.run_session("--exit-after", "90", "--screenshot", "shot.png")
+        box = self.first_box()
+        window = xdotool("search", "--name", "calligraphy train").split()[0]
+        median = medians("一", SAMPLE)[0]
+        path = [box.data_to_px(p) for p in along(median, [i / 16 for i in range(17)])]
+        path.append(box.data_to_px((median[-1][0] + 30, median[-1][1])))
+        time.sleep(1.5)  # unattended: the trial starts a second after it is announced
+        xdotool("mousemove", "--window", window, round(path[0][0]), round(path[0][1]))
+        time.sleep(0.8)  # the hand carries the stylus over the start
+        xdotool("mousedown", 1)
+        time.sleep(0.8)
+        for x, y in path[1:]:
+            xdotool("mousemove", "--window", window, round(x), round(y))
+            time.sleep(0.1)
+        time.sleep(0.5)
+        xdotool("mouseup", 1)
+        self.assertEqual(self.process.wait(timeout=120), 0, self.errors())
+        trials = sorted((self.session_folder() / "trials").glob("*.json"))
+        self.assertEqual([t.name for t in trials], ["001-test-vision-r1-U4E00.json", "002-test-haptic-r1-U4E00.json"])
+        first, second = (json.loads(t.read_text(encoding="utf-8")) for t in trials)
+        self.assertEqual((first["condition"], first["end_reason"], first["strokes_completed"]), ("vision", "completed", 1))
+        self.assertFalse(first["force_law"]["guidance"])
+        self.assertEqual((second["condition"], second["end_reason"]), ("haptic", "time_limit"))
+        self.assertTrue(second["force_law"]["guidance"])
+        for record in (first, second):
+            self.assertEqual(record["device"]["name"], "mouse-hand")
+            self.assertEqual(record["writer"]["kind"], "human")
+        log = [json.loads(l) for l in (self.session_folder() / "log.jsonl").read_text().splitlines()]
+        self.assertIn("session_completed", [e["event"] for e in log])
+        image = read_png(self.folder / "shot.png")
+        inner = along(median, [i / 20 for i in range(2, 19)])
+        self.assertGreater(fraction([near(image, box.data_to_px(p), 6, is_blue) for p in inner]), 0.9)
+        self.assertGreater(fraction([near(image, box.data_to_px(p), 15, is_yellow) for p in inner]), 0.9)
+
+    def test_sigint_ends_the_session_keeping_the_running_trial_as_an_attempt(self):
+        self.run_session()  # attended: the first trial waits for Space
+        self.first_box()
+        window = xdotool("search", "--name", "calligraphy train").split()[0]
+        time.sleep(0.5)
+        xdotool("windowfocus", "--sync", window)
+        xdotool("key", "--window", window, "space")
+        time.sleep(2.5)
+        self.assertIsNone(self.process.poll(), self.errors())
+        self.process.send_signal(signal.SIGINT)
+        self.assertEqual(self.process.wait(timeout=60), 130, self.errors())
+        session = self.session_folder()
+        self.assertEqual(list((session / "trials").glob("*.json")), [])
+        (attempt,) = (session / "trials" / "attempts").glob("*.json")
+        record = json.loads(attempt.read_text(encoding="utf-8"))
+        self.assertEqual(record["end_reason"], "interrupted")
+        self.assertIn("session resume", self.errors())
 
 
 if __name__ == "__main__":

@@ -56,6 +56,10 @@ struct SessionRunOptions {
   /// Overrides the session's pacing for this run (e.g. a session begun in real time resumed lock-step);
   /// nullopt: the pacing in session.json.
   std::optional<TrialPacing> pacing;
+  /// Called with each trial's options just before the trial runs, on the runner's thread, to add what
+  /// only the caller has (a window's display channel, TrialOptions::display; memory locking off in a
+  /// window process); empty: the options are used as `study_trial_options` made them.
+  std::function<void(const PlannedTrial&, TrialOptions&)> prepare_trial;
 };
 
 /// What `run_session` did.

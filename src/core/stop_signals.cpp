@@ -1,11 +1,11 @@
-#include "cli/signals.hpp"
+#include "core/stop_signals.hpp"
 
 #include <atomic>
 #include <csignal>
 
 #include "calligraphy/core/errors.hpp"
 
-namespace calligraphy::cli {
+namespace calligraphy {
 namespace {
 
 // Written by the handler, read by the command's thread: it must be lock-free to be async-signal-safe
@@ -25,12 +25,12 @@ struct SavedDispositions {
   struct sigaction pipe;
 };
 SavedDispositions saved;
-std::atomic<bool> installed{false};
+std::atomic<bool> installed_flag{false};
 
 }  // namespace
 
 StopSignals::StopSignals() {
-  if (installed.exchange(true)) throw StateError("stop signal handlers are installed already");
+  if (installed_flag.exchange(true)) throw StateError("stop signal handlers are installed already");
   received_signal.store(0);
   struct sigaction action {};
   action.sa_handler = record_stop_signal;
@@ -49,8 +49,10 @@ StopSignals::~StopSignals() {
   for (std::size_t i = 0; i < std::size(kStopSignals); ++i)
     sigaction(kStopSignals[i], &saved.stop[i], nullptr);
   sigaction(SIGPIPE, &saved.pipe, nullptr);
-  installed.store(false);
+  installed_flag.store(false);
 }
+
+bool StopSignals::installed() noexcept { return installed_flag.load(); }
 
 int StopSignals::received() noexcept { return received_signal.load(std::memory_order_relaxed); }
 
@@ -71,4 +73,4 @@ const char* signal_name(int signal) noexcept {
   }
 }
 
-}  // namespace calligraphy::cli
+}  // namespace calligraphy

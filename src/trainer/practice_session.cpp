@@ -1,0 +1,104 @@
+#include "trainer/practice_session.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include "calligraphy/report/trial_report.hpp"
+#include "calligraphy/study/protocol.hpp"
+#include "core/unicode.hpp"
+#include "study/trial_record.hpp"
+
+namespace calligraphy::trainer {
+namespace {
+
+// The "train" protocol: the row once under the first condition; the other conditions are defined so that
+// the trials the window runs under them name a condition of the session's own protocol.
+LoadedProtocol practice_protocol(const PracticeSetup& setup) {
+  nlohmann::json items = nlohmann::json::array();
+  for (const char32_t c : decode_utf8(setup.characters_utf8)) items.push_back(encode_utf8(c));
+  const nlohmann::json protocol = {
+      {"format", "calligraphy-study-protocol"},
+      {"version", 1},
+      {"name", "train"},
+      {"description", "free practice in the trainer window (calligraphy train); the trials are those run"},
+      {"conditions",
+       {{{"name", kHapticCondition}, {"mode", "haptic"}},
+        {{"name", kVisionCondition}, {"mode", "vision"}},
+        {{"name", kQuizCondition}, {"mode", "quiz"}},
+        {{"name", kFadingCondition}, {"mode", "fading"}},
+        {{"name", kReplayCondition}, {"mode", "replay"}}}},
+      {"test", {{"characters", items}, {"conditions", {setup.first_condition}}, {"repetitions", 1}}}};
+  return protocol_from_text(protocol.dump(2) + "\n", "calligraphy-train");
+}
+
+SessionFolder create_folder(const PracticeSetup& setup) {
+  SessionSetup session;
+  session.subject = {setup.subject, trailing_number(setup.subject)};
+  session.device = setup.device;
+  session.writer = setup.simulated_writer ? "simulated" : "human";
+  session.writer_profile = setup.writer_profile;
+  session.writer_seed = setup.writer_seed;
+  session.pacing = "real-time";
+  return SessionFolder::create(setup.root, session, practice_protocol(setup));
+}
+
+}  // namespace
+
+PracticeSession::PracticeSession(const PracticeSetup& setup) : setup_(setup), folder_(create_folder(setup)) {
+  folder_.log("session_started", R"({"mode":"practice"})");
+}
+
+std::pair<std::filesystem::path, bool> PracticeSession::save(const PracticeTrial& trial,
+                                                             const TrialResult& result) {
+  PlannedTrial planned;
+  planned.index = trials_++;
+  planned.phase = StudyPhase::test;
+  planned.condition = trial.condition;
+  planned.characters = std::u32string(1, trial.character);
+  planned.item = trial.item;
+  planned.repetition = ++repetitions_[{trial.item, trial.condition}];
+
+  const SessionManifest& manifest = folder_.manifest();
+  const StudyCondition& condition = manifest.protocol.protocol.condition(trial.condition);
+  study_detail::TrialRecordContext context;
+  context.session = &manifest;
+  context.trial = &planned;
+  context.condition = &condition;
+  context.options = trial.options;
+  context.device_name = setup_.device;
+  context.device_info = setup_.device_info;
+  context.hardware = setup_.hardware;
+  context.simulated_writer = setup_.simulated_writer;
+  context.start_utc = trial.start_utc;
+  context.end_utc = trial.end_utc;
+  context.wall_time_s = trial.wall_time_s;
+  const std::string stem = SessionFolder::trial_stem(planned);
+  context.csv_file = stem + ".csv";
+  context.svg_file = stem + ".svg";
+  const Scene& scene = *trial.scene;
+  const std::vector<CharacterScore> scores = study_detail::score_characters(scene, result.trace);
+  std::vector<std::vector<QuizEvent>> quiz;
+  if (condition.mode == ConditionMode::quiz)
+    quiz = study_detail::quiz_characters(scene, result.trace, condition.quiz);
+  const bool keep_as_trial = result.end == TrialEnd::completed || result.end == TrialEnd::time_limit ||
+                             result.end == TrialEnd::writer_gave_up;
+  const nlohmann::json details = {{"trial", planned.index + 1},
+                                  {"condition", planned.condition},
+                                  {"characters", encode_utf8(trial.character)},
+                                  {"file", stem},
+                                  {"end_reason", to_string(result.end)}};
+  if (keep_as_trial) {
+    const std::string record =
+        study_detail::trial_record_json(context, scene, result, scores, quiz.empty() ? nullptr : &quiz);
+    folder_.save_trial(planned, record, trial_csv(result.trace), trial_svg(scene, result));
+    folder_.log("trial_saved", details.dump());
+    return {folder_.trial_file(planned, "json"), true};
+  }
+  context.svg_file.clear();
+  const std::string record =
+      study_detail::trial_record_json(context, scene, result, scores, quiz.empty() ? nullptr : &quiz);
+  const std::filesystem::path kept = folder_.save_attempt(planned, record, trial_csv(result.trace));
+  folder_.log(result.end == TrialEnd::interrupted ? "trial_interrupted" : "trial_failed", details.dump());
+  return {kept, false};
+}
+
+}  // namespace calligraphy::trainer
