@@ -398,3 +398,16 @@ TEST_CASE("a crash between saving a trial and logging it, or in a log line, is m
   CHECK(saved == 3);
   CHECK(recovered == 1);
 }
+
+TEST_CASE("a session's simulated writer is any known profile", "[study][session]") {
+  TempFolder temp;
+  SessionSetup setup = simulated("W1");
+  setup.writer_profile = "foreign";
+  SessionFolder session = SessionFolder::create(temp.path, setup, small_protocol());
+  run_session(session);
+  REQUIRE(session.is_saved(session.plan()[0]));
+  CHECK(record_of(session, session.plan()[0])["writer"]["profile"]["name"] == "foreign");
+  setup.writer_profile = "expert";
+  CHECK_THROWS_WITH(SessionFolder::create(temp.path, setup, small_protocol()),
+                    Catch::Contains("expert") && Catch::Contains("skilled"));
+}
