@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -109,11 +110,51 @@ TEST_CASE("protocol errors name the file and the JSON pointer", "[study][protoco
 
 TEST_CASE("fading and replay conditions are read with their parameters", "[study][protocol]") {
   const StudyProtocol p = parse_study_protocol(
-      R"({"name": "f", "conditions": [{"name": "fade", "mode": "fading", "parameters": {"start_gain": 1, "end_gain": 0}}],
-          "test": {"characters": ["大"], "conditions": ["fade"], "repetitions": 1}})",
+      R"({"name": "f", "conditions": [
+            {"name": "fade", "mode": "fading",
+             "parameters": {"start_gain": 0.8, "forgetting_factor": 0.5, "error_gain_per_m": 100}},
+            {"name": "play", "mode": "replay", "parameters": {"max_lead_m": 0.002},
+             "teachers": {"大": "teachers/da.json"}},
+            {"name": "fade0", "mode": "fading"}],
+          "test": {"characters": ["大", "山"], "conditions": ["fade", "play", "fade0"], "repetitions": 1}})",
       "f.json");
-  CHECK(p.conditions[0].mode == ConditionMode::fading);
-  CHECK(p.conditions[0].guidance_parameters.at("end_gain") == 0.0);
+  const StudyCondition& fade = p.condition("fade");
+  CHECK(fade.mode == ConditionMode::fading);
+  CHECK(fade.start_gain == 0.8);
+  CHECK(fade.fading_rule.forgetting_factor == 0.5);
+  CHECK(fade.fading_rule.error_gain_per_m == 100.0);
+  CHECK(fade.guidance_parameters.at("start_gain") == 0.8);
+  const StudyCondition& play = p.condition("play");
+  CHECK(play.replay_max_lead_m == std::optional<double>(0.002));
+  CHECK(play.teachers.at(U"大") == "teachers/da.json");
+  CHECK(play.teachers.count(U"山") == 0);  // recorded by the runner
+  const StudyCondition& defaults = p.condition("fade0");
+  CHECK(defaults.start_gain == 1.0);
+  CHECK(defaults.fading_rule.forgetting_factor == FadingRule{}.forgetting_factor);
+}
+
+TEST_CASE("fading and replay parameters and teachers are checked naming the JSON pointer",
+          "[study][protocol]") {
+  const auto with_condition = [](const std::string& condition) {
+    return R"({"name": "t", "conditions": [)" + condition +
+           R"(], "test": {"characters": ["大"], "conditions": ["A"], "repetitions": 1}})";
+  };
+  check_error(with_condition(R"({"name": "A", "mode": "fading", "parameters": {"end_gain": 0}})"),
+              "/conditions/0/parameters/end_gain", "unknown key");
+  check_error(with_condition(R"({"name": "A", "mode": "fading", "parameters": {"start_gain": 1.5}})"),
+              "/conditions/0/parameters/start_gain", "1.5");
+  check_error(with_condition(R"({"name": "A", "mode": "fading", "parameters": {"forgetting_factor": -1}})"),
+              "/conditions/0/parameters/forgetting_factor", "-1");
+  check_error(with_condition(R"({"name": "A", "mode": "replay", "parameters": {"start_gain": 1}})"),
+              "/conditions/0/parameters/start_gain", "unknown key");
+  check_error(with_condition(R"({"name": "A", "mode": "replay", "parameters": {"max_lead_m": 0}})"),
+              "/conditions/0/parameters/max_lead_m", "> 0");
+  check_error(with_condition(R"({"name": "A", "mode": "haptic", "teachers": {"大": "t.json"}})"),
+              "/conditions/0/teachers", "replay");
+  check_error(with_condition(R"({"name": "A", "mode": "replay", "teachers": {"山": "t.json"}})"),
+              "/conditions/0/teachers/山", "not an item");
+  check_error(with_condition(R"({"name": "A", "mode": "replay", "teachers": {"大": ""}})"),
+              "/conditions/0/teachers/大", "empty");
 }
 
 TEST_CASE("a balanced Latin square: each condition once per row, every ordered pair equally often",

@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -168,15 +169,108 @@ TEST_CASE("a simulated subject writes the same for the same id and differently f
   CHECK(times[0] != times[2]);
 }
 
-TEST_CASE("a condition this build cannot render is refused before any trial runs", "[study][session]") {
-  TempFolder temp;
-  const LoadedProtocol protocol = protocol_from_text(
-      R"({"name": "f", "conditions": [{"name": "vision", "mode": "vision"}, {"name": "fade", "mode": "fading"}],
-          "test": {"characters": ["十"], "conditions": ["vision", "fade"], "repetitions": 1}})",
+namespace {
+
+nlohmann::json record_of(const SessionFolder& session, const PlannedTrial& trial) {
+  return nlohmann::json::parse(read(session.trial_file(trial, "json")));
+}
+
+LoadedProtocol fading_protocol() {
+  return protocol_from_text(
+      R"({"name": "f", "conditions": [{"name": "fade", "mode": "fading",
+            "parameters": {"start_gain": 0.9, "forgetting_factor": 0.7, "error_gain_per_m": 150}}],
+          "test": {"characters": ["十", "人"], "conditions": ["fade"], "repetitions": 3},
+          "trial": {"max_duration_s": 40}})",
       "f.json");
-  SessionFolder session = SessionFolder::create(temp.path, simulated("S03"), protocol);
-  CHECK_THROWS_WITH(run_session(session), Catch::Contains("condition 'fade'"));
-  CHECK(session.saved_count() == 0);
+}
+
+}  // namespace
+
+TEST_CASE("a fading gain follows the previous repetition of the item, the same after a resume",
+          "[study][session][guidance]") {
+  TempFolder temp;
+  const LoadedProtocol protocol = fading_protocol();
+  // One session run straight through, one stopped after two trials and resumed: the same subject.
+  SessionFolder whole = SessionFolder::create(temp.path / "whole", simulated("F1"), protocol);
+  REQUIRE(run_session(whole).complete());
+  fs::path folder;
+  {
+    SessionFolder session = SessionFolder::create(temp.path / "resumed", simulated("F1"), protocol);
+    folder = session.path();
+    StopAfter host(2);
+    SessionRunOptions options;
+    options.host = &host;
+    options.should_stop = [&] { return host.ended >= 2; };
+    REQUIRE(run_session(session, options).saved_now == 2);
+  }
+  SessionFolder resumed = SessionFolder::open(folder);
+  REQUIRE(run_session(resumed).complete());
+
+  const StudyCondition& fade = protocol.protocol.condition("fade");
+  std::map<std::u32string, std::pair<double, double>> previous;  // item -> (gain, mean deviation [mm])
+  for (const PlannedTrial& trial : whole.plan()) {
+    const auto record = record_of(whole, trial);
+    const double gain = record["guidance"]["gain"].get<double>();
+    CHECK(record["force_law"]["guidance_gain"].get<double>() == gain);
+    CHECK(record["force_law"]["guidance_mode"] == "fading");
+    const auto before = previous.find(trial.characters);
+    if (before == previous.end()) {
+      CHECK(gain == fade.start_gain);
+      CHECK(record["guidance"]["previous_trial"].is_null());
+    } else {
+      CHECK(gain == next_guidance_gain(before->second.first, before->second.second * 1e-3, fade.fading_rule));
+    }
+    previous[trial.characters] = {gain, record["mean_deviation_mm"].get<double>()};
+    CHECK(record_of(resumed, trial)["guidance"] == record["guidance"]);
+  }
+}
+
+TEST_CASE("a replay condition follows a teacher kept in the session folder and names its SHA-256",
+          "[study][session][guidance]") {
+  TempFolder temp;
+  const std::string conditions =
+      R"({"name": "r", "conditions": [{"name": "play", "mode": "replay"TEACHERS}],
+          "test": {"characters": ["十"], "conditions": ["play"], "repetitions": 1},
+          "trial": {"max_duration_s": 40}})";
+  const auto protocol_with = [&](const std::string& teachers) {
+    std::string text = conditions;
+    text.replace(text.find("TEACHERS"), 8, teachers);
+    const fs::path path = temp.path / "protocols" / "r.json";
+    fs::create_directories(path.parent_path());
+    std::ofstream(path) << text;
+    return load_study_protocol(path);
+  };
+  // No teacher in the protocol: a skilled simulated writer records one into the session folder.
+  SessionFolder recorded = SessionFolder::create(temp.path / "a", simulated("R1"), protocol_with(""));
+  REQUIRE(run_session(recorded).complete());
+  const fs::path teacher_file = recorded.path() / "teachers" / "play-U5341.json";
+  REQUIRE(fs::exists(teacher_file));
+  const auto record = record_of(recorded, recorded.plan()[0]);
+  CHECK(record["force_law"]["guidance_mode"] == "replay");
+  CHECK(record["guidance"]["teacher"]["file"] == "teachers/play-U5341.json");
+  CHECK(record["guidance"]["teacher"]["source"] == "recorded");
+  CHECK(record["guidance"]["teacher"]["sha256"] == sha256_hex(read(teacher_file)));
+  CHECK(record["completed_in_order"] == true);
+
+  // The protocol's teacher (a path relative to the protocol file) is copied and named.
+  fs::create_directories(temp.path / "protocols" / "t");
+  fs::copy_file(teacher_file, temp.path / "protocols" / "t" / "shi.json");
+  SessionFolder given = SessionFolder::create(temp.path / "b", simulated("R1"),
+                                              protocol_with(R"(, "teachers": {"十": "t/shi.json"})"));
+  REQUIRE(run_session(given).complete());
+  const auto given_record = record_of(given, given.plan()[0]);
+  CHECK(given_record["guidance"]["teacher"]["source"] == "t/shi.json");
+  CHECK(given_record["guidance"]["teacher"]["sha256"] == sha256_hex(read(teacher_file)));
+  CHECK(read(given.path() / "teachers" / "play-U5341.json") == read(teacher_file));
+
+  // A recording of another character is refused before the trial runs.
+  std::string other = read(teacher_file);
+  other.replace(other.find("\"十\""), std::string("\"十\"").size(), "\"人\"");
+  std::ofstream(temp.path / "protocols" / "t" / "ren.json") << other;
+  SessionFolder wrong = SessionFolder::create(temp.path / "c", simulated("R1"),
+                                              protocol_with(R"(, "teachers": {"十": "t/ren.json"})"));
+  CHECK_THROWS_WITH(run_session(wrong), Catch::Contains("condition 'play'") && Catch::Contains("人"));
+  CHECK(wrong.saved_count() == 0);
 }
 
 TEST_CASE("a damaged session.json is refused naming the file and the JSON pointer", "[study][session]") {
@@ -303,4 +397,17 @@ TEST_CASE("a crash between saving a trial and logging it, or in a log line, is m
   CHECK(torn == 1);  // the torn line stands alone, every later line is whole
   CHECK(saved == 3);
   CHECK(recovered == 1);
+}
+
+TEST_CASE("a session's simulated writer is any known profile", "[study][session]") {
+  TempFolder temp;
+  SessionSetup setup = simulated("W1");
+  setup.writer_profile = "foreign";
+  SessionFolder session = SessionFolder::create(temp.path, setup, small_protocol());
+  run_session(session);
+  REQUIRE(session.is_saved(session.plan()[0]));
+  CHECK(record_of(session, session.plan()[0])["writer"]["profile"]["name"] == "foreign");
+  setup.writer_profile = "expert";
+  CHECK_THROWS_WITH(SessionFolder::create(temp.path, setup, small_protocol()),
+                    Catch::Contains("expert") && Catch::Contains("skilled"));
 }

@@ -194,6 +194,25 @@ CLI::Option* add_text(CLI::App& app, const std::string& name, std::string& targe
   });
 }
 
+CLI::Option* add_repeated_text(CLI::App& app, const std::string& name, std::vector<std::string>& target,
+                               const std::string& value_name, const std::string& description) {
+  CLI::Option* option = app.add_option(
+      name,
+      [name, value_name, &target](const CLI::results_t& results) {
+        for (const std::string& text : results) {
+          require_not_option_like(name, text, value_name);
+          target.push_back(text);
+        }
+        return true;
+      },
+      description + " (default: none)");
+  option->type_size(1);
+  option->expected(1);
+  option->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);  // every repeat is kept
+  option->option_text(value_name);
+  return option;
+}
+
 CLI::Option* add_input_path(CLI::App& app, const std::string& name, std::string& target,
                             const std::string& value_name, const std::string& description,
                             const std::string& default_text) {

@@ -68,6 +68,10 @@ CLI::Option* add_choice(CLI::App& app, const std::string& name, std::string& tar
 CLI::Option* add_text(CLI::App& app, const std::string& name, std::string& target,
                       const std::string& value_name, const std::string& description,
                       const std::string& default_text = "");
+/// Free text that may be given many times (`--writer-param a=1 --writer-param b=2`), each value in turn
+/// appended to `target`; "(default: none)" in --help.
+CLI::Option* add_repeated_text(CLI::App& app, const std::string& name, std::vector<std::string>& target,
+                               const std::string& value_name, const std::string& description);
 /// A file or folder that is read.
 CLI::Option* add_input_path(CLI::App& app, const std::string& name, std::string& target,
                             const std::string& value_name, const std::string& description,

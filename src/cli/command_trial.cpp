@@ -11,8 +11,10 @@
 
 #include "calligraphy/devices/device_registry.hpp"
 #include "calligraphy/model/scene.hpp"
+#include "calligraphy/report/teacher_recording.hpp"
 #include "calligraphy/report/trial_report.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/trial/trial.hpp"
 #include "cli/cli_devices.hpp"
 #include "cli/commands.hpp"
@@ -28,6 +30,12 @@ struct TrialCommand {
   std::string device = "simulated";
   std::string guidance = "on";
   std::string writer = "novice";
+  std::vector<std::string> writer_parameters;  // "key=value", applied in turn
+  std::string guidance_mode = "fixed";
+  double guidance_gain = 1.0;
+  const CLI::Option* gain_option = nullptr;
+  std::string teacher;  // replay: the recording's path
+  std::string record;   // write the trial as a teacher's recording
   std::uint64_t seed = 0;
   double rate_hz = TrialOptions{}.rate_hz;
   std::string pacing = "auto";
@@ -50,15 +58,68 @@ DeviceListing find_device(const std::string& name) {
                    "'; registered devices: " + (names.empty() ? "none" : names));
 }
 
+// The profile of --writer with each --writer-param applied; a UsageError naming the setting and listing
+// the known keys when one is refused.
+WriterProfile writer_from(const TrialCommand& command) {
+  WriterProfile profile = writer_profile(command.writer);
+  for (const std::string& setting : command.writer_parameters) {
+    try {
+      apply_writer_setting(profile, setting);
+    } catch (const InvalidArgument& e) {
+      std::string message = std::string("--writer-param '") + setting + "': " + e.what();
+      if (message.find("known:") == std::string::npos) {
+        std::string keys;
+        for (const std::string& key : writer_parameter_names()) keys += (keys.empty() ? "" : ", ") + key;
+        message += "; known keys: " + keys;
+      }
+      throw UsageError(message);
+    }
+  }
+  return profile;
+}
+
+// The combinations of the guidance options that mean nothing are refused before anything runs.
+void check_guidance_options(const TrialCommand& command) {
+  if (command.guidance == "off" && command.guidance_mode != "fixed") {
+    throw UsageError("--guidance-mode " + command.guidance_mode +
+                     ": needs guidance on (it is given with --guidance off)");
+  }
+  if (command.gain_option->count() > 0 && command.guidance_mode != "fading") {
+    throw UsageError("--guidance-gain applies to --guidance-mode fading only");
+  }
+  if (command.guidance_mode == "replay" && command.teacher.empty()) {
+    throw UsageError("--teacher: required with --guidance-mode replay (a recording made with --record)");
+  }
+  if (!command.teacher.empty() && command.guidance_mode != "replay") {
+    throw UsageError("--teacher applies to --guidance-mode replay only");
+  }
+}
+
+// The teacher's recording of --teacher, checked against the characters to write (a DataError naming the
+// file when it cannot be read, an InvalidArgument naming both character lists when they differ).
+TeacherRecording teacher_for(const TrialCommand& command) {
+  TeacherRecording teacher = read_teacher_recording(command.teacher);
+  try {
+    require_teacher_for(teacher, command.characters);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument("--teacher " + command.teacher + ": " + e.what());
+  }
+  return teacher;
+}
+
 // Every use of the trial runner's options and run_trial is here, in one place.
 TrialResult run_trial_on_device(const TrialCommand& command, const DeviceListing& device, const Scene& scene,
+                                const WriterProfile& writer, const TeacherRecording* teacher,
                                 TrialDescription& description) {
   TrialOptions options;
   options.force.guidance = command.guidance == "on";
-  options.simulation.writer = command.writer == "novice" ? WriterProfile::novice() : WriterProfile::skilled();
+  options.force.guidance_mode = *guidance_mode_from_string(command.guidance_mode);
+  options.force.guidance_gain = command.guidance_gain;
+  if (teacher) options.force.teacher_trajectory = teacher->samples;
+  options.simulation.writer = writer;
   options.simulation.seed = command.seed;
   options.rate_hz = command.rate_hz;
-  options.keep_trace = !command.svg.empty() || !command.csv.empty();
+  options.keep_trace = !command.svg.empty() || !command.csv.empty() || !command.record.empty();
   options.pacing = command.pacing == "lock-step"   ? TrialPacing::lock_step
                    : command.pacing == "real-time" ? TrialPacing::real_time
                                                    : TrialPacing::automatic;
@@ -70,6 +131,16 @@ TrialResult run_trial_on_device(const TrialCommand& command, const DeviceListing
       command.characters,      options.force.guidance, device.hardware ? "human" : command.writer,
       options.simulation.seed, options.rate_hz,        device.name,
       device.info.model};
+  description.guidance_mode = options.force.guidance_mode;
+  description.guidance_gain = options.force.guidance_gain;
+  if (teacher) {
+    description.teacher_file = command.teacher;
+    description.teacher_characters = teacher->characters;
+  }
+  if (!device.hardware) {
+    description.writer_profile = writer.name;
+    description.writer_parameters = command.writer_parameters;
+  }
   return calligraphy::run_trial(device.name, scene, options);
 }
 
@@ -96,6 +167,34 @@ bool write_trial_outputs(const TrialCommand& command, const TrialDescription& de
   return all_written;
 }
 
+// --record: the trial as a teacher's recording, only when every stroke was written in order (a replay
+// follows the teacher stroke by stroke). Returns whether it was written.
+bool write_teacher_recording(const TrialCommand& command, const TrialDescription& description,
+                             const TrialResult& result) {
+  if (command.record.empty()) return true;
+  if (result.aborted || !result.metrics.completed_in_order) {
+    std::fprintf(
+        stderr,
+        "calligraphy trial: error: --record %s: not written: the trial did not complete every stroke "
+        "in order (%zu of %zu strokes, %s), so it cannot teach them\n",
+        command.record.c_str(), result.metrics.strokes_completed, result.metrics.strokes_total,
+        to_string(result.end));
+    return false;
+  }
+  try {
+    const TeacherRecording recording = teacher_recording_from_trace(
+        description.characters, description.writer, description.device, description.rate_hz, result.trace);
+    write_output(command.record, teacher_recording_json(recording));
+    return true;
+  } catch (const Error& e) {
+    std::fprintf(stderr, "calligraphy trial: error: --record: %s\n", e.what());
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "calligraphy trial: error: %s: cannot write: out of memory\n",
+                 command.record.c_str());
+  }
+  return false;
+}
+
 int run_trial(const TrialCommand& command) {
   require_one_standard_output(
       {{"--json", command.json == "-"}, {"--svg", command.svg == "-"}, {"--csv", command.csv == "-"}});
@@ -107,6 +206,10 @@ int run_trial(const TrialCommand& command) {
     throw UsageError(
         "--watchdog-ms applies to real-time pacing only (--pacing real-time, or a hardware device)");
   }
+  check_guidance_options(command);
+  const WriterProfile writer = writer_from(command);
+  std::unique_ptr<TeacherRecording> teacher;
+  if (!command.teacher.empty()) teacher = std::make_unique<TeacherRecording>(teacher_for(command));
   // From here a stop signal ends the trial at its next tick and the outputs are still written.
   const StopSignals stop_signals;
   const CharacterSource source(command.library);  // only these characters are read (on demand from a store)
@@ -121,14 +224,15 @@ int run_trial(const TrialCommand& command) {
   }
 
   TrialDescription description;
-  TrialResult result = run_trial_on_device(command, device, scene, description);
+  TrialResult result = run_trial_on_device(command, device, scene, writer, teacher.get(), description);
   const int signal = StopSignals::received();
   if (result.end == TrialEnd::interrupted && result.abort_reason.empty() && signal != 0) {
     result.abort_reason = std::string("stopped by ") + signal_name(signal);
   }
   // The recording first (it cannot be repeated), then the table. Outputs are written for a trial that
   // ended early too: they hold every tick recorded.
-  const bool written = write_trial_outputs(command, description, scene, result);
+  const bool written = write_trial_outputs(command, description, scene, result) &&
+                       write_teacher_recording(command, description, result);
   // Standard output carries one document: the table, or the output given as '-'.
   if (command.json != "-" && command.svg != "-" && command.csv != "-")
     print_trial_table(description, scene, result);
@@ -156,8 +260,18 @@ void add_trial_command(CLI::App& root, Commands& commands) {
   add_positional(*app, "CHARS", command->characters, "the characters to write, left to right (UTF-8)");
   add_text(*app, "--device", command->device, "NAME", "the device, by its name in `calligraphy devices`");
   add_choice(*app, "--guidance", command->guidance, {"on", "off"}, "guiding force towards the stroke");
-  add_choice(*app, "--writer", command->writer, {"novice", "skilled"},
-             "the simulated writer's profile (simulated and emulated devices)");
+  add_choice(
+      *app, "--guidance-mode", command->guidance_mode, {"fixed", "fading", "replay"},
+      "how the guidance attracts: the paper's fixture, faded by --guidance-gain, or replaying --teacher");
+  command->gain_option =
+      add_number(*app, "--guidance-gain", command->guidance_gain, "G", "fading: gain on the guiding force",
+                 "a number in [0, 1]", [](double gain) { return gain >= 0.0 && gain <= 1.0; });
+  add_input_path(*app, "--teacher", command->teacher, "FILE",
+                 "replay: the teacher's recording of CHARS (made with --record)", "none");
+  add_choice(*app, "--writer", command->writer, {"novice", "skilled", "foreign"},
+             "the simulated writer's profile (simulated and emulated devices; docs/writer.md)");
+  add_repeated_text(*app, "--writer-param", command->writer_parameters, "KEY=VALUE",
+                    "set a field of the writer's profile (repeatable; keys: docs/writer.md)");
   add_unsigned(*app, "--seed", command->seed, "N", "seed of the simulated writer (a 64-bit integer)");
   add_number(*app, "--rate", command->rate_hz, "HZ", "servo rate [Hz]", "a number of Hz in [100, 100000]",
              [](double hz) { return hz >= 100.0 && hz <= 100000.0; });
@@ -177,6 +291,10 @@ void add_trial_command(CLI::App& root, Commands& commands) {
   add_output_path(*app, "--csv", command->csv,
                   "write the trace (t,x,y,z,fx,fy,fz,state,stroke,element; s, m, N) as CSV",
                   StandardOutput::allowed);
+  add_output_path(*app, "--record", command->record,
+                  "write the trial as a teacher's recording for --guidance-mode replay (a trial that wrote "
+                  "every stroke in order)",
+                  StandardOutput::refused);
 }
 
 }  // namespace calligraphy::cli

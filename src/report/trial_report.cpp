@@ -122,6 +122,12 @@ std::string trial_json(const TrialDescription& d, const TrialResult& result) {
                         {"state_transitions", m.state_transitions},
                         {"per_stroke", per_stroke}};
   if (result.loop) doc["loop"] = loop_json(*result.loop);  // real-time trials only
+  doc["guidance_mode"] = to_string(d.guidance_mode);
+  if (d.guidance_mode == GuidanceMode::fading) doc["guidance_gain"] = d.guidance_gain;
+  if (d.guidance_mode == GuidanceMode::replay)
+    doc["teacher"] = {{"file", d.teacher_file}, {"characters", d.teacher_characters}};
+  if (!d.writer_profile.empty()) doc["writer_profile"] = d.writer_profile;
+  if (!d.writer_parameters.empty()) doc["writer_parameters"] = d.writer_parameters;
   return doc.dump(2) + "\n";
 }
 

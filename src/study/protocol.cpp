@@ -82,6 +82,68 @@ QuizOptions read_quiz(const json& value, const std::string& pointer, const std::
   return quiz;
 }
 
+// The documented parameters of the `fading` and `replay` modes (docs/experiments.md); an unknown key or
+// a value out of range is an error naming its pointer.
+void read_guidance_parameters(const json& parameters, const std::string& pointer, const std::string& source,
+                              StudyCondition& condition) {
+  ObjectReader reader(parameters, pointer, source);
+  if (condition.mode == ConditionMode::fading) {
+    condition.start_gain = reader.number_or("start_gain", condition.start_gain, 0.0, 1.0);
+    condition.fading_rule.forgetting_factor =
+        reader.number_or("forgetting_factor", condition.fading_rule.forgetting_factor, 0.0, 1.0);
+    condition.fading_rule.error_gain_per_m =
+        reader.number_or("error_gain_per_m", condition.fading_rule.error_gain_per_m, 0.0, 1e6);
+  } else {
+    if (reader.has("max_lead_m")) {
+      const double lead_m = reader.number("max_lead_m", 0.0, 0.1);
+      if (!(lead_m > 0.0)) fail(source, reader.pointer("max_lead_m"), "expected a number > 0");
+      condition.replay_max_lead_m = lead_m;
+    }
+  }
+  reader.finish();  // any other key: an error naming it
+  for (const auto& item : parameters.items())
+    condition.guidance_parameters[item.key()] = item.value().get<double>();
+}
+
+// "teachers": {"<item>": "path"}: keys are items (checked against the protocol's items later).
+std::map<std::u32string, std::string> read_teachers(const json& value, const std::string& pointer,
+                                                    const std::string& source) {
+  if (!value.is_object()) {
+    fail(source, pointer,
+         "expected an object of items and recording files, got " + study_detail::describe(value));
+  }
+  std::map<std::u32string, std::string> teachers;
+  for (const auto& item : value.items()) {
+    const std::string at = child_pointer(pointer, item.key());
+    std::u32string characters;
+    try {
+      characters = decode_utf8(item.key());
+    } catch (const InvalidArgument& e) {
+      fail(source, at, std::string("not UTF-8: ") + e.what());
+    }
+    const std::string path = as_string(item.value(), at, source);
+    if (path.empty()) fail(source, at, "expected the path of a teacher's recording, got an empty string");
+    teachers[characters] = path;
+  }
+  return teachers;
+}
+
+// Every item a replay condition names a teacher for is one the protocol writes.
+void check_teacher_items(const StudyProtocol& protocol, const std::string& source) {
+  for (std::size_t i = 0; i < protocol.conditions.size(); ++i) {
+    for (const auto& [item, path] : protocol.conditions[i].teachers) {
+      const auto written = [&](const std::vector<std::u32string>& items) {
+        return std::find(items.begin(), items.end(), item) != items.end();
+      };
+      if (written(protocol.test_items) || (protocol.practice && written(protocol.practice->items))) continue;
+      std::string utf8;
+      for (const char32_t c : item) utf8 += encode_utf8(c);
+      fail(source, child_pointer(child_pointer(child_pointer("/conditions", i), "teachers"), utf8),
+           "\"" + utf8 + "\" is not an item of the protocol (test or practice characters)");
+    }
+  }
+}
+
 StudyCondition read_condition(const json& value, const std::string& pointer, const std::string& source) {
   ObjectReader reader(value, pointer, source);
   StudyCondition condition;
@@ -110,11 +172,13 @@ StudyCondition read_condition(const json& value, const std::string& pointer, con
     if (condition.mode != ConditionMode::fading && condition.mode != ConditionMode::replay) {
       fail(source, at, "only the modes \"fading\" and \"replay\" take parameters");
     }
-    ObjectReader parameter_reader(*parameters, at, source);
-    for (const auto& item : parameters->items()) {
-      condition.guidance_parameters[item.key()] = parameter_reader.number(
-          item.key(), -std::numeric_limits<double>::max(), std::numeric_limits<double>::max());
+    read_guidance_parameters(*parameters, at, source, condition);
+  }
+  if (const json* teachers = reader.optional("teachers")) {
+    if (condition.mode != ConditionMode::replay) {
+      fail(source, reader.pointer("teachers"), "only the mode \"replay\" takes teachers");
     }
+    condition.teachers = read_teachers(*teachers, reader.pointer("teachers"), source);
   }
   if (const json* quiz = reader.optional("quiz")) {
     if (condition.mode != ConditionMode::quiz) {
@@ -287,6 +351,7 @@ StudyProtocol parse_study_protocol(std::string_view json_text, const std::string
   protocol.repetitions = static_cast<int>(test.integer("repetitions", 1, kMaxRepetitions));
   test.finish();
 
+  check_teacher_items(protocol, source);
   read_order(root, protocol);
   read_breaks(root, protocol);
   read_trial_settings(root, protocol);

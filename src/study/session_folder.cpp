@@ -14,6 +14,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/report/atomic_file.hpp"
+#include "calligraphy/sim/writer_profile.hpp"
 #include "core/unicode.hpp"
 #include "study/json_reader.hpp"
 #include "study/manifest_json.hpp"
@@ -86,9 +87,7 @@ void check_setup(const SessionSetup& setup) {
   if (setup.writer != "simulated" && setup.writer != "human") {
     throw InvalidArgument("writer '" + setup.writer + "': expected 'simulated' or 'human'");
   }
-  if (setup.writer_profile != "novice" && setup.writer_profile != "skilled") {
-    throw InvalidArgument("writer profile '" + setup.writer_profile + "': expected 'novice' or 'skilled'");
-  }
+  (void)writer_profile(setup.writer_profile);  // InvalidArgument naming it and the known profiles
   if (setup.pacing != "auto" && setup.pacing != "lock-step" && setup.pacing != "real-time") {
     throw InvalidArgument("pacing '" + setup.pacing + "': expected 'auto', 'lock-step' or 'real-time'");
   }

@@ -12,9 +12,11 @@
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/report/trial_report.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/trial/runner.hpp"
 #include "core/unicode.hpp"
 #include "study/names.hpp"
+#include "study/trial_guidance.hpp"
 #include "study/trial_record.hpp"
 
 namespace calligraphy {
@@ -45,6 +47,8 @@ DeviceListing find_listing(const DeviceRegistry& registry, const std::string& na
 void check_plan(const SessionManifest& session, const DeviceListing& device) {
   for (const PlannedTrial& trial : session.plan) {
     const StudyCondition& condition = session.protocol.protocol.condition(trial.condition);
+    // A replay's teacher is read (or recorded) when its trial comes; every other setting is checked now.
+    if (condition.mode == ConditionMode::replay) continue;
     (void)study_trial_options(session, condition, trial);
   }
   if (session.setup.writer == "simulated" && device.hardware) {
@@ -93,7 +97,7 @@ void SessionHost::rest(double, const PlannedTrial&, const std::function<bool()>&
 void SessionHost::after_trial(const PlannedTrial&, const TrialOutcome&) {}
 
 TrialOptions study_trial_options(const SessionManifest& session, const StudyCondition& condition,
-                                 const PlannedTrial& trial) {
+                                 const PlannedTrial& trial, const TrialGuidance& guidance) {
   TrialOptions options;
   switch (condition.mode) {
     case ConditionMode::vision:
@@ -102,16 +106,28 @@ TrialOptions study_trial_options(const SessionManifest& session, const StudyCond
       break;
     case ConditionMode::haptic:
       options.force.guidance = true;
-      if (condition.guidance_stiffness_n_per_m) {
-        options.force.guidance_stiffness_n_per_m = *condition.guidance_stiffness_n_per_m;
-      }
       break;
     case ConditionMode::fading:
+      options.force.guidance = true;
+      options.force.guidance_mode = GuidanceMode::fading;
+      if (!(guidance.gain >= 0.0 && guidance.gain <= 1.0)) {
+        throw InvalidArgument("condition '" + condition.name + "': guidance gain " +
+                              std::to_string(guidance.gain) + " outside [0, 1]");
+      }
+      options.force.guidance_gain = guidance.gain;
+      break;
     case ConditionMode::replay:
-      throw InvalidArgument(
-          "condition '" + condition.name + "': the guidance mode '" + to_string(condition.mode) +
-          "' is not rendered by this build; the protocol keeps its parameters for a renderer "
-          "that does");
+      options.force.guidance = true;
+      options.force.guidance_mode = GuidanceMode::replay;
+      if (guidance.teacher.size() < 2) {
+        throw InvalidArgument("condition '" + condition.name + "': a replay needs the teacher's recording");
+      }
+      options.force.teacher_trajectory = guidance.teacher;
+      if (condition.replay_max_lead_m) options.force.replay_max_lead_m = *condition.replay_max_lead_m;
+      break;
+  }
+  if (condition.guidance_stiffness_n_per_m && options.force.guidance) {
+    options.force.guidance_stiffness_n_per_m = *condition.guidance_stiffness_n_per_m;
   }
   const StudyProtocol& protocol = session.protocol.protocol;
   options.rate_hz = protocol.trial.rate_hz;
@@ -121,8 +137,7 @@ TrialOptions study_trial_options(const SessionManifest& session, const StudyCond
   options.pacing = pacing == "lock-step"   ? TrialPacing::lock_step
                    : pacing == "real-time" ? TrialPacing::real_time
                                            : TrialPacing::automatic;
-  options.simulation.writer =
-      session.setup.writer_profile == "skilled" ? WriterProfile::skilled() : WriterProfile::novice();
+  options.simulation.writer = writer_profile(session.setup.writer_profile);
   options.simulation.seed =
       study_detail::mix64(session.setup.writer_seed ^ study_detail::mix64(trial.index + 1));
   options.validate();
@@ -183,13 +198,18 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     if (run_options.host) run_options.host->before_trial(trial, result.planned);
 
     const StudyCondition& condition = manifest.protocol.protocol.condition(trial.condition);
-    TrialOptions options = study_trial_options(manifest, condition, trial);
-    options.should_stop = run_options.should_stop;
-    if (run_options.pacing) options.pacing = *run_options.pacing;
-    if (run_options.prepare_trial) run_options.prepare_trial(trial, options);
     std::vector<Character> models;
     for (const char32_t c : trial.characters) models.push_back(character(c));
     const Scene scene = Scene::lay_out(models);
+    study_detail::PreparedGuidance guidance;
+    if (condition.mode == ConditionMode::fading)
+      guidance = study_detail::fading_guidance(session, condition, trial);
+    if (condition.mode == ConditionMode::replay)
+      guidance = study_detail::replay_guidance(session, condition, trial, scene);
+    TrialOptions options = study_trial_options(manifest, condition, trial, guidance.guidance);
+    options.should_stop = run_options.should_stop;
+    if (run_options.pacing) options.pacing = *run_options.pacing;
+    if (run_options.prepare_trial) run_options.prepare_trial(trial, options);
 
     std::unique_ptr<HapticDevice> device = registry.create(manifest.setup.device);
     const DeviceInfo device_info = device->info();
@@ -203,6 +223,7 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     context.device_info = device_info;
     context.hardware = listing.hardware;
     context.simulated_writer = simulated_writer;
+    context.guidance = study_detail::guidance_record_json(condition, guidance);
     context.start_utc = study_detail::utc_now_iso8601();
     const auto wall_start = std::chrono::steady_clock::now();
     const TrialResult trial_result = run_trial(*device, scene, options);

@@ -47,6 +47,9 @@ const char* pacing_name(TrialPacing pacing) {
 
 json force_law_json(const ForceLawParameters& f) {
   return {{"guidance", f.guidance},
+          {"guidance_mode", to_string(f.guidance_mode)},
+          {"guidance_gain", f.guidance_gain},
+          {"replay_max_lead_m", f.replay_max_lead_m},
           {"guidance_stiffness_n_per_m", f.guidance_stiffness_n_per_m},
           {"paper_stiffness_n_per_m", f.paper_stiffness_n_per_m},
           {"constraint_radius_m", f.constraint_radius_m},
@@ -315,6 +318,7 @@ std::string trial_record_json(const TrialRecordContext& c, const Scene& scene, c
   if (c.device_name == "simulated") document["device"]["simulated_device"] = simulated_device_json();
   if (!c.condition->guidance_parameters.empty())
     document["guidance_parameters"] = c.condition->guidance_parameters;
+  if (!c.guidance.is_null()) document["guidance"] = c.guidance;
   if (result.loop) document["loop"] = loop_json(*result.loop);
   if (quiz) {
     json characters = json::array();

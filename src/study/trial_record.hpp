@@ -1,6 +1,7 @@
 #pragma once
 // The JSON record of one study trial: results, scores and full provenance (format: docs/experiments.md).
 // Internal.
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -28,7 +29,8 @@ struct TrialRecordContext {
   std::string start_utc;
   std::string end_utc;
   double wall_time_s = 0.0;
-  std::string csv_file;  ///< file names beside the JSON
+  nlohmann::json guidance;  ///< the "guidance" object (trial_guidance.hpp); null: none
+  std::string csv_file;     ///< file names beside the JSON
   std::string svg_file;
 };
 

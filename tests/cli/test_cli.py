@@ -425,6 +425,75 @@ class Determinism(CliTestCase):
         self.assertEqual((self.cwd / "a.json").read_bytes(), (self.cwd / "b.json").read_bytes())
 
 
+class GuidanceModesAndWriters(CliTestCase):
+    """`trial --writer`, `--writer-param`, `--guidance-mode`, `--guidance-gain`, `--teacher`, `--record`."""
+
+    def test_foreign_writer_runs_and_is_recorded(self):
+        metrics = self.trial_json("十", "--writer", "foreign", "--seed", "2")
+        self.assertEqual(metrics["writer"], "foreign")
+        self.assertEqual(metrics["writer_profile"], "foreign")
+        self.assertEqual(metrics["guidance_mode"], "fixed")
+        self.assertGreater(metrics["time_s"], 0.0)
+
+    def test_writer_param_changes_the_trial_and_a_bad_key_is_refused(self):
+        plain = self.trial_json("十", "--seed", "4")
+        biased = self.trial_json("十", "--seed", "4", "--writer-param", "bias_offset_m=0.004",
+                                 "--writer-param", "writing_speed_m_s=0.04")
+        self.assertEqual(biased["writer_parameters"], ["bias_offset_m=0.004", "writing_speed_m_s=0.04"])
+        self.assertNotIn("writer_parameters", plain)
+        self.assertNotEqual(plain["time_s"], biased["time_s"])
+        message = self.assert_usage_error(["trial", "十", "--writer-param", "bias_offset=1"], "--writer-param")
+        self.assertIn("bias_offset", message)
+        self.assertIn("bias_offset_m", message)  # the known keys are listed
+        message = self.assert_usage_error(["trial", "十", "--writer-param", "bias_offset_m=far"], "--writer-param")
+        self.assertIn("hand_stiffness_n_per_m", message)
+        self.assert_usage_error(["trial", "十", "--writer-param", "bias_offset_m=-1"], "bias_offset_m")
+
+    def test_recorded_teacher_is_replayed_on_the_same_character(self):
+        record = self.run_cli("trial", "十", "--writer", "skilled", "--seed", "1", "--record", "teacher.json")
+        self.assertEqual(record.returncode, 0, record.stderr.decode())
+        teacher = json.loads((self.cwd / "teacher.json").read_text(encoding="utf-8"))
+        self.assertEqual(teacher["format"], "calligraphy-teacher-recording")
+        self.assertEqual(teacher["characters"], "十")
+        replay = self.trial_json("十", "--seed", "3", "--guidance-mode", "replay", "--teacher", "teacher.json")
+        self.assertTrue(replay["completed_in_order"])
+        self.assertEqual(replay["guidance_mode"], "replay")
+        self.assertEqual(replay["teacher"], {"file": "teacher.json", "characters": "十"})
+        other = self.run_cli("trial", "人", "--guidance-mode", "replay", "--teacher", "teacher.json")
+        self.assertEqual(other.returncode, 1)
+        self.assertIn("teacher.json", other.stderr.decode())
+        self.assertIn("人", other.stderr.decode())
+
+    def test_record_refused_for_a_trial_not_completed_in_order(self):
+        # A writer who gives up on the first attempt at a stroke out of order cannot teach the order.
+        result = self.run_cli("trial", "永", "--writer", "foreign", "--seed", "1", "--writer-param",
+                              "order_error_probability=1", "--writer-param", "max_attempts_per_stroke=1",
+                              "--record", "teacher.json", "--json", "t.json")
+        metrics = json.loads((self.cwd / "t.json").read_text(encoding="utf-8"))
+        self.assertFalse(metrics["completed_in_order"])
+        self.assertEqual(result.returncode, 1)
+        self.assertIn("--record", result.stderr.decode())
+        self.assertFalse((self.cwd / "teacher.json").exists())
+
+    def test_fading_gain_zero_leaves_a_novice_further_off_than_gain_one(self):
+        for character in ("十", "人", "永"):
+            faded = self.trial_json(character, "--seed", "5", "--guidance-mode", "fading", "--guidance-gain", "0")
+            full = self.trial_json(character, "--seed", "5", "--guidance-mode", "fading", "--guidance-gain", "1")
+            self.assertEqual((faded["guidance_gain"], full["guidance_gain"]), (0.0, 1.0))
+            self.assertGreater(faded["mean_deviation_mm"], full["mean_deviation_mm"], character)
+
+    def test_usage_errors(self):
+        self.assert_usage_error(["trial", "十", "--guidance", "off", "--guidance-mode", "fading"], "--guidance-mode")
+        self.assert_usage_error(["trial", "十", "--guidance-gain", "0.5"], "--guidance-gain")
+        self.assert_usage_error(["trial", "十", "--guidance-mode", "fading", "--guidance-gain", "1.5"],
+                                "--guidance-gain")
+        self.assert_usage_error(["trial", "十", "--guidance-mode", "replay"], "--teacher")
+        self.assert_usage_error(["trial", "十", "--teacher", "t.json"], "--teacher")
+        self.assert_usage_error(["trial", "十", "--writer", "expert"], "--writer")
+        self.assert_usage_error(["trial", "十", "--record", "-"], "--record")
+        self.assertEqual(self.files_here(), [])
+
+
 if __name__ == "__main__":
     program = unittest.main(exit=False, verbosity=2)
     result = program.result

@@ -119,10 +119,12 @@ class SessionCliTest(unittest.TestCase):
         self.assertRegex(result.stderr.decode(), r"p\.json: /order/conditions: expected one of fixed, latin_square")
         self.assertFalse((self.cwd / "out").exists())
         fading = dict(LONG_PROTOCOL, conditions=[{"name": "vision", "mode": "vision"},
-                                                 {"name": "haptic", "mode": "fading"}])
+                                                 {"name": "haptic", "mode": "fading",
+                                                  "parameters": {"end_gain": 0}}])
         result = self.run_cli("session", "run", self.write_protocol(fading), "--subject", "P1", "--out", "out")
         self.assertEqual(result.returncode, 1)
-        self.assertIn("condition 'haptic': the guidance mode 'fading'", result.stderr.decode())
+        self.assertIn("p.json: /conditions/1/parameters/end_gain: unknown key", result.stderr.decode())
+        self.assertFalse((self.cwd / "out").exists())
 
     def test_usage(self):
         protocol = self.write_protocol(LONG_PROTOCOL)
@@ -175,6 +177,42 @@ class SessionCliTest(unittest.TestCase):
         record = json.loads(self.saved(sessions[0])[0].read_text(encoding="utf-8"))
         for key in ("frechet_mm", "dtw_mm", "order_errors", "backwards_strokes"):
             self.assertIn(key, record)
+
+    def test_guidance_retention_protocol_with_simulated_subjects(self):
+        """The shipped training-then-retention protocol: every trial saved, replay teachers recorded and named,
+        fading gains that fall after a repetition whose deviation the rule counts as small."""
+        protocol_path = SOURCE / "examples" / "protocols" / "guidance-retention.json"
+        protocol = json.loads(protocol_path.read_text(encoding="utf-8"))
+        fading = next(c for c in protocol["conditions"] if c["mode"] == "fading")["parameters"]
+        result = self.run_cli("session", "run", protocol_path, "--subjects", "2", "--out", "study")
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
+        sessions = sorted((self.cwd / "study").glob("S0*/guidance-retention-*"))
+        self.assertEqual(len(sessions), 2)
+        small_deviations = 0
+        for session in sessions:
+            planned = json.loads((session / "session.json").read_text(encoding="utf-8"))["plan"]
+            records = [json.loads((session / "trials" / f"{t['file']}.json").read_text(encoding="utf-8"))
+                       for t in planned]
+            self.assertEqual(len(self.saved(session)), len(planned))
+            self.assertEqual(records[-1]["mode"], "vision")  # retention last
+            self.assertFalse(records[-1]["force_law"]["guidance"])
+            for record in records:
+                if record["mode"] == "replay":
+                    teacher = record["guidance"]["teacher"]
+                    self.assertEqual(teacher["sha256"], digest(session / teacher["file"]))
+                    self.assertEqual(teacher["source"], "recorded")
+            by_item = {}
+            for record in (r for r in records if r["mode"] == "fading"):
+                by_item.setdefault(record["characters"], []).append(record["guidance"])
+            for gains in by_item.values():
+                self.assertEqual(gains[0]["gain"], fading["start_gain"])
+                for before, after in zip(gains, gains[1:]):
+                    deviation_m = after["previous_mean_deviation_mm"] * 1e-3
+                    # g' = f g + k e falls below g exactly when e < (1 - f) g / k.
+                    if deviation_m < (1 - fading["forgetting_factor"]) * before["gain"] / fading["error_gain_per_m"]:
+                        small_deviations += 1
+                        self.assertLess(after["gain"], before["gain"])
+        self.assertGreater(small_deviations, 0, "no repetition was written closely enough for the gain to fall")
 
 
 if __name__ == "__main__":

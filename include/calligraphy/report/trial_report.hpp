@@ -1,7 +1,9 @@
 #pragma once
 // Reports of a trial: the printed table, JSON (keys fixed by the CLI's contract), SVG and CSV.
 #include <string>
+#include <vector>
 
+#include "calligraphy/render/guidance_mode.hpp"
 #include "calligraphy/trial/trial.hpp"
 
 namespace calligraphy {
@@ -14,6 +16,15 @@ struct TrialDescription {
   double rate_hz = 1000.0;
   std::string device = "simulated";  // registry name
   std::string device_model = "Phantom Desktop (simulated)";
+  // Provenance of the guidance and the simulated writer (each with a default, so that the fields above can
+  // be given alone). In the JSON as "guidance_mode", "guidance_gain" (fading), "teacher" (replay),
+  // "writer_profile" and "writer_parameters" (docs/cli.md).
+  GuidanceMode guidance_mode = GuidanceMode::fixed;
+  double guidance_gain = 1.0;                    ///< fading only
+  std::string teacher_file{};                    ///< replay only: the recording's path
+  std::string teacher_characters{};              ///< replay only: the characters it was recorded on
+  std::string writer_profile{};                  ///< the simulated writer's profile; empty for a person
+  std::vector<std::string> writer_parameters{};  ///< "key=value" settings applied to the profile
 };
 
 /// The table of the metrics, and a line saying why when the trial was aborted.

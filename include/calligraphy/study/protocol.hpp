@@ -11,14 +11,16 @@
 #include <string_view>
 #include <vector>
 
+#include "calligraphy/render/guidance_mode.hpp"
+
 namespace calligraphy {
 
 /// What the writer gets in a condition.
 enum class ConditionMode {
   vision,  ///< vision only: the paper force, no in-plane guidance (the paper's "no force feedback")
   haptic,  ///< vision and the guiding force of paper section 5 (the paper's "with force feedback")
-  fading,  ///< guidance whose gain fades over repetitions (a renderer mode not in this build yet)
-  replay,  ///< the reference movement played back through the device (not in this build yet)
+  fading,  ///< guidance whose gain follows the writer's deviation over repetitions (GuidanceMode::fading)
+  replay,  ///< guidance that replays a teacher's recorded trial of the item (GuidanceMode::replay)
   quiz,    ///< vision only, each stroke judged when the pen lifts (quiz.hpp)
 };
 
@@ -44,10 +46,20 @@ struct StudyCondition {
   ConditionMode mode = ConditionMode::vision;
   /// Overrides the guidance stiffness K_et (ForceLawParameters, paper eq. 8) [N/m]; haptic modes only.
   std::optional<double> guidance_stiffness_n_per_m;
-  /// Parameters of the `fading` and `replay` modes, by name, as the protocol gives them: kept for the
-  /// renderer that implements them and recorded with every trial.
+  /// Parameters of the `fading` and `replay` modes, by name, as the protocol gives them (recorded with
+  /// every trial); read into the fields after `quiz`.
   std::map<std::string, double> guidance_parameters;
   QuizOptions quiz;  ///< `quiz` mode only
+  /// `fading` ("start_gain", in [0, 1]): the gain of the first repetition of an item in the condition.
+  double start_gain = 1.0;
+  /// `fading` ("forgetting_factor" in [0, 1], "error_gain_per_m" >= 0): the gain of each later repetition
+  /// is `next_guidance_gain(previous gain, previous mean deviation, fading_rule)` (Emken et al. 2007).
+  FadingRule fading_rule{};
+  /// `replay` ("max_lead_m", in (0, 0.1]): ForceLawParameters::replay_max_lead_m [m] when given.
+  std::optional<double> replay_max_lead_m{};
+  /// `replay`: the teacher's recording of an item (teacher_recording.hpp), by item; the path as given,
+  /// relative to the protocol file. An item without one gets a teacher recorded by the session runner.
+  std::map<std::u32string, std::string> teachers{};
 };
 
 /// How the blocks of conditions are ordered for a subject.

@@ -11,9 +11,11 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "calligraphy/devices/device_registry.hpp"
 #include "calligraphy/model/character.hpp"
+#include "calligraphy/render/guidance_mode.hpp"
 #include "calligraphy/study/schedule.hpp"
 #include "calligraphy/study/session_folder.hpp"
 #include "calligraphy/trial/options.hpp"
@@ -74,18 +76,29 @@ struct SessionRunResult {
   [[nodiscard]] bool complete() const { return saved_before + saved_now == planned; }
 };
 
-/// The options of the trials of `condition` in `session`, trial `trial`: servo rate and duration from the
-/// protocol, guidance on for `haptic` (with the condition's stiffness), off for `vision` and `quiz`, the
-/// session's pacing, the simulated writer's profile and a seed derived from the subject's seed and the
-/// trial's index. Throws InvalidArgument naming the condition for a mode this build cannot render
-/// (`fading`, `replay`).
-[[nodiscard]] TrialOptions study_trial_options(const SessionManifest& session,
-                                               const StudyCondition& condition, const PlannedTrial& trial);
+/// What the guidance of a `fading` or `replay` trial takes from the session (docs/experiments.md): the
+/// runner works it out from the saved trials and the teachers kept in the session folder.
+struct TrialGuidance {
+  double gain = 1.0;                   ///< `fading`: the trial's gain in [0, 1] (ForceLawParameters)
+  std::vector<TeacherSample> teacher;  ///< `replay`: the teacher's pen, device frame [m], times [s]
+};
 
-/// Runs every unsaved trial of `session` (see the file comment). Throws InvalidArgument before any trial
-/// when a planned condition cannot run or a simulated writer is asked to move a device a person holds,
-/// DeviceNotFound when the device is not in the registry, CharacterNotFound for a missing character, and
-/// DataError when a file cannot be saved; what was saved before stays saved.
+/// The options of the trials of `condition` in `session`, trial `trial`: servo rate and duration from the
+/// protocol, guidance on for `haptic`, `fading` and `replay` (with the condition's stiffness; the gain or
+/// the teacher from `guidance`), off for `vision` and `quiz`, the session's pacing, the simulated writer's
+/// profile and a seed derived from the subject's seed and the trial's index. Throws InvalidArgument
+/// naming the condition for a `replay` condition without a teacher in `guidance`, or a gain outside [0, 1].
+[[nodiscard]] TrialOptions study_trial_options(const SessionManifest& session,
+                                               const StudyCondition& condition, const PlannedTrial& trial,
+                                               const TrialGuidance& guidance = {});
+
+/// Runs every unsaved trial of `session` (see the file comment). A `fading` trial's gain follows the
+/// previous saved repetition of its item in the condition; a `replay` trial follows the teacher kept in
+/// the session folder's teachers/ (copied from the protocol, or recorded by a skilled simulated writer
+/// when the protocol names none), each named with its SHA-256 in the trial's record. Throws
+/// InvalidArgument before any trial when a planned condition cannot run or a simulated writer is asked to
+/// move a device a person holds, DeviceNotFound when the device is not in the registry, CharacterNotFound for
+/// a missing character, and DataError when a file cannot be saved; what was saved before stays saved.
 SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& options = {});
 
 }  // namespace calligraphy

@@ -1,0 +1,164 @@
+#include "study/trial_guidance.hpp"
+
+#include <cstdio>
+#include <system_error>
+
+#include "calligraphy/core/atomic_file.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/render/guidance_mode.hpp"
+#include "calligraphy/trial/runner.hpp"
+#include "core/unicode.hpp"
+#include "study/names.hpp"
+
+namespace calligraphy::study_detail {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+std::string utf8(const std::u32string& text) {
+  std::string out;
+  for (const char32_t c : text) out += encode_utf8(c);
+  return out;
+}
+
+// "teachers/CONDITION-U5341_U4EBA.json": one teacher per condition and item.
+std::string teacher_file_name(const StudyCondition& condition, const std::u32string& characters) {
+  std::string name = "teachers/" + condition.name + "-";
+  for (std::size_t i = 0; i < characters.size(); ++i) {
+    char code[16];
+    std::snprintf(code, sizeof code, "%sU%04X", i == 0 ? "" : "_", static_cast<unsigned>(characters[i]));
+    name += code;
+  }
+  return name + ".json";
+}
+
+// The teacher a skilled simulated writer records on `scene`: guided by the paper's fixture, lock-step.
+std::string record_teacher(const SessionFolder& session, const Scene& scene,
+                           const std::u32string& characters) {
+  const ProtocolTrialSettings& settings = session.manifest().protocol.protocol.trial;
+  TrialOptions options;
+  options.force.guidance = true;
+  options.simulation.writer = WriterProfile::skilled();
+  options.simulation.seed = kRecordedTeacherSeed;
+  options.rate_hz = settings.rate_hz;
+  options.max_duration_s = settings.max_duration_s;
+  options.pacing = TrialPacing::lock_step;
+  options.keep_trace = true;
+  const TrialResult result = run_simulated_trial(scene, options);
+  if (result.aborted || !result.metrics.completed_in_order) {
+    throw StateError("the simulated teacher of \"" + utf8(characters) + "\" wrote " +
+                     std::to_string(result.metrics.strokes_completed) + " of " +
+                     std::to_string(result.metrics.strokes_total) + " strokes in order (" +
+                     to_string(result.end) + "): give the condition a teacher's recording of it");
+  }
+  return teacher_recording_json(teacher_recording_from_trace(utf8(characters), "simulated skilled",
+                                                             "simulated", options.rate_hz, result.trace));
+}
+
+}  // namespace
+
+PreparedGuidance fading_guidance(const SessionFolder& session, const StudyCondition& condition,
+                                 const PlannedTrial& trial) {
+  PreparedGuidance prepared;
+  prepared.guidance.gain = condition.start_gain;
+  const PlannedTrial* previous = nullptr;
+  for (const PlannedTrial& earlier : session.plan()) {
+    if (earlier.index >= trial.index) break;
+    if (earlier.condition == trial.condition && earlier.characters == trial.characters) previous = &earlier;
+  }
+  if (!previous) return prepared;
+  const fs::path file = session.trial_file(*previous, "json");
+  if (!session.is_saved(*previous)) {
+    throw StateError("trial " + SessionFolder::trial_stem(trial) + ": its gain follows " +
+                     SessionFolder::trial_stem(*previous) + ", which is not saved");
+  }
+  const std::string text = read_small_file(file, std::uintmax_t{64} << 20, "trial record");
+  try {
+    const json record = json::parse(text);
+    prepared.previous_trial = SessionFolder::trial_stem(*previous);
+    prepared.previous_gain = record.at("guidance").at("gain").get<double>();
+    prepared.previous_deviation_mm = record.at("mean_deviation_mm");
+  } catch (const json::exception& e) {
+    throw DataError(file.string() + ": no guidance gain and mean deviation to fade from: " + e.what());
+  }
+  // A repetition that wrote nothing gives no error to fade on: full guidance again.
+  prepared.guidance.gain =
+      prepared.previous_deviation_mm.is_number()
+          ? next_guidance_gain(prepared.previous_gain, prepared.previous_deviation_mm.get<double>() * 1e-3,
+                               condition.fading_rule)
+          : 1.0;
+  return prepared;
+}
+
+PreparedGuidance replay_guidance(SessionFolder& session, const StudyCondition& condition,
+                                 const PlannedTrial& trial, const Scene& scene) {
+  PreparedGuidance prepared;
+  prepared.teacher_file = teacher_file_name(condition, trial.characters);
+  const fs::path path = session.path() / prepared.teacher_file;
+  const auto given = condition.teachers.find(trial.characters);
+  prepared.teacher_source = given == condition.teachers.end() ? "recorded" : given->second;
+  const auto checked = [&](const std::string& text, const std::string& source) {
+    TeacherRecording teacher = parse_teacher_recording(text, source);
+    try {
+      require_teacher_for(teacher, utf8(trial.characters));
+    } catch (const InvalidArgument& e) {
+      throw InvalidArgument("condition '" + condition.name + "', teacher " + prepared.teacher_source + ": " +
+                            e.what());
+    }
+    return teacher;
+  };
+  std::error_code error;
+  if (!fs::exists(path, error)) {
+    std::string text;
+    if (given == condition.teachers.end()) {
+      text = record_teacher(session, scene, trial.characters);
+    } else {
+      const fs::path source = session.manifest().protocol.path.parent_path() / given->second;
+      text = read_small_file(source, kMaxTeacherRecordingBytes, "teacher's recording");
+      (void)checked(text, source.string());  // before it is copied
+    }
+    fs::create_directories(path.parent_path(), error);
+    write_file_atomically(path, text);
+    session.log("teacher_saved", json{{"condition", condition.name},
+                                      {"characters", utf8(trial.characters)},
+                                      {"file", prepared.teacher_file},
+                                      {"source", prepared.teacher_source},
+                                      {"sha256", sha256_hex(text)}}
+                                     .dump());
+  }
+  const std::string text = read_small_file(path, kMaxTeacherRecordingBytes, "teacher's recording");
+  TeacherRecording teacher = checked(text, path.string());
+  prepared.teacher_sha256 = sha256_hex(text);
+  prepared.teacher_writer = teacher.writer;
+  prepared.teacher_characters = teacher.characters;
+  prepared.guidance.teacher = std::move(teacher.samples);
+  return prepared;
+}
+
+json guidance_record_json(const StudyCondition& condition, const PreparedGuidance& prepared) {
+  json guidance = {{"mode", to_string(condition.mode)}};
+  if (condition.mode == ConditionMode::fading) {
+    guidance["gain"] = prepared.guidance.gain;
+    guidance["start_gain"] = condition.start_gain;
+    guidance["forgetting_factor"] = condition.fading_rule.forgetting_factor;
+    guidance["error_gain_per_m"] = condition.fading_rule.error_gain_per_m;
+    guidance["previous_trial"] =
+        prepared.previous_trial.empty() ? json(nullptr) : json(prepared.previous_trial);
+    if (!prepared.previous_trial.empty()) {
+      guidance["previous_gain"] = prepared.previous_gain;
+      guidance["previous_mean_deviation_mm"] = prepared.previous_deviation_mm;
+    }
+  } else if (condition.mode == ConditionMode::replay) {
+    guidance["teacher"] = {
+        {"file", prepared.teacher_file},
+        {"sha256", prepared.teacher_sha256},
+        {"source", prepared.teacher_source},
+        {"writer", prepared.teacher_writer},
+        {"characters", prepared.teacher_characters},
+        {"seed", prepared.teacher_source == "recorded" ? json(kRecordedTeacherSeed) : json(nullptr)}};
+  }
+  return guidance;
+}
+
+}  // namespace calligraphy::study_detail
