@@ -11,9 +11,6 @@
 #include <algorithm>
 #include <calligraphy/model/character_library.hpp>
 #include <calligraphy/model/scene.hpp>
-#include <calligraphy/render/renderer.hpp>
-#include <calligraphy/sim/simulated_device.hpp>
-#include <calligraphy/sim/simulated_writer.hpp>
 #include <calligraphy/trial/score.hpp>
 #include <calligraphy/trial/trial.hpp>
 #include <cmath>
@@ -43,38 +40,17 @@ struct Run {
   std::size_t refusals = 0;
 };
 
-// One lock-step trial, as run_trial runs it on the simulated device, keeping the writer.
+// One lock-step trial on the simulated device (run_simulated_trial), with the writer's log.
 Run run_trial(const Scene& scene, const WriterProfile& profile, bool guidance, std::uint64_t seed) {
-  SimulatedDeviceParameters device_parameters;
-  SimulatedDevice device(device_parameters);
-  SimulatedWriter writer(scene, profile, seed);
-  device.attach_hand(&writer);
-  device.open();
-  ForceLawParameters force;
-  force.guidance = guidance;
-  RendererOptions options;
-  Renderer renderer(scene, force, device.info(), options);
-  device.enable_forces(true);
-  TrialRecorder recorder(scene, true);
-  const double dt = 1.0 / options.rate_hz;
-  double end_time = 0.0;
-  for (long k = 0; k < 300'000; ++k) {  // at most 300 s
-    const DeviceState state = device.read_state();
-    const RenderOutput out = renderer.tick(state);
-    device.write_force(out.force_n);
-    recorder.record(state, out);
-    end_time = state.time_s;
-    if (out.finished) break;
-    writer.observe(out, state);
-    if (writer.done()) break;
-    device.advance(dt);
-  }
-  device.attach_hand(nullptr);
-  device.close();
-  recorder.finish(end_time);
+  TrialOptions options;
+  options.force.guidance = guidance;
+  options.simulation.writer = profile;
+  options.simulation.seed = seed;
+  options.max_duration_s = 300.0;
+  const TrialResult result = run_simulated_trial(scene, options);
 
   std::vector<PenSample> pen;
-  for (const TrialSample& s : recorder.trace()) {
+  for (const TrialSample& s : result.trace) {
     pen.push_back(PenSample{s.time_s, s.position_m.head<2>(), s.position_m.z() <= scene.layout.paper_z_m});
   }
   const CharacterScore score = score_trace(scene.characters[0], pen);
@@ -84,12 +60,12 @@ Run run_trial(const Scene& scene, const WriterProfile& profile, bool guidance, s
   run.guidance = guidance;
   run.seed = seed;
   run.deviation_mm = score.totals.deviation ? score.totals.deviation->mean_m * 1e3 : std::nan("");
-  run.renderer_deviation_mm = recorder.metrics().mean_deviation_m.value_or(std::nan("")) * 1e3;
+  run.renderer_deviation_mm = result.metrics.mean_deviation_m.value_or(std::nan("")) * 1e3;
   run.time_s = score.totals.total_time_s;
   run.order_errors = score.order_errors;
   run.backwards = score.backwards_strokes;
-  run.in_order = recorder.metrics().completed_in_order;
-  run.refusals = writer.log().refusals;
+  run.in_order = result.metrics.completed_in_order;
+  run.refusals = result.writer_log ? result.writer_log->refusals : 0;
   return run;
 }
 

@@ -10,6 +10,7 @@
 #include <thread>
 #include <vector>
 
+#include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/session_folder.hpp"
 #include "calligraphy/study/session_runner.hpp"
@@ -175,9 +176,13 @@ std::vector<std::string> split_profiles(const std::string& text) {
   while (true) {
     const std::size_t comma = text.find(',', start);
     std::string name = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    if (name != "novice" && name != "skilled") {
-      throw UsageError("--writer-profile: expected novice, skilled or a comma-separated list of them, got '" +
-                       text + "'");
+    try {
+      (void)writer_profile(name);
+    } catch (const InvalidArgument&) {
+      throw UsageError(
+          "--writer-profile: expected novice, skilled, foreign or a comma-separated list of "
+          "them, got '" +
+          text + "'");
     }
     profiles.push_back(name);
     if (comma == std::string::npos) return profiles;
@@ -322,7 +327,8 @@ void add_session_commands(CLI::App& root, Commands& commands) {
       "on a simulated or emulated device, human on hardware");
   add_text(
       *app, "--writer-profile", run->writer_profile, "PROFILES",
-      "the simulated writer's profile, novice or skilled; a comma-separated list is used by subject in turn");
+      "the simulated writer's profile, novice, skilled or foreign; a comma-separated list is used by subject "
+      "in turn");
   add_choice(*app, "--pacing", run->pacing, {"auto", "lock-step", "real-time"},
              "auto: lock-step for a simulated writer, real time for a person; real-time paces a simulated "
              "writer by the wall clock");
