@@ -304,7 +304,7 @@ TEST_CASE("A stroke written twice is not taken for a neighbouring stroke never w
           if (k == repeated) order.push_back(k);
         }
         const CharacterScore score =
-            score_trace(character, written_in_order(character, order, 0.1e-3).samples);
+            score_trace(character, written_in_order(character, order, 0.25e-3).samples);
         INFO("character U+" << std::hex << static_cast<unsigned>(c) << std::dec << ", stroke " << omitted
                             << " omitted, stroke " << repeated << " written twice");
         CHECK(score.strokes_written == n - 1);

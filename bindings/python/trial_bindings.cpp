@@ -248,6 +248,20 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   description.seed = options.simulation.seed;
   description.rate_hz = options.rate_hz;
   if (!device_name.empty()) description.device = device_name;
+  // The guidance and writer provenance, as `calligraphy trial --json` gives it.
+  description.guidance_mode = options.force.guidance_mode;
+  description.guidance_gain = options.force.guidance_gain;
+  if (options.force.guidance_mode == GuidanceMode::replay) {
+    description.teacher_characters =
+        label;  // a recording was checked against them; samples are taken as given
+  }
+  description.writer_profile = description.writer;
+  if (a.writer_params && !a.writer_params->object.is_none()) {
+    for (const auto& [key, value] : a.writer_params->object.cast<py::dict>()) {
+      description.writer_parameters.push_back(py::str(key).cast<std::string>() + "=" +
+                                              py::repr(value).cast<std::string>());
+    }
+  }
   PyTrialResult out = to_python(result, trial_metrics(description, result), scene_object);
   out.writer = options.simulation.writer;
   return out;
