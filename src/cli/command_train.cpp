@@ -193,12 +193,14 @@ void add_train_command(CLI::App& root, Commands& commands) {
   add_output_path(*app, "--screenshot", command->screenshot,
                   "write the window as PNG after the last character's trial, or at exit",
                   StandardOutput::refused);
-  CLI::Option* quiz = add_flag(*app, "--quiz",  command->quiz,
-                                "a quiz (docs/trainer.md): no guidance; each stroke is judged as the pen lifts, "
-                                "accepted or missed, as in Hanzi Writer's quiz");
-  add_number(*app, "--leniency", command->leniency, "X",
-             "quiz: scales the distance, shape and length thresholds of the stroke tests; bigger is more lenient",
-             "a number in [0.001, 1000]", [](double x) { return x >= 1e-3 && x <= 1e3; })
+  CLI::Option* quiz =
+      add_flag(*app, "--quiz", command->quiz,
+               "a quiz (docs/trainer.md): no guidance; each stroke is judged as the pen lifts, "
+               "accepted or missed, as in Hanzi Writer's quiz");
+  add_number(
+      *app, "--leniency", command->leniency, "X",
+      "quiz: scales the distance, shape and length thresholds of the stroke tests; bigger is more lenient",
+      "a number in [0.001, 1000]", [](double x) { return x >= 1e-3 && x <= 1e3; })
       ->needs(quiz);
   add_integer(*app, "--hint-after", command->hint_after, "N",
               "quiz: show the expected stroke after N misses on it, and after each further miss; 0: never", 0,

@@ -96,7 +96,8 @@ void quiz_state(const TrialView& view, const PanelInput& input) {
     if (!session.complete()) {
       ImGui::Text("misses on this stroke %d, in all %d", session.misses_on_stroke(), session.total_misses());
     }
-    if (quiz.hinted()[c]) ImGui::TextColored(ImVec4(0.35f, 0.35f, 0.9f, 1), "hint: stroke %zu shown", *quiz.hinted()[c] + 1);
+    if (quiz.hinted()[c])
+      ImGui::TextColored(ImVec4(0.35f, 0.35f, 0.9f, 1), "hint: stroke %zu shown", *quiz.hinted()[c] + 1);
   }
   if (const auto& last = quiz.last_event()) {
     const QuizEvent& e = last->second;
@@ -116,7 +117,8 @@ void quiz_state(const TrialView& view, const PanelInput& input) {
     if (quiz.last_backwards()[last->first]) ImGui::TextColored(kBad, "backwards: written from its end");
   }
   if (quiz.dropped_points() > 0)
-    ImGui::TextColored(kBad, "%llu pen samples missed", static_cast<unsigned long long>(quiz.dropped_points()));
+    ImGui::TextColored(kBad, "%llu pen samples missed",
+                       static_cast<unsigned long long>(quiz.dropped_points()));
 }
 
 void summary(const TrialView& view, const PanelInput& input) {
@@ -190,7 +192,9 @@ void draw_panel(const WindowLayout& layout, double panel_width_px, const PanelIn
   ImGui::TextColored(state_colour(s.state), "%s", to_string(s.state));
   if (input.large_font != nullptr) ImGui::PopFont();
   ImGui::SameLine();
-  ImGui::TextColored(state_colour(s.state), "%s", state_meaning(s.state));
+  ImGui::TextColored(
+      state_colour(s.state), "%s",
+      view->quiz && s.state == InteractionState::calibration ? "in the character" : state_meaning(s.state));
   const std::uint32_t shown_stroke = s.finished ? s.strokes_total : s.stroke_index + 1;
   if (s.finished) {
     ImGui::Text("stroke %u / %u   every stroke written", shown_stroke, s.strokes_total);

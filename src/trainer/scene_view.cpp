@@ -173,16 +173,15 @@ void draw_scene(ImDrawList& draw, const WindowLayout& layout, const std::vector<
     for (std::size_t p = 0; p < art[c].polygons.size(); ++p) {
       std::vector<ImVec2> points;
       for (const Vec2& v : art[c].polygons[p]) points.push_back(im(layout.data_to_screen(c, v)));
-      const ImU32 colour = quiz     ? quiz_fill(*view, c, art[c].polygon_stroke[p])
-                           : active ? kActive
-                                    : kOutline;
+      const ImU32 colour = quiz ? quiz_fill(*view, c, art[c].polygon_stroke[p]) : active ? kActive : kOutline;
       fill_polygon(draw, points, art[c].triangles[p], colour);
     }
     draw.Flags = flags;
   }
   if (quiz) {  // Hanzi Writer's quiz shows the outline only: no reference, no start of the next stroke
     draw_quiz_ink(draw, layout, *view);
-  } else if (view != nullptr) {  // the trace under the reference, so that both stay visible where they overlap
+  } else if (view !=
+             nullptr) {  // the trace under the reference, so that both stay visible where they overlap
     for (const TraceSegment& segment : view->segments) {
       std::vector<ImVec2> points;
       for (const Vec2& p : segment.points_m) points.push_back(im(trial_to_screen(layout, *view, p)));

@@ -33,10 +33,10 @@ struct TrainerOptions {
   std::vector<TeacherSample> teacher;  ///< replay: the teacher's pen (one character, its recording)
   /// A quiz (Hanzi Writer's, study/quiz.hpp): guidance off, each stroke judged live as the pen lifts.
   bool quiz = false;
-  QuizOptions quiz_options;     ///< leniency, hint after N misses
+  QuizOptions quiz_options;      ///< leniency, hint after N misses
   std::string quiz_screenshots;  ///< non-empty: a folder where a PNG is written after each judged stroke
-  std::string record;       ///< non-empty: each completed trial is written here as a teacher recording
-  std::string session_dir;  ///< empty: trials are not saved
+  std::string record;            ///< non-empty: each completed trial is written here as a teacher recording
+  std::string session_dir;       ///< empty: trials are not saved
   std::string subject = "anonymous";
   int width_px = 1280;
   int height_px = 800;
@@ -62,9 +62,9 @@ struct TrainerSessionOptions {
   std::function<TrainerCharacter(char32_t)> load_character;
   int width_px = 1280;
   int height_px = 800;
-  std::string screenshot;     ///< PNG written after the last planned trial's outcome, or at exit
+  std::string screenshot;        ///< PNG written after the last planned trial's outcome, or at exit
   std::string quiz_screenshots;  ///< non-empty: a folder where a PNG is written after each judged stroke
-  double exit_after_s = 0.0;  ///< > 0: unattended (trials start by themselves); quit after this long
+  double exit_after_s = 0.0;     ///< > 0: unattended (trials start by themselves); quit after this long
   std::string library_version;
 };
 

@@ -503,17 +503,19 @@ class TrainerApp {
         const QuizEvent& b = live[c][k];
         same = a.kind == b.kind && a.stroke == b.stroke && a.backwards == b.backwards &&
                a.misses_on_stroke == b.misses_on_stroke && a.total_misses == b.total_misses &&
-               a.time_s == b.time_s && a.samples == b.samples && a.closer_later_stroke == b.closer_later_stroke;
+               a.time_s == b.time_s && a.samples == b.samples &&
+               a.closer_later_stroke == b.closer_later_stroke;
         ++count;
       }
     }
     if (same) {
       std::fprintf(stderr, "calligraphy train: quiz: the %zu live verdicts are the saved record's\n", count);
     } else {
-      std::fprintf(stderr,
-                   "calligraphy train: warning: quiz: the live verdicts differ from the saved record's, which "
-                   "judges the whole trace (%llu trace points did not reach the window)\n",
-                   static_cast<unsigned long long>(quiz.dropped_points()));
+      std::fprintf(
+          stderr,
+          "calligraphy train: warning: quiz: the live verdicts differ from the saved record's, which "
+          "judges the whole trace (%llu trace points did not reach the window)\n",
+          static_cast<unsigned long long>(quiz.dropped_points()));
     }
   }
 
@@ -576,6 +578,8 @@ class TrainerApp {
     }
     // The last character's trial ended in this very iteration: its summary, after the last stroke.
     if (!options_.screenshot.empty() && !screenshot_taken_ && !x11_error_seen() && view_) render(true);
+    // A stroke judged as the trial ended (the pen still down): the frame that shows it.
+    if (!quiz_screenshot_.empty() && !x11_error_seen() && view_) render(false);
   }
 
   double seconds_since_start() const {

@@ -53,7 +53,8 @@ struct TrialView {
   std::vector<std::pair<std::size_t, QuizEvent>> quiz_unlogged;
 
   /// Copies the latest snapshot (keeping the last one when a publish overlapped) and drains the trace
-  /// and the events; feeds a quiz every trace point, and finishes it when the trial ends. `typical_ids` gives each stroke's typical id, by stroke index in the character.
+  /// and the events; feeds a quiz every trace point, and finishes it when the trial ends. `typical_ids` gives
+  /// each stroke's typical id, by stroke index in the character.
   void consume(DisplayChannel& channel, const std::vector<int>& typical_ids);
 
  private:
