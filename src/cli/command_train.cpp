@@ -38,6 +38,10 @@ struct TrainCommand {
   std::string window = "1280x800";
   std::string screenshot;
   double exit_after_s = 0.0;
+  bool quiz = false;
+  double leniency = 1.0;
+  std::int64_t hint_after = 3;
+  std::string quiz_screenshots;
 };
 
 #ifdef CALLIGRAPHY_WITH_TRAINER
@@ -93,6 +97,14 @@ int run_train(const TrainCommand& command) {
     }
   }
   options.guidance = command.guidance == "on";
+  options.quiz = command.quiz;
+  options.quiz_options.leniency = command.leniency;
+  options.quiz_options.hint_after_misses = static_cast<int>(command.hint_after);
+  options.quiz_screenshots = command.quiz_screenshots;
+  if (!command.quiz && !command.quiz_screenshots.empty())
+    throw UsageError("--quiz-screenshots: only with --quiz");
+  if (command.quiz && command.guidance_mode != "fixed")
+    throw UsageError("--quiz: a quiz has no guidance; drop --guidance-mode " + command.guidance_mode);
   options.guidance_mode = *guidance_mode_from_string(command.guidance_mode);
   options.guidance_gain = command.guidance_gain;
   options.record = command.record;
@@ -181,6 +193,22 @@ void add_train_command(CLI::App& root, Commands& commands) {
   add_output_path(*app, "--screenshot", command->screenshot,
                   "write the window as PNG after the last character's trial, or at exit",
                   StandardOutput::refused);
+  CLI::Option* quiz =
+      add_flag(*app, "--quiz", command->quiz,
+               "a quiz (docs/trainer.md): no guidance; each stroke is judged as the pen lifts, "
+               "accepted or missed, as in Hanzi Writer's quiz");
+  add_number(
+      *app, "--leniency", command->leniency, "X",
+      "quiz: scales the distance, shape and length thresholds of the stroke tests; bigger is more lenient",
+      "a number in [0.001, 1000]", [](double x) { return x >= 1e-3 && x <= 1e3; })
+      ->needs(quiz);
+  add_integer(*app, "--hint-after", command->hint_after, "N",
+              "quiz: show the expected stroke after N misses on it, and after each further miss; 0: never", 0,
+              1000)
+      ->needs(quiz);
+  add_text(*app, "--quiz-screenshots", command->quiz_screenshots, "DIR",
+           "quiz: write the window as DIR/quiz-NN-VERDICT.png on the first frame after each judged stroke "
+           "(an existing folder)");
   add_number(*app, "--exit-after", command->exit_after_s, "SECONDS",
              "unattended: quit after this long [s], or once every character had its trial",
              "a number of seconds > 0", [](double s) { return s > 0.0 && s <= 86400.0; });

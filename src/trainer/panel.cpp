@@ -74,6 +74,53 @@ void results_table(const TrialView& view) {
   }
 }
 
+const ImVec4 kGood(0.1f, 0.55f, 0.15f, 1);
+const ImVec4 kBad(0.8f, 0.1f, 0.1f, 1);
+
+// The quiz's state: per character, stroke k of n and the misses; the last verdict, "backwards" when the
+// stroke was written from its end, the hint, and "complete, M misses" once every stroke is accepted.
+void quiz_state(const TrialView& view, const PanelInput& input) {
+  const LiveQuiz& quiz = *view.quiz;
+  ImGui::Text("Quiz: write each stroke in order");
+  for (std::size_t c = 0; c < quiz.sessions().size(); ++c) {
+    const QuizSession& session = quiz.sessions()[c];
+    const std::size_t n = session.character().strokes.size();
+    const std::string label = quiz.sessions().size() > 1 ? "character " + std::to_string(c + 1) + ": " : "";
+    if (input.large_font != nullptr) ImGui::PushFont(input.large_font);
+    if (session.complete()) {
+      ImGui::TextColored(kGood, "%scomplete, %d misses", label.c_str(), session.total_misses());
+    } else {
+      ImGui::Text("%sstroke %zu of %zu", label.c_str(), session.current_stroke() + 1, n);
+    }
+    if (input.large_font != nullptr) ImGui::PopFont();
+    if (!session.complete()) {
+      ImGui::Text("misses on this stroke %d, in all %d", session.misses_on_stroke(), session.total_misses());
+    }
+    if (quiz.hinted()[c])
+      ImGui::TextColored(ImVec4(0.35f, 0.35f, 0.9f, 1), "hint: stroke %zu shown", *quiz.hinted()[c] + 1);
+  }
+  if (const auto& last = quiz.last_event()) {
+    const QuizEvent& e = last->second;
+    switch (e.kind) {
+      case QuizEvent::Kind::stroke_accepted:
+      case QuizEvent::Kind::character_completed:
+        ImGui::TextColored(kGood, "stroke %zu accepted", e.stroke + 1);
+        break;
+      case QuizEvent::Kind::stroke_missed:
+      case QuizEvent::Kind::hint:
+        ImGui::TextColored(kBad, "stroke %zu missed", e.stroke + 1);
+        break;
+      case QuizEvent::Kind::too_short:
+        ImGui::TextDisabled("too short to judge");
+        break;
+    }
+    if (quiz.last_backwards()[last->first]) ImGui::TextColored(kBad, "backwards: written from its end");
+  }
+  if (quiz.dropped_points() > 0)
+    ImGui::TextColored(kBad, "%llu pen samples missed",
+                       static_cast<unsigned long long>(quiz.dropped_points()));
+}
+
 void summary(const TrialView& view, const PanelInput& input) {
   ImGui::Separator();
   const TrialMetrics& m = view.metrics;
@@ -100,8 +147,10 @@ void summary(const TrialView& view, const PanelInput& input) {
     ImGui::Text("Space  start the next trial   Esc  end the session");
   } else {
     ImGui::Text("R  repeat   N  next character");
-    ImGui::Text("G  guidance (next trial: %s)", input.next_guidance ? "on" : "off");
-    ImGui::Text("M  guidance mode (next trial: %s, gain %.2f)", input.next_mode.c_str(), input.next_gain);
+    if (!input.quiz) {
+      ImGui::Text("G  guidance (next trial: %s)", input.next_guidance ? "on" : "off");
+      ImGui::Text("M  guidance mode (next trial: %s, gain %.2f)", input.next_mode.c_str(), input.next_gain);
+    }
     ImGui::Text("Q / Esc  quit");
   }
 }
@@ -135,7 +184,7 @@ void draw_panel(const WindowLayout& layout, double panel_width_px, const PanelIn
               input.characters);
   ImGui::Text("device %s", input.device.c_str());
   ImGui::Text("%s, guidance %s", view->condition.c_str(), view->guidance ? "on" : "off");
-  if (input.session.empty())
+  if (input.session.empty() && !input.quiz)
     ImGui::Text("next: guidance %s, mode %s, gain %.2f", input.next_guidance ? "on" : "off",
                 input.next_mode.c_str(), input.next_gain);
   ImGui::Separator();
@@ -143,7 +192,9 @@ void draw_panel(const WindowLayout& layout, double panel_width_px, const PanelIn
   ImGui::TextColored(state_colour(s.state), "%s", to_string(s.state));
   if (input.large_font != nullptr) ImGui::PopFont();
   ImGui::SameLine();
-  ImGui::TextColored(state_colour(s.state), "%s", state_meaning(s.state));
+  ImGui::TextColored(
+      state_colour(s.state), "%s",
+      view->quiz && s.state == InteractionState::calibration ? "in the character" : state_meaning(s.state));
   const std::uint32_t shown_stroke = s.finished ? s.strokes_total : s.stroke_index + 1;
   if (s.finished) {
     ImGui::Text("stroke %u / %u   every stroke written", shown_stroke, s.strokes_total);
@@ -155,12 +206,16 @@ void draw_panel(const WindowLayout& layout, double panel_width_px, const PanelIn
   ImGui::Text("pen height %+.1f mm", s.pen_height_m * 1e3);
   ImGui::Text("force in plane %.2f N, normal %.2f N", std::hypot(s.force_n.x, s.force_n.y), s.force_n.z);
   ImGui::Separator();
+  if (view->quiz) {
+    quiz_state(*view, input);
+    ImGui::Separator();
+  }
   results_table(*view);
   if (view->have_result) {
     summary(*view, input);
   } else if (!input.unattended && input.session.empty()) {
     ImGui::Spacing();
-    ImGui::TextDisabled("R repeat  N next  G guidance  Q quit");
+    ImGui::TextDisabled(input.quiz ? "R repeat  N next  Q quit" : "R repeat  N next  G guidance  Q quit");
   }
   if (!input.status.empty()) ImGui::TextWrapped("%s", input.status.c_str());
   ImGui::SetCursorPosY(static_cast<float>(layout.height_px()) - 30.0f);

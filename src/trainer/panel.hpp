@@ -19,6 +19,7 @@ struct PanelInput {
   std::string next_mode = "fixed";  ///< the next trial's guidance mode (M cycles it)
   double next_gain = 1.0;           ///< the next trial's fading gain
   bool unattended = false;
+  bool quiz = false;    ///< `train --quiz`: G and M do nothing
   std::string status;   ///< a line for errors or notices
   std::string session;  ///< a study session: subject, trial i of n, phase, condition; empty otherwise
   std::string prompt;   ///< what the person is asked to do now (start, rest), shown large; may be empty

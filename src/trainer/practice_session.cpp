@@ -23,7 +23,12 @@ LoadedProtocol practice_protocol(const PracticeSetup& setup) {
       {"conditions",
        {{{"name", kHapticCondition}, {"mode", "haptic"}},
         {{"name", kVisionCondition}, {"mode", "vision"}},
-        {{"name", kQuizCondition}, {"mode", "quiz"}},
+        {{"name", kQuizCondition},
+         {"mode", "quiz"},
+         {"quiz",
+          {{"leniency", setup.quiz.leniency},
+           {"hint_after_misses", setup.quiz.hint_after_misses},
+           {"accept_backwards", setup.quiz.accept_backwards}}}},
         {{"name", kFadingCondition}, {"mode", "fading"}},
         {{"name", kReplayCondition}, {"mode", "replay"}}}},
       {"test", {{"characters", items}, {"conditions", {setup.first_condition}}, {"repetitions", 1}}}};

@@ -12,6 +12,7 @@
 
 #include "calligraphy/core/device_types.hpp"
 #include "calligraphy/model/scene.hpp"
+#include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/session_folder.hpp"
 #include "calligraphy/trial/options.hpp"
 #include "calligraphy/trial/result.hpp"
@@ -38,6 +39,7 @@ struct PracticeSetup {
   bool simulated_writer = false;
   std::string writer_profile = "novice";
   std::uint64_t writer_seed = 0;
+  QuizOptions quiz;  ///< the "quiz" condition's options
 };
 
 /// One finished trial of the practice.

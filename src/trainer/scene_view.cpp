@@ -3,6 +3,7 @@
 #include <imgui.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 
@@ -23,6 +24,13 @@ constexpr ImU32 kHint = IM_COL32(235, 0, 0, 255);
 constexpr ImU32 kPen = IM_COL32(40, 40, 40, 255);
 constexpr ImU32 kVirtualTip = IM_COL32(255, 120, 0, 255);
 constexpr ImU32 kForce = IM_COL32(150, 0, 200, 255);
+// The quiz (after Hanzi Writer's look: drawing colour #333, highlight #AAF): an accepted stroke filled in
+// green, a miss's trace in red for kMissFlashS, the expected stroke in light blue-violet after a hint.
+constexpr ImU32 kQuizAccepted = IM_COL32(20, 150, 60, 255);
+constexpr ImU32 kQuizInk = IM_COL32(51, 51, 51, 255);
+constexpr ImU32 kQuizMiss = IM_COL32(230, 0, 0, 255);
+constexpr ImU32 kQuizHint = IM_COL32(170, 170, 255, 255);
+constexpr double kMissFlashS = 0.5;
 
 // Window pixel of a point of the view's trial [m].
 Vec2 trial_to_screen(const WindowLayout& layout, const TrialView& view, const Vec2& trial_m) {
@@ -108,8 +116,42 @@ CharacterArt prepare_art(const TrainerCharacter& character) {
   return art;
 }
 
+namespace {
+
+// A stroke's colour in a quiz: accepted, hinted, or the plain outline; per character of the row.
+ImU32 quiz_fill(const TrialView& view, std::size_t row_character, std::size_t stroke) {
+  const std::size_t q = view.whole_row ? row_character : 0;
+  if (!view.whole_row && row_character != view.character) return kOutline;
+  if (q >= view.quiz->sessions().size()) return kOutline;
+  if (stroke < view.quiz->sessions()[q].current_stroke()) return kQuizAccepted;
+  if (view.quiz->hinted()[q] == stroke) return kQuizHint;
+  return kOutline;
+}
+
+void draw_ink(ImDrawList& draw, const WindowLayout& layout, const TrialView& view,
+              const std::vector<Vec2>& points_m, ImU32 colour) {
+  std::vector<ImVec2> points;
+  for (const Vec2& p : points_m) points.push_back(im(trial_to_screen(layout, view, p)));
+  if (points.size() == 1) draw.AddCircleFilled(points[0], 3.0f, colour);
+  if (points.size() > 1) draw.AddPolyline(points.data(), static_cast<int>(points.size()), colour, 0, 6.0f);
+}
+
+// The quiz's ink over the outlines: the stroke being written, and each miss for a moment.
+void draw_quiz_ink(ImDrawList& draw, const WindowLayout& layout, const TrialView& view) {
+  const auto now = std::chrono::steady_clock::now();
+  for (const QuizInk& ink : view.quiz->inks()) {
+    if (ink.verdict != QuizEvent::Kind::stroke_missed) continue;
+    if (std::chrono::duration<double>(now - ink.judged_at).count() < kMissFlashS)
+      draw_ink(draw, layout, view, ink.points_m, kQuizMiss);
+  }
+  draw_ink(draw, layout, view, view.quiz->open_run(), kQuizInk);
+}
+
+}  // namespace
+
 void draw_scene(ImDrawList& draw, const WindowLayout& layout, const std::vector<CharacterArt>& art,
                 const Scene& trial_scene, const TrialView* view) {
+  const bool quiz = view != nullptr && view->quiz.has_value();
   draw.AddRectFilled(
       ImVec2(0, 0),
       ImVec2(static_cast<float>(layout.area_width_px()), static_cast<float>(layout.height_px())), kPaper);
@@ -131,11 +173,15 @@ void draw_scene(ImDrawList& draw, const WindowLayout& layout, const std::vector<
     for (std::size_t p = 0; p < art[c].polygons.size(); ++p) {
       std::vector<ImVec2> points;
       for (const Vec2& v : art[c].polygons[p]) points.push_back(im(layout.data_to_screen(c, v)));
-      fill_polygon(draw, points, art[c].triangles[p], active ? kActive : kOutline);
+      const ImU32 colour = quiz ? quiz_fill(*view, c, art[c].polygon_stroke[p]) : active ? kActive : kOutline;
+      fill_polygon(draw, points, art[c].triangles[p], colour);
     }
     draw.Flags = flags;
   }
-  if (view != nullptr) {  // the trace under the reference, so that both stay visible where they overlap
+  if (quiz) {  // Hanzi Writer's quiz shows the outline only: no reference, no start of the next stroke
+    draw_quiz_ink(draw, layout, *view);
+  } else if (view !=
+             nullptr) {  // the trace under the reference, so that both stay visible where they overlap
     for (const TraceSegment& segment : view->segments) {
       std::vector<ImVec2> points;
       for (const Vec2& p : segment.points_m) points.push_back(im(trial_to_screen(layout, *view, p)));
@@ -144,7 +190,7 @@ void draw_scene(ImDrawList& draw, const WindowLayout& layout, const std::vector<
         draw.AddPolyline(points.data(), static_cast<int>(points.size()), kTrace, 0, 5.0f);
     }
   }
-  for (std::size_t c = 0; c < art.size(); ++c) {
+  for (std::size_t c = 0; c < art.size() && !quiz; ++c) {
     for (const std::vector<Vec2>& stroke : art[c].reference) {
       std::vector<ImVec2> points;
       for (const Vec2& p : stroke) points.push_back(im(layout.data_to_screen(c, p)));
@@ -154,7 +200,9 @@ void draw_scene(ImDrawList& draw, const WindowLayout& layout, const std::vector<
   if (view == nullptr) return;
   const DisplaySnapshot& s = view->snapshot;
   const double r = trial_scene.layout.start_radius_m * layout.scale_px_per_m();
-  if (view->ended || s.finished) {  // the writing result: every stroke's start (Fig. 31)
+  if (quiz) {
+    // no start hints: the order is what the quiz asks
+  } else if (view->ended || s.finished) {  // the writing result: every stroke's start (Fig. 31)
     for (const PlacedCharacter& placed : trial_scene.characters) {
       for (const PlacedStroke& stroke : placed.strokes)
         draw_ellipse(draw, trial_to_screen(layout, *view, stroke.start()), r, 0.7 * r, kHint, 2.5f);

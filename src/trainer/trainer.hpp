@@ -9,6 +9,7 @@
 #include "calligraphy/model/character.hpp"
 #include "calligraphy/model/stroke_outline.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
+#include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/session_runner.hpp"
 
 namespace calligraphy::trainer {
@@ -30,8 +31,12 @@ struct TrainerOptions {
   GuidanceMode guidance_mode = GuidanceMode::fixed;  ///< how guidance attracts (M cycles it)
   double guidance_gain = 1.0;          ///< the fading mode's first gain in [0, 1]; faded after each trial
   std::vector<TeacherSample> teacher;  ///< replay: the teacher's pen (one character, its recording)
-  std::string record;       ///< non-empty: each completed trial is written here as a teacher recording
-  std::string session_dir;  ///< empty: trials are not saved
+  /// A quiz (Hanzi Writer's, study/quiz.hpp): guidance off, each stroke judged live as the pen lifts.
+  bool quiz = false;
+  QuizOptions quiz_options;      ///< leniency, hint after N misses
+  std::string quiz_screenshots;  ///< non-empty: a folder where a PNG is written after each judged stroke
+  std::string record;            ///< non-empty: each completed trial is written here as a teacher recording
+  std::string session_dir;       ///< empty: trials are not saved
   std::string subject = "anonymous";
   int width_px = 1280;
   int height_px = 800;
@@ -57,8 +62,9 @@ struct TrainerSessionOptions {
   std::function<TrainerCharacter(char32_t)> load_character;
   int width_px = 1280;
   int height_px = 800;
-  std::string screenshot;     ///< PNG written after the last planned trial's outcome, or at exit
-  double exit_after_s = 0.0;  ///< > 0: unattended (trials start by themselves); quit after this long
+  std::string screenshot;        ///< PNG written after the last planned trial's outcome, or at exit
+  std::string quiz_screenshots;  ///< non-empty: a folder where a PNG is written after each judged stroke
+  double exit_after_s = 0.0;     ///< > 0: unattended (trials start by themselves); quit after this long
   std::string library_version;
 };
 

@@ -31,6 +31,7 @@
 #include "calligraphy/trial/trial.hpp"
 #include "core/stop_signals.hpp"
 #include "study/names.hpp"
+#include "study/trial_record.hpp"
 #include "trainer/layout.hpp"
 #include "trainer/panel.hpp"
 #include "trainer/pointer_devices.hpp"
@@ -110,7 +111,7 @@ class TrainerApp {
       for (const Stroke& s : c.model.strokes) ids.push_back(s.typical_id);
       typical_ids_.push_back(std::move(ids));
     }
-    guidance_ = options.guidance;
+    guidance_ = options.guidance && !options.quiz;  // a quiz is force-free but for the paper
     guidance_mode_ = options.guidance_mode;
     guidance_gain_ = options.guidance_gain;
     condition_outputs_force_ = options.device != "mouse";
@@ -135,6 +136,7 @@ class TrainerApp {
       setup.simulated_writer = options_.simulated_writer;
       setup.writer_profile = options_.writer_profile;
       setup.writer_seed = options_.seed;
+      setup.quiz = options_.quiz_options;
       practice_.emplace(setup);
       std::fprintf(stderr, "calligraphy train: saving into %s\n", practice_->path().c_str());
     }
@@ -247,6 +249,7 @@ class TrainerApp {
     trial_options_ = trial;
     trial_options_.display = nullptr;
     worker_.start(std::move(scene), options_.device, std::move(trial));
+    if (options_.quiz) view_->quiz.emplace(worker_.scene(), options_.quiz_options);
     advance_at_.reset();
   }
 
@@ -267,6 +270,8 @@ class TrainerApp {
       return;
     }
     view.consume(*channel_, typical_ids_[view.character]);
+    log_quiz(view);
+    if (view.quiz) check_quiz_against_trace(*view.quiz, result);
     view.have_result = true;
     view.ended = true;
     view.end = result.end;
@@ -339,6 +344,7 @@ class TrainerApp {
     if (!view_ || s.trial_generation != shown_generation_) return;
     if (s.channel && s.channel != session_channel_) session_channel_ = s.channel;
     if (session_channel_) view_->consume(*session_channel_, typical_ids_.front());
+    log_quiz(*view_);
     if (s.outcome && !view_->have_result) {
       view_->have_result = true;
       view_->ended = true;
@@ -385,6 +391,10 @@ class TrainerApp {
     view_->condition = s.trial.condition;
     session_channel_.reset();
     session_scene_ = session_scene(s.trial);
+    if (s.mode == ConditionMode::quiz) {
+      view_->quiz.emplace(session_scene_,
+                          session_->manifest->protocol.protocol.condition(s.trial.condition).quiz);
+    }
   }
 
   Scene session_scene(const PlannedTrial& trial) const {
@@ -449,8 +459,69 @@ class TrainerApp {
     }
   }
 
+  // The quiz's new verdicts: one stderr line each (the test harness and logs read them), and a screenshot
+  // of the frame that first shows a judged stroke when asked.
+  void log_quiz(TrialView& view) {
+    if (!view.quiz) return;
+    const char* who = session_ ? "calligraphy session" : "calligraphy train";
+    for (const auto& [character, event] : view.quiz_unlogged) {
+      const std::string utf8 = character_utf8(view, character);
+      std::fprintf(stderr, "%s: quiz %s %s\n", who, utf8.c_str(), describe(event).c_str());
+      if (event.kind == QuizEvent::Kind::character_completed) {
+        std::fprintf(stderr, "%s: quiz %s complete, %d misses\n", who, utf8.c_str(), event.total_misses);
+      }
+      const bool judged = event.kind == QuizEvent::Kind::stroke_accepted ||
+                          event.kind == QuizEvent::Kind::stroke_missed ||
+                          event.kind == QuizEvent::Kind::too_short;
+      if (judged && !options_.quiz_screenshots.empty()) {
+        char name[64];
+        std::snprintf(name, sizeof name, "quiz-%02zu-%s.png", ++quiz_verdicts_, to_string(event.kind));
+        quiz_screenshot_ = (std::filesystem::path(options_.quiz_screenshots) / name).string();
+      }
+    }
+    view.quiz_unlogged.clear();
+  }
+
+  [[nodiscard]] std::string character_utf8(const TrialView& view, std::size_t character) const {
+    if (session_ == nullptr) return options_.characters[view.character].utf8;
+    const char32_t c = session_view_.trial.characters.at(character);
+    return options_.characters[index_of_.at(c)].utf8;
+  }
+
+  // The saved record judges the whole trace after the trial (study_detail::quiz_characters): the verdicts
+  // shown live must be the same ones.
+  void check_quiz_against_trace(const LiveQuiz& quiz, const TrialResult& result) {
+    const std::vector<std::vector<QuizEvent>> saved =
+        study_detail::quiz_characters(worker_.scene(), result.trace, options_.quiz_options);
+    const std::vector<std::vector<QuizEvent>> live = quiz.events();
+    bool same = saved.size() == live.size();
+    std::size_t count = 0;
+    for (std::size_t c = 0; same && c < saved.size(); ++c) {
+      same = saved[c].size() == live[c].size();
+      for (std::size_t k = 0; same && k < saved[c].size(); ++k) {
+        const QuizEvent& a = saved[c][k];
+        const QuizEvent& b = live[c][k];
+        same = a.kind == b.kind && a.stroke == b.stroke && a.backwards == b.backwards &&
+               a.misses_on_stroke == b.misses_on_stroke && a.total_misses == b.total_misses &&
+               a.time_s == b.time_s && a.samples == b.samples &&
+               a.closer_later_stroke == b.closer_later_stroke;
+        ++count;
+      }
+    }
+    if (same) {
+      std::fprintf(stderr, "calligraphy train: quiz: the %zu live verdicts are the saved record's\n", count);
+    } else {
+      std::fprintf(
+          stderr,
+          "calligraphy train: warning: quiz: the live verdicts differ from the saved record's, which "
+          "judges the whole trace (%llu trace points did not reach the window)\n",
+          static_cast<unsigned long long>(quiz.dropped_points()));
+    }
+  }
+
   // The condition of the next trial, as the session folder names it.
   [[nodiscard]] std::string condition_name() const {
+    if (options_.quiz) return kQuizCondition;
     if (!guidance_ || !condition_outputs_force_) return kVisionCondition;
     switch (guidance_mode_) {
       case GuidanceMode::fading:
@@ -485,7 +556,10 @@ class TrainerApp {
       }
       if (quit_ && worker_.active() && !worker_.done()) worker_.request_stop();
       if (pending_ != NextAction::none && worker_.active() && !worker_.done()) worker_.request_stop();
-      if (view_ && worker_.active()) view_->consume(*channel_, typical_ids_[view_->character]);
+      if (view_ && worker_.active()) {
+        view_->consume(*channel_, typical_ids_[view_->character]);
+        log_quiz(*view_);
+      }
       if (worker_.active() && worker_.done()) finish_trial();
       if (!worker_.active() && session_ == nullptr) {
         if (quit_) break;
@@ -504,6 +578,8 @@ class TrainerApp {
     }
     // The last character's trial ended in this very iteration: its summary, after the last stroke.
     if (!options_.screenshot.empty() && !screenshot_taken_ && !x11_error_seen() && view_) render(true);
+    // A stroke judged as the trial ended (the pen still down): the frame that shows it.
+    if (!quiz_screenshot_.empty() && !x11_error_seen() && view_) render(false);
   }
 
   double seconds_since_start() const {
@@ -526,11 +602,11 @@ class TrainerApp {
         case GLFW_KEY_N:
           if (session_ == nullptr) pending_ = NextAction::next;
           break;
-        case GLFW_KEY_G:
-          if (session_ == nullptr) guidance_ = !guidance_;
+        case GLFW_KEY_G:  // a quiz has no guidance
+          if (session_ == nullptr && !options_.quiz) guidance_ = !guidance_;
           break;
         case GLFW_KEY_M:  // the guidance mode of the next trial: fixed, fading, replay (with a teacher)
-          if (session_ == nullptr) {
+          if (session_ == nullptr && !options_.quiz) {
             guidance_mode_ = guidance_mode_ == GuidanceMode::fixed ? GuidanceMode::fading
                              : guidance_mode_ == GuidanceMode::fading && !options_.teacher.empty()
                                  ? GuidanceMode::replay
@@ -570,6 +646,7 @@ class TrainerApp {
     panel.device = options_.device;
     panel.characters = options_.characters.size();
     panel.next_guidance = guidance_;
+    panel.quiz = options_.quiz;
     panel.next_mode = to_string(guidance_mode_);
     panel.next_gain = guidance_gain_;
     panel.unattended = unattended();
@@ -585,6 +662,16 @@ class TrainerApp {
     glClearColor(1.0f, 1.0f, 1.0f, 1.0f);
     glClear(GL_COLOR_BUFFER_BIT);
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    if (!quiz_screenshot_.empty()) {  // the first frame that shows the latest judged stroke
+      try {
+        write_framebuffer_png(quiz_screenshot_, width, height);
+        std::fprintf(stderr, "calligraphy train: quiz screenshot %s\n", quiz_screenshot_.c_str());
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "calligraphy train: error: %s\n", e.what());
+        status_ = 1;
+      }
+      quiz_screenshot_.clear();
+    }
     if (take_screenshot) {
       try {
         write_framebuffer_png(options_.screenshot, width, height);
@@ -651,6 +738,8 @@ class TrainerApp {
   NextAction pending_ = NextAction::none;
   std::optional<Clock::time_point> advance_at_;
   bool screenshot_due_ = false;
+  std::size_t quiz_verdicts_ = 0;
+  std::string quiz_screenshot_;  // written at the next frame
   bool screenshot_taken_ = false;
   Clock::time_point started_;
   std::size_t frames_ = 0;
@@ -705,6 +794,7 @@ SessionRunResult run_trainer_session(const TrainerSessionOptions& options) {
   window.width_px = options.width_px;
   window.height_px = options.height_px;
   window.screenshot = options.screenshot;
+  window.quiz_screenshots = options.quiz_screenshots;
   window.exit_after_s = options.exit_after_s;
   window.library_version = options.library_version;
   std::optional<StopSignals> signals;

@@ -12,19 +12,7 @@ constexpr double kTraceStepM = 0.0001;
 
 void TrialView::consume(DisplayChannel& channel, const std::vector<int>& typical_ids) {
   channel.try_latest(snapshot);
-  for (TracePoint p; channel.poll_trace(p);) {
-    if (p.state != InteractionState::writing) {
-      segment_open = false;
-      continue;
-    }
-    const Vec2 point(p.hip_m.x, p.hip_m.y);
-    if (!segment_open || segments.back().stroke_index != p.stroke_index) {
-      segments.push_back(TraceSegment{p.stroke_index, p.tick, {point}});
-      segment_open = true;
-    } else if ((segments.back().points_m.back() - point).norm() >= kTraceStepM) {
-      segments.back().points_m.push_back(point);
-    }
-  }
+  drain_trace(channel);
   for (DisplayEvent e; channel.poll_event(e);) {
     switch (e.kind) {
       case DisplayEventKind::stroke_completed: {
@@ -51,7 +39,32 @@ void TrialView::consume(DisplayChannel& channel, const std::vector<int>& typical
       case DisplayEventKind::trial_ended:
         ended = true;
         end = e.end;
+        // The last ticks' points were pushed before this event: take them before the quiz's last verdicts.
+        drain_trace(channel);
+        if (quiz) {
+          quiz->note_dropped(channel.dropped_trace_points());
+          for (auto& event : quiz->finish()) quiz_unlogged.push_back(event);
+        }
         break;
+    }
+  }
+}
+
+void TrialView::drain_trace(DisplayChannel& channel) {
+  for (TracePoint p; channel.poll_trace(p);) {
+    if (quiz) {
+      for (auto& event : quiz->feed(p)) quiz_unlogged.push_back(event);
+    }
+    if (p.state != InteractionState::writing) {
+      segment_open = false;
+      continue;
+    }
+    const Vec2 point(p.hip_m.x, p.hip_m.y);
+    if (!segment_open || segments.back().stroke_index != p.stroke_index) {
+      segments.push_back(TraceSegment{p.stroke_index, p.tick, {point}});
+      segment_open = true;
+    } else if ((segments.back().points_m.back() - point).norm() >= kTraceStepM) {
+      segments.back().points_m.push_back(point);
     }
   }
 }

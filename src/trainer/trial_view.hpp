@@ -2,11 +2,13 @@
 // What the window shows of the trial that runs (or just ended), built on the window thread from the
 // display channel: the latest snapshot, the pen's trace per stroke, the per-stroke results.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "calligraphy/trial/display.hpp"
 #include "calligraphy/trial/result.hpp"
+#include "trainer/live_quiz.hpp"
 
 namespace calligraphy::trainer {
 
@@ -45,10 +47,18 @@ struct TrialView {
   std::string end_reason;
   std::string saved_as;    ///< the JSON file, or empty
   std::string save_error;  ///< why saving failed, or empty
+  /// A quiz trial: each stroke judged as the pen lifts, fed from the trace queue (live_quiz.hpp).
+  std::optional<LiveQuiz> quiz;
+  /// The quiz's events not yet logged, "CHARACTER-INDEX stroke k: kind (...)" lines for stderr.
+  std::vector<std::pair<std::size_t, QuizEvent>> quiz_unlogged;
 
   /// Copies the latest snapshot (keeping the last one when a publish overlapped) and drains the trace
-  /// and the events. `typical_ids` gives each stroke's typical id, by stroke index in the character.
+  /// and the events; feeds a quiz every trace point, and finishes it when the trial ends. `typical_ids` gives
+  /// each stroke's typical id, by stroke index in the character.
   void consume(DisplayChannel& channel, const std::vector<int>& typical_ids);
+
+ private:
+  void drain_trace(DisplayChannel& channel);
 };
 
 }  // namespace calligraphy::trainer

@@ -145,6 +145,14 @@ def is_red(r, g, b):
     return r > 190 and g < 70 and b < 70
 
 
+def is_accepted(r, g, b):  # the quiz's accepted stroke (20, 150, 60)
+    return g > 120 and r < 60 and b < 100
+
+
+def is_hint(r, g, b):  # the quiz's hint, Hanzi Writer's highlight colour #AAF
+    return b > 230 and 140 < r < 200 and 140 < g < 200
+
+
 def fraction(hits):
     return sum(hits) / len(hits)
 
@@ -230,6 +238,79 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual((record["strokes_completed"], record["strokes_total"]), (1, 1))
         self.assertEqual(record["end_reason"], "completed")
         self.assertLess(record["per_stroke"][0]["mean_deviation_mm"], 1.5)
+
+    def write_with_the_mouse(self, window, points, pause=0.12):
+        """Presses at the first point, moves through the others, and lifts the pen."""
+        xdotool("mousemove", "--window", window, round(points[0][0]), round(points[0][1]))
+        time.sleep(0.3)
+        xdotool("mousedown", 1)
+        time.sleep(0.3)
+        for x, y in points[1:]:
+            xdotool("mousemove", "--window", window, round(x), round(y))
+            time.sleep(pause)
+        time.sleep(0.3)
+        xdotool("mouseup", 1)
+
+    def test_the_quiz_misses_a_backwards_stroke_and_accepts_the_right_one_live(self):
+        shots = pathlib.Path(self.folder) / "shots"
+        shots.mkdir()
+        trainer = self.start("一", "--device", "mouse", "--data", SAMPLE, "--quiz", "--hint-after", "1",
+                             "--session", "out", "--quiz-screenshots", "shots", "--exit-after", "60")
+        (box,) = trainer.boxes()
+        window = trainer.window()
+        median = medians("一", SAMPLE)[0]
+        forwards = [box.data_to_px(p) for p in along(median, [i / 12 for i in range(13)])]
+        time.sleep(0.5)
+        self.write_with_the_mouse(window, forwards[::-1])  # from its end to its start: missed, backwards
+        deadline = time.time() + 20
+        while "stroke_missed" not in trainer.errors() and time.time() < deadline:
+            time.sleep(0.1)
+        self.assertIn("quiz 一 stroke 1: stroke_missed (misses 1 on the stroke, 1 in all, backwards)",
+                      trainer.errors())
+        time.sleep(0.8)
+        self.write_with_the_mouse(window, forwards + [box.data_to_px((median[-1][0] + 15, median[-1][1]))])
+        self.assertEqual(trainer.wait(), 0, trainer.errors())
+        errors = trainer.errors()
+        self.assertIn("quiz 一 stroke 1: stroke_accepted (misses 0 on the stroke, 1 in all)", errors)
+        self.assertIn("quiz 一 complete, 1 misses", errors)
+        self.assertIn("live verdicts are the saved record's", errors)
+
+        (record_path,) = saved_trials(pathlib.Path(self.folder) / "out")
+        record = json.loads(record_path.read_text(encoding="utf-8"))
+        self.assertEqual(record["condition"], "quiz")
+        self.assertFalse(record["force_law"]["guidance"])
+        quiz = record["quiz"]
+        self.assertEqual(quiz["hint_after_misses"], 1)
+        self.assertEqual((quiz["strokes_accepted"], quiz["misses"], quiz["hints"], quiz["backwards"]), (1, 1, 1, 1))
+        events = quiz["characters"][0]["events"]
+        self.assertEqual([e["kind"] for e in events], ["stroke_missed", "hint", "stroke_accepted", "character_completed"])
+        self.assertTrue(events[0]["backwards"])
+        # The stderr lines the window printed as each verdict came are the saved record's events.
+        logged = [l.split("quiz 一 ", 1)[1] for l in errors.splitlines() if "quiz 一 stroke" in l]
+        expected = ["stroke %d: %s (misses %d on the stroke, %d in all%s)"
+                    % (e["stroke"], e["kind"], e["misses_on_stroke"], e["total_misses"],
+                       ", backwards" if e["backwards"] else "") for e in events]
+        self.assertEqual(logged, expected)
+
+        # What the window showed after each verdict.
+        inner = along(median, [i / 20 for i in range(2, 19)])
+        missed = read_png(shots / "quiz-01-stroke_missed.png")
+        self.assertGreater(fraction([near(missed, box.data_to_px(p), 4, is_red) for p in inner]), 0.9,
+                           "the missed trace flashes red along the stroke")
+        self.assertGreater(fraction([near(missed, box.data_to_px(p), 4, is_hint) for p in inner]), 0.9,
+                           "the expected stroke highlighted after one miss")
+        self.assertEqual(fraction([near(missed, box.data_to_px(p), 4, is_accepted) for p in inner]), 0.0)
+        accepted = read_png(shots / "quiz-02-stroke_accepted.png")
+        self.assertGreater(fraction([near(accepted, box.data_to_px(p), 4, is_accepted) for p in inner]), 0.9,
+                           "the accepted stroke filled in green")
+        self.assertEqual(fraction([near(accepted, box.data_to_px(p), 4, is_red) for p in inner]), 0.0)
+        # Hanzi Writer's quiz shows no reference and no start of the next stroke.
+        self.assertEqual(fraction([near(missed, box.data_to_px(p), 4, is_blue) for p in inner]), 0.0)
+
+    def test_the_quiz_options_need_quiz(self):
+        result = subprocess.run([CLI, "train", "一", "--leniency", "2"], capture_output=True, text=True)
+        self.assertEqual(result.returncode, 2, result.stderr)
+        self.assertIn("--quiz", result.stderr)
 
     def write_yi_beside_the_stroke(self, guidance, offset):
         """On mouse-hand, presses at the start of 一, then moves the pointer `offset` data units below the
