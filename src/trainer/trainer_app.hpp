@@ -1,0 +1,133 @@
+#pragma once
+// TrainerApp: the window of `calligraphy train` and of a study session in the window (trainer.hpp). Its
+// methods live in files by job: trainer_app.cpp (construction, the loop, keys, pointer), trainer_window.cpp
+// (window, fonts, drawing, screenshots), trainer_trials.cpp (a trial's start and end, measurements),
+// trainer_session_view.cpp (a study session's view), trainer_quiz_log.cpp (the quiz's verdicts).
+#include <imgui.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "calligraphy/core/device_types.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/render/guidance_mode.hpp"
+#include "calligraphy/trial/trial.hpp"
+#include "trainer/layout.hpp"
+#include "trainer/live_quiz.hpp"
+#include "trainer/panel.hpp"
+#include "trainer/practice_session.hpp"
+#include "trainer/scene_view.hpp"
+#include "trainer/session_host.hpp"
+#include "trainer/trainer.hpp"
+#include "trainer/trial_view.hpp"
+#include "trainer/trial_worker.hpp"
+
+struct GLFWwindow;
+
+namespace calligraphy::trainer {
+
+constexpr double kPanelWidthPx = 400.0;
+constexpr double kAdvanceDelayS = 1.0;  // unattended: pause on a trial's summary before the next
+
+using Clock = std::chrono::steady_clock;
+
+enum class NextAction { none, repeat, next, quit };
+
+// A study session the window hosts (run_trainer_session): the host and whether its thread is done.
+struct SessionLink {
+  WindowSessionHost* host = nullptr;
+  const std::atomic<bool>* done = nullptr;
+  const SessionManifest* manifest = nullptr;
+};
+
+class TrainerApp {
+ public:
+  TrainerApp(const TrainerOptions& options, DeviceInfo device_info, bool hardware,
+             const SessionLink* session = nullptr);
+
+  int run();
+
+ private:
+  // the loop, keys and pointer (trainer_app.cpp)
+  [[nodiscard]] std::string condition_name() const;
+  [[nodiscard]] bool unattended() const;
+  void loop();
+  double seconds_since_start() const;
+  void handle_keys();
+  void update_pointer();
+
+  // window, fonts, drawing (trainer_window.cpp)
+  void open_window();
+  void load_fonts();
+  void close_window();
+  void render(bool take_screenshot);
+
+  // a trial's start and end, measurements (trainer_trials.cpp)
+  void start_trial(std::size_t character);
+  void finish_trial();
+  void save_recording(TrialView& view, const TrialResult& result);
+  void print_measurements() const;
+
+  // a study session's view (trainer_session_view.cpp)
+  void follow_session();
+  void show_session_trial(const SessionView& s);
+  Scene session_scene(const PlannedTrial& trial) const;
+  void session_panel(PanelInput& panel) const;
+
+  // the quiz's verdicts (trainer_quiz_log.cpp)
+  void log_quiz(TrialView& view);
+  [[nodiscard]] std::string character_utf8(const TrialView& view, std::size_t character) const;
+  void check_quiz_against_trace(const LiveQuiz& quiz, const TrialResult& result);
+
+  TrainerOptions options_;
+  DeviceInfo device_info_;
+  bool hardware_ = false;
+  std::optional<PracticeSession> practice_;
+  const SessionLink* session_ = nullptr;
+  SessionView session_view_;
+  std::uint64_t shown_generation_ = 0;
+  std::shared_ptr<DisplayChannel> session_channel_;
+  Scene session_scene_;
+  std::vector<CharacterArt> all_art_;
+  std::vector<std::vector<int>> all_typical_ids_;
+  std::map<char32_t, std::size_t> index_of_;
+  TrialOptions trial_options_;
+  Clock::time_point trial_wall_start_;
+  std::vector<CharacterArt> art_;
+  std::vector<std::vector<int>> typical_ids_;
+  GLFWwindow* window_ = nullptr;
+  ImFont* large_font_ = nullptr;
+  ImVector<ImWchar> glyph_ranges_;
+  std::optional<WindowLayout> layout_;
+  std::vector<int> keys_;
+  TrialWorker worker_;
+  std::unique_ptr<DisplayChannel> channel_;
+  std::optional<TrialView> view_;
+  std::size_t trials_started_ = 0;
+  std::string trial_start_utc_;
+  bool guidance_ = true;
+  GuidanceMode guidance_mode_ = GuidanceMode::fixed;
+  double guidance_gain_ = 1.0;
+  bool condition_outputs_force_ = true;
+  bool quit_ = false;
+  bool quit_seen_ = false;
+  NextAction pending_ = NextAction::none;
+  std::optional<Clock::time_point> advance_at_;
+  bool screenshot_due_ = false;
+  std::size_t quiz_verdicts_ = 0;
+  std::string quiz_screenshot_;  // written at the next frame
+  bool screenshot_taken_ = false;
+  Clock::time_point started_;
+  std::size_t frames_ = 0;
+  std::vector<double> latencies_ms_;
+  int status_ = 0;
+};
+
+}  // namespace calligraphy::trainer

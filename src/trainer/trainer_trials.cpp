@@ -1,0 +1,171 @@
+// The trainer's trials: one started on the worker thread, its result taken, saved and summarised; the
+// window's measurements (frame rate, display latency).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "calligraphy/core/atomic_file.hpp"
+#include "calligraphy/report/teacher_recording.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
+#include "study/names.hpp"
+#include "trainer/trainer_app.hpp"
+
+namespace calligraphy::trainer {
+namespace {
+
+double percentile(std::vector<double> values, double p) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const auto k = static_cast<std::size_t>(std::ceil(p * static_cast<double>(values.size())));
+  return values[std::min(values.size() - 1, k == 0 ? 0 : k - 1)];
+}
+
+}  // namespace
+
+// ---- Trials.
+void TrainerApp::start_trial(std::size_t character) {
+  std::vector<Character> one{options_.characters[character].model};
+  Scene scene = Scene::lay_out(one);  // at the device's centre; the row shows it at its place
+  channel_ = std::make_unique<DisplayChannel>();
+  view_.emplace();
+  view_->character = character;
+  view_->number = ++trials_started_;
+  view_->guidance = guidance_;
+  view_->condition = condition_name();
+  TrialOptions trial;
+  trial.force.guidance = guidance_;
+  trial.force.guidance_mode = guidance_mode_;
+  trial.force.guidance_gain = guidance_gain_;
+  if (guidance_mode_ == GuidanceMode::replay) trial.force.teacher_trajectory = options_.teacher;
+  trial.pacing = TrialPacing::real_time;
+  // A window process maps memory all the time (the GL driver): mlockall(MCL_FUTURE) would lock all of
+  // it, or make its allocations fail under a memory-lock limit. The trace is touched in advance instead.
+  trial.loop.lock_memory = false;
+  trial.keep_trace = true;
+  trial.simulation.writer =
+      options_.writer_profile == "skilled" ? WriterProfile::skilled() : WriterProfile::novice();
+  trial.simulation.seed = options_.seed + trials_started_ - 1;
+  trial.display = channel_.get();
+  trial_start_utc_ = study_detail::utc_now_iso8601();
+  trial_wall_start_ = Clock::now();
+  trial_options_ = trial;
+  trial_options_.display = nullptr;
+  worker_.start(std::move(scene), options_.device, std::move(trial));
+  if (options_.quiz) view_->quiz.emplace(worker_.scene(), options_.quiz_options);
+  advance_at_.reset();
+}
+
+// The worker is done: takes its result, saves it, and shows the summary.
+void TrainerApp::finish_trial() {
+  TrialView& view = *view_;
+  TrialResult result;
+  try {
+    result = worker_.take();
+  } catch (const std::exception& e) {
+    view.have_result = true;
+    view.ended = true;
+    view.end = TrialEnd::device_fault;
+    view.end_reason = e.what();
+    std::fprintf(stderr, "calligraphy train: the trial could not run: %s\n", e.what());
+    status_ = 1;
+    quit_ = true;  // nothing to retry with the same device
+    return;
+  }
+  view.consume(*channel_, typical_ids_[view.character]);
+  log_quiz(view);
+  if (view.quiz) check_quiz_against_trace(*view.quiz, result);
+  view.have_result = true;
+  view.ended = true;
+  view.end = result.end;
+  view.metrics = result.metrics;
+  view.end_reason = result.abort_reason;
+  if (result.end == TrialEnd::device_fault || result.end == TrialEnd::watchdog) status_ = 1;
+  if (guidance_ && trial_options_.force.guidance_mode == GuidanceMode::fading &&
+      result.metrics.mean_deviation_m) {  // performance-based fading (Emken et al. 2007)
+    guidance_gain_ = next_guidance_gain(guidance_gain_, *result.metrics.mean_deviation_m);
+    std::fprintf(stderr, "calligraphy train: fading: next trial's guidance gain %.3f\n", guidance_gain_);
+  }
+  if (!options_.record.empty() && result.end == TrialEnd::completed) save_recording(view, result);
+  const std::string& utf8 = options_.characters[view.character].utf8;
+  std::fprintf(stderr,
+               "calligraphy train: trial %zu %s: %s, %zu/%zu strokes in order, mean %.2f mm, %.1f s\n",
+               view.number, utf8.c_str(), to_string(result.end), result.metrics.strokes_completed,
+               result.metrics.strokes_total, result.metrics.mean_deviation_m.value_or(std::nan("")) * 1e3,
+               result.metrics.time_s);
+  if (result.loop) {
+    const ServoLoopStats& loop = *result.loop;
+    std::fprintf(stderr,
+                 "calligraphy train: servo loop: %llu ticks, %llu late, %llu forces withheld, period jitter "
+                 "p50 %.1f us, p99 %.1f us, max %.1f us, longest stall %.2f ms\n",
+                 static_cast<unsigned long long>(loop.ticks),
+                 static_cast<unsigned long long>(loop.late_ticks),
+                 static_cast<unsigned long long>(loop.forces_withheld), loop.period_jitter_us_p50,
+                 loop.period_jitter_us_p99, loop.period_jitter_us_max, loop.longest_stall_s * 1e3);
+  }
+  if (practice_) {
+    PracticeTrial trial;
+    trial.item = view.character;
+    trial.character = options_.characters[view.character].model.code_point;
+    trial.condition = view.condition;
+    trial.scene = &worker_.scene();
+    trial.options = &trial_options_;
+    trial.start_utc = trial_start_utc_;
+    trial.end_utc = study_detail::utc_now_iso8601();
+    trial.wall_time_s = std::chrono::duration<double>(Clock::now() - trial_wall_start_).count();
+    try {
+      const auto [path, as_trial] = practice_->save(trial, result);
+      view.saved_as = (as_trial ? "" : "attempts/") + path.filename().string();
+      std::fprintf(stderr, "calligraphy train: saved %s (%s)\n", path.c_str(),
+                   as_trial ? "the trial, .csv, .svg" : "an attempt, .csv");
+    } catch (const std::exception& e) {
+      view.save_error = std::string("not saved: ") + e.what();
+      std::fprintf(stderr, "calligraphy train: error: the trial was not saved: %s\n", e.what());
+      status_ = 1;
+    }
+  }
+  const bool last = view.character + 1 == options_.characters.size();
+  if (last) screenshot_due_ = true;  // after the last character's last stroke
+  if (unattended()) {
+    if (last) {
+      quit_ = true;
+    } else {
+      advance_at_ = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                       std::chrono::duration<double>(kAdvanceDelayS));
+    }
+  }
+}
+
+// The last completed trial as a teacher's recording (replay guidance), replaced atomically.
+void TrainerApp::save_recording(TrialView& view, const TrialResult& result) {
+  try {
+    const TeacherRecording recording =
+        teacher_recording_from_trace(options_.characters[view.character].utf8,
+                                     options_.simulated_writer ? options_.writer_profile : "human",
+                                     options_.device, trial_options_.rate_hz, result.trace);
+    write_file_atomically(options_.record, teacher_recording_json(recording));
+    std::fprintf(stderr, "calligraphy train: teacher recording %s (%zu samples)\n", options_.record.c_str(),
+                 recording.samples.size());
+  } catch (const std::exception& e) {
+    view.save_error += std::string(" recording not written: ") + e.what();
+    std::fprintf(stderr, "calligraphy train: error: the recording was not written: %s\n", e.what());
+    status_ = 1;
+  }
+}
+
+void TrainerApp::print_measurements() const {
+  const double seconds = seconds_since_start();
+  std::fprintf(
+      stderr,
+      "calligraphy train: %zu frames in %.1f s (%.1f frames/s); display latency, servo tick to frame "
+      "shown: p50 %.2f ms, p99 %.2f ms, max %.2f ms over %zu frames\n",
+      frames_, seconds, static_cast<double>(frames_) / std::max(seconds, 1e-9),
+      percentile(latencies_ms_, 0.5), percentile(latencies_ms_, 0.99), percentile(latencies_ms_, 1.0),
+      latencies_ms_.size());
+}
+
+}  // namespace calligraphy::trainer

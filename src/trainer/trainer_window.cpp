@@ -1,0 +1,163 @@
+// The trainer's window: GLFW and Dear ImGui set up and torn down, the fonts, one frame drawn, screenshots.
+#define GLFW_INCLUDE_NONE
+#include <GL/gl.h>
+#include <GLFW/glfw3.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
+
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "calligraphy/core/errors.hpp"
+#include "trainer/screenshot.hpp"
+#include "trainer/trainer_app.hpp"
+#include "trainer/x11_errors.hpp"
+
+namespace calligraphy::trainer {
+namespace {
+
+constexpr const char* kChineseFont = "/usr/share/fonts/truetype/arphic/ukai.ttc";
+
+void print_glfw_error(int code, const char* description) {
+  std::fprintf(stderr, "calligraphy train: GLFW error %d: %s\n", code, description);
+}
+
+std::int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count();
+}
+
+// Keys pressed since the last frame (GLFW's key callback, on the window thread).
+std::vector<int>* pending_keys = nullptr;
+void record_key(GLFWwindow* /*window*/, int key, int /*scancode*/, int action, int /*mods*/) {
+  if (action == GLFW_PRESS && pending_keys != nullptr) pending_keys->push_back(key);
+}
+
+}  // namespace
+
+void TrainerApp::open_window() {
+  glfwSetErrorCallback(print_glfw_error);
+  if (glfwInit() == GLFW_FALSE) {
+    throw Error("cannot open a window: GLFW could not initialise (no X display? DISPLAY is '" +
+                std::string(std::getenv("DISPLAY") ? std::getenv("DISPLAY") : "") + "'; try xvfb-run)");
+  }
+  install_x11_error_handler();
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);
+  std::string title = "calligraphy train";
+  for (const TrainerCharacter& c : options_.characters) title += " " + c.utf8;
+  window_ = glfwCreateWindow(options_.width_px, options_.height_px, title.c_str(), nullptr, nullptr);
+  if (window_ == nullptr) {
+    glfwTerminate();
+    throw Error("cannot open a window of " + std::to_string(options_.width_px) + "x" +
+                std::to_string(options_.height_px) + " with OpenGL 3.3 core");
+  }
+  glfwMakeContextCurrent(window_);
+  glfwSwapInterval(1);
+  pending_keys = &keys_;
+  glfwSetKeyCallback(window_, record_key);  // before ImGui's, which calls it in turn
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGuiIO& io = ImGui::GetIO();
+  io.IniFilename = nullptr;
+  ImGui::StyleColorsLight();
+  load_fonts();
+  ImGui_ImplGlfw_InitForOpenGL(window_, true);
+  ImGui_ImplOpenGL3_Init("#version 330 core");
+}
+
+void TrainerApp::load_fonts() {
+  ImGuiIO& io = ImGui::GetIO();
+  if (!std::filesystem::exists(kChineseFont)) {
+    std::fprintf(stderr,
+                 "calligraphy train: %s not found (Debian fonts-arphic-ukai): characters show as '?'\n",
+                 kChineseFont);
+    return;
+  }
+  ImFontGlyphRangesBuilder builder;
+  builder.AddRanges(io.Fonts->GetGlyphRangesDefault());
+  for (const TrainerCharacter& c : options_.characters) builder.AddText(c.utf8.c_str());
+  builder.BuildRanges(&glyph_ranges_);
+  ImFontConfig config;
+  config.FontNo = 0;
+  io.Fonts->AddFontFromFileTTF(kChineseFont, 20.0f, &config, glyph_ranges_.Data);
+  large_font_ = io.Fonts->AddFontFromFileTTF(kChineseFont, 34.0f, &config, glyph_ranges_.Data);
+}
+
+void TrainerApp::close_window() {
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+  if (!x11_error_seen()) glfwDestroyWindow(window_);
+  glfwTerminate();
+  pending_keys = nullptr;
+}
+
+void TrainerApp::render(bool take_screenshot) {
+  ImGui_ImplOpenGL3_NewFrame();
+  ImGui_ImplGlfw_NewFrame();
+  ImGui::NewFrame();
+  const Scene& scene = session_ ? session_scene_ : worker_.scene();
+  draw_scene(*ImGui::GetBackgroundDrawList(), *layout_, art_, scene, view_ ? &*view_ : nullptr);
+  PanelInput panel;
+  panel.view = view_ ? &*view_ : nullptr;
+  if (view_ && session_ == nullptr) panel.character = options_.characters[view_->character].utf8;
+  if (session_ != nullptr) session_panel(panel);
+  panel.device = options_.device;
+  panel.characters = options_.characters.size();
+  panel.next_guidance = guidance_;
+  panel.quiz = options_.quiz;
+  panel.next_mode = to_string(guidance_mode_);
+  panel.next_gain = guidance_gain_;
+  panel.unattended = unattended();
+  panel.frame_rate_hz = ImGui::GetIO().Framerate;
+  panel.large_font = large_font_;
+  if (quit_seen_ && worker_.active() && !worker_.done()) panel.status = "ending the trial...";
+  draw_panel(*layout_, kPanelWidthPx, panel);
+  ImGui::Render();
+  int width = 0;
+  int height = 0;
+  glfwGetFramebufferSize(window_, &width, &height);
+  glViewport(0, 0, width, height);
+  glClearColor(1.0f, 1.0f, 1.0f, 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT);
+  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+  if (!quiz_screenshot_.empty()) {  // the first frame that shows the latest judged stroke
+    try {
+      write_framebuffer_png(quiz_screenshot_, width, height);
+      std::fprintf(stderr, "calligraphy train: quiz screenshot %s\n", quiz_screenshot_.c_str());
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "calligraphy train: error: %s\n", e.what());
+      status_ = 1;
+    }
+    quiz_screenshot_.clear();
+  }
+  if (take_screenshot) {
+    try {
+      write_framebuffer_png(options_.screenshot, width, height);
+      std::fprintf(stderr, "calligraphy train: screenshot %s\n", options_.screenshot.c_str());
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "calligraphy train: error: %s\n", e.what());
+      status_ = 1;
+    }
+    screenshot_taken_ = true;
+  }
+  glfwSwapBuffers(window_);
+  ++frames_;
+  // Display latency: from the servo tick that published the snapshot to the frame that shows it.
+  const bool live = (worker_.active() && !worker_.done()) ||
+                    (session_ != nullptr && session_view_.phase == SessionPhase::running);
+  if (view_ && live && view_->snapshot.tick > 0) {
+    latencies_ms_.push_back(static_cast<double>(steady_ns() - view_->snapshot.published_ns) * 1e-6);
+  }
+}
+
+}  // namespace calligraphy::trainer
