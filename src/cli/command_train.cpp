@@ -208,7 +208,7 @@ void add_train_command(CLI::App& root, Commands& commands) {
       ->needs(quiz);
   add_text(*app, "--quiz-screenshots", command->quiz_screenshots, "DIR",
            "quiz: write the window as DIR/quiz-NN-VERDICT.png on the first frame after each judged stroke "
-           "(an existing folder)");
+           "(an existing folder) (default: not written)");
   add_number(*app, "--exit-after", command->exit_after_s, "SECONDS",
              "unattended: quit after this long [s], or once every character had its trial",
              "a number of seconds > 0", [](double s) { return s > 0.0 && s <= 86400.0; });
