@@ -2,11 +2,11 @@
 
 #include <charconv>
 #include <cmath>
-#include <fstream>
 #include <optional>
 #include <system_error>
 
 #include "calligraphy/core/errors.hpp"
+#include "core/whole_file.hpp"
 
 namespace calligraphy {
 namespace {
@@ -177,23 +177,8 @@ std::vector<PenSample> parse_pen_trace_csv(std::string_view text, const std::str
 std::vector<PenSample> read_pen_trace_csv(const std::filesystem::path& file, const Placement& placement,
                                           const PenTraceCsvOptions& options) {
   check_options(options, placement);
-  const std::string name = file.string();
-  std::error_code error;
-  const auto status = std::filesystem::status(file, error);
-  if (error || !std::filesystem::exists(status)) throw DataError(name + ": no such file");
-  if (!std::filesystem::is_regular_file(status)) throw DataError(name + ": not a regular file");
-  const std::uintmax_t size = std::filesystem::file_size(file, error);
-  if (error) throw DataError(name + ": cannot read its size (" + error.message() + ")");
-  if (size > options.max_file_bytes) {
-    throw DataError(name + ": " + std::to_string(size) + " bytes, more than the limit of " +
-                    std::to_string(options.max_file_bytes));
-  }
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw DataError(name + ": cannot be opened");
-  std::string text(static_cast<std::size_t>(size), '\0');
-  in.read(text.data(), static_cast<std::streamsize>(size));
-  if (static_cast<std::uintmax_t>(in.gcount()) != size) throw DataError(name + ": could not be read whole");
-  return Reader(name, placement, options).parse(text);
+  const std::string text = read_regular_file(file, options.max_file_bytes);
+  return Reader(file.string(), placement, options).parse(text);
 }
 
 }  // namespace calligraphy

@@ -1,10 +1,10 @@
 #include "calligraphy/report/teacher_recording.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "calligraphy/core/errors.hpp"
+#include "core/whole_file.hpp"
 
 namespace calligraphy {
 namespace {
@@ -129,23 +129,8 @@ TeacherRecording parse_teacher_recording(std::string_view json_text, const std::
 }
 
 TeacherRecording read_teacher_recording(const std::filesystem::path& path) {
-  const std::string name = path.string();
-  std::error_code error;
-  const auto status = std::filesystem::status(path, error);
-  if (error || !std::filesystem::exists(status)) throw DataError(name + ": no such file");
-  if (!std::filesystem::is_regular_file(status)) throw DataError(name + ": not a regular file");
-  const std::uintmax_t size = std::filesystem::file_size(path, error);
-  if (error) throw DataError(name + ": cannot read its size (" + error.message() + ")");
-  if (size > kMaxTeacherRecordingBytes) {
-    throw DataError(name + ": " + std::to_string(size) + " bytes, more than the limit of " +
-                    std::to_string(kMaxTeacherRecordingBytes));
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw DataError(name + ": cannot be opened");
-  std::string text(static_cast<std::size_t>(size), '\0');
-  in.read(text.data(), static_cast<std::streamsize>(size));
-  if (static_cast<std::uintmax_t>(in.gcount()) != size) throw DataError(name + ": could not be read whole");
-  return parse_teacher_recording(text, name);
+  const std::string text = read_regular_file(path, kMaxTeacherRecordingBytes);
+  return parse_teacher_recording(text, path.string());
 }
 
 void require_teacher_for(const TeacherRecording& recording, std::string_view characters) {

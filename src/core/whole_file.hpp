@@ -1,0 +1,13 @@
+#pragma once
+// Reading a whole input file of bounded size: a trace, a recording. Internal.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+namespace calligraphy {
+
+/// The bytes of the regular file `path`. Throws DataError naming the path when it does not exist, is not a
+/// regular file (a device or FIFO is never read), is larger than `max_bytes`, or cannot be read whole.
+[[nodiscard]] std::string read_regular_file(const std::filesystem::path& path, std::uintmax_t max_bytes);
+
+}  // namespace calligraphy
