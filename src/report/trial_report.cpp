@@ -57,8 +57,20 @@ nlohmann::json loop_json(const ServoLoopStats& loop) {
 
 void print_trial_table(const TrialDescription& d, const Scene& scene, const TrialResult& result) {
   const TrialMetrics& m = result.metrics;
+  // The guidance as given: "on" (the paper's fixed fixture), "fading, gain G", "replay of TEACHER", "off".
+  char guidance[512];
+  if (!d.guidance) {
+    std::snprintf(guidance, sizeof guidance, "off");
+  } else if (d.guidance_mode == GuidanceMode::fading) {
+    std::snprintf(guidance, sizeof guidance, "fading, gain %.3g", d.guidance_gain);
+  } else if (d.guidance_mode == GuidanceMode::replay) {
+    std::snprintf(guidance, sizeof guidance, "replay of %s",
+                  d.teacher_file.empty() ? "a teacher" : d.teacher_file.c_str());
+  } else {
+    std::snprintf(guidance, sizeof guidance, "on");
+  }
   std::printf("Trial %s: guidance %s, %s writer, seed %llu, %.0f Hz, device %s (%s)\n", d.characters.c_str(),
-              d.guidance ? "on" : "off", d.writer.c_str(), static_cast<unsigned long long>(d.seed), d.rate_hz,
+              guidance, d.writer.c_str(), static_cast<unsigned long long>(d.seed), d.rate_hz,
               d.device.c_str(), d.device_model.c_str());
   std::printf("\n  %-6s %-5s %-6s %-4s %9s %9s %9s %8s %9s\n", "stroke", "char", "type", "ID", "mean[mm]",
               "max[mm]", "time[s]", "attempts", "completed");
