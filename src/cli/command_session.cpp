@@ -103,17 +103,12 @@ SessionRunOptions run_options(const LibraryOptions& library, SessionHost* host,
   return options;
 }
 
-// Prints one line per session; returns the exit status: 0 when complete, 128 + the signal when stopped
-// by one, 1 after a device fault.
-bool in_window(const SessionDisplay& display, const std::string& writer) {
 #ifdef CALLIGRAPHY_WITH_TRAINER
+// A person's session goes to the trainer window unless --display terminal.
+bool in_window(const SessionDisplay& display, const std::string& writer) {
   return writer == "human" && display.display == "window";
-#else
-  (void)display;
-  (void)writer;
-  return false;
-#endif
 }
+#endif
 
 // Runs the session in the trainer window (a person writes) or headless, with the terminal as host.
 SessionRunResult run_one(SessionFolder& session, const SessionRunOptions& options,
@@ -150,6 +145,8 @@ SessionRunResult run_one(SessionFolder& session, const SessionRunOptions& option
   return run_session(session, options);
 }
 
+// Prints one line per session; returns the exit status: 0 when complete, 128 + the signal when stopped
+// by one, 1 after a device fault.
 int report_run(const SessionFolder& session, const SessionRunResult& result, double seconds) {
   std::printf("%s: %zu of %zu trials saved (%zu now, %zu attempts kept) in %s, %.1f s\n",
               session.manifest().setup.subject.id.c_str(), result.saved_before + result.saved_now,
