@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <new>
 #include <string>
@@ -214,7 +215,11 @@ int run_trial(const TrialCommand& command) {
   const StopSignals stop_signals;
   const CharacterSource source(command.library);  // only these characters are read (on demand from a store)
   std::vector<Character> characters;
-  for (char32_t c : chars) characters.push_back(source.load(c));
+  std::map<char32_t, std::size_t> loaded;  // a character repeated in CHARS is read and fitted once
+  for (char32_t c : chars) {
+    const auto [at, added] = loaded.try_emplace(c, characters.size());
+    characters.push_back(added ? source.load(c) : characters[at->second]);
+  }
   const Scene scene = Scene::lay_out(characters);
   // A signal while the characters were read: nothing recorded yet, no device opened, no file written.
   if (const int signal = StopSignals::received()) {
