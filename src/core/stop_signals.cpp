@@ -46,8 +46,12 @@ StopSignals::StopSignals() {
 }
 
 StopSignals::~StopSignals() {
-  for (std::size_t i = 0; i < std::size(kStopSignals); ++i)
-    sigaction(kStopSignals[i], &saved.stop[i], nullptr);
+  // After a stop the recording handler stays: a second Ctrl-C while the program shuts down (files being
+  // closed, the sanitizers' checks at exit) must not end it another way than the first one asked for.
+  if (received() == 0) {
+    for (std::size_t i = 0; i < std::size(kStopSignals); ++i)
+      sigaction(kStopSignals[i], &saved.stop[i], nullptr);
+  }
   sigaction(SIGPIPE, &saved.pipe, nullptr);
   installed_flag.store(false);
 }
