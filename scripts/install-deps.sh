@@ -8,7 +8,7 @@ packages=(
   build-essential cmake ninja-build git ca-certificates
   clang libclang-rt-14-dev            # sanitizer and fuzzer builds
   libeigen3-dev libspdlog-dev catch2 nlohmann-json3-dev libbenchmark-dev
-  libcli11-dev zlib1g-dev            # command-line parsing, CRC-32
+  libcli11-dev zlib1g-dev libssl-dev # command-line parsing, CRC-32, SHA-256
   libusb-1.0-0-dev libhidapi-dev     # Phantom backend (optional at configure time)
   pkg-config lib2geom-dev            # lib2geom column of `bench nearest` (optional at configure time)
   pybind11-dev python3-dev python3-numpy python3-pytest
