@@ -4,8 +4,8 @@
 #include <cstdio>
 #include <ctime>
 
+#include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/report/atomic_file.hpp"
 
 namespace calligraphy::study_detail {
 

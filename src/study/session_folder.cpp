@@ -12,8 +12,8 @@
 #include <ctime>
 #include <utility>
 
+#include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/report/atomic_file.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
 #include "core/unicode.hpp"
 #include "study/json_reader.hpp"

@@ -9,8 +9,8 @@
 #include <span>
 #include <vector>
 
+#include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/report/atomic_file.hpp"
 
 namespace calligraphy::trainer {
 namespace {
