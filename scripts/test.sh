@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Runs every test: installs dependencies, builds with warnings as errors and runs the Catch2 and
 # pytest suites through CTest, then again under AddressSanitizer + UndefinedBehaviorSanitizer, then the
-# servo-loop tests under ThreadSanitizer, then installs the library and builds a separate project
-# against it with find_package(calligraphy).
+# servo-loop tests under ThreadSanitizer, then builds the fuzzers and replays their inputs, then
+# installs the library and builds a separate project against it with find_package(calligraphy).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -37,6 +37,16 @@ cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCALLIGRAPH
   -DCALLIGRAPHY_BUILD_BENCH=OFF -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_EXAMPLES=OFF >/dev/null
 cmake --build build-tsan -j "$jobs" --target calligraphy_tests
 TSAN_OPTIONS=halt_on_error=1 build-tsan/bin/calligraphy_tests "[servo],[log_queue]"
+
+echo "== Fuzzers (clang, libFuzzer): build, and replay their seeds and every input that ever failed"
+# A replay, not a fuzzing run (docs/corpus.md has those): it keeps the fuzz targets building as sources
+# move, and every seed and regression input passing.
+cmake -S . -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCALLIGRAPHY_BUILD_FUZZERS=ON \
+  -DCALLIGRAPHY_BUILD_TESTS=OFF -DCALLIGRAPHY_BUILD_BENCH=OFF -DCALLIGRAPHY_BUILD_PYTHON=OFF \
+  -DCALLIGRAPHY_BUILD_EXAMPLES=OFF -DCALLIGRAPHY_BUILD_TOOLS=OFF -DCALLIGRAPHY_BUILD_TRAINER=OFF >/dev/null
+cmake --build build-fuzz -j "$jobs" --target character_data_fuzzer corpus_store_fuzzer
+build-fuzz/bin/character_data_fuzzer -runs=0 data/hanzi-writer-data tests/data/hostile
+build-fuzz/bin/corpus_store_fuzzer -runs=0 fuzz/seeds tests/data/store_regressions
 
 echo "== install + find_package(calligraphy) from another project"
 rm -rf build/stage build/consumer
