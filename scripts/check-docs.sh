@@ -3,7 +3,8 @@
 # cannot follow: a notes file that is not in the repository (REFERENCE.md, seed-paper.txt, the
 # shared/reference folder) or a work item of this project ("issue 5", "issues 3", "Deliver 1",
 # "work item 2"). Cite the original source instead (docs/references.md lists them) and say what the
-# code does and why.
+# code does and why. Also fails when the README, the docs or the examples name a public header
+# (calligraphy/<module>/<name>.hpp) that does not exist.
 #
 # An issue of ANOTHER project may be named as "<project> issue #N" (e.g. "libnifalcon issue #27"):
 # the "#" keeps it out of the patterns below. This script itself is exempt, since it has to spell
@@ -30,6 +31,19 @@ fi
 if [[ -n "$hits" ]]; then
   echo "check-docs: cite the original source (docs/references.md), not a notes file or a work item:" >&2
   printf '%s\n' "$hits" >&2
+  exit 1
+fi
+
+# Every public header the README, the docs and the examples name must exist: a header that moved
+# (e.g. into its module's folder) leaves readers with an #include that does not compile.
+missing=""
+while IFS=: read -r file line header; do
+  [[ -f "include/$header" ]] || missing+="$file:$line: $header is not under include/"$'\n'
+done < <(grep -rnoE 'calligraphy/[a-z0-9_/]+\.hpp' README.md docs examples --include='*.md' --include='*.cpp' \
+           --include='*.py' || true)
+if [[ -n "$missing" ]]; then
+  echo "check-docs: the docs name public headers that do not exist:" >&2
+  printf '%s' "$missing" >&2
   exit 1
 fi
 echo "check-docs: ok"
