@@ -172,7 +172,7 @@ def main(argv):
     parser.add_argument("--every", type=int, default=1, help="keep every K-th character (default 1: all)")
     parser.add_argument("--limit", type=int, default=0, help="at most N characters (default: no limit)")
     parser.add_argument("--seeds", type=int, default=1, help="seeds per character and guidance (default 1)")
-    parser.add_argument("--writer", choices=("novice", "skilled"), default="novice")
+    parser.add_argument("--writer", choices=("novice", "skilled", "foreign"), default="novice")
     parser.add_argument("--workers", type=int, default=None, help="local processes (default: every core)")
     parser.add_argument("--scheduler", help="address of a Dask scheduler to run on instead (tcp://host:8786)")
     parser.add_argument("--out", default="corpus_sweep_out", help="folder for the table and the figure")
