@@ -192,9 +192,11 @@ void draw_panel(const WindowLayout& layout, double panel_width_px, const PanelIn
   ImGui::TextColored(state_colour(s.state), "%s", to_string(s.state));
   if (input.large_font != nullptr) ImGui::PopFont();
   ImGui::SameLine();
-  ImGui::TextColored(
-      state_colour(s.state), "%s",
-      view->quiz && s.state == InteractionState::calibration ? "in the character" : state_meaning(s.state));
+  // "Go to the red hint" is advice for a stroke still to write: none is left once every stroke is.
+  // The quiz shows no hint.
+  const bool without_advice = s.state == InteractionState::calibration && (view->quiz || s.finished);
+  ImGui::TextColored(state_colour(s.state), "%s",
+                     without_advice ? "in the character" : state_meaning(s.state));
   const std::uint32_t shown_stroke = s.finished ? s.strokes_total : s.stroke_index + 1;
   if (s.finished) {
     ImGui::Text("stroke %u / %u   every stroke written", shown_stroke, s.strokes_total);
