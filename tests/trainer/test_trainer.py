@@ -531,10 +531,37 @@ class SessionWindowTest(unittest.TestCase):
         self.assertIn("session resume", self.errors())
 
 
+# CTest runs the tests in these groups (tests/CMakeLists.txt), so that no one CTest test runs for minutes.
+# A test is in the first group whose pattern its id contains; a test in no group fails the run.
+GROUPS = {
+    "writing": ("test_simulated_writer", "test_the_real_pointer", "test_guidance_pulls"),
+    "quiz": ("quiz",),
+    "keeps_data": ("keeps_the_data", "test_record_then_replay", "test_each_run"),
+    "session": ("SessionWindowTest",),
+}
+
+
+def group_of(test_id):
+    return next((name for name, patterns in GROUPS.items() if any(p in test_id for p in patterns)), None)
+
+
+def selected_tests(group):
+    everything = unittest.defaultTestLoader.loadTestsFromModule(sys.modules[__name__])
+    tests = [t for suite in everything for t in suite]
+    orphans = [t.id() for t in tests if group_of(t.id()) is None]
+    if orphans:
+        sys.exit(f"tests in no group of GROUPS: {', '.join(orphans)}")
+    return unittest.TestSuite(t for t in tests if group is None or group_of(t.id()) == group)
+
+
 if __name__ == "__main__":
     try:
         xdotool("getdisplaygeometry")
     except (OSError, subprocess.CalledProcessError) as e:
         print(f"trainer tests skipped: no X server ({e})")
         sys.exit(77)
-    unittest.main(verbosity=2)
+    group = sys.argv[2] if len(sys.argv) == 3 and sys.argv[1] == "--group" else None
+    if group is not None and group not in GROUPS:
+        sys.exit(f"no group {group}: the groups are {', '.join(GROUPS)}")
+    result = unittest.TextTestRunner(verbosity=2).run(selected_tests(group))
+    sys.exit(0 if result.wasSuccessful() and result.testsRun > 0 else 1)
