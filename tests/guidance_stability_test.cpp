@@ -11,6 +11,7 @@
 
 #include "calligraphy/render/passivity.hpp"
 #include "hand_models.hpp"
+#include "test_sizing.hpp"
 #include "writer_test_harness.hpp"
 
 using namespace calligraphy;
@@ -156,11 +157,14 @@ HoldRun hold_in_writing(GuidanceMode mode, Hand hand, double rate_hz, double sti
 
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 constexpr double kHoldSeconds = 20.0;
-const std::u32string kTrialCharacters = U"永";
 #else
 constexpr double kHoldSeconds = 60.0;
-const std::u32string kTrialCharacters = U"永我乙";
 #endif
+const std::u32string kTrialCharacters = U"永我乙";
+// Guided trials per sanitizer run, drawn from the 27 of rate x character x mode (tests/test_sizing.hpp).
+constexpr std::size_t kSanitizedTrials = 3;
+// Held pens per sanitizer run, drawn from the 36 of rate x mode x hand x stiffness.
+constexpr std::size_t kSanitizedHolds = 12;
 constexpr double kGrowthTolerance_j = 5e-4;  // as tests/passivity_test.cpp
 constexpr double kBoundedEnergy_j = 0.01;
 constexpr double kDeviceDamping = 0.5;  // SimulatedDeviceParameters' default b [N s/m]
@@ -169,53 +173,70 @@ constexpr double kDeviceDamping = 0.5;  // SimulatedDeviceParameters' default b 
 
 TEST_CASE("Every guidance mode keeps the per-tick force change within the limit at 1, 4 and 10 kHz",
           "[guidance][smoothness]") {
+  struct Case {
+    double rate_hz;
+    char32_t character;
+    GuidanceMode mode;
+  };
+  std::vector<Case> cases;
   for (const double rate : {1000.0, 4000.0, 10000.0}) {
     for (const char32_t c : kTrialCharacters) {
-      const Scene scene = scene_of(c);
-      for (const GuidanceMode mode : {GuidanceMode::fixed, GuidanceMode::fading, GuidanceMode::replay}) {
-        WriterTrialOptions options;
-        options.seed = 1;
-        options.rate_hz = rate;
-        options.force = mode_parameters(mode, scene, rate);
-        options.safety.max_force_change_n_per_tick = 0.0;  // the smoothing alone
-        const WriterTrial trial = run_writer_trial(scene, options);
-        double max_step = 0.0;
-        bool finite = true;
-        for (std::size_t k = 0; k < trial.trace.size(); ++k) {
-          finite = finite && trial.trace[k].force_n.allFinite();
-          if (k > 0)
-            max_step = std::max(max_step, (trial.trace[k].force_n - trial.trace[k - 1].force_n).norm());
-        }
-        INFO(name(mode) << " mode, " << rate << " Hz, U+" << std::hex << static_cast<unsigned>(c) << std::dec
-                        << ": max per-tick change " << max_step << " N");
-        CHECK(trial.metrics.completed_in_order);
-        CHECK(finite);
-        CHECK(max_step <= SafetyChainParameters{}.max_force_change_n_per_tick);
-      }
+      for (const GuidanceMode mode : {GuidanceMode::fixed, GuidanceMode::fading, GuidanceMode::replay})
+        cases.push_back({rate, c, mode});
     }
+  }
+  for (const Case& trial_case :
+       sanitizer_subset(cases, kSanitizedTrials, "rate x character x guidance mode")) {
+    const Scene scene = scene_of(trial_case.character);
+    WriterTrialOptions options;
+    options.seed = 1;
+    options.rate_hz = trial_case.rate_hz;
+    options.force = mode_parameters(trial_case.mode, scene, trial_case.rate_hz);
+    options.safety.max_force_change_n_per_tick = 0.0;  // the smoothing alone
+    const WriterTrial trial = run_writer_trial(scene, options);
+    double max_step = 0.0;
+    bool finite = true;
+    for (std::size_t k = 0; k < trial.trace.size(); ++k) {
+      finite = finite && trial.trace[k].force_n.allFinite();
+      if (k > 0) max_step = std::max(max_step, (trial.trace[k].force_n - trial.trace[k - 1].force_n).norm());
+    }
+    INFO(name(trial_case.mode) << " mode, " << trial_case.rate_hz << " Hz, U+" << std::hex
+                               << static_cast<unsigned>(trial_case.character) << std::dec
+                               << ": max per-tick change " << max_step << " N");
+    CHECK(trial.metrics.completed_in_order);
+    CHECK(finite);
+    CHECK(max_step <= SafetyChainParameters{}.max_force_change_n_per_tick);
   }
 }
 
 TEST_CASE("Up to Colgate's bound a pen held in WS takes no growing energy in any guidance mode",
           "[guidance][passivity]") {
+  // Only held pens: without a hand (a 0.5 N weight, no grip) the pen does not stay in WS in any mode, the
+  // fixed one included: the fixture swings it across the stroke and it bounces off the paper
+  // (docs/force-rendering.md). The paper contact without a hand is tests/passivity_test.cpp's.
+  struct Case {
+    double rate_hz;
+    GuidanceMode mode;
+    Hand hand;
+    double share;  // of Colgate's bound
+  };
+  std::vector<Case> cases;
   for (const double rate : {1000.0, 4000.0, 10000.0}) {
-    const double bound = colgate_stiffness_bound(kDeviceDamping, rate);
     for (const GuidanceMode mode : {GuidanceMode::fixed, GuidanceMode::fading, GuidanceMode::replay}) {
-      // Only held pens: without a hand (a 0.5 N weight, no grip) the pen does not stay in WS in any
-      // mode, the fixed one included: the fixture swings it across the stroke and it bounces off the
-      // paper (docs/force-rendering.md). The paper contact without a hand is tests/passivity_test.cpp's.
       for (const Hand hand : {Hand::relaxed, Hand::stiff}) {
-        for (const double share : {0.5, 0.9}) {
-          const HoldRun run = hold_in_writing(mode, hand, rate, share * bound, kHoldSeconds);
-          INFO(name(mode) << " mode, hand " << static_cast<int>(hand) << ", " << rate
-                          << " Hz, g K = " << share * bound << " N/m: energy max " << run.max_energy_j
-                          << " J, first 10 s " << run.max_energy_first_j << " J, last 10 s "
-                          << run.max_energy_last_j << " J, max force " << run.max_force_n << " N");
-          CHECK(run.stayed_writing);
-          CHECK(run.max_energy_last_j <= std::max(run.max_energy_first_j, 0.0) + kGrowthTolerance_j);
-          CHECK(run.max_energy_j <= kBoundedEnergy_j);
-        }
+        for (const double share : {0.5, 0.9}) cases.push_back({rate, mode, hand, share});
       }
     }
+  }
+  for (const Case& hold : sanitizer_subset(cases, kSanitizedHolds, "rate x mode x hand x stiffness")) {
+    const double stiffness = hold.share * colgate_stiffness_bound(kDeviceDamping, hold.rate_hz);
+    const HoldRun run = hold_in_writing(hold.mode, hold.hand, hold.rate_hz, stiffness, kHoldSeconds);
+    INFO(name(hold.mode) << " mode, hand " << static_cast<int>(hold.hand) << ", " << hold.rate_hz
+                         << " Hz, g K = " << stiffness << " N/m: energy max " << run.max_energy_j
+                         << " J, first 10 s " << run.max_energy_first_j << " J, last 10 s "
+                         << run.max_energy_last_j << " J, max force " << run.max_force_n << " N");
+    CHECK(run.stayed_writing);
+    CHECK(run.max_energy_last_j <= std::max(run.max_energy_first_j, 0.0) + kGrowthTolerance_j);
+    CHECK(run.max_energy_j <= kBoundedEnergy_j);
   }
 }

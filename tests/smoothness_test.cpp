@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "calligraphy//model/character_library.hpp"
@@ -13,6 +14,7 @@
 #include "calligraphy/render/renderer.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
 #include "calligraphy/trial/trial.hpp"
+#include "test_sizing.hpp"
 
 using namespace calligraphy;
 
@@ -124,34 +126,30 @@ double corner_max_step(const ForceLawParameters& force) {
 
 }  // namespace
 
-// The sanitizer builds (Debug, about 100 times slower: 7 s per trial) write every other character
-// with one seed; the Release build writes all 20 with two seeds.
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-constexpr std::size_t kCharacterStride = 2;
-const std::vector<std::uint64_t> kSeeds = {1};
-#else
-constexpr std::size_t kCharacterStride = 1;
-const std::vector<std::uint64_t> kSeeds = {1, 2};
-#endif
+// 20 characters x 2 seeds in Release; under the sanitizers 6 of those 40 trials drawn at random
+// (tests/test_sizing.hpp).
+constexpr std::size_t kSanitizedTrials = 6;
 
 TEST_CASE("Through full guided trials on 20 characters the per-tick force change stays within the limit",
           "[smoothness][safety]") {
-  for (std::size_t i = 0; i < kCharacters.size(); i += kCharacterStride) {
-    const char32_t c = kCharacters[i];
-    for (const std::uint64_t seed : kSeeds) {
-      TrialOptions options = guided_novice(seed);
-      options.keep_trace = true;
-      const StepFigures chain = trial_steps(c, options);
-      options.safety.max_force_change_n_per_tick = 0.0;  // the smoothing alone, without the rate limit
-      const StepFigures smoothing = trial_steps(c, options);
-      INFO(utf8(c) << " seed " << seed << ": max per-tick change " << chain.max_step_n
-                   << " N with the chain, " << smoothing.max_step_n << " N without its rate limit");
-      CHECK(chain.completed);
-      CHECK(chain.all_finite);
-      CHECK(smoothing.all_finite);
-      CHECK(chain.max_step_n <= SafetyChainParameters{}.max_force_change_n_per_tick + 1e-9);
-      CHECK(smoothing.max_step_n <= SafetyChainParameters{}.max_force_change_n_per_tick);
-    }
+  std::vector<std::pair<char32_t, std::uint64_t>> trials;
+  for (const char32_t c : kCharacters) {
+    for (const std::uint64_t seed : {1u, 2u}) trials.emplace_back(c, seed);
+  }
+  for (const auto& [c, seed] :
+       calligraphy::testing::sanitizer_subset(trials, kSanitizedTrials, "character x seed")) {
+    TrialOptions options = guided_novice(seed);
+    options.keep_trace = true;
+    const StepFigures chain = trial_steps(c, options);
+    options.safety.max_force_change_n_per_tick = 0.0;  // the smoothing alone, without the rate limit
+    const StepFigures smoothing = trial_steps(c, options);
+    INFO(utf8(c) << " seed " << seed << ": max per-tick change " << chain.max_step_n << " N with the chain, "
+                 << smoothing.max_step_n << " N without its rate limit");
+    CHECK(chain.completed);
+    CHECK(chain.all_finite);
+    CHECK(smoothing.all_finite);
+    CHECK(chain.max_step_n <= SafetyChainParameters{}.max_force_change_n_per_tick + 1e-9);
+    CHECK(smoothing.max_step_n <= SafetyChainParameters{}.max_force_change_n_per_tick);
   }
 }
 

@@ -5,7 +5,10 @@
 // written in order. Only directions are asserted; the measured sizes are in docs/writer.md.
 #include <catch2/catch.hpp>
 #include <string>
+#include <utility>
+#include <vector>
 
+#include "test_sizing.hpp"
 #include "writer_test_harness.hpp"
 
 using namespace calligraphy;
@@ -64,26 +67,38 @@ TEST_CASE("Guidance lowers a novice's deviation and writing time on held-out cha
   }
 }
 
-TEST_CASE("The foreign writer errs in order and direction without guidance, and writes in order with it",
-          "[writer]") {
+// Two test cases, so that CTest runs them side by side. Without guidance every pair runs in every build:
+// about half the foreign writer's trials of one character have no order error and two thirds no backwards
+// stroke (measured on the 58 embedded characters x 2 seeds), so a smaller sample could miss both by chance.
+TEST_CASE("The foreign writer errs in order and direction without guidance", "[writer]") {
   std::size_t order_errors = 0;
   std::size_t backwards = 0;
   for (const char32_t c : held_out()) {
     const Scene scene = scene_of(c);
     for (const std::uint64_t seed : {1u, 2u}) {
-      WriterTrialOptions on;
-      on.writer = WriterProfile::foreign();
-      on.seed = seed;
-      WriterTrialOptions off = on;
+      WriterTrialOptions off;
+      off.writer = WriterProfile::foreign();
+      off.seed = seed;
       off.force.guidance = false;
       const Outcome without = outcome(scene, off);
-      const Outcome with = outcome(scene, on);
-      INFO("U+" << std::hex << static_cast<unsigned>(c) << std::dec << " seed " << seed);
-      CHECK(with.in_order);
       order_errors += without.order_errors;
       backwards += without.backwards;
     }
   }
   CHECK(order_errors > 0);
   CHECK(backwards > 0);
+}
+
+TEST_CASE("The foreign writer writes in order with guidance", "[writer]") {
+  std::vector<std::pair<char32_t, std::uint64_t>> pairs;
+  for (const char32_t c : held_out()) {
+    for (const std::uint64_t seed : {1u, 2u}) pairs.emplace_back(c, seed);
+  }
+  for (const auto& [c, seed] : sanitizer_subset(pairs, 4, "character x seed")) {
+    WriterTrialOptions on;
+    on.writer = WriterProfile::foreign();
+    on.seed = seed;
+    INFO("U+" << std::hex << static_cast<unsigned>(c) << std::dec << " seed " << seed);
+    CHECK(outcome(scene_of(c), on).in_order);
+  }
 }
