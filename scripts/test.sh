@@ -3,42 +3,101 @@
 # pytest suites through CTest, then again under AddressSanitizer + UndefinedBehaviorSanitizer, then the
 # servo-loop tests under ThreadSanitizer, then builds the fuzzers and replays their inputs, then
 # installs the library and builds a separate project against it with find_package(calligraphy).
+# Each stage builds only what it tests; at the end the script prints each stage's time, and after each
+# CTest run its ten slowest tests (docs/testing.md: the time budget and how to run the long sweeps).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install-deps.sh
 jobs=$(nproc)
+# A hang fails with the test's name instead of eating the run: no test needs more than a minute here.
+test_timeout_s=300
 
-echo "== Layering and docs checks"
+stage_names=()
+stage_seconds=()
+stage_name=""
+stage_start=0
+script_start=$(date +%s)
+begin_stage() {
+  stage_name=$1
+  stage_start=$(date +%s)
+  echo "== $1"
+}
+end_stage() {
+  stage_names+=("$stage_name")
+  stage_seconds+=($(($(date +%s) - stage_start)))
+}
+print_stage_times() {
+  local status=$?
+  [ "${#stage_names[@]}" -gt 0 ] || return "$status"
+  echo "== time per stage"
+  local i
+  for i in "${!stage_names[@]}"; do
+    printf '%6d s  %s\n' "${stage_seconds[$i]}" "${stage_names[$i]}"
+  done
+  [ "$status" -eq 0 ] || printf '%6d s  %s (failed)\n' $(($(date +%s) - stage_start)) "$stage_name"
+  printf '%6d s  in all\n' $(($(date +%s) - script_start))
+  return "$status"
+}
+trap print_stage_times EXIT
+
+# ctest in DIR with the given arguments; its output also goes to DIR/ctest-output.log, from which the ten
+# slowest tests are printed whether the run passed or failed.
+run_ctest() {
+  local dir=$1
+  shift
+  local status=0
+  ctest --test-dir "$dir" --output-on-failure -j "$jobs" --timeout "$test_timeout_s" "$@" 2>&1 |
+    tee "$dir/ctest-output.log" || status=$?
+  echo "-- ten slowest tests of this stage (s):"
+  sed -nE 's/^ *[0-9]+\/[0-9]+ Test +#[0-9]+: (.*[^.]) \.+ *[^.]+ +([0-9.]+) sec$/\2  \1/p' \
+    "$dir/ctest-output.log" | sort -rn | head -n 10
+  return "$status"
+}
+
+begin_stage "Dependencies"
+bash scripts/install-deps.sh
+end_stage
+
+begin_stage "Layering and docs checks"
 python3 scripts/check-layering.py .
 bash scripts/check-docs.sh
+end_stage
 
-echo "== Release build, warnings as errors"
+begin_stage "Release build, warnings as errors"
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON \
   -DCALLIGRAPHY_BUILD_PYTHON=ON -DCALLIGRAPHY_BUILD_TESTS=ON >/dev/null
 cmake --build build -j "$jobs"
-ctest --test-dir build --output-on-failure -j "$jobs"
+end_stage
+begin_stage "Release tests"
+run_ctest build
+end_stage
 
-echo "== AddressSanitizer + UndefinedBehaviorSanitizer"
-# The trainer's window (Mesa, X11) and the report in Chromium are left to the Release stage: under our
-# sanitizers they test other programs' code, and they are the slowest tests at -O0. (-O1 would be faster,
-# but GCC 12 then warns maybe-uninitialized inside std::function in Catch2's main.)
-cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug \
+begin_stage "AddressSanitizer + UndefinedBehaviorSanitizer: build"
+# At -O1 (-O0 made the sweeps 2-3 times slower), with line tables only (-g1: enough for the sanitizers'
+# stack traces, which name functions, files and lines; less to write and link than -g). The trainer's window (Mesa, X11), the Python module (the
+# interpreter is not instrumented) and the benchmarks are left to the Release stage: here they would test
+# other programs' code or nothing of their own. The sweeps run on random subsets sized
+# for the sanitizer (tests/test_sizing.hpp prints the seed).
+cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" \
   -DCALLIGRAPHY_SANITIZE=address,undefined -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_BENCH=OFF \
   -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_TRAINER=OFF >/dev/null
 cmake --build build-asan -j "$jobs"
-ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 ctest --test-dir build-asan --output-on-failure \
-  -j "$jobs" -E "study_report_chromium"
+end_stage
+begin_stage "AddressSanitizer + UndefinedBehaviorSanitizer: tests"
+ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 run_ctest build-asan -E "study_report_chromium"
+end_stage
 
-echo "== ThreadSanitizer: the servo loop and its log queue"
+begin_stage "ThreadSanitizer: the servo loop and its log queue"
 # -Wno-tsan: GCC warns that TSan does not model atomic_thread_fence (the OpenHaptics seqlock uses it);
-# those tests are not run here.
-cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCALLIGRAPHY_SANITIZE=thread \
+# those tests are not run here. Only the servo-loop test program and the modules it links are built, at -O1.
+cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
+  -DCALLIGRAPHY_SANITIZE=thread \
   -DCMAKE_CXX_FLAGS=-Wno-tsan -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_TOOLS=OFF \
   -DCALLIGRAPHY_BUILD_BENCH=OFF -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_EXAMPLES=OFF >/dev/null
-cmake --build build-tsan -j "$jobs" --target calligraphy_tests
-TSAN_OPTIONS=halt_on_error=1 build-tsan/bin/calligraphy_tests "[servo],[log_queue]"
+cmake --build build-tsan -j "$jobs" --target calligraphy_servo_tests
+TSAN_OPTIONS=halt_on_error=1 build-tsan/bin/calligraphy_servo_tests "[servo],[log_queue]"
+end_stage
 
-echo "== Fuzzers (clang, libFuzzer): build, and replay their seeds and every input that ever failed"
+begin_stage "Fuzzers (clang, libFuzzer): build, and replay their seeds and every input that ever failed"
 # A replay, not a fuzzing run (docs/corpus.md has those): it keeps the fuzz targets building as sources
 # move, and every seed and regression input passing.
 cmake -S . -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCALLIGRAPHY_BUILD_FUZZERS=ON \
@@ -47,11 +106,13 @@ cmake -S . -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCALLIGRAPHY_BUI
 cmake --build build-fuzz -j "$jobs" --target character_data_fuzzer corpus_store_fuzzer
 build-fuzz/bin/character_data_fuzzer -runs=0 data/hanzi-writer-data tests/data/hostile
 build-fuzz/bin/corpus_store_fuzzer -runs=0 fuzz/seeds tests/data/store_regressions
+end_stage
 
-echo "== install + find_package(calligraphy) from another project"
+begin_stage "install + find_package(calligraphy) from another project"
 rm -rf build/stage build/consumer
 cmake --install build --prefix build/stage >/dev/null
 cmake -S tests/consumer -B build/consumer -G Ninja -DCMAKE_PREFIX_PATH="$PWD/build/stage" >/dev/null
 cmake --build build/consumer
 build/consumer/consumer
+end_stage
 echo "== all tests passed"
