@@ -9,8 +9,11 @@
 set(CALLIGRAPHY_INSTALLED_MODULES "" CACHE INTERNAL "")
 
 # calligraphy_precompile(TARGET [header...]): precompiles Eigen, the standard headers most files include
-# and the given third-party headers for TARGET. Eigen, CLI11, Catch2 and nlohmann-json are header-only and
-# parsed again by every file that includes them: most of a clean build's time before this (docs/testing.md).
+# and the given third-party headers for TARGET. CLI11, Catch2, pybind11 and nlohmann-json are header-only
+# and were parsed again by every file of the CLI, the tests and the Python module (docs/testing.md). Not
+# used for the library's modules: there GCC 12 at -O3 with a precompiled header gave a false
+# -Warray-bounds inside std::string (src/devices/phantom/phantom_backends.cpp), and their files include
+# little beyond Eigen.
 function(calligraphy_precompile target)
   target_precompile_headers(${target} PRIVATE <Eigen/Core> <algorithm> <cmath> <string> <vector> ${ARGN})
 endfunction()
@@ -38,7 +41,6 @@ function(calligraphy_module name)
     target_link_libraries(${target} PUBLIC calligraphy_${dependency})
   endforeach()
   target_link_libraries(${target} PRIVATE $<BUILD_INTERFACE:calligraphy_warnings>)
-  calligraphy_precompile(${target})
   target_compile_features(${target} PUBLIC cxx_std_20)
   set_target_properties(${target} PROPERTIES EXPORT_NAME ${name})
   if(NOT module_NOT_INSTALLED)
