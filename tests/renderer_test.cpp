@@ -1,6 +1,8 @@
 #include "calligraphy/render/renderer.hpp"
 
+#include <algorithm>
 #include <catch2/catch.hpp>
+#include <cmath>
 
 #include "calligraphy/sim/simulated_device.hpp"
 
@@ -45,6 +47,16 @@ ForceLawParameters unsmoothed() {
   return p;
 }
 
+// The pen moved from `from` to `to` (data units) in steps of one data unit (0.06 mm), one tick each, as a
+// hand moves it: progress along a stroke is credited only for continuous forward motion.
+RenderOutput glide(Renderer& r, const Scene& scene, const Vec2& from, const Vec2& to, double z) {
+  const int steps = std::max(1, static_cast<int>(std::ceil((to - from).norm())));
+  RenderOutput out;
+  for (int i = 1; i <= steps; ++i)
+    out = r.tick(at(scene, from + (to - from) * (static_cast<double>(i) / steps), z));
+  return out;
+}
+
 RendererOptions no_ramp_no_rate_limit() {
   RendererOptions o;
   o.safety.start_ramp_n_per_s = 0.0;
@@ -77,6 +89,7 @@ TEST_CASE("Renderer: states, plane popping, completion and per-state forces", "[
   CHECK(out.state == InteractionState::writing);
   CHECK(out.element == 0);
   // Off the stroke by 40 data units (2.34 mm): attraction back towards it, in -y.
+  glide(r, scene, {210, 600}, {490, 640}, below);
   out = r.tick(at(scene, {500, 640}, below));
   CHECK(out.in_constraint_space);
   const double offset_m = 40 * 0.06 / 1024;
@@ -84,36 +97,67 @@ TEST_CASE("Renderer: states, plane popping, completion and per-state forces", "[
   CHECK(out.force_n.y() == Approx(-400.0 * 1.5 * offset_m).epsilon(1e-9));
   CHECK(out.force_n.x() == Approx(0.0).margin(1e-12));
   // Moving backwards along the element: resistance pushes forward (+x).
+  glide(r, scene, {500, 640}, {510, 600}, below);
   out = r.tick(at(scene, {500, 600}, below, Vec2(-0.02, 0.0)));
   CHECK(out.force_n.x() == Approx(15.0 * 0.02));
-  // Crossing the feature plane at x = 800 pops to the vertical element.
-  out = r.tick(at(scene, {805, 590}, below));
+  // Going round the corner at (800, 600), cutting it 10 units inside, pops to the vertical element: the
+  // pen never crosses the feature plane x = 800.
+  glide(r, scene, {500, 600}, {780, 600}, below);
+  out = glide(r, scene, {780, 600}, {790, 560}, below);
   CHECK(out.element == 1);
   CHECK(out.stroke == 0);
-  // Lifting mid-stroke abandons it: the feature points are reloaded.
-  out = r.tick(at(scene, {805, 400}, 0.01));
+  // Lifting mid-stroke abandons it as too short: the feature points are reloaded.
+  glide(r, scene, {790, 560}, {795, 400}, below);
+  out = r.tick(at(scene, {795, 400}, 0.01));
   CHECK(out.state == InteractionState::separation);
   CHECK(out.stroke_abandoned);
+  CHECK(out.refusal == StrokeRefusal::too_short);
   CHECK(r.active().element_index() == 0);
   CHECK(r.active().stroke_index() == 0);
-  // Write it again, all the way through the last plane: the stroke completes, the next is active.
+  // Write it again and lift 30 units (1.8 mm) short of the end: the stroke completes at the lift.
   r.tick(at(scene, {200, 600}, below));
-  r.tick(at(scene, {810, 600}, below));
-  out = r.tick(at(scene, {800, 90}, below));
+  glide(r, scene, {200, 600}, {800, 600}, below);
+  out = glide(r, scene, {800, 600}, {800, 130}, below);
+  CHECK(out.state == InteractionState::writing);
+  CHECK_FALSE(out.stroke_completed);
+  out = r.tick(at(scene, {800, 130}, 0.01));
   CHECK(out.stroke_completed);
-  CHECK(out.state == InteractionState::calibration);
+  CHECK_FALSE(out.stroke_abandoned);
+  CHECK(out.state == InteractionState::separation);
   CHECK(out.stroke == 1);
   CHECK(r.active().strokes_written() == 1);
   // The written stroke is not written again: touching its start now is plain CS.
-  out = r.tick(at(scene, {200, 600}, 0.01));
   out = r.tick(at(scene, {200, 600}, below));
   CHECK(out.state == InteractionState::calibration);
-  // The next stroke starts at its own neighbourhood.
+  // The next stroke starts at its own neighbourhood; carried 20 units past its end the pen is left alone
+  // (no in-plane guidance back to the end), and the lift writes it.
+  out = r.tick(at(scene, {200, 300}, 0.01));
   out = r.tick(at(scene, {200, 300}, below));
   CHECK(out.state == InteractionState::writing);
-  out = r.tick(at(scene, {720, 300}, below));
+  out = glide(r, scene, {200, 300}, {720, 300}, below);
+  CHECK(out.state == InteractionState::writing);
+  CHECK_FALSE(out.in_constraint_space);
+  CHECK(out.force_n.head<2>().isZero());
+  out = r.tick(at(scene, {720, 300}, 0.01));
   CHECK(out.stroke_completed);
   CHECK(out.finished);
+}
+
+TEST_CASE("Renderer: a pen that passes the end and leaves the end neighbourhood loses the stroke",
+          "[renderer]") {
+  const Scene scene = two_stroke_scene();
+  Renderer r(scene, unsmoothed(), simulated_phantom_desktop_info(), no_ramp_no_rate_limit());
+  const double below = -0.001;
+  r.tick(at(scene, {200, 600}, below));
+  glide(r, scene, {200, 600}, {800, 600}, below);
+  glide(r, scene, {800, 600}, {800, 100}, below);
+  // On into the next stroke's region without lifting: 10 mm from the end.
+  glide(r, scene, {800, 100}, {630, 100}, below);
+  const RenderOutput out = r.tick(at(scene, {630, 100}, 0.01));
+  CHECK(out.stroke_abandoned);
+  CHECK_FALSE(out.stroke_completed);
+  CHECK(out.refusal == StrokeRefusal::wrong_stroke);
+  CHECK(r.active().strokes_written() == 0);
 }
 
 TEST_CASE("Renderer: non-finite input gives zero force, never NaN", "[renderer]") {

@@ -72,7 +72,6 @@ ForceLawParameters unsmoothed() {
   p.constraint_taper_m = 0.0;
   p.crossfade_s = 0.0;
   p.paper_fade_s = 0.0;
-  p.feature_plane_margin_m = 0.0;
   p.max_foot_speed_m_s = 1e6;
   p.friction_coefficient = 0.0;
   return p;

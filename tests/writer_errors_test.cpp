@@ -87,7 +87,11 @@ TEST_CASE("Strokes written backwards stay backwards without guidance and are ref
 
 TEST_CASE("A stroke cleared after a lift in its middle is written again, with or without guidance",
           "[writer]") {
-  const Scene scene = scene_of(U'十');
+  // 人: every element is 20 mm or longer, so a lift at 30-70 % of one is outside the start neighbourhood
+  // and more than the allowed shortfall from the end. (On 十, whose strokes begin with a 4 mm entry
+  // element, the pen touching down again inside the start neighbourhood starts a new attempt that writes
+  // the whole stroke, as it should.)
+  const Scene scene = scene_of(U'人');
   for (const bool guidance : {false, true}) {
     WriterTrialOptions options;
     options.writer = careful_novice();

@@ -7,6 +7,7 @@
 
 #include "bindings.hpp"
 #include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/collision/stroke_progress.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "model_bindings.hpp"
 #include "numpy_arrays.hpp"
@@ -95,6 +96,30 @@ void bind_collision(py::module_& m) {
       .field("newton_starts", &NearestPointOptions::newton_starts, "'newton' only: starts, 1..1000")
       .field("newton_iterations", &NearestPointOptions::newton_iterations,
              "'newton' only: iterations per start, 1..1000")
+      .finish();
+
+  ParameterClass<StrokeAcceptance>(
+      m, "StrokeAcceptance",
+      "When a stroke counts as written: progress along its centre line (the data's median) within a "
+      "corridor, with a bounded mean distance, far enough along it. Lengths in m; defaults for a "
+      "60 mm character from people's distances to hanzi-writer-data's medians (docs/stroke-acceptance.md).",
+      [](const StrokeAcceptance& a) { a.validate(); })
+      .field("corridor_m", &StrokeAcceptance::corridor_m,
+             "farthest from the centre line that makes progress [m]")
+      .field("mean_deviation_m", &StrokeAcceptance::mean_deviation_m,
+             "largest mean distance from the centre line over the pen's path [m]")
+      .field("shortfall_m", &StrokeAcceptance::shortfall_m,
+             "how much shorter than the stroke the pen's way along it may be [m]")
+      .field("shortfall_fraction", &StrokeAcceptance::shortfall_fraction,
+             "the same as a fraction of the stroke's length, in (0, 1); the smaller applies")
+      .field("displacement_m", &StrokeAcceptance::displacement_m,
+             "how far a copy may be displaced along the stroke [m]")
+      .field("max_gain_ratio", &StrokeAcceptance::max_gain_ratio,
+             "most arc credited per length of pen motion, >= 1")
+      .field("follow_through_m", &StrokeAcceptance::follow_through_m,
+             "radius of the end neighbourhood a pen past the end may move in before it lifts [m]")
+      .field("lookahead_m", &StrokeAcceptance::lookahead_m,
+             "how far along the line the foot point is looked for around the progress [m]")
       .finish();
 
   m.def("nearest_point", &nearest_point_py, py::arg("element"), py::arg("point"),

@@ -116,8 +116,8 @@ void bind_force_law_parameters(py::module_& m) {
              "cross-fade time of the in-plane force when the active element or state changes [s]; 0 = off")
       .field("paper_fade_s", &ForceLawParameters::paper_fade_s,
              "fade time of the paper force when it starts or stops pushing (AS <-> CS) [s]; 0 = off")
-      .field("feature_plane_margin_m", &ForceLawParameters::feature_plane_margin_m,
-             "hysteresis of the feature planes (eq. 6) [m]")
+      .field("acceptance", &ForceLawParameters::acceptance,
+             "StrokeAcceptance: when a corner counts as gone round and a stroke as written")
       .field("paper_damping_n_s_per_m", &ForceLawParameters::paper_damping_n_s_per_m,
              "damping of the paper on inward motion only [N s/m]; 0 = off")
       .field("max_foot_speed_m_s", &ForceLawParameters::max_foot_speed_m_s,

@@ -13,7 +13,7 @@ void add_model_command(CLI::App& root, Commands& commands);     // model CHAR [.
 void add_strokes_command(CLI::App& root, Commands& commands);   // strokes [--markdown FILE] [--json]
 void add_devices_command(CLI::App& root, Commands& commands);   // devices [--json]
 void add_corpus_commands(CLI::App& root, Commands& commands);   // corpus build|stats|fidelity|validate
-void add_bench_commands(CLI::App& root, Commands& commands);    // bench nearest|jumps|tick|loop
+void add_bench_commands(CLI::App& root, Commands& commands);    // bench nearest|jumps|tick|loop|acceptance
 void add_session_commands(CLI::App& root, Commands& commands);  // session run|resume
 void add_report_command(CLI::App& root, Commands& commands);    // report DIR... --out FILE
 
@@ -26,5 +26,6 @@ void add_bench_nearest_command(CLI::App& bench, Commands& commands);
 void add_bench_jumps_command(CLI::App& bench, Commands& commands);
 void add_bench_tick_command(CLI::App& bench, Commands& commands);
 void add_bench_loop_command(CLI::App& bench, Commands& commands);
+void add_bench_acceptance_command(CLI::App& bench, Commands& commands);
 
 }  // namespace calligraphy::cli

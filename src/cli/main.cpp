@@ -48,6 +48,7 @@ void add_bench_commands(CLI::App& root, Commands& commands) {
   add_bench_jumps_command(*bench, commands);
   add_bench_tick_command(*bench, commands);
   add_bench_loop_command(*bench, commands);
+  add_bench_acceptance_command(*bench, commands);
 }
 
 }  // namespace calligraphy::cli

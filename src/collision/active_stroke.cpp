@@ -4,13 +4,18 @@
 
 namespace calligraphy {
 
-ActiveStroke::ActiveStroke(const Scene& scene) noexcept : scene_(&scene) { reset(); }
+ActiveStroke::ActiveStroke(const Scene& scene, const StrokeAcceptance& acceptance) noexcept
+    : scene_(&scene), acceptance_(acceptance) {
+  reset();
+}
 
 void ActiveStroke::reset() noexcept {
   character_ = 0;
   stroke_ = 0;
   element_ = 0;
   written_ = 0;
+  attempt_ = StrokeProgressTracker{};
+  attempt_open_ = false;
   // Skip characters without strokes so that the active stroke always exists until finished.
   while (character_ < scene_->characters.size() && scene_->characters[character_].strokes.empty())
     ++character_;
@@ -26,23 +31,46 @@ void ActiveStroke::next_stroke() noexcept {
   }
 }
 
-StrokeProgress ActiveStroke::advance(const Vec2& tip_m, double plane_margin_m) noexcept {
-  StrokeProgress progress;
-  const PlacedStroke* s = stroke();
-  if (s == nullptr) return progress;
-  while (element_ < s->elements.size() &&
-         feature_plane_passed(s->elements[element_], tip_m, plane_margin_m)) {
-    ++element_;
-    ++progress.planes_passed;
+void ActiveStroke::begin(const Vec2& tip_m) noexcept {
+  if (const PlacedStroke* s = stroke()) {
+    attempt_.begin(*s, tip_m, acceptance_);
+    attempt_open_ = true;
   }
-  if (element_ >= s->elements.size()) {
+}
+
+StrokeProgress ActiveStroke::advance(const Vec2& tip_m) noexcept {
+  StrokeProgress progress;
+  if (stroke() == nullptr || !attempt_.in_attempt()) return progress;
+  const bool completed = attempt_.update(tip_m);
+  const std::size_t element = attempt_.element_index();
+  if (element > element_) {
+    progress.elements_passed = static_cast<int>(element - element_);
+    element_ = element;
+  }
+  if (completed) {
     progress.stroke_completed = true;
+    attempt_open_ = false;
     next_stroke();
+  } else if (!attempt_.in_attempt()) {
+    element_ = 0;  // the pen left the stroke's end across it: nothing of this attempt counts
   }
   return progress;
 }
 
-void ActiveStroke::reload() noexcept { element_ = 0; }
+StrokeProgress ActiveStroke::lift() noexcept {
+  StrokeProgress progress;
+  if (stroke() == nullptr || !attempt_open_) return progress;
+  attempt_open_ = false;
+  progress.refusal = attempt_.refusal();
+  if (attempt_.lift()) {
+    progress.stroke_completed = true;
+    progress.refusal = StrokeRefusal::none;
+    next_stroke();
+  } else {
+    element_ = 0;  // the stroke's feature points are loaded again (section 4.3.3)
+  }
+  return progress;
+}
 
 const PlacedCharacter* ActiveStroke::character() const noexcept {
   return finished() ? nullptr : &scene_->characters[character_];

@@ -51,6 +51,7 @@ Scene Scene::lay_out(const std::vector<Character>& characters, const SceneLayout
         ps.elements.push_back(e);
       }
       for (const Vec2& p : stroke.median) ps.median_m.push_back(placed.placement.to_paper(p));
+      ps.centre_line = StrokeCentreLine::of(ps.median_m, ps.elements);
       placed.strokes.push_back(std::move(ps));
     }
     placed.bounding_box.min().array() -= layout.box_margin_m;

@@ -23,7 +23,7 @@ void ForceLawParameters::validate() const {
   check(constraint_taper_m, "constraint_taper_m", false);
   check(crossfade_s, "crossfade_s", false);
   check(paper_fade_s, "paper_fade_s", false);
-  check(feature_plane_margin_m, "feature_plane_margin_m", false);
+  acceptance.validate();
   check(paper_damping_n_s_per_m, "paper_damping_n_s_per_m", false);
   check(max_foot_speed_m_s, "max_foot_speed_m_s", true);
   check(friction_coefficient, "friction_coefficient", false);

@@ -57,7 +57,7 @@ Renderer::Renderer(const Scene& scene, const ForceLawParameters& parameters, con
       parameters_(parameters),
       options_(checked(options)),
       period_s_(1.0 / options.rate_hz),
-      active_(scene),
+      active_(scene, parameters.acceptance),
       chain_(chain_parameters(options, checked(device)), options.rate_hz),
       passivity_(options.passivity, options.rate_hz) {
   parameters_.validate();
@@ -124,7 +124,9 @@ Vec2 Renderer::guidance_force(const DeviceState& device, RenderOutput& out, bool
   const NearestPoint nearest = element.degree == 1
                                    ? nearest_point_on_segment(element.start(), element.end(), tip)
                                    : tracker_.update(element, tip);
-  const ElementContact contact = element_contact_at(element, tip, nearest, parameters_.constraint_radius_m);
+  ElementContact contact = element_contact_at(element, tip, nearest, parameters_.constraint_radius_m);
+  // Past the end of a written stroke there is nothing to pull the pen back to (it completes at the lift).
+  if (active_.attempt().passed_end()) contact.inside = false;
   out.in_constraint_space = contact.inside;
   out.foot_m = nearest.foot;
   // Foot-point jumps (a new element, a jump of the tracker to another minimum) move the attraction
@@ -189,11 +191,16 @@ RenderOutput Renderer::tick(const DeviceState& device) noexcept {
   }
   InteractionState next = next_state(state_, inputs);
   if (state_ == InteractionState::writing && next == InteractionState::separation) {
-    active_.reload();  // lifting in WS abandons the stroke (section 4.3.3)
-    out.stroke_abandoned = true;
+    // Lifting in WS ends the attempt: written when it reached the end neighbourhood, else abandoned and
+    // the stroke's feature points reloaded (section 4.3.3).
+    const StrokeProgress lifted = active_.lift();
+    out.stroke_completed = lifted.stroke_completed;
+    out.stroke_abandoned = !lifted.stroke_completed;
+    out.refusal = lifted.refusal;
   }
   if (next == InteractionState::writing) {
-    if (active_.advance(tip, parameters_.feature_plane_margin_m).stroke_completed) {
+    if (state_ != InteractionState::writing) active_.begin(tip);
+    if (active_.advance(tip).stroke_completed) {
       out.stroke_completed = true;
       next = InteractionState::calibration;  // written; the next stroke starts at its own neighbourhood
     }
@@ -235,7 +242,7 @@ RenderOutput Renderer::tick(const DeviceState& device) noexcept {
   // from the active start in another direction), never against coming back to it.
   off_stroke_velocity_ += off_stroke_alpha_ * (device.velocity_m_s.head<2>() - off_stroke_velocity_);
   const bool off_in_calibration = state_ == InteractionState::calibration;
-  const bool off_in_writing = writing && !out.in_constraint_space;
+  const bool off_in_writing = writing && !out.in_constraint_space && !active_.attempt().passed_end();
   if (!off_in_calibration) anchor_valid_ = false;
   if (parameters_.guidance && off_in_calibration) {
     if (!anchor_valid_) off_stroke_anchor_ = tip;  // adheres where CS was entered

@@ -10,18 +10,6 @@
 #include "calligraphy/render/interaction_state.hpp"
 
 namespace calligraphy {
-namespace {
-
-// Elements of stroke `scene_stroke` (counted over the scene).
-std::size_t scene_element_count(const Scene& scene, std::size_t scene_stroke) {
-  for (const PlacedCharacter& c : scene.characters) {
-    if (scene_stroke < c.strokes.size()) return c.strokes[scene_stroke].elements.size();
-    scene_stroke -= c.strokes.size();
-  }
-  return 0;
-}
-
-}  // namespace
 
 TeacherReplay::TeacherReplay(const Scene& scene, std::span<const TeacherSample> samples,
                              const ForceLawParameters& force) {
@@ -35,10 +23,11 @@ TeacherReplay::TeacherReplay(const Scene& scene, std::span<const TeacherSample> 
     positions_m_.push_back(s.position_m.head<2>());
   }
   // Read the recording as the renderer reads a live pen: the window of a stroke opens when WS is entered
-  // and closes when its last feature plane is passed; a lift in WS reopens it at the next entry.
+  // and closes when the stroke is written (its end passed, or a lift near it); a lift short of it reopens
+  // the window at the next entry.
   const std::size_t strokes = scene.stroke_count();
   std::vector<Window> windows(strokes);
-  ActiveStroke active(scene);
+  ActiveStroke active(scene, force.acceptance);
   InteractionState state = InteractionState::separation;
   double entered_s = samples.front().time_s;
   const double paper_z = scene.layout.paper_z_m;
@@ -53,14 +42,28 @@ TeacherReplay::TeacherReplay(const Scene& scene, std::span<const TeacherSample> 
     inputs.inside_box = active.character()->bounding_box.contains(tip);
     inputs.in_start_neighbourhood = (tip - active.stroke()->start()).norm() <= scene.layout.start_radius_m;
     InteractionState next = next_state(state, inputs);
-    if (state == InteractionState::writing && next == InteractionState::separation) active.reload();
-    if (next == InteractionState::writing && state != InteractionState::writing) entered_s = s.time_s;
+    if (state == InteractionState::writing && next == InteractionState::separation) {
+      const std::size_t index = active.strokes_written();
+      if (active.lift().stroke_completed) {
+        windows[index] = Window{entered_s, s.time_s};
+        // The lift sample closes the window: the teacher is where it last wrote.
+        if (i > 0) {
+          elements_[i] = elements_[i - 1];
+          parameters_[i] = parameters_[i - 1];
+        }
+      }
+    }
+    if (next == InteractionState::writing && state != InteractionState::writing) {
+      entered_s = s.time_s;
+      active.begin(tip);
+    }
     if (next == InteractionState::writing) {
       const std::size_t index = active.strokes_written();
-      if (active.advance(tip, force.feature_plane_margin_m).stroke_completed) {
+      const std::size_t last_element = active.stroke()->elements.size() - 1;
+      if (active.advance(tip).stroke_completed) {
         windows[index] = Window{entered_s, s.time_s};
         next = InteractionState::calibration;
-        elements_[i] = scene_element_count(scene, index) - 1;
+        elements_[i] = last_element;
         parameters_[i] = 1.0;
       } else {
         elements_[i] = active.element_index();

@@ -2,33 +2,41 @@
 /// \file active_stroke.hpp
 /// The active character, active stroke and the feature-point stack of the active stroke (paper
 /// sections 2.2 step 4, 4.3 and 6). Strokes are written in order; a written stroke is never active
-/// again, so it cannot be written twice, and every character but the active one is masked.
-/// Servo path: no allocation, noexcept.
+/// again, so it cannot be written twice, and every character but the active one is masked. The active
+/// element and the stroke's completion follow the pen's progress along the stroke
+/// (stroke_progress.hpp), not the feature planes alone. Servo path: no allocation, noexcept.
 #include <cstddef>
 
+#include "calligraphy/collision/stroke_progress.hpp"
 #include "calligraphy/model/scene.hpp"
 
 namespace calligraphy {
 
-/// What `ActiveStroke::advance` did this tick.
+/// What `ActiveStroke::advance` or `lift` did this tick.
 struct StrokeProgress {
-  int planes_passed = 0;          ///< feature planes popped this tick
-  bool stroke_completed = false;  ///< the last plane of the stroke popped; the next stroke is now active
+  int elements_passed = 0;                      ///< corners (feature points) the pen went round this tick
+  bool stroke_completed = false;                ///< the stroke is written; the next stroke is now active
+  StrokeRefusal refusal = StrokeRefusal::none;  ///< `lift` of a stroke not written: why
 };
 
 class ActiveStroke {
  public:
-  /// Starts at the first stroke of the first character. `scene` must outlive this object.
-  explicit ActiveStroke(const Scene& scene) noexcept;
+  /// Starts at the first stroke of the first character. `scene` must outlive this object;
+  /// `acceptance` must be valid (StrokeAcceptance::validate).
+  explicit ActiveStroke(const Scene& scene, const StrokeAcceptance& acceptance = {}) noexcept;
 
   /// Back to the first stroke, nothing written.
   void reset() noexcept;
-  /// Pops every feature plane the tip has crossed (eq. 6), possibly several in one tick, and
-  /// completes the stroke when its last plane pops. Tip on the paper plane [m]; `plane_margin_m` is
-  /// the feature-plane hysteresis of `feature_plane_passed` [m].
-  StrokeProgress advance(const Vec2& tip_m, double plane_margin_m = 0.0) noexcept;
-  /// Pen lifted in WS: the active stroke's feature points are loaded again (section 4.3.3).
-  void reload() noexcept;
+  /// The pen entered WS at `tip_m` [m]: an attempt at the active stroke begins.
+  void begin(const Vec2& tip_m) noexcept;
+  /// The pen at `tip_m` [m] in WS: pops the feature points it has gone round (the elements whose arc
+  /// its progress passed, possibly several in one tick); completes the stroke when a pen that passed the
+  /// end leaves the end neighbourhood back along the stroke (most strokes complete at `lift`). Does
+  /// nothing outside an attempt.
+  StrokeProgress advance(const Vec2& tip_m) noexcept;
+  /// Pen lifted in WS: the stroke is written when the attempt meets the tolerances (short of the end or
+  /// past it); otherwise its feature points are loaded again (section 4.3.3) and `refusal` says why.
+  StrokeProgress lift() noexcept;
 
   [[nodiscard]] bool finished() const noexcept { return character_ >= scene_->characters.size(); }
   /// Indices of the active character, its stroke, and the active element; meaningless once finished.
@@ -43,11 +51,17 @@ class ActiveStroke {
   [[nodiscard]] const StrokeElement* element() const noexcept;
   /// Attraction factor at parameter t of the active element, interpolated between its feature points.
   [[nodiscard]] double attraction(double t) const noexcept;
+  /// The running (or last) attempt at the active stroke.
+  [[nodiscard]] const StrokeProgressTracker& attempt() const noexcept { return attempt_; }
+  [[nodiscard]] const StrokeAcceptance& acceptance() const noexcept { return acceptance_; }
 
  private:
   void next_stroke() noexcept;
 
   const Scene* scene_;
+  StrokeAcceptance acceptance_;
+  StrokeProgressTracker attempt_;
+  bool attempt_open_ = false;  // begun and neither written nor lifted
   std::size_t character_ = 0;
   std::size_t stroke_ = 0;
   std::size_t element_ = 0;  // top of the feature-point stack: the element being written

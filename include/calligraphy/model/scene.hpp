@@ -31,12 +31,28 @@ struct SceneLayout {
   double start_radius_m = 0.005;   ///< radius of the start-point neighbourhood (paper Fig. 5, Table 1) [m]
 };
 
+/// The centre line a person follows when writing a stroke: the data's median (what the outline shows,
+/// brush hooks included), or the elements sampled densely when the stroke has no median. Progress and
+/// acceptance of a stroke are measured along it (collision/stroke_progress.hpp).
+struct StrokeCentreLine {
+  std::vector<Vec2> points_m;  ///< polyline [m], at least 2 points, no repeats
+  std::vector<double> arc_m;   ///< arc length from the first point to each point [m], same size
+  /// Arc [m] of each element's end feature point projected on the line, non-decreasing, one per element:
+  /// the last is where the stroke ends; the others are the corners between elements.
+  std::vector<double> element_end_arc_m;
+  double start_arc_m = 0.0;  ///< arc [m] of the first feature point projected on the line
+  [[nodiscard]] double length_m() const { return arc_m.empty() ? 0.0 : arc_m.back(); }
+  /// The centre line of a stroke from its median (or elements) and elements, in the same units.
+  static StrokeCentreLine of(const std::vector<Vec2>& median, const std::vector<StrokeElement>& elements);
+};
+
 /// A stroke in metres.
 struct PlacedStroke {
   int typical_id = 0;
   std::vector<StrokeElement> elements;     ///< control points in metres on the paper
   std::vector<double> attraction_factors;  ///< one per feature point, dimensionless
   std::vector<Vec2> median_m;              ///< the source median in metres, for drawing
+  StrokeCentreLine centre_line;            ///< what progress is measured along (set by Scene::lay_out)
   [[nodiscard]] const Vec2& start() const { return elements.front().start(); }
   [[nodiscard]] const Vec2& end() const { return elements.back().end(); }
   [[nodiscard]] double length_m() const;

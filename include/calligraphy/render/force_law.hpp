@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/collision/stroke_progress.hpp"
 #include "calligraphy/core/geometry.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
 
@@ -81,9 +82,9 @@ struct ForceLawParameters {
   /// Time [s] over which the paper force fades in when the paper starts to push (AS/SS -> CS/WS) and
   /// out when it stops (CS -> AS). 0 = off.
   double paper_fade_s = 0.2;
-  /// Hysteresis of the feature planes (eq. 6) [m]: a plane counts as passed when the tip is this far
-  /// past it, so that encoder noise at the plane does not switch the active element early.
-  double feature_plane_margin_m = 0.0002;
+  /// When the pen has gone round a corner and when a stroke is written (stroke_progress.hpp): progress
+  /// along the stroke's centre line within a corridor, ends short or past within a tolerance.
+  StrokeAcceptance acceptance{};
   /// Damping of the paper on inward motion only (v_z < 0, below the paper) [N s/m]. Colgate's bound
   /// shrinks by it: K <= 2 (b - B) / T. 0 = off.
   double paper_damping_n_s_per_m = 0.0;

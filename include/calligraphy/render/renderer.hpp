@@ -36,18 +36,19 @@ struct RenderOutput {
   Vec3 force_n = Vec3::Zero();  ///< command for the device [N], finite, within the safety chain's limits
   InteractionState state = InteractionState::separation;
   bool state_changed = false;
-  std::size_t character = 0;                 ///< active character index (valid unless `finished`)
-  std::size_t stroke = 0;                    ///< active stroke index within the character
-  std::size_t element = 0;                   ///< active element index within the stroke
-  bool finished = false;                     ///< every stroke of the scene has been written
-  bool in_constraint_space = false;          ///< the tip is inside R_res of the active element
-  Vec2 foot_m = Vec2::Zero();                ///< X_S on the active element (WS only) [m]
-  bool stroke_completed = false;             ///< this tick wrote the last feature point of a stroke
-  bool stroke_abandoned = false;             ///< the pen was lifted in WS: the stroke was reloaded
-  bool input_rejected = false;               ///< the device state was not finite: zero force
-  bool force_error = false;                  ///< the force law gave a non-finite force: zero force
-  std::uint8_t limits = safety_none;         ///< SafetyLimit bits: which safety stages acted
-  double passivity_damping_n_s_per_m = 0.0;  ///< damper added by the passivity controller [N s/m]
+  std::size_t character = 0;         ///< active character index (valid unless `finished`)
+  std::size_t stroke = 0;            ///< active stroke index within the character
+  std::size_t element = 0;           ///< active element index within the stroke
+  bool finished = false;             ///< every stroke of the scene has been written
+  bool in_constraint_space = false;  ///< the tip is inside R_res of the active element
+  Vec2 foot_m = Vec2::Zero();        ///< X_S on the active element (WS only) [m]
+  bool stroke_completed = false;     ///< this tick wrote a stroke (passed its end, or lifted near it)
+  bool stroke_abandoned = false;     ///< the pen was lifted in WS short of the tolerances: reloaded
+  StrokeRefusal refusal = StrokeRefusal::none;  ///< why an abandoned stroke was refused (stroke_progress.hpp)
+  bool input_rejected = false;                  ///< the device state was not finite: zero force
+  bool force_error = false;                     ///< the force law gave a non-finite force: zero force
+  std::uint8_t limits = safety_none;            ///< SafetyLimit bits: which safety stages acted
+  double passivity_damping_n_s_per_m = 0.0;     ///< damper added by the passivity controller [N s/m]
 };
 
 class Renderer {

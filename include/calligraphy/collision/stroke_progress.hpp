@@ -1,0 +1,153 @@
+#pragma once
+/// \file stroke_progress.hpp
+/// How far a pen has written the active stroke, and whether that stroke is written: the one rule of
+/// stroke acceptance, used by the renderer tick by tick and by `match_stroke` (stroke_matcher.hpp) on a
+/// recorded trace, so that both give the same verdict for the same pen path.
+///
+/// The paper advances the active element when the tip crosses the feature plane at the element's end
+/// (section 4.3.3, eq. 6) and completes the stroke at the last plane. A hand does not do that: it rounds
+/// a corner inside the fitted corner point (whose plane it then never crosses), and it lifts the pen short
+/// of the end about as often as past it. Here progress is the arc length, along the stroke's centre line
+/// (`StrokeCentreLine`: the data's median, which is what the outline shows), of the pen's foot point,
+/// credited only while the pen moves forward along the line and stays within a corridor; the active
+/// element is the one whose arc contains the progress, so a corner counts as gone round once the pen has
+/// gone round it on either side, and no feature plane is needed. This resolves the corner and end
+/// ambiguity of the paper's section 6 with one rule:
+///
+///   a stroke of length L (along the centre line, from its first feature point to its last) is written
+///   when the pen entered it in the start neighbourhood (WS) and, within `corridor_m` of it and with a
+///   mean distance of at most `mean_deviation_m`, went along it for at least L - min(`shortfall_m`,
+///   `shortfall_fraction` L), leaving at most max(that, `displacement_m`) unwritten at either end. The
+///   way along counts the arc the pen gained, plus up to `displacement_m` of run before the start and past
+///   the end, so that a copy displaced along the stroke is written and a half stroke is not.
+///
+/// It completes when the pen is lifted, short of the end or past it. Past the end the pen may move freely
+/// within the end neighbourhood (`follow_through_m`). A pen that leaves it before lifting completes the
+/// stroke if it is still on it (it came back along the stroke) and otherwise has gone on into another
+/// shape (a scribble that began with the stroke, a stroke run on into the next) and loses it.
+///
+/// Servo path: `begin`, `update` and `lift` are noexcept, allocation-free and O(centre-line points).
+#include <cstddef>
+#include <cstdint>
+
+#include "calligraphy/model/scene.hpp"
+
+namespace calligraphy {
+
+/// Tolerances of stroke acceptance, SI units. Defaults for a 60 mm character box from how far people's
+/// strokes lie from hanzi-writer-data's medians: hand-drawn centre lines of an independent data set,
+/// aligned to the medians, have a discrete Frechet distance of median 2.3 mm, 95th percentile 3.4 mm,
+/// largest 6.1 mm, and end points within 3.5 mm of the medians' (measured with Hanzi Writer's own
+/// matcher, chanind/hanzi-writer 3.7.3 `strokeMatches.ts`, whose end-point tolerance is 250/1024 of the
+/// box, 14.6 mm here, and whose length test accepts 35 % of a stroke: both too lenient to refuse half
+/// strokes). Scale them with the character size. docs/stroke-acceptance.md has the measured acceptance.
+struct StrokeAcceptance {
+  /// Farthest a pen may be from the centre line and still make progress [m]: people's largest Frechet
+  /// distance, 6.1 mm, plus 0.4 mm.
+  double corridor_m = 0.0065;
+  /// Largest mean distance of the pen from the centre line over its path in WS [m] (each distance capped
+  /// at twice the corridor): people's 95th-percentile Frechet distance is 3.4 mm and their mean distance
+  /// far less; a stroke moved 3 mm or more across is in the wrong place.
+  double mean_deviation_m = 0.003;
+  /// How much shorter than the stroke the pen's way along it may be [m]: each end within 3.5 mm of the
+  /// median's, not both 3.5 mm short at once.
+  double shortfall_m = 0.006;
+  /// The same as a fraction of the stroke's length, the smaller applying: a half stroke (0.5) is refused
+  /// with a margin on the shortest strokes (dots), where 6 mm would be most of the stroke.
+  double shortfall_fraction = 0.35;
+  /// How far a copy of the stroke may be displaced along it [m]: up to this much run before the start or
+  /// past the end counts towards the way along, and either end may be left unwritten by this much on a
+  /// short stroke. People's copies lie a median 2.3 mm from the medians (Frechet distance).
+  double displacement_m = 0.0025;
+  /// How far along the centre line, ahead of and behind the progress, the foot point is looked for [m]:
+  /// the most a foot may run ahead in one step (a corner cut inside by 2.5 mm skips about 5 mm of a
+  /// right angle); shorter than a stroke's return to itself past a hook.
+  double lookahead_m = 0.006;
+  /// Most arc credited per length of pen motion, dimensionless, >= 1: a pen cutting a corner gains more
+  /// arc than it moves (1.4 times at a right angle, 2.6 times for a 135-degree turn cut close to its
+  /// corner, which hands do not do by much); a path that jumps between the legs of a folded stroke would
+  /// gain far more. Past it the progress catches up as the pen moves on.
+  double max_gain_ratio = 2.0;
+  /// Radius of the end neighbourhood a pen past the end may move in before it lifts [m]: people end up
+  /// to 3.5 mm past the end (the measured end scatter), a brush's exit further; a pen that leaves it
+  /// before lifting and off the stroke loses the stroke.
+  double follow_through_m = 0.008;
+
+  /// Throws InvalidArgument naming the field when a value is not finite and > 0 (the fraction in (0, 1)).
+  void validate() const;
+  /// The most a stroke of `length_m` may be written short by [m].
+  [[nodiscard]] double allowed_shortfall_m(double length_m) const noexcept;
+};
+
+/// Why a stroke attempt was not accepted, in the learner's terms.
+enum class StrokeRefusal : std::uint8_t {
+  none,          ///< accepted (or still being written)
+  too_short,     ///< went along the stroke but stopped before its end neighbourhood
+  backwards,     ///< written from its end towards its start
+  wrong_place,   ///< not along the stroke: started elsewhere, or too far from it on average
+  wrong_stroke,  ///< another stroke's shape, or a stroke of the character already written
+  wrong_order,   ///< a stroke of the character that comes later
+};
+
+/// "too_short", "backwards", "wrong_place", "wrong_stroke", "wrong_order", or "none".
+[[nodiscard]] const char* to_string(StrokeRefusal refusal) noexcept;
+
+/// Progress of one pen-down attempt at one stroke. Value type; `begin` starts an attempt.
+class StrokeProgressTracker {
+ public:
+  /// Starts an attempt at `stroke` (which must outlive the attempt) with the pen at `tip_m` [m], where
+  /// it entered WS. `acceptance` is copied; it must be valid.
+  void begin(const PlacedStroke& stroke, const Vec2& tip_m, const StrokeAcceptance& acceptance) noexcept;
+  /// The pen at `tip_m` [m] on the paper. Returns true when this step completes the stroke: the pen had
+  /// passed the end (everything else holding) and now left the end neighbourhood along the stroke; the
+  /// attempt then ends. Leaving it off the stroke ends the attempt refused (`in_attempt` false, `refusal`
+  /// wrong_stroke).
+  bool update(const Vec2& tip_m) noexcept;
+  /// The pen was lifted: true when the stroke is written (short of the end, within the tolerances). The
+  /// attempt ends either way.
+  bool lift() noexcept;
+
+  [[nodiscard]] bool in_attempt() const noexcept { return attempt_; }
+  /// The pen has passed the end with the stroke written: nothing is left to guide it to.
+  [[nodiscard]] bool passed_end() const noexcept { return passed_end_; }
+  /// Furthest arc credited along the centre line [m].
+  [[nodiscard]] double progress_m() const noexcept { return progress_m_; }
+  /// The pen's way along the stroke so far [m]: arc gained plus run before the start and past the end
+  /// (each up to `displacement_m`).
+  [[nodiscard]] double way_along_m() const noexcept;
+  /// The stroke's length L between its first and last feature points along the centre line [m].
+  [[nodiscard]] double stroke_length_m() const noexcept;
+  /// Mean distance of the pen from the centre line over its path so far [m].
+  [[nodiscard]] double mean_deviation_m() const noexcept;
+  /// The element that contains the progress: 0 before the first corner, the last one after the last.
+  [[nodiscard]] std::size_t element_index() const noexcept;
+  /// Why the attempt would be refused if the pen were lifted now (none when it would be accepted).
+  [[nodiscard]] StrokeRefusal refusal() const noexcept;
+
+ private:
+  struct Foot {
+    double arc_m;
+    double distance_m;
+    Vec2 tangent;
+  };
+  [[nodiscard]] Foot foot_near(const Vec2& tip_m, double from_arc_m, double to_arc_m) const noexcept;
+  [[nodiscard]] bool written() const noexcept;
+
+  const PlacedStroke* stroke_ = nullptr;
+  StrokeAcceptance acceptance_{};
+  double entry_arc_m_ = 0.0;  // foot of the pen where it entered
+  double progress_m_ = 0.0;   // furthest foot credited
+  Vec2 last_tip_m_ = Vec2::Zero();
+  double travel_m_ = 0.0;              // pen path length in this attempt
+  double distance_integral_m2_ = 0.0;  // integral of the capped distance over the pen path
+  double entry_distance_m_ = 0.0;
+  double backward_m_ = 0.0;        // pen motion against the line within the corridor
+  double before_start_m_ = 0.0;    // how far before the start the pen entered, along the stroke
+  double past_end_m_ = 0.0;        // how far past the end the pen went, along the stroke
+  bool outside_corridor_ = false;  // the last step was outside the corridor
+  bool attempt_ = false;
+  bool passed_end_ = false;  // written up to the end; waiting for the lift in the end neighbourhood
+  bool lost_ = false;        // left the end neighbourhood across: refused
+};
+
+}  // namespace calligraphy

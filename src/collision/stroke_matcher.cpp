@@ -1,0 +1,110 @@
+#include "calligraphy/collision/stroke_matcher.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "calligraphy/core/errors.hpp"
+
+namespace calligraphy {
+namespace {
+
+// Longest straight step fed to the tracker [m]: a recorded path is read as straight lines between its
+// points, as fine as a 1 kHz pen at 250 mm/s, so that a sparse path (a median's few vertices, a 60 Hz
+// pointer) is read as the renderer would read the same motion.
+constexpr double kStep_m = 0.00025;
+
+struct Attempt {
+  bool entered = false;
+  bool written = false;
+  StrokeRefusal refusal = StrokeRefusal::wrong_place;
+  double way_along_m = 0.0;
+  double length_m = 0.0;
+  double mean_deviation_m = 0.0;
+};
+
+// Feeds the path to a tracker as the renderer would: WS from the first point within the start
+// neighbourhood; the path's end is the lift.
+Attempt attempt(const PlacedStroke& stroke, std::span<const Vec2> path, double start_radius_m,
+                const StrokeAcceptance& acceptance) {
+  Attempt result;
+  StrokeProgressTracker tracker;
+  bool written_on_the_way = false;  // completed before the path's end (left the end neighbourhood along it)
+  const auto feed = [&](const Vec2& p) {
+    if (written_on_the_way) return;
+    if (!tracker.in_attempt()) {
+      if (result.entered || (p - stroke.start()).norm() > start_radius_m) return;
+      result.entered = true;
+      tracker.begin(stroke, p, acceptance);
+    }
+    written_on_the_way = tracker.update(p);
+  };
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    if (i == 0) {
+      feed(path[0]);
+      continue;
+    }
+    const Vec2 step = path[i] - path[i - 1];
+    const int pieces = std::max(1, static_cast<int>(std::ceil(step.norm() / kStep_m)));
+    for (int k = 1; k <= pieces; ++k) feed(path[i - 1] + step * (static_cast<double>(k) / pieces));
+  }
+  if (!result.entered) return result;
+  result.refusal = tracker.refusal();
+  result.way_along_m = tracker.way_along_m();
+  result.length_m = tracker.stroke_length_m();
+  result.mean_deviation_m = tracker.mean_deviation_m();
+  result.written = written_on_the_way || tracker.lift();
+  if (result.written) result.refusal = StrokeRefusal::none;
+  return result;
+}
+
+}  // namespace
+
+StrokeMatch match_stroke(const PlacedCharacter& character, std::size_t expected, std::span<const Vec2> path_m,
+                         double start_radius_m, const StrokeAcceptance& acceptance) {
+  if (expected >= character.strokes.size()) {
+    throw InvalidArgument("match_stroke: stroke " + std::to_string(expected) + " of a character with " +
+                          std::to_string(character.strokes.size()) + " strokes");
+  }
+  if (path_m.empty()) throw InvalidArgument("match_stroke: an empty path");
+  for (std::size_t i = 0; i < path_m.size(); ++i) {
+    if (!path_m[i].allFinite()) {
+      throw InvalidArgument("match_stroke: path point " + std::to_string(i) + " is not finite");
+    }
+  }
+  if (!(start_radius_m > 0.0) || !std::isfinite(start_radius_m)) {
+    throw InvalidArgument("match_stroke: start radius " + std::to_string(start_radius_m) + " m must be > 0");
+  }
+  acceptance.validate();
+  const PlacedStroke& stroke = character.strokes[expected];
+  const Attempt own = attempt(stroke, path_m, start_radius_m, acceptance);
+  StrokeMatch match;
+  match.matched_stroke = expected;
+  match.covered_fraction =
+      own.length_m > 0.0 ? std::clamp(own.way_along_m / own.length_m, 0.0, 1.0) : (own.written ? 1.0 : 0.0);
+  match.mean_deviation_m = own.mean_deviation_m;
+  if (own.written) {
+    match.accepted = true;
+    match.refusal = StrokeRefusal::none;
+    return match;
+  }
+  // Another stroke of the character: a later one is out of order, an earlier one written again.
+  for (std::size_t k = 0; k < character.strokes.size(); ++k) {
+    if (k == expected) continue;
+    if (attempt(character.strokes[k], path_m, start_radius_m, acceptance).written) {
+      match.refusal = k > expected ? StrokeRefusal::wrong_order : StrokeRefusal::wrong_stroke;
+      match.matched_stroke = k;
+      return match;
+    }
+  }
+  std::vector<Vec2> reversed(path_m.rbegin(), path_m.rend());
+  if (attempt(stroke, reversed, start_radius_m, acceptance).written) {
+    match.refusal = StrokeRefusal::backwards;
+    return match;
+  }
+  match.refusal = own.entered ? own.refusal : StrokeRefusal::wrong_place;
+  return match;
+}
+
+}  // namespace calligraphy

@@ -1,0 +1,206 @@
+#include "calligraphy/collision/stroke_progress.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "calligraphy/collision/constraint_space.hpp"
+#include "calligraphy/core/errors.hpp"
+
+namespace calligraphy {
+
+void StrokeAcceptance::validate() const {
+  const auto check = [](double value, const char* name) {
+    if (!std::isfinite(value) || !(value > 0.0)) {
+      throw InvalidArgument(std::string("StrokeAcceptance.") + name + " = " + std::to_string(value) +
+                            " must be finite and > 0");
+    }
+  };
+  check(corridor_m, "corridor_m");
+  check(mean_deviation_m, "mean_deviation_m");
+  check(shortfall_m, "shortfall_m");
+  check(displacement_m, "displacement_m");
+  check(lookahead_m, "lookahead_m");
+  check(follow_through_m, "follow_through_m");
+  if (!std::isfinite(max_gain_ratio) || !(max_gain_ratio >= 1.0)) {
+    throw InvalidArgument("StrokeAcceptance.max_gain_ratio = " + std::to_string(max_gain_ratio) +
+                          " must be finite and >= 1");
+  }
+  if (!(shortfall_fraction > 0.0 && shortfall_fraction < 1.0)) {
+    throw InvalidArgument("StrokeAcceptance.shortfall_fraction = " + std::to_string(shortfall_fraction) +
+                          " must be in (0, 1)");
+  }
+}
+
+double StrokeAcceptance::allowed_shortfall_m(double length_m) const noexcept {
+  return std::min(shortfall_m, shortfall_fraction * length_m);
+}
+
+const char* to_string(StrokeRefusal refusal) noexcept {
+  switch (refusal) {
+    case StrokeRefusal::none:
+      return "none";
+    case StrokeRefusal::too_short:
+      return "too_short";
+    case StrokeRefusal::backwards:
+      return "backwards";
+    case StrokeRefusal::wrong_place:
+      return "wrong_place";
+    case StrokeRefusal::wrong_stroke:
+      return "wrong_stroke";
+    case StrokeRefusal::wrong_order:
+      return "wrong_order";
+  }
+  return "?";
+}
+
+StrokeProgressTracker::Foot StrokeProgressTracker::foot_near(const Vec2& tip_m, double from_arc_m,
+                                                             double to_arc_m) const noexcept {
+  const StrokeCentreLine& line = stroke_->centre_line;
+  Foot best{from_arc_m, std::numeric_limits<double>::infinity(), Vec2::UnitX()};
+  for (std::size_t k = 1; k < line.points_m.size(); ++k) {
+    const double arc_a = line.arc_m[k - 1];
+    const double arc_b = line.arc_m[k];
+    if (arc_b < from_arc_m || arc_a > to_arc_m) continue;
+    const Vec2& a = line.points_m[k - 1];
+    const Vec2& b = line.points_m[k];
+    const double segment = arc_b - arc_a;
+    if (!(segment > 0.0)) continue;
+    const double t_from = std::max(0.0, (from_arc_m - arc_a) / segment);
+    const double t_to = std::min(1.0, (to_arc_m - arc_a) / segment);
+    const double t = std::clamp(segment_parameter(a, b, tip_m), t_from, t_to);
+    const double distance = (a + t * (b - a) - tip_m).norm();
+    if (distance < best.distance_m) best = Foot{arc_a + t * segment, distance, (b - a) / segment};
+  }
+  if (!std::isfinite(best.distance_m)) {  // a zero-length line: its one point
+    best.distance_m = (line.points_m.front() - tip_m).norm();
+    best.arc_m = 0.0;
+  }
+  return best;
+}
+
+void StrokeProgressTracker::begin(const PlacedStroke& stroke, const Vec2& tip_m,
+                                  const StrokeAcceptance& acceptance) noexcept {
+  stroke_ = &stroke;
+  acceptance_ = acceptance;
+  const StrokeCentreLine& line = stroke.centre_line;
+  const Foot foot = foot_near(tip_m, 0.0, line.start_arc_m + acceptance_.lookahead_m);
+  entry_arc_m_ = foot.arc_m;
+  progress_m_ = foot.arc_m;
+  last_tip_m_ = tip_m;
+  travel_m_ = 0.0;
+  distance_integral_m2_ = 0.0;
+  entry_distance_m_ = std::min(foot.distance_m, 2.0 * acceptance_.corridor_m);
+  backward_m_ = 0.0;
+  past_end_m_ = 0.0;
+  before_start_m_ = std::max(0.0, (stroke.start() - tip_m).dot(stroke.elements.front().unit_tangent(0.0)));
+  outside_corridor_ = foot.distance_m > acceptance_.corridor_m;
+  attempt_ = true;
+  passed_end_ = false;
+  lost_ = false;
+}
+
+bool StrokeProgressTracker::update(const Vec2& tip_m) noexcept {
+  if (!attempt_) return false;
+  if (passed_end_) {
+    // In the end neighbourhood the pen may go anywhere until it lifts; leaving it ends the attempt: written
+    // if the pen is back on the stroke, lost if it went off it.
+    if ((tip_m - stroke_->end()).norm() <= acceptance_.follow_through_m) return false;
+    attempt_ = false;
+    const Foot foot =
+        foot_near(tip_m, progress_m_ - acceptance_.follow_through_m - acceptance_.lookahead_m, progress_m_);
+    lost_ = foot.distance_m > acceptance_.mean_deviation_m;
+    return !lost_;
+  }
+  const Vec2 step = tip_m - last_tip_m_;
+  const double step_m = step.norm();
+  last_tip_m_ = tip_m;
+  const Foot foot =
+      foot_near(tip_m, progress_m_ - acceptance_.lookahead_m, progress_m_ + acceptance_.lookahead_m);
+  travel_m_ += step_m;
+  distance_integral_m2_ += step_m * std::min(foot.distance_m, 2.0 * acceptance_.corridor_m);
+  outside_corridor_ = foot.distance_m > acceptance_.corridor_m;
+  if (!outside_corridor_) {
+    const double along = step.dot(foot.tangent);
+    if (along > 0.0 && foot.arc_m > progress_m_) {
+      progress_m_ = std::min(foot.arc_m, progress_m_ + acceptance_.max_gain_ratio * step_m);
+    } else if (along < 0.0) {
+      backward_m_ -= along;
+    }
+    // A pen that carried on past a corner (outside it) has crossed the corner's feature plane (eq. 6)
+    // while its foot on the rounded median may still lie just short of the corner: the corner is gone round.
+    const std::size_t element = element_index();
+    const std::vector<double>& corners = stroke_->centre_line.element_end_arc_m;
+    if (element + 1 < corners.size() && progress_m_ >= corners[element] - acceptance_.lookahead_m &&
+        feature_plane_passed(stroke_->elements[element], tip_m)) {
+      progress_m_ = std::max(progress_m_, corners[element]);
+    }
+  }
+  if (progress_m_ >= stroke_->centre_line.element_end_arc_m.back()) {
+    past_end_m_ =
+        std::max(past_end_m_, (tip_m - stroke_->end()).dot(stroke_->elements.back().unit_tangent(1.0)));
+    passed_end_ = written();
+  }
+  return false;
+}
+
+bool StrokeProgressTracker::lift() noexcept {
+  if (!attempt_) return false;
+  attempt_ = false;
+  return passed_end_ || written();
+}
+
+double StrokeProgressTracker::stroke_length_m() const noexcept {
+  if (stroke_ == nullptr) return 0.0;
+  const StrokeCentreLine& line = stroke_->centre_line;
+  return std::max(0.0, line.element_end_arc_m.back() - line.start_arc_m);
+}
+
+double StrokeProgressTracker::way_along_m() const noexcept {
+  if (stroke_ == nullptr) return 0.0;
+  // The arc gained between the first and last feature points (not along a brush hook of the median
+  // before or after them), and the run beyond each, measured along the stroke's direction there.
+  const StrokeCentreLine& line = stroke_->centre_line;
+  const double from = std::max(entry_arc_m_, line.start_arc_m);
+  const double to = std::min(progress_m_, line.element_end_arc_m.back());
+  const double d = acceptance_.displacement_m;
+  return std::max(0.0, to - from) + std::min(before_start_m_, d) + std::min(past_end_m_, d);
+}
+
+double StrokeProgressTracker::mean_deviation_m() const noexcept {
+  return travel_m_ > 0.0 ? distance_integral_m2_ / travel_m_ : entry_distance_m_;
+}
+
+bool StrokeProgressTracker::written() const noexcept {
+  const StrokeCentreLine& line = stroke_->centre_line;
+  const double length = stroke_length_m();
+  const double shortfall = acceptance_.allowed_shortfall_m(length);
+  const double end_gap_limit = std::max(shortfall, acceptance_.displacement_m);
+  const double start_gap = entry_arc_m_ - line.start_arc_m;
+  const double end_gap = line.element_end_arc_m.back() - progress_m_;
+  return way_along_m() >= length - shortfall && start_gap <= end_gap_limit && end_gap <= end_gap_limit &&
+         mean_deviation_m() <= acceptance_.mean_deviation_m;
+}
+
+std::size_t StrokeProgressTracker::element_index() const noexcept {
+  if (stroke_ == nullptr) return 0;
+  const std::vector<double>& ends = stroke_->centre_line.element_end_arc_m;
+  for (std::size_t i = 0; i + 1 < ends.size(); ++i) {
+    if (progress_m_ < ends[i]) return i;
+  }
+  return ends.empty() ? 0 : ends.size() - 1;
+}
+
+StrokeRefusal StrokeProgressTracker::refusal() const noexcept {
+  if (stroke_ == nullptr) return StrokeRefusal::wrong_place;
+  if (lost_) return StrokeRefusal::wrong_stroke;
+  if (passed_end_ || written()) return StrokeRefusal::none;
+  if (mean_deviation_m() > acceptance_.mean_deviation_m) return StrokeRefusal::wrong_place;
+  const double forward = progress_m_ - entry_arc_m_;
+  if (backward_m_ > forward && backward_m_ > 0.25 * acceptance_.corridor_m) return StrokeRefusal::backwards;
+  if (outside_corridor_) return StrokeRefusal::wrong_stroke;
+  return StrokeRefusal::too_short;
+}
+
+}  // namespace calligraphy
