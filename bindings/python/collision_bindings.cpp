@@ -1,14 +1,21 @@
 // collision: the nearest point on a stroke element (include/calligraphy/collision/nearest_point.hpp,
-// paper section 4.3) and its options.
+// paper section 4.3) and its options; stroke acceptance and the stroke matcher (stroke_progress.hpp,
+// stroke_matcher.hpp).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 
+#include <cstddef>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "bindings.hpp"
 #include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/collision/stroke_matcher.hpp"
 #include "calligraphy/collision/stroke_progress.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/scene.hpp"
 #include "model_bindings.hpp"
 #include "numpy_arrays.hpp"
 #include "parameter_class.hpp"
@@ -72,6 +79,53 @@ py::tuple nearest_point_py(const ElementLike& element_object, const ArrayLike& p
   return py::make_tuple(t, foot, distance);
 }
 
+// Indices name a character or stroke by its place in the writing order, so negative ones (Python's
+// counting from the end) are refused rather than silently naming the last stroke.
+std::size_t index_below(const Checked<long long>& index, std::size_t count, const std::string& name,
+                        const std::string& what) {
+  const long long i = take(index, name);
+  if (i < 0 || static_cast<unsigned long long>(i) >= count) {
+    throw py::index_error(name + ": " + std::to_string(i) + " is not in 0.." +
+                          std::to_string(static_cast<long long>(count) - 1) + " (" + what + " has " +
+                          std::to_string(count) + ")");
+  }
+  return static_cast<std::size_t>(i);
+}
+
+// A pen-down path (N, 2) [m], N >= 1, every point finite.
+std::vector<Vec2> path_from(py::handle object) {
+  const Vectors v = as_vectors(object, 2, "path_m");
+  if (v.single) throw InvalidArgument("path_m: expected shape (N, 2), got (2,); one point is [[x, y]]");
+  if (v.count == 0) throw InvalidArgument("path_m: expected at least one point, got shape (0, 2)");
+  std::vector<Vec2> path;
+  path.reserve(static_cast<std::size_t>(v.count));
+  for (py::ssize_t i = 0; i < v.count; ++i) {
+    path.push_back(v.vec2(i));
+    if (!path.back().allFinite())
+      throw InvalidArgument("path_m: point " + std::to_string(i) + " is not finite");
+  }
+  return path;
+}
+
+StrokeMatch match_stroke_py(const Checked<Scene>& scene_object, const Checked<long long>& character_index,
+                            const Checked<long long>& stroke_index, const ArrayLike& path_object,
+                            const std::optional<Checked<StrokeAcceptance>>& acceptance_object) {
+  if (!py::isinstance<Scene>(scene_object.object)) throw_type_error("scene", "Scene", scene_object.object);
+  const Scene& scene = scene_object.object.cast<const Scene&>();
+  const PlacedCharacter& character = scene.characters[index_below(
+      character_index, scene.characters.size(), "character_index", "the scene's characters")];
+  const std::size_t stroke =
+      index_below(stroke_index, character.strokes.size(), "stroke_index", "the character's strokes");
+  const std::vector<Vec2> path_m = path_from(path_object.object);
+  const StrokeAcceptance acceptance =
+      acceptance_object ? take(*acceptance_object, "acceptance") : StrokeAcceptance{};
+  const double start_radius_m = scene.layout.start_radius_m;
+  // Long enough for other Python threads to run meanwhile: the path is read in 0.25 mm steps, on every
+  // stroke of the character and reversed.
+  py::gil_scoped_release release;
+  return match_stroke(character, stroke, path_m, start_radius_m, acceptance);
+}
+
 }  // namespace
 
 void bind_collision(py::module_& m) {
@@ -121,6 +175,55 @@ void bind_collision(py::module_& m) {
       .field("lookahead_m", &StrokeAcceptance::lookahead_m,
              "how far along the line the foot point is looked for around the progress [m]")
       .finish();
+
+  py::enum_<StrokeRefusal>(m, "StrokeRefusal",
+                           "Why a stroke attempt was not accepted, in the learner's terms "
+                           "(include/calligraphy/collision/stroke_progress.hpp).")
+      .value("none", StrokeRefusal::none, "accepted")
+      .value("too_short", StrokeRefusal::too_short,
+             "went along the stroke but stopped before its end neighbourhood")
+      .value("backwards", StrokeRefusal::backwards, "written from its end towards its start")
+      .value("wrong_place", StrokeRefusal::wrong_place,
+             "not along the stroke: started elsewhere, or too far from it on average")
+      .value("wrong_stroke", StrokeRefusal::wrong_stroke,
+             "another stroke's shape, or a stroke of the character already written")
+      .value("wrong_order", StrokeRefusal::wrong_order, "a stroke of the character that comes later");
+
+  py::class_<StrokeMatch>(m, "StrokeMatch",
+                          "The verdict of match_stroke on one pen-down path "
+                          "(include/calligraphy/collision/stroke_matcher.hpp).")
+      .def_readonly("accepted", &StrokeMatch::accepted, "the path writes the expected stroke")
+      .def_readonly("refusal", &StrokeMatch::refusal, "a StrokeRefusal, StrokeRefusal.none when accepted")
+      .def_readonly("matched_stroke", &StrokeMatch::matched_stroke,
+                    "for wrong_order and wrong_stroke the index of the stroke the path writes instead; "
+                    "otherwise the expected stroke's index")
+      .def_readonly("covered_fraction", &StrokeMatch::covered_fraction,
+                    "the pen's way along the expected stroke / its length, in [0, 1]")
+      .def_readonly("mean_deviation_m", &StrokeMatch::mean_deviation_m,
+                    "mean distance of the path from the expected stroke's centre line [m]")
+      .def("__repr__", [](const StrokeMatch& s) {
+        return std::string("<StrokeMatch ") + (s.accepted ? "accepted" : to_string(s.refusal)) + ", stroke " +
+               std::to_string(s.matched_stroke) + ", covered " + std::to_string(s.covered_fraction) +
+               ", mean deviation " + std::to_string(s.mean_deviation_m) + " m>";
+      });
+
+  m.def("match_stroke", &match_stroke_py, py::arg("scene"), py::arg("character_index"),
+        py::arg("stroke_index"), py::arg("path_m"), py::arg("acceptance") = py::none(),
+        R"(Whether one pen-down path writes stroke `stroke_index` of character `character_index` of `scene`
+(taking the strokes before it as written), and if not, why (include/calligraphy/collision/stroke_matcher.hpp).
+It is the renderer's rule: the path enters the stroke where it first comes within
+scene.layout.start_radius_m of the stroke's start (WS), progress is tracked along the stroke's centre
+line, and the path's end is the pen's lift, so a Renderer ticked along the same path gives the same
+verdict. A refusal is named by trying the path on the character's other strokes and reversed.
+
+path_m: array-like (N, 2), N >= 1, points on the paper in writing order [m], at any spacing (read as
+        straight lines between them).
+acceptance: a StrokeAcceptance (default: the C++ defaults, as ForceLawParameters().acceptance).
+Returns a StrokeMatch: accepted (bool), refusal (StrokeRefusal), matched_stroke (int),
+covered_fraction (float, in [0, 1]), mean_deviation_m (float) [m]. The GIL is released while matching.
+Raises IndexError naming character_index or stroke_index out of range, InvalidArgument (a ValueError)
+naming path_m for another shape, no points or a point that is not finite, TypeError naming the argument
+for a value of the wrong type.)");
 
   m.def("nearest_point", &nearest_point_py, py::arg("element"), py::arg("point"),
         py::arg("method") = NearestPointMethod::exact, py::arg("tolerance") = 1e-12,

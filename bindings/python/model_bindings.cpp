@@ -428,6 +428,23 @@ void bind_scene(py::module_& m) {
           "median_m", [](const PlacedStroke& s) { return read_only(points_to_array(s.median_m)); },
           "(M, 2) float64, the source median [m] (empty for a corpus store's character)")
       .def_property_readonly(
+          "centre_line_m",
+          [](const PlacedStroke& s) { return read_only(points_to_array(s.centre_line.points_m)); },
+          "(L, 2) float64, the centre line a person follows, along which progress and acceptance are "
+          "measured (match_stroke): the source median, or the elements sampled densely without one [m]")
+      .def_property_readonly(
+          "corner_arcs_m",
+          [](const PlacedStroke& s) {
+            // The last element's end is the stroke's end, not a corner.
+            const std::vector<double>& ends = s.centre_line.element_end_arc_m;
+            const std::size_t corners = ends.empty() ? 0 : ends.size() - 1;
+            auto out = new_array({static_cast<py::ssize_t>(corners)});
+            for (std::size_t i = 0; i < corners; ++i) out.mutable_at(static_cast<py::ssize_t>(i)) = ends[i];
+            return read_only(out);
+          },
+          "(len(elements) - 1,) float64, where each corner between elements lies along centre_line_m: arc "
+          "length from its first point [m], non-decreasing")
+      .def_property_readonly(
           "start_m", [](const PlacedStroke& s) { return to_array(s.start()); },
           "(2,) float64, start point [m]")
       .def_property_readonly(

@@ -1,16 +1,23 @@
-// sim: the simulated device and writer (include/calligraphy/sim/) and the device registry with the
-// simulated device registered (devices/device_registry.hpp).
+// sim: the simulated device and writer (include/calligraphy/sim/), labelled person-like pen paths
+// (person_traces.hpp) and the device registry with the simulated device registered
+// (devices/device_registry.hpp).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <memory>
+#include <random>
 #include <string>
+#include <vector>
 
 #include "bindings.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/devices/device_registry.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/sim/person_traces.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
 #include "calligraphy/sim/simulated_writer.hpp"
 #include "log_forwarding.hpp"
@@ -233,12 +240,113 @@ void bind_registry(py::module_& m) {
       "a note instead of raising.");
 }
 
+// Indices name a character or stroke by its place in the writing order, so negative ones (Python's
+// counting from the end) are refused rather than silently naming the last stroke.
+std::size_t index_below(const Checked<long long>& index, std::size_t count, const std::string& name,
+                        const std::string& what) {
+  const long long i = take(index, name);
+  if (i < 0 || static_cast<unsigned long long>(i) >= count) {
+    throw py::index_error(name + ": " + std::to_string(i) + " is not in 0.." +
+                          std::to_string(static_cast<long long>(count) - 1) + " (" + what + " has " +
+                          std::to_string(count) + ")");
+  }
+  return static_cast<std::size_t>(i);
+}
+
+struct StrokeOfScene {
+  const PlacedCharacter& character;
+  std::size_t stroke;
+};
+
+StrokeOfScene stroke_of_scene(const Checked<Scene>& scene_object, const Checked<long long>& character_index,
+                              const Checked<long long>& stroke_index) {
+  if (!py::isinstance<Scene>(scene_object.object)) throw_type_error("scene", "Scene", scene_object.object);
+  const Scene& scene = scene_object.object.cast<const Scene&>();
+  const PlacedCharacter& character = scene.characters[index_below(
+      character_index, scene.characters.size(), "character_index", "the scene's characters")];
+  return {character,
+          index_below(stroke_index, character.strokes.size(), "stroke_index", "the character's strokes")};
+}
+
+void bind_person_traces(py::module_& m) {
+  py::enum_<TraceKind>(m, "TraceKind",
+                       "Kinds of labelled pen paths for testing stroke acceptance "
+                       "(include/calligraphy/sim/person_traces.hpp, docs/stroke-acceptance.md): "
+                       "positives write the stroke, negatives must be refused (is_positive).")
+      .value("median", TraceKind::median, "positive: the data's median vertices as they are")
+      .value("human", TraceKind::human,
+             "positive: human pace: offset, turn and scale of the copy, drift, tremor, ends short or past")
+      .value("corners_cut", TraceKind::corners_cut,
+             "positive: as 'human', corners rounded inside by 2-5 mm of smoothing")
+      .value("corners_overshot", TraceKind::corners_overshot,
+             "positive: as 'human', each corner overshot outside by 1-2.5 mm before turning")
+      .value("ends_short", TraceKind::ends_short,
+             "positive: as 'human', lifted 0.5-3 mm short of the end (at most a fifth of the stroke)")
+      .value("ends_past", TraceKind::ends_past, "positive: as 'human', carried 0.5-4 mm past the end")
+      .value("pointer", TraceKind::pointer,
+             "positive: a mouse: 60 Hz samples at 60-110 mm/s, wobble, 0.15 mm pixels, lifted short")
+      .value("reversed", TraceKind::reversed, "negative: a 'human' path from the end to the start")
+      .value("half", TraceKind::half,
+             "negative: the first or the second half of the stroke, written as 'human' (ends exact)")
+      .value("shifted", TraceKind::shifted,
+             "negative: a 'human' path (without its own offset), every point moved 4-8 mm across it")
+      .value("other_stroke", TraceKind::other_stroke,
+             "negative: a 'human' path of another stroke of the character")
+      .value("swapped_order", TraceKind::swapped_order,
+             "negative: a 'human' path of the next stroke, written first")
+      .value("scribble", TraceKind::scribble, "negative: a zig-zag from the stroke's start");
+
+  m.def(
+      "is_positive", [](const Checked<TraceKind>& kind) { return is_positive(take(kind, "kind")); },
+      py::arg("kind"),
+      "True for the TraceKinds that write the stroke (median .. pointer), False for those a matcher must "
+      "refuse. kind: a TraceKind or its name. Raises InvalidArgument (a ValueError) for an unknown name, "
+      "TypeError naming `kind` for another type.");
+  m.def(
+      "trace_applies",
+      [](const Checked<Scene>& scene, const Checked<long long>& character_index,
+         const Checked<long long>& stroke_index, const Checked<TraceKind>& kind) {
+        const StrokeOfScene target = stroke_of_scene(scene, character_index, stroke_index);
+        return trace_applies(target.character, target.stroke, take(kind, "kind"));
+      },
+      py::arg("scene"), py::arg("character_index"), py::arg("stroke_index"), py::arg("kind"),
+      "True when person_trace can make `kind` for this stroke: other_stroke needs a character of two "
+      "strokes or more, swapped_order a next stroke. Raises IndexError naming character_index or "
+      "stroke_index out of range, InvalidArgument or TypeError naming `kind`.");
+  m.def(
+      "person_trace",
+      [](const Checked<Scene>& scene, const Checked<long long>& character_index,
+         const Checked<long long>& stroke_index, const Checked<TraceKind>& kind,
+         const Checked<std::uint64_t>& seed) {
+        const StrokeOfScene target = stroke_of_scene(scene, character_index, stroke_index);
+        const TraceKind chosen = take(kind, "kind");
+        std::mt19937_64 random(take(seed, "seed"));
+        return points_to_array(person_trace(target.character, target.stroke, chosen, random));
+      },
+      py::arg("scene"), py::arg("character_index"), py::arg("stroke_index"), py::arg("kind"),
+      py::arg("seed") = 0,
+      R"(A labelled pen-down path for stroke `stroke_index` of character `character_index` of `scene`
+(include/calligraphy/sim/person_traces.hpp): what a person writing it would draw (the positive kinds),
+or a mistake a matcher must refuse (the negative kinds). Built from the stroke's median_m only, never
+from the fitted elements or the centre line match_stroke reads.
+
+kind: a TraceKind or its name, e.g. 'human' or 'shifted'.
+seed: int in 0..2**64-1, seeds the std::mt19937_64 the path is drawn from: the same seed gives the
+      same path.
+Returns an (N, 2) float64 array, points on the paper in writing order [m], for match_stroke.
+Raises IndexError naming character_index or stroke_index out of range; InvalidArgument (a ValueError)
+naming `kind` or `seed` for an unknown name or a seed out of range, or when the kind does not apply to
+the stroke (trace_applies) or the stroke has no median (a corpus store's character); TypeError naming
+the argument for a value of the wrong type.)");
+}
+
 }  // namespace
 
 void bind_sim(py::module_& m) {
   bind_writer_profile(m);
   bind_simulated_device(m);
   bind_registry(m);
+  bind_person_traces(m);
 }
 
 }  // namespace calligraphy::python

@@ -40,7 +40,8 @@ int run_acceptance(const AcceptanceCommand& command) {
   if (!command.markdown.empty()) invocation += " --markdown " + command.markdown;
   invocation +=
       " --characters " + std::to_string(command.characters) + " --seed " + std::to_string(command.seed);
-  const std::string section = acceptance_markdown(measurement, invocation);
+  const std::string section = std::string(kAcceptanceGeneratedBegin) + "\n" +
+                              acceptance_markdown(measurement, invocation) + kGeneratedEnd + "\n";
   if (command.markdown.empty() || command.markdown == "-") {
     write_standard_output(section);
     return 0;
