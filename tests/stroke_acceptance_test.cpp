@@ -3,6 +3,8 @@
 // docs/stroke-acceptance.md (`calligraphy bench acceptance`). The package comes from
 // scripts/fetch-hanzi-writer-data.sh (scripts/test.sh runs it and sets CALLIGRAPHY_CORPUS_DIR); without it
 // the test says so and uses the 121-character sample in tests/data.
+#include "eval/stroke_acceptance.hpp"
+
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdlib>
@@ -10,7 +12,6 @@
 #include <iostream>
 
 #include "calligraphy/model/character_library.hpp"
-#include "eval/stroke_acceptance.hpp"
 #include "test_sizing.hpp"
 
 using namespace calligraphy;
@@ -20,11 +21,13 @@ namespace {
 std::filesystem::path corpus_folder() {
   if (const char* set = std::getenv("CALLIGRAPHY_CORPUS_DIR"); set != nullptr && *set != '\0') return set;
   if (const char* home = std::getenv("HOME"); home != nullptr) {
-    const std::filesystem::path cached = std::filesystem::path(home) / ".cache/calligraphy/hanzi-writer-data-2.0.1";
+    const std::filesystem::path cached =
+        std::filesystem::path(home) / ".cache/calligraphy/hanzi-writer-data-2.0.1";
     if (std::filesystem::is_directory(cached)) return cached;
   }
-  std::cout << "stroke acceptance: no hanzi-writer-data package (run scripts/fetch-hanzi-writer-data.sh and set "
-               "CALLIGRAPHY_CORPUS_DIR); using the sample in tests/data\n";
+  std::cout
+      << "stroke acceptance: no hanzi-writer-data package (run scripts/fetch-hanzi-writer-data.sh and set "
+         "CALLIGRAPHY_CORPUS_DIR); using the sample in tests/data\n";
   return std::filesystem::path(CALLIGRAPHY_SOURCE_DIR) / "tests/data/hanzi-writer-sample";
 }
 
@@ -41,8 +44,9 @@ double slack(double rate, std::size_t n) {
 
 }  // namespace
 
-TEST_CASE("People's strokes are accepted and wrong strokes refused on 500 characters the engine was not tuned on",
-          "[stroke_progress][acceptance]") {
+TEST_CASE(
+    "People's strokes are accepted and wrong strokes refused on 500 characters the engine was not tuned on",
+    "[stroke_progress][acceptance]") {
   const CharacterLibrary library = CharacterLibrary::from_directory(corpus_folder());
   const std::uint64_t seed = 2026;
   std::vector<char32_t> characters =

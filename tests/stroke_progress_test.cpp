@@ -1,12 +1,13 @@
 // Stroke progress and the stroke matcher (collision/stroke_progress.hpp, collision/stroke_matcher.hpp):
 // corners gone round on either side, ends short of or past the end, and the refusals, on strokes laid
 // out in a 60 mm box.
+#include "calligraphy/collision/stroke_progress.hpp"
+
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <vector>
 
 #include "calligraphy/collision/stroke_matcher.hpp"
-#include "calligraphy/collision/stroke_progress.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/scene.hpp"
 
@@ -84,8 +85,8 @@ TEST_CASE("A corner counts as gone round when the pen cuts it inside or overshoo
     INFO("cut inside by " << cut_mm << " mm");
     // Straight from 2 cut-lengths before the corner to 2 cut-lengths below it: the pen never crosses the
     // corner's feature plane x = corner.x.
-    const std::vector<Vec2> path = along({start, corner - mm(2 * cut_mm, 0), corner + mm(0, -2 * cut_mm),
-                                          corner + mm(0, -10)});
+    const std::vector<Vec2> path =
+        along({start, corner - mm(2 * cut_mm, 0), corner + mm(0, -2 * cut_mm), corner + mm(0, -10)});
     StrokeProgressTracker tracker;
     tracker.begin(hz, path.front(), StrokeAcceptance{});
     bool advanced = false;
@@ -105,7 +106,8 @@ TEST_CASE("A corner counts as gone round when the pen cuts it inside or overshoo
   CHECK(tracker.element_index() == 1);
 }
 
-TEST_CASE("A stroke is written when the pen lifts short of its end or past it, not half way", "[stroke_progress]") {
+TEST_CASE("A stroke is written when the pen lifts short of its end or past it, not half way",
+          "[stroke_progress]") {
   const Scene scene = test_scene();
   const PlacedStroke& h = scene.characters[0].strokes[1];
   const Vec2 a = h.start();
@@ -127,8 +129,9 @@ TEST_CASE("A stroke is written when the pen lifts short of its end or past it, n
   CHECK(moved.refusal == StrokeRefusal::wrong_place);
 }
 
-TEST_CASE("Past the end the pen may move in the end neighbourhood; leaving it off the stroke loses the stroke",
-          "[stroke_progress]") {
+TEST_CASE(
+    "Past the end the pen may move in the end neighbourhood; leaving it off the stroke loses the stroke",
+    "[stroke_progress]") {
   const Scene scene = test_scene();
   const PlacedStroke& h = scene.characters[0].strokes[1];
   const Vec2 a = h.start();
@@ -172,7 +175,8 @@ TEST_CASE("The stroke matcher names why a path does not write the expected strok
   CHECK(m.refusal == StrokeRefusal::none);
   CHECK(m.covered_fraction == Approx(1.0).margin(0.02));
   // A sparse path (the corners only) is read as straight lines between its points.
-  CHECK(match_stroke(c, 0, std::vector<Vec2>{hz.start(), hz.elements[0].end(), hz.end()}, kStartRadius).accepted);
+  CHECK(match_stroke(c, 0, std::vector<Vec2>{hz.start(), hz.elements[0].end(), hz.end()}, kStartRadius)
+            .accepted);
 
   m = match_stroke(c, 0, h_path, kStartRadius);
   CHECK_FALSE(m.accepted);
@@ -190,7 +194,8 @@ TEST_CASE("The stroke matcher names why a path does not write the expected strok
   for (Vec2& p : far) p += mm(0, 12);
   CHECK(match_stroke(c, 0, far, kStartRadius).refusal == StrokeRefusal::wrong_place);
 
-  const std::vector<Vec2> first_third(hz_path.begin(), hz_path.begin() + static_cast<long>(hz_path.size() / 3));
+  const std::vector<Vec2> first_third(hz_path.begin(),
+                                      hz_path.begin() + static_cast<long>(hz_path.size() / 3));
   CHECK(match_stroke(c, 0, first_third, kStartRadius).refusal == StrokeRefusal::too_short);
 }
 

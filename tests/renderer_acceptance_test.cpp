@@ -1,0 +1,138 @@
+// The renderer driven tick by tick by a pen that follows paths the engine did not make: the data's medians
+// and person-like paths (sim/person_traces.hpp) on random characters of the whole hanzi-writer-data
+// package. The renderer's verdict must be the stroke matcher's (collision/stroke_matcher.hpp) for the same
+// path: one rule of acceptance for every front-end.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <random>
+
+#include "calligraphy/collision/stroke_matcher.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/render/renderer.hpp"
+#include "calligraphy/sim/person_traces.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
+#include "eval/stroke_acceptance.hpp"
+#include "test_sizing.hpp"
+
+using namespace calligraphy;
+
+namespace {
+
+std::filesystem::path corpus_folder() {
+  if (const char* set = std::getenv("CALLIGRAPHY_CORPUS_DIR"); set != nullptr && *set != '\0') return set;
+  if (const char* home = std::getenv("HOME"); home != nullptr) {
+    const std::filesystem::path cached =
+        std::filesystem::path(home) / ".cache/calligraphy/hanzi-writer-data-2.0.1";
+    if (std::filesystem::is_directory(cached)) return cached;
+  }
+  std::cout << "renderer acceptance: no hanzi-writer-data package; using the sample in tests/data\n";
+  return std::filesystem::path(CALLIGRAPHY_SOURCE_DIR) / "tests/data/hanzi-writer-sample";
+}
+
+constexpr double kPeriod_s = 1e-3;
+constexpr double kSpeed_m_s = 0.08;  // a brisk hand: 80 mm/s
+constexpr double kDown_m = -0.0005;  // pressed 0.5 mm into the paper
+constexpr double kUp_m = 0.005;
+
+// A kinematic pen: ticks the renderer along `path` at kSpeed_m_s with the pen down, then lifts it. Returns
+// the renderer's output at the lift.
+struct Pen {
+  Renderer& renderer;
+  double time_s = 0.0;
+
+  RenderOutput at(const Vec2& p, double z, const Vec2& velocity) {
+    DeviceState s;
+    s.time_s = time_s;
+    s.position_m = Vec3(p.x(), p.y(), z);
+    s.velocity_m_s = Vec3(velocity.x(), velocity.y(), 0.0);
+    time_s += kPeriod_s;
+    return renderer.tick(s);
+  }
+
+  RenderOutput write(const std::vector<Vec2>& path) {
+    at(path.front(), kUp_m, Vec2::Zero());
+    at(path.front(), kDown_m, Vec2::Zero());
+    for (std::size_t i = 1; i < path.size(); ++i) {
+      const Vec2 step = path[i] - path[i - 1];
+      const int ticks = std::max(1, static_cast<int>(std::ceil(step.norm() / (kSpeed_m_s * kPeriod_s))));
+      const Vec2 velocity = step / (ticks * kPeriod_s);
+      for (int k = 1; k <= ticks; ++k)
+        at(path[i - 1] + step * (static_cast<double>(k) / ticks), kDown_m, velocity);
+    }
+    return at(path.back(), kUp_m, Vec2::Zero());
+  }
+};
+
+ForceLawParameters no_guidance() {
+  ForceLawParameters p;
+  p.guidance = false;  // a kinematic pen: the force does not move it, and its verdict is what is tested
+  return p;
+}
+
+}  // namespace
+
+TEST_CASE("The data's medians written tick by tick at a hand's pace complete every stroke of 100 characters",
+          "[stroke_progress][renderer]") {
+  const CharacterLibrary library = CharacterLibrary::from_directory(corpus_folder());
+  std::vector<char32_t> characters =
+      random_characters(library, 100, 7, CharacterLibrary::embedded().characters());
+  characters = testing::sanitizer_subset(characters, 10, "characters written tick by tick");
+  std::size_t strokes = 0;
+  std::size_t completed = 0;
+  std::size_t finished = 0;
+  for (const char32_t c : characters) {
+    const Scene scene = Scene::lay_out({library.load(c)});
+    Renderer renderer(scene, no_guidance(), simulated_phantom_desktop_info());
+    Pen pen{renderer};
+    for (const PlacedStroke& stroke : scene.characters[0].strokes) {
+      ++strokes;
+      if (pen.write(stroke.median_m).stroke_completed) ++completed;
+    }
+    if (renderer.active().finished()) ++finished;
+  }
+  std::cout << "medians tick by tick: " << completed << " of " << strokes << " strokes, " << finished
+            << " of " << characters.size() << " characters\n";
+  CHECK(completed == strokes);
+  CHECK(finished == characters.size());
+}
+
+TEST_CASE("The renderer and the stroke matcher give the same verdict on person-like paths",
+          "[stroke_progress][renderer]") {
+  const CharacterLibrary library = CharacterLibrary::from_directory(corpus_folder());
+  std::vector<char32_t> characters =
+      random_characters(library, 60, 11, CharacterLibrary::embedded().characters());
+  characters = testing::sanitizer_subset(characters, 6, "characters for the renderer-matcher comparison");
+  std::size_t paths = 0;
+  std::size_t agree = 0;
+  std::size_t accepted = 0;
+  for (const char32_t c : characters) {
+    const Scene scene = Scene::lay_out({library.load(c)});
+    const PlacedCharacter& character = scene.characters[0];
+    std::mt19937_64 random(c);
+    for (std::size_t s = 0; s < character.strokes.size(); ++s) {
+      for (const TraceKind kind : {TraceKind::human, TraceKind::pointer, TraceKind::ends_short,
+                                   TraceKind::half, TraceKind::reversed}) {
+        const std::vector<Vec2> path = person_trace(character, s, kind, random);
+        // A fresh renderer with the strokes before `s` written along their medians.
+        Renderer renderer(scene, no_guidance(), simulated_phantom_desktop_info());
+        Pen pen{renderer};
+        for (std::size_t before = 0; before < s; ++before) pen.write(character.strokes[before].median_m);
+        REQUIRE(renderer.active().stroke_index() == s);
+        const bool rendered = pen.write(path).stroke_completed;
+        const StrokeMatch match = match_stroke(character, s, path, scene.layout.start_radius_m);
+        ++paths;
+        if (rendered == match.accepted) ++agree;
+        if (match.accepted) ++accepted;
+      }
+    }
+  }
+  std::cout << "renderer and matcher: " << agree << " of " << paths
+            << " verdicts agree; the matcher accepted " << accepted << "\n";
+  // The matcher reads a path as straight lines every 0.25 mm, the renderer every tick (0.08 mm at 80 mm/s):
+  // a path right at a threshold may fall either side.
+  CHECK(static_cast<double>(agree) >= 0.995 * static_cast<double>(paths));
+  CHECK(accepted > paths / 3);  // both verdicts occur: the agreement is not vacuous
+}
