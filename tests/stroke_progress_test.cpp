@@ -130,7 +130,7 @@ TEST_CASE("A stroke is written when the pen lifts short of its end or past it, n
 }
 
 TEST_CASE(
-    "Past the end the pen may move in the end neighbourhood; leaving it off the stroke loses the stroke",
+    "Past the end the pen may move in the end neighbourhood, and leaving it off the stroke loses the stroke",
     "[stroke_progress]") {
   const Scene scene = test_scene();
   const PlacedStroke& h = scene.characters[0].strokes[1];
@@ -147,7 +147,7 @@ TEST_CASE(
   CHECK(back.completed_on_the_way);
 }
 
-TEST_CASE("A dot displaced along itself is written; half a dot is not", "[stroke_progress]") {
+TEST_CASE("A dot displaced along itself is written, and half a dot is not", "[stroke_progress]") {
   const Scene scene = test_scene();
   const PlacedStroke& dot = scene.characters[0].strokes[2];
   const Vec2 a = dot.start();

@@ -155,6 +155,10 @@ Vec2 Renderer::guidance_force(const DeviceState& device, RenderOutput& out, bool
   const double gain = parameters_.guidance_mode == GuidanceMode::fading ? parameters_.guidance_gain : 1.0;
   const double factor = gain * active_.attraction(nearest.t);
   Vec2 attraction = attraction_force(tip, rendered_foot_, parameters_.guidance_stiffness_n_per_m, factor);
+  // A pen past the element's end (its foot clamped there) is pulled onto the line, never back along the
+  // stroke to an end or corner it has passed; on the end plane the along-stroke part is zero, so this is
+  // continuous.
+  if (nearest.t >= 1.0) attraction -= attraction.dot(tangent) * tangent;
   // The replay point may lead or trail the pen along the stroke by more than R_res: the spring is
   // saturated at its force at replay_max_lead_m, so the force stays bounded and continuous. (The foot
   // point of the other modes is never further than R_res.)
@@ -242,7 +246,14 @@ RenderOutput Renderer::tick(const DeviceState& device) noexcept {
   // from the active start in another direction), never against coming back to it.
   off_stroke_velocity_ += off_stroke_alpha_ * (device.velocity_m_s.head<2>() - off_stroke_velocity_);
   const bool off_in_calibration = state_ == InteractionState::calibration;
-  const bool off_in_writing = writing && !out.in_constraint_space && !active_.attempt().passed_end();
+  // Past the end of the stroke (its last element's end plane, eq. 6) the pen is finishing, not leaving
+  // the stroke: nothing resists it or pulls it back to the end (docs/stroke-acceptance.md).
+  const PlacedStroke* active_stroke = active_.stroke();
+  const bool beyond_end =
+      writing && active_stroke != nullptr &&
+      (active_.attempt().passed_end() || (active_.element_index() + 1 == active_stroke->elements.size() &&
+                                          feature_plane_passed(active_stroke->elements.back(), tip)));
+  const bool off_in_writing = writing && !out.in_constraint_space && !beyond_end;
   if (!off_in_calibration) anchor_valid_ = false;
   if (parameters_.guidance && off_in_calibration) {
     if (!anchor_valid_) off_stroke_anchor_ = tip;  // adheres where CS was entered
