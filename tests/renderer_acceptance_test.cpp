@@ -14,23 +14,13 @@
 #include "calligraphy/render/renderer.hpp"
 #include "calligraphy/sim/person_traces.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
+#include "corpus_folder.hpp"
 #include "eval/stroke_acceptance.hpp"
 #include "test_sizing.hpp"
 
 using namespace calligraphy;
 
 namespace {
-
-std::filesystem::path corpus_folder() {
-  if (const char* set = std::getenv("CALLIGRAPHY_CORPUS_DIR"); set != nullptr && *set != '\0') return set;
-  if (const char* home = std::getenv("HOME"); home != nullptr) {
-    const std::filesystem::path cached =
-        std::filesystem::path(home) / ".cache/calligraphy/hanzi-writer-data-2.0.1";
-    if (std::filesystem::is_directory(cached)) return cached;
-  }
-  std::cout << "renderer acceptance: no hanzi-writer-data package; using the sample in tests/data\n";
-  return std::filesystem::path(CALLIGRAPHY_SOURCE_DIR) / "tests/data/hanzi-writer-sample";
-}
 
 constexpr double kPeriod_s = 1e-3;
 constexpr double kSpeed_m_s = 0.08;  // a brisk hand: 80 mm/s
@@ -76,7 +66,7 @@ ForceLawParameters no_guidance() {
 
 TEST_CASE("The data's medians written tick by tick at a hand's pace complete every stroke of 100 characters",
           "[stroke_progress][renderer]") {
-  const CharacterLibrary library = CharacterLibrary::from_directory(corpus_folder());
+  const CharacterLibrary library = CharacterLibrary::from_directory(testing::corpus_folder());
   std::vector<char32_t> characters =
       random_characters(library, 100, 7, CharacterLibrary::embedded().characters());
   characters = testing::sanitizer_subset(characters, 10, "characters written tick by tick");
@@ -101,7 +91,7 @@ TEST_CASE("The data's medians written tick by tick at a hand's pace complete eve
 
 TEST_CASE("The renderer and the stroke matcher give the same verdict on person-like paths",
           "[stroke_progress][renderer]") {
-  const CharacterLibrary library = CharacterLibrary::from_directory(corpus_folder());
+  const CharacterLibrary library = CharacterLibrary::from_directory(testing::corpus_folder());
   std::vector<char32_t> characters =
       random_characters(library, 60, 11, CharacterLibrary::embedded().characters());
   characters = testing::sanitizer_subset(characters, 6, "characters for the renderer-matcher comparison");

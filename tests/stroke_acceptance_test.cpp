@@ -12,24 +12,12 @@
 #include <iostream>
 
 #include "calligraphy/model/character_library.hpp"
+#include "corpus_folder.hpp"
 #include "test_sizing.hpp"
 
 using namespace calligraphy;
 
 namespace {
-
-std::filesystem::path corpus_folder() {
-  if (const char* set = std::getenv("CALLIGRAPHY_CORPUS_DIR"); set != nullptr && *set != '\0') return set;
-  if (const char* home = std::getenv("HOME"); home != nullptr) {
-    const std::filesystem::path cached =
-        std::filesystem::path(home) / ".cache/calligraphy/hanzi-writer-data-2.0.1";
-    if (std::filesystem::is_directory(cached)) return cached;
-  }
-  std::cout
-      << "stroke acceptance: no hanzi-writer-data package (run scripts/fetch-hanzi-writer-data.sh and set "
-         "CALLIGRAPHY_CORPUS_DIR); using the sample in tests/data\n";
-  return std::filesystem::path(CALLIGRAPHY_SOURCE_DIR) / "tests/data/hanzi-writer-sample";
-}
 
 // Rates the matcher reaches on these paths (docs/stroke-acceptance.md): at least 98 % of each positive
 // kind accepted (99.3 % or more but for strokes lifted short, 98.0-98.7 %), at most 1 % of each negative
@@ -47,7 +35,7 @@ double slack(double rate, std::size_t n) {
 TEST_CASE(
     "People's strokes are accepted and wrong strokes refused on 500 characters the engine was not tuned on",
     "[stroke_progress][acceptance]") {
-  const CharacterLibrary library = CharacterLibrary::from_directory(corpus_folder());
+  const CharacterLibrary library = CharacterLibrary::from_directory(testing::corpus_folder());
   const std::uint64_t seed = 2026;
   std::vector<char32_t> characters =
       random_characters(library, 500, seed, CharacterLibrary::embedded().characters());
