@@ -79,19 +79,6 @@ py::tuple nearest_point_py(const ElementLike& element_object, const ArrayLike& p
   return py::make_tuple(t, foot, distance);
 }
 
-// Indices name a character or stroke by its place in the writing order, so negative ones (Python's
-// counting from the end) are refused rather than silently naming the last stroke.
-std::size_t index_below(const Checked<long long>& index, std::size_t count, const std::string& name,
-                        const std::string& what) {
-  const long long i = take(index, name);
-  if (i < 0 || static_cast<unsigned long long>(i) >= count) {
-    throw py::index_error(name + ": " + std::to_string(i) + " is not in 0.." +
-                          std::to_string(static_cast<long long>(count) - 1) + " (" + what + " has " +
-                          std::to_string(count) + ")");
-  }
-  return static_cast<std::size_t>(i);
-}
-
 // A pen-down path (N, 2) [m], N >= 1, every point finite.
 std::vector<Vec2> path_from(py::handle object) {
   const Vectors v = as_vectors(object, 2, "path_m");
@@ -110,12 +97,10 @@ std::vector<Vec2> path_from(py::handle object) {
 StrokeMatch match_stroke_py(const Checked<Scene>& scene_object, const Checked<long long>& character_index,
                             const Checked<long long>& stroke_index, const ArrayLike& path_object,
                             const std::optional<Checked<StrokeAcceptance>>& acceptance_object) {
-  if (!py::isinstance<Scene>(scene_object.object)) throw_type_error("scene", "Scene", scene_object.object);
+  const StrokeOfScene target = stroke_of_scene(scene_object, character_index, stroke_index);
+  const PlacedCharacter& character = target.character;
+  const std::size_t stroke = target.stroke;
   const Scene& scene = scene_object.object.cast<const Scene&>();
-  const PlacedCharacter& character = scene.characters[index_below(
-      character_index, scene.characters.size(), "character_index", "the scene's characters")];
-  const std::size_t stroke =
-      index_below(stroke_index, character.strokes.size(), "stroke_index", "the character's strokes");
   const std::vector<Vec2> path_m = path_from(path_object.object);
   const StrokeAcceptance acceptance =
       acceptance_object ? take(*acceptance_object, "acceptance") : StrokeAcceptance{};
@@ -213,8 +198,9 @@ void bind_collision(py::module_& m) {
 (taking the strokes before it as written), and if not, why (include/calligraphy/collision/stroke_matcher.hpp).
 It is the renderer's rule: the path enters the stroke where it first comes within
 scene.layout.start_radius_m of the stroke's start (WS), progress is tracked along the stroke's centre
-line, and the path's end is the pen's lift, so a Renderer ticked along the same path gives the same
-verdict. A refusal is named by trying the path on the character's other strokes and reversed.
+line, and the path's end is the pen's lift, so a Renderer whose pen moves along the same path (points at
+most 0.25 mm apart, one per tick: how the matcher reads it) writes the stroke exactly when this accepts
+it. A refusal is named by trying the path on the character's other strokes and reversed.
 
 path_m: array-like (N, 2), N >= 1, points on the paper in writing order [m], at any spacing (read as
         straight lines between them).

@@ -522,4 +522,29 @@ void bind_model(py::module_& m) {
   bind_scene(m);
 }
 
+namespace {
+
+std::size_t index_below(const Checked<long long>& index, std::size_t count, const std::string& name,
+                        const std::string& what) {
+  const long long i = take(index, name);
+  if (i < 0 || static_cast<unsigned long long>(i) >= count) {
+    throw py::index_error(name + ": " + std::to_string(i) + " is not in 0.." +
+                          std::to_string(static_cast<long long>(count) - 1) + " (" + what + " has " +
+                          std::to_string(count) + ")");
+  }
+  return static_cast<std::size_t>(i);
+}
+
+}  // namespace
+
+StrokeOfScene stroke_of_scene(const Checked<Scene>& scene_object, const Checked<long long>& character_index,
+                              const Checked<long long>& stroke_index) {
+  if (!py::isinstance<Scene>(scene_object.object)) throw_type_error("scene", "Scene", scene_object.object);
+  const Scene& scene = scene_object.object.cast<const Scene&>();
+  const PlacedCharacter& character = scene.characters[index_below(
+      character_index, scene.characters.size(), "character_index", "the scene's characters")];
+  return {character,
+          index_below(stroke_index, character.strokes.size(), "stroke_index", "the character's strokes")};
+}
+
 }  // namespace calligraphy::python

@@ -5,8 +5,10 @@
 #include <string>
 #include <vector>
 
+#include "arguments.hpp"
 #include "calligraphy/model/character.hpp"
 #include "calligraphy/model/element.hpp"
+#include "calligraphy/model/scene.hpp"
 #include "character_source.hpp"
 
 namespace calligraphy::python {
@@ -20,5 +22,15 @@ StrokeElement element_from_points(py::handle object, const std::string& name);
 /// Characters; TypeError or InvalidArgument naming `name` otherwise or when there are none.
 std::vector<Character> characters_from(py::handle object, const CharacterSource& library,
                                        const std::string& name);
+
+/// Stroke `stroke_index` of character `character_index` of `scene`. Indices name a stroke by its place in
+/// the writing order, so negative ones (Python's counting from the end) are refused with the others out of
+/// range: IndexError naming the argument; TypeError when `scene` is not a Scene. The scene must outlive it.
+struct StrokeOfScene {
+  const PlacedCharacter& character;
+  std::size_t stroke;
+};
+StrokeOfScene stroke_of_scene(const Checked<Scene>& scene, const Checked<long long>& character_index,
+                              const Checked<long long>& stroke_index);
 
 }  // namespace calligraphy::python

@@ -21,6 +21,7 @@
 #include "calligraphy/sim/simulated_device.hpp"
 #include "calligraphy/sim/simulated_writer.hpp"
 #include "log_forwarding.hpp"
+#include "model_bindings.hpp"
 #include "numpy_arrays.hpp"
 #include "parameter_class.hpp"
 
@@ -238,34 +239,6 @@ void bind_registry(py::module_& m) {
       "`calligraphy devices` does (which also lists its Phantom emulator). Returns a DeviceSurvey; a backend "
       "that fails adds "
       "a note instead of raising.");
-}
-
-// Indices name a character or stroke by its place in the writing order, so negative ones (Python's
-// counting from the end) are refused rather than silently naming the last stroke.
-std::size_t index_below(const Checked<long long>& index, std::size_t count, const std::string& name,
-                        const std::string& what) {
-  const long long i = take(index, name);
-  if (i < 0 || static_cast<unsigned long long>(i) >= count) {
-    throw py::index_error(name + ": " + std::to_string(i) + " is not in 0.." +
-                          std::to_string(static_cast<long long>(count) - 1) + " (" + what + " has " +
-                          std::to_string(count) + ")");
-  }
-  return static_cast<std::size_t>(i);
-}
-
-struct StrokeOfScene {
-  const PlacedCharacter& character;
-  std::size_t stroke;
-};
-
-StrokeOfScene stroke_of_scene(const Checked<Scene>& scene_object, const Checked<long long>& character_index,
-                              const Checked<long long>& stroke_index) {
-  if (!py::isinstance<Scene>(scene_object.object)) throw_type_error("scene", "Scene", scene_object.object);
-  const Scene& scene = scene_object.object.cast<const Scene&>();
-  const PlacedCharacter& character = scene.characters[index_below(
-      character_index, scene.characters.size(), "character_index", "the scene's characters")];
-  return {character,
-          index_below(stroke_index, character.strokes.size(), "stroke_index", "the character's strokes")};
 }
 
 void bind_person_traces(py::module_& m) {
