@@ -59,10 +59,13 @@ StrokeProgressTracker::Foot StrokeProgressTracker::foot_near(const Vec2& tip_m, 
                                                              double to_arc_m) const noexcept {
   const StrokeCentreLine& line = stroke_->centre_line;
   Foot best{from_arc_m, std::numeric_limits<double>::infinity(), Vec2::UnitX()};
-  for (std::size_t k = 1; k < line.points_m.size(); ++k) {
+  // Only the segments in the window: the first that ends at or after from_arc_m, by bisection (the arcs
+  // increase), up to the first that starts after to_arc_m.
+  const auto first_end = std::lower_bound(line.arc_m.begin() + 1, line.arc_m.end(), from_arc_m);
+  for (auto k = static_cast<std::size_t>(first_end - line.arc_m.begin()); k < line.points_m.size(); ++k) {
     const double arc_a = line.arc_m[k - 1];
     const double arc_b = line.arc_m[k];
-    if (arc_b < from_arc_m || arc_a > to_arc_m) continue;
+    if (arc_a > to_arc_m) break;
     const Vec2& a = line.points_m[k - 1];
     const Vec2& b = line.points_m[k];
     const double segment = arc_b - arc_a;

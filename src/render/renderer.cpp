@@ -248,12 +248,13 @@ RenderOutput Renderer::tick(const DeviceState& device) noexcept {
   const bool off_in_calibration = state_ == InteractionState::calibration;
   // Past the end of the stroke (its last element's end plane, eq. 6) the pen is finishing, not leaving
   // the stroke: nothing resists it or pulls it back to the end (docs/stroke-acceptance.md).
-  const PlacedStroke* active_stroke = active_.stroke();
-  const bool beyond_end =
-      writing && active_stroke != nullptr &&
-      (active_.attempt().passed_end() || (active_.element_index() + 1 == active_stroke->elements.size() &&
-                                          feature_plane_passed(active_stroke->elements.back(), tip)));
-  const bool off_in_writing = writing && !out.in_constraint_space && !beyond_end;
+  const auto beyond_end = [&] {
+    const PlacedStroke* s = active_.stroke();
+    return s != nullptr &&
+           (active_.attempt().passed_end() || (active_.element_index() + 1 == s->elements.size() &&
+                                               feature_plane_passed(s->elements.back(), tip)));
+  };
+  const bool off_in_writing = writing && !out.in_constraint_space && !beyond_end();
   if (!off_in_calibration) anchor_valid_ = false;
   if (parameters_.guidance && off_in_calibration) {
     if (!anchor_valid_) off_stroke_anchor_ = tip;  // adheres where CS was entered
