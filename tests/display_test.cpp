@@ -175,6 +175,7 @@ TEST_CASE("A lock-step trial publishes each tick, its trace, and its stroke even
     CHECK(completed[i].mean_deviation_m == m.mean_deviation_m);
     CHECK(completed[i].max_deviation_m == m.max_deviation_m);
     CHECK(completed[i].attempts == m.attempts);
+    CHECK(completed[i].refusal == StrokeRefusal::none);
   }
   REQUIRE(characters.size() == 2);
   CHECK(characters[0].character == 0);
@@ -185,7 +186,7 @@ TEST_CASE("A lock-step trial publishes each tick, its trace, and its stroke even
   CHECK(events.back().end == TrialEnd::completed);
 }
 
-TEST_CASE("Lifting the pen while writing publishes the abandoned stroke", "[display]") {
+TEST_CASE("Lifting the pen while writing publishes the abandoned stroke and why", "[display]") {
   const Scene scene = scene_of(U"十");
   DisplayChannel channel;
   TrialSession session(scene, simulated_phantom_desktop_info(), TrialOptions{});
@@ -202,8 +203,8 @@ TEST_CASE("Lifting the pen while writing publishes the abandoned stroke", "[disp
   for (int i = 0; i < 20; ++i) at(start, 0.01);    // above the paper: SS
   for (int i = 0; i < 20; ++i) at(start, -0.002);  // down at the start: WS
   CHECK(channel.latest().state == InteractionState::writing);
-  for (int i = 0; i < 20; ++i) at(start + 0.3 * (end - start), -0.002);
-  for (int i = 0; i < 20; ++i) at(start + 0.3 * (end - start), 0.01);  // lifted: abandoned
+  for (int i = 0; i < 20; ++i) at(start + 0.3 * (i / 19.0) * (end - start), -0.002);  // a third along
+  for (int i = 0; i < 20; ++i) at(start + 0.3 * (end - start), 0.01);                 // lifted: abandoned
   const DisplaySnapshot lifted = channel.latest();
   CHECK(lifted.state == InteractionState::separation);
   CHECK(lifted.pen_height_m == Approx(0.01));
@@ -214,6 +215,7 @@ TEST_CASE("Lifting the pen while writing publishes the abandoned stroke", "[disp
   CHECK(events[0].kind == DisplayEventKind::stroke_abandoned);
   CHECK(events[0].stroke_index == 0);
   CHECK(events[0].tick == 61);
+  CHECK(events[0].refusal == StrokeRefusal::too_short);  // the renderer's reason, for the learner
 
   session.attach_display(nullptr);  // detached: nothing more is published
   at(start, 0.01);

@@ -83,6 +83,13 @@ std::vector<std::pair<std::size_t, QuizEvent>> LiveQuiz::finish() {
   return out;
 }
 
+bool LiveQuiz::complete() const noexcept {
+  for (const QuizSession& s : sessions_) {
+    if (!s.complete()) return false;
+  }
+  return true;
+}
+
 std::vector<std::vector<QuizEvent>> LiveQuiz::events() const {
   std::vector<std::vector<QuizEvent>> all;
   for (const QuizSession& s : sessions_) all.push_back(s.events());

@@ -57,6 +57,8 @@ class LiveQuiz {
     return last_event_;
   }
   [[nodiscard]] bool finished() const noexcept { return finished_; }
+  /// Every stroke of every character accepted: the quiz, and so its trial, is complete.
+  [[nodiscard]] bool complete() const noexcept;
   [[nodiscard]] std::uint64_t dropped_points() const noexcept { return dropped_points_; }
 
  private:

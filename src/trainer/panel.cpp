@@ -42,6 +42,7 @@ ImVec4 state_colour(InteractionState state) {
 
 void results_table(const TrialView& view) {
   if (view.results.empty()) {
+    if (view.refused) return;  // the refusal above says what happened
     ImGui::TextDisabled("no stroke written yet");
     return;
   }
@@ -76,6 +77,20 @@ void results_table(const TrialView& view) {
 
 const ImVec4 kGood(0.1f, 0.55f, 0.15f, 1);
 const ImVec4 kBad(0.8f, 0.1f, 0.1f, 1);
+
+// The last refused attempt, until the pen touches the paper again: what it did, large, and what to do.
+void refusal(const TrialView& view, const PanelInput& input) {
+  const RefusedStroke& r = *view.refused;
+  const RefusalWords words = learner_words(r.refusal);
+  ImGui::Text("stroke %u not written:", r.stroke + 1);
+  if (input.large_font != nullptr) ImGui::PushFont(input.large_font);
+  ImGui::TextColored(kBad, "%s", words.what);
+  if (input.large_font != nullptr) ImGui::PopFont();
+  ImGui::PushStyleColor(ImGuiCol_Text, kBad);
+  ImGui::TextWrapped("%s", words.advice);
+  ImGui::PopStyleColor();
+  ImGui::Separator();
+}
 
 // The quiz's state: per character, stroke k of n and the misses; the last verdict, "backwards" when the
 // stroke was written from its end, the hint, and "complete, M misses" once every stroke is accepted.
@@ -157,6 +172,24 @@ void summary(const TrialView& view, const PanelInput& input) {
 
 }  // namespace
 
+RefusalWords learner_words(StrokeRefusal refusal) noexcept {
+  switch (refusal) {
+    case StrokeRefusal::too_short:
+      return {"too short", "carry the stroke to its end"};
+    case StrokeRefusal::backwards:
+      return {"backwards", "start from the other end"};
+    case StrokeRefusal::wrong_place:
+      return {"wrong place", "follow the outline"};
+    case StrokeRefusal::wrong_stroke:
+      return {"wrong stroke", "that is another stroke"};
+    case StrokeRefusal::wrong_order:
+      return {"wrong order", "that stroke comes later"};
+    case StrokeRefusal::none:
+      break;
+  }
+  return {"not written", "try it again"};
+}
+
 void draw_panel(const WindowLayout& layout, double panel_width_px, const PanelInput& input) {
   ImGui::SetNextWindowPos(ImVec2(static_cast<float>(layout.area_width_px()), 0));
   ImGui::SetNextWindowSize(
@@ -212,6 +245,7 @@ void draw_panel(const WindowLayout& layout, double panel_width_px, const PanelIn
     quiz_state(*view, input);
     ImGui::Separator();
   }
+  if (view->refused) refusal(*view, input);
   results_table(*view);
   if (view->have_result) {
     summary(*view, input);

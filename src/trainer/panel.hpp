@@ -1,8 +1,10 @@
 #pragma once
 // The panel on the right of the trainer's window: the trial, the interaction state (SS/AS/CS/WS, paper
-// Table 1), the pen, the per-stroke results as strokes finish, and the summary with the keys at the end.
+// Table 1), the pen, why the last attempt was refused, the per-stroke results as strokes finish, and the
+// summary with the keys at the end.
 #include <string>
 
+#include "calligraphy/collision/stroke_progress.hpp"
 #include "trainer/layout.hpp"
 #include "trainer/trial_view.hpp"
 
@@ -26,6 +28,14 @@ struct PanelInput {
   double frame_rate_hz = 0.0;
   ImFont* large_font = nullptr;
 };
+
+/// A refusal in the learner's words: what the attempt did ("backwards") and what to do instead ("start
+/// from the other end").
+struct RefusalWords {
+  const char* what;
+  const char* advice;
+};
+[[nodiscard]] RefusalWords learner_words(StrokeRefusal refusal) noexcept;
 
 void draw_panel(const WindowLayout& layout, double panel_width_px, const PanelInput& input);
 

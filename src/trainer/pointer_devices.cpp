@@ -89,6 +89,7 @@ class MouseHandDevice final : public HapticDevice {
   void open() override {
     device_.open();
     last_s_ = steady_seconds();
+    touched_ = false;
   }
   void close() noexcept override { device_.close(); }
   [[nodiscard]] bool is_open() const override { return device_.is_open(); }
@@ -99,9 +100,35 @@ class MouseHandDevice final : public HapticDevice {
     // A stalled thread does not make the physics jump: at most 50 ms are integrated at once.
     device_.advance(std::clamp(now_s - last_s_, 0.0, 0.05));
     last_s_ = now_s;
-    return device_.read_state();
+    DeviceState state = device_.read_state();
+    hold_on_paper_while_pressed(state);
+    return state;
   }
   void write_force(const Vec3& force_n) override { device_.write_force(force_n); }
+
+  // One touch is one pen-down. The simulated stylus lands on a stiff paper behind a soft, lightly damped
+  // hand, so it bounces: about 57 ms above the paper's contact hysteresis, which the renderer reads as a
+  // lift and a new touch (an abandoned attempt, a doubled count, a spurious "too short" in a quiz). A
+  // hand's pen does not leave the paper while it presses, so from the first contact of a press until the
+  // button is released the reported pen is held at most on the paper (the stylus' in-plane motion and its
+  // depth below the paper are reported as they are). A release debounce (e.g. 30 ms) would not do: it
+  // must outlast the bounce, and every real lift would then come that much late, the pen moving on the
+  // paper meanwhile; with the hold, a release lifts the pen at once.
+  void hold_on_paper_while_pressed(DeviceState& state) {
+    double x = 0.0;
+    double y = 0.0;
+    bool pressed = false;
+    pointer_input().get(x, y, pressed);
+    if (!pressed) {
+      touched_ = false;
+      return;
+    }
+    if (state.position_m.z() <= kPaperZM) touched_ = true;
+    if (touched_ && state.position_m.z() > kPaperZM) {
+      state.position_m.z() = kPaperZM;
+      state.velocity_m_s.z() = 0.0;  // held on the paper: not moving off it
+    }
+  }
 
   static SimulatedDeviceParameters parameters() {
     SimulatedDeviceParameters p;
@@ -111,9 +138,11 @@ class MouseHandDevice final : public HapticDevice {
   }
 
  private:
+  static constexpr double kPaperZM = 0.0;  // the trainer's scenes lay the paper at z = 0 (SceneLayout)
   SimulatedDevice device_;
   PointerHand hand_;
   double last_s_ = 0.0;
+  bool touched_ = false;  // the pen has met the paper since the button went down
 };
 
 DeviceInfo mouse_info() {

@@ -3,7 +3,9 @@
 //   "mouse"       2-DOF on the paper plane; the left button puts the pen on the paper; no force output
 //                 (the paper's vision-only condition, section 7.1).
 //   "mouse-hand"  a simulated Phantom Desktop whose stylus is held by a simulated hand coupled to the
-//                 mouse through a hand impedance, so guidance visibly pulls the pen towards the stroke.
+//                 mouse through a hand impedance, so guidance visibly pulls the pen towards the stroke;
+//                 from its first contact until the button is released the pen stays on the paper (one
+//                 press, one touch: the stylus' bounce on landing is not a lift).
 // The window thread writes the pointer (paper metres, button) and the servo thread reads it, lock-free.
 #include <atomic>
 #include <cstdint>

@@ -20,6 +20,9 @@ constexpr ImU32 kOutline = IM_COL32(214, 214, 214, 255);
 constexpr ImU32 kActive = IM_COL32(255, 214, 0, 255);
 constexpr ImU32 kReference = IM_COL32(0, 60, 255, 255);
 constexpr ImU32 kTrace = IM_COL32(110, 230, 110, 255);
+// A refused attempt stays until the next touch-down, greyed so that it reads as not written next to the
+// green of the written strokes, yet stays visible on the yellow of the active character.
+constexpr ImU32 kRefused = IM_COL32(150, 150, 150, 255);
 constexpr ImU32 kHint = IM_COL32(235, 0, 0, 255);
 constexpr ImU32 kPen = IM_COL32(40, 40, 40, 255);
 constexpr ImU32 kVirtualTip = IM_COL32(255, 120, 0, 255);
@@ -182,6 +185,7 @@ void draw_scene(ImDrawList& draw, const WindowLayout& layout, const std::vector<
     draw_quiz_ink(draw, layout, *view);
   } else if (view !=
              nullptr) {  // the trace under the reference, so that both stay visible where they overlap
+    if (view->refused) draw_ink(draw, layout, *view, view->refused->points_m, kRefused);
     for (const TraceSegment& segment : view->segments) {
       std::vector<ImVec2> points;
       for (const Vec2& p : segment.points_m) points.push_back(im(trial_to_screen(layout, *view, p)));

@@ -2,9 +2,9 @@
 // Draws the row of characters and the live trial into the window's background (paper section 7.2,
 // Figs. 30-31, and Hanzi Writer's look): filled stroke outlines in light grey, the active character's in
 // yellow; the reference (the fitted stroke elements) in blue; the pen's trace while writing in light
-// green; a red ellipse at the active stroke's start (at every stroke's start once the trial ended); the
-// pen tip (HIP, and the VTP on the paper when the HIP is below it) with its height on a gauge; the
-// in-plane force as an arrow.
+// green, a refused attempt in grey until the next touch-down; a red ellipse at the active stroke's start (at
+// every stroke's start once the trial ended); the pen tip (HIP, and the VTP on the paper when the HIP is
+// below it) with its height on a gauge; the in-plane force as an arrow.
 #include <array>
 #include <vector>
 

@@ -57,6 +57,7 @@ void WindowSessionHost::prepare_trial(const PlannedTrial& /*trial*/, TrialOption
   options.display = channel.get();
   const std::lock_guard lock(mutex_);
   view_.channel = std::move(channel);  // kept alive here and by the window's copies
+  view_.acceptance = options.force.acceptance;
   view_.phase = SessionPhase::running;
 }
 

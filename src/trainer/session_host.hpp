@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 
+#include "calligraphy/collision/stroke_progress.hpp"
 #include "calligraphy/study/session_runner.hpp"
 #include "calligraphy/trial/display.hpp"
 
@@ -27,6 +28,7 @@ struct SessionView {
   ConditionMode mode = ConditionMode::vision;
   bool guidance = false;
   std::shared_ptr<DisplayChannel> channel;  ///< the running (or last) trial's
+  StrokeAcceptance acceptance;  ///< the running (or last) trial's, to judge pen-downs that never reach WS
   std::chrono::steady_clock::time_point rest_until;
   std::optional<TrialOutcome> outcome;
 };

@@ -125,6 +125,10 @@ void TrainerApp::loop() {
     if (view_ && worker_.active()) {
       view_->consume(*channel_, typical_ids_[view_->character]);
       log_quiz(*view_);
+      log_refusal(*view_);
+      // The quiz asks for every stroke in order, judged its own way: once each is accepted the trial has
+      // done its job and ends (saved as completed, see finish_trial), whatever the renderer counted.
+      if (view_->quiz && view_->quiz->complete() && !worker_.done()) worker_.request_stop();
     }
     if (worker_.active() && worker_.done()) finish_trial();
     if (!worker_.active() && session_ == nullptr) {

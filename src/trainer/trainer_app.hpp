@@ -2,7 +2,8 @@
 // TrainerApp: the window of `calligraphy train` and of a study session in the window (trainer.hpp). Its
 // methods live in files by job: trainer_app.cpp (construction, the loop, keys, pointer), trainer_window.cpp
 // (window, fonts, drawing, screenshots), trainer_trials.cpp (a trial's start and end, measurements),
-// trainer_session_view.cpp (a study session's view), trainer_quiz_log.cpp (the quiz's verdicts).
+// trainer_session_view.cpp (a study session's view), trainer_quiz_log.cpp (the quiz's verdicts, refused
+// strokes).
 #include <imgui.h>
 
 #include <atomic>
@@ -81,8 +82,9 @@ class TrainerApp {
   Scene session_scene(const PlannedTrial& trial) const;
   void session_panel(PanelInput& panel) const;
 
-  // the quiz's verdicts (trainer_quiz_log.cpp)
+  // the quiz's verdicts and the refused strokes (trainer_quiz_log.cpp)
   void log_quiz(TrialView& view);
+  void log_refusal(TrialView& view);
   [[nodiscard]] std::string character_utf8(const TrialView& view, std::size_t character) const;
   void check_quiz_against_trace(const LiveQuiz& quiz, const TrialResult& result);
 

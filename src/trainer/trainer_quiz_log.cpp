@@ -1,11 +1,12 @@
 // The trainer's quiz log: each live verdict on stderr (and a screenshot when asked), and the live verdicts
-// checked against those the saved record gives for the whole trace.
+// checked against those the saved record gives for the whole trace; each refused stroke on stderr.
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "study/trial_record.hpp"
+#include "trainer/panel.hpp"
 #include "trainer/trainer_app.hpp"
 
 namespace calligraphy::trainer {
@@ -31,6 +32,19 @@ void TrainerApp::log_quiz(TrialView& view) {
     }
   }
   view.quiz_unlogged.clear();
+}
+
+// A refused attempt, as the panel words it, once on stderr (the test harness and logs read it).
+void TrainerApp::log_refusal(TrialView& view) {
+  if (view.refusals == view.refusals_logged) return;
+  view.refusals_logged = view.refusals;
+  if (!view.refused) return;  // already replaced by a touch-down in the same frame
+  const RefusedStroke& r = *view.refused;
+  const RefusalWords words = learner_words(r.refusal);
+  std::fprintf(stderr, "%s: %s stroke %u not written: %s: %s (%s; %s)\n",
+               session_ ? "calligraphy session" : "calligraphy train",
+               character_utf8(view, r.character).c_str(), r.stroke + 1, words.what, words.advice,
+               to_string(r.refusal), r.judged_from_path ? "judged from the pen-down path" : "judged in WS");
 }
 
 std::string TrainerApp::character_utf8(const TrialView& view, std::size_t character) const {

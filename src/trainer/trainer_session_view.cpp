@@ -48,9 +48,14 @@ void TrainerApp::follow_session() {
     show_session_trial(s);
   }
   if (!view_ || s.trial_generation != shown_generation_) return;
-  if (s.channel && s.channel != session_channel_) session_channel_ = s.channel;
+  if (s.channel && s.channel != session_channel_) {
+    session_channel_ = s.channel;
+    view_->scene = &session_scene_;  // laid out as the session runner lays out the trial's scene
+    view_->acceptance = s.acceptance;
+  }
   if (session_channel_) view_->consume(*session_channel_, typical_ids_.front());
   log_quiz(*view_);
+  log_refusal(*view_);
   if (s.outcome && !view_->have_result) {
     view_->have_result = true;
     view_->ended = true;

@@ -56,6 +56,8 @@ void TrainerApp::start_trial(std::size_t character) {
   trial_options_ = trial;
   trial_options_.display = nullptr;
   worker_.start(std::move(scene), options_.device, std::move(trial));
+  view_->scene = &worker_.scene();
+  view_->acceptance = trial_options_.force.acceptance;
   if (options_.quiz) view_->quiz.emplace(worker_.scene(), options_.quiz_options);
   advance_at_.reset();
 }
@@ -78,7 +80,15 @@ void TrainerApp::finish_trial() {
   }
   view.consume(*channel_, typical_ids_[view.character]);
   log_quiz(view);
+  log_refusal(view);
   if (view.quiz) check_quiz_against_trace(*view.quiz, result);
+  if (view.quiz && view.quiz->complete() && result.end == TrialEnd::interrupted) {
+    // Stopped once the quiz was complete (by the loop, or a key in the same moment): the quiz's task is
+    // done, so the trial is complete, and saved as a trial rather than an attempt.
+    result.end = TrialEnd::completed;
+    result.aborted = false;
+    result.abort_reason.clear();
+  }
   view.have_result = true;
   view.ended = true;
   view.end = result.end;
@@ -90,7 +100,11 @@ void TrainerApp::finish_trial() {
     guidance_gain_ = next_guidance_gain(guidance_gain_, *result.metrics.mean_deviation_m);
     std::fprintf(stderr, "calligraphy train: fading: next trial's guidance gain %.3f\n", guidance_gain_);
   }
-  if (!options_.record.empty() && result.end == TrialEnd::completed) save_recording(view, result);
+  // A teacher's recording must write every stroke as the renderer reads it (replay follows it stroke by
+  // stroke); a completed quiz need not have.
+  if (!options_.record.empty() && result.end == TrialEnd::completed &&
+      result.metrics.strokes_completed == result.metrics.strokes_total)
+    save_recording(view, result);
   const std::string& utf8 = options_.characters[view.character].utf8;
   std::fprintf(stderr,
                "calligraphy train: trial %zu %s: %s, %zu/%zu strokes in order, mean %.2f mm, %.1f s\n",

@@ -115,6 +115,7 @@ void DisplayPublisher::publish_tick(std::uint64_t tick, const DeviceState& state
     e.stroke = s.stroke;
     e.stroke_index = s.stroke_index;
     e.strokes_completed = s.strokes_completed;
+    e.refusal = output.refusal;
     channel_->push_event(e);
   }
   // The recorder completes strokes in order, so the one completed this tick is the last one counted.

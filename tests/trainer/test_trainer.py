@@ -18,6 +18,7 @@ import time
 import unittest
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from hand import Hand  # noqa: E402
 from png import read_png  # noqa: E402
 
 CLI = os.environ.get("CALLIGRAPHY_CLI", "calligraphy")
@@ -79,6 +80,18 @@ class Trainer:
 
     def errors(self):
         return (self.folder / "stderr.txt").read_text()
+
+    def wait_for(self, text, timeout=20):
+        """Waits until the trainer has printed `text` on stderr."""
+        deadline = time.time() + timeout
+        while text not in self.errors():
+            if time.time() > deadline or self.process.poll() is not None:
+                raise AssertionError(f"no '{text}' on stderr within {timeout} s:\n" + self.errors())
+            time.sleep(0.05)
+
+    def hand(self, box, **timing):
+        """A hand moving the pointer in the trainer's window, at the scale of `box`."""
+        return Hand(self.window(), box.size / (CHARACTER_SIZE_M * 1e3), **timing)
 
     def close(self):
         if self.process.poll() is None:
@@ -155,6 +168,18 @@ def is_hint(r, g, b):  # the quiz's hint, Hanzi Writer's highlight colour #AAF
 
 def fraction(hits):
     return sum(hits) / len(hits)
+
+
+def is_refused(r, g, b):  # a refused attempt, greyed (150, 150, 150); blue over yellow blends near it
+    return all(abs(c - 150) <= 6 for c in (r, g, b))
+
+
+def keep_artifact(path):
+    """Copies a picture to CALLIGRAPHY_TEST_ARTIFACTS when that names a folder, to look at after the run."""
+    folder = os.environ.get("CALLIGRAPHY_TEST_ARTIFACTS")
+    if folder:
+        pathlib.Path(folder).mkdir(parents=True, exist_ok=True)
+        shutil.copy(path, pathlib.Path(folder) / pathlib.Path(path).name)
 
 
 class TrainerTest(unittest.TestCase):
@@ -359,6 +384,97 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual(free["condition"], "vision")
         self.assertLess(guided["mean_deviation_mm"], 0.7 * free["mean_deviation_mm"])
 
+    def write_like_a_person(self, device, **timing):
+        """Writes 十口人永, one trial each, moving the pointer as a person moves a pen (hand.py): minimum-jerk
+        along each displayed median, a 0.3 mm wobble, corners rounded, the pen lifted 0.5-1.5 mm short of
+        the end. Every stroke must be written at its first touch. Returns the saved records."""
+        characters = "十口人永"
+        trainer = self.start(characters, "--device", device, "--session", "out", "--exit-after", "55")
+        boxes = trainer.boxes()
+        hand = trainer.hand(boxes[0], seed=7, **timing)
+        time.sleep(0.5)
+        for k, (box, character) in enumerate(zip(boxes, characters)):
+            if k > 0:
+                trainer.wait_for(f"trial {k} {characters[k - 1]}: completed")
+                time.sleep(1.3)  # unattended: the next character's trial starts a second later
+            for median in medians(character):
+                hand.write([box.data_to_px(p) for p in median])
+        self.assertEqual(trainer.wait(timeout=30), 0, trainer.errors())
+        self.assertNotIn("not written", trainer.errors())
+        records = [json.loads(p.read_text(encoding="utf-8")) for p in saved_trials(pathlib.Path(self.folder) / "out")]
+        self.assertEqual([r["characters"] for r in records], list(characters))
+        for record in records:
+            self.assertEqual(record["device"]["name"], device)
+            self.assertEqual(record["end_reason"], "completed", record["characters"])
+            self.assertEqual(record["strokes_completed"], record["strokes_total"], record["characters"])
+            self.assertEqual([s["attempts"] for s in record["per_stroke"]], [1] * record["strokes_total"],
+                             f"{record['characters']}: one touch, one attempt")
+        return records
+
+    def test_a_hand_writes_shi_kou_ren_yong_on_the_mouse(self):
+        self.write_like_a_person("mouse")
+
+    def test_a_hand_writes_shi_kou_ren_yong_on_the_mouse_hand(self):
+        # The pen follows the pointer through a simulated hand: it needs a moment to get over the start and
+        # onto the paper.
+        self.write_like_a_person("mouse-hand", settle_s=0.45, press_s=0.3)
+
+    def test_a_refused_stroke_stays_faded_and_the_panel_says_why(self):
+        trainer = self.start("十", "--device", "mouse", "--screenshot", "refused.png")
+        (box,) = trainer.boxes()
+        hand = trainer.hand(box, seed=11)
+        across, down = medians("十")
+        time.sleep(0.5)
+        # Half of stroke 1: the renderer refuses it as the pen lifts in WS, through the display channel.
+        hand.write([box.data_to_px(p) for p in along(across, [i / 10 for i in range(6)])])
+        trainer.wait_for("十 stroke 1 not written: too short: carry the stroke to its end (too_short; judged in WS)")
+        # Stroke 2 first: the pen never comes near stroke 1's start (no WS); the matcher names it.
+        hand.write([box.data_to_px(p) for p in down])
+        trainer.wait_for("十 stroke 1 not written: wrong order: that stroke comes later (wrong_order; judged from "
+                         "the pen-down path)")
+        # Stroke 1 from its end.
+        hand.write([box.data_to_px(p) for p in across[::-1]])
+        trainer.wait_for("十 stroke 1 not written: backwards: start from the other end (backwards; judged ")
+        time.sleep(0.3)
+        window = trainer.window()
+        xdotool("windowfocus", "--sync", window)
+        xdotool("key", "--window", window, "q")  # the screenshot shows the window as the exit came
+        self.assertEqual(trainer.wait(timeout=30), 0, trainer.errors())
+        picture = pathlib.Path(self.folder) / "refused.png"
+        keep_artifact(picture)
+        image = read_png(picture)
+        inner = along(across, [i / 20 for i in range(2, 19)])
+        self.assertGreater(fraction([near(image, box.data_to_px(p), 5, is_refused) for p in inner]), 0.9,
+                           "the refused attempt stays, greyed, along the stroke")
+        self.assertEqual(fraction([near(image, box.data_to_px(p), 5, is_green) for p in inner]), 0.0,
+                         "nothing written")
+        # Only the last refusal is shown: the earlier attempt at stroke 2 went at the touch-down.
+        lower = along(down, [i / 20 for i in range(13, 19)])
+        self.assertEqual(fraction([near(image, box.data_to_px(p), 5, is_refused) for p in lower]), 0.0)
+
+    def test_a_quiz_ends_completed_once_every_stroke_is_accepted(self):
+        # 一 begun 8 mm in from its start: the quiz (Hanzi Writer's tolerances) accepts it, while the pen never
+        # comes near enough to the start for the renderer to count it written. On mouse-hand, where the pen
+        # landing on the paper must not count twice.
+        trainer = self.start("一", "--device", "mouse-hand", "--data", SAMPLE, "--quiz", "--session", "out",
+                             "--exit-after", "50")
+        (box,) = trainer.boxes()
+        hand = trainer.hand(box, seed=5, settle_s=0.45, press_s=0.3)
+        median = medians("一", SAMPLE)[0]
+        time.sleep(0.5)
+        started = time.time()
+        hand.write([box.data_to_px(p) for p in along(median, [0.16 + i * 0.84 / 12 for i in range(13)])])
+        self.assertEqual(trainer.wait(timeout=30), 0, trainer.errors())
+        self.assertLess(time.time() - started, 20, "the trial ended with the quiz, not at --exit-after")
+        errors = trainer.errors()
+        self.assertIn("quiz 一 complete, 0 misses", errors)
+        self.assertNotIn("too_short", errors)
+        (record_path,) = saved_trials(pathlib.Path(self.folder) / "out")
+        record = json.loads(record_path.read_text(encoding="utf-8"))
+        self.assertEqual((record["condition"], record["end_reason"]), ("quiz", "completed"))
+        self.assertEqual(record["strokes_completed"], 0)  # the renderer's count: the quiz judged it
+        self.assertEqual((record["quiz"]["strokes_accepted"], record["quiz"]["misses"]), (1, 0))
+
     def ended_mid_trial(self, end):
         """Starts 永 with the simulated writer (no time limit of its own), lets it write a while, then calls
         `end`, and checks the trial was kept whole as an interrupted attempt."""
@@ -534,7 +650,11 @@ class SessionWindowTest(unittest.TestCase):
 # CTest runs the tests in these groups (tests/CMakeLists.txt), so that no one CTest test runs for minutes.
 # A test is in the first group whose pattern its id contains; a test in no group fails the run.
 GROUPS = {
-    "writing": ("test_simulated_writer", "test_the_real_pointer", "test_guidance_pulls"),
+    "writing": ("test_simulated_writer", "test_the_real_pointer", "test_guidance_pulls", "test_a_refused_stroke"),
+    # A person's hand on each pointer device, its own group each (about 30 s): the first match wins, so the
+    # longer name comes first.
+    "hand_mouse_hand": ("test_a_hand_writes_shi_kou_ren_yong_on_the_mouse_hand",),
+    "hand_mouse": ("test_a_hand_writes_shi_kou_ren_yong_on_the_mouse",),
     "quiz": ("quiz",),
     "keeps_data": ("keeps_the_data", "test_record_then_replay", "test_each_run"),
     "session": ("SessionWindowTest",),

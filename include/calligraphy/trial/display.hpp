@@ -28,6 +28,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "calligraphy/collision/stroke_progress.hpp"
 #include "calligraphy/core/device_types.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/render/renderer.hpp"
@@ -76,7 +77,7 @@ struct DisplaySnapshot {
 
 enum class DisplayEventKind : std::uint8_t {
   stroke_completed,     ///< the last feature point of a stroke was written; its metrics are set
-  stroke_abandoned,     ///< the pen left the paper in WS: the attempt's trace is to be cleared (4.3.3)
+  stroke_abandoned,     ///< the pen left the paper in WS unwritten (4.3.3); `refusal` says why
   character_completed,  ///< the last stroke of a character was written
   trial_ended,          ///< `TrialSession::finish` was called; `end` says how
 };
@@ -98,6 +99,8 @@ struct DisplayEvent {
   double max_deviation_m = 0.0;   ///< largest such distance [m]
   double stroke_time_s = 0.0;     ///< from entering WS to the last feature point [s]
   std::int32_t attempts = 0;      ///< times WS was entered on the stroke
+  // stroke_abandoned: why the attempt was refused (the renderer's `RenderOutput::refusal`)
+  StrokeRefusal refusal = StrokeRefusal::none;
   // trial_ended
   TrialEnd end = TrialEnd::completed;
 };
