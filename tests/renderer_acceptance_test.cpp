@@ -4,8 +4,6 @@
 // path: one rule of acceptance for every front-end.
 #include <catch2/catch.hpp>
 #include <cmath>
-#include <cstdlib>
-#include <filesystem>
 #include <iostream>
 #include <random>
 

@@ -7,8 +7,6 @@
 
 #include <catch2/catch.hpp>
 #include <cmath>
-#include <cstdlib>
-#include <filesystem>
 #include <iostream>
 
 #include "calligraphy/model/character_library.hpp"

@@ -40,11 +40,8 @@ Attempt attempt(const PlacedStroke& stroke, std::span<const Vec2> path, double s
     }
     written_on_the_way = tracker.update(p);
   };
-  for (std::size_t i = 0; i < path.size(); ++i) {
-    if (i == 0) {
-      feed(path[0]);
-      continue;
-    }
+  feed(path.front());
+  for (std::size_t i = 1; i < path.size(); ++i) {
     const Vec2 step = path[i] - path[i - 1];
     const int pieces = std::max(1, static_cast<int>(std::ceil(step.norm() / kStep_m)));
     for (int k = 1; k <= pieces; ++k) feed(path[i - 1] + step * (static_cast<double>(k) / pieces));
