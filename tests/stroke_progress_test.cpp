@@ -199,6 +199,47 @@ TEST_CASE("The stroke matcher names why a path does not write the expected strok
   CHECK(match_stroke(c, 0, first_third, kStartRadius).refusal == StrokeRefusal::too_short);
 }
 
+TEST_CASE("attempt_stroke is the pairwise test of the matcher: one stroke, no other named",
+          "[stroke_progress]") {
+  const Scene scene = test_scene();
+  const PlacedCharacter& c = scene.characters[0];
+  const PlacedStroke& hz = c.strokes[0];
+  const PlacedStroke& h = c.strokes[1];
+  const std::vector<Vec2> hz_path = along({hz.start(), hz.elements[0].end(), hz.end()});
+  const std::vector<Vec2> h_path = along({h.start(), h.end()});
+
+  const StrokeAttempt own = attempt_stroke(hz, hz_path, kStartRadius);
+  CHECK(own.entered);
+  CHECK(own.written);
+  CHECK(own.refusal == StrokeRefusal::none);
+  const StrokeMatch matched = match_stroke(c, 0, hz_path, kStartRadius);
+  CHECK(own.covered_fraction == matched.covered_fraction);
+  CHECK(own.mean_deviation_m == matched.mean_deviation_m);
+
+  // The 横 tried on the 横折: never within the start radius of its start, so never entered.
+  const StrokeAttempt other = attempt_stroke(hz, h_path, kStartRadius);
+  CHECK_FALSE(other.entered);
+  CHECK_FALSE(other.written);
+  CHECK(other.refusal == StrokeRefusal::wrong_place);
+  CHECK(other.covered_fraction == 0.0);
+  // ... where match_stroke names the stroke it writes.
+  CHECK(attempt_stroke(h, h_path, kStartRadius).written);
+
+  // Reversed: refused by the tracker alone as not along the stroke; written when reversed back.
+  const std::vector<Vec2> reversed(hz_path.rbegin(), hz_path.rend());
+  CHECK_FALSE(attempt_stroke(hz, reversed, kStartRadius).written);
+  const std::vector<Vec2> first_third(hz_path.begin(),
+                                      hz_path.begin() + static_cast<long>(hz_path.size() / 3));
+  const StrokeAttempt short_one = attempt_stroke(hz, first_third, kStartRadius);
+  CHECK(short_one.entered);
+  CHECK(short_one.refusal == StrokeRefusal::too_short);
+  CHECK(short_one.covered_fraction == Approx(1.0 / 3.0).margin(0.03));
+
+  CHECK_THROWS_WITH(attempt_stroke(hz, std::vector<Vec2>{}, kStartRadius),
+                    Catch::Contains("attempt_stroke") && Catch::Contains("empty path"));
+  CHECK_THROWS_AS(attempt_stroke(hz, hz_path, std::nan("")), InvalidArgument);
+}
+
 TEST_CASE("Bad input to the stroke matcher is refused naming it", "[stroke_progress]") {
   const Scene scene = test_scene();
   const PlacedCharacter& c = scene.characters[0];

@@ -15,20 +15,28 @@ namespace {
 // pointer) is read as the renderer would read the same motion.
 constexpr double kStep_m = 0.00025;
 
-struct Attempt {
-  bool entered = false;
-  bool written = false;
-  StrokeRefusal refusal = StrokeRefusal::wrong_place;
-  double way_along_m = 0.0;
-  double length_m = 0.0;
-  double mean_deviation_m = 0.0;
-};
+// Throws InvalidArgument, naming `function`, for an empty path, a point that is not finite, a start radius
+// that is not finite and > 0, or an invalid acceptance.
+void check_attempt_arguments(const char* function, std::span<const Vec2> path, double start_radius_m,
+                             const StrokeAcceptance& acceptance) {
+  if (path.empty()) throw InvalidArgument(std::string(function) + ": an empty path");
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    if (!path[i].allFinite()) {
+      throw InvalidArgument(std::string(function) + ": path point " + std::to_string(i) + " is not finite");
+    }
+  }
+  if (!(start_radius_m > 0.0) || !std::isfinite(start_radius_m)) {
+    throw InvalidArgument(std::string(function) + ": start radius " + std::to_string(start_radius_m) +
+                          " m must be > 0");
+  }
+  acceptance.validate();
+}
 
 // Feeds the path to a tracker as the renderer would: WS from the first point within the start
-// neighbourhood; the path's end is the lift.
-Attempt attempt(const PlacedStroke& stroke, std::span<const Vec2> path, double start_radius_m,
-                const StrokeAcceptance& acceptance) {
-  Attempt result;
+// neighbourhood; the path's end is the lift. The arguments are checked.
+StrokeAttempt attempt(const PlacedStroke& stroke, std::span<const Vec2> path, double start_radius_m,
+                      const StrokeAcceptance& acceptance) {
+  StrokeAttempt result;
   StrokeProgressTracker tracker;
   bool written_on_the_way = false;  // completed before the path's end (left the end neighbourhood along it)
   const auto feed = [&](const Vec2& p) {
@@ -48,11 +56,13 @@ Attempt attempt(const PlacedStroke& stroke, std::span<const Vec2> path, double s
   }
   if (!result.entered) return result;
   result.refusal = tracker.refusal();
-  result.way_along_m = tracker.way_along_m();
-  result.length_m = tracker.stroke_length_m();
+  const double way_along_m = tracker.way_along_m();
+  const double length_m = tracker.stroke_length_m();
   result.mean_deviation_m = tracker.mean_deviation_m();
   result.written = written_on_the_way || tracker.lift();
   if (result.written) result.refusal = StrokeRefusal::none;
+  result.covered_fraction =
+      length_m > 0.0 ? std::clamp(way_along_m / length_m, 0.0, 1.0) : (result.written ? 1.0 : 0.0);
   return result;
 }
 
@@ -64,22 +74,12 @@ StrokeMatch match_stroke(const PlacedCharacter& character, std::size_t expected,
     throw InvalidArgument("match_stroke: stroke " + std::to_string(expected) + " of a character with " +
                           std::to_string(character.strokes.size()) + " strokes");
   }
-  if (path_m.empty()) throw InvalidArgument("match_stroke: an empty path");
-  for (std::size_t i = 0; i < path_m.size(); ++i) {
-    if (!path_m[i].allFinite()) {
-      throw InvalidArgument("match_stroke: path point " + std::to_string(i) + " is not finite");
-    }
-  }
-  if (!(start_radius_m > 0.0) || !std::isfinite(start_radius_m)) {
-    throw InvalidArgument("match_stroke: start radius " + std::to_string(start_radius_m) + " m must be > 0");
-  }
-  acceptance.validate();
+  check_attempt_arguments("match_stroke", path_m, start_radius_m, acceptance);
   const PlacedStroke& stroke = character.strokes[expected];
-  const Attempt own = attempt(stroke, path_m, start_radius_m, acceptance);
+  const StrokeAttempt own = attempt(stroke, path_m, start_radius_m, acceptance);
   StrokeMatch match;
   match.matched_stroke = expected;
-  match.covered_fraction =
-      own.length_m > 0.0 ? std::clamp(own.way_along_m / own.length_m, 0.0, 1.0) : (own.written ? 1.0 : 0.0);
+  match.covered_fraction = own.covered_fraction;
   match.mean_deviation_m = own.mean_deviation_m;
   if (own.written) {
     match.accepted = true;
@@ -102,6 +102,12 @@ StrokeMatch match_stroke(const PlacedCharacter& character, std::size_t expected,
   }
   match.refusal = own.entered ? own.refusal : StrokeRefusal::wrong_place;
   return match;
+}
+
+StrokeAttempt attempt_stroke(const PlacedStroke& stroke, std::span<const Vec2> path_m, double start_radius_m,
+                             const StrokeAcceptance& acceptance) {
+  check_attempt_arguments("attempt_stroke", path_m, start_radius_m, acceptance);
+  return attempt(stroke, path_m, start_radius_m, acceptance);
 }
 
 }  // namespace calligraphy
