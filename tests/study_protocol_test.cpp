@@ -17,7 +17,8 @@ namespace {
 std::string protocol_text(const std::string& order = "fixed", int repetitions = 2,
                           const std::string& extra = "") {
   return R"({"name": "t", "conditions": [{"name": "A", "mode": "vision"}, {"name": "B", "mode": "haptic"},
-             {"name": "C", "mode": "quiz", "quiz": {"leniency": 1.5, "hint_after_misses": 2}}],
+             {"name": "C", "mode": "quiz", "quiz": {"acceptance": {"corridor_m": 0.008, "shortfall_fraction": 0.3},
+                                                  "hint_after_misses": 2}}],
     "practice": {"characters": ["永"], "condition": "B", "repetitions": 2},
     "test": {"characters": ["大", "山", "木"], "conditions": ["A", "B", "C"], "repetitions": )" +
          std::to_string(repetitions) + R"(},
@@ -61,7 +62,10 @@ TEST_CASE("a protocol is read with every field", "[study][protocol]") {
   CHECK(p.name == "t");
   REQUIRE(p.conditions.size() == 3);
   CHECK(p.conditions[2].mode == ConditionMode::quiz);
-  CHECK(p.conditions[2].quiz.leniency == 1.5);
+  CHECK(p.conditions[2].quiz.acceptance.corridor_m == 0.008);
+  CHECK(p.conditions[2].quiz.acceptance.shortfall_fraction == 0.3);
+  CHECK(p.conditions[2].quiz.acceptance.mean_deviation_m == StrokeAcceptance{}.mean_deviation_m);
+  CHECK(p.conditions[2].quiz.start_radius_m == SceneLayout{}.start_radius_m);
   CHECK(p.conditions[2].quiz.hint_after_misses == 2);
   REQUIRE(p.practice);
   CHECK(p.practice->items == std::vector<std::u32string>{U"永"});
@@ -155,6 +159,42 @@ TEST_CASE("fading and replay parameters and teachers are checked naming the JSON
               "/conditions/0/teachers/山", "not an item");
   check_error(with_condition(R"({"name": "A", "mode": "replay", "teachers": {"大": ""}})"),
               "/conditions/0/teachers/大", "empty");
+}
+
+TEST_CASE("a quiz condition's acceptance is checked naming the key, and leniency is refused",
+          "[study][protocol]") {
+  const auto with_quiz = [](const std::string& quiz) {
+    return R"({"name": "t", "conditions": [{"name": "A", "mode": "quiz", "quiz": )" + quiz +
+           R"(}], "test": {"characters": ["大"], "conditions": ["A"], "repetitions": 1}})";
+  };
+  check_error(with_quiz(R"({"leniency": 1.5})"), "/conditions/0/quiz/leniency", "replaced by \"acceptance\"");
+  check_error(with_quiz(R"({"acceptance": {"corridor": 0.005}})"), "/conditions/0/quiz/acceptance/corridor",
+              "unknown key");
+  check_error(with_quiz(R"({"acceptance": {"mean_deviation_m": 0}})"),
+              "/conditions/0/quiz/acceptance/mean_deviation_m", "> 0");
+  check_error(with_quiz(R"({"acceptance": {"corridor_m": 2}})"), "/conditions/0/quiz/acceptance/corridor_m",
+              "2");
+  check_error(with_quiz(R"({"acceptance": {"shortfall_fraction": 1}})"),
+              "/conditions/0/quiz/acceptance/shortfall_fraction", "(0, 1)");
+  check_error(with_quiz(R"({"acceptance": {"max_gain_ratio": 0.5}})"),
+              "/conditions/0/quiz/acceptance/max_gain_ratio", "0.5");
+  check_error(with_quiz(R"({"acceptance": 3})"), "/conditions/0/quiz/acceptance", "object");
+  // Every key a trial record writes is read.
+  const StudyProtocol p = parse_study_protocol(
+      with_quiz(R"({"acceptance": {"corridor_m": 0.007, "mean_deviation_m": 0.0035, "shortfall_m": 0.005,
+        "shortfall_fraction": 0.4, "displacement_m": 0.002, "follow_through_m": 0.009, "max_gain_ratio": 3,
+        "lookahead_m": 0.005}, "accept_backwards": true})"),
+      "p.json");
+  const StrokeAcceptance& a = p.conditions[0].quiz.acceptance;
+  CHECK(a.corridor_m == 0.007);
+  CHECK(a.mean_deviation_m == 0.0035);
+  CHECK(a.shortfall_m == 0.005);
+  CHECK(a.shortfall_fraction == 0.4);
+  CHECK(a.displacement_m == 0.002);
+  CHECK(a.follow_through_m == 0.009);
+  CHECK(a.max_gain_ratio == 3.0);
+  CHECK(a.lookahead_m == 0.005);
+  CHECK(p.conditions[0].quiz.accept_backwards);
 }
 
 TEST_CASE("a balanced Latin square: each condition once per row, every ordered pair equally often",

@@ -59,6 +59,8 @@ TEST_CASE("quiz accepts the strokes written in order and completes the character
   CHECK(first[0].kind == QuizEvent::Kind::stroke_accepted);
   CHECK(first[0].stroke == 0);
   CHECK_FALSE(first[0].backwards);
+  CHECK(first[0].refusal == StrokeRefusal::none);
+  CHECK_FALSE(first[0].written_stroke);
   CHECK(writer.quiz.current_stroke() == 1);
   const auto second = writer.write(stroke_points(shi.strokes[1]));
   CHECK(has(second, QuizEvent::Kind::stroke_accepted));
@@ -80,6 +82,8 @@ TEST_CASE("quiz misses a stroke written out of order and hints after the set num
   CHECK(first[0].kind == QuizEvent::Kind::stroke_missed);
   CHECK(first[0].stroke == 0);
   CHECK(first[0].misses_on_stroke == 1);
+  CHECK(first[0].refusal == StrokeRefusal::wrong_order);
+  CHECK(first[0].written_stroke == 1u);
   const auto second = writer.write(stroke_points(shi.strokes[1]));
   CHECK(has(second, QuizEvent::Kind::stroke_missed));
   CHECK(has(second, QuizEvent::Kind::hint));
@@ -100,6 +104,7 @@ TEST_CASE("quiz reports a stroke written backwards and accepts it only when aske
   REQUIRE_FALSE(events.empty());
   CHECK(events[0].kind == QuizEvent::Kind::stroke_missed);
   CHECK(events[0].backwards);
+  CHECK(events[0].refusal == StrokeRefusal::backwards);
   CHECK(strict.quiz.current_stroke() == 0);
 
   QuizOptions lenient;
@@ -109,21 +114,30 @@ TEST_CASE("quiz reports a stroke written backwards and accepts it only when aske
   REQUIRE_FALSE(accepted.empty());
   CHECK(accepted[0].kind == QuizEvent::Kind::stroke_accepted);
   CHECK(accepted[0].backwards);
+  CHECK(accepted[0].refusal == StrokeRefusal::none);
 }
 
-TEST_CASE("quiz leniency decides a stroke written off its place", "[study][quiz]") {
+TEST_CASE("quiz acceptance decides a stroke written off its place", "[study][quiz]") {
   const PlacedCharacter& shi = character_of(U'十');
-  // Shifted across the stroke by 9 mm (150 data units of the 6 cm box): beyond the strict thresholds,
-  // within lenient ones.
-  const Vec2 shift(0.0, 0.009);
-  QuizOptions strict;
-  strict.leniency = 0.5;
-  Writer strict_writer{QuizSession(shi, strict)};
-  CHECK(has(strict_writer.write(stroke_points(shi.strokes[0], shift)), QuizEvent::Kind::stroke_missed));
+  // Shifted across the stroke by 4 mm: within the start neighbourhood (5 mm) and the corridor (6.5 mm),
+  // beyond the default mean deviation (3 mm), within a mean deviation of 5 mm.
+  const Vec2 shift(0.0, 0.004);
+  Writer strict_writer{QuizSession(shi)};
+  const auto refused = strict_writer.write(stroke_points(shi.strokes[0], shift));
+  REQUIRE(refused.size() == 1);
+  CHECK(refused[0].kind == QuizEvent::Kind::stroke_missed);
+  CHECK(refused[0].refusal == StrokeRefusal::wrong_place);
+  CHECK_FALSE(refused[0].written_stroke);
   QuizOptions lenient;
-  lenient.leniency = 2.0;
+  lenient.acceptance.mean_deviation_m = 0.005;
   Writer lenient_writer{QuizSession(shi, lenient)};
   CHECK(has(lenient_writer.write(stroke_points(shi.strokes[0], shift)), QuizEvent::Kind::stroke_accepted));
+  // A start neighbourhood smaller than the shift: never entered, so in the wrong place whatever the rest.
+  lenient.start_radius_m = 0.003;
+  Writer small_start{QuizSession(shi, lenient)};
+  const auto outside = small_start.write(stroke_points(shi.strokes[0], shift));
+  REQUIRE(outside.size() == 1);
+  CHECK(outside[0].refusal == StrokeRefusal::wrong_place);
 }
 
 TEST_CASE("quiz neither accepts nor counts a touch too short to judge", "[study][quiz]") {
@@ -158,8 +172,11 @@ TEST_CASE("quiz refuses samples going back in time or not finite, naming the sam
   CHECK_THROWS_WITH(quiz.feed({0.5, Vec2::Zero(), false}), Catch::Contains("sample 1"));
   CHECK_THROWS_AS(quiz.feed({2.0, Vec2(std::nan(""), 0.0), true}), InvalidArgument);
   QuizOptions bad;
-  bad.leniency = 0.0;
-  CHECK_THROWS_AS(QuizSession(shi, bad), InvalidArgument);
+  bad.acceptance.corridor_m = 0.0;
+  CHECK_THROWS_WITH(QuizSession(shi, bad), Catch::Contains("corridor_m"));
+  bad = QuizOptions{};
+  bad.start_radius_m = -1.0;
+  CHECK_THROWS_WITH(QuizSession(shi, bad), Catch::Contains("start_radius_m"));
   PlacedCharacter empty = shi;
   empty.strokes.clear();
   CHECK_THROWS_AS(QuizSession(empty), InvalidArgument);

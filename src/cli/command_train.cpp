@@ -39,7 +39,6 @@ struct TrainCommand {
   std::string screenshot;
   double exit_after_s = 0.0;
   bool quiz = false;
-  double leniency = 1.0;
   std::int64_t hint_after = 3;
   std::string quiz_screenshots;
 };
@@ -98,7 +97,6 @@ int run_train(const TrainCommand& command) {
   }
   options.guidance = command.guidance == "on";
   options.quiz = command.quiz;
-  options.quiz_options.leniency = command.leniency;
   options.quiz_options.hint_after_misses = static_cast<int>(command.hint_after);
   options.quiz_screenshots = command.quiz_screenshots;
   if (!command.quiz && !command.quiz_screenshots.empty())
@@ -196,12 +194,7 @@ void add_train_command(CLI::App& root, Commands& commands) {
   CLI::Option* quiz =
       add_flag(*app, "--quiz", command->quiz,
                "a quiz (docs/trainer.md): no guidance; each stroke is judged as the pen lifts, "
-               "accepted or missed, as in Hanzi Writer's quiz");
-  add_number(
-      *app, "--leniency", command->leniency, "X",
-      "quiz: scales the distance, shape and length thresholds of the stroke tests; bigger is more lenient",
-      "a number in [0.001, 1000]", [](double x) { return x >= 1e-3 && x <= 1e3; })
-      ->needs(quiz);
+               "accepted or missed by the stroke matcher the renderer uses (docs/stroke-acceptance.md)");
   add_integer(*app, "--hint-after", command->hint_after, "N",
               "quiz: show the expected stroke after N misses on it, and after each further miss; 0: never", 0,
               1000)

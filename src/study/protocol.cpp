@@ -70,11 +70,44 @@ std::vector<std::u32string> read_items(const json& value, const std::string& poi
   return items;
 }
 
+// Largest length tolerance a protocol may give [m]: beyond the 60 mm character box it means nothing.
+constexpr double kMaxAcceptanceLength_m = 0.1;
+
+// "acceptance": the stroke matcher's tolerances by name, the keys a trial record writes (trial_record.cpp);
+// a key left out keeps its default.
+StrokeAcceptance read_acceptance(const json& value, const std::string& pointer, const std::string& source) {
+  ObjectReader reader(value, pointer, source);
+  StrokeAcceptance a;
+  const auto length = [&](const char* key, double& field) {
+    field = reader.number_or(key, field, 0.0, kMaxAcceptanceLength_m);
+    if (!(field > 0.0)) fail(source, reader.pointer(key), "expected a length > 0 [m]");
+  };
+  length("corridor_m", a.corridor_m);
+  length("mean_deviation_m", a.mean_deviation_m);
+  length("shortfall_m", a.shortfall_m);
+  length("displacement_m", a.displacement_m);
+  length("follow_through_m", a.follow_through_m);
+  length("lookahead_m", a.lookahead_m);
+  a.shortfall_fraction = reader.number_or("shortfall_fraction", a.shortfall_fraction, 0.0, 1.0);
+  if (!(a.shortfall_fraction > 0.0 && a.shortfall_fraction < 1.0)) {
+    fail(source, reader.pointer("shortfall_fraction"), "expected a number in (0, 1)");
+  }
+  a.max_gain_ratio = reader.number_or("max_gain_ratio", a.max_gain_ratio, 1.0, 100.0);
+  reader.finish();  // any other key: an error naming it
+  return a;
+}
+
 QuizOptions read_quiz(const json& value, const std::string& pointer, const std::string& source) {
   ObjectReader reader(value, pointer, source);
   QuizOptions quiz;
-  quiz.leniency = reader.number_or("leniency", quiz.leniency, 1e-3, 1e3);
-  if (!(quiz.leniency > 0.0)) fail(source, reader.pointer("leniency"), "expected a number > 0");
+  if (reader.has("leniency")) {
+    fail(source, reader.pointer("leniency"),
+         "replaced by \"acceptance\": the quiz judges with the stroke matcher's tolerances "
+         "(corridor_m, mean_deviation_m, ...; docs/stroke-acceptance.md)");
+  }
+  if (const json* acceptance = reader.optional("acceptance")) {
+    quiz.acceptance = read_acceptance(*acceptance, reader.pointer("acceptance"), source);
+  }
   quiz.hint_after_misses =
       static_cast<int>(reader.integer_or("hint_after_misses", quiz.hint_after_misses, 0, 1000));
   quiz.accept_backwards = reader.boolean_or("accept_backwards", quiz.accept_backwards);
@@ -275,8 +308,10 @@ const char* to_string(ItemOrder order) noexcept {
 }
 
 void QuizOptions::validate() const {
-  if (!std::isfinite(leniency) || leniency <= 0.0) {
-    throw InvalidArgument("QuizOptions::leniency must be finite and > 0, got " + std::to_string(leniency));
+  acceptance.validate();
+  if (!std::isfinite(start_radius_m) || !(start_radius_m > 0.0)) {
+    throw InvalidArgument("QuizOptions::start_radius_m must be finite and > 0, got " +
+                          std::to_string(start_radius_m));
   }
   if (hint_after_misses < 0) {
     throw InvalidArgument("QuizOptions::hint_after_misses must be >= 0, got " +

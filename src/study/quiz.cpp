@@ -2,17 +2,12 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "calligraphy/core/errors.hpp"
+#include "trial/segmentation.hpp"
 
 namespace calligraphy {
-namespace {
-
-// The judgement needs the matching and the mean distance only, not fine curve distances: a coarse
-// comparison keeps each judgement within milliseconds.
-constexpr std::size_t kQuizCurvePoints = 64;
-
-}  // namespace
 
 const char* to_string(QuizEvent::Kind kind) noexcept {
   switch (kind) {
@@ -41,22 +36,6 @@ QuizSession::QuizSession(PlacedCharacter character, const QuizOptions& options)
   }
 }
 
-QuizSession::Verdict QuizSession::judge(std::size_t stroke, double leniency) const {
-  PlacedCharacter alone = character_;  // the expected stroke alone: the match is against it only
-  alone.strokes = {character_.strokes[stroke]};
-  ScoreOptions options;
-  options.leniency = leniency;
-  options.metrics.curves.max_points = kQuizCurvePoints;
-  const CharacterScore score = score_trace(alone, segment_, options);
-  Verdict verdict;
-  verdict.too_short = score.segments.size() == 1 && score.segments.front().ignored;
-  const StrokeScore& result = score.strokes.front();
-  verdict.matched = result.written;
-  verdict.backwards = result.backwards;
-  if (result.metrics) verdict.mean_distance_m = result.metrics->deviation.mean_m;
-  return verdict;
-}
-
 std::vector<QuizEvent> QuizSession::judge_segment() {
   std::vector<QuizEvent> out;
   if (segment_.empty() || complete()) {
@@ -67,30 +46,22 @@ std::vector<QuizEvent> QuizSession::judge_segment() {
   event.stroke = current_;
   event.time_s = segment_.back().time_s;
   event.samples = segment_.size();
-  Verdict verdict = judge(current_, options_.leniency);
-  if (verdict.too_short) {
+  const ScoreOptions too_short;  // score_trace's rule for a segment it ignores
+  const std::vector<WrittenSegment> runs = trial_detail::pen_down_segments(
+      segment_, too_short.min_segment_samples, too_short.min_segment_length_m);
+  if (runs.size() == 1 && runs.front().ignored) {
     event.kind = QuizEvent::Kind::too_short;
     event.misses_on_stroke = misses_on_stroke_;
     event.total_misses = total_misses_;
     out.push_back(event);
   } else {
-    if (verdict.matched && !verdict.backwards) {
-      // A later stroke matched more closely: the writer probably wrote that one (Hanzi Writer's check).
-      double closest = verdict.mean_distance_m;
-      for (std::size_t later = current_ + 1; later < character_.strokes.size(); ++later) {
-        const Verdict other = judge(later, options_.leniency);
-        if (other.matched && !other.backwards && other.mean_distance_m < closest) {
-          closest = other.mean_distance_m;
-          event.closer_later_stroke = later;
-        }
-      }
-      if (event.closer_later_stroke && verdict.mean_distance_m > 0.0) {
-        verdict = judge(current_,
-                        options_.leniency * closer_stroke_leniency_factor(closest, verdict.mean_distance_m));
-      }
-    }
-    const bool accepted = verdict.matched && (!verdict.backwards || options_.accept_backwards);
-    event.backwards = verdict.matched && verdict.backwards;
+    std::vector<Vec2> path;
+    path.reserve(segment_.size());
+    for (const PenSample& s : segment_) path.push_back(s.position_m);
+    const StrokeMatch match =
+        match_stroke(character_, current_, path, options_.start_radius_m, options_.acceptance);
+    event.backwards = match.refusal == StrokeRefusal::backwards;
+    const bool accepted = match.accepted || (event.backwards && options_.accept_backwards);
     if (accepted) {
       event.kind = QuizEvent::Kind::stroke_accepted;
       misses_on_stroke_ = 0;
@@ -101,11 +72,13 @@ std::vector<QuizEvent> QuizSession::judge_segment() {
         QuizEvent done = event;
         done.kind = QuizEvent::Kind::character_completed;
         done.backwards = false;
-        done.closer_later_stroke.reset();
         out.push_back(done);
       }
     } else {
       event.kind = QuizEvent::Kind::stroke_missed;
+      event.refusal = match.refusal;
+      // Another stroke written (a wrong_stroke that set off along the expected one and left it names none).
+      if (match.matched_stroke != current_) event.written_stroke = match.matched_stroke;
       event.misses_on_stroke = ++misses_on_stroke_;
       event.total_misses = ++total_misses_;
       out.push_back(event);
@@ -113,7 +86,8 @@ std::vector<QuizEvent> QuizSession::judge_segment() {
         QuizEvent hint = event;
         hint.kind = QuizEvent::Kind::hint;
         hint.backwards = false;
-        hint.closer_later_stroke.reset();
+        hint.refusal = StrokeRefusal::none;
+        hint.written_stroke.reset();
         out.push_back(hint);
       }
     }

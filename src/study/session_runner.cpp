@@ -101,8 +101,11 @@ TrialOptions study_trial_options(const SessionManifest& session, const StudyCond
   TrialOptions options;
   switch (condition.mode) {
     case ConditionMode::vision:
+      options.force.guidance = false;
+      break;
     case ConditionMode::quiz:
       options.force.guidance = false;
+      options.force.acceptance = condition.quiz.acceptance;  // the renderer judges strokes as the quiz does
       break;
     case ConditionMode::haptic:
       options.force.guidance = true;

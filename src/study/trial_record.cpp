@@ -58,15 +58,7 @@ json force_law_json(const ForceLawParameters& f) {
           {"constraint_taper_m", f.constraint_taper_m},
           {"crossfade_s", f.crossfade_s},
           {"paper_fade_s", f.paper_fade_s},
-          {"acceptance",
-           {{"corridor_m", f.acceptance.corridor_m},
-            {"mean_deviation_m", f.acceptance.mean_deviation_m},
-            {"shortfall_m", f.acceptance.shortfall_m},
-            {"shortfall_fraction", f.acceptance.shortfall_fraction},
-            {"displacement_m", f.acceptance.displacement_m},
-            {"follow_through_m", f.acceptance.follow_through_m},
-            {"max_gain_ratio", f.acceptance.max_gain_ratio},
-            {"lookahead_m", f.acceptance.lookahead_m}}},
+          {"acceptance", acceptance_json(f.acceptance)},
           {"paper_damping_n_s_per_m", f.paper_damping_n_s_per_m},
           {"max_foot_speed_m_s", f.max_foot_speed_m_s},
           {"friction_coefficient", f.friction_coefficient},
@@ -201,6 +193,13 @@ json nullable(const std::optional<double>& value, double scale) {
 }
 
 }  // namespace
+
+json acceptance_json(const StrokeAcceptance& a) {
+  return {{"corridor_m", a.corridor_m},         {"mean_deviation_m", a.mean_deviation_m},
+          {"shortfall_m", a.shortfall_m},       {"shortfall_fraction", a.shortfall_fraction},
+          {"displacement_m", a.displacement_m}, {"follow_through_m", a.follow_through_m},
+          {"max_gain_ratio", a.max_gain_ratio}, {"lookahead_m", a.lookahead_m}};
+}
 
 std::vector<PenSample> pen_samples_of_character(const Scene& scene, const std::vector<TrialSample>& trace,
                                                 std::size_t character) {
@@ -342,7 +341,8 @@ std::string trial_record_json(const TrialRecordContext& c, const Scene& scene, c
                       {"total_misses", e.total_misses},
                       {"time_s", e.time_s},
                       {"samples", e.samples}};
-        if (e.closer_later_stroke) event["closer_later_stroke"] = *e.closer_later_stroke + 1;
+        event["refusal"] = to_string(e.refusal);
+        if (e.written_stroke) event["written_stroke"] = *e.written_stroke + 1;
         events.push_back(event);
         accepted += e.kind == QuizEvent::Kind::stroke_accepted ? 1 : 0;
         hints += e.kind == QuizEvent::Kind::hint ? 1 : 0;
@@ -352,7 +352,8 @@ std::string trial_record_json(const TrialRecordContext& c, const Scene& scene, c
       characters.push_back({{"character", encode_utf8(scene.characters[i].code_point)}, {"events", events}});
     }
     const QuizOptions& q = c.condition->quiz;
-    document["quiz"] = {{"leniency", q.leniency},
+    document["quiz"] = {{"acceptance", acceptance_json(q.acceptance)},
+                        {"start_radius_m", q.start_radius_m},
                         {"hint_after_misses", q.hint_after_misses},
                         {"accept_backwards", q.accept_backwards},
                         {"strokes_accepted", accepted},

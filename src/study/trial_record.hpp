@@ -34,6 +34,10 @@ struct TrialRecordContext {
   std::string svg_file;
 };
 
+/// The stroke matcher's tolerances as a JSON object, by the names a protocol's quiz condition reads them
+/// by (corridor_m, mean_deviation_m, ...): the record's force.acceptance and quiz.acceptance.
+nlohmann::json acceptance_json(const StrokeAcceptance& acceptance);
+
 /// The pen samples of `trace` while character `character` of `scene` was the active one: pen down when
 /// the tip is within the contact threshold of `calligraphy score` (PenTraceCsvOptions) above the paper.
 std::vector<PenSample> pen_samples_of_character(const Scene& scene, const std::vector<TrialSample>& trace,

@@ -1,6 +1,7 @@
 #include "trainer/live_quiz.hpp"
 
 #include <cstdio>
+#include <string>
 
 #include "calligraphy/report/pen_trace_csv.hpp"
 
@@ -22,6 +23,7 @@ LiveQuiz::LiveQuiz(const Scene& scene, const QuizOptions& options) : paper_z_m_(
   }
   hinted_.resize(sessions_.size());
   last_backwards_.resize(sessions_.size(), false);
+  last_refusal_.resize(sessions_.size(), StrokeRefusal::none);
 }
 
 // As study_detail::pen_samples_of_character: a tick belongs to the character whose strokes hold the active
@@ -44,6 +46,7 @@ void LiveQuiz::take(std::size_t character, const std::vector<QuizEvent>& events,
       case QuizEvent::Kind::stroke_missed:
       case QuizEvent::Kind::too_short:
         last_backwards_[character] = e.backwards;
+        last_refusal_[character] = e.refusal;
         inks_.push_back(QuizInk{character, character == open_character_ ? open_run_ : std::vector<Vec2>{},
                                 e.kind, std::chrono::steady_clock::now()});
         if (e.kind == QuizEvent::Kind::stroke_accepted) hinted_[character].reset();
@@ -97,10 +100,16 @@ std::vector<std::vector<QuizEvent>> LiveQuiz::events() const {
 }
 
 std::string describe(const QuizEvent& event) {
+  std::string why;
+  if (event.backwards) {
+    why = ", backwards";
+  } else if (event.refusal != StrokeRefusal::none) {
+    why = std::string(", ") + to_string(event.refusal);
+  }
+  if (event.written_stroke) why += ", wrote stroke " + std::to_string(*event.written_stroke + 1);
   char line[160];
   std::snprintf(line, sizeof line, "stroke %zu: %s (misses %d on the stroke, %d in all%s)", event.stroke + 1,
-                to_string(event.kind), event.misses_on_stroke, event.total_misses,
-                event.backwards ? ", backwards" : "");
+                to_string(event.kind), event.misses_on_stroke, event.total_misses, why.c_str());
   return line;
 }
 

@@ -1,5 +1,5 @@
 #pragma once
-// The quiz judged live in the window (Hanzi Writer's quiz, chanind/hanzi-writer src/Quiz.ts): the pen's
+// The quiz judged live in the window (study/quiz.hpp: the stroke matcher, as the renderer judges): the pen's
 // positions arrive on the window thread through the display channel's trace queue, one `QuizSession` per
 // character of the trial's scene judges each stroke the moment the pen lifts, and the window shows the
 // verdicts at once. Never on the servo thread: a judgement takes up to milliseconds.
@@ -52,6 +52,8 @@ class LiveQuiz {
   [[nodiscard]] const std::vector<std::optional<std::size_t>>& hinted() const noexcept { return hinted_; }
   /// The last judged stroke was written from its end to its start, per character.
   [[nodiscard]] const std::vector<bool>& last_backwards() const noexcept { return last_backwards_; }
+  /// Why the last judged stroke was missed (none when it was accepted or too short), per character.
+  [[nodiscard]] const std::vector<StrokeRefusal>& last_refusal() const noexcept { return last_refusal_; }
   /// The most recent event of any character, for the panel.
   [[nodiscard]] const std::optional<std::pair<std::size_t, QuizEvent>>& last_event() const noexcept {
     return last_event_;
@@ -74,12 +76,14 @@ class LiveQuiz {
   std::vector<QuizInk> inks_;
   std::vector<std::optional<std::size_t>> hinted_;
   std::vector<bool> last_backwards_;
+  std::vector<StrokeRefusal> last_refusal_;
   std::optional<std::pair<std::size_t, QuizEvent>> last_event_;
   bool finished_ = false;
   std::uint64_t dropped_points_ = 0;
 };
 
-/// "stroke 2: stroke_missed (misses 1 on the stroke, 1 in all, backwards)": one line for logs.
+/// "stroke 2: stroke_missed (misses 1 on the stroke, 1 in all, backwards)", "stroke 2: stroke_missed (misses
+/// 2 on the stroke, 2 in all, wrong_order, wrote stroke 3)": one line for logs; strokes 1-based.
 [[nodiscard]] std::string describe(const QuizEvent& event);
 
 }  // namespace calligraphy::trainer

@@ -92,8 +92,9 @@ void refusal(const TrialView& view, const PanelInput& input) {
   ImGui::Separator();
 }
 
-// The quiz's state: per character, stroke k of n and the misses; the last verdict, "backwards" when the
-// stroke was written from its end, the hint, and "complete, M misses" once every stroke is accepted.
+// The quiz's state: per character, stroke k of n and the misses; the last verdict, why a stroke was missed
+// (in the learner's words, as a refused stroke), the hint, and "complete, M misses" once every stroke is
+// accepted.
 void quiz_state(const TrialView& view, const PanelInput& input) {
   const LiveQuiz& quiz = *view.quiz;
   ImGui::Text("Quiz: write each stroke in order");
@@ -129,7 +130,13 @@ void quiz_state(const TrialView& view, const PanelInput& input) {
         ImGui::TextDisabled("too short to judge");
         break;
     }
-    if (quiz.last_backwards()[last->first]) ImGui::TextColored(kBad, "backwards: written from its end");
+    const StrokeRefusal refusal = quiz.last_refusal()[last->first];
+    if (refusal != StrokeRefusal::none) {
+      const RefusalWords words = learner_words(refusal);
+      ImGui::TextColored(kBad, "%s: %s", words.what, words.advice);
+    } else if (quiz.last_backwards()[last->first]) {
+      ImGui::TextColored(kBad, "backwards: written from its end");
+    }
   }
   if (quiz.dropped_points() > 0)
     ImGui::TextColored(kBad, "%llu pen samples missed",

@@ -26,7 +26,7 @@ LoadedProtocol practice_protocol(const PracticeSetup& setup) {
         {{"name", kQuizCondition},
          {"mode", "quiz"},
          {"quiz",
-          {{"leniency", setup.quiz.leniency},
+          {{"acceptance", study_detail::acceptance_json(setup.quiz.acceptance)},
            {"hint_after_misses", setup.quiz.hint_after_misses},
            {"accept_backwards", setup.quiz.accept_backwards}}}},
         {{"name", kFadingCondition}, {"mode", "fading"}},

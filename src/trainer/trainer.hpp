@@ -31,9 +31,12 @@ struct TrainerOptions {
   GuidanceMode guidance_mode = GuidanceMode::fixed;  ///< how guidance attracts (M cycles it)
   double guidance_gain = 1.0;          ///< the fading mode's first gain in [0, 1]; faded after each trial
   std::vector<TeacherSample> teacher;  ///< replay: the teacher's pen (one character, its recording)
-  /// A quiz (Hanzi Writer's, study/quiz.hpp): guidance off, each stroke judged live as the pen lifts.
+  /// A quiz (study/quiz.hpp): guidance off, each stroke judged live by the stroke matcher as the pen lifts.
   bool quiz = false;
-  QuizOptions quiz_options;      ///< leniency, hint after N misses
+  /// Hint after N misses, backwards accepted or not. The trainer sets the acceptance and start radius to its
+  /// trials' (the renderer's tolerances and the scene's start neighbourhood), so that quiz and renderer
+  /// agree.
+  QuizOptions quiz_options;
   std::string quiz_screenshots;  ///< non-empty: a folder where a PNG is written after each judged stroke
   std::string record;            ///< non-empty: each completed trial is written here as a teacher recording
   std::string session_dir;       ///< empty: trials are not saved

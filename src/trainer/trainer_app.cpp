@@ -39,6 +39,10 @@ TrainerApp::TrainerApp(const TrainerOptions& options, DeviceInfo device_info, bo
     typical_ids_.push_back(std::move(ids));
   }
   guidance_ = options.guidance && !options.quiz;  // a quiz is force-free but for the paper
+  // The quiz judges with the renderer's tolerances and start neighbourhood: those of the trials start_trial
+  // runs (default ForceLawParameters, a default scene layout), also in the practice protocol saved first.
+  options_.quiz_options.acceptance = TrialOptions{}.force.acceptance;
+  options_.quiz_options.start_radius_m = SceneLayout{}.start_radius_m;
   guidance_mode_ = options.guidance_mode;
   guidance_gain_ = options.guidance_gain;
   condition_outputs_force_ = options.device != "mouse";

@@ -68,7 +68,8 @@ void TrainerApp::check_quiz_against_trace(const LiveQuiz& quiz, const TrialResul
       const QuizEvent& b = live[c][k];
       same = a.kind == b.kind && a.stroke == b.stroke && a.backwards == b.backwards &&
              a.misses_on_stroke == b.misses_on_stroke && a.total_misses == b.total_misses &&
-             a.time_s == b.time_s && a.samples == b.samples && a.closer_later_stroke == b.closer_later_stroke;
+             a.time_s == b.time_s && a.samples == b.samples && a.refusal == b.refusal &&
+             a.written_stroke == b.written_stroke;
       ++count;
     }
   }

@@ -58,6 +58,10 @@ void TrainerApp::start_trial(std::size_t character) {
   worker_.start(std::move(scene), options_.device, std::move(trial));
   view_->scene = &worker_.scene();
   view_->acceptance = trial_options_.force.acceptance;
+  // The quiz and the renderer judge a stroke alike (the live quiz, and the saved record's quiz through the
+  // practice protocol: the same values, set when the trainer started).
+  options_.quiz_options.acceptance = trial_options_.force.acceptance;
+  options_.quiz_options.start_radius_m = worker_.scene().layout.start_radius_m;
   if (options_.quiz) view_->quiz.emplace(worker_.scene(), options_.quiz_options);
   advance_at_.reset();
 }

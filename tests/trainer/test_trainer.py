@@ -314,7 +314,9 @@ class TrainerTest(unittest.TestCase):
         logged = [l.split("quiz 一 ", 1)[1] for l in errors.splitlines() if "quiz 一 stroke" in l]
         expected = ["stroke %d: %s (misses %d on the stroke, %d in all%s)"
                     % (e["stroke"], e["kind"], e["misses_on_stroke"], e["total_misses"],
-                       ", backwards" if e["backwards"] else "") for e in events]
+                       ", backwards" if e["backwards"] else
+                       "" if e["refusal"] == "none" else ", " + e["refusal"]) for e in events]
+        self.assertEqual(events[0]["refusal"], "backwards")
         self.assertEqual(logged, expected)
 
         # What the window showed after each verdict.
@@ -333,9 +335,13 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual(fraction([near(missed, box.data_to_px(p), 4, is_blue) for p in inner]), 0.0)
 
     def test_the_quiz_options_need_quiz(self):
-        result = subprocess.run([CLI, "train", "一", "--leniency", "2"], capture_output=True, text=True)
+        result = subprocess.run([CLI, "train", "一", "--hint-after", "2"], capture_output=True, text=True)
         self.assertEqual(result.returncode, 2, result.stderr)
         self.assertIn("--quiz", result.stderr)
+        # The quiz judges with the stroke matcher's tolerances: there is no leniency to set.
+        result = subprocess.run([CLI, "train", "一", "--quiz", "--leniency", "2"], capture_output=True, text=True)
+        self.assertEqual(result.returncode, 2, result.stderr)
+        self.assertIn("--leniency", result.stderr)
 
     def write_yi_beside_the_stroke(self, guidance, offset):
         """On mouse-hand, presses at the start of 一, then moves the pointer `offset` data units below the
@@ -453,9 +459,9 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual(fraction([near(image, box.data_to_px(p), 5, is_refused) for p in lower]), 0.0)
 
     def test_a_quiz_ends_completed_once_every_stroke_is_accepted(self):
-        # 一 begun 8 mm in from its start: the quiz (Hanzi Writer's tolerances) accepts it, while the pen never
-        # comes near enough to the start for the renderer to count it written. On mouse-hand, where the pen
-        # landing on the paper must not count twice.
+        # 一 written along its median: the quiz accepts it as the renderer completes it (one stroke matcher,
+        # the renderer's tolerances), and the trial ends at once. On mouse-hand, where the pen landing on the
+        # paper must not count twice.
         trainer = self.start("一", "--device", "mouse-hand", "--data", SAMPLE, "--quiz", "--session", "out",
                              "--exit-after", "50")
         (box,) = trainer.boxes()
@@ -463,7 +469,7 @@ class TrainerTest(unittest.TestCase):
         median = medians("一", SAMPLE)[0]
         time.sleep(0.5)
         started = time.time()
-        hand.write([box.data_to_px(p) for p in along(median, [0.16 + i * 0.84 / 12 for i in range(13)])])
+        hand.write([box.data_to_px(p) for p in along(median, [i / 12 for i in range(13)])])
         self.assertEqual(trainer.wait(timeout=30), 0, trainer.errors())
         self.assertLess(time.time() - started, 20, "the trial ended with the quiz, not at --exit-after")
         errors = trainer.errors()
@@ -472,8 +478,9 @@ class TrainerTest(unittest.TestCase):
         (record_path,) = saved_trials(pathlib.Path(self.folder) / "out")
         record = json.loads(record_path.read_text(encoding="utf-8"))
         self.assertEqual((record["condition"], record["end_reason"]), ("quiz", "completed"))
-        self.assertEqual(record["strokes_completed"], 0)  # the renderer's count: the quiz judged it
+        self.assertEqual(record["strokes_completed"], 1)  # the renderer's count: the same verdict
         self.assertEqual((record["quiz"]["strokes_accepted"], record["quiz"]["misses"]), (1, 0))
+        self.assertEqual(record["quiz"]["acceptance"], record["force_law"]["acceptance"])
 
     def ended_mid_trial(self, end):
         """Starts 永 with the simulated writer (no time limit of its own), lets it write a while, then calls

@@ -11,6 +11,8 @@
 #include <string_view>
 #include <vector>
 
+#include "calligraphy/collision/stroke_progress.hpp"
+#include "calligraphy/model/scene.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
 
 namespace calligraphy {
@@ -27,10 +29,17 @@ enum class ConditionMode {
 /// "vision", "haptic", "fading", "replay", "quiz".
 [[nodiscard]] const char* to_string(ConditionMode mode) noexcept;
 
-/// How a quiz judges strokes (Hanzi Writer's quiz, chanind/hanzi-writer src/Quiz.ts and strokeMatches.ts).
+/// How a quiz judges strokes: each pen-down run with the stroke matcher (`match_stroke`,
+/// collision/stroke_matcher.hpp), the rule the renderer and `score_trace` use (docs/stroke-acceptance.md);
+/// misses and hints as in Hanzi Writer's quiz (chanind/hanzi-writer src/Quiz.ts).
 struct QuizOptions {
-  /// Scales the distance, shape and length thresholds of the stroke tests; bigger is more lenient. > 0.
-  double leniency = 1.0;
+  /// The stroke matcher's tolerances (SI units). The trainer gives its trials' (ForceLawParameters::
+  /// acceptance) and a study session gives the renderer the quiz condition's, so that quiz and renderer
+  /// agree.
+  StrokeAcceptance acceptance{};
+  /// Radius of the start neighbourhood (WS) a run must enter the stroke in [m]: the scene's
+  /// (SceneLayout::start_radius_m). Finite, > 0.
+  double start_radius_m = SceneLayout{}.start_radius_m;
   /// A hint (the expected stroke shown) after this many misses on one stroke, and after each further
   /// miss; 0: never. Hanzi Writer's default is 3.
   int hint_after_misses = 3;

@@ -1,19 +1,20 @@
 #pragma once
 /// \file quiz.hpp
 /// A stroke-order quiz for vision-only input, after Hanzi Writer's quiz (chanind/hanzi-writer,
-/// src/Quiz.ts and src/strokeMatches.ts): pen samples go in; each time the pen lifts, the stroke just
-/// written is judged against the stroke expected next, and accepted or missed. The judgement is
-/// `score_trace`'s (trial/score.hpp: Hanzi Writer's five tests with a leniency): the written stroke is
-/// scored against the expected stroke alone. As in Hanzi Writer, when it passes but matches a later
-/// stroke more closely (a smaller mean distance), it is tested again with the leniency scaled by
-/// 0.6 (d_later + d_expected) / (2 d_expected), i.e. by 0.3 to 0.6. A stroke that matches only from its
-/// end to its start is reported as backwards (and accepted only with `accept_backwards`). After
-/// `hint_after_misses` misses on one stroke, and after each further miss, a hint event asks to show the
-/// expected stroke. Not for the servo thread: judging takes up to milliseconds per pen lift.
+/// src/Quiz.ts): pen samples go in; each time the pen lifts, the stroke just written is judged against the
+/// stroke expected next, and accepted or missed. A run too short to judge (the rule by which `score_trace`
+/// ignores a segment: trial/score.hpp) is neither. Every other run is judged by the stroke matcher,
+/// `match_stroke(character, expected, run, start_radius_m, acceptance)` (collision/stroke_matcher.hpp):
+/// the renderer's rule, so that the quiz, the renderer and `score_trace`'s segment verdicts agree on the
+/// same trace (docs/stroke-acceptance.md). A run refused as backwards is a miss reported as backwards, or
+/// accepted (still reported as backwards) with `accept_backwards`. After `hint_after_misses` misses on
+/// one stroke, and after each further miss, a hint event asks to show the expected stroke. Not for the
+/// servo thread: judging takes up to milliseconds per pen lift.
 #include <cstddef>
 #include <optional>
 #include <vector>
 
+#include "calligraphy/collision/stroke_matcher.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/trial/score.hpp"
@@ -24,20 +25,24 @@ namespace calligraphy {
 struct QuizEvent {
   enum class Kind {
     stroke_accepted,      ///< the written stroke is the expected one: show it, expect the next
-    stroke_missed,        ///< not the expected stroke (wrong place, shape, direction or order)
+    stroke_missed,        ///< not the expected stroke: `refusal` says why
     hint,                 ///< show the expected stroke (after enough misses)
     character_completed,  ///< every stroke accepted
     too_short,            ///< a touch or a dot too short to judge: neither accepted nor a miss
   };
   Kind kind = Kind::stroke_missed;
   std::size_t stroke = 0;    ///< the expected stroke, 0-based in the character's stroke order
-  bool backwards = false;    ///< the written stroke matched the expected one only from its end to its start
+  bool backwards = false;    ///< the written stroke writes the expected one from its end to its start
   int misses_on_stroke = 0;  ///< misses on `stroke` so far (0 after it is accepted)
   int total_misses = 0;      ///< misses on the whole character so far
   double time_s = 0.0;       ///< time of the last pen-down sample of the judged stroke [s]
   std::size_t samples = 0;   ///< pen-down samples of the judged stroke
-  /// A later stroke the written one matched more closely (the leniency was then lowered), 0-based.
-  std::optional<std::size_t> closer_later_stroke;
+  /// Why the stroke matcher refused the written stroke (stroke_missed); none otherwise, also for a
+  /// backwards stroke accepted with `accept_backwards`.
+  StrokeRefusal refusal = StrokeRefusal::none;
+  /// For a stroke_missed refused as wrong_order or wrong_stroke because the run wrote another stroke of the
+  /// character: that stroke (StrokeMatch::matched_stroke), 0-based.
+  std::optional<std::size_t> written_stroke;
 };
 
 /// "stroke_accepted", "stroke_missed", "hint", "character_completed", "too_short".
@@ -67,13 +72,6 @@ class QuizSession {
   [[nodiscard]] const PlacedCharacter& character() const noexcept { return character_; }
 
  private:
-  struct Verdict {
-    bool matched = false;  // forwards or backwards
-    bool backwards = false;
-    bool too_short = false;
-    double mean_distance_m = 0.0;
-  };
-  Verdict judge(std::size_t stroke, double leniency) const;
   std::vector<QuizEvent> judge_segment();
 
   PlacedCharacter character_;
