@@ -160,7 +160,8 @@ TEST_CASE("Without the smoothing and the rate limit the paper's force law steps 
   options.safety.start_ramp_n_per_s = 0.0;
   const StepFigures raw = trial_steps(U'我', options);
   INFO("max per-tick change " << raw.max_step_n << " N");
-  CHECK(raw.max_step_n > 4.0 * SafetyChainParameters{}.max_force_change_n_per_tick);
+  // Above the limit, so the trial test above fails on this force law.
+  CHECK(raw.max_step_n > SafetyChainParameters{}.max_force_change_n_per_tick);
 }
 
 TEST_CASE("F_et tapers to zero at the constraint-space edge", "[smoothness]") {

@@ -40,7 +40,8 @@ WriterProfile unbiased_novice() {
 constexpr double kStep_s = 1e-3;
 
 // Drives `writer` open-loop for `seconds`: each millisecond it is shown the pen where `pen_at` puts
-// it (given the writer's own target), and a display that never changes; returns its targets.
+// it (given the writer's own target), and a display that never changes (it never takes the stroke, so
+// each attempt written whole ends `not_accepted`); returns its targets.
 std::vector<Vec3> drive(SimulatedWriter& writer, double seconds,
                         const std::function<Vec3(double, const Vec3&)>& pen_at) {
   std::vector<Vec3> targets;
@@ -106,8 +107,8 @@ TEST_CASE("A pen held on the stroke is written faster than one the writer sees o
   REQUIRE(!free.log().attempts.empty());
   const WriterAttempt& h = held.log().attempts.front();
   const WriterAttempt& f = free.log().attempts.front();
-  REQUIRE(h.end == AttemptEnd::completed);
-  REQUIRE(f.end == AttemptEnd::completed);
+  REQUIRE(h.end == AttemptEnd::not_accepted);
+  REQUIRE(f.end == AttemptEnd::not_accepted);
   INFO("held " << h.end_s - h.touch_down_s << " s, free " << f.end_s - f.touch_down_s << " s");
   CHECK(h.end_s - h.touch_down_s < 0.9 * (f.end_s - f.touch_down_s));
 }
@@ -117,7 +118,7 @@ TEST_CASE("The hand's target moves in minimum-jerk segments: at rest at both end
   SimulatedWriter writer(scene, unbiased_novice(), 2);
   const std::vector<Vec3> x = drive(writer, 6.0, [](double, const Vec3& target) { return target; });
   const WriterAttempt& a = writer.log().attempts.front();
-  REQUIRE(a.end == AttemptEnd::completed);
+  REQUIRE(a.end == AttemptEnd::not_accepted);
   const auto begin = static_cast<std::size_t>(std::lround(a.touch_down_s / kStep_s)) + 1;
   // The writing ends where the lift begins: the target's z starts to rise.
   std::size_t end = begin;
@@ -153,4 +154,39 @@ TEST_CASE("A writer's trial is deterministic for a seed and differs across seeds
   options.seed = 4;
   const WriterTrial other = run_writer_trial(scene, options);
   CHECK(other.metrics.mean_deviation_m != first.metrics.mean_deviation_m);
+}
+
+TEST_CASE("A stroke the display does not take is written again, and one it takes is not", "[writer]") {
+  const Scene scene = horizontal_scene();
+  const double paper_z = scene.layout.paper_z_m;
+  for (const bool display_takes_it : {false, true}) {
+    SimulatedWriter writer(scene, unbiased_novice(), 4);
+    bool written = false;  // the display's verdict: the pen wrote on the paper and left it
+    bool touched = false;
+    for (int k = 0; k < 20000 && !writer.done(); ++k) {
+      const double t = k * kStep_s;
+      DeviceState pen;
+      pen.time_s = t;
+      pen.position_m = writer.target(t);
+      touched = touched || pen.position_m.z() < paper_z;
+      if (display_takes_it && touched && pen.position_m.z() > paper_z) written = true;
+      RenderOutput display;
+      display.stroke = written ? 1 : 0;
+      display.finished = written;
+      writer.observe(display, pen);
+    }
+    const WriterLog& log = writer.log();
+    INFO("display takes it: " << display_takes_it);
+    REQUIRE(!log.attempts.empty());
+    if (display_takes_it) {
+      CHECK(log.attempts.size() == 1);
+      CHECK(log.attempts.front().end == AttemptEnd::completed);
+      CHECK(log.not_accepted == 0);
+    } else {
+      // Written whole each time, seen not taken, written again until the writer gives up.
+      CHECK(log.attempts.size() == static_cast<std::size_t>(unbiased_novice().max_attempts_per_stroke));
+      CHECK(log.not_accepted == log.attempts.size());
+      CHECK(log.gave_up);
+    }
+  }
 }

@@ -45,7 +45,10 @@ void check_writer(const WriterProfile& w) {
       {w.noise_fraction, "noise_fraction"},
       {w.tremor_amplitude_n, "tremor_amplitude_n"},
       {w.tremor_frequency_hz, "tremor_frequency_hz"},
-      {w.overshoot_m, "overshoot_m"},
+      {w.corner_cut_m, "corner_cut_m"},
+      {w.end_short_m, "end_short_m"},
+      {w.end_past_m, "end_past_m"},
+      {w.follow_through_m, "follow_through_m"},
       {w.correction_per_attempt, "correction_per_attempt"},
   };
   for (const auto& [value, name] : values) {
@@ -81,8 +84,13 @@ void bind_writer_profile(py::module_& m) {
       .field("press_depth_m", &WriterProfile::press_depth_m,
              "how far below the paper the hand aims while writing [m], >= 0")
       .field("lift_height_m", &WriterProfile::lift_height_m, "pen-up height above the paper [m], > 0")
-      .field("overshoot_m", &WriterProfile::overshoot_m,
-             "follow-through past turns and the stroke's end [m], >= 0")
+      .field("corner_cut_m", &WriterProfile::corner_cut_m,
+             "most the writer cuts inside a corner of the stroke [m], >= 0 (uniform per corner)")
+      .field("end_short_m", &WriterProfile::end_short_m,
+             "the pen lifts uniformly between end_short_m short of the seen end and end_past_m past it [m]")
+      .field("end_past_m", &WriterProfile::end_past_m, "see end_short_m [m], >= 0")
+      .field("follow_through_m", &WriterProfile::follow_through_m,
+             "a run past the end added to the end draw (a brush's exit) [m], >= 0; 0 by default")
       .field("bias_offset_m", &WriterProfile::bias_offset_m, "offset of the whole copy [m], >= 0")
       .field("scale_error", &WriterProfile::scale_error,
              "relative mis-scale of the copy about the character centre, in (-0.5, 0.5)")

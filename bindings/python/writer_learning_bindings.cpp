@@ -26,7 +26,9 @@ void bind_writer_log(py::module_& m) {
       .value("completed", AttemptEnd::completed, "the whole path written and the pen lifted")
       .value("refused", AttemptEnd::refused, "the writer felt resistance and broke the attempt off")
       .value("interrupted", AttemptEnd::interrupted,
-             "the stroke was cleared after a lift in the middle and started again");
+             "the stroke was cleared after a lift in the middle and started again")
+      .value("not_accepted", AttemptEnd::not_accepted,
+             "written whole at the stroke the display showed as next, and seen not taken: written again");
   py::class_<WriterAttempt>(m, "WriterAttempt", "One attempt of a simulated writer at one stroke.")
       .def_readonly("character", &WriterAttempt::character, "character index in the scene, 0-based")
       .def_readonly("stroke", &WriterAttempt::stroke, "stroke index within the character the writer meant")
@@ -49,6 +51,8 @@ void bind_writer_log(py::module_& m) {
       m, "WriterLog", "What a simulated writer did in a trial, attempt by attempt (TrialResult.writer_log).")
       .def_readonly("attempts", &WriterLog::attempts, "list of WriterAttempt, in the order made")
       .def_readonly("refusals", &WriterLog::refusals, "attempts broken off because of resistance")
+      .def_readonly("not_accepted", &WriterLog::not_accepted,
+                    "attempts written whole that the display was seen not to take")
       .def_readonly("gave_up", &WriterLog::gave_up, "the writer gave up on a stroke")
       .def("out_of_order_attempts", &WriterLog::out_of_order_attempts, "strokes started out of order")
       .def("backwards_attempts", &WriterLog::backwards_attempts, "strokes started from their end")

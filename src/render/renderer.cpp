@@ -19,6 +19,25 @@ double smoothstep(double u) noexcept {
   return u * u * (3.0 - 2.0 * u);
 }
 
+// Rounding a corner: near the end of an element that another follows, a hand turns where the median it
+// follows turns, inside the fitted corner point (by up to a few millimetres: the fitted corner is where the
+// two elements' lines meet), so that the active element's line, its backward resistance and the off-stroke
+// damper all lie across its way. There the fixture goes slack: weight 1 within R_res / 2 of the corner
+// point, 0 beyond R_res, a smoothstep between, so the force stays continuous; past the corner the next
+// element guides again.
+struct CornerRelease {
+  double weight = 0.0;
+  [[nodiscard]] Vec2 released(const Vec2& force) const noexcept { return (1.0 - weight) * force; }
+};
+
+CornerRelease corner_release(const ActiveStroke& active, const Vec2& tip, double radius_m) noexcept {
+  const PlacedStroke* stroke = active.stroke();
+  const std::size_t e = active.element_index();
+  if (stroke == nullptr || e + 1 >= stroke->elements.size() || !(radius_m > 0.0)) return {};
+  const double d = (tip - stroke->elements[e].end()).norm();
+  return {smoothstep((radius_m - d) / (0.5 * radius_m))};
+}
+
 // The safety chain's parameters with the device's peak and continuous force filled in.
 SafetyChainParameters chain_parameters(const RendererOptions& options, const DeviceInfo& device) {
   SafetyChainParameters p = options.safety;
@@ -159,6 +178,8 @@ Vec2 Renderer::guidance_force(const DeviceState& device, RenderOutput& out, bool
   // stroke to an end or corner it has passed; on the end plane the along-stroke part is zero, so this is
   // continuous.
   if (nearest.t >= 1.0) attraction -= attraction.dot(tangent) * tangent;
+  const CornerRelease corner = corner_release(active_, tip, parameters_.constraint_radius_m);
+  attraction = corner.released(attraction);
   // The replay point may lead or trail the pen along the stroke by more than R_res: the spring is
   // saturated at its force at replay_max_lead_m, so the force stays bounded and continuous. (The foot
   // point of the other modes is never further than R_res.)
@@ -167,8 +188,8 @@ Vec2 Renderer::guidance_force(const DeviceState& device, RenderOutput& out, bool
   const double limit = parameters_.guidance_stiffness_n_per_m * factor * reach;
   const double magnitude = attraction.norm();
   if (magnitude > limit) attraction *= limit / magnitude;
-  return taper * attraction +
-         resistance_force(device.velocity_m_s.head<2>(), tangent, parameters_.resistance_damping_n_s_per_m);
+  return taper * attraction + corner.released(resistance_force(device.velocity_m_s.head<2>(), tangent,
+                                                               parameters_.resistance_damping_n_s_per_m));
 }
 
 RenderOutput Renderer::tick(const DeviceState& device) noexcept {
@@ -266,8 +287,10 @@ RenderOutput Renderer::tick(const DeviceState& device) noexcept {
     const double distance = away.norm();
     const double outward = distance > 0.0 ? std::max(0.0, off_stroke_velocity_.dot(away) / distance) : 0.0;
     if (outward > 0.0) {
-      target = off_stroke_resistance(outward * away / distance, parameters_.off_stroke_damping_n_s_per_m,
-                                     parameters_.off_stroke_speed_m_s);
+      target = corner_release(active_, tip, parameters_.constraint_radius_m)
+                   .released(off_stroke_resistance(outward * away / distance,
+                                                   parameters_.off_stroke_damping_n_s_per_m,
+                                                   parameters_.off_stroke_speed_m_s));
     }
   }
   const bool off_stroke_changed = off_in_calibration != (state_before == InteractionState::calibration);

@@ -27,7 +27,10 @@ constexpr std::array kFields = {
     Field{"travel_speed_m_s", &WriterProfile::travel_speed_m_s},
     Field{"press_depth_m", &WriterProfile::press_depth_m},
     Field{"lift_height_m", &WriterProfile::lift_height_m},
-    Field{"overshoot_m", &WriterProfile::overshoot_m},
+    Field{"corner_cut_m", &WriterProfile::corner_cut_m},
+    Field{"end_short_m", &WriterProfile::end_short_m},
+    Field{"end_past_m", &WriterProfile::end_past_m},
+    Field{"follow_through_m", &WriterProfile::follow_through_m},
     Field{"bias_offset_m", &WriterProfile::bias_offset_m},
     Field{"scale_error", &WriterProfile::scale_error},
     Field{"stroke_jitter_m", &WriterProfile::stroke_jitter_m},
@@ -134,7 +137,10 @@ void WriterProfile::validate() const {
   check_range("travel_speed_m_s", travel_speed_m_s, 0.0, 10.0, true);
   check_range("press_depth_m", press_depth_m, 0.0, 0.1);
   check_range("lift_height_m", lift_height_m, 0.0, 0.2, true);
-  check_range("overshoot_m", overshoot_m, 0.0, 0.05);
+  check_range("corner_cut_m", corner_cut_m, 0.0, 0.02);
+  check_range("end_short_m", end_short_m, 0.0, 0.02);
+  check_range("end_past_m", end_past_m, 0.0, 0.02);
+  check_range("follow_through_m", follow_through_m, 0.0, 0.05);
   check_range("bias_offset_m", bias_offset_m, 0.0, 0.05);
   check_range("scale_error", scale_error, -0.5, 0.5, true, true);
   check_range("stroke_jitter_m", stroke_jitter_m, 0.0, 0.05);

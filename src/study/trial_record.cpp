@@ -127,7 +127,10 @@ json writer_json(const TrialRecordContext& c) {
             {"noise_fraction", w.noise_fraction},
             {"tremor_amplitude_n", w.tremor_amplitude_n},
             {"tremor_frequency_hz", w.tremor_frequency_hz},
-            {"overshoot_m", w.overshoot_m},
+            {"corner_cut_m", w.corner_cut_m},
+            {"end_short_m", w.end_short_m},
+            {"end_past_m", w.end_past_m},
+            {"follow_through_m", w.follow_through_m},
             {"correction_per_attempt", w.correction_per_attempt},
             {"max_attempts_per_stroke", w.max_attempts_per_stroke}}}};
 }

@@ -14,6 +14,9 @@ enum class AttemptEnd {
   completed,    ///< the writer wrote its whole path and lifted the pen
   refused,      ///< the writer felt resistance and broke the attempt off (guidance refused the stroke)
   interrupted,  ///< the writer saw its stroke cleared after a lift in the middle and started it again
+  /// The writer wrote its whole path at the stroke the display showed as next, lifted the pen and saw the
+  /// display not take it (the stroke was refused: too short, in the wrong place, ...); it writes it again.
+  not_accepted,
 };
 
 /// One attempt at one stroke.
@@ -39,8 +42,9 @@ struct WriterAttempt {
 /// Every attempt in the order made, and what the writer perceived.
 struct WriterLog {
   std::vector<WriterAttempt> attempts;
-  std::size_t refusals = 0;  ///< attempts broken off because of resistance
-  bool gave_up = false;      ///< the writer gave up on a stroke after `max_attempts_per_stroke`
+  std::size_t refusals = 0;      ///< attempts broken off because of resistance
+  std::size_t not_accepted = 0;  ///< attempts written whole that the display did not take (seen)
+  bool gave_up = false;          ///< the writer gave up on a stroke after `max_attempts_per_stroke`
 
   /// Attempts that were out of order / backwards / of each error kind.
   [[nodiscard]] std::size_t out_of_order_attempts() const noexcept;

@@ -26,7 +26,16 @@ struct WriterProfile {
   double travel_speed_m_s = 0.08;    ///< mean speed of pen-up moves [m/s], > 0
   double press_depth_m = 0.005;      ///< how far below the paper the hand aims while writing [m], >= 0
   double lift_height_m = 0.01;       ///< pen-up height above the paper [m], > 0
-  double overshoot_m = 0.003;        ///< follow-through past turns and the stroke's end [m], >= 0
+  /// Most the writer cuts inside a corner of the stroke [m], >= 0: each corner is cut by a uniform draw in
+  /// [0, this] (the data's medians round their corners over 2-3 vertices; people's copies lie a median
+  /// 2.3 mm from them, docs/stroke-acceptance.md).
+  double corner_cut_m = 0.0015;
+  /// Where the pen is lifted, relative to the end of the stroke the writer sees on the display: a uniform
+  /// draw from `end_short_m` short of it to `end_past_m` past it [m], both >= 0 (another hand's strokes end
+  /// 2 mm short to 2.5 mm past hanzi-writer-data's medians, within 3.5 mm; docs/stroke-acceptance.md).
+  double end_short_m = 0.002;
+  double end_past_m = 0.0025;     ///< see `end_short_m` [m], >= 0
+  double follow_through_m = 0.0;  ///< a run past the end added to the draw (a brush's exit) [m], >= 0
 
   // Systematic bias of the writer's copy of the character, so that guidance has work to do.
   double bias_offset_m = 0.002;  ///< offset of the whole copy [m], >= 0
