@@ -250,6 +250,10 @@ TEST_CASE("Bad input to the stroke matcher is refused naming it", "[stroke_progr
   nan[1].x() = std::nan("");
   CHECK_THROWS_WITH(match_stroke(c, 0, nan, kStartRadius), Catch::Contains("path point 1"));
   CHECK_THROWS_AS(match_stroke(c, 0, path, 0.0), InvalidArgument);
+  // A finite step too long to have a finite length (a sample from another world): read, and refused.
+  const StrokeMatch wild =
+      match_stroke(c, 0, std::vector<Vec2>{c.strokes[0].start(), Vec2(1e300, -1e300)}, kStartRadius);
+  CHECK_FALSE(wild.accepted);
   StrokeAcceptance bad;
   bad.corridor_m = -1.0;
   CHECK_THROWS_WITH(bad.validate(), Catch::Contains("corridor_m"));

@@ -14,6 +14,9 @@ namespace {
 // points, as fine as a 1 kHz pen at 250 mm/s, so that a sparse path (a median's few vertices, a 60 Hz
 // pointer) is read as the renderer would read the same motion.
 constexpr double kStep_m = 0.00025;
+// Most pieces one step of the path is cut into (a step of 262 m): a longer step, nowhere near a character,
+// is read more coarsely rather than overflowing the count (a finite step can have an infinite length).
+constexpr int kMaxPieces = 1 << 20;
 
 // Throws InvalidArgument, naming `function`, for an empty path, a point that is not finite, a start radius
 // that is not finite and > 0, or an invalid acceptance.
@@ -51,7 +54,9 @@ StrokeAttempt attempt(const PlacedStroke& stroke, std::span<const Vec2> path, do
   feed(path.front());
   for (std::size_t i = 1; i < path.size(); ++i) {
     const Vec2 step = path[i] - path[i - 1];
-    const int pieces = std::max(1, static_cast<int>(std::ceil(step.norm() / kStep_m)));
+    const double length_in_steps = std::ceil(step.norm() / kStep_m);
+    const int pieces =
+        length_in_steps < kMaxPieces ? std::max(1, static_cast<int>(length_in_steps)) : kMaxPieces;
     for (int k = 1; k <= pieces; ++k) feed(path[i - 1] + step * (static_cast<double>(k) / pieces));
   }
   if (!result.entered) return result;
