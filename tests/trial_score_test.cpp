@@ -82,6 +82,8 @@ TEST_CASE("The reference itself, densely sampled, scores as perfect", "[score]")
   CHECK(score.backwards_strokes == 0);
   CHECK(score.strokes_in_order);
   CHECK(score.completed_in_order);
+  CHECK(score.strokes_accepted == 5);  // the renderer's verdicts in turn
+  CHECK(score.refusals.total() == 0);
   CHECK(score.totals.pen_lifts == 4);
   const double step = ScoreOptions{}.metrics.curves.reference_step_m;
   for (const StrokeScore& s : score.strokes) {
@@ -145,6 +147,14 @@ TEST_CASE("A stroke written from its end is matched backwards", "[score]") {
   CHECK(score.strokes[3].backwards);
   CHECK(score.segments[3].backwards);
   CHECK(score.order_errors == 0);
+  // In turn: strokes 0-2 accepted, 3 refused as backwards, and 4 then out of order (3 still expected).
+  CHECK(score.strokes_accepted == 3);
+  REQUIRE(score.segments[3].verdict);
+  CHECK(score.segments[3].verdict->refusal == StrokeRefusal::backwards);
+  REQUIRE(score.segments[4].verdict);
+  CHECK(score.segments[4].verdict->refusal == StrokeRefusal::wrong_order);
+  CHECK(score.refusals.backwards == 1);
+  CHECK(score.refusals.wrong_order == 1);
   // Shape is measured against the stroke traversed the way it was written.
   REQUIRE(score.strokes[3].metrics);
   CHECK(score.strokes[3].metrics->curves.frechet_m < 0.1e-3);
@@ -241,11 +251,18 @@ TEST_CASE("A bad trace is refused, naming the sample", "[score]") {
   far[4].position_m.x() = 1e305;  // finite in metres, not in data units
   CHECK_THROWS_WITH(score_trace(yong, far), Catch::Contains("sample 4"));
   ScoreOptions options;
-  options.leniency = 0.0;
-  CHECK_THROWS_AS(score_trace(yong, trace.samples, options), InvalidArgument);
+  options.start_radius_m = 0.0;
+  CHECK_THROWS_WITH(score_trace(yong, trace.samples, options), Catch::Contains("start_radius_m"));
+  options = ScoreOptions{};
+  options.acceptance.mean_deviation_m = NAN;
+  CHECK_THROWS_WITH(score_trace(yong, trace.samples, options), Catch::Contains("mean_deviation_m"));
   PlacedCharacter hollow = yong;
   hollow.strokes[2].elements.clear();
   CHECK_THROWS_WITH(score_trace(hollow, trace.samples), Catch::Contains("stroke 2"));
+  PlacedCharacter unplaced = yong;
+  unplaced.strokes[1].centre_line = StrokeCentreLine{};
+  CHECK_THROWS_WITH(score_trace(unplaced, trace.samples),
+                    Catch::Contains("stroke 1") && Catch::Contains("centre line"));
 }
 
 TEST_CASE("A pen held still is ignored, even without a minimum length", "[score]") {
@@ -261,15 +278,27 @@ TEST_CASE("A pen held still is ignored, even without a minimum length", "[score]
   CHECK_FALSE(score.totals.normalised_jerk);
 }
 
-TEST_CASE("Leniency scales how far a stroke may stray", "[score]") {
+TEST_CASE("The stroke acceptance decides how far a stroke may stray", "[score]") {
   const PlacedCharacter& yong = scene_of(U'永').characters.front();
-  // 8 mm beside the model: 137 data units, within Hanzi Writer's mean distance of 175 at leniency 1, not
-  // within 175 x 0.5.
-  const TraceBuilder trace = written_in_order(yong, {3}, 0.05e-3, 8e-3);
-  ScoreOptions strict;
-  strict.leniency = 0.5;
-  CHECK(score_trace(yong, trace.samples, strict).strokes_written == 0);
-  CHECK(score_trace(yong, trace.samples).strokes[3].written);
+  // 4 mm beside the model: within the start neighbourhood (5 mm) and the corridor (6.5 mm), beyond the
+  // default mean deviation of 3 mm.
+  const TraceBuilder trace = written_in_order(yong, {3}, 0.05e-3, 4e-3);
+  const CharacterScore strict = score_trace(yong, trace.samples);
+  CHECK(strict.strokes_written == 0);
+  CHECK(strict.unmatched_strokes == 1);
+  REQUIRE(strict.segments.front().verdict);
+  CHECK(strict.segments.front().verdict->refusal == StrokeRefusal::wrong_place);
+  CHECK(strict.refusals.wrong_place == 1);
+  ScoreOptions lenient;
+  lenient.acceptance.mean_deviation_m = 0.005;
+  const CharacterScore written = score_trace(yong, trace.samples, lenient);
+  CHECK(written.strokes[3].written);
+  REQUIRE(written.strokes[3].metrics);
+  CHECK(written.strokes[3].metrics->deviation.mean_m == Approx(4e-3).epsilon(0.1));
+  // In turn the renderer expects stroke 0: this is a later stroke, out of order.
+  REQUIRE(written.segments.front().verdict);
+  CHECK(written.segments.front().verdict->refusal == StrokeRefusal::wrong_order);
+  CHECK(written.segments.front().verdict->matched_stroke == 3u);
 }
 
 TEST_CASE("Scoring a 5-stroke trace of about 15,000 samples (timing printed)", "[.][score_timing]") {
@@ -289,8 +318,8 @@ TEST_CASE("Scoring a 5-stroke trace of about 15,000 samples (timing printed)", "
 }
 
 TEST_CASE("A stroke written twice is not taken for a neighbouring stroke never written", "[score]") {
-  // Hanzi Writer's closer-stroke rule: the repeat matches its own stroke more closely, so it must pass the
-  // tests against the unwritten one at a lower leniency. Every (omitted, repeated) pair of strokes.
+  // The stroke matcher does not write a neighbouring stroke with a repeat of another, and the assignment of
+  // least total deviation gives the repeat to its own stroke. Every (omitted, repeated) pair of strokes.
   for (const char32_t c : {U'鼎', U'说', U'电', U'月', U'日'}) {
     const PlacedCharacter& character = scene_of(c).characters.front();
     const std::size_t n = character.strokes.size();

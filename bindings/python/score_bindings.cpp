@@ -12,6 +12,7 @@
 
 #include "arguments.hpp"
 #include "bindings.hpp"
+#include "calligraphy/collision/stroke_progress.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/report/pen_trace_csv.hpp"
@@ -83,7 +84,7 @@ std::vector<PenSample> samples_from_columns(const py::object& columns, TraceUnit
 
 py::dict score_py(const py::object& trace, const py::object& character, const std::string& units_name,
                   const std::optional<Checked<CharacterSource>>& library, double contact_threshold_m,
-                  double leniency) {
+                  const std::optional<Checked<StrokeAcceptance>>& acceptance, double start_radius_m) {
   const TraceUnits units = parse_trace_units(units_name == "m" ? "metres" : units_name);
   Character model;
   if (py::isinstance<Character>(character)) {
@@ -109,7 +110,8 @@ py::dict score_py(const py::object& trace, const py::object& character, const st
     samples = samples_from_columns(trace, units, placed.placement, contact_threshold_m);
   }
   ScoreOptions options;
-  options.leniency = leniency;
+  if (acceptance) options.acceptance = take(*acceptance, "acceptance");
+  options.start_radius_m = start_radius_m;
   const CharacterScore score = score_trace(placed, samples, options);
   const ScoreDescription description{encode_utf8(placed.code_point), trace_name,
                                      units == TraceUnits::data ? "data" : "m", samples.size()};
@@ -123,10 +125,11 @@ void bind_score(py::module_& m) {
       "score", &score_py, py::arg("trace"), py::arg("character"), py::arg("units") = "m",
       py::arg("library") = py::none(),
       py::arg("contact_threshold_m") = PenTraceCsvOptions{}.contact_threshold_m,
-      py::arg("leniency") = ScoreOptions{}.leniency,
+      py::arg("acceptance") = py::none(), py::arg("start_radius_m") = ScoreOptions{}.start_radius_m,
       R"(Scores a pen trace from any source against a character, as `calligraphy score` does (trial/score.hpp;
 metrics defined in docs/metrics.md): strokes segmented at pen lifts and matched to the reference strokes
-with Hanzi Writer's quiz tests, so order and direction errors are found.
+with the stroke matcher the renderer uses (match_stroke, docs/stroke-acceptance.md), so order and
+direction errors are found, and each segment gets the verdict the renderer would have given it in turn.
 
 trace: the path of a CSV file (header t, x, y and pen or z; other columns ignored: `trial --csv` output
        reads as it is), or a mapping of columns (a dict of 1-D arrays, a pandas DataFrame) with `t` [s],
@@ -134,9 +137,14 @@ trace: the path of a CSV file (header t, x, y and pen or z; other columns ignore
 character: a str of one character (loaded from `library`, default the embedded set) or a Character,
            laid out as `simulate_trial` places it.
 units: 'm' (metres on the paper plane of that placement) or 'data' (the 1024-unit box, y up).
-leniency: scales the match tests' thresholds, > 0 (Hanzi Writer's quiz leniency).
+acceptance: a StrokeAcceptance (default: the C++ defaults, the renderer's).
+start_radius_m: radius of the start neighbourhood a segment must enter a stroke in [m], > 0 (default the
+                scene's, 0.005).
 Returns a dict with the keys of `calligraphy score --json` (per_stroke, order_errors, backwards_strokes,
-mean_deviation_mm, frechet_mm, dtw_mm, ...); a value that does not exist is None.
+mean_deviation_mm, frechet_mm, dtw_mm, strokes_accepted, refusals: {reason: count}, segments: one dict per
+pen-down segment with begin/end sample indices (0-based, end exclusive), matched_stroke and a verdict dict
+(accepted, refusal name, expected_stroke, matched_stroke) or None; stroke numbers 1-based as in
+per_stroke's index, ...); a value that does not exist is None.
 Raises DataError (file unreadable, bad row: naming line and column), InvalidArgument (a bad column,
 sample or option, naming it), CharacterNotFound, TypeError.)");
 }

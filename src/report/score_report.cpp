@@ -44,6 +44,40 @@ nlohmann::json stroke_json(const StrokeScore& stroke) {
           {"normalised_jerk", value_or_null(get([](auto& x) { return x.kinematics.normalised_jerk; }))}};
 }
 
+constexpr StrokeRefusal kRefusals[] = {StrokeRefusal::too_short, StrokeRefusal::backwards,
+                                       StrokeRefusal::wrong_place, StrokeRefusal::wrong_stroke,
+                                       StrokeRefusal::wrong_order};
+
+nlohmann::json refusals_json(const RefusalCounts& counts) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const StrokeRefusal r : kRefusals) out[to_string(r)] = counts.of(r);
+  return out;
+}
+
+// Every pen-down segment in writing order, with its match (for the metrics) and the renderer's verdict in
+// sequence; sample indices 0-based (begin inclusive, end exclusive), strokes 1-based.
+nlohmann::json segments_json(const CharacterScore& score) {
+  nlohmann::json out = nlohmann::json::array();
+  std::size_t expected = 0;  // the stroke each verdict judged against: the verdicts accepted before it
+  for (const WrittenSegment& s : score.segments) {
+    nlohmann::json verdict = nullptr;
+    if (s.verdict) {
+      const StrokeMatch& v = *s.verdict;
+      verdict = {{"expected_stroke", expected + 1},        {"accepted", v.accepted},
+                 {"refusal", to_string(v.refusal)},        {"matched_stroke", v.matched_stroke + 1},
+                 {"covered_fraction", v.covered_fraction}, {"mean_deviation_mm", v.mean_deviation_m * 1e3}};
+      if (v.accepted) ++expected;
+    }
+    out.push_back({{"begin", s.begin},
+                   {"end", s.end},
+                   {"ignored", s.ignored},
+                   {"matched_stroke", s.matched_stroke ? nlohmann::json(*s.matched_stroke + 1) : nullptr},
+                   {"backwards", s.backwards},
+                   {"verdict", verdict}});
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string score_table(const ScoreDescription& d, const CharacterScore& score) {
@@ -70,6 +104,14 @@ std::string score_table(const ScoreDescription& d, const CharacterScore& score) 
   };
   appendf(out, "\n  strokes written            %zu / %zu%s\n", score.strokes_written, score.strokes.size(),
           score.completed_in_order ? "  (complete, in order)" : "");
+  appendf(out, "  accepted in turn           %zu / %zu  (the renderer's verdicts, pen lift by pen lift)\n",
+          score.strokes_accepted, score.strokes.size());
+  std::string refused;
+  for (const StrokeRefusal r : kRefusals) {
+    if (score.refusals.of(r) > 0)
+      appendf(refused, "%s%s %zu", refused.empty() ? "" : ", ", to_string(r), score.refusals.of(r));
+  }
+  appendf(out, "  refused                    %s\n", refused.empty() ? "-" : refused.c_str());
   appendf(out, "  order errors               %zu\n", score.order_errors);
   appendf(out, "  backwards strokes          %zu\n", score.backwards_strokes);
   appendf(out, "  unmatched / ignored        %zu / %zu segments\n", score.unmatched_strokes,
@@ -106,6 +148,8 @@ std::string score_json(const ScoreDescription& d, const CharacterScore& score) {
                               {"samples", d.samples},
                               {"strokes_total", score.strokes.size()},
                               {"strokes_written", score.strokes_written},
+                              {"strokes_accepted", score.strokes_accepted},
+                              {"refusals", refusals_json(score.refusals)},
                               {"completed_in_order", score.completed_in_order},
                               {"strokes_in_order", score.strokes_in_order},
                               {"order_errors", score.order_errors},
@@ -126,7 +170,8 @@ std::string score_json(const ScoreDescription& d, const CharacterScore& score) {
                               {"mean_speed_m_s", value_or_null(t.mean_speed_m_per_s)},
                               {"velocity_peaks", t.velocity_peaks},
                               {"normalised_jerk", value_or_null(t.normalised_jerk)},
-                              {"per_stroke", per_stroke}};
+                              {"per_stroke", per_stroke},
+                              {"segments", segments_json(score)}};
   return doc.dump(2) + "\n";
 }
 

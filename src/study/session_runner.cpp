@@ -239,7 +239,8 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     const std::string stem = SessionFolder::trial_stem(trial);
     context.csv_file = stem + ".csv";
     context.svg_file = stem + ".svg";
-    const std::vector<CharacterScore> scores = study_detail::score_characters(scene, trial_result.trace);
+    const std::vector<CharacterScore> scores =
+        study_detail::score_characters(scene, trial_result.trace, options.force.acceptance);
     std::vector<std::vector<QuizEvent>> quiz;
     if (condition.mode == ConditionMode::quiz) {
       quiz = study_detail::quiz_characters(scene, trial_result.trace, condition.quiz);

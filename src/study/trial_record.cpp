@@ -220,10 +220,14 @@ std::vector<PenSample> pen_samples_of_character(const Scene& scene, const std::v
   return samples;
 }
 
-std::vector<CharacterScore> score_characters(const Scene& scene, const std::vector<TrialSample>& trace) {
+std::vector<CharacterScore> score_characters(const Scene& scene, const std::vector<TrialSample>& trace,
+                                             const StrokeAcceptance& acceptance) {
+  ScoreOptions options;
+  options.acceptance = acceptance;
+  options.start_radius_m = scene.layout.start_radius_m;
   std::vector<CharacterScore> scores;
   for (std::size_t c = 0; c < scene.characters.size(); ++c) {
-    scores.push_back(score_trace(scene.characters[c], pen_samples_of_character(scene, trace, c)));
+    scores.push_back(score_trace(scene.characters[c], pen_samples_of_character(scene, trace, c), options));
   }
   return scores;
 }

@@ -43,8 +43,10 @@ nlohmann::json acceptance_json(const StrokeAcceptance& acceptance);
 std::vector<PenSample> pen_samples_of_character(const Scene& scene, const std::vector<TrialSample>& trace,
                                                 std::size_t character);
 
-/// The score of each character of the scene against its part of the trace.
-std::vector<CharacterScore> score_characters(const Scene& scene, const std::vector<TrialSample>& trace);
+/// The score of each character of the scene against its part of the trace, its segment verdicts with the
+/// trial's stroke `acceptance` and the scene's start radius: the renderer's.
+std::vector<CharacterScore> score_characters(const Scene& scene, const std::vector<TrialSample>& trace,
+                                             const StrokeAcceptance& acceptance);
 
 /// The quiz events of each character, the trace fed through a `QuizSession` per character.
 std::vector<std::vector<QuizEvent>> quiz_characters(const Scene& scene, const std::vector<TrialSample>& trace,

@@ -80,7 +80,8 @@ std::pair<std::filesystem::path, bool> PracticeSession::save(const PracticeTrial
   context.csv_file = stem + ".csv";
   context.svg_file = stem + ".svg";
   const Scene& scene = *trial.scene;
-  const std::vector<CharacterScore> scores = study_detail::score_characters(scene, result.trace);
+  const std::vector<CharacterScore> scores =
+      study_detail::score_characters(scene, result.trace, trial.options->force.acceptance);
   std::vector<std::vector<QuizEvent>> quiz;
   if (condition.mode == ConditionMode::quiz)
     quiz = study_detail::quiz_characters(scene, result.trace, condition.quiz);

@@ -9,7 +9,6 @@
 #include "trial/assignment.hpp"
 #include "trial/input_checks.hpp"
 #include "trial/segmentation.hpp"
-#include "trial/stroke_match.hpp"
 
 namespace calligraphy {
 namespace {
@@ -21,28 +20,16 @@ std::string character_name(char32_t code_point) {
 }
 
 void check_options(const ScoreOptions& options) {
-  if (!std::isfinite(options.leniency) || options.leniency <= 0.0) {
-    throw InvalidArgument("ScoreOptions: leniency " + std::to_string(options.leniency) +
-                          " is not finite and > 0");
+  options.acceptance.validate();
+  if (!std::isfinite(options.start_radius_m) || !(options.start_radius_m > 0.0)) {
+    throw InvalidArgument("ScoreOptions: start_radius_m " + std::to_string(options.start_radius_m) +
+                          " m is not finite and > 0");
   }
   if (!std::isfinite(options.min_segment_length_m) || options.min_segment_length_m < 0.0) {
     throw InvalidArgument("ScoreOptions: minimum segment length " +
                           std::to_string(options.min_segment_length_m) + " m is not finite and >= 0");
   }
   trial_detail::require_valid_options(options.metrics);
-}
-
-// The reference of the match tests: the stroke's median in data units (what Hanzi Writer matches against),
-// or the element joints when the stroke was placed without one.
-trial_detail::MatchCurve reference_curve(const PlacedStroke& stroke, const Placement& placement) {
-  std::vector<Vec2> points;
-  if (stroke.median_m.size() >= 2) {
-    for (const Vec2& p : stroke.median_m) points.push_back(placement.to_data(p));
-  } else {
-    points.push_back(placement.to_data(stroke.start()));
-    for (const StrokeElement& e : stroke.elements) points.push_back(placement.to_data(e.end()));
-  }
-  return trial_detail::reference_match_curve(points);
 }
 
 // Pairs (i < j) with sequence[i] > sequence[j].
@@ -98,9 +85,48 @@ void add_spatial_totals(CharacterScore& score) {
 
 }  // namespace
 
-double closer_stroke_leniency_factor(double closer_distance, double own_distance) noexcept {
-  if (!(own_distance > 0.0)) return 1.0;
-  return 0.6 * (closer_distance + own_distance) / (2.0 * own_distance);
+std::size_t RefusalCounts::of(StrokeRefusal refusal) const noexcept {
+  switch (refusal) {
+    case StrokeRefusal::too_short:
+      return too_short;
+    case StrokeRefusal::backwards:
+      return backwards;
+    case StrokeRefusal::wrong_place:
+      return wrong_place;
+    case StrokeRefusal::wrong_stroke:
+      return wrong_stroke;
+    case StrokeRefusal::wrong_order:
+      return wrong_order;
+    case StrokeRefusal::none:
+      break;
+  }
+  return 0;
+}
+
+void RefusalCounts::add(StrokeRefusal refusal) noexcept {
+  switch (refusal) {
+    case StrokeRefusal::too_short:
+      ++too_short;
+      break;
+    case StrokeRefusal::backwards:
+      ++backwards;
+      break;
+    case StrokeRefusal::wrong_place:
+      ++wrong_place;
+      break;
+    case StrokeRefusal::wrong_stroke:
+      ++wrong_stroke;
+      break;
+    case StrokeRefusal::wrong_order:
+      ++wrong_order;
+      break;
+    case StrokeRefusal::none:
+      break;
+  }
+}
+
+std::size_t RefusalCounts::total() const noexcept {
+  return too_short + backwards + wrong_place + wrong_stroke + wrong_order;
 }
 
 CharacterScore score_trace(const PlacedCharacter& character, std::span<const PenSample> trace,
@@ -121,6 +147,12 @@ CharacterScore score_trace(const PlacedCharacter& character, std::span<const Pen
       throw InvalidArgument("score_trace: stroke " + std::to_string(r) + " of character " +
                             character_name(character.code_point) + " has no element");
     }
+    const StrokeCentreLine& line = character.strokes[r].centre_line;
+    if (line.points_m.size() < 2 || line.element_end_arc_m.size() != character.strokes[r].elements.size()) {
+      throw InvalidArgument("score_trace: stroke " + std::to_string(r) + " of character " +
+                            character_name(character.code_point) +
+                            " has no centre line to match against (place it with Scene::lay_out)");
+    }
   }
   validate_pen_trace(trace);
 
@@ -135,11 +167,10 @@ CharacterScore score_trace(const PlacedCharacter& character, std::span<const Pen
   score.segments =
       trial_detail::pen_down_segments(trace, options.min_segment_samples, options.min_segment_length_m);
 
-  // Samples, kinematics and match curves of the scored segments.
+  // Samples and kinematics of the scored segments.
   std::vector<std::size_t> scored;  // indices into score.segments
   std::vector<std::vector<double>> times;
   std::vector<std::vector<Vec2>> positions;
-  std::vector<trial_detail::MatchCurve> written;
   for (std::size_t k = 0; k < score.segments.size(); ++k) {
     WrittenSegment& segment = score.segments[k];
     if (segment.ignored) {
@@ -148,12 +179,10 @@ CharacterScore score_trace(const PlacedCharacter& character, std::span<const Pen
     }
     std::vector<double> t;
     std::vector<Vec2> p;
-    std::vector<Vec2> data;
     for (std::size_t i = segment.begin; i < segment.end; ++i) {
       t.push_back(trace[i].time_s);
       p.push_back(trace[i].position_m);
-      data.push_back(placement.to_data(trace[i].position_m));
-      if (!data.back().allFinite()) {
+      if (!placement.to_data(trace[i].position_m).allFinite()) {
         throw InvalidArgument("score_trace: sample " + std::to_string(i) +
                               " is too far away to convert to data units");
       }
@@ -162,39 +191,44 @@ CharacterScore score_trace(const PlacedCharacter& character, std::span<const Pen
     scored.push_back(k);
     times.push_back(std::move(t));
     positions.push_back(std::move(p));
-    written.push_back(trial_detail::written_match_curve(data));
   }
 
-  // Hanzi Writer's tests for every (reference stroke, scored segment) pair, then a one-to-one assignment.
+  // The renderer's verdict on each segment in sequence: the stroke expected advances with each acceptance.
   const std::size_t strokes = character.strokes.size();
+  std::size_t expected = 0;
+  for (std::size_t w = 0; w < scored.size() && expected < strokes; ++w) {
+    const StrokeMatch verdict =
+        match_stroke(character, expected, positions[w], options.start_radius_m, options.acceptance);
+    score.segments[scored[w]].verdict = verdict;
+    if (verdict.accepted) {
+      ++expected;
+      ++score.strokes_accepted;
+    } else {
+      score.refusals.add(verdict.refusal);
+    }
+  }
+
+  // Every (reference stroke, scored segment) pair the stroke matcher writes, forwards or else backwards, at
+  // the cost of the attempt's mean deviation; then the one-to-one assignment.
   std::vector<std::vector<std::optional<double>>> costs(strokes,
                                                         std::vector<std::optional<double>>(scored.size()));
   std::vector<std::vector<bool>> reversed(strokes, std::vector<bool>(scored.size(), false));
-  std::vector<trial_detail::MatchCurve> references;
-  for (const PlacedStroke& stroke : character.strokes)
-    references.push_back(reference_curve(stroke, placement));
-  std::vector<trial_detail::MatchResult> matches(strokes);
   for (std::size_t w = 0; w < scored.size(); ++w) {
+    const std::vector<Vec2> backwards_path(positions[w].rbegin(), positions[w].rend());
     for (std::size_t r = 0; r < strokes; ++r) {
-      matches[r] = trial_detail::match_stroke(written[w], references[r], options.leniency);
-    }
-    for (std::size_t r = 0; r < strokes; ++r) {
-      trial_detail::MatchResult match = matches[r];
-      if (match.kind == trial_detail::MatchKind::miss) continue;
-      // Another stroke that this segment matches forwards more closely: probably the one written.
-      double closer = match.mean_distance;
-      for (std::size_t other = 0; other < strokes; ++other) {
-        if (other != r && matches[other].kind == trial_detail::MatchKind::forwards)
-          closer = std::min(closer, matches[other].mean_distance);
+      const PlacedStroke& stroke = character.strokes[r];
+      const StrokeAttempt forwards =
+          attempt_stroke(stroke, positions[w], options.start_radius_m, options.acceptance);
+      if (forwards.written) {
+        costs[r][w] = forwards.mean_deviation_m;
+        continue;
       }
-      if (closer < match.mean_distance) {
-        match = trial_detail::match_stroke(
-            written[w], references[r],
-            options.leniency * closer_stroke_leniency_factor(closer, match.mean_distance));
-        if (match.kind == trial_detail::MatchKind::miss) continue;
+      const StrokeAttempt backwards =
+          attempt_stroke(stroke, backwards_path, options.start_radius_m, options.acceptance);
+      if (backwards.written) {
+        costs[r][w] = backwards.mean_deviation_m;
+        reversed[r][w] = true;
       }
-      costs[r][w] = match.mean_distance;
-      reversed[r][w] = match.kind == trial_detail::MatchKind::backwards;
     }
   }
   const std::vector<std::optional<std::size_t>> assignment = trial_detail::optimal_assignment(costs);

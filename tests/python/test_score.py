@@ -56,6 +56,47 @@ def test_swapped_and_reversed_strokes_are_found():
     assert reversed_stroke["backwards_strokes"] == 1
 
 
+def test_segments_carry_the_renderers_verdicts_in_turn():
+    reversed_stroke = calligraphy.score(reference_trace("木", reverse=(1,)), "木")
+    segments = reversed_stroke["segments"]
+    assert len(segments) == 4
+    verdicts = [s["verdict"] for s in segments]
+    # Stroke 1 (1-based) accepted, stroke 2 refused as backwards; strokes 3 and 4 then come too early.
+    assert [v["accepted"] for v in verdicts] == [True, False, False, False]
+    assert [v["refusal"] for v in verdicts] == ["none", "backwards", "wrong_order", "wrong_order"]
+    assert [v["expected_stroke"] for v in verdicts] == [1, 2, 2, 2]
+    assert [v["matched_stroke"] for v in verdicts] == [1, 2, 3, 4]
+    assert reversed_stroke["strokes_accepted"] == 1
+    assert reversed_stroke["refusals"] == {"too_short": 0, "backwards": 1, "wrong_place": 0,
+                                           "wrong_stroke": 0, "wrong_order": 2}
+    # The matching for the metrics still pairs every segment with its stroke.
+    assert [s["matched_stroke"] for s in segments] == [1, 2, 3, 4]
+    assert [s["backwards"] for s in segments] == [False, True, False, False]
+    first = calligraphy.Scene("木").characters[0].strokes[0]
+    assert segments[0]["begin"] == 0 and segments[0]["end"] == 50 * len(first.elements)  # sample indices
+
+
+def test_acceptance_and_start_radius_decide_the_verdicts():
+    beside = reference_trace("木", offset_m=0.004)  # beyond the 3 mm mean deviation, within the corridor
+    strict = calligraphy.score(beside, "木")
+    assert strict["strokes_written"] == 0
+    assert strict["strokes_accepted"] == 0
+    wider = calligraphy.StrokeAcceptance(mean_deviation_m=0.005)
+    lenient = calligraphy.score(beside, "木", acceptance=wider)
+    assert lenient["strokes_written"] == 4
+    assert lenient["strokes_accepted"] == 4
+    # A start neighbourhood smaller than the offset: no stroke is ever entered.
+    small = calligraphy.score(beside, "木", acceptance=wider, start_radius_m=0.003)
+    assert small["strokes_accepted"] == 0
+    assert small["refusals"]["wrong_place"] == 4
+    with pytest.raises(calligraphy.InvalidArgument, match="start_radius_m"):
+        calligraphy.score(beside, "木", start_radius_m=0.0)
+    with pytest.raises(TypeError, match="acceptance"):
+        calligraphy.score(beside, "木", acceptance={"corridor_m": 0.01})
+    with pytest.raises(TypeError):
+        calligraphy.score(beside, "木", leniency=1.0)
+
+
 def test_dataframe_and_csv_give_the_dict_result(tmp_path):
     pandas = pytest.importorskip("pandas")
     columns = reference_trace("大", offset_m=0.0005)

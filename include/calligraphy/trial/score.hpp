@@ -1,14 +1,16 @@
 #pragma once
 /// \file score.hpp
 /// Scoring a pen trace against one placed character: the trace is cut into written strokes at pen
-/// lifts, each written stroke is matched to a reference stroke with the tests of Hanzi Writer's quiz
-/// (chanind/hanzi-writer, src/strokeMatches.ts), and every matched stroke gets the metrics of
-/// metrics.hpp. Definitions and sources: docs/metrics.md.
+/// lifts, each written stroke is matched to a reference stroke with the stroke matcher the renderer uses
+/// (collision/stroke_matcher.hpp, docs/stroke-acceptance.md), and every matched stroke gets the metrics of
+/// metrics.hpp. Each written stroke also gets the verdict the renderer would have given it in turn.
+/// Definitions and sources: docs/metrics.md.
 #include <cstddef>
 #include <optional>
 #include <span>
 #include <vector>
 
+#include "calligraphy/collision/stroke_matcher.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/trial/metrics.hpp"
 
@@ -35,13 +37,21 @@ struct WrittenSegment {
   std::optional<std::size_t> matched_stroke;   ///< reference stroke index, when matched
   bool backwards = false;                      ///< matched with its samples reversed
   std::optional<StrokeKinematics> kinematics;  ///< every segment not ignored
+  /// The verdict the renderer (and the quiz) would give this segment in sequence:
+  /// `match_stroke(character, expected, its path, start_radius_m, acceptance)`, where `expected` is 0 for
+  /// the first segment judged and goes up by one after each accepted verdict. Absent for an ignored
+  /// segment and once every stroke has been accepted.
+  std::optional<StrokeMatch> verdict;
 };
 
 /// How a trace is cut and matched.
 struct ScoreOptions {
-  /// Hanzi Writer's leniency: scales its distance, Frechet and length thresholds (bigger = more lenient).
-  /// Finite, > 0.
-  double leniency = 1.0;
+  /// The stroke matcher's tolerances (SI units): give the renderer's (ForceLawParameters::acceptance) to
+  /// get its verdicts. Valid (StrokeAcceptance::validate).
+  StrokeAcceptance acceptance{};
+  /// Radius of the start neighbourhood a segment must enter a stroke in [m]: the scene's
+  /// (SceneLayout::start_radius_m). Finite, > 0.
+  double start_radius_m = SceneLayout{}.start_radius_m;
   std::size_t min_segment_samples = 3;  ///< a segment with fewer samples is ignored
   double min_segment_length_m = 1e-3;   ///< a segment with a shorter pen-down path is ignored [m]
   MetricsOptions metrics{};
@@ -60,6 +70,20 @@ struct StrokeScore {
   std::optional<StrokeWritingMetrics> metrics;
 };
 
+/// Verdicts refused, by reason (StrokeRefusal).
+struct RefusalCounts {
+  std::size_t too_short = 0;
+  std::size_t backwards = 0;
+  std::size_t wrong_place = 0;
+  std::size_t wrong_stroke = 0;
+  std::size_t wrong_order = 0;
+  /// The count of `refusal`; 0 for none.
+  [[nodiscard]] std::size_t of(StrokeRefusal refusal) const noexcept;
+  /// Counts one more `refusal`; none is not counted.
+  void add(StrokeRefusal refusal) noexcept;
+  [[nodiscard]] std::size_t total() const noexcept;
+};
+
 /// The score of a trace against one character.
 struct CharacterScore {
   char32_t code_point = 0;
@@ -75,23 +99,24 @@ struct CharacterScore {
   std::size_t order_errors = 0;
   bool strokes_in_order = false;    ///< at least one stroke written and order_errors == 0
   bool completed_in_order = false;  ///< every reference stroke written and order_errors == 0
+  /// Segment verdicts accepted (WrittenSegment::verdict): the strokes the renderer would have completed in
+  /// turn, writing the trace with the pen.
+  std::size_t strokes_accepted = 0;
+  RefusalCounts refusals;  ///< segment verdicts refused, by reason
   CharacterWritingMetrics totals;
 };
 
-/// Hanzi Writer's rule (chanind/hanzi-writer, src/strokeMatches.ts) when another stroke matches a written
-/// stroke more closely than the stroke it is tested against: the writer probably wrote that other one,
-/// so the test is repeated with the leniency times 0.6 (closer + own) / (2 own), between 0.3 and 0.6.
-/// `closer_distance` < `own_distance`, both >= 0 (any unit); 1 when own_distance is 0.
-[[nodiscard]] double closer_stroke_leniency_factor(double closer_distance, double own_distance) noexcept;
-
-/// Scores `trace` against `character`. Segments are matched one to one to reference strokes: among the
-/// pairs that pass the Hanzi Writer tests (forwards, else backwards; a pair whose segment another stroke
-/// matches forwards more closely must pass them again at the leniency `closer_stroke_leniency_factor`
-/// gives), as many pairs as possible, and among those the least sum of mean distances (an optimal
-/// assignment, Kuhn 1955 / Munkres 1957). Throws
-/// InvalidArgument for a bad trace (see validate_pen_trace, and positions too large to convert to data
-/// units), a character without strokes, a stroke without elements, a placement that is not finite with a
-/// positive scale, or options out of range.
+/// Scores `trace` against `character`. Every scored segment is tried on every reference stroke with
+/// `attempt_stroke` (the renderer's reading of a pen-down path): a pair is possible forwards when the
+/// attempt writes the stroke, else backwards when it writes it on the reversed path, at a cost of that
+/// attempt's mean deviation. Segments and strokes are then paired one to one: as many pairs as possible,
+/// and among those the least total mean deviation (an optimal assignment, Kuhn 1955 / Munkres 1957), so a
+/// segment that could be either of two strokes goes to the one that leaves the rest best placed. The pairs
+/// give the metrics, the order errors and the backwards strokes; each segment's `verdict` gives what the
+/// renderer would have said in sequence. Throws InvalidArgument for a bad trace (see validate_pen_trace, and
+/// positions too large to convert to data units), a character without strokes, a stroke without elements or
+/// without a centre line (placed otherwise than by Scene::lay_out), a placement that is not finite with a
+/// positive scale, or options out of range (naming the field).
 CharacterScore score_trace(const PlacedCharacter& character, std::span<const PenSample> trace,
                            const ScoreOptions& options = {});
 
