@@ -238,6 +238,12 @@ TEST_CASE("attempt_stroke is the pairwise test of the matcher: one stroke, no ot
   CHECK_THROWS_WITH(attempt_stroke(hz, std::vector<Vec2>{}, kStartRadius),
                     Catch::Contains("attempt_stroke") && Catch::Contains("empty path"));
   CHECK_THROWS_AS(attempt_stroke(hz, hz_path, std::nan("")), InvalidArgument);
+  PlacedStroke unplaced = hz;
+  unplaced.centre_line = StrokeCentreLine{};
+  CHECK_THROWS_WITH(attempt_stroke(unplaced, hz_path, kStartRadius), Catch::Contains("centre line"));
+  PlacedCharacter partly = c;
+  partly.strokes[2].centre_line = StrokeCentreLine{};
+  CHECK_THROWS_WITH(match_stroke(partly, 0, hz_path, kStartRadius), Catch::Contains("stroke 2"));
 }
 
 TEST_CASE("Bad input to the stroke matcher is refused naming it", "[stroke_progress]") {

@@ -35,6 +35,17 @@ void check_attempt_arguments(const char* function, std::span<const Vec2> path, d
   acceptance.validate();
 }
 
+// Throws InvalidArgument, naming `function` and the stroke, when the stroke has no element or no centre line
+// for its elements (it was not placed by Scene::lay_out): the tracker reads both.
+void check_stroke(const char* function, const PlacedStroke& stroke, const std::string& name) {
+  const StrokeCentreLine& line = stroke.centre_line;
+  if (stroke.elements.empty() || line.points_m.size() < 2 || line.arc_m.size() != line.points_m.size() ||
+      line.element_end_arc_m.size() != stroke.elements.size()) {
+    throw InvalidArgument(std::string(function) + ": " + name +
+                          " has no elements or no centre line (place it with Scene::lay_out)");
+  }
+}
+
 // Feeds the path to a tracker as the renderer would: WS from the first point within the start
 // neighbourhood; the path's end is the lift. The arguments are checked.
 StrokeAttempt attempt(const PlacedStroke& stroke, std::span<const Vec2> path, double start_radius_m,
@@ -80,6 +91,8 @@ StrokeMatch match_stroke(const PlacedCharacter& character, std::size_t expected,
                           std::to_string(character.strokes.size()) + " strokes");
   }
   check_attempt_arguments("match_stroke", path_m, start_radius_m, acceptance);
+  for (std::size_t k = 0; k < character.strokes.size(); ++k)
+    check_stroke("match_stroke", character.strokes[k], "stroke " + std::to_string(k));
   const PlacedStroke& stroke = character.strokes[expected];
   const StrokeAttempt own = attempt(stroke, path_m, start_radius_m, acceptance);
   StrokeMatch match;
@@ -112,6 +125,7 @@ StrokeMatch match_stroke(const PlacedCharacter& character, std::size_t expected,
 StrokeAttempt attempt_stroke(const PlacedStroke& stroke, std::span<const Vec2> path_m, double start_radius_m,
                              const StrokeAcceptance& acceptance) {
   check_attempt_arguments("attempt_stroke", path_m, start_radius_m, acceptance);
+  check_stroke("attempt_stroke", stroke, "the stroke");
   return attempt(stroke, path_m, start_radius_m, acceptance);
 }
 

@@ -44,7 +44,8 @@ struct StrokeAttempt {
 /// first comes within `start_radius_m` [m] of the stroke's start, each point is one tick of
 /// `StrokeProgressTracker`, and the path's end is the lift. Names no other stroke: a path that writes
 /// another stroke is simply not written here. Throws InvalidArgument when the path is empty, a point is not
-/// finite, `start_radius_m` is not finite and > 0, or `acceptance` is invalid.
+/// finite, `start_radius_m` is not finite and > 0, `acceptance` is invalid, or the stroke has no elements
+/// or no centre line (it was not placed by Scene::lay_out).
 [[nodiscard]] StrokeAttempt attempt_stroke(const PlacedStroke& stroke, std::span<const Vec2> path_m,
                                            double start_radius_m, const StrokeAcceptance& acceptance = {});
 
@@ -56,7 +57,7 @@ struct StrokeAttempt {
 /// reversed path: wrong_order (it writes a later stroke), wrong_stroke (an earlier stroke, or it set off
 /// from the start and left the stroke), backwards (it writes the stroke reversed, or went against it),
 /// too_short, wrong_place. Throws InvalidArgument when `expected` is not a stroke of the character, and as
-/// `attempt_stroke`.
+/// `attempt_stroke` (for any stroke of the character).
 [[nodiscard]] StrokeMatch match_stroke(const PlacedCharacter& character, std::size_t expected,
                                        std::span<const Vec2> path_m, double start_radius_m,
                                        const StrokeAcceptance& acceptance = {});
