@@ -38,6 +38,7 @@ struct Run {
   std::size_t backwards = 0;
   bool in_order = false;  // the renderer accepted every stroke, each in its turn
   std::size_t refusals = 0;
+  std::size_t not_accepted = 0;  // strokes the writer wrote whole, saw not taken and wrote again
 };
 
 // One lock-step trial on the simulated device (run_simulated_trial), with the writer's log.
@@ -66,6 +67,7 @@ Run run_trial(const Scene& scene, const WriterProfile& profile, bool guidance, s
   run.backwards = score.backwards_strokes;
   run.in_order = result.metrics.completed_in_order;
   run.refusals = result.writer_log ? result.writer_log->refusals : 0;
+  run.not_accepted = result.writer_log ? result.writer_log->not_accepted : 0;
   return run;
 }
 
@@ -175,14 +177,14 @@ int main(int argc, char** argv) {
       std::ofstream out(csv);
       out << "character,code_point,profile,guidance,seed,mean_deviation_mm,renderer_deviation_mm,writing_"
              "time_s,"
-             "order_errors,backwards_strokes,completed_in_order,refusals\n";
+             "order_errors,backwards_strokes,completed_in_order,refusals,not_accepted\n";
       for (const Run& r : runs) {
         char line[256];
-        std::snprintf(line, sizeof line, "%s,U+%04X,%s,%d,%llu,%.4f,%.4f,%.3f,%zu,%zu,%d,%zu\n",
+        std::snprintf(line, sizeof line, "%s,U+%04X,%s,%d,%llu,%.4f,%.4f,%.3f,%zu,%zu,%d,%zu,%zu\n",
                       utf8(r.character).c_str(), static_cast<unsigned>(r.character), r.profile.c_str(),
                       r.guidance ? 1 : 0, static_cast<unsigned long long>(r.seed), r.deviation_mm,
                       r.renderer_deviation_mm, r.time_s, r.order_errors, r.backwards, r.in_order ? 1 : 0,
-                      r.refusals);
+                      r.refusals, r.not_accepted);
         out << line;
       }
     }
@@ -253,6 +255,21 @@ int main(int argc, char** argv) {
         "foreign, with guidance: every stroke in order in %zu of %zu; traces with order errors %zu, "
         "with backwards strokes %zu\n",
         on_in_order, foreign_on, on_order, on_backwards);
+    for (const char* profile : {"novice", "foreign"}) {
+      for (const bool guidance : {false, true}) {
+        std::size_t trials = 0, in_order = 0, rewritten = 0;
+        for (const Run& r : runs) {
+          if (r.profile != profile || r.guidance != guidance) continue;
+          ++trials;
+          if (r.in_order) ++in_order;
+          rewritten += r.not_accepted;
+        }
+        std::printf(
+            "%s, guidance %s: every stroke in order in %zu of %zu; strokes written again after the "
+            "display did not take them %zu\n",
+            profile, guidance ? "on" : "off", in_order, trials, rewritten);
+      }
+    }
     std::printf("all guided trials: every stroke in order in %zu of %zu\n", guided_in_order, guided);
     return guided_in_order == guided ? 0 : 1;
   } catch (const std::exception& e) {

@@ -131,7 +131,7 @@ void bind_writer_profile(py::module_& m) {
       .field("outside_touch_probability", &WriterProfile::outside_touch_probability,
              "the pen touches the paper outside the character's box (AS)")
       .field("hesitation_probability", &WriterProfile::hesitation_probability,
-             "the writer pauses before a stroke or at a feature point")
+             "the writer pauses before a stroke or at a corner")
       .field("hesitation_s", &WriterProfile::hesitation_s, "mean length of a pause [s], >= 0")
       .field("learning_rate", &WriterProfile::learning_rate,
              "lambda of the exponential practice law per repetition, >= 0; 0 = no learning")

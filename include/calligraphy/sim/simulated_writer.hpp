@@ -4,7 +4,9 @@
 /// constant and its source):
 ///  - Hand: an impedance F = k (x_d - x) + b (x_d' - x') + noise + tremor (the noise grows with the
 ///    force, Harris & Wolpert 1998) holds the stylus; x_d moves in minimum-jerk segments (Flash & Hogan
-///    1985) along the writer's own, biased copy of each stroke (offset, mis-scale, per-attempt jitter).
+///    1985) along the writer's own, biased copy (offset, mis-scale, per-attempt jitter) of what a person
+///    sees of each stroke: its median, cut into legs at its corners, each corner cut inside; the pen is
+///    lifted short of or past the end the display shows (a cited end scatter), with no follow-through.
 ///  - Vision: the writer sees its pen and the display a visuomotor delay late (120 ms; Miall, Weir,
 ///    Wolpert & Stein 1993; Saunders & Knill 2005: corrections across the path within 117 ms),
 ///    corrects x_d towards the reference stroke when the seen error exceeds its tolerance, and paces
@@ -15,7 +17,8 @@
 ///  - Responses: a resistance it feels against its intended motion for a reaction time (the renderer's
 ///    resistance of Fig. 4 and its off-stroke resistance under guidance) makes it break the attempt off
 ///    and write the stroke the display hints, forwards, with less bias, and from then on follow the
-///    hint; seeing its stroke cleared after a lift in the middle makes it write the stroke again.
+///    hint; seeing its stroke cleared after a lift in the middle, or a stroke it wrote in turn not taken by
+///    the display, makes it write the stroke again.
 ///    Without guidance nothing refuses a stroke out of order, and the writer keeps to its own order.
 /// All randomness is seeded: the plan (which strokes go out of order or backwards) is drawn at
 /// construction, the other errors at the start of each attempt, the hand's noise from a stream of its

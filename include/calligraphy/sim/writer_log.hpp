@@ -30,7 +30,7 @@ struct WriterAttempt {
   bool out_of_order = false;
   bool follows_hint = false;     ///< the writer wrote the stroke the display hinted, after a refusal
   bool outside_touch = false;    ///< the pen touched the paper outside the character's box before it
-  bool hesitation = false;       ///< the writer paused before the stroke or at a feature point
+  bool hesitation = false;       ///< the writer paused before the stroke or at a corner
   bool mid_stroke_lift = false;  ///< the pen was lifted in the middle of the stroke
   int attempt = 1;               ///< 1 for the first attempt at this stroke, 2 for the next, ...
   double start_s = 0.0;          ///< the writer set off towards the stroke [s]

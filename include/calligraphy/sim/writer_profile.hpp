@@ -70,7 +70,7 @@ struct WriterProfile {
   double backwards_probability = 0.0;         ///< a stroke is written from its end to its start
   double mid_stroke_lift_probability = 0.02;  ///< the pen is lifted in the middle of a stroke
   double outside_touch_probability = 0.02;    ///< the pen touches the paper outside the character's box (AS)
-  double hesitation_probability = 0.05;       ///< the writer pauses before a stroke or at a feature point
+  double hesitation_probability = 0.05;       ///< the writer pauses before a stroke or at a corner
   double hesitation_s = 0.5;                  ///< mean length of a pause [s], >= 0
 
   // Learning across repetitions (writer_learning.hpp).
