@@ -47,6 +47,21 @@ TEST_CASE("write_file_atomically keeps permission bits and symbolic links", "[at
   CHECK((status.st_mode & 07777) == 0640);
 }
 
+TEST_CASE("a dangling symbolic link is kept and the file it names is created", "[atomic_file]") {
+  TemporaryFolder folder;
+  fs::create_directory(folder.path / "out");
+  const fs::path link = folder.path / "link.txt";
+  fs::create_symlink("out/new.txt", link);  // relative: read from the link's folder
+  CHECK(written_path(link) == folder.path / "out" / "new.txt");
+  write_file_atomically(link, std::string_view("new"));
+  CHECK(fs::is_symlink(link));
+  CHECK(fs::read_symlink(link) == "out/new.txt");
+  CHECK(contents(folder.path / "out" / "new.txt") == "new");
+  const fs::path loop = folder.path / "loop";
+  fs::create_symlink("loop", loop);
+  CHECK_THROWS_WITH(write_file_atomically(loop, std::string_view("x")), Catch::Contains(loop.string()));
+}
+
 TEST_CASE("a failed write throws naming the file and keeps the earlier one", "[atomic_file]") {
   TemporaryFolder folder;
   const fs::path target = folder.path / "store.bin";

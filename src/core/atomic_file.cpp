@@ -118,23 +118,32 @@ void sync_folder(const fs::path& target, const fs::path& reported) {
 
 }  // namespace
 
+fs::path written_path(const fs::path& path) {
+  fs::path current = path;
+  for (int links = 0; links <= 40; ++links) {
+    struct stat status {};
+    if (::lstat(current.c_str(), &status) != 0 || !S_ISLNK(status.st_mode)) return current;
+    std::error_code error;
+    const fs::path target = fs::read_symlink(current, error);
+    if (error) fail(path, "cannot read the symbolic link", error.value());
+    current = target.is_absolute() ? target : current.parent_path() / target;
+  }
+  fail(path, "cannot resolve the symbolic link", ELOOP);
+}
+
 void write_file_atomically(const fs::path& path, std::string_view content) {
   if (path.empty()) throw DataError("cannot write a file with an empty name");
+  // A symbolic link keeps pointing where it did: the file it names is replaced, or created when the link
+  // dangles.
+  const fs::path target = written_path(path);
   struct stat status {};
-  fs::path target = path;
   bool exists = false;
-  if (::stat(path.c_str(), &status) == 0) {
+  if (::stat(target.c_str(), &status) == 0) {
     if (!S_ISREG(status.st_mode)) return write_in_place(path, content);
     // A read-only file stays as it is, as it would were it overwritten in place (the rename alone needs
     // only the folder's permission).
-    if (::access(path.c_str(), W_OK) != 0) fail(path, "cannot write", errno);
+    if (::access(target.c_str(), W_OK) != 0) fail(path, "cannot write", errno);
     exists = true;
-    struct stat link_status {};
-    if (::lstat(path.c_str(), &link_status) == 0 && S_ISLNK(link_status.st_mode)) {
-      std::error_code error;
-      target = fs::canonical(path, error);  // replace the file the link points to, keep the link
-      if (error) fail(path, "cannot resolve the symbolic link", error.value());
-    }
   } else if (errno != ENOENT) {
     fail(path, "cannot write", errno);
   }

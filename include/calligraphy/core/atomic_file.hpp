@@ -7,7 +7,8 @@
 /// folder, is written completely (every write checked, interrupted and short writes resumed), fsync'ed,
 /// closed (checked) and renamed over the target (rename(2) replaces a file atomically within one file
 /// system, POSIX.1-2017); the folder is then fsync'ed so that the rename itself is durable. A symbolic link
-/// keeps pointing where it did: the file it points to is replaced. The new file gets the earlier file's
+/// keeps pointing where it did: the file it points to is replaced, and a dangling link's target is created
+/// (the link is never replaced by a regular file; see `written_path`). The new file gets the earlier file's
 /// permission bits, or 0666 less the umask for a new file; an earlier file the caller may not write
 /// (access(2) W_OK) is refused rather than replaced. On failure the temporary is removed and the earlier
 /// file is untouched.
@@ -28,6 +29,11 @@ namespace calligraphy {
 /// system's reason (e.g. "No space left on device", "Permission denied", "Is a directory") when any step
 /// fails: the folder cannot hold a temporary file, a write, fsync, close or the rename fails.
 void write_file_atomically(const std::filesystem::path& path, std::string_view content);
+
+/// The path a write to `path` replaces or creates: symbolic links followed one by one (a relative target
+/// read from the link's folder), a dangling link to the path it names, any other path as it is. Throws
+/// DataError naming `path` when a link cannot be read or there are more than 40 links in a chain (ELOOP).
+[[nodiscard]] std::filesystem::path written_path(const std::filesystem::path& path);
 
 /// The same for binary content (e.g. an encoded corpus store).
 void write_file_atomically(const std::filesystem::path& path, std::span<const std::uint8_t> content);
