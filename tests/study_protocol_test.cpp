@@ -112,6 +112,33 @@ TEST_CASE("protocol errors name the file and the JSON pointer", "[study][protoco
   CHECK_THROWS_WITH(load_study_protocol("/nonexistent/p.json"), Catch::Contains("/nonexistent/p.json"));
 }
 
+TEST_CASE("a plan over the limit of trials per session is refused with its size", "[study][protocol]") {
+  // 1,000 strings x 26 conditions x 1,000 repetitions: within every other bound, 26,000,000 trials.
+  std::string conditions;
+  std::string names;
+  for (char c = 'A'; c <= 'Z'; ++c) {
+    conditions +=
+        std::string(conditions.empty() ? "" : ", ") + R"({"name": ")" + c + R"(", "mode": "vision"})";
+    names += std::string(names.empty() ? "" : ", ") + '"' + c + '"';
+  }
+  std::string items;
+  for (int i = 0; i < 1000; ++i) items += std::string(items.empty() ? "" : ", ") + "\"大\"";
+  const auto text = [&](int repetitions) {
+    return R"({"name": "huge", "conditions": [)" + conditions + R"(], "test": {"characters": [)" + items +
+           R"(], "conditions": [)" + names + R"(], "repetitions": )" + std::to_string(repetitions) + "}}";
+  };
+  CHECK_THROWS_WITH(parse_study_protocol(text(1000), "huge.json"),
+                    Catch::StartsWith("huge.json: /test: 26,000,000 trials planned") &&
+                        Catch::Contains("limit of 1,000,000 trials per session"));
+  // 38 repetitions: 988,000 trials, within the limit, counted without planning them.
+  const StudyProtocol within = parse_study_protocol(text(38), "within.json");
+  CHECK(planned_trial_count(within) == 988000);
+  CHECK(planned_trial_count(within) <= kMaxPlannedTrials);
+  CHECK(thousands(26000000) == "26,000,000");
+  CHECK(thousands(999) == "999");
+  CHECK(thousands(1000) == "1,000");
+}
+
 TEST_CASE("fading and replay conditions are read with their parameters", "[study][protocol]") {
   const StudyProtocol p = parse_study_protocol(
       R"({"name": "f", "conditions": [

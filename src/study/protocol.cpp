@@ -397,7 +397,38 @@ StudyProtocol parse_study_protocol(std::string_view json_text, const std::string
          "order \"abba\" splits each condition's repetitions over two blocks: expected an even number, got " +
              std::to_string(protocol.repetitions));
   }
+  const std::uint64_t planned = planned_trial_count(protocol);
+  if (planned > kMaxPlannedTrials) {
+    fail(source, "/test",
+         thousands(planned) + " trials planned (" + std::to_string(protocol.test_items.size()) +
+             " strings x " + std::to_string(protocol.test_conditions.size()) + " conditions x " +
+             std::to_string(protocol.repetitions) + " repetitions" +
+             (protocol.practice ? " + practice" : "") + "), more than the limit of " +
+             thousands(kMaxPlannedTrials) + " trials per session");
+  }
   return protocol;
+}
+
+std::uint64_t planned_trial_count(const StudyProtocol& protocol) noexcept {
+  // Each factor is at most 1,000 (strings, repetitions) or 26 (conditions): no overflow.
+  std::uint64_t count = static_cast<std::uint64_t>(protocol.test_items.size()) *
+                        static_cast<std::uint64_t>(protocol.test_conditions.size()) *
+                        static_cast<std::uint64_t>(std::max(protocol.repetitions, 0));
+  if (protocol.practice) {
+    count += static_cast<std::uint64_t>(protocol.practice->items.size()) *
+             static_cast<std::uint64_t>(std::max(protocol.practice->repetitions, 0));
+  }
+  return count;
+}
+
+std::string thousands(std::uint64_t count) {
+  const std::string digits = std::to_string(count);
+  std::string out;  // built by appends (GCC 12 warns on insert into a string: -Wrestrict)
+  for (std::size_t i = 0; i < digits.size(); ++i) {
+    if (i > 0 && (digits.size() - i) % 3 == 0) out.push_back(',');
+    out.push_back(digits[i]);
+  }
+  return out;
 }
 
 LoadedProtocol protocol_from_text(std::string text, const std::filesystem::path& path) {

@@ -109,6 +109,12 @@ std::vector<std::string> test_block_conditions(const StudyProtocol& protocol,
 }
 
 std::vector<PlannedTrial> plan_session(const StudyProtocol& protocol, const SubjectAssignment& subject) {
+  const std::uint64_t planned = planned_trial_count(protocol);  // before anything per trial is allocated
+  if (planned > kMaxPlannedTrials) {
+    throw InvalidArgument("protocol '" + protocol.name + "': " + thousands(planned) +
+                          " trials planned, more than the limit of " + thousands(kMaxPlannedTrials) +
+                          " trials per session");
+  }
   const std::vector<std::string> blocks = test_block_conditions(protocol, subject);
   std::vector<PlannedTrial> trials;
   std::map<std::pair<std::string, std::size_t>, int> written;  // (condition, item) -> times planned so far

@@ -126,11 +126,25 @@ struct StudyProtocol {
   [[nodiscard]] const StudyCondition& condition(std::string_view name) const;
 };
 
+/// Most trials one session of a protocol may plan: 1,000,000 (at 10 s a trial, 116 days of writing; the
+/// paper's study plans 26). A session's plan is held in memory and in its session.json, so a protocol within
+/// every other bound (1,000 strings x 26 conditions x 1,000 repetitions: 26,000,000 trials) is refused
+/// rather than run out of memory.
+inline constexpr std::uint64_t kMaxPlannedTrials = 1'000'000;
+
+/// The number of trials one session of `protocol` plans: practice strings x practice repetitions + test
+/// strings x test conditions x repetitions, computed without allocating anything per trial.
+[[nodiscard]] std::uint64_t planned_trial_count(const StudyProtocol& protocol) noexcept;
+
+/// `count` with thousands separators ("26,000,000").
+[[nodiscard]] std::string thousands(std::uint64_t count);
+
 /// Parses a protocol. `source` names the text in errors (a file name). Throws DataError naming the
 /// source and the JSON pointer of the offending value (e.g. "paper.json: /test/repetitions: expected an
 /// integer >= 1, got 0"): malformed JSON (with the byte offset), a missing or unknown key, a value of
 /// the wrong type or out of range, a condition named twice or not defined, a character list that is
-/// empty or not UTF-8, repetitions that `abba` cannot split evenly.
+/// empty or not UTF-8, repetitions that `abba` cannot split evenly, a plan of more than kMaxPlannedTrials
+/// trials (the message states the plan's size, e.g. "26,000,000 trials planned").
 [[nodiscard]] StudyProtocol parse_study_protocol(std::string_view json_text, const std::string& source);
 
 /// A protocol read from a file, with the exact text and its SHA-256 (so that a trial names the protocol
