@@ -26,6 +26,9 @@ struct AcceptanceCommand {
 };
 
 int run_acceptance(const AcceptanceCommand& command) {
+  FilePlan files;  // the document is read and its generated section replaced: it is the one output
+  add_library_inputs(files, command.library);
+  files.output("--markdown", command.markdown);
   const CharacterLibrary library = library_from(command.library);
   const std::vector<char32_t> chosen =
       random_characters(library, static_cast<std::size_t>(command.characters), command.seed,

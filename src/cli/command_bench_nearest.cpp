@@ -48,6 +48,8 @@ struct NearestCommand {
 
 int run_nearest(const NearestCommand& command) {
   require_one_standard_output({{"--json", command.json}, {"--markdown -", command.markdown == "-"}});
+  FilePlan files;  // the document is read and its generated section replaced: it is the one output
+  files.output("--markdown", command.markdown);
   MeasurementSettings settings;
   settings.queries = static_cast<int>(command.queries);
   settings.seed = command.seed;
@@ -79,6 +81,8 @@ struct JumpsCommand {
 
 int run_jumps(const JumpsCommand& command) {
   require_one_standard_output({{"--json", command.json}, {"--markdown -", command.markdown == "-"}});
+  FilePlan files;
+  files.output("--markdown", command.markdown);
   JumpSettings settings;
   settings.seeds.clear();
   for (std::int64_t seed = 1; seed <= command.seeds; ++seed)

@@ -54,6 +54,9 @@ struct BuildCommand {
 
 int run_build(const BuildCommand& command) {
   const std::filesystem::path folder = corpus_folder(command.fit);
+  FilePlan files;
+  files.input_folder("--data", folder.string());
+  files.output("--out", command.out);
   const CharacterLibrary library = CharacterLibrary::from_directory(folder);
   FitOptions fit_options;
   fit_options.tolerance = command.tolerance;
@@ -98,7 +101,11 @@ struct FidelityCommand {
 };
 
 int run_fidelity(const FidelityCommand& command) {
-  const CharacterLibrary library = CharacterLibrary::from_directory(corpus_folder(command.fit));
+  const std::filesystem::path folder = corpus_folder(command.fit);
+  FilePlan files;
+  files.input_folder("--data", folder.string());
+  files.output("--markdown", command.markdown);
+  const CharacterLibrary library = CharacterLibrary::from_directory(folder);
   const int steps = std::stoi(command.fit.steps);
   const std::vector<FidelityRow> rows =
       measure_corpus_fidelity(library, command.tolerances, steps, static_cast<unsigned>(command.fit.threads));

@@ -46,6 +46,11 @@ std::string summary_text(const CncharValidation& result, const std::string& data
 
 int run_validate(const ValidateCommand& command) {
   require_one_standard_output({{"--json", command.json}, {"--markdown -", command.markdown == "-"}});
+  FilePlan files;
+  files.input("--cnchar", command.cnchar);
+  add_library_inputs(files, command.library);
+  files.output("--features", command.features);
+  files.output("--markdown", command.markdown);
   const auto labels = parse_cnchar_orders(
       read_input_file(command.cnchar, "cnchar-order's cnchar.order.min.js"), command.cnchar);
   const CharacterLibrary library = library_from(command.library);

@@ -24,6 +24,9 @@ int run_model(const ModelCommand& command) {
   require_one_standard_output({{"--json", command.json}, {"--svg -", command.svg == "-"}});
   const std::u32string chars = characters_from(command.character, "CHAR");
   if (chars.size() != 1) throw UsageError("CHAR: expects one character, got " + std::to_string(chars.size()));
+  FilePlan files;
+  add_library_inputs(files, command.library);
+  files.output("--svg", command.svg);
   const Character character = CharacterSource(command.library).load(chars[0]);
   if (!command.svg.empty()) write_output(command.svg, model_svg(character));
   if (command.json) {

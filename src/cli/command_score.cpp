@@ -27,6 +27,10 @@ int run_score(const ScoreCommand& command) {
   if (chars.size() != 1) {
     throw UsageError("--character: expects one character, got " + std::to_string(chars.size()));
   }
+  FilePlan files;
+  files.input("TRACE", command.trace);
+  add_library_inputs(files, command.library);
+  files.output("--json", command.json);
   const Scene scene = Scene::lay_out({CharacterSource(command.library).load(chars[0])});
   const PlacedCharacter& character = scene.characters.front();
   PenTraceCsvOptions options;

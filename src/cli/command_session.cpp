@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -18,6 +19,8 @@
 #include "cli/commands.hpp"
 #include "cli/interrupt.hpp"
 #include "cli/library_options.hpp"
+#include "cli/output.hpp"
+#include "cli/signals.hpp"
 #include "core/unicode.hpp"
 #ifdef CALLIGRAPHY_WITH_TRAINER
 #include "trainer/trainer.hpp"
@@ -92,6 +95,31 @@ class TerminalHost final : public SessionHost {
   }
 };
 
+// Every character the protocol names is looked up (read and modelled) before any folder is made or trial
+// run: one the library lacks is a DataError naming the protocol file, the string's JSON pointer and the
+// character, not a failure in the middle of a study.
+void require_characters(const LoadedProtocol& loaded, const CharacterSource& source) {
+  std::set<char32_t> checked;
+  const auto check = [&](const std::vector<std::u32string>& items, const std::string& pointer) {
+    for (std::size_t i = 0; i < items.size(); ++i) {
+      for (const char32_t c : items[i]) {
+        if (!checked.insert(c).second) continue;
+        try {
+          (void)source.load(c);
+        } catch (const Error& e) {
+          char code[16];
+          std::snprintf(code, sizeof code, "U+%04X", static_cast<unsigned>(c));
+          throw DataError(loaded.path.string() + ": " + pointer + "/" + std::to_string(i) +
+                          ": the character " + encode_utf8(c) + " (" + code +
+                          ") cannot be written: " + e.what() + "; nothing was run or written");
+        }
+      }
+    }
+  };
+  if (loaded.protocol.practice) check(loaded.protocol.practice->items, "/practice/characters");
+  check(loaded.protocol.test_items, "/test/characters");
+}
+
 SessionRunOptions run_options(const LibraryOptions& library, SessionHost* host,
                               std::shared_ptr<CharacterSource>& source) {
   source = std::make_shared<CharacterSource>(library);
@@ -99,6 +127,9 @@ SessionRunOptions run_options(const LibraryOptions& library, SessionHost* host,
   options.registry = &cli_device_registry();
   options.load_character = [source](char32_t c) { return source->load(c); };
   options.should_stop = [] { return stop_requested(); };
+  options.stop_reason = [] {
+    return stop_signal() != 0 ? std::string(signal_name(stop_signal())) : std::string();
+  };
   options.host = host;
   return options;
 }
@@ -216,6 +247,14 @@ int run_sessions(const SessionRunCommand& command) {
     throw UsageError("--subject-number: simulated subjects are numbered 1 to N");
   }
   const std::vector<std::string> profiles = split_profiles(command.writer_profile);
+  // The files: nothing written may replace the protocol, the library or a record saved under --out.
+  FilePlan files;
+  files.input("PROTOCOL", command.protocol);
+  add_library_inputs(files, command.library);
+  files.input_folder("--out", command.out);
+  files.output("--screenshot", command.display.screenshot);
+  files.output_folder("--out", command.out);
+  require_characters(protocol, CharacterSource(command.library));
 
   std::vector<SubjectAssignment> subjects;
   if (command.subjects > 0) {
@@ -259,7 +298,13 @@ int resume_session(const SessionResumeCommand& command) {
 #ifdef CALLIGRAPHY_WITH_TRAINER
   if (command.display.display == "window") trainer::register_trainer_devices();
 #endif
+  // Saved records are inputs: no output may replace one.
+  FilePlan files;
+  files.input_folder("DIR", command.folder);
+  add_library_inputs(files, command.library);
+  files.output("--screenshot", command.display.screenshot);
   SessionFolder session = SessionFolder::open(command.folder);
+  require_characters(session.manifest().protocol, CharacterSource(command.library));
   if (!session.next_unsaved()) {
     std::printf("%s: every trial of %s is saved already\n", session.manifest().setup.subject.id.c_str(),
                 session.path().c_str());

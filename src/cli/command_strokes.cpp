@@ -17,6 +17,8 @@ struct StrokesCommand {
 
 int run_strokes(const StrokesCommand& command) {
   require_one_standard_output({{"--json", command.json}, {"--markdown -", command.markdown == "-"}});
+  FilePlan files;
+  files.output("--markdown", command.markdown);
   if (!command.markdown.empty()) write_output(command.markdown, typical_strokes_markdown());
   if (command.json) {
     write_standard_output(typical_strokes_json().dump(2) + "\n");

@@ -13,6 +13,7 @@
 #include "cli/cli_devices.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
+#include "cli/output.hpp"
 #include "core/unicode.hpp"
 #include "study/names.hpp"
 #ifdef CALLIGRAPHY_WITH_TRAINER
@@ -43,6 +44,20 @@ struct TrainCommand {
   std::string quiz_screenshots;
 };
 
+// The files of the command, checked before anything opens (and in a build without the window too): the
+// inputs, the outputs (none the same file as another or as an input), the folders written in.
+void check_train_files(const TrainCommand& command) {
+  if (!command.quiz && !command.quiz_screenshots.empty())
+    throw UsageError("--quiz-screenshots: only with --quiz");
+  FilePlan files;
+  files.input("--teacher", command.teacher);
+  add_library_inputs(files, command.library);
+  files.output("--record", command.record);
+  files.output("--screenshot", command.screenshot);
+  files.output_folder("--session", command.session);
+  files.existing_output_folder("--quiz-screenshots", command.quiz_screenshots);
+}
+
 #ifdef CALLIGRAPHY_WITH_TRAINER
 // "WxH" in pixels, each in [min, 8192].
 std::pair<int, int> window_size(const std::string& text) {
@@ -72,6 +87,7 @@ void require_device(const std::string& name) {
 }
 
 int run_train(const TrainCommand& command) {
+  check_train_files(command);
   trainer::register_trainer_devices();
   const std::u32string chars = characters_from(command.characters, "CHARS");
   trainer::TrainerOptions options;
@@ -99,8 +115,6 @@ int run_train(const TrainCommand& command) {
   options.quiz = command.quiz;
   options.quiz_options.hint_after_misses = static_cast<int>(command.hint_after);
   options.quiz_screenshots = command.quiz_screenshots;
-  if (!command.quiz && !command.quiz_screenshots.empty())
-    throw UsageError("--quiz-screenshots: only with --quiz");
   if (command.quiz && command.guidance_mode != "fixed")
     throw UsageError("--quiz: a quiz has no guidance; drop --guidance-mode " + command.guidance_mode);
   options.guidance_mode = *guidance_mode_from_string(command.guidance_mode);
@@ -146,7 +160,8 @@ int run_train(const TrainCommand& command) {
   return trainer::run_trainer(options);
 }
 #else
-int run_train(const TrainCommand& /*command*/) {
+int run_train(const TrainCommand& command) {
+  check_train_files(command);  // wrong options are reported as such in this build too
   throw Error(
       "this calligraphy was built without the trainer window (CALLIGRAPHY_BUILD_TRAINER=OFF; it needs GLFW 3 "
       "and Dear ImGui: libglfw3-dev libimgui-dev)");

@@ -208,6 +208,14 @@ int run_trial(const TrialCommand& command) {
         "--watchdog-ms applies to real-time pacing only (--pacing real-time, or a hardware device)");
   }
   check_guidance_options(command);
+  // Every input and output is checked before the trial: no output replaces an input or another output.
+  FilePlan files;
+  files.input("--teacher", command.teacher);
+  add_library_inputs(files, command.library);
+  files.output("--json", command.json);
+  files.output("--csv", command.csv);
+  files.output("--svg", command.svg);
+  files.output("--record", command.record);
   const WriterProfile writer = writer_from(command);
   std::unique_ptr<TeacherRecording> teacher;
   if (!command.teacher.empty()) teacher = std::make_unique<TeacherRecording>(teacher_for(command));

@@ -1,6 +1,7 @@
 #include "cli/library_options.hpp"
 
 #include "calligraphy/core/errors.hpp"
+#include "cli/output.hpp"
 #include "core/unicode.hpp"
 
 namespace calligraphy::cli {
@@ -15,6 +16,11 @@ void add_library_options(CLI::App& app, LibraryOptions& options, bool with_store
                        "read fitted characters from this corpus store (corpus build)", "none");
     store->excludes(data);
   }
+}
+
+void add_library_inputs(FilePlan& plan, const LibraryOptions& options) {
+  plan.input("--store", options.store_file);
+  plan.input_folder("--data", options.data_folder);
 }
 
 CharacterLibrary library_from(const LibraryOptions& options) {

@@ -10,6 +10,8 @@
 
 namespace calligraphy::cli {
 
+class FilePlan;
+
 struct LibraryOptions {
   std::string data_folder;  ///< --data DIR; empty: the embedded characters
   std::string store_file;   ///< --store FILE; empty: none
@@ -35,6 +37,9 @@ class CharacterSource {
   CharacterLibrary library_;
   bool embedded_ = false;  // the embedded default set: a missing character gets the --data hint
 };
+
+/// Registers --store FILE and --data DIR (every file in it) as inputs of `plan`: no output may replace them.
+void add_library_inputs(FilePlan& plan, const LibraryOptions& options);
 
 /// The code points of a CHARS argument; throws UsageError naming `what` (e.g. "--chars") when it is
 /// empty or not UTF-8.

@@ -1,12 +1,17 @@
 #include "cli/output.hpp"
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <iostream>
 
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "cli/app.hpp"
 
 namespace calligraphy::cli {
 
@@ -41,6 +46,144 @@ int finish_standard_output(int status, const std::string& command) {
   std::fprintf(stderr, "%s: error: standard output: cannot write%s%s\n", command.c_str(), error ? ": " : "",
                error ? std::strerror(error) : "");
   return 1;
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string named(const std::string& what, const std::string& path) { return what + " " + path; }
+
+bool same_file(const FilePlan::Identity& a, const FilePlan::Identity& b) {
+  if (a.exists != b.exists) return false;
+  return a.exists ? a.device == b.device && a.inode == b.inode : a.path == b.path;
+}
+
+FilePlan::Identity identity_of(const struct stat& status, const fs::path& path) {
+  FilePlan::Identity identity;
+  identity.exists = true;
+  identity.regular = S_ISREG(status.st_mode);
+  identity.folder = S_ISDIR(status.st_mode);
+  identity.device = static_cast<unsigned long long>(status.st_dev);
+  identity.inode = static_cast<unsigned long long>(status.st_ino);
+  std::error_code error;
+  const fs::path canonical = fs::canonical(path, error);
+  identity.path = (error ? path : canonical).string();
+  return identity;
+}
+
+// A folder files are created in: it must be one, and the command must be allowed to add to it.
+void require_writable_folder(const std::string& what, const std::string& path, const fs::path& folder) {
+  struct stat status {};
+  if (::stat(folder.c_str(), &status) != 0) {
+    const int error = errno;
+    throw DataError(named(what, path) + ": the folder " + folder.string() + " " +
+                    (error == ENOENT ? std::string("does not exist") : std::string(std::strerror(error))));
+  }
+  if (!S_ISDIR(status.st_mode)) {
+    throw DataError(named(what, path) + ": " + folder.string() + " is not a folder");
+  }
+  if (::access(folder.c_str(), W_OK | X_OK) != 0) {
+    throw DataError(named(what, path) + ": the folder " + folder.string() +
+                    " is not writable: " + std::strerror(errno));
+  }
+}
+
+fs::path folder_of(const fs::path& file) {
+  const fs::path absolute = fs::absolute(file);
+  return absolute.parent_path();
+}
+
+}  // namespace
+
+FilePlan::Identity identify_file(const std::string& what, const std::string& path) {
+  fs::path target;
+  try {
+    target = written_path(path);
+  } catch (const DataError& e) {
+    throw DataError(what + " " + e.what());
+  }
+  struct stat status {};
+  if (::stat(target.c_str(), &status) == 0) return identity_of(status, target);
+  if (errno != ENOENT && errno != ENOTDIR) {
+    throw DataError(named(what, path) + ": cannot examine: " + std::strerror(errno));
+  }
+  FilePlan::Identity identity;  // not there yet: the resolved folder and the name
+  const fs::path absolute = fs::absolute(target);
+  std::error_code error;
+  const fs::path folder = fs::weakly_canonical(absolute.parent_path(), error);
+  identity.path = ((error ? absolute.parent_path() : folder) / absolute.filename()).string();
+  return identity;
+}
+
+void FilePlan::add_input(const std::string& what, const std::string& given, const Identity& identity) {
+  inputs_.push_back({what, given, identity});
+}
+
+void FilePlan::input(const std::string& what, const std::string& path) {
+  if (path.empty() || path == "-") return;
+  add_input(named(what, path), path, identify_file(what, path));
+}
+
+void FilePlan::input_folder(const std::string& what, const std::string& path) {
+  if (path.empty()) return;
+  const Identity folder = identify_file(what, path);
+  add_input(named(what, path), path, folder);
+  if (!folder.exists || !folder.folder) return;  // the reader names what is missing
+  std::error_code error;
+  fs::recursive_directory_iterator it(path, fs::directory_options::skip_permission_denied, error);
+  for (; !error && it != fs::recursive_directory_iterator(); it.increment(error)) {
+    struct stat status {};
+    if (::stat(it->path().c_str(), &status) == 0 && S_ISREG(status.st_mode)) {
+      add_input(it->path().string() + ", a file under " + named(what, path), it->path().string(),
+                identity_of(status, it->path()));
+    }
+  }
+}
+
+void FilePlan::output(const std::string& what, const std::string& path) {
+  if (path.empty() || path == "-") return;
+  const Identity identity = identify_file(what, path);
+  if (identity.folder || (!identity.exists && (path.back() == '/' || fs::path(path).filename() == ".." ||
+                                               fs::path(path).filename() == "."))) {
+    throw DataError(named(what, path) + ": is a folder, not a file");
+  }
+  if (identity.exists && !identity.regular) return;  // a device or FIFO: written in place, never replaced
+  for (const Entry& input : inputs_) {
+    if (!same_file(identity, input.identity)) continue;
+    throw UsageError(named(what, path) + " is the same file as " + input.what + " (" + identity.path +
+                     "), which this command reads: refused, nothing written");
+  }
+  for (const Entry& output : outputs_) {
+    if (!same_file(identity, output.identity)) continue;
+    throw UsageError(named(what, path) + " and " + named(output.what, output.given) + " are the same file (" +
+                     identity.path + "): one output would overwrite the other; nothing written");
+  }
+  if (identity.exists && ::access(identity.path.c_str(), W_OK) != 0) {
+    throw DataError(named(what, path) + ": cannot write: " + std::strerror(errno));
+  }
+  require_writable_folder(what, path, folder_of(identity.path));
+  outputs_.push_back({what, path, identity});
+}
+
+void FilePlan::output_folder(const std::string& what, const std::string& path) {
+  if (path.empty()) return;
+  fs::path folder = fs::absolute(path);
+  struct stat status {};
+  while (::stat(folder.c_str(), &status) != 0) {  // the nearest folder that exists is the one written in
+    if (errno != ENOENT) throw DataError(named(what, path) + ": cannot examine: " + std::strerror(errno));
+    if (folder == folder.root_path()) break;
+    folder = folder.parent_path();
+  }
+  if (folder == fs::absolute(path) && !S_ISDIR(status.st_mode)) {
+    throw DataError(named(what, path) + ": is not a folder");
+  }
+  require_writable_folder(what, path, folder);
+}
+
+void FilePlan::existing_output_folder(const std::string& what, const std::string& path) {
+  if (path.empty()) return;
+  require_writable_folder(what, path, fs::path(path));
 }
 
 }  // namespace calligraphy::cli

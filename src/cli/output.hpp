@@ -3,6 +3,7 @@
 // standard output for the path "-"; every write is checked.
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace calligraphy::cli {
 
@@ -21,5 +22,56 @@ std::string read_input_file(const std::string& path, const std::string& what);
 /// Flushes standard output and checks that everything written to it arrived; prints a one-line error
 /// and returns 1 (or `status` when that is already an error) when not. What main() returns.
 int finish_standard_output(int status, const std::string& command);
+
+/// The files one command reads and writes, checked before its first trial and its first write
+/// (docs/cli.md, "Outputs"). Inputs are registered first, then each output is checked as it is added:
+///  - a path is resolved through symbolic links (a dangling link to the file it names, which is where
+///    write_file_atomically writes) and identified by (device, inode) when the file exists, by the resolved
+///    path when it does not;
+///  - an output may not be the same file as another output or any input (UsageError, exit 2, naming both
+///    options and paths); a file under a folder of saved records counts as an input;
+///  - an output file's folder must exist and be writable, an existing output file writable, and an
+///    output that names a folder is refused (DataError, exit 1, naming the option and path).
+/// "" and "-" (standard output) are not files. An existing device or FIFO (/dev/null) is written in place,
+/// never replaced, and may be given more than once.
+class FilePlan {
+ public:
+  /// A file the command reads, named `what` in messages ("--teacher", "TRACE").
+  void input(const std::string& what, const std::string& path);
+  /// A folder the command reads (--data, a session folder): every regular file under it is an input.
+  void input_folder(const std::string& what, const std::string& path);
+  /// A file the command writes (write_output). Throws as the class comment says.
+  void output(const std::string& what, const std::string& path);
+  /// A folder the command creates files or folders in: it must be a writable folder, or not exist yet
+  /// with a writable folder as its nearest existing ancestor. Throws DataError naming `what` and the path.
+  void output_folder(const std::string& what, const std::string& path);
+  /// An existing folder the command writes new files into (e.g. screenshots): it must exist and be
+  /// writable. Throws DataError naming `what` and the path.
+  void existing_output_folder(const std::string& what, const std::string& path);
+
+  /// The identity of a file: exists, (device, inode), resolved path.
+  struct Identity {
+    bool exists = false;
+    bool regular = false;
+    bool folder = false;
+    unsigned long long device = 0;
+    unsigned long long inode = 0;
+    std::string path;  ///< the resolved path (canonical when it exists)
+  };
+
+ private:
+  struct Entry {
+    std::string what;
+    std::string given;  ///< the path as given
+    Identity identity;
+  };
+  void add_input(const std::string& what, const std::string& given, const Identity& identity);
+  std::vector<Entry> inputs_;
+  std::vector<Entry> outputs_;
+};
+
+/// The identity of `path` (see FilePlan): symbolic links followed, a dangling one to the path it names.
+/// Throws DataError naming `what` and the path when a link loops or a component cannot be examined.
+FilePlan::Identity identify_file(const std::string& what, const std::string& path);
 
 }  // namespace calligraphy::cli
