@@ -26,6 +26,12 @@ using nlohmann::json;
 
 bool stop_requested(const SessionRunOptions& options) { return options.should_stop && options.should_stop(); }
 
+// Why the run was asked to stop (SessionRunOptions::stop_reason), or "interrupted".
+std::string stop_reason(const SessionRunOptions& options) {
+  std::string reason = options.stop_reason ? options.stop_reason() : std::string();
+  return reason.empty() ? "interrupted" : reason;
+}
+
 std::string utf8(const std::u32string& text) {
   std::string out;
   for (const char32_t c : text) out += encode_utf8(c);
@@ -229,7 +235,9 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     context.guidance = study_detail::guidance_record_json(condition, guidance);
     context.start_utc = study_detail::utc_now_iso8601();
     const auto wall_start = std::chrono::steady_clock::now();
-    const TrialResult trial_result = run_trial(*device, scene, options);
+    TrialResult trial_result = run_trial(*device, scene, options);
+    if (trial_result.end == TrialEnd::interrupted && trial_result.abort_reason.empty())
+      trial_result.abort_reason = "stopped by " + stop_reason(run_options);
     context.wall_time_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     context.end_utc = study_detail::utc_now_iso8601();
@@ -273,6 +281,7 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
       details["abort_reason"] = trial_result.abort_reason;
       ++result.attempts_kept;
       if (trial_result.end == TrialEnd::interrupted) {
+        details["reason"] = stop_reason(run_options);
         session.log("trial_interrupted", details.dump());
         result.interrupted = true;
       } else {
@@ -289,9 +298,9 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
   } else {
     session.log("session_stopped", json{{"saved_trials", result.saved_before + result.saved_now},
                                         {"planned", result.planned},
-                                        {"reason", result.interrupted     ? "interrupted"
-                                                   : result.device_failed ? "device_fault"
-                                                                          : "unknown"}}
+                                        {"reason", result.interrupted     ? stop_reason(run_options)
+                                                   : result.device_failed ? std::string("device_fault")
+                                                                          : std::string("unknown")}}
                                        .dump());
   }
   return result;

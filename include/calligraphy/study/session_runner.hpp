@@ -54,6 +54,10 @@ struct SessionRunOptions {
   /// Polled between trials and during each trial (TrialOptions::should_stop); true ends the session after
   /// keeping the running trial as an attempt.
   std::function<bool()> should_stop;
+  /// Why should_stop turned true, read once it did: e.g. "SIGTERM", "display_lost". Logged as the
+  /// `reason` of `trial_interrupted` and `session_stopped`, and the interrupted attempt's `abort_reason`
+  /// says "stopped by REASON"; empty (or no function): the reason is "interrupted".
+  std::function<std::string()> stop_reason;
   SessionHost* host = nullptr;  ///< nullptr: nobody is told
   /// Overrides the session's pacing for this run (e.g. a session begun in real time resumed lock-step);
   /// nullopt: the pacing in session.json.
