@@ -87,11 +87,11 @@ std::pair<std::filesystem::path, bool> PracticeSession::save(const PracticeTrial
     quiz = study_detail::quiz_characters(scene, result.trace, condition.quiz);
   const bool keep_as_trial = result.end == TrialEnd::completed || result.end == TrialEnd::time_limit ||
                              result.end == TrialEnd::writer_gave_up;
-  const nlohmann::json details = {{"trial", planned.index + 1},
-                                  {"condition", planned.condition},
-                                  {"characters", encode_utf8(trial.character)},
-                                  {"file", stem},
-                                  {"end_reason", to_string(result.end)}};
+  nlohmann::json details = {{"trial", planned.index + 1},
+                            {"condition", planned.condition},
+                            {"characters", encode_utf8(trial.character)},
+                            {"file", stem},
+                            {"end_reason", to_string(result.end)}};
   if (keep_as_trial) {
     const std::string record =
         study_detail::trial_record_json(context, scene, result, scores, quiz.empty() ? nullptr : &quiz);
@@ -103,8 +103,13 @@ std::pair<std::filesystem::path, bool> PracticeSession::save(const PracticeTrial
   const std::string record =
       study_detail::trial_record_json(context, scene, result, scores, quiz.empty() ? nullptr : &quiz);
   const std::filesystem::path kept = folder_.save_attempt(planned, record, trial_csv(result.trace));
+  details["abort_reason"] = result.abort_reason;
   folder_.log(result.end == TrialEnd::interrupted ? "trial_interrupted" : "trial_failed", details.dump());
   return {kept, false};
+}
+
+void PracticeSession::log_stop(const std::string& reason) {
+  folder_.log("session_stopped", nlohmann::json{{"reason", reason}, {"trials", trials_}}.dump());
 }
 
 }  // namespace calligraphy::trainer

@@ -66,6 +66,10 @@ class PracticeSession {
   /// a file cannot be written.
   std::pair<std::filesystem::path, bool> save(const PracticeTrial& trial, const TrialResult& result);
 
+  /// Logs `session_stopped` with `reason` (e.g. "display_lost", "SIGTERM", "device_fault") and the number
+  /// of trials run.
+  void log_stop(const std::string& reason);
+
   [[nodiscard]] const std::filesystem::path& path() const noexcept { return folder_.path(); }
 
  private:

@@ -26,8 +26,16 @@ namespace calligraphy::trainer {
 namespace {
 
 constexpr double kFramePeriodS = 1.0 / 60.0;
+// After a lost display: how long the trial (or the session's thread) may take to stop and be saved.
+constexpr auto kSaveAfterLostDisplay = std::chrono::seconds(5);
 
 }  // namespace
+
+std::string stop_reason() {
+  if (display_lost()) return "display_lost";
+  if (StopSignals::received() != 0) return signal_name(StopSignals::received());
+  return {};
+}
 
 TrainerApp::TrainerApp(const TrainerOptions& options, DeviceInfo device_info, bool hardware,
                        const SessionLink* session)
@@ -71,6 +79,7 @@ int TrainerApp::run() {
     practice_.emplace(setup);
     std::fprintf(stderr, "calligraphy train: saving into %s\n", practice_->path().c_str());
   }
+  set_display_lost_ending([this] { end_after_lost_display(); });
   open_window();
   layout_.emplace(session_ ? 1 : options_.characters.size(), options_.width_px, options_.height_px,
                   kPanelWidthPx);
@@ -85,8 +94,48 @@ int TrainerApp::run() {
   if (session_ == nullptr) start_trial(0);
   loop();
   close_window();
+  set_display_lost_ending({});
   print_measurements();
+  const int signal = StopSignals::received();
+  if (signal != 0 && session_ == nullptr) {
+    std::fprintf(stderr, "calligraphy train: stopped by %s\n", signal_name(signal));
+    if (practice_) practice_->log_stop(signal_name(signal));
+    if (status_ == 0) status_ = exit_status_after(signal);
+  }
   return status_;
+}
+
+// The I/O error handler's ending (x11_errors.hpp), on the window thread inside Xlib: no Xlib, GLFW or GL
+// call. The servo side stops (zero force, forces off) and the trial is saved as interrupted with every
+// tick, as when the window is closed; a study session's thread keeps it as an attempt and logs the stop.
+void TrainerApp::end_after_lost_display() {
+  const auto deadline = Clock::now() + kSaveAfterLostDisplay;
+  const auto wait_until = [&deadline](const auto& done) {
+    while (!done() && Clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    return done();
+  };
+  if (session_ != nullptr) {
+    session_->host->request_stop();
+    if (wait_until([this] { return session_->done->load(); })) {
+      std::fprintf(stderr,
+                   "calligraphy session: stopped: the display was lost; the running trial is kept as an "
+                   "attempt; resume with: calligraphy session resume SESSION_FOLDER\n");
+    } else {
+      std::fprintf(stderr, "calligraphy session: error: the session did not end within %lld s\n",
+                   static_cast<long long>(kSaveAfterLostDisplay.count()));
+    }
+    return;
+  }
+  if (worker_.active() && !worker_.done()) worker_.request_stop();
+  if (worker_.active()) {
+    if (wait_until([this] { return worker_.done(); })) {
+      finish_trial();
+    } else {
+      std::fprintf(stderr, "calligraphy train: error: the trial did not end within %lld s\n",
+                   static_cast<long long>(kSaveAfterLostDisplay.count()));
+    }
+  }
+  if (practice_) practice_->log_stop("display_lost");
 }
 
 // The condition of the next trial, as the session folder names it.

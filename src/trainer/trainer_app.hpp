@@ -41,6 +41,10 @@ using Clock = std::chrono::steady_clock;
 
 enum class NextAction { none, repeat, next, quit };
 
+/// Why the window ends its trial early: "display_lost" after a lost X connection, the stop signal's name
+/// ("SIGINT", "SIGTERM", "SIGHUP"), or empty (a key, the window closed).
+[[nodiscard]] std::string stop_reason();
+
 // A study session the window hosts (run_trainer_session): the host and whether its thread is done.
 struct SessionLink {
   WindowSessionHost* host = nullptr;
@@ -63,6 +67,7 @@ class TrainerApp {
   double seconds_since_start() const;
   void handle_keys();
   void update_pointer();
+  void end_after_lost_display();
 
   // window, fonts, drawing (trainer_window.cpp)
   void open_window();

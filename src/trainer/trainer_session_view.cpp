@@ -187,6 +187,11 @@ SessionRunResult run_trainer_session(const TrainerSessionOptions& options) {
   run.should_stop = [&host, outer_stop] {
     return host.stop_requested() || StopSignals::received() != 0 || (outer_stop && outer_stop());
   };
+  const std::function<std::string()> outer_reason = options.run.stop_reason;
+  run.stop_reason = [outer_reason] {
+    const std::string reason = stop_reason();
+    return !reason.empty() || !outer_reason ? reason : outer_reason();
+  };
   std::atomic<bool> done{false};
   std::optional<SessionRunResult> result;
   std::exception_ptr failure;

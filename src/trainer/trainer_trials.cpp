@@ -93,6 +93,8 @@ void TrainerApp::finish_trial() {
     result.aborted = false;
     result.abort_reason.clear();
   }
+  if (result.end == TrialEnd::interrupted && result.abort_reason.empty() && !stop_reason().empty())
+    result.abort_reason = "stopped by " + stop_reason();  // a lost display or a stop signal
   view.have_result = true;
   view.ended = true;
   view.end = result.end;
