@@ -1,7 +1,10 @@
 """The trainer's window end to end on a virtual X server (run by run_under_xvfb.sh): the simulated writer
 writes 永 live and the screenshot shows the reference, the trace, the active character and the hints
 where the printed layout puts them; the real pointer, driven with xdotool, writes 一 on --device mouse;
-closing the window, pressing Q or sending SIGTERM mid-trial ends it safely with every tick kept.
+closing the window, pressing Q or sending SIGTERM mid-trial ends it safely with every tick kept; a lost
+display (the X server killed), SIGTERM and SIGHUP end `train` and a session in the window with the trial
+kept whole as an interrupted attempt, the reason in its record and in the session's log, and the documented
+exit status (4 after a lost display, 128 + the signal's number).
 
 Environment: CALLIGRAPHY_CLI (the program), CALLIGRAPHY_SOURCE_DIR (the source tree)."""
 import csv
@@ -482,15 +485,15 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual((record["quiz"]["strokes_accepted"], record["quiz"]["misses"]), (1, 0))
         self.assertEqual(record["quiz"]["acceptance"], record["force_law"]["acceptance"])
 
-    def ended_mid_trial(self, end):
+    def ended_mid_trial(self, end, status=0):
         """Starts 永 with the simulated writer (no time limit of its own), lets it write a while, then calls
-        `end`, and checks the trial was kept whole as an interrupted attempt."""
+        `end`, and checks the trial was kept whole as an interrupted attempt and the exit `status`."""
         trainer = self.start("永", "--writer", "simulated", "--session", "out", "--subject", "s01")
         trainer.boxes()
         time.sleep(4.0)
         self.assertIsNone(trainer.process.poll(), "the trial should still run: " + trainer.errors())
         end(trainer)
-        self.assertEqual(trainer.wait(timeout=30), 0, trainer.errors())
+        self.assertEqual(trainer.wait(timeout=30), status, trainer.errors())
         out = pathlib.Path(self.folder) / "out"
         self.assertEqual(saved_trials(out, "s01"), [])
         (record_path,) = kept_attempts(out, "s01")
@@ -516,7 +519,8 @@ class TrainerTest(unittest.TestCase):
         self.ended_mid_trial(press_q)
 
     def test_sigterm_mid_trial_keeps_the_data(self):
-        self.ended_mid_trial(lambda trainer: trainer.process.send_signal(signal.SIGTERM))
+        record = self.ended_mid_trial(lambda trainer: trainer.process.send_signal(signal.SIGTERM), 128 + 15)
+        self.assertEqual(record["abort_reason"], "stopped by SIGTERM")
 
     def test_record_then_replay_and_fading_name_their_conditions(self):
         first = self.start("一", "--writer", "simulated", "--data", SAMPLE, "--record", "teacher.json",
@@ -654,6 +658,190 @@ class SessionWindowTest(unittest.TestCase):
         self.assertIn("session resume", self.errors())
 
 
+class OwnDisplay:
+    """A virtual X server of a test's own (Xvfb), to be killed under the program; None where Xvfb cannot
+    start."""
+
+    def __init__(self):
+        read, write = os.pipe()
+        self.process = subprocess.Popen(["Xvfb", "-displayfd", str(write), "-screen", "0", "1400x900x24",
+                                         "-nolisten", "tcp"], pass_fds=(write,), stdout=subprocess.DEVNULL,
+                                        stderr=subprocess.DEVNULL)
+        os.close(write)
+        with os.fdopen(read) as f:
+            number = f.readline().strip()
+        if not number:
+            self.process.wait()
+            raise OSError("Xvfb printed no display number")
+        self.name = ":" + number
+        self.environment = dict(os.environ, DISPLAY=self.name)
+
+    def xdotool(self, *args):
+        return subprocess.run(["xdotool", *map(str, args)], check=True, capture_output=True, text=True,
+                              env=self.environment).stdout
+
+    def kill(self):
+        if self.process.poll() is None:
+            self.process.kill()
+            self.process.wait()
+
+
+def records_and_rows(attempts):
+    """The one interrupted attempt's record and its CSV's row count."""
+    (record_path,) = attempts
+    record = json.loads(record_path.read_text(encoding="utf-8"))
+    with open(record_path.with_suffix(".csv"), newline="") as f:
+        rows = sum(1 for _ in csv.DictReader(f))
+    return record, rows
+
+
+class EndingTest(unittest.TestCase):
+    """A lost display, SIGTERM and SIGHUP mid-trial, in `train --session` and in `session run` in the window:
+    the servo side stops, the trial is kept whole as an interrupted attempt naming the reason, the session's
+    log records the stop with it, and the program exits with the documented status."""
+
+    def setUp(self):
+        self.folder = pathlib.Path(tempfile.mkdtemp(prefix="calligraphy-ending-"))
+        (self.folder / "tiny.json").write_text(json.dumps(TINY_PROTOCOL, ensure_ascii=False), encoding="utf-8")
+        self.stdout = open(self.folder / "stdout.txt", "w+")
+        self.stderr = open(self.folder / "stderr.txt", "w+")
+        self.process = None
+        self.display = None
+
+    def tearDown(self):
+        if self.process is not None and self.process.poll() is None:
+            self.process.kill()
+            self.process.wait()
+        if self.display is not None:
+            self.display.kill()
+        self.stdout.close()
+        self.stderr.close()
+        shutil.rmtree(self.folder, ignore_errors=True)
+
+    def errors(self):
+        return (self.folder / "stderr.txt").read_text()
+
+    def own_display(self):
+        try:
+            self.display = OwnDisplay()
+        except OSError as e:
+            self.skipTest(f"no Xvfb of the test's own: {e}")
+        return self.display
+
+    def start(self, command, environment=None):
+        self.process = subprocess.Popen([CLI, *command], stdout=self.stdout, stderr=self.stderr, cwd=self.folder,
+                                        env=environment)
+
+    def first_box(self, timeout=30):
+        deadline = time.time() + timeout
+        while time.time() < deadline:
+            lines = [l for l in (self.folder / "stdout.txt").read_text().splitlines() if l.startswith("box ")]
+            if lines:
+                return Box(lines[0])
+            self.assertIsNone(self.process.poll(), "the program ended before its window showed: " + self.errors())
+            time.sleep(0.1)
+        raise AssertionError("no box line within %s s" % timeout)
+
+    def move_pointer(self, box, tool):
+        """The pointer moved a little over the character's box while the trial runs."""
+        window = tool("search", "--name", "calligraphy train").split()[0]
+        for k in range(6):
+            x, y = box.data_to_px((300 + 40 * k, 500))
+            tool("mousemove", "--window", window, round(x), round(y))
+            time.sleep(0.15)
+
+    def check_ended(self, status, reason, session, seconds=1.5):
+        """Waits for the program's `status` within a few seconds, then checks the kept attempt and the log
+        of `session`, a function returning the session folder."""
+        started = time.time()
+        self.assertEqual(self.process.wait(timeout=10), status, self.errors())
+        self.assertLess(time.time() - started, 8.0)
+        folder = session()
+        self.assertEqual(list((folder / "trials").glob("*.json")), [])
+        record, rows = records_and_rows(sorted((folder / "trials" / "attempts").glob("*.json")))
+        self.assertEqual(record["end_reason"], "interrupted")
+        self.assertTrue(record["aborted"])
+        self.assertEqual(record["abort_reason"], "stopped by " + reason)
+        self.assertGreater(rows, seconds * 1000 * 0.8)  # the trial ran about `seconds` at 1 kHz
+        self.assertEqual(rows, record["loop"]["ticks"])  # every tick kept
+        log = [json.loads(l) for l in (folder / "log.jsonl").read_text().splitlines()]
+        (stopped,) = [e for e in log if e["event"] == "session_stopped"]
+        self.assertEqual(stopped["reason"], reason)
+        return log
+
+    def train(self, environment=None):
+        self.start(["train", "永", "--device", "mouse", "--session", "out", "--exit-after", "60"], environment)
+
+    def train_session(self):
+        (folder,) = (self.folder / "out").glob("anonymous/train-*")
+        return folder
+
+    def session_run(self, environment=None):
+        # Unattended: the first trial starts a second after it is announced, and lasts up to 8 s.
+        self.start(["session", "run", "tiny.json", "--subject", "S01", "--device", "mouse", "--writer", "human",
+                    "--out", "out", "--data", SAMPLE, "--exit-after", "60"], environment)
+
+    def study_session(self):
+        (folder,) = (self.folder / "out" / "S01").glob("tiny-*")
+        return folder
+
+    def test_a_lost_display_ends_train_keeping_the_trial(self):
+        display = self.own_display()
+        self.train(display.environment)
+        self.move_pointer(self.first_box(), display.xdotool)
+        time.sleep(1.0)
+        self.assertIsNone(self.process.poll(), self.errors())
+        display.kill()
+        self.check_ended(4, "display_lost", self.train_session)
+        self.assertIn(f"the display was lost (X connection to {display.name} broken)", self.errors())
+
+    def test_a_lost_display_ends_the_session_keeping_the_running_trial(self):
+        display = self.own_display()
+        self.session_run(display.environment)
+        box = self.first_box()
+        time.sleep(1.5)  # the trial starts
+        self.move_pointer(box, display.xdotool)
+        time.sleep(0.5)
+        self.assertIsNone(self.process.poll(), self.errors())
+        display.kill()
+        log = self.check_ended(4, "display_lost", self.study_session, seconds=1.0)
+        (interrupted,) = [e for e in log if e["event"] == "trial_interrupted"]
+        self.assertEqual(interrupted["reason"], "display_lost")
+
+    def signal_ends_train(self, number, name):
+        self.train()
+        self.move_pointer(self.first_box(), xdotool)
+        time.sleep(1.0)
+        self.assertIsNone(self.process.poll(), self.errors())
+        self.process.send_signal(number)
+        self.check_ended(128 + number, name, self.train_session)
+        self.assertIn("stopped by " + name, self.errors())
+
+    def signal_ends_the_session(self, number, name):
+        self.session_run()
+        box = self.first_box()
+        time.sleep(1.5)
+        self.move_pointer(box, xdotool)
+        time.sleep(0.5)
+        self.assertIsNone(self.process.poll(), self.errors())
+        self.process.send_signal(number)
+        log = self.check_ended(128 + number, name, self.study_session, seconds=1.0)
+        (interrupted,) = [e for e in log if e["event"] == "trial_interrupted"]
+        self.assertEqual(interrupted["reason"], name)
+
+    def test_sigterm_ends_train_keeping_the_trial(self):
+        self.signal_ends_train(signal.SIGTERM, "SIGTERM")
+
+    def test_sighup_ends_train_keeping_the_trial(self):
+        self.signal_ends_train(signal.SIGHUP, "SIGHUP")
+
+    def test_sigterm_ends_the_session_keeping_the_running_trial(self):
+        self.signal_ends_the_session(signal.SIGTERM, "SIGTERM")
+
+    def test_sighup_ends_the_session_keeping_the_running_trial(self):
+        self.signal_ends_the_session(signal.SIGHUP, "SIGHUP")
+
+
 # CTest runs the tests in these groups (tests/CMakeLists.txt), so that no one CTest test runs for minutes.
 # A test is in the first group whose pattern its id contains; a test in no group fails the run.
 GROUPS = {
@@ -665,6 +853,9 @@ GROUPS = {
     "quiz": ("quiz",),
     "keeps_data": ("keeps_the_data", "test_record_then_replay", "test_each_run"),
     "session": ("SessionWindowTest",),
+    # Each test ends its program early (a few seconds each): a lost display, then the stop signals.
+    "lost_display": ("test_a_lost_display",),
+    "stop_signals": ("EndingTest",),
 }
 
 
