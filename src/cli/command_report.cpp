@@ -21,9 +21,9 @@ struct ReportCommand {
 
 int run_report(const ReportCommand& command) {
   const auto start = std::chrono::steady_clock::now();
-  // Every file under the folders read (saved trial records among them) is an input: --out replaces none.
+  // Every file of the session folders read (saved trial records among them) is an input: --out replaces none.
   FilePlan files;
-  for (const std::string& folder : command.folders) files.input_folder("DIR", folder);
+  for (const std::string& folder : command.folders) add_saved_sessions(files, "DIR", folder);
   files.output("--out", command.out);
   std::vector<std::filesystem::path> roots(command.folders.begin(), command.folders.end());
   const StudyReport report = read_study_report(roots);

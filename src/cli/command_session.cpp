@@ -251,7 +251,7 @@ int run_sessions(const SessionRunCommand& command) {
   FilePlan files;
   files.input("PROTOCOL", command.protocol);
   add_library_inputs(files, command.library);
-  files.input_folder("--out", command.out);
+  add_saved_sessions(files, "--out", command.out);
   files.output("--screenshot", command.display.screenshot);
   files.output_folder("--out", command.out);
   require_characters(protocol, CharacterSource(command.library));

@@ -11,6 +11,7 @@
 
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/study/session_folder.hpp"
 #include "cli/app.hpp"
 
 namespace calligraphy::cli {
@@ -139,6 +140,18 @@ void FilePlan::input_folder(const std::string& what, const std::string& path) {
                 identity_of(status, it->path()));
     }
   }
+}
+
+void add_saved_sessions(FilePlan& plan, const std::string& what, const std::string& root) {
+  std::error_code error;
+  if (root.empty() || !fs::is_directory(root, error)) return;
+  std::vector<fs::path> sessions;
+  try {
+    sessions = find_session_folders(root);
+  } catch (const DataError&) {
+    return;  // the reader lists the folder again and names what is wrong
+  }
+  for (const fs::path& session : sessions) plan.input_folder(what, session.string());
 }
 
 void FilePlan::output(const std::string& what, const std::string& path) {

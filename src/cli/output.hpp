@@ -70,6 +70,12 @@ class FilePlan {
   std::vector<Entry> outputs_;
 };
 
+/// Every file of every session folder under `root` (find_session_folders: the saved trial records,
+/// session.json, the log, the kept teachers) as an input of `plan`, named `what` ("DIR", "--out"). Other
+/// files under `root` (an earlier report page) are not inputs. A `root` that is not a folder adds nothing:
+/// the command's reader names it.
+void add_saved_sessions(FilePlan& plan, const std::string& what, const std::string& root);
+
 /// The identity of `path` (see FilePlan): symbolic links followed, a dangling one to the path it names.
 /// Throws DataError naming `what` and the path when a link loops or a component cannot be examined.
 FilePlan::Identity identify_file(const std::string& what, const std::string& path);

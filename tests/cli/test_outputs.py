@@ -167,6 +167,21 @@ class SavedRecords(OutputTestCase):
         result = self.run_cli("session", "resume", session)
         self.assertIn("saved already", result.stdout.decode())
 
+    def test_a_report_beside_the_sessions_is_replaced_when_made_again(self):
+        self.small_session()
+        for _ in range(2):  # the page is no file of a session folder: the second run replaces the first
+            result = self.run_cli("report", "study", "--out", "study/report.html")
+            self.assertEqual(result.returncode, 0, result.stderr.decode())
+        self.assertIn("<html", (self.cwd / "study" / "report.html").read_text(encoding="utf-8").lower())
+
+    def test_run_screenshot_onto_a_record_under_out_is_refused(self):
+        _, record = self.small_session()
+        before = tree(self.cwd / "study")
+        result = self.run_cli("session", "run", PROTOCOL, "--writer", "simulated", "--subjects", "1", "--out",
+                              "study", "--screenshot", record)
+        self.assert_refused(result, 2, f"--screenshot {record}", "a file under --out")
+        self.assertEqual(tree(self.cwd / "study"), before)  # no second session folder either
+
     def test_resume_screenshot_onto_the_session_log_is_refused(self):
         session, _ = self.small_session()
         before = tree(self.cwd / "study")
