@@ -2,6 +2,7 @@
 // resumption without losing or overwriting a saved trial, the records, the report read back.
 #include <unistd.h>
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
@@ -9,11 +10,13 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/report/study_report_html.hpp"
 #include "calligraphy/study/session_reader.hpp"
 #include "calligraphy/study/session_runner.hpp"
+#include "probe_device.hpp"
 
 using namespace calligraphy;
 namespace fs = std::filesystem;
@@ -152,6 +155,80 @@ TEST_CASE("a session stopped between trials starts no further trial", "[study][s
   CHECK(result.interrupted);
   CHECK(result.saved_now == 1);
   CHECK(result.attempts_kept == 0);
+}
+
+namespace {
+
+// The log's events of `folder`, as JSON objects.
+std::vector<nlohmann::json> log_events(const fs::path& folder) {
+  std::ifstream log(folder / "log.jsonl");
+  std::vector<nlohmann::json> events;
+  for (std::string line; std::getline(log, line);) events.push_back(nlohmann::json::parse(line));
+  return events;
+}
+
+const nlohmann::json& only_event(const std::vector<nlohmann::json>& events, const std::string& name) {
+  const auto is = [&name](const nlohmann::json& e) { return e.at("event") == name; };
+  REQUIRE(std::count_if(events.begin(), events.end(), is) == 1);
+  return *std::find_if(events.begin(), events.end(), is);
+}
+
+}  // namespace
+
+TEST_CASE("a session stopped mid-trial logs why, and the attempt says it", "[study][session]") {
+  TempFolder temp;
+  SessionFolder session = SessionFolder::create(temp.path, simulated("S05"), small_protocol());
+  std::size_t polls = 0;
+  SessionRunOptions options;
+  options.should_stop = [&] { return ++polls > 500; };
+  options.stop_reason = [] { return std::string("display_lost"); };
+  const SessionRunResult result = run_session(session, options);
+  CHECK(result.interrupted);
+  CHECK(result.attempts_kept == 1);
+  const std::vector<nlohmann::json> events = log_events(session.path());
+  CHECK(only_event(events, "trial_interrupted")["reason"] == "display_lost");
+  CHECK(only_event(events, "session_stopped")["reason"] == "display_lost");
+  const fs::path attempt = session.path() / "trials" / "attempts" /
+                           (SessionFolder::trial_stem(session.plan()[0]) + ".attempt-1.json");
+  const auto record = nlohmann::json::parse(read(attempt));
+  CHECK(record["end_reason"] == "interrupted");
+  CHECK(record["abort_reason"] == "stopped by display_lost");
+
+  // Without a reason: "interrupted", as before.
+  SessionFolder other = SessionFolder::create(temp.path, simulated("S06"), small_protocol());
+  polls = 0;
+  options.stop_reason = nullptr;
+  CHECK(run_session(other, options).interrupted);
+  CHECK(only_event(log_events(other.path()), "session_stopped")["reason"] == "interrupted");
+}
+
+TEST_CASE("a device lost mid-trial keeps the attempt and stops the session naming the fault",
+          "[study][session]") {
+  TempFolder temp;
+  SessionSetup setup = simulated("S07");
+  setup.device = "probe";
+  SessionFolder session = SessionFolder::create(temp.path, setup, small_protocol());
+  DeviceRegistry registry;
+  registry.register_device("probe", test::ProbeDevice().info(),
+                           [] { return std::make_unique<test::ProbeDevice>(/*fail_on_read=*/700); });
+  SessionRunOptions options;
+  options.registry = &registry;
+  const SessionRunResult result = run_session(session, options);
+  CHECK(result.device_failed);
+  CHECK(result.failure.find("timed out on read 700") != std::string::npos);
+  CHECK(result.attempts_kept == 1);
+  CHECK(result.saved_now == 0);
+  const std::vector<nlohmann::json> events = log_events(session.path());
+  CHECK(only_event(events, "trial_failed")["end_reason"] == "device_fault");
+  CHECK(only_event(events, "session_stopped")["reason"] == "device_fault");
+  const fs::path attempt =
+      session.path() / "trials" / "attempts" / (SessionFolder::trial_stem(session.plan()[0]) + ".attempt-1");
+  const auto record = nlohmann::json::parse(read(fs::path(attempt.string() + ".json")));
+  CHECK(record["end_reason"] == "device_fault");
+  std::ifstream csv(attempt.string() + ".csv");
+  std::size_t rows = 0;
+  for (std::string line; std::getline(csv, line);) ++rows;
+  CHECK(rows == 700 + 1);  // every tick before the lost read, and the header
 }
 
 TEST_CASE("a simulated subject writes the same for the same id and differently for another",
