@@ -202,6 +202,21 @@ TEST_CASE("a session stopped mid-trial logs why, and the attempt says it", "[stu
   CHECK(only_event(log_events(other.path()), "session_stopped")["reason"] == "interrupted");
 }
 
+TEST_CASE("a character that cannot be loaded mid-session is logged before the error ends the run",
+          "[study][session]") {
+  TempFolder temp;
+  SessionFolder session = SessionFolder::create(temp.path, simulated("S07"), small_protocol());
+  SessionRunOptions options;
+  options.load_character = [](char32_t) -> Character { throw DataError("no such character in the data"); };
+  CHECK_THROWS_WITH(run_session(session, options), Catch::Contains("no such character"));
+  const std::vector<nlohmann::json> events = log_events(session.path());
+  const nlohmann::json& failed = only_event(events, "trial_failed");
+  CHECK(failed["trial"] == 1);
+  CHECK(failed["error"] == "no such character in the data");
+  CHECK(only_event(events, "session_stopped")["reason"] == "character_not_loaded");
+  CHECK(session.saved_count() == 0);
+}
+
 TEST_CASE("a device lost mid-trial keeps the attempt and stops the session naming the fault",
           "[study][session]") {
   TempFolder temp;

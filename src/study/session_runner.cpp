@@ -208,7 +208,18 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
 
     const StudyCondition& condition = manifest.protocol.protocol.condition(trial.condition);
     std::vector<Character> models;
-    for (const char32_t c : trial.characters) models.push_back(character(c));
+    try {
+      for (const char32_t c : trial.characters) models.push_back(character(c));
+    } catch (const Error& e) {  // a character the library lacks: logged before the error ends the run
+      json details = trial_details(trial);
+      details["error"] = e.what();
+      session.log("trial_failed", details.dump());
+      session.log("session_stopped", json{{"saved_trials", result.saved_before + result.saved_now},
+                                          {"planned", result.planned},
+                                          {"reason", "character_not_loaded"}}
+                                         .dump());
+      throw;
+    }
     const Scene scene = Scene::lay_out(models);
     study_detail::PreparedGuidance guidance;
     if (condition.mode == ConditionMode::fading)
