@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "calligraphy/core/errors.hpp"
 
@@ -129,4 +131,46 @@ TEST_CASE("Files are read whole, regular and bounded in size", "[pen_trace_csv]"
   const TemporaryFile bad("t,x,y,pen\n0,0,0,1\n0.1,0,0,yes\n", "bad.csv");
   CHECK_THROWS_WITH(read_pen_trace_csv(bad.path, test_placement()),
                     Catch::Contains("bad.csv:3") && Catch::Contains("column 4 (pen)"));
+}
+
+TEST_CASE("A UTF-8 byte-order mark before the header is skipped", "[pen_trace_csv]") {
+  // As spreadsheet programs write a CSV file ("CSV UTF-8"), with CR LF.
+  const std::string text = "\xEF\xBB\xBFt,x,y,pen\r\n0,0.001,0.002,1\r\n0.001,0.002,0.003,1\r\n";
+  const auto samples = parse_pen_trace_csv(text, "inline", test_placement());
+  REQUIRE(samples.size() == 2);
+  CHECK(samples[1].position_m == Vec2(0.002, 0.003));
+  const TemporaryFile file(text);
+  CHECK(read_pen_trace_csv(file.path, test_placement()).size() == 2);
+  // Only at the start: elsewhere it is part of a field, and refused as such.
+  CHECK_THROWS_WITH(parse_pen_trace_csv("t,x,y,pen\n\xEF\xBB\xBF"
+                                        "0,0,0,1\n",
+                                        "inline", test_placement()),
+                    Catch::Contains("inline:2") && Catch::Contains("not a number"));
+}
+
+TEST_CASE("A trace with more pen-down segments than the limit is refused while reading", "[pen_trace_csv]") {
+  PenTraceCsvOptions options;
+  options.max_pen_down_segments = 3;
+  std::string text = "t,x,y,pen\n";
+  for (int k = 0; k < 3; ++k) {
+    text += std::to_string(3 * k) + ",0,0,1\n" + std::to_string(3 * k + 1) + ",0,0,1\n" +
+            std::to_string(3 * k + 2) + ",0,0,0\n";
+  }
+  CHECK(parse_pen_trace_csv(text, "inline", test_placement(), options).size() == 9);
+  text += "9,0,0,1\n10,0,0,1\nnot read, so not refused as a row\n";
+  CHECK_THROWS_WITH(parse_pen_trace_csv(text, "inline", test_placement(), options),
+                    Catch::StartsWith("inline:11: ") && Catch::Contains("more than 3 pen-down segments"));
+  CHECK(PenTraceCsvOptions{}.max_pen_down_segments == kMaxScoredSegments);
+  options.max_pen_down_segments = 0;
+  CHECK_THROWS_AS(parse_pen_trace_csv("t,x,y,pen\n", "inline", test_placement(), options), InvalidArgument);
+}
+
+TEST_CASE("The reader reports its progress through the text", "[pen_trace_csv]") {
+  PenTraceCsvOptions options;
+  std::vector<std::pair<std::size_t, std::size_t>> calls;
+  options.progress = [&calls](std::size_t parsed, std::size_t total) { calls.emplace_back(parsed, total); };
+  const std::string text = "t,x,y,pen\n0,0,0,1\n";
+  parse_pen_trace_csv(text, "inline", test_placement(), options);
+  REQUIRE_FALSE(calls.empty());
+  CHECK(calls.back() == std::pair{text.size(), text.size()});
 }

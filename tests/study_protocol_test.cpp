@@ -85,6 +85,15 @@ TEST_CASE("the shipped paper-table5 protocol is valid", "[study][protocol]") {
   CHECK(loaded.sha256 == sha256_hex(loaded.text));
 }
 
+TEST_CASE("a protocol saved with a UTF-8 byte-order mark is read", "[study][protocol]") {
+  // As some editors save JSON; nlohmann-json skips the mark (lexer::skip_bom). The SHA-256 is of the bytes.
+  const std::string text = "\xEF\xBB\xBF" + protocol_text();
+  CHECK(parse_study_protocol(text, "p.json").name == "t");
+  const LoadedProtocol loaded = protocol_from_text(text, "p.json");
+  CHECK(loaded.protocol.test_items.size() == 3);
+  CHECK(loaded.sha256 == sha256_hex(text));
+}
+
 TEST_CASE("protocol errors name the file and the JSON pointer", "[study][protocol]") {
   CHECK_THROWS_WITH(parse_study_protocol("{", "p.json"),
                     Catch::StartsWith("p.json: not valid JSON at byte "));

@@ -2,9 +2,12 @@
 // a bad file (report/teacher_recording.hpp).
 #include "calligraphy/report/teacher_recording.hpp"
 
+#include <unistd.h>
+
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
+#include <string>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/character_library.hpp"
@@ -66,4 +69,20 @@ TEST_CASE("A bad teacher recording is refused naming the file and the key", "[gu
   CHECK_THROWS_WITH(read_teacher_recording("/nonexistent/teacher.json"), Catch::Contains("no such file"));
   CHECK_THROWS_WITH(read_teacher_recording("/dev/zero"), Catch::Contains("not a regular file"));
   CHECK_THROWS_AS(teacher_recording_from_trace("十", "skilled", "simulated", 1000.0, {}), InvalidArgument);
+}
+
+TEST_CASE("A teacher recording edited in a program that writes a byte-order mark is read",
+          "[guidance][teacher]") {
+  // nlohmann-json skips a UTF-8 byte-order mark at the start of the text (lexer::skip_bom).
+  const std::string text =
+      "\xEF\xBB\xBF"
+      R"({"format":"calligraphy-teacher-recording","version":1,"characters":"十","writer":"human",)"
+      R"("device":"mouse","rate_hz":1000,"library_version":"","samples":{"t_s":[0,0.001,0.002],)"
+      R"("x_m":[0,0,0],"y_m":[0,0.001,0.002],"z_m":[0,0,0]}})";
+  CHECK(parse_teacher_recording(text, "t.json").samples.size() == 3);
+  const std::filesystem::path path = std::filesystem::temp_directory_path() /
+                                     ("calligraphy_teacher_bom_" + std::to_string(::getpid()) + ".json");
+  std::ofstream(path, std::ios::binary) << text;
+  CHECK(read_teacher_recording(path).characters == "十");
+  std::filesystem::remove(path);
 }

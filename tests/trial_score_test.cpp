@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <utility>
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
@@ -343,4 +344,24 @@ TEST_CASE("A stroke written twice is not taken for a neighbouring stroke never w
       }
     }
   }
+}
+
+TEST_CASE("A trace with more pen-down segments than the limit is refused before matching", "[score]") {
+  const PlacedCharacter& yong = scene_of(U'永').characters.front();
+  TraceBuilder trace = written_in_order(yong, kYongOrder, 0.5e-3);  // 5 segments
+  ScoreOptions options;
+  std::vector<std::pair<std::size_t, std::size_t>> calls;
+  options.progress = [&calls](std::size_t matched, std::size_t total) { calls.emplace_back(matched, total); };
+  CHECK(score_trace(yong, trace.samples, options).strokes_written == 5);
+  REQUIRE(calls.size() == 6);  // before the first segment and after each
+  CHECK(calls.front() == std::pair<std::size_t, std::size_t>{0, 5});
+  CHECK(calls.back() == std::pair<std::size_t, std::size_t>{5, 5});
+  options.max_segments = 4;
+  calls.clear();
+  CHECK_THROWS_WITH(score_trace(yong, trace.samples, options),
+                    Catch::Contains("5 pen-down segments") && Catch::Contains("limit of 4"));
+  CHECK(calls.empty());
+  options.max_segments = 0;
+  CHECK_THROWS_WITH(score_trace(yong, trace.samples, options), Catch::Contains("max_segments"));
+  CHECK(ScoreOptions{}.max_segments == kMaxScoredSegments);
 }

@@ -1,5 +1,6 @@
 // `calligraphy score TRACE.csv --character C ...`: scores a recorded pen trace (any device, any program;
 // `trial --csv` writes one) against the character laid out as `trial` places it (docs/metrics.md).
+#include <cstddef>
 #include <memory>
 #include <string>
 
@@ -10,6 +11,7 @@
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 #include "cli/output.hpp"
+#include "cli/progress.hpp"
 
 namespace calligraphy::cli {
 namespace {
@@ -33,10 +35,18 @@ int run_score(const ScoreCommand& command) {
   files.output("--json", command.json);
   const Scene scene = Scene::lay_out({CharacterSource(command.library).load(chars[0])});
   const PlacedCharacter& character = scene.characters.front();
+  TerminalProgress progress("reading " + command.trace);  // on stderr, only when it is a terminal
   PenTraceCsvOptions options;
   options.units = command.units == "data" ? TraceUnits::data : TraceUnits::metres;
+  options.progress = [&progress](std::size_t parsed, std::size_t total) { progress.update(parsed, total); };
   const std::vector<PenSample> trace = read_pen_trace_csv(command.trace, character.placement, options);
-  const CharacterScore score = score_trace(character, trace);
+  progress.relabel("scoring " + command.trace);
+  ScoreOptions score_options;
+  score_options.progress = [&progress](std::size_t matched, std::size_t total) {
+    progress.update(matched, total, "segments");
+  };
+  const CharacterScore score = score_trace(character, trace, score_options);
+  progress.relabel("");
   const ScoreDescription description{command.character, command.trace, command.units, trace.size()};
   if (command.json != "-") write_standard_output(score_table(description, score));
   if (!command.json.empty()) write_output(command.json, score_json(description, score));

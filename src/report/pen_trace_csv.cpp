@@ -46,8 +46,13 @@ class Reader {
   std::vector<PenSample> parse(std::string_view text) {
     std::vector<PenSample> samples;
     std::optional<Columns> columns;
-    std::size_t line_start = 0;
+    // A UTF-8 byte-order mark, as spreadsheet programs write at the start of a CSV file.
+    constexpr std::string_view kByteOrderMark = "\xEF\xBB\xBF";
+    std::size_t line_start = text.starts_with(kByteOrderMark) ? kByteOrderMark.size() : 0;
+    std::size_t pen_down_segments = 0;
+    constexpr std::size_t kProgressLines = std::size_t{1} << 16;
     while (line_start < text.size()) {
+      if (options_.progress && line_number_ % kProgressLines == 0) options_.progress(line_start, text.size());
       const std::size_t newline = text.find('\n', line_start);
       std::string_view line = text.substr(
           line_start, newline == std::string_view::npos ? std::string_view::npos : newline - line_start);
@@ -62,6 +67,11 @@ class Reader {
         continue;
       }
       samples.push_back(row(fields, *columns));
+      if (samples.back().pen_down && (samples.size() == 1 || !samples[samples.size() - 2].pen_down) &&
+          ++pen_down_segments > options_.max_pen_down_segments) {
+        fail("more than " + std::to_string(options_.max_pen_down_segments) +
+             " pen-down segments, the limit of one scored trace (the rest of the file is not read)");
+      }
       if (samples.size() > 1 && samples.back().time_s < samples[samples.size() - 2].time_s) {
         fail(columns->t, fields[columns->t],
              "time goes backwards (previous sample at " + std::to_string(samples[samples.size() - 2].time_s) +
@@ -69,6 +79,7 @@ class Reader {
       }
     }
     if (!columns) throw DataError(source_ + ": no header line (expected columns t, x, y and pen or z)");
+    if (options_.progress) options_.progress(text.size(), text.size());
     return samples;
   }
 
@@ -152,6 +163,9 @@ void check_options(const PenTraceCsvOptions& options, const Placement& placement
                           std::to_string(options.contact_threshold_m) + " m is not finite");
   }
   if (options.max_file_bytes == 0) throw InvalidArgument("PenTraceCsvOptions: max_file_bytes is 0");
+  if (options.max_pen_down_segments == 0) {
+    throw InvalidArgument("PenTraceCsvOptions: max_pen_down_segments is 0");
+  }
   if (options.units == TraceUnits::data &&
       (!placement.origin_m.allFinite() || !std::isfinite(placement.metres_per_unit) ||
        !(placement.metres_per_unit > 0.0))) {

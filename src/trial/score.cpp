@@ -29,6 +29,7 @@ void check_options(const ScoreOptions& options) {
     throw InvalidArgument("ScoreOptions: minimum segment length " +
                           std::to_string(options.min_segment_length_m) + " m is not finite and >= 0");
   }
+  if (options.max_segments == 0) throw InvalidArgument("ScoreOptions: max_segments is 0");
   trial_detail::require_valid_options(options.metrics);
 }
 
@@ -166,6 +167,11 @@ CharacterScore score_trace(const PlacedCharacter& character, std::span<const Pen
   }
   score.segments =
       trial_detail::pen_down_segments(trace, options.min_segment_samples, options.min_segment_length_m);
+  if (score.segments.size() > options.max_segments) {
+    throw InvalidArgument("score_trace: the trace has " + std::to_string(score.segments.size()) +
+                          " pen-down segments, more than the limit of " +
+                          std::to_string(options.max_segments) + " for one scored trace");
+  }
 
   // Samples and kinematics of the scored segments.
   std::vector<std::size_t> scored;  // indices into score.segments
@@ -213,7 +219,9 @@ CharacterScore score_trace(const PlacedCharacter& character, std::span<const Pen
   std::vector<std::vector<std::optional<double>>> costs(strokes,
                                                         std::vector<std::optional<double>>(scored.size()));
   std::vector<std::vector<bool>> reversed(strokes, std::vector<bool>(scored.size(), false));
+  if (options.progress) options.progress(0, scored.size());
   for (std::size_t w = 0; w < scored.size(); ++w) {
+    if (options.progress && w > 0) options.progress(w, scored.size());
     const std::vector<Vec2> backwards_path(positions[w].rbegin(), positions[w].rend());
     for (std::size_t r = 0; r < strokes; ++r) {
       const PlacedStroke& stroke = character.strokes[r];
@@ -231,6 +239,7 @@ CharacterScore score_trace(const PlacedCharacter& character, std::span<const Pen
       }
     }
   }
+  if (options.progress) options.progress(scored.size(), scored.size());
   const std::vector<std::optional<std::size_t>> assignment = trial_detail::optimal_assignment(costs);
 
   for (std::size_t r = 0; r < strokes; ++r) {

@@ -6,9 +6,15 @@
 /// by header name (others are ignored, order is free): `t` time [s], `x` and `y` the pen tip, and either
 /// `pen` (1 = touching the paper, 0 = lifted) or `z`, the height of the tip above the paper [m] (the pen
 /// touches when z <= the contact threshold). Blank lines and lines starting with `#` are skipped; a line
-/// may end in CR LF; fields may be padded with spaces; no quoting. Times must not decrease.
+/// may end in CR LF; fields may be padded with spaces; no quoting. Times must not decrease. A UTF-8
+/// byte-order mark at the start (as spreadsheet programs write) is skipped.
+///
+/// Limits, refused while reading (before the rest of the file is parsed): at most
+/// `PenTraceCsvOptions::max_file_bytes` bytes and `max_pen_down_segments` pen-down segments (maximal runs
+/// of samples with the pen down), the segments `score_trace` takes (ScoreOptions::max_segments).
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -34,12 +40,19 @@ struct PenTraceCsvOptions {
   /// of a desktop haptic device above a virtual paper plane (a choice). Finite.
   double contact_threshold_m = 0.5e-3;
   std::uintmax_t max_file_bytes = std::uintmax_t{256} << 20;  ///< larger files are refused (256 MiB)
+  /// A trace with more pen-down segments is refused at the line that starts the first one too many
+  /// (ScoreOptions::max_segments, what one scored trace may have). > 0.
+  std::size_t max_pen_down_segments = kMaxScoredSegments;
+  /// When set, called now and then while parsing with the bytes parsed so far and the text's size (for
+  /// a progress display); it may throw to stop the reading.
+  std::function<void(std::size_t parsed_bytes, std::size_t total_bytes)> progress;
 };
 
 /// Parses CSV text. `source` names the text in errors; `placement` converts data units to metres. Throws
 /// DataError naming source:line, the column (number and name) and the value for a missing or duplicate
 /// column, a row with the wrong number of fields, a value that is not a finite number (or not 0/1 for
-/// `pen`), or a time below the previous one; InvalidArgument for bad options.
+/// `pen`), a time below the previous one, or more pen-down segments than options.max_pen_down_segments;
+/// InvalidArgument for bad options.
 std::vector<PenSample> parse_pen_trace_csv(std::string_view text, const std::string& source,
                                            const Placement& placement,
                                            const PenTraceCsvOptions& options = {});

@@ -6,6 +6,7 @@
 /// metrics.hpp. Each written stroke also gets the verdict the renderer would have given it in turn.
 /// Definitions and sources: docs/metrics.md.
 #include <cstddef>
+#include <functional>
 #include <optional>
 #include <span>
 #include <vector>
@@ -44,6 +45,11 @@ struct WrittenSegment {
   std::optional<StrokeMatch> verdict;
 };
 
+/// The most pen-down segments one scored trace may have (ScoreOptions::max_segments): a character has at
+/// most a few dozen strokes, and every segment is tried on every stroke, so a trace with more is refused
+/// up front rather than matched for minutes.
+inline constexpr std::size_t kMaxScoredSegments = 10000;
+
 /// How a trace is cut and matched.
 struct ScoreOptions {
   /// The stroke matcher's tolerances (SI units): give the renderer's (ForceLawParameters::acceptance) to
@@ -55,6 +61,11 @@ struct ScoreOptions {
   std::size_t min_segment_samples = 3;  ///< a segment with fewer samples is ignored
   double min_segment_length_m = 1e-3;   ///< a segment with a shorter pen-down path is ignored [m]
   MetricsOptions metrics{};
+  /// A trace with more pen-down segments (ignored ones included) is refused before any is matched. > 0.
+  std::size_t max_segments = kMaxScoredSegments;
+  /// When set, called with the segments matched so far and the segments to match, before the first and
+  /// after each (for a progress display); it may throw to stop the scoring.
+  std::function<void(std::size_t matched, std::size_t total)> progress;
 };
 
 /// The score of one reference stroke.
@@ -114,7 +125,8 @@ struct CharacterScore {
 /// segment that could be either of two strokes goes to the one that leaves the rest best placed. The pairs
 /// give the metrics, the order errors and the backwards strokes; each segment's `verdict` gives what the
 /// renderer would have said in sequence. Throws InvalidArgument for a bad trace (see validate_pen_trace, and
-/// positions too large to convert to data units), a character without strokes, a stroke without elements or
+/// positions too large to convert to data units, more pen-down segments than options.max_segments), a
+/// character without strokes, a stroke without elements or
 /// without a centre line (placed otherwise than by Scene::lay_out), a placement that is not finite with a
 /// positive scale, or options out of range (naming the field).
 CharacterScore score_trace(const PlacedCharacter& character, std::span<const PenSample> trace,

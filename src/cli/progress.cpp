@@ -1,0 +1,43 @@
+#include "cli/progress.hpp"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <utility>
+
+namespace calligraphy::cli {
+
+TerminalProgress::TerminalProgress(std::string label)
+    : enabled_(::isatty(STDERR_FILENO) == 1), label_(std::move(label)) {}
+
+TerminalProgress::~TerminalProgress() { clear(); }
+
+void TerminalProgress::clear() {
+  if (!shown_) return;
+  std::fprintf(stderr, "\r\033[K");
+  std::fflush(stderr);
+  shown_ = false;
+}
+
+void TerminalProgress::relabel(std::string label) {
+  clear();
+  label_ = std::move(label);
+}
+
+void TerminalProgress::update(std::size_t done, std::size_t total, const char* unit) {
+  if (!enabled_) return;
+  using namespace std::chrono_literals;
+  const auto now = std::chrono::steady_clock::now();
+  if (now - start_ < 500ms || (shown_ && now - last_ < 100ms)) return;
+  last_ = now;
+  shown_ = true;
+  if (unit[0] != '\0') {
+    std::fprintf(stderr, "\r\033[K%s %zu / %zu %s", label_.c_str(), done, total, unit);
+  } else {
+    const double percent = total > 0 ? 100.0 * static_cast<double>(done) / static_cast<double>(total) : 100.0;
+    std::fprintf(stderr, "\r\033[K%s %.0f%%", label_.c_str(), percent);
+  }
+  std::fflush(stderr);
+}
+
+}  // namespace calligraphy::cli
