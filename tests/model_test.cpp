@@ -1,10 +1,12 @@
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/model/fitting.hpp"
+#include "calligraphy/model/scene.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
 #include "core/unicode.hpp"
 
@@ -126,4 +128,14 @@ TEST_CASE("UTF-8 round trip and malformed input", "[model]") {
   CHECK(encode_utf8(U'永') == "永");
   CHECK_THROWS_AS(decode_utf8("\xE6\xB0"), InvalidArgument);
   CHECK_THROWS_AS(decode_utf8("\xC0\x80"), InvalidArgument);
+}
+
+TEST_CASE("A scene holds at most kMaxSceneCharacters characters", "[model]") {
+  const Character yong = CharacterLibrary::embedded().load(U'永');
+  CHECK(Scene::lay_out(std::vector<Character>(kMaxSceneCharacters, yong)).characters.size() ==
+        kMaxSceneCharacters);
+  CHECK_THROWS_WITH(Scene::lay_out(std::vector<Character>(kMaxSceneCharacters + 1, yong)),
+                    Catch::Contains("1001 characters") && Catch::Contains("limit of 1000"));
+  CHECK_NOTHROW(check_scene_size(kMaxSceneCharacters, "CHARS"));
+  CHECK_THROWS_WITH(check_scene_size(100000, "CHARS"), Catch::StartsWith("CHARS: 100000 characters"));
 }

@@ -200,6 +200,7 @@ int run_trial(const TrialCommand& command) {
   require_one_standard_output(
       {{"--json", command.json == "-"}, {"--svg", command.svg == "-"}, {"--csv", command.csv == "-"}});
   const std::u32string chars = characters_from(command.characters, "CHARS");
+  check_scene_size(chars.size(), "CHARS");  // before any is loaded
   const DeviceListing device = find_device(command.device);
   // Lock-step pacing has no wall clock, so no stall can be bounded: the option would be ignored.
   const bool real_time = command.pacing == "real-time" || (command.pacing == "auto" && device.hardware);

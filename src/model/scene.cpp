@@ -18,7 +18,15 @@ std::size_t Scene::stroke_count() const {
   return n;
 }
 
+void check_scene_size(std::size_t count, const std::string& what) {
+  if (count > kMaxSceneCharacters) {
+    throw InvalidArgument(what + ": " + std::to_string(count) + " characters, more than a scene's limit of " +
+                          std::to_string(kMaxSceneCharacters));
+  }
+}
+
 Scene Scene::lay_out(const std::vector<Character>& characters, const SceneLayout& layout) {
+  check_scene_size(characters.size(), "Scene::lay_out");
   if (!(layout.character_size_m > 0.0) || !(layout.spacing_m > 0.0) || !(layout.start_radius_m > 0.0) ||
       !(layout.box_margin_m >= 0.0) || !layout.centre_m.allFinite() || !std::isfinite(layout.paper_z_m)) {
     throw InvalidArgument("SceneLayout out of range: character size " +

@@ -66,13 +66,23 @@ struct PlacedCharacter {
   Eigen::AlignedBox2d bounding_box;  ///< strokes' box plus the margin [m]
 };
 
+/// The most characters one scene holds: a row of them is written in one trial (at the default 66 mm
+/// spacing, 1000 characters are 66 m of paper), and each costs memory and loading time, so a longer text
+/// is refused up front (Scene::lay_out; front ends check the count before loading the characters).
+inline constexpr std::size_t kMaxSceneCharacters = 1000;
+
+/// Throws InvalidArgument "<what>: N characters, more than a scene's limit of kMaxSceneCharacters" when
+/// `count` > kMaxSceneCharacters.
+void check_scene_size(std::size_t count, const std::string& what);
+
 /// Characters placed in a row, written left to right.
 struct Scene {
   std::vector<PlacedCharacter> characters;
   SceneLayout layout;
 
   [[nodiscard]] std::size_t stroke_count() const;
-  /// Scene for the given characters. Throws InvalidArgument for a non-positive size, radius or spacing.
+  /// Scene for the given characters. Throws InvalidArgument for a non-positive size, radius or spacing,
+  /// or more than kMaxSceneCharacters characters.
   static Scene lay_out(const std::vector<Character>& characters, const SceneLayout& layout = {});
 };
 
