@@ -8,6 +8,7 @@
 // for arguments of several types (ArrayLike: numpy-convertible, shown as numpy.typing.ArrayLike).
 #include <pybind11/pybind11.h>
 
+#include <limits>
 #include <string>
 #include <type_traits>
 
@@ -66,6 +67,11 @@ std::string short_repr(py::handle value);
 /// TypeError "<name>: expected <expected>, got <type> <repr>".
 [[noreturn]] void throw_type_error(const std::string& name, const std::string& expected, py::handle value);
 
+/// InvalidArgument "<name>: <value> is out of range: expected an int in <range>", the range of an integer
+/// of `digits` value bits, signed or not; the bounds are also written as powers of two.
+[[noreturn]] void throw_int_out_of_range(const std::string& name, py::handle value, bool is_signed,
+                                         int digits);
+
 /// The Python name of T: "float", "int", "str", "bool", or a bound class's name.
 template <typename T>
 std::string python_type_name() {
@@ -74,6 +80,14 @@ std::string python_type_name() {
   } else {
     return py::detail::make_caster<T>::name.text;
   }
+}
+
+/// InvalidArgument (a ValueError) "<name>: <value> is out of range: expected an int in <min>..<max>",
+/// the range of T ("0..2**64-1" for std::uint64_t).
+template <typename T>
+[[noreturn]] void throw_out_of_range(const std::string& name, py::handle value) {
+  throw_int_out_of_range(name, value, std::numeric_limits<T>::is_signed,
+                         static_cast<int>(std::numeric_limits<T>::digits));
 }
 
 /// Converts `value` to T, naming `name` in the TypeError (or, for an int out of T's range, ValueError).
@@ -99,12 +113,22 @@ T convert_named(py::handle value, const std::string& name) {
     }
   }
   try {
+    if constexpr (std::is_enum_v<T>) {
+      // TraceKind(-1) makes an instance that is no member: refused, as an unknown name is.
+      const py::dict members = py::type::of<T>().attr("__members__");
+      if (py::isinstance<T>(value)) {
+        bool member = false;
+        for (const auto& item : members) member = member || item.second.equal(value);
+        if (!member) {
+          throw InvalidArgument(name + ": " + short_repr(value) + " is not a member of " +
+                                python_type_name<T>());
+        }
+      }
+    }
     return value.cast<T>();
   } catch (const py::cast_error&) {
     if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
-      if (PyLong_Check(value.ptr())) {
-        throw InvalidArgument(name + ": " + short_repr(value) + " is out of range for this argument");
-      }
+      if (PyLong_Check(value.ptr())) throw_out_of_range<T>(name, value);
     }
     throw_type_error(name, python_type_name<T>(), value);
   }

@@ -107,6 +107,7 @@ void set_log_level(const Annotated<LogLevelTag>& level) {
     value = number.cast<int>();
   } else if (PyLong_Check(level.object.ptr()) && !PyBool_Check(level.object.ptr())) {
     value = convert_named<int>(level.object, "level");
+    if (value < 0) throw_int_out_of_range("level", level.object, false, 31);  // logging levels are >= 0
   } else {
     throw_type_error("level", "a logging level (int) or its name (str)", level.object);
   }

@@ -7,6 +7,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -39,10 +40,18 @@ std::vector<Character> characters_from(py::handle object, const CharacterSource&
                                        const std::string& name) {
   std::vector<Character> characters;
   if (py::isinstance<py::str>(object)) {
-    for (char32_t c : decode_utf8(object.cast<std::string>())) characters.push_back(library.load(c));
+    const std::u32string text = decode_utf8(object.cast<std::string>());
+    check_scene_size(text.size(), name);   // before loading any
+    std::map<char32_t, Character> loaded;  // each character loaded once
+    for (char32_t c : text) {
+      auto found = loaded.find(c);
+      if (found == loaded.end()) found = loaded.emplace(c, library.load(c)).first;
+      characters.push_back(found->second);
+    }
   } else if (py::isinstance<Character>(object)) {
     characters.push_back(object.cast<Character>());
   } else if (py::isinstance<py::sequence>(object) && !py::isinstance<py::bytes>(object)) {
+    check_scene_size(py::len(object), name);
     for (const py::handle item : object) {
       if (!py::isinstance<Character>(item)) {
         throw_type_error(name, "a str, a Character or a sequence of Characters", item);
@@ -116,11 +125,13 @@ const TypicalStroke& typical_stroke_by_key(py::handle key) {
                           "'; acronyms: " + known);
   }
   if (PyIndex_Check(key.ptr()) && !PyBool_Check(key.ptr())) {
-    const long long id = py::reinterpret_steal<py::int_>(PyNumber_Index(key.ptr())).cast<long long>();
-    if (id < 1 || id > static_cast<long long>(typical_strokes().size())) {
-      throw InvalidArgument("typical_stroke: ID " + std::to_string(id) + " is not in 1..39");
+    const py::object id = py::reinterpret_steal<py::object>(PyNumber_Index(key.ptr()));
+    if (!id) throw py::error_already_set();
+    if (id < py::int_(1) || id > py::int_(typical_strokes().size())) {  // any int, however large
+      throw InvalidArgument("key: typical-stroke ID " + short_repr(id) + " is not in 1.." +
+                            std::to_string(typical_strokes().size()));
     }
-    return typical_stroke(static_cast<int>(id));
+    return typical_stroke(id.cast<int>());
   }
   throw_type_error("key", "a typical-stroke ID (int) or acronym (str)", key);
 }
@@ -526,13 +537,18 @@ namespace {
 
 std::size_t index_below(const Checked<long long>& index, std::size_t count, const std::string& name,
                         const std::string& what) {
-  const long long i = take(index, name);
-  if (i < 0 || static_cast<unsigned long long>(i) >= count) {
-    throw py::index_error(name + ": " + std::to_string(i) + " is not in 0.." +
+  // Any int, however large, is compared with the range (2**70 is as much out of it as 5).
+  const py::handle value = index.object;
+  const bool is_int = PyIndex_Check(value.ptr()) && !PyBool_Check(value.ptr());
+  const py::object i = is_int ? py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr())) : py::object();
+  if (is_int && !i) throw py::error_already_set();
+  if (!is_int) static_cast<void>(take(index, name));  // the TypeError naming the argument
+  if (i < py::int_(0) || i >= py::int_(count)) {
+    throw py::index_error(name + ": " + short_repr(i) + " is not in 0.." +
                           std::to_string(static_cast<long long>(count) - 1) + " (" + what + " has " +
                           std::to_string(count) + ")");
   }
-  return static_cast<std::size_t>(i);
+  return i.cast<std::size_t>();
 }
 
 }  // namespace
