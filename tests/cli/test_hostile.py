@@ -350,5 +350,94 @@ class Signals(HostileTestCase):
         self.assertGreater(report["ticks"], 0)
 
 
+class HostileSizes(HostileTestCase):
+    """A byte-order mark before a trace's header, traces and scenes over their documented limits (docs/cli.md,
+    "Pen traces: format and limits"), and the progress of a long score on a terminal."""
+
+    MAX_SEGMENTS = 10000  # kMaxScoredSegments
+    MAX_CHARACTERS = 1000  # kMaxSceneCharacters
+
+    def trace(self, name, segments, samples_per_segment=5, bom=False):
+        """A trace of `segments` pen-down segments, each a short line near the centre of 永's box."""
+        lines = ["t,x,y,pen"]
+        t = 0
+        for k in range(segments):
+            for i in range(samples_per_segment):
+                lines.append(f"{t * 1e-3:.3f},{-0.02 + 0.0004 * i:.4f},{0.001 * (k % 20) - 0.01:.4f},1")
+                t += 1
+            lines.append(f"{t * 1e-3:.3f},0,0,0")
+            t += 1
+        path = self.cwd / name
+        path.write_bytes((b"\xef\xbb\xbf" if bom else b"") + ("\r\n".join(lines) + "\r\n").encode())
+        return path
+
+    def test_byte_order_mark_before_the_header(self):
+        self.trace("plain.csv", 3)
+        self.trace("bom.csv", 3, bom=True)
+        plain = self.run_cli("score", "plain.csv", "--character", YONG, "--json", "-")
+        marked = self.run_cli("score", "bom.csv", "--character", YONG, "--json", "-")
+        self.assertEqual(marked.returncode, 0, marked.stderr.decode())
+        plain_score, marked_score = json.loads(plain.stdout), json.loads(marked.stdout)
+        self.assertEqual(marked_score.pop("trace"), "bom.csv")
+        self.assertEqual(plain_score.pop("trace"), "plain.csv")
+        self.assertEqual(marked_score, plain_score)
+        self.assertEqual(marked_score["samples"], 3 * 6)
+
+    def test_too_many_pen_down_segments_are_refused_while_reading(self):
+        self.trace("many.csv", self.MAX_SEGMENTS + 1, samples_per_segment=2)
+        started = time.monotonic()
+        error = self.assert_error(self.run_cli("score", "many.csv", "--character", YONG), 1, "many.csv",
+                                  f"more than {self.MAX_SEGMENTS} pen-down segments")
+        self.assertIn(f"many.csv:{3 * self.MAX_SEGMENTS + 2}:", error)  # the line starting one too many
+        self.assertLess(time.monotonic() - started, 10)
+
+    def test_the_limit_itself_is_scored(self):
+        self.trace("limit.csv", self.MAX_SEGMENTS, samples_per_segment=2)
+        result = self.run_cli("score", "limit.csv", "--character", YONG, "--json", "-")
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
+        self.assertEqual(len(json.loads(result.stdout)["segments"]), self.MAX_SEGMENTS)
+
+    def test_a_scene_over_the_limit_is_refused_before_loading(self):
+        started = time.monotonic()
+        self.assert_error(self.run_cli("trial", YONG * (self.MAX_CHARACTERS + 1)), 1, "CHARS",
+                          f"{self.MAX_CHARACTERS + 1} characters", f"limit of {self.MAX_CHARACTERS}")
+        self.assertLess(time.monotonic() - started, 10)
+
+    def run_on_terminal(self, *args):
+        """Runs the program with stderr on a pseudo-terminal (stdout a pipe); returns (status, stdout, what the
+        terminal showed)."""
+        import pty
+        controller, terminal = pty.openpty()
+        process = subprocess.Popen([CLI, *map(str, args)], cwd=self.cwd, stdout=subprocess.PIPE, stderr=terminal)
+        os.close(terminal)
+        shown = b""
+        while True:
+            try:
+                chunk = os.read(controller, 65536)
+            except OSError:  # EIO: the program closed the terminal
+                break
+            if not chunk:
+                break
+            shown += chunk
+        stdout = process.stdout.read()
+        process.wait(timeout=TIMEOUT_S)
+        os.close(controller)
+        return process.returncode, stdout, shown.decode(errors="replace")
+
+    def test_progress_of_a_long_score_on_a_terminal_only(self):
+        # One pen-down zig-zag of 1.5 million samples (45 MB): a second or more to read and score.
+        rows = "".join(f"{i * 1e-3:.3f},{0.0002 * (i % 100) - 0.01:.4f},{0.0001 * (i % 37):.4f},1\n"
+                       for i in range(1_500_000))
+        (self.cwd / "long.csv").write_text("t,x,y,pen\n" + rows)
+        status, stdout, shown = self.run_on_terminal("score", "long.csv", "--character", YONG)
+        self.assertEqual(status, 0, shown)
+        self.assertIn("Score of long.csv", stdout.decode())
+        self.assertRegex(shown, r"\r\x1b\[K(reading long\.csv \d+%|scoring long\.csv \d+ / 1 segments)")
+        self.assertTrue(shown.endswith("\r\x1b[K"), repr(shown[-40:]))  # the line is cleared at the end
+        piped = self.run_cli("score", "long.csv", "--character", YONG)
+        self.assertEqual(piped.returncode, 0)
+        self.assertEqual(piped.stderr, b"")  # no progress into a pipe or a log
+
+
 if __name__ == "__main__":
     unittest.main(verbosity=2)
