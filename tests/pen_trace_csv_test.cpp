@@ -174,3 +174,15 @@ TEST_CASE("The reader reports its progress through the text", "[pen_trace_csv]")
   REQUIRE_FALSE(calls.empty());
   CHECK(calls.back() == std::pair{text.size(), text.size()});
 }
+
+TEST_CASE("A trace with more samples than the limit is refused while reading", "[pen_trace_csv]") {
+  PenTraceCsvOptions options;
+  options.max_samples = 3;
+  const std::string three = "t,x,y,pen\n0,0,0,1\n1,0,0,1\n2,0,0,1\n";
+  CHECK(parse_pen_trace_csv(three, "inline", test_placement(), options).size() == 3);
+  CHECK_THROWS_WITH(parse_pen_trace_csv(three + "3,0,0,1\nnot read\n", "inline", test_placement(), options),
+                    Catch::StartsWith("inline:5: ") && Catch::Contains("more than 3 samples"));
+  CHECK(PenTraceCsvOptions{}.max_samples == 1'000'000);
+  options.max_samples = 0;
+  CHECK_THROWS_AS(parse_pen_trace_csv(three, "inline", test_placement(), options), InvalidArgument);
+}

@@ -66,6 +66,10 @@ class Reader {
         header_ = fields;
         continue;
       }
+      if (samples.size() == options_.max_samples) {
+        fail("more than " + std::to_string(options_.max_samples) +
+             " samples, the limit of one trace (the rest of the file is not read)");
+      }
       samples.push_back(row(fields, *columns));
       if (samples.back().pen_down && (samples.size() == 1 || !samples[samples.size() - 2].pen_down) &&
           ++pen_down_segments > options_.max_pen_down_segments) {
@@ -163,6 +167,7 @@ void check_options(const PenTraceCsvOptions& options, const Placement& placement
                           std::to_string(options.contact_threshold_m) + " m is not finite");
   }
   if (options.max_file_bytes == 0) throw InvalidArgument("PenTraceCsvOptions: max_file_bytes is 0");
+  if (options.max_samples == 0) throw InvalidArgument("PenTraceCsvOptions: max_samples is 0");
   if (options.max_pen_down_segments == 0) {
     throw InvalidArgument("PenTraceCsvOptions: max_pen_down_segments is 0");
   }

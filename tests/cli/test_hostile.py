@@ -391,6 +391,12 @@ class HostileSizes(HostileTestCase):
         self.assertIn(f"many.csv:{3 * self.MAX_SEGMENTS + 2}:", error)  # the line starting one too many
         self.assertLess(time.monotonic() - started, 10)
 
+    def test_too_many_samples_are_refused_while_reading(self):
+        rows = "".join(f"{i * 1e-3:.3f},{0.0002 * (i % 100) - 0.01:.4f},0,1\n" for i in range(1_000_001))
+        (self.cwd / "samples.csv").write_text("t,x,y,pen\n" + rows)
+        self.assert_error(self.run_cli("score", "samples.csv", "--character", YONG), 1,
+                          "samples.csv:1000002:", "more than 1000000 samples")
+
     def test_the_limit_itself_is_scored(self):
         self.trace("limit.csv", self.MAX_SEGMENTS, samples_per_segment=2)
         result = self.run_cli("score", "limit.csv", "--character", YONG, "--json", "-")
@@ -425,9 +431,9 @@ class HostileSizes(HostileTestCase):
         return process.returncode, stdout, shown.decode(errors="replace")
 
     def test_progress_of_a_long_score_on_a_terminal_only(self):
-        # One pen-down zig-zag of 1.5 million samples (45 MB): a second or more to read and score.
+        # One pen-down zig-zag of a million samples (the limit, 30 MB): a second or more to read and score.
         rows = "".join(f"{i * 1e-3:.3f},{0.0002 * (i % 100) - 0.01:.4f},{0.0001 * (i % 37):.4f},1\n"
-                       for i in range(1_500_000))
+                       for i in range(1_000_000))
         (self.cwd / "long.csv").write_text("t,x,y,pen\n" + rows)
         status, stdout, shown = self.run_on_terminal("score", "long.csv", "--character", YONG)
         self.assertEqual(status, 0, shown)

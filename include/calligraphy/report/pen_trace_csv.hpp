@@ -10,8 +10,9 @@
 /// byte-order mark at the start (as spreadsheet programs write) is skipped.
 ///
 /// Limits, refused while reading (before the rest of the file is parsed): at most
-/// `PenTraceCsvOptions::max_file_bytes` bytes and `max_pen_down_segments` pen-down segments (maximal runs
-/// of samples with the pen down), the segments `score_trace` takes (ScoreOptions::max_segments).
+/// `PenTraceCsvOptions::max_file_bytes` bytes, `max_samples` samples and `max_pen_down_segments` pen-down
+/// segments (maximal runs of samples with the pen down), the segments `score_trace` takes
+/// (ScoreOptions::max_segments).
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -43,6 +44,9 @@ struct PenTraceCsvOptions {
   /// A trace with more pen-down segments is refused at the line that starts the first one too many
   /// (ScoreOptions::max_segments, what one scored trace may have). > 0.
   std::size_t max_pen_down_segments = kMaxScoredSegments;
+  /// A trace with more samples is refused at the line of the first one too many: 1,000,000 is over 16
+  /// minutes at 1 kHz, and scoring takes time in proportion to the samples (a few seconds at the limit). > 0.
+  std::size_t max_samples = 1'000'000;
   /// When set, called now and then while parsing with the bytes parsed so far and the text's size (for
   /// a progress display); it may throw to stop the reading.
   std::function<void(std::size_t parsed_bytes, std::size_t total_bytes)> progress;
@@ -51,7 +55,8 @@ struct PenTraceCsvOptions {
 /// Parses CSV text. `source` names the text in errors; `placement` converts data units to metres. Throws
 /// DataError naming source:line, the column (number and name) and the value for a missing or duplicate
 /// column, a row with the wrong number of fields, a value that is not a finite number (or not 0/1 for
-/// `pen`), a time below the previous one, or more pen-down segments than options.max_pen_down_segments;
+/// `pen`), a time below the previous one, or more samples or pen-down segments than options.max_samples or
+/// max_pen_down_segments;
 /// InvalidArgument for bad options.
 std::vector<PenSample> parse_pen_trace_csv(std::string_view text, const std::string& source,
                                            const Placement& placement,
