@@ -99,7 +99,7 @@ int TrainerApp::run() {
   const int signal = StopSignals::received();
   if (signal != 0 && session_ == nullptr) {
     std::fprintf(stderr, "calligraphy train: stopped by %s\n", signal_name(signal));
-    if (practice_) practice_->log_stop(signal_name(signal));
+    log_stop(signal_name(signal));
     if (status_ == 0) status_ = exit_status_after(signal);
   }
   return status_;
@@ -135,7 +135,7 @@ void TrainerApp::end_after_lost_display() {
                    static_cast<long long>(kSaveAfterLostDisplay.count()));
     }
   }
-  if (practice_) practice_->log_stop("display_lost");
+  log_stop("display_lost");
 }
 
 // The condition of the next trial, as the session folder names it.

@@ -79,6 +79,7 @@ class TrainerApp {
   void start_trial(std::size_t character);
   void finish_trial();
   void save_recording(TrialView& view, const TrialResult& result);
+  void log_stop(const std::string& reason);
   void print_measurements() const;
 
   // a study session's view (trainer_session_view.cpp)
@@ -125,6 +126,7 @@ class TrainerApp {
   bool condition_outputs_force_ = true;
   bool quit_ = false;
   bool quit_seen_ = false;
+  bool stop_logged_ = false;
   NextAction pending_ = NextAction::none;
   std::optional<Clock::time_point> advance_at_;
   bool screenshot_due_ = false;

@@ -80,6 +80,7 @@ void TrainerApp::finish_trial() {
     std::fprintf(stderr, "calligraphy train: the trial could not run: %s\n", e.what());
     status_ = 1;
     quit_ = true;  // nothing to retry with the same device
+    log_stop("device_fault");
     return;
   }
   view.consume(*channel_, typical_ids_[view.character]);
@@ -148,6 +149,12 @@ void TrainerApp::finish_trial() {
       status_ = 1;
     }
   }
+  if (result.end == TrialEnd::device_fault) {  // the device is lost: no further trial can run on it
+    std::fprintf(stderr, "calligraphy train: error: the device failed (%s); the window closes\n",
+                 result.abort_reason.c_str());
+    quit_ = true;
+    log_stop("device_fault");
+  }
   const bool last = view.character + 1 == options_.characters.size();
   if (last) screenshot_due_ = true;  // after the last character's last stroke
   if (unattended()) {
@@ -157,6 +164,19 @@ void TrainerApp::finish_trial() {
       advance_at_ = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                        std::chrono::duration<double>(kAdvanceDelayS));
     }
+  }
+}
+
+// The practice's session_stopped event (once), when the window ends early: a lost display, a stop signal,
+// a lost device.
+void TrainerApp::log_stop(const std::string& reason) {
+  if (!practice_ || stop_logged_) return;
+  stop_logged_ = true;
+  try {
+    practice_->log_stop(reason);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "calligraphy train: error: the session's log: %s\n", e.what());
+    status_ = 1;
   }
 }
 
