@@ -101,8 +101,9 @@ void configure_root(CLI::App& root) {
   root.formatter(formatter);
   root.footer(
       "Exit status: 0 success; 1 a library or I/O error, an aborted trial, or a failed check; 2 wrong usage; "
-      "3 an internal error. Every output file is written whole or not at all; '-' as an output file means "
-      "standard output. docs/cli.md describes every command.");
+      "3 an internal error; 4 the trainer window lost its display (the running trial kept); 128 + N stopped "
+      "by signal N (130 SIGINT, 143 SIGTERM, 129 SIGHUP). Every output file is written whole or not at all; "
+      "'-' as an output file means standard output. docs/cli.md describes every command.");
 }
 
 CLI::Option* add_flag(CLI::App& app, const std::string& name, bool& target, const std::string& description) {
