@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
@@ -185,4 +186,37 @@ TEST_CASE("A trace with more samples than the limit is refused while reading", "
   CHECK(PenTraceCsvOptions{}.max_samples == 1'000'000);
   options.max_samples = 0;
   CHECK_THROWS_AS(parse_pen_trace_csv(three, "inline", test_placement(), options), InvalidArgument);
+}
+
+TEST_CASE("A file is read in blocks as the same text parsed whole", "[pen_trace_csv]") {
+  // Over 1 MiB blocks: lines cross block ends; CR LF, a byte-order mark and no LF after the last line.
+  std::string text = "\xEF\xBB\xBFt,x,y,pen\r\n";
+  for (int i = 0; i < 150000; ++i) {
+    text += std::to_string(i) + ".5," + std::to_string(i % 97) + "e-4," + std::to_string(i % 89) + "e-4," +
+            (i % 100 == 0 ? "0" : "1") + "\r\n";
+  }
+  text += "150000,0,0,1";
+  REQUIRE(text.size() > (std::size_t{3} << 20));
+  const TemporaryFile file(text);
+  PenTraceCsvOptions options;
+  std::vector<std::pair<std::size_t, std::size_t>> calls;
+  options.progress = [&calls](std::size_t parsed, std::size_t total) { calls.emplace_back(parsed, total); };
+  const auto read = read_pen_trace_csv(file.path, test_placement(), options);
+  const auto parsed = parse_pen_trace_csv(text, "inline", test_placement());
+  REQUIRE(read.size() == 150001);
+  REQUIRE(read.size() == parsed.size());
+  for (std::size_t i = 0; i < read.size(); ++i) {
+    REQUIRE(read[i].time_s == parsed[i].time_s);
+    REQUIRE(read[i].position_m == parsed[i].position_m);
+    REQUIRE(read[i].pen_down == parsed[i].pen_down);
+  }
+  REQUIRE(calls.size() > 2);
+  CHECK(std::is_sorted(calls.begin(), calls.end()));
+  CHECK(calls.back() == std::pair{text.size(), text.size()});
+  // An error past the first block names its line.
+  std::string bad = text;
+  bad.replace(bad.find("\r\n120000.5,") + 2, 1, "x");
+  const TemporaryFile bad_file(bad);
+  CHECK_THROWS_WITH(read_pen_trace_csv(bad_file.path, test_placement()),
+                    Catch::Contains("trace.csv:120002:") && Catch::Contains("not a number"));
 }

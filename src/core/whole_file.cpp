@@ -6,7 +6,7 @@
 
 namespace calligraphy {
 
-std::string read_regular_file(const std::filesystem::path& path, std::uintmax_t max_bytes) {
+std::uintmax_t regular_file_size(const std::filesystem::path& path, std::uintmax_t max_bytes) {
   const std::string name = path.string();
   std::error_code error;
   const auto status = std::filesystem::status(path, error);
@@ -18,6 +18,12 @@ std::string read_regular_file(const std::filesystem::path& path, std::uintmax_t 
     throw DataError(name + ": " + std::to_string(size) + " bytes, more than the limit of " +
                     std::to_string(max_bytes));
   }
+  return size;
+}
+
+std::string read_regular_file(const std::filesystem::path& path, std::uintmax_t max_bytes) {
+  const std::string name = path.string();
+  const std::uintmax_t size = regular_file_size(path, max_bytes);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw DataError(name + ": cannot be opened");
   std::string text(static_cast<std::size_t>(size), '\0');

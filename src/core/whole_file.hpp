@@ -6,6 +6,10 @@
 
 namespace calligraphy {
 
+/// The size of the regular file `path`, for a reader that streams it. Throws DataError naming the path when
+/// it does not exist, is not a regular file, or is larger than `max_bytes`.
+[[nodiscard]] std::uintmax_t regular_file_size(const std::filesystem::path& path, std::uintmax_t max_bytes);
+
 /// The bytes of the regular file `path`. Throws DataError naming the path when it does not exist, is not a
 /// regular file (a device or FIFO is never read), is larger than `max_bytes`, or cannot be read whole.
 [[nodiscard]] std::string read_regular_file(const std::filesystem::path& path, std::uintmax_t max_bytes);

@@ -1,9 +1,12 @@
 #include "calligraphy/report/pen_trace_csv.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <fstream>
 #include <optional>
 #include <system_error>
+#include <utility>
 
 #include "calligraphy/core/errors.hpp"
 #include "core/whole_file.hpp"
@@ -43,48 +46,61 @@ class Reader {
   Reader(const std::string& source, const Placement& placement, const PenTraceCsvOptions& options)
       : source_(source), placement_(placement), options_(options) {}
 
-  std::vector<PenSample> parse(std::string_view text) {
-    std::vector<PenSample> samples;
-    std::optional<Columns> columns;
+  /// One line of the text, without its LF.
+  void line(std::string_view line) {
+    ++line_number_;
     // A UTF-8 byte-order mark, as spreadsheet programs write at the start of a CSV file.
     constexpr std::string_view kByteOrderMark = "\xEF\xBB\xBF";
-    std::size_t line_start = text.starts_with(kByteOrderMark) ? kByteOrderMark.size() : 0;
-    std::size_t pen_down_segments = 0;
-    constexpr std::size_t kProgressLines = std::size_t{1} << 16;
-    while (line_start < text.size()) {
-      if (options_.progress && line_number_ % kProgressLines == 0) options_.progress(line_start, text.size());
-      const std::size_t newline = text.find('\n', line_start);
-      std::string_view line = text.substr(
-          line_start, newline == std::string_view::npos ? std::string_view::npos : newline - line_start);
-      line_start = newline == std::string_view::npos ? text.size() : newline + 1;
-      ++line_number_;
-      if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-      if (trimmed(line).empty() || trimmed(line).front() == '#') continue;
-      const std::vector<std::string_view> fields = fields_of(line);
-      if (!columns) {
-        columns = header(fields);
-        header_ = fields;
-        continue;
-      }
-      if (samples.size() == options_.max_samples) {
-        fail("more than " + std::to_string(options_.max_samples) +
-             " samples, the limit of one trace (the rest of the file is not read)");
-      }
-      samples.push_back(row(fields, *columns));
-      if (samples.back().pen_down && (samples.size() == 1 || !samples[samples.size() - 2].pen_down) &&
-          ++pen_down_segments > options_.max_pen_down_segments) {
-        fail("more than " + std::to_string(options_.max_pen_down_segments) +
-             " pen-down segments, the limit of one scored trace (the rest of the file is not read)");
-      }
-      if (samples.size() > 1 && samples.back().time_s < samples[samples.size() - 2].time_s) {
-        fail(columns->t, fields[columns->t],
-             "time goes backwards (previous sample at " + std::to_string(samples[samples.size() - 2].time_s) +
-                 " s)");
-      }
+    if (line_number_ == 1 && line.starts_with(kByteOrderMark)) line.remove_prefix(kByteOrderMark.size());
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    if (trimmed(line).empty() || trimmed(line).front() == '#') return;
+    const std::vector<std::string_view> fields = fields_of(line);
+    if (!columns_) {
+      header_.assign(fields.begin(), fields.end());
+      columns_ = header(fields);
+      return;
     }
-    if (!columns) throw DataError(source_ + ": no header line (expected columns t, x, y and pen or z)");
-    if (options_.progress) options_.progress(text.size(), text.size());
-    return samples;
+    if (samples_.size() == options_.max_samples) {
+      fail("more than " + std::to_string(options_.max_samples) +
+           " samples, the limit of one trace (the rest of the file is not read)");
+    }
+    samples_.push_back(row(fields, *columns_));
+    if (samples_.back().pen_down && (samples_.size() == 1 || !samples_[samples_.size() - 2].pen_down) &&
+        ++pen_down_segments_ > options_.max_pen_down_segments) {
+      fail("more than " + std::to_string(options_.max_pen_down_segments) +
+           " pen-down segments, the limit of one scored trace (the rest of the file is not read)");
+    }
+    if (samples_.size() > 1 && samples_.back().time_s < samples_[samples_.size() - 2].time_s) {
+      fail(columns_->t, fields[columns_->t],
+           "time goes backwards (previous sample at " + std::to_string(samples_[samples_.size() - 2].time_s) +
+               " s)");
+    }
+  }
+
+  /// The lines of `text` that end in LF; returns where the unfinished last line starts (text.size() when
+  /// none). Reports progress as `offset` + the bytes passed of `total`.
+  std::size_t lines(std::string_view text, std::size_t offset, std::size_t total) {
+    std::size_t line_start = 0;
+    while (true) {
+      const std::size_t newline = text.find('\n', line_start);
+      if (newline == std::string_view::npos) return line_start;
+      if (options_.progress && line_number_ % kProgressLines == 0)
+        options_.progress(offset + line_start, total);
+      line(text.substr(line_start, newline - line_start));
+      line_start = newline + 1;
+    }
+  }
+
+  std::vector<PenSample> finish(std::size_t total) {
+    if (!columns_) throw DataError(source_ + ": no header line (expected columns t, x, y and pen or z)");
+    if (options_.progress) options_.progress(total, total);
+    return std::move(samples_);
+  }
+
+  std::vector<PenSample> parse(std::string_view text) {
+    const std::size_t rest = lines(text, 0, text.size());
+    if (rest < text.size()) line(text.substr(rest));
+    return finish(text.size());
   }
 
  private:
@@ -157,8 +173,12 @@ class Reader {
   const std::string& source_;
   const Placement& placement_;
   const PenTraceCsvOptions& options_;
+  static constexpr std::size_t kProgressLines = std::size_t{1} << 16;
   std::size_t line_number_ = 0;
-  std::vector<std::string_view> header_;
+  std::vector<std::string> header_;
+  std::optional<Columns> columns_;
+  std::vector<PenSample> samples_;
+  std::size_t pen_down_segments_ = 0;
 };
 
 void check_options(const PenTraceCsvOptions& options, const Placement& placement) {
@@ -196,8 +216,30 @@ std::vector<PenSample> parse_pen_trace_csv(std::string_view text, const std::str
 std::vector<PenSample> read_pen_trace_csv(const std::filesystem::path& file, const Placement& placement,
                                           const PenTraceCsvOptions& options) {
   check_options(options, placement);
-  const std::string text = read_regular_file(file, options.max_file_bytes);
-  return Reader(file.string(), placement, options).parse(text);
+  // Streamed a block at a time, so that memory holds the samples read, not the file: a trace over a limit
+  // is refused at its line without the rest being read.
+  const std::string name = file.string();
+  const auto size = static_cast<std::size_t>(regular_file_size(file, options.max_file_bytes));
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw DataError(name + ": cannot be opened");
+  Reader reader(name, placement, options);
+  constexpr std::size_t kBlockBytes = std::size_t{1} << 20;
+  std::string buffer;        // an unfinished line, then the next block
+  std::size_t consumed = 0;  // bytes of the file before buffer
+  std::size_t read = 0;
+  while (read < size) {
+    const std::size_t kept = buffer.size();
+    const std::size_t block = std::min(kBlockBytes, size - read);
+    buffer.resize(kept + block);
+    in.read(buffer.data() + kept, static_cast<std::streamsize>(block));
+    if (static_cast<std::size_t>(in.gcount()) != block) throw DataError(name + ": could not be read whole");
+    read += block;
+    const std::size_t rest = reader.lines(buffer, consumed, size);
+    consumed += rest;
+    buffer.erase(0, rest);
+  }
+  if (!buffer.empty()) reader.line(buffer);
+  return reader.finish(size);
 }
 
 }  // namespace calligraphy

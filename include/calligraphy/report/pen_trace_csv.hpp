@@ -62,8 +62,9 @@ std::vector<PenSample> parse_pen_trace_csv(std::string_view text, const std::str
                                            const Placement& placement,
                                            const PenTraceCsvOptions& options = {});
 
-/// Reads and parses a CSV file. Throws DataError naming the file when it does not exist, is not a regular
-/// file, is larger than options.max_file_bytes or cannot be read, and as `parse_pen_trace_csv`.
+/// Reads and parses a CSV file, a block at a time (memory holds the samples, not the file). Throws DataError
+/// naming the file when it does not exist, is not a regular file, is larger than options.max_file_bytes or
+/// cannot be read, and as `parse_pen_trace_csv`.
 std::vector<PenSample> read_pen_trace_csv(const std::filesystem::path& file, const Placement& placement,
                                           const PenTraceCsvOptions& options = {});
 
