@@ -252,8 +252,8 @@ int run_sessions(const SessionRunCommand& command) {
   files.input("PROTOCOL", command.protocol);
   add_library_inputs(files, command.library);
   add_saved_sessions(files, "--out", command.out);
-  files.output("--screenshot", command.display.screenshot);
   files.output_folder("--out", command.out);
+  files.output("--screenshot", command.display.screenshot);
   require_characters(protocol, CharacterSource(command.library));
 
   std::vector<SubjectAssignment> subjects;

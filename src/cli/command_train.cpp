@@ -52,9 +52,9 @@ void check_train_files(const TrainCommand& command) {
   FilePlan files;
   files.input("--teacher", command.teacher);
   add_library_inputs(files, command.library);
+  files.output_folder("--session", command.session);
   files.output("--record", command.record);
   files.output("--screenshot", command.screenshot);
-  files.output_folder("--session", command.session);
   files.existing_output_folder("--quiz-screenshots", command.quiz_screenshots);
 }
 

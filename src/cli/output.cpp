@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -175,7 +176,15 @@ void FilePlan::output(const std::string& what, const std::string& path) {
   if (identity.exists && ::access(identity.path.c_str(), W_OK) != 0) {
     throw DataError(named(what, path) + ": cannot write: " + std::strerror(errno));
   }
-  require_writable_folder(what, path, folder_of(identity.path));
+  // A file in a folder this command makes (--session, --out) is written once that folder exists; the
+  // folder itself was checked by output_folder.
+  const fs::path folder = folder_of(identity.path).lexically_normal();
+  const bool in_made_folder =
+      std::any_of(made_folders_.begin(), made_folders_.end(), [&](const fs::path& made) {
+        const fs::path relative = folder.lexically_relative(made);
+        return !relative.empty() && *relative.begin() != "..";
+      });
+  if (!in_made_folder) require_writable_folder(what, path, folder);
   outputs_.push_back({what, path, identity});
 }
 
@@ -192,6 +201,7 @@ void FilePlan::output_folder(const std::string& what, const std::string& path) {
     throw DataError(named(what, path) + ": is not a folder");
   }
   require_writable_folder(what, path, folder);
+  if (folder != fs::absolute(path)) made_folders_.push_back(fs::absolute(path).lexically_normal());
 }
 
 void FilePlan::existing_output_folder(const std::string& what, const std::string& path) {

@@ -1,6 +1,7 @@
 #pragma once
 // Where the command line's outputs go: a file, written whole or not at all (write_file_atomically), or
 // standard output for the path "-"; every write is checked.
+#include <filesystem>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -44,6 +45,7 @@ class FilePlan {
   void output(const std::string& what, const std::string& path);
   /// A folder the command creates files or folders in: it must be a writable folder, or not exist yet
   /// with a writable folder as its nearest existing ancestor. Throws DataError naming `what` and the path.
+  /// Outputs given after it may lie in it (or under it) before it exists: the command makes it first.
   void output_folder(const std::string& what, const std::string& path);
   /// An existing folder the command writes new files into (e.g. screenshots): it must exist and be
   /// writable. Throws DataError naming `what` and the path.
@@ -68,6 +70,7 @@ class FilePlan {
   void add_input(const std::string& what, const std::string& given, const Identity& identity);
   std::vector<Entry> inputs_;
   std::vector<Entry> outputs_;
+  std::vector<std::filesystem::path> made_folders_;  // output folders that do not exist yet
 };
 
 /// Every file of every session folder under `root` (find_session_folders: the saved trial records,
