@@ -246,6 +246,25 @@ TEST_CASE("a device lost mid-trial keeps the attempt and stops the session namin
   CHECK(rows == 700 + 1);  // every tick before the lost read, and the header
 }
 
+TEST_CASE("a device that does not open is logged with the session's stop before the error ends the run",
+          "[study][session]") {
+  TempFolder temp;
+  SessionSetup setup = simulated("S08");
+  setup.device = "unplugged";
+  SessionFolder session = SessionFolder::create(temp.path, setup, small_protocol());
+  DeviceRegistry registry;
+  registry.register_device("unplugged", test::ProbeDevice().info(), []() -> std::unique_ptr<HapticDevice> {
+    throw DeviceError("the device is not connected");
+  });
+  SessionRunOptions options;
+  options.registry = &registry;
+  CHECK_THROWS_WITH(run_session(session, options), Catch::Contains("not connected"));
+  const std::vector<nlohmann::json> events = log_events(session.path());
+  CHECK(only_event(events, "trial_failed")["error"] == "the device is not connected");
+  CHECK(only_event(events, "session_stopped")["reason"] == "device_not_opened");
+  CHECK(session.saved_count() == 0);
+}
+
 TEST_CASE("a simulated subject writes the same for the same id and differently for another",
           "[study][session]") {
   TempFolder temp;

@@ -207,17 +207,22 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     if (run_options.host) run_options.host->before_trial(trial, result.planned);
 
     const StudyCondition& condition = manifest.protocol.protocol.condition(trial.condition);
-    std::vector<Character> models;
-    try {
-      for (const char32_t c : trial.characters) models.push_back(character(c));
-    } catch (const Error& e) {  // a character the library lacks: logged before the error ends the run
+    // An error before the trial runs (a character the library lacks, a device that does not open) is
+    // logged, with the session's stop and its reason, before it ends the run.
+    const auto log_failure = [&](const Error& e, const char* reason) {
       json details = trial_details(trial);
       details["error"] = e.what();
       session.log("trial_failed", details.dump());
       session.log("session_stopped", json{{"saved_trials", result.saved_before + result.saved_now},
                                           {"planned", result.planned},
-                                          {"reason", "character_not_loaded"}}
+                                          {"reason", reason}}
                                          .dump());
+    };
+    std::vector<Character> models;
+    try {
+      for (const char32_t c : trial.characters) models.push_back(character(c));
+    } catch (const Error& e) {
+      log_failure(e, "character_not_loaded");
       throw;
     }
     const Scene scene = Scene::lay_out(models);
@@ -231,8 +236,15 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     if (run_options.pacing) options.pacing = *run_options.pacing;
     if (run_options.prepare_trial) run_options.prepare_trial(trial, options);
 
-    std::unique_ptr<HapticDevice> device = registry.create(manifest.setup.device);
-    const DeviceInfo device_info = device->info();
+    std::unique_ptr<HapticDevice> device;
+    DeviceInfo device_info;
+    try {
+      device = registry.create(manifest.setup.device);
+      device_info = device->info();
+    } catch (const Error& e) {
+      log_failure(e, "device_not_opened");
+      throw;
+    }
     session.log("trial_started", trial_details(trial).dump());
     study_detail::TrialRecordContext context;
     context.session = &manifest;
