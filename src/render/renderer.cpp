@@ -24,18 +24,13 @@ double smoothstep(double u) noexcept {
 // two elements' lines meet), so that the active element's line, its backward resistance and the off-stroke
 // damper all lie across its way. There the fixture goes slack: weight 1 within R_res / 2 of the corner
 // point, 0 beyond R_res, a smoothstep between, so the force stays continuous; past the corner the next
-// element guides again.
-struct CornerRelease {
-  double weight = 0.0;
-  [[nodiscard]] Vec2 released(const Vec2& force) const noexcept { return (1.0 - weight) * force; }
-};
-
-CornerRelease corner_release(const ActiveStroke& active, const Vec2& tip, double radius_m) noexcept {
+// element guides again. Returns that weight: the in-plane guidance is scaled by 1 - weight.
+double corner_slack(const ActiveStroke& active, const Vec2& tip, double radius_m) noexcept {
   const PlacedStroke* stroke = active.stroke();
   const std::size_t e = active.element_index();
-  if (stroke == nullptr || e + 1 >= stroke->elements.size() || !(radius_m > 0.0)) return {};
+  if (stroke == nullptr || e + 1 >= stroke->elements.size() || !(radius_m > 0.0)) return 0.0;
   const double d = (tip - stroke->elements[e].end()).norm();
-  return {smoothstep((radius_m - d) / (0.5 * radius_m))};
+  return smoothstep((radius_m - d) / (0.5 * radius_m));
 }
 
 // The safety chain's parameters with the device's peak and continuous force filled in.
@@ -135,7 +130,8 @@ void Renderer::reset() noexcept {
 
 // F_et (eq. 8) with the taper at R_res and a rate-limited foot point, plus the resistance force, for
 // the active element; zero outside the constraint space. Fills the contact fields of `out`.
-Vec2 Renderer::guidance_force(const DeviceState& device, RenderOutput& out, bool element_changed) noexcept {
+Vec2 Renderer::guidance_force(const DeviceState& device, RenderOutput& out, bool element_changed,
+                              double slack) noexcept {
   const StrokeElement& element = *active_.element();
   const Vec2 tip = device.position_m.head<2>();
   if (element_changed) tracker_.reset();
@@ -178,8 +174,7 @@ Vec2 Renderer::guidance_force(const DeviceState& device, RenderOutput& out, bool
   // stroke to an end or corner it has passed; on the end plane the along-stroke part is zero, so this is
   // continuous.
   if (nearest.t >= 1.0) attraction -= attraction.dot(tangent) * tangent;
-  const CornerRelease corner = corner_release(active_, tip, parameters_.constraint_radius_m);
-  attraction = corner.released(attraction);
+  attraction *= 1.0 - slack;
   // The replay point may lead or trail the pen along the stroke by more than R_res: the spring is
   // saturated at its force at replay_max_lead_m, so the force stays bounded and continuous. (The foot
   // point of the other modes is never further than R_res.)
@@ -188,8 +183,8 @@ Vec2 Renderer::guidance_force(const DeviceState& device, RenderOutput& out, bool
   const double limit = parameters_.guidance_stiffness_n_per_m * factor * reach;
   const double magnitude = attraction.norm();
   if (magnitude > limit) attraction *= limit / magnitude;
-  return taper * attraction + corner.released(resistance_force(device.velocity_m_s.head<2>(), tangent,
-                                                               parameters_.resistance_damping_n_s_per_m));
+  return taper * attraction + (1.0 - slack) * resistance_force(device.velocity_m_s.head<2>(), tangent,
+                                                               parameters_.resistance_damping_n_s_per_m);
 }
 
 RenderOutput Renderer::tick(const DeviceState& device) noexcept {
@@ -257,8 +252,9 @@ RenderOutput Renderer::tick(const DeviceState& device) noexcept {
 
   // In-plane guidance, cross-faded when its source changes (element, stroke, character, WS, CS, inside).
   Vec2 target = Vec2::Zero();
+  const double slack = writing ? corner_slack(active_, tip, parameters_.constraint_radius_m) : 0.0;
   if (writing) {
-    target = guidance_force(device, out, element_changed);
+    target = guidance_force(device, out, element_changed, slack);
   } else {
     foot_valid_ = false;
   }
@@ -287,10 +283,9 @@ RenderOutput Renderer::tick(const DeviceState& device) noexcept {
     const double distance = away.norm();
     const double outward = distance > 0.0 ? std::max(0.0, off_stroke_velocity_.dot(away) / distance) : 0.0;
     if (outward > 0.0) {
-      target = corner_release(active_, tip, parameters_.constraint_radius_m)
-                   .released(off_stroke_resistance(outward * away / distance,
-                                                   parameters_.off_stroke_damping_n_s_per_m,
-                                                   parameters_.off_stroke_speed_m_s));
+      target = (1.0 - slack) * off_stroke_resistance(outward * away / distance,
+                                                     parameters_.off_stroke_damping_n_s_per_m,
+                                                     parameters_.off_stroke_speed_m_s);
     }
   }
   const bool off_stroke_changed = off_in_calibration != (state_before == InteractionState::calibration);

@@ -76,7 +76,9 @@ class Renderer {
   [[nodiscard]] const TeacherReplay& teacher_replay() const noexcept { return replay_; }
 
  private:
-  Vec2 guidance_force(const DeviceState& device, RenderOutput& out, bool element_changed) noexcept;
+  /// `slack` in [0, 1]: the share of the guidance released near a corner (renderer.cpp, corner_slack).
+  Vec2 guidance_force(const DeviceState& device, RenderOutput& out, bool element_changed,
+                      double slack) noexcept;
   void command(const Vec3& force, RenderOutput& out) noexcept;
 
   const Scene* scene_;
