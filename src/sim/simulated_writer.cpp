@@ -6,6 +6,7 @@
 #include <numbers>
 #include <random>
 
+#include "model/polyline.hpp"
 #include "sim/writer_program.hpp"
 #include "sim/writer_stroke_path.hpp"
 
@@ -31,7 +32,7 @@ constexpr double kMinimumLeg_s = 0.15;    // shortest leg of a stroke (between c
 // the data's 1024 box at 60 mm), the corner count that agreed with cnchar-order's fold counts on 97.4 % of
 // hanzi-writer-data's strokes (docs/writer.md).
 constexpr double kCornerWindow_m = 0.0028;
-constexpr double kCornerTurn_rad = 70.0 * std::numbers::pi / 180.0;
+constexpr double kCornerTurn_deg = 70.0;
 // The most of a stroke (or of its last leg) a lift short of the end leaves out: people's strokes measured
 // against the medians (docs/stroke-acceptance.md) end short by at most 12 % of a short stroke.
 constexpr double kMostShortShare = 0.12;
@@ -535,13 +536,13 @@ void SimulatedWriter::State::start_attempt(const PlannedStroke& target, bool fol
   attempt.reference = seen;
   attempt.start_m = seen.front();
   const std::vector<std::size_t> corners =
-      writer_detail::corner_vertices(seen, kCornerWindow_m, kCornerTurn_rad);
+      writer_detail::corner_vertices(seen, kCornerWindow_m, kCornerTurn_deg);
   std::vector<double> cuts;
   for (std::size_t k = 0; k < corners.size(); ++k) cuts.push_back(profile.corner_cut_m * uniform(plan_rng));
   // Where the pen lifts, relative to the seen end; never more than a share of a short stroke.
   const double end_draw =
       std::max(-profile.end_short_m + (profile.end_short_m + profile.end_past_m) * uniform(plan_rng),
-               -kMostShortShare * writer_detail::length_of(seen)) +
+               -kMostShortShare * polyline_length(seen)) +
       profile.follow_through_m;
 
   const Vec2 centre = character.bounding_box.center();
@@ -558,7 +559,7 @@ void SimulatedWriter::State::start_attempt(const PlannedStroke& target, bool fol
     Polyline& last = legs.back();
     const Vec2 direction = (last.back() - last[last.size() - 2]).normalized();
     const double short_m = direction.allFinite() ? (seen.back() - last.back()).dot(direction) : 0.0;
-    beyond_m = std::max(short_m + end_draw, -kMostShortShare * writer_detail::length_of(last));
+    beyond_m = std::max(short_m + end_draw, -kMostShortShare * polyline_length(last));
     last = writer_detail::with_end_moved(last, beyond_m);
   }
   const double z0 = scene->layout.paper_z_m;

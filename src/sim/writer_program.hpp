@@ -14,7 +14,7 @@ enum class SegmentKind {
   travel,   // pen up, towards the next start
   descend,  // pen up to hovering above the start
   touch,    // onto the paper
-  write,    // along a stroke element (steered: speed from the seen error)
+  write,    // along a leg of a stroke (steered: speed from the seen error)
   lift,     // off the paper
   pause,    // holding still (a hesitation, the top of a mid-stroke lift)
   stray,    // sliding on the paper outside the character's box
@@ -26,7 +26,6 @@ struct Segment {
   std::vector<double> arc;    // cumulative length along path [m]
   double duration_s = 0.0;    // at speed factor 1
   bool steered = false;       // write segments: the rate follows the writer's speed factor
-  int element = -1;           // reference element written (index within the stroke), -1 none
   bool aim_at_start = false;  // the writer corrects towards the stroke's start while on it
   bool mid_stroke = false;    // part of a lift in the middle of a stroke
   double follow_from_m = std::numeric_limits<double>::infinity();  // arc beyond which it is follow-through

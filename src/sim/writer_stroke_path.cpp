@@ -3,43 +3,37 @@
 #include <algorithm>
 #include <cmath>
 
+#include "model/polyline.hpp"
+
 namespace calligraphy::writer_detail {
 namespace {
 
 constexpr int kSamplesPerElement = 16;  // outline centre of a stroke without a median
 
-double signed_turn(const Vec2& in, const Vec2& out) {
-  return std::atan2(in.x() * out.y() - in.y() * out.x(), in.dot(out));
-}
-
 }  // namespace
 
 Polyline seen_stroke(const PlacedStroke& stroke) {
-  Polyline line;
-  if (stroke.median_m.size() >= 2) {
-    for (const Vec2& p : stroke.median_m) {
-      if (line.empty() || p != line.back()) line.push_back(p);
-    }
-  } else {
-    line.push_back(stroke.start());
+  Polyline line = without_repeats(stroke.median_m);
+  if (stroke.median_m.size() < 2) {
+    line = {stroke.start()};
     for (const StrokeElement& e : stroke.elements) {
-      for (int i = 1; i <= kSamplesPerElement; ++i)
-        line.push_back(e.point(static_cast<double>(i) / kSamplesPerElement));
+      const std::vector<Vec2> samples = sample_element(e, kSamplesPerElement);
+      line.insert(line.end(), samples.begin() + 1, samples.end());
     }
   }
   if (line.size() < 2) line.push_back(line.front());
   return line;
 }
 
-std::vector<std::size_t> corner_vertices(const Polyline& line, double window_m, double min_turn_rad) {
+std::vector<std::size_t> corner_vertices(const Polyline& line, double window_m, double min_turn_deg) {
   const std::size_t n = line.size();
   std::vector<double> arc(n, 0.0);
   for (std::size_t i = 1; i < n; ++i) arc[i] = arc[i - 1] + (line[i] - line[i - 1]).norm();
-  std::vector<double> turn(n, 0.0);
+  std::vector<double> turn(n, 0.0);  // degrees
   for (std::size_t i = 1; i + 1 < n; ++i) {
     const Vec2 in = line[i] - line[i - 1];
     const Vec2 out = line[i + 1] - line[i];
-    if (in.norm() > 0.0 && out.norm() > 0.0) turn[i] = signed_turn(in, out);
+    if (in.norm() > 0.0 && out.norm() > 0.0) turn[i] = turn_deg(in, out);
   }
   std::vector<std::size_t> corners;
   for (std::size_t i = 1; i + 1 < n; ++i) {
@@ -52,7 +46,7 @@ std::vector<std::size_t> corner_vertices(const Polyline& line, double window_m, 
       if (std::abs(turn[j]) > std::abs(turn[i]) || (j < i && std::abs(turn[j]) == std::abs(turn[i])))
         largest = false;
     }
-    if (largest && std::abs(summed) > min_turn_rad) corners.push_back(i);
+    if (largest && std::abs(summed) > min_turn_deg) corners.push_back(i);
   }
   return corners;
 }
@@ -78,12 +72,6 @@ std::vector<Polyline> legs_through_corners(const Polyline& line, const std::vect
   return legs;
 }
 
-double length_of(const Polyline& line) {
-  double length = 0.0;
-  for (std::size_t i = 1; i < line.size(); ++i) length += (line[i] - line[i - 1]).norm();
-  return length;
-}
-
 Polyline with_end_moved(const Polyline& line, double delta_m) {
   Polyline out = line;
   if (line.size() < 2 || delta_m == 0.0) return out;
@@ -92,7 +80,7 @@ Polyline with_end_moved(const Polyline& line, double delta_m) {
     if (d.norm() > 0.0) out.push_back(line.back() + delta_m * d.normalized());
     return out;
   }
-  double cut = std::min(-delta_m, length_of(line));
+  double cut = std::min(-delta_m, polyline_length(line));
   while (out.size() >= 2) {
     const Vec2 last = out.back();
     const Vec2 before = out[out.size() - 2];

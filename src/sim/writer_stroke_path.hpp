@@ -15,19 +15,16 @@ using Polyline = std::vector<Vec2>;
 /// outline's centre sampled from the elements.
 [[nodiscard]] Polyline seen_stroke(const PlacedStroke& stroke);
 
-/// Interior vertices of `line` where it turns by more than `min_turn_rad` within +-`window_m` of arc (the
+/// Interior vertices of `line` where it turns by more than `min_turn_deg` within +-`window_m` of arc (the
 /// data rounds a corner over two or three vertices): one index per corner, the vertex turning most.
 [[nodiscard]] std::vector<std::size_t> corner_vertices(const Polyline& line, double window_m,
-                                                       double min_turn_rad);
+                                                       double min_turn_deg);
 
 /// `line` cut into legs at `corners` (vertex indices, ascending): each corner vertex moved by `cut_m[k]`
 /// along its inner bisector (< 0: outside), ending one leg and starting the next.
 [[nodiscard]] std::vector<Polyline> legs_through_corners(const Polyline& line,
                                                          const std::vector<std::size_t>& corners,
                                                          const std::vector<double>& cut_m);
-
-/// Arc length of `line` [m].
-[[nodiscard]] double length_of(const Polyline& line);
 
 /// `line` with its end moved by `delta_m` along the line: < 0 cut back (never past its first point),
 /// > 0 carried on along its last direction.
