@@ -84,46 +84,34 @@ void add_spatial_totals(CharacterScore& score) {
   score.totals.dtw_m = dtw_weighted / static_cast<double>(score.totals.deviation->samples);
 }
 
+// The counter of `refusal`; none has no counter.
+std::size_t RefusalCounts::*counter_of(StrokeRefusal refusal) noexcept {
+  switch (refusal) {
+    case StrokeRefusal::too_short:
+      return &RefusalCounts::too_short;
+    case StrokeRefusal::backwards:
+      return &RefusalCounts::backwards;
+    case StrokeRefusal::wrong_place:
+      return &RefusalCounts::wrong_place;
+    case StrokeRefusal::wrong_stroke:
+      return &RefusalCounts::wrong_stroke;
+    case StrokeRefusal::wrong_order:
+      return &RefusalCounts::wrong_order;
+    case StrokeRefusal::none:
+      break;
+  }
+  return nullptr;
+}
+
 }  // namespace
 
 std::size_t RefusalCounts::of(StrokeRefusal refusal) const noexcept {
-  switch (refusal) {
-    case StrokeRefusal::too_short:
-      return too_short;
-    case StrokeRefusal::backwards:
-      return backwards;
-    case StrokeRefusal::wrong_place:
-      return wrong_place;
-    case StrokeRefusal::wrong_stroke:
-      return wrong_stroke;
-    case StrokeRefusal::wrong_order:
-      return wrong_order;
-    case StrokeRefusal::none:
-      break;
-  }
-  return 0;
+  const auto counter = counter_of(refusal);
+  return counter != nullptr ? this->*counter : 0;
 }
 
 void RefusalCounts::add(StrokeRefusal refusal) noexcept {
-  switch (refusal) {
-    case StrokeRefusal::too_short:
-      ++too_short;
-      break;
-    case StrokeRefusal::backwards:
-      ++backwards;
-      break;
-    case StrokeRefusal::wrong_place:
-      ++wrong_place;
-      break;
-    case StrokeRefusal::wrong_stroke:
-      ++wrong_stroke;
-      break;
-    case StrokeRefusal::wrong_order:
-      ++wrong_order;
-      break;
-    case StrokeRefusal::none:
-      break;
-  }
+  if (const auto counter = counter_of(refusal)) ++(this->*counter);
 }
 
 std::size_t RefusalCounts::total() const noexcept {
