@@ -5,7 +5,6 @@
 // same pairwise test (attempt_stroke), finds the order and direction of the strokes written.
 #include <algorithm>
 #include <catch2/catch.hpp>
-#include <map>
 #include <optional>
 #include <random>
 #include <set>
@@ -16,18 +15,13 @@
 #include "calligraphy/sim/person_traces.hpp"
 #include "calligraphy/study/quiz.hpp"
 #include "calligraphy/trial/score.hpp"
+#include "embedded_scenes.hpp"
 
 using namespace calligraphy;
 
 namespace {
 
-const PlacedCharacter& character_of(char32_t c) {
-  static std::map<char32_t, Scene> scenes;
-  auto it = scenes.find(c);
-  if (it == scenes.end())
-    it = scenes.emplace(c, Scene::lay_out({CharacterLibrary::embedded().load(c)})).first;
-  return it->second.characters.front();
-}
+const PlacedCharacter& character_of(char32_t c) { return testing::embedded_scene(c).characters.front(); }
 
 // The runs as a pen trace at 1 kHz: each run's points pen down, then the pen lifted for 100 ms (samples at
 // the run's last point).

@@ -1,24 +1,18 @@
 // QuizSession on hand-made pen traces over 十 (horizontal, then vertical) and 口.
 #include <catch2/catch.hpp>
-#include <map>
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/study/quiz.hpp"
 #include "calligraphy/trial/metrics.hpp"
+#include "embedded_scenes.hpp"
 
 using namespace calligraphy;
 
 namespace {
 
-const PlacedCharacter& character_of(char32_t c) {
-  static std::map<char32_t, Scene> scenes;
-  auto it = scenes.find(c);
-  if (it == scenes.end())
-    it = scenes.emplace(c, Scene::lay_out({CharacterLibrary::embedded().load(c)})).first;
-  return it->second.characters.front();
-}
+const PlacedCharacter& character_of(char32_t c) { return testing::embedded_scene(c).characters.front(); }
 
 // The reference stroke as points 0.5 mm apart, shifted by `offset_m`, optionally reversed.
 std::vector<Vec2> stroke_points(const PlacedStroke& stroke, const Vec2& offset_m = Vec2::Zero(),

@@ -2,25 +2,19 @@
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <cmath>
-#include <map>
 #include <utility>
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/trial/score.hpp"
+#include "embedded_scenes.hpp"
 
 using namespace calligraphy;
 
 namespace {
 
-const Scene& scene_of(char32_t c) {
-  static std::map<char32_t, Scene> scenes;
-  auto it = scenes.find(c);
-  if (it == scenes.end())
-    it = scenes.emplace(c, Scene::lay_out({CharacterLibrary::embedded().load(c)})).first;
-  return it->second;
-}
+const Scene& scene_of(char32_t c) { return testing::embedded_scene(c); }
 
 // The stroke as points `spacing_m` apart along its elements, each moved `offset_m` along the left normal
 // of the polyline (the direction 90 degrees counter-clockwise from the writing direction).

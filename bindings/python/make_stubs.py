@@ -42,9 +42,9 @@ def split_top_level(text):
             quote = None if c == quote else quote
         elif c in "'\"":
             quote = c
-        elif c in "([{":
+        elif c in "([{<":  # < > of a default's repr, e.g. <TraceKind.human: 1>
             depth += 1
-        elif c in ")]}":
+        elif c in ")]}>":
             depth -= 1
         elif c == "," and depth == 0:
             parts.append(current.strip())

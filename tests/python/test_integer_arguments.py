@@ -8,7 +8,9 @@ a new function or keyword with an int argument fails `test_every_integer_argumen
 is added to CASES below.
 """
 
+import importlib.util
 import inspect
+import pathlib
 import re
 
 import pytest
@@ -17,29 +19,13 @@ import calligraphy
 from calligraphy import _calligraphy as native
 
 HOSTILE_VALUES = [2**70, -1, 2**64]
+
+# The stub generator's splitter of a signature's parameter list (commas outside brackets and quotes).
+_STUBS = pathlib.Path(__file__).resolve().parents[2] / "bindings" / "python" / "make_stubs.py"
+_spec = importlib.util.spec_from_file_location("make_stubs", _STUBS)
+make_stubs = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(make_stubs)
 ACCEPTED_ERRORS = (TypeError, ValueError, OverflowError, IndexError)
-
-
-def split_parameters(text):
-    """The parameters of a signature's parameter list, split at the commas outside brackets and quotes."""
-    parts, depth, current, quote = [], 0, "", None
-    for ch in text:
-        if quote:
-            quote = None if ch == quote else quote
-        elif ch in "'\"":
-            quote = ch
-        elif ch in "([{<":
-            depth += 1
-        elif ch in ")]}>":
-            depth -= 1
-        elif ch == "," and depth == 0:
-            parts.append(current.strip())
-            current = ""
-            continue
-        current += ch
-    if current.strip():
-        parts.append(current.strip())
-    return parts
 
 
 def signatures(doc, name):
@@ -64,7 +50,7 @@ def integer_parameters(doc, name):
     """Names of the parameters annotated `int`, or a Union/Optional holding int."""
     names = []
     for signature in signatures(doc, name):
-        for parameter in split_parameters(signature):
+        for parameter in make_stubs.split_top_level(signature):
             match = re.match(r"^(\w+)\s*:\s*([^=]+?)\s*(=.*)?$", parameter)
             if match and re.search(r"(?<![\w.])int(?![\w.])", match.group(2)):
                 names.append(match.group(1))

@@ -54,6 +54,20 @@ class Box:
         return self.data_to_px((x_m * units + 512, y_m * units + 388))
 
 
+def box_lines(folder, process, who, timeout=30):
+    """The character boxes the window printed on stdout (folder/stdout.txt) once it has drawn; fails when
+    `process` ends first (naming `who` and its stderr, folder/stderr.txt) or after `timeout` s."""
+    deadline = time.time() + timeout
+    while time.time() < deadline:
+        lines = [l for l in (folder / "stdout.txt").read_text().splitlines() if l.startswith("box ")]
+        if lines:
+            return [Box(l) for l in lines]
+        if process.poll() is not None:
+            raise AssertionError(who + " ended before its window showed: " + (folder / "stderr.txt").read_text())
+        time.sleep(0.1)
+    raise AssertionError("no box line within %s s" % timeout)
+
+
 class Trainer:
     """`calligraphy train` running in the background."""
 
@@ -65,15 +79,7 @@ class Trainer:
                                         cwd=self.folder)
 
     def boxes(self, timeout=30):
-        deadline = time.time() + timeout
-        while time.time() < deadline:
-            lines = [l for l in (self.folder / "stdout.txt").read_text().splitlines() if l.startswith("box ")]
-            if lines:
-                return [Box(l) for l in lines]
-            if self.process.poll() is not None:
-                raise AssertionError("the trainer ended before drawing: " + self.errors())
-            time.sleep(0.1)
-        raise AssertionError("no box line within %s s" % timeout)
+        return box_lines(self.folder, self.process, "the trainer", timeout)
 
     def window(self):
         return xdotool("search", "--name", "calligraphy train").split()[0]
@@ -591,14 +597,7 @@ class SessionWindowTest(unittest.TestCase):
         return (self.folder / "stderr.txt").read_text()
 
     def first_box(self, timeout=30):
-        deadline = time.time() + timeout
-        while time.time() < deadline:
-            lines = [l for l in (self.folder / "stdout.txt").read_text().splitlines() if l.startswith("box ")]
-            if lines:
-                return Box(lines[0])
-            self.assertIsNone(self.process.poll(), "the session ended before its window showed: " + self.errors())
-            time.sleep(0.1)
-        raise AssertionError("no box line within %s s" % timeout)
+        return box_lines(self.folder, self.process, "the session", timeout)[0]
 
     def session_folder(self):
         (session,) = (self.folder / "out" / "S01").glob("tiny-*")
@@ -733,14 +732,7 @@ class EndingTest(unittest.TestCase):
                                         env=environment)
 
     def first_box(self, timeout=30):
-        deadline = time.time() + timeout
-        while time.time() < deadline:
-            lines = [l for l in (self.folder / "stdout.txt").read_text().splitlines() if l.startswith("box ")]
-            if lines:
-                return Box(lines[0])
-            self.assertIsNone(self.process.poll(), "the program ended before its window showed: " + self.errors())
-            time.sleep(0.1)
-        raise AssertionError("no box line within %s s" % timeout)
+        return box_lines(self.folder, self.process, "the program", timeout)[0]
 
     def move_pointer(self, box, tool):
         """The pointer moved a little over the character's box while the trial runs."""
