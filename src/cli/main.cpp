@@ -10,6 +10,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "cli/commands.hpp"
 #include "cli/output.hpp"
+#include "cli/suggest.hpp"
 
 namespace calligraphy::cli {
 namespace {
@@ -84,11 +85,11 @@ int main(int argc, char** argv) {
         const auto parent_end = name.rfind(' ');
         std::fputs(deepest->help(parent_end == std::string::npos ? "" : name.substr(0, parent_end)).c_str(),
                    stderr);
-        const std::vector<std::string> unknown = deepest->remaining();
-        if (!unknown.empty()) {
-          message = (unknown.front().rfind('-', 0) == 0 ? "unknown option '" : "unknown command '") +
-                    unknown.front() + "'";
-        }
+      }
+      // An argument left unplaced is the cause of these errors (a mistyped option also leaves the option
+      // it meant missing, `score T --charcter C`): it is named, with what it was likely meant to be.
+      if (dynamic_cast<const CLI::ExtrasError*>(&e) || dynamic_cast<const CLI::RequiredError*>(&e)) {
+        if (std::string unknown = unknown_argument_message(*deepest); !unknown.empty()) message = unknown;
       }
       print_error(name, message);
       return 2;
