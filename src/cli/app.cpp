@@ -237,6 +237,15 @@ CLI::Option* add_output_path(CLI::App& app, const std::string& name, std::string
       });
 }
 
+CLI::Option* add_output_folder(CLI::App& app, const std::string& name, std::string& target,
+                               const std::string& description, const std::string& default_text) {
+  return add_single(app, name, "DIR", description, default_text, [=, &target](const std::string& text) {
+    if (text == "-") throw CLI::ValidationError(name, "expects a folder, got '-' (standard output)");
+    require_not_option_like(name, text, "a folder name");
+    target = text;
+  });
+}
+
 CLI::Option* required(CLI::Option* option) {
   option->required();
   std::string description = option->get_description();
@@ -247,9 +256,10 @@ CLI::Option* required(CLI::Option* option) {
 }
 
 CLI::Option* add_positional(CLI::App& app, const std::string& name, std::string& target,
-                            const std::string& description) {
+                            const std::string& description, const std::string& value_name) {
   CLI::Option* option = app.add_option(name, target, description);
   option->required();
+  option->type_name(value_name);
   return option;
 }
 

@@ -83,12 +83,16 @@ enum class StandardOutput { allowed, refused };
 CLI::Option* add_output_path(CLI::App& app, const std::string& name, std::string& target,
                              const std::string& description, StandardOutput standard_output);
 
+/// A folder that is written in (DIR in --help; "-" refused).
+CLI::Option* add_output_folder(CLI::App& app, const std::string& name, std::string& target,
+                               const std::string& description, const std::string& default_text);
+
 /// Makes an option required and says so in --help.
 CLI::Option* required(CLI::Option* option);
 
-/// A required positional argument.
+/// A required positional argument; --help shows `value_name` after its name (FILE, DIR, TEXT).
 CLI::Option* add_positional(CLI::App& app, const std::string& name, std::string& target,
-                            const std::string& description);
+                            const std::string& description, const std::string& value_name = "TEXT");
 
 /// Throws UsageError when more than one of `uses` (option name, writes standard output) is true:
 /// standard output carries one document at a time.

@@ -137,7 +137,7 @@ void add_corpus_stats_command(CLI::App& corpus, Commands& commands) {
       commands.add(corpus, "stats",
                    "Characters, strokes, elements, bytes, typical-stroke histogram and checksums of a store",
                    [command] { return run_stats(*command); });
-  add_positional(*app, "FILE", command->store, "the corpus store");
+  add_positional(*app, "FILE", command->store, "the corpus store", "FILE");
   add_flag(*app, "--json", command->json, "print the statistics as JSON");
 }
 

@@ -46,7 +46,8 @@ void add_report_command(CLI::App& root, Commands& commands) {
                                [command] { return run_report(*command); });
   app->add_option("DIR", command->folders,
                   "session folders, or folders holding them (e.g. a `session run --out` folder)")
-      ->required();
+      ->required()
+      ->type_name("DIR");
   required(add_output_path(*app, "--out", command->out, "the HTML page", StandardOutput::allowed));
 }
 

@@ -61,7 +61,8 @@ void add_score_command(CLI::App& root, Commands& commands) {
                                [command] { return run_score(*command); });
   add_positional(*app, "TRACE", command->trace,
                  "CSV with a header naming t [s], x, y and pen (1/0) or z [m]; other columns are ignored, "
-                 "so `trial --csv` output is read as it is");
+                 "so `trial --csv` output is read as it is",
+                 "FILE");
   required(add_text(*app, "--character", command->character, "C", "the character the trace writes"));
   add_choice(*app, "--units", command->units, {"m", "data"},
              "units of x and y: metres on the paper as `trial` places the character, or the character's "

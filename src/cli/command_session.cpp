@@ -350,7 +350,7 @@ void add_session_commands(CLI::App& root, Commands& commands) {
       "Run a study protocol for one subject, or for N simulated subjects; SIGINT or SIGTERM stops it "
       "after keeping the running trial (exit status 128 + the signal)",
       [run] { return run_sessions(*run); });
-  add_positional(*app, "PROTOCOL", run->protocol, "the study protocol (JSON; docs/experiments.md)");
+  add_positional(*app, "PROTOCOL", run->protocol, "the study protocol (JSON; docs/experiments.md)", "FILE");
   add_text(*app, "--subject", run->subject, "ID",
            "the subject's id (letters, digits, '_', '-'); with --subjects, the prefix of the simulated ids",
            "required; with --subjects: S");
@@ -383,7 +383,8 @@ void add_session_commands(CLI::App& root, Commands& commands) {
   CLI::App* resume_app =
       commands.add(*group, "resume", "Go on with a stopped or crashed session from its first unsaved trial",
                    [resume] { return resume_session(*resume); });
-  add_positional(*resume_app, "DIR", resume->folder, "the session folder (the one holding session.json)");
+  add_positional(*resume_app, "DIR", resume->folder, "the session folder (the one holding session.json)",
+                 "DIR");
   add_choice(*resume_app, "--pacing", resume->pacing, {"auto", "lock-step", "real-time"},
              "overrides the pacing the session was started with (default: that pacing)");
   add_library_options(*resume_app, resume->library, true);

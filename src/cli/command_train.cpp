@@ -196,10 +196,10 @@ void add_train_command(CLI::App& root, Commands& commands) {
                   StandardOutput::refused);
   add_unsigned(*app, "--seed", command->seed, "N", "seed of the simulated writer (a 64-bit integer)");
   add_library_options(*app, command->library, true);
-  add_output_path(
+  add_output_folder(
       *app, "--session", command->session,
       "save the trials as they end into a session folder DIR/SUBJECT/train-TIME/ (docs/experiments.md)",
-      StandardOutput::refused);
+      "not saved");
   add_text(*app, "--subject", command->subject, "ID",
            "the subject's id in the saved trials (A-Z a-z 0-9 _ -)");
   add_text(*app, "--window", command->window, "WxH", "window size [px]");
@@ -214,9 +214,10 @@ void add_train_command(CLI::App& root, Commands& commands) {
               "quiz: show the expected stroke after N misses on it, and after each further miss; 0: never", 0,
               1000)
       ->needs(quiz);
-  add_text(*app, "--quiz-screenshots", command->quiz_screenshots, "DIR",
-           "quiz: write the window as DIR/quiz-NN-VERDICT.png on the first frame after each judged stroke "
-           "(an existing folder) (default: not written)");
+  add_output_folder(*app, "--quiz-screenshots", command->quiz_screenshots,
+                    "quiz: write the window as DIR/quiz-NN-VERDICT.png on the first frame after each judged "
+                    "stroke (an existing folder)",
+                    "not written");
   add_number(*app, "--exit-after", command->exit_after_s, "SECONDS",
              "unattended: quit after this long [s], or once every character had its trial",
              "a number of seconds > 0", [](double s) { return s > 0.0 && s <= 86400.0; });
