@@ -117,6 +117,7 @@ TrialResult run_trial_on_device(const TrialCommand& command, const DeviceListing
   options.force.guidance_mode = *guidance_mode_from_string(command.guidance_mode);
   options.force.guidance_gain = command.guidance_gain;
   if (teacher) options.force.teacher_trajectory = teacher->samples;
+  fit_default_stiffness(options.force, device.info);
   options.simulation.writer = writer;
   options.simulation.seed = command.seed;
   options.rate_hz = command.rate_hz;
