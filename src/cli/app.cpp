@@ -3,6 +3,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <map>
 #include <memory>
 #include <system_error>
 
@@ -171,15 +172,20 @@ CLI::Option* add_number_list(CLI::App& app, const std::string& name, std::vector
 }
 
 CLI::Option* add_choice(CLI::App& app, const std::string& name, std::string& target,
-                        const std::vector<std::string>& choices, const std::string& description) {
+                        const std::vector<std::string>& choices, const std::string& description,
+                        const std::string& default_text, const std::map<std::string, std::string>& retired) {
   std::string list;
   for (const auto& choice : choices) list += (list.empty() ? "" : "|") + choice;
-  return add_single(app, name, list, description, target, [=, &target](const std::string& text) {
+  const std::string shown = default_text.empty() ? target : default_text;
+  return add_single(app, name, list, description, shown, [=, &target](const std::string& text) {
     for (const auto& choice : choices) {
       if (choice == text) {
         target = text;
         return;
       }
+    }
+    if (const auto hint = retired.find(text); hint != retired.end()) {
+      throw CLI::ValidationError(name + " " + text + ": " + hint->second);
     }
     invalid(name, list, text);
   });

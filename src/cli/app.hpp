@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -61,9 +62,13 @@ CLI::Option* add_number(CLI::App& app, const std::string& name, double& target, 
 CLI::Option* add_number_list(CLI::App& app, const std::string& name, std::vector<double>& target,
                              const std::string& value_name, const std::string& description,
                              const std::string& expectation, std::function<bool(double)> valid);
-/// One of `choices`.
+/// One of `choices`. The default shown is `target`, or `default_text` when given. A value of `retired`
+/// (one the option took before it changed meaning) is refused with its message, which says what to write
+/// instead.
 CLI::Option* add_choice(CLI::App& app, const std::string& name, std::string& target,
-                        const std::vector<std::string>& choices, const std::string& description);
+                        const std::vector<std::string>& choices, const std::string& description,
+                        const std::string& default_text = "",
+                        const std::map<std::string, std::string>& retired = {});
 /// Free text (characters, a device name). `default_text` describes the default when `target` is empty.
 CLI::Option* add_text(CLI::App& app, const std::string& name, std::string& target,
                       const std::string& value_name, const std::string& description,

@@ -21,6 +21,7 @@
 #include "cli/library_options.hpp"
 #include "cli/output.hpp"
 #include "cli/signals.hpp"
+#include "cli/writer_options.hpp"
 #include "core/unicode.hpp"
 #ifdef CALLIGRAPHY_WITH_TRAINER
 #include "trainer/trainer.hpp"
@@ -43,8 +44,9 @@ struct SessionRunCommand {
   const CLI::Option* subject_number_option = nullptr;
   std::int64_t subjects = 0;
   std::string device = "simulated";
-  std::string writer = "auto";
+  std::string writer;  // person or simulated; empty: the device's own (writer_for_device)
   std::string writer_profile = "novice";
+  const CLI::Option* profile_option = nullptr;
   std::string pacing = "auto";
   std::string out;
   LibraryOptions library;
@@ -245,12 +247,17 @@ int run_sessions(const SessionRunCommand& command) {
     for (const DeviceListing& listing : survey.devices) names += (names.empty() ? "" : ", ") + listing.name;
     throw UsageError("--device: unknown device '" + command.device + "'; registered devices: " + names);
   }
-  const std::string writer =
-      command.writer == "auto" ? (device->hardware ? "human" : "simulated") : command.writer;
-  if (writer == "simulated" && device->hardware) {
-    throw UsageError("--writer simulated: the device '" + command.device + "' is moved by a person");
+  // Simulated subjects rule out a person before the device is looked at.
+  if (command.subjects > 0 && command.writer == kPersonWriter) {
+    throw UsageError("--subjects: simulated subjects need --writer simulated");
   }
-  if (command.subjects > 0 && writer != "simulated") {
+  // The session folder's format calls a person "human" (SessionSetup::writer).
+  const bool person = writer_for_device(command.writer, *device) == kPersonWriter;
+  const std::string writer = person ? "human" : "simulated";
+  if (person && command.profile_option->count() > 0) {
+    throw UsageError("--writer-profile applies to the simulated writer, not to a person (--writer person)");
+  }
+  if (command.subjects > 0 && person) {
     throw UsageError("--subjects: simulated subjects need --writer simulated");
   }
   if (command.subjects == 0 && command.subject.empty()) {
@@ -288,7 +295,7 @@ int run_sessions(const SessionRunCommand& command) {
   TerminalHost host;
   std::shared_ptr<CharacterSource> source;
   const SessionRunOptions options =
-      run_options(command.library, writer == "human" ? &host : nullptr, device->info, source);
+      run_options(command.library, person ? &host : nullptr, device->info, source);
   for (std::size_t i = 0; i < subjects.size(); ++i) {
     if (stop_requested()) return 128 + stop_signal();
     SessionSetup setup;
@@ -378,11 +385,11 @@ void add_session_commands(CLI::App& root, Commands& commands) {
       "run N simulated subjects ID01..IDN, numbered 1..N, one session each (needs --writer simulated)", 0,
       1000, "none");
   add_text(*app, "--device", run->device, "NAME", "the device, by its name in `calligraphy devices`");
-  add_choice(
-      *app, "--writer", run->writer, {"simulated", "human"},
-      "who writes: a simulated writer (simulated and emulated devices) or a person; default: simulated "
-      "on a simulated or emulated device, human on hardware");
-  add_text(
+  add_writer_option(*app, run->writer,
+                    "who writes: the simulated writer (on the simulated and emulated devices it moves) or a "
+                    "person (on hardware, or mouse and mouse-hand in the window)",
+                    "simulated on a simulated or emulated device, person on hardware");
+  run->profile_option = add_text(
       *app, "--writer-profile", run->writer_profile, "PROFILES",
       "the simulated writer's profile, novice, skilled or foreign; a comma-separated list is used by subject "
       "in turn");

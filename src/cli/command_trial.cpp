@@ -22,6 +22,7 @@
 #include "cli/library_options.hpp"
 #include "cli/output.hpp"
 #include "cli/signals.hpp"
+#include "cli/writer_options.hpp"
 
 namespace calligraphy::cli {
 namespace {
@@ -30,7 +31,9 @@ struct TrialCommand {
   std::string characters;
   std::string device = "simulated";
   std::string guidance = "on";
-  std::string writer = "novice";
+  std::string writer;  // person or simulated; empty: the device's own (writer_for_device)
+  std::string writer_profile = "novice";
+  const CLI::Option* profile_option = nullptr;
   std::vector<std::string> writer_parameters;  // "key=value", applied in turn
   std::string guidance_mode = "fixed";
   double guidance_gain = 1.0;
@@ -59,10 +62,10 @@ DeviceListing find_device(const std::string& name) {
                    "'; registered devices: " + (names.empty() ? "none" : names));
 }
 
-// The profile of --writer with each --writer-param applied; a UsageError naming the setting and listing
-// the known keys when one is refused.
+// The profile of --writer-profile with each --writer-param applied; a UsageError naming the setting and
+// listing the known keys when one is refused.
 WriterProfile writer_from(const TrialCommand& command) {
-  WriterProfile profile = writer_profile(command.writer);
+  WriterProfile profile = writer_profile(command.writer_profile);
   for (const std::string& setting : command.writer_parameters) {
     try {
       apply_writer_setting(profile, setting);
@@ -108,8 +111,20 @@ TeacherRecording teacher_for(const TrialCommand& command) {
   return teacher;
 }
 
+// A profile or its settings describe the simulated writer: with a person writing they would be ignored.
+void check_writer_options(const TrialCommand& command, const std::string& writer) {
+  if (writer != kPersonWriter) return;
+  if (command.profile_option->count() > 0) {
+    throw UsageError("--writer-profile applies to the simulated writer, not to a person (--writer person)");
+  }
+  if (!command.writer_parameters.empty()) {
+    throw UsageError("--writer-param applies to the simulated writer, not to a person (--writer person)");
+  }
+}
+
 // Every use of the trial runner's options and run_trial is here, in one place.
-TrialResult run_trial_on_device(const TrialCommand& command, const DeviceListing& device, const Scene& scene,
+TrialResult run_trial_on_device(const TrialCommand& command, const DeviceListing& device,
+                                const std::string& who_writes, const Scene& scene,
                                 const WriterProfile& writer, const TeacherRecording* teacher,
                                 TrialDescription& description) {
   TrialOptions options;
@@ -128,9 +143,10 @@ TrialResult run_trial_on_device(const TrialCommand& command, const DeviceListing
   options.loop.realtime = command.realtime == "enforce" ? RealtimeMode::enforce : RealtimeMode::ignore;
   options.loop.stall_timeout_s = static_cast<double>(command.watchdog_ms) / 1000.0;
   options.should_stop = StopSignals::stop_requested();
-  // On hardware a person writes; the simulated writer only moves simulated and emulated devices.
+  // The report calls a person "human" (trial_json); the simulated writer by its profile.
+  const bool person = who_writes == kPersonWriter;
   description = TrialDescription{
-      command.characters,      options.force.guidance, device.hardware ? "human" : command.writer,
+      command.characters,      options.force.guidance, person ? "human" : command.writer_profile,
       options.simulation.seed, options.rate_hz,        device.name,
       device.info.model};
   description.guidance_mode = options.force.guidance_mode;
@@ -139,7 +155,7 @@ TrialResult run_trial_on_device(const TrialCommand& command, const DeviceListing
     description.teacher_file = command.teacher;
     description.teacher_characters = teacher->characters;
   }
-  if (!device.hardware) {
+  if (!person) {
     description.writer_profile = writer.name;
     description.writer_parameters = command.writer_parameters;
   }
@@ -203,6 +219,8 @@ int run_trial(const TrialCommand& command) {
   const std::u32string chars = characters_from(command.characters, "CHARS");
   check_scene_size(chars.size(), "CHARS");  // before any is loaded
   const DeviceListing device = find_device(command.device);
+  const std::string who_writes = writer_for_device(command.writer, device);
+  check_writer_options(command, who_writes);
   // Lock-step pacing has no wall clock, so no stall can be bounded: the option would be ignored.
   const bool real_time = command.pacing == "real-time" || (command.pacing == "auto" && device.hardware);
   if (command.watchdog_option->count() > 0 && !real_time) {
@@ -239,7 +257,8 @@ int run_trial(const TrialCommand& command) {
   }
 
   TrialDescription description;
-  TrialResult result = run_trial_on_device(command, device, scene, writer, teacher.get(), description);
+  TrialResult result =
+      run_trial_on_device(command, device, who_writes, scene, writer, teacher.get(), description);
   const int signal = StopSignals::received();
   if (result.end == TrialEnd::interrupted && result.abort_reason.empty() && signal != 0) {
     result.abort_reason = std::string("stopped by ") + signal_name(signal);
@@ -283,10 +302,15 @@ void add_trial_command(CLI::App& root, Commands& commands) {
                  "a number in [0, 1]", [](double gain) { return gain >= 0.0 && gain <= 1.0; });
   add_input_path(*app, "--teacher", command->teacher, "FILE",
                  "replay: the teacher's recording of CHARS (made with --record)", "none");
-  add_choice(*app, "--writer", command->writer, {"novice", "skilled", "foreign"},
-             "the simulated writer's profile (simulated and emulated devices; docs/writer.md)");
+  add_writer_option(*app, command->writer,
+                    "who writes: the simulated writer (on the simulated and emulated devices it moves) or a "
+                    "person (on a hardware device)",
+                    "simulated on a simulated or emulated device, person on hardware");
+  command->profile_option =
+      add_choice(*app, "--writer-profile", command->writer_profile, {"novice", "skilled", "foreign"},
+                 "the simulated writer's profile (docs/writer.md)");
   add_repeated_text(*app, "--writer-param", command->writer_parameters, "KEY=VALUE",
-                    "set a field of the writer's profile (repeatable; keys: docs/writer.md)");
+                    "set a field of the simulated writer's profile (repeatable; keys: docs/writer.md)");
   add_unsigned(*app, "--seed", command->seed, "N", "seed of the simulated writer (a 64-bit integer)");
   add_number(*app, "--rate", command->rate_hz, "HZ", "servo rate [Hz]", "a number of Hz in [100, 100000]",
              [](double hz) { return hz >= 100.0 && hz <= 100000.0; });

@@ -426,10 +426,10 @@ class Determinism(CliTestCase):
 
 
 class GuidanceModesAndWriters(CliTestCase):
-    """`trial --writer`, `--writer-param`, `--guidance-mode`, `--guidance-gain`, `--teacher`, `--record`."""
+    """`trial --writer-profile`, `--writer-param`, `--guidance-mode`, `--guidance-gain`, `--teacher`, `--record`."""
 
     def test_foreign_writer_runs_and_is_recorded(self):
-        metrics = self.trial_json("十", "--writer", "foreign", "--seed", "2")
+        metrics = self.trial_json("十", "--writer-profile", "foreign", "--seed", "2")
         self.assertEqual(metrics["writer"], "foreign")
         self.assertEqual(metrics["writer_profile"], "foreign")
         self.assertEqual(metrics["guidance_mode"], "fixed")
@@ -450,7 +450,8 @@ class GuidanceModesAndWriters(CliTestCase):
         self.assert_usage_error(["trial", "十", "--writer-param", "bias_offset_m=-1"], "bias_offset_m")
 
     def test_recorded_teacher_is_replayed_on_the_same_character(self):
-        record = self.run_cli("trial", "十", "--writer", "skilled", "--seed", "1", "--record", "teacher.json")
+        record = self.run_cli("trial", "十", "--writer-profile", "skilled", "--seed", "1", "--record",
+                              "teacher.json")
         self.assertEqual(record.returncode, 0, record.stderr.decode())
         teacher = json.loads((self.cwd / "teacher.json").read_text(encoding="utf-8"))
         self.assertEqual(teacher["format"], "calligraphy-teacher-recording")
@@ -466,7 +467,7 @@ class GuidanceModesAndWriters(CliTestCase):
 
     def test_record_refused_for_a_trial_not_completed_in_order(self):
         # A writer who gives up on the first attempt at a stroke out of order cannot teach the order.
-        result = self.run_cli("trial", "永", "--writer", "foreign", "--seed", "1", "--writer-param",
+        result = self.run_cli("trial", "永", "--writer-profile", "foreign", "--seed", "1", "--writer-param",
                               "order_error_probability=1", "--writer-param", "max_attempts_per_stroke=1",
                               "--record", "teacher.json", "--json", "t.json")
         metrics = json.loads((self.cwd / "t.json").read_text(encoding="utf-8"))
@@ -490,6 +491,7 @@ class GuidanceModesAndWriters(CliTestCase):
         self.assert_usage_error(["trial", "十", "--guidance-mode", "replay"], "--teacher")
         self.assert_usage_error(["trial", "十", "--teacher", "t.json"], "--teacher")
         self.assert_usage_error(["trial", "十", "--writer", "expert"], "--writer")
+        self.assert_usage_error(["trial", "十", "--writer-profile", "expert"], "--writer-profile")
         self.assert_usage_error(["trial", "十", "--record", "-"], "--record")
         self.assertEqual(self.files_here(), [])
 

@@ -42,7 +42,7 @@ def test_metrics_equal_the_cli(cli, tmp_path, yong_seed3):
 
 
 def test_metrics_equal_the_cli_skilled_unguided(cli, tmp_path):
-    expected = run_cli(cli, tmp_path, "九", "--seed", "11", "--writer", "skilled", "--guidance", "off")
+    expected = run_cli(cli, tmp_path, "九", "--seed", "11", "--writer-profile", "skilled", "--guidance", "off")
     result = calligraphy.simulate_trial("九", writer="skilled", guidance=False, seed=11, keep_trace=False)
     assert result.metrics == expected
     assert result.time_s.shape == (0,)

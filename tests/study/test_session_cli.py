@@ -130,7 +130,7 @@ class SessionCliTest(unittest.TestCase):
         protocol = self.write_protocol(LONG_PROTOCOL)
         for args, words in [
             (["--out", "o"], "--subject"),
-            (["--subjects", "2", "--writer", "human", "--out", "o"], "--subjects"),
+            (["--subjects", "2", "--writer", "person", "--out", "o"], "--subjects"),
             (["--subjects", "2", "--subject-number", "3", "--out", "o"], "--subject-number"),
             (["--subject", "P1", "--writer-profile", "expert", "--out", "o"], "--writer-profile"),
             (["--subject", "P1", "--device", "nothing", "--out", "o"], "--device"),

@@ -590,7 +590,7 @@ class SessionWindowTest(unittest.TestCase):
 
     def run_session(self, *extra):
         self.process = subprocess.Popen(
-            [CLI, "session", "run", "tiny.json", "--subject", "S01", "--device", "mouse-hand", "--writer", "human",
+            [CLI, "session", "run", "tiny.json", "--subject", "S01", "--device", "mouse-hand", "--writer", "person",
              "--out", "out", "--data", SAMPLE, *extra], stdout=self.stdout, stderr=self.stderr, cwd=self.folder)
 
     def errors(self):
@@ -770,7 +770,7 @@ class EndingTest(unittest.TestCase):
 
     def session_run(self, environment=None):
         # Unattended: the first trial starts a second after it is announced, and lasts up to 8 s.
-        self.start(["session", "run", "tiny.json", "--subject", "S01", "--device", "mouse", "--writer", "human",
+        self.start(["session", "run", "tiny.json", "--subject", "S01", "--device", "mouse", "--writer", "person",
                     "--out", "out", "--data", SAMPLE, "--exit-after", "60"], environment)
 
     def study_session(self):

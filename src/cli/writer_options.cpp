@@ -1,0 +1,48 @@
+#include "cli/writer_options.hpp"
+
+#include <map>
+
+#include "calligraphy/sim/hand_port.hpp"
+#include "cli/cli_devices.hpp"
+
+namespace calligraphy::cli {
+
+CLI::Option* add_writer_option(CLI::App& app, std::string& target, const std::string& description,
+                               const std::string& default_text) {
+  // --writer's values from before it meant who writes (trial: the profile; session run: human) are
+  // refused saying what to write now, so an old command line is not read as something else.
+  const std::string meaning = "--writer is who writes (person or simulated); ";
+  const std::map<std::string, std::string> retired{
+      {"novice", meaning + "the profile is --writer-profile novice"},
+      {"skilled", meaning + "the profile is --writer-profile skilled"},
+      {"foreign", meaning + "the profile is --writer-profile foreign"},
+      {"human", meaning + "a person writing is --writer person"},
+  };
+  return add_choice(app, "--writer", target, {kPersonWriter, kSimulatedWriter}, description, default_text,
+                    retired);
+}
+
+bool simulated_writer_moves(const DeviceListing& device) {
+  // A simulated hand pushes a device through its hand port (the simulated device, the emulated Phantom);
+  // a physical device has none, nor have the window's mouse devices, which a person moves.
+  if (device.hardware) return false;
+  return dynamic_cast<HandPort*>(cli_device_registry().create(device.name).get()) != nullptr;
+}
+
+std::string writer_for_device(const std::string& given, const DeviceListing& device) {
+  const bool simulated_device = simulated_writer_moves(device);
+  if (given.empty()) return simulated_device ? kSimulatedWriter : kPersonWriter;
+  if (given == kSimulatedWriter && !simulated_device) {
+    throw UsageError("--writer simulated: the device '" + device.name +
+                     "' is moved by a person (--writer person); the simulated writer moves simulated and "
+                     "emulated-phantom");
+  }
+  if (given == kPersonWriter && simulated_device) {
+    throw UsageError("--writer person: a person cannot hold the device '" + device.name +
+                     "', the simulated writer moves it (--writer simulated); a person writes on a haptic "
+                     "device of `calligraphy devices`, or with the mouse in `calligraphy train`");
+  }
+  return given;
+}
+
+}  // namespace calligraphy::cli

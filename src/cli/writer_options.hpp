@@ -1,0 +1,31 @@
+#pragma once
+// --writer and --writer-profile, one meaning on every command: --writer is who writes (person or
+// simulated), --writer-profile is how the simulated writer writes (novice, skilled, foreign). The spellings
+// the commands took before (`trial --writer novice`, `session run --writer human`) are usage errors that
+// say what to write instead, so that an old command line is not read as something else.
+#include <string>
+
+#include "calligraphy/devices/device_registry.hpp"
+#include "cli/app.hpp"
+
+namespace calligraphy::cli {
+
+/// Who writes, as --writer spells it.
+inline constexpr const char* kPersonWriter = "person";
+inline constexpr const char* kSimulatedWriter = "simulated";
+
+/// --writer person|simulated into `target` (left as it is when not given: "" lets the device decide, see
+/// `writer_for_device`); `default_text` is the default --help shows. The values --writer took before
+/// (novice, skilled, foreign, human) are usage errors saying what to write instead.
+CLI::Option* add_writer_option(CLI::App& app, std::string& target, const std::string& description,
+                               const std::string& default_text);
+
+/// Whether the simulated writer can move `device` (it has a hand port); else a person moves it.
+bool simulated_writer_moves(const DeviceListing& device);
+
+/// Who writes on `device`: `given` ("person", "simulated", or "" for the device's own: the simulated
+/// writer on a device it moves, a person on any other). Throws UsageError naming --writer when that writer
+/// cannot move the device.
+std::string writer_for_device(const std::string& given, const DeviceListing& device);
+
+}  // namespace calligraphy::cli
