@@ -9,6 +9,7 @@ import json
 import os
 import re
 import resource
+import shutil
 import signal
 import stat
 import subprocess
@@ -494,6 +495,141 @@ class GuidanceModesAndWriters(CliTestCase):
         self.assert_usage_error(["trial", "十", "--writer-profile", "expert"], "--writer-profile")
         self.assert_usage_error(["trial", "十", "--record", "-"], "--record")
         self.assertEqual(self.files_here(), [])
+
+
+# A study protocol of one guided trial of 永, for the session commands' default runs.
+ONE_TRIAL_PROTOCOL = {
+    "format": "calligraphy-study-protocol", "version": 1, "name": "one",
+    "description": "one guided trial of one character",
+    "conditions": [{"name": "haptic", "mode": "haptic"}],
+    "test": {"characters": ["永"], "conditions": ["haptic"], "repetitions": 1},
+    "trial": {"max_duration_s": 60, "rate_hz": 1000},
+}
+
+
+class OneCommandLine(CliTestCase):
+    """One meaning per option name, "did you mean" for a typo, DIR and FILE in --help, quiet defaults."""
+
+    def write_protocol(self):
+        (self.cwd / "p.json").write_text(json.dumps(ONE_TRIAL_PROTOCOL, ensure_ascii=False), encoding="utf-8")
+        return "p.json"
+
+    def last_error_line(self, args):
+        """Exit status 2 (usage) and the `calligraphy ...: error:` line, the last on stderr."""
+        result = self.run_cli(*args)
+        self.assertEqual(result.returncode, 2, f"{args}: {result.stderr.decode()}")
+        line = result.stderr.decode().splitlines()[-1]
+        self.assertIn(": error: ", line, args)
+        return line
+
+    def test_writer_is_who_writes_and_the_old_spellings_say_what_to_write(self):
+        for profile in ("novice", "skilled", "foreign"):
+            message = self.assert_usage_error(["trial", "十", "--writer", profile], "--writer")
+            self.assertIn("who writes (person or simulated)", message)
+            self.assertIn(f"the profile is --writer-profile {profile}", message)
+        message = self.assert_usage_error(["session", "run", "p.json", "--writer", "human", "--out", "o"],
+                                          "--writer")
+        self.assertIn("--writer person", message)
+        for command in (["trial"], ["train"], ["session", "run"]):
+            self.assertIn("--writer person|simulated", self.run_cli(*command, "--help").stdout.decode(), command)
+        # The new spellings: the simulated writer with a profile; a person cannot hold the simulated device.
+        metrics = self.trial_json("十", "--writer", "simulated", "--writer-profile", "skilled", "--seed", "1")
+        self.assertEqual((metrics["writer"], metrics["writer_profile"]), ("skilled", "skilled"))
+        self.assertEqual(metrics, self.trial_json("十", "--writer-profile", "skilled", "--seed", "1"))
+        for device in ("simulated", "emulated-phantom"):
+            message = self.assert_usage_error(["trial", "十", "--device", device, "--writer", "person"], "--writer")
+            self.assertIn(f"a person cannot hold the device '{device}'", message)
+        protocol = self.write_protocol()
+        message = self.assert_usage_error(["session", "run", protocol, "--subject", "S1", "--writer", "person",
+                                           "--out", "o"], "--writer person")
+        self.assertIn("'simulated'", message)
+        self.assertFalse((self.cwd / "o").exists())
+        result = self.run_cli("session", "run", protocol, "--writer", "simulated", "--subjects", "1", "--out", "o")
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
+        (session,) = (self.cwd / "o" / "S01").iterdir()
+        self.assertEqual(json.loads((session / "session.json").read_text())["writer"], "simulated")
+
+    def test_a_mistyped_command_is_named_with_the_command_meant(self):
+        line = self.last_error_line(["trail", "永"])
+        self.assertIn("unknown command 'trail'", line)
+        self.assertRegex(line, r"did you mean 'trial'")
+        self.assertIn("did you mean 'build'?", self.last_error_line(["corpus", "biuld"]))
+        self.assertIn("did you mean 'trial'?", self.last_error_line(["tri", "永"]))  # the one name it begins
+        self.assertIn("did you mean 'tick'?", self.last_error_line(["bench", "tik"]))
+        far = self.last_error_line(["xyzzy"])  # nothing close: nothing suggested
+        self.assertIn("unknown command 'xyzzy'", far)
+        self.assertNotIn("did you mean", far)
+
+    def test_a_mistyped_option_is_named_with_the_option_meant(self):
+        for args in (["trial", "永", "--guidence", "on"], ["trial", "永", "--guidence=on"]):
+            line = self.assert_usage_error(args, "--guidence")
+            self.assertIn("unknown option '--guidence'; did you mean '--guidance'?", line)
+        # The typo, not the option it left missing, is the error.
+        line = self.assert_usage_error(["score", "t.csv", "--charcter", "永"], "--charcter")
+        self.assertIn("did you mean '--character'?", line)
+        self.assertIn("did you mean '--json'?", self.assert_usage_error(["model", "永", "--jsn"], "--jsn"))
+        self.assertIn("did you mean '--version'?", self.last_error_line(["--verison"]))
+        far = self.assert_usage_error(["trial", "永", "--zzzzzz"], "--zzzzzz")
+        self.assertNotIn("did you mean", far)
+
+    def test_help_says_dir_for_a_folder_and_file_for_a_file(self):
+        expected = {
+            ("train",): {"--session": "DIR", "--quiz-screenshots": "DIR", "--data": "DIR", "--store": "FILE",
+                         "--teacher": "FILE", "--record": "FILE", "--screenshot": "FILE"},
+            ("trial",): {"--data": "DIR", "--store": "FILE", "--teacher": "FILE", "--record": "FILE",
+                         "--json": "FILE|-", "--csv": "FILE|-", "--svg": "FILE|-"},
+            ("session", "run"): {"PROTOCOL": "FILE", "--out": "DIR", "--screenshot": "FILE"},
+            ("session", "resume"): {"DIR": "DIR", "--screenshot": "FILE"},
+            ("report",): {"DIR": "DIR", "--out": "FILE|-"},
+            ("score",): {"TRACE": "FILE", "--json": "FILE|-"},
+            ("corpus", "stats"): {"FILE": "FILE"},
+            ("corpus", "build"): {"--out": "FILE", "--data": "DIR"},
+            ("corpus", "validate"): {"--cnchar": "FILE", "--data": "DIR", "--features": "FILE"},
+        }
+        for command, values in expected.items():
+            text = self.run_cli(*command, "--help").stdout.decode()
+            for name, value in values.items():
+                self.assertRegex(text, rf"(?m)^  {re.escape(name)} {re.escape(value)}( |$)", f"{command} {name}")
+
+    def warnings(self, *args, program=(CLI,)):
+        """The lines of stderr that warn, of a run that must succeed."""
+        result = subprocess.run([*program, *args], cwd=self.cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                timeout=300)
+        self.assertEqual(result.returncode, 0, f"{args}: {result.stderr.decode()}")
+        return [line for line in result.stderr.decode().splitlines() if "warn" in line.lower()]
+
+    def test_default_runs_print_no_warning(self):
+        protocol = self.write_protocol()
+        runs = [
+            ["trial", "永", "--csv", "t.csv"], ["score", "t.csv", "--character", "永"], ["model", "永"],
+            ["strokes"], ["devices"], ["bench", "tick", "--chars", "永", "--passes", "1"],
+            ["bench", "loop", "--seconds", "0.2"], ["bench", "nearest", "--queries", "10"],
+            ["session", "run", protocol, "--subject", "S01", "--out", "study"], ["report", "study", "--out", "r.html"],
+        ]
+        for args in runs:
+            self.assertEqual(self.warnings(*args), [], args)
+
+    def test_the_emulated_phantom_runs_within_its_stiffness(self):
+        # The force law's default paper stiffness (800 N/m) is above the Phantom Omni's stable 700 N/m: the
+        # commands cap it at the device's limit instead of warning about their own default.
+        protocol = self.write_protocol()
+        for args in (["trial", "永", "--device", "emulated-phantom"],
+                     ["session", "run", protocol, "--device", "emulated-phantom", "--subject", "S01", "--out", "o"]):
+            # The Phantom driver states at every open() what was never checked on hardware (devices module).
+            found = [line for line in self.warnings(*args) if "Phantom: NOT verified" not in line]
+            self.assertEqual(found, [], args)
+        (session,) = (self.cwd / "o" / "S01").iterdir()
+        (record,) = (session / "trials").glob("*.json")
+        force_law = json.loads(record.read_text(encoding="utf-8"))["force_law"]
+        self.assertEqual(force_law["paper_stiffness_n_per_m"], 700.0)
+
+    def test_train_default_run_prints_no_warning(self):
+        if not shutil.which("xvfb-run"):
+            self.skipTest("xvfb-run is not installed")
+        probe = self.run_cli("train", "永", "--window", "10x10")
+        if probe.returncode == 1 and b"without the trainer" in probe.stderr:
+            self.skipTest("built without the trainer window")
+        self.assertEqual(self.warnings("train", "永", "--exit-after", "1", program=("xvfb-run", "-a", CLI)), [])
 
 
 if __name__ == "__main__":
