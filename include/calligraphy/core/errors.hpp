@@ -2,7 +2,9 @@
 /// \file errors.hpp
 /// The library's exception hierarchy. Every error message names the thing at fault
 /// (file, character, stroke, position). Bad input throws `DataError` or `InvalidArgument`;
-/// device faults throw `DeviceError` subclasses. Nothing in the servo path throws past the loop.
+/// device faults off the servo path throw `DeviceError` subclasses. On the servo path nothing throws: a
+/// device returns a `DeviceFault` code (device_fault.hpp), and `throw_device_fault` is the one mapping
+/// from such a code to `CommunicationError` or `SafetyFault`, used off the servo path.
 
 #include <stdexcept>
 #include <string>
