@@ -48,20 +48,35 @@ class VoiceCoilPuck final : public calligraphy::HapticDevice, public calligraphy
     if (!enabled) force_ = Vec3::Zero();
   }
   bool forces_enabled() const override { return forces_enabled_; }
-  // Servo path: no allocation, no lock, no logging. A lost link would throw CommunicationError.
-  calligraphy::DeviceState read_state() override {
-    calligraphy::DeviceState state;
+  // Servo path: noexcept, and no allocation, lock, logging or string, also when it fails. A fault is a
+  // code (calligraphy/core/device_fault.hpp): the servo loop stops on it with zero force, and off the
+  // servo path calligraphy::throw_device_fault turns it into CommunicationError or SafetyFault. A real
+  // device would return DeviceFault::link_lost for a lost link; its detail (an error number, a packet)
+  // goes into a counter or a plain record that is formatted later, away from the servo thread.
+  calligraphy::DeviceFault read_state(calligraphy::DeviceState& state) noexcept override {
+    if (!open_) return calligraphy::DeviceFault::not_open;
     state.position_m = (position_ / kEncoderStep).array().round().matrix() * kEncoderStep;
     state.velocity_m_s = velocity_;
+    state.buttons = 0;
     state.time_s = time_;
-    return state;
+    return calligraphy::DeviceFault::none;
   }
-  void write_force(const Vec3& force_n) override {
-    if (!force_n.allFinite()) throw calligraphy::SafetyFault("puck: non-finite force command");
+  calligraphy::DeviceFault write_force(const Vec3& force_n) noexcept override {
+    if (!open_) return calligraphy::DeviceFault::not_open;
+    if (!force_n.allFinite()) {  // zero force, forces off, and say why
+      force_ = Vec3::Zero();
+      forces_enabled_ = false;
+      ++non_finite_commands_;
+      return calligraphy::DeviceFault::non_finite_force;
+    }
     const double norm = force_n.norm();
     const Vec3 limited = norm > info_.max_force_n ? force_n * (info_.max_force_n / norm) : force_n;
     force_ = forces_enabled_ ? limited : Vec3::Zero();
+    return calligraphy::DeviceFault::none;
   }
+
+  /// Non-finite force commands refused so far: a detail kept as a counter on the servo path.
+  long non_finite_commands() const noexcept { return non_finite_commands_; }
 
   // --- HandPort: only because this device is simulated ---
   void attach_hand(calligraphy::HandModel* hand) noexcept override { hand_ = hand; }
@@ -88,6 +103,7 @@ class VoiceCoilPuck final : public calligraphy::HapticDevice, public calligraphy
   double time_ = 0.0;
   bool open_ = false;
   bool forces_enabled_ = false;
+  long non_finite_commands_ = 0;  // a counter, not a message: read and reported off the servo path
 };
 
 }  // namespace
@@ -104,6 +120,12 @@ int main() {
   options.simulation.seed = 1;
   const TrialResult result = run_trial("voice-coil-puck", scene, options);
 
+  // A device fault mid-trial ends it with the code and its message (device_fault_message); off the servo
+  // path, throw_device_fault would make it the typed exception.
+  if (result.device_fault != DeviceFault::none) {
+    std::fprintf(stderr, "device fault %s: %s\n", device_fault_name(result.device_fault),
+                 result.abort_reason.c_str());
+  }
   const TrialMetrics& m = result.metrics;
   std::printf(
       "口 on the voice-coil puck: %zu/%zu strokes in %.1f s, mean deviation %.2f mm, max |F| %.2f N%s\n",

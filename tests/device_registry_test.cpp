@@ -30,8 +30,13 @@ class FixedDevice final : public HapticDevice {
   bool is_open() const override { return open_; }
   void enable_forces(bool enabled) override { enabled_ = enabled; }
   bool forces_enabled() const override { return enabled_; }
-  calligraphy::DeviceState read_state() override { return {}; }
-  void write_force(const Vec3&) override {}
+  calligraphy::DeviceFault read_state(calligraphy::DeviceState& state) noexcept override {
+    state = {};
+    return calligraphy::DeviceFault::none;
+  }
+  calligraphy::DeviceFault write_force(const Vec3&) noexcept override {
+    return calligraphy::DeviceFault::none;
+  }
 
  private:
   DeviceInfo info_;
@@ -153,12 +158,14 @@ TEST_CASE("The process registry offers the emulated Phantom and runs a servo loo
   REQUIRE(device->is_calibrated());  // powered on in the inkwell
   device->enable_forces(true);
   // 200 ticks of a spring towards a point 2 cm above the start, as a trial would do.
-  const Vec3 start = device->read_state().position_m;
-  const Vec3 target = start + Vec3(0, 0, 0.02);
   calligraphy::DeviceState state;
+  REQUIRE(device->read_state(state) == calligraphy::DeviceFault::none);
+  const Vec3 start = state.position_m;
+  const Vec3 target = start + Vec3(0, 0, 0.02);
   for (int tick = 0; tick < 200; ++tick) {
-    state = device->read_state();
-    device->write_force(200.0 * (target - state.position_m) - 2.0 * state.velocity_m_s);
+    REQUIRE(device->read_state(state) == calligraphy::DeviceFault::none);
+    REQUIRE(device->write_force(200.0 * (target - state.position_m) - 2.0 * state.velocity_m_s) ==
+            calligraphy::DeviceFault::none);
   }
   CHECK(state.position_m.z() > start.z() + 0.005);  // left the inkwell after 50 ms and rose
   CHECK(state.time_s == Approx(0.202).margin(0.0015));

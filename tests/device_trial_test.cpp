@@ -44,11 +44,11 @@ class UnpluggedPhantom final : public HapticDevice, public HandPort {
   bool is_calibrated() const override { return inner_.is_calibrated(); }
   void enable_forces(bool enabled) override { inner_.enable_forces(enabled); }
   bool forces_enabled() const override { return inner_.forces_enabled(); }
-  DeviceState read_state() override {
+  DeviceFault read_state(DeviceState& state) noexcept override {
     if (++reads_ == unplug_at_) inner_.emulator().disconnect();
-    return inner_.read_state();
+    return inner_.read_state(state);
   }
-  void write_force(const Vec3& force_n) override { inner_.write_force(force_n); }
+  DeviceFault write_force(const Vec3& force_n) noexcept override { return inner_.write_force(force_n); }
   void attach_hand(HandModel* hand) noexcept override { inner_.attach_hand(hand); }
   void advance(double dt_s) noexcept override { inner_.advance(dt_s); }
   EmulatedPhantomDevice& inner() { return inner_; }
@@ -75,16 +75,19 @@ class FaultingDevice final : public HapticDevice {
   bool is_open() const override { return open_; }
   void enable_forces(bool enabled) override { forces_ = enabled; }
   bool forces_enabled() const override { return forces_; }
-  DeviceState read_state() override {
-    if (++reads == fault_at_) throw SafetyFault("test: force limit tripped");
-    DeviceState state;
+  DeviceFault read_state(DeviceState& state) noexcept override {
+    if (++reads == fault_at_) {
+      forces_ = false;  // a device turns its forces off on a fault
+      return DeviceFault::safety_limit;
+    }
     state.position_m = Vec3(0.0, -0.05, 0.02);
     state.time_s = 0.001 * reads;
-    return state;
+    return DeviceFault::none;
   }
-  void write_force(const Vec3& force_n) override {
+  DeviceFault write_force(const Vec3& force_n) noexcept override {
     ++writes;
     last_force = force_n;
+    return DeviceFault::none;
   }
   int reads = 0;
   int writes = 0;
@@ -184,6 +187,9 @@ TEST_CASE("A disconnect mid-trial aborts it with forces zeroed and the recording
   const TrialResult result = run_trial(device, scene, TrialOptions{});
   REQUIRE(result.aborted);
   INFO(result.abort_reason);
+  CHECK(result.end == TrialEnd::device_fault);
+  CHECK(result.device_fault == DeviceFault::link_lost);
+  CHECK(result.abort_reason == device_fault_message(DeviceFault::link_lost, device.info().model));
   CHECK(result.abort_reason.find("unplugged") != std::string::npos);
   // Every tick before the failed read is kept and readable.
   REQUIRE(result.trace.size() == kUnplugAt - 1);
@@ -211,6 +217,7 @@ TEST_CASE("The reports of an aborted trial say so and keep what was recorded", "
   TrialOptions options;
   const TrialResult result = run_trial(device, scene, options);
   REQUIRE(result.aborted);
+  CHECK(result.device_fault == DeviceFault::link_lost);
   const TrialDescription description{
       "口", true, "novice", 0, 1000.0, "emulated-phantom", device.info().model};
   const std::string json = trial_json(description, result);
@@ -232,7 +239,9 @@ TEST_CASE("A safety fault aborts a trial on the servo loop, ticks are paced by a
   const TrialResult result = run_trial(device, scene, options);
   const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   REQUIRE(result.aborted);
-  CHECK(result.abort_reason == "test: force limit tripped");
+  CHECK(result.end == TrialEnd::device_fault);
+  CHECK(result.device_fault == DeviceFault::safety_limit);
+  CHECK(result.abort_reason == to_string(DeviceFault::safety_limit));  // the device has no model name
   CHECK(result.trace.size() == 39);
   // No hand port: the trial runs on the ServoLoop, which writes the 39 ticks' forces, then zero force
   // when the fault stops it.

@@ -136,8 +136,10 @@ HoldRun hold_in_writing(GuidanceMode mode, Hand hand, double rate_hz, double sti
   const auto ticks = static_cast<long>(std::lround(seconds * rate_hz));
   const double window = seconds / 6.0;
   for (long k = 0; k < ticks; ++k) {
-    const RenderOutput out = renderer.tick(device.read_state());
-    device.write_force(out.force_n);
+    DeviceState state;
+    if (device.read_state(state) != DeviceFault::none) FAIL("the simulated device faulted");
+    const RenderOutput out = renderer.tick(state);
+    if (device.write_force(out.force_n) != DeviceFault::none) FAIL("the simulated device faulted");
     const Vec3 before = device.true_position();
     const Vec3 applied = device.applied_force();
     device.advance(dt);

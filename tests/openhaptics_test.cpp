@@ -57,8 +57,17 @@ TEST_CASE("HD error codes map onto the exception hierarchy", "[openhaptics]") {
                              HD_EXCEEDED_MAX_VELOCITY, HD_FORCE_ERROR}) {
     CHECK(classify_hd_error(code) == HdErrorKind::safety);
     CHECK_THROWS_AS(throw_hd_error({code, 0, 0}, "test"), calligraphy::SafetyFault);
-    CHECK_THROWS_AS(throw_hd_servo_error(code), calligraphy::SafetyFault);
+    // The servo path gets a code; off it, the one mapping gives the same exception type.
+    CHECK(hd_servo_fault(code) == calligraphy::DeviceFault::safety_limit);
+    CHECK_THROWS_AS(calligraphy::throw_device_fault(hd_servo_fault(code), "test"), calligraphy::SafetyFault);
   }
+  for (const HDerror code :
+       {HD_COMM_ERROR, HD_TIMER_ERROR, HD_DEVICE_FAULT, HD_ILLEGAL_END, HDerror{0x7777}}) {
+    CHECK(hd_servo_fault(code) == calligraphy::DeviceFault::driver_error);
+    CHECK_THROWS_AS(calligraphy::throw_device_fault(hd_servo_fault(code), "test"),
+                    calligraphy::CommunicationError);
+  }
+  CHECK(hd_servo_fault(HD_SUCCESS) == calligraphy::DeviceFault::none);
   CHECK(classify_hd_error(HD_ILLEGAL_END) == HdErrorKind::usage);
   CHECK(classify_hd_error(HD_INVALID_LICENSE) == HdErrorKind::setup);
   CHECK(classify_hd_error(0x7777) == HdErrorKind::setup);
@@ -70,9 +79,9 @@ TEST_CASE("HD error codes map onto the exception hierarchy", "[openhaptics]") {
                                                                           Catch::Contains("HD_COMM_ERROR") &&
                                                                           Catch::Contains("internal 5"));
   CHECK_THROWS_AS(throw_hd_error({HD_INVALID_LICENSE, 0, 0}, "init"), calligraphy::DeviceError);
-  // The servo path never throws anything but CommunicationError or SafetyFault.
-  CHECK_THROWS_AS(throw_hd_servo_error(HD_ILLEGAL_BEGIN), calligraphy::CommunicationError);
-  CHECK_THROWS_AS(throw_hd_servo_error(HD_INVALID_LICENSE), calligraphy::CommunicationError);
+  // The servo path gets only driver_error or safety_limit: CommunicationError or SafetyFault off it.
+  CHECK(hd_servo_fault(HD_ILLEGAL_BEGIN) == calligraphy::DeviceFault::driver_error);
+  CHECK(hd_servo_fault(HD_INVALID_LICENSE) == calligraphy::DeviceFault::driver_error);
 }
 
 TEST_CASE("HD millimetres and axes convert to device metres, forces map back power-consistently",
@@ -109,7 +118,9 @@ TEST_CASE("Without libHD: DeviceNotFound 'OpenHaptics not found' listing the pat
     OpenHapticsDevice device;
     CHECK_THROWS_AS(device.open(), calligraphy::DeviceNotFound);
     CHECK_FALSE(device.is_open());
-    CHECK_THROWS_AS(device.read_state(), calligraphy::CommunicationError);
+    calligraphy::DeviceState state;
+    CHECK(device.read_state(state) == calligraphy::DeviceFault::not_open);
+    CHECK(device.write_force(Vec3::Zero()) == calligraphy::DeviceFault::not_open);
   }
   {
     // A library that loads but is not libHD is rejected by its missing symbols, not crashed on.

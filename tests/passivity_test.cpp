@@ -71,8 +71,10 @@ ContactRun run_contact(Hand hand, double rate_hz, double stiffness_n_per_m, bool
   const double dt = 1.0 / rate_hz;
   const auto ticks = static_cast<long>(std::lround(seconds * rate_hz));
   for (long k = 0; k < ticks; ++k) {
-    const RenderOutput out = renderer.tick(device.read_state());
-    device.write_force(out.force_n);
+    DeviceState state;
+    if (device.read_state(state) != DeviceFault::none) FAIL("the simulated device faulted");
+    const RenderOutput out = renderer.tick(state);
+    if (device.write_force(out.force_n) != DeviceFault::none) FAIL("the simulated device faulted");
     const Vec3 before = device.true_position();
     const Vec3 applied = device.applied_force();  // held over the tick (zero-order hold)
     device.advance(dt);

@@ -1,12 +1,12 @@
 #pragma once
 // A simulated device that the servo-loop and trial tests watch and disturb: it counts reads, force writes
-// and writes of a marker force, can throw CommunicationError on one read, and can sleep in one hand-port
-// step (a stall on the loop thread). Its hand port lets a real-time trial step the physics after each write.
+// and writes of a marker force, can fail one read with a fault code (link_lost by default), and can sleep
+// in one hand-port step (a stall on the loop thread). Its hand port lets a real-time trial step the
+// physics after each write.
 #include <chrono>
-#include <string>
 #include <thread>
 
-#include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/device_fault.hpp"
 #include "calligraphy/devices/haptic_device.hpp"
 #include "calligraphy/sim/hand_port.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
@@ -17,8 +17,11 @@ class ProbeDevice final : public HapticDevice, public HandPort {
  public:
   static constexpr double kMarker = 1.25;  ///< x of the marker force [N]
 
-  /// Opened. `fail_on_read`: the 0-based read that throws CommunicationError; -1: none.
-  explicit ProbeDevice(long fail_on_read = -1) : fail_on_read_(fail_on_read) { inner_.open(); }
+  /// Opened. `fail_on_read`: the 0-based read that returns `fault`; -1: none.
+  explicit ProbeDevice(long fail_on_read = -1, DeviceFault fault = DeviceFault::link_lost)
+      : fail_on_read_(fail_on_read), fault_(fault) {
+    inner_.open();
+  }
 
   const DeviceInfo& info() const override { return inner_.info(); }
   void open() override { inner_.open(); }
@@ -26,17 +29,18 @@ class ProbeDevice final : public HapticDevice, public HandPort {
   bool is_open() const override { return inner_.is_open(); }
   void enable_forces(bool enabled) override { inner_.enable_forces(enabled); }
   bool forces_enabled() const override { return inner_.forces_enabled(); }
-  DeviceState read_state() override {
-    if (reads_++ == fail_on_read_)
-      throw CommunicationError("probe device: USB transfer timed out on read " +
-                               std::to_string(fail_on_read_));
-    return inner_.read_state();
+  DeviceFault read_state(DeviceState& state) noexcept override {
+    if (reads_++ == fail_on_read_) {
+      inner_.enable_forces(false);  // what a device does on a fault: forces off
+      return fault_;
+    }
+    return inner_.read_state(state);
   }
-  void write_force(const Vec3& force_n) override {
+  DeviceFault write_force(const Vec3& force_n) noexcept override {
     ++writes_;
     if (force_n.x() == kMarker) ++marker_writes_;
     last_force_ = force_n;
-    inner_.write_force(force_n);
+    return inner_.write_force(force_n);
   }
   void attach_hand(HandModel* hand) noexcept override { inner_.attach_hand(hand); }
   void advance(double dt_s) override {
@@ -60,6 +64,7 @@ class ProbeDevice final : public HapticDevice, public HandPort {
 
  private:
   long fail_on_read_;
+  DeviceFault fault_;
   long stall_after_advances_ = -1;
   int stall_ms_ = 0;
 };

@@ -44,7 +44,7 @@ class CountingHand final : public HandModel {
 TEST_CASE("advance(100 s) under 1 N gives the damped mass's analytic displacement", "[simulated_device]") {
   const SimulatedDeviceParameters p = free_parameters(0.2, 0.5);  // the defaults: tau = 0.4 s
   SimulatedDevice d(p);
-  d.write_force(Vec3(1.0, 0.0, 0.0));
+  CHECK(d.write_force(Vec3(1.0, 0.0, 0.0)) == DeviceFault::none);
   d.advance(100.0);
   const double expected =
       damped_displacement_m(1.0, p.moving_mass_kg, p.damping_n_s_per_m, 100.0);  // 199.2 m
@@ -54,7 +54,8 @@ TEST_CASE("advance(100 s) under 1 N gives the damped mass's analytic displacemen
         Approx(1.0 / p.damping_n_s_per_m).epsilon(1e-12));  // terminal velocity F / b
   CHECK(d.true_position().y() == 0.0);
   CHECK(d.time() == Approx(100.0).epsilon(1e-12));
-  const DeviceState state = d.read_state();
+  DeviceState state;
+  CHECK(d.read_state(state) == DeviceFault::none);
   CHECK(state.position_m.allFinite());
   CHECK(state.velocity_m_s.allFinite());
 }
@@ -62,7 +63,7 @@ TEST_CASE("advance(100 s) under 1 N gives the damped mass's analytic displacemen
 TEST_CASE("Without damping a long step follows x = F t^2 / (2 m)", "[simulated_device]") {
   const SimulatedDeviceParameters p = free_parameters(0.2, 0.0);
   SimulatedDevice d(p);
-  d.write_force(Vec3(0.0, 0.0, -1.0));
+  CHECK(d.write_force(Vec3(0.0, 0.0, -1.0)) == DeviceFault::none);
   d.advance(100.0);
   CHECK(d.true_position().z() == Approx(-1.0 * 100.0 * 100.0 / (2.0 * p.moving_mass_kg)).epsilon(1e-6));
   CHECK(d.true_velocity().z() == Approx(-1.0 * 100.0 / p.moving_mass_kg).epsilon(1e-12));
@@ -71,7 +72,7 @@ TEST_CASE("Without damping a long step follows x = F t^2 / (2 m)", "[simulated_d
 TEST_CASE("A heavily damped light device stays finite and reaches F / b", "[simulated_device]") {
   const SimulatedDeviceParameters p = free_parameters(1e-3, 1e3);  // tau = 1 us, a thousandth of a servo tick
   SimulatedDevice d(p);
-  d.write_force(Vec3(1.0, 0.0, 0.0));
+  CHECK(d.write_force(Vec3(1.0, 0.0, 0.0)) == DeviceFault::none);
   for (int i = 0; i < 1000; ++i) d.advance(1e-3);
   CHECK(d.true_position().allFinite());
   CHECK(d.true_velocity().x() == Approx(1.0 / p.damping_n_s_per_m).epsilon(1e-9));
@@ -92,7 +93,7 @@ TEST_CASE("A light device held by a stiff hand settles where the hand and the fo
   const Vec3 target(0.01, 0.0, 0.0);
   testing::ImpedanceHand hand = testing::stiff_hand(target);  // 600 N/m, 8 N s/m
   d.attach_hand(&hand);
-  d.write_force(Vec3(-1.2, 0.0, 0.0));
+  CHECK(d.write_force(Vec3(-1.2, 0.0, 0.0)) == DeviceFault::none);
   // Overdamped: settles with the time constant (b + b_hand) / k = 0.18 s; 4 s is 22 of them.
   for (int i = 0; i < 4000; ++i) d.advance(1e-3);
   // k (x_target - x) + F = 0: x = x_target + F / k = 10 mm - 2 mm.
@@ -136,7 +137,7 @@ TEST_CASE("The substep is no longer than 1 / physics_rate_hz nor m / b, and the 
 TEST_CASE("advance refuses a negative or non-finite step and leaves the device as it was",
           "[simulated_device]") {
   SimulatedDevice d;
-  d.write_force(Vec3(1.0, 0.0, 0.0));
+  CHECK(d.write_force(Vec3(1.0, 0.0, 0.0)) == DeviceFault::none);
   d.advance(1e-3);
   const Vec3 position = d.true_position();
   const double time_s = d.time();

@@ -36,9 +36,10 @@ TEST_CASE("A session stepped from the application's own loop records the runner'
   TrialSession session(scene, device.info(), options);
   session.reserve_trace();
   while (true) {
-    const DeviceState state = device.read_state();
+    DeviceState state;
+    REQUIRE(device.read_state(state) == DeviceFault::none);
     const ServoCommand command = session.step(state);
-    device.write_force(command.force_n);
+    REQUIRE(device.write_force(command.force_n) == DeviceFault::none);
     if (command.stop) break;
     writer.observe(session.last_output(), state);
     if (writer.done()) break;

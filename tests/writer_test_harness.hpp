@@ -48,9 +48,10 @@ inline WriterTrial run_writer_trial(const Scene& scene, const WriterTrialOptions
   const auto ticks = static_cast<long>(std::ceil(options.max_duration_s * options.rate_hz));
   double end_time = 0.0;
   for (long k = 0; k < ticks; ++k) {
-    const DeviceState state = device.read_state();
+    DeviceState state;
+    if (device.read_state(state) != DeviceFault::none) break;  // the simulated device never faults
     const RenderOutput out = renderer.tick(state);
-    device.write_force(out.force_n);
+    if (device.write_force(out.force_n) != DeviceFault::none) break;
     recorder.record(state, out);
     end_time = state.time_s;
     if (out.finished) break;

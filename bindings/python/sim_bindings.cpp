@@ -182,13 +182,28 @@ void bind_simulated_device(py::module_& m) {
            }),
            py::arg("parameters") = py::none(),
            "Opened on creation. Raises InvalidArgument (a ValueError) for parameters out of range.")
-      .def("read_state", &SimulatedDevice::read_state,
-           "The DeviceState: position quantised to the encoder [m], low-passed velocity [m/s], time [s].")
+      // The C++ calls return a DeviceFault code (the servo path never throws); Python raises the typed
+      // exception of a fault through the library's one mapping, throw_device_fault.
+      .def(
+          "read_state",
+          [](SimulatedDevice& d) {
+            DeviceState state;
+            if (const DeviceFault fault = d.read_state(state); fault != DeviceFault::none)
+              throw_device_fault(fault, d.info().model);
+            return state;
+          },
+          "The DeviceState: position quantised to the encoder [m], low-passed velocity [m/s], time [s]. "
+          "A device fault raises CommunicationError or SafetyFault (the simulated device has none).")
       .def(
           "write_force",
-          [](SimulatedDevice& d, const ArrayLike& force) { d.write_force(as_vec3(force.object, "force_n")); },
+          [](SimulatedDevice& d, const ArrayLike& force) {
+            if (const DeviceFault fault = d.write_force(as_vec3(force.object, "force_n"));
+                fault != DeviceFault::none)
+              throw_device_fault(fault, d.info().model);
+          },
           py::arg("force_n"),
-          "Commands a force (3,) [N], held until the next command, saturated at info.max_force_n.")
+          "Commands a force (3,) [N], held until the next command, saturated at info.max_force_n. A device "
+          "fault raises CommunicationError or SafetyFault (the simulated device has none).")
       .def(
           "advance", [](SimulatedDevice& d, const Checked<double>& dt) { d.advance(take(dt, "dt_s")); },
           py::arg("dt_s"),

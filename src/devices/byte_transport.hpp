@@ -9,6 +9,8 @@
 #include <span>
 #include <string>
 
+#include "calligraphy/core/device_fault.hpp"
+
 namespace calligraphy::devices {
 
 /// Abstract, message-oriented byte transport. Not thread-safe: one thread (the servo thread) uses it
@@ -27,15 +29,19 @@ class ByteTransport {
   virtual void close() noexcept = 0;
   [[nodiscard]] virtual bool is_open() const noexcept = 0;
 
-  /// Sends one packet. Servo path. Throws CommunicationError when the device is gone (unplugged),
-  /// the transport is closed, or the packet is not accepted within `timeout`.
-  virtual void write(std::span<const std::uint8_t> packet, std::chrono::microseconds timeout) = 0;
+  /// Sends one packet. Servo path: never throws, allocates or builds a string. Returns
+  /// `DeviceFault::none`; `not_open` when the transport is closed; `link_lost` when the device is gone
+  /// (unplugged), or the packet is refused or not accepted within `timeout`.
+  [[nodiscard]] virtual DeviceFault write(std::span<const std::uint8_t> packet,
+                                          std::chrono::microseconds timeout) noexcept = 0;
 
-  /// Receives one packet into `buffer` and returns its length in bytes; 0 when nothing arrived within
-  /// `timeout`. A packet longer than `buffer` is cut to `buffer.size()`, so pass a buffer longer than
-  /// the expected packet to detect over-long packets. Servo path. Throws CommunicationError when the
-  /// device is gone (unplugged) or the transport is closed.
-  virtual std::size_t read(std::span<std::uint8_t> buffer, std::chrono::microseconds timeout) = 0;
+  /// Receives one packet into `buffer` and sets `received` to its length in bytes; 0 when nothing
+  /// arrived within `timeout` (not a fault). A packet longer than `buffer` is cut to `buffer.size()`, so
+  /// pass a buffer longer than the expected packet to detect over-long packets. Servo path: never
+  /// throws, allocates or builds a string. Returns `DeviceFault::none`; `not_open` when the transport is
+  /// closed; `link_lost` when the device is gone (unplugged) or the transfer failed (`received` is 0).
+  [[nodiscard]] virtual DeviceFault read(std::span<std::uint8_t> buffer, std::chrono::microseconds timeout,
+                                         std::size_t& received) noexcept = 0;
 
   /// Human-readable description for logs, e.g. "hidraw /dev/hidraw3 (2988:0301)". Not servo path.
   [[nodiscard]] virtual std::string description() const = 0;

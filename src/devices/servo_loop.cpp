@@ -101,10 +101,6 @@ const char* to_string(LoopFaultKind kind) noexcept {
       return "none";
     case LoopFaultKind::watchdog:
       return "watchdog";
-    case LoopFaultKind::communication:
-      return "communication";
-    case LoopFaultKind::safety:
-      return "safety";
     case LoopFaultKind::device:
       return "device";
     case LoopFaultKind::callback:
@@ -145,8 +141,8 @@ struct ServoLoop::Impl {
       : device(d), callback(std::move(c)), options(o) {}
 
   void run() noexcept;
-  void record_fault(LoopFaultKind kind, const char* message, std::uint64_t tick,
-                    double stall_ms = 0.0) noexcept;
+  void record_fault(LoopFaultKind kind, const char* message, std::uint64_t tick, double stall_ms = 0.0,
+                    DeviceFault device_fault = DeviceFault::none) noexcept;
   void log(LogLevel level, std::uint16_t code, std::uint64_t count, double a = 0.0, double b = 0.0,
            const char* text = nullptr, double c = 0.0) noexcept {
     LogRecord r;
@@ -185,8 +181,10 @@ struct ServoLoop::Impl {
   std::atomic<std::uint64_t> wake_latency_max_ns{0};
   LatencyHistogram jitter{1000};        // 1 us bins
   LatencyHistogram callback_time{100};  // 0.1 us bins
-  // The fault: message characters first, then the kind with release; readers acquire the kind.
+  // The fault: message characters and device code first, then the kind with release; readers acquire
+  // the kind.
   std::atomic<int> fault_kind{0};
+  std::atomic<DeviceFault> fault_device{DeviceFault::none};
   std::array<std::atomic<char>, kFaultMessageBytes> fault_message{};
   std::exception_ptr fault_exception;  // set by the loop thread, read after join
 };
@@ -202,18 +200,20 @@ void ServoLoop::Impl::reset_stats() noexcept {
   jitter.clear();
   callback_time.clear();
   fault_kind.store(0, std::memory_order_release);
+  fault_device.store(DeviceFault::none, std::memory_order_relaxed);
   for (auto& c : fault_message) c.store('\0', std::memory_order_relaxed);
   fault_exception = nullptr;
 }
 
 void ServoLoop::Impl::record_fault(LoopFaultKind kind, const char* message, std::uint64_t tick,
-                                   double stall_ms) noexcept {
+                                   double stall_ms, DeviceFault device_fault) noexcept {
   std::size_t i = 0;
   if (message != nullptr) {
     for (; i + 1 < kFaultMessageBytes && message[i] != '\0'; ++i)
       fault_message[i].store(message[i], std::memory_order_relaxed);
   }
   fault_message[i].store('\0', std::memory_order_relaxed);
+  fault_device.store(device_fault, std::memory_order_relaxed);
   fault_kind.store(static_cast<int>(kind), std::memory_order_release);
   log(LogLevel::error, kind == LoopFaultKind::watchdog ? kWatchdog : kFault, tick, stall_ms, 0.0, message);
 }
@@ -222,6 +222,7 @@ LoopFault ServoLoop::Impl::fault() const {
   LoopFault f;
   f.kind = static_cast<LoopFaultKind>(fault_kind.load(std::memory_order_acquire));
   if (f.kind == LoopFaultKind::none) return f;
+  f.device = fault_device.load(std::memory_order_relaxed);
   for (const auto& c : fault_message) {
     const char ch = c.load(std::memory_order_relaxed);
     if (ch == '\0') break;
@@ -267,43 +268,34 @@ void ServoLoop::Impl::run() noexcept {
     std::int64_t written = 0;
     std::int64_t stall = 0;
     std::int64_t force_age = 0;
+    DeviceFault device_fault = DeviceFault::none;
     try {
-      const DeviceState state =
-          device.read_state();  // read at `wake`: the age of the state counts from there
-      const std::int64_t call = monotonic_ns();
-      const ServoCommand command = callback(state, dt_s);
-      const std::int64_t returned = monotonic_ns();
-      callback_time.add(returned - call);
-      stall = returned - last_update - period;
-      force_age = returned - wake;
-      stalled = stall_limit_ns > 0 && stall > stall_limit_ns;
-      if (stalled || force_age > max_force_age_ns) {
-        // Zero force is passive whatever the state; a force computed from an old state on a stiff fixture
-        // is not (Colgate & Schenkel 1997).
-        device.write_force(Vec3::Zero());
-        withheld.store(++withheld_count, std::memory_order_relaxed);
-        if (!stalled && worth_logging(withheld_count)) {
-          log(LogLevel::warn, kForceWithheld, tick + 1, static_cast<double>(force_age) * 1e-3,
-              static_cast<double>(withheld_count));
+      DeviceState state;
+      device_fault = device.read_state(state);  // read at `wake`: the age of the state counts from there
+      if (device_fault == DeviceFault::none) {
+        const std::int64_t call = monotonic_ns();
+        const ServoCommand command = callback(state, dt_s);
+        const std::int64_t returned = monotonic_ns();
+        callback_time.add(returned - call);
+        stall = returned - last_update - period;
+        force_age = returned - wake;
+        stalled = stall_limit_ns > 0 && stall > stall_limit_ns;
+        if (stalled || force_age > max_force_age_ns) {
+          // Zero force is passive whatever the state; a force computed from an old state on a stiff fixture
+          // is not (Colgate & Schenkel 1997).
+          device_fault = device.write_force(Vec3::Zero());
+          withheld.store(++withheld_count, std::memory_order_relaxed);
+          if (!stalled && worth_logging(withheld_count)) {
+            log(LogLevel::warn, kForceWithheld, tick + 1, static_cast<double>(force_age) * 1e-3,
+                static_cast<double>(withheld_count));
+          }
+        } else {
+          device_fault = device.write_force(command.force_n);
         }
-      } else {
-        device.write_force(command.force_n);
+        written = monotonic_ns();  // the device holds this force from here: stalls count from the write
+        if (device_fault == DeviceFault::none && after_write && !command.stop && !stalled) after_write();
+        stop_after = command.stop;
       }
-      written = monotonic_ns();  // the device holds this force from here: stalls count from the write
-      if (after_write && !command.stop && !stalled) after_write();
-      stop_after = command.stop;
-    } catch (const CommunicationError& e) {
-      fault_exception = std::current_exception();
-      record_fault(LoopFaultKind::communication, e.what(), tick);
-      break;
-    } catch (const SafetyFault& e) {
-      fault_exception = std::current_exception();
-      record_fault(LoopFaultKind::safety, e.what(), tick);
-      break;
-    } catch (const DeviceError& e) {
-      fault_exception = std::current_exception();
-      record_fault(LoopFaultKind::device, e.what(), tick);
-      break;
     } catch (const std::exception& e) {
       fault_exception = std::current_exception();
       record_fault(LoopFaultKind::callback, e.what(), tick);
@@ -311,6 +303,10 @@ void ServoLoop::Impl::run() noexcept {
     } catch (...) {
       fault_exception = std::current_exception();
       record_fault(LoopFaultKind::callback, "unknown exception from the servo callback", tick);
+      break;
+    }
+    if (device_fault != DeviceFault::none) {  // a code, not an exception: nothing allocated on this path
+      record_fault(LoopFaultKind::device, to_string(device_fault), tick, 0.0, device_fault);
       break;
     }
     last_update = written;
@@ -341,11 +337,9 @@ void ServoLoop::Impl::run() noexcept {
     }
   }
 
-  // Whatever ended the run, the device is left with zero force and forces off.
-  try {
-    device.write_force(Vec3::Zero());
-  } catch (...) {  // the transport may be gone; disabling below is the next line of defence
-  }
+  // Whatever ended the run, the device is left with zero force and forces off. The transport may be
+  // gone (a fault code then): disabling below is the next line of defence.
+  static_cast<void>(device.write_force(Vec3::Zero()));
   try {
     device.enable_forces(false);
   } catch (...) {
@@ -431,7 +425,9 @@ LoopFault ServoLoop::stop() noexcept {
   try {
     return m.fault();
   } catch (...) {  // out of memory copying the message
-    return LoopFault{static_cast<LoopFaultKind>(m.fault_kind.load(std::memory_order_acquire)), {}};
+    return LoopFault{static_cast<LoopFaultKind>(m.fault_kind.load(std::memory_order_acquire)),
+                     m.fault_device.load(std::memory_order_relaxed),
+                     {}};
   }
 }
 
@@ -441,6 +437,7 @@ void ServoLoop::wait() {
   m.log_drain.stop();
   const LoopFault f = m.fault();
   if (!f) return;
+  if (f.kind == LoopFaultKind::device) throw_device_fault(f.device, m.device.info().model);
   if (m.fault_exception) std::rethrow_exception(m.fault_exception);
   throw SafetyFault(f.message);
 }

@@ -26,7 +26,8 @@ ServoLoopStats run_free_loop(const ServoLoopOptions& options, double seconds,
       device,
       [&](const DeviceState& state, double) {
         const Vec3 force = -200.0 * (state.position_m - home) - 2.0 * state.velocity_m_s;  // [N/m], [N s/m]
-        device.write_force(force);
+        // Written here too, so that the step below acts under it (the simulated device has no faults).
+        if (device.write_force(force) != DeviceFault::none) return ServoCommand{Vec3::Zero(), true};
         device.advance(period_s);
         return ServoCommand{force, false};
       },
@@ -94,7 +95,10 @@ std::string loop_bench_json(const LoopBenchResult& result, const LoopBenchSettin
                           {"cpu", s.realtime.cpu},
                           {"memory_locked", s.realtime.memory_locked},
                           {"not_obtained", s.realtime.problems}}},
-                        {"fault", {{"kind", to_string(s.fault.kind)}, {"message", s.fault.message}}},
+                        {"fault",
+                         {{"kind", to_string(s.fault.kind)},
+                          {"device", device_fault_name(s.fault.device)},
+                          {"message", s.fault.message}}},
                         {"period_jitter_histogram_us", histogram}};
   out["seconds"] = settings.seconds;
   out["realtime_mode"] = settings.realtime_mode;

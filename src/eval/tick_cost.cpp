@@ -32,10 +32,11 @@ std::vector<DeviceState> record_states(const Scene& scene, double rate_hz, doubl
   const double dt = 1.0 / rate_hz;
   const auto ticks = static_cast<std::size_t>(max_duration_s * rate_hz);
   for (std::size_t k = 0; k < ticks; ++k) {
-    const DeviceState state = device.read_state();
+    DeviceState state;
+    if (device.read_state(state) != DeviceFault::none) break;  // the simulated device has no faults
     states.push_back(state);
     const RenderOutput out = renderer.tick(state);
-    device.write_force(out.force_n);
+    if (device.write_force(out.force_n) != DeviceFault::none) break;
     if (out.finished) break;
     writer.observe(out, state);
     if (writer.done()) break;

@@ -72,8 +72,9 @@ void SimulatedDevice::enable_forces(bool enabled) {
   if (!enabled) force_ = Vec3::Zero();
 }
 
-void SimulatedDevice::write_force(const Vec3& force_n) {
+DeviceFault SimulatedDevice::write_force(const Vec3& force_n) noexcept {
   force_ = forces_enabled_ ? clamp_force(force_n, parameters_.info.max_force_n) : Vec3::Zero();
+  return DeviceFault::none;
 }
 
 void SimulatedDevice::advance(double dt_s) {
@@ -151,7 +152,7 @@ void SimulatedDevice::integrate_exactly(double duration_s) {
   time_ += duration_s;
 }
 
-DeviceState SimulatedDevice::read_state() {
+DeviceFault SimulatedDevice::read_state(DeviceState& state) noexcept {
   const double q = parameters_.encoder_resolution_m;
   Vec3 quantised = position_;
   if (q > 0.0) quantised = (position_ / q).array().round().matrix() * q;
@@ -165,11 +166,11 @@ DeviceState SimulatedDevice::read_state() {
   read_before_ = true;
   last_read_time_ = time_;
   reported_position_ = quantised;
-  DeviceState state;
+  state = DeviceState{};
   state.position_m = reported_position_;
   state.velocity_m_s = reported_velocity_;
   state.time_s = time_;
-  return state;
+  return DeviceFault::none;
 }
 
 void register_simulated_device(DeviceRegistry& registry) {

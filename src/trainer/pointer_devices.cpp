@@ -30,12 +30,13 @@ class MouseDevice final : public HapticDevice {
   [[nodiscard]] bool is_open() const override { return open_; }
   void enable_forces(bool enabled) override { forces_ = enabled; }
   [[nodiscard]] bool forces_enabled() const override { return forces_; }
-  DeviceState read_state() override {
+  // Servo path: never faults (the pointer is always there).
+  [[nodiscard]] DeviceFault read_state(DeviceState& state) noexcept override {
     double x = 0.0;
     double y = 0.0;
     bool pressed = false;
     pointer_input().get(x, y, pressed);
-    DeviceState state;
+    state = DeviceState{};
     state.time_s = steady_seconds() - start_s_;
     state.position_m = Vec3(x, y, pressed ? -kMousePressDepthM : kMouseLiftHeightM);
     state.buttons = pressed ? 1U : 0U;
@@ -48,9 +49,11 @@ class MouseDevice final : public HapticDevice {
     state.velocity_m_s = velocity_;
     last_ = state;
     have_last_ = true;
-    return state;
+    return DeviceFault::none;
   }
-  void write_force(const Vec3& /*force_n*/) override {}  // a mouse renders no force
+  [[nodiscard]] DeviceFault write_force(const Vec3& /*force_n*/) noexcept override {
+    return DeviceFault::none;  // a mouse renders no force
+  }
 
  private:
   DeviceInfo info_;
@@ -95,16 +98,20 @@ class MouseHandDevice final : public HapticDevice {
   [[nodiscard]] bool is_open() const override { return device_.is_open(); }
   void enable_forces(bool enabled) override { device_.enable_forces(enabled); }
   [[nodiscard]] bool forces_enabled() const override { return device_.forces_enabled(); }
-  DeviceState read_state() override {
+  // Servo path: the simulated device never faults. `advance` throws only for a negative or non-finite
+  // step, which the clamp rules out.
+  [[nodiscard]] DeviceFault read_state(DeviceState& state) noexcept override {
     const double now_s = steady_seconds();
     // A stalled thread does not make the physics jump: at most 50 ms are integrated at once.
     device_.advance(std::clamp(now_s - last_s_, 0.0, 0.05));
     last_s_ = now_s;
-    DeviceState state = device_.read_state();
-    hold_on_paper_while_pressed(state);
-    return state;
+    const DeviceFault fault = device_.read_state(state);
+    if (fault == DeviceFault::none) hold_on_paper_while_pressed(state);
+    return fault;
   }
-  void write_force(const Vec3& force_n) override { device_.write_force(force_n); }
+  [[nodiscard]] DeviceFault write_force(const Vec3& force_n) noexcept override {
+    return device_.write_force(force_n);
+  }
 
   // One touch is one pen-down. The simulated stylus lands on a stiff paper behind a soft, lightly damped
   // hand, so it bounces: about 57 ms above the paper's contact hysteresis, which the renderer reads as a

@@ -28,7 +28,8 @@ class DeviceShutdown {
   ~DeviceShutdown() {
     try {
       // The last tick's force must not outlive the trial (the real-time loop has zeroed and disabled it).
-      if (device_.is_open() && device_.forces_enabled()) device_.write_force(Vec3::Zero());
+      // A fault code here is ignored: disabling and closing still follow.
+      if (device_.is_open() && device_.forces_enabled()) static_cast<void>(device_.write_force(Vec3::Zero()));
     } catch (...) {
       // The link may be gone (the trial may be ending because of it); disabling and closing still follow.
     }
@@ -53,37 +54,38 @@ TrialResult run_lock_step(HapticDevice& device, HandPort& hand, SimulatedWriter&
   const double period_s = 1.0 / options.rate_hz;
   double end_time_s = -1.0;
   TrialEnd end = TrialEnd::time_limit;
-  std::string reason;
-  try {
-    while (true) {
-      if (options.should_stop && options.should_stop()) {
-        end = TrialEnd::interrupted;
-        break;
-      }
-      const DeviceState state = device.read_state();
-      const ServoCommand command = session.step(state);
-      device.write_force(command.force_n);
-      end_time_s = state.time_s;
-      if (session.finished()) {
-        end = TrialEnd::completed;
-        break;
-      }
-      writer.observe(session.last_output(), state);
-      if (writer.done()) {
-        end = TrialEnd::writer_gave_up;
-        break;
-      }
-      if (command.stop) {  // out of time after this tick: the trial lasted until the next would start
-        end_time_s = state.time_s + period_s;
-        break;
-      }
-      hand.advance(period_s);
+  DeviceFault fault = DeviceFault::none;  // the device's calls return codes: nothing to catch here
+  while (true) {
+    if (options.should_stop && options.should_stop()) {
+      end = TrialEnd::interrupted;
+      break;
     }
-  } catch (const DeviceError& e) {  // link lost, safety fault, or another device's fault
-    end = TrialEnd::device_fault;
-    reason = e.what();
+    DeviceState state;
+    if (fault = device.read_state(state); fault != DeviceFault::none) break;
+    const ServoCommand command = session.step(state);
+    if (fault = device.write_force(command.force_n); fault != DeviceFault::none) break;
+    end_time_s = state.time_s;
+    if (session.finished()) {
+      end = TrialEnd::completed;
+      break;
+    }
+    writer.observe(session.last_output(), state);
+    if (writer.done()) {
+      end = TrialEnd::writer_gave_up;
+      break;
+    }
+    if (command.stop) {  // out of time after this tick: the trial lasted until the next would start
+      end_time_s = state.time_s + period_s;
+      break;
+    }
+    hand.advance(period_s);
   }
-  return session.finish(end, std::move(reason), end_time_s);
+  if (fault == DeviceFault::none) return session.finish(end, {}, end_time_s);
+  // Link lost, safety fault: the code's message, built now that the loop has ended.
+  TrialResult result =
+      session.finish(TrialEnd::device_fault, device_fault_message(fault, device.info().model), end_time_s);
+  result.device_fault = fault;
+  return result;
 }
 
 // Real time on the ServoLoop: the loop thread steps the session (and a simulated writer and the device's
@@ -131,7 +133,12 @@ TrialResult run_real_time(HapticDevice& device, HandPort* hand, SimulatedWriter*
   } else if (!interrupted && session.out_of_time()) {
     end = TrialEnd::time_limit;
   }
-  TrialResult result = session.finish(end, fault ? fault.message : std::string());
+  // A device fault is the device's code (the loop recorded it without building a string): its message
+  // is built here, off the loop thread, by the one mapping from codes to messages.
+  TrialResult result = session.finish(end, fault.kind == LoopFaultKind::device
+                                               ? device_fault_message(fault.device, device.info().model)
+                                               : fault.message);
+  result.device_fault = fault.device;
   result.loop = loop.stats();
   return result;
 }

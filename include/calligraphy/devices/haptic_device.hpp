@@ -4,14 +4,19 @@
 /// positions in m, velocities in m/s, forces in N, stiffness in N/m, damping in N s/m, time in s.
 /// Device coordinates: x right, y away from the writer, z up out of the paper.
 
+#include "calligraphy/core/device_fault.hpp"
 #include "calligraphy/core/device_types.hpp"
 
 namespace calligraphy {
 
-/// Abstract haptic device. Implementations: `SimulatedDevice`, the Phantom backends.
-/// `read_state` and `write_force` are called from the servo thread at up to 10 kHz: implementations
-/// must not allocate, lock or log there; a transport fault throws `CommunicationError` (the servo
-/// loop catches it, zeroes forces and stops).
+/// Abstract haptic device. Implementations: `SimulatedDevice`, the Phantom backends, OpenHaptics.
+/// `read_state` and `write_force` are the servo path, called from the servo thread at up to 10 kHz:
+/// they are noexcept and return a `DeviceFault` code (device_fault.hpp) instead of throwing, and must
+/// not allocate, lock, log or build a string, also when they fail (fixed messages; details go to
+/// counters or plain records read later from another thread). On a fault the device turns its forces
+/// off; the servo loop then zeroes the force, stops and reports the code, and
+/// `throw_device_fault(code, info().model)` turns it into the typed exception off the servo path.
+/// `open`, `calibrate` and `enable_forces(true)` are off the servo path and throw typed exceptions.
 class HapticDevice {
  public:
   virtual ~HapticDevice() = default;
@@ -40,11 +45,13 @@ class HapticDevice {
   virtual void enable_forces(bool enabled) = 0;
   [[nodiscard]] virtual bool forces_enabled() const = 0;
 
-  /// Reads the current state. Servo path.
-  virtual DeviceState read_state() = 0;
-  /// Commands a force [N] to be held until the next command (zero-order hold). Servo path.
-  /// Implementations clamp to `info().max_force_n` preserving direction.
-  virtual void write_force(const Vec3& force_n) = 0;
+  /// Servo path: reads the current state into `state` and returns `DeviceFault::none`, or returns the
+  /// fault (`state` then holds the last good state, or is untouched). Never throws or allocates.
+  [[nodiscard]] virtual DeviceFault read_state(DeviceState& state) noexcept = 0;
+  /// Servo path: commands a force [N] to be held until the next command (zero-order hold) and returns
+  /// `DeviceFault::none`, or the fault (e.g. `non_finite_force`: zero force is commanded instead).
+  /// Implementations clamp to `info().max_force_n` preserving direction. Never throws or allocates.
+  [[nodiscard]] virtual DeviceFault write_force(const Vec3& force_n) noexcept = 0;
 };
 
 }  // namespace calligraphy

@@ -11,10 +11,13 @@
 /// instead of being caught up. Only a stall longer than `stall_timeout_s` ends the run, safely.
 ///
 /// Inside the loop nothing allocates, locks, logs synchronously, builds a string or lets an exception
-/// escape: device faults and callback exceptions are caught on the loop thread, the force is zeroed,
-/// forces are disabled, the fault is recorded, the loop stops, and `wait()` rethrows it on the caller's
-/// thread. Statistics are atomics, readable from any thread while the loop runs. Log records go through
-/// a lock-free queue to a normal thread that calls spdlog. Linux only (clock_nanosleep, SCHED_FIFO).
+/// escape: a device fault is the `DeviceFault` code `read_state` or `write_force` returns (no exception
+/// on that path), a callback's exception is caught on the loop thread; either way the force is zeroed,
+/// forces are disabled, the fault is recorded (the code with its fixed message), the loop stops, and
+/// `wait()` throws it on the caller's thread (`throw_device_fault` for a device fault, the callback's own
+/// exception). Statistics are atomics, readable from any thread while the loop runs. Log records go
+/// through a lock-free queue to a normal thread that calls spdlog. Linux only (clock_nanosleep,
+/// SCHED_FIFO).
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -73,13 +76,13 @@ struct ServoCommand {
 /// (the loop contains it: see the file comment).
 using ServoCallback = std::function<ServoCommand(const DeviceState& state, double dt_s)>;
 
+/// What ended a run. A device's faults are not kinds of their own: they are `device` with the device's
+/// `DeviceFault` code in `LoopFault::device` (one taxonomy, device_fault.hpp).
 enum class LoopFaultKind {
   none,
-  watchdog,       ///< a stall longer than `stall_timeout_s`
-  communication,  ///< CommunicationError from the device
-  safety,         ///< SafetyFault from the device or the callback
-  device,         ///< another DeviceError
-  callback,       ///< any other exception from the callback
+  watchdog,  ///< a stall longer than `stall_timeout_s` (the loop's own bound)
+  device,    ///< `read_state` or `write_force` returned a fault: `LoopFault::device` says which
+  callback,  ///< an exception from the callback or the after-write hook
 };
 [[nodiscard]] const char* to_string(LoopFaultKind kind) noexcept;
 
@@ -89,7 +92,10 @@ inline constexpr const char* kStallFaultMessage =
 
 struct LoopFault {
   LoopFaultKind kind = LoopFaultKind::none;
-  /// The exception's what() (truncated to 127 bytes), or `kStallFaultMessage` for the watchdog.
+  /// The device's fault code for `LoopFaultKind::device` (`link_lost`, `watchdog`, ...); none otherwise.
+  DeviceFault device = DeviceFault::none;
+  /// `to_string(device)` for a device fault, the exception's what() (truncated to 127 bytes) for a
+  /// callback, `kStallFaultMessage` for the watchdog.
   std::string message;
   [[nodiscard]] explicit operator bool() const noexcept { return kind != LoopFaultKind::none; }
 };
@@ -172,7 +178,8 @@ class ServoLoop {
   /// callback should return `ServoCommand::stop` instead).
   LoopFault stop() noexcept;
   /// Waits until the loop ends by itself (its callback asked to stop, or a fault) and joins it; then
-  /// rethrows the fault: the device's or the callback's own exception, or a SafetyFault for a stall
+  /// throws the fault: for a device fault `throw_device_fault(code, device.info().model)`
+  /// (CommunicationError or SafetyFault), the callback's own exception, or a SafetyFault for a stall
   /// (`kStallFaultMessage`). Returns normally when the run ended without a fault. Blocks forever if
   /// nothing ends it.
   void wait();

@@ -73,8 +73,11 @@ class SimulatedDevice final : public HapticDevice, public HandPort {
   [[nodiscard]] bool is_open() const override { return open_; }
   void enable_forces(bool enabled) override;
   [[nodiscard]] bool forces_enabled() const override { return forces_enabled_; }
-  DeviceState read_state() override;
-  void write_force(const Vec3& force_n) override;
+  /// Never faults: always `DeviceFault::none` (also before open(), for tests and tools).
+  [[nodiscard]] DeviceFault read_state(DeviceState& state) noexcept override;
+  /// Never faults: always `DeviceFault::none`. Saturates at info().max_force_n keeping the direction;
+  /// a non-finite force, or any force while forces are disabled, applies zero force.
+  [[nodiscard]] DeviceFault write_force(const Vec3& force_n) noexcept override;
 
   /// The unquantised position and velocity, for tests [m], [m/s].
   [[nodiscard]] const Vec3& true_position() const noexcept { return position_; }

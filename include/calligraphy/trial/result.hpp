@@ -16,7 +16,7 @@ namespace calligraphy {
 enum class TrialEnd {
   completed,       ///< every stroke written, each in its turn
   time_limit,      ///< `max_duration_s` ran out first
-  device_fault,    ///< the device failed (link lost, safety fault, another DeviceError)
+  device_fault,    ///< the device returned a fault code (`TrialResult::device_fault`), or a callback threw
   watchdog,        ///< the servo loop stalled longer than its bound
   interrupted,     ///< `TrialOptions::should_stop` (e.g. SIGINT or SIGTERM, a closed window)
   writer_gave_up,  ///< the simulated writer stopped before every stroke was written
@@ -30,8 +30,12 @@ struct TrialResult {
   TrialMetrics metrics;
   std::vector<TrialSample> trace;  ///< one sample per tick, when `keep_trace`
   TrialEnd end = TrialEnd::completed;
-  bool aborted = false;      ///< every end but `completed`
-  std::string abort_reason;  ///< the device's or the loop's message for a fault, else a short reason or empty
+  bool aborted = false;  ///< every end but `completed`
+  /// For `TrialEnd::device_fault` ended by the device: its fault code (device_fault.hpp); else none.
+  DeviceFault device_fault = DeviceFault::none;
+  /// For a device fault `device_fault_message(device_fault, model)`; the loop's message for another
+  /// fault; else a short reason or empty.
+  std::string abort_reason;
   std::optional<ServoLoopStats> loop;  ///< the servo loop's statistics, for a real-time trial
   /// What the simulated writer did, attempt by attempt, when one moved the device (its `log()`); empty on
   /// a device a person moves. Feeds `RepetitionOutcome::from_log` for learning across repetitions.

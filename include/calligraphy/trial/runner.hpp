@@ -13,9 +13,11 @@
 /// hand-port device runs there too with `TrialPacing::real_time` (its writer and physics then step on the
 /// loop thread right after each force write).
 ///
-/// Endings: see `TrialEnd`. A device fault (`DeviceError` from the device, a stall of the loop) ends the
-/// trial with `aborted` set and the device's message; every tick recorded before it is kept. Any other
-/// exception turns forces off, closes the device, and propagates.
+/// Endings: see `TrialEnd`. A device fault (a `DeviceFault` code from `read_state` or `write_force`, a
+/// stall of the loop) ends the trial with `aborted` set, the code in `TrialResult::device_fault` and its
+/// message (`device_fault_message`) in `abort_reason`; every tick recorded before it is kept. Any
+/// exception (from `open()`, `calibrate()`, a simulated writer) turns forces off, closes the device, and
+/// propagates.
 #include <string_view>
 
 #include "calligraphy/devices/haptic_device.hpp"

@@ -7,12 +7,17 @@
 ///
 ///     TrialSession session(scene, device.info(), options);
 ///     session.reserve_trace();                              // before a real-time loop
+///     DeviceFault fault = DeviceFault::none;
+///     DeviceState state;
 ///     while (running) {                                    // the application's 1 kHz loop
-///       const ServoCommand command = session.step(device.read_state());
-///       device.write_force(command.force_n);
+///       if ((fault = device.read_state(state)) != DeviceFault::none) break;
+///       const ServoCommand command = session.step(state);
+///       if ((fault = device.write_force(command.force_n)) != DeviceFault::none) break;
 ///       if (command.stop) break;
 ///     }
-///     TrialResult result = session.finish(TrialEnd::completed);
+///     TrialResult result = fault == DeviceFault::none
+///         ? session.finish(TrialEnd::completed)
+///         : session.finish(TrialEnd::device_fault, device_fault_message(fault, device.info().model));
 ///
 /// `step` never locks, logs or throws, and after `reserve_trace()` it never allocates; it asks to stop
 /// when every stroke is written or `max_duration_s` x `rate_hz` ticks were stepped. With a display

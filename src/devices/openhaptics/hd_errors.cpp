@@ -104,12 +104,15 @@ void throw_hd_error(const hd::HDErrorInfo& error, std::string_view context) {
   }
 }
 
-void throw_hd_servo_error(hd::HDerror code) {
-  if (classify_hd_error(code) == HdErrorKind::safety) {
-    throw SafetyFault(std::string("OpenHaptics: ") + hd_error_name(code) + "; forces turned off");
+DeviceFault hd_servo_fault(hd::HDerror code) noexcept {
+  switch (classify_hd_error(code)) {
+    case HdErrorKind::none:
+      return DeviceFault::none;
+    case HdErrorKind::safety:
+      return DeviceFault::safety_limit;
+    default:
+      return DeviceFault::driver_error;
   }
-  throw CommunicationError(std::string("OpenHaptics: ") + hd_error_name(code) +
-                           " in the servo loop; forces off");
 }
 
 }  // namespace calligraphy::openhaptics

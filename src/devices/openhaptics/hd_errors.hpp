@@ -2,6 +2,7 @@
 // HDAPI error codes mapped onto the library's exception hierarchy (errors.hpp).
 #include <string_view>
 
+#include "calligraphy/core/device_fault.hpp"
 #include "devices/openhaptics/hd_api.hpp"
 
 namespace calligraphy::openhaptics {
@@ -22,8 +23,9 @@ enum class HdErrorKind {
 /// Throws the exception of the error's kind: CommunicationError, SafetyFault, or DeviceError (usage,
 /// setup). The message names `context`, the code and the internal code. Precondition: an error.
 [[noreturn]] void throw_hd_error(const hd::HDErrorInfo& error, std::string_view context);
-/// Servo-path variant: only CommunicationError or SafetyFault (every non-safety kind is reported as
-/// a CommunicationError, since the servo loop's reaction is the same: stop, forces off).
-[[noreturn]] void throw_hd_servo_error(hd::HDerror code);
+/// Servo-path variant, a code instead of an exception: `safety_limit` for the safety kind, and
+/// `driver_error` for every other kind (the servo loop's reaction is the same: stop, forces off).
+/// Off the servo path, `throw_device_fault` turns it into SafetyFault or CommunicationError.
+[[nodiscard]] DeviceFault hd_servo_fault(hd::HDerror code) noexcept;
 
 }  // namespace calligraphy::openhaptics

@@ -88,6 +88,14 @@ void OpenHapticsDevice::close() noexcept {
     open_ = false;
     return;
   }
+  if (const hd::HDerror error = scheduler_error_.load(); error != hd::HD_SUCCESS) {
+    try {  // the servo path kept only the code; it is worded here, off the servo thread
+      spdlog::warn("OpenHaptics: the scheduler reported {} ({}) during the run", hd_error_name(error),
+                   device_fault_name(hd_servo_fault(error)));
+    } catch (...) {
+      // Logging must not turn close() into a throwing call.
+    }
+  }
   forces_enabled_.store(false);
   library_->stop_scheduler();
   if (servo_callback_ != 0) library_->unschedule(servo_callback_);
@@ -182,36 +190,33 @@ hd::HDCallbackCode OpenHapticsDevice::servo_tick(void* self) noexcept {
   return hd::HD_CALLBACK_CONTINUE;
 }
 
-DeviceState OpenHapticsDevice::read_state() {
-  if (!open_) throw CommunicationError("OpenHaptics: read_state() on a device that is not open");
+// Servo path: codes, no exception, allocation or string (the HD code is kept in scheduler_error_).
+DeviceFault OpenHapticsDevice::read_state(DeviceState& state) noexcept {
+  if (!open_) return DeviceFault::not_open;
   if (const hd::HDerror error = scheduler_error_.load(std::memory_order_relaxed); error != hd::HD_SUCCESS) {
     forces_enabled_.store(false);
-    throw_hd_servo_error(error);
+    return hd_servo_fault(error);
   }
-  if (watchdog_tripped_.exchange(false)) {
-    // A fixed message: the servo path builds no strings, also when it fails.
-    throw SafetyFault("OpenHaptics: watchdog: no force command within its timeout; forces turned off");
-  }
+  if (watchdog_tripped_.exchange(false)) return DeviceFault::watchdog;
   const auto values = state_.load();
-  DeviceState state;
   state.position_m = Vec3(values[0], values[1], values[2]);
   state.velocity_m_s = Vec3(values[3], values[4], values[5]);
   state.buttons = static_cast<std::uint32_t>(values[6]);
   state.time_s = values[7];
-  return state;
+  return DeviceFault::none;
 }
 
-void OpenHapticsDevice::write_force(const Vec3& force_n) {
-  if (!open_) throw CommunicationError("OpenHaptics: write_force() on a device that is not open");
+DeviceFault OpenHapticsDevice::write_force(const Vec3& force_n) noexcept {
+  if (!open_) return DeviceFault::not_open;
   const double now = monotonic_seconds();
   if (!force_n.allFinite()) {
     forces_enabled_.store(false, std::memory_order_release);
     command_.store({0.0, 0.0, 0.0, now});
-    throw SafetyFault(
-        "OpenHaptics: non-finite force command (NaN or infinity); zero force, forces turned off");
+    return DeviceFault::non_finite_force;
   }
   const Vec3 limited = clamp_force_magnitude(force_n, info_.max_force_n);
   command_.store({limited.x(), limited.y(), limited.z(), now});
+  return DeviceFault::none;
 }
 
 }  // namespace calligraphy::openhaptics

@@ -40,12 +40,15 @@ class OpenHapticsDevice final : public HapticDevice {
   [[nodiscard]] bool forces_enabled() const override {
     return forces_enabled_.load(std::memory_order_acquire);
   }
-  /// Servo path. Throws CommunicationError (link errors and any non-safety HD error from the scheduler)
-  /// or SafetyFault (HD force/velocity/temperature errors, or the watchdog); forces are then off.
-  DeviceState read_state() override;
-  /// Servo path. Clamps to info().max_force_n keeping the direction. Throws SafetyFault on a NaN or
-  /// infinite component (zero force, forces off) and CommunicationError when not open.
-  void write_force(const Vec3& force_n) override;
+  /// Servo path. Faults: `driver_error` (link errors and any non-safety HD error from the scheduler),
+  /// `safety_limit` (HD force/velocity/temperature errors), `watchdog`, `not_open`; forces are then off.
+  /// The HD error code itself is kept (`servo_error`) and logged at close(), off the servo path.
+  [[nodiscard]] DeviceFault read_state(DeviceState& state) noexcept override;
+  /// Servo path. Clamps to info().max_force_n keeping the direction. Faults: `non_finite_force` on a NaN
+  /// or infinite component (zero force, forces off), `not_open`.
+  [[nodiscard]] DeviceFault write_force(const Vec3& force_n) noexcept override;
+  /// The first HD error the scheduler callback saw since open() (HD_SUCCESS: none). Any thread.
+  [[nodiscard]] hd::HDerror servo_error() const noexcept { return scheduler_error_.load(); }
 
  private:
   static hd::HDCallbackCode servo_tick(void* self) noexcept;

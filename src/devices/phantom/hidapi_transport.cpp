@@ -21,7 +21,7 @@ std::string narrow(const wchar_t* text) {
   return out;
 }
 
-int to_milliseconds(std::chrono::microseconds timeout) {
+int to_milliseconds(std::chrono::microseconds timeout) noexcept {
   return static_cast<int>(std::max<std::int64_t>(1, (timeout.count() + 999) / 1000));
 }
 
@@ -66,23 +66,25 @@ void HidapiTransport::close() noexcept {
   device_ = nullptr;
 }
 
-void HidapiTransport::write(std::span<const std::uint8_t> packet, std::chrono::microseconds /*timeout*/) {
-  if (device_ == nullptr) throw CommunicationError("hidapi: write on a closed device");
-  if (packet.size() + 1 > report_.size()) throw CommunicationError("hidapi: packet longer than 64 bytes");
+DeviceFault HidapiTransport::write(std::span<const std::uint8_t> packet,
+                                   std::chrono::microseconds /*timeout*/) noexcept {
+  // Codes, not exceptions: the servo path neither throws nor builds a string, also when it fails.
+  if (device_ == nullptr) return DeviceFault::not_open;
+  if (packet.size() + 1 > report_.size()) return DeviceFault::link_lost;  // longer than 64 bytes: refused
   report_[0] = 0;  // report id 0: the device uses unnumbered reports (assumption, unverified)
   std::copy(packet.begin(), packet.end(), report_.begin() + 1);
-  if (hid_write(device_, report_.data(), packet.size() + 1) < 0) {
-    throw CommunicationError("hidapi: write failed (unplugged?)");  // fixed: servo path
-  }
+  if (hid_write(device_, report_.data(), packet.size() + 1) < 0) return DeviceFault::link_lost;  // unplugged?
+  return DeviceFault::none;
 }
 
-std::size_t HidapiTransport::read(std::span<std::uint8_t> buffer, std::chrono::microseconds timeout) {
-  if (device_ == nullptr) throw CommunicationError("hidapi: read on a closed device");
-  const int received = hid_read_timeout(device_, buffer.data(), buffer.size(), to_milliseconds(timeout));
-  if (received < 0) {
-    throw CommunicationError("hidapi: read failed (unplugged?)");  // fixed: servo path
-  }
-  return static_cast<std::size_t>(received);
+DeviceFault HidapiTransport::read(std::span<std::uint8_t> buffer, std::chrono::microseconds timeout,
+                                  std::size_t& received) noexcept {
+  received = 0;
+  if (device_ == nullptr) return DeviceFault::not_open;
+  const int count = hid_read_timeout(device_, buffer.data(), buffer.size(), to_milliseconds(timeout));
+  if (count < 0) return DeviceFault::link_lost;  // unplugged?
+  received = static_cast<std::size_t>(count);
+  return DeviceFault::none;
 }
 
 std::string HidapiTransport::description() const {

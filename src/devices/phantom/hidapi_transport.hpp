@@ -33,11 +33,13 @@ class HidapiTransport final : public devices::ByteTransport {
   void close() noexcept override;
   [[nodiscard]] bool is_open() const noexcept override { return device_ != nullptr; }
   /// Sends the packet as an output report with report id 0. hidapi's write has no timeout: `timeout`
-  /// is not enforced (hidraw writes return at once unless the kernel queue is full). Throws
-  /// CommunicationError on failure (e.g. unplugged) or when the packet exceeds 64 bytes.
-  void write(std::span<const std::uint8_t> packet, std::chrono::microseconds timeout) override;
-  /// One input report, 0 on timeout. Throws CommunicationError on failure (e.g. unplugged).
-  std::size_t read(std::span<std::uint8_t> buffer, std::chrono::microseconds timeout) override;
+  /// is not enforced (hidraw writes return at once unless the kernel queue is full). `link_lost` on
+  /// failure (e.g. unplugged) or when the packet exceeds 64 bytes; `not_open` when closed.
+  [[nodiscard]] DeviceFault write(std::span<const std::uint8_t> packet,
+                                  std::chrono::microseconds timeout) noexcept override;
+  /// One input report, `received` 0 on timeout. `link_lost` on failure (e.g. unplugged).
+  [[nodiscard]] DeviceFault read(std::span<std::uint8_t> buffer, std::chrono::microseconds timeout,
+                                 std::size_t& received) noexcept override;
   [[nodiscard]] std::string description() const override;
 
  private:

@@ -12,7 +12,7 @@
 namespace calligraphy::phantom {
 namespace {
 
-unsigned int to_milliseconds(std::chrono::microseconds timeout) {
+unsigned int to_milliseconds(std::chrono::microseconds timeout) noexcept {
   return static_cast<unsigned int>(std::max<std::int64_t>(1, (timeout.count() + 999) / 1000));
 }
 
@@ -135,28 +135,36 @@ void LibusbTransport::close() noexcept {
   context_ = nullptr;
 }
 
-void LibusbTransport::write(std::span<const std::uint8_t> packet, std::chrono::microseconds timeout) {
-  // Fixed messages below: the servo path builds no strings, also when it fails.
-  if (handle_ == nullptr) throw CommunicationError("libusb: write on a closed device");
-  if (packet.size() > out_buffer_.size()) throw CommunicationError("libusb: packet longer than 64 bytes");
+DeviceFault LibusbTransport::write(std::span<const std::uint8_t> packet,
+                                   std::chrono::microseconds timeout) noexcept {
+  // Codes, not exceptions: the servo path neither throws nor builds a string, also when it fails.
+  if (handle_ == nullptr) return DeviceFault::not_open;
+  if (packet.size() > out_buffer_.size()) return DeviceFault::link_lost;  // longer than 64 bytes: refused
   std::copy(packet.begin(), packet.end(), out_buffer_.begin());
   int sent = 0;
   const int rc = libusb_bulk_transfer(handle_, endpoint_out_, out_buffer_.data(),
                                       static_cast<int>(packet.size()), &sent, to_milliseconds(timeout));
-  if (rc == LIBUSB_ERROR_NO_DEVICE) throw CommunicationError("libusb: device unplugged");
-  if (rc != 0) throw CommunicationError("libusb: bulk write failed");
-  if (sent != static_cast<int>(packet.size())) throw CommunicationError("libusb: short bulk write");
+  // Unplugged (LIBUSB_ERROR_NO_DEVICE), any other failure, or a short write.
+  if (rc != 0 || sent != static_cast<int>(packet.size())) return DeviceFault::link_lost;
+  return DeviceFault::none;
 }
 
-std::size_t LibusbTransport::read(std::span<std::uint8_t> buffer, std::chrono::microseconds timeout) {
-  if (handle_ == nullptr) throw CommunicationError("libusb: read on a closed device");
-  int received = 0;
+DeviceFault LibusbTransport::read(std::span<std::uint8_t> buffer, std::chrono::microseconds timeout,
+                                  std::size_t& received) noexcept {
+  received = 0;
+  if (handle_ == nullptr) return DeviceFault::not_open;
+  int count = 0;
   const int rc = libusb_bulk_transfer(handle_, endpoint_in_, buffer.data(), static_cast<int>(buffer.size()),
-                                      &received, to_milliseconds(timeout));
-  if (rc == 0 || rc == LIBUSB_ERROR_TIMEOUT) return static_cast<std::size_t>(received);
-  if (rc == LIBUSB_ERROR_OVERFLOW) return buffer.size();  // longer than the buffer: the caller rejects it
-  if (rc == LIBUSB_ERROR_NO_DEVICE) throw CommunicationError("libusb: device unplugged");
-  throw CommunicationError("libusb: bulk read failed");
+                                      &count, to_milliseconds(timeout));
+  if (rc == 0 || rc == LIBUSB_ERROR_TIMEOUT) {
+    received = static_cast<std::size_t>(count);
+    return DeviceFault::none;
+  }
+  if (rc == LIBUSB_ERROR_OVERFLOW) {  // longer than the buffer: the caller rejects it
+    received = buffer.size();
+    return DeviceFault::none;
+  }
+  return DeviceFault::link_lost;  // unplugged (LIBUSB_ERROR_NO_DEVICE) or another libusb error
 }
 
 std::string LibusbTransport::description() const {

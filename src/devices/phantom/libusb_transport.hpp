@@ -34,12 +34,16 @@ class LibusbTransport final : public devices::ByteTransport {
   void open() override;
   void close() noexcept override;
   [[nodiscard]] bool is_open() const noexcept override { return handle_ != nullptr; }
-  /// One bulk OUT transfer. Throws CommunicationError when unplugged, on timeout or a short write.
-  /// Note: libusb's synchronous API allocates a transfer internally on every call.
-  void write(std::span<const std::uint8_t> packet, std::chrono::microseconds timeout) override;
-  /// One bulk IN transfer; 0 on timeout; a packet longer than `buffer` returns buffer.size(). Throws
-  /// CommunicationError when unplugged or on any other libusb error.
-  std::size_t read(std::span<std::uint8_t> buffer, std::chrono::microseconds timeout) override;
+  /// One bulk OUT transfer. `link_lost` when unplugged, on timeout or a short write; `not_open` when
+  /// closed. Note: libusb's synchronous API allocates a transfer internally on every call (the one
+  /// allocation on this path that is not ours: the asynchronous API with preallocated transfers would
+  /// remove it).
+  [[nodiscard]] DeviceFault write(std::span<const std::uint8_t> packet,
+                                  std::chrono::microseconds timeout) noexcept override;
+  /// One bulk IN transfer; `received` 0 on timeout, buffer.size() for a packet longer than `buffer`.
+  /// `link_lost` when unplugged or on any other libusb error.
+  [[nodiscard]] DeviceFault read(std::span<std::uint8_t> buffer, std::chrono::microseconds timeout,
+                                 std::size_t& received) noexcept override;
   [[nodiscard]] std::string description() const override;
 
  private:

@@ -36,6 +36,19 @@ PhantomDeviceConfig validated(PhantomDeviceConfig config) {
 
 }  // namespace
 
+std::string describe(const PhantomFaultRecord& record) {
+  if (record.fault == DeviceFault::none) return {};
+  std::string text = "at " + std::to_string(record.time_s) + " s";
+  if (record.bad_reads > 0) {
+    text +=
+        "; " + std::to_string(record.bad_reads) + " reads in a row without a valid status packet, the last ";
+    text += record.last_read_timed_out
+                ? std::string("a timeout")
+                : std::string("rejected: ") + packet_error_name(record.last_packet_error);
+  }
+  return text;
+}
+
 PhantomDeviceConfig phantom_omni_config() {
   PhantomDeviceConfig config;
   config.info = phantom_omni_info();
@@ -84,15 +97,15 @@ void PhantomDevice::open() {
   enable_bit_zero_sent_ = false;
   velocity_filter_.reset();
   watchdog_.disarm();
-  try {
-    send_command(CommandPacket{});  // forces off before anything else
-    // receive_status throws CommunicationError after max_consecutive_bad_packets bad reads.
-    while (!receive_status(now_s())) {
-    }
-  } catch (...) {
+  fault_record_ = PhantomFaultRecord{};
+  DeviceFault fault = send_command(CommandPacket{});  // forces off before anything else
+  // receive_status gives up after max_consecutive_bad_packets bad reads.
+  for (bool valid = false; fault == DeviceFault::none && !valid;) fault = receive_status(now_s(), valid);
+  if (fault != DeviceFault::none) {
+    record(fault);
     open_ = false;
     transport_->close();
-    throw;
+    throw_fault(fault);
   }
   if (is_calibrated()) {
     spdlog::info("Phantom: homed from the inkwell (docked bit set)");
@@ -102,13 +115,19 @@ void PhantomDevice::open() {
 }
 
 void PhantomDevice::close() noexcept {
+  if (fault_record_.fault != DeviceFault::none) {
+    try {  // the servo path kept the fault as plain data; it is worded here, off the servo thread
+      spdlog::warn("Phantom: last fault: {} ({}): {}", device_fault_name(fault_record_.fault),
+                   describe(fault_record_), to_string(fault_record_.fault));
+    } catch (...) {
+      // Logging must not turn close() into a throwing call.
+    }
+    fault_record_ = PhantomFaultRecord{};
+  }
   if (open_) {
     turn_forces_off_locally();
-    try {
-      send_command(CommandPacket{});
-    } catch (...) {
-      // The link is already gone; the device's own watchdog drops the forces.
-    }
+    // Best effort: when the link is already gone, the device's own watchdog drops the forces.
+    static_cast<void>(send_command(CommandPacket{}));
     open_ = false;
     const auto errors = packet_errors();
     const auto safety = safety_events();
@@ -127,7 +146,9 @@ void PhantomDevice::close() noexcept {
 
 void PhantomDevice::calibrate() {
   if (!open_) throw DeviceError("Phantom: calibrate() on a device that is not open");
-  while (!receive_status(now_s())) {
+  for (bool valid = false; !valid;) {
+    if (const DeviceFault fault = receive_status(now_s(), valid); fault != DeviceFault::none)
+      throw_fault(record(fault));
   }
   if (!last_status_.docked) {
     throw CalibrationNeeded("Phantom " + config_.info.model +
@@ -150,35 +171,40 @@ void PhantomDevice::enable_forces(bool enabled) {
   if (enabled && !forces_requested_.load(std::memory_order_acquire)) {
     // First half of the Omni's 0 -> 1 force-enable toggle, sent now so that the first write_force
     // already carries its force. The watchdog is armed by that first write_force.
-    send_command(CommandPacket{});
+    if (const DeviceFault fault = send_command(CommandPacket{}); fault != DeviceFault::none)
+      throw_fault(record(fault));
     enable_bit_zero_sent_ = true;
   }
   forces_requested_.store(enabled, std::memory_order_release);
 }
 
-DeviceState PhantomDevice::read_state() {
-  if (!open_) throw CommunicationError("Phantom: read_state() on a device that is not open");
+// Servo path from here to the end of write_force: codes and counters, no exception, allocation or string.
+DeviceFault PhantomDevice::read_state(DeviceState& state) noexcept {
+  if (!open_) return record(DeviceFault::not_open);
   const double now = now_s();
   if (watchdog_.expired(now)) {
     turn_forces_off_locally();
     counters_.watchdog_trips.fetch_add(1, std::memory_order_relaxed);
-    send_command(CommandPacket{});  // CommunicationError here means the link is gone as well
-    // A fixed message: the servo path builds no strings, also when it fails.
-    throw SafetyFault("Phantom: watchdog: no force command within its timeout; forces turned off");
+    // A link fault here means the link is gone as well: that is the fault to report.
+    if (const DeviceFault fault = send_command(CommandPacket{}); fault != DeviceFault::none)
+      return record(fault);
+    return record(DeviceFault::watchdog);
   }
-  receive_status(now);
-  return state_;
+  bool valid = false;
+  if (const DeviceFault fault = receive_status(now, valid); fault != DeviceFault::none) return record(fault);
+  state = state_;  // a fresh state, or the previous one after a rejected or missing packet
+  return DeviceFault::none;
 }
 
-void PhantomDevice::write_force(const Vec3& force_n) {
-  if (!open_) throw CommunicationError("Phantom: write_force() on a device that is not open");
+DeviceFault PhantomDevice::write_force(const Vec3& force_n) noexcept {
+  if (!open_) return record(DeviceFault::not_open);
   const double now = now_s();
   if (!force_n.allFinite()) {
     counters_.non_finite_commands.fetch_add(1, std::memory_order_relaxed);
     turn_forces_off_locally();
-    send_command(CommandPacket{});
-    throw SafetyFault(
-        "Phantom: non-finite force command (NaN or infinity); zero force sent, forces turned off");
+    if (const DeviceFault fault = send_command(CommandPacket{}); fault != DeviceFault::none)
+      return record(fault);
+    return record(DeviceFault::non_finite_force);
   }
   CommandPacket command;
   if (!forces_requested_.load(std::memory_order_acquire)) {
@@ -196,7 +222,21 @@ void PhantomDevice::write_force(const Vec3& force_n) {
     command.force_enable = true;
     watchdog_.kick(now);
   }
-  send_command(command);
+  if (const DeviceFault fault = send_command(command); fault != DeviceFault::none) return record(fault);
+  return DeviceFault::none;
+}
+
+DeviceFault PhantomDevice::record(DeviceFault fault) noexcept {
+  fault_record_.fault = fault;
+  fault_record_.time_s = state_.time_s;
+  fault_record_.bad_reads = fault == DeviceFault::no_valid_status ? consecutive_bad_reads_ : 0;
+  fault_record_.last_packet_error = last_packet_error_;
+  fault_record_.last_read_timed_out = last_read_timed_out_;
+  return fault;
+}
+
+void PhantomDevice::throw_fault(DeviceFault fault) const {
+  throw_device_fault(fault, config_.info.model, describe(fault_record_));
 }
 
 PacketErrorCounts PhantomDevice::packet_errors() const noexcept {
@@ -217,13 +257,13 @@ SafetyEventCounts PhantomDevice::safety_events() const noexcept {
   return counts;
 }
 
-bool PhantomDevice::receive_status(double now) {
+DeviceFault PhantomDevice::receive_status(double now, bool& valid) noexcept {
+  valid = false;
   std::size_t received = 0;
-  try {
-    received = transport_->read(receive_buffer_, config_.packet_timeout);
-  } catch (const CommunicationError&) {
+  if (const DeviceFault fault = transport_->read(receive_buffer_, config_.packet_timeout, received);
+      fault != DeviceFault::none) {
     lose_link();
-    throw;
+    return fault;
   }
   StatusPacket status;
   PacketError error = PacketError::none;
@@ -234,15 +274,14 @@ bool PhantomDevice::receive_status(double now) {
     if (error != PacketError::none) count_rejected(error);
   }
   if (received == 0 || error != PacketError::none) {
+    // The detail stays plain data; describe() words it off the servo path.
     last_packet_error_ = error;
+    last_read_timed_out_ = received == 0;
     if (++consecutive_bad_reads_ >= config_.max_consecutive_bad_packets) {
       lose_link();
-      throw CommunicationError(
-          "Phantom: no valid status packet in " + std::to_string(consecutive_bad_reads_) +
-          " reads (last problem: " + (received == 0 ? std::string("timeout") : packet_error_name(error)) +
-          "); forces turned off, device closed");
+      return DeviceFault::no_valid_status;
     }
-    return false;
+    return DeviceFault::none;
   }
   consecutive_bad_reads_ = 0;
   if (have_status_) {
@@ -252,7 +291,8 @@ bool PhantomDevice::receive_status(double now) {
   }
   if (status.docked && !is_calibrated()) home_at_inkwell(status);
   apply_status(status, now);
-  return true;
+  valid = true;
+  return DeviceFault::none;
 }
 
 void PhantomDevice::count_rejected(PacketError error) noexcept {
@@ -285,14 +325,11 @@ void PhantomDevice::home_at_inkwell(const StatusPacket& status) noexcept {
   calibrated_.store(true, std::memory_order_release);
 }
 
-void PhantomDevice::send_command(const CommandPacket& command) {
+DeviceFault PhantomDevice::send_command(const CommandPacket& command) noexcept {
   encode_command(command, send_buffer_);
-  try {
-    transport_->write(send_buffer_, config_.packet_timeout);
-  } catch (const CommunicationError&) {
-    lose_link();
-    throw;
-  }
+  const DeviceFault fault = transport_->write(send_buffer_, config_.packet_timeout);
+  if (fault != DeviceFault::none) lose_link();
+  return fault;
 }
 
 void PhantomDevice::turn_forces_off_locally() noexcept {
@@ -306,11 +343,8 @@ void PhantomDevice::lose_link() noexcept {
   if (!open_) return;
   open_ = false;  // before the best-effort write, so that a failing write does not recurse here
   encode_command(CommandPacket{}, send_buffer_);
-  try {
-    transport_->write(send_buffer_, config_.packet_timeout);
-  } catch (...) {
-    // Unplugged: nothing more to do on this side; the device's watchdog drops its forces.
-  }
+  // Unplugged: nothing more to do on this side; the device's watchdog drops its forces.
+  static_cast<void>(transport_->write(send_buffer_, config_.packet_timeout));
   transport_->close();
 }
 

@@ -11,7 +11,12 @@
 ///
 /// Threading: `read_state` and `write_force` belong to one servo thread. `enable_forces(false)`,
 /// `forces_enabled`, `is_calibrated`, `info`, `packet_errors` and `safety_events` may be called from any
-/// thread. `open`, `close`, `calibrate` and `enable_forces(true)` must not run while the servo loop runs.
+/// thread. `open`, `close`, `calibrate`, `enable_forces(true)` and `last_fault` must not run while the
+/// servo loop runs.
+///
+/// The servo path (`read_state`, `write_force`, and the codec and transport calls under them) neither
+/// throws, allocates nor builds a string: a fault is a `DeviceFault` code, its detail a plain
+/// `PhantomFaultRecord` and counters, formatted off the servo thread (`describe`, the log at `close()`).
 
 #include <array>
 #include <atomic>
@@ -19,6 +24,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <string>
 
 #include "calligraphy/devices/haptic_device.hpp"
 #include "devices/byte_transport.hpp"
@@ -43,10 +49,10 @@ struct PhantomDeviceConfig {
   double velocity_cutoff_hz = 50.0;                  ///< velocity filter cut-off [Hz] (velocity_filter.hpp)
   std::chrono::microseconds packet_timeout{2000};    ///< per read or write
   /// This many reads in a row without a valid status packet (timeouts, rejected packets) is a broken
-  /// link: CommunicationError. 50 is 50 ms at 1 kHz.
+  /// link: `DeviceFault::no_valid_status`. 50 is 50 ms at 1 kHz.
   int max_consecutive_bad_packets = 50;
   /// Monotonic time [s] used for time stamps, velocity and the watchdog. Empty: std::chrono::steady_clock.
-  /// Must not allocate or lock (it is called on the servo path).
+  /// Must not allocate, lock or throw (it is called on the servo path).
   std::function<double()> clock;
 };
 
@@ -57,10 +63,27 @@ struct PhantomDeviceConfig {
 
 /// Safety events since open(), for reports.
 struct SafetyEventCounts {
-  std::uint64_t non_finite_commands = 0;  ///< NaN/inf forces: zero force sent, SafetyFault thrown
+  std::uint64_t non_finite_commands = 0;  ///< NaN/inf forces: zero force sent, `non_finite_force`
   std::uint64_t clamped_commands = 0;     ///< forces above info().max_force_n, scaled down
   std::uint64_t watchdog_trips = 0;       ///< forces turned off because write_force stopped
 };
+
+/// The last servo-path fault and its detail, as plain data: written on the servo thread without
+/// allocating, formatted off it (`describe`).
+struct PhantomFaultRecord {
+  DeviceFault fault = DeviceFault::none;
+  double time_s = 0.0;  ///< the device clock at the fault [s]
+  /// Reads in a row without a valid status packet when the fault came (for `no_valid_status`).
+  int bad_reads = 0;
+  /// The problem of the last read without a valid status packet: a rejected packet's error, or none
+  /// for a timeout (nothing arrived).
+  PacketError last_packet_error = PacketError::none;
+  bool last_read_timed_out = false;
+};
+
+/// The record in words, e.g. "at 1.234 s; 50 reads in a row without a valid status packet, the last a
+/// timeout". Allocates: off the servo path. Empty for no fault.
+[[nodiscard]] std::string describe(const PhantomFaultRecord& record);
 
 class PhantomDevice final : public HapticDevice {
  public:
@@ -73,10 +96,11 @@ class PhantomDevice final : public HapticDevice {
 
   /// Opens the transport, logs what is and is not verified, sends a forces-off packet and waits for a
   /// valid status packet; homes the encoders when that packet says the stylus is docked. Throws
-  /// DeviceNotFound (transport cannot open) or CommunicationError (no valid status packet).
+  /// DeviceNotFound (transport cannot open) or CommunicationError (link lost, no valid status packet:
+  /// `throw_device_fault` with the record's detail).
   void open() override;
   /// Sends a forces-off packet (best effort), closes the transport, logs the packet and safety
-  /// counters. Never throws.
+  /// counters and the last servo-path fault with its detail. Never throws.
   void close() noexcept override;
   [[nodiscard]] bool is_open() const override { return open_; }
 
@@ -98,16 +122,16 @@ class PhantomDevice final : public HapticDevice {
 
   /// Servo path: reads one status packet (position [m], filtered velocity [m/s], buttons, time [s]).
   /// A rejected or missing packet is counted and the previous state is returned. Until is_calibrated()
-  /// the position is not meaningful. Throws CommunicationError when the link is lost (unplug, or
-  /// `max_consecutive_bad_packets` bad reads in a row: forces are turned off, the device closes) and
-  /// SafetyFault when the watchdog expired (no write_force for `watchdog_timeout_s`: forces turned off,
-  /// call enable_forces(true) to resume).
-  DeviceState read_state() override;
+  /// the position is not meaningful. Faults: `not_open`; `link_lost` (unplugged) and `no_valid_status`
+  /// (`max_consecutive_bad_packets` bad reads in a row): forces turned off, the device closes;
+  /// `watchdog` (forces on and no write_force for `watchdog_timeout_s`): forces turned off, call
+  /// enable_forces(true) to resume.
+  [[nodiscard]] DeviceFault read_state(DeviceState& state) noexcept override;
   /// Servo path: clamps `force_n` [N] to info().max_force_n keeping its direction, maps it to joint
-  /// torques (J^T F) and DAC counts, and sends one command packet. Throws SafetyFault on a NaN or
-  /// infinite component (zero force is sent and forces are turned off) and CommunicationError when the
-  /// link is lost (forces off, device closed).
-  void write_force(const Vec3& force_n) override;
+  /// torques (J^T F) and DAC counts, and sends one command packet. Faults: `non_finite_force` (a NaN or
+  /// infinite component: zero force is sent and forces are turned off), `not_open`, `link_lost`
+  /// (forces off, device closed).
+  [[nodiscard]] DeviceFault write_force(const Vec3& force_n) noexcept override;
 
   /// Rejected packets and link counters since construction. Any thread.
   [[nodiscard]] PacketErrorCounts packet_errors() const noexcept;
@@ -117,6 +141,9 @@ class PhantomDevice final : public HapticDevice {
   [[nodiscard]] const JointAngles& joint_angles() const noexcept { return joint_angles_; }
   /// The last valid status packet (raw). Servo thread only.
   [[nodiscard]] const StatusPacket& last_status() const noexcept { return last_status_; }
+  /// The last servo-path fault since open(), with its detail (`describe` words it). Servo thread, or any
+  /// thread once the servo loop has stopped.
+  [[nodiscard]] const PhantomFaultRecord& last_fault() const noexcept { return fault_record_; }
 
  private:
   struct AtomicCounters {
@@ -124,17 +151,22 @@ class PhantomDevice final : public HapticDevice {
     std::atomic<std::uint64_t> non_finite_commands{0}, clamped_commands{0}, watchdog_trips{0};
   };
 
-  double now_s() const { return config_.clock(); }
-  /// Reads once; on a valid packet updates the state and returns true. Throws CommunicationError when
-  /// the link is lost or too many bad reads in a row.
-  bool receive_status(double now_s);
+  double now_s() const noexcept { return config_.clock(); }
+  /// Reads once; on a valid packet updates the state and sets `valid`. Returns `link_lost` or
+  /// `not_open` (transport) or `no_valid_status` (too many bad reads in a row): the link is then lost.
+  [[nodiscard]] DeviceFault receive_status(double now_s, bool& valid) noexcept;
   void count_rejected(PacketError error) noexcept;
   void apply_status(const StatusPacket& status, double now_s) noexcept;
   void home_at_inkwell(const StatusPacket& status) noexcept;
-  void send_command(const CommandPacket& command);
+  /// Sends one command packet; on a transport fault loses the link and returns the fault.
+  [[nodiscard]] DeviceFault send_command(const CommandPacket& command) noexcept;
   /// Forces off on both sides (best effort), device closed. Never throws.
   void lose_link() noexcept;
   void turn_forces_off_locally() noexcept;
+  /// Keeps the fault and its detail in `fault_record_` and returns it. No allocation.
+  DeviceFault record(DeviceFault fault) noexcept;
+  /// Off the servo path: throws the typed exception of `fault` with the record's detail.
+  [[noreturn]] void throw_fault(DeviceFault fault) const;
   void log_start_up() const;
 
   std::unique_ptr<devices::ByteTransport> transport_;
@@ -156,6 +188,8 @@ class PhantomDevice final : public HapticDevice {
   bool have_status_ = false;
   int consecutive_bad_reads_ = 0;
   PacketError last_packet_error_ = PacketError::none;
+  bool last_read_timed_out_ = false;
+  PhantomFaultRecord fault_record_;
   StatusPacket last_status_;
   JointAngles joint_angles_ = JointAngles::Zero();
   DeviceState state_;

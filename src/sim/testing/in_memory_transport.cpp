@@ -19,21 +19,26 @@ void InMemoryTransport::close() noexcept { open_ = false; }
 
 bool InMemoryTransport::is_open() const noexcept { return open_; }
 
-void InMemoryTransport::throw_if_unusable(const char* /*operation*/) const {
+DeviceFault InMemoryTransport::usable() const noexcept {
   // Unplug is checked first: that is the fault a caller needs to see after a mid-stream disconnect.
-  // Fixed messages: the servo path builds no strings, also when it fails.
-  if (!peer_->connected()) throw CommunicationError("in-memory transport: device unplugged");
-  if (!open_) throw CommunicationError("in-memory transport: closed link");
+  if (!peer_->connected()) return DeviceFault::link_lost;
+  if (!open_) return DeviceFault::not_open;
+  return DeviceFault::none;
 }
 
-void InMemoryTransport::write(std::span<const std::uint8_t> packet, std::chrono::microseconds /*timeout*/) {
-  throw_if_unusable("write");
+DeviceFault InMemoryTransport::write(std::span<const std::uint8_t> packet,
+                                     std::chrono::microseconds /*timeout*/) noexcept {
+  if (const DeviceFault fault = usable(); fault != DeviceFault::none) return fault;
   peer_->receive_from_host(packet);
+  return DeviceFault::none;
 }
 
-std::size_t InMemoryTransport::read(std::span<std::uint8_t> buffer, std::chrono::microseconds /*timeout*/) {
-  throw_if_unusable("read");
-  return peer_->send_to_host(buffer);
+DeviceFault InMemoryTransport::read(std::span<std::uint8_t> buffer, std::chrono::microseconds /*timeout*/,
+                                    std::size_t& received) noexcept {
+  received = 0;
+  if (const DeviceFault fault = usable(); fault != DeviceFault::none) return fault;
+  received = peer_->send_to_host(buffer);
+  return DeviceFault::none;
 }
 
 std::string InMemoryTransport::description() const { return "in-memory link to an emulated device"; }

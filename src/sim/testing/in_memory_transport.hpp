@@ -14,7 +14,7 @@ namespace calligraphy::devices {
 class InMemoryPeer {
  public:
   virtual ~InMemoryPeer() = default;
-  /// False once the peer has been unplugged; the transport then throws CommunicationError.
+  /// False once the peer has been unplugged; the transport then returns `DeviceFault::link_lost`.
   [[nodiscard]] virtual bool connected() const noexcept = 0;
   /// The device receives one packet from the host.
   virtual void receive_from_host(std::span<const std::uint8_t> packet) noexcept = 0;
@@ -32,14 +32,16 @@ class InMemoryTransport final : public ByteTransport {
   void open() override;
   void close() noexcept override;
   [[nodiscard]] bool is_open() const noexcept override;
-  /// Throws CommunicationError when closed or when the peer was unplugged. `timeout` is ignored.
-  void write(std::span<const std::uint8_t> packet, std::chrono::microseconds timeout) override;
-  /// Throws CommunicationError when closed or when the peer was unplugged. `timeout` is ignored.
-  std::size_t read(std::span<std::uint8_t> buffer, std::chrono::microseconds timeout) override;
+  /// `link_lost` when the peer was unplugged, `not_open` when closed. `timeout` is ignored.
+  [[nodiscard]] DeviceFault write(std::span<const std::uint8_t> packet,
+                                  std::chrono::microseconds timeout) noexcept override;
+  /// `link_lost` when the peer was unplugged, `not_open` when closed. `timeout` is ignored.
+  [[nodiscard]] DeviceFault read(std::span<std::uint8_t> buffer, std::chrono::microseconds timeout,
+                                 std::size_t& received) noexcept override;
   [[nodiscard]] std::string description() const override;
 
  private:
-  void throw_if_unusable(const char* operation) const;
+  [[nodiscard]] DeviceFault usable() const noexcept;
 
   std::shared_ptr<InMemoryPeer> peer_;
   bool open_ = false;

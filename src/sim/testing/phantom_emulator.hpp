@@ -55,7 +55,7 @@ class PhantomEmulator final : public devices::InMemoryPeer {
   std::size_t send_to_host(std::span<std::uint8_t> buffer) noexcept override;
 
   // Test controls.
-  /// Unplugs: every later transport call throws CommunicationError; the motors stop.
+  /// Unplugs: every later transport call returns `DeviceFault::link_lost`; the motors stop.
   void disconnect() noexcept;
   /// Stylus into (true) or out of the inkwell. Docked, the arm is held at the inkwell pose.
   void set_docked(bool docked) noexcept { docked_ = docked; }
@@ -151,8 +151,12 @@ class EmulatedPhantomDevice final : public HapticDevice, public HandPort {
   [[nodiscard]] bool is_calibrated() const override { return device_->is_calibrated(); }
   void enable_forces(bool enabled) override { device_->enable_forces(enabled); }
   [[nodiscard]] bool forces_enabled() const override { return device_->forces_enabled(); }
-  DeviceState read_state() override { return device_->read_state(); }
-  void write_force(const Vec3& force_n) override { device_->write_force(force_n); }
+  [[nodiscard]] DeviceFault read_state(DeviceState& state) noexcept override {
+    return device_->read_state(state);
+  }
+  [[nodiscard]] DeviceFault write_force(const Vec3& force_n) noexcept override {
+    return device_->write_force(force_n);
+  }
 
   void attach_hand(HandModel* hand) noexcept override;
   void advance(double dt_s) noexcept override;
