@@ -19,6 +19,7 @@
 #include "calligraphy/render/renderer.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
 #include "calligraphy/trial/trial.hpp"
+#include "probe_device.hpp"
 
 namespace {
 thread_local bool watched = false;  // set by a thread to have its own allocations counted
@@ -86,6 +87,38 @@ TEST_CASE("The servo loop thread does not allocate while it renders and records"
   CHECK_FALSE(loop.stats().fault);
   CHECK(transitions > 0);
   CHECK(watched_allocations.load() == before);
+}
+
+TEST_CASE("A device fault ends the loop without an allocation on the servo thread", "[servo]") {
+  // The fault is a code from read_state: the loop records it (code and fixed message), zeroes the force,
+  // disables forces and ends, all without allocating or building a string; the typed exception is made
+  // only by wait(), on this thread.
+  using namespace calligraphy;
+  for (const DeviceFault fault : {DeviceFault::link_lost, DeviceFault::watchdog}) {
+    test::ProbeDevice device(/*fail_on_read=*/300, fault);
+    ServoLoopOptions options;
+    options.lock_memory = false;
+    options.stall_timeout_s = 0.0;
+    options.max_force_age_s = 1.0;
+    ServoLoop loop(
+        device,
+        [&](const DeviceState& state, double) {
+          watched = true;  // from the first tick on, everything this thread does is counted
+          return ServoCommand{Vec3(0.1 * state.position_m.x(), 0.0, 0.0), false};
+        },
+        options);
+    const long before = watched_allocations.load();
+    loop.start();
+    if (fault == DeviceFault::link_lost) {
+      CHECK_THROWS_AS(loop.wait(), CommunicationError);
+    } else {
+      CHECK_THROWS_AS(loop.wait(), SafetyFault);
+    }
+    CHECK(loop.stats().ticks == 300);
+    CHECK(loop.stats().fault.device == fault);
+    CHECK(watched_allocations.load() == before);
+    CHECK(device.inner_.applied_force() == Vec3::Zero());
+  }
 }
 
 TEST_CASE("A trial session publishing to a display does not allocate on the servo thread",
