@@ -7,8 +7,8 @@
 #include <random>
 #include <vector>
 
-#include "calligraphy/collision/nearest_point.hpp"
-#include "calligraphy/collision/nearest_point_tracker.hpp"
+#include "calligraphy/model/nearest_point.hpp"
+#include "calligraphy/model/nearest_point_tracker.hpp"
 #include "eval/nearest_point_scenarios.hpp"
 
 namespace {

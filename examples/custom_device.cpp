@@ -11,6 +11,7 @@
 #include <calligraphy/devices/device_registry.hpp>
 #include <calligraphy/model/character_library.hpp>
 #include <calligraphy/sim/hand_port.hpp>
+#include <calligraphy/sim/simulated_hand.hpp>
 #include <calligraphy/trial/trial.hpp>
 #include <cmath>
 #include <cstdio>
@@ -117,8 +118,9 @@ int main() {
 
   const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'口')});
   TrialOptions options;  // 1 kHz, novice writer, guidance on
-  options.simulation.seed = 1;
-  const TrialResult result = run_trial("voice-coil-puck", scene, options);
+  SimulationOptions simulation;  // the simulated writer that holds the puck (it has a hand port)
+  simulation.seed = 1;
+  const TrialResult result = run_trial("voice-coil-puck", scene, options, simulation);
 
   // A device fault mid-trial ends it with the code and its message (device_fault_message); off the servo
   // path, throw_device_fault would make it the typed exception.

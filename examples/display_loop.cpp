@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <calligraphy/model/character_library.hpp>
 #include <calligraphy/model/scene.hpp>
+#include <calligraphy/sim/simulated_hand.hpp>
 #include <calligraphy/trial/trial.hpp>
 #include <chrono>
 #include <cmath>
@@ -44,7 +45,6 @@ int main(int argc, char** argv) {
     DisplayChannel channel;
     TrialOptions options;
     options.pacing = TrialPacing::real_time;  // the simulated writer writes at the wall clock's pace
-    options.simulation.seed = argc > 2 ? std::strtoull(argv[2], nullptr, 10) : 0;
     options.keep_trace = true;
     // As the trainer's window does: an application with a display maps memory all the time, which
     // mlockall(MCL_FUTURE) would lock too; the trial touches its trace in advance instead.
@@ -54,7 +54,9 @@ int main(int argc, char** argv) {
     std::exception_ptr failure;
     std::thread servo_side([&] {
       try {
-        result = run_trial("simulated", scene, options);
+        SimulationOptions simulation;
+        simulation.seed = argc > 2 ? std::strtoull(argv[2], nullptr, 10) : 0;
+        result = run_trial("simulated", scene, options, simulation);
       } catch (...) {
         failure = std::current_exception();
         channel.push_event(

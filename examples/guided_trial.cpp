@@ -2,6 +2,7 @@
 // simulated device, and print the metrics.
 #include <calligraphy/model/character_library.hpp>
 #include <calligraphy/model/scene.hpp>
+#include <calligraphy/sim/simulated_hand.hpp>
 #include <calligraphy/trial/trial.hpp>
 #include <cmath>
 #include <cstdio>
@@ -13,8 +14,9 @@ int main() {
 
   TrialOptions options;                              // 1 kHz, simulated Phantom Desktop, novice writer
   options.force.guidance_stiffness_n_per_m = 400.0;  // K_et [N/m], eq. (8)
-  options.simulation.seed = 1;
-  const TrialResult result = run_simulated_trial(scene, options);
+  SimulationOptions simulation;                      // the simulated writer and device (calligraphy/sim)
+  simulation.seed = 1;
+  const TrialResult result = run_simulated_trial(scene, options, simulation);
 
   const TrialMetrics& m = result.metrics;
   std::printf("%zu/%zu strokes, mean deviation %.2f mm, max |F| %.2f N\n", m.strokes_completed,

@@ -11,13 +11,15 @@
 #include <algorithm>
 #include <calligraphy/model/character_library.hpp>
 #include <calligraphy/model/scene.hpp>
-#include <calligraphy/trial/score.hpp>
+#include <calligraphy/sim/simulated_hand.hpp>
+#include <calligraphy/analysis/score.hpp>
 #include <calligraphy/trial/trial.hpp>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,10 +47,12 @@ struct Run {
 Run run_trial(const Scene& scene, const WriterProfile& profile, bool guidance, std::uint64_t seed) {
   TrialOptions options;
   options.force.guidance = guidance;
-  options.simulation.writer = profile;
-  options.simulation.seed = seed;
   options.max_duration_s = 300.0;
-  const TrialResult result = run_simulated_trial(scene, options);
+  SimulationOptions simulation;
+  simulation.writer = profile;
+  simulation.seed = seed;
+  std::optional<WriterLog> log;
+  const TrialResult result = run_simulated_trial(scene, options, simulation, &log);
 
   std::vector<PenSample> pen;
   for (const TrialSample& s : result.trace) {
@@ -66,8 +70,8 @@ Run run_trial(const Scene& scene, const WriterProfile& profile, bool guidance, s
   run.order_errors = score.order_errors;
   run.backwards = score.backwards_strokes;
   run.in_order = result.metrics.completed_in_order;
-  run.refusals = result.writer_log ? result.writer_log->refusals : 0;
-  run.not_accepted = result.writer_log ? result.writer_log->not_accepted : 0;
+  run.refusals = log ? log->refusals : 0;
+  run.not_accepted = log ? log->not_accepted : 0;
   return run;
 }
 

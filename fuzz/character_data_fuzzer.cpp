@@ -20,7 +20,7 @@
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/fitting.hpp"
-#include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/model/nearest_point.hpp"
 
 namespace {
 

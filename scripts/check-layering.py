@@ -1,19 +1,72 @@
 #!/usr/bin/env python3
-"""Fails when a source file includes a module above its own.
+"""Fails when a source file includes a module its own module does not depend on.
 
-The modules, lowest first (docs/architecture.md): core, model, collision, render, devices, sim (its testing
-part, the emulator, only for eval and programs), trial, report, study, eval, then the programs (cli, bindings, tests, bench, examples, fuzz),
-which may include any module. A file's module is the folder after src/ or include/calligraphy/; an
-include's module is the folder after calligraphy/ (a public header) or the first folder of a private
-header under src/. Usage: check-layering.py [ROOT] -> exit 1 listing each upward include as
-file:line: message.
+The modules and what each depends on directly (docs/architecture.md) are MODULE_DEPENDS below, the same graph
+as the `calligraphy_module(NAME DEPENDS ...)` lines of CMakeLists.txt (checked when that file is there, so
+the two cannot drift apart). A module may include itself and every module it reaches through the graph. The
+testing part (the emulator) is a side branch only eval and programs use. Programs (cli, bindings, tests,
+bench, examples, fuzz, trainer) may include any module. A file's module is the folder after src/ or
+include/calligraphy/; an include's module is the folder after calligraphy/ (a public header) or the first
+folder of a private header under src/. Usage: check-layering.py [ROOT] -> exit 1 listing each bad include
+as file:line: message.
 """
 import pathlib
 import re
 import sys
 
-ORDER = ["core", "model", "collision", "render", "devices", "sim", "testing", "trial", "report", "study", "eval"]
-RANK = {name: rank for rank, name in enumerate(ORDER)}
+MODULE_DEPENDS = {
+    "core": [],
+    "model": ["core"],
+    "collision": ["model"],
+    "render": ["collision"],
+    "analysis": ["model"],
+    "devices": ["core"],
+    "trial": ["render", "devices", "analysis"],
+    "sim": ["devices", "render", "trial"],
+    "testing": ["sim"],
+    "report": ["trial", "analysis"],
+    "study": ["report", "sim"],
+    "eval": ["study", "testing"],
+}
+
+
+def reachable(module):
+    seen, todo = set(), [module]
+    while todo:
+        for dependency in MODULE_DEPENDS[todo.pop()]:
+            if dependency not in seen:
+                seen.add(dependency)
+                todo.append(dependency)
+    return seen
+
+
+REACHES = {name: reachable(name) for name in MODULE_DEPENDS}
+RANK = REACHES  # the modules the checker knows
+CMAKE_MODULE = re.compile(r"^calligraphy_module\((\w+)([^)]*)\)", re.MULTILINE)
+
+
+def cmake_graph_problems(root: pathlib.Path):
+    """The DEPENDS of CMakeLists.txt's calligraphy_module lines, against MODULE_DEPENDS."""
+    cmake = root / "CMakeLists.txt"
+    if not cmake.is_file():
+        return []
+    problems = []
+    for name, rest in CMAKE_MODULE.findall(cmake.read_text(encoding="utf-8")):
+        words = rest.split()
+        depends = []
+        if "DEPENDS" in words:
+            for word in words[words.index("DEPENDS") + 1:]:
+                if word.isupper():
+                    break
+                depends.append(word)
+        if name not in MODULE_DEPENDS:
+            problems.append(f"CMakeLists.txt: module '{name}' is not in check-layering's MODULE_DEPENDS")
+        elif sorted(depends) != sorted(MODULE_DEPENDS[name]):
+            problems.append(f"CMakeLists.txt: module '{name}' DEPENDS {depends}, check-layering says "
+                            f"{MODULE_DEPENDS[name]}")
+    return problems
+
+
 INCLUDE = re.compile(r'^\s*#\s*include\s*"([^"]+)"')
 
 
@@ -54,9 +107,9 @@ def check(root: pathlib.Path):
                 if not match:
                     continue
                 target = module_of_include(match.group(1))
-                if target in RANK and RANK[target] > RANK[own]:
+                if target in RANK and target != own and target not in REACHES[own] and target != "testing":
                     problems.append(f"{relative}:{number}: module '{own}' includes '{match.group(1)}' "
-                                    f"of module '{target}', which is above it")
+                                    f"of module '{target}', which it does not depend on")
                 elif target == "testing" and own not in ("testing", "eval"):
                     # The testing part (emulator, in-memory link) is a side branch for tests, not a layer
                     # the library builds on.
@@ -70,13 +123,13 @@ def main():
     if not (root / "src").is_dir():
         print(f"check-layering: {root} has no src/ folder", file=sys.stderr)
         return 2
-    problems = check(root)
+    problems = cmake_graph_problems(root) + check(root)
     for problem in problems:
         print(problem)
     if problems:
-        print(f"check-layering: {len(problems)} upward include(s)", file=sys.stderr)
+        print(f"check-layering: {len(problems)} problem(s)", file=sys.stderr)
         return 1
-    print("check-layering: every include points to the same module or one below")
+    print("check-layering: every include points to the same module or one it depends on")
     return 0
 
 

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <string>
 
+#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/report/trial_report.hpp"
@@ -108,7 +109,7 @@ TEST_CASE("A trial of 永 runs end to end on the emulated Phantom through the Ph
   const Scene scene = scene_of(U"永");
   EmulatedPhantomDevice device(phantom::phantom_omni_config(),
                                undocking_emulator(phantom::phantom_omni_config()));
-  const TrialResult result = run_trial(device, scene, TrialOptions{});
+  const TrialResult result = run_trial(device, scene, TrialOptions{}, SimulationOptions{});
   CHECK_FALSE(result.aborted);
   CHECK(result.abort_reason.empty());
   CHECK(result.metrics.strokes_total == 5);
@@ -135,10 +136,11 @@ TEST_CASE("Lock-step trials on the emulated Phantom are deterministic for a seed
   calligraphy::testing::register_emulated_phantom(calligraphy::device_registry());
   const Scene scene = scene_of(U"口");
   TrialOptions options;
-  options.simulation.seed = 5;
   options.keep_trace = false;
-  const auto first = run_trial("emulated-phantom", scene, options);
-  const auto again = run_trial("emulated-phantom", scene, options);
+  SimulationOptions simulation;
+  simulation.seed = 5;
+  const auto first = run_trial("emulated-phantom", scene, options, simulation);
+  const auto again = run_trial("emulated-phantom", scene, options, simulation);
   CHECK(first.metrics.strokes_completed == first.metrics.strokes_total);
   CHECK(first.metrics.mean_deviation_m == again.metrics.mean_deviation_m);
   CHECK(first.metrics.time_s == again.metrics.time_s);
@@ -166,13 +168,12 @@ TEST_CASE("The CLI's runner takes a registry name, an unknown name lists the dev
 
 TEST_CASE("The simulated device runs the same loop as run_simulated_trial", "[device-trial]") {
   const Scene scene = scene_of(U"九");
-  TrialOptions simulated;
-  simulated.simulation.seed = 2;
-  TrialOptions on_device;
-  on_device.simulation.seed = 2;
-  SimulatedDevice device(simulated.simulation.device);
-  const auto a = run_simulated_trial(scene, simulated);
-  const auto b = run_trial(device, scene, on_device);
+  const TrialOptions options;
+  SimulationOptions simulation;
+  simulation.seed = 2;
+  SimulatedDevice device(simulation.device);
+  const auto a = run_simulated_trial(scene, options, simulation);
+  const auto b = run_trial(device, scene, options, simulation);
   CHECK(a.metrics.mean_deviation_m == b.metrics.mean_deviation_m);
   CHECK(a.metrics.time_s == b.metrics.time_s);
   CHECK(a.trace.size() == b.trace.size());
@@ -184,7 +185,7 @@ TEST_CASE("A disconnect mid-trial aborts it with forces zeroed and the recording
   const Scene scene = scene_of(U"永");
   constexpr int kUnplugAt = 3000;  // 3 s in: the first stroke is being written
   UnpluggedPhantom device(kUnplugAt);
-  const TrialResult result = run_trial(device, scene, TrialOptions{});
+  const TrialResult result = run_trial(device, scene, TrialOptions{}, SimulationOptions{});
   REQUIRE(result.aborted);
   INFO(result.abort_reason);
   CHECK(result.end == TrialEnd::device_fault);
@@ -215,12 +216,12 @@ TEST_CASE("The reports of an aborted trial say so and keep what was recorded", "
   const Scene scene = scene_of(U"口");
   UnpluggedPhantom device(1500);
   TrialOptions options;
-  const TrialResult result = run_trial(device, scene, options);
+  const TrialResult result = run_trial(device, scene, options, SimulationOptions{});
   REQUIRE(result.aborted);
   CHECK(result.device_fault == DeviceFault::link_lost);
   const TrialDescription description{
       "口", true, "novice", 0, 1000.0, "emulated-phantom", device.info().model};
-  const std::string json = trial_json(description, result);
+  const std::string json = trial_json(description, result, trial_writing_metrics(scene, result, StrokeAcceptance{}));
   CHECK(json.find("\"aborted\": true") != std::string::npos);
   CHECK(json.find("unplugged") != std::string::npos);
   CHECK(json.find("\"device\": \"emulated-phantom\"") != std::string::npos);
@@ -236,7 +237,7 @@ TEST_CASE("A safety fault aborts a trial on the servo loop, ticks are paced by a
   FaultingDevice device(40);
   TrialOptions options;
   const auto start = std::chrono::steady_clock::now();
-  const TrialResult result = run_trial(device, scene, options);
+  const TrialResult result = run_trial(device, scene, options, SimulationOptions{});
   const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   REQUIRE(result.aborted);
   CHECK(result.end == TrialEnd::device_fault);
@@ -258,7 +259,7 @@ TEST_CASE("A device that cannot calibrate refuses the trial and is closed", "[de
   auto parameters = phantom::emulator_matching(config);
   parameters.start_docked = false;  // never in the inkwell: encoders cannot be homed
   EmulatedPhantomDevice device(config, parameters);
-  CHECK_THROWS_AS(run_trial(device, scene_of(U"口"), TrialOptions{}), CalibrationNeeded);
+  CHECK_THROWS_AS(run_trial(device, scene_of(U"口"), TrialOptions{}, SimulationOptions{}), CalibrationNeeded);
   CHECK_FALSE(device.is_open());
   CHECK_FALSE(device.emulator().forces_active());
 }
@@ -266,7 +267,7 @@ TEST_CASE("A device that cannot calibrate refuses the trial and is closed", "[de
 TEST_CASE("A device without a usable force limit is refused after open() and closed again",
           "[device-trial]") {
   FaultingDevice device(1000, 0.0);
-  CHECK_THROWS_AS(run_trial(device, scene_of(U"口"), TrialOptions{}), InvalidArgument);
+  CHECK_THROWS_AS(run_trial(device, scene_of(U"口"), TrialOptions{}, SimulationOptions{}), InvalidArgument);
   CHECK(device.reads == 0);
   CHECK(device.closes == 1);
   CHECK_FALSE(device.is_open());

@@ -1,6 +1,7 @@
 // The servo-to-display channel: the seqlock never hands out a torn value while another thread writes,
 // the SPSC queue keeps order and counts what it refuses, and a trial publishes what the display needs
 // (snapshots, trace, the stroke and trial events), also while a display thread reads concurrently.
+#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/trial/display.hpp"
 
 #include <atomic>
@@ -130,9 +131,10 @@ TEST_CASE("A lock-step trial publishes each tick, its trace, and its stroke even
   channel_options.trace_capacity = std::size_t{1} << 20;
   DisplayChannel channel(channel_options);
   TrialOptions options;
-  options.simulation.seed = 5;
   options.display = &channel;
-  const TrialResult result = run_simulated_trial(scene, options);
+  SimulationOptions simulation;
+  simulation.seed = 5;
+  const TrialResult result = run_simulated_trial(scene, options, simulation);
   REQUIRE(result.end == TrialEnd::completed);
   const std::size_t ticks = result.trace.size();
 
@@ -233,12 +235,13 @@ TEST_CASE("A display thread reads a real-time trial while it runs and sees whole
   options.pacing = TrialPacing::real_time;
   options.loop.lock_memory = false;
   options.loop.priority = 0;
-  options.simulation.seed = 2;
   options.display = &channel;
+  SimulationOptions simulation;
+  simulation.seed = 2;
   std::atomic<bool> trial_done{false};
   TrialResult result;
   std::thread trial([&] {
-    result = run_simulated_trial(scene, options);
+    result = run_simulated_trial(scene, options, simulation);
     trial_done.store(true);
   });
   std::uint64_t reads = 0;

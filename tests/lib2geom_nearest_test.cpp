@@ -7,7 +7,7 @@
 #include <limits>
 #include <random>
 
-#include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/model/nearest_point.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "eval/nearest_point_measurement.hpp"
 #include "eval/nearest_point_report.hpp"

@@ -5,8 +5,9 @@
 #include <cstdlib>
 #include <new>
 
-#include "calligraphy/collision/nearest_point.hpp"
-#include "calligraphy/collision/nearest_point_tracker.hpp"
+#include "calligraphy/sim/simulated_hand.hpp"
+#include "calligraphy/model/nearest_point.hpp"
+#include "calligraphy/model/nearest_point_tracker.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/render/renderer.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
@@ -55,8 +56,9 @@ TEST_CASE("Renderer ticks (smoothing, passivity controller, safety chain) do not
   using namespace calligraphy;
   const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'永')});
   TrialOptions trial;
-  trial.simulation.seed = 1;
-  const TrialResult recorded = run_simulated_trial(scene, trial);  // positions of a real trial
+  SimulationOptions simulation;
+  simulation.seed = 1;
+  const TrialResult recorded = run_simulated_trial(scene, trial, simulation);  // positions of a real trial
   REQUIRE(recorded.trace.size() > 1000);
   RendererOptions options;
   options.passivity.enabled = true;

@@ -5,8 +5,8 @@
 #include <numbers>
 #include <random>
 
-#include "calligraphy/collision/nearest_point.hpp"
-#include "calligraphy/collision/nearest_point_tracker.hpp"
+#include "calligraphy/model/nearest_point.hpp"
+#include "calligraphy/model/nearest_point_tracker.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "eval/nearest_point_reference.hpp"

@@ -1,6 +1,6 @@
 // Nearest point on a stroke element: every method on every extreme case (see extreme_cases below),
 // against the independent high-precision reference of src/cli/nearest_point_reference.hpp.
-#include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/model/nearest_point.hpp"
 
 #include <catch2/catch.hpp>
 #include <cmath>

@@ -1,12 +1,12 @@
 // NearestPointTracker: hysteresis between equal minima, following a moving point, reset, bad input.
-#include "calligraphy/collision/nearest_point_tracker.hpp"
+#include "calligraphy/model/nearest_point_tracker.hpp"
 
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
 #include <utility>
 
-#include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/model/nearest_point.hpp"
 #include "calligraphy/core/errors.hpp"
 
 using calligraphy::NearestPoint;

@@ -10,11 +10,11 @@
 #include <set>
 #include <vector>
 
-#include "calligraphy/collision/stroke_matcher.hpp"
+#include "calligraphy/analysis/stroke_matcher.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/sim/person_traces.hpp"
 #include "calligraphy/study/quiz.hpp"
-#include "calligraphy/trial/score.hpp"
+#include "calligraphy/analysis/score.hpp"
 #include "embedded_scenes.hpp"
 
 using namespace calligraphy;

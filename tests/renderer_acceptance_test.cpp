@@ -1,13 +1,13 @@
 // The renderer driven tick by tick by a pen that follows paths the engine did not make: the data's medians
 // and person-like paths (sim/person_traces.hpp) on random characters of the whole hanzi-writer-data
-// package. The renderer's verdict must be the stroke matcher's (collision/stroke_matcher.hpp) for the same
+// package. The renderer's verdict must be the stroke matcher's (analysis/stroke_matcher.hpp) for the same
 // path: one rule of acceptance for every front-end.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <iostream>
 #include <random>
 
-#include "calligraphy/collision/stroke_matcher.hpp"
+#include "calligraphy/analysis/stroke_matcher.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/render/renderer.hpp"
 #include "calligraphy/sim/person_traces.hpp"

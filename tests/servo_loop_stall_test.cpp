@@ -9,6 +9,7 @@
 #include <limits>
 #include <thread>
 
+#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/devices/servo_loop.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
@@ -155,7 +156,7 @@ TEST_CASE("A real-time trial ended by a stall keeps every tick recorded, the tri
   options.loop = stall_test_options();
   options.loop.stall_timeout_s = 0.1;
   options.max_duration_s = 2.0;
-  const TrialResult result = run_trial(device, scene, options);
+  const TrialResult result = run_trial(device, scene, options, SimulationOptions{});
   CHECK(result.end == TrialEnd::watchdog);
   CHECK(result.aborted);
   CHECK(device.advances_ == 100);

@@ -2,6 +2,7 @@
 // real-time trial on the simulated device (late ticks and stalls: servo_loop_stall_test.cpp). Timing is
 // asserted only as loose properties (tick counts within 20 %), never as benchmarks; `calligraphy bench
 // loop` measures jitter.
+#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/devices/servo_loop.hpp"
 
 #include <dirent.h>
@@ -293,12 +294,13 @@ TEST_CASE("Enforced realtime that cannot be had fails at start with the reason",
 TEST_CASE("A real-time trial on the simulated device records the lock-step trial's trace", "[servo]") {
   const Scene scene = scene_of(U"口");
   TrialOptions trial;
-  trial.simulation.writer = WriterProfile::skilled();
   trial.max_duration_s = 2.5;  // about the first stroke of 口 (a whole trial would take 6 s of wall clock)
-  const TrialResult lockstep = run_simulated_trial(scene, trial);
+  SimulationOptions skilled;
+  skilled.writer = WriterProfile::skilled();
+  const TrialResult lockstep = run_simulated_trial(scene, trial, skilled);
   trial.pacing = TrialPacing::real_time;
   trial.loop = test_options();
-  const TrialResult realtime = run_simulated_trial(scene, trial);
+  const TrialResult realtime = run_simulated_trial(scene, trial, skilled);
 
   CHECK(realtime.end == TrialEnd::time_limit);
   REQUIRE(realtime.loop.has_value());
@@ -329,7 +331,7 @@ TEST_CASE("A device fault during a real-time trial keeps the recording and repor
   options.pacing = TrialPacing::real_time;
   options.loop = test_options();
   options.max_duration_s = 2.0;
-  const TrialResult result = run_trial(device, scene, options);
+  const TrialResult result = run_trial(device, scene, options, SimulationOptions{});
   CHECK(result.end == TrialEnd::device_fault);
   CHECK(result.aborted);
   CHECK(result.device_fault == DeviceFault::link_lost);

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy//model/character_library.hpp"
 #include "calligraphy/collision/constraint_space.hpp"
 #include "calligraphy/render/force_law.hpp"
@@ -44,9 +45,13 @@ struct StepFigures {
   bool completed = false;
 };
 
-StepFigures trial_steps(char32_t c, const TrialOptions& options) {
+// A guided novice of seed `seed` writes `c` with `options`.
+StepFigures trial_steps(char32_t c, const TrialOptions& options, std::uint64_t seed) {
   const Scene scene = scene_of(c);
-  const TrialResult result = run_simulated_trial(scene, options);
+  SimulationOptions novice;
+  novice.writer = WriterProfile::novice();
+  novice.seed = seed;
+  const TrialResult result = run_simulated_trial(scene, options, novice);
   StepFigures f;
   f.completed = result.metrics.completed_in_order;
   for (std::size_t k = 0; k < result.trace.size(); ++k) {
@@ -58,11 +63,9 @@ StepFigures trial_steps(char32_t c, const TrialOptions& options) {
   return f;
 }
 
-TrialOptions guided_novice(std::uint64_t seed) {
+TrialOptions guided() {
   TrialOptions options;
-  options.simulation.seed = seed;
   options.force.guidance = true;
-  options.simulation.writer = WriterProfile::novice();
   return options;
 }
 
@@ -137,11 +140,11 @@ TEST_CASE("Through full guided trials on 20 characters the per-tick force change
   }
   for (const auto& [c, seed] :
        calligraphy::testing::sanitizer_subset(trials, kSanitizedTrials, "character x seed")) {
-    TrialOptions options = guided_novice(seed);
+    TrialOptions options = guided();
     options.keep_trace = true;
-    const StepFigures chain = trial_steps(c, options);
+    const StepFigures chain = trial_steps(c, options, seed);
     options.safety.max_force_change_n_per_tick = 0.0;  // the smoothing alone, without the rate limit
-    const StepFigures smoothing = trial_steps(c, options);
+    const StepFigures smoothing = trial_steps(c, options, seed);
     INFO(utf8(c) << " seed " << seed << ": max per-tick change " << chain.max_step_n << " N with the chain, "
                  << smoothing.max_step_n << " N without its rate limit");
     CHECK(chain.completed);
@@ -154,11 +157,11 @@ TEST_CASE("Through full guided trials on 20 characters the per-tick force change
 
 TEST_CASE("Without the smoothing and the rate limit the paper's force law steps (the trial test can fail)",
           "[smoothness]") {
-  TrialOptions options = guided_novice(1);
+  TrialOptions options = guided();
   options.force = unsmoothed();
   options.safety.max_force_change_n_per_tick = 0.0;
   options.safety.start_ramp_n_per_s = 0.0;
-  const StepFigures raw = trial_steps(U'我', options);
+  const StepFigures raw = trial_steps(U'我', options, 1);
   INFO("max per-tick change " << raw.max_step_n << " N");
   // Above the limit, so the trial test above fails on this force law.
   CHECK(raw.max_step_n > SafetyChainParameters{}.max_force_change_n_per_tick);
@@ -267,10 +270,10 @@ TEST_CASE("Trials figures for docs/force-rendering.md", "[.smoothness-figures]")
   std::printf("char  seed  max_step_N(chain)  max_step_N(no rate limit)  max_force_N  completed\n");
   for (const char32_t c : kCharacters) {
     for (const std::uint64_t seed : {1u, 2u}) {
-      TrialOptions options = guided_novice(seed);
-      const StepFigures with = trial_steps(c, options);
+      TrialOptions options = guided();
+      const StepFigures with = trial_steps(c, options, seed);
       options.safety.max_force_change_n_per_tick = 0.0;
-      const StepFigures without = trial_steps(c, options);
+      const StepFigures without = trial_steps(c, options, seed);
       std::printf("%s  %4llu  %17.4f  %25.4f  %11.3f  %s\n", utf8(c).c_str(),
                   static_cast<unsigned long long>(seed), with.max_step_n, without.max_step_n,
                   with.max_force_n, with.completed ? "yes" : "no");

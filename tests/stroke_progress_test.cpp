@@ -1,13 +1,13 @@
-// Stroke progress and the stroke matcher (collision/stroke_progress.hpp, collision/stroke_matcher.hpp):
+// Stroke progress and the stroke matcher (model/stroke_progress.hpp, analysis/stroke_matcher.hpp):
 // corners gone round on either side, ends short of or past the end, and the refusals, on strokes laid
 // out in a 60 mm box.
-#include "calligraphy/collision/stroke_progress.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <vector>
 
-#include "calligraphy/collision/stroke_matcher.hpp"
+#include "calligraphy/analysis/stroke_matcher.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/scene.hpp"
 

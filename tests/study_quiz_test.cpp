@@ -5,7 +5,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/study/quiz.hpp"
-#include "calligraphy/trial/metrics.hpp"
+#include "calligraphy/analysis/metrics.hpp"
 #include "embedded_scenes.hpp"
 
 using namespace calligraphy;

@@ -129,7 +129,7 @@ TEST_CASE("a session stopped mid-trial resumes without losing or overwriting a s
   for (const PlannedTrial& trial : resumed.plan()) {
     const auto record = nlohmann::json::parse(read(resumed.trial_file(trial, "json")));
     for (const char* key :
-         {"frechet_mm", "dtw_mm", "order_errors", "backwards_strokes", "time_s", "mean_deviation_mm",
+         {"frechet_mm", "dtw_mm", "order_errors", "backwards_strokes", "total_time_s", "mean_deviation_mm",
           "start_time_utc", "force_law", "renderer", "scene", "writer"}) {
       CHECK(record.contains(key));
     }
@@ -274,7 +274,7 @@ TEST_CASE("a simulated subject writes the same for the same id and differently f
     SessionFolder session = SessionFolder::create(temp.path, simulated(id), protocol);
     run_session(session);
     const auto record = nlohmann::json::parse(read(session.trial_file(session.plan()[0], "json")));
-    times.push_back(record["per_stroke"].dump() + record["time_s"].dump());
+    times.push_back(record["per_stroke"].dump() + record["total_time_s"].dump());
   }
   CHECK(times[0] == times[1]);
   CHECK(times[0] != times[2]);

@@ -1,5 +1,6 @@
 // The teacher's recording file of the replay guidance mode: round trip through JSON and the errors of
 // a bad file (report/teacher_recording.hpp).
+#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/report/teacher_recording.hpp"
 
 #include <unistd.h>
@@ -20,10 +21,11 @@ namespace {
 
 TeacherRecording recorded_teacher(const Scene& scene) {
   TrialOptions options;
-  options.simulation.writer = WriterProfile::skilled();
-  options.simulation.seed = 5;
   options.keep_trace = true;
-  const TrialResult result = run_simulated_trial(scene, options);
+  SimulationOptions teacher;
+  teacher.writer = WriterProfile::skilled();
+  teacher.seed = 5;
+  const TrialResult result = run_simulated_trial(scene, options, teacher);
   REQUIRE(result.metrics.completed_in_order);
   return teacher_recording_from_trace("十", "skilled", "simulated", options.rate_hz, result.trace);
 }

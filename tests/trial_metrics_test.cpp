@@ -3,7 +3,7 @@
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/trial/metrics.hpp"
+#include "calligraphy/analysis/metrics.hpp"
 
 using namespace calligraphy;
 

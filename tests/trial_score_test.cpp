@@ -7,7 +7,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/character_library.hpp"
-#include "calligraphy/trial/score.hpp"
+#include "calligraphy/analysis/score.hpp"
 #include "embedded_scenes.hpp"
 
 using namespace calligraphy;

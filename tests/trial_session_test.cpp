@@ -2,6 +2,7 @@
 // the loop statistics kept, an interrupt, the time limit, a writer that gives up.
 #include <catch2/catch.hpp>
 
+#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
 #include "calligraphy/sim/simulated_writer.hpp"
@@ -25,11 +26,12 @@ Scene scene_of(std::u32string chars) {
 TEST_CASE("A session stepped from the application's own loop records the runner's trial", "[trial]") {
   const Scene scene = scene_of(U"九");
   TrialOptions options;
-  options.simulation.seed = 3;
-  const TrialResult by_runner = run_simulated_trial(scene, options);
+  SimulationOptions simulation;
+  simulation.seed = 3;
+  const TrialResult by_runner = run_simulated_trial(scene, options, simulation);
 
-  SimulatedDevice device(options.simulation.device);
-  SimulatedWriter writer(scene, options.simulation.writer, options.simulation.seed);
+  SimulatedDevice device(simulation.device);
+  SimulatedWriter writer(scene, simulation.writer, simulation.seed);
   device.attach_hand(&writer);
   device.open();
   device.enable_forces(true);
@@ -64,7 +66,7 @@ TEST_CASE("Every tick writes the force once, lock-step and in real time", "[tria
     options.loop.realtime = RealtimeMode::ignore;
     options.loop.priority = 0;
     options.loop.lock_memory = false;
-    const TrialResult result = run_trial(device, scene, options);
+    const TrialResult result = run_trial(device, scene, options, SimulationOptions{});
     INFO("pacing " << static_cast<int>(pacing));
     CHECK(result.end == TrialEnd::time_limit);
     CHECK(result.aborted);
@@ -93,7 +95,7 @@ TEST_CASE("should_stop ends a trial as interrupted with the ticks kept", "[trial
     long polls = 0;
     options.should_stop = [&polls, stop_after] { return ++polls > stop_after; };
     ProbeDevice device;
-    const TrialResult result = run_trial(device, scene, options);
+    const TrialResult result = run_trial(device, scene, options, SimulationOptions{});
     INFO("pacing " << static_cast<int>(pacing));
     CHECK(result.end == TrialEnd::interrupted);
     // Zero force commanded, forces disabled and the device closed before the result is returned.
@@ -110,14 +112,14 @@ TEST_CASE("should_stop ends a trial as interrupted with the ticks kept", "[trial
   }
 }
 
-TEST_CASE("A writer that stops early ends the trial as writer_gave_up", "[trial]") {
+TEST_CASE("A writer that stops early ends the trial as gave_up", "[trial]") {
   const Scene scene = scene_of(U"口");
   TrialOptions options;
   options.rate_hz = 100.0;  // too coarse a tick for this writer: it misses every stroke and gives up
   const TrialResult result = run_simulated_trial(scene, options);
   CHECK(result.metrics.strokes_completed == 0);
-  CHECK(result.end == TrialEnd::writer_gave_up);
-  CHECK(std::string(to_string(result.end)) == "writer_gave_up");
+  CHECK(result.end == TrialEnd::gave_up);
+  CHECK(std::string(to_string(result.end)) == "gave_up");
   CHECK(result.aborted);
 }
 

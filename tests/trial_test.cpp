@@ -1,3 +1,4 @@
+#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/trial/trial.hpp"
 
 #include <catch2/catch.hpp>
@@ -31,12 +32,13 @@ TEST_CASE("For the same seeded novice, guidance lowers the mean deviation", "[tr
     const Scene scene = scene_of(std::u32string(1, c));
     for (std::uint64_t seed : {0u, 7u}) {
       TrialOptions on;
-      on.simulation.seed = seed;
       on.keep_trace = false;
       TrialOptions off = on;
       off.force.guidance = false;
-      const auto with = run_simulated_trial(scene, on).metrics;
-      const auto without = run_simulated_trial(scene, off).metrics;
+      SimulationOptions simulation;
+      simulation.seed = seed;
+      const auto with = run_simulated_trial(scene, on, simulation).metrics;
+      const auto without = run_simulated_trial(scene, off, simulation).metrics;
       INFO("character U+" << std::hex << static_cast<unsigned>(c) << " seed " << seed);
       REQUIRE(with.strokes_completed == with.strokes_total);
       CHECK(with.mean_deviation_m < without.mean_deviation_m);
@@ -46,14 +48,15 @@ TEST_CASE("For the same seeded novice, guidance lowers the mean deviation", "[tr
 
 TEST_CASE("Trials are deterministic for a seed and differ across seeds", "[trial]") {
   const Scene scene = scene_of(U"口");
-  TrialOptions a;
-  a.simulation.seed = 3;
-  const auto first = run_simulated_trial(scene, a).metrics;
-  const auto again = run_simulated_trial(scene, a).metrics;
+  const TrialOptions a;
+  SimulationOptions simulation;
+  simulation.seed = 3;
+  const auto first = run_simulated_trial(scene, a, simulation).metrics;
+  const auto again = run_simulated_trial(scene, a, simulation).metrics;
   CHECK(first.mean_deviation_m == again.mean_deviation_m);
   CHECK(first.time_s == again.time_s);
-  a.simulation.seed = 4;
-  CHECK(run_simulated_trial(scene, a).metrics.mean_deviation_m != first.mean_deviation_m);
+  simulation.seed = 4;
+  CHECK(run_simulated_trial(scene, a, simulation).metrics.mean_deviation_m != first.mean_deviation_m);
 }
 
 TEST_CASE("A character group is written one character after another", "[trial]") {

@@ -10,7 +10,7 @@
 #include "calligraphy/render/renderer.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
 #include "calligraphy/sim/simulated_writer.hpp"
-#include "calligraphy/trial/score.hpp"
+#include "calligraphy/analysis/score.hpp"
 #include "calligraphy/trial/trial.hpp"
 
 namespace calligraphy::testing {

@@ -1,4 +1,4 @@
-// collision: the nearest point on a stroke element (include/calligraphy/collision/nearest_point.hpp,
+// collision: the nearest point on a stroke element (include/calligraphy/model/nearest_point.hpp,
 // paper section 4.3) and its options; stroke acceptance and the stroke matcher (stroke_progress.hpp,
 // stroke_matcher.hpp).
 #include <pybind11/numpy.h>
@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "bindings.hpp"
-#include "calligraphy/collision/nearest_point.hpp"
-#include "calligraphy/collision/stroke_matcher.hpp"
-#include "calligraphy/collision/stroke_progress.hpp"
+#include "calligraphy/model/nearest_point.hpp"
+#include "calligraphy/analysis/stroke_matcher.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "model_bindings.hpp"
@@ -163,7 +163,7 @@ void bind_collision(py::module_& m) {
 
   py::enum_<StrokeRefusal>(m, "StrokeRefusal",
                            "Why a stroke attempt was not accepted, in the learner's terms "
-                           "(include/calligraphy/collision/stroke_progress.hpp).")
+                           "(include/calligraphy/model/stroke_progress.hpp).")
       .value("none", StrokeRefusal::none, "accepted")
       .value("too_short", StrokeRefusal::too_short,
              "went along the stroke but stopped before its end neighbourhood")
@@ -176,7 +176,7 @@ void bind_collision(py::module_& m) {
 
   py::class_<StrokeMatch>(m, "StrokeMatch",
                           "The verdict of match_stroke on one pen-down path "
-                          "(include/calligraphy/collision/stroke_matcher.hpp).")
+                          "(include/calligraphy/analysis/stroke_matcher.hpp).")
       .def_readonly("accepted", &StrokeMatch::accepted, "the path writes the expected stroke")
       .def_readonly("refusal", &StrokeMatch::refusal, "a StrokeRefusal, StrokeRefusal.none when accepted")
       .def_readonly("matched_stroke", &StrokeMatch::matched_stroke,
@@ -195,7 +195,7 @@ void bind_collision(py::module_& m) {
   m.def("match_stroke", &match_stroke_py, py::arg("scene"), py::arg("character_index"),
         py::arg("stroke_index"), py::arg("path_m"), py::arg("acceptance") = py::none(),
         R"(Whether one pen-down path writes stroke `stroke_index` of character `character_index` of `scene`
-(taking the strokes before it as written), and if not, why (include/calligraphy/collision/stroke_matcher.hpp).
+(taking the strokes before it as written), and if not, why (include/calligraphy/analysis/stroke_matcher.hpp).
 It is the renderer's rule: the path enters the stroke where it first comes within
 scene.layout.start_radius_m of the stroke's start (WS), progress is tracked along the stroke's centre
 line, and the path's end is the pen's lift, so a Renderer whose pen moves along the same path (points at

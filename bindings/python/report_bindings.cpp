@@ -17,8 +17,9 @@
 
 namespace calligraphy::python {
 
-py::dict trial_metrics(const TrialDescription& description, const TrialResult& result) {
-  const std::string text = trial_json(description, result);
+py::dict trial_metrics(const TrialDescription& description, const TrialResult& result,
+                       const WritingMetrics& writing) {
+  const std::string text = trial_json(description, result, writing);
   return py::module_::import("json").attr("loads")(py::str(text));
 }
 

@@ -12,7 +12,8 @@ namespace calligraphy::python {
 namespace py = pybind11;
 
 /// The trial's metrics as a dict with the keys of `calligraphy trial --json`.
-py::dict trial_metrics(const TrialDescription& description, const TrialResult& result);
+py::dict trial_metrics(const TrialDescription& description, const TrialResult& result,
+                       const WritingMetrics& writing);
 
 /// Writes `recording` as JSON to `path` atomically (write_file_atomically).
 void write_teacher_recording(const TeacherRecording& recording, const std::filesystem::path& path);

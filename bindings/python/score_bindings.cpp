@@ -1,5 +1,5 @@
 // score: a pen trace from any source (a CSV file, or columns from numpy or pandas) scored against a
-// character, as `calligraphy score` does (trial/score.hpp, report/score_report.hpp), with the same JSON keys.
+// character, as `calligraphy score` does (analysis/score.hpp, report/score_report.hpp), with the same JSON keys.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -12,12 +12,12 @@
 
 #include "arguments.hpp"
 #include "bindings.hpp"
-#include "calligraphy/collision/stroke_progress.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/report/pen_trace_csv.hpp"
 #include "calligraphy/report/score_report.hpp"
-#include "calligraphy/trial/score.hpp"
+#include "calligraphy/analysis/writing_metrics.hpp"
 #include "character_source.hpp"
 #include "core/unicode.hpp"
 
@@ -93,7 +93,11 @@ py::dict score_py(const py::object& trace, const py::object& character, const st
     const CharacterSource source = library ? take(*library, "library") : CharacterSource::embedded();
     model = source.load(one_character(convert_named<std::string>(character, "character"), "character"));
   }
-  const Scene scene = Scene::lay_out({model});
+  if (!std::isfinite(start_radius_m) || !(start_radius_m > 0.0))
+    throw InvalidArgument("start_radius_m: " + std::to_string(start_radius_m) + " m is not finite and > 0");
+  SceneLayout layout;
+  layout.start_radius_m = start_radius_m;
+  const Scene scene = Scene::lay_out({model}, layout);
   const PlacedCharacter& placed = scene.characters.front();
 
   std::vector<PenSample> samples;
@@ -111,11 +115,10 @@ py::dict score_py(const py::object& trace, const py::object& character, const st
   }
   ScoreOptions options;
   if (acceptance) options.acceptance = take(*acceptance, "acceptance");
-  options.start_radius_m = start_radius_m;
-  const CharacterScore score = score_trace(placed, samples, options);
+  const WritingMetrics metrics = writing_metrics(scene, samples, options);
   const ScoreDescription description{encode_utf8(placed.code_point), trace_name,
                                      units == TraceUnits::data ? "data" : "m", samples.size()};
-  return py::module_::import("json").attr("loads")(py::str(score_json(description, score)));
+  return py::module_::import("json").attr("loads")(py::str(score_json(description, metrics)));
 }
 
 }  // namespace
@@ -126,7 +129,7 @@ void bind_score(py::module_& m) {
       py::arg("library") = py::none(),
       py::arg("contact_threshold_m") = PenTraceCsvOptions{}.contact_threshold_m,
       py::arg("acceptance") = py::none(), py::arg("start_radius_m") = ScoreOptions{}.start_radius_m,
-      R"(Scores a pen trace from any source against a character, as `calligraphy score` does (trial/score.hpp;
+      R"(Scores a pen trace from any source against a character, as `calligraphy score` does (analysis/score.hpp;
 metrics defined in docs/metrics.md): strokes segmented at pen lifts and matched to the reference strokes
 with the stroke matcher the renderer uses (match_stroke, docs/stroke-acceptance.md), so order and
 direction errors are found, and each segment gets the verdict the renderer would have given it in turn.

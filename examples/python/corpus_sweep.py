@@ -36,7 +36,7 @@ import time
 import calligraphy
 import calligraphy.experiments
 
-METRICS = ("mean_deviation_mm", "time_s")
+METRICS = ("mean_deviation_mm", "total_time_s")
 
 
 # %% [markdown]
@@ -67,7 +67,7 @@ def run_sweep(characters, args, client):
         store=args.store, data=args.data, progress=not args.quiet, workers=args.workers)
     wall_s = time.perf_counter() - start
     print(f"{len(table)} trials of {len(characters)} characters in {wall_s:.1f} s wall: "
-          f"{len(table) / wall_s:.2f} trials/s, {table.time_s.sum() / wall_s:.0f} simulated s per wall s")
+          f"{len(table) / wall_s:.2f} trials/s, {table.trial_time_s.sum() / wall_s:.0f} simulated s per wall s")
     return table
 
 
@@ -98,7 +98,7 @@ def summarise(table):
     for guidance, group in ran.groupby("guidance"):
         share = group.completed_in_order.astype(bool).mean()
         print(f"guidance {'on ' if guidance else 'off'}: {share:6.1%} of {len(group)} trials completed in order; "
-              f"mean deviation {group.mean_deviation_mm.mean():.2f} mm, writing time {group.time_s.mean():.1f} s")
+              f"mean deviation {group.mean_deviation_mm.mean():.2f} mm, writing time {group.total_time_s.mean():.1f} s")
     failed = table[table.error.notna()]
     if len(failed):
         print(f"{len(failed)} trials failed ({failed.character.nunique()} characters), e.g.:")

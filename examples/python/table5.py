@@ -70,7 +70,7 @@ def trial_cell(character, writer, guidance, seeds):
     for seed in seeds:
         result = calligraphy.simulate_trial(character, writer=writer, guidance=guidance, seed=seed,
                                             keep_trace=False)
-        times.append(result.metrics["time_s"])
+        times.append(result.metrics["total_time_s"])
         deviations.append(result.metrics["mean_deviation_mm"])
         in_order += bool(result.metrics["completed_in_order"])
         order_errors.append(result.writer_log.out_of_order_attempts())
@@ -145,7 +145,7 @@ def train_and_retain(mode, seed, characters, repetitions, learning_rate, teacher
     for index, char in enumerate(characters):
         result = calligraphy.simulate_trial(char, writer=profile, guidance=False, seed=seed * 1000 + 900 + index,
                                             keep_trace=False)
-        times.append(result.metrics["time_s"])
+        times.append(result.metrics["total_time_s"])
         deviations.append(result.metrics["mean_deviation_mm"])
         order_errors += result.writer_log.out_of_order_attempts()
     return (statistics.mean(times), mean_of_known(deviations), order_errors, profile, gain,

@@ -7,7 +7,7 @@
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/report/pen_trace_csv.hpp"
 #include "calligraphy/report/score_report.hpp"
-#include "calligraphy/trial/score.hpp"
+#include "calligraphy/analysis/writing_metrics.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 #include "cli/output.hpp"
@@ -26,14 +26,19 @@ struct ScoreCommand {
 
 int run_score(const ScoreCommand& command) {
   const std::u32string chars = characters_from(command.character, "--character");
-  if (chars.size() != 1) {
-    throw UsageError("--character: expects one character, got " + std::to_string(chars.size()));
+  if (chars.size() != 1 && command.units == "data") {
+    throw UsageError("--character: --units data takes one character (data units are one character's); got " +
+                     std::to_string(chars.size()));
   }
   FilePlan files;
   files.input("TRACE", command.trace);
   add_library_inputs(files, command.library);
   files.output("--json", command.json);
-  const Scene scene = Scene::lay_out({CharacterSource(command.library).load(chars[0])});
+  // Several characters are placed as a trial places them (Scene::lay_out), so a trial's CSV scores as written.
+  std::vector<Character> models;
+  const CharacterSource source(command.library);
+  for (const char32_t c : chars) models.push_back(source.load(c));
+  const Scene scene = Scene::lay_out(models);
   const PlacedCharacter& character = scene.characters.front();
   TerminalProgress progress("reading " + command.trace);  // on stderr, only when it is a terminal
   PenTraceCsvOptions options;
@@ -45,11 +50,11 @@ int run_score(const ScoreCommand& command) {
   score_options.progress = [&progress](std::size_t matched, std::size_t total) {
     progress.update(matched, total, "segments");
   };
-  const CharacterScore score = score_trace(character, trace, score_options);
+  const WritingMetrics metrics = writing_metrics(scene, trace, score_options);
   progress.relabel("");
   const ScoreDescription description{command.character, command.trace, command.units, trace.size()};
-  if (command.json != "-") write_standard_output(score_table(description, score));
-  if (!command.json.empty()) write_output(command.json, score_json(description, score));
+  if (command.json != "-") write_standard_output(score_table(description, metrics));
+  if (!command.json.empty()) write_output(command.json, score_json(description, metrics));
   return 0;
 }
 
@@ -57,13 +62,14 @@ int run_score(const ScoreCommand& command) {
 
 void add_score_command(CLI::App& root, Commands& commands) {
   auto command = std::make_shared<ScoreCommand>();
-  CLI::App* app = commands.add(root, "score", "Score a pen trace (CSV) against a character",
+  CLI::App* app = commands.add(root, "score", "Score a pen trace (CSV) against a character or a row of characters",
                                [command] { return run_score(*command); });
   add_positional(*app, "TRACE", command->trace,
                  "CSV with a header naming t [s], x, y and pen (1/0) or z [m]; other columns are ignored, "
                  "so `trial --csv` output is read as it is",
                  "FILE");
-  required(add_text(*app, "--character", command->character, "C", "the character the trace writes"));
+  required(add_text(*app, "--character", command->character, "CHARS",
+                    "the character(s) the trace writes, placed as a trial places them"));
   add_choice(*app, "--units", command->units, {"m", "data"},
              "units of x and y: metres on the paper as `trial` places the character, or the character's "
              "1024-unit data box (y up)");

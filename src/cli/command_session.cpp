@@ -338,9 +338,7 @@ int resume_session(const SessionResumeCommand& command) {
       run_options(command.library, session.manifest().setup.writer == "human" ? &host : nullptr,
                   device_info(session.manifest().setup.device), source);
   if (!command.pacing.empty()) {
-    options.pacing = command.pacing == "lock-step"   ? TrialPacing::lock_step
-                     : command.pacing == "real-time" ? TrialPacing::real_time
-                                                     : TrialPacing::automatic;
+    options.pacing = parse_trial_pacing(command.pacing, "--pacing");
   }
   const auto start = std::chrono::steady_clock::now();
   const SessionRunResult result = run_one(session, options, command.display, command.library);

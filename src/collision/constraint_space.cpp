@@ -49,8 +49,5 @@ ElementContact element_contact_at(const StrokeElement& element, const Vec2& tip,
   return contact;
 }
 
-bool feature_plane_passed(const StrokeElement& element, const Vec2& tip, double margin_m) noexcept {
-  return element.unit_tangent(1.0).dot(tip - element.end()) > margin_m;
-}
 
 }  // namespace calligraphy

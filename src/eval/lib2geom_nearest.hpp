@@ -5,7 +5,7 @@
 // `Lib2geomCurve` throws.
 #include <memory>
 
-#include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/model/nearest_point.hpp"
 #include "calligraphy/model/element.hpp"
 
 namespace calligraphy::cli {

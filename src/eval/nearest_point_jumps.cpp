@@ -5,8 +5,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "calligraphy/collision/nearest_point.hpp"
-#include "calligraphy/collision/nearest_point_tracker.hpp"
+#include "calligraphy/sim/simulated_hand.hpp"
+#include "calligraphy/model/nearest_point.hpp"
+#include "calligraphy/model/nearest_point_tracker.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/trial/trial.hpp"
@@ -128,9 +129,10 @@ JumpMeasurement measure_foot_jumps(const JumpSettings& settings) {
     for (const Scene& scene : scenes) {
       for (const std::uint64_t seed : settings.seeds) {
         TrialOptions options;  // 1 kHz, simulated Phantom Desktop, novice writer; the renderer uses exact
-        options.simulation.seed = seed;
         options.force.guidance = guidance;
-        const TrialResult trial = run_simulated_trial(scene, options);
+        SimulationOptions simulation;
+        simulation.seed = seed;
+        const TrialResult trial = run_simulated_trial(scene, options, simulation);
         ++measurement.trials;
         if (trial.metrics.completed_in_order) ++measurement.trials_completed;
         for (std::size_t f = 0; f < finders.size(); ++f) {

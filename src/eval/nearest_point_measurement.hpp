@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/model/nearest_point.hpp"
 #include "eval/nearest_point_scenarios.hpp"
 
 namespace calligraphy::cli {

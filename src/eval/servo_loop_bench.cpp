@@ -6,6 +6,7 @@
 #include <thread>
 #include <vector>
 
+#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
 #include "calligraphy/trial/trial.hpp"

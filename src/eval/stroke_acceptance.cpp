@@ -5,7 +5,7 @@
 #include <random>
 #include <set>
 
-#include "calligraphy/collision/stroke_matcher.hpp"
+#include "calligraphy/analysis/stroke_matcher.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "core/unicode.hpp"
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "calligraphy/collision/stroke_progress.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/sim/person_traces.hpp"
 

@@ -119,4 +119,8 @@ double StrokeElement::arc_length() const {
   return adaptive_length(*this, 0.0, 1.0, whole, 1e-9 * (polygon_length() + 1e-300), 0);
 }
 
+bool feature_plane_passed(const StrokeElement& element, const Vec2& tip, double margin_m) noexcept {
+  return element.unit_tangent(1.0).dot(tip - element.end()) > margin_m;
+}
+
 }  // namespace calligraphy

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "calligraphy/collision/active_stroke.hpp"
-#include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/model/nearest_point.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/render/force_law.hpp"
 #include "calligraphy/render/interaction_state.hpp"

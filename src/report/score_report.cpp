@@ -5,13 +5,20 @@
 #include <optional>
 
 #include "calligraphy/model/typical_strokes.hpp"
+#include "core/unicode.hpp"
 #include "report/appendf.hpp"
+#include "report/metrics_object.hpp"
 
 namespace calligraphy {
 namespace {
 
 nlohmann::json value_or_null(const std::optional<double>& value, double scale = 1.0) {
   return value ? nlohmann::json(*value * scale) : nlohmann::json(nullptr);
+}
+
+// One member of a deviation summary in millimetres; null without a summary (nothing matched).
+nlohmann::json deviation_mm(const std::optional<DeviationSummary>& summary, double DeviationSummary::*member) {
+  return value_or_null(summary ? std::optional<double>((*summary).*member) : std::nullopt, 1e3);
 }
 
 std::string fixed(const std::optional<double>& value, double scale, const char* pattern) {
@@ -27,7 +34,7 @@ nlohmann::json stroke_json(const StrokeScore& stroke) {
     if (!m) return std::nullopt;
     return static_cast<double>(member(*m));
   };
-  return {{"index", stroke.index + 1},
+  return {{"index", stroke.index},
           {"typical_id", stroke.typical_id},
           {"written", stroke.written},
           {"backwards", stroke.backwards},
@@ -55,7 +62,7 @@ nlohmann::json refusals_json(const RefusalCounts& counts) {
 }
 
 // Every pen-down segment in writing order, with its match (for the metrics) and the renderer's verdict in
-// sequence; sample indices 0-based (begin inclusive, end exclusive), strokes 1-based.
+// sequence; sample indices (begin inclusive, end exclusive) and strokes 0-based.
 nlohmann::json segments_json(const CharacterScore& score) {
   nlohmann::json out = nlohmann::json::array();
   std::size_t expected = 0;  // the stroke each verdict judged against: the verdicts accepted before it
@@ -63,15 +70,15 @@ nlohmann::json segments_json(const CharacterScore& score) {
     nlohmann::json verdict = nullptr;
     if (s.verdict) {
       const StrokeMatch& v = *s.verdict;
-      verdict = {{"expected_stroke", expected + 1},        {"accepted", v.accepted},
-                 {"refusal", to_string(v.refusal)},        {"matched_stroke", v.matched_stroke + 1},
+      verdict = {{"expected_stroke", expected},        {"accepted", v.accepted},
+                 {"refusal", to_string(v.refusal)},        {"matched_stroke", v.matched_stroke},
                  {"covered_fraction", v.covered_fraction}, {"mean_deviation_mm", v.mean_deviation_m * 1e3}};
       if (v.accepted) ++expected;
     }
     out.push_back({{"begin", s.begin},
                    {"end", s.end},
                    {"ignored", s.ignored},
-                   {"matched_stroke", s.matched_stroke ? nlohmann::json(*s.matched_stroke + 1) : nullptr},
+                   {"matched_stroke", s.matched_stroke ? nlohmann::json(*s.matched_stroke) : nullptr},
                    {"backwards", s.backwards},
                    {"verdict", verdict}});
   }
@@ -80,17 +87,16 @@ nlohmann::json segments_json(const CharacterScore& score) {
 
 }  // namespace
 
-std::string score_table(const ScoreDescription& d, const CharacterScore& score) {
+namespace {
+
+void append_character_table(std::string& out, const CharacterScore& score) {
   const CharacterWritingMetrics& t = score.totals;
-  std::string out;
-  appendf(out, "Score of %s against %s (%zu samples, x and y in %s)\n", d.trace.c_str(), d.character.c_str(),
-          d.samples, d.units.c_str());
   appendf(out, "\n  %-6s %-6s %-4s %-7s %-9s %9s %9s %11s %9s %9s\n", "stroke", "type", "ID", "written",
           "backwards", "mean[mm]", "max[mm]", "Frechet[mm]", "DTW[mm]", "time[s]");
   for (const StrokeScore& s : score.strokes) {
     const auto& m = s.metrics;
     const auto mm = [&](auto member) { return m ? std::optional<double>(member(*m)) : std::nullopt; };
-    appendf(out, "  %-6zu %-6s %-4d %-7s %-9s %9s %9s %11s %9s %9s\n", s.index + 1,
+    appendf(out, "  %-6zu %-6s %-4d %-7s %-9s %9s %9s %11s %9s %9s\n", s.index,
             std::string(typical_stroke(s.typical_id).acronym).c_str(), s.typical_id, s.written ? "yes" : "no",
             s.backwards ? "yes" : "no",
             fixed(mm([](auto& x) { return x.deviation.mean_m; }), 1e3, "%.2f").c_str(),
@@ -130,48 +136,104 @@ std::string score_table(const ScoreDescription& d, const CharacterScore& score) 
   appendf(out, "  mean speed                 %s m/s\n", fixed(t.mean_speed_m_per_s, 1.0, "%.4f").c_str());
   appendf(out, "  velocity peaks             %d\n", t.velocity_peaks);
   appendf(out, "  normalised jerk            %s\n", fixed(t.normalised_jerk, 1.0, "%.1f").c_str());
+}
+
+}  // namespace
+
+std::string score_table(const ScoreDescription& d, const WritingMetrics& metrics) {
+  std::string out;
+  appendf(out, "Score of %s against %s (%zu samples, x and y in %s; strokes numbered from 0)\n", d.trace.c_str(),
+          d.character.c_str(), d.samples, d.units.c_str());
+  for (const CharacterScore& score : metrics.characters) {
+    if (metrics.characters.size() > 1) appendf(out, "\n%s\n", encode_utf8(score.code_point).c_str());
+    append_character_table(out, score);
+  }
+  if (metrics.characters.size() > 1) {
+    const auto mm = [](const std::optional<double>& v) { return fixed(v, 1e3, "%.3f"); };
+    appendf(out, "\nAll %zu characters\n", metrics.characters.size());
+    appendf(out, "  strokes written            %zu / %zu%s\n", metrics.strokes_written, metrics.strokes_total,
+            metrics.completed_in_order ? "  (complete, in order)" : "");
+    appendf(out, "  accepted in turn           %zu / %zu\n", metrics.strokes_accepted, metrics.strokes_total);
+    appendf(out, "  order errors               %zu\n", metrics.order_errors);
+    appendf(out, "  backwards strokes          %zu\n", metrics.backwards_strokes);
+    appendf(out, "  mean deviation             %s mm\n",
+            mm(metrics.deviation ? std::optional<double>(metrics.deviation->mean_m) : std::nullopt).c_str());
+    appendf(out, "  Frechet (worst stroke)     %s mm\n", mm(metrics.frechet_m).c_str());
+    appendf(out, "  DTW (mean)                 %s mm\n", mm(metrics.dtw_m).c_str());
+    appendf(out, "  time                       %.2f s (pen down %.2f s)\n", metrics.total_time_s,
+            metrics.pen_down_time_s);
+  }
   return out;
 }
 
-std::string score_json(const ScoreDescription& d, const CharacterScore& score) {
+namespace {
+
+// One character's score: every key of docs/metrics.md's per-character record.
+nlohmann::json character_object(const CharacterScore& score) {
   const CharacterWritingMetrics& t = score.totals;
   nlohmann::json per_stroke = nlohmann::json::array();
   for (const StrokeScore& s : score.strokes) per_stroke.push_back(stroke_json(s));
-  nlohmann::json missing = nlohmann::json::array();
-  for (std::size_t index : score.missing_strokes) missing.push_back(index + 1);
-  const auto deviation = [&](double DeviationSummary::*member) {
-    return value_or_null(t.deviation ? std::optional<double>((*t.deviation).*member) : std::nullopt, 1e3);
-  };
-  const nlohmann::json doc = {{"character", d.character},
-                              {"trace", d.trace},
-                              {"units", d.units},
-                              {"samples", d.samples},
-                              {"strokes_total", score.strokes.size()},
-                              {"strokes_written", score.strokes_written},
-                              {"strokes_accepted", score.strokes_accepted},
-                              {"refusals", refusals_json(score.refusals)},
-                              {"completed_in_order", score.completed_in_order},
-                              {"strokes_in_order", score.strokes_in_order},
-                              {"order_errors", score.order_errors},
-                              {"backwards_strokes", score.backwards_strokes},
-                              {"missing_strokes", missing},
-                              {"unmatched_strokes", score.unmatched_strokes},
-                              {"ignored_segments", score.ignored_segments},
-                              {"pen_lifts", t.pen_lifts},
-                              {"time_s", t.total_time_s},
-                              {"writing_time_s", t.writing_time_s},
-                              {"in_air_time_s", t.in_air_time_s},
-                              {"mean_deviation_mm", deviation(&DeviationSummary::mean_m)},
-                              {"max_deviation_mm", deviation(&DeviationSummary::max_m)},
-                              {"rms_deviation_mm", deviation(&DeviationSummary::rms_m)},
-                              {"frechet_mm", value_or_null(t.frechet_m, 1e3)},
-                              {"dtw_mm", value_or_null(t.dtw_m, 1e3)},
-                              {"path_length_mm", t.path_length_m * 1e3},
-                              {"mean_speed_m_s", value_or_null(t.mean_speed_m_per_s)},
-                              {"velocity_peaks", t.velocity_peaks},
-                              {"normalised_jerk", value_or_null(t.normalised_jerk)},
-                              {"per_stroke", per_stroke},
-                              {"segments", segments_json(score)}};
+  return {{"character", encode_utf8(score.code_point)},
+          {"strokes_total", score.strokes.size()},
+          {"strokes_written", score.strokes_written},
+          {"strokes_accepted", score.strokes_accepted},
+          {"refusals", refusals_json(score.refusals)},
+          {"completed_in_order", score.completed_in_order},
+          {"strokes_in_order", score.strokes_in_order},
+          {"order_errors", score.order_errors},
+          {"backwards_strokes", score.backwards_strokes},
+          {"missing_strokes", score.missing_strokes},
+          {"unmatched_segments", score.unmatched_strokes},
+          {"ignored_segments", score.ignored_segments},
+          {"pen_lifts", t.pen_lifts},
+          {"total_time_s", t.total_time_s},
+          {"pen_down_time_s", t.writing_time_s},
+          {"in_air_time_s", t.in_air_time_s},
+          {"mean_deviation_mm", deviation_mm(t.deviation, &DeviationSummary::mean_m)},
+          {"max_deviation_mm", deviation_mm(t.deviation, &DeviationSummary::max_m)},
+          {"rms_deviation_mm", deviation_mm(t.deviation, &DeviationSummary::rms_m)},
+          {"frechet_mm", value_or_null(t.frechet_m, 1e3)},
+          {"dtw_mm", value_or_null(t.dtw_m, 1e3)},
+          {"path_length_mm", t.path_length_m * 1e3},
+          {"mean_speed_m_s", value_or_null(t.mean_speed_m_per_s)},
+          {"velocity_peaks", t.velocity_peaks},
+          {"normalised_jerk", value_or_null(t.normalised_jerk)},
+          {"per_stroke", per_stroke},
+          {"segments", segments_json(score)}};
+}
+
+}  // namespace
+
+nlohmann::json report_detail::writing_metrics_object(const WritingMetrics& m) {
+  nlohmann::json characters = nlohmann::json::array();
+  for (const CharacterScore& score : m.characters) characters.push_back(character_object(score));
+  return {{"strokes_total", m.strokes_total},
+          {"strokes_written", m.strokes_written},
+          {"strokes_accepted", m.strokes_accepted},
+          {"refusals", refusals_json(m.refusals)},
+          {"completed_in_order", m.completed_in_order},
+          {"order_errors", m.order_errors},
+          {"backwards_strokes", m.backwards_strokes},
+          {"unmatched_segments", m.unmatched_segments},
+          {"mean_deviation_mm", deviation_mm(m.deviation, &DeviationSummary::mean_m)},
+          {"max_deviation_mm", deviation_mm(m.deviation, &DeviationSummary::max_m)},
+          {"rms_deviation_mm", deviation_mm(m.deviation, &DeviationSummary::rms_m)},
+          {"frechet_mm", value_or_null(m.frechet_m, 1e3)},
+          {"dtw_mm", value_or_null(m.dtw_m, 1e3)},
+          {"total_time_s", m.total_time_s},
+          {"pen_down_time_s", m.pen_down_time_s},
+          {"velocity_peaks", m.velocity_peaks},
+          {"normalised_jerk", value_or_null(m.normalised_jerk)},
+          {"per_character", characters}};
+}
+
+std::string writing_metrics_json(const WritingMetrics& metrics) {
+  return report_detail::writing_metrics_object(metrics).dump(2) + "\n";
+}
+
+std::string score_json(const ScoreDescription& d, const WritingMetrics& metrics) {
+  nlohmann::json doc = {{"character", d.character}, {"trace", d.trace}, {"units", d.units}, {"samples", d.samples}};
+  doc.update(report_detail::writing_metrics_object(metrics));
   return doc.dump(2) + "\n";
 }
 

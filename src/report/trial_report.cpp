@@ -1,5 +1,6 @@
 #include "calligraphy/report/trial_report.hpp"
 
+#include <charconv>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -10,6 +11,7 @@
 #include "calligraphy/model/typical_strokes.hpp"
 #include "core/unicode.hpp"
 #include "model/polyline.hpp"
+#include "report/metrics_object.hpp"
 
 namespace calligraphy {
 namespace {
@@ -22,16 +24,7 @@ std::string millimetres(const std::optional<double>& metres, int decimals) {
   return text;
 }
 
-// A length [m] as JSON millimetres, or null when there is none.
-nlohmann::json millimetres_json(const std::optional<double>& metres) {
-  return metres ? nlohmann::json(*metres * 1e3) : nlohmann::json(nullptr);
-}
-
-// A stroke's writing time exists only once it is written.
-std::optional<double> stroke_time_s(const StrokeMetrics& stroke) {
-  return stroke.completed ? std::optional<double>(stroke.time_s) : std::nullopt;
-}
-
+// The servo loop's statistics of a real-time trial, under the table.
 void print_loop_statistics(const ServoLoopStats& loop) {
   std::printf("  servo loop                 %llu ticks, %llu late, %llu forces withheld\n",
               static_cast<unsigned long long>(loop.ticks), static_cast<unsigned long long>(loop.late_ticks),
@@ -55,7 +48,9 @@ nlohmann::json loop_json(const ServoLoopStats& loop) {
 
 }  // namespace
 
-void print_trial_table(const TrialDescription& d, const Scene& scene, const TrialResult& result) {
+void print_trial_table(const TrialDescription& d, const Scene& scene, const TrialResult& result,
+                       const WritingMetrics& writing) {
+  (void)scene;
   const TrialMetrics& m = result.metrics;
   // The guidance as given: "on" (the paper's fixed fixture), "fading, gain G", "replay of TEACHER", "off".
   char guidance[512];
@@ -72,26 +67,45 @@ void print_trial_table(const TrialDescription& d, const Scene& scene, const Tria
   std::printf("Trial %s: guidance %s, %s writer, seed %llu, %.0f Hz, device %s (%s)\n", d.characters.c_str(),
               guidance, d.writer.c_str(), static_cast<unsigned long long>(d.seed), d.rate_hz,
               d.device.c_str(), d.device_model.c_str());
-  std::printf("\n  %-6s %-5s %-6s %-4s %9s %9s %9s %8s %9s\n", "stroke", "char", "type", "ID", "mean[mm]",
-              "max[mm]", "time[s]", "attempts", "completed");
-  for (const StrokeMetrics& s : m.per_stroke) {
-    const TypicalStroke& type = typical_stroke(s.typical_id);
-    const std::optional<double> time_s = stroke_time_s(s);
-    char time_text[32] = "-";
-    if (time_s) std::snprintf(time_text, sizeof time_text, "%.2f", *time_s);
-    std::printf("  %-6zu %-5s %-6s %-4d %9s %9s %9s %8d %9s\n", s.index + 1,
-                encode_utf8(scene.characters[s.character].code_point).c_str(),
-                std::string(type.acronym).c_str(), s.typical_id, millimetres(s.mean_deviation_m, 2).c_str(),
-                millimetres(s.max_deviation_m, 2).c_str(), time_text, s.attempts, s.completed ? "yes" : "no");
+  std::printf("\n  %-6s %-5s %-6s %-4s %9s %9s %11s %9s %9s %8s %9s\n", "stroke", "char", "type", "ID",
+              "mean[mm]", "max[mm]", "Frechet[mm]", "DTW[mm]", "time[s]", "attempts", "completed");
+  std::size_t scene_stroke = 0;  // strokes numbered over the scene, from 0, as the renderer counts them
+  for (const CharacterScore& character : writing.characters) {
+    for (const StrokeScore& s : character.strokes) {
+      const auto& w = s.metrics;
+      const auto value = [&](auto member) { return w ? std::optional<double>(member(*w)) : std::nullopt; };
+      const StrokeMetrics* live = scene_stroke < m.per_stroke.size() ? &m.per_stroke[scene_stroke] : nullptr;
+      char time_text[32] = "-";
+      if (w) std::snprintf(time_text, sizeof time_text, "%.2f", w->kinematics.writing_time_s);
+      std::printf("  %-6zu %-5s %-6s %-4d %9s %9s %11s %9s %9s %8d %9s\n", scene_stroke,
+                  encode_utf8(character.code_point).c_str(),
+                  std::string(typical_stroke(s.typical_id).acronym).c_str(), s.typical_id,
+                  millimetres(value([](auto& x) { return x.deviation.mean_m; }), 2).c_str(),
+                  millimetres(value([](auto& x) { return x.deviation.max_m; }), 2).c_str(),
+                  millimetres(value([](auto& x) { return x.curves.frechet_m; }), 2).c_str(),
+                  millimetres(value([](auto& x) { return x.curves.dtw_m; }), 2).c_str(), time_text,
+                  live ? live->attempts : 0, live && live->completed ? "yes" : "no");
+      ++scene_stroke;
+    }
   }
+  const std::optional<double> mean =
+      writing.deviation ? std::optional<double>(writing.deviation->mean_m) : std::nullopt;
+  const std::optional<double> max =
+      writing.deviation ? std::optional<double>(writing.deviation->max_m) : std::nullopt;
   std::printf("\n  strokes completed in order  %zu / %zu%s\n", m.strokes_completed, m.strokes_total,
               m.completed_in_order ? "" : "  (incomplete)");
+  std::printf("  accepted in turn           %zu / %zu (order errors %zu, backwards %zu)\n",
+              writing.strokes_accepted, writing.strokes_total, writing.order_errors, writing.backwards_strokes);
   // "-" without a unit: nothing was written, so there is no deviation to give.
-  std::printf("  mean deviation             %s%s\n", millimetres(m.mean_deviation_m, 3).c_str(),
-              m.mean_deviation_m ? " mm" : "");
-  std::printf("  max deviation              %s%s\n", millimetres(m.max_deviation_m, 3).c_str(),
-              m.max_deviation_m ? " mm" : "");
-  std::printf("  writing time               %.2f s\n", m.time_s);
+  std::printf("  mean deviation             %s%s\n", millimetres(mean, 3).c_str(), mean ? " mm" : "");
+  std::printf("  max deviation              %s%s\n", millimetres(max, 3).c_str(), max ? " mm" : "");
+  std::printf("  Frechet (worst stroke)     %s%s\n", millimetres(writing.frechet_m, 3).c_str(),
+              writing.frechet_m ? " mm" : "");
+  std::printf("  DTW (mean)                 %s%s\n", millimetres(writing.dtw_m, 3).c_str(),
+              writing.dtw_m ? " mm" : "");
+  std::printf("  writing time               %.2f s (pen down %.2f s)\n", writing.total_time_s,
+              writing.pen_down_time_s);
+  std::printf("  trial time                 %.2f s\n", m.time_s);
   std::printf("  state transitions          %zu\n", m.state_transitions);
   std::printf("  max |F|                    %.3f N\n", m.max_force_n);
   std::printf("  max per-tick |dF|          %.3f N\n", m.max_force_step_n);
@@ -102,17 +116,17 @@ void print_trial_table(const TrialDescription& d, const Scene& scene, const Tria
   }
 }
 
-std::string trial_json(const TrialDescription& d, const TrialResult& result) {
+std::string trial_json(const TrialDescription& d, const TrialResult& result, const WritingMetrics& writing) {
   const TrialMetrics& m = result.metrics;
-  nlohmann::json per_stroke = nlohmann::json::array();
+  // The renderer's view of each stroke (its attempts, whether it completed it in turn); what was written is
+  // the one metrics record merged in below.
+  nlohmann::json renderer_strokes = nlohmann::json::array();
   for (const StrokeMetrics& s : m.per_stroke) {
-    per_stroke.push_back({{"index", s.index + 1},
-                          {"typical_id", s.typical_id},
-                          {"mean_deviation_mm", millimetres_json(s.mean_deviation_m)},
-                          {"max_deviation_mm", millimetres_json(s.max_deviation_m)},
-                          {"time_s", stroke_time_s(s) ? nlohmann::json(s.time_s) : nlohmann::json(nullptr)},
-                          {"completed", s.completed},
-                          {"attempts", s.attempts}});
+    renderer_strokes.push_back({{"index", s.index},
+                                {"character", s.character},
+                                {"typical_id", s.typical_id},
+                                {"completed", s.completed},
+                                {"attempts", s.attempts}});
   }
   nlohmann::json doc = {{"character", d.characters},
                         {"guidance", d.guidance},
@@ -123,16 +137,13 @@ std::string trial_json(const TrialDescription& d, const TrialResult& result) {
                         {"aborted", result.aborted},
                         {"end_reason", to_string(result.end)},
                         {"abort_reason", result.abort_reason},
-                        {"strokes_total", m.strokes_total},
                         {"strokes_completed", m.strokes_completed},
-                        {"completed_in_order", m.completed_in_order},
-                        {"time_s", m.time_s},
-                        {"mean_deviation_mm", millimetres_json(m.mean_deviation_m)},
-                        {"max_deviation_mm", millimetres_json(m.max_deviation_m)},
+                        {"trial_time_s", m.time_s},
                         {"max_force_n", m.max_force_n},
                         {"max_force_step_n", m.max_force_step_n},
                         {"state_transitions", m.state_transitions},
-                        {"per_stroke", per_stroke}};
+                        {"renderer_strokes", renderer_strokes}};
+  doc.update(report_detail::writing_metrics_object(writing));
   if (result.loop) doc["loop"] = loop_json(*result.loop);  // real-time trials only
   doc["guidance_mode"] = to_string(d.guidance_mode);
   if (d.guidance_mode == GuidanceMode::fading) doc["guidance_gain"] = d.guidance_gain;
@@ -196,10 +207,21 @@ std::string trial_csv(const std::vector<TrialSample>& trace) {
   std::ostringstream csv;
   csv << "t,x,y,z,fx,fy,fz,state,stroke,element\n";
   char line[256];
+  // Time and position in the shortest text that reads back as the same double, so that `calligraphy score`
+  // on this file gives the trial's own metrics exactly (one metrics record, docs/metrics.md).
+  const auto exact = [](char*& out, char* end, double value) {
+    out = std::to_chars(out, end, value).ptr;
+    *out++ = ',';
+  };
   for (const TrialSample& s : trace) {
-    std::snprintf(line, sizeof line, "%.4f,%.7f,%.7f,%.7f,%.5f,%.5f,%.5f,%s,%zu,%zu\n", s.time_s,
-                  s.position_m.x(), s.position_m.y(), s.position_m.z(), s.force_n.x(), s.force_n.y(),
-                  s.force_n.z(), to_string(s.state), s.stroke, s.element);
+    char* out = line;
+    char* const end = line + sizeof line;
+    exact(out, end, s.time_s);
+    exact(out, end, s.position_m.x());
+    exact(out, end, s.position_m.y());
+    exact(out, end, s.position_m.z());
+    std::snprintf(out, static_cast<std::size_t>(end - out), "%.5f,%.5f,%.5f,%s,%zu,%zu\n", s.force_n.x(),
+                  s.force_n.y(), s.force_n.z(), to_string(s.state), s.stroke, s.element);
     csv << line;
   }
   return csv.str();

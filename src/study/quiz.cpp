@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
-#include "trial/segmentation.hpp"
+#include "analysis/segmentation.hpp"
 
 namespace calligraphy {
 

@@ -15,6 +15,7 @@
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/trial/options.hpp"
 #include "core/unicode.hpp"
 #include "study/json_reader.hpp"
 #include "study/manifest_json.hpp"
@@ -88,9 +89,7 @@ void check_setup(const SessionSetup& setup) {
     throw InvalidArgument("writer '" + setup.writer + "': expected 'simulated' or 'human'");
   }
   (void)writer_profile(setup.writer_profile);  // InvalidArgument naming it and the known profiles
-  if (setup.pacing != "auto" && setup.pacing != "lock-step" && setup.pacing != "real-time") {
-    throw InvalidArgument("pacing '" + setup.pacing + "': expected 'auto', 'lock-step' or 'real-time'");
-  }
+  (void)parse_trial_pacing(setup.pacing, "session setup");  // InvalidArgument naming the spellings
   if (setup.device.empty()) throw InvalidArgument("session setup: the device name is empty");
 }
 

@@ -138,7 +138,7 @@ ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifes
   trial.index = plan.index + 1;
   trial.item = plan.item;
   trial.repetition = plan.repetition;
-  trial.time_total_s = number(record, "time_s", source);
+  trial.time_total_s = number(record, "total_time_s", source);
   trial.mean_deviation_mm = number(record, "mean_deviation_mm", source);
   trial.frechet_mm = optional_number(record, "frechet_mm", source);
   trial.dtw_mm = optional_number(record, "dtw_mm", source);

@@ -39,12 +39,6 @@ const char* method_name(NearestPointMethod method) {
   return "unknown";
 }
 
-const char* pacing_name(TrialPacing pacing) {
-  return pacing == TrialPacing::lock_step   ? "lock-step"
-         : pacing == TrialPacing::real_time ? "real-time"
-                                            : "auto";
-}
-
 json force_law_json(const ForceLawParameters& f) {
   return {{"guidance", f.guidance},
           {"guidance_mode", to_string(f.guidance_mode)},
@@ -73,7 +67,7 @@ json force_law_json(const ForceLawParameters& f) {
 json renderer_json(const TrialOptions& o) {
   const SafetyChainParameters& s = o.safety;
   return {{"rate_hz", o.rate_hz},
-          {"pacing", pacing_name(o.pacing)},
+          {"pacing", to_string(o.pacing)},
           {"max_duration_s", o.max_duration_s},
           {"safety",
            {{"max_force_n", s.max_force_n},
@@ -109,9 +103,9 @@ json device_info_json(const DeviceInfo& d) {
 
 json writer_json(const TrialRecordContext& c) {
   if (!c.simulated_writer) return {{"kind", "human"}, {"subject", c.session->setup.subject.id}};
-  const WriterProfile& w = c.options->simulation.writer;
+  const WriterProfile& w = c.simulation.writer;
   return {{"kind", "simulated"},
-          {"seed", c.options->simulation.seed},
+          {"seed", c.simulation.seed},
           {"subject_seed", c.session->setup.writer_seed},
           {"profile",
            {{"name", w.name},
@@ -191,10 +185,6 @@ json loop_json(const ServoLoopStats& s) {
           {"callback_us_max", s.callback_us_max}};
 }
 
-json nullable(const std::optional<double>& value, double scale) {
-  return value ? json(*value * scale) : json(nullptr);
-}
-
 }  // namespace
 
 json acceptance_json(const StrokeAcceptance& a) {
@@ -220,18 +210,6 @@ std::vector<PenSample> pen_samples_of_character(const Scene& scene, const std::v
   return samples;
 }
 
-std::vector<CharacterScore> score_characters(const Scene& scene, const std::vector<TrialSample>& trace,
-                                             const StrokeAcceptance& acceptance) {
-  ScoreOptions options;
-  options.acceptance = acceptance;
-  options.start_radius_m = scene.layout.start_radius_m;
-  std::vector<CharacterScore> scores;
-  for (std::size_t c = 0; c < scene.characters.size(); ++c) {
-    scores.push_back(score_trace(scene.characters[c], pen_samples_of_character(scene, trace, c), options));
-  }
-  return scores;
-}
-
 std::vector<std::vector<QuizEvent>> quiz_characters(const Scene& scene, const std::vector<TrialSample>& trace,
                                                     const QuizOptions& options) {
   std::vector<std::vector<QuizEvent>> events;
@@ -245,42 +223,22 @@ std::vector<std::vector<QuizEvent>> quiz_characters(const Scene& scene, const st
 }
 
 std::string trial_record_json(const TrialRecordContext& c, const Scene& scene, const TrialResult& result,
-                              const std::vector<CharacterScore>& scores,
+                              const WritingMetrics& writing,
                               const std::vector<std::vector<QuizEvent>>* quiz) {
   const TrialMetrics& m = result.metrics;
   json per_stroke = json::array();
   for (const StrokeMetrics& s : m.per_stroke) {
     const bool has_trace = s.trace_end > s.trace_begin && s.trace_end <= result.trace.size();
-    per_stroke.push_back({{"index", s.index + 1},
-                          {"character", s.character + 1},
+    // The renderer's view of the stroke (attempts, completed in turn, when); what was written is in the
+    // one metrics record below.
+    per_stroke.push_back({{"index", s.index},
+                          {"character", s.character},
                           {"typical_id", s.typical_id},
                           {"completed", s.completed},
                           {"attempts", s.attempts},
-                          {"mean_deviation_mm", nullable(s.mean_deviation_m, 1e3)},
-                          {"max_deviation_mm", nullable(s.max_deviation_m, 1e3)},
-                          {"time_s", s.time_s},
                           {"start_s", has_trace ? json(result.trace[s.trace_begin].time_s) : json(nullptr)},
                           {"end_s", has_trace ? json(result.trace[s.trace_end - 1].time_s) : json(nullptr)}});
   }
-  // Scores over the trial's characters: the worst Frechet, DTW weighted by the strokes written, sums.
-  std::optional<double> frechet_m, dtw_m;
-  double dtw_weighted = 0.0;
-  std::size_t dtw_weight = 0, order_errors = 0, backwards = 0;
-  json score_documents = json::array();
-  for (std::size_t i = 0; i < scores.size(); ++i) {
-    const CharacterScore& s = scores[i];
-    if (s.totals.frechet_m) frechet_m = std::max(frechet_m.value_or(0.0), *s.totals.frechet_m);
-    if (s.totals.dtw_m) {
-      dtw_weighted += *s.totals.dtw_m * static_cast<double>(s.strokes_written);
-      dtw_weight += s.strokes_written;
-    }
-    order_errors += s.order_errors;
-    backwards += s.backwards_strokes;
-    const ScoreDescription description{encode_utf8(s.code_point), c.csv_file, "m", 0};
-    score_documents.push_back(json::parse(score_json(description, s)));
-  }
-  if (dtw_weight > 0) dtw_m = dtw_weighted / static_cast<double>(dtw_weight);
-
   const PlannedTrial& t = *c.trial;
   json document = {
       {"format", kFormat},
@@ -312,23 +270,15 @@ std::string trial_record_json(const TrialRecordContext& c, const Scene& scene, c
       {"end_reason", to_string(result.end)},
       {"aborted", result.aborted},
       {"abort_reason", result.abort_reason},
-      {"strokes_total", m.strokes_total},
       {"strokes_completed", m.strokes_completed},
-      {"completed_in_order", m.completed_in_order},
-      {"time_s", m.time_s},
-      {"mean_deviation_mm", nullable(m.mean_deviation_m, 1e3)},
-      {"max_deviation_mm", nullable(m.max_deviation_m, 1e3)},
+      {"trial_time_s", m.time_s},
       {"max_force_n", m.max_force_n},
       {"max_force_step_n", m.max_force_step_n},
       {"state_transitions", m.state_transitions},
-      {"frechet_mm", nullable(frechet_m, 1e3)},
-      {"dtw_mm", nullable(dtw_m, 1e3)},
-      {"order_errors", order_errors},
-      {"backwards_strokes", backwards},
       {"per_stroke", per_stroke},
-      {"score", score_documents},
       {"samples", result.trace.size()},
       {"files", {{"csv", c.csv_file}, {"svg", c.svg_file}}}};
+  document.update(json::parse(writing_metrics_json(writing)));  // the one metrics record
   if (c.device_name == "simulated") document["device"]["simulated_device"] = simulated_device_json();
   if (!c.condition->guidance_parameters.empty())
     document["guidance_parameters"] = c.condition->guidance_parameters;
@@ -342,14 +292,14 @@ std::string trial_record_json(const TrialRecordContext& c, const Scene& scene, c
       json events = json::array();
       for (const QuizEvent& e : (*quiz)[i]) {
         json event = {{"kind", to_string(e.kind)},
-                      {"stroke", e.stroke + 1},
+                      {"stroke", e.stroke},
                       {"backwards", e.backwards},
                       {"misses_on_stroke", e.misses_on_stroke},
                       {"total_misses", e.total_misses},
                       {"time_s", e.time_s},
                       {"samples", e.samples}};
         event["refusal"] = to_string(e.refusal);
-        if (e.written_stroke) event["written_stroke"] = *e.written_stroke + 1;
+        if (e.written_stroke) event["written_stroke"] = *e.written_stroke;
         events.push_back(event);
         accepted += e.kind == QuizEvent::Kind::stroke_accepted ? 1 : 0;
         hints += e.kind == QuizEvent::Kind::hint ? 1 : 0;

@@ -10,9 +10,10 @@
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/study/quiz.hpp"
 #include "calligraphy/study/session_folder.hpp"
+#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/trial/options.hpp"
 #include "calligraphy/trial/result.hpp"
-#include "calligraphy/trial/score.hpp"
+#include "calligraphy/analysis/score.hpp"
 
 namespace calligraphy::study_detail {
 
@@ -26,6 +27,7 @@ struct TrialRecordContext {
   DeviceInfo device_info;
   bool hardware = false;
   bool simulated_writer = false;
+  SimulationOptions simulation;  ///< the simulated writer and its seed, when `simulated_writer`
   std::string start_utc;
   std::string end_utc;
   double wall_time_s = 0.0;
@@ -43,18 +45,14 @@ nlohmann::json acceptance_json(const StrokeAcceptance& acceptance);
 std::vector<PenSample> pen_samples_of_character(const Scene& scene, const std::vector<TrialSample>& trace,
                                                 std::size_t character);
 
-/// The score of each character of the scene against its part of the trace, its segment verdicts with the
-/// trial's stroke `acceptance` and the scene's start radius: the renderer's.
-std::vector<CharacterScore> score_characters(const Scene& scene, const std::vector<TrialSample>& trace,
-                                             const StrokeAcceptance& acceptance);
-
 /// The quiz events of each character, the trace fed through a `QuizSession` per character.
 std::vector<std::vector<QuizEvent>> quiz_characters(const Scene& scene, const std::vector<TrialSample>& trace,
                                                     const QuizOptions& options);
 
-/// The record as JSON text (2-space indent). `quiz` is given for quiz conditions.
+/// The record as JSON text (2-space indent): the context, the renderer's figures and every key of the one
+/// metrics record `writing` (trial_writing_metrics). `quiz` is given for quiz conditions.
 std::string trial_record_json(const TrialRecordContext& context, const Scene& scene,
-                              const TrialResult& result, const std::vector<CharacterScore>& scores,
+                              const TrialResult& result, const WritingMetrics& writing,
                               const std::vector<std::vector<QuizEvent>>* quiz);
 
 }  // namespace calligraphy::study_detail

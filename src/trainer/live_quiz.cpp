@@ -106,9 +106,9 @@ std::string describe(const QuizEvent& event) {
   } else if (event.refusal != StrokeRefusal::none) {
     why = std::string(", ") + to_string(event.refusal);
   }
-  if (event.written_stroke) why += ", wrote stroke " + std::to_string(*event.written_stroke + 1);
+  if (event.written_stroke) why += ", wrote stroke " + std::to_string(*event.written_stroke);
   char line[160];
-  std::snprintf(line, sizeof line, "stroke %zu: %s (misses %d on the stroke, %d in all%s)", event.stroke + 1,
+  std::snprintf(line, sizeof line, "stroke %zu: %s (misses %d on the stroke, %d in all%s)", event.stroke,
                 to_string(event.kind), event.misses_on_stroke, event.total_misses, why.c_str());
   return line;
 }

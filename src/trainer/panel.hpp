@@ -4,7 +4,7 @@
 // summary with the keys at the end.
 #include <string>
 
-#include "calligraphy/collision/stroke_progress.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 #include "trainer/layout.hpp"
 #include "trainer/trial_view.hpp"
 

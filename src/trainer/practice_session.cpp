@@ -73,6 +73,7 @@ std::pair<std::filesystem::path, bool> PracticeSession::save(const PracticeTrial
   context.device_info = setup_.device_info;
   context.hardware = setup_.hardware;
   context.simulated_writer = setup_.simulated_writer;
+  context.simulation = trial.simulation;
   context.start_utc = trial.start_utc;
   context.end_utc = trial.end_utc;
   context.wall_time_s = trial.wall_time_s;
@@ -80,13 +81,12 @@ std::pair<std::filesystem::path, bool> PracticeSession::save(const PracticeTrial
   context.csv_file = stem + ".csv";
   context.svg_file = stem + ".svg";
   const Scene& scene = *trial.scene;
-  const std::vector<CharacterScore> scores =
-      study_detail::score_characters(scene, result.trace, trial.options->force.acceptance);
+  const WritingMetrics writing = trial_writing_metrics(scene, result, trial.options->force.acceptance);
   std::vector<std::vector<QuizEvent>> quiz;
   if (condition.mode == ConditionMode::quiz)
     quiz = study_detail::quiz_characters(scene, result.trace, condition.quiz);
   const bool keep_as_trial = result.end == TrialEnd::completed || result.end == TrialEnd::time_limit ||
-                             result.end == TrialEnd::writer_gave_up;
+                             result.end == TrialEnd::gave_up;
   nlohmann::json details = {{"trial", planned.index + 1},
                             {"condition", planned.condition},
                             {"characters", encode_utf8(trial.character)},
@@ -94,14 +94,14 @@ std::pair<std::filesystem::path, bool> PracticeSession::save(const PracticeTrial
                             {"end_reason", to_string(result.end)}};
   if (keep_as_trial) {
     const std::string record =
-        study_detail::trial_record_json(context, scene, result, scores, quiz.empty() ? nullptr : &quiz);
+        study_detail::trial_record_json(context, scene, result, writing, quiz.empty() ? nullptr : &quiz);
     folder_.save_trial(planned, record, trial_csv(result.trace), trial_svg(scene, result));
     folder_.log("trial_saved", details.dump());
     return {folder_.trial_file(planned, "json"), true};
   }
   context.svg_file.clear();
   const std::string record =
-      study_detail::trial_record_json(context, scene, result, scores, quiz.empty() ? nullptr : &quiz);
+      study_detail::trial_record_json(context, scene, result, writing, quiz.empty() ? nullptr : &quiz);
   const std::filesystem::path kept = folder_.save_attempt(planned, record, trial_csv(result.trace));
   details["abort_reason"] = result.abort_reason;
   folder_.log(result.end == TrialEnd::interrupted ? "trial_interrupted" : "trial_failed", details.dump());

@@ -14,6 +14,7 @@
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/session_folder.hpp"
+#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/trial/options.hpp"
 #include "calligraphy/trial/result.hpp"
 
@@ -49,6 +50,7 @@ struct PracticeTrial {
   std::string condition;         ///< one of the three conditions
   const Scene* scene = nullptr;  ///< the trial's scene
   const TrialOptions* options = nullptr;
+  SimulationOptions simulation;  ///< the simulated writer, when the setup has one
   std::string start_utc, end_utc;
   double wall_time_s = 0.0;
 };

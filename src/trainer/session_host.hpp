@@ -11,7 +11,7 @@
 #include <optional>
 #include <string>
 
-#include "calligraphy/collision/stroke_progress.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/study/session_runner.hpp"
 #include "calligraphy/trial/display.hpp"
 

@@ -19,6 +19,7 @@
 #include "calligraphy/core/device_types.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
+#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/trial/trial.hpp"
 #include "trainer/layout.hpp"
 #include "trainer/live_quiz.hpp"
@@ -107,6 +108,7 @@ class TrainerApp {
   std::vector<std::vector<int>> all_typical_ids_;
   std::map<char32_t, std::size_t> index_of_;
   TrialOptions trial_options_;
+  SimulationOptions trial_simulation_;  ///< the simulated writer of the trial (a hand-port device only)
   Clock::time_point trial_wall_start_;
   std::vector<CharacterArt> art_;
   std::vector<std::vector<int>> typical_ids_;

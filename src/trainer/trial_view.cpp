@@ -1,6 +1,6 @@
 #include "trainer/trial_view.hpp"
 
-#include "calligraphy/collision/stroke_matcher.hpp"
+#include "calligraphy/analysis/stroke_matcher.hpp"
 
 namespace calligraphy::trainer {
 namespace {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "calligraphy/collision/stroke_progress.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/trial/display.hpp"
 #include "calligraphy/trial/result.hpp"

@@ -22,11 +22,29 @@ void TrialOptions::validate() const {
   }
   force.validate();
   passivity.validate();
-  simulation.writer.validate();
-  simulation.device.validate();
   ServoLoopOptions paced = loop;
   paced.rate_hz = std::min(rate_hz, 10000.0);  // the loop's other fields; its rate is the trial's
   paced.validate();
+}
+
+const char* to_string(TrialPacing pacing) noexcept {
+  switch (pacing) {
+    case TrialPacing::lock_step:
+      return "lock-step";
+    case TrialPacing::real_time:
+      return "real-time";
+    case TrialPacing::automatic:
+      break;
+  }
+  return "auto";
+}
+
+TrialPacing parse_trial_pacing(std::string_view text, std::string_view what) {
+  for (const TrialPacing pacing : {TrialPacing::automatic, TrialPacing::lock_step, TrialPacing::real_time}) {
+    if (text == to_string(pacing)) return pacing;
+  }
+  throw InvalidArgument(std::string(what) + ": '" + std::string(text) +
+                        "' is not a pacing: expected 'auto', 'lock-step' or 'real-time'");
 }
 
 }  // namespace calligraphy

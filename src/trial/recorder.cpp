@@ -1,7 +1,7 @@
 #include <algorithm>
 #include <limits>
 
-#include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/model/nearest_point.hpp"
 #include "calligraphy/trial/trial.hpp"
 
 namespace calligraphy {

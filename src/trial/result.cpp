@@ -14,10 +14,27 @@ const char* to_string(TrialEnd end) noexcept {
       return "watchdog";
     case TrialEnd::interrupted:
       return "interrupted";
-    case TrialEnd::writer_gave_up:
-      return "writer_gave_up";
+    case TrialEnd::gave_up:
+      return "gave_up";
   }
   return "unknown";
+}
+
+std::vector<PenSample> pen_samples(const Scene& scene, std::span<const TrialSample> trace) {
+  std::vector<PenSample> samples;
+  samples.reserve(trace.size());
+  for (const TrialSample& s : trace) {
+    samples.push_back(
+        {s.time_s, s.position_m.head<2>(), s.position_m.z() - scene.layout.paper_z_m <= kPenContactThresholdM});
+  }
+  return samples;
+}
+
+WritingMetrics trial_writing_metrics(const Scene& scene, const TrialResult& result,
+                                     const StrokeAcceptance& acceptance) {
+  ScoreOptions options;
+  options.acceptance = acceptance;
+  return writing_metrics(scene, pen_samples(scene, result.trace), options);
 }
 
 }  // namespace calligraphy

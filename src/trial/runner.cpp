@@ -3,16 +3,10 @@
 
 #include <atomic>
 #include <chrono>
-#include <memory>
-#include <optional>
 #include <string>
 #include <thread>
 
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/devices/device_registry.hpp"
-#include "calligraphy/sim/hand_port.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
-#include "calligraphy/sim/simulated_writer.hpp"
 #include "calligraphy/trial/session.hpp"
 
 namespace calligraphy {
@@ -22,7 +16,7 @@ namespace {
 // (the link may be gone).
 class DeviceShutdown {
  public:
-  DeviceShutdown(HapticDevice& device, HandPort* hand) : device_(device), hand_(hand) {}
+  DeviceShutdown(HapticDevice& device, TrialHand* hand) : device_(device), hand_(hand) {}
   DeviceShutdown(const DeviceShutdown&) = delete;
   DeviceShutdown& operator=(const DeviceShutdown&) = delete;
   ~DeviceShutdown() {
@@ -38,19 +32,19 @@ class DeviceShutdown {
     } catch (...) {
       // Disabling is documented not to throw; a broken backend must still get close().
     }
-    if (hand_ != nullptr) hand_->attach_hand(nullptr);
+    if (hand_ != nullptr) hand_->release();
     device_.close();
   }
 
  private:
   HapticDevice& device_;
-  HandPort* hand_;
+  TrialHand* hand_;
 };
 
-// Lock-step: each tick reads the device, steps the session, commands the force, lets the writer see the
-// display and advances the device's time by one period. No wall clock.
-TrialResult run_lock_step(HapticDevice& device, HandPort& hand, SimulatedWriter& writer,
-                          TrialSession& session, const TrialOptions& options) {
+// Lock-step: each tick reads the device, steps the session, commands the force, lets the hand see the
+// output and advances the device's time by one period. No wall clock.
+TrialResult run_lock_step(HapticDevice& device, TrialHand& hand, TrialSession& session,
+                          const TrialOptions& options) {
   const double period_s = 1.0 / options.rate_hz;
   double end_time_s = -1.0;
   TrialEnd end = TrialEnd::time_limit;
@@ -69,9 +63,9 @@ TrialResult run_lock_step(HapticDevice& device, HandPort& hand, SimulatedWriter&
       end = TrialEnd::completed;
       break;
     }
-    writer.observe(session.last_output(), state);
-    if (writer.done()) {
-      end = TrialEnd::writer_gave_up;
+    hand.observe(session.last_output(), state);
+    if (hand.stopped()) {
+      end = TrialEnd::gave_up;
       break;
     }
     if (command.stop) {  // out of time after this tick: the trial lasted until the next would start
@@ -88,23 +82,23 @@ TrialResult run_lock_step(HapticDevice& device, HandPort& hand, SimulatedWriter&
   return result;
 }
 
-// Real time on the ServoLoop: the loop thread steps the session (and a simulated writer and the device's
-// physics right after the force write); this thread polls `should_stop`.
-TrialResult run_real_time(HapticDevice& device, HandPort* hand, SimulatedWriter* writer,
-                          TrialSession& session, const TrialOptions& options) {
+// Real time on the ServoLoop: the loop thread steps the session (and a hand, which sees the output and
+// moves the device right after the force write); this thread polls `should_stop`.
+TrialResult run_real_time(HapticDevice& device, TrialHand* hand, TrialSession& session,
+                          const TrialOptions& options) {
   ServoLoopOptions loop_options = options.loop;
   loop_options.rate_hz = options.rate_hz;
   const double period_s = 1.0 / options.rate_hz;
-  std::atomic<bool> writer_gave_up{false};
+  std::atomic<bool> hand_stopped{false};
   session.reserve_trace();
   ServoLoop loop(
       device,
       [&](const DeviceState& state, double /*dt_s*/) -> ServoCommand {
         ServoCommand command = session.step(state);
-        if (writer != nullptr && !command.stop) {
-          writer->observe(session.last_output(), state);
-          if (writer->done()) {
-            writer_gave_up.store(true, std::memory_order_relaxed);
+        if (hand != nullptr && !command.stop) {
+          hand->observe(session.last_output(), state);
+          if (hand->stopped()) {
+            hand_stopped.store(true, std::memory_order_relaxed);
             command.stop = true;
           }
         }
@@ -128,8 +122,8 @@ TrialResult run_real_time(HapticDevice& device, HandPort* hand, SimulatedWriter*
     end = fault.kind == LoopFaultKind::watchdog ? TrialEnd::watchdog : TrialEnd::device_fault;
   } else if (session.finished()) {
     end = TrialEnd::completed;
-  } else if (writer_gave_up.load(std::memory_order_relaxed)) {
-    end = TrialEnd::writer_gave_up;
+  } else if (hand_stopped.load(std::memory_order_relaxed)) {
+    end = TrialEnd::gave_up;
   } else if (!interrupted && session.out_of_time()) {
     end = TrialEnd::time_limit;
   }
@@ -145,47 +139,21 @@ TrialResult run_real_time(HapticDevice& device, HandPort* hand, SimulatedWriter*
 
 }  // namespace
 
-TrialResult run_trial(HapticDevice& device, const Scene& scene, const TrialOptions& options) {
+TrialResult run_trial(HapticDevice& device, const Scene& scene, const TrialOptions& options, TrialHand* hand) {
   options.validate();
-  // Discovered once: the loops never ask again.
-  HandPort* const hand = dynamic_cast<HandPort*>(&device);
   if (hand == nullptr && options.pacing == TrialPacing::lock_step) {
-    throw InvalidArgument("lock-step pacing needs a device a simulated writer can move (a HandPort); '" +
+    throw InvalidArgument("lock-step pacing needs a hand that moves the device (a simulated writer); '" +
                           device.info().model + "' is moved by a person: use real-time pacing");
   }
   const bool real_time = hand == nullptr || options.pacing == TrialPacing::real_time;
-  std::optional<SimulatedWriter> writer;
-  if (hand != nullptr) {
-    writer.emplace(scene, options.simulation.writer, options.simulation.seed);
-    hand->attach_hand(&*writer);
-  }
   const DeviceShutdown shutdown(device, hand);
   if (!device.is_open()) device.open();
   if (!device.is_calibrated()) device.calibrate();
   // After open(): some devices know their limits only then (OpenHaptics reads them from the driver).
   TrialSession session(scene, device.info(), options);
-  TrialResult result;
-  if (real_time) {
-    result = run_real_time(device, hand, writer ? &*writer : nullptr, session, options);
-  } else {
-    device.enable_forces(true);
-    result = run_lock_step(device, *hand, *writer, session, options);
-  }
-  // The loops have stopped: the writer is no longer stepped and its log is final.
-  if (writer) result.writer_log = writer->log();
-  return result;
-}
-
-TrialResult run_trial(std::string_view device_name, const Scene& scene, const TrialOptions& options) {
-  options.validate();  // before a device is created (and possibly opened by its backend)
-  const std::unique_ptr<HapticDevice> device = device_registry_with_simulation().create(device_name);
-  return run_trial(*device, scene, options);
-}
-
-TrialResult run_simulated_trial(const Scene& scene, const TrialOptions& options) {
-  options.validate();
-  SimulatedDevice device(options.simulation.device);
-  return run_trial(device, scene, options);
+  if (real_time) return run_real_time(device, hand, session, options);
+  device.enable_forces(true);
+  return run_lock_step(device, *hand, session, options);
 }
 
 }  // namespace calligraphy

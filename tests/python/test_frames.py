@@ -40,11 +40,12 @@ def test_one_row_per_stroke(result):
     assert frame.index.name == "stroke"
     assert list(frame["character"]) == ["九"] * 2 + ["心"] * 4
     assert list(frame["acronym"]) == [s.acronym for s in scene.strokes]
-    for stroke, entry in zip(frame.itertuples(), result.metrics["per_stroke"]):
+    written = [entry for character in result.metrics["per_character"] for entry in character["per_stroke"]]
+    for stroke, entry, live in zip(frame.itertuples(), written, result.metrics["renderer_strokes"]):
         assert stroke.mean_deviation_mm == entry["mean_deviation_mm"]
-        assert stroke.completed == entry["completed"] and stroke.attempts == entry["attempts"]
-    # The per-stroke deviation is measured over the stroke's last attempt, which stroke_trace_range
-    # locates in the trace: its ticks are all of that stroke.
+        assert stroke.completed == live["completed"] and stroke.attempts == live["attempts"]
+    # The renderer's last attempt at each stroke, which stroke_trace_range locates in the trace: its ticks are
+    # all of that stroke.
     for k, (begin, end) in enumerate(result.stroke_trace_range):
         assert end > begin
         assert np.all(result.stroke[begin:end] == k)

@@ -30,7 +30,7 @@ def cpp_fields(header, struct):
     "cls, header, struct",
     [
         (calligraphy.ForceLawParameters, "render/force_law.hpp", "ForceLawParameters"),
-        (calligraphy.NearestPointOptions, "collision/nearest_point.hpp", "NearestPointOptions"),
+        (calligraphy.NearestPointOptions, "model/nearest_point.hpp", "NearestPointOptions"),
         (calligraphy.WriterProfile, "sim/writer_profile.hpp", "WriterProfile"),
         (calligraphy.SimulatedDeviceParameters, "sim/simulated_device.hpp", "SimulatedDeviceParameters"),
         (calligraphy.DeviceInfo, "core/device_types.hpp", "DeviceInfo"),

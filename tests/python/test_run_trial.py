@@ -7,13 +7,13 @@ import calligraphy
 def test_run_trial_on_the_simulated_device_is_simulate_trial():
     by_name = calligraphy.run_trial("九", device="simulated", seed=2, keep_trace=False)
     simulated = calligraphy.simulate_trial("九", seed=2, keep_trace=False)
-    for key in ("mean_deviation_mm", "time_s", "strokes_completed", "end_reason"):
+    for key in ("mean_deviation_mm", "total_time_s", "strokes_completed", "end_reason"):
         assert by_name.metrics[key] == simulated.metrics[key]
     assert by_name.metrics["device"] == "simulated"
 
 
 def test_run_trial_in_real_time_keeps_its_ticks():
-    result = calligraphy.run_trial("永", device="simulated", pacing="real_time", max_duration_s=0.3)
+    result = calligraphy.run_trial("永", device="simulated", pacing="real-time", max_duration_s=0.3)
     assert result.metrics["end_reason"] == "time_limit"
     assert result.metrics["aborted"]
     assert len(result.time_s) == 300  # the time limit counts ticks: 0.3 s at 1 kHz

@@ -58,19 +58,19 @@ def test_swapped_and_reversed_strokes_are_found():
 
 def test_segments_carry_the_renderers_verdicts_in_turn():
     reversed_stroke = calligraphy.score(reference_trace("木", reverse=(1,)), "木")
-    segments = reversed_stroke["segments"]
+    segments = reversed_stroke["per_character"][0]["segments"]
     assert len(segments) == 4
     verdicts = [s["verdict"] for s in segments]
-    # Stroke 1 (1-based) accepted, stroke 2 refused as backwards; strokes 3 and 4 then come too early.
+    # Stroke 0 accepted, stroke 1 refused as backwards; strokes 2 and 3 then come too early.
     assert [v["accepted"] for v in verdicts] == [True, False, False, False]
     assert [v["refusal"] for v in verdicts] == ["none", "backwards", "wrong_order", "wrong_order"]
-    assert [v["expected_stroke"] for v in verdicts] == [1, 2, 2, 2]
-    assert [v["matched_stroke"] for v in verdicts] == [1, 2, 3, 4]
+    assert [v["expected_stroke"] for v in verdicts] == [0, 1, 1, 1]
+    assert [v["matched_stroke"] for v in verdicts] == [0, 1, 2, 3]
     assert reversed_stroke["strokes_accepted"] == 1
     assert reversed_stroke["refusals"] == {"too_short": 0, "backwards": 1, "wrong_place": 0,
                                            "wrong_stroke": 0, "wrong_order": 2}
     # The matching for the metrics still pairs every segment with its stroke.
-    assert [s["matched_stroke"] for s in segments] == [1, 2, 3, 4]
+    assert [s["matched_stroke"] for s in segments] == [0, 1, 2, 3]
     assert [s["backwards"] for s in segments] == [False, True, False, False]
     first = calligraphy.Scene("木").characters[0].strokes[0]
     assert segments[0]["begin"] == 0 and segments[0]["end"] == 50 * len(first.elements)  # sample indices

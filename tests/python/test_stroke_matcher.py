@@ -10,7 +10,7 @@ Refusal = calligraphy.StrokeRefusal
 States = calligraphy.InteractionState
 CHARACTERS = "永口十"
 
-# The stroke matcher reads a path in steps of 0.25 mm (src/collision/stroke_matcher.cpp); a renderer fed
+# The stroke matcher reads a path in steps of 0.25 mm (src/analysis/stroke_matcher.cpp); a renderer fed
 # the same points, one per tick, sees the pen move exactly as the matcher reads it.
 STEP_M = 0.00025
 

@@ -37,7 +37,8 @@ def test_one_row_per_combination_character_and_seed_in_order(local_table):
     assert list(zip(local_table.guidance, local_table.character, local_table.seed)) == expected
     assert (local_table.guidance_stiffness_n_per_m == 250.0).all()
     assert list(local_table.columns[:4]) == ["character", "seed", "guidance", "guidance_stiffness_n_per_m"]
-    assert "per_stroke" not in local_table.columns and "error" in local_table.columns
+    assert "renderer_strokes" not in local_table.columns and "characters" not in local_table.columns
+    assert "error" in local_table.columns
 
 
 def test_rows_are_the_trials_metrics(local_table):
@@ -45,9 +46,9 @@ def test_rows_are_the_trials_metrics(local_table):
     for _, row in local_table[local_table.character != "\u00e9"].iterrows():
         metrics = calligraphy.simulate_trial(row.character, guidance=bool(row.guidance), seed=int(row.seed),
                                              force_law=law, keep_trace=False).metrics
-        for key in ("mean_deviation_mm", "max_deviation_mm", "time_s", "completed_in_order", "strokes_total"):
+        for key in ("mean_deviation_mm", "max_deviation_mm", "total_time_s", "completed_in_order", "strokes_total"):
             assert row[key] == metrics[key], key
-        assert row.attempts_total == sum(stroke["attempts"] for stroke in metrics["per_stroke"])
+        assert row.attempts_total == sum(stroke["attempts"] for stroke in metrics["renderer_strokes"])
         assert row.error is None
 
 
@@ -77,7 +78,7 @@ def test_writer_and_nested_fields_reach_the_trial():
     expected = calligraphy.simulate_trial("口", writer=writer, force_law=law, seed=3, keep_trace=False).metrics
     assert table.error.isna().all()
     assert table.mean_deviation_mm[0] == expected["mean_deviation_mm"]
-    assert table.time_s[0] == expected["time_s"]
+    assert table.total_time_s[0] == expected["total_time_s"]
     assert table.writer[0] == "skilled"
 
 

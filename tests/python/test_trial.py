@@ -33,7 +33,7 @@ def test_metrics_have_the_keys_of_the_cli_json(cli, tmp_path, yong_seed3):
     # One list of keys, in the same order, down to the per-stroke entries.
     assert list(yong_seed3.metrics) == list(expected)
     assert keys(yong_seed3.metrics) == keys(expected)
-    assert len(yong_seed3.metrics["per_stroke"]) == 5
+    assert len(yong_seed3.metrics["per_character"][0]["per_stroke"]) == 5
 
 
 def test_metrics_equal_the_cli(cli, tmp_path, yong_seed3):

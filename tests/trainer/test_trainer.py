@@ -219,7 +219,7 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual(record["subject"], "anonymous")
         self.assertEqual(record["condition"], "haptic")
         self.assertEqual(record["device"]["name"], "simulated")
-        for key in ("start_time_utc", "library", "mean_deviation_mm", "per_stroke", "loop", "score"):
+        for key in ("start_time_utc", "library", "mean_deviation_mm", "per_stroke", "loop", "per_character"):
             self.assertIn(key, record)
         with open(record_path.with_suffix(".csv"), newline="") as f:
             trace = list(csv.DictReader(f))
@@ -271,7 +271,7 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual(record["condition"], "vision")
         self.assertEqual((record["strokes_completed"], record["strokes_total"]), (1, 1))
         self.assertEqual(record["end_reason"], "completed")
-        self.assertLess(record["per_stroke"][0]["mean_deviation_mm"], 1.5)
+        self.assertLess(record["per_character"][0]["per_stroke"][0]["mean_deviation_mm"], 1.5)
 
     def write_with_the_mouse(self, window, points, pause=0.12):
         """Presses at the first point, moves through the others, and lifts the pen."""
@@ -299,13 +299,13 @@ class TrainerTest(unittest.TestCase):
         deadline = time.time() + 20
         while "stroke_missed" not in trainer.errors() and time.time() < deadline:
             time.sleep(0.1)
-        self.assertIn("quiz 一 stroke 1: stroke_missed (misses 1 on the stroke, 1 in all, backwards)",
+        self.assertIn("quiz 一 stroke 0: stroke_missed (misses 1 on the stroke, 1 in all, backwards)",
                       trainer.errors())
         time.sleep(0.8)
         self.write_with_the_mouse(window, forwards + [box.data_to_px((median[-1][0] + 15, median[-1][1]))])
         self.assertEqual(trainer.wait(), 0, trainer.errors())
         errors = trainer.errors()
-        self.assertIn("quiz 一 stroke 1: stroke_accepted (misses 0 on the stroke, 1 in all)", errors)
+        self.assertIn("quiz 一 stroke 0: stroke_accepted (misses 0 on the stroke, 1 in all)", errors)
         self.assertIn("quiz 一 complete, 1 misses", errors)
         self.assertIn("live verdicts are the saved record's", errors)
 

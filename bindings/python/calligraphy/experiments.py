@@ -157,10 +157,14 @@ def _library(source: _Source) -> CharacterLibrary:
 
 
 def _flat_metrics(metrics: dict[str, typing.Any]) -> dict[str, typing.Any]:
-    """The scalar metrics of `calligraphy trial --json`; the per-stroke list summarised as the total
-    number of attempts over the strokes."""
-    flat = {key: value for key, value in metrics.items() if key != "per_stroke"}
-    flat["attempts_total"] = sum(stroke["attempts"] for stroke in metrics["per_stroke"])
+    """The scalar metrics of `calligraphy trial --json` (the one metrics record and the renderer's figures);
+    the lists summarised: the renderer's attempts as their total over the strokes, the refusals one column
+    per reason, the characters left out."""
+    flat = {key: value for key, value in metrics.items()
+            if key not in ("renderer_strokes", "per_character", "refusals")}
+    flat["attempts_total"] = sum(stroke["attempts"] for stroke in metrics["renderer_strokes"])
+    for reason, count in metrics["refusals"].items():
+        flat[f"refused_{reason}"] = count
     return flat
 
 

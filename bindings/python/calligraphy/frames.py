@@ -66,31 +66,42 @@ def trial_dataframe(result: TrialResult) -> pandas.DataFrame:
 
 def per_stroke_dataframe(result: TrialResult) -> pandas.DataFrame:
     """One row per stroke of the scene, indexed by the stroke over the scene (0-based, named
-    ``stroke`` as in ``trial_dataframe``), from ``result.metrics['per_stroke']``.
+    ``stroke`` as in ``trial_dataframe``): what was written, from the one metrics record
+    (``result.metrics['per_character'][c]['per_stroke']``, docs/metrics.md), and the renderer's attempts
+    (``result.metrics['renderer_strokes']``).
 
     Columns: ``character`` (str), ``acronym`` of its typical stroke, ``typical_id`` (1..39),
-    ``completed`` (bool), ``attempts`` (int), ``mean_deviation_mm`` and ``max_deviation_mm`` [mm],
-    ``time_s`` [s] (the last attempt's writing time). Raises ImportError when pandas is missing.
+    ``written`` and ``backwards`` (bool), ``mean_deviation_mm``, ``max_deviation_mm``, ``frechet_mm`` and
+    ``dtw_mm`` [mm] (NaN for a stroke not written), ``time_s`` [s] (its pen-down writing time),
+    ``completed`` (bool, the renderer completed it in turn) and ``attempts`` (int). Raises ImportError when
+    pandas is missing.
     """
     pandas = _pandas()
-    characters = [placed.char for placed in result.scene.characters for _ in placed.strokes]
     acronyms = [stroke.acronym for stroke in result.scene.strokes]
+    renderer = result.metrics["renderer_strokes"]
     rows = []
-    for entry in result.metrics["per_stroke"]:
-        stroke = entry["index"] - 1  # the JSON counts from 1
-        rows.append(
-            {
-                "stroke": stroke,
-                "character": characters[stroke],
-                "acronym": acronyms[stroke],
-                "typical_id": entry["typical_id"],
-                "completed": entry["completed"],
-                "attempts": entry["attempts"],
-                "mean_deviation_mm": entry["mean_deviation_mm"],
-                "max_deviation_mm": entry["max_deviation_mm"],
-                "time_s": entry["time_s"],
-            }
-        )
-    columns = ["stroke", "character", "acronym", "typical_id", "completed", "attempts", "mean_deviation_mm",
-               "max_deviation_mm", "time_s"]
+    stroke = 0
+    for character in result.metrics["per_character"]:
+        for entry in character["per_stroke"]:
+            live = renderer[stroke] if stroke < len(renderer) else {"completed": False, "attempts": 0}
+            rows.append(
+                {
+                    "stroke": stroke,
+                    "character": character["character"],
+                    "acronym": acronyms[stroke],
+                    "typical_id": entry["typical_id"],
+                    "written": entry["written"],
+                    "backwards": entry["backwards"],
+                    "mean_deviation_mm": entry["mean_deviation_mm"],
+                    "max_deviation_mm": entry["max_deviation_mm"],
+                    "frechet_mm": entry["frechet_mm"],
+                    "dtw_mm": entry["dtw_mm"],
+                    "time_s": entry["time_s"],
+                    "completed": live["completed"],
+                    "attempts": live["attempts"],
+                }
+            )
+            stroke += 1
+    columns = ["stroke", "character", "acronym", "typical_id", "written", "backwards", "mean_deviation_mm",
+               "max_deviation_mm", "frechet_mm", "dtw_mm", "time_s", "completed", "attempts"]
     return pandas.DataFrame(rows, columns=columns).set_index("stroke")

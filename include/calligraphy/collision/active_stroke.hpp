@@ -7,7 +7,7 @@
 /// (stroke_progress.hpp), not the feature planes alone. Servo path: no allocation, noexcept.
 #include <cstddef>
 
-#include "calligraphy/collision/stroke_progress.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/model/scene.hpp"
 
 namespace calligraphy {

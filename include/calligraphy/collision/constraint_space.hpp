@@ -2,7 +2,7 @@
 /// \file constraint_space.hpp
 /// Constraint space of stroke elements and feature planes (paper section 4.3). Servo path: no
 /// allocation, no exceptions; callers pass finite values. Lengths in m.
-#include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/model/nearest_point.hpp"
 #include "calligraphy/model/element.hpp"
 
 namespace calligraphy {
@@ -28,11 +28,5 @@ struct ElementContact {
 /// The same with the foot point already found (e.g. by a NearestPointTracker): the inside rules only.
 [[nodiscard]] ElementContact element_contact_at(const StrokeElement& element, const Vec2& tip,
                                                 const NearestPoint& nearest, double radius_m) noexcept;
-
-/// Eq. (6): the feature point at the end of `element` has been written (phi > 0) when
-/// V_t . V_f > margin, V_t the element's unit tangent at its end and V_f the vector from that point to
-/// the tip. `margin_m` >= 0 [m] is a hysteresis band (section 6): 0 is the paper's rule.
-[[nodiscard]] bool feature_plane_passed(const StrokeElement& element, const Vec2& tip,
-                                        double margin_m = 0.0) noexcept;
 
 }  // namespace calligraphy

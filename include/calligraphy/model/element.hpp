@@ -54,4 +54,10 @@ struct StrokeElement {
   [[nodiscard]] double arc_length() const;
 };
 
+/// Eq. (6): the feature point at the end of `element` has been written (phi > 0) when
+/// V_t . V_f > margin, V_t the element's unit tangent at its end and V_f the vector from that point to
+/// the tip. `margin_m` >= 0 [m] is a hysteresis band (section 6): 0 is the paper's rule.
+[[nodiscard]] bool feature_plane_passed(const StrokeElement& element, const Vec2& tip,
+                                        double margin_m = 0.0) noexcept;
+
 }  // namespace calligraphy

@@ -33,7 +33,7 @@ struct SceneLayout {
 
 /// The centre line a person follows when writing a stroke: the data's median (what the outline shows,
 /// brush hooks included), or the elements sampled densely when the stroke has no median. Progress and
-/// acceptance of a stroke are measured along it (collision/stroke_progress.hpp).
+/// acceptance of a stroke are measured along it (model/stroke_progress.hpp).
 struct StrokeCentreLine {
   std::vector<Vec2> points_m;  ///< polyline [m], at least 2 points, no repeats
   std::vector<double> arc_m;   ///< arc length from the first point to each point [m], same size

@@ -4,8 +4,8 @@
 /// (noexcept, no allocation). Device frame: the paper is z = z0, +z out of the paper.
 #include <vector>
 
-#include "calligraphy/collision/nearest_point.hpp"
-#include "calligraphy/collision/stroke_progress.hpp"
+#include "calligraphy/model/nearest_point.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/core/geometry.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
 

@@ -10,7 +10,7 @@
 #include <cstdint>
 
 #include "calligraphy/collision/active_stroke.hpp"
-#include "calligraphy/collision/nearest_point_tracker.hpp"
+#include "calligraphy/model/nearest_point_tracker.hpp"
 #include "calligraphy/core/device_types.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/render/force_law.hpp"

@@ -1,6 +1,6 @@
 #pragma once
 /// \file pen_trace_csv.hpp
-/// Reading a pen trace from CSV for `score_trace` (trial/score.hpp).
+/// Reading a pen trace from CSV for `score_trace` (analysis/score.hpp).
 ///
 /// Format: comma-separated, one header line naming the columns, then one sample a line. Columns are found
 /// by header name (others are ignored, order is free): `t` time [s], `x` and `y` the pen tip, and either
@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "calligraphy/model/scene.hpp"
-#include "calligraphy/trial/score.hpp"
+#include "calligraphy/analysis/score.hpp"
 
 namespace calligraphy {
 
@@ -37,9 +37,9 @@ TraceUnits parse_trace_units(std::string_view name);
 /// Options of the reader.
 struct PenTraceCsvOptions {
   TraceUnits units = TraceUnits::metres;
-  /// With a `z` column: the pen touches the paper when z <= this [m]. 0.5 mm allows for the tracking noise
-  /// of a desktop haptic device above a virtual paper plane (a choice). Finite.
-  double contact_threshold_m = 0.5e-3;
+  /// With a `z` column: the pen touches the paper when z <= this [m] (kPenContactThresholdM, score.hpp).
+  /// Finite.
+  double contact_threshold_m = kPenContactThresholdM;
   std::uintmax_t max_file_bytes = std::uintmax_t{256} << 20;  ///< larger files are refused (256 MiB)
   /// A trace with more pen-down segments is refused at the line that starts the first one too many
   /// (ScoreOptions::max_segments, what one scored trace may have). > 0.

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "calligraphy/render/guidance_mode.hpp"
+#include "calligraphy/analysis/writing_metrics.hpp"
 #include "calligraphy/trial/trial.hpp"
 
 namespace calligraphy {
@@ -27,13 +28,20 @@ struct TrialDescription {
   std::vector<std::string> writer_parameters{};  ///< "key=value" settings applied to the profile
 };
 
-/// The table of the metrics, and a line saying why when the trial was aborted.
-void print_trial_table(const TrialDescription& d, const Scene& scene, const TrialResult& result);
-/// The metrics as JSON, with `device`, `aborted` and `abort_reason`.
-std::string trial_json(const TrialDescription& d, const TrialResult& result);
+/// The table of what was written (`writing`, the one metrics record: trial_writing_metrics, result.hpp), the
+/// renderer's attempts and completions per stroke and its force figures, and a line saying why when the
+/// trial was aborted. Strokes are numbered over the scene from 0.
+void print_trial_table(const TrialDescription& d, const Scene& scene, const TrialResult& result,
+                       const WritingMetrics& writing);
+/// The trial as JSON: the description, how it ended (`end_reason`, `aborted`, `abort_reason`), the renderer's
+/// figures (`strokes_completed`, `trial_time_s`, `max_force_n`, `max_force_step_n`, `state_transitions`,
+/// `renderer_strokes`, `loop`) and every key of the one metrics record (`writing_metrics_json`,
+/// score_report.hpp) with its values.
+std::string trial_json(const TrialDescription& d, const TrialResult& result, const WritingMetrics& writing);
 /// Reference in blue, pen trace in green, each stroke's start hint as a red ellipse (paper Figs. 30-31).
 std::string trial_svg(const Scene& scene, const TrialResult& result);
-/// The 1 kHz trace: t,x,y,z,fx,fy,fz,state,stroke,element (SI units).
+/// The trace, one row per tick: t,x,y,z,fx,fy,fz,state,stroke,element (SI units); t, x, y, z in the shortest
+/// text that reads back as the same double, so a score of the file gives the trial's own metrics.
 std::string trial_csv(const std::vector<TrialSample>& trace);
 /// Writes text to a file, whole or not at all (`write_file_atomically`, atomic_file.hpp); throws DataError
 /// naming the path when it cannot.

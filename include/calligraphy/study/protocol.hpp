@@ -11,7 +11,7 @@
 #include <string_view>
 #include <vector>
 
-#include "calligraphy/collision/stroke_progress.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
 
@@ -30,7 +30,7 @@ enum class ConditionMode {
 [[nodiscard]] const char* to_string(ConditionMode mode) noexcept;
 
 /// How a quiz judges strokes: each pen-down run with the stroke matcher (`match_stroke`,
-/// collision/stroke_matcher.hpp), the rule the renderer and `score_trace` use (docs/stroke-acceptance.md);
+/// analysis/stroke_matcher.hpp), the rule the renderer and `score_trace` use (docs/stroke-acceptance.md);
 /// misses and hints as in Hanzi Writer's quiz (chanind/hanzi-writer src/Quiz.ts).
 struct QuizOptions {
   /// The stroke matcher's tolerances (SI units). The trainer gives its trials' (ForceLawParameters::

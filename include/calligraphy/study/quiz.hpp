@@ -3,8 +3,8 @@
 /// A stroke-order quiz for vision-only input, after Hanzi Writer's quiz (chanind/hanzi-writer,
 /// src/Quiz.ts): pen samples go in; each time the pen lifts, the stroke just written is judged against the
 /// stroke expected next, and accepted or missed. A run too short to judge (the rule by which `score_trace`
-/// ignores a segment: trial/score.hpp) is neither. Every other run is judged by the stroke matcher,
-/// `match_stroke(character, expected, run, start_radius_m, acceptance)` (collision/stroke_matcher.hpp):
+/// ignores a segment: analysis/score.hpp) is neither. Every other run is judged by the stroke matcher,
+/// `match_stroke(character, expected, run, start_radius_m, acceptance)` (analysis/stroke_matcher.hpp):
 /// the renderer's rule, so that the quiz, the renderer and `score_trace`'s segment verdicts agree on the
 /// same trace (docs/stroke-acceptance.md). A run refused as backwards is a miss reported as backwards, or
 /// accepted (still reported as backwards) with `accept_backwards`. After `hint_after_misses` misses on
@@ -14,10 +14,10 @@
 #include <optional>
 #include <vector>
 
-#include "calligraphy/collision/stroke_matcher.hpp"
+#include "calligraphy/analysis/stroke_matcher.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/study/protocol.hpp"
-#include "calligraphy/trial/score.hpp"
+#include "calligraphy/analysis/score.hpp"
 
 namespace calligraphy {
 

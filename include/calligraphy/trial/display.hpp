@@ -28,14 +28,14 @@
 #include <cstdint>
 #include <vector>
 
-#include "calligraphy/collision/stroke_progress.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/core/device_types.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/render/renderer.hpp"
 #include "calligraphy/trial/recorder.hpp"
 #include "calligraphy/trial/result.hpp"
-#include "calligraphy/trial/seqlock.hpp"
-#include "calligraphy/trial/spsc_queue.hpp"
+#include "calligraphy/core/seqlock.hpp"
+#include "calligraphy/core/spsc_queue.hpp"
 
 namespace calligraphy {
 

@@ -2,32 +2,29 @@
 /// \file options.hpp
 /// The options of a guided writing trial, one struct for every device and pacing (validated once, in
 /// `TrialOptions::validate`).
-#include <cstdint>
 #include <functional>
+#include <string_view>
 
 #include "calligraphy/devices/servo_loop.hpp"
 #include "calligraphy/render/force_law.hpp"
 #include "calligraphy/render/renderer.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
-#include "calligraphy/sim/simulated_writer.hpp"
 #include "calligraphy/trial/display.hpp"
 
 namespace calligraphy {
 
 /// How a trial's ticks are paced.
 enum class TrialPacing {
-  automatic,  ///< lock-step for a device a simulated writer moves (a `HandPort`), real time otherwise
-  lock_step,  ///< no wall clock: only for a device with a hand port (else InvalidArgument)
+  automatic,  ///< lock-step when the trial is given a hand (hand.hpp), real time otherwise
+  lock_step,  ///< no wall clock: only with a hand that moves the device (else InvalidArgument)
   real_time,  ///< the `ServoLoop` at `rate_hz` on its own thread, with `loop`'s realtime settings
 };
 
-/// The simulated part of a trial: who moves a device that has a hand port, and the simulated device
-/// `run_simulated_trial` creates. Unused on a device a person moves.
-struct SimulationOptions {
-  WriterProfile writer = WriterProfile::novice();  ///< the simulated writer
-  SimulatedDeviceParameters device{};              ///< the device `run_simulated_trial` creates
-  std::uint64_t seed = 0;                          ///< seeds the writer's bias, noise and tremor
-};
+/// "auto", "lock-step" or "real-time": the one spelling of a pacing in the CLI, protocols, session folders,
+/// records and Python.
+[[nodiscard]] const char* to_string(TrialPacing pacing) noexcept;
+/// The pacing spelled `text` (as `to_string` spells it). Throws InvalidArgument naming `what` (the option or
+/// field) and the three spellings otherwise.
+[[nodiscard]] TrialPacing parse_trial_pacing(std::string_view text, std::string_view what = "pacing");
 
 /// Options of a trial on any device.
 struct TrialOptions {
@@ -41,7 +38,6 @@ struct TrialOptions {
   ServoLoopOptions loop{};
   double max_duration_s = 300.0;  ///< the trial ends after this much device time [s]
   bool keep_trace = true;         ///< keep one `TrialSample` per tick in the result
-  SimulationOptions simulation{};
   /// Polled by the thread that runs the trial (never the servo thread): once per tick in lock-step,
   /// every millisecond in real time. Returning true ends the trial at the next tick with
   /// `TrialEnd::interrupted` (zero force, forces disabled, every recorded tick kept). May be empty.

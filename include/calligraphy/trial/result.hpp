@@ -3,11 +3,13 @@
 /// What a trial returns: the metrics, the trace, how it ended, and the servo loop's statistics when it
 /// ran in real time.
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
+#include "calligraphy/analysis/writing_metrics.hpp"
 #include "calligraphy/devices/servo_loop.hpp"
-#include "calligraphy/sim/writer_log.hpp"
+#include "calligraphy/model/scene.hpp"
 #include "calligraphy/trial/recorder.hpp"
 
 namespace calligraphy {
@@ -19,10 +21,10 @@ enum class TrialEnd {
   device_fault,    ///< the device returned a fault code (`TrialResult::device_fault`), or a callback threw
   watchdog,        ///< the servo loop stalled longer than its bound
   interrupted,     ///< `TrialOptions::should_stop` (e.g. SIGINT or SIGTERM, a closed window)
-  writer_gave_up,  ///< the simulated writer stopped before every stroke was written
+  gave_up,         ///< the hand moving the device (hand.hpp) stopped before every stroke was written
 };
 
-/// "completed", "time_limit", "device_fault", "watchdog", "interrupted", "writer_gave_up".
+/// "completed", "time_limit", "device_fault", "watchdog", "interrupted", "gave_up".
 [[nodiscard]] const char* to_string(TrialEnd end) noexcept;
 
 /// The outcome of a trial. The metrics and trace hold every tick recorded, whatever ended the trial.
@@ -37,9 +39,16 @@ struct TrialResult {
   /// fault; else a short reason or empty.
   std::string abort_reason;
   std::optional<ServoLoopStats> loop;  ///< the servo loop's statistics, for a real-time trial
-  /// What the simulated writer did, attempt by attempt, when one moved the device (its `log()`); empty on
-  /// a device a person moves. Feeds `RepetitionOutcome::from_log` for learning across repetitions.
-  std::optional<WriterLog> writer_log;
 };
+
+/// The trace as pen samples in the paper plane: the pen is down when the HIP is at most
+/// kPenContactThresholdM above the scene's paper (the rule of the pen-trace CSV reader). Samples as `trace`.
+[[nodiscard]] std::vector<PenSample> pen_samples(const Scene& scene, std::span<const TrialSample> trace);
+
+/// The one metrics record (analysis/writing_metrics.hpp) of the trial's trace, with the renderer's stroke
+/// acceptance: what `calligraphy trial`, study records and Python report. Needs the trace (`keep_trace`);
+/// without one nothing was written as far as the record can tell. Throws what `writing_metrics` throws.
+[[nodiscard]] WritingMetrics trial_writing_metrics(const Scene& scene, const TrialResult& result,
+                                                   const StrokeAcceptance& acceptance);
 
 }  // namespace calligraphy

@@ -1,4 +1,4 @@
-#include "trial/segmentation.hpp"
+#include "analysis/segmentation.hpp"
 
 #include <cmath>
 #include <string>

@@ -1,7 +1,7 @@
 // The multi-start Newton method (as msdfgen, Chlumsky's signed distance field generator, does for curves).
 #include <algorithm>
 
-#include "collision/nearest_point_methods.hpp"
+#include "model/nearest_point_methods.hpp"
 
 namespace calligraphy::detail {
 

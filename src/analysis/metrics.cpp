@@ -1,4 +1,4 @@
-#include "calligraphy/trial/metrics.hpp"
+#include "calligraphy/analysis/metrics.hpp"
 
 #include <string>
 

@@ -1,4 +1,4 @@
-#include "collision/local_curve.hpp"
+#include "model/local_curve.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <limits>
 
-#include "collision/bernstein.hpp"
-#include "collision/nearest_point_methods.hpp"
+#include "model/bernstein.hpp"
+#include "model/nearest_point_methods.hpp"
 
 namespace calligraphy::detail {
 

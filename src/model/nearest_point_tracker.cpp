@@ -1,4 +1,4 @@
-#include "calligraphy/collision/nearest_point_tracker.hpp"
+#include "calligraphy/model/nearest_point_tracker.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,8 +6,8 @@
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
-#include "collision/local_curve.hpp"
-#include "collision/nearest_point_methods.hpp"
+#include "model/local_curve.hpp"
+#include "model/nearest_point_methods.hpp"
 
 namespace calligraphy {
 

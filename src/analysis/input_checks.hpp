@@ -4,7 +4,7 @@
 #include <span>
 #include <string>
 
-#include "calligraphy/trial/metrics.hpp"
+#include "calligraphy/analysis/metrics.hpp"
 
 namespace calligraphy::trial_detail {
 

@@ -5,8 +5,8 @@
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/trial/metrics.hpp"
-#include "trial/input_checks.hpp"
+#include "calligraphy/analysis/metrics.hpp"
+#include "analysis/input_checks.hpp"
 
 namespace calligraphy {
 namespace {

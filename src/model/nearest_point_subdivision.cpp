@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "collision/nearest_point_methods.hpp"
+#include "model/nearest_point_methods.hpp"
 
 namespace calligraphy::detail {
 

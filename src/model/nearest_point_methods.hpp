@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <limits>
 
-#include "calligraphy/collision/nearest_point.hpp"
-#include "collision/local_curve.hpp"
+#include "calligraphy/model/nearest_point.hpp"
+#include "model/local_curve.hpp"
 
 namespace calligraphy::detail {
 

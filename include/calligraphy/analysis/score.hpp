@@ -2,7 +2,7 @@
 /// \file score.hpp
 /// Scoring a pen trace against one placed character: the trace is cut into written strokes at pen
 /// lifts, each written stroke is matched to a reference stroke with the stroke matcher the renderer uses
-/// (collision/stroke_matcher.hpp, docs/stroke-acceptance.md), and every matched stroke gets the metrics of
+/// (analysis/stroke_matcher.hpp, docs/stroke-acceptance.md), and every matched stroke gets the metrics of
 /// metrics.hpp. Each written stroke also gets the verdict the renderer would have given it in turn.
 /// Definitions and sources: docs/metrics.md.
 #include <cstddef>
@@ -11,11 +11,16 @@
 #include <span>
 #include <vector>
 
-#include "calligraphy/collision/stroke_matcher.hpp"
+#include "calligraphy/analysis/stroke_matcher.hpp"
 #include "calligraphy/model/scene.hpp"
-#include "calligraphy/trial/metrics.hpp"
+#include "calligraphy/analysis/metrics.hpp"
 
 namespace calligraphy {
+
+/// A pen touches the paper when its tip is at most this far above the paper plane [m]: 0.5 mm allows for the
+/// tracking noise of a desktop haptic device above a virtual paper plane (a choice). Trials, the pen-trace
+/// CSV reader and the quiz use it.
+inline constexpr double kPenContactThresholdM = 0.5e-3;
 
 /// One sample of a pen trace, in the paper plane of the character's placement.
 struct PenSample {

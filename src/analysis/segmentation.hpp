@@ -3,7 +3,7 @@
 #include <span>
 #include <vector>
 
-#include "calligraphy/trial/score.hpp"
+#include "calligraphy/analysis/score.hpp"
 
 namespace calligraphy::trial_detail {
 

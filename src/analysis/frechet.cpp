@@ -1,8 +1,8 @@
 #include <algorithm>
 #include <vector>
 
-#include "calligraphy/trial/metrics.hpp"
-#include "trial/input_checks.hpp"
+#include "calligraphy/analysis/metrics.hpp"
+#include "analysis/input_checks.hpp"
 
 namespace calligraphy {
 

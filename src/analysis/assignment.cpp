@@ -1,4 +1,4 @@
-#include "trial/assignment.hpp"
+#include "analysis/assignment.hpp"
 
 #include <limits>
 

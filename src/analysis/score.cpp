@@ -1,4 +1,4 @@
-#include "calligraphy/trial/score.hpp"
+#include "calligraphy/analysis/score.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,9 +6,9 @@
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
-#include "trial/assignment.hpp"
-#include "trial/input_checks.hpp"
-#include "trial/segmentation.hpp"
+#include "analysis/assignment.hpp"
+#include "analysis/input_checks.hpp"
+#include "analysis/segmentation.hpp"
 
 namespace calligraphy {
 namespace {

@@ -8,7 +8,7 @@
 #include <cstddef>
 #include <span>
 
-#include "calligraphy/collision/stroke_progress.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/model/scene.hpp"
 
 namespace calligraphy {

@@ -4,8 +4,8 @@
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/collision/nearest_point.hpp"
-#include "calligraphy/trial/metrics.hpp"
+#include "calligraphy/model/nearest_point.hpp"
+#include "calligraphy/analysis/metrics.hpp"
 
 namespace calligraphy {
 namespace {

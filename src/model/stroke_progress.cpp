@@ -1,11 +1,10 @@
-#include "calligraphy/collision/stroke_progress.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
 
-#include "calligraphy/collision/constraint_space.hpp"
 #include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {

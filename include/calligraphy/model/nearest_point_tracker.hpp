@@ -9,7 +9,7 @@
 /// becomes clearly nearer (the pen crossed the curve's medial axis), which the force path must smooth.
 /// Behaviour and measurements: docs/nearest-point.md.
 
-#include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/model/nearest_point.hpp"
 #include "calligraphy/model/element.hpp"
 
 namespace calligraphy {

@@ -6,7 +6,7 @@
 // global coordinates.
 #include <array>
 
-#include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/model/nearest_point.hpp"
 #include "calligraphy/model/element.hpp"
 
 namespace calligraphy::detail {

@@ -1,4 +1,4 @@
-#include "calligraphy/collision/stroke_matcher.hpp"
+#include "calligraphy/analysis/stroke_matcher.hpp"
 
 #include <algorithm>
 #include <cmath>

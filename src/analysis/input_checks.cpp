@@ -1,4 +1,4 @@
-#include "trial/input_checks.hpp"
+#include "analysis/input_checks.hpp"
 
 #include <cmath>
 #include <string>

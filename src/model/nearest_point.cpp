@@ -1,5 +1,5 @@
 // Validation and dispatch of `nearest_point`, and the servo-path segment projection.
-#include "calligraphy/collision/nearest_point.hpp"
+#include "calligraphy/model/nearest_point.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,8 +7,8 @@
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
-#include "collision/local_curve.hpp"
-#include "collision/nearest_point_methods.hpp"
+#include "model/local_curve.hpp"
+#include "model/nearest_point_methods.hpp"
 
 namespace calligraphy {
 

@@ -1,0 +1,118 @@
+// The one metrics record of a written trace (writing_metrics.hpp, docs/metrics.md).
+#include "calligraphy/analysis/writing_metrics.hpp"
+
+#include <limits>
+#include <vector>
+
+#include "calligraphy/core/errors.hpp"
+
+namespace calligraphy {
+namespace {
+
+// The character each pen-down run of `trace` belongs to, as an index per sample (pen-up samples: none).
+std::vector<std::size_t> character_of_samples(const Scene& scene, std::span<const PenSample> trace) {
+  constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
+  std::vector<std::size_t> owner(trace.size(), kNone);
+  std::vector<std::size_t> inside(scene.characters.size());
+  std::size_t i = 0;
+  while (i < trace.size()) {
+    if (!trace[i].pen_down) {
+      ++i;
+      continue;
+    }
+    std::size_t end = i;
+    std::fill(inside.begin(), inside.end(), 0);
+    for (; end < trace.size() && trace[end].pen_down; ++end) {
+      for (std::size_t c = 0; c < scene.characters.size(); ++c) {
+        if (scene.characters[c].bounding_box.contains(trace[end].position_m)) ++inside[c];
+      }
+    }
+    std::size_t best = 0;
+    for (std::size_t c = 1; c < inside.size(); ++c) best = inside[c] > inside[best] ? c : best;
+    if (inside[best] == 0) {  // outside every box: the nearest box to where the pen came down
+      double nearest = std::numeric_limits<double>::infinity();
+      for (std::size_t c = 0; c < scene.characters.size(); ++c) {
+        const double distance = scene.characters[c].bounding_box.exteriorDistance(trace[i].position_m);
+        if (distance < nearest) {
+          nearest = distance;
+          best = c;
+        }
+      }
+    }
+    std::fill(owner.begin() + static_cast<std::ptrdiff_t>(i), owner.begin() + static_cast<std::ptrdiff_t>(end),
+              best);
+    i = end;
+  }
+  return owner;
+}
+
+void add_totals(WritingMetrics& metrics, const CharacterScore& score) {
+  metrics.strokes_total += score.strokes.size();
+  metrics.strokes_written += score.strokes_written;
+  metrics.strokes_accepted += score.strokes_accepted;
+  metrics.order_errors += score.order_errors;
+  metrics.backwards_strokes += score.backwards_strokes;
+  metrics.unmatched_segments += score.unmatched_strokes;
+  for (const StrokeRefusal refusal : {StrokeRefusal::too_short, StrokeRefusal::backwards,
+                                      StrokeRefusal::wrong_place, StrokeRefusal::wrong_stroke,
+                                      StrokeRefusal::wrong_order}) {
+    for (std::size_t k = score.refusals.of(refusal); k > 0; --k) metrics.refusals.add(refusal);
+  }
+}
+
+}  // namespace
+
+WritingMetrics writing_metrics(const Scene& scene, std::span<const PenSample> trace,
+                               const ScoreOptions& options) {
+  if (scene.characters.empty()) throw InvalidArgument("writing_metrics: the scene has no characters");
+  validate_pen_trace(trace);
+  ScoreOptions scored = options;
+  scored.start_radius_m = scene.layout.start_radius_m;
+  const std::vector<std::size_t> owner = character_of_samples(scene, trace);
+
+  WritingMetrics metrics;
+  metrics.completed_in_order = true;
+  std::vector<DeviationSummary> deviations;
+  double dtw_weighted = 0.0;
+  double jerk_sum = 0.0;
+  std::size_t jerk_count = 0;
+  std::vector<PenSample> own(trace.begin(), trace.end());
+  for (std::size_t c = 0; c < scene.characters.size(); ++c) {
+    for (std::size_t k = 0; k < trace.size(); ++k) own[k].pen_down = trace[k].pen_down && owner[k] == c;
+    CharacterScore score = score_trace(scene.characters[c], own, scored);
+    add_totals(metrics, score);
+    metrics.completed_in_order = metrics.completed_in_order && score.completed_in_order;
+    if (score.totals.deviation) {
+      deviations.push_back(*score.totals.deviation);
+      dtw_weighted += score.totals.dtw_m.value_or(0.0) * static_cast<double>(score.totals.deviation->samples);
+      if (!metrics.frechet_m || score.totals.frechet_m.value_or(0.0) > *metrics.frechet_m)
+        metrics.frechet_m = score.totals.frechet_m;
+    }
+    for (const WrittenSegment& segment : score.segments) {
+      if (!segment.kinematics) continue;
+      metrics.velocity_peaks += segment.kinematics->velocity_peaks;
+      jerk_sum += segment.kinematics->normalised_jerk;
+      ++jerk_count;
+    }
+    metrics.characters.push_back(std::move(score));
+  }
+  if (!deviations.empty()) {
+    metrics.deviation = pool_deviation_summaries(deviations);
+    metrics.dtw_m = dtw_weighted / static_cast<double>(metrics.deviation->samples);
+  }
+  if (jerk_count > 0) metrics.normalised_jerk = jerk_sum / static_cast<double>(jerk_count);
+
+  // Times over the whole trace, whichever character a run belongs to.
+  std::optional<double> first_down;
+  double last_down = 0.0;
+  for (std::size_t k = 0; k < trace.size(); ++k) {
+    if (!trace[k].pen_down) continue;
+    if (!first_down) first_down = trace[k].time_s;
+    last_down = trace[k].time_s;
+    if (k > 0 && trace[k - 1].pen_down) metrics.pen_down_time_s += trace[k].time_s - trace[k - 1].time_s;
+  }
+  if (first_down) metrics.total_time_s = last_down - *first_down;
+  return metrics;
+}
+
+}  // namespace calligraphy
