@@ -18,6 +18,22 @@ function(calligraphy_precompile target)
   target_precompile_headers(${target} PRIVATE <Eigen/Core> <algorithm> <cmath> <string> <vector> ${ARGN})
 endfunction()
 
+# calligraphy_private_link(TARGET dependency... [INSTALLED library...]): links TARGET to the dependencies
+# (imported targets or library paths) in this build only, and names the INSTALLED plain libraries in the
+# exported package instead. The modules are static archives, so a consumer still links what they call
+# (-lspdlog, -lz, ...), but needs no find_package of our private dependencies: the installed
+# calligraphyConfig.cmake finds Eigen3 alone, and holds no path of the machine that built it.
+# A header-only dependency (nlohmann_json) has no INSTALLED library.
+function(calligraphy_private_link target)
+  cmake_parse_arguments(link "" "" "INSTALLED" ${ARGN})
+  foreach(dependency IN LISTS link_UNPARSED_ARGUMENTS)
+    target_link_libraries(${target} PRIVATE $<BUILD_INTERFACE:${dependency}>)
+  endforeach()
+  foreach(library IN LISTS link_INSTALLED)
+    target_link_libraries(${target} PRIVATE $<INSTALL_INTERFACE:${library}>)
+  endforeach()
+endfunction()
+
 function(calligraphy_module name)
   cmake_parse_arguments(module "NOT_INSTALLED" "SOURCE_DIR" "DEPENDS;SOURCES" ${ARGN})
   if(NOT module_SOURCE_DIR)
