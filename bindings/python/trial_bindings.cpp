@@ -14,6 +14,9 @@
 
 #include "arguments.hpp"
 #include "bindings.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/sim/simulated_hand.hpp"
+#include "calligraphy/study/trial_spec_runner.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
@@ -94,8 +97,7 @@ PyTrialResult to_python(const TrialResult& result, py::dict metrics, py::object 
     rw(i, 1) = n > 0 ? static_cast<std::int64_t>(m.trace_end) : 0;
   }
   return PyTrialResult{
-      time, position,         force, state, stroke, element, ranges, std::move(metrics), std::move(scene),
-      {},   result.writer_log};
+      time, position, force, state, stroke, element, ranges, std::move(metrics), std::move(scene), {}, {}};
 }
 
 // Polls Python's signal handlers from a thread that does not hold the GIL, at most every 50 ms.
@@ -201,13 +203,17 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   TrialOptions options;
   options.pacing = pacing;
   if (a.force_law) options.force = take(*a.force_law, "force_law");
-  options.simulation.writer =
+  SimulationOptions simulation;
+  simulation.writer =
       writer_with_settings(a.writer.object, a.writer_params ? a.writer_params->object : py::none());
   options.rate_hz = take(a.rate_hz, "rate_hz");
-  options.simulation.seed = take(a.seed, "seed");
+  simulation.seed = take(a.seed, "seed");
   options.max_duration_s = take(a.max_duration_s, "max_duration_s");
-  options.keep_trace = take(a.keep_trace, "keep_trace");
-  if (device) options.simulation.device = take(*device, "device");
+  // The trace is always recorded: the metrics are taken from it (trial_writing_metrics); keep_trace=False
+  // only leaves the returned arrays empty.
+  const bool keep_trace = take(a.keep_trace, "keep_trace");
+  options.keep_trace = true;
+  if (device) simulation.device = take(*device, "device");
   if (safety) options.safety = take(*safety, "safety");
   if (passivity) options.passivity = take(*passivity, "passivity");
 
@@ -224,28 +230,59 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
 
   apply_guidance(a, label, options.force);
   options.validate();
+  simulation.validate();
   if (!(options.rate_hz * options.max_duration_s <= kMaxTicks)) {
     throw InvalidArgument("max_duration_s: " + std::to_string(options.max_duration_s) + " s at " +
                           std::to_string(options.rate_hz) + " Hz is more than 10^7 servo ticks");
   }
 
+  // The trial specification of these arguments, run by its one runner (trial_spec_runner.hpp), as
+  // `calligraphy trial` runs its options. What a specification does not state (a WriterProfile object, the
+  // simulated device's parameters, force-law, safety and passivity tuning, a teacher given as samples) goes
+  // in as the runner's inputs.
+  TrialSpec spec;
+  spec.characters = label;
+  spec.device = device_name.empty() ? std::string("simulated") : device_name;
+  spec.guidance = options.force.guidance;
+  if (spec.guidance) spec.guidance_mode = options.force.guidance_mode;
+  if (spec.guidance_mode == GuidanceMode::fading) spec.guidance_gain = options.force.guidance_gain;
+  if (spec.guidance_mode == GuidanceMode::replay) spec.teacher = "teacher=";  // given as samples, below
+  spec.seed = simulation.seed;
+  spec.rate_hz = options.rate_hz;
+  spec.pacing = options.pacing;
+  spec.max_duration_s = options.max_duration_s;
+  spec.validate();
+  std::unique_ptr<SimulatedDevice> simulated_device;
+  TrialRunInputs inputs;
+  if (device_name.empty()) {
+    simulated_device = std::make_unique<SimulatedDevice>(simulation.device);
+    inputs.device = simulated_device.get();
+  }
+  inputs.writer = simulation.writer;
+  inputs.teacher = options.force.teacher_trajectory;
+  inputs.adjust = [&options](TrialOptions& run_options) {
+    run_options.force = options.force;  // the force law as given (no stiffness fitted to the device)
+    run_options.safety = options.safety;
+    run_options.passivity = options.passivity;
+  };
   // Ctrl-C: the trial runs without the GIL; every 50 ms of wall clock the runner's thread takes the GIL
   // and lets Python run its signal handlers. A KeyboardInterrupt (or any exception a handler raises)
   // ends the trial at the next tick and is raised once the device is shut down.
   SignalPoll poll;
-  options.should_stop = [&poll] { return poll.interrupted(); };
-  TrialResult result;
+  inputs.should_stop = [&poll] { return poll.interrupted(); };
+  TrialRun run;
   {
     py::gil_scoped_release release;
-    result =
-        device_name.empty() ? run_simulated_trial(scene, options) : run_trial(device_name, scene, options);
+    run = run_trial_spec(spec, scene, inputs);
   }
   poll.raise_if_interrupted();
+  TrialResult& result = run.result;
+  std::optional<WriterLog>& writer_log = run.writer_log;
   TrialDescription description;
   description.characters = label;
   description.guidance = options.force.guidance;
-  description.writer = options.simulation.writer.name.empty() ? "custom" : options.simulation.writer.name;
-  description.seed = options.simulation.seed;
+  description.writer = simulation.writer.name.empty() ? "custom" : simulation.writer.name;
+  description.seed = simulation.seed;
   description.rate_hz = options.rate_hz;
   if (!device_name.empty()) description.device = device_name;
   // The guidance and writer provenance, as `calligraphy trial --json` gives it.
@@ -262,8 +299,11 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
                                               py::repr(value).cast<std::string>());
     }
   }
-  PyTrialResult out = to_python(result, trial_metrics(description, result), scene_object);
-  out.writer = options.simulation.writer;
+  const WritingMetrics& writing = run.metrics;
+  if (!keep_trace) result.trace = {};
+  PyTrialResult out = to_python(result, trial_metrics(description, result, writing), scene_object);
+  out.writer = simulation.writer;
+  out.writer_log = std::move(writer_log);
   return out;
 }
 
@@ -282,15 +322,7 @@ PyTrialResult run_trial_py(
   const TrialArguments arguments{CALLIGRAPHY_TRIAL_ARGUMENTS(CALLIGRAPHY_TRIAL_VALUE)};
   const std::string name = take(device, "device");
   if (name.empty()) throw InvalidArgument("device: a device name of list_devices() is needed");
-  const std::string how = take(pacing, "pacing");
-  TrialPacing chosen = TrialPacing::automatic;
-  if (how == "lock_step") {
-    chosen = TrialPacing::lock_step;
-  } else if (how == "real_time") {
-    chosen = TrialPacing::real_time;
-  } else if (how != "auto") {
-    throw InvalidArgument("pacing: expected 'auto', 'lock_step' or 'real_time', got '" + how + "'");
-  }
+  const TrialPacing chosen = parse_trial_pacing(take(pacing, "pacing"));
   return trial_py(name, chosen, characters, arguments, std::nullopt, std::nullopt, std::nullopt);
 }
 
@@ -400,8 +432,8 @@ of the wrong type.)");
 real time on the servo loop's own thread. The GIL is released while it runs; Ctrl-C ends the trial at
 the next tick (forces off, the device closed) and raises KeyboardInterrupt.
 
-pacing: 'auto' (lock-step for a device a simulated writer moves, real time otherwise), 'lock_step' or
-'real_time'. rate_hz: servo rate [Hz] (at most 10000 in real time). The other arguments as for
+pacing: 'auto' (lock-step for a device a simulated writer moves, real time otherwise), 'lock-step' or
+'real-time' (the spellings of `calligraphy trial --pacing` and of protocols). rate_hz: servo rate [Hz] (at most 10000 in real time). The other arguments as for
 simulate_trial. Returns a TrialResult whose metrics carry `end_reason`. Raises DeviceNotFound (a
 LookupError) naming the devices there are, InvalidArgument, RealtimeError, CommunicationError.)");
   m.def("record_teacher", &record_teacher_py, py::arg("result"), py::arg("path") = py::none(),

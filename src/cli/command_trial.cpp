@@ -1,6 +1,7 @@
 // `calligraphy trial CHARS ...`: a whole guided writing trial on any registered device (the simulated one
-// by default), through run_trial: lock-step for devices a simulated writer moves, on the real-time
-// ServoLoop otherwise or with --pacing real-time.
+// by default). The options are the trial specification's (trial_spec.hpp), parsed and validated by it, and
+// the trial is run by its one runner (run_trial_spec): lock-step for devices a simulated writer moves, on
+// the real-time ServoLoop otherwise or with --pacing real-time.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -15,7 +16,10 @@
 #include "calligraphy/report/teacher_recording.hpp"
 #include "calligraphy/report/trial_report.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/study/trial_spec.hpp"
+#include "calligraphy/study/trial_spec_runner.hpp"
 #include "calligraphy/trial/trial.hpp"
 #include "cli/cli_devices.hpp"
 #include "cli/commands.hpp"
@@ -41,7 +45,8 @@ struct TrialCommand {
   std::string teacher;  // replay: the recording's path
   std::string record;   // write the trial as a teacher's recording
   std::uint64_t seed = 0;
-  double rate_hz = TrialOptions{}.rate_hz;
+  std::string rate_text = "1000";  // given to the specification's parser as it was typed
+  std::string max_duration_text;  // "": the specification's default
   std::string pacing = "auto";
   std::string realtime = "ignore";
   std::int64_t watchdog_ms = std::llround(ServoLoopOptions{}.stall_timeout_s * 1000.0);
@@ -62,110 +67,67 @@ DeviceListing find_device(const std::string& name) {
                    "'; registered devices: " + (names.empty() ? "none" : names));
 }
 
-// The profile of --writer-profile with each --writer-param applied; a UsageError naming the setting and
-// listing the known keys when one is refused.
-WriterProfile writer_from(const TrialCommand& command) {
-  WriterProfile profile = writer_profile(command.writer_profile);
-  for (const std::string& setting : command.writer_parameters) {
-    try {
-      apply_writer_setting(profile, setting);
-    } catch (const InvalidArgument& e) {
-      std::string message = std::string("--writer-param '") + setting + "': " + e.what();
-      if (message.find("known:") == std::string::npos) {
-        std::string keys;
-        for (const std::string& key : writer_parameter_names()) keys += (keys.empty() ? "" : ", ") + key;
-        message += "; known keys: " + keys;
-      }
-      throw UsageError(message);
-    }
+// The trial specification of the command line: every option given goes through the specification's one
+// parser (trial_spec.hpp) and its validate(); an error there is a usage error naming the option.
+TrialSpec spec_from(const TrialCommand& command) {
+  std::vector<std::string> args{command.characters};
+  const auto add = [&args](const char* option, const std::string& value) {
+    args.emplace_back(option);
+    args.push_back(value);
+  };
+  add("--device", command.device);
+  add("--guidance", command.guidance);
+  add("--guidance-mode", command.guidance_mode);
+  if (command.gain_option->count() > 0) {
+    char gain[32];
+    std::snprintf(gain, sizeof gain, "%.17g", command.guidance_gain);  // every bit of the number given
+    add("--guidance-gain", gain);
   }
-  return profile;
-}
-
-// The combinations of the guidance options that mean nothing are refused before anything runs.
-void check_guidance_options(const TrialCommand& command) {
-  if (command.guidance == "off" && command.guidance_mode != "fixed") {
-    throw UsageError("--guidance-mode " + command.guidance_mode +
-                     ": needs guidance on (it is given with --guidance off)");
-  }
-  if (command.gain_option->count() > 0 && command.guidance_mode != "fading") {
-    throw UsageError("--guidance-gain applies to --guidance-mode fading only");
-  }
-  if (command.guidance_mode == "replay" && command.teacher.empty()) {
-    throw UsageError("--teacher: required with --guidance-mode replay (a recording made with --record)");
-  }
-  if (!command.teacher.empty() && command.guidance_mode != "replay") {
-    throw UsageError("--teacher applies to --guidance-mode replay only");
-  }
-}
-
-// The teacher's recording of --teacher, checked against the characters to write (a DataError naming the
-// file when it cannot be read, an InvalidArgument naming both character lists when they differ).
-TeacherRecording teacher_for(const TrialCommand& command) {
-  TeacherRecording teacher = read_teacher_recording(command.teacher);
+  if (!command.teacher.empty()) add("--teacher", command.teacher);
+  if (!command.writer.empty()) add("--writer", command.writer);
+  if (command.profile_option->count() > 0) add("--writer-profile", command.writer_profile);
+  for (const std::string& setting : command.writer_parameters) add("--writer-param", setting);
+  add("--seed", std::to_string(command.seed));
+  add("--rate", command.rate_text);
+  add("--pacing", command.pacing);
+  add("--realtime", command.realtime);
+  if (command.watchdog_option->count() > 0) add("--watchdog-ms", std::to_string(command.watchdog_ms));
+  if (!command.max_duration_text.empty()) add("--max-duration", command.max_duration_text);
+  if (!command.json.empty()) add("--json", command.json);
+  if (!command.csv.empty()) add("--csv", command.csv);
+  if (!command.svg.empty()) add("--svg", command.svg);
+  if (!command.record.empty()) add("--record", command.record);
   try {
-    require_teacher_for(teacher, command.characters);
+    return trial_spec_from_args(args);
   } catch (const InvalidArgument& e) {
-    throw InvalidArgument("--teacher " + command.teacher + ": " + e.what());
-  }
-  return teacher;
-}
-
-// A profile or its settings describe the simulated writer: with a person writing they would be ignored.
-void check_writer_options(const TrialCommand& command, const std::string& writer) {
-  if (writer != kPersonWriter) return;
-  if (command.profile_option->count() > 0) {
-    throw UsageError("--writer-profile applies to the simulated writer, not to a person (--writer person)");
-  }
-  if (!command.writer_parameters.empty()) {
-    throw UsageError("--writer-param applies to the simulated writer, not to a person (--writer person)");
+    throw UsageError(e.what());
   }
 }
 
-// Every use of the trial runner's options and run_trial is here, in one place.
-TrialResult run_trial_on_device(const TrialCommand& command, const DeviceListing& device,
-                                const std::string& who_writes, const Scene& scene,
-                                const WriterProfile& writer, const TeacherRecording* teacher,
-                                TrialDescription& description) {
-  TrialOptions options;
-  options.force.guidance = command.guidance == "on";
-  options.force.guidance_mode = *guidance_mode_from_string(command.guidance_mode);
-  options.force.guidance_gain = command.guidance_gain;
-  if (teacher) options.force.teacher_trajectory = teacher->samples;
-  fit_default_stiffness(options.force, device.info);
-  options.simulation.writer = writer;
-  options.simulation.seed = command.seed;
-  options.rate_hz = command.rate_hz;
-  options.keep_trace = !command.svg.empty() || !command.csv.empty() || !command.record.empty();
-  options.pacing = command.pacing == "lock-step"   ? TrialPacing::lock_step
-                   : command.pacing == "real-time" ? TrialPacing::real_time
-                                                   : TrialPacing::automatic;
-  options.loop.realtime = command.realtime == "enforce" ? RealtimeMode::enforce : RealtimeMode::ignore;
-  options.loop.stall_timeout_s = static_cast<double>(command.watchdog_ms) / 1000.0;
-  options.should_stop = StopSignals::stop_requested();
-  // The report calls a person "human" (trial_json); the simulated writer by its profile.
-  const bool person = who_writes == kPersonWriter;
-  description = TrialDescription{
-      command.characters,      options.force.guidance, person ? "human" : command.writer_profile,
-      options.simulation.seed, options.rate_hz,        device.name,
-      device.info.model};
-  description.guidance_mode = options.force.guidance_mode;
-  description.guidance_gain = options.force.guidance_gain;
-  if (teacher) {
-    description.teacher_file = command.teacher;
-    description.teacher_characters = teacher->characters;
+// What the trial's JSON and table say of it: the specification and the device it ran on.
+TrialDescription describe(const TrialSpec& spec, const TrialRun& run, const DeviceListing& device) {
+  // The report calls a person "human"; the simulated writer by its profile.
+  TrialDescription description{spec.characters, spec.guidance,
+                               run.simulated_writer ? spec.writer_profile : "human",
+                               spec.seed,       spec.rate_hz,  device.name,
+                               device.info.model};
+  description.guidance_mode = spec.guidance_mode;
+  description.guidance_gain = spec.guidance_gain;
+  if (spec.guidance_mode == GuidanceMode::replay) {
+    description.teacher_file = spec.teacher;
+    description.teacher_characters = spec.characters;  // the runner refuses a recording of others
   }
-  if (!person) {
-    description.writer_profile = writer.name;
-    description.writer_parameters = command.writer_parameters;
+  if (run.simulated_writer) {
+    description.writer_profile = run.writer.name;
+    description.writer_parameters = spec.writer_parameters;
   }
-  return calligraphy::run_trial(device.name, scene, options);
+  return description;
 }
 
 // Writes each output given; one that fails is reported on stderr and does not keep the others from being
 // written. Returns whether all were written.
-bool write_trial_outputs(const TrialCommand& command, const TrialDescription& description, const Scene& scene,
-                         const TrialResult& result) {
+bool write_trial_outputs(const TrialSpec& spec, const TrialDescription& description, const Scene& scene,
+                         const TrialResult& result, const WritingMetrics& writing) {
   bool all_written = true;
   const auto write = [&](const std::string& path, const auto& text) {
     if (path.empty()) return;
@@ -179,36 +141,36 @@ bool write_trial_outputs(const TrialCommand& command, const TrialDescription& de
       all_written = false;
     }
   };
-  write(command.json, [&] { return trial_json(description, result); });
-  write(command.csv, [&] { return trial_csv(result.trace); });
-  write(command.svg, [&] { return trial_svg(scene, result); });
+  write(spec.json_file, [&] { return trial_json(description, result, writing); });
+  write(spec.csv_file, [&] { return trial_csv(result.trace); });
+  write(spec.svg_file, [&] { return trial_svg(scene, result); });
   return all_written;
 }
 
 // --record: the trial as a teacher's recording, only when every stroke was written in order (a replay
 // follows the teacher stroke by stroke). Returns whether it was written.
-bool write_teacher_recording(const TrialCommand& command, const TrialDescription& description,
+bool write_teacher_recording(const TrialSpec& spec, const TrialDescription& description,
                              const TrialResult& result) {
-  if (command.record.empty()) return true;
+  if (spec.record_file.empty()) return true;
   if (result.aborted || !result.metrics.completed_in_order) {
     std::fprintf(
         stderr,
         "calligraphy trial: error: --record %s: not written: the trial did not complete every stroke "
         "in order (%zu of %zu strokes, %s), so it cannot teach them\n",
-        command.record.c_str(), result.metrics.strokes_completed, result.metrics.strokes_total,
+        spec.record_file.c_str(), result.metrics.strokes_completed, result.metrics.strokes_total,
         to_string(result.end));
     return false;
   }
   try {
     const TeacherRecording recording = teacher_recording_from_trace(
         description.characters, description.writer, description.device, description.rate_hz, result.trace);
-    write_output(command.record, teacher_recording_json(recording));
+    write_output(spec.record_file, teacher_recording_json(recording));
     return true;
   } catch (const Error& e) {
     std::fprintf(stderr, "calligraphy trial: error: --record: %s\n", e.what());
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "calligraphy trial: error: %s: cannot write: out of memory\n",
-                 command.record.c_str());
+                 spec.record_file.c_str());
   }
   return false;
 }
@@ -216,29 +178,38 @@ bool write_teacher_recording(const TrialCommand& command, const TrialDescription
 int run_trial(const TrialCommand& command) {
   require_one_standard_output(
       {{"--json", command.json == "-"}, {"--svg", command.svg == "-"}, {"--csv", command.csv == "-"}});
-  const std::u32string chars = characters_from(command.characters, "CHARS");
-  check_scene_size(chars.size(), "CHARS");  // before any is loaded
-  const DeviceListing device = find_device(command.device);
-  const std::string who_writes = writer_for_device(command.writer, device);
-  check_writer_options(command, who_writes);
+  check_scene_size(characters_from(command.characters, "CHARS").size(), "CHARS");  // before any is loaded
+  const TrialSpec spec = spec_from(command);
+  const std::u32string chars = characters_from(spec.characters, "CHARS");
+  const DeviceListing device = find_device(spec.device);
+  bool simulated = false;
+  try {
+    simulated = simulated_writer_writes(spec, simulated_writer_moves(device));
+  } catch (const InvalidArgument& e) {
+    throw UsageError(e.what());
+  }
+  // A profile or its settings describe the simulated writer: with a person writing they would be ignored.
+  if (!simulated && command.profile_option->count() > 0) {
+    throw UsageError("--writer-profile applies to the simulated writer, not to a person (--writer person)");
+  }
+  if (!simulated && !spec.writer_parameters.empty()) {
+    throw UsageError("--writer-param applies to the simulated writer, not to a person (--writer person)");
+  }
   // Lock-step pacing has no wall clock, so no stall can be bounded: the option would be ignored.
-  const bool real_time = command.pacing == "real-time" || (command.pacing == "auto" && device.hardware);
+  const bool real_time =
+      spec.pacing == TrialPacing::real_time || (spec.pacing == TrialPacing::automatic && device.hardware);
   if (command.watchdog_option->count() > 0 && !real_time) {
     throw UsageError(
         "--watchdog-ms applies to real-time pacing only (--pacing real-time, or a hardware device)");
   }
-  check_guidance_options(command);
   // Every input and output is checked before the trial: no output replaces an input or another output.
   FilePlan files;
-  files.input("--teacher", command.teacher);
+  files.input("--teacher", spec.teacher);
   add_library_inputs(files, command.library);
-  files.output("--json", command.json);
-  files.output("--csv", command.csv);
-  files.output("--svg", command.svg);
-  files.output("--record", command.record);
-  const WriterProfile writer = writer_from(command);
-  std::unique_ptr<TeacherRecording> teacher;
-  if (!command.teacher.empty()) teacher = std::make_unique<TeacherRecording>(teacher_for(command));
+  files.output("--json", spec.json_file);
+  files.output("--csv", spec.csv_file);
+  files.output("--svg", spec.svg_file);
+  files.output("--record", spec.record_file);
   // From here a stop signal ends the trial at its next tick and the outputs are still written.
   const StopSignals stop_signals;
   const CharacterSource source(command.library);  // only these characters are read (on demand from a store)
@@ -256,20 +227,23 @@ int run_trial(const TrialCommand& command) {
     return exit_status_after(signal);
   }
 
-  TrialDescription description;
-  TrialResult result =
-      run_trial_on_device(command, device, who_writes, scene, writer, teacher.get(), description);
+  TrialRunInputs inputs;
+  inputs.registry = &cli_device_registry();
+  inputs.should_stop = StopSignals::stop_requested();
+  TrialRun run = run_trial_spec(spec, scene, inputs);
+  TrialResult& result = run.result;
+  const TrialDescription description = describe(spec, run, device);
   const int signal = StopSignals::received();
   if (result.end == TrialEnd::interrupted && result.abort_reason.empty() && signal != 0) {
     result.abort_reason = std::string("stopped by ") + signal_name(signal);
   }
   // The recording first (it cannot be repeated), then the table. Outputs are written for a trial that
   // ended early too: they hold every tick recorded.
-  const bool written = write_trial_outputs(command, description, scene, result) &&
-                       write_teacher_recording(command, description, result);
+  const bool written = write_trial_outputs(spec, description, scene, result, run.metrics) &&
+                       write_teacher_recording(spec, description, result);
   // Standard output carries one document: the table, or the output given as '-'.
-  if (command.json != "-" && command.svg != "-" && command.csv != "-")
-    print_trial_table(description, scene, result);
+  if (spec.json_file != "-" && spec.svg_file != "-" && spec.csv_file != "-")
+    print_trial_table(description, scene, result, run.metrics);
   if (signal != 0) {
     std::fprintf(stderr, "calligraphy trial: stopped by %s after %.3f s (%s); %s\n", signal_name(signal),
                  result.metrics.time_s, to_string(result.end),
@@ -312,8 +286,9 @@ void add_trial_command(CLI::App& root, Commands& commands) {
   add_repeated_text(*app, "--writer-param", command->writer_parameters, "KEY=VALUE",
                     "set a field of the simulated writer's profile (repeatable; keys: docs/writer.md)");
   add_unsigned(*app, "--seed", command->seed, "N", "seed of the simulated writer (a 64-bit integer)");
-  add_number(*app, "--rate", command->rate_hz, "HZ", "servo rate [Hz]", "a number of Hz in [100, 100000]",
-             [](double hz) { return hz >= 100.0 && hz <= 100000.0; });
+  add_text(*app, "--rate", command->rate_text, "HZ", "servo rate [Hz], in [100, 100000] (real time: at most 10000)");
+  add_text(*app, "--max-duration", command->max_duration_text, "S", "the trial ends after this much time [s]",
+           "300");
   add_choice(*app, "--pacing", command->pacing, {"auto", "lock-step", "real-time"},
              "auto: lock-step for devices a simulated writer moves, real time for any other");
   add_choice(

@@ -12,8 +12,8 @@
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/report/trial_report.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/study/trial_spec_runner.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
-#include "calligraphy/trial/runner.hpp"
 #include "core/unicode.hpp"
 #include "study/names.hpp"
 #include "study/trial_guidance.hpp"
@@ -102,53 +102,64 @@ void SessionHost::before_trial(const PlannedTrial&, std::size_t) {}
 void SessionHost::rest(double, const PlannedTrial&, const std::function<bool()>&) {}
 void SessionHost::after_trial(const PlannedTrial&, const TrialOutcome&) {}
 
-TrialOptions study_trial_options(const SessionManifest& session, const StudyCondition& condition,
-                                 const PlannedTrial& trial, const TrialGuidance& guidance) {
-  TrialOptions options;
-  switch (condition.mode) {
-    case ConditionMode::vision:
-      options.force.guidance = false;
-      break;
-    case ConditionMode::quiz:
-      options.force.guidance = false;
-      options.force.acceptance = condition.quiz.acceptance;  // the renderer judges strokes as the quiz does
-      break;
-    case ConditionMode::haptic:
-      options.force.guidance = true;
-      break;
-    case ConditionMode::fading:
-      options.force.guidance = true;
-      options.force.guidance_mode = GuidanceMode::fading;
-      if (!(guidance.gain >= 0.0 && guidance.gain <= 1.0)) {
-        throw InvalidArgument("condition '" + condition.name + "': guidance gain " +
-                              std::to_string(guidance.gain) + " outside [0, 1]");
-      }
-      options.force.guidance_gain = guidance.gain;
-      break;
-    case ConditionMode::replay:
-      options.force.guidance = true;
-      options.force.guidance_mode = GuidanceMode::replay;
-      if (guidance.teacher.size() < 2) {
-        throw InvalidArgument("condition '" + condition.name + "': a replay needs the teacher's recording");
-      }
-      options.force.teacher_trajectory = guidance.teacher;
-      if (condition.replay_max_lead_m) options.force.replay_max_lead_m = *condition.replay_max_lead_m;
-      break;
+TrialSpec study_trial_spec(const SessionManifest& session, const StudyCondition& condition,
+                           const PlannedTrial& trial, const TrialGuidance& guidance) {
+  TrialSpec spec;
+  for (const char32_t c : trial.characters) spec.characters += encode_utf8(c);
+  spec.device = session.setup.device;
+  spec.guidance = condition.mode == ConditionMode::haptic || condition.mode == ConditionMode::fading ||
+                  condition.mode == ConditionMode::replay;
+  if (condition.mode == ConditionMode::fading) {
+    spec.guidance_mode = GuidanceMode::fading;
+    if (!(guidance.gain >= 0.0 && guidance.gain <= 1.0)) {
+      throw InvalidArgument("condition '" + condition.name + "': guidance gain " + std::to_string(guidance.gain) +
+                            " outside [0, 1]");
+    }
+    spec.guidance_gain = guidance.gain;
+  }
+  if (condition.mode == ConditionMode::replay) {
+    if (guidance.teacher.size() < 2) {
+      throw InvalidArgument("condition '" + condition.name + "': a replay needs the teacher's recording");
+    }
+    spec.guidance_mode = GuidanceMode::replay;
+    // The session folder's copy (teachers/...), given to the runner as read (TrialRunInputs::teacher).
+    spec.teacher = guidance.teacher_file.empty() ? std::string("teachers/") : guidance.teacher_file;
+  }
+  const bool simulated = session.setup.writer == "simulated";
+  spec.writer = simulated ? TrialWriter::simulated : TrialWriter::person;
+  if (simulated) spec.writer_profile = session.setup.writer_profile;
+  // A seed of the simulated subject's own per trial.
+  spec.seed = study_detail::mix64(session.setup.writer_seed ^ study_detail::mix64(trial.index + 1));
+  const StudyProtocol& protocol = session.protocol.protocol;
+  spec.rate_hz = protocol.trial.rate_hz;
+  spec.max_duration_s = protocol.trial.max_duration_s;
+  spec.pacing = parse_trial_pacing(session.setup.pacing, "session pacing");
+  spec.validate();
+  return spec;
+}
+
+namespace {
+
+// What a condition sets beyond the specification: the quiz's acceptance, the replay's teacher and lead, a
+// guidance stiffness of its own.
+void apply_condition(const StudyCondition& condition, const TrialGuidance& guidance, TrialOptions& options) {
+  // The renderer judges strokes as the quiz does.
+  if (condition.mode == ConditionMode::quiz) options.force.acceptance = condition.quiz.acceptance;
+  if (condition.mode == ConditionMode::replay) {
+    options.force.teacher_trajectory = guidance.teacher;
+    if (condition.replay_max_lead_m) options.force.replay_max_lead_m = *condition.replay_max_lead_m;
   }
   if (condition.guidance_stiffness_n_per_m && options.force.guidance) {
     options.force.guidance_stiffness_n_per_m = *condition.guidance_stiffness_n_per_m;
   }
-  const StudyProtocol& protocol = session.protocol.protocol;
-  options.rate_hz = protocol.trial.rate_hz;
-  options.max_duration_s = protocol.trial.max_duration_s;
-  options.keep_trace = true;
-  const std::string& pacing = session.setup.pacing;
-  options.pacing = pacing == "lock-step"   ? TrialPacing::lock_step
-                   : pacing == "real-time" ? TrialPacing::real_time
-                                           : TrialPacing::automatic;
-  options.simulation.writer = writer_profile(session.setup.writer_profile);
-  options.simulation.seed =
-      study_detail::mix64(session.setup.writer_seed ^ study_detail::mix64(trial.index + 1));
+}
+
+}  // namespace
+
+TrialOptions study_trial_options(const SessionManifest& session, const StudyCondition& condition,
+                                 const PlannedTrial& trial, const TrialGuidance& guidance) {
+  TrialOptions options = trial_options(study_trial_spec(session, condition, trial, guidance), DeviceInfo{});
+  apply_condition(condition, guidance, options);
   options.validate();
   return options;
 }
@@ -231,10 +242,8 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
       guidance = study_detail::fading_guidance(session, condition, trial);
     if (condition.mode == ConditionMode::replay)
       guidance = study_detail::replay_guidance(session, condition, trial, scene);
-    TrialOptions options = study_trial_options(manifest, condition, trial, guidance.guidance);
-    options.should_stop = run_options.should_stop;
-    if (run_options.pacing) options.pacing = *run_options.pacing;
-    if (run_options.prepare_trial) run_options.prepare_trial(trial, options);
+    TrialSpec spec = study_trial_spec(manifest, condition, trial, guidance.guidance);
+    if (run_options.pacing) spec.pacing = *run_options.pacing;
 
     std::unique_ptr<HapticDevice> device;
     DeviceInfo device_info;
@@ -246,11 +255,20 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
       throw;
     }
     session.log("trial_started", trial_details(trial).dump());
+    // The one runner of a trial specification; the device (made above, so that a failure is logged), the
+    // teacher kept in the session folder and the condition's own settings are its inputs.
+    TrialRunInputs inputs;
+    inputs.device = device.get();
+    inputs.teacher = guidance.guidance.teacher;
+    inputs.should_stop = run_options.should_stop;
+    inputs.adjust = [&](TrialOptions& options) {
+      apply_condition(condition, guidance.guidance, options);
+      if (run_options.prepare_trial) run_options.prepare_trial(trial, options);
+    };
     study_detail::TrialRecordContext context;
     context.session = &manifest;
     context.trial = &trial;
     context.condition = &condition;
-    context.options = &options;
     context.device_name = manifest.setup.device;
     context.device_info = device_info;
     context.hardware = listing.hardware;
@@ -258,35 +276,38 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     context.guidance = study_detail::guidance_record_json(condition, guidance);
     context.start_utc = study_detail::utc_now_iso8601();
     const auto wall_start = std::chrono::steady_clock::now();
-    TrialResult trial_result = run_trial(*device, scene, options);
+    TrialRun run = run_trial_spec(spec, scene, inputs);
+    TrialResult& trial_result = run.result;
     if (trial_result.end == TrialEnd::interrupted && trial_result.abort_reason.empty())
       trial_result.abort_reason = "stopped by " + stop_reason(run_options);
     context.wall_time_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     context.end_utc = study_detail::utc_now_iso8601();
+    context.options = &run.options;
+    context.simulation.writer = run.writer;
+    context.simulation.seed = spec.seed;
     device.reset();
     ran_one = true;
 
     const std::string stem = SessionFolder::trial_stem(trial);
     context.csv_file = stem + ".csv";
     context.svg_file = stem + ".svg";
-    const std::vector<CharacterScore> scores =
-        study_detail::score_characters(scene, trial_result.trace, options.force.acceptance);
+    const WritingMetrics& writing = run.metrics;
     std::vector<std::vector<QuizEvent>> quiz;
     if (condition.mode == ConditionMode::quiz) {
       quiz = study_detail::quiz_characters(scene, trial_result.trace, condition.quiz);
     }
     const bool keep_as_trial = trial_result.end == TrialEnd::completed ||
                                trial_result.end == TrialEnd::time_limit ||
-                               trial_result.end == TrialEnd::writer_gave_up;
+                               trial_result.end == TrialEnd::gave_up;
     TrialOutcome outcome;
     outcome.end_reason = to_string(trial_result.end);
-    outcome.time_s = trial_result.metrics.time_s;
-    outcome.mean_deviation_mm = trial_result.metrics.mean_deviation_m.value_or(std::nan("")) * 1e3;
+    outcome.time_s = writing.total_time_s;
+    outcome.mean_deviation_mm = writing.deviation ? writing.deviation->mean_m * 1e3 : std::nan("");
     json details = trial_details(trial);
     details["end_reason"] = outcome.end_reason;
     if (keep_as_trial) {
-      const std::string record = study_detail::trial_record_json(context, scene, trial_result, scores,
+      const std::string record = study_detail::trial_record_json(context, scene, trial_result, writing,
                                                                  quiz.empty() ? nullptr : &quiz);
       session.save_trial(trial, record, trial_csv(trial_result.trace), trial_svg(scene, trial_result));
       outcome.saved = true;
@@ -296,7 +317,7 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
       ++result.saved_now;
     } else {
       context.svg_file.clear();
-      const std::string record = study_detail::trial_record_json(context, scene, trial_result, scores,
+      const std::string record = study_detail::trial_record_json(context, scene, trial_result, writing,
                                                                  quiz.empty() ? nullptr : &quiz);
       const auto kept = session.save_attempt(trial, record, trial_csv(trial_result.trace));
       outcome.json_file = kept.string();

@@ -6,7 +6,7 @@
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
-#include "calligraphy/trial/runner.hpp"
+#include "calligraphy/study/trial_spec_runner.hpp"
 #include "core/unicode.hpp"
 #include "study/names.hpp"
 
@@ -37,15 +37,16 @@ std::string teacher_file_name(const StudyCondition& condition, const std::u32str
 std::string record_teacher(const SessionFolder& session, const Scene& scene,
                            const std::u32string& characters) {
   const ProtocolTrialSettings& settings = session.manifest().protocol.protocol.trial;
-  TrialOptions options;
-  options.force.guidance = true;
-  options.simulation.writer = WriterProfile::skilled();
-  options.simulation.seed = kRecordedTeacherSeed;
-  options.rate_hz = settings.rate_hz;
-  options.max_duration_s = settings.max_duration_s;
-  options.pacing = TrialPacing::lock_step;
-  options.keep_trace = true;
-  const TrialResult result = run_simulated_trial(scene, options);
+  TrialSpec teacher;
+  teacher.characters = utf8(characters);
+  teacher.guidance = true;
+  teacher.writer = TrialWriter::simulated;
+  teacher.writer_profile = "skilled";
+  teacher.seed = kRecordedTeacherSeed;
+  teacher.rate_hz = settings.rate_hz;
+  teacher.max_duration_s = settings.max_duration_s;
+  teacher.pacing = TrialPacing::lock_step;
+  const TrialResult result = run_trial_spec(teacher, scene).result;
   if (result.aborted || !result.metrics.completed_in_order) {
     throw StateError("the simulated teacher of \"" + utf8(characters) + "\" wrote " +
                      std::to_string(result.metrics.strokes_completed) + " of " +
@@ -53,7 +54,7 @@ std::string record_teacher(const SessionFolder& session, const Scene& scene,
                      to_string(result.end) + "): give the condition a teacher's recording of it");
   }
   return teacher_recording_json(teacher_recording_from_trace(utf8(characters), "simulated skilled",
-                                                             "simulated", options.rate_hz, result.trace));
+                                                             teacher.device, teacher.rate_hz, result.trace));
 }
 
 }  // namespace
@@ -133,6 +134,7 @@ PreparedGuidance replay_guidance(SessionFolder& session, const StudyCondition& c
   prepared.teacher_writer = teacher.writer;
   prepared.teacher_characters = teacher.characters;
   prepared.guidance.teacher = std::move(teacher.samples);
+  prepared.guidance.teacher_file = prepared.teacher_file;
   return prepared;
 }
 

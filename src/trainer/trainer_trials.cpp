@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <exception>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,25 +38,34 @@ void TrainerApp::start_trial(std::size_t character) {
   view_->number = ++trials_started_;
   view_->guidance = guidance_;
   view_->condition = condition_name();
-  TrialOptions trial;
-  trial.force.guidance = guidance_;
-  trial.force.guidance_mode = guidance_mode_;
-  trial.force.guidance_gain = guidance_gain_;
-  if (guidance_mode_ == GuidanceMode::replay) trial.force.teacher_trajectory = options_.teacher;
-  trial.pacing = TrialPacing::real_time;
-  // A window process maps memory all the time (the GL driver): mlockall(MCL_FUTURE) would lock all of
-  // it, or make its allocations fail under a memory-lock limit. The trace is touched in advance instead.
-  trial.loop.lock_memory = false;
-  trial.keep_trace = true;
-  trial.simulation.writer =
-      options_.writer_profile == "skilled" ? WriterProfile::skilled() : WriterProfile::novice();
-  trial.simulation.seed = options_.seed + trials_started_ - 1;
-  trial.display = channel_.get();
+  // The trial specification of this trial; the teacher, the display channel and what a window process
+  // needs are the runner's inputs.
+  TrialSpec spec;
+  spec.characters = options_.characters[character].utf8;
+  spec.device = options_.device;
+  spec.guidance = guidance_;
+  if (guidance_) spec.guidance_mode = guidance_mode_;
+  if (spec.guidance_mode == GuidanceMode::fading) spec.guidance_gain = guidance_gain_;
+  if (spec.guidance_mode == GuidanceMode::replay) spec.teacher = options_.teacher_file;
+  spec.writer = options_.simulated_writer ? TrialWriter::simulated : TrialWriter::person;
+  if (options_.simulated_writer) spec.writer_profile = options_.writer_profile;
+  spec.seed = options_.seed + trials_started_ - 1;
+  spec.pacing = TrialPacing::real_time;
+  TrialRunInputs inputs;
+  inputs.teacher = options_.teacher;
+  DisplayChannel* const channel = channel_.get();
+  inputs.adjust = [channel](TrialOptions& trial) {
+    // A window process maps memory all the time (the GL driver): mlockall(MCL_FUTURE) would lock all of
+    // it, or make its allocations fail under a memory-lock limit. The trace is touched in advance instead.
+    trial.loop.lock_memory = false;
+    trial.display = channel;
+  };
+  trial_options_ = trial_options(spec, DeviceInfo{});  // what the view needs before the device is open
+  trial_simulation_.writer = writer_profile(spec.writer_profile);
+  trial_simulation_.seed = spec.seed;
   trial_start_utc_ = study_detail::utc_now_iso8601();
   trial_wall_start_ = Clock::now();
-  trial_options_ = trial;
-  trial_options_.display = nullptr;
-  worker_.start(std::move(scene), options_.device, std::move(trial));
+  worker_.start(std::move(scene), std::move(spec), std::move(inputs));
   view_->scene = &worker_.scene();
   view_->acceptance = trial_options_.force.acceptance;
   // The quiz and the renderer judge a stroke alike (the live quiz, and the saved record's quiz through the
@@ -69,9 +79,9 @@ void TrainerApp::start_trial(std::size_t character) {
 // The worker is done: takes its result, saves it, and shows the summary.
 void TrainerApp::finish_trial() {
   TrialView& view = *view_;
-  TrialResult result;
+  TrialRun run;
   try {
-    result = worker_.take();
+    run = worker_.take();
   } catch (const std::exception& e) {
     view.have_result = true;
     view.ended = true;
@@ -83,6 +93,8 @@ void TrainerApp::finish_trial() {
     log_stop("device_fault");
     return;
   }
+  trial_options_ = run.options;  // what the trial ran with (the stiffness fitted to the device)
+  TrialResult& result = run.result;
   view.consume(*channel_, typical_ids_[view.character]);
   log_quiz(view);
   log_refusal(view);
@@ -99,12 +111,19 @@ void TrainerApp::finish_trial() {
   view.have_result = true;
   view.ended = true;
   view.end = result.end;
+  // What the panel and the log report of the writing is the one metrics record (as a session record and
+  // `calligraphy score` would give it); the renderer's counts stay as they were.
+  const WritingMetrics& writing = run.metrics;
   view.metrics = result.metrics;
+  view.metrics.mean_deviation_m =
+      writing.deviation ? std::optional<double>(writing.deviation->mean_m) : std::nullopt;
+  view.metrics.max_deviation_m = writing.deviation ? std::optional<double>(writing.deviation->max_m) : std::nullopt;
+  view.metrics.time_s = writing.total_time_s;
   view.end_reason = result.abort_reason;
   if (result.end == TrialEnd::device_fault || result.end == TrialEnd::watchdog) status_ = 1;
   if (guidance_ && trial_options_.force.guidance_mode == GuidanceMode::fading &&
-      result.metrics.mean_deviation_m) {  // performance-based fading (Emken et al. 2007)
-    guidance_gain_ = next_guidance_gain(guidance_gain_, *result.metrics.mean_deviation_m);
+      view.metrics.mean_deviation_m) {  // performance-based fading (Emken et al. 2007)
+    guidance_gain_ = next_guidance_gain(guidance_gain_, *view.metrics.mean_deviation_m);
     std::fprintf(stderr, "calligraphy train: fading: next trial's guidance gain %.3f\n", guidance_gain_);
   }
   // A teacher's recording must write every stroke as the renderer reads it (replay follows it stroke by
@@ -116,8 +135,8 @@ void TrainerApp::finish_trial() {
   std::fprintf(stderr,
                "calligraphy train: trial %zu %s: %s, %zu/%zu strokes in order, mean %.2f mm, %.1f s\n",
                view.number, utf8.c_str(), to_string(result.end), result.metrics.strokes_completed,
-               result.metrics.strokes_total, result.metrics.mean_deviation_m.value_or(std::nan("")) * 1e3,
-               result.metrics.time_s);
+               result.metrics.strokes_total, view.metrics.mean_deviation_m.value_or(std::nan("")) * 1e3,
+               view.metrics.time_s);
   if (result.loop) {
     const ServoLoopStats& loop = *result.loop;
     std::fprintf(stderr,
@@ -135,6 +154,7 @@ void TrainerApp::finish_trial() {
     trial.condition = view.condition;
     trial.scene = &worker_.scene();
     trial.options = &trial_options_;
+    trial.simulation = trial_simulation_;
     trial.start_utc = trial_start_utc_;
     trial.end_utc = study_detail::utc_now_iso8601();
     trial.wall_time_s = std::chrono::duration<double>(Clock::now() - trial_wall_start_).count();

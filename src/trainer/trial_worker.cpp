@@ -11,7 +11,7 @@ TrialWorker::~TrialWorker() {
   }
 }
 
-void TrialWorker::start(Scene scene, std::string device, TrialOptions options) {
+void TrialWorker::start(Scene scene, TrialSpec spec, TrialRunInputs inputs) {
   if (thread_.joinable()) {
     request_stop();
     thread_.join();
@@ -21,10 +21,10 @@ void TrialWorker::start(Scene scene, std::string device, TrialOptions options) {
   done_.store(false);
   result_.reset();
   failure_ = nullptr;
-  options.should_stop = [this] { return stop_.load(std::memory_order_relaxed); };
-  thread_ = std::thread([this, device = std::move(device), options = std::move(options)] {
+  inputs.should_stop = [this] { return stop_.load(std::memory_order_relaxed); };
+  thread_ = std::thread([this, spec = std::move(spec), inputs = std::move(inputs)] {
     try {
-      result_ = run_trial(device, scene_, options);
+      result_ = run_trial_spec(spec, scene_, inputs);
     } catch (...) {
       failure_ = std::current_exception();
     }
@@ -32,14 +32,14 @@ void TrialWorker::start(Scene scene, std::string device, TrialOptions options) {
   });
 }
 
-TrialResult TrialWorker::take() {
+TrialRun TrialWorker::take() {
   if (thread_.joinable()) thread_.join();
   if (failure_) {
     std::exception_ptr failure = failure_;
     failure_ = nullptr;
     std::rethrow_exception(failure);
   }
-  TrialResult result = std::move(*result_);
+  TrialRun result = std::move(*result_);
   result_.reset();
   return result;
 }

@@ -1,6 +1,6 @@
 #pragma once
-// One trial on its own thread: run_trial with real-time pacing (the ServoLoop on yet another thread),
-// stopped through TrialOptions::should_stop. The window thread starts it, polls `done()` once a frame
+// One trial on its own thread: the trial specification's runner (run_trial_spec) with real-time pacing (the
+// ServoLoop on yet another thread), stopped through TrialRunInputs::should_stop. The window thread starts it, polls `done()` once a frame
 // and takes the result only once it is done, so it never waits on the servo side (except when quitting).
 #include <atomic>
 #include <exception>
@@ -9,7 +9,7 @@
 #include <thread>
 
 #include "calligraphy/model/scene.hpp"
-#include "calligraphy/trial/trial.hpp"
+#include "calligraphy/study/trial_spec_runner.hpp"
 
 namespace calligraphy::trainer {
 
@@ -20,16 +20,16 @@ class TrialWorker {
   TrialWorker& operator=(const TrialWorker&) = delete;
   ~TrialWorker();
 
-  /// Starts the trial of `scene` (kept here) on the device called `device`. `options.should_stop` is
-  /// replaced by this worker's stop flag.
-  void start(Scene scene, std::string device, TrialOptions options);
+  /// Starts the trial `spec` of `scene` (kept here) with `inputs`, whose `should_stop` is replaced by this
+  /// worker's stop flag.
+  void start(Scene scene, TrialSpec spec, TrialRunInputs inputs);
   [[nodiscard]] bool active() const noexcept { return thread_.joinable(); }
   /// True once the trial thread has finished (its result is ready).
   [[nodiscard]] bool done() const noexcept { return done_.load(std::memory_order_acquire); }
   /// Asks the trial to end (TrialEnd::interrupted, zero force, forces off, every tick kept).
   void request_stop() noexcept { stop_.store(true, std::memory_order_relaxed); }
-  /// Joins the thread and returns the result; rethrows what run_trial threw.
-  TrialResult take();
+  /// Joins the thread and returns what ran; rethrows what run_trial_spec threw.
+  TrialRun take();
   [[nodiscard]] const Scene& scene() const noexcept { return scene_; }
 
  private:
@@ -37,7 +37,7 @@ class TrialWorker {
   std::thread thread_;
   std::atomic<bool> stop_{false};
   std::atomic<bool> done_{false};
-  std::optional<TrialResult> result_;
+  std::optional<TrialRun> result_;
   std::exception_ptr failure_;
 };
 

@@ -373,26 +373,30 @@ class Score(CliTestCase):
         self.assertEqual(result.returncode, 0, result.stderr.decode())
         return json.loads(result.stdout)
 
-    def test_trace_of_a_lock_step_trial_scores_complete(self):
-        trial = self.run_cli("trial", "永", "--seed", "7", "--csv", "t.csv", "--json", "t.json")
-        self.assertEqual(trial.returncode, 0, trial.stderr.decode())
-        metrics = json.loads((self.cwd / "t.json").read_text())
-        result = self.run_cli("score", "t.csv", "--character", "永", "--json", "s.json")
-        self.assertEqual(result.returncode, 0, result.stderr.decode())
-        self.assertIn("strokes written", result.stdout.decode())  # the table
-        score = json.loads((self.cwd / "s.json").read_text())
-        self.assertEqual(score["strokes_total"], metrics["strokes_total"])
-        self.assertEqual(score["strokes_written"], metrics["strokes_total"])
-        self.assertTrue(score["completed_in_order"])
-        self.assertEqual(score["order_errors"], 0)
-        self.assertEqual(score["backwards_strokes"], 0)
-        self.assertEqual([s["typical_id"] for s in score["per_stroke"]],
-                         [s["typical_id"] for s in metrics["per_stroke"]])
-        for key in ("mean_deviation_mm", "max_deviation_mm", "per_stroke", "completed_in_order", "time_s",
-                    "frechet_mm", "dtw_mm", "rms_deviation_mm", "order_errors", "backwards_strokes", "pen_lifts",
-                    "in_air_time_s", "velocity_peaks", "normalised_jerk", "mean_speed_m_s"):
-            self.assertIn(key, score)
-        self.assertLessEqual(score["mean_deviation_mm"], score["max_deviation_mm"])
+    # The keys of the one metrics record (docs/metrics.md): `trial`, `score` and a session's records carry them.
+    METRIC_KEYS = ("strokes_total", "strokes_written", "strokes_accepted", "refusals", "completed_in_order",
+                   "order_errors", "backwards_strokes", "unmatched_segments", "mean_deviation_mm",
+                   "max_deviation_mm", "rms_deviation_mm", "frechet_mm", "dtw_mm", "total_time_s",
+                   "pen_down_time_s", "velocity_peaks", "normalised_jerk", "per_character")
+
+    def test_a_trials_csv_scores_to_the_trials_own_metrics(self):
+        # One trace, one record: the score of the trial's CSV repeats every metric the trial reported.
+        for characters, extra in (("永", ["--guidance", "off"]), ("口九", [])):
+            trial = self.run_cli("trial", characters, "--seed", "7", "--csv", "t.csv", "--json", "t.json", *extra)
+            self.assertEqual(trial.returncode, 0, trial.stderr.decode())
+            metrics = json.loads((self.cwd / "t.json").read_text())
+            result = self.run_cli("score", "t.csv", "--character", characters, "--json", "s.json")
+            self.assertEqual(result.returncode, 0, result.stderr.decode())
+            self.assertIn("strokes written", result.stdout.decode())  # the table
+            score = json.loads((self.cwd / "s.json").read_text())
+            for key in self.METRIC_KEYS:
+                self.assertEqual(score[key], metrics[key], f"{characters}: {key}")
+            self.assertEqual(len(score["per_character"]), len(characters))
+            self.assertGreater(score["strokes_written"], 0)
+            self.assertLessEqual(score["mean_deviation_mm"], score["max_deviation_mm"])
+            # Indices count from 0 everywhere.
+            self.assertEqual([s["index"] for s in score["per_character"][0]["per_stroke"]],
+                             list(range(score["per_character"][0]["strokes_total"])))
 
     def test_the_reference_itself_scores_near_zero(self):
         model = json.loads(self.run_cli("model", "永", "--json").stdout)
@@ -401,7 +405,7 @@ class Score(CliTestCase):
         self.assertTrue(score["completed_in_order"])
         # Samples on the elements themselves: only rounding to 1e-4 data units (6e-6 mm) remains.
         self.assertLess(score["max_deviation_mm"], 1e-3)
-        self.assertEqual(score["pen_lifts"], len(model["strokes"]) - 1)
+        self.assertEqual(score["per_character"][0]["pen_lifts"], len(model["strokes"]) - 1)
 
     def test_order_and_direction_errors_are_counted(self):
         model = json.loads(self.run_cli("model", "永", "--json").stdout)
@@ -411,10 +415,10 @@ class Score(CliTestCase):
         self.assertFalse(reversed_order["completed_in_order"])
         backwards = self.score(model_trace(model, reverse={0}), "永", "--units", "data")
         self.assertEqual(backwards["backwards_strokes"], 1)
-        self.assertTrue(backwards["per_stroke"][0]["backwards"])
+        self.assertTrue(backwards["per_character"][0]["per_stroke"][0]["backwards"])
 
     def test_usage(self):
-        self.assert_usage_error(["score", "t.csv", "--character", "永我"], "--character")
+        self.assert_usage_error(["score", "t.csv", "--character", "永我", "--units", "data"], "--character")
         self.assert_usage_error(["score", "t.csv"], "--character")
         self.assert_usage_error(["score", "t.csv", "--character", "永", "--units", "metres"], "--units")
 
@@ -434,7 +438,7 @@ class GuidanceModesAndWriters(CliTestCase):
         self.assertEqual(metrics["writer"], "foreign")
         self.assertEqual(metrics["writer_profile"], "foreign")
         self.assertEqual(metrics["guidance_mode"], "fixed")
-        self.assertGreater(metrics["time_s"], 0.0)
+        self.assertGreater(metrics["total_time_s"], 0.0)
 
     def test_writer_param_changes_the_trial_and_a_bad_key_is_refused(self):
         plain = self.trial_json("十", "--seed", "4")
@@ -442,7 +446,7 @@ class GuidanceModesAndWriters(CliTestCase):
                                  "--writer-param", "writing_speed_m_s=0.04")
         self.assertEqual(biased["writer_parameters"], ["bias_offset_m=0.004", "writing_speed_m_s=0.04"])
         self.assertNotIn("writer_parameters", plain)
-        self.assertNotEqual(plain["time_s"], biased["time_s"])
+        self.assertNotEqual(plain["total_time_s"], biased["total_time_s"])
         message = self.assert_usage_error(["trial", "十", "--writer-param", "bias_offset=1"], "--writer-param")
         self.assertIn("bias_offset", message)
         self.assertIn("bias_offset_m", message)  # the known keys are listed
@@ -629,7 +633,10 @@ class OneCommandLine(CliTestCase):
         probe = self.run_cli("train", "永", "--window", "10x10")
         if probe.returncode == 1 and b"without the trainer" in probe.stderr:
             self.skipTest("built without the trainer window")
-        self.assertEqual(self.warnings("train", "永", "--exit-after", "1", program=("xvfb-run", "-a", CLI)), [])
+        # A tick late on a loaded machine is the servo loop reporting the machine, not a default warning about
+        # itself.
+        warnings = self.warnings("train", "永", "--exit-after", "1", program=("xvfb-run", "-a", CLI))
+        self.assertEqual([line for line in warnings if "missed its deadline" not in line], [])
 
 
 if __name__ == "__main__":

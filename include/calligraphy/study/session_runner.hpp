@@ -18,6 +18,7 @@
 #include "calligraphy/render/guidance_mode.hpp"
 #include "calligraphy/study/schedule.hpp"
 #include "calligraphy/study/session_folder.hpp"
+#include "calligraphy/study/trial_spec.hpp"
 #include "calligraphy/trial/options.hpp"
 
 namespace calligraphy {
@@ -26,7 +27,7 @@ namespace calligraphy {
 struct TrialOutcome {
   std::string end_reason;          ///< TrialEnd as text
   bool saved = false;              ///< saved as the trial (else kept as an attempt)
-  double time_s = 0.0;             ///< writing time [s]
+  double time_s = 0.0;             ///< writing time, first to last pen-down sample [s] (total_time_s)
   double mean_deviation_mm = 0.0;  ///< NaN when no stroke was written
   std::string json_file;           ///< the saved trial's or the attempt's JSON
 };
@@ -85,12 +86,21 @@ struct SessionRunResult {
 struct TrialGuidance {
   double gain = 1.0;                   ///< `fading`: the trial's gain in [0, 1] (ForceLawParameters)
   std::vector<TeacherSample> teacher;  ///< `replay`: the teacher's pen, device frame [m], times [s]
+  std::string teacher_file;            ///< `replay`: its file in the session folder ("teachers/....json")
 };
 
-/// The options of the trials of `condition` in `session`, trial `trial`: servo rate and duration from the
-/// protocol, guidance on for `haptic`, `fading` and `replay` (with the condition's stiffness; the gain or
-/// the teacher from `guidance`), off for `vision` and `quiz`, the session's pacing, the simulated writer's
-/// profile and a seed derived from the subject's seed and the trial's index. Throws InvalidArgument
+/// The trial specification (trial_spec.hpp) of `trial` of `condition` in `session`: its characters, the
+/// session's device, writer, profile and pacing, a seed of the simulated subject's own per trial (from the
+/// subject's seed and the trial's index), servo rate and duration from the protocol, guidance on for
+/// `haptic`, `fading` and `replay` (the gain or the teacher's file from `guidance`), off for `vision` and
+/// `quiz`. Throws InvalidArgument naming the condition for a `replay` condition without a teacher in
+/// `guidance` or a gain outside [0, 1], and what `TrialSpec::validate` throws.
+[[nodiscard]] TrialSpec study_trial_spec(const SessionManifest& session, const StudyCondition& condition,
+                                         const PlannedTrial& trial, const TrialGuidance& guidance = {});
+
+/// The runner's options of that specification on a device stating no limits (`trial_options`), with what
+/// the condition sets beyond it: the quiz's acceptance, the replay's teacher and lead, the condition's
+/// guidance stiffness. Throws InvalidArgument
 /// naming the condition for a `replay` condition without a teacher in `guidance`, or a gain outside [0, 1].
 [[nodiscard]] TrialOptions study_trial_options(const SessionManifest& session,
                                                const StudyCondition& condition, const PlannedTrial& trial,

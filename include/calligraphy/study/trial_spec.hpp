@@ -1,0 +1,99 @@
+#pragma once
+/// \file trial_spec.hpp
+/// The one trial specification: what to write, on which device, with which guidance, pacing, writer and
+/// recording. A value type with one parser and one serialiser for each of its two forms, JSON and the
+/// command line's option strings (`calligraphy trial CHARS --guidance off ...`), which round-trip, and one
+/// `validate()` whose errors name the field. The one runner of a specification is `run_trial_spec`
+/// (trial_spec_runner.hpp); `calligraphy trial`, the trainer, study sessions and Python all go through it.
+/// The fields, their JSON keys, options and meaning: docs/cli.md ("The trial specification").
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "calligraphy/devices/servo_loop.hpp"
+#include "calligraphy/render/guidance_mode.hpp"
+#include "calligraphy/trial/options.hpp"
+
+namespace calligraphy {
+
+/// Who writes: the device's own writer (the simulated writer on a device it can move, a person on any
+/// other), a person, or the simulated writer. Spelled "auto", "person", "simulated".
+enum class TrialWriter : std::uint8_t { automatic, person, simulated };
+
+[[nodiscard]] const char* to_string(TrialWriter writer) noexcept;
+
+/// One trial, as a person or a script states it. Lengths in m, times in s, rates in Hz.
+struct TrialSpec {
+  std::string characters;                            ///< UTF-8, written left to right (1..1000)
+  std::string device = "simulated";                  ///< a device name of `calligraphy devices`
+  bool guidance = true;                              ///< in-plane guidance (the paper force stays)
+  GuidanceMode guidance_mode = GuidanceMode::fixed;  ///< the paper's fixture, fading or replay
+  double guidance_gain = 1.0;                        ///< fading only: gain in [0, 1]
+  std::string teacher;                               ///< replay only: a teacher's recording (JSON file)
+  TrialWriter writer = TrialWriter::automatic;       ///< who writes
+  std::string writer_profile = "novice";             ///< the simulated writer's profile (docs/writer.md)
+  std::vector<std::string> writer_parameters;        ///< "key=value" settings applied to the profile in turn
+  std::uint64_t seed = 0;                            ///< the simulated writer's seed
+  double rate_hz = 1000.0;                       ///< servo rate [Hz]: [100, 100000], real time [100, 10000]
+  TrialPacing pacing = TrialPacing::automatic;   ///< lock-step, real time, or the device's own
+  RealtimeMode realtime = RealtimeMode::ignore;  ///< real time: require SCHED_FIFO, pinning, locked memory
+  double watchdog_s = ServoLoopOptions{}.stall_timeout_s;  ///< real time: longest stall [s] in [0, 60]; 0 off
+  double max_duration_s = 300.0;  ///< the trial ends after this much time [s], (0, 86400]
+  std::string json_file;          ///< the metrics as JSON ("-": standard output; "": none)
+  std::string csv_file;           ///< the trace as CSV
+  std::string svg_file;           ///< the reference and the trace as SVG
+  std::string record_file;        ///< the trial as a teacher's recording (only "" or a file)
+
+  /// Throws InvalidArgument naming the field (its JSON key and its option) when a value is out of range or
+  /// two fields contradict each other: characters empty or over 1,000, an unknown writer profile or
+  /// parameter, a guidance mode or gain without the guidance it needs, a replay without a teacher or a
+  /// teacher without a replay, a profile for a person, a rate outside the pacing's range, more than 10^7
+  /// ticks, a teacher's recording on standard output. Outputs on one file are the front-end's to refuse
+  /// (it resolves links: the CLI's file plan).
+  void validate() const;
+
+  bool operator==(const TrialSpec&) const = default;
+};
+
+/// One field of the specification in both forms: its JSON key and its option on the command line.
+struct TrialSpecField {
+  std::string_view key;         ///< JSON key, e.g. "guidance_mode"
+  std::string_view option;      ///< option, e.g. "--guidance-mode"; "CHARS" for the positional characters
+  std::string_view value_name;  ///< what the value is, e.g. "fixed|fading|replay", "HZ", "FILE"
+  std::string_view help;        ///< one line for --help and the docs
+  bool repeated = false;        ///< given once per value (`--writer-param`), a JSON array
+};
+
+/// Every field, in the order the forms list them.
+[[nodiscard]] std::span<const TrialSpecField> trial_spec_fields();
+
+/// Sets the field with JSON key or option `name` from its text as the command line spells it ("on",
+/// "lock-step", "0.5"); a repeated field appends. The one parser of both forms. Throws InvalidArgument
+/// naming the field and the accepted values for an unknown name or a value that is not one; the range
+/// checks are `validate()`'s.
+void set_trial_spec_field(TrialSpec& spec, std::string_view name, std::string_view text);
+
+/// The field's value as the command line spells it (one string per value of a repeated field; doubles with
+/// 17 significant digits, so that parsing gives the same value back). Throws InvalidArgument for an
+/// unknown name.
+[[nodiscard]] std::vector<std::string> trial_spec_field_text(const TrialSpec& spec, std::string_view name);
+
+/// The specification from command-line words: CHARS first, then "--option value" pairs (each option as
+/// `trial_spec_fields()` names it). Throws InvalidArgument naming the word or the option at fault, then
+/// validates.
+[[nodiscard]] TrialSpec trial_spec_from_args(std::span<const std::string> args);
+/// The words `trial_spec_from_args` reads back as `spec`: CHARS, then every field that differs from a
+/// default `TrialSpec`.
+[[nodiscard]] std::vector<std::string> trial_spec_args(const TrialSpec& spec);
+
+/// The specification from a JSON object whose keys are the fields' keys (numbers as numbers, `guidance` a
+/// boolean, `writer_parameters` an array of strings); a missing key keeps its default. Throws DataError
+/// naming `source` and the JSON pointer of a value at fault or an unknown key, then validates
+/// (InvalidArgument naming the field).
+[[nodiscard]] TrialSpec trial_spec_from_json(std::string_view text, const std::string& source);
+/// The JSON object `trial_spec_from_json` reads back as `spec` (every field, keys in field order).
+[[nodiscard]] std::string trial_spec_json(const TrialSpec& spec);
+
+}  // namespace calligraphy

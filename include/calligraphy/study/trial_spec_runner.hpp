@@ -1,0 +1,75 @@
+#pragma once
+/// \file trial_spec_runner.hpp
+/// The one runner of a trial specification (trial_spec.hpp), which `calligraphy trial`, the trainer, study
+/// sessions and Python call: the specification becomes the runner's `TrialOptions` (`trial_options`), its
+/// device is created from a registry (or given), and when the simulated writer writes, a `SimulatedHand` on
+/// the device is made and given to `run_trial` (runner.hpp) as its hand: simulation is an input to the
+/// trial, never part of it. The result carries the one metrics record (writing_metrics.hpp).
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "calligraphy/analysis/writing_metrics.hpp"
+#include "calligraphy/devices/device_registry.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/sim/writer_log.hpp"
+#include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/study/trial_spec.hpp"
+#include "calligraphy/trial/result.hpp"
+
+namespace calligraphy {
+
+/// What a trial needs beyond its specification: what only its caller has. Every member may stay empty.
+struct TrialRunInputs {
+  /// Where `TrialSpec::device` is created; nullptr: `device_registry_with_simulation()`.
+  const DeviceRegistry* registry = nullptr;
+  /// A device the caller made (not owned; opened here when it is not open, closed at the end), used
+  /// instead of creating `TrialSpec::device` (e.g. a simulated device with the caller's parameters).
+  HapticDevice* device = nullptr;
+  /// A teacher's pen read by the caller (a session keeps its teacher in its folder), used instead of
+  /// reading the file `TrialSpec::teacher`; device frame [m], times [s].
+  std::vector<TeacherSample> teacher;
+  /// A profile for the simulated writer used instead of `TrialSpec::writer_profile` and its parameters.
+  std::optional<WriterProfile> writer;
+  /// Polled by the thread that runs the trial (TrialOptions::should_stop); may be empty.
+  std::function<bool()> should_stop;
+  /// Called with the options made from the specification just before the trial: what only the caller
+  /// sets (a window's display channel, memory locking off in a window process, a condition's stiffness or
+  /// acceptance, force-law tuning from Python). May be empty.
+  std::function<void(TrialOptions&)> adjust;
+};
+
+/// What ran, and what it gave.
+struct TrialRun {
+  TrialResult result;
+  TrialOptions options;                 ///< the options the trial ran with (should_stop and display cleared)
+  DeviceInfo device;                    ///< the device's figures
+  bool simulated_writer = false;        ///< the simulated writer wrote (else a person)
+  WriterProfile writer;                 ///< the profile it wrote with (after the parameters)
+  std::optional<WriterLog> writer_log;  ///< what it did, attempt by attempt; nullopt for a person
+  WritingMetrics metrics;               ///< the one metrics record of the trace (writing_metrics.hpp)
+};
+
+/// The runner's options for `spec` on a device with figures `device`: guidance, mode, gain, rate, pacing,
+/// real-time settings and duration from `spec`; the force law's default stiffnesses capped at the device's
+/// stable maximum (`DeviceInfo::max_stiffness_n_per_m`), so that defaults never draw the renderer's
+/// over-limit warning. The teacher's trajectory is not read here. Throws what `TrialSpec::validate`
+/// throws.
+[[nodiscard]] TrialOptions trial_options(const TrialSpec& spec, const DeviceInfo& device);
+
+/// Who writes `spec` on a device: `TrialWriter::simulated` or `person` as stated, else the simulated writer
+/// when `simulated_writer_can_move` (the device has a hand port), a person otherwise. Throws
+/// InvalidArgument naming writer (--writer) when the simulated writer is asked to write on a device it
+/// cannot move.
+[[nodiscard]] bool simulated_writer_writes(const TrialSpec& spec, bool simulated_writer_can_move);
+
+/// Runs the trial `spec` states on `scene` (laid out from `spec.characters` by the caller, who knows where
+/// characters come from). Validates first; creates the device (unless given), reads the teacher (unless
+/// given), makes the simulated writer's hand when it writes, runs `run_trial`, and scores the trace.
+/// Writes none of `spec`'s output files (the caller's: they depend on its front-end). Throws what
+/// `validate` throws, DeviceNotFound, DataError for a teacher that cannot be read, InvalidArgument for one
+/// of other characters, and what `run_trial` throws.
+[[nodiscard]] TrialRun run_trial_spec(const TrialSpec& spec, const Scene& scene,
+                                      const TrialRunInputs& inputs = {});
+
+}  // namespace calligraphy

@@ -1,0 +1,405 @@
+#include "calligraphy/study/trial_spec.hpp"
+
+#include <array>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <nlohmann/json.hpp>
+
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/sim/writer_profile.hpp"
+#include "core/unicode.hpp"
+#include "study/json_reader.hpp"
+
+namespace calligraphy {
+namespace {
+
+using nlohmann::json;
+
+// The fields in both forms. The keys are the JSON names; the options those of `calligraphy trial`.
+constexpr std::array kFields{
+    TrialSpecField{"characters", "CHARS", "CHARS", "the characters to write, left to right (UTF-8)"},
+    TrialSpecField{"device", "--device", "NAME", "the device, by its name in `calligraphy devices`"},
+    TrialSpecField{"guidance", "--guidance", "on|off", "guiding force towards the stroke"},
+    TrialSpecField{"guidance_mode", "--guidance-mode", "fixed|fading|replay",
+                   "how the guidance attracts: the paper's fixture, faded by --guidance-gain, or replaying "
+                   "--teacher"},
+    TrialSpecField{"guidance_gain", "--guidance-gain", "G", "fading: gain on the guiding force, in [0, 1]"},
+    TrialSpecField{"teacher", "--teacher", "FILE",
+                   "replay: the teacher's recording of CHARS (made with --record)"},
+    TrialSpecField{"writer", "--writer", "auto|person|simulated",
+                   "who writes: the simulated writer (on the simulated and emulated devices it moves) or a "
+                   "person (on a hardware device); auto: the device's own"},
+    TrialSpecField{"writer_profile", "--writer-profile", "novice|skilled|foreign",
+                   "the simulated writer's profile (docs/writer.md)"},
+    TrialSpecField{"writer_parameters", "--writer-param", "KEY=VALUE",
+                   "set a field of the simulated writer's profile (repeatable; keys: docs/writer.md)", true},
+    TrialSpecField{"seed", "--seed", "N", "seed of the simulated writer (a 64-bit integer)"},
+    TrialSpecField{"rate_hz", "--rate", "HZ", "servo rate [Hz], in [100, 100000] (real time: at most 10000)"},
+    TrialSpecField{"pacing", "--pacing", "auto|lock-step|real-time",
+                   "auto: lock-step for devices a simulated writer moves, real time for any other"},
+    TrialSpecField{"realtime", "--realtime", "enforce|ignore",
+                   "real-time pacing: fail unless SCHED_FIFO, CPU pinning and locked memory are obtained "
+                   "(enforce)"},
+    TrialSpecField{"watchdog_s", "--watchdog-ms", "MS",
+                   "real-time pacing: end the trial when the device holds one force longer than this [ms], "
+                   "0..60000; 0: off (JSON: watchdog_s in s)"},
+    TrialSpecField{"max_duration_s", "--max-duration", "S", "the trial ends after this much time [s]"},
+    TrialSpecField{"json_file", "--json", "FILE", "write the metrics as JSON ('-': standard output)"},
+    TrialSpecField{"csv_file", "--csv", "FILE",
+                   "write the trace (t,x,y,z,fx,fy,fz,state,stroke,element; s, m, N) as CSV ('-': standard "
+                   "output)"},
+    TrialSpecField{"svg_file", "--svg", "FILE",
+                   "draw the reference and the pen trace as SVG ('-': standard output)"},
+    TrialSpecField{"record_file", "--record", "FILE",
+                   "write the trial as a teacher's recording for --guidance-mode replay (a trial that wrote "
+                   "every stroke in order)"},
+};
+
+const TrialSpecField& field_named(std::string_view name) {
+  for (const TrialSpecField& field : kFields) {
+    if (name == field.key || name == field.option) return field;
+  }
+  std::string names;
+  for (const TrialSpecField& field : kFields) names += (names.empty() ? "" : ", ") + std::string(field.key);
+  throw InvalidArgument("trial specification: no field '" + std::string(name) + "'; fields: " + names);
+}
+
+// "guidance_mode (--guidance-mode)": how an error names a field in either form.
+std::string field_label(std::string_view key) {
+  const TrialSpecField& field = field_named(key);
+  return std::string(field.key) + " (" + std::string(field.option) + ")";
+}
+
+[[noreturn]] void refuse(std::string_view key, const std::string& message) {
+  throw InvalidArgument(field_label(key) + ": " + message);
+}
+
+double parse_number(std::string_view key, std::string_view text) {
+  const std::string copy(text);
+  char* end = nullptr;
+  errno = 0;
+  const double value = std::strtod(copy.c_str(), &end);
+  if (copy.empty() || end != copy.c_str() + copy.size() || errno == ERANGE || !std::isfinite(value)) {
+    refuse(key, "'" + copy + "' is not a finite number");
+  }
+  return value;
+}
+
+std::uint64_t parse_unsigned(std::string_view key, std::string_view text) {
+  std::uint64_t value = 0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (text.empty() || error != std::errc() || end != text.data() + text.size()) {
+    refuse(key, "'" + std::string(text) + "' is not an integer in 0..18446744073709551615");
+  }
+  return value;
+}
+
+std::string number_text(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.17g", value);
+  return text;
+}
+
+const char* to_string(RealtimeMode mode) noexcept {
+  return mode == RealtimeMode::enforce ? "enforce" : "ignore";
+}
+
+template <typename Enum, std::size_t N>
+Enum parse_choice(std::string_view key, std::string_view text, const std::array<Enum, N>& choices) {
+  std::string spellings;
+  for (const Enum choice : choices) {
+    if (text == to_string(choice)) return choice;
+    spellings += (spellings.empty() ? "'" : ", '") + std::string(to_string(choice)) + "'";
+  }
+  refuse(key, "'" + std::string(text) + "' is not one of " + spellings);
+}
+
+}  // namespace
+
+const char* to_string(TrialWriter writer) noexcept {
+  switch (writer) {
+    case TrialWriter::person:
+      return "person";
+    case TrialWriter::simulated:
+      return "simulated";
+    case TrialWriter::automatic:
+      break;
+  }
+  return "auto";
+}
+
+std::span<const TrialSpecField> trial_spec_fields() { return kFields; }
+
+void set_trial_spec_field(TrialSpec& spec, std::string_view name, std::string_view text) {
+  const std::string_view key = field_named(name).key;
+  if (key == "characters") {
+    spec.characters = text;
+  } else if (key == "device") {
+    spec.device = text;
+  } else if (key == "guidance") {
+    if (text != "on" && text != "off") refuse(key, "'" + std::string(text) + "' is not one of 'on', 'off'");
+    spec.guidance = text == "on";
+  } else if (key == "guidance_mode") {
+    spec.guidance_mode =
+        parse_choice(key, text, std::array{GuidanceMode::fixed, GuidanceMode::fading, GuidanceMode::replay});
+  } else if (key == "guidance_gain") {
+    spec.guidance_gain = parse_number(key, text);
+  } else if (key == "teacher") {
+    spec.teacher = text;
+  } else if (key == "writer") {
+    spec.writer = parse_choice(
+        key, text, std::array{TrialWriter::automatic, TrialWriter::person, TrialWriter::simulated});
+  } else if (key == "writer_profile") {
+    spec.writer_profile = text;
+  } else if (key == "writer_parameters") {
+    spec.writer_parameters.emplace_back(text);
+  } else if (key == "seed") {
+    spec.seed = parse_unsigned(key, text);
+  } else if (key == "rate_hz") {
+    spec.rate_hz = parse_number(key, text);
+  } else if (key == "pacing") {
+    spec.pacing = parse_choice(
+        key, text, std::array{TrialPacing::automatic, TrialPacing::lock_step, TrialPacing::real_time});
+  } else if (key == "realtime") {
+    spec.realtime = parse_choice(key, text, std::array{RealtimeMode::enforce, RealtimeMode::ignore});
+  } else if (key == "watchdog_s") {
+    // Whole milliseconds on the command line, as the servo loop's stall bound has always been given there.
+    const std::uint64_t ms = parse_unsigned(key, text);
+    if (ms > 60000) refuse(key, "'" + std::string(text) + "' ms is outside 0..60000");
+    spec.watchdog_s = static_cast<double>(ms) / 1000.0;
+  } else if (key == "max_duration_s") {
+    spec.max_duration_s = parse_number(key, text);
+  } else if (key == "json_file") {
+    spec.json_file = text;
+  } else if (key == "csv_file") {
+    spec.csv_file = text;
+  } else if (key == "svg_file") {
+    spec.svg_file = text;
+  } else if (key == "record_file") {
+    spec.record_file = text;
+  }
+}
+
+std::vector<std::string> trial_spec_field_text(const TrialSpec& spec, std::string_view name) {
+  const std::string_view key = field_named(name).key;
+  if (key == "characters") return {spec.characters};
+  if (key == "device") return {spec.device};
+  if (key == "guidance") return {spec.guidance ? "on" : "off"};
+  if (key == "guidance_mode") return {to_string(spec.guidance_mode)};
+  if (key == "guidance_gain") return {number_text(spec.guidance_gain)};
+  if (key == "teacher") return {spec.teacher};
+  if (key == "writer") return {to_string(spec.writer)};
+  if (key == "writer_profile") return {spec.writer_profile};
+  if (key == "writer_parameters") return spec.writer_parameters;
+  if (key == "seed") return {std::to_string(spec.seed)};
+  if (key == "rate_hz") return {number_text(spec.rate_hz)};
+  if (key == "pacing") return {to_string(spec.pacing)};
+  if (key == "realtime") return {to_string(spec.realtime)};
+  if (key == "watchdog_s") return {std::to_string(std::llround(spec.watchdog_s * 1000.0))};
+  if (key == "max_duration_s") return {number_text(spec.max_duration_s)};
+  if (key == "json_file") return {spec.json_file};
+  if (key == "csv_file") return {spec.csv_file};
+  if (key == "svg_file") return {spec.svg_file};
+  return {spec.record_file};
+}
+
+void TrialSpec::validate() const {
+  std::u32string decoded;
+  try {
+    decoded = decode_utf8(characters);
+  } catch (const Error& e) {
+    refuse("characters", e.what());
+  }
+  if (decoded.empty()) refuse("characters", "no character to write");
+  try {
+    check_scene_size(decoded.size(), "characters");
+  } catch (const InvalidArgument& e) {
+    refuse("characters", e.what());
+  }
+  if (device.empty()) refuse("device", "no device named");
+  if (!guidance && guidance_mode != GuidanceMode::fixed) {
+    refuse("guidance_mode", std::string("'") + calligraphy::to_string(guidance_mode) +
+                                "' needs guidance on (guidance is off)");
+  }
+  if (!(guidance_gain >= 0.0 && guidance_gain <= 1.0)) {
+    refuse("guidance_gain", number_text(guidance_gain) + " is outside [0, 1]");
+  }
+  if (guidance_gain != 1.0 && guidance_mode != GuidanceMode::fading) {
+    refuse("guidance_gain", "applies to guidance mode 'fading' only");
+  }
+  if (guidance_mode == GuidanceMode::replay && teacher.empty()) {
+    refuse("teacher", "required with guidance mode 'replay' (a recording made with --record)");
+  }
+  if (!teacher.empty() && guidance_mode != GuidanceMode::replay) {
+    refuse("teacher", "applies to guidance mode 'replay' only");
+  }
+  if (writer == TrialWriter::person && writer_profile != TrialSpec{}.writer_profile) {
+    refuse("writer_profile", "applies to the simulated writer, not to a person (writer 'person')");
+  }
+  if (writer == TrialWriter::person && !writer_parameters.empty()) {
+    refuse("writer_parameters", "apply to the simulated writer, not to a person (writer 'person')");
+  }
+  WriterProfile profile;
+  try {
+    profile = calligraphy::writer_profile(writer_profile);
+  } catch (const InvalidArgument& e) {
+    refuse("writer_profile", e.what());
+  }
+  for (const std::string& setting : writer_parameters) {
+    try {
+      apply_writer_setting(profile, setting);
+    } catch (const InvalidArgument& e) {
+      std::string message = e.what();
+      if (message.find("known:") == std::string::npos) {
+        std::string keys;
+        for (const std::string& key : writer_parameter_names()) keys += (keys.empty() ? "" : ", ") + key;
+        message += "; known keys: " + keys;
+      }
+      refuse("writer_parameters", "'" + setting + "': " + message);
+    }
+  }
+  const bool real_time = pacing == TrialPacing::real_time;
+  const double max_rate_hz = real_time ? 10000.0 : 100000.0;
+  if (!(rate_hz >= 100.0 && rate_hz <= max_rate_hz)) {
+    refuse("rate_hz", number_text(rate_hz) + " Hz is outside [100, " + number_text(max_rate_hz) + "]" +
+                          (real_time ? " (real-time pacing)" : ""));
+  }
+  if (!(watchdog_s >= 0.0 && watchdog_s <= 60.0) ||
+      watchdog_s != static_cast<double>(std::llround(watchdog_s * 1000.0)) / 1000.0) {
+    refuse("watchdog_s", number_text(watchdog_s) + " s is not a whole number of milliseconds in [0, 60] s");
+  }
+  if (pacing == TrialPacing::lock_step && watchdog_s != TrialSpec{}.watchdog_s) {
+    refuse("watchdog_s", "applies to real-time pacing only (lock-step has no wall clock to bound)");
+  }
+  if (!(max_duration_s > 0.0 && max_duration_s <= 86400.0)) {
+    refuse("max_duration_s", number_text(max_duration_s) + " is outside (0, 86400]");
+  }
+  // A trace longer than this would not fit a trial's memory (one sample per tick).
+  if (rate_hz * max_duration_s > 1e7) {
+    refuse("max_duration_s", number_text(max_duration_s) + " s at " + number_text(rate_hz) +
+                                 " Hz is more than 10^7 servo ticks");
+  }
+  // Outputs on one file are the front-end's to find (after resolving links: the CLI's file plan).
+  if (record_file == "-")
+    refuse("record_file", "a teacher's recording goes to a file, not to standard output");
+}
+
+TrialSpec trial_spec_from_args(std::span<const std::string> args) {
+  TrialSpec spec;
+  std::size_t i = 0;
+  if (i < args.size() && !args[i].starts_with("--")) set_trial_spec_field(spec, "characters", args[i++]);
+  for (; i < args.size(); ++i) {
+    const std::string& word = args[i];
+    if (!word.starts_with("--") || word == "CHARS") {
+      throw InvalidArgument("trial specification: '" + word + "' at word " + std::to_string(i + 1) +
+                            " is not an option (CHARS comes first, then --option value)");
+    }
+    (void)field_named(word);  // an unknown option is named before its value is looked for
+    if (i + 1 >= args.size()) throw InvalidArgument("trial specification: " + word + ": needs a value");
+    set_trial_spec_field(spec, word, args[++i]);
+  }
+  spec.validate();
+  return spec;
+}
+
+std::vector<std::string> trial_spec_args(const TrialSpec& spec) {
+  const TrialSpec defaults;
+  std::vector<std::string> args{spec.characters};
+  for (const TrialSpecField& field : kFields) {
+    if (field.key == "characters") continue;
+    const std::vector<std::string> values = trial_spec_field_text(spec, field.key);
+    if (values == trial_spec_field_text(defaults, field.key)) continue;
+    for (const std::string& value : values) {
+      args.emplace_back(field.option);
+      args.push_back(value);
+    }
+  }
+  return args;
+}
+
+TrialSpec trial_spec_from_json(std::string_view text, const std::string& source) {
+  const json document = study_detail::parse_json(text, source);
+  study_detail::ObjectReader reader(document, "", source);
+  TrialSpec spec;
+  for (const TrialSpecField& field : kFields) {
+    const std::string key(field.key);
+    const json* value = reader.optional(key);
+    if (value == nullptr) continue;
+    const std::string pointer = reader.pointer(key);
+    // Each JSON value becomes the text the command line would give, so that both forms share one parser.
+    const auto set = [&](const json& item, const std::string& at) {
+      std::string item_text;
+      if (key == "guidance") {
+        if (!item.is_boolean())
+          study_detail::fail(source, at, "expected true or false, got " + study_detail::describe(item));
+        item_text = item.get<bool>() ? "on" : "off";
+      } else if (key == "seed") {
+        if (!item.is_number_unsigned()) {
+          study_detail::fail(source, at, "expected an integer >= 0, got " + study_detail::describe(item));
+        }
+        item_text = std::to_string(item.get<std::uint64_t>());
+      } else if (key == "watchdog_s") {
+        if (!item.is_number())
+          study_detail::fail(source, at, "expected a number, got " + study_detail::describe(item));
+        const double ms = item.get<double>() * 1000.0;
+        if (!(ms >= 0.0 && ms <= 60000.0) || std::abs(ms - std::round(ms)) > 1e-6) {
+          study_detail::fail(source, at, "expected a whole number of milliseconds in [0, 60] s");
+        }
+        item_text = std::to_string(std::llround(ms));
+      } else if (key == "guidance_gain" || key == "rate_hz" || key == "max_duration_s") {
+        if (!item.is_number())
+          study_detail::fail(source, at, "expected a number, got " + study_detail::describe(item));
+        item_text = number_text(item.get<double>());
+      } else {
+        item_text = study_detail::as_string(item, at, source);
+      }
+      try {
+        set_trial_spec_field(spec, key, item_text);
+      } catch (const InvalidArgument& e) {
+        study_detail::fail(source, at, e.what());
+      }
+    };
+    if (field.repeated) {
+      if (!value->is_array())
+        study_detail::fail(source, pointer, "expected an array, got " + study_detail::describe(*value));
+      for (std::size_t i = 0; i < value->size(); ++i)
+        set((*value)[i], study_detail::child_pointer(pointer, i));
+    } else {
+      set(*value, pointer);
+    }
+  }
+  reader.finish();
+  spec.validate();
+  return spec;
+}
+
+std::string trial_spec_json(const TrialSpec& spec) {
+  nlohmann::ordered_json document = nlohmann::ordered_json::object();  // in field order
+  for (const TrialSpecField& field : kFields) {
+    const std::string key(field.key);
+    if (key == "guidance") {
+      document[key] = spec.guidance;
+    } else if (key == "seed") {
+      document[key] = spec.seed;
+    } else if (key == "guidance_gain") {
+      document[key] = spec.guidance_gain;
+    } else if (key == "rate_hz") {
+      document[key] = spec.rate_hz;
+    } else if (key == "watchdog_s") {
+      document[key] = spec.watchdog_s;
+    } else if (key == "max_duration_s") {
+      document[key] = spec.max_duration_s;
+    } else if (field.repeated) {
+      document[key] = trial_spec_field_text(spec, key);
+    } else {
+      document[key] = trial_spec_field_text(spec, key).front();
+    }
+  }
+  return document.dump(2) + "\n";
+}
+
+}  // namespace calligraphy

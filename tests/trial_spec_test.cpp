@@ -1,0 +1,209 @@
+// The one trial specification: both forms (JSON, command-line words) round-trip, errors name the field,
+// and its runner writes a trial with the simulated writer as an input.
+#include "calligraphy/study/trial_spec.hpp"
+
+#include <catch2/catch.hpp>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/study/trial_spec_runner.hpp"
+
+using namespace calligraphy;
+
+namespace {
+
+// A specification with every field away from its default.
+TrialSpec everything_set() {
+  TrialSpec spec;
+  spec.characters = "口九";
+  spec.device = "emulated-phantom";
+  spec.guidance = true;
+  spec.guidance_mode = GuidanceMode::fading;
+  spec.guidance_gain = 0.3;
+  spec.writer = TrialWriter::simulated;
+  spec.writer_profile = "skilled";
+  spec.writer_parameters = {"bias_offset_m=0.0005", "stroke_jitter_m=0"};
+  spec.seed = 18446744073709551615ULL;
+  spec.rate_hz = 2000.0 / 3.0;  // no short decimal: the text must keep every bit
+  spec.pacing = TrialPacing::real_time;
+  spec.realtime = RealtimeMode::enforce;
+  spec.watchdog_s = 0.2;
+  spec.max_duration_s = 12.5;
+  spec.json_file = "out.json";
+  spec.csv_file = "-";
+  spec.svg_file = "out.svg";
+  spec.record_file = "teacher.json";
+  return spec;
+}
+
+// A valid specification drawn at random (guidance, mode, pacing, numbers and outputs).
+TrialSpec random_spec(std::mt19937_64& random) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  TrialSpec spec;
+  spec.characters = random() % 2 ? "永" : "十人";
+  spec.guidance = random() % 4 != 0;
+  if (spec.guidance && random() % 2) {
+    spec.guidance_mode = GuidanceMode::fading;
+    spec.guidance_gain = unit(random);
+  }
+  spec.writer = static_cast<TrialWriter>(random() % 3);
+  if (spec.writer != TrialWriter::person && random() % 2) {
+    spec.writer_profile = "foreign";
+    spec.writer_parameters.push_back("stroke_jitter_m=" + std::to_string(unit(random) * 1e-4));
+  }
+  spec.seed = random();
+  spec.pacing = static_cast<TrialPacing>(random() % 3);
+  spec.rate_hz = 100.0 + unit(random) * 9900.0;
+  spec.max_duration_s = 1.0 + unit(random) * 100.0;
+  if (spec.pacing != TrialPacing::lock_step) spec.watchdog_s = static_cast<double>(random() % 60001) / 1000.0;
+  if (random() % 2) spec.json_file = "m" + std::to_string(random() % 10) + ".json";
+  if (random() % 2) spec.csv_file = "-";
+  return spec;
+}
+
+std::string error_of(const std::function<void()>& call) {
+  try {
+    call();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("a trial specification round-trips through its JSON and its command-line words") {
+  SECTION("defaults") {
+    TrialSpec spec;
+    spec.characters = "永";
+    CHECK(trial_spec_args(spec) == std::vector<std::string>{"永"});
+    CHECK(trial_spec_from_args(trial_spec_args(spec)) == spec);
+    CHECK(trial_spec_from_json(trial_spec_json(spec), "spec.json") == spec);
+  }
+  SECTION("every field set") {
+    const TrialSpec spec = everything_set();
+    spec.validate();
+    CHECK(trial_spec_from_args(trial_spec_args(spec)) == spec);
+    CHECK(trial_spec_from_json(trial_spec_json(spec), "spec.json") == spec);
+    // and the two forms meet: JSON -> spec -> words -> spec
+    CHECK(trial_spec_from_args(trial_spec_args(trial_spec_from_json(trial_spec_json(spec), "x"))) == spec);
+  }
+  SECTION("200 random specifications") {
+    std::mt19937_64 random(20261123);
+    for (int i = 0; i < 200; ++i) {
+      const TrialSpec spec = random_spec(random);
+      INFO(trial_spec_json(spec));
+      REQUIRE_NOTHROW(spec.validate());
+      CHECK(trial_spec_from_args(trial_spec_args(spec)) == spec);
+      CHECK(trial_spec_from_json(trial_spec_json(spec), "spec.json") == spec);
+    }
+  }
+}
+
+TEST_CASE("every field of the specification has both names and a parser") {
+  TrialSpec spec = everything_set();
+  for (const TrialSpecField& field : trial_spec_fields()) {
+    INFO(field.key);
+    CHECK(!field.help.empty());
+    // Setting a field from its own text, by either name, gives the same specification back.
+    for (const std::string_view name : {field.key, field.option}) {
+      TrialSpec copy = spec;
+      if (field.repeated) copy.writer_parameters.clear();
+      for (const std::string& text : trial_spec_field_text(spec, field.key))
+        set_trial_spec_field(copy, name, text);
+      CHECK(copy == spec);
+    }
+  }
+}
+
+TEST_CASE("a specification's errors name the field in both its forms") {
+  TrialSpec spec;
+  spec.characters = "永";
+  const auto fails_naming = [](TrialSpec bad, const std::string& expected) {
+    const std::string message = error_of([&] { bad.validate(); });
+    INFO(message);
+    CHECK(message.find(expected) != std::string::npos);
+  };
+  TrialSpec bad = spec;
+  bad.characters = "";
+  fails_naming(bad, "characters (CHARS)");
+  bad = spec;
+  bad.guidance = false;
+  bad.guidance_mode = GuidanceMode::fading;
+  fails_naming(bad, "guidance_mode (--guidance-mode)");
+  bad = spec;
+  bad.guidance_gain = 0.5;
+  fails_naming(bad, "guidance_gain (--guidance-gain): applies to guidance mode 'fading' only");
+  bad = spec;
+  bad.guidance_mode = GuidanceMode::replay;
+  fails_naming(bad, "teacher (--teacher): required");
+  bad = spec;
+  bad.writer = TrialWriter::person;
+  bad.writer_profile = "skilled";
+  fails_naming(bad, "writer_profile (--writer-profile)");
+  bad = spec;
+  bad.writer_profile = "expert";
+  fails_naming(bad, "writer_profile (--writer-profile)");
+  bad = spec;
+  bad.writer_parameters = {"no_such_key=1"};
+  fails_naming(bad, "writer_parameters (--writer-param): 'no_such_key=1'");
+  bad = spec;
+  bad.pacing = TrialPacing::real_time;
+  bad.rate_hz = 20000.0;
+  fails_naming(bad, "rate_hz (--rate)");
+  bad = spec;
+  bad.max_duration_s = 1e6;
+  fails_naming(bad, "max_duration_s (--max-duration)");
+  bad = spec;
+  bad.record_file = "-";
+  fails_naming(bad, "record_file (--record)");
+
+  CHECK_THAT(
+      error_of([] {
+        (void)trial_spec_from_args(std::vector<std::string>{"永", "--pacing", "lock_step"});
+      }),
+      Catch::Contains("pacing (--pacing): 'lock_step' is not one of 'auto', 'lock-step', 'real-time'"));
+  CHECK_THAT(error_of([] {
+               (void)trial_spec_from_args(std::vector<std::string>{"永", "--guidence", "on"});
+             }),
+             Catch::Contains("no field '--guidence'"));
+  CHECK_THAT(error_of([] {
+               (void)trial_spec_from_args(std::vector<std::string>{"永", "--seed"});
+             }),
+             Catch::Contains("--seed: needs a value"));
+  CHECK_THAT(error_of([] { (void)trial_spec_from_json(R"({"characters": "永", "sede": 3})", "s.json"); }),
+             Catch::Contains("s.json") && Catch::Contains("sede"));
+  CHECK_THAT(error_of([] { (void)trial_spec_from_json(R"({"characters": "永", "seed": -3})", "s.json"); }),
+             Catch::Contains("s.json: /seed"));
+  CHECK_THAT(
+      error_of([] { (void)trial_spec_from_json(R"({"characters": "永", "guidance": "on"})", "s.json"); }),
+      Catch::Contains("s.json: /guidance: expected true or false"));
+}
+
+TEST_CASE("the runner of a specification gives the simulated writer to the trial as its hand") {
+  TrialSpec spec;
+  spec.characters = "十";
+  spec.seed = 4;
+  const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'十')});
+  const TrialRun run = run_trial_spec(spec, scene);
+  CHECK(run.simulated_writer);
+  CHECK(run.writer_log.has_value());
+  CHECK(run.result.end == TrialEnd::completed);
+  CHECK(run.metrics.strokes_total == 2);
+  CHECK(run.metrics.strokes_accepted == 2);
+  CHECK(run.options.force.guidance);
+  // The one metrics record is the trace's, as any front-end scores it.
+  CHECK(run.metrics.total_time_s ==
+        trial_writing_metrics(scene, run.result, run.options.force.acceptance).total_time_s);
+
+  TrialSpec person = spec;
+  person.writer = TrialWriter::person;
+  CHECK_THAT(error_of([&] { (void)run_trial_spec(person, scene); }),
+             Catch::Contains("writer (--writer): 'person'"));
+  TrialSpec nowhere = spec;
+  nowhere.device = "no-such-device";
+  CHECK_THROWS_AS(run_trial_spec(nowhere, scene), DeviceNotFound);
+}
