@@ -14,6 +14,7 @@
 #include "bindings.hpp"
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/report/teacher_recording.hpp"
+#include "calligraphy/study/study_tables.hpp"
 
 namespace calligraphy::python {
 
@@ -29,6 +30,24 @@ void write_teacher_recording(const TeacherRecording& recording, const std::files
 }
 
 void bind_report(py::module_& m) {
+  m.def(
+      "_study_tables_csv",
+      [](const py::list& roots) {
+        std::vector<std::filesystem::path> paths;
+        for (const py::handle root : roots) {
+          paths.push_back(convert_named<std::filesystem::path>(py::reinterpret_borrow<py::object>(root), "paths"));
+        }
+        StudyTables tables;
+        {
+          py::gil_scoped_release release;  // reading many records takes a while
+          tables = read_study_tables(paths);
+        }
+        return py::make_tuple(trials_csv(tables), strokes_csv(tables));
+      },
+      py::arg("paths"),
+      "The tidy tables of the session folders under `paths` as the CSV texts (trials, strokes) that "
+      "`calligraphy report --csv` writes (read_study_tables, include/calligraphy/study/study_tables.hpp); "
+      "calligraphy.study.load makes DataFrames of them. Raises DataError naming a damaged file.");
   py::class_<TeacherRecording>(
       m, "TeacherRecording",
       "A teacher's recorded trial for the replay guidance mode (include/calligraphy/report/"

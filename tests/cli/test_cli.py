@@ -600,7 +600,10 @@ class OneCommandLine(CliTestCase):
         result = subprocess.run([*program, *args], cwd=self.cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                 timeout=300)
         self.assertEqual(result.returncode, 0, f"{args}: {result.stderr.decode()}")
-        return [line for line in result.stderr.decode().splitlines() if "warn" in line.lower()]
+        # A tick late on a loaded machine is the servo loop reporting the machine, not a default that warns
+        # about itself.
+        return [line for line in result.stderr.decode().splitlines()
+                if "warn" in line.lower() and "missed its deadline" not in line]
 
     def test_default_runs_print_no_warning(self):
         protocol = self.write_protocol()
@@ -633,10 +636,7 @@ class OneCommandLine(CliTestCase):
         probe = self.run_cli("train", "永", "--window", "10x10")
         if probe.returncode == 1 and b"without the trainer" in probe.stderr:
             self.skipTest("built without the trainer window")
-        # A tick late on a loaded machine is the servo loop reporting the machine, not a default warning about
-        # itself.
-        warnings = self.warnings("train", "永", "--exit-after", "1", program=("xvfb-run", "-a", CLI))
-        self.assertEqual([line for line in warnings if "missed its deadline" not in line], [])
+        self.assertEqual(self.warnings("train", "永", "--exit-after", "1", program=("xvfb-run", "-a", CLI)), [])
 
 
 if __name__ == "__main__":

@@ -1,0 +1,105 @@
+"""A study as tidy pandas tables: ``load(path)`` reads session folders into one row per trial and one row per
+reference stroke, and gives each trial's samples on demand.
+
+The tables are the ones ``calligraphy report DIR --csv TABLES`` writes (``read_study_tables``,
+include/calligraphy/study/study_tables.hpp): the same code, so R, spreadsheet and Python users see the same
+numbers. Metrics are each trial record's one metrics record (docs/metrics.md) in SI units, the unit in every
+column name; indices are 0-based. Traces are never read by ``load``: ``Study.samples(trial)`` reads one trial's
+CSV when asked, and ``Study.iter_samples()`` streams them one at a time. Columns: docs/experiments.md ("Tidy
+tables"). Tidy data: Wickham 2014, J Stat Softw 59(10).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import io
+import os
+import typing
+
+from . import _calligraphy
+
+if typing.TYPE_CHECKING:  # pandas is optional for the package as a whole
+    import pandas
+
+PathLike = typing.Union[str, "os.PathLike[str]"]
+
+# Columns whose empty fields are absent values (NaN); every other empty field is an empty string.
+_NUMERIC_TRIAL_COLUMNS = (
+    "block", "trial", "item", "repetition", "strokes_total", "strokes_written", "strokes_accepted",
+    "order_errors", "backwards_strokes", "unmatched_segments", "mean_deviation_m", "max_deviation_m",
+    "rms_deviation_m", "frechet_m", "dtw_m", "total_time_s", "pen_down_time_s", "velocity_peaks",
+    "normalised_jerk")
+_NUMERIC_STROKE_COLUMNS = (
+    "trial", "character", "stroke", "typical_id", "segments", "refused_segments", "mean_deviation_m",
+    "max_deviation_m", "rms_deviation_m", "frechet_m", "dtw_m", "time_s", "path_length_m")
+_CATEGORIES = ("subject", "session", "protocol", "phase", "condition", "mode", "writer", "end_reason")
+# The trace CSV's columns (calligraphy trial --csv) with their SI units named.
+_SAMPLE_COLUMNS = {"t": "t_s", "x": "x_m", "y": "y_m", "z": "z_m", "fx": "fx_n", "fy": "fy_n", "fz": "fz_n"}
+
+
+def _pandas() -> typing.Any:
+    try:
+        import pandas
+    except ImportError as error:  # pragma: no cover - pandas is a Debian package here
+        raise ImportError("calligraphy.study needs pandas (Debian: python3-pandas)") from error
+    return pandas
+
+
+def _read_table(text: str, numeric: tuple[str, ...], booleans: tuple[str, ...]) -> "pandas.DataFrame":
+    pd = _pandas()
+    # round_trip: every double as the C++ side wrote it (the default parser may differ in the last bit).
+    frame = pd.read_csv(io.StringIO(text), keep_default_na=False, na_values={c: [""] for c in numeric},
+                        float_precision="round_trip",
+                        dtype={c: "float64" for c in numeric})
+    for column in booleans:
+        frame[column] = frame[column] == "true"
+    for column in numeric:  # counts and indices without a gap are integers
+        if frame[column].notna().all() and (frame[column] % 1 == 0).all():
+            frame[column] = frame[column].astype("int64")
+    for column in _CATEGORIES:
+        if column in frame:
+            frame[column] = frame[column].astype("category")
+    return frame
+
+
+@dataclasses.dataclass(frozen=True)
+class Study:
+    """The tidy tables of one or many session folders.
+
+    trials: one row per saved trial (subject, session, protocol, phase, block, condition, mode, characters,
+        trial, item, repetition (0-based), writer, end_reason, start_utc, completed_in_order, stroke counts,
+        order_errors, backwards_strokes, unmatched_segments, mean/max/rms_deviation_m, frechet_m, dtw_m [m],
+        total_time_s, pen_down_time_s [s], velocity_peaks, normalised_jerk, trace_file).
+    strokes: one row per reference stroke of each saved trial (subject, session, trial, phase, condition,
+        character (0-based in the trial), character_text, stroke (0-based in its character), typical_id,
+        written, backwards, segments, refused_segments, refusal, the per-stroke deviations [m], time_s [s],
+        path_length_m [m]).
+    """
+
+    trials: "pandas.DataFrame"
+    strokes: "pandas.DataFrame"
+
+    def samples(self, trial: typing.Union[int, "pandas.Series"]) -> "pandas.DataFrame":
+        """One trial's trace, read now: a DataFrame of N ticks with t_s [s], x_m, y_m, z_m [m] (device frame),
+        fx_n, fy_n, fz_n [N], state, stroke, element (0-based). `trial` is a row of `trials` or its index
+        label. Raises KeyError for an unknown label, FileNotFoundError when the trace is gone."""
+        row = self.trials.loc[trial] if not hasattr(trial, "trace_file") else trial
+        frame = _pandas().read_csv(row["trace_file"])
+        return frame.rename(columns=_SAMPLE_COLUMNS)
+
+    def iter_samples(self) -> typing.Iterator[tuple[typing.Any, "pandas.DataFrame"]]:
+        """(index label, samples) for every trial in turn, one trace in memory at a time."""
+        for label, row in self.trials.iterrows():
+            yield label, self.samples(row)
+
+
+def load(paths: typing.Union[PathLike, typing.Sequence[PathLike]]) -> Study:
+    """Reads the saved trials of the session folders under `paths` (a session folder, a study folder made by
+    ``calligraphy session run --out``, or a list of either) into a `Study` of tidy DataFrames. Only the
+    session manifests and trial records are read, never the traces. Raises DataError naming the file (and
+    JSON pointer) for a path without a session folder or a damaged record, ImportError without pandas."""
+    roots = [paths] if isinstance(paths, (str, os.PathLike)) else list(paths)
+    trials_text, strokes_text = _calligraphy._study_tables_csv([os.fspath(root) for root in roots])
+    trials = _read_table(trials_text, _NUMERIC_TRIAL_COLUMNS, ("completed_in_order",))
+    strokes = _read_table(strokes_text, _NUMERIC_STROKE_COLUMNS, ("written", "backwards"))
+    return Study(trials=trials, strokes=strokes)

@@ -1,0 +1,92 @@
+#pragma once
+/// \file study_tables.hpp
+/// A study as tidy tables (Wickham 2014, "Tidy data", J Stat Softw 59(10)): one row per saved trial and one
+/// row per reference stroke of each saved trial, read from session folders (session_folder.hpp). The metrics
+/// are the one metrics record each trial record holds (writing_metrics.hpp), in SI units with the unit in
+/// every column name; indices are 0-based. `calligraphy report --csv DIR` writes them as CSV and Python's
+/// `calligraphy.study.load` gives them as pandas DataFrames. The traces are not read: a row names its trace
+/// file, read on demand. Columns and meaning: docs/experiments.md ("Tidy tables").
+#include <cstddef>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace calligraphy {
+
+/// One saved trial.
+struct TrialRow {
+  std::string subject;
+  std::string session;     ///< the session folder's name
+  std::string protocol;    ///< the protocol's name
+  std::string phase;       ///< "practice" or "test"
+  std::size_t block = 0;   ///< 0-based block of the session's plan
+  std::string condition;   ///< the condition's name
+  std::string mode;        ///< the condition's mode ("vision", "haptic", "fading", "replay", "quiz")
+  std::string characters;  ///< UTF-8, written left to right
+  std::size_t trial = 0;   ///< 0-based position in the session's plan
+  std::size_t item = 0;    ///< 0-based index of `characters` in the phase's list
+  std::size_t repetition = 0;  ///< 0-based repetition of the item in the condition
+  std::string writer;          ///< "simulated" or "human"
+  std::string end_reason;      ///< how the trial ended (TrialEnd as text)
+  std::string start_utc;       ///< ISO 8601
+  bool completed_in_order = false;
+  std::size_t strokes_total = 0;
+  std::size_t strokes_written = 0;
+  std::size_t strokes_accepted = 0;
+  std::size_t order_errors = 0;
+  std::size_t backwards_strokes = 0;
+  std::size_t unmatched_segments = 0;
+  std::optional<double> mean_deviation_m;  ///< absent when nothing was matched
+  std::optional<double> max_deviation_m;
+  std::optional<double> rms_deviation_m;
+  std::optional<double> frechet_m;
+  std::optional<double> dtw_m;
+  double total_time_s = 0.0;
+  double pen_down_time_s = 0.0;
+  int velocity_peaks = 0;
+  std::optional<double> normalised_jerk;  ///< dimensionless
+  std::filesystem::path trace_file;       ///< the trial's CSV trace (t,x,y,z,fx,fy,fz,state,stroke,element)
+};
+
+/// One reference stroke of one saved trial.
+struct StrokeRow {
+  std::string subject;
+  std::string session;
+  std::size_t trial = 0;      ///< the trial's `TrialRow::trial`
+  std::string phase;
+  std::string condition;
+  std::size_t character = 0;  ///< 0-based index of the character in the trial
+  std::string character_text;  ///< UTF-8
+  std::size_t stroke = 0;      ///< 0-based index of the stroke in its character
+  int typical_id = 0;          ///< the typical stroke's fixed ID (1..39)
+  bool written = false;        ///< a pen-down segment was matched to it
+  bool backwards = false;      ///< it was written from its end
+  std::size_t segments = 0;    ///< pen-down segments the matcher gave this stroke as their expected or matched one
+  std::size_t refused_segments = 0;  ///< those refused
+  std::string refusal;               ///< the last refused one's reason ("too_short", ...); "" when none
+  std::optional<double> mean_deviation_m;
+  std::optional<double> max_deviation_m;
+  std::optional<double> rms_deviation_m;
+  std::optional<double> frechet_m;
+  std::optional<double> dtw_m;
+  std::optional<double> time_s;         ///< its segment's duration [s]
+  std::optional<double> path_length_m;
+};
+
+struct StudyTables {
+  std::vector<TrialRow> trials;    ///< sessions sorted by path, trials in planned order
+  std::vector<StrokeRow> strokes;  ///< in the order of `trials`, then characters, then strokes
+};
+
+/// The tables of every saved trial in the session folders under `roots` (each a session folder or a folder
+/// holding some). Reads session.json and each trial's JSON record, never the traces. Throws DataError naming
+/// the file (and JSON pointer) for a root without a session folder, a damaged manifest or record.
+[[nodiscard]] StudyTables read_study_tables(const std::vector<std::filesystem::path>& roots);
+
+/// The trials table as CSV (RFC 4180): a header of the column names, one line per row; absent values empty.
+[[nodiscard]] std::string trials_csv(const StudyTables& tables);
+/// The strokes table as CSV.
+[[nodiscard]] std::string strokes_csv(const StudyTables& tables);
+
+}  // namespace calligraphy

@@ -1,0 +1,68 @@
+"""calligraphy.study.load: a study's tidy tables are the CLI's `report --csv` tables, hold every saved trial with
+its record's metrics in SI units, and give each trial's samples on demand."""
+
+import json
+import subprocess
+from pathlib import Path
+
+import pytest
+
+pd = pytest.importorskip("pandas")
+
+import calligraphy.study  # noqa: E402
+
+SOURCE = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def study_folder(cli, tmp_path_factory):
+    folder = tmp_path_factory.mktemp("study")
+    protocol = json.loads((SOURCE / "examples" / "protocols" / "paper-table5.json").read_text(encoding="utf-8"))
+    protocol["practice"]["repetitions"] = 1
+    protocol["test"].update({"characters": ["十", "人"], "repetitions": 1})
+    protocol["breaks"] = {}
+    (folder / "p.json").write_text(json.dumps(protocol), encoding="utf-8")
+    run = subprocess.run([cli, "session", "run", "p.json", "--writer", "simulated", "--subjects", "2", "--out",
+                          "study"], cwd=folder, capture_output=True)
+    assert run.returncode == 0, run.stderr.decode()
+    return folder
+
+
+def test_the_tables_are_the_cli_tables_and_the_records(cli, study_folder):
+    study = calligraphy.study.load(study_folder / "study")
+    records = sorted((study_folder / "study").glob("S*/*/trials/*.json"))
+    assert len(study.trials) == len(records) == 2 * (1 + 2 * 2)  # subjects x (practice + characters x conditions)
+    assert set(study.trials["phase"]) == {"practice", "test"}
+    assert set(study.trials["subject"]) == {"S01", "S02"}
+    for _, row in study.trials.iterrows():
+        record = json.loads(Path(row["trace_file"]).with_suffix(".json").read_text(encoding="utf-8"))
+        assert row["mean_deviation_m"] == pytest.approx(record["mean_deviation_mm"] * 1e-3, rel=1e-12)
+        assert row["total_time_s"] == record["total_time_s"]
+        assert row["repetition"] == record["repetition"] - 1
+        assert row["condition"] == record["condition"]
+    assert len(study.strokes) == study.trials["strokes_total"].sum()
+    # The CLI writes the same tables.
+    (study_folder / "tables").mkdir(exist_ok=True)
+    run = subprocess.run([cli, "report", "study", "--csv", "tables"], cwd=study_folder, capture_output=True)
+    assert run.returncode == 0, run.stderr.decode()
+    cli_trials = pd.read_csv(study_folder / "tables" / "trials.csv")
+    assert list(cli_trials.columns) == list(study.trials.columns)
+    assert cli_trials["mean_deviation_m"].tolist() == pytest.approx(study.trials["mean_deviation_m"].tolist())
+    cli_strokes = pd.read_csv(study_folder / "tables" / "strokes.csv")
+    assert len(cli_strokes) == len(study.strokes)
+
+
+def test_samples_are_read_on_demand_in_si_units(study_folder):
+    study = calligraphy.study.load([study_folder / "study"])
+    first = study.trials.iloc[0]
+    samples = study.samples(first)
+    record = json.loads(Path(first["trace_file"]).with_suffix(".json").read_text(encoding="utf-8"))
+    assert len(samples) == record["samples"]
+    assert {"t_s", "x_m", "y_m", "z_m", "fx_n", "fy_n", "fz_n", "state", "stroke", "element"} <= set(samples)
+    assert samples["t_s"].is_monotonic_increasing
+    assert sum(1 for _ in study.iter_samples()) == len(study.trials)
+
+
+def test_a_folder_without_sessions_is_named(tmp_path):
+    with pytest.raises(calligraphy.DataError, match=str(tmp_path)):
+        calligraphy.study.load(tmp_path)
