@@ -13,6 +13,7 @@ packages=(
   pkg-config lib2geom-dev            # lib2geom column of `bench nearest` (optional at configure time)
   pybind11-dev python3-dev python3-numpy python3-pytest
   python3-pandas python3-matplotlib python3-tqdm python3-mypy   # Python tables, figures, stubgen
+  python3-scipy python3-statsmodels   # calligraphy.statistics: tests, intervals, mixed models, power
   python3-dask python3-distributed    # parallel experiments from Python
   fonts-arphic-ukai                   # a CJK font for calligraphy.plot
   nodejs npm                          # npm pack for hanzi-writer-data
