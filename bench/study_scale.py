@@ -75,12 +75,13 @@ def main() -> int:
     parser.add_argument("--work", required=True, help="a folder for the study (replaced)")
     parser.add_argument("--seed", type=int, default=1)
     arguments = parser.parse_args()
-    work = pathlib.Path(arguments.work)
+    work = pathlib.Path(arguments.work).resolve()
+    cli = str(pathlib.Path(arguments.cli).resolve())
     shutil.rmtree(work, ignore_errors=True)
     work.mkdir(parents=True)
     (work / "scale.json").write_text(json.dumps(protocol(arguments.trials)), encoding="utf-8")
     start = time.perf_counter()
-    subprocess.run([arguments.cli, "session", "run", "scale.json", "--writer", "simulated", "--subjects", "1",
+    subprocess.run([cli, "session", "run", "scale.json", "--writer", "simulated", "--subjects", "1",
                     "--out", "study"], cwd=work, check=True, stdout=subprocess.DEVNULL)
     print(f"one subject run for real: {time.perf_counter() - start:.1f} s")
     template = work / "study" / "S01"
