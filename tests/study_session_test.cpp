@@ -16,6 +16,7 @@
 #include "calligraphy/report/study_report_html.hpp"
 #include "calligraphy/study/session_reader.hpp"
 #include "calligraphy/study/session_runner.hpp"
+#include "temp_folder.hpp"
 #include "probe_device.hpp"
 
 using namespace calligraphy;
@@ -23,18 +24,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct TempFolder {
-  fs::path path;
-  TempFolder() {
-    std::string pattern = (fs::temp_directory_path() / "calligraphy-study-XXXXXX").string();
-    REQUIRE(::mkdtemp(pattern.data()) != nullptr);
-    path = pattern;
-  }
-  ~TempFolder() {
-    std::error_code ignored;
-    fs::remove_all(path, ignored);
-  }
-};
 
 std::string read(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);

@@ -12,25 +12,13 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/study/session_runner.hpp"
+#include "temp_folder.hpp"
 #include "calligraphy/study/study_tables.hpp"
 
 using namespace calligraphy;
 namespace fs = std::filesystem;
 
 namespace {
-
-struct TempFolder {
-  fs::path path;
-  TempFolder() {
-    std::string pattern = (fs::temp_directory_path() / "calligraphy-tables-XXXXXX").string();
-    REQUIRE(::mkdtemp(pattern.data()) != nullptr);
-    path = pattern;
-  }
-  ~TempFolder() {
-    std::error_code ignored;
-    fs::remove_all(path, ignored);
-  }
-};
 
 nlohmann::json read_json(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);

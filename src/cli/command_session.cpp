@@ -122,14 +122,11 @@ void require_characters(const LoadedProtocol& loaded, const CharacterSource& sou
   check(loaded.protocol.test_items, "/test/characters");
 }
 
-SessionRunOptions run_options(const LibraryOptions& library, SessionHost* host, const DeviceInfo& device,
+SessionRunOptions run_options(const LibraryOptions& library, SessionHost* host,
                               std::shared_ptr<CharacterSource>& source) {
   source = std::make_shared<CharacterSource>(library);
   SessionRunOptions options;
-  // The trial record keeps the stiffness used (TrialRecordContext::options, read after this).
-  options.prepare_trial = [device](const PlannedTrial&, TrialOptions& trial) {
-    fit_default_stiffness(trial.force, device);
-  };
+  // The force law's default stiffness is fitted to the device by the trial's runner (trial_options).
   options.registry = &cli_device_registry();
   options.load_character = [source](char32_t c) { return source->load(c); };
   options.should_stop = [] { return stop_requested(); };
@@ -202,15 +199,6 @@ int report_run(const SessionFolder& session, const SessionRunResult& result, dou
     return stop_signal() != 0 ? 128 + stop_signal() : 1;
   }
   return 0;
-}
-
-// The listed limits of the device named `name`; none (nothing fitted) when it is not attached now, which
-// the runner reports.
-DeviceInfo device_info(const std::string& name) {
-  for (const DeviceListing& listing : cli_device_registry().survey().devices) {
-    if (listing.name == name) return listing.info;
-  }
-  return {};
 }
 
 std::vector<std::string> split_profiles(const std::string& text) {
@@ -295,7 +283,7 @@ int run_sessions(const SessionRunCommand& command) {
   TerminalHost host;
   std::shared_ptr<CharacterSource> source;
   const SessionRunOptions options =
-      run_options(command.library, person ? &host : nullptr, device->info, source);
+      run_options(command.library, person ? &host : nullptr, source);
   for (std::size_t i = 0; i < subjects.size(); ++i) {
     if (stop_requested()) return 128 + stop_signal();
     SessionSetup setup;
@@ -335,8 +323,7 @@ int resume_session(const SessionResumeCommand& command) {
   TerminalHost host;
   std::shared_ptr<CharacterSource> source;
   SessionRunOptions options =
-      run_options(command.library, session.manifest().setup.writer == "human" ? &host : nullptr,
-                  device_info(session.manifest().setup.device), source);
+      run_options(command.library, session.manifest().setup.writer == "human" ? &host : nullptr, source);
   if (!command.pacing.empty()) {
     options.pacing = parse_trial_pacing(command.pacing, "--pacing");
   }

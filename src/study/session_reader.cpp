@@ -9,7 +9,7 @@
 #include "calligraphy/report/pen_trace_csv.hpp"
 #include "core/unicode.hpp"
 #include "study/json_reader.hpp"
-#include "study/manifest_json.hpp"
+#include "study/saved_sessions.hpp"
 #include "study/names.hpp"
 
 namespace calligraphy {
@@ -19,8 +19,6 @@ namespace {
 using nlohmann::json;
 using study_detail::fail;
 using study_detail::ObjectReader;
-
-constexpr std::uintmax_t kMaxRecordBytes = std::uintmax_t{64} << 20;
 
 Vec2 vec2(const json& value, const std::string& pointer, const std::string& source) {
   if (!value.is_array() || value.size() < 2) fail(source, pointer, "expected [x, y]");
@@ -122,11 +120,7 @@ void read_trace(const fs::path& file, double paper_z_m, ReportTrial& trial) {
 
 ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifest, const PlannedTrial& plan) {
   const std::string source = json_file.string();
-  const json record = study_detail::parse_json(
-      study_detail::read_small_file(json_file, kMaxRecordBytes, "trial record (JSON)"), source);
-  if (!record.is_object() || record.value("format", "") != "calligraphy-study-trial") {
-    fail(source, "/format", "expected \"calligraphy-study-trial\"");
-  }
+  const json record = study_detail::read_trial_record(json_file);
   ReportTrial trial;
   trial.subject = manifest.setup.subject.id;
   trial.session = manifest.session_id;
@@ -173,24 +167,12 @@ std::string session_line(const SessionManifest& m, const fs::path& folder, std::
 }  // namespace
 
 StudyReport read_study_report(const std::vector<fs::path>& roots) {
-  std::vector<fs::path> folders;
-  for (const fs::path& root : roots) {
-    for (fs::path& folder : find_session_folders(root)) folders.push_back(std::move(folder));
-  }
-  if (folders.empty()) {
-    std::string names;
-    for (const fs::path& root : roots) names += (names.empty() ? "" : ", ") + root.string();
-    throw DataError(names + ": no session folder (one holding a session.json) found");
-  }
+  const std::vector<fs::path> folders = study_detail::session_folders_under(roots);
   StudyReport report;
   std::set<std::string> protocols;
   bool simulated = false;
   for (const fs::path& folder : folders) {
-    const fs::path manifest_path = folder / "session.json";
-    SessionManifest manifest = study_detail::manifest_from_json(
-        study_detail::read_small_file(manifest_path, kMaxRecordBytes, "session manifest"),
-        manifest_path.string());
-    manifest.session_id = folder.filename().string();
+    const SessionManifest manifest = study_detail::read_session_manifest(folder);
     if (report.title.empty()) {
       const StudyProtocol& p = manifest.protocol.protocol;
       report.title = "Study report: " + p.name;

@@ -7,7 +7,7 @@
 #include "calligraphy/study/session_folder.hpp"
 #include "core/unicode.hpp"
 #include "study/json_reader.hpp"
-#include "study/manifest_json.hpp"
+#include "study/saved_sessions.hpp"
 #include "study/names.hpp"
 
 namespace calligraphy {
@@ -16,8 +16,6 @@ namespace {
 
 using nlohmann::json;
 using study_detail::fail;
-
-constexpr std::uintmax_t kMaxRecordBytes = std::uintmax_t{64} << 20;
 
 // A record's length in mm as metres; absent when missing or null.
 std::optional<double> metres(const json& object, const char* key_mm, const std::string& source,
@@ -98,11 +96,7 @@ void add_strokes(const json& character, std::size_t index, const std::string& so
 TrialRow read_trial_row(const fs::path& json_file, const SessionManifest& manifest, const PlannedTrial& plan,
                         std::vector<StrokeRow>& strokes) {
   const std::string source = json_file.string();
-  const json record = study_detail::parse_json(
-      study_detail::read_small_file(json_file, kMaxRecordBytes, "trial record (JSON)"), source);
-  if (!record.is_object() || record.value("format", "") != "calligraphy-study-trial") {
-    fail(source, "/format", "expected \"calligraphy-study-trial\"");
-  }
+  const json record = study_detail::read_trial_record(json_file);
   TrialRow row;
   row.subject = manifest.setup.subject.id;
   row.session = manifest.session_id;
@@ -174,22 +168,10 @@ void line(std::string& out, const Fields&... fields) {
 }  // namespace
 
 StudyTables read_study_tables(const std::vector<fs::path>& roots) {
-  std::vector<fs::path> folders;
-  for (const fs::path& root : roots) {
-    for (fs::path& folder : find_session_folders(root)) folders.push_back(std::move(folder));
-  }
-  if (folders.empty()) {
-    std::string names;
-    for (const fs::path& root : roots) names += (names.empty() ? "" : ", ") + root.string();
-    throw DataError(names + ": no session folder (one holding a session.json) found");
-  }
+  const std::vector<fs::path> folders = study_detail::session_folders_under(roots);
   StudyTables tables;
   for (const fs::path& folder : folders) {
-    const fs::path manifest_path = folder / "session.json";
-    SessionManifest manifest = study_detail::manifest_from_json(
-        study_detail::read_small_file(manifest_path, kMaxRecordBytes, "session manifest"),
-        manifest_path.string());
-    manifest.session_id = folder.filename().string();
+    const SessionManifest manifest = study_detail::read_session_manifest(folder);
     for (const PlannedTrial& plan : manifest.plan) {
       const fs::path json_file = folder / "trials" / (SessionFolder::trial_stem(plan) + ".json");
       std::error_code error;

@@ -5,7 +5,10 @@ CALLIGRAPHY_CLI to the ``calligraphy`` program. A run that collects fewer tests 
 so that a broken import or a renamed file cannot pass as "no tests ran".
 """
 
+import json
 import os
+import pathlib
+import subprocess
 
 import pytest
 
@@ -36,3 +39,23 @@ def library():
     import calligraphy
 
     return calligraphy.CharacterLibrary.default()
+
+
+@pytest.fixture(scope="session")
+def small_study(cli):
+    """Makes FOLDER/study: paper-table5 (examples/protocols) shrunk to one practice trial and the characters 十
+    and 人 with `repetitions`, written by `subjects` simulated subjects through `calligraphy session run`."""
+
+    def make(folder: pathlib.Path, subjects: int, repetitions: int) -> pathlib.Path:
+        source = pathlib.Path(__file__).resolve().parents[2] / "examples" / "protocols" / "paper-table5.json"
+        protocol = json.loads(source.read_text(encoding="utf-8"))
+        protocol["practice"]["repetitions"] = 1
+        protocol["test"].update({"characters": ["十", "人"], "repetitions": repetitions})
+        protocol["breaks"] = {}
+        (folder / "p.json").write_text(json.dumps(protocol), encoding="utf-8")
+        run = subprocess.run([cli, "session", "run", "p.json", "--writer", "simulated", "--subjects", str(subjects),
+                              "--out", "study"], cwd=folder, capture_output=True)
+        assert run.returncode == 0, run.stderr.decode()
+        return folder / "study"
+
+    return make

@@ -4,7 +4,6 @@ and a decodable PNG; the page is self-contained and reads summary first in Chrom
 is wrong. A synthetic study whose condition effect is known needs no C++ session; one test runs a real one."""
 
 import html.parser
-import json
 import os
 import shutil
 import subprocess
@@ -25,7 +24,6 @@ import calligraphy  # noqa: E402
 import calligraphy.study  # noqa: E402
 from calligraphy import study_report  # noqa: E402
 
-SOURCE = Path(__file__).resolve().parents[2]
 SUBJECTS = 6
 CHARACTERS = "大山木中"
 CONDITIONS = ("vision", "haptic")
@@ -344,18 +342,11 @@ def test_chromium_shows_the_summary_first_at_1280_px(report, tmp_path):
     assert "<details open" not in dom
 
 
-def test_a_real_study_from_session_run(cli, tmp_path):
+def test_a_real_study_from_session_run(small_study, tmp_path):
     """paper-table5 shrunk to 2 characters x 2 repetitions, 3 simulated subjects, through the CLI and load."""
     if not hasattr(calligraphy._calligraphy, "_study_tables_csv"):
         pytest.skip("this calligraphy build has no study tables binding (calligraphy.study.load)")
-    protocol = json.loads((SOURCE / "examples" / "protocols" / "paper-table5.json").read_text(encoding="utf-8"))
-    protocol["practice"]["repetitions"] = 1
-    protocol["test"].update({"characters": ["十", "人"], "repetitions": 2})
-    protocol["breaks"] = {}
-    (tmp_path / "p.json").write_text(json.dumps(protocol), encoding="utf-8")
-    run = subprocess.run([cli, "session", "run", "p.json", "--writer", "simulated", "--subjects", "3", "--out",
-                          "study"], cwd=tmp_path, capture_output=True)
-    assert run.returncode == 0, run.stderr.decode()
+    small_study(tmp_path, subjects=3, repetitions=2)
     made = run_module(tmp_path / "study", "--out", tmp_path / "report", "--title", "Three simulated subjects",
                       cwd=tmp_path)
     assert made.returncode == 0, made.stderr

@@ -11,20 +11,10 @@ pd = pytest.importorskip("pandas")
 
 import calligraphy.study  # noqa: E402
 
-SOURCE = Path(__file__).resolve().parents[2]
-
-
 @pytest.fixture(scope="module")
-def study_folder(cli, tmp_path_factory):
+def study_folder(small_study, tmp_path_factory):
     folder = tmp_path_factory.mktemp("study")
-    protocol = json.loads((SOURCE / "examples" / "protocols" / "paper-table5.json").read_text(encoding="utf-8"))
-    protocol["practice"]["repetitions"] = 1
-    protocol["test"].update({"characters": ["十", "人"], "repetitions": 1})
-    protocol["breaks"] = {}
-    (folder / "p.json").write_text(json.dumps(protocol), encoding="utf-8")
-    run = subprocess.run([cli, "session", "run", "p.json", "--writer", "simulated", "--subjects", "2", "--out",
-                          "study"], cwd=folder, capture_output=True)
-    assert run.returncode == 0, run.stderr.decode()
+    small_study(folder, subjects=2, repetitions=1)
     return folder
 
 

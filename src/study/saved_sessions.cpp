@@ -1,0 +1,41 @@
+#include "study/saved_sessions.hpp"
+
+#include "calligraphy/core/errors.hpp"
+#include "study/json_reader.hpp"
+#include "study/manifest_json.hpp"
+#include "study/names.hpp"
+
+namespace calligraphy::study_detail {
+namespace fs = std::filesystem;
+
+std::vector<fs::path> session_folders_under(const std::vector<fs::path>& roots) {
+  std::vector<fs::path> folders;
+  for (const fs::path& root : roots) {
+    for (fs::path& folder : find_session_folders(root)) folders.push_back(std::move(folder));
+  }
+  if (folders.empty()) {
+    std::string names;
+    for (const fs::path& root : roots) names += (names.empty() ? "" : ", ") + root.string();
+    throw DataError(names + ": no session folder (one holding a session.json) found");
+  }
+  return folders;
+}
+
+SessionManifest read_session_manifest(const fs::path& folder) {
+  const fs::path path = folder / "session.json";
+  SessionManifest manifest =
+      manifest_from_json(read_small_file(path, kMaxRecordBytes, "session manifest"), path.string());
+  manifest.session_id = folder.filename().string();
+  return manifest;
+}
+
+nlohmann::json read_trial_record(const fs::path& json_file) {
+  const std::string source = json_file.string();
+  nlohmann::json record = parse_json(read_small_file(json_file, kMaxRecordBytes, "trial record (JSON)"), source);
+  if (!record.is_object() || record.value("format", "") != "calligraphy-study-trial") {
+    fail(source, "/format", "expected \"calligraphy-study-trial\"");
+  }
+  return record;
+}
+
+}  // namespace calligraphy::study_detail

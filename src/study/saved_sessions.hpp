@@ -1,0 +1,27 @@
+#pragma once
+// Reading saved sessions back, shared by the report and the tidy tables: the session folders under given
+// roots, each one's manifest, and each saved trial's record. Internal.
+#include <cstdint>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "calligraphy/study/session_folder.hpp"
+
+namespace calligraphy::study_detail {
+
+/// Largest session manifest or trial record read: 64 MiB.
+inline constexpr std::uintmax_t kMaxRecordBytes = std::uintmax_t{64} << 20;
+
+/// The session folders under `roots` (each a session folder or a folder holding some), sorted by path within
+/// each root. Throws DataError naming the roots when there is none.
+std::vector<std::filesystem::path> session_folders_under(const std::vector<std::filesystem::path>& roots);
+
+/// The manifest of the session folder `folder`, its `session_id` the folder's name. Throws DataError naming
+/// the file (and JSON pointer) when it cannot be read.
+SessionManifest read_session_manifest(const std::filesystem::path& folder);
+
+/// The record of a saved trial (its format checked). Throws DataError naming the file.
+nlohmann::json read_trial_record(const std::filesystem::path& json_file);
+
+}  // namespace calligraphy::study_detail
