@@ -30,7 +30,12 @@ def test_the_tables_are_the_cli_tables_and_the_records(cli, study_folder):
         assert row["total_time_s"] == record["total_time_s"]
         assert row["repetition"] == record["repetition"] - 1
         assert row["condition"] == record["condition"]
+        assert row["completed_in_order"] == record["completed_in_order"]
+        assert row["strokes_accepted"] == record["strokes_accepted"]
     assert len(study.strokes) == study.trials["strokes_total"].sum()
+    assert study.trials["completed_in_order"].dtype == bool and study.trials["completed_in_order"].any()
+    assert study.strokes["written"].dtype == bool
+    assert study.strokes["written"].sum() == study.trials["strokes_written"].sum()
     # The CLI writes the same tables.
     (study_folder / "tables").mkdir(exist_ok=True)
     run = subprocess.run([cli, "report", "study", "--csv", "tables"], cwd=study_folder, capture_output=True)

@@ -51,8 +51,9 @@ def _read_table(text: str, numeric: tuple[str, ...], booleans: tuple[str, ...]) 
     frame = pd.read_csv(io.StringIO(text), keep_default_na=False, na_values={c: [""] for c in numeric},
                         float_precision="round_trip",
                         dtype={c: "float64" for c in numeric})
-    for column in booleans:
-        frame[column] = frame[column] == "true"
+    for column in booleans:  # pandas may have read "true"/"false" as booleans already
+        if frame[column].dtype != bool:
+            frame[column] = frame[column].astype(str) == "true"
     for column in numeric:  # counts and indices without a gap are integers
         if frame[column].notna().all() and (frame[column] % 1 == 0).all():
             frame[column] = frame[column].astype("int64")
