@@ -17,19 +17,19 @@ namespace {
 using nlohmann::json;
 using study_detail::fail;
 
-// A record's length in mm as metres; absent when missing or null.
-std::optional<double> metres(const json& object, const char* key_mm, const std::string& source,
-                             const std::string& pointer) {
-  const auto found = object.find(key_mm);
-  if (found == object.end() || found->is_null()) return std::nullopt;
-  return study_detail::as_number(*found, pointer + "/" + key_mm, source, -1e12, 1e12) * 1e-3;
-}
-
+// A record's number; absent when missing or null.
 std::optional<double> optional_number(const json& object, const char* key, const std::string& source,
                                       const std::string& pointer) {
   const auto found = object.find(key);
   if (found == object.end() || found->is_null()) return std::nullopt;
   return study_detail::as_number(*found, pointer + "/" + key, source, -1e12, 1e12);
+}
+
+// A record's length in mm as metres; absent when missing or null.
+std::optional<double> metres(const json& object, const char* key_mm, const std::string& source,
+                             const std::string& pointer) {
+  const std::optional<double> millimetres = optional_number(object, key_mm, source, pointer);
+  return millimetres ? std::optional<double>(*millimetres * 1e-3) : std::nullopt;
 }
 
 double number(const json& object, const char* key, const std::string& source, const std::string& pointer) {
