@@ -3,12 +3,14 @@
 #include <catch2/catch.hpp>
 #include <map>
 #include <optional>
+#include <random>
 #include <set>
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/schedule.hpp"
+#include "calligraphy/study/transfer_set.hpp"
 
 using namespace calligraphy;
 
@@ -67,9 +69,12 @@ TEST_CASE("a protocol is read with every field", "[study][protocol]") {
   CHECK(p.conditions[2].quiz.acceptance.mean_deviation_m == StrokeAcceptance{}.mean_deviation_m);
   CHECK(p.conditions[2].quiz.start_radius_m == SceneLayout{}.start_radius_m);
   CHECK(p.conditions[2].quiz.hint_after_misses == 2);
-  REQUIRE(p.practice);
-  CHECK(p.practice->items == std::vector<std::u32string>{U"永"});
-  CHECK(p.test_items == std::vector<std::u32string>{U"大", U"山", U"木"});
+  REQUIRE(p.phases.size() == 2);
+  CHECK(p.phases[0].kind == StudyPhase::practice);
+  CHECK(p.phases[0].items == std::vector<std::u32string>{U"永"});
+  CHECK(p.phases[1].kind == StudyPhase::test);
+  CHECK(p.phases[1].items == std::vector<std::u32string>{U"大", U"山", U"木"});
+  CHECK(p.session_count() == 1);
   CHECK(p.item_order == ItemOrder::random);
   CHECK(p.seed == 5);
   CHECK(p.breaks.every_trials == 4);
@@ -80,8 +85,9 @@ TEST_CASE("a protocol is read with every field", "[study][protocol]") {
 TEST_CASE("the shipped paper-table5 protocol is valid", "[study][protocol]") {
   const LoadedProtocol loaded =
       load_study_protocol(std::string(CALLIGRAPHY_SOURCE_DIR) + "/examples/protocols/paper-table5.json");
-  CHECK(loaded.protocol.test_items.size() == 4);
-  CHECK(loaded.protocol.test_conditions == std::vector<std::string>{"vision", "haptic"});
+  REQUIRE(loaded.protocol.phases.size() == 2);
+  CHECK(loaded.protocol.phases[1].items.size() == 4);
+  CHECK(loaded.protocol.phases[1].conditions == std::vector<std::string>{"vision", "haptic"});
   CHECK(loaded.sha256 == sha256_hex(loaded.text));
 }
 
@@ -90,7 +96,7 @@ TEST_CASE("a protocol saved with a UTF-8 byte-order mark is read", "[study][prot
   const std::string text = "\xEF\xBB\xBF" + protocol_text();
   CHECK(parse_study_protocol(text, "p.json").name == "t");
   const LoadedProtocol loaded = protocol_from_text(text, "p.json");
-  CHECK(loaded.protocol.test_items.size() == 3);
+  CHECK(loaded.protocol.phases.back().items.size() == 3);
   CHECK(loaded.sha256 == sha256_hex(text));
 }
 
@@ -238,23 +244,25 @@ TEST_CASE("a balanced Latin square: each condition once per row, every ordered p
   for (const int n : {2, 3, 4, 5}) {
     StudyProtocol p;
     p.name = "l";
+    ProtocolPhase test;
     for (int k = 0; k < n; ++k) {
       p.conditions.push_back({std::string(1, static_cast<char>('A' + k)), ConditionMode::vision, {}, {}, {}});
-      p.test_conditions.push_back(p.conditions.back().name);
+      test.conditions.push_back(p.conditions.back().name);
     }
-    p.test_items = {U"大"};
+    test.items = {U"大"};
+    p.phases = {test};
     p.condition_order = ConditionOrder::latin_square;
     const std::size_t rows = n % 2 == 0 ? static_cast<std::size_t>(n) : static_cast<std::size_t>(2 * n);
     std::map<std::pair<std::string, std::string>, int> pairs;
     std::map<std::pair<std::string, std::size_t>, int> positions;
     for (std::size_t subject = 1; subject <= rows; ++subject) {
-      const auto blocks = test_block_conditions(p, {subject_id(subject), subject});
+      const auto blocks = block_conditions(p, p.phases[0], {subject_id(subject), subject});
       REQUIRE(blocks.size() == static_cast<std::size_t>(n));
       CHECK(std::set<std::string>(blocks.begin(), blocks.end()).size() == static_cast<std::size_t>(n));
       for (std::size_t j = 0; j < blocks.size(); ++j) ++positions[{blocks[j], j}];
       for (std::size_t j = 1; j < blocks.size(); ++j) ++pairs[{blocks[j - 1], blocks[j]}];
       // The next cycle of subjects repeats the rows.
-      CHECK(test_block_conditions(p, {"T", subject + rows}) == blocks);
+      CHECK(block_conditions(p, p.phases[0], {"T", subject + rows}) == blocks);
     }
     CHECK(pairs.size() == static_cast<std::size_t>(n * (n - 1)));
     for (const auto& [pair, count] : pairs) CHECK(count == pairs.begin()->second);
@@ -264,11 +272,11 @@ TEST_CASE("a balanced Latin square: each condition once per row, every ordered p
 
 TEST_CASE("a session plan: practice, blocks, repetitions, ABBA and breaks", "[study][schedule]") {
   const StudyProtocol abba = parse_study_protocol(protocol_text("abba", 4), "p.json");
-  const auto odd = test_block_conditions(abba, {"S1", 1});
-  const auto even = test_block_conditions(abba, {"S2", 2});
+  const auto odd = block_conditions(abba, abba.phases.back(), {"S1", 1});
+  const auto even = block_conditions(abba, abba.phases.back(), {"S2", 2});
   CHECK(odd == std::vector<std::string>{"A", "B", "C", "C", "B", "A"});
   CHECK(even == std::vector<std::string>{"C", "B", "A", "A", "B", "C"});
-  CHECK_THROWS_AS(test_block_conditions(abba, {"anonymous", 0}), InvalidArgument);
+  CHECK_THROWS_AS(block_conditions(abba, abba.phases.back(), {"anonymous", 0}), InvalidArgument);
 
   const std::vector<PlannedTrial> plan = plan_session(abba, {"S1", 1});
   REQUIRE(plan.size() == 2 + 3 * 3 * 4);
@@ -291,10 +299,160 @@ TEST_CASE("a session plan: practice, blocks, repetitions, ABBA and breaks", "[st
   CHECK(plan_session(random, {"S1", 0}).size() == a.size());
   std::set<std::vector<std::string>> orders;
   for (int s = 1; s <= 12; ++s)
-    orders.insert(test_block_conditions(random, {subject_id(static_cast<std::size_t>(s)), 0}));
+    orders.insert(
+        block_conditions(random, random.phases.back(), {subject_id(static_cast<std::size_t>(s)), 0}));
   CHECK(orders.size() > 1);
-  CHECK(test_block_conditions(random, {"S1", 0}) == test_block_conditions(random, {"S1", 9}));
+  CHECK(block_conditions(random, random.phases.back(), {"S1", 0}) ==
+        block_conditions(random, random.phases.back(), {"S1", 9}));
   CHECK(trailing_number("S07") == 7);
   CHECK(trailing_number("anna") == 0);
   CHECK_THROWS_AS(plan_session(random, {"bad id", 1}), InvalidArgument);
+}
+
+namespace {
+
+// Pre-test, training between subjects, post-test, then a second session a day later: retention and transfer.
+std::string phases_text(const std::string& retention = R"("delay_s": 86400)",
+                        const std::string& transfer = R"(["大"])", const std::string& extra_phase = "") {
+  return R"({"name": "r", "conditions": [{"name": "free", "mode": "vision"}, {"name": "fixture", "mode": "haptic"},
+             {"name": "fading", "mode": "fading"}],
+    "phases": [
+      {"phase": "pre-test", "condition": "free", "characters": ["十", "人"]},)" +
+         extra_phase + R"(
+      {"phase": "training", "conditions": ["fixture", "fading"], "assignment": "between-subjects",
+       "characters": ["十", "人"], "repetitions": 3},
+      {"phase": "post-test", "condition": "free", "characters": ["十", "人"], "delay_s": 60},
+      {"phase": "retention", "condition": "free", "characters": ["十", "人"], "session": 2, )" +
+         retention + R"(},
+      {"phase": "transfer", "condition": "free", "characters": )" +
+         transfer + R"(, "session": 2}
+    ]})";
+}
+
+}  // namespace
+
+TEST_CASE("a protocol of phases: pre-test, training, post-test, retention after a delay, transfer",
+          "[study][protocol][phases]") {
+  const StudyProtocol p = parse_study_protocol(phases_text(), "p.json");
+  REQUIRE(p.phases.size() == 5);
+  CHECK(p.phases[0].kind == StudyPhase::pre_test);
+  CHECK(p.phases[1].assignment == ConditionAssignment::between_subjects);
+  CHECK(p.phases[3].kind == StudyPhase::retention);
+  CHECK(p.phases[3].delay_s == 86400.0);
+  CHECK(p.phases[4].pointer == "/phases/4");
+  CHECK(p.session_count() == 2);
+  CHECK(p.trained_characters() == U"十人");
+  // The largest session: 2 pre-test + 2 x 3 training (one condition: between subjects) + 2 post-test.
+  CHECK(planned_trial_count(p) == 10);
+
+  // Groups alternate by subject number; each subject trains in its group's condition only.
+  CHECK(subject_group(p, {"S1", 1}) == "fixture");
+  CHECK(subject_group(p, {"S2", 2}) == "fading");
+  CHECK(subject_group(p, {"S3", 3}) == "fixture");
+  CHECK_THROWS_WITH(subject_group(p, {"anna", 0}), Catch::Contains("number"));
+  const std::vector<PlannedTrial> first = plan_session(p, {"S2", 2}, 1);
+  REQUIRE(first.size() == 10);
+  std::vector<std::string> phases;
+  for (const PlannedTrial& t : first) {
+    if (phases.empty() || phases.back() != to_string(t.phase)) phases.push_back(to_string(t.phase));
+    if (t.phase == StudyPhase::training) CHECK(t.condition == "fading");
+  }
+  CHECK(phases == std::vector<std::string>{"pre-test", "training", "post-test"});
+  CHECK(first[2].repetition == 1);
+  CHECK(first[7].repetition == 3);
+  // The post-test's delay within the session is a rest before its first trial.
+  CHECK(first[8].break_before_s == 60.0);
+  const std::vector<PlannedTrial> second = plan_session(p, {"S2", 2}, 2);
+  REQUIRE(second.size() == 3);
+  CHECK(second[0].phase == StudyPhase::retention);
+  CHECK(second[0].break_before_s == 0.0);  // the day between sessions is the sessions' link, not a rest
+  CHECK(second[2].phase == StudyPhase::transfer);
+  CHECK(second[2].characters == U"大");
+  CHECK_THROWS_WITH(plan_session(p, {"S2", 2}, 3), Catch::Contains("sessions 1 to 2"));
+}
+
+TEST_CASE("a protocol of phases that makes no sense is refused, naming the phase",
+          "[study][protocol][phases]") {
+  check_error(phases_text(R"("delay_s": 0)"), "/phases/3/delay_s", "after a stated delay");
+  check_error(phases_text(R"("delay_s": 1)", R"(["十"])"), "/phases/4/characters/0", "is trained");
+  check_error(phases_text(R"("delay_s": 1)", R"({"choose": 1, "from": ["大", "人"]})"),
+              "/phases/4/characters/from/1", "is trained");
+  check_error(phases_text(R"("delay_s": 1)", R"({"choose": 3, "from": ["大", "天"]})"),
+              "/phases/4/characters/choose", "more characters to choose");
+  const std::string untrained_retention = R"({"name": "b", "conditions": [{"name": "A", "mode": "vision"}],
+      "phases": [{"phase": "training", "condition": "A", "characters": ["十"]},
+                 {"phase": "retention", "condition": "A", "characters": ["十", "十口"], "delay_s": 600}]})";
+  check_error(untrained_retention, "/phases/1/characters/1", "\"口\" is not trained");
+  check_error(phases_text(R"("delay_s": 1)", R"(["大"])",
+                          R"({"phase": "post-test", "condition": "free", "characters": ["十"]},)"),
+              "/phases/1/phase", "comes after the training");
+  check_error(
+      phases_text(R"("delay_s": 1)", R"(["大"])",
+                  R"({"phase": "training", "condition": "free", "characters": ["十"], "session": 3},)"),
+      "/phases/1/session", "without gaps");
+  check_error(phases_text(R"("delay_s": 1)", R"(["大"])",
+                          R"({"phase": "training", "conditions": ["free"], "assignment": "between-subjects",
+                              "characters": ["十"]},)"),
+              "/phases/1/assignment", "two or more");
+  check_error(
+      phases_text(
+          R"("delay_s": 1)", R"(["大"])",
+          R"({"phase": "pre-test", "condition": "free", "characters": {"choose": 1, "from": ["大"]}},)"),
+      "/phases/1/characters", "only a transfer phase chooses");
+  check_error(phases_text(R"("delay_s": 1)", R"(["大"])",
+                          R"({"phase": "warm-up", "condition": "free", "characters": ["十"]},)"),
+              "/phases/1/phase", "expected one of practice, test, pre-test");
+  const std::string both = R"({"name": "b", "conditions": [{"name": "A", "mode": "vision"}],
+      "test": {"characters": ["十"], "conditions": ["A"], "repetitions": 1},
+      "phases": [{"phase": "test", "condition": "A", "characters": ["十"]}]})";
+  check_error(both, "/phases", "not both");
+  const std::string late_pre_test = R"({"name": "b", "conditions": [{"name": "A", "mode": "vision"}],
+      "phases": [{"phase": "training", "condition": "A", "characters": ["十"]},
+                 {"phase": "pre-test", "condition": "A", "characters": ["十"]}]})";
+  check_error(late_pre_test, "/phases/1/phase", "before the training");
+  const std::string no_training = R"({"name": "b", "conditions": [{"name": "A", "mode": "vision"}],
+      "phases": [{"phase": "post-test", "condition": "A", "characters": ["十"]}]})";
+  check_error(no_training, "/phases/0/phase", "needs a training phase");
+}
+
+TEST_CASE("a transfer set: untrained characters made of trained typical strokes, most coverage first",
+          "[study][protocol][phases]") {
+  // Made-up characters (code points 0x4E00 + k) with random typical strokes: the rule, not any real
+  // character.
+  std::mt19937 random(7);
+  for (int round = 0; round < 200; ++round) {
+    std::map<char32_t, std::vector<int>> strokes;
+    std::uniform_int_distribution<int> id(1, 8), length(1, 5);
+    for (char32_t c = 0x4E00; c < 0x4E00 + 30; ++c) {
+      const int n = length(random);
+      for (int k = 0; k < n; ++k) strokes[c].push_back(id(random));
+    }
+    const auto ids = [&strokes](char32_t c) { return strokes.at(c); };
+    const std::u32string trained = {0x4E00, 0x4E01, 0x4E02, 0x4E03};
+    std::u32string candidates;
+    for (char32_t c = 0x4E00; c < 0x4E00 + 30; ++c) candidates.push_back(c);
+    std::set<int> trained_ids;
+    for (const char32_t c : trained) trained_ids.insert(strokes[c].begin(), strokes[c].end());
+    std::vector<char32_t> eligible;
+    for (const char32_t c : candidates) {
+      const bool covered =
+          std::all_of(strokes[c].begin(), strokes[c].end(), [&](int i) { return trained_ids.count(i) > 0; });
+      if (trained.find(c) == std::u32string::npos && covered) eligible.push_back(c);
+    }
+    if (eligible.size() < 2) {
+      CHECK_THROWS_WITH(choose_transfer_characters(trained, candidates, 2, ids), Catch::Contains("2 asked"));
+      continue;
+    }
+    const std::u32string chosen = choose_transfer_characters(trained, candidates, 2, ids);
+    REQUIRE(chosen.size() == 2);
+    CHECK(chosen[0] != chosen[1]);
+    for (const char32_t c : chosen) {
+      CHECK(std::find(eligible.begin(), eligible.end(), c) != eligible.end());
+    }
+    // The first covers at least as many distinct typical strokes as any other eligible character.
+    const auto distinct = [&](char32_t c) {
+      return std::set<int>(strokes[c].begin(), strokes[c].end()).size();
+    };
+    for (const char32_t c : eligible) CHECK(distinct(chosen[0]) >= distinct(c));
+  }
 }

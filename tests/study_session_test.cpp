@@ -16,14 +16,15 @@
 #include "calligraphy/report/study_report_html.hpp"
 #include "calligraphy/study/session_reader.hpp"
 #include "calligraphy/study/session_runner.hpp"
-#include "temp_folder.hpp"
+#include "calligraphy/study/session_series.hpp"
+#include "calligraphy/study/study_tables.hpp"
 #include "probe_device.hpp"
+#include "temp_folder.hpp"
 
 using namespace calligraphy;
 namespace fs = std::filesystem;
 
 namespace {
-
 
 std::string read(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
@@ -510,4 +511,88 @@ TEST_CASE("a session's simulated writer is any known profile", "[study][session]
   setup.writer_profile = "expert";
   CHECK_THROWS_WITH(SessionFolder::create(temp.path, setup, small_protocol()),
                     Catch::Contains("expert") && Catch::Contains("skilled"));
+}
+
+TEST_CASE("a protocol over two days: sessions linked, the delay recorded, groups and phases in the tables",
+          "[study][session][phases]") {
+  TempFolder temp;
+  const LoadedProtocol protocol = protocol_from_text(
+      R"({"name": "days", "conditions": [{"name": "free", "mode": "vision"}, {"name": "fixture", "mode": "haptic"},
+          {"name": "fading", "mode": "fading"}],
+          "phases": [
+            {"phase": "pre-test", "condition": "free", "characters": ["十"]},
+            {"phase": "training", "conditions": ["fixture", "fading"], "assignment": "between-subjects",
+             "characters": ["十"]},
+            {"phase": "post-test", "condition": "free", "characters": ["十"]},
+            {"phase": "retention", "condition": "free", "characters": ["十"], "session": 2, "delay_s": 86400},
+            {"phase": "transfer", "condition": "free", "characters": ["人"], "session": 2}],
+          "trial": {"max_duration_s": 40}})",
+      "days.json");
+  SessionSetup setup = simulated("S1");
+  SessionSeries series = session_series(temp.path, "S1", protocol);
+  CHECK(series.next == 1);
+  CHECK(series.sessions == 2);
+  CHECK(series.due());
+  // A later session needs the one before it.
+  setup.session_number = 2;
+  CHECK_THROWS_WITH(SessionFolder::create(temp.path, setup, protocol), Catch::Contains("needs the previous"));
+  setup.session_number = 1;
+
+  std::string first_id;
+  {
+    SessionFolder first = SessionFolder::create(temp.path, setup, protocol);
+    first_id = first.manifest().session_id;
+    CHECK(first.manifest().group == "fixture");
+    StopAfter host(1);
+    SessionRunOptions options;
+    options.host = &host;
+    options.should_stop = [&host] { return host.ended >= 1; };
+    REQUIRE_FALSE(run_session(first, options).complete());
+  }
+  series = session_series(temp.path, "S1", protocol);
+  REQUIRE(series.unfinished);  // resumed before the next session starts
+  CHECK(series.next == 1);
+  {
+    SessionFolder first = SessionFolder::open(*series.unfinished);
+    REQUIRE(run_session(first).complete());
+  }
+  series = session_series(temp.path, "S1", protocol);
+  CHECK_FALSE(series.unfinished);
+  REQUIRE(series.next == 2);
+  REQUIRE(series.previous);
+  CHECK(series.previous->session_id == first_id);
+  CHECK(series.previous->delay_s == 86400.0);
+  CHECK(series.previous->elapsed_s >= 0.0);
+  CHECK(series.previous->elapsed_s < 3600.0);
+  CHECK_FALSE(series.due());
+
+  PreviousSession previous = *series.previous;
+  previous.delay = "simulated";
+  setup.session_number = 2;
+  fs::path second_folder;
+  {
+    SessionFolder second = SessionFolder::create(temp.path, setup, protocol, previous);
+    second_folder = second.path();
+    REQUIRE(second.plan().size() == 2);
+    REQUIRE(run_session(second).complete());
+  }
+  const SessionFolder reopened = SessionFolder::open(second_folder);
+  REQUIRE(reopened.manifest().previous);
+  CHECK(reopened.manifest().previous->session_id == first_id);
+  CHECK(reopened.manifest().previous->delay == "simulated");
+  CHECK(reopened.manifest().setup.session_number == 2);
+  series = session_series(temp.path, "S1", protocol);
+  CHECK(series.next == 3);
+  CHECK(series.folders.size() == 2);
+
+  const StudyTables tables = read_study_tables({temp.path});
+  REQUIRE(tables.trials.size() == 5);
+  std::vector<std::string> phases;
+  for (const TrialRow& row : tables.trials) {
+    phases.push_back(row.phase);
+    CHECK(row.group == "fixture");
+    CHECK(row.session_number == (row.phase == "retention" || row.phase == "transfer" ? 2 : 1));
+  }
+  CHECK(phases == std::vector<std::string>{"pre-test", "training", "post-test", "retention", "transfer"});
+  CHECK(tables.trials[1].condition == "fixture");
 }

@@ -71,7 +71,7 @@ TEST_CASE("a study's tidy tables hold every saved trial with its record's metric
   // The CSV: a header and one line per row.
   CHECK(lines(trials_csv(tables)) == tables.trials.size() + 1);
   CHECK(lines(strokes_csv(tables)) == tables.strokes.size() + 1);
-  CHECK(trials_csv(tables).rfind("subject,session,protocol,phase,block,condition", 0) == 0);
+  CHECK(trials_csv(tables).rfind("subject,session,protocol,session_number,group,phase,block,condition", 0) == 0);
 }
 
 TEST_CASE("a table field with a comma or a quote is quoted, and a missing metric is empty", "[study][tables]") {

@@ -15,6 +15,8 @@
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/session_folder.hpp"
 #include "calligraphy/study/session_runner.hpp"
+#include "calligraphy/study/session_series.hpp"
+#include "calligraphy/study/transfer_set.hpp"
 #include "cli/cli_devices.hpp"
 #include "cli/commands.hpp"
 #include "cli/interrupt.hpp"
@@ -49,6 +51,7 @@ struct SessionRunCommand {
   const CLI::Option* profile_option = nullptr;
   std::string pacing = "auto";
   std::string out;
+  bool ignore_delay = false;
   LibraryOptions library;
   SessionDisplay display;
 };
@@ -118,8 +121,14 @@ void require_characters(const LoadedProtocol& loaded, const CharacterSource& sou
       }
     }
   };
-  if (loaded.protocol.practice) check(loaded.protocol.practice->items, "/practice/characters");
-  check(loaded.protocol.test_items, "/test/characters");
+  const StudyProtocol& protocol = loaded.protocol;
+  for (const ProtocolPhase& phase : protocol.phases) {
+    if (phase.choice) {
+      check(phase.choice->candidates, phase.pointer + "/characters/from");
+    } else {
+      check(phase.items, phase.pointer + "/characters");
+    }
+  }
 }
 
 SessionRunOptions run_options(const LibraryOptions& library, SessionHost* host,
@@ -279,26 +288,69 @@ int run_sessions(const SessionRunCommand& command) {
     subjects.push_back({command.subject, number});
   }
 
+  // A transfer set chosen by typical-stroke coverage is chosen once, the same for every subject.
+  LoadedProtocol resolved = protocol;
+  try {
+    const CharacterSource characters(command.library);
+    resolve_transfer_choices(resolved.protocol, [&characters](char32_t c) { return characters.load(c); });
+  } catch (const InvalidArgument& e) {
+    throw DataError(protocol.path.string() + ": " + e.what());
+  }
+
   install_stop_handlers();
   TerminalHost host;
   std::shared_ptr<CharacterSource> source;
-  const SessionRunOptions options =
-      run_options(command.library, person ? &host : nullptr, source);
+  const SessionRunOptions options = run_options(command.library, person ? &host : nullptr, source);
+  const int sessions = resolved.protocol.session_count();
   for (std::size_t i = 0; i < subjects.size(); ++i) {
-    if (stop_requested()) return 128 + stop_signal();
-    SessionSetup setup;
-    setup.subject = subjects[i];
-    setup.device = command.device;
-    setup.writer = writer;
-    setup.writer_profile = profiles[i % profiles.size()];
-    setup.writer_seed = subject_seed(setup.subject.id);
-    setup.pacing = command.pacing;
-    SessionFolder session = SessionFolder::create(command.out, setup, protocol);
-    const auto start = std::chrono::steady_clock::now();
-    const SessionRunResult result = run_one(session, options, command.display, command.library);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const int status = report_run(session, result, seconds);
-    if (status != 0) return status;
+    // The subject's series: a simulated subject writes every remaining session in a row (the delays taken
+    // as passed), a person the next one, when its delay has passed.
+    while (true) {
+      if (stop_requested()) return 128 + stop_signal();
+      // A protocol of one session starts a new one on every run, as before sessions were linked.
+      const SessionSeries series =
+          sessions > 1 ? session_series(command.out, subjects[i].id, resolved) : SessionSeries{};
+      if (series.unfinished) {
+        throw StateError(
+            subjects[i].id + ": session " + std::to_string(series.next) + " of " + protocol.protocol.name +
+            " is not finished; resume it first: calligraphy session resume " + series.unfinished->string());
+      }
+      if (series.next > sessions) {
+        std::printf("%s: every session of %s is done (%d)\n", subjects[i].id.c_str(),
+                    protocol.protocol.name.c_str(), sessions);
+        break;
+      }
+      std::optional<PreviousSession> previous = series.previous;
+      if (previous && !series.due()) {
+        if (!person) {
+          previous->delay = "simulated";
+        } else if (command.ignore_delay) {
+          previous->delay = "overridden";
+        } else {
+          throw StateError(subjects[i].id + ": session " + std::to_string(series.next) + " of " +
+                           protocol.protocol.name + " is due " + std::to_string(previous->delay_s) +
+                           " s after session " + std::to_string(series.next - 1) + " ended (" +
+                           previous->ended_utc + "); " +
+                           std::to_string(static_cast<long long>(previous->delay_s - previous->elapsed_s)) +
+                           " s to go. --ignore-delay starts it now (recorded as overridden)");
+        }
+      }
+      SessionSetup setup;
+      setup.subject = subjects[i];
+      setup.device = command.device;
+      setup.writer = writer;
+      setup.writer_profile = profiles[i % profiles.size()];
+      setup.writer_seed = subject_seed(setup.subject.id);
+      setup.pacing = command.pacing;
+      setup.session_number = series.next;
+      SessionFolder session = SessionFolder::create(command.out, setup, resolved, previous);
+      const auto start = std::chrono::steady_clock::now();
+      const SessionRunResult result = run_one(session, options, command.display, command.library);
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const int status = report_run(session, result, seconds);
+      if (status != 0) return status;
+      if (person || sessions == 1) break;
+    }
   }
   return 0;
 }
@@ -382,7 +434,10 @@ void add_session_commands(CLI::App& root, Commands& commands) {
              "auto: lock-step for a simulated writer, real time for a person; real-time paces a simulated "
              "writer by the wall clock");
   required(add_text(*app, "--out", run->out, "DIR",
-                    "the study folder: sessions go to DIR/SUBJECT/PROTOCOL-TIME/"));
+                    "the study folder: sessions go to DIR/SUBJECT/PROTOCOL-TIME/; a protocol of several "
+                    "sessions goes on with the subject's next one there"));
+  add_flag(*app, "--ignore-delay", run->ignore_delay,
+           "start a person's next session before the protocol's delay has passed (recorded as overridden)");
   add_library_options(*app, run->library, true);
   add_display_options(*app, run->display);
 

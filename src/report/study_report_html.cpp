@@ -121,7 +121,7 @@ void append_summary_table(std::string& out, const StudyReport& report, const Mea
 void append_learning_curve(std::string& out, const StudyReport& report, const MeasureInfo& info) {
   int repetitions = 0;
   for (const ReportTrial& t : report.trials) {
-    if (t.phase == "test") repetitions = std::max(repetitions, t.repetition);
+    if (t.phase == report.phase) repetitions = std::max(repetitions, t.repetition);
   }
   if (repetitions == 0) return;
   struct Point {
@@ -378,7 +378,7 @@ std::vector<double> measure_values(const StudyReport& report, ReportMeasure meas
                                    std::optional<int> repetition) {
   std::vector<double> values;
   for (const ReportTrial& trial : report.trials) {
-    if (trial.phase != "test" || trial.condition != condition) continue;
+    if (trial.phase != report.phase || trial.condition != condition) continue;
     if (item && trial.item != *item) continue;
     if (repetition && trial.repetition != *repetition) continue;
     if (const std::optional<double> value = value_of(trial, measure)) values.push_back(*value);
@@ -392,9 +392,9 @@ std::string study_report_html(const StudyReport& report) {
   out += "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" + escape(report.title) +
          "</title>\n" + kStyle + "</head><body>\n<h1>" + escape(report.title) + "</h1>\n";
   std::size_t test_trials = 0;
-  for (const ReportTrial& t : report.trials) test_trials += t.phase == "test" ? 1 : 0;
-  appendf(out, "<p>%zu sessions, %zu trials (%zu test trials).</p>\n<ul class=\"sessions\">\n",
-          report.sessions.size(), report.trials.size(), test_trials);
+  for (const ReportTrial& t : report.trials) test_trials += t.phase == report.phase ? 1 : 0;
+  appendf(out, "<p>%zu sessions, %zu trials (%zu %s trials).</p>\n<ul class=\"sessions\">\n",
+          report.sessions.size(), report.trials.size(), test_trials, escape(report.phase).c_str());
   for (const std::string& s : report.sessions) out += "<li>" + escape(s) + "</li>\n";
   out += "</ul>\n";
   for (const std::string& note : report.notes) out += "<p class=\"note\">" + escape(note) + "</p>\n";

@@ -10,6 +10,17 @@ namespace {
 using nlohmann::json;
 constexpr const char* kFormat = "calligraphy-study-session";
 
+StudyPhase phase_from_text(const std::string& text, const std::string& pointer, const std::string& source) {
+  for (const StudyPhase phase :
+       {StudyPhase::practice, StudyPhase::test, StudyPhase::pre_test, StudyPhase::training,
+        StudyPhase::post_test, StudyPhase::retention, StudyPhase::transfer}) {
+    if (text == to_string(phase)) return phase;
+  }
+  fail(source, pointer,
+       "expected a phase (practice, test, pre-test, training, post-test, retention, transfer), got \"" +
+           text + "\"");
+}
+
 PlannedTrial planned_trial_from(const json& value, const std::string& pointer, const std::string& source,
                                 std::size_t expected_index) {
   ObjectReader reader(value, pointer, source);
@@ -20,9 +31,7 @@ PlannedTrial planned_trial_from(const json& value, const std::string& pointer, c
          "expected " + std::to_string(expected_index + 1) + " (trials in order)");
   }
   const std::string phase = reader.string("phase");
-  if (phase != "practice" && phase != "test")
-    fail(source, reader.pointer("phase"), "expected practice or test");
-  trial.phase = phase == "practice" ? StudyPhase::practice : StudyPhase::test;
+  trial.phase = phase_from_text(phase, reader.pointer("phase"), source);
   trial.block = static_cast<std::size_t>(reader.integer("block", 0, 1000000));
   trial.condition = reader.string("condition");
   try {
@@ -66,22 +75,32 @@ std::string manifest_to_json(const SessionManifest& manifest) {
   json plan = json::array();
   for (const PlannedTrial& trial : manifest.plan) plan.push_back(planned_trial_json(trial));
   const SessionSetup& setup = manifest.setup;
-  const json document = {{"format", kFormat},
-                         {"version", 1},
-                         {"created_utc", manifest.created_utc},
-                         {"subject", {{"id", setup.subject.id}, {"number", setup.subject.number}}},
-                         {"device", setup.device},
-                         {"writer", setup.writer},
-                         {"writer_profile", setup.writer_profile},
-                         {"writer_seed", setup.writer_seed},
-                         {"pacing", setup.pacing},
-                         {"library", library_build_json(manifest.library)},
-                         {"protocol",
-                          {{"name", manifest.protocol.protocol.name},
-                           {"path", manifest.protocol.path.string()},
-                           {"sha256", manifest.protocol.sha256},
-                           {"text", manifest.protocol.text}}},
-                         {"plan", plan}};
+  json document = {{"format", kFormat},
+                   {"version", 1},
+                   {"created_utc", manifest.created_utc},
+                   {"subject", {{"id", setup.subject.id}, {"number", setup.subject.number}}},
+                   {"session_number", setup.session_number},
+                   {"group", manifest.group},
+                   {"device", setup.device},
+                   {"writer", setup.writer},
+                   {"writer_profile", setup.writer_profile},
+                   {"writer_seed", setup.writer_seed},
+                   {"pacing", setup.pacing},
+                   {"library", library_build_json(manifest.library)},
+                   {"protocol",
+                    {{"name", manifest.protocol.protocol.name},
+                     {"path", manifest.protocol.path.string()},
+                     {"sha256", manifest.protocol.sha256},
+                     {"text", manifest.protocol.text}}},
+                   {"plan", plan}};
+  if (manifest.previous) {
+    const PreviousSession& p = *manifest.previous;
+    document["previous_session"] = {{"session_id", p.session_id},
+                                    {"ended_utc", p.ended_utc},
+                                    {"delay_s", p.delay_s},
+                                    {"elapsed_s", p.elapsed_s},
+                                    {"delay", p.delay}};
+  }
   return document.dump(2) + "\n";
 }
 
@@ -101,6 +120,23 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
   manifest.setup.writer_profile = root.string("writer_profile");
   manifest.setup.writer_seed = root.unsigned_or("writer_seed", 0);
   manifest.setup.pacing = root.string("pacing");
+  // Sessions made before protocols had phases are each the first of their series.
+  manifest.setup.session_number = static_cast<int>(root.integer_or("session_number", 1, 1, 20));
+  manifest.group = root.string_or("group", "");
+  if (const json* previous = root.optional("previous_session")) {
+    ObjectReader reader(*previous, "/previous_session", source);
+    PreviousSession p;
+    p.session_id = reader.string("session_id");
+    p.ended_utc = reader.string("ended_utc");
+    p.delay_s = reader.number("delay_s", 0.0, 1e9);
+    p.elapsed_s = reader.number("elapsed_s", -1e9, 1e12);
+    p.delay = reader.string("delay");
+    reader.finish();
+    manifest.previous = std::move(p);
+  }
+  if (manifest.previous.has_value() != (manifest.setup.session_number > 1)) {
+    fail(source, "/previous_session", "expected exactly for a session after the first");
+  }
   ObjectReader library(root.required("library"), "/library", source);
   manifest.library = {library.string("version"), library.string("build_type"), library.string("compiler"),
                       library.string("cxx_standard")};
@@ -146,6 +182,8 @@ std::string session_created_details(const SessionManifest& manifest) {
               {"writer_profile", setup.writer_profile},
               {"protocol", manifest.protocol.protocol.name},
               {"protocol_sha256", manifest.protocol.sha256},
+              {"session_number", setup.session_number},
+              {"group", manifest.group},
               {"trials_planned", manifest.plan.size()}}
       .dump();
 }

@@ -39,6 +39,33 @@ std::string read_small_file(const std::filesystem::path& path, std::uintmax_t ma
   return std::move(*text);
 }
 
+double utc_seconds(std::string_view iso8601) {
+  const std::string text(iso8601);
+  std::tm utc{};
+  int consumed = 0;
+  const int fields = std::sscanf(text.c_str(), "%4d-%2d-%2dT%2d:%2d:%2d%n", &utc.tm_year, &utc.tm_mon,
+                                 &utc.tm_mday, &utc.tm_hour, &utc.tm_min, &utc.tm_sec, &consumed);
+  std::string_view rest = iso8601.substr(static_cast<std::size_t>(fields == 6 ? consumed : 0));
+  double fraction = 0.0;
+  if (fields == 6 && rest.size() > 1 && rest.front() == '.') {
+    std::size_t digits = 1;
+    double scale = 0.1;
+    while (digits < rest.size() && rest[digits] >= '0' && rest[digits] <= '9') {
+      fraction += scale * (rest[digits] - '0');
+      scale /= 10.0;
+      ++digits;
+    }
+    rest.remove_prefix(digits);
+  }
+  if (fields != 6 || rest != "Z" || utc.tm_mon < 1 || utc.tm_mon > 12 || utc.tm_mday < 1 ||
+      utc.tm_mday > 31) {
+    throw InvalidArgument("'" + text + "' is not a UTC time like 2024-05-01T12:34:56.789Z");
+  }
+  utc.tm_year -= 1900;
+  utc.tm_mon -= 1;
+  return static_cast<double>(timegm(&utc)) + fraction;
+}
+
 std::string utc_now_iso8601() {
   const auto now = std::chrono::system_clock::now();
   const std::time_t seconds = std::chrono::system_clock::to_time_t(now);

@@ -18,6 +18,10 @@ std::string read_small_file(const std::filesystem::path& path, std::uintmax_t ma
 /// The current time in UTC, ISO 8601 with milliseconds: "2024-05-01T12:34:56.789Z".
 std::string utc_now_iso8601();
 
+/// Seconds since 1970-01-01T00:00:00Z of a time `utc_now_iso8601` wrote ("2024-05-01T12:34:56.789Z"; the
+/// fraction optional). Throws InvalidArgument quoting the text when it is not such a time.
+double utc_seconds(std::string_view iso8601);
+
 /// 64-bit FNV-1a of `text` (Fowler, Noll & Vo; IETF draft-eastlake-fnv): a stable seed from a name.
 std::uint64_t fnv1a_64(std::string_view text);
 /// SplitMix64's finaliser (Steele, Lea & Flood 2014, "Fast splittable pseudorandom number generators",

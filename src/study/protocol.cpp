@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -12,33 +13,12 @@
 #include "core/unicode.hpp"
 #include "study/json_reader.hpp"
 #include "study/names.hpp"
+#include "study/protocol_reading.hpp"
 
 namespace calligraphy {
-namespace {
+namespace study_detail {
 
 using nlohmann::json;
-using study_detail::as_string;
-using study_detail::child_pointer;
-using study_detail::fail;
-using study_detail::ObjectReader;
-
-constexpr const char* kFormat = "calligraphy-study-protocol";
-constexpr std::size_t kMaxItems = 1000;
-constexpr std::size_t kMaxCharactersPerItem = 16;
-constexpr std::int64_t kMaxRepetitions = 1000;
-
-template <typename Enum, std::size_t N>
-Enum choice(ObjectReader& reader, const std::string& key, const std::array<Enum, N>& values, Enum fallback) {
-  const json* value = reader.optional(key);
-  if (!value) return fallback;
-  const std::string text = as_string(*value, reader.pointer(key), reader.source());
-  std::string names;
-  for (const Enum candidate : values) {
-    if (text == to_string(candidate)) return candidate;
-    names += (names.empty() ? "" : ", ") + std::string(to_string(candidate));
-  }
-  fail(reader.source(), reader.pointer(key), "expected one of " + names + "; got \"" + text + "\"");
-}
 
 std::vector<std::u32string> read_items(const json& value, const std::string& pointer,
                                        const std::string& source) {
@@ -68,6 +48,46 @@ std::vector<std::u32string> read_items(const json& value, const std::string& poi
     items.push_back(characters);
   }
   return items;
+}
+
+// The name of a condition the protocol defines, or an error naming `pointer`.
+std::string condition_name(const json& value, const std::string& pointer, const std::string& source,
+                           const std::vector<StudyCondition>& conditions) {
+  const std::string name = as_string(value, pointer, source);
+  std::string names;
+  for (const StudyCondition& c : conditions) {
+    if (c.name == name) return name;
+    names += (names.empty() ? "" : ", ") + c.name;
+  }
+  fail(source, pointer, "no condition is called \"" + name + "\" (defined: " + names + ")");
+}
+
+}  // namespace study_detail
+
+namespace {
+
+using nlohmann::json;
+using study_detail::as_string;
+using study_detail::child_pointer;
+using study_detail::condition_name;
+using study_detail::fail;
+using study_detail::kMaxRepetitions;
+using study_detail::ObjectReader;
+using study_detail::read_items;
+
+constexpr const char* kFormat = "calligraphy-study-protocol";
+
+template <typename Enum, std::size_t N>
+Enum choice(ObjectReader& reader, const std::string& key, const std::array<Enum, N>& values, Enum fallback) {
+  const json* value = reader.optional(key);
+  if (!value) return fallback;
+  const std::string text = as_string(*value, reader.pointer(key), reader.source());
+  std::string names;
+  for (const Enum candidate : values) {
+    if (text == to_string(candidate)) return candidate;
+    names += (names.empty() ? "" : ", ") + std::string(to_string(candidate));
+  }
+  fail(reader.source(), reader.pointer(key), "expected one of " + names + "; got \"" + text + "\"");
 }
 
 // Largest length tolerance a protocol may give [m]: beyond the 60 mm character box it means nothing.
@@ -165,14 +185,14 @@ std::map<std::u32string, std::string> read_teachers(const json& value, const std
 void check_teacher_items(const StudyProtocol& protocol, const std::string& source) {
   for (std::size_t i = 0; i < protocol.conditions.size(); ++i) {
     for (const auto& [item, path] : protocol.conditions[i].teachers) {
-      const auto written = [&](const std::vector<std::u32string>& items) {
-        return std::find(items.begin(), items.end(), item) != items.end();
-      };
-      if (written(protocol.test_items) || (protocol.practice && written(protocol.practice->items))) continue;
-      std::string utf8;
-      for (const char32_t c : item) utf8 += encode_utf8(c);
-      fail(source, child_pointer(child_pointer(child_pointer("/conditions", i), "teachers"), utf8),
-           "\"" + utf8 + "\" is not an item of the protocol (test or practice characters)");
+      const bool written =
+          std::any_of(protocol.phases.begin(), protocol.phases.end(), [&](const ProtocolPhase& p) {
+            return std::find(p.items.begin(), p.items.end(), item) != p.items.end();
+          });
+      if (written) continue;
+      const std::string text = study_detail::utf8_of(item);
+      fail(source, child_pointer(child_pointer(child_pointer("/conditions", i), "teachers"), text),
+           "\"" + text + "\" is not an item of the protocol (the characters of its phases)");
     }
   }
 }
@@ -223,18 +243,6 @@ StudyCondition read_condition(const json& value, const std::string& pointer, con
   return condition;
 }
 
-// The name of a condition the protocol defines, or an error naming `pointer`.
-std::string condition_name(const json& value, const std::string& pointer, const std::string& source,
-                           const std::vector<StudyCondition>& conditions) {
-  const std::string name = as_string(value, pointer, source);
-  std::string names;
-  for (const StudyCondition& c : conditions) {
-    if (c.name == name) return name;
-    names += (names.empty() ? "" : ", ") + c.name;
-  }
-  fail(source, pointer, "no condition is called \"" + name + "\" (defined: " + names + ")");
-}
-
 void read_order(ObjectReader& reader, StudyProtocol& protocol) {
   const json* value = reader.optional("order");
   if (!value) return;
@@ -271,7 +279,82 @@ void read_trial_settings(ObjectReader& reader, StudyProtocol& protocol) {
   trial.finish();
 }
 
+// The paper's format: an optional "practice" block, then "test" blocks of every condition (section 7.1).
+void read_paper_phases(ObjectReader& root, StudyProtocol& protocol) {
+  const std::string& source = root.source();
+  if (const json* practice = root.optional("practice")) {
+    ObjectReader reader(*practice, "/practice", source);
+    ProtocolPhase phase;
+    phase.pointer = "/practice";
+    phase.kind = StudyPhase::practice;
+    phase.items = read_items(reader.required("characters"), reader.pointer("characters"), source);
+    phase.conditions = {condition_name(reader.required("condition"), reader.pointer("condition"), source,
+                                       protocol.conditions)};
+    phase.repetitions = static_cast<int>(reader.integer_or("repetitions", 1, 1, kMaxRepetitions));
+    reader.finish();
+    protocol.phases.push_back(std::move(phase));
+  }
+  ObjectReader test(root.required("test"), "/test", source);
+  ProtocolPhase phase;
+  phase.pointer = "/test";
+  phase.kind = StudyPhase::test;
+  phase.items = read_items(test.required("characters"), test.pointer("characters"), source);
+  const json& tested = test.required("conditions");
+  if (!tested.is_array() || tested.empty()) {
+    fail(source, "/test/conditions",
+         "expected a list of condition names, got " + study_detail::describe(tested));
+  }
+  for (std::size_t i = 0; i < tested.size(); ++i) {
+    const std::string at = child_pointer("/test/conditions", i);
+    std::string name = condition_name(tested[i], at, source, protocol.conditions);
+    if (std::find(phase.conditions.begin(), phase.conditions.end(), name) != phase.conditions.end()) {
+      fail(source, at, "the condition \"" + name + "\" is listed twice");
+    }
+    phase.conditions.push_back(std::move(name));
+  }
+  phase.repetitions = static_cast<int>(test.integer("repetitions", 1, kMaxRepetitions));
+  test.finish();
+  if (protocol.condition_order == ConditionOrder::abba && phase.repetitions % 2 != 0) {
+    fail(source, "/test/repetitions",
+         "order \"abba\" splits each condition's repetitions over two blocks: expected an even number, got " +
+             std::to_string(phase.repetitions));
+  }
+  protocol.phases.push_back(std::move(phase));
+}
+
 }  // namespace
+
+const char* to_string(StudyPhase phase) noexcept {
+  switch (phase) {
+    case StudyPhase::practice:
+      return "practice";
+    case StudyPhase::test:
+      return "test";
+    case StudyPhase::pre_test:
+      return "pre-test";
+    case StudyPhase::training:
+      return "training";
+    case StudyPhase::post_test:
+      return "post-test";
+    case StudyPhase::retention:
+      return "retention";
+    case StudyPhase::transfer:
+      return "transfer";
+  }
+  return "unknown";
+}
+
+const char* to_string(ConditionAssignment assignment) noexcept {
+  return assignment == ConditionAssignment::between_subjects ? "between-subjects" : "within-subjects";
+}
+
+namespace study_detail {
+std::string utf8_of(const std::u32string& text) {
+  std::string out;
+  for (const char32_t c : text) out += encode_utf8(c);
+  return out;
+}
+}  // namespace study_detail
 
 const char* to_string(ConditionMode mode) noexcept {
   switch (mode) {
@@ -356,69 +439,65 @@ StudyProtocol parse_study_protocol(std::string_view json_text, const std::string
     protocol.conditions.push_back(std::move(condition));
   }
 
-  if (const json* practice = root.optional("practice")) {
-    ObjectReader reader(*practice, "/practice", source);
-    PracticePhase phase;
-    phase.items = read_items(reader.required("characters"), reader.pointer("characters"), source);
-    phase.condition = condition_name(reader.required("condition"), reader.pointer("condition"), source,
-                                     protocol.conditions);
-    phase.repetitions = static_cast<int>(reader.integer_or("repetitions", 1, 1, kMaxRepetitions));
-    reader.finish();
-    protocol.practice = std::move(phase);
-  }
-
-  ObjectReader test(root.required("test"), "/test", source);
-  protocol.test_items = read_items(test.required("characters"), test.pointer("characters"), source);
-  const json& tested = test.required("conditions");
-  if (!tested.is_array() || tested.empty()) {
-    fail(source, "/test/conditions",
-         "expected a list of condition names, got " + study_detail::describe(tested));
-  }
-  for (std::size_t i = 0; i < tested.size(); ++i) {
-    const std::string at = child_pointer("/test/conditions", i);
-    std::string name = condition_name(tested[i], at, source, protocol.conditions);
-    if (std::find(protocol.test_conditions.begin(), protocol.test_conditions.end(), name) !=
-        protocol.test_conditions.end()) {
-      fail(source, at, "the condition \"" + name + "\" is listed twice");
-    }
-    protocol.test_conditions.push_back(std::move(name));
-  }
-  protocol.repetitions = static_cast<int>(test.integer("repetitions", 1, kMaxRepetitions));
-  test.finish();
-
-  check_teacher_items(protocol, source);
   read_order(root, protocol);
+  const bool paper_format = root.has("test") || root.has("practice");
+  if (paper_format && root.has("phases")) {
+    fail(source, "/phases",
+         "a protocol gives either \"phases\" or the paper's \"practice\" and \"test\", not both");
+  }
+  if (paper_format) {
+    read_paper_phases(root, protocol);
+  } else {
+    study_detail::read_phases(root.required("phases"), "/phases", source, protocol);
+  }
+  check_teacher_items(protocol, source);
   read_breaks(root, protocol);
   read_trial_settings(root, protocol);
   root.finish();
 
-  if (protocol.condition_order == ConditionOrder::abba && protocol.repetitions % 2 != 0) {
-    fail(source, "/test/repetitions",
-         "order \"abba\" splits each condition's repetitions over two blocks: expected an even number, got " +
-             std::to_string(protocol.repetitions));
-  }
   const std::uint64_t planned = planned_trial_count(protocol);
   if (planned > kMaxPlannedTrials) {
-    fail(source, "/test",
-         thousands(planned) + " trials planned (" + std::to_string(protocol.test_items.size()) +
-             " strings x " + std::to_string(protocol.test_conditions.size()) + " conditions x " +
-             std::to_string(protocol.repetitions) + " repetitions" +
-             (protocol.practice ? " + practice" : "") + "), more than the limit of " +
+    fail(source, paper_format ? "/test" : "/phases",
+         thousands(planned) + " trials planned in one session, more than the limit of " +
              thousands(kMaxPlannedTrials) + " trials per session");
   }
   return protocol;
 }
 
 std::uint64_t planned_trial_count(const StudyProtocol& protocol) noexcept {
-  // Each factor is at most 1,000 (strings, repetitions) or 26 (conditions): no overflow.
-  std::uint64_t count = static_cast<std::uint64_t>(protocol.test_items.size()) *
-                        static_cast<std::uint64_t>(protocol.test_conditions.size()) *
-                        static_cast<std::uint64_t>(std::max(protocol.repetitions, 0));
-  if (protocol.practice) {
-    count += static_cast<std::uint64_t>(protocol.practice->items.size()) *
-             static_cast<std::uint64_t>(std::max(protocol.practice->repetitions, 0));
+  // Each factor is at most 1,000 (strings, repetitions) or 26 (conditions), and phases at most 20: no
+  // overflow.
+  std::map<int, std::uint64_t> per_session;
+  for (const ProtocolPhase& phase : protocol.phases) {
+    const std::uint64_t conditions =
+        phase.assignment == ConditionAssignment::between_subjects ? 1 : phase.conditions.size();
+    per_session[phase.session] += static_cast<std::uint64_t>(phase.item_count()) * conditions *
+                                  static_cast<std::uint64_t>(std::max(phase.repetitions, 0));
   }
-  return count;
+  std::uint64_t largest = 0;
+  for (const auto& [session, count] : per_session) largest = std::max(largest, count);
+  return largest;
+}
+
+int StudyProtocol::session_count() const noexcept {
+  int sessions = 1;
+  for (const ProtocolPhase& phase : phases) sessions = std::max(sessions, phase.session);
+  return sessions;
+}
+
+std::u32string StudyProtocol::trained_characters() const {
+  const bool any_training = std::any_of(
+      phases.begin(), phases.end(), [](const ProtocolPhase& p) { return p.kind == StudyPhase::training; });
+  std::u32string trained;
+  for (const ProtocolPhase& phase : phases) {
+    if (any_training && phase.kind != StudyPhase::training) continue;
+    for (const std::u32string& item : phase.items) {
+      for (const char32_t c : item) {
+        if (trained.find(c) == std::u32string::npos) trained.push_back(c);
+      }
+    }
+  }
+  return trained;
 }
 
 std::string thousands(std::uint64_t count) {

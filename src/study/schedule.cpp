@@ -57,10 +57,6 @@ void check_subject(const SubjectAssignment& subject) {
 
 }  // namespace
 
-const char* to_string(StudyPhase phase) noexcept {
-  return phase == StudyPhase::practice ? "practice" : "test";
-}
-
 std::size_t trailing_number(std::string_view subject_id) noexcept {
   std::size_t begin = subject_id.size();
   while (begin > 0 && subject_id[begin - 1] >= '0' && subject_id[begin - 1] <= '9') --begin;
@@ -72,16 +68,32 @@ std::size_t trailing_number(std::string_view subject_id) noexcept {
   return number;
 }
 
-std::vector<std::string> test_block_conditions(const StudyProtocol& protocol,
-                                               const SubjectAssignment& subject) {
+std::vector<std::string> block_conditions(const StudyProtocol& protocol, const ProtocolPhase& phase,
+                                          const SubjectAssignment& subject) {
   check_subject(subject);
-  const std::vector<std::string>& listed = protocol.test_conditions;
+  const std::vector<std::string>& listed = phase.conditions;
+  // Familiarisation is written as listed: the order counterbalances what is compared.
+  if (phase.kind == StudyPhase::practice) return listed;
   const std::size_t n = listed.size();
+  const bool between = phase.assignment == ConditionAssignment::between_subjects;
   const bool needs_number = protocol.condition_order == ConditionOrder::latin_square ||
-                            protocol.condition_order == ConditionOrder::abba;
+                            protocol.condition_order == ConditionOrder::abba ||
+                            (between && protocol.condition_order == ConditionOrder::fixed);
   if (needs_number && subject.number == 0) {
-    throw InvalidArgument("subject '" + subject.id + "': the order '" + to_string(protocol.condition_order) +
-                          "' needs the subject's number (1, 2, ...) to counterbalance");
+    throw InvalidArgument("subject '" + subject.id + "': " +
+                          (between ? std::string("the between-subjects ") + to_string(phase.kind) +
+                                         " phase assigns groups by the subject's number (1, 2, ...)"
+                                   : "the order '" + std::string(to_string(protocol.condition_order)) +
+                                         "' needs the subject's number (1, 2, ...) to counterbalance"));
+  }
+  if (between) {
+    // Groups in turn by number (balanced), or drawn per subject from the seed under a random order.
+    if (protocol.condition_order == ConditionOrder::random) {
+      std::vector<std::string> drawn = listed;
+      shuffle(drawn, subject_seed(protocol, subject));
+      return {drawn.front()};
+    }
+    return {listed[(subject.number - 1) % n]};
   }
   std::vector<std::string> blocks;
   switch (protocol.condition_order) {
@@ -108,22 +120,37 @@ std::vector<std::string> test_block_conditions(const StudyProtocol& protocol,
   return blocks;
 }
 
-std::vector<PlannedTrial> plan_session(const StudyProtocol& protocol, const SubjectAssignment& subject) {
+std::string subject_group(const StudyProtocol& protocol, const SubjectAssignment& subject) {
+  std::string group;
+  for (const ProtocolPhase& phase : protocol.phases) {
+    if (phase.assignment != ConditionAssignment::between_subjects) continue;
+    group += (group.empty() ? "" : "/") + block_conditions(protocol, phase, subject).front();
+  }
+  return group;
+}
+
+std::vector<PlannedTrial> plan_session(const StudyProtocol& protocol, const SubjectAssignment& subject,
+                                       int session) {
   const std::uint64_t planned = planned_trial_count(protocol);  // before anything per trial is allocated
   if (planned > kMaxPlannedTrials) {
     throw InvalidArgument("protocol '" + protocol.name + "': " + thousands(planned) +
                           " trials planned, more than the limit of " + thousands(kMaxPlannedTrials) +
                           " trials per session");
   }
-  const std::vector<std::string> blocks = test_block_conditions(protocol, subject);
+  if (session < 1 || session > protocol.session_count()) {
+    throw InvalidArgument("protocol '" + protocol.name + "' has sessions 1 to " +
+                          std::to_string(protocol.session_count()) + ", not " + std::to_string(session));
+  }
+  check_subject(subject);
   std::vector<PlannedTrial> trials;
-  std::map<std::pair<std::string, std::size_t>, int> written;  // (condition, item) -> times planned so far
+  std::map<std::string, int> written;  // phase/condition/item -> times planned so far
   std::size_t block = 0;
-  const auto add_block = [&](StudyPhase phase, const std::string& condition,
-                             const std::vector<std::u32string>& items, int rounds, bool shuffled) {
+  const auto add_block = [&](const ProtocolPhase& phase, const std::string& condition, int rounds,
+                             double rest_before_s) {
     const std::size_t first = trials.size();
+    const bool shuffled = phase.kind != StudyPhase::practice && protocol.item_order == ItemOrder::random;
     for (int round = 0; round < rounds; ++round) {
-      std::vector<std::size_t> order(items.size());
+      std::vector<std::size_t> order(phase.items.size());
       for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
       if (shuffled) {
         shuffle(order, study_detail::mix64(
@@ -133,27 +160,41 @@ std::vector<PlannedTrial> plan_session(const StudyProtocol& protocol, const Subj
       for (const std::size_t item : order) {
         PlannedTrial trial;
         trial.index = trials.size();
-        trial.phase = phase;
+        trial.phase = phase.kind;
         trial.block = block;
         trial.condition = condition;
-        trial.characters = items[item];
+        trial.characters = phase.items[item];
         trial.item = item;
-        trial.repetition = ++written[{std::string(to_string(phase)) + "/" + condition, item}];
+        trial.repetition =
+            ++written[std::string(to_string(phase.kind)) + "/" + condition + "/" + std::to_string(item)];
         trials.push_back(std::move(trial));
       }
     }
-    if (block > 0 && first < trials.size()) trials[first].break_before_s = protocol.breaks.between_blocks_s;
+    if (first < trials.size()) {
+      const double between = block > 0 ? protocol.breaks.between_blocks_s : 0.0;
+      trials[first].break_before_s = std::max(between, rest_before_s);
+    }
     ++block;
   };
-  if (protocol.practice) {
-    add_block(StudyPhase::practice, protocol.practice->condition, protocol.practice->items,
-              protocol.practice->repetitions, false);
-  }
-  const int rounds =
-      protocol.condition_order == ConditionOrder::abba ? protocol.repetitions / 2 : protocol.repetitions;
-  for (const std::string& condition : blocks) {
-    add_block(StudyPhase::test, condition, protocol.test_items, rounds,
-              protocol.item_order == ItemOrder::random);
+  bool first_phase = true;
+  for (const ProtocolPhase& phase : protocol.phases) {
+    if (phase.session != session) continue;
+    if (phase.choice && phase.items.empty()) {
+      throw InvalidArgument(
+          "protocol '" + protocol.name + "': the " + to_string(phase.kind) +
+          " phase's characters are to be chosen (resolve_transfer_choices) before a session "
+          "is planned");
+    }
+    // The first phase of a later session waits in the session's link (session_series.hpp), not as a rest.
+    double rest_before_s = first_phase ? 0.0 : phase.delay_s;
+    const std::vector<std::string> blocks = block_conditions(protocol, phase, subject);
+    const bool split = phase.assignment == ConditionAssignment::within_subjects &&
+                       protocol.condition_order == ConditionOrder::abba && phase.kind != StudyPhase::practice;
+    for (const std::string& condition : blocks) {
+      add_block(phase, condition, split ? phase.repetitions / 2 : phase.repetitions, rest_before_s);
+      rest_before_s = 0.0;
+    }
+    first_phase = false;
   }
   const auto every = static_cast<std::size_t>(protocol.breaks.every_trials);
   if (every > 0) {

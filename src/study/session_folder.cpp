@@ -138,14 +138,23 @@ SessionFolder::~SessionFolder() {
 }
 
 SessionFolder SessionFolder::create(const fs::path& root, const SessionSetup& setup,
-                                    const LoadedProtocol& protocol) {
+                                    const LoadedProtocol& protocol,
+                                    const std::optional<PreviousSession>& previous) {
   check_setup(setup);
+  if (previous.has_value() != (setup.session_number > 1)) {
+    throw InvalidArgument(
+        "session " + std::to_string(setup.session_number) + " of protocol '" + protocol.protocol.name +
+        "': " +
+        (previous ? "the first session has no previous one" : "a later session needs the previous one"));
+  }
   SessionManifest manifest;
   manifest.setup = setup;
   manifest.protocol = protocol;
   manifest.library = library_build();
   manifest.created_utc = study_detail::utc_now_iso8601();
-  manifest.plan = plan_session(protocol.protocol, setup.subject);
+  manifest.plan = plan_session(protocol.protocol, setup.subject, setup.session_number);
+  manifest.previous = previous;
+  manifest.group = subject_group(protocol.protocol, setup.subject);
 
   const fs::path subject_folder = root / setup.subject.id;
   make_folder(subject_folder);

@@ -1,5 +1,6 @@
 #include "calligraphy/study/session_reader.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <set>
@@ -9,8 +10,8 @@
 #include "calligraphy/report/pen_trace_csv.hpp"
 #include "core/unicode.hpp"
 #include "study/json_reader.hpp"
-#include "study/saved_sessions.hpp"
 #include "study/names.hpp"
+#include "study/saved_sessions.hpp"
 
 namespace calligraphy {
 namespace fs = std::filesystem;
@@ -176,8 +177,21 @@ StudyReport read_study_report(const std::vector<fs::path>& roots) {
     if (report.title.empty()) {
       const StudyProtocol& p = manifest.protocol.protocol;
       report.title = "Study report: " + p.name;
-      report.conditions = p.test_conditions;
-      for (const std::u32string& item : p.test_items) {
+      // The paper's test phase, else the training: the phase whose conditions the tables compare.
+      const ProtocolPhase* shown = nullptr;
+      for (const StudyPhase kind : {StudyPhase::training, StudyPhase::test}) {
+        for (const ProtocolPhase& phase : p.phases) shown = phase.kind == kind ? &phase : shown;
+      }
+      if (shown == nullptr) shown = &p.phases.front();
+      report.phase = to_string(shown->kind);
+      for (const ProtocolPhase& phase : p.phases) {
+        if (phase.kind != shown->kind) continue;
+        for (const std::string& c : phase.conditions) {
+          if (std::find(report.conditions.begin(), report.conditions.end(), c) == report.conditions.end())
+            report.conditions.push_back(c);
+        }
+      }
+      for (const std::u32string& item : shown->items) {
         std::string text;
         for (const char32_t c : item) text += encode_utf8(c);
         report.items.push_back(text);

@@ -12,8 +12,8 @@
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/report/trial_report.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
-#include "calligraphy/study/trial_spec_runner.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/study/trial_spec_runner.hpp"
 #include "core/unicode.hpp"
 #include "study/names.hpp"
 #include "study/trial_guidance.hpp"
@@ -112,8 +112,8 @@ TrialSpec study_trial_spec(const SessionManifest& session, const StudyCondition&
   if (condition.mode == ConditionMode::fading) {
     spec.guidance_mode = GuidanceMode::fading;
     if (!(guidance.gain >= 0.0 && guidance.gain <= 1.0)) {
-      throw InvalidArgument("condition '" + condition.name + "': guidance gain " + std::to_string(guidance.gain) +
-                            " outside [0, 1]");
+      throw InvalidArgument("condition '" + condition.name + "': guidance gain " +
+                            std::to_string(guidance.gain) + " outside [0, 1]");
     }
     spec.guidance_gain = guidance.gain;
   }
@@ -128,8 +128,12 @@ TrialSpec study_trial_spec(const SessionManifest& session, const StudyCondition&
   const bool simulated = session.setup.writer == "simulated";
   spec.writer = simulated ? TrialWriter::simulated : TrialWriter::person;
   if (simulated) spec.writer_profile = session.setup.writer_profile;
-  // A seed of the simulated subject's own per trial.
-  spec.seed = study_detail::mix64(session.setup.writer_seed ^ study_detail::mix64(trial.index + 1));
+  // A seed of the simulated subject's own per trial, and per session of a series: a retention test on the
+  // second day does not repeat the first day's trials stroke for stroke. The first session's seeds are
+  // those of sessions made before protocols had several (plans hold at most kMaxPlannedTrials trials).
+  const std::uint64_t position =
+      trial.index + 1 + kMaxPlannedTrials * static_cast<std::uint64_t>(session.setup.session_number - 1);
+  spec.seed = study_detail::mix64(session.setup.writer_seed ^ study_detail::mix64(position));
   const StudyProtocol& protocol = session.protocol.protocol;
   spec.rate_hz = protocol.trial.rate_hz;
   spec.max_duration_s = protocol.trial.max_duration_s;

@@ -7,8 +7,8 @@
 #include "calligraphy/study/session_folder.hpp"
 #include "core/unicode.hpp"
 #include "study/json_reader.hpp"
-#include "study/saved_sessions.hpp"
 #include "study/names.hpp"
+#include "study/saved_sessions.hpp"
 
 namespace calligraphy {
 namespace fs = std::filesystem;
@@ -38,10 +38,12 @@ double number(const json& object, const char* key, const std::string& source, co
   return study_detail::as_number(*found, pointer + "/" + key, source, -1e12, 1e12);
 }
 
-std::size_t count(const json& object, const char* key, const std::string& source, const std::string& pointer) {
+std::size_t count(const json& object, const char* key, const std::string& source,
+                  const std::string& pointer) {
   const auto found = object.find(key);
   if (found == object.end()) fail(source, pointer + "/" + key, "missing (required)");
-  return static_cast<std::size_t>(study_detail::as_integer(*found, pointer + "/" + key, source, 0, 1LL << 40));
+  return static_cast<std::size_t>(
+      study_detail::as_integer(*found, pointer + "/" + key, source, 0, 1LL << 40));
 }
 
 // The strokes of one character of a record: its per-stroke metrics and the verdicts of the segments the
@@ -81,8 +83,9 @@ void add_strokes(const json& character, std::size_t index, const std::string& so
     const json& verdict = segment.value("verdict", json());
     if (!verdict.is_object()) continue;  // an ignored segment (a dot, a touch) has no verdict
     // The stroke the segment was written for: the one it matched, else the one expected then.
-    const json& stroke = verdict.value("matched_stroke", json()).is_number() ? verdict["matched_stroke"]
-                                                                              : verdict.value("expected_stroke", json());
+    const json& stroke = verdict.value("matched_stroke", json()).is_number()
+                             ? verdict["matched_stroke"]
+                             : verdict.value("expected_stroke", json());
     if (!stroke.is_number_unsigned() || stroke.get<std::size_t>() >= per_stroke.size()) continue;
     StrokeRow& row = strokes[first + stroke.get<std::size_t>()];
     ++row.segments;
@@ -101,6 +104,8 @@ TrialRow read_trial_row(const fs::path& json_file, const SessionManifest& manife
   row.subject = manifest.setup.subject.id;
   row.session = manifest.session_id;
   row.protocol = manifest.protocol.protocol.name;
+  row.session_number = manifest.setup.session_number;
+  row.group = manifest.group;
   row.phase = to_string(plan.phase);
   row.block = plan.block;
   row.condition = plan.condition;
@@ -184,16 +189,18 @@ StudyTables read_study_tables(const std::vector<fs::path>& roots) {
 
 std::string trials_csv(const StudyTables& tables) {
   std::string out =
-      "subject,session,protocol,phase,block,condition,mode,characters,trial,item,repetition,writer,end_reason,"
+      "subject,session,protocol,session_number,group,phase,block,condition,mode,characters,trial,item,"
+      "repetition,writer,end_reason,"
       "start_utc,completed_in_order,strokes_total,strokes_written,strokes_accepted,order_errors,"
       "backwards_strokes,unmatched_segments,mean_deviation_m,max_deviation_m,rms_deviation_m,frechet_m,dtw_m,"
       "total_time_s,pen_down_time_s,velocity_peaks,normalised_jerk,trace_file\n";
   for (const TrialRow& r : tables.trials) {
-    line(out, r.subject, r.session, r.protocol, r.phase, r.block, r.condition, r.mode, r.characters, r.trial,
-         r.item, r.repetition, r.writer, r.end_reason, r.start_utc, r.completed_in_order, r.strokes_total,
-         r.strokes_written, r.strokes_accepted, r.order_errors, r.backwards_strokes, r.unmatched_segments,
-         r.mean_deviation_m, r.max_deviation_m, r.rms_deviation_m, r.frechet_m, r.dtw_m, r.total_time_s,
-         r.pen_down_time_s, r.velocity_peaks, r.normalised_jerk, r.trace_file.string());
+    line(out, r.subject, r.session, r.protocol, r.session_number, r.group, r.phase, r.block, r.condition,
+         r.mode, r.characters, r.trial, r.item, r.repetition, r.writer, r.end_reason, r.start_utc,
+         r.completed_in_order, r.strokes_total, r.strokes_written, r.strokes_accepted, r.order_errors,
+         r.backwards_strokes, r.unmatched_segments, r.mean_deviation_m, r.max_deviation_m, r.rms_deviation_m,
+         r.frechet_m, r.dtw_m, r.total_time_s, r.pen_down_time_s, r.velocity_peaks, r.normalised_jerk,
+         r.trace_file.string());
   }
   return out;
 }

@@ -322,3 +322,43 @@ def test_categorical_columns_give_the_same_results_as_strings():
     learned = statistics.learning(categorical, VALUE, pre="practice", post="test")
     pandas.testing.assert_frame_equal(statistics.learning(trials, VALUE, pre="practice", post="test"),
                                       learned.astype({"subject": str}))
+
+
+def test_group_comparison_agrees_with_scipy_and_finds_a_planted_group_effect():
+    rng = np.random.default_rng(11)
+    n = 12
+    table = pandas.DataFrame({
+        "subject": [f"S{k:02d}" for k in range(2 * n)],
+        "group": ["fixture"] * n + ["fading"] * n,
+        # retention error [m]: the fading group keeps 1 mm less error, sd 0.5 mm.
+        "retention": np.concatenate([rng.normal(3e-3, 5e-4, n), rng.normal(2e-3, 7e-4, n)]),
+    })
+    result = statistics.group_comparison(table, "retention", "fixture", "fading")
+    x = table.retention[:n].to_numpy()
+    y = table.retention[n:].to_numpy()
+    welch = stats.ttest_ind(x, y, equal_var=False)
+    assert result.t == pytest.approx(welch.statistic) and result.p == pytest.approx(welch.pvalue)
+    assert result.p < 0.01 and result.mean_difference == pytest.approx(x.mean() - y.mean())
+    assert result.ci95_low < result.mean_difference < result.ci95_high
+    assert result.ci95_low > 0  # the planted 1 mm lies in a clearly positive interval
+    assert min(n, n) - 1 <= result.df <= 2 * n - 2  # Welch-Satterthwaite bounds
+    assert result.g > 1.0 and result.power > 0.9
+    # The n per group for 80 % power reaches it, and one fewer does not.
+    from statsmodels.stats.power import TTestIndPower
+    needed = int(result.n_per_group_for_80_percent_power)
+    assert TTestIndPower().power(abs(result.g), needed, 0.05) >= 0.8
+    assert needed == 2 or TTestIndPower().power(abs(result.g), needed - 1, 0.05) < 0.8
+    assert "Welch" in result.test and len(result.to_frame()) == 1
+    with pytest.raises(ValueError, match="'none' is not in the 'group' column"):
+        statistics.group_comparison(table, "retention", "fixture", "none")
+    with pytest.raises(ValueError, match="one row per subject"):
+        statistics.group_comparison(pandas.concat([table, table]), "retention", "fixture", "fading")
+
+
+def test_learning_keeps_each_subjects_group():
+    trials = pandas.DataFrame({
+        "subject": ["A", "A", "B", "B"], "group": ["fixture", "fixture", "fading", "fading"],
+        "phase": ["pre-test", "post-test"] * 2, VALUE: [3e-3, 2e-3, 3e-3, 1e-3]})
+    table = statistics.learning(trials, VALUE, "pre-test", "post-test")
+    assert list(table.group) == ["fixture", "fading"]
+    assert list(table.gain) == pytest.approx([1e-3, 2e-3])

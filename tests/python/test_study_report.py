@@ -360,3 +360,43 @@ def test_a_real_study_from_session_run(small_study, tmp_path):
     assert len(page.details) == 3
     for stem in ("learning_total_time_s", "learning_mean_deviation_m"):
         assert matplotlib.image.imread(tmp_path / "report" / "figures" / f"{stem}.png").size > 0
+
+
+def test_a_study_of_phases_gets_learning_retention_and_transfer_by_group(tmp_path):
+    """Between-subjects groups through pre-test, training, post-test, retention and transfer, with a planted
+    retention advantage of the 'fading' group: the section, its CSV tables and the group comparison."""
+    rng = np.random.default_rng(24)
+    rows = []
+    for s in range(8):
+        group = ("fixture", "fading")[s % 2]
+        kept_m = 0.2e-3 if group == "fading" else 0.8e-3  # error regained by retention
+        means = {"pre-test": 2.0e-3, "training": 1.2e-3, "post-test": 1.0e-3, "retention": 1.0e-3 + kept_m,
+                 "transfer": 1.6e-3}
+        trial = 0
+        for phase, mean in means.items():
+            for repetition in range(2):
+                rows.append({"subject": f"S{s + 1:02d}", "group": group, "phase": phase,
+                             "condition": group if phase == "training" else "free", "characters": "十",
+                             "repetition": repetition, "trial": trial,
+                             "mean_deviation_m": mean + rng.normal(0.0, 0.05e-3),
+                             "total_time_s": 10.0 + rng.normal(0.0, 0.5)})
+                trial += 1
+    trials = pandas.DataFrame(rows)
+    for column in ("subject", "group", "phase", "condition"):
+        trials[column] = trials[column].astype("category")
+    index = study_report.write_report(calligraphy.study.Study(trials=trials, strokes=pandas.DataFrame()),
+                                      tmp_path / "report")
+    page = index.read_text(encoding="utf-8")
+    assert "Learning, retention and transfer" in page
+    assert "training trials" in page  # 'auto' chose the training phase for Table 5 and the curves
+    learning = pandas.read_csv(tmp_path / "report" / "tables" / "learning.csv")
+    deviation = learning[learning.value == "mean_deviation_m"].set_index("group")
+    assert set(deviation.index) == {"fading", "fixture"}
+    assert (deviation["pre_count"] == 4).all()
+    assert deviation.loc["fading", "retention_mean"] == pytest.approx(1.2e-3, abs=0.1e-3)
+    assert deviation.loc["fixture", "retention_mean"] == pytest.approx(1.8e-3, abs=0.1e-3)
+    compared = pandas.read_csv(tmp_path / "report" / "tables" / "group_comparisons.csv")
+    retention = compared[(compared.value == "mean_deviation_m") & (compared.quantity == "retention")].iloc[0]
+    assert (retention.a, retention.b, retention.n_a, retention.n_b) == ("fading", "fixture", 4, 4)
+    assert retention.mean_difference == pytest.approx(-0.6e-3, abs=0.1e-3)
+    assert retention.p < 0.001 and retention.ci95_high < 0

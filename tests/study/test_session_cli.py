@@ -112,6 +112,59 @@ class SessionCliTest(unittest.TestCase):
     def test_sigkill_crash_resumes(self):
         self.interrupt_and_resume(signal.SIGKILL, -signal.SIGKILL)
 
+    def test_a_protocol_over_two_days_links_each_subjects_sessions(self):
+        protocol = {
+            "name": "days",
+            "conditions": [{"name": "free", "mode": "vision"}, {"name": "fixture", "mode": "haptic"},
+                           {"name": "fading", "mode": "fading"}],
+            "phases": [
+                {"phase": "pre-test", "condition": "free", "characters": ["十"]},
+                {"phase": "training", "conditions": ["fixture", "fading"], "assignment": "between-subjects",
+                 "characters": ["十", "口"]},
+                {"phase": "post-test", "condition": "free", "characters": ["十"]},
+                {"phase": "retention", "condition": "free", "characters": ["十"], "session": 2, "delay_s": 86400},
+                {"phase": "transfer", "condition": "free", "session": 2,
+                 "characters": {"choose": 1, "from": ["大", "山", "日"]}}],
+            "trial": {"max_duration_s": 30},
+        }
+        path = self.write_protocol(protocol)
+        result = self.run_cli("session", "run", path, "--subjects", "2", "--out", "out")
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
+        for number, group in ((1, "fixture"), (2, "fading")):
+            folders = sorted((self.cwd / "out" / f"S0{number}").iterdir())
+            self.assertEqual(len(folders), 2)
+            first, second = (json.loads((f / "session.json").read_text(encoding="utf-8")) for f in folders)
+            self.assertEqual((first["session_number"], second["session_number"]), (1, 2))
+            self.assertEqual(first["group"], group)
+            self.assertNotIn("previous_session", first)
+            link = second["previous_session"]
+            self.assertEqual(link["session_id"], folders[0].name)
+            self.assertEqual((link["delay_s"], link["delay"]), (86400, "simulated"))
+            self.assertEqual([t["phase"] for t in second["plan"]], ["retention", "transfer"])
+            # 十 and 口 trained (typical strokes 1, 2, 7): of 大 (1, 32, 5), 山 (2, 21, 2) and 日 (2, 7, 1, 1)
+            # only 日 is made of them.
+            self.assertEqual(second["plan"][1]["characters"], "日")
+            self.assertEqual(len(self.saved(folders[1])), 2)
+        again = self.run_cli("session", "run", path, "--subjects", "2", "--out", "out")
+        self.assertEqual(again.returncode, 0, again.stderr.decode())
+        self.assertIn("S01: every session of days is done (2)", again.stdout.decode())
+        self.assertEqual(len(list((self.cwd / "out" / "S01").iterdir())), 2)
+
+        # A first session left unfinished is resumed before the second starts.
+        unfinished = self.run_cli("session", "run", path, "--subject", "T1", "--out", "out2")
+        self.assertEqual(unfinished.returncode, 0, unfinished.stderr.decode())
+        folders = sorted((self.cwd / "out2" / "T1").iterdir())
+        for folder in folders[1:]:
+            for file in sorted(folder.rglob("*"), reverse=True):
+                file.unlink() if file.is_file() else file.rmdir()
+            folder.rmdir()
+        last = self.saved(folders[0])[-1]
+        last.unlink()
+        refused = self.run_cli("session", "run", path, "--subject", "T1", "--out", "out2")
+        self.assertEqual(refused.returncode, 1)
+        self.assertIn("session 1 of days is not finished; resume it first: calligraphy session resume",
+                      refused.stderr.decode())
+
     def test_protocol_errors_name_file_and_pointer(self):
         bad = dict(LONG_PROTOCOL, order={"conditions": "latin"})
         result = self.run_cli("session", "run", self.write_protocol(bad), "--subject", "P1", "--out", "out")

@@ -1,5 +1,5 @@
 """Statistics a study publishes, over a tidy table of trials: intervals, paired comparisons between
-conditions, a linear mixed model, learning and retention.
+conditions, a linear mixed model, learning and retention, and groups compared between subjects.
 
 ``trials`` is a pandas DataFrame with one row per trial and the columns ``subject``, ``session``,
 ``phase`` (e.g. 'practice', 'test', or 'pre-test', 'training', 'post-test', 'retention', 'transfer'),
@@ -32,8 +32,10 @@ if typing.TYPE_CHECKING:  # pragma: no cover
     import pandas
 
 __all__ = [
+    "GroupComparison",
     "PairedComparison",
     "describe",
+    "group_comparison",
     "learning",
     "mixed_model",
     "paired_comparison",
@@ -579,7 +581,8 @@ def learning(trials: pandas.DataFrame, value: str, pre: str, post: str, retentio
     uses: 'pre-test', 'post-test', 'retention', ...). Each subject's trials in a phase are averaged (NaN
     trials left out).
 
-    Returns a DataFrame with one row per subject (sorted): ``subject``; ``pre``, ``post`` and, when
+    Returns a DataFrame with one row per subject (sorted): ``subject``; ``group`` when ``trials`` has that
+    column (the subject's between-subjects group); ``pre``, ``post`` and, when
     named, ``retention`` and ``transfer``, the subject's means in those phases [unit of value; NaN when
     the subject has no value there]; ``gain`` = pre - post, since the outcomes here are errors and times,
     lower being better (post - pre with ``lower_is_better=False``); ``relative_gain`` = gain / pre (NaN
@@ -609,6 +612,10 @@ def learning(trials: pandas.DataFrame, value: str, pre: str, post: str, retentio
     chosen = trials[trials[by].isin(list(phases.values()))]
     means = chosen.groupby(["subject", by], observed=True, sort=True)[value].mean().unstack(by)
     table = pandas.DataFrame({"subject": means.index.to_numpy()})
+    if "group" in trials.columns:  # the subject's between-subjects group (one per subject)
+        groups = chosen.groupby("subject", observed=True, sort=True)["group"].agg(
+            lambda g: "/".join(sorted({str(x) for x in g})))
+        table.insert(1, "group", groups.reindex(means.index).to_numpy())
     for role, name in phases.items():
         table[role] = means[name].to_numpy(dtype=float) if name in means.columns else np.nan
     sign = 1.0 if lower_is_better else -1.0
@@ -622,6 +629,141 @@ def learning(trials: pandas.DataFrame, value: str, pre: str, post: str, retentio
     table.attrs["phases"] = dict(phases)
     table.attrs["value"] = value
     return table
+
+
+@dataclasses.dataclass(frozen=True)
+class GroupComparison:
+    """``value`` compared between two groups of subjects (``group_comparison``); the difference is a - b.
+
+    Fields: ``value``, ``by``, ``a``, ``b``; ``n_a``, ``n_b`` (subjects with a value); ``mean_a``,
+    ``mean_b``, ``sd_a``, ``sd_b``; ``mean_difference`` with ``ci95_low``, ``ci95_high`` (Welch's
+    interval); ``t``, ``df`` (Welch-Satterthwaite), ``p`` (two-sided Welch t-test, Welch 1947,
+    ``scipy.stats.ttest_ind(equal_var=False)``); ``mann_whitney_u``, ``mann_whitney_p`` (two-sided,
+    Mann & Whitney 1947, ``scipy.stats.mannwhitneyu``); ``g`` (Hedges' g: the difference over the pooled
+    sd, times 1 - 3 / (4 (n_a + n_b) - 9); Hedges 1981, Lakens 2013 eq. 4); ``power`` of a two-sided
+    two-sample t-test at alpha .05 for |g| with these group sizes, and ``n_per_group_for_80_percent_power``
+    (equal groups; statsmodels TTestIndPower, Cohen 1988; NaN when g is 0 or undefined); ``test``,
+    ``assumptions``.
+    """
+
+    value: str
+    by: str
+    a: typing.Any
+    b: typing.Any
+    n_a: int
+    n_b: int
+    mean_a: float
+    mean_b: float
+    sd_a: float
+    sd_b: float
+    mean_difference: float
+    ci95_low: float
+    ci95_high: float
+    t: float
+    df: float
+    p: float
+    mann_whitney_u: float
+    mann_whitney_p: float
+    g: float
+    power: float
+    n_per_group_for_80_percent_power: float
+    test: str
+    assumptions: str
+
+    def to_frame(self) -> pandas.DataFrame:
+        """One row with every field, the fields' names as columns."""
+        return _pandas().DataFrame([dataclasses.asdict(self)])
+
+
+def _independent_power(effect: float, n_a: int, n_b: int) -> float:
+    from statsmodels.stats.power import TTestIndPower
+    capped = min(effect, _NONCENTRALITY_LIMIT / math.sqrt(n_a * n_b / (n_a + n_b)))  # as in _power
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return float(TTestIndPower().power(effect_size=capped, nobs1=n_a, ratio=n_b / n_a, alpha=ALPHA,
+                                           alternative="two-sided"))
+
+
+def _per_group_for_power(effect: float) -> float:
+    """The fewest subjects per group (equal groups, at least 2) reaching TARGET_POWER for ``effect`` > 0."""
+    n = 2
+    while _independent_power(effect, n, n) < TARGET_POWER:
+        n = n * 2 if n < 1_000_000 else n
+        if n >= 1_000_000:
+            return math.nan
+    low = max(2, n // 2)  # power grows with n: bisect between the last miss and the first hit
+    while low < n:
+        middle = (low + n) // 2
+        if _independent_power(effect, middle, middle) >= TARGET_POWER:
+            n = middle
+        else:
+            low = middle + 1
+    return float(n)
+
+
+def group_comparison(table: pandas.DataFrame, value: str, a: typing.Any, b: typing.Any, by: str = "group"
+                     ) -> GroupComparison:
+    """Compares ``value`` between the subjects of groups ``a`` and ``b`` (values of column ``by``), for a
+    between-subjects design: a protocol phase with ``"assignment": "between-subjects"``.
+
+    ``table`` has one row per subject, e.g. ``learning(trials, ...)`` (columns ``group``, ``gain``,
+    ``retention``, ``retention_ratio``, ``transfer``, ...). Rows with NaN ``value`` are left out. Tests:
+    Welch's t-test (unequal variances) and the Mann-Whitney U test as the check that needs no normality;
+    effect size Hedges' g; power from statsmodels' TTestIndPower. Returns a ``GroupComparison``.
+
+    Raises TypeError when ``table`` is not a DataFrame or ``value`` is not numeric; ValueError naming a
+    missing column, a group not present (listing those present), a = b, a subject in more than one row,
+    or fewer than 2 subjects with a value in either group.
+    """
+    caller = "group_comparison"
+    stats = _scipy_stats()
+    _check_frame(table, caller)
+    _require_columns(table, ["subject", by, value], caller)
+    _require_numeric(table, value, caller)
+    if table["subject"].duplicated().any():
+        raise ValueError(f"{caller}: expected one row per subject (e.g. from learning()); "
+                         f"{table['subject'][table['subject'].duplicated()].iloc[0]!r} has several")
+    present = _levels(table[by])
+    for name in (a, b):
+        if name not in present:
+            raise ValueError(f"{caller}: group {name!r} is not in the {by!r} column; present: "
+                             f"{', '.join(repr(level) for level in present)}")
+    if a == b:
+        raise ValueError(f"{caller}: a and b are both {a!r}; compare two different groups")
+    x = table.loc[(table[by] == a) & table[value].notna(), value].to_numpy(dtype=float)
+    y = table.loc[(table[by] == b) & table[value].notna(), value].to_numpy(dtype=float)
+    if len(x) < 2 or len(y) < 2:
+        raise _TooFewData(f"{caller}: {len(x)} subject(s) in {a!r} and {len(y)} in {b!r} have a value of "
+                          f"{value!r}; a comparison needs at least 2 in each")
+    welch = stats.ttest_ind(x, y, equal_var=False)
+    # Welch-Satterthwaite df and interval (scipy 1.10's ttest_ind returns neither).
+    share_a, share_b = np.var(x, ddof=1) / len(x), np.var(y, ddof=1) / len(y)
+    standard_error = math.sqrt(share_a + share_b)
+    denominator = share_a ** 2 / (len(x) - 1) + share_b ** 2 / (len(y) - 1)
+    df = (share_a + share_b) ** 2 / denominator if denominator > 0 else math.nan
+    u_test = stats.mannwhitneyu(x, y, alternative="two-sided")
+    n_a, n_b = len(x), len(y)
+    pooled = math.sqrt(((n_a - 1) * np.var(x, ddof=1) + (n_b - 1) * np.var(y, ddof=1)) / (n_a + n_b - 2))
+    difference = float(np.mean(x) - np.mean(y))
+    g = difference / pooled * (1.0 - 3.0 / (4.0 * (n_a + n_b) - 9.0)) if pooled > 0 else math.nan
+    half_width = float(stats.t.ppf(0.975, df) * standard_error) if math.isfinite(df) else math.nan
+    power = needed = math.nan
+    if math.isfinite(g) and g != 0:
+        power = _independent_power(abs(g), n_a, n_b)
+        needed = _per_group_for_power(abs(g))
+    return GroupComparison(
+        value=value, by=by, a=a, b=b, n_a=n_a, n_b=n_b,
+        mean_a=float(np.mean(x)), mean_b=float(np.mean(y)),
+        sd_a=float(np.std(x, ddof=1)), sd_b=float(np.std(y, ddof=1)),
+        mean_difference=difference, ci95_low=difference - half_width, ci95_high=difference + half_width,
+        t=float(welch.statistic), df=float(df), p=float(welch.pvalue),
+        mann_whitney_u=float(u_test.statistic), mann_whitney_p=float(u_test.pvalue),
+        g=float(g), power=power, n_per_group_for_80_percent_power=needed,
+        test=("Welch t-test (Welch 1947), scipy.stats.ttest_ind(equal_var=False); Mann-Whitney U (Mann & "
+              "Whitney 1947), scipy.stats.mannwhitneyu; Hedges' g (Hedges 1981); power, statsmodels "
+              "TTestIndPower (Cohen 1988)"),
+        assumptions=("subjects independent, each in one group; values approximately normal within groups "
+                     "(t-test; variances may differ) or distributions of the same shape (Mann-Whitney)"),
+    )
 
 
 def _row(**entries: typing.Any) -> dict[str, typing.Any]:

@@ -25,14 +25,14 @@ PathLike = typing.Union[str, "os.PathLike[str]"]
 
 # Columns whose empty fields are absent values (NaN); every other empty field is an empty string.
 _NUMERIC_TRIAL_COLUMNS = (
-    "block", "trial", "item", "repetition", "strokes_total", "strokes_written", "strokes_accepted",
+    "session_number", "block", "trial", "item", "repetition", "strokes_total", "strokes_written", "strokes_accepted",
     "order_errors", "backwards_strokes", "unmatched_segments", "mean_deviation_m", "max_deviation_m",
     "rms_deviation_m", "frechet_m", "dtw_m", "total_time_s", "pen_down_time_s", "velocity_peaks",
     "normalised_jerk")
 _NUMERIC_STROKE_COLUMNS = (
     "trial", "character", "stroke", "typical_id", "segments", "refused_segments", "mean_deviation_m",
     "max_deviation_m", "rms_deviation_m", "frechet_m", "dtw_m", "time_s", "path_length_m")
-_CATEGORIES = ("subject", "session", "protocol", "phase", "condition", "mode", "writer", "end_reason")
+_CATEGORIES = ("subject", "session", "protocol", "group", "phase", "condition", "mode", "writer", "end_reason")
 # The trace CSV's columns (calligraphy trial --csv) with their SI units named.
 _SAMPLE_COLUMNS = {"t": "t_s", "x": "x_m", "y": "y_m", "z": "z_m", "fx": "fx_n", "fy": "fy_n", "fz": "fz_n"}
 
@@ -67,7 +67,8 @@ def _read_table(text: str, numeric: tuple[str, ...], booleans: tuple[str, ...]) 
 class Study:
     """The tidy tables of one or many session folders.
 
-    trials: one row per saved trial (subject, session, protocol, phase, block, condition, mode, characters,
+    trials: one row per saved trial (subject, session, protocol, session_number (1-based: which of the
+        protocol's sessions), group (the subject's between-subjects group, '' when none), phase, block, condition, mode, characters,
         trial, item, repetition (0-based), writer, end_reason, start_utc, completed_in_order, stroke counts,
         order_errors, backwards_strokes, unmatched_segments, mean/max/rms_deviation_m, frechet_m, dtw_m [m],
         total_time_s, pen_down_time_s [s], velocity_peaks, normalised_jerk, trace_file).

@@ -29,6 +29,7 @@ import argparse
 import contextlib
 import dataclasses
 import html
+import itertools
 import io
 import math
 import os
@@ -591,6 +592,98 @@ def _subjects_html(trials: "pandas.DataFrame", values: typing.Sequence[str], per
     return "".join(out)
 
 
+# ---------------------------------------------------------------------------------------------- learning
+
+
+_LEARNING_PHASES = ("pre-test", "post-test", "retention", "transfer")
+
+
+def _learning_tables(trials: "pandas.DataFrame", value: str) -> tuple["pandas.DataFrame", "pandas.DataFrame"]:
+    """Per group (or 'all'), the subjects' mean pre, post, retention and transfer values, gain and retention
+    ratio (``statistics.learning``); and every pair of groups compared on gain and retention
+    (``statistics.group_comparison``; pairs with fewer than 2 subjects a side are left out)."""
+    from . import statistics
+
+    pandas = _pandas()
+    present = set(trials["phase"].astype(str))
+    table = statistics.learning(trials, value, "pre-test", "post-test",
+                                retention="retention" if "retention" in present else None,
+                                transfer="transfer" if "transfer" in present else None)
+    if "group" not in table or not table["group"].astype(str).str.len().any():
+        table["group"] = "all"
+    columns = [c for c in ("pre", "post", "retention", "transfer", "gain", "retention_ratio", "transfer_gain")
+               if c in table]
+    summary = table.groupby("group", sort=True)[columns].agg(["mean", "std", "count"])
+    comparisons = []
+    groups = sorted(str(g) for g in table["group"].unique())
+    for a, b in itertools.combinations(groups, 2):
+        for quantity in ("gain", "retention", "transfer"):
+            if quantity not in table:
+                continue
+            try:
+                c = statistics.group_comparison(table, quantity, a, b)
+            except ValueError:  # fewer than 2 subjects with a value in a group
+                continue
+            comparisons.append({"value": value, "quantity": quantity, "a": a, "b": b, "n_a": c.n_a, "n_b": c.n_b,
+                                "mean_difference": c.mean_difference, "ci95_low": c.ci95_low,
+                                "ci95_high": c.ci95_high, "t": c.t, "df": c.df, "p": c.p, "g": c.g,
+                                "mann_whitney_p": c.mann_whitney_p, "test": c.test})
+    return summary, pandas.DataFrame(comparisons)
+
+
+def _learning_html(trials: "pandas.DataFrame", values: typing.Sequence[str], tables: pathlib.Path) -> str:
+    """The section on learning, retention and transfer of a protocol with a pre-test and a post-test
+    (docs/experiments.md, "Phases"); '' without them. Also writes tables/learning.csv and
+    tables/group_comparisons.csv."""
+    pandas = _pandas()
+    present = set(trials["phase"].astype(str))
+    if not {"pre-test", "post-test"} <= present:
+        return ""
+    parts = ["<section id=\"learning-retention\">\n<h2>Learning, retention and transfer</h2>\n"
+             "<p class=\"files\">Each subject's trials averaged per phase; gain = pre-test - post-test (lower "
+             "is better); retention ratio = (pre - retention) / (pre - post): 1 kept, 0 lost. Groups are the "
+             "between-subjects training conditions. Mean ± SD over subjects (n).</p>\n"]
+    summaries, comparisons = [], []
+    for value in values:
+        summary, compared = _learning_tables(trials, value)
+        display = _display(value)
+        unit = f" [{display.unit}]" if display.unit else ""
+        columns = list(dict.fromkeys(c for c, _ in summary.columns))
+        header = "".join(f"<th>{_e(c.replace('_', ' '))}</th>" for c in columns)
+        rows = []
+        for group, row in summary.iterrows():
+            cells = []
+            for column in columns:
+                scale = 1.0 if column == "retention_ratio" else display.scale
+                mean, sd, n = row[(column, "mean")], row[(column, "std")], row[(column, "count")]
+                cells.append(f"<td>{_fixed(mean * scale, display.decimals)} ± {_fixed(sd * scale, display.decimals)}"
+                             f" ({_integer(n)})</td>")
+            rows.append(f"<tr><th>{_e(group)}</th>{''.join(cells)}</tr>")
+        parts.append(f"<table><caption>{_e(display.label.capitalize())}{_e(unit)} by phase (retention ratio "
+                     f"without unit)</caption><tr><th>group</th>{header}</tr>{''.join(rows)}</table>\n")
+        flat = summary.copy()
+        flat.columns = [f"{c}_{stat}" for c, stat in summary.columns]
+        summaries.append(flat.reset_index().assign(value=value))
+        if not compared.empty:
+            comparisons.append(compared)
+            lines = "".join(
+                f"<tr><td>{_e(r.quantity)}</td><td>{_e(r.a)} - {_e(r.b)}</td><td>{r.n_a}, {r.n_b}</td>"
+                f"<td>{_fixed(r.mean_difference * display.scale, display.decimals)} "
+                f"[{_fixed(r.ci95_low * display.scale, display.decimals)}, "
+                f"{_fixed(r.ci95_high * display.scale, display.decimals)}]</td><td>{_significant(r.t)}</td>"
+                f"<td>{_significant(r.df)}</td><td>{_p_value(r.p)}</td><td>{_significant(r.g)}</td></tr>"
+                for r in compared.itertuples())
+            parts.append(f"<table><caption>Groups compared, {_e(display.label)}{_e(unit)}: Welch t-test, "
+                         "Hedges' g</caption><tr><th>quantity</th><th>groups</th><th>n</th><th>difference "
+                         f"[95 % CI]</th><th>t</th><th>df</th><th>p</th><th>g</th></tr>{lines}</table>\n")
+    _write_atomic(tables / "learning.csv", pandas.concat(summaries, ignore_index=True).to_csv(index=False))
+    if comparisons:
+        _write_atomic(tables / "group_comparisons.csv",
+                      pandas.concat(comparisons, ignore_index=True).to_csv(index=False))
+    parts.append("</section>\n")
+    return "".join(parts)
+
+
 def _relative_link(target: PathLike, out_dir: pathlib.Path) -> str:
     relative = os.path.relpath(os.path.abspath(os.fspath(target)), os.path.abspath(out_dir))
     return urllib.parse.quote(pathlib.PurePath(relative).as_posix())
@@ -598,7 +691,7 @@ def _relative_link(target: PathLike, out_dir: pathlib.Path) -> str:
 
 def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Optional[str] = None,
                  values: typing.Sequence[str] = ("total_time_s", "mean_deviation_m"),
-                 phase: typing.Optional[str] = "test", per_trial_page: typing.Optional[PathLike] = None
+                 phase: typing.Optional[str] = "auto", per_trial_page: typing.Optional[PathLike] = None
                  ) -> pathlib.Path:
     """Writes the report of `study` into `out_dir` (created if missing) and returns the path of its
     index.html.
@@ -607,8 +700,11 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
     characters, repetition (0-based), phase, the `values`, and optionally protocol, session, writer, trial,
     block, end_reason). values: numeric columns in SI units, one Table-5 table, statistics table and
     learning-curve figure each (lengths shown in mm, times in s). phase: the trials the tables, statistics
-    and curves use ('test', as the paper's Table 5; None for all); the per-subject sections list every
-    trial. per_trial_page: the C++ ``calligraphy report`` page, linked (relative to `out_dir`) for each
+    and curves use ('test', as the paper's Table 5; None for all; 'auto': 'test' when present, else
+    'training' when present, else all); the per-subject sections list every trial. A study with a pre-test
+    and a post-test also gets a section on learning, retention and transfer per group
+    (``statistics.learning`` and ``statistics.group_comparison``; tables/learning.csv and
+    tables/group_comparisons.csv). per_trial_page: the C++ ``calligraphy report`` page, linked (relative to `out_dir`) for each
     trial's figures.
 
     Writes index.html, figures/learning_<value>.svg and .png (150 dpi), tables/summary.csv (per value the
@@ -626,6 +722,9 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
     if not isinstance(trials, pandas.DataFrame):
         raise TypeError(f"write_report: study must be a calligraphy.study.Study (calligraphy.study.load), "
                         f"got {type(study).__name__}")
+    if phase == "auto":
+        present = set(trials["phase"].astype(str)) if "phase" in trials else set()
+        phase = "test" if "test" in present else "training" if "training" in present else None
     trials = _check_trials(trials, values, phase, "write_report")
     data = _phase_trials(trials, phase)
     out = pathlib.Path(out_dir)
@@ -667,6 +766,7 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
             "unit shown, d_z and g_av standardized; p two-sided.</p>\n",
             *(_statistics_html(t, v, phase) for t, v in zip(statistics_tables, values)), "</section>\n",
             "<section id=\"learning\">\n<h2>Learning curves</h2>\n", *figure_html, "</section>\n",
+            _learning_html(trials, values, tables) if "phase" in trials else "",
             _subjects_html(trials, values, per_trial_link),
             "</body></html>\n"]
     index = out / "index.html"

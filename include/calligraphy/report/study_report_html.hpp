@@ -58,9 +58,11 @@ struct ReportTrial {
 /// What the page shows.
 struct StudyReport {
   std::string title;
-  std::vector<std::string> sessions;    ///< one line per session: subject, folder, protocol, device, writer
-  std::vector<std::string> conditions;  ///< row order of the tables (the protocol's test conditions)
-  std::vector<std::string> items;       ///< test characters in the protocol's order (UTF-8): C1, C2, ...
+  std::vector<std::string> sessions;  ///< one line per session: subject, folder, protocol, device, writer
+  /// The phase the tables and curves show: "test" (the paper's design), else "training".
+  std::string phase = "test";
+  std::vector<std::string> conditions;  ///< row order of the tables (the conditions of that phase)
+  std::vector<std::string> items;  ///< that phase's characters in the protocol's order (UTF-8): C1, C2, ...
   std::vector<ReportTrial> trials;
   std::vector<std::string> notes;  ///< shown under the header (e.g. what a simulated subject is)
 };

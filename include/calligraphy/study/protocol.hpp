@@ -11,8 +11,8 @@
 #include <string_view>
 #include <vector>
 
-#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/model/scene.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
 
 namespace calligraphy {
@@ -86,12 +86,54 @@ enum class ItemOrder {
 [[nodiscard]] const char* to_string(ConditionOrder order) noexcept;
 [[nodiscard]] const char* to_string(ItemOrder order) noexcept;
 
-/// The familiarisation phase before the test (paper section 7.1: "participants are allowed to write a
-/// specified character for a few times to get familiar with the system").
-struct PracticePhase {
-  std::vector<std::u32string> items;  ///< each item is written in one trial (one or more characters)
-  std::string condition;              ///< name of one of the protocol's conditions
-  int repetitions = 1;                ///< times each item is written, >= 1
+/// The phases of a motor-learning study (Schmidt & Lee, Motor Control and Learning, ch. 9: acquisition,
+/// then retention and transfer tests), and the two of a protocol of the paper's design (section 7.1).
+enum class StudyPhase {
+  practice,   ///< familiarisation with the system ("participants are allowed to write ... a few times")
+  test,       ///< the paper's test blocks: conditions compared within one sitting
+  pre_test,   ///< performance before any training
+  training,   ///< acquisition: practice under the training condition(s)
+  post_test,  ///< right after training
+  retention,  ///< after a stated delay, on trained characters
+  transfer,   ///< on characters not trained
+};
+/// "practice", "test", "pre-test", "training", "post-test", "retention", "transfer".
+[[nodiscard]] const char* to_string(StudyPhase phase) noexcept;
+
+/// How the conditions of a phase are given to subjects.
+enum class ConditionAssignment {
+  within_subjects,   ///< every subject writes every condition, in blocks ordered by the protocol's order
+  between_subjects,  ///< each subject writes one: the group of `subject_group`
+};
+/// "within-subjects", "between-subjects".
+[[nodiscard]] const char* to_string(ConditionAssignment assignment) noexcept;
+
+/// A transfer set chosen by typical-stroke coverage (`choose_transfer_characters`) when a session is made.
+struct TransferChoice {
+  std::size_t count = 1;                   ///< characters chosen, >= 1
+  std::vector<std::u32string> candidates;  ///< single characters to choose from, in order of preference
+};
+
+/// One phase of a protocol: its characters written in one or more conditions, a number of rounds each.
+struct ProtocolPhase {
+  StudyPhase kind = StudyPhase::test;
+  std::vector<std::string> conditions;  ///< names of the protocol's conditions, in listed order
+  ConditionAssignment assignment = ConditionAssignment::within_subjects;
+  /// Each item is written in one trial (one or more characters); empty while `choice` is not resolved.
+  std::vector<std::u32string> items;
+  std::optional<TransferChoice> choice;  ///< `transfer` only: items chosen when a session is made
+  int repetitions = 1;                   ///< times each item is written in each condition, >= 1
+  /// 1-based: the session (a sitting, usually a day) the phase is written in. A later session is its own
+  /// folder, linked to the subject's previous one (session_series.hpp).
+  int session = 1;
+  /// The phase starts at least this long after the previous phase ended [s]; for the first phase of a
+  /// later session, after the previous session's last trial. Within a session it is a rest.
+  double delay_s = 0.0;
+  std::string pointer;  ///< where the protocol file gives it ("/test", "/phases/2"): for messages
+  /// Items written in the phase: `choice->count` when the choice is not resolved yet.
+  [[nodiscard]] std::size_t item_count() const noexcept {
+    return choice && items.empty() ? choice->count : items.size();
+  }
 };
 
 /// Rests between trials [s]. Breaks are taken by a person; a simulated writer only logs them.
@@ -112,10 +154,8 @@ struct StudyProtocol {
   std::string name;  ///< [A-Za-z0-9_-], 1..64 characters; names session folders
   std::string description;
   std::vector<StudyCondition> conditions;
-  std::optional<PracticePhase> practice;
-  std::vector<std::u32string> test_items;    ///< each written in one trial (one or more characters)
-  std::vector<std::string> test_conditions;  ///< names of the conditions tested, in listed order
-  int repetitions = 1;                       ///< times each test item is written in each test condition, >= 1
+  /// In order. The paper's format ("practice" and "test") reads as a `practice` and a `test` phase.
+  std::vector<ProtocolPhase> phases;
   ConditionOrder condition_order = ConditionOrder::fixed;
   ItemOrder item_order = ItemOrder::fixed;
   std::uint64_t seed = 0;  ///< seeds the random orders
@@ -124,6 +164,10 @@ struct StudyProtocol {
 
   /// The condition called `name`; throws InvalidArgument naming it when there is none.
   [[nodiscard]] const StudyCondition& condition(std::string_view name) const;
+  /// Sessions the phases span (the largest `ProtocolPhase::session`), >= 1.
+  [[nodiscard]] int session_count() const noexcept;
+  /// The characters of the `training` phases, or of every phase when there is none (each once, in order).
+  [[nodiscard]] std::u32string trained_characters() const;
 };
 
 /// Most trials one session of a protocol may plan: 1,000,000 (at 10 s a trial, 116 days of writing; the
@@ -132,8 +176,8 @@ struct StudyProtocol {
 /// rather than run out of memory.
 inline constexpr std::uint64_t kMaxPlannedTrials = 1'000'000;
 
-/// The number of trials one session of `protocol` plans: practice strings x practice repetitions + test
-/// strings x test conditions x repetitions, computed without allocating anything per trial.
+/// The number of trials the largest session of `protocol` plans: per phase, strings x conditions (one when
+/// between subjects) x repetitions, computed without allocating anything per trial.
 [[nodiscard]] std::uint64_t planned_trial_count(const StudyProtocol& protocol) noexcept;
 
 /// `count` with thousands separators ("26,000,000").
@@ -144,7 +188,10 @@ inline constexpr std::uint64_t kMaxPlannedTrials = 1'000'000;
 /// integer >= 1, got 0"): malformed JSON (with the byte offset), a missing or unknown key, a value of
 /// the wrong type or out of range, a condition named twice or not defined, a character list that is
 /// empty or not UTF-8, repetitions that `abba` cannot split evenly, a plan of more than kMaxPlannedTrials
-/// trials (the message states the plan's size, e.g. "26,000,000 trials planned").
+/// trials (the message states the plan's size, e.g. "26,000,000 trials planned"); for "phases": sessions
+/// out of order, a pre-test after training, a post-test, retention or transfer test before it, a retention
+/// test without a delay or on characters not trained, a transfer test on characters trained, a
+/// between-subjects phase of one condition.
 [[nodiscard]] StudyProtocol parse_study_protocol(std::string_view json_text, const std::string& source);
 
 /// A protocol read from a file, with the exact text and its SHA-256 (so that a trial names the protocol

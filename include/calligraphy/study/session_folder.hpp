@@ -44,6 +44,19 @@ struct SessionSetup {
                                           ///< "skilled" or "foreign"
   std::uint64_t writer_seed = 0;          ///< the simulated subject's seed (see `subject_seed`)
   std::string pacing = "auto";            ///< "auto", "lock-step" or "real-time" (TrialPacing)
+  /// 1-based: which of the protocol's sessions (ProtocolPhase::session) this one is.
+  int session_number = 1;
+};
+
+/// The session before this one in a subject's series of sessions of one protocol (session_series.hpp).
+struct PreviousSession {
+  std::string session_id;  ///< its folder's name, beside this one in the subject's folder
+  std::string ended_utc;   ///< when its last trial ended (ISO 8601)
+  double delay_s = 0.0;    ///< the protocol's delay before this session [s]
+  double elapsed_s = 0.0;  ///< from `ended_utc` to this session's creation [s]
+  /// "waited" (elapsed_s >= delay_s), "simulated" (a simulated writer: the delay is taken as passed, not
+  /// waited) or "overridden" (started early on the experimenter's request).
+  std::string delay = "waited";
 };
 
 /// The seed of a simulated subject, derived from its id alone (FNV-1a of the id, mixed by SplitMix64), so
@@ -58,17 +71,22 @@ struct SessionManifest {
   LoadedProtocol protocol;  ///< `text` is the copy kept in session.json; `path` where it was read from
   LibraryBuild library;     ///< the build that created the session
   std::vector<PlannedTrial> plan;
+  std::optional<PreviousSession> previous;  ///< sessions after the first: the one before
+  std::string group;  ///< the subject's group (`subject_group`): "" when every phase is within subjects
 };
 
 /// A session folder, opened by one process at a time. Move-only; the lock is released on destruction.
 class SessionFolder {
  public:
   /// Creates ROOT/SUBJECT/PROTOCOL-YYYYMMDD-HHMMSS (a "-2", "-3" ... suffix when it exists), writes
-  /// session.json with the plan of `plan_session` and starts the log ("session_created"). Throws
-  /// InvalidArgument for a bad setup (subject id, writer, profile, pacing), DataError naming the path
-  /// when a folder or file cannot be made.
+  /// session.json with the plan of `plan_session` for `setup.session_number` and starts the log
+  /// ("session_created"). A transfer choice of the protocol must be resolved (`resolve_transfer_choices`).
+  /// Throws InvalidArgument for a bad setup (subject id, writer, profile, pacing, a session number the
+  /// protocol does not have, `previous` missing for a later session or given for the first), DataError
+  /// naming the path when a folder or file cannot be made.
   static SessionFolder create(const std::filesystem::path& root, const SessionSetup& setup,
-                              const LoadedProtocol& protocol);
+                              const LoadedProtocol& protocol,
+                              const std::optional<PreviousSession>& previous = std::nullopt);
   /// Opens an existing session: reads session.json (the plan recorded there is the plan), checks the
   /// protocol copy against its SHA-256 and locks the log. Throws DataError naming the file and JSON
   /// pointer for a missing or damaged session.json, StateError when another process has the session open.

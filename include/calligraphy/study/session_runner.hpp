@@ -91,10 +91,10 @@ struct TrialGuidance {
 
 /// The trial specification (trial_spec.hpp) of `trial` of `condition` in `session`: its characters, the
 /// session's device, writer, profile and pacing, a seed of the simulated subject's own per trial (from the
-/// subject's seed and the trial's index), servo rate and duration from the protocol, guidance on for
-/// `haptic`, `fading` and `replay` (the gain or the teacher's file from `guidance`), off for `vision` and
-/// `quiz`. Throws InvalidArgument naming the condition for a `replay` condition without a teacher in
-/// `guidance` or a gain outside [0, 1], and what `TrialSpec::validate` throws.
+/// subject's seed, the trial's index and the session's number), servo rate and duration from the protocol,
+/// guidance on for `haptic`, `fading` and `replay` (the gain or the teacher's file from `guidance`), off for
+/// `vision` and `quiz`. Throws InvalidArgument naming the condition for a `replay` condition without a
+/// teacher in `guidance` or a gain outside [0, 1], and what `TrialSpec::validate` throws.
 [[nodiscard]] TrialSpec study_trial_spec(const SessionManifest& session, const StudyCondition& condition,
                                          const PlannedTrial& trial, const TrialGuidance& guidance = {});
 

@@ -19,13 +19,15 @@ struct TrialRow {
   std::string subject;
   std::string session;     ///< the session folder's name
   std::string protocol;    ///< the protocol's name
-  std::string phase;       ///< "practice" or "test"
-  std::size_t block = 0;   ///< 0-based block of the session's plan
-  std::string condition;   ///< the condition's name
-  std::string mode;        ///< the condition's mode ("vision", "haptic", "fading", "replay", "quiz")
-  std::string characters;  ///< UTF-8, written left to right
-  std::size_t trial = 0;   ///< 0-based position in the session's plan
-  std::size_t item = 0;    ///< 0-based index of `characters` in the phase's list
+  int session_number = 1;  ///< which of the protocol's sessions (1-based; a retention test a day later: 2)
+  std::string group;       ///< the subject's between-subjects group (`subject_group`); "" when none
+  std::string phase;  ///< "practice", "test", "pre-test", "training", "post-test", "retention", "transfer"
+  std::size_t block = 0;       ///< 0-based block of the session's plan
+  std::string condition;       ///< the condition's name
+  std::string mode;            ///< the condition's mode ("vision", "haptic", "fading", "replay", "quiz")
+  std::string characters;      ///< UTF-8, written left to right
+  std::size_t trial = 0;       ///< 0-based position in the session's plan
+  std::size_t item = 0;        ///< 0-based index of `characters` in the phase's list
   std::size_t repetition = 0;  ///< 0-based repetition of the item in the condition
   std::string writer;          ///< "simulated" or "human"
   std::string end_reason;      ///< how the trial ended (TrialEnd as text)
@@ -53,16 +55,17 @@ struct TrialRow {
 struct StrokeRow {
   std::string subject;
   std::string session;
-  std::size_t trial = 0;      ///< the trial's `TrialRow::trial`
+  std::size_t trial = 0;  ///< the trial's `TrialRow::trial`
   std::string phase;
   std::string condition;
-  std::size_t character = 0;  ///< 0-based index of the character in the trial
+  std::size_t character = 0;   ///< 0-based index of the character in the trial
   std::string character_text;  ///< UTF-8
   std::size_t stroke = 0;      ///< 0-based index of the stroke in its character
   int typical_id = 0;          ///< the typical stroke's fixed ID (1..39)
   bool written = false;        ///< a pen-down segment was matched to it
   bool backwards = false;      ///< it was written from its end
-  std::size_t segments = 0;    ///< pen-down segments the matcher gave this stroke as their expected or matched one
+  std::size_t segments =
+      0;  ///< pen-down segments the matcher gave this stroke as their expected or matched one
   std::size_t refused_segments = 0;  ///< those refused
   std::string refusal;               ///< the last refused one's reason ("too_short", ...); "" when none
   std::optional<double> mean_deviation_m;
@@ -70,7 +73,7 @@ struct StrokeRow {
   std::optional<double> rms_deviation_m;
   std::optional<double> frechet_m;
   std::optional<double> dtw_m;
-  std::optional<double> time_s;         ///< its segment's duration [s]
+  std::optional<double> time_s;  ///< its segment's duration [s]
   std::optional<double> path_length_m;
 };
 

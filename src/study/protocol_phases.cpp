@@ -1,0 +1,211 @@
+// A protocol's "phases" (docs/experiments.md): pre-test, training, post-test, retention after a delay and
+// transfer on characters not trained, the design motor-learning studies report (Schmidt & Lee, Motor
+// Control and Learning, ch. 9), over one or more sessions.
+#include <algorithm>
+#include <array>
+
+#include "calligraphy/core/errors.hpp"
+#include "core/unicode.hpp"
+#include "study/protocol_reading.hpp"
+
+namespace calligraphy::study_detail {
+namespace {
+
+using nlohmann::json;
+
+constexpr std::size_t kMaxPhases = 20;
+// A delay longer than a year is a typo, not a design.
+constexpr double kMaxDelay_s = 366.0 * 86400.0;
+
+StudyPhase read_kind(ObjectReader& reader) {
+  constexpr std::array<StudyPhase, 7> kKinds{
+      StudyPhase::practice,  StudyPhase::test,      StudyPhase::pre_test, StudyPhase::training,
+      StudyPhase::post_test, StudyPhase::retention, StudyPhase::transfer};
+  const std::string text = reader.string("phase");
+  std::string names;
+  for (const StudyPhase kind : kKinds) {
+    if (text == to_string(kind)) return kind;
+    names += (names.empty() ? "" : ", ") + std::string(to_string(kind));
+  }
+  fail(reader.source(), reader.pointer("phase"), "expected one of " + names + "; got \"" + text + "\"");
+}
+
+// "condition": "name" or "conditions": ["a", "b"].
+std::vector<std::string> read_conditions(ObjectReader& reader, const std::vector<StudyCondition>& defined) {
+  const std::string& source = reader.source();
+  if (reader.has("condition") == reader.has("conditions")) {
+    fail(source, reader.pointer("condition"), "give either \"condition\" or \"conditions\"");
+  }
+  if (reader.has("condition")) {
+    return {condition_name(reader.required("condition"), reader.pointer("condition"), source, defined)};
+  }
+  const json& listed = reader.required("conditions");
+  if (!listed.is_array() || listed.empty()) {
+    fail(source, reader.pointer("conditions"), "expected a list of condition names, got " + describe(listed));
+  }
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < listed.size(); ++i) {
+    const std::string at = child_pointer(reader.pointer("conditions"), i);
+    std::string name = condition_name(listed[i], at, source, defined);
+    if (std::find(names.begin(), names.end(), name) != names.end()) {
+      fail(source, at, "the condition \"" + name + "\" is listed twice");
+    }
+    names.push_back(std::move(name));
+  }
+  return names;
+}
+
+// "characters": a list of strings, or {"choose": N, "from": [...]} (transfer only).
+void read_characters(ObjectReader& reader, ProtocolPhase& phase) {
+  const std::string& source = reader.source();
+  const json& value = reader.required("characters");
+  const std::string at = reader.pointer("characters");
+  if (!value.is_object()) {
+    phase.items = read_items(value, at, source);
+    return;
+  }
+  if (phase.kind != StudyPhase::transfer) {
+    fail(source, at, "only a transfer phase chooses its characters; expected a list of strings");
+  }
+  ObjectReader choice(value, at, source);
+  TransferChoice chosen;
+  chosen.count = static_cast<std::size_t>(choice.integer("choose", 1, static_cast<std::int64_t>(kMaxItems)));
+  chosen.candidates = read_items(choice.required("from"), choice.pointer("from"), source);
+  for (std::size_t i = 0; i < chosen.candidates.size(); ++i) {
+    if (chosen.candidates[i].size() != 1) {
+      fail(source, child_pointer(choice.pointer("from"), i), "expected one character per candidate");
+    }
+  }
+  if (chosen.count > chosen.candidates.size()) {
+    fail(source, choice.pointer("choose"),
+         "more characters to choose (" + std::to_string(chosen.count) + ") than candidates (" +
+             std::to_string(chosen.candidates.size()) + ")");
+  }
+  choice.finish();
+  phase.choice = std::move(chosen);
+}
+
+ProtocolPhase read_phase(const json& value, const std::string& pointer, const std::string& source,
+                         const StudyProtocol& protocol) {
+  ObjectReader reader(value, pointer, source);
+  ProtocolPhase phase;
+  phase.pointer = pointer;
+  phase.kind = read_kind(reader);
+  phase.conditions = read_conditions(reader, protocol.conditions);
+  if (const json* assignment = reader.optional("assignment")) {
+    const std::string text = as_string(*assignment, reader.pointer("assignment"), source);
+    if (text == to_string(ConditionAssignment::between_subjects)) {
+      phase.assignment = ConditionAssignment::between_subjects;
+    } else if (text != to_string(ConditionAssignment::within_subjects)) {
+      fail(source, reader.pointer("assignment"),
+           "expected within-subjects or between-subjects; got \"" + text + "\"");
+    }
+    if (phase.assignment == ConditionAssignment::between_subjects && phase.conditions.size() < 2) {
+      fail(source, reader.pointer("assignment"), "between-subjects needs two or more \"conditions\"");
+    }
+  }
+  read_characters(reader, phase);
+  phase.repetitions = static_cast<int>(reader.integer_or("repetitions", 1, 1, kMaxRepetitions));
+  phase.session = static_cast<int>(reader.integer_or("session", 1, 1, static_cast<std::int64_t>(kMaxPhases)));
+  phase.delay_s = reader.number_or("delay_s", 0.0, 0.0, kMaxDelay_s);
+  reader.finish();
+  const bool ordered = phase.assignment == ConditionAssignment::within_subjects &&
+                       protocol.condition_order == ConditionOrder::abba;
+  if (ordered && phase.repetitions % 2 != 0) {
+    fail(source, reader.pointer("repetitions"),
+         "order \"abba\" splits each condition's repetitions over two blocks: expected an even number, got " +
+             std::to_string(phase.repetitions));
+  }
+  return phase;
+}
+
+std::string quoted(const std::string& text) {
+  std::string out = "\"";
+  out += text;
+  out += '"';
+  return out;
+}
+
+bool shares_a_character(const std::u32string& item, const std::u32string& characters) {
+  return std::any_of(item.begin(), item.end(),
+                     [&](char32_t c) { return characters.find(c) != std::u32string::npos; });
+}
+
+// The design makes sense: sessions in order, tests around the training, retention on what was trained after
+// a delay, transfer on what was not.
+void check_design(const StudyProtocol& protocol, const std::string& pointer, const std::string& source) {
+  const auto& phases = protocol.phases;
+  const auto at = [&](std::size_t i, const std::string& key) {
+    return child_pointer(child_pointer(pointer, i), key);
+  };
+  const auto first_training = std::find_if(
+      phases.begin(), phases.end(), [](const ProtocolPhase& p) { return p.kind == StudyPhase::training; });
+  const std::size_t training = static_cast<std::size_t>(first_training - phases.begin());
+  const std::u32string trained = protocol.trained_characters();
+  for (std::size_t i = 0; i < phases.size(); ++i) {
+    const ProtocolPhase& phase = phases[i];
+    const int previous_session = i == 0 ? 1 : phases[i - 1].session;
+    if (phase.session != previous_session && phase.session != previous_session + 1) {
+      fail(source, at(i, "session"),
+           "expected session " + std::to_string(previous_session) + " or " +
+               std::to_string(previous_session + 1) +
+               " (phases in order, sessions numbered from 1 without gaps), got " +
+               std::to_string(phase.session));
+    }
+    const char* name = to_string(phase.kind);
+    if (phase.kind == StudyPhase::pre_test && i > training) {
+      fail(source, at(i, "phase"), "a pre-test comes before the training");
+    }
+    const bool after_training = phase.kind == StudyPhase::post_test || phase.kind == StudyPhase::retention ||
+                                phase.kind == StudyPhase::transfer;
+    const std::string test =
+        phase.kind == StudyPhase::post_test ? std::string("a post-test") : std::string("a ") + name + " test";
+    if (after_training && training == phases.size()) {
+      fail(source, at(i, "phase"), test + " needs a training phase before it");
+    }
+    if (after_training && i < training) fail(source, at(i, "phase"), test + " comes after the training");
+    if (phase.kind == StudyPhase::retention) {
+      if (!(phase.delay_s > 0.0)) {
+        fail(source, at(i, "delay_s"), "a retention test comes after a stated delay: expected delay_s > 0");
+      }
+      for (std::size_t k = 0; k < phase.items.size(); ++k) {
+        for (const char32_t c : phase.items[k]) {
+          if (trained.find(c) != std::u32string::npos) continue;
+          // Appended, not concatenated: GCC 12 warns falsely on "x" + string (-Wrestrict).
+          fail(source, child_pointer(at(i, "characters"), k),
+               quoted(encode_utf8(c)) + " is not trained: a test on it is a transfer test");
+        }
+      }
+    }
+    if (phase.kind == StudyPhase::transfer) {
+      const std::vector<std::u32string>& listed = phase.choice ? phase.choice->candidates : phase.items;
+      for (std::size_t k = 0; k < listed.size(); ++k) {
+        if (!shares_a_character(listed[k], trained)) continue;
+        fail(source,
+             phase.choice ? child_pointer(child_pointer(at(i, "characters"), "from"), k)
+                          : child_pointer(at(i, "characters"), k),
+             quoted(utf8_of(listed[k])) + " is trained: a transfer test is on characters not trained");
+      }
+    }
+  }
+}
+
+}  // namespace
+
+void read_phases(const json& value, const std::string& pointer, const std::string& source,
+                 StudyProtocol& protocol) {
+  if (!value.is_array() || value.empty() || value.size() > kMaxPhases) {
+    fail(source, pointer,
+         "expected a list of 1 to " + std::to_string(kMaxPhases) + " phases, got " + describe(value));
+  }
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    protocol.phases.push_back(read_phase(value[i], child_pointer(pointer, i), source, protocol));
+  }
+  if (protocol.phases.front().session != 1) {
+    fail(source, child_pointer(child_pointer(pointer, std::size_t{0}), "session"),
+         "the first phase is in session 1");
+  }
+  check_design(protocol, pointer, source);
+}
+
+}  // namespace calligraphy::study_detail
