@@ -14,6 +14,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/report/study_report_html.hpp"
+#include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/study/session_reader.hpp"
 #include "calligraphy/study/session_runner.hpp"
 #include "calligraphy/study/session_series.hpp"
@@ -595,4 +596,63 @@ TEST_CASE("a protocol over two days: sessions linked, the delay recorded, groups
   }
   CHECK(phases == std::vector<std::string>{"pre-test", "training", "post-test", "retention", "transfer"});
   CHECK(tables.trials[1].condition == "fixture");
+}
+
+TEST_CASE("a learning simulated subject writes with what it learned, the same after a resume and a day later",
+          "[study][session][phases][memory]") {
+  const LoadedProtocol protocol = protocol_from_text(
+      R"({"name": "learn", "conditions": [{"name": "free", "mode": "vision"}],
+          "phases": [
+            {"phase": "training", "condition": "free", "characters": ["十"], "repetitions": 4},
+            {"phase": "post-test", "condition": "free", "characters": ["十"]},
+            {"phase": "retention", "condition": "free", "characters": ["十"], "session": 2, "delay_s": 86400}],
+          "trial": {"max_duration_s": 40}})",
+      "learn.json");
+  // Both days of subject L1 under `root`; the first day stopped after `stop_after` trials and resumed.
+  const auto run_days = [&protocol](const fs::path& root, std::size_t stop_after) {
+    SessionSetup setup = simulated("L1");
+    setup.writer_learning = "two-state";
+    fs::path first_folder;
+    {
+      SessionFolder first = SessionFolder::create(root, setup, protocol);
+      first_folder = first.path();
+      if (stop_after > 0) {
+        StopAfter host(stop_after);
+        SessionRunOptions options;
+        options.host = &host;
+        options.should_stop = [&host] { return host.ended >= host.after; };
+        REQUIRE_FALSE(run_session(first, options).complete());
+      }
+    }
+    SessionFolder first = SessionFolder::open(first_folder);
+    REQUIRE(run_session(first).complete());
+    const SessionSeries series = session_series(root, "L1", protocol);
+    REQUIRE(series.previous);
+    PreviousSession previous = *series.previous;
+    previous.delay = "simulated";
+    setup.session_number = 2;
+    SessionFolder second = SessionFolder::create(root, setup, protocol, previous);
+    REQUIRE(run_session(second).complete());
+    // Each saved trial's bias, as its record's writer profile says, in order.
+    std::vector<double> bias;
+    for (const TrialRow& row : read_study_tables({root}).trials) {
+      REQUIRE(row.shape_skill);  // the skill the trial started with, in the tables
+      CHECK(*row.shape_skill >= 0.0);
+      CHECK(*row.shape_skill < 1.0);
+      const nlohmann::json record =
+          nlohmann::json::parse(read(fs::path(row.trace_file).replace_extension(".json")));
+      bias.push_back(record["writer"]["profile"]["bias_offset_m"].get<double>());
+    }
+    return bias;
+  };
+  TempFolder temp;
+  const std::vector<double> straight = run_days(temp.path / "straight", 0);
+  const std::vector<double> resumed = run_days(temp.path / "resumed", 2);
+  REQUIRE(straight.size() == 6);
+  CHECK(resumed == straight);  // rebuilt from the records, the memory is the one a straight run had
+  const double own = WriterProfile::novice().bias_offset_m;
+  CHECK(straight[0] == own);  // nothing learned before the first trial
+  for (std::size_t i = 1; i < 5; ++i) CHECK(straight[i] < straight[i - 1]);  // practice lowers the bias
+  CHECK(straight[5] > straight[4]);  // a day later the fast state is gone...
+  CHECK(straight[5] < own);          // ...and the slow one kept
 }

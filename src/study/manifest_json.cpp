@@ -85,6 +85,7 @@ std::string manifest_to_json(const SessionManifest& manifest) {
                    {"writer", setup.writer},
                    {"writer_profile", setup.writer_profile},
                    {"writer_seed", setup.writer_seed},
+                   {"writer_learning", setup.writer_learning},
                    {"pacing", setup.pacing},
                    {"library", library_build_json(manifest.library)},
                    {"protocol",
@@ -119,6 +120,11 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
   manifest.setup.writer = root.string("writer");
   manifest.setup.writer_profile = root.string("writer_profile");
   manifest.setup.writer_seed = root.unsigned_or("writer_seed", 0);
+  manifest.setup.writer_learning =
+      root.string_or("writer_learning", "none");  // "none" before writers learned
+  if (manifest.setup.writer_learning != "none" && manifest.setup.writer_learning != "two-state") {
+    fail(source, "/writer_learning", "expected \"none\" or \"two-state\"");
+  }
   manifest.setup.pacing = root.string("pacing");
   // Sessions made before protocols had phases are each the first of their series.
   manifest.setup.session_number = static_cast<int>(root.integer_or("session_number", 1, 1, 20));
@@ -180,6 +186,7 @@ std::string session_created_details(const SessionManifest& manifest) {
               {"device", setup.device},
               {"writer", setup.writer},
               {"writer_profile", setup.writer_profile},
+              {"writer_learning", setup.writer_learning},
               {"protocol", manifest.protocol.protocol.name},
               {"protocol_sha256", manifest.protocol.sha256},
               {"session_number", setup.session_number},

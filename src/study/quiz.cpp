@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "calligraphy/core/errors.hpp"
 #include "analysis/segmentation.hpp"
+#include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
 

@@ -31,7 +31,8 @@ SessionManifest read_session_manifest(const fs::path& folder) {
 
 nlohmann::json read_trial_record(const fs::path& json_file) {
   const std::string source = json_file.string();
-  nlohmann::json record = parse_json(read_small_file(json_file, kMaxRecordBytes, "trial record (JSON)"), source);
+  nlohmann::json record =
+      parse_json(read_small_file(json_file, kMaxRecordBytes, "trial record (JSON)"), source);
   if (!record.is_object() || record.value("format", "") != "calligraphy-study-trial") {
     fail(source, "/format", "expected \"calligraphy-study-trial\"");
   }

@@ -91,6 +91,13 @@ void check_setup(const SessionSetup& setup) {
   (void)writer_profile(setup.writer_profile);  // InvalidArgument naming it and the known profiles
   (void)parse_trial_pacing(setup.pacing, "session setup");  // InvalidArgument naming the spellings
   if (setup.device.empty()) throw InvalidArgument("session setup: the device name is empty");
+  if (setup.writer_learning != "none" && setup.writer_learning != "two-state") {
+    throw InvalidArgument("writer learning '" + setup.writer_learning + "': expected 'none' or 'two-state'");
+  }
+  if (setup.writer_learning != "none" && setup.writer != "simulated") {
+    throw InvalidArgument("writer learning '" + setup.writer_learning +
+                          "' models a simulated writer, not a person");
+  }
 }
 
 }  // namespace

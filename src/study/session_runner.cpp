@@ -16,6 +16,7 @@
 #include "calligraphy/study/trial_spec_runner.hpp"
 #include "core/unicode.hpp"
 #include "study/names.hpp"
+#include "study/remembered_writer.hpp"
 #include "study/trial_guidance.hpp"
 #include "study/trial_record.hpp"
 
@@ -198,6 +199,9 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
                    {"next_trial", first ? json(*first + 1) : json(nullptr)},
                    {"library", library_build().version}}
                   .dump());
+  // A learning simulated subject remembers its saved trials, of this session and the ones before it.
+  const bool learning = simulated_writer && manifest.setup.writer_learning == "two-state";
+  WriterMemory memory = learning ? study_detail::remembered(session) : WriterMemory{};
   bool ran_one = false;
   for (const PlannedTrial& trial : session.plan()) {
     if (session.is_saved(trial)) continue;
@@ -248,6 +252,17 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
       guidance = study_detail::replay_guidance(session, condition, trial, scene);
     TrialSpec spec = study_trial_spec(manifest, condition, trial, guidance.guidance);
     if (run_options.pacing) spec.pacing = *run_options.pacing;
+    json started = trial_details(trial);
+    std::optional<std::pair<double, double>> skills;
+    if (learning) {
+      const std::vector<int> ids = study_detail::typical_ids(scene);
+      spec.writer_parameters =
+          study_detail::learned_parameters(memory, manifest.setup.writer_profile, ids, trial.characters);
+      spec.validate();
+      skills = std::pair{shape_skill(memory, ids), order_skill(memory, trial.characters)};
+      started["shape_skill"] = skills->first;
+      started["order_skill"] = skills->second;
+    }
 
     std::unique_ptr<HapticDevice> device;
     DeviceInfo device_info;
@@ -258,7 +273,7 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
       log_failure(e, "device_not_opened");
       throw;
     }
-    session.log("trial_started", trial_details(trial).dump());
+    session.log("trial_started", started.dump());
     // The one runner of a trial specification; the device (made above, so that a failure is logged), the
     // teacher kept in the session folder and the condition's own settings are its inputs.
     TrialRunInputs inputs;
@@ -278,6 +293,7 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     context.hardware = listing.hardware;
     context.simulated_writer = simulated_writer;
     context.guidance = study_detail::guidance_record_json(condition, guidance);
+    context.writer_skills = skills;
     context.start_utc = study_detail::utc_now_iso8601();
     const auto wall_start = std::chrono::steady_clock::now();
     TrialRun run = run_trial_spec(spec, scene, inputs);
@@ -314,6 +330,10 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
       const std::string record = study_detail::trial_record_json(context, scene, trial_result, writing,
                                                                  quiz.empty() ? nullptr : &quiz);
       session.save_trial(trial, record, trial_csv(trial_result.trace), trial_svg(scene, trial_result));
+      // Learned from as the record says, the same as when the memory is rebuilt on a resume.
+      if (learning)
+        study_detail::practise_record(memory, json::parse(record),
+                                      session.trial_file(trial, "json").string());
       outcome.saved = true;
       outcome.json_file = session.trial_file(trial, "json").string();
       details["time_s"] = outcome.time_s;

@@ -133,6 +133,9 @@ TrialRow read_trial_row(const fs::path& json_file, const SessionManifest& manife
   row.pen_down_time_s = number(record, "pen_down_time_s", source, "");
   row.velocity_peaks = static_cast<int>(count(record, "velocity_peaks", source, ""));
   row.normalised_jerk = optional_number(record, "normalised_jerk", source, "");
+  const json& memory = record.value("writer", json::object()).value("memory", json::object());
+  row.shape_skill = optional_number(memory, "shape_skill", source, "/writer/memory");
+  row.order_skill = optional_number(memory, "order_skill", source, "/writer/memory");
   const std::string csv = record.value("files", json::object()).value("csv", "");
   if (csv.empty() || csv.find('/') != std::string::npos) fail(source, "/files/csv", "expected a file name");
   row.trace_file = json_file.parent_path() / csv;
@@ -193,14 +196,14 @@ std::string trials_csv(const StudyTables& tables) {
       "repetition,writer,end_reason,"
       "start_utc,completed_in_order,strokes_total,strokes_written,strokes_accepted,order_errors,"
       "backwards_strokes,unmatched_segments,mean_deviation_m,max_deviation_m,rms_deviation_m,frechet_m,dtw_m,"
-      "total_time_s,pen_down_time_s,velocity_peaks,normalised_jerk,trace_file\n";
+      "total_time_s,pen_down_time_s,velocity_peaks,normalised_jerk,shape_skill,order_skill,trace_file\n";
   for (const TrialRow& r : tables.trials) {
     line(out, r.subject, r.session, r.protocol, r.session_number, r.group, r.phase, r.block, r.condition,
          r.mode, r.characters, r.trial, r.item, r.repetition, r.writer, r.end_reason, r.start_utc,
          r.completed_in_order, r.strokes_total, r.strokes_written, r.strokes_accepted, r.order_errors,
          r.backwards_strokes, r.unmatched_segments, r.mean_deviation_m, r.max_deviation_m, r.rms_deviation_m,
          r.frechet_m, r.dtw_m, r.total_time_s, r.pen_down_time_s, r.velocity_peaks, r.normalised_jerk,
-         r.trace_file.string());
+         r.shape_skill, r.order_skill, r.trace_file.string());
   }
   return out;
 }

@@ -104,29 +104,35 @@ json device_info_json(const DeviceInfo& d) {
 json writer_json(const TrialRecordContext& c) {
   if (!c.simulated_writer) return {{"kind", "human"}, {"subject", c.session->setup.subject.id}};
   const WriterProfile& w = c.simulation.writer;
-  return {{"kind", "simulated"},
-          {"seed", c.simulation.seed},
-          {"subject_seed", c.session->setup.writer_seed},
-          {"profile",
-           {{"name", w.name},
-            {"hand_stiffness_n_per_m", w.hand_stiffness_n_per_m},
-            {"hand_damping_n_s_per_m", w.hand_damping_n_s_per_m},
-            {"writing_speed_m_s", w.writing_speed_m_s},
-            {"travel_speed_m_s", w.travel_speed_m_s},
-            {"press_depth_m", w.press_depth_m},
-            {"lift_height_m", w.lift_height_m},
-            {"bias_offset_m", w.bias_offset_m},
-            {"scale_error", w.scale_error},
-            {"stroke_jitter_m", w.stroke_jitter_m},
-            {"noise_fraction", w.noise_fraction},
-            {"tremor_amplitude_n", w.tremor_amplitude_n},
-            {"tremor_frequency_hz", w.tremor_frequency_hz},
-            {"corner_cut_m", w.corner_cut_m},
-            {"end_short_m", w.end_short_m},
-            {"end_past_m", w.end_past_m},
-            {"follow_through_m", w.follow_through_m},
-            {"correction_per_attempt", w.correction_per_attempt},
-            {"max_attempts_per_stroke", w.max_attempts_per_stroke}}}};
+  json writer = {{"kind", "simulated"},
+                 {"seed", c.simulation.seed},
+                 {"subject_seed", c.session->setup.writer_seed},
+                 {"profile",
+                  {{"name", w.name},
+                   {"hand_stiffness_n_per_m", w.hand_stiffness_n_per_m},
+                   {"hand_damping_n_s_per_m", w.hand_damping_n_s_per_m},
+                   {"writing_speed_m_s", w.writing_speed_m_s},
+                   {"travel_speed_m_s", w.travel_speed_m_s},
+                   {"press_depth_m", w.press_depth_m},
+                   {"lift_height_m", w.lift_height_m},
+                   {"bias_offset_m", w.bias_offset_m},
+                   {"scale_error", w.scale_error},
+                   {"stroke_jitter_m", w.stroke_jitter_m},
+                   {"noise_fraction", w.noise_fraction},
+                   {"tremor_amplitude_n", w.tremor_amplitude_n},
+                   {"tremor_frequency_hz", w.tremor_frequency_hz},
+                   {"corner_cut_m", w.corner_cut_m},
+                   {"end_short_m", w.end_short_m},
+                   {"end_past_m", w.end_past_m},
+                   {"follow_through_m", w.follow_through_m},
+                   {"correction_per_attempt", w.correction_per_attempt},
+                   {"max_attempts_per_stroke", w.max_attempts_per_stroke}}}};
+  if (c.writer_skills) {
+    writer["memory"] = {{"model", c.session->setup.writer_learning},
+                        {"shape_skill", c.writer_skills->first},
+                        {"order_skill", c.writer_skills->second}};
+  }
+  return writer;
 }
 
 json simulated_device_json() {

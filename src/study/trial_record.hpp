@@ -6,14 +6,14 @@
 #include <string>
 #include <vector>
 
+#include "calligraphy/analysis/score.hpp"
 #include "calligraphy/core/device_types.hpp"
 #include "calligraphy/model/scene.hpp"
+#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/study/quiz.hpp"
 #include "calligraphy/study/session_folder.hpp"
-#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/trial/options.hpp"
 #include "calligraphy/trial/result.hpp"
-#include "calligraphy/analysis/score.hpp"
 
 namespace calligraphy::study_detail {
 
@@ -32,7 +32,9 @@ struct TrialRecordContext {
   std::string end_utc;
   double wall_time_s = 0.0;
   nlohmann::json guidance;  ///< the "guidance" object (trial_guidance.hpp); null: none
-  std::string csv_file;     ///< file names beside the JSON
+  /// A learning simulated writer's skills before the trial (writer_memory.hpp): shape, order; none: nullopt.
+  std::optional<std::pair<double, double>> writer_skills;
+  std::string csv_file;  ///< file names beside the JSON
   std::string svg_file;
 };
 

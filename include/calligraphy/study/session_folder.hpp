@@ -43,7 +43,11 @@ struct SessionSetup {
   std::string writer_profile = "novice";  ///< the simulated writer's profile (`writer_profile`): "novice",
                                           ///< "skilled" or "foreign"
   std::uint64_t writer_seed = 0;          ///< the simulated subject's seed (see `subject_seed`)
-  std::string pacing = "auto";            ///< "auto", "lock-step" or "real-time" (TrialPacing)
+  /// How a simulated subject learns from trial to trial: "none" (each trial from its profile) or "two-state"
+  /// (a memory per typical stroke and character, sim/writer_memory.hpp, rebuilt from the saved trials of
+  /// this session and the ones before it).
+  std::string writer_learning = "none";
+  std::string pacing = "auto";  ///< "auto", "lock-step" or "real-time" (TrialPacing)
   /// 1-based: which of the protocol's sessions (ProtocolPhase::session) this one is.
   int session_number = 1;
 };

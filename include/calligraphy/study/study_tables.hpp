@@ -48,7 +48,11 @@ struct TrialRow {
   double pen_down_time_s = 0.0;
   int velocity_peaks = 0;
   std::optional<double> normalised_jerk;  ///< dimensionless
-  std::filesystem::path trace_file;       ///< the trial's CSV trace (t,x,y,z,fx,fy,fz,state,stroke,element)
+  /// A learning simulated writer's skills before the trial, in [0, 1] (docs/writer.md, "Memory"); absent
+  /// otherwise.
+  std::optional<double> shape_skill;
+  std::optional<double> order_skill;
+  std::filesystem::path trace_file;  ///< the trial's CSV trace (t,x,y,z,fx,fy,fz,state,stroke,element)
 };
 
 /// One reference stroke of one saved trial.

@@ -1,0 +1,83 @@
+#pragma once
+/// \file writer_memory.hpp
+/// A simulated writer's motor memory across trials and sessions, a model (docs/writer.md, "Memory"): per
+/// typical stroke (paper section 3.1) a skill of shape and direction, per character a skill of its stroke
+/// order, each the sum of a fast and a slow state updated after every trial by the two-state model of
+/// Smith, Ghazizadeh & Shadmehr (2006, PLoS Biol 4(6):e179):
+///
+///     x_f <- A_f x_f + B_f e,   x_s <- A_s x_s + B_s e,   x = clamp(x_f + x_s, 0, 1),
+///
+/// with the error the writer itself experiences e = (1 - x)(1 - h): guidance that does a share h of the
+/// correction removes that share of the error the writer learns from (error-based learning with robotic
+/// assistance, Emken, Benitez, Sideris, Bobrow & Reinkensmeyer 2007, J Neurophysiol 97:3997). h comes from
+/// the physics of the two springs acting on the pen: the fixture's g K against the hand's k, h = g K / (g K +
+/// k). Practice of a character trains the typical strokes it holds, so a character not practised starts from
+/// what its typical strokes learned elsewhere (transfer). Between sessions (hours or days) the fast state is
+/// gone and the slow one kept: long-term retention follows the slow state (Joiner & Smith 2008, J
+/// Neurophysiol 100:2948). The skill moves a profile from the writer's own towards the skilled writer's.
+/// Deterministic: the same trials give the same memory, so a resumed session rebuilds it from its records.
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "calligraphy/sim/writer_profile.hpp"
+
+namespace calligraphy {
+
+/// The retention factors A and learning rates B of the two-state model, per trial. Defaults: the values
+/// Smith, Ghazizadeh & Shadmehr (2006) simulate force-field adaptation with.
+struct TwoStateRates {
+  double fast_retention = 0.92;   ///< A_f, in [0, 1)
+  double fast_learning = 0.03;    ///< B_f, in (0, 1]
+  double slow_retention = 0.996;  ///< A_s, in [0, 1), > A_f
+  double slow_learning = 0.004;   ///< B_s, in (0, 1], < B_f
+  /// Throws InvalidArgument naming the field when a value is out of its range.
+  void validate() const;
+};
+
+/// One skill: a fast and a slow state; the skill is their sum, in [0, 1].
+struct SkillMemory {
+  double fast = 0.0;
+  double slow = 0.0;
+  [[nodiscard]] double skill() const noexcept;
+};
+
+/// A writer's memory: skills by typical stroke ID (1-39) and by character.
+struct WriterMemory {
+  std::map<int, SkillMemory> typical_strokes;  ///< shape and direction of each typical stroke written
+  std::map<char32_t, SkillMemory> characters;  ///< stroke order of each character written
+};
+
+/// The share of the correction a guiding spring of stiffness `gain` x `guidance_stiffness_n_per_m` takes
+/// from a hand of stiffness `hand_stiffness_n_per_m`: g K / (g K + k), in [0, 1). Throws InvalidArgument for
+/// a gain outside [0, 1] or a stiffness that is negative or (for the hand) not > 0.
+[[nodiscard]] double guidance_assistance_share(double gain, double guidance_stiffness_n_per_m,
+                                               double hand_stiffness_n_per_m);
+
+/// One trial of practice: every memory decays by its retention (A_f, A_s); then each typical stroke of
+/// `typical_ids` (one per stroke of the trial's characters; a stroke type written twice learns twice) and
+/// each character of `characters` learns from the error e = (1 - x)(1 - `assistance_share`). Throws
+/// InvalidArgument for a share outside [0, 1] or bad rates.
+void practise(WriterMemory& memory, const std::vector<int>& typical_ids, const std::u32string& characters,
+              double assistance_share, const TwoStateRates& rates = {});
+
+/// The passing of hours or days between sessions: every fast state is set to 0, slow states are kept.
+void consolidate(WriterMemory& memory);
+
+/// The shape skill of a trial: the mean skill of its typical strokes (0 for a stroke type never written).
+[[nodiscard]] double shape_skill(const WriterMemory& memory, const std::vector<int>& typical_ids);
+/// The order skill of a trial: the mean skill of its characters.
+[[nodiscard]] double order_skill(const WriterMemory& memory, const std::u32string& characters);
+
+/// The profile a writer starting from `own` writes with at shape skill `shape` and order skill `order` (both
+/// in [0, 1]): bias (offset, scale error, jitter), corner cutting, fluency errors (lifts, touches outside,
+/// hesitations) and speed move linearly from `own`'s to `skilled`'s by `shape`; order and backwards error
+/// rates by `order`. Throws InvalidArgument for a skill outside [0, 1] and what `validate` throws.
+[[nodiscard]] WriterProfile learned_profile(const WriterProfile& own, const WriterProfile& skilled,
+                                            double shape, double order);
+
+/// The numeric fields `learned_profile` changes, by name (`set_writer_parameter` keys), in order.
+[[nodiscard]] const std::vector<std::string>& learned_profile_fields();
+
+}  // namespace calligraphy

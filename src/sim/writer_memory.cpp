@@ -1,0 +1,153 @@
+#include "calligraphy/sim/writer_memory.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <string>
+
+#include "calligraphy/core/errors.hpp"
+
+namespace calligraphy {
+namespace {
+
+// The error the writer experiences: what it has still to learn, less the share the guidance corrects.
+double error_of(const SkillMemory& memory, double assistance_share) {
+  return (1.0 - memory.skill()) * (1.0 - assistance_share);
+}
+
+void learn(SkillMemory& memory, double error, const TwoStateRates& rates) {
+  memory.fast += rates.fast_learning * error;
+  memory.slow += rates.slow_learning * error;
+}
+
+void decay(SkillMemory& memory, const TwoStateRates& rates) {
+  memory.fast *= rates.fast_retention;
+  memory.slow *= rates.slow_retention;
+}
+
+double blend(double own, double skilled, double skill) { return own + (skilled - own) * skill; }
+
+void check_skill(double skill, const char* name) {
+  if (!(skill >= 0.0 && skill <= 1.0)) {
+    throw InvalidArgument(std::string("learned_profile: ") + name + " skill " + std::to_string(skill) +
+                          " outside [0, 1]");
+  }
+}
+
+}  // namespace
+
+void TwoStateRates::validate() const {
+  const auto check = [](double value, bool ok, const char* name, const char* range) {
+    if (!std::isfinite(value) || !ok) {
+      throw InvalidArgument(std::string("TwoStateRates.") + name + " = " + std::to_string(value) +
+                            " must be " + range);
+    }
+  };
+  check(fast_retention, fast_retention >= 0.0 && fast_retention < 1.0, "fast_retention", "in [0, 1)");
+  check(slow_retention, slow_retention > fast_retention && slow_retention < 1.0, "slow_retention",
+        "in (fast_retention, 1)");
+  check(fast_learning, fast_learning > 0.0 && fast_learning <= 1.0, "fast_learning", "in (0, 1]");
+  check(slow_learning, slow_learning > 0.0 && slow_learning < fast_learning, "slow_learning",
+        "in (0, fast_learning)");
+}
+
+double SkillMemory::skill() const noexcept { return std::clamp(fast + slow, 0.0, 1.0); }
+
+double guidance_assistance_share(double gain, double guidance_stiffness_n_per_m,
+                                 double hand_stiffness_n_per_m) {
+  if (!(gain >= 0.0 && gain <= 1.0)) {
+    throw InvalidArgument("guidance gain " + std::to_string(gain) + " outside [0, 1]");
+  }
+  if (!(guidance_stiffness_n_per_m >= 0.0) || !std::isfinite(guidance_stiffness_n_per_m)) {
+    throw InvalidArgument("guidance stiffness " + std::to_string(guidance_stiffness_n_per_m) +
+                          " N/m must be finite and >= 0");
+  }
+  if (!(hand_stiffness_n_per_m > 0.0) || !std::isfinite(hand_stiffness_n_per_m)) {
+    throw InvalidArgument("hand stiffness " + std::to_string(hand_stiffness_n_per_m) +
+                          " N/m must be finite and > 0");
+  }
+  const double guide = gain * guidance_stiffness_n_per_m;
+  return guide / (guide + hand_stiffness_n_per_m);
+}
+
+void practise(WriterMemory& memory, const std::vector<int>& typical_ids, const std::u32string& characters,
+              double assistance_share, const TwoStateRates& rates) {
+  rates.validate();
+  if (!(assistance_share >= 0.0 && assistance_share <= 1.0)) {
+    throw InvalidArgument("practise: assistance share " + std::to_string(assistance_share) +
+                          " outside [0, 1]");
+  }
+  // x(n+1) = A x(n) + B e(n), e(n) from the skill before the trial; a stroke type written k times learns k
+  // times from that error.
+  std::map<int, double> stroke_errors;
+  for (const int id : typical_ids)
+    stroke_errors[id] += error_of(memory.typical_strokes[id], assistance_share);
+  std::map<char32_t, double> character_errors;
+  for (const char32_t c : characters) character_errors[c] += error_of(memory.characters[c], assistance_share);
+  for (auto& [id, skill] : memory.typical_strokes) decay(skill, rates);
+  for (auto& [character, skill] : memory.characters) decay(skill, rates);
+  for (const auto& [id, error] : stroke_errors) learn(memory.typical_strokes[id], error, rates);
+  for (const auto& [c, error] : character_errors) learn(memory.characters[c], error, rates);
+}
+
+void consolidate(WriterMemory& memory) {
+  for (auto& [id, skill] : memory.typical_strokes) skill.fast = 0.0;
+  for (auto& [character, skill] : memory.characters) skill.fast = 0.0;
+}
+
+double shape_skill(const WriterMemory& memory, const std::vector<int>& typical_ids) {
+  if (typical_ids.empty()) return 0.0;
+  double sum = 0.0;
+  for (const int id : typical_ids) {
+    const auto found = memory.typical_strokes.find(id);
+    sum += found == memory.typical_strokes.end() ? 0.0 : found->second.skill();
+  }
+  return sum / static_cast<double>(typical_ids.size());
+}
+
+double order_skill(const WriterMemory& memory, const std::u32string& characters) {
+  if (characters.empty()) return 0.0;
+  double sum = 0.0;
+  for (const char32_t c : characters) {
+    const auto found = memory.characters.find(c);
+    sum += found == memory.characters.end() ? 0.0 : found->second.skill();
+  }
+  return sum / static_cast<double>(characters.size());
+}
+
+const std::vector<std::string>& learned_profile_fields() {
+  static const std::vector<std::string> fields{"bias_offset_m",
+                                               "scale_error",
+                                               "stroke_jitter_m",
+                                               "corner_cut_m",
+                                               "writing_speed_m_s",
+                                               "mid_stroke_lift_probability",
+                                               "outside_touch_probability",
+                                               "hesitation_probability",
+                                               "order_error_probability",
+                                               "backwards_probability"};
+  return fields;
+}
+
+WriterProfile learned_profile(const WriterProfile& own, const WriterProfile& skilled, double shape,
+                              double order) {
+  check_skill(shape, "shape");
+  check_skill(order, "order");
+  WriterProfile p = own;
+  p.bias_offset_m = blend(own.bias_offset_m, skilled.bias_offset_m, shape);
+  p.scale_error = blend(own.scale_error, skilled.scale_error, shape);
+  p.stroke_jitter_m = blend(own.stroke_jitter_m, skilled.stroke_jitter_m, shape);
+  p.corner_cut_m = blend(own.corner_cut_m, skilled.corner_cut_m, shape);
+  p.writing_speed_m_s = blend(own.writing_speed_m_s, skilled.writing_speed_m_s, shape);
+  p.mid_stroke_lift_probability =
+      blend(own.mid_stroke_lift_probability, skilled.mid_stroke_lift_probability, shape);
+  p.outside_touch_probability =
+      blend(own.outside_touch_probability, skilled.outside_touch_probability, shape);
+  p.hesitation_probability = blend(own.hesitation_probability, skilled.hesitation_probability, shape);
+  p.order_error_probability = blend(own.order_error_probability, skilled.order_error_probability, order);
+  p.backwards_probability = blend(own.backwards_probability, skilled.backwards_probability, order);
+  p.validate();
+  return p;
+}
+
+}  // namespace calligraphy

@@ -1,0 +1,91 @@
+#include "study/remembered_writer.hpp"
+
+#include <cstdio>
+
+#include "calligraphy/core/errors.hpp"
+#include "core/unicode.hpp"
+#include "study/json_reader.hpp"
+#include "study/saved_sessions.hpp"
+
+namespace calligraphy::study_detail {
+namespace fs = std::filesystem;
+namespace {
+
+using nlohmann::json;
+
+// The subject's saved trials of one session folder as practice, in planned order.
+void practise_session(WriterMemory& memory, const fs::path& folder, const SessionManifest& manifest) {
+  for (const PlannedTrial& trial : manifest.plan) {
+    const fs::path file = folder / "trials" / (SessionFolder::trial_stem(trial) + ".json");
+    std::error_code error;
+    if (!fs::exists(file, error)) break;  // trials are saved in order: the rest are not yet
+    practise_record(memory, read_trial_record(file), file.string());
+  }
+}
+
+void remember(WriterMemory& memory, const fs::path& folder, const SessionManifest& manifest, int depth) {
+  if (manifest.previous && depth < 20) {
+    const fs::path before = folder.parent_path() / manifest.previous->session_id;
+    remember(memory, before, read_session_manifest(before), depth + 1);
+    consolidate(memory);  // hours or days between the sessions
+  }
+  practise_session(memory, folder, manifest);
+}
+
+}  // namespace
+
+void practise_record(WriterMemory& memory, const json& record, const std::string& source) {
+  std::vector<int> ids;
+  std::u32string characters;
+  const json& placed = record.value("scene", json::object()).value("characters", json::array());
+  for (const json& character : placed) {
+    const std::string text = character.value("character", "");
+    const std::u32string decoded = decode_utf8(text);
+    if (decoded.size() != 1) fail(source, "/scene/characters", "expected one character each");
+    characters += decoded;
+    for (const json& stroke : character.value("strokes", json::array()))
+      ids.push_back(stroke.value("typical_id", 0));
+  }
+  if (ids.empty()) fail(source, "/scene", "no strokes: the trial's characters are not recorded");
+  const json& force = record.value("force_law", json::object());
+  double share = 0.0;
+  if (force.value("guidance", false)) {
+    const double hand = record.value("writer", json::object())
+                            .value("profile", json::object())
+                            .value("hand_stiffness_n_per_m", 0.0);
+    if (!(hand > 0.0))
+      fail(source, "/writer/profile/hand_stiffness_n_per_m", "expected the hand's stiffness > 0");
+    share = guidance_assistance_share(force.value("guidance_gain", 1.0),
+                                      force.value("guidance_stiffness_n_per_m", 0.0), hand);
+  }
+  practise(memory, ids, characters, share);
+}
+
+WriterMemory remembered(const SessionFolder& session) {
+  WriterMemory memory;
+  remember(memory, session.path(), session.manifest(), 0);
+  return memory;
+}
+
+std::vector<int> typical_ids(const Scene& scene) {
+  std::vector<int> ids;
+  for (const PlacedCharacter& character : scene.characters) {
+    for (const PlacedStroke& stroke : character.strokes) ids.push_back(stroke.typical_id);
+  }
+  return ids;
+}
+
+std::vector<std::string> learned_parameters(const WriterMemory& memory, const std::string& profile_name,
+                                            const std::vector<int>& ids, const std::u32string& characters) {
+  const WriterProfile learned = learned_profile(writer_profile(profile_name), WriterProfile::skilled(),
+                                                shape_skill(memory, ids), order_skill(memory, characters));
+  std::vector<std::string> parameters;
+  for (const std::string& field : learned_profile_fields()) {
+    char value[40];
+    std::snprintf(value, sizeof value, "%.17g", writer_parameter(learned, field));
+    parameters.push_back(field + "=" + value);
+  }
+  return parameters;
+}
+
+}  // namespace calligraphy::study_detail

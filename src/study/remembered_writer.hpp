@@ -1,0 +1,32 @@
+#pragma once
+// A simulated subject that learns (SessionSetup::writer_learning "two-state"): its memory (sim/
+// writer_memory.hpp) rebuilt from the saved trial records of its sessions, and the profile it writes with.
+// Internal.
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/sim/writer_memory.hpp"
+#include "calligraphy/study/session_folder.hpp"
+
+namespace calligraphy::study_detail {
+
+/// One saved trial as practice: the typical strokes of its scene, its characters, and the share of the
+/// correction its guidance took from the hand (the record's force law and writer profile). Throws DataError
+/// naming `source` when the record lacks them.
+void practise_record(WriterMemory& memory, const nlohmann::json& record, const std::string& source);
+
+/// The memory of `session`'s subject before its first unsaved trial: the sessions before it (by their
+/// `previous_session` links, each followed by `consolidate`), then this session's saved trials in order.
+WriterMemory remembered(const SessionFolder& session);
+
+/// The typical stroke IDs of a scene, stroke by stroke.
+std::vector<int> typical_ids(const Scene& scene);
+
+/// "key=value" writer parameters of the profile `profile_name` learned to `memory`'s skill for a trial of
+/// `characters` with strokes `ids` (learned_profile, towards the skilled profile).
+std::vector<std::string> learned_parameters(const WriterMemory& memory, const std::string& profile_name,
+                                            const std::vector<int>& ids, const std::u32string& characters);
+
+}  // namespace calligraphy::study_detail

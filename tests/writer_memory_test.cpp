@@ -1,0 +1,111 @@
+// The writer's memory (writer_memory.hpp): the two-state model's learning and forgetting, the error that
+// guidance takes away (slacking), consolidation between sessions, transfer through typical strokes.
+#include "calligraphy/sim/writer_memory.hpp"
+
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "calligraphy/core/errors.hpp"
+
+using namespace calligraphy;
+
+namespace {
+
+// The skill of one typical stroke after `trials` trials of one stroke each with assistance `share`.
+double skill_after(int trials, double share) {
+  WriterMemory memory;
+  for (int i = 0; i < trials; ++i) practise(memory, {1}, U"十", share);
+  return memory.typical_strokes.at(1).skill();
+}
+
+}  // namespace
+
+TEST_CASE("the two-state model learns by its rates and the closed form", "[sim][memory]") {
+  const TwoStateRates rates;
+  WriterMemory memory;
+  practise(memory, {1}, U"十", 0.0);
+  // First trial from 0: the error is 1, so x_f = B_f and x_s = B_s.
+  CHECK(memory.typical_strokes.at(1).fast == Approx(rates.fast_learning));
+  CHECK(memory.typical_strokes.at(1).slow == Approx(rates.slow_learning));
+  // Second: x' = A x + B (1 - x_f - x_s) per state.
+  practise(memory, {1}, U"十", 0.0);
+  const double x = rates.fast_learning + rates.slow_learning;
+  CHECK(memory.typical_strokes.at(1).fast ==
+        Approx(rates.fast_retention * rates.fast_learning + rates.fast_learning * (1 - x)));
+  CHECK(memory.typical_strokes.at(1).slow ==
+        Approx(rates.slow_retention * rates.slow_learning + rates.slow_learning * (1 - x)));
+  // Practice raises the skill, by ever smaller steps over equal numbers of trials, and never past 1.
+  double previous = 0.0, step = 1.0;
+  for (int n = 40; n <= 400; n += 40) {
+    const double now = skill_after(n, 0.0);
+    CHECK(now > previous);
+    CHECK(now <= 1.0);
+    CHECK(now - previous < step);
+    step = now - previous;
+    previous = now;
+  }
+}
+
+TEST_CASE("guidance that corrects for the writer leaves less learned (slacking)", "[sim][memory]") {
+  const double alone = skill_after(30, 0.0);
+  const double half = skill_after(30, guidance_assistance_share(1.0, 150.0, 150.0));
+  const double fixture = skill_after(30, guidance_assistance_share(1.0, 600.0, 150.0));
+  CHECK(guidance_assistance_share(1.0, 150.0, 150.0) == Approx(0.5));
+  CHECK(guidance_assistance_share(0.0, 600.0, 150.0) == 0.0);
+  CHECK(alone > half);
+  CHECK(half > fixture);
+  CHECK(fixture > 0.0);
+  CHECK_THROWS_AS(guidance_assistance_share(1.5, 600.0, 150.0), InvalidArgument);
+  CHECK_THROWS_AS(guidance_assistance_share(1.0, 600.0, 0.0), InvalidArgument);
+  WriterMemory memory;
+  CHECK_THROWS_AS(practise(memory, {1}, U"十", -0.1), InvalidArgument);
+}
+
+TEST_CASE("between sessions the fast state is gone and the slow one kept; unpractised skills decay",
+          "[sim][memory]") {
+  WriterMemory memory;
+  for (int i = 0; i < 20; ++i) practise(memory, {1, 2}, U"十", 0.0);
+  const SkillMemory before = memory.typical_strokes.at(1);
+  consolidate(memory);
+  CHECK(memory.typical_strokes.at(1).fast == 0.0);
+  CHECK(memory.typical_strokes.at(1).slow == before.slow);
+  CHECK(memory.typical_strokes.at(1).skill() < before.skill());
+  // Writing other strokes lets stroke 1 decay by the retention factors.
+  const SkillMemory kept = memory.typical_strokes.at(1);
+  practise(memory, {3}, U"人", 0.0);
+  CHECK(memory.typical_strokes.at(1).slow == Approx(kept.slow * TwoStateRates{}.slow_retention));
+}
+
+TEST_CASE("a character not practised starts from what its typical strokes learned elsewhere",
+          "[sim][memory]") {
+  WriterMemory memory;
+  // 十 (typical strokes 1, 2) and 人 (3, 5) practised; 木 is 1, 2, 3, 5 and 山 is 2, 21, 2.
+  for (int i = 0; i < 10; ++i) {
+    practise(memory, {1, 2}, U"十", 0.0);
+    practise(memory, {3, 5}, U"人", 0.0);
+  }
+  CHECK(shape_skill(memory, {1, 2, 3, 5}) > 0.0);
+  CHECK(shape_skill(memory, {1, 2, 3, 5}) > shape_skill(memory, {2, 21, 2}));
+  CHECK(shape_skill(memory, {21}) == 0.0);
+  CHECK(order_skill(memory, U"木") == 0.0);  // its order was never practised
+  CHECK(order_skill(memory, U"十") > 0.0);
+}
+
+TEST_CASE("the learned profile moves from the writer's own to the skilled writer's", "[sim][memory]") {
+  const WriterProfile own = WriterProfile::foreign();
+  const WriterProfile skilled = WriterProfile::skilled();
+  const WriterProfile none = learned_profile(own, skilled, 0.0, 0.0);
+  CHECK(none.bias_offset_m == own.bias_offset_m);
+  CHECK(none.order_error_probability == own.order_error_probability);
+  const WriterProfile all = learned_profile(own, skilled, 1.0, 1.0);
+  CHECK(all.bias_offset_m == Approx(skilled.bias_offset_m));
+  CHECK(all.backwards_probability == Approx(skilled.backwards_probability));
+  CHECK(all.hand_stiffness_n_per_m == own.hand_stiffness_n_per_m);  // the hand itself does not change
+  const WriterProfile half = learned_profile(own, skilled, 0.5, 0.0);
+  CHECK(half.bias_offset_m == Approx((own.bias_offset_m + skilled.bias_offset_m) / 2));
+  CHECK(half.order_error_probability == own.order_error_probability);
+  CHECK_THROWS_AS(learned_profile(own, skilled, 1.5, 0.0), InvalidArgument);
+  for (const std::string& field : learned_profile_fields()) {
+    CHECK_NOTHROW(writer_parameter(all, field));
+  }
+}
