@@ -61,7 +61,7 @@ TEST_CASE("guidance that corrects for the writer leaves less learned (slacking)"
   CHECK_THROWS_AS(practise(memory, {1}, U"十", -0.1), InvalidArgument);
 }
 
-TEST_CASE("between sessions the fast state is gone and the slow one kept; unpractised skills decay",
+TEST_CASE("between sessions the fast state is gone and the slow one kept, and unpractised skills decay",
           "[sim][memory]") {
   WriterMemory memory;
   for (int i = 0; i < 20; ++i) practise(memory, {1, 2}, U"十", 0.0);

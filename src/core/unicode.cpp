@@ -45,6 +45,12 @@ std::u32string decode_utf8(std::string_view text) {
   return out;
 }
 
+std::string encode_utf8(const std::u32string& text) {
+  std::string out;
+  for (const char32_t c : text) out += encode_utf8(c);
+  return out;
+}
+
 std::string encode_utf8(char32_t cp) {
   if (cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) {
     throw InvalidArgument("encode_utf8: not a Unicode scalar value: " +

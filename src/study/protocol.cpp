@@ -190,7 +190,7 @@ void check_teacher_items(const StudyProtocol& protocol, const std::string& sourc
             return std::find(p.items.begin(), p.items.end(), item) != p.items.end();
           });
       if (written) continue;
-      const std::string text = study_detail::utf8_of(item);
+      const std::string text = encode_utf8(item);
       fail(source, child_pointer(child_pointer(child_pointer("/conditions", i), "teachers"), text),
            "\"" + text + "\" is not an item of the protocol (the characters of its phases)");
     }
@@ -347,14 +347,6 @@ const char* to_string(StudyPhase phase) noexcept {
 const char* to_string(ConditionAssignment assignment) noexcept {
   return assignment == ConditionAssignment::between_subjects ? "between-subjects" : "within-subjects";
 }
-
-namespace study_detail {
-std::string utf8_of(const std::u32string& text) {
-  std::string out;
-  for (const char32_t c : text) out += encode_utf8(c);
-  return out;
-}
-}  // namespace study_detail
 
 const char* to_string(ConditionMode mode) noexcept {
   switch (mode) {

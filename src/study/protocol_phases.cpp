@@ -184,7 +184,7 @@ void check_design(const StudyProtocol& protocol, const std::string& pointer, con
         fail(source,
              phase.choice ? child_pointer(child_pointer(at(i, "characters"), "from"), k)
                           : child_pointer(at(i, "characters"), k),
-             quoted(utf8_of(listed[k])) + " is trained: a transfer test is on characters not trained");
+             quoted(encode_utf8(listed[k])) + " is trained: a transfer test is on characters not trained");
       }
     }
   }

@@ -29,7 +29,4 @@ std::string condition_name(const nlohmann::json& value, const std::string& point
 void read_phases(const nlohmann::json& value, const std::string& pointer, const std::string& source,
                  StudyProtocol& protocol);
 
-/// UTF-8 of `text`.
-std::string utf8_of(const std::u32string& text);
-
 }  // namespace calligraphy::study_detail

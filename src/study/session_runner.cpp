@@ -33,12 +33,6 @@ std::string stop_reason(const SessionRunOptions& options) {
   return reason.empty() ? "interrupted" : reason;
 }
 
-std::string utf8(const std::u32string& text) {
-  std::string out;
-  for (const char32_t c : text) out += encode_utf8(c);
-  return out;
-}
-
 // The registry's listing of the session's device (whether a person moves it, what it can do).
 DeviceListing find_listing(const DeviceRegistry& registry, const std::string& name) {
   DeviceSurvey survey = registry.survey();
@@ -66,7 +60,7 @@ void check_plan(const SessionManifest& session, const DeviceListing& device) {
 
 json trial_details(const PlannedTrial& trial) {
   return {{"trial", trial.index + 1},       {"phase", to_string(trial.phase)},
-          {"condition", trial.condition},   {"characters", utf8(trial.characters)},
+          {"condition", trial.condition},   {"characters", encode_utf8(trial.characters)},
           {"repetition", trial.repetition}, {"file", SessionFolder::trial_stem(trial)}};
 }
 

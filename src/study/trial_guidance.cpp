@@ -16,12 +16,6 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-std::string utf8(const std::u32string& text) {
-  std::string out;
-  for (const char32_t c : text) out += encode_utf8(c);
-  return out;
-}
-
 // "teachers/CONDITION-U5341_U4EBA.json": one teacher per condition and item.
 std::string teacher_file_name(const StudyCondition& condition, const std::u32string& characters) {
   std::string name = "teachers/" + condition.name + "-";
@@ -38,7 +32,7 @@ std::string record_teacher(const SessionFolder& session, const Scene& scene,
                            const std::u32string& characters) {
   const ProtocolTrialSettings& settings = session.manifest().protocol.protocol.trial;
   TrialSpec teacher;
-  teacher.characters = utf8(characters);
+  teacher.characters = encode_utf8(characters);
   teacher.guidance = true;
   teacher.writer = TrialWriter::simulated;
   teacher.writer_profile = "skilled";
@@ -48,12 +42,12 @@ std::string record_teacher(const SessionFolder& session, const Scene& scene,
   teacher.pacing = TrialPacing::lock_step;
   const TrialResult result = run_trial_spec(teacher, scene).result;
   if (result.aborted || !result.metrics.completed_in_order) {
-    throw StateError("the simulated teacher of \"" + utf8(characters) + "\" wrote " +
+    throw StateError("the simulated teacher of \"" + encode_utf8(characters) + "\" wrote " +
                      std::to_string(result.metrics.strokes_completed) + " of " +
                      std::to_string(result.metrics.strokes_total) + " strokes in order (" +
                      to_string(result.end) + "): give the condition a teacher's recording of it");
   }
-  return teacher_recording_json(teacher_recording_from_trace(utf8(characters), "simulated skilled",
+  return teacher_recording_json(teacher_recording_from_trace(encode_utf8(characters), "simulated skilled",
                                                              teacher.device, teacher.rate_hz, result.trace));
 }
 
@@ -102,7 +96,7 @@ PreparedGuidance replay_guidance(SessionFolder& session, const StudyCondition& c
   const auto checked = [&](const std::string& text, const std::string& source) {
     TeacherRecording teacher = parse_teacher_recording(text, source);
     try {
-      require_teacher_for(teacher, utf8(trial.characters));
+      require_teacher_for(teacher, encode_utf8(trial.characters));
     } catch (const InvalidArgument& e) {
       throw InvalidArgument("condition '" + condition.name + "', teacher " + prepared.teacher_source + ": " +
                             e.what());
@@ -122,7 +116,7 @@ PreparedGuidance replay_guidance(SessionFolder& session, const StudyCondition& c
     fs::create_directories(path.parent_path(), error);
     write_file_atomically(path, text);
     session.log("teacher_saved", json{{"condition", condition.name},
-                                      {"characters", utf8(trial.characters)},
+                                      {"characters", encode_utf8(trial.characters)},
                                       {"file", prepared.teacher_file},
                                       {"source", prepared.teacher_source},
                                       {"sha256", sha256_hex(text)}}

@@ -21,12 +21,6 @@ constexpr const char* kFormat = "calligraphy-study-trial";
 json vec(const Vec2& v) { return json::array({v.x(), v.y()}); }
 json vec(const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
 
-std::string utf8(const std::u32string& text) {
-  std::string out;
-  for (const char32_t c : text) out += encode_utf8(c);
-  return out;
-}
-
 const char* method_name(NearestPointMethod method) {
   switch (method) {
     case NearestPointMethod::exact:
@@ -256,7 +250,7 @@ std::string trial_record_json(const TrialRecordContext& c, const Scene& scene, c
       {"phase", to_string(t.phase)},
       {"condition", t.condition},
       {"mode", to_string(c.condition->mode)},
-      {"characters", utf8(t.characters)},
+      {"characters", encode_utf8(t.characters)},
       {"repetition", t.repetition},
       {"start_time_utc", c.start_utc},
       {"end_time_utc", c.end_utc},
