@@ -8,6 +8,7 @@
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/study/curriculum.hpp"
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/schedule.hpp"
 #include "calligraphy/study/transfer_set.hpp"
@@ -455,4 +456,52 @@ TEST_CASE("a transfer set: untrained characters made of trained typical strokes,
     };
     for (const char32_t c : eligible) CHECK(distinct(chosen[0]) >= distinct(c));
   }
+}
+
+TEST_CASE("a curriculum proposes new typical strokes first, then weak ones, over characters not written",
+          "[study][curriculum]") {
+  // Made-up characters and strokes: the rule, not any real character.
+  const std::map<char32_t, std::vector<int>> strokes{{U'a', {1, 2}},   {U'b', {1, 8, 9}},  {U'c', {3}},
+                                                     {U'd', {8}},      {U'e', {4, 5}},     {U'f', {1, 2, 3}},
+                                                     {U'g', {10, 11}}, {U'h', {10, 11, 1}}};
+  const auto ids = [&strokes](char32_t c) { return strokes.at(c); };
+  // Written: 1 (3 mm), 2 (1 mm), 3 (2 mm), 4 (0.5 mm); 5 seen but never matched. Median 1.5 mm: 1 and 3 weak.
+  std::vector<TypicalStrokeRecord> record{
+      {1, 4, 3e-3}, {2, 4, 1e-3}, {3, 2, 2e-3}, {4, 1, 0.5e-3}, {5, 0, {}}};
+  const std::vector<ProposedCharacter> proposed = propose_characters(record, U"a", U"abcdefgh", 10, ids);
+  std::u32string order;
+  for (const ProposedCharacter& p : proposed) order.push_back(p.character);
+  // b brings 8 and 9 new (2 each) and 1 weak (1): 5; then g brings 10 and 11 new: 4, as h does (its 1 is
+  // covered now) with more strokes; then e brings 5 (never matched: new); then c brings 3 (weak), as f does
+  // with more strokes; d and h add nothing left.
+  CHECK(order == U"bgec");
+  CHECK(proposed[0].new_strokes == std::vector<int>{8, 9});
+  CHECK(proposed[0].weak_strokes == std::vector<int>{1});
+  CHECK(proposed[1].new_strokes == std::vector<int>{10, 11});
+  CHECK(proposed[2].new_strokes == std::vector<int>{5});
+  CHECK(proposed[3].weak_strokes == std::vector<int>{3});
+  CHECK(propose_characters(record, U"a", U"abcdefgh", 2, ids).size() == 2);
+  CHECK(propose_characters(record, U"abcdefgh", U"abcdefgh", 5, ids).empty());  // all written
+
+  StudyTables tables;
+  StrokeRow row;
+  row.subject = "S1";
+  row.typical_id = 7;
+  row.written = true;
+  row.mean_deviation_m = 2e-3;
+  tables.strokes.push_back(row);
+  row.mean_deviation_m = 4e-3;
+  tables.strokes.push_back(row);
+  row.typical_id = 9;
+  row.written = false;
+  row.mean_deviation_m.reset();
+  tables.strokes.push_back(row);
+  const std::vector<TypicalStrokeRecord> read = typical_stroke_record(tables, "S1");
+  REQUIRE(read.size() == 2);
+  CHECK(read[0].typical_id == 7);
+  CHECK(read[0].written == 2);
+  CHECK(*read[0].mean_deviation_m == Approx(3e-3));
+  CHECK(read[1].written == 0);
+  CHECK_FALSE(read[1].mean_deviation_m);
+  CHECK_THROWS_WITH(typical_stroke_record(tables, "S2"), Catch::Contains("'S2' has no saved trial"));
 }

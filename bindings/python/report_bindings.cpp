@@ -14,7 +14,10 @@
 #include "bindings.hpp"
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/report/teacher_recording.hpp"
+#include "calligraphy/study/curriculum.hpp"
 #include "calligraphy/study/study_tables.hpp"
+#include "character_source.hpp"
+#include "core/unicode.hpp"
 
 namespace calligraphy::python {
 
@@ -35,7 +38,8 @@ void bind_report(py::module_& m) {
       [](const py::list& roots) {
         std::vector<std::filesystem::path> paths;
         for (const py::handle root : roots) {
-          paths.push_back(convert_named<std::filesystem::path>(py::reinterpret_borrow<py::object>(root), "paths"));
+          paths.push_back(
+              convert_named<std::filesystem::path>(py::reinterpret_borrow<py::object>(root), "paths"));
         }
         StudyTables tables;
         {
@@ -48,6 +52,37 @@ void bind_report(py::module_& m) {
       "The tidy tables of the session folders under `paths` as the CSV texts (trials, strokes) that "
       "`calligraphy report --csv` writes (read_study_tables, include/calligraphy/study/study_tables.hpp); "
       "calligraphy.study.load makes DataFrames of them. Raises DataError naming a damaged file.");
+  m.def(
+      "_propose_characters",
+      [](const py::list& roots, const std::string& subject, const std::string& candidates, std::size_t count,
+         const CharacterSource& library) {
+        std::vector<std::filesystem::path> paths;
+        for (const py::handle root : roots) {
+          paths.push_back(
+              convert_named<std::filesystem::path>(py::reinterpret_borrow<py::object>(root), "paths"));
+        }
+        const StudyTables tables = read_study_tables(paths);
+        const auto typical_ids = [&library](char32_t c) {
+          std::vector<int> ids;
+          for (const Stroke& stroke : library.load(c).strokes) ids.push_back(stroke.typical_id);
+          return ids;
+        };
+        py::list out;
+        for (const ProposedCharacter& p :
+             propose_characters(typical_stroke_record(tables, subject), written_characters(tables, subject),
+                                decode_utf8(candidates), count, typical_ids)) {
+          py::dict row;
+          row["character"] = encode_utf8(p.character);
+          row["new_strokes"] = p.new_strokes;
+          row["weak_strokes"] = p.weak_strokes;
+          out.append(row);
+        }
+        return out;
+      },
+      py::arg("paths"), py::arg("subject"), py::arg("candidates"), py::arg("count"), py::arg("library"),
+      "The characters `subject` should practise next (propose_characters, include/calligraphy/study/"
+      "curriculum.hpp): a list of dicts (character, new_strokes, weak_strokes: typical-stroke IDs). "
+      "calligraphy.study.propose_characters wraps it.");
   py::class_<TeacherRecording>(
       m, "TeacherRecording",
       "A teacher's recorded trial for the replay guidance mode (include/calligraphy/report/"

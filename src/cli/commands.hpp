@@ -15,7 +15,8 @@ void add_devices_command(CLI::App& root, Commands& commands);   // devices [--js
 void add_corpus_commands(CLI::App& root, Commands& commands);   // corpus build|stats|fidelity|validate
 void add_bench_commands(CLI::App& root, Commands& commands);    // bench nearest|jumps|tick|loop|acceptance
 void add_session_commands(CLI::App& root, Commands& commands);  // session run|resume
-void add_report_command(CLI::App& root, Commands& commands);    // report DIR... --out FILE
+void add_report_command(CLI::App& root, Commands& commands);
+void add_curriculum_command(CLI::App& root, Commands& commands);  // curriculum DIR... --subject ID --from CHARS    // report DIR... --out FILE
 
 // The subcommands of the groups, one file each.
 void add_corpus_build_command(CLI::App& corpus, Commands& commands);

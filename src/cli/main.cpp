@@ -70,6 +70,7 @@ int main(int argc, char** argv) {
   add_bench_commands(root, commands);
   add_session_commands(root, commands);
   add_report_command(root, commands);
+  add_curriculum_command(root, commands);
 
   int status = 0;
   try {

@@ -351,6 +351,9 @@ def test_group_comparison_agrees_with_scipy_and_finds_a_planted_group_effect():
     assert "Welch" in result.test and len(result.to_frame()) == 1
     with pytest.raises(ValueError, match="'none' is not in the 'group' column"):
         statistics.group_comparison(table, "retention", "fixture", "none")
+    constant = table.assign(retention=np.where(table.group == "fixture", 3e-3, 2e-3))
+    with pytest.raises(ValueError, match="does not vary within either group"):
+        statistics.group_comparison(constant, "retention", "fixture", "fading")
     with pytest.raises(ValueError, match="one row per subject"):
         statistics.group_comparison(pandas.concat([table, table]), "retention", "fixture", "fading")
 

@@ -61,3 +61,17 @@ def test_samples_are_read_on_demand_in_si_units(study_folder):
 def test_a_folder_without_sessions_is_named(tmp_path):
     with pytest.raises(calligraphy.DataError, match=str(tmp_path)):
         calligraphy.study.load(tmp_path)
+
+
+def test_the_curriculum_is_the_clis(cli, study_folder):
+    # paper-table5 shrunk to 永 (practice), 十 and 人: what comes next among characters not written.
+    candidates = "大天木山中日千永十"
+    proposed = calligraphy.study.propose_characters(study_folder / "study", "S01", candidates, count=3)
+    run = subprocess.run([cli, "curriculum", "study", "--subject", "S01", "--from", candidates, "--count", "3",
+                          "--json"], cwd=study_folder, capture_output=True)
+    assert run.returncode == 0, run.stderr.decode()
+    assert proposed == json.loads(run.stdout)
+    assert proposed and all(p["character"] not in "永十人" for p in proposed)
+    assert proposed[0]["new_strokes"]  # something never written comes first
+    with pytest.raises(Exception, match="'nobody' has no saved trial"):
+        calligraphy.study.propose_characters(study_folder / "study", "nobody", candidates)

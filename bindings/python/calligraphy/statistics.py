@@ -712,7 +712,7 @@ def group_comparison(table: pandas.DataFrame, value: str, a: typing.Any, b: typi
 
     Raises TypeError when ``table`` is not a DataFrame or ``value`` is not numeric; ValueError naming a
     missing column, a group not present (listing those present), a = b, a subject in more than one row,
-    or fewer than 2 subjects with a value in either group.
+    fewer than 2 subjects with a value in either group, or a value constant within both groups.
     """
     caller = "group_comparison"
     stats = _scipy_stats()
@@ -734,6 +734,9 @@ def group_comparison(table: pandas.DataFrame, value: str, a: typing.Any, b: typi
     if len(x) < 2 or len(y) < 2:
         raise _TooFewData(f"{caller}: {len(x)} subject(s) in {a!r} and {len(y)} in {b!r} have a value of "
                           f"{value!r}; a comparison needs at least 2 in each")
+    if np.ptp(x) == 0 and np.ptp(y) == 0:
+        raise ValueError(f"{caller}: {value!r} does not vary within either group; a test of the difference "
+                         "says nothing (the difference is exact)")
     welch = stats.ttest_ind(x, y, equal_var=False)
     # Welch-Satterthwaite df and interval (scipy 1.10's ttest_ind returns neither).
     share_a, share_b = np.var(x, ddof=1) / len(x), np.var(y, ddof=1) / len(y)

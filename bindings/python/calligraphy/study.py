@@ -106,3 +106,19 @@ def load(paths: typing.Union[PathLike, typing.Sequence[PathLike]]) -> Study:
     trials = _read_table(trials_text, _NUMERIC_TRIAL_COLUMNS, ("completed_in_order",))
     strokes = _read_table(strokes_text, _NUMERIC_STROKE_COLUMNS, ("written", "backwards"))
     return Study(trials=trials, strokes=strokes)
+
+
+def propose_characters(paths: typing.Union[PathLike, typing.Sequence[PathLike]], subject: str, candidates: str,
+                       count: int = 3, library: typing.Any = None) -> list[dict]:
+    """The characters `subject` should practise next, from its saved trials under `paths` (as `load`):
+    greedily those of `candidates` (a str of characters) that bring the most typical strokes it never wrote
+    (2 each) and that it writes worst (1 each: a mean deviation above the median of its typical strokes),
+    ties to fewer strokes; characters it has written are not proposed (include/calligraphy/study/
+    curriculum.hpp; the same as ``calligraphy curriculum``). Returns up to `count` dicts: character,
+    new_strokes and weak_strokes (typical-stroke IDs). library: a calligraphy.CharacterLibrary for the
+    candidates (default: the embedded characters). Raises InvalidArgument for a subject without saved
+    trials, CharacterNotFound for a candidate the library lacks, DataError for a damaged record."""
+    if library is None:
+        library = _calligraphy.CharacterLibrary.default()
+    roots = [paths] if isinstance(paths, (str, os.PathLike)) else list(paths)
+    return _calligraphy._propose_characters([os.fspath(root) for root in roots], subject, candidates, count, library)
