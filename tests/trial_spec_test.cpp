@@ -140,6 +140,12 @@ TEST_CASE("a specification's errors name the field in both its forms") {
   bad = spec;
   bad.guidance_mode = GuidanceMode::replay;
   fails_naming(bad, "teacher (--teacher): required");
+  // A teacher given as samples to the runner needs no file, and a file beside them would not be read.
+  CHECK_NOTHROW(bad.validate(TeacherSource::samples));
+  bad.teacher = "teacher.json";
+  CHECK_NOTHROW(bad.validate());
+  CHECK_THROWS_WITH(bad.validate(TeacherSource::samples),
+                    Catch::Contains("teacher (--teacher): the teacher is given as samples"));
   bad = spec;
   bad.writer = TrialWriter::person;
   bad.writer_profile = "skilled";

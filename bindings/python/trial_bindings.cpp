@@ -14,14 +14,14 @@
 
 #include "arguments.hpp"
 #include "bindings.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
-#include "calligraphy/sim/simulated_hand.hpp"
-#include "calligraphy/study/trial_spec_runner.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
 #include "calligraphy/render/passivity.hpp"
 #include "calligraphy/render/safety_chain.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/sim/simulated_hand.hpp"
+#include "calligraphy/study/trial_spec_runner.hpp"
 #include "calligraphy/trial/trial.hpp"
 #include "character_source.hpp"
 #include "core/unicode.hpp"
@@ -246,12 +246,12 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   spec.guidance = options.force.guidance;
   if (spec.guidance) spec.guidance_mode = options.force.guidance_mode;
   if (spec.guidance_mode == GuidanceMode::fading) spec.guidance_gain = options.force.guidance_gain;
-  if (spec.guidance_mode == GuidanceMode::replay) spec.teacher = "teacher=";  // given as samples, below
   spec.seed = simulation.seed;
   spec.rate_hz = options.rate_hz;
   spec.pacing = options.pacing;
   spec.max_duration_s = options.max_duration_s;
-  spec.validate();
+  // A replay's teacher is given as samples (TrialRunInputs::teacher), below.
+  spec.validate(spec.guidance_mode == GuidanceMode::replay ? TeacherSource::samples : TeacherSource::file);
   std::unique_ptr<SimulatedDevice> simulated_device;
   TrialRunInputs inputs;
   if (device_name.empty()) {

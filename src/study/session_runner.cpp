@@ -116,9 +116,9 @@ TrialSpec study_trial_spec(const SessionManifest& session, const StudyCondition&
     if (guidance.teacher.size() < 2) {
       throw InvalidArgument("condition '" + condition.name + "': a replay needs the teacher's recording");
     }
+    // The session folder's copy (teachers/...), given to the runner as read (TrialRunInputs::teacher); the
+    // record names its file under "guidance".
     spec.guidance_mode = GuidanceMode::replay;
-    // The session folder's copy (teachers/...), given to the runner as read (TrialRunInputs::teacher).
-    spec.teacher = guidance.teacher_file.empty() ? std::string("teachers/") : guidance.teacher_file;
   }
   const bool simulated = session.setup.writer == "simulated";
   spec.writer = simulated ? TrialWriter::simulated : TrialWriter::person;
@@ -133,7 +133,7 @@ TrialSpec study_trial_spec(const SessionManifest& session, const StudyCondition&
   spec.rate_hz = protocol.trial.rate_hz;
   spec.max_duration_s = protocol.trial.max_duration_s;
   spec.pacing = parse_trial_pacing(session.setup.pacing, "session pacing");
-  spec.validate();
+  spec.validate(condition.mode == ConditionMode::replay ? TeacherSource::samples : TeacherSource::file);
   return spec;
 }
 
@@ -252,7 +252,6 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
       const std::vector<int> ids = study_detail::typical_ids(scene);
       spec.writer_parameters =
           study_detail::learned_parameters(memory, manifest.setup.writer_profile, ids, trial.characters);
-      spec.validate();
       skills = std::pair{shape_skill(memory, ids), order_skill(memory, trial.characters)};
       started["shape_skill"] = skills->first;
       started["order_skill"] = skills->second;

@@ -207,7 +207,7 @@ std::vector<std::string> trial_spec_field_text(const TrialSpec& spec, std::strin
   return {spec.record_file};
 }
 
-void TrialSpec::validate() const {
+void TrialSpec::validate(TeacherSource teacher_from) const {
   std::u32string decoded;
   try {
     decoded = decode_utf8(characters);
@@ -231,8 +231,11 @@ void TrialSpec::validate() const {
   if (guidance_gain != 1.0 && guidance_mode != GuidanceMode::fading) {
     refuse("guidance_gain", "applies to guidance mode 'fading' only");
   }
-  if (guidance_mode == GuidanceMode::replay && teacher.empty()) {
+  if (guidance_mode == GuidanceMode::replay && teacher.empty() && teacher_from == TeacherSource::file) {
     refuse("teacher", "required with guidance mode 'replay' (a recording made with --record)");
+  }
+  if (!teacher.empty() && teacher_from == TeacherSource::samples) {
+    refuse("teacher", "the teacher is given as samples; the file would not be read");
   }
   if (!teacher.empty() && guidance_mode != GuidanceMode::replay) {
     refuse("teacher", "applies to guidance mode 'replay' only");

@@ -36,7 +36,8 @@ WriterProfile profile_of(const TrialSpec& spec) {
 }  // namespace
 
 TrialOptions trial_options(const TrialSpec& spec, const DeviceInfo& device) {
-  spec.validate();
+  // The teacher is the caller's to read or give: a replay without a file is not an error here.
+  spec.validate(spec.teacher.empty() ? TeacherSource::samples : TeacherSource::file);
   TrialOptions options;
   options.force.guidance = spec.guidance;
   options.force.guidance_mode = spec.guidance_mode;
@@ -74,7 +75,7 @@ bool simulated_writer_writes(const TrialSpec& spec, bool simulated_writer_can_mo
 }
 
 TrialRun run_trial_spec(const TrialSpec& spec, const Scene& scene, const TrialRunInputs& inputs) {
-  spec.validate();
+  spec.validate(inputs.teacher.empty() ? TeacherSource::file : TeacherSource::samples);
   TrialRun run;
   run.writer = inputs.writer ? *inputs.writer : profile_of(spec);
   run.writer.validate();

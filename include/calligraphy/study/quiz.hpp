@@ -14,10 +14,10 @@
 #include <optional>
 #include <vector>
 
+#include "calligraphy/analysis/score.hpp"
 #include "calligraphy/analysis/stroke_matcher.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/study/protocol.hpp"
-#include "calligraphy/analysis/score.hpp"
 
 namespace calligraphy {
 

@@ -24,6 +24,10 @@ enum class TrialWriter : std::uint8_t { automatic, person, simulated };
 
 [[nodiscard]] const char* to_string(TrialWriter writer) noexcept;
 
+/// Where a replay's teacher comes from: the recording file `TrialSpec::teacher`, or the teacher's samples
+/// given to the runner (a session keeps its teacher in its folder; Python passes a TeacherRecording).
+enum class TeacherSource { file, samples };
+
 /// One trial, as a person or a script states it. Lengths in m, times in s, rates in Hz.
 struct TrialSpec {
   std::string characters;                            ///< UTF-8, written left to right (1..1000)
@@ -51,8 +55,10 @@ struct TrialSpec {
   /// parameter, a guidance mode or gain without the guidance it needs, a replay without a teacher or a
   /// teacher without a replay, a profile for a person, a rate outside the pacing's range, more than 10^7
   /// ticks, a teacher's recording on standard output. Outputs on one file are the front-end's to refuse
-  /// (it resolves links: the CLI's file plan).
-  void validate() const;
+  /// (it resolves links: the CLI's file plan). `teacher_from`: where a replay's teacher comes from, the file
+  /// `teacher` (required then) or samples the runner is given (TrialRunInputs::teacher; `teacher` must then
+  /// be empty: nothing would read it).
+  void validate(TeacherSource teacher_from = TeacherSource::file) const;
 
   bool operator==(const TrialSpec&) const = default;
 };

@@ -53,8 +53,8 @@ struct TrialRun {
 /// The runner's options for `spec` on a device with figures `device`: guidance, mode, gain, rate, pacing,
 /// real-time settings and duration from `spec`; the force law's default stiffnesses capped at the device's
 /// stable maximum (`DeviceInfo::max_stiffness_n_per_m`), so that defaults never draw the renderer's
-/// over-limit warning. The teacher's trajectory is not read here. Throws what `TrialSpec::validate`
-/// throws.
+/// over-limit warning. The teacher's trajectory is not read here, and a replay need not name its file (the
+/// caller reads it or gives its samples). Throws what `TrialSpec::validate` throws.
 [[nodiscard]] TrialOptions trial_options(const TrialSpec& spec, const DeviceInfo& device);
 
 /// Who writes `spec` on a device: `TrialWriter::simulated` or `person` as stated, else the simulated writer
@@ -64,9 +64,10 @@ struct TrialRun {
 [[nodiscard]] bool simulated_writer_writes(const TrialSpec& spec, bool simulated_writer_can_move);
 
 /// Runs the trial `spec` states on `scene` (laid out from `spec.characters` by the caller, who knows where
-/// characters come from). Validates first; creates the device (unless given), reads the teacher (unless
-/// given), makes the simulated writer's hand when it writes, runs `run_trial`, and scores the trace.
-/// Writes none of `spec`'s output files (the caller's: they depend on its front-end). Throws what
+/// characters come from). Validates first (a replay's teacher from the file `spec.teacher`, or from
+/// `inputs.teacher` when given, `spec.teacher` then empty); creates the device (unless given), reads the
+/// teacher (unless given), makes the simulated writer's hand when it writes, runs `run_trial`, and scores the
+/// trace. Writes none of `spec`'s output files (the caller's: they depend on its front-end). Throws what
 /// `validate` throws, DeviceNotFound, DataError for a teacher that cannot be read, InvalidArgument for one
 /// of other characters, and what `run_trial` throws.
 [[nodiscard]] TrialRun run_trial_spec(const TrialSpec& spec, const Scene& scene,
