@@ -25,6 +25,18 @@ void decay(SkillMemory& memory, const TwoStateRates& rates) {
   memory.slow *= rates.slow_retention;
 }
 
+// The mean skill of `keys` (one per stroke or character, repeats counted); 0 for one never practised.
+template <typename Key, typename Keys>
+double mean_skill(const std::map<Key, SkillMemory>& skills, const Keys& keys) {
+  if (keys.empty()) return 0.0;
+  double sum = 0.0;
+  for (const Key key : keys) {
+    const auto found = skills.find(key);
+    sum += found == skills.end() ? 0.0 : found->second.skill();
+  }
+  return sum / static_cast<double>(keys.size());
+}
+
 double blend(double own, double skilled, double skill) { return own + (skilled - own) * skill; }
 
 void check_skill(double skill, const char* name) {
@@ -96,23 +108,11 @@ void consolidate(WriterMemory& memory) {
 }
 
 double shape_skill(const WriterMemory& memory, const std::vector<int>& typical_ids) {
-  if (typical_ids.empty()) return 0.0;
-  double sum = 0.0;
-  for (const int id : typical_ids) {
-    const auto found = memory.typical_strokes.find(id);
-    sum += found == memory.typical_strokes.end() ? 0.0 : found->second.skill();
-  }
-  return sum / static_cast<double>(typical_ids.size());
+  return mean_skill(memory.typical_strokes, typical_ids);
 }
 
 double order_skill(const WriterMemory& memory, const std::u32string& characters) {
-  if (characters.empty()) return 0.0;
-  double sum = 0.0;
-  for (const char32_t c : characters) {
-    const auto found = memory.characters.find(c);
-    sum += found == memory.characters.end() ? 0.0 : found->second.skill();
-  }
-  return sum / static_cast<double>(characters.size());
+  return mean_skill(memory.characters, characters);
 }
 
 const std::vector<std::string>& learned_profile_fields() {
