@@ -131,7 +131,6 @@ int run_train(const TrainCommand& command) {
                        " (a trial is one character: practise that one character alone)");
     }
     options.teacher = teacher.samples;
-    options.teacher_file = command.teacher;
   }
   options.seed = command.seed;
   options.session_dir = command.session;

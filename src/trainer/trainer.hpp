@@ -31,7 +31,6 @@ struct TrainerOptions {
   GuidanceMode guidance_mode = GuidanceMode::fixed;  ///< how guidance attracts (M cycles it)
   double guidance_gain = 1.0;          ///< the fading mode's first gain in [0, 1]; faded after each trial
   std::vector<TeacherSample> teacher;  ///< replay: the teacher's pen (one character, its recording)
-  std::string teacher_file;            ///< replay: the recording's file, `teacher` as read from it
   /// A quiz (study/quiz.hpp): guidance off, each stroke judged live by the stroke matcher as the pen lifts.
   bool quiz = false;
   /// Hint after N misses, backwards accepted or not. The trainer sets the acceptance and start radius to its

@@ -38,15 +38,14 @@ void TrainerApp::start_trial(std::size_t character) {
   view_->number = ++trials_started_;
   view_->guidance = guidance_;
   view_->condition = condition_name();
-  // The trial specification of this trial; the teacher, the display channel and what a window process
-  // needs are the runner's inputs.
+  // The trial specification of this trial; the teacher (read once, as samples), the display channel and what
+  // a window process needs are the runner's inputs.
   TrialSpec spec;
   spec.characters = options_.characters[character].utf8;
   spec.device = options_.device;
   spec.guidance = guidance_;
   if (guidance_) spec.guidance_mode = guidance_mode_;
   if (spec.guidance_mode == GuidanceMode::fading) spec.guidance_gain = guidance_gain_;
-  if (spec.guidance_mode == GuidanceMode::replay) spec.teacher = options_.teacher_file;
   spec.writer = options_.simulated_writer ? TrialWriter::simulated : TrialWriter::person;
   if (options_.simulated_writer) spec.writer_profile = options_.writer_profile;
   spec.seed = options_.seed + trials_started_ - 1;
@@ -117,7 +116,8 @@ void TrainerApp::finish_trial() {
   view.metrics = result.metrics;
   view.metrics.mean_deviation_m =
       writing.deviation ? std::optional<double>(writing.deviation->mean_m) : std::nullopt;
-  view.metrics.max_deviation_m = writing.deviation ? std::optional<double>(writing.deviation->max_m) : std::nullopt;
+  view.metrics.max_deviation_m =
+      writing.deviation ? std::optional<double>(writing.deviation->max_m) : std::nullopt;
   view.metrics.time_s = writing.total_time_s;
   view.end_reason = result.abort_reason;
   if (result.end == TrialEnd::device_fault || result.end == TrialEnd::watchdog) status_ = 1;
