@@ -414,6 +414,13 @@ TEST_CASE("a protocol of phases that makes no sense is refused, naming the phase
   const std::string no_training = R"({"name": "b", "conditions": [{"name": "A", "mode": "vision"}],
       "phases": [{"phase": "post-test", "condition": "A", "characters": ["十"]}]})";
   check_error(no_training, "/phases/0/phase", "needs a training phase");
+  // A null is not a missing value that falls back to a default.
+  check_error(R"({"name": "b", "conditions": [{"name": "A", "mode": null}],
+      "phases": [{"phase": "test", "condition": "A", "characters": ["十"]}]})",
+              "/conditions/0/mode", "expected a string");
+  check_error(R"({"name": "b", "conditions": [{"name": "A", "mode": "vision"}],
+      "phases": [{"phase": null, "condition": "A", "characters": ["十"]}]})",
+              "/phases/0/phase", "expected a string");
 }
 
 TEST_CASE("a transfer set: untrained characters made of trained typical strokes, most coverage first",

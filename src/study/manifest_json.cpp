@@ -3,23 +3,13 @@
 #include "calligraphy/core/errors.hpp"
 #include "core/unicode.hpp"
 #include "study/json_reader.hpp"
+#include "study/protocol_reading.hpp"
 
 namespace calligraphy::study_detail {
 namespace {
 
 using nlohmann::json;
 constexpr const char* kFormat = "calligraphy-study-session";
-
-StudyPhase phase_from_text(const std::string& text, const std::string& pointer, const std::string& source) {
-  for (const StudyPhase phase :
-       {StudyPhase::practice, StudyPhase::test, StudyPhase::pre_test, StudyPhase::training,
-        StudyPhase::post_test, StudyPhase::retention, StudyPhase::transfer}) {
-    if (text == to_string(phase)) return phase;
-  }
-  fail(source, pointer,
-       "expected a phase (practice, test, pre-test, training, post-test, retention, transfer), got \"" +
-           text + "\"");
-}
 
 PlannedTrial planned_trial_from(const json& value, const std::string& pointer, const std::string& source,
                                 std::size_t expected_index) {
@@ -30,8 +20,7 @@ PlannedTrial planned_trial_from(const json& value, const std::string& pointer, c
     fail(source, reader.pointer("index"),
          "expected " + std::to_string(expected_index + 1) + " (trials in order)");
   }
-  const std::string phase = reader.string("phase");
-  trial.phase = phase_from_text(phase, reader.pointer("phase"), source);
+  trial.phase = choice(reader, "phase", kStudyPhases);
   trial.block = static_cast<std::size_t>(reader.integer("block", 0, 1000000));
   trial.condition = reader.string("condition");
   try {

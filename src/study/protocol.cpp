@@ -69,6 +69,7 @@ namespace {
 using nlohmann::json;
 using study_detail::as_string;
 using study_detail::child_pointer;
+using study_detail::choice;
 using study_detail::condition_name;
 using study_detail::fail;
 using study_detail::kMaxRepetitions;
@@ -76,19 +77,6 @@ using study_detail::ObjectReader;
 using study_detail::read_items;
 
 constexpr const char* kFormat = "calligraphy-study-protocol";
-
-template <typename Enum, std::size_t N>
-Enum choice(ObjectReader& reader, const std::string& key, const std::array<Enum, N>& values, Enum fallback) {
-  const json* value = reader.optional(key);
-  if (!value) return fallback;
-  const std::string text = as_string(*value, reader.pointer(key), reader.source());
-  std::string names;
-  for (const Enum candidate : values) {
-    if (text == to_string(candidate)) return candidate;
-    names += (names.empty() ? "" : ", ") + std::string(to_string(candidate));
-  }
-  fail(reader.source(), reader.pointer(key), "expected one of " + names + "; got \"" + text + "\"");
-}
 
 // Largest length tolerance a protocol may give [m]: beyond the 60 mm character box it means nothing.
 constexpr double kMaxAcceptanceLength_m = 0.1;
@@ -208,8 +196,7 @@ StudyCondition read_condition(const json& value, const std::string& pointer, con
   constexpr std::array<ConditionMode, 5> kModes{ConditionMode::vision, ConditionMode::haptic,
                                                 ConditionMode::fading, ConditionMode::replay,
                                                 ConditionMode::quiz};
-  if (!reader.has("mode")) fail(source, reader.pointer("mode"), "missing (required)");
-  condition.mode = choice(reader, "mode", kModes, ConditionMode::vision);
+  condition.mode = choice(reader, "mode", kModes);
   const bool guided = condition.mode == ConditionMode::haptic || condition.mode == ConditionMode::fading ||
                       condition.mode == ConditionMode::replay;
   if (const json* stiffness = reader.optional("guidance_stiffness_n_per_m")) {

@@ -17,19 +17,6 @@ constexpr std::size_t kMaxPhases = 20;
 // A delay longer than a year is a typo, not a design.
 constexpr double kMaxDelay_s = 366.0 * 86400.0;
 
-StudyPhase read_kind(ObjectReader& reader) {
-  constexpr std::array<StudyPhase, 7> kKinds{
-      StudyPhase::practice,  StudyPhase::test,      StudyPhase::pre_test, StudyPhase::training,
-      StudyPhase::post_test, StudyPhase::retention, StudyPhase::transfer};
-  const std::string text = reader.string("phase");
-  std::string names;
-  for (const StudyPhase kind : kKinds) {
-    if (text == to_string(kind)) return kind;
-    names += (names.empty() ? "" : ", ") + std::string(to_string(kind));
-  }
-  fail(reader.source(), reader.pointer("phase"), "expected one of " + names + "; got \"" + text + "\"");
-}
-
 // "condition": "name" or "conditions": ["a", "b"].
 std::vector<std::string> read_conditions(ObjectReader& reader, const std::vector<StudyCondition>& defined) {
   const std::string& source = reader.source();
@@ -90,19 +77,13 @@ ProtocolPhase read_phase(const json& value, const std::string& pointer, const st
   ObjectReader reader(value, pointer, source);
   ProtocolPhase phase;
   phase.pointer = pointer;
-  phase.kind = read_kind(reader);
+  phase.kind = choice(reader, "phase", kStudyPhases);
   phase.conditions = read_conditions(reader, protocol.conditions);
-  if (const json* assignment = reader.optional("assignment")) {
-    const std::string text = as_string(*assignment, reader.pointer("assignment"), source);
-    if (text == to_string(ConditionAssignment::between_subjects)) {
-      phase.assignment = ConditionAssignment::between_subjects;
-    } else if (text != to_string(ConditionAssignment::within_subjects)) {
-      fail(source, reader.pointer("assignment"),
-           "expected within-subjects or between-subjects; got \"" + text + "\"");
-    }
-    if (phase.assignment == ConditionAssignment::between_subjects && phase.conditions.size() < 2) {
-      fail(source, reader.pointer("assignment"), "between-subjects needs two or more \"conditions\"");
-    }
+  constexpr std::array<ConditionAssignment, 2> kAssignments{ConditionAssignment::within_subjects,
+                                                            ConditionAssignment::between_subjects};
+  phase.assignment = choice(reader, "assignment", kAssignments, ConditionAssignment::within_subjects);
+  if (phase.assignment == ConditionAssignment::between_subjects && phase.conditions.size() < 2) {
+    fail(source, reader.pointer("assignment"), "between-subjects needs two or more \"conditions\"");
   }
   read_characters(reader, phase);
   phase.repetitions = static_cast<int>(reader.integer_or("repetitions", 1, 1, kMaxRepetitions));

@@ -1,5 +1,6 @@
 #pragma once
 // Readers shared by the protocol's parts (protocol.cpp, protocol_phases.cpp). Internal.
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -14,6 +15,38 @@ namespace calligraphy::study_detail {
 inline constexpr std::size_t kMaxItems = 1000;
 inline constexpr std::size_t kMaxCharactersPerItem = 16;
 inline constexpr std::int64_t kMaxRepetitions = 1000;
+
+/// Every phase, in the order the docs list them.
+inline constexpr std::array<StudyPhase, 7> kStudyPhases{
+    StudyPhase::practice,  StudyPhase::test,      StudyPhase::pre_test, StudyPhase::training,
+    StudyPhase::post_test, StudyPhase::retention, StudyPhase::transfer};
+
+/// `value` among `values` by their `to_string` names; DataError naming `pointer` and listing the names for
+/// anything else.
+template <typename Enum, std::size_t N>
+Enum choice_of(const nlohmann::json& value, const std::string& pointer, const std::string& source,
+               const std::array<Enum, N>& values) {
+  const std::string text = as_string(value, pointer, source);
+  std::string names;
+  for (const Enum candidate : values) {
+    if (text == to_string(candidate)) return candidate;
+    names += (names.empty() ? "" : ", ") + std::string(to_string(candidate));
+  }
+  fail(source, pointer, "expected one of " + names + "; got \"" + text + "\"");
+}
+
+/// Member `key` as `choice_of`; `fallback` when it is missing.
+template <typename Enum, std::size_t N>
+Enum choice(ObjectReader& reader, const std::string& key, const std::array<Enum, N>& values, Enum fallback) {
+  const nlohmann::json* value = reader.optional(key);
+  return value ? choice_of(*value, reader.pointer(key), reader.source(), values) : fallback;
+}
+
+/// Member `key` as `choice_of`; DataError naming it when it is missing.
+template <typename Enum, std::size_t N>
+Enum choice(ObjectReader& reader, const std::string& key, const std::array<Enum, N>& values) {
+  return choice_of(reader.required(key), reader.pointer(key), reader.source(), values);
+}
 
 /// A list of 1 to kMaxItems strings of 1 to kMaxCharactersPerItem characters each, none a space or control
 /// character; DataError naming the pointer of the one at fault.
