@@ -275,7 +275,8 @@ int run_sessions(const SessionRunCommand& command) {
   add_saved_sessions(files, "--out", command.out);
   files.output_folder("--out", command.out);
   files.output("--screenshot", command.display.screenshot);
-  require_characters(protocol, CharacterSource(command.library));
+  const CharacterSource characters(command.library);
+  require_characters(protocol, characters);
 
   std::vector<SubjectAssignment> subjects;
   if (command.subjects > 0) {
@@ -295,7 +296,6 @@ int run_sessions(const SessionRunCommand& command) {
   // A transfer set chosen by typical-stroke coverage is chosen once, the same for every subject.
   LoadedProtocol resolved = protocol;
   try {
-    const CharacterSource characters(command.library);
     resolve_transfer_choices(resolved.protocol, [&characters](char32_t c) { return characters.load(c); });
   } catch (const InvalidArgument& e) {
     throw DataError(protocol.path.string() + ": " + e.what());
