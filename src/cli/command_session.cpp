@@ -64,12 +64,6 @@ struct SessionResumeCommand {
   SessionDisplay display;
 };
 
-std::string utf8(const std::u32string& text) {
-  std::string out;
-  for (const char32_t c : text) out += encode_utf8(c);
-  return out;
-}
-
 // Tells the person at the device what to write next (on stderr: stdout carries the summary) and waits for
 // Enter when a terminal is attached; breaks count down.
 class TerminalHost final : public SessionHost {
@@ -77,7 +71,7 @@ class TerminalHost final : public SessionHost {
   void before_trial(const PlannedTrial& trial, std::size_t total) override {
     std::fprintf(stderr, "trial %zu/%zu (%s, %s, repetition %d): write %s", trial.index + 1, total,
                  to_string(trial.phase), trial.condition.c_str(), trial.repetition,
-                 utf8(trial.characters).c_str());
+                 encode_utf8(trial.characters).c_str());
     if (::isatty(STDIN_FILENO)) {
       std::fprintf(stderr, " -- press Enter to start\n");
       int c = 0;
