@@ -204,6 +204,51 @@ TEST_CASE("fading and replay parameters and teachers are checked naming the JSON
               "/conditions/0/teachers/大", "empty");
 }
 
+TEST_CASE("the other guidance schedules are read with their parameters, checked naming the JSON pointer",
+          "[study][protocol]") {
+  const StudyProtocol p = protocol_from_text(
+                              R"({"name": "t", "conditions": [
+            {"name": "A", "mode": "assist-as-needed",
+             "parameters": {"start_band_m": 0.002, "target_error_m": 0.001, "band_rate": 0.5, "max_band_m": 0.003}},
+            {"name": "E", "mode": "error-amplification", "parameters": {"amplification_gain": 0.4, "max_force_n": 0.2}},
+            {"name": "S", "mode": "skill-adaptive", "parameters": {"threshold_m": 0.0015}},
+            {"name": "T", "mode": "timing", "parameters": {"speed_m_s": 0.02}}],
+          "test": {"characters": ["大"], "conditions": ["A", "E", "S", "T"], "repetitions": 1}})",
+                              "t.json")
+                              .protocol;
+  CHECK(p.condition("A").start_band_m == 0.002);
+  CHECK(p.condition("A").assist_rule.target_error_m == 0.001);
+  CHECK(p.condition("A").assist_rule.rate == 0.5);
+  CHECK(p.condition("A").assist_rule.max_band_m == 0.003);
+  CHECK(p.condition("E").amplification_gain == 0.4);
+  CHECK(p.condition("E").amplification_max_force_n == 0.2);
+  CHECK(p.condition("S").skill_rule.threshold_m == 0.0015);
+  CHECK(p.condition("T").timing_speed_m_s == 0.02);
+  for (const ConditionMode mode : condition_modes())
+    CHECK(renders_guidance(mode) == (mode != ConditionMode::vision && mode != ConditionMode::quiz));
+  const auto with_condition = [](const std::string& condition) {
+    return R"({"name": "t", "conditions": [)" + condition +
+           R"(], "test": {"characters": ["大"], "conditions": ["A"], "repetitions": 1}})";
+  };
+  check_error(with_condition(R"({"name": "A", "mode": "assist-as-needed", "parameters": {"start_gain": 1}})"),
+              "/conditions/0/parameters/start_gain", "unknown key");
+  check_error(
+      with_condition(
+          R"({"name": "A", "mode": "assist-as-needed", "parameters": {"min_band_m": 0.003, "max_band_m": 0.001}})"),
+      "/conditions/0/parameters/max_band_m", "min_band_m");
+  check_error(with_condition(
+                  R"({"name": "A", "mode": "error-amplification", "parameters": {"amplification_gain": 2}})"),
+              "/conditions/0/parameters/amplification_gain", "2");
+  check_error(with_condition(R"({"name": "A", "mode": "skill-adaptive", "parameters": {"threshold_m": 0}})"),
+              "/conditions/0/parameters/threshold_m", "> 0");
+  check_error(with_condition(R"({"name": "A", "mode": "timing", "parameters": {"speed_m_s": 0}})"),
+              "/conditions/0/parameters/speed_m_s", "> 0");
+  check_error(with_condition(R"({"name": "A", "mode": "haptic", "parameters": {"speed_m_s": 0.1}})"),
+              "/conditions/0/parameters", "takes no parameters");
+  check_error(with_condition(R"({"name": "A", "mode": "vision", "parameters": {}})"),
+              "/conditions/0/parameters", "takes no parameters");
+}
+
 TEST_CASE("a quiz condition's acceptance is checked naming the key, and leniency is refused",
           "[study][protocol]") {
   const auto with_quiz = [](const std::string& quiz) {

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -325,6 +326,71 @@ TEST_CASE("a fading gain follows the previous repetition of the item, the same a
     previous[trial.characters] = {gain, record["mean_deviation_mm"].get<double>()};
     CHECK(record_of(resumed, trial)["guidance"] == record["guidance"]);
   }
+}
+
+TEST_CASE("an assist band and a skill-adaptive mode follow the previous repetition, the same after a resume",
+          "[study][session][guidance]") {
+  TempFolder temp;
+  const LoadedProtocol protocol = protocol_from_text(
+      R"({"name": "a", "conditions": [
+            {"name": "band", "mode": "assist-as-needed",
+             "parameters": {"start_band_m": 0.002, "target_error_m": 0.001, "band_rate": 2}},
+            {"name": "adapt", "mode": "skill-adaptive", "parameters": {"threshold_m": 0.0012}},
+            {"name": "pace", "mode": "timing", "parameters": {"speed_m_s": 0.03}}],
+          "test": {"characters": ["十", "人"], "conditions": ["band", "adapt", "pace"], "repetitions": 3},
+          "trial": {"max_duration_s": 40}})",
+      "a.json");
+  SessionFolder whole = SessionFolder::create(temp.path / "whole", simulated("A1"), protocol);
+  REQUIRE(run_session(whole).complete());
+  fs::path folder;
+  {
+    SessionFolder session = SessionFolder::create(temp.path / "resumed", simulated("A1"), protocol);
+    folder = session.path();
+    StopAfter host(4);
+    SessionRunOptions options;
+    options.host = &host;
+    options.should_stop = [&] { return host.ended >= 4; };
+    REQUIRE(run_session(session, options).saved_now == 4);
+  }
+  SessionFolder resumed = SessionFolder::open(folder);
+  REQUIRE(run_session(resumed).complete());
+
+  const StudyCondition& band = protocol.protocol.condition("band");
+  const StudyCondition& adapt = protocol.protocol.condition("adapt");
+  // condition and item -> (band [m], mean deviation [mm]) of the previous repetition
+  std::map<std::pair<std::string, std::u32string>, std::pair<double, double>> previous;
+  std::set<std::string> adaptive_modes;
+  for (const PlannedTrial& trial : whole.plan()) {
+    const auto record = record_of(whole, trial);
+    const auto key = std::make_pair(trial.condition, trial.characters);
+    const auto before = previous.find(key);
+    const double deviation_mm = record["mean_deviation_mm"].get<double>();
+    if (trial.condition == "band") {
+      const double b = record["guidance"]["band_m"].get<double>();
+      CHECK(record["force_law"]["guidance_mode"] == "assist-as-needed");
+      CHECK(record["force_law"]["assist_band_m"].get<double>() == b);
+      CHECK(b ==
+            (before == previous.end()
+                 ? band.start_band_m
+                 : next_assist_band(before->second.first, before->second.second * 1e-3, band.assist_rule)));
+      previous[key] = {b, deviation_mm};
+    } else if (trial.condition == "adapt") {
+      const std::string selected = record["guidance"]["selected_mode"].get<std::string>();
+      CHECK(record["force_law"]["guidance_mode"] == selected);
+      const std::string expected =
+          before == previous.end()
+              ? "fixed"
+              : to_string(skill_adaptive_mode(before->second.second * 1e-3, adapt.skill_rule));
+      CHECK(selected == expected);
+      adaptive_modes.insert(selected);
+      previous[key] = {0.0, deviation_mm};
+    } else {
+      CHECK(record["force_law"]["guidance_mode"] == "timing");
+      CHECK(record["force_law"]["timing_speed_m_s"].get<double>() == 0.03);
+    }
+    CHECK(record_of(resumed, trial)["guidance"] == record["guidance"]);
+  }
+  CHECK(adaptive_modes.count("fixed") == 1);
 }
 
 TEST_CASE("a replay condition follows a teacher kept in the session folder and names its SHA-256",

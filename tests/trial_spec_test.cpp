@@ -46,8 +46,24 @@ TrialSpec random_spec(std::mt19937_64& random) {
   spec.characters = random() % 2 ? "永" : "十人";
   spec.guidance = random() % 4 != 0;
   if (spec.guidance && random() % 2) {
-    spec.guidance_mode = GuidanceMode::fading;
-    spec.guidance_gain = unit(random);
+    switch (random() % 4) {
+      case 0:
+        spec.guidance_mode = GuidanceMode::fading;
+        spec.guidance_gain = unit(random);
+        break;
+      case 1:
+        spec.guidance_mode = GuidanceMode::assist_as_needed;
+        spec.assist_band_m = unit(random) * 0.004;
+        break;
+      case 2:
+        spec.guidance_mode = GuidanceMode::error_amplification;
+        spec.amplification_gain = unit(random);
+        break;
+      default:
+        spec.guidance_mode = GuidanceMode::timing;
+        spec.timing_speed_m_s = 0.001 + unit(random) * 0.1;
+        break;
+    }
   }
   spec.writer = static_cast<TrialWriter>(random() % 3);
   if (spec.writer != TrialWriter::person && random() % 2) {
@@ -137,6 +153,22 @@ TEST_CASE("a specification's errors name the field in both its forms") {
   bad = spec;
   bad.guidance_gain = 0.5;
   fails_naming(bad, "guidance_gain (--guidance-gain): applies to guidance mode 'fading' only");
+  bad = TrialSpec{};
+  bad.characters = "永";
+  bad.assist_band_m = 0.002;
+  fails_naming(bad, "assist_band_m (--assist-band): applies to guidance mode 'assist-as-needed' only");
+  bad.guidance_mode = GuidanceMode::assist_as_needed;
+  bad.assist_band_m = -0.001;
+  fails_naming(bad, "assist_band_m (--assist-band)");
+  bad = TrialSpec{};
+  bad.characters = "永";
+  bad.guidance_mode = GuidanceMode::error_amplification;
+  bad.amplification_gain = 1.5;
+  fails_naming(bad, "amplification_gain (--amplification-gain)");
+  bad = TrialSpec{};
+  bad.characters = "永";
+  bad.timing_speed_m_s = 0.05;
+  fails_naming(bad, "timing_speed_m_s (--timing-speed): applies to guidance mode 'timing' only");
   bad = spec;
   bad.guidance_mode = GuidanceMode::replay;
   fails_naming(bad, "teacher (--teacher): required");

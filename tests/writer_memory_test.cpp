@@ -58,7 +58,10 @@ TEST_CASE("guidance that corrects for the writer leaves less learned (slacking)"
   CHECK_THROWS_AS(guidance_assistance_share(1.5, 600.0, 150.0), InvalidArgument);
   CHECK_THROWS_AS(guidance_assistance_share(1.0, 600.0, 0.0), InvalidArgument);
   WriterMemory memory;
-  CHECK_THROWS_AS(practise(memory, {1}, U"十", -0.1), InvalidArgument);
+  // A negative share is an error a repulsive field enlarged (error amplification), down to the guard.
+  CHECK_NOTHROW(practise(memory, {1}, U"十", -0.1));
+  CHECK_THROWS_AS(practise(memory, {1}, U"十", kMinAssistanceShare - 0.1), InvalidArgument);
+  CHECK_THROWS_AS(practise(memory, {1}, U"十", 1.1), InvalidArgument);
 }
 
 TEST_CASE("between sessions the fast state is gone and the slow one kept, and unpractised skills decay",

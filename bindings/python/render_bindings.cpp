@@ -32,7 +32,14 @@ void bind_guidance(py::module_& m) {
       .value(
           "replay", GuidanceMode::replay,
           "the attraction point follows a teacher's recording in time (Henmi & Yoshikawa 1998; Feygin et al. "
-          "2002)");
+          "2002)")
+      .value("assist_as_needed", GuidanceMode::assist_as_needed,
+             "eq. (8) on the deviation beyond assist_band_m only (Emken, Bobrow & Reinkensmeyer 2005)")
+      .value("error_amplification", GuidanceMode::error_amplification,
+             "a bounded repulsive field, amplification_gain x eq. (8) turned round (Patton et al. 2006)")
+      .value("timing", GuidanceMode::timing,
+             "a minimum-jerk target along the stroke at timing_speed_m_s, pulling along the stroke only "
+             "(Flash & Hogan 1985)");
   py::class_<TeacherSample>(m, "TeacherSample", "One sample of a teacher's recorded pen.")
       .def(py::init([](double time_s, const py::object& position_m) {
              return TeacherSample{time_s, as_vec3(position_m, "position_m")};
@@ -72,6 +79,46 @@ Benitez & Reinkensmeyer 2007). gain: this repetition's gain in [0, 1]; error_m: 
 example the trial's mean deviation (metrics['mean_deviation_mm'] / 1000). Returns a float in [0, 1].
 Raises InvalidArgument (a ValueError) for a gain outside [0, 1], a negative or non-finite error or a bad
 rule; TypeError naming the argument for a value of the wrong type.)");
+  ParameterClass<AssistBandRule>(
+      m, "AssistBandRule",
+      "The assist-as-needed band rule b(n+1) = clamp(b(n) + k (e* - e(n)), b_min, b_max) of "
+      "next_assist_band: "
+      "an error below the target widens the band (less help), above it narrows it (Emken, Bobrow & "
+      "Reinkensmeyer 2005; Banala et al. 2009).",
+      [](const AssistBandRule& rule) { rule.validate(); })
+      .field("target_error_m", &AssistBandRule::target_error_m, "e* [m] > 0")
+      .field("rate", &AssistBandRule::rate, "k >= 0, dimensionless")
+      .field("min_band_m", &AssistBandRule::min_band_m, "b_min [m] >= 0")
+      .field("max_band_m", &AssistBandRule::max_band_m, "b_max [m] >= b_min")
+      .finish();
+  m.def(
+      "next_assist_band",
+      [](const Checked<double>& band_m, const Checked<double>& error_m,
+         const std::optional<Checked<AssistBandRule>>& rule) {
+        return next_assist_band(take(band_m, "band_m"), take(error_m, "error_m"),
+                                rule ? take(*rule, "rule") : AssistBandRule{});
+      },
+      py::arg("band_m"), py::arg("error_m"), py::arg("rule") = py::none(),
+      R"(The assist-as-needed band [m] of the next repetition (include/calligraphy/render/guidance_mode.hpp)
+from this repetition's band_m >= 0 and error_m >= 0 [m] (e.g. the mean deviation) under `rule` (an
+AssistBandRule). Returns a float in [min_band_m, max_band_m]. Raises InvalidArgument (a ValueError) for a
+negative or non-finite band or error or a bad rule.)");
+  ParameterClass<SkillAdaptiveRule>(
+      m, "SkillAdaptiveRule",
+      "Skill-adaptive selection (Milot et al. 2010): fixed guidance at or above threshold_m of error, error "
+      "amplification below.",
+      [](const SkillAdaptiveRule& rule) { rule.validate(); })
+      .field("threshold_m", &SkillAdaptiveRule::threshold_m, "error [m] > 0 from which the writer is guided")
+      .finish();
+  m.def(
+      "skill_adaptive_mode",
+      [](double previous_error_m, const std::optional<Checked<SkillAdaptiveRule>>& rule) {
+        return skill_adaptive_mode(previous_error_m, rule ? take(*rule, "rule") : SkillAdaptiveRule{});
+      },
+      py::arg("previous_error_m"), py::arg("rule") = py::none(),
+      R"(The GuidanceMode of the next repetition from the previous one's error [m] (NaN: nothing written):
+GuidanceMode.fixed at or above rule.threshold_m, else GuidanceMode.error_amplification (Milot et al. 2010).
+Raises InvalidArgument (a ValueError) for a negative error or a bad rule.)");
 }
 
 void bind_force_law_parameters(py::module_& m) {
@@ -94,12 +141,21 @@ void bind_force_law_parameters(py::module_& m) {
       .field("guidance", &ForceLawParameters::guidance,
              "in-plane guidance on (F_et and the resistance force); the paper force is always rendered")
       .field("guidance_mode", &ForceLawParameters::guidance_mode,
-             "how F_et attracts, a GuidanceMode (fixed as eq. 8, fading by guidance_gain, or replay of a "
-             "teacher)")
+             "how F_et acts, a GuidanceMode (fixed as eq. 8, fading by guidance_gain, replay of a teacher, "
+             "assist_as_needed, error_amplification, timing)")
       .field("guidance_gain", &ForceLawParameters::guidance_gain,
              "scale of F_et in the fading mode, in [0, 1]")
       .field("replay_max_lead_m", &ForceLawParameters::replay_max_lead_m,
-             "replay: the farthest the attraction point leads the pen [m], in (0, constraint_radius_m]")
+             "replay and timing: the lead at which the spring to the moving point saturates [m], in (0, "
+             "constraint_radius_m]")
+      .field("assist_band_m", &ForceLawParameters::assist_band_m,
+             "assist_as_needed: half-width of the band without force around the active element [m], >= 0")
+      .field("amplification_gain", &ForceLawParameters::amplification_gain,
+             "error_amplification: the repulsive stiffness as a share of K_et, in [0, 1]")
+      .field("amplification_max_force_n", &ForceLawParameters::amplification_max_force_n,
+             "error_amplification: bound of the repulsive force [N], >= 0")
+      .field("timing_speed_m_s", &ForceLawParameters::timing_speed_m_s,
+             "timing: mean speed of the target along each stroke [m/s], > 0")
       .field("off_stroke_force_n", &ForceLawParameters::off_stroke_force_n,
              "friction against writing away from the active stroke in CS [N], >= 0; 0 = the paper's CS")
       .field("off_stroke_travel_m", &ForceLawParameters::off_stroke_travel_m,

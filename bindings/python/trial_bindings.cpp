@@ -246,6 +246,10 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   spec.guidance = options.force.guidance;
   if (spec.guidance) spec.guidance_mode = options.force.guidance_mode;
   if (spec.guidance_mode == GuidanceMode::fading) spec.guidance_gain = options.force.guidance_gain;
+  if (spec.guidance_mode == GuidanceMode::assist_as_needed) spec.assist_band_m = options.force.assist_band_m;
+  if (spec.guidance_mode == GuidanceMode::error_amplification)
+    spec.amplification_gain = options.force.amplification_gain;
+  if (spec.guidance_mode == GuidanceMode::timing) spec.timing_speed_m_s = options.force.timing_speed_m_s;
   spec.seed = simulation.seed;
   spec.rate_hz = options.rate_hz;
   spec.pacing = options.pacing;

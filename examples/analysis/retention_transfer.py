@@ -1,19 +1,21 @@
 #!/usr/bin/env python3
 """Guidance compared on what it leaves behind: a simulated retention and transfer experiment.
 
-Runs examples/protocols/retention-transfer.json (day 1: unguided pre-test, training in one of three
-groups, unguided post-test; day 2: unguided retention and transfer tests) with learning simulated
+Runs examples/protocols/retention-transfer.json, or another protocol of that design such as
+guidance-schedules.json (day 1: unguided pre-test, training in one group per training condition, unguided
+post-test; day 2: unguided retention and transfer tests) with learning simulated
 subjects (`--writer-learning two-state`: the two-state memory of Smith, Ghazizadeh & Shadmehr 2006, which
 learns from the error the guidance leaves it; docs/writer.md), then prints each group's learning,
 retention and transfer (calligraphy.statistics.learning) and the groups compared (group_comparison: Welch
 t-test, Hedges' g). Optionally writes the study report. The subjects are a model, not people: what it
 prints is what the model predicts (docs/experiments.md, "Retention and transfer in simulation").
 
-    python3 examples/analysis/retention_transfer.py --cli build/bin/calligraphy --per-group 10 [--out DIR] [--report DIR]
+    python3 examples/analysis/retention_transfer.py --cli build/bin/calligraphy --per-group 10 [--protocol FILE] [--out DIR] [--report DIR]
 """
 
 import argparse
 import itertools
+import json
 import pathlib
 import subprocess
 import sys
@@ -24,12 +26,20 @@ import calligraphy.statistics as statistics
 import calligraphy.study
 
 PROTOCOL = pathlib.Path(__file__).resolve().parents[1] / "protocols" / "retention-transfer.json"
-GROUPS = 3  # the protocol's training conditions, assigned by subject number in turn
+
+
+def training_groups(protocol: pathlib.Path) -> int:
+    """The protocol's between-subjects training conditions, assigned by subject number in turn."""
+    phases = json.loads(protocol.read_text(encoding="utf-8"))["phases"]
+    return max(len(phase.get("conditions", [])) for phase in phases if phase["phase"] == "training")
 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cli", default="calligraphy", help="the calligraphy program")
+    parser.add_argument("--protocol", default=str(PROTOCOL),
+                        help="the protocol (default: retention-transfer.json; guidance-schedules.json has all seven "
+                             "schedules)")
     parser.add_argument("--per-group", type=int, default=10, help="simulated subjects in each group")
     parser.add_argument("--profile", default="foreign", help="the subjects' writer profile")
     parser.add_argument("--out", help="a new folder for the sessions (default: a temporary one)")
@@ -40,7 +50,8 @@ def main() -> int:
     out = arguments.out or str(pathlib.Path(tempfile.mkdtemp(prefix="retention-")) / "study")
 
     started = time.monotonic()
-    subprocess.run([arguments.cli, "session", "run", str(PROTOCOL), "--subjects", str(GROUPS * arguments.per_group),
+    groups = training_groups(pathlib.Path(arguments.protocol))
+    subprocess.run([arguments.cli, "session", "run", arguments.protocol, "--subjects", str(groups * arguments.per_group),
                     "--writer-profile", arguments.profile, "--writer-learning", "two-state", "--out", out],
                    check=True, stdout=subprocess.DEVNULL)
     study = calligraphy.study.load(out)

@@ -183,9 +183,11 @@ void add_train_command(CLI::App& root, Commands& commands) {
              "who writes: a person, or the simulated writer live on the simulated device (a demonstration)");
   add_choice(*app, "--guidance", command->guidance, {"on", "off"},
              "guiding force towards the stroke (G toggles)");
-  add_choice(*app, "--guidance-mode", command->guidance_mode, {"fixed", "fading", "replay"},
-             "how guidance attracts (docs/force-rendering.md): the paper's fixed fixture, faded trial by "
-             "trial from the mean deviation, or along a teacher's recording (M cycles it)");
+  add_choice(*app, "--guidance-mode", command->guidance_mode,
+             {"fixed", "fading", "replay", "assist-as-needed", "error-amplification", "timing"},
+             "how guidance acts (docs/force-rendering.md): the paper's fixed fixture, faded trial by trial "
+             "from the mean deviation, along a teacher's recording, only beyond a band that adapts trial by "
+             "trial, a gentle push off the stroke, or a target pacing the stroke (M cycles it)");
   add_number(*app, "--guidance-gain", command->guidance_gain, "G",
              "fading: the first trial's gain, faded after each trial", "a number in [0, 1]",
              [](double g) { return g >= 0.0 && g <= 1.0; });

@@ -42,11 +42,14 @@ struct TrialCommand {
   std::string guidance_mode = "fixed";
   double guidance_gain = 1.0;
   const CLI::Option* gain_option = nullptr;
-  std::string teacher;  // replay: the recording's path
-  std::string record;   // write the trial as a teacher's recording
+  std::string assist_band_text;         // "": the specification's default
+  std::string amplification_gain_text;  // "": the specification's default
+  std::string timing_speed_text;        // "": the specification's default
+  std::string teacher;                  // replay: the recording's path
+  std::string record;                   // write the trial as a teacher's recording
   std::uint64_t seed = 0;
   std::string rate_text = "1000";  // given to the specification's parser as it was typed
-  std::string max_duration_text;  // "": the specification's default
+  std::string max_duration_text;   // "": the specification's default
   std::string pacing = "auto";
   std::string realtime = "ignore";
   std::int64_t watchdog_ms = std::llround(ServoLoopOptions{}.stall_timeout_s * 1000.0);
@@ -83,6 +86,9 @@ TrialSpec spec_from(const TrialCommand& command) {
     std::snprintf(gain, sizeof gain, "%.17g", command.guidance_gain);  // every bit of the number given
     add("--guidance-gain", gain);
   }
+  if (!command.assist_band_text.empty()) add("--assist-band", command.assist_band_text);
+  if (!command.amplification_gain_text.empty()) add("--amplification-gain", command.amplification_gain_text);
+  if (!command.timing_speed_text.empty()) add("--timing-speed", command.timing_speed_text);
   if (!command.teacher.empty()) add("--teacher", command.teacher);
   if (!command.writer.empty()) add("--writer", command.writer);
   if (command.profile_option->count() > 0) add("--writer-profile", command.writer_profile);
@@ -107,10 +113,10 @@ TrialSpec spec_from(const TrialCommand& command) {
 // What the trial's JSON and table say of it: the specification and the device it ran on.
 TrialDescription describe(const TrialSpec& spec, const TrialRun& run, const DeviceListing& device) {
   // The report calls a person "human"; the simulated writer by its profile.
-  TrialDescription description{spec.characters, spec.guidance,
-                               run.simulated_writer ? spec.writer_profile : "human",
-                               spec.seed,       spec.rate_hz,  device.name,
-                               device.info.model};
+  TrialDescription description{
+      spec.characters,  spec.guidance, run.simulated_writer ? spec.writer_profile : "human",
+      spec.seed,        spec.rate_hz,  device.name,
+      device.info.model};
   description.guidance_mode = spec.guidance_mode;
   description.guidance_gain = spec.guidance_gain;
   if (spec.guidance_mode == GuidanceMode::replay) {
@@ -269,11 +275,21 @@ void add_trial_command(CLI::App& root, Commands& commands) {
   add_text(*app, "--device", command->device, "NAME", "the device, by its name in `calligraphy devices`");
   add_choice(*app, "--guidance", command->guidance, {"on", "off"}, "guiding force towards the stroke");
   add_choice(
-      *app, "--guidance-mode", command->guidance_mode, {"fixed", "fading", "replay"},
-      "how the guidance attracts: the paper's fixture, faded by --guidance-gain, or replaying --teacher");
+      *app, "--guidance-mode", command->guidance_mode,
+      {"fixed", "fading", "replay", "assist-as-needed", "error-amplification", "timing"},
+      "how the guidance acts: the paper's fixture, faded by --guidance-gain, replaying --teacher, only "
+      "beyond --assist-band, pushing off the stroke (--amplification-gain), or pulling along it at "
+      "--timing-speed");
   command->gain_option =
       add_number(*app, "--guidance-gain", command->guidance_gain, "G", "fading: gain on the guiding force",
                  "a number in [0, 1]", [](double gain) { return gain >= 0.0 && gain <= 1.0; });
+  add_text(*app, "--assist-band", command->assist_band_text, "M",
+           "assist-as-needed: half-width of the band without force around the stroke [m]", "0.001");
+  add_text(*app, "--amplification-gain", command->amplification_gain_text, "G",
+           "error-amplification: the repulsive field's stiffness as a share of the guidance's, in [0, 1]",
+           "0.25");
+  add_text(*app, "--timing-speed", command->timing_speed_text, "M/S",
+           "timing: mean speed of the target along each stroke [m/s]", "0.04");
   add_input_path(*app, "--teacher", command->teacher, "FILE",
                  "replay: the teacher's recording of CHARS (made with --record)", "none");
   add_writer_option(*app, command->writer,
@@ -286,7 +302,8 @@ void add_trial_command(CLI::App& root, Commands& commands) {
   add_repeated_text(*app, "--writer-param", command->writer_parameters, "KEY=VALUE",
                     "set a field of the simulated writer's profile (repeatable; keys: docs/writer.md)");
   add_unsigned(*app, "--seed", command->seed, "N", "seed of the simulated writer (a 64-bit integer)");
-  add_text(*app, "--rate", command->rate_text, "HZ", "servo rate [Hz], in [100, 100000] (real time: at most 10000)");
+  add_text(*app, "--rate", command->rate_text, "HZ",
+           "servo rate [Hz], in [100, 100000] (real time: at most 10000)");
   add_text(*app, "--max-duration", command->max_duration_text, "S", "the trial ends after this much time [s]",
            "300");
   add_choice(*app, "--pacing", command->pacing, {"auto", "lock-step", "real-time"},

@@ -37,14 +37,22 @@ void ForceLawParameters::validate() const {
     throw InvalidArgument("ForceLawParameters.guidance_gain = " + std::to_string(guidance_gain) +
                           " must be in [0, 1]");
   }
+  if (!(amplification_gain >= 0.0 && amplification_gain <= 1.0)) {
+    throw InvalidArgument("ForceLawParameters.amplification_gain = " + std::to_string(amplification_gain) +
+                          " must be in [0, 1]");
+  }
+  check(assist_band_m, "assist_band_m", false);
+  check(amplification_max_force_n, "amplification_max_force_n", false);
+  check(timing_speed_m_s, "timing_speed_m_s", true);
   if (guidance_mode == GuidanceMode::replay) validate_teacher_trajectory(teacher_trajectory);
-  // The lead is bounded by the constraint space only where it is used: a replay's attraction point must
-  // stay within R_res of the pen.
-  const double max_lead_m = guidance_mode == GuidanceMode::replay ? constraint_radius_m : 1.0;
+  // The lead is bounded by the constraint space only where it is used: a replay's or timing target's
+  // attraction point must stay within R_res of the pen.
+  const bool moving_target = guidance_mode == GuidanceMode::replay || guidance_mode == GuidanceMode::timing;
+  const double max_lead_m = moving_target ? constraint_radius_m : 1.0;
   if (!(replay_max_lead_m > 0.0 && replay_max_lead_m <= max_lead_m)) {
     throw InvalidArgument("ForceLawParameters.replay_max_lead_m = " + std::to_string(replay_max_lead_m) +
                           " must be in (0, " + std::to_string(max_lead_m) + "] m" +
-                          (guidance_mode == GuidanceMode::replay ? " (constraint_radius_m in replay)" : ""));
+                          (moving_target ? " (constraint_radius_m in replay and timing)" : ""));
   }
   if (constraint_taper_m > constraint_radius_m) {
     throw InvalidArgument("ForceLawParameters.constraint_taper_m = " + std::to_string(constraint_taper_m) +

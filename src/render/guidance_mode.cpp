@@ -1,6 +1,7 @@
 #include "calligraphy/render/guidance_mode.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -16,12 +17,32 @@ const char* to_string(GuidanceMode mode) noexcept {
       return "fading";
     case GuidanceMode::replay:
       return "replay";
+    case GuidanceMode::assist_as_needed:
+      return "assist-as-needed";
+    case GuidanceMode::error_amplification:
+      return "error-amplification";
+    case GuidanceMode::timing:
+      return "timing";
   }
   return "?";
 }
 
+std::span<const GuidanceMode> guidance_modes() noexcept {
+  static constexpr std::array<GuidanceMode, 6> kModes{GuidanceMode::fixed,
+                                                      GuidanceMode::fading,
+                                                      GuidanceMode::replay,
+                                                      GuidanceMode::assist_as_needed,
+                                                      GuidanceMode::error_amplification,
+                                                      GuidanceMode::timing};
+  return kModes;
+}
+
+const char* guidance_mode_names() noexcept {
+  return "fixed|fading|replay|assist-as-needed|error-amplification|timing";
+}
+
 std::optional<GuidanceMode> guidance_mode_from_string(std::string_view name) noexcept {
-  for (const GuidanceMode mode : {GuidanceMode::fixed, GuidanceMode::fading, GuidanceMode::replay}) {
+  for (const GuidanceMode mode : guidance_modes()) {
     if (name == to_string(mode)) return mode;
   }
   return std::nullopt;
@@ -66,6 +87,44 @@ double next_guidance_gain(double gain, double error_m, const FadingRule& rule) {
                           " must be finite and >= 0");
   }
   return std::clamp(rule.forgetting_factor * gain + rule.error_gain_per_m * error_m, 0.0, 1.0);
+}
+
+namespace {
+
+void check_length(double value, const char* name, bool positive) {
+  if (!std::isfinite(value) || value < 0.0 || (positive && value == 0.0)) {
+    throw InvalidArgument(std::string(name) + " = " + std::to_string(value) +
+                          (positive ? " must be finite and > 0" : " must be finite and >= 0"));
+  }
+}
+
+}  // namespace
+
+void AssistBandRule::validate() const {
+  check_length(target_error_m, "AssistBandRule.target_error_m", true);
+  check_length(rate, "AssistBandRule.rate", false);
+  check_length(min_band_m, "AssistBandRule.min_band_m", false);
+  check_length(max_band_m, "AssistBandRule.max_band_m", false);
+  if (max_band_m < min_band_m) {
+    throw InvalidArgument("AssistBandRule.max_band_m = " + std::to_string(max_band_m) +
+                          " must be >= min_band_m = " + std::to_string(min_band_m));
+  }
+}
+
+double next_assist_band(double band_m, double error_m, const AssistBandRule& rule) {
+  rule.validate();
+  check_length(band_m, "next_assist_band: band_m", false);
+  check_length(error_m, "next_assist_band: error_m", false);
+  return std::clamp(band_m + rule.rate * (rule.target_error_m - error_m), rule.min_band_m, rule.max_band_m);
+}
+
+void SkillAdaptiveRule::validate() const { check_length(threshold_m, "SkillAdaptiveRule.threshold_m", true); }
+
+GuidanceMode skill_adaptive_mode(double previous_error_m, const SkillAdaptiveRule& rule) {
+  rule.validate();
+  if (std::isnan(previous_error_m)) return GuidanceMode::fixed;
+  check_length(previous_error_m, "skill_adaptive_mode: previous_error_m", false);
+  return previous_error_m >= rule.threshold_m ? GuidanceMode::fixed : GuidanceMode::error_amplification;
 }
 
 }  // namespace calligraphy

@@ -78,6 +78,8 @@ Renderer::Renderer(const Scene& scene, const ForceLawParameters& parameters, con
   if (parameters_.guidance_mode == GuidanceMode::replay) {
     replay_ = TeacherReplay(scene, parameters_.teacher_trajectory, parameters_);
   }
+  if (parameters_.guidance_mode == GuidanceMode::timing)
+    timing_ = TimingTarget(scene, parameters_.timing_speed_m_s);
   off_stroke_alpha_ =
       1.0 - std::exp(-2.0 * std::numbers::pi * parameters_.off_stroke_velocity_cutoff_hz * period_s_);
   const double k_paper = parameters_.paper_stiffness_n_per_m;
@@ -147,11 +149,15 @@ Vec2 Renderer::guidance_force(const DeviceState& device, RenderOutput& out, bool
   // Foot-point jumps (a new element, a jump of the tracker to another minimum) move the attraction
   // target at a bounded speed instead of stepping the force.
   // In the replay mode the attraction point is where the teacher was, as many seconds into the stroke as
-  // the pen has been writing it, kept on the active element, with the same bounded speed.
+  // the pen has been writing it, kept on the active element, with the same bounded speed; in the timing
+  // mode it is the minimum-jerk target that many seconds into the stroke.
+  const GuidanceMode mode = parameters_.guidance_mode;
+  const double elapsed_s = device.time_s - writing_since_s_;
   const Vec2 attraction_point =
-      parameters_.guidance_mode == GuidanceMode::replay
-          ? replay_.attraction_point(active_.strokes_written(), device.time_s - writing_since_s_,
-                                     active_.element_index(), element)
+      mode == GuidanceMode::replay
+          ? replay_.attraction_point(active_.strokes_written(), elapsed_s, active_.element_index(), element)
+      : mode == GuidanceMode::timing
+          ? timing_.attraction_point(active_.strokes_written(), elapsed_s, active_.element_index(), element)
           : nearest.foot;
   const double max_move = parameters_.max_foot_speed_m_s * period_s_;
   const Vec2 move = attraction_point - rendered_foot_;
@@ -167,24 +173,42 @@ Vec2 Renderer::guidance_force(const DeviceState& device, RenderOutput& out, bool
   const double taper =
       constraint_taper(nearest.distance, parameters_.constraint_radius_m, parameters_.constraint_taper_m);
   const Vec2 tangent = element.unit_tangent(nearest.t);
-  const double gain = parameters_.guidance_mode == GuidanceMode::fading ? parameters_.guidance_gain : 1.0;
+  const double gain = mode == GuidanceMode::fading                ? parameters_.guidance_gain
+                      : mode == GuidanceMode::error_amplification ? parameters_.amplification_gain
+                                                                  : 1.0;
   const double factor = gain * active_.attraction(nearest.t);
-  Vec2 attraction = attraction_force(tip, rendered_foot_, parameters_.guidance_stiffness_n_per_m, factor);
+  const double stiffness = parameters_.guidance_stiffness_n_per_m;
+  Vec2 attraction = attraction_force(tip, rendered_foot_, stiffness, factor);
+  // Assist-as-needed: the spring acts on the deviation beyond the band only, K a (d - b)+, continuous at b.
+  if (mode == GuidanceMode::assist_as_needed) {
+    const double d = (rendered_foot_ - tip).norm();
+    attraction *= d > parameters_.assist_band_m ? (d - parameters_.assist_band_m) / d : 0.0;
+  }
+  // Error amplification: the same field turned round, pushing the pen off the element.
+  if (mode == GuidanceMode::error_amplification) attraction = -attraction;
   // A pen past the element's end (its foot clamped there) is pulled onto the line, never back along the
   // stroke to an end or corner it has passed; on the end plane the along-stroke part is zero, so this is
-  // continuous.
-  if (nearest.t >= 1.0) attraction -= attraction.dot(tangent) * tangent;
+  // continuous. Timing guidance is the opposite: along the stroke only, never across it.
+  if (mode == GuidanceMode::timing) {
+    attraction = attraction.dot(tangent) * tangent;
+  } else if (nearest.t >= 1.0) {
+    attraction -= attraction.dot(tangent) * tangent;
+  }
   attraction *= 1.0 - slack;
-  // The replay point may lead or trail the pen along the stroke by more than R_res: the spring is
-  // saturated at its force at replay_max_lead_m, so the force stays bounded and continuous. (The foot
-  // point of the other modes is never further than R_res.)
-  const double reach = parameters_.guidance_mode == GuidanceMode::replay ? parameters_.replay_max_lead_m
-                                                                         : parameters_.constraint_radius_m;
-  const double limit = parameters_.guidance_stiffness_n_per_m * factor * reach;
+  // The replay and timing points may lead or trail the pen along the stroke by more than R_res: the spring
+  // is saturated at its force at replay_max_lead_m, so the force stays bounded and continuous. (The foot
+  // point of the other modes is never further than R_res.) The repulsive field has its own bound.
+  const bool moving_target = mode == GuidanceMode::replay || mode == GuidanceMode::timing;
+  const double reach = moving_target ? parameters_.replay_max_lead_m : parameters_.constraint_radius_m;
+  double limit = stiffness * factor * reach;
+  if (mode == GuidanceMode::error_amplification)
+    limit = std::min(limit, parameters_.amplification_max_force_n);
   const double magnitude = attraction.norm();
   if (magnitude > limit) attraction *= limit / magnitude;
-  return taper * attraction + (1.0 - slack) * resistance_force(device.velocity_m_s.head<2>(), tangent,
-                                                               parameters_.resistance_damping_n_s_per_m);
+  // Timing guidance leaves the direction to the writer too: no resistance to moving backwards.
+  const double resistance = mode == GuidanceMode::timing ? 0.0 : parameters_.resistance_damping_n_s_per_m;
+  return taper * attraction +
+         (1.0 - slack) * resistance_force(device.velocity_m_s.head<2>(), tangent, resistance);
 }
 
 RenderOutput Renderer::tick(const DeviceState& device) noexcept {

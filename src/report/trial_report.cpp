@@ -61,8 +61,10 @@ void print_trial_table(const TrialDescription& d, const Scene& scene, const Tria
   } else if (d.guidance_mode == GuidanceMode::replay) {
     std::snprintf(guidance, sizeof guidance, "replay of %s",
                   d.teacher_file.empty() ? "a teacher" : d.teacher_file.c_str());
-  } else {
+  } else if (d.guidance_mode == GuidanceMode::fixed) {
     std::snprintf(guidance, sizeof guidance, "on");
+  } else {
+    std::snprintf(guidance, sizeof guidance, "%s", to_string(d.guidance_mode));
   }
   std::printf("Trial %s: guidance %s, %s writer, seed %llu, %.0f Hz, device %s (%s)\n", d.characters.c_str(),
               guidance, d.writer.c_str(), static_cast<unsigned long long>(d.seed), d.rate_hz,
@@ -95,7 +97,8 @@ void print_trial_table(const TrialDescription& d, const Scene& scene, const Tria
   std::printf("\n  strokes completed in order  %zu / %zu%s\n", m.strokes_completed, m.strokes_total,
               m.completed_in_order ? "" : "  (incomplete)");
   std::printf("  accepted in turn           %zu / %zu (order errors %zu, backwards %zu)\n",
-              writing.strokes_accepted, writing.strokes_total, writing.order_errors, writing.backwards_strokes);
+              writing.strokes_accepted, writing.strokes_total, writing.order_errors,
+              writing.backwards_strokes);
   // "-" without a unit: nothing was written, so there is no deviation to give.
   std::printf("  mean deviation             %s%s\n", millimetres(mean, 3).c_str(), mean ? " mm" : "");
   std::printf("  max deviation              %s%s\n", millimetres(max, 3).c_str(), max ? " mm" : "");

@@ -85,9 +85,9 @@ double guidance_assistance_share(double gain, double guidance_stiffness_n_per_m,
 void practise(WriterMemory& memory, const std::vector<int>& typical_ids, const std::u32string& characters,
               double assistance_share, const TwoStateRates& rates) {
   rates.validate();
-  if (!(assistance_share >= 0.0 && assistance_share <= 1.0)) {
-    throw InvalidArgument("practise: assistance share " + std::to_string(assistance_share) +
-                          " outside [0, 1]");
+  if (!(assistance_share >= kMinAssistanceShare && assistance_share <= 1.0)) {
+    throw InvalidArgument("practise: assistance share " + std::to_string(assistance_share) + " outside [" +
+                          std::to_string(kMinAssistanceShare) + ", 1]");
   }
   // x(n+1) = A x(n) + B e(n), e(n) from the skill before the trial; a stroke type written k times learns k
   // times from that error.

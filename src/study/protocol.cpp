@@ -123,23 +123,53 @@ QuizOptions read_quiz(const json& value, const std::string& pointer, const std::
   return quiz;
 }
 
-// The documented parameters of the `fading` and `replay` modes (docs/experiments.md); an unknown key or
-// a value out of range is an error naming its pointer.
+// The documented parameters of the guidance modes (docs/experiments.md); an unknown key or a value out of
+// range is an error naming its pointer.
 void read_guidance_parameters(const json& parameters, const std::string& pointer, const std::string& source,
                               StudyCondition& condition) {
   ObjectReader reader(parameters, pointer, source);
-  if (condition.mode == ConditionMode::fading) {
-    condition.start_gain = reader.number_or("start_gain", condition.start_gain, 0.0, 1.0);
-    condition.fading_rule.forgetting_factor =
-        reader.number_or("forgetting_factor", condition.fading_rule.forgetting_factor, 0.0, 1.0);
-    condition.fading_rule.error_gain_per_m =
-        reader.number_or("error_gain_per_m", condition.fading_rule.error_gain_per_m, 0.0, 1e6);
-  } else {
-    if (reader.has("max_lead_m")) {
-      const double lead_m = reader.number("max_lead_m", 0.0, 0.1);
-      if (!(lead_m > 0.0)) fail(source, reader.pointer("max_lead_m"), "expected a number > 0");
-      condition.replay_max_lead_m = lead_m;
+  const auto positive = [&](const char* key, double high) {
+    const double value = reader.number(key, 0.0, high);
+    if (!(value > 0.0)) fail(source, reader.pointer(key), "expected a number > 0");
+    return value;
+  };
+  switch (condition.mode) {
+    case ConditionMode::fading:
+      condition.start_gain = reader.number_or("start_gain", condition.start_gain, 0.0, 1.0);
+      condition.fading_rule.forgetting_factor =
+          reader.number_or("forgetting_factor", condition.fading_rule.forgetting_factor, 0.0, 1.0);
+      condition.fading_rule.error_gain_per_m =
+          reader.number_or("error_gain_per_m", condition.fading_rule.error_gain_per_m, 0.0, 1e6);
+      break;
+    case ConditionMode::replay:
+      if (reader.has("max_lead_m")) condition.replay_max_lead_m = positive("max_lead_m", 0.1);
+      break;
+    case ConditionMode::assist_as_needed: {
+      AssistBandRule& rule = condition.assist_rule;
+      condition.start_band_m = reader.number_or("start_band_m", condition.start_band_m, 0.0, 0.1);
+      if (reader.has("target_error_m")) rule.target_error_m = positive("target_error_m", 0.1);
+      rule.rate = reader.number_or("band_rate", rule.rate, 0.0, 100.0);
+      rule.min_band_m = reader.number_or("min_band_m", rule.min_band_m, 0.0, 0.1);
+      rule.max_band_m = reader.number_or("max_band_m", rule.max_band_m, 0.0, 0.1);
+      if (rule.max_band_m < rule.min_band_m) {
+        fail(source, reader.pointer("max_band_m"), "expected a band at least min_band_m");
+      }
+      break;
     }
+    case ConditionMode::skill_adaptive:
+      if (reader.has("threshold_m")) condition.skill_rule.threshold_m = positive("threshold_m", 0.1);
+      [[fallthrough]];
+    case ConditionMode::error_amplification:
+      if (reader.has("amplification_gain"))
+        condition.amplification_gain = reader.number("amplification_gain", 0.0, 1.0);
+      if (reader.has("max_force_n"))
+        condition.amplification_max_force_n = reader.number("max_force_n", 0.0, 10.0);
+      break;
+    case ConditionMode::timing:
+      if (reader.has("speed_m_s")) condition.timing_speed_m_s = positive("speed_m_s", 1.0);
+      break;
+    default:
+      break;
   }
   reader.finish();  // any other key: an error naming it
   for (const auto& item : parameters.items())
@@ -193,12 +223,8 @@ StudyCondition read_condition(const json& value, const std::string& pointer, con
     fail(source, reader.pointer("name"),
          "expected 1 to 32 letters, digits, '_' or '-', got \"" + condition.name + "\"");
   }
-  constexpr std::array<ConditionMode, 5> kModes{ConditionMode::vision, ConditionMode::haptic,
-                                                ConditionMode::fading, ConditionMode::replay,
-                                                ConditionMode::quiz};
-  condition.mode = choice(reader, "mode", kModes);
-  const bool guided = condition.mode == ConditionMode::haptic || condition.mode == ConditionMode::fading ||
-                      condition.mode == ConditionMode::replay;
+  condition.mode = choice(reader, "mode", study_detail::kConditionModes);
+  const bool guided = renders_guidance(condition.mode);
   if (const json* stiffness = reader.optional("guidance_stiffness_n_per_m")) {
     if (!guided) {
       fail(source, reader.pointer("guidance_stiffness_n_per_m"),
@@ -209,8 +235,8 @@ StudyCondition read_condition(const json& value, const std::string& pointer, con
   }
   if (const json* parameters = reader.optional("parameters")) {
     const std::string at = reader.pointer("parameters");
-    if (condition.mode != ConditionMode::fading && condition.mode != ConditionMode::replay) {
-      fail(source, at, "only the modes \"fading\" and \"replay\" take parameters");
+    if (!guided || condition.mode == ConditionMode::haptic) {
+      fail(source, at, std::string("mode \"") + to_string(condition.mode) + "\" takes no parameters");
     }
     read_guidance_parameters(*parameters, at, source, condition);
   }
@@ -347,8 +373,22 @@ const char* to_string(ConditionMode mode) noexcept {
       return "replay";
     case ConditionMode::quiz:
       return "quiz";
+    case ConditionMode::assist_as_needed:
+      return "assist-as-needed";
+    case ConditionMode::error_amplification:
+      return "error-amplification";
+    case ConditionMode::skill_adaptive:
+      return "skill-adaptive";
+    case ConditionMode::timing:
+      return "timing";
   }
   return "unknown";
+}
+
+std::span<const ConditionMode> condition_modes() noexcept { return study_detail::kConditionModes; }
+
+bool renders_guidance(ConditionMode mode) noexcept {
+  return mode != ConditionMode::vision && mode != ConditionMode::quiz;
 }
 
 const char* to_string(ConditionOrder order) noexcept {

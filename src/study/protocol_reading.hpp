@@ -21,6 +21,17 @@ inline constexpr std::array<StudyPhase, 7> kStudyPhases{
     StudyPhase::practice,  StudyPhase::test,      StudyPhase::pre_test, StudyPhase::training,
     StudyPhase::post_test, StudyPhase::retention, StudyPhase::transfer};
 
+/// Every condition mode, in declaration order (condition_modes()).
+inline constexpr std::array<ConditionMode, 9> kConditionModes{ConditionMode::vision,
+                                                              ConditionMode::haptic,
+                                                              ConditionMode::fading,
+                                                              ConditionMode::replay,
+                                                              ConditionMode::quiz,
+                                                              ConditionMode::assist_as_needed,
+                                                              ConditionMode::error_amplification,
+                                                              ConditionMode::skill_adaptive,
+                                                              ConditionMode::timing};
+
 /// `value` among `values` by their `to_string` names; DataError naming `pointer` and listing the names for
 /// anything else.
 template <typename Enum, std::size_t N>

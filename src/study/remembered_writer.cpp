@@ -1,8 +1,11 @@
 #include "study/remembered_writer.hpp"
 
+#include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/study/guidance_share.hpp"
 #include "core/unicode.hpp"
 #include "study/json_reader.hpp"
 #include "study/saved_sessions.hpp"
@@ -47,16 +50,36 @@ void practise_record(WriterMemory& memory, const json& record, const std::string
       ids.push_back(stroke.value("typical_id", 0));
   }
   if (ids.empty()) fail(source, "/scene", "no strokes: the trial's characters are not recorded");
-  const json& force = record.value("force_law", json::object());
+  const json& force_law = record.value("force_law", json::object());
   double share = 0.0;
-  if (force.value("guidance", false)) {
+  if (force_law.value("guidance", false)) {
     const double hand = record.value("writer", json::object())
                             .value("profile", json::object())
                             .value("hand_stiffness_n_per_m", 0.0);
     if (!(hand > 0.0))
       fail(source, "/writer/profile/hand_stiffness_n_per_m", "expected the hand's stiffness > 0");
-    share = guidance_assistance_share(force.value("guidance_gain", 1.0),
-                                      force.value("guidance_stiffness_n_per_m", 0.0), hand);
+    // The mode's parameters as recorded (records from before a mode existed hold the defaults).
+    ForceLawParameters force;
+    const std::string mode = force_law.value("guidance_mode", "fixed");
+    const std::optional<GuidanceMode> parsed = guidance_mode_from_string(mode);
+    if (!parsed) fail(source, "/force_law/guidance_mode", "unknown guidance mode \"" + mode + "\"");
+    force.guidance_mode = *parsed;
+    force.guidance_gain = force_law.value("guidance_gain", 1.0);
+    force.guidance_stiffness_n_per_m = force_law.value("guidance_stiffness_n_per_m", 0.0);
+    force.assist_band_m = force_law.value("assist_band_m", force.assist_band_m);
+    force.amplification_gain = force_law.value("amplification_gain", force.amplification_gain);
+    force.amplification_max_force_n =
+        force_law.value("amplification_max_force_n", force.amplification_max_force_n);
+    force.timing_speed_m_s = force_law.value("timing_speed_m_s", force.timing_speed_m_s);
+    // A replay's teacher is not in the record; its share does not depend on it.
+    if (force.guidance_mode == GuidanceMode::replay) force.guidance_mode = GuidanceMode::fixed;
+    const json& deviation = record.value("mean_deviation_mm", json(nullptr));
+    const double deviation_m = deviation.is_number() ? deviation.get<double>() * 1e-3 : std::nan("");
+    try {
+      share = guidance_share(force, hand, deviation_m);
+    } catch (const InvalidArgument& e) {
+      fail(source, "/force_law", e.what());
+    }
   }
   practise(memory, ids, characters, share);
 }

@@ -102,8 +102,7 @@ TrialSpec study_trial_spec(const SessionManifest& session, const StudyCondition&
   TrialSpec spec;
   for (const char32_t c : trial.characters) spec.characters += encode_utf8(c);
   spec.device = session.setup.device;
-  spec.guidance = condition.mode == ConditionMode::haptic || condition.mode == ConditionMode::fading ||
-                  condition.mode == ConditionMode::replay;
+  spec.guidance = renders_guidance(condition.mode);
   if (condition.mode == ConditionMode::fading) {
     spec.guidance_mode = GuidanceMode::fading;
     if (!(guidance.gain >= 0.0 && guidance.gain <= 1.0)) {
@@ -119,6 +118,28 @@ TrialSpec study_trial_spec(const SessionManifest& session, const StudyCondition&
     // The session folder's copy (teachers/...), given to the runner as read (TrialRunInputs::teacher); the
     // record names its file under "guidance".
     spec.guidance_mode = GuidanceMode::replay;
+  }
+  if (condition.mode == ConditionMode::assist_as_needed) {
+    spec.guidance_mode = GuidanceMode::assist_as_needed;
+    spec.assist_band_m = guidance.band_m;
+  }
+  if (condition.mode == ConditionMode::error_amplification)
+    spec.guidance_mode = GuidanceMode::error_amplification;
+  if (condition.mode == ConditionMode::skill_adaptive) {
+    spec.guidance_mode = guidance.mode.value_or(GuidanceMode::fixed);
+    if (spec.guidance_mode != GuidanceMode::fixed &&
+        spec.guidance_mode != GuidanceMode::error_amplification) {
+      throw InvalidArgument("condition '" + condition.name +
+                            "': skill-adaptive chooses fixed guidance or error "
+                            "amplification, not " +
+                            to_string(spec.guidance_mode));
+    }
+  }
+  if (spec.guidance_mode == GuidanceMode::error_amplification && condition.amplification_gain)
+    spec.amplification_gain = *condition.amplification_gain;
+  if (condition.mode == ConditionMode::timing) {
+    spec.guidance_mode = GuidanceMode::timing;
+    if (condition.timing_speed_m_s) spec.timing_speed_m_s = *condition.timing_speed_m_s;
   }
   const bool simulated = session.setup.writer == "simulated";
   spec.writer = simulated ? TrialWriter::simulated : TrialWriter::person;
@@ -137,28 +158,10 @@ TrialSpec study_trial_spec(const SessionManifest& session, const StudyCondition&
   return spec;
 }
 
-namespace {
-
-// What a condition sets beyond the specification: the quiz's acceptance, the replay's teacher and lead, a
-// guidance stiffness of its own.
-void apply_condition(const StudyCondition& condition, const TrialGuidance& guidance, TrialOptions& options) {
-  // The renderer judges strokes as the quiz does.
-  if (condition.mode == ConditionMode::quiz) options.force.acceptance = condition.quiz.acceptance;
-  if (condition.mode == ConditionMode::replay) {
-    options.force.teacher_trajectory = guidance.teacher;
-    if (condition.replay_max_lead_m) options.force.replay_max_lead_m = *condition.replay_max_lead_m;
-  }
-  if (condition.guidance_stiffness_n_per_m && options.force.guidance) {
-    options.force.guidance_stiffness_n_per_m = *condition.guidance_stiffness_n_per_m;
-  }
-}
-
-}  // namespace
-
 TrialOptions study_trial_options(const SessionManifest& session, const StudyCondition& condition,
                                  const PlannedTrial& trial, const TrialGuidance& guidance) {
   TrialOptions options = trial_options(study_trial_spec(session, condition, trial, guidance), DeviceInfo{});
-  apply_condition(condition, guidance, options);
+  study_detail::apply_condition(condition, guidance, options);
   options.validate();
   return options;
 }
@@ -240,8 +243,8 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     }
     const Scene scene = Scene::lay_out(models);
     study_detail::PreparedGuidance guidance;
-    if (condition.mode == ConditionMode::fading)
-      guidance = study_detail::fading_guidance(session, condition, trial);
+    if (study_detail::adapts_by_repetition(condition.mode))
+      guidance = study_detail::repetition_guidance(session, condition, trial);
     if (condition.mode == ConditionMode::replay)
       guidance = study_detail::replay_guidance(session, condition, trial, scene);
     TrialSpec spec = study_trial_spec(manifest, condition, trial, guidance.guidance);
@@ -274,7 +277,7 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     inputs.teacher = guidance.guidance.teacher;
     inputs.should_stop = run_options.should_stop;
     inputs.adjust = [&](TrialOptions& options) {
-      apply_condition(condition, guidance.guidance, options);
+      study_detail::apply_condition(condition, guidance.guidance, options);
       if (run_options.prepare_trial) run_options.prepare_trial(trial, options);
     };
     study_detail::TrialRecordContext context;

@@ -9,6 +9,7 @@
 #include "study/json_reader.hpp"
 #include "study/names.hpp"
 #include "study/saved_sessions.hpp"
+#include "study/trial_row.hpp"
 
 namespace calligraphy {
 namespace fs = std::filesystem;
@@ -100,6 +101,18 @@ TrialRow read_trial_row(const fs::path& json_file, const SessionManifest& manife
                         std::vector<StrokeRow>& strokes) {
   const std::string source = json_file.string();
   const json record = study_detail::read_trial_record(json_file);
+  TrialRow row = study_detail::trial_row(record, source, manifest, plan, strokes);
+  const std::string csv = record.value("files", json::object()).value("csv", "");
+  if (csv.empty() || csv.find('/') != std::string::npos) fail(source, "/files/csv", "expected a file name");
+  row.trace_file = json_file.parent_path() / csv;
+  return row;
+}
+
+}  // namespace
+
+TrialRow study_detail::trial_row(const json& record, const std::string& source,
+                                 const SessionManifest& manifest, const PlannedTrial& plan,
+                                 std::vector<StrokeRow>& strokes) {
   TrialRow row;
   row.subject = manifest.setup.subject.id;
   row.session = manifest.session_id;
@@ -136,13 +149,12 @@ TrialRow read_trial_row(const fs::path& json_file, const SessionManifest& manife
   const json& memory = record.value("writer", json::object()).value("memory", json::object());
   row.shape_skill = optional_number(memory, "shape_skill", source, "/writer/memory");
   row.order_skill = optional_number(memory, "order_skill", source, "/writer/memory");
-  const std::string csv = record.value("files", json::object()).value("csv", "");
-  if (csv.empty() || csv.find('/') != std::string::npos) fail(source, "/files/csv", "expected a file name");
-  row.trace_file = json_file.parent_path() / csv;
   const json& characters = record.value("per_character", json::array());
   for (std::size_t c = 0; c < characters.size(); ++c) add_strokes(characters[c], c, source, row, strokes);
   return row;
 }
+
+namespace {
 
 // One CSV field: quoted when it holds a comma, a quote or a line break (RFC 4180).
 std::string field(const std::string& text) {

@@ -1,5 +1,6 @@
 #include "study/trial_guidance.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <system_error>
 
@@ -53,37 +54,77 @@ std::string record_teacher(const SessionFolder& session, const Scene& scene,
 
 }  // namespace
 
-PreparedGuidance fading_guidance(const SessionFolder& session, const StudyCondition& condition,
-                                 const PlannedTrial& trial) {
-  PreparedGuidance prepared;
-  prepared.guidance.gain = condition.start_gain;
+const PlannedTrial* previous_repetition(const std::vector<PlannedTrial>& plan, const PlannedTrial& trial) {
   const PlannedTrial* previous = nullptr;
-  for (const PlannedTrial& earlier : session.plan()) {
+  for (const PlannedTrial& earlier : plan) {
     if (earlier.index >= trial.index) break;
     if (earlier.condition == trial.condition && earlier.characters == trial.characters) previous = &earlier;
   }
-  if (!previous) return prepared;
+  return previous;
+}
+
+PreparedGuidance repetition_guidance(const StudyCondition& condition, const PlannedTrial* previous,
+                                     const json* previous_record, const std::string& source) {
+  PreparedGuidance prepared;
+  prepared.guidance.gain = condition.start_gain;
+  prepared.guidance.band_m = condition.start_band_m;
+  if (condition.mode == ConditionMode::skill_adaptive) prepared.guidance.mode = GuidanceMode::fixed;
+  if (!previous || !previous_record) return prepared;
+  try {
+    const json& record = *previous_record;
+    prepared.previous_trial = SessionFolder::trial_stem(*previous);
+    const json& guidance = record.at("guidance");
+    if (condition.mode == ConditionMode::fading) prepared.previous_gain = guidance.at("gain").get<double>();
+    if (condition.mode == ConditionMode::assist_as_needed)
+      prepared.previous_band_m = guidance.at("band_m").get<double>();
+    prepared.previous_deviation_mm = record.at("mean_deviation_mm");
+  } catch (const json::exception& e) {
+    throw DataError(source + ": no guidance and mean deviation to adapt from: " + e.what());
+  }
+  // A repetition that wrote nothing gives no error to adapt on: full guidance again.
+  const bool wrote = prepared.previous_deviation_mm.is_number();
+  const double error_m = wrote ? prepared.previous_deviation_mm.get<double>() * 1e-3 : 0.0;
+  switch (condition.mode) {
+    case ConditionMode::fading:
+      prepared.guidance.gain =
+          wrote ? next_guidance_gain(prepared.previous_gain, error_m, condition.fading_rule) : 1.0;
+      break;
+    case ConditionMode::assist_as_needed:
+      prepared.guidance.band_m =
+          wrote ? next_assist_band(prepared.previous_band_m, error_m, condition.assist_rule)
+                : condition.assist_rule.min_band_m;
+      break;
+    case ConditionMode::skill_adaptive:
+      prepared.guidance.mode = skill_adaptive_mode(wrote ? error_m : std::nan(""), condition.skill_rule);
+      break;
+    default:
+      break;
+  }
+  return prepared;
+}
+
+PreparedGuidance repetition_guidance(const SessionFolder& session, const StudyCondition& condition,
+                                     const PlannedTrial& trial) {
+  const PlannedTrial* previous = previous_repetition(session.plan(), trial);
+  if (!previous) return repetition_guidance(condition, nullptr, nullptr, "");
   const fs::path file = session.trial_file(*previous, "json");
   if (!session.is_saved(*previous)) {
-    throw StateError("trial " + SessionFolder::trial_stem(trial) + ": its gain follows " +
+    throw StateError("trial " + SessionFolder::trial_stem(trial) + ": its guidance follows " +
                      SessionFolder::trial_stem(*previous) + ", which is not saved");
   }
   const std::string text = read_small_file(file, std::uintmax_t{64} << 20, "trial record");
+  json record;
   try {
-    const json record = json::parse(text);
-    prepared.previous_trial = SessionFolder::trial_stem(*previous);
-    prepared.previous_gain = record.at("guidance").at("gain").get<double>();
-    prepared.previous_deviation_mm = record.at("mean_deviation_mm");
+    record = json::parse(text);
   } catch (const json::exception& e) {
-    throw DataError(file.string() + ": no guidance gain and mean deviation to fade from: " + e.what());
+    throw DataError(file.string() + ": no guidance and mean deviation to adapt from: " + e.what());
   }
-  // A repetition that wrote nothing gives no error to fade on: full guidance again.
-  prepared.guidance.gain =
-      prepared.previous_deviation_mm.is_number()
-          ? next_guidance_gain(prepared.previous_gain, prepared.previous_deviation_mm.get<double>() * 1e-3,
-                               condition.fading_rule)
-          : 1.0;
-  return prepared;
+  return repetition_guidance(condition, previous, &record, file.string());
+}
+
+bool adapts_by_repetition(ConditionMode mode) noexcept {
+  return mode == ConditionMode::fading || mode == ConditionMode::assist_as_needed ||
+         mode == ConditionMode::skill_adaptive;
 }
 
 PreparedGuidance replay_guidance(SessionFolder& session, const StudyCondition& condition,
@@ -139,12 +180,16 @@ json guidance_record_json(const StudyCondition& condition, const PreparedGuidanc
     guidance["start_gain"] = condition.start_gain;
     guidance["forgetting_factor"] = condition.fading_rule.forgetting_factor;
     guidance["error_gain_per_m"] = condition.fading_rule.error_gain_per_m;
-    guidance["previous_trial"] =
-        prepared.previous_trial.empty() ? json(nullptr) : json(prepared.previous_trial);
-    if (!prepared.previous_trial.empty()) {
-      guidance["previous_gain"] = prepared.previous_gain;
-      guidance["previous_mean_deviation_mm"] = prepared.previous_deviation_mm;
-    }
+  } else if (condition.mode == ConditionMode::assist_as_needed) {
+    guidance["band_m"] = prepared.guidance.band_m;
+    guidance["start_band_m"] = condition.start_band_m;
+    guidance["target_error_m"] = condition.assist_rule.target_error_m;
+    guidance["band_rate"] = condition.assist_rule.rate;
+    guidance["min_band_m"] = condition.assist_rule.min_band_m;
+    guidance["max_band_m"] = condition.assist_rule.max_band_m;
+  } else if (condition.mode == ConditionMode::skill_adaptive) {
+    guidance["selected_mode"] = to_string(prepared.guidance.mode.value_or(GuidanceMode::fixed));
+    guidance["threshold_m"] = condition.skill_rule.threshold_m;
   } else if (condition.mode == ConditionMode::replay) {
     guidance["teacher"] = {
         {"file", prepared.teacher_file},
@@ -154,7 +199,31 @@ json guidance_record_json(const StudyCondition& condition, const PreparedGuidanc
         {"characters", prepared.teacher_characters},
         {"seed", prepared.teacher_source == "recorded" ? json(kRecordedTeacherSeed) : json(nullptr)}};
   }
+  if (adapts_by_repetition(condition.mode)) {
+    guidance["previous_trial"] =
+        prepared.previous_trial.empty() ? json(nullptr) : json(prepared.previous_trial);
+    if (!prepared.previous_trial.empty()) {
+      if (condition.mode == ConditionMode::fading) guidance["previous_gain"] = prepared.previous_gain;
+      if (condition.mode == ConditionMode::assist_as_needed)
+        guidance["previous_band_m"] = prepared.previous_band_m;
+      guidance["previous_mean_deviation_mm"] = prepared.previous_deviation_mm;
+    }
+  }
   return guidance;
+}
+
+void apply_condition(const StudyCondition& condition, const TrialGuidance& guidance, TrialOptions& options) {
+  // The renderer judges strokes as the quiz does.
+  if (condition.mode == ConditionMode::quiz) options.force.acceptance = condition.quiz.acceptance;
+  if (condition.mode == ConditionMode::replay) {
+    options.force.teacher_trajectory = guidance.teacher;
+    if (condition.replay_max_lead_m) options.force.replay_max_lead_m = *condition.replay_max_lead_m;
+  }
+  if (condition.amplification_max_force_n)
+    options.force.amplification_max_force_n = *condition.amplification_max_force_n;
+  if (condition.guidance_stiffness_n_per_m && options.force.guidance) {
+    options.force.guidance_stiffness_n_per_m = *condition.guidance_stiffness_n_per_m;
+  }
 }
 
 }  // namespace calligraphy::study_detail

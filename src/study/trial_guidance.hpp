@@ -1,7 +1,8 @@
 #pragma once
-// The guidance of trials in `fading` and `replay` conditions, which depends on the session itself: the gain
-// of a repetition follows the saved previous one, and a replay follows a teacher's recording kept in the
-// session folder (docs/experiments.md, "Fading and replay conditions"). Internal.
+// The guidance of trials in conditions whose guidance depends on the session itself: the gain, band or mode
+// of a repetition follows the saved previous one (fading, assist-as-needed, skill-adaptive), and a replay
+// follows a teacher's recording kept in the session folder (docs/experiments.md, "Fading and replay
+// conditions"). Internal.
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -20,9 +21,10 @@ inline constexpr std::uint64_t kRecordedTeacherSeed = 1;
 /// A trial's guidance with its provenance.
 struct PreparedGuidance {
   TrialGuidance guidance;
-  // fading
-  std::string previous_trial;  ///< file stem of the repetition the gain follows from; empty for the first
-  double previous_gain = 0.0;
+  // fading, assist-as-needed, skill-adaptive
+  std::string previous_trial;  ///< file stem of the repetition the guidance follows from; empty for the first
+  double previous_gain = 0.0;  ///< fading
+  double previous_band_m = 0.0;          ///< assist-as-needed
   nlohmann::json previous_deviation_mm;  ///< null when the previous repetition wrote no stroke
   // replay
   std::string teacher_file;    ///< relative to the session folder: "teachers/....json"
@@ -32,13 +34,33 @@ struct PreparedGuidance {
   std::string teacher_characters;
 };
 
-/// The gain of `trial` in the fading `condition`: the condition's start gain for the first repetition of
-/// the item, else `next_guidance_gain` from the gain and mean deviation recorded in the previous
-/// repetition's saved JSON (so that a resumed session computes the same gain); 1 (full guidance) after a
-/// repetition that wrote no stroke. Throws StateError when the previous repetition is not saved, DataError
-/// when its record cannot be read.
-PreparedGuidance fading_guidance(const SessionFolder& session, const StudyCondition& condition,
-                                 const PlannedTrial& trial);
+/// The guidance of `trial` in a condition that adapts repetition by repetition (`adapts_by_repetition`):
+/// for the first repetition of the item, the condition's start (gain, band; fixed guidance for skill-
+/// adaptive); for a later one, from the guidance and mean deviation recorded in the previous repetition's
+/// saved JSON (so that a resumed session computes the same): `next_guidance_gain` (fading),
+/// `next_assist_band` (assist-as-needed), `skill_adaptive_mode` (skill-adaptive). After a repetition that
+/// wrote no stroke: full guidance (gain 1, the narrowest band, fixed guidance). Throws StateError when the
+/// previous repetition is not saved, DataError when its record cannot be read.
+PreparedGuidance repetition_guidance(const SessionFolder& session, const StudyCondition& condition,
+                                     const PlannedTrial& trial);
+
+/// The repetition whose guidance `trial` follows: the last trial of `plan` before it with the same condition
+/// and characters; nullptr for the first.
+const PlannedTrial* previous_repetition(const std::vector<PlannedTrial>& plan, const PlannedTrial& trial);
+
+/// `repetition_guidance` from the previous repetition and its record, held by the caller (a simulated cohort
+/// keeps them in memory): the condition's start when `previous` or `previous_record` is nullptr. Throws
+/// DataError naming `source` when the record lacks the guidance or the deviation.
+PreparedGuidance repetition_guidance(const StudyCondition& condition, const PlannedTrial* previous,
+                                     const nlohmann::json* previous_record, const std::string& source);
+
+/// What a condition sets beyond the trial specification: the quiz's acceptance, the replay's teacher and
+/// lead, the repulsive field's bound, a guidance stiffness of its own (the runner's TrialRunInputs::adjust).
+void apply_condition(const StudyCondition& condition, const TrialGuidance& guidance, TrialOptions& options);
+
+/// Whether a mode's guidance follows the previous repetition of the item: fading, assist-as-needed,
+/// skill-adaptive.
+[[nodiscard]] bool adapts_by_repetition(ConditionMode mode) noexcept;
 
 /// The teacher of `trial` in the replay `condition`: the copy in the session folder's teachers/ when there
 /// is one; else the protocol's recording of the item (copied there), or one recorded there by a skilled

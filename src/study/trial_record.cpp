@@ -38,6 +38,10 @@ json force_law_json(const ForceLawParameters& f) {
           {"guidance_mode", to_string(f.guidance_mode)},
           {"guidance_gain", f.guidance_gain},
           {"replay_max_lead_m", f.replay_max_lead_m},
+          {"assist_band_m", f.assist_band_m},
+          {"amplification_gain", f.amplification_gain},
+          {"amplification_max_force_n", f.amplification_max_force_n},
+          {"timing_speed_m_s", f.timing_speed_m_s},
           {"guidance_stiffness_n_per_m", f.guidance_stiffness_n_per_m},
           {"paper_stiffness_n_per_m", f.paper_stiffness_n_per_m},
           {"constraint_radius_m", f.constraint_radius_m},
@@ -222,9 +226,8 @@ std::vector<std::vector<QuizEvent>> quiz_characters(const Scene& scene, const st
   return events;
 }
 
-std::string trial_record_json(const TrialRecordContext& c, const Scene& scene, const TrialResult& result,
-                              const WritingMetrics& writing,
-                              const std::vector<std::vector<QuizEvent>>* quiz) {
+nlohmann::json trial_record(const TrialRecordContext& c, const Scene& scene, const TrialResult& result,
+                            const WritingMetrics& writing, const std::vector<std::vector<QuizEvent>>* quiz) {
   const TrialMetrics& m = result.metrics;
   json per_stroke = json::array();
   for (const StrokeMetrics& s : m.per_stroke) {
@@ -319,7 +322,13 @@ std::string trial_record_json(const TrialRecordContext& c, const Scene& scene, c
                         {"backwards", quiz_backwards},
                         {"characters", characters}};
   }
-  return document.dump(2) + "\n";
+  return document;
+}
+
+std::string trial_record_json(const TrialRecordContext& context, const Scene& scene,
+                              const TrialResult& result, const WritingMetrics& writing,
+                              const std::vector<std::vector<QuizEvent>>* quiz) {
+  return trial_record(context, scene, result, writing, quiz).dump(2) + "\n";
 }
 
 }  // namespace calligraphy::study_detail

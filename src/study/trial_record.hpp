@@ -51,7 +51,12 @@ std::vector<PenSample> pen_samples_of_character(const Scene& scene, const std::v
 std::vector<std::vector<QuizEvent>> quiz_characters(const Scene& scene, const std::vector<TrialSample>& trace,
                                                     const QuizOptions& options);
 
-/// The record as JSON text (2-space indent): the context, the renderer's figures and every key of the one
+/// The record: the context, the renderer's figures and every key of the one metrics record `writing`
+/// (trial_writing_metrics). `quiz` is given for quiz conditions.
+nlohmann::json trial_record(const TrialRecordContext& context, const Scene& scene, const TrialResult& result,
+                            const WritingMetrics& writing, const std::vector<std::vector<QuizEvent>>* quiz);
+
+/// `trial_record` as JSON text (2-space indent): the context, the renderer's figures and every key of the one
 /// metrics record `writing` (trial_writing_metrics). `quiz` is given for quiz conditions.
 std::string trial_record_json(const TrialRecordContext& context, const Scene& scene,
                               const TrialResult& result, const WritingMetrics& writing,

@@ -24,10 +24,19 @@ constexpr std::array kFields{
     TrialSpecField{"characters", "CHARS", "CHARS", "the characters to write, left to right (UTF-8)"},
     TrialSpecField{"device", "--device", "NAME", "the device, by its name in `calligraphy devices`"},
     TrialSpecField{"guidance", "--guidance", "on|off", "guiding force towards the stroke"},
-    TrialSpecField{"guidance_mode", "--guidance-mode", "fixed|fading|replay",
-                   "how the guidance attracts: the paper's fixture, faded by --guidance-gain, or replaying "
-                   "--teacher"},
+    TrialSpecField{
+        "guidance_mode", "--guidance-mode", "fixed|fading|replay|assist-as-needed|error-amplification|timing",
+        "how the guidance acts: the paper's fixture, faded by --guidance-gain, replaying --teacher, "
+        "only beyond --assist-band, pushing off the stroke (--amplification-gain), or pulling "
+        "along it at --timing-speed"},
     TrialSpecField{"guidance_gain", "--guidance-gain", "G", "fading: gain on the guiding force, in [0, 1]"},
+    TrialSpecField{"assist_band_m", "--assist-band", "M",
+                   "assist-as-needed: half-width of the band without force around the stroke [m], >= 0"},
+    TrialSpecField{"amplification_gain", "--amplification-gain", "G",
+                   "error-amplification: the repulsive field's stiffness as a share of the guidance's, in "
+                   "[0, 1]"},
+    TrialSpecField{"timing_speed_m_s", "--timing-speed", "M/S",
+                   "timing: mean speed of the target along each stroke [m/s], > 0"},
     TrialSpecField{"teacher", "--teacher", "FILE",
                    "replay: the teacher's recording of CHARS (made with --record)"},
     TrialSpecField{"writer", "--writer", "auto|person|simulated",
@@ -144,10 +153,18 @@ void set_trial_spec_field(TrialSpec& spec, std::string_view name, std::string_vi
     if (text != "on" && text != "off") refuse(key, "'" + std::string(text) + "' is not one of 'on', 'off'");
     spec.guidance = text == "on";
   } else if (key == "guidance_mode") {
-    spec.guidance_mode =
-        parse_choice(key, text, std::array{GuidanceMode::fixed, GuidanceMode::fading, GuidanceMode::replay});
+    spec.guidance_mode = parse_choice(
+        key, text,
+        std::array{GuidanceMode::fixed, GuidanceMode::fading, GuidanceMode::replay,
+                   GuidanceMode::assist_as_needed, GuidanceMode::error_amplification, GuidanceMode::timing});
   } else if (key == "guidance_gain") {
     spec.guidance_gain = parse_number(key, text);
+  } else if (key == "assist_band_m") {
+    spec.assist_band_m = parse_number(key, text);
+  } else if (key == "amplification_gain") {
+    spec.amplification_gain = parse_number(key, text);
+  } else if (key == "timing_speed_m_s") {
+    spec.timing_speed_m_s = parse_number(key, text);
   } else if (key == "teacher") {
     spec.teacher = text;
   } else if (key == "writer") {
@@ -191,6 +208,9 @@ std::vector<std::string> trial_spec_field_text(const TrialSpec& spec, std::strin
   if (key == "guidance") return {spec.guidance ? "on" : "off"};
   if (key == "guidance_mode") return {to_string(spec.guidance_mode)};
   if (key == "guidance_gain") return {number_text(spec.guidance_gain)};
+  if (key == "assist_band_m") return {number_text(spec.assist_band_m)};
+  if (key == "amplification_gain") return {number_text(spec.amplification_gain)};
+  if (key == "timing_speed_m_s") return {number_text(spec.timing_speed_m_s)};
   if (key == "teacher") return {spec.teacher};
   if (key == "writer") return {to_string(spec.writer)};
   if (key == "writer_profile") return {spec.writer_profile};
@@ -230,6 +250,27 @@ void TrialSpec::validate(TeacherSource teacher_from) const {
   }
   if (guidance_gain != 1.0 && guidance_mode != GuidanceMode::fading) {
     refuse("guidance_gain", "applies to guidance mode 'fading' only");
+  }
+  // Each mode's own parameter: in range, and given only with its mode (a value nothing reads is a mistake).
+  const TrialSpec defaults;
+  if (!(assist_band_m >= 0.0) || !std::isfinite(assist_band_m)) {
+    refuse("assist_band_m", number_text(assist_band_m) + " must be finite and >= 0");
+  }
+  if (assist_band_m != defaults.assist_band_m && guidance_mode != GuidanceMode::assist_as_needed) {
+    refuse("assist_band_m", "applies to guidance mode 'assist-as-needed' only");
+  }
+  if (!(amplification_gain >= 0.0 && amplification_gain <= 1.0)) {
+    refuse("amplification_gain", number_text(amplification_gain) + " is outside [0, 1]");
+  }
+  if (amplification_gain != defaults.amplification_gain &&
+      guidance_mode != GuidanceMode::error_amplification) {
+    refuse("amplification_gain", "applies to guidance mode 'error-amplification' only");
+  }
+  if (!(timing_speed_m_s > 0.0) || !std::isfinite(timing_speed_m_s)) {
+    refuse("timing_speed_m_s", number_text(timing_speed_m_s) + " must be finite and > 0");
+  }
+  if (timing_speed_m_s != defaults.timing_speed_m_s && guidance_mode != GuidanceMode::timing) {
+    refuse("timing_speed_m_s", "applies to guidance mode 'timing' only");
   }
   if (guidance_mode == GuidanceMode::replay && teacher.empty() && teacher_from == TeacherSource::file) {
     refuse("teacher", "required with guidance mode 'replay' (a recording made with --record)");
@@ -353,7 +394,8 @@ TrialSpec trial_spec_from_json(std::string_view text, const std::string& source)
           study_detail::fail(source, at, "expected a whole number of milliseconds in [0, 60] s");
         }
         item_text = std::to_string(std::llround(ms));
-      } else if (key == "guidance_gain" || key == "rate_hz" || key == "max_duration_s") {
+      } else if (key == "guidance_gain" || key == "assist_band_m" || key == "amplification_gain" ||
+                 key == "timing_speed_m_s" || key == "rate_hz" || key == "max_duration_s") {
         if (!item.is_number())
           study_detail::fail(source, at, "expected a number, got " + study_detail::describe(item));
         item_text = number_text(item.get<double>());
@@ -390,6 +432,12 @@ std::string trial_spec_json(const TrialSpec& spec) {
       document[key] = spec.seed;
     } else if (key == "guidance_gain") {
       document[key] = spec.guidance_gain;
+    } else if (key == "assist_band_m") {
+      document[key] = spec.assist_band_m;
+    } else if (key == "amplification_gain") {
+      document[key] = spec.amplification_gain;
+    } else if (key == "timing_speed_m_s") {
+      document[key] = spec.timing_speed_m_s;
     } else if (key == "rate_hz") {
       document[key] = spec.rate_hz;
     } else if (key == "watchdog_s") {

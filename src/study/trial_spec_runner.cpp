@@ -42,6 +42,9 @@ TrialOptions trial_options(const TrialSpec& spec, const DeviceInfo& device) {
   options.force.guidance = spec.guidance;
   options.force.guidance_mode = spec.guidance_mode;
   options.force.guidance_gain = spec.guidance_gain;
+  options.force.assist_band_m = spec.assist_band_m;
+  options.force.amplification_gain = spec.amplification_gain;
+  options.force.timing_speed_m_s = spec.timing_speed_m_s;
   fit_default_stiffness(options.force, device);
   options.rate_hz = spec.rate_hz;
   options.pacing = spec.pacing;

@@ -30,7 +30,10 @@ LoadedProtocol practice_protocol(const PracticeSetup& setup) {
            {"hint_after_misses", setup.quiz.hint_after_misses},
            {"accept_backwards", setup.quiz.accept_backwards}}}},
         {{"name", kFadingCondition}, {"mode", "fading"}},
-        {{"name", kReplayCondition}, {"mode", "replay"}}}},
+        {{"name", kReplayCondition}, {"mode", "replay"}},
+        {{"name", kAssistCondition}, {"mode", "assist-as-needed"}},
+        {{"name", kAmplificationCondition}, {"mode", "error-amplification"}},
+        {{"name", kTimingCondition}, {"mode", "timing"}}}},
       {"test", {{"characters", items}, {"conditions", {setup.first_condition}}, {"repetitions", 1}}}};
   return protocol_from_text(protocol.dump(2) + "\n", "calligraphy-train");
 }

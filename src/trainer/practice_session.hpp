@@ -12,9 +12,9 @@
 
 #include "calligraphy/core/device_types.hpp"
 #include "calligraphy/model/scene.hpp"
+#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/session_folder.hpp"
-#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/trial/options.hpp"
 #include "calligraphy/trial/result.hpp"
 
@@ -25,8 +25,11 @@ namespace calligraphy::trainer {
 inline constexpr const char* kHapticCondition = "haptic";
 inline constexpr const char* kVisionCondition = "vision";
 inline constexpr const char* kQuizCondition = "quiz";
-inline constexpr const char* kFadingCondition = "fading";  ///< guidance faded trial by trial
-inline constexpr const char* kReplayCondition = "replay";  ///< guidance along a teacher's recording
+inline constexpr const char* kFadingCondition = "fading";            ///< guidance faded trial by trial
+inline constexpr const char* kReplayCondition = "replay";            ///< guidance along a teacher's recording
+inline constexpr const char* kAssistCondition = "assist-as-needed";  ///< force only beyond a band
+inline constexpr const char* kAmplificationCondition = "error-amplification";  ///< a repulsive field
+inline constexpr const char* kTimingCondition = "timing";  ///< a target along the stroke, no shape guidance
 
 /// What the session folder is created with.
 struct PracticeSetup {

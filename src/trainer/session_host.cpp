@@ -15,8 +15,7 @@ void WindowSessionHost::before_trial(const PlannedTrial& trial, std::size_t tota
   view_.trial = trial;
   view_.total = total;
   view_.mode = condition.mode;
-  view_.guidance = condition.mode == ConditionMode::haptic || condition.mode == ConditionMode::fading ||
-                   condition.mode == ConditionMode::replay;
+  view_.guidance = renders_guidance(condition.mode);
   view_.channel.reset();
   view_.outcome.reset();
   start_ = false;

@@ -3,6 +3,9 @@
 // thread through run_trial with real-time pacing, the ServoLoop on its own thread.
 #include "trainer/trainer_app.hpp"
 
+#include <algorithm>
+#include <span>
+
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 
@@ -10,6 +13,7 @@
 #include <cstdio>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <thread>
 #include <vector>
@@ -147,6 +151,12 @@ std::string TrainerApp::condition_name() const {
       return kFadingCondition;
     case GuidanceMode::replay:
       return kReplayCondition;
+    case GuidanceMode::assist_as_needed:
+      return kAssistCondition;
+    case GuidanceMode::error_amplification:
+      return kAmplificationCondition;
+    case GuidanceMode::timing:
+      return kTimingCondition;
     case GuidanceMode::fixed:
       break;
   }
@@ -228,12 +238,14 @@ void TrainerApp::handle_keys() {
       case GLFW_KEY_G:  // a quiz has no guidance
         if (session_ == nullptr && !options_.quiz) guidance_ = !guidance_;
         break;
-      case GLFW_KEY_M:  // the guidance mode of the next trial: fixed, fading, replay (with a teacher)
+      case GLFW_KEY_M:  // the guidance mode of the next trial, in turn (replay only with a teacher)
         if (session_ == nullptr && !options_.quiz) {
-          guidance_mode_ = guidance_mode_ == GuidanceMode::fixed ? GuidanceMode::fading
-                           : guidance_mode_ == GuidanceMode::fading && !options_.teacher.empty()
-                               ? GuidanceMode::replay
-                               : GuidanceMode::fixed;
+          const std::span<const GuidanceMode> modes = guidance_modes();
+          auto at = std::find(modes.begin(), modes.end(), guidance_mode_);
+          do {
+            at = std::next(at) == modes.end() ? modes.begin() : std::next(at);
+          } while (*at == GuidanceMode::replay && options_.teacher.empty());
+          guidance_mode_ = *at;
         }
         break;
       default:

@@ -125,6 +125,7 @@ class TrainerApp {
   bool guidance_ = true;
   GuidanceMode guidance_mode_ = GuidanceMode::fixed;
   double guidance_gain_ = 1.0;
+  double assist_band_m_ = ForceLawParameters{}.assist_band_m;  // assist-as-needed: the next trial's band
   bool condition_outputs_force_ = true;
   bool quit_ = false;
   bool quit_seen_ = false;

@@ -33,6 +33,14 @@ const char* mode_meaning(ConditionMode mode) {
       return "fading guidance";
     case ConditionMode::replay:
       return "the teacher's movement replayed";
+    case ConditionMode::assist_as_needed:
+      return "help only beyond a band around the stroke";
+    case ConditionMode::error_amplification:
+      return "errors enlarged by a gentle push off the stroke";
+    case ConditionMode::skill_adaptive:
+      return "help or error enlargement, by your last error";
+    case ConditionMode::timing:
+      return "a target that paces you along the stroke";
   }
   return "";
 }

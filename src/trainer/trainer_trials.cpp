@@ -46,6 +46,7 @@ void TrainerApp::start_trial(std::size_t character) {
   spec.guidance = guidance_;
   if (guidance_) spec.guidance_mode = guidance_mode_;
   if (spec.guidance_mode == GuidanceMode::fading) spec.guidance_gain = guidance_gain_;
+  if (spec.guidance_mode == GuidanceMode::assist_as_needed) spec.assist_band_m = assist_band_m_;
   spec.writer = options_.simulated_writer ? TrialWriter::simulated : TrialWriter::person;
   if (options_.simulated_writer) spec.writer_profile = options_.writer_profile;
   spec.seed = options_.seed + trials_started_ - 1;
@@ -125,6 +126,12 @@ void TrainerApp::finish_trial() {
       view.metrics.mean_deviation_m) {  // performance-based fading (Emken et al. 2007)
     guidance_gain_ = next_guidance_gain(guidance_gain_, *view.metrics.mean_deviation_m);
     std::fprintf(stderr, "calligraphy train: fading: next trial's guidance gain %.3f\n", guidance_gain_);
+  }
+  if (guidance_ && trial_options_.force.guidance_mode == GuidanceMode::assist_as_needed &&
+      view.metrics.mean_deviation_m) {  // the band adapts to the error (next_assist_band)
+    assist_band_m_ = next_assist_band(assist_band_m_, *view.metrics.mean_deviation_m);
+    std::fprintf(stderr, "calligraphy train: assist-as-needed: next trial's band %.2f mm\n",
+                 assist_band_m_ * 1e3);
   }
   // A teacher's recording must write every stroke as the renderer reads it (replay follows it stroke by
   // stroke); a completed quiz need not have.

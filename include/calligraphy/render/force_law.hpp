@@ -4,9 +4,9 @@
 /// (noexcept, no allocation). Device frame: the paper is z = z0, +z out of the paper.
 #include <vector>
 
+#include "calligraphy/core/geometry.hpp"
 #include "calligraphy/model/nearest_point.hpp"
 #include "calligraphy/model/stroke_progress.hpp"
-#include "calligraphy/core/geometry.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
 
 namespace calligraphy {
@@ -38,11 +38,27 @@ struct ForceLawParameters {
   /// recorded trial's trace: `TrialSample::time_s`, `position_m`). Read at renderer construction
   /// (teacher_replay.hpp); ignored in the other modes.
   std::vector<TeacherSample> teacher_trajectory;
-  /// Replay only: the spring towards the teacher's point pulls at most as hard as it does at this
+  /// Replay and timing: the spring towards the teacher's (or the timing target's) point pulls at most as
+  /// hard as it does at this
   /// distance [m], in (0, R_res]: K_et a d_max. The point may lead or trail the pen along the stroke by
   /// more (a trainee slower than the teacher); the bound keeps the pull moderate and the force step
   /// small when a pen held back that hard crosses the taper band at the edge of R_res.
   double replay_max_lead_m = 0.003;
+  /// `assist_as_needed` only: the half-width b [m] >= 0 of the band around the active element within which
+  /// the fixture is slack; beyond it the spring acts on d - b only, so the force is continuous at the band
+  /// (set per repetition, or from performance with `next_assist_band`).
+  double assist_band_m = 0.001;
+  /// `error_amplification` only: the repulsive field's stiffness as a share g in [0, 1] of K_et: g K_et a
+  /// (X_p - X_S). Below the hand's stiffness the pen keeps an equilibrium on the stroke (0.25 x 400 = 100
+  /// N/m against the simulated relaxed hand's 150 N/m).
+  double amplification_gain = 0.25;
+  /// `error_amplification` only: the repulsive force's bound [N] >= 0, so that a deviation is enlarged,
+  /// never thrown: within the constraint space the field stores at most this force times R_res of energy.
+  double amplification_max_force_n = 0.3;
+  /// `timing` only: the mean speed [m/s] > 0 of the target along each stroke (the stroke's length over its
+  /// duration; a minimum-jerk profile within it). Default: a fluent writer's pace (the simulated skilled
+  /// writer's, docs/writer.md).
+  double timing_speed_m_s = 0.04;
   // Off-stroke resistance (docs/force-rendering.md): under guidance, writing off the active stroke is
   // felt. The paper's resistance of Fig. 4 extended from the direction within a stroke to the order of
   // the strokes (section 2.2; section 6: the active stroke masks the others). Both parts 0 = the
@@ -100,8 +116,8 @@ struct ForceLawParameters {
   NearestPointOptions nearest{};
 
   /// Throws InvalidArgument when a value is negative, not finite, the radius or the stick speed is not
-  /// positive, the taper band is wider than the radius, the gain is outside [0, 1], or the mode is
-  /// `replay` and the teacher trajectory is bad (validate_teacher_trajectory).
+  /// positive, the taper band is wider than the radius, a gain is outside [0, 1], the timing speed is not
+  /// > 0, or the mode is `replay` and the teacher trajectory is bad (validate_teacher_trajectory).
   void validate() const;
 };
 

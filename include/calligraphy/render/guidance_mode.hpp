@@ -8,6 +8,18 @@
 ///  - `replay`: a recorded trial of a teacher becomes time-indexed guidance: the attraction point moves
 ///    along the teacher's pen path at the teacher's pace ("record and replay": Henmi & Yoshikawa 1998,
 ///    Feygin, Keehner & Tendick 2002). The clock of stroke k starts when the pen enters WS on it.
+///  - `assist_as_needed`: the fixture's spring acts only on the deviation beyond a band around the stroke,
+///    K_et a (d - b)+, so errors within the band are the writer's own to correct; the band b widens as the
+///    writer's error falls and narrows as it grows (`next_assist_band`): assist-as-needed (Emken, Bobrow &
+///    Reinkensmeyer 2005; Banala et al. 2009, a force tunnel around the path).
+///  - `error_amplification`: a bounded repulsive field that enlarges the deviation, g K_et a (X_p - X_S),
+///    at most `amplification_max_force_n` (error augmentation: Emken & Reinkensmeyer 2005; Patton et al.
+///    2006).
+///  - `timing`: a target moves along the stroke's centre line at a minimum-jerk pace (Flash & Hogan 1985)
+///    and the pen is pulled towards it along the stroke only, never across it: guidance on timing, not on
+///    shape.
+/// Skill-adaptive selection (Milot et al. 2010: guidance for the less skilled, amplification for the
+/// more skilled) chooses one of these per repetition: `skill_adaptive_mode`.
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -18,14 +30,21 @@
 namespace calligraphy {
 
 enum class GuidanceMode : std::uint8_t {
-  fixed,   ///< eq. (8) as printed (with the attracting sign): the paper's virtual fixture
-  fading,  ///< eq. (8) scaled by ForceLawParameters::guidance_gain in [0, 1]
-  replay,  ///< the attraction point follows ForceLawParameters::teacher_trajectory in time
+  fixed,                ///< eq. (8) as printed (with the attracting sign): the paper's virtual fixture
+  fading,               ///< eq. (8) scaled by ForceLawParameters::guidance_gain in [0, 1]
+  replay,               ///< the attraction point follows ForceLawParameters::teacher_trajectory in time
+  assist_as_needed,     ///< eq. (8) on the deviation beyond ForceLawParameters::assist_band_m only
+  error_amplification,  ///< a bounded repulsive field, ForceLawParameters::amplification_gain x eq. (8)
+  timing,               ///< a minimum-jerk target along the stroke, pulled towards along the stroke only
 };
 
-/// "fixed", "fading" or "replay".
+/// "fixed", "fading", "replay", "assist-as-needed", "error-amplification" or "timing".
 const char* to_string(GuidanceMode mode) noexcept;
-/// The mode called `name` ("fixed", "fading", "replay"); nullopt for any other name.
+/// Every mode, in declaration order.
+[[nodiscard]] std::span<const GuidanceMode> guidance_modes() noexcept;
+/// The names of every mode joined by '|' ("fixed|fading|..."), for help texts and errors.
+[[nodiscard]] const char* guidance_mode_names() noexcept;
+/// The mode called `name` (as `to_string` spells it); nullopt for any other name.
 std::optional<GuidanceMode> guidance_mode_from_string(std::string_view name) noexcept;
 
 /// One sample of a teacher's recorded pen: time [s] and position in the device frame [m] (the scene's
@@ -54,5 +73,36 @@ struct FadingRule {
 /// example the mean deviation of the trial). Throws InvalidArgument for a gain outside [0, 1], a
 /// negative or non-finite error, or a bad rule.
 [[nodiscard]] double next_guidance_gain(double gain, double error_m, const FadingRule& rule = {});
+
+/// The assist-as-needed band rule: b(n+1) = clamp(b(n) + k (e* - e(n)), b_min, b_max). An error e below
+/// the target e* widens the band (less help), above it narrows it (more help): the error-based adaptation
+/// of assistance of Emken, Bobrow & Reinkensmeyer (2005, Proc. IEEE ICORR) applied to the width of a
+/// force tunnel (Banala et al. 2009, IEEE TNSRE 17:2), once per repetition.
+struct AssistBandRule {
+  double target_error_m = 0.0015;  ///< e* [m] > 0: the deviation the band adapts towards
+  double rate = 1.0;               ///< k >= 0 (dimensionless): 1 mm of error below e* widens the band 1 mm
+  double min_band_m = 0.0;         ///< b_min [m] >= 0
+  double max_band_m = 0.004;       ///< b_max [m] >= b_min
+  /// Throws InvalidArgument naming the field when a value is out of range or not finite.
+  void validate() const;
+};
+
+/// The next repetition's band [m] from this repetition's band b(n) >= 0 and error e(n) >= 0 [m]. Throws
+/// InvalidArgument for a negative or non-finite band or error, or a bad rule.
+[[nodiscard]] double next_assist_band(double band_m, double error_m, const AssistBandRule& rule = {});
+
+/// Skill-adaptive selection (Milot, Marchal-Crespo, Green, Cramer & Reinkensmeyer 2010, Exp Brain Res
+/// 201:119: haptic guidance helped the less skilled learn, error amplification the more skilled).
+struct SkillAdaptiveRule {
+  /// Error [m] > 0 at or above which the writer counts as less skilled and is guided.
+  double threshold_m = 0.002;
+  /// Throws InvalidArgument naming the field when the threshold is not finite and > 0.
+  void validate() const;
+};
+
+/// The mode of the next repetition from the error of the previous one [m] >= 0 (NaN: no stroke written,
+/// the least skilled): `fixed` when the error is at or above the threshold, else `error_amplification`.
+/// Throws InvalidArgument for a negative error or a bad rule.
+[[nodiscard]] GuidanceMode skill_adaptive_mode(double previous_error_m, const SkillAdaptiveRule& rule = {});
 
 }  // namespace calligraphy

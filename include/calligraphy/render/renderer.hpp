@@ -10,14 +10,15 @@
 #include <cstdint>
 
 #include "calligraphy/collision/active_stroke.hpp"
-#include "calligraphy/model/nearest_point_tracker.hpp"
 #include "calligraphy/core/device_types.hpp"
+#include "calligraphy/model/nearest_point_tracker.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/render/force_law.hpp"
 #include "calligraphy/render/interaction_state.hpp"
 #include "calligraphy/render/passivity.hpp"
 #include "calligraphy/render/safety_chain.hpp"
 #include "calligraphy/render/teacher_replay.hpp"
+#include "calligraphy/render/timing_target.hpp"
 
 namespace calligraphy {
 
@@ -91,6 +92,7 @@ class Renderer {
   PassivityController passivity_;
   NearestPointTracker tracker_;
   TeacherReplay replay_;
+  TimingTarget timing_;           // the `timing` mode's moving target
   double writing_since_s_ = 0.0;  // device time at which WS was entered on the active stroke (replay clock)
   Vec2 off_stroke_velocity_ = Vec2::Zero();  // low-passed in-plane velocity for the off-stroke damper
   Vec2 off_stroke_anchor_ = Vec2::Zero();    // adhesion point of the off-stroke friction in CS

@@ -55,10 +55,16 @@ struct WriterMemory {
 [[nodiscard]] double guidance_assistance_share(double gain, double guidance_stiffness_n_per_m,
                                                double hand_stiffness_n_per_m);
 
+/// The lowest assistance share `practise` takes: -9, an error enlarged tenfold (a guard on the fast state's
+/// step B_f e; error amplification with the default field enlarges it at most threefold, guidance_share.hpp).
+inline constexpr double kMinAssistanceShare = -9.0;
+
 /// One trial of practice: every memory decays by its retention (A_f, A_s); then each typical stroke of
 /// `typical_ids` (one per stroke of the trial's characters; a stroke type written twice learns twice) and
-/// each character of `characters` learns from the error e = (1 - x)(1 - `assistance_share`). Throws
-/// InvalidArgument for a share outside [0, 1] or bad rates.
+/// each character of `characters` learns from the error e = (1 - x)(1 - `assistance_share`): a share in (0,
+/// 1] is the correction guidance took, a negative share an error a repulsive field enlarged by the factor 1 -
+/// share (error augmentation: Emken & Reinkensmeyer 2005, IEEE TNSRE 13:33). Throws InvalidArgument for a
+/// share outside [kMinAssistanceShare, 1] or bad rates.
 void practise(WriterMemory& memory, const std::vector<int>& typical_ids, const std::u32string& characters,
               double assistance_share, const TwoStateRates& rates = {});
 

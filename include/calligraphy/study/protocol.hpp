@@ -7,12 +7,14 @@
 #include <filesystem>
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/model/stroke_progress.hpp"
+#include "calligraphy/render/force_law.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
 
 namespace calligraphy {
@@ -24,10 +26,20 @@ enum class ConditionMode {
   fading,  ///< guidance whose gain follows the writer's deviation over repetitions (GuidanceMode::fading)
   replay,  ///< guidance that replays a teacher's recorded trial of the item (GuidanceMode::replay)
   quiz,    ///< vision only, each stroke judged when the pen lifts (quiz.hpp)
+  assist_as_needed,     ///< force only beyond a band that adapts to the writer's error
+                        ///< (GuidanceMode::assist_as_needed)
+  error_amplification,  ///< a bounded repulsive field (GuidanceMode::error_amplification)
+  skill_adaptive,       ///< per repetition: fixed guidance or error amplification by the previous error
+  timing,               ///< a minimum-jerk target along the stroke, no shape guidance (GuidanceMode::timing)
 };
 
-/// "vision", "haptic", "fading", "replay", "quiz".
+/// "vision", "haptic", "fading", "replay", "quiz", "assist-as-needed", "error-amplification",
+/// "skill-adaptive", "timing".
 [[nodiscard]] const char* to_string(ConditionMode mode) noexcept;
+/// Every mode, in declaration order.
+[[nodiscard]] std::span<const ConditionMode> condition_modes() noexcept;
+/// Whether trials of the mode render in-plane guidance (every mode but `vision` and `quiz`).
+[[nodiscard]] bool renders_guidance(ConditionMode mode) noexcept;
 
 /// How a quiz judges strokes: each pen-down run with the stroke matcher (`match_stroke`,
 /// analysis/stroke_matcher.hpp), the rule the renderer and `score_trace` use (docs/stroke-acceptance.md);
@@ -55,8 +67,8 @@ struct StudyCondition {
   ConditionMode mode = ConditionMode::vision;
   /// Overrides the guidance stiffness K_et (ForceLawParameters, paper eq. 8) [N/m]; haptic modes only.
   std::optional<double> guidance_stiffness_n_per_m;
-  /// Parameters of the `fading` and `replay` modes, by name, as the protocol gives them (recorded with
-  /// every trial); read into the fields after `quiz`.
+  /// Parameters of the guidance modes, by name, as the protocol gives them (recorded with every trial);
+  /// read into the fields after `quiz`.
   std::map<std::string, double> guidance_parameters;
   QuizOptions quiz;  ///< `quiz` mode only
   /// `fading` ("start_gain", in [0, 1]): the gain of the first repetition of an item in the condition.
@@ -66,6 +78,20 @@ struct StudyCondition {
   FadingRule fading_rule{};
   /// `replay` ("max_lead_m", in (0, 0.1]): ForceLawParameters::replay_max_lead_m [m] when given.
   std::optional<double> replay_max_lead_m{};
+  /// `assist-as-needed` ("start_band_m" in [0, 0.1]): the band of the first repetition of an item [m].
+  double start_band_m = ForceLawParameters{}.assist_band_m;
+  /// `assist-as-needed` ("target_error_m", "band_rate", "min_band_m", "max_band_m"): each later repetition's
+  /// band is `next_assist_band(previous band, previous mean deviation, assist_rule)`.
+  AssistBandRule assist_rule{};
+  /// `error-amplification` and `skill-adaptive` ("amplification_gain" in [0, 1], "max_force_n" in [0, 10]):
+  /// ForceLawParameters::amplification_gain and amplification_max_force_n when given.
+  std::optional<double> amplification_gain{};
+  std::optional<double> amplification_max_force_n{};
+  /// `skill-adaptive` ("threshold_m" in (0, 0.1]): `skill_adaptive_mode` of the previous repetition's mean
+  /// deviation (its first repetition is guided).
+  SkillAdaptiveRule skill_rule{};
+  /// `timing` ("speed_m_s" in (0, 1]): ForceLawParameters::timing_speed_m_s when given.
+  std::optional<double> timing_speed_m_s{};
   /// `replay`: the teacher's recording of an item (teacher_recording.hpp), by item; the path as given,
   /// relative to the protocol file. An item without one gets a teacher recorded by the session runner.
   std::map<std::u32string, std::string> teachers{};

@@ -81,10 +81,14 @@ struct SessionRunResult {
   [[nodiscard]] bool complete() const { return saved_before + saved_now == planned; }
 };
 
-/// What the guidance of a `fading` or `replay` trial takes from the session (docs/experiments.md): the
-/// runner works it out from the saved trials and the teachers kept in the session folder.
+/// What the guidance of a `fading`, `assist-as-needed`, `skill-adaptive` or `replay` trial takes from the
+/// session (docs/experiments.md): the runner works it out from the saved trials and the teachers kept in the
+/// session folder.
 struct TrialGuidance {
-  double gain = 1.0;                   ///< `fading`: the trial's gain in [0, 1] (ForceLawParameters)
+  double gain = 1.0;  ///< `fading`: the trial's gain in [0, 1] (ForceLawParameters)
+  double band_m = ForceLawParameters{}.assist_band_m;  ///< `assist-as-needed`: the trial's band [m] >= 0
+  /// `skill-adaptive`: the mode chosen for the trial (fixed or error amplification); nullopt: fixed.
+  std::optional<GuidanceMode> mode;
   std::vector<TeacherSample> teacher;  ///< `replay`: the teacher's pen, device frame [m], times [s]
   std::string teacher_file;            ///< `replay`: its file in the session folder ("teachers/....json")
 };

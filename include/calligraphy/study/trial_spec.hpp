@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "calligraphy/devices/servo_loop.hpp"
+#include "calligraphy/render/force_law.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
 #include "calligraphy/trial/options.hpp"
 
@@ -33,13 +34,19 @@ struct TrialSpec {
   std::string characters;                            ///< UTF-8, written left to right (1..1000)
   std::string device = "simulated";                  ///< a device name of `calligraphy devices`
   bool guidance = true;                              ///< in-plane guidance (the paper force stays)
-  GuidanceMode guidance_mode = GuidanceMode::fixed;  ///< the paper's fixture, fading or replay
+  GuidanceMode guidance_mode = GuidanceMode::fixed;  ///< the paper's fixture or another mode
   double guidance_gain = 1.0;                        ///< fading only: gain in [0, 1]
-  std::string teacher;                               ///< replay only: a teacher's recording (JSON file)
-  TrialWriter writer = TrialWriter::automatic;       ///< who writes
-  std::string writer_profile = "novice";             ///< the simulated writer's profile (docs/writer.md)
-  std::vector<std::string> writer_parameters;        ///< "key=value" settings applied to the profile in turn
-  std::uint64_t seed = 0;                            ///< the simulated writer's seed
+  /// assist-as-needed only: the band's half-width [m] >= 0 (ForceLawParameters::assist_band_m)
+  double assist_band_m = ForceLawParameters{}.assist_band_m;
+  /// error-amplification only: the repulsive stiffness's share of K_et, in [0, 1]
+  double amplification_gain = ForceLawParameters{}.amplification_gain;
+  /// timing only: the target's mean speed along each stroke [m/s] > 0
+  double timing_speed_m_s = ForceLawParameters{}.timing_speed_m_s;
+  std::string teacher;                           ///< replay only: a teacher's recording (JSON file)
+  TrialWriter writer = TrialWriter::automatic;   ///< who writes
+  std::string writer_profile = "novice";         ///< the simulated writer's profile (docs/writer.md)
+  std::vector<std::string> writer_parameters;    ///< "key=value" settings applied to the profile in turn
+  std::uint64_t seed = 0;                        ///< the simulated writer's seed
   double rate_hz = 1000.0;                       ///< servo rate [Hz]: [100, 100000], real time [100, 10000]
   TrialPacing pacing = TrialPacing::automatic;   ///< lock-step, real time, or the device's own
   RealtimeMode realtime = RealtimeMode::ignore;  ///< real time: require SCHED_FIFO, pinning, locked memory

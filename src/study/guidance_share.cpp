@@ -1,0 +1,56 @@
+#include "calligraphy/study/guidance_share.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/sim/writer_memory.hpp"
+
+namespace calligraphy {
+
+double guidance_share(const ForceLawParameters& force, double hand_stiffness_n_per_m,
+                      double mean_deviation_m) {
+  force.validate();
+  const double k = hand_stiffness_n_per_m;
+  if (!(k > 0.0) || !std::isfinite(k)) {
+    throw InvalidArgument("guidance_share: hand stiffness " + std::to_string(k) +
+                          " N/m must be finite and > 0");
+  }
+  const double e = mean_deviation_m;
+  const bool written = !std::isnan(e);
+  if (written && (!(e >= 0.0) || !std::isfinite(e))) {
+    throw InvalidArgument("guidance_share: mean deviation " + std::to_string(e) +
+                          " m must be finite and >= 0");
+  }
+  if (!force.guidance) return 0.0;
+  const double stiffness = force.guidance_stiffness_n_per_m;
+  switch (force.guidance_mode) {
+    case GuidanceMode::timing:
+      return 0.0;
+    case GuidanceMode::fixed:
+    case GuidanceMode::replay:
+      return guidance_assistance_share(1.0, stiffness, k);
+    case GuidanceMode::fading:
+      return guidance_assistance_share(force.guidance_gain, stiffness, k);
+    case GuidanceMode::assist_as_needed: {
+      // Within the band the deviation is the writer's own to correct; a trial with no stroke got all help.
+      double beyond = 1.0;
+      if (written) beyond = e > 0.0 ? std::max(0.0, 1.0 - force.assist_band_m / e) : 0.0;
+      return beyond * guidance_assistance_share(1.0, stiffness, k);
+    }
+    case GuidanceMode::error_amplification: {
+      if (!written) return 0.0;
+      const double repulsive = force.amplification_gain * stiffness;
+      const double linear = repulsive < k ? k / (k - repulsive) : std::numeric_limits<double>::infinity();
+      const double saturated =
+          e > 0.0 ? 1.0 + force.amplification_max_force_n / (k * e) : std::numeric_limits<double>::infinity();
+      const double factor = std::min({linear, saturated, 1.0 - kMinAssistanceShare});
+      return 1.0 - factor;
+    }
+  }
+  return 0.0;
+}
+
+}  // namespace calligraphy
