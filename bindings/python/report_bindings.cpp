@@ -14,8 +14,10 @@
 #include "bindings.hpp"
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/report/teacher_recording.hpp"
+#include "calligraphy/study/cohort.hpp"
 #include "calligraphy/study/curriculum.hpp"
 #include "calligraphy/study/study_tables.hpp"
+#include "calligraphy/study/transfer_set.hpp"
 #include "character_source.hpp"
 #include "core/unicode.hpp"
 
@@ -52,6 +54,36 @@ void bind_report(py::module_& m) {
       "The tidy tables of the session folders under `paths` as the CSV texts (trials, strokes) that "
       "`calligraphy report --csv` writes (read_study_tables, include/calligraphy/study/study_tables.hpp); "
       "calligraphy.study.load makes DataFrames of them. Raises DataError naming a damaged file.");
+  m.def(
+      "_simulate_cohort_csv",
+      [](const std::string& protocol_path, const std::vector<std::pair<std::string, std::size_t>>& subjects,
+         const std::string& profile, const std::string& learning, const CharacterSource& library,
+         unsigned threads) {
+        LoadedProtocol protocol = load_study_protocol(protocol_path);
+        const auto load = [&library](char32_t c) { return library.load(c); };
+        try {
+          resolve_transfer_choices(protocol.protocol, load);
+        } catch (const InvalidArgument& e) {
+          throw InvalidArgument(protocol_path + ": " + e.what());
+        }
+        std::vector<SubjectAssignment> assigned;
+        for (const auto& [id, number] : subjects) assigned.push_back({id, number});
+        CohortSetup setup;
+        setup.writer_profile = profile;
+        setup.writer_learning = learning;
+        setup.load_character = load;
+        StudyTables tables;
+        {
+          py::gil_scoped_release release;  // minutes of simulation
+          tables = simulate_cohort(protocol, assigned, setup, threads);
+        }
+        return py::make_tuple(trials_csv(tables), strokes_csv(tables));
+      },
+      py::arg("protocol"), py::arg("subjects"), py::arg("profile"), py::arg("learning"), py::arg("library"),
+      py::arg("threads"),
+      "Simulated subjects [(id, number), ...] through every session of the protocol file in memory "
+      "(simulate_cohort, include/calligraphy/study/cohort.hpp) on `threads` threads: the CSV texts (trials, "
+      "strokes) of their tidy tables. calligraphy.experiments.cohort wraps it.");
   m.def(
       "_propose_characters",
       [](const py::list& roots, const std::string& subject, const std::string& candidates, std::size_t count,

@@ -6,23 +6,23 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
-#include <set>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/study/cohort.hpp"
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/session_folder.hpp"
 #include "calligraphy/study/session_runner.hpp"
 #include "calligraphy/study/session_series.hpp"
-#include "calligraphy/study/transfer_set.hpp"
 #include "cli/cli_devices.hpp"
 #include "cli/commands.hpp"
 #include "cli/interrupt.hpp"
 #include "cli/library_options.hpp"
 #include "cli/output.hpp"
 #include "cli/signals.hpp"
+#include "cli/study_inputs.hpp"
 #include "cli/writer_options.hpp"
 #include "core/unicode.hpp"
 #ifdef CALLIGRAPHY_WITH_TRAINER
@@ -94,37 +94,6 @@ class TerminalHost final : public SessionHost {
                  outcome.saved ? "" : " (kept as an attempt)");
   }
 };
-
-// Every character the protocol names is looked up (read and modelled) before any folder is made or trial
-// run: one the library lacks is a DataError naming the protocol file, the string's JSON pointer and the
-// character, not a failure in the middle of a study.
-void require_characters(const LoadedProtocol& loaded, const CharacterSource& source) {
-  std::set<char32_t> checked;
-  const auto check = [&](const std::vector<std::u32string>& items, const std::string& pointer) {
-    for (std::size_t i = 0; i < items.size(); ++i) {
-      for (const char32_t c : items[i]) {
-        if (!checked.insert(c).second) continue;
-        try {
-          (void)source.load(c);
-        } catch (const Error& e) {
-          char code[16];
-          std::snprintf(code, sizeof code, "U+%04X", static_cast<unsigned>(c));
-          throw DataError(loaded.path.string() + ": " + pointer + "/" + std::to_string(i) +
-                          ": the character " + encode_utf8(c) + " (" + code +
-                          ") cannot be written: " + e.what() + "; nothing was run or written");
-        }
-      }
-    }
-  };
-  const StudyProtocol& protocol = loaded.protocol;
-  for (const ProtocolPhase& phase : protocol.phases) {
-    if (phase.choice) {
-      check(phase.choice->candidates, phase.pointer + "/characters/from");
-    } else {
-      check(phase.items, phase.pointer + "/characters");
-    }
-  }
-}
 
 SessionRunOptions run_options(const LibraryOptions& library, SessionHost* host,
                               std::shared_ptr<CharacterSource>& source) {
@@ -274,11 +243,11 @@ int run_sessions(const SessionRunCommand& command) {
 
   std::vector<SubjectAssignment> subjects;
   if (command.subjects > 0) {
-    const std::string prefix = command.subject.empty() ? "S" : command.subject;
-    for (std::int64_t k = 1; k <= command.subjects; ++k) {
-      char number[32];
-      std::snprintf(number, sizeof number, "%02lld", static_cast<long long>(k));
-      subjects.push_back({prefix + number, static_cast<std::size_t>(k)});
+    try {
+      subjects = numbered_subjects(static_cast<std::size_t>(command.subjects),
+                                   command.subject.empty() ? "S" : command.subject);
+    } catch (const InvalidArgument& e) {
+      throw UsageError(std::string("--subject: ") + e.what());
     }
   } else {
     const std::size_t number = command.subject_number_option->count() > 0
@@ -287,13 +256,7 @@ int run_sessions(const SessionRunCommand& command) {
     subjects.push_back({command.subject, number});
   }
 
-  // A transfer set chosen by typical-stroke coverage is chosen once, the same for every subject.
-  LoadedProtocol resolved = protocol;
-  try {
-    resolve_transfer_choices(resolved.protocol, [&characters](char32_t c) { return characters.load(c); });
-  } catch (const InvalidArgument& e) {
-    throw DataError(protocol.path.string() + ": " + e.what());
-  }
+  const LoadedProtocol resolved = resolved_protocol(protocol, characters);
 
   install_stop_handlers();
   TerminalHost host;
@@ -399,8 +362,8 @@ void add_display_options(CLI::App& app, SessionDisplay& display) {
 }
 
 void add_session_commands(CLI::App& root, Commands& commands) {
-  CLI::App* group =
-      commands.add_group(root, "session", "Study sessions: run a protocol, resume a stopped session");
+  CLI::App* group = commands.add_group(
+      root, "session", "Study sessions: run a protocol, resume a stopped session, simulate a cohort");
 
   auto run = std::make_shared<SessionRunCommand>();
   CLI::App* app = commands.add(
@@ -443,6 +406,8 @@ void add_session_commands(CLI::App& root, Commands& commands) {
            "start a person's next session before the protocol's delay has passed (recorded as overridden)");
   add_library_options(*app, run->library, true);
   add_display_options(*app, run->display);
+
+  add_session_cohort_command(*group, commands);
 
   auto resume = std::make_shared<SessionResumeCommand>();
   CLI::App* resume_app =

@@ -16,7 +16,9 @@ void add_corpus_commands(CLI::App& root, Commands& commands);   // corpus build|
 void add_bench_commands(CLI::App& root, Commands& commands);    // bench nearest|jumps|tick|loop|acceptance
 void add_session_commands(CLI::App& root, Commands& commands);  // session run|resume
 void add_report_command(CLI::App& root, Commands& commands);
-void add_curriculum_command(CLI::App& root, Commands& commands);  // curriculum DIR... --subject ID --from CHARS    // report DIR... --out FILE
+void add_curriculum_command(
+    CLI::App& root,
+    Commands& commands);  // curriculum DIR... --subject ID --from CHARS    // report DIR... --out FILE
 
 // The subcommands of the groups, one file each.
 void add_corpus_build_command(CLI::App& corpus, Commands& commands);
@@ -28,5 +30,6 @@ void add_bench_jumps_command(CLI::App& bench, Commands& commands);
 void add_bench_tick_command(CLI::App& bench, Commands& commands);
 void add_bench_loop_command(CLI::App& bench, Commands& commands);
 void add_bench_acceptance_command(CLI::App& bench, Commands& commands);
+void add_session_cohort_command(CLI::App& session, Commands& commands);
 
 }  // namespace calligraphy::cli

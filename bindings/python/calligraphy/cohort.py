@@ -1,0 +1,119 @@
+"""Simulated cohorts: many simulated subjects through every session of a study protocol, in memory, on every
+local core or on a Dask cluster.
+
+``simulate(protocol, subjects)`` runs subjects 1..N (ids S01, S02, ...) through the protocol's phases and
+sessions as ``calligraphy session run --subjects N`` would, with the same plan, seeds, guidance schedules and
+learning memory, but without session folders, traces or per-trial files (``simulate_cohort``,
+include/calligraphy/study/cohort.hpp), and returns a ``calligraphy.study.Study``: the tidy tables that
+``calligraphy.study.load`` reads from folders, row for row, except for the ``session`` name ("PROTOCOL-sN"),
+an empty ``start_utc`` and no trace file. The tables feed ``calligraphy.statistics`` (``learning``,
+``group_comparison``) as they are.
+
+Locally the subjects run on C++ threads in this process. With a ``distributed.Client`` (or any
+``concurrent.futures.Executor``) they run in batches on its workers, each batch one task that carries only
+the protocol's path, the subjects' ids and numbers and the names of the profile and learning; every subject
+is deterministic, so the tables do not depend on where or in which batches it ran.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import os
+import typing
+
+from . import study as _study
+from ._calligraphy import _simulate_cohort_csv
+from .experiments import _library, _local_workers, _source
+
+__all__ = ["simulate"]
+
+PathLike = typing.Union[str, "os.PathLike[str]"]
+
+# Subjects per task on an executor: a subject is 50 trials or so (a second or two), so a few subjects
+# make a task long enough that its overhead (milliseconds on Dask) does not count.
+_DEFAULT_BATCH = 4
+
+
+def _subject_list(subjects: typing.Any, prefix: str) -> list[tuple[str, int]]:
+    if isinstance(subjects, bool) or not isinstance(subjects, int):
+        raise TypeError(f"subjects: expected an int (the number of simulated subjects), got {subjects!r}")
+    if subjects < 1:
+        raise ValueError(f"subjects: expected at least 1 subject, got {subjects}")
+    return [(f"{prefix}{number:02d}", number) for number in range(1, subjects + 1)]
+
+
+def _run_batch(protocol: str, batch: list[tuple[str, int]], profile: str, learning: str,
+               source: tuple[str, str]) -> tuple[str, str]:
+    """One task on a worker: the batch's subjects one after another; the CSV texts of their tables."""
+    return _simulate_cohort_csv(protocol, batch, profile, learning, _library(source), 1)
+
+
+def _body(text: str) -> str:
+    """A CSV text without its header line."""
+    return text.split("\n", 1)[1] if "\n" in text else ""
+
+
+def simulate(protocol: PathLike, subjects: int, *, profile: str = "novice", learning: str = "two-state",
+             prefix: str = "S", client: typing.Any = None, workers: typing.Optional[int] = None,
+             store: typing.Optional[PathLike] = None, data: typing.Optional[PathLike] = None,
+             batch_size: typing.Optional[int] = None, progress: bool = True) -> "_study.Study":
+    """Runs simulated subjects 1..`subjects` through every session of `protocol` (a study protocol file,
+    docs/experiments.md) and returns their tidy tables as a ``calligraphy.study.Study`` (trials: one row per
+    trial; strokes: one row per reference stroke; columns as ``calligraphy.study.load``'s).
+
+    profile: the simulated writer's profile, 'novice', 'skilled' or 'foreign'. learning: 'two-state' (the
+        learning memory of docs/writer.md, practised by every trial and consolidated between sessions) or
+        'none'. prefix: the subjects' ids are prefix + the number in two digits or more.
+    client: None runs on `workers` C++ threads in this process (default: every core this process may use);
+        a distributed.Client (or any concurrent.futures.Executor) runs batches of `batch_size` subjects
+        (default 4) as its tasks, one thread each. The protocol file and the character source must be
+        readable by every worker.
+    store / data: characters from a corpus store or a hanzi-writer-data folder instead of the embedded set.
+    progress: a tqdm bar over the batches on an executor (when tqdm is installed).
+
+    Raises TypeError or ValueError for a bad argument, InvalidArgument for a bad profile or learning, a
+    protocol with a replay condition (its teacher lives in a session folder) or a transfer choice that
+    cannot be made; DataError naming the protocol file when it cannot be read; CharacterNotFound for a
+    character the source lacks; ImportError without pandas. A simulated subject is a model, not a person.
+    """
+    subject_list = _subject_list(subjects, prefix)
+    path = os.path.abspath(os.fspath(protocol))
+    source = _source(store, data)
+    if client is None:
+        threads = workers if workers is not None else _local_workers()
+        if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
+            raise ValueError(f"workers: expected an int >= 1, got {workers!r}")
+        trials_text, strokes_text = _simulate_cohort_csv(path, subject_list, profile, learning, _library(source),
+                                                         threads)
+    else:
+        size = batch_size if batch_size is not None else _DEFAULT_BATCH
+        if isinstance(size, bool) or not isinstance(size, int) or size < 1:
+            raise ValueError(f"batch_size: expected an int >= 1, got {batch_size!r}")
+        executor = client.get_executor() if hasattr(client, "get_executor") else client
+        batches = [subject_list[i:i + size] for i in range(0, len(subject_list), size)]
+        futures = [executor.submit(_run_batch, path, batch, profile, learning, source) for batch in batches]
+        bar = _progress(len(subject_list), progress)
+        try:
+            for future, batch in zip(futures, batches):
+                future.add_done_callback(lambda _, n=len(batch): bar.update(n) if bar is not None else None)
+            texts = [future.result() for future in futures]  # in subject order; the first error is raised
+        finally:
+            for future in futures:
+                future.cancel()
+            if bar is not None:
+                bar.close()
+        trials_text = texts[0][0] + "".join(_body(trials) for trials, _ in texts[1:])
+        strokes_text = texts[0][1] + "".join(_body(strokes) for _, strokes in texts[1:])
+    return _study.Study(trials=_study._read_table(trials_text, _study._NUMERIC_TRIAL_COLUMNS, ("completed_in_order",)),
+                        strokes=_study._read_table(strokes_text, _study._NUMERIC_STROKE_COLUMNS,
+                                                   ("written", "backwards")))
+
+
+def _progress(total: int, enabled: bool) -> typing.Any:
+    if not enabled:
+        return None
+    try:
+        from tqdm.auto import tqdm  # type: ignore[import]
+    except ImportError:  # tqdm is optional: no bar
+        return None
+    return tqdm(total=total, unit="subject", desc="cohort")

@@ -1,0 +1,100 @@
+// `calligraphy session cohort PROTOCOL --subjects N --csv DIR`: N simulated subjects through every session
+// of a protocol in memory (study/cohort.hpp), on every core, without session folders; the study's tidy
+// tables (trials.csv, strokes.csv) are written at the end, as `report --csv` writes them for folders.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "calligraphy/study/cohort.hpp"
+#include "calligraphy/study/study_tables.hpp"
+#include "cli/commands.hpp"
+#include "cli/library_options.hpp"
+#include "cli/output.hpp"
+#include "cli/progress.hpp"
+#include "cli/study_inputs.hpp"
+
+namespace calligraphy::cli {
+namespace {
+
+struct SessionCohortCommand {
+  std::string protocol;
+  std::int64_t subjects = 0;
+  std::string prefix = "S";
+  std::string writer_profile = "novice";
+  std::string writer_learning = "two-state";
+  std::int64_t jobs = 0;  // 0: every core
+  std::string csv;
+  LibraryOptions library;
+};
+
+int run_session_cohort(const SessionCohortCommand& command) {
+  const auto start = std::chrono::steady_clock::now();
+  FilePlan files;
+  files.input("PROTOCOL", command.protocol);
+  add_library_inputs(files, command.library);
+  const std::filesystem::path tables_folder(command.csv);
+  files.existing_output_folder("--csv", command.csv);
+  files.output("--csv", (tables_folder / "trials.csv").string());
+  files.output("--csv", (tables_folder / "strokes.csv").string());
+
+  const LoadedProtocol protocol = load_study_protocol(command.protocol);
+  const CharacterSource characters(command.library);
+  require_characters(protocol, characters);
+  const LoadedProtocol resolved = resolved_protocol(protocol, characters);
+  CohortSetup setup;
+  setup.writer_profile = command.writer_profile;
+  setup.writer_learning = command.writer_learning;
+  setup.load_character = [&characters](char32_t c) { return characters.load(c); };
+  std::vector<SubjectAssignment> subjects;
+  try {
+    subjects = numbered_subjects(static_cast<std::size_t>(command.subjects), command.prefix);
+  } catch (const InvalidArgument& e) {
+    throw UsageError(std::string("--subject: ") + e.what());
+  }
+  const unsigned threads = command.jobs > 0 ? static_cast<unsigned>(command.jobs)
+                                            : std::max(1u, std::thread::hardware_concurrency());
+
+  TerminalProgress progress("subjects");
+  const StudyTables tables = simulate_cohort(resolved, subjects, setup, threads, [&](std::size_t done) {
+    progress.update(done, subjects.size(), "subjects");
+  });
+  write_output((tables_folder / "trials.csv").string(), trials_csv(tables));
+  write_output((tables_folder / "strokes.csv").string(), strokes_csv(tables));
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf(
+      "%s: %zu subjects, %zu trials on %u threads in %.1f s: trials.csv (%zu rows), strokes.csv (%zu rows)\n",
+      command.csv.c_str(), subjects.size(), tables.trials.size(), threads, seconds, tables.trials.size(),
+      tables.strokes.size());
+  return 0;
+}
+
+}  // namespace
+
+void add_session_cohort_command(CLI::App& session, Commands& commands) {
+  auto command = std::make_shared<SessionCohortCommand>();
+  CLI::App* app = commands.add(
+      session, "cohort",
+      "Run N simulated subjects through every session of a protocol in memory, on every core, and write the "
+      "study's tidy tables (no session folders; the same trials as session run)",
+      [command] { return run_session_cohort(*command); });
+  add_positional(*app, "PROTOCOL", command->protocol, "the study protocol (JSON; docs/experiments.md)",
+                 "FILE");
+  required(add_integer(*app, "--subjects", command->subjects, "N",
+                       "simulated subjects PREFIX01..PREFIXN, numbered 1..N", 1, 100000));
+  add_text(*app, "--subject", command->prefix, "PREFIX", "the prefix of the subjects' ids");
+  add_choice(*app, "--writer-profile", command->writer_profile, {"novice", "skilled", "foreign"},
+             "the simulated subjects' profile");
+  add_choice(*app, "--writer-learning", command->writer_learning, {"none", "two-state"},
+             "how a subject learns: none (every trial from its profile) or two-state (docs/writer.md)");
+  add_integer(*app, "--jobs", command->jobs, "N", "threads, each simulating one subject at a time", 1, 1024,
+              "every core");
+  required(add_output_folder(
+      *app, "--csv", command->csv,
+      "an existing folder for the tidy tables trials.csv and strokes.csv (docs/experiments.md)", ""));
+  add_library_options(*app, command->library, true);
+}
+
+}  // namespace calligraphy::cli

@@ -1,0 +1,55 @@
+#include "cli/study_inputs.hpp"
+
+#include <cstdio>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/study/transfer_set.hpp"
+#include "core/unicode.hpp"
+
+namespace calligraphy::cli {
+
+// Every character the protocol names is looked up (read and modelled) before any folder is made or trial
+// run: one the library lacks is a DataError naming the protocol file, the string's JSON pointer and the
+// character, not a failure in the middle of a study.
+void require_characters(const LoadedProtocol& loaded, const CharacterSource& source) {
+  std::set<char32_t> checked;
+  const auto check = [&](const std::vector<std::u32string>& items, const std::string& pointer) {
+    for (std::size_t i = 0; i < items.size(); ++i) {
+      for (const char32_t c : items[i]) {
+        if (!checked.insert(c).second) continue;
+        try {
+          (void)source.load(c);
+        } catch (const Error& e) {
+          char code[16];
+          std::snprintf(code, sizeof code, "U+%04X", static_cast<unsigned>(c));
+          throw DataError(loaded.path.string() + ": " + pointer + "/" + std::to_string(i) +
+                          ": the character " + encode_utf8(c) + " (" + code +
+                          ") cannot be written: " + e.what() + "; nothing was run or written");
+        }
+      }
+    }
+  };
+  const StudyProtocol& protocol = loaded.protocol;
+  for (const ProtocolPhase& phase : protocol.phases) {
+    if (phase.choice) {
+      check(phase.choice->candidates, phase.pointer + "/characters/from");
+    } else {
+      check(phase.items, phase.pointer + "/characters");
+    }
+  }
+}
+
+LoadedProtocol resolved_protocol(const LoadedProtocol& loaded, const CharacterSource& source) {
+  LoadedProtocol resolved = loaded;
+  try {
+    resolve_transfer_choices(resolved.protocol, [&source](char32_t c) { return source.load(c); });
+  } catch (const InvalidArgument& e) {
+    throw DataError(loaded.path.string() + ": " + e.what());
+  }
+  return resolved;
+}
+
+}  // namespace calligraphy::cli

@@ -1,0 +1,250 @@
+#include "calligraphy/study/cohort.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <map>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <thread>
+#include <utility>
+
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/sim/writer_memory.hpp"
+#include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/study/session_runner.hpp"
+#include "calligraphy/study/trial_spec_runner.hpp"
+#include "study/names.hpp"
+#include "study/remembered_writer.hpp"
+#include "study/trial_guidance.hpp"
+#include "study/trial_record.hpp"
+#include "study/trial_row.hpp"
+
+namespace calligraphy {
+namespace {
+
+using nlohmann::json;
+
+// The device every simulated subject writes on: the registry's simulated Phantom.
+constexpr const char* kCohortDevice = "simulated";
+
+// The manifest a session folder of this subject's session `number` would hold, without its folder.
+SessionManifest cohort_manifest(const LoadedProtocol& protocol, const SubjectAssignment& subject,
+                                const CohortSetup& setup, int number) {
+  SessionManifest manifest;
+  manifest.session_id = protocol.protocol.name + "-s" + std::to_string(number);
+  manifest.setup.subject = subject;
+  manifest.setup.device = kCohortDevice;
+  manifest.setup.writer = "simulated";
+  manifest.setup.writer_profile = setup.writer_profile;
+  manifest.setup.writer_seed = subject_seed(subject.id);
+  manifest.setup.writer_learning = setup.writer_learning;
+  manifest.setup.pacing = "lock-step";
+  manifest.setup.session_number = number;
+  manifest.protocol = protocol;
+  manifest.plan = plan_session(protocol.protocol, subject, number);
+  manifest.group = subject_group(protocol.protocol, subject);
+  return manifest;
+}
+
+// A replay's teacher is recorded into its session folder, which a cohort does not have.
+void refuse_replay(const StudyProtocol& protocol) {
+  for (const StudyCondition& condition : protocol.conditions) {
+    if (condition.mode == ConditionMode::replay) {
+      throw InvalidArgument("condition '" + condition.name +
+                            "': a replay's teacher is kept in a session folder; a simulated cohort runs "
+                            "without one (run it with calligraphy session run)");
+    }
+  }
+}
+
+// One trial as a session folder would save it: its record (trial_record.hpp), kept in memory.
+json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& trial,
+                         const StudyCondition& condition, const Scene& scene, WriterMemory& memory,
+                         const json* previous_record) {
+  const std::string source = manifest.setup.subject.id + ", session " +
+                             std::to_string(manifest.setup.session_number) + ", trial " +
+                             std::to_string(trial.index + 1);
+  study_detail::PreparedGuidance guidance;
+  if (study_detail::adapts_by_repetition(condition.mode)) {
+    const PlannedTrial* previous = study_detail::previous_repetition(manifest.plan, trial);
+    guidance = study_detail::repetition_guidance(condition, previous, previous_record, source);
+  }
+  TrialSpec spec = study_trial_spec(manifest, condition, trial, guidance.guidance);
+  const bool learning = manifest.setup.writer_learning == "two-state";
+  std::optional<std::pair<double, double>> skills;
+  if (learning) {
+    const std::vector<int> ids = study_detail::typical_ids(scene);
+    spec.writer_parameters =
+        study_detail::learned_parameters(memory, manifest.setup.writer_profile, ids, trial.characters);
+    skills = std::pair{shape_skill(memory, ids), order_skill(memory, trial.characters)};
+  }
+  TrialRunInputs inputs;
+  inputs.adjust = [&](TrialOptions& options) {
+    study_detail::apply_condition(condition, guidance.guidance, options);
+  };
+  const auto wall_start = std::chrono::steady_clock::now();
+  const TrialRun run = run_trial_spec(spec, scene, inputs);
+  const TrialResult& result = run.result;
+  if (result.end != TrialEnd::completed && result.end != TrialEnd::time_limit &&
+      result.end != TrialEnd::gave_up) {
+    throw StateError(source + ": the trial ended " + std::string(to_string(result.end)) + " (" +
+                     result.abort_reason + ") and was not kept");
+  }
+  study_detail::TrialRecordContext context;
+  context.session = &manifest;
+  context.trial = &trial;
+  context.condition = &condition;
+  context.device_name = manifest.setup.device;
+  context.device_info = run.device;
+  context.simulated_writer = true;
+  context.guidance = study_detail::guidance_record_json(condition, guidance);
+  context.writer_skills = skills;
+  context.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  context.options = &run.options;
+  context.simulation.writer = run.writer;
+  context.simulation.seed = spec.seed;
+  std::vector<std::vector<QuizEvent>> quiz;
+  if (condition.mode == ConditionMode::quiz)
+    quiz = study_detail::quiz_characters(scene, result.trace, condition.quiz);
+  json record =
+      study_detail::trial_record(context, scene, result, run.metrics, quiz.empty() ? nullptr : &quiz);
+  // Learned from as a session learns from its saved record.
+  if (learning) study_detail::practise_record(memory, record, source);
+  return record;
+}
+
+}  // namespace
+
+void CohortSetup::validate() const {
+  try {
+    (void)calligraphy::writer_profile(writer_profile);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(std::string("CohortSetup.writer_profile: ") + e.what());
+  }
+  if (writer_learning != "none" && writer_learning != "two-state") {
+    throw InvalidArgument("CohortSetup.writer_learning '" + writer_learning +
+                          "': expected 'none' or 'two-state'");
+  }
+}
+
+std::vector<SubjectAssignment> numbered_subjects(std::size_t count, const std::string& prefix) {
+  if (count == 0) throw InvalidArgument("numbered_subjects: a cohort needs at least one subject");
+  std::vector<SubjectAssignment> subjects;
+  subjects.reserve(count);
+  for (std::size_t k = 1; k <= count; ++k) {
+    char number[32];
+    std::snprintf(number, sizeof number, "%02zu", k);
+    SubjectAssignment subject{prefix + number, k};
+    if (!study_detail::is_label(subject.id, 64)) {
+      throw InvalidArgument("subject prefix '" + prefix + "': '" + subject.id +
+                            "' is not a subject id (1-64 of A-Z a-z 0-9 _ -)");
+    }
+    subjects.push_back(std::move(subject));
+  }
+  return subjects;
+}
+
+StudyTables simulate_subject(const LoadedProtocol& protocol, const SubjectAssignment& subject,
+                             const CohortSetup& setup) {
+  setup.validate();
+  refuse_replay(protocol.protocol);
+  const CharacterLibrary embedded = CharacterLibrary::embedded();
+  std::map<char32_t, Character> characters;  // fitted once per subject
+  const auto character = [&](char32_t code_point) -> const Character& {
+    auto found = characters.find(code_point);
+    if (found == characters.end()) {
+      Character model = setup.load_character ? setup.load_character(code_point) : embedded.load(code_point);
+      found = characters.emplace(code_point, std::move(model)).first;
+    }
+    return found->second;
+  };
+  StudyTables tables;
+  WriterMemory memory;
+  for (int number = 1; number <= protocol.protocol.session_count(); ++number) {
+    if (number > 1) consolidate(memory);  // hours or days between the sessions
+    const SessionManifest manifest = cohort_manifest(protocol, subject, setup, number);
+    std::vector<json> records(manifest.plan.size());
+    for (const PlannedTrial& trial : manifest.plan) {
+      const StudyCondition& condition = protocol.protocol.condition(trial.condition);
+      std::vector<Character> models;
+      for (const char32_t c : trial.characters) models.push_back(character(c));
+      const Scene scene = Scene::lay_out(models);
+      const PlannedTrial* previous = study_detail::previous_repetition(manifest.plan, trial);
+      records[trial.index] = cohort_trial_record(manifest, trial, condition, scene, memory,
+                                                 previous ? &records[previous->index] : nullptr);
+      tables.trials.push_back(study_detail::trial_row(records[trial.index], manifest.setup.subject.id,
+                                                      manifest, trial, tables.strokes));
+    }
+  }
+  return tables;
+}
+
+StudyTables simulate_cohort(const LoadedProtocol& protocol, const std::vector<SubjectAssignment>& subjects,
+                            const CohortSetup& setup, unsigned threads,
+                            const std::function<void(std::size_t)>& progress) {
+  if (threads == 0) throw InvalidArgument("simulate_cohort: threads must be at least 1");
+  setup.validate();
+  refuse_replay(protocol.protocol);
+  // Every character of every subject's plan, loaded here once: the workers only read the map.
+  const CharacterLibrary embedded = CharacterLibrary::embedded();
+  std::map<char32_t, Character> characters;
+  for (const SubjectAssignment& subject : subjects) {
+    for (int number = 1; number <= protocol.protocol.session_count(); ++number) {
+      for (const PlannedTrial& trial : plan_session(protocol.protocol, subject, number)) {
+        for (const char32_t c : trial.characters) {
+          if (characters.count(c) == 0)
+            characters.emplace(c, setup.load_character ? setup.load_character(c) : embedded.load(c));
+        }
+      }
+    }
+  }
+  CohortSetup shared = setup;
+  shared.load_character = [&characters](char32_t c) { return characters.at(c); };
+
+  std::vector<StudyTables> per_subject(subjects.size());
+  std::atomic<std::size_t> next{0};
+  std::atomic<bool> failed{false};
+  std::mutex mutex;  // guards first_error, done and the progress callback
+  std::exception_ptr first_error;
+  std::size_t done = 0;
+  const auto work = [&] {
+    while (!failed.load()) {
+      const std::size_t i = next.fetch_add(1);
+      if (i >= subjects.size()) return;
+      try {
+        per_subject[i] = simulate_subject(protocol, subjects[i], shared);
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(mutex);
+        if (!first_error) first_error = std::current_exception();
+        failed.store(true);
+        return;
+      }
+      const std::lock_guard<std::mutex> lock(mutex);
+      ++done;
+      if (progress) progress(done);
+    }
+  };
+  const unsigned count = static_cast<unsigned>(std::min<std::size_t>(threads, subjects.size()));
+  std::vector<std::thread> workers;
+  for (unsigned t = 1; t < count; ++t) workers.emplace_back(work);
+  work();
+  for (std::thread& worker : workers) worker.join();
+  if (first_error) std::rethrow_exception(first_error);
+
+  StudyTables tables;
+  for (StudyTables& subject : per_subject) {
+    tables.trials.insert(tables.trials.end(), std::make_move_iterator(subject.trials.begin()),
+                         std::make_move_iterator(subject.trials.end()));
+    tables.strokes.insert(tables.strokes.end(), std::make_move_iterator(subject.strokes.begin()),
+                          std::make_move_iterator(subject.strokes.end()));
+  }
+  return tables;
+}
+
+}  // namespace calligraphy
