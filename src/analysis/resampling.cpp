@@ -3,9 +3,10 @@
 #include <string>
 #include <vector>
 
-#include "calligraphy/core/errors.hpp"
-#include "calligraphy/analysis/metrics.hpp"
+#include "analysis/curve_distances.hpp"
 #include "analysis/input_checks.hpp"
+#include "calligraphy/analysis/metrics.hpp"
+#include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
 namespace {
@@ -88,7 +89,7 @@ CurveDistances compare_curves(std::span<const Vec2> samples_m, std::span<const S
   if (reference_reversed) std::reverse(reference.begin(), reference.end());
   std::vector<Vec2> written = without_consecutive_repeats(samples_m);
   if (written.size() > options.max_points) written = resample_by_arc_length(written, options.max_points);
-  return {discrete_frechet_distance(written, reference), dtw_mean_distance(written, reference)};
+  return trial_detail::frechet_and_dtw(written, reference, "compare_curves");
 }
 
 }  // namespace calligraphy

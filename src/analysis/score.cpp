@@ -5,10 +5,11 @@
 #include <cstdio>
 #include <string>
 
-#include "calligraphy/core/errors.hpp"
 #include "analysis/assignment.hpp"
 #include "analysis/input_checks.hpp"
+#include "analysis/segment_metrics.hpp"
 #include "analysis/segmentation.hpp"
+#include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
 namespace {
@@ -241,8 +242,9 @@ CharacterScore score_trace(const PlacedCharacter& character, std::span<const Pen
     s.written = true;
     s.segment = scored[w];
     s.backwards = reversed[r][w];
-    s.metrics = stroke_writing_metrics(times[w], positions[w], character.strokes[r].elements, options.metrics,
-                                       s.backwards);
+    // The segment's kinematics, computed above from the same samples and options.
+    s.metrics = trial_detail::stroke_writing_metrics(
+        *segment.kinematics, positions[w], character.strokes[r].elements, options.metrics, s.backwards);
     segment.matched_stroke = r;
     segment.backwards = s.backwards;
     ++score.strokes_written;

@@ -94,6 +94,10 @@ void TrialRecorder::reserve(std::size_t ticks) {
   trace_.resize(size);
 }
 
+void TrialRecorder::reserve_untouched(std::size_t ticks) {
+  if (keep_trace_) trace_.reserve(ticks);
+}
+
 void TrialRecorder::finish(double end_time_s) {
   if (current_ < metrics_.per_stroke.size()) {  // the stroke under way when the trial ended
     close_attempt(metrics_.per_stroke[current_]);

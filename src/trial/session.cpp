@@ -1,5 +1,6 @@
 #include "calligraphy/trial/session.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -14,6 +15,9 @@ RendererOptions renderer_options(const TrialOptions& options) {
   return render;
 }
 
+// Most ticks of trace room reserved before the trial, untouched: 2^19, 42 MB of address space.
+constexpr std::size_t kUntouchedTraceTicks = std::size_t{1} << 19;
+
 }  // namespace
 
 TrialSession::TrialSession(const Scene& scene, const DeviceInfo& device, const TrialOptions& options)
@@ -21,6 +25,11 @@ TrialSession::TrialSession(const Scene& scene, const DeviceInfo& device, const T
       renderer_(scene, options.force, device, renderer_options(options)),
       recorder_(scene, options.keep_trace),
       max_ticks_(static_cast<std::size_t>(std::ceil(options.max_duration_s * options.rate_hz))) {
+  // Room for the whole trace, untouched (pages are touched as samples are written): the trace never moves
+  // while it grows, which a lock-step trial would otherwise pay for in copies and page faults. Capped, so
+  // that a long fast trial does not reserve gigabytes of address space up front.
+  if (options.keep_trace)
+    recorder_.reserve_untouched(std::min<std::size_t>(max_ticks_, kUntouchedTraceTicks));
   attach_display(options.display);
 }
 

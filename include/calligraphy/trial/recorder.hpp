@@ -71,6 +71,9 @@ class TrialRecorder {
   /// Allocates (and touches) room for `ticks` samples of the trace, so that the next `ticks` calls of
   /// `record` never allocate: for a real-time loop. Nothing when the trace is not kept.
   void reserve(std::size_t ticks);
+  /// Room for `ticks` samples without touching it (std::vector::reserve): the trace does not move while it
+  /// grows to that size. Nothing when the trace is not kept.
+  void reserve_untouched(std::size_t ticks);
   /// Closes the metrics at `end_time_s` (time_s of an unfinished trial); the deviations of the attempt
   /// under way, if it has WS ticks, are added to its stroke and to the totals.
   void finish(double end_time_s);
