@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <exception>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -15,6 +16,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/model/scene.hpp"
+#include "calligraphy/sim/simulated_device.hpp"
 #include "calligraphy/sim/writer_memory.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/study/session_runner.hpp"
@@ -30,7 +32,8 @@ namespace {
 
 using nlohmann::json;
 
-// The device every simulated subject writes on: the registry's simulated Phantom.
+// The device every simulated subject writes on: the registry's simulated Phantom (SimulatedDevice with its
+// default parameters), by the name session run records.
 constexpr const char* kCohortDevice = "simulated";
 
 // The manifest a session folder of this subject's session `number` would hold, without its folder.
@@ -84,7 +87,11 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
         study_detail::learned_parameters(memory, manifest.setup.writer_profile, ids, trial.characters);
     skills = std::pair{shape_skill(memory, ids), order_skill(memory, trial.characters)};
   }
+  // The registry's simulated device, made here: asking the registry would scan every hardware backend (USB)
+  // for each trial, from every thread at once.
+  const auto device = std::make_unique<SimulatedDevice>();
   TrialRunInputs inputs;
+  inputs.device = device.get();
   inputs.adjust = [&](TrialOptions& options) {
     study_detail::apply_condition(condition, guidance.guidance, options);
   };
