@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cwchar>
+#include <mutex>
 #include <utility>
 
 #include "calligraphy/core/errors.hpp"
@@ -25,6 +26,14 @@ int to_milliseconds(std::chrono::microseconds timeout) noexcept {
   return static_cast<int>(std::max<std::int64_t>(1, (timeout.count() + 999) / 1000));
 }
 
+// hidapi's library state (hid_init, the enumeration, opening a path) is global and not thread-safe (hidapi's
+// README: call hid_init before threads use the library); a registry may be asked from several threads at once
+// (simulated cohorts, Python threads), so these calls take turns. Reads and writes on an open handle do not.
+std::mutex& hidapi_library_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
 std::string hex_id(std::uint16_t vendor, std::uint16_t product) {
   char buffer[16];
   std::snprintf(buffer, sizeof buffer, "%04x:%04x", vendor, product);
@@ -34,6 +43,7 @@ std::string hex_id(std::uint16_t vendor, std::uint16_t product) {
 }  // namespace
 
 std::vector<HidDeviceEntry> find_hid_phantoms() {
+  const std::lock_guard<std::mutex> lock(hidapi_library_mutex());
   if (hid_init() != 0) throw CommunicationError("hidapi: hid_init failed");
   std::vector<HidDeviceEntry> found;
   hid_device_info* list = hid_enumerate(kTouchUsbVendorId, 0);
@@ -52,6 +62,7 @@ HidapiTransport::~HidapiTransport() { close(); }
 
 void HidapiTransport::open() {
   if (device_ != nullptr) return;
+  const std::lock_guard<std::mutex> lock(hidapi_library_mutex());
   if (hid_init() != 0) throw CommunicationError("hidapi: hid_init failed");
   device_ = hid_open_path(entry_.path.c_str());
   if (device_ == nullptr) {
