@@ -29,9 +29,9 @@ __all__ = ["simulate"]
 
 PathLike = typing.Union[str, "os.PathLike[str]"]
 
-# Subjects per task on an executor: a subject is 50 trials or so (a second or two), so a few subjects
-# make a task long enough that its overhead (milliseconds on Dask) does not count.
-_DEFAULT_BATCH = 4
+# Subjects per task on an executor: a subject is 50 trials or so (a second or two), long enough that a
+# task's overhead (milliseconds on Dask) does not count, and one a task balances the workers best.
+_DEFAULT_BATCH = 1
 
 
 def _subject_list(subjects: typing.Any, prefix: str) -> list[tuple[str, int]]:
@@ -66,7 +66,7 @@ def simulate(protocol: PathLike, subjects: int, *, profile: str = "novice", lear
         'none'. prefix: the subjects' ids are prefix + the number in two digits or more.
     client: None runs on `workers` C++ threads in this process (default: every core this process may use);
         a distributed.Client (or any concurrent.futures.Executor) runs batches of `batch_size` subjects
-        (default 4) as its tasks, one thread each. The protocol file and the character source must be
+        (default 1) as its tasks, one thread each. The protocol file and the character source must be
         readable by every worker.
     store / data: characters from a corpus store or a hanzi-writer-data folder instead of the embedded set.
     progress: a tqdm bar over the batches on an executor (when tqdm is installed).
