@@ -17,28 +17,6 @@ using namespace calligraphy::testing;
 
 namespace {
 
-// One character with one 横 from (200, 600) to (800, 600), data units.
-Scene one_stroke_scene() {
-  Character c;
-  c.code_point = U'一';
-  Stroke h;
-  h.typical_id = 1;
-  h.elements = {StrokeElement::line({200, 600}, {800, 600})};
-  h.attraction_factors = {1.0, 1.0};
-  c.strokes = {h};
-  return Scene::lay_out({c});
-}
-
-DeviceState at(const Scene& scene, const Vec2& data, double z, double time_s = 0.0,
-               const Vec2& velocity = Vec2::Zero()) {
-  DeviceState s;
-  const Vec2 p = scene.characters[0].placement.to_paper(data);
-  s.position_m = Vec3(p.x(), p.y(), z);
-  s.velocity_m_s = Vec3(velocity.x(), velocity.y(), 0.0);
-  s.time_s = time_s;
-  return s;
-}
-
 // Single ticks show the force law exactly: no smoothing, ramp or rate limit, no friction.
 ForceLawParameters exact() {
   ForceLawParameters p;
@@ -59,11 +37,11 @@ RendererOptions exact_options() {
 
 // In-plane force with the pen in WS at data x = 400, 30 data units (1.76 mm) above the 横.
 Vec2 guidance_at_offset(const ForceLawParameters& force) {
-  const Scene scene = one_stroke_scene();
+  const Scene scene = horizontal_stroke_scene();
   Renderer r(scene, force, simulated_phantom_desktop_info(), exact_options());
   const double z = scene.layout.paper_z_m - 0.0005;
-  r.tick(at(scene, {205, 600}, z));  // touch down at the start: WS
-  const RenderOutput out = r.tick(at(scene, {400, 630}, z));
+  r.tick(device_state_at(scene, {205, 600}, z));  // touch down at the start: WS
+  const RenderOutput out = r.tick(device_state_at(scene, {400, 630}, z));
   REQUIRE(out.state == InteractionState::writing);
   return out.force_n.head<2>();
 }
@@ -173,7 +151,7 @@ TEST_CASE("A teacher's trial gives one window per stroke, read with the renderer
 }
 
 TEST_CASE("A bad teacher trajectory is refused naming the sample or the stroke", "[guidance]") {
-  const Scene scene = one_stroke_scene();
+  const Scene scene = horizontal_stroke_scene();
   std::vector<TeacherSample> samples = straight_teacher(scene);
   CHECK_NOTHROW(TeacherReplay(scene, samples, ForceLawParameters{}));
   std::vector<TeacherSample> backwards_in_time = samples;
@@ -192,19 +170,19 @@ TEST_CASE("A bad teacher trajectory is refused naming the sample or the stroke",
 }
 
 TEST_CASE("In the replay mode the attraction point moves at the teacher's pace", "[guidance]") {
-  const Scene scene = one_stroke_scene();
+  const Scene scene = horizontal_stroke_scene();
   ForceLawParameters force = exact();
   force.guidance_mode = GuidanceMode::replay;
   force.teacher_trajectory = straight_teacher(scene);
   Renderer r(scene, force, simulated_phantom_desktop_info(), exact_options());
   const double z = scene.layout.paper_z_m - 0.0005;
   const double entered = 10.0;
-  r.tick(at(scene, {200, 600}, z, entered));  // WS at the start; the replay clock starts
+  r.tick(device_state_at(scene, {200, 600}, z, entered));  // WS at the start; the replay clock starts
   // The pen stays at the start; the teacher moves right at 50 mm/s, so the pull along +x grows as
   // 50 mm/s * t * K_et until the spring saturates at K_et replay_max_lead_m (3 mm: after 60 ms).
   double previous = 0.0;
   for (const double t : {0.02, 0.04, 0.05, 0.07}) {
-    const RenderOutput out = r.tick(at(scene, {200, 600}, z, entered + t));
+    const RenderOutput out = r.tick(device_state_at(scene, {200, 600}, z, entered + t));
     REQUIRE(out.state == InteractionState::writing);
     const double expected = force.guidance_stiffness_n_per_m * std::min(0.05 * t, force.replay_max_lead_m);
     CHECK(out.force_n.x() >= previous);
@@ -212,14 +190,14 @@ TEST_CASE("In the replay mode the attraction point moves at the teacher's pace",
     CHECK(std::abs(out.force_n.y()) < 1e-6);
     previous = out.force_n.x();
   }
-  const RenderOutput late = r.tick(at(scene, {200, 600}, z, entered + 5.0));
+  const RenderOutput late = r.tick(device_state_at(scene, {200, 600}, z, entered + 5.0));
   CHECK(late.force_n.head<2>().norm() <=
         force.guidance_stiffness_n_per_m * force.replay_max_lead_m * (1.0 + 1e-9));
 }
 
 TEST_CASE("Off-stroke resistance: friction in CS, a damper on leaving the element in WS, under guidance only",
           "[guidance]") {
-  const Scene scene = one_stroke_scene();
+  const Scene scene = horizontal_stroke_scene();
   const double z = scene.layout.paper_z_m - 0.0005;
   const double metres_per_unit = scene.characters[0].placement.metres_per_unit;
   ForceLawParameters force = exact();
@@ -227,15 +205,15 @@ TEST_CASE("Off-stroke resistance: friction in CS, a damper on leaving the elemen
     force.guidance = guidance;
     Renderer r(scene, force, simulated_phantom_desktop_info(), exact_options());
     // Touch down in CS, away from the start, and slide +y by 0.25 mm per tick.
-    RenderOutput out = r.tick(at(scene, {500, 560}, z));
+    RenderOutput out = r.tick(device_state_at(scene, {500, 560}, z));
     REQUIRE(out.state == InteractionState::calibration);
     CHECK(out.force_n.head<2>().norm() < 1e-12);  // held where it touched down
-    out = r.tick(at(scene, {500, 560 + 0.0005 / metres_per_unit}, z, 1e-3));
+    out = r.tick(device_state_at(scene, {500, 560 + 0.0005 / metres_per_unit}, z, 1e-3));
     if (guidance) {
       CHECK(out.force_n.y() == Approx(-0.5 * force.off_stroke_force_n));  // half the travel: half the force
     }
     for (int k = 2; k < 10; ++k)
-      out = r.tick(at(scene, {500, 560 + 0.00025 * k / metres_per_unit}, z, 1e-3 * k));
+      out = r.tick(device_state_at(scene, {500, 560 + 0.00025 * k / metres_per_unit}, z, 1e-3 * k));
     REQUIRE(out.state == InteractionState::calibration);
     if (guidance) {
       CHECK(out.force_n.y() == Approx(-force.off_stroke_force_n));  // dragged: the full force, at any speed

@@ -19,27 +19,6 @@ using namespace calligraphy::testing;
 
 namespace {
 
-// One character with one 横 from (200, 600) to (800, 600), data units.
-Scene one_stroke_scene() {
-  Character c;
-  c.code_point = U'一';
-  Stroke h;
-  h.typical_id = 1;
-  h.elements = {StrokeElement::line({200, 600}, {800, 600})};
-  h.attraction_factors = {1.0, 1.0};
-  c.strokes = {h};
-  return Scene::lay_out({c});
-}
-
-DeviceState at(const Scene& scene, const Vec2& data, double z, double time_s) {
-  DeviceState s;
-  const Vec2 p = scene.characters[0].placement.to_paper(data);
-  s.position_m = Vec3(p.x(), p.y(), z);
-  s.velocity_m_s = Vec3::Zero();
-  s.time_s = time_s;
-  return s;
-}
-
 // The force law alone: no smoothing, ramp, rate limit, friction or resistance.
 ForceLawParameters exact(GuidanceMode mode) {
   ForceLawParameters p;
@@ -55,19 +34,19 @@ ForceLawParameters exact(GuidanceMode mode) {
 
 // In-plane force with the pen in WS at data (x, 600 + offset), `elapsed_s` after touching down at the start.
 Vec2 force_at(const ForceLawParameters& force, double x, double offset, double elapsed_s = 0.001) {
-  const Scene scene = one_stroke_scene();
+  const Scene scene = horizontal_stroke_scene();
   RendererOptions options;
   options.safety.start_ramp_n_per_s = 0.0;
   options.safety.max_force_change_n_per_tick = 0.0;
   Renderer r(scene, force, simulated_phantom_desktop_info(), options);
   const double z = scene.layout.paper_z_m - 0.0005;
-  r.tick(at(scene, {205, 600}, z, 0.0));
-  const RenderOutput out = r.tick(at(scene, {x, 600 + offset}, z, elapsed_s));
+  r.tick(device_state_at(scene, {205, 600}, z, 0.0));
+  const RenderOutput out = r.tick(device_state_at(scene, {x, 600 + offset}, z, elapsed_s));
   REQUIRE(out.state == InteractionState::writing);
   return out.force_n.head<2>();
 }
 
-double metres_per_unit() { return one_stroke_scene().characters[0].placement.metres_per_unit; }
+double metres_per_unit() { return horizontal_stroke_scene().characters[0].placement.metres_per_unit; }
 
 }  // namespace
 
@@ -129,7 +108,7 @@ TEST_CASE("Timing guidance pulls along the stroke only, towards a target that mo
 
 TEST_CASE("The timing target follows a minimum-jerk profile over the stroke's length at the mean speed",
           "[guidance]") {
-  const Scene scene = one_stroke_scene();
+  const Scene scene = horizontal_stroke_scene();
   const double length_m = 600 * metres_per_unit();
   const TimingTarget target(scene, 0.05);
   const double duration = target.duration_s(0);

@@ -14,18 +14,6 @@ using namespace calligraphy::testing;
 
 namespace {
 
-// One 横 from (200, 600) to (800, 600) in data units: 35 mm on the default 60 mm box.
-Scene horizontal_scene() {
-  Character c;
-  c.code_point = U'一';
-  Stroke h;
-  h.typical_id = 1;
-  h.elements = {StrokeElement::line({200, 600}, {800, 600})};
-  h.attraction_factors = {1.0, 1.0};
-  c.strokes = {h};
-  return Scene::lay_out({c});
-}
-
 WriterProfile unbiased_novice() {
   WriterProfile p = WriterProfile::novice();
   p.bias_offset_m = 0.0;
@@ -60,7 +48,7 @@ std::vector<Vec3> drive(SimulatedWriter& writer, double seconds,
 }  // namespace
 
 TEST_CASE("The writer corrects a displaced pen only after its visuomotor delay", "[writer]") {
-  const Scene scene = horizontal_scene();
+  const Scene scene = horizontal_stroke_scene();
   const WriterProfile profile = unbiased_novice();
   SimulatedWriter probe(scene, profile, 5);
   drive(probe, 4.0, [](double, const Vec3& target) { return target; });
@@ -94,7 +82,7 @@ TEST_CASE("The writer corrects a displaced pen only after its visuomotor delay",
 
 TEST_CASE("A pen held on the stroke is written faster than one the writer sees off it (steering law)",
           "[writer]") {
-  const Scene scene = horizontal_scene();
+  const Scene scene = horizontal_stroke_scene();
   WriterProfile profile = unbiased_novice();
   profile.bias_offset_m = 0.0025;  // its copy lies 2.5 mm off the reference
   const double stroke_y = scene.characters[0].strokes[0].start().y();
@@ -114,7 +102,7 @@ TEST_CASE("A pen held on the stroke is written faster than one the writer sees o
 }
 
 TEST_CASE("The hand's target moves in minimum-jerk segments: at rest at both ends of a stroke", "[writer]") {
-  const Scene scene = horizontal_scene();
+  const Scene scene = horizontal_stroke_scene();
   SimulatedWriter writer(scene, unbiased_novice(), 2);
   const std::vector<Vec3> x = drive(writer, 6.0, [](double, const Vec3& target) { return target; });
   const WriterAttempt& a = writer.log().attempts.front();
@@ -157,7 +145,7 @@ TEST_CASE("A writer's trial is deterministic for a seed and differs across seeds
 }
 
 TEST_CASE("A stroke the display does not take is written again, and one it takes is not", "[writer]") {
-  const Scene scene = horizontal_scene();
+  const Scene scene = horizontal_stroke_scene();
   const double paper_z = scene.layout.paper_z_m;
   for (const bool display_takes_it : {false, true}) {
     SimulatedWriter writer(scene, unbiased_novice(), 4);

@@ -6,11 +6,11 @@
 #include <string>
 #include <vector>
 
+#include "calligraphy/analysis/score.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/render/renderer.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
 #include "calligraphy/sim/simulated_writer.hpp"
-#include "calligraphy/analysis/score.hpp"
 #include "calligraphy/trial/trial.hpp"
 
 namespace calligraphy::testing {
@@ -31,6 +31,30 @@ struct WriterTrialOptions {
   double max_duration_s = 300.0;
   SafetyChainParameters safety{};
 };
+
+/// One character with one 横 from (200, 600) to (800, 600) in data units: 35 mm on the default 60 mm box.
+inline Scene horizontal_stroke_scene() {
+  Character c;
+  c.code_point = U'一';
+  Stroke h;
+  h.typical_id = 1;
+  h.elements = {StrokeElement::line({200, 600}, {800, 600})};
+  h.attraction_factors = {1.0, 1.0};
+  c.strokes = {h};
+  return Scene::lay_out({c});
+}
+
+/// The device at `data` (data units of the scene's first character), `z` [m] high, at `time_s` [s], moving
+/// in the paper plane at `velocity_m_s`.
+inline DeviceState device_state_at(const Scene& scene, const Vec2& data, double z, double time_s = 0.0,
+                                   const Vec2& velocity_m_s = Vec2::Zero()) {
+  DeviceState s;
+  const Vec2 p = scene.characters[0].placement.to_paper(data);
+  s.position_m = Vec3(p.x(), p.y(), z);
+  s.velocity_m_s = Vec3(velocity_m_s.x(), velocity_m_s.y(), 0.0);
+  s.time_s = time_s;
+  return s;
+}
 
 inline WriterTrial run_writer_trial(const Scene& scene, const WriterTrialOptions& options) {
   SimulatedDeviceParameters device_parameters;

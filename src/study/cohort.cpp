@@ -81,12 +81,8 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
   TrialSpec spec = study_trial_spec(manifest, condition, trial, guidance.guidance);
   const bool learning = manifest.setup.writer_learning == "two-state";
   std::optional<std::pair<double, double>> skills;
-  if (learning) {
-    const std::vector<int> ids = study_detail::typical_ids(scene);
-    spec.writer_parameters =
-        study_detail::learned_parameters(memory, manifest.setup.writer_profile, ids, trial.characters);
-    skills = std::pair{shape_skill(memory, ids), order_skill(memory, trial.characters)};
-  }
+  if (learning)
+    skills = study_detail::learn_into(spec, memory, manifest.setup.writer_profile, scene, trial.characters);
   // The registry's simulated device, made here: asking the registry would scan every hardware backend (USB)
   // for each trial, from every thread at once.
   const auto device = std::make_unique<SimulatedDevice>();

@@ -111,4 +111,12 @@ std::vector<std::string> learned_parameters(const WriterMemory& memory, const st
   return parameters;
 }
 
+std::pair<double, double> learn_into(TrialSpec& spec, const WriterMemory& memory,
+                                     const std::string& profile_name, const Scene& scene,
+                                     const std::u32string& characters) {
+  const std::vector<int> ids = typical_ids(scene);
+  spec.writer_parameters = learned_parameters(memory, profile_name, ids, characters);
+  return {shape_skill(memory, ids), order_skill(memory, characters)};
+}
+
 }  // namespace calligraphy::study_detail

@@ -4,11 +4,13 @@
 // Internal.
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/sim/writer_memory.hpp"
 #include "calligraphy/study/session_folder.hpp"
+#include "calligraphy/study/trial_spec.hpp"
 
 namespace calligraphy::study_detail {
 
@@ -28,5 +30,11 @@ std::vector<int> typical_ids(const Scene& scene);
 /// `characters` with strokes `ids` (learned_profile, towards the skilled profile).
 std::vector<std::string> learned_parameters(const WriterMemory& memory, const std::string& profile_name,
                                             const std::vector<int>& ids, const std::u32string& characters);
+
+/// Makes `spec` the trial of a learning subject: its writer parameters `learned_parameters` for the strokes
+/// of `scene` and `characters`. Returns the skills before the trial (shape, order).
+std::pair<double, double> learn_into(TrialSpec& spec, const WriterMemory& memory,
+                                     const std::string& profile_name, const Scene& scene,
+                                     const std::u32string& characters);
 
 }  // namespace calligraphy::study_detail

@@ -252,10 +252,7 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     json started = trial_details(trial);
     std::optional<std::pair<double, double>> skills;
     if (learning) {
-      const std::vector<int> ids = study_detail::typical_ids(scene);
-      spec.writer_parameters =
-          study_detail::learned_parameters(memory, manifest.setup.writer_profile, ids, trial.characters);
-      skills = std::pair{shape_skill(memory, ids), order_skill(memory, trial.characters)};
+      skills = study_detail::learn_into(spec, memory, manifest.setup.writer_profile, scene, trial.characters);
       started["shape_skill"] = skills->first;
       started["order_skill"] = skills->second;
     }

@@ -17,13 +17,12 @@ is deterministic, so the tables do not depend on where or in which batches it ra
 
 from __future__ import annotations
 
-import concurrent.futures
 import os
 import typing
 
 from . import study as _study
 from ._calligraphy import _simulate_cohort_csv
-from .experiments import _library, _local_workers, _source
+from .experiments import _library, _local_workers, _progress_bar, _source
 
 __all__ = ["simulate"]
 
@@ -92,7 +91,7 @@ def simulate(protocol: PathLike, subjects: int, *, profile: str = "novice", lear
         executor = client.get_executor() if hasattr(client, "get_executor") else client
         batches = [subject_list[i:i + size] for i in range(0, len(subject_list), size)]
         futures = [executor.submit(_run_batch, path, batch, profile, learning, source) for batch in batches]
-        bar = _progress(len(subject_list), progress)
+        bar = _progress_bar(len(subject_list), progress, unit="subject", desc="cohort")
         try:
             for future, batch in zip(futures, batches):
                 future.add_done_callback(lambda _, n=len(batch): bar.update(n) if bar is not None else None)
@@ -107,13 +106,3 @@ def simulate(protocol: PathLike, subjects: int, *, profile: str = "novice", lear
     return _study.Study(trials=_study._read_table(trials_text, _study._NUMERIC_TRIAL_COLUMNS, ("completed_in_order",)),
                         strokes=_study._read_table(strokes_text, _study._NUMERIC_STROKE_COLUMNS,
                                                    ("written", "backwards")))
-
-
-def _progress(total: int, enabled: bool) -> typing.Any:
-    if not enabled:
-        return None
-    try:
-        from tqdm.auto import tqdm  # type: ignore[import]
-    except ImportError:  # tqdm is optional: no bar
-        return None
-    return tqdm(total=total, unit="subject", desc="cohort")

@@ -239,14 +239,14 @@ def _process_pool(workers: int) -> concurrent.futures.ProcessPoolExecutor:
                                                   mp_context=multiprocessing.get_context(method))
 
 
-def _progress_bar(total: int, enabled: bool) -> typing.Any:
+def _progress_bar(total: int, enabled: bool, unit: str = "trial", desc: str = "sweep") -> typing.Any:
     if not enabled:
         return None
     try:
         from tqdm.auto import tqdm  # type: ignore[import]
     except ImportError:  # tqdm is optional: no bar
         return None
-    return tqdm(total=total, unit="trial", desc="sweep")
+    return tqdm(total=total, unit=unit, desc=desc)
 
 
 def _execute(executor: concurrent.futures.Executor, batches: list[list[_TrialSpec]], source: _Source,
