@@ -3,6 +3,7 @@
 #include <imgui.h>
 
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <string>
 #include <string_view>
@@ -11,6 +12,14 @@
 
 namespace calligraphy::trainer {
 namespace {
+
+// The next trial's mode, with its gain where the gain means something (fading).
+std::string next_mode_text(const PanelInput& input) {
+  if (input.next_mode != "fading") return input.next_mode;
+  char gain[32];
+  std::snprintf(gain, sizeof gain, ", gain %.2f", input.next_gain);
+  return input.next_mode + gain;
+}
 
 const char* state_meaning(InteractionState state) {
   switch (state) {
@@ -171,7 +180,7 @@ void summary(const TrialView& view, const PanelInput& input) {
     ImGui::Text("R  repeat   N  next character");
     if (!input.quiz) {
       ImGui::Text("G  guidance (next trial: %s)", input.next_guidance ? "on" : "off");
-      ImGui::Text("M  guidance mode (next trial: %s, gain %.2f)", input.next_mode.c_str(), input.next_gain);
+      ImGui::TextWrapped("M  guidance mode (next trial: %s)", next_mode_text(input).c_str());
     }
     ImGui::Text("Q / Esc  quit");
   }
@@ -225,8 +234,8 @@ void draw_panel(const WindowLayout& layout, double panel_width_px, const PanelIn
   ImGui::Text("device %s", input.device.c_str());
   ImGui::Text("%s, guidance %s", view->condition.c_str(), view->guidance ? "on" : "off");
   if (input.session.empty() && !input.quiz)
-    ImGui::Text("next: guidance %s, mode %s, gain %.2f", input.next_guidance ? "on" : "off",
-                input.next_mode.c_str(), input.next_gain);
+    ImGui::TextWrapped("next: guidance %s, %s", input.next_guidance ? "on" : "off",
+                       next_mode_text(input).c_str());
   ImGui::Separator();
   if (input.large_font != nullptr) ImGui::PushFont(input.large_font);
   ImGui::TextColored(state_colour(s.state), "%s", to_string(s.state));
