@@ -14,6 +14,7 @@
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 #include "cli/output.hpp"
+#include "cli/writer_options.hpp"
 #include "core/unicode.hpp"
 #include "study/names.hpp"
 #ifdef CALLIGRAPHY_WITH_TRAINER
@@ -183,8 +184,7 @@ void add_train_command(CLI::App& root, Commands& commands) {
              "who writes: a person, or the simulated writer live on the simulated device (a demonstration)");
   add_choice(*app, "--guidance", command->guidance, {"on", "off"},
              "guiding force towards the stroke (G toggles)");
-  add_choice(*app, "--guidance-mode", command->guidance_mode,
-             {"fixed", "fading", "replay", "assist-as-needed", "error-amplification", "timing"},
+  add_choice(*app, "--guidance-mode", command->guidance_mode, guidance_mode_choices(),
              "how guidance acts (docs/force-rendering.md): the paper's fixed fixture, faded trial by trial "
              "from the mean deviation, along a teacher's recording, only beyond a band that adapts trial by "
              "trial, a gentle push off the stroke, or a target pacing the stroke (M cycles it)");

@@ -275,8 +275,7 @@ void add_trial_command(CLI::App& root, Commands& commands) {
   add_text(*app, "--device", command->device, "NAME", "the device, by its name in `calligraphy devices`");
   add_choice(*app, "--guidance", command->guidance, {"on", "off"}, "guiding force towards the stroke");
   add_choice(
-      *app, "--guidance-mode", command->guidance_mode,
-      {"fixed", "fading", "replay", "assist-as-needed", "error-amplification", "timing"},
+      *app, "--guidance-mode", command->guidance_mode, guidance_mode_choices(),
       "how the guidance acts: the paper's fixture, faded by --guidance-gain, replaying --teacher, only "
       "beyond --assist-band, pushing off the stroke (--amplification-gain), or pulling along it at "
       "--timing-speed");

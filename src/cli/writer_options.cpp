@@ -2,6 +2,7 @@
 
 #include <map>
 
+#include "calligraphy/render/guidance_mode.hpp"
 #include "calligraphy/sim/hand_port.hpp"
 #include "cli/cli_devices.hpp"
 
@@ -43,6 +44,12 @@ std::string writer_for_device(const std::string& given, const DeviceListing& dev
                      "device of `calligraphy devices`, or with the mouse in `calligraphy train`");
   }
   return given;
+}
+
+std::vector<std::string> guidance_mode_choices() {
+  std::vector<std::string> names;
+  for (const GuidanceMode mode : guidance_modes()) names.emplace_back(to_string(mode));
+  return names;
 }
 
 }  // namespace calligraphy::cli

@@ -4,6 +4,7 @@
 // the commands took before (`trial --writer novice`, `session run --writer human`) are usage errors that
 // say what to write instead, so that an old command line is not read as something else.
 #include <string>
+#include <vector>
 
 #include "calligraphy/devices/device_registry.hpp"
 #include "cli/app.hpp"
@@ -27,5 +28,8 @@ bool simulated_writer_moves(const DeviceListing& device);
 /// writer on a device it moves, a person on any other). Throws UsageError naming --writer when that writer
 /// cannot move the device.
 std::string writer_for_device(const std::string& given, const DeviceListing& device);
+
+/// Every guidance mode's name (`guidance_modes`, render/guidance_mode.hpp), for --guidance-mode.
+std::vector<std::string> guidance_mode_choices();
 
 }  // namespace calligraphy::cli
