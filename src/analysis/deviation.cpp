@@ -3,25 +3,12 @@
 #include <limits>
 #include <string>
 
+#include "calligraphy/analysis/metrics.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/nearest_point.hpp"
-#include "calligraphy/analysis/metrics.hpp"
 
 namespace calligraphy {
 namespace {
-
-// Distance from p to the box of the element's control points: a lower bound of the distance to the
-// element, since a Bezier curve lies in the convex hull of its control points.
-double distance_to_control_box(const StrokeElement& element, const Vec2& p) {
-  Vec2 low = element.control[0];
-  Vec2 high = element.control[0];
-  for (int i = 1; i <= element.degree; ++i) {
-    low = low.cwiseMin(element.control[static_cast<std::size_t>(i)]);
-    high = high.cwiseMax(element.control[static_cast<std::size_t>(i)]);
-  }
-  const Vec2 outside = (low - p).cwiseMax(p - high).cwiseMax(Vec2::Zero());
-  return outside.norm();
-}
 
 std::string point_text(const Vec2& p) {
   return "(" + std::to_string(p.x()) + ", " + std::to_string(p.y()) + ")";
@@ -34,12 +21,7 @@ double deviation_from_stroke_m(std::span<const StrokeElement> reference_m, const
     throw InvalidArgument("deviation_from_stroke_m: the reference stroke has no element");
   if (!point_m.allFinite())
     throw InvalidArgument("deviation_from_stroke_m: point " + point_text(point_m) + " is not finite");
-  double best = std::numeric_limits<double>::infinity();
-  for (const StrokeElement& element : reference_m) {
-    if (distance_to_control_box(element, point_m) >= best) continue;  // cannot be nearer
-    best = std::min(best, nearest_point(element, point_m).distance);
-  }
-  return best;
+  return distance_to_elements(reference_m, point_m);
 }
 
 DeviationPool::DeviationPool(double tube_radius_m) : tube_radius_m_(tube_radius_m) {

@@ -4,9 +4,9 @@
 #include <string>
 #include <vector>
 
-#include "calligraphy/core/errors.hpp"
-#include "calligraphy/analysis/metrics.hpp"
 #include "analysis/input_checks.hpp"
+#include "calligraphy/analysis/metrics.hpp"
+#include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
 namespace {
@@ -69,15 +69,16 @@ std::vector<Vec2> gaussian_filtered(const std::vector<Vec2>& signal, double sigm
     total += weights[static_cast<std::size_t>(j + half_width)] = std::exp(-0.5 * x * x);
   }
   for (double& w : weights) w /= total;
-  const auto last = static_cast<std::ptrdiff_t>(signal.size()) - 1;
+  // The held ends written out, so that the taps need no bounds check.
+  const auto width = static_cast<std::size_t>(half_width);
+  std::vector<Vec2> held(signal.size() + 2 * width, signal.front());
+  std::copy(signal.begin(), signal.end(), held.begin() + half_width);
+  std::fill(held.end() - half_width, held.end(), signal.back());
   std::vector<Vec2> out(signal.size(), Vec2::Zero());
-  for (std::ptrdiff_t k = 0; k <= last; ++k) {
+  for (std::size_t k = 0; k < signal.size(); ++k) {
     Vec2 sum = Vec2::Zero();
-    for (std::ptrdiff_t j = -half_width; j <= half_width; ++j) {
-      sum += weights[static_cast<std::size_t>(j + half_width)] *
-             signal[static_cast<std::size_t>(std::clamp(k + j, std::ptrdiff_t{0}, last))];
-    }
-    out[static_cast<std::size_t>(k)] = sum;
+    for (std::size_t j = 0; j < weights.size(); ++j) sum += weights[j] * held[k + j];
+    out[k] = sum;
   }
   return out;
 }

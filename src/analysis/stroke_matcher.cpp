@@ -64,8 +64,14 @@ StrokeAttempt attempt(const PlacedStroke& stroke, std::span<const Vec2> path, do
   };
   feed(path.front());
   for (std::size_t i = 1; i < path.size(); ++i) {
+    if (written_on_the_way || (result.entered && !tracker.in_attempt())) break;  // feed reads no more
     const Vec2 step = path[i] - path[i - 1];
-    const double length_in_steps = std::ceil(step.norm() / kStep_m);
+    const double step_m = step.norm();
+    // Before the start neighbourhood is entered, a step that cannot reach it (by the triangle inequality,
+    // with a margin for rounding) feeds nothing.
+    if (!result.entered && (path[i - 1] - stroke.start()).norm() > start_radius_m + step_m + kStep_m)
+      continue;
+    const double length_in_steps = std::ceil(step_m / kStep_m);
     const int pieces =
         length_in_steps < kMaxPieces ? std::max(1, static_cast<int>(length_in_steps)) : kMaxPieces;
     for (int k = 1; k <= pieces; ++k) feed(path[i - 1] + step * (static_cast<double>(k) / pieces));

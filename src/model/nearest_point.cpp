@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
@@ -64,7 +65,29 @@ void validate(const StrokeElement& element, const Vec2& p, const NearestPointOpt
   }
 }
 
+// Distance from p to the box of the element's control points: a lower bound of the distance to the
+// element, since a Bezier curve lies in the convex hull of its control points.
+double distance_to_control_box(const StrokeElement& element, const Vec2& p) {
+  Vec2 low = element.control[0];
+  Vec2 high = element.control[0];
+  for (int i = 1; i <= element.degree; ++i) {
+    low = low.cwiseMin(element.control[static_cast<std::size_t>(i)]);
+    high = high.cwiseMax(element.control[static_cast<std::size_t>(i)]);
+  }
+  const Vec2 outside = (low - p).cwiseMax(p - high).cwiseMax(Vec2::Zero());
+  return outside.norm();
+}
+
 }  // namespace
+
+double distance_to_elements(std::span<const StrokeElement> elements, const Vec2& p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const StrokeElement& element : elements) {
+    if (distance_to_control_box(element, p) >= best) continue;  // cannot be nearer
+    best = std::min(best, nearest_point(element, p).distance);
+  }
+  return best;
+}
 
 NearestPoint nearest_point(const StrokeElement& element, const Vec2& p, const NearestPointOptions& options) {
   validate(element, p, options);

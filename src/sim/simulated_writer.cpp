@@ -44,7 +44,6 @@ constexpr double kMidLift_s = 0.12;         // how long up and down,
 constexpr double kMidLiftHold_s = 0.1;      // and how long the pen stays up
 constexpr double kStrayDistance_m = 0.004;  // a touch outside the box lands this far outside it
 constexpr double kStrayLength_m = 0.004;    // and slides this far along it
-constexpr double kDerivativeStep_s = 1e-4;  // central difference for the hand's target velocity
 
 double uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1p-53; }
 
@@ -140,15 +139,22 @@ struct SimulatedWriter::State {
   PlannedStroke redo_target;
   bool done = false;
 
+  // The motor command issued at the last observation: where the plan puts the hand and how fast it moves
+  // there; the hand follows its first-order hold until the next observation.
+  writer_detail::Motion command;
+  double command_s = 0.0;
+
   Vec3 noise_n = Vec3::Zero();
   double noise_time_s = -1.0;
   double tremor_phase_x = 0.0;
   double tremor_phase_y = 0.0;
+  Vec3 tremor_n = Vec3::Zero();
 
   State(const Scene& s, const WriterProfile& p, std::uint64_t seed);
-  [[nodiscard]] Vec3 desired(double time_s) const;
+  [[nodiscard]] writer_detail::Motion desired(double time_s) const;
   [[nodiscard]] Vec3 planned_now() const;
   void update_rate();
+  void issue_command(double time_s);
   void advance(double dt, double time_s);
   void store_seen(const RenderOutput& output, const DeviceState& pen);
   [[nodiscard]] const VisionSample* seen_at(double time_s) const;
@@ -204,13 +210,19 @@ Vec3 SimulatedWriter::State::planned_now() const {
   return current < program.size() ? program[current].at_phase(phase) : hold;
 }
 
-Vec3 SimulatedWriter::State::desired(double time_s) const {
+// The hand's target: the program's point now, moved by the correction, and its exact time derivative (the
+// hand's damping acts on the error in velocity, Flash & Hogan's minimum-jerk speed profile included).
+writer_detail::Motion SimulatedWriter::State::desired(double time_s) const {
   const double ahead = time_s - observed_s;
-  Vec3 base = hold;
-  if (current < program.size())
-    base = program[current].at_phase(std::clamp(phase + rate_per_s * ahead, 0.0, 1.0));
+  writer_detail::Motion motion{hold, Vec3::Zero()};
+  if (current < program.size()) {
+    const double unclamped = phase + rate_per_s * ahead;
+    motion = program[current].motion_at_phase(std::clamp(unclamped, 0.0, 1.0), rate_per_s);
+  }
   const Vec2 c = correction_m + correction_rate_m_s * ahead;
-  return base + Vec3(c.x(), c.y(), 0.0);
+  motion.position_m += Vec3(c.x(), c.y(), 0.0);
+  motion.velocity_m_s += Vec3(correction_rate_m_s.x(), correction_rate_m_s.y(), 0.0);
+  return motion;
 }
 
 void SimulatedWriter::State::update_rate() {
@@ -672,7 +684,8 @@ const std::vector<PlannedStroke>& SimulatedWriter::plan() const noexcept { retur
 const WriterProfile& SimulatedWriter::profile() const noexcept { return state_->profile; }
 
 Vec3 SimulatedWriter::target(double time_s) const {
-  return state_->started ? state_->desired(time_s) : state_->hold;
+  const State& s = *state_;
+  return s.started ? Vec3(s.command.position_m + (time_s - s.command_s) * s.command.velocity_m_s) : s.hold;
 }
 
 void SimulatedWriter::observe(const RenderOutput& output, const DeviceState& pen) {
@@ -689,7 +702,10 @@ void SimulatedWriter::observe(const RenderOutput& output, const DeviceState& pen
   s.advance(dt, time_s);
   s.observed_s = time_s;
   s.store_seen(output, pen);
-  if (s.done) return;
+  if (s.done) {
+    s.issue_command(time_s);
+    return;
+  }
   s.feel(output, dt, time_s);
   while (time_s >= s.next_vision_s) {
     s.look(time_s);
@@ -698,6 +714,12 @@ void SimulatedWriter::observe(const RenderOutput& output, const DeviceState& pen
   s.pace(dt);
   if (s.program.empty()) s.choose_next(time_s);
   s.update_rate();
+  s.issue_command(time_s);
+}
+
+void SimulatedWriter::State::issue_command(double time_s) {
+  command = desired(time_s);
+  command_s = time_s;
 }
 
 Vec3 SimulatedWriter::hand_force(double time_s, const Vec3& position_m, const Vec3& velocity_m_s) {
@@ -705,22 +727,21 @@ Vec3 SimulatedWriter::hand_force(double time_s, const Vec3& position_m, const Ve
   const WriterProfile& p = s.profile;
   if (!s.started) s.hold = position_m;  // before the first observation the hand holds still
   const Vec3 x_d = target(time_s);
-  const Vec3 v_d =
-      s.started ? Vec3((s.desired(time_s + kDerivativeStep_s) - s.desired(time_s - kDerivativeStep_s)) /
-                       (2.0 * kDerivativeStep_s))
-                : Vec3(Vec3::Zero());
+  const Vec3 v_d = s.started ? s.command.velocity_m_s : Vec3(Vec3::Zero());
   const Vec3 force =
       p.hand_stiffness_n_per_m * (x_d - position_m) + p.hand_damping_n_s_per_m * (v_d - velocity_m_s);
-  if (time_s - s.noise_time_s >=
-      kNoiseUpdate_s) {  // signal-dependent noise (Harris & Wolpert 1998), in plane
+  // Signal-dependent noise (Harris & Wolpert 1998) and the physiological tremor, in plane, both held for
+  // kNoiseUpdate_s: the 8-12 Hz tremor is smooth on that scale, and a sine per physics substep cost a
+  // tenth of a simulated trial.
+  if (time_s - s.noise_time_s >= kNoiseUpdate_s) {
     s.noise_time_s = time_s;
     const double sigma = p.noise_fraction * force.norm();
     s.noise_n = Vec3(sigma * gaussian(s.noise_rng), sigma * gaussian(s.noise_rng), 0.0);
+    const double w = 2.0 * std::numbers::pi * p.tremor_frequency_hz * time_s;
+    s.tremor_n =
+        p.tremor_amplitude_n * Vec3(std::sin(w + s.tremor_phase_x), std::sin(w + s.tremor_phase_y), 0.0);
   }
-  const double w = 2.0 * std::numbers::pi * p.tremor_frequency_hz * time_s;
-  const Vec3 tremor =
-      p.tremor_amplitude_n * Vec3(std::sin(w + s.tremor_phase_x), std::sin(w + s.tremor_phase_y), 0.0);
-  return force + s.noise_n + tremor;
+  return force + s.noise_n + s.tremor_n;
 }
 
 }  // namespace calligraphy

@@ -9,6 +9,26 @@ double Segment::minimum_jerk(double phase) {
   return p * p * p * (10.0 - 15.0 * p + 6.0 * p * p);
 }
 
+double Segment::minimum_jerk_slope(double phase) {
+  if (!(phase > 0.0 && phase < 1.0)) return 0.0;
+  const double q = phase * (1.0 - phase);
+  return 30.0 * q * q;
+}
+
+Motion Segment::motion_at_phase(double phase, double rate_per_s) const {
+  const double s = length_m() * minimum_jerk(phase);
+  const auto upper = std::upper_bound(arc.begin(), arc.end(), s);
+  if (upper == arc.end()) return {path.back(), Vec3::Zero()};  // at the end, where the speed is zero
+  if (upper == arc.begin()) return {path.front(), Vec3::Zero()};
+  const auto i = static_cast<std::size_t>(upper - arc.begin());
+  const double span = arc[i] - arc[i - 1];
+  if (!(span > 0.0)) return {path[i - 1], Vec3::Zero()};
+  const Vec3 leg = path[i] - path[i - 1];
+  // d/dt of the point at arc L mj(phase): the phase's rate times L mj'(phase), along the leg.
+  const double speed_m_s = rate_per_s * length_m() * minimum_jerk_slope(phase);
+  return {path[i - 1] + ((s - arc[i - 1]) / span) * leg, (speed_m_s / span) * leg};
+}
+
 Vec3 Segment::at_arc(double s) const {
   const auto upper = std::upper_bound(arc.begin(), arc.end(), s);
   if (upper == arc.end()) return path.back();

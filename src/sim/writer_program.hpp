@@ -20,6 +20,12 @@ enum class SegmentKind {
   stray,    // sliding on the paper outside the character's box
 };
 
+/// Where the hand means to be and how fast it means to move there.
+struct Motion {
+  Vec3 position_m = Vec3::Zero();
+  Vec3 velocity_m_s = Vec3::Zero();
+};
+
 struct Segment {
   SegmentKind kind = SegmentKind::travel;
   std::vector<Vec3> path;     // at least one point, device frame [m]
@@ -37,8 +43,13 @@ struct Segment {
   [[nodiscard]] Vec2 direction_at_arc(double s) const;
   /// Point at phase `phase` in [0, 1] of the minimum-jerk profile.
   [[nodiscard]] Vec3 at_phase(double phase) const { return at_arc(length_m() * minimum_jerk(phase)); }
+  /// Point [m] and velocity [m/s] at phase `phase` in [0, 1] while the phase advances at `rate_per_s`
+  /// [1/s]: at_phase(phase), and its time derivative rate L mj'(phase) along the path's unit tangent.
+  [[nodiscard]] Motion motion_at_phase(double phase, double rate_per_s) const;
   /// Minimum-jerk position profile on [0, 1]: 10 p^3 - 15 p^4 + 6 p^5 (Flash & Hogan 1985).
   [[nodiscard]] static double minimum_jerk(double phase);
+  /// Its derivative d/dp: 30 p^2 (1 - p)^2, zero outside [0, 1].
+  [[nodiscard]] static double minimum_jerk_slope(double phase);
 };
 
 /// A segment through `path` lasting max(minimum_s, length / speed_m_s) at speed factor 1.

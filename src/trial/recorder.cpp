@@ -1,21 +1,9 @@
 #include <algorithm>
-#include <limits>
 
 #include "calligraphy/model/nearest_point.hpp"
 #include "calligraphy/trial/trial.hpp"
 
 namespace calligraphy {
-namespace {
-
-// Distance from the tip to the nearest element of the stroke (the whole reference, not only the active
-// element).
-double distance_to_stroke(const PlacedStroke& stroke, const Vec2& tip) {
-  double best = std::numeric_limits<double>::infinity();
-  for (const StrokeElement& e : stroke.elements) best = std::min(best, nearest_point(e, tip).distance);
-  return best;
-}
-
-}  // namespace
 
 TrialRecorder::TrialRecorder(const Scene& scene, bool keep_trace) : scene_(&scene), keep_trace_(keep_trace) {
   for (std::size_t c = 0; c < scene.characters.size(); ++c) {
@@ -56,7 +44,9 @@ void TrialRecorder::record(const DeviceState& state, const RenderOutput& out) {
   }
   if (writing_this) {
     const auto [c, s] = stroke_location_[current_];
-    const double d = distance_to_stroke(scene_->characters[c].strokes[s], state.position_m.head<2>());
+    // To the whole reference stroke, not only the active element.
+    const double d =
+        distance_to_elements(scene_->characters[c].strokes[s].elements, state.position_m.head<2>());
     attempt_.sum += d;
     ++attempt_.count;
     attempt_.max = std::max(attempt_.max, d);

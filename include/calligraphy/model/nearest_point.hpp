@@ -9,6 +9,8 @@
 /// projection of `nearest_point_on_segment` with every method, as the paper does (section 4.3.1).
 /// Measured accuracy and speed of every method: docs/nearest-point.md.
 
+#include <span>
+
 #include "calligraphy/model/element.hpp"
 
 namespace calligraphy {
@@ -65,6 +67,12 @@ struct NearestPoint {
 /// points the one with the smallest t is returned. Allocation-free.
 NearestPoint nearest_point(const StrokeElement& element, const Vec2& p,
                            const NearestPointOptions& options = {});
+
+/// Distance from `p` to the nearest of `elements` (element units, m for placed elements; infinity for
+/// none): the least `nearest_point(e, p).distance`, exact, skipping each element whose control points'
+/// bounding box is already no nearer (a Bezier curve lies in the convex hull of its control points).
+/// Throws as `nearest_point`.
+double distance_to_elements(std::span<const StrokeElement> elements, const Vec2& p);
 
 /// Nearest point on the segment a-b (t clamped to [0, 1]; a zero-length segment gives t = 0).
 /// Lengths in the caller's units (m). No checks: the caller guarantees finite input. Used on the

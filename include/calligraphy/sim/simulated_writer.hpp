@@ -62,7 +62,8 @@ class SimulatedWriter final : public HandModel {
   void observe(const RenderOutput& output, const DeviceState& pen);
   /// True when the writer has finished (its plan written, or the display finished) or given up.
   [[nodiscard]] bool done() const noexcept;
-  /// The hand's target x_d at `time_s` [m], from the state of the last `observe` (for tests).
+  /// The hand's target x_d at `time_s` [m]: the motor command issued at the last `observe` (the plan's
+  /// point and velocity then), held to first order until the next (for tests).
   [[nodiscard]] Vec3 target(double time_s) const;
 
   /// What the writer did so far.
