@@ -81,6 +81,7 @@ void check_same_trials(const TrialRow& a, const TrialRow& b) {
   CHECK(a.velocity_peaks == b.velocity_peaks);
   CHECK(a.shape_skill == b.shape_skill);
   CHECK(a.order_skill == b.order_skill);
+  CHECK(a.timing_skill == b.timing_skill);
 }
 
 }  // namespace
@@ -109,6 +110,7 @@ TEST_CASE("a cohort in memory gives the rows of the same subjects' session folde
   std::vector<std::string> groups;
   for (const TrialRow& row : memory.trials) {
     CHECK(row.shape_skill.has_value());
+    CHECK(row.timing_skill.has_value());
     if (groups.empty() || groups.back() != row.group) groups.push_back(row.group);
   }
   CHECK(groups == std::vector<std::string>{"fading", "band", "adapt", "push"});

@@ -705,6 +705,9 @@ TEST_CASE("a learning simulated subject writes with what it learned, the same af
       REQUIRE(row.shape_skill);  // the skill the trial started with, in the tables
       CHECK(*row.shape_skill >= 0.0);
       CHECK(*row.shape_skill < 1.0);
+      REQUIRE(row.timing_skill);
+      CHECK(*row.timing_skill >= 0.0);
+      CHECK(*row.timing_skill < 1.0);
       const nlohmann::json record =
           nlohmann::json::parse(read(fs::path(row.trace_file).replace_extension(".json")));
       bias.push_back(record["writer"]["profile"]["bias_offset_m"].get<double>());

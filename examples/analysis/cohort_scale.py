@@ -33,30 +33,37 @@ def timed(label: str, run) -> "calligraphy.study.Study":
     return study
 
 
+# What each group's training left behind: the error across the stroke, and the time the pen was down (the
+# timing skill: speed and pauses), each with its scale and unit.
+OUTCOMES = (("mean_deviation_m", 1e3, "mm"), ("pen_down_time_s", 1.0, "s"))
+
+
 def compare_groups(trials: "pandas.DataFrame") -> None:
-    """Each group's learning, retention and transfer in deviation, and each schedule against the unguided."""
-    learning = statistics.learning(trials, "mean_deviation_m", pre="pre-test", post="post-test",
-                                   retention="retention", transfer="transfer")
-    learning["retention_loss"] = learning["retention"] - learning["post"]
-    columns = ["pre", "post", "retention", "transfer", "gain", "retention_loss"]
-    print(f"\nmean deviation [mm] per group, means over subjects ({trials.subject.nunique()} subjects, "
-          f"{len(trials)} trials):")
-    print((learning.groupby("group")[columns].mean() * 1e3).round(3).to_string())
-    skills = trials.pivot_table(index="group", columns="phase", values="shape_skill", aggfunc="mean", observed=True)
-    print("\nshape skill at the start of each phase's trials:")
-    print(skills[[p for p in ("pre-test", "training", "post-test", "retention", "transfer") if p in skills]]
-          .round(3).to_string())
-    if "unguided" not in set(learning.group):
-        return
-    if learning.groupby("group").size().min() < 2:
-        print("\n(groups of fewer than 2 subjects: no comparisons)")
-        return
-    print("\neach schedule - unguided (Welch t-test, Hedges' g; mm):")
-    for group in sorted(set(learning.group) - {"unguided"}):
-        for quantity in ("gain", "retention", "transfer"):
-            c = statistics.group_comparison(learning, quantity, group, "unguided")
-            print(f"  {group:17} {quantity:9} {c.mean_difference * 1e3:+.3f} [{c.ci95_low * 1e3:+.3f}, "
-                  f"{c.ci95_high * 1e3:+.3f}], p = {c.p:.3g}, g = {c.g:+.2f} (n = {c.n_a}, {c.n_b})")
+    """Each group's learning, retention and transfer, and each schedule against the unguided, per outcome."""
+    print(f"\n{trials.subject.nunique()} subjects, {len(trials)} trials")
+    for skill in ("shape_skill", "timing_skill"):
+        skills = trials.pivot_table(index="group", columns="phase", values=skill, aggfunc="mean", observed=True)
+        print(f"\n{skill.replace('_', ' ')} at the start of each phase's trials:")
+        print(skills[[p for p in ("pre-test", "training", "post-test", "retention", "transfer") if p in skills]]
+              .round(3).to_string())
+    for value, scale, unit in OUTCOMES:
+        learning = statistics.learning(trials, value, pre="pre-test", post="post-test", retention="retention",
+                                       transfer="transfer")
+        learning["retention_loss"] = learning["retention"] - learning["post"]
+        columns = ["pre", "post", "retention", "transfer", "gain", "retention_loss"]
+        print(f"\n{value} [{unit}] per group, means over subjects:")
+        print((learning.groupby("group")[columns].mean() * scale).round(3).to_string())
+        if "unguided" not in set(learning.group):
+            continue
+        if learning.groupby("group").size().min() < 2:
+            print("(groups of fewer than 2 subjects: no comparisons)")
+            continue
+        print(f"each schedule - unguided (Welch t-test, Hedges' g; {unit}):")
+        for group in sorted(set(learning.group) - {"unguided"}):
+            for quantity in ("gain", "retention", "transfer"):
+                c = statistics.group_comparison(learning, quantity, group, "unguided")
+                print(f"  {group:17} {quantity:9} {c.mean_difference * scale:+.3f} [{c.ci95_low * scale:+.3f}, "
+                      f"{c.ci95_high * scale:+.3f}], p = {c.p:.3g}, g = {c.g:+.2f} (n = {c.n_a}, {c.n_b})")
 
 
 def main() -> int:

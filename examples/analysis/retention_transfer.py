@@ -57,12 +57,14 @@ def main() -> int:
     study = calligraphy.study.load(out)
     print(f"{out}: {len(study.trials)} trials of {study.trials.subject.nunique()} subjects in "
           f"{time.monotonic() - started:.1f} s")
-    # The model's own state, free of the trials' noise: the shape skill each phase's trials started with.
-    skills = study.trials.pivot_table(index="group", columns="phase", values="shape_skill", aggfunc="mean",
-                                      observed=True)
-    print("\nshape skill (0 to 1) at the start of each phase's trials, mean over trials and subjects")
-    print(skills[["pre-test", "training", "post-test", "retention", "transfer"]].to_string(float_format=lambda x: f"{x:.3f}"))
-    for value in ("mean_deviation_m", "total_time_s"):
+    # The model's own state, free of the trials' noise: the skills each phase's trials started with.
+    for skill in ("shape_skill", "timing_skill"):
+        skills = study.trials.pivot_table(index="group", columns="phase", values=skill, aggfunc="mean",
+                                          observed=True)
+        print(f"\n{skill.replace('_', ' ')} (0 to 1) at the start of each phase's trials, mean over trials and subjects")
+        print(skills[["pre-test", "training", "post-test", "retention", "transfer"]]
+              .to_string(float_format=lambda x: f"{x:.3f}"))
+    for value in ("mean_deviation_m", "pen_down_time_s"):
         table = statistics.learning(study.trials, value, "pre-test", "post-test", retention="retention",
                                     transfer="transfer")
         columns = ["pre", "post", "retention", "transfer", "gain", "retention_ratio", "transfer_gain"]

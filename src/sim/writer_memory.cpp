@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <string>
+#include <utility>
 
 #include "calligraphy/core/errors.hpp"
 
@@ -83,27 +84,35 @@ double guidance_assistance_share(double gain, double guidance_stiffness_n_per_m,
 }
 
 void practise(WriterMemory& memory, const std::vector<int>& typical_ids, const std::u32string& characters,
-              double assistance_share, const TwoStateRates& rates) {
+              const AssistanceShares& shares, const TwoStateRates& rates) {
   rates.validate();
-  if (!(assistance_share >= kMinAssistanceShare && assistance_share <= 1.0)) {
-    throw InvalidArgument("practise: assistance share " + std::to_string(assistance_share) + " outside [" +
-                          std::to_string(kMinAssistanceShare) + ", 1]");
+  for (const auto& [name, share] : {std::pair{"shape", shares.shape}, std::pair{"timing", shares.timing}}) {
+    if (!(share >= kMinAssistanceShare && share <= 1.0)) {
+      throw InvalidArgument(std::string("practise: ") + name + " assistance share " + std::to_string(share) +
+                            " outside [" + std::to_string(kMinAssistanceShare) + ", 1]");
+    }
   }
   // x(n+1) = A x(n) + B e(n), e(n) from the skill before the trial; a stroke type written k times learns k
   // times from that error.
-  std::map<int, double> stroke_errors;
-  for (const int id : typical_ids)
-    stroke_errors[id] += error_of(memory.typical_strokes[id], assistance_share);
+  std::map<int, double> shape_errors;
+  std::map<int, double> timing_errors;
+  for (const int id : typical_ids) {
+    shape_errors[id] += error_of(memory.typical_strokes[id], shares.shape);
+    timing_errors[id] += error_of(memory.stroke_timing[id], shares.timing);
+  }
   std::map<char32_t, double> character_errors;
-  for (const char32_t c : characters) character_errors[c] += error_of(memory.characters[c], assistance_share);
+  for (const char32_t c : characters) character_errors[c] += error_of(memory.characters[c], shares.shape);
   for (auto& [id, skill] : memory.typical_strokes) decay(skill, rates);
+  for (auto& [id, skill] : memory.stroke_timing) decay(skill, rates);
   for (auto& [character, skill] : memory.characters) decay(skill, rates);
-  for (const auto& [id, error] : stroke_errors) learn(memory.typical_strokes[id], error, rates);
+  for (const auto& [id, error] : shape_errors) learn(memory.typical_strokes[id], error, rates);
+  for (const auto& [id, error] : timing_errors) learn(memory.stroke_timing[id], error, rates);
   for (const auto& [c, error] : character_errors) learn(memory.characters[c], error, rates);
 }
 
 void consolidate(WriterMemory& memory) {
   for (auto& [id, skill] : memory.typical_strokes) skill.fast = 0.0;
+  for (auto& [id, skill] : memory.stroke_timing) skill.fast = 0.0;
   for (auto& [character, skill] : memory.characters) skill.fast = 0.0;
 }
 
@@ -111,8 +120,18 @@ double shape_skill(const WriterMemory& memory, const std::vector<int>& typical_i
   return mean_skill(memory.typical_strokes, typical_ids);
 }
 
+double timing_skill(const WriterMemory& memory, const std::vector<int>& typical_ids) {
+  return mean_skill(memory.stroke_timing, typical_ids);
+}
+
 double order_skill(const WriterMemory& memory, const std::u32string& characters) {
   return mean_skill(memory.characters, characters);
+}
+
+WriterSkills writer_skills(const WriterMemory& memory, const std::vector<int>& typical_ids,
+                           const std::u32string& characters) {
+  return {shape_skill(memory, typical_ids), order_skill(memory, characters),
+          timing_skill(memory, typical_ids)};
 }
 
 const std::vector<std::string>& learned_profile_fields() {
@@ -129,23 +148,26 @@ const std::vector<std::string>& learned_profile_fields() {
   return fields;
 }
 
-WriterProfile learned_profile(const WriterProfile& own, const WriterProfile& skilled, double shape,
-                              double order) {
-  check_skill(shape, "shape");
-  check_skill(order, "order");
+WriterProfile learned_profile(const WriterProfile& own, const WriterProfile& skilled,
+                              const WriterSkills& skills) {
+  check_skill(skills.shape, "shape");
+  check_skill(skills.order, "order");
+  check_skill(skills.timing, "timing");
+  const double shape = skills.shape;
   WriterProfile p = own;
   p.bias_offset_m = blend(own.bias_offset_m, skilled.bias_offset_m, shape);
   p.scale_error = blend(own.scale_error, skilled.scale_error, shape);
   p.stroke_jitter_m = blend(own.stroke_jitter_m, skilled.stroke_jitter_m, shape);
   p.corner_cut_m = blend(own.corner_cut_m, skilled.corner_cut_m, shape);
-  p.writing_speed_m_s = blend(own.writing_speed_m_s, skilled.writing_speed_m_s, shape);
   p.mid_stroke_lift_probability =
       blend(own.mid_stroke_lift_probability, skilled.mid_stroke_lift_probability, shape);
   p.outside_touch_probability =
       blend(own.outside_touch_probability, skilled.outside_touch_probability, shape);
-  p.hesitation_probability = blend(own.hesitation_probability, skilled.hesitation_probability, shape);
-  p.order_error_probability = blend(own.order_error_probability, skilled.order_error_probability, order);
-  p.backwards_probability = blend(own.backwards_probability, skilled.backwards_probability, order);
+  p.writing_speed_m_s = blend(own.writing_speed_m_s, skilled.writing_speed_m_s, skills.timing);
+  p.hesitation_probability = blend(own.hesitation_probability, skilled.hesitation_probability, skills.timing);
+  p.order_error_probability =
+      blend(own.order_error_probability, skilled.order_error_probability, skills.order);
+  p.backwards_probability = blend(own.backwards_probability, skilled.backwards_probability, skills.order);
   p.validate();
   return p;
 }

@@ -80,7 +80,7 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
   }
   TrialSpec spec = study_trial_spec(manifest, condition, trial, guidance.guidance);
   const bool learning = manifest.setup.writer_learning == "two-state";
-  std::optional<std::pair<double, double>> skills;
+  std::optional<WriterSkills> skills;
   if (learning)
     skills = study_detail::learn_into(spec, memory, manifest.setup.writer_profile, scene, trial.characters);
   // The registry's simulated device, made here: asking the registry would scan every hardware backend (USB)

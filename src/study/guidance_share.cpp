@@ -6,25 +6,13 @@
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/sim/writer_memory.hpp"
 
 namespace calligraphy {
 
-double guidance_share(const ForceLawParameters& force, double hand_stiffness_n_per_m,
-                      double mean_deviation_m) {
-  force.validate();
-  const double k = hand_stiffness_n_per_m;
-  if (!(k > 0.0) || !std::isfinite(k)) {
-    throw InvalidArgument("guidance_share: hand stiffness " + std::to_string(k) +
-                          " N/m must be finite and > 0");
-  }
-  const double e = mean_deviation_m;
-  const bool written = !std::isnan(e);
-  if (written && (!(e >= 0.0) || !std::isfinite(e))) {
-    throw InvalidArgument("guidance_share: mean deviation " + std::to_string(e) +
-                          " m must be finite and >= 0");
-  }
-  if (!force.guidance) return 0.0;
+namespace {
+
+// The share across the stroke, for guidance that is on.
+double shape_share(const ForceLawParameters& force, double k, double e, bool written) {
   const double stiffness = force.guidance_stiffness_n_per_m;
   switch (force.guidance_mode) {
     case GuidanceMode::timing:
@@ -51,6 +39,29 @@ double guidance_share(const ForceLawParameters& force, double hand_stiffness_n_p
     }
   }
   return 0.0;
+}
+
+}  // namespace
+
+AssistanceShares guidance_shares(const ForceLawParameters& force, double hand_stiffness_n_per_m,
+                                 double mean_deviation_m) {
+  force.validate();
+  const double k = hand_stiffness_n_per_m;
+  if (!(k > 0.0) || !std::isfinite(k)) {
+    throw InvalidArgument("guidance_shares: hand stiffness " + std::to_string(k) +
+                          " N/m must be finite and > 0");
+  }
+  const double e = mean_deviation_m;
+  const bool written = !std::isnan(e);
+  if (written && (!(e >= 0.0) || !std::isfinite(e))) {
+    throw InvalidArgument("guidance_shares: mean deviation " + std::to_string(e) +
+                          " m must be finite and >= 0");
+  }
+  if (!force.guidance) return {};
+  const bool along =
+      force.guidance_mode == GuidanceMode::timing || force.guidance_mode == GuidanceMode::replay;
+  return {shape_share(force, k, e, written),
+          along ? guidance_assistance_share(1.0, force.guidance_stiffness_n_per_m, k) : 0.0};
 }
 
 }  // namespace calligraphy

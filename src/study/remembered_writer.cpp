@@ -51,7 +51,7 @@ void practise_record(WriterMemory& memory, const json& record, const std::string
   }
   if (ids.empty()) fail(source, "/scene", "no strokes: the trial's characters are not recorded");
   const json& force_law = record.value("force_law", json::object());
-  double share = 0.0;
+  AssistanceShares shares;
   if (force_law.value("guidance", false)) {
     const double hand = record.value("writer", json::object())
                             .value("profile", json::object())
@@ -71,17 +71,19 @@ void practise_record(WriterMemory& memory, const json& record, const std::string
     force.amplification_max_force_n =
         force_law.value("amplification_max_force_n", force.amplification_max_force_n);
     force.timing_speed_m_s = force_law.value("timing_speed_m_s", force.timing_speed_m_s);
-    // A replay's teacher is not in the record; its share does not depend on it.
-    if (force.guidance_mode == GuidanceMode::replay) force.guidance_mode = GuidanceMode::fixed;
+    // A replay's teacher is not in the record; its shares do not depend on it, so a stand-in of two samples
+    // passes the parameters' validation.
+    if (force.guidance_mode == GuidanceMode::replay)
+      force.teacher_trajectory = {TeacherSample{}, TeacherSample{}};
     const json& deviation = record.value("mean_deviation_mm", json(nullptr));
     const double deviation_m = deviation.is_number() ? deviation.get<double>() * 1e-3 : std::nan("");
     try {
-      share = guidance_share(force, hand, deviation_m);
+      shares = guidance_shares(force, hand, deviation_m);
     } catch (const InvalidArgument& e) {
       fail(source, "/force_law", e.what());
     }
   }
-  practise(memory, ids, characters, share);
+  practise(memory, ids, characters, shares);
 }
 
 WriterMemory remembered(const SessionFolder& session) {
@@ -101,7 +103,7 @@ std::vector<int> typical_ids(const Scene& scene) {
 std::vector<std::string> learned_parameters(const WriterMemory& memory, const std::string& profile_name,
                                             const std::vector<int>& ids, const std::u32string& characters) {
   const WriterProfile learned = learned_profile(writer_profile(profile_name), WriterProfile::skilled(),
-                                                shape_skill(memory, ids), order_skill(memory, characters));
+                                                writer_skills(memory, ids, characters));
   std::vector<std::string> parameters;
   for (const std::string& field : learned_profile_fields()) {
     char value[40];
@@ -111,12 +113,11 @@ std::vector<std::string> learned_parameters(const WriterMemory& memory, const st
   return parameters;
 }
 
-std::pair<double, double> learn_into(TrialSpec& spec, const WriterMemory& memory,
-                                     const std::string& profile_name, const Scene& scene,
-                                     const std::u32string& characters) {
+WriterSkills learn_into(TrialSpec& spec, const WriterMemory& memory, const std::string& profile_name,
+                        const Scene& scene, const std::u32string& characters) {
   const std::vector<int> ids = typical_ids(scene);
   spec.writer_parameters = learned_parameters(memory, profile_name, ids, characters);
-  return {shape_skill(memory, ids), order_skill(memory, characters)};
+  return writer_skills(memory, ids, characters);
 }
 
 }  // namespace calligraphy::study_detail

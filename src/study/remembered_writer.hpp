@@ -4,7 +4,6 @@
 // Internal.
 #include <nlohmann/json.hpp>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "calligraphy/model/scene.hpp"
@@ -14,7 +13,7 @@
 
 namespace calligraphy::study_detail {
 
-/// One saved trial as practice: the typical strokes of its scene, its characters, and the share of the
+/// One saved trial as practice: the typical strokes of its scene, its characters, and the shares of the
 /// correction its guidance took from the hand (the record's force law and writer profile). Throws DataError
 /// naming `source` when the record lacks them.
 void practise_record(WriterMemory& memory, const nlohmann::json& record, const std::string& source);
@@ -32,9 +31,8 @@ std::vector<std::string> learned_parameters(const WriterMemory& memory, const st
                                             const std::vector<int>& ids, const std::u32string& characters);
 
 /// Makes `spec` the trial of a learning subject: its writer parameters `learned_parameters` for the strokes
-/// of `scene` and `characters`. Returns the skills before the trial (shape, order).
-std::pair<double, double> learn_into(TrialSpec& spec, const WriterMemory& memory,
-                                     const std::string& profile_name, const Scene& scene,
-                                     const std::u32string& characters);
+/// of `scene` and `characters`. Returns the skills before the trial.
+WriterSkills learn_into(TrialSpec& spec, const WriterMemory& memory, const std::string& profile_name,
+                        const Scene& scene, const std::u32string& characters);
 
 }  // namespace calligraphy::study_detail

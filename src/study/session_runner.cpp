@@ -250,11 +250,12 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     TrialSpec spec = study_trial_spec(manifest, condition, trial, guidance.guidance);
     if (run_options.pacing) spec.pacing = *run_options.pacing;
     json started = trial_details(trial);
-    std::optional<std::pair<double, double>> skills;
+    std::optional<WriterSkills> skills;
     if (learning) {
       skills = study_detail::learn_into(spec, memory, manifest.setup.writer_profile, scene, trial.characters);
-      started["shape_skill"] = skills->first;
-      started["order_skill"] = skills->second;
+      started["shape_skill"] = skills->shape;
+      started["order_skill"] = skills->order;
+      started["timing_skill"] = skills->timing;
     }
 
     std::unique_ptr<HapticDevice> device;

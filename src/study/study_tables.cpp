@@ -149,6 +149,7 @@ TrialRow study_detail::trial_row(const json& record, const std::string& source,
   const json& memory = record.value("writer", json::object()).value("memory", json::object());
   row.shape_skill = optional_number(memory, "shape_skill", source, "/writer/memory");
   row.order_skill = optional_number(memory, "order_skill", source, "/writer/memory");
+  row.timing_skill = optional_number(memory, "timing_skill", source, "/writer/memory");
   const json& characters = record.value("per_character", json::array());
   for (std::size_t c = 0; c < characters.size(); ++c) add_strokes(characters[c], c, source, row, strokes);
   return row;
@@ -208,14 +209,15 @@ std::string trials_csv(const StudyTables& tables) {
       "repetition,writer,end_reason,"
       "start_utc,completed_in_order,strokes_total,strokes_written,strokes_accepted,order_errors,"
       "backwards_strokes,unmatched_segments,mean_deviation_m,max_deviation_m,rms_deviation_m,frechet_m,dtw_m,"
-      "total_time_s,pen_down_time_s,velocity_peaks,normalised_jerk,shape_skill,order_skill,trace_file\n";
+      "total_time_s,pen_down_time_s,velocity_peaks,normalised_jerk,shape_skill,order_skill,timing_skill,"
+      "trace_file\n";
   for (const TrialRow& r : tables.trials) {
     line(out, r.subject, r.session, r.protocol, r.session_number, r.group, r.phase, r.block, r.condition,
          r.mode, r.characters, r.trial, r.item, r.repetition, r.writer, r.end_reason, r.start_utc,
          r.completed_in_order, r.strokes_total, r.strokes_written, r.strokes_accepted, r.order_errors,
          r.backwards_strokes, r.unmatched_segments, r.mean_deviation_m, r.max_deviation_m, r.rms_deviation_m,
          r.frechet_m, r.dtw_m, r.total_time_s, r.pen_down_time_s, r.velocity_peaks, r.normalised_jerk,
-         r.shape_skill, r.order_skill, r.trace_file.string());
+         r.shape_skill, r.order_skill, r.timing_skill, r.trace_file.string());
   }
   return out;
 }

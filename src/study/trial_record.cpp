@@ -127,8 +127,9 @@ json writer_json(const TrialRecordContext& c) {
                    {"max_attempts_per_stroke", w.max_attempts_per_stroke}}}};
   if (c.writer_skills) {
     writer["memory"] = {{"model", c.session->setup.writer_learning},
-                        {"shape_skill", c.writer_skills->first},
-                        {"order_skill", c.writer_skills->second}};
+                        {"shape_skill", c.writer_skills->shape},
+                        {"order_skill", c.writer_skills->order},
+                        {"timing_skill", c.writer_skills->timing}};
   }
   return writer;
 }

@@ -10,6 +10,7 @@
 #include "calligraphy/core/device_types.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/sim/simulated_hand.hpp"
+#include "calligraphy/sim/writer_memory.hpp"
 #include "calligraphy/study/quiz.hpp"
 #include "calligraphy/study/session_folder.hpp"
 #include "calligraphy/trial/options.hpp"
@@ -32,8 +33,8 @@ struct TrialRecordContext {
   std::string end_utc;
   double wall_time_s = 0.0;
   nlohmann::json guidance;  ///< the "guidance" object (trial_guidance.hpp); null: none
-  /// A learning simulated writer's skills before the trial (writer_memory.hpp): shape, order; none: nullopt.
-  std::optional<std::pair<double, double>> writer_skills;
+  /// A learning simulated writer's skills before the trial (writer_memory.hpp); none: nullopt.
+  std::optional<WriterSkills> writer_skills;
   std::string csv_file;  ///< file names beside the JSON
   std::string svg_file;
 };

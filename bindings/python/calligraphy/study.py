@@ -28,7 +28,7 @@ _NUMERIC_TRIAL_COLUMNS = (
     "session_number", "block", "trial", "item", "repetition", "strokes_total", "strokes_written", "strokes_accepted",
     "order_errors", "backwards_strokes", "unmatched_segments", "mean_deviation_m", "max_deviation_m",
     "rms_deviation_m", "frechet_m", "dtw_m", "total_time_s", "pen_down_time_s", "velocity_peaks",
-    "normalised_jerk", "shape_skill", "order_skill")
+    "normalised_jerk", "shape_skill", "order_skill", "timing_skill")
 _NUMERIC_STROKE_COLUMNS = (
     "trial", "character", "stroke", "typical_id", "segments", "refused_segments", "mean_deviation_m",
     "max_deviation_m", "rms_deviation_m", "frechet_m", "dtw_m", "time_s", "path_length_m")
@@ -71,8 +71,8 @@ class Study:
         protocol's sessions), group (the subject's between-subjects group, '' when none), phase, block,
         condition, mode, characters, trial, item, repetition (0-based), writer, end_reason, start_utc,
         completed_in_order, stroke counts, order_errors, backwards_strokes, unmatched_segments, mean/max/rms_deviation_m, frechet_m, dtw_m [m],
-        total_time_s, pen_down_time_s [s], velocity_peaks, normalised_jerk, shape_skill and order_skill (a
-        learning simulated writer's skills before the trial, NaN otherwise), trace_file).
+        total_time_s, pen_down_time_s [s], velocity_peaks, normalised_jerk, shape_skill, order_skill and
+        timing_skill (a learning simulated writer's skills before the trial, NaN otherwise), trace_file).
     strokes: one row per reference stroke of each saved trial (subject, session, trial, phase, condition,
         character (0-based in the trial), character_text, stroke (0-based in its character), typical_id,
         written, backwards, segments, refused_segments, refusal, the per-stroke deviations [m], time_s [s],

@@ -1,21 +1,24 @@
 #pragma once
 /// \file writer_memory.hpp
 /// A simulated writer's motor memory across trials and sessions, a model (docs/writer.md, "Memory"): per
-/// typical stroke (paper section 3.1) a skill of shape and direction, per character a skill of its stroke
-/// order, each the sum of a fast and a slow state updated after every trial by the two-state model of
-/// Smith, Ghazizadeh & Shadmehr (2006, PLoS Biol 4(6):e179):
+/// typical stroke (paper section 3.1) a skill of shape and direction and a skill of timing (speed and
+/// pauses), per character a skill of its stroke order, each the sum of a fast and a slow state updated after
+/// every trial by the two-state model of Smith, Ghazizadeh & Shadmehr (2006, PLoS Biol 4(6):e179):
 ///
 ///     x_f <- A_f x_f + B_f e,   x_s <- A_s x_s + B_s e,   x = clamp(x_f + x_s, 0, 1),
 ///
 /// with the error the writer itself experiences e = (1 - x)(1 - h): guidance that does a share h of the
 /// correction removes that share of the error the writer learns from (error-based learning with robotic
 /// assistance, Emken, Benitez, Sideris, Bobrow & Reinkensmeyer 2007, J Neurophysiol 97:3997). h comes from
-/// the physics of the two springs acting on the pen: the fixture's g K against the hand's k, h = g K / (g K +
-/// k). Practice of a character trains the typical strokes it holds, so a character not practised starts from
-/// what its typical strokes learned elsewhere (transfer). Between sessions (hours or days) the fast state is
-/// gone and the slow one kept: long-term retention follows the slow state (Joiner & Smith 2008, J
-/// Neurophysiol 100:2948). The skill moves a profile from the writer's own towards the skilled writer's.
-/// Deterministic: the same trials give the same memory, so a resumed session rebuilds it from its records.
+/// the physics of the two springs acting on the pen, g K / (g K + k) for the fixture's g K against the hand's
+/// k, and it is counted apart across the stroke (shape, order, direction) and along it (timing): a fixture
+/// pulls towards the nearest point and so takes no timing, a moving target pulls along and takes no shape
+/// (study/guidance_share.hpp). Practice of a character trains the typical strokes it holds, so a character
+/// not practised starts from what its typical strokes learned elsewhere (transfer). Between sessions (hours
+/// or days) the fast state is gone and the slow one kept: long-term retention follows the slow state (Joiner
+/// & Smith 2008, J Neurophysiol 100:2948). The skills move a profile from the writer's own towards the
+/// skilled writer's. Deterministic: the same trials give the same memory, so a resumed session rebuilds it
+/// from its records.
 #include <cstdint>
 #include <map>
 #include <string>
@@ -46,7 +49,24 @@ struct SkillMemory {
 /// A writer's memory: skills by typical stroke ID (1-39) and by character.
 struct WriterMemory {
   std::map<int, SkillMemory> typical_strokes;  ///< shape and direction of each typical stroke written
+  std::map<int, SkillMemory> stroke_timing;    ///< timing (speed, pauses) of each typical stroke written
   std::map<char32_t, SkillMemory> characters;  ///< stroke order of each character written
+};
+
+/// The shares h of a trial's correction its guidance took (study/guidance_share.hpp): across the stroke,
+/// which the shape and order skills learn with, and along it, which the timing skill learns with. Each in
+/// [kMinAssistanceShare, 1]: negative for an error a repulsive field enlarged.
+struct AssistanceShares {
+  double shape = 0.0;
+  double timing = 0.0;
+};
+
+/// A writer's skills for one trial, each in [0, 1]: the mean over its strokes' typical strokes (shape,
+/// timing) and over its characters (order).
+struct WriterSkills {
+  double shape = 0.0;
+  double order = 0.0;
+  double timing = 0.0;
 };
 
 /// The share of the correction a guiding spring of stiffness `gain` x `guidance_stiffness_n_per_m` takes
@@ -61,27 +81,34 @@ inline constexpr double kMinAssistanceShare = -9.0;
 
 /// One trial of practice: every memory decays by its retention (A_f, A_s); then each typical stroke of
 /// `typical_ids` (one per stroke of the trial's characters; a stroke type written twice learns twice) and
-/// each character of `characters` learns from the error e = (1 - x)(1 - `assistance_share`): a share in (0,
-/// 1] is the correction guidance took, a negative share an error a repulsive field enlarged by the factor 1 -
-/// share (error augmentation: Emken & Reinkensmeyer 2005, IEEE TNSRE 13:33). Throws InvalidArgument for a
-/// share outside [kMinAssistanceShare, 1] or bad rates.
+/// each character of `characters` learns from the error e = (1 - x)(1 - h), h the shape share for shape and
+/// order and the timing share for timing: a share in (0, 1] is the correction guidance took, a negative
+/// share an error a repulsive field enlarged by the factor 1 - share (error augmentation: Emken &
+/// Reinkensmeyer 2005, IEEE TNSRE 13:33). Throws InvalidArgument for a share outside [kMinAssistanceShare, 1]
+/// or bad rates.
 void practise(WriterMemory& memory, const std::vector<int>& typical_ids, const std::u32string& characters,
-              double assistance_share, const TwoStateRates& rates = {});
+              const AssistanceShares& shares, const TwoStateRates& rates = {});
 
 /// The passing of hours or days between sessions: every fast state is set to 0, slow states are kept.
 void consolidate(WriterMemory& memory);
 
 /// The shape skill of a trial: the mean skill of its typical strokes (0 for a stroke type never written).
 [[nodiscard]] double shape_skill(const WriterMemory& memory, const std::vector<int>& typical_ids);
+/// The timing skill of a trial: the mean timing skill of its typical strokes (0 for one never written).
+[[nodiscard]] double timing_skill(const WriterMemory& memory, const std::vector<int>& typical_ids);
 /// The order skill of a trial: the mean skill of its characters.
 [[nodiscard]] double order_skill(const WriterMemory& memory, const std::u32string& characters);
+/// All three for a trial of `characters` with strokes `typical_ids`.
+[[nodiscard]] WriterSkills writer_skills(const WriterMemory& memory, const std::vector<int>& typical_ids,
+                                         const std::u32string& characters);
 
-/// The profile a writer starting from `own` writes with at shape skill `shape` and order skill `order` (both
-/// in [0, 1]): bias (offset, scale error, jitter), corner cutting, fluency errors (lifts, touches outside,
-/// hesitations) and speed move linearly from `own`'s to `skilled`'s by `shape`; order and backwards error
-/// rates by `order`. Throws InvalidArgument for a skill outside [0, 1] and what `validate` throws.
+/// The profile a writer starting from `own` writes with at `skills`, each field moving linearly from `own`'s
+/// to `skilled`'s: by the shape skill its bias (offset, scale error, jitter), corner cutting and spatial
+/// errors (lifts in a stroke, touches outside); by the timing skill its writing speed and hesitations; by the
+/// order skill its order and backwards error rates. Throws InvalidArgument for a skill outside [0, 1] and
+/// what `validate` throws.
 [[nodiscard]] WriterProfile learned_profile(const WriterProfile& own, const WriterProfile& skilled,
-                                            double shape, double order);
+                                            const WriterSkills& skills);
 
 /// The numeric fields `learned_profile` changes, by name (`set_writer_parameter` keys), in order.
 [[nodiscard]] const std::vector<std::string>& learned_profile_fields();

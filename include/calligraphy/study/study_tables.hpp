@@ -52,6 +52,7 @@ struct TrialRow {
   /// otherwise.
   std::optional<double> shape_skill;
   std::optional<double> order_skill;
+  std::optional<double> timing_skill;
   std::filesystem::path trace_file;  ///< the trial's CSV trace (t,x,y,z,fx,fy,fz,state,stroke,element)
 };
 
