@@ -47,11 +47,14 @@ constexpr double kStrayLength_m = 0.004;    // and slides this far along it
 
 double uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1p-53; }
 
-double gaussian(std::mt19937_64& rng) {
-  // Box-Muller on our own uniform draws, so results do not depend on the standard library's distributions.
+// Two independent standard normal draws: Box-Muller on our own uniform draws, so results do not depend on
+// the standard library's distributions.
+Vec2 gaussian_pair(std::mt19937_64& rng) {
   const double u1 = (static_cast<double>(rng() >> 11) + 0.5) * 0x1p-53;
   const double u2 = uniform(rng);
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
+  const double radius = std::sqrt(-2.0 * std::log(u1));
+  const double angle = 2.0 * std::numbers::pi * u2;
+  return radius * Vec2(std::cos(angle), std::sin(angle));
 }
 
 // SplitMix64 (Steele, Lea & Flood 2014): independent seeds for the plan and the hand's noise.
@@ -146,8 +149,8 @@ struct SimulatedWriter::State {
 
   Vec3 noise_n = Vec3::Zero();
   double noise_time_s = -1.0;
-  double tremor_phase_x = 0.0;
-  double tremor_phase_y = 0.0;
+  Vec2 tremor_cos = Vec2::Ones();  // the cosines and sines of the tremor's phases on x and y
+  Vec2 tremor_sin = Vec2::Zero();
   Vec3 tremor_n = Vec3::Zero();
 
   State(const Scene& s, const WriterProfile& p, std::uint64_t seed);
@@ -157,6 +160,7 @@ struct SimulatedWriter::State {
   void issue_command(double time_s);
   void advance(double dt, double time_s);
   void store_seen(const RenderOutput& output, const DeviceState& pen);
+  [[nodiscard]] const VisionSample& stored(std::size_t k) const;  // the k-th newest, k in [1, ring_count]
   [[nodiscard]] const VisionSample* seen_at(double time_s) const;
   void look(double time_s);
   void feel(const RenderOutput& output, double dt, double time_s);
@@ -201,8 +205,10 @@ SimulatedWriter::State::State(const Scene& s, const WriterProfile& p, std::uint6
     scene_stroke += n;
   }
   written.assign(scene_stroke, false);
-  tremor_phase_x = 2.0 * std::numbers::pi * uniform(noise_rng);
-  tremor_phase_y = 2.0 * std::numbers::pi * uniform(noise_rng);
+  const double tremor_phase_x = 2.0 * std::numbers::pi * uniform(noise_rng);
+  const double tremor_phase_y = 2.0 * std::numbers::pi * uniform(noise_rng);
+  tremor_cos = Vec2(std::cos(tremor_phase_x), std::cos(tremor_phase_y));
+  tremor_sin = Vec2(std::sin(tremor_phase_x), std::sin(tremor_phase_y));
   ring.resize(static_cast<std::size_t>(std::ceil(profile.visual_delay_s / kVisionSample_s)) + 16);
 }
 
@@ -281,24 +287,36 @@ void SimulatedWriter::State::store_seen(const RenderOutput& output, const Device
   ring_count = std::min(ring_count + 1, ring.size());
 }
 
+const SimulatedWriter::State::VisionSample& SimulatedWriter::State::stored(std::size_t k) const {
+  return ring[ring_next >= k ? ring_next - k : ring_next + ring.size() - k];
+}
+
 const SimulatedWriter::State::VisionSample* SimulatedWriter::State::seen_at(double time_s) const {
-  const VisionSample* oldest = nullptr;
-  for (std::size_t k = 1; k <= ring_count; ++k) {
-    const VisionSample& v = ring[(ring_next + ring.size() - k) % ring.size()];
-    if (v.time_s <= time_s + 1e-12) return &v;
-    oldest = &v;
+  if (ring_count == 0) return nullptr;
+  // The newest sample at or before time_s: the samples' times fall with k, so bisect for the least such k.
+  std::size_t low = 1;
+  std::size_t high = ring_count;
+  if (!(stored(high).time_s <= time_s + 1e-12)) return &stored(high);  // nothing that old yet: the earliest
+  while (low < high) {
+    const std::size_t k = low + (high - low) / 2;
+    if (stored(k).time_s <= time_s + 1e-12) {
+      high = k;
+    } else {
+      low = k + 1;
+    }
   }
-  return oldest;  // nothing that old yet: the earliest the writer has
+  return &stored(low);
 }
 
 // Vision, every vision_period_s: the pen and the display as they were visual_delay_s ago.
 void SimulatedWriter::State::look(double time_s) {
   const VisionSample* seen = seen_at(time_s - profile.visual_delay_s);
   if (seen == nullptr) return;
-  // A stroke cleared after a lift in the middle of it: write it again.
-  for (std::size_t k = ring_count; k >= 1; --k) {
-    const VisionSample& v = ring[(ring_next + ring.size() - k) % ring.size()];
-    if (v.sequence <= processed_sequence || v.sequence > seen->sequence) continue;
+  // A stroke cleared after a lift in the middle of it: write it again. The samples seen since the last look,
+  // oldest first; the k-th newest has sequence number `sequence` + 1 - k.
+  const std::size_t newest_unseen = std::min<std::uint64_t>(ring_count, sequence - processed_sequence);
+  for (std::size_t k = newest_unseen; k >= 1 && sequence + 1 - k <= seen->sequence; --k) {
+    const VisionSample& v = stored(k);
     if (v.abandoned && !attempt.ended && attempt.mid_lift_reached) {
       break_off(time_s, AttemptEnd::interrupted, Next::redo);
     }
@@ -518,7 +536,7 @@ void SimulatedWriter::State::start_attempt(const PlannedStroke& target, bool fol
   const bool lift = uniform(plan_rng) < care * profile.mid_stroke_lift_probability;
   const double lift_where = uniform(plan_rng);
   const double lift_fraction = 0.3 + 0.4 * uniform(plan_rng);
-  const Vec2 jitter = care * profile.stroke_jitter_m * Vec2(gaussian(plan_rng), gaussian(plan_rng));
+  const Vec2 jitter = care * profile.stroke_jitter_m * gaussian_pair(plan_rng);
 
   WriterAttempt entry;
   entry.character = target.character;
@@ -735,11 +753,12 @@ Vec3 SimulatedWriter::hand_force(double time_s, const Vec3& position_m, const Ve
   // tenth of a simulated trial.
   if (time_s - s.noise_time_s >= kNoiseUpdate_s) {
     s.noise_time_s = time_s;
-    const double sigma = p.noise_fraction * force.norm();
-    s.noise_n = Vec3(sigma * gaussian(s.noise_rng), sigma * gaussian(s.noise_rng), 0.0);
+    const Vec2 noise = p.noise_fraction * force.norm() * gaussian_pair(s.noise_rng);
+    s.noise_n = Vec3(noise.x(), noise.y(), 0.0);
+    // sin(w + phase) = sin w cos phase + cos w sin phase: one sine and cosine of w serve both axes.
     const double w = 2.0 * std::numbers::pi * p.tremor_frequency_hz * time_s;
-    s.tremor_n =
-        p.tremor_amplitude_n * Vec3(std::sin(w + s.tremor_phase_x), std::sin(w + s.tremor_phase_y), 0.0);
+    const Vec2 tremor = std::sin(w) * s.tremor_cos + std::cos(w) * s.tremor_sin;
+    s.tremor_n = p.tremor_amplitude_n * Vec3(tremor.x(), tremor.y(), 0.0);
   }
   return force + s.noise_n + s.tremor_n;
 }
