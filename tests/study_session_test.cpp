@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
@@ -724,4 +725,33 @@ TEST_CASE("a learning simulated subject writes with what it learned, the same af
   for (std::size_t i = 1; i < 5; ++i) CHECK(straight[i] < straight[i - 1]);  // practice lowers the bias
   CHECK(straight[5] > straight[4]);  // a day later the fast state is gone...
   CHECK(straight[5] < own);          // ...and the slow one kept
+}
+
+TEST_CASE("a learning subject's guidance takes shape and timing apart: the fixture shape, a replay both",
+          "[study][session][memory]") {
+  // The same subject trained three times on 十 under each condition; the skills its last trial started with.
+  const auto skills_after = [](const std::string& mode) {
+    TempFolder temp;
+    const LoadedProtocol protocol =
+        protocol_from_text(R"({"name": "apart", "conditions": [{"name": "c", "mode": ")" + mode + R"("}],
+            "phases": [{"phase": "training", "condition": "c", "characters": ["十"], "repetitions": 3}],
+            "trial": {"max_duration_s": 40}})",
+                           "apart.json");
+    SessionSetup setup = simulated("A1");
+    setup.writer_learning = "two-state";
+    SessionFolder session = SessionFolder::create(temp.path, setup, protocol);
+    REQUIRE(run_session(session).complete());
+    const TrialRow last = read_study_tables({temp.path}).trials.back();
+    REQUIRE(last.shape_skill);
+    REQUIRE(last.timing_skill);
+    return std::pair{*last.shape_skill, *last.timing_skill};
+  };
+  const auto [alone_shape, alone_timing] = skills_after("vision");
+  const auto [fixture_shape, fixture_timing] = skills_after("haptic");
+  const auto [replay_shape, replay_timing] = skills_after("replay");
+  CHECK(alone_shape == Approx(alone_timing));
+  CHECK(fixture_shape < alone_shape);
+  CHECK(fixture_timing == Approx(alone_timing));  // the fixture pulls to the nearest point: no timing
+  CHECK(replay_shape < alone_shape);
+  CHECK(replay_timing < alone_timing);  // the teacher's point at the teacher's time paces the writer
 }
