@@ -68,6 +68,23 @@ def box_lines(folder, process, who, timeout=30):
     raise AssertionError("no box line within %s s" % timeout)
 
 
+def program_window(pid, tool=None, timeout=10):
+    """The window of the program with process id `pid`: searched by its pid as well as its title, so that the
+    window of a program that has just ended (still listed for a moment by the X server) is never taken."""
+    tool = tool or xdotool
+    deadline = time.time() + timeout
+    while True:
+        try:
+            found = tool("search", "--all", "--pid", pid, "--name", "calligraphy train").split()
+        except subprocess.CalledProcessError:  # xdotool search exits 1 when nothing matches
+            found = []
+        if found:
+            return found[-1]
+        if time.time() > deadline:
+            raise AssertionError(f"no window of process {pid} within {timeout} s")
+        time.sleep(0.1)
+
+
 class Trainer:
     """`calligraphy train` running in the background."""
 
@@ -82,7 +99,7 @@ class Trainer:
         return box_lines(self.folder, self.process, "the trainer", timeout)
 
     def window(self):
-        return xdotool("search", "--name", "calligraphy train").split()[0]
+        return program_window(self.process.pid)
 
     def wait(self, timeout=120):
         return self.process.wait(timeout=timeout)
@@ -606,7 +623,7 @@ class SessionWindowTest(unittest.TestCase):
     def test_a_person_writes_the_session_in_the_window_and_every_trial_is_saved(self):
         self.run_session("--exit-after", "90", "--screenshot", "shot.png")
         box = self.first_box()
-        window = xdotool("search", "--name", "calligraphy train").split()[0]
+        window = program_window(self.process.pid)
         median = medians("一", SAMPLE)[0]
         path = [box.data_to_px(p) for p in along(median, [i / 16 for i in range(17)])]
         path.append(box.data_to_px((median[-1][0] + 30, median[-1][1])))
@@ -641,7 +658,7 @@ class SessionWindowTest(unittest.TestCase):
     def test_sigint_ends_the_session_keeping_the_running_trial_as_an_attempt(self):
         self.run_session()  # attended: the first trial waits for Space
         self.first_box()
-        window = xdotool("search", "--name", "calligraphy train").split()[0]
+        window = program_window(self.process.pid)
         time.sleep(0.5)
         xdotool("windowfocus", "--sync", window)
         xdotool("key", "--window", window, "space")
@@ -736,7 +753,7 @@ class EndingTest(unittest.TestCase):
 
     def move_pointer(self, box, tool):
         """The pointer moved a little over the character's box while the trial runs."""
-        window = tool("search", "--name", "calligraphy train").split()[0]
+        window = program_window(self.process.pid, tool)
         for k in range(6):
             x, y = box.data_to_px((300 + 40 * k, 500))
             tool("mousemove", "--window", window, round(x), round(y))
