@@ -42,7 +42,7 @@ struct Segment {
   /// Unit in-plane direction of the path at arc length `s` (zero for a point).
   [[nodiscard]] Vec2 direction_at_arc(double s) const;
   /// Point at phase `phase` in [0, 1] of the minimum-jerk profile.
-  [[nodiscard]] Vec3 at_phase(double phase) const { return at_arc(length_m() * minimum_jerk(phase)); }
+  [[nodiscard]] Vec3 at_phase(double phase) const { return motion_at_phase(phase, 0.0).position_m; }
   /// Point [m] and velocity [m/s] at phase `phase` in [0, 1] while the phase advances at `rate_per_s`
   /// [1/s]: at_phase(phase), and its time derivative rate L mj'(phase) along the path's unit tangent.
   [[nodiscard]] Motion motion_at_phase(double phase, double rate_per_s) const;
