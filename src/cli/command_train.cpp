@@ -40,6 +40,8 @@ struct TrainCommand {
   std::string window = "1280x800";
   std::string screenshot;
   double exit_after_s = 0.0;
+  std::int64_t watchdog_ms = 0;
+  const CLI::Option* watchdog_option = nullptr;  // given on the command line when its count() > 0
   bool quiz = false;
   std::int64_t hint_after = 3;
   std::string quiz_screenshots;
@@ -143,6 +145,8 @@ int run_train(const TrainCommand& command) {
   std::tie(options.width_px, options.height_px) = window_size(command.window);
   options.screenshot = command.screenshot;
   options.exit_after_s = command.exit_after_s;
+  if (command.watchdog_option->count() > 0)
+    options.watchdog_s = static_cast<double>(command.watchdog_ms) / 1000.0;
   options.library_version = CALLIGRAPHY_VERSION;
   const CharacterSource source(command.library);
   const CharacterLibrary outlines = library_from(command.library);
@@ -223,6 +227,11 @@ void add_train_command(CLI::App& root, Commands& commands) {
   add_number(*app, "--exit-after", command->exit_after_s, "SECONDS",
              "unattended: quit after this long [s], or once every character had its trial",
              "a number of seconds > 0", [](double s) { return s > 0.0 && s <= 86400.0; });
+  command->watchdog_option = add_integer(
+      *app, "--watchdog-ms", command->watchdog_ms, "MS",
+      "end the trial when the device holds one force longer than this [ms]; 0: off (default: 50 on a haptic "
+      "device, off on mouse, mouse-hand and simulated, which hold no force against a hand)",
+      0, 60000);
 }
 
 }  // namespace calligraphy::cli

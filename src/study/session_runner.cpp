@@ -249,6 +249,8 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
       guidance = study_detail::replay_guidance(session, condition, trial, scene);
     TrialSpec spec = study_trial_spec(manifest, condition, trial, guidance.guidance);
     if (run_options.pacing) spec.pacing = *run_options.pacing;
+    if (!simulated_writer && spec.pacing != TrialPacing::lock_step)  // a person, in real time
+      spec.watchdog_s = default_watchdog_s(listing.hardware);
     json started = trial_details(trial);
     std::optional<WriterSkills> skills;
     if (learning) {

@@ -129,6 +129,10 @@ Enum parse_choice(std::string_view key, std::string_view text, const std::array<
 
 }  // namespace
 
+double default_watchdog_s(bool hardware_device) noexcept {
+  return hardware_device ? TrialSpec{}.watchdog_s : 0.0;
+}
+
 const char* to_string(TrialWriter writer) noexcept {
   switch (writer) {
     case TrialWriter::person:

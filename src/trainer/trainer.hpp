@@ -3,6 +3,7 @@
 // servo loop on its own thread. See docs/trainer.md.
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,11 @@ struct TrainerOptions {
   int height_px = 800;
   std::string screenshot;     ///< PNG written after the last character's trial, or at exit
   double exit_after_s = 0.0;  ///< > 0: unattended; quit after this long or once every character had its trial
+  /// The servo loop's stall bound [s] in [0, 60] (ServoLoopOptions::stall_timeout_s; 0: off). Unset: 50 ms on
+  /// a haptic device, off on the mouse, mouse-hand and simulated devices, whose stalls hold no force against
+  /// a hand (a busy desktop stalls a loop without real-time rights for tens of ms, which would end the
+  /// trial).
+  std::optional<double> watchdog_s;
   std::string library_version;
 };
 

@@ -51,6 +51,7 @@ void TrainerApp::start_trial(std::size_t character) {
   if (options_.simulated_writer) spec.writer_profile = options_.writer_profile;
   spec.seed = options_.seed + trials_started_ - 1;
   spec.pacing = TrialPacing::real_time;
+  spec.watchdog_s = options_.watchdog_s.value_or(default_watchdog_s(hardware_));
   TrialRunInputs inputs;
   inputs.teacher = options_.teacher;
   DisplayChannel* const channel = channel_.get();

@@ -106,6 +106,8 @@ class HelpAndVersion(CliTestCase):
         self.assert_usage_error(["train", "永", "--writer", "simulated", "--device", "mouse"], "--writer")
         self.assert_usage_error(["train", "永", "--device", "simulated"], "--device")
         self.assert_usage_error(["train", "永", "--exit-after", "0"], "--exit-after")
+        self.assert_usage_error(["train", "永", "--watchdog-ms", "60001"], "--watchdog-ms")
+        self.assert_usage_error(["train", "永", "--watchdog-ms", "-1"], "--watchdog-ms")
         self.assert_usage_error(["train", "永", "--screenshot", "-"], "--screenshot")
 
     def test_trial_help_is_help_not_a_character(self):

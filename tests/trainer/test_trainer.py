@@ -224,7 +224,7 @@ class TrainerTest(unittest.TestCase):
 
     def test_simulated_writer_writes_yong_and_the_screenshot_shows_it(self):
         trainer = self.start("永", "--writer", "simulated", "--session", "out", "--screenshot", "out/yong.png",
-                             "--exit-after", "60")
+                             "--exit-after", "60", "--watchdog-ms", "2000")
         (box,) = trainer.boxes()
         self.assertEqual(trainer.wait(), 0, trainer.errors())
         (record_path,) = saved_trials(pathlib.Path(self.folder) / "out")
@@ -236,6 +236,7 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual(record["subject"], "anonymous")
         self.assertEqual(record["condition"], "haptic")
         self.assertEqual(record["device"]["name"], "simulated")
+        self.assertEqual(record["renderer"]["loop"]["stall_timeout_s"], 2.0)  # --watchdog-ms, in s
         for key in ("start_time_utc", "library", "mean_deviation_mm", "per_stroke", "loop", "per_character"):
             self.assertIn(key, record)
         with open(record_path.with_suffix(".csv"), newline="") as f:
@@ -438,6 +439,8 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual([r["characters"] for r in records], list(characters))
         for record in records:
             self.assertEqual(record["device"]["name"], device)
+            # A pointer device holds no force against a hand: no stall bound ends its trial on a busy desktop.
+            self.assertEqual(record["renderer"]["loop"]["stall_timeout_s"], 0.0)
             self.assertEqual(record["end_reason"], "completed", record["characters"])
             self.assertEqual(record["strokes_completed"], record["strokes_total"], record["characters"])
             self.assertEqual([s["attempts"] for s in record["per_stroke"]], [1] * record["strokes_total"],
@@ -649,6 +652,7 @@ class SessionWindowTest(unittest.TestCase):
         for record in (first, second):
             self.assertEqual(record["device"]["name"], "mouse-hand")
             self.assertEqual(record["writer"]["kind"], "human")
+            self.assertEqual(record["renderer"]["loop"]["stall_timeout_s"], 0.0)  # no motors: no stall bound
         log = [json.loads(l) for l in (self.session_folder() / "log.jsonl").read_text().splitlines()]
         self.assertIn("session_completed", [e["event"] for e in log])
         image = read_png(self.folder / "shot.png")

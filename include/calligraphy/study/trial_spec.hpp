@@ -70,6 +70,12 @@ struct TrialSpec {
   bool operator==(const TrialSpec&) const = default;
 };
 
+/// The stall bound [s] a front-end sets when its user gives none: `TrialSpec::watchdog_s` (50 ms, the
+/// Phantom's own command watchdog) on a haptic device; 0 (off) on a device with no motors (simulated, mouse,
+/// mouse-hand), which holds no force against a hand, so that a stall of a loop without real-time rights (tens
+/// of ms on a busy desktop) does not end a person's trial.
+[[nodiscard]] double default_watchdog_s(bool hardware_device) noexcept;
+
 /// One field of the specification in both forms: its JSON key and its option on the command line.
 struct TrialSpecField {
   std::string_view key;         ///< JSON key, e.g. "guidance_mode"
