@@ -90,11 +90,18 @@ def main() -> int:
     many = timed(f"threads: {arguments.workers}", lambda: simulate(workers=arguments.workers))
     pandas.testing.assert_frame_equal(one.trials, many.trials)
     if not arguments.no_dask:
+        import dask.config
         import distributed
 
+        from calligraphy.experiments import DASK_WORKER_ENVIRONMENT
+
+        # glibc's own malloc thresholds in the workers, not the nanny's (calligraphy.experiments).
+        environment = {f"distributed.nanny.pre-spawn-environ.{key}": value
+                       for key, value in DASK_WORKER_ENVIRONMENT.items()}
         for workers in sorted({1, arguments.workers}):
-            with distributed.LocalCluster(n_workers=workers, processes=True, threads_per_worker=1,
-                                          dashboard_address=None, silence_logs=50) as cluster, \
+            with dask.config.set(environment), \
+                    distributed.LocalCluster(n_workers=workers, processes=True, threads_per_worker=1,
+                                             dashboard_address=None, silence_logs=50) as cluster, \
                     distributed.Client(cluster) as client:
                 on_dask = timed(f"Dask LocalCluster: {workers} worker(s)", lambda: simulate(client=client))
             pandas.testing.assert_frame_equal(on_dask.trials, one.trials)

@@ -19,7 +19,7 @@ import sys
 import time
 
 import calligraphy
-from calligraphy.experiments import sweep
+from calligraphy.experiments import DASK_WORKER_ENVIRONMENT, sweep
 
 
 def one_trial(keep_trace):
@@ -69,19 +69,24 @@ def main(argv):
     _, local = timed_sweep(f"local, {args.workers} workers", characters, args.seeds, reference,
                            workers=args.workers)
     try:
+        import dask.config
         import distributed
     except ImportError:
         print("distributed is not installed: no Dask run")
-        dask = None
+        on_dask = None
     else:
         start = time.perf_counter()
-        with distributed.LocalCluster(n_workers=args.workers, processes=True, threads_per_worker=1,
-                                      dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        # glibc's own malloc thresholds in the workers, not the nanny's (calligraphy.experiments).
+        environment = {f"distributed.nanny.pre-spawn-environ.{key}": value
+                       for key, value in DASK_WORKER_ENVIRONMENT.items()}
+        with dask.config.set(environment), \
+                distributed.LocalCluster(n_workers=args.workers, processes=True, threads_per_worker=1,
+                                         dashboard_address=None) as cluster, distributed.Client(cluster) as client:
             print(f"(Dask LocalCluster of {args.workers} workers started in {time.perf_counter() - start:.1f} s)")
-            _, dask = timed_sweep(f"Dask LocalCluster, {args.workers} workers", characters, args.seeds,
-                                  reference, client=client)
+            _, on_dask = timed_sweep(f"Dask LocalCluster, {args.workers} workers", characters, args.seeds,
+                                     reference, client=client)
     print(f"scaling 1 -> {args.workers} local workers: x{local / single:.2f}"
-          + (f"; Dask: x{dask / single:.2f}" if dask else ""))
+          + (f"; Dask: x{on_dask / single:.2f}" if on_dask else ""))
     return 0
 
 

@@ -2,11 +2,12 @@
 cluster, failed trials as rows, grid names and values checked before anything runs."""
 
 import concurrent.futures
+import os
 
 import pytest
 
 import calligraphy
-from calligraphy.experiments import parameter_names, sweep
+from calligraphy.experiments import DASK_WORKER_ENVIRONMENT, parameter_names, sweep
 
 pandas = pytest.importorskip("pandas")
 
@@ -25,9 +26,18 @@ def local_table():
 @pytest.fixture(scope="module")
 def dask_table():
     distributed = pytest.importorskip("distributed")
-    with distributed.LocalCluster(n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None,
-                                  silence_logs=50) as cluster, distributed.Client(cluster) as client:
+    import dask.config
+
+    # The workers get glibc's malloc thresholds instead of the nanny's trim threshold; the workers' own
+    # environment shows that the configuration key still reaches them.
+    environment = {f"distributed.nanny.pre-spawn-environ.{key}": value
+                   for key, value in DASK_WORKER_ENVIRONMENT.items()}
+    with dask.config.set(environment), \
+            distributed.LocalCluster(n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None,
+                                     silence_logs=50) as cluster, distributed.Client(cluster) as client:
         assert len(client.nthreads()) == 2
+        seen = client.run(lambda: {key: os.environ.get(key) for key in DASK_WORKER_ENVIRONMENT})
+        assert list(seen.values()) == [{key: str(value) for key, value in DASK_WORKER_ENVIRONMENT.items()}] * 2
         return sweep(CHARACTERS, GRID, SEEDS, client=client, progress=False)
 
 

@@ -32,7 +32,18 @@ from ._calligraphy import CharacterLibrary, ForceLawParameters, WriterProfile, s
 if typing.TYPE_CHECKING:  # pragma: no cover
     import pandas
 
-__all__ = ["parameter_names", "sweep"]
+__all__ = ["DASK_WORKER_ENVIRONMENT", "parameter_names", "sweep"]
+
+# glibc's malloc settings for Dask workers that run trials. distributed's nanny starts every worker with
+# MALLOC_TRIM_THRESHOLD_=65536 (its config key distributed.nanny.pre-spawn-environ), and setting any of these
+# variables turns glibc's adaptive thresholds off (mallopt(3), M_MMAP_THRESHOLD): every vector of a trial
+# above 128 KiB (its trace, the matcher's copies) is then a fresh mapping that page-faults in again, and a
+# worker runs trials about 1.7 times slower than a local pool. These are the values glibc's adaptation
+# reaches on 64-bit Linux (an mmap threshold of at most 32 MiB, trim at twice that): give them before the
+# cluster starts, e.g.
+#     dask.config.set({f"distributed.nanny.pre-spawn-environ.{k}": v for k, v in DASK_WORKER_ENVIRONMENT.items()})
+# or in the cluster's own Dask configuration.
+DASK_WORKER_ENVIRONMENT = {"MALLOC_MMAP_THRESHOLD_": 32 << 20, "MALLOC_TRIM_THRESHOLD_": 64 << 20}
 
 # Arguments of simulate_trial that a grid may set directly. `writer` is a profile name ('novice',
 # 'skilled') or a WriterProfile; WriterProfile fields swept at the same time change that profile.
