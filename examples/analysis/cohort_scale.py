@@ -93,13 +93,11 @@ def main() -> int:
         import dask.config
         import distributed
 
-        from calligraphy.experiments import DASK_WORKER_ENVIRONMENT
+        from calligraphy.experiments import dask_worker_config
 
         # glibc's own malloc thresholds in the workers, not the nanny's (calligraphy.experiments).
-        environment = {f"distributed.nanny.pre-spawn-environ.{key}": value
-                       for key, value in DASK_WORKER_ENVIRONMENT.items()}
         for workers in sorted({1, arguments.workers}):
-            with dask.config.set(environment), \
+            with dask.config.set(dask_worker_config()), \
                     distributed.LocalCluster(n_workers=workers, processes=True, threads_per_worker=1,
                                              dashboard_address=None, silence_logs=50) as cluster, \
                     distributed.Client(cluster) as client:

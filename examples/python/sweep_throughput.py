@@ -19,7 +19,7 @@ import sys
 import time
 
 import calligraphy
-from calligraphy.experiments import DASK_WORKER_ENVIRONMENT, sweep
+from calligraphy.experiments import dask_worker_config, sweep
 
 
 def one_trial(keep_trace):
@@ -77,9 +77,7 @@ def main(argv):
     else:
         start = time.perf_counter()
         # glibc's own malloc thresholds in the workers, not the nanny's (calligraphy.experiments).
-        environment = {f"distributed.nanny.pre-spawn-environ.{key}": value
-                       for key, value in DASK_WORKER_ENVIRONMENT.items()}
-        with dask.config.set(environment), \
+        with dask.config.set(dask_worker_config()), \
                 distributed.LocalCluster(n_workers=args.workers, processes=True, threads_per_worker=1,
                                          dashboard_address=None) as cluster, distributed.Client(cluster) as client:
             print(f"(Dask LocalCluster of {args.workers} workers started in {time.perf_counter() - start:.1f} s)")

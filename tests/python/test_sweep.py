@@ -7,7 +7,7 @@ import os
 import pytest
 
 import calligraphy
-from calligraphy.experiments import DASK_WORKER_ENVIRONMENT, parameter_names, sweep
+from calligraphy.experiments import DASK_WORKER_ENVIRONMENT, dask_worker_config, parameter_names, sweep
 
 pandas = pytest.importorskip("pandas")
 
@@ -30,9 +30,7 @@ def dask_table():
 
     # The workers get glibc's malloc thresholds instead of the nanny's trim threshold; the workers' own
     # environment shows that the configuration key still reaches them.
-    environment = {f"distributed.nanny.pre-spawn-environ.{key}": value
-                   for key, value in DASK_WORKER_ENVIRONMENT.items()}
-    with dask.config.set(environment), \
+    with dask.config.set(dask_worker_config()), \
             distributed.LocalCluster(n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None,
                                      silence_logs=50) as cluster, distributed.Client(cluster) as client:
         assert len(client.nthreads()) == 2

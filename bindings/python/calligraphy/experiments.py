@@ -32,7 +32,7 @@ from ._calligraphy import CharacterLibrary, ForceLawParameters, WriterProfile, s
 if typing.TYPE_CHECKING:  # pragma: no cover
     import pandas
 
-__all__ = ["DASK_WORKER_ENVIRONMENT", "parameter_names", "sweep"]
+__all__ = ["DASK_WORKER_ENVIRONMENT", "dask_worker_config", "parameter_names", "sweep"]
 
 # glibc's malloc settings for Dask workers that run trials. distributed's nanny starts every worker with
 # MALLOC_TRIM_THRESHOLD_=65536 (its config key distributed.nanny.pre-spawn-environ), and setting any of these
@@ -40,10 +40,14 @@ __all__ = ["DASK_WORKER_ENVIRONMENT", "parameter_names", "sweep"]
 # above 128 KiB (its trace, the matcher's copies) is then a fresh mapping that page-faults in again, and a
 # worker runs trials about 1.7 times slower than a local pool. These are the values glibc's adaptation
 # reaches on 64-bit Linux (an mmap threshold of at most 32 MiB, trim at twice that): give them before the
-# cluster starts, e.g.
-#     dask.config.set({f"distributed.nanny.pre-spawn-environ.{k}": v for k, v in DASK_WORKER_ENVIRONMENT.items()})
-# or in the cluster's own Dask configuration.
+# cluster starts: ``with dask.config.set(dask_worker_config()):``, or in the cluster's own Dask configuration.
 DASK_WORKER_ENVIRONMENT = {"MALLOC_MMAP_THRESHOLD_": 32 << 20, "MALLOC_TRIM_THRESHOLD_": 64 << 20}
+
+
+def dask_worker_config() -> dict[str, int]:
+    """``DASK_WORKER_ENVIRONMENT`` as Dask configuration keys (``distributed.nanny.pre-spawn-environ.<name>``:
+    bytes), for ``dask.config.set`` before a cluster's workers start. Needs no Dask import; raises nothing."""
+    return {f"distributed.nanny.pre-spawn-environ.{name}": value for name, value in DASK_WORKER_ENVIRONMENT.items()}
 
 # Arguments of simulate_trial that a grid may set directly. `writer` is a profile name ('novice',
 # 'skilled') or a WriterProfile; WriterProfile fields swept at the same time change that profile.
