@@ -4,14 +4,17 @@
 #include <spdlog/spdlog.h>
 #include <time.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <exception>
 #include <thread>
 
+#include "calligraphy/devices/device_servo_clock.hpp"
 #include "devices/latency_histogram.hpp"
 #include "devices/log_queue.hpp"
 #include "devices/servo_loop_realtime.hpp"
@@ -140,7 +143,13 @@ struct ServoLoop::Impl {
   Impl(HapticDevice& d, ServoCallback c, const ServoLoopOptions& o)
       : device(d), callback(std::move(c)), options(o) {}
 
-  void run() noexcept;
+  void run_thread() noexcept;
+  static void on_device_frame(void* self) noexcept;
+  void begin_run() noexcept;
+  bool tick_once(std::int64_t wake, std::int64_t deadline) noexcept;
+  void finish_run() noexcept;
+  void stop_device_clock() noexcept;
+  [[nodiscard]] bool clock_went_silent() const noexcept;
   void record_fault(LoopFaultKind kind, const char* message, std::uint64_t tick, double stall_ms = 0.0,
                     DeviceFault device_fault = DeviceFault::none) noexcept;
   void log(LogLevel level, std::uint16_t code, std::uint64_t count, double a = 0.0, double b = 0.0,
@@ -162,6 +171,9 @@ struct ServoLoop::Impl {
   std::function<void()> after_write;  // optional, on the loop thread after each tick's force write
   ServoLoopOptions options;
   std::thread thread;
+  // The device driver's servo thread while a run is attached to it; set and cleared by the controlling
+  // thread, read by running() from any thread.
+  std::atomic<DeviceServoClock*> clock{nullptr};
   devices::LogQueue log_queue;
   devices::LogDrain log_drain;
 
@@ -171,7 +183,27 @@ struct ServoLoop::Impl {
   std::atomic<int> startup{0};
   RealtimeStatus realtime;  // written before the handshake / by start(), read after it: ordered by `startup`
 
-  // Statistics: single writer (the loop thread), relaxed atomics for the readers.
+  // One run's state, touched only by whichever thread ticks (the loop's or the driver's) and by start()
+  // before the first tick.
+  struct RunState {
+    std::int64_t period = 0;
+    double period_s = 0.0;
+    std::int64_t max_force_age_ns = 0;
+    std::int64_t stall_limit_ns = 0;  // 0: no bound
+    std::int64_t last_update = 0;     // the last force update the device got (start: forces just enabled)
+    std::int64_t previous_wake = 0;
+    std::int64_t last_written = 0;
+    std::uint64_t tick = 0;
+    std::uint64_t late_count = 0;
+    std::uint64_t withheld_count = 0;
+    std::int64_t longest_stall = 0;
+  } run;
+  // The last time the driver called the frame function [ns, CLOCK_MONOTONIC]; read by other threads to
+  // notice a driver that stopped calling.
+  std::atomic<std::int64_t> last_frame_ns{0};
+  std::atomic<std::thread::id> frame_thread{};  // the driver's thread, once it called
+
+  // Statistics: single writer (the ticking thread), relaxed atomics for the readers.
   std::atomic<std::uint64_t> ticks{0};
   std::atomic<std::uint64_t> late{0};
   std::atomic<std::uint64_t> withheld{0};
@@ -186,7 +218,7 @@ struct ServoLoop::Impl {
   std::atomic<int> fault_kind{0};
   std::atomic<DeviceFault> fault_device{DeviceFault::none};
   std::array<std::atomic<char>, kFaultMessageBytes> fault_message{};
-  std::exception_ptr fault_exception;  // set by the loop thread, read after join
+  std::exception_ptr fault_exception;  // set by the ticking thread, read after it ended
 };
 
 void ServoLoop::Impl::reset_stats() noexcept {
@@ -231,124 +263,179 @@ LoopFault ServoLoop::Impl::fault() const {
   return f;
 }
 
-// The loop body. Deadlines are absolute, on a grid of whole periods: a tick that is a little late does
-// not shift later ones. A tick that ends past the next deadline re-anchors the grid one period after
-// its own end, so missed ticks are never run back to back and the callback's dt stays about a period
-// after the first tick behind a stall. What a late tick writes: see ServoLoopOptions.
-void ServoLoop::Impl::run() noexcept {
-  const std::int64_t period = options.period_ns();
-  const double period_s = static_cast<double>(period) * 1e-9;
-  const std::int64_t max_force_age_ns = std::llround(options.max_force_age_s * 1e9);
-  const std::int64_t stall_limit_ns = std::llround(options.stall_timeout_s * 1e9);  // 0: no bound
-  const std::int64_t start = monotonic_ns();
-  std::int64_t next = start + period;
-  std::int64_t last_update = start;  // the last force update the device got (start: forces just enabled)
-  std::int64_t previous_wake = 0;
-  std::uint64_t tick = 0;
-  std::uint64_t late_count = 0;
-  std::uint64_t withheld_count = 0;
-  std::int64_t longest_stall = 0;
+void ServoLoop::Impl::begin_run() noexcept {
+  run = RunState{};
+  run.period = options.period_ns();
+  run.period_s = static_cast<double>(run.period) * 1e-9;
+  run.max_force_age_ns = std::llround(options.max_force_age_s * 1e9);
+  run.stall_limit_ns = std::llround(options.stall_timeout_s * 1e9);
+  run.last_update = monotonic_ns();
+  last_frame_ns.store(run.last_update, std::memory_order_relaxed);
+}
 
-  while (!stop_requested.load(std::memory_order_acquire)) {
-    sleep_until(next);
-    const std::int64_t wake = monotonic_ns();
-    const std::int64_t deadline = next + period;  // the force must be out before the next tick starts
-    if (wake - next > static_cast<std::int64_t>(wake_latency_max_ns.load(std::memory_order_relaxed))) {
-      wake_latency_max_ns.store(static_cast<std::uint64_t>(wake - next), std::memory_order_relaxed);
-    }
-    double dt_s = period_s;
-    if (tick > 0) {
-      jitter.add(std::llabs((wake - previous_wake) - period));
-      dt_s = static_cast<double>(wake - previous_wake) * 1e-9;
-    }
-    previous_wake = wake;
+// One tick: read, callback, the stale-force and stall guards, write, the after-write hook, statistics.
+// `wake` is when the tick began (the state's age counts from there); the force must reach the device
+// before `deadline`. False when the run ends with this tick (a fault, or the callback asked to stop).
+bool ServoLoop::Impl::tick_once(std::int64_t wake, std::int64_t deadline) noexcept {
+  double dt_s = run.period_s;
+  if (run.tick > 0) {
+    jitter.add(std::llabs((wake - run.previous_wake) - run.period));
+    dt_s = static_cast<double>(wake - run.previous_wake) * 1e-9;
+  }
+  run.previous_wake = wake;
 
-    bool stop_after = false;
-    bool stalled = false;
-    std::int64_t written = 0;
-    std::int64_t stall = 0;
-    std::int64_t force_age = 0;
-    DeviceFault device_fault = DeviceFault::none;
-    try {
-      DeviceState state;
-      device_fault = device.read_state(state);  // read at `wake`: the age of the state counts from there
-      if (device_fault == DeviceFault::none) {
-        const std::int64_t call = monotonic_ns();
-        const ServoCommand command = callback(state, dt_s);
-        const std::int64_t returned = monotonic_ns();
-        callback_time.add(returned - call);
-        stall = returned - last_update - period;
-        force_age = returned - wake;
-        stalled = stall_limit_ns > 0 && stall > stall_limit_ns;
-        if (stalled || force_age > max_force_age_ns) {
-          // Zero force is passive whatever the state; a force computed from an old state on a stiff fixture
-          // is not (Colgate & Schenkel 1997).
-          device_fault = device.write_force(Vec3::Zero());
-          withheld.store(++withheld_count, std::memory_order_relaxed);
-          if (!stalled && worth_logging(withheld_count)) {
-            log(LogLevel::warn, kForceWithheld, tick + 1, static_cast<double>(force_age) * 1e-3,
-                static_cast<double>(withheld_count));
-          }
-        } else {
-          device_fault = device.write_force(command.force_n);
+  bool stop_after = false;
+  bool stalled = false;
+  std::int64_t written = 0;
+  std::int64_t stall = 0;
+  std::int64_t force_age = 0;
+  DeviceFault device_fault = DeviceFault::none;
+  try {
+    DeviceState state;
+    device_fault = device.read_state(state);  // read at `wake`: the age of the state counts from there
+    if (device_fault == DeviceFault::none) {
+      const std::int64_t call = monotonic_ns();
+      const ServoCommand command = callback(state, dt_s);
+      const std::int64_t returned = monotonic_ns();
+      callback_time.add(returned - call);
+      stall = returned - run.last_update - run.period;
+      force_age = returned - wake;
+      stalled = run.stall_limit_ns > 0 && stall > run.stall_limit_ns;
+      if (stalled || force_age > run.max_force_age_ns) {
+        // Zero force is passive whatever the state; a force computed from an old state on a stiff fixture
+        // is not (Colgate & Schenkel 1997).
+        device_fault = device.write_force(Vec3::Zero());
+        withheld.store(++run.withheld_count, std::memory_order_relaxed);
+        if (!stalled && worth_logging(run.withheld_count)) {
+          log(LogLevel::warn, kForceWithheld, run.tick + 1, static_cast<double>(force_age) * 1e-3,
+              static_cast<double>(run.withheld_count));
         }
-        written = monotonic_ns();  // the device holds this force from here: stalls count from the write
-        if (device_fault == DeviceFault::none && after_write && !command.stop && !stalled) after_write();
-        stop_after = command.stop;
+      } else {
+        device_fault = device.write_force(command.force_n);
       }
-    } catch (const std::exception& e) {
-      fault_exception = std::current_exception();
-      record_fault(LoopFaultKind::callback, e.what(), tick);
-      break;
-    } catch (...) {
-      fault_exception = std::current_exception();
-      record_fault(LoopFaultKind::callback, "unknown exception from the servo callback", tick);
-      break;
+      written = monotonic_ns();  // the device holds this force from here: stalls count from the write
+      if (device_fault == DeviceFault::none && after_write && !command.stop && !stalled) after_write();
+      stop_after = command.stop;
     }
-    if (device_fault != DeviceFault::none) {  // a code, not an exception: nothing allocated on this path
-      record_fault(LoopFaultKind::device, to_string(device_fault), tick, 0.0, device_fault);
-      break;
-    }
-    last_update = written;
-    ticks.store(++tick, std::memory_order_relaxed);
-    if (stall > longest_stall) {
-      longest_stall = stall;
-      longest_stall_ns.store(stall, std::memory_order_relaxed);
-    }
-    if (written > deadline) {
-      late.store(++late_count, std::memory_order_relaxed);
-      if (worth_logging(late_count)) {
-        log(LogLevel::warn, kDeadlineMissed, tick, static_cast<double>(written - deadline) * 1e-3,
-            static_cast<double>(late_count));
-      }
-    }
-    if (stalled) {  // counted above like any tick; the run ends here with zero force written
-      record_fault(LoopFaultKind::watchdog, kStallFaultMessage, tick, static_cast<double>(stall) * 1e-6);
-      break;
-    }
-    if (stop_after) break;
-    next += period;
-    if (written >= next) {  // behind: the deadlines that passed are dropped and the grid restarts from now
-      const std::int64_t passed = (written - next) / period + 1;
-      next = written + period;
-      skipped.store(skipped.load(std::memory_order_relaxed) + static_cast<std::uint64_t>(passed),
-                    std::memory_order_relaxed);
-      reanchors.store(reanchors.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  } catch (const std::exception& e) {
+    fault_exception = std::current_exception();
+    record_fault(LoopFaultKind::callback, e.what(), run.tick);
+    return false;
+  } catch (...) {
+    fault_exception = std::current_exception();
+    record_fault(LoopFaultKind::callback, "unknown exception from the servo callback", run.tick);
+    return false;
+  }
+  if (device_fault != DeviceFault::none) {  // a code, not an exception: nothing allocated on this path
+    record_fault(LoopFaultKind::device, to_string(device_fault), run.tick, 0.0, device_fault);
+    return false;
+  }
+  run.last_update = written;
+  run.last_written = written;
+  ticks.store(++run.tick, std::memory_order_relaxed);
+  if (stall > run.longest_stall) {
+    run.longest_stall = stall;
+    longest_stall_ns.store(stall, std::memory_order_relaxed);
+  }
+  if (written > deadline) {
+    late.store(++run.late_count, std::memory_order_relaxed);
+    if (worth_logging(run.late_count)) {
+      log(LogLevel::warn, kDeadlineMissed, run.tick, static_cast<double>(written - deadline) * 1e-3,
+          static_cast<double>(run.late_count));
     }
   }
+  if (stalled) {  // counted above like any tick; the run ends here with zero force written
+    record_fault(LoopFaultKind::watchdog, kStallFaultMessage, run.tick, static_cast<double>(stall) * 1e-6);
+    return false;
+  }
+  return !stop_after;
+}
 
-  // Whatever ended the run, the device is left with zero force and forces off. The transport may be
-  // gone (a fault code then): disabling below is the next line of defence.
+// Whatever ended the run, the device is left with zero force and forces off. The transport may be gone (a
+// fault code then): disabling below is the next line of defence.
+void ServoLoop::Impl::finish_run() noexcept {
   static_cast<void>(device.write_force(Vec3::Zero()));
   try {
     device.enable_forces(false);
   } catch (...) {
   }
-  log(LogLevel::info, kStopped, tick, static_cast<double>(late_count),
-      static_cast<double>(longest_stall) * 1e-6, nullptr, static_cast<double>(withheld_count));
+  log(LogLevel::info, kStopped, run.tick, static_cast<double>(run.late_count),
+      static_cast<double>(run.longest_stall) * 1e-6, nullptr, static_cast<double>(run.withheld_count));
   log(LogLevel::info, kStoppedGrid, reanchors.load(std::memory_order_relaxed),
       static_cast<double>(skipped.load(std::memory_order_relaxed)));
   running.store(false, std::memory_order_release);
+  running.notify_all();
+}
+
+// The loop's own clock. Deadlines are absolute, on a grid of whole periods: a tick that is a little late
+// does not shift later ones. A tick that ends past the next deadline re-anchors the grid one period after
+// its own end, so missed ticks are never run back to back and the callback's dt stays about a period after
+// the first tick behind a stall. What a late tick writes: see ServoLoopOptions.
+void ServoLoop::Impl::run_thread() noexcept {
+  begin_run();
+  const std::int64_t period = run.period;
+  std::int64_t next = run.last_update + period;
+  while (!stop_requested.load(std::memory_order_acquire)) {
+    sleep_until(next);
+    const std::int64_t wake = monotonic_ns();
+    if (wake - next > static_cast<std::int64_t>(wake_latency_max_ns.load(std::memory_order_relaxed))) {
+      wake_latency_max_ns.store(static_cast<std::uint64_t>(wake - next), std::memory_order_relaxed);
+    }
+    if (!tick_once(wake, next + period)) break;  // the force must be out before the next tick starts
+    next += period;
+    if (run.last_written >= next) {  // behind: the deadlines that passed are dropped, the grid restarts
+      const std::int64_t passed = (run.last_written - next) / period + 1;
+      next = run.last_written + period;
+      skipped.store(skipped.load(std::memory_order_relaxed) + static_cast<std::uint64_t>(passed),
+                    std::memory_order_relaxed);
+      reanchors.store(reanchors.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+    }
+  }
+  finish_run();
+}
+
+// The device's clock: one tick per driver frame, in the frame that read the state, so the force answers
+// that state in the same frame. The driver's own jitter is the period jitter; there is no deadline grid
+// to re-anchor (the driver keeps its own).
+void ServoLoop::Impl::on_device_frame(void* self) noexcept {
+  Impl& m = *static_cast<Impl*>(self);
+  if (!m.running.load(std::memory_order_acquire)) return;  // the run ended; the driver still frames
+  const std::int64_t wake = monotonic_ns();
+  m.last_frame_ns.store(wake, std::memory_order_relaxed);
+  m.frame_thread.store(std::this_thread::get_id(), std::memory_order_relaxed);
+  if (m.stop_requested.load(std::memory_order_acquire) || !m.tick_once(wake, wake + m.run.period)) {
+    m.finish_run();
+  }
+}
+
+// True when the driver has not called for longer than the stall bound (plus a period): its clock stopped,
+// and no tick will notice. Off when the stall bound is off.
+bool ServoLoop::Impl::clock_went_silent() const noexcept {
+  if (clock.load(std::memory_order_acquire) == nullptr || options.stall_timeout_s <= 0.0) return false;
+  const std::int64_t silent = monotonic_ns() - last_frame_ns.load(std::memory_order_relaxed);
+  return silent > std::llround(options.stall_timeout_s * 1e9) + options.period_ns();
+}
+
+// Ends a run on the device's clock from a normal thread: asks the next frame to finish it, waits for that
+// (a few periods), detaches, and finishes it here when the driver stopped calling (a stall then).
+void ServoLoop::Impl::stop_device_clock() noexcept {
+  stop_requested.store(true, std::memory_order_release);
+  const std::int64_t wait_until =
+      monotonic_ns() + std::max<std::int64_t>(100'000'000, 10 * options.period_ns());  // 100 ms at least
+  while (running.load(std::memory_order_acquire) && monotonic_ns() < wait_until && !clock_went_silent()) {
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  clock.load(std::memory_order_acquire)->detach();  // no frame runs after this returns
+  clock.store(nullptr, std::memory_order_release);
+  if (running.load(std::memory_order_acquire)) {
+    const double silent_ms =
+        static_cast<double>(monotonic_ns() - last_frame_ns.load(std::memory_order_relaxed)) * 1e-6;
+    if (options.stall_timeout_s > 0.0 && silent_ms > options.stall_timeout_s * 1e3 &&
+        fault_kind.load(std::memory_order_acquire) == 0) {
+      record_fault(LoopFaultKind::watchdog, kStallFaultMessage, run.tick, silent_ms);
+    }
+    finish_run();
+  }
 }
 
 ServoLoop::ServoLoop(HapticDevice& device, ServoCallback callback, const ServoLoopOptions& options) {
@@ -363,14 +450,24 @@ void ServoLoop::start() {
   Impl& m = *impl_;
   if (m.running.load(std::memory_order_acquire))
     throw StateError("ServoLoop::start: the loop is already running");
-  if (m.thread.joinable()) m.thread.join();  // the previous run ended by itself
+  if (m.thread.joinable()) m.thread.join();              // the previous run ended by itself
+  if (m.clock.load() != nullptr) m.stop_device_clock();  // the previous run ended by itself
   m.log_drain.stop();
   if (!m.device.is_open())
     throw DeviceError("ServoLoop::start: the device '" + m.device.info().model + "' is not open");
+  DeviceServoClock* const device_clock = m.device.servo_clock();
+  if (device_clock != nullptr &&
+      std::abs(device_clock->servo_rate_hz() - m.options.rate_hz) > 1e-6 * m.options.rate_hz) {
+    throw InvalidArgument("ServoLoopOptions.rate_hz = " + std::to_string(m.options.rate_hz) + " Hz, but '" +
+                          m.device.info().model + "' runs its own servo clock at " +
+                          std::to_string(device_clock->servo_rate_hz()) + " Hz: ask for that rate");
+  }
 
+  m.frame_thread.store(std::thread::id{}, std::memory_order_relaxed);
   m.startup.store(0, std::memory_order_release);  // readers stop copying the previous run's realtime status
   m.reset_stats();
   m.realtime = RealtimeStatus{};
+  m.realtime.device_clock = device_clock != nullptr;
   if (m.options.lock_memory) {
     m.realtime.memory_locked = devices::lock_process_memory(m.realtime.problems);
     if (!m.realtime.memory_locked && m.options.realtime == RealtimeMode::enforce) {
@@ -384,6 +481,28 @@ void ServoLoop::start() {
   // spdlog creates its default logger lazily; create it here, before the drain thread can race to it.
   static_cast<void>(spdlog::default_logger_raw());
   m.log_drain.start(m.log_queue, log_sink);
+  if (device_clock != nullptr) {
+    // The driver's thread ticks: its priority and CPU are the driver's to set, not the loop's.
+    m.begin_run();
+    try {
+      device_clock->attach(&Impl::on_device_frame, &m);
+    } catch (...) {
+      m.running.store(false, std::memory_order_release);
+      m.log_drain.stop();
+      try {
+        m.device.enable_forces(false);
+      } catch (...) {
+      }
+      throw;
+    }
+    m.clock.store(device_clock, std::memory_order_release);
+    m.startup.store(1, std::memory_order_release);
+    spdlog::info(
+        "servo loop: started on the device's own servo clock at {} Hz (the driver's thread); memory "
+        "locked {}",
+        m.options.rate_hz, m.realtime.memory_locked ? "yes" : "no");
+    return;
+  }
   m.thread = std::thread([&m] {
     devices::apply_thread_realtime(m.options, m.realtime);
     const bool failed = m.options.realtime == RealtimeMode::enforce && !m.realtime.problems.empty();
@@ -396,7 +515,7 @@ void ServoLoop::start() {
     devices::prefault_stack();
     m.startup.store(1, std::memory_order_release);
     m.startup.notify_one();
-    m.run();
+    m.run_thread();
   });
   m.startup.wait(0, std::memory_order_acquire);
   if (m.startup.load(std::memory_order_acquire) == 2) {
@@ -418,9 +537,11 @@ void ServoLoop::start() {
 LoopFault ServoLoop::stop() noexcept {
   Impl& m = *impl_;
   m.stop_requested.store(true, std::memory_order_release);
-  if (m.thread.get_id() == std::this_thread::get_id())
+  if (m.thread.get_id() == std::this_thread::get_id() ||
+      (m.clock.load() != nullptr && m.frame_thread.load() == std::this_thread::get_id()))
     return {};  // called from the callback: stops after this tick
   if (m.thread.joinable()) m.thread.join();
+  if (m.clock.load() != nullptr) m.stop_device_clock();
   m.log_drain.stop();
   try {
     return m.fault();
@@ -434,6 +555,13 @@ LoopFault ServoLoop::stop() noexcept {
 void ServoLoop::wait() {
   Impl& m = *impl_;
   if (m.thread.joinable()) m.thread.join();
+  if (m.clock.load() != nullptr) {
+    // The driver ends the run in one of its frames; a driver that stopped calling is a stall.
+    while (m.running.load(std::memory_order_acquire) && !m.clock_went_silent()) {
+      std::this_thread::sleep_for(std::chrono::microseconds(500));
+    }
+    m.stop_device_clock();
+  }
   m.log_drain.stop();
   const LoopFault f = m.fault();
   if (!f) return;
@@ -442,7 +570,11 @@ void ServoLoop::wait() {
   throw SafetyFault(f.message);
 }
 
-bool ServoLoop::running() const noexcept { return impl_->running.load(std::memory_order_acquire); }
+bool ServoLoop::running() const noexcept {
+  // On a device's clock, a driver that stopped calling leaves no thread to notice: the run counts as over
+  // (stop() then records the stall) once the silence passes the stall bound.
+  return impl_->running.load(std::memory_order_acquire) && !impl_->clock_went_silent();
+}
 
 const ServoLoopOptions& ServoLoop::options() const noexcept { return impl_->options; }
 

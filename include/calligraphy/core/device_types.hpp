@@ -31,7 +31,10 @@ struct DeviceState {
   Vec3 position_m = Vec3::Zero();    ///< tip (HIP) position [m]
   Vec3 velocity_m_s = Vec3::Zero();  ///< tip velocity [m/s]
   std::uint32_t buttons = 0;         ///< bit i set when button i is pressed
-  double time_s = 0.0;               ///< device time stamp [s], monotonic
+  /// Time stamp [s] on the device's own clock: monotonic, seconds, origin the device's (the simulated
+  /// device counts from its open(), OpenHaptics from the machine's boot). Only differences are meaningful:
+  /// a trial counts its times from its first tick (`TrialSession`).
+  double time_s = 0.0;
 };
 
 }  // namespace calligraphy

@@ -9,6 +9,8 @@
 
 namespace calligraphy {
 
+class DeviceServoClock;
+
 /// Abstract haptic device. Implementations: `SimulatedDevice`, the Phantom backends, OpenHaptics.
 /// `read_state` and `write_force` are the servo path, called from the servo thread at up to 10 kHz:
 /// they are noexcept and return a `DeviceFault` code (device_fault.hpp) instead of throwing, and must
@@ -52,6 +54,11 @@ class HapticDevice {
   /// `DeviceFault::none`, or the fault (e.g. `non_finite_force`: zero force is commanded instead).
   /// Implementations clamp to `info().max_force_n` preserving direction. Never throws or allocates.
   [[nodiscard]] virtual DeviceFault write_force(const Vec3& force_n) noexcept = 0;
+
+  /// The device driver's own servo thread (device_servo_clock.hpp), or nullptr when the device has none
+  /// and the caller's loop is the clock (`ServoLoop`'s thread). A `ServoLoop` on a device with a clock runs
+  /// each tick inside the driver's frame. Valid while the device is open.
+  [[nodiscard]] virtual DeviceServoClock* servo_clock() noexcept { return nullptr; }
 };
 
 }  // namespace calligraphy

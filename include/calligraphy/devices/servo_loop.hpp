@@ -1,9 +1,14 @@
 #pragma once
 /// \file servo_loop.hpp
-/// The real-time servo loop: a dedicated thread that, at a fixed rate with absolute deadlines,
-/// reads the device state, calls a callback that returns a force command, and writes the force
-/// (the paper runs its haptic loop at 1 kHz, sections 1 and 7). The loop's structure follows libfranka's
-/// `Robot::control` callback loop and its `RealtimeConfig` {enforce, ignore}.
+/// The real-time servo loop: at a fixed rate, reads the device state, calls a callback that returns a force
+/// command, and writes the force (the paper runs its haptic loop at 1 kHz, sections 1 and 7). The loop's
+/// structure follows libfranka's `Robot::control` callback loop and its `RealtimeConfig` {enforce, ignore}.
+///
+/// Who keeps the time: a device whose driver owns a servo thread (`HapticDevice::servo_clock()`, e.g.
+/// OpenHaptics' scheduler) runs each tick inside the driver's frame, so the force answers the state read in
+/// the same frame; the realtime settings are then the driver's (only `lock_memory` applies), and `rate_hz`
+/// must equal the driver's rate. Any other device gets a dedicated thread with absolute deadlines. The
+/// tick, its guards and its statistics are the same either way.
 ///
 /// Late ticks do not end the loop: a force computed from a state older than `max_force_age_s` is
 /// replaced by zero force (a stale force on a stiff virtual fixture is what makes a sampled haptic loop
@@ -102,6 +107,9 @@ struct LoopFault {
 
 /// What the realtime settings gave (see `RealtimeMode`).
 struct RealtimeStatus {
+  /// The ticks ran in the device driver's own servo thread (`HapticDevice::servo_clock()`): its priority
+  /// and CPU are the driver's, and the fields below about the loop thread stay unset.
+  bool device_clock = false;
   bool fifo_scheduling = false;  ///< the loop thread runs SCHED_FIFO
   int priority = 0;              ///< its priority (0 when not SCHED_FIFO)
   int cpu = -1;                  ///< the CPU it is pinned to, -1 when not pinned
@@ -148,9 +156,10 @@ struct ServoLoopStats {
   LoopFault fault;  ///< the fault that stopped the last run, if any
 };
 
-/// Runs a callback on a dedicated thread at a fixed rate against a device. Not copyable or movable.
-/// The device is used only by the loop thread between `start()` and the end of the run: do not touch
-/// it from other threads meanwhile (the loop's thread start and join order the accesses).
+/// Runs a callback at a fixed rate against a device, on a dedicated thread or on the device driver's own
+/// servo thread (see the file comment). Not copyable or movable. The device is used only by the ticking
+/// thread between `start()` and the end of the run: do not touch it from other threads meanwhile (the
+/// thread's start and join, or the clock's attach and detach, order the accesses).
 class ServoLoop {
  public:
   /// `device` must outlive the loop. Throws InvalidArgument for bad options or an empty callback.
@@ -160,10 +169,12 @@ class ServoLoop {
   ServoLoop(const ServoLoop&) = delete;
   ServoLoop& operator=(const ServoLoop&) = delete;
 
-  /// Starts the loop thread: clears the statistics, locks memory when asked, enables forces when asked,
-  /// applies the realtime settings on the new thread and returns once they are applied. Throws
-  /// RealtimeError (mode `enforce`, with the reason), DeviceError (the device is not open, or from
-  /// `enable_forces`), or StateError when the loop is already running. A loop that ended (stopped by its
+  /// Starts the run: clears the statistics, locks memory when asked, enables forces when asked, then
+  /// either attaches to the device's own servo clock or starts the loop thread, applies the realtime
+  /// settings on it and returns once they are applied. Throws RealtimeError (mode `enforce`, with the
+  /// reason), DeviceError (the device is not open, or from `enable_forces` or the clock's attach),
+  /// InvalidArgument (`rate_hz` differs from the device clock's rate, both named), or StateError when the
+  /// loop is already running. A loop that ended (stopped by its
   /// callback, by `stop()` or by a fault) can be started again.
   void start();
   /// Optional: called on the loop thread right after each tick's force write (the callback's force or
@@ -172,18 +183,21 @@ class ServoLoop {
   /// stall bound. Same rules as the callback; its exceptions are contained like the callback's.
   /// Throws StateError while the loop runs.
   void set_after_write(std::function<void()> hook);
-  /// Asks the loop to stop, waits for the thread to end and returns the fault that ended the run, if
-  /// any (none when it was stopped or ended by its callback). Forces are zero and disabled on return.
-  /// Never throws; does nothing when not started. Called from the callback it only requests the stop (the
-  /// callback should return `ServoCommand::stop` instead).
+  /// Asks the loop to stop, waits for the thread to end (or for the device clock's next frame, then
+  /// detaches from it; a clock that stopped calling is detached after 100 ms) and returns the fault that
+  /// ended the run, if any (none when it was stopped or ended by its callback). Forces are zero and disabled
+  /// on return. Never throws; does nothing when not started. Called from the callback it only requests the
+  /// stop (the callback should return `ServoCommand::stop` instead).
   LoopFault stop() noexcept;
   /// Waits until the loop ends by itself (its callback asked to stop, or a fault) and joins it; then
   /// throws the fault: for a device fault `throw_device_fault(code, device.info().model)`
   /// (CommunicationError or SafetyFault), the callback's own exception, or a SafetyFault for a stall
   /// (`kStallFaultMessage`). Returns normally when the run ended without a fault. Blocks forever if
-  /// nothing ends it.
+  /// nothing ends it (on a device clock: a driver that stopped calling ends the run as a stall once the
+  /// silence passes `stall_timeout_s`, unless the bound is off).
   void wait();
-  /// True from `start()` until the loop thread has left its loop. Any thread.
+  /// True from `start()` until the loop thread has left its loop (on a device clock: until the frame that
+  /// ended the run, or until the driver has been silent longer than `stall_timeout_s`). Any thread.
   [[nodiscard]] bool running() const noexcept;
   /// A snapshot of the statistics; lock-free, from any thread while the loop runs or after it ended (not
   /// concurrently with `start()`, which resets them).
