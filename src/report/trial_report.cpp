@@ -32,7 +32,9 @@ void print_loop_statistics(const ServoLoopStats& loop) {
   std::printf("  longest stall              %.3f ms\n", loop.longest_stall_s * 1e3);
   std::printf("  period jitter p99 / max    %.0f / %.0f us (%s)\n", loop.period_jitter_us_p99,
               loop.period_jitter_us_max,
-              loop.realtime.fifo_scheduling ? "SCHED_FIFO" : "normal scheduling, not SCHED_FIFO");
+              loop.realtime.device_clock      ? "the device driver's servo thread"
+              : loop.realtime.fifo_scheduling ? "SCHED_FIFO"
+                                              : "normal scheduling, not SCHED_FIFO");
 }
 
 nlohmann::json loop_json(const ServoLoopStats& loop) {
@@ -43,7 +45,8 @@ nlohmann::json loop_json(const ServoLoopStats& loop) {
           {"deadline_reanchors", loop.deadline_reanchors},
           {"period_jitter_us_p99", loop.period_jitter_us_p99},
           {"period_jitter_us_max", loop.period_jitter_us_max},
-          {"fifo_scheduling", loop.realtime.fifo_scheduling}};
+          {"fifo_scheduling", loop.realtime.fifo_scheduling},
+          {"device_clock", loop.realtime.device_clock}};
 }
 
 }  // namespace
@@ -142,6 +145,7 @@ std::string trial_json(const TrialDescription& d, const TrialResult& result, con
                         {"abort_reason", result.abort_reason},
                         {"strokes_completed", m.strokes_completed},
                         {"trial_time_s", m.time_s},
+                        {"device_time_at_start_s", result.device_time_at_start_s},
                         {"max_force_n", m.max_force_n},
                         {"max_force_step_n", m.max_force_step_n},
                         {"state_transitions", m.state_transitions},

@@ -187,7 +187,8 @@ json loop_json(const ServoLoopStats& s) {
           {"longest_stall_s", s.longest_stall_s},
           {"period_jitter_us_p99", s.period_jitter_us_p99},
           {"period_jitter_us_max", s.period_jitter_us_max},
-          {"callback_us_max", s.callback_us_max}};
+          {"callback_us_max", s.callback_us_max},
+          {"device_clock", s.realtime.device_clock}};
 }
 
 }  // namespace
@@ -266,7 +267,10 @@ nlohmann::json trial_record(const TrialRecordContext& c, const Scene& scene, con
       {"library", library_build_json(library_build())},
       {"session_library", library_build_json(c.session->library)},
       {"device",
-       {{"name", c.device_name}, {"hardware", c.hardware}, {"info", device_info_json(c.device_info)}}},
+       {{"name", c.device_name},
+        {"hardware", c.hardware},
+        {"info", device_info_json(c.device_info)},
+        {"time_at_start_s", result.device_time_at_start_s}}},
       {"writer", writer_json(c)},
       {"force_law", force_law_json(c.options->force)},
       {"renderer", renderer_json(*c.options)},

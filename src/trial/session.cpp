@@ -43,7 +43,12 @@ void TrialSession::attach_display(DisplayChannel* channel) {
 
 void TrialSession::reserve_trace() { recorder_.reserve(max_ticks_); }
 
-ServoCommand TrialSession::step(const DeviceState& state) noexcept {
+ServoCommand TrialSession::step(const DeviceState& device_state) noexcept {
+  // One time base for every device: the trial's clock starts at its first tick, whatever the device's
+  // clock counts from (the simulated device from open(), OpenHaptics from the machine's boot).
+  if (ticks_ == 0) device_origin_s_ = device_state.time_s;
+  DeviceState state = device_state;
+  state.time_s = device_state.time_s - device_origin_s_;
   last_output_ = renderer_.tick(state);
   recorder_.record(state, last_output_);
   ++ticks_;
@@ -53,14 +58,16 @@ ServoCommand TrialSession::step(const DeviceState& state) noexcept {
 }
 
 TrialResult TrialSession::finish(TrialEnd end, std::string reason, double end_time_s) {
-  recorder_.finish(end_time_s < 0.0 ? last_time_s_ : end_time_s);
-  if (display_) display_->publish_end(end, end_time_s < 0.0 ? last_time_s_ : end_time_s);
+  const double trial_end_s = end_time_s < 0.0 ? last_time_s_ : end_time_s - device_origin_s_;
+  recorder_.finish(trial_end_s);
+  if (display_) display_->publish_end(end, trial_end_s);
   TrialResult result;
   result.metrics = recorder_.metrics();
   result.trace = recorder_.take_trace();  // the session is spent after finish
   result.end = end;
   result.aborted = end != TrialEnd::completed;
   result.abort_reason = std::move(reason);
+  result.device_time_at_start_s = device_origin_s_;
   return result;
 }
 

@@ -16,12 +16,12 @@ namespace calligraphy {
 
 /// How a trial ended.
 enum class TrialEnd {
-  completed,       ///< every stroke written, each in its turn
-  time_limit,      ///< `max_duration_s` ran out first
-  device_fault,    ///< the device returned a fault code (`TrialResult::device_fault`), or a callback threw
-  watchdog,        ///< the servo loop stalled longer than its bound
-  interrupted,     ///< `TrialOptions::should_stop` (e.g. SIGINT or SIGTERM, a closed window)
-  gave_up,         ///< the hand moving the device (hand.hpp) stopped before every stroke was written
+  completed,     ///< every stroke written, each in its turn
+  time_limit,    ///< `max_duration_s` ran out first
+  device_fault,  ///< the device returned a fault code (`TrialResult::device_fault`), or a callback threw
+  watchdog,      ///< the servo loop stalled longer than its bound
+  interrupted,   ///< `TrialOptions::should_stop` (e.g. SIGINT or SIGTERM, a closed window)
+  gave_up,       ///< the hand moving the device (hand.hpp) stopped before every stroke was written
 };
 
 /// "completed", "time_limit", "device_fault", "watchdog", "interrupted", "gave_up".
@@ -39,6 +39,10 @@ struct TrialResult {
   /// fault; else a short reason or empty.
   std::string abort_reason;
   std::optional<ServoLoopStats> loop;  ///< the servo loop's statistics, for a real-time trial
+  /// The device's own time stamp [s] of the first tick (`DeviceState::time_s`): the trace's and the
+  /// metrics' times count from it, so t = 0 is the trial's first tick on every device. Device time of a
+  /// sample = its t + this.
+  double device_time_at_start_s = 0.0;
 };
 
 /// The trace as pen samples in the paper plane: the pen is down when the HIP is at most

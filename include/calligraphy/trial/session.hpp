@@ -56,7 +56,8 @@ class TrialSession {
 
   /// One servo tick: renders the force for `state` and records the tick. `stop` is set when every
   /// stroke is written or the time limit is reached. Servo path: no lock, log or exception, and no
-  /// allocation after `reserve_trace()`.
+  /// allocation after `reserve_trace()`. Times: the trial's clock starts at 0 with the first tick;
+  /// `state.time_s` is on the device's clock (any origin) and only its differences are used.
   ServoCommand step(const DeviceState& state) noexcept;
 
   /// What the renderer made of the last step (state, active stroke, hint, force, events).
@@ -69,10 +70,10 @@ class TrialSession {
   [[nodiscard]] bool out_of_time() const noexcept { return ticks_ >= max_ticks_; }
   [[nodiscard]] const TrialOptions& options() const noexcept { return options_; }
 
-  /// Closes the metrics at `end_time_s` (the device time the trial ended; the last tick's time when
-  /// negative) and returns the recording with how it ended. `reason` is kept as `abort_reason`.
-  /// Call once, after the loop stopped stepping; the session is spent after it. With a display
-  /// attached it pushes the `trial_ended` event.
+  /// Closes the metrics at `end_time_s` (when the trial ended, on the device's clock as the states
+  /// stepped; the last tick's time when negative) and returns the recording with how it ended. `reason` is
+  /// kept as `abort_reason`. Call once, after the loop stopped stepping; the session is spent after it. With
+  /// a display attached it pushes the `trial_ended` event.
   [[nodiscard]] TrialResult finish(TrialEnd end, std::string reason = {}, double end_time_s = -1.0);
 
  private:
@@ -83,7 +84,8 @@ class TrialSession {
   std::optional<DisplayPublisher> display_;
   std::size_t ticks_ = 0;
   std::size_t max_ticks_ = 0;
-  double last_time_s_ = 0.0;
+  double last_time_s_ = 0.0;      // the trial's clock: 0 at the first tick
+  double device_origin_s_ = 0.0;  // the device's time stamp of the first tick
 };
 
 }  // namespace calligraphy
