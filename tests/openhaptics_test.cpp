@@ -1,9 +1,17 @@
-// The OpenHaptics backend without libHD (none is installed here): error mapping, conversions and the
-// "not found" path. The scheduler code itself is untested.
+// The OpenHaptics backend without libHD: error mapping, conversions, the "not found" path, and damaged
+// libraries named by CALLIGRAPHY_LIBHD (the scheduler code runs against the stand-in libHD in
+// openhaptics_standin_test.cpp).
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <catch2/catch.hpp>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/devices/device_registry.hpp"
@@ -11,6 +19,7 @@
 #include "devices/openhaptics/hd_errors.hpp"
 #include "devices/openhaptics/hd_library.hpp"
 #include "devices/openhaptics/openhaptics_device.hpp"
+#include "devices/shared_library_check.hpp"
 
 using namespace calligraphy::openhaptics;
 using calligraphy::Vec3;
@@ -20,9 +29,14 @@ namespace {
 // Sets CALLIGRAPHY_LIBHD for one scope.
 class ScopedLibhdPath {
  public:
+  /// nullptr unsets it.
   explicit ScopedLibhdPath(const char* value) {
     if (const char* old = std::getenv("CALLIGRAPHY_LIBHD")) previous_ = old;
-    ::setenv("CALLIGRAPHY_LIBHD", value, 1);
+    if (value == nullptr) {
+      ::unsetenv("CALLIGRAPHY_LIBHD");
+    } else {
+      ::setenv("CALLIGRAPHY_LIBHD", value, 1);
+    }
   }
   ~ScopedLibhdPath() {
     if (previous_) {
@@ -40,6 +54,16 @@ std::string not_found_message() {
   try {
     (void)HdLibrary::load();
   } catch (const calligraphy::DeviceNotFound& e) {
+    return e.what();
+  }
+  return {};
+}
+
+// What loading says of a CALLIGRAPHY_LIBHD that is not a loadable libHD.
+std::string unavailable_message() {
+  try {
+    (void)HdLibrary::load();
+  } catch (const calligraphy::DeviceUnavailable& e) {
     return e.what();
   }
   return {};
@@ -109,10 +133,9 @@ TEST_CASE("HD millimetres and axes convert to device metres, forces map back pow
 
 TEST_CASE("Without libHD: DeviceNotFound 'OpenHaptics not found' listing the paths tried", "[openhaptics]") {
   {
-    const ScopedLibhdPath path("/nonexistent/libHD.so");
+    const ScopedLibhdPath path(nullptr);
     const std::string message = not_found_message();
     CHECK(message.find("OpenHaptics not found") != std::string::npos);
-    CHECK(message.find("/nonexistent/libHD.so") != std::string::npos);
     CHECK(message.find("libHD.so.3.4") != std::string::npos);
     CHECK(message.find("/usr/lib/libHD.so") != std::string::npos);
     OpenHapticsDevice device;
@@ -121,15 +144,90 @@ TEST_CASE("Without libHD: DeviceNotFound 'OpenHaptics not found' listing the pat
     calligraphy::DeviceState state;
     CHECK(device.read_state(state) == calligraphy::DeviceFault::not_open);
     CHECK(device.write_force(Vec3::Zero()) == calligraphy::DeviceFault::not_open);
+    const auto survey = calligraphy::device_registry().survey();
+    bool noted = false;
+    for (const auto& note : survey.notes)
+      noted = noted || note.rfind("openhaptics: OpenHaptics not found", 0) == 0;
+    CHECK(noted);
+  }
+  {
+    // A path the user named is that path or nothing: its problem is the error, named.
+    const ScopedLibhdPath path("/nonexistent/libHD.so");
+    const std::string message = unavailable_message();
+    CHECK(message.find("CALLIGRAPHY_LIBHD=/nonexistent/libHD.so") != std::string::npos);
+    CHECK(message.find("No such file") != std::string::npos);
   }
   {
     // A library that loads but is not libHD is rejected by its missing symbols, not crashed on.
     const ScopedLibhdPath path("libm.so.6");
-    CHECK(not_found_message().find("libm.so.6: loaded, but lacks hdInitDevice") != std::string::npos);
+    CHECK(unavailable_message().find("libm.so.6 cannot be loaded: loaded, but lacks hdInitDevice") !=
+          std::string::npos);
   }
-  const auto survey = calligraphy::device_registry().survey();
-  bool noted = false;
-  for (const auto& note : survey.notes)
-    noted = noted || note.rfind("openhaptics: OpenHaptics not found", 0) == 0;
-  CHECK(noted);
+}
+
+TEST_CASE("A damaged CALLIGRAPHY_LIBHD is an error naming the path and why, never a crash or a hang",
+          "[openhaptics]") {
+  const std::filesystem::path folder =
+      std::filesystem::temp_directory_path() / ("calligraphy-libhd-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(folder);
+  const auto write = [&](const char* name, const std::string& bytes) {
+    const auto file = folder / name;
+    std::ofstream(file, std::ios::binary) << bytes;
+    return file.string();
+  };
+  // The first bytes of a real shared object (this machine's libm), cut short: its segments point past
+  // the end of the file, which is what makes dlopen fault with SIGBUS.
+  std::string library_head;
+  {
+    std::ifstream libm("/lib/x86_64-linux-gnu/libm.so.6", std::ios::binary);
+    library_head.assign(std::istreambuf_iterator<char>(libm), {});
+    library_head.resize(std::min<std::size_t>(library_head.size(), 8192));
+  }
+  const std::string fifo = (folder / "fifo.so").string();
+  ::mkfifo(fifo.c_str(), 0600);
+  struct Case {
+    std::string path;
+    const char* why;
+  };
+  std::vector<Case> cases = {{folder.string(), "a directory"},
+                             {write("empty.so", ""), "empty"},
+                             {write("short.so", "not a library\n"), "too short"},
+                             {write("text.so", std::string(200, 'x')), "not an ELF file"},
+                             {fifo, "a FIFO"},
+                             {"/dev/zero", "a character device"}};
+  if (library_head.size() == 8192) cases.push_back({write("truncated.so", library_head), "truncated"});
+  for (const Case& c : cases) {
+    INFO(c.path);
+    const ScopedLibhdPath path(c.path.c_str());
+    const std::string message = unavailable_message();
+    CHECK(message.find(c.path) != std::string::npos);
+    CHECK(message.find(c.why) != std::string::npos);
+    OpenHapticsDevice device;
+    CHECK_THROWS_AS(device.open(), calligraphy::DeviceUnavailable);
+  }
+  std::filesystem::remove_all(folder);
+}
+
+TEST_CASE("The probe loads a library in a child process and reports a crash there", "[openhaptics]") {
+  using calligraphy::devices::probe_shared_library;
+  CHECK(probe_shared_library("libm.so.6", "cos").empty());
+  CHECK(probe_shared_library("libm.so.6", "hdInitDevice") == "loaded, but lacks hdInitDevice");
+  CHECK(probe_shared_library("/nonexistent/libHD.so", "hdInitDevice").find("No such file") !=
+        std::string::npos);
+  // A truncated shared object, past the checks that would refuse it: loading it is the child's problem.
+  std::string library_head;
+  {
+    std::ifstream libm("/lib/x86_64-linux-gnu/libm.so.6", std::ios::binary);
+    library_head.assign(std::istreambuf_iterator<char>(libm), {});
+  }
+  if (library_head.size() > 8192) {
+    library_head.resize(8192);
+    const auto file = std::filesystem::temp_directory_path() /
+                      ("calligraphy-truncated-" + std::to_string(::getpid()) + ".so");
+    std::ofstream(file, std::ios::binary) << library_head;
+    const std::string outcome = probe_shared_library(file.string(), "cos");
+    INFO(outcome);
+    CHECK_FALSE(outcome.empty());
+    std::filesystem::remove(file);
+  }
 }

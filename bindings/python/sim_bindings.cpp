@@ -238,6 +238,8 @@ void bind_registry(py::module_& m) {
       .def_readonly("hardware", &DeviceListing::hardware,
                     "a physical device (False for simulated and emulated)")
       .def_readonly("details", &DeviceListing::details, "free text: transport, caveats")
+      .def_readonly("limits_known", &DeviceListing::limits_known,
+                    "False when info's limits are read only when the device is opened (they are 0 here)")
       .def("__repr__", [](const DeviceListing& d) {
         return "<DeviceListing " + d.name + " (" + d.info.model + (d.hardware ? ", hardware" : "") + ")>";
       });

@@ -1,10 +1,17 @@
 #pragma once
 // The devices the command line offers: the process registry with the simulated device and the
 // Phantom emulator registered.
+#include <string>
+
 #include "calligraphy/devices/device_registry.hpp"
 
 namespace calligraphy::cli {
 
 DeviceRegistry& cli_device_registry();
+
+/// The listing of the device `name` given to `option`, scanning only its backend. A name no backend knows
+/// is a UsageError (exit 2) naming the option and the devices there are; a known device that cannot be
+/// used now propagates DeviceUnavailable with the backend's reason (exit 1).
+[[nodiscard]] DeviceListing find_cli_device(const char* option, const std::string& name);
 
 }  // namespace calligraphy::cli

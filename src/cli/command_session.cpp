@@ -199,15 +199,8 @@ int run_sessions(const SessionRunCommand& command) {
   if (command.display.display == "window") trainer::register_trainer_devices();  // mouse, mouse-hand
 #endif
   const LoadedProtocol protocol = load_study_protocol(command.protocol);
-  const DeviceSurvey survey = cli_device_registry().survey();
-  const DeviceListing* device = nullptr;
-  for (const DeviceListing& listing : survey.devices)
-    device = listing.name == command.device ? &listing : device;
-  if (!device) {
-    std::string names;
-    for (const DeviceListing& listing : survey.devices) names += (names.empty() ? "" : ", ") + listing.name;
-    throw UsageError("--device: unknown device '" + command.device + "'; registered devices: " + names);
-  }
+  const DeviceListing found_device = find_cli_device("--device", command.device);
+  const DeviceListing* device = &found_device;
   // Simulated subjects rule out a person before the device is looked at.
   if (command.subjects > 0 && command.writer == kPersonWriter) {
     throw UsageError("--subjects: simulated subjects need --writer simulated");

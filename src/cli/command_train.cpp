@@ -79,15 +79,7 @@ std::pair<int, int> window_size(const std::string& text) {
   return {width, height};
 }
 
-void require_device(const std::string& name) {
-  const DeviceSurvey survey = cli_device_registry().survey();
-  for (const DeviceListing& listing : survey.devices) {
-    if (listing.name == name) return;
-  }
-  std::string names;
-  for (const DeviceListing& listing : survey.devices) names += (names.empty() ? "" : ", ") + listing.name;
-  throw UsageError("--device: unknown device '" + name + "'; registered devices: " + names);
-}
+void require_device(const std::string& name) { static_cast<void>(find_cli_device("--device", name)); }
 
 int run_train(const TrainCommand& command) {
   check_train_files(command);

@@ -58,17 +58,10 @@ struct TrialCommand {
   std::string json, svg, csv;
 };
 
-// The listing of `name`, or a UsageError (exit 2) naming every device that can be opened.
-DeviceListing find_device(const std::string& name) {
-  const DeviceSurvey survey = cli_device_registry().survey();
-  const auto found = std::find_if(survey.devices.begin(), survey.devices.end(),
-                                  [&](const DeviceListing& listing) { return listing.name == name; });
-  if (found != survey.devices.end()) return *found;
-  std::string names;
-  for (const DeviceListing& listing : survey.devices) names += (names.empty() ? "" : ", ") + listing.name;
-  throw UsageError("--device: unknown device '" + name +
-                   "'; registered devices: " + (names.empty() ? "none" : names));
-}
+// The listing of `name`. A name no backend knows is a UsageError (exit 2) naming the devices there are; a
+// known device that cannot be used now (DeviceUnavailable: no arm, a damaged driver library) keeps its
+// own error, with its reason (exit 1).
+DeviceListing find_device(const std::string& name) { return find_cli_device("--device", name); }
 
 // The trial specification of the command line: every option given goes through the specification's one
 // parser (trial_spec.hpp) and its validate(); an error there is a usage error naming the option.

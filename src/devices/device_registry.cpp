@@ -1,6 +1,7 @@
 #include "calligraphy/devices/device_registry.hpp"
 
 #include <algorithm>
+#include <optional>
 #include <ostream>
 #include <utility>
 
@@ -113,20 +114,64 @@ DeviceSurvey DeviceRegistry::survey() const {
   return all;
 }
 
-std::unique_ptr<HapticDevice> DeviceRegistry::create(std::string_view name) const {
-  std::string available;
-  for (const auto& backend : snapshot()) {
-    for (const auto& device : scan_one(backend).devices) {
-      if (device.name == name) {
-        auto created = backend.create(device);
-        if (!created) throw DeviceError("device '" + device.name + "': the backend returned no device");
-        return created;
-      }
-      available += (available.empty() ? "" : ", ") + device.name;
+namespace {
+
+// True when `backend` names its devices so that `name` is one of them: "<backend>" or "<backend>:<id>".
+bool names_device(const DeviceBackend& backend, std::string_view name) {
+  return name == backend.name ||
+         (name.size() > backend.name.size() && name.substr(0, backend.name.size()) == backend.name &&
+          name[backend.name.size()] == ':');
+}
+
+std::optional<DeviceListing> listed(DeviceSurvey& survey, const DeviceBackend& backend,
+                                    std::string_view name) {
+  for (auto& device : survey.devices) {
+    if (device.name != name) continue;
+    device.backend = backend.name;
+    return std::move(device);
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+DeviceRegistry::Found DeviceRegistry::find_with_backend(std::string_view name) const {
+  const std::vector<DeviceBackend> backends = snapshot();
+  // Only the backend that makes devices of this name is scanned: opening the simulated device must not
+  // load a driver library or touch USB devices.
+  for (const auto& backend : backends) {
+    if (!names_device(backend, name)) continue;
+    DeviceSurvey survey;
+    try {
+      survey = backend.scan();
+    } catch (const Error& e) {
+      throw DeviceUnavailable("device '" + std::string(name) + "' cannot be used: " + e.what());
     }
+    if (auto device = listed(survey, backend, name)) return {std::move(*device), backend};
+    std::string why;
+    for (const auto& note : survey.notes) why += (why.empty() ? "" : "; ") + note;
+    throw DeviceUnavailable("device '" + std::string(name) + "' cannot be used now: " +
+                            (why.empty() ? "its backend '" + backend.name + "' found no such device" : why) +
+                            " (`calligraphy devices` lists what each backend finds)");
+  }
+  // Backends that name their devices otherwise: every one is asked.
+  std::string available;
+  for (const auto& backend : backends) {
+    DeviceSurvey survey = scan_one(backend);
+    if (auto device = listed(survey, backend, name)) return {std::move(*device), backend};
+    for (const auto& device : survey.devices) available += (available.empty() ? "" : ", ") + device.name;
   }
   throw DeviceNotFound("no haptic device named '" + std::string(name) +
                        "'; available: " + (available.empty() ? "none" : available));
+}
+
+DeviceListing DeviceRegistry::find(std::string_view name) const { return find_with_backend(name).listing; }
+
+std::unique_ptr<HapticDevice> DeviceRegistry::create(std::string_view name) const {
+  const Found found = find_with_backend(name);
+  auto created = found.backend.create(found.listing);
+  if (!created) throw DeviceError("device '" + found.listing.name + "': the backend returned no device");
+  return created;
 }
 
 std::unique_ptr<HapticDevice> DeviceRegistry::open(std::string_view name) const {
@@ -152,14 +197,18 @@ void print_device_survey(std::ostream& out, const DeviceSurvey& survey) {
   for (const auto& device : survey.devices) {
     const auto& info = device.info;
     out << device.name << (device.hardware ? "" : "  (not hardware)") << '\n'
-        << "  model:              " << info.model << " (" << info.manufacturer << ")\n"
-        << "  max force:          " << info.max_force_n << " N (continuous " << info.max_continuous_force_n
-        << " N)\n"
-        << "  max stiffness:      " << info.max_stiffness_n_per_m << " N/m\n"
-        << "  max damping:        " << info.max_damping_n_s_per_m << " N s/m\n"
-        << "  workspace:          radius " << info.workspace_radius_m << " m, box "
-        << info.workspace_size_m.x() << " x " << info.workspace_size_m.y() << " x "
-        << info.workspace_size_m.z() << " m\n";
+        << "  model:              " << info.model << " (" << info.manufacturer << ")\n";
+    if (!device.limits_known) {
+      out << "  limits:             read from the device when it is opened\n";
+    } else {
+      out << "  max force:          " << info.max_force_n << " N (continuous " << info.max_continuous_force_n
+          << " N)\n"
+          << "  max stiffness:      " << info.max_stiffness_n_per_m << " N/m\n"
+          << "  max damping:        " << info.max_damping_n_s_per_m << " N s/m\n"
+          << "  workspace:          radius " << info.workspace_radius_m << " m, box "
+          << info.workspace_size_m.x() << " x " << info.workspace_size_m.y() << " x "
+          << info.workspace_size_m.z() << " m\n";
+    }
     if (!device.details.empty()) out << "  details:            " << device.details << '\n';
   }
   if (!survey.any_hardware()) {

@@ -13,6 +13,7 @@ std::string device_survey_json(const DeviceSurvey& survey) {
          {"backend", listing.backend},
          {"hardware", listing.hardware},
          {"details", listing.details},
+         {"limits_known", listing.limits_known},
          {"info",
           {{"model", info.model},
            {"manufacturer", info.manufacturer},

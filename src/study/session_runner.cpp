@@ -34,16 +34,6 @@ std::string stop_reason(const SessionRunOptions& options) {
 }
 
 // The registry's listing of the session's device (whether a person moves it, what it can do).
-DeviceListing find_listing(const DeviceRegistry& registry, const std::string& name) {
-  DeviceSurvey survey = registry.survey();
-  for (DeviceListing& listing : survey.devices) {
-    if (listing.name == name) return std::move(listing);
-  }
-  std::string names;
-  for (const DeviceListing& listing : survey.devices) names += (names.empty() ? "" : ", ") + listing.name;
-  throw DeviceNotFound("device '" + name + "' is not attached; devices: " + (names.empty() ? "none" : names));
-}
-
 // Refuses, before any trial runs, a plan this build or this device cannot carry out.
 void check_plan(const SessionManifest& session, const DeviceListing& device) {
   for (const PlannedTrial& trial : session.plan) {
@@ -170,7 +160,7 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
   const SessionManifest& manifest = session.manifest();
   const DeviceRegistry& registry =
       run_options.registry ? *run_options.registry : device_registry_with_simulation();
-  const DeviceListing listing = find_listing(registry, manifest.setup.device);
+  const DeviceListing listing = registry.find(manifest.setup.device);  // only its backend is scanned
   check_plan(manifest, listing);
   const bool simulated_writer = manifest.setup.writer == "simulated";
 

@@ -288,9 +288,7 @@ int run_trainer(const TrainerOptions& options) {
   // installed the handlers already (a study session) keeps them.
   std::optional<StopSignals> signals;
   if (!StopSignals::installed()) signals.emplace();
-  bool hardware = false;
-  for (const DeviceListing& listing : device_registry_with_simulation().survey().devices)
-    hardware = hardware || (listing.name == options.device && listing.hardware);
+  const bool hardware = device_registry_with_simulation().find(options.device).hardware;
   TrainerApp app(options, probe->info(), hardware);
   return app.run();
 }

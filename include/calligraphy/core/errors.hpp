@@ -49,6 +49,15 @@ class DeviceNotFound : public DeviceError {
   using DeviceError::DeviceError;
 };
 
+/// A backend knows the device that was asked for but cannot use it now: its driver loaded but found no
+/// arm, the USB device refused access, a library on the way is damaged. The message names the backend's
+/// reason and what to try. Unlike a name that no backend knows (DeviceNotFound), this is not a typing
+/// error.
+class DeviceUnavailable : public DeviceError {
+ public:
+  using DeviceError::DeviceError;
+};
+
 /// The transport to the device failed: timeout, unplug, malformed packet stream.
 class CommunicationError : public DeviceError {
  public:

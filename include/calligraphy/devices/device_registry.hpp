@@ -30,6 +30,9 @@ struct DeviceListing {
   DeviceInfo info;        ///< SI units
   bool hardware = false;  ///< a physical device (false for simulated and emulated ones)
   std::string details;    ///< free text for people: transport, caveats
+  /// False when `info`'s limits are read from the device only when it is opened (OpenHaptics): they are
+  /// zero here, and listings say so instead of printing them.
+  bool limits_known = true;
 };
 
 /// What a scan of the backends found, plus notes on what was checked and not found.
@@ -39,9 +42,10 @@ struct DeviceSurvey {
   [[nodiscard]] bool any_hardware() const;
 };
 
-/// A source of devices. `scan` may be slow (USB enumeration, dlopen) and may throw DeviceError, which
-/// the registry turns into a note. `create` gets a listing that `scan` returned and returns an unopened
-/// device; it throws DeviceError subclasses.
+/// A source of devices. A backend names its devices as itself ("simulated") or "<backend>:<id>"
+/// ("phantom-hid:/dev/hidraw3"), so that opening one device scans only its backend. `scan` may be slow (USB
+/// enumeration, dlopen) and may throw DeviceError, which the registry turns into a note. `create` gets a
+/// listing that `scan` returned and returns an unopened device; it throws DeviceError subclasses.
 struct DeviceBackend {
   std::string name;
   std::function<DeviceSurvey()> scan;
@@ -69,13 +73,24 @@ class DeviceRegistry {
 
   /// Scans every backend. A backend that throws adds a note instead of failing the survey.
   [[nodiscard]] DeviceSurvey survey() const;
-  /// Creates (does not open) the device called `name`. Throws DeviceNotFound naming the devices that
-  /// exist, or what the backend's factory throws.
+  /// The listing of the device called `name`. Only the backend whose devices are named so is scanned
+  /// (a device of another backend's driver is never loaded or touched); a name no backend claims asks
+  /// every backend. Throws DeviceUnavailable when its backend exists but cannot give the device now (the
+  /// message has the backend's reason and what to try: a driver that found no arm, a damaged library, a
+  /// USB permission), DeviceNotFound when no backend has such a device (naming those that exist).
+  [[nodiscard]] DeviceListing find(std::string_view name) const;
+  /// Creates (does not open) the device called `name`: find(name), then the backend's factory. Throws
+  /// what find() throws, or what the factory throws.
   [[nodiscard]] std::unique_ptr<HapticDevice> create(std::string_view name) const;
   /// create(name), then open(). Throws what either throws.
   [[nodiscard]] std::unique_ptr<HapticDevice> open(std::string_view name) const;
 
  private:
+  struct Found {
+    DeviceListing listing;
+    DeviceBackend backend;
+  };
+  [[nodiscard]] Found find_with_backend(std::string_view name) const;
   [[nodiscard]] std::vector<DeviceBackend> snapshot() const;
   // Adds a checked backend under the lock; false when its name is taken.
   bool add_if_absent(DeviceBackend backend);

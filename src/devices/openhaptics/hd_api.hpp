@@ -97,5 +97,6 @@ using StartSchedulerFn = void (*)();
 using StopSchedulerFn = void (*)();
 using CheckCalibrationFn = HDenum (*)();
 using UpdateCalibrationFn = void (*)(HDint style);
+using SetSchedulerRateFn = void (*)(unsigned long rate_hz);
 
 }  // namespace calligraphy::openhaptics::hd

@@ -90,6 +90,25 @@ const char* hd_error_name(hd::HDerror code) noexcept {
   }
 }
 
+const char* hd_init_advice(hd::HDerror code) noexcept {
+  using namespace hd;
+  switch (code) {
+    case HD_COMM_CONFIG_ERROR:
+      return "no arm answers under that configuration: check that the device is plugged in and powered, and "
+             "that its configuration (Touch Setup / Geomagic Touch Diagnostic) names it";
+    case HD_COMM_ERROR:
+    case HD_DEVICE_FAULT:
+    case HD_TIMER_ERROR:
+      return "the link to the arm failed: re-plug it, check its power, and run the vendor's diagnostic";
+    case HD_DEVICE_ALREADY_INITIATED:
+      return "another program (or another part of this one) holds the device: close it and try again";
+    case HD_INVALID_LICENSE:
+      return "the OpenHaptics licence was refused: check the installation of OpenHaptics";
+    default:
+      return "run the vendor's diagnostic tool to see whether the device works outside this program";
+  }
+}
+
 void throw_hd_error(const hd::HDErrorInfo& error, std::string_view context) {
   const std::string message = "OpenHaptics: " + std::string(context) + ": " + hd_error_name(error.errorCode) +
                               " (code " + std::to_string(error.errorCode) + ", internal " +

@@ -20,6 +20,10 @@ enum class HdErrorKind {
 /// "HD_COMM_ERROR" etc.; "HD_UNKNOWN_ERROR" for codes not listed in hd_api.hpp. Static storage.
 [[nodiscard]] const char* hd_error_name(hd::HDerror code) noexcept;
 
+/// What to try when hdInitDevice fails with `code`, for people ("check that the arm is connected ...").
+/// Static storage.
+[[nodiscard]] const char* hd_init_advice(hd::HDerror code) noexcept;
+
 /// Throws the exception of the error's kind: CommunicationError, SafetyFault, or DeviceError (usage,
 /// setup). The message names `context`, the code and the internal code. Precondition: an error.
 [[noreturn]] void throw_hd_error(const hd::HDErrorInfo& error, std::string_view context);

@@ -1,10 +1,12 @@
 #include "devices/openhaptics/hd_library.hpp"
 
 #include <dlfcn.h>
+#include <sys/stat.h>
 
 #include <cstdlib>
 
 #include "calligraphy/core/errors.hpp"
+#include "devices/shared_library_check.hpp"
 
 namespace calligraphy::openhaptics {
 namespace {
@@ -41,7 +43,32 @@ std::vector<std::string> HdLibrary::candidate_paths() {
 
 std::shared_ptr<const HdLibrary> HdLibrary::load() {
   std::string tried;
+  const char* explicit_path = std::getenv("CALLIGRAPHY_LIBHD");
   for (const auto& path : candidate_paths()) {
+    const bool named_by_user = explicit_path != nullptr && path == explicit_path;
+    // A path is checked before this process maps it, and a file that passes is loaded once in a child
+    // process first: a damaged library must not take the caller down (SIGBUS) or hang it (a FIFO).
+    if (path.find('/') != std::string::npos) {
+      struct stat info {};
+      if (!named_by_user && ::stat(path.c_str(), &info) != 0) {
+        tried += "\n  " + path + ": no such file";
+        continue;
+      }
+      if (std::string problem = devices::shared_library_problem(path); !problem.empty()) {
+        if (named_by_user)
+          throw DeviceUnavailable("OpenHaptics: CALLIGRAPHY_LIBHD=" + path + " cannot be loaded: " + problem +
+                                  "; set it to the full path of libHD.so, or unset it");
+        tried += "\n  " + path + ": " + problem;
+        continue;
+      }
+    }
+    if (std::string problem = devices::probe_shared_library(path, "hdInitDevice"); !problem.empty()) {
+      if (named_by_user)
+        throw DeviceUnavailable("OpenHaptics: CALLIGRAPHY_LIBHD=" + path + " cannot be loaded: " + problem +
+                                "; set it to the full path of libHD.so, or unset it");
+      tried += "\n  " + path + ": " + problem;
+      continue;
+    }
     void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
     if (handle == nullptr) {
       const char* why = dlerror();
@@ -70,6 +97,7 @@ std::shared_ptr<const HdLibrary> HdLibrary::load() {
     bind(handle, "hdStopScheduler", library->stop_scheduler, missing);
     bind(handle, "hdCheckCalibration", library->check_calibration, missing);
     bind(handle, "hdUpdateCalibration", library->update_calibration, missing);
+    bind(handle, "hdSetSchedulerRate", library->set_scheduler_rate, missing);
     if (missing.empty()) return library;
     tried += "\n  " + path + ": loaded, but lacks " + missing;
   }

@@ -14,7 +14,10 @@ class HdLibrary {
   /// Where load() looks, in order: $CALLIGRAPHY_LIBHD when set, then the loader's search path and the
   /// usual install locations.
   [[nodiscard]] static std::vector<std::string> candidate_paths();
-  /// Loads the first candidate that opens and has every symbol. Throws DeviceNotFound
+  /// Loads the first candidate that opens and has every symbol. A candidate that is a path is checked
+  /// first (shared_library_check.hpp) and every candidate is loaded once in a child process before this
+  /// one maps it, so a damaged file cannot crash or hang the caller. Throws DeviceUnavailable naming
+  /// $CALLIGRAPHY_LIBHD and why when that path is not a loadable library, else DeviceNotFound
   /// "OpenHaptics not found" listing each path tried and why it failed.
   [[nodiscard]] static std::shared_ptr<const HdLibrary> load();
 
@@ -41,6 +44,7 @@ class HdLibrary {
   hd::StopSchedulerFn stop_scheduler = nullptr;
   hd::CheckCalibrationFn check_calibration = nullptr;
   hd::UpdateCalibrationFn update_calibration = nullptr;
+  hd::SetSchedulerRateFn set_scheduler_rate = nullptr;
 
  private:
   HdLibrary() = default;

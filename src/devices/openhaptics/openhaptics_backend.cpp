@@ -14,7 +14,7 @@ DeviceSurvey scan() {
   std::shared_ptr<const HdLibrary> library;
   try {
     library = HdLibrary::load();
-  } catch (const DeviceNotFound& e) {
+  } catch (const DeviceError& e) {  // not found, or a damaged CALLIGRAPHY_LIBHD
     return DeviceSurvey{{}, {std::string("openhaptics: ") + e.what()}};
   }
   // Like CHAI3D: initialise the default device to learn whether one is there and what it can do.
@@ -22,8 +22,8 @@ DeviceSurvey scan() {
   if (const hd::HDErrorInfo error = library->get_error(); error.errorCode != hd::HD_SUCCESS) {
     return DeviceSurvey{
         {},
-        {"openhaptics: " + library->path + " loaded, but no device: hdInitDevice failed with " +
-         hd_error_name(error.errorCode)}};
+        {"openhaptics: " + library->path + " loaded, but hdInitDevice(default device) failed with " +
+         hd_error_name(error.errorCode) + ": " + hd_init_advice(error.errorCode)}};
   }
   library->disable_device(handle);
   DeviceListing listing;
@@ -31,8 +31,11 @@ DeviceSurvey scan() {
   listing.hardware = true;
   listing.info.model = "OpenHaptics default device";
   listing.info.manufacturer = "see info() after open()";
+  listing.limits_known = false;
   listing.details =
-      "via " + library->path + "; limits are read at open(); this backend is untested (no libHD here)";
+      "via " + library->path +
+      "; the force is computed in the HD scheduler's own frame; tested against a stand-in libHD "
+      "written from the public HDAPI reference, not against a real arm";
   return DeviceSurvey{{listing}, {}};
 }
 

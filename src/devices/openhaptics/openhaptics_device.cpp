@@ -3,6 +3,8 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <cmath>
+#include <thread>
 #include <utility>
 
 #include "calligraphy/core/errors.hpp"
@@ -24,9 +26,16 @@ void throw_if_error(const HdLibrary& library, std::string_view context) {
 
 }  // namespace
 
-OpenHapticsDevice::OpenHapticsDevice(std::string configuration_name, double watchdog_timeout_s)
-    : configuration_name_(std::move(configuration_name)), watchdog_timeout_s_(watchdog_timeout_s) {
+OpenHapticsDevice::OpenHapticsDevice(std::string configuration_name, double watchdog_timeout_s,
+                                     double servo_rate_hz)
+    : configuration_name_(std::move(configuration_name)),
+      watchdog_timeout_s_(watchdog_timeout_s),
+      servo_rate_hz_(servo_rate_hz) {
   if (!(watchdog_timeout_s > 0.0)) throw InvalidArgument("OpenHapticsDevice: watchdog timeout must be > 0 s");
+  if (!(servo_rate_hz >= 100.0 && servo_rate_hz <= 10000.0)) {
+    throw InvalidArgument("OpenHapticsDevice: servo rate " + std::to_string(servo_rate_hz) +
+                          " Hz must be in [100, 10000] Hz");
+  }
   info_.model = "OpenHaptics device (not opened)";
   info_.manufacturer = "unknown";
 }
@@ -51,23 +60,32 @@ void OpenHapticsDevice::open() {
   if (open_) return;
   library_ = HdLibrary::load();  // DeviceNotFound "OpenHaptics not found ..."
   spdlog::warn(
-      "OpenHaptics: using {}; this backend was never run against a real libHD (none on the build machine)",
+      "OpenHaptics: using {}; this backend was tested against a stand-in libHD written from the public HDAPI "
+      "reference (frames, scheduler, errors, calibration, faults), never against 3D Systems' libHD and an "
+      "arm",
       library_->path);
   handle_ = library_->init_device(configuration_name_.empty() ? nullptr : configuration_name_.c_str());
   if (const hd::HDErrorInfo error = library_->get_error(); error.errorCode != hd::HD_SUCCESS) {
     handle_ = hd::HD_INVALID_HANDLE;
+    const std::string path = library_->path;
     library_.reset();
-    throw DeviceNotFound(std::string("OpenHaptics: hdInitDevice(") +
-                         (configuration_name_.empty() ? "default device" : configuration_name_) +
-                         ") failed: " + hd_error_name(error.errorCode));
+    throw DeviceUnavailable(std::string("OpenHaptics: ") + path + " loaded, but hdInitDevice(" +
+                            (configuration_name_.empty() ? "default device" : configuration_name_) +
+                            ") failed with " + hd_error_name(error.errorCode) + " (internal code " +
+                            std::to_string(error.internalErrorCode) +
+                            "): " + hd_init_advice(error.errorCode));
   }
   try {
     read_info();
     library_->enable(hd::HD_FORCE_OUTPUT);  // forces stay zero until enable_forces(true)
     scheduler_error_.store(hd::HD_SUCCESS);
     watchdog_tripped_.store(false);
+    library_->set_scheduler_rate(static_cast<unsigned long>(std::lround(servo_rate_hz_)));
+    throw_if_error(*library_,
+                   "setting the scheduler rate to " + std::to_string(std::lround(servo_rate_hz_)) + " Hz");
     servo_callback_ = library_->schedule_asynchronous(&OpenHapticsDevice::servo_tick, this,
                                                       hd::HD_DEFAULT_SCHEDULER_PRIORITY);
+    throw_if_error(*library_, "scheduling the servo callback");
     library_->start_scheduler();
     throw_if_error(*library_, "starting the scheduler");
     open_ = true;
@@ -97,6 +115,7 @@ void OpenHapticsDevice::close() noexcept {
     }
   }
   forces_enabled_.store(false);
+  detach();
   library_->stop_scheduler();
   if (servo_callback_ != 0) library_->unschedule(servo_callback_);
   servo_callback_ = 0;
@@ -161,11 +180,39 @@ hd::HDCallbackCode OpenHapticsDevice::servo_tick(void* self) noexcept {
   hd_api.get_doublev(hd::HD_CURRENT_POSITION, position_mm.data());
   hd_api.get_doublev(hd::HD_CURRENT_VELOCITY, velocity_mm_s.data());
   hd_api.get_integerv(hd::HD_CURRENT_BUTTONS, &buttons);
+  // An error of this frame's reads (a lost link) is known before the frame function runs, so the tick
+  // that reads this state also sees the fault.
+  const auto note_error = [device](const hd::HDErrorInfo& error) noexcept {
+    if (error.errorCode == hd::HD_SUCCESS) return;
+    hd::HDerror expected = hd::HD_SUCCESS;
+    device->scheduler_error_.compare_exchange_strong(expected, error.errorCode);
+    device->forces_enabled_.store(false, std::memory_order_release);
+  };
+  note_error(hd_api.get_error());
+  device->frame_state_.position_m = hd_mm_to_device_m(position_mm);
+  device->frame_state_.velocity_m_s = hd_mm_to_device_m(velocity_mm_s);
+  device->frame_state_.buttons = static_cast<std::uint32_t>(buttons);
+  device->frame_state_.time_s = now;
 
-  const auto command = device->command_.load();
   Vec3 force = Vec3::Zero();
-  if (device->forces_enabled_.load(std::memory_order_acquire) &&
-      device->scheduler_error_.load(std::memory_order_relaxed) == hd::HD_SUCCESS) {
+  const bool healthy = device->forces_enabled_.load(std::memory_order_acquire) &&
+                       device->scheduler_error_.load(std::memory_order_relaxed) == hd::HD_SUCCESS;
+  // Device clock: the attached tick reads this frame's state and sets this frame's force.
+  device->frame_busy_.store(true, std::memory_order_seq_cst);
+  const FrameFunction frame = device->frame_.load(std::memory_order_seq_cst);
+  if (frame != nullptr) {
+    device->frame_force_set_ = false;
+    device->in_frame_.store(true, std::memory_order_relaxed);
+    frame(device->frame_context_.load(std::memory_order_relaxed));
+    device->in_frame_.store(false, std::memory_order_relaxed);
+    if (device->frame_force_set_ && device->forces_enabled_.load(std::memory_order_acquire) &&
+        device->scheduler_error_.load(std::memory_order_relaxed) == hd::HD_SUCCESS) {
+      force = device->frame_force_;
+    }
+  }
+  device->frame_busy_.store(false, std::memory_order_release);
+  if (frame == nullptr && healthy) {  // the latest command of another thread, within the watchdog
+    const auto command = device->command_.load();
     if (now - command[3] > device->watchdog_timeout_s_) {
       device->watchdog_tripped_.store(true, std::memory_order_release);
       device->forces_enabled_.store(false, std::memory_order_release);
@@ -176,18 +223,30 @@ hd::HDCallbackCode OpenHapticsDevice::servo_tick(void* self) noexcept {
   const auto hd_force = device_force_to_hd(force);
   hd_api.set_doublev(hd::HD_CURRENT_FORCE, hd_force.data());
   hd_api.end_frame(device->handle_);
-
-  const hd::HDErrorInfo error = hd_api.get_error();
-  if (error.errorCode != hd::HD_SUCCESS) {
-    hd::HDerror expected = hd::HD_SUCCESS;
-    device->scheduler_error_.compare_exchange_strong(expected, error.errorCode);
-    device->forces_enabled_.store(false, std::memory_order_release);
-  }
-  const Vec3 position = hd_mm_to_device_m(position_mm);
-  const Vec3 velocity = hd_mm_to_device_m(velocity_mm_s);
-  device->state_.store({position.x(), position.y(), position.z(), velocity.x(), velocity.y(), velocity.z(),
-                        static_cast<double>(buttons), now});
+  note_error(hd_api.get_error());
+  device->publish_frame_state(now);
   return hd::HD_CALLBACK_CONTINUE;
+}
+
+void OpenHapticsDevice::publish_frame_state(double now) noexcept {
+  const DeviceState& s = frame_state_;
+  state_.store({s.position_m.x(), s.position_m.y(), s.position_m.z(), s.velocity_m_s.x(), s.velocity_m_s.y(),
+                s.velocity_m_s.z(), static_cast<double>(s.buttons), now});
+}
+
+void OpenHapticsDevice::attach(FrameFunction frame, void* context) {
+  if (!open_) throw DeviceError("OpenHaptics: attach() to a device that is not open");
+  if (frame == nullptr) throw InvalidArgument("OpenHaptics: attach() needs a frame function");
+  if (frame_.load() != nullptr) throw StateError("OpenHaptics: a frame function is attached already");
+  frame_context_.store(context, std::memory_order_relaxed);
+  frame_.store(frame, std::memory_order_seq_cst);
+}
+
+void OpenHapticsDevice::detach() noexcept {
+  frame_.store(nullptr, std::memory_order_seq_cst);
+  // The scheduler marks itself busy before it loads the function: once it is not busy after the store
+  // above, no call of the old function is under way or can start.
+  while (frame_busy_.load(std::memory_order_seq_cst)) std::this_thread::yield();
 }
 
 // Servo path: codes, no exception, allocation or string (the HD code is kept in scheduler_error_).
@@ -196,6 +255,10 @@ DeviceFault OpenHapticsDevice::read_state(DeviceState& state) noexcept {
   if (const hd::HDerror error = scheduler_error_.load(std::memory_order_relaxed); error != hd::HD_SUCCESS) {
     forces_enabled_.store(false);
     return hd_servo_fault(error);
+  }
+  if (in_frame_.load(std::memory_order_relaxed)) {  // the device clock's tick: this frame's own state
+    state = frame_state_;
+    return DeviceFault::none;
   }
   if (watchdog_tripped_.exchange(false)) return DeviceFault::watchdog;
   const auto values = state_.load();
@@ -208,13 +271,23 @@ DeviceFault OpenHapticsDevice::read_state(DeviceState& state) noexcept {
 
 DeviceFault OpenHapticsDevice::write_force(const Vec3& force_n) noexcept {
   if (!open_) return DeviceFault::not_open;
-  const double now = monotonic_seconds();
+  const bool in_frame = in_frame_.load(std::memory_order_relaxed);
+  const double now = in_frame ? frame_state_.time_s : monotonic_seconds();
   if (!force_n.allFinite()) {
     forces_enabled_.store(false, std::memory_order_release);
+    if (in_frame) {
+      frame_force_ = Vec3::Zero();
+      frame_force_set_ = true;
+    }
     command_.store({0.0, 0.0, 0.0, now});
     return DeviceFault::non_finite_force;
   }
   const Vec3 limited = clamp_force_magnitude(force_n, info_.max_force_n);
+  if (in_frame) {  // the device clock's tick: this frame sends it
+    frame_force_ = limited;
+    frame_force_set_ = true;
+    return DeviceFault::none;
+  }
   command_.store({limited.x(), limited.y(), limited.z(), now});
   return DeviceFault::none;
 }

@@ -1,26 +1,32 @@
 #pragma once
-// HapticDevice over OpenHaptics' HDAPI, loaded at run time (hd_library.hpp). UNTESTED here: no libHD
-// was available on the build machine; only the error mapping, unit conversions and the "not found"
-// path are covered by tests.
+// HapticDevice over OpenHaptics' HDAPI, loaded at run time (hd_library.hpp). Tested against a stand-in
+// libHD written from the public HDAPI reference (tests/hd_stand_in), never against 3D Systems' own.
 //
-// OpenHaptics owns the 1 kHz loop: an asynchronous scheduler callback reads position (mm), velocity
-// (mm/s) and buttons and writes the latest commanded force (N) inside hdBeginFrame/hdEndFrame. The
-// servo thread exchanges data with it through sequence locks (no locks, no allocation).
+// OpenHaptics owns the 1 kHz loop: an asynchronous scheduler callback brackets each servo frame with
+// hdBeginFrame/hdEndFrame, reads position (mm), velocity (mm/s) and buttons, and sets the force (N). The
+// device is its own servo clock (device_servo_clock.hpp): with a frame function attached (a ServoLoop),
+// the callback calls it between the reads and the force, so the force answers the position of the same
+// frame. Without one, read_state/write_force exchange data with the callback through sequence locks (no
+// locks, no allocation) and the force is the latest command, one frame or more behind.
 #include <atomic>
 #include <memory>
 #include <string>
 
+#include "calligraphy/devices/device_servo_clock.hpp"
 #include "calligraphy/devices/haptic_device.hpp"
 #include "devices/openhaptics/hd_library.hpp"
 #include "devices/openhaptics/seqlock.hpp"
 
 namespace calligraphy::openhaptics {
 
-class OpenHapticsDevice final : public HapticDevice {
+class OpenHapticsDevice final : public HapticDevice, public DeviceServoClock {
  public:
   /// `configuration_name`: an OpenHaptics device configuration name; empty for HD_DEFAULT_DEVICE.
-  /// `watchdog_timeout_s` [s]: no write_force for this long turns forces off.
-  explicit OpenHapticsDevice(std::string configuration_name = {}, double watchdog_timeout_s = 0.05);
+  /// `watchdog_timeout_s` [s]: without a frame function attached, no write_force for this long turns
+  /// forces off. `servo_rate_hz`: the HD scheduler's rate (hdSetSchedulerRate; devices accept 500, 1000
+  /// and some 2000). Throws InvalidArgument for a timeout <= 0 or a rate outside [100, 10000] Hz.
+  explicit OpenHapticsDevice(std::string configuration_name = {}, double watchdog_timeout_s = 0.05,
+                             double servo_rate_hz = 1000.0);
   ~OpenHapticsDevice() override;
 
   /// Valid after open(); before, a placeholder with zero limits.
@@ -50,13 +56,23 @@ class OpenHapticsDevice final : public HapticDevice {
   /// The first HD error the scheduler callback saw since open() (HD_SUCCESS: none). Any thread.
   [[nodiscard]] hd::HDerror servo_error() const noexcept { return scheduler_error_.load(); }
 
+  /// The HD scheduler is this device's servo clock.
+  [[nodiscard]] DeviceServoClock* servo_clock() noexcept override { return this; }
+  [[nodiscard]] double servo_rate_hz() const noexcept override { return servo_rate_hz_; }
+  /// Throws DeviceError when not open, StateError when a frame function is attached already.
+  void attach(FrameFunction frame, void* context) override;
+  void detach() noexcept override;
+
  private:
   static hd::HDCallbackCode servo_tick(void* self) noexcept;
   static hd::HDCallbackCode calibration_check(void* self) noexcept;
   void read_info();
 
+  void publish_frame_state(double now) noexcept;
+
   std::string configuration_name_;
   double watchdog_timeout_s_;
+  double servo_rate_hz_;
   std::shared_ptr<const HdLibrary> library_;
   hd::HHD handle_ = hd::HD_INVALID_HANDLE;
   hd::HDSchedulerHandle servo_callback_ = 0;
@@ -69,6 +85,17 @@ class OpenHapticsDevice final : public HapticDevice {
   hd::HDenum calibration_result_ = hd::HD_CALIBRATION_OK;  // written by the synchronous calibration call
   SeqLocked<8> state_;    // position m (3), velocity m/s (3), buttons, time s
   SeqLocked<4> command_;  // force N in device frame (3), time s of the write
+
+  // The attached frame function (device clock). `frame_busy_` is set by the scheduler around its check
+  // and call, so that detach() can wait until no call is under way.
+  std::atomic<FrameFunction> frame_{nullptr};
+  std::atomic<void*> frame_context_{nullptr};
+  std::atomic<bool> frame_busy_{false};
+  // Inside a frame call, on the scheduler thread only: the frame's state and the force it will send.
+  std::atomic<bool> in_frame_{false};
+  DeviceState frame_state_;
+  Vec3 frame_force_ = Vec3::Zero();
+  bool frame_force_set_ = false;
 };
 
 }  // namespace calligraphy::openhaptics
