@@ -265,6 +265,50 @@ class TrainerTest(unittest.TestCase):
         outside = [(x, y) for x in range(0, int(box.x) - 2, 4) for y in range(0, image.height, 4)]
         self.assertFalse(any(is_blue(*image.pixel(x, y)) or is_yellow(*image.pixel(x, y)) for x, y in outside))
 
+    def test_a_haptic_device_writes_yong_through_the_stand_in_libhd(self):
+        """`train --device openhaptics` on the stand-in libHD the tests build (CALLIGRAPHY_HD_STAND_IN), whose
+        hand plays back the simulated writer's pen path: the trial runs on the HD scheduler's clock."""
+        stand_in = os.environ.get("CALLIGRAPHY_HD_STAND_IN", "")
+        if not stand_in or not pathlib.Path(stand_in).exists():
+            self.skipTest("no stand-in libHD (CALLIGRAPHY_HD_STAND_IN)")
+        folder = pathlib.Path(self.folder)
+        written = subprocess.run([CLI, "trial", "永", "--csv", str(folder / "writer.csv")], capture_output=True)
+        self.assertEqual(written.returncode, 0, written.stderr.decode())
+        with open(folder / "writer.csv", newline="") as f:
+            rows = list(csv.DictReader(f))
+        with open(folder / "path.txt", "w") as f:  # HDAPI's frame and mm; 1 s of rest while the window opens
+            points = [(0.0, rows[0])] + [(1.0 + float(row["t"]), row) for row in rows[::5] + rows[-1:]]
+            for t, row in points:
+                x, y, z = (float(row[k]) for k in ("x", "y", "z"))
+                f.write(f"{t} {1000 * x} {1000 * z} {-1000 * y}\n")
+            f.write(f"{points[-1][0] + 0.1} {1000 * x} {1000 * z + 10} {-1000 * y}\n")  # then lifts the pen
+        environment = {"CALLIGRAPHY_LIBHD": stand_in, "HD_STAND_IN_PATH": str(folder / "path.txt")}
+        saved = {k: os.environ.get(k) for k in environment}
+        os.environ.update(environment)
+        try:
+            trainer = self.start("永", "--device", "openhaptics", "--session", "out", "--screenshot",
+                                 "out/openhaptics.png", "--exit-after", "60")
+        finally:
+            for k, v in saved.items():
+                if v is None:
+                    os.environ.pop(k, None)
+                else:
+                    os.environ[k] = v
+        self.assertEqual(trainer.wait(), 0, trainer.errors())
+        (record_path,) = saved_trials(folder / "out")
+        record = json.loads(record_path.read_text(encoding="utf-8"))
+        self.assertEqual(record["device"]["name"], "openhaptics")
+        self.assertTrue(record["device"]["hardware"])
+        self.assertEqual(record["end_reason"], "completed")
+        self.assertEqual((record["strokes_completed"], record["strokes_total"]), (5, 5))
+        self.assertTrue(record["loop"]["device_clock"])
+        self.assertGreater(record["device"]["time_at_start_s"], 100.0)  # the stand-in's own clock
+        with open(record_path.with_suffix(".csv"), newline="") as f:
+            trace = list(csv.DictReader(f))
+        self.assertEqual(float(trace[0]["t"]), 0.0)
+        self.assertEqual(len(trace), record["loop"]["ticks"])
+        keep_artifact(folder / "out" / "openhaptics.png")
+
     def test_the_real_pointer_writes_yi_on_the_mouse_device(self):
         trainer = self.start("一", "--device", "mouse", "--data", SAMPLE, "--session", "out", "--exit-after", "60")
         (box,) = trainer.boxes()
@@ -870,6 +914,7 @@ GROUPS = {
     # Each test ends its program early (a few seconds each): a lost display, then the stop signals.
     "lost_display": ("test_a_lost_display",),
     "stop_signals": ("EndingTest",),
+    "openhaptics": ("test_a_haptic_device_writes_yong_through_the_stand_in_libhd",),
 }
 
 

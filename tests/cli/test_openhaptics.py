@@ -1,0 +1,150 @@
+#!/usr/bin/env python3
+"""The `calligraphy` program with the OpenHaptics backend (docs/devices.md), run by CTest as
+`cli_openhaptics_tests` against the stand-in libHD the test suite builds (tests/hd_stand_in), which is
+set up through its environment variables:
+
+- a trial on the stand-in: the stand-in's hand plays back a pen path (from the simulated writer's trace of
+  the same character, turned into HDAPI's frame and millimetres); the trial completes and its times start
+  at 0 although the stand-in's clock reads its own;
+- a device that cannot initialise: exit 1 with the HD error and what to try, not "unknown device";
+- a CALLIGRAPHY_LIBHD that is not a loadable library (a folder, an empty, short, truncated or text file, a
+  FIFO, /dev/zero, a missing file): commands that do not use OpenHaptics run as if it were not set and
+  never load it, `devices` notes the path and why, `--device openhaptics` exits 1 naming them; nothing
+  crashes or hangs.
+
+CALLIGRAPHY_CLI names the program, CALLIGRAPHY_HD_STAND_IN the stand-in. Standard library only (unittest).
+"""
+import csv
+import json
+import os
+import shutil
+import subprocess
+import tempfile
+import unittest
+from pathlib import Path
+
+CLI = os.environ.get("CALLIGRAPHY_CLI", "")
+STAND_IN = os.environ.get("CALLIGRAPHY_HD_STAND_IN", "")
+YONG = "永"
+TIMEOUT_S = 120  # a hang fails the case instead of blocking CTest
+
+
+def hd_mm(x, y, z):
+    """HDAPI's frame (x right, y up, z towards the user; mm) from the library's (x right, y away, z up; m)."""
+    return 1000.0 * x, 1000.0 * z, -1000.0 * y
+
+
+class OpenHapticsTestCase(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        if not CLI or not Path(CLI).exists():
+            raise unittest.SkipTest(f"CALLIGRAPHY_CLI={CLI!r} is not the calligraphy program")
+        if not STAND_IN or not Path(STAND_IN).exists():
+            raise AssertionError(f"CALLIGRAPHY_HD_STAND_IN={STAND_IN!r} is not the stand-in libHD")
+        cls.folder = tempfile.TemporaryDirectory(prefix="calligraphy-openhaptics-")
+        cls.dir = Path(cls.folder.name)
+        # A pen path: the simulated writer's trace of the character, 1 kHz, resampled at 5 ms.
+        trace = cls.dir / "writer.csv"
+        result = subprocess.run([CLI, "trial", YONG, "--csv", str(trace)], capture_output=True, timeout=TIMEOUT_S)
+        assert result.returncode == 0, result.stderr.decode()
+        with open(trace, newline="") as f:
+            rows = list(csv.DictReader(f))
+        cls.path = cls.dir / "path.txt"
+        x = y = z = 0.0
+        with open(cls.path, "w") as f:
+            f.write(f"0 {' '.join(map(str, hd_mm(float(rows[0]['x']), float(rows[0]['y']), float(rows[0]['z']))))}\n")
+            for row in rows[::5] + rows[-1:]:
+                x, y, z = hd_mm(float(row["x"]), float(row["y"]), float(row["z"]))
+                f.write(f"{0.3 + float(row['t'])} {x} {y} {z}\n")  # 0.3 s of rest while the trial starts
+            # The trace ends where the last stroke was accepted, pen down: the hand then lifts the pen.
+            f.write(f"{0.4 + float(rows[-1]['t'])} {x} {y + 10.0} {z}\n")
+        cls.written_s = 0.4 + float(rows[-1]["t"])
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.folder.cleanup()
+
+    def run_cli(self, *args, **environment):
+        env = {k: v for k, v in os.environ.items() if not k.startswith(("CALLIGRAPHY_LIBHD", "HD_STAND_IN_"))}
+        env.update(environment)
+        return subprocess.run([CLI, *map(str, args)], cwd=self.dir, env=env, capture_output=True, timeout=TIMEOUT_S)
+
+    def test_a_trial_on_the_stand_in_completes_with_times_from_zero(self):
+        out = self.dir / "trial.json"
+        trace = self.dir / "trial.csv"
+        result = self.run_cli("trial", YONG, "--device", "openhaptics", "--json", out, "--csv", trace,
+                              CALLIGRAPHY_LIBHD=STAND_IN, HD_STAND_IN_PATH=str(self.path))
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
+        record = json.loads(out.read_text())
+        self.assertEqual(record["end_reason"], "completed")
+        self.assertEqual(record["strokes_completed"], 5)
+        self.assertLess(record["trial_time_s"], self.written_s + 1.0)
+        self.assertGreater(record["device_time_at_start_s"], 100.0)  # the stand-in's own clock
+        self.assertTrue(record["loop"]["device_clock"])
+        with open(trace, newline="") as f:
+            first = next(csv.DictReader(f))
+        self.assertEqual(float(first["t"]), 0.0)
+
+    def test_a_device_that_cannot_initialise_is_named_with_its_reason(self):
+        result = self.run_cli("trial", YONG, "--device", "openhaptics", CALLIGRAPHY_LIBHD=STAND_IN,
+                              HD_STAND_IN_FAIL_INIT="0x303")
+        message = result.stderr.decode()
+        self.assertEqual(result.returncode, 1, message)
+        self.assertIn("HD_COMM_CONFIG_ERROR", message)
+        self.assertIn("plugged in", message)
+        self.assertNotIn("unknown device", message)
+        listing = self.run_cli("devices", CALLIGRAPHY_LIBHD=STAND_IN, HD_STAND_IN_FAIL_INIT="0x303")
+        self.assertEqual(listing.returncode, 0)
+        self.assertIn("HD_COMM_CONFIG_ERROR", listing.stdout.decode())
+        working = self.run_cli("devices", CALLIGRAPHY_LIBHD=STAND_IN)
+        self.assertIn("openhaptics", working.stdout.decode())
+        self.assertIn("read from the device when it is opened", working.stdout.decode())
+        self.assertNotIn("max force:          0 N", working.stdout.decode())
+
+    def damaged_paths(self):
+        folder = self.dir / "damaged"
+        folder.mkdir(exist_ok=True)
+        library = Path(STAND_IN).read_bytes()
+        cases = {"a folder": (folder, "a directory"), "/dev/zero": (Path("/dev/zero"), "a character device"),
+                 "missing": (folder / "missing.so", "No such file")}
+        for name, content, why in [("empty.so", b"", "empty"), ("short.so", b"libHD\n", "too short"),
+                                   ("text.so", b"x" * 300, "not an ELF file"),
+                                   ("truncated.so", library[: len(library) // 3], "truncated")]:
+            (folder / name).write_bytes(content)
+            cases[name] = (folder / name, why)
+        fifo = folder / "fifo.so"
+        if not fifo.exists():
+            os.mkfifo(fifo)
+        cases["fifo"] = (fifo, "a FIFO")
+        return cases
+
+    def test_a_damaged_libhd_path_never_crashes_or_hangs_a_command(self):
+        for name, (path, why) in self.damaged_paths().items():
+            with self.subTest(name):
+                plain = self.run_cli("trial", YONG, CALLIGRAPHY_LIBHD=str(path))
+                self.assertEqual(plain.returncode, 0, plain.stderr.decode())
+                listing = self.run_cli("devices", CALLIGRAPHY_LIBHD=str(path))
+                self.assertEqual(listing.returncode, 0, listing.stderr.decode())
+                self.assertIn(str(path), listing.stdout.decode())
+                self.assertIn(why, listing.stdout.decode())
+                asked = self.run_cli("trial", YONG, "--device", "openhaptics", CALLIGRAPHY_LIBHD=str(path))
+                message = asked.stderr.decode()
+                self.assertEqual(asked.returncode, 1, message)
+                self.assertIn(str(path), message)
+                self.assertIn(why, message)
+
+    def test_commands_on_the_simulated_device_never_load_libhd(self):
+        marker = self.dir / "loaded"
+        for args in (["trial", YONG], ["trial", YONG, "--pacing", "real-time", "--max-duration", "1"]):
+            with self.subTest(" ".join(args)):
+                marker.unlink(missing_ok=True)
+                result = self.run_cli(*args, CALLIGRAPHY_LIBHD=STAND_IN, HD_STAND_IN_LOADED_MARKER=str(marker))
+                self.assertIn(result.returncode, (0, 1), result.stderr.decode())
+                self.assertFalse(marker.exists(), "the command loaded libHD")
+        # The marker does work: `devices` probes every backend and so loads it.
+        self.run_cli("devices", CALLIGRAPHY_LIBHD=STAND_IN, HD_STAND_IN_LOADED_MARKER=str(marker))
+        self.assertTrue(marker.exists())
+
+
+if __name__ == "__main__":
+    unittest.main()
