@@ -5,6 +5,9 @@
 # installs the library and builds a separate project against it with find_package(calligraphy).
 # Each stage builds only what it tests; at the end the script prints each stage's time, and after each
 # CTest run its ten slowest tests (docs/testing.md: the time budget and how to run the long sweeps).
+# A build that the running tests do not need is made beside them, in the background at idle priority
+# (SCHED_IDLE: it takes only the processor time the tests leave, which is much: the trainer's and the
+# real-time tests wait on a person's pace and on the clock), so the two cores are not left idle.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
@@ -37,7 +40,42 @@ print_stage_times() {
   printf '%6d s  in all\n' $(($(date +%s) - script_start))
   return "$status"
 }
-trap print_stage_times EXIT
+trap 'stop_background; print_stage_times' EXIT
+
+# A build in the background (setsid: its own process group, so that a failure elsewhere ends it too), at
+# idle priority; its output is printed, and its time counted as a stage of its own, when it is waited for.
+background_pid=""
+background_name=""
+background_log=""
+background_start=0
+start_background() {
+  background_name=$1
+  background_log=$(mktemp)
+  background_start=$(date +%s)
+  echo "== $1: in the background at idle priority, beside the next stage"
+  setsid chrt --idle 0 bash -c "$2" >"$background_log" 2>&1 &
+  background_pid=$!
+}
+wait_background() {
+  local status=0
+  wait "$background_pid" || status=$?
+  background_pid=""
+  echo "== $background_name (output of the background build)"
+  cat "$background_log"
+  rm -f "$background_log"
+  stage_names+=("$background_name (in the background)")
+  stage_seconds+=($(($(date +%s) - background_start)))
+  if [ "$status" -ne 0 ]; then
+    stage_name="$background_name"
+    stage_start=$background_start
+    return "$status"
+  fi
+}
+stop_background() {
+  [ -n "$background_pid" ] || return 0
+  kill -- "-$background_pid" 2>/dev/null || true
+  wait "$background_pid" 2>/dev/null || true
+}
 
 # ctest in DIR with the given arguments; its output also goes to DIR/ctest-output.log, from which the ten
 # slowest tests are printed whether the run passed or failed.
@@ -71,43 +109,46 @@ cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCALLIGRAPHY_WARNINGS_A
   -DCALLIGRAPHY_BUILD_PYTHON=ON -DCALLIGRAPHY_BUILD_TESTS=ON >/dev/null
 cmake --build build -j "$jobs"
 end_stage
-begin_stage "Release tests"
-run_ctest build
-end_stage
-
-begin_stage "AddressSanitizer + UndefinedBehaviorSanitizer: build"
 # At -O1 (-O0 made the sweeps 2-3 times slower), with line tables only (-g1: enough for the sanitizers'
 # stack traces, which name functions, files and lines; less to write and link than -g). The trainer's window (Mesa, X11), the Python module (the
 # interpreter is not instrumented) and the benchmarks are left to the Release stage: here they would test
 # other programs' code or nothing of their own. The sweeps run on random subsets sized
 # for the sanitizer (tests/test_sizing.hpp prints the seed).
-cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" \
-  -DCALLIGRAPHY_SANITIZE=address,undefined -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_BENCH=OFF \
-  -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_TRAINER=OFF >/dev/null
-cmake --build build-asan -j "$jobs"
+start_background "AddressSanitizer + UndefinedBehaviorSanitizer: build" "
+  cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG='-O1 -g1' \
+    -DCALLIGRAPHY_SANITIZE=address,undefined -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_BENCH=OFF \
+    -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_TRAINER=OFF >/dev/null &&
+  cmake --build build-asan -j $jobs"
+begin_stage "Release tests"
+run_ctest build
 end_stage
+wait_background
+
+# -Wno-tsan: GCC warns that TSan does not model atomic_thread_fence (the OpenHaptics seqlock uses it);
+# the seqlock's fields are atomics, so no race is hidden. Only the servo-loop test program (with the
+# OpenHaptics stand-in it loads) and the modules it links are built, at -O1. The fuzzers: a replay, not a
+# fuzzing run (docs/corpus.md has those): it keeps the fuzz targets building as sources move, and every
+# seed and regression input passing. Both are built beside the sanitizer tests.
+start_background "ThreadSanitizer and fuzzer (clang, libFuzzer) builds" "
+  cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO='-O1 -g1' \
+    -DCALLIGRAPHY_SANITIZE=thread \
+    -DCMAKE_CXX_FLAGS=-Wno-tsan -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_TOOLS=OFF \
+    -DCALLIGRAPHY_BUILD_BENCH=OFF -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_EXAMPLES=OFF >/dev/null &&
+  cmake --build build-tsan -j $jobs --target calligraphy_servo_tests &&
+  cmake -S . -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCALLIGRAPHY_BUILD_FUZZERS=ON \
+    -DCALLIGRAPHY_BUILD_TESTS=OFF -DCALLIGRAPHY_BUILD_BENCH=OFF -DCALLIGRAPHY_BUILD_PYTHON=OFF \
+    -DCALLIGRAPHY_BUILD_EXAMPLES=OFF -DCALLIGRAPHY_BUILD_TOOLS=OFF -DCALLIGRAPHY_BUILD_TRAINER=OFF >/dev/null &&
+  cmake --build build-fuzz -j $jobs --target character_data_fuzzer corpus_store_fuzzer"
 begin_stage "AddressSanitizer + UndefinedBehaviorSanitizer: tests"
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 run_ctest build-asan -E "study_report_chromium"
 end_stage
+wait_background
 
-begin_stage "ThreadSanitizer: the servo loop and its log queue"
-# -Wno-tsan: GCC warns that TSan does not model atomic_thread_fence (the OpenHaptics seqlock uses it);
-# those tests are not run here. Only the servo-loop test program and the modules it links are built, at -O1.
-cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
-  -DCALLIGRAPHY_SANITIZE=thread \
-  -DCMAKE_CXX_FLAGS=-Wno-tsan -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_TOOLS=OFF \
-  -DCALLIGRAPHY_BUILD_BENCH=OFF -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_EXAMPLES=OFF >/dev/null
-cmake --build build-tsan -j "$jobs" --target calligraphy_servo_tests
+begin_stage "ThreadSanitizer: the servo loop, its log queue and the OpenHaptics stand-in"
 TSAN_OPTIONS=halt_on_error=1 build-tsan/bin/calligraphy_servo_tests "[servo],[log_queue]"
 end_stage
 
-begin_stage "Fuzzers (clang, libFuzzer): build, and replay their seeds and every input that ever failed"
-# A replay, not a fuzzing run (docs/corpus.md has those): it keeps the fuzz targets building as sources
-# move, and every seed and regression input passing.
-cmake -S . -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCALLIGRAPHY_BUILD_FUZZERS=ON \
-  -DCALLIGRAPHY_BUILD_TESTS=OFF -DCALLIGRAPHY_BUILD_BENCH=OFF -DCALLIGRAPHY_BUILD_PYTHON=OFF \
-  -DCALLIGRAPHY_BUILD_EXAMPLES=OFF -DCALLIGRAPHY_BUILD_TOOLS=OFF -DCALLIGRAPHY_BUILD_TRAINER=OFF >/dev/null
-cmake --build build-fuzz -j "$jobs" --target character_data_fuzzer corpus_store_fuzzer
+begin_stage "Fuzzers: replay their seeds and every input that ever failed"
 build-fuzz/bin/character_data_fuzzer -runs=0 data/hanzi-writer-data tests/data/hostile
 build-fuzz/bin/corpus_store_fuzzer -runs=0 fuzz/seeds tests/data/store_regressions
 end_stage
