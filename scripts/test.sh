@@ -108,6 +108,7 @@ begin_stage "Release build, warnings as errors"
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON \
   -DCALLIGRAPHY_BUILD_PYTHON=ON -DCALLIGRAPHY_BUILD_TESTS=ON >/dev/null
 cmake --build build -j "$jobs"
+python3 scripts/build-times.py build  # where the build's time went: per target, and the slowest steps
 end_stage
 # At -O1 (-O0 made the sweeps 2-3 times slower), with line tables only (-g1: enough for the sanitizers'
 # stack traces, which name functions, files and lines; less to write and link than -g). The trainer's window (Mesa, X11), the Python module (the
@@ -123,6 +124,7 @@ begin_stage "Release tests"
 run_ctest build
 end_stage
 wait_background
+python3 scripts/build-times.py build-asan
 
 # -Wno-tsan: GCC warns that TSan does not model atomic_thread_fence (the OpenHaptics seqlock uses it);
 # the seqlock's fields are atomics, so no race is hidden. Only the servo-loop test program (with the

@@ -97,7 +97,8 @@ std::shared_ptr<const HdLibrary> HdLibrary::load() {
     bind(handle, "hdStopScheduler", library->stop_scheduler, missing);
     bind(handle, "hdCheckCalibration", library->check_calibration, missing);
     bind(handle, "hdUpdateCalibration", library->update_calibration, missing);
-    bind(handle, "hdSetSchedulerRate", library->set_scheduler_rate, missing);
+    // Optional: without it the scheduler keeps its default rate, 1000 Hz (HDAPI reference).
+    library->set_scheduler_rate = reinterpret_cast<hd::SetSchedulerRateFn>(dlsym(handle, "hdSetSchedulerRate"));
     if (missing.empty()) return library;
     tried += "\n  " + path + ": loaded, but lacks " + missing;
   }

@@ -44,7 +44,7 @@ class HdLibrary {
   hd::StopSchedulerFn stop_scheduler = nullptr;
   hd::CheckCalibrationFn check_calibration = nullptr;
   hd::UpdateCalibrationFn update_calibration = nullptr;
-  hd::SetSchedulerRateFn set_scheduler_rate = nullptr;
+  hd::SetSchedulerRateFn set_scheduler_rate = nullptr;  ///< may be null: the scheduler then runs at 1000 Hz
 
  private:
   HdLibrary() = default;

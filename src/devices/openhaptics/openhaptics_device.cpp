@@ -15,6 +15,8 @@
 namespace calligraphy::openhaptics {
 namespace {
 
+constexpr double kDefaultSchedulerRateHz = 1000.0;  // HDAPI reference: the scheduler's default rate
+
 double monotonic_seconds() noexcept {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
@@ -80,9 +82,15 @@ void OpenHapticsDevice::open() {
     library_->enable(hd::HD_FORCE_OUTPUT);  // forces stay zero until enable_forces(true)
     scheduler_error_.store(hd::HD_SUCCESS);
     watchdog_tripped_.store(false);
-    library_->set_scheduler_rate(static_cast<unsigned long>(std::lround(servo_rate_hz_)));
-    throw_if_error(*library_,
-                   "setting the scheduler rate to " + std::to_string(std::lround(servo_rate_hz_)) + " Hz");
+    if (library_->set_scheduler_rate != nullptr) {
+      library_->set_scheduler_rate(static_cast<unsigned long>(std::lround(servo_rate_hz_)));
+      throw_if_error(*library_,
+                     "setting the scheduler rate to " + std::to_string(std::lround(servo_rate_hz_)) + " Hz");
+    } else if (servo_rate_hz_ != kDefaultSchedulerRateHz) {
+      throw DeviceError("OpenHaptics: " + library_->path +
+                        " has no hdSetSchedulerRate, so its scheduler runs at 1000 Hz, not " +
+                        std::to_string(std::lround(servo_rate_hz_)) + " Hz");
+    }
     servo_callback_ = library_->schedule_asynchronous(&OpenHapticsDevice::servo_tick, this,
                                                       hd::HD_DEFAULT_SCHEDULER_PRIORITY);
     throw_if_error(*library_, "scheduling the servo callback");
