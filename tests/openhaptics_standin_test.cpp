@@ -248,7 +248,9 @@ TEST_CASE(
   CHECK(result.metrics.strokes_completed == 5);
   REQUIRE_FALSE(result.trace.empty());
   CHECK(result.trace.front().time_s == 0.0);
-  CHECK(result.metrics.time_s < path.t_s.back() + 1.0);
+  // The trial's clock, not the stand-in's (1600 s and more); longer than the path on a loaded machine,
+  // whose hand keeps its own ticks' time.
+  CHECK(result.metrics.time_s < 2.0 * path.t_s.back() + 5.0);
   CHECK(result.device_time_at_start_s > 100.0);  // the stand-in's clock is not the trial's
   REQUIRE(result.loop);
   CHECK(result.loop->realtime.device_clock);

@@ -78,7 +78,9 @@ class OpenHapticsTestCase(unittest.TestCase):
         record = json.loads(out.read_text())
         self.assertEqual(record["end_reason"], "completed")
         self.assertEqual(record["strokes_completed"], 5)
-        self.assertLess(record["trial_time_s"], self.written_s + 1.0)
+        # The trial's clock, not the stand-in's (which reads 1600 s and more): about the path's length in
+        # time, longer on a loaded machine (the stand-in's hand keeps its own ticks' time).
+        self.assertLess(record["trial_time_s"], 2.0 * self.written_s + 5.0)
         self.assertGreater(record["device_time_at_start_s"], 100.0)  # the stand-in's own clock
         self.assertTrue(record["loop"]["device_clock"])
         with open(trace, newline="") as f:
