@@ -33,7 +33,7 @@ nlohmann::json read_trial_record(const fs::path& json_file) {
   const std::string source = json_file.string();
   nlohmann::json record =
       parse_json(read_small_file(json_file, kMaxRecordBytes, "trial record (JSON)"), source);
-  if (!record.is_object() || record.value("format", "") != "calligraphy-study-trial") {
+  if (!record.is_object() || !record.contains("format") || record["format"] != "calligraphy-study-trial") {
     fail(source, "/format", "expected \"calligraphy-study-trial\"");
   }
   return record;

@@ -2,6 +2,8 @@
 
 #include <map>
 
+#include "calligraphy/core/errors.hpp"
+#include "study/json_reader.hpp"
 #include "study/names.hpp"
 #include "study/saved_sessions.hpp"
 
@@ -44,8 +46,14 @@ SessionSeries session_series(const fs::path& root, const std::string& subject_id
     // What links the next session to this one: its last trial's end and the next session's delay.
     PreviousSession previous;
     previous.session_id = manifest.session_id;
-    previous.ended_utc =
-        study_detail::read_trial_record(last_record).value("end_time_utc", manifest.created_utc);
+    const nlohmann::json record = study_detail::read_trial_record(last_record);
+    const study_detail::JsonView view(record, "", last_record.string());
+    previous.ended_utc = view.string_or("end_time_utc", manifest.created_utc);
+    try {
+      (void)study_detail::utc_seconds(previous.ended_utc);
+    } catch (const InvalidArgument& e) {
+      study_detail::fail(last_record.string(), "/end_time_utc", e.what());
+    }
     for (const ProtocolPhase& phase : protocol.protocol.phases) {
       if (phase.session == number + 1) {
         previous.delay_s = phase.delay_s;

@@ -1,0 +1,187 @@
+#!/usr/bin/env python3
+"""Damaged study files through the program, run by CTest as `study_damaged_cli`: every value of a trial
+record, a session manifest and a protocol replaced by one of another type or beyond a double's range gives
+the data error (exit 1) naming the file, never an internal error (exit 3); a trial that wrote no stroke is
+shown on the report page; subnormal option values are finite.
+
+CALLIGRAPHY_CLI names the program. Standard library only.
+"""
+import hashlib
+import json
+import os
+import resource
+import shutil
+import signal
+import subprocess
+import tempfile
+import unittest
+from pathlib import Path
+
+CLI = os.environ.get("CALLIGRAPHY_CLI", "")
+
+PROTOCOL = {
+    "format": "calligraphy-study-protocol",
+    "version": 1,
+    "name": "damage",
+    "conditions": [{"name": "vision", "mode": "vision"}, {"name": "haptic", "mode": "haptic"}],
+    "phases": [
+        {"phase": "pre-test", "condition": "vision", "characters": ["十"]},
+        {"phase": "training", "condition": "haptic", "characters": ["十"]},
+        {"phase": "post-test", "condition": "vision", "characters": ["十"]},
+        {"phase": "retention", "condition": "vision", "characters": ["十"], "session": 2, "delay_s": 60},
+    ],
+    "trial": {"max_duration_s": 20},
+}
+
+# Values of other types, and numbers a double cannot hold (written into the text: json.dumps refuses them).
+WRONG_VALUES = ["5", "\"x\"", "[]", "{}", "true", "[1e999]", "1e999", "-1e999", "1e400"]
+
+
+def digest(path):
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+class DamagedStudyTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        if not CLI or not Path(CLI).exists():
+            raise unittest.SkipTest(f"CALLIGRAPHY_CLI={CLI!r} is not the calligraphy program: run through ctest")
+        cls.pristine = tempfile.TemporaryDirectory(prefix="calligraphy-damaged-")
+        root = Path(cls.pristine.name)
+        (root / "p.json").write_text(json.dumps(PROTOCOL, ensure_ascii=False), encoding="utf-8")
+        done = subprocess.run([CLI, "session", "run", "p.json", "--writer", "simulated", "--subjects", "1",
+                               "--out", "S"], cwd=root, capture_output=True, timeout=600)
+        assert done.returncode == 0, done.stderr.decode()
+        cls.sessions = sorted(p for p in (root / "S" / "S01").iterdir() if p.is_dir())
+        assert len(cls.sessions) == 2
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.pristine.cleanup()
+
+    def setUp(self):
+        self.folder = tempfile.TemporaryDirectory(prefix="calligraphy-damaged-run-")
+        self.cwd = Path(self.folder.name)
+        shutil.copytree(Path(self.pristine.name), self.cwd, dirs_exist_ok=True)
+
+    def tearDown(self):
+        self.folder.cleanup()
+
+    def run_cli(self, *args):
+        return subprocess.run([CLI, *map(str, args)], cwd=self.cwd, capture_output=True, timeout=600)
+
+    def first_session(self):
+        return self.cwd / "S" / "S01" / self.sessions[0].name
+
+    def assert_data_error(self, result, file_name, what):
+        stderr = result.stderr.decode()
+        self.assertEqual(result.returncode, 1, f"{what}: exit {result.returncode}: {stderr}")
+        self.assertNotIn("internal error", stderr, what)
+        self.assertIn(file_name, stderr, what)
+
+    def damaged_copies(self, path):
+        """(description, text) for the JSON file at `path` with one value replaced by a wrong one: every
+        member at any depth (the first element of each array), each top-level one by every wrong value,
+        deeper ones by three in turn."""
+        original = json.loads(path.read_text(encoding="utf-8"))
+        paths = []
+
+        def walk(value, at):
+            paths.append(at)
+            if isinstance(value, dict):
+                for key, member in value.items():
+                    walk(member, at + [key])
+            elif isinstance(value, list) and value:
+                walk(value[0], at + [0])
+
+        walk(original, [])
+        for number, at in enumerate(paths[1:]):
+            wrongs = WRONG_VALUES if len(at) == 1 else [WRONG_VALUES[(number + k) % len(WRONG_VALUES)]
+                                                        for k in (0, 3, 6)]
+            for wrong in wrongs:
+                document = json.loads(json.dumps(original))
+                parent = document
+                for step in at[:-1]:
+                    parent = parent[step]
+                parent[at[-1]] = "@@"
+                pointer = "/" + "/".join(str(step) for step in at)
+                yield f"{path.name}: {pointer} = {wrong}", json.dumps(document).replace("\"@@\"", wrong)
+
+    def test_every_wrong_value_of_a_trial_record_is_a_data_error_naming_the_file(self):
+        record = sorted((self.first_session() / "trials").glob("*.json"))[0]
+        text = record.read_text(encoding="utf-8")
+        for what, damaged in self.damaged_copies(record):
+            with self.subTest(what):
+                record.write_text(damaged, encoding="utf-8")
+                for command in (["report", "S", "--csv", "."], ["report", "S", "--out", "r.html"]):
+                    result = self.run_cli(*command)
+                    # A key its readers do not need may hold anything; one they read is named.
+                    if result.returncode != 0:
+                        self.assert_data_error(result, record.name, f"{what} ({command[2]})")
+        record.write_text(text, encoding="utf-8")
+
+    def test_every_wrong_value_of_a_session_manifest_is_a_data_error_naming_the_file(self):
+        manifest = self.first_session() / "session.json"
+        for what, damaged in self.damaged_copies(manifest):
+            with self.subTest(what):
+                manifest.write_text(damaged, encoding="utf-8")
+                result = self.run_cli("report", "S", "--csv", ".")
+                if result.returncode != 0:
+                    self.assert_data_error(result, "session.json", what)
+
+    def test_a_previous_session_end_of_another_type_is_named_by_session_run(self):
+        shutil.rmtree(self.cwd / "S" / "S01" / self.sessions[1].name)
+        last = sorted((self.first_session() / "trials").glob("*.json"))[-1]
+        original = json.loads(last.read_text(encoding="utf-8"))
+        for wrong in ["12345", "null", "[]", "\"yesterday\"", "1e999"]:
+            with self.subTest(end_time_utc=wrong):
+                document = dict(original, end_time_utc="@@")
+                last.write_text(json.dumps(document).replace("\"@@\"", wrong), encoding="utf-8")
+                result = self.run_cli("session", "run", "p.json", "--writer", "simulated", "--subject", "S01",
+                                      "--out", "S")
+                if wrong == "null":  # a missing end: the session's creation time stands in
+                    self.assertEqual(result.returncode, 0, result.stderr.decode())
+                    shutil.rmtree(max((self.cwd / "S" / "S01").iterdir()))
+                else:
+                    self.assert_data_error(result, last.name, f"end_time_utc {wrong}")
+                    self.assertIn("/end_time_utc", result.stderr.decode())
+
+    def test_protocol_numbers_beyond_a_double_name_the_pointer(self):
+        for wrong in ["1e999", "-1e999", "1e400"]:
+            with self.subTest(wrong):
+                text = json.dumps(PROTOCOL).replace("\"max_duration_s\": 20", f"\"max_duration_s\": {wrong}")
+                (self.cwd / "bad.json").write_text(text, encoding="utf-8")
+                result = self.run_cli("session", "run", "bad.json", "--writer", "simulated", "--subjects", "1",
+                                      "--out", "T")
+                self.assert_data_error(result, "bad.json", wrong)
+                self.assertIn("/trial/max_duration_s", result.stderr.decode())
+
+    def test_a_trial_that_wrote_no_stroke_is_shown_on_the_page(self):
+        record = sorted((self.first_session() / "trials").glob("*.json"))[0]
+        document = json.loads(record.read_text(encoding="utf-8"))
+        for key in ("mean_deviation_mm", "max_deviation_mm", "rms_deviation_mm", "frechet_mm", "dtw_mm",
+                    "normalised_jerk"):
+            document[key] = None
+        document["end_reason"] = "time_limit"
+        for stroke in document["per_stroke"]:
+            stroke.update(start_s=None, end_s=None)
+        record.write_text(json.dumps(document), encoding="utf-8")
+        result = self.run_cli("report", "S", "--out", "r.html")
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
+        page = (self.cwd / "r.html").read_text(encoding="utf-8")
+        self.assertIn("time_limit", page)
+        self.assertNotIn("nan", page.lower().replace("nano", ""))
+
+    def test_subnormal_numbers_are_finite_options(self):
+        for option in (["--guidance-mode", "assist-as-needed", "--assist-band", "1e-310"],
+                       ["--guidance-mode", "fading", "--guidance-gain", "1e-310"]):
+            with self.subTest(option):
+                result = self.run_cli("trial", "十", *option, "--json", "t.json")
+                self.assertEqual(result.returncode, 0, result.stderr.decode())
+        refused = self.run_cli("trial", "十", "--guidance-gain", "1e999", "--json", "t.json")
+        self.assertEqual(refused.returncode, 2)
+        self.assertIn("--guidance-gain", refused.stderr.decode())
+
+
+if __name__ == "__main__":
+    unittest.main()
