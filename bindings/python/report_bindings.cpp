@@ -54,6 +54,7 @@ void bind_report(py::module_& m) {
       "The tidy tables of the session folders under `paths` as the CSV texts (trials, strokes) that "
       "`calligraphy report --csv` writes (read_study_tables, include/calligraphy/study/study_tables.hpp); "
       "calligraphy.study.load makes DataFrames of them. Raises DataError naming a damaged file.");
+  m.attr("_MAX_COHORT_SUBJECTS") = kMaxCohortSubjects;
   m.def(
       "_simulate_cohort_csv",
       [](const std::string& protocol_path, const std::vector<std::pair<std::string, std::size_t>>& subjects,

@@ -6,7 +6,9 @@
 
 #include <atomic>
 #include <cerrno>
+#include <memory>
 #include <system_error>
+#include <vector>
 
 #include "calligraphy/core/errors.hpp"
 
@@ -151,6 +153,38 @@ void write_file_atomically(const fs::path& path, std::string_view content) {
   temporary.write(content);
   temporary.rename_to(target);
   sync_folder(target, path);
+}
+
+void write_files_atomically(std::span<const FileContent> files) {
+  // Every temporary is written, synced and closed before any target is replaced: a failure while writing
+  // (a full disk) removes them all and leaves every earlier file as it was.
+  std::vector<std::unique_ptr<TemporaryFile>> temporaries;
+  std::vector<fs::path> targets;
+  std::vector<const FileContent*> in_place;
+  for (const FileContent& file : files) {
+    if (file.path.empty()) throw DataError("cannot write a file with an empty name");
+    const fs::path target = written_path(file.path);
+    struct stat status {};
+    bool exists = false;
+    if (::stat(target.c_str(), &status) == 0) {
+      if (S_ISDIR(status.st_mode)) fail(file.path, "cannot write", EISDIR);
+      if (!S_ISREG(status.st_mode)) {  // a device or FIFO: nothing to replace, written last as it is
+        in_place.push_back(&file);
+        continue;
+      }
+      if (::access(target.c_str(), W_OK) != 0) fail(file.path, "cannot write", errno);
+      exists = true;
+    } else if (errno != ENOENT) {
+      fail(file.path, "cannot write", errno);
+    }
+    temporaries.push_back(std::make_unique<TemporaryFile>(target, file.path, status.st_mode & 07777, exists));
+    temporaries.back()->write(file.content);
+    targets.push_back(target);
+  }
+  // Renames need no data blocks: once every temporary is whole, the set is replaced in one short run.
+  for (std::size_t i = 0; i < temporaries.size(); ++i) temporaries[i]->rename_to(targets[i]);
+  for (const fs::path& target : targets) sync_folder(target, target);
+  for (const FileContent* file : in_place) write_in_place(file->path, file->content);
 }
 
 void write_file_atomically(const fs::path& path, std::span<const std::uint8_t> content) {

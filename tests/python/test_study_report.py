@@ -289,6 +289,46 @@ def test_a_file_that_cannot_be_written_is_named(study, tmp_path):
     assert not list(out.glob(".*.tmp"))
 
 
+def test_a_report_that_fails_while_writing_leaves_the_earlier_report_whole(study, tmp_path):
+    import hashlib
+    import resource
+    import signal
+
+    out = tmp_path / "report"
+    study_report.write_report(study, out, values=("total_time_s",))
+
+    def digests():
+        return {p.relative_to(out): hashlib.sha256(p.read_bytes()).hexdigest() for p in sorted(out.rglob("*"))
+                if p.is_file()}
+
+    before = digests()
+    largest = max(p.stat().st_size for p in out.rglob("*") if p.is_file())
+    smallest = min(p.stat().st_size for p in out.rglob("*") if p.is_file())
+    assert smallest < largest // 2
+    # Files beyond half the largest cannot be written (EFBIG), as on a full disk: some of the new report is
+    # written, then a file fails. A title makes every new page differ from the earlier one.
+    saved_limit = resource.getrlimit(resource.RLIMIT_FSIZE)
+    saved_handler = signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    resource.setrlimit(resource.RLIMIT_FSIZE, (largest // 2, saved_limit[1]))
+    try:
+        with pytest.raises(OSError, match="cannot write"):
+            study_report.write_report(study, out, values=("total_time_s",), title="the second report")
+    finally:
+        resource.setrlimit(resource.RLIMIT_FSIZE, saved_limit)
+        signal.signal(signal.SIGXFSZ, saved_handler)
+    assert digests() == before
+    assert not [p for p in out.rglob(".*") if p.is_file()]
+
+
+def test_an_empty_output_folder_is_refused(study, tmp_path):
+    (tmp_path / "index.html").write_text("someone's page", encoding="utf-8")
+    with pytest.raises(ValueError, match="out_dir is empty"):
+        study_report.write_report(study, "")
+    empty = run_module(tmp_path, "--out", "", cwd=tmp_path)
+    assert empty.returncode == 2 and "--out" in empty.stderr
+    assert (tmp_path / "index.html").read_text(encoding="utf-8") == "someone's page"
+
+
 def test_bad_arguments_are_named(study, tmp_path):
     with pytest.raises(ValueError, match="'pen_up_time_s'"):
         study_report.write_report(study, tmp_path, values=("pen_up_time_s",))

@@ -2,7 +2,7 @@
 """Damaged study files through the program, run by CTest as `study_damaged_cli`: every value of a trial
 record, a session manifest and a protocol replaced by one of another type or beyond a double's range gives
 the data error (exit 1) naming the file, never an internal error (exit 3); a trial that wrote no stroke is
-shown on the report page; subnormal option values are finite.
+shown on the report page; the cohort's tables are replaced together or not at all.
 
 CALLIGRAPHY_CLI names the program. Standard library only.
 """
@@ -181,6 +181,32 @@ class DamagedStudyTest(unittest.TestCase):
         refused = self.run_cli("trial", "十", "--guidance-gain", "1e999", "--json", "t.json")
         self.assertEqual(refused.returncode, 2)
         self.assertIn("--guidance-gain", refused.stderr.decode())
+
+    def test_a_cohort_that_fails_while_writing_keeps_the_previous_pair_of_tables(self):
+        first = self.run_cli("session", "cohort", "p.json", "--subjects", "1", "--csv", ".")
+        self.assertEqual(first.returncode, 0, first.stderr.decode())
+        before = {name: digest(self.cwd / name) for name in ("trials.csv", "strokes.csv")}
+        # The sizes the next run's tables will have (the same subjects give the same rows), measured apart.
+        (self.cwd / "sizes").mkdir()
+        measured = self.run_cli("session", "cohort", "p.json", "--subjects", "3", "--csv", "sizes")
+        self.assertEqual(measured.returncode, 0, measured.stderr.decode())
+        trials_size = (self.cwd / "sizes" / "trials.csv").stat().st_size
+        strokes_size = (self.cwd / "sizes" / "strokes.csv").stat().st_size
+        self.assertLess(trials_size, strokes_size)
+        # Files beyond this size cannot be written (EFBIG), as on a full disk: trials.csv is written whole,
+        # then strokes.csv fails.
+        limit = (trials_size + strokes_size) // 2
+
+        def small_files():
+            signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+            resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+        failed = subprocess.run([CLI, "session", "cohort", "p.json", "--subjects", "3", "--csv", "."],
+                                cwd=self.cwd, capture_output=True, timeout=600, preexec_fn=small_files)
+        self.assertEqual(failed.returncode, 1, failed.stderr.decode())
+        self.assertIn("strokes.csv", failed.stderr.decode())
+        self.assertEqual(before, {name: digest(self.cwd / name) for name in before})
+        self.assertEqual([p.name for p in self.cwd.glob(".*tmp*")], [])
 
 
 if __name__ == "__main__":
