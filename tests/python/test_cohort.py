@@ -92,6 +92,8 @@ def test_bad_arguments_are_named(protocol):
         calligraphy.cohort.simulate(protocol, "4")
     with pytest.raises(ValueError, match="workers"):
         calligraphy.cohort.simulate(protocol, 1, workers=0)
+    with pytest.raises(ValueError, match="workers: expected an int in 1..1024"):
+        calligraphy.cohort.simulate(protocol, 1, workers=10**6)
     with pytest.raises(ValueError, match="writer_profile"):
         calligraphy.cohort.simulate(protocol, 1, profile="expert")
     with pytest.raises(ValueError, match="writer_learning"):
