@@ -29,6 +29,19 @@ SessionManifest read_session_manifest(const fs::path& folder) {
   return manifest;
 }
 
+bool DistinctSessions::add(const fs::path& folder, const SessionManifest& manifest) {
+  const std::string key = manifest.setup.subject.id + '\n' + manifest.protocol.sha256 + '\n' +
+                          std::to_string(manifest.setup.session_number) + '\n' + manifest.created_utc;
+  const auto [at, inserted] = seen_.emplace(key, folder);
+  if (inserted) return true;
+  std::error_code error;
+  if (fs::equivalent(at->second, folder, error)) return false;
+  throw DataError((folder / "session.json").string() + ": the same session as " + at->second.string() +
+                  " (subject " + manifest.setup.subject.id + ", session " +
+                  std::to_string(manifest.setup.session_number) + ", created " + manifest.created_utc +
+                  "): a copy; remove one so that its trials are not counted twice");
+}
+
 nlohmann::json read_trial_record(const fs::path& json_file) {
   const std::string source = json_file.string();
   nlohmann::json record =

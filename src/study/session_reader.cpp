@@ -156,11 +156,13 @@ std::string session_line(const SessionManifest& m, const fs::path& folder, std::
 
 StudyReport read_study_report(const std::vector<fs::path>& roots) {
   const std::vector<fs::path> folders = study_detail::session_folders_under(roots);
+  study_detail::DistinctSessions distinct;
   StudyReport report;
   std::set<std::string> protocols;
   bool simulated = false;
   for (const fs::path& folder : folders) {
     const SessionManifest manifest = study_detail::read_session_manifest(folder);
+    if (!distinct.add(folder, manifest)) continue;
     if (report.title.empty()) {
       const StudyProtocol& p = manifest.protocol.protocol;
       report.title = "Study report: " + p.name;

@@ -171,9 +171,11 @@ void line(std::string& out, const Fields&... fields) {
 
 StudyTables read_study_tables(const std::vector<fs::path>& roots) {
   const std::vector<fs::path> folders = study_detail::session_folders_under(roots);
+  study_detail::DistinctSessions distinct;
   StudyTables tables;
   for (const fs::path& folder : folders) {
     const SessionManifest manifest = study_detail::read_session_manifest(folder);
+    if (!distinct.add(folder, manifest)) continue;
     for (const PlannedTrial& plan : manifest.plan) {
       const fs::path json_file = folder / "trials" / (SessionFolder::trial_stem(plan) + ".json");
       std::error_code error;
