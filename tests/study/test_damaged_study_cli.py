@@ -4,7 +4,7 @@ record, a session manifest and a protocol replaced by one of another type or bey
 the data error (exit 1) naming the file, never an internal error (exit 3); a trial that wrote no stroke is
 shown on the report page; the cohort's tables are replaced together or not at all.
 
-CALLIGRAPHY_CLI names the program. Standard library only.
+CALLIGRAPHY_CLI names the program, CALLIGRAPHY_SOURCE_DIR the source tree. Standard library only.
 """
 import hashlib
 import json
@@ -18,6 +18,7 @@ import unittest
 from pathlib import Path
 
 CLI = os.environ.get("CALLIGRAPHY_CLI", "")
+SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 
 PROTOCOL = {
     "format": "calligraphy-study-protocol",
@@ -34,7 +35,7 @@ PROTOCOL = {
 }
 
 # Values of other types, and numbers a double cannot hold (written into the text: json.dumps refuses them).
-WRONG_VALUES = ["5", "\"x\"", "[]", "{}", "true", "[1e999]", "1e999", "-1e999", "1e400"]
+WRONG_VALUES = ["5", "\"x\"", "[]", "{}", "true", "null", "[1e999]", "1e999", "-1e999", "1e400"]
 
 
 def digest(path):
@@ -81,8 +82,8 @@ class DamagedStudyTest(unittest.TestCase):
 
     def damaged_copies(self, path):
         """(description, text) for the JSON file at `path` with one value replaced by a wrong one: every
-        member at any depth (the first element of each array), each top-level one by every wrong value,
-        deeper ones by three in turn."""
+        member at any depth (every element of an array of up to 3, else the first), each top-level one by
+        every wrong value, deeper ones by three in turn."""
         original = json.loads(path.read_text(encoding="utf-8"))
         paths = []
 
@@ -91,8 +92,9 @@ class DamagedStudyTest(unittest.TestCase):
             if isinstance(value, dict):
                 for key, member in value.items():
                     walk(member, at + [key])
-            elif isinstance(value, list) and value:
-                walk(value[0], at + [0])
+            elif isinstance(value, list):
+                for index, element in enumerate(value if len(value) <= 3 else value[:1]):
+                    walk(element, at + [index])
 
         walk(original, [])
         for number, at in enumerate(paths[1:]):
@@ -145,6 +147,19 @@ class DamagedStudyTest(unittest.TestCase):
                 else:
                     self.assert_data_error(result, last.name, f"end_time_utc {wrong}")
                     self.assertIn("/end_time_utc", result.stderr.decode())
+
+    def test_every_wrong_value_of_a_protocol_is_refused_naming_the_file(self):
+        # A protocol with guidance parameters, groups and a transfer choice: more members to damage.
+        protocol = self.cwd / "retention-transfer.json"
+        shutil.copyfile(SOURCE / "examples" / "protocols" / "retention-transfer.json", protocol)
+        for what, damaged in self.damaged_copies(protocol):
+            with self.subTest(what):
+                (self.cwd / "bad.json").write_text(damaged, encoding="utf-8")
+                result = self.run_cli("session", "run", "bad.json", "--writer", "simulated", "--subjects", "1",
+                                      "--out", "T")
+                shutil.rmtree(self.cwd / "T", ignore_errors=True)
+                if result.returncode != 0:
+                    self.assert_data_error(result, "bad.json", what)
 
     def test_protocol_numbers_beyond_a_double_name_the_pointer(self):
         for wrong in ["1e999", "-1e999", "1e400"]:
