@@ -287,6 +287,7 @@ def test_a_file_that_cannot_be_written_is_named(study, tmp_path):
     with pytest.raises(OSError, match="index.html"):
         study_report.write_report(study, out, values=("total_time_s",))
     assert not list(out.glob(".*.tmp"))
+    assert not (out / "tables" / "summary.csv").exists()  # refused before any file of the set is written
 
 
 def test_a_report_that_fails_while_writing_leaves_the_earlier_report_whole(study, tmp_path):

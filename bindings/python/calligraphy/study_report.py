@@ -29,6 +29,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import dataclasses
+import errno
 import html
 import itertools
 import io
@@ -175,6 +176,10 @@ def _write_together(files: dict[pathlib.Path, typing.Union[bytes, str]]) -> None
     and synced, and only once every one is whole, each renamed over its target in the order given. A failure
     while writing (a full disk) removes every temporary and leaves the earlier set whole, so that a reader
     never finds new tables beside an old page. Raises OSError naming the file at fault."""
+    # A folder where a file goes would fail only at its rename, after others were replaced: refused first.
+    for path in files:
+        if path.is_dir():
+            raise OSError(errno.EISDIR, f"cannot write {path}: {os.strerror(errno.EISDIR)}")
     written: list[tuple[pathlib.Path, pathlib.Path]] = []
     try:
         for path, data in files.items():
