@@ -321,6 +321,17 @@ def test_a_report_that_fails_while_writing_leaves_the_earlier_report_whole(study
     assert not [p for p in out.rglob(".*") if p.is_file()]
 
 
+def test_an_infinite_value_is_missing_on_the_page_and_said(study, tmp_path):
+    damaged = calligraphy.study.Study(trials=study.trials.copy(), strokes=pandas.DataFrame())
+    damaged.trials.loc[damaged.trials.index[-1], "total_time_s"] = np.inf
+    with pytest.warns(calligraphy.statistics.NonFiniteValueWarning, match="'total_time_s'"):
+        index = study_report.write_report(damaged, tmp_path / "report", values=("total_time_s",))
+    page = index.read_text(encoding="utf-8")
+    assert "inf" not in page.replace("info", "")
+    summary = pandas.read_csv(tmp_path / "report" / "tables" / "summary.csv")
+    assert np.isfinite(summary["mean"].dropna()).all()
+
+
 def test_an_empty_output_folder_is_refused(study, tmp_path):
     (tmp_path / "index.html").write_text("someone's page", encoding="utf-8")
     with pytest.raises(ValueError, match="out_dir is empty"):

@@ -247,9 +247,13 @@ def _check_trials(trials: "pandas.DataFrame", values: typing.Sequence[str], phas
     if missing:
         raise ValueError(f"{caller}: the trials have no column {', '.join(map(repr, missing))}; its columns: "
                          f"{', '.join(map(repr, trials.columns))}")
+    from . import statistics
+
     for value in values:
         if not pandas.api.types.is_numeric_dtype(trials[value]) or pandas.api.types.is_bool_dtype(trials[value]):
             raise ValueError(f"{caller}: value {value!r} is not a numeric column (dtype {trials[value].dtype})")
+        # An infinite value counts as missing in every table and figure, as in the statistics (warned).
+        trials = statistics._finite_outcome(trials, value, caller)
     if trials.empty:
         raise ValueError(f"{caller}: there are no trials")
     if phase is not None and phase not in set(trials["phase"].astype(str)):
