@@ -61,6 +61,9 @@ def test_samples_are_read_on_demand_in_si_units(study_folder):
 def test_a_folder_without_sessions_is_named(tmp_path):
     with pytest.raises(calligraphy.DataError, match=str(tmp_path)):
         calligraphy.study.load(tmp_path)
+    for nothing in ([], "", [tmp_path, ""]):
+        with pytest.raises(ValueError, match="load: paths must name"):
+            calligraphy.study.load(nothing)
 
 
 def test_the_curriculum_is_the_clis(cli, study_folder):

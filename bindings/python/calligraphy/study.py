@@ -128,8 +128,11 @@ def load(paths: typing.Union[PathLike, typing.Sequence[PathLike]]) -> Study:
     """Reads the saved trials of the session folders under `paths` (a session folder, a study folder made by
     ``calligraphy session run --out``, or a list of either) into a `Study` of tidy DataFrames. Only the
     session manifests and trial records are read, never the traces. Raises DataError naming the file (and
-    JSON pointer) for a path without a session folder or a damaged record, ImportError without pandas."""
+    JSON pointer) for a path without a session folder or a damaged record, ValueError for no path or an
+    empty one, ImportError without pandas."""
     roots = [paths] if isinstance(paths, (str, os.PathLike)) else list(paths)
+    if not roots or any(not os.fspath(root) for root in roots):
+        raise ValueError(f"load: paths must name session or study folders, got {paths!r}")
     trials_text, strokes_text = _calligraphy._study_tables_csv([os.fspath(root) for root in roots])
     trials = _read_table(trials_text, _NUMERIC_TRIAL_COLUMNS, ("completed_in_order",))
     strokes = _read_table(strokes_text, _NUMERIC_STROKE_COLUMNS, ("written", "backwards"))
