@@ -3,11 +3,17 @@
 // limit fail with EFBIG, whoever runs the test, root included) and with /dev/full (ENOSPC).
 #include "calligraphy/core/atomic_file.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
+#include <atomic>
 #include <catch2/catch.hpp>
+#include <chrono>
 #include <filesystem>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
@@ -136,4 +142,32 @@ TEST_CASE("write_files_atomically replaces a set together, or leaves the earlier
     CHECK(contents(strokes) == large);
     CHECK(folder.names() == std::vector<std::string>{"strokes.csv", "trials.csv"});
   }
+}
+
+TEST_CASE("write_files_atomically replaces a set only while no other writer holds its folder", "[atomic_file]") {
+  // Another writer in the middle of its renames holds the folder's lock: this set waits, so the two sets
+  // are never interleaved file by file.
+  TemporaryFolder folder;
+  const fs::path trials = folder.path / "trials.csv";
+  const fs::path strokes = folder.path / "strokes.csv";
+  const FileContent old_set[] = {{trials, "old trials\n"}, {strokes, "old strokes\n"}};
+  write_files_atomically(old_set);
+  const int other_writer = ::open(folder.path.c_str(), O_RDONLY | O_DIRECTORY);
+  REQUIRE(other_writer >= 0);
+  REQUIRE(::flock(other_writer, LOCK_EX) == 0);
+  std::atomic<bool> done{false};
+  std::thread writer([&] {
+    const FileContent new_set[] = {{trials, "new trials\n"}, {strokes, "new strokes\n"}};
+    write_files_atomically(new_set);
+    done = true;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  CHECK_FALSE(done);
+  CHECK(contents(trials) == "old trials\n");
+  CHECK(contents(strokes) == "old strokes\n");
+  ::close(other_writer);  // the other writer is done
+  writer.join();
+  CHECK(done);
+  CHECK(contents(trials) == "new trials\n");
+  CHECK(contents(strokes) == "new strokes\n");
 }

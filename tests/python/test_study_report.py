@@ -332,6 +332,29 @@ def test_an_infinite_value_is_missing_on_the_page_and_said(study, tmp_path):
     assert np.isfinite(summary["mean"].dropna()).all()
 
 
+def test_a_report_waits_for_another_writer_of_its_folder(study, tmp_path):
+    import fcntl
+    import threading
+
+    out = tmp_path / "report"
+    study_report.write_report(study, out, values=("total_time_s",))
+    before = (out / "index.html").read_bytes()
+    other_writer = os.open(out, os.O_RDONLY | os.O_DIRECTORY)  # another report in the middle of its renames
+    fcntl.flock(other_writer, fcntl.LOCK_EX)
+    thread = threading.Thread(target=study_report.write_report, args=(study, out),
+                              kwargs={"values": ("total_time_s",), "title": "the second report"})
+    thread.start()
+    thread.join(timeout=5.0)
+    try:
+        assert thread.is_alive()  # waiting for the folder
+        assert (out / "index.html").read_bytes() == before
+    finally:
+        os.close(other_writer)
+    thread.join(timeout=60.0)
+    assert not thread.is_alive()
+    assert "the second report" in (out / "index.html").read_text(encoding="utf-8")
+
+
 def test_an_empty_output_folder_is_refused(study, tmp_path):
     (tmp_path / "index.html").write_text("someone's page", encoding="utf-8")
     with pytest.raises(ValueError, match="out_dir is empty"):

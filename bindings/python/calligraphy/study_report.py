@@ -30,6 +30,7 @@ import argparse
 import contextlib
 import dataclasses
 import errno
+import fcntl
 import html
 import itertools
 import io
@@ -195,18 +196,30 @@ def _write_together(files: dict[pathlib.Path, typing.Union[bytes, str]]) -> None
                     os.fsync(handle.fileno())
             except OSError as error:
                 raise OSError(error.errno, f"cannot write {path}: {error.strerror or error}") from error
-        # Renames need no space: once every temporary is whole the set is replaced in one short run.
-        while written:
-            temporary, path = written[0]
-            try:
-                os.replace(temporary, path)
-            except OSError as error:
-                raise OSError(error.errno, f"cannot write {path}: {error.strerror or error}") from error
-            written.pop(0)
+        # Renames need no space: once every temporary is whole the set is replaced in one short run, under an
+        # exclusive lock of each folder (as the library's write_files_atomically), so that two reports written
+        # into one folder at once are never interleaved file by file.
+        with contextlib.ExitStack() as locks:
+            for folder in sorted({path.parent for path in files}):
+                descriptor = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
+                locks.callback(os.close, descriptor)
+                fcntl.flock(descriptor, fcntl.LOCK_EX)
+            _rename_all(written)
     finally:
         for temporary, _ in written:
             with contextlib.suppress(OSError):
                 os.unlink(temporary)
+
+
+def _rename_all(written: list[tuple[pathlib.Path, pathlib.Path]]) -> None:
+    """Each temporary over its target, in order; those renamed are taken off `written`."""
+    while written:
+        temporary, path = written[0]
+        try:
+            os.replace(temporary, path)
+        except OSError as error:
+            raise OSError(error.errno, f"cannot write {path}: {error.strerror or error}") from error
+        written.pop(0)
 
 
 def _make_folder(folder: pathlib.Path) -> None:

@@ -42,7 +42,9 @@ struct FileContent {
 };
 
 /// Writes a set of files that belong together (a study's tables): every file's temporary is written whole,
-/// fsync'ed and closed first; only then are the targets replaced, one rename each, in the given order. A
+/// fsync'ed and closed first; only then are the targets replaced, one rename each, in the given order,
+/// under an exclusive flock(2) of their folders, so that two processes writing the same set leave one
+/// writer's whole set, never a mix of both. A
 /// failure while writing (e.g. a full disk) removes every temporary and leaves every earlier file as it
 /// was, so a reader never finds a new file beside an old one of the set. (Between the renames, which need
 /// no space, only a crash of the machine or the process can leave part of the set replaced.) Throws
