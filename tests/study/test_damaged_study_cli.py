@@ -2,7 +2,8 @@
 """Damaged study files through the program, run by CTest as `study_damaged_cli`: every value of a trial
 record, a session manifest and a protocol replaced by one of another type or beyond a double's range gives
 the data error (exit 1) naming the file, never an internal error (exit 3); a trial that wrote no stroke is
-shown on the report page; the cohort's tables are replaced together or not at all.
+shown on the report page; subnormal option values are finite; the cohort's tables are replaced together or
+not at all, also when the cohort is killed.
 
 CALLIGRAPHY_CLI names the program, CALLIGRAPHY_SOURCE_DIR the source tree. Standard library only.
 """
@@ -14,6 +15,7 @@ import shutil
 import signal
 import subprocess
 import tempfile
+import time
 import unittest
 from pathlib import Path
 
@@ -222,6 +224,35 @@ class DamagedStudyTest(unittest.TestCase):
         self.assertIn("strokes.csv", failed.stderr.decode())
         self.assertEqual(before, {name: digest(self.cwd / name) for name in before})
         self.assertEqual([p.name for p in self.cwd.glob(".*tmp*")], [])
+
+    def test_a_cohort_killed_at_any_moment_leaves_one_whole_pair_of_tables(self):
+        first = self.run_cli("session", "cohort", "p.json", "--subjects", "1", "--csv", ".")
+        self.assertEqual(first.returncode, 0, first.stderr.decode())
+        pairs = [{name: (self.cwd / name).read_bytes() for name in ("trials.csv", "strokes.csv")}]
+        (self.cwd / "whole").mkdir()
+        whole = self.run_cli("session", "cohort", "p.json", "--subjects", "8", "--csv", "whole")
+        self.assertEqual(whole.returncode, 0, whole.stderr.decode())
+        pairs.append({name: (self.cwd / "whole" / name).read_bytes() for name in ("trials.csv", "strokes.csv")})
+        # SIGKILL at moments spread over a run, the last ones about when the tables are written.
+        for fraction in (0.2, 0.5, 0.8, 0.9, 0.95, 1.0, 1.05):
+            run = subprocess.Popen([CLI, "session", "cohort", "p.json", "--subjects", "8", "--csv", "."],
+                                   cwd=self.cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            time.sleep(fraction * self.cohort_seconds)
+            run.kill()
+            run.wait()
+            found = {name: (self.cwd / name).read_bytes() for name in ("trials.csv", "strokes.csv")}
+            self.assertIn(found, pairs, f"killed after {fraction:.2f} of a run")
+
+    @property
+    def cohort_seconds(self):
+        """How long an 8-subject cohort takes here, measured once."""
+        if not hasattr(self, "_cohort_seconds"):
+            (self.cwd / "timed").mkdir(exist_ok=True)
+            begin = time.monotonic()
+            timed = self.run_cli("session", "cohort", "p.json", "--subjects", "8", "--csv", "timed")
+            self.assertEqual(timed.returncode, 0, timed.stderr.decode())
+            self._cohort_seconds = time.monotonic() - begin
+        return self._cohort_seconds
 
 
 if __name__ == "__main__":
