@@ -29,7 +29,7 @@ void practise_session(WriterMemory& memory, const fs::path& folder, const Sessio
 void remember(WriterMemory& memory, const fs::path& folder, const SessionManifest& manifest, int depth) {
   if (manifest.previous && depth < 20) {
     const fs::path before = folder.parent_path() / manifest.previous->session_id;
-    remember(memory, before, read_session_manifest(before), depth + 1);
+    remember(memory, before, read_previous_session(folder, manifest), depth + 1);
     consolidate(memory);  // hours or days between the sessions
   }
   practise_session(memory, folder, manifest);

@@ -29,6 +29,22 @@ SessionManifest read_session_manifest(const fs::path& folder) {
   return manifest;
 }
 
+SessionManifest read_previous_session(const fs::path& folder, const SessionManifest& manifest) {
+  const PreviousSession& link = manifest.previous.value();
+  const fs::path before = folder.parent_path() / link.session_id;
+  const fs::path path = before / "session.json";
+  const std::string text = read_small_file(path, kMaxRecordBytes, "session manifest");
+  if (!link.session_sha256.empty() && sha256_hex(text) != link.session_sha256) {
+    fail((folder / "session.json").string(), "/previous_session/session_sha256",
+         path.string() +
+             " is not the session this one follows (its SHA-256 differs: replaced or edited?): restore the "
+             "original folder");
+  }
+  SessionManifest previous = manifest_from_json(text, path.string());
+  previous.session_id = before.filename().string();
+  return previous;
+}
+
 bool DistinctSessions::add(const fs::path& folder, const SessionManifest& manifest) {
   const std::string key = manifest.setup.subject.id + '\n' + manifest.protocol.sha256 + '\n' +
                           std::to_string(manifest.setup.session_number) + '\n' + manifest.created_utc;

@@ -23,6 +23,11 @@ std::vector<std::filesystem::path> session_folders_under(const std::vector<std::
 /// the file (and JSON pointer) when it cannot be read.
 SessionManifest read_session_manifest(const std::filesystem::path& folder);
 
+/// The manifest of the session that `manifest` (the session in `folder`) follows, from the folder beside it.
+/// Throws DataError naming the file when it cannot be read or its session.json is not the one the link
+/// recorded (another SHA-256: replaced or edited).
+SessionManifest read_previous_session(const std::filesystem::path& folder, const SessionManifest& manifest);
+
 /// The session folders already read, by what makes a session itself (subject, protocol, session number and
 /// creation time), so that a copy of one is refused rather than counted twice.
 class DistinctSessions {

@@ -34,12 +34,7 @@ void check_link(const fs::path& folder, const SessionManifest& manifest, const f
                            " (moved, renamed or copied from elsewhere?): put the session it follows back in " +
                            folder.parent_path().string());
   }
-  if (!previous.session_sha256.empty() && previous.session_sha256 != manifest_sha256(before)) {
-    study_detail::fail(source, "/previous_session/session_sha256",
-                       (before / "session.json").string() +
-                           " is not the session this one follows (its SHA-256 differs: replaced or edited?): "
-                           "restore the original folder");
-  }
+  (void)study_detail::read_previous_session(folder, manifest);  // its content, where the link recorded it
 }
 
 // The first planned trial of a session without its record, or nullopt when every one is saved.

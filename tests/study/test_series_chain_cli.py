@@ -103,6 +103,19 @@ class SeriesChainTest(unittest.TestCase):
         result = self.run_subject()
         self.assert_refused(result, "/previous_session/session_sha256", str(manifest.relative_to(self.cwd)))
 
+    def test_a_resumed_learning_session_refuses_a_replaced_predecessor(self):
+        done = self.run_cli("session", "run", "p.json", "--writer", "simulated", "--writer-learning", "two-state",
+                            "--subject", "S01", "--out", "S")
+        self.assertEqual(done.returncode, 0, done.stderr.decode())
+        sessions = self.sessions()
+        for record in (sessions[2] / "trials").glob("*.json"):
+            record.unlink()  # unsaved again: the resume writes it with the memory of session 1
+        manifest = sessions[1] / "session.json"
+        manifest.write_text(manifest.read_text(encoding="utf-8").replace('"group": ""', '"group": "  "'),
+                            encoding="utf-8")
+        resumed = self.run_cli("session", "resume", sessions[2])
+        self.assert_refused(resumed, "/previous_session/session_sha256", str(manifest.relative_to(self.cwd)))
+
     def test_a_predecessor_with_a_trial_unsaved_names_session_resume(self):
         first = self.first_session_only()
         sorted((first / "trials").glob("002-*.json"))[0].unlink()
