@@ -37,15 +37,13 @@ void check_link(const fs::path& folder, const SessionManifest& manifest, const f
   (void)study_detail::read_previous_session(folder, manifest);  // its content, where the link recorded it
 }
 
-// The first planned trial of a session without its record, or nullopt when every one is saved.
-std::optional<std::string> first_unsaved(const fs::path& folder, const SessionManifest& manifest) {
+// Whether any planned trial of the session has no record (not only its last: a record may be lost).
+bool has_unsaved_trial(const fs::path& folder, const SessionManifest& manifest) {
   for (const PlannedTrial& trial : manifest.plan) {
     std::error_code error;
-    if (!fs::exists(folder / "trials" / (SessionFolder::trial_stem(trial) + ".json"), error)) {
-      return SessionFolder::trial_stem(trial);
-    }
+    if (!fs::exists(folder / "trials" / (SessionFolder::trial_stem(trial) + ".json"), error)) return true;
   }
-  return std::nullopt;
+  return false;
 }
 
 }  // namespace
@@ -92,7 +90,7 @@ SessionSeries session_series(const fs::path& root, const std::string& subject_id
     if (number > 1) check_link(folder, manifest, series.folders.back(), number);
     series.folders.push_back(folder);
     series.next = number + 1;
-    if (first_unsaved(folder, manifest)) {
+    if (has_unsaved_trial(folder, manifest)) {
       series.unfinished = folder;
       series.next = number;
       series.previous.reset();
