@@ -2,8 +2,8 @@
 // Strict reading of JSON documents for the study files (protocols, session manifests, trial records):
 // every error names the source (a file) and the JSON pointer (RFC 6901) of the value at fault. Internal.
 #include <cstdint>
-#include <optional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <string>
 #include <string_view>
@@ -13,7 +13,8 @@ namespace calligraphy::study_detail {
 /// Throws DataError "SOURCE: POINTER: MESSAGE" (the pointer "/" for the document itself).
 [[noreturn]] void fail(const std::string& source, const std::string& pointer, const std::string& message);
 
-/// Parses `text`; throws DataError naming the source and the byte offset of malformed JSON.
+/// Parses `text` (report_detail::parse_json_document); throws DataError naming the source and the byte
+/// offset of malformed JSON, or the JSON pointer of a number beyond a double's range.
 nlohmann::json parse_json(std::string_view text, const std::string& source);
 
 /// A short rendering of a value for messages: "0", "\"latin\"", "an object".
