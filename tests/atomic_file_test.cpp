@@ -3,11 +3,17 @@
 // limit fail with EFBIG, whoever runs the test, root included) and with /dev/full (ENOSPC).
 #include "calligraphy/core/atomic_file.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
+#include <atomic>
 #include <catch2/catch.hpp>
+#include <chrono>
 #include <filesystem>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
@@ -99,4 +105,69 @@ TEST_CASE("read_file_for_update reads regular files only, within a bound", "[ato
   CHECK(read_file_for_update(document) == std::optional<std::string>("# Title\n"));
   CHECK_FALSE(read_file_for_update("/dev/zero").has_value());  // never read: it would not end
   CHECK_THROWS_WITH(read_file_for_update(document, 4), Catch::Contains(document.string()));
+}
+
+TEST_CASE("write_files_atomically replaces a set together, or leaves the earlier set whole", "[atomic_file]") {
+  TemporaryFolder folder;
+  const fs::path trials = folder.path / "trials.csv";
+  const fs::path strokes = folder.path / "strokes.csv";
+  const std::string small(100, 't'), large(4000, 's');
+  {
+    const FileContent first[] = {{trials, "old trials\n"}, {strokes, "old strokes\n"}};
+    write_files_atomically(first);
+  }
+  CHECK(contents(trials) == "old trials\n");
+  CHECK(contents(strokes) == "old strokes\n");
+
+  SECTION("a write that fails after the first file is whole replaces neither") {
+    {
+      FileSizeLimit limit(1024);  // the first fits, the second cannot be written (EFBIG), as on a full disk
+      const FileContent next[] = {{trials, small}, {strokes, large}};
+      CHECK_THROWS_WITH(write_files_atomically(next), Catch::Contains("strokes.csv"));
+    }
+    CHECK(contents(trials) == "old trials\n");
+    CHECK(contents(strokes) == "old strokes\n");
+    CHECK(folder.names() == std::vector<std::string>{"strokes.csv", "trials.csv"});
+  }
+  SECTION("a target that is a folder is refused before any file is replaced") {
+    fs::create_directory(folder.path / "summary.csv");
+    const FileContent next[] = {{trials, small}, {folder.path / "summary.csv", small}};
+    CHECK_THROWS_WITH(write_files_atomically(next), Catch::Contains("summary.csv"));
+    CHECK(contents(trials) == "old trials\n");
+  }
+  SECTION("a set that is written whole replaces every file") {
+    const FileContent next[] = {{trials, small}, {strokes, large}};
+    write_files_atomically(next);
+    CHECK(contents(trials) == small);
+    CHECK(contents(strokes) == large);
+    CHECK(folder.names() == std::vector<std::string>{"strokes.csv", "trials.csv"});
+  }
+}
+
+TEST_CASE("write_files_atomically replaces a set only while no other writer holds its folder", "[atomic_file]") {
+  // Another writer in the middle of its renames holds the folder's lock: this set waits, so the two sets
+  // are never interleaved file by file.
+  TemporaryFolder folder;
+  const fs::path trials = folder.path / "trials.csv";
+  const fs::path strokes = folder.path / "strokes.csv";
+  const FileContent old_set[] = {{trials, "old trials\n"}, {strokes, "old strokes\n"}};
+  write_files_atomically(old_set);
+  const int other_writer = ::open(folder.path.c_str(), O_RDONLY | O_DIRECTORY);
+  REQUIRE(other_writer >= 0);
+  REQUIRE(::flock(other_writer, LOCK_EX) == 0);
+  std::atomic<bool> done{false};
+  std::thread writer([&] {
+    const FileContent new_set[] = {{trials, "new trials\n"}, {strokes, "new strokes\n"}};
+    write_files_atomically(new_set);
+    done = true;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  CHECK_FALSE(done);
+  CHECK(contents(trials) == "old trials\n");
+  CHECK(contents(strokes) == "old strokes\n");
+  ::close(other_writer);  // the other writer is done
+  writer.join();
+  CHECK(done);
+  CHECK(contents(trials) == "new trials\n");
+  CHECK(contents(strokes) == "new strokes\n");
 }

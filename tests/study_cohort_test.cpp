@@ -151,6 +151,11 @@ TEST_CASE("a cohort refuses what it cannot run, naming it", "[study][cohort]") {
                     Catch::Contains("CohortSetup.writer_learning"));
   CHECK_THROWS_AS(simulate_cohort(two_day_protocol(), numbered_subjects(1), {}, 0), InvalidArgument);
   CHECK_THROWS_AS(numbered_subjects(0), InvalidArgument);
+  // The bound of every entry (CLI, Python, library), refused before anything is made or run.
+  CHECK(numbered_subjects(kMaxCohortSubjects).size() == kMaxCohortSubjects);
+  CHECK_THROWS_WITH(numbered_subjects(kMaxCohortSubjects + 1), Catch::Contains("1 to 100000 subjects"));
+  const std::vector<SubjectAssignment> too_many(kMaxCohortSubjects + 1, SubjectAssignment{"S01", 1});
+  CHECK_THROWS_WITH(simulate_cohort(two_day_protocol(), too_many, {}), Catch::Contains("at most 100000"));
   CHECK_THROWS_WITH(numbered_subjects(2, "a/b"), Catch::Contains("subject prefix 'a/b'"));
   CHECK(numbered_subjects(12).back().id == "S12");
   CHECK(numbered_subjects(12).back().number == 12);

@@ -67,7 +67,11 @@ TEST_CASE("A bad teacher recording is refused naming the file and the key", "[gu
   refused(good, R"("x_m":[0,0,0]|"x_m":[0,0])", "different lengths");
   refused(good, R"("y_m":[0,0.001,0.002]|"y_m":[0,"a",0.002])", "/samples/y_m/1");
   refused(good, R"("characters":"十",|)", "characters");
-  CHECK_THROWS_WITH(parse_teacher_recording("{", "t.json"), Catch::Contains("t.json: not JSON"));
+  // A number beyond a double's range, wherever it is, is a data error naming its pointer.
+  refused(good, R"("y_m":[0,0.001,0.002]|"y_m":[0,1e999,0.002])", "/samples/y_m/1: not a finite number");
+  refused(good, R"("rate_hz":1000|"rate_hz":-1e400)", "/rate_hz: not a finite number");
+  refused(good, R"("characters":"十"|"characters":[1e999])", "/characters/0: not a finite number");
+  CHECK_THROWS_WITH(parse_teacher_recording("{", "t.json"), Catch::Contains("t.json: not valid JSON at byte"));
   CHECK_THROWS_WITH(read_teacher_recording("/nonexistent/teacher.json"), Catch::Contains("no such file"));
   CHECK_THROWS_WITH(read_teacher_recording("/dev/zero"), Catch::Contains("not a regular file"));
   CHECK_THROWS_AS(teacher_recording_from_trace("十", "skilled", "simulated", 1000.0, {}), InvalidArgument);

@@ -3,6 +3,7 @@
 #include "calligraphy/study/trial_spec.hpp"
 
 #include <catch2/catch.hpp>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -106,6 +107,21 @@ TEST_CASE("a trial specification round-trips through its JSON and its command-li
     CHECK(trial_spec_from_json(trial_spec_json(spec), "spec.json") == spec);
     // and the two forms meet: JSON -> spec -> words -> spec
     CHECK(trial_spec_from_args(trial_spec_args(trial_spec_from_json(trial_spec_json(spec), "x"))) == spec);
+  }
+  SECTION("subnormal values are finite numbers like any other") {
+    TrialSpec spec;
+    spec.characters = "永";
+    spec.guidance_mode = GuidanceMode::assist_as_needed;
+    spec.assist_band_m = 1e-310;
+    REQUIRE_NOTHROW(spec.validate());
+    CHECK(trial_spec_from_args(trial_spec_args(spec)) == spec);
+    CHECK(trial_spec_from_json(trial_spec_json(spec), "spec.json") == spec);
+    spec.guidance_mode = GuidanceMode::fading;
+    spec.assist_band_m = TrialSpec{}.assist_band_m;
+    spec.guidance_gain = std::numeric_limits<double>::denorm_min();
+    REQUIRE_NOTHROW(spec.validate());
+    CHECK(trial_spec_from_args(trial_spec_args(spec)) == spec);
+    CHECK(trial_spec_from_json(trial_spec_json(spec), "spec.json") == spec);
   }
   SECTION("200 random specifications") {
     std::mt19937_64 random(20261123);

@@ -30,6 +30,8 @@ py::dict trial_metrics(const TrialDescription& description, const TrialResult& r
 }
 
 void write_teacher_recording(const TeacherRecording& recording, const std::filesystem::path& path) {
+  // An empty name is a mistake of the caller (a usage error), not a file that could not be written.
+  if (path.empty()) throw InvalidArgument("path: empty; name the file to write the recording to");
   // Atomically: a reader (a running trainer, a protocol) never sees half a recording.
   write_file_atomically(path, teacher_recording_json(recording));
 }
@@ -54,6 +56,7 @@ void bind_report(py::module_& m) {
       "The tidy tables of the session folders under `paths` as the CSV texts (trials, strokes) that "
       "`calligraphy report --csv` writes (read_study_tables, include/calligraphy/study/study_tables.hpp); "
       "calligraphy.study.load makes DataFrames of them. Raises DataError naming a damaged file.");
+  m.attr("_MAX_COHORT_SUBJECTS") = kMaxCohortSubjects;
   m.def(
       "_simulate_cohort_csv",
       [](const std::string& protocol_path, const std::vector<std::pair<std::string, std::size_t>>& subjects,
@@ -139,8 +142,8 @@ void bind_report(py::module_& m) {
             write_teacher_recording(recording, convert_named<std::filesystem::path>(path.object, "path"));
           },
           py::arg("path"),
-          "Writes the JSON to `path` atomically (a temporary file renamed over it). Raises Error naming the "
-          "path when it cannot be written.")
+          "Writes the JSON to `path` atomically (a temporary file renamed over it). Raises InvalidArgument "
+          "(a ValueError) for an empty path, Error naming the path when it cannot be written.")
       .def_static(
           "load",
           [](const PathLike& path) {

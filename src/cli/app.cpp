@@ -7,6 +7,8 @@
 #include <memory>
 #include <system_error>
 
+#include "core/decimal_number.hpp"
+
 namespace calligraphy::cli {
 namespace {
 
@@ -31,9 +33,9 @@ bool parse_integer(const std::string& text, Integer& value) {
 }
 
 bool parse_number(const std::string& text, double& value) {
-  const char* end = text.data() + text.size();
-  const auto [stop, error] = std::from_chars(text.data(), end, value, std::chars_format::general);
-  return error == std::errc() && stop == end && !text.empty() && std::isfinite(value);
+  const std::optional<double> parsed = parse_finite_double(text);
+  if (parsed) value = *parsed;
+  return parsed.has_value();
 }
 
 std::string shortest(double value) {

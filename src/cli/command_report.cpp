@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/report/study_report_html.hpp"
 #include "calligraphy/study/session_reader.hpp"
 #include "calligraphy/study/study_tables.hpp"
@@ -41,8 +42,11 @@ int run_report(const ReportCommand& command) {
   };
   if (!command.csv.empty()) {
     const StudyTables tables = read_study_tables(roots);
-    write_output((tables_folder / "trials.csv").string(), trials_csv(tables));
-    write_output((tables_folder / "strokes.csv").string(), strokes_csv(tables));
+    // Both tables or neither: a failure leaves the previous pair whole.
+    const std::string trials_text = trials_csv(tables), strokes_text = strokes_csv(tables);
+    const FileContent table_files[] = {{tables_folder / "trials.csv", trials_text},
+                                       {tables_folder / "strokes.csv", strokes_text}};
+    write_files_atomically(table_files);
     if (command.out != "-") {
       std::printf("%s: trials.csv (%zu rows), strokes.csv (%zu rows), %.1f s\n", command.csv.c_str(),
                   tables.trials.size(), tables.strokes.size(), elapsed());

@@ -5,7 +5,9 @@
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -261,6 +263,14 @@ int run_sessions(const SessionRunCommand& command) {
     // as passed), a person the next one, when its delay has passed.
     while (true) {
       if (stop_requested()) return 128 + stop_signal();
+      // Held until this session is written: another run of the subject waits, then sees it.
+      std::optional<SeriesLock> lock;
+      if (sessions > 1) {
+        lock.emplace(command.out, subjects[i].id, [&](const std::filesystem::path& path) {
+          std::fprintf(stderr, "%s: waiting for another run of this subject to end (%s)\n",
+                       subjects[i].id.c_str(), path.c_str());
+        });
+      }
       // A protocol of one session starts a new one on every run, as before sessions were linked.
       const SessionSeries series =
           sessions > 1 ? session_series(command.out, subjects[i].id, resolved) : SessionSeries{};
@@ -275,6 +285,14 @@ int run_sessions(const SessionRunCommand& command) {
         break;
       }
       std::optional<PreviousSession> previous = series.previous;
+      if (series.ended_in_future() && person && !command.ignore_delay) {
+        throw StateError(subjects[i].id + ": session " + std::to_string(series.next - 1) + " of " +
+                         protocol.protocol.name + " ended " + previous->ended_utc + " (" +
+                         series.previous_record.string() + "), " +
+                         std::to_string(static_cast<long long>(-previous->elapsed_s)) +
+                         " s after now by this computer's clock: another or a wrong clock. --ignore-delay "
+                         "starts it now (recorded as overridden, the elapsed time as measured)");
+      }
       if (previous && !series.due()) {
         if (!person) {
           previous->delay = "simulated";
@@ -396,7 +414,8 @@ void add_session_commands(CLI::App& root, Commands& commands) {
                     "the study folder: sessions go to DIR/SUBJECT/PROTOCOL-TIME/; a protocol of several "
                     "sessions goes on with the subject's next one there"));
   add_flag(*app, "--ignore-delay", run->ignore_delay,
-           "start a person's next session before the protocol's delay has passed (recorded as overridden)");
+           "start a person's next session before the protocol's delay has passed, or after a session that "
+           "ended later than now by this computer's clock (recorded as overridden)");
   add_library_options(*app, run->library, true);
   add_display_options(*app, run->display);
 

@@ -8,6 +8,7 @@
 #include <string>
 #include <thread>
 
+#include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/study/cohort.hpp"
 #include "calligraphy/study/study_tables.hpp"
 #include "cli/commands.hpp"
@@ -61,8 +62,11 @@ int run_session_cohort(const SessionCohortCommand& command) {
   const StudyTables tables = simulate_cohort(resolved, subjects, setup, threads, [&](std::size_t done) {
     progress.update(done, subjects.size(), "subjects");
   });
-  write_output((tables_folder / "trials.csv").string(), trials_csv(tables));
-  write_output((tables_folder / "strokes.csv").string(), strokes_csv(tables));
+  // Both tables or neither: a failure leaves the previous pair whole.
+  const std::string trials_text = trials_csv(tables), strokes_text = strokes_csv(tables);
+  const FileContent table_files[] = {{tables_folder / "trials.csv", trials_text},
+                                     {tables_folder / "strokes.csv", strokes_text}};
+  write_files_atomically(table_files);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf(
       "%s: %zu subjects, %zu trials on %u threads in %.1f s: trials.csv (%zu rows), strokes.csv (%zu rows)\n",
@@ -83,7 +87,8 @@ void add_session_cohort_command(CLI::App& session, Commands& commands) {
   add_positional(*app, "PROTOCOL", command->protocol, "the study protocol (JSON; docs/experiments.md)",
                  "FILE");
   required(add_integer(*app, "--subjects", command->subjects, "N",
-                       "simulated subjects PREFIX01..PREFIXN, numbered 1..N", 1, 100000));
+                       "simulated subjects PREFIX01..PREFIXN, numbered 1..N", 1,
+                       static_cast<long long>(kMaxCohortSubjects)));
   add_text(*app, "--subject", command->prefix, "PREFIX", "the prefix of the subjects' ids");
   add_choice(*app, "--writer-profile", command->writer_profile, {"novice", "skilled", "foreign"},
              "the simulated subjects' profile");

@@ -1,12 +1,16 @@
 #include "calligraphy/core/atomic_file.hpp"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
+#include <memory>
+#include <set>
 #include <system_error>
+#include <vector>
 
 #include "calligraphy/core/errors.hpp"
 
@@ -116,6 +120,33 @@ void sync_folder(const fs::path& target, const fs::path& reported) {
   }
 }
 
+// flock(2) on the folders of a set's targets, taken in sorted order (no two writers deadlock) and released
+// on destruction. A folder that cannot be opened or locked is left unlocked: the renames go on as before.
+class FolderLocks {
+ public:
+  explicit FolderLocks(const std::vector<fs::path>& targets) {
+    std::set<fs::path> folders;
+    for (const fs::path& target : targets) {
+      folders.insert(target.parent_path().empty() ? fs::path(".") : target.parent_path());
+    }
+    for (const fs::path& folder : folders) {
+      const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+      if (fd < 0) continue;
+      while (::flock(fd, LOCK_EX) != 0 && errno == EINTR) {
+      }
+      fds_.push_back(fd);
+    }
+  }
+  FolderLocks(const FolderLocks&) = delete;
+  FolderLocks& operator=(const FolderLocks&) = delete;
+  ~FolderLocks() {
+    for (const int fd : fds_) ::close(fd);
+  }
+
+ private:
+  std::vector<int> fds_;
+};
+
 }  // namespace
 
 fs::path written_path(const fs::path& path) {
@@ -151,6 +182,40 @@ void write_file_atomically(const fs::path& path, std::string_view content) {
   temporary.write(content);
   temporary.rename_to(target);
   sync_folder(target, path);
+}
+
+void write_files_atomically(std::span<const FileContent> files) {
+  // Every temporary is written, synced and closed before any target is replaced: a failure while writing
+  // (a full disk) removes them all and leaves every earlier file as it was.
+  std::vector<std::unique_ptr<TemporaryFile>> temporaries;
+  std::vector<fs::path> targets;
+  std::vector<const FileContent*> in_place;
+  for (const FileContent& file : files) {
+    if (file.path.empty()) throw DataError("cannot write a file with an empty name");
+    const fs::path target = written_path(file.path);
+    struct stat status {};
+    bool exists = false;
+    if (::stat(target.c_str(), &status) == 0) {
+      if (S_ISDIR(status.st_mode)) fail(file.path, "cannot write", EISDIR);
+      if (!S_ISREG(status.st_mode)) {  // a device or FIFO: nothing to replace, written last as it is
+        in_place.push_back(&file);
+        continue;
+      }
+      if (::access(target.c_str(), W_OK) != 0) fail(file.path, "cannot write", errno);
+      exists = true;
+    } else if (errno != ENOENT) {
+      fail(file.path, "cannot write", errno);
+    }
+    temporaries.push_back(std::make_unique<TemporaryFile>(target, file.path, status.st_mode & 07777, exists));
+    temporaries.back()->write(file.content);
+    targets.push_back(target);
+  }
+  // Renames need no data blocks: once every temporary is whole, the set is replaced in one short run, under
+  // an exclusive lock of each folder, so that two writers of one set never interleave their renames.
+  const FolderLocks locks(targets);
+  for (std::size_t i = 0; i < temporaries.size(); ++i) temporaries[i]->rename_to(targets[i]);
+  for (const fs::path& target : targets) sync_folder(target, target);
+  for (const FileContent* file : in_place) write_in_place(file->path, file->content);
 }
 
 void write_file_atomically(const fs::path& path, std::span<const std::uint8_t> content) {

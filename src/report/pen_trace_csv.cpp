@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "calligraphy/core/errors.hpp"
+#include "core/decimal_number.hpp"
 #include "core/whole_file.hpp"
 
 namespace calligraphy {
@@ -141,14 +142,9 @@ class Reader {
 
   double number(const std::vector<std::string_view>& fields, std::size_t column) const {
     const std::string_view field = fields[column];
-    double value = 0.0;
-    const auto [end, error] = std::from_chars(field.data(), field.data() + field.size(), value);
-    if (error == std::errc::result_out_of_range) fail(column, field, "out of the range of a double");
-    if (field.empty() || error != std::errc() || end != field.data() + field.size()) {
-      fail(column, field, "not a number");
-    }
-    if (!std::isfinite(value)) fail(column, field, "not a finite number");
-    return value;
+    const std::optional<double> value = parse_finite_double(field);
+    if (!value) fail(column, field, "not a number (a finite decimal within the range of a double is expected)");
+    return *value;
   }
 
   PenSample row(const std::vector<std::string_view>& fields, const Columns& c) const {

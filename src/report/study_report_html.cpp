@@ -58,7 +58,7 @@ const char* colour_of(const StudyReport& report, const std::string& condition) {
   return kConditionColours[index % kConditionColours.size()];
 }
 
-std::optional<double> value_of(const ReportTrial& trial, ReportMeasure measure) {
+std::optional<double> recorded_value(const ReportTrial& trial, ReportMeasure measure) {
   switch (measure) {
     case ReportMeasure::time_s:
       return trial.time_total_s;
@@ -70,6 +70,13 @@ std::optional<double> value_of(const ReportTrial& trial, ReportMeasure measure) 
       return static_cast<double>(trial.order_errors);
   }
   return std::nullopt;
+}
+
+// A trial's value of a measure; none for one it lacks or that is not finite (a trial that wrote no stroke
+// has no deviation), so that a summary counts and averages only the values there are.
+std::optional<double> value_of(const ReportTrial& trial, ReportMeasure measure) {
+  const std::optional<double> value = recorded_value(trial, measure);
+  return value && std::isfinite(*value) ? value : std::nullopt;
 }
 
 struct MeasureInfo {

@@ -5,6 +5,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "core/whole_file.hpp"
+#include "report/json_document.hpp"
 
 namespace calligraphy {
 namespace {
@@ -82,12 +83,7 @@ std::string teacher_recording_json(const TeacherRecording& recording) {
 }
 
 TeacherRecording parse_teacher_recording(std::string_view json_text, const std::string& source) {
-  nlohmann::json document;
-  try {
-    document = nlohmann::json::parse(json_text);
-  } catch (const nlohmann::json::parse_error& e) {
-    fail(source, "not JSON (byte " + std::to_string(e.byte) + ")");
-  }
+  const nlohmann::json document = report_detail::parse_json_document(json_text, source);
   if (!document.is_object()) fail(source, "expected a JSON object");
   const nlohmann::json& format = member(document, "format", source, "/");
   if (format != kFormat) fail(source, std::string("/format: expected \"") + kFormat + "\"");

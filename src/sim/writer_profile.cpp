@@ -7,6 +7,7 @@
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
+#include "core/decimal_number.hpp"
 
 namespace calligraphy {
 namespace {
@@ -215,13 +216,12 @@ void apply_writer_setting(WriterProfile& profile, std::string_view setting) {
   }
   const std::string_view key = setting.substr(0, equals);
   const std::string_view text = setting.substr(equals + 1);
-  double value = 0.0;
-  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (error != std::errc() || end != text.data() + text.size() || text.empty()) {
+  const std::optional<double> value = parse_finite_double(text);
+  if (!value) {
     throw InvalidArgument("writer setting '" + std::string(setting) + "': '" + std::string(text) +
-                          "' is not a number");
+                          "' is not a number (a finite decimal within the range of a double is expected)");
   }
-  set_writer_parameter(profile, key, value);
+  set_writer_parameter(profile, key, *value);
 }
 
 }  // namespace calligraphy

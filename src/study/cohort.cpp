@@ -137,7 +137,10 @@ void CohortSetup::validate() const {
 }
 
 std::vector<SubjectAssignment> numbered_subjects(std::size_t count, const std::string& prefix) {
-  if (count == 0) throw InvalidArgument("numbered_subjects: a cohort needs at least one subject");
+  if (count == 0 || count > kMaxCohortSubjects) {
+    throw InvalidArgument("numbered_subjects: a cohort has 1 to " + std::to_string(kMaxCohortSubjects) +
+                          " subjects, got " + std::to_string(count));
+  }
   std::vector<SubjectAssignment> subjects;
   subjects.reserve(count);
   for (std::size_t k = 1; k <= count; ++k) {
@@ -192,6 +195,10 @@ StudyTables simulate_cohort(const LoadedProtocol& protocol, const std::vector<Su
                             const CohortSetup& setup, unsigned threads,
                             const std::function<void(std::size_t)>& progress) {
   if (threads == 0) throw InvalidArgument("simulate_cohort: threads must be at least 1");
+  if (subjects.size() > kMaxCohortSubjects) {
+    throw InvalidArgument("simulate_cohort: a cohort has at most " + std::to_string(kMaxCohortSubjects) +
+                          " subjects, got " + std::to_string(subjects.size()));
+  }
   setup.validate();
   refuse_replay(protocol.protocol);
   // Every character of every subject's plan, loaded here once: the workers only read the map.

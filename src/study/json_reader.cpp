@@ -2,8 +2,10 @@
 
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "calligraphy/core/errors.hpp"
+#include "report/json_document.hpp"
 
 namespace calligraphy::study_detail {
 
@@ -12,11 +14,7 @@ void fail(const std::string& source, const std::string& pointer, const std::stri
 }
 
 nlohmann::json parse_json(std::string_view text, const std::string& source) {
-  try {
-    return nlohmann::json::parse(text.begin(), text.end());
-  } catch (const nlohmann::json::parse_error& e) {
-    throw DataError(source + ": not valid JSON at byte " + std::to_string(e.byte) + ": " + e.what());
-  }
+  return report_detail::parse_json_document(text, source);
 }
 
 std::string describe(const nlohmann::json& value) {
@@ -157,6 +155,98 @@ bool ObjectReader::boolean_or(const std::string& key, bool fallback) {
   if (!value) return fallback;
   if (!value->is_boolean()) fail(source_, pointer(key), "expected true or false, got " + describe(*value));
   return value->get<bool>();
+}
+
+namespace {
+const nlohmann::json& empty_object() {
+  static const nlohmann::json empty = nlohmann::json::object();
+  return empty;
+}
+const nlohmann::json& empty_array() {
+  static const nlohmann::json empty = nlohmann::json::array();
+  return empty;
+}
+}  // namespace
+
+const nlohmann::json* JsonView::member(const std::string& key) const {
+  if (!value_.is_object()) fail(source_, pointer_, "expected an object, got " + describe(value_));
+  const auto found = value_.find(key);
+  return found == value_.end() || found->is_null() ? nullptr : &*found;
+}
+
+bool JsonView::has(const std::string& key) const {
+  if (!value_.is_object()) return false;
+  const auto found = value_.find(key);
+  return found != value_.end() && !found->is_null();
+}
+
+JsonView JsonView::object(const std::string& key) const {
+  const nlohmann::json* value = member(key);
+  if (value && !value->is_object()) {
+    fail(source_, child_pointer(pointer_, key), "expected an object, got " + describe(*value));
+  }
+  return {value ? *value : empty_object(), child_pointer(pointer_, key), source_};
+}
+
+JsonView JsonView::array(const std::string& key) const {
+  const nlohmann::json* value = member(key);
+  if (value && !value->is_array()) {
+    fail(source_, child_pointer(pointer_, key), "expected an array, got " + describe(*value));
+  }
+  return {value ? *value : empty_array(), child_pointer(pointer_, key), source_};
+}
+
+std::size_t JsonView::size() const { return value_.is_array() ? value_.size() : 0; }
+
+JsonView JsonView::at(std::size_t index) const {
+  if (!value_.is_array() || index >= value_.size()) {
+    fail(source_, child_pointer(pointer_, index), "missing (required)");
+  }
+  return {value_[index], child_pointer(pointer_, index), source_};
+}
+
+JsonView JsonView::object_at(std::size_t index) const {
+  JsonView element = at(index);
+  if (!element.json().is_object()) {
+    fail(source_, element.pointer(), "expected an object, got " + describe(element.json()));
+  }
+  return element;
+}
+
+std::string JsonView::string_or(const std::string& key, const std::string& fallback) const {
+  const nlohmann::json* value = member(key);
+  return value ? as_string(*value, child_pointer(pointer_, key), source_) : fallback;
+}
+
+bool JsonView::boolean_or(const std::string& key, bool fallback) const {
+  const nlohmann::json* value = member(key);
+  if (!value) return fallback;
+  if (!value->is_boolean()) {
+    fail(source_, child_pointer(pointer_, key), "expected true or false, got " + describe(*value));
+  }
+  return value->get<bool>();
+}
+
+std::optional<double> JsonView::optional_number(const std::string& key, double minimum, double maximum) const {
+  const nlohmann::json* value = member(key);
+  if (!value) return std::nullopt;
+  return as_number(*value, child_pointer(pointer_, key), source_, minimum, maximum);
+}
+
+double JsonView::number_or(const std::string& key, double fallback, double minimum, double maximum) const {
+  return optional_number(key, minimum, maximum).value_or(fallback);
+}
+
+double JsonView::number(const std::string& key, double minimum, double maximum) const {
+  const std::optional<double> value = optional_number(key, minimum, maximum);
+  if (!value) fail(source_, child_pointer(pointer_, key), "missing (required)");
+  return *value;
+}
+
+std::int64_t JsonView::integer_or(const std::string& key, std::int64_t fallback, std::int64_t minimum,
+                                  std::int64_t maximum) const {
+  const nlohmann::json* value = member(key);
+  return value ? as_integer(*value, child_pointer(pointer_, key), source_, minimum, maximum) : fallback;
 }
 
 }  // namespace calligraphy::study_detail

@@ -3,6 +3,7 @@
 // every error names the source (a file) and the JSON pointer (RFC 6901) of the value at fault. Internal.
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <string>
 #include <string_view>
@@ -12,7 +13,8 @@ namespace calligraphy::study_detail {
 /// Throws DataError "SOURCE: POINTER: MESSAGE" (the pointer "/" for the document itself).
 [[noreturn]] void fail(const std::string& source, const std::string& pointer, const std::string& message);
 
-/// Parses `text`; throws DataError naming the source and the byte offset of malformed JSON.
+/// Parses `text` (report_detail::parse_json_document); throws DataError naming the source and the byte
+/// offset of malformed JSON, or the JSON pointer of a number beyond a double's range.
 nlohmann::json parse_json(std::string_view text, const std::string& source);
 
 /// A short rendering of a value for messages: "0", "\"latin\"", "an object".
@@ -50,6 +52,46 @@ class ObjectReader {
   std::string pointer_;
   const std::string& source_;
   std::set<std::string> read_;
+};
+
+/// One value of a document read by its consumers (trial records): lenient about a missing or null member
+/// (the fallback) and strict about its type, so that no damaged record reaches nlohmann's own type errors.
+/// Every error is a DataError naming the source and the member's JSON pointer.
+class JsonView {
+ public:
+  JsonView(const nlohmann::json& value, std::string pointer, std::string source)
+      : value_(value), pointer_(std::move(pointer)), source_(std::move(source)) {}
+  [[nodiscard]] const nlohmann::json& json() const { return value_; }
+  [[nodiscard]] const std::string& pointer() const { return pointer_; }
+  [[nodiscard]] const std::string& source() const { return source_; }
+  /// True when the member is present and not null (false for a value that is not an object).
+  [[nodiscard]] bool has(const std::string& key) const;
+  /// The member as an object; an empty object when missing or null; throws DataError for another type.
+  [[nodiscard]] JsonView object(const std::string& key) const;
+  /// The member as an array; an empty array when missing or null; throws DataError for another type.
+  [[nodiscard]] JsonView array(const std::string& key) const;
+  /// The elements of this array (0 for a value that is not an array).
+  [[nodiscard]] std::size_t size() const;
+  /// Element `index` of this array, which must be an object; throws DataError otherwise.
+  [[nodiscard]] JsonView object_at(std::size_t index) const;
+  /// Element `index` of this array, as it is.
+  [[nodiscard]] JsonView at(std::size_t index) const;
+  [[nodiscard]] std::string string_or(const std::string& key, const std::string& fallback) const;
+  [[nodiscard]] bool boolean_or(const std::string& key, bool fallback) const;
+  /// The member as a number in [minimum, maximum], or nullopt when missing or null.
+  [[nodiscard]] std::optional<double> optional_number(const std::string& key, double minimum,
+                                                      double maximum) const;
+  [[nodiscard]] double number_or(const std::string& key, double fallback, double minimum, double maximum) const;
+  /// The member as a number in [minimum, maximum]; throws DataError when it is missing.
+  [[nodiscard]] double number(const std::string& key, double minimum, double maximum) const;
+  [[nodiscard]] std::int64_t integer_or(const std::string& key, std::int64_t fallback, std::int64_t minimum,
+                                        std::int64_t maximum) const;
+
+ private:
+  [[nodiscard]] const nlohmann::json* member(const std::string& key) const;
+  const nlohmann::json& value_;
+  std::string pointer_;
+  std::string source_;  // a copy: a view may outlive the string it was made from
 };
 
 /// The value as a string / number in range / integer in range; throws DataError naming `pointer`.

@@ -90,6 +90,7 @@ std::string manifest_to_json(const SessionManifest& manifest) {
                                     {"delay_s", p.delay_s},
                                     {"elapsed_s", p.elapsed_s},
                                     {"delay", p.delay}};
+    if (!p.session_sha256.empty()) document["previous_session"]["session_sha256"] = p.session_sha256;
   }
   return document.dump(2) + "\n";
 }
@@ -124,8 +125,10 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
     p.session_id = reader.string("session_id");
     p.ended_utc = reader.string("ended_utc");
     p.delay_s = reader.number("delay_s", 0.0, 1e9);
-    p.elapsed_s = reader.number("elapsed_s", -1e9, 1e12);
+    // Any finite time: a clock that differs between the sessions is recorded as it was measured.
+    p.elapsed_s = reader.number("elapsed_s", -1e15, 1e15);
     p.delay = reader.string("delay");
+    p.session_sha256 = reader.string_or("session_sha256", "");
     reader.finish();
     manifest.previous = std::move(p);
   }

@@ -172,8 +172,10 @@ void read_guidance_parameters(const json& parameters, const std::string& pointer
       break;
   }
   reader.finish();  // any other key: an error naming it
-  for (const auto& item : parameters.items())
-    condition.guidance_parameters[item.key()] = item.value().get<double>();
+  // Every key was read above as a number in range; a null one (taken as absent) is not a parameter.
+  for (const auto& item : parameters.items()) {
+    if (item.value().is_number()) condition.guidance_parameters[item.key()] = item.value().get<double>();
+  }
 }
 
 // "teachers": {"<item>": "path"}: keys are items (checked against the protocol's items later).

@@ -29,7 +29,7 @@ void practise_session(WriterMemory& memory, const fs::path& folder, const Sessio
 void remember(WriterMemory& memory, const fs::path& folder, const SessionManifest& manifest, int depth) {
   if (manifest.previous && depth < 20) {
     const fs::path before = folder.parent_path() / manifest.previous->session_id;
-    remember(memory, before, read_session_manifest(before), depth + 1);
+    remember(memory, before, read_previous_session(folder, manifest), depth + 1);
     consolidate(memory);  // hours or days between the sessions
   }
   practise_session(memory, folder, manifest);
@@ -37,46 +37,47 @@ void remember(WriterMemory& memory, const fs::path& folder, const SessionManifes
 
 }  // namespace
 
-void practise_record(WriterMemory& memory, const json& record, const std::string& source) {
+void practise_record(WriterMemory& memory, const json& document, const std::string& source) {
+  const JsonView record(document, "", source);
   std::vector<int> ids;
   std::u32string characters;
-  const json& placed = record.value("scene", json::object()).value("characters", json::array());
-  for (const json& character : placed) {
-    const std::string text = character.value("character", "");
-    const std::u32string decoded = decode_utf8(text);
-    if (decoded.size() != 1) fail(source, "/scene/characters", "expected one character each");
+  const JsonView placed = record.object("scene").array("characters");
+  for (std::size_t c = 0; c < placed.size(); ++c) {
+    const JsonView character = placed.object_at(c);
+    const std::u32string decoded = decode_utf8(character.string_or("character", ""));
+    if (decoded.size() != 1) fail(source, character.pointer() + "/character", "expected one character");
     characters += decoded;
-    for (const json& stroke : character.value("strokes", json::array()))
-      ids.push_back(stroke.value("typical_id", 0));
+    const JsonView strokes = character.array("strokes");
+    for (std::size_t s = 0; s < strokes.size(); ++s)
+      ids.push_back(static_cast<int>(strokes.object_at(s).integer_or("typical_id", 0, 0, 39)));
   }
   if (ids.empty()) fail(source, "/scene", "no strokes: the trial's characters are not recorded");
-  const json& force_law = record.value("force_law", json::object());
+  const JsonView force_law = record.object("force_law");
   AssistanceShares shares;
-  if (force_law.value("guidance", false)) {
-    const double hand = record.value("writer", json::object())
-                            .value("profile", json::object())
-                            .value("hand_stiffness_n_per_m", 0.0);
+  if (force_law.boolean_or("guidance", false)) {
+    const double hand = record.object("writer").object("profile").number_or("hand_stiffness_n_per_m", 0.0,
+                                                                            -1e12, 1e12);
     if (!(hand > 0.0))
       fail(source, "/writer/profile/hand_stiffness_n_per_m", "expected the hand's stiffness > 0");
     // The mode's parameters as recorded (records from before a mode existed hold the defaults).
     ForceLawParameters force;
-    const std::string mode = force_law.value("guidance_mode", "fixed");
+    const std::string mode = force_law.string_or("guidance_mode", "fixed");
     const std::optional<GuidanceMode> parsed = guidance_mode_from_string(mode);
     if (!parsed) fail(source, "/force_law/guidance_mode", "unknown guidance mode \"" + mode + "\"");
     force.guidance_mode = *parsed;
-    force.guidance_gain = force_law.value("guidance_gain", 1.0);
-    force.guidance_stiffness_n_per_m = force_law.value("guidance_stiffness_n_per_m", 0.0);
-    force.assist_band_m = force_law.value("assist_band_m", force.assist_band_m);
-    force.amplification_gain = force_law.value("amplification_gain", force.amplification_gain);
+    constexpr double kLimit = 1e12;  // far beyond any parameter; the force law's validation bounds each
+    force.guidance_gain = force_law.number_or("guidance_gain", 1.0, -kLimit, kLimit);
+    force.guidance_stiffness_n_per_m = force_law.number_or("guidance_stiffness_n_per_m", 0.0, -kLimit, kLimit);
+    force.assist_band_m = force_law.number_or("assist_band_m", force.assist_band_m, -kLimit, kLimit);
+    force.amplification_gain = force_law.number_or("amplification_gain", force.amplification_gain, -kLimit, kLimit);
     force.amplification_max_force_n =
-        force_law.value("amplification_max_force_n", force.amplification_max_force_n);
-    force.timing_speed_m_s = force_law.value("timing_speed_m_s", force.timing_speed_m_s);
+        force_law.number_or("amplification_max_force_n", force.amplification_max_force_n, -kLimit, kLimit);
+    force.timing_speed_m_s = force_law.number_or("timing_speed_m_s", force.timing_speed_m_s, -kLimit, kLimit);
     // A replay's teacher is not in the record; its shares do not depend on it, so a stand-in of two samples
     // passes the parameters' validation.
     if (force.guidance_mode == GuidanceMode::replay)
       force.teacher_trajectory = {TeacherSample{}, TeacherSample{}};
-    const json& deviation = record.value("mean_deviation_mm", json(nullptr));
-    const double deviation_m = deviation.is_number() ? deviation.get<double>() * 1e-3 : std::nan("");
+    const double deviation_m = record.number_or("mean_deviation_mm", std::nan(""), -kLimit, kLimit) * 1e-3;
     try {
       shares = guidance_shares(force, hand, deviation_m);
     } catch (const InvalidArgument& e) {

@@ -29,11 +29,40 @@ SessionManifest read_session_manifest(const fs::path& folder) {
   return manifest;
 }
 
+SessionManifest read_previous_session(const fs::path& folder, const SessionManifest& manifest) {
+  const PreviousSession& link = manifest.previous.value();
+  const fs::path before = folder.parent_path() / link.session_id;
+  const fs::path path = before / "session.json";
+  const std::string text = read_small_file(path, kMaxRecordBytes, "session manifest");
+  if (!link.session_sha256.empty() && sha256_hex(text) != link.session_sha256) {
+    fail((folder / "session.json").string(), "/previous_session/session_sha256",
+         path.string() +
+             " is not the session this one follows (its SHA-256 differs: replaced or edited?): restore the "
+             "original folder");
+  }
+  SessionManifest previous = manifest_from_json(text, path.string());
+  previous.session_id = before.filename().string();
+  return previous;
+}
+
+bool DistinctSessions::add(const fs::path& folder, const SessionManifest& manifest) {
+  const std::string key = manifest.setup.subject.id + '\n' + manifest.protocol.sha256 + '\n' +
+                          std::to_string(manifest.setup.session_number) + '\n' + manifest.created_utc;
+  const auto [at, inserted] = seen_.emplace(key, folder);
+  if (inserted) return true;
+  std::error_code error;
+  if (fs::equivalent(at->second, folder, error)) return false;
+  throw DataError((folder / "session.json").string() + ": the same session as " + at->second.string() +
+                  " (subject " + manifest.setup.subject.id + ", session " +
+                  std::to_string(manifest.setup.session_number) + ", created " + manifest.created_utc +
+                  "): a copy; remove one so that its trials are not counted twice");
+}
+
 nlohmann::json read_trial_record(const fs::path& json_file) {
   const std::string source = json_file.string();
   nlohmann::json record =
       parse_json(read_small_file(json_file, kMaxRecordBytes, "trial record (JSON)"), source);
-  if (!record.is_object() || record.value("format", "") != "calligraphy-study-trial") {
+  if (!record.is_object() || !record.contains("format") || record["format"] != "calligraphy-study-trial") {
     fail(source, "/format", "expected \"calligraphy-study-trial\"");
   }
   return record;

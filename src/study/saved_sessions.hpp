@@ -3,6 +3,8 @@
 // roots, each one's manifest, and each saved trial's record. Internal.
 #include <cstdint>
 #include <filesystem>
+#include <map>
+#include <string>
 #include <nlohmann/json.hpp>
 #include <vector>
 
@@ -20,6 +22,23 @@ std::vector<std::filesystem::path> session_folders_under(const std::vector<std::
 /// The manifest of the session folder `folder`, its `session_id` the folder's name. Throws DataError naming
 /// the file (and JSON pointer) when it cannot be read.
 SessionManifest read_session_manifest(const std::filesystem::path& folder);
+
+/// The manifest of the session that `manifest` (the session in `folder`) follows, from the folder beside it.
+/// Throws DataError naming the file when it cannot be read or its session.json is not the one the link
+/// recorded (another SHA-256: replaced or edited).
+SessionManifest read_previous_session(const std::filesystem::path& folder, const SessionManifest& manifest);
+
+/// The session folders already read, by what makes a session itself (subject, protocol, session number and
+/// creation time), so that a copy of one is refused rather than counted twice.
+class DistinctSessions {
+ public:
+  /// False when this folder was read already (a root given twice); throws DataError naming both folders when
+  /// `manifest` is a session already read from another folder.
+  [[nodiscard]] bool add(const std::filesystem::path& folder, const SessionManifest& manifest);
+
+ private:
+  std::map<std::string, std::filesystem::path> seen_;
+};
 
 /// The record of a saved trial (its format checked). Throws DataError naming the file.
 nlohmann::json read_trial_record(const std::filesystem::path& json_file);

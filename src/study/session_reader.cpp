@@ -8,6 +8,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/report/pen_trace_csv.hpp"
+#include "core/decimal_number.hpp"
 #include "core/unicode.hpp"
 #include "study/json_reader.hpp"
 #include "study/names.hpp"
@@ -21,54 +22,37 @@ using nlohmann::json;
 using study_detail::fail;
 using study_detail::ObjectReader;
 
-Vec2 vec2(const json& value, const std::string& pointer, const std::string& source) {
-  if (!value.is_array() || value.size() < 2) fail(source, pointer, "expected [x, y]");
-  return {study_detail::as_number(value[0], pointer + "/0", source, -1e6, 1e6),
-          study_detail::as_number(value[1], pointer + "/1", source, -1e6, 1e6)};
-}
-
-std::optional<double> optional_number(const json& record, const char* key, const std::string& source) {
-  const auto found = record.find(key);
-  if (found == record.end() || found->is_null()) return std::nullopt;
-  return study_detail::as_number(*found, std::string("/") + key, source, -1e12, 1e12);
-}
-
-double number(const json& record, const char* key, const std::string& source) {
-  const auto found = record.find(key);
-  if (found == record.end()) fail(source, std::string("/") + key, "missing (required)");
-  return study_detail::as_number(*found, std::string("/") + key, source, -1e12, 1e12);
+Vec2 vec2(const study_detail::JsonView& value) {
+  if (!value.json().is_array() || value.size() < 2) fail(value.source(), value.pointer(), "expected [x, y]");
+  return {study_detail::as_number(value.json()[0], value.pointer() + "/0", value.source(), -1e6, 1e6),
+          study_detail::as_number(value.json()[1], value.pointer() + "/1", value.source(), -1e6, 1e6)};
 }
 
 // The reference strokes and start points from the record's scene.
-void read_scene(const json& record, const std::string& source, ReportTrial& trial) {
-  const auto scene = record.find("scene");
-  if (scene == record.end() || !scene->contains("characters")) fail(source, "/scene", "missing (required)");
-  const json& characters = (*scene)["characters"];
+void read_scene(const study_detail::JsonView& record, ReportTrial& trial) {
+  if (!record.object("scene").has("characters")) fail(record.source(), "/scene", "missing (required)");
+  const study_detail::JsonView characters = record.object("scene").array("characters");
   for (std::size_t c = 0; c < characters.size(); ++c) {
-    const std::string at = "/scene/characters/" + std::to_string(c) + "/strokes";
-    const json& strokes = characters[c].value("strokes", json::array());
+    const study_detail::JsonView strokes = characters.object_at(c).array("strokes");
     for (std::size_t s = 0; s < strokes.size(); ++s) {
-      const std::string stroke_at = at + "/" + std::to_string(s);
+      const study_detail::JsonView stroke = strokes.object_at(s);
       std::vector<Vec2> polyline;
-      const json& points = strokes[s].value("polyline_m", json::array());
-      for (std::size_t i = 0; i < points.size(); ++i) {
-        polyline.push_back(vec2(points[i], stroke_at + "/polyline_m/" + std::to_string(i), source));
-      }
+      const study_detail::JsonView points = stroke.array("polyline_m");
+      for (std::size_t i = 0; i < points.size(); ++i) polyline.push_back(vec2(points.at(i)));
       trial.reference_m.push_back(std::move(polyline));
-      trial.stroke_starts_m.push_back(
-          vec2(strokes[s].value("start_m", json()), stroke_at + "/start_m", source));
+      trial.stroke_starts_m.push_back(vec2(study_detail::JsonView(
+          stroke.has("start_m") ? stroke.json()["start_m"] : json(), stroke.pointer() + "/start_m", stroke.source())));
     }
   }
 }
 
 double parse_field(std::string_view field, const std::string& source, std::size_t line, const char* column) {
-  double value = 0.0;
-  const auto [end, error] = std::from_chars(field.data(), field.data() + field.size(), value);
-  if (error != std::errc() || end != field.data() + field.size() || !std::isfinite(value)) {
+  const std::optional<double> value = parse_finite_double(field);
+  if (!value) {
     throw DataError(source + ":" + std::to_string(line) + ": column " + column + ": not a finite number: '" +
                     std::string(field) + "'");
   }
-  return value;
+  return *value;
 }
 
 // The trial CSV (t,x,y,z,fx,fy,fz,state,stroke,element): times, positions, pen down, in-plane force.
@@ -121,36 +105,39 @@ void read_trace(const fs::path& file, double paper_z_m, ReportTrial& trial) {
 
 ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifest, const PlannedTrial& plan) {
   const std::string source = json_file.string();
-  const json record = study_detail::read_trial_record(json_file);
+  const json document = study_detail::read_trial_record(json_file);
+  const study_detail::JsonView record(document, "", source);
   ReportTrial trial;
   trial.subject = manifest.setup.subject.id;
   trial.session = manifest.session_id;
   trial.phase = to_string(plan.phase);
   trial.condition = plan.condition;
-  trial.mode = record.value("mode", "");
+  trial.mode = record.string_or("mode", "");
   for (const char32_t c : plan.characters) trial.characters += encode_utf8(c);
-  trial.end_reason = record.value("end_reason", "");
+  trial.end_reason = record.string_or("end_reason", "");
   trial.index = plan.index + 1;
   trial.item = plan.item;
   trial.repetition = plan.repetition;
-  trial.time_total_s = number(record, "total_time_s", source);
-  trial.mean_deviation_mm = number(record, "mean_deviation_mm", source);
-  trial.frechet_mm = optional_number(record, "frechet_mm", source);
-  trial.dtw_mm = optional_number(record, "dtw_mm", source);
-  trial.order_errors = static_cast<std::size_t>(number(record, "order_errors", source));
-  trial.backwards_strokes = static_cast<std::size_t>(number(record, "backwards_strokes", source));
-  trial.completed = record.value("end_reason", "") == "completed";
-  if (record.contains("quiz")) trial.quiz_misses = record["quiz"].value("misses", 0);
-  read_scene(record, source, trial);
-  const json& per_stroke = record.value("per_stroke", json::array());
+  trial.time_total_s = record.number("total_time_s", -1e12, 1e12);
+  // null for a trial in which no stroke was written (the time ran out first): shown as such, not refused
+  trial.mean_deviation_mm = record.number_or("mean_deviation_mm", std::nan(""), -1e12, 1e12);
+  trial.frechet_mm = record.optional_number("frechet_mm", -1e12, 1e12);
+  trial.dtw_mm = record.optional_number("dtw_mm", -1e12, 1e12);
+  trial.order_errors = static_cast<std::size_t>(record.number("order_errors", 0.0, 1e12));
+  trial.backwards_strokes = static_cast<std::size_t>(record.number("backwards_strokes", 0.0, 1e12));
+  trial.completed = trial.end_reason == "completed";
+  if (record.has("quiz")) trial.quiz_misses = static_cast<int>(record.object("quiz").integer_or("misses", 0, 0, 1 << 30));
+  read_scene(record, trial);
+  const study_detail::JsonView per_stroke = record.array("per_stroke");
   for (std::size_t i = 0; i < per_stroke.size(); ++i) {
-    const json& s = per_stroke[i];
-    if (!s.value("start_s", json()).is_number() || !s.value("end_s", json()).is_number()) continue;
-    trial.strokes.push_back(
-        {i, s["start_s"].get<double>(), s["end_s"].get<double>(), s.value("completed", false)});
+    const study_detail::JsonView stroke = per_stroke.object_at(i);
+    const std::optional<double> start_s = stroke.optional_number("start_s", -1e12, 1e12);
+    const std::optional<double> end_s = stroke.optional_number("end_s", -1e12, 1e12);
+    if (!start_s || !end_s) continue;  // a stroke never written
+    trial.strokes.push_back({i, *start_s, *end_s, stroke.boolean_or("completed", false)});
   }
-  const double paper_z = record["scene"].value("layout", json::object()).value("paper_z_m", 0.0);
-  const std::string csv = record.value("files", json::object()).value("csv", "");
+  const double paper_z = record.object("scene").object("layout").number_or("paper_z_m", 0.0, -1e6, 1e6);
+  const std::string csv = record.object("files").string_or("csv", "");
   if (csv.empty() || csv.find('/') != std::string::npos) fail(source, "/files/csv", "expected a file name");
   read_trace(json_file.parent_path() / csv, paper_z, trial);
   return trial;
@@ -169,11 +156,13 @@ std::string session_line(const SessionManifest& m, const fs::path& folder, std::
 
 StudyReport read_study_report(const std::vector<fs::path>& roots) {
   const std::vector<fs::path> folders = study_detail::session_folders_under(roots);
+  study_detail::DistinctSessions distinct;
   StudyReport report;
   std::set<std::string> protocols;
   bool simulated = false;
   for (const fs::path& folder : folders) {
     const SessionManifest manifest = study_detail::read_session_manifest(folder);
+    if (!distinct.add(folder, manifest)) continue;
     if (report.title.empty()) {
       const StudyProtocol& p = manifest.protocol.protocol;
       report.title = "Study report: " + p.name;

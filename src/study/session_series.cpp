@@ -1,12 +1,52 @@
 #include "calligraphy/study/session_series.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <map>
 
+#include "calligraphy/core/errors.hpp"
+#include "study/json_reader.hpp"
 #include "study/names.hpp"
 #include "study/saved_sessions.hpp"
 
 namespace calligraphy {
 namespace fs = std::filesystem;
+namespace {
+
+std::string manifest_sha256(const fs::path& folder) {
+  return sha256_hex(
+      study_detail::read_small_file(folder / "session.json", study_detail::kMaxRecordBytes, "session manifest"));
+}
+
+// Session `number` (> 1) must follow the folder found for the session before it: by name, and by content
+// where the link recorded it.
+void check_link(const fs::path& folder, const SessionManifest& manifest, const fs::path& before, int number) {
+  const std::string source = (folder / "session.json").string();
+  const PreviousSession& previous = *manifest.previous;
+  if (previous.session_id != before.filename().string()) {
+    study_detail::fail(source, "/previous_session/session_id",
+                       "session " + std::to_string(number) + " follows '" + previous.session_id + "', but session " +
+                           std::to_string(number - 1) + " is " + before.string() +
+                           " (moved, renamed or copied from elsewhere?): put the session it follows back in " +
+                           folder.parent_path().string());
+  }
+  (void)study_detail::read_previous_session(folder, manifest);  // its content, where the link recorded it
+}
+
+// Whether any planned trial of the session has no record (not only its last: a record may be lost).
+bool has_unsaved_trial(const fs::path& folder, const SessionManifest& manifest) {
+  for (const PlannedTrial& trial : manifest.plan) {
+    std::error_code error;
+    if (!fs::exists(folder / "trials" / (SessionFolder::trial_stem(trial) + ".json"), error)) return true;
+  }
+  return false;
+}
+
+}  // namespace
 
 SessionSeries session_series(const fs::path& root, const std::string& subject_id,
                              const LoadedProtocol& protocol) {
@@ -19,6 +59,11 @@ SessionSeries session_series(const fs::path& root, const std::string& subject_id
     for (const fs::path& folder : find_session_folders(subject_folder)) {
       SessionManifest manifest = study_detail::read_session_manifest(folder);
       if (manifest.protocol.sha256 != protocol.sha256) continue;
+      if (manifest.setup.subject.id != subject_id) {
+        study_detail::fail((folder / "session.json").string(), "/subject/id",
+                           "a session of subject '" + manifest.setup.subject.id + "' in the folder of '" +
+                               subject_id + "': move it back to " + (root / manifest.setup.subject.id).string());
+      }
       const int number = manifest.setup.session_number;
       const auto known = by_number.find(number);
       if (known == by_number.end() || known->second.second.created_utc <= manifest.created_utc) {
@@ -26,38 +71,85 @@ SessionSeries session_series(const fs::path& root, const std::string& subject_id
       }
     }
   }
+  // A later session without an earlier one: the earlier folder was moved or deleted.
+  int expected = 1;
+  for (const auto& [number, entry] : by_number) {
+    if (number != expected) {
+      throw DataError(subject_folder.string() + ": session " + std::to_string(expected) + " of " +
+                      protocol.protocol.name + " is missing, but session " + std::to_string(number) + " is " +
+                      entry.first.string() +
+                      (entry.second.previous ? " (it follows '" + entry.second.previous->session_id + "')" : "") +
+                      ": put the missing session folder back before running the next session");
+    }
+    ++expected;
+  }
   for (int number = 1; number <= series.sessions; ++number) {
     const auto found = by_number.find(number);
     if (found == by_number.end()) break;
     const auto& [folder, manifest] = found->second;
+    if (number > 1) check_link(folder, manifest, series.folders.back(), number);
     series.folders.push_back(folder);
     series.next = number + 1;
-    const PlannedTrial& last = manifest.plan.back();
-    const fs::path last_record = folder / "trials" / (SessionFolder::trial_stem(last) + ".json");
-    if (!fs::exists(last_record, error)) {
+    if (has_unsaved_trial(folder, manifest)) {
       series.unfinished = folder;
       series.next = number;
       series.previous.reset();
       return series;
     }
     if (number == series.sessions) continue;
-    // What links the next session to this one: its last trial's end and the next session's delay.
+    // What links the next session to this one: its last trial's end, its content and the next session's delay.
+    const fs::path last_record = folder / "trials" / (SessionFolder::trial_stem(manifest.plan.back()) + ".json");
     PreviousSession previous;
     previous.session_id = manifest.session_id;
-    previous.ended_utc =
-        study_detail::read_trial_record(last_record).value("end_time_utc", manifest.created_utc);
+    previous.session_sha256 = manifest_sha256(folder);
+    const nlohmann::json record = study_detail::read_trial_record(last_record);
+    previous.ended_utc = study_detail::JsonView(record, "", last_record.string())
+                             .string_or("end_time_utc", manifest.created_utc);
+    double ended_s = 0.0;
+    try {
+      ended_s = study_detail::utc_seconds(previous.ended_utc);
+    } catch (const InvalidArgument& e) {
+      study_detail::fail(last_record.string(), "/end_time_utc", e.what());
+    }
     for (const ProtocolPhase& phase : protocol.protocol.phases) {
       if (phase.session == number + 1) {
         previous.delay_s = phase.delay_s;
         break;
       }
     }
-    previous.elapsed_s = study_detail::utc_seconds(study_detail::utc_now_iso8601()) -
-                         study_detail::utc_seconds(previous.ended_utc);
+    // Negative when the previous session's clock was ahead of this one's: recorded as measured.
+    previous.elapsed_s = study_detail::utc_seconds(study_detail::utc_now_iso8601()) - ended_s;
     series.previous = std::move(previous);
+    series.previous_record = last_record;
   }
-  if (series.next > series.sessions) series.previous.reset();
+  if (series.next > series.sessions) {
+    series.previous.reset();
+    series.previous_record.clear();
+  }
   return series;
+}
+
+SeriesLock::SeriesLock(const fs::path& root, const std::string& subject_id,
+                       const std::function<void(const fs::path&)>& waiting)
+    : path_(root / subject_id) {
+  // The subject's folder itself is locked (flock(2) takes a directory): no lock file among the sessions.
+  std::error_code error;
+  fs::create_directories(path_, error);
+  if (error) throw DataError(path_.string() + ": cannot create the folder: " + error.message());
+  fd_ = ::open(path_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd_ < 0) throw DataError(path_.string() + ": cannot open the lock: " + std::strerror(errno));
+  if (::flock(fd_, LOCK_EX | LOCK_NB) == 0) return;
+  if (errno == EWOULDBLOCK && waiting) waiting(path_);
+  while (::flock(fd_, LOCK_EX) != 0) {
+    if (errno == EINTR) continue;
+    const int reason = errno;
+    ::close(fd_);
+    throw DataError(path_.string() + ": cannot lock: " + std::strerror(reason));
+  }
+}
+
+SeriesLock::~SeriesLock() {
+  if (fd_ >= 0) ::close(fd_);  // closing the descriptor releases the lock
 }
 
 }  // namespace calligraphy

@@ -18,45 +18,27 @@ namespace {
 using nlohmann::json;
 using study_detail::fail;
 
-// A record's number; absent when missing or null.
-std::optional<double> optional_number(const json& object, const char* key, const std::string& source,
-                                      const std::string& pointer) {
-  const auto found = object.find(key);
-  if (found == object.end() || found->is_null()) return std::nullopt;
-  return study_detail::as_number(*found, pointer + "/" + key, source, -1e12, 1e12);
-}
+using study_detail::JsonView;
 
 // A record's length in mm as metres; absent when missing or null.
-std::optional<double> metres(const json& object, const char* key_mm, const std::string& source,
-                             const std::string& pointer) {
-  const std::optional<double> millimetres = optional_number(object, key_mm, source, pointer);
+std::optional<double> metres(const JsonView& object, const char* key_mm) {
+  const std::optional<double> millimetres = object.optional_number(key_mm, -1e12, 1e12);
   return millimetres ? std::optional<double>(*millimetres * 1e-3) : std::nullopt;
 }
 
-double number(const json& object, const char* key, const std::string& source, const std::string& pointer) {
-  const auto found = object.find(key);
-  if (found == object.end()) fail(source, pointer + "/" + key, "missing (required)");
-  return study_detail::as_number(*found, pointer + "/" + key, source, -1e12, 1e12);
-}
-
-std::size_t count(const json& object, const char* key, const std::string& source,
-                  const std::string& pointer) {
-  const auto found = object.find(key);
-  if (found == object.end()) fail(source, pointer + "/" + key, "missing (required)");
-  return static_cast<std::size_t>(
-      study_detail::as_integer(*found, pointer + "/" + key, source, 0, 1LL << 40));
+std::size_t count(const JsonView& object, const char* key) {
+  if (!object.has(key)) fail(object.source(), object.pointer() + "/" + key, "missing (required)");
+  return static_cast<std::size_t>(object.integer_or(key, 0, 0, 1LL << 40));
 }
 
 // The strokes of one character of a record: its per-stroke metrics and the verdicts of the segments the
 // matcher gave each stroke.
-void add_strokes(const json& character, std::size_t index, const std::string& source, const TrialRow& trial,
+void add_strokes(const JsonView& character, std::size_t index, const TrialRow& trial,
                  std::vector<StrokeRow>& strokes) {
-  const std::string at = "/per_character/" + std::to_string(index);
-  const json& per_stroke = character.value("per_stroke", json::array());
+  const JsonView per_stroke = character.array("per_stroke");
   const std::size_t first = strokes.size();
   for (std::size_t s = 0; s < per_stroke.size(); ++s) {
-    const json& metrics = per_stroke[s];
-    const std::string pointer = at + "/per_stroke/" + std::to_string(s);
+    const JsonView metrics = per_stroke.object_at(s);
     StrokeRow row;
     row.subject = trial.subject;
     row.session = trial.session;
@@ -64,35 +46,33 @@ void add_strokes(const json& character, std::size_t index, const std::string& so
     row.phase = trial.phase;
     row.condition = trial.condition;
     row.character = index;
-    row.character_text = character.value("character", "");
+    row.character_text = character.string_or("character", "");
     row.stroke = s;
-    row.typical_id = static_cast<int>(study_detail::as_integer(metrics.value("typical_id", json(0)),
-                                                               pointer + "/typical_id", source, 0, 39));
-    row.written = metrics.value("written", false);
-    row.backwards = metrics.value("backwards", false);
-    row.mean_deviation_m = metres(metrics, "mean_deviation_mm", source, pointer);
-    row.max_deviation_m = metres(metrics, "max_deviation_mm", source, pointer);
-    row.rms_deviation_m = metres(metrics, "rms_deviation_mm", source, pointer);
-    row.frechet_m = metres(metrics, "frechet_mm", source, pointer);
-    row.dtw_m = metres(metrics, "dtw_mm", source, pointer);
-    row.path_length_m = metres(metrics, "path_length_mm", source, pointer);
-    row.time_s = optional_number(metrics, "time_s", source, pointer);
+    row.typical_id = static_cast<int>(metrics.integer_or("typical_id", 0, 0, 39));
+    row.written = metrics.boolean_or("written", false);
+    row.backwards = metrics.boolean_or("backwards", false);
+    row.mean_deviation_m = metres(metrics, "mean_deviation_mm");
+    row.max_deviation_m = metres(metrics, "max_deviation_mm");
+    row.rms_deviation_m = metres(metrics, "rms_deviation_mm");
+    row.frechet_m = metres(metrics, "frechet_mm");
+    row.dtw_m = metres(metrics, "dtw_mm");
+    row.path_length_m = metres(metrics, "path_length_mm");
+    row.time_s = metrics.optional_number("time_s", -1e12, 1e12);
     strokes.push_back(std::move(row));
   }
-  const json& segments = character.value("segments", json::array());
-  for (const json& segment : segments) {
-    const json& verdict = segment.value("verdict", json());
-    if (!verdict.is_object()) continue;  // an ignored segment (a dot, a touch) has no verdict
+  const JsonView segments = character.array("segments");
+  for (std::size_t i = 0; i < segments.size(); ++i) {
+    const JsonView verdict = segments.object_at(i).object("verdict");
+    if (verdict.json().empty()) continue;  // an ignored segment (a dot, a touch) has no verdict
     // The stroke the segment was written for: the one it matched, else the one expected then.
-    const json& stroke = verdict.value("matched_stroke", json()).is_number()
-                             ? verdict["matched_stroke"]
-                             : verdict.value("expected_stroke", json());
-    if (!stroke.is_number_unsigned() || stroke.get<std::size_t>() >= per_stroke.size()) continue;
-    StrokeRow& row = strokes[first + stroke.get<std::size_t>()];
+    const char* key = verdict.has("matched_stroke") ? "matched_stroke" : "expected_stroke";
+    const std::int64_t stroke = verdict.integer_or(key, -1, -1, 1LL << 40);
+    if (stroke < 0 || static_cast<std::size_t>(stroke) >= per_stroke.size()) continue;
+    StrokeRow& row = strokes[first + static_cast<std::size_t>(stroke)];
     ++row.segments;
-    if (!verdict.value("accepted", false)) {
+    if (!verdict.boolean_or("accepted", false)) {
       ++row.refused_segments;
-      row.refusal = verdict.value("refusal", "");
+      row.refusal = verdict.string_or("refusal", "");
     }
   }
 }
@@ -102,7 +82,7 @@ TrialRow read_trial_row(const fs::path& json_file, const SessionManifest& manife
   const std::string source = json_file.string();
   const json record = study_detail::read_trial_record(json_file);
   TrialRow row = study_detail::trial_row(record, source, manifest, plan, strokes);
-  const std::string csv = record.value("files", json::object()).value("csv", "");
+  const std::string csv = JsonView(record, "", source).object("files").string_or("csv", "");
   if (csv.empty() || csv.find('/') != std::string::npos) fail(source, "/files/csv", "expected a file name");
   row.trace_file = json_file.parent_path() / csv;
   return row;
@@ -110,9 +90,10 @@ TrialRow read_trial_row(const fs::path& json_file, const SessionManifest& manife
 
 }  // namespace
 
-TrialRow study_detail::trial_row(const json& record, const std::string& source,
+TrialRow study_detail::trial_row(const json& document, const std::string& source,
                                  const SessionManifest& manifest, const PlannedTrial& plan,
                                  std::vector<StrokeRow>& strokes) {
+  const JsonView record(document, "", source);
   TrialRow row;
   row.subject = manifest.setup.subject.id;
   row.session = manifest.session_id;
@@ -122,36 +103,36 @@ TrialRow study_detail::trial_row(const json& record, const std::string& source,
   row.phase = to_string(plan.phase);
   row.block = plan.block;
   row.condition = plan.condition;
-  row.mode = record.value("mode", "");
+  row.mode = record.string_or("mode", "");
   for (const char32_t c : plan.characters) row.characters += encode_utf8(c);
   row.trial = plan.index;
   row.item = plan.item;
   row.repetition = static_cast<std::size_t>(plan.repetition - 1);
   row.writer = manifest.setup.writer;
-  row.end_reason = record.value("end_reason", "");
-  row.start_utc = record.value("start_time_utc", "");
-  row.completed_in_order = record.value("completed_in_order", false);
-  row.strokes_total = count(record, "strokes_total", source, "");
-  row.strokes_written = count(record, "strokes_written", source, "");
-  row.strokes_accepted = count(record, "strokes_accepted", source, "");
-  row.order_errors = count(record, "order_errors", source, "");
-  row.backwards_strokes = count(record, "backwards_strokes", source, "");
-  row.unmatched_segments = count(record, "unmatched_segments", source, "");
-  row.mean_deviation_m = metres(record, "mean_deviation_mm", source, "");
-  row.max_deviation_m = metres(record, "max_deviation_mm", source, "");
-  row.rms_deviation_m = metres(record, "rms_deviation_mm", source, "");
-  row.frechet_m = metres(record, "frechet_mm", source, "");
-  row.dtw_m = metres(record, "dtw_mm", source, "");
-  row.total_time_s = number(record, "total_time_s", source, "");
-  row.pen_down_time_s = number(record, "pen_down_time_s", source, "");
-  row.velocity_peaks = static_cast<int>(count(record, "velocity_peaks", source, ""));
-  row.normalised_jerk = optional_number(record, "normalised_jerk", source, "");
-  const json& memory = record.value("writer", json::object()).value("memory", json::object());
-  row.shape_skill = optional_number(memory, "shape_skill", source, "/writer/memory");
-  row.order_skill = optional_number(memory, "order_skill", source, "/writer/memory");
-  row.timing_skill = optional_number(memory, "timing_skill", source, "/writer/memory");
-  const json& characters = record.value("per_character", json::array());
-  for (std::size_t c = 0; c < characters.size(); ++c) add_strokes(characters[c], c, source, row, strokes);
+  row.end_reason = record.string_or("end_reason", "");
+  row.start_utc = record.string_or("start_time_utc", "");
+  row.completed_in_order = record.boolean_or("completed_in_order", false);
+  row.strokes_total = count(record, "strokes_total");
+  row.strokes_written = count(record, "strokes_written");
+  row.strokes_accepted = count(record, "strokes_accepted");
+  row.order_errors = count(record, "order_errors");
+  row.backwards_strokes = count(record, "backwards_strokes");
+  row.unmatched_segments = count(record, "unmatched_segments");
+  row.mean_deviation_m = metres(record, "mean_deviation_mm");
+  row.max_deviation_m = metres(record, "max_deviation_mm");
+  row.rms_deviation_m = metres(record, "rms_deviation_mm");
+  row.frechet_m = metres(record, "frechet_mm");
+  row.dtw_m = metres(record, "dtw_mm");
+  row.total_time_s = record.number("total_time_s", -1e12, 1e12);
+  row.pen_down_time_s = record.number("pen_down_time_s", -1e12, 1e12);
+  row.velocity_peaks = static_cast<int>(count(record, "velocity_peaks"));
+  row.normalised_jerk = record.optional_number("normalised_jerk", -1e12, 1e12);
+  const JsonView memory = record.object("writer").object("memory");
+  row.shape_skill = memory.optional_number("shape_skill", -1e12, 1e12);
+  row.order_skill = memory.optional_number("order_skill", -1e12, 1e12);
+  row.timing_skill = memory.optional_number("timing_skill", -1e12, 1e12);
+  const JsonView characters = record.array("per_character");
+  for (std::size_t c = 0; c < characters.size(); ++c) add_strokes(characters.object_at(c), c, row, strokes);
   return row;
 }
 
@@ -190,9 +171,11 @@ void line(std::string& out, const Fields&... fields) {
 
 StudyTables read_study_tables(const std::vector<fs::path>& roots) {
   const std::vector<fs::path> folders = study_detail::session_folders_under(roots);
+  study_detail::DistinctSessions distinct;
   StudyTables tables;
   for (const fs::path& folder : folders) {
     const SessionManifest manifest = study_detail::read_session_manifest(folder);
+    if (!distinct.add(folder, manifest)) continue;
     for (const PlannedTrial& plan : manifest.plan) {
       const fs::path json_file = folder / "trials" / (SessionFolder::trial_stem(plan) + ".json");
       std::error_code error;

@@ -9,6 +9,7 @@
 #include "calligraphy/render/guidance_mode.hpp"
 #include "calligraphy/study/trial_spec_runner.hpp"
 #include "core/unicode.hpp"
+#include "study/json_reader.hpp"
 #include "study/names.hpp"
 
 namespace calligraphy::study_detail {
@@ -70,17 +71,18 @@ PreparedGuidance repetition_guidance(const StudyCondition& condition, const Plan
   prepared.guidance.band_m = condition.start_band_m;
   if (condition.mode == ConditionMode::skill_adaptive) prepared.guidance.mode = GuidanceMode::fixed;
   if (!previous || !previous_record) return prepared;
-  try {
-    const json& record = *previous_record;
-    prepared.previous_trial = SessionFolder::trial_stem(*previous);
-    const json& guidance = record.at("guidance");
-    if (condition.mode == ConditionMode::fading) prepared.previous_gain = guidance.at("gain").get<double>();
-    if (condition.mode == ConditionMode::assist_as_needed)
-      prepared.previous_band_m = guidance.at("band_m").get<double>();
-    prepared.previous_deviation_mm = record.at("mean_deviation_mm");
-  } catch (const json::exception& e) {
-    throw DataError(source + ": no guidance and mean deviation to adapt from: " + e.what());
-  }
+  const study_detail::JsonView record(*previous_record, "", source);
+  prepared.previous_trial = SessionFolder::trial_stem(*previous);
+  if (!record.has("guidance")) study_detail::fail(source, "/guidance", "missing (required): no guidance to adapt from");
+  const study_detail::JsonView guidance = record.object("guidance");
+  if (condition.mode == ConditionMode::fading) prepared.previous_gain = guidance.number("gain", 0.0, 1e6);
+  if (condition.mode == ConditionMode::assist_as_needed)
+    prepared.previous_band_m = guidance.number("band_m", 0.0, 1e6);
+  if (!record.json().contains("mean_deviation_mm"))
+    study_detail::fail(source, "/mean_deviation_mm", "missing (required): no mean deviation to adapt from");
+  // null when the repetition wrote nothing
+  const std::optional<double> deviation_mm = record.optional_number("mean_deviation_mm", -1e12, 1e12);
+  prepared.previous_deviation_mm = deviation_mm ? json(*deviation_mm) : json(nullptr);
   // A repetition that wrote nothing gives no error to adapt on: full guidance again.
   const bool wrote = prepared.previous_deviation_mm.is_number();
   const double error_m = wrote ? prepared.previous_deviation_mm.get<double>() * 1e-3 : 0.0;
@@ -113,12 +115,7 @@ PreparedGuidance repetition_guidance(const SessionFolder& session, const StudyCo
                      SessionFolder::trial_stem(*previous) + ", which is not saved");
   }
   const std::string text = read_small_file(file, std::uintmax_t{64} << 20, "trial record");
-  json record;
-  try {
-    record = json::parse(text);
-  } catch (const json::exception& e) {
-    throw DataError(file.string() + ": no guidance and mean deviation to adapt from: " + e.what());
-  }
+  const json record = study_detail::parse_json(text, file.string());
   return repetition_guidance(condition, previous, &record, file.string());
 }
 

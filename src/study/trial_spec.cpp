@@ -11,6 +11,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
+#include "core/decimal_number.hpp"
 #include "core/unicode.hpp"
 #include "study/json_reader.hpp"
 
@@ -88,14 +89,9 @@ std::string field_label(std::string_view key) {
 }
 
 double parse_number(std::string_view key, std::string_view text) {
-  const std::string copy(text);
-  char* end = nullptr;
-  errno = 0;
-  const double value = std::strtod(copy.c_str(), &end);
-  if (copy.empty() || end != copy.c_str() + copy.size() || errno == ERANGE || !std::isfinite(value)) {
-    refuse(key, "'" + copy + "' is not a finite number");
-  }
-  return value;
+  const std::optional<double> value = parse_finite_double(text);
+  if (!value) refuse(key, "'" + std::string(text) + "' is not a finite number");
+  return *value;
 }
 
 std::uint64_t parse_unsigned(std::string_view key, std::string_view text) {

@@ -85,10 +85,15 @@ def test_the_tables_feed_the_statistics(threads):
 def test_bad_arguments_are_named(protocol):
     with pytest.raises(ValueError, match="subjects"):
         calligraphy.cohort.simulate(protocol, 0)
+    # The CLI's bound, refused before anything is built (a list of 10**9 ids would fill the memory).
+    with pytest.raises(ValueError, match="1 to 100000 subjects, got 1000000000"):
+        calligraphy.cohort.simulate(protocol, 10**9)
     with pytest.raises(TypeError, match="subjects"):
         calligraphy.cohort.simulate(protocol, "4")
     with pytest.raises(ValueError, match="workers"):
         calligraphy.cohort.simulate(protocol, 1, workers=0)
+    with pytest.raises(ValueError, match="workers: expected an int in 1..1024"):
+        calligraphy.cohort.simulate(protocol, 1, workers=10**6)
     with pytest.raises(ValueError, match="writer_profile"):
         calligraphy.cohort.simulate(protocol, 1, profile="expert")
     with pytest.raises(ValueError, match="writer_learning"):

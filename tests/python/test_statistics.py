@@ -365,3 +365,29 @@ def test_learning_keeps_each_subjects_group():
     table = statistics.learning(trials, VALUE, "pre-test", "post-test")
     assert list(table.group) == ["fixture", "fading"]
     assert list(table.gain) == pytest.approx([1e-3, 2e-3])
+
+
+@pytest.mark.parametrize("infinity", [np.inf, -np.inf])
+def test_an_infinite_outcome_counts_as_missing_and_is_said(infinity):
+    trials = make_trials(seed=21)
+    finite = trials.copy()
+    damaged = trials.copy()
+    damaged.loc[damaged.index[5], VALUE] = infinity
+    finite.loc[finite.index[5], VALUE] = np.nan  # what the infinite value must count as
+
+    with pytest.warns(statistics.NonFiniteValueWarning, match=f"'{VALUE}' holds 1 infinite"):
+        described = statistics.describe(damaged, VALUE)
+    expected = statistics.describe(finite, VALUE)
+    pandas.testing.assert_frame_equal(described, expected)
+    assert described["n_missing"].sum() == 1
+    assert np.isfinite(described["mean"]).all()
+
+    with pytest.warns(statistics.NonFiniteValueWarning):
+        model = statistics.mixed_model(damaged, VALUE, fixed="condition", phase="test")
+    reference = statistics.mixed_model(finite, VALUE, fixed="condition", phase="test")
+    assert model["n_dropped"].iloc[0] == reference["n_dropped"].iloc[0] == 1
+    np.testing.assert_allclose(model["estimate"], reference["estimate"])
+
+    with pytest.warns(statistics.NonFiniteValueWarning):
+        paired = statistics.paired_comparison(damaged, VALUE, "vision", "haptic")
+    assert np.isfinite(paired.mean_difference)

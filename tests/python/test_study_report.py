@@ -287,6 +287,81 @@ def test_a_file_that_cannot_be_written_is_named(study, tmp_path):
     with pytest.raises(OSError, match="index.html"):
         study_report.write_report(study, out, values=("total_time_s",))
     assert not list(out.glob(".*.tmp"))
+    assert not (out / "tables" / "summary.csv").exists()  # refused before any file of the set is written
+
+
+def test_a_report_that_fails_while_writing_leaves_the_earlier_report_whole(study, tmp_path):
+    import hashlib
+    import resource
+    import signal
+
+    out = tmp_path / "report"
+    study_report.write_report(study, out, values=("total_time_s",))
+
+    def digests():
+        return {p.relative_to(out): hashlib.sha256(p.read_bytes()).hexdigest() for p in sorted(out.rglob("*"))
+                if p.is_file()}
+
+    before = digests()
+    largest = max(p.stat().st_size for p in out.rglob("*") if p.is_file())
+    smallest = min(p.stat().st_size for p in out.rglob("*") if p.is_file())
+    assert smallest < largest // 2
+    # Files beyond half the largest cannot be written (EFBIG), as on a full disk: some of the new report is
+    # written, then a file fails. A title makes every new page differ from the earlier one.
+    saved_limit = resource.getrlimit(resource.RLIMIT_FSIZE)
+    saved_handler = signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    resource.setrlimit(resource.RLIMIT_FSIZE, (largest // 2, saved_limit[1]))
+    try:
+        with pytest.raises(OSError, match="cannot write"):
+            study_report.write_report(study, out, values=("total_time_s",), title="the second report")
+    finally:
+        resource.setrlimit(resource.RLIMIT_FSIZE, saved_limit)
+        signal.signal(signal.SIGXFSZ, saved_handler)
+    assert digests() == before
+    assert not [p for p in out.rglob(".*") if p.is_file()]
+
+
+def test_an_infinite_value_is_missing_on_the_page_and_said(study, tmp_path):
+    damaged = calligraphy.study.Study(trials=study.trials.copy(), strokes=pandas.DataFrame())
+    damaged.trials.loc[damaged.trials.index[-1], "total_time_s"] = np.inf
+    with pytest.warns(calligraphy.statistics.NonFiniteValueWarning, match="'total_time_s'"):
+        index = study_report.write_report(damaged, tmp_path / "report", values=("total_time_s",))
+    page = index.read_text(encoding="utf-8")
+    assert "inf" not in page.replace("info", "")
+    summary = pandas.read_csv(tmp_path / "report" / "tables" / "summary.csv")
+    assert np.isfinite(summary["mean"].dropna()).all()
+
+
+def test_a_report_waits_for_another_writer_of_its_folder(study, tmp_path):
+    import fcntl
+    import threading
+
+    out = tmp_path / "report"
+    study_report.write_report(study, out, values=("total_time_s",))
+    before = (out / "index.html").read_bytes()
+    other_writer = os.open(out, os.O_RDONLY | os.O_DIRECTORY)  # another report in the middle of its renames
+    fcntl.flock(other_writer, fcntl.LOCK_EX)
+    thread = threading.Thread(target=study_report.write_report, args=(study, out),
+                              kwargs={"values": ("total_time_s",), "title": "the second report"})
+    thread.start()
+    thread.join(timeout=5.0)
+    try:
+        assert thread.is_alive()  # waiting for the folder
+        assert (out / "index.html").read_bytes() == before
+    finally:
+        os.close(other_writer)
+    thread.join(timeout=60.0)
+    assert not thread.is_alive()
+    assert "the second report" in (out / "index.html").read_text(encoding="utf-8")
+
+
+def test_an_empty_output_folder_is_refused(study, tmp_path):
+    (tmp_path / "index.html").write_text("someone's page", encoding="utf-8")
+    with pytest.raises(ValueError, match="out_dir is empty"):
+        study_report.write_report(study, "")
+    empty = run_module(tmp_path, "--out", "", cwd=tmp_path)
+    assert empty.returncode == 2 and "--out" in empty.stderr
+    assert (tmp_path / "index.html").read_text(encoding="utf-8") == "someone's page"
 
 
 def test_bad_arguments_are_named(study, tmp_path):

@@ -61,6 +61,9 @@ def test_samples_are_read_on_demand_in_si_units(study_folder):
 def test_a_folder_without_sessions_is_named(tmp_path):
     with pytest.raises(calligraphy.DataError, match=str(tmp_path)):
         calligraphy.study.load(tmp_path)
+    for nothing in ([], "", [tmp_path, ""]):
+        with pytest.raises(ValueError, match="load: paths must name"):
+            calligraphy.study.load(nothing)
 
 
 def test_the_curriculum_is_the_clis(cli, study_folder):
@@ -75,3 +78,38 @@ def test_the_curriculum_is_the_clis(cli, study_folder):
     assert proposed[0]["new_strokes"]  # something never written comes first
     with pytest.raises(Exception, match="'nobody' has no saved trial"):
         calligraphy.study.propose_characters(study_folder / "study", "nobody", candidates)
+
+
+def test_a_damaged_record_is_a_data_error_naming_the_file_and_pointer(study_folder, tmp_path):
+    import shutil
+
+    copy = tmp_path / "study"
+    shutil.copytree(study_folder / "study", copy)
+    record = sorted(copy.glob("S01/*/trials/*.json"))[0]
+    text = record.read_text(encoding="utf-8")
+    for old, new, pointer in [('"format": "calligraphy-study-trial"', '"format": 5', "/format"),
+                              ('"per_character": [', '"per_character": "x", "was": [', "/per_character"),
+                              ('"mean_deviation_mm": ', '"mean_deviation_mm": 1e999, "was": ', "/mean_deviation_mm"),
+                              ('"end_reason": "', '"end_reason": [], "was": "', "/end_reason")]:
+        compact = json.dumps(json.loads(text))  # one spelling of the separators for the replacements
+        assert old in compact, old
+        record.write_text(compact.replace(old, new, 1), encoding="utf-8")
+        with pytest.raises(calligraphy.DataError, match=f"{record.name}: {pointer}"):
+            calligraphy.study.load(copy)
+    record.write_text(text, encoding="utf-8")
+
+
+def test_a_damaged_trace_is_a_data_error_naming_the_file_and_line(study_folder, tmp_path):
+    import shutil
+
+    copy = tmp_path / "study"
+    shutil.copytree(study_folder / "study", copy)
+    study = calligraphy.study.load(copy)
+    trace = Path(study.trials.iloc[0]["trace_file"])
+    lines = trace.read_text(encoding="utf-8").splitlines()
+    for line, damaged, column in [(3, lines[2].replace(",", ",1e999x", 1), "x"), (4, "inf" + lines[3][1:], "t"),
+                                  (1, "t,x,y", None)]:
+        trace.write_text("\n".join(lines[:line - 1] + [damaged] + lines[line:]) + "\n", encoding="utf-8")
+        expected = f"{trace.name}:{line}: column {column}" if column else f"{trace.name}:1: expected the header"
+        with pytest.raises(calligraphy.DataError, match=expected):
+            study.samples(study.trials.iloc[0])

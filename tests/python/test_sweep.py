@@ -110,5 +110,12 @@ def test_values_and_arguments_are_checked_before_running():
         sweep("口", {"friction_coefficient": [0.1], "force_law.friction_coefficient": [0.2]}, [0], progress=False)
     with pytest.raises(ValueError, match="seeds"):
         sweep("口", {}, [], progress=False)
+    # Bounds, refused before a list of that size is built.
+    with pytest.raises(ValueError, match="seeds: expected a count in 1..1000000"):
+        sweep("口", {}, 10**9, progress=False)
+    with pytest.raises(ValueError, match="2000000 trials"):
+        sweep("口", {"guidance": [True, False]}, 10**6, progress=False)
+    with pytest.raises(ValueError, match="workers: expected an int in 1..1024"):
+        sweep("口", {}, [0], workers=10**6, progress=False)
     with pytest.raises(calligraphy.DataError, match="no-such-folder"):
         sweep("口", {}, [0], data="no-such-folder", progress=False)

@@ -29,6 +29,11 @@ def test_file_round_trip_is_exact_and_atomic(skilled_trial, tmp_path):
     read = calligraphy.TeacherRecording.load(path)
     assert read.to_json() == written.to_json()
     assert calligraphy.TeacherRecording.from_json(path.read_text(encoding="utf-8")).to_json() == read.to_json()
+    # An empty name is refused, not taken as the current folder.
+    with pytest.raises(calligraphy.InvalidArgument, match="path: empty"):
+        read.save("")
+    with pytest.raises(calligraphy.InvalidArgument, match="path: empty"):
+        calligraphy.record_teacher(skilled_trial, "")
 
 
 def test_replayed_teacher_guides_a_novice_through_in_order(skilled_trial, tmp_path):
@@ -68,3 +73,9 @@ def test_bad_files_are_named(tmp_path):
     bad.write_text('{"format": "calligraphy-teacher-recording", "version": 1}', encoding="utf-8")
     with pytest.raises(calligraphy.DataError, match="bad.json"):
         calligraphy.TeacherRecording.load(bad)
+    # A number beyond a double's range is a data error naming the file and its JSON pointer.
+    overflow = tmp_path / "overflow.json"
+    overflow.write_text('{"format": "calligraphy-teacher-recording", "version": 1, "rate_hz": 1e999}',
+                        encoding="utf-8")
+    with pytest.raises(calligraphy.DataError, match="overflow.json: /rate_hz: not a finite number"):
+        calligraphy.TeacherRecording.load(overflow)

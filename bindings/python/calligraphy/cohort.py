@@ -21,7 +21,8 @@ import os
 import typing
 
 from . import study as _study
-from ._calligraphy import _simulate_cohort_csv
+from ._calligraphy import _MAX_COHORT_SUBJECTS, _simulate_cohort_csv
+from .experiments import MAX_WORKERS as _MAX_WORKERS
 from .experiments import _library, _local_workers, _progress_bar, _source
 
 __all__ = ["simulate"]
@@ -36,8 +37,8 @@ _DEFAULT_BATCH = 1
 def _subject_list(subjects: typing.Any, prefix: str) -> list[tuple[str, int]]:
     if isinstance(subjects, bool) or not isinstance(subjects, int):
         raise TypeError(f"subjects: expected an int (the number of simulated subjects), got {subjects!r}")
-    if subjects < 1:
-        raise ValueError(f"subjects: expected at least 1 subject, got {subjects}")
+    if subjects < 1 or subjects > _MAX_COHORT_SUBJECTS:
+        raise ValueError(f"subjects: expected 1 to {_MAX_COHORT_SUBJECTS} subjects, got {subjects}")
     return [(f"{prefix}{number:02d}", number) for number in range(1, subjects + 1)]
 
 
@@ -70,7 +71,8 @@ def simulate(protocol: PathLike, subjects: int, *, profile: str = "novice", lear
     store / data: characters from a corpus store or a hanzi-writer-data folder instead of the embedded set.
     progress: a tqdm bar over the batches on an executor (when tqdm is installed).
 
-    Raises TypeError or ValueError for a bad argument, InvalidArgument for a bad profile or learning, a
+    Raises TypeError or ValueError for a bad argument (subjects beyond 1..100000 or workers beyond 1..1024, the
+    CLI's bounds), InvalidArgument for a bad profile or learning, a
     protocol with a replay condition (its teacher lives in a session folder) or a transfer choice that
     cannot be made; DataError naming the protocol file when it cannot be read; CharacterNotFound for a
     character the source lacks; ImportError without pandas. A simulated subject is a model, not a person.
@@ -80,8 +82,8 @@ def simulate(protocol: PathLike, subjects: int, *, profile: str = "novice", lear
     source = _source(store, data)
     if client is None:
         threads = workers if workers is not None else _local_workers()
-        if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
-            raise ValueError(f"workers: expected an int >= 1, got {workers!r}")
+        if isinstance(threads, bool) or not isinstance(threads, int) or not 1 <= threads <= _MAX_WORKERS:
+            raise ValueError(f"workers: expected an int in 1..{_MAX_WORKERS}, got {workers!r}")
         trials_text, strokes_text = _simulate_cohort_csv(path, subject_list, profile, learning, _library(source),
                                                          threads)
     else:

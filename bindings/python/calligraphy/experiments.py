@@ -32,7 +32,7 @@ from ._calligraphy import CharacterLibrary, ForceLawParameters, WriterProfile, s
 if typing.TYPE_CHECKING:  # pragma: no cover
     import pandas
 
-__all__ = ["DASK_WORKER_ENVIRONMENT", "dask_worker_config", "parameter_names", "sweep"]
+__all__ = ["DASK_WORKER_ENVIRONMENT", "MAX_SWEEP_TRIALS", "MAX_WORKERS", "dask_worker_config", "parameter_names", "sweep"]
 
 # glibc's malloc settings for Dask workers that run trials. distributed's nanny starts every worker with
 # MALLOC_TRIM_THRESHOLD_=65536 (its config key distributed.nanny.pre-spawn-environ), and setting any of these
@@ -61,6 +61,10 @@ _Source = typing.Tuple[str, str]
 # The largest default batch: large enough that a task's overhead (about a millisecond on a process
 # pool, several on Dask) is small against its trials (0.05-1 s each), small enough to balance load.
 _MAX_DEFAULT_BATCH = 32
+# Bounds of a sweep, checked before any list is built: trials (a million is hours of simulation and the
+# largest table kept in memory) and local workers (as `session cohort --jobs`).
+MAX_SWEEP_TRIALS = 1_000_000
+MAX_WORKERS = 1024
 # Default batches per worker, so that a slow batch at the end does not leave the other workers idle.
 _BATCHES_PER_WORKER = 4
 
@@ -228,8 +232,8 @@ def _character_labels(characters: typing.Any, library: CharacterLibrary) -> list
 
 def _seed_list(seeds: typing.Any) -> list[int]:
     if isinstance(seeds, int) and not isinstance(seeds, bool):
-        if seeds < 1:
-            raise ValueError(f"seeds: expected a count >= 1 or a list of seeds, got {seeds}")
+        if seeds < 1 or seeds > MAX_SWEEP_TRIALS:
+            raise ValueError(f"seeds: expected a count in 1..{MAX_SWEEP_TRIALS} or a list of seeds, got {seeds}")
         return list(range(seeds))
     values = list(typing.cast(typing.Iterable[int], seeds))
     if not values:
@@ -326,7 +330,7 @@ def sweep(characters: typing.Union[str, typing.Sequence[str], None],
     missing), e.g. "CharacterNotFound: ...".
 
     Raises ValueError for an unknown grid name (listing the valid ones), an empty value list or a
-    value out of range, TypeError for a value of the wrong type (both before any trial runs),
+    value out of range, more than MAX_SWEEP_TRIALS (1,000,000) trials or workers beyond 1..MAX_WORKERS (1024), TypeError for a value of the wrong type (both before any trial runs),
     DataError when the store or folder cannot be opened, ImportError without pandas.
     """
     from .frames import _pandas
@@ -336,6 +340,10 @@ def sweep(characters: typing.Union[str, typing.Sequence[str], None],
     source = _source(store, data)
     labels = _character_labels(characters, _library(source))
     seed_values = _seed_list(seeds)
+    trial_count = len(labels) * len(seed_values) * math.prod(len(values) for _, values in axes)
+    if trial_count > MAX_SWEEP_TRIALS:
+        raise ValueError(f"sweep: {trial_count} trials (characters x seeds x grid combinations) exceed the bound "
+                         f"of {MAX_SWEEP_TRIALS}; split the sweep")
     combinations = [tuple(zip([name for name, _ in axes], values))
                     for values in itertools.product(*[values for _, values in axes])]
     for combination in combinations:
@@ -350,8 +358,8 @@ def sweep(characters: typing.Union[str, typing.Sequence[str], None],
     executor: concurrent.futures.Executor
     if client is None:
         worker_count = workers if workers is not None else _local_workers()
-        if worker_count < 1:
-            raise ValueError(f"workers: expected >= 1, got {worker_count}")
+        if isinstance(worker_count, bool) or not isinstance(worker_count, int) or not 1 <= worker_count <= MAX_WORKERS:
+            raise ValueError(f"workers: expected an int in 1..{MAX_WORKERS}, got {worker_count!r}")
         executor = own_pool = _process_pool(min(worker_count, max(1, len(specs))))
     elif isinstance(client, concurrent.futures.Executor):
         executor = client

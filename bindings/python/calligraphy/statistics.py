@@ -6,7 +6,8 @@ conditions, a linear mixed model, learning and retention, and groups compared be
 ``condition``, ``characters`` (str) and ``repetition`` (int, 0-based, as calligraphy.study gives it), plus numeric outcomes in SI units
 named with their unit: ``mean_deviation_m``, ``max_deviation_m``, ``total_time_s``, ``pen_down_time_s``
 (NaN for a trial that wrote nothing). Each function needs only the columns it uses, and reports in the
-outcome's own unit.
+outcome's own unit. An infinite outcome counts as missing, like NaN, with a NonFiniteValueWarning naming
+the column.
 
 Trials of one subject are not independent. Inference about conditions therefore takes the subject as
 its unit: ``paired_comparison`` averages each subject's trials per condition, ``mixed_model`` gives each
@@ -33,6 +34,7 @@ if typing.TYPE_CHECKING:  # pragma: no cover
 
 __all__ = [
     "GroupComparison",
+    "NonFiniteValueWarning",
     "PairedComparison",
     "describe",
     "group_comparison",
@@ -100,11 +102,24 @@ def _require_columns(trials: pandas.DataFrame, columns: typing.Iterable[str], ca
         raise ValueError(f"{caller}: column {names} is not in trials; its columns: {present}")
 
 
-def _require_numeric(trials: pandas.DataFrame, value: str, caller: str) -> None:
+class NonFiniteValueWarning(UserWarning):
+    """An outcome column held +inf or -inf: those values were counted as missing, like NaN."""
+
+
+def _finite_outcome(trials: pandas.DataFrame, value: str, caller: str) -> pandas.DataFrame:
+    """``trials`` with ``value`` checked numeric and its infinite values made NaN (missing), so that every
+    statistic leaves them out and counts them in ``n_missing`` instead of returning NaN or inf. Warns
+    NonFiniteValueWarning naming the column and the count; raises TypeError for a column not numeric."""
     pandas = _pandas()
     if not pandas.api.types.is_numeric_dtype(trials[value]) or pandas.api.types.is_bool_dtype(trials[value]):
         raise TypeError(f"{caller}: column {value!r} must be numeric (an outcome in SI units), "
                         f"it has dtype {trials[value].dtype}")
+    infinite = np.isinf(trials[value].to_numpy(dtype=float))
+    if not infinite.any():
+        return trials
+    warnings.warn(f"{caller}: column {value!r} holds {int(infinite.sum())} infinite value(s); they are counted "
+                  "as missing (like NaN)", NonFiniteValueWarning, stacklevel=3)
+    return trials.assign(**{value: trials[value].where(~infinite, np.nan)})
 
 
 def _levels(column: pandas.Series) -> list[typing.Any]:
@@ -172,7 +187,7 @@ def describe(trials: pandas.DataFrame, value: str, by: str | typing.Sequence[str
     ``unit="trial"`` (default) describes the trials of each group as they are; ``unit="subject"`` first
     averages each subject's trials within the group and describes those subject means, so that n counts
     subjects, the unit of inference when trials of one subject are not independent. NaN values (a trial
-    that wrote nothing) are left out and counted.
+    that wrote nothing) and infinite values (warned as NonFiniteValueWarning) are left out and counted.
 
     Returns a DataFrame with one row per group (sorted by ``by``; one row in all for ``by=()``): the
     ``by`` columns, ``unit`` ('trial' or 'subject'), ``n`` (trials or subjects with a value),
@@ -194,7 +209,7 @@ def describe(trials: pandas.DataFrame, value: str, by: str | typing.Sequence[str
         raise ValueError("describe: by contains 'subject', so each group holds one subject; use unit='trial'")
     needed = [*by, value] + (["subject"] if unit == "subject" else [])
     _require_columns(trials, needed, caller)
-    _require_numeric(trials, value, caller)
+    trials = _finite_outcome(trials, value, caller)
 
     # A constant key stands in for the groups when the whole table is one group.
     everything = "__all__"
@@ -366,7 +381,7 @@ def paired_comparison(trials: pandas.DataFrame, value: str, a: typing.Any, b: ty
         raise _statsmodels_import_error(error) from error
     _check_frame(trials, caller)
     _require_columns(trials, ["subject", by, value], caller)
-    _require_numeric(trials, value, caller)
+    trials = _finite_outcome(trials, value, caller)
     data = _select_phase(trials, phase, caller)
     present = _levels(data[by])
     for name in (a, b):
@@ -474,7 +489,7 @@ def mixed_model(trials: pandas.DataFrame, value: str, fixed: str = "condition", 
         raise _statsmodels_import_error(error) from error
     _check_frame(trials, caller)
     _require_columns(trials, ["subject", "characters", fixed, value], caller)
-    _require_numeric(trials, value, caller)
+    trials = _finite_outcome(trials, value, caller)
     data = _select_phase(trials, phase, caller)
     kept = data[data[value].notna()]
     n_dropped = len(data) - len(kept)
@@ -598,7 +613,7 @@ def learning(trials: pandas.DataFrame, value: str, pre: str, post: str, retentio
     pandas = _pandas()
     _check_frame(trials, caller)
     _require_columns(trials, ["subject", by, value], caller)
-    _require_numeric(trials, value, caller)
+    trials = _finite_outcome(trials, value, caller)
     phases = {role: name for role, name in
               (("pre", pre), ("post", post), ("retention", retention), ("transfer", transfer)) if name is not None}
     present = _levels(trials[by])
@@ -718,7 +733,7 @@ def group_comparison(table: pandas.DataFrame, value: str, a: typing.Any, b: typi
     stats = _scipy_stats()
     _check_frame(table, caller)
     _require_columns(table, ["subject", by, value], caller)
-    _require_numeric(table, value, caller)
+    table = _finite_outcome(table, value, caller)
     if table["subject"].duplicated().any():
         raise ValueError(f"{caller}: expected one row per subject (e.g. from learning()); "
                          f"{table['subject'][table['subject'].duplicated()].iloc[0]!r} has several")
@@ -821,7 +836,7 @@ def statistics_table(trials: pandas.DataFrame, value: str, by: str = "condition"
     pandas = _pandas()
     _check_frame(trials, caller)
     _require_columns(trials, ["subject", "characters", by, value], caller)
-    _require_numeric(trials, value, caller)
+    trials = _finite_outcome(trials, value, caller)
     data = _select_phase(trials, phase, caller)
     rows = []
     for described in describe(data, value, by=(by,), unit="subject").to_dict("records"):

@@ -37,6 +37,34 @@ _CATEGORIES = ("subject", "session", "protocol", "group", "phase", "condition", 
 _SAMPLE_COLUMNS = {"t": "t_s", "x": "x_m", "y": "y_m", "z": "z_m", "fx": "fx_n", "fy": "fy_n", "fz": "fz_n"}
 
 
+_TRACE_HEADER = ["t", "x", "y", "z", "fx", "fy", "fz", "state", "stroke", "element"]
+
+
+def _read_trace(path: str) -> "pandas.DataFrame":
+    """A trial's trace CSV as samples; DataError naming the file and line for damage."""
+    import numpy as np
+
+    from . import DataError
+
+    pd = _pandas()
+    try:
+        frame = pd.read_csv(path, dtype=str, keep_default_na=False)
+    except (ValueError, pd.errors.ParserError, UnicodeDecodeError) as error:
+        raise DataError(f"{path}: not a trial trace (CSV): {error}") from error
+    if list(frame.columns) != _TRACE_HEADER:
+        raise DataError(f"{path}:1: expected the header '{','.join(_TRACE_HEADER)}'")
+    for column in _TRACE_HEADER:
+        if column == "state":
+            continue
+        values = pd.to_numeric(frame[column], errors="coerce").to_numpy(dtype=float)
+        bad = ~np.isfinite(values) if column not in ("stroke", "element") else ~np.isfinite(values) | (values != np.round(values))
+        if bad.any():
+            first = int(np.argmax(bad))
+            raise DataError(f"{path}:{first + 2}: column {column}: not a finite number: {frame[column].iloc[first]!r}")
+        frame[column] = values.astype(int) if column in ("stroke", "element") else values
+    return frame.rename(columns=_SAMPLE_COLUMNS)
+
+
 def _pandas() -> typing.Any:
     try:
         import pandas
@@ -85,10 +113,10 @@ class Study:
     def samples(self, trial: typing.Union[int, "pandas.Series"]) -> "pandas.DataFrame":
         """One trial's trace, read now: a DataFrame of N ticks with t_s [s], x_m, y_m, z_m [m] (device frame),
         fx_n, fy_n, fz_n [N], state, stroke, element (0-based). `trial` is a row of `trials` or its index
-        label. Raises KeyError for an unknown label, FileNotFoundError when the trace is gone."""
+        label. Raises KeyError for an unknown label, FileNotFoundError when the trace is gone, DataError naming
+        the file and the line of a damaged trace (another header, a field that is not a finite number)."""
         row = self.trials.loc[trial] if not hasattr(trial, "trace_file") else trial
-        frame = _pandas().read_csv(row["trace_file"])
-        return frame.rename(columns=_SAMPLE_COLUMNS)
+        return _read_trace(row["trace_file"])
 
     def iter_samples(self) -> typing.Iterator[tuple[typing.Any, "pandas.DataFrame"]]:
         """(index label, samples) for every trial in turn, one trace in memory at a time."""
@@ -100,8 +128,11 @@ def load(paths: typing.Union[PathLike, typing.Sequence[PathLike]]) -> Study:
     """Reads the saved trials of the session folders under `paths` (a session folder, a study folder made by
     ``calligraphy session run --out``, or a list of either) into a `Study` of tidy DataFrames. Only the
     session manifests and trial records are read, never the traces. Raises DataError naming the file (and
-    JSON pointer) for a path without a session folder or a damaged record, ImportError without pandas."""
+    JSON pointer) for a path without a session folder or a damaged record, ValueError for no path or an
+    empty one, ImportError without pandas."""
     roots = [paths] if isinstance(paths, (str, os.PathLike)) else list(paths)
+    if not roots or any(not os.fspath(root) for root in roots):
+        raise ValueError(f"load: paths must name session or study folders, got {paths!r}")
     trials_text, strokes_text = _calligraphy._study_tables_csv([os.fspath(root) for root in roots])
     trials = _read_table(trials_text, _NUMERIC_TRIAL_COLUMNS, ("completed_in_order",))
     strokes = _read_table(strokes_text, _NUMERIC_STROKE_COLUMNS, ("written", "backwards"))

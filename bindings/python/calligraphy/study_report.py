@@ -12,7 +12,8 @@
 * ``tables/summary.csv`` and ``tables/statistics.csv``: the page's tables in SI units.
 
 Every file is written atomically (a temporary file in the same folder, flushed, then renamed over the
-target). Values stay in SI units (m, s) in the API and the CSV files; the page and figures show lengths in
+target), and the report's files together: every temporary is written whole before any file is replaced, so a
+failure while writing leaves the earlier report whole. Values stay in SI units (m, s) in the API and the CSV files; the page and figures show lengths in
 mm and label every unit. The per-trial figures (trajectory, forces) are the C++ ``calligraphy report``
 page's; this page links to it (``per_trial_page``) rather than drawing the trials again.
 
@@ -28,6 +29,8 @@ from __future__ import annotations
 import argparse
 import contextlib
 import dataclasses
+import errno
+import fcntl
 import html
 import itertools
 import io
@@ -169,27 +172,54 @@ def _has_cjk(text: str) -> bool:
 # ---------------------------------------------------------------------------------------------- files
 
 
-def _write_atomic(path: pathlib.Path, data: typing.Union[bytes, str]) -> None:
-    """Writes `data` to `path` through a temporary file in the same folder, flushed and synced, then renamed
-    over `path`: a reader sees the old file or the new one, never a part. Raises OSError naming `path`."""
-    payload = data.encode("utf-8") if isinstance(data, str) else data
-    temporary = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp")
-    descriptor = -1
+def _write_together(files: dict[pathlib.Path, typing.Union[bytes, str]]) -> None:
+    """Writes a set of files that belong together (a report): each to a temporary file beside it, flushed
+    and synced, and only once every one is whole, each renamed over its target in the order given. A failure
+    while writing (a full disk) removes every temporary and leaves the earlier set whole, so that a reader
+    never finds new tables beside an old page. Raises OSError naming the file at fault."""
+    # A folder where a file goes would fail only at its rename, after others were replaced: refused first.
+    for path in files:
+        if path.is_dir():
+            raise OSError(errno.EISDIR, f"cannot write {path}: {os.strerror(errno.EISDIR)}")
+    written: list[tuple[pathlib.Path, pathlib.Path]] = []
     try:
-        # os.open with 0o666 lets the umask decide the permissions, as for any new file.
-        descriptor = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
-        with os.fdopen(descriptor, "wb") as handle:
-            descriptor = -1  # the file object owns it now
-            handle.write(payload)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.replace(temporary, path)
-    except OSError as error:
-        if descriptor >= 0:
-            os.close(descriptor)
-        with contextlib.suppress(OSError):
-            os.unlink(temporary)
-        raise OSError(error.errno, f"cannot write {path}: {error.strerror or error}") from error
+        for path, data in files.items():
+            payload = data.encode("utf-8") if isinstance(data, str) else data
+            temporary = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp")
+            try:
+                # os.open with 0o666 lets the umask decide the permissions, as for any new file.
+                descriptor = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+                written.append((temporary, path))
+                with os.fdopen(descriptor, "wb") as handle:
+                    handle.write(payload)
+                    handle.flush()
+                    os.fsync(handle.fileno())
+            except OSError as error:
+                raise OSError(error.errno, f"cannot write {path}: {error.strerror or error}") from error
+        # Renames need no space: once every temporary is whole the set is replaced in one short run, under an
+        # exclusive lock of each folder (as the library's write_files_atomically), so that two reports written
+        # into one folder at once are never interleaved file by file.
+        with contextlib.ExitStack() as locks:
+            for folder in sorted({path.parent for path in files}):
+                descriptor = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
+                locks.callback(os.close, descriptor)
+                fcntl.flock(descriptor, fcntl.LOCK_EX)
+            _rename_all(written)
+    finally:
+        for temporary, _ in written:
+            with contextlib.suppress(OSError):
+                os.unlink(temporary)
+
+
+def _rename_all(written: list[tuple[pathlib.Path, pathlib.Path]]) -> None:
+    """Each temporary over its target, in order; those renamed are taken off `written`."""
+    while written:
+        temporary, path = written[0]
+        try:
+            os.replace(temporary, path)
+        except OSError as error:
+            raise OSError(error.errno, f"cannot write {path}: {error.strerror or error}") from error
+        written.pop(0)
 
 
 def _make_folder(folder: pathlib.Path) -> None:
@@ -230,9 +260,13 @@ def _check_trials(trials: "pandas.DataFrame", values: typing.Sequence[str], phas
     if missing:
         raise ValueError(f"{caller}: the trials have no column {', '.join(map(repr, missing))}; its columns: "
                          f"{', '.join(map(repr, trials.columns))}")
+    from . import statistics
+
     for value in values:
         if not pandas.api.types.is_numeric_dtype(trials[value]) or pandas.api.types.is_bool_dtype(trials[value]):
             raise ValueError(f"{caller}: value {value!r} is not a numeric column (dtype {trials[value].dtype})")
+        # An infinite value counts as missing in every table and figure, as in the statistics (warned).
+        trials = statistics._finite_outcome(trials, value, caller)
     if trials.empty:
         raise ValueError(f"{caller}: there are no trials")
     if phase is not None and phase not in set(trials["phase"].astype(str)):
@@ -388,14 +422,15 @@ def learning_figure(trials: "pandas.DataFrame", value: str, phase: typing.Option
     return figure
 
 
-def _save_figure(figure: "matplotlib.figure.Figure", folder: pathlib.Path, stem: str) -> None:
+def _save_figure(figure: "matplotlib.figure.Figure", folder: pathlib.Path, stem: str,
+                 files: dict[pathlib.Path, typing.Union[bytes, str]]) -> None:
     import matplotlib
 
     with matplotlib.rc_context(_FIGURE_RC):
         for extension, options in (("svg", {"metadata": {"Date": None}}), ("png", {"dpi": PNG_DPI})):
             buffer = io.BytesIO()
             figure.savefig(buffer, format=extension, **options)
-            _write_atomic(folder / f"{stem}.{extension}", buffer.getvalue())
+            files[folder / f"{stem}.{extension}"] = buffer.getvalue()
 
 
 # ---------------------------------------------------------------------------------------------- page
@@ -631,10 +666,11 @@ def _learning_tables(trials: "pandas.DataFrame", value: str) -> tuple["pandas.Da
     return summary, pandas.DataFrame(comparisons)
 
 
-def _learning_html(trials: "pandas.DataFrame", values: typing.Sequence[str], tables: pathlib.Path) -> str:
+def _learning_html(trials: "pandas.DataFrame", values: typing.Sequence[str], tables: pathlib.Path,
+                   files: dict[pathlib.Path, typing.Union[bytes, str]]) -> str:
     """The section on learning, retention and transfer of a protocol with a pre-test and a post-test
-    (docs/experiments.md, "Phases"); '' without them. Also writes tables/learning.csv and
-    tables/group_comparisons.csv."""
+    (docs/experiments.md, "Phases"); '' without them. Also adds tables/learning.csv and
+    tables/group_comparisons.csv to `files`."""
     pandas = _pandas()
     present = set(trials["phase"].astype(str))
     if not {"pre-test", "post-test"} <= present:
@@ -676,10 +712,9 @@ def _learning_html(trials: "pandas.DataFrame", values: typing.Sequence[str], tab
             parts.append(f"<table><caption>Groups compared, {_e(display.label)}{_e(unit)}: Welch t-test, "
                          "Hedges' g</caption><tr><th>quantity</th><th>groups</th><th>n</th><th>difference "
                          f"[95 % CI]</th><th>t</th><th>df</th><th>p</th><th>g</th></tr>{lines}</table>\n")
-    _write_atomic(tables / "learning.csv", pandas.concat(summaries, ignore_index=True).to_csv(index=False))
+    files[tables / "learning.csv"] = pandas.concat(summaries, ignore_index=True).to_csv(index=False)
     if comparisons:
-        _write_atomic(tables / "group_comparisons.csv",
-                      pandas.concat(comparisons, ignore_index=True).to_csv(index=False))
+        files[tables / "group_comparisons.csv"] = pandas.concat(comparisons, ignore_index=True).to_csv(index=False)
     parts.append("</section>\n")
     return "".join(parts)
 
@@ -713,8 +748,8 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
     (``calligraphy.statistics.statistics_table`` of each value, a `value` column first). Table 5 after
     Wang, Zhang & Yao 2006, section 7; the statistics' sources are those of calligraphy.statistics.
 
-    Raises TypeError when `study` has no trials DataFrame; ValueError naming a missing or non-numeric column
-    or a phase not present (listing those present); OSError naming a file or folder that could not be
+    Raises TypeError when `study` has no trials DataFrame; ValueError naming a missing or non-numeric column,
+    a phase not present (listing those present) or an empty `out_dir`; OSError naming a file or folder that could not be
     written; ImportError without pandas, matplotlib, SciPy or statsmodels.
     """
     pandas = _pandas()
@@ -727,6 +762,8 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
         phase = "test" if "test" in present else "training" if "training" in present else None
     trials = _check_trials(trials, values, phase, "write_report")
     data = _phase_trials(trials, phase)
+    if not os.fspath(out_dir).strip():
+        raise ValueError("write_report: out_dir is empty; name the report folder")
     out = pathlib.Path(out_dir)
     figures, tables = out / "figures", out / "tables"
     for folder in (out, figures, tables):
@@ -737,15 +774,15 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
 
     table5s = [_table5(data, value) for value in values]
     statistics_tables = [_statistics(data, value) for value in values]
-    _write_atomic(tables / "summary.csv",
-                  pandas.DataFrame([row for t in table5s for row in _summary_rows(t)]).to_csv(index=False))
-    _write_atomic(tables / "statistics.csv", pandas.concat(statistics_tables, ignore_index=True).to_csv(index=False))
+    files: dict[pathlib.Path, typing.Union[bytes, str]] = {}  # written together at the end, the page last
+    files[tables / "summary.csv"] = pandas.DataFrame([row for t in table5s for row in _summary_rows(t)]).to_csv(index=False)
+    files[tables / "statistics.csv"] = pandas.concat(statistics_tables, ignore_index=True).to_csv(index=False)
 
     figure_html = []
     for value in values:
         stem = f"learning_{_file_name(value)}"
         figure = learning_figure(data, value, phase=None)
-        _save_figure(figure, figures, stem)
+        _save_figure(figure, figures, stem, files)
         width_px = round(figure.get_figwidth() * 96)  # the SVG's size in CSS px (its pt x 96/72)
         display = _display(value)
         figure_html.append(
@@ -766,11 +803,12 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
             "unit shown, d_z and g_av standardized; p two-sided.</p>\n",
             *(_statistics_html(t, v, phase) for t, v in zip(statistics_tables, values)), "</section>\n",
             "<section id=\"learning\">\n<h2>Learning curves</h2>\n", *figure_html, "</section>\n",
-            _learning_html(trials, values, tables) if "phase" in trials else "",
+            _learning_html(trials, values, tables, files) if "phase" in trials else "",
             _subjects_html(trials, values, per_trial_link),
             "</body></html>\n"]
     index = out / "index.html"
-    _write_atomic(index, "".join(page))
+    files[index] = "".join(page)
+    _write_together(files)
     return index
 
 
@@ -797,6 +835,8 @@ def main(argv: typing.Optional[typing.Sequence[str]] = None) -> int:
         parser.error("argument --title: is empty")
     if arguments.per_trial_page is not None and not os.path.isfile(arguments.per_trial_page):
         parser.error(f"argument --per-trial-page: {arguments.per_trial_page} is not a file")
+    if not arguments.out.strip():
+        parser.error("argument --out: is empty; name the report folder")
     if os.path.exists(arguments.out) and not os.path.isdir(arguments.out):
         parser.error(f"argument --out: {arguments.out} exists and is not a folder")
 

@@ -35,6 +35,22 @@ void write_file_atomically(const std::filesystem::path& path, std::string_view c
 /// DataError naming `path` when a link cannot be read or there are more than 40 links in a chain (ELOOP).
 [[nodiscard]] std::filesystem::path written_path(const std::filesystem::path& path);
 
+/// One file of a set written together.
+struct FileContent {
+  std::filesystem::path path;
+  std::string_view content;
+};
+
+/// Writes a set of files that belong together (a study's tables): every file's temporary is written whole,
+/// fsync'ed and closed first; only then are the targets replaced, one rename each, in the given order,
+/// under an exclusive flock(2) of their folders, so that two processes writing the same set leave one
+/// writer's whole set, never a mix of both. A
+/// failure while writing (e.g. a full disk) removes every temporary and leaves every earlier file as it
+/// was, so a reader never finds a new file beside an old one of the set. (Between the renames, which need
+/// no space, only a crash of the machine or the process can leave part of the set replaced.) Throws
+/// DataError naming the file at fault, as `write_file_atomically`.
+void write_files_atomically(std::span<const FileContent> files);
+
 /// The same for binary content (e.g. an encoded corpus store).
 void write_file_atomically(const std::filesystem::path& path, std::span<const std::uint8_t> content);
 

@@ -46,7 +46,7 @@ struct ReportTrial {
   std::vector<double> in_plane_force_n;        ///< |(Fx, Fy)| commanded [N]
   std::vector<ReportStrokeSpan> strokes;
   double time_total_s = 0.0;       ///< the trial's writing time [s]
-  double mean_deviation_mm = 0.0;  ///< the trial's mean deviation [mm]
+  double mean_deviation_mm = 0.0;  ///< the trial's mean deviation [mm]; NaN when it wrote no stroke
   std::optional<double> frechet_mm;
   std::optional<double> dtw_mm;
   std::size_t order_errors = 0;

@@ -33,9 +33,13 @@ struct CohortSetup {
   void validate() const;
 };
 
+/// The most subjects one cohort simulates (the CLI, Python and the library alike): the tables of more do not
+/// fit a computer's memory.
+inline constexpr std::size_t kMaxCohortSubjects = 100000;
+
 /// The simulated subjects 1..`count`, with the ids `session run --subjects` gives them: `prefix` and the
-/// number in at least two digits ("S01"). Throws InvalidArgument for a count of 0 or a prefix that makes no
-/// subject id.
+/// number in at least two digits ("S01"). Throws InvalidArgument for a count of 0 or above
+/// kMaxCohortSubjects, or a prefix that makes no subject id.
 [[nodiscard]] std::vector<SubjectAssignment> numbered_subjects(std::size_t count,
                                                                const std::string& prefix = "S");
 
@@ -54,7 +58,8 @@ struct CohortSetup {
 /// the rows in the order of `subjects`. The characters of the protocol are loaded once, before any trial.
 /// `progress`, when given, is called after each subject with the number done (from the worker threads, one
 /// call at a time). The first error of any subject is thrown once every thread has stopped; no subject
-/// starts after it. Throws as `simulate_subject`, and InvalidArgument for 0 threads.
+/// starts after it. Throws as `simulate_subject`, and InvalidArgument for 0 threads or more than
+/// kMaxCohortSubjects subjects.
 [[nodiscard]] StudyTables simulate_cohort(const LoadedProtocol& protocol,
                                           const std::vector<SubjectAssignment>& subjects,
                                           const CohortSetup& setup, unsigned threads = 1,

@@ -59,8 +59,12 @@ struct PreviousSession {
   double delay_s = 0.0;    ///< the protocol's delay before this session [s]
   double elapsed_s = 0.0;  ///< from `ended_utc` to this session's creation [s]
   /// "waited" (elapsed_s >= delay_s), "simulated" (a simulated writer: the delay is taken as passed, not
-  /// waited) or "overridden" (started early on the experimenter's request).
+  /// waited) or "overridden" (started early on the experimenter's request, or after a session whose end
+  /// lies in the future by this computer's clock: `elapsed_s` is then negative, recorded as measured).
   std::string delay = "waited";
+  /// Lower-case hex SHA-256 of its session.json when this session was made: the content id that tells the
+  /// previous session from another one of the same name. Empty for sessions made before it was recorded.
+  std::string session_sha256;
 };
 
 /// The seed of a simulated subject, derived from its id alone (FNV-1a of the id, mixed by SplitMix64), so

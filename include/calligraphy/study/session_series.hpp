@@ -4,6 +4,7 @@
 /// a day after training) is run as one session folder per session, each linked to the one before it
 /// (session.json "previous_session"). This finds where a subject stands and links the next session.
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,17 +22,46 @@ struct SessionSeries {
   int next = 1;  ///< the session to start next; `sessions + 1` when every session is complete
   /// A session with unsaved trials (resume it before the next starts); nullopt when none.
   std::optional<std::filesystem::path> unfinished;
-  /// What links session `next` to the one before it (its `elapsed_s` measured now and `delay` "waited"
-  /// or not yet due); nullopt for the first session or when every session is complete.
+  /// What links session `next` to the one before it (its `elapsed_s` measured now, its session.json's
+  /// SHA-256, `delay` "waited" or not yet due); nullopt for the first session or when every session is
+  /// complete.
   std::optional<PreviousSession> previous;
+  /// The trial record whose end `previous->ended_utc` is (empty without `previous`).
+  std::filesystem::path previous_record;
   /// True when session `next` may start now: the first, or the previous one's delay has passed.
   [[nodiscard]] bool due() const noexcept { return !previous || previous->elapsed_s >= previous->delay_s; }
+  /// True when the previous session ended after now by this computer's clock (another clock, or a wrong one).
+  [[nodiscard]] bool ended_in_future() const noexcept { return previous && previous->elapsed_s < 0.0; }
 };
 
 /// The series of `subject_id` under the study folder `root` (ROOT/SUBJECT/..., as SessionFolder::create
-/// lays it out) for `protocol`. A missing subject folder is a series not begun. Throws DataError naming the
-/// file for a damaged session.json or trial record.
+/// lays it out) for `protocol`, checked as a chain: each session after the first follows the folder of the
+/// session before it by name and, where recorded, by its session.json's SHA-256. A missing subject folder is
+/// a series not begun; a session with any planned trial unsaved is `unfinished`. Throws DataError naming the
+/// file for a damaged session.json or trial record, a session of another subject in the folder (naming where
+/// it belongs), a session missing before a later one (moved or deleted), or a link to another folder or
+/// content than the session before it.
 [[nodiscard]] SessionSeries session_series(const std::filesystem::path& root, const std::string& subject_id,
                                            const LoadedProtocol& protocol);
+
+/// An exclusive lock on one subject's series under `root` (flock(2) on the folder ROOT/SUBJECT), held by a
+/// run from reading the series until its session is written, so that concurrent runs of one subject take
+/// turns (the later sees what the earlier wrote) instead of starting a session twice. The system releases
+/// it when the holder ends, however it ends.
+class SeriesLock {
+ public:
+  /// Creates the subject's folder when missing and waits until the lock is free, calling `waiting` with the
+  /// folder's path once when it is not free at first. Throws DataError naming the folder when it cannot be
+  /// created or locked.
+  SeriesLock(const std::filesystem::path& root, const std::string& subject_id,
+             const std::function<void(const std::filesystem::path&)>& waiting = {});
+  SeriesLock(const SeriesLock&) = delete;
+  SeriesLock& operator=(const SeriesLock&) = delete;
+  ~SeriesLock();
+
+ private:
+  std::filesystem::path path_;
+  int fd_ = -1;
+};
 
 }  // namespace calligraphy

@@ -1,0 +1,259 @@
+#!/usr/bin/env python3
+"""Damaged study files through the program, run by CTest as `study_damaged_cli`: every value of a trial
+record, a session manifest and a protocol replaced by one of another type or beyond a double's range gives
+the data error (exit 1) naming the file, never an internal error (exit 3); a trial that wrote no stroke is
+shown on the report page; subnormal option values are finite; the cohort's tables are replaced together or
+not at all, also when the cohort is killed.
+
+CALLIGRAPHY_CLI names the program, CALLIGRAPHY_SOURCE_DIR the source tree. Standard library only.
+"""
+import hashlib
+import json
+import os
+import resource
+import shutil
+import signal
+import subprocess
+import tempfile
+import time
+import unittest
+from pathlib import Path
+
+CLI = os.environ.get("CALLIGRAPHY_CLI", "")
+SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
+
+PROTOCOL = {
+    "format": "calligraphy-study-protocol",
+    "version": 1,
+    "name": "damage",
+    "conditions": [{"name": "vision", "mode": "vision"}, {"name": "haptic", "mode": "haptic"}],
+    "phases": [
+        {"phase": "pre-test", "condition": "vision", "characters": ["十"]},
+        {"phase": "training", "condition": "haptic", "characters": ["十"]},
+        {"phase": "post-test", "condition": "vision", "characters": ["十"]},
+        {"phase": "retention", "condition": "vision", "characters": ["十"], "session": 2, "delay_s": 60},
+    ],
+    "trial": {"max_duration_s": 20},
+}
+
+# Values of other types, and numbers a double cannot hold (written into the text: json.dumps refuses them).
+WRONG_VALUES = ["5", "\"x\"", "[]", "{}", "true", "null", "[1e999]", "1e999", "-1e999", "1e400"]
+
+
+def digest(path):
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+class DamagedStudyTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        if not CLI or not Path(CLI).exists():
+            raise unittest.SkipTest(f"CALLIGRAPHY_CLI={CLI!r} is not the calligraphy program: run through ctest")
+        cls.pristine = tempfile.TemporaryDirectory(prefix="calligraphy-damaged-")
+        root = Path(cls.pristine.name)
+        (root / "p.json").write_text(json.dumps(PROTOCOL, ensure_ascii=False), encoding="utf-8")
+        done = subprocess.run([CLI, "session", "run", "p.json", "--writer", "simulated", "--subjects", "1",
+                               "--out", "S"], cwd=root, capture_output=True, timeout=600)
+        assert done.returncode == 0, done.stderr.decode()
+        cls.sessions = sorted(p for p in (root / "S" / "S01").iterdir() if p.is_dir())
+        assert len(cls.sessions) == 2
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.pristine.cleanup()
+
+    def setUp(self):
+        self.folder = tempfile.TemporaryDirectory(prefix="calligraphy-damaged-run-")
+        self.cwd = Path(self.folder.name)
+        shutil.copytree(Path(self.pristine.name), self.cwd, dirs_exist_ok=True)
+
+    def tearDown(self):
+        self.folder.cleanup()
+
+    def run_cli(self, *args):
+        return subprocess.run([CLI, *map(str, args)], cwd=self.cwd, capture_output=True, timeout=600)
+
+    def first_session(self):
+        return self.cwd / "S" / "S01" / self.sessions[0].name
+
+    def assert_data_error(self, result, file_name, what):
+        stderr = result.stderr.decode()
+        self.assertEqual(result.returncode, 1, f"{what}: exit {result.returncode}: {stderr}")
+        self.assertNotIn("internal error", stderr, what)
+        self.assertIn(file_name, stderr, what)
+
+    def damaged_copies(self, path):
+        """(description, text) for the JSON file at `path` with one value replaced by a wrong one: every
+        member at any depth (every element of an array of up to 3, else the first), each top-level one by
+        every wrong value, deeper ones by three in turn."""
+        original = json.loads(path.read_text(encoding="utf-8"))
+        paths = []
+
+        def walk(value, at):
+            paths.append(at)
+            if isinstance(value, dict):
+                for key, member in value.items():
+                    walk(member, at + [key])
+            elif isinstance(value, list):
+                for index, element in enumerate(value if len(value) <= 3 else value[:1]):
+                    walk(element, at + [index])
+
+        walk(original, [])
+        for number, at in enumerate(paths[1:]):
+            wrongs = WRONG_VALUES if len(at) == 1 else [WRONG_VALUES[(number + k) % len(WRONG_VALUES)]
+                                                        for k in (0, 3, 6)]
+            for wrong in wrongs:
+                document = json.loads(json.dumps(original))
+                parent = document
+                for step in at[:-1]:
+                    parent = parent[step]
+                parent[at[-1]] = "@@"
+                pointer = "/" + "/".join(str(step) for step in at)
+                yield f"{path.name}: {pointer} = {wrong}", json.dumps(document).replace("\"@@\"", wrong)
+
+    def test_every_wrong_value_of_a_trial_record_is_a_data_error_naming_the_file(self):
+        record = sorted((self.first_session() / "trials").glob("*.json"))[0]
+        text = record.read_text(encoding="utf-8")
+        for what, damaged in self.damaged_copies(record):
+            with self.subTest(what):
+                record.write_text(damaged, encoding="utf-8")
+                for command in (["report", "S", "--csv", "."], ["report", "S", "--out", "r.html"]):
+                    result = self.run_cli(*command)
+                    # A key its readers do not need may hold anything; one they read is named.
+                    if result.returncode != 0:
+                        self.assert_data_error(result, record.name, f"{what} ({command[2]})")
+        record.write_text(text, encoding="utf-8")
+
+    def test_every_wrong_value_of_a_session_manifest_is_a_data_error_naming_the_file(self):
+        manifest = self.first_session() / "session.json"
+        for what, damaged in self.damaged_copies(manifest):
+            with self.subTest(what):
+                manifest.write_text(damaged, encoding="utf-8")
+                result = self.run_cli("report", "S", "--csv", ".")
+                if result.returncode != 0:
+                    self.assert_data_error(result, "session.json", what)
+
+    def test_a_previous_session_end_of_another_type_is_named_by_session_run(self):
+        shutil.rmtree(self.cwd / "S" / "S01" / self.sessions[1].name)
+        last = sorted((self.first_session() / "trials").glob("*.json"))[-1]
+        original = json.loads(last.read_text(encoding="utf-8"))
+        for wrong in ["12345", "null", "[]", "\"yesterday\"", "1e999"]:
+            with self.subTest(end_time_utc=wrong):
+                document = dict(original, end_time_utc="@@")
+                last.write_text(json.dumps(document).replace("\"@@\"", wrong), encoding="utf-8")
+                result = self.run_cli("session", "run", "p.json", "--writer", "simulated", "--subject", "S01",
+                                      "--out", "S")
+                if wrong == "null":  # a missing end: the session's creation time stands in
+                    self.assertEqual(result.returncode, 0, result.stderr.decode())
+                    shutil.rmtree(max((self.cwd / "S" / "S01").iterdir()))
+                else:
+                    self.assert_data_error(result, last.name, f"end_time_utc {wrong}")
+                    self.assertIn("/end_time_utc", result.stderr.decode())
+
+    def test_every_wrong_value_of_a_protocol_is_refused_naming_the_file(self):
+        # A protocol with guidance parameters, groups and a transfer choice: more members to damage.
+        protocol = self.cwd / "retention-transfer.json"
+        shutil.copyfile(SOURCE / "examples" / "protocols" / "retention-transfer.json", protocol)
+        for what, damaged in self.damaged_copies(protocol):
+            with self.subTest(what):
+                (self.cwd / "bad.json").write_text(damaged, encoding="utf-8")
+                result = self.run_cli("session", "run", "bad.json", "--writer", "simulated", "--subjects", "1",
+                                      "--out", "T")
+                shutil.rmtree(self.cwd / "T", ignore_errors=True)
+                if result.returncode != 0:
+                    self.assert_data_error(result, "bad.json", what)
+
+    def test_protocol_numbers_beyond_a_double_name_the_pointer(self):
+        for wrong in ["1e999", "-1e999", "1e400"]:
+            with self.subTest(wrong):
+                text = json.dumps(PROTOCOL).replace("\"max_duration_s\": 20", f"\"max_duration_s\": {wrong}")
+                (self.cwd / "bad.json").write_text(text, encoding="utf-8")
+                result = self.run_cli("session", "run", "bad.json", "--writer", "simulated", "--subjects", "1",
+                                      "--out", "T")
+                self.assert_data_error(result, "bad.json", wrong)
+                self.assertIn("/trial/max_duration_s", result.stderr.decode())
+
+    def test_a_trial_that_wrote_no_stroke_is_shown_on_the_page(self):
+        record = sorted((self.first_session() / "trials").glob("*.json"))[0]
+        document = json.loads(record.read_text(encoding="utf-8"))
+        for key in ("mean_deviation_mm", "max_deviation_mm", "rms_deviation_mm", "frechet_mm", "dtw_mm",
+                    "normalised_jerk"):
+            document[key] = None
+        document["end_reason"] = "time_limit"
+        for stroke in document["per_stroke"]:
+            stroke.update(start_s=None, end_s=None)
+        record.write_text(json.dumps(document), encoding="utf-8")
+        result = self.run_cli("report", "S", "--out", "r.html")
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
+        page = (self.cwd / "r.html").read_text(encoding="utf-8")
+        self.assertIn("time_limit", page)
+        self.assertNotIn("nan", page.lower().replace("nano", ""))
+
+    def test_subnormal_numbers_are_finite_options(self):
+        for option in (["--guidance-mode", "assist-as-needed", "--assist-band", "1e-310"],
+                       ["--guidance-mode", "fading", "--guidance-gain", "1e-310"]):
+            with self.subTest(option):
+                result = self.run_cli("trial", "十", *option, "--json", "t.json")
+                self.assertEqual(result.returncode, 0, result.stderr.decode())
+        refused = self.run_cli("trial", "十", "--guidance-gain", "1e999", "--json", "t.json")
+        self.assertEqual(refused.returncode, 2)
+        self.assertIn("--guidance-gain", refused.stderr.decode())
+
+    def test_a_cohort_that_fails_while_writing_keeps_the_previous_pair_of_tables(self):
+        first = self.run_cli("session", "cohort", "p.json", "--subjects", "1", "--csv", ".")
+        self.assertEqual(first.returncode, 0, first.stderr.decode())
+        before = {name: digest(self.cwd / name) for name in ("trials.csv", "strokes.csv")}
+        # The sizes the next run's tables will have (the same subjects give the same rows), measured apart.
+        (self.cwd / "sizes").mkdir()
+        measured = self.run_cli("session", "cohort", "p.json", "--subjects", "3", "--csv", "sizes")
+        self.assertEqual(measured.returncode, 0, measured.stderr.decode())
+        trials_size = (self.cwd / "sizes" / "trials.csv").stat().st_size
+        strokes_size = (self.cwd / "sizes" / "strokes.csv").stat().st_size
+        self.assertLess(trials_size, strokes_size)
+        # Files beyond this size cannot be written (EFBIG), as on a full disk: trials.csv is written whole,
+        # then strokes.csv fails.
+        limit = (trials_size + strokes_size) // 2
+
+        def small_files():
+            signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+            resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+        failed = subprocess.run([CLI, "session", "cohort", "p.json", "--subjects", "3", "--csv", "."],
+                                cwd=self.cwd, capture_output=True, timeout=600, preexec_fn=small_files)
+        self.assertEqual(failed.returncode, 1, failed.stderr.decode())
+        self.assertIn("strokes.csv", failed.stderr.decode())
+        self.assertEqual(before, {name: digest(self.cwd / name) for name in before})
+        self.assertEqual([p.name for p in self.cwd.glob(".*tmp*")], [])
+
+    def test_a_cohort_killed_at_any_moment_leaves_one_whole_pair_of_tables(self):
+        first = self.run_cli("session", "cohort", "p.json", "--subjects", "1", "--csv", ".")
+        self.assertEqual(first.returncode, 0, first.stderr.decode())
+        pairs = [{name: (self.cwd / name).read_bytes() for name in ("trials.csv", "strokes.csv")}]
+        (self.cwd / "whole").mkdir()
+        whole = self.run_cli("session", "cohort", "p.json", "--subjects", "8", "--csv", "whole")
+        self.assertEqual(whole.returncode, 0, whole.stderr.decode())
+        pairs.append({name: (self.cwd / "whole" / name).read_bytes() for name in ("trials.csv", "strokes.csv")})
+        # SIGKILL at moments spread over a run, the last ones about when the tables are written.
+        for fraction in (0.2, 0.5, 0.8, 0.9, 0.95, 1.0, 1.05):
+            run = subprocess.Popen([CLI, "session", "cohort", "p.json", "--subjects", "8", "--csv", "."],
+                                   cwd=self.cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            time.sleep(fraction * self.cohort_seconds)
+            run.kill()
+            run.wait()
+            found = {name: (self.cwd / name).read_bytes() for name in ("trials.csv", "strokes.csv")}
+            self.assertIn(found, pairs, f"killed after {fraction:.2f} of a run")
+
+    @property
+    def cohort_seconds(self):
+        """How long an 8-subject cohort takes here, measured once."""
+        if not hasattr(self, "_cohort_seconds"):
+            (self.cwd / "timed").mkdir(exist_ok=True)
+            begin = time.monotonic()
+            timed = self.run_cli("session", "cohort", "p.json", "--subjects", "8", "--csv", "timed")
+            self.assertEqual(timed.returncode, 0, timed.stderr.decode())
+            self._cohort_seconds = time.monotonic() - begin
+        return self._cohort_seconds
+
+
+if __name__ == "__main__":
+    unittest.main()
