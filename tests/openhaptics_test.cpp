@@ -50,24 +50,20 @@ class ScopedLibhdPath {
   std::optional<std::string> previous_;
 };
 
-std::string not_found_message() {
+// The message of the `Failure` that loading libHD throws; empty when it throws nothing.
+template <typename Failure>
+std::string load_failure() {
   try {
     (void)HdLibrary::load();
-  } catch (const calligraphy::DeviceNotFound& e) {
+  } catch (const Failure& e) {
     return e.what();
   }
   return {};
 }
 
+std::string not_found_message() { return load_failure<calligraphy::DeviceNotFound>(); }
 // What loading says of a CALLIGRAPHY_LIBHD that is not a loadable libHD.
-std::string unavailable_message() {
-  try {
-    (void)HdLibrary::load();
-  } catch (const calligraphy::DeviceUnavailable& e) {
-    return e.what();
-  }
-  return {};
-}
+std::string unavailable_message() { return load_failure<calligraphy::DeviceUnavailable>(); }
 
 }  // namespace
 

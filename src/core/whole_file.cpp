@@ -1,5 +1,7 @@
 #include "core/whole_file.hpp"
 
+#include <sys/stat.h>
+
 #include <fstream>
 
 #include "calligraphy/core/errors.hpp"
@@ -30,6 +32,15 @@ std::string read_regular_file(const std::filesystem::path& path, std::uintmax_t 
   in.read(text.data(), static_cast<std::streamsize>(size));
   if (static_cast<std::uintmax_t>(in.gcount()) != size) throw DataError(name + ": could not be read whole");
   return text;
+}
+
+const char* file_kind(mode_t mode) noexcept {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
 }
 
 }  // namespace calligraphy

@@ -1,5 +1,7 @@
 #pragma once
 // Reading a whole input file of bounded size: a trace, a recording. Internal.
+#include <sys/types.h>
+
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -13,5 +15,9 @@ namespace calligraphy {
 /// The bytes of the regular file `path`. Throws DataError naming the path when it does not exist, is not a
 /// regular file (a device or FIFO is never read), is larger than `max_bytes`, or cannot be read whole.
 [[nodiscard]] std::string read_regular_file(const std::filesystem::path& path, std::uintmax_t max_bytes);
+
+/// What a file that is not regular is, for messages: "a directory", "a FIFO", "a character device", ...
+/// (`mode` as stat(2) gives it). Static storage.
+[[nodiscard]] const char* file_kind(mode_t mode) noexcept;
 
 }  // namespace calligraphy

@@ -16,6 +16,8 @@
 #include <thread>
 #include <vector>
 
+#include "core/whole_file.hpp"
+
 namespace calligraphy::devices {
 namespace {
 
@@ -55,15 +57,6 @@ bool read_exactly(int fd, void* out, std::size_t bytes, off_t offset) {
   return true;
 }
 
-std::string file_kind(mode_t mode) {
-  if (S_ISDIR(mode)) return "a directory";
-  if (S_ISFIFO(mode)) return "a FIFO";
-  if (S_ISCHR(mode)) return "a character device";
-  if (S_ISBLK(mode)) return "a block device";
-  if (S_ISSOCK(mode)) return "a socket";
-  return "not a regular file";
-}
-
 std::string errno_text(int error) { return std::strerror(error); }
 
 }  // namespace
@@ -71,7 +64,7 @@ std::string errno_text(int error) { return std::strerror(error); }
 std::string shared_library_problem(const std::string& path) {
   struct stat info {};
   if (::stat(path.c_str(), &info) != 0) return errno_text(errno);
-  if (!S_ISREG(info.st_mode)) return file_kind(info.st_mode) + ", not a shared library";
+  if (!S_ISREG(info.st_mode)) return std::string(file_kind(info.st_mode)) + ", not a shared library";
   if (info.st_size == 0) return "an empty file, not a shared library";
   const auto size = static_cast<std::uint64_t>(info.st_size);
   // O_NONBLOCK: the file was regular a moment ago, but it must not block if it was swapped for a FIFO.

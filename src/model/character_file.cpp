@@ -11,6 +11,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "core/unicode.hpp"
+#include "core/whole_file.hpp"
 
 namespace calligraphy::detail {
 namespace {
@@ -28,15 +29,6 @@ class FileDescriptor {
  private:
   int fd_;
 };
-
-const char* file_kind(mode_t mode) {
-  if (S_ISDIR(mode)) return "a directory";
-  if (S_ISFIFO(mode)) return "a FIFO";
-  if (S_ISCHR(mode)) return "a character device";
-  if (S_ISBLK(mode)) return "a block device";
-  if (S_ISSOCK(mode)) return "a socket";
-  return "not a regular file";
-}
 
 }  // namespace
 
