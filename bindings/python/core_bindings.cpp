@@ -30,7 +30,7 @@ py::object new_exception(py::module_& m, const char* name, const py::tuple& base
 
 struct ExceptionTypes {
   py::object error, invalid_argument, data_error, character_not_found, device_error, device_not_found,
-      communication_error, safety_fault, calibration_needed, realtime_error, state_error;
+      device_unavailable, communication_error, safety_fault, calibration_needed, realtime_error, state_error;
 };
 
 void bind_exceptions(py::module_& m) {
@@ -57,6 +57,10 @@ void bind_exceptions(py::module_& m) {
   types->device_not_found = new_exception(
       m, "DeviceNotFound", py::make_tuple(types->device_error, builtin(PyExc_LookupError)),
       "No device of the requested name is attached (C++ calligraphy::DeviceNotFound); a LookupError.");
+  types->device_unavailable = new_exception(
+      m, "DeviceUnavailable", py::make_tuple(types->device_error),
+      "A known device its backend cannot give now: the driver found no arm, a damaged driver library, a "
+      "refused USB device (C++ calligraphy::DeviceUnavailable); the message has the reason and what to try.");
   types->communication_error = new_exception(
       m, "CommunicationError", py::make_tuple(types->device_error, builtin(PyExc_ConnectionError)),
       "The transport to the device failed: timeout, unplug, malformed packets (C++ "
@@ -92,6 +96,8 @@ void bind_exceptions(py::module_& m) {
       raise(types->invalid_argument, e);
     } catch (const DeviceNotFound& e) {
       raise(types->device_not_found, e);
+    } catch (const DeviceUnavailable& e) {
+      raise(types->device_unavailable, e);
     } catch (const CommunicationError& e) {
       raise(types->communication_error, e);
     } catch (const SafetyFault& e) {

@@ -139,7 +139,11 @@ ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifes
   const double paper_z = record.object("scene").object("layout").number_or("paper_z_m", 0.0, -1e6, 1e6);
   const std::string csv = record.object("files").string_or("csv", "");
   if (csv.empty() || csv.find('/') != std::string::npos) fail(source, "/files/csv", "expected a file name");
-  read_trace(json_file.parent_path() / csv, paper_z, trial);
+  try {
+    read_trace(json_file.parent_path() / csv, paper_z, trial);
+  } catch (const DataError& e) {  // the record names the trace: it is the record that is at fault
+    fail(source, "/files/csv", "names the trace '" + csv + "', which cannot be read: " + e.what());
+  }
   return trial;
 }
 

@@ -16,8 +16,8 @@ def test_exception_hierarchy():
     assert issubclass(calligraphy.DeviceError, RuntimeError)
     assert issubclass(calligraphy.DeviceNotFound, LookupError)
     assert issubclass(calligraphy.CommunicationError, ConnectionError)
-    for cls in (calligraphy.DeviceNotFound, calligraphy.CommunicationError, calligraphy.SafetyFault,
-                calligraphy.CalibrationNeeded):
+    for cls in (calligraphy.DeviceNotFound, calligraphy.DeviceUnavailable, calligraphy.CommunicationError,
+                calligraphy.SafetyFault, calligraphy.CalibrationNeeded):
         assert issubclass(cls, calligraphy.DeviceError)
     for cls in (calligraphy.InvalidArgument, calligraphy.DataError, calligraphy.DeviceError):
         assert issubclass(cls, calligraphy.Error)

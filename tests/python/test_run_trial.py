@@ -28,6 +28,17 @@ def test_run_trial_names_what_is_wrong():
         calligraphy.run_trial("九", device=3)
 
 
+def test_a_known_device_that_cannot_be_used_says_why(monkeypatch, tmp_path):
+    # A damaged CALLIGRAPHY_LIBHD: the OpenHaptics device is known, and its backend's reason is the error.
+    (tmp_path / "libHD.so").write_bytes(b"")
+    monkeypatch.setenv("CALLIGRAPHY_LIBHD", str(tmp_path / "libHD.so"))
+    with pytest.raises(calligraphy.DeviceUnavailable, match="empty"):
+        calligraphy.run_trial("九", device="openhaptics", pacing="real-time", max_duration_s=0.1)
+    # The simulated device never loads it.
+    result = calligraphy.run_trial("九", device="simulated", keep_trace=False)
+    assert result.metrics["strokes_completed"] >= 0
+
+
 def test_every_error_class_of_the_library_is_there():
     assert issubclass(calligraphy.RealtimeError, calligraphy.DeviceError)
     assert issubclass(calligraphy.StateError, calligraphy.Error)

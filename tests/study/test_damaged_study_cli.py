@@ -5,11 +5,16 @@ the data error (exit 1) naming the file, never an internal error (exit 3); a tri
 shown on the report page; subnormal option values are finite; the cohort's tables are replaced together or
 not at all, also when the cohort is killed.
 
+Every damaged copy of a file is one or two runs of the program: all of them (about 1,200) take minutes, so
+each run of the tests draws CALLIGRAPHY_DAMAGE_SAMPLE of them per file (default 60; 0 for all) with the seed
+CALLIGRAPHY_TEST_SEED (random when unset, printed), as the C++ sweeps do (tests/test_sizing.hpp).
+
 CALLIGRAPHY_CLI names the program, CALLIGRAPHY_SOURCE_DIR the source tree. Standard library only.
 """
 import hashlib
 import json
 import os
+import random
 import resource
 import shutil
 import signal
@@ -37,6 +42,10 @@ PROTOCOL = {
 }
 
 # Values of other types, and numbers a double cannot hold (written into the text: json.dumps refuses them).
+SAMPLE = int(os.environ.get("CALLIGRAPHY_DAMAGE_SAMPLE", "60"))
+SEED = int(os.environ.get("CALLIGRAPHY_TEST_SEED") or random.SystemRandom().randrange(1 << 32))
+print(f"study_damaged_cli: {SAMPLE or 'all'} damaged copies per file, seed {SEED} "
+      f"(CALLIGRAPHY_DAMAGE_SAMPLE, CALLIGRAPHY_TEST_SEED)", flush=True)
 WRONG_VALUES = ["5", "\"x\"", "[]", "{}", "true", "null", "[1e999]", "1e999", "-1e999", "1e400"]
 
 
@@ -99,17 +108,21 @@ class DamagedStudyTest(unittest.TestCase):
                     walk(element, at + [index])
 
         walk(original, [])
+        cases = []
         for number, at in enumerate(paths[1:]):
             wrongs = WRONG_VALUES if len(at) == 1 else [WRONG_VALUES[(number + k) % len(WRONG_VALUES)]
                                                         for k in (0, 3, 6)]
-            for wrong in wrongs:
-                document = json.loads(json.dumps(original))
-                parent = document
-                for step in at[:-1]:
-                    parent = parent[step]
-                parent[at[-1]] = "@@"
-                pointer = "/" + "/".join(str(step) for step in at)
-                yield f"{path.name}: {pointer} = {wrong}", json.dumps(document).replace("\"@@\"", wrong)
+            cases.extend((at, wrong) for wrong in wrongs)
+        if 0 < SAMPLE < len(cases):
+            cases = random.Random(f"{SEED}:{path.name}").sample(cases, SAMPLE)
+        for at, wrong in cases:
+            document = json.loads(json.dumps(original))
+            parent = document
+            for step in at[:-1]:
+                parent = parent[step]
+            parent[at[-1]] = "@@"
+            pointer = "/" + "/".join(str(step) for step in at)
+            yield f"{path.name}: {pointer} = {wrong}", json.dumps(document).replace("\"@@\"", wrong)
 
     def test_every_wrong_value_of_a_trial_record_is_a_data_error_naming_the_file(self):
         record = sorted((self.first_session() / "trials").glob("*.json"))[0]

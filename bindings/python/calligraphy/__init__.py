@@ -30,8 +30,9 @@ Main entry points:
 
 Errors carry the C++ class names: ``Error`` (the base), ``InvalidArgument`` (a ValueError),
 ``DataError`` (a RuntimeError), ``CharacterNotFound`` (a KeyError and a DataError), ``DeviceError``
-(a RuntimeError) with ``DeviceNotFound`` (a LookupError), ``CommunicationError`` (a ConnectionError),
-``SafetyFault`` and ``CalibrationNeeded``. An argument of the wrong type raises TypeError naming it.
+(a RuntimeError) with ``DeviceNotFound`` (a LookupError), ``DeviceUnavailable`` (a known device that cannot
+be used now: its backend's reason), ``CommunicationError`` (a ConnectionError), ``SafetyFault`` and
+``CalibrationNeeded``. An argument of the wrong type raises TypeError naming it.
 See docs/python.md.
 """
 
@@ -50,6 +51,7 @@ from ._calligraphy import (  # noqa: F401
     DeviceInfo,
     DeviceListing,
     DeviceNotFound,
+    DeviceUnavailable,
     DeviceState,
     DeviceSurvey,
     Error,
@@ -129,6 +131,7 @@ __all__ = [
     "DeviceInfo",
     "DeviceListing",
     "DeviceNotFound",
+    "DeviceUnavailable",
     "DeviceState",
     "DeviceSurvey",
     "Error",
