@@ -24,22 +24,12 @@ import time
 import unittest
 from pathlib import Path
 
+from study_protocols import two_session_protocol
+
 CLI = os.environ.get("CALLIGRAPHY_CLI", "")
 SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 
-PROTOCOL = {
-    "format": "calligraphy-study-protocol",
-    "version": 1,
-    "name": "damage",
-    "conditions": [{"name": "vision", "mode": "vision"}, {"name": "haptic", "mode": "haptic"}],
-    "phases": [
-        {"phase": "pre-test", "condition": "vision", "characters": ["十"]},
-        {"phase": "training", "condition": "haptic", "characters": ["十"]},
-        {"phase": "post-test", "condition": "vision", "characters": ["十"]},
-        {"phase": "retention", "condition": "vision", "characters": ["十"], "session": 2, "delay_s": 60},
-    ],
-    "trial": {"max_duration_s": 20},
-}
+PROTOCOL = two_session_protocol("damage")
 
 # Values of other types, and numbers a double cannot hold (written into the text: json.dumps refuses them).
 SAMPLE = int(os.environ.get("CALLIGRAPHY_DAMAGE_SAMPLE", "60"))

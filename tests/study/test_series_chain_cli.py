@@ -16,21 +16,11 @@ import tempfile
 import unittest
 from pathlib import Path
 
+from study_protocols import two_session_protocol
+
 CLI = os.environ.get("CALLIGRAPHY_CLI", "")
 
-PROTOCOL = {
-    "format": "calligraphy-study-protocol",
-    "version": 1,
-    "name": "chain",
-    "conditions": [{"name": "vision", "mode": "vision"}, {"name": "haptic", "mode": "haptic"}],
-    "phases": [
-        {"phase": "pre-test", "condition": "vision", "characters": ["十"]},
-        {"phase": "training", "condition": "haptic", "characters": ["十"]},
-        {"phase": "post-test", "condition": "vision", "characters": ["十"]},
-        {"phase": "retention", "condition": "vision", "characters": ["十"], "session": 2, "delay_s": 60},
-    ],
-    "trial": {"max_duration_s": 20},
-}
+PROTOCOL = two_session_protocol("chain")
 
 
 class SeriesChainTest(unittest.TestCase):
