@@ -141,12 +141,7 @@ DeviceRegistry::Found DeviceRegistry::find_with_backend(std::string_view name) c
   // load a driver library or touch USB devices.
   for (const auto& backend : backends) {
     if (!names_device(backend, name)) continue;
-    DeviceSurvey survey;
-    try {
-      survey = backend.scan();
-    } catch (const Error& e) {
-      throw DeviceUnavailable("device '" + std::string(name) + "' cannot be used: " + e.what());
-    }
+    DeviceSurvey survey = scan_one(backend);  // a backend that throws gives its reason as a note
     if (auto device = listed(survey, backend, name)) return {std::move(*device), backend};
     std::string why;
     for (const auto& note : survey.notes) why += (why.empty() ? "" : "; ") + note;

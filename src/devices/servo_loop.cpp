@@ -192,7 +192,6 @@ struct ServoLoop::Impl {
     std::int64_t stall_limit_ns = 0;  // 0: no bound
     std::int64_t last_update = 0;     // the last force update the device got (start: forces just enabled)
     std::int64_t previous_wake = 0;
-    std::int64_t last_written = 0;
     std::uint64_t tick = 0;
     std::uint64_t late_count = 0;
     std::uint64_t withheld_count = 0;
@@ -331,7 +330,6 @@ bool ServoLoop::Impl::tick_once(std::int64_t wake, std::int64_t deadline) noexce
     return false;
   }
   run.last_update = written;
-  run.last_written = written;
   ticks.store(++run.tick, std::memory_order_relaxed);
   if (stall > run.longest_stall) {
     run.longest_stall = stall;
@@ -383,9 +381,9 @@ void ServoLoop::Impl::run_thread() noexcept {
     }
     if (!tick_once(wake, next + period)) break;  // the force must be out before the next tick starts
     next += period;
-    if (run.last_written >= next) {  // behind: the deadlines that passed are dropped, the grid restarts
-      const std::int64_t passed = (run.last_written - next) / period + 1;
-      next = run.last_written + period;
+    if (run.last_update >= next) {  // behind: the deadlines that passed are dropped, the grid restarts
+      const std::int64_t passed = (run.last_update - next) / period + 1;
+      next = run.last_update + period;
       skipped.store(skipped.load(std::memory_order_relaxed) + static_cast<std::uint64_t>(passed),
                     std::memory_order_relaxed);
       reanchors.store(reanchors.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);

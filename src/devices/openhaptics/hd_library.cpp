@@ -1,7 +1,6 @@
 #include "devices/openhaptics/hd_library.hpp"
 
 #include <dlfcn.h>
-#include <sys/stat.h>
 
 #include <cstdlib>
 
@@ -48,21 +47,9 @@ std::shared_ptr<const HdLibrary> HdLibrary::load() {
     const bool named_by_user = explicit_path != nullptr && path == explicit_path;
     // A path is checked before this process maps it, and a file that passes is loaded once in a child
     // process first: a damaged library must not take the caller down (SIGBUS) or hang it (a FIFO).
-    if (path.find('/') != std::string::npos) {
-      struct stat info {};
-      if (!named_by_user && ::stat(path.c_str(), &info) != 0) {
-        tried += "\n  " + path + ": no such file";
-        continue;
-      }
-      if (std::string problem = devices::shared_library_problem(path); !problem.empty()) {
-        if (named_by_user)
-          throw DeviceUnavailable("OpenHaptics: CALLIGRAPHY_LIBHD=" + path + " cannot be loaded: " + problem +
-                                  "; set it to the full path of libHD.so, or unset it");
-        tried += "\n  " + path + ": " + problem;
-        continue;
-      }
-    }
-    if (std::string problem = devices::probe_shared_library(path, "hdInitDevice"); !problem.empty()) {
+    std::string problem = path.find('/') != std::string::npos ? devices::shared_library_problem(path) : "";
+    if (problem.empty()) problem = devices::probe_shared_library(path, "hdInitDevice");
+    if (!problem.empty()) {
       if (named_by_user)
         throw DeviceUnavailable("OpenHaptics: CALLIGRAPHY_LIBHD=" + path + " cannot be loaded: " + problem +
                                 "; set it to the full path of libHD.so, or unset it");

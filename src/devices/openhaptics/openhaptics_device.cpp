@@ -232,14 +232,14 @@ hd::HDCallbackCode OpenHapticsDevice::servo_tick(void* self) noexcept {
   hd_api.set_doublev(hd::HD_CURRENT_FORCE, hd_force.data());
   hd_api.end_frame(device->handle_);
   note_error(hd_api.get_error());
-  device->publish_frame_state(now);
+  device->publish_frame_state();
   return hd::HD_CALLBACK_CONTINUE;
 }
 
-void OpenHapticsDevice::publish_frame_state(double now) noexcept {
+void OpenHapticsDevice::publish_frame_state() noexcept {
   const DeviceState& s = frame_state_;
   state_.store({s.position_m.x(), s.position_m.y(), s.position_m.z(), s.velocity_m_s.x(), s.velocity_m_s.y(),
-                s.velocity_m_s.z(), static_cast<double>(s.buttons), now});
+                s.velocity_m_s.z(), static_cast<double>(s.buttons), s.time_s});
 }
 
 void OpenHapticsDevice::attach(FrameFunction frame, void* context) {

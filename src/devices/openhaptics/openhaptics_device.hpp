@@ -68,7 +68,7 @@ class OpenHapticsDevice final : public HapticDevice, public DeviceServoClock {
   static hd::HDCallbackCode calibration_check(void* self) noexcept;
   void read_info();
 
-  void publish_frame_state(double now) noexcept;
+  void publish_frame_state() noexcept;  // frame_state_ for readers on other threads
 
   std::string configuration_name_;
   double watchdog_timeout_s_;
