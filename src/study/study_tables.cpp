@@ -109,6 +109,10 @@ TrialRow study_detail::trial_row(const json& document, const std::string& source
   row.item = plan.item;
   row.repetition = static_cast<std::size_t>(plan.repetition - 1);
   row.writer = manifest.setup.writer;
+  if (row.writer == "simulated") {
+    row.writer_profile = manifest.setup.writer_profile;
+    row.writer_learning = manifest.setup.writer_learning;
+  }
   row.end_reason = record.string_or("end_reason", "");
   row.start_utc = record.string_or("start_time_utc", "");
   row.completed_in_order = record.boolean_or("completed_in_order", false);
@@ -189,18 +193,19 @@ StudyTables read_study_tables(const std::vector<fs::path>& roots) {
 std::string trials_csv(const StudyTables& tables) {
   std::string out =
       "subject,session,protocol,session_number,group,phase,block,condition,mode,characters,trial,item,"
-      "repetition,writer,end_reason,"
+      "repetition,writer,writer_profile,writer_learning,end_reason,"
       "start_utc,completed_in_order,strokes_total,strokes_written,strokes_accepted,order_errors,"
       "backwards_strokes,unmatched_segments,mean_deviation_m,max_deviation_m,rms_deviation_m,frechet_m,dtw_m,"
       "total_time_s,pen_down_time_s,velocity_peaks,normalised_jerk,shape_skill,order_skill,timing_skill,"
       "trace_file\n";
   for (const TrialRow& r : tables.trials) {
     line(out, r.subject, r.session, r.protocol, r.session_number, r.group, r.phase, r.block, r.condition,
-         r.mode, r.characters, r.trial, r.item, r.repetition, r.writer, r.end_reason, r.start_utc,
-         r.completed_in_order, r.strokes_total, r.strokes_written, r.strokes_accepted, r.order_errors,
-         r.backwards_strokes, r.unmatched_segments, r.mean_deviation_m, r.max_deviation_m, r.rms_deviation_m,
-         r.frechet_m, r.dtw_m, r.total_time_s, r.pen_down_time_s, r.velocity_peaks, r.normalised_jerk,
-         r.shape_skill, r.order_skill, r.timing_skill, r.trace_file.string());
+         r.mode, r.characters, r.trial, r.item, r.repetition, r.writer, r.writer_profile, r.writer_learning,
+         r.end_reason, r.start_utc, r.completed_in_order, r.strokes_total, r.strokes_written,
+         r.strokes_accepted, r.order_errors, r.backwards_strokes, r.unmatched_segments, r.mean_deviation_m,
+         r.max_deviation_m, r.rms_deviation_m, r.frechet_m, r.dtw_m, r.total_time_s, r.pen_down_time_s,
+         r.velocity_peaks, r.normalised_jerk, r.shape_skill, r.order_skill, r.timing_skill,
+         r.trace_file.string());
   }
   return out;
 }

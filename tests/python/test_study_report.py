@@ -199,7 +199,7 @@ def test_the_summary_csv_holds_the_table_in_si_units(study, report):
         for condition in CONDITIONS:
             assert overall.loc[condition, "mean"] == pytest.approx(means[condition].mean(), rel=1e-9)
             assert overall.loc[condition, "n"] == SUBJECTS
-        assert set(rows.si_unit) == {"m" if value.endswith("_m") else "s"}
+        assert set(rows.unit) == {"m" if value.endswith("_m") else "s"}
 
 
 def test_the_statistics_name_their_test_and_n_and_find_the_planted_effect(report):
@@ -209,33 +209,32 @@ def test_the_statistics_name_their_test_and_n_and_find_the_planted_effect(report
     for table in tables:
         header = [row for row in table["rows"] if row["section"] == "thead"][0]["cells"]
         body = [row for row in table["rows"] if row["section"] == "tbody"]
-        assert len(body) == 2 + 6 + 2  # a mean per condition, one pair's six rows, two fixed effects
+        assert len(body) == 2 + 6  # a mean per condition, one pair's six rows (the mixed model is above)
         # The quantity cell spans its rows, so a row without it is one cell shorter: read from the right.
         test_cells = [row["cells"][header.index("test") - len(header)] for row in body]
         n_cells = [row["cells"][header.index("n") - len(header)] for row in body]
         assert all(test_cells) and not any(text.startswith("not computed") for text in test_cells)
         assert n_cells.count(str(SUBJECTS)) == 8
-        assert n_cells.count(str(SUBJECTS * len(CHARACTERS) * len(CONDITIONS) * REPETITIONS)) == 2
         t_test = dict(zip(header[::-1], body[2]["cells"][::-1]))
         assert "paired t-test" in t_test["test"]
         # p with 3 significant digits or "< 0.001"; the planted effect is large against its noise.
         assert t_test["p"] == "< 0.001" or (len(t_test["p"].replace(".", "").lstrip("0")) == 3
                                              and float(t_test["p"]) < 0.05)
-        assert t_test["comparison"] == "haptic - vision"
+        assert t_test["comparison"] == "vision - haptic"  # the control (vision, no guidance) first
         assert t_test["effect"].startswith("mean difference [")
-        assert float(t_test["effect"].split("=")[1]) < 0  # guidance is faster and closer
+        assert float(t_test["effect"].split("=")[1]) > 0  # guidance is faster and closer
     statistics = pandas.read_csv(index.parent / "tables" / "statistics.csv")
-    assert list(statistics.columns[:3]) == ["value", "quantity", "comparison"]
+    assert list(statistics.columns[:4]) == ["value", "unit", "quantity", "comparison"]
     paired = statistics[statistics.test.str.startswith("paired t-test")].set_index("value")
-    assert paired.loc["total_time_s", "effect"] == pytest.approx(HAPTIC_TIME_S, abs=1.0)  # SI units: s
-    assert paired.loc["mean_deviation_m", "effect"] == pytest.approx(HAPTIC_DEVIATION_M, abs=0.3e-3)  # m
+    assert paired.loc["total_time_s", "effect"] == pytest.approx(-HAPTIC_TIME_S, abs=1.0)  # SI units: s
+    assert paired.loc["mean_deviation_m", "effect"] == pytest.approx(-HAPTIC_DEVIATION_M, abs=0.3e-3)  # m
 
 
 def test_every_figure_is_an_svg_and_a_decodable_png(report):
     index, page = report
     figures = index.parent / "figures"
     stems = sorted(path.stem for path in figures.glob("*.svg"))
-    assert stems == sorted(f"learning_{value}" for value in VALUES)
+    assert stems == sorted([f"learning_{value}" for value in VALUES] + [f"phase_{value}" for value in VALUES])
     for stem in stems:
         ElementTree.parse(figures / f"{stem}.svg")  # well-formed
         image = matplotlib.image.imread(figures / f"{stem}.png")
@@ -268,12 +267,12 @@ def test_the_page_is_self_contained_and_the_subjects_are_collapsed(report):
     text = index.read_text(encoding="utf-8")
     assert page.scripts == 0 and "<script" not in text.lower()
     assert "http://" not in text and "https://" not in text
-    assert len(page.details) == SUBJECTS
+    assert len(page.details) == 1 + SUBJECTS  # the exclusion counts, then one per subject
     assert all("open" not in attrs for attrs in page.details)
     sections = [name for kind, name in page.order if kind == "section"]
-    assert sections == ["table5", "statistics", "learning", "subjects"]
-    first_details = next(k for k, (kind, _) in enumerate(page.order) if kind == "details")
-    assert page.order.index(("section", "learning")) < first_details
+    assert sections == ["summary", "questions", "phases", "table5", "statistics", "learning", "subjects"]
+    first_subject = next(k for k, (kind, name) in enumerate(page.order) if kind == "details" and name != "exclusions")
+    assert page.order.index(("section", "learning")) < first_subject
     assert "../trials.html" in page.links  # the per-trial page, relative to the report
     # The simulated subjects are said to be a model.
     assert "simulated" in text and "not people" in text
@@ -367,8 +366,8 @@ def test_an_empty_output_folder_is_refused(study, tmp_path):
 def test_bad_arguments_are_named(study, tmp_path):
     with pytest.raises(ValueError, match="'pen_up_time_s'"):
         study_report.write_report(study, tmp_path, values=("pen_up_time_s",))
-    with pytest.raises(ValueError, match="phase 'retention'.*'practice', 'test'"):
-        study_report.write_report(study, tmp_path, phase="retention")
+    with pytest.raises(ValueError, match="reference 'none' is not a condition.*'vision', 'haptic'"):
+        study_report.write_report(study, tmp_path, reference="none")
     with pytest.raises(TypeError, match="study must be"):
         study_report.write_report(study.trials, tmp_path)
 
@@ -410,9 +409,10 @@ def test_chromium_shows_the_summary_first_at_1280_px(report, tmp_path):
     if os.environ.get("CALLIGRAPHY_SCREENSHOT"):
         shutil.copyfile(shot, os.environ["CALLIGRAPHY_SCREENSHOT"])
     dom = chromium("--dump-dom", index.as_uri(), profile=tmp_path / "p2").stdout
-    first_details = dom.index("<details")
-    for section in ('id="table5"', 'id="statistics"', 'id="learning"'):
-        assert dom.index(section) < first_details
+    first_subject = dom.index('<details id="subject-')
+    order = [dom.index(section) for section in ('id="summary"', 'id="questions"', 'id="table5"', 'id="statistics"',
+                                                'id="learning"')]
+    assert order == sorted(order) and order[-1] < first_subject  # the summary first, the subjects last
     assert dom.count('class="cell"') == SUBJECTS * len(CHARACTERS) * len(VALUES)
     assert "<details open" not in dom
 
@@ -432,7 +432,9 @@ def test_a_real_study_from_session_run(small_study, tmp_path):
     assert [sum(row["section"] == "tbody" for row in t["rows"]) for t in table5s] == [3 * 2, 3 * 2]
     statistics = pandas.read_csv(tmp_path / "report" / "tables" / "statistics.csv")
     assert (statistics.n[statistics.test.str.startswith("paired t-test")] == 3).all()
-    assert len(page.details) == 3
+    assert len(page.details) == 1 + 3  # the exclusion counts, then one per subject
+    questions = pandas.read_csv(tmp_path / "report" / "tables" / "questions.csv", keep_default_na=False)
+    assert set(questions.comparison) == {"haptic - vision"} and set(questions.phase) == {"test"}
     for stem in ("learning_total_time_s", "learning_mean_deviation_m"):
         assert matplotlib.image.imread(tmp_path / "report" / "figures" / f"{stem}.png").size > 0
 
@@ -462,16 +464,23 @@ def test_a_study_of_phases_gets_learning_retention_and_transfer_by_group(tmp_pat
     index = study_report.write_report(calligraphy.study.Study(trials=trials, strokes=pandas.DataFrame()),
                                       tmp_path / "report")
     page = index.read_text(encoding="utf-8")
-    assert "Learning, retention and transfer" in page
-    assert "training trials" in page  # 'auto' chose the training phase for Table 5 and the curves
-    learning = pandas.read_csv(tmp_path / "report" / "tables" / "learning.csv")
-    deviation = learning[learning.value == "mean_deviation_m"].set_index("group")
-    assert set(deviation.index) == {"fading", "fixture"}
-    assert (deviation["pre_count"] == 4).all()
-    assert deviation.loc["fading", "retention_mean"] == pytest.approx(1.2e-3, abs=0.1e-3)
-    assert deviation.loc["fixture", "retention_mean"] == pytest.approx(1.8e-3, abs=0.1e-3)
-    compared = pandas.read_csv(tmp_path / "report" / "tables" / "group_comparisons.csv")
-    retention = compared[(compared.value == "mean_deviation_m") & (compared.quantity == "retention")].iloc[0]
-    assert (retention.a, retention.b, retention.n_a, retention.n_b) == ("fading", "fixture", 4, 4)
-    assert retention.mean_difference == pytest.approx(-0.6e-3, abs=0.1e-3)
-    assert retention.p < 0.001 and retention.ci95_high < 0
+    # The design read from the table: groups between subjects, the first group in protocol order the control.
+    assert "Between-subjects: 2 groups trained in training (fixture (control) n = 4, fading n = 4" in page
+    means = pandas.read_csv(tmp_path / "report" / "tables" / "phase_means.csv", keep_default_na=False)
+    deviation = means[means.value == "mean_deviation_m"]
+    assert list(dict.fromkeys(deviation.phase)) == ["pre-test", "training", "post-test", "retention", "transfer"]
+    assert set(deviation.unit) == {"m"} and (deviation.n == 4).all()  # n = subjects, SD over subjects
+    retention_means = deviation[deviation.phase == "retention"].set_index("condition")["mean"]
+    assert retention_means["fading"] == pytest.approx(1.2e-3, abs=0.1e-3)
+    assert retention_means["fixture"] == pytest.approx(1.8e-3, abs=0.1e-3)
+    questions = pandas.read_csv(tmp_path / "report" / "tables" / "questions.csv", keep_default_na=False)
+    retention = questions[(questions.value == "mean_deviation_m") & (questions.phase == "retention")].iloc[0]
+    assert retention.comparison == "fading - fixture" and retention.unit == "m"
+    assert retention.estimate == pytest.approx(-0.6e-3, abs=0.1e-3)  # adjusted for the pre-test
+    assert float(retention.df) == 8 - 3  # subjects - (intercept, pre-test slope, one group contrast)
+    assert float(retention.p) < 0.001 and float(retention.p_holm) >= float(retention.p)
+    assert retention.apa.startswith("t(5) = -") and retention.apa.endswith(" mm")
+    ratios = pandas.read_csv(tmp_path / "report" / "tables" / "retention.csv")
+    kept = ratios[ratios.value == "mean_deviation_m"].set_index("group")["retention_ratio"]
+    assert kept["fading"] == pytest.approx(0.8, abs=0.1) and kept["fixture"] == pytest.approx(0.2, abs=0.1)
+    assert "十 were also pre-tested" in page

@@ -457,7 +457,9 @@ def mixed_model(trials: pandas.DataFrame, value: str, fixed: str = "condition", 
     ``MixedLM.from_formula("value ~ C(fixed)", groups="subject", re_formula="1",
     vc_formula={"character": "0 + C(characters)"})``, in lme4's notation (Bates et al. 2015)
     ``value ~ fixed + (1 | subject) + (1 | subject:characters)``: the character component is one
-    intercept per character within each subject. With a single character it is left out.
+    intercept per character within each subject. With a single character it is left out. Wald z is a
+    large-sample test: a study with few subjects, every subject writing every character, is analysed with
+    subjects and items crossed and Satterthwaite df by ``calligraphy.design_analysis`` (R's lme4, lmerTest).
 
     Rows whose ``value`` is NaN are dropped and counted. ``phase`` (a name, several, or None for every
     row) restricts the trials first. ``reference`` is the level the others are compared with (default:
@@ -812,12 +814,13 @@ def _paired_rows(comparison: PairedComparison) -> list[dict[str, typing.Any]]:
     ]
 
 
-def statistics_table(trials: pandas.DataFrame, value: str, by: str = "condition", phase: Phase = None
-                     ) -> pandas.DataFrame:
+def statistics_table(trials: pandas.DataFrame, value: str, by: str = "condition", phase: Phase = None,
+                     *, with_mixed_model: bool = True) -> pandas.DataFrame:
     """One tidy table of ``value`` for a report: per condition (value of ``by``) its mean over subjects
     (``describe(..., unit="subject")``), every pairwise ``paired_comparison`` between the conditions
     present (in sorted order or a categorical column's order, a - b), and the fixed effects of
-    ``mixed_model(trials, value, fixed=by)``. ``phase`` (a name, several, or None for every row)
+    ``mixed_model(trials, value, fixed=by)`` (left out with ``with_mixed_model=False``; the small-sample
+    model with subjects and items crossed is ``calligraphy.design_analysis.design_questions``). ``phase`` (a name, several, or None for every row)
     restricts the trials first; without it, trials of all phases are pooled.
 
     Returns a DataFrame with the columns ``quantity``, ``comparison``, ``test``, ``n`` (subjects; trials
@@ -853,11 +856,11 @@ def statistics_table(trials: pandas.DataFrame, value: str, by: str = "condition"
             continue
         rows.extend(_paired_rows(comparison))
     try:
-        model = mixed_model(data, value, fixed=by)
+        model = mixed_model(data, value, fixed=by) if with_mixed_model else None
     except _TooFewData as error:
         rows.append(_row(quantity="fixed effect", comparison=by, test=f"not computed: {error}", assumptions=""))
     else:
-        for effect in model.itertuples(index=False):
+        for effect in (model.itertuples(index=False) if model is not None else ()):
             rows.append(_row(quantity="fixed effect", comparison=effect.term, test=effect.test,
                              n=effect.n_observations, statistic=effect.z, p=effect.p, effect=effect.estimate,
                              effect_name=f"estimate [{value}]", ci95_low=effect.ci95_low,

@@ -32,7 +32,8 @@ _NUMERIC_TRIAL_COLUMNS = (
 _NUMERIC_STROKE_COLUMNS = (
     "trial", "character", "stroke", "typical_id", "segments", "refused_segments", "mean_deviation_m",
     "max_deviation_m", "rms_deviation_m", "frechet_m", "dtw_m", "time_s", "path_length_m")
-_CATEGORIES = ("subject", "session", "protocol", "group", "phase", "condition", "mode", "writer", "end_reason")
+_CATEGORIES = ("subject", "session", "protocol", "group", "phase", "condition", "mode", "writer", "writer_profile",
+               "writer_learning", "end_reason")
 # The trace CSV's columns (calligraphy trial --csv) with their SI units named.
 _SAMPLE_COLUMNS = {"t": "t_s", "x": "x_m", "y": "y_m", "z": "z_m", "fx": "fx_n", "fy": "fy_n", "fz": "fz_n"}
 
@@ -127,7 +128,9 @@ class Study:
 def load(paths: typing.Union[PathLike, typing.Sequence[PathLike]]) -> Study:
     """Reads the saved trials of the session folders under `paths` (a session folder, a study folder made by
     ``calligraphy session run --out``, or a list of either) into a `Study` of tidy DataFrames. Only the
-    session manifests and trial records are read, never the traces. Raises DataError naming the file (and
+    session manifests and trial records are read, never the traces. ``phase`` is an ordered categorical in
+    the protocol's order and ``condition`` and ``group`` categoricals with the control (the condition without
+    guidance, ``calligraphy.design_analysis.study_design``) first. Raises DataError naming the file (and
     JSON pointer) for a path without a session folder or a damaged record, ValueError for no path or an
     empty one, ImportError without pandas."""
     roots = [paths] if isinstance(paths, (str, os.PathLike)) else list(paths)
@@ -136,6 +139,11 @@ def load(paths: typing.Union[PathLike, typing.Sequence[PathLike]]) -> Study:
     trials_text, strokes_text = _calligraphy._study_tables_csv([os.fspath(root) for root in roots])
     trials = _read_table(trials_text, _NUMERIC_TRIAL_COLUMNS, ("completed_in_order",))
     strokes = _read_table(strokes_text, _NUMERIC_STROKE_COLUMNS, ("written", "backwards"))
+    if not trials.empty:
+        from . import design_analysis
+
+        # The design's order, not the alphabet's: phases as the protocol runs them, the control condition first.
+        trials = design_analysis.ordered(trials, design_analysis.study_design(trials))
     return Study(trials=trials, strokes=strokes)
 
 

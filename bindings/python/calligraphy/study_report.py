@@ -48,6 +48,8 @@ from . import study as _study
 
 if typing.TYPE_CHECKING:  # pragma: no cover
     import matplotlib.figure
+
+    from . import design_analysis
     import pandas
 
 __all__ = ["learning_figure", "main", "write_report"]
@@ -55,8 +57,9 @@ __all__ = ["learning_figure", "main", "write_report"]
 PathLike = typing.Union[str, "os.PathLike[str]"]
 
 PNG_DPI = 150
-# Condition colours in the conditions' order (matplotlib's tab10 blue and red first, as the C++ report).
-_CONDITION_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b")
+# Condition colours in the design's order, the control first: the colour-blind-safe palette of Okabe & Ito
+# (2008, "Color Universal Design"), black for the control; the same condition has the same colour on every figure.
+_CONDITION_COLOURS = ("#000000", "#E69F00", "#56B4E9", "#009E73", "#D55E00", "#0072B2", "#CC79A7", "#F0E442")
 _FIGURE_RC = {"svg.fonttype": "path", "svg.hashsalt": "calligraphy-study-report", "font.size": 9.0}
 
 
@@ -315,12 +318,12 @@ def _summary_rows(table: _Table5) -> list[dict]:
         for character in table.characters:
             for condition in table.conditions:
                 mean, sd, n = table.cells.get((subject, character, condition), (math.nan, math.nan, 0))
-                rows.append({"quantity": table.value, "si_unit": unit, "row": "subject x character",
+                rows.append({"quantity": table.value, "unit": unit, "row": "subject x character",
                              "subject": subject, "characters": character, "condition": condition, "n": n,
                              "n_of": "trials", "mean": mean, "sd": sd})
     for condition in table.conditions:
         mean, sd, n = table.summary.get(condition, (math.nan, math.nan, 0))
-        rows.append({"quantity": table.value, "si_unit": unit, "row": "mean over subjects", "subject": "",
+        rows.append({"quantity": table.value, "unit": unit, "row": "mean over subjects", "subject": "",
                      "characters": "", "condition": condition, "n": n, "n_of": "subjects", "mean": mean, "sd": sd})
     return rows
 
@@ -332,12 +335,13 @@ def _statistics(data: "pandas.DataFrame", value: str) -> "pandas.DataFrame":
 
     pandas = _pandas()
     try:
-        table = statistics.statistics_table(data, value, by="condition")
+        table = statistics.statistics_table(data, value, by="condition", with_mixed_model=False)
     except ValueError as error:
         row: dict[str, typing.Any] = {column: math.nan for column in statistics.TABLE_COLUMNS}
         row.update(quantity=value, comparison="condition", test=f"not computed: {error}", assumptions="")
         table = pandas.DataFrame([row], columns=statistics.TABLE_COLUMNS)
     table.insert(0, "value", value)
+    table.insert(1, "unit", _si_unit(value))
     return table
 
 
@@ -471,39 +475,27 @@ def _scaled_effect(row: dict, value: str) -> bool:
     return f"[{value}]" in str(row.get("effect_name", ""))
 
 
-def _header_html(trials: "pandas.DataFrame", data: "pandas.DataFrame", title: str, phase: typing.Optional[str],
-                 per_trial_link: typing.Optional[str]) -> str:
+def _header_html(trials: "pandas.DataFrame", title: str, design: "design_analysis.StudyDesign",
+                 per_trial_link: typing.Optional[str], tables: pathlib.Path,
+                 files: dict[pathlib.Path, typing.Union[bytes, str]]) -> str:
     protocols = [str(p) for p in _levels(trials["protocol"])] if "protocol" in trials else []
     subjects = trials["subject"].nunique()
     sessions = trials["session"].nunique() if "session" in trials else None
-    writers = [str(w) for w in _levels(trials["writer"])] if "writer" in trials else []
-    characters = _characters_in_order(data)
-    conditions = [str(c) for c in _levels(data["condition"])]
-    repetitions = int(data["repetition"].max()) + 1 if data["repetition"].notna().any() else 0
     facts = [f"Protocol{'s' if len(protocols) != 1 else ''} <b>{_e(', '.join(protocols) or 'unnamed')}</b>",
              f"{subjects} subject{'s' if subjects != 1 else ''}"]
     if sessions is not None:
         facts.append(f"{sessions} session{'s' if sessions != 1 else ''}")
-    phase_words = f"{phase} " if phase else ""
-    facts.append(f"{len(trials)} trials ({len(data)} {phase_words}trials)")
-    facts.append(f"writer: {_e(' and '.join(writers) or 'not recorded')}")
+    facts.append(f"{len(trials)} trials")
     parts = [f"<header>\n<h1>{_e(title)}</h1>\n<p class=\"lead\">{' &middot; '.join(facts)}</p>\n",
-             f"<p>Design of the {_e(phase_words)}trials: {len(characters)} item{'s' if len(characters) != 1 else ''} "
-             f"(<span class=\"glyph\">{_e(' '.join(characters))}</span>) &times; {len(conditions)} condition"
-             f"{'s' if len(conditions) != 1 else ''} ({_e(', '.join(conditions))}) &times; up to {repetitions} "
-             f"repetition{'s' if repetitions != 1 else ''}, after Wang, Zhang &amp; Yao 2006, section 7 "
-             "(their Table 5 compares the writing time per character with and without haptic guidance).</p>\n"]
-    if "simulated" in writers:
-        parts.append("<p class=\"note\">" + ("Some subjects are" if len(writers) > 1 else "The subjects are") +
-                     " simulated: a model of a writer moving a simulated device, not people. Their numbers test "
-                     "the procedure and the analysis; they are no evidence of how people write or learn (a "
-                     "simulated subject of a session does not learn between trials).</p>\n")
-    files = ["<a href=\"tables/summary.csv\">tables/summary.csv</a>",
-             "<a href=\"tables/statistics.csv\">tables/statistics.csv</a>",
-             "figures in <a href=\"figures/\">figures/</a> (SVG and PNG)"]
+             f"<p>{_e(design.sentence())}</p>\n"]
+    sentence = _subjects_sentence(trials)
+    parts.append(f"<p class=\"{'note' if 'simulated' in sentence else 'lead'}\">{_e(sentence)}</p>\n")
+    links = [f"<a href=\"tables/{name}\">tables/{name}</a>" for name in sorted(
+        path.name for path in files if path.parent == tables)]
+    listed = links + ["figures in <a href=\"figures/\">figures/</a> (SVG and PNG)"]
     if per_trial_link:
-        files.append(f"every trial's trajectory and forces: <a href=\"{_e(per_trial_link)}\">per-trial page</a>")
-    parts.append(f"<p class=\"files\">Files: {'; '.join(files)}.</p>\n</header>\n")
+        listed.append(f"every trial's trajectory and forces: <a href=\"{_e(per_trial_link)}\">per-trial page</a>")
+    parts.append(f"<p class=\"files\">Files: {'; '.join(listed)}.</p>\n</header>\n")
     return "".join(parts)
 
 
@@ -627,96 +619,160 @@ def _subjects_html(trials: "pandas.DataFrame", values: typing.Sequence[str], per
     return "".join(out)
 
 
-# ---------------------------------------------------------------------------------------------- learning
+# ---------------------------------------------------------------------------------------------- the design's answers
 
 
-_LEARNING_PHASES = ("pre-test", "post-test", "retention", "transfer")
-
-
-def _learning_tables(trials: "pandas.DataFrame", value: str) -> tuple["pandas.DataFrame", "pandas.DataFrame"]:
-    """Per group (or 'all'), the subjects' mean pre, post, retention and transfer values, gain and retention
-    ratio (``statistics.learning``); and every pair of groups compared on gain and retention
-    (``statistics.group_comparison``; pairs with fewer than 2 subjects a side are left out)."""
+def _phase_means(data: "pandas.DataFrame", value: str, design: "design_analysis.StudyDesign") -> "pandas.DataFrame":
+    """Per phase and condition (group), the mean over subjects of each subject's mean, its SD over subjects,
+    n = subjects and the 95 % t interval (the one definition of a summary on this page), in SI units."""
     from . import statistics
 
-    pandas = _pandas()
-    present = set(trials["phase"].astype(str))
-    table = statistics.learning(trials, value, "pre-test", "post-test",
-                                retention="retention" if "retention" in present else None,
-                                transfer="transfer" if "transfer" in present else None)
-    if "group" not in table or not table["group"].astype(str).str.len().any():
-        table["group"] = "all"
-    columns = [c for c in ("pre", "post", "retention", "transfer", "gain", "retention_ratio", "transfer_gain")
-               if c in table]
-    summary = table.groupby("group", sort=True)[columns].agg(["mean", "std", "count"])
-    comparisons = []
-    groups = sorted(str(g) for g in table["group"].unique())
-    for a, b in itertools.combinations(groups, 2):
-        for quantity in ("gain", "retention", "transfer"):
-            if quantity not in table:
-                continue
-            try:
-                c = statistics.group_comparison(table, quantity, a, b)
-            except ValueError:  # fewer than 2 subjects with a value in a group
-                continue
-            comparisons.append({"value": value, "quantity": quantity, "a": a, "b": b, "n_a": c.n_a, "n_b": c.n_b,
-                                "mean_difference": c.mean_difference, "ci95_low": c.ci95_low,
-                                "ci95_high": c.ci95_high, "t": c.t, "df": c.df, "p": c.p, "g": c.g,
-                                "mann_whitney_p": c.mann_whitney_p, "test": c.test})
-    return summary, pandas.DataFrame(comparisons)
+    by = "group" if design.kind == "between-subjects" else "condition"
+    rows = data[data[value].notna()]
+    if design.kind != "between-subjects":
+        rows = rows.assign(condition=rows["condition"].astype(str))
+    described = statistics.describe(rows.assign(phase=rows["phase"].astype(str), **{by: rows[by].astype(str)}),
+                                    value, by=("phase", by), unit="subject")
+    described = described.drop(columns=["unit"]).rename(columns={by: "condition"})
+    described.insert(0, "value", value)
+    described.insert(1, "unit", _si_unit(value))
+    order = {p: k for k, p in enumerate(design.phases)}
+    conditions = list(design.conditions)
+    described["_p"] = described["phase"].map(order)
+    described["_c"] = described["condition"].map(lambda c: conditions.index(c) if c in conditions else len(conditions))
+    described = described.sort_values(["_p", "_c"], kind="stable").drop(columns=["_p", "_c"])
+    return described[["value", "unit", "phase", "condition", "n", "mean", "sd", "ci95_low", "ci95_high"]]
 
 
-def _learning_html(trials: "pandas.DataFrame", values: typing.Sequence[str], tables: pathlib.Path,
-                   files: dict[pathlib.Path, typing.Union[bytes, str]]) -> str:
-    """The section on learning, retention and transfer of a protocol with a pre-test and a post-test
-    (docs/experiments.md, "Phases"); '' without them. Also adds tables/learning.csv and
-    tables/group_comparisons.csv to `files`."""
-    pandas = _pandas()
-    present = set(trials["phase"].astype(str))
-    if not {"pre-test", "post-test"} <= present:
+def phase_figure(means: "pandas.DataFrame", value: str, design: "design_analysis.StudyDesign"
+                 ) -> "matplotlib.figure.Figure":
+    """The study at a glance: ``value`` by phase (protocol order, x) and condition or group (one line each, the
+    control black), the mean over subjects with its 95 % t interval (n = subjects), from ``means``
+    (``_phase_means``). Returns a matplotlib Figure (Agg canvas)."""
+    from matplotlib.ticker import MaxNLocator
+
+    matplotlib, canvas = _matplotlib()
+    display = _display(value)
+    phases = [p for p in design.phases if p in set(means["phase"])]
+    conditions = [c for c in design.conditions if c in set(means["condition"])] + [
+        c for c in dict.fromkeys(means["condition"]) if c not in design.conditions]
+    with matplotlib.rc_context(_FIGURE_RC):
+        figure = matplotlib.figure.Figure(figsize=(max(3.2, 1.15 * len(phases) + 1.6), 2.9), layout="constrained")
+        canvas(figure)
+        ax = figure.subplots()
+        width = 0.5 / max(1, len(conditions))
+        for k, condition in enumerate(conditions):
+            line = means[means["condition"] == condition]
+            x = [phases.index(p) + (k - (len(conditions) - 1) / 2) * width for p in line["phase"]]
+            mean = line["mean"].to_numpy(dtype=float) * display.scale
+            low = line["ci95_low"].to_numpy(dtype=float) * display.scale
+            high = line["ci95_high"].to_numpy(dtype=float) * display.scale
+            colour = _condition_colour(list(design.conditions) or conditions, condition) \
+                if condition in design.conditions else "#777777"
+            label = f"{condition} (control)" if condition == design.control else str(condition)
+            ax.plot(x, mean, "-o", color=colour, ms=4, lw=1.3, label=label)
+            finite = [i for i in range(len(x)) if math.isfinite(low[i]) and math.isfinite(high[i])]
+            if finite:
+                ax.errorbar([x[i] for i in finite], [mean[i] for i in finite],
+                            yerr=[[mean[i] - low[i] for i in finite], [high[i] - mean[i] for i in finite]],
+                            fmt="none", ecolor=colour, elinewidth=1.0, capsize=2.5)
+        ax.set_xticks(range(len(phases)), phases)
+        ax.set_ylabel(display.axis_label())
+        ax.yaxis.set_major_locator(MaxNLocator(nbins=5, steps=[1, 2, 2.5, 5, 10]))
+        ax.grid(axis="y", color="#dddddd", lw=0.6)
+        ax.spines[["top", "right"]].set_visible(False)
+        ax.legend(title="group" if design.kind == "between-subjects" else "condition", fontsize=8, title_fontsize=8,
+                  frameon=False, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    return figure
+
+
+def _subjects_sentence(trials: "pandas.DataFrame") -> str:
+    """Who the subjects were: people, or simulated subjects with their profile and learning model."""
+    writers = [str(w) for w in _levels(trials["writer"])] if "writer" in trials else []
+    if "simulated" not in writers:
+        return f"Subjects: {'people' if writers else 'not recorded'}."
+    simulated = trials[trials["writer"].astype(str) == "simulated"]
+    profiles = sorted({str(p) for p in simulated.get("writer_profile", []) if str(p)}) or ["not recorded"]
+    models = sorted({str(m) for m in simulated.get("writer_learning", []) if str(m)}) or ["not recorded"]
+    learns = ("they learn from trial to trial by that model (docs/writer.md)" if models != ["none"]
+              else "they do not learn between trials")
+    who = "Some subjects are" if len(writers) > 1 else "The subjects are"
+    return (f"{who} simulated (profile {', '.join(profiles)}; learning model {', '.join(models)}: {learns}): a model "
+            "of a writer moving a simulated device, not people. Their numbers test the procedure and the analysis; "
+            "they are no evidence of how people write or learn.")
+
+
+def _exclusions_html(counts: "pandas.DataFrame", policy: "design_analysis.ExclusionPolicy") -> str:
+    if counts.empty:
         return ""
-    parts = ["<section id=\"learning-retention\">\n<h2>Learning, retention and transfer</h2>\n"
-             "<p class=\"files\">Each subject's trials averaged per phase; gain = pre-test - post-test (lower "
-             "is better); retention ratio = (pre - retention) / (pre - post): 1 kept, 0 lost. Groups are the "
-             "between-subjects training conditions. Mean ± SD over subjects (n).</p>\n"]
-    summaries, comparisons = [], []
-    for value in values:
-        summary, compared = _learning_tables(trials, value)
-        display = _display(value)
-        unit = f" [{display.unit}]" if display.unit else ""
-        columns = list(dict.fromkeys(c for c, _ in summary.columns))
-        header = "".join(f"<th>{_e(c.replace('_', ' '))}</th>" for c in columns)
-        rows = []
-        for group, row in summary.iterrows():
-            cells = []
-            for column in columns:
-                scale = 1.0 if column == "retention_ratio" else display.scale
-                mean, sd, n = row[(column, "mean")], row[(column, "std")], row[(column, "count")]
-                cells.append(f"<td>{_fixed(mean * scale, display.decimals)} ± {_fixed(sd * scale, display.decimals)}"
-                             f" ({_integer(n)})</td>")
-            rows.append(f"<tr><th>{_e(group)}</th>{''.join(cells)}</tr>")
-        parts.append(f"<table><caption>{_e(display.label.capitalize())}{_e(unit)} by phase (retention ratio "
-                     f"without unit)</caption><tr><th>group</th>{header}</tr>{''.join(rows)}</table>\n")
-        flat = summary.copy()
-        flat.columns = [f"{c}_{stat}" for c, stat in summary.columns]
-        summaries.append(flat.reset_index().assign(value=value))
-        if not compared.empty:
-            comparisons.append(compared)
-            lines = "".join(
-                f"<tr><td>{_e(r.quantity)}</td><td>{_e(r.a)} - {_e(r.b)}</td><td>{r.n_a}, {r.n_b}</td>"
-                f"<td>{_fixed(r.mean_difference * display.scale, display.decimals)} "
-                f"[{_fixed(r.ci95_low * display.scale, display.decimals)}, "
-                f"{_fixed(r.ci95_high * display.scale, display.decimals)}]</td><td>{_significant(r.t)}</td>"
-                f"<td>{_significant(r.df)}</td><td>{_p_value(r.p)}</td><td>{_significant(r.g)}</td></tr>"
-                for r in compared.itertuples())
-            parts.append(f"<table><caption>Groups compared, {_e(display.label)}{_e(unit)}: Welch t-test, "
-                         "Hedges' g</caption><tr><th>quantity</th><th>groups</th><th>n</th><th>difference "
-                         f"[95 % CI]</th><th>t</th><th>df</th><th>p</th><th>g</th></tr>{lines}</table>\n")
-    files[tables / "learning.csv"] = pandas.concat(summaries, ignore_index=True).to_csv(index=False)
-    if comparisons:
-        files[tables / "group_comparisons.csv"] = pandas.concat(comparisons, ignore_index=True).to_csv(index=False)
-    parts.append("</section>\n")
-    return "".join(parts)
+    key = "group" if "group" in counts.columns else "condition"
+    reasons = [c for c in counts.columns if c.startswith("excluded_")]
+    total, kept = int(counts["trials"].sum()), int(counts["kept"].sum())
+    head = "".join(f"<th>{_e(c)}</th>" for c in ["phase", key, "trials", "analysed", *(r[9:] for r in reasons)])
+    body = "".join(
+        "<tr>" + "".join(f"<td>{_e(row[c])}</td>" for c in ("phase", key))
+        + "".join(f"<td class=\"num\">{int(row[c])}</td>" for c in ("trials", "kept", *reasons)) + "</tr>\n"
+        for row in counts.to_dict("records"))
+    return (f"<p>Completion: {kept} of {total} trials analysed ({100.0 * kept / total:.0f} %). {_e(policy.sentence())}"
+            "</p>\n<details id=\"exclusions\"><summary>Trials analysed and excluded, by phase</summary>\n"
+            f"<table class=\"exclusions\"><thead><tr>{head}</tr></thead><tbody>\n{body}</tbody></table></details>\n")
+
+
+def _questions_html(questions: "pandas.DataFrame", value: str) -> str:
+    display = _display(value)
+    unit = f" [{display.unit}]" if display.unit else ""
+    out = [f"<table class=\"questions\" data-value=\"{_e(value)}\">\n<caption>{_e(display.label.capitalize())}"
+           f"{_e(unit)}: each condition against the control</caption>\n<thead><tr><th>phase</th><th>comparison</th>"
+           "<th>model</th><th>result</th><th>p (Holm)</th><th>difference [95 % CI]</th><th>note</th></tr></thead>"
+           "\n<tbody>\n"]
+    for row in questions.to_dict("records"):
+        difference = "–"
+        if _finite(row["estimate"]):
+            difference = _fixed(row["estimate"] * display.scale, display.decimals)
+            if _finite(row["ci95_low"]) and _finite(row["ci95_high"]):
+                difference += (f" [{_fixed(row['ci95_low'] * display.scale, display.decimals)}, "
+                               f"{_fixed(row['ci95_high'] * display.scale, display.decimals)}]")
+        note = str(row["note"]) if isinstance(row["note"], str) else ""
+        css = " class=\"not-tested\"" if note.startswith(("not tested", "not computed")) else ""
+        out.append(f"<tr{css}><td>{_e(row['phase'])}</td><td>{_e(row['comparison'])}</td>"
+                   f"<td class=\"test\">{_e(row['test'] or '–')}</td><td>{_e(row['apa'] or '–')}</td>"
+                   f"<td class=\"num\">{_p_value(row['p_holm'])}</td><td class=\"num\">{difference}</td>"
+                   f"<td class=\"test\">{_e(note)}</td></tr>\n")
+    out.append("</tbody></table>\n")
+    return "".join(out)
+
+
+def _phase_means_html(means: "pandas.DataFrame", value: str, design: "design_analysis.StudyDesign") -> str:
+    display = _display(value)
+    unit = f" [{display.unit}]" if display.unit else ""
+    conditions = [c for c in design.conditions if c in set(means["condition"])]
+    phases = [p for p in design.phases if p in set(means["phase"])]
+    cells = {(r["phase"], r["condition"]): r for r in means.to_dict("records")}
+    head = "".join(f"<th>{_e(c)}{' (control)' if c == design.control else ''}</th>" for c in conditions)
+    body = []
+    for phase in phases:
+        row = [f"<th>{_e(phase)}</th>"]
+        for condition in conditions:
+            cell = cells.get((phase, condition))
+            row.append("<td class=\"num\">–</td>" if cell is None else
+                       f"<td class=\"num\">{_fixed(cell['mean'] * display.scale, display.decimals)} &plusmn; "
+                       f"{_fixed(cell['sd'] * display.scale, display.decimals)} <span class=\"n\">({int(cell['n'])})"
+                       "</span></td>")
+        body.append("<tr>" + "".join(row) + "</tr>\n")
+    return (f"<table class=\"phase-means\" data-value=\"{_e(value)}\"><caption>{_e(display.label.capitalize())}{_e(unit)}"
+            f": mean &plusmn; SD over subjects (n subjects)</caption><thead><tr><th>phase</th>{head}</tr></thead>"
+            f"<tbody>\n{''.join(body)}</tbody></table>\n")
+
+
+def _retention_html(ratios: "pandas.DataFrame") -> str:
+    if ratios.empty:
+        return ""
+    rows = "".join(f"<tr><td>{_e(r['group'])}</td><td class=\"num\">{_integer(r['n'])}</td><td class=\"num\">"
+                   f"{_significant(r['retention_ratio'])}</td><td class=\"test\">{_e(r['note'])}</td></tr>\n"
+                   for r in ratios.to_dict("records"))
+    return ("<table class=\"retention\"><caption>Share of the gain kept at retention, mean(pre - retention) / "
+            "mean(pre - post) per group</caption><thead><tr><th>group</th><th>n</th><th>ratio</th><th>note</th></tr>"
+            f"</thead><tbody>\n{rows}</tbody></table>\n")
 
 
 def _relative_link(target: PathLike, out_dir: pathlib.Path) -> str:
@@ -726,44 +782,59 @@ def _relative_link(target: PathLike, out_dir: pathlib.Path) -> str:
 
 def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Optional[str] = None,
                  values: typing.Sequence[str] = ("total_time_s", "mean_deviation_m"),
-                 phase: typing.Optional[str] = "auto", per_trial_page: typing.Optional[PathLike] = None
-                 ) -> pathlib.Path:
-    """Writes the report of `study` into `out_dir` (created if missing) and returns the path of its
-    index.html.
+                 per_trial_page: typing.Optional[PathLike] = None, reference: typing.Optional[str] = None,
+                 keep_end_reasons: typing.Optional[typing.Sequence[str]] = ("completed",),
+                 ddf: str = "Satterthwaite") -> pathlib.Path:
+    """Writes the report of `study` into `out_dir` (created if missing) and returns the path of its index.html.
 
-    study: a calligraphy.study.Study (``calligraphy.study.load``; its ``trials`` need subject, condition,
-    characters, repetition (0-based), phase, the `values`, and optionally protocol, session, writer, trial,
-    block, end_reason). values: numeric columns in SI units, one Table-5 table, statistics table and
-    learning-curve figure each (lengths shown in mm, times in s). phase: the trials the tables, statistics
-    and curves use ('test', as the paper's Table 5; None for all; 'auto': 'test' when present, else
-    'training' when present, else all); the per-subject sections list every trial. A study with a pre-test
-    and a post-test also gets a section on learning, retention and transfer per group
-    (``statistics.learning`` and ``statistics.group_comparison``; tables/learning.csv and
-    tables/group_comparisons.csv). per_trial_page: the C++ ``calligraphy report`` page, linked (relative to `out_dir`) for each
-    trial's figures.
+    study: a calligraphy.study.Study (``calligraphy.study.load``; its ``trials`` need subject, phase,
+    condition, characters, repetition, the `values`, and optionally group, mode, session, session_number,
+    block, trial, writer, writer_profile, writer_learning, end_reason). values: numeric columns in SI units
+    (lengths shown in mm, times in s). reference: the control every other condition (group) is compared with
+    (default: the one condition without guidance, else the first in protocol order). keep_end_reasons: the
+    trials analysed by how they ended (default: only 'completed'; None: all); the others are counted on the
+    page. ddf: the mixed model's degrees of freedom, 'Satterthwaite' or 'Kenward-Roger'. per_trial_page: the
+    C++ ``calligraphy report`` page, linked (relative to `out_dir`) for each trial's figures.
 
-    Writes index.html, figures/learning_<value>.svg and .png (150 dpi), tables/summary.csv (per value the
-    Table-5 cells: quantity, si_unit, row ('subject x character' or 'mean over subjects'), subject,
-    characters, condition, n, n_of (trials or subjects), mean, sd, in SI units) and tables/statistics.csv
-    (``calligraphy.statistics.statistics_table`` of each value, a `value` column first). Table 5 after
-    Wang, Zhang & Yao 2006, section 7; the statistics' sources are those of calligraphy.statistics.
+    The page (``calligraphy.design_analysis`` gives its numbers): a header (protocols, subjects and what they
+    were, the design, completion and exclusions); the summary: per value a figure of the outcome by phase and
+    condition with 95 % intervals and the table of the design's questions, each condition against the control
+    with its APA sentence and Holm-adjusted p; then the details: phase means, retention and transfer, for a
+    within-subjects design the Table-5 grids (Wang, Zhang & Yao 2006, section 7) and the paired statistics,
+    learning curves over repetitions, one collapsed section per subject. One definition of a summary
+    throughout: each subject's trials averaged first, SD over subjects, n = subjects.
+
+    Writes index.html, figures/phase_<value>.svg/.png and figures/learning_<value>.svg/.png (150 dpi), and
+    tidy tables with a ``unit`` column in SI units: tables/phase_means.csv, tables/questions.csv
+    (``design_analysis.QUESTION_COLUMNS``), tables/exclusions.csv, tables/retention.csv (when there is a
+    retention phase), and for a within-subjects design tables/summary.csv (the Table-5 cells) and
+    tables/statistics.csv (``statistics.statistics_table``). docs/experiments.md lists every column.
 
     Raises TypeError when `study` has no trials DataFrame; ValueError naming a missing or non-numeric column,
-    a phase not present (listing those present) or an empty `out_dir`; OSError naming a file or folder that could not be
-    written; ImportError without pandas, matplotlib, SciPy or statsmodels.
+    an unknown reference or an empty `out_dir`; OSError naming a file or folder that could not be written;
+    ImportError without pandas, matplotlib, SciPy or statsmodels. Without R (lme4, lmerTest) the mixed
+    models' rows say "not computed" and name the packages.
     """
+    from . import design_analysis, statistics
+
     pandas = _pandas()
     trials = getattr(study, "trials", None)
     if not isinstance(trials, pandas.DataFrame):
         raise TypeError(f"write_report: study must be a calligraphy.study.Study (calligraphy.study.load), "
                         f"got {type(study).__name__}")
-    if phase == "auto":
-        present = set(trials["phase"].astype(str)) if "phase" in trials else set()
-        phase = "test" if "test" in present else "training" if "training" in present else None
-    trials = _check_trials(trials, values, phase, "write_report")
-    data = _phase_trials(trials, phase)
+    trials = _check_trials(trials, values, None, "write_report")
+    if "phase" not in trials.columns:
+        raise ValueError("write_report: the trials have no column 'phase'")
     if not os.fspath(out_dir).strip():
         raise ValueError("write_report: out_dir is empty; name the report folder")
+    design = design_analysis.study_design(trials, reference)
+    trials = design_analysis.ordered(trials, design)
+    policy = design_analysis.ExclusionPolicy(None if keep_end_reasons is None else tuple(keep_end_reasons))
+    if policy.keep_end_reasons is not None and "end_reason" not in trials.columns:
+        policy = design_analysis.ExclusionPolicy(None)
+    kept, exclusions = design_analysis.apply_exclusions(trials, policy)
+    phase = design.compared_phase
+    data = _phase_trials(kept, phase)
     out = pathlib.Path(out_dir)
     figures, tables = out / "figures", out / "tables"
     for folder in (out, figures, tables):
@@ -771,45 +842,105 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
     per_trial_link = _relative_link(per_trial_page, out) if per_trial_page is not None else None
     protocols = [str(p) for p in _levels(trials["protocol"])] if "protocol" in trials else []
     title = title or f"Study report: {', '.join(protocols) or 'study'}"
+    within = design.kind == "within-subjects"
 
-    table5s = [_table5(data, value) for value in values]
-    statistics_tables = [_statistics(data, value) for value in values]
     files: dict[pathlib.Path, typing.Union[bytes, str]] = {}  # written together at the end, the page last
-    files[tables / "summary.csv"] = pandas.DataFrame([row for t in table5s for row in _summary_rows(t)]).to_csv(index=False)
-    files[tables / "statistics.csv"] = pandas.concat(statistics_tables, ignore_index=True).to_csv(index=False)
-
-    figure_html = []
+    summary_html, question_html, means_html, learning_html = [], [], [], []
+    all_means, all_questions, all_ratios = [], [], []
     for value in values:
-        stem = f"learning_{_file_name(value)}"
-        figure = learning_figure(data, value, phase=None)
-        _save_figure(figure, figures, stem, files)
-        width_px = round(figure.get_figwidth() * 96)  # the SVG's size in CSS px (its pt x 96/72)
         display = _display(value)
-        figure_html.append(
-            f"<figure><img src=\"figures/{_e(stem)}.svg\" width=\"{width_px}\" "
-            f"alt=\"Learning curves of {_e(display.label)}\"><figcaption>{_e(display.label.capitalize())} over "
-            "repetitions (counted from 1): per condition the mean over subjects with its 95 % t interval (each "
-            "subject's trials averaged first; n = subjects). Left: all characters; then each character. One y "
-            "axis for all panels.</figcaption></figure>\n")
-
+        means = _phase_means(kept, value, design)
+        all_means.append(means)
+        stem = f"phase_{_file_name(value)}"
+        figure = phase_figure(means, value, design)
+        _save_figure(figure, figures, stem, files)
+        width_px = round(figure.get_figwidth() * 96)
+        summary_html.append(
+            f"<figure><img src=\"figures/{_e(stem)}.svg\" width=\"{width_px}\" alt=\"{_e(display.label.capitalize())} "
+            f"by phase and {'group' if not within else 'condition'}\"><figcaption>{_e(display.label.capitalize())} by "
+            "phase: the mean over subjects with its 95 % t interval (each subject's analysed trials averaged first; "
+            "n = subjects).</figcaption></figure>\n")
+        questions = design_analysis.design_questions(trials, value, design, policy=policy, ddf=ddf,
+                                                     scale=display.scale, display_unit=display.unit)
+        all_questions.append(questions)
+        question_html.append(_questions_html(questions, value))
+        means_html.append(_phase_means_html(means, value, design))
+        ratios = design_analysis.retention_ratios(trials, value, design, policy)
+        if not ratios.empty:
+            all_ratios.append(ratios.assign(value=value, unit=_si_unit(value)))
+            means_html.append(_retention_html(ratios))
+        if phase is not None and not data.empty:
+            stem = f"learning_{_file_name(value)}"
+            figure = learning_figure(data, value, phase=None)
+            _save_figure(figure, figures, stem, files)
+            width_px = round(figure.get_figwidth() * 96)
+            learning_html.append(
+                f"<figure><img src=\"figures/{_e(stem)}.svg\" width=\"{width_px}\" "
+                f"alt=\"Learning curves of {_e(display.label)}\"><figcaption>{_e(display.label.capitalize())} over "
+                f"repetitions in {_e(phase)} (counted as the tables count them): per condition the mean over subjects "
+                "with its 95 % t interval (n = subjects). Left: all characters; then each character. One y axis for "
+                "all panels.</figcaption></figure>\n")
+    files[tables / "phase_means.csv"] = pandas.concat(all_means, ignore_index=True).to_csv(index=False)
+    files[tables / "questions.csv"] = pandas.concat(all_questions, ignore_index=True).to_csv(index=False)
+    files[tables / "exclusions.csv"] = exclusions.to_csv(index=False)
+    if all_ratios:
+        files[tables / "retention.csv"] = pandas.concat(all_ratios, ignore_index=True).to_csv(index=False)
+    table5_html = ""
+    statistics_html = ""
+    if within and not data.empty:
+        table5s = [_table5(data, value) for value in values]
+        statistics_tables = [_statistics(data, value) for value in values]
+        files[tables / "summary.csv"] = pandas.DataFrame(
+            [row for t in table5s for row in _summary_rows(t)]).to_csv(index=False)
+        files[tables / "statistics.csv"] = pandas.concat(statistics_tables, ignore_index=True).to_csv(index=False)
+        table5_html = ("<section id=\"table5\">\n<h2>Means per subject and character (after Table 5)</h2>\n"
+                       "<div class=\"table5s\">\n" + "".join(_table5_html(t, phase) for t in table5s) + "</div>\n"
+                       "</section>\n")
+        statistics_html = ("<section id=\"statistics\">\n<h2>Paired statistics of the " + _e(phase) + " trials</h2>\n"
+                           "<p class=\"files\">Over subjects: each subject's trials are averaged per condition. n "
+                           "counts subjects (trials for the mixed model); effects are in the unit shown, d_z and g_av "
+                           "standardized; p two-sided, not adjusted (the adjusted ones are above).</p>\n"
+                           + "".join(_statistics_html(t, v, phase) for t, v in zip(statistics_tables, values))
+                           + "</section>\n")
+    transfer = design_analysis.transfer_baseline(kept, design)
     page = ["<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
             "<meta name=\"viewport\" content=\"width=device-width\">"
             f"<title>{_e(title)}</title>\n{_STYLE}</head><body>\n",
-            _header_html(trials, data, title, phase, per_trial_link),
-            "<section id=\"table5\">\n<h2>Means per subject and character (after Table 5)</h2>\n"
-            "<div class=\"table5s\">\n", *(_table5_html(t, phase) for t in table5s), "</div>\n</section>\n",
-            "<section id=\"statistics\">\n<h2>Statistics</h2>\n<p class=\"files\">Over subjects: each subject's "
-            "trials are averaged per condition. n counts subjects (trials for the mixed model); effects are in the "
-            "unit shown, d_z and g_av standardized; p two-sided.</p>\n",
-            *(_statistics_html(t, v, phase) for t, v in zip(statistics_tables, values)), "</section>\n",
-            "<section id=\"learning\">\n<h2>Learning curves</h2>\n", *figure_html, "</section>\n",
-            _learning_html(trials, values, tables, files) if "phase" in trials else "",
+            _header_html(trials, title, design, per_trial_link, tables, files),
+            _exclusions_html(exclusions, policy),
+            "<section id=\"summary\">\n<h2>Summary</h2>\n<div class=\"figures\">\n", *summary_html, "</div>\n</section>\n",
+            "<section id=\"questions\">\n<h2>The design's questions</h2>\n<p class=\"files\">",
+            _e(_methods_sentence(design, ddf)), "</p>\n", *question_html, "</section>\n",
+            "<section id=\"phases\">\n<h2>Means by phase</h2>\n", *means_html,
+            f"<p>{_e(transfer)}</p>\n" if transfer else "", "</section>\n",
+            table5_html, statistics_html,
+            "<section id=\"learning\">\n<h2>Learning curves</h2>\n", *learning_html, "</section>\n"
+            if learning_html else "",
             _subjects_html(trials, values, per_trial_link),
             "</body></html>\n"]
     index = out / "index.html"
     files[index] = "".join(page)
     _write_together(files)
     return index
+
+
+def _methods_sentence(design: "design_analysis.StudyDesign", ddf: str) -> str:
+    control = design.control or "the first condition"
+    parts = [f"Each {'group' if design.kind == 'between-subjects' else 'condition'} is compared with the control, "
+             f"{control}."]
+    if design.compared_phase:
+        parts.append(f"In {design.compared_phase}: a linear mixed model with subjects and characters crossed as "
+                     f"random intercepts, fitted by REML with R's lme4, t tests with {ddf} df (lmerTest); a singular "
+                     "or non-converged fit is reported without a test.")
+    if design.kind == "between-subjects" and design.pre_test and design.after_training:
+        parts.append(f"After training ({', '.join(design.after_training)}): an ANCOVA on subject means, the phase's "
+                     "mean adjusted for the pre-test mean (statsmodels OLS).")
+    if design.kind == "within-subjects":
+        parts.append("Paired t-tests on subject means.")
+    parts.append("p values are Holm-adjusted within each outcome (all its comparisons against the control); g is "
+                 "Hedges' g with an approximate 95 % interval; the difference and its 95 % interval are in the "
+                 "unit of the table.")
+    return " ".join(parts)
 
 
 # ---------------------------------------------------------------------------------------------- command line
@@ -830,6 +961,13 @@ def main(argv: typing.Optional[typing.Sequence[str]] = None) -> int:
     parser.add_argument("--title", help="the page's title (default: 'Study report: ' and the protocols)")
     parser.add_argument("--per-trial-page", metavar="FILE",
                         help="the page of `calligraphy report DIR --out FILE`, linked for each trial's figures")
+    parser.add_argument("--reference", metavar="NAME",
+                        help="the control group or condition (default: the one without guidance, 'vision' mode)")
+    parser.add_argument("--analyse", metavar="END_REASONS", default="completed",
+                        help="the trials analysed, by how they ended: a comma-separated list of end reasons, or "
+                             "'all' (default: completed)")
+    parser.add_argument("--ddf", choices=("Satterthwaite", "Kenward-Roger"), default="Satterthwaite",
+                        help="the mixed models' degrees of freedom (default: Satterthwaite)")
     arguments = parser.parse_args(argv)
     if arguments.title is not None and not arguments.title.strip():
         parser.error("argument --title: is empty")
@@ -837,6 +975,10 @@ def main(argv: typing.Optional[typing.Sequence[str]] = None) -> int:
         parser.error(f"argument --per-trial-page: {arguments.per_trial_page} is not a file")
     if not arguments.out.strip():
         parser.error("argument --out: is empty; name the report folder")
+    reasons = [r.strip() for r in arguments.analyse.split(",")]
+    if not all(reasons):
+        parser.error(f"argument --analyse: {arguments.analyse!r} has an empty end reason")
+    keep = None if reasons == ["all"] else tuple(reasons)
     if os.path.exists(arguments.out) and not os.path.isdir(arguments.out):
         parser.error(f"argument --out: {arguments.out} exists and is not a folder")
 
@@ -845,7 +987,8 @@ def main(argv: typing.Optional[typing.Sequence[str]] = None) -> int:
     started = time.monotonic()
     try:
         study = _study.load(arguments.folders)
-        index = write_report(study, arguments.out, title=arguments.title, per_trial_page=arguments.per_trial_page)
+        index = write_report(study, arguments.out, title=arguments.title, per_trial_page=arguments.per_trial_page,
+                             reference=arguments.reference, keep_end_reasons=keep, ddf=arguments.ddf)
     except (DataError, ValueError, TypeError, OSError, ImportError) as error:
         print(f"calligraphy.study_report: {error}", file=sys.stderr)
         return 1

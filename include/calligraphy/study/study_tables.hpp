@@ -30,8 +30,12 @@ struct TrialRow {
   std::size_t item = 0;        ///< 0-based index of `characters` in the phase's list
   std::size_t repetition = 0;  ///< 0-based repetition of the item in the condition
   std::string writer;          ///< "simulated" or "human"
-  std::string end_reason;      ///< how the trial ended (TrialEnd as text)
-  std::string start_utc;       ///< ISO 8601
+  /// A simulated writer's profile ("novice", "skilled", "foreign") and learning model ("none", "two-state");
+  /// "" for a person.
+  std::string writer_profile;
+  std::string writer_learning;
+  std::string end_reason;  ///< how the trial ended (TrialEnd as text)
+  std::string start_utc;   ///< ISO 8601
   bool completed_in_order = false;
   std::size_t strokes_total = 0;
   std::size_t strokes_written = 0;

@@ -1,0 +1,511 @@
+"""The questions a study's design asks, answered the way a reviewer in motor learning expects.
+
+``trials`` is the tidy table of ``calligraphy.study.load`` (one row per trial: ``subject``, ``phase``,
+``condition``, ``group``, ``characters``, ``session_number``, ``block``, ``end_reason``, ``mode`` and the
+outcomes in SI units). The functions here:
+
+* ``study_design`` reads the design from the table: between-subjects (each subject trains in one ``group``)
+  or within-subjects (every subject writes every condition), the phases in protocol order, the control;
+* ``ordered`` makes phase (protocol order), condition and group (control first) ordered categories;
+* ``apply_exclusions`` applies a stated exclusion policy (by default only trials that ended ``completed``
+  are analysed) and counts what it left out, per phase and group;
+* ``design_questions`` answers the design's questions for one outcome, each guided condition against the
+  control, Holm-adjusted within the outcome's family:
+
+  - during training (or, within subjects, in the conditions' phase): a linear mixed model with subjects and
+    items (the characters) crossed, ``outcome ~ condition + (1 | subject) + (1 | item)``, fitted by R's lme4
+    with Satterthwaite degrees of freedom from lmerTest (``calligraphy.mixed_models``); a fit that is
+    singular or did not converge is reported as such and its tests are not given as tests;
+  - after training (post-test, retention, transfer), between subjects: an ANCOVA on subject means,
+    ``post ~ pre + group`` (ordinary least squares, statsmodels; the same model as R's ``lm``), i.e. the
+    groups compared adjusted for the pre-test (Vickers & Altman 2001, BMJ 323:1123; Van Breukelen 2006);
+  - within subjects: paired t-tests on subject means (``calligraphy.statistics.paired_comparison``).
+
+  Holm (1979) adjusts the p values within a family: one outcome's comparisons against the control.
+  Effect sizes: the difference (adjusted for the pre-test in an ANCOVA) with its 95 % interval in the
+  outcome's unit, and Hedges' g with an approximate 95 % interval (Hedges & Olkin 1985, eq. 5.14).
+* ``retention_ratios`` gives each group's share of its gain kept at retention, only where the gain is
+  reliable; ``transfer_baseline`` says whether a transfer phase has a pre-test on the same characters.
+
+Sources: docs/references.md. pandas, SciPy and statsmodels are imported when a function is called; R (Debian
+r-base-core r-cran-lme4 r-cran-lmertest r-cran-pbkrtest) when a mixed model is fitted.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import typing
+
+import numpy as np
+
+from . import mixed_models, statistics
+
+if typing.TYPE_CHECKING:  # pragma: no cover
+    import pandas
+
+__all__ = [
+    "ExclusionPolicy",
+    "QUESTION_COLUMNS",
+    "StudyDesign",
+    "apa_sentence",
+    "apply_exclusions",
+    "design_questions",
+    "ordered",
+    "retention_ratios",
+    "study_design",
+    "transfer_baseline",
+]
+
+# Phases that test what training left, in the order a protocol runs them (docs/experiments.md, "Phases").
+PRE_TEST = "pre-test"
+AFTER_TRAINING = ("post-test", "retention", "transfer")
+# Modes that give no guidance: a condition in one of them is the natural control.
+_UNGUIDED_MODES = ("vision",)
+
+QUESTION_COLUMNS = ["value", "unit", "family", "question", "phase", "comparison", "model", "test", "n", "df",
+                    "statistic", "p", "p_holm", "estimate", "ci95_low", "ci95_high", "g", "g_ci95_low",
+                    "g_ci95_high", "apa", "note"]
+
+
+def _pandas():
+    return statistics._pandas()
+
+
+def _unit(value: str) -> str:
+    return "m" if value.endswith("_m") else "s" if value.endswith("_s") else ""
+
+
+# ---------------------------------------------------------------------------------------------- design
+
+
+@dataclasses.dataclass(frozen=True)
+class StudyDesign:
+    """What a study's table says about its design.
+
+    ``kind``: 'between-subjects' (each subject in one ``group``), 'within-subjects' (every subject writes
+    every condition of a phase) or 'single-condition'. ``phases``: in protocol order (by session, then
+    block). ``conditions``: the compared conditions, the control first (the groups for a between-subjects
+    design). ``control``: the reference every other condition is compared with. ``compared_phase``: where
+    the conditions differ ('training', or the within-subjects phase). ``n_per_condition``: subjects per
+    group (between) or subjects writing each condition (within). ``pre_test``: the pre-test phase or None.
+    ``after_training``: the post-test, retention and transfer phases present, in order."""
+
+    kind: str
+    phases: tuple[str, ...]
+    conditions: tuple[str, ...]
+    control: typing.Optional[str]
+    compared_phase: typing.Optional[str]
+    n_per_condition: dict[str, int]
+    pre_test: typing.Optional[str]
+    after_training: tuple[str, ...]
+
+    def sentence(self) -> str:
+        """The design in one sentence, for a report's method section."""
+        counts = ", ".join(f"{c} {'(control) ' if c == self.control else ''}n = {self.n_per_condition.get(c, 0)}"
+                           for c in self.conditions)
+        phases = ", ".join(self.phases)
+        if self.kind == "between-subjects":
+            return (f"Between-subjects: {len(self.conditions)} groups trained in {self.compared_phase} "
+                    f"({counts} subjects); phases in order: {phases}.")
+        if self.kind == "within-subjects":
+            return (f"Within-subjects: every subject wrote {len(self.conditions)} conditions in "
+                    f"{self.compared_phase} ({counts} subjects); phases in order: {phases}.")
+        return f"One condition ({counts} subjects); phases in order: {phases}."
+
+
+def _first_appearance(trials: pandas.DataFrame, column: str) -> list[str]:
+    """The values of ``column`` in the order the protocol first runs them: by session, block and trial, and
+    among trials at the same place by subject (groups are assigned by subject number in turn)."""
+    keys = [c for c in ("session_number", "block", "trial", "subject") if c in trials.columns]
+    rows = trials.sort_values(keys, kind="stable") if keys else trials
+    return [str(v) for v in dict.fromkeys(rows[column].astype(str)) if str(v) != ""]
+
+
+def _phase_order(trials: pandas.DataFrame) -> list[str]:
+    return _first_appearance(trials, "phase")
+
+
+def _condition_order(trials: pandas.DataFrame, column: str, reference: typing.Optional[str]) -> list[str]:
+    """The levels of ``column`` with the control first: ``reference`` when given, else the one condition in an
+    unguided mode ('vision'), else the first in protocol order."""
+    levels = _first_appearance(trials, column)
+    present = trials[trials[column].astype(str) != ""]
+    if reference is None and "mode" in trials.columns:
+        mode_of = present.assign(key=present[column].astype(str)).groupby("key", observed=True)["mode"].agg(
+            lambda modes: "/".join(sorted({str(m) for m in modes})))
+        unguided = [level for level in levels if mode_of.get(level, "") in _UNGUIDED_MODES]
+        if len(unguided) == 1:
+            reference = unguided[0]
+    if reference is None:
+        return levels
+    if reference not in levels:
+        raise ValueError(f"study_design: reference {reference!r} is not a {column} of the study; present: "
+                         f"{', '.join(repr(level) for level in levels)}")
+    return [reference] + [level for level in levels if level != reference]
+
+
+def study_design(trials: pandas.DataFrame, reference: typing.Optional[str] = None) -> StudyDesign:
+    """Reads the design from ``trials`` (see the module's docstring). ``reference`` names the control (a group
+    or condition); by default the one condition without guidance ('vision' mode), else the first in protocol
+    order. Raises TypeError for a table that is not a DataFrame; ValueError naming a missing column or a
+    reference not present."""
+    statistics._check_frame(trials, "study_design")
+    statistics._require_columns(trials, ["subject", "phase", "condition"], "study_design")
+    phases = _phase_order(trials)
+    per_phase = trials.groupby(trials["phase"].astype(str))["condition"].nunique()
+    varied = [p for p in phases if per_phase.get(p, 0) >= 2]
+    compared_phase = varied[0] if varied else None
+    data = trials[trials["phase"].astype(str) == compared_phase] if compared_phase else trials
+    groups = data["group"].astype(str) if "group" in data.columns else None
+    if groups is not None and (groups != "").any() and (data.groupby("subject", observed=True)["condition"].nunique()
+                                                        == 1).all():
+        data = data[groups != ""]
+        conditions = _condition_order(data, "group", reference)
+        counts = data.groupby(data["group"].astype(str))["subject"].nunique()
+        kind = "between-subjects"
+    else:
+        conditions = _condition_order(data, "condition", reference)
+        counts = data.groupby(data["condition"].astype(str))["subject"].nunique()
+        kind = "within-subjects" if len(conditions) >= 2 else "single-condition"
+    return StudyDesign(kind=kind, phases=tuple(phases), conditions=tuple(conditions),
+                       control=conditions[0] if conditions else None, compared_phase=compared_phase,
+                       n_per_condition={c: int(counts.get(c, 0)) for c in conditions},
+                       pre_test=PRE_TEST if PRE_TEST in phases else None,
+                       after_training=tuple(p for p in AFTER_TRAINING if p in phases))
+
+
+def ordered(trials: pandas.DataFrame, design: StudyDesign) -> pandas.DataFrame:
+    """``trials`` with ``phase`` an ordered categorical in protocol order and ``condition`` and ``group``
+    categoricals with the control first (other conditions of other phases after them), so that sorting,
+    grouping, patsy and plots follow the design instead of the alphabet."""
+    pandas = _pandas()
+    out = trials.copy()
+    out["phase"] = pandas.Categorical(out["phase"].astype(str), categories=list(design.phases), ordered=True)
+    for column in ("condition", "group"):
+        if column not in out.columns:
+            continue
+        values = out[column].astype(str)
+        rest = [v for v in dict.fromkeys(values) if v not in design.conditions]
+        out[column] = pandas.Categorical(values, categories=list(design.conditions) + rest)
+    return out
+
+
+# ---------------------------------------------------------------------------------------------- exclusions
+
+
+@dataclasses.dataclass(frozen=True)
+class ExclusionPolicy:
+    """Which trials enter the outcome analysis. ``keep_end_reasons``: the trials whose ``end_reason`` is one of
+    these (default: only 'completed': a trial the writer gave up, that reached its time limit or was
+    interrupted measured only part of the character, so its deviation and time are not comparable); None
+    keeps every trial. A trial without a value of the outcome is left out of that outcome either way."""
+
+    keep_end_reasons: typing.Optional[tuple[str, ...]] = ("completed",)
+
+    def sentence(self) -> str:
+        if self.keep_end_reasons is None:
+            return "Every trial is analysed, however it ended."
+        return (f"Only trials that ended {' or '.join(repr(r) for r in self.keep_end_reasons)} are analysed; the "
+                "others are counted below, by phase and group.")
+
+
+def apply_exclusions(trials: pandas.DataFrame, policy: ExclusionPolicy = ExclusionPolicy()
+                     ) -> tuple[pandas.DataFrame, pandas.DataFrame]:
+    """The trials the policy keeps, and a count table: one row per phase and group (or condition) with
+    ``trials``, ``kept`` and one column per end reason excluded. Raises ValueError naming a missing
+    ``end_reason`` column when the policy needs it."""
+    pandas = _pandas()
+    if policy.keep_end_reasons is None:
+        kept = trials
+    else:
+        statistics._require_columns(trials, ["end_reason"], "apply_exclusions")
+        kept = trials[trials["end_reason"].astype(str).isin(policy.keep_end_reasons)]
+    by = ["phase", "group"] if "group" in trials.columns and (trials["group"].astype(str) != "").any() else [
+        "phase", "condition"]
+    reasons = trials["end_reason"].astype(str) if "end_reason" in trials.columns else pandas.Series(
+        "", index=trials.index)
+    excluded = pandas.Series(~trials.index.isin(kept.index), index=trials.index)
+    rows = []
+    for key, rows_of in trials.groupby(by, observed=True, sort=True):
+        dropped = excluded.loc[rows_of.index]
+        counts = {"trials": len(rows_of), "kept": int((~dropped).sum())}
+        for reason, n in reasons.loc[rows_of.index][dropped].value_counts().items():
+            counts[f"excluded_{reason}"] = int(n)
+        rows.append({by[0]: key[0], by[1]: key[1], **counts})
+    table = pandas.DataFrame(rows).fillna(0)
+    for column in table.columns:
+        if column.startswith("excluded_") or column in ("trials", "kept"):
+            table[column] = table[column].astype(int)
+    return kept, table
+
+
+# ---------------------------------------------------------------------------------------------- numbers
+
+
+def apa_sentence(df: float, t: float, p: float, g: float = math.nan, ci: tuple[float, float] = (math.nan, math.nan),
+                 unit: str = "", scale: float = 1.0, decimals: int = 2) -> str:
+    """An APA-style result (APA Publication Manual, 7th ed., 6.43-6.46): 't(7.8) = 2.43, p = .042, g = 1.39,
+    95 % CI [0.01, 0.55] mm'; df with one decimal unless whole, p without its leading zero ('< .001' below),
+    the interval of the difference multiplied by ``scale`` into ``unit``."""
+    if not (math.isfinite(df) and math.isfinite(t)):
+        return ""
+    df_text = f"{df:.0f}" if abs(df - round(df)) < 0.05 else f"{df:.1f}"
+    p_text = "p < .001" if p < 0.001 else f"p = {p:.3f}".replace("0.", ".", 1)
+    parts = [f"t({df_text}) = {t:.2f}", p_text]
+    if math.isfinite(g):
+        parts.append(f"g = {g:.2f}")
+    if all(math.isfinite(x) for x in ci):
+        parts.append(f"95 % CI [{ci[0] * scale:.{decimals}f}, {ci[1] * scale:.{decimals}f}]{' ' + unit if unit else ''}")
+    return ", ".join(parts)
+
+
+def _holm(p_values: list[float]) -> list[float]:
+    """Holm's (1979) step-down adjusted p values; NaN entries stay NaN and are not counted."""
+    from statsmodels.stats.multitest import multipletests
+
+    finite = [k for k, p in enumerate(p_values) if isinstance(p, float) and math.isfinite(p)]
+    adjusted = [math.nan] * len(p_values)
+    if finite:
+        _, corrected, _, _ = multipletests([p_values[k] for k in finite], alpha=statistics.ALPHA, method="holm")
+        for k, value in zip(finite, corrected):
+            adjusted[k] = float(value)
+    return adjusted
+
+
+def _hedges_g(difference: float, sd_a: float, sd_b: float, n_a: int, n_b: int) -> tuple[float, float, float]:
+    """Hedges' g = difference / pooled SD x J, J = 1 - 3 / (4 (n_a + n_b) - 9) (Hedges 1981), with the normal
+    approximation of its 95 % interval, SE = sqrt((n_a + n_b) / (n_a n_b) + g^2 / (2 (n_a + n_b))) (Hedges &
+    Olkin 1985, eq. 5.14)."""
+    if n_a < 2 or n_b < 2:
+        return math.nan, math.nan, math.nan
+    pooled = math.sqrt(((n_a - 1) * sd_a ** 2 + (n_b - 1) * sd_b ** 2) / (n_a + n_b - 2))
+    if not pooled > 0:
+        return math.nan, math.nan, math.nan
+    g = difference / pooled * (1.0 - 3.0 / (4.0 * (n_a + n_b) - 9.0))
+    se = math.sqrt((n_a + n_b) / (n_a * n_b) + g * g / (2.0 * (n_a + n_b)))
+    return g, g - 1.959963984540054 * se, g + 1.959963984540054 * se
+
+
+def _row(**entries: typing.Any) -> dict[str, typing.Any]:
+    row: dict[str, typing.Any] = dict.fromkeys(QUESTION_COLUMNS, math.nan)
+    row.update(note="", apa="", model="", test="")
+    row.update(entries)
+    return row
+
+
+def _subject_means(data: pandas.DataFrame, value: str) -> pandas.Series:
+    return data.groupby(data["subject"].astype(str), observed=True)[value].mean().dropna()
+
+
+# ---------------------------------------------------------------------------------------------- training
+
+
+def _training_rows(data: pandas.DataFrame, value: str, design: StudyDesign, ddf: str) -> list[dict]:
+    """The crossed mixed model of the compared phase: each condition against the control."""
+    pandas = _pandas()
+    column = "group" if design.kind == "between-subjects" else "condition"
+    phase = design.compared_phase
+    rows_of = data[(data["phase"].astype(str) == phase) & data[value].notna()]
+    model = f"{value} ~ {column} + (1 | subject) + (1 | item)"
+    base = {"value": value, "unit": _unit(value), "family": value, "phase": phase, "model": model,
+            "question": f"{phase}: {column} against the control (mixed model, subjects x items crossed)"}
+    n_items = rows_of["characters"].nunique()
+    formula = "outcome ~ factor + (1 | subject)" + (" + (1 | item)" if n_items >= 2 else "")
+    frame = pandas.DataFrame({"outcome": rows_of[value].to_numpy(dtype=float),
+                              "factor": rows_of[column].astype(str).to_numpy(),
+                              "subject": rows_of["subject"].astype(str).to_numpy(),
+                              "item": rows_of["characters"].astype(str).to_numpy()})
+    levels = [c for c in design.conditions if c in set(frame["factor"])]
+    if len(levels) < 2 or design.control not in levels or frame["subject"].nunique() < 3:
+        return [_row(**base, comparison=f"{column}", note="not computed: fewer than 2 conditions with values "
+                     "or fewer than 3 subjects")]
+    try:
+        fit = mixed_models.lmer(frame, formula, {"factor": levels}, ddf=ddf)
+    except mixed_models.RUnavailable as error:
+        return [_row(**base, comparison=column, note=f"not computed: {error}")]
+    except RuntimeError as error:
+        return [_row(**base, comparison=column, note=f"not computed: {error}")]
+    variances = ", ".join(f"{'item' if k == 'item' else k.lower()} {v:.3g}" for k, v in fit.variances.items())
+    rows = []
+    for effect in fit.fixed.itertuples(index=False):
+        if effect.factor != "factor":
+            continue
+        trusted = fit.trustworthy
+        problems = []
+        if fit.singular:
+            problems.append("singular fit (a variance estimated at 0: " + variances + " [" + _unit(value) + "^2])")
+        if not fit.converged:
+            problems.append("did not converge: " + fit.messages)
+        counts = frame.groupby("factor")["subject"].nunique()
+        g, g_low, g_high = math.nan, math.nan, math.nan
+        if design.kind == "between-subjects":
+            means = frame.groupby(["factor", "subject"])["outcome"].mean()
+            a, b = means.loc[effect.level], means.loc[design.control]
+            g, g_low, g_high = _hedges_g(float(effect.estimate), float(a.std(ddof=1)), float(b.std(ddof=1)),
+                                         len(a), len(b))
+        rows.append(_row(
+            **base, comparison=f"{effect.level} - {design.control}",
+            test=f"linear mixed model (REML), lme4 {fit.ddf} t ({fit.versions})",
+            n=int(counts.get(effect.level, 0) + counts.get(design.control, 0)),
+            df=float(effect.df) if trusted else math.nan, statistic=float(effect.t) if trusted else math.nan,
+            p=float(effect.p) if trusted else math.nan, estimate=float(effect.estimate),
+            ci95_low=float(effect.ci95_low) if trusted else math.nan,
+            ci95_high=float(effect.ci95_high) if trusted else math.nan, g=g, g_ci95_low=g_low, g_ci95_high=g_high,
+            note=("not tested: " + "; ".join(problems)) if problems else f"variances: {variances} [" + _unit(value) + "^2]"))
+    return rows
+
+
+# ---------------------------------------------------------------------------------------------- after training
+
+
+def _ancova_rows(data: pandas.DataFrame, value: str, design: StudyDesign, phase: str) -> list[dict]:
+    """``post ~ pre + group`` on subject means: each group against the control, adjusted for the pre-test."""
+    import statsmodels.formula.api as smf
+
+    pandas = _pandas()
+    base = {"value": value, "unit": _unit(value), "family": value, "phase": phase,
+            "model": f"{phase} mean ~ pre-test mean + group (subject means, OLS)",
+            "question": f"{phase}: group against the control, adjusted for the pre-test (ANCOVA)"}
+    groups = data.groupby(data["subject"].astype(str), observed=True)["group"].agg(lambda g: str(g.iloc[0]))
+    pre = _subject_means(data[data["phase"].astype(str) == design.pre_test], value)
+    post = _subject_means(data[data["phase"].astype(str) == phase], value)
+    subjects = sorted(set(pre.index) & set(post.index))
+    frame = pandas.DataFrame({"post": post.reindex(subjects).to_numpy(), "pre": pre.reindex(subjects).to_numpy(),
+                              "group": groups.reindex(subjects).to_numpy()})
+    levels = [g for g in design.conditions if g in set(frame["group"])]
+    if design.control not in levels or len(levels) < 2 or len(frame) < len(levels) + 2:
+        return [_row(**base, comparison="group", note=f"not computed: {len(frame)} subjects with a pre-test and a "
+                     f"{phase} value in {len(levels)} group(s)")]
+    frame["group"] = pandas.Categorical(frame["group"], categories=levels)
+    fit = smf.ols("post ~ pre + C(group, Treatment(reference=0))", data=frame).fit()
+    interval = fit.conf_int(alpha=statistics.ALPHA)
+    rows = []
+    for k, level in enumerate(levels[1:], start=1):
+        name = f"C(group, Treatment(reference=0))[T.{level}]"
+        a = frame.loc[frame["group"] == level, "post"]
+        b = frame.loc[frame["group"] == design.control, "post"]
+        estimate = float(fit.params[name])
+        g, g_low, g_high = _hedges_g(estimate, float(a.std(ddof=1)), float(b.std(ddof=1)), len(a), len(b))
+        rows.append(_row(**base, comparison=f"{level} - {design.control}",
+                         test="ANCOVA (OLS on subject means, statsmodels); t of the adjusted difference",
+                         n=len(a) + len(b), df=float(fit.df_resid), statistic=float(fit.tvalues[name]),
+                         p=float(fit.pvalues[name]), estimate=estimate, ci95_low=float(interval.loc[name, 0]),
+                         ci95_high=float(interval.loc[name, 1]), g=g, g_ci95_low=g_low, g_ci95_high=g_high,
+                         note=f"pre-test slope {float(fit.params['pre']):.3g}; n per group "
+                              + ", ".join(f"{lv} {int((frame['group'] == lv).sum())}" for lv in levels)))
+    return rows
+
+
+def _paired_rows(data: pandas.DataFrame, value: str, design: StudyDesign) -> list[dict]:
+    phase = design.compared_phase
+    rows_of = data[data["phase"].astype(str) == phase]
+    base = {"value": value, "unit": _unit(value), "family": value, "phase": phase,
+            "model": "subject means per condition", "question": f"{phase}: condition against the control "
+            "(paired, within subjects)"}
+    rows = []
+    for level in design.conditions[1:]:
+        try:
+            c = statistics.paired_comparison(rows_of, value, level, design.control, by="condition")
+        except ValueError as error:
+            rows.append(_row(**base, comparison=f"{level} - {design.control}", note=f"not computed: {error}"))
+            continue
+        g_se = math.sqrt(1.0 / c.n_subjects + c.g_av ** 2 / (2.0 * c.n_subjects)) if math.isfinite(c.g_av) else math.nan
+        rows.append(_row(**base, comparison=f"{level} - {design.control}",
+                         test="paired t-test on subject means (scipy.stats.ttest_rel); Hedges' g_av",
+                         n=c.n_subjects, df=float(c.df), statistic=float(c.t), p=float(c.p),
+                         estimate=float(c.mean_difference), ci95_low=float(c.ci95_low), ci95_high=float(c.ci95_high),
+                         g=float(c.g_av), g_ci95_low=c.g_av - 1.96 * g_se, g_ci95_high=c.g_av + 1.96 * g_se))
+    return rows
+
+
+def design_questions(trials: pandas.DataFrame, value: str, design: typing.Optional[StudyDesign] = None, *,
+                     policy: ExclusionPolicy = ExclusionPolicy(), ddf: str = "Satterthwaite",
+                     scale: float = 1.0, display_unit: str = "") -> pandas.DataFrame:
+    """The design's questions for the outcome ``value`` (see the module's docstring), one row per comparison
+    against the control, with the columns of ``QUESTION_COLUMNS``: ``value``, ``unit`` (the SI unit of
+    ``estimate`` and its interval), ``family`` (Holm's family: the outcome), ``question``, ``phase``,
+    ``comparison`` ('level - control'), ``model``, ``test``, ``n`` (subjects), ``df``, ``statistic`` (t),
+    ``p`` (two-sided), ``p_holm`` (Holm-adjusted within the family), ``estimate`` with ``ci95_low`` and
+    ``ci95_high`` [SI unit], ``g`` with ``g_ci95_low``/``g_ci95_high`` (Hedges' g; g_av within subjects),
+    ``apa`` (the sentence, its interval multiplied by ``scale`` into ``display_unit``) and ``note`` (why a
+    row is not computed or not tested, or the variances). A model that is singular or did not converge keeps
+    its estimate but has no df, statistic, p or interval: it is no test.
+
+    ``trials`` are filtered by ``policy`` first. Raises ValueError naming a missing column."""
+    pandas = _pandas()
+    statistics._check_frame(trials, "design_questions")
+    statistics._require_columns(trials, ["subject", "phase", "condition", "characters", value], "design_questions")
+    trials = statistics._finite_outcome(trials, value, "design_questions")
+    design = design or study_design(trials)
+    data, _ = apply_exclusions(trials, policy)
+    rows: list[dict] = []
+    if design.kind != "single-condition" and design.compared_phase is not None:
+        rows += _training_rows(data, value, design, ddf)
+    if design.kind == "between-subjects" and design.pre_test is not None:
+        for phase in design.after_training:
+            rows += _ancova_rows(data, value, design, phase)
+    elif design.kind == "within-subjects":
+        rows += _paired_rows(data, value, design)
+    adjusted = _holm([float(r["p"]) for r in rows])
+    for row, p_holm in zip(rows, adjusted):
+        row["p_holm"] = p_holm
+        row["apa"] = apa_sentence(row["df"], row["statistic"], row["p"], row["g"],
+                                  (row["ci95_low"], row["ci95_high"]), display_unit, scale)
+    return pandas.DataFrame(rows, columns=QUESTION_COLUMNS)
+
+
+# ---------------------------------------------------------------------------------------------- retention, transfer
+
+
+def retention_ratios(trials: pandas.DataFrame, value: str, design: StudyDesign,
+                     policy: ExclusionPolicy = ExclusionPolicy()) -> pandas.DataFrame:
+    """Per group, the share of its gain kept at retention, mean(pre - retention) / mean(pre - post) over the
+    group's subjects (errors and times: lower is better), computed only when the group's mean gain is
+    reliably above 0 (its 95 % t interval excludes 0): a ratio of a gain near 0 is unbounded. Columns:
+    ``group``, ``n``, ``gain`` with ``gain_ci95_low``/``gain_ci95_high`` [SI unit], ``retention_ratio``
+    (NaN when not computed) and ``note``. Empty without pre-test, post-test and retention phases."""
+    pandas = _pandas()
+    if design.pre_test is None or not {"post-test", "retention"} <= set(design.after_training):
+        return pandas.DataFrame(columns=["group", "n", "gain", "gain_ci95_low", "gain_ci95_high",
+                                         "retention_ratio", "note"])
+    data, _ = apply_exclusions(statistics._finite_outcome(trials, value, "retention_ratios"), policy)
+    table = statistics.learning(data, value, design.pre_test, "post-test", retention="retention")
+    column = "group" if "group" in table.columns else None
+    rows = []
+    for group in (design.conditions if column else ("all",)):
+        subset = table[table[column].astype(str) == group] if column else table
+        both = subset.dropna(subset=["pre", "post", "retention"])
+        gains = (both["pre"] - both["post"]).to_numpy(dtype=float)
+        n = len(gains)
+        low, high = statistics._t_interval(np.array([gains.mean() if n else math.nan]),
+                                           np.array([gains.std(ddof=1) if n > 1 else math.nan]), np.array([n]))
+        ratio, note = math.nan, ""
+        if n < 2:
+            note = "not computed: fewer than 2 subjects with pre-test, post-test and retention"
+        elif not low[0] > 0:
+            note = (f"not computed: the group's gain is not reliably above 0 (95 % CI [{low[0]:.3g}, "
+                    f"{high[0]:.3g}])")
+        else:
+            ratio = float((both["pre"] - both["retention"]).mean() / gains.mean())
+        rows.append({"group": group, "n": n, "gain": float(gains.mean()) if n else math.nan,
+                     "gain_ci95_low": float(low[0]), "gain_ci95_high": float(high[0]), "retention_ratio": ratio,
+                     "note": note})
+    return pandas.DataFrame(rows)
+
+
+def transfer_baseline(trials: pandas.DataFrame, design: StudyDesign) -> str:
+    """Why a transfer gain can or cannot be computed: a gain needs the transfer characters written in the
+    pre-test too (the same characters before and after), else it measures the characters' difficulty."""
+    if "transfer" not in design.after_training or design.pre_test is None:
+        return ""
+    pre = set(trials.loc[trials["phase"].astype(str) == design.pre_test, "characters"].astype(str))
+    transfer = set(trials.loc[trials["phase"].astype(str) == "transfer", "characters"].astype(str))
+    shared = sorted(pre & transfer)
+    if shared:
+        return (f"The transfer characters {' '.join(shared)} were also pre-tested: their gain is a gain on the "
+                "same characters.")
+    return ("No transfer gain is computed: the transfer characters (" + " ".join(sorted(transfer)) + ") were not "
+            "written in the pre-test, so a difference from the pre-test would be the characters' difficulty, not "
+            "transfer. The transfer row compares the groups' transfer performance adjusted for their pre-test skill "
+            "on the trained characters. For a transfer gain, add the transfer characters to the pre-test.")

@@ -1,0 +1,68 @@
+# Fits one linear mixed model with lme4 (Bates, Maechler, Bolker & Walker 2015, J Stat Softw 67(1)) and tests
+# its fixed effects with lmerTest's small-sample degrees of freedom (Kuznetsova, Brockhoff & Christensen 2017,
+# J Stat Softw 82(13)): Satterthwaite (1946) or Kenward & Roger (1997, through pbkrtest).
+# Run by calligraphy.mixed_models (python), never by hand:
+#   Rscript lmer_fit.R FOLDER FORMULA DDF
+# FOLDER holds data.csv (UTF-8) and levels.csv (factor, level: each factor's levels in order, reference
+# first); the script writes fixed.csv, random.csv and fit.csv (key, value) there.
+# Exit status 0 when the results were written (a fit that did not converge or is singular says so in
+# fit.csv), 1 with a message on standard error otherwise.
+arguments <- commandArgs(trailingOnly = TRUE)
+if (length(arguments) != 3) stop("usage: Rscript lmer_fit.R FOLDER FORMULA DDF")
+folder <- arguments[1]
+model_formula <- stats::as.formula(arguments[2])
+ddf <- arguments[3]
+
+suppressPackageStartupMessages({
+  library(lme4)
+  library(lmerTest)
+})
+
+data <- utils::read.csv(file.path(folder, "data.csv"), encoding = "UTF-8", stringsAsFactors = FALSE,
+                        check.names = FALSE)
+levels_table <- utils::read.csv(file.path(folder, "levels.csv"), encoding = "UTF-8", stringsAsFactors = FALSE,
+                                colClasses = "character")
+for (factor_name in unique(levels_table$factor)) {
+  ordered_levels <- levels_table$level[levels_table$factor == factor_name]
+  # An unordered factor gets R's default treatment coding, the first level (the control) the reference: each
+  # other level's coefficient, named factor followed by level, is its difference from the control.
+  data[[factor_name]] <- factor(as.character(data[[factor_name]]), levels = ordered_levels)
+}
+
+messages <- character(0)
+fit <- withCallingHandlers(
+  lmerTest::lmer(model_formula, data = data, REML = TRUE),
+  warning = function(w) {
+    messages <<- c(messages, conditionMessage(w))
+    invokeRestart("muffleWarning")
+  },
+  message = function(m) {
+    messages <<- c(messages, trimws(conditionMessage(m)))
+    invokeRestart("muffleMessage")
+  })
+# lme4 files its "boundary (singular) fit" note with the convergence messages; singularity is reported apart.
+convergence <- fit@optinfo$conv$lme4$messages
+convergence <- convergence[!grepl("singular", convergence)]
+messages <- unique(c(messages, convergence))
+singular <- lme4::isSingular(fit)
+
+coefficients <- summary(fit, ddf = ddf)$coefficients
+df <- coefficients[, "df"]
+half_width <- stats::qt(0.975, df) * coefficients[, "Std. Error"]
+fixed <- data.frame(term = rownames(coefficients), estimate = coefficients[, "Estimate"],
+                    std_error = coefficients[, "Std. Error"], df = df, t = coefficients[, "t value"],
+                    p = coefficients[, "Pr(>|t|)"], ci95_low = coefficients[, "Estimate"] - half_width,
+                    ci95_high = coefficients[, "Estimate"] + half_width)
+utils::write.csv(fixed, file.path(folder, "fixed.csv"), row.names = FALSE, fileEncoding = "UTF-8")
+
+components <- as.data.frame(lme4::VarCorr(fit))
+random <- data.frame(group = components$grp, variance = components$vcov)
+utils::write.csv(random, file.path(folder, "random.csv"), row.names = FALSE, fileEncoding = "UTF-8")
+
+info <- data.frame(
+  key = c("n_observations", "singular", "converged", "messages", "ddf", "lme4_version", "lmertest_version",
+          "r_version"),
+  value = c(stats::nobs(fit), singular, length(convergence) == 0, paste(messages, collapse = "; "), ddf,
+            as.character(utils::packageVersion("lme4")), as.character(utils::packageVersion("lmerTest")),
+            paste(R.version$major, R.version$minor, sep = ".")))
+utils::write.csv(info, file.path(folder, "fit.csv"), row.names = FALSE, fileEncoding = "UTF-8")
