@@ -5,16 +5,16 @@ Runs examples/protocols/retention-transfer.json, or another protocol of that des
 guidance-schedules.json (day 1: unguided pre-test, training in one group per training condition, unguided
 post-test; day 2: unguided retention and transfer tests) with learning simulated
 subjects (`--writer-learning two-state`: the two-state memory of Smith, Ghazizadeh & Shadmehr 2006, which
-learns from the error the guidance leaves it; docs/writer.md), then prints each group's learning,
-retention and transfer (calligraphy.statistics.learning) and the groups compared (group_comparison: Welch
-t-test, Hedges' g). Optionally writes the study report. The subjects are a model, not people: what it
+learns from the error the guidance leaves it; docs/writer.md), then prints the design's questions
+(calligraphy.design_analysis: during training a mixed model with subjects and characters crossed and
+Satterthwaite df from R's lmerTest; after training each group against the unguided control adjusted for the
+pre-test (ANCOVA); Holm within each outcome; Hedges' g) and the guarded share of the gain kept. Optionally writes the study report. The subjects are a model, not people: what it
 prints is what the model predicts (docs/experiments.md, "Retention and transfer in simulation").
 
     python3 examples/analysis/retention_transfer.py --cli build/bin/calligraphy --per-group 10 [--protocol FILE] [--out DIR] [--report DIR]
 """
 
 import argparse
-import itertools
 import json
 import pathlib
 import subprocess
@@ -22,8 +22,8 @@ import sys
 import tempfile
 import time
 
-import calligraphy.statistics as statistics
 import calligraphy.study
+from calligraphy import design_analysis
 
 PROTOCOL = pathlib.Path(__file__).resolve().parents[1] / "protocols" / "retention-transfer.json"
 
@@ -64,17 +64,24 @@ def main() -> int:
         print(f"\n{skill.replace('_', ' ')} (0 to 1) at the start of each phase's trials, mean over trials and subjects")
         print(skills[["pre-test", "training", "post-test", "retention", "transfer"]]
               .to_string(float_format=lambda x: f"{x:.3f}"))
+    design = design_analysis.study_design(study.trials)
+    print(f"\n{design.sentence()}")
     for value in ("mean_deviation_m", "pen_down_time_s"):
-        table = statistics.learning(study.trials, value, "pre-test", "post-test", retention="retention",
-                                    transfer="transfer")
-        columns = ["pre", "post", "retention", "transfer", "gain", "retention_ratio", "transfer_gain"]
-        print(f"\n{value}: means over each group's subjects")
-        print(table.groupby("group")[columns].mean().to_string(float_format=lambda x: f"{x:.4g}"))
-        for a, b in itertools.combinations(sorted(table.group.unique()), 2):
-            for quantity in ("gain", "retention", "transfer"):
-                c = statistics.group_comparison(table, quantity, a, b)
-                print(f"  {quantity:9} {a} - {b}: {c.mean_difference:+.4g} [{c.ci95_low:+.4g}, {c.ci95_high:+.4g}], "
-                      f"t({c.df:.1f}) = {c.t:.2f}, p = {c.p:.3g}, g = {c.g:+.2f} (n = {c.n_a}, {c.n_b})")
+        millimetres = value.endswith("_m")
+        questions = design_analysis.design_questions(study.trials, value, design, scale=1e3 if millimetres else 1.0,
+                                                     display_unit="mm" if millimetres else "s")
+        print(f"\n{value}: each group against {design.control} (training: crossed mixed model; after: ANCOVA on "
+              "the pre-test; p Holm-adjusted)")
+        for row in questions.itertuples():
+            result = row.apa or row.note
+            print(f"  {row.phase:9} {row.comparison:22} {result}" + (f", p(Holm) = {row.p_holm:.3g}"
+                                                                     if row.apa else ""))
+        ratios = design_analysis.retention_ratios(study.trials, value, design)
+        for ratio in ratios.itertuples():
+            print(f"  share of the gain kept at retention, {ratio.group}: "
+                  f"{ratio.retention_ratio:.2f}" if ratio.retention_ratio == ratio.retention_ratio else
+                  f"  share of the gain kept at retention, {ratio.group}: {ratio.note}")
+    print(f"\n{design_analysis.transfer_baseline(study.trials, design)}")
     if arguments.report:
         from calligraphy import study_report
         print(study_report.write_report(study, arguments.report))

@@ -215,7 +215,7 @@ def test_mixed_model_records_convergence_warnings_instead_of_raising():
 def test_learning_gives_exact_gain_and_retention():
     # Per-subject phase means built to known values; labels as a pre/post/retention protocol names them.
     design = {"S1": (2.0e-3, 1.0e-3, 1.5e-3, 1.8e-3), "S2": (1.6e-3, 0.8e-3, 0.8e-3, 1.2e-3),
-              "S3": (1.0e-3, 1.0e-3, 1.2e-3, 0.9e-3)}
+              "S3": (1.0e-3, 1.0e-3, 1.2e-3, 0.9e-3), "S4": (1.0e-3, 0.99e-3, 1.3e-3, 1.0e-3)}
     labels = ("baseline", "after", "one week", "new characters")
     rows = []
     for subject, means in design.items():
@@ -234,6 +234,7 @@ def test_learning_gives_exact_gain_and_retention():
     assert table.loc["S1", "retention_ratio"] == pytest.approx(0.5)  # half of 1 mm gain kept
     assert table.loc["S2", "retention_ratio"] == pytest.approx(1.0)  # all kept
     assert np.isnan(table.loc["S3", "retention_ratio"])  # no gain: no ratio
+    assert np.isnan(table.loc["S4", "retention_ratio"])  # a 1 % gain: a ratio of -30 would say nothing
     assert table.attrs["phases"]["retention"] == "one week"
     scores = statistics.learning(pandas.DataFrame(rows), VALUE, pre="baseline", post="after",
                                  lower_is_better=False).set_index("subject")

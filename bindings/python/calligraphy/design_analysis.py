@@ -13,7 +13,8 @@ outcomes in SI units). The functions here:
   control, Holm-adjusted within the outcome's family:
 
   - during training (or, within subjects, in the conditions' phase): a linear mixed model with subjects and
-    items (the characters) crossed, ``outcome ~ condition + (1 | subject) + (1 | item)``, fitted by R's lme4
+    items (the characters) crossed, ``outcome ~ condition + (1 | subject) + (1 | item)`` (within subjects
+    ``(1 + condition | subject)``, a random slope per subject), fitted by R's lme4
     with Satterthwaite degrees of freedom from lmerTest (``calligraphy.mixed_models``); a fit that is
     singular or did not converge is reported as such and its tests are not given as tests;
   - after training (post-test, retention, transfer), between subjects: an ANCOVA on subject means,
@@ -307,11 +308,15 @@ def _training_rows(data: pandas.DataFrame, value: str, design: StudyDesign, ddf:
     column = "group" if design.kind == "between-subjects" else "condition"
     phase = design.compared_phase
     rows_of = data[(data["phase"].astype(str) == phase) & data[value].notna()]
-    model = f"{value} ~ {column} + (1 | subject) + (1 | item)"
+    # Within subjects the condition's effect varies by subject: a random slope keeps its test at the subjects'
+    # level (Barr, Levy, Scheepers & Tily 2013, J Mem Lang 68:255); without it the df are the trials'.
+    within = design.kind == "within-subjects"
+    subject_term = "(1 + factor | subject)" if within else "(1 | subject)"
+    model = f"{value} ~ {column} + {subject_term.replace('factor', column)} + (1 | item)"
     base = {"value": value, "unit": _unit(value), "family": value, "phase": phase, "model": model,
             "question": f"{phase}: {column} against the control (mixed model, subjects x items crossed)"}
     n_items = rows_of["characters"].nunique()
-    formula = "outcome ~ factor + (1 | subject)" + (" + (1 | item)" if n_items >= 2 else "")
+    formula = f"outcome ~ factor + {subject_term}" + (" + (1 | item)" if n_items >= 2 else "")
     frame = pandas.DataFrame({"outcome": rows_of[value].to_numpy(dtype=float),
                               "factor": rows_of[column].astype(str).to_numpy(),
                               "subject": rows_of["subject"].astype(str).to_numpy(),
@@ -326,7 +331,7 @@ def _training_rows(data: pandas.DataFrame, value: str, design: StudyDesign, ddf:
         return [_row(**base, comparison=column, note=f"not computed: {error}")]
     except RuntimeError as error:
         return [_row(**base, comparison=column, note=f"not computed: {error}")]
-    variances = ", ".join(f"{'item' if k == 'item' else k.lower()} {v:.3g}" for k, v in fit.variances.items())
+    variances = ", ".join(f"{k.lower().replace('factor', column + ' ')} {v:.3g}" for k, v in fit.variances.items())
     rows = []
     for effect in fit.fixed.itertuples(index=False):
         if effect.factor != "factor":
@@ -334,7 +339,7 @@ def _training_rows(data: pandas.DataFrame, value: str, design: StudyDesign, ddf:
         trusted = fit.trustworthy
         problems = []
         if fit.singular:
-            problems.append("singular fit (a variance estimated at 0: " + variances + " [" + _unit(value) + "^2])")
+            problems.append("singular fit (a variance estimated at 0 or a correlation at +-1: " + variances + " [" + _unit(value) + "^2])")
         if not fit.converged:
             problems.append("did not converge: " + fit.messages)
         counts = frame.groupby("factor")["subject"].nunique()

@@ -56,7 +56,14 @@ fixed <- data.frame(term = rownames(coefficients), estimate = coefficients[, "Es
 utils::write.csv(fixed, file.path(folder, "fixed.csv"), row.names = FALSE, fileEncoding = "UTF-8")
 
 components <- as.data.frame(lme4::VarCorr(fit))
-random <- data.frame(group = components$grp, variance = components$vcov)
+# One row per variance or covariance: "subject" for a random intercept alone, "subject (Intercept)" and
+# "subject factorB" with random slopes, "subject cov (Intercept) factorB" for their covariance.
+component_name <- ifelse(is.na(components$var1), components$grp,
+                         ifelse(is.na(components$var2),
+                                ifelse(table(components$grp)[components$grp] > 1,
+                                       paste(components$grp, components$var1), components$grp),
+                                paste(components$grp, "cov", components$var1, components$var2)))
+random <- data.frame(group = component_name, variance = components$vcov)
 utils::write.csv(random, file.path(folder, "random.csv"), row.names = FALSE, fileEncoding = "UTF-8")
 
 info <- data.frame(

@@ -13,7 +13,6 @@ with a large-sample Wald test.
 from __future__ import annotations
 
 import dataclasses
-import math
 import os
 import pathlib
 import shutil

@@ -588,8 +588,8 @@ def mixed_model(trials: pandas.DataFrame, value: str, fixed: str = "condition", 
 
 
 def learning(trials: pandas.DataFrame, value: str, pre: str, post: str, retention: str | None = None,
-             transfer: str | None = None, by: str = "phase", *, lower_is_better: bool = True
-             ) -> pandas.DataFrame:
+             transfer: str | None = None, by: str = "phase", *, lower_is_better: bool = True,
+             min_relative_gain: float = 0.05) -> pandas.DataFrame:
     """Each subject's learning between named phases, as motor learning studies measure it (Schmidt & Lee
     2019): performance before practice, right after it, after a delay (retention) and on a new task
     (transfer).
@@ -604,8 +604,11 @@ def learning(trials: pandas.DataFrame, value: str, pre: str, post: str, retentio
     the subject has no value there]; ``gain`` = pre - post, since the outcomes here are errors and times,
     lower being better (post - pre with ``lower_is_better=False``); ``relative_gain`` = gain / pre (NaN
     when pre is 0); with retention, ``retention_ratio`` = (pre - retention) / (pre - post): 1 when all of
-    the gain was kept, 0 when all was lost, below 0 when worse than before practice (NaN when the gain
-    is 0); with transfer, ``transfer_gain`` = pre - transfer (sign as for gain). ``.attrs['phases']``
+    the gain was kept, 0 when all was lost, below 0 when worse than before practice; NaN unless the subject
+    gained at least ``min_relative_gain`` of its pre-test (a ratio over a gain near 0 is unbounded: a
+    subject who gained 1 % and lost 30 % would read -30); with transfer, ``transfer_gain`` = pre - transfer
+    (sign as for gain), which measures transfer only when the transfer characters were also pre-tested
+    (``calligraphy.design_analysis.transfer_baseline``). ``.attrs['phases']``
     maps pre/post/retention/transfer to the phase names.
 
     Raises TypeError when ``trials`` is not a DataFrame or ``value`` is not numeric; ValueError naming a
@@ -640,7 +643,8 @@ def learning(trials: pandas.DataFrame, value: str, pre: str, post: str, retentio
     table["relative_gain"] = table["gain"] / table["pre"].where(table["pre"] != 0)
     if retention is not None:
         gained = table["pre"] - table["post"]
-        table["retention_ratio"] = (table["pre"] - table["retention"]) / gained.where(gained != 0)
+        reliable = (gained > 0) & (gained >= min_relative_gain * table["pre"].abs())
+        table["retention_ratio"] = (table["pre"] - table["retention"]) / gained.where(reliable)
     if transfer is not None:
         table["transfer_gain"] = sign * (table["pre"] - table["transfer"])
     table.attrs["phases"] = dict(phases)

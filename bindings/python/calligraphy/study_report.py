@@ -32,7 +32,6 @@ import dataclasses
 import errno
 import fcntl
 import html
-import itertools
 import io
 import math
 import os
@@ -815,7 +814,7 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
     ImportError without pandas, matplotlib, SciPy or statsmodels. Without R (lme4, lmerTest) the mixed
     models' rows say "not computed" and name the packages.
     """
-    from . import design_analysis, statistics
+    from . import design_analysis
 
     pandas = _pandas()
     trials = getattr(study, "trials", None)
