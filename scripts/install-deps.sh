@@ -12,6 +12,7 @@ packages=(
   libusb-1.0-0-dev libhidapi-dev     # Phantom backend (optional at configure time)
   pkg-config lib2geom-dev            # lib2geom column of `bench nearest` (optional at configure time)
   pybind11-dev python3-dev python3-numpy python3-pytest
+  python3-setuptools python3-wheel python3-venv python3-pip     # the Python wheel and its install into a venv
   python3-pandas python3-matplotlib python3-tqdm python3-mypy   # Python tables, figures, stubgen
   python3-scipy python3-statsmodels   # calligraphy.statistics: tests, intervals, mixed models, power
   python3-dask python3-distributed    # parallel experiments from Python

@@ -1,0 +1,73 @@
+"""The wheel installs into a virtual environment and imports from there: packs the build's package
+(bindings/python/make_wheel.py), makes a venv of the build interpreter with its site packages (numpy,
+pandas from Debian), `pip install --no-index` the wheel, and in the venv's interpreter imports calligraphy
+from the venv, runs a trial of 十, and finds the R script of the mixed models beside the package. Then checks
+that a venv without numpy refuses the wheel naming numpy, offline. Exit 0 or 1 (77: venv or pip missing).
+
+    python3 check_wheel.py --build BUILD --version 0.1.0
+"""
+
+import argparse
+import pathlib
+import subprocess
+import sys
+import tempfile
+
+SOURCE = pathlib.Path(__file__).resolve().parents[2]
+
+
+def run(command, **options):
+    return subprocess.run([str(c) for c in command], capture_output=True, text=True, timeout=600, **options)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--build", required=True)
+    parser.add_argument("--version", required=True)
+    arguments = parser.parse_args()
+    try:
+        import ensurepip  # noqa: F401
+        import venv  # noqa: F401
+    except ImportError:
+        print("SKIP: this interpreter has no venv/ensurepip (Debian: apt-get install python3-venv)")
+        return 77
+    with tempfile.TemporaryDirectory(prefix="calligraphy-wheel-test-") as folder:
+        folder = pathlib.Path(folder)
+        made = run([sys.executable, SOURCE / "bindings/python/make_wheel.py", "--package",
+                    pathlib.Path(arguments.build) / "python/calligraphy", "--version", arguments.version,
+                    "--out", folder / "dist"])
+        if made.returncode != 0:
+            print(made.stdout, made.stderr)
+            return 1
+        wheel = pathlib.Path(made.stdout.strip().splitlines()[-1])
+        tag = f"cp{sys.version_info.major}{sys.version_info.minor}"
+        assert wheel.name == f"calligraphy-{arguments.version}-{tag}-{tag}-linux_x86_64.whl", wheel.name
+
+        env = folder / "venv"
+        created = run([sys.executable, "-m", "venv", "--system-site-packages", env])
+        assert created.returncode == 0, created.stderr
+        installed = run([env / "bin/pip", "install", "--no-index", "--quiet", wheel])
+        assert installed.returncode == 0, installed.stderr
+        probe = run([env / "bin/python", "-c",
+                     "import calligraphy, calligraphy.mixed_models as m, pathlib, sys; "
+                     "print(pathlib.Path(calligraphy.__file__).resolve()); print(m._SCRIPT.is_file()); "
+                     "r = calligraphy.run_trial('十'); print(r.metrics['strokes_accepted'], r.metrics['strokes_total'])"],
+                    cwd=folder)
+        assert probe.returncode == 0, probe.stderr
+        location, script, strokes = probe.stdout.split("\n")[:3]
+        assert pathlib.Path(location).is_relative_to(env.resolve()), location  # the venv's, not Debian's copy
+        assert script == "True" and strokes == "2 2", probe.stdout
+        uninstalled = run([env / "bin/pip", "uninstall", "--yes", "--quiet", "calligraphy"])
+        assert uninstalled.returncode == 0, uninstalled.stderr
+
+        bare = folder / "bare"
+        assert run([sys.executable, "-m", "venv", bare]).returncode == 0
+        refused = run([bare / "bin/pip", "install", "--no-index", wheel])
+        assert refused.returncode != 0 and "numpy" in refused.stdout + refused.stderr, refused.stderr
+    print(f"wheel {wheel.name}: installed into a venv, imported from it, a trial of 十 written; a venv without "
+          "numpy refuses it naming numpy")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
