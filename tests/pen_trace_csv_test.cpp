@@ -1,6 +1,7 @@
 #include "calligraphy/report/pen_trace_csv.hpp"
 
 #include <unistd.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <catch2/catch.hpp>
@@ -219,4 +220,53 @@ TEST_CASE("A file is read in blocks as the same text parsed whole", "[pen_trace_
   const TemporaryFile bad_file(bad);
   CHECK_THROWS_WITH(read_pen_trace_csv(bad_file.path, test_placement()),
                     Catch::Contains("trace.csv:120002:") && Catch::Contains("not a number"));
+}
+
+namespace {
+
+// `text` gzip-compressed into `path` by zlib's own file interface (as `gzip` writes it).
+void write_gzip(const std::filesystem::path& path, const std::string& text) {
+  gzFile out = gzopen(path.c_str(), "wb");
+  REQUIRE(out != nullptr);
+  REQUIRE(gzwrite(out, text.data(), static_cast<unsigned>(text.size())) == static_cast<int>(text.size()));
+  REQUIRE(gzclose(out) == Z_OK);
+}
+
+}  // namespace
+
+TEST_CASE("A gzip-compressed trace reads as its text, and a damaged one is named", "[pen_trace_csv]") {
+  std::string text = "t,x,y,pen\n";
+  for (int i = 0; i < 20000; ++i) {
+    text += std::to_string(i * 0.001) + "," + std::to_string(0.0001 * (i % 97)) + ",0.002," +
+            (i % 500 < 400 ? "1" : "0") + "\n";
+  }
+  const TemporaryFile plain(text);
+  const TemporaryFile compressed("", "trace.csv.gz");
+  write_gzip(compressed.path, text);
+  const auto expected = read_pen_trace_csv(plain.path, test_placement());
+  const auto read = read_pen_trace_csv(compressed.path, test_placement());
+  REQUIRE(read.size() == expected.size());
+  REQUIRE(read.size() == 20000);
+  for (std::size_t i = 0; i < read.size(); ++i) {
+    CHECK(read[i].time_s == expected[i].time_s);
+    CHECK(read[i].position_m == expected[i].position_m);
+    CHECK(read[i].pen_down == expected[i].pen_down);
+  }
+  // Cut short: the end of the stream is missing.
+  const auto size = std::filesystem::file_size(compressed.path);
+  std::filesystem::resize_file(compressed.path, size / 2);
+  CHECK_THROWS_WITH(read_pen_trace_csv(compressed.path, test_placement()),
+                    Catch::Contains("trace.csv.gz") && Catch::Contains("gzip"));
+  // A gzip header followed by what is not deflate.
+  const TemporaryFile damaged(
+      std::string("\x1f\x8b\x08\x00\x00\x00\x00\x00\x00\x03", 10) + "not deflate data", "damaged.csv.gz");
+  CHECK_THROWS_WITH(read_pen_trace_csv(damaged.path, test_placement()), Catch::Contains("damaged.csv.gz"));
+  // A small file whose text is over the limit is refused as it decompresses, not read whole.
+  const TemporaryFile bomb("", "bomb.csv.gz");
+  write_gzip(bomb.path, "t,x,y,pen\n" + std::string(4 << 20, '#') + "\n");
+  REQUIRE(std::filesystem::file_size(bomb.path) < 64 * 1024);
+  PenTraceCsvOptions small;
+  small.max_file_bytes = 1 << 20;
+  CHECK_THROWS_WITH(read_pen_trace_csv(bomb.path, test_placement(), small),
+                    Catch::Contains("bomb.csv.gz") && Catch::Contains("the limit"));
 }
