@@ -29,8 +29,8 @@ namespace {
 struct ReportCommand {
   std::vector<std::string> folders;
   std::string out;
-  std::string csv;  // a folder for trials.csv and strokes.csv
-  int jobs = 0;     // 0: one a core
+  std::string csv;        // a folder for trials.csv and strokes.csv
+  std::int64_t jobs = 0;  // 0: every core
 };
 
 // Each session's page, built as its trials are read and written whole (atomically) before the next
@@ -179,10 +179,8 @@ void add_report_command(CLI::App& root, Commands& commands) {
   add_output_folder(*app, "--csv", command->csv,
                     "an existing folder for the tidy tables trials.csv and strokes.csv (docs/experiments.md)",
                     "not written");
-  app->add_option("--jobs", command->jobs, "threads reading sessions for the pages; 0: one a core")
-      ->type_name("N")
-      ->check(CLI::Range(0, 256))
-      ->capture_default_str();
+  add_integer(*app, "--jobs", command->jobs, "N", "threads reading sessions for the pages", 1, 256,
+              "every core");
 }
 
 }  // namespace calligraphy::cli

@@ -415,7 +415,7 @@ void add_session_commands(CLI::App& root, Commands& commands) {
              "auto: lock-step for a simulated writer, real time for a person; real-time paces a simulated "
              "writer by the wall clock");
   required(add_text(*app, "--out", run->out, "DIR",
-                    "the study folder: sessions go to DIR/SUBJECT/PROTOCOL-TIME/; a protocol of several "
+                    "the study folder: sessions go to DIR/SUBJECT/PROTOCOL-SUBJECT-TIME/; a protocol of several "
                     "sessions goes on with the subject's next one there"));
   add_flag(*app, "--ignore-delay", run->ignore_delay,
            "start a person's next session before the protocol's delay has passed, or after a session that "
