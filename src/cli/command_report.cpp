@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdio>
 #include <exception>
+#include <iterator>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -34,7 +35,8 @@ struct ReportCommand {
 };
 
 // Each session's page, built as its trials are read and written whole (atomically) before the next
-// session is read: memory holds one session's page and one trial per thread.
+// session is read: memory holds one session's page and one trial per thread. With `tables`, each
+// session's rows of the tidy tables are read from the same parse of its records.
 class PagesWriter {
  public:
   PagesWriter(const StudyReportSessions& sessions, const std::vector<fs::path>& page_files,
@@ -50,6 +52,7 @@ class PagesWriter {
   std::exception_ptr failure;
   std::atomic<std::size_t> trials{0};
   std::atomic<std::uintmax_t> bytes{0};
+  std::vector<StudyTables>* tables = nullptr;  // one per session, when the tables are wanted too
 
   void work() {
     while (!failed) {
@@ -58,7 +61,9 @@ class PagesWriter {
       try {
         const ReportedSession& session = study.sessions[i];
         SessionPageHtml page(session.shown, study.index.title, index_href_from_page);
-        read_session_trials(session, [&page](const ReportTrial& trial) { page.add(trial); });
+        read_session_trials(
+            session, [&page](const ReportTrial& trial) { page.add(trial); },
+            tables != nullptr ? &(*tables)[i] : nullptr);
         trials += page.trials();
         const std::string text = page.finish();
         bytes += text.size();
@@ -93,41 +98,17 @@ int run_report(const ReportCommand& command) {
   const auto elapsed = [&start] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
-  // The tables (records only) are read on a thread of their own beside the pages (records and traces):
-  // both are bound by the processor, and a study's are independent.
-  std::string tables_line;
-  std::exception_ptr tables_failure;
-  const auto write_tables = [&] {
-    try {
-      const StudyTables tables = read_study_tables(roots);
-      // Both tables or neither: a failure leaves the previous pair whole.
-      const std::string trials_text = trials_csv(tables), strokes_text = strokes_csv(tables);
-      const FileContent table_files[] = {{tables_folder / "trials.csv", trials_text},
-                                         {tables_folder / "strokes.csv", strokes_text}};
-      write_files_atomically(table_files);
-      char line[256];
-      std::snprintf(line, sizeof line, "trials.csv (%zu rows), strokes.csv (%zu rows), %.1f s",
-                    tables.trials.size(), tables.strokes.size(), elapsed());
-      tables_line = command.csv + ": " + line;
-    } catch (...) {
-      tables_failure = std::current_exception();
-    }
+  const auto write_tables = [&](const StudyTables& tables) {
+    // Both tables or neither: a failure leaves the previous pair whole.
+    const std::string trials_text = trials_csv(tables), strokes_text = strokes_csv(tables);
+    const FileContent table_files[] = {{tables_folder / "trials.csv", trials_text},
+                                       {tables_folder / "strokes.csv", strokes_text}};
+    write_files_atomically(table_files);
+    std::printf("%s: trials.csv (%zu rows), strokes.csv (%zu rows), %.1f s\n", command.csv.c_str(),
+                tables.trials.size(), tables.strokes.size(), elapsed());
   };
-  std::thread tables_thread;
-  if (!command.csv.empty()) {
-    if (command.out.empty()) {
-      write_tables();
-    } else {
-      tables_thread = std::thread(write_tables);
-    }
-  }
-  // Joins the tables' thread however this function is left.
-  struct Joined {
-    std::thread& thread;
-    ~Joined() {
-      if (thread.joinable()) thread.join();
-    }
-  } joined{tables_thread};
+  // The tables alone read the records only; with the pages they come from the pages' read of each record.
+  if (!command.csv.empty() && command.out.empty()) write_tables(read_study_tables(roots));
   if (!command.out.empty()) {
     const StudyReportSessions study = list_report_sessions(roots);
     const fs::path index_path(command.out);
@@ -142,6 +123,8 @@ int run_report(const ReportCommand& command) {
       files.output("--out", pages.back().string());
     }
     PagesWriter writer(study, pages, "../../" + index_name);
+    std::vector<StudyTables> session_tables(command.csv.empty() ? 0 : study.sessions.size());
+    if (!command.csv.empty()) writer.tables = &session_tables;
     const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
     const std::size_t threads =
         std::min<std::size_t>(command.jobs > 0 ? static_cast<std::size_t>(command.jobs) : cores,
@@ -151,15 +134,21 @@ int run_report(const ReportCommand& command) {
     writer.work();
     for (std::thread& thread : pool) thread.join();
     if (writer.failure) std::rethrow_exception(writer.failure);
+    if (!command.csv.empty()) {  // the sessions' rows in the sessions' order, as read_study_tables gives them
+      StudyTables tables;
+      for (StudyTables& rows : session_tables) {
+        std::move(rows.trials.begin(), rows.trials.end(), std::back_inserter(tables.trials));
+        std::move(rows.strokes.begin(), rows.strokes.end(), std::back_inserter(tables.strokes));
+        rows = StudyTables{};
+      }
+      write_tables(tables);
+    }
     const std::string index = study_index_html(study.index, index_name);
     write_file_atomically(index_path, index);
     std::printf("%s: %zu sessions, %zu trials, %zu pages in %s (%.1f MB), %.1f s\n", command.out.c_str(),
                 study.sessions.size(), writer.trials.load(), pages.size(), pages_folder.string().c_str(),
                 static_cast<double>(writer.bytes.load() + index.size()) / 1e6, elapsed());
   }
-  if (tables_thread.joinable()) tables_thread.join();
-  if (tables_failure) std::rethrow_exception(tables_failure);
-  if (!tables_line.empty()) std::printf("%s\n", tables_line.c_str());
   return 0;
 }
 

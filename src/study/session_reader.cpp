@@ -14,6 +14,7 @@
 #include "study/json_reader.hpp"
 #include "study/names.hpp"
 #include "study/saved_sessions.hpp"
+#include "study/trial_row.hpp"
 
 namespace calligraphy {
 namespace fs = std::filesystem;
@@ -57,6 +58,19 @@ double parse_field(std::string_view field, const std::string& source, std::size_
   return *value;
 }
 
+// A trace line's first six fields (t, x, y, z, fx, fy) as finite numbers, each followed by a comma, and
+// the line's 10 fields in all: true; false for anything else (the field-by-field reading names the fault).
+bool read_leading_numbers(std::string_view line, std::array<double, 6>& values) {
+  const char* at = line.data();
+  const char* const end = at + line.size();
+  for (double& value : values) {
+    const auto [next, error] = std::from_chars(at, end, value);
+    if (error != std::errc() || next == end || *next != ',' || !std::isfinite(value)) return false;
+    at = next + 1;
+  }
+  return std::count(at, end, ',') == 3;  // state, stroke, element
+}
+
 // The trial's trace (t,x,y,z,fx,fy,fz,state,stroke,element; gzip or plain CSV), streamed: times, positions,
 // pen down, in-plane force.
 void read_trace(const fs::path& file, double paper_z_m, ReportTrial& trial) {
@@ -74,6 +88,18 @@ void read_trace(const fs::path& file, double paper_z_m, ReportTrial& trial) {
       return;
     }
     if (line.empty()) return;
+    std::array<double, 6> values{};
+    if (read_leading_numbers(line, values)) {  // the common case, parsed where it stands
+      if (!trial.time_s.empty() && values[0] < trial.time_s.back()) {
+        throw DataError(source + ":" + std::to_string(line_number) + ": time goes backwards");
+      }
+      trial.time_s.push_back(values[0]);
+      trial.position_m.emplace_back(values[1], values[2]);
+      trial.pen_down.push_back(values[3] - paper_z_m <= contact_m);
+      trial.in_plane_force_n.push_back(Vec2(values[4], values[5]).norm());
+      return;
+    }
+    // Anything else field by field, so that an error names the field.
     std::array<std::string_view, 10> fields;
     std::size_t count = 0, start = 0;
     while (count < fields.size()) {
@@ -104,10 +130,19 @@ void read_trace(const fs::path& file, double paper_z_m, ReportTrial& trial) {
   if (line_number == 0) throw DataError(source + ":1: expected the header '" + std::string(kHeader) + "'");
 }
 
-ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifest, const PlannedTrial& plan) {
+ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifest, const PlannedTrial& plan,
+                       StudyTables* rows) {
   const std::string source = json_file.string();
   const json document = study_detail::read_trial_record(json_file);
   const study_detail::JsonView record(document, "", source);
+  if (rows != nullptr) {  // the tidy tables' rows from the same parse of the record
+    TrialRow row = study_detail::trial_row(document, source, manifest, plan, rows->strokes);
+    const std::string trace = record.object("files").string_or("csv", "");
+    if (trace.empty() || trace.find('/') != std::string::npos)
+      fail(source, "/files/csv", "expected a file name");
+    row.trace_file = json_file.parent_path() / trace;
+    rows->trials.push_back(std::move(row));
+  }
   ReportTrial trial;
   trial.subject = manifest.setup.subject.id;
   trial.session = manifest.session_id;
@@ -222,11 +257,11 @@ StudyReportSessions list_report_sessions(const std::vector<fs::path>& roots) {
   return found;
 }
 
-void read_session_trials(const ReportedSession& session,
-                         const std::function<void(const ReportTrial&)>& trial) {
+void read_session_trials(const ReportedSession& session, const std::function<void(const ReportTrial&)>& trial,
+                         StudyTables* rows) {
   for (const PlannedTrial& plan : session.manifest.plan) {
     if (!is_saved(session.folder, plan)) continue;  // not saved (yet): a running session can be reported
-    trial(read_trial(trial_record_file(session.folder, plan), session.manifest, plan));
+    trial(read_trial(trial_record_file(session.folder, plan), session.manifest, plan, rows));
   }
 }
 

@@ -11,6 +11,7 @@
 
 #include "calligraphy/report/study_report_html.hpp"
 #include "calligraphy/study/session_folder.hpp"
+#include "calligraphy/study/study_tables.hpp"
 
 namespace calligraphy {
 
@@ -37,9 +38,11 @@ struct StudyReportSessions {
 [[nodiscard]] StudyReportSessions list_report_sessions(const std::vector<std::filesystem::path>& roots);
 
 /// Calls `trial` with each saved trial of `session` in planned order, its record and trace read just
-/// before and dropped after. Throws DataError naming the file (and JSON pointer or trace line) for a
-/// damaged trial record or trace (a record naming a trace that cannot be read is at fault).
-void read_session_trials(const ReportedSession& session,
-                         const std::function<void(const ReportTrial&)>& trial);
+/// before and dropped after. With `rows`, also appends each trial's rows of the tidy tables to it, from the
+/// same read of its record: the rows `read_study_tables` gives for this session. Throws DataError naming
+/// the file (and JSON pointer or trace line) for a damaged trial record or trace (a record naming a trace
+/// that cannot be read is at fault).
+void read_session_trials(const ReportedSession& session, const std::function<void(const ReportTrial&)>& trial,
+                         StudyTables* rows = nullptr);
 
 }  // namespace calligraphy
