@@ -57,6 +57,13 @@ def test_the_tables_are_the_cli_tables_and_the_records(cli, study_folder):
     assert cli_trials["mean_deviation_m"].tolist() == pytest.approx(study.trials["mean_deviation_m"].tolist())
     cli_strokes = pd.read_csv(study_folder / "tables" / "strokes.csv")
     assert len(cli_strokes) == len(study.strokes)
+    # With the per-trial pages, the tables come from the pages' read of each record: the same bytes.
+    (study_folder / "with_pages").mkdir(exist_ok=True)
+    run = subprocess.run([cli, "report", "study", "--csv", "with_pages", "--out", "with_pages/trials.html"],
+                         cwd=study_folder, capture_output=True)
+    assert run.returncode == 0, run.stderr.decode()
+    for name in ("trials.csv", "strokes.csv"):
+        assert (study_folder / "with_pages" / name).read_bytes() == (study_folder / "tables" / name).read_bytes()
 
 
 def test_samples_are_read_on_demand_in_si_units(study_folder):
