@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/report/trial_report.hpp"
 
 using namespace calligraphy;
 
@@ -269,4 +271,31 @@ TEST_CASE("A gzip-compressed trace reads as its text, and a damaged one is named
   small.max_file_bytes = 1 << 20;
   CHECK_THROWS_WITH(read_pen_trace_csv(bomb.path, test_placement(), small),
                     Catch::Contains("bomb.csv.gz") && Catch::Contains("the limit"));
+}
+
+TEST_CASE("A trial's trace is written to a fixed precision in the fewest characters", "[pen_trace_csv]") {
+  std::vector<TrialSample> trace(3);
+  double t = 0.0;
+  for (TrialSample& s : trace) {  // time summed tick by tick, as a device clock drifts from k ms
+    s.time_s = t;
+    t += 0.001;
+  }
+  trace[1].position_m = Vec3(-0.011845, 0.0104650000000001, -0.0);
+  trace[1].force_n = Vec3(-0.00980123, 0.5, 1.0 / 3.0);
+  trace[2].position_m = Vec3(0.123456789, -1e-9, 0.02001);
+  trace[2].state = InteractionState::writing;
+  trace[2].stroke = 2;
+  const std::string csv = trial_csv(trace);
+  CHECK(csv ==
+        "t,x,y,z,fx,fy,fz,state,stroke,element\n"
+        "0,0,0,0,0,0,0,SS,0,0\n"
+        "0.001,-0.011845,0.010465,0,-0.0098,0.5,0.3333,SS,0,0\n"
+        "0.002,0.1234568,0,0.02001,0,0,0,WS,2,0\n");
+  // Read back, every value within half its last decimal of the one written.
+  const auto samples = parse_pen_trace_csv(csv, "trace", test_placement());
+  REQUIRE(samples.size() == trace.size());
+  for (std::size_t i = 0; i < trace.size(); ++i) {
+    CHECK(std::abs(samples[i].time_s - trace[i].time_s) <= 0.5e-6);
+    CHECK((samples[i].position_m - trace[i].position_m.head<2>()).cwiseAbs().maxCoeff() <= 0.5e-7);
+  }
 }
