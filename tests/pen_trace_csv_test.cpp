@@ -283,12 +283,13 @@ TEST_CASE("A trial's trace is written to a fixed precision in the fewest charact
   trace[1].position_m = Vec3(-0.011845, 0.0104650000000001, -0.0);
   trace[1].force_n = Vec3(-0.00980123, 0.5, 1.0 / 3.0);
   trace[2].position_m = Vec3(0.123456789, -1e-9, 0.02001);
+  trace[0].force_n = Vec3(0.0, 0.0, 1e300);  // a fault's value: round-trip text, the row within bounds
   trace[2].state = InteractionState::writing;
   trace[2].stroke = 2;
   const std::string csv = trial_csv(trace);
   CHECK(csv ==
         "t,x,y,z,fx,fy,fz,state,stroke,element\n"
-        "0,0,0,0,0,0,0,SS,0,0\n"
+        "0,0,0,0,0,0,1e+300,SS,0,0\n"
         "0.001,-0.011845,0.010465,0,-0.0098,0.5,0.3333,SS,0,0\n"
         "0.002,0.1234568,0,0.02001,0,0,0,WS,2,0\n");
   // Read back, every value within half its last decimal of the one written.

@@ -1,6 +1,7 @@
 #include "calligraphy/report/trial_report.hpp"
 
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -223,6 +224,9 @@ namespace {
 // precision in the fewest characters.
 char* fixed(char* out, char* end, double value, int decimals) {
   char* const start = out;
+  // Beyond 1e15 (no device reports such a value; a fault might) and NaN: the shortest round-trip text,
+  // so that a row stays within its buffer.
+  if (!(std::abs(value) < 1e15)) return std::to_chars(out, end, value).ptr;
   const auto [ptr, error] = std::to_chars(out, end, value, std::chars_format::fixed, decimals);
   if (error != std::errc{}) return out;
   out = ptr;
