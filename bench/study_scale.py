@@ -37,13 +37,15 @@ def protocol(trials: int) -> dict:
 
 
 def copy_subject(template: pathlib.Path, target: pathlib.Path, subject: str, factor: float) -> None:
-    """The template subject's folder as another subject's: ids replaced, deviations and times scaled."""
+    """The template subject's folder as another subject's: ids replaced (the subject's, and the session id,
+    which names the subject), deviations and times scaled."""
     for source in template.rglob("*"):
-        destination = target / source.relative_to(template)
+        destination = target / str(source.relative_to(template)).replace("-S01-", f"-{subject}-")
         if source.is_dir():
             destination.mkdir(parents=True, exist_ok=True)
         elif source.suffix == ".json":
             text = source.read_text(encoding="utf-8").replace('"S01"', json.dumps(subject))
+            text = text.replace("-S01-", f"-{subject}-")
             if source.parent.name == "trials":
                 record = json.loads(text)
                 for key in ("mean_deviation_mm", "max_deviation_mm", "rms_deviation_mm", "total_time_s"):

@@ -1,9 +1,11 @@
 #include "calligraphy/report/pen_trace_csv.hpp"
 
 #include <unistd.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -11,6 +13,7 @@
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/report/trial_report.hpp"
 
 using namespace calligraphy;
 
@@ -219,4 +222,81 @@ TEST_CASE("A file is read in blocks as the same text parsed whole", "[pen_trace_
   const TemporaryFile bad_file(bad);
   CHECK_THROWS_WITH(read_pen_trace_csv(bad_file.path, test_placement()),
                     Catch::Contains("trace.csv:120002:") && Catch::Contains("not a number"));
+}
+
+namespace {
+
+// `text` gzip-compressed into `path` by zlib's own file interface (as `gzip` writes it).
+void write_gzip(const std::filesystem::path& path, const std::string& text) {
+  gzFile out = gzopen(path.c_str(), "wb");
+  REQUIRE(out != nullptr);
+  REQUIRE(gzwrite(out, text.data(), static_cast<unsigned>(text.size())) == static_cast<int>(text.size()));
+  REQUIRE(gzclose(out) == Z_OK);
+}
+
+}  // namespace
+
+TEST_CASE("A gzip-compressed trace reads as its text, and a damaged one is named", "[pen_trace_csv]") {
+  std::string text = "t,x,y,pen\n";
+  for (int i = 0; i < 20000; ++i) {
+    text += std::to_string(i * 0.001) + "," + std::to_string(0.0001 * (i % 97)) + ",0.002," +
+            (i % 500 < 400 ? "1" : "0") + "\n";
+  }
+  const TemporaryFile plain(text);
+  const TemporaryFile compressed("", "trace.csv.gz");
+  write_gzip(compressed.path, text);
+  const auto expected = read_pen_trace_csv(plain.path, test_placement());
+  const auto read = read_pen_trace_csv(compressed.path, test_placement());
+  REQUIRE(read.size() == expected.size());
+  REQUIRE(read.size() == 20000);
+  for (std::size_t i = 0; i < read.size(); ++i) {
+    CHECK(read[i].time_s == expected[i].time_s);
+    CHECK(read[i].position_m == expected[i].position_m);
+    CHECK(read[i].pen_down == expected[i].pen_down);
+  }
+  // Cut short: the end of the stream is missing.
+  const auto size = std::filesystem::file_size(compressed.path);
+  std::filesystem::resize_file(compressed.path, size / 2);
+  CHECK_THROWS_WITH(read_pen_trace_csv(compressed.path, test_placement()),
+                    Catch::Contains("trace.csv.gz") && Catch::Contains("gzip"));
+  // A gzip header followed by what is not deflate.
+  const TemporaryFile damaged(
+      std::string("\x1f\x8b\x08\x00\x00\x00\x00\x00\x00\x03", 10) + "not deflate data", "damaged.csv.gz");
+  CHECK_THROWS_WITH(read_pen_trace_csv(damaged.path, test_placement()), Catch::Contains("damaged.csv.gz"));
+  // A small file whose text is over the limit is refused as it decompresses, not read whole.
+  const TemporaryFile bomb("", "bomb.csv.gz");
+  write_gzip(bomb.path, "t,x,y,pen\n" + std::string(4 << 20, '#') + "\n");
+  REQUIRE(std::filesystem::file_size(bomb.path) < 64 * 1024);
+  PenTraceCsvOptions small;
+  small.max_file_bytes = 1 << 20;
+  CHECK_THROWS_WITH(read_pen_trace_csv(bomb.path, test_placement(), small),
+                    Catch::Contains("bomb.csv.gz") && Catch::Contains("the limit"));
+}
+
+TEST_CASE("A trial's trace is written to a fixed precision in the fewest characters", "[pen_trace_csv]") {
+  std::vector<TrialSample> trace(3);
+  double t = 0.0;
+  for (TrialSample& s : trace) {  // time summed tick by tick, as a device clock drifts from k ms
+    s.time_s = t;
+    t += 0.001;
+  }
+  trace[1].position_m = Vec3(-0.011845, 0.0104650000000001, -0.0);
+  trace[1].force_n = Vec3(-0.00980123, 0.5, 1.0 / 3.0);
+  trace[2].position_m = Vec3(0.123456789, -1e-9, 0.02001);
+  trace[0].force_n = Vec3(0.0, 0.0, 1e300);  // a fault's value: round-trip text, the row within bounds
+  trace[2].state = InteractionState::writing;
+  trace[2].stroke = 2;
+  const std::string csv = trial_csv(trace);
+  CHECK(csv ==
+        "t,x,y,z,fx,fy,fz,state,stroke,element\n"
+        "0,0,0,0,0,0,1e+300,SS,0,0\n"
+        "0.001,-0.011845,0.010465,0,-0.0098,0.5,0.3333,SS,0,0\n"
+        "0.002,0.1234568,0,0.02001,0,0,0,WS,2,0\n");
+  // Read back, every value within half its last decimal of the one written.
+  const auto samples = parse_pen_trace_csv(csv, "trace", test_placement());
+  REQUIRE(samples.size() == trace.size());
+  for (std::size_t i = 0; i < trace.size(); ++i) {
+    CHECK(std::abs(samples[i].time_s - trace[i].time_s) <= 0.5e-6);
+    CHECK((samples[i].position_m - trace[i].position_m.head<2>()).cwiseAbs().maxCoeff() <= 0.5e-7);
+  }
 }

@@ -98,7 +98,8 @@ TEST_CASE("a cohort in memory gives the rows of the same subjects' session folde
   REQUIRE(memory.trials.size() == 4 * 8);
   for (std::size_t i = 0; i < memory.trials.size(); ++i) {
     check_same_trials(memory.trials[i], folders.trials[i]);
-    CHECK(memory.trials[i].session == "cohort-s" + std::to_string(memory.trials[i].session_number));
+    CHECK(memory.trials[i].session ==
+          "cohort-" + memory.trials[i].subject + "-s" + std::to_string(memory.trials[i].session_number));
     CHECK(memory.trials[i].trace_file.empty());
   }
   REQUIRE(memory.strokes.size() == folders.strokes.size());

@@ -1,6 +1,7 @@
 // Study sessions end to end in the library: folders, the runner with a simulated writer, interruption and
 // resumption without losing or overwriting a saved trial, the records, the report read back.
 #include <unistd.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <catch2/catch.hpp>
@@ -233,9 +234,13 @@ TEST_CASE("a device lost mid-trial keeps the attempt and stops the session namin
       session.path() / "trials" / "attempts" / (SessionFolder::trial_stem(session.plan()[0]) + ".attempt-1");
   const auto record = nlohmann::json::parse(read(fs::path(attempt.string() + ".json")));
   CHECK(record["end_reason"] == "device_fault");
-  std::ifstream csv(attempt.string() + ".csv");
+  // The attempt's trace, gzip-compressed as a saved trial's.
+  gzFile csv = gzopen((attempt.string() + ".csv.gz").c_str(), "rb");
+  REQUIRE(csv != nullptr);
   std::size_t rows = 0;
-  for (std::string line; std::getline(csv, line);) ++rows;
+  char line[1024];
+  while (gzgets(csv, line, sizeof line) != nullptr) ++rows;
+  gzclose(csv);
   CHECK(rows == 700 + 1);  // every tick before the lost read, and the header
 }
 
@@ -442,6 +447,26 @@ TEST_CASE("a replay condition follows a teacher kept in the session folder and n
   CHECK(wrong.saved_count() == 0);
 }
 
+TEST_CASE("two subjects' sessions started in the same second have different ids", "[study][session]") {
+  TempFolder temp;
+  const LoadedProtocol protocol = small_protocol();
+  // The ids end in the UTC second the session began: made back to back, two sessions share it (a few
+  // tries cover a second's turn between them).
+  for (int attempt = 0; attempt < 5; ++attempt) {
+    const fs::path root = temp.path / std::to_string(attempt);
+    const SessionFolder first = SessionFolder::create(root, simulated("S01"), protocol);
+    const SessionFolder second = SessionFolder::create(root, simulated("S02"), protocol);
+    const std::string a = first.manifest().session_id, b = second.manifest().session_id;
+    CHECK(a.starts_with(protocol.protocol.name + "-S01-"));
+    CHECK(b.starts_with(protocol.protocol.name + "-S02-"));
+    if (a.substr(a.size() - 15) != b.substr(b.size() - 15)) continue;  // another second
+    CHECK(a != b);
+    CHECK(first.path().filename() == a);  // the folder's name is the id
+    return;
+  }
+  FAIL("five pairs of sessions made back to back never began in the same second");
+}
+
 TEST_CASE("a damaged session.json is refused naming the file and the JSON pointer", "[study][session]") {
   TempFolder temp;
   fs::path folder;
@@ -459,57 +484,74 @@ TEST_CASE("a damaged session.json is refused naming the file and the JSON pointe
   CHECK_THROWS_AS(SessionFolder::create(temp.path, simulated("no/slash"), small_protocol()), InvalidArgument);
 }
 
-TEST_CASE("the report of saved sessions has a trajectory and a force figure per trial", "[study][report]") {
+TEST_CASE("the per-trial pages of saved sessions: a trajectory and a force figure per trial, no summary",
+          "[study][report]") {
   TempFolder temp;
   const LoadedProtocol protocol = small_protocol();
   for (const char* id : {"S01", "S02"}) {
     SessionFolder session = SessionFolder::create(temp.path / "study", simulated(id), protocol);
     run_session(session);
   }
-  const StudyReport report = read_study_report({temp.path / "study"});
-  REQUIRE(report.trials.size() == 6);
-  CHECK(report.sessions.size() == 2);
-  CHECK(report.conditions == std::vector<std::string>{"vision", "haptic", "quiz"});
-  for (const ReportTrial& trial : report.trials) {
-    CHECK(trial.time_s.size() == trial.position_m.size());
-    CHECK_FALSE(trial.time_s.empty());
-    CHECK(trial.reference_m.size() == 2);
-    CHECK(trial.strokes.size() == 2);
+  const StudyReportSessions study = list_report_sessions({temp.path / "study"});
+  REQUIRE(study.sessions.size() == 2);
+  CHECK(study.index.sessions.size() == 2);
+  CHECK(study.sessions[0].shown.subject == "S01");
+  CHECK(study.sessions[0].shown.saved == 3);
+  CHECK(study.sessions[0].shown.conditions == std::vector<std::string>{"vision", "haptic", "quiz"});
+  // Session ids name the subject: two subjects' sessions started in the same second differ.
+  CHECK(study.sessions[0].shown.session != study.sessions[1].shown.session);
+  std::size_t trials = 0;
+  for (const ReportedSession& session : study.sessions) {
+    SessionPageHtml page(session.shown, study.index.title, "../../index.html");
+    std::size_t number = 0;
+    read_session_trials(session, [&](const ReportTrial& trial) {
+      ++number;
+      CHECK(trial.index == number);  // 1-based, in planned order
+      CHECK(trial.session == session.shown.session);
+      CHECK(trial.time_s.size() == trial.position_m.size());
+      CHECK_FALSE(trial.time_s.empty());
+      CHECK(trial.reference_m.size() == 2);
+      CHECK(trial.strokes.size() == 2);
+      CHECK(trial.repetition >= 1);
+      CHECK(trial.item >= 1);
+      CHECK(trial.block >= 1);
+      page.add(trial);
+    });
+    trials += number;
+    const std::string text = page.finish();
+    const auto count = [&](const std::string& needle) {
+      std::size_t n = 0;
+      for (std::size_t at = text.find(needle); at != std::string::npos; at = text.find(needle, at + 1)) ++n;
+      return n;
+    };
+    CHECK(count("<figure class=\"trajectory\"") == 3);
+    CHECK(count("<figure class=\"force\"") == 3);
+    CHECK(count("<table") == 0);  // no summary over trials: the study report's
+    CHECK(count("learning-curve") == 0);
+    for (std::size_t n = 1; n <= 3; ++n)
+      CHECK(count("id=\"" + trial_anchor(session.shown.session, n) + "\"") == 1);
+    CHECK(text.find("http") == text.find("http://www.w3.org/2000/svg"));  // only the SVG namespace
   }
-  const std::vector<double> times = measure_values(report, ReportMeasure::time_s, "vision");
-  REQUIRE(times.size() == 2);
-  const MeanSd summary = mean_and_sd(times);
-  CHECK(summary.mean == Approx((times[0] + times[1]) / 2));
-  const std::string page = study_report_html(report);
-  const auto count = [&](const std::string& needle) {
-    std::size_t n = 0;
-    for (std::size_t at = page.find(needle); at != std::string::npos; at = page.find(needle, at + 1)) ++n;
-    return n;
-  };
-  CHECK(count("<figure class=\"trajectory\"") == 6);
-  CHECK(count("<figure class=\"force\"") == 6);
-  CHECK(count("<table class=\"summary\"") == 4);
-  CHECK(page.find("http") ==
-        page.find("http://www.w3.org/2000/svg"));  // only the SVG namespace, nothing loaded
-  CHECK_THROWS_AS(read_study_report({temp.path / "nothing-here"}), DataError);
+  CHECK(trials == 6);
+  const std::string index = study_index_html(study.index, "trials.html");
+  CHECK(index.find(session_page_path("trials.html", "S02", study.sessions[1].shown.session)) !=
+        std::string::npos);
+  CHECK(session_page_path("trials.html", "S01", "p-S01-1") == "trials_files/S01/p-S01-1.html");
+  CHECK(trial_anchor("p-S01-1", 7) == "trial-p-S01-1-7");
+  CHECK_THROWS_AS(list_report_sessions({temp.path / "nothing-here"}), DataError);
 }
 
-TEST_CASE("mean and sample standard deviation", "[study][report]") {
-  const std::vector<double> values{2.0, 4.0, 4.0, 4.0, 5.0, 5.0, 7.0, 9.0};
-  const MeanSd s = mean_and_sd(values);
-  CHECK(s.n == 8);
-  CHECK(s.mean == Approx(5.0));
-  CHECK(s.sd == Approx(std::sqrt(32.0 / 7.0)));
-  CHECK(std::isnan(mean_and_sd(std::vector<double>{1.0}).sd));
-  CHECK(mean_and_sd(std::vector<double>{}).n == 0);
-}
-
-TEST_CASE("the report page escapes what sessions wrote", "[study][report]") {
-  StudyReport report;
-  report.title = "<script>alert(1)</script>";
-  report.conditions = {"a"};
+TEST_CASE("the per-trial pages escape what sessions wrote", "[study][report]") {
+  StudyReportIndex index;
+  index.title = "<script>alert(1)</script>";
+  ReportSession session;
+  session.subject = "S<1>";
+  session.session = "s\"1";
+  session.conditions = {"a"};
+  index.sessions = {session};
   ReportTrial trial;
   trial.subject = "S<1>";
+  trial.session = "s\"1";
   trial.condition = "a";
   trial.phase = "test";
   trial.characters = "\"&'";
@@ -517,12 +559,20 @@ TEST_CASE("the report page escapes what sessions wrote", "[study][report]") {
   trial.position_m = {Vec2::Zero(), Vec2(0.01, 0.0)};
   trial.pen_down = {true, true};
   trial.in_plane_force_n = {0.0, 1.0};
-  report.trials = {trial};
-  const std::string page = study_report_html(report);
-  CHECK(page.find("<script>") == std::string::npos);
-  CHECK(page.find("&lt;script&gt;") != std::string::npos);
-  CHECK(page.find("S&lt;1&gt;") != std::string::npos);
-  CHECK(page.find("&quot;&amp;&#39;") != std::string::npos);
+  SessionPageHtml page(session, index.title, "../../index.html");
+  page.add(trial);
+  for (const std::string& text : {page.finish(), study_index_html(index, "index.html")}) {
+    CHECK(text.find("<script>") == std::string::npos);
+    CHECK(text.find("&lt;script&gt;") != std::string::npos);
+    CHECK(text.find("S&lt;1&gt;") != std::string::npos);
+  }
+  SessionPageHtml again(session, index.title, "../../index.html");
+  again.add(trial);
+  const std::string text = again.finish();
+  CHECK(text.find("&quot;&amp;&#39;") != std::string::npos);
+  CHECK(text.find("id=\"trial-s&quot;1-1\"") != std::string::npos);
+  CHECK(study_index_html(index, "index.html").find("href=\"index_files/S%3C1%3E/s%221.html\"") !=
+        std::string::npos);
 }
 
 TEST_CASE("a crash between saving a trial and logging it, or in a log line, is mended on resume",
@@ -709,8 +759,8 @@ TEST_CASE("a learning simulated subject writes with what it learned, the same af
       REQUIRE(row.timing_skill);
       CHECK(*row.timing_skill >= 0.0);
       CHECK(*row.timing_skill < 1.0);
-      const nlohmann::json record =
-          nlohmann::json::parse(read(fs::path(row.trace_file).replace_extension(".json")));
+      const nlohmann::json record = nlohmann::json::parse(
+          read(fs::path(row.trace_file).replace_extension().replace_extension(".json")));
       bias.push_back(record["writer"]["profile"]["bias_offset_m"].get<double>());
     }
     return bias;

@@ -1,5 +1,7 @@
 // A study as tidy tables: one row per saved trial with its record's metrics in SI units, one row per
 // reference stroke, CSV that quotes what needs quoting.
+#include "calligraphy/study/study_tables.hpp"
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -13,7 +15,6 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/study/session_runner.hpp"
 #include "temp_folder.hpp"
-#include "calligraphy/study/study_tables.hpp"
 
 using namespace calligraphy;
 namespace fs = std::filesystem;
@@ -27,7 +28,9 @@ nlohmann::json read_json(const fs::path& file) {
   return nlohmann::json::parse(text.str());
 }
 
-std::size_t lines(const std::string& text) { return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')); }
+std::size_t lines(const std::string& text) {
+  return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n'));
+}
 
 }  // namespace
 
@@ -50,10 +53,17 @@ TEST_CASE("a study's tidy tables hold every saved trial with its record's metric
   std::size_t strokes = 0;
   for (const TrialRow& row : tables.trials) {
     INFO(row.trace_file.string());
-    const nlohmann::json record = read_json(fs::path(row.trace_file).replace_extension(".json"));
+    const nlohmann::json record =
+        read_json(fs::path(row.trace_file).replace_extension().replace_extension(".json"));
     CHECK(row.subject == record["subject"].get<std::string>());
     CHECK(row.condition == record["condition"].get<std::string>());
-    CHECK(row.repetition + 1 == record["repetition"].get<std::size_t>());  // 0-based in the table
+    CHECK(row.repetition == record["repetition"].get<std::size_t>());  // 1-based in both
+    CHECK(row.trial == record["trial"]["index"].get<std::size_t>());
+    CHECK(row.block == record["trial"]["block"].get<std::size_t>());
+    CHECK(row.item == record["trial"]["item"].get<std::size_t>());
+    CHECK(row.trial >= 1);
+    CHECK(row.block >= 1);
+    CHECK(row.item >= 1);
     CHECK(row.strokes_total == record["strokes_total"].get<std::size_t>());
     REQUIRE(row.mean_deviation_m.has_value());
     CHECK(*row.mean_deviation_m == Approx(record["mean_deviation_mm"].get<double>() * 1e-3).epsilon(1e-12));
@@ -71,10 +81,12 @@ TEST_CASE("a study's tidy tables hold every saved trial with its record's metric
   // The CSV: a header and one line per row.
   CHECK(lines(trials_csv(tables)) == tables.trials.size() + 1);
   CHECK(lines(strokes_csv(tables)) == tables.strokes.size() + 1);
-  CHECK(trials_csv(tables).rfind("subject,session,protocol,session_number,group,phase,block,condition", 0) == 0);
+  CHECK(trials_csv(tables).rfind("subject,session,protocol,session_number,group,phase,block,condition", 0) ==
+        0);
 }
 
-TEST_CASE("a table field with a comma or a quote is quoted, and a missing metric is empty", "[study][tables]") {
+TEST_CASE("a table field with a comma or a quote is quoted, and a missing metric is empty",
+          "[study][tables]") {
   StudyTables tables;
   TrialRow row;
   row.subject = "S01";

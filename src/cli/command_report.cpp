@@ -1,13 +1,22 @@
-// `calligraphy report DIR... --out report.html --csv TABLES`: one self-contained HTML page for the saved trials
-// of one or many study sessions (study/session_reader.hpp, report/study_report_html.hpp), and the study as
-// tidy tables (study/study_tables.hpp): TABLES/trials.csv and TABLES/strokes.csv.
+// `calligraphy report DIR... --out trials.html --csv TABLES`: the per-trial pages of one or many study
+// sessions (study/session_reader.hpp, report/study_report_html.hpp): an index page and one page per session
+// in trials_files/SUBJECT/SESSION.html; and the study as tidy tables (study/study_tables.hpp):
+// TABLES/trials.csv and TABLES/strokes.csv.
+#include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <exception>
+#include <iterator>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <thread>
+#include <utility>
 #include <vector>
 
 #include "calligraphy/core/atomic_file.hpp"
+#include "calligraphy/core/errors.hpp"
 #include "calligraphy/report/study_report_html.hpp"
 #include "calligraphy/study/session_reader.hpp"
 #include "calligraphy/study/study_tables.hpp"
@@ -15,12 +24,61 @@
 #include "cli/output.hpp"
 
 namespace calligraphy::cli {
+namespace fs = std::filesystem;
 namespace {
 
 struct ReportCommand {
   std::vector<std::string> folders;
   std::string out;
-  std::string csv;  // a folder for trials.csv and strokes.csv
+  std::string csv;        // a folder for trials.csv and strokes.csv
+  std::int64_t jobs = 0;  // 0: every core
+};
+
+// Each session's page, built as its trials are read and written whole (atomically) before the next
+// session is read: memory holds one session's page and one trial per thread. With `tables`, each
+// session's rows of the tidy tables are read from the same parse of its records.
+class PagesWriter {
+ public:
+  PagesWriter(const StudyReportSessions& sessions, const std::vector<fs::path>& page_files,
+              std::string index_href)
+      : study(sessions), pages(page_files), index_href_from_page(std::move(index_href)) {}
+
+  const StudyReportSessions& study;
+  const std::vector<fs::path>& pages;
+  std::string index_href_from_page;
+  std::atomic<std::size_t> next{0};
+  std::atomic<bool> failed{false};
+  std::mutex error_mutex;
+  std::exception_ptr failure;
+  std::atomic<std::size_t> trials{0};
+  std::atomic<std::uintmax_t> bytes{0};
+  std::vector<StudyTables>* tables = nullptr;  // one per session, when the tables are wanted too
+
+  void work() {
+    while (!failed) {
+      const std::size_t i = next++;
+      if (i >= study.sessions.size()) return;
+      try {
+        const ReportedSession& session = study.sessions[i];
+        SessionPageHtml page(session.shown, study.index.title, index_href_from_page);
+        read_session_trials(
+            session, [&page](const ReportTrial& trial) { page.add(trial); },
+            tables != nullptr ? &(*tables)[i] : nullptr);
+        trials += page.trials();
+        const std::string text = page.finish();
+        bytes += text.size();
+        std::error_code error;
+        fs::create_directories(pages[i].parent_path(), error);
+        if (error)
+          throw DataError(pages[i].parent_path().string() + ": cannot create the folder: " + error.message());
+        write_file_atomically(pages[i], text);
+      } catch (...) {
+        const std::lock_guard lock(error_mutex);
+        if (!failure) failure = std::current_exception();
+        failed = true;
+      }
+    }
+  }
 };
 
 int run_report(const ReportCommand& command) {
@@ -30,37 +88,66 @@ int run_report(const ReportCommand& command) {
   FilePlan files;
   for (const std::string& folder : command.folders) add_saved_sessions(files, "DIR", folder);
   files.output("--out", command.out);
-  const std::filesystem::path tables_folder(command.csv);
+  const fs::path tables_folder(command.csv);
   if (!command.csv.empty()) {
     files.existing_output_folder("--csv", command.csv);
     files.output("--csv", (tables_folder / "trials.csv").string());
     files.output("--csv", (tables_folder / "strokes.csv").string());
   }
-  std::vector<std::filesystem::path> roots(command.folders.begin(), command.folders.end());
+  std::vector<fs::path> roots(command.folders.begin(), command.folders.end());
   const auto elapsed = [&start] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
-  if (!command.csv.empty()) {
-    const StudyTables tables = read_study_tables(roots);
+  const auto write_tables = [&](const StudyTables& tables) {
     // Both tables or neither: a failure leaves the previous pair whole.
     const std::string trials_text = trials_csv(tables), strokes_text = strokes_csv(tables);
     const FileContent table_files[] = {{tables_folder / "trials.csv", trials_text},
                                        {tables_folder / "strokes.csv", strokes_text}};
     write_files_atomically(table_files);
-    if (command.out != "-") {
-      std::printf("%s: trials.csv (%zu rows), strokes.csv (%zu rows), %.1f s\n", command.csv.c_str(),
-                  tables.trials.size(), tables.strokes.size(), elapsed());
-    }
-  }
+    std::printf("%s: trials.csv (%zu rows), strokes.csv (%zu rows), %.1f s\n", command.csv.c_str(),
+                tables.trials.size(), tables.strokes.size(), elapsed());
+  };
+  // The tables alone read the records only; with the pages they come from the pages' read of each record.
+  if (!command.csv.empty() && command.out.empty()) write_tables(read_study_tables(roots));
   if (!command.out.empty()) {
-    const StudyReport report = read_study_report(roots);
-    const std::string page = study_report_html(report);
-    write_output(command.out, page);
-    if (command.out != "-") {
-      std::printf("%s: %zu sessions, %zu trials, %.1f MB, %.1f s\n", command.out.c_str(),
-                  report.sessions.size(), report.trials.size(), static_cast<double>(page.size()) / 1e6,
-                  elapsed());
+    const StudyReportSessions study = list_report_sessions(roots);
+    const fs::path index_path(command.out);
+    const std::string index_name = index_path.filename().string();
+    // The pages are outputs too: none may be a file the command reads.
+    const fs::path pages_folder = index_path.parent_path() / session_pages_folder(index_name);
+    files.output_folder("--out", pages_folder.string());
+    std::vector<fs::path> pages;
+    for (const ReportedSession& s : study.sessions) {
+      pages.push_back(index_path.parent_path() /
+                      session_page_path(index_name, s.shown.subject, s.shown.session));
+      files.output("--out", pages.back().string());
     }
+    PagesWriter writer(study, pages, "../../" + index_name);
+    std::vector<StudyTables> session_tables(command.csv.empty() ? 0 : study.sessions.size());
+    if (!command.csv.empty()) writer.tables = &session_tables;
+    const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+    const std::size_t threads =
+        std::min<std::size_t>(command.jobs > 0 ? static_cast<std::size_t>(command.jobs) : cores,
+                              std::max<std::size_t>(1, pages.size()));
+    std::vector<std::thread> pool;
+    for (std::size_t t = 1; t < threads; ++t) pool.emplace_back([&writer] { writer.work(); });
+    writer.work();
+    for (std::thread& thread : pool) thread.join();
+    if (writer.failure) std::rethrow_exception(writer.failure);
+    if (!command.csv.empty()) {  // the sessions' rows in the sessions' order, as read_study_tables gives them
+      StudyTables tables;
+      for (StudyTables& rows : session_tables) {
+        std::move(rows.trials.begin(), rows.trials.end(), std::back_inserter(tables.trials));
+        std::move(rows.strokes.begin(), rows.strokes.end(), std::back_inserter(tables.strokes));
+        rows = StudyTables{};
+      }
+      write_tables(tables);
+    }
+    const std::string index = study_index_html(study.index, index_name);
+    write_file_atomically(index_path, index);
+    std::printf("%s: %zu sessions, %zu trials, %zu pages in %s (%.1f MB), %.1f s\n", command.out.c_str(),
+                study.sessions.size(), writer.trials.load(), pages.size(), pages_folder.string().c_str(),
+                static_cast<double>(writer.bytes.load() + index.size()) / 1e6, elapsed());
   }
   return 0;
 }
@@ -69,16 +156,20 @@ int run_report(const ReportCommand& command) {
 
 void add_report_command(CLI::App& root, Commands& commands) {
   auto command = std::make_shared<ReportCommand>();
-  CLI::App* app = commands.add(root, "report", "Turn study sessions into one self-contained HTML page",
+  CLI::App* app = commands.add(root, "report", "Per-trial pages and tidy tables of study sessions",
                                [command] { return run_report(*command); });
   app->add_option("DIR", command->folders,
                   "session folders, or folders holding them (e.g. a `session run --out` folder)")
       ->required()
       ->type_name("DIR");
-  add_output_path(*app, "--out", command->out, "the HTML page", StandardOutput::allowed);
+  add_output_path(*app, "--out", command->out,
+                  "the index page; each session's page goes to NAME_files/SUBJECT/SESSION.html beside it",
+                  StandardOutput::refused);
   add_output_folder(*app, "--csv", command->csv,
                     "an existing folder for the tidy tables trials.csv and strokes.csv (docs/experiments.md)",
                     "not written");
+  add_integer(*app, "--jobs", command->jobs, "N", "threads reading sessions for the pages", 1, 256,
+              "every core");
 }
 
 }  // namespace calligraphy::cli

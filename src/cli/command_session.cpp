@@ -51,7 +51,10 @@ struct SessionRunCommand {
   std::string writer;  // person or simulated; empty: the device's own (writer_for_device)
   std::string writer_profile = "novice";
   const CLI::Option* profile_option = nullptr;
-  std::string writer_learning = "none";
+  // A simulated subject of a learning study learns, as in `session cohort`; a person's own learning is
+  // not modelled, so a person's session records "none" unless the option asks otherwise (refused).
+  std::string writer_learning = "two-state";
+  const CLI::Option* learning_option = nullptr;
   std::string pacing = "auto";
   std::string out;
   bool ignore_delay = false;
@@ -210,7 +213,7 @@ int run_sessions(const SessionRunCommand& command) {
   // The session folder's format calls a person "human" (SessionSetup::writer).
   const bool person = writer_for_device(command.writer, *device) == kPersonWriter;
   const std::string writer = person ? "human" : "simulated";
-  if (person && command.writer_learning != "none") {
+  if (person && command.learning_option->count() > 0 && command.writer_learning != "none") {
     throw UsageError("--writer-learning models the simulated writer, not a person (--writer person)");
   }
   if (person && command.profile_option->count() > 0) {
@@ -313,7 +316,7 @@ int run_sessions(const SessionRunCommand& command) {
       setup.writer = writer;
       setup.writer_profile = profiles[i % profiles.size()];
       setup.writer_seed = subject_seed(setup.subject.id);
-      setup.writer_learning = command.writer_learning;
+      setup.writer_learning = person ? "none" : command.writer_learning;
       setup.pacing = command.pacing;
       setup.session_number = series.next;
       SessionFolder session = SessionFolder::create(command.out, setup, resolved, previous);
@@ -403,15 +406,16 @@ void add_session_commands(CLI::App& root, Commands& commands) {
       *app, "--writer-profile", run->writer_profile, "PROFILES",
       "the simulated writer's profile, novice, skilled or foreign; a comma-separated list is used by subject "
       "in turn");
-  add_choice(
+  run->learning_option = add_choice(
       *app, "--writer-learning", run->writer_learning, {"none", "two-state"},
       "how a simulated subject learns: none (every trial from its profile) or two-state (a memory per "
-      "typical stroke and character that practice builds and time between sessions thins; docs/writer.md)");
+      "typical stroke and character that practice builds and time between sessions thins; docs/writer.md), "
+      "as `session cohort`; a person's session records none");
   add_choice(*app, "--pacing", run->pacing, {"auto", "lock-step", "real-time"},
              "auto: lock-step for a simulated writer, real time for a person; real-time paces a simulated "
              "writer by the wall clock");
   required(add_text(*app, "--out", run->out, "DIR",
-                    "the study folder: sessions go to DIR/SUBJECT/PROTOCOL-TIME/; a protocol of several "
+                    "the study folder: sessions go to DIR/SUBJECT/PROTOCOL-SUBJECT-TIME/; a protocol of several "
                     "sessions goes on with the subject's next one there"));
   add_flag(*app, "--ignore-delay", run->ignore_delay,
            "start a person's next session before the protocol's delay has passed, or after a session that "

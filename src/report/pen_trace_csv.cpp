@@ -10,7 +10,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "core/decimal_number.hpp"
-#include "core/whole_file.hpp"
+#include "report/compressed_text.hpp"
 
 namespace calligraphy {
 namespace {
@@ -86,7 +86,7 @@ class Reader {
       const std::size_t newline = text.find('\n', line_start);
       if (newline == std::string_view::npos) return line_start;
       if (options_.progress && line_number_ % kProgressLines == 0)
-        options_.progress(offset + line_start, total);
+        options_.progress(std::min(offset + line_start, total), total);
       line(text.substr(line_start, newline - line_start));
       line_start = newline + 1;
     }
@@ -143,7 +143,8 @@ class Reader {
   double number(const std::vector<std::string_view>& fields, std::size_t column) const {
     const std::string_view field = fields[column];
     const std::optional<double> value = parse_finite_double(field);
-    if (!value) fail(column, field, "not a number (a finite decimal within the range of a double is expected)");
+    if (!value)
+      fail(column, field, "not a number (a finite decimal within the range of a double is expected)");
     return *value;
   }
 
@@ -212,26 +213,22 @@ std::vector<PenSample> parse_pen_trace_csv(std::string_view text, const std::str
 std::vector<PenSample> read_pen_trace_csv(const std::filesystem::path& file, const Placement& placement,
                                           const PenTraceCsvOptions& options) {
   check_options(options, placement);
-  // Streamed a block at a time, so that memory holds the samples read, not the file: a trace over a limit
-  // is refused at its line without the rest being read.
+  // Streamed a block at a time (decompressed on the way for a gzip file), so that memory holds the samples
+  // read, not the file: a trace over a limit is refused at its line without the rest being read.
   const std::string name = file.string();
-  const auto size = static_cast<std::size_t>(regular_file_size(file, options.max_file_bytes));
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw DataError(name + ": cannot be opened");
+  TextFileReader in(file, options.max_file_bytes, options.max_file_bytes);
+  const auto size = static_cast<std::size_t>(in.file_bytes());
   Reader reader(name, placement, options);
   constexpr std::size_t kBlockBytes = std::size_t{1} << 20;
-  std::string buffer;        // an unfinished line, then the next block
-  std::size_t consumed = 0;  // bytes of the file before buffer
-  std::size_t read = 0;
-  while (read < size) {
+  std::string buffer;  // an unfinished line, then the next block
+  while (true) {
     const std::size_t kept = buffer.size();
-    const std::size_t block = std::min(kBlockBytes, size - read);
-    buffer.resize(kept + block);
-    in.read(buffer.data() + kept, static_cast<std::streamsize>(block));
-    if (static_cast<std::size_t>(in.gcount()) != block) throw DataError(name + ": could not be read whole");
-    read += block;
-    const std::size_t rest = reader.lines(buffer, consumed, size);
-    consumed += rest;
+    const auto offset = static_cast<std::size_t>(in.file_offset());  // on disk, for the progress
+    buffer.resize(kept + kBlockBytes);
+    const std::size_t got = in.read(buffer.data() + kept, kBlockBytes);
+    buffer.resize(kept + got);
+    if (got == 0) break;
+    const std::size_t rest = reader.lines(buffer, offset, size);
     buffer.erase(0, rest);
   }
   if (!buffer.empty()) reader.line(buffer);

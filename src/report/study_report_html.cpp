@@ -1,22 +1,26 @@
-// The study report page (study_report_html.hpp): tables, learning curves and per-trial figures as
-// inline SVG.
+// The per-trial pages of a study (study_report_html.hpp): per trial its figures as inline SVG and its
+// own values; an index of the sessions.
 #include "calligraphy/report/study_report_html.hpp"
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <map>
 #include <string>
+#include <utility>
 
 #include "report/appendf.hpp"
 
 namespace calligraphy {
 namespace {
 
-constexpr std::array<const char*, 6> kConditionColours{"#d62728", "#1f77b4", "#2ca02c",
-                                                       "#9467bd", "#ff7f0e", "#8c564b"};
+// Okabe & Ito's colour-blind-safe palette (Okabe & Ito 2008, "Color Universal Design"), one colour per
+// condition in the protocol's order.
+constexpr std::array<const char*, 7> kConditionColours{"#0072B2", "#E69F00", "#009E73", "#CC79A7",
+                                                       "#56B4E9", "#D55E00", "#000000"};
 
 std::string escape(const std::string& text) {
   std::string out;
@@ -52,150 +56,38 @@ std::string number(double value, int decimals) {
   return text;
 }
 
-const char* colour_of(const StudyReport& report, const std::string& condition) {
-  const auto found = std::find(report.conditions.begin(), report.conditions.end(), condition);
-  const auto index = static_cast<std::size_t>(found - report.conditions.begin());
+const char* colour_of(const std::vector<std::string>& conditions, const std::string& condition) {
+  const auto found = std::find(conditions.begin(), conditions.end(), condition);
+  const auto index = static_cast<std::size_t>(found - conditions.begin());
   return kConditionColours[index % kConditionColours.size()];
 }
 
-std::optional<double> recorded_value(const ReportTrial& trial, ReportMeasure measure) {
-  switch (measure) {
-    case ReportMeasure::time_s:
-      return trial.time_total_s;
-    case ReportMeasure::mean_deviation_mm:
-      return trial.mean_deviation_mm;
-    case ReportMeasure::frechet_mm:
-      return trial.frechet_mm;
-    case ReportMeasure::order_errors:
-      return static_cast<double>(trial.order_errors);
+// A path for an href: each byte outside RFC 3986's unreserved characters and '/' percent-encoded.
+std::string href(const std::string& path) {
+  std::string out;
+  for (const char c : path) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (std::isalnum(byte) != 0 || c == '-' || c == '.' || c == '_' || c == '~' || c == '/') {
+      out += c;
+    } else {
+      appendf(out, "%%%02X", byte);
+    }
   }
-  return std::nullopt;
-}
-
-// A trial's value of a measure; none for one it lacks or that is not finite (a trial that wrote no stroke
-// has no deviation), so that a summary counts and averages only the values there are.
-std::optional<double> value_of(const ReportTrial& trial, ReportMeasure measure) {
-  const std::optional<double> value = recorded_value(trial, measure);
-  return value && std::isfinite(*value) ? value : std::nullopt;
-}
-
-struct MeasureInfo {
-  ReportMeasure measure;
-  const char* title;
-  const char* unit;
-  int decimals;
-};
-constexpr std::array<MeasureInfo, 4> kMeasures{{
-    {ReportMeasure::time_s, "Writing time", "s", 1},
-    {ReportMeasure::mean_deviation_mm, "Mean deviation", "mm", 2},
-    {ReportMeasure::frechet_mm, "Fr&eacute;chet distance (worst stroke)", "mm", 2},
-    {ReportMeasure::order_errors, "Stroke order errors", "pairs", 2},
-}};
-
-// ---- Summary tables ----------------------------------------------------------------------------
-
-std::string cell(const MeanSd& summary, int decimals) {
-  if (summary.n == 0) return "<td class=\"num\">&ndash;</td>";
-  std::string out = "<td class=\"num\">" + number(summary.mean, decimals);
-  if (summary.n >= 2) out += " &plusmn; " + number(summary.sd, decimals);
-  out += " <span class=\"n\">(" + std::to_string(summary.n) + ")</span></td>";
   return out;
 }
 
-void append_summary_table(std::string& out, const StudyReport& report, const MeasureInfo& info) {
-  appendf(out,
-          "<table class=\"summary\" data-measure=\"%s\">\n<caption>%s [%s]: mean &plusmn; SD (n) over "
-          "subjects and repetitions</caption>\n<tr><th>Condition</th>",
-          info.unit, info.title, info.unit);
-  for (std::size_t i = 0; i < report.items.size(); ++i) {
-    appendf(out, "<th>C%zu %s</th>", i + 1, escape(report.items[i]).c_str());
-  }
-  out += "<th>all</th></tr>\n";
-  for (const std::string& condition : report.conditions) {
-    appendf(out, "<tr><th style=\"color:%s\">%s</th>", colour_of(report, condition),
-            escape(condition).c_str());
-    for (std::size_t i = 0; i < report.items.size(); ++i) {
-      out += cell(mean_and_sd(measure_values(report, info.measure, condition, i)), info.decimals);
-    }
-    out += cell(mean_and_sd(measure_values(report, info.measure, condition)), info.decimals);
-    out += "</tr>\n";
-  }
-  out += "</table>\n";
-}
-
-// ---- Learning curves ---------------------------------------------------------------------------
-
-void append_learning_curve(std::string& out, const StudyReport& report, const MeasureInfo& info) {
-  int repetitions = 0;
-  for (const ReportTrial& t : report.trials) {
-    if (t.phase == report.phase) repetitions = std::max(repetitions, t.repetition);
-  }
-  if (repetitions == 0) return;
-  struct Point {
-    int repetition;
-    MeanSd summary;
-  };
-  std::map<std::string, std::vector<Point>> curves;
-  double high = 0.0;
-  for (const std::string& condition : report.conditions) {
-    for (int r = 1; r <= repetitions; ++r) {
-      const MeanSd s = mean_and_sd(measure_values(report, info.measure, condition, std::nullopt, r));
-      if (s.n == 0) continue;
-      curves[condition].push_back({r, s});
-      high = std::max(high, s.mean + (std::isfinite(s.sd) ? s.sd : 0.0));
-    }
-  }
-  if (high <= 0.0) high = 1.0;
-  constexpr double kWidth = 420.0, kHeight = 220.0, kLeft = 48.0, kRight = 80.0, kTop = 14.0, kBottom = 34.0;
-  const double plot_w = kWidth - kLeft - kRight, plot_h = kHeight - kTop - kBottom;
-  const auto x_of = [&](double r) {
-    return kLeft + (repetitions == 1 ? plot_w / 2 : (r - 1.0) / (repetitions - 1.0) * plot_w);
-  };
-  const auto y_of = [&](double v) { return kTop + plot_h * (1.0 - v / (high * 1.05)); };
-  appendf(out,
-          "<figure class=\"learning-curve\"><svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" "
-          "height=\"%.0f\" viewBox=\"0 0 %.0f %.0f\" role=\"img\">\n",
-          kWidth, kHeight, kWidth, kHeight);
-  appendf(out, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"none\" stroke=\"#999\"/>\n",
-          kLeft, kTop, plot_w, plot_h);
-  for (int k = 0; k <= 4; ++k) {  // y ticks
-    const double v = high * 1.05 * k / 4.0;
-    appendf(out, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"10\" text-anchor=\"end\">%s</text>\n", kLeft - 4,
-            y_of(v) + 3, number(v, info.decimals > 1 ? 1 : 0).c_str());
-  }
-  for (int r = 1; r <= repetitions; ++r) {
-    appendf(out, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"10\" text-anchor=\"middle\">%d</text>\n", x_of(r),
-            kTop + plot_h + 13, r);
-  }
-  appendf(out, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"10\" text-anchor=\"middle\">repetition</text>\n",
-          kLeft + plot_w / 2, kHeight - 4);
-  double legend_y = kTop + 10;
-  for (const auto& [condition, points] : curves) {
-    const char* colour = colour_of(report, condition);
-    out += "<polyline fill=\"none\" stroke-width=\"2\" stroke=\"" + std::string(colour) + "\" points=\"";
-    for (const Point& p : points) appendf(out, "%.1f,%.1f ", x_of(p.repetition), y_of(p.summary.mean));
-    out += "\"/>\n";
-    for (const Point& p : points) {
-      const double x = x_of(p.repetition) + (colour == kConditionColours[0] ? -3.0 : 3.0);
-      if (std::isfinite(p.summary.sd)) {
-        appendf(out, "<line x1=\"%.1f\" x2=\"%.1f\" y1=\"%.1f\" y2=\"%.1f\" stroke=\"%s\"/>\n", x, x,
-                y_of(std::max(0.0, p.summary.mean - p.summary.sd)), y_of(p.summary.mean + p.summary.sd),
-                colour);
-      }
-      appendf(out, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"3\" fill=\"%s\"/>\n", x_of(p.repetition),
-              y_of(p.summary.mean), colour);
-    }
-    appendf(out, "<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\" fill=\"%s\">%s</text>\n", kLeft + plot_w + 8,
-            legend_y, colour, escape(condition).c_str());
-    legend_y += 14;
-  }
-  appendf(out,
-          "</svg><figcaption>%s [%s] over repetitions, mean &plusmn; SD over subjects and "
-          "characters</figcaption></figure>\n",
-          info.title, info.unit);
-}
-
 // ---- Per-trial figures -------------------------------------------------------------------------
+
+// "x,y " with one decimal: a polyline's point (to_chars: the figures of a study have millions of points).
+void append_point(std::string& out, const Vec2& p) {
+  char text[64];
+  char* end = text + sizeof text;
+  char* at = std::to_chars(text, end, p.x(), std::chars_format::fixed, 1).ptr;
+  *at++ = ',';
+  at = std::to_chars(at, end, p.y(), std::chars_format::fixed, 1).ptr;
+  *at++ = ' ';
+  out.append(text, at);
+}
 
 // Trajectory over the reference: reference strokes in blue, pen-down trace in green, start points as red
 // ellipses (the paper's display, section 7.2).
@@ -229,7 +121,7 @@ void append_trajectory_figure(std::string& out, const ReportTrial& trial) {
     out +=
         "<polyline fill=\"none\" stroke=\"#3060d0\" stroke-opacity=\"0.6\" stroke-width=\"5\" "
         "stroke-linecap=\"round\" stroke-linejoin=\"round\" points=\"";
-    for (const Vec2& p : stroke) appendf(out, "%.1f,%.1f ", px(p).x(), px(p).y());
+    for (const Vec2& p : stroke) append_point(out, px(p));
     out += "\"/>\n";
   }
   // Pen-down runs, thinned to points at least 0.25 mm apart.
@@ -251,7 +143,7 @@ void append_trajectory_figure(std::string& out, const ReportTrial& trial) {
     } else if ((p - last).norm() < min_step_m && i + 1 < trial.position_m.size() && trial.pen_down[i + 1]) {
       continue;
     }
-    appendf(out, "%.1f,%.1f ", px(p).x(), px(p).y());
+    append_point(out, px(p));
     last = p;
   }
   if (open) out += "\"/>\n";
@@ -303,7 +195,7 @@ void append_force_figure(std::string& out, const ReportTrial& trial) {
       if (trial.in_plane_force_n[i] > trial.in_plane_force_n[hi]) hi = i;
     }
     for (const std::size_t i : {std::min(lo, hi), std::max(lo, hi)}) {
-      appendf(out, "%.1f,%.1f ", x_of(trial.time_s[i]), y_of(trial.in_plane_force_n[i]));
+      append_point(out, Vec2(x_of(trial.time_s[i]), y_of(trial.in_plane_force_n[i])));
     }
     begin = end;
   }
@@ -323,13 +215,17 @@ void append_force_figure(std::string& out, const ReportTrial& trial) {
       "WS to its last feature point</figcaption></figure>\n";
 }
 
-void append_trial(std::string& out, const StudyReport& report, const ReportTrial& trial) {
+void append_trial(std::string& out, const std::vector<std::string>& conditions, const ReportTrial& trial) {
   appendf(out,
-          "<article class=\"trial\" data-subject=\"%s\" data-condition=\"%s\" data-phase=\"%s\">\n<h4>#%zu "
-          "<span class=\"glyph\">%s</span> <span style=\"color:%s\">%s</span> %s r%d</h4>\n",
-          escape(trial.subject).c_str(), escape(trial.condition).c_str(), escape(trial.phase).c_str(),
-          trial.index, escape(trial.characters).c_str(), colour_of(report, trial.condition),
-          escape(trial.condition).c_str(), escape(trial.phase).c_str(), trial.repetition);
+          "<article class=\"trial\" id=\"%s\" data-subject=\"%s\" data-condition=\"%s\" "
+          "data-phase=\"%s\">\n<h4><a href=\"#%s\">#%zu</a> <span class=\"glyph\">%s</span> %s <span "
+          "style=\"color:%s\">%s</span> block %zu, item %zu, r%d</h4>\n",
+          escape(trial_anchor(trial.session, trial.index)).c_str(), escape(trial.subject).c_str(),
+          escape(trial.condition).c_str(), escape(trial.phase).c_str(),
+          escape(href(trial_anchor(trial.session, trial.index))).c_str(), trial.index,
+          escape(trial.characters).c_str(), escape(trial.phase).c_str(),
+          colour_of(conditions, trial.condition), escape(trial.condition).c_str(), trial.block, trial.item,
+          trial.repetition);
   appendf(
       out,
       "<p class=\"metrics\">%s s &middot; deviation %s mm &middot; Fr&eacute;chet %s mm &middot; DTW %s mm "
@@ -349,85 +245,85 @@ void append_trial(std::string& out, const StudyReport& report, const ReportTrial
 constexpr const char* kStyle = R"(<style>
 body{font-family:"Noto Sans","DejaVu Sans",sans-serif;margin:1.5em;color:#222;max-width:1600px}
 h1{font-size:1.5em}h2{margin-top:1.6em;border-bottom:1px solid #ccc}h3{margin-bottom:.3em}
-table.summary{border-collapse:collapse;margin:.6em 1.2em .6em 0;display:inline-table;vertical-align:top}
-table.summary td,table.summary th{border:1px solid #ccc;padding:.25em .5em}
-table.summary caption{text-align:left;font-weight:bold;padding:.2em 0}
-td.num{text-align:right;font-variant-numeric:tabular-nums}.n{color:#888;font-size:.85em}
+table.sessions{border-collapse:collapse;font-size:.85em}
+table.sessions td,table.sessions th{border:1px solid #ccc;padding:.25em .5em;text-align:left}
+td.num{text-align:right;font-variant-numeric:tabular-nums}
 figure{margin:.3em;display:inline-block;vertical-align:top}figcaption{font-size:.75em;color:#555;max-width:380px}
 figure.trajectory figcaption{max-width:220px}
 .trials{display:flex;flex-wrap:wrap;gap:.6em}
 article.trial{flex:0 0 auto;width:620px;border:1px solid #ddd;border-radius:4px;padding:.3em .6em;background:#fafafa}
 article.trial h4{margin:.2em 0}.glyph{font-size:1.3em}p.metrics{font-size:.8em;margin:.2em 0}
 .figures{display:flex;flex-wrap:wrap;align-items:flex-start}
-ul.sessions{font-size:.85em}
+article.trial:target{border-color:#0072B2;box-shadow:0 0 0 2px #0072B2}
 </style>
 )";
 
+void append_head(std::string& out, const std::string& title) {
+  out += "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" + escape(title) +
+         "</title>\n" + kStyle + "</head><body>\n";
+}
+
 }  // namespace
 
-MeanSd mean_and_sd(std::span<const double> values) {
-  MeanSd out;
-  out.n = values.size();
-  if (values.empty()) return out;
-  double sum = 0.0;
-  for (const double v : values) sum += v;
-  out.mean = sum / static_cast<double>(values.size());
-  if (values.size() >= 2) {
-    double squares = 0.0;
-    for (const double v : values) squares += (v - out.mean) * (v - out.mean);
-    out.sd = std::sqrt(squares / static_cast<double>(values.size() - 1));
-  }
-  return out;
+std::string trial_anchor(const std::string& session, std::size_t number) {
+  return "trial-" + session + "-" + std::to_string(number);
 }
 
-std::vector<double> measure_values(const StudyReport& report, ReportMeasure measure,
-                                   const std::string& condition, std::optional<std::size_t> item,
-                                   std::optional<int> repetition) {
-  std::vector<double> values;
-  for (const ReportTrial& trial : report.trials) {
-    if (trial.phase != report.phase || trial.condition != condition) continue;
-    if (item && trial.item != *item) continue;
-    if (repetition && trial.repetition != *repetition) continue;
-    if (const std::optional<double> value = value_of(trial, measure)) values.push_back(*value);
-  }
-  return values;
+std::string session_pages_folder(const std::string& index_name) {
+  std::string stem = index_name;
+  if (stem.size() > 5 && stem.ends_with(".html")) stem.resize(stem.size() - 5);
+  return stem + "_files";
 }
 
-std::string study_report_html(const StudyReport& report) {
+std::string session_page_path(const std::string& index_name, const std::string& subject,
+                              const std::string& session) {
+  return session_pages_folder(index_name) + "/" + subject + "/" + session + ".html";
+}
+
+std::string study_index_html(const StudyReportIndex& index, const std::string& index_name) {
   std::string out;
-  out.reserve(64 * 1024 + report.trials.size() * 24 * 1024);
-  out += "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" + escape(report.title) +
-         "</title>\n" + kStyle + "</head><body>\n<h1>" + escape(report.title) + "</h1>\n";
-  std::size_t test_trials = 0;
-  for (const ReportTrial& t : report.trials) test_trials += t.phase == report.phase ? 1 : 0;
-  appendf(out, "<p>%zu sessions, %zu trials (%zu %s trials).</p>\n<ul class=\"sessions\">\n",
-          report.sessions.size(), report.trials.size(), test_trials, escape(report.phase).c_str());
-  for (const std::string& s : report.sessions) out += "<li>" + escape(s) + "</li>\n";
-  out += "</ul>\n";
-  for (const std::string& note : report.notes) out += "<p class=\"note\">" + escape(note) + "</p>\n";
-
-  out += "<h2>Per condition (test trials)</h2>\n<section class=\"tables\">\n";
-  for (const MeasureInfo& info : kMeasures) append_summary_table(out, report, info);
-  out += "</section>\n<h3>Learning curves</h3>\n<section class=\"curves\">\n";
-  append_learning_curve(out, report, kMeasures[0]);
-  append_learning_curve(out, report, kMeasures[1]);
-  out += "</section>\n<h2>Trials</h2>\n";
-  std::string current;
-  bool open = false;
-  for (const ReportTrial& trial : report.trials) {
-    const std::string key = trial.subject + "/" + trial.session;
-    if (key != current) {
-      if (open) out += "</div></section>\n";
-      out += "<section class=\"session\"><h3>Subject " + escape(trial.subject) + " &mdash; " +
-             escape(trial.session) + "</h3><div class=\"trials\">\n";
-      current = key;
-      open = true;
-    }
-    append_trial(out, report, trial);
+  append_head(out, index.title);
+  out += "<h1>" + escape(index.title) + "</h1>\n";
+  std::size_t saved = 0;
+  for (const ReportSession& s : index.sessions) saved += s.saved;
+  appendf(out,
+          "<p>%zu sessions, %zu trials: one page per session, each trial's trajectory over the reference, "
+          "its force over time and its own values. The study's summaries and statistics are the study "
+          "report's (<code>python3 -m calligraphy.study_report</code>).</p>\n",
+          index.sessions.size(), saved);
+  for (const std::string& note : index.notes) out += "<p class=\"note\">" + escape(note) + "</p>\n";
+  out +=
+      "<table class=\"sessions\">\n<tr><th>Subject</th><th>Group</th><th>Session</th><th>Trials saved</th>"
+      "<th>Details</th></tr>\n";
+  for (const ReportSession& s : index.sessions) {
+    appendf(out,
+            "<tr><td>%s</td><td>%s</td><td><a href=\"%s\">%s</a></td><td class=\"num\">%zu of "
+            "%zu</td><td>%s</td></tr>\n",
+            escape(s.subject).c_str(), escape(s.group).c_str(),
+            escape(href(session_page_path(index_name, s.subject, s.session))).c_str(),
+            escape(s.session).c_str(), s.saved, s.planned, escape(s.description).c_str());
   }
-  if (open) out += "</div></section>\n";
-  out += "</body></html>\n";
+  out += "</table>\n</body></html>\n";
   return out;
+}
+
+SessionPageHtml::SessionPageHtml(const ReportSession& session, const std::string& title,
+                                 const std::string& index_href)
+    : conditions_(session.conditions) {
+  append_head(out_, title + ": " + session.session);
+  out_ += "<p><a href=\"" + escape(href(index_href)) + "\">" + escape(title) + "</a></p>\n<h1>Subject " +
+          escape(session.subject) + " &mdash; " + escape(session.session) + "</h1>\n<p>" +
+          escape(session.description) + "</p>\n<div class=\"trials\">\n";
+}
+
+void SessionPageHtml::add(const ReportTrial& trial) {
+  append_trial(out_, conditions_, trial);
+  ++trials_;
+}
+
+std::string SessionPageHtml::finish() {
+  out_ += "</div>\n</body></html>\n";
+  return std::move(out_);
 }
 
 }  // namespace calligraphy

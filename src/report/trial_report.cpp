@@ -1,10 +1,12 @@
 #include "calligraphy/report/trial_report.hpp"
 
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
+#include <system_error>
 
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
@@ -192,10 +194,16 @@ std::string trial_svg(const Scene& scene, const TrialResult& result) {
        result.metrics.per_stroke) {  // pen trace in green, last attempt of each stroke
     if (m.trace_end <= m.trace_begin || m.trace_end > trace.size()) continue;
     svg << "<polyline fill=\"none\" stroke=\"limegreen\" stroke-width=\"1.5\" points=\"";
-    for (std::size_t i = m.trace_begin; i < m.trace_end; i += 5) {
+    // Points at least a pixel apart (and the last): the line looks the same in fewer bytes.
+    svg.precision(1);
+    Vec2 last(-1e9, -1e9);
+    for (std::size_t i = m.trace_begin; i < m.trace_end; ++i) {
       const Vec2 p = px(trace[i].position_m.head<2>());
+      if ((p - last).norm() < 1.0 && i + 1 < m.trace_end) continue;
       svg << p.x() << "," << p.y() << " ";
+      last = p;
     }
+    svg.precision(2);
     svg << "\"/>\n";
   }
   for (const auto& c : scene.characters) {  // start hints as red ellipses
@@ -210,28 +218,50 @@ std::string trial_svg(const Scene& scene, const TrialResult& result) {
   return svg.str();
 }
 
+namespace {
+
+// `value` with `decimals` decimals, trailing zeros (and a bare point) dropped, "-0" written "0": a fixed
+// precision in the fewest characters.
+char* fixed(char* out, char* end, double value, int decimals) {
+  char* const start = out;
+  // Beyond 1e15 (no device reports such a value; a fault might) and NaN: the shortest round-trip text,
+  // so that a row stays within its buffer.
+  if (!(std::abs(value) < 1e15)) return std::to_chars(out, end, value).ptr;
+  const auto [ptr, error] = std::to_chars(out, end, value, std::chars_format::fixed, decimals);
+  if (error != std::errc{}) return out;
+  out = ptr;
+  if (decimals > 0) {
+    while (out[-1] == '0') --out;
+    if (out[-1] == '.') --out;
+  }
+  if (out - start == 2 && start[0] == '-' && start[1] == '0') {
+    start[0] = '0';
+    out = start + 1;
+  }
+  return out;
+}
+
+}  // namespace
+
 std::string trial_csv(const std::vector<TrialSample>& trace) {
-  std::ostringstream csv;
-  csv << "t,x,y,z,fx,fy,fz,state,stroke,element\n";
-  char line[256];
-  // Time and position in the shortest text that reads back as the same double, so that `calligraphy score`
-  // on this file gives the trial's own metrics exactly (one metrics record, docs/metrics.md).
-  const auto exact = [](char*& out, char* end, double value) {
-    out = std::to_chars(out, end, value).ptr;
-    *out++ = ',';
-  };
+  std::string csv = "t,x,y,z,fx,fy,fz,state,stroke,element\n";
+  csv.reserve(csv.size() + trace.size() * 64);
+  char line[512];
   for (const TrialSample& s : trace) {
     char* out = line;
     char* const end = line + sizeof line;
-    exact(out, end, s.time_s);
-    exact(out, end, s.position_m.x());
-    exact(out, end, s.position_m.y());
-    exact(out, end, s.position_m.z());
-    std::snprintf(out, static_cast<std::size_t>(end - out), "%.5f,%.5f,%.5f,%s,%zu,%zu\n", s.force_n.x(),
-                  s.force_n.y(), s.force_n.z(), to_string(s.state), s.stroke, s.element);
-    csv << line;
+    const auto field = [&](double value, int decimals) {
+      out = fixed(out, end, value, decimals);
+      *out++ = ',';
+    };
+    field(s.time_s, kTraceTimeDecimals);
+    for (int axis = 0; axis < 3; ++axis) field(s.position_m[axis], kTracePositionDecimals);
+    for (int axis = 0; axis < 3; ++axis) field(s.force_n[axis], kTraceForceDecimals);
+    out += std::snprintf(out, static_cast<std::size_t>(end - out), "%s,%zu,%zu\n", to_string(s.state),
+                         s.stroke, s.element);
+    csv.append(line, out);
   }
-  return csv.str();
+  return csv;
 }
 
 void write_file(const std::string& path, const std::string& text) { write_file_atomically(path, text); }

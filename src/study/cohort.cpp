@@ -40,7 +40,8 @@ constexpr const char* kCohortDevice = "simulated";
 SessionManifest cohort_manifest(const LoadedProtocol& protocol, const SubjectAssignment& subject,
                                 const CohortSetup& setup, int number) {
   SessionManifest manifest;
-  manifest.session_id = protocol.protocol.name + "-s" + std::to_string(number);
+  // A key across subjects, as a session folder's name is: the protocol, the subject, the session number.
+  manifest.session_id = protocol.protocol.name + "-" + subject.id + "-s" + std::to_string(number);
   manifest.setup.subject = subject;
   manifest.setup.device = kCohortDevice;
   manifest.setup.writer = "simulated";

@@ -10,9 +10,13 @@ namespace {
 
 using nlohmann::json;
 constexpr const char* kFormat = "calligraphy-study-session";
+// Version 2 counts a planned trial's block and item from 1, as its index and repetition; version 1 (older
+// folders) counted them from 0.
+constexpr std::int64_t kVersion = 2;
 
 PlannedTrial planned_trial_from(const json& value, const std::string& pointer, const std::string& source,
-                                std::size_t expected_index) {
+                                std::size_t expected_index, std::int64_t version) {
+  const std::int64_t first = version >= 2 ? 1 : 0;  // the first block and item
   ObjectReader reader(value, pointer, source);
   PlannedTrial trial;
   trial.index = static_cast<std::size_t>(reader.integer("index", 1, 1000000)) - 1;
@@ -21,7 +25,7 @@ PlannedTrial planned_trial_from(const json& value, const std::string& pointer, c
          "expected " + std::to_string(expected_index + 1) + " (trials in order)");
   }
   trial.phase = choice(reader, "phase", kStudyPhases);
-  trial.block = static_cast<std::size_t>(reader.integer("block", 0, 1000000));
+  trial.block = static_cast<std::size_t>(reader.integer("block", first, 1000000) - first);
   trial.condition = reader.string("condition");
   try {
     trial.characters = decode_utf8(reader.string("characters"));
@@ -29,7 +33,7 @@ PlannedTrial planned_trial_from(const json& value, const std::string& pointer, c
     fail(source, reader.pointer("characters"), std::string("not UTF-8: ") + e.what());
   }
   if (trial.characters.empty()) fail(source, reader.pointer("characters"), "empty");
-  trial.item = static_cast<std::size_t>(reader.integer("item", 0, 1000000));
+  trial.item = static_cast<std::size_t>(reader.integer("item", first, 1000000) - first);
   trial.repetition = static_cast<int>(reader.integer("repetition", 1, 1000000));
   trial.break_before_s = reader.number_or("break_before_s", 0.0, 0.0, 86400.0);
   reader.optional("file");
@@ -51,10 +55,10 @@ json planned_trial_json(const PlannedTrial& trial) {
   for (const char32_t c : trial.characters) characters += encode_utf8(c);
   return {{"index", trial.index + 1},
           {"phase", to_string(trial.phase)},
-          {"block", trial.block},
+          {"block", trial.block + 1},
           {"condition", trial.condition},
           {"characters", characters},
-          {"item", trial.item},
+          {"item", trial.item + 1},
           {"repetition", trial.repetition},
           {"break_before_s", trial.break_before_s},
           {"file", SessionFolder::trial_stem(trial)}};
@@ -65,7 +69,7 @@ std::string manifest_to_json(const SessionManifest& manifest) {
   for (const PlannedTrial& trial : manifest.plan) plan.push_back(planned_trial_json(trial));
   const SessionSetup& setup = manifest.setup;
   json document = {{"format", kFormat},
-                   {"version", 1},
+                   {"version", kVersion},
                    {"created_utc", manifest.created_utc},
                    {"subject", {{"id", setup.subject.id}, {"number", setup.subject.number}}},
                    {"session_number", setup.session_number},
@@ -99,7 +103,7 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
   const json document = parse_json(text, source);
   ObjectReader root(document, "", source);
   if (root.string("format") != kFormat) fail(source, "/format", std::string("expected \"") + kFormat + "\"");
-  root.integer("version", 1, 1);
+  const std::int64_t version = root.integer("version", 1, kVersion);
   SessionManifest manifest;
   manifest.created_utc = root.string("created_utc");
   ObjectReader subject(root.required("subject"), "/subject", source);
@@ -158,7 +162,7 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
   const json& plan = root.required("plan");
   if (!plan.is_array() || plan.empty()) fail(source, "/plan", "expected a list of planned trials");
   for (std::size_t i = 0; i < plan.size(); ++i) {
-    PlannedTrial trial = planned_trial_from(plan[i], child_pointer("/plan", i), source, i);
+    PlannedTrial trial = planned_trial_from(plan[i], child_pointer("/plan", i), source, i, version);
     // Only conditions of the protocol can run.
     bool known = false;
     for (const StudyCondition& c : manifest.protocol.protocol.conditions)

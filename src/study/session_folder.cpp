@@ -17,6 +17,7 @@
 #include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/trial/options.hpp"
 #include "core/unicode.hpp"
+#include "report/compressed_text.hpp"
 #include "study/json_reader.hpp"
 #include "study/manifest_json.hpp"
 #include "study/names.hpp"
@@ -165,7 +166,9 @@ SessionFolder SessionFolder::create(const fs::path& root, const SessionSetup& se
 
   const fs::path subject_folder = root / setup.subject.id;
   make_folder(subject_folder);
-  const std::string base = protocol.protocol.name + "-" + folder_timestamp();
+  // The session id names the protocol, the subject and the second it began, so ids are keys across
+  // subjects (two subjects started in the same second differ) and sort by time within a subject.
+  const std::string base = protocol.protocol.name + "-" + setup.subject.id + "-" + folder_timestamp();
   fs::path folder;
   for (int suffix = 1;; ++suffix) {
     const std::string name = suffix == 1 ? base : base + "-" + std::to_string(suffix);
@@ -254,7 +257,7 @@ void SessionFolder::save_trial(const PlannedTrial& trial, std::string_view json,
   const fs::path target = trial_file(trial, "json");
   if (is_saved(trial))
     throw StateError(target.string() + ": the trial is saved already; it is never overwritten");
-  write_file_atomically(trial_file(trial, "csv"), csv);
+  write_file_atomically(trial_file(trial, kTraceExtension), gzip_text(csv));
   write_file_atomically(trial_file(trial, "svg"), svg);
   // The JSON marks the trial saved: written whole to a temporary, then linked to its name, which fails
   // (EEXIST) instead of replacing a file that appeared meanwhile.
@@ -280,7 +283,7 @@ fs::path SessionFolder::save_attempt(const PlannedTrial& trial, std::string_view
     const fs::path temporary = json_path.string() + ".part";
     std::error_code error;
     if (fs::exists(json_path, error)) continue;
-    write_file_atomically(folder / (stem + ".csv"), csv);
+    write_file_atomically(folder / (stem + "." + std::string(kTraceExtension)), gzip_text(csv));
     write_file_atomically(temporary, json);
     const int linked = ::link(temporary.c_str(), json_path.c_str());
     const int link_error = errno;

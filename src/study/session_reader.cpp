@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <set>
 #include <string>
 
@@ -10,9 +11,11 @@
 #include "calligraphy/report/pen_trace_csv.hpp"
 #include "core/decimal_number.hpp"
 #include "core/unicode.hpp"
+#include "report/compressed_text.hpp"
 #include "study/json_reader.hpp"
 #include "study/names.hpp"
 #include "study/saved_sessions.hpp"
+#include "study/trial_row.hpp"
 
 namespace calligraphy {
 namespace fs = std::filesystem;
@@ -40,8 +43,9 @@ void read_scene(const study_detail::JsonView& record, ReportTrial& trial) {
       const study_detail::JsonView points = stroke.array("polyline_m");
       for (std::size_t i = 0; i < points.size(); ++i) polyline.push_back(vec2(points.at(i)));
       trial.reference_m.push_back(std::move(polyline));
-      trial.stroke_starts_m.push_back(vec2(study_detail::JsonView(
-          stroke.has("start_m") ? stroke.json()["start_m"] : json(), stroke.pointer() + "/start_m", stroke.source())));
+      trial.stroke_starts_m.push_back(
+          vec2(study_detail::JsonView(stroke.has("start_m") ? stroke.json()["start_m"] : json(),
+                                      stroke.pointer() + "/start_m", stroke.source())));
     }
   }
 }
@@ -55,25 +59,82 @@ double parse_field(std::string_view field, const std::string& source, std::size_
   return *value;
 }
 
-// The trial CSV (t,x,y,z,fx,fy,fz,state,stroke,element): times, positions, pen down, in-plane force.
+// A plain decimal ("-0.011845", "2.998", "0") of at most 15 digits at `at`, up to `end`: its value and where
+// it ends; nullptr for anything else. The digits as an integer and the power of ten are both exact doubles,
+// so one division rounds correctly: the value from_chars gives (Clinger 1990, "How to read floating point
+// numbers accurately", PLDI), in a fraction of its time; a trace has millions of such numbers.
+const char* plain_decimal(const char* at, const char* end, double& value) {
+  static constexpr double kPowers[] = {1e0, 1e1, 1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                       1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15};
+  const bool negative = at != end && *at == '-';
+  if (negative) ++at;
+  std::int64_t digits = 0;
+  int count = 0, decimals = 0;
+  bool point = false;
+  for (; at != end; ++at) {
+    if (*at >= '0' && *at <= '9') {
+      if (++count > 15) return nullptr;
+      digits = digits * 10 + (*at - '0');
+      decimals += point ? 1 : 0;
+    } else if (*at == '.' && !point) {
+      point = true;
+    } else {
+      break;
+    }
+  }
+  if (count == 0) return nullptr;
+  value = static_cast<double>(digits) / kPowers[decimals];
+  if (negative) value = -value;
+  return at;
+}
+
+// A trace line's first six fields (t, x, y, z, fx, fy) as finite numbers, each followed by a comma, and
+// the line's 10 fields in all: true; false for anything else (the field-by-field reading names the fault).
+bool read_leading_numbers(std::string_view line, std::array<double, 6>& values) {
+  const char* at = line.data();
+  const char* const end = at + line.size();
+  for (double& value : values) {
+    const char* next = plain_decimal(at, end, value);
+    if (next == nullptr) {  // an exponent, more digits: the full parse
+      const auto [parsed, error] = std::from_chars(at, end, value);
+      if (error != std::errc() || !std::isfinite(value)) return false;
+      next = parsed;
+    }
+    if (next == end || *next != ',') return false;
+    at = next + 1;
+  }
+  return std::count(at, end, ',') == 3;  // state, stroke, element
+}
+
+// The trial's trace (t,x,y,z,fx,fy,fz,state,stroke,element; gzip or plain CSV), streamed: times, positions,
+// pen down, in-plane force.
 void read_trace(const fs::path& file, double paper_z_m, ReportTrial& trial) {
-  const std::string text = study_detail::read_small_file(file, kMaxTrialCsvBytes, "trial trace (CSV)");
   const std::string source = file.string();
+  TextFileReader reader(file, kMaxTrialCsvBytes, kMaxTrialCsvBytes);
   const double contact_m = PenTraceCsvOptions{}.contact_threshold_m;
-  std::size_t line_number = 0, begin = 0;
-  constexpr const char* kHeader = "t,x,y,z,fx,fy,fz,state,stroke,element";
-  while (begin < text.size()) {
-    std::size_t end = text.find('\n', begin);
-    if (end == std::string::npos) end = text.size();
-    std::string_view line(text.data() + begin, end - begin);
-    begin = end + 1;
+  std::size_t line_number = 0;
+  constexpr std::string_view kHeader = "t,x,y,z,fx,fy,fz,state,stroke,element";
+  constexpr std::size_t kMaxLineBytes = 4096;
+  for_each_line(reader, source, kMaxLineBytes, [&](std::string_view line) {
     ++line_number;
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (line_number == 1) {
       if (line != kHeader) throw DataError(source + ":1: expected the header '" + std::string(kHeader) + "'");
-      continue;
+      return;
     }
-    if (line.empty()) continue;
+    if (line.empty()) return;
+    std::array<double, 6> values{};
+    if (read_leading_numbers(line, values)) {  // the common case, parsed where it stands
+      if (!trial.time_s.empty() && values[0] < trial.time_s.back()) {
+        throw DataError(source + ":" + std::to_string(line_number) + ": time goes backwards");
+      }
+      trial.time_s.push_back(values[0]);
+      trial.position_m.emplace_back(values[1], values[2]);
+      trial.pen_down.push_back(values[3] - paper_z_m <= contact_m);
+      trial.in_plane_force_n.push_back(Vec2(values[4], values[5]).norm());
+      return;
+    }
+    // Anything else field by field, so that an error names the field.
     std::array<std::string_view, 10> fields;
     std::size_t count = 0, start = 0;
     while (count < fields.size()) {
@@ -100,13 +161,23 @@ void read_trace(const fs::path& file, double paper_z_m, ReportTrial& trial) {
     trial.position_m.push_back(position);
     trial.pen_down.push_back(z - paper_z_m <= contact_m);
     trial.in_plane_force_n.push_back(force.norm());
-  }
+  });
+  if (line_number == 0) throw DataError(source + ":1: expected the header '" + std::string(kHeader) + "'");
 }
 
-ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifest, const PlannedTrial& plan) {
+ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifest, const PlannedTrial& plan,
+                       StudyTables* rows) {
   const std::string source = json_file.string();
   const json document = study_detail::read_trial_record(json_file);
   const study_detail::JsonView record(document, "", source);
+  if (rows != nullptr) {  // the tidy tables' rows from the same parse of the record
+    TrialRow row = study_detail::trial_row(document, source, manifest, plan, rows->strokes);
+    const std::string trace = record.object("files").string_or("csv", "");
+    if (trace.empty() || trace.find('/') != std::string::npos)
+      fail(source, "/files/csv", "expected a file name");
+    row.trace_file = json_file.parent_path() / trace;
+    rows->trials.push_back(std::move(row));
+  }
   ReportTrial trial;
   trial.subject = manifest.setup.subject.id;
   trial.session = manifest.session_id;
@@ -116,7 +187,8 @@ ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifes
   for (const char32_t c : plan.characters) trial.characters += encode_utf8(c);
   trial.end_reason = record.string_or("end_reason", "");
   trial.index = plan.index + 1;
-  trial.item = plan.item;
+  trial.block = plan.block + 1;
+  trial.item = plan.item + 1;
   trial.repetition = plan.repetition;
   trial.time_total_s = record.number("total_time_s", -1e12, 1e12);
   // null for a trial in which no stroke was written (the time ran out first): shown as such, not refused
@@ -126,7 +198,8 @@ ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifes
   trial.order_errors = static_cast<std::size_t>(record.number("order_errors", 0.0, 1e12));
   trial.backwards_strokes = static_cast<std::size_t>(record.number("backwards_strokes", 0.0, 1e12));
   trial.completed = trial.end_reason == "completed";
-  if (record.has("quiz")) trial.quiz_misses = static_cast<int>(record.object("quiz").integer_or("misses", 0, 0, 1 << 30));
+  if (record.has("quiz"))
+    trial.quiz_misses = static_cast<int>(record.object("quiz").integer_or("misses", 0, 0, 1 << 30));
   read_scene(record, trial);
   const study_detail::JsonView per_stroke = record.array("per_stroke");
   for (std::size_t i = 0; i < per_stroke.size(); ++i) {
@@ -148,73 +221,83 @@ ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifes
 }
 
 std::string session_line(const SessionManifest& m, const fs::path& folder, std::size_t saved) {
-  std::string writer =
-      m.setup.writer == "simulated" ? "simulated writer (" + m.setup.writer_profile + ")" : "human";
-  return "Subject " + m.setup.subject.id + ": " + folder.string() + ", protocol " + m.protocol.protocol.name +
-         " (sha256 " + m.protocol.sha256.substr(0, 12) + "), device " + m.setup.device + ", " + writer +
-         ", " + std::to_string(saved) + " of " + std::to_string(m.plan.size()) + " trials saved, library " +
-         m.library.version + " " + m.library.build_type;
+  std::string writer = m.setup.writer == "simulated" ? "simulated writer (" + m.setup.writer_profile +
+                                                           ", learning " + m.setup.writer_learning + ")"
+                                                     : "human";
+  return folder.string() + ", protocol " + m.protocol.protocol.name + " (sha256 " +
+         m.protocol.sha256.substr(0, 12) + "), session " + std::to_string(m.setup.session_number) +
+         ", device " + m.setup.device + ", " + writer + ", " + std::to_string(saved) + " of " +
+         std::to_string(m.plan.size()) + " trials saved, library " + m.library.version + " " +
+         m.library.build_type;
+}
+
+fs::path trial_record_file(const fs::path& folder, const PlannedTrial& plan) {
+  return folder / "trials" / (SessionFolder::trial_stem(plan) + ".json");
+}
+
+bool is_saved(const fs::path& folder, const PlannedTrial& plan) {
+  std::error_code error;
+  return fs::exists(trial_record_file(folder, plan), error);
+}
+
+// What the simulated subjects were, from the learning models their sessions ran with.
+std::string simulated_note(const std::set<std::string>& learning) {
+  std::string note =
+      "Simulated subjects: a simulated writer (hand impedance, minimum-jerk strokes, a seeded bias and "
+      "tremor) moves a simulated device; it is a model of a writer, not a person.";
+  if (learning.contains("two-state")) {
+    note +=
+        " With writer learning two-state it learns: a memory of each typical stroke and character that "
+        "practice builds and time between sessions thins (docs/writer.md).";
+  }
+  if (learning.contains("none")) {
+    note += " With writer learning none it does not learn: its repetitions differ only by their seeds.";
+  }
+  return note;
 }
 
 }  // namespace
 
-StudyReport read_study_report(const std::vector<fs::path>& roots) {
+StudyReportSessions list_report_sessions(const std::vector<fs::path>& roots) {
   const std::vector<fs::path> folders = study_detail::session_folders_under(roots);
   study_detail::DistinctSessions distinct;
-  StudyReport report;
-  std::set<std::string> protocols;
-  bool simulated = false;
+  StudyReportSessions found;
+  std::set<std::string> protocols, protocol_names, learning;
   for (const fs::path& folder : folders) {
-    const SessionManifest manifest = study_detail::read_session_manifest(folder);
+    SessionManifest manifest = study_detail::read_session_manifest(folder);
     if (!distinct.add(folder, manifest)) continue;
-    if (report.title.empty()) {
-      const StudyProtocol& p = manifest.protocol.protocol;
-      report.title = "Study report: " + p.name;
-      // The paper's test phase, else the training: the phase whose conditions the tables compare.
-      const ProtocolPhase* shown = nullptr;
-      for (const StudyPhase kind : {StudyPhase::training, StudyPhase::test}) {
-        for (const ProtocolPhase& phase : p.phases) shown = phase.kind == kind ? &phase : shown;
-      }
-      if (shown == nullptr) shown = &p.phases.front();
-      report.phase = to_string(shown->kind);
-      for (const ProtocolPhase& phase : p.phases) {
-        if (phase.kind != shown->kind) continue;
-        for (const std::string& c : phase.conditions) {
-          if (std::find(report.conditions.begin(), report.conditions.end(), c) == report.conditions.end())
-            report.conditions.push_back(c);
-        }
-      }
-      for (const std::u32string& item : shown->items) {
-        std::string text;
-        for (const char32_t c : item) text += encode_utf8(c);
-        report.items.push_back(text);
-      }
-    }
     protocols.insert(manifest.protocol.sha256);
-    simulated = simulated || manifest.setup.writer == "simulated";
-    std::size_t saved = 0;
-    for (const PlannedTrial& plan : manifest.plan) {
-      const fs::path json_file = folder / "trials" / (SessionFolder::trial_stem(plan) + ".json");
-      std::error_code error;
-      if (!fs::exists(json_file, error)) continue;
-      report.trials.push_back(read_trial(json_file, manifest, plan));
-      ++saved;
-    }
-    report.sessions.push_back(session_line(manifest, folder, saved));
+    protocol_names.insert(manifest.protocol.protocol.name);
+    if (manifest.setup.writer == "simulated") learning.insert(manifest.setup.writer_learning);
+    ReportSession shown;
+    shown.subject = manifest.setup.subject.id;
+    shown.session = manifest.session_id;
+    shown.group = manifest.group;
+    shown.planned = manifest.plan.size();
+    for (const PlannedTrial& plan : manifest.plan) shown.saved += is_saved(folder, plan) ? 1 : 0;
+    shown.description = session_line(manifest, folder, shown.saved);
+    for (const StudyCondition& condition : manifest.protocol.protocol.conditions)
+      shown.conditions.push_back(condition.name);
+    found.index.sessions.push_back(shown);
+    found.sessions.push_back({std::move(shown), folder, std::move(manifest)});
   }
+  std::string names;
+  for (const std::string& name : protocol_names) names += (names.empty() ? "" : ", ") + name;
+  found.index.title = "Trials of " + names;
   if (protocols.size() > 1) {
-    report.notes.push_back("The sessions ran under " + std::to_string(protocols.size()) +
-                           " different protocol files; the tables use the first session's conditions and "
-                           "characters.");
+    found.index.notes.push_back("The sessions ran under " + std::to_string(protocols.size()) +
+                                " different protocol files.");
   }
-  if (simulated) {
-    report.notes.push_back(
-        "Simulated subjects: a simulated writer (hand impedance, minimum-jerk strokes, a "
-        "seeded bias and tremor) moves a simulated device. It does not learn: its "
-        "repetitions differ only by their seeds, so its learning curves are flat by "
-        "construction.");
+  if (!learning.empty()) found.index.notes.push_back(simulated_note(learning));
+  return found;
+}
+
+void read_session_trials(const ReportedSession& session, const std::function<void(const ReportTrial&)>& trial,
+                         StudyTables* rows) {
+  for (const PlannedTrial& plan : session.manifest.plan) {
+    if (!is_saved(session.folder, plan)) continue;  // not saved (yet): a running session can be reported
+    trial(read_trial(trial_record_file(session.folder, plan), session.manifest, plan, rows));
   }
-  return report;
 }
 
 }  // namespace calligraphy

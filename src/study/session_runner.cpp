@@ -296,7 +296,7 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     ran_one = true;
 
     const std::string stem = SessionFolder::trial_stem(trial);
-    context.csv_file = stem + ".csv";
+    context.csv_file = stem + "." + std::string(SessionFolder::kTraceExtension);
     context.svg_file = stem + ".svg";
     const WritingMetrics& writing = run.metrics;
     std::vector<std::vector<QuizEvent>> quiz;

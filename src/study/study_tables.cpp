@@ -45,9 +45,9 @@ void add_strokes(const JsonView& character, std::size_t index, const TrialRow& t
     row.trial = trial.trial;
     row.phase = trial.phase;
     row.condition = trial.condition;
-    row.character = index;
+    row.character = index + 1;
     row.character_text = character.string_or("character", "");
-    row.stroke = s;
+    row.stroke = s + 1;
     row.typical_id = static_cast<int>(metrics.integer_or("typical_id", 0, 0, 39));
     row.written = metrics.boolean_or("written", false);
     row.backwards = metrics.boolean_or("backwards", false);
@@ -101,13 +101,14 @@ TrialRow study_detail::trial_row(const json& document, const std::string& source
   row.session_number = manifest.setup.session_number;
   row.group = manifest.group;
   row.phase = to_string(plan.phase);
-  row.block = plan.block;
+  row.block = plan.block + 1;
   row.condition = plan.condition;
   row.mode = record.string_or("mode", "");
   for (const char32_t c : plan.characters) row.characters += encode_utf8(c);
-  row.trial = plan.index;
-  row.item = plan.item;
-  row.repetition = static_cast<std::size_t>(plan.repetition - 1);
+  // Design ordinals count from 1, as the trial files (001-..., r1) and session numbers do.
+  row.trial = plan.index + 1;
+  row.item = plan.item + 1;
+  row.repetition = static_cast<std::size_t>(plan.repetition);
   row.writer = manifest.setup.writer;
   if (row.writer == "simulated") {
     row.writer_profile = manifest.setup.writer_profile;

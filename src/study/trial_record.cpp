@@ -245,9 +245,10 @@ nlohmann::json trial_record(const TrialRecordContext& c, const Scene& scene, con
                           {"end_s", has_trace ? json(result.trace[s.trace_end - 1].time_s) : json(nullptr)}});
   }
   const PlannedTrial& t = *c.trial;
+  // Version 2: the trial's block and item count from 1, as its index and repetition (version 1: from 0).
   json document = {
       {"format", kFormat},
-      {"version", 1},
+      {"version", 2},
       {"subject", c.session->setup.subject.id},
       {"subject_number", c.session->setup.subject.number},
       {"session", c.session->session_id},

@@ -81,7 +81,7 @@ std::pair<std::filesystem::path, bool> PracticeSession::save(const PracticeTrial
   context.end_utc = trial.end_utc;
   context.wall_time_s = trial.wall_time_s;
   const std::string stem = SessionFolder::trial_stem(planned);
-  context.csv_file = stem + ".csv";
+  context.csv_file = stem + "." + std::string(SessionFolder::kTraceExtension);
   context.svg_file = stem + ".svg";
   const Scene& scene = *trial.scene;
   const WritingMetrics writing = trial_writing_metrics(scene, result, trial.options->force.acceptance);

@@ -368,6 +368,23 @@ def model_trace(model, order=None, reverse=()):
     return "\n".join(rows) + "\n"
 
 
+def assert_same_record(case, scored, recorded, where):
+    """The metrics of a trace file and of the trial itself agree: counts, flags and texts exactly, numbers to
+    the trace's precision (times to 1 us, lengths to 0.1 um; docs/experiments.md), so to 1e-6 relative."""
+    if isinstance(recorded, dict):
+        case.assertEqual(sorted(scored), sorted(recorded), where)
+        for key in recorded:
+            assert_same_record(case, scored[key], recorded[key], f"{where}/{key}")
+    elif isinstance(recorded, list):
+        case.assertEqual(len(scored), len(recorded), where)
+        for index, (a, b) in enumerate(zip(scored, recorded)):
+            assert_same_record(case, a, b, f"{where}/{index}")
+    elif isinstance(recorded, float) and not isinstance(recorded, bool):
+        case.assertAlmostEqual(scored, recorded, delta=1e-6 * max(1.0, abs(recorded)), msg=where)
+    else:
+        case.assertEqual(scored, recorded, where)
+
+
 class Score(CliTestCase):
     def score(self, trace_text, character, *args):
         (self.cwd / "trace.csv").write_text(trace_text)
@@ -392,7 +409,7 @@ class Score(CliTestCase):
             self.assertIn("strokes written", result.stdout.decode())  # the table
             score = json.loads((self.cwd / "s.json").read_text())
             for key in self.METRIC_KEYS:
-                self.assertEqual(score[key], metrics[key], f"{characters}: {key}")
+                assert_same_record(self, score[key], metrics[key], f"{characters}: {key}")
             self.assertEqual(len(score["per_character"]), len(characters))
             self.assertGreater(score["strokes_written"], 0)
             self.assertLessEqual(score["mean_deviation_mm"], score["max_deviation_mm"])
@@ -586,7 +603,7 @@ class OneCommandLine(CliTestCase):
                          "--json": "FILE|-", "--csv": "FILE|-", "--svg": "FILE|-"},
             ("session", "run"): {"PROTOCOL": "FILE", "--out": "DIR", "--screenshot": "FILE"},
             ("session", "resume"): {"DIR": "DIR", "--screenshot": "FILE"},
-            ("report",): {"DIR": "DIR", "--out": "FILE|-"},
+            ("report",): {"DIR": "DIR", "--out": "FILE"},
             ("score",): {"TRACE": "FILE", "--json": "FILE|-"},
             ("corpus", "stats"): {"FILE": "FILE"},
             ("corpus", "build"): {"--out": "FILE", "--data": "DIR"},

@@ -54,7 +54,9 @@ def test_the_rows_are_those_of_the_session_folders(cli, protocol, threads):
                                       folders.trials.drop(columns=FOLDER_ONLY), check_categorical=False)
     pandas.testing.assert_frame_equal(threads.strokes.drop(columns=["session"]),
                                       folders.strokes.drop(columns=["session"]), check_categorical=False)
-    assert set(threads.trials.session) == {"py-cohort-s1", "py-cohort-s2"}
+    # Session ids are keys across subjects: the protocol, the subject, the session number.
+    assert set(threads.trials.session) == {f"py-cohort-{subject}-s{number}"
+                                           for subject in threads.trials.subject.unique() for number in (1, 2)}
 
 
 def test_a_dask_cluster_and_the_cli_give_the_same_tables(cli, protocol, threads):

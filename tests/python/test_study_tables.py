@@ -1,6 +1,7 @@
 """calligraphy.study.load: a study's tidy tables are the CLI's `report --csv` tables, hold every saved trial with
 its record's metrics in SI units, and give each trial's samples on demand."""
 
+import gzip
 import json
 import subprocess
 from pathlib import Path
@@ -10,6 +11,12 @@ import pytest
 pd = pytest.importorskip("pandas")
 
 import calligraphy.study  # noqa: E402
+
+def record_path(trace_file):
+    """The trial record beside a trace: STEM.json for STEM.csv.gz (or an older folder's STEM.csv)."""
+    trace = Path(trace_file)
+    return trace.with_name(trace.name.removesuffix(".gz").removesuffix(".csv") + ".json")
+
 
 @pytest.fixture(scope="module")
 def study_folder(small_study, tmp_path_factory):
@@ -25,10 +32,14 @@ def test_the_tables_are_the_cli_tables_and_the_records(cli, study_folder):
     assert set(study.trials["phase"]) == {"practice", "test"}
     assert set(study.trials["subject"]) == {"S01", "S02"}
     for _, row in study.trials.iterrows():
-        record = json.loads(Path(row["trace_file"]).with_suffix(".json").read_text(encoding="utf-8"))
+        record = json.loads(record_path(row["trace_file"]).read_text(encoding="utf-8"))
         assert row["mean_deviation_m"] == pytest.approx(record["mean_deviation_mm"] * 1e-3, rel=1e-12)
         assert row["total_time_s"] == record["total_time_s"]
-        assert row["repetition"] == record["repetition"] - 1
+        # Indices count from 1, as the record's and the file's (001-..., r1).
+        assert row["repetition"] == record["repetition"] == record["trial"]["repetition"]
+        assert row["trial"] == record["trial"]["index"] == int(Path(row["trace_file"]).name[:3])
+        assert row["block"] == record["trial"]["block"] >= 1
+        assert row["item"] == record["trial"]["item"] >= 1
         assert row["condition"] == record["condition"]
         assert row["completed_in_order"] == record["completed_in_order"]
         assert row["strokes_accepted"] == record["strokes_accepted"]
@@ -36,6 +47,7 @@ def test_the_tables_are_the_cli_tables_and_the_records(cli, study_folder):
     assert study.trials["completed_in_order"].dtype == bool and study.trials["completed_in_order"].any()
     assert study.strokes["written"].dtype == bool
     assert study.strokes["written"].sum() == study.trials["strokes_written"].sum()
+    assert study.strokes["stroke"].min() == 1 and study.strokes["character"].min() == 1
     # The CLI writes the same tables.
     (study_folder / "tables").mkdir(exist_ok=True)
     run = subprocess.run([cli, "report", "study", "--csv", "tables"], cwd=study_folder, capture_output=True)
@@ -45,13 +57,20 @@ def test_the_tables_are_the_cli_tables_and_the_records(cli, study_folder):
     assert cli_trials["mean_deviation_m"].tolist() == pytest.approx(study.trials["mean_deviation_m"].tolist())
     cli_strokes = pd.read_csv(study_folder / "tables" / "strokes.csv")
     assert len(cli_strokes) == len(study.strokes)
+    # With the per-trial pages, the tables come from the pages' read of each record: the same bytes.
+    (study_folder / "with_pages").mkdir(exist_ok=True)
+    run = subprocess.run([cli, "report", "study", "--csv", "with_pages", "--out", "with_pages/trials.html"],
+                         cwd=study_folder, capture_output=True)
+    assert run.returncode == 0, run.stderr.decode()
+    for name in ("trials.csv", "strokes.csv"):
+        assert (study_folder / "with_pages" / name).read_bytes() == (study_folder / "tables" / name).read_bytes()
 
 
 def test_samples_are_read_on_demand_in_si_units(study_folder):
     study = calligraphy.study.load([study_folder / "study"])
     first = study.trials.iloc[0]
     samples = study.samples(first)
-    record = json.loads(Path(first["trace_file"]).with_suffix(".json").read_text(encoding="utf-8"))
+    record = json.loads(record_path(first["trace_file"]).read_text(encoding="utf-8"))
     assert len(samples) == record["samples"]
     assert {"t_s", "x_m", "y_m", "z_m", "fx_n", "fy_n", "fz_n", "state", "stroke", "element"} <= set(samples)
     assert samples["t_s"].is_monotonic_increasing
@@ -106,10 +125,53 @@ def test_a_damaged_trace_is_a_data_error_naming_the_file_and_line(study_folder, 
     shutil.copytree(study_folder / "study", copy)
     study = calligraphy.study.load(copy)
     trace = Path(study.trials.iloc[0]["trace_file"])
-    lines = trace.read_text(encoding="utf-8").splitlines()
+    assert trace.name.endswith(".csv.gz")  # stored compressed
+    lines = gzip.decompress(trace.read_bytes()).decode("utf-8").splitlines()
     for line, damaged, column in [(3, lines[2].replace(",", ",1e999x", 1), "x"), (4, "inf" + lines[3][1:], "t"),
                                   (1, "t,x,y", None)]:
-        trace.write_text("\n".join(lines[:line - 1] + [damaged] + lines[line:]) + "\n", encoding="utf-8")
+        text = "\n".join(lines[:line - 1] + [damaged] + lines[line:]) + "\n"
+        trace.write_bytes(gzip.compress(text.encode("utf-8")))
         expected = f"{trace.name}:{line}: column {column}" if column else f"{trace.name}:1: expected the header"
         with pytest.raises(calligraphy.DataError, match=expected):
             study.samples(study.trials.iloc[0])
+
+
+def test_a_plain_csv_trace_of_an_older_folder_reads_as_the_compressed_one(cli, study_folder, tmp_path):
+    """Folders written before traces were compressed name a plain .csv trace in their records."""
+    import shutil
+
+    copy = tmp_path / "study"
+    shutil.copytree(study_folder / "study", copy)
+    compressed = calligraphy.study.load(copy)
+    expected = compressed.samples(compressed.trials.iloc[0])
+    trace = Path(compressed.trials.iloc[0]["trace_file"])
+    record_file = record_path(trace)
+    plain = trace.with_name(trace.name.removesuffix(".gz"))
+    plain.write_bytes(gzip.decompress(trace.read_bytes()))
+    trace.unlink()
+    record = json.loads(record_file.read_text(encoding="utf-8"))
+    record["files"]["csv"] = plain.name
+    record_file.write_text(json.dumps(record), encoding="utf-8")
+    older = calligraphy.study.load(copy)
+    assert older.trials.iloc[0]["trace_file"] == str(plain)
+    pd.testing.assert_frame_equal(older.samples(older.trials.iloc[0]), expected)
+    # The C++ readers take it too: the per-trial pages.
+    run = subprocess.run([cli, "report", str(copy), "--out", str(tmp_path / "t.html")],
+                         capture_output=True)
+    assert run.returncode == 0, run.stderr.decode()
+
+
+def test_a_truncated_compressed_trace_is_a_data_error_naming_the_file(study_folder, tmp_path):
+    import shutil
+
+    copy = tmp_path / "study"
+    shutil.copytree(study_folder / "study", copy)
+    study = calligraphy.study.load(copy)
+    trace = Path(study.trials.iloc[0]["trace_file"])
+    data = trace.read_bytes()
+    trace.write_bytes(data[: len(data) // 2])
+    with pytest.raises(calligraphy.DataError, match=trace.name):
+        study.samples(study.trials.iloc[0])
+    trace.write_bytes(b"\x1f\x8b" + b"not deflate at all" * 10)
+    with pytest.raises(calligraphy.DataError, match=trace.name):
+        study.samples(study.trials.iloc[0])

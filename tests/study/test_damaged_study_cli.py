@@ -188,7 +188,8 @@ class DamagedStudyTest(unittest.TestCase):
         record.write_text(json.dumps(document), encoding="utf-8")
         result = self.run_cli("report", "S", "--out", "r.html")
         self.assertEqual(result.returncode, 0, result.stderr.decode())
-        page = (self.cwd / "r.html").read_text(encoding="utf-8")
+        # The trial is on its session's page, beside the index.
+        page = (self.cwd / "r_files" / "S01" / f"{record.parents[1].name}.html").read_text(encoding="utf-8")
         self.assertIn("time_limit", page)
         self.assertNotIn("nan", page.lower().replace("nano", ""))
 

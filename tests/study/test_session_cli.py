@@ -74,7 +74,7 @@ class SessionCliTest(unittest.TestCase):
         self.assertEqual(process.returncode, expected_status, stderr.decode())
         planned = json.loads((session / "session.json").read_text(encoding="utf-8"))["plan"]
         before = {path.name: digest(path) for path in (session / "trials").glob("*.*") if
-                  path.with_suffix(".json").exists() and not path.name.endswith(".part")}
+                  path.with_name(path.name.split(".")[0] + ".json").exists() and not path.name.endswith(".part")}
         self.assertLess(len(self.saved(session)), len(planned), "the signal came after the last trial")
         if signal_number != signal.SIGKILL:
             self.assertIn("resume with: calligraphy session resume", stderr.decode())
@@ -84,8 +84,8 @@ class SessionCliTest(unittest.TestCase):
         self.assertEqual(len(self.saved(session)), len(planned))
         for name, value in before.items():  # every trial saved before the signal is unchanged
             self.assertEqual(digest(session / "trials" / name), value, name)
-        for trial in planned:  # every planned trial has its JSON, CSV and SVG
-            for extension in ("json", "csv", "svg"):
+        for trial in planned:  # every planned trial has its JSON, trace (compressed CSV) and SVG
+            for extension in ("json", "csv.gz", "svg"):
                 self.assertTrue((session / "trials" / f"{trial['file']}.{extension}").is_file(), trial["file"])
         events, torn = [], 0
         for line in (session / "log.jsonl").read_text(encoding="utf-8").splitlines():
@@ -223,10 +223,23 @@ class SessionCliTest(unittest.TestCase):
         trials = sum(len(m["plan"]) for m in manifests)
         report = self.run_cli("report", "study", "--out", "study/report.html")
         self.assertEqual(report.returncode, 0, report.stderr.decode())
-        page = (self.cwd / "study" / "report.html").read_text(encoding="utf-8")
-        self.assertEqual(page.count('<figure class="trajectory"'), trials)
-        self.assertEqual(page.count('<figure class="force"'), trials)
-        self.assertEqual(page.count('<table class="summary"'), 4)
+        index = (self.cwd / "study" / "report.html").read_text(encoding="utf-8")
+        # One page per session, linked from the index; each trial anchored by its session id and number.
+        pages = sorted((self.cwd / "study" / "report_files").glob("S0*/*.html"))
+        self.assertEqual([p.stem for p in pages], [s.name for s in sessions])
+        for page_file, session, manifest in zip(pages, sessions, manifests):
+            self.assertIn(f'href="report_files/{page_file.parent.name}/{page_file.name}"', index)
+            page = page_file.read_text(encoding="utf-8")
+            self.assertEqual(page.count('<figure class="trajectory"'), len(manifest["plan"]))
+            self.assertEqual(page.count('<figure class="force"'), len(manifest["plan"]))
+            for number in range(1, len(manifest["plan"]) + 1):
+                self.assertIn(f'id="trial-{session.name}-{number}"', page)
+            self.assertNotIn("<table", page)  # no summary over trials: the study report's
+        self.assertEqual(sum(len(m["plan"]) for m in manifests), trials)
+        # The session ids name the subject: keys across subjects.
+        self.assertEqual(len({s.name for s in sessions}), 3)
+        for session in sessions:
+            self.assertIn(f"-{session.parent.name}-", session.name)
         record = json.loads(self.saved(sessions[0])[0].read_text(encoding="utf-8"))
         for key in ("frechet_mm", "dtw_mm", "order_errors", "backwards_strokes"):
             self.assertIn(key, record)

@@ -8,6 +8,7 @@ exit status (4 after a lost display, 128 + the signal's number).
 
 Environment: CALLIGRAPHY_CLI (the program), CALLIGRAPHY_SOURCE_DIR (the source tree)."""
 import csv
+import gzip
 import json
 import math
 import os
@@ -239,7 +240,7 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual(record["renderer"]["loop"]["stall_timeout_s"], 2.0)  # --watchdog-ms, in s
         for key in ("start_time_utc", "library", "mean_deviation_mm", "per_stroke", "loop", "per_character"):
             self.assertIn(key, record)
-        with open(record_path.with_suffix(".csv"), newline="") as f:
+        with gzip.open(record_path.with_suffix(".csv.gz"), "rt", newline="") as f:
             trace = list(csv.DictReader(f))
         self.assertEqual(len(trace), record["loop"]["ticks"])  # every tick kept
         self.assertTrue(record_path.with_suffix(".svg").read_text().startswith("<svg"))
@@ -303,7 +304,7 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual((record["strokes_completed"], record["strokes_total"]), (5, 5))
         self.assertTrue(record["loop"]["device_clock"])
         self.assertGreater(record["device"]["time_at_start_s"], 100.0)  # the stand-in's own clock
-        with open(record_path.with_suffix(".csv"), newline="") as f:
+        with gzip.open(record_path.with_suffix(".csv.gz"), "rt", newline="") as f:
             trace = list(csv.DictReader(f))
         self.assertEqual(float(trace[0]["t"]), 0.0)
         self.assertEqual(len(trace), record["loop"]["ticks"])
@@ -573,7 +574,7 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual(record["end_reason"], "interrupted")
         self.assertTrue(record["aborted"])
         self.assertLess(record["strokes_completed"], 5)
-        with open(record_path.with_suffix(".csv"), newline="") as f:
+        with gzip.open(record_path.with_suffix(".csv.gz"), "rt", newline="") as f:
             rows = sum(1 for _ in csv.DictReader(f))
         self.assertGreater(rows, 3000)  # about 4 s at 1 kHz
         self.assertEqual(rows, record["loop"]["ticks"])
@@ -755,7 +756,7 @@ def records_and_rows(attempts):
     """The one interrupted attempt's record and its CSV's row count."""
     (record_path,) = attempts
     record = json.loads(record_path.read_text(encoding="utf-8"))
-    with open(record_path.with_suffix(".csv"), newline="") as f:
+    with gzip.open(record_path.with_suffix(".csv.gz"), "rt", newline="") as f:
         rows = sum(1 for _ in csv.DictReader(f))
     return record, rows
 

@@ -5,7 +5,7 @@ local core or on a Dask cluster.
 sessions as ``calligraphy session run --subjects N`` would, with the same plan, seeds, guidance schedules and
 learning memory, but without session folders, traces or per-trial files (``simulate_cohort``,
 include/calligraphy/study/cohort.hpp), and returns a ``calligraphy.study.Study``: the tidy tables that
-``calligraphy.study.load`` reads from folders, row for row, except for the ``session`` name ("PROTOCOL-sN"),
+``calligraphy.study.load`` reads from folders, row for row, except for the ``session`` name ("PROTOCOL-SUBJECT-sN"),
 an empty ``start_utc`` and no trace file. The tables feed ``calligraphy.statistics`` (``learning``,
 ``group_comparison``) as they are.
 

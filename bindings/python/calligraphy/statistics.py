@@ -3,7 +3,7 @@ conditions, a linear mixed model, learning and retention, and groups compared be
 
 ``trials`` is a pandas DataFrame with one row per trial and the columns ``subject``, ``session``,
 ``phase`` (e.g. 'practice', 'test', or 'pre-test', 'training', 'post-test', 'retention', 'transfer'),
-``condition``, ``characters`` (str) and ``repetition`` (int, 0-based, as calligraphy.study gives it), plus numeric outcomes in SI units
+``condition``, ``characters`` (str) and ``repetition`` (int, 1-based, as calligraphy.study gives it), plus numeric outcomes in SI units
 named with their unit: ``mean_deviation_m``, ``max_deviation_m``, ``total_time_s``, ``pen_down_time_s``
 (NaN for a trial that wrote nothing). Each function needs only the columns it uses, and reports in the
 outcome's own unit. An infinite outcome counts as missing, like NaN, with a NonFiniteValueWarning naming

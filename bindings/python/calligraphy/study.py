@@ -4,8 +4,10 @@ reference stroke, and gives each trial's samples on demand.
 The tables are the ones ``calligraphy report DIR --csv TABLES`` writes (``read_study_tables``,
 include/calligraphy/study/study_tables.hpp): the same code, so R, spreadsheet and Python users see the same
 numbers. Metrics are each trial record's one metrics record (docs/metrics.md) in SI units, the unit in every
-column name; indices are 0-based. Traces are never read by ``load``: ``Study.samples(trial)`` reads one trial's
-CSV when asked, and ``Study.iter_samples()`` streams them one at a time. Columns: docs/experiments.md ("Tidy
+column name; indices (trial, block, item, repetition, character, stroke) count from 1, as the trial files'
+numbers (001-..., r1) do. Traces are never read by ``load``: ``Study.samples(trial)`` reads one trial's
+trace (its CSV, gzip-compressed: ``.csv.gz``; a plain ``.csv`` in older folders) when asked, and
+``Study.iter_samples()`` streams them one at a time. Columns: docs/experiments.md ("Tidy
 tables"). Tidy data: Wickham 2014, J Stat Softw 59(10).
 """
 
@@ -42,14 +44,20 @@ _TRACE_HEADER = ["t", "x", "y", "z", "fx", "fy", "fz", "state", "stroke", "eleme
 
 
 def _read_trace(path: str) -> "pandas.DataFrame":
-    """A trial's trace CSV as samples; DataError naming the file and line for damage."""
+    """A trial's trace as samples: its CSV, gzip-compressed (``.csv.gz``, decompressed as it is read) or plain
+    (``.csv``, older session folders); DataError naming the file and line for damage."""
+    import gzip
+    import zlib
+
     import numpy as np
 
     from . import DataError
 
     pd = _pandas()
     try:
-        frame = pd.read_csv(path, dtype=str, keep_default_na=False)
+        frame = pd.read_csv(path, dtype=str, keep_default_na=False, compression="infer")
+    except (gzip.BadGzipFile, EOFError, zlib.error) as error:
+        raise DataError(f"{path}: not a gzip-compressed trial trace: {error}") from error
     except (ValueError, pd.errors.ParserError, UnicodeDecodeError) as error:
         raise DataError(f"{path}: not a trial trace (CSV): {error}") from error
     if list(frame.columns) != _TRACE_HEADER:
@@ -98,12 +106,12 @@ class Study:
 
     trials: one row per saved trial (subject, session, protocol, session_number (1-based: which of the
         protocol's sessions), group (the subject's between-subjects group, '' when none), phase, block,
-        condition, mode, characters, trial, item, repetition (0-based), writer, end_reason, start_utc,
+        condition, mode, characters, trial, item, repetition (1-based), writer, end_reason, start_utc,
         completed_in_order, stroke counts, order_errors, backwards_strokes, unmatched_segments, mean/max/rms_deviation_m, frechet_m, dtw_m [m],
         total_time_s, pen_down_time_s [s], velocity_peaks, normalised_jerk, shape_skill, order_skill and
         timing_skill (a learning simulated writer's skills before the trial, NaN otherwise), trace_file).
     strokes: one row per reference stroke of each saved trial (subject, session, trial, phase, condition,
-        character (0-based in the trial), character_text, stroke (0-based in its character), typical_id,
+        character (1-based in the trial), character_text, stroke (1-based in its character), typical_id,
         written, backwards, segments, refused_segments, refusal, the per-stroke deviations [m], time_s [s],
         path_length_m [m]).
     """
@@ -113,7 +121,7 @@ class Study:
 
     def samples(self, trial: typing.Union[int, "pandas.Series"]) -> "pandas.DataFrame":
         """One trial's trace, read now: a DataFrame of N ticks with t_s [s], x_m, y_m, z_m [m] (device frame),
-        fx_n, fy_n, fz_n [N], state, stroke, element (0-based). `trial` is a row of `trials` or its index
+        fx_n, fy_n, fz_n [N], state, stroke, element (positions in the scene's arrays, 0-based). `trial` is a row of `trials` or its index
         label. Raises KeyError for an unknown label, FileNotFoundError when the trace is gone, DataError naming
         the file and the line of a damaged trace (another header, a field that is not a finite number)."""
         row = self.trials.loc[trial] if not hasattr(trial, "trace_file") else trial

@@ -357,8 +357,7 @@ def learning_figure(trials: "pandas.DataFrame", value: str, phase: typing.Option
     interval (``calligraphy.statistics.describe(..., unit="subject")``: each subject's trials averaged
     first, n = subjects; Student 1908). Panels: all characters (each subject's mean over them), then one per
     character when there are several; one shared y axis with even ticks (MaxNLocator), the value in its
-    display unit (mm for lengths, s for times). The x axis counts repetitions from 1 (the table's
-    0-based ``repetition`` + 1).
+    display unit (mm for lengths, s for times). The x axis is the tables' ``repetition``, counted from 1.
 
     trials: one row per trial with subject, condition, characters, repetition, `value` and, for a `phase`,
     phase (None: every row). Returns a matplotlib Figure (not registered with pyplot; Agg canvas).
@@ -394,7 +393,7 @@ def learning_figure(trials: "pandas.DataFrame", value: str, phase: typing.Option
                 line = curve[curve["condition"] == condition].sort_values("repetition")
                 if line.empty:
                     continue
-                x = line["repetition"].to_numpy(dtype=float) + 1.0 + offsets[condition]
+                x = line["repetition"].to_numpy(dtype=float) + offsets[condition]
                 mean = line["mean"].to_numpy(dtype=float) * display.scale
                 low = line["ci95_low"].to_numpy(dtype=float) * display.scale
                 high = line["ci95_high"].to_numpy(dtype=float) * display.scale
@@ -413,7 +412,7 @@ def learning_figure(trials: "pandas.DataFrame", value: str, phase: typing.Option
                 ax.set_title(title, fontsize=9)
             ax.set_xlabel("repetition")
             if repetitions:
-                ax.set_xlim(repetitions[0] + 0.6, repetitions[-1] + 1.4)
+                ax.set_xlim(repetitions[0] - 0.4, repetitions[-1] + 0.4)
             ax.xaxis.set_major_locator(MaxNLocator(integer=True))
             ax.yaxis.set_major_locator(MaxNLocator(nbins=5, steps=[1, 2, 2.5, 5, 10]))
             ax.grid(axis="y", color="#dddddd", lw=0.6)
@@ -579,6 +578,14 @@ def _statistics_html(table: "pandas.DataFrame", value: str, phase: typing.Option
     return "".join(out)
 
 
+def _trial_anchor(per_trial_link: str, row: dict) -> str:
+    """The link to one trial's drawings on the per-trial pages of ``calligraphy report --out FILE.html``:
+    FILE_files/SUBJECT/SESSION.html#trial-SESSION-N, N the tables' 1-based ``trial``."""
+    stem = per_trial_link[:-len(".html")] if per_trial_link.endswith(".html") else per_trial_link
+    subject, session, trial = (urllib.parse.quote(str(row[c])) for c in ("subject", "session", "trial"))
+    return f"{stem}_files/{subject}/{session}.html#trial-{session}-{int(row['trial'])}"
+
+
 def _subjects_html(trials: "pandas.DataFrame", values: typing.Sequence[str], per_trial_link: typing.Optional[str]
                    ) -> str:
     out = ["<section id=\"subjects\">\n<h2>Subjects</h2>\n"]
@@ -604,12 +611,13 @@ def _subjects_html(trials: "pandas.DataFrame", values: typing.Sequence[str], per
             out.append("<tr>")
             for column in columns:
                 cell = row[column]
-                if column in ("trial", "repetition") and _finite(cell):
-                    cell = int(cell) + 1  # counted from 1 on the page, as the per-trial page numbers trials
-                elif column == "block" and _finite(cell):
-                    cell = int(cell)
+                if column in ("trial", "repetition", "block") and _finite(cell):
+                    cell = int(cell)  # counted from 1, as in the tables and the per-trial pages
                 css = " class=\"glyph\"" if column == "characters" else ""
-                out.append(f"<td{css}>{_e(cell)}</td>")
+                if column == "trial" and per_trial_link and _finite(row[column]) and "session" in row:
+                    out.append(f"<td><a href=\"{_e(_trial_anchor(per_trial_link, row))}\">{_e(cell)}</a></td>")
+                else:
+                    out.append(f"<td{css}>{_e(cell)}</td>")
             for value, display in displays:
                 out.append(f"<td class=\"num\">{_fixed(row[value] * display.scale, display.decimals)}</td>")
             out.append("</tr>\n")
@@ -876,7 +884,7 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
             learning_html.append(
                 f"<figure><img src=\"figures/{_e(stem)}.svg\" width=\"{width_px}\" "
                 f"alt=\"Learning curves of {_e(display.label)}\"><figcaption>{_e(display.label.capitalize())} over "
-                f"repetitions in {_e(phase)} (counted as the tables count them): per condition the mean over subjects "
+                f"repetitions in {_e(phase)} (counted from 1): per condition the mean over subjects "
                 "with its 95 % t interval (n = subjects). Left: all characters; then each character. One y axis for "
                 "all panels.</figcaption></figure>\n")
     files[tables / "phase_means.csv"] = pandas.concat(all_means, ignore_index=True).to_csv(index=False)

@@ -20,8 +20,8 @@
 #include <string_view>
 #include <vector>
 
-#include "calligraphy/model/scene.hpp"
 #include "calligraphy/analysis/score.hpp"
+#include "calligraphy/model/scene.hpp"
 
 namespace calligraphy {
 
@@ -40,7 +40,8 @@ struct PenTraceCsvOptions {
   /// With a `z` column: the pen touches the paper when z <= this [m] (kPenContactThresholdM, score.hpp).
   /// Finite.
   double contact_threshold_m = kPenContactThresholdM;
-  std::uintmax_t max_file_bytes = std::uintmax_t{256} << 20;  ///< larger files are refused (256 MiB)
+  /// Larger files are refused (256 MiB), and a gzip file whose text is larger.
+  std::uintmax_t max_file_bytes = std::uintmax_t{256} << 20;
   /// A trace with more pen-down segments is refused at the line that starts the first one too many
   /// (ScoreOptions::max_segments, what one scored trace may have). > 0.
   std::size_t max_pen_down_segments = kMaxScoredSegments;
@@ -62,8 +63,10 @@ std::vector<PenSample> parse_pen_trace_csv(std::string_view text, const std::str
                                            const Placement& placement,
                                            const PenTraceCsvOptions& options = {});
 
-/// Reads and parses a CSV file, a block at a time (memory holds the samples, not the file). Throws DataError
-/// naming the file when it does not exist, is not a regular file, is larger than options.max_file_bytes or
+/// Reads and parses a CSV file, a block at a time (memory holds the samples, not the file). A gzip file
+/// (RFC 1952, by its first bytes: a saved trial's `.csv.gz`) is decompressed on the way. Throws DataError
+/// naming the file when it does not exist, is not a regular file, is larger than options.max_file_bytes
+/// (on disk or decompressed), is damaged or truncated gzip or
 /// cannot be read, and as `parse_pen_trace_csv`.
 std::vector<PenSample> read_pen_trace_csv(const std::filesystem::path& file, const Placement& placement,
                                           const PenTraceCsvOptions& options = {});

@@ -3,8 +3,8 @@
 #include <string>
 #include <vector>
 
-#include "calligraphy/render/guidance_mode.hpp"
 #include "calligraphy/analysis/writing_metrics.hpp"
+#include "calligraphy/render/guidance_mode.hpp"
 #include "calligraphy/trial/trial.hpp"
 
 namespace calligraphy {
@@ -40,8 +40,15 @@ void print_trial_table(const TrialDescription& d, const Scene& scene, const Tria
 std::string trial_json(const TrialDescription& d, const TrialResult& result, const WritingMetrics& writing);
 /// Reference in blue, pen trace in green, each stroke's start hint as a red ellipse (paper Figs. 30-31).
 std::string trial_svg(const Scene& scene, const TrialResult& result);
-/// The trace, one row per tick: t,x,y,z,fx,fy,fz,state,stroke,element (SI units); t, x, y, z in the shortest
-/// text that reads back as the same double, so a score of the file gives the trial's own metrics.
+/// Decimals of the trace's columns: t to 1 us (a 1 kHz servo tick is 1000 us), x, y, z to 0.1 um (far finer
+/// than a Phantom Desktop's 0.023 mm encoder resolution; the simulated device's 1 um steps are kept
+/// exactly), forces to 0.1 mN (guidance forces are tenths of a newton and more). A score of the file gives
+/// the trial's own metrics to this precision (times within 0.5 us, lengths within 0.05 um).
+inline constexpr int kTraceTimeDecimals = 6;
+inline constexpr int kTracePositionDecimals = 7;
+inline constexpr int kTraceForceDecimals = 4;
+/// The trace, one row per tick: t,x,y,z,fx,fy,fz,state,stroke,element (SI units: s, m, N), each number with
+/// the decimals above and no trailing zeros ("0.001", "-0.011845", "0").
 std::string trial_csv(const std::vector<TrialSample>& trace);
 /// Writes text to a file, whole or not at all (`write_file_atomically`, atomic_file.hpp); throws DataError
 /// naming the path when it cannot.

@@ -86,7 +86,8 @@ struct SessionManifest {
 /// A session folder, opened by one process at a time. Move-only; the lock is released on destruction.
 class SessionFolder {
  public:
-  /// Creates ROOT/SUBJECT/PROTOCOL-YYYYMMDD-HHMMSS (a "-2", "-3" ... suffix when it exists), writes
+  /// Creates ROOT/SUBJECT/PROTOCOL-SUBJECT-YYYYMMDD-HHMMSS (UTC; a "-2", "-3" ... suffix when it exists;
+  /// the name is the session id, unique across subjects), writes
   /// session.json with the plan of `plan_session` for `setup.session_number` and starts the log
   /// ("session_created"). A transfer choice of the protocol must be resolved (`resolve_transfer_choices`).
   /// Throws InvalidArgument for a bad setup (subject id, writer, profile, pacing, a session number the
@@ -112,6 +113,10 @@ class SessionFolder {
 
   /// "003-test-vision-r1-U5927": the file name of a trial without extension.
   [[nodiscard]] static std::string trial_stem(const PlannedTrial& trial);
+  /// The extension of a saved trial's pen trace: its CSV compressed with gzip (RFC 1952; `zcat` and pandas
+  /// read it). Folders written before hold plain `.csv` traces, which readers still read: a trial record's
+  /// `files.csv` names its trace.
+  static constexpr std::string_view kTraceExtension = "csv.gz";
   /// trials/STEM.EXTENSION
   [[nodiscard]] std::filesystem::path trial_file(const PlannedTrial& trial, std::string_view extension) const;
   /// True when the trial's JSON exists.
@@ -120,12 +125,14 @@ class SessionFolder {
   /// The first planned trial not saved yet, or nullopt when every trial is saved.
   [[nodiscard]] std::optional<std::size_t> next_unsaved() const;
 
-  /// Saves a finished trial: `csv` and `svg` atomically, then `json` with link(2), so it never replaces a
-  /// file. Throws StateError naming the file when the trial was saved already, DataError when a write fails.
+  /// Saves a finished trial: `csv` (the trace's text, stored gzip-compressed as STEM.csv.gz) and `svg`
+  /// atomically, then `json` with link(2), so it never replaces a file. Throws StateError naming the file
+  /// when the trial was saved already, DataError when a write fails.
   void save_trial(const PlannedTrial& trial, std::string_view json, std::string_view csv,
                   std::string_view svg);
   /// Keeps an attempt that did not become the saved trial (interrupted, failed) in trials/attempts/ as
-  /// STEM.attempt-K.json and .csv with the first free K. Returns the JSON's path.
+  /// STEM.attempt-K.json and .csv.gz (compressed as save_trial's) with the first free K. Returns the
+  /// JSON's path.
   std::filesystem::path save_attempt(const PlannedTrial& trial, std::string_view json, std::string_view csv);
 
   /// Appends {"time_utc": ..., "event": EVENT, ...details} as one line to log.jsonl and fsyncs it.

@@ -1,23 +1,48 @@
 #pragma once
 /// \file session_reader.hpp
-/// Reads saved sessions back: the folders under given roots (session_folder.hpp), each saved trial's
-/// JSON record and CSV trace, into the model of the study report page (report/study_report_html.hpp).
-/// Reading takes no lock, so a running session can be reported; trials not saved yet are left out.
+/// Reads saved sessions back for the per-trial pages (report/study_report_html.hpp): the session folders
+/// under given roots (session_folder.hpp), then one session's saved trials at a time, each trial's JSON
+/// record and trace (`.csv.gz`, or a plain `.csv` of older folders) read as it is needed and dropped after,
+/// so memory holds one trial, not the study. Reading takes no lock, so a running session can be reported;
+/// trials not saved yet are left out.
 #include <filesystem>
+#include <functional>
 #include <vector>
 
 #include "calligraphy/report/study_report_html.hpp"
+#include "calligraphy/study/session_folder.hpp"
+#include "calligraphy/study/study_tables.hpp"
 
 namespace calligraphy {
 
-/// Largest trial CSV read: 256 MiB (an hour at 1 kHz is about 300 MB; a study trial lasts minutes).
+/// Largest trial trace read: 256 MiB of text (an hour at 1 kHz is about 300 MB; a study trial lasts
+/// minutes), on disk and decompressed.
 inline constexpr std::uintmax_t kMaxTrialCsvBytes = std::uintmax_t{256} << 20;
 
-/// The report of every session under `roots` (each a session folder or a folder holding some): sessions
-/// sorted by path, trials in planned order. Conditions and test characters come from the first session's
-/// protocol; a note says when sessions ran under different protocols. Throws DataError naming the file
-/// (and JSON pointer or CSV line) for a root that is not a folder, no session found, a damaged
-/// session.json, trial record or trace.
-[[nodiscard]] StudyReport read_study_report(const std::vector<std::filesystem::path>& roots);
+/// One session to report: what the index and its page show, and what its trials are read by.
+struct ReportedSession {
+  ReportSession shown;
+  std::filesystem::path folder;
+  SessionManifest manifest;
+};
+
+/// The sessions under some roots.
+struct StudyReportSessions {
+  StudyReportIndex index;                 ///< the title, every session, notes (what simulated subjects were)
+  std::vector<ReportedSession> sessions;  ///< sorted by path, as `index.sessions`
+};
+
+/// Every session under `roots` (each a session folder or a folder holding some), its manifest read and its
+/// saved trials counted; no trial is read. Throws DataError naming the file (and JSON pointer) for a root
+/// that is not a folder, no session found, a damaged session.json.
+[[nodiscard]] StudyReportSessions list_report_sessions(const std::vector<std::filesystem::path>& roots);
+
+/// Calls `trial` with each saved trial of `session` in planned order, its record and trace read just
+/// before and dropped after. With `rows`, also appends each trial's rows of the tidy tables to it, from the
+/// same read of its record: the rows `read_study_tables` gives for this session. Throws DataError naming
+/// the file (and JSON pointer or trace line) for a damaged trial record or trace (a record naming a trace
+/// that cannot be read is at fault).
+void read_session_trials(const ReportedSession& session, const std::function<void(const ReportTrial&)>& trial,
+                         StudyTables* rows = nullptr);
 
 }  // namespace calligraphy

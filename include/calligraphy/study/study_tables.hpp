@@ -3,9 +3,10 @@
 /// A study as tidy tables (Wickham 2014, "Tidy data", J Stat Softw 59(10)): one row per saved trial and one
 /// row per reference stroke of each saved trial, read from session folders (session_folder.hpp). The metrics
 /// are the one metrics record each trial record holds (writing_metrics.hpp), in SI units with the unit in
-/// every column name; indices are 0-based. `calligraphy report --csv DIR` writes them as CSV and Python's
-/// `calligraphy.study.load` gives them as pandas DataFrames. The traces are not read: a row names its trace
-/// file, read on demand. Columns and meaning: docs/experiments.md ("Tidy tables").
+/// every column name; indices count from 1 (trial, block, item, repetition, character, stroke), as the trial
+/// files' numbers (001-..., r1) and session numbers do. `calligraphy report --csv DIR` writes them as CSV and
+/// Python's `calligraphy.study.load` gives them as pandas DataFrames. The traces are not read: a row names
+/// its trace file, read on demand. Columns and meaning: docs/experiments.md ("Tidy tables").
 #include <cstddef>
 #include <filesystem>
 #include <optional>
@@ -22,13 +23,13 @@ struct TrialRow {
   int session_number = 1;  ///< which of the protocol's sessions (1-based; a retention test a day later: 2)
   std::string group;       ///< the subject's between-subjects group (`subject_group`); "" when none
   std::string phase;  ///< "practice", "test", "pre-test", "training", "post-test", "retention", "transfer"
-  std::size_t block = 0;       ///< 0-based block of the session's plan
+  std::size_t block = 1;       ///< 1-based block of the session's plan
   std::string condition;       ///< the condition's name
   std::string mode;            ///< the condition's mode ("vision", "haptic", "fading", "replay", "quiz")
   std::string characters;      ///< UTF-8, written left to right
-  std::size_t trial = 0;       ///< 0-based position in the session's plan
-  std::size_t item = 0;        ///< 0-based index of `characters` in the phase's list
-  std::size_t repetition = 0;  ///< 0-based repetition of the item in the condition
+  std::size_t trial = 1;       ///< 1-based position in the session's plan (the NNN of its files)
+  std::size_t item = 1;        ///< 1-based position of `characters` in the phase's list
+  std::size_t repetition = 1;  ///< 1-based repetition of the item in the condition (the rN of its files)
   std::string writer;          ///< "simulated" or "human"
   /// A simulated writer's profile ("novice", "skilled", "foreign") and learning model ("none", "two-state");
   /// "" for a person.
@@ -64,12 +65,12 @@ struct TrialRow {
 struct StrokeRow {
   std::string subject;
   std::string session;
-  std::size_t trial = 0;  ///< the trial's `TrialRow::trial`
+  std::size_t trial = 1;  ///< the trial's `TrialRow::trial`
   std::string phase;
   std::string condition;
-  std::size_t character = 0;   ///< 0-based index of the character in the trial
+  std::size_t character = 1;   ///< 1-based position of the character in the trial
   std::string character_text;  ///< UTF-8
-  std::size_t stroke = 0;      ///< 0-based index of the stroke in its character
+  std::size_t stroke = 1;      ///< 1-based position of the stroke in its character (writing order)
   int typical_id = 0;          ///< the typical stroke's fixed ID (1..39)
   bool written = false;        ///< a pen-down segment was matched to it
   bool backwards = false;      ///< it was written from its end
