@@ -8,6 +8,7 @@ import os
 import shutil
 import subprocess
 import sys
+import urllib.parse
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
@@ -422,8 +423,11 @@ def test_a_real_study_from_session_run(small_study, tmp_path):
     if not hasattr(calligraphy._calligraphy, "_study_tables_csv"):
         pytest.skip("this calligraphy build has no study tables binding (calligraphy.study.load)")
     small_study(tmp_path, subjects=3, repetitions=2)
+    drawn = subprocess.run([os.environ["CALLIGRAPHY_CLI"], "report", "study", "--out", "trials.html"], cwd=tmp_path,
+                           capture_output=True, text=True, timeout=120)
+    assert drawn.returncode == 0, drawn.stderr
     made = run_module(tmp_path / "study", "--out", tmp_path / "report", "--title", "Three simulated subjects",
-                      cwd=tmp_path)
+                      "--per-trial-page", tmp_path / "trials.html", cwd=tmp_path)
     assert made.returncode == 0, made.stderr
     index = tmp_path / "report" / "index.html"
     assert made.stdout.startswith(f"{index}: 3 subjects, {3 * (1 + 2 * 2 * 2)} trials,")
@@ -433,6 +437,12 @@ def test_a_real_study_from_session_run(small_study, tmp_path):
     statistics = pandas.read_csv(tmp_path / "report" / "tables" / "statistics.csv")
     assert (statistics.n[statistics.test.str.startswith("paired t-test")] == 3).all()
     assert len(page.details) == 1 + 3  # the exclusion counts, then one per subject
+    # Every trial links to its drawing on its session's per-trial page, and the anchor is there.
+    anchors = [link for link in page.links if link and "#trial-" in link]
+    assert len(anchors) == 3 * (1 + 2 * 2 * 2)
+    for link in anchors:
+        path, anchor = urllib.parse.unquote(link).split("#")
+        assert f'id="{anchor}"' in (tmp_path / "report" / path).resolve().read_text(encoding="utf-8"), link
     questions = pandas.read_csv(tmp_path / "report" / "tables" / "questions.csv", keep_default_na=False)
     assert set(questions.comparison) == {"haptic - vision"} and set(questions.phase) == {"test"}
     for stem in ("learning_total_time_s", "learning_mean_deviation_m"):
