@@ -679,6 +679,7 @@ TEST_CASE("a learning simulated subject writes with what it learned, the same af
   const auto run_days = [&protocol](const fs::path& root, std::size_t stop_after) {
     SessionSetup setup = simulated("L1");
     setup.writer_learning = "two-state";
+    setup.individual_differences = false;  // compared with the novice profile's own fields below
     fs::path first_folder;
     {
       SessionFolder first = SessionFolder::create(root, setup, protocol);

@@ -52,6 +52,7 @@ struct SessionRunCommand {
   std::string writer_profile = "novice";
   const CLI::Option* profile_option = nullptr;
   std::string writer_learning = "none";
+  std::string individual_differences = "on";
   std::string pacing = "auto";
   std::string out;
   bool ignore_delay = false;
@@ -314,6 +315,7 @@ int run_sessions(const SessionRunCommand& command) {
       setup.writer_profile = profiles[i % profiles.size()];
       setup.writer_seed = subject_seed(setup.subject.id);
       setup.writer_learning = command.writer_learning;
+      setup.individual_differences = !person && command.individual_differences == "on";
       setup.pacing = command.pacing;
       setup.session_number = series.next;
       SessionFolder session = SessionFolder::create(command.out, setup, resolved, previous);
@@ -407,6 +409,9 @@ void add_session_commands(CLI::App& root, Commands& commands) {
       *app, "--writer-learning", run->writer_learning, {"none", "two-state"},
       "how a simulated subject learns: none (every trial from its profile) or two-state (a memory per "
       "typical stroke and character that practice builds and time between sessions thins; docs/writer.md)");
+  add_choice(*app, "--individual-differences", run->individual_differences, {"on", "off"},
+             "on: each simulated subject draws its own baseline skill, motor noise and learning rates from "
+             "its id (docs/writer.md); off: every subject is the profile itself");
   add_choice(*app, "--pacing", run->pacing, {"auto", "lock-step", "real-time"},
              "auto: lock-step for a simulated writer, real time for a person; real-time paces a simulated "
              "writer by the wall clock");

@@ -212,7 +212,7 @@ std::string trial_svg(const Scene& scene, const TrialResult& result) {
 
 std::string trial_csv(const std::vector<TrialSample>& trace) {
   std::ostringstream csv;
-  csv << "t,x,y,z,fx,fy,fz,state,stroke,element\n";
+  csv << "t,x,y,z,fx,fy,fz,state,stroke,element,attempt,rewritten\n";
   char line[256];
   // Time and position in the shortest text that reads back as the same double, so that `calligraphy score`
   // on this file gives the trial's own metrics exactly (one metrics record, docs/metrics.md).
@@ -227,8 +227,9 @@ std::string trial_csv(const std::vector<TrialSample>& trace) {
     exact(out, end, s.position_m.x());
     exact(out, end, s.position_m.y());
     exact(out, end, s.position_m.z());
-    std::snprintf(out, static_cast<std::size_t>(end - out), "%.5f,%.5f,%.5f,%s,%zu,%zu\n", s.force_n.x(),
-                  s.force_n.y(), s.force_n.z(), to_string(s.state), s.stroke, s.element);
+    std::snprintf(out, static_cast<std::size_t>(end - out), "%.5f,%.5f,%.5f,%s,%zu,%zu,%d,%d\n",
+                  s.force_n.x(), s.force_n.y(), s.force_n.z(), to_string(s.state), s.stroke, s.element,
+                  s.attempt, s.rewritten ? 1 : 0);
     csv << line;
   }
   return csv.str();

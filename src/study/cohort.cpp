@@ -47,6 +47,7 @@ SessionManifest cohort_manifest(const LoadedProtocol& protocol, const SubjectAss
   manifest.setup.writer_profile = setup.writer_profile;
   manifest.setup.writer_seed = subject_seed(subject.id);
   manifest.setup.writer_learning = setup.writer_learning;
+  manifest.setup.individual_differences = setup.individual_differences;
   manifest.setup.pacing = "lock-step";
   manifest.setup.session_number = number;
   manifest.protocol = protocol;
@@ -82,7 +83,8 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
   const bool learning = manifest.setup.writer_learning == "two-state";
   std::optional<WriterSkills> skills;
   if (learning)
-    skills = study_detail::learn_into(spec, memory, manifest.setup.writer_profile, scene, trial.characters);
+    skills = study_detail::learn_into(spec, memory, study_detail::subject_profile(manifest.setup), scene,
+                                      trial.characters);
   // The registry's simulated device, made here: asking the registry would scan every hardware backend (USB)
   // for each trial, from every thread at once.
   const auto device = std::make_unique<SimulatedDevice>();
@@ -118,7 +120,9 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
   json record =
       study_detail::trial_record(context, scene, result, run.metrics, quiz.empty() ? nullptr : &quiz);
   // Learned from as a session learns from its saved record.
-  if (learning) study_detail::practise_record(memory, record, source);
+  if (learning)
+    study_detail::practise_record(memory, record, source,
+                                  study_detail::subject_traits(manifest.setup).learning);
   return record;
 }
 

@@ -55,13 +55,16 @@ double parse_field(std::string_view field, const std::string& source, std::size_
   return *value;
 }
 
-// The trial CSV (t,x,y,z,fx,fy,fz,state,stroke,element): times, positions, pen down, in-plane force.
+// The trial CSV (t,x,y,z,fx,fy,fz,state,stroke,element[,attempt,rewritten]: traces saved before attempts
+// were marked lack the last two): times, positions, pen down, in-plane force.
 void read_trace(const fs::path& file, double paper_z_m, ReportTrial& trial) {
   const std::string text = study_detail::read_small_file(file, kMaxTrialCsvBytes, "trial trace (CSV)");
   const std::string source = file.string();
   const double contact_m = PenTraceCsvOptions{}.contact_threshold_m;
   std::size_t line_number = 0, begin = 0;
-  constexpr const char* kHeader = "t,x,y,z,fx,fy,fz,state,stroke,element";
+  constexpr std::string_view kHeader = "t,x,y,z,fx,fy,fz,state,stroke,element";
+  constexpr std::string_view kMarkedHeader = "t,x,y,z,fx,fy,fz,state,stroke,element,attempt,rewritten";
+  std::size_t field_count = 10;
   while (begin < text.size()) {
     std::size_t end = text.find('\n', begin);
     if (end == std::string::npos) end = text.size();
@@ -70,11 +73,15 @@ void read_trace(const fs::path& file, double paper_z_m, ReportTrial& trial) {
     ++line_number;
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (line_number == 1) {
-      if (line != kHeader) throw DataError(source + ":1: expected the header '" + std::string(kHeader) + "'");
+      if (line != kHeader && line != kMarkedHeader) {
+        throw DataError(source + ":1: expected the header '" + std::string(kMarkedHeader) + "' (or '" +
+                        std::string(kHeader) + "')");
+      }
+      field_count = line == kMarkedHeader ? 12 : 10;
       continue;
     }
     if (line.empty()) continue;
-    std::array<std::string_view, 10> fields;
+    std::array<std::string_view, 12> fields;
     std::size_t count = 0, start = 0;
     while (count < fields.size()) {
       const std::size_t comma = line.find(',', start);
@@ -83,9 +90,9 @@ void read_trace(const fs::path& file, double paper_z_m, ReportTrial& trial) {
       if (comma == std::string_view::npos) break;
       start = comma + 1;
     }
-    if (count != 10) {
-      throw DataError(source + ":" + std::to_string(line_number) + ": expected 10 fields, got " +
-                      std::to_string(count));
+    if (count != field_count) {
+      throw DataError(source + ":" + std::to_string(line_number) + ": expected " +
+                      std::to_string(field_count) + " fields, got " + std::to_string(count));
     }
     const double t = parse_field(fields[0], source, line_number, "t");
     if (!trial.time_s.empty() && t < trial.time_s.back()) {
