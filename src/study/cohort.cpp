@@ -97,7 +97,7 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
   const TrialRun run = run_trial_spec(spec, scene, inputs);
   const TrialResult& result = run.result;
   if (result.end != TrialEnd::completed && result.end != TrialEnd::time_limit &&
-      result.end != TrialEnd::gave_up) {
+      result.end != TrialEnd::gave_up && result.end != TrialEnd::writer_finished) {
     throw StateError(source + ": the trial ended " + std::string(to_string(result.end)) + " (" +
                      result.abort_reason + ") and was not kept");
   }
@@ -114,6 +114,7 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
   context.options = &run.options;
   context.simulation.writer = run.writer;
   context.simulation.seed = spec.seed;
+  context.writer_log = run.writer_log;
   std::vector<std::vector<QuizEvent>> quiz;
   if (condition.mode == ConditionMode::quiz)
     quiz = study_detail::quiz_characters(scene, result.trace, condition.quiz);

@@ -298,6 +298,7 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     context.options = &run.options;
     context.simulation.writer = run.writer;
     context.simulation.seed = spec.seed;
+    context.writer_log = run.writer_log;
     device.reset();
     ran_one = true;
 
@@ -311,7 +312,8 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     }
     const bool keep_as_trial = trial_result.end == TrialEnd::completed ||
                                trial_result.end == TrialEnd::time_limit ||
-                               trial_result.end == TrialEnd::gave_up;
+                               trial_result.end == TrialEnd::gave_up ||
+                               trial_result.end == TrialEnd::writer_finished;
     TrialOutcome outcome;
     outcome.end_reason = to_string(trial_result.end);
     outcome.time_s = writing.total_time_s;

@@ -138,6 +138,14 @@ json writer_json(const TrialRecordContext& c) {
                                 {"fast_retention_per_trial", traits.learning.fast_retention},
                                 {"slow_retention_per_trial", traits.learning.slow_retention}};
   }
+  if (c.writer_log) {
+    // The writer's own account (docs/writer.md, "Give-up and retries"): how often it wrote a stroke again,
+    // and which strokes it left after its last attempt.
+    writer["log"] = {{"attempts", c.writer_log->attempts.size()},
+                     {"refusals", c.writer_log->refusals},
+                     {"not_accepted", c.writer_log->not_accepted},
+                     {"strokes_given_up", c.writer_log->strokes_given_up}};
+  }
   if (c.writer_skills) {
     writer["memory"] = {{"model", c.session->setup.writer_learning},
                         {"shape_skill", c.writer_skills->shape},

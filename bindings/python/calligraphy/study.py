@@ -31,7 +31,7 @@ _NUMERIC_TRIAL_COLUMNS = (
     "normalised_jerk", "shape_skill", "order_skill", "timing_skill", "subject_writing_speed_factor",
     "subject_spatial_error_factor", "subject_error_rate_factor", "subject_motor_noise_factor",
     "subject_fast_learning_per_trial", "subject_slow_learning_per_trial", "subject_fast_retention_per_trial",
-    "subject_slow_retention_per_trial")
+    "subject_slow_retention_per_trial", "strokes_given_up")
 _NUMERIC_STROKE_COLUMNS = (
     "trial", "character", "stroke", "typical_id", "segments", "refused_segments", "mean_deviation_m",
     "max_deviation_m", "rms_deviation_m", "frechet_m", "dtw_m", "time_s", "path_length_m")
@@ -115,7 +115,8 @@ class Study:
         subject's traits subject_writing_speed_factor, subject_spatial_error_factor, subject_error_rate_factor,
         subject_motor_noise_factor (dimensionless factors on its profile) and subject_fast/slow_learning_per_trial,
         subject_fast/slow_retention_per_trial (its two-state rates; all NaN when subjects do not differ,
-        docs/writer.md), trace_file).
+        docs/writer.md), strokes_given_up (strokes a simulated writer left after its last attempt, NaN for a
+        person), trace_file).
     strokes: one row per reference stroke of each saved trial (subject, session, trial, phase, condition,
         character (0-based in the trial), character_text, stroke (0-based in its character), typical_id,
         written, backwards, segments, refused_segments, refusal, the per-stroke deviations [m], time_s [s],

@@ -63,6 +63,9 @@ struct TrialRow {
   std::optional<double> subject_slow_learning_per_trial;
   std::optional<double> subject_fast_retention_per_trial;
   std::optional<double> subject_slow_retention_per_trial;
+  /// Strokes a simulated writer gave up on after its last attempt and left (docs/writer.md, "Give-up and
+  /// retries"); absent for a person and for records from before it was kept.
+  std::optional<double> strokes_given_up;
   std::filesystem::path trace_file;  ///< the trial's CSV trace (t,x,y,z,fx,fy,fz,state,stroke,element)
 };
 
