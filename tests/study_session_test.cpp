@@ -753,7 +753,7 @@ TEST_CASE("a learning subject's guidance takes shape and timing apart: the fixtu
   CHECK(alone_timing < alone_shape);  // vision shows the writer only part of its timing error
   CHECK(fixture_shape < alone_shape);
   CHECK(fixture_timing == Approx(alone_timing));  // the fixture pulls to the nearest point: no timing
-  CHECK(replay_shape < alone_shape);  // the guidance hypothesis, for shape
+  CHECK(replay_shape < alone_shape);              // the guidance hypothesis, for shape
   // The teacher's point at the teacher's time paces the writer and demonstrates the timing: more timing
   // learned than from vision (the direction of Feygin, Keehner & Tendick 2002).
   CHECK(replay_timing > alone_timing);

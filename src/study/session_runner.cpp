@@ -310,10 +310,9 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     if (condition.mode == ConditionMode::quiz) {
       quiz = study_detail::quiz_characters(scene, trial_result.trace, condition.quiz);
     }
-    const bool keep_as_trial = trial_result.end == TrialEnd::completed ||
-                               trial_result.end == TrialEnd::time_limit ||
-                               trial_result.end == TrialEnd::gave_up ||
-                               trial_result.end == TrialEnd::writer_finished;
+    const bool keep_as_trial =
+        trial_result.end == TrialEnd::completed || trial_result.end == TrialEnd::time_limit ||
+        trial_result.end == TrialEnd::gave_up || trial_result.end == TrialEnd::writer_finished;
     TrialOutcome outcome;
     outcome.end_reason = to_string(trial_result.end);
     outcome.time_s = writing.total_time_s;

@@ -215,7 +215,8 @@ std::string trials_csv(const StudyTables& tables) {
          r.shape_skill, r.order_skill, r.timing_skill, r.subject_writing_speed_factor,
          r.subject_spatial_error_factor, r.subject_error_rate_factor, r.subject_motor_noise_factor,
          r.subject_fast_learning_per_trial, r.subject_slow_learning_per_trial,
-         r.subject_fast_retention_per_trial, r.subject_slow_retention_per_trial, r.strokes_given_up, r.trace_file.string());
+         r.subject_fast_retention_per_trial, r.subject_slow_retention_per_trial, r.strokes_given_up,
+         r.trace_file.string());
   }
   return out;
 }
