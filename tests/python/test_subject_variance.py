@@ -62,7 +62,7 @@ def test_a_pilot_has_a_subject_variance_only_when_subjects_differ(cli, tmp_path,
     singular_on, subject_sd_on = results["on"]
     singular_off, subject_sd_off = results["off"]
     assert not singular_on and subject_sd_on > 1e-4  # metres: a tenth of a millimetre at least
-    assert singular_off and subject_sd_off == 0.0
+    assert singular_off and subject_sd_off < 1e-6  # lme4 puts it at the boundary (0 or round-off)
 
 
 def test_the_cli_and_python_draw_the_same_subjects(cli, tmp_path):
