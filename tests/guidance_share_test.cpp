@@ -49,6 +49,10 @@ TEST_CASE("Along the stroke only timing and replay take a share, that of their s
   const AssistanceShares replayed = guidance_shares(replay, kHand, 0.001);
   CHECK(replayed.timing == Approx(spring));
   CHECK(replayed.shape == Approx(spring));
+  // Both move the pen in time: they demonstrate the timing they take.
+  CHECK(replayed.timing_demonstration == Approx(spring));
+  CHECK(guidance_shares(mode(GuidanceMode::timing), kHand, 0.001).timing_demonstration == Approx(spring));
+  CHECK(guidance_shares(mode(GuidanceMode::fixed), kHand, 0.001).timing_demonstration == 0.0);
   for (const GuidanceMode m : {GuidanceMode::fixed, GuidanceMode::fading, GuidanceMode::assist_as_needed,
                                GuidanceMode::error_amplification}) {
     CAPTURE(to_string(m));

@@ -286,12 +286,14 @@ TEST_CASE("A trial's trace is written to a fixed precision in the fewest charact
   trace[0].force_n = Vec3(0.0, 0.0, 1e300);  // a fault's value: round-trip text, the row within bounds
   trace[2].state = InteractionState::writing;
   trace[2].stroke = 2;
+  trace[2].attempt = 3;  // the third attempt at its stroke, written again later
+  trace[2].rewritten = true;
   const std::string csv = trial_csv(trace);
   CHECK(csv ==
-        "t,x,y,z,fx,fy,fz,state,stroke,element\n"
-        "0,0,0,0,0,0,1e+300,SS,0,0\n"
-        "0.001,-0.011845,0.010465,0,-0.0098,0.5,0.3333,SS,0,0\n"
-        "0.002,0.1234568,0,0.02001,0,0,0,WS,2,0\n");
+        "t,x,y,z,fx,fy,fz,state,stroke,element,attempt,rewritten\n"
+        "0,0,0,0,0,0,1e+300,SS,0,0,0,0\n"
+        "0.001,-0.011845,0.010465,0,-0.0098,0.5,0.3333,SS,0,0,0,0\n"
+        "0.002,0.1234568,0,0.02001,0,0,0,WS,2,0,3,1\n");
   // Read back, every value within half its last decimal of the one written.
   const auto samples = parse_pen_trace_csv(csv, "trace", test_placement());
   REQUIRE(samples.size() == trace.size());

@@ -2,6 +2,7 @@
 // subjects, profile and learning, its rows equal those read from the folders `session run` makes, trial by
 // trial and stroke by stroke, over two sessions, every adaptive schedule and a between-subjects design; its
 // threads change nothing; and what it cannot do (a replay, a bad setup) is refused by name.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <optional>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/sim/subject_traits.hpp"
 #include "calligraphy/study/cohort.hpp"
 #include "calligraphy/study/session_runner.hpp"
 #include "calligraphy/study/session_series.hpp"
@@ -49,6 +51,7 @@ StudyTables through_folders(const std::filesystem::path& root, const LoadedProto
       setup.writer_profile = cohort.writer_profile;
       setup.writer_seed = subject_seed(subject.id);
       setup.writer_learning = cohort.writer_learning;
+      setup.individual_differences = cohort.individual_differences;
       setup.session_number = number;
       std::optional<PreviousSession> previous = session_series(root, subject.id, protocol).previous;
       if (previous) previous->delay = "simulated";
@@ -82,6 +85,8 @@ void check_same_trials(const TrialRow& a, const TrialRow& b) {
   CHECK(a.shape_skill == b.shape_skill);
   CHECK(a.order_skill == b.order_skill);
   CHECK(a.timing_skill == b.timing_skill);
+  CHECK(a.subject_writing_speed_factor == b.subject_writing_speed_factor);
+  CHECK(a.subject_fast_learning_per_trial == b.subject_fast_learning_per_trial);
 }
 
 }  // namespace
@@ -115,6 +120,43 @@ TEST_CASE("a cohort in memory gives the rows of the same subjects' session folde
     if (groups.empty() || groups.back() != row.group) groups.push_back(row.group);
   }
   CHECK(groups == std::vector<std::string>{"fading", "band", "adapt", "push"});
+}
+
+TEST_CASE("a cohort's subjects differ, each by the traits its id draws, unless told otherwise",
+          "[study][cohort][subjects]") {
+  LoadedProtocol protocol = two_day_protocol();
+  const std::vector<SubjectAssignment> subjects = numbered_subjects(4);
+  CohortSetup setup;
+  setup.writer_profile = "foreign";
+  const StudyTables differ = simulate_cohort(protocol, subjects, setup, 2);
+  setup.individual_differences = false;
+  const StudyTables alike = simulate_cohort(protocol, subjects, setup, 2);
+  REQUIRE(differ.trials.size() == alike.trials.size());
+  std::vector<double> speeds;
+  for (std::size_t i = 0; i < differ.trials.size(); ++i) {
+    const TrialRow& row = differ.trials[i];
+    const SubjectTraits traits = draw_subject_traits(subject_seed(row.subject));
+    REQUIRE(row.subject_writing_speed_factor.has_value());
+    CHECK(*row.subject_writing_speed_factor == traits.writing_speed_factor);
+    CHECK(*row.subject_spatial_error_factor == traits.spatial_error_factor);
+    CHECK(*row.subject_slow_learning_per_trial == traits.learning.slow_learning);
+    if (speeds.empty() || speeds.back() != *row.subject_writing_speed_factor)
+      speeds.push_back(*row.subject_writing_speed_factor);
+    CHECK_FALSE(alike.trials[i].subject_writing_speed_factor.has_value());
+  }
+  CHECK(speeds.size() == 4);  // one person per subject, none the same
+  // Subjects alike write their profile: every subject's pre-test of the same character at the same seed
+  // differs only by the seed's draws, so the drawn subjects' spread of writing time is larger.
+  const auto spread = [](const StudyTables& tables) {
+    double low = 1e9, high = -1e9;
+    for (const TrialRow& row : tables.trials) {
+      if (row.phase != "pre-test") continue;
+      low = std::min(low, row.total_time_s);
+      high = std::max(high, row.total_time_s);
+    }
+    return high - low;
+  };
+  CHECK(spread(differ) > spread(alike));
 }
 
 TEST_CASE("a cohort's threads change none of its rows", "[study][cohort]") {

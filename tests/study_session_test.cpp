@@ -729,6 +729,7 @@ TEST_CASE("a learning simulated subject writes with what it learned, the same af
   const auto run_days = [&protocol](const fs::path& root, std::size_t stop_after) {
     SessionSetup setup = simulated("L1");
     setup.writer_learning = "two-state";
+    setup.individual_differences = false;  // compared with the novice profile's own fields below
     fs::path first_folder;
     {
       SessionFolder first = SessionFolder::create(root, setup, protocol);
@@ -799,9 +800,11 @@ TEST_CASE("a learning subject's guidance takes shape and timing apart: the fixtu
   const auto [alone_shape, alone_timing] = skills_after("vision");
   const auto [fixture_shape, fixture_timing] = skills_after("haptic");
   const auto [replay_shape, replay_timing] = skills_after("replay");
-  CHECK(alone_shape == Approx(alone_timing));
+  CHECK(alone_timing < alone_shape);  // vision shows the writer only part of its timing error
   CHECK(fixture_shape < alone_shape);
   CHECK(fixture_timing == Approx(alone_timing));  // the fixture pulls to the nearest point: no timing
-  CHECK(replay_shape < alone_shape);
-  CHECK(replay_timing < alone_timing);  // the teacher's point at the teacher's time paces the writer
+  CHECK(replay_shape < alone_shape);              // the guidance hypothesis, for shape
+  // The teacher's point at the teacher's time paces the writer and demonstrates the timing: more timing
+  // learned than from vision (the direction of Feygin, Keehner & Tendick 2002).
+  CHECK(replay_timing > alone_timing);
 }

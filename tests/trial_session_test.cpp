@@ -2,9 +2,9 @@
 // the loop statistics kept, an interrupt, the time limit, a writer that gives up.
 #include <catch2/catch.hpp>
 
-#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/sim/simulated_writer.hpp"
 #include "calligraphy/trial/trial.hpp"
 #include "probe_device.hpp"
@@ -112,15 +112,37 @@ TEST_CASE("should_stop ends a trial as interrupted with the ticks kept", "[trial
   }
 }
 
-TEST_CASE("A writer that stops early ends the trial as gave_up", "[trial]") {
+namespace {
+
+// A hand that stops at once without having written anything: it gave up.
+class QuittingHand final : public TrialHand {
+ public:
+  void observe(const RenderOutput&, const DeviceState&) override {}
+  [[nodiscard]] bool stopped() const noexcept override { return true; }
+  void advance(double) override {}
+  void release() noexcept override {}
+};
+
+}  // namespace
+
+TEST_CASE("A writer that stops early ends the trial as writer_finished, a hand that quits as gave_up",
+          "[trial]") {
   const Scene scene = scene_of(U"口");
   TrialOptions options;
-  options.rate_hz = 100.0;  // too coarse a tick for this writer: it misses every stroke and gives up
+  options.rate_hz = 100.0;  // too coarse a tick for this writer: the display takes none of its strokes
   const TrialResult result = run_simulated_trial(scene, options);
   CHECK(result.metrics.strokes_completed == 0);
-  CHECK(result.end == TrialEnd::gave_up);
-  CHECK(std::string(to_string(result.end)) == "gave_up");
+  // It gave up on each stroke in turn, moved on, and stopped having written them all.
+  CHECK(result.end == TrialEnd::writer_finished);
+  CHECK(std::string(to_string(result.end)) == "writer_finished");
   CHECK(result.aborted);
+
+  SimulatedDevice device;
+  QuittingHand quitter;
+  const TrialResult quit = run_trial(device, scene, TrialOptions{}, &quitter);
+  CHECK(quit.end == TrialEnd::gave_up);
+  CHECK(std::string(to_string(quit.end)) == "gave_up");
+  CHECK(quit.aborted);
 }
 
 TEST_CASE("The rate is checked against the pacing", "[trial]") {

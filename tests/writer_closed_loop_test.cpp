@@ -175,6 +175,31 @@ TEST_CASE("A stroke the display does not take is written again, and one it takes
       CHECK(log.attempts.size() == static_cast<std::size_t>(unbiased_novice().max_attempts_per_stroke));
       CHECK(log.not_accepted == log.attempts.size());
       CHECK(log.gave_up);
+      CHECK(log.strokes_given_up == 1);
     }
   }
+}
+
+TEST_CASE("A writer that gives up on a stroke moves on to the next one and writes it", "[writer]") {
+  // 十 on a display that never takes a stroke: the first is written `max_attempts_per_stroke` times, then
+  // left; the second is written once (the writer no longer looks for the display's verdict) and the writer
+  // is done, having written every stroke it meant to.
+  const Scene scene = scene_of(U'十');
+  const WriterProfile profile = unbiased_novice();
+  SimulatedWriter writer(scene, profile, 4);
+  for (int k = 0; k < 60000 && !writer.done(); ++k) {
+    const double t = k * kStep_s;
+    DeviceState pen;
+    pen.time_s = t;
+    pen.position_m = writer.target(t);
+    writer.observe(RenderOutput{}, pen);
+  }
+  REQUIRE(writer.done());
+  const WriterLog& log = writer.log();
+  CHECK(log.gave_up);
+  CHECK(log.strokes_given_up == 1);
+  REQUIRE(log.attempts.size() == static_cast<std::size_t>(profile.max_attempts_per_stroke) + 1);
+  for (std::size_t a = 0; a + 1 < log.attempts.size(); ++a) CHECK(log.attempts[a].scene_stroke == 0);
+  CHECK(log.attempts.back().scene_stroke == 1);
+  CHECK(log.attempts.back().end == AttemptEnd::completed);
 }

@@ -61,7 +61,7 @@ void bind_report(py::module_& m) {
       "_simulate_cohort_csv",
       [](const std::string& protocol_path, const std::vector<std::pair<std::string, std::size_t>>& subjects,
          const std::string& profile, const std::string& learning, const CharacterSource& library,
-         unsigned threads) {
+         unsigned threads, bool individual_differences) {
         LoadedProtocol protocol = load_study_protocol(protocol_path);
         const auto load = [&library](char32_t c) { return library.load(c); };
         try {
@@ -74,6 +74,7 @@ void bind_report(py::module_& m) {
         CohortSetup setup;
         setup.writer_profile = profile;
         setup.writer_learning = learning;
+        setup.individual_differences = individual_differences;
         setup.load_character = load;
         StudyTables tables;
         {
@@ -83,10 +84,11 @@ void bind_report(py::module_& m) {
         return py::make_tuple(trials_csv(tables), strokes_csv(tables));
       },
       py::arg("protocol"), py::arg("subjects"), py::arg("profile"), py::arg("learning"), py::arg("library"),
-      py::arg("threads"),
+      py::arg("threads"), py::arg("individual_differences") = true,
       "Simulated subjects [(id, number), ...] through every session of the protocol file in memory "
-      "(simulate_cohort, include/calligraphy/study/cohort.hpp) on `threads` threads: the CSV texts (trials, "
-      "strokes) of their tidy tables. calligraphy.experiments.cohort wraps it.");
+      "(simulate_cohort, include/calligraphy/study/cohort.hpp) on `threads` threads, each drawing its own "
+      "traits from its id when `individual_differences` (sim/subject_traits.hpp): the CSV texts (trials, "
+      "strokes) of their tidy tables. calligraphy.cohort.simulate wraps it.");
   m.def(
       "_propose_characters",
       [](const py::list& roots, const std::string& subject, const std::string& candidates, std::size_t count,

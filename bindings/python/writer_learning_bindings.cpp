@@ -53,7 +53,11 @@ void bind_writer_log(py::module_& m) {
       .def_readonly("refusals", &WriterLog::refusals, "attempts broken off because of resistance")
       .def_readonly("not_accepted", &WriterLog::not_accepted,
                     "attempts written whole that the display was seen not to take")
-      .def_readonly("gave_up", &WriterLog::gave_up, "the writer gave up on a stroke")
+      .def_readonly("gave_up", &WriterLog::gave_up,
+                    "the writer gave up on a stroke after max_attempts_per_stroke attempts and moved on")
+      .def_readonly(
+          "strokes_given_up", &WriterLog::strokes_given_up,
+          "strokes the writer left after its last attempt (docs/writer.md, \"Give-up and retries\")")
       .def("out_of_order_attempts", &WriterLog::out_of_order_attempts, "strokes started out of order")
       .def("backwards_attempts", &WriterLog::backwards_attempts, "strokes started from their end")
       .def("refused_out_of_order", &WriterLog::refused_out_of_order, "out-of-order attempts refused")

@@ -55,6 +55,7 @@ struct SessionRunCommand {
   // not modelled, so a person's session records "none" unless the option asks otherwise (refused).
   std::string writer_learning = "two-state";
   const CLI::Option* learning_option = nullptr;
+  std::string individual_differences = "on";
   std::string pacing = "auto";
   std::string out;
   bool ignore_delay = false;
@@ -317,6 +318,7 @@ int run_sessions(const SessionRunCommand& command) {
       setup.writer_profile = profiles[i % profiles.size()];
       setup.writer_seed = subject_seed(setup.subject.id);
       setup.writer_learning = person ? "none" : command.writer_learning;
+      setup.individual_differences = !person && command.individual_differences == "on";
       setup.pacing = command.pacing;
       setup.session_number = series.next;
       SessionFolder session = SessionFolder::create(command.out, setup, resolved, previous);
@@ -411,12 +413,16 @@ void add_session_commands(CLI::App& root, Commands& commands) {
       "how a simulated subject learns: none (every trial from its profile) or two-state (a memory per "
       "typical stroke and character that practice builds and time between sessions thins; docs/writer.md), "
       "as `session cohort`; a person's session records none");
+  add_choice(*app, "--individual-differences", run->individual_differences, {"on", "off"},
+             "on: each simulated subject draws its own baseline skill, motor noise and learning rates from "
+             "its id (docs/writer.md); off: every subject is the profile itself");
   add_choice(*app, "--pacing", run->pacing, {"auto", "lock-step", "real-time"},
              "auto: lock-step for a simulated writer, real time for a person; real-time paces a simulated "
              "writer by the wall clock");
-  required(add_text(*app, "--out", run->out, "DIR",
-                    "the study folder: sessions go to DIR/SUBJECT/PROTOCOL-SUBJECT-TIME/; a protocol of several "
-                    "sessions goes on with the subject's next one there"));
+  required(
+      add_text(*app, "--out", run->out, "DIR",
+               "the study folder: sessions go to DIR/SUBJECT/PROTOCOL-SUBJECT-TIME/; a protocol of several "
+               "sessions goes on with the subject's next one there"));
   add_flag(*app, "--ignore-delay", run->ignore_delay,
            "start a person's next session before the protocol's delay has passed, or after a session that "
            "ended later than now by this computer's clock (recorded as overridden)");

@@ -26,6 +26,7 @@ struct SessionCohortCommand {
   std::string prefix = "S";
   std::string writer_profile = "novice";
   std::string writer_learning = "two-state";
+  std::string individual_differences = "on";
   std::int64_t jobs = 0;  // 0: every core
   std::string csv;
   LibraryOptions library;
@@ -48,6 +49,7 @@ int run_session_cohort(const SessionCohortCommand& command) {
   CohortSetup setup;
   setup.writer_profile = command.writer_profile;
   setup.writer_learning = command.writer_learning;
+  setup.individual_differences = command.individual_differences == "on";
   setup.load_character = [&characters](char32_t c) { return characters.load(c); };
   std::vector<SubjectAssignment> subjects;
   try {
@@ -94,6 +96,9 @@ void add_session_cohort_command(CLI::App& session, Commands& commands) {
              "the simulated subjects' profile");
   add_choice(*app, "--writer-learning", command->writer_learning, {"none", "two-state"},
              "how a subject learns: none (every trial from its profile) or two-state (docs/writer.md)");
+  add_choice(*app, "--individual-differences", command->individual_differences, {"on", "off"},
+             "on: each subject draws its own baseline skill, motor noise and learning rates from its id "
+             "(docs/writer.md); off: every subject is the profile itself");
   add_integer(*app, "--jobs", command->jobs, "N", "threads, each simulating one subject at a time", 1, 1024,
               "every core");
   required(add_output_folder(

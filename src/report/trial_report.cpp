@@ -244,7 +244,7 @@ char* fixed(char* out, char* end, double value, int decimals) {
 }  // namespace
 
 std::string trial_csv(const std::vector<TrialSample>& trace) {
-  std::string csv = "t,x,y,z,fx,fy,fz,state,stroke,element\n";
+  std::string csv = "t,x,y,z,fx,fy,fz,state,stroke,element,attempt,rewritten\n";
   csv.reserve(csv.size() + trace.size() * 64);
   char line[512];
   for (const TrialSample& s : trace) {
@@ -257,8 +257,8 @@ std::string trial_csv(const std::vector<TrialSample>& trace) {
     field(s.time_s, kTraceTimeDecimals);
     for (int axis = 0; axis < 3; ++axis) field(s.position_m[axis], kTracePositionDecimals);
     for (int axis = 0; axis < 3; ++axis) field(s.force_n[axis], kTraceForceDecimals);
-    out += std::snprintf(out, static_cast<std::size_t>(end - out), "%s,%zu,%zu\n", to_string(s.state),
-                         s.stroke, s.element);
+    out += std::snprintf(out, static_cast<std::size_t>(end - out), "%s,%zu,%zu,%d,%d\n", to_string(s.state),
+                         s.stroke, s.element, s.attempt, s.rewritten ? 1 : 0);
     csv.append(line, out);
   }
   return csv;

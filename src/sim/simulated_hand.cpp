@@ -18,9 +18,13 @@ SimulatedHand::SimulatedHand(HandPort& port, const Scene& scene, const WriterPro
 
 SimulatedHand::~SimulatedHand() { release(); }
 
-void SimulatedHand::observe(const RenderOutput& output, const DeviceState& pen) { writer_.observe(output, pen); }
+void SimulatedHand::observe(const RenderOutput& output, const DeviceState& pen) {
+  writer_.observe(output, pen);
+}
 
 bool SimulatedHand::stopped() const noexcept { return writer_.done(); }
+
+bool SimulatedHand::finished() const noexcept { return writer_.done(); }
 
 void SimulatedHand::advance(double dt_s) { port_.advance(dt_s); }
 
@@ -39,7 +43,8 @@ std::unique_ptr<SimulatedHand> simulated_hand_for(HapticDevice& device, const Sc
 TrialResult run_trial(HapticDevice& device, const Scene& scene, const TrialOptions& options,
                       const SimulationOptions& simulation, std::optional<WriterLog>* writer_log) {
   simulation.validate();
-  const std::unique_ptr<SimulatedHand> hand = simulated_hand_for(device, scene, simulation.writer, simulation.seed);
+  const std::unique_ptr<SimulatedHand> hand =
+      simulated_hand_for(device, scene, simulation.writer, simulation.seed);
   TrialResult result = run_trial(device, scene, options, hand.get());
   if (writer_log != nullptr) {
     writer_log->reset();

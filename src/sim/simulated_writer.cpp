@@ -141,6 +141,9 @@ struct SimulatedWriter::State {
   bool awaiting_verdict = false;  // pausing after a stroke to see whether the display took it
   PlannedStroke redo_target;
   bool done = false;
+  // Past its last attempt at a stroke the writer moved on (docs/writer.md, "Give-up and retries"): it writes
+  // the rest of its own plan and no longer waits for, or yields to, the display.
+  bool moved_on = false;
 
   // The motor command issued at the last observation: where the plan puts the hand and how fast it moves
   // there; the hand follows its first-order hold until the next observation.
@@ -377,7 +380,7 @@ void SimulatedWriter::State::feel(const RenderOutput& output, double dt, double 
   const Vec3& f = output.force_n;
   const double against = -f.head<2>().dot(intended) - profile.expected_drag_ratio * std::max(f.z(), 0.0);
   resisted_s = (!intended.isZero() && against > profile.resistance_threshold_n) ? resisted_s + dt : 0.0;
-  if (resisted_s >= profile.reaction_time_s) {
+  if (resisted_s >= profile.reaction_time_s && !moved_on) {
     ++log.refusals;
     break_off(time_s, AttemptEnd::refused, Next::hint);
   }
@@ -443,7 +446,9 @@ void SimulatedWriter::State::choose_next(double time_s) {
   const bool in_turn = !log.attempts.empty() && attempt.ended &&
                        log.attempts[attempt.log_index].end == AttemptEnd::completed &&
                        attempt.display_at_start == attempt.target.scene_stroke;
-  if (awaiting_verdict) {
+  if (moved_on) {
+    awaiting_verdict = false;  // moving on: no more looking whether the display took a stroke
+  } else if (awaiting_verdict) {
     awaiting_verdict = false;
     if (in_turn && !attempt.accepted) {
       log.attempts[attempt.log_index].end = AttemptEnd::not_accepted;
@@ -460,11 +465,11 @@ void SimulatedWriter::State::choose_next(double time_s) {
   }
   PlannedStroke target;
   bool follows_hint = false;
-  if (next == Next::hint || (next == Next::plan && log.refusals > 0)) {
+  if (!moved_on && (next == Next::hint || (next == Next::plan && log.refusals > 0))) {
     // After a refusal the writer has learnt that the display leads, and writes what it hints.
     target = hinted();
     follows_hint = true;
-  } else if (next == Next::redo) {
+  } else if (next == Next::redo && !moved_on) {
     target = redo_target;
   } else {
     const auto open = std::find_if(plan.begin(), plan.end(),
@@ -518,8 +523,15 @@ void SimulatedWriter::State::start_attempt(const PlannedStroke& target, bool fol
     if (a.scene_stroke == target.scene_stroke) ++number;
   }
   if (number > profile.max_attempts_per_stroke) {
+    // As an experimenter tells a learner stuck on a stroke: leave it and go on with the next one. The
+    // stroke stays as its last attempt left it; the writer counts it as written and writes the rest of its
+    // own plan (each further give-up marks one more stroke written, so this ends).
     log.gave_up = true;
-    done = true;
+    ++log.strokes_given_up;
+    written[target.scene_stroke] = true;
+    moved_on = true;
+    next = Next::plan;
+    choose_next(time_s);
     return;
   }
   // Each re-attempt is more careful: bias and error rates shrink by correction_per_attempt.

@@ -94,11 +94,18 @@ void practise(WriterMemory& memory, const std::vector<int>& typical_ids, const s
   }
   // x(n+1) = A x(n) + B e(n), e(n) from the skill before the trial; a stroke type written k times learns k
   // times from that error.
+  if (!(shares.timing_demonstration >= 0.0 && shares.timing_demonstration <= 1.0)) {
+    throw InvalidArgument("practise: timing demonstration " + std::to_string(shares.timing_demonstration) +
+                          " outside [0, 1]");
+  }
   std::map<int, double> shape_errors;
   std::map<int, double> timing_errors;
   for (const int id : typical_ids) {
     shape_errors[id] += error_of(memory.typical_strokes[id], shares.shape);
-    timing_errors[id] += error_of(memory.stroke_timing[id], shares.timing);
+    // Timing: the share of its own error the writer perceives, plus what a guide demonstrated.
+    const SkillMemory& timing = memory.stroke_timing[id];
+    timing_errors[id] += kSeenTimingShare * error_of(timing, shares.timing) +
+                         (1.0 - timing.skill()) * shares.timing_demonstration;
   }
   std::map<char32_t, double> character_errors;
   for (const char32_t c : characters) character_errors[c] += error_of(memory.characters[c], shares.shape);

@@ -48,6 +48,7 @@ SessionManifest cohort_manifest(const LoadedProtocol& protocol, const SubjectAss
   manifest.setup.writer_profile = setup.writer_profile;
   manifest.setup.writer_seed = subject_seed(subject.id);
   manifest.setup.writer_learning = setup.writer_learning;
+  manifest.setup.individual_differences = setup.individual_differences;
   manifest.setup.pacing = "lock-step";
   manifest.setup.session_number = number;
   manifest.protocol = protocol;
@@ -83,7 +84,8 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
   const bool learning = manifest.setup.writer_learning == "two-state";
   std::optional<WriterSkills> skills;
   if (learning)
-    skills = study_detail::learn_into(spec, memory, manifest.setup.writer_profile, scene, trial.characters);
+    skills = study_detail::learn_into(spec, memory, study_detail::subject_profile(manifest.setup), scene,
+                                      trial.characters);
   // The registry's simulated device, made here: asking the registry would scan every hardware backend (USB)
   // for each trial, from every thread at once.
   const auto device = std::make_unique<SimulatedDevice>();
@@ -96,7 +98,7 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
   const TrialRun run = run_trial_spec(spec, scene, inputs);
   const TrialResult& result = run.result;
   if (result.end != TrialEnd::completed && result.end != TrialEnd::time_limit &&
-      result.end != TrialEnd::gave_up) {
+      result.end != TrialEnd::gave_up && result.end != TrialEnd::writer_finished) {
     throw StateError(source + ": the trial ended " + std::string(to_string(result.end)) + " (" +
                      result.abort_reason + ") and was not kept");
   }
@@ -113,13 +115,16 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
   context.options = &run.options;
   context.simulation.writer = run.writer;
   context.simulation.seed = spec.seed;
+  context.writer_log = run.writer_log;
   std::vector<std::vector<QuizEvent>> quiz;
   if (condition.mode == ConditionMode::quiz)
     quiz = study_detail::quiz_characters(scene, result.trace, condition.quiz);
   json record =
       study_detail::trial_record(context, scene, result, run.metrics, quiz.empty() ? nullptr : &quiz);
   // Learned from as a session learns from its saved record.
-  if (learning) study_detail::practise_record(memory, record, source);
+  if (learning)
+    study_detail::practise_record(memory, record, source,
+                                  study_detail::subject_traits(manifest.setup).learning);
   return record;
 }
 

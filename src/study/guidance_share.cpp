@@ -60,8 +60,11 @@ AssistanceShares guidance_shares(const ForceLawParameters& force, double hand_st
   if (!force.guidance) return {};
   const bool along =
       force.guidance_mode == GuidanceMode::timing || force.guidance_mode == GuidanceMode::replay;
-  return {shape_share(force, k, e, written),
-          along ? guidance_assistance_share(1.0, force.guidance_stiffness_n_per_m, k) : 0.0};
+  // A guide that moves the pen along the stroke in time takes that share of the timing correction and
+  // demonstrates it: the writer feels the time course done.
+  const double along_share =
+      along ? guidance_assistance_share(1.0, force.guidance_stiffness_n_per_m, k) : 0.0;
+  return {shape_share(force, k, e, written), along_share, along_share};
 }
 
 }  // namespace calligraphy

@@ -79,6 +79,7 @@ std::string manifest_to_json(const SessionManifest& manifest) {
                    {"writer_profile", setup.writer_profile},
                    {"writer_seed", setup.writer_seed},
                    {"writer_learning", setup.writer_learning},
+                   {"individual_differences", setup.individual_differences},
                    {"pacing", setup.pacing},
                    {"library", library_build_json(manifest.library)},
                    {"protocol",
@@ -119,6 +120,8 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
   if (manifest.setup.writer_learning != "none" && manifest.setup.writer_learning != "two-state") {
     fail(source, "/writer_learning", "expected \"none\" or \"two-state\"");
   }
+  // Sessions made before subjects differed: every subject was its profile.
+  manifest.setup.individual_differences = root.boolean_or("individual_differences", false);
   manifest.setup.pacing = root.string("pacing");
   // Sessions made before protocols had phases are each the first of their series.
   manifest.setup.session_number = static_cast<int>(root.integer_or("session_number", 1, 1, 20));
@@ -183,6 +186,7 @@ std::string session_created_details(const SessionManifest& manifest) {
               {"writer", setup.writer},
               {"writer_profile", setup.writer_profile},
               {"writer_learning", setup.writer_learning},
+              {"individual_differences", setup.individual_differences},
               {"protocol", manifest.protocol.protocol.name},
               {"protocol_sha256", manifest.protocol.sha256},
               {"session_number", setup.session_number},

@@ -18,11 +18,12 @@ using nlohmann::json;
 
 // The subject's saved trials of one session folder as practice, in planned order.
 void practise_session(WriterMemory& memory, const fs::path& folder, const SessionManifest& manifest) {
+  const TwoStateRates rates = subject_traits(manifest.setup).learning;
   for (const PlannedTrial& trial : manifest.plan) {
     const fs::path file = folder / "trials" / (SessionFolder::trial_stem(trial) + ".json");
     std::error_code error;
     if (!fs::exists(file, error)) break;  // trials are saved in order: the rest are not yet
-    practise_record(memory, read_trial_record(file), file.string());
+    practise_record(memory, read_trial_record(file), file.string(), rates);
   }
 }
 
@@ -35,9 +36,35 @@ void remember(WriterMemory& memory, const fs::path& folder, const SessionManifes
   practise_session(memory, folder, manifest);
 }
 
+std::string setting(const std::string& key, double value) {
+  char text[40];
+  std::snprintf(text, sizeof text, "%.17g", value);
+  return key + "=" + text;
+}
+
 }  // namespace
 
-void practise_record(WriterMemory& memory, const json& document, const std::string& source) {
+SubjectTraits subject_traits(const SessionSetup& setup) {
+  if (setup.writer != "simulated" || !setup.individual_differences) return SubjectTraits{};
+  return draw_subject_traits(setup.writer_seed);
+}
+
+WriterProfile subject_profile(const SessionSetup& setup) {
+  return individual_profile(writer_profile(setup.writer_profile), subject_traits(setup));
+}
+
+std::vector<std::string> individual_parameters(const SessionSetup& setup) {
+  const SubjectTraits traits = subject_traits(setup);
+  if (!traits.drawn) return {};
+  const WriterProfile own = individual_profile(writer_profile(setup.writer_profile), traits);
+  std::vector<std::string> parameters;
+  for (const std::string& field : individual_profile_fields())
+    parameters.push_back(setting(field, writer_parameter(own, field)));
+  return parameters;
+}
+
+void practise_record(WriterMemory& memory, const json& document, const std::string& source,
+                     const TwoStateRates& rates) {
   const JsonView record(document, "", source);
   std::vector<int> ids;
   std::u32string characters;
@@ -55,8 +82,8 @@ void practise_record(WriterMemory& memory, const json& document, const std::stri
   const JsonView force_law = record.object("force_law");
   AssistanceShares shares;
   if (force_law.boolean_or("guidance", false)) {
-    const double hand = record.object("writer").object("profile").number_or("hand_stiffness_n_per_m", 0.0,
-                                                                            -1e12, 1e12);
+    const double hand =
+        record.object("writer").object("profile").number_or("hand_stiffness_n_per_m", 0.0, -1e12, 1e12);
     if (!(hand > 0.0))
       fail(source, "/writer/profile/hand_stiffness_n_per_m", "expected the hand's stiffness > 0");
     // The mode's parameters as recorded (records from before a mode existed hold the defaults).
@@ -67,9 +94,11 @@ void practise_record(WriterMemory& memory, const json& document, const std::stri
     force.guidance_mode = *parsed;
     constexpr double kLimit = 1e12;  // far beyond any parameter; the force law's validation bounds each
     force.guidance_gain = force_law.number_or("guidance_gain", 1.0, -kLimit, kLimit);
-    force.guidance_stiffness_n_per_m = force_law.number_or("guidance_stiffness_n_per_m", 0.0, -kLimit, kLimit);
+    force.guidance_stiffness_n_per_m =
+        force_law.number_or("guidance_stiffness_n_per_m", 0.0, -kLimit, kLimit);
     force.assist_band_m = force_law.number_or("assist_band_m", force.assist_band_m, -kLimit, kLimit);
-    force.amplification_gain = force_law.number_or("amplification_gain", force.amplification_gain, -kLimit, kLimit);
+    force.amplification_gain =
+        force_law.number_or("amplification_gain", force.amplification_gain, -kLimit, kLimit);
     force.amplification_max_force_n =
         force_law.number_or("amplification_max_force_n", force.amplification_max_force_n, -kLimit, kLimit);
     force.timing_speed_m_s = force_law.number_or("timing_speed_m_s", force.timing_speed_m_s, -kLimit, kLimit);
@@ -84,7 +113,7 @@ void practise_record(WriterMemory& memory, const json& document, const std::stri
       fail(source, "/force_law", e.what());
     }
   }
-  practise(memory, ids, characters, shares);
+  practise(memory, ids, characters, shares, rates);
 }
 
 WriterMemory remembered(const SessionFolder& session) {
@@ -101,23 +130,21 @@ std::vector<int> typical_ids(const Scene& scene) {
   return ids;
 }
 
-std::vector<std::string> learned_parameters(const WriterMemory& memory, const std::string& profile_name,
+std::vector<std::string> learned_parameters(const WriterMemory& memory, const WriterProfile& own,
                                             const std::vector<int>& ids, const std::u32string& characters) {
-  const WriterProfile learned = learned_profile(writer_profile(profile_name), WriterProfile::skilled(),
-                                                writer_skills(memory, ids, characters));
+  const WriterProfile learned =
+      learned_profile(own, WriterProfile::skilled(), writer_skills(memory, ids, characters));
   std::vector<std::string> parameters;
-  for (const std::string& field : learned_profile_fields()) {
-    char value[40];
-    std::snprintf(value, sizeof value, "%.17g", writer_parameter(learned, field));
-    parameters.push_back(field + "=" + value);
-  }
+  for (const std::string& field : learned_profile_fields())
+    parameters.push_back(setting(field, writer_parameter(learned, field)));
   return parameters;
 }
 
-WriterSkills learn_into(TrialSpec& spec, const WriterMemory& memory, const std::string& profile_name,
+WriterSkills learn_into(TrialSpec& spec, const WriterMemory& memory, const WriterProfile& own,
                         const Scene& scene, const std::u32string& characters) {
   const std::vector<int> ids = typical_ids(scene);
-  spec.writer_parameters = learned_parameters(memory, profile_name, ids, characters);
+  for (std::string& parameter : learned_parameters(memory, own, ids, characters))
+    spec.writer_parameters.push_back(std::move(parameter));
   return writer_skills(memory, ids, characters);
 }
 

@@ -89,8 +89,9 @@ const char* plain_decimal(const char* at, const char* end, double& value) {
 }
 
 // A trace line's first six fields (t, x, y, z, fx, fy) as finite numbers, each followed by a comma, and
-// the line's 10 fields in all: true; false for anything else (the field-by-field reading names the fault).
-bool read_leading_numbers(std::string_view line, std::array<double, 6>& values) {
+// the line's `field_count` fields in all: true; false for anything else (the field-by-field reading names
+// the fault).
+bool read_leading_numbers(std::string_view line, std::size_t field_count, std::array<double, 6>& values) {
   const char* at = line.data();
   const char* const end = at + line.size();
   for (double& value : values) {
@@ -103,28 +104,35 @@ bool read_leading_numbers(std::string_view line, std::array<double, 6>& values) 
     if (next == end || *next != ',') return false;
     at = next + 1;
   }
-  return std::count(at, end, ',') == 3;  // state, stroke, element
+  // The rest: state, stroke, element (and attempt, rewritten in a marked trace).
+  return static_cast<std::size_t>(std::count(at, end, ',')) == field_count - 7;
 }
 
-// The trial's trace (t,x,y,z,fx,fy,fz,state,stroke,element; gzip or plain CSV), streamed: times, positions,
-// pen down, in-plane force.
+// The trial's trace (t,x,y,z,fx,fy,fz,state,stroke,element[,attempt,rewritten]: traces saved before attempts
+// were marked lack the last two; gzip or plain CSV), streamed: times, positions, pen down, in-plane force.
 void read_trace(const fs::path& file, double paper_z_m, ReportTrial& trial) {
   const std::string source = file.string();
   TextFileReader reader(file, kMaxTrialCsvBytes, kMaxTrialCsvBytes);
   const double contact_m = PenTraceCsvOptions{}.contact_threshold_m;
   std::size_t line_number = 0;
   constexpr std::string_view kHeader = "t,x,y,z,fx,fy,fz,state,stroke,element";
+  constexpr std::string_view kMarkedHeader = "t,x,y,z,fx,fy,fz,state,stroke,element,attempt,rewritten";
+  std::size_t field_count = 10;
   constexpr std::size_t kMaxLineBytes = 4096;
   for_each_line(reader, source, kMaxLineBytes, [&](std::string_view line) {
     ++line_number;
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (line_number == 1) {
-      if (line != kHeader) throw DataError(source + ":1: expected the header '" + std::string(kHeader) + "'");
+      if (line != kHeader && line != kMarkedHeader) {
+        throw DataError(source + ":1: expected the header '" + std::string(kMarkedHeader) + "' (or '" +
+                        std::string(kHeader) + "')");
+      }
+      field_count = line == kMarkedHeader ? 12 : 10;
       return;
     }
     if (line.empty()) return;
     std::array<double, 6> values{};
-    if (read_leading_numbers(line, values)) {  // the common case, parsed where it stands
+    if (read_leading_numbers(line, field_count, values)) {  // the common case, parsed where it stands
       if (!trial.time_s.empty() && values[0] < trial.time_s.back()) {
         throw DataError(source + ":" + std::to_string(line_number) + ": time goes backwards");
       }
@@ -135,7 +143,7 @@ void read_trace(const fs::path& file, double paper_z_m, ReportTrial& trial) {
       return;
     }
     // Anything else field by field, so that an error names the field.
-    std::array<std::string_view, 10> fields;
+    std::array<std::string_view, 12> fields;
     std::size_t count = 0, start = 0;
     while (count < fields.size()) {
       const std::size_t comma = line.find(',', start);
@@ -144,9 +152,9 @@ void read_trace(const fs::path& file, double paper_z_m, ReportTrial& trial) {
       if (comma == std::string_view::npos) break;
       start = comma + 1;
     }
-    if (count != 10) {
-      throw DataError(source + ":" + std::to_string(line_number) + ": expected 10 fields, got " +
-                      std::to_string(count));
+    if (count != field_count) {
+      throw DataError(source + ":" + std::to_string(line_number) + ": expected " +
+                      std::to_string(field_count) + " fields, got " + std::to_string(count));
     }
     const double t = parse_field(fields[0], source, line_number, "t");
     if (!trial.time_s.empty() && t < trial.time_s.back()) {
@@ -162,7 +170,8 @@ void read_trace(const fs::path& file, double paper_z_m, ReportTrial& trial) {
     trial.pen_down.push_back(z - paper_z_m <= contact_m);
     trial.in_plane_force_n.push_back(force.norm());
   });
-  if (line_number == 0) throw DataError(source + ":1: expected the header '" + std::string(kHeader) + "'");
+  if (line_number == 0)
+    throw DataError(source + ":1: expected the header '" + std::string(kMarkedHeader) + "'");
 }
 
 ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifest, const PlannedTrial& plan,

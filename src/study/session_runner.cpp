@@ -133,7 +133,12 @@ TrialSpec study_trial_spec(const SessionManifest& session, const StudyCondition&
   }
   const bool simulated = session.setup.writer == "simulated";
   spec.writer = simulated ? TrialWriter::simulated : TrialWriter::person;
-  if (simulated) spec.writer_profile = session.setup.writer_profile;
+  if (simulated) {
+    spec.writer_profile = session.setup.writer_profile;
+    // The subject's own baseline skill and motor noise (its traits); a learning subject's learned fields
+    // are appended after these.
+    spec.writer_parameters = study_detail::individual_parameters(session.setup);
+  }
   // A seed of the simulated subject's own per trial, and per session of a series: a retention test on the
   // second day does not repeat the first day's trials stroke for stroke. The first session's seeds are
   // those of sessions made before protocols had several (plans hold at most kMaxPlannedTrials trials).
@@ -244,7 +249,8 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     json started = trial_details(trial);
     std::optional<WriterSkills> skills;
     if (learning) {
-      skills = study_detail::learn_into(spec, memory, manifest.setup.writer_profile, scene, trial.characters);
+      skills = study_detail::learn_into(spec, memory, study_detail::subject_profile(manifest.setup), scene,
+                                        trial.characters);
       started["shape_skill"] = skills->shape;
       started["order_skill"] = skills->order;
       started["timing_skill"] = skills->timing;
@@ -292,6 +298,7 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     context.options = &run.options;
     context.simulation.writer = run.writer;
     context.simulation.seed = spec.seed;
+    context.writer_log = run.writer_log;
     device.reset();
     ran_one = true;
 
@@ -303,9 +310,9 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     if (condition.mode == ConditionMode::quiz) {
       quiz = study_detail::quiz_characters(scene, trial_result.trace, condition.quiz);
     }
-    const bool keep_as_trial = trial_result.end == TrialEnd::completed ||
-                               trial_result.end == TrialEnd::time_limit ||
-                               trial_result.end == TrialEnd::gave_up;
+    const bool keep_as_trial =
+        trial_result.end == TrialEnd::completed || trial_result.end == TrialEnd::time_limit ||
+        trial_result.end == TrialEnd::gave_up || trial_result.end == TrialEnd::writer_finished;
     TrialOutcome outcome;
     outcome.end_reason = to_string(trial_result.end);
     outcome.time_s = writing.total_time_s;
@@ -318,8 +325,8 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
       session.save_trial(trial, record, trial_csv(trial_result.trace), trial_svg(scene, trial_result));
       // Learned from as the record says, the same as when the memory is rebuilt on a resume.
       if (learning)
-        study_detail::practise_record(memory, json::parse(record),
-                                      session.trial_file(trial, "json").string());
+        study_detail::practise_record(memory, json::parse(record), session.trial_file(trial, "json").string(),
+                                      study_detail::subject_traits(manifest.setup).learning);
       outcome.saved = true;
       outcome.json_file = session.trial_file(trial, "json").string();
       details["time_s"] = outcome.time_s;

@@ -136,6 +136,16 @@ TrialRow study_detail::trial_row(const json& document, const std::string& source
   row.shape_skill = memory.optional_number("shape_skill", -1e12, 1e12);
   row.order_skill = memory.optional_number("order_skill", -1e12, 1e12);
   row.timing_skill = memory.optional_number("timing_skill", -1e12, 1e12);
+  const JsonView traits = record.object("writer").object("subject_traits");
+  row.subject_writing_speed_factor = traits.optional_number("writing_speed_factor", 0.0, 1e6);
+  row.subject_spatial_error_factor = traits.optional_number("spatial_error_factor", 0.0, 1e6);
+  row.subject_error_rate_factor = traits.optional_number("error_rate_factor", 0.0, 1e6);
+  row.subject_motor_noise_factor = traits.optional_number("motor_noise_factor", 0.0, 1e6);
+  row.subject_fast_learning_per_trial = traits.optional_number("fast_learning_per_trial", 0.0, 1.0);
+  row.subject_slow_learning_per_trial = traits.optional_number("slow_learning_per_trial", 0.0, 1.0);
+  row.subject_fast_retention_per_trial = traits.optional_number("fast_retention_per_trial", 0.0, 1.0);
+  row.subject_slow_retention_per_trial = traits.optional_number("slow_retention_per_trial", 0.0, 1.0);
+  row.strokes_given_up = record.object("writer").object("log").optional_number("strokes_given_up", 0.0, 1e9);
   const JsonView characters = record.array("per_character");
   for (std::size_t c = 0; c < characters.size(); ++c) add_strokes(characters.object_at(c), c, row, strokes);
   return row;
@@ -198,7 +208,9 @@ std::string trials_csv(const StudyTables& tables) {
       "start_utc,completed_in_order,strokes_total,strokes_written,strokes_accepted,order_errors,"
       "backwards_strokes,unmatched_segments,mean_deviation_m,max_deviation_m,rms_deviation_m,frechet_m,dtw_m,"
       "total_time_s,pen_down_time_s,velocity_peaks,normalised_jerk,shape_skill,order_skill,timing_skill,"
-      "trace_file\n";
+      "subject_writing_speed_factor,subject_spatial_error_factor,subject_error_rate_factor,"
+      "subject_motor_noise_factor,subject_fast_learning_per_trial,subject_slow_learning_per_trial,"
+      "subject_fast_retention_per_trial,subject_slow_retention_per_trial,strokes_given_up,trace_file\n";
   for (const TrialRow& r : tables.trials) {
     line(out, r.subject, r.session, r.protocol, r.session_number, r.group, r.phase, r.block, r.condition,
          r.mode, r.characters, r.trial, r.item, r.repetition, r.writer, r.writer_profile, r.writer_learning,
@@ -206,6 +218,9 @@ std::string trials_csv(const StudyTables& tables) {
          r.strokes_accepted, r.order_errors, r.backwards_strokes, r.unmatched_segments, r.mean_deviation_m,
          r.max_deviation_m, r.rms_deviation_m, r.frechet_m, r.dtw_m, r.total_time_s, r.pen_down_time_s,
          r.velocity_peaks, r.normalised_jerk, r.shape_skill, r.order_skill, r.timing_skill,
+         r.subject_writing_speed_factor, r.subject_spatial_error_factor, r.subject_error_rate_factor,
+         r.subject_motor_noise_factor, r.subject_fast_learning_per_trial, r.subject_slow_learning_per_trial,
+         r.subject_fast_retention_per_trial, r.subject_slow_retention_per_trial, r.strokes_given_up,
          r.trace_file.string());
   }
   return out;

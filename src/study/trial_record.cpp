@@ -10,6 +10,7 @@
 #include "core/unicode.hpp"
 #include "model/polyline.hpp"
 #include "study/manifest_json.hpp"
+#include "study/remembered_writer.hpp"
 
 namespace calligraphy::study_detail {
 namespace {
@@ -125,6 +126,26 @@ json writer_json(const TrialRecordContext& c) {
                    {"follow_through_m", w.follow_through_m},
                    {"correction_per_attempt", w.correction_per_attempt},
                    {"max_attempts_per_stroke", w.max_attempts_per_stroke}}}};
+  const SubjectTraits traits = subject_traits(c.session->setup);
+  if (traits.drawn) {
+    // Who this subject is among the others of its profile (docs/writer.md, "Individual differences").
+    writer["subject_traits"] = {{"writing_speed_factor", traits.writing_speed_factor},
+                                {"spatial_error_factor", traits.spatial_error_factor},
+                                {"error_rate_factor", traits.error_rate_factor},
+                                {"motor_noise_factor", traits.motor_noise_factor},
+                                {"fast_learning_per_trial", traits.learning.fast_learning},
+                                {"slow_learning_per_trial", traits.learning.slow_learning},
+                                {"fast_retention_per_trial", traits.learning.fast_retention},
+                                {"slow_retention_per_trial", traits.learning.slow_retention}};
+  }
+  if (c.writer_log) {
+    // The writer's own account (docs/writer.md, "Give-up and retries"): how often it wrote a stroke again,
+    // and which strokes it left after its last attempt.
+    writer["log"] = {{"attempts", c.writer_log->attempts.size()},
+                     {"refusals", c.writer_log->refusals},
+                     {"not_accepted", c.writer_log->not_accepted},
+                     {"strokes_given_up", c.writer_log->strokes_given_up}};
+  }
   if (c.writer_skills) {
     writer["memory"] = {{"model", c.session->setup.writer_learning},
                         {"shape_skill", c.writer_skills->shape},

@@ -10,6 +10,7 @@
 #include "calligraphy/core/device_types.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/sim/simulated_hand.hpp"
+#include "calligraphy/sim/writer_log.hpp"
 #include "calligraphy/sim/writer_memory.hpp"
 #include "calligraphy/study/quiz.hpp"
 #include "calligraphy/study/session_folder.hpp"
@@ -35,6 +36,8 @@ struct TrialRecordContext {
   nlohmann::json guidance;  ///< the "guidance" object (trial_guidance.hpp); null: none
   /// A learning simulated writer's skills before the trial (writer_memory.hpp); none: nullopt.
   std::optional<WriterSkills> writer_skills;
+  /// What the simulated writer did (its log): attempts, refusals, strokes not taken, strokes given up.
+  std::optional<WriterLog> writer_log;
   std::string csv_file;  ///< file names beside the JSON
   std::string svg_file;
 };

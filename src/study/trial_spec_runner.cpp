@@ -8,6 +8,7 @@
 #include "calligraphy/sim/hand_port.hpp"
 #include "calligraphy/sim/simulated_device.hpp"
 #include "calligraphy/sim/simulated_hand.hpp"
+#include "calligraphy/sim/trace_attempts.hpp"
 #include "calligraphy/trial/runner.hpp"
 
 namespace calligraphy {
@@ -113,7 +114,11 @@ TrialRun run_trial_spec(const TrialSpec& spec, const Scene& scene, const TrialRu
   std::unique_ptr<SimulatedHand> hand;
   if (run.simulated_writer) hand = simulated_hand_for(*device, scene, run.writer, spec.seed);
   run.result = run_trial(*device, scene, run.options, hand.get());
-  if (hand) run.writer_log = hand->log();
+  if (hand) {
+    run.writer_log = hand->log();
+    // The writer knows which stroke each pen-down segment meant, and which it wrote again.
+    mark_writer_attempts(run.result.trace, *run.writer_log);
+  }
   hand.reset();  // lets go of the device before it goes
   run.options.should_stop = nullptr;
   run.options.display = nullptr;

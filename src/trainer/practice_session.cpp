@@ -89,7 +89,7 @@ std::pair<std::filesystem::path, bool> PracticeSession::save(const PracticeTrial
   if (condition.mode == ConditionMode::quiz)
     quiz = study_detail::quiz_characters(scene, result.trace, condition.quiz);
   const bool keep_as_trial = result.end == TrialEnd::completed || result.end == TrialEnd::time_limit ||
-                             result.end == TrialEnd::gave_up;
+                             result.end == TrialEnd::gave_up || result.end == TrialEnd::writer_finished;
   nlohmann::json details = {{"trial", planned.index + 1},
                             {"condition", planned.condition},
                             {"characters", encode_utf8(trial.character)},

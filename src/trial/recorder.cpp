@@ -42,6 +42,11 @@ void TrialRecorder::record(const DeviceState& state, const RenderOutput& out) {
     ++m.attempts;
     m.trace_begin = index;
   }
+  if (keep_trace_ && writing_this) trace_.back().attempt = m.attempts;
+  // A cleared attempt is written again: its ticks are not the final writing (no allocation: marks only).
+  if (keep_trace_ && out.stroke_abandoned) {
+    for (std::size_t i = m.trace_begin; i <= index && i < trace_.size(); ++i) trace_[i].rewritten = true;
+  }
   if (writing_this) {
     const auto [c, s] = stroke_location_[current_];
     // To the whole reference stroke, not only the active element.

@@ -16,6 +16,8 @@ const char* to_string(TrialEnd end) noexcept {
       return "interrupted";
     case TrialEnd::gave_up:
       return "gave_up";
+    case TrialEnd::writer_finished:
+      return "writer_finished";
   }
   return "unknown";
 }

@@ -65,7 +65,7 @@ TrialResult run_lock_step(HapticDevice& device, TrialHand& hand, TrialSession& s
     }
     hand.observe(session.last_output(), state);
     if (hand.stopped()) {
-      end = TrialEnd::gave_up;
+      end = hand.finished() ? TrialEnd::writer_finished : TrialEnd::gave_up;
       break;
     }
     if (command.stop) {  // out of time after this tick: the trial lasted until the next would start
@@ -123,7 +123,7 @@ TrialResult run_real_time(HapticDevice& device, TrialHand* hand, TrialSession& s
   } else if (session.finished()) {
     end = TrialEnd::completed;
   } else if (hand_stopped.load(std::memory_order_relaxed)) {
-    end = TrialEnd::gave_up;
+    end = hand->finished() ? TrialEnd::writer_finished : TrialEnd::gave_up;
   } else if (!interrupted && session.out_of_time()) {
     end = TrialEnd::time_limit;
   }

@@ -18,7 +18,7 @@ def test_trial_result_carries_the_writers_log():
     assert log.completed_order() == list(range(len(log.attempts) - 1)) or log.completed_order() == list(
         range(len(log.attempts)))
     assert all(a.end == calligraphy.AttemptEnd.completed for a in log.attempts[:-1])
-    assert log.out_of_order_attempts() == 0 and not log.gave_up
+    assert log.out_of_order_attempts() == 0 and not log.gave_up and log.strokes_given_up == 0
 
 
 def train(profile, repetitions, guidance):

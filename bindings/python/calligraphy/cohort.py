@@ -43,9 +43,9 @@ def _subject_list(subjects: typing.Any, prefix: str) -> list[tuple[str, int]]:
 
 
 def _run_batch(protocol: str, batch: list[tuple[str, int]], profile: str, learning: str,
-               source: tuple[str, str]) -> tuple[str, str]:
+               source: tuple[str, str], individual_differences: bool = True) -> tuple[str, str]:
     """One task on a worker: the batch's subjects one after another; the CSV texts of their tables."""
-    return _simulate_cohort_csv(protocol, batch, profile, learning, _library(source), 1)
+    return _simulate_cohort_csv(protocol, batch, profile, learning, _library(source), 1, individual_differences)
 
 
 def _body(text: str) -> str:
@@ -54,7 +54,7 @@ def _body(text: str) -> str:
 
 
 def simulate(protocol: PathLike, subjects: int, *, profile: str = "novice", learning: str = "two-state",
-             prefix: str = "S", client: typing.Any = None, workers: typing.Optional[int] = None,
+             individual_differences: bool = True, prefix: str = "S", client: typing.Any = None, workers: typing.Optional[int] = None,
              store: typing.Optional[PathLike] = None, data: typing.Optional[PathLike] = None,
              batch_size: typing.Optional[int] = None, progress: bool = True) -> "_study.Study":
     """Runs simulated subjects 1..`subjects` through every session of `protocol` (a study protocol file,
@@ -63,7 +63,9 @@ def simulate(protocol: PathLike, subjects: int, *, profile: str = "novice", lear
 
     profile: the simulated writer's profile, 'novice', 'skilled' or 'foreign'. learning: 'two-state' (the
         learning memory of docs/writer.md, practised by every trial and consolidated between sessions) or
-        'none'. prefix: the subjects' ids are prefix + the number in two digits or more.
+        'none'. individual_differences: True (each subject draws its own baseline skill, motor noise and
+        learning rates from its id, as ``session run`` and ``session cohort`` do; docs/writer.md) or False
+        (every subject is the profile itself). prefix: the subjects' ids are prefix + the number in two digits or more.
     client: None runs on `workers` C++ threads in this process (default: every core this process may use);
         a distributed.Client (or any concurrent.futures.Executor) runs batches of `batch_size` subjects
         (default 1) as its tasks, one thread each. The protocol file and the character source must be
@@ -77,6 +79,8 @@ def simulate(protocol: PathLike, subjects: int, *, profile: str = "novice", lear
     cannot be made; DataError naming the protocol file when it cannot be read; CharacterNotFound for a
     character the source lacks; ImportError without pandas. A simulated subject is a model, not a person.
     """
+    if not isinstance(individual_differences, bool):
+        raise TypeError(f"individual_differences: expected a bool, got {individual_differences!r}")
     subject_list = _subject_list(subjects, prefix)
     path = os.path.abspath(os.fspath(protocol))
     source = _source(store, data)
@@ -85,14 +89,15 @@ def simulate(protocol: PathLike, subjects: int, *, profile: str = "novice", lear
         if isinstance(threads, bool) or not isinstance(threads, int) or not 1 <= threads <= _MAX_WORKERS:
             raise ValueError(f"workers: expected an int in 1..{_MAX_WORKERS}, got {workers!r}")
         trials_text, strokes_text = _simulate_cohort_csv(path, subject_list, profile, learning, _library(source),
-                                                         threads)
+                                                         threads, individual_differences)
     else:
         size = batch_size if batch_size is not None else _DEFAULT_BATCH
         if isinstance(size, bool) or not isinstance(size, int) or size < 1:
             raise ValueError(f"batch_size: expected an int >= 1, got {batch_size!r}")
         executor = client.get_executor() if hasattr(client, "get_executor") else client
         batches = [subject_list[i:i + size] for i in range(0, len(subject_list), size)]
-        futures = [executor.submit(_run_batch, path, batch, profile, learning, source) for batch in batches]
+        futures = [executor.submit(_run_batch, path, batch, profile, learning, source,
+                                   individual_differences) for batch in batches]
         bar = _progress_bar(len(subject_list), progress, unit="subject", desc="cohort")
         try:
             for future, batch in zip(futures, batches):

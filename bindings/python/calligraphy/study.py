@@ -30,7 +30,10 @@ _NUMERIC_TRIAL_COLUMNS = (
     "session_number", "block", "trial", "item", "repetition", "strokes_total", "strokes_written", "strokes_accepted",
     "order_errors", "backwards_strokes", "unmatched_segments", "mean_deviation_m", "max_deviation_m",
     "rms_deviation_m", "frechet_m", "dtw_m", "total_time_s", "pen_down_time_s", "velocity_peaks",
-    "normalised_jerk", "shape_skill", "order_skill", "timing_skill")
+    "normalised_jerk", "shape_skill", "order_skill", "timing_skill", "subject_writing_speed_factor",
+    "subject_spatial_error_factor", "subject_error_rate_factor", "subject_motor_noise_factor",
+    "subject_fast_learning_per_trial", "subject_slow_learning_per_trial", "subject_fast_retention_per_trial",
+    "subject_slow_retention_per_trial", "strokes_given_up")
 _NUMERIC_STROKE_COLUMNS = (
     "trial", "character", "stroke", "typical_id", "segments", "refused_segments", "mean_deviation_m",
     "max_deviation_m", "rms_deviation_m", "frechet_m", "dtw_m", "time_s", "path_length_m")
@@ -41,6 +44,10 @@ _SAMPLE_COLUMNS = {"t": "t_s", "x": "x_m", "y": "y_m", "z": "z_m", "fx": "fx_n",
 
 
 _TRACE_HEADER = ["t", "x", "y", "z", "fx", "fy", "fz", "state", "stroke", "element"]
+# Traces saved since attempts were marked add the attempt at the stroke (1-based, 0 outside any) and whether
+# it was written again later (1: not the final writing); older traces lack both.
+_MARKED_TRACE_HEADER = _TRACE_HEADER + ["attempt", "rewritten"]
+_WHOLE_NUMBER_COLUMNS = ("stroke", "element", "attempt", "rewritten")
 
 
 def _read_trace(path: str) -> "pandas.DataFrame":
@@ -60,17 +67,21 @@ def _read_trace(path: str) -> "pandas.DataFrame":
         raise DataError(f"{path}: not a gzip-compressed trial trace: {error}") from error
     except (ValueError, pd.errors.ParserError, UnicodeDecodeError) as error:
         raise DataError(f"{path}: not a trial trace (CSV): {error}") from error
-    if list(frame.columns) != _TRACE_HEADER:
-        raise DataError(f"{path}:1: expected the header '{','.join(_TRACE_HEADER)}'")
-    for column in _TRACE_HEADER:
+    if list(frame.columns) not in (_TRACE_HEADER, _MARKED_TRACE_HEADER):
+        raise DataError(f"{path}:1: expected the header '{','.join(_MARKED_TRACE_HEADER)}' "
+                        f"(or '{','.join(_TRACE_HEADER)}')")
+    for column in frame.columns:
         if column == "state":
             continue
         values = pd.to_numeric(frame[column], errors="coerce").to_numpy(dtype=float)
-        bad = ~np.isfinite(values) if column not in ("stroke", "element") else ~np.isfinite(values) | (values != np.round(values))
+        whole = column in _WHOLE_NUMBER_COLUMNS
+        bad = ~np.isfinite(values) if not whole else ~np.isfinite(values) | (values != np.round(values))
+        if column == "rewritten":
+            bad |= (values != 0) & (values != 1)
         if bad.any():
             first = int(np.argmax(bad))
             raise DataError(f"{path}:{first + 2}: column {column}: not a finite number: {frame[column].iloc[first]!r}")
-        frame[column] = values.astype(int) if column in ("stroke", "element") else values
+        frame[column] = values.astype(int) if whole else values
     return frame.rename(columns=_SAMPLE_COLUMNS)
 
 
@@ -109,7 +120,12 @@ class Study:
         condition, mode, characters, trial, item, repetition (1-based), writer, end_reason, start_utc,
         completed_in_order, stroke counts, order_errors, backwards_strokes, unmatched_segments, mean/max/rms_deviation_m, frechet_m, dtw_m [m],
         total_time_s, pen_down_time_s [s], velocity_peaks, normalised_jerk, shape_skill, order_skill and
-        timing_skill (a learning simulated writer's skills before the trial, NaN otherwise), trace_file).
+        timing_skill (a learning simulated writer's skills before the trial, NaN otherwise), the simulated
+        subject's traits subject_writing_speed_factor, subject_spatial_error_factor, subject_error_rate_factor,
+        subject_motor_noise_factor (dimensionless factors on its profile) and subject_fast/slow_learning_per_trial,
+        subject_fast/slow_retention_per_trial (its two-state rates; all NaN when subjects do not differ,
+        docs/writer.md), strokes_given_up (strokes a simulated writer left after its last attempt, NaN for a
+        person), trace_file).
     strokes: one row per reference stroke of each saved trial (subject, session, trial, phase, condition,
         character (1-based in the trial), character_text, stroke (1-based in its character), typical_id,
         written, backwards, segments, refused_segments, refusal, the per-stroke deviations [m], time_s [s],

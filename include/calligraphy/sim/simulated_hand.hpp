@@ -39,6 +39,9 @@ class SimulatedHand final : public TrialHand {
 
   void observe(const RenderOutput& output, const DeviceState& pen) override;
   [[nodiscard]] bool stopped() const noexcept override;
+  /// True once stopped: the writer stops only when it has written its plan (it moves on past a stroke it
+  /// gives up on, docs/writer.md "Give-up and retries").
+  [[nodiscard]] bool finished() const noexcept override;
   void advance(double dt_s) override;
   void release() noexcept override;
 

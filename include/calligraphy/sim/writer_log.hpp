@@ -44,7 +44,10 @@ struct WriterLog {
   std::vector<WriterAttempt> attempts;
   std::size_t refusals = 0;      ///< attempts broken off because of resistance
   std::size_t not_accepted = 0;  ///< attempts written whole that the display did not take (seen)
-  bool gave_up = false;          ///< the writer gave up on a stroke after `max_attempts_per_stroke`
+  /// The writer gave up on a stroke after `max_attempts_per_stroke` attempts and moved on to the rest of
+  /// its plan (docs/writer.md, "Give-up and retries").
+  bool gave_up = false;
+  std::size_t strokes_given_up = 0;  ///< strokes it gave up on so (each left as its last attempt left it)
 
   /// Attempts that were out of order / backwards / of each error kind.
   [[nodiscard]] std::size_t out_of_order_attempts() const noexcept;

@@ -59,7 +59,16 @@ struct WriterMemory {
 struct AssistanceShares {
   double shape = 0.0;
   double timing = 0.0;
+  /// The share of the timing a guide demonstrated by moving the pen along the stroke in time (a replay's
+  /// teacher, a timing guide's moving target), in [0, 1]: the writer feels the time course done and learns
+  /// it as an error it perceives (use-dependent learning from guided movement, Diedrichsen et al. 2010).
+  double timing_demonstration = 0.0;
 };
+
+/// The share of its timing error a writer perceives without a demonstration: the display's reference has no
+/// time course, so vision shows its own pace and pauses but not the target's (assumed 0.5, the share of the
+/// feedback the trace alone gives in writer_learning.hpp; docs/writer.md, "What a demonstration teaches").
+inline constexpr double kSeenTimingShare = 0.5;
 
 /// A writer's skills for one trial, each in [0, 1]: the mean over its strokes' typical strokes (shape,
 /// timing) and over its characters (order).
@@ -82,7 +91,8 @@ inline constexpr double kMinAssistanceShare = -9.0;
 /// One trial of practice: every memory decays by its retention (A_f, A_s); then each typical stroke of
 /// `typical_ids` (one per stroke of the trial's characters; a stroke type written twice learns twice) and
 /// each character of `characters` learns from the error e = (1 - x)(1 - h), h the shape share for shape and
-/// order and the timing share for timing: a share in (0, 1] is the correction guidance took, a negative
+/// order; timing from e = (1 - x)(kSeenTimingShare (1 - h) + d), h the timing share and d the timing
+/// demonstration (in [0, 1]): a share in (0, 1] is the correction guidance took, a negative
 /// share an error a repulsive field enlarged by the factor 1 - share (error augmentation: Emken &
 /// Reinkensmeyer 2005, IEEE TNSRE 13:33). Throws InvalidArgument for a share outside [kMinAssistanceShare, 1]
 /// or bad rates.

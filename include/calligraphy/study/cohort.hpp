@@ -27,6 +27,9 @@ struct CohortSetup {
   /// "none" (every trial from the profile) or "two-state" (the learning memory,
   /// SessionSetup::writer_learning).
   std::string writer_learning = "two-state";
+  /// Whether the subjects differ from one another (SessionSetup::individual_differences, sim/
+  /// subject_traits.hpp); false: every subject is the profile itself.
+  bool individual_differences = true;
   /// Loads a character's model; empty: the embedded characters. Called from one thread at a time.
   std::function<Character(char32_t)> load_character;
   /// Throws InvalidArgument naming the field for an unknown profile or learning.

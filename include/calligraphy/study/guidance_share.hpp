@@ -21,7 +21,9 @@ namespace calligraphy {
 ///    once it saturates at F_max, the smaller of the two (1 when e is NaN), at most 1 - kMinAssistanceShare.
 /// Timing, along the stroke: K / (K + k) for `timing` (its moving target) and `replay` (the teacher's point
 /// at the teacher's time); 0 for the others, whose springs pull towards the nearest point of the stroke and
-/// so have no component along it. Throws InvalidArgument for a hand stiffness that is not finite and > 0, a
+/// so have no component along it. The timing demonstration (AssistanceShares::timing_demonstration) is the
+/// timing share of `timing` and `replay`, whose guide moves the pen in time, and 0 for the others. Throws
+/// InvalidArgument for a hand stiffness that is not finite and > 0, a
 /// negative deviation, or what `ForceLawParameters::validate` throws.
 [[nodiscard]] AssistanceShares guidance_shares(const ForceLawParameters& force, double hand_stiffness_n_per_m,
                                                double mean_deviation_m);

@@ -47,6 +47,10 @@ struct SessionSetup {
   /// (a memory per typical stroke and character, sim/writer_memory.hpp, rebuilt from the saved trials of
   /// this session and the ones before it).
   std::string writer_learning = "none";
+  /// Whether a simulated subject differs from the others of its profile (sim/subject_traits.hpp: its own
+  /// baseline skill, motor noise and learning rates, drawn from `writer_seed`); false: every subject is the
+  /// profile itself. Sessions made before subjects differed read as false.
+  bool individual_differences = true;
   std::string pacing = "auto";  ///< "auto", "lock-step" or "real-time" (TrialPacing)
   /// 1-based: which of the protocol's sessions (ProtocolPhase::session) this one is.
   int session_number = 1;

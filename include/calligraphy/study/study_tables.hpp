@@ -58,6 +58,19 @@ struct TrialRow {
   std::optional<double> shape_skill;
   std::optional<double> order_skill;
   std::optional<double> timing_skill;
+  /// A simulated subject's traits (sim/subject_traits.hpp, docs/writer.md "Individual differences"): factors
+  /// on its profile (dimensionless) and its two-state rates per trial; absent when subjects do not differ.
+  std::optional<double> subject_writing_speed_factor;
+  std::optional<double> subject_spatial_error_factor;
+  std::optional<double> subject_error_rate_factor;
+  std::optional<double> subject_motor_noise_factor;
+  std::optional<double> subject_fast_learning_per_trial;
+  std::optional<double> subject_slow_learning_per_trial;
+  std::optional<double> subject_fast_retention_per_trial;
+  std::optional<double> subject_slow_retention_per_trial;
+  /// Strokes a simulated writer gave up on after its last attempt and left (docs/writer.md, "Give-up and
+  /// retries"); absent for a person and for records from before it was kept.
+  std::optional<double> strokes_given_up;
   std::filesystem::path trace_file;  ///< the trial's CSV trace (t,x,y,z,fx,fy,fz,state,stroke,element)
 };
 

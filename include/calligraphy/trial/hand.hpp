@@ -23,6 +23,9 @@ class TrialHand {
   /// True once the hand has stopped writing before the character was written (it gave up); the trial then
   /// ends with `TrialEnd::gave_up`.
   [[nodiscard]] virtual bool stopped() const noexcept = 0;
+  /// True when the hand stopped because it wrote all it meant to write, not because it gave up: the trial
+  /// then ends with `TrialEnd::writer_finished`. The default: false.
+  [[nodiscard]] virtual bool finished() const noexcept { return false; }
   /// Lets `dt_s` seconds [s] of the device's time pass under the force held since the last
   /// `write_force` and the hand's own force (the device's time advances only here).
   virtual void advance(double dt_s) = 0;

@@ -21,6 +21,14 @@ struct TrialSample {
   InteractionState state = InteractionState::separation;
   std::size_t stroke = 0;   ///< active stroke, counted over the whole scene (0-based)
   std::size_t element = 0;  ///< active element within it
+  /// The attempt at a stroke this tick belongs to, 1-based; 0 outside any. The renderer's count (times WS
+  /// was entered on the active stroke) as recorded; a simulated writer's own count (its log: an attempt runs
+  /// from setting off to lifting, pen up or down) once `mark_writer_attempts` (sim/trace_attempts.hpp) ran.
+  int attempt = 0;
+  /// Part of an attempt at a stroke that was written again later (cleared, refused, not taken): not the
+  /// final writing. From the renderer, the WS ticks of a cleared attempt; from a simulated writer's log,
+  /// every tick of an attempt followed by another at the same stroke.
+  bool rewritten = false;
 };
 
 /// Metrics of one stroke. Deviations are distances in the paper plane from the pen tip to the stroke's

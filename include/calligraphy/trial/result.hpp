@@ -22,9 +22,12 @@ enum class TrialEnd {
   watchdog,      ///< the servo loop stalled longer than its bound
   interrupted,   ///< `TrialOptions::should_stop` (e.g. SIGINT or SIGTERM, a closed window)
   gave_up,       ///< the hand moving the device (hand.hpp) stopped before every stroke was written
+  /// The hand finished what it meant to write (TrialHand::finished) before the display took every stroke:
+  /// strokes out of order or not taken, or given up on and left (a simulated writer, docs/writer.md).
+  writer_finished,
 };
 
-/// "completed", "time_limit", "device_fault", "watchdog", "interrupted", "gave_up".
+/// "completed", "time_limit", "device_fault", "watchdog", "interrupted", "gave_up", "writer_finished".
 [[nodiscard]] const char* to_string(TrialEnd end) noexcept;
 
 /// The outcome of a trial. The metrics and trace hold every tick recorded, whatever ended the trial.
