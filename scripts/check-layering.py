@@ -25,7 +25,8 @@ MODULE_DEPENDS = {
     "sim": ["devices", "render", "trial"],
     "testing": ["sim"],
     "report": ["trial", "analysis"],
-    "study": ["report", "sim"],
+    "legibility": ["trial"],
+    "study": ["report", "sim", "legibility"],
     "eval": ["study", "testing"],
 }
 

@@ -146,6 +146,9 @@ TrialRow study_detail::trial_row(const json& document, const std::string& source
   row.subject_fast_retention_per_trial = traits.optional_number("fast_retention_per_trial", 0.0, 1.0);
   row.subject_slow_retention_per_trial = traits.optional_number("slow_retention_per_trial", 0.0, 1.0);
   row.strokes_given_up = record.object("writer").object("log").optional_number("strokes_given_up", 0.0, 1e9);
+  const JsonView legibility = record.object("legibility");
+  row.legibility_top1 = legibility.optional_number("top1", 0.0, 1.0);
+  row.legibility_top5 = legibility.optional_number("top5", 0.0, 1.0);
   const JsonView characters = record.array("per_character");
   for (std::size_t c = 0; c < characters.size(); ++c) add_strokes(characters.object_at(c), c, row, strokes);
   return row;
@@ -210,7 +213,8 @@ std::string trials_csv(const StudyTables& tables) {
       "total_time_s,pen_down_time_s,velocity_peaks,normalised_jerk,shape_skill,order_skill,timing_skill,"
       "subject_writing_speed_factor,subject_spatial_error_factor,subject_error_rate_factor,"
       "subject_motor_noise_factor,subject_fast_learning_per_trial,subject_slow_learning_per_trial,"
-      "subject_fast_retention_per_trial,subject_slow_retention_per_trial,strokes_given_up,trace_file\n";
+      "subject_fast_retention_per_trial,subject_slow_retention_per_trial,strokes_given_up,legibility_top1,"
+      "legibility_top5,trace_file\n";
   for (const TrialRow& r : tables.trials) {
     line(out, r.subject, r.session, r.protocol, r.session_number, r.group, r.phase, r.block, r.condition,
          r.mode, r.characters, r.trial, r.item, r.repetition, r.writer, r.writer_profile, r.writer_learning,
@@ -221,7 +225,7 @@ std::string trials_csv(const StudyTables& tables) {
          r.subject_writing_speed_factor, r.subject_spatial_error_factor, r.subject_error_rate_factor,
          r.subject_motor_noise_factor, r.subject_fast_learning_per_trial, r.subject_slow_learning_per_trial,
          r.subject_fast_retention_per_trial, r.subject_slow_retention_per_trial, r.strokes_given_up,
-         r.trace_file.string());
+         r.legibility_top1, r.legibility_top5, r.trace_file.string());
   }
   return out;
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <nlohmann/json.hpp>
 
+#include "calligraphy/legibility/legibility.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
 #include "calligraphy/report/pen_trace_csv.hpp"
 #include "calligraphy/report/score_report.hpp"
@@ -249,6 +250,32 @@ std::vector<std::vector<QuizEvent>> quiz_characters(const Scene& scene, const st
   return events;
 }
 
+namespace {
+
+// The written characters as an independent recogniser reads them (legibility/legibility.hpp): null when no
+// recogniser is available. top1 and top5 are the shares of the trial's characters recognised first, or
+// among the first five.
+json legibility_json(const Scene& scene, const TrialResult& result) {
+  const std::vector<CharacterLegibility> verdicts = trial_legibility(scene, result.trace);
+  if (verdicts.empty()) return nullptr;
+  json characters = json::array();
+  std::size_t first = 0, among_five = 0;
+  for (const CharacterLegibility& v : verdicts) {
+    first += v.rank == 1 ? 1 : 0;
+    among_five += v.rank >= 1 ? 1 : 0;
+    characters.push_back({{"character", encode_utf8(v.expected)}, {"rank", v.rank}, {"top1", v.top1}});
+  }
+  const double count = static_cast<double>(verdicts.size());
+  return {{"recogniser", "zinnia"},
+          {"model", legibility_model_path()},
+          {"candidates", kLegibilityCandidates},
+          {"top1", static_cast<double>(first) / count},
+          {"top5", static_cast<double>(among_five) / count},
+          {"per_character", characters}};
+}
+
+}  // namespace
+
 nlohmann::json trial_record(const TrialRecordContext& c, const Scene& scene, const TrialResult& result,
                             const WritingMetrics& writing, const std::vector<std::vector<QuizEvent>>* quiz) {
   const TrialMetrics& m = result.metrics;
@@ -267,48 +294,49 @@ nlohmann::json trial_record(const TrialRecordContext& c, const Scene& scene, con
   }
   const PlannedTrial& t = *c.trial;
   // Version 2: the trial's block and item count from 1, as its index and repetition (version 1: from 0).
-  json document = {
-      {"format", kFormat},
-      {"version", 2},
-      {"subject", c.session->setup.subject.id},
-      {"subject_number", c.session->setup.subject.number},
-      {"session", c.session->session_id},
-      {"trial", planned_trial_json(t)},
-      {"phase", to_string(t.phase)},
-      {"condition", t.condition},
-      {"mode", to_string(c.condition->mode)},
-      {"characters", encode_utf8(t.characters)},
-      {"repetition", t.repetition},
-      {"start_time_utc", c.start_utc},
-      {"end_time_utc", c.end_utc},
-      {"wall_time_s", c.wall_time_s},
-      {"protocol",
-       {{"name", c.session->protocol.protocol.name},
-        {"path", c.session->protocol.path.string()},
-        {"sha256", c.session->protocol.sha256}}},
-      {"library", library_build_json(library_build())},
-      {"session_library", library_build_json(c.session->library)},
-      {"device",
-       {{"name", c.device_name},
-        {"hardware", c.hardware},
-        {"info", device_info_json(c.device_info)},
-        {"time_at_start_s", result.device_time_at_start_s}}},
-      {"writer", writer_json(c)},
-      {"force_law", force_law_json(c.options->force)},
-      {"renderer", renderer_json(*c.options)},
-      {"scene", scene_json(scene)},
-      {"end_reason", to_string(result.end)},
-      {"aborted", result.aborted},
-      {"abort_reason", result.abort_reason},
-      {"strokes_completed", m.strokes_completed},
-      {"trial_time_s", m.time_s},
-      {"max_force_n", m.max_force_n},
-      {"max_force_step_n", m.max_force_step_n},
-      {"state_transitions", m.state_transitions},
-      {"per_stroke", per_stroke},
-      {"samples", result.trace.size()},
-      {"files", {{"csv", c.csv_file}, {"svg", c.svg_file}}}};
+  json document = {{"format", kFormat},
+                   {"version", 2},
+                   {"subject", c.session->setup.subject.id},
+                   {"subject_number", c.session->setup.subject.number},
+                   {"session", c.session->session_id},
+                   {"trial", planned_trial_json(t)},
+                   {"phase", to_string(t.phase)},
+                   {"condition", t.condition},
+                   {"mode", to_string(c.condition->mode)},
+                   {"characters", encode_utf8(t.characters)},
+                   {"repetition", t.repetition},
+                   {"start_time_utc", c.start_utc},
+                   {"end_time_utc", c.end_utc},
+                   {"wall_time_s", c.wall_time_s},
+                   {"protocol",
+                    {{"name", c.session->protocol.protocol.name},
+                     {"path", c.session->protocol.path.string()},
+                     {"sha256", c.session->protocol.sha256}}},
+                   {"library", library_build_json(library_build())},
+                   {"session_library", library_build_json(c.session->library)},
+                   {"device",
+                    {{"name", c.device_name},
+                     {"hardware", c.hardware},
+                     {"info", device_info_json(c.device_info)},
+                     {"time_at_start_s", result.device_time_at_start_s}}},
+                   {"writer", writer_json(c)},
+                   {"force_law", force_law_json(c.options->force)},
+                   {"renderer", renderer_json(*c.options)},
+                   {"scene", scene_json(scene)},
+                   {"end_reason", to_string(result.end)},
+                   {"aborted", result.aborted},
+                   {"abort_reason", result.abort_reason},
+                   {"strokes_completed", m.strokes_completed},
+                   {"trial_time_s", m.time_s},
+                   {"max_force_n", m.max_force_n},
+                   {"max_force_step_n", m.max_force_step_n},
+                   {"state_transitions", m.state_transitions},
+                   {"per_stroke", per_stroke},
+                   {"samples", result.trace.size()},
+                   {"files", {{"csv", c.csv_file}, {"svg", c.svg_file}}}};
   document.update(json::parse(writing_metrics_json(writing)));  // the one metrics record
+  if (json legibility = legibility_json(scene, result); !legibility.is_null())
+    document["legibility"] = legibility;
   if (c.device_name == "simulated") document["device"]["simulated_device"] = simulated_device_json();
   if (!c.condition->guidance_parameters.empty())
     document["guidance_parameters"] = c.condition->guidance_parameters;

@@ -33,7 +33,7 @@ _NUMERIC_TRIAL_COLUMNS = (
     "normalised_jerk", "shape_skill", "order_skill", "timing_skill", "subject_writing_speed_factor",
     "subject_spatial_error_factor", "subject_error_rate_factor", "subject_motor_noise_factor",
     "subject_fast_learning_per_trial", "subject_slow_learning_per_trial", "subject_fast_retention_per_trial",
-    "subject_slow_retention_per_trial", "strokes_given_up")
+    "subject_slow_retention_per_trial", "strokes_given_up", "legibility_top1", "legibility_top5")
 _NUMERIC_STROKE_COLUMNS = (
     "trial", "character", "stroke", "typical_id", "segments", "refused_segments", "mean_deviation_m",
     "max_deviation_m", "rms_deviation_m", "frechet_m", "dtw_m", "time_s", "path_length_m")

@@ -703,6 +703,12 @@ def _subjects_sentence(trials: "pandas.DataFrame") -> str:
     models = sorted({str(m) for m in simulated.get("writer_learning", []) if str(m)}) or ["not recorded"]
     learns = ("they learn from trial to trial by that model (docs/writer.md)" if models != ["none"]
               else "they do not learn between trials")
+    traits = simulated.get("subject_writing_speed_factor")
+    if traits is not None and traits.notna().any():
+        learns += ("; each subject has its own baseline skill, motor noise and learning rates, drawn from the "
+                   "distributions of docs/writer.md (individual differences)")
+    else:
+        learns += "; all subjects of a profile alike (no individual differences)"
     who = "Some subjects are" if len(writers) > 1 else "The subjects are"
     return (f"{who} simulated (profile {', '.join(profiles)}; learning model {', '.join(models)}: {learns}): a model "
             "of a writer moving a simulated device, not people. Their numbers test the procedure and the analysis; "

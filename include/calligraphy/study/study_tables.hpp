@@ -71,6 +71,10 @@ struct TrialRow {
   /// Strokes a simulated writer gave up on after its last attempt and left (docs/writer.md, "Give-up and
   /// retries"); absent for a person and for records from before it was kept.
   std::optional<double> strokes_given_up;
+  /// Shares of the trial's characters that an independent recogniser (zinnia) ranked first, and among its
+  /// first five, reading the final writing (legibility/legibility.hpp); absent without a recogniser.
+  std::optional<double> legibility_top1;
+  std::optional<double> legibility_top5;
   std::filesystem::path trace_file;  ///< the trial's CSV trace (t,x,y,z,fx,fy,fz,state,stroke,element)
 };
 

@@ -1,0 +1,73 @@
+"""Legibility read by an independent recogniser (zinnia with the Tegaki Simplified-Chinese model): the
+tables carry each trial's top-1 and top-5 recognition of the final writing; a skilled simulated writer is
+read about as often as the data's own medians (read by the zinnia program, a route that shares no code with
+the library's); and learning subjects are read more often after training than before. Skipped, saying
+why, without zinnia."""
+
+import json
+import os
+import pathlib
+import shutil
+import subprocess
+
+import pandas
+import pytest
+
+MODEL = pathlib.Path("/usr/share/tegaki/models/zinnia/handwriting-zh_CN.model")
+DATA = pathlib.Path(__file__).resolve().parents[2] / "data" / "hanzi-writer-data"
+PROTOCOLS = pathlib.Path(__file__).resolve().parents[2] / "examples" / "protocols"
+
+pytestmark = pytest.mark.skipif(
+    shutil.which("zinnia") is None or not MODEL.is_file(),
+    reason="zinnia or its model is not installed (Debian: zinnia-utils tegaki-zinnia-simplified-chinese)")
+
+
+def cohort(tmp_path, protocol, subjects, profile, learning, name):
+    out = tmp_path / name
+    out.mkdir()
+    run = subprocess.run([os.environ["CALLIGRAPHY_CLI"], "session", "cohort", str(protocol), "--subjects",
+                          str(subjects), "--writer-profile", profile, "--writer-learning", learning, "--csv", str(out)],
+                         capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr
+    return pandas.read_csv(out / "trials.csv")
+
+
+def medians_top1(characters):
+    """The share of `characters` whose hanzi-writer-data medians zinnia ranks first: y flipped into screen
+    coordinates (900 - y, the data's own SVG transform) in a 1024-unit box."""
+    lines = []
+    for character in characters:
+        medians = json.loads((DATA / f"{character}.json").read_text(encoding="utf-8"))["medians"]
+        strokes = " ".join("(" + " ".join(f"({x} {900 - y})" for x, y in median) + ")" for median in medians)
+        lines.append(f"(character (value {character}) (width 1024) (height 1024) (strokes {strokes}))")
+    read = subprocess.run(["zinnia", "-m", str(MODEL), "-n", "1"], input="\n".join(lines) + "\n",
+                          capture_output=True, text=True, timeout=120)
+    assert read.returncode == 0, read.stderr
+    answers = read.stdout.split("Answer: ")[1:]
+    assert len(answers) == len(characters)
+    return sum(block.split("\n")[1].split()[0] == block.split("\n")[0].strip() for block in answers) / len(answers)
+
+
+def test_a_skilled_writer_is_read_about_as_often_as_the_data_medians(tmp_path):
+    characters = sorted(path.stem for path in DATA.glob("*.json"))
+    protocol = {"format": "calligraphy-study-protocol", "version": 1, "name": "every-character",
+                "conditions": [{"name": "unguided", "mode": "vision"}],
+                "phases": [{"phase": "pre-test", "condition": "unguided", "characters": characters}],
+                "trial": {"max_duration_s": 60, "rate_hz": 1000}}
+    path = tmp_path / "every-character.json"
+    path.write_text(json.dumps(protocol, ensure_ascii=False), encoding="utf-8")
+    skilled = cohort(tmp_path, path, 3, "skilled", "none", "skilled")
+    foreign = cohort(tmp_path, path, 3, "foreign", "none", "foreign")
+    assert skilled.legibility_top1.notna().all() and skilled.legibility_top5.between(0, 1).all()
+    assert (skilled.legibility_top5 >= skilled.legibility_top1).all()
+    reference = medians_top1(characters)
+    # The medians are what the skilled writer aims at; its own noise may cost a character or two in 50.
+    assert skilled.legibility_top1.mean() >= reference - 0.1, (skilled.legibility_top1.mean(), reference)
+    # A writer who does not know the characters is read less often than one who does.
+    assert foreign.legibility_top1.mean() < skilled.legibility_top1.mean() - 0.1
+
+
+def test_learning_subjects_are_read_more_often_after_training(tmp_path):
+    trials = cohort(tmp_path, PROTOCOLS / "retention-transfer.json", 30, "foreign", "two-state", "learning")
+    by_phase = trials.groupby("phase").legibility_top1.mean()
+    assert by_phase["post-test"] > by_phase["pre-test"], by_phase.to_dict()
