@@ -912,7 +912,9 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
         statistics_html = ("<section id=\"statistics\">\n<h2>Paired statistics of the " + _e(phase) + " trials</h2>\n"
                            "<p class=\"files\">Over subjects: each subject's trials are averaged per condition. n "
                            "counts subjects (trials for the mixed model); effects are in the unit shown, d_z and g_av "
-                           "standardized; p two-sided, not adjusted (the adjusted ones are above).</p>\n"
+                           "standardized; p two-sided, not adjusted (the adjusted ones are above). The power and "
+                           "the subjects for 80 % power take the observed d_z as true" + _power_basis(trials)
+                           + ".</p>\n"
                            + "".join(_statistics_html(t, v, phase) for t, v in zip(statistics_tables, values))
                            + "</section>\n")
     transfer = design_analysis.transfer_baseline(kept, design)
@@ -935,6 +937,21 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
     files[index] = "".join(page)
     _write_together(files)
     return index
+
+
+def _power_basis(trials: "pandas.DataFrame") -> str:
+    """What a power figure of these subjects rests on: people, or simulated subjects whose spread is the
+    model's (individual differences drawn from the distributions of docs/writer.md, or none)."""
+    writers = {str(w) for w in trials["writer"]} if "writer" in trials else set()
+    if "simulated" not in writers:
+        return ""
+    traits = trials.get("subject_writing_speed_factor")
+    if traits is not None and traits.notna().any():
+        return ("; these subjects are simulated, so it is the spread between subjects that the model's "
+                "individual differences assume (log-normal factors on the profile, docs/writer.md, \"Individual "
+                "differences\"), not people's")
+    return ("; these subjects are simulated without individual differences, so the spread between them is only "
+            "their trial-to-trial noise: the power is far too high for people")
 
 
 def _methods_sentence(design: "design_analysis.StudyDesign", ddf: str) -> str:
