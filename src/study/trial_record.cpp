@@ -271,7 +271,7 @@ json legibility_json(const Scene& scene, const TrialResult& result) {
           {"candidates", kLegibilityCandidates},
           {"top1", static_cast<double>(first) / count},
           {"top5", static_cast<double>(among_five) / count},
-          {"per_character", characters}};
+          {"characters", characters}};
 }
 
 }  // namespace
