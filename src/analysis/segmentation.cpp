@@ -1,6 +1,8 @@
 #include "analysis/segmentation.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
@@ -44,6 +46,42 @@ std::vector<WrittenSegment> pen_down_segments(std::span<const PenSample> trace, 
     segments.push_back(segment);
   }
   return segments;
+}
+
+std::vector<std::size_t> character_of_samples(const Scene& scene, std::span<const PenSample> trace) {
+  constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
+  std::vector<std::size_t> owner(trace.size(), kNone);
+  std::vector<std::size_t> inside(scene.characters.size());
+  std::size_t i = 0;
+  while (i < trace.size()) {
+    if (!trace[i].pen_down) {
+      ++i;
+      continue;
+    }
+    std::size_t end = i;
+    std::fill(inside.begin(), inside.end(), 0);
+    for (; end < trace.size() && trace[end].pen_down; ++end) {
+      for (std::size_t c = 0; c < scene.characters.size(); ++c) {
+        if (scene.characters[c].bounding_box.contains(trace[end].position_m)) ++inside[c];
+      }
+    }
+    std::size_t best = 0;
+    for (std::size_t c = 1; c < inside.size(); ++c) best = inside[c] > inside[best] ? c : best;
+    if (inside[best] == 0) {  // outside every box: the nearest box to where the pen came down
+      double nearest = std::numeric_limits<double>::infinity();
+      for (std::size_t c = 0; c < scene.characters.size(); ++c) {
+        const double distance = scene.characters[c].bounding_box.exteriorDistance(trace[i].position_m);
+        if (distance < nearest) {
+          nearest = distance;
+          best = c;
+        }
+      }
+    }
+    std::fill(owner.begin() + static_cast<std::ptrdiff_t>(i),
+              owner.begin() + static_cast<std::ptrdiff_t>(end), best);
+    i = end;
+  }
+  return owner;
 }
 
 }  // namespace trial_detail

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "calligraphy/analysis/score.hpp"
+#include "calligraphy/model/scene.hpp"
 
 namespace calligraphy::trial_detail {
 
@@ -12,5 +13,10 @@ namespace calligraphy::trial_detail {
 /// zero length) or no time span. Other fields left empty.
 std::vector<WrittenSegment> pen_down_segments(std::span<const PenSample> trace, std::size_t min_samples,
                                               double min_length_m);
+
+/// The character of `scene` each pen-down run of `trace` belongs to, as an index per sample (pen-up samples:
+/// SIZE_MAX): the character whose box (`PlacedCharacter::bounding_box`) holds most of the run's samples, or,
+/// when no box holds any, the one whose box is nearest the run's first sample. `scene` has a character.
+std::vector<std::size_t> character_of_samples(const Scene& scene, std::span<const PenSample> trace);
 
 }  // namespace calligraphy::trial_detail

@@ -1,50 +1,13 @@
 // The one metrics record of a written trace (writing_metrics.hpp, docs/metrics.md).
 #include "calligraphy/analysis/writing_metrics.hpp"
 
-#include <limits>
 #include <vector>
 
+#include "analysis/segmentation.hpp"
 #include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
 namespace {
-
-// The character each pen-down run of `trace` belongs to, as an index per sample (pen-up samples: none).
-std::vector<std::size_t> character_of_samples(const Scene& scene, std::span<const PenSample> trace) {
-  constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
-  std::vector<std::size_t> owner(trace.size(), kNone);
-  std::vector<std::size_t> inside(scene.characters.size());
-  std::size_t i = 0;
-  while (i < trace.size()) {
-    if (!trace[i].pen_down) {
-      ++i;
-      continue;
-    }
-    std::size_t end = i;
-    std::fill(inside.begin(), inside.end(), 0);
-    for (; end < trace.size() && trace[end].pen_down; ++end) {
-      for (std::size_t c = 0; c < scene.characters.size(); ++c) {
-        if (scene.characters[c].bounding_box.contains(trace[end].position_m)) ++inside[c];
-      }
-    }
-    std::size_t best = 0;
-    for (std::size_t c = 1; c < inside.size(); ++c) best = inside[c] > inside[best] ? c : best;
-    if (inside[best] == 0) {  // outside every box: the nearest box to where the pen came down
-      double nearest = std::numeric_limits<double>::infinity();
-      for (std::size_t c = 0; c < scene.characters.size(); ++c) {
-        const double distance = scene.characters[c].bounding_box.exteriorDistance(trace[i].position_m);
-        if (distance < nearest) {
-          nearest = distance;
-          best = c;
-        }
-      }
-    }
-    std::fill(owner.begin() + static_cast<std::ptrdiff_t>(i), owner.begin() + static_cast<std::ptrdiff_t>(end),
-              best);
-    i = end;
-  }
-  return owner;
-}
 
 void add_totals(WritingMetrics& metrics, const CharacterScore& score) {
   metrics.strokes_total += score.strokes.size();
@@ -53,9 +16,9 @@ void add_totals(WritingMetrics& metrics, const CharacterScore& score) {
   metrics.order_errors += score.order_errors;
   metrics.backwards_strokes += score.backwards_strokes;
   metrics.unmatched_segments += score.unmatched_strokes;
-  for (const StrokeRefusal refusal : {StrokeRefusal::too_short, StrokeRefusal::backwards,
-                                      StrokeRefusal::wrong_place, StrokeRefusal::wrong_stroke,
-                                      StrokeRefusal::wrong_order}) {
+  for (const StrokeRefusal refusal :
+       {StrokeRefusal::too_short, StrokeRefusal::backwards, StrokeRefusal::wrong_place,
+        StrokeRefusal::wrong_stroke, StrokeRefusal::wrong_order}) {
     for (std::size_t k = score.refusals.of(refusal); k > 0; --k) metrics.refusals.add(refusal);
   }
 }
@@ -68,7 +31,7 @@ WritingMetrics writing_metrics(const Scene& scene, std::span<const PenSample> tr
   validate_pen_trace(trace);
   ScoreOptions scored = options;
   scored.start_radius_m = scene.layout.start_radius_m;
-  const std::vector<std::size_t> owner = character_of_samples(scene, trace);
+  const std::vector<std::size_t> owner = trial_detail::character_of_samples(scene, trace);
 
   WritingMetrics metrics;
   metrics.completed_in_order = true;

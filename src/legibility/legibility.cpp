@@ -7,8 +7,10 @@
 #include <memory>
 #include <mutex>
 
+#include "analysis/segmentation.hpp"
 #include "calligraphy/analysis/score.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/trial/result.hpp"
 #include "core/unicode.hpp"
 
 #ifdef CALLIGRAPHY_WITH_ZINNIA
@@ -132,38 +134,29 @@ std::optional<CharacterLegibility> character_legibility(
 std::vector<CharacterLegibility> trial_legibility(const Scene& scene, std::span<const TrialSample> trace) {
   std::vector<CharacterLegibility> verdicts;
   if (!legibility_available() || scene.characters.empty()) return verdicts;
-  // The final writing: pen-down runs on the paper, the ticks of attempts written again later left out.
-  std::vector<std::vector<Vec2>> runs;
-  bool in_run = false;
-  for (const TrialSample& sample : trace) {
-    const bool down =
-        sample.position_m.z() - scene.layout.paper_z_m <= kPenContactThresholdM && !sample.rewritten;
-    if (down && sample.position_m.allFinite()) {
-      if (!in_run) runs.emplace_back();
-      runs.back().push_back(sample.position_m.head<2>());
-    }
-    in_run = down;
+  // The final writing: pen-down runs on the paper without the ticks of attempts written again later (or a
+  // sample that is not finite), each run given to its character as the metrics give it (writing_metrics),
+  // and without the runs the scorer ignores (ScoreOptions: a touch that barely moves, the pen set down and
+  // lifted at a stroke's start), so that the reader sees the strokes the scorer scores.
+  std::vector<PenSample> samples = pen_samples(scene, trace);
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    samples[k].pen_down = samples[k].pen_down && !trace[k].rewritten && trace[k].position_m.allFinite();
   }
-  // A touch that barely moves (the pen set down, lifted and set down again at a stroke's start) is no stroke:
-  // the scorer's rule for a segment it ignores (ScoreOptions), so that a reader sees the strokes it scores.
-  const ScoreOptions ignored;
-  std::erase_if(runs, [&](const std::vector<Vec2>& run) {
-    double length_m = 0.0;
-    for (std::size_t i = 1; i < run.size(); ++i) length_m += (run[i] - run[i - 1]).norm();
-    return run.size() < ignored.min_segment_samples || length_m < ignored.min_segment_length_m;
-  });
-  // Each run to the character whose box holds most of its samples (as writing_metrics assigns runs).
+  const std::vector<std::size_t> owner = trial_detail::character_of_samples(scene, samples);
+  const ScoreOptions scored;
   std::vector<std::vector<std::vector<Vec2>>> per_character(scene.characters.size());
-  for (std::vector<Vec2>& run : runs) {
-    std::size_t best = 0, best_count = 0;
-    for (std::size_t c = 0; c < scene.characters.size(); ++c) {
-      std::size_t count = 0;
-      for (const Vec2& p : run) count += scene.characters[c].bounding_box.contains(p) ? 1 : 0;
-      if (count > best_count) best = c, best_count = count;
+  for (const WrittenSegment& run :
+       trial_detail::pen_down_segments(samples, scored.min_segment_samples, scored.min_segment_length_m)) {
+    const PlacedCharacter& character = scene.characters[owner[run.begin]];
+    // Ink outside every character's box is no part of a character a reader is shown.
+    const auto in_box = [&](const PenSample& s) { return character.bounding_box.contains(s.position_m); };
+    if (run.ignored || std::none_of(samples.begin() + static_cast<std::ptrdiff_t>(run.begin),
+                                    samples.begin() + static_cast<std::ptrdiff_t>(run.end), in_box)) {
+      continue;
     }
-    if (best_count == 0) continue;  // written off every character
-    for (Vec2& p : run) p = scene.characters[best].placement.to_data(p);
-    per_character[best].push_back(std::move(run));
+    std::vector<Vec2>& stroke = per_character[owner[run.begin]].emplace_back();
+    for (std::size_t k = run.begin; k < run.end; ++k)
+      stroke.push_back(character.placement.to_data(samples[k].position_m));
   }
   for (std::size_t c = 0; c < scene.characters.size(); ++c) {
     std::optional<CharacterLegibility> verdict =
