@@ -274,16 +274,16 @@ def _holm(p_values: list[float]) -> list[float]:
     return adjusted
 
 
-def _hedges_g(difference: float, sd_a: float, sd_b: float, n_a: int, n_b: int) -> tuple[float, float, float]:
-    """Hedges' g = difference / pooled SD x J, J = 1 - 3 / (4 (n_a + n_b) - 9) (Hedges 1981), with the normal
-    approximation of its 95 % interval, SE = sqrt((n_a + n_b) / (n_a n_b) + g^2 / (2 (n_a + n_b))) (Hedges &
+def _hedges_g_interval(difference: float, sd_a: float, sd_b: float, n_a: int, n_b: int
+                       ) -> tuple[float, float, float]:
+    """Hedges' g (``statistics._hedges_g``: the difference over the pooled SD, small-sample corrected) with
+    the normal approximation of its 95 % interval, SE = sqrt((n_a + n_b) / (n_a n_b) + g^2 / (2 (n_a + n_b))) (Hedges &
     Olkin 1985, eq. 5.14)."""
     if n_a < 2 or n_b < 2:
         return math.nan, math.nan, math.nan
-    pooled = math.sqrt(((n_a - 1) * sd_a ** 2 + (n_b - 1) * sd_b ** 2) / (n_a + n_b - 2))
-    if not pooled > 0:
+    g = statistics._hedges_g(difference, sd_a ** 2, sd_b ** 2, n_a, n_b)
+    if not math.isfinite(g):
         return math.nan, math.nan, math.nan
-    g = difference / pooled * (1.0 - 3.0 / (4.0 * (n_a + n_b) - 9.0))
     se = math.sqrt((n_a + n_b) / (n_a * n_b) + g * g / (2.0 * (n_a + n_b)))
     return g, g - 1.959963984540054 * se, g + 1.959963984540054 * se
 
@@ -310,8 +310,7 @@ def _training_rows(data: pandas.DataFrame, value: str, design: StudyDesign, ddf:
     rows_of = data[(data["phase"].astype(str) == phase) & data[value].notna()]
     # Within subjects the condition's effect varies by subject: a random slope keeps its test at the subjects'
     # level (Barr, Levy, Scheepers & Tily 2013, J Mem Lang 68:255); without it the df are the trials'.
-    within = design.kind == "within-subjects"
-    subject_term = "(1 + factor | subject)" if within else "(1 | subject)"
+    subject_term = "(1 + factor | subject)" if design.kind == "within-subjects" else "(1 | subject)"
     model = f"{value} ~ {column} + {subject_term.replace('factor', column)} + (1 | item)"
     base = {"value": value, "unit": _unit(value), "family": value, "phase": phase, "model": model,
             "question": f"{phase}: {column} against the control (mixed model, subjects x items crossed)"}
@@ -327,28 +326,29 @@ def _training_rows(data: pandas.DataFrame, value: str, design: StudyDesign, ddf:
                      "or fewer than 3 subjects")]
     try:
         fit = mixed_models.lmer(frame, formula, {"factor": levels}, ddf=ddf)
-    except mixed_models.RUnavailable as error:
+    except RuntimeError as error:  # RUnavailable among them: R or its packages missing
         return [_row(**base, comparison=column, note=f"not computed: {error}")]
-    except RuntimeError as error:
-        return [_row(**base, comparison=column, note=f"not computed: {error}")]
+    # One fit: whether it is a test, its note, subjects per level and subject means hold for every row.
+    trusted = fit.trustworthy
     variances = ", ".join(f"{k.lower().replace('factor', column + ' ')} {v:.3g}" for k, v in fit.variances.items())
+    variances += f" [{_unit(value)}^2]"
+    problems = []
+    if fit.singular:
+        problems.append(f"singular fit (a variance estimated at 0 or a correlation at +-1: {variances})")
+    if not fit.converged:
+        problems.append("did not converge: " + fit.messages)
+    note = ("not tested: " + "; ".join(problems)) if problems else f"variances: {variances}"
+    counts = frame.groupby("factor")["subject"].nunique()
+    subject_means = frame.groupby(["factor", "subject"])["outcome"].mean()
     rows = []
     for effect in fit.fixed.itertuples(index=False):
         if effect.factor != "factor":
             continue
-        trusted = fit.trustworthy
-        problems = []
-        if fit.singular:
-            problems.append("singular fit (a variance estimated at 0 or a correlation at +-1: " + variances + " [" + _unit(value) + "^2])")
-        if not fit.converged:
-            problems.append("did not converge: " + fit.messages)
-        counts = frame.groupby("factor")["subject"].nunique()
         g, g_low, g_high = math.nan, math.nan, math.nan
         if design.kind == "between-subjects":
-            means = frame.groupby(["factor", "subject"])["outcome"].mean()
-            a, b = means.loc[effect.level], means.loc[design.control]
-            g, g_low, g_high = _hedges_g(float(effect.estimate), float(a.std(ddof=1)), float(b.std(ddof=1)),
-                                         len(a), len(b))
+            a, b = subject_means.loc[effect.level], subject_means.loc[design.control]
+            g, g_low, g_high = _hedges_g_interval(float(effect.estimate), float(a.std(ddof=1)),
+                                                  float(b.std(ddof=1)), len(a), len(b))
         rows.append(_row(
             **base, comparison=f"{effect.level} - {design.control}",
             test=f"linear mixed model (REML), lme4 {fit.ddf} t ({fit.versions})",
@@ -357,7 +357,7 @@ def _training_rows(data: pandas.DataFrame, value: str, design: StudyDesign, ddf:
             p=float(effect.p) if trusted else math.nan, estimate=float(effect.estimate),
             ci95_low=float(effect.ci95_low) if trusted else math.nan,
             ci95_high=float(effect.ci95_high) if trusted else math.nan, g=g, g_ci95_low=g_low, g_ci95_high=g_high,
-            note=("not tested: " + "; ".join(problems)) if problems else f"variances: {variances} [" + _unit(value) + "^2]"))
+            note=note))
     return rows
 
 
@@ -391,7 +391,7 @@ def _ancova_rows(data: pandas.DataFrame, value: str, design: StudyDesign, phase:
         a = frame.loc[frame["group"] == level, "post"]
         b = frame.loc[frame["group"] == design.control, "post"]
         estimate = float(fit.params[name])
-        g, g_low, g_high = _hedges_g(estimate, float(a.std(ddof=1)), float(b.std(ddof=1)), len(a), len(b))
+        g, g_low, g_high = _hedges_g_interval(estimate, float(a.std(ddof=1)), float(b.std(ddof=1)), len(a), len(b))
         rows.append(_row(**base, comparison=f"{level} - {design.control}",
                          test="ANCOVA (OLS on subject means, statsmodels); t of the adjusted difference",
                          n=len(a) + len(b), df=float(fit.df_resid), statistic=float(fit.tvalues[name]),

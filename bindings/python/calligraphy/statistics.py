@@ -721,6 +721,14 @@ def _per_group_for_power(effect: float) -> float:
     return float(n)
 
 
+def _hedges_g(difference: float, variance_a: float, variance_b: float, n_a: int, n_b: int) -> float:
+    """Hedges' g of a difference between two independent groups: the difference over the pooled sd, times
+    J = 1 - 3 / (4 (n_a + n_b) - 9) (Hedges 1981; Lakens 2013 eq. 4); NaN when the pooled sd is 0. The
+    variances are the groups' sample variances (n - 1); n_a + n_b > 2."""
+    pooled = math.sqrt(((n_a - 1) * variance_a + (n_b - 1) * variance_b) / (n_a + n_b - 2))
+    return difference / pooled * (1.0 - 3.0 / (4.0 * (n_a + n_b) - 9.0)) if pooled > 0 else math.nan
+
+
 def group_comparison(table: pandas.DataFrame, value: str, a: typing.Any, b: typing.Any, by: str = "group"
                      ) -> GroupComparison:
     """Compares ``value`` between the subjects of groups ``a`` and ``b`` (values of column ``by``), for a
@@ -766,9 +774,8 @@ def group_comparison(table: pandas.DataFrame, value: str, a: typing.Any, b: typi
     df = (share_a + share_b) ** 2 / denominator if denominator > 0 else math.nan
     u_test = stats.mannwhitneyu(x, y, alternative="two-sided")
     n_a, n_b = len(x), len(y)
-    pooled = math.sqrt(((n_a - 1) * np.var(x, ddof=1) + (n_b - 1) * np.var(y, ddof=1)) / (n_a + n_b - 2))
     difference = float(np.mean(x) - np.mean(y))
-    g = difference / pooled * (1.0 - 3.0 / (4.0 * (n_a + n_b) - 9.0)) if pooled > 0 else math.nan
+    g = _hedges_g(difference, float(np.var(x, ddof=1)), float(np.var(y, ddof=1)), n_a, n_b)
     half_width = float(stats.t.ppf(0.975, df) * standard_error) if math.isfinite(df) else math.nan
     power = needed = math.nan
     if math.isfinite(g) and g != 0:

@@ -636,8 +636,6 @@ def _phase_means(data: "pandas.DataFrame", value: str, design: "design_analysis.
 
     by = "group" if design.kind == "between-subjects" else "condition"
     rows = data[data[value].notna()]
-    if design.kind != "between-subjects":
-        rows = rows.assign(condition=rows["condition"].astype(str))
     described = statistics.describe(rows.assign(phase=rows["phase"].astype(str), **{by: rows[by].astype(str)}),
                                     value, by=("phase", by), unit="subject")
     described = described.drop(columns=["unit"]).rename(columns={by: "condition"})
