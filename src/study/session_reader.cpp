@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <cstdint>
 #include <set>
 #include <string>
 
@@ -59,35 +58,6 @@ double parse_field(std::string_view field, const std::string& source, std::size_
   return *value;
 }
 
-// A plain decimal ("-0.011845", "2.998", "0") of at most 15 digits at `at`, up to `end`: its value and where
-// it ends; nullptr for anything else. The digits as an integer and the power of ten are both exact doubles,
-// so one division rounds correctly: the value from_chars gives (Clinger 1990, "How to read floating point
-// numbers accurately", PLDI), in a fraction of its time; a trace has millions of such numbers.
-const char* plain_decimal(const char* at, const char* end, double& value) {
-  static constexpr double kPowers[] = {1e0, 1e1, 1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
-                                       1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15};
-  const bool negative = at != end && *at == '-';
-  if (negative) ++at;
-  std::int64_t digits = 0;
-  int count = 0, decimals = 0;
-  bool point = false;
-  for (; at != end; ++at) {
-    if (*at >= '0' && *at <= '9') {
-      if (++count > 15) return nullptr;
-      digits = digits * 10 + (*at - '0');
-      decimals += point ? 1 : 0;
-    } else if (*at == '.' && !point) {
-      point = true;
-    } else {
-      break;
-    }
-  }
-  if (count == 0) return nullptr;
-  value = static_cast<double>(digits) / kPowers[decimals];
-  if (negative) value = -value;
-  return at;
-}
-
 // A trace line's first six fields (t, x, y, z, fx, fy) as finite numbers, each followed by a comma, and
 // the line's `field_count` fields in all: true; false for anything else (the field-by-field reading names
 // the fault).
@@ -95,7 +65,7 @@ bool read_leading_numbers(std::string_view line, std::size_t field_count, std::a
   const char* at = line.data();
   const char* const end = at + line.size();
   for (double& value : values) {
-    const char* next = plain_decimal(at, end, value);
+    const char* next = parse_plain_decimal(at, end, value);
     if (next == nullptr) {  // an exponent, more digits: the full parse
       const auto [parsed, error] = std::from_chars(at, end, value);
       if (error != std::errc() || !std::isfinite(value)) return false;
