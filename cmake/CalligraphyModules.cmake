@@ -1,12 +1,15 @@
-# calligraphy_module(NAME [DEPENDS module...] [SOURCE_DIR dir] [SOURCES extra...] [NOT_INSTALLED])
+# calligraphy_module(NAME PACKAGE haptics|research|none [DEPENDS module...] [SOURCE_DIR dir] [SOURCES extra...])
 #
 # Declares the static library calligraphy_NAME from src/<SOURCE_DIR or NAME>/*.cpp. Its public headers
 # are include/calligraphy/NAME/; the target sees them through a folder of its own in the build tree
 # (module-include/NAME/calligraphy/NAME -> include/calligraphy/NAME), and a module sees another's
 # public headers only by linking it. So a file that includes a module above its own does not compile.
 # Private headers stay under src/ (PRIVATE include path); scripts/check-layering.py checks their
-# include lines too.
-set(CALLIGRAPHY_INSTALLED_MODULES "" CACHE INTERNAL "")
+# include lines too. PACKAGE names the installed package the module belongs to (docs/architecture.md,
+# "Packages"): `haptics` (what a haptic application needs), `research` (simulated writers, studies,
+# reports), or `none` (not installed).
+set(CALLIGRAPHY_HAPTICS_MODULES "" CACHE INTERNAL "")
+set(CALLIGRAPHY_RESEARCH_MODULES "" CACHE INTERNAL "")
 
 # calligraphy_precompile(TARGET [header...]): precompiles Eigen, the standard headers most files include
 # and the given third-party headers for TARGET. CLI11, Catch2, pybind11 and nlohmann-json are header-only
@@ -35,7 +38,10 @@ function(calligraphy_private_link target)
 endfunction()
 
 function(calligraphy_module name)
-  cmake_parse_arguments(module "NOT_INSTALLED" "SOURCE_DIR" "DEPENDS;SOURCES" ${ARGN})
+  cmake_parse_arguments(module "" "SOURCE_DIR;PACKAGE" "DEPENDS;SOURCES" ${ARGN})
+  if(NOT module_PACKAGE MATCHES "^(haptics|research|none)$")
+    message(FATAL_ERROR "calligraphy_module(${name}): PACKAGE must be haptics, research or none")
+  endif()
   if(NOT module_SOURCE_DIR)
     set(module_SOURCE_DIR ${name})
   endif()
@@ -59,7 +65,9 @@ function(calligraphy_module name)
   target_link_libraries(${target} PRIVATE $<BUILD_INTERFACE:calligraphy_warnings>)
   target_compile_features(${target} PUBLIC cxx_std_20)
   set_target_properties(${target} PROPERTIES EXPORT_NAME ${name})
-  if(NOT module_NOT_INSTALLED)
-    set(CALLIGRAPHY_INSTALLED_MODULES ${CALLIGRAPHY_INSTALLED_MODULES} ${target} CACHE INTERNAL "")
+  if(module_PACKAGE STREQUAL "haptics")
+    set(CALLIGRAPHY_HAPTICS_MODULES ${CALLIGRAPHY_HAPTICS_MODULES} ${target} CACHE INTERNAL "")
+  elseif(module_PACKAGE STREQUAL "research")
+    set(CALLIGRAPHY_RESEARCH_MODULES ${CALLIGRAPHY_RESEARCH_MODULES} ${target} CACHE INTERNAL "")
   endif()
 endfunction()

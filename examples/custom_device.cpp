@@ -10,7 +10,7 @@
 #include <calligraphy/core/errors.hpp>
 #include <calligraphy/devices/device_registry.hpp>
 #include <calligraphy/model/character_library.hpp>
-#include <calligraphy/sim/hand_port.hpp>
+#include <calligraphy/devices/hand_port.hpp>
 #include <calligraphy/sim/simulated_hand.hpp>
 #include <calligraphy/trial/trial.hpp>
 #include <cmath>
@@ -21,7 +21,7 @@ namespace {
 
 using calligraphy::Vec3;
 
-class VoiceCoilPuck final : public calligraphy::HapticDevice, public calligraphy::HandPort {
+class VoiceCoilPuck final : public calligraphy::HandDrivenDevice {
  public:
   VoiceCoilPuck() {
     info_.model = "voice-coil puck (example)";
@@ -111,16 +111,17 @@ class VoiceCoilPuck final : public calligraphy::HapticDevice, public calligraphy
 
 int main() {
   using namespace calligraphy;
-  // Registering is optional (run_trial also takes the device itself); a registered device is
-  // listed by `device_registry().survey()` and opened by name, like the built-in ones.
-  device_registry().register_device("voice-coil-puck", VoiceCoilPuck{}.info(),
-                                    [] { return std::make_unique<VoiceCoilPuck>(); });
+  // Registering is optional (run_trial also takes the device itself); a device registered in a registry
+  // the application owns is listed by its `survey()` and opened by name, like the standard ones.
+  DeviceRegistry registry = standard_device_registry();
+  registry.register_device("voice-coil-puck", VoiceCoilPuck{}.info(), [] { return std::make_unique<VoiceCoilPuck>(); },
+                           DeviceCapabilities{.moved_by_simulated_hand = true});
 
   const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'口')});
   TrialOptions options;  // 1 kHz, novice writer, guidance on
   SimulationOptions simulation;  // the simulated writer that holds the puck (it has a hand port)
   simulation.seed = 1;
-  const TrialResult result = run_trial("voice-coil-puck", scene, options, simulation);
+  const TrialResult result = run_trial(registry, "voice-coil-puck", scene, options, simulation);
 
   // A device fault mid-trial ends it with the code and its message (device_fault_message); off the servo
   // path, throw_device_fault would make it the typed exception.

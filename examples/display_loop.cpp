@@ -46,9 +46,8 @@ int main(int argc, char** argv) {
     TrialOptions options;
     options.pacing = TrialPacing::real_time;  // the simulated writer writes at the wall clock's pace
     options.keep_trace = true;
-    // As the trainer's window does: an application with a display maps memory all the time, which
-    // mlockall(MCL_FUTURE) would lock too; the trial touches its trace in advance instead.
-    options.loop.lock_memory = false;
+    // The loop's defaults lock no memory (an application with a display maps memory all the time, which
+    // mlockall(MCL_FUTURE) would lock too); the trial touches its trace in advance instead.
     options.display = &channel;
     TrialResult result;
     std::exception_ptr failure;
@@ -56,7 +55,7 @@ int main(int argc, char** argv) {
       try {
         SimulationOptions simulation;
         simulation.seed = argc > 2 ? std::strtoull(argv[2], nullptr, 10) : 0;
-        result = run_trial("simulated", scene, options, simulation);
+        result = run_trial(standard_device_registry(), "simulated", scene, options, simulation);
       } catch (...) {
         failure = std::current_exception();
         channel.push_event(

@@ -21,9 +21,10 @@ MODULE_DEPENDS = {
     "render": ["collision"],
     "analysis": ["model"],
     "devices": ["core"],
+    "phantom_usb": ["devices"],
+    "testing": ["devices"],
     "trial": ["render", "devices", "analysis"],
     "sim": ["devices", "render", "trial"],
-    "testing": ["sim"],
     "report": ["trial", "analysis"],
     "legibility": ["trial"],
     "study": ["report", "sim", "legibility"],
@@ -76,8 +77,6 @@ def module_of_file(relative: pathlib.PurePosixPath):
     if parts[:2] == ("include", "calligraphy") and len(parts) > 3:
         return parts[2]
     if parts[0] == "src" and len(parts) > 2:
-        if parts[1] == "sim" and parts[2] == "testing":
-            return "testing"
         return parts[1]
     return None
 
@@ -86,8 +85,6 @@ def module_of_include(path: str):
     parts = pathlib.PurePosixPath(path).parts
     if parts[0] == "calligraphy" and len(parts) > 2:
         return parts[1]
-    if len(parts) > 1 and parts[0] == "sim" and parts[1] == "testing":
-        return "testing"
     if len(parts) > 1 and parts[0] in RANK:
         return parts[0]
     return None

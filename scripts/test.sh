@@ -156,7 +156,7 @@ build-fuzz/bin/corpus_store_fuzzer -runs=0 fuzz/seeds tests/data/store_regressio
 end_stage
 
 begin_stage "install + find_package(calligraphy) from another project"
-rm -rf build/stage build/consumer
+rm -rf build/stage build/consumer build/consumer-haptics
 cmake --install build --prefix build/stage >/dev/null
 # Only Eigen3 may be found: a find_dependency of anything else in the installed package fails the configure.
 cmake --no-warn-unused-cli -S tests/consumer -B build/consumer -G Ninja \
@@ -166,5 +166,15 @@ cmake --no-warn-unused-cli -S tests/consumer -B build/consumer -G Ninja \
   -DCMAKE_DISABLE_FIND_PACKAGE_OpenSSL=ON -DCMAKE_DISABLE_FIND_PACKAGE_Threads=ON >/dev/null
 cmake --build build/consumer
 build/consumer/consumer
+# A haptic application: only the haptics component, its examples built and run, and their link lines free
+# of OpenSSL and the USB libraries.
+cmake --no-warn-unused-cli -S tests/consumer/haptics -B build/consumer-haptics -G Ninja \
+  -DCMAKE_PREFIX_PATH="$PWD/build/stage" \
+  -DCMAKE_DISABLE_FIND_PACKAGE_spdlog=ON -DCMAKE_DISABLE_FIND_PACKAGE_fmt=ON \
+  -DCMAKE_DISABLE_FIND_PACKAGE_OpenSSL=ON >/dev/null
+cmake --build build/consumer-haptics
+bash tests/consumer/check_link_line.sh build/consumer-haptics/own_loop build/consumer-haptics/custom_device_loop
+build/consumer-haptics/own_loop
+build/consumer-haptics/custom_device_loop
 end_stage
 echo "== all tests passed"

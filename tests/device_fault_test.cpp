@@ -17,7 +17,7 @@ namespace {
 constexpr DeviceFault kFaults[] = {DeviceFault::not_open,        DeviceFault::link_lost,
                                    DeviceFault::no_valid_status, DeviceFault::driver_error,
                                    DeviceFault::watchdog,        DeviceFault::non_finite_force,
-                                   DeviceFault::safety_limit};
+                                   DeviceFault::safety_limit,    DeviceFault::not_advanced};
 static_assert(std::size(kFaults) + 1 == kDeviceFaultCount);
 
 }  // namespace

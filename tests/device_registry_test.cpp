@@ -1,4 +1,6 @@
 #include "calligraphy/devices/device_registry.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
+#include "calligraphy/phantom_usb/phantom_usb_backends.hpp"
 
 #include <atomic>
 #include <catch2/catch.hpp>
@@ -61,7 +63,7 @@ TEST_CASE("Backends register factories, devices are listed and created by name",
   pair.name = "pair";
   pair.scan = [] {
     return DeviceSurvey{
-        {{"pair:a", "", info_named("A"), true, ""}, {"pair:b", "", info_named("B"), true, ""}},
+        {{"pair:a", "", info_named("A"), {.hardware = true}, ""}, {"pair:b", "", info_named("B"), {.hardware = true}, ""}},
         {"pair: scanned two"}};
   };
   pair.create = [](const DeviceListing& listing) { return std::make_unique<FixedDevice>(listing.info); };
@@ -91,6 +93,22 @@ TEST_CASE("Backends register factories, devices are listed and created by name",
   CHECK(registry.unregister_backend("pair"));
   CHECK_FALSE(registry.unregister_backend("pair"));
   CHECK(registry.backend_names() == std::vector<std::string>{"simulated"});
+}
+
+TEST_CASE("A listing that contradicts its device's hand port is refused when the device is created", "[registry]") {
+  DeviceRegistry registry;
+  // A simulated device (it has a hand port) registered as if a person moved it, and the other way round.
+  registry.register_device("unmarked", info_named("U"), [] { return std::make_unique<calligraphy::SimulatedDevice>(); });
+  registry.register_device("overclaimed", info_named("O"), [] { return std::make_unique<FixedDevice>(info_named("O")); },
+                           calligraphy::DeviceCapabilities{.moved_by_simulated_hand = true});
+  CHECK_THROWS_WITH(registry.create("unmarked"),
+                    Catch::Contains("'unmarked': its listing says it is not moved by a simulated hand"));
+  CHECK_THROWS_WITH(registry.create("overclaimed"),
+                    Catch::Contains("'overclaimed': its listing says it is moved by a simulated hand, but the device "
+                                    "has none"));
+  // A registry moves whole: the backends go with it.
+  DeviceRegistry moved = std::move(registry);
+  CHECK(moved.backend_names() == std::vector<std::string>{"unmarked", "overclaimed"});
 }
 
 TEST_CASE("Registering a device if absent keeps the first of a name, also from many threads", "[registry]") {
@@ -132,9 +150,9 @@ TEST_CASE("A backend that fails to scan becomes a note, not a failure", "[regist
   CHECK(out.str().find("note: broken: bus on fire") != std::string::npos);
 }
 
-TEST_CASE("The process registry offers the emulated Phantom and runs a servo loop through it",
-          "[registry][phantom]") {
-  auto& registry = calligraphy::device_registry();
+TEST_CASE("A registry offers the emulated Phantom and runs a servo loop through it", "[registry][phantom]") {
+  calligraphy::DeviceRegistry registry = calligraphy::standard_device_registry();
+  calligraphy::register_phantom_usb_backends(registry);
   calligraphy::testing::register_emulated_phantom(registry);
   const auto names = registry.backend_names();
   CHECK(std::find(names.begin(), names.end(), "emulated-phantom") != names.end());
@@ -145,7 +163,17 @@ TEST_CASE("The process registry offers the emulated Phantom and runs a servo loo
   const auto emulated = std::find_if(survey.devices.begin(), survey.devices.end(),
                                      [](const DeviceListing& d) { return d.name == "emulated-phantom"; });
   REQUIRE(emulated != survey.devices.end());
-  CHECK_FALSE(emulated->hardware);
+  // What it is, from the listing alone: moved by a simulated hand, homed in the inkwell, not hardware.
+  CHECK(emulated->capabilities == calligraphy::DeviceCapabilities{.hardware = false,
+                                                                   .moved_by_simulated_hand = true,
+                                                                   .needs_calibration = true});
+  const auto simulated = std::find_if(survey.devices.begin(), survey.devices.end(),
+                                      [](const DeviceListing& d) { return d.name == "simulated"; });
+  REQUIRE(simulated != survey.devices.end());
+  CHECK(simulated->capabilities.moved_by_simulated_hand);
+  CHECK_FALSE(simulated->capabilities.needs_calibration);
+  CHECK(registry.create("simulated")->hand_port() != nullptr);
+  CHECK(registry.create("emulated-phantom")->hand_port() != nullptr);
   CHECK(emulated->info.max_force_n == 3.3);
   CHECK(emulated->info.max_continuous_force_n == 0.88);
   CHECK(emulated->info.max_stiffness_n_per_m == 700.0);

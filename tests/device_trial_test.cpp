@@ -11,7 +11,7 @@
 #include "calligraphy/report/trial_report.hpp"
 #include "calligraphy/testing/emulated_phantom.hpp"
 #include "calligraphy/trial/trial.hpp"
-#include "sim/testing/phantom_emulator.hpp"
+#include "testing/phantom_emulator.hpp"
 
 using namespace calligraphy;
 using phantom::EmulatedPhantomDevice;
@@ -32,7 +32,7 @@ phantom::EmulatorParameters undocking_emulator(const phantom::PhantomDeviceConfi
 }
 
 // The emulated Phantom, unplugged when the host asks for its `unplug_at`-th state (1-based).
-class UnpluggedPhantom final : public HapticDevice, public HandPort {
+class UnpluggedPhantom final : public HandDrivenDevice {
  public:
   explicit UnpluggedPhantom(int unplug_at)
       : inner_(phantom::phantom_omni_config(), undocking_emulator(phantom::phantom_omni_config())),
@@ -133,14 +133,15 @@ TEST_CASE("A trial of 永 runs end to end on the emulated Phantom through the Ph
 
 TEST_CASE("Lock-step trials on the emulated Phantom are deterministic for a seed",
           "[device-trial][phantom]") {
-  calligraphy::testing::register_emulated_phantom(calligraphy::device_registry());
+  DeviceRegistry registry;
+  calligraphy::testing::register_emulated_phantom(registry);
   const Scene scene = scene_of(U"口");
   TrialOptions options;
   options.keep_trace = false;
   SimulationOptions simulation;
   simulation.seed = 5;
-  const auto first = run_trial("emulated-phantom", scene, options, simulation);
-  const auto again = run_trial("emulated-phantom", scene, options, simulation);
+  const auto first = run_trial(registry, "emulated-phantom", scene, options, simulation);
+  const auto again = run_trial(registry, "emulated-phantom", scene, options, simulation);
   CHECK(first.metrics.strokes_completed == first.metrics.strokes_total);
   CHECK(first.metrics.mean_deviation_m == again.metrics.mean_deviation_m);
   CHECK(first.metrics.time_s == again.metrics.time_s);
@@ -148,15 +149,16 @@ TEST_CASE("Lock-step trials on the emulated Phantom are deterministic for a seed
 
 TEST_CASE("The CLI's runner takes a registry name, an unknown name lists the devices",
           "[device-trial][registry]") {
-  calligraphy::testing::register_emulated_phantom(calligraphy::device_registry());
+  DeviceRegistry registry = standard_device_registry();
+  calligraphy::testing::register_emulated_phantom(registry);
   const Scene scene = scene_of(U"口");
   TrialOptions options;
   options.keep_trace = false;
-  const TrialResult result = run_trial("emulated-phantom", scene, options);
+  const TrialResult result = run_trial(registry, "emulated-phantom", scene, options);
   CHECK_FALSE(result.aborted);
   CHECK(result.metrics.strokes_completed == 3);
   try {
-    (void)run_trial("no-such-device", scene, options);
+    (void)run_trial(registry, "no-such-device", scene, options);
     FAIL("expected DeviceNotFound");
   } catch (const DeviceNotFound& e) {
     const std::string message = e.what();

@@ -2,7 +2,7 @@
 // Hand models for the stability tests: the hand holding the simulated device's stylus. The relaxed
 // and stiff hands (a relaxed grip 150 N/m, 3 N s/m; a stiff grip 600 N/m, 8 N s/m) are assumed,
 // order-of-magnitude figures, not measured on people. Test helpers, not library API.
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 
 namespace calligraphy::testing {
 

@@ -10,7 +10,7 @@
 #include "calligraphy/model/nearest_point_tracker.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/render/renderer.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/trial/trial.hpp"
 
 // AddressSanitizer owns operator new/delete; replacing them there mixes its allocator with ours

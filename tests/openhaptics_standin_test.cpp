@@ -16,7 +16,7 @@
 #include "calligraphy/devices/servo_loop.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/trial/runner.hpp"
-#include "devices/builtin_backends.hpp"
+#include "devices/standard_backends.hpp"
 #include "devices/openhaptics/openhaptics_device.hpp"
 #include "hd_stand_in_control.h"
 
@@ -190,7 +190,9 @@ TEST_CASE("OpenHaptics on the stand-in: a device that cannot initialise is named
   CHECK_THROWS_WITH(registry.find("openhaptics"), Catch::Contains("HD_COMM_CONFIG_ERROR"));
   stand_in.fail_init(0);
   const DeviceListing listing = registry.find("openhaptics");
-  CHECK(listing.hardware);
+  CHECK(listing.capabilities.hardware);
+  CHECK(listing.capabilities.needs_calibration);
+  CHECK_FALSE(listing.capabilities.moved_by_simulated_hand);
   CHECK_FALSE(listing.limits_known);
 }
 

@@ -140,7 +140,7 @@ TEST_CASE("Without libHD: DeviceNotFound 'OpenHaptics not found' listing the pat
     calligraphy::DeviceState state;
     CHECK(device.read_state(state) == calligraphy::DeviceFault::not_open);
     CHECK(device.write_force(Vec3::Zero()) == calligraphy::DeviceFault::not_open);
-    const auto survey = calligraphy::device_registry().survey();
+    const auto survey = calligraphy::standard_device_registry().survey();
     bool noted = false;
     for (const auto& note : survey.notes)
       noted = noted || note.rfind("openhaptics: OpenHaptics not found", 0) == 0;

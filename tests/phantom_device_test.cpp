@@ -6,8 +6,8 @@
 #include <limits>
 
 #include "calligraphy/core/errors.hpp"
-#include "sim/testing/in_memory_transport.hpp"
-#include "sim/testing/phantom_emulator.hpp"
+#include "testing/in_memory_transport.hpp"
+#include "testing/phantom_emulator.hpp"
 
 using namespace calligraphy::phantom;
 using calligraphy::CalibrationNeeded;

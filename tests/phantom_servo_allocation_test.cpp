@@ -21,7 +21,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/devices/servo_loop.hpp"
 #include "calligraphy/testing/emulated_phantom.hpp"
-#include "sim/testing/phantom_emulator.hpp"
+#include "testing/phantom_emulator.hpp"
 
 namespace {
 thread_local bool watched = false;  // set by a thread to have its own allocations counted

@@ -8,12 +8,12 @@
 
 #include "calligraphy/core/device_fault.hpp"
 #include "calligraphy/devices/haptic_device.hpp"
-#include "calligraphy/sim/hand_port.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/hand_port.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 
 namespace calligraphy::test {
 
-class ProbeDevice final : public HapticDevice, public HandPort {
+class ProbeDevice final : public HandDrivenDevice {
  public:
   static constexpr double kMarker = 1.25;  ///< x of the marker force [N]
 

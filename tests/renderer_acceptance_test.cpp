@@ -11,7 +11,7 @@
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/render/renderer.hpp"
 #include "calligraphy/sim/person_traces.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "corpus_folder.hpp"
 #include "eval/stroke_acceptance.hpp"
 #include "test_sizing.hpp"

@@ -17,7 +17,7 @@
 #include "calligraphy/devices/servo_loop.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/render/renderer.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/trial/trial.hpp"
 #include "probe_device.hpp"
 

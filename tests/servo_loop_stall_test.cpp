@@ -12,7 +12,7 @@
 #include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/devices/servo_loop.hpp"
 #include "calligraphy/model/character_library.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/trial/trial.hpp"
 #include "probe_device.hpp"
 

@@ -14,7 +14,7 @@
 #include <thread>
 
 #include "calligraphy/model/character_library.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/trial/trial.hpp"
 #include "devices/latency_histogram.hpp"
 #include "probe_device.hpp"

@@ -6,7 +6,7 @@
 #include <limits>
 
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "hand_models.hpp"
 
 using namespace calligraphy;

@@ -1,4 +1,4 @@
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -13,7 +13,7 @@
 #include "calligraphy/collision/constraint_space.hpp"
 #include "calligraphy/render/force_law.hpp"
 #include "calligraphy/render/renderer.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/trial/trial.hpp"
 #include "test_sizing.hpp"
 

@@ -219,7 +219,8 @@ TEST_CASE("a device lost mid-trial keeps the attempt and stops the session namin
   SessionFolder session = SessionFolder::create(temp.path, setup, small_protocol());
   DeviceRegistry registry;
   registry.register_device("probe", test::ProbeDevice().info(),
-                           [] { return std::make_unique<test::ProbeDevice>(/*fail_on_read=*/700); });
+                           [] { return std::make_unique<test::ProbeDevice>(/*fail_on_read=*/700); },
+                           DeviceCapabilities{.moved_by_simulated_hand = true});
   SessionRunOptions options;
   options.registry = &registry;
   const SessionRunResult result = run_session(session, options);

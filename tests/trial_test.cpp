@@ -4,7 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include "calligraphy/model/character_library.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 
 using namespace calligraphy;
 

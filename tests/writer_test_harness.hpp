@@ -9,7 +9,7 @@
 #include "calligraphy/analysis/score.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/render/renderer.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/sim/simulated_writer.hpp"
 #include "calligraphy/trial/trial.hpp"
 

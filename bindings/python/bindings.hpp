@@ -19,3 +19,14 @@ void bind_trial(py::module_& m);            // simulated trials
 void bind_score(py::module_& m);            // scoring of any pen trace
 
 }  // namespace calligraphy::python
+
+namespace calligraphy {
+class DeviceRegistry;
+}  // namespace calligraphy
+
+namespace calligraphy::python {
+
+/// The module's device registry: the standard backends and the Phantom over USB (sim_bindings.cpp).
+[[nodiscard]] const DeviceRegistry& python_device_registry();
+
+}  // namespace calligraphy::python

@@ -16,7 +16,7 @@
 #include "calligraphy/render/guidance_mode.hpp"
 #include "calligraphy/render/interaction_state.hpp"
 #include "calligraphy/render/renderer.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "log_forwarding.hpp"
 #include "numpy_arrays.hpp"
 #include "parameter_class.hpp"

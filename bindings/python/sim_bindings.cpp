@@ -16,9 +16,10 @@
 #include "bindings.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/devices/device_registry.hpp"
+#include "calligraphy/phantom_usb/phantom_usb_backends.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/sim/person_traces.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/sim/simulated_writer.hpp"
 #include "log_forwarding.hpp"
 #include "model_bindings.hpp"
@@ -26,6 +27,17 @@
 #include "parameter_class.hpp"
 
 namespace calligraphy::python {
+
+const DeviceRegistry& python_device_registry() {
+  // The module's one registry, as the command line has its own: built once, never changed after.
+  static const DeviceRegistry registry = [] {
+    DeviceRegistry built = standard_device_registry();
+    register_phantom_usb_backends(built);
+    return built;
+  }();
+  return registry;
+}
+
 namespace {
 
 // WriterProfile::validate leaves some fields unchecked (tremor frequency, infinities of the offsets);
@@ -171,7 +183,7 @@ void bind_simulated_device(py::module_& m) {
       .finish();
 
   py::class_<SimulatedDevice>(m, "SimulatedDevice",
-                              "A simulated Phantom Desktop (include/calligraphy/sim/simulated_device.hpp), "
+                              "A simulated Phantom Desktop (include/calligraphy/devices/simulated_device.hpp), "
                               "no hand attached: it moves only under the commanded force. Deterministic; no "
                               "wall clock.")
       .def(py::init([](const std::optional<Checked<SimulatedDeviceParameters>>& parameters) {
@@ -235,13 +247,21 @@ void bind_registry(py::module_& m) {
       .def_readonly("name", &DeviceListing::name, "unique, e.g. 'simulated' or 'phantom-hid:/dev/hidraw3'")
       .def_readonly("backend", &DeviceListing::backend, "the backend that found it")
       .def_readonly("info", &DeviceListing::info, "its DeviceInfo, SI units")
-      .def_readonly("hardware", &DeviceListing::hardware,
-                    "a physical device (False for simulated and emulated)")
+      .def_property_readonly(
+          "hardware", [](const DeviceListing& d) { return d.capabilities.hardware; },
+          "a physical device (False for simulated and emulated)")
+      .def_property_readonly(
+          "moved_by_simulated_hand", [](const DeviceListing& d) { return d.capabilities.moved_by_simulated_hand; },
+          "a simulated hand moves it and its time passes only when advanced (a simulated writer can write on "
+          "it)")
+      .def_property_readonly(
+          "needs_calibration", [](const DeviceListing& d) { return d.capabilities.needs_calibration; },
+          "its encoders must be homed (e.g. a Phantom's stylus in the inkwell) before forces")
       .def_readonly("details", &DeviceListing::details, "free text: transport, caveats")
       .def_readonly("limits_known", &DeviceListing::limits_known,
                     "False when info's limits are read only when the device is opened (they are 0 here)")
       .def("__repr__", [](const DeviceListing& d) {
-        return "<DeviceListing " + d.name + " (" + d.info.model + (d.hardware ? ", hardware" : "") + ")>";
+        return "<DeviceListing " + d.name + " (" + d.info.model + (d.capabilities.hardware ? ", hardware" : "") + ")>";
       });
   py::class_<DeviceSurvey>(m, "DeviceSurvey", "What a scan of the device backends found.")
       .def_readonly("devices", &DeviceSurvey::devices, "list of DeviceListing")
@@ -257,7 +277,7 @@ void bind_registry(py::module_& m) {
       "list_devices",
       []() {
         py::gil_scoped_release release;  // a scan may enumerate USB devices and load OpenHaptics
-        return device_registry_with_simulation().survey();
+        return python_device_registry().survey();
       },
       py::call_guard<ForwardLog>(),
       "Scans every registered backend (the simulated device, Phantoms over HID or USB, OpenHaptics) as "

@@ -19,7 +19,7 @@
 #include "calligraphy/render/guidance_mode.hpp"
 #include "calligraphy/render/passivity.hpp"
 #include "calligraphy/render/safety_chain.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/study/trial_spec_runner.hpp"
 #include "calligraphy/trial/trial.hpp"
@@ -258,6 +258,8 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   spec.validate(spec.guidance_mode == GuidanceMode::replay ? TeacherSource::samples : TeacherSource::file);
   std::unique_ptr<SimulatedDevice> simulated_device;
   TrialRunInputs inputs;
+  inputs.registry = &python_device_registry();
+  inputs.host_process = true;  // the interpreter is the application: no memory locking, no SCHED_FIFO
   if (device_name.empty()) {
     simulated_device = std::make_unique<SimulatedDevice>(simulation.device);
     inputs.device = simulated_device.get();

@@ -1,15 +1,20 @@
 #include "cli/cli_devices.hpp"
 
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/phantom_usb/phantom_usb_backends.hpp"
 #include "calligraphy/testing/emulated_phantom.hpp"
 #include "cli/app.hpp"
 
 namespace calligraphy::cli {
 
 DeviceRegistry& cli_device_registry() {
-  DeviceRegistry& registry = device_registry_with_simulation();
-  testing::register_emulated_phantom(registry);
+  // The program's one registry: built once; the window commands add the trainer's pointer devices.
+  static DeviceRegistry registry = [] {
+    DeviceRegistry built = standard_device_registry();
+    register_phantom_usb_backends(built);
+    testing::register_emulated_phantom(built);
+    return built;
+  }();
   return registry;
 }
 

@@ -1,6 +1,6 @@
 #pragma once
-// The devices the command line offers: the process registry with the simulated device and the
-// Phantom emulator registered.
+// The devices the command line offers: the standard backends (simulated, OpenHaptics), the Phantom over
+// USB and the Phantom emulator; the window commands add the mouse devices.
 #include <string>
 
 #include "calligraphy/devices/device_registry.hpp"

@@ -202,7 +202,7 @@ std::vector<std::string> split_profiles(const std::string& text) {
 
 int run_sessions(const SessionRunCommand& command) {
 #ifdef CALLIGRAPHY_WITH_TRAINER
-  if (command.display.display == "window") trainer::register_trainer_devices();  // mouse, mouse-hand
+  if (command.display.display == "window") trainer::register_trainer_devices(cli_device_registry());  // mouse, mouse-hand
 #endif
   const LoadedProtocol protocol = load_study_protocol(command.protocol);
   const DeviceListing found_device = find_cli_device("--device", command.device);
@@ -335,7 +335,7 @@ int run_sessions(const SessionRunCommand& command) {
 
 int resume_session(const SessionResumeCommand& command) {
 #ifdef CALLIGRAPHY_WITH_TRAINER
-  if (command.display.display == "window") trainer::register_trainer_devices();
+  if (command.display.display == "window") trainer::register_trainer_devices(cli_device_registry());
 #endif
   // Saved records are inputs: no output may replace one.
   FilePlan files;

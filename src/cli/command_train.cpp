@@ -9,7 +9,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/devices/device_registry.hpp"
 #include "calligraphy/report/teacher_recording.hpp"
-#include "calligraphy/sim/hand_port.hpp"
+#include "calligraphy/devices/hand_port.hpp"
 #include "cli/cli_devices.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
@@ -83,7 +83,7 @@ void require_device(const std::string& name) { static_cast<void>(find_cli_device
 
 int run_train(const TrainCommand& command) {
   check_train_files(command);
-  trainer::register_trainer_devices();
+  trainer::register_trainer_devices(cli_device_registry());
   const std::u32string chars = characters_from(command.characters, "CHARS");
   trainer::TrainerOptions options;
   options.simulated_writer = command.writer == "simulated";
@@ -92,8 +92,7 @@ int run_train(const TrainCommand& command) {
                                               : "mouse-hand";
   require_device(options.device);
   {  // a simulated writer moves only a device with a hand port; a person moves any other
-    const bool hand_port =
-        dynamic_cast<HandPort*>(cli_device_registry().create(options.device).get()) != nullptr;
+    const bool hand_port = cli_device_registry().find(options.device).capabilities.moved_by_simulated_hand;
     if (options.simulated_writer && !hand_port) {
       throw UsageError(
           "--writer simulated needs a device a simulated writer can move (simulated, "

@@ -15,7 +15,7 @@
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/report/teacher_recording.hpp"
 #include "calligraphy/report/trial_report.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/study/trial_spec.hpp"
@@ -196,7 +196,7 @@ int run_trial(const TrialCommand& command) {
   }
   // Lock-step pacing has no wall clock, so no stall can be bounded: the option would be ignored.
   const bool real_time =
-      spec.pacing == TrialPacing::real_time || (spec.pacing == TrialPacing::automatic && device.hardware);
+      spec.pacing == TrialPacing::real_time || (spec.pacing == TrialPacing::automatic && device.capabilities.hardware);
   if (command.watchdog_option->count() > 0 && !real_time) {
     throw UsageError(
         "--watchdog-ms applies to real-time pacing only (--pacing real-time, or a hardware device)");

@@ -3,7 +3,7 @@
 #include <map>
 
 #include "calligraphy/render/guidance_mode.hpp"
-#include "calligraphy/sim/hand_port.hpp"
+#include "calligraphy/devices/hand_port.hpp"
 #include "cli/cli_devices.hpp"
 
 namespace calligraphy::cli {
@@ -26,8 +26,7 @@ CLI::Option* add_writer_option(CLI::App& app, std::string& target, const std::st
 bool simulated_writer_moves(const DeviceListing& device) {
   // A simulated hand pushes a device through its hand port (the simulated device, the emulated Phantom);
   // a physical device has none, nor have the window's mouse devices, which a person moves.
-  if (device.hardware) return false;
-  return dynamic_cast<HandPort*>(cli_device_registry().create(device.name).get()) != nullptr;
+  return device.capabilities.moved_by_simulated_hand;
 }
 
 std::string writer_for_device(const std::string& given, const DeviceListing& device) {

@@ -22,6 +22,8 @@ const char* device_fault_name(DeviceFault fault) noexcept {
       return "non_finite_force";
     case DeviceFault::safety_limit:
       return "safety_limit";
+    case DeviceFault::not_advanced:
+      return "not_advanced";
   }
   return "unknown";
 }
@@ -46,6 +48,9 @@ const char* to_string(DeviceFault fault) noexcept {
     case DeviceFault::safety_limit:
       return "the device tripped a safety limit (force, impulse, velocity or motor temperature); forces "
              "turned off";
+    case DeviceFault::not_advanced:
+      return "simulated device read again without advance(): its time passes only when the program calls "
+             "advance(dt_s) once per tick, after write_force; forces turned off";
   }
   return "unknown device fault";
 }

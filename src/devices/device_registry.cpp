@@ -6,12 +6,11 @@
 #include <utility>
 
 #include "calligraphy/core/errors.hpp"
-#include "devices/builtin_backends.hpp"
 
 namespace calligraphy {
 
 bool DeviceSurvey::any_hardware() const {
-  return std::any_of(devices.begin(), devices.end(), [](const DeviceListing& d) { return d.hardware; });
+  return std::any_of(devices.begin(), devices.end(), [](const DeviceListing& d) { return d.capabilities.hardware; });
 }
 
 namespace {
@@ -25,10 +24,10 @@ void check_backend(const DeviceBackend& backend) {
 
 // A backend that always lists exactly one device, named as the backend.
 DeviceBackend single_device_backend(std::string name, DeviceInfo info,
-                                    std::function<std::unique_ptr<HapticDevice>()> factory, bool hardware,
-                                    std::string details) {
+                                    std::function<std::unique_ptr<HapticDevice>()> factory,
+                                    DeviceCapabilities capabilities, std::string details) {
   if (!factory) throw InvalidArgument("device '" + name + "': the factory must be set");
-  DeviceListing listing{name, name, std::move(info), hardware, std::move(details)};
+  DeviceListing listing{name, name, std::move(info), capabilities, std::move(details)};
   DeviceBackend backend;
   backend.name = std::move(name);
   backend.scan = [listing] { return DeviceSurvey{{listing}, {}}; };
@@ -48,6 +47,20 @@ bool DeviceRegistry::add_if_absent(DeviceBackend backend) {
   return true;
 }
 
+DeviceRegistry::DeviceRegistry(DeviceRegistry&& other) noexcept {
+  const std::lock_guard lock(other.mutex_);
+  backends_ = std::move(other.backends_);
+}
+
+DeviceRegistry& DeviceRegistry::operator=(DeviceRegistry&& other) noexcept {
+  if (this == &other) return *this;
+  const std::scoped_lock lock(mutex_, other.mutex_);
+  backends_ = std::move(other.backends_);
+  return *this;
+}
+
+bool DeviceRegistry::register_backend_if_absent(DeviceBackend backend) { return add_if_absent(std::move(backend)); }
+
 void DeviceRegistry::register_backend(DeviceBackend backend) {
   const std::string name = backend.name;
   if (!add_if_absent(std::move(backend))) {
@@ -56,16 +69,16 @@ void DeviceRegistry::register_backend(DeviceBackend backend) {
 }
 
 void DeviceRegistry::register_device(std::string name, DeviceInfo info,
-                                     std::function<std::unique_ptr<HapticDevice>()> factory, bool hardware,
-                                     std::string details) {
-  register_backend(single_device_backend(std::move(name), std::move(info), std::move(factory), hardware,
+                                     std::function<std::unique_ptr<HapticDevice>()> factory,
+                                     DeviceCapabilities capabilities, std::string details) {
+  register_backend(single_device_backend(std::move(name), std::move(info), std::move(factory), capabilities,
                                          std::move(details)));
 }
 
 bool DeviceRegistry::register_device_if_absent(std::string name, DeviceInfo info,
                                                std::function<std::unique_ptr<HapticDevice>()> factory,
-                                               bool hardware, std::string details) {
-  return add_if_absent(single_device_backend(std::move(name), std::move(info), std::move(factory), hardware,
+                                               DeviceCapabilities capabilities, std::string details) {
+  return add_if_absent(single_device_backend(std::move(name), std::move(info), std::move(factory), capabilities,
                                              std::move(details)));
 }
 
@@ -166,6 +179,15 @@ std::unique_ptr<HapticDevice> DeviceRegistry::create(std::string_view name) cons
   const Found found = find_with_backend(name);
   auto created = found.backend.create(found.listing);
   if (!created) throw DeviceError("device '" + found.listing.name + "': the backend returned no device");
+  // The listing is what callers decide by (a simulated writer or a person); it must say what the device is.
+  const bool hand_port = created->hand_port() != nullptr;
+  if (hand_port != found.listing.capabilities.moved_by_simulated_hand) {
+    throw InvalidArgument("device '" + found.listing.name + "': its listing says it is " +
+                          (hand_port ? "not " : "") + "moved by a simulated hand, but the device has " +
+                          (hand_port ? "a hand port" : "none") +
+                          "; register it with DeviceCapabilities::moved_by_simulated_hand = " +
+                          (hand_port ? "true" : "false"));
+  }
   return created;
 }
 
@@ -175,23 +197,10 @@ std::unique_ptr<HapticDevice> DeviceRegistry::open(std::string_view name) const 
   return device;
 }
 
-DeviceRegistry& device_registry() {
-  static DeviceRegistry* const registry = [] {
-    auto* created = new DeviceRegistry;  // never destroyed: backends may be used during static destruction
-    register_builtin_device_backends(*created);
-    return created;
-  }();
-  return *registry;
-}
-
-void register_device_backend(DeviceBackend backend) {
-  device_registry().register_backend(std::move(backend));
-}
-
 void print_device_survey(std::ostream& out, const DeviceSurvey& survey) {
   for (const auto& device : survey.devices) {
     const auto& info = device.info;
-    out << device.name << (device.hardware ? "" : "  (not hardware)") << '\n'
+    out << device.name << (device.capabilities.hardware ? "" : "  (not hardware)") << '\n'
         << "  model:              " << info.model << " (" << info.manufacturer << ")\n";
     if (!device.limits_known) {
       out << "  limits:             read from the device when it is opened\n";

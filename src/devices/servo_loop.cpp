@@ -1,7 +1,7 @@
 #include "calligraphy/devices/servo_loop.hpp"
 
 #include <sched.h>
-#include <spdlog/spdlog.h>
+#include "core/library_log.hpp"
 #include <time.h>
 
 #include <algorithm>
@@ -58,32 +58,32 @@ enum LogCode : std::uint16_t {
 void log_sink(const LogRecord& r) {
   switch (r.code) {
     case kDeadlineMissed:
-      spdlog::warn("servo loop: tick {} missed its deadline by {:.1f} us ({} late so far)", r.count,
+      calligraphy::detail::library_log().warn("servo loop: tick {} missed its deadline by {:.1f} us ({} late so far)", r.count,
                    r.values[0], static_cast<std::uint64_t>(r.values[1]));
       break;
     case kForceWithheld:
-      spdlog::warn("servo loop: tick {} withheld a force computed from a state {:.1f} us old ({} so far)",
+      calligraphy::detail::library_log().warn("servo loop: tick {} withheld a force computed from a state {:.1f} us old ({} so far)",
                    r.count, r.values[0], static_cast<std::uint64_t>(r.values[1]));
       break;
     case kWatchdog:
-      spdlog::error("servo loop: watchdog at tick {}: stall of {:.1f} ms: {}", r.count, r.values[0],
+      calligraphy::detail::library_log().error("servo loop: watchdog at tick {}: stall of {:.1f} ms: {}", r.count, r.values[0],
                     r.text.data());
       break;
     case kFault:
-      spdlog::error("servo loop: fault at tick {}: {}", r.count, r.text.data());
+      calligraphy::detail::library_log().error("servo loop: fault at tick {}: {}", r.count, r.text.data());
       break;
     case kStopped:
-      spdlog::info(
+      calligraphy::detail::library_log().info(
           "servo loop: stopped after {} ticks: {} late ticks, longest stall {:.3f} ms, {} forces withheld",
           r.count, static_cast<std::uint64_t>(r.values[0]), r.values[1],
           static_cast<std::uint64_t>(r.values[2]));
       break;
     case kStoppedGrid:
-      spdlog::info("servo loop: deadlines re-anchored {} times, {} deadlines skipped", r.count,
+      calligraphy::detail::library_log().info("servo loop: deadlines re-anchored {} times, {} deadlines skipped", r.count,
                    static_cast<std::uint64_t>(r.values[0]));
       break;
     default:
-      spdlog::debug("servo loop: log record {}", r.code);
+      calligraphy::detail::library_log().debug("servo loop: log record {}", r.code);
   }
 }
 
@@ -476,8 +476,8 @@ void ServoLoop::start() {
 
   m.stop_requested.store(false, std::memory_order_relaxed);
   m.running.store(true, std::memory_order_release);
-  // spdlog creates its default logger lazily; create it here, before the drain thread can race to it.
-  static_cast<void>(spdlog::default_logger_raw());
+  // The library's logger is registered on first use; do it here, before the drain thread logs.
+  static_cast<void>(calligraphy::detail::library_log());
   m.log_drain.start(m.log_queue, log_sink);
   if (device_clock != nullptr) {
     // The driver's thread ticks: its priority and CPU are the driver's to set, not the loop's.
@@ -495,7 +495,7 @@ void ServoLoop::start() {
     }
     m.clock.store(device_clock, std::memory_order_release);
     m.startup.store(1, std::memory_order_release);
-    spdlog::info(
+    calligraphy::detail::library_log().info(
         "servo loop: started on the device's own servo clock at {} Hz (the driver's thread); memory "
         "locked {}",
         m.options.rate_hz, m.realtime.memory_locked ? "yes" : "no");
@@ -525,7 +525,7 @@ void ServoLoop::start() {
     }
     throw RealtimeError("ServoLoop::start: realtime required but " + m.realtime.problems);
   }
-  spdlog::info("servo loop: started at {} Hz; SCHED_FIFO {}, CPU {}, memory locked {}{}{}", m.options.rate_hz,
+  calligraphy::detail::library_log().info("servo loop: started at {} Hz; SCHED_FIFO {}, CPU {}, memory locked {}{}{}", m.options.rate_hz,
                m.realtime.fifo_scheduling ? std::to_string(m.realtime.priority) : "no",
                m.realtime.cpu >= 0 ? std::to_string(m.realtime.cpu) : "not pinned",
                m.realtime.memory_locked ? "yes" : "no",

@@ -8,7 +8,7 @@
 
 #include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/model/scene.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/trial/trial.hpp"
 #include "core/unicode.hpp"
 #include "report/appendf.hpp"

@@ -1,6 +1,6 @@
 #include "calligraphy/render/renderer.hpp"
 
-#include <spdlog/spdlog.h>
+#include "core/library_log.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -86,7 +86,7 @@ Renderer::Renderer(const Scene& scene, const ForceLawParameters& parameters, con
   const double k_guidance = parameters_.guidance_stiffness_n_per_m;
   const double k_max = device.max_stiffness_n_per_m;
   if (k_max > 0.0 && (k_paper > k_max || k_guidance > k_max)) {
-    spdlog::warn("stiffness above the device's stable maximum of {} N/m ({}): paper {} N/m, guidance {} N/m",
+    calligraphy::detail::library_log().warn("stiffness above the device's stable maximum of {} N/m ({}): paper {} N/m, guidance {} N/m",
                  k_max, device.model, k_paper, k_guidance);
   }
   const double b_device = device.intrinsic_damping_n_s_per_m;
@@ -101,13 +101,13 @@ Renderer::Renderer(const Scene& scene, const ForceLawParameters& parameters, con
         colgate_stiffness_bound(b_device, options_.rate_hz, parameters_.paper_damping_n_s_per_m);
     const double guidance_bound = colgate_stiffness_bound(b_device, options_.rate_hz);
     if (k_paper > paper_bound) {
-      spdlog::warn(
+      calligraphy::detail::library_log().warn(
           "paper stiffness {} N/m above the passivity bound 2 (b - B) / T = {} N/m (b = {} N s/m, B = {} "
           "N s/m, {} Hz): the contact may be unstable without a hand or the passivity controller",
           k_paper, paper_bound, b_device, parameters_.paper_damping_n_s_per_m, options_.rate_hz);
     }
     if (parameters_.guidance && k_guidance > guidance_bound) {
-      spdlog::warn(
+      calligraphy::detail::library_log().warn(
           "guidance stiffness {} N/m above the passivity bound 2 b / T = {} N/m (b = {} N s/m, {} Hz)",
           k_guidance, guidance_bound, b_device, options_.rate_hz);
     }

@@ -11,7 +11,9 @@ std::string device_survey_json(const DeviceSurvey& survey) {
     devices.push_back(
         {{"name", listing.name},
          {"backend", listing.backend},
-         {"hardware", listing.hardware},
+         {"hardware", listing.capabilities.hardware},
+         {"moved_by_simulated_hand", listing.capabilities.moved_by_simulated_hand},
+         {"needs_calibration", listing.capabilities.needs_calibration},
          {"details", listing.details},
          {"limits_known", listing.limits_known},
          {"info",

@@ -35,7 +35,7 @@ const WriterLog& SimulatedHand::log() const { return writer_.log(); }
 std::unique_ptr<SimulatedHand> simulated_hand_for(HapticDevice& device, const Scene& scene,
                                                   const WriterProfile& profile, std::uint64_t seed) {
   // Found once, here: the trial never asks what its device is.
-  auto* const port = dynamic_cast<HandPort*>(&device);
+  HandPort* const port = device.hand_port();
   if (port == nullptr) return nullptr;
   return std::make_unique<SimulatedHand>(*port, scene, profile, seed);
 }
@@ -53,11 +53,12 @@ TrialResult run_trial(HapticDevice& device, const Scene& scene, const TrialOptio
   return result;
 }
 
-TrialResult run_trial(std::string_view device_name, const Scene& scene, const TrialOptions& options,
-                      const SimulationOptions& simulation, std::optional<WriterLog>* writer_log) {
+TrialResult run_trial(const DeviceRegistry& registry, std::string_view device_name, const Scene& scene,
+                      const TrialOptions& options, const SimulationOptions& simulation,
+                      std::optional<WriterLog>* writer_log) {
   options.validate();  // before a device is created (and possibly opened by its backend)
   simulation.validate();
-  const std::unique_ptr<HapticDevice> device = device_registry_with_simulation().create(device_name);
+  const std::unique_ptr<HapticDevice> device = registry.create(device_name);
   return run_trial(*device, scene, options, simulation, writer_log);
 }
 

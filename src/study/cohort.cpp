@@ -16,7 +16,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/model/scene.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/sim/writer_memory.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/study/session_runner.hpp"

@@ -11,7 +11,7 @@
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/report/trial_report.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/study/trial_spec_runner.hpp"
 #include "core/unicode.hpp"
@@ -42,7 +42,7 @@ void check_plan(const SessionManifest& session, const DeviceListing& device) {
     if (condition.mode == ConditionMode::replay) continue;
     (void)study_trial_options(session, condition, trial);
   }
-  if (session.setup.writer == "simulated" && device.hardware) {
+  if (session.setup.writer == "simulated" && device.capabilities.hardware) {
     throw InvalidArgument("device '" + device.name +
                           "' is moved by a person: a simulated writer cannot write on it (writer 'human')");
   }
@@ -163,8 +163,8 @@ TrialOptions study_trial_options(const SessionManifest& session, const StudyCond
 
 SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& run_options) {
   const SessionManifest& manifest = session.manifest();
-  const DeviceRegistry& registry =
-      run_options.registry ? *run_options.registry : device_registry_with_simulation();
+  const DeviceRegistry standard = run_options.registry ? DeviceRegistry{} : standard_device_registry();
+  const DeviceRegistry& registry = run_options.registry ? *run_options.registry : standard;
   const DeviceListing listing = registry.find(manifest.setup.device);  // only its backend is scanned
   check_plan(manifest, listing);
   const bool simulated_writer = manifest.setup.writer == "simulated";
@@ -245,7 +245,7 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     TrialSpec spec = study_trial_spec(manifest, condition, trial, guidance.guidance);
     if (run_options.pacing) spec.pacing = *run_options.pacing;
     if (!simulated_writer && spec.pacing != TrialPacing::lock_step)  // a person, in real time
-      spec.watchdog_s = default_watchdog_s(listing.hardware);
+      spec.watchdog_s = default_watchdog_s(listing.capabilities.hardware);
     json started = trial_details(trial);
     std::optional<WriterSkills> skills;
     if (learning) {
@@ -282,7 +282,7 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     context.condition = &condition;
     context.device_name = manifest.setup.device;
     context.device_info = device_info;
-    context.hardware = listing.hardware;
+    context.hardware = listing.capabilities.hardware;
     context.simulated_writer = simulated_writer;
     context.guidance = study_detail::guidance_record_json(condition, guidance);
     context.writer_skills = skills;

@@ -7,7 +7,7 @@
 #include "calligraphy/model/typical_strokes.hpp"
 #include "calligraphy/report/pen_trace_csv.hpp"
 #include "calligraphy/report/score_report.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "core/unicode.hpp"
 #include "model/polyline.hpp"
 #include "study/manifest_json.hpp"

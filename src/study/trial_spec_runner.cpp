@@ -5,8 +5,8 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/report/teacher_recording.hpp"
-#include "calligraphy/sim/hand_port.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/hand_port.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/sim/trace_attempts.hpp"
 #include "calligraphy/trial/runner.hpp"
@@ -97,17 +97,20 @@ TrialRun run_trial_spec(const TrialSpec& spec, const Scene& scene, const TrialRu
   std::unique_ptr<HapticDevice> created;
   HapticDevice* device = inputs.device;
   if (device == nullptr) {
-    const DeviceRegistry& registry = inputs.registry ? *inputs.registry : device_registry_with_simulation();
-    created = registry.create(spec.device);
+    created = inputs.registry ? inputs.registry->create(spec.device) : standard_device_registry().create(spec.device);
     device = created.get();
   }
   run.device = device->info();
   // Found once, here: the trial never asks what its device is.
-  run.simulated_writer = simulated_writer_writes(spec, dynamic_cast<HandPort*>(device) != nullptr);
+  run.simulated_writer = simulated_writer_writes(spec, device->hand_port() != nullptr);
 
   run.options = trial_options(spec, run.device);
   if (spec.guidance_mode == GuidanceMode::replay) run.options.force.teacher_trajectory = std::move(teacher);
   run.options.should_stop = inputs.should_stop;
+  if (!inputs.host_process) {  // a program that exists to run the trial asks for the real-time settings
+    run.options.loop.priority = kDedicatedServoPriority;
+    run.options.loop.lock_memory = true;
+  }
   if (inputs.adjust) inputs.adjust(run.options);
   run.options.validate();
 

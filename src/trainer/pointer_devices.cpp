@@ -6,8 +6,8 @@
 #include <cstring>
 #include <memory>
 
-#include "calligraphy/sim/hand_port.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/hand_port.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 
 namespace calligraphy::trainer {
 namespace {
@@ -192,14 +192,14 @@ PointerInput& pointer_input() {
 void register_pointer_devices(DeviceRegistry& registry) {
   if (!registered(registry, "mouse")) {
     registry.register_device(
-        "mouse", mouse_info(), [] { return std::make_unique<MouseDevice>(mouse_info()); }, false,
+        "mouse", mouse_info(), [] { return std::make_unique<MouseDevice>(mouse_info()); }, DeviceCapabilities{},
         "the window's pointer on the paper plane; left button = pen on the paper; no force output "
         "(calligraphy train only)");
   }
   if (!registered(registry, "mouse-hand")) {
     registry.register_device(
         "mouse-hand", MouseHandDevice::parameters().info, [] { return std::make_unique<MouseHandDevice>(); },
-        false,
+        DeviceCapabilities{},
         "simulated Phantom Desktop held by a hand (150 N/m, 3 N s/m) coupled to the window's pointer "
         "(calligraphy train only)");
   }

@@ -24,7 +24,10 @@ struct TrainerCharacter {
 
 struct TrainerOptions {
   std::vector<TrainerCharacter> characters;  ///< the row, practised left to right
-  std::string device = "mouse-hand";         ///< a name in the device registry
+  std::string device = "mouse-hand";         ///< a name in `registry`
+  /// Where `device` is created (not owned; outlives the run). nullptr: a standard registry
+  /// (`standard_device_registry()`) with the trainer's pointer devices (`register_trainer_devices`).
+  const DeviceRegistry* registry = nullptr;
   bool simulated_writer = false;             ///< the simulated writer writes (device with a hand port)
   std::string writer_profile = "novice";     ///< novice or skilled
   std::uint64_t seed = 0;
@@ -86,8 +89,8 @@ struct TrainerSessionOptions {
 /// window can open.
 SessionRunResult run_trainer_session(const TrainerSessionOptions& options);
 
-/// Registers the trainer's pointer devices ("mouse", "mouse-hand") in the process registry the
-/// command line uses.
-void register_trainer_devices();
+/// Registers the trainer's pointer devices ("mouse", "mouse-hand") in `registry` (nothing for a name already
+/// taken). They move only while a trainer window is open.
+void register_trainer_devices(DeviceRegistry& registry);
 
 }  // namespace calligraphy::trainer

@@ -20,7 +20,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/devices/device_registry.hpp"
-#include "calligraphy/sim/hand_port.hpp"
+#include "calligraphy/devices/hand_port.hpp"
 #include "core/stop_signals.hpp"
 #include "study/names.hpp"
 #include "trainer/pointer_devices.hpp"
@@ -268,11 +268,18 @@ void TrainerApp::update_pointer() {
   pointer_input().set(trial_m.x(), trial_m.y(), pressed);
 }
 
-int run_trainer(const TrainerOptions& options) {
-  if (options.characters.empty()) throw InvalidArgument("calligraphy train: no characters to practise");
+int run_trainer(const TrainerOptions& given) {
+  if (given.characters.empty()) throw InvalidArgument("calligraphy train: no characters to practise");
+  TrainerOptions options = given;
+  DeviceRegistry standard;
+  if (options.registry == nullptr) {
+    standard = standard_device_registry();
+    register_trainer_devices(standard);
+    options.registry = &standard;
+  }
   // The device must exist, and a simulated writer can move only a device with a hand port.
-  const std::unique_ptr<HapticDevice> probe = device_registry_with_simulation().create(options.device);
-  const bool hand_port = dynamic_cast<HandPort*>(probe.get()) != nullptr;
+  const DeviceListing listing = options.registry->find(options.device);
+  const bool hand_port = listing.capabilities.moved_by_simulated_hand;
   if (options.simulated_writer && !hand_port) {
     throw InvalidArgument(
         "--writer simulated needs a device a simulated writer can move (simulated, "
@@ -288,11 +295,10 @@ int run_trainer(const TrainerOptions& options) {
   // installed the handlers already (a study session) keeps them.
   std::optional<StopSignals> signals;
   if (!StopSignals::installed()) signals.emplace();
-  const bool hardware = device_registry_with_simulation().find(options.device).hardware;
-  TrainerApp app(options, probe->info(), hardware);
+  TrainerApp app(options, options.registry->create(options.device)->info(), listing.capabilities.hardware);
   return app.run();
 }
 
-void register_trainer_devices() { register_pointer_devices(device_registry_with_simulation()); }
+void register_trainer_devices(DeviceRegistry& registry) { register_pointer_devices(registry); }
 
 }  // namespace calligraphy::trainer

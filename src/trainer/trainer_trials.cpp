@@ -12,7 +12,7 @@
 
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/report/teacher_recording.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "study/names.hpp"
 #include "trainer/trainer_app.hpp"
 
@@ -53,6 +53,7 @@ void TrainerApp::start_trial(std::size_t character) {
   spec.pacing = TrialPacing::real_time;
   spec.watchdog_s = options_.watchdog_s.value_or(default_watchdog_s(hardware_));
   TrialRunInputs inputs;
+  inputs.registry = options_.registry;
   inputs.teacher = options_.teacher;
   DisplayChannel* const channel = channel_.get();
   inputs.adjust = [channel](TrialOptions& trial) {

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <utility>
 
+#include "core/library_log.hpp"
+
 namespace calligraphy {
 namespace {
 
@@ -68,6 +70,17 @@ TrialResult TrialSession::finish(TrialEnd end, std::string reason, double end_ti
   result.aborted = end != TrialEnd::completed;
   result.abort_reason = std::move(reason);
   result.device_time_at_start_s = device_origin_s_;
+  if (ticks_ >= 2 && last_time_s_ > 0.0) {
+    result.device_tick_rate_hz = static_cast<double>(ticks_ - 1) / last_time_s_;
+    const double ratio = result.device_tick_rate_hz / options_.rate_hz;
+    if (ticks_ >= 100 && (ratio < 0.9 || ratio > 1.1)) {
+      calligraphy::detail::library_log().warn(
+          "trial: the device's clock says the ticks came at {:.1f} Hz, but the trial was set up for rate_hz = "
+          "{:.1f} Hz: step the session once per period of TrialOptions::rate_hz (time-based parts of the "
+          "force law run at the wrong speed otherwise)",
+          result.device_tick_rate_hz, options_.rate_hz);
+    }
+  }
   return result;
 }
 

@@ -26,15 +26,18 @@ enum class DeviceFault : std::uint8_t {
   watchdog,          ///< forces were on and no force command came within the device's watchdog timeout
   non_finite_force,  ///< a force command with a NaN or infinite component; zero force sent instead
   safety_limit,      ///< the device tripped a safety limit of its own (force, impulse, velocity, warm motors)
+  // A usage fault: CommunicationError off the servo path (the device's time source is the program).
+  not_advanced,  ///< a simulated device held by a hand read again with no `advance` since its last force
 };
 
 /// Number of `DeviceFault` values (for tables indexed by the code).
-inline constexpr std::size_t kDeviceFaultCount = 8;
+inline constexpr std::size_t kDeviceFaultCount = 9;
 
 /// Whether the fault is a link fault (`CommunicationError`) rather than a safety fault (`SafetyFault`).
 [[nodiscard]] constexpr bool is_link_fault(DeviceFault fault) noexcept {
   return fault == DeviceFault::not_open || fault == DeviceFault::link_lost ||
-         fault == DeviceFault::no_valid_status || fault == DeviceFault::driver_error;
+         fault == DeviceFault::no_valid_status || fault == DeviceFault::driver_error ||
+         fault == DeviceFault::not_advanced;
 }
 
 /// The code's name, e.g. "link_lost" (for JSON, logs and tests). Static storage.

@@ -10,8 +10,10 @@
 namespace calligraphy {
 
 class DeviceServoClock;
+class HandPort;
 
-/// Abstract haptic device. Implementations: `SimulatedDevice`, the Phantom backends, OpenHaptics.
+/// Abstract haptic device. Implementations: `SimulatedDevice` (simulated_device.hpp), the Phantom backends,
+/// OpenHaptics.
 /// `read_state` and `write_force` are the servo path, called from the servo thread at up to 10 kHz:
 /// they are noexcept and return a `DeviceFault` code (device_fault.hpp) instead of throwing, and must
 /// not allocate, lock, log or build a string, also when they fail (fixed messages; details go to
@@ -59,6 +61,10 @@ class HapticDevice {
   /// and the caller's loop is the clock (`ServoLoop`'s thread). A `ServoLoop` on a device with a clock runs
   /// each tick inside the driver's frame. Valid while the device is open.
   [[nodiscard]] virtual DeviceServoClock* servo_clock() noexcept { return nullptr; }
+  /// The device's hand port (hand_port.hpp) when a simulated hand can move it and its time passes only when
+  /// told to (the simulated device, the emulated Phantom), else nullptr (a person moves it). The one way to
+  /// ask; its listing says the same (`DeviceCapabilities::moved_by_simulated_hand`).
+  [[nodiscard]] virtual HandPort* hand_port() noexcept { return nullptr; }
 };
 
 }  // namespace calligraphy

@@ -27,6 +27,8 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
@@ -39,17 +41,24 @@ namespace calligraphy {
 /// settings, runs anyway, and records what was obtained in `ServoLoopStats::realtime`.
 enum class RealtimeMode { enforce, ignore };
 
+/// The SCHED_FIFO priority a program that exists to run the haptic loop asks for (the command line's trials
+/// and study sessions): above the kernel's threaded interrupts (50), below its watchdogs (99).
+inline constexpr int kDedicatedServoPriority = 80;
+
+/// The defaults suit a library inside a larger program: normal scheduling, no CPU pinning and no memory
+/// locking, nothing that changes the process. A program that exists to run the loop asks for them
+/// (`priority = kDedicatedServoPriority`, `lock_memory = true`; docs/servo-loop.md).
 struct ServoLoopOptions {
   double rate_hz = 1000.0;  ///< servo rate [Hz], in [100, 10000]
   RealtimeMode realtime = RealtimeMode::ignore;
-  /// SCHED_FIFO priority of the loop thread, 1..99; 0 asks for none (normal scheduling; not allowed
-  /// with `enforce`).
-  int priority = 80;
+  /// SCHED_FIFO priority of the loop thread, 1..99; 0 (the default) asks for none (normal scheduling; not
+  /// allowed with `enforce`). Usually needs CAP_SYS_NICE or an rtprio limit.
+  int priority = 0;
   int cpu = -1;  ///< pin the loop thread to this CPU; -1: no pinning
   /// mlockall(MCL_CURRENT | MCL_FUTURE) at start, so the loop never takes a page fault. Process-wide
-  /// and not undone at stop. Unavailable in sanitizer builds (their shadow memory cannot be locked):
-  /// there `enforce` throws and `ignore` records it as not obtained.
-  bool lock_memory = true;
+  /// and not undone at stop, so off by default. Unavailable in sanitizer builds (their shadow memory
+  /// cannot be locked): there `enforce` throws and `ignore` records it as not obtained.
+  bool lock_memory = false;
   /// Stale-force guard [s], in (0, 1]: the longest time from the start of a tick's `read_state` to the
   /// return of its callback for which the callback's force is still written. A later tick (the thread
   /// lost the CPU inside the tick) commands zero force instead, counts it in `forces_withheld`, and the
@@ -164,6 +173,12 @@ class ServoLoop {
  public:
   /// `device` must outlive the loop. Throws InvalidArgument for bad options or an empty callback.
   ServoLoop(HapticDevice& device, ServoCallback callback, const ServoLoopOptions& options = {});
+  /// The same from any callable (a lambda): it must be callable as `ServoCommand(const DeviceState&, double
+  /// dt_s)`; one that returns a bare force (Vec3) is refused at compile time with that message.
+  template <typename Callback>
+    requires(!std::is_same_v<std::decay_t<Callback>, ServoCallback>)
+  ServoLoop(HapticDevice& device, Callback&& callback, const ServoLoopOptions& options = {})
+      : ServoLoop(device, to_servo_callback(std::forward<Callback>(callback)), options) {}
   /// Stops the loop (see `stop()`). Never throws.
   ~ServoLoop();
   ServoLoop(const ServoLoop&) = delete;
@@ -205,6 +220,22 @@ class ServoLoop {
   [[nodiscard]] const ServoLoopOptions& options() const noexcept;
 
  private:
+  template <typename Callback>
+  static ServoCallback to_servo_callback(Callback&& callback) {
+    constexpr bool kCallable = std::is_invocable_v<Callback&, const DeviceState&, double>;
+    static_assert(kCallable, "ServoLoop: the callback must be callable as ServoCommand(const DeviceState&, double dt_s)");
+    if constexpr (kCallable) {
+      using Result = std::decay_t<std::invoke_result_t<Callback&, const DeviceState&, double>>;
+      static_assert(!std::is_same_v<Result, Vec3>,
+                    "ServoLoop: the callback returns a Vec3; return ServoCommand{force_n, stop} instead");
+      static_assert(std::is_same_v<Result, ServoCommand>,
+                    "ServoLoop: the callback must return ServoCommand (the force [N] and whether to stop)");
+      return ServoCallback(std::forward<Callback>(callback));
+    } else {
+      return {};
+    }
+  }
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -11,8 +11,8 @@
 
 #include "calligraphy/devices/haptic_device.hpp"
 #include "calligraphy/model/scene.hpp"
-#include "calligraphy/sim/hand_port.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/hand_port.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/sim/simulated_writer.hpp"
 #include "calligraphy/trial/hand.hpp"
 #include "calligraphy/trial/runner.hpp"
@@ -66,12 +66,13 @@ class SimulatedHand final : public TrialHand {
 TrialResult run_trial(HapticDevice& device, const Scene& scene, const TrialOptions& options,
                       const SimulationOptions& simulation, std::optional<WriterLog>* writer_log = nullptr);
 
-/// The trial on the device called `device_name` in `device_registry_with_simulation()` (e.g. "simulated"),
-/// created for this trial, written by `simulation`'s writer when the device has a hand port (else by a
-/// person, in real time). `writer_log`, when given, receives the writer's log (reset: no writer wrote). Throws DeviceNotFound naming the devices that exist when there is none of that name, and what
-/// `run_trial` throws.
-TrialResult run_trial(std::string_view device_name, const Scene& scene, const TrialOptions& options,
-                      const SimulationOptions& simulation = {},
+/// The trial on the device called `device_name` in `registry` (e.g. "simulated" in a
+/// `standard_device_registry()`), created for this trial, written by `simulation`'s writer when the device
+/// has a hand port (else by a person, in real time). `writer_log`, when given, receives the writer's log
+/// (reset: no writer wrote). Throws DeviceNotFound naming the devices that exist when there is none of that
+/// name, and what `run_trial` throws.
+TrialResult run_trial(const DeviceRegistry& registry, std::string_view device_name, const Scene& scene,
+                      const TrialOptions& options, const SimulationOptions& simulation = {},
                       std::optional<WriterLog>* writer_log = nullptr);
 
 /// The trial on a `SimulatedDevice` made from `simulation.device`, written by `simulation`'s writer:

@@ -29,8 +29,8 @@
 
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/render/renderer.hpp"
-#include "calligraphy/sim/hand_port.hpp"
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/hand_port.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/sim/writer_log.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
 

@@ -48,7 +48,7 @@ class SessionHost {
 
 /// Options of `run_session`.
 struct SessionRunOptions {
-  /// Where the device named in the session is created; nullptr: `device_registry_with_simulation()`.
+  /// Where the device named in the session is created (not owned); nullptr: a `standard_device_registry()`.
   const DeviceRegistry* registry = nullptr;
   /// Loads a character's model; empty: the embedded characters (CharacterLibrary::embedded()).
   std::function<Character(char32_t)> load_character;

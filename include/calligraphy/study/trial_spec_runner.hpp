@@ -21,7 +21,7 @@ namespace calligraphy {
 
 /// What a trial needs beyond its specification: what only its caller has. Every member may stay empty.
 struct TrialRunInputs {
-  /// Where `TrialSpec::device` is created; nullptr: `device_registry_with_simulation()`.
+  /// Where `TrialSpec::device` is created (not owned); nullptr: a `standard_device_registry()`.
   const DeviceRegistry* registry = nullptr;
   /// A device the caller made (not owned; opened here when it is not open, closed at the end), used
   /// instead of creating `TrialSpec::device` (e.g. a simulated device with the caller's parameters).
@@ -33,6 +33,10 @@ struct TrialRunInputs {
   std::optional<WriterProfile> writer;
   /// Polled by the thread that runs the trial (TrialOptions::should_stop); may be empty.
   std::function<bool()> should_stop;
+  /// False (the command line, study sessions): a real-time trial asks for SCHED_FIFO at
+  /// `kDedicatedServoPriority` and locked memory, as a program that exists to run it. True (a window, the
+  /// Python module): nothing process-wide, the `ServoLoopOptions` defaults.
+  bool host_process = false;
   /// Called with the options made from the specification just before the trial: what only the caller
   /// sets (a window's display channel, memory locking off in a window process, a condition's stiffness or
   /// acceptance, force-law tuning from Python). May be empty.

@@ -13,7 +13,7 @@ namespace calligraphy::testing {
 
 /// A Phantom Omni emulator as the registry offers it: powers on docked, so `open()` homes the encoders;
 /// the stylus leaves the inkwell after 50 ms of emulated time. The device also implements `HandPort`
-/// (calligraphy/sim/hand_port.hpp), so a simulated writer can move it.
+/// (calligraphy/devices/hand_port.hpp), so a simulated writer can move it.
 [[nodiscard]] std::unique_ptr<HapticDevice> make_emulated_phantom();
 
 /// Registers that device as "emulated-phantom" in `registry`; nothing when a backend of that name is

@@ -46,6 +46,12 @@ struct TrialResult {
   /// metrics' times count from it, so t = 0 is the trial's first tick on every device. Device time of a
   /// sample = its t + this.
   double device_time_at_start_s = 0.0;
+  /// The rate the ticks came at by the device's clock [Hz]: (ticks - 1) over the time from the first tick to
+  /// the last; 0 for fewer than 2 ticks or a clock that did not move. The renderer assumed
+  /// `TrialOptions::rate_hz`; a loop that ticks at another rate (more than 10 % off over 100 ticks or more)
+  /// is logged as a warning when the trial finishes (`TrialSession::finish`), since time-based parts of the
+  /// force law (fades, filters, replay) would run at the wrong speed.
+  double device_tick_rate_hz = 0.0;
 };
 
 /// The trace as pen samples in the paper plane: the pen is down when the HIP is at most

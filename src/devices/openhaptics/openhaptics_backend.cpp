@@ -2,7 +2,7 @@
 #include <memory>
 
 #include "calligraphy/core/errors.hpp"
-#include "devices/builtin_backends.hpp"
+#include "devices/standard_backends.hpp"
 #include "devices/openhaptics/hd_errors.hpp"
 #include "devices/openhaptics/hd_library.hpp"
 #include "devices/openhaptics/openhaptics_device.hpp"
@@ -28,7 +28,7 @@ DeviceSurvey scan() {
   library->disable_device(handle);
   DeviceListing listing;
   listing.name = "openhaptics";
-  listing.hardware = true;
+  listing.capabilities = DeviceCapabilities{.hardware = true, .needs_calibration = true};
   listing.info.model = "OpenHaptics default device";
   listing.info.manufacturer = "see info() after open()";
   listing.limits_known = false;
@@ -42,7 +42,7 @@ DeviceSurvey scan() {
 }  // namespace
 
 void register_backend(DeviceRegistry& registry) {
-  registry.register_backend(
+  registry.register_backend_if_absent(
       {"openhaptics", scan, [](const DeviceListing&) { return std::make_unique<OpenHapticsDevice>(); }});
 }
 

@@ -1,6 +1,6 @@
 #include "devices/openhaptics/openhaptics_device.hpp"
 
-#include <spdlog/spdlog.h>
+#include "core/library_log.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -61,7 +61,7 @@ void OpenHapticsDevice::read_info() {
 void OpenHapticsDevice::open() {
   if (open_) return;
   library_ = HdLibrary::load();  // DeviceNotFound "OpenHaptics not found ..."
-  spdlog::warn(
+  calligraphy::detail::library_log().warn(
       "OpenHaptics: using {}; this backend was tested against a stand-in libHD written from the public HDAPI "
       "reference (frames, scheduler, errors, calibration, faults), never against 3D Systems' libHD and an "
       "arm",
@@ -105,7 +105,7 @@ void OpenHapticsDevice::open() {
     close();
     throw;
   }
-  spdlog::info("OpenHaptics: opened {} ({}), max force {} N, {}", info_.model, info_.manufacturer,
+  calligraphy::detail::library_log().info("OpenHaptics: opened {} ({}), max force {} N, {}", info_.model, info_.manufacturer,
                info_.max_force_n, is_calibrated() ? "calibrated" : "needs calibrate()");
 }
 
@@ -116,7 +116,7 @@ void OpenHapticsDevice::close() noexcept {
   }
   if (const hd::HDerror error = scheduler_error_.load(); error != hd::HD_SUCCESS) {
     try {  // the servo path kept only the code; it is worded here, off the servo thread
-      spdlog::warn("OpenHaptics: the scheduler reported {} ({}) during the run", hd_error_name(error),
+      calligraphy::detail::library_log().warn("OpenHaptics: the scheduler reported {} ({}) during the run", hd_error_name(error),
                    device_fault_name(hd_servo_fault(error)));
     } catch (...) {
       // Logging must not turn close() into a throwing call.

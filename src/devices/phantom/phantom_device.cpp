@@ -1,6 +1,6 @@
 #include "devices/phantom/phantom_device.hpp"
 
-#include <spdlog/spdlog.h>
+#include "core/library_log.hpp"
 
 #include <string>
 #include <utility>
@@ -74,14 +74,14 @@ PhantomDevice::PhantomDevice(std::unique_ptr<devices::ByteTransport> transport, 
 PhantomDevice::~PhantomDevice() { close(); }
 
 void PhantomDevice::log_start_up() const {
-  spdlog::info("Phantom: opening {} on {}", config_.info.model, transport_->description());
-  spdlog::info(
+  calligraphy::detail::library_log().info("Phantom: opening {} on {}", config_.info.model, transport_->description());
+  calligraphy::detail::library_log().info(
       "Phantom: verified (by tests, against published sources): the packet codec against the FireWire Omni "
       "field list of raw_omni / phantom-drivers (field order and byte order are this library's choice, see "
       "docs/devices.md); the kinematics against Cavusoglu et al.'s Phantom 1.5 model (here l1 = {} m, "
       "l2 = {} m)",
       config_.geometry.first_link_m, config_.geometry.second_link_m);
-  spdlog::warn(
+  calligraphy::detail::library_log().warn(
       "Phantom: NOT verified: nothing was run on hardware; the USB Touch's packet framing is not public; "
       "the USB ids 0x2988 / 0x0301, 0x0302 are unconfirmed; motor constants and the inkwell pose are "
       "placeholders");
@@ -108,16 +108,16 @@ void PhantomDevice::open() {
     throw_fault(fault);
   }
   if (is_calibrated()) {
-    spdlog::info("Phantom: homed from the inkwell (docked bit set)");
+    calligraphy::detail::library_log().info("Phantom: homed from the inkwell (docked bit set)");
   } else {
-    spdlog::warn("Phantom: not calibrated: put the stylus in the inkwell and call calibrate()");
+    calligraphy::detail::library_log().warn("Phantom: not calibrated: put the stylus in the inkwell and call calibrate()");
   }
 }
 
 void PhantomDevice::close() noexcept {
   if (fault_record_.fault != DeviceFault::none) {
     try {  // the servo path kept the fault as plain data; it is worded here, off the servo thread
-      spdlog::warn("Phantom: last fault: {} ({}): {}", device_fault_name(fault_record_.fault),
+      calligraphy::detail::library_log().warn("Phantom: last fault: {} ({}): {}", device_fault_name(fault_record_.fault),
                    describe(fault_record_), to_string(fault_record_.fault));
     } catch (...) {
       // Logging must not turn close() into a throwing call.
@@ -132,7 +132,7 @@ void PhantomDevice::close() noexcept {
     const auto errors = packet_errors();
     const auto safety = safety_events();
     try {
-      spdlog::info(
+      calligraphy::detail::library_log().info(
           "Phantom: closed; rejected packets {} (short {}, long {}, malformed {}), timeouts {}, lost {}; "
           "NaN commands {}, clamped {}, watchdog trips {}",
           errors.rejected(), errors.too_short, errors.too_long, errors.malformed, errors.timeouts,
@@ -156,7 +156,7 @@ void PhantomDevice::calibrate() {
   }
   home_at_inkwell(last_status_);
   apply_status(last_status_, state_.time_s);
-  spdlog::info("Phantom: homed from the inkwell");
+  calligraphy::detail::library_log().info("Phantom: homed from the inkwell");
 }
 
 void PhantomDevice::enable_forces(bool enabled) {

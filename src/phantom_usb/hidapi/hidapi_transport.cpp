@@ -1,4 +1,4 @@
-#include "devices/phantom/hidapi_transport.hpp"
+#include "phantom_usb/hidapi/hidapi_transport.hpp"
 
 #include <hidapi.h>
 

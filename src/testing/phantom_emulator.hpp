@@ -13,11 +13,11 @@
 #include <cstdint>
 #include <memory>
 
-#include "calligraphy/sim/hand_port.hpp"
+#include "calligraphy/devices/hand_port.hpp"
 #include "devices/phantom/phantom_arm.hpp"
 #include "devices/phantom/phantom_codec.hpp"
 #include "devices/phantom/phantom_device.hpp"
-#include "sim/testing/in_memory_transport.hpp"
+#include "testing/in_memory_transport.hpp"
 
 namespace calligraphy::phantom {
 
@@ -137,7 +137,7 @@ struct EmulatedPhantom {
 /// over the tick (`PhantomEmulator::set_external_torque`). The emulator integrates a tick each time
 /// the host reads a status packet, so `advance(dt)` sets the tick length and the hand torque, and the
 /// next `read_state` moves the arm.
-class EmulatedPhantomDevice final : public HapticDevice, public HandPort {
+class EmulatedPhantomDevice final : public HandDrivenDevice {
  public:
   /// `parameters` default to emulator_matching(config). Throws InvalidArgument like PhantomDevice.
   explicit EmulatedPhantomDevice(PhantomDeviceConfig config = phantom_omni_config());

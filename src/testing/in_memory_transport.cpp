@@ -1,4 +1,4 @@
-#include "sim/testing/in_memory_transport.hpp"
+#include "testing/in_memory_transport.hpp"
 
 #include <utility>
 

@@ -1,4 +1,4 @@
-#include "sim/testing/phantom_emulator.hpp"
+#include "testing/phantom_emulator.hpp"
 
 #include <algorithm>
 #include <utility>

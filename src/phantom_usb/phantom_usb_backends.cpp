@@ -1,4 +1,4 @@
-// Registers the Phantom backends: the USB transports that were built (the emulator registers itself
+// Registers the Phantom backends over the USB transports that were built (the emulator registers itself
 // from the testing target, calligraphy/testing/emulated_phantom.hpp).
 #include <cstdio>
 #include <memory>
@@ -6,18 +6,21 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/devices/phantom_models.hpp"
-#include "devices/builtin_backends.hpp"
+#include "calligraphy/phantom_usb/phantom_usb_backends.hpp"
 #include "devices/phantom/phantom_device.hpp"
 #include "devices/phantom/usb_ids.hpp"
 #if defined(CALLIGRAPHY_WITH_HIDAPI)
-#include "devices/phantom/hidapi_transport.hpp"
+#include "phantom_usb/hidapi/hidapi_transport.hpp"
 #endif
 #if defined(CALLIGRAPHY_WITH_LIBUSB)
-#include "devices/phantom/libusb_transport.hpp"
+#include "phantom_usb/libusb/libusb_transport.hpp"
 #endif
 
 namespace calligraphy::phantom {
 namespace {
+
+// A physical arm whose encoders are homed in the inkwell.
+[[maybe_unused]] constexpr DeviceCapabilities kPhantomCapabilities{.hardware = true, .needs_calibration = true};
 
 [[maybe_unused]] constexpr const char* kUsbCaveat =
     "UNVERIFIED: USB id reported by users, not confirmed; the packet codec is the FireWire Omni's, the USB "
@@ -45,7 +48,7 @@ DeviceSurvey scan_hid() {
   DeviceSurvey survey;
   for (const auto& entry : find_hid_phantoms()) {
     survey.devices.push_back(
-        {"phantom-hid:" + entry.path, "", usb_touch_info(entry.vendor_id, entry.product_id), true,
+        {"phantom-hid:" + entry.path, "", usb_touch_info(entry.vendor_id, entry.product_id), kPhantomCapabilities,
          "hidapi " + entry.path + (entry.product.empty() ? "" : ", \"" + entry.product + "\"") + "; " +
              kUsbCaveat});
   }
@@ -74,7 +77,7 @@ DeviceSurvey scan_usb() {
   DeviceSurvey survey;
   for (const auto& entry : find_usb_phantoms()) {
     survey.devices.push_back(
-        {usb_name(entry), "", usb_touch_info(entry.vendor_id, entry.product_id), true,
+        {usb_name(entry), "", usb_touch_info(entry.vendor_id, entry.product_id), kPhantomCapabilities,
          std::string("libusb bulk; the same device may also be listed as phantom-hid; ") + kUsbCaveat});
   }
   if (survey.devices.empty())
@@ -94,8 +97,12 @@ std::unique_ptr<HapticDevice> create_usb(const DeviceListing& listing) {
 #endif
 
 }  // namespace
+}  // namespace calligraphy::phantom
 
-void register_backends(DeviceRegistry& registry) {
+namespace calligraphy {
+
+void register_phantom_usb_backends(DeviceRegistry& registry) {
+  using namespace phantom;
 #if defined(CALLIGRAPHY_WITH_HIDAPI)
   registry.register_backend({"phantom-hid", scan_hid, create_hid});
 #else
@@ -110,4 +117,4 @@ void register_backends(DeviceRegistry& registry) {
 #endif
 }
 
-}  // namespace calligraphy::phantom
+}  // namespace calligraphy

@@ -1,4 +1,4 @@
-#include "devices/phantom/libusb_transport.hpp"
+#include "phantom_usb/libusb/libusb_transport.hpp"
 
 #include <libusb.h>
 

@@ -5,6 +5,7 @@
 /// the emulated Phantom). A trial on a device with a hand port runs lock-step with a simulated writer,
 /// deterministic for a seed; a real device has no hand port (a person moves it) and runs in real time.
 #include "calligraphy/core/geometry.hpp"
+#include "calligraphy/devices/haptic_device.hpp"
 
 namespace calligraphy {
 
@@ -16,9 +17,9 @@ class HandModel {
 };
 
 /// A device whose stylus a `HandModel` can push, and whose time advances only when told to.
-/// Implemented next to `HapticDevice` (a class derives from both); `run_device_trial` finds it once
-/// with dynamic_cast. Not thread-safe: the servo thread calls it between `write_force` and the next
-/// `read_state`.
+/// A device implements it by deriving from `HandDrivenDevice`; callers find it with
+/// `HapticDevice::hand_port()`. Not thread-safe: the servo thread calls it between `write_force` and the
+/// next `read_state`.
 class HandPort {
  public:
   virtual ~HandPort() = default;
@@ -28,6 +29,13 @@ class HandPort {
   /// and the hand's force. The next `read_state` reports the state after them. An implementation may
   /// throw InvalidArgument for a negative or non-finite dt_s (the simulated device does).
   virtual void advance(double dt_s) = 0;
+};
+
+/// The base of a device that a simulated hand moves: a `HapticDevice` that is its own `HandPort`
+/// (`hand_port()` returns it), so that nobody needs to probe with dynamic_cast.
+class HandDrivenDevice : public HapticDevice, public HandPort {
+ public:
+  [[nodiscard]] HandPort* hand_port() noexcept final { return this; }
 };
 
 }  // namespace calligraphy

@@ -17,8 +17,8 @@
 /// `kMaxSubstepsPerAdvance` substeps are taken per call; the time left after them is integrated with the
 /// exact solution of the damped mass under the force held constant (see `advance`).
 #include "calligraphy/devices/device_registry.hpp"
+#include "calligraphy/devices/hand_port.hpp"
 #include "calligraphy/devices/haptic_device.hpp"
-#include "calligraphy/sim/hand_port.hpp"
 
 namespace calligraphy {
 
@@ -48,7 +48,7 @@ struct SimulatedDeviceParameters {
   void validate() const;
 };
 
-class SimulatedDevice final : public HapticDevice, public HandPort {
+class SimulatedDevice final : public HandDrivenDevice {
  public:
   explicit SimulatedDevice(const SimulatedDeviceParameters& parameters = {});
 
@@ -73,7 +73,10 @@ class SimulatedDevice final : public HapticDevice, public HandPort {
   [[nodiscard]] bool is_open() const override { return open_; }
   void enable_forces(bool enabled) override;
   [[nodiscard]] bool forces_enabled() const override { return forces_enabled_; }
-  /// Never faults: always `DeviceFault::none` (also before open(), for tests and tools).
+  /// `DeviceFault::none` (also before open(), for tests and tools), except one misuse: with a hand attached,
+  /// a read that follows a read and a `write_force` with no `advance` between them returns
+  /// `DeviceFault::not_advanced` and turns forces off (the program forgot to let time pass: the pen would
+  /// stay at rest while the hand writes). The tick order is read_state, write_force, advance(dt_s).
   [[nodiscard]] DeviceFault read_state(DeviceState& state) noexcept override;
   /// Never faults: always `DeviceFault::none`. Saturates at info().max_force_n keeping the direction;
   /// a non-finite force, or any force while forces are disabled, applies zero force.
@@ -99,16 +102,15 @@ class SimulatedDevice final : public HapticDevice, public HandPort {
   Vec3 reported_velocity_ = Vec3::Zero();
   double last_read_time_ = 0.0;
   bool read_before_ = false;
+  bool read_since_advance_ = false;  // read_state since the last advance
+  bool written_since_read_ = false;  // write_force after that read
 
   void integrate_exactly(double duration_s);
 };
 
-/// Registers a `SimulatedDevice` with default parameters as "simulated" in `registry`; nothing when a
-/// backend of that name is already there. Thread-safe.
+/// Registers a `SimulatedDevice` with default parameters as "simulated" in `registry` (one of the standard
+/// backends, `register_standard_device_backends`); nothing when a backend of that name is already there.
+/// Thread-safe.
 void register_simulated_device(DeviceRegistry& registry);
-
-/// The process-wide `device_registry()` with the simulated device registered: the registry that
-/// `calligraphy trial --device NAME` and the by-name trial runner use.
-[[nodiscard]] DeviceRegistry& device_registry_with_simulation();
 
 }  // namespace calligraphy

@@ -1,4 +1,4 @@
-#include "calligraphy/sim/simulated_device.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 
 #include <algorithm>
 #include <array>
@@ -10,7 +10,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/devices/phantom_models.hpp"
-#include "calligraphy/render/force_law.hpp"
+#include "calligraphy/core/force_limits.hpp"
 
 namespace calligraphy {
 
@@ -73,7 +73,8 @@ void SimulatedDevice::enable_forces(bool enabled) {
 }
 
 DeviceFault SimulatedDevice::write_force(const Vec3& force_n) noexcept {
-  force_ = forces_enabled_ ? clamp_force(force_n, parameters_.info.max_force_n) : Vec3::Zero();
+  force_ = forces_enabled_ ? clamp_force_magnitude(force_n, parameters_.info.max_force_n) : Vec3::Zero();
+  written_since_read_ = read_since_advance_;
   return DeviceFault::none;
 }
 
@@ -84,6 +85,8 @@ void SimulatedDevice::advance(double dt_s) {
     throw InvalidArgument(std::string("SimulatedDevice::advance: dt_s = ") + number.data() +
                           " must be finite and >= 0 s");
   }
+  read_since_advance_ = false;
+  written_since_read_ = false;
   if (dt_s == 0.0) return;
   const double m = parameters_.moving_mass_kg;
   const double b = parameters_.damping_n_s_per_m;
@@ -153,6 +156,14 @@ void SimulatedDevice::integrate_exactly(double duration_s) {
 }
 
 DeviceFault SimulatedDevice::read_state(DeviceState& state) noexcept {
+  // A held pen read, commanded and read again with no advance() between: the program forgot to let time
+  // pass, and the pen would sit still while the hand "writes". Refused, so it cannot go unnoticed.
+  if (hand_ != nullptr && read_since_advance_ && written_since_read_) {
+    enable_forces(false);
+    return DeviceFault::not_advanced;
+  }
+  read_since_advance_ = true;
+  written_since_read_ = false;
   const double q = parameters_.encoder_resolution_m;
   Vec3 quantised = position_;
   if (q > 0.0) quantised = (position_ / q).array().round().matrix() * q;
@@ -175,13 +186,9 @@ DeviceFault SimulatedDevice::read_state(DeviceState& state) noexcept {
 
 void register_simulated_device(DeviceRegistry& registry) {
   registry.register_device_if_absent("simulated", SimulatedDevice{}.info(),
-                                     [] { return std::make_unique<SimulatedDevice>(); });
-}
-
-DeviceRegistry& device_registry_with_simulation() {
-  DeviceRegistry& registry = device_registry();
-  register_simulated_device(registry);
-  return registry;
+                                     [] { return std::make_unique<SimulatedDevice>(); },
+                                     DeviceCapabilities{.moved_by_simulated_hand = true},
+                                     "a point mass moved by a simulated hand; its time passes on advance()");
 }
 
 }  // namespace calligraphy

@@ -4,7 +4,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/devices/phantom_models.hpp"
 #include "calligraphy/testing/emulated_phantom.hpp"
-#include "sim/testing/phantom_emulator.hpp"
+#include "testing/phantom_emulator.hpp"
 
 namespace calligraphy::testing {
 namespace {
@@ -29,7 +29,8 @@ std::unique_ptr<HapticDevice> make_emulated_phantom() {
 
 void register_emulated_phantom(DeviceRegistry& registry) {
   registry.register_device_if_absent(
-      "emulated-phantom", emulated_info(), make_emulated_phantom, false,
+      "emulated-phantom", emulated_info(), make_emulated_phantom,
+      DeviceCapabilities{.moved_by_simulated_hand = true, .needs_calibration = true},
       "PhantomEmulator over an in-memory link, through the real PhantomDevice "
       "code path; starts docked, leaves the inkwell after 50 ms of emulated time");
 }
