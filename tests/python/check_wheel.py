@@ -1,19 +1,23 @@
 """The wheel installs into a virtual environment and imports from there: packs the build's package
 (bindings/python/make_wheel.py), makes a venv of the build interpreter with its site packages (numpy,
 pandas from Debian), `pip install --no-index` the wheel, and in the venv's interpreter imports calligraphy
-from the venv, runs a trial of 十, and finds the R script of the mixed models beside the package. Then checks
+from the venv, runs a trial of 十, finds the R script of the mixed models beside the package, and runs binding
+tests (VENV_TESTS) with the venv's interpreter on the installed package. Then checks
 that a venv without numpy refuses the wheel naming numpy, offline. Exit 0 or 1 (77: venv or pip missing).
 
     python3 check_wheel.py --build BUILD --version 0.1.0
 """
 
 import argparse
+import os
 import pathlib
 import subprocess
 import sys
 import tempfile
 
 SOURCE = pathlib.Path(__file__).resolve().parents[2]
+# Binding tests that need only the installed package (no build tree, no CLI), run inside the venv.
+VENV_TESTS = ("test_sim.py", "test_scene.py", "test_force_law.py", "test_renderer.py", "test_run_trial.py", "test_logging.py")
 
 
 def run(command, **options):
@@ -57,6 +61,13 @@ def main() -> int:
         location, script, strokes = probe.stdout.split("\n")[:3]
         assert pathlib.Path(location).is_relative_to(env.resolve()), location  # the venv's, not Debian's copy
         assert script == "True" and strokes == "2 2", probe.stdout
+        # The binding tests that need no build tree, run by the venv's interpreter on the installed package
+        # (conftest.py checks that `calligraphy` comes from the venv, not from a build or Debian's folders).
+        tested = run([env / "bin/python", "-m", "pytest", "-q", "-p", "no:cacheprovider",
+                      *(SOURCE / "tests/python" / name for name in VENV_TESTS)],
+                     cwd=folder, env={**os.environ, "PYTHONPATH": "", "CALLIGRAPHY_EXPECT_PACKAGE_UNDER": str(env)})
+        assert tested.returncode == 0, tested.stdout[-3000:] + tested.stderr[-2000:]
+        passed = tested.stdout.strip().splitlines()[-1]
         uninstalled = run([env / "bin/pip", "uninstall", "--yes", "--quiet", "calligraphy"])
         assert uninstalled.returncode == 0, uninstalled.stderr
 
@@ -64,8 +75,8 @@ def main() -> int:
         assert run([sys.executable, "-m", "venv", bare]).returncode == 0
         refused = run([bare / "bin/pip", "install", "--no-index", wheel])
         assert refused.returncode != 0 and "numpy" in refused.stdout + refused.stderr, refused.stderr
-    print(f"wheel {wheel.name}: installed into a venv, imported from it, a trial of 十 written; a venv without "
-          "numpy refuses it naming numpy")
+    print(f"wheel {wheel.name}: installed into a venv, imported from it, a trial of 十 written, the binding tests "
+          f"{', '.join(VENV_TESTS)} in the venv: {passed}; a venv without numpy refuses it naming numpy")
     return 0
 
 

@@ -24,6 +24,17 @@ def pytest_collection_finish(session):
         )
 
 
+def pytest_sessionstart(session):
+    # check_wheel.py runs some of these tests in a venv: they must test the package installed there.
+    expected = os.environ.get("CALLIGRAPHY_EXPECT_PACKAGE_UNDER")
+    if expected:
+        import calligraphy
+
+        location = pathlib.Path(calligraphy.__file__).resolve()
+        if not location.is_relative_to(pathlib.Path(expected).resolve()):
+            raise pytest.UsageError(f"calligraphy imported from {location}, not from {expected}")
+
+
 @pytest.fixture(scope="session")
 def cli():
     path = os.environ.get("CALLIGRAPHY_CLI")
