@@ -41,7 +41,7 @@ class WriterErrorInjector {
   /// The offset of the writer's copy of a character [m]: bias_offset_m in a direction drawn (one draw).
   [[nodiscard]] Vec2 draw_character_offset(std::mt19937_64& rng) const;
   /// The writer's order of a character's `stroke_count` strokes: the reference order, each stroke swapped
-  /// with the next at order_error_probability (one draw per stroke not swapped already).
+  /// with the next at order_error_probability (one draw at each stroke a swap could still start at).
   [[nodiscard]] std::vector<std::size_t> draw_stroke_order(std::size_t stroke_count,
                                                            std::mt19937_64& rng) const;
   /// Whether the writer means a stroke backwards, at backwards_probability (one draw).

@@ -55,7 +55,8 @@ class WriterPlanner {
   [[nodiscard]] const std::vector<PlannedStroke>& plan() const noexcept { return plan_; }
   [[nodiscard]] const WriterLog& log() const noexcept { return log_; }
   [[nodiscard]] const OpenAttempt& attempt() const noexcept { return attempt_; }
-  /// The writer has finished (its plan written, or the display finished) or given up on the rest.
+  /// The writer has finished: its own plan written (a stroke given up on counts as written), or the
+  /// display finished.
   [[nodiscard]] bool done() const noexcept { return done_; }
   /// Past its last attempt at a stroke the writer moved on (docs/writer.md, "Give-up and retries"): it
   /// writes the rest of its own plan and no longer waits for, or yields to, the display.
