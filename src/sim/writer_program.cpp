@@ -1,6 +1,7 @@
 #include "sim/writer_program.hpp"
 
 #include <algorithm>
+#include <utility>
 
 namespace calligraphy::writer_detail {
 
@@ -58,6 +59,13 @@ Segment make_segment(SegmentKind kind, std::vector<Vec3> path, double speed_m_s,
     s.arc.push_back(s.arc.back() + (path[i] - path[i - 1]).norm());
   s.path = std::move(path);
   s.duration_s = std::max(minimum_s, s.arc.back() / speed_m_s);
+  return s;
+}
+
+Segment make_write_segment(std::vector<Vec3> path, double speed_m_s, double follow_from_m) {
+  Segment s = make_segment(SegmentKind::write, std::move(path), speed_m_s, kMinimumLeg_s);
+  s.steered = true;
+  s.follow_from_m = follow_from_m;
   return s;
 }
 

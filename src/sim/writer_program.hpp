@@ -10,6 +10,15 @@
 
 namespace calligraphy::writer_detail {
 
+// The segments' shortest durations and the hover (docs/writer.md, "Movement"): assumed figures of an
+// unhurried writer.
+constexpr double kTravelMinimum_s = 0.3;  // shortest pen-up move between strokes
+constexpr double kDescend_s = 0.2;        // quick descent to just above the start
+constexpr double kTouchDown_s = 0.3;      // gentle touch-down onto the paper
+constexpr double kLift_s = 0.2;           // lift at the end of a stroke
+constexpr double kMinimumLeg_s = 0.15;    // shortest leg of a stroke (between corners)
+constexpr double kHoverHeight_m = 0.002;  // descent ends this far above the paper
+
 enum class SegmentKind {
   travel,   // pen up, towards the next start
   descend,  // pen up to hovering above the start
@@ -54,6 +63,11 @@ struct Segment {
 
 /// A segment through `path` lasting max(minimum_s, length / speed_m_s) at speed factor 1.
 Segment make_segment(SegmentKind kind, std::vector<Vec3> path, double speed_m_s, double minimum_s);
+
+/// A steered write segment through `path` at `speed_m_s` (at least kMinimumLeg_s), follow-through beyond
+/// `follow_from_m` of its arc [m].
+Segment make_write_segment(std::vector<Vec3> path, double speed_m_s,
+                           double follow_from_m = std::numeric_limits<double>::infinity());
 
 /// Nearest point to `p` on the polyline `points` (at least one point) and the unit direction of the
 /// polyline there (zero for a single point).
