@@ -212,12 +212,14 @@ json guidance_record_json(const StudyCondition& condition, const PreparedGuidanc
 void apply_condition(const StudyCondition& condition, const TrialGuidance& guidance, TrialOptions& options) {
   // The renderer judges strokes as the quiz does.
   if (condition.mode == ConditionMode::quiz) options.force.acceptance = condition.quiz.acceptance;
-  if (condition.mode == ConditionMode::replay) {
-    options.force.teacher_trajectory = guidance.teacher;
-    if (condition.replay_max_lead_m) options.force.replay_max_lead_m = *condition.replay_max_lead_m;
+  if (auto* replay = std::get_if<ReplayGuidance>(&options.force.guidance_law)) {
+    replay->teacher_trajectory = guidance.teacher;
+    if (condition.replay_max_lead_m) replay->max_lead_m = *condition.replay_max_lead_m;
   }
-  if (condition.amplification_max_force_n)
-    options.force.amplification_max_force_n = *condition.amplification_max_force_n;
+  if (auto* amplification = std::get_if<ErrorAmplificationGuidance>(&options.force.guidance_law);
+      amplification && condition.amplification_max_force_n) {
+    amplification->max_force_n = *condition.amplification_max_force_n;
+  }
   if (condition.guidance_stiffness_n_per_m && options.force.guidance) {
     options.force.guidance_stiffness_n_per_m = *condition.guidance_stiffness_n_per_m;
   }

@@ -28,6 +28,25 @@ void fit_default_stiffness(ForceLawParameters& force, const DeviceInfo& device) 
   }
 }
 
+// The specification's mode with the parameters it sets; a replay's teacher is the runner's to add.
+GuidanceLaw guidance_law_of(const TrialSpec& spec) {
+  switch (spec.guidance_mode) {
+    case GuidanceMode::fixed:
+      break;
+    case GuidanceMode::fading:
+      return FadingGuidance{.gain = spec.guidance_gain};
+    case GuidanceMode::replay:
+      return ReplayGuidance{};
+    case GuidanceMode::assist_as_needed:
+      return AssistAsNeededGuidance{.band_m = spec.assist_band_m};
+    case GuidanceMode::error_amplification:
+      return ErrorAmplificationGuidance{.gain = spec.amplification_gain};
+    case GuidanceMode::timing:
+      return TimingGuidance{.speed_m_s = spec.timing_speed_m_s};
+  }
+  return FixedGuidance{};
+}
+
 WriterProfile profile_of(const TrialSpec& spec) {
   WriterProfile profile = writer_profile(spec.writer_profile);
   for (const std::string& setting : spec.writer_parameters) apply_writer_setting(profile, setting);
@@ -41,11 +60,7 @@ TrialOptions trial_options(const TrialSpec& spec, const DeviceInfo& device) {
   spec.validate(spec.teacher.empty() ? TeacherSource::samples : TeacherSource::file);
   TrialOptions options;
   options.force.guidance = spec.guidance;
-  options.force.guidance_mode = spec.guidance_mode;
-  options.force.guidance_gain = spec.guidance_gain;
-  options.force.assist_band_m = spec.assist_band_m;
-  options.force.amplification_gain = spec.amplification_gain;
-  options.force.timing_speed_m_s = spec.timing_speed_m_s;
+  options.force.guidance_law = guidance_law_of(spec);
   fit_default_stiffness(options.force, device);
   options.rate_hz = spec.rate_hz;
   options.pacing = spec.pacing;
@@ -106,7 +121,8 @@ TrialRun run_trial_spec(const TrialSpec& spec, const Scene& scene, const TrialRu
   run.simulated_writer = simulated_writer_writes(spec, dynamic_cast<HandPort*>(device) != nullptr);
 
   run.options = trial_options(spec, run.device);
-  if (spec.guidance_mode == GuidanceMode::replay) run.options.force.teacher_trajectory = std::move(teacher);
+  if (auto* replay = std::get_if<ReplayGuidance>(&run.options.force.guidance_law))
+    replay->teacher_trajectory = std::move(teacher);
   run.options.should_stop = inputs.should_stop;
   if (inputs.adjust) inputs.adjust(run.options);
   run.options.validate();

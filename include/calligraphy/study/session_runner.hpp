@@ -15,7 +15,7 @@
 
 #include "calligraphy/devices/device_registry.hpp"
 #include "calligraphy/model/character.hpp"
-#include "calligraphy/render/guidance_mode.hpp"
+#include "calligraphy/render/guidance_law.hpp"
 #include "calligraphy/study/schedule.hpp"
 #include "calligraphy/study/session_folder.hpp"
 #include "calligraphy/study/trial_spec.hpp"
@@ -86,7 +86,7 @@ struct SessionRunResult {
 /// session folder.
 struct TrialGuidance {
   double gain = 1.0;  ///< `fading`: the trial's gain in [0, 1] (ForceLawParameters)
-  double band_m = ForceLawParameters{}.assist_band_m;  ///< `assist-as-needed`: the trial's band [m] >= 0
+  double band_m = AssistAsNeededGuidance{}.band_m;  ///< `assist-as-needed`: the trial's band [m] >= 0
   /// `skill-adaptive`: the mode chosen for the trial (fixed or error amplification); nullopt: fixed.
   std::optional<GuidanceMode> mode;
   std::vector<TeacherSample> teacher;  ///< `replay`: the teacher's pen, device frame [m], times [s]
