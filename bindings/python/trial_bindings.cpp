@@ -283,11 +283,9 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   }
   inputs.writer = simulation.writer;
   if (const auto* replay = std::get_if<ReplayGuidance>(&law)) inputs.teacher = replay->teacher_trajectory;
-  inputs.adjust = [&options](TrialOptions& run_options) {
-    run_options.force = options.force;  // the force law as given (no stiffness fitted to the device)
-    run_options.safety = options.safety;
-    run_options.passivity = options.passivity;
-  };
+  inputs.force_law = options.force;  // the force law as given (no stiffness fitted to the device)
+  inputs.safety = options.safety;
+  inputs.passivity = options.passivity;
   // Ctrl-C: the trial runs without the GIL; every 50 ms of wall clock the runner's thread takes the GIL
   // and lets Python run its signal handlers. A KeyboardInterrupt (or any exception a handler raises)
   // ends the trial at the next tick and is raised once the device is shut down.

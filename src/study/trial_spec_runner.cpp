@@ -121,10 +121,25 @@ TrialRun run_trial_spec(const TrialSpec& spec, const Scene& scene, const TrialRu
   run.simulated_writer = simulated_writer_writes(spec, dynamic_cast<HandPort*>(device) != nullptr);
 
   run.options = trial_options(spec, run.device);
+  if (inputs.force_law) {
+    const bool same_guidance =
+        inputs.force_law->guidance == spec.guidance &&
+        (!spec.guidance || mode_of(inputs.force_law->guidance_law) == spec.guidance_mode);
+    if (!same_guidance) {
+      throw InvalidArgument(
+          std::string("trial inputs: the force law's guidance (") +
+          (inputs.force_law->guidance ? to_string(mode_of(inputs.force_law->guidance_law)) : "off") +
+          ") is not the specification's (" + (spec.guidance ? to_string(spec.guidance_mode) : "off") + ")");
+    }
+    run.options.force = *inputs.force_law;
+  }
   if (auto* replay = std::get_if<ReplayGuidance>(&run.options.force.guidance_law))
     replay->teacher_trajectory = std::move(teacher);
+  if (inputs.safety) run.options.safety = *inputs.safety;
+  if (inputs.passivity) run.options.passivity = *inputs.passivity;
+  run.options.display = inputs.display;
+  run.options.loop.lock_memory = inputs.lock_memory;
   run.options.should_stop = inputs.should_stop;
-  if (inputs.adjust) inputs.adjust(run.options);
   run.options.validate();
 
   std::unique_ptr<SimulatedHand> hand;

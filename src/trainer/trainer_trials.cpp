@@ -54,13 +54,8 @@ void TrainerApp::start_trial(std::size_t character) {
   spec.watchdog_s = options_.watchdog_s.value_or(default_watchdog_s(hardware_));
   TrialRunInputs inputs;
   inputs.teacher = options_.teacher;
-  DisplayChannel* const channel = channel_.get();
-  inputs.adjust = [channel](TrialOptions& trial) {
-    // A window process maps memory all the time (the GL driver): mlockall(MCL_FUTURE) would lock all of
-    // it, or make its allocations fail under a memory-lock limit. The trace is touched in advance instead.
-    trial.loop.lock_memory = false;
-    trial.display = channel;
-  };
+  inputs.display = channel_.get();
+  inputs.lock_memory = false;                          // a window process (TrialRunInputs::lock_memory)
   trial_options_ = trial_options(spec, DeviceInfo{});  // what the view needs before the device is open
   trial_simulation_.writer = writer_profile(spec.writer_profile);
   trial_simulation_.seed = spec.seed;

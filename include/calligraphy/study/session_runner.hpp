@@ -63,9 +63,10 @@ struct SessionRunOptions {
   /// Overrides the session's pacing for this run (e.g. a session begun in real time resumed lock-step);
   /// nullopt: the pacing in session.json.
   std::optional<TrialPacing> pacing;
-  /// Called with each trial's options just before the trial runs, on the runner's thread, to add what
-  /// only the caller has (a window's display channel, TrialOptions::display; memory locking off in a
-  /// window process); empty: the options are used as `study_trial_options` made them.
+  /// The one per-trial host hook: called with each trial's options (the specification's on the session's
+  /// device, with the condition's force law) before the trial runs, on the runner's thread, to add what only
+  /// the host has: a window's display channel (TrialOptions::display) and memory locking off in a window
+  /// process (ServoLoopOptions::lock_memory); these two are taken from it. Empty: neither.
   std::function<void(const PlannedTrial&, TrialOptions&)> prepare_trial;
 };
 
