@@ -86,22 +86,22 @@ TEST_CASE("Fading scales F_et by its gain and the fixed mode ignores the gain", 
   const Vec2 full = guidance_at_offset(fixed);
   REQUIRE(full.norm() > 0.1);
   ForceLawParameters fading = fixed;
-  fading.guidance_mode = GuidanceMode::fading;
+  fading.guidance_law = default_guidance_law(GuidanceMode::fading);
   for (const double gain : {0.0, 0.25, 0.5, 1.0}) {
-    fading.guidance_gain = gain;
+    std::get<FadingGuidance>(fading.guidance_law).gain = gain;
     const Vec2 faded = guidance_at_offset(fading);
     CHECK(faded.x() == Approx(gain * full.x()).margin(1e-12));
     CHECK(faded.y() == Approx(gain * full.y()).margin(1e-12));
   }
-  fixed.guidance_gain = 0.25;  // not the fading mode: the paper's fixture at full strength
+  // A fixed law has no gain to apply: the paper's fixture at full strength.
   CHECK(guidance_at_offset(fixed).y() == Approx(full.y()));
 }
 
 TEST_CASE("The guidance gain and the fading rule are validated", "[guidance]") {
   ForceLawParameters p;
-  p.guidance_gain = 1.5;
-  CHECK_THROWS_WITH(p.validate(), Catch::Contains("guidance_gain"));
-  p.guidance_gain = -0.1;
+  p.guidance_law = FadingGuidance{.gain = 1.5};
+  CHECK_THROWS_WITH(p.validate(), Catch::Contains("FadingGuidance.gain"));
+  p.guidance_law = FadingGuidance{.gain = -0.1};
   CHECK_THROWS_AS(p.validate(), InvalidArgument);
   CHECK_THROWS_WITH(next_guidance_gain(1.2, 0.0), Catch::Contains("gain"));
   CHECK_THROWS_WITH(next_guidance_gain(0.5, -1e-3), Catch::Contains("error_m"));
@@ -165,34 +165,36 @@ TEST_CASE("A bad teacher trajectory is refused naming the sample or the stroke",
   CHECK_THROWS_WITH(TeacherReplay(scene, short_of_the_end, ForceLawParameters{}),
                     Catch::Contains("stroke 0"));
   ForceLawParameters replay;
-  replay.guidance_mode = GuidanceMode::replay;  // without a trajectory
+  replay.guidance_law = default_guidance_law(GuidanceMode::replay);  // without a trajectory
   CHECK_THROWS_AS(Renderer(scene, replay, simulated_phantom_desktop_info()), InvalidArgument);
 }
 
 TEST_CASE("In the replay mode the attraction point moves at the teacher's pace", "[guidance]") {
   const Scene scene = horizontal_stroke_scene();
   ForceLawParameters force = exact();
-  force.guidance_mode = GuidanceMode::replay;
-  force.teacher_trajectory = straight_teacher(scene);
+  force.guidance_law = default_guidance_law(GuidanceMode::replay);
+  std::get<ReplayGuidance>(force.guidance_law).teacher_trajectory = straight_teacher(scene);
   Renderer r(scene, force, simulated_phantom_desktop_info(), exact_options());
   const double z = scene.layout.paper_z_m - 0.0005;
   const double entered = 10.0;
   r.tick(device_state_at(scene, {200, 600}, z, entered));  // WS at the start; the replay clock starts
   // The pen stays at the start; the teacher moves right at 50 mm/s, so the pull along +x grows as
-  // 50 mm/s * t * K_et until the spring saturates at K_et replay_max_lead_m (3 mm: after 60 ms).
+  // 50 mm/s * t * K_et until the spring saturates at K_et max_lead_m (3 mm: after 60 ms).
   double previous = 0.0;
   for (const double t : {0.02, 0.04, 0.05, 0.07}) {
     const RenderOutput out = r.tick(device_state_at(scene, {200, 600}, z, entered + t));
     REQUIRE(out.state == InteractionState::writing);
-    const double expected = force.guidance_stiffness_n_per_m * std::min(0.05 * t, force.replay_max_lead_m);
+    const double expected = force.guidance_stiffness_n_per_m *
+                            std::min(0.05 * t, std::get<ReplayGuidance>(force.guidance_law).max_lead_m);
     CHECK(out.force_n.x() >= previous);
     CHECK(out.force_n.x() == Approx(expected).epsilon(0.1));
     CHECK(std::abs(out.force_n.y()) < 1e-6);
     previous = out.force_n.x();
   }
   const RenderOutput late = r.tick(device_state_at(scene, {200, 600}, z, entered + 5.0));
-  CHECK(late.force_n.head<2>().norm() <=
-        force.guidance_stiffness_n_per_m * force.replay_max_lead_m * (1.0 + 1e-9));
+  CHECK(late.force_n.head<2>().norm() <= force.guidance_stiffness_n_per_m *
+                                             std::get<ReplayGuidance>(force.guidance_law).max_lead_m *
+                                             (1.0 + 1e-9));
 }
 
 TEST_CASE("Off-stroke resistance: friction in CS, a damper on leaving the element in WS, under guidance only",
@@ -239,9 +241,10 @@ TEST_CASE("A novice guided by a skilled teacher's replay writes every stroke in 
   REQUIRE(recorded.metrics.completed_in_order);
   WriterTrialOptions student;
   student.seed = 4;
-  student.force.guidance_mode = GuidanceMode::replay;
+  student.force.guidance_law = default_guidance_law(GuidanceMode::replay);
   for (const TrialSample& s : recorded.trace)
-    student.force.teacher_trajectory.push_back({s.time_s, s.position_m});
+    std::get<ReplayGuidance>(student.force.guidance_law)
+        .teacher_trajectory.push_back({s.time_s, s.position_m});
   const WriterTrial replayed = run_writer_trial(scene, student);
   CHECK(replayed.metrics.completed_in_order);
   WriterTrialOptions unguided = student;

@@ -22,7 +22,7 @@ namespace {
 // The force law alone: no smoothing, ramp, rate limit, friction or resistance.
 ForceLawParameters exact(GuidanceMode mode) {
   ForceLawParameters p;
-  p.guidance_mode = mode;
+  p.guidance_law = default_guidance_law(mode);
   p.constraint_taper_m = 0.0;
   p.crossfade_s = 0.0;
   p.paper_fade_s = 0.0;
@@ -61,10 +61,10 @@ TEST_CASE("Assist-as-needed leaves the band to the writer and is continuous at i
   const Vec2 fixed = force_at(exact(GuidanceMode::fixed), 400, 30);
   REQUIRE(fixed.norm() > 0.1);
   ForceLawParameters assist = exact(GuidanceMode::assist_as_needed);
-  assist.assist_band_m = 1.2 * offset_m;
+  std::get<AssistAsNeededGuidance>(assist.guidance_law).band_m = 1.2 * offset_m;
   CHECK(force_at(assist, 400, 30).norm() == Approx(0.0).margin(1e-12));  // within the band
   for (const double share : {0.0, 0.25, 0.5, 0.999}) {
-    assist.assist_band_m = share * offset_m;
+    std::get<AssistAsNeededGuidance>(assist.guidance_law).band_m = share * offset_m;
     const Vec2 f = force_at(assist, 400, 30);
     // K a (d - b): the fixture's force scaled by the deviation beyond the band, in the same direction.
     CHECK(f.y() == Approx((1.0 - share) * fixed.y()).margin(1e-9));
@@ -75,17 +75,17 @@ TEST_CASE("Assist-as-needed leaves the band to the writer and is continuous at i
 TEST_CASE("Error amplification pushes off the stroke and stays within its bound", "[guidance]") {
   const Vec2 fixed = force_at(exact(GuidanceMode::fixed), 400, 30);
   ForceLawParameters amplify = exact(GuidanceMode::error_amplification);
-  amplify.amplification_max_force_n = 10.0;
+  std::get<ErrorAmplificationGuidance>(amplify.guidance_law).max_force_n = 10.0;
   for (const double gain : {0.0, 0.25, 1.0}) {
-    amplify.amplification_gain = gain;
+    std::get<ErrorAmplificationGuidance>(amplify.guidance_law).gain = gain;
     const Vec2 f = force_at(amplify, 400, 30);
     CHECK(f.y() == Approx(-gain * fixed.y()).margin(1e-9));  // away from the stroke
   }
-  amplify.amplification_gain = 1.0;
-  amplify.amplification_max_force_n = 0.1;
+  std::get<ErrorAmplificationGuidance>(amplify.guidance_law).gain = 1.0;
+  std::get<ErrorAmplificationGuidance>(amplify.guidance_law).max_force_n = 0.1;
   CHECK(force_at(amplify, 400, 30).norm() == Approx(0.1).epsilon(1e-9));
   // Below the stroke the push is downwards: the deviation's side.
-  amplify.amplification_max_force_n = 10.0;
+  std::get<ErrorAmplificationGuidance>(amplify.guidance_law).max_force_n = 10.0;
   CHECK(force_at(amplify, 400, -30).y() < 0.0);
   CHECK(force_at(amplify, 400, 30).y() > 0.0);
 }
@@ -93,7 +93,7 @@ TEST_CASE("Error amplification pushes off the stroke and stays within its bound"
 TEST_CASE("Timing guidance pulls along the stroke only, towards a target that moves at its pace",
           "[guidance]") {
   ForceLawParameters timing = exact(GuidanceMode::timing);
-  timing.timing_speed_m_s = 0.04;
+  std::get<TimingGuidance>(timing.guidance_law).speed_m_s = 0.04;
   // Just after touch-down the target is at the start: a pen further on is pulled back along the stroke, never
   // sideways however far off it is.
   const Vec2 early = force_at(timing, 400, 30, 0.001);
@@ -103,7 +103,8 @@ TEST_CASE("Timing guidance pulls along the stroke only, towards a target that mo
   const Vec2 late = force_at(timing, 400, 30, 100.0);
   CHECK(late.x() > 0.0);
   CHECK(late.y() == Approx(0.0).margin(1e-12));
-  CHECK(late.norm() <= timing.guidance_stiffness_n_per_m * timing.replay_max_lead_m + 1e-12);
+  CHECK(late.norm() <=
+        timing.guidance_stiffness_n_per_m * std::get<TimingGuidance>(timing.guidance_law).max_lead_m + 1e-12);
 }
 
 TEST_CASE("The timing target follows a minimum-jerk profile over the stroke's length at the mean speed",
@@ -180,9 +181,12 @@ TEST_CASE("Every new schedule writes held-out characters within the force-step l
     WriterTrialOptions options;
     options.seed = 3;
     options.rate_hz = trial_case.rate_hz;
-    options.force.guidance_mode = trial_case.mode;
-    options.force.assist_band_m = 0.0015;
-    options.force.amplification_gain = 0.5;  // twice the default: a harder push than the schedule uses
+    options.force.guidance_law = default_guidance_law(trial_case.mode);
+    if (auto* assist = std::get_if<AssistAsNeededGuidance>(&options.force.guidance_law))
+      assist->band_m = 0.0015;
+    // Twice the default gain: a harder push than the schedule uses.
+    if (auto* amplify = std::get_if<ErrorAmplificationGuidance>(&options.force.guidance_law))
+      amplify->gain = 0.5;
     options.safety.max_force_change_n_per_tick = 0.0;  // the smoothing alone
     const WriterTrial trial = run_writer_trial(scene, options);
     double max_step = 0.0;

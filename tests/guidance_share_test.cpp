@@ -21,7 +21,7 @@ double shape_share(const ForceLawParameters& force, double hand_n_per_m, double 
 
 ForceLawParameters mode(GuidanceMode m) {
   ForceLawParameters force;
-  force.guidance_mode = m;
+  force.guidance_law = default_guidance_law(m);
   return force;
 }
 
@@ -37,7 +37,7 @@ TEST_CASE("Guidance takes the share of two springs, and off and timing take none
   CHECK(shape_share(off, kHand, 0.001) == 0.0);
   CHECK(shape_share(mode(GuidanceMode::timing), kHand, 0.001) == 0.0);
   ForceLawParameters fading = mode(GuidanceMode::fading);
-  fading.guidance_gain = 0.5;
+  std::get<FadingGuidance>(fading.guidance_law).gain = 0.5;
   CHECK(shape_share(fading, kHand, 0.001) == Approx(200.0 / 350.0));
 }
 
@@ -45,7 +45,8 @@ TEST_CASE("Along the stroke only timing and replay take a share, that of their s
   const double spring = 400.0 / 550.0;
   CHECK(guidance_shares(mode(GuidanceMode::timing), kHand, 0.001).timing == Approx(spring));
   ForceLawParameters replay = mode(GuidanceMode::replay);
-  replay.teacher_trajectory = {TeacherSample{}, TeacherSample{1.0, Vec3::Zero()}};
+  std::get<ReplayGuidance>(replay.guidance_law).teacher_trajectory = {TeacherSample{},
+                                                                      TeacherSample{1.0, Vec3::Zero()}};
   const AssistanceShares replayed = guidance_shares(replay, kHand, 0.001);
   CHECK(replayed.timing == Approx(spring));
   CHECK(replayed.shape == Approx(spring));
@@ -65,7 +66,7 @@ TEST_CASE("Along the stroke only timing and replay take a share, that of their s
 
 TEST_CASE("Assist-as-needed takes the share of the deviation beyond its band", "[memory]") {
   ForceLawParameters assist = mode(GuidanceMode::assist_as_needed);
-  assist.assist_band_m = 0.001;
+  std::get<AssistAsNeededGuidance>(assist.guidance_law).band_m = 0.001;
   const double full = shape_share(mode(GuidanceMode::fixed), kHand, 0.002);
   CHECK(shape_share(assist, kHand, 0.0005) == 0.0);  // within the band: the writer's own
   CHECK(shape_share(assist, kHand, 0.002) == Approx(0.5 * full));
@@ -76,15 +77,15 @@ TEST_CASE("Assist-as-needed takes the share of the deviation beyond its band", "
 TEST_CASE("Error amplification enlarges the error the writer learns from, within its force bound",
           "[memory]") {
   ForceLawParameters amplify = mode(GuidanceMode::error_amplification);
-  amplify.amplification_gain = 0.25;  // 100 N/m against the hand's 150
-  amplify.amplification_max_force_n = 1.0;
+  std::get<ErrorAmplificationGuidance>(amplify.guidance_law).gain = 0.25;  // 100 N/m against the hand's 150
+  std::get<ErrorAmplificationGuidance>(amplify.guidance_law).max_force_n = 1.0;
   // Unsaturated: k / (k - g K) = 3, a share of -2.
   CHECK(shape_share(amplify, kHand, 0.001) == Approx(-2.0));
   // Saturated at 0.3 N: 1 + F / (k e) = 1 + 0.3 / (150 x 0.004) = 1.5.
-  amplify.amplification_max_force_n = 0.3;
+  std::get<ErrorAmplificationGuidance>(amplify.guidance_law).max_force_n = 0.3;
   CHECK(shape_share(amplify, kHand, 0.004) == Approx(-0.5));
   // A field stiffer than the hand is held by its bound; never below the memory's guard.
-  amplify.amplification_gain = 1.0;
+  std::get<ErrorAmplificationGuidance>(amplify.guidance_law).gain = 1.0;
   CHECK(shape_share(amplify, kHand, 0.004) == Approx(-0.5));
   CHECK(shape_share(amplify, kHand, 0.0) == Approx(kMinAssistanceShare));
   CHECK(shape_share(amplify, kHand, std::nan("")) == 0.0);

@@ -36,9 +36,10 @@ std::vector<TeacherSample> teacher_of(const Scene& scene, double rate_hz) {
 
 ForceLawParameters mode_parameters(GuidanceMode mode, const Scene& scene, double rate_hz) {
   ForceLawParameters force;
-  force.guidance_mode = mode;
-  if (mode == GuidanceMode::fading) force.guidance_gain = 0.5;
-  if (mode == GuidanceMode::replay) force.teacher_trajectory = teacher_of(scene, rate_hz);
+  force.guidance_law = default_guidance_law(mode);
+  if (mode == GuidanceMode::fading) std::get<FadingGuidance>(force.guidance_law).gain = 0.5;
+  if (mode == GuidanceMode::replay)
+    std::get<ReplayGuidance>(force.guidance_law).teacher_trajectory = teacher_of(scene, rate_hz);
   return force;
 }
 
@@ -114,17 +115,18 @@ HoldRun hold_in_writing(GuidanceMode mode, Hand hand, double rate_hz, double sti
                                            : static_cast<HandModel*>(&weight));
   device.open();
   ForceLawParameters force;
-  force.guidance_mode = mode;
+  force.guidance_law = default_guidance_law(mode);
   force.guidance_stiffness_n_per_m = stiffness_n_per_m;
   if (mode == GuidanceMode::fading) {
-    force.guidance_gain = 0.5;
+    std::get<FadingGuidance>(force.guidance_law).gain = 0.5;
     force.guidance_stiffness_n_per_m = 2.0 * stiffness_n_per_m;  // the effective stiffness g K is the same
   }
   if (mode == GuidanceMode::replay) {
     // The teacher touches down at the start of the first stroke, moves 5 mm along it and stays there
     // past the test's end (a fixed attraction point that is not the foot point), then writes the
     // rest of that stroke and the others, so that the recording is complete.
-    force.teacher_trajectory = teacher_holding(scene, 0.005, seconds + 100.0);
+    std::get<ReplayGuidance>(force.guidance_law).teacher_trajectory =
+        teacher_holding(scene, 0.005, seconds + 100.0);
   }
   RendererOptions options;
   options.rate_hz = rate_hz;
@@ -243,7 +245,7 @@ TEST_CASE("Up to Colgate's bound a pen held in WS takes no growing energy in any
       // The timing target is not a fixed point: it moves along the stroke and drags the held pen after it,
       // so it may do work, but never more than its saturated pull (or the device's peak) over the stroke.
       static const Scene scene = scene_of(U'口');
-      const double pull_n = std::min(stiffness * ForceLawParameters{}.replay_max_lead_m, run.max_force_n);
+      const double pull_n = std::min(stiffness * kDefaultMaxLeadM, run.max_force_n);
       CHECK(run.max_energy_j <= pull_n * scene.characters[0].strokes[0].length_m());
     } else {
       CHECK(run.max_energy_j <= kBoundedEnergy_j);

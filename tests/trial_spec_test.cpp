@@ -261,3 +261,22 @@ TEST_CASE("the runner of a specification gives the simulated writer to the trial
   nowhere.device = "no-such-device";
   CHECK_THROWS_AS(run_trial_spec(nowhere, scene), DeviceNotFound);
 }
+
+TEST_CASE("the runner takes a force law made before the trial, whose guidance must be the specification's") {
+  TrialSpec spec;
+  spec.characters = "十";
+  spec.seed = 4;
+  spec.max_duration_s = 0.05;
+  const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'十')});
+  TrialRunInputs inputs;
+  ForceLawParameters force;
+  force.guidance_stiffness_n_per_m = 250.0;
+  inputs.force_law = force;
+  inputs.lock_memory = false;
+  const TrialRun run = run_trial_spec(spec, scene, inputs);
+  CHECK(run.options.force.guidance_stiffness_n_per_m == 250.0);
+  CHECK_FALSE(run.options.loop.lock_memory);
+  inputs.force_law->guidance_law = FadingGuidance{.gain = 0.5};
+  CHECK_THAT(error_of([&] { (void)run_trial_spec(spec, scene, inputs); }),
+             Catch::Contains("the force law's guidance (fading) is not the specification's (fixed)"));
+}

@@ -12,8 +12,10 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <type_traits>
+#include <variant>
 #include <vector>
 
 #include "arguments.hpp"
@@ -113,12 +115,76 @@ class ParameterClass {
     return *this;
   }
 
+  /// Adds field `name` holding one of several parameter classes bound before (a std::variant of them, e.g.
+  /// ForceLawParameters::guidance_law): read as a copy of the alternative held (assign a new one to change
+  /// it), set with an instance of any alternative or a dict of its fields with "law" naming its class
+  /// (what to_dict gives).
+  template <typename... Alternatives>
+  ParameterClass& variant_field(const char* name, std::variant<Alternatives...> S::*member,
+                                const std::string& doc) {
+    using V = std::variant<Alternatives...>;
+    Field f;
+    f.name = name;
+    const std::string qualified = name_ + "." + name;
+    std::string type = "Union[";
+    ((type += python_type_name<Alternatives>() + ", "), ...);
+    f.type = type.substr(0, type.size() - 2) + "]";
+    const std::string expected = f.type;
+    const auto convert = [qualified, expected](py::handle v) -> V {
+      if (py::isinstance<py::dict>(v)) {
+        py::dict fields = py::reinterpret_borrow<py::dict>(v).attr("copy")();
+        const std::string law = fields.contains("law") ? std::string(py::str(fields.attr("pop")("law"))) : "";
+        std::optional<V> out;
+        ((law == python_type_name<Alternatives>()
+              ? void(out = V(py::type::of<Alternatives>()(**fields).template cast<Alternatives>()))
+              : void()),
+         ...);
+        if (!out) throw py::type_error(qualified + ": a dict needs \"law\", one of " + expected);
+        return *out;
+      }
+      std::optional<V> out;
+      ((!out && py::isinstance<Alternatives>(v) ? void(out = V(v.cast<Alternatives>())) : void()), ...);
+      if (!out) throw_type_error(qualified, expected, v);
+      return *out;
+    };
+    f.set = [member, convert](S& s, py::handle v) { s.*member = convert(v); };
+    f.repr = [member](const S& s) {
+      return std::visit([](const auto& law) { return std::string(py::repr(py::cast(law))); }, s.*member);
+    };
+    f.to_python = [member](const S& s) {
+      return std::visit(
+          [](const auto& law) {
+            py::object object = py::cast(law);
+            py::dict out;
+            out["law"] = object.get_type().attr("__name__");
+            for (const auto item : py::dict(object.attr("to_dict")())) out[item.first] = item.second;
+            return py::object(out);
+          },
+          s.*member);
+    };
+    f.equal = [member](const S& a, const S& b) { return a.*member == b.*member; };
+    auto shared = shared_;
+    cls_.def_property(
+        name,
+        [member](const S& s) { return std::visit([](const auto& law) { return py::cast(law); }, s.*member); },
+        [member, convert, shared](S& s, const py::object& v) {
+          S copy = s;
+          copy.*member = convert(v);
+          shared->validate(copy);
+          s = copy;
+        },
+        (doc + " One of " + expected + "; a copy: assign a new one to change it.").c_str());
+    shared_->fields.push_back(std::move(f));
+    return *this;
+  }
+
   /// Adds the constructor and the generic methods; returns the class for further definitions.
   py::class_<S>& finish() {
     auto shared = shared_;
     const std::string name = name_;
     const S defaults{};
-    std::string signature = "__init__(self: " + name + ", *";
+    // A class without fields (FixedGuidance) takes no arguments: a bare "*" is not a Python signature.
+    std::string signature = "__init__(self: " + name + (shared->fields.empty() ? "" : ", *");
     for (const Field& f : shared->fields)
       signature += ", " + f.name + ": " + f.type + " = " + f.repr(defaults);
     signature += ") -> None";

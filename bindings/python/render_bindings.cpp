@@ -5,6 +5,7 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -13,7 +14,7 @@
 #include "bindings.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/render/force_law.hpp"
-#include "calligraphy/render/guidance_mode.hpp"
+#include "calligraphy/render/guidance_law.hpp"
 #include "calligraphy/render/interaction_state.hpp"
 #include "calligraphy/render/renderer.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
@@ -28,18 +29,21 @@ void bind_guidance(py::module_& m) {
   py::enum_<GuidanceMode>(m, "GuidanceMode", "How F_et attracts (docs/force-rendering.md, Guidance modes).")
       .value("fixed", GuidanceMode::fixed, "eq. (8): the paper's fixed virtual fixture")
       .value("fading", GuidanceMode::fading,
-             "eq. (8) scaled by guidance_gain (Marchal-Crespo & Reinkensmeyer)")
+             "eq. (8) scaled by FadingGuidance.gain (Marchal-Crespo & Reinkensmeyer)")
       .value(
           "replay", GuidanceMode::replay,
           "the attraction point follows a teacher's recording in time (Henmi & Yoshikawa 1998; Feygin et al. "
           "2002)")
       .value("assist_as_needed", GuidanceMode::assist_as_needed,
-             "eq. (8) on the deviation beyond assist_band_m only (Emken, Bobrow & Reinkensmeyer 2005)")
+             "eq. (8) on the deviation beyond AssistAsNeededGuidance.band_m only (Emken, Bobrow & "
+             "Reinkensmeyer 2005)")
       .value("error_amplification", GuidanceMode::error_amplification,
-             "a bounded repulsive field, amplification_gain x eq. (8) turned round (Patton et al. 2006)")
-      .value("timing", GuidanceMode::timing,
-             "a minimum-jerk target along the stroke at timing_speed_m_s, pulling along the stroke only "
-             "(Flash & Hogan 1985)");
+             "a bounded repulsive field, ErrorAmplificationGuidance.gain x eq. (8) turned round (Patton et "
+             "al. 2006)")
+      .value(
+          "timing", GuidanceMode::timing,
+          "a minimum-jerk target along the stroke at TimingGuidance.speed_m_s, pulling along the stroke only "
+          "(Flash & Hogan 1985)");
   py::class_<TeacherSample>(m, "TeacherSample", "One sample of a teacher's recorded pen.")
       .def(py::init([](double time_s, const py::object& position_m) {
              return TeacherSample{time_s, as_vec3(position_m, "position_m")};
@@ -121,6 +125,73 @@ GuidanceMode.fixed at or above rule.threshold_m, else GuidanceMode.error_amplifi
 Raises InvalidArgument (a ValueError) for a negative error or a bad rule.)");
 }
 
+// A single law is checked as far as it can be alone: a moving target's lead against the constraint radius,
+// and a replay's teacher once it has one, are ForceLawParameters.validate()'s.
+void validate_alone(const GuidanceLaw& law) {
+  GuidanceLaw probe = law;
+  if (auto* replay = std::get_if<ReplayGuidance>(&probe); replay && replay->teacher_trajectory.empty())
+    replay->teacher_trajectory = {TeacherSample{}, TeacherSample{}};
+  validate_guidance_law(probe, std::numeric_limits<double>::infinity());
+}
+
+void bind_guidance_laws(py::module_& m) {
+  const auto check = [](const auto& law) { validate_alone(law); };
+  ParameterClass<FixedGuidance>(m, "FixedGuidance",
+                                "The fixed guidance law: the paper's virtual fixture, eq. (8); no parameter.",
+                                check)
+      .finish();
+  ParameterClass<FadingGuidance>(
+      m, "FadingGuidance", "The fading guidance law: eq. (8) scaled by a gain (next_guidance_gain).", check)
+      .field("gain", &FadingGuidance::gain, "g on F_et, in [0, 1]")
+      .finish();
+  ParameterClass<ReplayGuidance>(
+      m, "ReplayGuidance",
+      "The replay guidance law: the attraction point follows a teacher's recorded pen in time.", check)
+      .field("max_lead_m", &ReplayGuidance::max_lead_m,
+             "the lead at which the spring to the teacher's point saturates [m], in (0, constraint_radius_m]")
+      .finish()
+      // Not a ParameterClass field (a list, not a value): not in to_dict() or the constructor.
+      .def_property(
+          "teacher_trajectory", [](const ReplayGuidance& g) { return g.teacher_trajectory; },
+          [](ReplayGuidance& g, const std::vector<TeacherSample>& samples) {
+            ReplayGuidance copy = g;
+            copy.teacher_trajectory = samples;
+            validate_alone(copy);
+            g = std::move(copy);
+          },
+          "The teacher's recorded pen, a list of TeacherSample in the device frame [m]");
+  ParameterClass<AssistAsNeededGuidance>(
+      m, "AssistAsNeededGuidance",
+      "The assist-as-needed guidance law: eq. (8) on the deviation beyond a band only (next_assist_band).",
+      check)
+      .field("band_m", &AssistAsNeededGuidance::band_m,
+             "half-width of the band without force around the active element [m], >= 0")
+      .finish();
+  ParameterClass<ErrorAmplificationGuidance>(
+      m, "ErrorAmplificationGuidance",
+      "The error-amplification guidance law: a bounded repulsive field, gain x eq. (8) turned round.", check)
+      .field("gain", &ErrorAmplificationGuidance::gain,
+             "the repulsive stiffness as a share of K_et, in [0, 1]")
+      .field("max_force_n", &ErrorAmplificationGuidance::max_force_n,
+             "bound of the repulsive force [N], >= 0")
+      .finish();
+  ParameterClass<TimingGuidance>(
+      m, "TimingGuidance",
+      "The timing guidance law: a minimum-jerk target along the stroke, pulled towards along it only.", check)
+      .field("speed_m_s", &TimingGuidance::speed_m_s, "mean speed of the target along each stroke [m/s], > 0")
+      .field("max_lead_m", &TimingGuidance::max_lead_m,
+             "the lead at which the spring to the target saturates [m], in (0, constraint_radius_m]")
+      .finish();
+  m.def(
+      "default_guidance_law",
+      [](const Checked<GuidanceMode>& mode) {
+        return std::visit([](const auto& law) { return py::cast(law); },
+                          default_guidance_law(take(mode, "mode")));
+      },
+      py::arg("mode"),
+      "The guidance law of `mode` (a GuidanceMode or its name) with its default parameters.");
+}
+
 void bind_force_law_parameters(py::module_& m) {
   ParameterClass<ForceLawParameters>(
       m, "ForceLawParameters",
@@ -140,22 +211,10 @@ void bind_force_law_parameters(py::module_& m) {
              "height above the paper at which a touching tip counts as lifted (section 6) [m]")
       .field("guidance", &ForceLawParameters::guidance,
              "in-plane guidance on (F_et and the resistance force); the paper force is always rendered")
-      .field("guidance_mode", &ForceLawParameters::guidance_mode,
-             "how F_et acts, a GuidanceMode (fixed as eq. 8, fading by guidance_gain, replay of a teacher, "
-             "assist_as_needed, error_amplification, timing)")
-      .field("guidance_gain", &ForceLawParameters::guidance_gain,
-             "scale of F_et in the fading mode, in [0, 1]")
-      .field("replay_max_lead_m", &ForceLawParameters::replay_max_lead_m,
-             "replay and timing: the lead at which the spring to the moving point saturates [m], in (0, "
-             "constraint_radius_m]")
-      .field("assist_band_m", &ForceLawParameters::assist_band_m,
-             "assist_as_needed: half-width of the band without force around the active element [m], >= 0")
-      .field("amplification_gain", &ForceLawParameters::amplification_gain,
-             "error_amplification: the repulsive stiffness as a share of K_et, in [0, 1]")
-      .field("amplification_max_force_n", &ForceLawParameters::amplification_max_force_n,
-             "error_amplification: bound of the repulsive force [N], >= 0")
-      .field("timing_speed_m_s", &ForceLawParameters::timing_speed_m_s,
-             "timing: mean speed of the target along each stroke [m/s], > 0")
+      .variant_field("guidance_law", &ForceLawParameters::guidance_law,
+                     "how F_et acts, with the mode's own parameters (FixedGuidance as eq. 8, "
+                     "FadingGuidance, ReplayGuidance, AssistAsNeededGuidance, ErrorAmplificationGuidance, "
+                     "TimingGuidance)")
       .field("off_stroke_force_n", &ForceLawParameters::off_stroke_force_n,
              "friction against writing away from the active stroke in CS [N], >= 0; 0 = the paper's CS")
       .field("off_stroke_travel_m", &ForceLawParameters::off_stroke_travel_m,
@@ -185,17 +244,9 @@ void bind_force_law_parameters(py::module_& m) {
       .field("nearest", &ForceLawParameters::nearest,
              "NearestPointOptions: how the foot point X_S on curve elements is found")
       .finish()
-      // Not a ParameterClass field (a list, not a value): not in to_dict() or the constructor.
-      .def_property(
-          "teacher_trajectory", [](const ForceLawParameters& p) { return p.teacher_trajectory; },
-          [](ForceLawParameters& p, const std::vector<TeacherSample>& samples) {
-            ForceLawParameters copy = p;
-            copy.teacher_trajectory = samples;
-            copy.validate();
-            p = std::move(copy);
-          },
-          "The teacher's recorded pen for the replay mode, a list of TeacherSample in the device frame [m] "
-          "(checked when guidance_mode is replay)");
+      .def_property_readonly(
+          "guidance_mode", [](const ForceLawParameters& p) { return mode_of(p.guidance_law); },
+          "The GuidanceMode of guidance_law.");
 }
 
 double number(const Checked<double>& value, const char* name) { return take(value, name); }
@@ -489,6 +540,7 @@ void bind_renderer(py::module_& m) {
 
 void bind_render(py::module_& m) {
   bind_guidance(m);
+  bind_guidance_laws(m);
   bind_force_law_parameters(m);
   bind_force_functions(m);
   bind_interaction_state(m);

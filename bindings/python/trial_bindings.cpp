@@ -16,7 +16,7 @@
 #include "bindings.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/scene.hpp"
-#include "calligraphy/render/guidance_mode.hpp"
+#include "calligraphy/render/guidance_law.hpp"
 #include "calligraphy/render/passivity.hpp"
 #include "calligraphy/render/safety_chain.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
@@ -169,25 +169,41 @@ std::vector<TeacherSample> teacher_samples(const py::object& teacher, const std:
   return convert_named<std::vector<TeacherSample>>(teacher, "teacher");
 }
 
-// Guidance: `guidance_mode` (else replay when a teacher is given, else the force law's mode),
-// `guidance_gain` and the teacher's samples replace the force law's.
+// Guidance: `guidance_mode` (else replay when a teacher is given, else the force law's mode) replaces the
+// force law's guidance law by that mode's defaults unless it is already of that mode; `guidance_gain` and the
+// teacher's samples then set the fading gain and the replay's teacher.
 void apply_guidance(const TrialArguments& a, const std::string& label, ForceLawParameters& force) {
   force.guidance = take(a.guidance, "guidance");
+  std::optional<GuidanceMode> mode;
   if (a.guidance_mode) {
-    force.guidance_mode = take(*a.guidance_mode, "guidance_mode");
+    mode = take(*a.guidance_mode, "guidance_mode");
   } else if (a.teacher && !a.teacher->object.is_none()) {
-    force.guidance_mode = GuidanceMode::replay;
+    mode = GuidanceMode::replay;
   }
-  if (a.guidance_gain) force.guidance_gain = take(*a.guidance_gain, "guidance_gain");
+  if (mode && mode_of(force.guidance_law) != *mode) force.guidance_law = default_guidance_law(*mode);
+  if (a.guidance_gain) {
+    auto* fading = std::get_if<FadingGuidance>(&force.guidance_law);
+    if (fading == nullptr) {
+      throw InvalidArgument(std::string("guidance_gain: applies to guidance_mode 'fading' only, got '") +
+                            to_string(mode_of(force.guidance_law)) + "'");
+    }
+    fading->gain = take(*a.guidance_gain, "guidance_gain");
+    try {
+      validate_guidance_law(force.guidance_law, force.constraint_radius_m);
+    } catch (const InvalidArgument& e) {
+      throw InvalidArgument(std::string("guidance_gain: ") + e.what());
+    }
+  }
+  auto* replay = std::get_if<ReplayGuidance>(&force.guidance_law);
   if (a.teacher && !a.teacher->object.is_none()) {
-    if (force.guidance_mode != GuidanceMode::replay) {
+    if (replay == nullptr) {
       throw InvalidArgument(std::string("teacher: only the 'replay' guidance mode uses a teacher, got "
                                         "guidance_mode '") +
-                            to_string(force.guidance_mode) + "'");
+                            to_string(mode_of(force.guidance_law)) + "'");
     }
-    force.teacher_trajectory = teacher_samples(a.teacher->object, label);
+    replay->teacher_trajectory = teacher_samples(a.teacher->object, label);
   }
-  if (force.guidance_mode == GuidanceMode::replay && force.teacher_trajectory.empty()) {
+  if (replay != nullptr && replay->teacher_trajectory.empty()) {
     throw InvalidArgument(
         "guidance_mode 'replay' needs teacher= (a TeacherRecording or a list of TeacherSample)");
   }
@@ -244,12 +260,15 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   spec.characters = label;
   spec.device = device_name.empty() ? std::string("simulated") : device_name;
   spec.guidance = options.force.guidance;
-  if (spec.guidance) spec.guidance_mode = options.force.guidance_mode;
-  if (spec.guidance_mode == GuidanceMode::fading) spec.guidance_gain = options.force.guidance_gain;
-  if (spec.guidance_mode == GuidanceMode::assist_as_needed) spec.assist_band_m = options.force.assist_band_m;
-  if (spec.guidance_mode == GuidanceMode::error_amplification)
-    spec.amplification_gain = options.force.amplification_gain;
-  if (spec.guidance_mode == GuidanceMode::timing) spec.timing_speed_m_s = options.force.timing_speed_m_s;
+  const GuidanceLaw& law = options.force.guidance_law;
+  if (spec.guidance) spec.guidance_mode = mode_of(law);
+  if (spec.guidance) {
+    if (const auto* fading = std::get_if<FadingGuidance>(&law)) spec.guidance_gain = fading->gain;
+    if (const auto* assist = std::get_if<AssistAsNeededGuidance>(&law)) spec.assist_band_m = assist->band_m;
+    if (const auto* amplify = std::get_if<ErrorAmplificationGuidance>(&law))
+      spec.amplification_gain = amplify->gain;
+    if (const auto* timing = std::get_if<TimingGuidance>(&law)) spec.timing_speed_m_s = timing->speed_m_s;
+  }
   spec.seed = simulation.seed;
   spec.rate_hz = options.rate_hz;
   spec.pacing = options.pacing;
@@ -265,12 +284,10 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
     inputs.device = simulated_device.get();
   }
   inputs.writer = simulation.writer;
-  inputs.teacher = options.force.teacher_trajectory;
-  inputs.adjust = [&options](TrialOptions& run_options) {
-    run_options.force = options.force;  // the force law as given (no stiffness fitted to the device)
-    run_options.safety = options.safety;
-    run_options.passivity = options.passivity;
-  };
+  if (const auto* replay = std::get_if<ReplayGuidance>(&law)) inputs.teacher = replay->teacher_trajectory;
+  inputs.force_law = options.force;  // the force law as given (no stiffness fitted to the device)
+  inputs.safety = options.safety;
+  inputs.passivity = options.passivity;
   // Ctrl-C: the trial runs without the GIL; every 50 ms of wall clock the runner's thread takes the GIL
   // and lets Python run its signal handlers. A KeyboardInterrupt (or any exception a handler raises)
   // ends the trial at the next tick and is raised once the device is shut down.
@@ -292,9 +309,9 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   description.rate_hz = options.rate_hz;
   if (!device_name.empty()) description.device = device_name;
   // The guidance and writer provenance, as `calligraphy trial --json` gives it.
-  description.guidance_mode = options.force.guidance_mode;
-  description.guidance_gain = options.force.guidance_gain;
-  if (options.force.guidance_mode == GuidanceMode::replay) {
+  description.guidance_mode = mode_of(law);
+  if (const auto* fading = std::get_if<FadingGuidance>(&law)) description.guidance_gain = fading->gain;
+  if (description.guidance_mode == GuidanceMode::replay) {
     description.teacher_characters =
         label;  // a recording was checked against them; samples are taken as given
   }

@@ -40,8 +40,7 @@ struct TrialCommand {
   const CLI::Option* profile_option = nullptr;
   std::vector<std::string> writer_parameters;  // "key=value", applied in turn
   std::string guidance_mode = "fixed";
-  double guidance_gain = 1.0;
-  const CLI::Option* gain_option = nullptr;
+  std::string guidance_gain_text;       // "": the specification's default
   std::string assist_band_text;         // "": the specification's default
   std::string amplification_gain_text;  // "": the specification's default
   std::string timing_speed_text;        // "": the specification's default
@@ -74,11 +73,7 @@ TrialSpec spec_from(const TrialCommand& command) {
   add("--device", command.device);
   add("--guidance", command.guidance);
   add("--guidance-mode", command.guidance_mode);
-  if (command.gain_option->count() > 0) {
-    char gain[32];
-    std::snprintf(gain, sizeof gain, "%.17g", command.guidance_gain);  // every bit of the number given
-    add("--guidance-gain", gain);
-  }
+  if (!command.guidance_gain_text.empty()) add("--guidance-gain", command.guidance_gain_text);
   if (!command.assist_band_text.empty()) add("--assist-band", command.assist_band_text);
   if (!command.amplification_gain_text.empty()) add("--amplification-gain", command.amplification_gain_text);
   if (!command.timing_speed_text.empty()) add("--timing-speed", command.timing_speed_text);
@@ -272,9 +267,8 @@ void add_trial_command(CLI::App& root, Commands& commands) {
       "how the guidance acts: the paper's fixture, faded by --guidance-gain, replaying --teacher, only "
       "beyond --assist-band, pushing off the stroke (--amplification-gain), or pulling along it at "
       "--timing-speed");
-  command->gain_option =
-      add_number(*app, "--guidance-gain", command->guidance_gain, "G", "fading: gain on the guiding force",
-                 "a number in [0, 1]", [](double gain) { return gain >= 0.0 && gain <= 1.0; });
+  add_text(*app, "--guidance-gain", command->guidance_gain_text, "G",
+           "fading: gain on the guiding force, in [0, 1]", "1");
   add_text(*app, "--assist-band", command->assist_band_text, "M",
            "assist-as-needed: half-width of the band without force around the stroke [m]", "0.001");
   add_text(*app, "--amplification-gain", command->amplification_gain_text, "G",

@@ -33,27 +33,8 @@ void ForceLawParameters::validate() const {
   check(off_stroke_damping_n_s_per_m, "off_stroke_damping_n_s_per_m", false);
   check(off_stroke_speed_m_s, "off_stroke_speed_m_s", true);
   check(off_stroke_velocity_cutoff_hz, "off_stroke_velocity_cutoff_hz", true);
-  if (!(guidance_gain >= 0.0 && guidance_gain <= 1.0)) {
-    throw InvalidArgument("ForceLawParameters.guidance_gain = " + std::to_string(guidance_gain) +
-                          " must be in [0, 1]");
-  }
-  if (!(amplification_gain >= 0.0 && amplification_gain <= 1.0)) {
-    throw InvalidArgument("ForceLawParameters.amplification_gain = " + std::to_string(amplification_gain) +
-                          " must be in [0, 1]");
-  }
-  check(assist_band_m, "assist_band_m", false);
-  check(amplification_max_force_n, "amplification_max_force_n", false);
-  check(timing_speed_m_s, "timing_speed_m_s", true);
-  if (guidance_mode == GuidanceMode::replay) validate_teacher_trajectory(teacher_trajectory);
-  // The lead is bounded by the constraint space only where it is used: a replay's or timing target's
-  // attraction point must stay within R_res of the pen.
-  const bool moving_target = guidance_mode == GuidanceMode::replay || guidance_mode == GuidanceMode::timing;
-  const double max_lead_m = moving_target ? constraint_radius_m : 1.0;
-  if (!(replay_max_lead_m > 0.0 && replay_max_lead_m <= max_lead_m)) {
-    throw InvalidArgument("ForceLawParameters.replay_max_lead_m = " + std::to_string(replay_max_lead_m) +
-                          " must be in (0, " + std::to_string(max_lead_m) + "] m" +
-                          (moving_target ? " (constraint_radius_m in replay and timing)" : ""));
-  }
+  // A replay's or timing target's attraction point must stay within R_res of the pen.
+  validate_guidance_law(guidance_law, constraint_radius_m);
   if (constraint_taper_m > constraint_radius_m) {
     throw InvalidArgument("ForceLawParameters.constraint_taper_m = " + std::to_string(constraint_taper_m) +
                           " must not exceed constraint_radius_m = " + std::to_string(constraint_radius_m));

@@ -75,11 +75,23 @@ Renderer::Renderer(const Scene& scene, const ForceLawParameters& parameters, con
       chain_(chain_parameters(options, checked(device)), options.rate_hz),
       passivity_(options.passivity, options.rate_hz) {
   parameters_.validate();
-  if (parameters_.guidance_mode == GuidanceMode::replay) {
-    replay_ = TeacherReplay(scene, parameters_.teacher_trajectory, parameters_);
+  const GuidanceLaw& law = parameters_.guidance_law;
+  mode_ = mode_of(law);
+  guidance_reach_m_ = parameters_.constraint_radius_m;
+  if (const auto* fading = std::get_if<FadingGuidance>(&law)) guidance_gain_ = fading->gain;
+  if (const auto* replay = std::get_if<ReplayGuidance>(&law)) {
+    replay_ = TeacherReplay(scene, replay->teacher_trajectory, parameters_);
+    guidance_reach_m_ = replay->max_lead_m;
   }
-  if (parameters_.guidance_mode == GuidanceMode::timing)
-    timing_ = TimingTarget(scene, parameters_.timing_speed_m_s);
+  if (const auto* assist = std::get_if<AssistAsNeededGuidance>(&law)) assist_band_m_ = assist->band_m;
+  if (const auto* amplification = std::get_if<ErrorAmplificationGuidance>(&law)) {
+    guidance_gain_ = amplification->gain;
+    guidance_max_force_n_ = amplification->max_force_n;
+  }
+  if (const auto* timing = std::get_if<TimingGuidance>(&law)) {
+    timing_ = TimingTarget(scene, timing->speed_m_s);
+    guidance_reach_m_ = timing->max_lead_m;
+  }
   off_stroke_alpha_ =
       1.0 - std::exp(-2.0 * std::numbers::pi * parameters_.off_stroke_velocity_cutoff_hz * period_s_);
   const double k_paper = parameters_.paper_stiffness_n_per_m;
@@ -151,7 +163,7 @@ Vec2 Renderer::guidance_force(const DeviceState& device, RenderOutput& out, bool
   // In the replay mode the attraction point is where the teacher was, as many seconds into the stroke as
   // the pen has been writing it, kept on the active element, with the same bounded speed; in the timing
   // mode it is the minimum-jerk target that many seconds into the stroke.
-  const GuidanceMode mode = parameters_.guidance_mode;
+  const GuidanceMode mode = mode_;
   const double elapsed_s = device.time_s - writing_since_s_;
   const Vec2 attraction_point =
       mode == GuidanceMode::replay
@@ -173,16 +185,13 @@ Vec2 Renderer::guidance_force(const DeviceState& device, RenderOutput& out, bool
   const double taper =
       constraint_taper(nearest.distance, parameters_.constraint_radius_m, parameters_.constraint_taper_m);
   const Vec2 tangent = element.unit_tangent(nearest.t);
-  const double gain = mode == GuidanceMode::fading                ? parameters_.guidance_gain
-                      : mode == GuidanceMode::error_amplification ? parameters_.amplification_gain
-                                                                  : 1.0;
-  const double factor = gain * active_.attraction(nearest.t);
+  const double factor = guidance_gain_ * active_.attraction(nearest.t);
   const double stiffness = parameters_.guidance_stiffness_n_per_m;
   Vec2 attraction = attraction_force(tip, rendered_foot_, stiffness, factor);
   // Assist-as-needed: the spring acts on the deviation beyond the band only, K a (d - b)+, continuous at b.
   if (mode == GuidanceMode::assist_as_needed) {
     const double d = (rendered_foot_ - tip).norm();
-    attraction *= d > parameters_.assist_band_m ? (d - parameters_.assist_band_m) / d : 0.0;
+    attraction *= d > assist_band_m_ ? (d - assist_band_m_) / d : 0.0;
   }
   // Error amplification: the same field turned round, pushing the pen off the element.
   if (mode == GuidanceMode::error_amplification) attraction = -attraction;
@@ -196,13 +205,9 @@ Vec2 Renderer::guidance_force(const DeviceState& device, RenderOutput& out, bool
   }
   attraction *= 1.0 - slack;
   // The replay and timing points may lead or trail the pen along the stroke by more than R_res: the spring
-  // is saturated at its force at replay_max_lead_m, so the force stays bounded and continuous. (The foot
+  // is saturated at its force at their max_lead_m, so the force stays bounded and continuous. (The foot
   // point of the other modes is never further than R_res.) The repulsive field has its own bound.
-  const bool moving_target = mode == GuidanceMode::replay || mode == GuidanceMode::timing;
-  const double reach = moving_target ? parameters_.replay_max_lead_m : parameters_.constraint_radius_m;
-  double limit = stiffness * factor * reach;
-  if (mode == GuidanceMode::error_amplification)
-    limit = std::min(limit, parameters_.amplification_max_force_n);
+  const double limit = std::min(stiffness * factor * guidance_reach_m_, guidance_max_force_n_);
   const double magnitude = attraction.norm();
   if (magnitude > limit) attraction *= limit / magnitude;
   // Timing guidance leaves the direction to the writer too: no resistance to moving backwards.

@@ -91,9 +91,8 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
   const auto device = std::make_unique<SimulatedDevice>();
   TrialRunInputs inputs;
   inputs.device = device.get();
-  inputs.adjust = [&](TrialOptions& options) {
-    study_detail::apply_condition(condition, guidance.guidance, options);
-  };
+  inputs.force_law = study_detail::condition_force_law(condition, guidance.guidance,
+                                                       trial_options(spec, device->info()).force);
   const auto wall_start = std::chrono::steady_clock::now();
   const TrialRun run = run_trial_spec(spec, scene, inputs);
   const TrialResult& result = run.result;

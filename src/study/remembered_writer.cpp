@@ -91,21 +91,38 @@ void practise_record(WriterMemory& memory, const json& document, const std::stri
     const std::string mode = force_law.string_or("guidance_mode", "fixed");
     const std::optional<GuidanceMode> parsed = guidance_mode_from_string(mode);
     if (!parsed) fail(source, "/force_law/guidance_mode", "unknown guidance mode \"" + mode + "\"");
-    force.guidance_mode = *parsed;
     constexpr double kLimit = 1e12;  // far beyond any parameter; the force law's validation bounds each
-    force.guidance_gain = force_law.number_or("guidance_gain", 1.0, -kLimit, kLimit);
-    force.guidance_stiffness_n_per_m =
-        force_law.number_or("guidance_stiffness_n_per_m", 0.0, -kLimit, kLimit);
-    force.assist_band_m = force_law.number_or("assist_band_m", force.assist_band_m, -kLimit, kLimit);
-    force.amplification_gain =
-        force_law.number_or("amplification_gain", force.amplification_gain, -kLimit, kLimit);
-    force.amplification_max_force_n =
-        force_law.number_or("amplification_max_force_n", force.amplification_max_force_n, -kLimit, kLimit);
-    force.timing_speed_m_s = force_law.number_or("timing_speed_m_s", force.timing_speed_m_s, -kLimit, kLimit);
-    // A replay's teacher is not in the record; its shares do not depend on it, so a stand-in of two samples
-    // passes the parameters' validation.
-    if (force.guidance_mode == GuidanceMode::replay)
-      force.teacher_trajectory = {TeacherSample{}, TeacherSample{}};
+    const auto number = [&](const char* key, double fallback) {
+      return force_law.number_or(key, fallback, -kLimit, kLimit);
+    };
+    force.guidance_stiffness_n_per_m = number("guidance_stiffness_n_per_m", 0.0);
+    switch (*parsed) {
+      case GuidanceMode::fixed:
+        break;
+      case GuidanceMode::fading:
+        force.guidance_law = FadingGuidance{.gain = number("guidance_gain", 1.0)};
+        break;
+      case GuidanceMode::replay:
+        // A replay's teacher is not in the record; its shares do not depend on it, so a stand-in of two
+        // samples passes the parameters' validation.
+        force.guidance_law = ReplayGuidance{.teacher_trajectory = {TeacherSample{}, TeacherSample{}}};
+        break;
+      case GuidanceMode::assist_as_needed:
+        force.guidance_law =
+            AssistAsNeededGuidance{.band_m = number("assist_band_m", AssistAsNeededGuidance{}.band_m)};
+        break;
+      case GuidanceMode::error_amplification: {
+        const ErrorAmplificationGuidance defaults;
+        force.guidance_law = ErrorAmplificationGuidance{
+            .gain = number("amplification_gain", defaults.gain),
+            .max_force_n = number("amplification_max_force_n", defaults.max_force_n)};
+        break;
+      }
+      case GuidanceMode::timing:
+        force.guidance_law =
+            TimingGuidance{.speed_m_s = number("timing_speed_m_s", TimingGuidance{}.speed_m_s)};
+        break;
+    }
     const double deviation_m = record.number_or("mean_deviation_mm", std::nan(""), -kLimit, kLimit) * 1e-3;
     try {
       shares = guidance_shares(force, hand, deviation_m);

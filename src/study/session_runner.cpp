@@ -156,7 +156,7 @@ TrialSpec study_trial_spec(const SessionManifest& session, const StudyCondition&
 TrialOptions study_trial_options(const SessionManifest& session, const StudyCondition& condition,
                                  const PlannedTrial& trial, const TrialGuidance& guidance) {
   TrialOptions options = trial_options(study_trial_spec(session, condition, trial, guidance), DeviceInfo{});
-  study_detail::apply_condition(condition, guidance, options);
+  options.force = study_detail::condition_force_law(condition, guidance, std::move(options.force));
   options.validate();
   return options;
 }
@@ -272,10 +272,15 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     inputs.device = device.get();
     inputs.teacher = guidance.guidance.teacher;
     inputs.should_stop = run_options.should_stop;
-    inputs.adjust = [&](TrialOptions& options) {
-      study_detail::apply_condition(condition, guidance.guidance, options);
-      if (run_options.prepare_trial) run_options.prepare_trial(trial, options);
-    };
+    // The trial's options, complete before it runs: the specification's on this device, the condition's
+    // force law, and what the host adds (its display channel, memory locking off in a window process).
+    TrialOptions planned = trial_options(spec, device_info);
+    planned.force = study_detail::condition_force_law(condition, guidance.guidance, std::move(planned.force));
+    planned.loop.lock_memory = inputs.lock_memory;  // a session's program locks memory unless its host says not
+    if (run_options.prepare_trial) run_options.prepare_trial(trial, planned);
+    inputs.force_law = std::move(planned.force);
+    inputs.display = planned.display;
+    inputs.lock_memory = planned.loop.lock_memory;
     study_detail::TrialRecordContext context;
     context.session = &manifest;
     context.trial = &trial;

@@ -209,18 +209,21 @@ json guidance_record_json(const StudyCondition& condition, const PreparedGuidanc
   return guidance;
 }
 
-void apply_condition(const StudyCondition& condition, const TrialGuidance& guidance, TrialOptions& options) {
+ForceLawParameters condition_force_law(const StudyCondition& condition, const TrialGuidance& guidance,
+                                       ForceLawParameters force) {
   // The renderer judges strokes as the quiz does.
-  if (condition.mode == ConditionMode::quiz) options.force.acceptance = condition.quiz.acceptance;
-  if (condition.mode == ConditionMode::replay) {
-    options.force.teacher_trajectory = guidance.teacher;
-    if (condition.replay_max_lead_m) options.force.replay_max_lead_m = *condition.replay_max_lead_m;
+  if (condition.mode == ConditionMode::quiz) force.acceptance = condition.quiz.acceptance;
+  if (auto* replay = std::get_if<ReplayGuidance>(&force.guidance_law)) {
+    replay->teacher_trajectory = guidance.teacher;
+    if (condition.replay_max_lead_m) replay->max_lead_m = *condition.replay_max_lead_m;
   }
-  if (condition.amplification_max_force_n)
-    options.force.amplification_max_force_n = *condition.amplification_max_force_n;
-  if (condition.guidance_stiffness_n_per_m && options.force.guidance) {
-    options.force.guidance_stiffness_n_per_m = *condition.guidance_stiffness_n_per_m;
+  if (auto* amplification = std::get_if<ErrorAmplificationGuidance>(&force.guidance_law);
+      amplification && condition.amplification_max_force_n) {
+    amplification->max_force_n = *condition.amplification_max_force_n;
   }
+  if (condition.guidance_stiffness_n_per_m && force.guidance)
+    force.guidance_stiffness_n_per_m = *condition.guidance_stiffness_n_per_m;
+  return force;
 }
 
 }  // namespace calligraphy::study_detail

@@ -54,9 +54,12 @@ const PlannedTrial* previous_repetition(const std::vector<PlannedTrial>& plan, c
 PreparedGuidance repetition_guidance(const StudyCondition& condition, const PlannedTrial* previous,
                                      const nlohmann::json* previous_record, const std::string& source);
 
-/// What a condition sets beyond the trial specification: the quiz's acceptance, the replay's teacher and
-/// lead, the repulsive field's bound, a guidance stiffness of its own (the runner's TrialRunInputs::adjust).
-void apply_condition(const StudyCondition& condition, const TrialGuidance& guidance, TrialOptions& options);
+/// The force law of a trial of `condition`: `force` (made from the trial's specification, fitted to the
+/// device) with what the condition sets beyond the specification, each where the protocol gives it: the
+/// quiz's acceptance, the replay's teacher and lead, the repulsive field's bound, a guidance stiffness of
+/// its own. Made before the trial and given to the runner (TrialRunInputs::force_law).
+[[nodiscard]] ForceLawParameters condition_force_law(const StudyCondition& condition,
+                                                     const TrialGuidance& guidance, ForceLawParameters force);
 
 /// Whether a mode's guidance follows the previous repetition of the item: fading, assist-as-needed,
 /// skill-adaptive.

@@ -35,15 +35,29 @@ const char* method_name(NearestPointMethod method) {
   return "unknown";
 }
 
+// The record keeps every mode's parameters under their flat keys: the active law's, the defaults of the
+// others.
+template <typename Law>
+Law law_or_default(const ForceLawParameters& f) {
+  const Law* law = std::get_if<Law>(&f.guidance_law);
+  return law != nullptr ? *law : Law{};
+}
+
+double max_lead_m(const GuidanceLaw& law) {
+  if (const auto* replay = std::get_if<ReplayGuidance>(&law)) return replay->max_lead_m;
+  if (const auto* timing = std::get_if<TimingGuidance>(&law)) return timing->max_lead_m;
+  return kDefaultMaxLeadM;
+}
+
 json force_law_json(const ForceLawParameters& f) {
   return {{"guidance", f.guidance},
-          {"guidance_mode", to_string(f.guidance_mode)},
-          {"guidance_gain", f.guidance_gain},
-          {"replay_max_lead_m", f.replay_max_lead_m},
-          {"assist_band_m", f.assist_band_m},
-          {"amplification_gain", f.amplification_gain},
-          {"amplification_max_force_n", f.amplification_max_force_n},
-          {"timing_speed_m_s", f.timing_speed_m_s},
+          {"guidance_mode", to_string(mode_of(f.guidance_law))},
+          {"guidance_gain", law_or_default<FadingGuidance>(f).gain},
+          {"replay_max_lead_m", max_lead_m(f.guidance_law)},
+          {"assist_band_m", law_or_default<AssistAsNeededGuidance>(f).band_m},
+          {"amplification_gain", law_or_default<ErrorAmplificationGuidance>(f).gain},
+          {"amplification_max_force_n", law_or_default<ErrorAmplificationGuidance>(f).max_force_n},
+          {"timing_speed_m_s", law_or_default<TimingGuidance>(f).speed_m_s},
           {"guidance_stiffness_n_per_m", f.guidance_stiffness_n_per_m},
           {"paper_stiffness_n_per_m", f.paper_stiffness_n_per_m},
           {"constraint_radius_m", f.constraint_radius_m},

@@ -28,6 +28,25 @@ void fit_default_stiffness(ForceLawParameters& force, const DeviceInfo& device) 
   }
 }
 
+// The specification's mode with the parameters it sets; a replay's teacher is the runner's to add.
+GuidanceLaw guidance_law_of(const TrialSpec& spec) {
+  switch (spec.guidance_mode) {
+    case GuidanceMode::fixed:
+      break;
+    case GuidanceMode::fading:
+      return FadingGuidance{.gain = spec.guidance_gain};
+    case GuidanceMode::replay:
+      return ReplayGuidance{};
+    case GuidanceMode::assist_as_needed:
+      return AssistAsNeededGuidance{.band_m = spec.assist_band_m};
+    case GuidanceMode::error_amplification:
+      return ErrorAmplificationGuidance{.gain = spec.amplification_gain};
+    case GuidanceMode::timing:
+      return TimingGuidance{.speed_m_s = spec.timing_speed_m_s};
+  }
+  return FixedGuidance{};
+}
+
 WriterProfile profile_of(const TrialSpec& spec) {
   WriterProfile profile = writer_profile(spec.writer_profile);
   for (const std::string& setting : spec.writer_parameters) apply_writer_setting(profile, setting);
@@ -41,11 +60,7 @@ TrialOptions trial_options(const TrialSpec& spec, const DeviceInfo& device) {
   spec.validate(spec.teacher.empty() ? TeacherSource::samples : TeacherSource::file);
   TrialOptions options;
   options.force.guidance = spec.guidance;
-  options.force.guidance_mode = spec.guidance_mode;
-  options.force.guidance_gain = spec.guidance_gain;
-  options.force.assist_band_m = spec.assist_band_m;
-  options.force.amplification_gain = spec.amplification_gain;
-  options.force.timing_speed_m_s = spec.timing_speed_m_s;
+  options.force.guidance_law = guidance_law_of(spec);
   fit_default_stiffness(options.force, device);
   options.rate_hz = spec.rate_hz;
   options.pacing = spec.pacing;
@@ -105,13 +120,28 @@ TrialRun run_trial_spec(const TrialSpec& spec, const Scene& scene, const TrialRu
   run.simulated_writer = simulated_writer_writes(spec, device->hand_port() != nullptr);
 
   run.options = trial_options(spec, run.device);
-  if (spec.guidance_mode == GuidanceMode::replay) run.options.force.teacher_trajectory = std::move(teacher);
+  if (inputs.force_law) {
+    const bool same_guidance =
+        inputs.force_law->guidance == spec.guidance &&
+        (!spec.guidance || mode_of(inputs.force_law->guidance_law) == spec.guidance_mode);
+    if (!same_guidance) {
+      throw InvalidArgument(
+          std::string("trial inputs: the force law's guidance (") +
+          (inputs.force_law->guidance ? to_string(mode_of(inputs.force_law->guidance_law)) : "off") +
+          ") is not the specification's (" + (spec.guidance ? to_string(spec.guidance_mode) : "off") + ")");
+    }
+    run.options.force = *inputs.force_law;
+  }
+  if (auto* replay = std::get_if<ReplayGuidance>(&run.options.force.guidance_law))
+    replay->teacher_trajectory = std::move(teacher);
+  if (inputs.safety) run.options.safety = *inputs.safety;
+  if (inputs.passivity) run.options.passivity = *inputs.passivity;
+  run.options.display = inputs.display;
   run.options.should_stop = inputs.should_stop;
   if (!inputs.host_process) {  // a program that exists to run the trial asks for the real-time settings
     run.options.loop.priority = kDedicatedServoPriority;
-    run.options.loop.lock_memory = true;
+    run.options.loop.lock_memory = inputs.lock_memory;
   }
-  if (inputs.adjust) inputs.adjust(run.options);
   run.options.validate();
 
   std::unique_ptr<SimulatedHand> hand;

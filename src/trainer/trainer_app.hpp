@@ -18,7 +18,7 @@
 
 #include "calligraphy/core/device_types.hpp"
 #include "calligraphy/model/scene.hpp"
-#include "calligraphy/render/guidance_mode.hpp"
+#include "calligraphy/render/guidance_law.hpp"
 #include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/trial/trial.hpp"
 #include "trainer/layout.hpp"
@@ -125,7 +125,7 @@ class TrainerApp {
   bool guidance_ = true;
   GuidanceMode guidance_mode_ = GuidanceMode::fixed;
   double guidance_gain_ = 1.0;
-  double assist_band_m_ = ForceLawParameters{}.assist_band_m;  // assist-as-needed: the next trial's band
+  double assist_band_m_ = AssistAsNeededGuidance{}.band_m;  // assist-as-needed: the next trial's band
   bool condition_outputs_force_ = true;
   bool quit_ = false;
   bool quit_seen_ = false;

@@ -55,13 +55,8 @@ void TrainerApp::start_trial(std::size_t character) {
   TrialRunInputs inputs;
   inputs.registry = options_.registry;
   inputs.teacher = options_.teacher;
-  DisplayChannel* const channel = channel_.get();
-  inputs.adjust = [channel](TrialOptions& trial) {
-    // A window process maps memory all the time (the GL driver): mlockall(MCL_FUTURE) would lock all of
-    // it, or make its allocations fail under a memory-lock limit. The trace is touched in advance instead.
-    trial.loop.lock_memory = false;
-    trial.display = channel;
-  };
+  inputs.display = channel_.get();
+  inputs.lock_memory = false;                          // a window process (TrialRunInputs::lock_memory)
   trial_options_ = trial_options(spec, DeviceInfo{});  // what the view needs before the device is open
   trial_simulation_.writer = writer_profile(spec.writer_profile);
   trial_simulation_.seed = spec.seed;
@@ -124,12 +119,12 @@ void TrainerApp::finish_trial() {
   view.metrics.time_s = writing.total_time_s;
   view.end_reason = result.abort_reason;
   if (result.end == TrialEnd::device_fault || result.end == TrialEnd::watchdog) status_ = 1;
-  if (guidance_ && trial_options_.force.guidance_mode == GuidanceMode::fading &&
+  if (guidance_ && mode_of(trial_options_.force.guidance_law) == GuidanceMode::fading &&
       view.metrics.mean_deviation_m) {  // performance-based fading (Emken et al. 2007)
     guidance_gain_ = next_guidance_gain(guidance_gain_, *view.metrics.mean_deviation_m);
     std::fprintf(stderr, "calligraphy train: fading: next trial's guidance gain %.3f\n", guidance_gain_);
   }
-  if (guidance_ && trial_options_.force.guidance_mode == GuidanceMode::assist_as_needed &&
+  if (guidance_ && mode_of(trial_options_.force.guidance_law) == GuidanceMode::assist_as_needed &&
       view.metrics.mean_deviation_m) {  // the band adapts to the error (next_assist_band)
     assist_band_m_ = next_assist_band(assist_band_m_, *view.metrics.mean_deviation_m);
     std::fprintf(stderr, "calligraphy train: assist-as-needed: next trial's band %.2f mm\n",

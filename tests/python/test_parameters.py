@@ -123,3 +123,39 @@ def test_interaction_state_is_an_enum_equal_to_its_int():
     stored = np.array([0, 3, 2, 3], dtype=np.uint8)
     np.testing.assert_array_equal(stored == states.writing, [False, True, False, True])
     assert states.writing != states.calibration and states.writing != "WS"
+
+
+def test_guidance_law_is_one_class_per_mode_with_its_own_parameters():
+    law = calligraphy.ForceLawParameters()
+    assert law.guidance_law == calligraphy.FixedGuidance()
+    assert law.guidance_mode == calligraphy.GuidanceMode.fixed
+    law.guidance_law = calligraphy.AssistAsNeededGuidance(band_m=0.002)
+    assert law.guidance_mode == calligraphy.GuidanceMode.assist_as_needed
+    assert law.guidance_law.band_m == 0.002
+    assert law.to_dict()["guidance_law"] == {"law": "AssistAsNeededGuidance", "band_m": 0.002}
+    namespace = {name: getattr(calligraphy, name) for name in calligraphy.__all__}
+    assert eval(repr(law), namespace) == law
+    assert pickle.loads(pickle.dumps(law)) == law
+    assert calligraphy.ForceLawParameters(guidance_law={"law": "FadingGuidance", "gain": 0.5}).guidance_law == \
+        calligraphy.FadingGuidance(gain=0.5)
+    classes = {"fixed": "FixedGuidance", "fading": "FadingGuidance", "replay": "ReplayGuidance",
+               "assist_as_needed": "AssistAsNeededGuidance", "error_amplification": "ErrorAmplificationGuidance",
+               "timing": "TimingGuidance"}
+    for name, mode in calligraphy.GuidanceMode.__members__.items():
+        assert type(calligraphy.default_guidance_law(mode)).__name__ == classes[name]
+    # Each law checks its own fields, naming them; the force law checks a moving target's lead against R_res.
+    with pytest.raises(ValueError, match="FadingGuidance.gain"):
+        calligraphy.FadingGuidance(gain=1.5)
+    with pytest.raises(ValueError, match="ErrorAmplificationGuidance.max_force_n"):
+        calligraphy.ErrorAmplificationGuidance(max_force_n=-1.0)
+    with pytest.raises(ValueError, match="TimingGuidance.max_lead_m"):
+        calligraphy.ForceLawParameters(guidance_law=calligraphy.TimingGuidance(max_lead_m=0.01))
+    with pytest.raises(TypeError, match="ForceLawParameters.guidance_law"):
+        law.guidance_law = 0.5
+    assert law.guidance_law.band_m == 0.002  # unchanged by the refused assignment
+    replay = calligraphy.ReplayGuidance(max_lead_m=0.002)
+    replay.teacher_trajectory = [calligraphy.TeacherSample(time_s=0.0, position_m=[0.0, 0.0, 0.0]),
+                                 calligraphy.TeacherSample(time_s=1.0, position_m=[0.01, 0.0, 0.0])]
+    assert len(replay.teacher_trajectory) == 2
+    with pytest.raises(ValueError, match="teacher trajectory"):
+        calligraphy.ForceLawParameters(guidance_law=calligraphy.ReplayGuidance())

@@ -21,7 +21,8 @@ Main entry points:
 * ``calligraphy.experiments.sweep(chars, grid, seeds)``: one trial per grid combination x character x
   seed on every core or a Dask cluster -> a pandas DataFrame, one row per trial
 * ``SimulatedDevice(SimulatedDeviceParameters(...))``, ``WriterProfile``, ``list_devices()``
-* guidance modes: ``simulate_trial(..., guidance_mode="fading", guidance_gain=g)``,
+* guidance modes: ``simulate_trial(..., guidance_mode="fading", guidance_gain=g)``, or a law with its
+  parameters: ``ForceLawParameters(guidance_law=AssistAsNeededGuidance(band_m=0.002))`` (one class per mode),
   ``next_guidance_gain(g, error_m)``; ``record_teacher(result)`` -> ``TeacherRecording`` for
   ``simulate_trial(..., teacher=recording)`` (replay)
 * writers: ``writer="foreign"``, ``writer_params={"key": value}``, ``writer_profile(name, params)``;
@@ -58,6 +59,13 @@ from ._calligraphy import (  # noqa: F401
     ForceLawParameters,
     InteractionState,
     GuidanceMode,
+    FixedGuidance,
+    FadingGuidance,
+    ReplayGuidance,
+    AssistAsNeededGuidance,
+    ErrorAmplificationGuidance,
+    TimingGuidance,
+    default_guidance_law,
     TeacherSample,
     InvalidArgument,
     NearestPointMethod,
@@ -138,6 +146,13 @@ __all__ = [
     "ForceLawParameters",
     "InteractionState",
     "GuidanceMode",
+    "FixedGuidance",
+    "FadingGuidance",
+    "ReplayGuidance",
+    "AssistAsNeededGuidance",
+    "ErrorAmplificationGuidance",
+    "TimingGuidance",
+    "default_guidance_law",
     "TeacherSample",
     "InvalidArgument",
     "NearestPointMethod",

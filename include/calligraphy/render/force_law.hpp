@@ -2,12 +2,10 @@
 /// \file force_law.hpp
 /// The force model of paper section 5: F_e = F_en + F_et (eq. 7). Free functions, SI units, servo path
 /// (noexcept, no allocation). Device frame: the paper is z = z0, +z out of the paper.
-#include <vector>
-
 #include "calligraphy/core/geometry.hpp"
 #include "calligraphy/model/nearest_point.hpp"
 #include "calligraphy/model/stroke_progress.hpp"
-#include "calligraphy/render/guidance_mode.hpp"
+#include "calligraphy/render/guidance_law.hpp"
 
 namespace calligraphy {
 
@@ -28,37 +26,10 @@ struct ForceLawParameters {
   /// always rendered.
   bool guidance = true;
 
-  // Guidance modes (guidance_mode.hpp; docs/force-rendering.md, "Guidance modes").
-  /// How F_et attracts: the paper's fixed fixture, faded by `guidance_gain`, or replaying a teacher.
-  GuidanceMode guidance_mode = GuidanceMode::fixed;
-  /// Gain g in [0, 1] on F_et in the `fading` mode (ignored in the others); set it per repetition, or
-  /// from performance with `next_guidance_gain`.
-  double guidance_gain = 1.0;
-  /// The teacher's recorded pen for the `replay` mode, device frame [m], times [s] non-decreasing (a
-  /// recorded trial's trace: `TrialSample::time_s`, `position_m`). Read at renderer construction
-  /// (teacher_replay.hpp); ignored in the other modes.
-  std::vector<TeacherSample> teacher_trajectory;
-  /// Replay and timing: the spring towards the teacher's (or the timing target's) point pulls at most as
-  /// hard as it does at this
-  /// distance [m], in (0, R_res]: K_et a d_max. The point may lead or trail the pen along the stroke by
-  /// more (a trainee slower than the teacher); the bound keeps the pull moderate and the force step
-  /// small when a pen held back that hard crosses the taper band at the edge of R_res.
-  double replay_max_lead_m = 0.003;
-  /// `assist_as_needed` only: the half-width b [m] >= 0 of the band around the active element within which
-  /// the fixture is slack; beyond it the spring acts on d - b only, so the force is continuous at the band
-  /// (set per repetition, or from performance with `next_assist_band`).
-  double assist_band_m = 0.001;
-  /// `error_amplification` only: the repulsive field's stiffness as a share g in [0, 1] of K_et: g K_et a
-  /// (X_p - X_S). Below the hand's stiffness the pen keeps an equilibrium on the stroke (0.25 x 400 = 100
-  /// N/m against the simulated relaxed hand's 150 N/m).
-  double amplification_gain = 0.25;
-  /// `error_amplification` only: the repulsive force's bound [N] >= 0, so that a deviation is enlarged,
-  /// never thrown: within the constraint space the field stores at most this force times R_res of energy.
-  double amplification_max_force_n = 0.3;
-  /// `timing` only: the mean speed [m/s] > 0 of the target along each stroke (the stroke's length over its
-  /// duration; a minimum-jerk profile within it). Default: a fluent writer's pace (the simulated skilled
-  /// writer's, docs/writer.md).
-  double timing_speed_m_s = 0.04;
+  /// How F_et attracts, with the mode's own parameters (guidance_law.hpp): the paper's fixed fixture by
+  /// default, or a fading, replay, assist-as-needed, error-amplification or timing law.
+  GuidanceLaw guidance_law{};
+
   // Off-stroke resistance (docs/force-rendering.md): under guidance, writing off the active stroke is
   // felt. The paper's resistance of Fig. 4 extended from the direction within a stroke to the order of
   // the strokes (section 2.2; section 6: the active stroke masks the others). Both parts 0 = the
@@ -116,8 +87,8 @@ struct ForceLawParameters {
   NearestPointOptions nearest{};
 
   /// Throws InvalidArgument when a value is negative, not finite, the radius or the stick speed is not
-  /// positive, the taper band is wider than the radius, a gain is outside [0, 1], the timing speed is not
-  /// > 0, or the mode is `replay` and the teacher trajectory is bad (validate_teacher_trajectory).
+  /// positive, the taper band is wider than the radius, or the guidance law's parameters are out of range
+  /// (validate_guidance_law, naming the field).
   void validate() const;
 };
 

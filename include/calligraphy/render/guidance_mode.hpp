@@ -13,8 +13,8 @@
 ///    writer's error falls and narrows as it grows (`next_assist_band`): assist-as-needed (Emken, Bobrow &
 ///    Reinkensmeyer 2005; Banala et al. 2009, a force tunnel around the path).
 ///  - `error_amplification`: a bounded repulsive field that enlarges the deviation, g K_et a (X_p - X_S),
-///    at most `amplification_max_force_n` (error augmentation: Emken & Reinkensmeyer 2005; Patton et al.
-///    2006).
+///    at most `ErrorAmplificationGuidance::max_force_n` (error augmentation: Emken & Reinkensmeyer 2005;
+///    Patton et al. 2006).
 ///  - `timing`: a target moves along the stroke's centre line at a minimum-jerk pace (Flash & Hogan 1985)
 ///    and the pen is pulled towards it along the stroke only, never across it: guidance on timing, not on
 ///    shape.
@@ -31,10 +31,10 @@ namespace calligraphy {
 
 enum class GuidanceMode : std::uint8_t {
   fixed,                ///< eq. (8) as printed (with the attracting sign): the paper's virtual fixture
-  fading,               ///< eq. (8) scaled by ForceLawParameters::guidance_gain in [0, 1]
-  replay,               ///< the attraction point follows ForceLawParameters::teacher_trajectory in time
-  assist_as_needed,     ///< eq. (8) on the deviation beyond ForceLawParameters::assist_band_m only
-  error_amplification,  ///< a bounded repulsive field, ForceLawParameters::amplification_gain x eq. (8)
+  fading,               ///< eq. (8) scaled by FadingGuidance::gain in [0, 1]
+  replay,               ///< the attraction point follows ReplayGuidance::teacher_trajectory in time
+  assist_as_needed,     ///< eq. (8) on the deviation beyond AssistAsNeededGuidance::band_m only
+  error_amplification,  ///< a bounded repulsive field, ErrorAmplificationGuidance::gain x eq. (8)
   timing,               ///< a minimum-jerk target along the stroke, pulled towards along the stroke only
 };
 
@@ -52,6 +52,9 @@ std::optional<GuidanceMode> guidance_mode_from_string(std::string_view name) noe
 struct TeacherSample {
   double time_s = 0.0;
   Vec3 position_m = Vec3::Zero();
+  friend bool operator==(const TeacherSample& a, const TeacherSample& b) {
+    return a.time_s == b.time_s && a.position_m == b.position_m;
+  }
 };
 
 /// Throws InvalidArgument naming the first sample whose time or position is not finite or whose time

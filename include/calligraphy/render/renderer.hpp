@@ -8,6 +8,7 @@
 /// passivity controller -> safety chain. The in-plane guidance has three modes (guidance_mode.hpp: the
 /// paper's fixed fixture, fading, teacher replay). Details and measurements: docs/force-rendering.md.
 #include <cstdint>
+#include <limits>
 
 #include "calligraphy/collision/active_stroke.hpp"
 #include "calligraphy/core/device_types.hpp"
@@ -93,6 +94,12 @@ class Renderer {
   NearestPointTracker tracker_;
   TeacherReplay replay_;
   TimingTarget timing_;           // the `timing` mode's moving target
+  // The guidance law's numbers, read from its variant once at construction so that a tick reads plain values.
+  GuidanceMode mode_ = GuidanceMode::fixed;
+  double guidance_gain_ = 1.0;     // the fading or repulsive gain; 1 in the other modes
+  double assist_band_m_ = 0.0;     // assist-as-needed's slack band; 0 in the other modes
+  double guidance_reach_m_ = 0.0;  // where the pull saturates: a moving target's max lead, else R_res
+  double guidance_max_force_n_ = std::numeric_limits<double>::infinity();  // the repulsive field's bound
   double writing_since_s_ = 0.0;  // device time at which WS was entered on the active stroke (replay clock)
   Vec2 off_stroke_velocity_ = Vec2::Zero();  // low-passed in-plane velocity for the off-stroke damper
   Vec2 off_stroke_anchor_ = Vec2::Zero();    // adhesion point of the off-stroke friction in CS

@@ -76,21 +76,21 @@ struct StudyCondition {
   /// `fading` ("forgetting_factor" in [0, 1], "error_gain_per_m" >= 0): the gain of each later repetition
   /// is `next_guidance_gain(previous gain, previous mean deviation, fading_rule)` (Emken et al. 2007).
   FadingRule fading_rule{};
-  /// `replay` ("max_lead_m", in (0, 0.1]): ForceLawParameters::replay_max_lead_m [m] when given.
+  /// `replay` ("max_lead_m", in (0, 0.1]): ReplayGuidance::max_lead_m [m] when given.
   std::optional<double> replay_max_lead_m{};
   /// `assist-as-needed` ("start_band_m" in [0, 0.1]): the band of the first repetition of an item [m].
-  double start_band_m = ForceLawParameters{}.assist_band_m;
+  double start_band_m = AssistAsNeededGuidance{}.band_m;
   /// `assist-as-needed` ("target_error_m", "band_rate", "min_band_m", "max_band_m"): each later repetition's
   /// band is `next_assist_band(previous band, previous mean deviation, assist_rule)`.
   AssistBandRule assist_rule{};
   /// `error-amplification` and `skill-adaptive` ("amplification_gain" in [0, 1], "max_force_n" in [0, 10]):
-  /// ForceLawParameters::amplification_gain and amplification_max_force_n when given.
+  /// ErrorAmplificationGuidance::gain and max_force_n when given.
   std::optional<double> amplification_gain{};
   std::optional<double> amplification_max_force_n{};
   /// `skill-adaptive` ("threshold_m" in (0, 0.1]): `skill_adaptive_mode` of the previous repetition's mean
   /// deviation (its first repetition is guided).
   SkillAdaptiveRule skill_rule{};
-  /// `timing` ("speed_m_s" in (0, 1]): ForceLawParameters::timing_speed_m_s when given.
+  /// `timing` ("speed_m_s" in (0, 1]): TimingGuidance::speed_m_s when given.
   std::optional<double> timing_speed_m_s{};
   /// `replay`: the teacher's recording of an item (teacher_recording.hpp), by item; the path as given,
   /// relative to the protocol file. An item without one gets a teacher recorded by the session runner.

@@ -15,7 +15,7 @@
 
 #include "calligraphy/devices/device_registry.hpp"
 #include "calligraphy/model/character.hpp"
-#include "calligraphy/render/guidance_mode.hpp"
+#include "calligraphy/render/guidance_law.hpp"
 #include "calligraphy/study/schedule.hpp"
 #include "calligraphy/study/session_folder.hpp"
 #include "calligraphy/study/trial_spec.hpp"
@@ -63,9 +63,10 @@ struct SessionRunOptions {
   /// Overrides the session's pacing for this run (e.g. a session begun in real time resumed lock-step);
   /// nullopt: the pacing in session.json.
   std::optional<TrialPacing> pacing;
-  /// Called with each trial's options just before the trial runs, on the runner's thread, to add what
-  /// only the caller has (a window's display channel, TrialOptions::display; memory locking off in a
-  /// window process); empty: the options are used as `study_trial_options` made them.
+  /// The one per-trial host hook: called with each trial's options (the specification's on the session's
+  /// device, with the condition's force law) before the trial runs, on the runner's thread, to add what only
+  /// the host has: a window's display channel (TrialOptions::display) and memory locking off in a window
+  /// process (ServoLoopOptions::lock_memory); these two are taken from it. Empty: neither.
   std::function<void(const PlannedTrial&, TrialOptions&)> prepare_trial;
 };
 
@@ -86,7 +87,7 @@ struct SessionRunResult {
 /// session folder.
 struct TrialGuidance {
   double gain = 1.0;  ///< `fading`: the trial's gain in [0, 1] (ForceLawParameters)
-  double band_m = ForceLawParameters{}.assist_band_m;  ///< `assist-as-needed`: the trial's band [m] >= 0
+  double band_m = AssistAsNeededGuidance{}.band_m;  ///< `assist-as-needed`: the trial's band [m] >= 0
   /// `skill-adaptive`: the mode chosen for the trial (fixed or error amplification); nullopt: fixed.
   std::optional<GuidanceMode> mode;
   std::vector<TeacherSample> teacher;  ///< `replay`: the teacher's pen, device frame [m], times [s]

@@ -36,12 +36,12 @@ struct TrialSpec {
   bool guidance = true;                              ///< in-plane guidance (the paper force stays)
   GuidanceMode guidance_mode = GuidanceMode::fixed;  ///< the paper's fixture or another mode
   double guidance_gain = 1.0;                        ///< fading only: gain in [0, 1]
-  /// assist-as-needed only: the band's half-width [m] >= 0 (ForceLawParameters::assist_band_m)
-  double assist_band_m = ForceLawParameters{}.assist_band_m;
+  /// assist-as-needed only: the band's half-width [m] >= 0 (AssistAsNeededGuidance::band_m)
+  double assist_band_m = AssistAsNeededGuidance{}.band_m;
   /// error-amplification only: the repulsive stiffness's share of K_et, in [0, 1]
-  double amplification_gain = ForceLawParameters{}.amplification_gain;
+  double amplification_gain = ErrorAmplificationGuidance{}.gain;
   /// timing only: the target's mean speed along each stroke [m/s] > 0
-  double timing_speed_m_s = ForceLawParameters{}.timing_speed_m_s;
+  double timing_speed_m_s = TimingGuidance{}.speed_m_s;
   std::string teacher;                           ///< replay only: a teacher's recording (JSON file)
   TrialWriter writer = TrialWriter::automatic;   ///< who writes
   std::string writer_profile = "novice";         ///< the simulated writer's profile (docs/writer.md)

@@ -37,10 +37,20 @@ struct TrialRunInputs {
   /// `kDedicatedServoPriority` and locked memory, as a program that exists to run it. True (a window, the
   /// Python module): nothing process-wide, the `ServoLoopOptions` defaults.
   bool host_process = false;
-  /// Called with the options made from the specification just before the trial: what only the caller
-  /// sets (a window's display channel, memory locking off in a window process, a condition's stiffness or
-  /// acceptance, force-law tuning from Python). May be empty.
-  std::function<void(TrialOptions&)> adjust;
+  /// The force law to run with instead of the one made from the specification (its default stiffnesses
+  /// fitted to the device): a study condition's (condition_force_law), or Python's tuning; taken as given.
+  /// Its guidance switch, and with guidance on its mode, must be the specification's (InvalidArgument
+  /// otherwise); a replay's teacher is the runner's to set (above).
+  std::optional<ForceLawParameters> force_law;
+  std::optional<SafetyChainParameters> safety;   ///< instead of the defaults
+  std::optional<PassivityParameters> passivity;  ///< instead of the defaults
+  /// Where the trial publishes what a window shows (TrialOptions::display; not owned); nullptr: nowhere.
+  DisplayChannel* display = nullptr;
+  /// With `host_process` false: lock the process's memory in a real-time trial (ServoLoopOptions::lock_memory).
+  /// A window process maps memory all the time (the GL driver): mlockall(MCL_FUTURE) would lock all of it,
+  /// or make its allocations fail under a memory-lock limit, so it sets false (the trace is touched in
+  /// advance instead) and keeps the real-time priority.
+  bool lock_memory = true;
 };
 
 /// What ran, and what it gave.
