@@ -265,7 +265,10 @@ TEST_CASE("A gzip-compressed trace reads as its text, and a damaged one is named
   CHECK_THROWS_WITH(read_pen_trace_csv(damaged.path, test_placement()), Catch::Contains("damaged.csv.gz"));
   // A small file whose text is over the limit is refused as it decompresses, not read whole.
   const TemporaryFile bomb("", "bomb.csv.gz");
-  write_gzip(bomb.path, "t,x,y,pen\n" + std::string(4 << 20, '#') + "\n");
+  std::string bomb_text = "t,x,y,pen\n";
+  bomb_text.append(std::size_t{4} << 20, '#');  // appended, not summed: GCC 12 warns of a false overflow
+  bomb_text += "\n";
+  write_gzip(bomb.path, bomb_text);
   REQUIRE(std::filesystem::file_size(bomb.path) < 64 * 1024);
   PenTraceCsvOptions small;
   small.max_file_bytes = 1 << 20;
@@ -301,4 +304,43 @@ TEST_CASE("A trial's trace is written to a fixed precision in the fewest charact
     CHECK(std::abs(samples[i].time_s - trace[i].time_s) <= 0.5e-6);
     CHECK((samples[i].position_m - trace[i].position_m.head<2>()).cwiseAbs().maxCoeff() <= 0.5e-7);
   }
+}
+
+TEST_CASE("A trial's trace is streamed row by row with its in-plane force over a raised paper",
+          "[pen_trace_csv]") {
+  std::vector<TrialSample> trace(3);
+  const double paper_z_m = 0.01;  // the paper 10 mm up in device space
+  for (std::size_t i = 0; i < trace.size(); ++i) {
+    trace[i].time_s = 0.001 * static_cast<double>(i);
+    trace[i].position_m = Vec3(0.001 * static_cast<double>(i), 0.002, paper_z_m);
+    trace[i].force_n = Vec3(0.3, -0.4, 2.0);
+  }
+  trace[1].position_m.z() = paper_z_m + 0.002;  // lifted 2 mm: above the 0.5 mm contact threshold
+  const TemporaryFile file(trial_csv(trace));
+  PenTraceCsvOptions options;
+  options.paper_z_m = paper_z_m;
+  options.read_force = true;
+  std::vector<PenTraceRow> rows;
+  for_each_pen_trace_row(file.path, test_placement(), options, [&rows](const PenTraceRow& r) { rows.push_back(r); });
+  REQUIRE(rows.size() == 3);
+  CHECK(rows[0].sample.pen_down);
+  CHECK_FALSE(rows[1].sample.pen_down);
+  CHECK(rows[2].sample.pen_down);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    CHECK(rows[i].in_plane_force_n == Approx(0.5).margin(1e-12));  // |(0.3, -0.4)|, fz left out
+    CHECK(rows[i].sample.time_s == trace[i].time_s);
+  }
+  // The same rows as the samples read whole; without the paper's height every sample is above the paper.
+  const std::vector<PenSample> whole = read_pen_trace_csv(file.path, test_placement(), options);
+  REQUIRE(whole.size() == rows.size());
+  for (std::size_t i = 0; i < whole.size(); ++i) CHECK(whole[i].pen_down == rows[i].sample.pen_down);
+  for (const PenSample& s : read_pen_trace_csv(file.path, test_placement())) CHECK_FALSE(s.pen_down);
+  // Force asked of a trace without it names the missing column; a bad force value names its column.
+  const TemporaryFile plain("t,x,y,pen\n0,0,0,1\n");
+  CHECK_THROWS_WITH(read_pen_trace_csv(plain.path, test_placement(), options), Catch::Contains("'fx'"));
+  const TemporaryFile bad("t,x,y,z,fx,fy\n0,0,0,0,0.1,nan\n");
+  CHECK_THROWS_WITH(read_pen_trace_csv(bad.path, test_placement(), options),
+                    Catch::Contains("trace.csv:2:") && Catch::Contains("(fy)"));
+  options.paper_z_m = std::nan("");
+  CHECK_THROWS_AS(read_pen_trace_csv(file.path, test_placement(), options), InvalidArgument);
 }

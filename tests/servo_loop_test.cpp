@@ -32,6 +32,7 @@ ServoLoopOptions test_options(double rate_hz = 1000.0) {
   ServoLoopOptions o;
   o.rate_hz = rate_hz;
   o.realtime = RealtimeMode::ignore;
+  o.priority = kDedicatedServoPriority;
   o.lock_memory = false;
   o.stall_timeout_s = 0.0;
   o.max_force_age_s = 1.0;
@@ -270,11 +271,29 @@ TEST_CASE("The statistics are readable from another thread while the loop runs",
   CHECK(last > 100);
 }
 
+TEST_CASE("The loop's defaults change nothing process-wide: no SCHED_FIFO, no locked memory", "[servo]") {
+  SimulatedDevice device;
+  device.open();
+  ServoLoopOptions defaults;
+  defaults.stall_timeout_s = 0.0;  // a loaded test machine may stall; not what this test is about
+  ServoLoop loop(device, [](const DeviceState&, double) { return ServoCommand{}; }, defaults);
+  loop.start();
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  loop.stop();
+  const RealtimeStatus realtime = loop.stats().realtime;
+  CHECK_FALSE(realtime.fifo_scheduling);
+  CHECK(realtime.priority == 0);
+  CHECK_FALSE(realtime.memory_locked);
+  CHECK(realtime.cpu == -1);
+  CHECK(realtime.problems.empty());  // nothing was asked, so nothing failed
+}
+
 TEST_CASE("Enforced realtime that cannot be had fails at start with the reason", "[servo]") {
   SimulatedDevice device;
   device.open();
   ServoLoopOptions o = test_options();
   o.realtime = RealtimeMode::enforce;
+  o.priority = kDedicatedServoPriority;  // the defaults ask for no priority, which enforce refuses
   o.cpu = 1023;  // no such CPU here: EINVAL (or EPERM for the priority when not privileged)
   const std::size_t threads_before = thread_count();
   ServoLoop loop(

@@ -15,22 +15,27 @@
 namespace calligraphy {
 namespace {
 
+bool is_blank(char c) { return c == ' ' || c == '\t'; }
+
 std::string_view trimmed(std::string_view s) {
-  const auto first = s.find_first_not_of(" \t");
-  if (first == std::string_view::npos) return {};
-  const auto last = s.find_last_not_of(" \t");
-  return s.substr(first, last - first + 1);
+  while (!s.empty() && is_blank(s.front())) s.remove_prefix(1);
+  while (!s.empty() && is_blank(s.back())) s.remove_suffix(1);
+  return s;
 }
 
-std::vector<std::string_view> fields_of(std::string_view line) {
-  std::vector<std::string_view> fields;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t comma = line.find(',', start);
-    fields.push_back(trimmed(
-        line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start)));
-    if (comma == std::string_view::npos) return fields;
-    start = comma + 1;
+// The first `wanted` fields of `line`, trimmed, into `fields` (kept between lines, so that a line allocates
+// nothing); returns how many fields the line has in all, the rest counted rather than split: a trace has
+// millions of lines and a reader needs a few of its columns.
+std::size_t split_fields(std::string_view line, std::size_t wanted, std::vector<std::string_view>& fields) {
+  fields.clear();
+  const char* start = line.data();
+  const char* const end = start + line.size();
+  for (const char* at = start;; ++at) {
+    if (at != end && *at != ',') continue;
+    fields.push_back(trimmed(std::string_view(start, static_cast<std::size_t>(at - start))));
+    if (at == end) return fields.size();
+    start = at + 1;
+    if (fields.size() == wanted) return wanted + 1 + static_cast<std::size_t>(std::count(start, end, ','));
   }
 }
 
@@ -40,12 +45,15 @@ struct Columns {
   std::size_t t = 0, x = 0, y = 0;
   std::optional<std::size_t> pen;
   std::optional<std::size_t> z;
+  std::size_t fx = 0, fy = 0;  // with PenTraceCsvOptions::read_force
+  std::size_t used = 0;        // the fields a row is read up to (one past the last column read)
 };
 
 class Reader {
  public:
-  Reader(const std::string& source, const Placement& placement, const PenTraceCsvOptions& options)
-      : source_(source), placement_(placement), options_(options) {}
+  Reader(const std::string& source, const Placement& placement, const PenTraceCsvOptions& options,
+         const std::function<void(const PenTraceRow&)>& sink)
+      : source_(source), placement_(placement), options_(options), sink_(sink) {}
 
   /// One line of the text, without its LF.
   void line(std::string_view line) {
@@ -55,27 +63,30 @@ class Reader {
     if (line_number_ == 1 && line.starts_with(kByteOrderMark)) line.remove_prefix(kByteOrderMark.size());
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (trimmed(line).empty() || trimmed(line).front() == '#') return;
-    const std::vector<std::string_view> fields = fields_of(line);
+    const std::size_t count = split_fields(line, columns_ ? columns_->used : fields_.max_size(), fields_);
+    const std::vector<std::string_view>& fields = fields_;
     if (!columns_) {
       header_.assign(fields.begin(), fields.end());
       columns_ = header(fields);
       return;
     }
-    if (samples_.size() == options_.max_samples) {
+    if (samples_ == options_.max_samples) {
       fail("more than " + std::to_string(options_.max_samples) +
            " samples, the limit of one trace (the rest of the file is not read)");
     }
-    samples_.push_back(row(fields, *columns_));
-    if (samples_.back().pen_down && (samples_.size() == 1 || !samples_[samples_.size() - 2].pen_down) &&
+    const PenTraceRow current = row(fields, count, *columns_);
+    if (current.sample.pen_down && (samples_ == 0 || !previous_.pen_down) &&
         ++pen_down_segments_ > options_.max_pen_down_segments) {
       fail("more than " + std::to_string(options_.max_pen_down_segments) +
            " pen-down segments, the limit of one scored trace (the rest of the file is not read)");
     }
-    if (samples_.size() > 1 && samples_.back().time_s < samples_[samples_.size() - 2].time_s) {
+    if (samples_ > 0 && current.sample.time_s < previous_.time_s) {
       fail(columns_->t, fields[columns_->t],
-           "time goes backwards (previous sample at " + std::to_string(samples_[samples_.size() - 2].time_s) +
-               " s)");
+           "time goes backwards (previous sample at " + std::to_string(previous_.time_s) + " s)");
     }
+    ++samples_;
+    previous_ = current.sample;
+    sink_(current);
   }
 
   /// The lines of `text` that end in LF; returns where the unfinished last line starts (text.size() when
@@ -92,16 +103,15 @@ class Reader {
     }
   }
 
-  std::vector<PenSample> finish(std::size_t total) {
+  void finish(std::size_t total) {
     if (!columns_) throw DataError(source_ + ": no header line (expected columns t, x, y and pen or z)");
     if (options_.progress) options_.progress(total, total);
-    return std::move(samples_);
   }
 
-  std::vector<PenSample> parse(std::string_view text) {
+  void parse(std::string_view text) {
     const std::size_t rest = lines(text, 0, text.size());
     if (rest < text.size()) line(text.substr(rest));
-    return finish(text.size());
+    finish(text.size());
   }
 
  private:
@@ -116,7 +126,7 @@ class Reader {
   Columns header(const std::vector<std::string_view>& names) {
     Columns c;
     c.count = names.size();
-    std::optional<std::size_t> t, x, y;
+    std::optional<std::size_t> t, x, y, fx, fy;
     for (std::size_t i = 0; i < names.size(); ++i) {
       for (std::size_t j = 0; j < i; ++j) {
         if (!names[i].empty() && names[i] == names[j])
@@ -127,9 +137,18 @@ class Reader {
       if (names[i] == "y") y = i;
       if (names[i] == "pen") c.pen = i;
       if (names[i] == "z") c.z = i;
+      if (names[i] == "fx") fx = i;
+      if (names[i] == "fy") fy = i;
     }
     for (const auto& [column, name] : {std::pair{t, "t"}, std::pair{x, "x"}, std::pair{y, "y"}}) {
       if (!column) fail(std::string("header has no column '") + name + "' (expected t, x, y and pen or z)");
+    }
+    if (options_.read_force) {
+      for (const auto& [column, name] : {std::pair{fx, "fx"}, std::pair{fy, "fy"}}) {
+        if (!column) fail(std::string("header has no column '") + name + "' (a trial's trace has fx and fy)");
+      }
+      c.fx = *fx;
+      c.fy = *fy;
     }
     if (!c.pen && !c.z) fail("header has neither a 'pen' nor a 'z' column");
     if (c.pen && c.z)
@@ -137,22 +156,28 @@ class Reader {
     c.t = *t;
     c.x = *x;
     c.y = *y;
+    c.used = 1 + std::max({c.t, c.x, c.y, c.pen.value_or(0), c.z.value_or(0), c.fx, c.fy});
     return c;
   }
 
   double number(const std::vector<std::string_view>& fields, std::size_t column) const {
     const std::string_view field = fields[column];
+    // A plain decimal (a trial's trace has millions) read where it stands, to the same value as
+    // parse_finite_double gives but without the round trip through its optional, which costs as much again.
+    double plain = 0.0;
+    const char* const end = field.data() + field.size();
+    if (!field.empty() && parse_plain_decimal(field.data(), end, plain) == end) return plain;
     const std::optional<double> value = parse_finite_double(field);
     if (!value)
       fail(column, field, "not a number (a finite decimal within the range of a double is expected)");
     return *value;
   }
 
-  PenSample row(const std::vector<std::string_view>& fields, const Columns& c) const {
-    if (fields.size() != c.count) {
-      fail(std::to_string(fields.size()) + " fields, the header has " + std::to_string(c.count));
-    }
-    PenSample s;
+  // `fields`: the row's first c.used fields; `count`: its fields in all.
+  PenTraceRow row(const std::vector<std::string_view>& fields, std::size_t count, const Columns& c) const {
+    if (count != c.count) fail(std::to_string(count) + " fields, the header has " + std::to_string(c.count));
+    PenTraceRow r;
+    PenSample& s = r.sample;
     s.time_s = number(fields, c.t);
     const Vec2 xy(number(fields, c.x), number(fields, c.y));
     s.position_m = options_.units == TraceUnits::data ? placement_.to_paper(xy) : xy;
@@ -162,19 +187,23 @@ class Reader {
       if (pen != "0" && pen != "1") fail(*c.pen, pen, "pen must be 1 (down) or 0 (up)");
       s.pen_down = pen == "1";
     } else {
-      s.pen_down = number(fields, *c.z) <= options_.contact_threshold_m;
+      s.pen_down = number(fields, *c.z) - options_.paper_z_m <= options_.contact_threshold_m;
     }
-    return s;
+    if (options_.read_force) r.in_plane_force_n = Vec2(number(fields, c.fx), number(fields, c.fy)).norm();
+    return r;
   }
 
   const std::string& source_;
   const Placement& placement_;
   const PenTraceCsvOptions& options_;
+  const std::function<void(const PenTraceRow&)>& sink_;
   static constexpr std::size_t kProgressLines = std::size_t{1} << 16;
   std::size_t line_number_ = 0;
   std::vector<std::string> header_;
   std::optional<Columns> columns_;
-  std::vector<PenSample> samples_;
+  std::vector<std::string_view> fields_;
+  std::size_t samples_ = 0;  // given to the sink
+  PenSample previous_;       // the last of them
   std::size_t pen_down_segments_ = 0;
 };
 
@@ -182,6 +211,10 @@ void check_options(const PenTraceCsvOptions& options, const Placement& placement
   if (!std::isfinite(options.contact_threshold_m)) {
     throw InvalidArgument("PenTraceCsvOptions: contact threshold " +
                           std::to_string(options.contact_threshold_m) + " m is not finite");
+  }
+  if (!std::isfinite(options.paper_z_m)) {
+    throw InvalidArgument("PenTraceCsvOptions: paper height " + std::to_string(options.paper_z_m) +
+                          " m is not finite");
   }
   if (options.max_file_bytes == 0) throw InvalidArgument("PenTraceCsvOptions: max_file_bytes is 0");
   if (options.max_samples == 0) throw InvalidArgument("PenTraceCsvOptions: max_samples is 0");
@@ -207,18 +240,23 @@ TraceUnits parse_trace_units(std::string_view name) {
 std::vector<PenSample> parse_pen_trace_csv(std::string_view text, const std::string& source,
                                            const Placement& placement, const PenTraceCsvOptions& options) {
   check_options(options, placement);
-  return Reader(source, placement, options).parse(text);
+  std::vector<PenSample> samples;
+  const std::function<void(const PenTraceRow&)> keep = [&samples](const PenTraceRow& r) {
+    samples.push_back(r.sample);
+  };
+  Reader(source, placement, options, keep).parse(text);
+  return samples;
 }
 
-std::vector<PenSample> read_pen_trace_csv(const std::filesystem::path& file, const Placement& placement,
-                                          const PenTraceCsvOptions& options) {
+void for_each_pen_trace_row(const std::filesystem::path& file, const Placement& placement,
+                            const PenTraceCsvOptions& options, const std::function<void(const PenTraceRow&)>& row) {
   check_options(options, placement);
-  // Streamed a block at a time (decompressed on the way for a gzip file), so that memory holds the samples
-  // read, not the file: a trace over a limit is refused at its line without the rest being read.
+  // Streamed a block at a time (decompressed on the way for a gzip file), so that memory holds a block, not
+  // the file: a trace over a limit is refused at its line without the rest being read.
   const std::string name = file.string();
   TextFileReader in(file, options.max_file_bytes, options.max_file_bytes);
   const auto size = static_cast<std::size_t>(in.file_bytes());
-  Reader reader(name, placement, options);
+  Reader reader(name, placement, options, row);
   constexpr std::size_t kBlockBytes = std::size_t{1} << 20;
   std::string buffer;  // an unfinished line, then the next block
   while (true) {
@@ -232,7 +270,14 @@ std::vector<PenSample> read_pen_trace_csv(const std::filesystem::path& file, con
     buffer.erase(0, rest);
   }
   if (!buffer.empty()) reader.line(buffer);
-  return reader.finish(size);
+  reader.finish(size);
+}
+
+std::vector<PenSample> read_pen_trace_csv(const std::filesystem::path& file, const Placement& placement,
+                                          const PenTraceCsvOptions& options) {
+  std::vector<PenSample> samples;
+  for_each_pen_trace_row(file, placement, options, [&samples](const PenTraceRow& r) { samples.push_back(r.sample); });
+  return samples;
 }
 
 }  // namespace calligraphy

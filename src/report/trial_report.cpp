@@ -13,7 +13,7 @@
 #include "calligraphy/model/typical_strokes.hpp"
 #include "core/unicode.hpp"
 #include "model/polyline.hpp"
-#include "report/metrics_object.hpp"
+#include "report/trial_outcome.hpp"
 
 namespace calligraphy {
 namespace {
@@ -125,34 +125,20 @@ void print_trial_table(const TrialDescription& d, const Scene& scene, const Tria
 }
 
 std::string trial_json(const TrialDescription& d, const TrialResult& result, const WritingMetrics& writing) {
-  const TrialMetrics& m = result.metrics;
   // The renderer's view of each stroke (its attempts, whether it completed it in turn); what was written is
-  // the one metrics record merged in below.
+  // the one metrics record in the outcome.
   nlohmann::json renderer_strokes = nlohmann::json::array();
-  for (const StrokeMetrics& s : m.per_stroke) {
-    renderer_strokes.push_back({{"index", s.index},
-                                {"character", s.character},
-                                {"typical_id", s.typical_id},
-                                {"completed", s.completed},
-                                {"attempts", s.attempts}});
-  }
-  nlohmann::json doc = {{"character", d.characters},
-                        {"guidance", d.guidance},
-                        {"writer", d.writer},
-                        {"seed", d.seed},
-                        {"rate_hz", d.rate_hz},
-                        {"device", d.device},
-                        {"aborted", result.aborted},
-                        {"end_reason", to_string(result.end)},
-                        {"abort_reason", result.abort_reason},
-                        {"strokes_completed", m.strokes_completed},
-                        {"trial_time_s", m.time_s},
-                        {"device_time_at_start_s", result.device_time_at_start_s},
-                        {"max_force_n", m.max_force_n},
-                        {"max_force_step_n", m.max_force_step_n},
-                        {"state_transitions", m.state_transitions},
-                        {"renderer_strokes", renderer_strokes}};
-  doc.update(report_detail::writing_metrics_object(writing));
+  for (const StrokeMetrics& s : result.metrics.per_stroke)
+    renderer_strokes.push_back(report_detail::renderer_stroke_object(s));
+  nlohmann::json doc = report_detail::trial_outcome_object(result, writing);
+  doc.update({{"character", d.characters},
+              {"guidance", d.guidance},
+              {"writer", d.writer},
+              {"seed", d.seed},
+              {"rate_hz", d.rate_hz},
+              {"device", d.device},
+              {"device_time_at_start_s", result.device_time_at_start_s},
+              {"renderer_strokes", renderer_strokes}});
   if (result.loop) doc["loop"] = loop_json(*result.loop);  // real-time trials only
   doc["guidance_mode"] = to_string(d.guidance_mode);
   if (d.guidance_mode == GuidanceMode::fading) doc["guidance_gain"] = d.guidance_gain;

@@ -1,16 +1,13 @@
 #include "calligraphy/study/session_reader.hpp"
 
-#include <algorithm>
-#include <charconv>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/report/pen_trace_csv.hpp"
-#include "core/decimal_number.hpp"
 #include "core/unicode.hpp"
-#include "report/compressed_text.hpp"
 #include "study/json_reader.hpp"
 #include "study/names.hpp"
 #include "study/saved_sessions.hpp"
@@ -49,99 +46,40 @@ void read_scene(const study_detail::JsonView& record, ReportTrial& trial) {
   }
 }
 
-double parse_field(std::string_view field, const std::string& source, std::size_t line, const char* column) {
-  const std::optional<double> value = parse_finite_double(field);
-  if (!value) {
-    throw DataError(source + ":" + std::to_string(line) + ": column " + column + ": not a finite number: '" +
-                    std::string(field) + "'");
-  }
-  return *value;
+// The name of the trace file a record names beside it (files.csv): a plain name, never a path.
+std::string trace_file_name(const study_detail::JsonView& record) {
+  const std::string csv = record.object("files").string_or("csv", "");
+  if (csv.empty() || csv.find('/') != std::string::npos)
+    fail(record.source(), "/files/csv", "expected a file name");
+  return csv;
 }
 
-// A trace line's first six fields (t, x, y, z, fx, fy) as finite numbers, each followed by a comma, and
-// the line's `field_count` fields in all: true; false for anything else (the field-by-field reading names
-// the fault).
-bool read_leading_numbers(std::string_view line, std::size_t field_count, std::array<double, 6>& values) {
-  const char* at = line.data();
-  const char* const end = at + line.size();
-  for (double& value : values) {
-    const char* next = parse_plain_decimal(at, end, value);
-    if (next == nullptr) {  // an exponent, more digits: the full parse
-      const auto [parsed, error] = std::from_chars(at, end, value);
-      if (error != std::errc() || !std::isfinite(value)) return false;
-      next = parsed;
-    }
-    if (next == end || *next != ',') return false;
-    at = next + 1;
-  }
-  // The rest: state, stroke, element (and attempt, rewritten in a marked trace).
-  return static_cast<std::size_t>(std::count(at, end, ',')) == field_count - 7;
-}
-
-// The trial's trace (t,x,y,z,fx,fy,fz,state,stroke,element[,attempt,rewritten]: traces saved before attempts
-// were marked lack the last two; gzip or plain CSV), streamed: times, positions, pen down, in-plane force.
+// The trial's trace (trial_csv: t,x,y,z,fx,fy,fz,state,stroke,element[,attempt,rewritten], gzip or plain CSV)
+// through the one trace parser, streamed: times, positions, pen down, in-plane force.
 void read_trace(const fs::path& file, double paper_z_m, ReportTrial& trial) {
-  const std::string source = file.string();
-  TextFileReader reader(file, kMaxTrialCsvBytes, kMaxTrialCsvBytes);
-  const double contact_m = PenTraceCsvOptions{}.contact_threshold_m;
-  std::size_t line_number = 0;
-  constexpr std::string_view kHeader = "t,x,y,z,fx,fy,fz,state,stroke,element";
-  constexpr std::string_view kMarkedHeader = "t,x,y,z,fx,fy,fz,state,stroke,element,attempt,rewritten";
-  std::size_t field_count = 10;
-  constexpr std::size_t kMaxLineBytes = 4096;
-  for_each_line(reader, source, kMaxLineBytes, [&](std::string_view line) {
-    ++line_number;
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    if (line_number == 1) {
-      if (line != kHeader && line != kMarkedHeader) {
-        throw DataError(source + ":1: expected the header '" + std::string(kMarkedHeader) + "' (or '" +
-                        std::string(kHeader) + "')");
-      }
-      field_count = line == kMarkedHeader ? 12 : 10;
-      return;
-    }
-    if (line.empty()) return;
-    std::array<double, 6> values{};
-    if (read_leading_numbers(line, field_count, values)) {  // the common case, parsed where it stands
-      if (!trial.time_s.empty() && values[0] < trial.time_s.back()) {
-        throw DataError(source + ":" + std::to_string(line_number) + ": time goes backwards");
-      }
-      trial.time_s.push_back(values[0]);
-      trial.position_m.emplace_back(values[1], values[2]);
-      trial.pen_down.push_back(values[3] - paper_z_m <= contact_m);
-      trial.in_plane_force_n.push_back(Vec2(values[4], values[5]).norm());
-      return;
-    }
-    // Anything else field by field, so that an error names the field.
-    std::array<std::string_view, 12> fields;
-    std::size_t count = 0, start = 0;
-    while (count < fields.size()) {
-      const std::size_t comma = line.find(',', start);
-      fields[count++] =
-          line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
-      if (comma == std::string_view::npos) break;
-      start = comma + 1;
-    }
-    if (count != field_count) {
-      throw DataError(source + ":" + std::to_string(line_number) + ": expected " +
-                      std::to_string(field_count) + " fields, got " + std::to_string(count));
-    }
-    const double t = parse_field(fields[0], source, line_number, "t");
-    if (!trial.time_s.empty() && t < trial.time_s.back()) {
-      throw DataError(source + ":" + std::to_string(line_number) + ": time goes backwards");
-    }
-    const Vec2 position(parse_field(fields[1], source, line_number, "x"),
-                        parse_field(fields[2], source, line_number, "y"));
-    const double z = parse_field(fields[3], source, line_number, "z");
-    const Vec2 force(parse_field(fields[4], source, line_number, "fx"),
-                     parse_field(fields[5], source, line_number, "fy"));
-    trial.time_s.push_back(t);
-    trial.position_m.push_back(position);
-    trial.pen_down.push_back(z - paper_z_m <= contact_m);
-    trial.in_plane_force_n.push_back(force.norm());
+  PenTraceCsvOptions options;
+  options.paper_z_m = paper_z_m;
+  options.read_force = true;
+  options.max_file_bytes = kMaxTrialCsvBytes;
+  // A study trial's trace is drawn, not scored: no limit on samples or segments beside the size's.
+  options.max_samples = std::numeric_limits<std::size_t>::max();
+  options.max_pen_down_segments = std::numeric_limits<std::size_t>::max();
+  for_each_pen_trace_row(file, Placement{}, options, [&trial](const PenTraceRow& row) {
+    trial.time_s.push_back(row.sample.time_s);
+    trial.position_m.push_back(row.sample.position_m);
+    trial.pen_down.push_back(row.sample.pen_down);
+    trial.in_plane_force_n.push_back(row.in_plane_force_n);
   });
-  if (line_number == 0)
-    throw DataError(source + ":1: expected the header '" + std::string(kMarkedHeader) + "'");
+}
+
+// The tidy tables' rows of the saved trial whose record `document` was read from `json_file`: the one
+// reading of a record into rows, for the tables alone and beside the pages.
+void append_trial_rows(const json& document, const fs::path& json_file, const SessionManifest& manifest,
+                       const PlannedTrial& plan, StudyTables& rows) {
+  const std::string source = json_file.string();
+  TrialRow row = study_detail::trial_row(document, source, manifest, plan, rows.strokes);
+  row.trace_file = json_file.parent_path() / trace_file_name(study_detail::JsonView(document, "", source));
+  rows.trials.push_back(std::move(row));
 }
 
 ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifest, const PlannedTrial& plan,
@@ -149,14 +87,8 @@ ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifes
   const std::string source = json_file.string();
   const json document = study_detail::read_trial_record(json_file);
   const study_detail::JsonView record(document, "", source);
-  if (rows != nullptr) {  // the tidy tables' rows from the same parse of the record
-    TrialRow row = study_detail::trial_row(document, source, manifest, plan, rows->strokes);
-    const std::string trace = record.object("files").string_or("csv", "");
-    if (trace.empty() || trace.find('/') != std::string::npos)
-      fail(source, "/files/csv", "expected a file name");
-    row.trace_file = json_file.parent_path() / trace;
-    rows->trials.push_back(std::move(row));
-  }
+  // the tidy tables' rows from the same parse of the record
+  if (rows != nullptr) append_trial_rows(document, json_file, manifest, plan, *rows);
   ReportTrial trial;
   trial.subject = manifest.setup.subject.id;
   trial.session = manifest.session_id;
@@ -189,8 +121,7 @@ ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifes
     trial.strokes.push_back({i, *start_s, *end_s, stroke.boolean_or("completed", false)});
   }
   const double paper_z = record.object("scene").object("layout").number_or("paper_z_m", 0.0, -1e6, 1e6);
-  const std::string csv = record.object("files").string_or("csv", "");
-  if (csv.empty() || csv.find('/') != std::string::npos) fail(source, "/files/csv", "expected a file name");
+  const std::string csv = trace_file_name(record);
   try {
     read_trace(json_file.parent_path() / csv, paper_z, trial);
   } catch (const DataError& e) {  // the record names the trace: it is the record that is at fault
@@ -276,6 +207,14 @@ void read_session_trials(const ReportedSession& session, const std::function<voi
   for (const PlannedTrial& plan : session.manifest.plan) {
     if (!is_saved(session.folder, plan)) continue;  // not saved (yet): a running session can be reported
     trial(read_trial(trial_record_file(session.folder, plan), session.manifest, plan, rows));
+  }
+}
+
+void read_session_rows(const ReportedSession& session, StudyTables& rows) {
+  for (const PlannedTrial& plan : session.manifest.plan) {
+    if (!is_saved(session.folder, plan)) continue;  // not saved (yet): a running session can be read
+    const fs::path json_file = trial_record_file(session.folder, plan);
+    append_trial_rows(study_detail::read_trial_record(json_file), json_file, session.manifest, plan, rows);
   }
 }
 

@@ -4,11 +4,10 @@
 #include <nlohmann/json.hpp>
 
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/study/session_folder.hpp"
+#include "calligraphy/study/session_reader.hpp"
 #include "core/unicode.hpp"
 #include "study/json_reader.hpp"
 #include "study/names.hpp"
-#include "study/saved_sessions.hpp"
 #include "study/trial_row.hpp"
 
 namespace calligraphy {
@@ -75,17 +74,6 @@ void add_strokes(const JsonView& character, std::size_t index, const TrialRow& t
       row.refusal = verdict.string_or("refusal", "");
     }
   }
-}
-
-TrialRow read_trial_row(const fs::path& json_file, const SessionManifest& manifest, const PlannedTrial& plan,
-                        std::vector<StrokeRow>& strokes) {
-  const std::string source = json_file.string();
-  const json record = study_detail::read_trial_record(json_file);
-  TrialRow row = study_detail::trial_row(record, source, manifest, plan, strokes);
-  const std::string csv = JsonView(record, "", source).object("files").string_or("csv", "");
-  if (csv.empty() || csv.find('/') != std::string::npos) fail(source, "/files/csv", "expected a file name");
-  row.trace_file = json_file.parent_path() / csv;
-  return row;
 }
 
 }  // namespace
@@ -188,19 +176,8 @@ void line(std::string& out, const Fields&... fields) {
 }  // namespace
 
 StudyTables read_study_tables(const std::vector<fs::path>& roots) {
-  const std::vector<fs::path> folders = study_detail::session_folders_under(roots);
-  study_detail::DistinctSessions distinct;
-  StudyTables tables;
-  for (const fs::path& folder : folders) {
-    const SessionManifest manifest = study_detail::read_session_manifest(folder);
-    if (!distinct.add(folder, manifest)) continue;
-    for (const PlannedTrial& plan : manifest.plan) {
-      const fs::path json_file = folder / "trials" / (SessionFolder::trial_stem(plan) + ".json");
-      std::error_code error;
-      if (!fs::exists(json_file, error)) continue;  // not saved (yet): a running session can be read
-      tables.trials.push_back(read_trial_row(json_file, manifest, plan, tables.strokes));
-    }
-  }
+  StudyTables tables;  // the folders read by the one reader of sessions, its records only
+  for (const ReportedSession& session : list_report_sessions(roots).sessions) read_session_rows(session, tables);
   return tables;
 }
 

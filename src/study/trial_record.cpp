@@ -6,10 +6,10 @@
 #include "calligraphy/legibility/legibility.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
 #include "calligraphy/report/pen_trace_csv.hpp"
-#include "calligraphy/report/score_report.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
 #include "core/unicode.hpp"
 #include "model/polyline.hpp"
+#include "report/trial_outcome.hpp"
 #include "study/manifest_json.hpp"
 #include "study/remembered_writer.hpp"
 
@@ -292,23 +292,21 @@ json legibility_json(const Scene& scene, const TrialResult& result) {
 
 nlohmann::json trial_record(const TrialRecordContext& c, const Scene& scene, const TrialResult& result,
                             const WritingMetrics& writing, const std::vector<std::vector<QuizEvent>>* quiz) {
-  const TrialMetrics& m = result.metrics;
   json per_stroke = json::array();
-  for (const StrokeMetrics& s : m.per_stroke) {
+  for (const StrokeMetrics& s : result.metrics.per_stroke) {
     const bool has_trace = s.trace_end > s.trace_begin && s.trace_end <= result.trace.size();
-    // The renderer's view of the stroke (attempts, completed in turn, when); what was written is in the
-    // one metrics record below.
-    per_stroke.push_back({{"index", s.index},
-                          {"character", s.character},
-                          {"typical_id", s.typical_id},
-                          {"completed", s.completed},
-                          {"attempts", s.attempts},
-                          {"start_s", has_trace ? json(result.trace[s.trace_begin].time_s) : json(nullptr)},
-                          {"end_s", has_trace ? json(result.trace[s.trace_end - 1].time_s) : json(nullptr)}});
+    // The renderer's view of the stroke (attempts, completed in turn) and when it was written.
+    json stroke = report_detail::renderer_stroke_object(s);
+    stroke["start_s"] = has_trace ? json(result.trace[s.trace_begin].time_s) : json(nullptr);
+    stroke["end_s"] = has_trace ? json(result.trace[s.trace_end - 1].time_s) : json(nullptr);
+    per_stroke.push_back(std::move(stroke));
   }
   const PlannedTrial& t = *c.trial;
+  // How the trial ended, the renderer's figures and the one metrics record, as every trial record holds
+  // them; then what a study adds.
+  json document = report_detail::trial_outcome_object(result, writing);
   // Version 2: the trial's block and item count from 1, as its index and repetition (version 1: from 0).
-  json document = {{"format", kFormat},
+  document.update({{"format", kFormat},
                    {"version", 2},
                    {"subject", c.session->setup.subject.id},
                    {"subject_number", c.session->setup.subject.number},
@@ -337,18 +335,9 @@ nlohmann::json trial_record(const TrialRecordContext& c, const Scene& scene, con
                    {"force_law", force_law_json(c.options->force)},
                    {"renderer", renderer_json(*c.options)},
                    {"scene", scene_json(scene)},
-                   {"end_reason", to_string(result.end)},
-                   {"aborted", result.aborted},
-                   {"abort_reason", result.abort_reason},
-                   {"strokes_completed", m.strokes_completed},
-                   {"trial_time_s", m.time_s},
-                   {"max_force_n", m.max_force_n},
-                   {"max_force_step_n", m.max_force_step_n},
-                   {"state_transitions", m.state_transitions},
                    {"per_stroke", per_stroke},
                    {"samples", result.trace.size()},
-                   {"files", {{"csv", c.csv_file}, {"svg", c.svg_file}}}};
-  document.update(json::parse(writing_metrics_json(writing)));  // the one metrics record
+                   {"files", {{"csv", c.csv_file}, {"svg", c.svg_file}}}});
   if (json legibility = legibility_json(scene, result); !legibility.is_null())
     document["legibility"] = legibility;
   if (c.device_name == "simulated") document["device"]["simulated_device"] = simulated_device_json();

@@ -1,11 +1,14 @@
 #pragma once
 /// \file pen_trace_csv.hpp
-/// Reading a pen trace from CSV for `score_trace` (analysis/score.hpp).
+/// Reading a pen trace from CSV: the one parser of trace files, for `score_trace` (analysis/score.hpp) and
+/// for a saved trial's trace (`trial_csv`, trial_report.hpp) that the per-trial pages draw
+/// (study/session_reader.hpp).
 ///
 /// Format: comma-separated, one header line naming the columns, then one sample a line. Columns are found
 /// by header name (others are ignored, order is free): `t` time [s], `x` and `y` the pen tip, and either
-/// `pen` (1 = touching the paper, 0 = lifted) or `z`, the height of the tip above the paper [m] (the pen
-/// touches when z <= the contact threshold). Blank lines and lines starting with `#` are skipped; a line
+/// `pen` (1 = touching the paper, 0 = lifted) or `z`, the height of the tip [m] (the pen touches when
+/// z - the paper's height <= the contact threshold); with `PenTraceCsvOptions::read_force`, also `fx` and
+/// `fy`, the force [N]. Blank lines and lines starting with `#` are skipped; a line
 /// may end in CR LF; fields may be padded with spaces; no quoting. Times must not decrease. A UTF-8
 /// byte-order mark at the start (as spreadsheet programs write) is skipped.
 ///
@@ -40,6 +43,11 @@ struct PenTraceCsvOptions {
   /// With a `z` column: the pen touches the paper when z <= this [m] (kPenContactThresholdM, score.hpp).
   /// Finite.
   double contact_threshold_m = kPenContactThresholdM;
+  /// With a `z` column: the height of the paper [m], which z is measured from (a trial's trace gives z in
+  /// device space: its scene's SceneLayout::paper_z_m). Finite.
+  double paper_z_m = 0.0;
+  /// Also read the columns `fx` and `fy` [N] (then required), as a trial's trace has them.
+  bool read_force = false;
   /// Larger files are refused (256 MiB), and a gzip file whose text is larger.
   std::uintmax_t max_file_bytes = std::uintmax_t{256} << 20;
   /// A trace with more pen-down segments is refused at the line that starts the first one too many
@@ -62,6 +70,19 @@ struct PenTraceCsvOptions {
 std::vector<PenSample> parse_pen_trace_csv(std::string_view text, const std::string& source,
                                            const Placement& placement,
                                            const PenTraceCsvOptions& options = {});
+
+/// One sample of a trace as `for_each_pen_trace_row` gives it.
+struct PenTraceRow {
+  PenSample sample;
+  /// |(fx, fy)|, the force in the paper plane [N], with PenTraceCsvOptions::read_force; 0 without.
+  double in_plane_force_n = 0.0;
+};
+
+/// Reads a CSV file as `read_pen_trace_csv` does (the same format, limits and errors), calling `row` with
+/// each sample in turn instead of keeping them: memory holds a block of the file, not its samples. `row` may
+/// throw to stop the reading.
+void for_each_pen_trace_row(const std::filesystem::path& file, const Placement& placement,
+                            const PenTraceCsvOptions& options, const std::function<void(const PenTraceRow&)>& row);
 
 /// Reads and parses a CSV file, a block at a time (memory holds the samples, not the file). A gzip file
 /// (RFC 1952, by its first bytes: a saved trial's `.csv.gz`) is decompressed on the way. Throws DataError

@@ -1,8 +1,9 @@
 #pragma once
 /// \file session_reader.hpp
-/// Reads saved sessions back for the per-trial pages (report/study_report_html.hpp): the session folders
-/// under given roots (session_folder.hpp), then one session's saved trials at a time, each trial's JSON
-/// record and trace (`.csv.gz`, or a plain `.csv` of older folders) read as it is needed and dropped after,
+/// The one reader of saved sessions, for the per-trial pages (report/study_report_html.hpp) and the tidy
+/// tables (study_tables.hpp): the session folders under given roots (session_folder.hpp), then one session's
+/// saved trials at a time, each trial's JSON record and trace (`.csv.gz`, or a plain `.csv` of older
+/// folders; read by the pen-trace reader, report/pen_trace_csv.hpp) read as it is needed and dropped after,
 /// so memory holds one trial, not the study. Reading takes no lock, so a running session can be reported;
 /// trials not saved yet are left out.
 #include <filesystem>
@@ -44,5 +45,10 @@ struct StudyReportSessions {
 /// that cannot be read is at fault).
 void read_session_trials(const ReportedSession& session, const std::function<void(const ReportTrial&)>& trial,
                          StudyTables* rows = nullptr);
+
+/// Appends the rows of the tidy tables of each saved trial of `session` to `rows`, in planned order, from its
+/// record alone (the trace is not read; a row names it). Throws DataError naming the file and JSON pointer
+/// for a damaged trial record.
+void read_session_rows(const ReportedSession& session, StudyTables& rows);
 
 }  // namespace calligraphy

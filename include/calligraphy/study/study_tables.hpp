@@ -1,10 +1,11 @@
 #pragma once
 /// \file study_tables.hpp
 /// A study as tidy tables (Wickham 2014, "Tidy data", J Stat Softw 59(10)): one row per saved trial and one
-/// row per reference stroke of each saved trial, read from session folders (session_folder.hpp). The metrics
-/// are the one metrics record each trial record holds (writing_metrics.hpp), in SI units with the unit in
-/// every column name; indices count from 1 (trial, block, item, repetition, character, stroke), as the trial
-/// files' numbers (001-..., r1) and session numbers do. `calligraphy report --csv DIR` writes them as CSV and
+/// row per reference stroke of each saved trial, read from session folders (session_folder.hpp) by the one
+/// reader of sessions (session_reader.hpp). The metrics are the one metrics record each trial record holds
+/// (writing_metrics.hpp), in SI units with the unit in every column name; indices count from 1 (trial,
+/// block, item, repetition, character, stroke), as the trial files' numbers (001-..., r1) and session
+/// numbers do. `calligraphy report --csv DIR` writes them as CSV and
 /// Python's `calligraphy.study.load` gives them as pandas DataFrames. The traces are not read: a row names
 /// its trace file, read on demand. Columns and meaning: docs/experiments.md ("Tidy tables").
 #include <cstddef>
