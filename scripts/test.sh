@@ -173,7 +173,8 @@ cmake --no-warn-unused-cli -S tests/consumer/haptics -B build/consumer-haptics -
   -DCMAKE_DISABLE_FIND_PACKAGE_spdlog=ON -DCMAKE_DISABLE_FIND_PACKAGE_fmt=ON \
   -DCMAKE_DISABLE_FIND_PACKAGE_OpenSSL=ON >/dev/null
 cmake --build build/consumer-haptics
-bash tests/consumer/check_link_line.sh build/consumer-haptics/own_loop build/consumer-haptics/custom_device_loop
+bash tests/consumer/check_link_line.sh build/consumer-haptics build/consumer-haptics/own_loop \
+  build/consumer-haptics/custom_device_loop
 build/consumer-haptics/own_loop
 build/consumer-haptics/custom_device_loop
 end_stage

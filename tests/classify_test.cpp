@@ -1,6 +1,7 @@
 // The 39 typical strokes, their classification against cnchar-order's labels, the robustness of the
 // fitting to hanzi-writer-data's quirks (brush hooks, rounded corners), and the Fig. 13 drawing of a model.
 #include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -15,7 +16,7 @@
 #include "calligraphy/model/typical_strokes.hpp"
 #include "calligraphy/report/model_svg.hpp"
 #include "eval/cnchar_validation.hpp"
-#include "report/typical_strokes_report.hpp"
+#include "calligraphy/report/typical_strokes_report.hpp"
 
 using namespace calligraphy;
 
@@ -88,13 +89,13 @@ TEST_CASE("Typical strokes: unique acronyms and code points, Unicode block facts
 TEST_CASE("docs/typical-strokes.md is what 'calligraphy strokes --markdown' generates", "[strokes]") {
   const std::string committed =
       read_text(std::filesystem::path(CALLIGRAPHY_SOURCE_DIR) / "docs/typical-strokes.md");
-  CHECK(committed == cli::typical_strokes_markdown());
-  const auto json = cli::typical_strokes_json();
+  CHECK(committed == typical_strokes_markdown());
+  const auto json = nlohmann::json::parse(typical_strokes_json());
   REQUIRE(json.size() == 39);
   CHECK(json[9]["acronym"] == "HZG");
   CHECK(json[9]["unicode"] == "U+31C6");
   CHECK(json[32]["unicode"].is_null());  // 左点 has no code point
-  CHECK(count(cli::typical_strokes_text(), "\n") == 40);
+  CHECK(count(typical_strokes_text(), "\n") == 40);
 }
 
 TEST_CASE("cnchar letters: every ID maps to one of cnchar's 26 letters, each letter reached", "[classify]") {

@@ -1,6 +1,6 @@
 // parse_finite_double (src/core/decimal_number.hpp), the one reading of a decimal number from text that
 // options, CSV fields and writer settings share: every finite double is read, subnormal ones included.
-#include "core/decimal_number.hpp"
+#include "calligraphy/core/decimal_number.hpp"
 
 #include <catch2/catch.hpp>
 #include <cstdio>

@@ -8,7 +8,7 @@
 #include "calligraphy/model/fitting.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 
 using namespace calligraphy;
 

@@ -1,7 +1,7 @@
 #include "character_source.hpp"
 
 #include "calligraphy/core/errors.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 
 namespace calligraphy::python {
 

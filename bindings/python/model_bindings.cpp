@@ -18,7 +18,7 @@
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
 #include "character_source.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "numpy_arrays.hpp"
 #include "parameter_class.hpp"
 

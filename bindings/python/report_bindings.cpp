@@ -19,7 +19,7 @@
 #include "calligraphy/study/study_tables.hpp"
 #include "calligraphy/study/transfer_set.hpp"
 #include "character_source.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 
 namespace calligraphy::python {
 

@@ -19,7 +19,7 @@
 #include "calligraphy/report/score_report.hpp"
 #include "calligraphy/analysis/writing_metrics.hpp"
 #include "character_source.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 
 namespace calligraphy::python {
 namespace {

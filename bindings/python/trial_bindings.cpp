@@ -24,7 +24,7 @@
 #include "calligraphy/study/trial_spec_runner.hpp"
 #include "calligraphy/trial/trial.hpp"
 #include "character_source.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "log_forwarding.hpp"
 #include "model_bindings.hpp"
 #include "numpy_arrays.hpp"

@@ -7,7 +7,7 @@
 #include <memory>
 #include <system_error>
 
-#include "core/decimal_number.hpp"
+#include "calligraphy/core/decimal_number.hpp"
 
 namespace calligraphy::cli {
 namespace {

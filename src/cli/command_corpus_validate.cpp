@@ -13,7 +13,7 @@
 #include "cli/library_options.hpp"
 #include "cli/output.hpp"
 #include "eval/cnchar_validation.hpp"
-#include "report/appendf.hpp"
+#include <fmt/printf.h>
 
 namespace calligraphy::cli {
 namespace {
@@ -30,17 +30,16 @@ struct ValidateCommand {
 std::string summary_text(const CncharValidation& result, const std::string& data_description, double seconds,
                          unsigned threads) {
   std::string out;
-  appendf(out, "cnchar labels: %zu characters; data: %s\n", result.labelled, data_description.c_str());
-  appendf(
-      out,
+  out += fmt::sprintf("cnchar labels: %zu characters; data: %s\n", result.labelled, data_description.c_str());
+  out += fmt::sprintf(
       "compared %zu characters (%zu strokes); skipped %zu not in the data, %zu with other stroke counts\n",
       result.compared, result.strokes, result.missing, result.count_mismatch.size());
-  appendf(out, "per-stroke agreement %.2f %% (%zu of %zu); characters fully agreeing %.2f %%\n",
+  out += fmt::sprintf("per-stroke agreement %.2f %% (%zu of %zu); characters fully agreeing %.2f %%\n",
           100.0 * result.agreement(), result.agreeing, result.strokes,
           result.compared ? 100.0 * static_cast<double>(result.characters_all_agree) /
                                 static_cast<double>(result.compared)
                           : 0.0);
-  appendf(out, "fit and classify: %.2f s on %u thread(s)\n", seconds, threads);
+  out += fmt::sprintf("fit and classify: %.2f s on %u thread(s)\n", seconds, threads);
   return out;
 }
 

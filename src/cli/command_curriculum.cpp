@@ -13,7 +13,7 @@
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 #include "cli/output.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 
 namespace calligraphy::cli {
 namespace {

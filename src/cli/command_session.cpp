@@ -26,7 +26,7 @@
 #include "cli/signals.hpp"
 #include "cli/study_inputs.hpp"
 #include "cli/writer_options.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 #ifdef CALLIGRAPHY_WITH_TRAINER
 #include "trainer/trainer.hpp"
 #endif

@@ -5,7 +5,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/output.hpp"
-#include "report/typical_strokes_report.hpp"
+#include "calligraphy/report/typical_strokes_report.hpp"
 
 namespace calligraphy::cli {
 namespace {
@@ -21,7 +21,7 @@ int run_strokes(const StrokesCommand& command) {
   files.output("--markdown", command.markdown);
   if (!command.markdown.empty()) write_output(command.markdown, typical_strokes_markdown());
   if (command.json) {
-    write_standard_output(typical_strokes_json().dump(2) + "\n");
+    write_standard_output(typical_strokes_json() + "\n");
   } else if (command.markdown.empty()) {
     write_standard_output(typical_strokes_text());
   }

@@ -15,7 +15,7 @@
 #include "cli/library_options.hpp"
 #include "cli/output.hpp"
 #include "cli/writer_options.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "study/names.hpp"
 #ifdef CALLIGRAPHY_WITH_TRAINER
 #include "trainer/trainer.hpp"
@@ -90,6 +90,7 @@ int run_train(const TrainCommand& command) {
   options.device = !command.device.empty()    ? command.device
                    : options.simulated_writer ? "simulated"
                                               : "mouse-hand";
+  options.registry = &cli_device_registry();  // the command line's devices, the mouse ones included
   require_device(options.device);
   {  // a simulated writer moves only a device with a hand port; a person moves any other
     const bool hand_port = cli_device_registry().find(options.device).capabilities.moved_by_simulated_hand;

@@ -2,7 +2,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "cli/output.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 
 namespace calligraphy::cli {
 

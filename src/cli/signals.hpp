@@ -1,7 +1,7 @@
 #pragma once
 // The command line's stop signals: the one implementation the trainer window shares (core/stop_signals.hpp),
 // under the names the commands use.
-#include "core/stop_signals.hpp"
+#include "calligraphy/core/stop_signals.hpp"
 
 namespace calligraphy::cli {
 

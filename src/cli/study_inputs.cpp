@@ -7,7 +7,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/study/transfer_set.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 
 namespace calligraphy::cli {
 

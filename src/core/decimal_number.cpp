@@ -1,4 +1,4 @@
-#include "core/decimal_number.hpp"
+#include "calligraphy/core/decimal_number.hpp"
 
 #include <charconv>
 #include <cmath>

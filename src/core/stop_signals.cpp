@@ -1,4 +1,4 @@
-#include "core/stop_signals.hpp"
+#include "calligraphy/core/stop_signals.hpp"
 
 #include <atomic>
 #include <csignal>

@@ -1,4 +1,4 @@
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 
 #include <cstdio>
 

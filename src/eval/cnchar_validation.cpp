@@ -8,7 +8,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 
 namespace calligraphy::cli {
 namespace {

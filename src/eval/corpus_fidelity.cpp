@@ -7,9 +7,9 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/corpus_store.hpp"
 #include "calligraphy/model/scene.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "eval/corpus_fit.hpp"
-#include "model/polyline.hpp"
+#include "calligraphy/model/polyline.hpp"
 
 namespace calligraphy::cli {
 namespace {

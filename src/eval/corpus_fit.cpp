@@ -10,7 +10,7 @@
 #include <thread>
 
 #include "calligraphy/core/errors.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 
 namespace calligraphy::cli {
 namespace {

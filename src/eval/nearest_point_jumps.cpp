@@ -11,7 +11,7 @@
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/trial/trial.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "eval/nearest_point_report.hpp"
 
 namespace calligraphy::cli {

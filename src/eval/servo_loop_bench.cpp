@@ -10,7 +10,7 @@
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/trial/trial.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "report/appendf.hpp"
 
 namespace calligraphy::cli {

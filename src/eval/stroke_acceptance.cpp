@@ -7,7 +7,7 @@
 
 #include "calligraphy/analysis/stroke_matcher.hpp"
 #include "calligraphy/core/errors.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 
 namespace calligraphy {
 

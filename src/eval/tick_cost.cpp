@@ -12,7 +12,7 @@
 #include "calligraphy/render/renderer.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/sim/simulated_writer.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 
 namespace calligraphy::cli {
 namespace {

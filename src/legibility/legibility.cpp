@@ -11,7 +11,7 @@
 #include "calligraphy/analysis/score.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/trial/result.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 
 #ifdef CALLIGRAPHY_WITH_ZINNIA
 #include <zinnia.h>

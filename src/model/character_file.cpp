@@ -10,7 +10,7 @@
 #include <cstring>
 
 #include "calligraphy/core/errors.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "core/whole_file.hpp"
 
 namespace calligraphy::detail {

@@ -4,7 +4,7 @@
 #include <system_error>
 
 #include "calligraphy/core/errors.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "model/character_file.hpp"
 #include "model/embedded_characters.hpp"
 #include "model/median_json_reader.hpp"

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <limits>
 
-#include "model/polyline.hpp"
+#include "calligraphy/model/polyline.hpp"
 
 namespace calligraphy::detail {
 namespace {

@@ -8,7 +8,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/corpus_store.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "model/corpus_store_format.hpp"
 
 namespace calligraphy {

@@ -14,7 +14,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
 #include "model/corner_search.hpp"
-#include "model/polyline.hpp"
+#include "calligraphy/model/polyline.hpp"
 
 namespace calligraphy {
 namespace {

@@ -1,4 +1,4 @@
-#include "model/polyline.hpp"
+#include "calligraphy/model/polyline.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -4,7 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "calligraphy/model/typical_strokes.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "report/appendf.hpp"
 
 namespace calligraphy {

@@ -2,7 +2,7 @@
 
 #include <cstdio>
 
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 
 namespace calligraphy {
 namespace {

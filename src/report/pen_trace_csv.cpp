@@ -9,7 +9,7 @@
 #include <utility>
 
 #include "calligraphy/core/errors.hpp"
-#include "core/decimal_number.hpp"
+#include "calligraphy/core/decimal_number.hpp"
 #include "report/compressed_text.hpp"
 
 namespace calligraphy {

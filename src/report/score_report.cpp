@@ -5,7 +5,7 @@
 #include <optional>
 
 #include "calligraphy/model/typical_strokes.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "report/appendf.hpp"
 #include "report/metrics_object.hpp"
 

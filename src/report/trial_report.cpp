@@ -11,8 +11,8 @@
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
-#include "core/unicode.hpp"
-#include "model/polyline.hpp"
+#include "calligraphy/core/unicode.hpp"
+#include "calligraphy/model/polyline.hpp"
 #include "report/trial_outcome.hpp"
 
 namespace calligraphy {

@@ -1,12 +1,13 @@
-#include "report/typical_strokes_report.hpp"
+#include "calligraphy/report/typical_strokes_report.hpp"
 
 #include <cmath>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 
 #include "calligraphy/model/typical_strokes.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 
-namespace calligraphy::cli {
+namespace calligraphy {
 namespace {
 
 std::string code_point(char32_t cp) {
@@ -105,7 +106,7 @@ std::string typical_strokes_markdown() {
   return md;
 }
 
-nlohmann::json typical_strokes_json() {
+std::string typical_strokes_json() {
   nlohmann::json list = nlohmann::json::array();
   for (const TypicalStroke& t : typical_strokes()) {
     nlohmann::json pieces = nlohmann::json::array();
@@ -131,7 +132,7 @@ nlohmann::json typical_strokes_json() {
                     {"default_attraction", t.default_attraction},
                     {"corner_attraction", t.corner_attraction}});
   }
-  return list;
+  return list.dump(2);
 }
 
-}  // namespace calligraphy::cli
+}  // namespace calligraphy

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <utility>
 
-#include "model/polyline.hpp"
+#include "calligraphy/model/polyline.hpp"
 #include "sim/writer_random.hpp"
 
 namespace calligraphy::writer_detail {

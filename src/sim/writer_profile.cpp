@@ -7,7 +7,7 @@
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
-#include "core/decimal_number.hpp"
+#include "calligraphy/core/decimal_number.hpp"
 
 namespace calligraphy {
 namespace {

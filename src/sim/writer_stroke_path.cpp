@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "model/polyline.hpp"
+#include "calligraphy/model/polyline.hpp"
 
 namespace calligraphy::writer_detail {
 namespace {

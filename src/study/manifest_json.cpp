@@ -1,7 +1,7 @@
 #include "study/manifest_json.hpp"
 
 #include "calligraphy/core/errors.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "study/json_reader.hpp"
 #include "study/protocol_reading.hpp"
 

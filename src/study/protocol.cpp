@@ -10,7 +10,7 @@
 #include <sstream>
 
 #include "calligraphy/core/errors.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "study/json_reader.hpp"
 #include "study/names.hpp"
 #include "study/protocol_reading.hpp"

@@ -5,7 +5,7 @@
 #include <array>
 
 #include "calligraphy/core/errors.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "study/protocol_reading.hpp"
 
 namespace calligraphy::study_detail {

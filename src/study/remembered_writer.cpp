@@ -6,7 +6,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/study/guidance_share.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "study/json_reader.hpp"
 #include "study/saved_sessions.hpp"
 

@@ -16,7 +16,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/trial/options.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "report/compressed_text.hpp"
 #include "study/json_reader.hpp"
 #include "study/manifest_json.hpp"

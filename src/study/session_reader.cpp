@@ -7,7 +7,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/report/pen_trace_csv.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "study/json_reader.hpp"
 #include "study/names.hpp"
 #include "study/saved_sessions.hpp"

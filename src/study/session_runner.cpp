@@ -3,7 +3,9 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -14,7 +16,7 @@
 #include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/study/trial_spec_runner.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "study/names.hpp"
 #include "study/remembered_writer.hpp"
 #include "study/trial_guidance.hpp"
@@ -161,152 +163,205 @@ TrialOptions study_trial_options(const SessionManifest& session, const StudyCond
   return options;
 }
 
-SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& run_options) {
-  const SessionManifest& manifest = session.manifest();
-  const DeviceRegistry standard = run_options.registry ? DeviceRegistry{} : standard_device_registry();
-  const DeviceRegistry& registry = run_options.registry ? *run_options.registry : standard;
-  const DeviceListing listing = registry.find(manifest.setup.device);  // only its backend is scanned
-  check_plan(manifest, listing);
-  const bool simulated_writer = manifest.setup.writer == "simulated";
+namespace {
 
-  CharacterLibrary embedded = CharacterLibrary::embedded();
-  std::map<char32_t, Character> characters;  // fitted once per session run
-  const auto character = [&](char32_t code_point) -> const Character& {
-    auto found = characters.find(code_point);
-    if (found == characters.end()) {
-      Character model =
-          run_options.load_character ? run_options.load_character(code_point) : embedded.load(code_point);
-      found = characters.emplace(code_point, std::move(model)).first;
+// One run of a session's unsaved trials, in its steps: the run's start, each trial's break, scene, plan,
+// device, run and keeping, and the run's end. Each step logs what it did to the session's log.
+class SessionRun {
+ public:
+  SessionRun(SessionFolder& session, const SessionRunOptions& run_options, const DeviceRegistry& registry)
+      : session_(session),
+        options_(run_options),
+        registry_(registry),
+        manifest_(session.manifest()),
+        listing_(registry.find(manifest_.setup.device)),  // only its backend is scanned
+        simulated_writer_(manifest_.setup.writer == "simulated"),
+        // A learning simulated subject remembers its saved trials, of this session and the ones before it.
+        learning_(simulated_writer_ && manifest_.setup.writer_learning == "two-state"),
+        embedded_(CharacterLibrary::embedded()) {
+    check_plan(manifest_, listing_);
+  }
+
+  SessionRunResult run() {
+    begin();
+    for (const PlannedTrial& trial : session_.plan()) {
+      if (session_.is_saved(trial)) continue;
+      if (!rest_before(trial)) break;
+      if (options_.host) options_.host->before_trial(trial, result_.planned);
+      run_trial(trial);
+      if (result_.interrupted || result_.device_failed) break;
     }
-    return found->second;
+    end();
+    return result_;
+  }
+
+ private:
+  // What a trial runs with, made before its device is opened.
+  struct PreparedTrial {
+    Scene scene;
+    study_detail::PreparedGuidance guidance;
+    TrialSpec spec;
+    json started;
+    std::optional<WriterSkills> skills;
   };
 
-  SessionRunResult result;
-  result.planned = session.plan().size();
-  result.saved_before = session.saved_count();
-  const std::optional<std::size_t> first = session.next_unsaved();
-  if (result.saved_before > 0) log_unlogged_saves(session);
-  session.log(result.saved_before == 0 ? "session_started" : "session_resumed",
-              json{{"saved_trials", result.saved_before},
-                   {"next_trial", first ? json(*first + 1) : json(nullptr)},
-                   {"library", library_build().version}}
-                  .dump());
-  // A learning simulated subject remembers its saved trials, of this session and the ones before it.
-  const bool learning = simulated_writer && manifest.setup.writer_learning == "two-state";
-  WriterMemory memory = learning ? study_detail::remembered(session) : WriterMemory{};
-  bool ran_one = false;
-  for (const PlannedTrial& trial : session.plan()) {
-    if (session.is_saved(trial)) continue;
-    if (stop_requested(run_options)) {
-      result.interrupted = true;
-      break;
-    }
-    if (trial.break_before_s > 0.0 && ran_one) {
-      session.log("break", json{{"before_trial", trial.index + 1},
-                                {"duration_s", trial.break_before_s},
-                                {"waited", !simulated_writer}}
-                               .dump());
-      if (!simulated_writer && run_options.host) {
-        run_options.host->rest(trial.break_before_s, trial,
-                               [&run_options] { return stop_requested(run_options); });
-      }
-      if (stop_requested(run_options)) {
-        result.interrupted = true;
-        break;
-      }
-    }
-    if (run_options.host) run_options.host->before_trial(trial, result.planned);
+  void begin() {
+    result_.planned = session_.plan().size();
+    result_.saved_before = session_.saved_count();
+    const std::optional<std::size_t> first = session_.next_unsaved();
+    if (result_.saved_before > 0) log_unlogged_saves(session_);
+    session_.log(result_.saved_before == 0 ? "session_started" : "session_resumed",
+                 json{{"saved_trials", result_.saved_before},
+                      {"next_trial", first ? json(*first + 1) : json(nullptr)},
+                      {"library", library_build().version}}
+                     .dump());
+    if (learning_) memory_ = study_detail::remembered(session_);
+  }
 
-    const StudyCondition& condition = manifest.protocol.protocol.condition(trial.condition);
-    // An error before the trial runs (a character the library lacks, a device that does not open) is
-    // logged, with the session's stop and its reason, before it ends the run.
-    const auto log_failure = [&](const Error& e, const char* reason) {
-      json details = trial_details(trial);
-      details["error"] = e.what();
-      session.log("trial_failed", details.dump());
-      session.log("session_stopped", json{{"saved_trials", result.saved_before + result.saved_now},
-                                          {"planned", result.planned},
-                                          {"reason", reason}}
-                                         .dump());
-    };
+  // The break before `trial` (logged; waited for with a person); false when the run is to stop.
+  bool rest_before(const PlannedTrial& trial) {
+    if (stop_requested(options_)) {
+      result_.interrupted = true;
+      return false;
+    }
+    if (trial.break_before_s > 0.0 && ran_one_) {
+      session_.log("break", json{{"before_trial", trial.index + 1},
+                                 {"duration_s", trial.break_before_s},
+                                 {"waited", !simulated_writer_}}
+                                .dump());
+      if (!simulated_writer_ && options_.host) {
+        options_.host->rest(trial.break_before_s, trial, [this] { return stop_requested(options_); });
+      }
+      if (stop_requested(options_)) {
+        result_.interrupted = true;
+        return false;
+      }
+    }
+    return true;
+  }
+
+  // An error before the trial runs (a character the library lacks, a device that does not open) is
+  // logged, with the session's stop and its reason, before it ends the run.
+  void log_failure(const PlannedTrial& trial, const Error& e, const char* reason) {
+    json details = trial_details(trial);
+    details["error"] = e.what();
+    session_.log("trial_failed", details.dump());
+    session_.log("session_stopped", json{{"saved_trials", result_.saved_before + result_.saved_now},
+                                         {"planned", result_.planned},
+                                         {"reason", reason}}
+                                        .dump());
+  }
+
+  // The character's model, fitted once per session run.
+  const Character& character(char32_t code_point) {
+    auto found = characters_.find(code_point);
+    if (found == characters_.end()) {
+      Character model = options_.load_character ? options_.load_character(code_point) : embedded_.load(code_point);
+      found = characters_.emplace(code_point, std::move(model)).first;
+    }
+    return found->second;
+  }
+
+  Scene scene_of(const PlannedTrial& trial) {
     std::vector<Character> models;
     try {
       for (const char32_t c : trial.characters) models.push_back(character(c));
     } catch (const Error& e) {
-      log_failure(e, "character_not_loaded");
+      log_failure(trial, e, "character_not_loaded");
       throw;
     }
-    const Scene scene = Scene::lay_out(models);
-    study_detail::PreparedGuidance guidance;
-    if (study_detail::adapts_by_repetition(condition.mode))
-      guidance = study_detail::repetition_guidance(session, condition, trial);
-    if (condition.mode == ConditionMode::replay)
-      guidance = study_detail::replay_guidance(session, condition, trial, scene);
-    TrialSpec spec = study_trial_spec(manifest, condition, trial, guidance.guidance);
-    if (run_options.pacing) spec.pacing = *run_options.pacing;
-    if (!simulated_writer && spec.pacing != TrialPacing::lock_step)  // a person, in real time
-      spec.watchdog_s = default_watchdog_s(listing.capabilities.hardware);
-    json started = trial_details(trial);
-    std::optional<WriterSkills> skills;
-    if (learning) {
-      skills = study_detail::learn_into(spec, memory, study_detail::subject_profile(manifest.setup), scene,
-                                        trial.characters);
-      started["shape_skill"] = skills->shape;
-      started["order_skill"] = skills->order;
-      started["timing_skill"] = skills->timing;
-    }
+    return Scene::lay_out(models);
+  }
 
-    std::unique_ptr<HapticDevice> device;
-    DeviceInfo device_info;
+  // The trial's guidance, specification and (a learning subject's) skills, before its device is opened.
+  PreparedTrial prepare(const PlannedTrial& trial, const StudyCondition& condition) {
+    PreparedTrial prepared{scene_of(trial), {}, {}, trial_details(trial), std::nullopt};
+    if (study_detail::adapts_by_repetition(condition.mode))
+      prepared.guidance = study_detail::repetition_guidance(session_, condition, trial);
+    if (condition.mode == ConditionMode::replay)
+      prepared.guidance = study_detail::replay_guidance(session_, condition, trial, prepared.scene);
+    prepared.spec = study_trial_spec(manifest_, condition, trial, prepared.guidance.guidance);
+    if (options_.pacing) prepared.spec.pacing = *options_.pacing;
+    if (!simulated_writer_ && prepared.spec.pacing != TrialPacing::lock_step)  // a person, in real time
+      prepared.spec.watchdog_s = default_watchdog_s(listing_.capabilities.hardware);
+    if (learning_) {
+      prepared.skills = study_detail::learn_into(prepared.spec, memory_, study_detail::subject_profile(manifest_.setup),
+                                                 prepared.scene, trial.characters);
+      prepared.started["shape_skill"] = prepared.skills->shape;
+      prepared.started["order_skill"] = prepared.skills->order;
+      prepared.started["timing_skill"] = prepared.skills->timing;
+    }
+    return prepared;
+  }
+
+  std::unique_ptr<HapticDevice> create_device(const PlannedTrial& trial) {
     try {
-      device = registry.create(manifest.setup.device);
-      device_info = device->info();
+      return registry_.create(manifest_.setup.device);
     } catch (const Error& e) {
-      log_failure(e, "device_not_opened");
+      log_failure(trial, e, "device_not_opened");
       throw;
     }
-    session.log("trial_started", started.dump());
-    // The one runner of a trial specification; the device (made above, so that a failure is logged), the
-    // teacher kept in the session folder and the condition's own settings are its inputs.
+  }
+
+  // The one runner of a trial specification; the device (made before, so that a failure is logged), the
+  // teacher kept in the session folder and the condition's own settings are its inputs. The trial's
+  // options are complete before it runs: the specification's on this device, the condition's force law,
+  // and what the host adds (its display channel, memory locking off in a window process).
+  TrialRunInputs inputs_for(const PlannedTrial& trial, const StudyCondition& condition, const PreparedTrial& prepared,
+                            HapticDevice& device) const {
     TrialRunInputs inputs;
-    inputs.device = device.get();
-    inputs.teacher = guidance.guidance.teacher;
-    inputs.should_stop = run_options.should_stop;
-    // The trial's options, complete before it runs: the specification's on this device, the condition's
-    // force law, and what the host adds (its display channel, memory locking off in a window process).
-    TrialOptions planned = trial_options(spec, device_info);
-    planned.force = study_detail::condition_force_law(condition, guidance.guidance, std::move(planned.force));
+    inputs.device = &device;
+    inputs.teacher = prepared.guidance.guidance.teacher;
+    inputs.should_stop = options_.should_stop;
+    TrialOptions planned = trial_options(prepared.spec, device.info());
+    planned.force = study_detail::condition_force_law(condition, prepared.guidance.guidance, std::move(planned.force));
     planned.loop.lock_memory = inputs.lock_memory;  // a session's program locks memory unless its host says not
-    if (run_options.prepare_trial) run_options.prepare_trial(trial, planned);
+    if (options_.prepare_trial) options_.prepare_trial(trial, planned);
     inputs.force_law = std::move(planned.force);
     inputs.display = planned.display;
     inputs.lock_memory = planned.loop.lock_memory;
+    return inputs;
+  }
+
+  void run_trial(const PlannedTrial& trial) {
+    const StudyCondition& condition = manifest_.protocol.protocol.condition(trial.condition);
+    PreparedTrial prepared = prepare(trial, condition);
+    std::unique_ptr<HapticDevice> device = create_device(trial);
+    session_.log("trial_started", prepared.started.dump());
+    const TrialRunInputs inputs = inputs_for(trial, condition, prepared, *device);
+
     study_detail::TrialRecordContext context;
-    context.session = &manifest;
+    context.session = &manifest_;
     context.trial = &trial;
     context.condition = &condition;
-    context.device_name = manifest.setup.device;
-    context.device_info = device_info;
-    context.hardware = listing.capabilities.hardware;
-    context.simulated_writer = simulated_writer;
-    context.guidance = study_detail::guidance_record_json(condition, guidance);
-    context.writer_skills = skills;
+    context.device_name = manifest_.setup.device;
+    context.device_info = device->info();
+    context.hardware = listing_.capabilities.hardware;
+    context.simulated_writer = simulated_writer_;
+    context.guidance = study_detail::guidance_record_json(condition, prepared.guidance);
+    context.writer_skills = prepared.skills;
     context.start_utc = study_detail::utc_now_iso8601();
     const auto wall_start = std::chrono::steady_clock::now();
-    TrialRun run = run_trial_spec(spec, scene, inputs);
-    TrialResult& trial_result = run.result;
-    if (trial_result.end == TrialEnd::interrupted && trial_result.abort_reason.empty())
-      trial_result.abort_reason = "stopped by " + stop_reason(run_options);
-    context.wall_time_s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    TrialRun run = run_trial_spec(prepared.spec, prepared.scene, inputs);
+    if (run.result.end == TrialEnd::interrupted && run.result.abort_reason.empty())
+      run.result.abort_reason = "stopped by " + stop_reason(options_);
+    context.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     context.end_utc = study_detail::utc_now_iso8601();
     context.options = &run.options;
     context.simulation.writer = run.writer;
-    context.simulation.seed = spec.seed;
+    context.simulation.seed = prepared.spec.seed;
     context.writer_log = run.writer_log;
     device.reset();
-    ran_one = true;
+    ran_one_ = true;
 
+    const TrialOutcome outcome = keep(trial, condition, prepared.scene, run, context);
+    if (options_.host) options_.host->after_trial(trial, outcome);
+  }
+
+  // Saves the trial (or keeps it as an attempt) with its record, and logs how it ended.
+  TrialOutcome keep(const PlannedTrial& trial, const StudyCondition& condition, const Scene& scene, const TrialRun& run,
+                    study_detail::TrialRecordContext& context) {
+    const TrialResult& trial_result = run.result;
     const std::string stem = SessionFolder::trial_stem(trial);
     context.csv_file = stem + "." + std::string(SessionFolder::kTraceExtension);
     context.svg_file = stem + ".svg";
@@ -327,49 +382,70 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
     if (keep_as_trial) {
       const std::string record = study_detail::trial_record_json(context, scene, trial_result, writing,
                                                                  quiz.empty() ? nullptr : &quiz);
-      session.save_trial(trial, record, trial_csv(trial_result.trace), trial_svg(scene, trial_result));
+      session_.save_trial(trial, record, trial_csv(trial_result.trace), trial_svg(scene, trial_result));
       // Learned from as the record says, the same as when the memory is rebuilt on a resume.
-      if (learning)
-        study_detail::practise_record(memory, json::parse(record), session.trial_file(trial, "json").string(),
-                                      study_detail::subject_traits(manifest.setup).learning);
+      if (learning_)
+        study_detail::practise_record(memory_, json::parse(record), session_.trial_file(trial, "json").string(),
+                                      study_detail::subject_traits(manifest_.setup).learning);
       outcome.saved = true;
-      outcome.json_file = session.trial_file(trial, "json").string();
+      outcome.json_file = session_.trial_file(trial, "json").string();
       details["time_s"] = outcome.time_s;
-      session.log("trial_saved", details.dump());
-      ++result.saved_now;
+      session_.log("trial_saved", details.dump());
+      ++result_.saved_now;
     } else {
       context.svg_file.clear();
       const std::string record = study_detail::trial_record_json(context, scene, trial_result, writing,
                                                                  quiz.empty() ? nullptr : &quiz);
-      const auto kept = session.save_attempt(trial, record, trial_csv(trial_result.trace));
+      const auto kept = session_.save_attempt(trial, record, trial_csv(trial_result.trace));
       outcome.json_file = kept.string();
       details["attempt"] = kept.filename().string();
       details["abort_reason"] = trial_result.abort_reason;
-      ++result.attempts_kept;
+      ++result_.attempts_kept;
       if (trial_result.end == TrialEnd::interrupted) {
-        details["reason"] = stop_reason(run_options);
-        session.log("trial_interrupted", details.dump());
-        result.interrupted = true;
+        details["reason"] = stop_reason(options_);
+        session_.log("trial_interrupted", details.dump());
+        result_.interrupted = true;
       } else {
-        session.log("trial_failed", details.dump());
-        result.device_failed = true;
-        result.failure = trial_result.abort_reason;
+        session_.log("trial_failed", details.dump());
+        result_.device_failed = true;
+        result_.failure = trial_result.abort_reason;
       }
     }
-    if (run_options.host) run_options.host->after_trial(trial, outcome);
-    if (result.interrupted || result.device_failed) break;
+    return outcome;
   }
-  if (result.complete()) {
-    session.log("session_completed", json{{"trials", result.planned}}.dump());
-  } else {
-    session.log("session_stopped", json{{"saved_trials", result.saved_before + result.saved_now},
-                                        {"planned", result.planned},
-                                        {"reason", result.interrupted     ? stop_reason(run_options)
-                                                   : result.device_failed ? std::string("device_fault")
-                                                                          : std::string("unknown")}}
-                                       .dump());
+
+  void end() {
+    if (result_.complete()) {
+      session_.log("session_completed", json{{"trials", result_.planned}}.dump());
+    } else {
+      session_.log("session_stopped", json{{"saved_trials", result_.saved_before + result_.saved_now},
+                                           {"planned", result_.planned},
+                                           {"reason", result_.interrupted     ? stop_reason(options_)
+                                                      : result_.device_failed ? std::string("device_fault")
+                                                                              : std::string("unknown")}}
+                                          .dump());
+    }
   }
-  return result;
+
+  SessionFolder& session_;
+  const SessionRunOptions& options_;
+  const DeviceRegistry& registry_;
+  const SessionManifest& manifest_;
+  const DeviceListing listing_;
+  const bool simulated_writer_;
+  const bool learning_;
+  CharacterLibrary embedded_;
+  std::map<char32_t, Character> characters_;
+  WriterMemory memory_;
+  SessionRunResult result_;
+  bool ran_one_ = false;
+};
+
+}  // namespace
+
+SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& run_options) {
+  const DeviceRegistry standard = run_options.registry ? DeviceRegistry{} : standard_device_registry();
+  return SessionRun(session, run_options, run_options.registry ? *run_options.registry : standard).run();
 }
 
 }  // namespace calligraphy

@@ -5,7 +5,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/study/session_reader.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "study/json_reader.hpp"
 #include "study/names.hpp"
 #include "study/trial_row.hpp"

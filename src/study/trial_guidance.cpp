@@ -8,7 +8,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
 #include "calligraphy/study/trial_spec_runner.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "study/json_reader.hpp"
 #include "study/names.hpp"
 

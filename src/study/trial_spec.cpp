@@ -11,8 +11,8 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
-#include "core/decimal_number.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/decimal_number.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "study/json_reader.hpp"
 
 namespace calligraphy {

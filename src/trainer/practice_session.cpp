@@ -4,7 +4,7 @@
 
 #include "calligraphy/report/trial_report.hpp"
 #include "calligraphy/study/protocol.hpp"
-#include "core/unicode.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "study/trial_record.hpp"
 
 namespace calligraphy::trainer {

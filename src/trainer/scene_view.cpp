@@ -7,7 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "model/polyline.hpp"
+#include "calligraphy/model/polyline.hpp"
 #include "trainer/triangulate.hpp"
 
 namespace calligraphy::trainer {

@@ -21,7 +21,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/devices/device_registry.hpp"
 #include "calligraphy/devices/hand_port.hpp"
-#include "core/stop_signals.hpp"
+#include "calligraphy/core/stop_signals.hpp"
 #include "study/names.hpp"
 #include "trainer/pointer_devices.hpp"
 #include "trainer/x11_errors.hpp"

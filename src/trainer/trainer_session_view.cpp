@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
-#include "core/stop_signals.hpp"
+#include "calligraphy/core/stop_signals.hpp"
 #include "trainer/trainer_app.hpp"
 
 namespace calligraphy::trainer {

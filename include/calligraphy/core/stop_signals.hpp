@@ -5,7 +5,7 @@
 // force and forces disabled, writes what was recorded and exits with 128 + the signal's number (130, 143,
 // 129), the shell's convention for a command ended by a signal. A recording that cannot be repeated is
 // thus never lost to a signal: the default action would end the process before any file is written.
-// One implementation for the command line and the trainer window. Internal.
+// One implementation for the command line, the trainer window and applications that run trials.
 #include <functional>
 
 namespace calligraphy {

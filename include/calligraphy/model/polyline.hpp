@@ -1,5 +1,7 @@
 #pragma once
-// Small polyline and angle helpers shared by fitting, metrics and drawing. Internal.
+/// \file polyline.hpp
+/// Small polyline and angle helpers shared by fitting, metrics and drawing (lengths in the polyline's units,
+/// angles in radians unless named _deg).
 #include <limits>
 #include <optional>
 #include <span>

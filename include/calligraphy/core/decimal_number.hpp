@@ -1,6 +1,6 @@
 #pragma once
-// Reading a decimal number from text (options, CSV fields, writer settings): one rule for every reader.
-// Internal.
+/// \file decimal_number.hpp
+/// Reading a decimal number from text (options, CSV fields, writer settings): one rule for every reader.
 #include <optional>
 #include <string_view>
 
