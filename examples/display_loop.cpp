@@ -46,8 +46,11 @@ int main(int argc, char** argv) {
     TrialOptions options;
     options.pacing = TrialPacing::real_time;  // the simulated writer writes at the wall clock's pace
     options.keep_trace = true;
-    // The loop's defaults lock no memory (an application with a display maps memory all the time, which
-    // mlockall(MCL_FUTURE) would lock too); the trial touches its trace in advance instead.
+    // As the trainer's window does: SCHED_FIFO for the loop thread when the system allows it (a busy desktop
+    // stalls a thread of normal priority for tens of ms), and no memory locking, the loop's default (an
+    // application with a display maps memory all the time, which mlockall(MCL_FUTURE) would lock too); the
+    // trial touches its trace in advance instead.
+    options.loop.priority = kDedicatedServoPriority;
     options.display = &channel;
     TrialResult result;
     std::exception_ptr failure;

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/logging.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/render/renderer.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
@@ -149,6 +150,32 @@ TEST_CASE("The renderer warns at construction when a stiffness exceeds the bound
   spdlog::set_default_logger(previous);
   CHECK(quiet.find("passivity bound") == std::string::npos);
   CHECK(warned.find("passivity bound") != std::string::npos);
+}
+
+TEST_CASE("The library's log goes to the logger an application registers as \"calligraphy\", at its level",
+          "[passivity][logging]") {
+  const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'口')});
+  std::ostringstream library_log;
+  std::ostringstream default_log;
+  const auto previous = spdlog::default_logger();
+  spdlog::set_default_logger(
+      std::make_shared<spdlog::logger>("capture", std::make_shared<spdlog::sinks::ostream_sink_mt>(default_log)));
+  spdlog::register_logger(std::make_shared<spdlog::logger>(
+      kLoggerName, std::make_shared<spdlog::sinks::ostream_sink_mt>(library_log)));
+  DeviceInfo device = simulated_phantom_desktop_info();
+  device.intrinsic_damping_n_s_per_m = kDeviceDamping;  // bound 1000 N/m
+  ForceLawParameters force;
+  force.paper_stiffness_n_per_m = 1500.0;
+  { const Renderer above(scene, force, device); }
+  const std::string redirected = library_log.str();
+  set_log_level(LogLevel::off);
+  { const Renderer again(scene, force, device); }
+  const std::string silenced = library_log.str();
+  spdlog::drop(kLoggerName);  // the streams end with this test
+  spdlog::set_default_logger(previous);
+  CHECK(redirected.find("passivity bound") != std::string::npos);
+  CHECK(default_log.str().empty());  // nothing went to the default logger
+  CHECK(silenced == redirected);     // off: nothing more
 }
 
 TEST_CASE("Up to Colgate's bound the energy supplied by the device does not grow over 60 s of contact",

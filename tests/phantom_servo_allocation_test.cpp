@@ -219,6 +219,7 @@ TEST_CASE("A servo loop on the emulated Phantom stops on an unplug without alloc
   const Vec3 target = first.position_m + Vec3(0.0, 0.0, 0.02);
   ServoLoopOptions options;
   options.lock_memory = false;
+  options.priority = kDedicatedServoPriority;  // best-effort SCHED_FIFO: steady counts on a busy machine
   options.stall_timeout_s = 0.0;
   options.max_force_age_s = 1.0;
   long ticks = 0;

@@ -65,6 +65,7 @@ TEST_CASE("The servo loop thread does not allocate while it renders and records"
   std::size_t transitions = 0;
   ServoLoopOptions options;
   options.lock_memory = false;
+  options.priority = kDedicatedServoPriority;  // best-effort SCHED_FIFO: steady counts on a busy machine
   options.stall_timeout_s = 0.0;
   ServoLoop loop(
       device,
@@ -98,6 +99,7 @@ TEST_CASE("A device fault ends the loop without an allocation on the servo threa
     test::ProbeDevice device(/*fail_on_read=*/300, fault);
     ServoLoopOptions options;
     options.lock_memory = false;
+    options.priority = kDedicatedServoPriority;  // best-effort SCHED_FIFO: steady counts on a busy machine
     options.stall_timeout_s = 0.0;
     options.max_force_age_s = 1.0;
     ServoLoop loop(
@@ -137,6 +139,7 @@ TEST_CASE("A trial session publishing to a display does not allocate on the serv
   session.reserve_trace();
   ServoLoopOptions options;
   options.lock_memory = false;
+  options.priority = kDedicatedServoPriority;  // best-effort SCHED_FIFO: steady counts on a busy machine
   options.stall_timeout_s = 0.0;
   ServoLoop loop(
       device,

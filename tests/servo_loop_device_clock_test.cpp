@@ -20,6 +20,7 @@ ServoLoopOptions clock_options() {
   ServoLoopOptions o;
   o.realtime = RealtimeMode::ignore;
   o.lock_memory = false;
+  o.priority = kDedicatedServoPriority;  // best-effort SCHED_FIFO: steady counts on a busy machine
   o.stall_timeout_s = 0.0;
   o.max_force_age_s = 1.0;
   return o;

@@ -3,7 +3,7 @@
 // Implement `HapticDevice` (SI units; x right, y away from the writer, z up out of the paper); its
 // `read_state` and `write_force` are the servo path: noexcept, no allocation, faults as `DeviceFault` codes.
 // The `ServoLoop` calls the callback once per tick on its own thread, paced by the wall clock; its defaults
-// change nothing process-wide (no SCHED_FIFO, no memory locking: ask with `priority` and `lock_memory`).
+// ask for nothing (no SCHED_FIFO, no memory locking): this example asks for the thread's priority only.
 // The callback steps a `TrialSession`, the one way to tick a trial from any loop.
 //
 // The device is a stand-in for hardware: a stylus resting 1 mm below the paper at the first stroke's start,
@@ -85,8 +85,14 @@ int main() {
   TrialSession session(scene, device.info(), options);
   session.reserve_trace();  // no allocation on the servo path after this
 
-  ServoLoopOptions loop_options;
+  ServoLoopOptions loop_options;  // the defaults change nothing process-wide: no mlockall
   loop_options.rate_hz = options.rate_hz;
+  // The loop thread's own priority, when the system allows it (RealtimeMode::ignore runs on without it): a
+  // thread of normal priority on a busy machine stalls for tens of ms.
+  loop_options.priority = kDedicatedServoPriority;
+  // This stand-in has no motors, so a stall holds no force against a hand: no stall bound (a real arm keeps
+  // the default 50 ms, which ends the run with zero force).
+  loop_options.stall_timeout_s = 0.0;
   double peak_paper_force_n = 0.0;  // written by the loop thread only; read after stop() joined it
   ServoLoop loop(
       device,

@@ -9,10 +9,9 @@
 ///    (`spdlog::register_logger(std::make_shared<spdlog::logger>("calligraphy", my_sink))`);
 ///  - to silence it or change its level, `set_log_level(LogLevel::off)` (or
 ///    `spdlog::get("calligraphy")->set_level(...)`).
-/// When the application registered none, the library registers one on its first message that writes to the
-/// sinks of spdlog's default logger at that moment (standard output, in colour, unless the application
-/// replaced the default logger). The command line writes it to standard error; the Python module forwards it
-/// to `logging.getLogger("calligraphy")`.
+/// While no logger of that name is registered, the library logs through spdlog's default logger (standard
+/// output, in colour, unless the application replaced it). The command line writes it to standard error; the
+/// Python module forwards it to `logging.getLogger("calligraphy")`.
 namespace calligraphy {
 
 /// The name of the library's spdlog logger.
@@ -21,8 +20,9 @@ inline constexpr const char* kLoggerName = "calligraphy";
 /// Levels of the library's log, spdlog's own (trace .. critical) without needing its headers.
 enum class LogLevel { trace, debug, info, warning, error, critical, off };
 
-/// Sets the level of the library's logger (registering it first, as above, when it is not there yet): messages
-/// below it are not even formatted. `LogLevel::off` silences it. Thread-safe; not for the servo path.
+/// Sets the level of the library's logger: messages below it are not even formatted; `LogLevel::off` silences
+/// it. When none is registered yet, registers one named `kLoggerName` that writes to the default logger's
+/// sinks as they are now, so that the library's level is its own. Thread-safe; not for the servo path.
 void set_log_level(LogLevel level);
 
 }  // namespace calligraphy
