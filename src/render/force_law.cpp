@@ -59,7 +59,7 @@ constexpr std::array kFields{
     Field{"friction_coefficient", "", kNonNegative,
           "Coulomb friction coefficient mu of the paper (not in the paper), dimensionless",
           &P::friction_coefficient},
-    Field{"friction_stick_speed_m_s", "m/s", kPositive, "stick band of the friction: viscous below it",
+    Field{"friction_stick_speed_m_s", "m/s", kPositive, "stick band of the friction, viscous below it",
           &P::friction_stick_speed_m_s},
 };
 

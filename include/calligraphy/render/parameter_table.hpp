@@ -33,8 +33,10 @@ struct ParameterField {
   std::string_view name;  ///< the member's name, units in it ("constraint_radius_m")
   std::string_view unit;  ///< "N/m", "m", "s", "Hz", "N s/m"; empty when dimensionless
   ParameterRange range;   ///< the values `validate` accepts
-  std::string_view doc;   ///< one line: what the value is (without unit and range)
-  double S::*member;      ///< where the value lives
+  /// One line, what the value is, without unit or range; no colon (Python's stub generator reads
+  /// "words:" at the start of a property's documentation as its type).
+  std::string_view doc;
+  double S::*member;  ///< where the value lives
 
   /// The field's default: the struct's own member initialiser.
   [[nodiscard]] double default_value() const { return S{}.*member; }
