@@ -3,6 +3,9 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
+#include <string>
+#include <type_traits>
+#include <vector>
 
 #include "calligraphy/core/errors.hpp"
 
@@ -52,4 +55,82 @@ TEST_CASE("Force-law parameters are validated", "[force]") {
   p = {};
   p.guidance_stiffness_n_per_m = -1.0;
   CHECK_THROWS_WITH(p.validate(), Catch::Contains("guidance_stiffness_n_per_m"));
+}
+
+namespace {
+
+// The force-law parameters holding `law` (a replay with a teacher, so that only the table is at stake).
+template <typename S>
+ForceLawParameters holding(const S& object) {
+  if constexpr (std::is_same_v<S, ForceLawParameters>) {
+    return object;
+  } else {
+    ForceLawParameters p;
+    S law = object;
+    if constexpr (std::is_same_v<S, ReplayGuidance>)
+      law.teacher_trajectory = {TeacherSample{}, TeacherSample{}};
+    p.guidance_law = law;
+    return p;
+  }
+}
+
+// Every entry of S's table: its default lies in its range, and the struct's validation refuses a value
+// just outside each bound (and infinities and NaN), naming "Struct.field".
+template <typename S>
+void check_table() {
+  const std::string struct_name(ParameterTable<S>::name);
+  CHECK_NOTHROW(holding(S{}).validate());
+  for (const ParameterField<S>& field : ParameterTable<S>::fields()) {
+    const std::string qualified = struct_name + "." + std::string(field.name);
+    INFO(qualified);
+    CHECK(!field.doc.empty());
+    CHECK(field.doc.find(':') == std::string_view::npos);  // Python's stubs would read "words:" as a type
+    CHECK(field.range.contains(field.default_value()));
+    CHECK(&parameter_field(field.member) == &field);
+    const ParameterRange& range = field.range;
+    std::vector<double> outside{std::numeric_limits<double>::quiet_NaN(),
+                                std::numeric_limits<double>::infinity(),
+                                -std::numeric_limits<double>::infinity()};
+    outside.push_back(range.low_open ? range.low : std::nextafter(range.low, -INFINITY));
+    if (std::isfinite(range.high))
+      outside.push_back(range.high_open ? range.high : std::nextafter(range.high, INFINITY));
+    for (const double value : outside) {
+      INFO(value);
+      S object{};
+      object.*field.member = value;
+      CHECK_FALSE(range.contains(value));
+      CHECK_THROWS_WITH(holding(object).validate(), Catch::Contains(qualified + " = "));
+    }
+    // Just inside each bound the table agrees (the struct's cross-field rules aside).
+    CHECK(range.contains(range.low_open ? std::nextafter(range.low, INFINITY) : range.low));
+    if (std::isfinite(range.high))
+      CHECK(range.contains(range.high_open ? std::nextafter(range.high, -INFINITY) : range.high));
+  }
+}
+
+}  // namespace
+
+TEST_CASE("Each parameter table holds its defaults, and validation refuses just outside each bound",
+          "[force]") {
+  check_table<ForceLawParameters>();
+  check_table<FadingGuidance>();
+  check_table<ReplayGuidance>();
+  check_table<AssistAsNeededGuidance>();
+  check_table<ErrorAmplificationGuidance>();
+  check_table<TimingGuidance>();
+  CHECK(ParameterTable<FixedGuidance>::fields().empty());
+}
+
+TEST_CASE("A parameter's error names the field, its value with the unit and the range", "[force]") {
+  ForceLawParameters p;
+  p.constraint_radius_m = 0.0;
+  CHECK_THROWS_WITH(p.validate(), "ForceLawParameters.constraint_radius_m = 0 m must be finite and > 0 m");
+  p = {};
+  p.guidance_law = FadingGuidance{.gain = 1.5};
+  CHECK_THROWS_WITH(p.validate(), "FadingGuidance.gain = 1.5 must be in [0, 1]");
+  p.guidance_law = TimingGuidance{.max_lead_m = 0.01};
+  CHECK_THROWS_WITH(p.validate(),
+                    Catch::Contains("TimingGuidance.max_lead_m") && Catch::Contains("0.006] m"));
+  CHECK(parameter_field(&ForceLawParameters::friction_stick_speed_m_s).description() ==
+        "stick band of the friction, viscous below it [m/s], > 0 m/s");
 }

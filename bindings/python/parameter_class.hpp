@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "arguments.hpp"
+#include "calligraphy/render/parameter_table.hpp"
 #include "numpy_arrays.hpp"
 
 namespace calligraphy::python {
@@ -113,6 +114,14 @@ class ParameterClass {
     }
     shared_->fields.push_back(std::move(f));
     return *this;
+  }
+
+  /// Adds the numeric field `member` as its `ParameterTable<S>` entry names and documents it (the doc, the
+  /// unit and the range: parameter_table.hpp), so that Python's documentation cannot drift from the check.
+  ParameterClass& field(double S::*member) {
+    const ParameterField<S>& entry = parameter_field(member);
+    // The tables' names are string literals: data() is null-terminated and lives as long as the program.
+    return field(entry.name.data(), member, entry.description());
   }
 
   /// Adds field `name` holding one of several parameter classes bound before (a std::variant of them, e.g.

@@ -142,13 +142,12 @@ void bind_guidance_laws(py::module_& m) {
       .finish();
   ParameterClass<FadingGuidance>(
       m, "FadingGuidance", "The fading guidance law: eq. (8) scaled by a gain (next_guidance_gain).", check)
-      .field("gain", &FadingGuidance::gain, "g on F_et, in [0, 1]")
+      .field(&FadingGuidance::gain)
       .finish();
   ParameterClass<ReplayGuidance>(
       m, "ReplayGuidance",
       "The replay guidance law: the attraction point follows a teacher's recorded pen in time.", check)
-      .field("max_lead_m", &ReplayGuidance::max_lead_m,
-             "the lead at which the spring to the teacher's point saturates [m], in (0, constraint_radius_m]")
+      .field(&ReplayGuidance::max_lead_m)
       .finish()
       // Not a ParameterClass field (a list, not a value): not in to_dict() or the constructor.
       .def_property(
@@ -164,23 +163,19 @@ void bind_guidance_laws(py::module_& m) {
       m, "AssistAsNeededGuidance",
       "The assist-as-needed guidance law: eq. (8) on the deviation beyond a band only (next_assist_band).",
       check)
-      .field("band_m", &AssistAsNeededGuidance::band_m,
-             "half-width of the band without force around the active element [m], >= 0")
+      .field(&AssistAsNeededGuidance::band_m)
       .finish();
   ParameterClass<ErrorAmplificationGuidance>(
       m, "ErrorAmplificationGuidance",
       "The error-amplification guidance law: a bounded repulsive field, gain x eq. (8) turned round.", check)
-      .field("gain", &ErrorAmplificationGuidance::gain,
-             "the repulsive stiffness as a share of K_et, in [0, 1]")
-      .field("max_force_n", &ErrorAmplificationGuidance::max_force_n,
-             "bound of the repulsive force [N], >= 0")
+      .field(&ErrorAmplificationGuidance::gain)
+      .field(&ErrorAmplificationGuidance::max_force_n)
       .finish();
   ParameterClass<TimingGuidance>(
       m, "TimingGuidance",
       "The timing guidance law: a minimum-jerk target along the stroke, pulled towards along it only.", check)
-      .field("speed_m_s", &TimingGuidance::speed_m_s, "mean speed of the target along each stroke [m/s], > 0")
-      .field("max_lead_m", &TimingGuidance::max_lead_m,
-             "the lead at which the spring to the target saturates [m], in (0, constraint_radius_m]")
+      .field(&TimingGuidance::speed_m_s)
+      .field(&TimingGuidance::max_lead_m)
       .finish();
   m.def(
       "default_guidance_law",
@@ -199,48 +194,31 @@ void bind_force_law_parameters(py::module_& m) {
       "The paper plane is z = paper_z_m, +z out of the paper. The smoothing fields (section 6) and "
       "friction are described in docs/force-rendering.md.",
       [](const ForceLawParameters& p) { p.validate(); })
-      .field("guidance_stiffness_n_per_m", &ForceLawParameters::guidance_stiffness_n_per_m,
-             "K_et per unit attraction factor (eq. 8) [N/m]")
-      .field("paper_stiffness_n_per_m", &ForceLawParameters::paper_stiffness_n_per_m,
-             "K_en, stiffness of the virtual paper (eq. 9) [N/m]")
-      .field("constraint_radius_m", &ForceLawParameters::constraint_radius_m,
-             "R_res, radius of the constraint space around the active element (section 4.3) [m], > 0")
-      .field("resistance_damping_n_s_per_m", &ForceLawParameters::resistance_damping_n_s_per_m,
-             "damping against writing backwards along the active element (Fig. 4) [N s/m]")
-      .field("contact_hysteresis_m", &ForceLawParameters::contact_hysteresis_m,
-             "height above the paper at which a touching tip counts as lifted (section 6) [m]")
+      .field(&ForceLawParameters::guidance_stiffness_n_per_m)
+      .field(&ForceLawParameters::paper_stiffness_n_per_m)
+      .field(&ForceLawParameters::constraint_radius_m)
+      .field(&ForceLawParameters::resistance_damping_n_s_per_m)
+      .field(&ForceLawParameters::contact_hysteresis_m)
       .field("guidance", &ForceLawParameters::guidance,
              "in-plane guidance on (F_et and the resistance force); the paper force is always rendered")
       .variant_field("guidance_law", &ForceLawParameters::guidance_law,
                      "how F_et acts, with the mode's own parameters (FixedGuidance as eq. 8, "
                      "FadingGuidance, ReplayGuidance, AssistAsNeededGuidance, ErrorAmplificationGuidance, "
                      "TimingGuidance)")
-      .field("off_stroke_force_n", &ForceLawParameters::off_stroke_force_n,
-             "friction against writing away from the active stroke in CS [N], >= 0; 0 = the paper's CS")
-      .field("off_stroke_travel_m", &ForceLawParameters::off_stroke_travel_m,
-             "travel before the off-stroke friction reaches its force [m], > 0")
-      .field("off_stroke_damping_n_s_per_m", &ForceLawParameters::off_stroke_damping_n_s_per_m,
-             "damping of motion away from the active element in WS outside R_res [N s/m], >= 0")
-      .field("off_stroke_speed_m_s", &ForceLawParameters::off_stroke_speed_m_s,
-             "speed below which that damping fades out [m/s], > 0")
-      .field("off_stroke_velocity_cutoff_hz", &ForceLawParameters::off_stroke_velocity_cutoff_hz,
-             "low-pass on the velocity the off-stroke damping reads [Hz], > 0")
-      .field("constraint_taper_m", &ForceLawParameters::constraint_taper_m,
-             "band at R_res over which F_et tapers to zero [m], in [0, R_res]; 0 = the paper's step")
-      .field("crossfade_s", &ForceLawParameters::crossfade_s,
-             "cross-fade time of the in-plane force when the active element or state changes [s]; 0 = off")
-      .field("paper_fade_s", &ForceLawParameters::paper_fade_s,
-             "fade time of the paper force when it starts or stops pushing (AS <-> CS) [s]; 0 = off")
+      .field(&ForceLawParameters::off_stroke_force_n)
+      .field(&ForceLawParameters::off_stroke_travel_m)
+      .field(&ForceLawParameters::off_stroke_damping_n_s_per_m)
+      .field(&ForceLawParameters::off_stroke_speed_m_s)
+      .field(&ForceLawParameters::off_stroke_velocity_cutoff_hz)
+      .field(&ForceLawParameters::constraint_taper_m)
+      .field(&ForceLawParameters::crossfade_s)
+      .field(&ForceLawParameters::paper_fade_s)
       .field("acceptance", &ForceLawParameters::acceptance,
              "StrokeAcceptance: when a corner counts as gone round and a stroke as written")
-      .field("paper_damping_n_s_per_m", &ForceLawParameters::paper_damping_n_s_per_m,
-             "damping of the paper on inward motion only [N s/m]; 0 = off")
-      .field("max_foot_speed_m_s", &ForceLawParameters::max_foot_speed_m_s,
-             "highest speed of the rendered attraction target X_S [m/s]")
-      .field("friction_coefficient", &ForceLawParameters::friction_coefficient,
-             "Coulomb friction coefficient mu of the paper (not in the paper), dimensionless")
-      .field("friction_stick_speed_m_s", &ForceLawParameters::friction_stick_speed_m_s,
-             "stick band of the friction [m/s], > 0: viscous below it")
+      .field(&ForceLawParameters::paper_damping_n_s_per_m)
+      .field(&ForceLawParameters::max_foot_speed_m_s)
+      .field(&ForceLawParameters::friction_coefficient)
+      .field(&ForceLawParameters::friction_stick_speed_m_s)
       .field("nearest", &ForceLawParameters::nearest,
              "NearestPointOptions: how the foot point X_S on curve elements is found")
       .finish()

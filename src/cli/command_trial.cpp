@@ -253,6 +253,15 @@ int run_trial(const TrialCommand& command) {
   return 0;
 }
 
+// The specification's help of field `key`: for a guidance law's parameter, its table's doc, unit and range,
+// the range the specification checks.
+std::string spec_help(std::string_view key) {
+  for (const TrialSpecField& field : trial_spec_fields()) {
+    if (field.key == key) return std::string(field.help);
+  }
+  return {};
+}
+
 }  // namespace
 
 void add_trial_command(CLI::App& root, Commands& commands) {
@@ -267,15 +276,11 @@ void add_trial_command(CLI::App& root, Commands& commands) {
       "how the guidance acts: the paper's fixture, faded by --guidance-gain, replaying --teacher, only "
       "beyond --assist-band, pushing off the stroke (--amplification-gain), or pulling along it at "
       "--timing-speed");
-  add_text(*app, "--guidance-gain", command->guidance_gain_text, "G",
-           "fading: gain on the guiding force, in [0, 1]", "1");
-  add_text(*app, "--assist-band", command->assist_band_text, "M",
-           "assist-as-needed: half-width of the band without force around the stroke [m]", "0.001");
+  add_text(*app, "--guidance-gain", command->guidance_gain_text, "G", spec_help("guidance_gain"), "1");
+  add_text(*app, "--assist-band", command->assist_band_text, "M", spec_help("assist_band_m"), "0.001");
   add_text(*app, "--amplification-gain", command->amplification_gain_text, "G",
-           "error-amplification: the repulsive field's stiffness as a share of the guidance's, in [0, 1]",
-           "0.25");
-  add_text(*app, "--timing-speed", command->timing_speed_text, "M/S",
-           "timing: mean speed of the target along each stroke [m/s]", "0.04");
+           spec_help("amplification_gain"), "0.25");
+  add_text(*app, "--timing-speed", command->timing_speed_text, "M/S", spec_help("timing_speed_m_s"), "0.04");
   add_input_path(*app, "--teacher", command->teacher, "FILE",
                  "replay: the teacher's recording of CHARS (made with --record)", "none");
   add_writer_option(*app, command->writer,

@@ -1,6 +1,7 @@
 #include "calligraphy/render/force_law.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -8,31 +9,69 @@
 
 namespace calligraphy {
 
+namespace {
+
+using Field = ParameterField<ForceLawParameters>;
+using P = ForceLawParameters;
+constexpr ParameterRange kNonNegative{};
+constexpr ParameterRange kPositive{.low_open = true};
+
+// In declaration order; the docs say what the value is, the header says why.
+constexpr std::array kFields{
+    Field{"guidance_stiffness_n_per_m", "N/m", kNonNegative, "K_et per unit attraction factor (eq. 8)",
+          &P::guidance_stiffness_n_per_m},
+    Field{"paper_stiffness_n_per_m", "N/m", kNonNegative, "K_en, stiffness of the virtual paper (eq. 9)",
+          &P::paper_stiffness_n_per_m},
+    Field{"constraint_radius_m", "m", kPositive,
+          "R_res, radius of the constraint space around the active element (section 4.3)",
+          &P::constraint_radius_m},
+    Field{"resistance_damping_n_s_per_m", "N s/m", kNonNegative,
+          "damping against writing backwards along the active element (Fig. 4)",
+          &P::resistance_damping_n_s_per_m},
+    Field{"contact_hysteresis_m", "m", kNonNegative,
+          "height above the paper at which a touching tip counts as lifted (section 6)",
+          &P::contact_hysteresis_m},
+    Field{"off_stroke_force_n", "N", kNonNegative,
+          "friction against writing away from the active stroke in CS; 0 = the paper's CS",
+          &P::off_stroke_force_n},
+    Field{"off_stroke_travel_m", "m", kPositive, "travel before the off-stroke friction reaches its force",
+          &P::off_stroke_travel_m},
+    Field{"off_stroke_damping_n_s_per_m", "N s/m", kNonNegative,
+          "damping of motion away from the active element in WS outside R_res",
+          &P::off_stroke_damping_n_s_per_m},
+    Field{"off_stroke_speed_m_s", "m/s", kPositive, "speed below which that damping fades out",
+          &P::off_stroke_speed_m_s},
+    Field{"off_stroke_velocity_cutoff_hz", "Hz", kPositive,
+          "low-pass on the velocity the off-stroke damping reads", &P::off_stroke_velocity_cutoff_hz},
+    Field{"constraint_taper_m", "m", kNonNegative,
+          "band at R_res over which F_et tapers to zero, at most R_res; 0 = the paper's step",
+          &P::constraint_taper_m},
+    Field{"crossfade_s", "s", kNonNegative,
+          "cross-fade time of the in-plane force when the active element or state changes; 0 = off",
+          &P::crossfade_s},
+    Field{"paper_fade_s", "s", kNonNegative,
+          "fade time of the paper force when it starts or stops pushing (AS <-> CS); 0 = off",
+          &P::paper_fade_s},
+    Field{"paper_damping_n_s_per_m", "N s/m", kNonNegative,
+          "damping of the paper on inward motion only; 0 = off", &P::paper_damping_n_s_per_m},
+    Field{"max_foot_speed_m_s", "m/s", kPositive, "highest speed of the rendered attraction target X_S",
+          &P::max_foot_speed_m_s},
+    Field{"friction_coefficient", "", kNonNegative,
+          "Coulomb friction coefficient mu of the paper (not in the paper), dimensionless",
+          &P::friction_coefficient},
+    Field{"friction_stick_speed_m_s", "m/s", kPositive, "stick band of the friction, viscous below it",
+          &P::friction_stick_speed_m_s},
+};
+
+}  // namespace
+
+std::span<const ParameterField<ForceLawParameters>> ParameterTable<ForceLawParameters>::fields() noexcept {
+  return kFields;
+}
+
 void ForceLawParameters::validate() const {
-  const auto check = [](double value, const char* name, bool positive) {
-    if (!std::isfinite(value) || value < 0.0 || (positive && value == 0.0)) {
-      throw InvalidArgument(std::string("ForceLawParameters.") + name + " = " + std::to_string(value) +
-                            (positive ? " must be finite and > 0" : " must be finite and >= 0"));
-    }
-  };
-  check(guidance_stiffness_n_per_m, "guidance_stiffness_n_per_m", false);
-  check(paper_stiffness_n_per_m, "paper_stiffness_n_per_m", false);
-  check(constraint_radius_m, "constraint_radius_m", true);
-  check(resistance_damping_n_s_per_m, "resistance_damping_n_s_per_m", false);
-  check(contact_hysteresis_m, "contact_hysteresis_m", false);
-  check(constraint_taper_m, "constraint_taper_m", false);
-  check(crossfade_s, "crossfade_s", false);
-  check(paper_fade_s, "paper_fade_s", false);
+  check_parameters(*this);
   acceptance.validate();
-  check(paper_damping_n_s_per_m, "paper_damping_n_s_per_m", false);
-  check(max_foot_speed_m_s, "max_foot_speed_m_s", true);
-  check(friction_coefficient, "friction_coefficient", false);
-  check(friction_stick_speed_m_s, "friction_stick_speed_m_s", true);
-  check(off_stroke_force_n, "off_stroke_force_n", false);
-  check(off_stroke_travel_m, "off_stroke_travel_m", true);
-  check(off_stroke_damping_n_s_per_m, "off_stroke_damping_n_s_per_m", false);
-  check(off_stroke_speed_m_s, "off_stroke_speed_m_s", true);
-  check(off_stroke_velocity_cutoff_hz, "off_stroke_velocity_cutoff_hz", true);
   // A replay's or timing target's attraction point must stay within R_res of the pen.
   validate_guidance_law(guidance_law, constraint_radius_m);
   if (constraint_taper_m > constraint_radius_m) {

@@ -1,6 +1,6 @@
 #include "calligraphy/render/guidance_law.hpp"
 
-#include <cmath>
+#include <array>
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
@@ -8,44 +8,79 @@
 namespace calligraphy {
 namespace {
 
-// The one range check of a guidance parameter: closed below, closed or open above.
-void check_range(double value, const char* name, const char* unit, double low, double high, bool open_low) {
-  const bool above_low = open_low ? value > low : value >= low;
-  if (!std::isfinite(value) || !above_low || !(value <= high)) {
-    throw InvalidArgument(std::string(name) + " = " + std::to_string(value) + (*unit ? " " : "") + unit +
-                          " must be in " + (open_low ? "(" : "[") + std::to_string(low) + ", " +
-                          (std::isinf(high) ? "inf)" : std::to_string(high) + "]"));
-  }
+// A moving target's attraction point must stay within R_res of the pen: the table's (0, inf) narrowed.
+void check_max_lead(std::string_view law_name, double max_lead_m, double constraint_radius_m) {
+  check_parameter(std::string(law_name) + ".max_lead_m (at most constraint_radius_m)", max_lead_m, "m",
+                  ParameterRange{.low = 0.0, .high = constraint_radius_m, .low_open = true});
 }
 
-constexpr double kUnbounded = INFINITY;
+constexpr ParameterRange kShare{.low = 0.0, .high = 1.0};
+constexpr ParameterRange kNonNegative{};
+constexpr ParameterRange kPositive{.low_open = true};
+constexpr std::string_view kMaxLeadDoc =
+    "the distance at which the pull towards the moving point saturates, at most constraint_radius_m";
+
+constexpr std::array kFadingFields{
+    ParameterField<FadingGuidance>{"gain", "", kShare, "gain g on the guiding force F_et",
+                                   &FadingGuidance::gain},
+};
+constexpr std::array kReplayFields{
+    ParameterField<ReplayGuidance>{"max_lead_m", "m", kPositive, kMaxLeadDoc, &ReplayGuidance::max_lead_m},
+};
+constexpr std::array kAssistFields{
+    ParameterField<AssistAsNeededGuidance>{"band_m", "m", kNonNegative,
+                                           "half-width of the band without force around the active element",
+                                           &AssistAsNeededGuidance::band_m},
+};
+constexpr std::array kAmplificationFields{
+    ParameterField<ErrorAmplificationGuidance>{
+        "gain", "", kShare, "the repulsive stiffness as a share of K_et", &ErrorAmplificationGuidance::gain},
+    ParameterField<ErrorAmplificationGuidance>{"max_force_n", "N", kNonNegative,
+                                               "bound of the repulsive force",
+                                               &ErrorAmplificationGuidance::max_force_n},
+};
+constexpr std::array kTimingFields{
+    ParameterField<TimingGuidance>{"speed_m_s", "m/s", kPositive,
+                                   "mean speed of the target along each stroke", &TimingGuidance::speed_m_s},
+    ParameterField<TimingGuidance>{"max_lead_m", "m", kPositive, kMaxLeadDoc, &TimingGuidance::max_lead_m},
+};
 
 struct Validator {
   double constraint_radius_m;
-  void operator()(const FixedGuidance&) const {}
-  void operator()(const FadingGuidance& law) const {
-    check_range(law.gain, "FadingGuidance.gain", "", 0.0, 1.0, false);
-  }
   void operator()(const ReplayGuidance& law) const {
     validate_teacher_trajectory(law.teacher_trajectory);
-    check_range(law.max_lead_m, "ReplayGuidance.max_lead_m (at most constraint_radius_m)", "m", 0.0,
-                constraint_radius_m, true);
-  }
-  void operator()(const AssistAsNeededGuidance& law) const {
-    check_range(law.band_m, "AssistAsNeededGuidance.band_m", "m", 0.0, kUnbounded, false);
-  }
-  void operator()(const ErrorAmplificationGuidance& law) const {
-    check_range(law.gain, "ErrorAmplificationGuidance.gain", "", 0.0, 1.0, false);
-    check_range(law.max_force_n, "ErrorAmplificationGuidance.max_force_n", "N", 0.0, kUnbounded, false);
+    check_parameters(law);
+    check_max_lead(ParameterTable<ReplayGuidance>::name, law.max_lead_m, constraint_radius_m);
   }
   void operator()(const TimingGuidance& law) const {
-    check_range(law.speed_m_s, "TimingGuidance.speed_m_s", "m/s", 0.0, kUnbounded, true);
-    check_range(law.max_lead_m, "TimingGuidance.max_lead_m (at most constraint_radius_m)", "m", 0.0,
-                constraint_radius_m, true);
+    check_parameters(law);
+    check_max_lead(ParameterTable<TimingGuidance>::name, law.max_lead_m, constraint_radius_m);
+  }
+  template <typename Law>
+  void operator()(const Law& law) const {
+    check_parameters(law);
   }
 };
 
 }  // namespace
+
+std::span<const ParameterField<FadingGuidance>> ParameterTable<FadingGuidance>::fields() noexcept {
+  return kFadingFields;
+}
+std::span<const ParameterField<ReplayGuidance>> ParameterTable<ReplayGuidance>::fields() noexcept {
+  return kReplayFields;
+}
+std::span<const ParameterField<AssistAsNeededGuidance>>
+ParameterTable<AssistAsNeededGuidance>::fields() noexcept {
+  return kAssistFields;
+}
+std::span<const ParameterField<ErrorAmplificationGuidance>>
+ParameterTable<ErrorAmplificationGuidance>::fields() noexcept {
+  return kAmplificationFields;
+}
+std::span<const ParameterField<TimingGuidance>> ParameterTable<TimingGuidance>::fields() noexcept {
+  return kTimingFields;
+}
 
 GuidanceMode mode_of(const GuidanceLaw& law) noexcept {
   // The alternatives are declared in GuidanceMode order.

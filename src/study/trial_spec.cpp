@@ -20,61 +20,78 @@ namespace {
 
 using nlohmann::json;
 
-// The fields in both forms. The keys are the JSON names; the options those of `calligraphy trial`.
-constexpr std::array kFields{
-    TrialSpecField{"characters", "CHARS", "CHARS", "the characters to write, left to right (UTF-8)"},
-    TrialSpecField{"device", "--device", "NAME", "the device, by its name in `calligraphy devices`"},
-    TrialSpecField{"guidance", "--guidance", "on|off", "guiding force towards the stroke"},
-    TrialSpecField{
-        "guidance_mode", "--guidance-mode", "fixed|fading|replay|assist-as-needed|error-amplification|timing",
-        "how the guidance acts: the paper's fixture, faded by --guidance-gain, replaying --teacher, "
-        "only beyond --assist-band, pushing off the stroke (--amplification-gain), or pulling "
-        "along it at --timing-speed"},
-    TrialSpecField{"guidance_gain", "--guidance-gain", "G", "fading: gain on the guiding force, in [0, 1]"},
-    TrialSpecField{"assist_band_m", "--assist-band", "M",
-                   "assist-as-needed: half-width of the band without force around the stroke [m], >= 0"},
-    TrialSpecField{"amplification_gain", "--amplification-gain", "G",
-                   "error-amplification: the repulsive field's stiffness as a share of the guidance's, in "
-                   "[0, 1]"},
-    TrialSpecField{"timing_speed_m_s", "--timing-speed", "M/S",
-                   "timing: mean speed of the target along each stroke [m/s], > 0"},
-    TrialSpecField{"teacher", "--teacher", "FILE",
-                   "replay: the teacher's recording of CHARS (made with --record)"},
-    TrialSpecField{"writer", "--writer", "auto|person|simulated",
-                   "who writes: the simulated writer (on the simulated and emulated devices it moves) or a "
-                   "person (on a hardware device); auto: the device's own"},
-    TrialSpecField{"writer_profile", "--writer-profile", "novice|skilled|foreign",
-                   "the simulated writer's profile (docs/writer.md)"},
-    TrialSpecField{"writer_parameters", "--writer-param", "KEY=VALUE",
-                   "set a field of the simulated writer's profile (repeatable; keys: docs/writer.md)", true},
-    TrialSpecField{"seed", "--seed", "N", "seed of the simulated writer (a 64-bit integer)"},
-    TrialSpecField{"rate_hz", "--rate", "HZ", "servo rate [Hz], in [100, 100000] (real time: at most 10000)"},
-    TrialSpecField{"pacing", "--pacing", "auto|lock-step|real-time",
-                   "auto: lock-step for devices a simulated writer moves, real time for any other"},
-    TrialSpecField{"realtime", "--realtime", "enforce|ignore",
-                   "real-time pacing: fail unless SCHED_FIFO, CPU pinning and locked memory are obtained "
-                   "(enforce)"},
-    TrialSpecField{"watchdog_s", "--watchdog-ms", "MS",
-                   "real-time pacing: end the trial when the device holds one force longer than this [ms], "
-                   "0..60000; 0: off (JSON: watchdog_s in s)"},
-    TrialSpecField{"max_duration_s", "--max-duration", "S", "the trial ends after this much time [s]"},
-    TrialSpecField{"json_file", "--json", "FILE", "write the metrics as JSON ('-': standard output)"},
-    TrialSpecField{"csv_file", "--csv", "FILE",
-                   "write the trace (t,x,y,z,fx,fy,fz,state,stroke,element; s, m, N) as CSV ('-': standard "
-                   "output)"},
-    TrialSpecField{"svg_file", "--svg", "FILE",
-                   "draw the reference and the pen trace as SVG ('-': standard output)"},
-    TrialSpecField{"record_file", "--record", "FILE",
-                   "write the trial as a teacher's recording for --guidance-mode replay (a trial that wrote "
-                   "every stroke in order)"},
-};
+// A guidance law's parameter's help: its mode, then the law's table entry (doc, unit and range), so that
+// the help states the range the check applies.
+template <typename Law>
+std::string law_help(std::string_view mode, double Law::*member) {
+  return std::string(mode) + ": " + parameter_field(member).description();
+}
+
+// The fields in both forms. The keys are the JSON names; the options those of `calligraphy trial`. Built
+// once, on first use: four helps come from the guidance laws' tables.
+const auto& fields_in_order() {
+  static const std::string gain_help = law_help("fading", &FadingGuidance::gain);
+  static const std::string band_help = law_help("assist-as-needed", &AssistAsNeededGuidance::band_m);
+  static const std::string amplification_help =
+      law_help("error-amplification", &ErrorAmplificationGuidance::gain);
+  static const std::string speed_help = law_help("timing", &TimingGuidance::speed_m_s);
+  static const std::array fields{
+      TrialSpecField{"characters", "CHARS", "CHARS", "the characters to write, left to right (UTF-8)"},
+      TrialSpecField{"device", "--device", "NAME", "the device, by its name in `calligraphy devices`"},
+      TrialSpecField{"guidance", "--guidance", "on|off", "guiding force towards the stroke"},
+      TrialSpecField{
+          "guidance_mode", "--guidance-mode",
+          "fixed|fading|replay|assist-as-needed|error-amplification|timing",
+          "how the guidance acts: the paper's fixture, faded by --guidance-gain, replaying --teacher, "
+          "only beyond --assist-band, pushing off the stroke (--amplification-gain), or pulling "
+          "along it at --timing-speed"},
+      TrialSpecField{"guidance_gain", "--guidance-gain", "G", gain_help},
+      TrialSpecField{"assist_band_m", "--assist-band", "M", band_help},
+      TrialSpecField{"amplification_gain", "--amplification-gain", "G", amplification_help},
+      TrialSpecField{"timing_speed_m_s", "--timing-speed", "M/S", speed_help},
+      TrialSpecField{"teacher", "--teacher", "FILE",
+                     "replay: the teacher's recording of CHARS (made with --record)"},
+      TrialSpecField{"writer", "--writer", "auto|person|simulated",
+                     "who writes: the simulated writer (on the simulated and emulated devices it moves) or a "
+                     "person (on a hardware device); auto: the device's own"},
+      TrialSpecField{"writer_profile", "--writer-profile", "novice|skilled|foreign",
+                     "the simulated writer's profile (docs/writer.md)"},
+      TrialSpecField{"writer_parameters", "--writer-param", "KEY=VALUE",
+                     "set a field of the simulated writer's profile (repeatable; keys: docs/writer.md)",
+                     true},
+      TrialSpecField{"seed", "--seed", "N", "seed of the simulated writer (a 64-bit integer)"},
+      TrialSpecField{"rate_hz", "--rate", "HZ",
+                     "servo rate [Hz], in [100, 100000] (real time: at most 10000)"},
+      TrialSpecField{"pacing", "--pacing", "auto|lock-step|real-time",
+                     "auto: lock-step for devices a simulated writer moves, real time for any other"},
+      TrialSpecField{"realtime", "--realtime", "enforce|ignore",
+                     "real-time pacing: fail unless SCHED_FIFO, CPU pinning and locked memory are obtained "
+                     "(enforce)"},
+      TrialSpecField{"watchdog_s", "--watchdog-ms", "MS",
+                     "real-time pacing: end the trial when the device holds one force longer than this [ms], "
+                     "0..60000; 0: off (JSON: watchdog_s in s)"},
+      TrialSpecField{"max_duration_s", "--max-duration", "S", "the trial ends after this much time [s]"},
+      TrialSpecField{"json_file", "--json", "FILE", "write the metrics as JSON ('-': standard output)"},
+      TrialSpecField{"csv_file", "--csv", "FILE",
+                     "write the trace (t,x,y,z,fx,fy,fz,state,stroke,element; s, m, N) as CSV ('-': standard "
+                     "output)"},
+      TrialSpecField{"svg_file", "--svg", "FILE",
+                     "draw the reference and the pen trace as SVG ('-': standard output)"},
+      TrialSpecField{
+          "record_file", "--record", "FILE",
+          "write the trial as a teacher's recording for --guidance-mode replay (a trial that wrote "
+          "every stroke in order)"},
+  };
+  return fields;
+}
 
 const TrialSpecField& field_named(std::string_view name) {
-  for (const TrialSpecField& field : kFields) {
+  for (const TrialSpecField& field : fields_in_order()) {
     if (name == field.key || name == field.option) return field;
   }
   std::string names;
-  for (const TrialSpecField& field : kFields) names += (names.empty() ? "" : ", ") + std::string(field.key);
+  for (const TrialSpecField& field : fields_in_order())
+    names += (names.empty() ? "" : ", ") + std::string(field.key);
   throw InvalidArgument("trial specification: no field '" + std::string(name) + "'; fields: " + names);
 }
 
@@ -113,6 +130,17 @@ const char* to_string(RealtimeMode mode) noexcept {
   return mode == RealtimeMode::enforce ? "enforce" : "ignore";
 }
 
+// A guidance law's parameter held by the specification, checked by the law's own table entry (one
+// definition of each range), the error naming both the specification's field and the law's.
+template <typename Law>
+void check_law_parameter(std::string_view key, double Law::*member, double value) {
+  try {
+    check_parameter(member, value);
+  } catch (const InvalidArgument& e) {
+    refuse(key, e.what());
+  }
+}
+
 template <typename Enum, std::size_t N>
 Enum parse_choice(std::string_view key, std::string_view text, const std::array<Enum, N>& choices) {
   std::string spellings;
@@ -141,7 +169,7 @@ const char* to_string(TrialWriter writer) noexcept {
   return "auto";
 }
 
-std::span<const TrialSpecField> trial_spec_fields() { return kFields; }
+std::span<const TrialSpecField> trial_spec_fields() { return fields_in_order(); }
 
 void set_trial_spec_field(TrialSpec& spec, std::string_view name, std::string_view text) {
   const std::string_view key = field_named(name).key;
@@ -245,30 +273,23 @@ void TrialSpec::validate(TeacherSource teacher_from) const {
     refuse("guidance_mode", std::string("'") + calligraphy::to_string(guidance_mode) +
                                 "' needs guidance on (guidance is off)");
   }
-  if (!(guidance_gain >= 0.0 && guidance_gain <= 1.0)) {
-    refuse("guidance_gain", number_text(guidance_gain) + " is outside [0, 1]");
-  }
+  check_law_parameter("guidance_gain", &FadingGuidance::gain, guidance_gain);
   if (guidance_gain != 1.0 && guidance_mode != GuidanceMode::fading) {
     refuse("guidance_gain", "applies to guidance mode 'fading' only");
   }
-  // Each mode's own parameter: in range, and given only with its mode (a value nothing reads is a mistake).
+  // Each mode's own parameter: in its law's range, and given only with its mode (a value nothing reads is
+  // a mistake).
   const TrialSpec defaults;
-  if (!(assist_band_m >= 0.0) || !std::isfinite(assist_band_m)) {
-    refuse("assist_band_m", number_text(assist_band_m) + " must be finite and >= 0");
-  }
+  check_law_parameter("assist_band_m", &AssistAsNeededGuidance::band_m, assist_band_m);
   if (assist_band_m != defaults.assist_band_m && guidance_mode != GuidanceMode::assist_as_needed) {
     refuse("assist_band_m", "applies to guidance mode 'assist-as-needed' only");
   }
-  if (!(amplification_gain >= 0.0 && amplification_gain <= 1.0)) {
-    refuse("amplification_gain", number_text(amplification_gain) + " is outside [0, 1]");
-  }
+  check_law_parameter("amplification_gain", &ErrorAmplificationGuidance::gain, amplification_gain);
   if (amplification_gain != defaults.amplification_gain &&
       guidance_mode != GuidanceMode::error_amplification) {
     refuse("amplification_gain", "applies to guidance mode 'error-amplification' only");
   }
-  if (!(timing_speed_m_s > 0.0) || !std::isfinite(timing_speed_m_s)) {
-    refuse("timing_speed_m_s", number_text(timing_speed_m_s) + " must be finite and > 0");
-  }
+  check_law_parameter("timing_speed_m_s", &TimingGuidance::speed_m_s, timing_speed_m_s);
   if (timing_speed_m_s != defaults.timing_speed_m_s && guidance_mode != GuidanceMode::timing) {
     refuse("timing_speed_m_s", "applies to guidance mode 'timing' only");
   }
@@ -353,7 +374,7 @@ TrialSpec trial_spec_from_args(std::span<const std::string> args) {
 std::vector<std::string> trial_spec_args(const TrialSpec& spec) {
   const TrialSpec defaults;
   std::vector<std::string> args{spec.characters};
-  for (const TrialSpecField& field : kFields) {
+  for (const TrialSpecField& field : fields_in_order()) {
     if (field.key == "characters") continue;
     const std::vector<std::string> values = trial_spec_field_text(spec, field.key);
     if (values == trial_spec_field_text(defaults, field.key)) continue;
@@ -369,7 +390,7 @@ TrialSpec trial_spec_from_json(std::string_view text, const std::string& source)
   const json document = study_detail::parse_json(text, source);
   study_detail::ObjectReader reader(document, "", source);
   TrialSpec spec;
-  for (const TrialSpecField& field : kFields) {
+  for (const TrialSpecField& field : fields_in_order()) {
     const std::string key(field.key);
     const json* value = reader.optional(key);
     if (value == nullptr) continue;
@@ -424,7 +445,7 @@ TrialSpec trial_spec_from_json(std::string_view text, const std::string& source)
 
 std::string trial_spec_json(const TrialSpec& spec) {
   nlohmann::ordered_json document = nlohmann::ordered_json::object();  // in field order
-  for (const TrialSpecField& field : kFields) {
+  for (const TrialSpecField& field : fields_in_order()) {
     const std::string key(field.key);
     if (key == "guidance") {
       document[key] = spec.guidance;

@@ -47,6 +47,19 @@ def test_every_cpp_field_is_bound(cls, header, struct):
         assert getattr(cls, name).__doc__, f"{struct}.{name} has no documentation"
 
 
+def test_every_numeric_force_law_field_documents_its_range():
+    # The numeric fields' documentation comes from the C++ parameter tables, which also check them: each
+    # states the range its value is checked against.
+    classes = [calligraphy.ForceLawParameters, calligraphy.FadingGuidance, calligraphy.ReplayGuidance,
+               calligraphy.AssistAsNeededGuidance, calligraphy.ErrorAmplificationGuidance,
+               calligraphy.TimingGuidance]
+    for cls in classes:
+        for name, value in cls().to_dict().items():
+            if isinstance(value, float):
+                doc = getattr(cls, name).__doc__
+                assert any(bound in doc for bound in (">= ", "> ", "in [", "in (")), f"{cls.__name__}.{name}: {doc}"
+
+
 def test_defaults_are_the_cpp_defaults():
     law = calligraphy.ForceLawParameters()
     assert law.guidance_stiffness_n_per_m == 400.0 and law.paper_stiffness_n_per_m == 800.0

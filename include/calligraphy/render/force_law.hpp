@@ -86,10 +86,20 @@ struct ForceLawParameters {
   /// How the foot point X_S on curve elements is found.
   NearestPointOptions nearest{};
 
-  /// Throws InvalidArgument when a value is negative, not finite, the radius or the stick speed is not
-  /// positive, the taper band is wider than the radius, or the guidance law's parameters are out of range
-  /// (validate_guidance_law, naming the field).
+  /// Throws InvalidArgument naming the field when a numeric value is outside its table's range
+  /// (`ParameterTable<ForceLawParameters>`: not finite, negative, or zero where it must be positive), the
+  /// acceptance is invalid, the guidance law's parameters are out of range (validate_guidance_law), or the
+  /// taper band is wider than the radius.
   void validate() const;
+};
+
+/// The numeric fields of ForceLawParameters (parameter_table.hpp): the one definition of their units and
+/// ranges. Not in it: `guidance`, `guidance_law` (its own tables), `acceptance` and `nearest` (their own
+/// validation).
+template <>
+struct ParameterTable<ForceLawParameters> {
+  static constexpr std::string_view name = "ForceLawParameters";
+  [[nodiscard]] static std::span<const ParameterField<ForceLawParameters>> fields() noexcept;
 };
 
 /// Eq. (9), written to push out of the paper: K_en (z0 - z) e_z when the tip is below the paper

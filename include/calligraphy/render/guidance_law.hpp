@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "calligraphy/render/guidance_mode.hpp"
+#include "calligraphy/render/parameter_table.hpp"
 
 namespace calligraphy {
 
@@ -63,6 +64,40 @@ struct TimingGuidance {
   bool operator==(const TimingGuidance&) const = default;
 };
 
+// Each law's table (parameter_table.hpp): the one definition of its fields' ranges, units and docs.
+// A moving target's max_lead_m is also at most the force law's constraint_radius_m, a rule across
+// structs that `validate_guidance_law` adds.
+template <>
+struct ParameterTable<FixedGuidance> {
+  static constexpr std::string_view name = "FixedGuidance";
+  [[nodiscard]] static std::span<const ParameterField<FixedGuidance>> fields() noexcept { return {}; }
+};
+template <>
+struct ParameterTable<FadingGuidance> {
+  static constexpr std::string_view name = "FadingGuidance";
+  [[nodiscard]] static std::span<const ParameterField<FadingGuidance>> fields() noexcept;
+};
+template <>
+struct ParameterTable<ReplayGuidance> {
+  static constexpr std::string_view name = "ReplayGuidance";
+  [[nodiscard]] static std::span<const ParameterField<ReplayGuidance>> fields() noexcept;
+};
+template <>
+struct ParameterTable<AssistAsNeededGuidance> {
+  static constexpr std::string_view name = "AssistAsNeededGuidance";
+  [[nodiscard]] static std::span<const ParameterField<AssistAsNeededGuidance>> fields() noexcept;
+};
+template <>
+struct ParameterTable<ErrorAmplificationGuidance> {
+  static constexpr std::string_view name = "ErrorAmplificationGuidance";
+  [[nodiscard]] static std::span<const ParameterField<ErrorAmplificationGuidance>> fields() noexcept;
+};
+template <>
+struct ParameterTable<TimingGuidance> {
+  static constexpr std::string_view name = "TimingGuidance";
+  [[nodiscard]] static std::span<const ParameterField<TimingGuidance>> fields() noexcept;
+};
+
 /// How F_et attracts, with the mode's own parameters. The alternatives are in `GuidanceMode` order.
 using GuidanceLaw = std::variant<FixedGuidance, FadingGuidance, ReplayGuidance, AssistAsNeededGuidance,
                                  ErrorAmplificationGuidance, TimingGuidance>;
@@ -74,8 +109,8 @@ using GuidanceLaw = std::variant<FixedGuidance, FadingGuidance, ReplayGuidance, 
 [[nodiscard]] GuidanceLaw default_guidance_law(GuidanceMode mode);
 
 /// Throws InvalidArgument naming the field (e.g. "FadingGuidance.gain"), its value and range when a value
-/// is out of range or not finite; a replay's teacher is checked by `validate_teacher_trajectory`. The
-/// moving targets' max_lead_m must be within `constraint_radius_m` [m].
+/// is out of range or not finite (the law's `ParameterTable`); a replay's teacher is checked by
+/// `validate_teacher_trajectory`. The moving targets' max_lead_m must be within `constraint_radius_m` [m].
 void validate_guidance_law(const GuidanceLaw& law, double constraint_radius_m);
 
 }  // namespace calligraphy
