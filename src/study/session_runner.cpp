@@ -12,6 +12,8 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/model/scene.hpp"
+#include "calligraphy/render/guidance_law.hpp"
+#include "calligraphy/render/parameter_table.hpp"
 #include "calligraphy/report/trial_report.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
@@ -97,9 +99,10 @@ TrialSpec study_trial_spec(const SessionManifest& session, const StudyCondition&
   spec.guidance = renders_guidance(condition.mode);
   if (condition.mode == ConditionMode::fading) {
     spec.guidance_mode = GuidanceMode::fading;
-    if (!(guidance.gain >= 0.0 && guidance.gain <= 1.0)) {
-      throw InvalidArgument("condition '" + condition.name + "': guidance gain " +
-                            std::to_string(guidance.gain) + " outside [0, 1]");
+    try {
+      check_parameter(&FadingGuidance::gain, guidance.gain);  // the law's own table: one range
+    } catch (const InvalidArgument& e) {
+      throw InvalidArgument("condition '" + condition.name + "': " + e.what());
     }
     spec.guidance_gain = guidance.gain;
   }
