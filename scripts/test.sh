@@ -106,7 +106,8 @@ end_stage
 
 begin_stage "Release build, warnings as errors"
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON \
-  -DCALLIGRAPHY_BUILD_PYTHON=ON -DCALLIGRAPHY_BUILD_TESTS=ON >/dev/null
+  -DCALLIGRAPHY_BUILD_PYTHON=ON -DCALLIGRAPHY_BUILD_TESTS=ON -DCALLIGRAPHY_BUILD_BENCH=ON \
+  -DCALLIGRAPHY_BUILD_EXAMPLES=ON >/dev/null
 cmake --build build -j "$jobs"
 python3 scripts/build-times.py build  # where the build's time went: per target, and the slowest steps
 end_stage
@@ -118,7 +119,7 @@ end_stage
 start_background "AddressSanitizer + UndefinedBehaviorSanitizer: build" "
   cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG='-O1 -g1' \
     -DCALLIGRAPHY_SANITIZE=address,undefined -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_BENCH=OFF \
-    -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_TRAINER=OFF >/dev/null &&
+    -DCALLIGRAPHY_BUILD_TESTS=ON -DCALLIGRAPHY_BUILD_EXAMPLES=ON -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_TRAINER=OFF >/dev/null &&
   cmake --build build-asan -j $jobs"
 begin_stage "Release tests"
 run_ctest build
@@ -133,7 +134,7 @@ python3 scripts/build-times.py build-asan
 # seed and regression input passing. Both are built beside the sanitizer tests.
 start_background "ThreadSanitizer and fuzzer (clang, libFuzzer) builds" "
   cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO='-O1 -g1' \
-    -DCALLIGRAPHY_SANITIZE=thread \
+    -DCALLIGRAPHY_SANITIZE=thread -DCALLIGRAPHY_BUILD_TESTS=ON \
     -DCMAKE_CXX_FLAGS=-Wno-tsan -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_TOOLS=OFF \
     -DCALLIGRAPHY_BUILD_BENCH=OFF -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_EXAMPLES=OFF >/dev/null &&
   cmake --build build-tsan -j $jobs --target calligraphy_servo_tests &&
@@ -157,7 +158,10 @@ end_stage
 
 begin_stage "install + find_package(calligraphy) from another project"
 rm -rf build/stage build/consumer build/consumer-haptics
+touch build/install-started
 cmake --install build --prefix build/stage >/dev/null
+# A staging install writes only under its prefix (no .pth into another interpreter's site-packages).
+bash tests/consumer/check_install_prefix.sh build build/stage build/install-started
 # Only Eigen3 may be found: a find_dependency of anything else in the installed package fails the configure.
 cmake --no-warn-unused-cli -S tests/consumer -B build/consumer -G Ninja \
   -DCMAKE_PREFIX_PATH="$PWD/build/stage" \
