@@ -141,8 +141,7 @@ SessionRunResult run_one(SessionFolder& session, const SessionRunOptions& option
       try {
         character.outlines = outlines->load_outlines(c);
       } catch (const DataError& e) {  // drawn without outlines
-        std::fprintf(stderr, "calligraphy session: warning: no stroke outlines for %s: %s\n",
-                     character.utf8.c_str(), e.what());
+        print_error_line("calligraphy session", "warning", "no stroke outlines for " + character.utf8 + ": " + e.what());
       }
       return character;
     };

@@ -149,8 +149,7 @@ int run_train(const TrainCommand& command) {
     try {
       character.outlines = outlines.load_outlines(c);
     } catch (const DataError& e) {  // e.g. a store without the data folder: drawn without outlines
-      std::fprintf(stderr, "calligraphy train: warning: no stroke outlines for %s: %s\n",
-                   character.utf8.c_str(), e.what());
+      print_error_line("calligraphy train", "warning", "no stroke outlines for " + character.utf8 + ": " + e.what());
     }
     options.characters.push_back(std::move(character));
   }

@@ -128,10 +128,10 @@ bool write_trial_outputs(const TrialSpec& spec, const TrialDescription& descript
     try {
       write_output(path, text());
     } catch (const Error& e) {  // DataError naming the path and the reason
-      std::fprintf(stderr, "calligraphy trial: error: %s\n", e.what());
+      print_error_line("calligraphy trial", "error", e.what());
       all_written = false;
     } catch (const std::bad_alloc&) {  // a trace too large to format in memory
-      std::fprintf(stderr, "calligraphy trial: error: %s: cannot write: out of memory\n", path.c_str());
+      print_error_line("calligraphy trial", "error", path + ": cannot write: out of memory");
       all_written = false;
     }
   };
@@ -161,10 +161,9 @@ bool write_teacher_recording(const TrialSpec& spec, const TrialDescription& desc
     write_output(spec.record_file, teacher_recording_json(recording));
     return true;
   } catch (const Error& e) {
-    std::fprintf(stderr, "calligraphy trial: error: --record: %s\n", e.what());
+    print_error_line("calligraphy trial", "error", std::string("--record: ") + e.what());
   } catch (const std::bad_alloc&) {
-    std::fprintf(stderr, "calligraphy trial: error: %s: cannot write: out of memory\n",
-                 spec.record_file.c_str());
+    print_error_line("calligraphy trial", "error", spec.record_file + ": cannot write: out of memory");
   }
   return false;
 }
@@ -246,8 +245,9 @@ int run_trial(const TrialCommand& command) {
   }
   if (!written) return 1;
   if (result.aborted) {
-    std::fprintf(stderr, "calligraphy trial: error: the trial ended early (%s)%s%s\n", to_string(result.end),
-                 result.abort_reason.empty() ? "" : ": ", result.abort_reason.c_str());
+    print_error_line("calligraphy trial", "error",
+                     std::string("the trial ended early (") + to_string(result.end) + ")" +
+                         (result.abort_reason.empty() ? "" : ": " + result.abort_reason));
     return 1;
   }
   return 0;

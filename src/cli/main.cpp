@@ -28,7 +28,7 @@ std::pair<std::string, const CLI::App*> given_command(const CLI::App& root) {
 }
 
 void print_error(const std::string& command, const std::string& message) {
-  std::fprintf(stderr, "%s: error: %s\n", command.c_str(), message.c_str());
+  print_error_line(command, "error", message);
 }
 
 }  // namespace
@@ -105,7 +105,7 @@ int main(int argc, char** argv) {
     print_error(given_command(root).first, e.what());
     status = 1;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s: internal error: %s\n", given_command(root).first.c_str(), e.what());
+    print_error_line(given_command(root).first, "internal error", e.what());
     status = 3;
   }
   return finish_standard_output(status, given_command(root).first);

@@ -12,6 +12,7 @@
 
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/printable_text.hpp"
 #include "calligraphy/study/session_folder.hpp"
 #include "cli/app.hpp"
 
@@ -38,6 +39,12 @@ std::string read_input_file(const std::string& path, const std::string& what) {
   return std::move(*text);
 }
 
+void print_error_line(std::string_view command, std::string_view kind, std::string_view message) {
+  const std::string line = printable_one_line(command, 200) + ": " + printable_one_line(kind, 100) + ": " +
+                           printable_one_line(message) + "\n";
+  std::fputs(line.c_str(), stderr);
+}
+
 int finish_standard_output(int status, const std::string& command) {
   errno = 0;
   std::cout.flush();  // synchronised with stdio: this flushes stdout, and may be where a failure shows
@@ -45,8 +52,8 @@ int finish_standard_output(int status, const std::string& command) {
   const int error = errno;  // a successful flush leaves errno as the first failure set it
   if (flushed && !std::ferror(stdout) && std::cout.good()) return status;
   if (status != 0) return status;  // the failure was reported already
-  std::fprintf(stderr, "%s: error: standard output: cannot write%s%s\n", command.c_str(), error ? ": " : "",
-               error ? std::strerror(error) : "");
+  print_error_line(command, "error",
+                   std::string("standard output: cannot write") + (error ? ": " : "") + (error ? std::strerror(error) : ""));
   return 1;
 }
 

@@ -20,6 +20,11 @@ void write_output(const std::string& path, std::string_view text);
 /// `what` it should hold when it does not exist, is not a regular file, is too large or cannot be read.
 std::string read_input_file(const std::string& path, const std::string& what);
 
+/// Prints "COMMAND: KIND: MESSAGE" as one line on standard error ("calligraphy trial", "error", ...): control
+/// characters in any part escaped and the message's length bounded (printable_one_line), whatever it quotes
+/// (docs/cli.md, "Errors").
+void print_error_line(std::string_view command, std::string_view kind, std::string_view message);
+
 /// Flushes standard output and checks that everything written to it arrived; prints a one-line error
 /// and returns 1 (or `status` when that is already an error) when not. What main() returns.
 int finish_standard_output(int status, const std::string& command);

@@ -447,5 +447,34 @@ class HostileSizes(HostileTestCase):
         self.assertEqual(piped.stderr, b"")  # no progress into a pipe or a log
 
 
+class HostileMessages(HostileTestCase):
+    """Whatever an error quotes (a device name, a file name), it is one line of printable text of bounded
+    length: no newline splits it, no escape sequence reaches the terminal (docs/cli.md, "Errors")."""
+
+    def assert_one_printable_line(self, result, status):
+        self.assertEqual(result.returncode, status, result.stderr)
+        lines = result.stderr.split(b"\n")
+        self.assertEqual(lines[-1], b"", "the message does not end its line")
+        self.assertEqual(len(lines), 2, f"not one line: {result.stderr!r}")
+        self.assertFalse(any(byte < 0x20 or byte == 0x7F for byte in lines[0]), f"control bytes: {lines[0]!r}")
+        return lines[0].decode()
+
+    def test_device_name_with_newline_and_escape(self):
+        name = "evil\nname\x1b[31m\r"
+        line = self.assert_one_printable_line(self.run_cli("trial", YONG, "--device", name), 2)
+        self.assertIn("evil\\nname\\x1b[31m\\r", line)
+        self.assertIn("simulated", line)  # what is available is still said
+
+    def test_file_name_with_control_characters(self):
+        line = self.assert_one_printable_line(self.run_cli("score", "no\x07such\nfile.csv", "--character", YONG), 1)
+        self.assertIn("no\\x07such\\nfile.csv", line)
+
+    def test_huge_name_gives_a_bounded_line(self):
+        name = "d" * 100_000  # one argument may hold at most 128 KiB (MAX_ARG_STRLEN)
+        line = self.assert_one_printable_line(self.run_cli("trial", YONG, "--device", name), 2)
+        self.assertLess(len(line), 3000)
+        self.assertRegex(line, r"\.\.\. \(\d+ more bytes\)$")
+
+
 if __name__ == "__main__":
     unittest.main(verbosity=2)
