@@ -1,7 +1,7 @@
 #pragma once
 // Progress of a long step on the terminal: "\r<label> 42%" on stderr, only when stderr is a terminal (never
 // into a redirected log or a pipe), first shown after half a second and at most ten times a second; the
-// line is cleared when the step ends.
+// line is cleared when the step ends. CALLIGRAPHY_PROGRESS_AFTER_S (seconds) changes the half second.
 #include <chrono>
 #include <cstddef>
 #include <string>
@@ -27,6 +27,7 @@ class TerminalProgress {
   bool enabled_ = false;
   bool shown_ = false;
   std::string label_;
+  std::chrono::steady_clock::duration first_shown_after_;
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
   std::chrono::steady_clock::time_point last_{};
 };

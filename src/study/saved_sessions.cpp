@@ -62,8 +62,18 @@ nlohmann::json read_trial_record(const fs::path& json_file) {
   const std::string source = json_file.string();
   nlohmann::json record =
       parse_json(read_small_file(json_file, kMaxRecordBytes, "trial record (JSON)"), source);
-  if (!record.is_object() || !record.contains("format") || record["format"] != "calligraphy-study-trial") {
-    fail(source, "/format", "expected \"calligraphy-study-trial\"");
+  if (!record.is_object() || !record.contains("format") || record["format"] != kTrialRecordFormat) {
+    fail(source, "/format", std::string("expected \"") + kTrialRecordFormat + "\"");
+  }
+  const auto version = record.find("version");
+  if (version == record.end() || !version->is_number_integer() || version->get<std::int64_t>() < 1 ||
+      version->get<std::int64_t>() > kTrialRecordVersion) {
+    fail(source, "/version",
+         "expected a trial record version from 1 to " + std::to_string(kTrialRecordVersion) + ", got " +
+             (version == record.end() ? std::string("none") : version->dump()) +
+             (version != record.end() && version->is_number_integer() && version->get<std::int64_t>() > kTrialRecordVersion
+                  ? " (written by a newer calligraphy: read it with that version)"
+                  : ""));
   }
   return record;
 }

@@ -40,7 +40,14 @@ class DistinctSessions {
   std::map<std::string, std::filesystem::path> seen_;
 };
 
-/// The record of a saved trial (its format checked). Throws DataError naming the file.
+/// The format name and the newest version of a saved trial's record (trial_record.cpp writes it; version 1
+/// counted a trial's block and item from 0).
+inline constexpr const char* kTrialRecordFormat = "calligraphy-study-trial";
+inline constexpr std::int64_t kTrialRecordVersion = 2;
+
+/// The record of a saved trial, its format and version checked: every reader of records reads them through
+/// this. Throws DataError naming the file and the field: not a record, or a version this library does not
+/// know (a newer calligraphy wrote it, or the file is damaged).
 nlohmann::json read_trial_record(const std::filesystem::path& json_file);
 
 }  // namespace calligraphy::study_detail

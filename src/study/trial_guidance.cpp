@@ -10,6 +10,7 @@
 #include "calligraphy/study/trial_spec_runner.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "study/json_reader.hpp"
+#include "study/saved_sessions.hpp"
 #include "study/names.hpp"
 
 namespace calligraphy::study_detail {
@@ -114,8 +115,7 @@ PreparedGuidance repetition_guidance(const SessionFolder& session, const StudyCo
     throw StateError("trial " + SessionFolder::trial_stem(trial) + ": its guidance follows " +
                      SessionFolder::trial_stem(*previous) + ", which is not saved");
   }
-  const std::string text = read_small_file(file, std::uintmax_t{64} << 20, "trial record");
-  const json record = study_detail::parse_json(text, file.string());
+  const json record = study_detail::read_trial_record(file);
   return repetition_guidance(condition, previous, &record, file.string());
 }
 

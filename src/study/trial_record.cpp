@@ -12,13 +12,13 @@
 #include "report/trial_outcome.hpp"
 #include "study/manifest_json.hpp"
 #include "study/remembered_writer.hpp"
+#include "study/saved_sessions.hpp"
 
 namespace calligraphy::study_detail {
 namespace {
 
 using nlohmann::json;
 
-constexpr const char* kFormat = "calligraphy-study-trial";
 
 json vec(const Vec2& v) { return json::array({v.x(), v.y()}); }
 json vec(const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
@@ -306,8 +306,8 @@ nlohmann::json trial_record(const TrialRecordContext& c, const Scene& scene, con
   // them; then what a study adds.
   json document = report_detail::trial_outcome_object(result, writing);
   // Version 2: the trial's block and item count from 1, as its index and repetition (version 1: from 0).
-  document.update({{"format", kFormat},
-                   {"version", 2},
+  document.update({{"format", kTrialRecordFormat},
+                   {"version", kTrialRecordVersion},
                    {"subject", c.session->setup.subject.id},
                    {"subject_number", c.session->setup.subject.number},
                    {"session", c.session->session_id},

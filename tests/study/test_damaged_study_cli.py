@@ -127,6 +127,31 @@ class DamagedStudyTest(unittest.TestCase):
                         self.assert_data_error(result, record.name, f"{what} ({command[2]})")
         record.write_text(text, encoding="utf-8")
 
+    def test_a_record_of_an_unknown_version_is_refused_by_every_reader(self):
+        """A newer (or damaged) version is never read as the current one: every command that reads records
+        refuses it naming the file and /version; the current version is read."""
+        record = sorted((self.first_session() / "trials").glob("*.json"))[0]
+        original = json.loads(record.read_text(encoding="utf-8"))
+        subject = original["subject"]
+        readers = (["report", "S", "--csv", "."], ["report", "S", "--out", "r.html"],
+                   ["curriculum", "S", "--subject", subject, "--from", "永十"])
+        for version in (3, 99, 0, -1, "2", 2.5, None):
+            with self.subTest(version=version):
+                document = dict(original)
+                if version is None:
+                    del document["version"]
+                else:
+                    document["version"] = version
+                record.write_text(json.dumps(document), encoding="utf-8")
+                for command in readers:
+                    result = self.run_cli(*command)
+                    self.assert_data_error(result, record.name, f"version {version!r} ({' '.join(command[:2])})")
+                    self.assertIn("/version", result.stderr.decode())
+        record.write_text(json.dumps(original), encoding="utf-8")
+        for command in readers:
+            result = self.run_cli(*command)
+            self.assertEqual(result.returncode, 0, result.stderr.decode())
+
     def test_every_wrong_value_of_a_session_manifest_is_a_data_error_naming_the_file(self):
         manifest = self.first_session() / "session.json"
         for what, damaged in self.damaged_copies(manifest):
