@@ -61,3 +61,17 @@ TEST_CASE("One mapping from fault codes to typed exceptions", "[device][fault]")
   // Both are DeviceErrors, so a caller that only cares that the device failed catches one type.
   CHECK_THROWS_AS(throw_device_fault(DeviceFault::non_finite_force, "Touch"), DeviceError);
 }
+
+TEST_CASE("kDeviceFaultCount counts the codes, and each code's name is its enumerator's", "[device][fault]") {
+  // Every value below the count is a code with a name and a message (none of the switches' fallbacks), and
+  // the value at the count is not a code: an enumerator added without raising the count fails here.
+  for (std::size_t value = 0; value < kDeviceFaultCount; ++value) {
+    const auto fault = static_cast<DeviceFault>(value);
+    INFO(value);
+    CHECK(std::string(device_fault_name(fault)) != "unknown");
+    CHECK(std::string(to_string(fault)) != "unknown device fault");
+  }
+  CHECK(std::string(device_fault_name(static_cast<DeviceFault>(kDeviceFaultCount))) == "unknown");
+  CHECK(std::string(device_fault_name(DeviceFault::not_advanced)) == "not_advanced");
+  CHECK(is_link_fault(DeviceFault::not_advanced));  // a usage fault, thrown as CommunicationError
+}

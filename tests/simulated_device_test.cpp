@@ -34,3 +34,39 @@ TEST_CASE("The simulated device saturates and quantises like a real one", "[devi
   bad.moving_mass_kg = 0.0;
   CHECK_THROWS_AS(SimulatedDevice(bad), InvalidArgument);
 }
+
+TEST_CASE("The simulated device's clock reads 0 at open() and counts whole ticks", "[device]") {
+  SimulatedDevice d;
+  DeviceState state;
+  d.open();
+  CHECK(d.read_state(state) == DeviceFault::none);
+  CHECK(state.time_s == 0.0);
+  for (int i = 0; i < 13073; ++i) d.advance(1e-3);
+  CHECK(d.read_state(state) == DeviceFault::none);
+  // Exact, not a sum of 130,730 rounded substeps: 13,073 ticks of 1 ms read 13.073 s.
+  CHECK(state.time_s == 13.073);
+  d.open();  // already open: nothing changes
+  CHECK(d.time() == 13.073);
+
+  CHECK(d.write_force(Vec3(1.0, 0.0, 0.0)) == DeviceFault::none);
+  for (int i = 0; i < 100; ++i) d.advance(1e-3);
+  d.close();
+  const Vec3 position = d.true_position();
+  d.open();  // the clock restarts; the stylus stays where it was
+  CHECK(d.time() == 0.0);
+  CHECK(d.true_position() == position);
+  CHECK(d.read_state(state) == DeviceFault::none);
+  CHECK(state.time_s == 0.0);
+  // The velocity filter starts afresh: nothing differenced across the re-open.
+  CHECK(state.velocity_m_s.isZero());
+  for (int i = 0; i < 250; ++i) d.advance(1e-3);
+  CHECK(d.read_state(state) == DeviceFault::none);
+  CHECK(state.time_s == 0.25);
+}
+
+TEST_CASE("The simulated device refuses a step that would run its clock past 2^62 ns", "[device]") {
+  SimulatedDevice d;
+  d.advance(1.0);
+  CHECK_THROWS_AS(d.advance(4.7e9), InvalidArgument);  // 149 years
+  CHECK(d.time() == 1.0);
+}

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "analysis/assignment.hpp"
+#include "analysis/durations.hpp"
 #include "analysis/input_checks.hpp"
 #include "analysis/segment_metrics.hpp"
 #include "analysis/segmentation.hpp"
@@ -63,8 +64,11 @@ void add_timing(CharacterScore& score, std::span<const PenSample> trace) {
   }
   if (!segments.empty()) {
     totals.pen_lifts = segments.size() - 1;
-    totals.total_time_s = trace[segments.back().end - 1].time_s - trace[segments.front().begin].time_s;
+    totals.total_time_s = analysis::whole_nanoseconds(trace[segments.back().end - 1].time_s -
+                                                      trace[segments.front().begin].time_s);
   }
+  totals.writing_time_s = analysis::whole_nanoseconds(totals.writing_time_s);
+  totals.in_air_time_s = analysis::whole_nanoseconds(totals.in_air_time_s);
   if (totals.writing_time_s > 0.0) totals.mean_speed_m_per_s = totals.path_length_m / totals.writing_time_s;
   if (jerk_count > 0) totals.normalised_jerk = jerk_sum / static_cast<double>(jerk_count);
 }

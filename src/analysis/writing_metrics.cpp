@@ -3,6 +3,7 @@
 
 #include <vector>
 
+#include "analysis/durations.hpp"
 #include "analysis/segmentation.hpp"
 #include "calligraphy/core/errors.hpp"
 
@@ -74,7 +75,8 @@ WritingMetrics writing_metrics(const Scene& scene, std::span<const PenSample> tr
     last_down = trace[k].time_s;
     if (k > 0 && trace[k - 1].pen_down) metrics.pen_down_time_s += trace[k].time_s - trace[k - 1].time_s;
   }
-  if (first_down) metrics.total_time_s = last_down - *first_down;
+  if (first_down) metrics.total_time_s = analysis::whole_nanoseconds(last_down - *first_down);
+  metrics.pen_down_time_s = analysis::whole_nanoseconds(metrics.pen_down_time_s);
   return metrics;
 }
 

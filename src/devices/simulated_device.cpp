@@ -3,14 +3,15 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <memory>
 #include <numbers>
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/devices/phantom_models.hpp"
 #include "calligraphy/core/force_limits.hpp"
+#include "calligraphy/devices/phantom_models.hpp"
 
 namespace calligraphy {
 
@@ -62,6 +63,18 @@ SimulatedDevice::SimulatedDevice(const SimulatedDeviceParameters& parameters)
   parameters_.info.intrinsic_damping_n_s_per_m = parameters_.damping_n_s_per_m;  // the simulation's truth
 }
 
+void SimulatedDevice::open() {
+  if (open_) return;
+  open_ = true;
+  // DeviceState::time_s counts from open(); a velocity differenced across the re-open would span the gap.
+  time_ns_ = 0;
+  last_read_ns_ = 0;
+  read_before_ = false;
+  reported_velocity_ = Vec3::Zero();
+  read_since_advance_ = false;
+  written_since_read_ = false;
+}
+
 void SimulatedDevice::close() noexcept {
   force_ = Vec3::Zero();
   open_ = false;
@@ -85,9 +98,20 @@ void SimulatedDevice::advance(double dt_s) {
     throw InvalidArgument(std::string("SimulatedDevice::advance: dt_s = ") + number.data() +
                           " must be finite and >= 0 s");
   }
+  // The clock's step in whole nanoseconds, checked before anything changes: 2^62 ns leaves room for the sum.
+  constexpr double kClockLimitNs = 4.611686018427387904e18;
+  const double step_ns = std::round(dt_s * 1e9);
+  if (step_ns > kClockLimitNs - static_cast<double>(time_ns_)) {
+    std::array<char, 48> number{};
+    std::snprintf(number.data(), number.size(), "%g", dt_s);
+    throw InvalidArgument(std::string("SimulatedDevice::advance: dt_s = ") + number.data() +
+                          " s would run the device's clock past 2^62 ns (146 years)");
+  }
   read_since_advance_ = false;
   written_since_read_ = false;
   if (dt_s == 0.0) return;
+  const std::int64_t start_ns = time_ns_;
+  const double start_s = time();
   const double m = parameters_.moving_mass_kg;
   const double b = parameters_.damping_n_s_per_m;
   // The longest stable, monotone substep (see the file comment); m / b only when there is damping.
@@ -112,20 +136,25 @@ void SimulatedDevice::advance(double dt_s) {
     }
   }
   for (long i = 0; i < substeps; ++i) {
-    const Vec3 hand = hand_ != nullptr ? hand_->hand_force(time_, position_, velocity_) : Vec3::Zero();
+    const double t = start_s + static_cast<double>(i) * h;  // not a running sum: its rounding would add up
+    const Vec3 hand = hand_ != nullptr ? hand_->hand_force(t, position_, velocity_) : Vec3::Zero();
     const Vec3 acceleration = (hand + force_ - b * velocity_) / m;
     velocity_ += h * acceleration;  // semi-implicit Euler: velocity first, then position with the new one
     position_ += h * velocity_;
-    time_ += h;
   }
-  if (rest_s > 0.0) integrate_exactly(rest_s);
+  if (rest_s > 0.0) {
+    const double substeps_s = static_cast<double>(substeps) * h;
+    time_ns_ = start_ns + static_cast<std::int64_t>(std::round(substeps_s * 1e9));  // kept if the rest throws
+    integrate_exactly(rest_s, start_s + substeps_s);
+  }
+  time_ns_ = start_ns + static_cast<std::int64_t>(step_ns);
 }
 
 // m x'' = F - b x' with F held constant over t, in closed form with s = b t / m:
 //   v(t) = v0 e^-s + (F / m) t phi1(s),   x(t) = x0 + v0 t phi1(s) + (F / m) t^2 phi2(s),
 //   phi1(s) = (1 - e^-s) / s,   phi2(s) = (s - 1 + e^-s) / s^2,
 // which stay accurate for small s (series; phi1(0) = 1, phi2(0) = 1/2: the undamped mass) and for b = 0.
-void SimulatedDevice::integrate_exactly(double duration_s) {
+void SimulatedDevice::integrate_exactly(double duration_s, double start_s) {
   const double m = parameters_.moving_mass_kg;
   const double s = parameters_.damping_n_s_per_m * duration_s / m;
   const double decay = std::exp(-s);
@@ -139,7 +168,7 @@ void SimulatedDevice::integrate_exactly(double duration_s) {
     phi1 = -em1 / s;
     phi2 = (s + em1) / (s * s);
   }
-  const Vec3 hand = hand_ != nullptr ? hand_->hand_force(time_, position_, velocity_) : Vec3::Zero();
+  const Vec3 hand = hand_ != nullptr ? hand_->hand_force(start_s, position_, velocity_) : Vec3::Zero();
   const Vec3 acceleration = (hand + force_) / m;  // the drive alone; the damping is in the closed form
   const Vec3 velocity = decay * velocity_ + (duration_s * phi1) * acceleration;
   const Vec3 position =
@@ -152,7 +181,6 @@ void SimulatedDevice::integrate_exactly(double duration_s) {
   }
   velocity_ = velocity;
   position_ = position;
-  time_ += duration_s;
 }
 
 DeviceFault SimulatedDevice::read_state(DeviceState& state) noexcept {
@@ -168,27 +196,27 @@ DeviceFault SimulatedDevice::read_state(DeviceState& state) noexcept {
   Vec3 quantised = position_;
   if (q > 0.0) quantised = (position_ / q).array().round().matrix() * q;
   if (!quantised.allFinite()) quantised = position_;  // x / q overflows only beyond 1e299 m
-  const double dt = time_ - last_read_time_;
+  const double dt = static_cast<double>(time_ns_ - last_read_ns_) / 1e9;
   if (read_before_ && dt > 0.0) {
     const Vec3 raw = (quantised - reported_position_) / dt;
     const double alpha = std::exp(-2.0 * std::numbers::pi * parameters_.velocity_cutoff_hz * dt);
     reported_velocity_ = alpha * reported_velocity_ + (1.0 - alpha) * raw;
   }
   read_before_ = true;
-  last_read_time_ = time_;
+  last_read_ns_ = time_ns_;
   reported_position_ = quantised;
   state = DeviceState{};
   state.position_m = reported_position_;
   state.velocity_m_s = reported_velocity_;
-  state.time_s = time_;
+  state.time_s = time();
   return DeviceFault::none;
 }
 
 void register_simulated_device(DeviceRegistry& registry) {
-  registry.register_device_if_absent("simulated", SimulatedDevice{}.info(),
-                                     [] { return std::make_unique<SimulatedDevice>(); },
-                                     DeviceCapabilities{.moved_by_simulated_hand = true},
-                                     "a point mass moved by a simulated hand; its time passes on advance()");
+  registry.register_device_if_absent(
+      "simulated", SimulatedDevice{}.info(), [] { return std::make_unique<SimulatedDevice>(); },
+      DeviceCapabilities{.moved_by_simulated_hand = true},
+      "a point mass moved by a simulated hand; its time passes on advance()");
 }
 
 }  // namespace calligraphy

@@ -90,6 +90,12 @@ struct ServoCommand {
 /// (the loop contains it: see the file comment).
 using ServoCallback = std::function<ServoCommand(const DeviceState& state, double dt_s)>;
 
+/// A callable the loop accepts as its callback: invoked as an lvalue with (state, dt_s), it returns a
+/// ServoCommand (by value or reference).
+template <typename Callback>
+concept servo_callback_for = std::is_invocable_v<Callback&, const DeviceState&, double> &&
+    std::is_same_v<std::decay_t<std::invoke_result_t<Callback&, const DeviceState&, double>>, ServoCommand>;
+
 /// What ended a run. A device's faults are not kinds of their own: they are `device` with the device's
 /// `DeviceFault` code in `LoopFault::device` (one taxonomy, device_fault.hpp).
 enum class LoopFaultKind {
@@ -173,12 +179,31 @@ class ServoLoop {
  public:
   /// `device` must outlive the loop. Throws InvalidArgument for bad options or an empty callback.
   ServoLoop(HapticDevice& device, ServoCallback callback, const ServoLoopOptions& options = {});
-  /// The same from any callable (a lambda): it must be callable as `ServoCommand(const DeviceState&, double
-  /// dt_s)`; one that returns a bare force (Vec3) is refused at compile time with that message.
+  /// The same from any callable (a lambda) callable as `ServoCommand(const DeviceState&, double dt_s)`.
   template <typename Callback>
-    requires(!std::is_same_v<std::decay_t<Callback>, ServoCallback>)
-  ServoLoop(HapticDevice& device, Callback&& callback, const ServoLoopOptions& options = {})
-      : ServoLoop(device, to_servo_callback(std::forward<Callback>(callback)), options) {}
+  requires(!std::is_same_v<std::decay_t<Callback>, ServoCallback> && servo_callback_for<Callback>)
+      ServoLoop(HapticDevice& device, Callback&& callback, const ServoLoopOptions& options = {})
+      : ServoLoop(device, ServoCallback(std::forward<Callback>(callback)), options) {}
+  /// Any other callable is refused at compile time with one message saying what is wrong (e.g. one that
+  /// returns a bare force, a Vec3). The constraint keeps such a callable away from std::function, whose
+  /// own errors would otherwise follow the message by some fifty lines.
+  template <typename Callback>
+  requires(!std::is_same_v<std::decay_t<Callback>, ServoCallback> && !servo_callback_for<Callback>)
+      ServoLoop(HapticDevice& device, Callback&& /*callback*/, const ServoLoopOptions& options = {})
+      : ServoLoop(device, ServoCallback{}, options) {
+    if constexpr (!std::is_invocable_v<Callback&, const DeviceState&, double>) {
+      static_assert(
+          kRefused<Callback>,
+          "ServoLoop: the callback must be callable as ServoCommand(const DeviceState&, double dt_s)");
+    } else if constexpr (std::is_convertible_v<std::invoke_result_t<Callback&, const DeviceState&, double>,
+                                               Vec3>) {
+      static_assert(kRefused<Callback>,
+                    "ServoLoop: the callback returns a Vec3; return ServoCommand{force_n, stop} instead");
+    } else {
+      static_assert(kRefused<Callback>,
+                    "ServoLoop: the callback must return ServoCommand (the force [N] and whether to stop)");
+    }
+  }
   /// Stops the loop (see `stop()`). Never throws.
   ~ServoLoop();
   ServoLoop(const ServoLoop&) = delete;
@@ -221,20 +246,7 @@ class ServoLoop {
 
  private:
   template <typename Callback>
-  static ServoCallback to_servo_callback(Callback&& callback) {
-    constexpr bool kCallable = std::is_invocable_v<Callback&, const DeviceState&, double>;
-    static_assert(kCallable, "ServoLoop: the callback must be callable as ServoCommand(const DeviceState&, double dt_s)");
-    if constexpr (kCallable) {
-      using Result = std::decay_t<std::invoke_result_t<Callback&, const DeviceState&, double>>;
-      static_assert(!std::is_same_v<Result, Vec3>,
-                    "ServoLoop: the callback returns a Vec3; return ServoCommand{force_n, stop} instead");
-      static_assert(std::is_same_v<Result, ServoCommand>,
-                    "ServoLoop: the callback must return ServoCommand (the force [N] and whether to stop)");
-      return ServoCallback(std::forward<Callback>(callback));
-    } else {
-      return {};
-    }
-  }
+  static constexpr bool kRefused = false;  // false, but only once instantiated for a refused callable
 
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -16,6 +16,12 @@
 /// mass above 0.5 g; raise `physics_rate_hz` for a lighter device or a stiffer hand. At most
 /// `kMaxSubstepsPerAdvance` substeps are taken per call; the time left after them is integrated with the
 /// exact solution of the damped mass under the force held constant (see `advance`).
+///
+/// Time: the device's clock (`DeviceState::time_s`, `time()`) reads 0 at `open()` and moves only in
+/// `advance`, in whole nanoseconds (its resolution), so that n ticks of 1 ms read exactly n ms, not a sum of
+/// rounded steps (13.072999999980317 s for 13,073 ticks).
+#include <cstdint>
+
 #include "calligraphy/devices/device_registry.hpp"
 #include "calligraphy/devices/hand_port.hpp"
 #include "calligraphy/devices/haptic_device.hpp"
@@ -60,7 +66,8 @@ class SimulatedDevice final : public HandDrivenDevice {
   /// `kMaxSubstepsPerAdvance` of them; the time left after those (only when dt_s exceeds
   /// kMaxSubstepsPerAdvance x h_max, e.g. 20 s at the defaults) follows the exact solution of
   /// m x'' = F - b x' with F the commanded force plus the hand's force at the start of that interval,
-  /// held constant. Throws InvalidArgument when dt_s is negative or not finite (the state is unchanged),
+  /// held constant. The clock moves by dt_s rounded to whole nanoseconds. Throws InvalidArgument when dt_s
+  /// is negative or not finite, or would take the clock past 2^62 ns (146 years) (the state is unchanged),
   /// or when the exact interval would take the state out of the range of a double (the state is then
   /// left after the substeps already taken).
   void advance(double dt_s) override;
@@ -68,7 +75,9 @@ class SimulatedDevice final : public HandDrivenDevice {
   static constexpr long kMaxSubstepsPerAdvance = 200'000;
 
   [[nodiscard]] const DeviceInfo& info() const override { return parameters_.info; }
-  void open() override { open_ = true; }
+  /// Opens the device: its clock restarts at 0 s and its velocity filter afresh (the first read reports
+  /// zero velocity); the stylus stays where it is. Opening an open device changes nothing. Never throws.
+  void open() override;
   void close() noexcept override;
   [[nodiscard]] bool is_open() const override { return open_; }
   void enable_forces(bool enabled) override;
@@ -87,25 +96,26 @@ class SimulatedDevice final : public HandDrivenDevice {
   [[nodiscard]] const Vec3& true_velocity() const noexcept { return velocity_; }
   /// The force actually applied after saturation [N].
   [[nodiscard]] const Vec3& applied_force() const noexcept { return force_; }
-  [[nodiscard]] double time() const noexcept { return time_; }
+  /// The device's clock [s]: 0 at `open()` (and at construction), moved only by `advance`.
+  [[nodiscard]] double time() const noexcept { return static_cast<double>(time_ns_) / 1e9; }
 
  private:
   SimulatedDeviceParameters parameters_;
   HandModel* hand_ = nullptr;
   bool open_ = false;
   bool forces_enabled_ = true;
-  double time_ = 0.0;
+  std::int64_t time_ns_ = 0;  // the clock in whole nanoseconds: exact, however many ticks it counts
   Vec3 position_;
   Vec3 velocity_ = Vec3::Zero();
   Vec3 force_ = Vec3::Zero();
   Vec3 reported_position_;
   Vec3 reported_velocity_ = Vec3::Zero();
-  double last_read_time_ = 0.0;
+  std::int64_t last_read_ns_ = 0;
   bool read_before_ = false;
   bool read_since_advance_ = false;  // read_state since the last advance
   bool written_since_read_ = false;  // write_force after that read
 
-  void integrate_exactly(double duration_s);
+  void integrate_exactly(double duration_s, double start_s);
 };
 
 /// Registers a `SimulatedDevice` with default parameters as "simulated" in `registry` (one of the standard
