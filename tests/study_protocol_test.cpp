@@ -128,6 +128,21 @@ TEST_CASE("protocol errors name the file and the JSON pointer", "[study][protoco
   CHECK_THROWS_WITH(load_study_protocol("/nonexistent/p.json"), Catch::Contains("/nonexistent/p.json"));
 }
 
+TEST_CASE("an integer in range but written in exponent form is refused saying why", "[study][protocol]") {
+  const auto with_seed = [](const std::string& seed) {
+    std::string text = protocol_text();
+    text.replace(text.find(R"("seed": 5)"), 9, "\"seed\": " + seed);
+    return text;
+  };
+  // 1e19 is below 2^64 - 1: the message must not merely repeat the range it is in.
+  check_error(with_seed("1e19"), "/order/seed", "write it in digits");
+  check_error(with_seed("-1"), "/order/seed", "[0, 18446744073709551615], got -1");
+  check_error(with_seed("2.5"), "/order/seed", "got 2.5");
+  // An exact integer in exponent form below 2^53 is that integer; the full range in digits is read.
+  CHECK(parse_study_protocol(with_seed("1e3"), "p.json").seed == 1000);
+  CHECK(parse_study_protocol(with_seed("18446744073709551615"), "p.json").seed == 18446744073709551615ULL);
+}
+
 TEST_CASE("a plan over the limit of trials per session is refused with its size", "[study][protocol]") {
   // 1,000 strings x 26 conditions x 1,000 repetitions: within every other bound, 26,000,000 trials.
   std::string conditions;

@@ -63,24 +63,46 @@ double as_number(const nlohmann::json& value, const std::string& pointer, const 
   return number;
 }
 
+namespace {
+
+// Every integer up to 2^53 is exact as a double; a number written with a fraction or an exponent above that
+// may already have been rounded when it was read, so it is not taken for the integer it seems to be.
+constexpr double kLargestExactInteger = 9007199254740992.0;
+
+// "expected an integer in [minimum, maximum], got VALUE", saying why when the value is in the range but
+// not an integer the file states exactly (a fraction or an exponent beyond 2^53: 1e19).
+[[noreturn]] void fail_integer(const nlohmann::json& value, const std::string& pointer, const std::string& source,
+                               const std::string& range) {
+  std::string message = "expected an integer in " + range + ", got " + describe(value);
+  if (value.is_number_float() && std::isfinite(value.get<double>()) &&
+      std::floor(value.get<double>()) == value.get<double>() &&
+      std::fabs(value.get<double>()) >= kLargestExactInteger) {
+    message += " (written with an exponent or a fraction: above 2^53 = 9007199254740992 write it in digits, "
+               "as such a number may have been rounded)";
+  }
+  fail(source, pointer, message);
+}
+
+bool is_exact_integral_float(const nlohmann::json& value) {
+  if (!value.is_number_float()) return false;
+  const double number = value.get<double>();
+  return std::isfinite(number) && std::floor(number) == number && std::fabs(number) < kLargestExactInteger;
+}
+
+}  // namespace
+
 std::int64_t as_integer(const nlohmann::json& value, const std::string& pointer, const std::string& source,
                         std::int64_t minimum, std::int64_t maximum) {
-  const bool integral =
-      value.is_number_integer() ||
-      (value.is_number_float() && std::isfinite(value.get<double>()) &&
-       std::floor(value.get<double>()) == value.get<double>() && std::fabs(value.get<double>()) < 9.0e15);
   std::string range = "[";
   range.append(std::to_string(minimum)).append(", ").append(std::to_string(maximum)).append("]");
-  if (!integral) fail(source, pointer, "expected an integer in " + range + ", got " + describe(value));
+  if (!value.is_number_integer() && !is_exact_integral_float(value)) fail_integer(value, pointer, source, range);
   if (value.is_number_unsigned() &&
       value.get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())) {
-    fail(source, pointer, "expected an integer in " + range + ", got " + describe(value));
+    fail_integer(value, pointer, source, range);
   }
   const std::int64_t number =
       value.is_number_float() ? static_cast<std::int64_t>(value.get<double>()) : value.get<std::int64_t>();
-  if (number < minimum || number > maximum) {
-    fail(source, pointer, "expected an integer in " + range + ", got " + describe(value));
-  }
+  if (number < minimum || number > maximum) fail_integer(value, pointer, source, range);
   return number;
 }
 
@@ -144,10 +166,13 @@ std::int64_t ObjectReader::integer_or(const std::string& key, std::int64_t fallb
 std::uint64_t ObjectReader::unsigned_or(const std::string& key, std::uint64_t fallback) {
   const nlohmann::json* value = optional(key);
   if (!value) return fallback;
-  if (!value->is_number_unsigned() && !(value->is_number_integer() && value->get<std::int64_t>() >= 0)) {
-    fail(source_, pointer(key), "expected an integer in [0, 18446744073709551615], got " + describe(*value));
+  static const std::string kRange = "[0, 18446744073709551615]";
+  if (value->is_number_unsigned()) return value->get<std::uint64_t>();
+  if (value->is_number_integer() && value->get<std::int64_t>() >= 0) return value->get<std::uint64_t>();
+  if (is_exact_integral_float(*value) && value->get<double>() >= 0.0) {
+    return static_cast<std::uint64_t>(value->get<double>());
   }
-  return value->get<std::uint64_t>();
+  fail_integer(*value, pointer(key), source_, kRange);
 }
 
 bool ObjectReader::boolean_or(const std::string& key, bool fallback) {
