@@ -495,7 +495,7 @@ void ServoLoop::start() {
     }
     m.clock.store(device_clock, std::memory_order_release);
     m.startup.store(1, std::memory_order_release);
-    calligraphy::detail::library_log().info(
+    calligraphy::detail::library_log().debug(
         "servo loop: started on the device's own servo clock at {} Hz (the driver's thread); memory "
         "locked {}",
         m.options.rate_hz, m.realtime.memory_locked ? "yes" : "no");
@@ -525,7 +525,8 @@ void ServoLoop::start() {
     }
     throw RealtimeError("ServoLoop::start: realtime required but " + m.realtime.problems);
   }
-  calligraphy::detail::library_log().info("servo loop: started at {} Hz; SCHED_FIFO {}, CPU {}, memory locked {}{}{}", m.options.rate_hz,
+  // Debug, not info: an application that starts a loop per trial would get a line per trial.
+  calligraphy::detail::library_log().debug("servo loop: started at {} Hz; SCHED_FIFO {}, CPU {}, memory locked {}{}{}", m.options.rate_hz,
                m.realtime.fifo_scheduling ? std::to_string(m.realtime.priority) : "no",
                m.realtime.cpu >= 0 ? std::to_string(m.realtime.cpu) : "not pinned",
                m.realtime.memory_locked ? "yes" : "no",
