@@ -1,6 +1,6 @@
 // The log the application owns (calligraphy/core/logging.hpp): a handler takes every message at the library's
 // level, with its level and without spdlog; an empty handler gives the log back to spdlog; set_log_level
-// filters and silences it.
+// filters and silences it. And how the library's messages print a rate.
 #include "calligraphy/core/logging.hpp"
 
 #include <spdlog/sinks/ostream_sink.h>
@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/library_log.hpp"
+#include "core/rate_text.hpp"
 
 using namespace calligraphy;
 
@@ -50,4 +51,13 @@ TEST_CASE("The library's log goes to the application's handler, at the library's
   const std::string through_spdlog = spdlog_stream.str();
   CHECK(through_spdlog.find("back to spdlog") != std::string::npos);
   CHECK(through_spdlog.find("stiffness") == std::string::npos);  // nothing the handler had went to spdlog too
+}
+
+TEST_CASE("Rates in messages read as numbers of Hz", "[log][rate]") {
+  CHECK(detail::rate_text(500.0) == "500 Hz");
+  CHECK(detail::rate_text(1000.0) == "1000 Hz");
+  CHECK(detail::rate_text(99.96) == "99.96 Hz");  // a refused rate shown as given, not rounded into range
+  CHECK(detail::measured_rate_text(678.33333) == "678.3 Hz");
+  CHECK(detail::measured_rate_text(999.97) == "1000 Hz");
+  CHECK(detail::measured_rate_text(2000.0 / 3.0) == "666.7 Hz");
 }
