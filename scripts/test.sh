@@ -171,15 +171,17 @@ cmake --no-warn-unused-cli -S tests/consumer -B build/consumer -G Ninja \
 cmake --build build/consumer
 build/consumer/consumer
 # A haptic application: only the haptics component, its examples built and run, and their link lines free
-# of OpenSSL and the USB libraries.
+# of OpenSSL and the USB libraries; log_redirect takes the library's log through a handler and a spdlog logger
+# of its own (spdlog's headers from the system, its package not found) and silences it.
 cmake --no-warn-unused-cli -S tests/consumer/haptics -B build/consumer-haptics -G Ninja \
   -DCMAKE_PREFIX_PATH="$PWD/build/stage" \
   -DCMAKE_DISABLE_FIND_PACKAGE_spdlog=ON -DCMAKE_DISABLE_FIND_PACKAGE_fmt=ON \
   -DCMAKE_DISABLE_FIND_PACKAGE_OpenSSL=ON >/dev/null
 cmake --build build/consumer-haptics
 bash tests/consumer/check_link_line.sh build/consumer-haptics build/consumer-haptics/own_loop \
-  build/consumer-haptics/custom_device_loop
+  build/consumer-haptics/custom_device_loop build/consumer-haptics/log_redirect
 build/consumer-haptics/own_loop
 build/consumer-haptics/custom_device_loop
+build/consumer-haptics/log_redirect
 end_stage
 echo "== all tests passed"

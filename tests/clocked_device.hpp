@@ -77,6 +77,9 @@ class ClockedDevice final : public HapticDevice, public DeviceServoClock {
     while (busy_.load()) std::this_thread::yield();
   }
 
+  /// The driver's clock advances this much per frame [s] (default one period): more than a period is a
+  /// loop whose ticks came late by the device's clock, whatever the wall clock did. Before open().
+  void set_time_per_frame_s(double time_s) { time_per_frame_s_ = time_s; }
   /// Stops calling frame functions (a driver whose scheduler died) or resumes.
   void pause(bool paused) { paused_.store(paused); }
   /// The 0-based frame (counted since open) whose read fails with link_lost.
@@ -95,7 +98,7 @@ class ClockedDevice final : public HapticDevice, public DeviceServoClock {
       if (paused_.load()) continue;
       const long frame = frames_.load();
       frame_state_.position_m = Vec3(((frame / kHalfPeriod) % 2 == 0) ? 0.0 : kStepM, 0.0, 0.0);
-      frame_state_.time_s = 5000.0 + static_cast<double>(frame) / rate_hz_;  // the driver's own clock
+      frame_state_.time_s = 5000.0 + static_cast<double>(frame) * time_per_frame_s_;  // the driver's own clock
       force_set_ = false;
       busy_.store(true);
       if (FrameFunction f = frame_.load(); f != nullptr) {
@@ -113,6 +116,7 @@ class ClockedDevice final : public HapticDevice, public DeviceServoClock {
   }
 
   double rate_hz_;
+  double time_per_frame_s_ = 1.0 / rate_hz_;
   DeviceInfo info_;
   bool open_ = false;
   std::thread driver_;

@@ -1,16 +1,14 @@
 #include "log_forwarding.hpp"
 
-#include <spdlog/sinks/base_sink.h>
-#include <spdlog/spdlog.h>
-
 #include <cctype>
 #include <deque>
-#include <memory>
 #include <mutex>
 #include <string>
+#include <string_view>
 
 #include "arguments.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/logging.hpp"
 
 namespace calligraphy::python {
 namespace {
@@ -24,28 +22,38 @@ struct QueuedMessage {
 // and on faults, never per tick.
 constexpr std::size_t kMaxQueued = 10000;
 
-int python_level(spdlog::level::level_enum level) {
+int python_level(LogLevel level) {
   switch (level) {
-    case spdlog::level::trace:
+    case LogLevel::trace:
       return 5;
-    case spdlog::level::debug:
+    case LogLevel::debug:
       return 10;
-    case spdlog::level::info:
+    case LogLevel::info:
       return 20;
-    case spdlog::level::warn:
+    case LogLevel::warning:
       return 30;
-    case spdlog::level::err:
+    case LogLevel::error:
       return 40;
     default:
       return 50;
   }
 }
 
-class QueueSink final : public spdlog::sinks::base_sink<std::mutex> {
+// What the library's log handler fills and `forward_queued_log` empties.
+class LogQueue {
  public:
+  void push(LogLevel level, std::string_view text) {
+    QueuedMessage queued{python_level(level), std::string(text)};
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (queue_.size() >= kMaxQueued) {
+      queue_.pop_front();
+      ++dropped_;
+    }
+    queue_.push_back(std::move(queued));
+  }
   // Takes what was queued and the number dropped since the last call.
   std::deque<QueuedMessage> take(std::size_t& dropped) {
-    std::lock_guard<std::mutex> lock(queue_mutex_);
+    std::lock_guard<std::mutex> lock(mutex_);
     std::deque<QueuedMessage> out;
     out.swap(queue_);
     dropped = dropped_;
@@ -53,39 +61,26 @@ class QueueSink final : public spdlog::sinks::base_sink<std::mutex> {
     return out;
   }
 
- protected:
-  void sink_it_(const spdlog::details::log_msg& message) override {
-    QueuedMessage queued{python_level(message.level),
-                         std::string(message.payload.data(), message.payload.size())};
-    std::lock_guard<std::mutex> lock(queue_mutex_);
-    if (queue_.size() >= kMaxQueued) {
-      queue_.pop_front();
-      ++dropped_;
-    }
-    queue_.push_back(std::move(queued));
-  }
-  void flush_() override {}
-
  private:
-  std::mutex queue_mutex_;  // separate from the sink's own, so `take` never waits on formatting
+  std::mutex mutex_;
   std::deque<QueuedMessage> queue_;
   std::size_t dropped_ = 0;
 };
 
-// Leaked on purpose: spdlog's registry may log through it until the process ends, after Python is gone.
-const std::shared_ptr<QueueSink>& sink() {
-  static const auto* instance = new std::shared_ptr<QueueSink>(std::make_shared<QueueSink>());
+// Leaked on purpose: the library may log through the handler until the process ends, after Python is gone.
+LogQueue& log_queue() {
+  static LogQueue* const instance = new LogQueue;
   return *instance;
 }
 
-spdlog::level::level_enum spdlog_level(int python_level) {
-  if (python_level <= 5) return spdlog::level::trace;
-  if (python_level <= 10) return spdlog::level::debug;
-  if (python_level <= 20) return spdlog::level::info;
-  if (python_level <= 30) return spdlog::level::warn;
-  if (python_level <= 40) return spdlog::level::err;
-  if (python_level <= 50) return spdlog::level::critical;
-  return spdlog::level::off;
+LogLevel library_level(int python_level) {
+  if (python_level <= 5) return LogLevel::trace;
+  if (python_level <= 10) return LogLevel::debug;
+  if (python_level <= 20) return LogLevel::info;
+  if (python_level <= 30) return LogLevel::warning;
+  if (python_level <= 40) return LogLevel::error;
+  if (python_level <= 50) return LogLevel::critical;
+  return LogLevel::off;
 }
 
 struct LogLevelTag {
@@ -111,7 +106,7 @@ void set_log_level(const Annotated<LogLevelTag>& level) {
   } else {
     throw_type_error("level", "a logging level (int) or its name (str)", level.object);
   }
-  spdlog::set_level(spdlog_level(value));
+  calligraphy::set_log_level(library_level(value));
   logging.attr("getLogger")("calligraphy").attr("setLevel")(value);
 }
 
@@ -119,7 +114,7 @@ void set_log_level(const Annotated<LogLevelTag>& level) {
 
 void forward_queued_log() noexcept {
   std::size_t dropped = 0;
-  std::deque<QueuedMessage> messages = sink()->take(dropped);
+  std::deque<QueuedMessage> messages = log_queue().take(dropped);
   if (messages.empty() && dropped == 0) return;
   try {
     const py::object logger = py::module_::import("logging").attr("getLogger")("calligraphy");
@@ -134,9 +129,8 @@ void forward_queued_log() noexcept {
 }
 
 void bind_logging(py::module_& m) {
-  auto logger = std::make_shared<spdlog::logger>("calligraphy", sink());
-  logger->set_level(spdlog::level::info);
-  spdlog::set_default_logger(logger);
+  // The library's own handler: the process's spdlog (its default logger, other loggers) is left alone.
+  set_log_handler([](LogLevel level, std::string_view message) { log_queue().push(level, message); });
 
   m.def("set_log_level", &set_log_level, py::arg("level"),
         "Sets the level of the library's log: a logging level (logging.DEBUG, 20, ...) or its name "

@@ -1,8 +1,9 @@
 #pragma once
-// The library's spdlog output, forwarded to Python's `logging` (logger "calligraphy").
+// The library's log, forwarded to Python's `logging` (logger "calligraphy").
 //
-// The C++ side never calls Python: a sink queues each message (bounded; the oldest are dropped and
-// counted when it is full), so a servo thread that logs neither takes the GIL nor waits for Python. The
+// The C++ side never calls Python: the library's log handler (calligraphy/core/logging.hpp) queues each
+// message (bounded; the oldest are dropped and counted when it is full), so the servo loop's log thread
+// neither takes the GIL nor waits for Python. The
 // queue is forwarded with the GIL held, at the end of each binding call that can log (`ForwardLog`, a
 // pybind11 call guard) and by `calligraphy.flush_log()`.
 #include <pybind11/pybind11.h>
@@ -11,8 +12,7 @@ namespace calligraphy::python {
 
 namespace py = pybind11;
 
-/// Installs the queueing sink as spdlog's default logger (named "calligraphy") and binds set_log_level
-/// and flush_log.
+/// Installs the queueing handler as the library's log handler and binds set_log_level and flush_log.
 void bind_logging(py::module_& m);
 
 /// Forwards the queued messages to logging.getLogger("calligraphy"). Needs the GIL; never throws (an

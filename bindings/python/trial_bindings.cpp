@@ -1,5 +1,6 @@
 // trial: a whole simulated trial (include/calligraphy/trial/trial.hpp, run_simulated_trial) and its
 // result. Every binding of the trial runner is in this file.
+#include <fmt/format.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -248,8 +249,8 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   options.validate();
   simulation.validate();
   if (!(options.rate_hz * options.max_duration_s <= kMaxTicks)) {
-    throw InvalidArgument("max_duration_s: " + std::to_string(options.max_duration_s) + " s at " +
-                          std::to_string(options.rate_hz) + " Hz is more than 10^7 servo ticks");
+    throw InvalidArgument(fmt::format("max_duration_s: {} s at {} Hz is more than 10^7 servo ticks",
+                                      options.max_duration_s, options.rate_hz));
   }
 
   // The trial specification of these arguments, run by its one runner (trial_spec_runner.hpp), as

@@ -4,7 +4,8 @@
 // `read_state` and `write_force` are the servo path: noexcept, no allocation, faults as `DeviceFault` codes.
 // The `ServoLoop` calls the callback once per tick on its own thread, paced by the wall clock; its defaults
 // ask for nothing (no SCHED_FIFO, no memory locking): this example asks for the thread's priority only.
-// The callback steps a `TrialSession`, the one way to tick a trial from any loop.
+// The callback is the `TrialSession`'s own (`servo_callback`), the one way to tick a trial from any loop; it
+// carries the session's rate, which the loop checks at start.
 //
 // The device is a stand-in for hardware: a stylus resting 1 mm below the paper at the first stroke's start,
 // its clock the machine's monotonic clock. A person would move it; here nobody does, so the run lasts
@@ -93,19 +94,15 @@ int main() {
   // This stand-in has no motors, so a stall holds no force against a hand: no stall bound (a real arm keeps
   // the default 50 ms, which ends the run with zero force).
   loop_options.stall_timeout_s = 0.0;
-  double peak_paper_force_n = 0.0;  // written by the loop thread only; read after stop() joined it
-  ServoLoop loop(
-      device,
-      [&session, &peak_paper_force_n](const DeviceState& state, double /*dt_s*/) {
-        const ServoCommand command = session.step(state);
-        peak_paper_force_n = std::max(peak_paper_force_n, command.force_n.z());
-        return command;
-      },
-      loop_options);
+  // The session's own callback steps it and tells the loop its rate: start() refuses a loop at another rate
+  // (a renderer built for 500 Hz and ticked by a 1 kHz loop would run its fades and filters twice as fast).
+  ServoLoop loop(device, session.servo_callback(), loop_options);
   loop.start();
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   const LoopFault fault = loop.stop();
   const TrialResult result = session.finish(fault ? TrialEnd::device_fault : TrialEnd::time_limit, fault.message);
+  double peak_paper_force_n = 0.0;
+  for (const TrialSample& sample : result.trace) peak_paper_force_n = std::max(peak_paper_force_n, sample.force_n.z());
 
   const ServoLoopStats stats = loop.stats();
   std::printf("十 on a custom device: %llu ticks at %.0f Hz by its clock, %llu late; paper force up to %.2f N; "

@@ -1,6 +1,7 @@
 #pragma once
-// The library's spdlog logger (calligraphy/core/logging.hpp): the one the application registered under
-// kLoggerName, or one the library registers on first use. Off the servo path only (it may lock).
+// The library's log (calligraphy/core/logging.hpp): the application's handler when it set one, else the
+// spdlog logger it registered under kLoggerName, else spdlog's default logger. Off the servo path only (it
+// may lock).
 #include <spdlog/logger.h>
 
 namespace calligraphy::detail {

@@ -1,7 +1,6 @@
 #include "calligraphy/devices/servo_loop.hpp"
 
 #include <sched.h>
-#include "core/library_log.hpp"
 #include <time.h>
 
 #include <algorithm>
@@ -15,6 +14,8 @@
 #include <thread>
 
 #include "calligraphy/devices/device_servo_clock.hpp"
+#include "core/library_log.hpp"
+#include "core/rate_text.hpp"
 #include "devices/latency_histogram.hpp"
 #include "devices/log_queue.hpp"
 #include "devices/servo_loop_realtime.hpp"
@@ -114,8 +115,7 @@ const char* to_string(LoopFaultKind kind) noexcept {
 
 void ServoLoopOptions::validate() const {
   if (!(rate_hz >= kMinRateHz && rate_hz <= kMaxRateHz)) {
-    throw InvalidArgument("ServoLoopOptions.rate_hz = " + std::to_string(rate_hz) +
-                          " must be in [100, 10000] Hz");
+    throw InvalidArgument("ServoLoopOptions.rate_hz = " + detail::rate_text(rate_hz) + " must be in [100, 10000] Hz");
   }
   if (priority < 0 || priority > 99) {
     throw InvalidArgument("ServoLoopOptions.priority = " + std::to_string(priority) + " must be in [0, 99]");
@@ -165,11 +165,14 @@ struct ServoLoop::Impl {
   }
   void reset_stats() noexcept;
   [[nodiscard]] LoopFault fault() const;
+  void check_rates(const DeviceServoClock* device_clock) const;
 
   HapticDevice& device;
   ServoCallback callback;
   std::function<void()> after_write;  // optional, on the loop thread after each tick's force write
   ServoLoopOptions options;
+  double callback_rate_hz = 0.0;  // the rate the callback was built for; 0: it does not say
+  std::string callback_rate_name;
   std::thread thread;
   // The device driver's servo thread while a run is attached to it; set and cleared by the controlling
   // thread, read by running() from any thread.
@@ -436,13 +439,45 @@ void ServoLoop::Impl::stop_device_clock() noexcept {
   }
 }
 
-ServoLoop::ServoLoop(HapticDevice& device, ServoCallback callback, const ServoLoopOptions& options) {
+ServoLoop::ServoLoop(HapticDevice& device, ServoCallback callback, const ServoLoopOptions& options)
+    : ServoLoop(device, Prepared{std::move(callback), 0.0, ""}, options) {}
+
+ServoLoop::ServoLoop(HapticDevice& device, Prepared prepared, const ServoLoopOptions& options) {
   options.validate();
-  if (!callback) throw InvalidArgument("ServoLoop: the callback is empty");
-  impl_ = std::make_unique<Impl>(device, std::move(callback), options);
+  if (!prepared.callback) throw InvalidArgument("ServoLoop: the callback is empty");
+  impl_ = std::make_unique<Impl>(device, std::move(prepared.callback), options);
+  impl_->callback_rate_hz = prepared.rate_hz;
+  impl_->callback_rate_name = prepared.rate_name != nullptr ? prepared.rate_name : "";
 }
 
 ServoLoop::~ServoLoop() { stop(); }
+
+// A loop, a device clock and a callback built for one rate must agree: a renderer stepped at another rate runs
+// its time-based parts (fades, filters, a replay) at the wrong speed, which no measurement after the run
+// could tell from a loaded machine.
+void ServoLoop::Impl::check_rates(const DeviceServoClock* device_clock) const {
+  const auto differ = [](double a, double b) { return std::abs(a - b) > 1e-6 * b; };
+  const bool says_rate = callback_rate_hz > 0.0;
+  if (device_clock != nullptr) {
+    const double clock_hz = device_clock->servo_rate_hz();
+    if (says_rate && differ(callback_rate_hz, clock_hz)) {
+      throw InvalidArgument("ServoLoop::start: the callback was built for " + detail::rate_text(callback_rate_hz) +
+                            " (" + callback_rate_name + "), but '" + device.info().model +
+                            "' runs its own servo clock at " + detail::rate_text(clock_hz) + ": set " +
+                            callback_rate_name + " to " + detail::rate_text(clock_hz));
+    }
+    if (differ(options.rate_hz, clock_hz)) {
+      throw InvalidArgument("ServoLoop::start: ServoLoopOptions::rate_hz is " + detail::rate_text(options.rate_hz) +
+                            ", but '" + device.info().model + "' runs its own servo clock at " +
+                            detail::rate_text(clock_hz) + ": ask for that rate");
+    }
+  }
+  if (says_rate && differ(callback_rate_hz, options.rate_hz)) {
+    throw InvalidArgument("ServoLoop::start: the callback was built for " + detail::rate_text(callback_rate_hz) +
+                          " (" + callback_rate_name + "), but the loop runs at " +
+                          detail::rate_text(options.rate_hz) + " (ServoLoopOptions::rate_hz): set both to one rate");
+  }
+}
 
 void ServoLoop::start() {
   Impl& m = *impl_;
@@ -454,12 +489,7 @@ void ServoLoop::start() {
   if (!m.device.is_open())
     throw DeviceError("ServoLoop::start: the device '" + m.device.info().model + "' is not open");
   DeviceServoClock* const device_clock = m.device.servo_clock();
-  if (device_clock != nullptr &&
-      std::abs(device_clock->servo_rate_hz() - m.options.rate_hz) > 1e-6 * m.options.rate_hz) {
-    throw InvalidArgument("ServoLoopOptions.rate_hz = " + std::to_string(m.options.rate_hz) + " Hz, but '" +
-                          m.device.info().model + "' runs its own servo clock at " +
-                          std::to_string(device_clock->servo_rate_hz()) + " Hz: ask for that rate");
-  }
+  m.check_rates(device_clock);
 
   m.frame_thread.store(std::thread::id{}, std::memory_order_relaxed);
   m.startup.store(0, std::memory_order_release);  // readers stop copying the previous run's realtime status
@@ -495,7 +525,7 @@ void ServoLoop::start() {
     }
     m.clock.store(device_clock, std::memory_order_release);
     m.startup.store(1, std::memory_order_release);
-    calligraphy::detail::library_log().info(
+    calligraphy::detail::library_log().debug(
         "servo loop: started on the device's own servo clock at {} Hz (the driver's thread); memory "
         "locked {}",
         m.options.rate_hz, m.realtime.memory_locked ? "yes" : "no");
@@ -525,7 +555,8 @@ void ServoLoop::start() {
     }
     throw RealtimeError("ServoLoop::start: realtime required but " + m.realtime.problems);
   }
-  calligraphy::detail::library_log().info("servo loop: started at {} Hz; SCHED_FIFO {}, CPU {}, memory locked {}{}{}", m.options.rate_hz,
+  // Debug, not info: an application that starts a loop per trial would get a line per trial.
+  calligraphy::detail::library_log().debug("servo loop: started at {} Hz; SCHED_FIFO {}, CPU {}, memory locked {}{}{}", m.options.rate_hz,
                m.realtime.fifo_scheduling ? std::to_string(m.realtime.priority) : "no",
                m.realtime.cpu >= 0 ? std::to_string(m.realtime.cpu) : "not pinned",
                m.realtime.memory_locked ? "yes" : "no",

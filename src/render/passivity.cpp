@@ -5,6 +5,7 @@
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
+#include "core/rate_text.hpp"
 
 namespace calligraphy {
 
@@ -15,8 +16,8 @@ double colgate_stiffness_bound(double device_damping_n_s_per_m, double rate_hz,
                           std::to_string(device_damping_n_s_per_m) + " N s/m must be finite and >= 0");
   }
   if (!std::isfinite(rate_hz) || !(rate_hz > 0.0)) {
-    throw InvalidArgument("colgate_stiffness_bound: rate " + std::to_string(rate_hz) +
-                          " Hz must be finite and > 0");
+    throw InvalidArgument("colgate_stiffness_bound: rate " + detail::rate_text(rate_hz) +
+                          " must be finite and > 0");
   }
   if (!std::isfinite(virtual_damping_n_s_per_m) || virtual_damping_n_s_per_m < 0.0) {
     throw InvalidArgument("colgate_stiffness_bound: virtual damping " +
@@ -40,7 +41,7 @@ PassivityController::PassivityController(const PassivityParameters& parameters, 
     : parameters_(parameters) {
   parameters_.validate();
   if (!std::isfinite(rate_hz) || !(rate_hz > 0.0)) {
-    throw InvalidArgument("PassivityController: rate_hz = " + std::to_string(rate_hz) +
+    throw InvalidArgument("PassivityController: rate_hz = " + detail::rate_text(rate_hz) +
                           " must be finite and > 0");
   }
   period_s_ = 1.0 / rate_hz;

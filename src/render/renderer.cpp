@@ -1,7 +1,5 @@
 #include "calligraphy/render/renderer.hpp"
 
-#include "core/library_log.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -10,6 +8,8 @@
 
 #include "calligraphy/collision/constraint_space.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "core/library_log.hpp"
+#include "core/rate_text.hpp"
 
 namespace calligraphy {
 namespace {
@@ -59,8 +59,7 @@ const RendererOptions& checked(const RendererOptions& options) {
 
 void RendererOptions::validate() const {
   if (!(rate_hz >= 100.0 && rate_hz <= 100000.0)) {
-    throw InvalidArgument("RendererOptions.rate_hz = " + std::to_string(rate_hz) +
-                          " must be in [100, 100000] Hz");
+    throw InvalidArgument("RendererOptions.rate_hz = " + detail::rate_text(rate_hz) + " must be in [100, 100000] Hz");
   }
   passivity.validate();
 }

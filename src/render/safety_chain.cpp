@@ -6,6 +6,7 @@
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
+#include "core/rate_text.hpp"
 
 namespace calligraphy {
 namespace {
@@ -43,7 +44,7 @@ void SafetyChainParameters::validate() const {
 SafetyChain::SafetyChain(const SafetyChainParameters& parameters, double rate_hz) : parameters_(parameters) {
   parameters_.validate();
   if (!std::isfinite(rate_hz) || !(rate_hz > 0.0)) {
-    throw InvalidArgument("SafetyChain: rate_hz = " + std::to_string(rate_hz) + " must be finite and > 0");
+    throw InvalidArgument("SafetyChain: rate_hz = " + detail::rate_text(rate_hz) + " must be finite and > 0");
   }
   period_s_ = 1.0 / rate_hz;
   low_pass_alpha_ = parameters_.low_pass_cutoff_hz > 0.0

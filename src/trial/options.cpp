@@ -5,6 +5,7 @@
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
+#include "core/rate_text.hpp"
 
 namespace calligraphy {
 
@@ -13,7 +14,7 @@ void TrialOptions::validate() const {
   // range.
   const double max_rate_hz = pacing == TrialPacing::real_time ? 10000.0 : 100000.0;
   if (!(rate_hz >= 100.0 && rate_hz <= max_rate_hz)) {
-    throw InvalidArgument("TrialOptions.rate_hz = " + std::to_string(rate_hz) + " must be in [100, " +
+    throw InvalidArgument("TrialOptions.rate_hz = " + detail::rate_text(rate_hz) + " must be in [100, " +
                           std::to_string(static_cast<int>(max_rate_hz)) + "] Hz" +
                           (pacing == TrialPacing::real_time ? " in real time" : ""));
   }

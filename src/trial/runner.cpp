@@ -91,20 +91,22 @@ TrialResult run_real_time(HapticDevice& device, TrialHand* hand, TrialSession& s
   const double period_s = 1.0 / options.rate_hz;
   std::atomic<bool> hand_stopped{false};
   session.reserve_trace();
-  ServoLoop loop(
-      device,
-      [&](const DeviceState& state, double /*dt_s*/) -> ServoCommand {
-        ServoCommand command = session.step(state);
-        if (hand != nullptr && !command.stop) {
-          hand->observe(session.last_output(), state);
-          if (hand->stopped()) {
-            hand_stopped.store(true, std::memory_order_relaxed);
-            command.stop = true;
-          }
-        }
-        return command;
-      },
-      loop_options);
+  // Carries the session's rate to the loop, which refuses a device clock at another rate at start.
+  ServoLoop loop(device,
+                 ticking(session,
+                         [&, step = session.servo_callback()](const DeviceState& state,
+                                                              double dt_s) mutable -> ServoCommand {
+                           ServoCommand command = step(state, dt_s);
+                           if (hand != nullptr && !command.stop) {
+                             hand->observe(session.last_output(), state);
+                             if (hand->stopped()) {
+                               hand_stopped.store(true, std::memory_order_relaxed);
+                               command.stop = true;
+                             }
+                           }
+                           return command;
+                         }),
+                 loop_options);
   if (hand != nullptr) loop.set_after_write([hand, period_s] { hand->advance(period_s); });
 
   loop.start();

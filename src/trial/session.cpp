@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "core/library_log.hpp"
+#include "core/rate_text.hpp"
 
 namespace calligraphy {
 namespace {
@@ -74,14 +75,38 @@ TrialResult TrialSession::finish(TrialEnd end, std::string reason, double end_ti
     result.device_tick_rate_hz = static_cast<double>(ticks_ - 1) / last_time_s_;
     const double ratio = result.device_tick_rate_hz / options_.rate_hz;
     if (ticks_ >= 100 && (ratio < 0.9 || ratio > 1.1)) {
-      calligraphy::detail::library_log().warn(
-          "trial: the device's clock says the ticks came at {:.1f} Hz, but the trial was set up for rate_hz = "
-          "{:.1f} Hz: step the session once per period of TrialOptions::rate_hz (time-based parts of the "
-          "force law run at the wrong speed otherwise)",
-          result.device_tick_rate_hz, options_.rate_hz);
+      calligraphy::detail::library_log().warn("{}", tick_rate_warning(result.device_tick_rate_hz));
     }
   }
   return result;
+}
+
+std::string TrialSession::tick_rate_warning(double measured_hz) const {
+  const std::string measured = detail::measured_rate_text(measured_hz);
+  const std::string asked = detail::rate_text(options_.rate_hz);
+  constexpr const char* kSlow = "time-based parts of the force law (fades, filters, a replay) ran slow";
+  // Load makes a loop keep fewer ticks than it is asked for, never more. On a loop that checked the rates at
+  // start, fewer is timing; on the application's own loop, its rate is its promise, which may be wrong.
+  if (measured_hz < options_.rate_hz && rate_checked_) {
+    return "trial: the servo loop kept " + measured + " of the " + asked +
+           " asked, by the device's clock: its ticks were late (load on the machine, a loop thread without "
+           "real-time priority), the rates were set equal; " +
+           kSlow;
+  }
+  if (measured_hz < options_.rate_hz) {
+    return "trial: the ticks came at " + measured + " by the device's clock, not the " + asked +
+           " of TrialOptions::rate_hz: late ticks (load on the machine) if the loop that steps the session "
+           "runs at that rate, else a loop at another rate (step the session once per period); " +
+           kSlow;
+  }
+  return "trial: the ticks came at " + measured + " by the device's clock, faster than the " + asked +
+         " of TrialOptions::rate_hz: step the session once per period of TrialOptions::rate_hz; time-based "
+         "parts of the force law (fades, filters, a replay) ran fast";
+}
+
+ServoCommand TrialSession::ServoTick::operator()(const DeviceState& state, double /*dt_s*/) const noexcept {
+  session->rate_checked_ = true;  // a ServoLoop calls this only after start() checked the rates
+  return session->step(state);
 }
 
 }  // namespace calligraphy

@@ -23,6 +23,7 @@
 /// exception). Statistics are atomics, readable from any thread while the loop runs. Log records go
 /// through a lock-free queue to a normal thread that calls spdlog. Linux only (clock_nanosleep,
 /// SCHED_FIFO).
+#include <concepts>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -95,6 +96,37 @@ using ServoCallback = std::function<ServoCommand(const DeviceState& state, doubl
 template <typename Callback>
 concept servo_callback_for = std::is_invocable_v<Callback&, const DeviceState&, double> &&
     std::is_same_v<std::decay_t<std::invoke_result_t<Callback&, const DeviceState&, double>>, ServoCommand>;
+
+/// Something built for one servo rate, whose time-based parts (fades, filters, a replay's clock) assume that
+/// many ticks a second: `Renderer` and `TrialSession` are. `servo_rate_name()` names where the rate was set
+/// (e.g. "RendererOptions::rate_hz"), for the error that refuses a loop at another rate.
+template <typename T>
+concept BuiltForServoRate = requires(const T& ticked) {
+  { ticked.servo_rate_hz() } -> std::convertible_to<double>;
+  { ticked.servo_rate_name() } -> std::convertible_to<const char*>;
+};
+
+/// A servo callback that says the rate it was built for (what `ticking` returns): handed to a `ServoLoop`,
+/// `start()` refuses a loop or a device clock at another rate.
+template <typename Callback>
+struct RatedServoCallback {
+  Callback callback;
+  double rate_hz = 0.0;        ///< the rate the callback was built for [Hz]
+  const char* rate_name = "";  ///< where that rate was set (a static string)
+  ServoCommand operator()(const DeviceState& state, double dt_s) { return callback(state, dt_s); }
+  [[nodiscard]] double servo_rate_hz() const noexcept { return rate_hz; }
+  [[nodiscard]] const char* servo_rate_name() const noexcept { return rate_name; }
+};
+
+/// `callback` as the servo callback of `ticked` (a `Renderer`, a `TrialSession`), carrying its rate to the
+/// loop: `ServoLoop loop(device, ticking(renderer, [&](const DeviceState& s, double) {...}), options)`.
+/// `start()` then throws InvalidArgument, naming both rates, when `ServoLoopOptions::rate_hz` or the device's
+/// own servo clock runs at another rate. Only the rate is read from `ticked`, now.
+template <BuiltForServoRate Ticked, typename Callback>
+[[nodiscard]] RatedServoCallback<std::decay_t<Callback>> ticking(const Ticked& ticked, Callback&& callback) {
+  return {std::forward<Callback>(callback), static_cast<double>(ticked.servo_rate_hz()),
+          ticked.servo_rate_name()};
+}
 
 /// What ended a run. A device's faults are not kinds of their own: they are `device` with the device's
 /// `DeviceFault` code in `LoopFault::device` (one taxonomy, device_fault.hpp).
@@ -179,11 +211,13 @@ class ServoLoop {
  public:
   /// `device` must outlive the loop. Throws InvalidArgument for bad options or an empty callback.
   ServoLoop(HapticDevice& device, ServoCallback callback, const ServoLoopOptions& options = {});
-  /// The same from any callable (a lambda) callable as `ServoCommand(const DeviceState&, double dt_s)`.
+  /// The same from any callable (a lambda) callable as `ServoCommand(const DeviceState&, double dt_s)`. A
+  /// callable that says the rate it was built for (`BuiltForServoRate`: what `ticking` and
+  /// `TrialSession::servo_callback` return) has it checked by `start()`.
   template <typename Callback>
   requires(!std::is_same_v<std::decay_t<Callback>, ServoCallback> && servo_callback_for<Callback>)
       ServoLoop(HapticDevice& device, Callback&& callback, const ServoLoopOptions& options = {})
-      : ServoLoop(device, ServoCallback(std::forward<Callback>(callback)), options) {}
+      : ServoLoop(device, prepare(std::forward<Callback>(callback)), options) {}
   /// Any other callable is refused at compile time with one message saying what is wrong (e.g. one that
   /// returns a bare force, a Vec3). The constraint keeps such a callable away from std::function, whose
   /// own errors would otherwise follow the message by some fifty lines.
@@ -213,9 +247,9 @@ class ServoLoop {
   /// either attaches to the device's own servo clock or starts the loop thread, applies the realtime
   /// settings on it and returns once they are applied. Throws RealtimeError (mode `enforce`, with the
   /// reason), DeviceError (the device is not open, or from `enable_forces` or the clock's attach),
-  /// InvalidArgument (`rate_hz` differs from the device clock's rate, both named), or StateError when the
-  /// loop is already running. A loop that ended (stopped by its
-  /// callback, by `stop()` or by a fault) can be started again.
+  /// InvalidArgument (`rate_hz`, or the rate the callback was built for, differs from the device clock's rate
+  /// or from each other: both named), or StateError when the loop is already running. A loop that ended
+  /// (stopped by its callback, by `stop()` or by a fault) can be started again.
   void start();
   /// Optional: called on the loop thread right after each tick's force write (the callback's force or
   /// the zero force that replaced it), except after a tick that asked to stop or ended the run. A
@@ -245,6 +279,25 @@ class ServoLoop {
   [[nodiscard]] const ServoLoopOptions& options() const noexcept;
 
  private:
+  // The callback and the rate it was built for (0: it does not say).
+  struct Prepared {
+    ServoCallback callback;
+    double rate_hz = 0.0;
+    const char* rate_name = "";
+  };
+  ServoLoop(HapticDevice& device, Prepared prepared, const ServoLoopOptions& options);
+
+  template <typename Callback>
+  static Prepared prepare(Callback&& callback) {
+    Prepared prepared;
+    if constexpr (BuiltForServoRate<std::decay_t<Callback>>) {
+      prepared.rate_hz = static_cast<double>(callback.servo_rate_hz());  // read before the callback moves
+      prepared.rate_name = callback.servo_rate_name();
+    }
+    prepared.callback = ServoCallback(std::forward<Callback>(callback));
+    return prepared;
+  }
+
   template <typename Callback>
   static constexpr bool kRefused = false;  // false, but only once instantiated for a refused callable
 

@@ -71,6 +71,10 @@ class Renderer {
   [[nodiscard]] InteractionState state() const noexcept { return state_; }
   [[nodiscard]] const ForceLawParameters& parameters() const noexcept { return parameters_; }
   [[nodiscard]] const RendererOptions& options() const noexcept { return options_; }
+  /// The rate `tick` must be called at [Hz] and where it was set: a `ServoLoop` given the renderer's callback
+  /// through `ticking(renderer, callback)` (servo_loop.hpp) refuses to start at another rate.
+  [[nodiscard]] double servo_rate_hz() const noexcept { return options_.rate_hz; }
+  [[nodiscard]] static const char* servo_rate_name() noexcept { return "RendererOptions::rate_hz"; }
   [[nodiscard]] const Scene& scene() const noexcept { return *scene_; }
   [[nodiscard]] const SafetyChain& safety_chain() const noexcept { return chain_; }
   [[nodiscard]] const PassivityController& passivity() const noexcept { return passivity_; }

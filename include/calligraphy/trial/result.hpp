@@ -48,9 +48,10 @@ struct TrialResult {
   double device_time_at_start_s = 0.0;
   /// The rate the ticks came at by the device's clock [Hz]: (ticks - 1) over the time from the first tick to
   /// the last; 0 for fewer than 2 ticks or a clock that did not move. The renderer assumed
-  /// `TrialOptions::rate_hz`; a loop that ticks at another rate (more than 10 % off over 100 ticks or more)
-  /// is logged as a warning when the trial finishes (`TrialSession::finish`), since time-based parts of the
-  /// force law (fades, filters, replay) would run at the wrong speed.
+  /// `TrialOptions::rate_hz`; ticks at another rate (more than 10 % off over 100 ticks or more) are logged as
+  /// a warning with the measured rate when the trial finishes (`TrialSession::finish`: late ticks on a loop
+  /// that checked the rates at start), since time-based parts of the force law (fades, filters, replay) ran at
+  /// the wrong speed.
   double device_tick_rate_hz = 0.0;
 };
 

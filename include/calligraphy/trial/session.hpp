@@ -26,6 +26,7 @@
 /// pushes the trial's end.
 #include <cstddef>
 #include <optional>
+#include <string>
 
 #include "calligraphy/core/device_types.hpp"
 #include "calligraphy/devices/servo_loop.hpp"
@@ -40,6 +41,12 @@ namespace calligraphy {
 
 class TrialSession {
  public:
+  /// What `servo_callback` wraps: steps the session on a `ServoLoop`.
+  struct ServoTick {
+    TrialSession* session;
+    ServoCommand operator()(const DeviceState& state, double dt_s) const noexcept;
+  };
+
   /// `scene` must outlive the session. The renderer takes the device's limits and its intrinsic damping
   /// (`DeviceInfo::damping_n_s_per_m`, for the stiffness bound) from `device`. Throws InvalidArgument for
   /// bad options or a device whose info is unusable (max force <= 0).
@@ -60,6 +67,18 @@ class TrialSession {
   /// `state.time_s` is on the device's clock (any origin) and only its differences are used.
   ServoCommand step(const DeviceState& state) noexcept;
 
+  /// The session as a `ServoLoop`'s callback: `ServoLoop loop(device, session.servo_callback(), options)`.
+  /// Each tick is `step`; the callback says the session's rate, so `ServoLoop::start()` refuses a loop or a
+  /// device clock at another rate (InvalidArgument naming both), and `finish` then knows that ticks that came
+  /// slower than `rate_hz` were late, not misconfigured. For a `ServoLoop` only (passed to it as is, not
+  /// through a `ServoCallback`); the session must outlive the loop's run.
+  [[nodiscard]] RatedServoCallback<ServoTick> servo_callback() noexcept {
+    return {ServoTick{this}, options_.rate_hz, servo_rate_name()};
+  }
+  /// The rate `step` must be called at [Hz] (`TrialOptions::rate_hz`) and where it was set (for `ticking`).
+  [[nodiscard]] double servo_rate_hz() const noexcept { return options_.rate_hz; }
+  [[nodiscard]] static const char* servo_rate_name() noexcept { return "TrialOptions::rate_hz"; }
+
   /// What the renderer made of the last step (state, active stroke, hint, force, events).
   [[nodiscard]] const RenderOutput& last_output() const noexcept { return last_output_; }
   /// Ticks stepped so far.
@@ -73,10 +92,15 @@ class TrialSession {
   /// Closes the metrics at `end_time_s` (when the trial ended, on the device's clock as the states
   /// stepped; the last tick's time when negative) and returns the recording with how it ended. `reason` is
   /// kept as `abort_reason`. Call once, after the loop stopped stepping; the session is spent after it. With
-  /// a display attached it pushes the `trial_ended` event.
+  /// a display attached it pushes the `trial_ended` event. When the device's clock says the ticks came more
+  /// than 10 % off `rate_hz` (over 100 ticks or more: `TrialResult::device_tick_rate_hz`), logs a warning
+  /// with the measured rate: late ticks (load on the machine) when they came slower on a rate-checked loop
+  /// (`servo_callback`), else also the possibility that the application's loop steps at another rate.
   [[nodiscard]] TrialResult finish(TrialEnd end, std::string reason = {}, double end_time_s = -1.0);
 
  private:
+  [[nodiscard]] std::string tick_rate_warning(double measured_hz) const;
+
   TrialOptions options_;
   Renderer renderer_;
   TrialRecorder recorder_;
@@ -86,6 +110,7 @@ class TrialSession {
   std::size_t max_ticks_ = 0;
   double last_time_s_ = 0.0;      // the trial's clock: 0 at the first tick
   double device_origin_s_ = 0.0;  // the device's time stamp of the first tick
+  bool rate_checked_ = false;     // stepped by a ServoLoop that checked the rates at start (servo_callback)
 };
 
 }  // namespace calligraphy
