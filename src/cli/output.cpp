@@ -183,15 +183,17 @@ void FilePlan::output(const std::string& what, const std::string& path) {
   if (identity.exists && ::access(identity.path.c_str(), W_OK) != 0) {
     throw DataError(named(what, path) + ": cannot write: " + std::strerror(errno));
   }
-  // A file in a folder this command makes (--session, --out) is written once that folder exists; the
-  // folder itself was checked by output_folder.
+  // A file under a folder this command makes files and folders in (--session, --out's pages) may be in a
+  // subfolder that does not exist yet (a subject who joined since the last report): the command makes it, and
+  // output_folder checked the nearest folder that exists. A subfolder that exists must be writable.
   const fs::path folder = folder_of(identity.path).lexically_normal();
-  const bool in_made_folder =
-      std::any_of(made_folders_.begin(), made_folders_.end(), [&](const fs::path& made) {
+  const bool in_output_folder =
+      std::any_of(output_folders_.begin(), output_folders_.end(), [&](const fs::path& made) {
         const fs::path relative = folder.lexically_relative(made);
         return !relative.empty() && *relative.begin() != "..";
       });
-  if (!in_made_folder) require_writable_folder(what, path, folder);
+  std::error_code error;
+  if (!in_output_folder || fs::exists(folder, error)) require_writable_folder(what, path, folder);
   outputs_.push_back({what, path, identity});
 }
 
@@ -208,7 +210,7 @@ void FilePlan::output_folder(const std::string& what, const std::string& path) {
     throw DataError(named(what, path) + ": is not a folder");
   }
   require_writable_folder(what, path, folder);
-  if (folder != fs::absolute(path)) made_folders_.push_back(fs::absolute(path).lexically_normal());
+  output_folders_.push_back(fs::absolute(path).lexically_normal());
 }
 
 void FilePlan::existing_output_folder(const std::string& what, const std::string& path) {

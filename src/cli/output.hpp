@@ -50,7 +50,7 @@ class FilePlan {
   void output(const std::string& what, const std::string& path);
   /// A folder the command creates files or folders in: it must be a writable folder, or not exist yet
   /// with a writable folder as its nearest existing ancestor. Throws DataError naming `what` and the path.
-  /// Outputs given after it may lie in it (or under it) before it exists: the command makes it first.
+  /// Outputs given after it may lie in it, or in subfolders of it, before they exist: the command makes them.
   void output_folder(const std::string& what, const std::string& path);
   /// An existing folder the command writes new files into (e.g. screenshots): it must exist and be
   /// writable. Throws DataError naming `what` and the path.
@@ -75,7 +75,7 @@ class FilePlan {
   void add_input(const std::string& what, const std::string& given, const Identity& identity);
   std::vector<Entry> inputs_;
   std::vector<Entry> outputs_;
-  std::vector<std::filesystem::path> made_folders_;  // output folders that do not exist yet
+  std::vector<std::filesystem::path> output_folders_;  // folders the command makes files and folders in
 };
 
 /// Every file of every session folder under `root` (find_session_folders: the saved trial records,

@@ -174,6 +174,21 @@ class SavedRecords(OutputTestCase):
             self.assertEqual(result.returncode, 0, result.stderr.decode())
         self.assertIn("<html", (self.cwd / "study" / "report.html").read_text(encoding="utf-8").lower())
 
+    def test_a_study_report_is_made_again_after_a_new_subject_joined(self):
+        """A running study is re-reported: the new subject's page folder is made under the existing one."""
+        self.small_session()
+        first = self.run_cli("report", "study", "--out", "report.html")
+        self.assertEqual(first.returncode, 0, first.stderr.decode())
+        protocol = self.cwd / "small.json"
+        joined = self.run_cli("session", "run", protocol, "--writer", "simulated", "--subjects", "2", "--out",
+                              "study")
+        self.assertEqual(joined.returncode, 0, joined.stderr.decode())
+        again = self.run_cli("report", "study", "--out", "report.html")
+        self.assertEqual(again.returncode, 0, again.stderr.decode())
+        subjects = {path.relative_to(self.cwd / "report_files").parts[0]
+                    for path in (self.cwd / "report_files").glob("*/*.html")}
+        self.assertEqual(subjects, {"S01", "S02"})
+
     def test_run_screenshot_onto_a_record_under_out_is_refused(self):
         _, record = self.small_session()
         before = tree(self.cwd / "study")
