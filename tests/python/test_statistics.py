@@ -276,6 +276,27 @@ def test_a_constant_outcome_is_described_and_not_modelled(recwarn):
     assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
 
 
+@pytest.mark.parametrize("missing", [np.nan, None])
+@pytest.mark.parametrize("column", ["condition", "subject", "characters"])
+def test_a_missing_level_of_a_grouping_column_is_a_value_error_naming_it(column, missing):
+    """A row that names no condition (or subject, or character) is neither dropped without a word nor a crash
+    inside a fit: every function raises ValueError naming the column."""
+    trials = make_trials(seed=12, subjects=4)
+    trials[column] = trials[column].astype(object)
+    trials.loc[trials.index[5], column] = missing
+    calls = {
+        "mixed_model": lambda: statistics.mixed_model(trials, VALUE),
+        "statistics_table": lambda: statistics.statistics_table(trials, VALUE),
+    }
+    if column != "characters":  # a paired comparison pools a subject's characters
+        calls["paired_comparison"] = lambda: statistics.paired_comparison(trials, VALUE, "vision", "haptic")
+    if column == "condition":
+        calls["describe"] = lambda: statistics.describe(trials, VALUE)
+    for name, call in calls.items():
+        with pytest.raises(ValueError, match=f"{name}: column '{column}' has 1 missing value"):
+            call()
+
+
 def test_errors_name_the_problem():
     trials = make_trials(seed=10, subjects=4)
     with pytest.raises(ValueError, match="'pen_lifts'"):

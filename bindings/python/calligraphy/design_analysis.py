@@ -153,6 +153,7 @@ def study_design(trials: pandas.DataFrame, reference: typing.Optional[str] = Non
     reference not present."""
     statistics._check_frame(trials, "study_design")
     statistics._require_columns(trials, ["subject", "phase", "condition"], "study_design")
+    statistics._require_groups(trials, ["subject", "phase", "condition"], "study_design")
     phases = _phase_order(trials)
     per_phase = trials.groupby(trials["phase"].astype(str))["condition"].nunique()
     varied = [p for p in phases if per_phase.get(p, 0) >= 2]
@@ -441,6 +442,7 @@ def design_questions(trials: pandas.DataFrame, value: str, design: typing.Option
     pandas = _pandas()
     statistics._check_frame(trials, "design_questions")
     statistics._require_columns(trials, ["subject", "phase", "condition", "characters", value], "design_questions")
+    statistics._require_groups(trials, ["subject", "phase", "condition", "characters"], "design_questions")
     trials = statistics._finite_outcome(trials, value, "design_questions")
     design = design or study_design(trials)
     data, _ = apply_exclusions(trials, policy)

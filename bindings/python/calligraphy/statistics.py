@@ -102,6 +102,18 @@ def _require_columns(trials: pandas.DataFrame, columns: typing.Iterable[str], ca
         raise ValueError(f"{caller}: column {names} is not in trials; its columns: {present}")
 
 
+def _require_groups(trials: pandas.DataFrame, columns: typing.Iterable[str], caller: str) -> None:
+    """Every row names its level of each grouping column (subject, condition, characters, ...): a missing
+    one (NaN, None, NaT) raises ValueError naming the column, the count and the first row's index, instead of
+    the row being dropped without a word or failing deep inside a fit."""
+    for column in dict.fromkeys(columns):
+        missing = trials[column].isna()
+        if missing.any():
+            first = trials.index[missing.to_numpy()][0]
+            raise ValueError(f"{caller}: column {column!r} has {int(missing.sum())} missing value(s) (NaN or "
+                             f"None), the first at row {first!r}: every trial must name its {column}")
+
+
 class NonFiniteValueWarning(UserWarning):
     """An outcome column held +inf or -inf: those values were counted as missing, like NaN."""
 
@@ -209,6 +221,7 @@ def describe(trials: pandas.DataFrame, value: str, by: str | typing.Sequence[str
         raise ValueError("describe: by contains 'subject', so each group holds one subject; use unit='trial'")
     needed = [*by, value] + (["subject"] if unit == "subject" else [])
     _require_columns(trials, needed, caller)
+    _require_groups(trials, [column for column in needed if column != value], caller)
     trials = _finite_outcome(trials, value, caller)
 
     # A constant key stands in for the groups when the whole table is one group.
@@ -381,6 +394,7 @@ def paired_comparison(trials: pandas.DataFrame, value: str, a: typing.Any, b: ty
         raise _statsmodels_import_error(error) from error
     _check_frame(trials, caller)
     _require_columns(trials, ["subject", by, value], caller)
+    _require_groups(trials, ["subject", by], caller)
     trials = _finite_outcome(trials, value, caller)
     data = _select_phase(trials, phase, caller)
     present = _levels(data[by])
@@ -491,6 +505,7 @@ def mixed_model(trials: pandas.DataFrame, value: str, fixed: str = "condition", 
         raise _statsmodels_import_error(error) from error
     _check_frame(trials, caller)
     _require_columns(trials, ["subject", "characters", fixed, value], caller)
+    _require_groups(trials, ["subject", "characters", fixed], caller)
     trials = _finite_outcome(trials, value, caller)
     data = _select_phase(trials, phase, caller)
     kept = data[data[value].notna()]
@@ -618,6 +633,7 @@ def learning(trials: pandas.DataFrame, value: str, pre: str, post: str, retentio
     pandas = _pandas()
     _check_frame(trials, caller)
     _require_columns(trials, ["subject", by, value], caller)
+    _require_groups(trials, ["subject", by], caller)
     trials = _finite_outcome(trials, value, caller)
     phases = {role: name for role, name in
               (("pre", pre), ("post", post), ("retention", retention), ("transfer", transfer)) if name is not None}
@@ -747,6 +763,7 @@ def group_comparison(table: pandas.DataFrame, value: str, a: typing.Any, b: typi
     stats = _scipy_stats()
     _check_frame(table, caller)
     _require_columns(table, ["subject", by, value], caller)
+    _require_groups(table, ["subject", by], caller)
     table = _finite_outcome(table, value, caller)
     if table["subject"].duplicated().any():
         raise ValueError(f"{caller}: expected one row per subject (e.g. from learning()); "
@@ -850,6 +867,7 @@ def statistics_table(trials: pandas.DataFrame, value: str, by: str = "condition"
     pandas = _pandas()
     _check_frame(trials, caller)
     _require_columns(trials, ["subject", "characters", by, value], caller)
+    _require_groups(trials, ["subject", "characters", by], caller)
     trials = _finite_outcome(trials, value, caller)
     data = _select_phase(trials, phase, caller)
     rows = []
