@@ -34,9 +34,9 @@ struct ReportCommand {
   std::int64_t jobs = 0;  // 0: every core
 };
 
-// Each session's page, built as its trials are read and written whole (atomically) before the next
-// session is read: memory holds one session's page and one trial per thread. With `tables`, each
-// session's rows of the tidy tables are read from the same parse of its records.
+// Each session's page, built as its trials are read and written whole (the temporary of its file in the
+// report's set) before the next session is read: memory holds one session's page and one trial per thread.
+// With `tables`, each session's rows of the tidy tables are read from the same parse of its records.
 class PagesWriter {
  public:
   PagesWriter(const StudyReportSessions& sessions, const std::vector<fs::path>& page_files,
@@ -53,6 +53,7 @@ class PagesWriter {
   std::atomic<std::size_t> trials{0};
   std::atomic<std::uintmax_t> bytes{0};
   std::vector<StudyTables>* tables = nullptr;  // one per session, when the tables are wanted too
+  AtomicFileSet* files = nullptr;              // the report's files, replaced together at the end
 
   void work() {
     while (!failed) {
@@ -71,7 +72,7 @@ class PagesWriter {
         fs::create_directories(pages[i].parent_path(), error);
         if (error)
           throw DataError(pages[i].parent_path().string() + ": cannot create the folder: " + error.message());
-        write_file_atomically(pages[i], text);
+        files->add(pages[i], text);
       } catch (...) {
         const std::lock_guard lock(error_mutex);
         if (!failure) failure = std::current_exception();
@@ -98,17 +99,21 @@ int run_report(const ReportCommand& command) {
   const auto elapsed = [&start] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
-  const auto write_tables = [&](const StudyTables& tables) {
-    // Both tables or neither: a failure leaves the previous pair whole.
-    const std::string trials_text = trials_csv(tables), strokes_text = strokes_csv(tables);
-    const FileContent table_files[] = {{tables_folder / "trials.csv", trials_text},
-                                       {tables_folder / "strokes.csv", strokes_text}};
-    write_files_atomically(table_files);
-    std::printf("%s: trials.csv (%zu rows), strokes.csv (%zu rows), %.1f s\n", command.csv.c_str(),
-                tables.trials.size(), tables.strokes.size(), elapsed());
+  // Everything this run writes (the tables, the pages, the index) is one set: replaced together at the end,
+  // or, on any failure, none of it, the earlier report and tables left whole.
+  AtomicFileSet report_files;
+  std::string tables_line;
+  const auto add_tables = [&](const StudyTables& tables) {
+    report_files.add(tables_folder / "trials.csv", trials_csv(tables));
+    report_files.add(tables_folder / "strokes.csv", strokes_csv(tables));
+    char line[256];
+    std::snprintf(line, sizeof line, "trials.csv (%zu rows), strokes.csv (%zu rows)", tables.trials.size(),
+                  tables.strokes.size());
+    tables_line = line;
   };
   // The tables alone read the records only; with the pages they come from the pages' read of each record.
-  if (!command.csv.empty() && command.out.empty()) write_tables(read_study_tables(roots));
+  if (!command.csv.empty() && command.out.empty()) add_tables(read_study_tables(roots));
+  std::string pages_line;
   if (!command.out.empty()) {
     const StudyReportSessions study = list_report_sessions(roots);
     const fs::path index_path(command.out);
@@ -123,6 +128,7 @@ int run_report(const ReportCommand& command) {
       files.output("--out", pages.back().string());
     }
     PagesWriter writer(study, pages, "../../" + index_name);
+    writer.files = &report_files;
     std::vector<StudyTables> session_tables(command.csv.empty() ? 0 : study.sessions.size());
     if (!command.csv.empty()) writer.tables = &session_tables;
     const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
@@ -141,14 +147,19 @@ int run_report(const ReportCommand& command) {
         std::move(rows.strokes.begin(), rows.strokes.end(), std::back_inserter(tables.strokes));
         rows = StudyTables{};
       }
-      write_tables(tables);
+      add_tables(tables);
     }
     const std::string index = study_index_html(study.index, index_name);
-    write_file_atomically(index_path, index);
-    std::printf("%s: %zu sessions, %zu trials, %zu pages in %s (%.1f MB), %.1f s\n", command.out.c_str(),
-                study.sessions.size(), writer.trials.load(), pages.size(), pages_folder.string().c_str(),
-                static_cast<double>(writer.bytes.load() + index.size()) / 1e6, elapsed());
+    report_files.add(index_path, index);
+    char line[512];
+    std::snprintf(line, sizeof line, "%zu sessions, %zu trials, %zu pages in %s (%.1f MB)", study.sessions.size(),
+                  writer.trials.load(), pages.size(), pages_folder.string().c_str(),
+                  static_cast<double>(writer.bytes.load() + index.size()) / 1e6);
+    pages_line = line;
   }
+  report_files.commit();
+  if (!tables_line.empty()) std::printf("%s: %s, %.1f s\n", command.csv.c_str(), tables_line.c_str(), elapsed());
+  if (!pages_line.empty()) std::printf("%s: %s, %.1f s\n", command.out.c_str(), pages_line.c_str(), elapsed());
   return 0;
 }
 

@@ -18,6 +18,7 @@
 /// directly, and every write and the close are checked.
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -41,14 +42,38 @@ struct FileContent {
   std::string_view content;
 };
 
-/// Writes a set of files that belong together (a study's tables): every file's temporary is written whole,
-/// fsync'ed and closed first; only then are the targets replaced, one rename each, in the given order,
-/// under an exclusive flock(2) of their folders, so that two processes writing the same set leave one
-/// writer's whole set, never a mix of both. A
-/// failure while writing (e.g. a full disk) removes every temporary and leaves every earlier file as it
-/// was, so a reader never finds a new file beside an old one of the set. (Between the renames, which need
-/// no space, only a crash of the machine or the process can leave part of the set replaced.) Throws
-/// DataError naming the file at fault, as `write_file_atomically`.
+/// A set of files that belong together (a study's tables, a report's pages), written so that a reader and a
+/// later run find the earlier set or the whole new one:
+///  - `add` writes one file's temporary beside its target, whole (fsync'ed and closed), so that a large set
+///    need not be held in memory; a failure (a full disk) throws and, once the set is destroyed, leaves every
+///    earlier file as it was. `add` may be called from several threads.
+///  - `commit` replaces the targets, one rename each in the order added, under an exclusive flock(2) of their
+///    folders (two writers of one set never interleave). Before the first rename each earlier file gets a
+///    second name (a hard link beside it), so that a rename failing part way (EIO, an immutable file) puts
+///    every replaced file back and throws naming the file at fault. A journal written and synced before the
+///    first rename (`.calligraphy-set-*.journal` in the first file's folder) records the set: a writer killed
+///    between two renames leaves it, and the next set committed in that folder first completes it from the
+///    whole temporaries, so the killed set ends whole.
+///  - destroyed without `commit`: the temporaries are removed and no target changes.
+/// Throws DataError naming the file at fault (as `write_file_atomically`), StateError for `add` after
+/// `commit` or a second `commit`. A device or FIFO among the targets is written in place after the renames.
+class AtomicFileSet {
+ public:
+  AtomicFileSet();
+  ~AtomicFileSet();
+  AtomicFileSet(const AtomicFileSet&) = delete;
+  AtomicFileSet& operator=(const AtomicFileSet&) = delete;
+  /// Writes the temporary of `path` (see the class comment).
+  void add(const std::filesystem::path& path, std::string_view content);
+  /// Replaces every target added (see the class comment).
+  void commit();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// The files of `files` as one `AtomicFileSet`, committed.
 void write_files_atomically(std::span<const FileContent> files);
 
 /// The same for binary content (e.g. an encoded corpus store).

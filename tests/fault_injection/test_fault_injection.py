@@ -1,0 +1,155 @@
+#!/usr/bin/env python3
+"""Faults injected at every step of writing a study's outputs, as SQLite tests itself; run by CTest as
+`fault_injection_cli`.
+
+The shim (fault_shim.c, LD_PRELOAD) fails the Nth call of one kind (open for writing, write, fsync, rename,
+link, mkdir, unlink, flock) under the output folder with ENOSPC, EIO, EROFS or ENOLCK, or kills the process
+with SIGKILL just before it. A first run without a fault counts the calls of each kind; then every N of every
+kind is tried, once failing and once killed. Each command replaces an earlier output set (the report of one
+subject) by a new one (the report after a second subject joined). What must hold after every fault:
+
+- a failed run exits 1 with one error line naming a file, never a crash (exit 3 or a signal);
+- the visible files are the earlier set or the whole new set, byte for byte, never a mix; a killed run may
+  also leave a journal of a set under way, which the next run completes;
+- a clean run afterwards writes the new set and leaves no temporary, second name or journal behind.
+
+Commands: `report --csv --out` (the tables, the pages and the index as one set) and `session cohort` (its
+pair of tables). CALLIGRAPHY_CLI names the program, CALLIGRAPHY_FAULT_SHIM the shim. Standard library only.
+"""
+import hashlib
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+from pathlib import Path
+
+CLI = os.environ.get("CALLIGRAPHY_CLI", "")
+SHIM = os.environ.get("CALLIGRAPHY_FAULT_SHIM", "")
+SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
+sys.path.insert(0, str(SOURCE / "tests" / "study"))
+from study_protocols import two_session_protocol  # noqa: E402
+
+KINDS = ("open", "write", "fsync", "rename", "link", "mkdir", "unlink", "flock")
+ERRNOS = ("ENOSPC", "EIO", "EROFS", "ENOLCK")
+TIMEOUT_S = 120
+LEFTOVER_MARKS = (".tmp-", ".kept-", ".calligraphy-set-")
+
+
+def snapshot(folder):
+    """{relative path: SHA-256} of the visible files under `folder` (hidden names are leftovers, below)."""
+    files = {}
+    for path in sorted(folder.rglob("*")):
+        relative = path.relative_to(folder)
+        if path.is_file() and not any(part.startswith(".") for part in relative.parts):
+            files[str(relative)] = hashlib.sha256(path.read_bytes()).hexdigest()
+    return files
+
+
+def leftovers(folder):
+    return sorted(str(path.relative_to(folder)) for path in folder.rglob("*")
+                  if any(mark in path.name for mark in LEFTOVER_MARKS))
+
+
+class FaultInjection(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        if not CLI or not Path(CLI).exists() or not SHIM or not Path(SHIM).exists():
+            raise unittest.SkipTest("run through ctest: CALLIGRAPHY_CLI and CALLIGRAPHY_FAULT_SHIM name the "
+                                    "program and the shim")
+        cls.scratch = tempfile.TemporaryDirectory(prefix="calligraphy-faults-")
+        root = Path(cls.scratch.name)
+        protocol = two_session_protocol("faults")
+        protocol["phases"] = protocol["phases"][:3]  # one session
+        (root / "p.json").write_text(json.dumps(protocol, ensure_ascii=False), encoding="utf-8")
+        cls.protocol = root / "p.json"
+        cls.one_subject = root / "one"
+        cls.two_subjects = root / "two"
+        for folder, subjects in ((cls.one_subject, "1"), (cls.two_subjects, "2")):
+            done = subprocess.run([CLI, "session", "run", cls.protocol, "--writer", "simulated", "--subjects",
+                                   subjects, "--out", folder / "study"], capture_output=True, timeout=TIMEOUT_S)
+            assert done.returncode == 0, done.stderr.decode()
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.scratch.cleanup()
+
+    def run_cli(self, arguments, cwd, fault=None):
+        environment = dict(os.environ)
+        if fault is not None:
+            environment.update(LD_PRELOAD=SHIM, CALLIGRAPHY_FAULT_UNDER=str(cwd / "out"), **fault)
+        return subprocess.run([CLI, *map(str, arguments)], cwd=cwd, capture_output=True, env=environment,
+                              timeout=TIMEOUT_S)
+
+    def sweep(self, arguments_for):
+        """Every fault at every step of `arguments_for(study)` writing over the output of the one-subject
+        study with the output of the two-subject study."""
+        work = Path(self.scratch.name) / "work"
+
+        def fresh():
+            """The work folder holding the earlier set only."""
+            shutil.rmtree(work, ignore_errors=True)
+            (work / "out").mkdir(parents=True)
+            done = self.run_cli(arguments_for(self.one_subject / "study"), work)
+            self.assertEqual(done.returncode, 0, done.stderr.decode())
+            return snapshot(work / "out")
+
+        earlier = fresh()
+        # The new set, as a clean run writes it over the earlier one (pages of sessions the new study lacks,
+        # if any, stay as they were).
+        done = self.run_cli(arguments_for(self.two_subjects / "study"), work)
+        self.assertEqual(done.returncode, 0, done.stderr.decode())
+        new = snapshot(work / "out")
+        self.assertNotEqual(earlier, new)
+        self.assertEqual(fresh(), earlier)
+        counts_file = Path(self.scratch.name) / "counts.txt"
+        counted = self.run_cli(arguments_for(self.two_subjects / "study"), work,
+                               {"CALLIGRAPHY_FAULT_COUNTS": str(counts_file)})
+        self.assertEqual(counted.returncode, 0, counted.stderr.decode())
+        counts = {kind: int(n) for kind, n in (line.split() for line in counts_file.read_text().splitlines())}
+        self.assertGreaterEqual(counts["rename"], 2, counts)  # the set's files are renamed into place
+        self.assertGreaterEqual(counts["fsync"], 2, counts)
+        tried = 0
+        for kind in KINDS:
+            for n in range(1, counts[kind] + 1):
+                for kill in (False, True):
+                    fault = {"CALLIGRAPHY_FAULT_CALL": kind, "CALLIGRAPHY_FAULT_AT": str(n),
+                             "CALLIGRAPHY_FAULT_ERRNO": ERRNOS[tried % len(ERRNOS)],
+                             "CALLIGRAPHY_FAULT_KILL": "1" if kill else "0"}
+                    with self.subTest(kind=kind, n=n, errno=fault["CALLIGRAPHY_FAULT_ERRNO"], kill=kill):
+                        self.assertEqual(fresh(), earlier)
+                        result = self.run_cli(arguments_for(self.two_subjects / "study"), work, fault)
+                        stderr = result.stderr.decode(errors="replace")
+                        after = snapshot(work / "out")
+                        if kill:
+                            self.assertEqual(result.returncode, -9, stderr)
+                            journals = [name for name in leftovers(work / "out") if ".calligraphy-set-" in name]
+                            self.assertTrue(after in (earlier, new) or journals,
+                                            f"a mix of the sets and no journal: {sorted(after)}")
+                        else:
+                            self.assertIn(result.returncode, (0, 1), stderr)
+                            self.assertNotIn("internal error", stderr)
+                            self.assertIn(after, (earlier, new), "a mix of the earlier and the new set")
+                            if result.returncode == 1:
+                                self.assertEqual(len(stderr.strip().splitlines()), 1, stderr)
+                                self.assertIn(": error: ", stderr)
+                        again = self.run_cli(arguments_for(self.two_subjects / "study"), work)
+                        self.assertEqual(again.returncode, 0, again.stderr.decode())
+                        self.assertEqual(snapshot(work / "out"), new)
+                        self.assertEqual(leftovers(work / "out"), [])
+                    tried += 1
+        print(f"{' '.join(map(str, arguments_for(Path('STUDY'))))}: {tried} faults at every step "
+              f"({', '.join(f'{kind} {counts[kind]}' for kind in KINDS)})", flush=True)
+
+    def test_report_tables_and_pages(self):
+        # One thread: the Nth call of a kind is then the same step in every run.
+        self.sweep(lambda study: ["report", study, "--csv", "out", "--out", "out/report.html", "--jobs", "1"])
+
+    def test_report_tables_alone(self):
+        self.sweep(lambda study: ["report", study, "--csv", "out"])
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
