@@ -1,11 +1,15 @@
 // core: the exception hierarchy (include/calligraphy/core/errors.hpp) and the device value types
 // (device_types.hpp).
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 
 #include <cmath>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "bindings.hpp"
+#include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/device_types.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "parameter_class.hpp"
@@ -170,6 +174,24 @@ void bind_core(py::module_& m) {
       .field("buttons", &DeviceState::buttons, "bit i set when button i is pressed")
       .field("time_s", &DeviceState::time_s, "device time stamp [s], monotonic")
       .finish();
+
+  // The one writer of a set of files (core/atomic_file.hpp, AtomicFileSet), for the Python modules that
+  // write a set (study_report): the same temporaries, second names, journal and folder locks as the C++
+  // commands, so a Python report is replaced whole or not at all, as theirs.
+  m.def(
+      "_write_files_together",
+      [](const std::vector<std::pair<std::string, py::bytes>>& files) {
+        std::vector<std::pair<std::string, std::string>> contents;
+        contents.reserve(files.size());
+        for (const auto& [path, data] : files) contents.emplace_back(path, std::string(data));
+        const py::gil_scoped_release released;
+        AtomicFileSet set;
+        for (const auto& [path, data] : contents) set.add(path, data);
+        set.commit();
+      },
+      py::arg("files"),
+      "Writes [(path, bytes)] as one set: every file or none replaced (AtomicFileSet). Raises DataError "
+      "naming the file at fault.");
 }
 
 }  // namespace calligraphy::python

@@ -13,8 +13,8 @@ subject) by a new one (the report after a second subject joined). What must hold
   also leave a journal of a set under way, which the next run completes;
 - a clean run afterwards writes the new set and leaves no temporary, second name or journal behind.
 
-Commands: `report --csv --out` (the tables, the pages and the index as one set) and `session cohort` (its
-pair of tables). CALLIGRAPHY_CLI names the program, CALLIGRAPHY_FAULT_SHIM the shim. Standard library only.
+Commands: `report --csv --out` (the tables, the pages and the index as one set), `report --csv` (the pair of
+tables), and the Python report's writer of its set of files (study_report, through the library's writer). CALLIGRAPHY_CLI names the program, CALLIGRAPHY_FAULT_SHIM the shim. Standard library only.
 """
 import hashlib
 import json
@@ -36,6 +36,28 @@ KINDS = ("open", "write", "fsync", "rename", "link", "mkdir", "unlink", "flock")
 ERRNOS = ("ENOSPC", "EIO", "EROFS", "ENOLCK")
 TIMEOUT_S = 120
 LEFTOVER_MARKS = (".tmp-", ".kept-", ".calligraphy-set-")
+
+# The Python side: study_report's writer of its set of files (the library's AtomicFileSet), given a study
+# folder whose files it writes, scaled, into out/ (a report's page, tables and figures stand in).
+PYTHON_WRITER = "python-report-writer"
+PYTHON_WRITER_CODE = """
+import pathlib, sys
+from calligraphy import study_report
+source = pathlib.Path(sys.argv[1])
+files = {}
+for path in sorted(source.rglob("*.json")):
+    relative = path.relative_to(source)
+    target = pathlib.Path("out") / ("figures" if len(files) % 2 else "tables") / (relative.stem + ".txt")
+    files[target] = path.read_bytes()
+(pathlib.Path("out") / "figures").mkdir(exist_ok=True)
+(pathlib.Path("out") / "tables").mkdir(exist_ok=True)
+files[pathlib.Path("out") / "index.html"] = ("<p>" + str(len(files)) + " files</p>").encode()
+try:
+    study_report._write_together(files)
+except OSError as error:
+    print(f"study_report: error: {error}", file=sys.stderr)
+    sys.exit(1)
+"""
 
 
 def snapshot(folder):
@@ -80,8 +102,9 @@ class FaultInjection(unittest.TestCase):
         environment = dict(os.environ)
         if fault is not None:
             environment.update(LD_PRELOAD=SHIM, CALLIGRAPHY_FAULT_UNDER=str(cwd / "out"), **fault)
-        return subprocess.run([CLI, *map(str, arguments)], cwd=cwd, capture_output=True, env=environment,
-                              timeout=TIMEOUT_S)
+        program = [CLI] if arguments[0] != PYTHON_WRITER else [sys.executable, "-c", PYTHON_WRITER_CODE]
+        return subprocess.run([*program, *map(str, arguments[1:] if program[0] != CLI else arguments)], cwd=cwd,
+                              capture_output=True, env=environment, timeout=TIMEOUT_S)
 
     def sweep(self, arguments_for):
         """Every fault at every step of `arguments_for(study)` writing over the output of the one-subject
@@ -146,6 +169,9 @@ class FaultInjection(unittest.TestCase):
     def test_report_tables_and_pages(self):
         # One thread: the Nth call of a kind is then the same step in every run.
         self.sweep(lambda study: ["report", study, "--csv", "out", "--out", "out/report.html", "--jobs", "1"])
+
+    def test_python_report_set(self):
+        self.sweep(lambda study: [PYTHON_WRITER, study])
 
     def test_report_tables_alone(self):
         self.sweep(lambda study: ["report", study, "--csv", "out"])

@@ -27,22 +27,20 @@ characters in figures). The statistics' sources are those of calligraphy.statist
 from __future__ import annotations
 
 import argparse
-import contextlib
 import dataclasses
 import errno
-import fcntl
 import html
 import io
 import math
 import os
 import pathlib
 import re
-import secrets
 import sys
 import time
 import typing
 import urllib.parse
 
+from . import _calligraphy
 from . import study as _study
 
 if typing.TYPE_CHECKING:  # pragma: no cover
@@ -175,53 +173,22 @@ def _has_cjk(text: str) -> bool:
 
 
 def _write_together(files: dict[pathlib.Path, typing.Union[bytes, str]]) -> None:
-    """Writes a set of files that belong together (a report): each to a temporary file beside it, flushed
-    and synced, and only once every one is whole, each renamed over its target in the order given. A failure
-    while writing (a full disk) removes every temporary and leaves the earlier set whole, so that a reader
-    never finds new tables beside an old page. Raises OSError naming the file at fault."""
-    # A folder where a file goes would fail only at its rename, after others were replaced: refused first.
+    """Writes a set of files that belong together (a report) with the library's one writer of sets
+    (AtomicFileSet, include/calligraphy/core/atomic_file.hpp): every temporary written whole first, then
+    every target replaced under the folders' locks, each earlier file kept under a second name until the
+    last rename, so that a failure at any step (a full disk, a rename refused) leaves the earlier set whole,
+    and a run killed between two renames leaves a journal the next write completes. A reader never finds new
+    tables beside an old page. Raises OSError naming the file at fault."""
+    # A folder where a file goes is refused before anything is written (the C++ writer refuses it too).
     for path in files:
         if path.is_dir():
             raise OSError(errno.EISDIR, f"cannot write {path}: {os.strerror(errno.EISDIR)}")
-    written: list[tuple[pathlib.Path, pathlib.Path]] = []
+    payloads = [(os.fspath(path), data.encode("utf-8") if isinstance(data, str) else bytes(data))
+                for path, data in files.items()]
     try:
-        for path, data in files.items():
-            payload = data.encode("utf-8") if isinstance(data, str) else data
-            temporary = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp")
-            try:
-                # os.open with 0o666 lets the umask decide the permissions, as for any new file.
-                descriptor = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
-                written.append((temporary, path))
-                with os.fdopen(descriptor, "wb") as handle:
-                    handle.write(payload)
-                    handle.flush()
-                    os.fsync(handle.fileno())
-            except OSError as error:
-                raise OSError(error.errno, f"cannot write {path}: {error.strerror or error}") from error
-        # Renames need no space: once every temporary is whole the set is replaced in one short run, under an
-        # exclusive lock of each folder (as the library's write_files_atomically), so that two reports written
-        # into one folder at once are never interleaved file by file.
-        with contextlib.ExitStack() as locks:
-            for folder in sorted({path.parent for path in files}):
-                descriptor = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
-                locks.callback(os.close, descriptor)
-                fcntl.flock(descriptor, fcntl.LOCK_EX)
-            _rename_all(written)
-    finally:
-        for temporary, _ in written:
-            with contextlib.suppress(OSError):
-                os.unlink(temporary)
-
-
-def _rename_all(written: list[tuple[pathlib.Path, pathlib.Path]]) -> None:
-    """Each temporary over its target, in order; those renamed are taken off `written`."""
-    while written:
-        temporary, path = written[0]
-        try:
-            os.replace(temporary, path)
-        except OSError as error:
-            raise OSError(error.errno, f"cannot write {path}: {error.strerror or error}") from error
-        written.pop(0)
+        _calligraphy._write_files_together(payloads)
+    except _calligraphy.DataError as error:
+        raise OSError(str(error)) from error  # "PATH: cannot write: REASON"
 
 
 def _make_folder(folder: pathlib.Path) -> None:
