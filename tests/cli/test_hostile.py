@@ -411,6 +411,12 @@ class HostileSizes(HostileTestCase):
                           f"{self.MAX_CHARACTERS + 1} characters", f"limit of {self.MAX_CHARACTERS}")
         self.assertLess(time.monotonic() - started, 10)
 
+    def test_score_refuses_a_scene_over_the_limit_before_loading(self):
+        # Characters that are not in the embedded set: were any loaded first, that would be the error.
+        trace = self.trace("few.csv", 1)
+        self.assert_error(self.run_cli("score", trace, "--character", "一" * (self.MAX_CHARACTERS + 1)), 1,
+                          "--character", f"{self.MAX_CHARACTERS + 1} characters", f"limit of {self.MAX_CHARACTERS}")
+
     def run_on_terminal(self, *args):
         """Runs the program with stderr on a pseudo-terminal (stdout a pipe); returns (status, stdout, what the
         terminal showed). Progress is shown from the start (CALLIGRAPHY_PROGRESS_AFTER_S=0), so that what the
