@@ -48,6 +48,13 @@ std::string child_pointer(const std::string& pointer, std::size_t index) {
 
 std::string as_string(const nlohmann::json& value, const std::string& pointer, const std::string& source) {
   if (!value.is_string()) fail(source, pointer, "expected a string, got " + describe(value));
+  // No field of a study's files is longer (a path, a row of characters, a note): a longer one is damage, and
+  // would otherwise be copied into every row of the tables and every page.
+  if (value.get_ref<const std::string&>().size() > kMaxStringBytes) {
+    fail(source, pointer,
+         "expected a string of at most " + std::to_string(kMaxStringBytes) + " bytes, got one of " +
+             std::to_string(value.get_ref<const std::string&>().size()) + " bytes");
+  }
   return value.get<std::string>();
 }
 
@@ -71,14 +78,15 @@ constexpr double kLargestExactInteger = 9007199254740992.0;
 
 // "expected an integer in [minimum, maximum], got VALUE", saying why when the value is in the range but
 // not an integer the file states exactly (a fraction or an exponent beyond 2^53: 1e19).
-[[noreturn]] void fail_integer(const nlohmann::json& value, const std::string& pointer, const std::string& source,
-                               const std::string& range) {
+[[noreturn]] void fail_integer(const nlohmann::json& value, const std::string& pointer,
+                               const std::string& source, const std::string& range) {
   std::string message = "expected an integer in " + range + ", got " + describe(value);
   if (value.is_number_float() && std::isfinite(value.get<double>()) &&
       std::floor(value.get<double>()) == value.get<double>() &&
       std::fabs(value.get<double>()) >= kLargestExactInteger) {
-    message += " (written with an exponent or a fraction: above 2^53 = 9007199254740992 write it in digits, "
-               "as such a number may have been rounded)";
+    message +=
+        " (written with an exponent or a fraction: above 2^53 = 9007199254740992 write it in digits, "
+        "as such a number may have been rounded)";
   }
   fail(source, pointer, message);
 }
@@ -95,7 +103,8 @@ std::int64_t as_integer(const nlohmann::json& value, const std::string& pointer,
                         std::int64_t minimum, std::int64_t maximum) {
   std::string range = "[";
   range.append(std::to_string(minimum)).append(", ").append(std::to_string(maximum)).append("]");
-  if (!value.is_number_integer() && !is_exact_integral_float(value)) fail_integer(value, pointer, source, range);
+  if (!value.is_number_integer() && !is_exact_integral_float(value))
+    fail_integer(value, pointer, source, range);
   if (value.is_number_unsigned() &&
       value.get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())) {
     fail_integer(value, pointer, source, range);
@@ -252,7 +261,8 @@ bool JsonView::boolean_or(const std::string& key, bool fallback) const {
   return value->get<bool>();
 }
 
-std::optional<double> JsonView::optional_number(const std::string& key, double minimum, double maximum) const {
+std::optional<double> JsonView::optional_number(const std::string& key, double minimum,
+                                                double maximum) const {
   const nlohmann::json* value = member(key);
   if (!value) return std::nullopt;
   return as_number(*value, child_pointer(pointer_, key), source_, minimum, maximum);

@@ -95,6 +95,9 @@ class JsonView {
 };
 
 /// The value as a string / number in range / integer in range; throws DataError naming `pointer`.
+/// The longest string any field of a study file may hold: 64 KiB.
+inline constexpr std::size_t kMaxStringBytes = std::size_t{64} << 10;
+
 std::string as_string(const nlohmann::json& value, const std::string& pointer, const std::string& source);
 double as_number(const nlohmann::json& value, const std::string& pointer, const std::string& source,
                  double minimum, double maximum);

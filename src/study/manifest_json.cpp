@@ -3,6 +3,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "study/json_reader.hpp"
+#include "study/names.hpp"
 #include "study/protocol_reading.hpp"
 
 namespace calligraphy::study_detail {
@@ -109,6 +110,11 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
   manifest.created_utc = root.string("created_utc");
   ObjectReader subject(root.required("subject"), "/subject", source);
   manifest.setup.subject.id = subject.string("id");
+  if (!is_label(manifest.setup.subject.id, 64)) {  // as check_setup refuses it when a session is made
+    fail(source, "/subject/id",
+         "expected 1 to 64 letters, digits, '_' or '-', got " +
+             study_detail::describe(nlohmann::json(manifest.setup.subject.id)));
+  }
   manifest.setup.subject.number = static_cast<std::size_t>(subject.integer("number", 0, 1000000000));
   subject.finish();
   manifest.setup.device = root.string("device");

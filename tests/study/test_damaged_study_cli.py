@@ -152,6 +152,22 @@ class DamagedStudyTest(unittest.TestCase):
             result = self.run_cli(*command)
             self.assertEqual(result.returncode, 0, result.stderr.decode())
 
+    def test_a_huge_or_odd_subject_id_is_refused_before_it_reaches_a_table(self):
+        manifest = self.first_session() / "session.json"
+        original = json.loads(manifest.read_text(encoding="utf-8"))
+        for subject, words in (("X" * 15_000_000, "at most 65536 bytes"), ("S 01\n", "letters, digits"),
+                               ("", "letters, digits")):
+            with self.subTest(subject=subject[:10]):
+                document = json.loads(json.dumps(original))
+                document["subject"]["id"] = subject
+                manifest.write_text(json.dumps(document), encoding="utf-8")
+                result = self.run_cli("report", "S", "--csv", ".")
+                self.assert_data_error(result, "session.json", f"subject {subject[:10]!r}")
+                self.assertIn("/subject/id", result.stderr.decode())
+                self.assertIn(words, result.stderr.decode())
+                self.assertLess(len(result.stderr), 3000)
+        manifest.write_text(json.dumps(original), encoding="utf-8")
+
     def test_every_wrong_value_of_a_session_manifest_is_a_data_error_naming_the_file(self):
         manifest = self.first_session() / "session.json"
         for what, damaged in self.damaged_copies(manifest):
