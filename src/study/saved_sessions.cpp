@@ -14,8 +14,14 @@ std::vector<fs::path> session_folders_under(const std::vector<fs::path>& roots) 
     for (fs::path& folder : find_session_folders(root)) folders.push_back(std::move(folder));
   }
   if (folders.empty()) {
+    // The first few folders given, and how many more: a shell glob may give thousands.
+    constexpr std::size_t kNamed = 3;
     std::string names;
-    for (const fs::path& root : roots) names += (names.empty() ? "" : ", ") + root.string();
+    for (std::size_t i = 0; i < roots.size() && i < kNamed; ++i) {
+      names.append(i == 0 ? "" : ", ").append(roots[i].string());
+    }
+    if (roots.size() > kNamed)
+      names.append(" and ").append(std::to_string(roots.size() - kNamed)).append(" more folders");
     throw DataError(names + ": no session folder (one holding a session.json) found");
   }
   return folders;
@@ -71,7 +77,8 @@ nlohmann::json read_trial_record(const fs::path& json_file) {
     fail(source, "/version",
          "expected a trial record version from 1 to " + std::to_string(kTrialRecordVersion) + ", got " +
              (version == record.end() ? std::string("none") : version->dump()) +
-             (version != record.end() && version->is_number_integer() && version->get<std::int64_t>() > kTrialRecordVersion
+             (version != record.end() && version->is_number_integer() &&
+                      version->get<std::int64_t>() > kTrialRecordVersion
                   ? " (written by a newer calligraphy: read it with that version)"
                   : ""));
   }

@@ -456,6 +456,17 @@ class HostileSizes(HostileTestCase):
         self.assertEqual(piped.stderr, b"")  # no progress into a pipe or a log
 
 
+class HostileFolders(HostileTestCase):
+    def test_thousands_of_empty_folders_are_named_in_a_short_line(self):
+        folders = []
+        for i in range(3000):
+            (self.cwd / f"empty{i:04d}").mkdir()
+            folders.append(f"empty{i:04d}")
+        line = self.assert_error(self.run_cli("report", *folders, "--csv", "."), 1, "empty0000",
+                                 "and 2997 more folders", "no session folder")
+        self.assertLess(len(line), 300)
+
+
 class HostileMessages(HostileTestCase):
     """Whatever an error quotes (a device name, a file name), it is one line of printable text of bounded
     length: no newline splits it, no escape sequence reaches the terminal (docs/cli.md, "Errors")."""
