@@ -1,17 +1,20 @@
 #include "calligraphy/legibility/legibility.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <mutex>
+#include <utility>
+#include <vector>
 
 #include "analysis/segmentation.hpp"
 #include "calligraphy/analysis/score.hpp"
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/trial/result.hpp"
 #include "calligraphy/core/unicode.hpp"
+#include "calligraphy/trial/result.hpp"
 
 #ifdef CALLIGRAPHY_WITH_ZINNIA
 #include <zinnia.h>
@@ -63,6 +66,63 @@ int canvas(double value) {
   return static_cast<int>(std::lround(std::clamp(value, -4.0 * kCanvasUnits, 5.0 * kCanvasUnits)));
 }
 
+#ifdef CALLIGRAPHY_WITH_ZINNIA
+// zinnia finds a stroke's vertices by splitting it at its farthest point, recursively, and keeps the k-th
+// split in slot 2k+1 or 2k+2 of one array: a stroke that needs d nested splits (a pen shaking along a long
+// path) makes it allocate 2^d slots, gigabytes past d = 27. What it is given is therefore simplified first
+// (Douglas & Peucker 1973, to one canvas unit, finer than its own split threshold on normal strokes), and a
+// stroke still over kMaxRecognisedPoints is thinned evenly, which bounds d, and the array, however the pen
+// moved.
+constexpr std::size_t kMaxRecognisedPoints = 20;
+
+using CanvasPoint = std::array<int, 2>;
+
+void keep_farthest(const std::vector<CanvasPoint>& points, std::size_t first, std::size_t last,
+                   std::vector<bool>& kept) {
+  // An explicit stack: a long stroke would otherwise recurse once per point.
+  std::vector<std::pair<std::size_t, std::size_t>> spans{{first, last}};
+  while (!spans.empty()) {
+    const auto [a, b] = spans.back();
+    spans.pop_back();
+    if (b <= a + 1) continue;
+    const double ax = points[a][0], ay = points[a][1], dx = points[b][0] - ax, dy = points[b][1] - ay;
+    const double length = std::hypot(dx, dy);
+    double farthest = 0.0;
+    std::size_t at = a;
+    for (std::size_t k = a + 1; k < b; ++k) {
+      const double px = points[k][0] - ax, py = points[k][1] - ay;
+      const double distance = length > 0.0 ? std::abs(px * dy - py * dx) / length : std::hypot(px, py);
+      if (distance > farthest) farthest = distance, at = k;
+    }
+    if (farthest <= 1.0) continue;
+    kept[at] = true;
+    spans.push_back({a, at});
+    spans.push_back({at, b});
+  }
+}
+
+std::vector<CanvasPoint> recognisable_stroke(const std::vector<Vec2>& stroke) {
+  std::vector<CanvasPoint> points;
+  for (const Vec2& point : stroke) {
+    const CanvasPoint p{canvas(point.x()), canvas(kDataTopY - point.y())};
+    if (points.empty() || points.back() != p) points.push_back(p);
+  }
+  if (points.size() <= 2) return points;
+  std::vector<bool> kept(points.size(), false);
+  kept.front() = kept.back() = true;
+  keep_farthest(points, 0, points.size() - 1, kept);
+  std::vector<CanvasPoint> simplified;
+  for (std::size_t k = 0; k < points.size(); ++k)
+    if (kept[k]) simplified.push_back(points[k]);
+  if (simplified.size() <= kMaxRecognisedPoints) return simplified;
+  std::vector<CanvasPoint> thinned;
+  for (std::size_t k = 0; k < kMaxRecognisedPoints; ++k) {
+    thinned.push_back(simplified[k * (simplified.size() - 1) / (kMaxRecognisedPoints - 1)]);
+  }
+  return thinned;
+}
+#endif
+
 }  // namespace
 
 bool legibility_available() {
@@ -108,8 +168,8 @@ std::optional<CharacterLegibility> character_legibility(
   std::size_t id = 0;
   for (const std::vector<Vec2>& stroke : strokes_data_units) {
     if (stroke.empty()) continue;
-    for (const Vec2& point : stroke)
-      zinnia_character_add(character, id, canvas(point.x()), canvas(kDataTopY - point.y()));
+    for (const CanvasPoint& point : recognisable_stroke(stroke))
+      zinnia_character_add(character, id, point[0], point[1]);
     ++id;
   }
   zinnia_result_t* result = zinnia_recognizer_classify(shared->recogniser, character, kLegibilityCandidates);

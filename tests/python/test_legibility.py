@@ -71,3 +71,32 @@ def test_learning_subjects_are_read_more_often_after_training(tmp_path):
     trials = cohort(tmp_path, PROTOCOLS / "retention-transfer.json", 30, "foreign", "two-state", "learning")
     by_phase = trials.groupby("phase").legibility_top1.mean()
     assert by_phase["post-test"] > by_phase["pre-test"], by_phase.to_dict()
+
+
+def test_a_shaking_pen_is_read_in_bounded_memory(tmp_path):
+    """At 100 Hz with a guidance stiffness of 1e5 N/m on the emulated Phantom the pen shakes along its path;
+    zinnia, given such a stroke as it is, split it ever deeper and asked for gigabytes (std::bad_alloc). The
+    session must end normally within 3 GB of address space, every trial with its legibility."""
+    import resource
+    import sys
+
+    sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "study"))
+    from study_protocols import two_session_protocol
+
+    protocol = two_session_protocol("shaking")
+    protocol["phases"] = protocol["phases"][:3]
+    protocol["trial"] = {"max_duration_s": 20, "rate_hz": 100}
+    protocol["conditions"][1]["guidance_stiffness_n_per_m"] = 1e5
+    (tmp_path / "p.json").write_text(json.dumps(protocol, ensure_ascii=False), encoding="utf-8")
+
+    def limit():
+        resource.setrlimit(resource.RLIMIT_AS, (3 << 30, 3 << 30))
+
+    run = subprocess.run([os.environ["CALLIGRAPHY_CLI"], "session", "run", "p.json", "--writer", "simulated",
+                          "--subjects", "1", "--device", "emulated-phantom", "--out", "S"], cwd=tmp_path,
+                         capture_output=True, text=True, timeout=600, preexec_fn=limit)
+    assert run.returncode == 0, run.stderr
+    records = sorted((tmp_path / "S").rglob("trials/*.json"))
+    assert len(records) == 3
+    for record in records:
+        assert json.loads(record.read_text(encoding="utf-8"))["legibility"]["recogniser"] == "zinnia"
