@@ -6,12 +6,13 @@
 
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/render/guidance_mode.hpp"
-#include "calligraphy/study/trial_spec_runner.hpp"
 #include "calligraphy/core/unicode.hpp"
+#include "calligraphy/render/guidance_mode.hpp"
+#include "calligraphy/render/guidance_schedule.hpp"
+#include "calligraphy/study/trial_spec_runner.hpp"
 #include "study/json_reader.hpp"
-#include "study/saved_sessions.hpp"
 #include "study/names.hpp"
+#include "study/saved_sessions.hpp"
 
 namespace calligraphy::study_detail {
 namespace {
@@ -65,16 +66,33 @@ const PlannedTrial* previous_repetition(const std::vector<PlannedTrial>& plan, c
   return previous;
 }
 
+GuidanceSchedule condition_schedule(const StudyCondition& condition) {
+  GuidanceSchedule schedule;
+  schedule.adapts = condition.mode == ConditionMode::assist_as_needed ? AdaptiveGuidance::assist_as_needed
+                    : condition.mode == ConditionMode::skill_adaptive ? AdaptiveGuidance::skill_adaptive
+                                                                      : AdaptiveGuidance::fading;
+  schedule.start_gain = condition.start_gain;
+  schedule.start_band_m = condition.start_band_m;
+  schedule.fading_rule = condition.fading_rule;
+  schedule.assist_rule = condition.assist_rule;
+  schedule.skill_rule = condition.skill_rule;
+  return schedule;
+}
+
 PreparedGuidance repetition_guidance(const StudyCondition& condition, const PlannedTrial* previous,
                                      const json* previous_record, const std::string& source) {
+  // The one schedule (render/guidance_schedule.hpp), as the trainer and Python use it.
+  const GuidanceSchedule schedule = condition_schedule(condition);
+  const RepetitionGuidance first = schedule.start();
   PreparedGuidance prepared;
-  prepared.guidance.gain = condition.start_gain;
-  prepared.guidance.band_m = condition.start_band_m;
-  if (condition.mode == ConditionMode::skill_adaptive) prepared.guidance.mode = GuidanceMode::fixed;
+  prepared.guidance.gain = first.gain;
+  prepared.guidance.band_m = first.band_m;
+  if (condition.mode == ConditionMode::skill_adaptive) prepared.guidance.mode = first.mode;
   if (!previous || !previous_record) return prepared;
   const study_detail::JsonView record(*previous_record, "", source);
   prepared.previous_trial = SessionFolder::trial_stem(*previous);
-  if (!record.has("guidance")) study_detail::fail(source, "/guidance", "missing (required): no guidance to adapt from");
+  if (!record.has("guidance"))
+    study_detail::fail(source, "/guidance", "missing (required): no guidance to adapt from");
   const study_detail::JsonView guidance = record.object("guidance");
   if (condition.mode == ConditionMode::fading) prepared.previous_gain = guidance.number("gain", 0.0, 1e6);
   if (condition.mode == ConditionMode::assist_as_needed)
@@ -84,25 +102,15 @@ PreparedGuidance repetition_guidance(const StudyCondition& condition, const Plan
   // null when the repetition wrote nothing
   const std::optional<double> deviation_mm = record.optional_number("mean_deviation_mm", -1e12, 1e12);
   prepared.previous_deviation_mm = deviation_mm ? json(*deviation_mm) : json(nullptr);
-  // A repetition that wrote nothing gives no error to adapt on: full guidance again.
-  const bool wrote = prepared.previous_deviation_mm.is_number();
-  const double error_m = wrote ? prepared.previous_deviation_mm.get<double>() * 1e-3 : 0.0;
-  switch (condition.mode) {
-    case ConditionMode::fading:
-      prepared.guidance.gain =
-          wrote ? next_guidance_gain(prepared.previous_gain, error_m, condition.fading_rule) : 1.0;
-      break;
-    case ConditionMode::assist_as_needed:
-      prepared.guidance.band_m =
-          wrote ? next_assist_band(prepared.previous_band_m, error_m, condition.assist_rule)
-                : condition.assist_rule.min_band_m;
-      break;
-    case ConditionMode::skill_adaptive:
-      prepared.guidance.mode = skill_adaptive_mode(wrote ? error_m : std::nan(""), condition.skill_rule);
-      break;
-    default:
-      break;
-  }
+  if (!adapts_by_repetition(condition.mode)) return prepared;
+  RepetitionGuidance before = first;
+  before.gain = condition.mode == ConditionMode::fading ? prepared.previous_gain : first.gain;
+  before.band_m = condition.mode == ConditionMode::assist_as_needed ? prepared.previous_band_m : first.band_m;
+  const RepetitionGuidance following =
+      schedule.next(before, deviation_mm ? std::optional<double>(*deviation_mm * 1e-3) : std::nullopt);
+  prepared.guidance.gain = following.gain;
+  prepared.guidance.band_m = following.band_m;
+  if (condition.mode == ConditionMode::skill_adaptive) prepared.guidance.mode = following.mode;
   return prepared;
 }
 

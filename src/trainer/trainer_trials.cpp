@@ -11,8 +11,9 @@
 #include <vector>
 
 #include "calligraphy/core/atomic_file.hpp"
-#include "calligraphy/report/teacher_recording.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
+#include "calligraphy/render/guidance_schedule.hpp"
+#include "calligraphy/report/teacher_recording.hpp"
 #include "study/names.hpp"
 #include "trainer/trainer_app.hpp"
 
@@ -119,16 +120,27 @@ void TrainerApp::finish_trial() {
   view.metrics.time_s = writing.total_time_s;
   view.end_reason = result.abort_reason;
   if (result.end == TrialEnd::device_fault || result.end == TrialEnd::watchdog) status_ = 1;
-  if (guidance_ && mode_of(trial_options_.force.guidance_law) == GuidanceMode::fading &&
-      view.metrics.mean_deviation_m) {  // performance-based fading (Emken et al. 2007)
-    guidance_gain_ = next_guidance_gain(guidance_gain_, *view.metrics.mean_deviation_m);
-    std::fprintf(stderr, "calligraphy train: fading: next trial's guidance gain %.3f\n", guidance_gain_);
-  }
-  if (guidance_ && mode_of(trial_options_.force.guidance_law) == GuidanceMode::assist_as_needed &&
-      view.metrics.mean_deviation_m) {  // the band adapts to the error (next_assist_band)
-    assist_band_m_ = next_assist_band(assist_band_m_, *view.metrics.mean_deviation_m);
-    std::fprintf(stderr, "calligraphy train: assist-as-needed: next trial's band %.2f mm\n",
-                 assist_band_m_ * 1e3);
+  // The next trial's gain or band from this one's outcome, by the one schedule the studies use
+  // (render/guidance_schedule.hpp): a trial that wrote no stroke brings full guidance back.
+  if (guidance_ && (mode_of(trial_options_.force.guidance_law) == GuidanceMode::fading ||
+                    mode_of(trial_options_.force.guidance_law) == GuidanceMode::assist_as_needed)) {
+    GuidanceSchedule schedule;
+    schedule.adapts = mode_of(trial_options_.force.guidance_law) == GuidanceMode::fading
+                          ? AdaptiveGuidance::fading
+                          : AdaptiveGuidance::assist_as_needed;
+    RepetitionGuidance now;
+    now.mode = mode_of(trial_options_.force.guidance_law);
+    now.gain = guidance_gain_;
+    now.band_m = assist_band_m_;
+    const RepetitionGuidance next = schedule.next(now, view.metrics.mean_deviation_m);
+    guidance_gain_ = next.gain;
+    assist_band_m_ = next.band_m;
+    if (schedule.adapts == AdaptiveGuidance::fading) {
+      std::fprintf(stderr, "calligraphy train: fading: next trial's guidance gain %.3f\n", guidance_gain_);
+    } else {
+      std::fprintf(stderr, "calligraphy train: assist-as-needed: next trial's band %.2f mm\n",
+                   assist_band_m_ * 1e3);
+    }
   }
   // A teacher's recording must write every stroke as the renderer reads it (replay follows it stroke by
   // stroke); a completed quiz need not have.
