@@ -198,7 +198,7 @@ class OpenHapticsTestCase(unittest.TestCase):
         script = ("import calligraphy\n"
                   "survey = calligraphy.list_devices()\n"
                   "print([d.name for d in survey.devices])\n"
-                  "print(survey.problems)\n")
+                  "print(survey.notes)\n")
         if not PYTHONPATH or subprocess.run([sys.executable, "-c", "from calligraphy import list_devices"], env=env,
                                             capture_output=True, timeout=TIMEOUT_S).returncode != 0:
             self.skipTest(f"the calligraphy Python package does not import from {PYTHONPATH!r}")
