@@ -156,7 +156,7 @@ TEST_CASE("Without libHD: DeviceNotFound 'OpenHaptics not found' listing the pat
   {
     // A library that loads but is not libHD is rejected by its missing symbols, not crashed on.
     const ScopedLibhdPath path("libm.so.6");
-    CHECK(unavailable_message().find("libm.so.6 cannot be loaded: loaded, but lacks hdInitDevice") !=
+    CHECK(unavailable_message().find("libm.so.6 cannot be used: loaded, but lacks hdInitDevice") !=
           std::string::npos);
   }
 }

@@ -141,7 +141,8 @@ TrialResult run_real_time(HapticDevice& device, TrialHand* hand, TrialSession& s
 
 }  // namespace
 
-TrialResult run_trial(HapticDevice& device, const Scene& scene, const TrialOptions& options, TrialHand* hand) {
+TrialResult run_trial(HapticDevice& device, const Scene& scene, const TrialOptions& options,
+                      TrialHand* hand) {
   options.validate();
   if (hand == nullptr && options.pacing == TrialPacing::lock_step) {
     throw InvalidArgument("lock-step pacing needs a hand that moves the device (a simulated writer); '" +
@@ -149,8 +150,16 @@ TrialResult run_trial(HapticDevice& device, const Scene& scene, const TrialOptio
   }
   const bool real_time = hand == nullptr || options.pacing == TrialPacing::real_time;
   const DeviceShutdown shutdown(device, hand);
-  if (!device.is_open()) device.open();
-  if (!device.is_calibrated()) device.calibrate();
+  try {
+    if (!device.is_open()) device.open();
+    if (!device.is_calibrated()) device.calibrate();
+  } catch (const DeviceError&) {
+    // A stop asked for while the device was opening (a driver waited for, e.g. OpenHaptics' scheduler,
+    // gives up on it): an interrupted trial with nothing recorded, written like any other, not an error.
+    if (!options.should_stop || !options.should_stop()) throw;
+    TrialSession stopped(scene, device.info(), options);
+    return stopped.finish(TrialEnd::interrupted);
+  }
   // After open(): some devices know their limits only then (OpenHaptics reads them from the driver).
   TrialSession session(scene, device.info(), options);
   if (real_time) return run_real_time(device, hand, session, options);

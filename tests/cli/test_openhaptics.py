@@ -10,21 +10,33 @@ set up through its environment variables:
 - a CALLIGRAPHY_LIBHD that is not a loadable library (a folder, an empty, short, truncated or text file, a
   FIFO, /dev/zero, a missing file): commands that do not use OpenHaptics run as if it were not set and
   never load it, `devices` notes the path and why, `--device openhaptics` exits 1 naming them; nothing
-  crashes or hangs.
+  crashes or hangs;
+- a hostile driver (the stand-in's HD_STAND_IN_INIT, HD_STAND_IN_EXIT_ON_LOAD, HD_STAND_IN_SCHEDULER_STALLED):
+  one that crashes, hangs or exits in hdInitDevice or while loading is named by `devices`, `trial --device
+  openhaptics` and Python's list_devices() with what it did, the command itself survives; one whose
+  scheduler never runs leaves a trial that SIGTERM still ends (143, outputs written);
+- a CALLIGRAPHY_LIBHD refused for missing symbols is never replaced by a libHD.so on the search path.
 
-CALLIGRAPHY_CLI names the program, CALLIGRAPHY_HD_STAND_IN the stand-in. Standard library only (unittest).
+CALLIGRAPHY_CLI names the program, CALLIGRAPHY_HD_STAND_IN the stand-in, CALLIGRAPHY_HD_PARTIAL a libHD with
+hdInitDevice only, CALLIGRAPHY_PYTHONPATH the Python package (its test is skipped when it does not import).
+Standard library only (unittest).
 """
 import csv
 import json
 import os
 import shutil
+import signal
 import subprocess
+import sys
 import tempfile
+import time
 import unittest
 from pathlib import Path
 
 CLI = os.environ.get("CALLIGRAPHY_CLI", "")
 STAND_IN = os.environ.get("CALLIGRAPHY_HD_STAND_IN", "")
+PARTIAL = os.environ.get("CALLIGRAPHY_HD_PARTIAL", "")
+PYTHONPATH = os.environ.get("CALLIGRAPHY_PYTHONPATH", "")
 YONG = "永"
 TIMEOUT_S = 120  # a hang fails the case instead of blocking CTest
 
@@ -146,6 +158,115 @@ class OpenHapticsTestCase(unittest.TestCase):
         # The marker does work: `devices` probes every backend and so loads it.
         self.run_cli("devices", CALLIGRAPHY_LIBHD=STAND_IN, HD_STAND_IN_LOADED_MARKER=str(marker))
         self.assertTrue(marker.exists())
+
+    # The stand-in misbehaving in the probe process, and what each command must say about it.
+    HOSTILE = {
+        "crash in hdInitDevice": ({"HD_STAND_IN_INIT": "crash"},
+                                  "the driver crashed with SIGSEGV while initialising the device"),
+        "hang in hdInitDevice": ({"HD_STAND_IN_INIT": "hang"}, "did not return from hdInitDevice within 5 s"),
+        "exit(0) while loading": ({"HD_STAND_IN_EXIT_ON_LOAD": "0"},
+                                  "the driver library exited the process (status 0) while loading"),
+        "exit(0) in hdInitDevice": ({"HD_STAND_IN_INIT": "exit:0"},
+                                    "the driver library exited the process (status 0) while initialising"),
+    }
+
+    def test_a_driver_that_crashes_hangs_or_exits_is_named_and_the_command_survives(self):
+        for name, (misbehaviour, why) in self.HOSTILE.items():
+            with self.subTest(name):
+                listing = self.run_cli("devices", CALLIGRAPHY_LIBHD=STAND_IN, **misbehaviour)
+                self.assertEqual(listing.returncode, 0, listing.stderr.decode())
+                notes = [line for line in listing.stdout.decode().splitlines() if "openhaptics:" in line]
+                self.assertEqual(len(notes), 1, listing.stdout.decode())
+                self.assertIn(STAND_IN, notes[0])
+                self.assertIn(why, notes[0])
+                self.assertIn("simulated", listing.stdout.decode())  # the rest of the listing is there
+                trial = self.dir / "hostile.json"
+                trial.unlink(missing_ok=True)
+                asked = self.run_cli("trial", YONG, "--device", "openhaptics", "--json", trial,
+                                     CALLIGRAPHY_LIBHD=STAND_IN, **misbehaviour)
+                message = asked.stderr.decode()
+                self.assertEqual(asked.returncode, 1, message)
+                errors = [line for line in message.splitlines() if "error:" in line]
+                self.assertEqual(len(errors), 1, message)
+                self.assertIn(STAND_IN, errors[0])
+                self.assertIn(why, errors[0])
+                self.assertFalse(trial.exists())
+
+    def test_python_list_devices_names_a_driver_that_crashes(self):
+        env = {k: v for k, v in os.environ.items() if not k.startswith(("CALLIGRAPHY_LIBHD", "HD_STAND_IN_"))}
+        env.update(PYTHONPATH=PYTHONPATH, CALLIGRAPHY_LIBHD=STAND_IN, HD_STAND_IN_INIT="crash")
+        script = ("import calligraphy\n"
+                  "survey = calligraphy.list_devices()\n"
+                  "print([d.name for d in survey.devices])\n"
+                  "print(survey.notes)\n")
+        if not PYTHONPATH or subprocess.run([sys.executable, "-c", "from calligraphy import list_devices"], env=env,
+                                            capture_output=True, timeout=TIMEOUT_S).returncode != 0:
+            self.skipTest(f"the calligraphy Python package does not import from {PYTHONPATH!r}")
+        result = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, timeout=TIMEOUT_S)
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
+        output = result.stdout.decode()
+        self.assertIn("simulated", output)
+        self.assertIn(STAND_IN, output)
+        self.assertIn("the driver crashed with SIGSEGV while initialising the device", output)
+
+    def test_sigterm_ends_a_trial_whose_driver_scheduler_never_runs(self):
+        out = self.dir / "stalled.json"
+        trace = self.dir / "stalled.csv"
+        for path in (out, trace):
+            path.unlink(missing_ok=True)
+        env = {k: v for k, v in os.environ.items() if not k.startswith(("CALLIGRAPHY_LIBHD", "HD_STAND_IN_"))}
+        env.update(CALLIGRAPHY_LIBHD=STAND_IN, HD_STAND_IN_SCHEDULER_STALLED="1")
+        process = subprocess.Popen([CLI, "trial", YONG, "--device", "openhaptics", "--json", str(out), "--csv",
+                                    str(trace)], cwd=self.dir, env=env, stdout=subprocess.PIPE,
+                                   stderr=subprocess.PIPE)
+        # The trial waits for the driver's first callback; the signal must end that wait, whenever it comes.
+        time.sleep(1.0)
+        process.send_signal(signal.SIGTERM)
+        try:
+            _, stderr = process.communicate(timeout=TIMEOUT_S)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.communicate()
+            self.fail("SIGTERM did not end a trial whose driver scheduler never runs")
+        message = stderr.decode()
+        self.assertEqual(process.returncode, 143, message)
+        self.assertIn("stopped by SIGTERM", message)
+        record = json.loads(out.read_text())
+        self.assertEqual(record["end_reason"], "interrupted")
+        self.assertEqual(record["max_force_n"], 0.0)  # no force was ever commanded
+        with open(trace, newline="") as f:
+            rows = list(csv.DictReader(f))
+        self.assertTrue(all(float(row[k]) == 0.0 for row in rows for k in ("fx", "fy", "fz")))
+
+    def test_a_trial_whose_driver_scheduler_never_runs_ends_with_the_reason(self):
+        asked = self.run_cli("trial", YONG, "--device", "openhaptics", CALLIGRAPHY_LIBHD=STAND_IN,
+                             HD_STAND_IN_SCHEDULER_STALLED="1")
+        message = asked.stderr.decode()
+        self.assertEqual(asked.returncode, 1, message)
+        self.assertIn(STAND_IN, message)
+        self.assertIn("ran no callback within 5 s", message)
+
+    def test_a_named_library_refused_for_missing_symbols_is_not_replaced(self):
+        if not PARTIAL or not Path(PARTIAL).exists():
+            self.skipTest(f"CALLIGRAPHY_HD_PARTIAL={PARTIAL!r} is not the partial libHD")
+        # The stand-in is on the search path as libHD.so: a fallback would find it and list the device.
+        search = {"LD_LIBRARY_PATH": str(Path(STAND_IN).parent)}
+        found = self.run_cli("devices", **search).stdout.decode()
+        self.assertIn("via libHD.so", found)  # the fallback a refused named library must not reach
+        listing = self.run_cli("devices", CALLIGRAPHY_LIBHD=PARTIAL, **search)
+        self.assertEqual(listing.returncode, 0, listing.stderr.decode())
+        output = listing.stdout.decode()
+        self.assertNotIn("via ", output)
+        notes = [line for line in output.splitlines() if "openhaptics:" in line]
+        self.assertEqual(len(notes), 1, output)
+        self.assertIn("CALLIGRAPHY_LIBHD=" + PARTIAL, notes[0])
+        self.assertIn("lacks hdDisableDevice", notes[0])
+        asked = self.run_cli("trial", YONG, "--device", "openhaptics", CALLIGRAPHY_LIBHD=PARTIAL, **search)
+        message = asked.stderr.decode()
+        self.assertEqual(asked.returncode, 1, message)
+        self.assertIn(PARTIAL, message)
+        self.assertIn("lacks hdDisableDevice", message)
+        self.assertNotIn(STAND_IN, message)
 
 
 if __name__ == "__main__":

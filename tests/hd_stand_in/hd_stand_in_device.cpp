@@ -1,7 +1,11 @@
 // hd_stand_in_device.cpp - HDAPI device routines of the stand-in libHD.so:
 // error stack, device handles, haptic frames, parameter get/set,
 // capabilities and calibration.
+#include <unistd.h>
+
 #include <cmath>
+#include <csignal>
+#include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <type_traits>
@@ -466,6 +470,17 @@ HDstring hdGetErrorString(HDerror code) {
 
 HHD hdInitDevice(HDstring pConfigName) {
   Lib& L = lib();
+  switch (environment_faults().init) {  // a hostile driver (HD_STAND_IN_INIT)
+    case InitMisbehaviour::crash:
+      std::raise(SIGSEGV);
+      break;
+    case InitMisbehaviour::hang:
+      for (;;) ::pause();
+    case InitMisbehaviour::exit:
+      std::exit(environment_faults().exit_status);
+    case InitMisbehaviour::none:
+      break;
+  }
   const HDerror fail = L.fail_init.load();
   if (fail != HD_SUCCESS) {
     const int fault = L.fail_init_fault.load();

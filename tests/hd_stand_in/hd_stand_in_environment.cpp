@@ -5,14 +5,54 @@
 //                                frame), t non-decreasing, from the scheduler's first tick
 //   HD_STAND_IN_LOADED_MARKER=FILE  FILE is created when the library is loaded (in any process): a test
 //                                can tell that a command never loaded it
+//   HD_STAND_IN_EXIT_ON_LOAD=STATUS  the library's constructor calls exit(STATUS)
+//   HD_STAND_IN_INIT=crash|hang|exit:STATUS  hdInitDevice raises SIGSEGV, never returns, or calls exit
+//   HD_STAND_IN_SCHEDULER_STALLED=1  hdStartScheduler succeeds but its thread never runs a tick
 // A value that cannot be read is reported on stderr and ignored.
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <vector>
 
 #include "hd_stand_in_control.h"
+#include "hd_stand_in_state.h"
 
 namespace {
+
+hdsi::EnvironmentFaults faults;
+
+bool read_status(const char* text, int& status) {
+  char* end = nullptr;
+  const long value = std::strtol(text, &end, 0);
+  if (end == text || *end != '\0' || value < 0 || value > 255) return false;
+  status = static_cast<int>(value);
+  return true;
+}
+
+void read_faults() {
+  if (const char* exit_status = std::getenv("HD_STAND_IN_EXIT_ON_LOAD");
+      exit_status != nullptr && *exit_status) {
+    int status = 0;
+    if (read_status(exit_status, status)) std::exit(status);
+    std::fprintf(stderr, "hd_stand_in: HD_STAND_IN_EXIT_ON_LOAD=%s is not a status 0..255; ignored\n",
+                 exit_status);
+  }
+  if (const char* init = std::getenv("HD_STAND_IN_INIT"); init != nullptr && *init) {
+    if (std::strcmp(init, "crash") == 0) {
+      faults.init = hdsi::InitMisbehaviour::crash;
+    } else if (std::strcmp(init, "hang") == 0) {
+      faults.init = hdsi::InitMisbehaviour::hang;
+    } else if (std::strncmp(init, "exit:", 5) == 0 && read_status(init + 5, faults.exit_status)) {
+      faults.init = hdsi::InitMisbehaviour::exit;
+    } else {
+      std::fprintf(stderr, "hd_stand_in: HD_STAND_IN_INIT=%s is not crash, hang or exit:STATUS; ignored\n",
+                   init);
+    }
+  }
+  if (const char* stalled = std::getenv("HD_STAND_IN_SCHEDULER_STALLED"); stalled != nullptr && *stalled) {
+    faults.scheduler_stalled = std::strcmp(stalled, "0") != 0;
+  }
+}
 
 void load_path(const char* file_name) {
   std::FILE* file = std::fopen(file_name, "r");
@@ -37,6 +77,7 @@ __attribute__((constructor)) void configure_from_environment() {
   if (const char* marker = std::getenv("HD_STAND_IN_LOADED_MARKER"); marker != nullptr && *marker != '\0') {
     if (std::FILE* file = std::fopen(marker, "a")) std::fclose(file);
   }
+  read_faults();
   if (const char* code = std::getenv("HD_STAND_IN_FAIL_INIT"); code != nullptr && *code != '\0') {
     char* end = nullptr;
     const unsigned long value = std::strtoul(code, &end, 0);
@@ -50,3 +91,5 @@ __attribute__((constructor)) void configure_from_environment() {
 }
 
 }  // namespace
+
+const hdsi::EnvironmentFaults& hdsi::environment_faults() { return faults; }

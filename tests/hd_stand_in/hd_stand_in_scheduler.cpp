@@ -245,6 +245,10 @@ void servo_main() {
   std::int64_t deadline = mono_ns();
   std::int64_t prev_start = 0;
   bool first = true;
+  if (environment_faults().scheduler_stalled) {  // HD_STAND_IN_SCHEDULER_STALLED: alive, never ticks
+    while (!L.stop.load(std::memory_order_acquire)) sleep_until(mono_ns() + 1'000'000);
+    return;
+  }
   while (!L.stop.load(std::memory_order_acquire)) {
     const unsigned long rate = L.rate_hz.load();
     const std::int64_t period = kNsPerS / static_cast<std::int64_t>(rate);

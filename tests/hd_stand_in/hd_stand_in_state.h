@@ -177,6 +177,16 @@ struct Lib {
 };
 
 Lib& lib();
+
+// Misbehaviours of a hostile driver, set from the environment when the library loads
+// (hd_stand_in_environment.cpp), for tests of a caller that must survive them.
+enum class InitMisbehaviour { none, crash, hang, exit };
+struct EnvironmentFaults {
+  InitMisbehaviour init = InitMisbehaviour::none;  // in hdInitDevice
+  int exit_status = 0;                             // for InitMisbehaviour::exit
+  bool scheduler_stalled = false;                  // hdStartScheduler succeeds, no tick ever runs
+};
+const EnvironmentFaults& environment_faults();
 extern thread_local bool tl_on_servo;
 
 std::int64_t mono_ns();

@@ -5,6 +5,7 @@
 #include <cstdlib>
 
 #include "calligraphy/core/errors.hpp"
+#include "devices/openhaptics/hd_probe.hpp"
 #include "devices/shared_library_check.hpp"
 
 namespace calligraphy::openhaptics {
@@ -40,26 +41,37 @@ std::vector<std::string> HdLibrary::candidate_paths() {
   return paths;
 }
 
-std::shared_ptr<const HdLibrary> HdLibrary::load() {
+std::shared_ptr<const HdLibrary> HdLibrary::load(const std::string& configuration) {
   std::string tried;
   const char* explicit_path = std::getenv("CALLIGRAPHY_LIBHD");
   for (const auto& path : candidate_paths()) {
     const bool named_by_user = explicit_path != nullptr && path == explicit_path;
-    // A path is checked before this process maps it, and a file that passes is loaded once in a child
-    // process first: a damaged library must not take the caller down (SIGBUS) or hang it (a FIFO).
-    std::string problem = path.find('/') != std::string::npos ? devices::shared_library_problem(path) : "";
-    if (problem.empty()) problem = devices::probe_shared_library(path, "hdInitDevice");
-    if (!problem.empty()) {
+    // A library the user named and that is refused is an error, never replaced by another libHD found
+    // on the search path: the session would run on a driver nobody chose.
+    const auto refuse = [&](const std::string& problem) {
       if (named_by_user)
-        throw DeviceUnavailable("OpenHaptics: CALLIGRAPHY_LIBHD=" + path + " cannot be loaded: " + problem +
-                                "; set it to the full path of libHD.so, or unset it");
+        throw DeviceUnavailable("OpenHaptics: CALLIGRAPHY_LIBHD=" + path + " cannot be used: " + problem +
+                                "; set it to the full path of a working libHD.so, or unset it");
       tried += "\n  " + path + ": " + problem;
+    };
+    // A path is checked before any process maps it (a truncated file raises SIGBUS, a FIFO blocks), then
+    // loaded and its device initialised in a probe process: only a driver that neither crashes, hangs nor
+    // exits there is loaded into this process.
+    const std::string problem =
+        path.find('/') != std::string::npos ? devices::shared_library_problem(path) : "";
+    if (!problem.empty()) {
+      refuse(problem);
+      continue;
+    }
+    const HdProbeResult probe = probe_hd_library(path, configuration);
+    if (!probe.problem.empty()) {
+      refuse(probe.problem);
       continue;
     }
     void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
     if (handle == nullptr) {
       const char* why = dlerror();
-      tried += "\n  " + path + ": " + (why != nullptr ? why : "not loadable");
+      refuse(why != nullptr ? why : "not loadable");
       continue;
     }
     std::shared_ptr<HdLibrary> library(new HdLibrary);
@@ -85,9 +97,11 @@ std::shared_ptr<const HdLibrary> HdLibrary::load() {
     bind(handle, "hdCheckCalibration", library->check_calibration, missing);
     bind(handle, "hdUpdateCalibration", library->update_calibration, missing);
     // Optional: without it the scheduler keeps its default rate, 1000 Hz (HDAPI reference).
-    library->set_scheduler_rate = reinterpret_cast<hd::SetSchedulerRateFn>(dlsym(handle, "hdSetSchedulerRate"));
+    library->set_scheduler_rate =
+        reinterpret_cast<hd::SetSchedulerRateFn>(dlsym(handle, "hdSetSchedulerRate"));
     if (missing.empty()) return library;
-    tried += "\n  " + path + ": loaded, but lacks " + missing;
+    library.reset();  // unloaded before the next candidate, or before the error
+    refuse("loaded, but lacks " + missing);
   }
   throw DeviceNotFound("OpenHaptics not found: libHD.so could not be loaded; tried:" + tried +
                        "\n(set CALLIGRAPHY_LIBHD to the full path of libHD.so)");

@@ -15,11 +15,13 @@ class HdLibrary {
   /// usual install locations.
   [[nodiscard]] static std::vector<std::string> candidate_paths();
   /// Loads the first candidate that opens and has every symbol. A candidate that is a path is checked
-  /// first (shared_library_check.hpp) and every candidate is loaded once in a child process before this
-  /// one maps it, so a damaged file cannot crash or hang the caller. Throws DeviceUnavailable naming
-  /// $CALLIGRAPHY_LIBHD and why when that path is not a loadable library, else DeviceNotFound
-  /// "OpenHaptics not found" listing each path tried and why it failed.
-  [[nodiscard]] static std::shared_ptr<const HdLibrary> load();
+  /// first (shared_library_check.hpp), and every candidate is loaded and its device (`configuration`,
+  /// empty: the default) initialised and released in a probe process (hd_probe.hpp) before this process
+  /// maps it, so a damaged file or a driver that crashes, hangs or exits cannot take the caller down.
+  /// Throws DeviceUnavailable naming $CALLIGRAPHY_LIBHD and why when that library is refused (then no
+  /// other is tried), else DeviceNotFound "OpenHaptics not found" listing each path tried and why it
+  /// failed. An HD error of hdInitDevice in the probe is not a refusal: the caller meets it again.
+  [[nodiscard]] static std::shared_ptr<const HdLibrary> load(const std::string& configuration = {});
 
   ~HdLibrary();
   HdLibrary(const HdLibrary&) = delete;

@@ -2,10 +2,10 @@
 #include <memory>
 
 #include "calligraphy/core/errors.hpp"
-#include "devices/standard_backends.hpp"
 #include "devices/openhaptics/hd_errors.hpp"
 #include "devices/openhaptics/hd_library.hpp"
 #include "devices/openhaptics/openhaptics_device.hpp"
+#include "devices/standard_backends.hpp"
 
 namespace calligraphy::openhaptics {
 namespace {
@@ -17,7 +17,8 @@ DeviceSurvey scan() {
   } catch (const DeviceError& e) {  // not found, or a damaged CALLIGRAPHY_LIBHD
     return DeviceSurvey{{}, {std::string("openhaptics: ") + e.what()}};
   }
-  // Like CHAI3D: initialise the default device to learn whether one is there and what it can do.
+  // Like CHAI3D: initialise the default device to learn whether one is there and what it can do (the
+  // probe in load() did so first in a process of its own, so a driver that crashes there is named).
   const hd::HHD handle = library->init_device(nullptr);
   if (const hd::HDErrorInfo error = library->get_error(); error.errorCode != hd::HD_SUCCESS) {
     return DeviceSurvey{

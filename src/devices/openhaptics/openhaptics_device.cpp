@@ -1,7 +1,5 @@
 #include "devices/openhaptics/openhaptics_device.hpp"
 
-#include "core/library_log.hpp"
-
 #include <chrono>
 #include <cmath>
 #include <thread>
@@ -9,6 +7,8 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/force_limits.hpp"
+#include "calligraphy/core/stop_signals.hpp"
+#include "core/library_log.hpp"
 #include "devices/openhaptics/hd_conversions.hpp"
 #include "devices/openhaptics/hd_errors.hpp"
 
@@ -16,6 +16,9 @@ namespace calligraphy::openhaptics {
 namespace {
 
 constexpr double kDefaultSchedulerRateHz = 1000.0;  // HDAPI reference: the scheduler's default rate
+// How long a call into the scheduler may wait for its callback to run: a running scheduler calls within a
+// period, so seconds mean that the driver's servo thread does not run.
+constexpr double kSchedulerCallTimeoutS = 5.0;
 
 double monotonic_seconds() noexcept {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -60,7 +63,7 @@ void OpenHapticsDevice::read_info() {
 
 void OpenHapticsDevice::open() {
   if (open_) return;
-  library_ = HdLibrary::load();  // DeviceNotFound "OpenHaptics not found ..."
+  library_ = HdLibrary::load(configuration_name_);  // probed in a child process first (hd_probe.hpp)
   calligraphy::detail::library_log().warn(
       "OpenHaptics: using {}; this backend was tested against a stand-in libHD written from the public HDAPI "
       "reference (frames, scheduler, errors, calibration, faults), never against 3D Systems' libHD and an "
@@ -97,16 +100,16 @@ void OpenHapticsDevice::open() {
     library_->start_scheduler();
     throw_if_error(*library_, "starting the scheduler");
     open_ = true;
-    library_->schedule_synchronous(&OpenHapticsDevice::calibration_check, this,
-                                   hd::HD_DEFAULT_SCHEDULER_PRIORITY);
+    call_in_scheduler(&OpenHapticsDevice::calibration_check, "checking the calibration");
     calibrated_.store(calibration_result_ == hd::HD_CALIBRATION_OK);
   } catch (...) {
     open_ = true;  // let close() undo what was done
     close();
     throw;
   }
-  calligraphy::detail::library_log().info("OpenHaptics: opened {} ({}), max force {} N, {}", info_.model, info_.manufacturer,
-               info_.max_force_n, is_calibrated() ? "calibrated" : "needs calibrate()");
+  calligraphy::detail::library_log().info("OpenHaptics: opened {} ({}), max force {} N, {}", info_.model,
+                                          info_.manufacturer, info_.max_force_n,
+                                          is_calibrated() ? "calibrated" : "needs calibrate()");
 }
 
 void OpenHapticsDevice::close() noexcept {
@@ -116,8 +119,8 @@ void OpenHapticsDevice::close() noexcept {
   }
   if (const hd::HDerror error = scheduler_error_.load(); error != hd::HD_SUCCESS) {
     try {  // the servo path kept only the code; it is worded here, off the servo thread
-      calligraphy::detail::library_log().warn("OpenHaptics: the scheduler reported {} ({}) during the run", hd_error_name(error),
-                   device_fault_name(hd_servo_fault(error)));
+      calligraphy::detail::library_log().warn("OpenHaptics: the scheduler reported {} ({}) during the run",
+                                              hd_error_name(error), device_fault_name(hd_servo_fault(error)));
     } catch (...) {
       // Logging must not turn close() into a throwing call.
     }
@@ -133,6 +136,50 @@ void OpenHapticsDevice::close() noexcept {
   open_ = false;
 }
 
+namespace {
+
+// One call of a device function in the scheduler's thread, and whether it ran.
+struct SchedulerCall {
+  OpenHapticsDevice* device;
+  hd::SchedulerCallback function;
+  std::atomic<bool> done{false};
+};
+
+hd::HDCallbackCode run_scheduler_call(void* context) noexcept {
+  auto* call = static_cast<SchedulerCall*>(context);
+  call->function(call->device);
+  call->done.store(true, std::memory_order_release);
+  return hd::HD_CALLBACK_DONE;
+}
+
+}  // namespace
+
+// hdScheduleSynchronous would block for as long as the driver's scheduler does not run, deaf to Ctrl-C:
+// the call is scheduled asynchronously instead and waited for here, bounded and polling the stop signals.
+void OpenHapticsDevice::call_in_scheduler(hd::SchedulerCallback function, const char* what) {
+  SchedulerCall call{this, function};
+  const hd::HDSchedulerHandle handle =
+      library_->schedule_asynchronous(&run_scheduler_call, &call, hd::HD_DEFAULT_SCHEDULER_PRIORITY);
+  throw_if_error(*library_, std::string("scheduling a call (") + what + ")");
+  const double give_up = monotonic_seconds() + kSchedulerCallTimeoutS;
+  int signal = 0;
+  while (!call.done.load(std::memory_order_acquire)) {
+    signal = StopSignals::received();
+    if (signal != 0 || monotonic_seconds() > give_up) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  if (call.done.load(std::memory_order_acquire)) return;
+  library_->unschedule(handle);  // returns once the call is not running: `call` may go
+  if (call.done.load(std::memory_order_acquire)) return;
+  if (signal != 0) {
+    throw DeviceError(std::string("OpenHaptics: stopped by ") + signal_name(signal) +
+                      " while waiting for the HD scheduler of " + library_->path + " (" + what + ")");
+  }
+  throw DeviceError("OpenHaptics: the HD scheduler of " + library_->path + " ran no callback within " +
+                    std::to_string(static_cast<int>(kSchedulerCallTimeoutS)) + " s (" + what +
+                    "): hdStartScheduler returned, but the driver's servo loop does not run");
+}
+
 hd::HDCallbackCode OpenHapticsDevice::calibration_check(void* self) noexcept {
   auto* device = static_cast<OpenHapticsDevice*>(self);
   device->calibration_result_ = device->library_->check_calibration();
@@ -141,8 +188,7 @@ hd::HDCallbackCode OpenHapticsDevice::calibration_check(void* self) noexcept {
 
 void OpenHapticsDevice::calibrate() {
   if (!open_) throw DeviceError("OpenHaptics: calibrate() on a device that is not open");
-  library_->schedule_synchronous(&OpenHapticsDevice::calibration_check, this,
-                                 hd::HD_DEFAULT_SCHEDULER_PRIORITY);
+  call_in_scheduler(&OpenHapticsDevice::calibration_check, "checking the calibration");
   if (calibration_result_ == hd::HD_CALIBRATION_NEEDS_UPDATE) {
     hd::HDint styles = 0;
     library_->get_integerv(hd::HD_CALIBRATION_STYLE, &styles);
@@ -153,8 +199,7 @@ void OpenHapticsDevice::calibrate() {
                                 : hd::HD_CALIBRATION_INKWELL;
     library_->update_calibration(style);
     throw_if_error(*library_, "hdUpdateCalibration");
-    library_->schedule_synchronous(&OpenHapticsDevice::calibration_check, this,
-                                   hd::HD_DEFAULT_SCHEDULER_PRIORITY);
+    call_in_scheduler(&OpenHapticsDevice::calibration_check, "checking the calibration");
   }
   if (calibration_result_ == hd::HD_CALIBRATION_NEEDS_MANUAL_INPUT) {
     calibrated_.store(false);

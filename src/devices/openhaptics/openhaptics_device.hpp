@@ -67,6 +67,9 @@ class OpenHapticsDevice final : public HapticDevice, public DeviceServoClock {
   static hd::HDCallbackCode servo_tick(void* self) noexcept;
   static hd::HDCallbackCode calibration_check(void* self) noexcept;
   void read_info();
+  /// Runs `function(this)` once in the HD scheduler's thread and waits for it: at most 5 s, and not past a
+  /// stop signal (stop_signals.hpp). Throws DeviceError naming the library when it did not run.
+  void call_in_scheduler(hd::SchedulerCallback function, const char* what);
 
   void publish_frame_state() noexcept;  // frame_state_ for readers on other threads
 
