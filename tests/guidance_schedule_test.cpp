@@ -40,7 +40,7 @@ const std::vector<std::optional<double>> kOutcomes = {0.002, 0.001, std::nullopt
 
 }  // namespace
 
-TEST_CASE("fading follows g(n+1) = clamp(f g(n) + k e(n), 0, 1); nothing written brings full guidance back",
+TEST_CASE("fading follows Emken's rule and a repetition with nothing written brings full guidance back",
           "[guidance][schedule]") {
   GuidanceSchedule schedule;
   schedule.start_gain = 0.5;
@@ -68,15 +68,9 @@ TEST_CASE("a study's repetition guidance from its records is the trainer's sched
     condition.fading_rule.forgetting_factor = 0.7;
     condition.assist_rule.target_error_m = 0.001;
     condition.skill_rule.threshold_m = 0.0015;
-    GuidanceSchedule schedule;
-    schedule.adapts = mode == ConditionMode::fading             ? AdaptiveGuidance::fading
-                      : mode == ConditionMode::assist_as_needed ? AdaptiveGuidance::assist_as_needed
-                                                                : AdaptiveGuidance::skill_adaptive;
-    schedule.start_gain = condition.start_gain;
-    schedule.start_band_m = condition.start_band_m;
-    schedule.fading_rule = condition.fading_rule;
-    schedule.assist_rule = condition.assist_rule;
-    schedule.skill_rule = condition.skill_rule;
+    const GuidanceSchedule schedule = study_detail::condition_schedule(condition);
+    REQUIRE(schedule.start_gain == condition.start_gain);
+    REQUIRE(schedule.fading_rule.forgetting_factor == condition.fading_rule.forgetting_factor);
     RepetitionGuidance in_memory = schedule.start();
     RepetitionGuidance from_records = in_memory;
     const study_detail::PreparedGuidance first =

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "calligraphy/model/scene.hpp"
+#include "calligraphy/render/guidance_schedule.hpp"
 #include "calligraphy/report/teacher_recording.hpp"
 #include "calligraphy/study/session_folder.hpp"
 #include "calligraphy/study/session_runner.hpp"
@@ -53,6 +54,9 @@ const PlannedTrial* previous_repetition(const std::vector<PlannedTrial>& plan, c
 /// DataError naming `source` when the record lacks the guidance or the deviation.
 PreparedGuidance repetition_guidance(const StudyCondition& condition, const PlannedTrial* previous,
                                      const nlohmann::json* previous_record, const std::string& source);
+
+/// The schedule of `condition`'s adaptive guidance (render/guidance_schedule.hpp): its mode, start and rules.
+GuidanceSchedule condition_schedule(const StudyCondition& condition);
 
 /// The force law of a trial of `condition`: `force` (made from the trial's specification, fitted to the
 /// device) with what the condition sets beyond the specification, each where the protocol gives it: the

@@ -114,38 +114,33 @@ __attribute__((destructor)) static void write_counts(void) {
 
 static int open_flags_create_or_write(int flags) { return (flags & (O_WRONLY | O_RDWR | O_CREAT)) != 0; }
 
+// The mode argument an open that creates a file passes after its flags (a GNU statement expression).
+#define MODE_AFTER(flags)                         \
+  __extension__({                                 \
+    mode_t mode_ = 0;                             \
+    if ((flags) & (O_CREAT | O_TMPFILE)) {        \
+      va_list arguments_;                         \
+      va_start(arguments_, flags);                \
+      mode_ = va_arg(arguments_, mode_t);         \
+      va_end(arguments_);                         \
+    }                                             \
+    mode_;                                        \
+  })
+
 int open(const char* path, int flags, ...) {
-  mode_t mode = 0;
-  if (flags & (O_CREAT | O_TMPFILE)) {
-    va_list arguments;
-    va_start(arguments, flags);
-    mode = va_arg(arguments, mode_t);
-    va_end(arguments);
-  }
+  const mode_t mode = MODE_AFTER(flags);
   if (open_flags_create_or_write(flags) && fault(k_open, path_is_under(path)) != 0) return -1;
   return NEXT(open)(path, flags, mode);
 }
 
 int open64(const char* path, int flags, ...) {
-  mode_t mode = 0;
-  if (flags & (O_CREAT | O_TMPFILE)) {
-    va_list arguments;
-    va_start(arguments, flags);
-    mode = va_arg(arguments, mode_t);
-    va_end(arguments);
-  }
+  const mode_t mode = MODE_AFTER(flags);
   if (open_flags_create_or_write(flags) && fault(k_open, path_is_under(path)) != 0) return -1;
   return NEXT(open64)(path, flags, mode);
 }
 
 int openat(int folder, const char* path, int flags, ...) {
-  mode_t mode = 0;
-  if (flags & (O_CREAT | O_TMPFILE)) {
-    va_list arguments;
-    va_start(arguments, flags);
-    mode = va_arg(arguments, mode_t);
-    va_end(arguments);
-  }
+  const mode_t mode = MODE_AFTER(flags);
   const int counted = folder == AT_FDCWD || (path[0] == '/') ? path_is_under(path) : fd_is_under(folder);
   if (open_flags_create_or_write(flags) && fault(k_open, counted) != 0) return -1;
   return NEXT(openat)(folder, path, flags, mode);
