@@ -4,10 +4,13 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <bit>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -321,7 +324,8 @@ TEST_CASE("A trial's trace is streamed row by row with its in-plane force over a
   options.paper_z_m = paper_z_m;
   options.read_force = true;
   std::vector<PenTraceRow> rows;
-  for_each_pen_trace_row(file.path, test_placement(), options, [&rows](const PenTraceRow& r) { rows.push_back(r); });
+  for_each_pen_trace_row(file.path, test_placement(), options,
+                         [&rows](const PenTraceRow& r) { rows.push_back(r); });
   REQUIRE(rows.size() == 3);
   CHECK(rows[0].sample.pen_down);
   CHECK_FALSE(rows[1].sample.pen_down);
@@ -343,4 +347,97 @@ TEST_CASE("A trial's trace is streamed row by row with its in-plane force over a
                     Catch::Contains("trace.csv:2:") && Catch::Contains("(fy)"));
   options.paper_z_m = std::nan("");
   CHECK_THROWS_AS(read_pen_trace_csv(file.path, test_placement(), options), InvalidArgument);
+}
+
+TEST_CASE("A trial's trace reads to the same samples by the fast way and the general one",
+          "[pen_trace_csv]") {
+  // Rows of plain decimals go the fast way (one pass over the line); the same rows with their fields padded
+  // with blanks, a comment between them and CR LF ends go the general way (fields split and trimmed, each
+  // number through parse_finite_double): every sample must be the same double for double.
+  std::vector<TrialSample> trace(20000);
+  std::mt19937_64 random(11);
+  std::uniform_real_distribution<double> metres(-0.1, 0.1), newtons(-3.0, 3.0), step(0.0, 0.002);
+  double t = 0.0;
+  for (TrialSample& s : trace) {
+    s.time_s = t;
+    t += step(random);
+    s.position_m = Vec3(metres(random), metres(random), 0.01 + metres(random) / 100.0);
+    s.force_n = Vec3(newtons(random), newtons(random), newtons(random));
+  }
+  trace[6].force_n.x() = 1e15;  // a fault's value, written in the shortest round-trip text: the general way
+  const std::string fast = trial_csv(trace);
+  std::string general;
+  for (std::size_t start = 0; start < fast.size();) {
+    const std::size_t end = fast.find('\n', start);
+    std::string line = fast.substr(start, end - start);
+    for (std::size_t comma = 0; (comma = line.find(',', comma)) != std::string::npos; comma += 3)
+      line.replace(comma, 1, " , ");
+    general += " " + line + " \r\n# a comment\r\n";
+    start = end + 1;
+  }
+  for (const TraceUnits units : {TraceUnits::metres, TraceUnits::data}) {
+    PenTraceCsvOptions options;
+    options.units = units;
+    options.paper_z_m = 0.01;
+    options.read_force = true;
+    std::vector<PenTraceRow> by_fast, by_general;
+    const TemporaryFile fast_file(fast), general_file(general);
+    for_each_pen_trace_row(fast_file.path, test_placement(), options,
+                           [&by_fast](const PenTraceRow& r) { by_fast.push_back(r); });
+    for_each_pen_trace_row(general_file.path, test_placement(), options,
+                           [&by_general](const PenTraceRow& r) { by_general.push_back(r); });
+    REQUIRE(by_fast.size() == trace.size());
+    REQUIRE(by_general.size() == trace.size());
+    for (std::size_t i = 0; i < trace.size(); ++i) {
+      INFO(i);
+      const PenTraceRow& a = by_fast[i];
+      const PenTraceRow& b = by_general[i];
+      CHECK(std::bit_cast<std::uint64_t>(a.sample.time_s) == std::bit_cast<std::uint64_t>(b.sample.time_s));
+      CHECK(std::bit_cast<std::uint64_t>(a.sample.position_m.x()) ==
+            std::bit_cast<std::uint64_t>(b.sample.position_m.x()));
+      CHECK(std::bit_cast<std::uint64_t>(a.sample.position_m.y()) ==
+            std::bit_cast<std::uint64_t>(b.sample.position_m.y()));
+      CHECK(a.sample.pen_down == b.sample.pen_down);
+      CHECK(std::bit_cast<std::uint64_t>(a.in_plane_force_n) ==
+            std::bit_cast<std::uint64_t>(b.in_plane_force_n));
+    }
+    CHECK(by_fast[6].in_plane_force_n == Approx(1e15));
+  }
+}
+
+TEST_CASE("A row the fast way cannot take is refused as before, naming its line and column",
+          "[pen_trace_csv]") {
+  const Placement p = test_placement();
+  const std::string header = "t,x,y,pen\n0,0.001,0.002,1\n";
+  for (const auto& [row, named] :
+       std::vector<std::pair<std::string, std::string>>{{"0.1,0.5x,0,1", "column 2 (x)"},
+                                                        {"0.1,0,0,1,", "5 fields"},
+                                                        {"0.1,0,0", "3 fields"},
+                                                        {"0.1,0,0,10", "column 4 (pen)"},
+                                                        {"0.1,0,0.1.2,1", "column 3 (y)"},
+                                                        {"0.1,0,1e999,1", "column 3 (y)"},
+                                                        {std::string("0.1,0\0,0,1", 10), "column 2 (x)"},
+                                                        {"-0.5,0,0,1", "backwards"}}) {
+    INFO(row);
+    CHECK_THROWS_WITH(parse_pen_trace_csv(header + row + "\n", "a.csv", p),
+                      Catch::Contains("a.csv:3") && Catch::Contains(named));
+  }
+  // Rows past a limit are refused at the first one over it, as the general way does.
+  PenTraceCsvOptions options;
+  options.max_samples = 1;
+  CHECK_THROWS_WITH(parse_pen_trace_csv(header + "0.1,0,0,1\n", "a.csv", p, options),
+                    Catch::Contains("a.csv:3") && Catch::Contains("more than 1 samples"));
+  options = {};
+  options.max_pen_down_segments = 1;
+  CHECK_THROWS_WITH(parse_pen_trace_csv(header + "0.1,0,0,0\n0.2,0,0,1\n", "a.csv", p, options),
+                    Catch::Contains("a.csv:4") && Catch::Contains("pen-down segments"));
+  // Values exact where they stand in the row, a 16-digit one through the general way.
+  const auto samples =
+      parse_pen_trace_csv(header + "0.1,-0,1234567890.12345,0\n0.2,0.1234567890123456,5.,1\n", "a.csv", p);
+  REQUIRE(samples.size() == 3);
+  CHECK(std::signbit(samples[1].position_m.x()));
+  CHECK(samples[1].position_m.y() == 1234567890.12345);
+  CHECK_FALSE(samples[1].pen_down);
+  CHECK(samples[2].position_m.x() == 0.1234567890123456);
+  CHECK(samples[2].position_m.y() == 5.0);
 }

@@ -2,36 +2,12 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 #include <string>
 
 namespace calligraphy {
-
-const char* parse_plain_decimal(const char* first, const char* last, double& value) {
-  static constexpr double kPowers[] = {1e0, 1e1, 1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
-                                       1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15};
-  const bool negative = first != last && *first == '-';
-  if (negative) ++first;
-  std::int64_t digits = 0;
-  int count = 0, decimals = 0;
-  bool point = false;
-  for (; first != last; ++first) {
-    if (*first >= '0' && *first <= '9') {
-      if (++count > 15) return nullptr;
-      digits = digits * 10 + (*first - '0');
-      decimals += point ? 1 : 0;
-    } else if (*first == '.' && !point) {
-      point = true;
-    } else {
-      break;
-    }
-  }
-  if (count == 0) return nullptr;
-  value = static_cast<double>(digits) / kPowers[decimals];
-  if (negative) value = -value;
-  return first;
-}
 
 std::optional<double> parse_finite_double(std::string_view text) {
   double value = 0.0;

@@ -1,0 +1,126 @@
+// Reading a trial's pen trace: samples per second (items_per_second) of the one trace parser
+// (report/pen_trace_csv.hpp) on a trace of about 1,000,000 rows written by `trial_csv`, the writer of
+// `trial --csv` and of a session's trials/*.csv.gz: parsed from memory, read from a plain file and read
+// from the gzip file a session saves (decompressed on the way), as `calligraphy report` reads it.
+// Run a Release build: build/bin/trace_read_bench --benchmark_repetitions=5
+//   --benchmark_report_aggregates_only=true   (the median row is the figure to quote)
+#include <benchmark/benchmark.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstddef>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "calligraphy/report/pen_trace_csv.hpp"
+#include "calligraphy/report/trial_report.hpp"
+#include "report/compressed_text.hpp"
+
+namespace {
+
+using namespace calligraphy;
+
+constexpr std::size_t kRows = 1'000'000;
+constexpr double kPaperZ = 0.01;
+
+// A pen writing at 1 kHz: loops of a few centimetres on the 0.023 mm encoder steps of a Phantom Desktop,
+// lifted now and then, with guidance forces of tenths of a newton, so that the fields have the lengths and
+// signs of a session's trials (about 64 bytes a row; times drift from k ms as a device clock's sum does).
+const std::string& trace_text() {
+  static const std::string text = [] {
+    std::vector<TrialSample> trace(kRows);
+    double t = 0.0;
+    for (std::size_t i = 0; i < kRows; ++i) {
+      const double phase = static_cast<double>(i) * 0.0037;
+      TrialSample& s = trace[i];
+      s.time_s = t;
+      t += 0.001;
+      const auto step = [](double m) { return std::round(m / 0.000023) * 0.000023; };
+      s.position_m = Vec3(step(0.02 * std::sin(phase)), step(-0.015 * std::cos(1.3 * phase)),
+                          kPaperZ + step((i / 700) % 3 == 0 ? 0.003 : -0.0008 * std::sin(0.01 * phase)));
+      s.force_n = Vec3(0.4 * std::cos(2.1 * phase), -0.25 * std::sin(phase), 1.5 + std::sin(0.7 * phase));
+      s.state = (i / 700) % 3 == 0 ? InteractionState::separation : InteractionState::writing;
+      s.stroke = i / 5000;
+      s.element = (i / 100) % 20;
+      s.attempt = 1;
+    }
+    return trial_csv(trace);
+  }();
+  return text;
+}
+
+// How the report reads a trial's trace (study/session_reader.cpp): z against the paper, the in-plane force.
+PenTraceCsvOptions report_options() {
+  PenTraceCsvOptions options;
+  options.paper_z_m = kPaperZ;
+  options.read_force = true;
+  options.max_samples = kRows + 1;
+  options.max_pen_down_segments = kRows;
+  return options;
+}
+
+// The trace written to a file of its own under the temporary directory (gzip or plain), removed at exit.
+const std::filesystem::path& trace_file(bool gzip) {
+  static const std::filesystem::path folder = [] {
+    const auto made = std::filesystem::temp_directory_path() /
+                      ("calligraphy_trace_read_bench_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(made);
+    std::ofstream(made / "trace.csv", std::ios::binary) << trace_text();
+    std::ofstream(made / "trace.csv.gz", std::ios::binary) << gzip_text(trace_text());
+    std::atexit([] {
+      std::error_code ignored;
+      std::filesystem::remove_all(std::filesystem::temp_directory_path() /
+                                      ("calligraphy_trace_read_bench_" + std::to_string(::getpid())),
+                                  ignored);
+    });
+    return made;
+  }();
+  static const std::filesystem::path plain = folder / "trace.csv", compressed = folder / "trace.csv.gz";
+  return gzip ? compressed : plain;
+}
+
+void trace_parse_memory(benchmark::State& state) {
+  const std::string& text = trace_text();
+  const PenTraceCsvOptions options = report_options();
+  for (auto _ : state) benchmark::DoNotOptimize(parse_pen_trace_csv(text, "trace", Placement{}, options));
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * kRows));
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * text.size()));
+}
+
+// A file streamed row by row into the columns the per-trial pages keep, as the report does.
+void read_file(benchmark::State& state, bool gzip) {
+  const std::filesystem::path& file = trace_file(gzip);
+  const PenTraceCsvOptions options = report_options();
+  std::vector<double> time_s, force_n;
+  std::vector<Vec2> position_m;
+  std::vector<bool> pen_down;
+  for (auto _ : state) {
+    time_s.clear();
+    force_n.clear();
+    position_m.clear();
+    pen_down.clear();
+    for_each_pen_trace_row(file, Placement{}, options, [&](const PenTraceRow& row) {
+      time_s.push_back(row.sample.time_s);
+      position_m.push_back(row.sample.position_m);
+      pen_down.push_back(row.sample.pen_down);
+      force_n.push_back(row.in_plane_force_n);
+    });
+    benchmark::DoNotOptimize(time_s.data());
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * kRows));
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * trace_text().size()));  // of text
+  state.counters["file_bytes"] = static_cast<double>(std::filesystem::file_size(file));
+}
+
+void trace_read_plain_file(benchmark::State& state) { read_file(state, false); }
+void trace_read_gzip_file(benchmark::State& state) { read_file(state, true); }
+
+}  // namespace
+
+BENCHMARK(trace_parse_memory)->Unit(benchmark::kMillisecond);
+BENCHMARK(trace_read_plain_file)->Unit(benchmark::kMillisecond);
+BENCHMARK(trace_read_gzip_file)->Unit(benchmark::kMillisecond);
+
+BENCHMARK_MAIN();
