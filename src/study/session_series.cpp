@@ -103,8 +103,20 @@ SessionSeries session_series(const fs::path& root, const std::string& subject_id
     previous.session_id = manifest.session_id;
     previous.session_sha256 = manifest_sha256(folder);
     const nlohmann::json record = study_detail::read_trial_record(last_record);
-    previous.ended_utc = study_detail::JsonView(record, "", last_record.string())
-                             .string_or("end_time_utc", manifest.created_utc);
+    // Every saved record has its end; one without (null or missing: the run was killed as it wrote, or the
+    // record was edited) gives no time to measure the delay from. The session's creation is not its end.
+    const study_detail::JsonView view(record, "", last_record.string());
+    if (!view.has("end_time_utc")) {
+      study_detail::fail(last_record.string(), "/end_time_utc",
+                         std::string(record.contains("end_time_utc") ? "null" : "missing") + ": session " +
+                             std::to_string(number) + " of " + protocol.protocol.name + " (" +
+                             folder.string() +
+                             ") did not end: its last trial has no end time, so the delay before session " +
+                             std::to_string(number + 1) +
+                             " cannot be measured; restore this trial record (a saved trial is never written "
+                             "again, so resume cannot)");
+    }
+    previous.ended_utc = view.string_or("end_time_utc", "");
     double ended_s = 0.0;
     try {
       ended_s = study_detail::utc_seconds(previous.ended_utc);
