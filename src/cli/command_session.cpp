@@ -269,10 +269,19 @@ int run_sessions(const SessionRunCommand& command) {
       // Held until this session is written: another run of the subject waits, then sees it.
       std::optional<SeriesLock> lock;
       if (sessions > 1) {
-        lock.emplace(command.out, subjects[i].id, [&](const std::filesystem::path& path) {
-          std::fprintf(stderr, "%s: waiting for another run of this subject to end (%s)\n",
-                       subjects[i].id.c_str(), path.c_str());
-        });
+        lock.emplace(
+            command.out, subjects[i].id,
+            [&](const std::filesystem::path& path) {
+              std::fprintf(stderr, "%s: waiting for another run of this subject to end (%s)\n",
+                           subjects[i].id.c_str(), path.c_str());
+            },
+            [] { return stop_requested(); });
+        if (!lock->held()) {
+          print_error_line("calligraphy session run", "error",
+                           subjects[i].id + ": stopped by " + signal_name(stop_signal()) +
+                               " while waiting for another run of this subject; nothing written for it");
+          return 128 + stop_signal();
+        }
       }
       // A protocol of one session starts a new one on every run, as before sessions were linked.
       const SessionSeries series =

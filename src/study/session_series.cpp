@@ -5,8 +5,11 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <map>
+#include <thread>
+#include <vector>
 
 #include "calligraphy/core/errors.hpp"
 #include "study/json_reader.hpp"
@@ -150,13 +153,25 @@ SeriesLock::SeriesLock(const fs::path& root, const std::string& subject_id,
   if (error) throw DataError(path_.string() + ": cannot create the folder: " + error.message());
   fd_ = ::open(path_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (fd_ < 0) throw DataError(path_.string() + ": cannot open the lock: " + std::strerror(errno));
-  if (::flock(fd_, LOCK_EX | LOCK_NB) == 0) return;
-  if (errno == EWOULDBLOCK && waiting) waiting(path_);
-  while (::flock(fd_, LOCK_EX) != 0) {
-    if (errno == EINTR) continue;
+  // A blocking flock restarts after a caught signal (SA_RESTART), so the wait polls instead: a stop request
+  // ends it within one interval.
+  bool told = false;
+  while (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
     const int reason = errno;
-    ::close(fd_);
-    throw DataError(path_.string() + ": cannot lock: " + std::strerror(reason));
+    if (reason == EINTR) continue;
+    if (reason != EWOULDBLOCK) {
+      ::close(fd_);
+      fd_ = -1;
+      throw DataError(path_.string() + ": cannot lock: " + std::strerror(reason));
+    }
+    if (!told && waiting) waiting(path_);
+    told = true;
+    if (should_stop && should_stop()) {
+      ::close(fd_);
+      fd_ = -1;
+      return;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
 }
 

@@ -51,13 +51,18 @@ struct SessionSeries {
 class SeriesLock {
  public:
   /// Creates the subject's folder when missing and waits until the lock is free, calling `waiting` with the
-  /// folder's path once when it is not free at first. Throws DataError naming the folder when it cannot be
-  /// created or locked.
+  /// folder's path once when it is not free at first. While it waits it polls `should_stop` (every 50 ms):
+  /// true ends the wait without the lock (`held()` false), so that a stop signal is not ignored behind
+  /// another run. Throws DataError naming the folder when it cannot be created or locked.
   SeriesLock(const std::filesystem::path& root, const std::string& subject_id,
-             const std::function<void(const std::filesystem::path&)>& waiting = {});
+             const std::function<void(const std::filesystem::path&)>& waiting = {},
+             const std::function<bool()>& should_stop = {});
   SeriesLock(const SeriesLock&) = delete;
   SeriesLock& operator=(const SeriesLock&) = delete;
   ~SeriesLock();
+
+  /// True when the lock is held (false only when `should_stop` ended the wait).
+  [[nodiscard]] bool held() const noexcept { return fd_ >= 0; }
 
  private:
   std::filesystem::path path_;
