@@ -45,6 +45,11 @@ SessionManifest read_previous_session(const fs::path& folder, const SessionManif
   return previous;
 }
 
+bool protocols_conflict(const LoadedProtocol& a, const LoadedProtocol& b) {
+  const auto practice = [](const LoadedProtocol& p) { return p.path == "calligraphy-train"; };
+  return a.protocol.name == b.protocol.name && a.sha256 != b.sha256 && !(practice(a) && practice(b));
+}
+
 bool DistinctSessions::add(const fs::path& folder, const SessionManifest& manifest) {
   const std::string key = manifest.setup.subject.id + '\n' + manifest.protocol.sha256 + '\n' +
                           std::to_string(manifest.setup.session_number) + '\n' + manifest.created_utc;

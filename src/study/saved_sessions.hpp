@@ -28,6 +28,11 @@ SessionManifest read_session_manifest(const std::filesystem::path& folder);
 /// recorded (another SHA-256: replaced or edited).
 SessionManifest read_previous_session(const std::filesystem::path& folder, const SessionManifest& manifest);
 
+/// True when `a` and `b` are two different protocols (another SHA-256) under one name, whose sessions a
+/// reader would pool as one design. The trainer's free practice (`calligraphy train`, protocol "train" made
+/// for each run from its characters) is one design whatever characters a run practised.
+[[nodiscard]] bool protocols_conflict(const LoadedProtocol& a, const LoadedProtocol& b);
+
 /// The session folders already read, by what makes a session itself (subject, protocol, session number and
 /// creation time), so that a copy of one is refused rather than counted twice.
 class DistinctSessions {
