@@ -12,7 +12,7 @@
 
 namespace calligraphy::study_detail {
 
-/// Largest session manifest or trial record read: 64 MiB.
+/// Largest trial record read: 64 MiB (a session manifest: kMaxSessionManifestBytes, session_folder.hpp).
 inline constexpr std::uintmax_t kMaxRecordBytes = std::uintmax_t{64} << 20;
 
 /// The session folders under `roots` (each a session folder or a folder holding some), sorted by path within

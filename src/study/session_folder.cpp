@@ -3,10 +3,12 @@
 #include <fcntl.h>
 #include <sys/file.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
@@ -14,9 +16,9 @@
 
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/trial/options.hpp"
-#include "calligraphy/core/unicode.hpp"
 #include "report/compressed_text.hpp"
 #include "study/json_reader.hpp"
 #include "study/manifest_json.hpp"
@@ -25,8 +27,6 @@
 namespace calligraphy {
 namespace fs = std::filesystem;
 namespace {
-
-constexpr std::uintmax_t kMaxManifestBytes = std::uintmax_t{16} << 20;
 
 [[noreturn]] void fail_errno(const fs::path& path, const std::string& what, int error) {
   throw DataError(path.string() + ": " + what + ": " + std::strerror(error));
@@ -101,7 +101,83 @@ void check_setup(const SessionSetup& setup) {
   }
 }
 
+SessionManifest make_manifest(const SessionSetup& setup, const LoadedProtocol& protocol,
+                              const std::optional<PreviousSession>& previous) {
+  SessionManifest manifest;
+  manifest.setup = setup;
+  manifest.protocol = protocol;
+  manifest.library = library_build();
+  manifest.created_utc = study_detail::utc_now_iso8601();
+  manifest.plan = plan_session(protocol.protocol, setup.subject, setup.session_number);
+  manifest.previous = previous;
+  manifest.group = subject_group(protocol.protocol, setup.subject);
+  return manifest;
+}
+
+// session.json's text, refused when a reader would refuse it (kMaxSessionManifestBytes).
+std::string manifest_text(const SessionManifest& manifest) {
+  std::string text = study_detail::manifest_to_json(manifest);
+  if (text.size() > kMaxSessionManifestBytes) {
+    char size[32];
+    std::snprintf(size, sizeof size, "%.1f MiB", static_cast<double>(text.size()) / (1 << 20));
+    throw DataError(
+        manifest.protocol.path.string() + ": session " + std::to_string(manifest.setup.session_number) +
+        " of subject " + manifest.setup.subject.id + " plans " + std::to_string(manifest.plan.size()) +
+        " trials, a session.json of " + size + ", more than the " +
+        std::to_string(kMaxSessionManifestBytes >> 20) +
+        " MiB a session's reader takes: fewer characters, conditions or repetitions a session, or "
+        "the phases over more sessions");
+  }
+  return text;
+}
+
 }  // namespace
+
+std::uintmax_t trial_files_bytes(const ProtocolTrialSettings& trial) {
+  const double ticks = std::ceil(trial.max_duration_s * trial.rate_hz);
+  return static_cast<std::uintmax_t>(ticks) * 64 + (std::uintmax_t{1} << 20);
+}
+
+void check_writable_folder(const fs::path& folder, std::uintmax_t free_bytes) {
+  const auto refuse = [&folder](const std::string& why) {
+    throw DataError(folder.string() + ": " + why + " (checked before the first trial; nothing was written)");
+  };
+  if (::access(folder.c_str(), W_OK) != 0)
+    refuse(std::string("cannot write in the folder: ") + std::strerror(errno));
+  // access(2) lets a privileged user pass a read-only or immutable folder: a file made and removed does not.
+  const fs::path probe = folder / (".calligraphy-write-probe-" + std::to_string(::getpid()));
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) refuse(std::string("cannot create a file in the folder: ") + std::strerror(errno));
+  ::close(fd);
+  if (::unlink(probe.c_str()) != 0)
+    refuse("cannot remove a file from the folder (" + probe.filename().string() +
+           "): " + std::strerror(errno));
+  struct statvfs space {};
+  if (::statvfs(folder.c_str(), &space) != 0)
+    refuse(std::string("cannot read its free space: ") + std::strerror(errno));
+  const std::uintmax_t available = static_cast<std::uintmax_t>(space.f_bavail) * space.f_frsize;
+  if (available < free_bytes) {
+    char text[96];
+    std::snprintf(text, sizeof text, "%.1f MiB free, less than the %.1f MiB one trial's files may take",
+                  static_cast<double>(available) / (1 << 20), static_cast<double>(free_bytes) / (1 << 20));
+    refuse(text);
+  }
+  // A file system that counts inodes (f_files > 0) may run out of them before its bytes.
+  if (space.f_files > 0 && space.f_favail < 16)
+    refuse(std::to_string(space.f_favail) + " inodes free, fewer than the 16 a trial's files may take");
+}
+
+void check_session_manifest_size(const SessionSetup& setup, const LoadedProtocol& protocol) {
+  std::optional<PreviousSession> previous;
+  if (setup.session_number > 1) {  // a link as long as a real one (its size counts too)
+    previous.emplace();
+    previous->session_id = protocol.protocol.name + "-" + setup.subject.id + "-YYYYMMDD-HHMMSS-1000";
+    previous->ended_utc = study_detail::utc_now_iso8601();
+    previous->session_sha256 = std::string(64, '0');
+    previous->delay = "overridden";
+  }
+  (void)manifest_text(make_manifest(setup, protocol, previous));
+}
 
 std::uint64_t subject_seed(std::string_view subject_id) {
   return study_detail::mix64(study_detail::fnv1a_64(subject_id));
@@ -155,14 +231,8 @@ SessionFolder SessionFolder::create(const fs::path& root, const SessionSetup& se
         "': " +
         (previous ? "the first session has no previous one" : "a later session needs the previous one"));
   }
-  SessionManifest manifest;
-  manifest.setup = setup;
-  manifest.protocol = protocol;
-  manifest.library = library_build();
-  manifest.created_utc = study_detail::utc_now_iso8601();
-  manifest.plan = plan_session(protocol.protocol, setup.subject, setup.session_number);
-  manifest.previous = previous;
-  manifest.group = subject_group(protocol.protocol, setup.subject);
+  SessionManifest manifest = make_manifest(setup, protocol, previous);
+  const std::string text = manifest_text(manifest);  // refused before any folder is made
 
   const fs::path subject_folder = root / setup.subject.id;
   make_folder(subject_folder);
@@ -183,7 +253,7 @@ SessionFolder SessionFolder::create(const fs::path& root, const SessionSetup& se
   make_folder(folder / "trials");
   const int fd = open_locked_log(folder / "log.jsonl");
   SessionFolder session(folder, std::move(manifest), fd);
-  write_file_atomically(folder / "session.json", study_detail::manifest_to_json(session.manifest_));
+  write_file_atomically(folder / "session.json", text);
   fsync_folder(subject_folder);
   session.log("session_created", study_detail::session_created_details(session.manifest_));
   return session;
@@ -192,7 +262,7 @@ SessionFolder SessionFolder::create(const fs::path& root, const SessionSetup& se
 SessionFolder SessionFolder::open(const fs::path& folder) {
   const fs::path manifest_path = folder / "session.json";
   const std::string text =
-      study_detail::read_small_file(manifest_path, kMaxManifestBytes, "session manifest");
+      study_detail::read_small_file(manifest_path, kMaxSessionManifestBytes, "session manifest");
   SessionManifest manifest = study_detail::manifest_from_json(text, manifest_path.string());
   manifest.session_id = folder.filename().string();
   if (manifest.session_id.empty()) manifest.session_id = folder.parent_path().filename().string();
@@ -295,6 +365,20 @@ fs::path SessionFolder::save_attempt(const PlannedTrial& trial, std::string_view
     if (link_error != EEXIST) fail_errno(json_path, "cannot keep the attempt", link_error);
   }
   throw DataError(folder.string() + ": too many attempts of trial " + trial_stem(trial));
+}
+
+void SessionFolder::check_writable() const {
+  const std::uintmax_t bytes = trial_files_bytes(manifest_.protocol.protocol.trial);
+  check_writable_folder(path_, bytes);  // teachers/ and trials/attempts/ are made here when first needed
+  for (const fs::path& folder : {path_ / "trials", path_ / "trials" / "attempts", path_ / "teachers"}) {
+    std::error_code error;
+    if (folder == path_ / "trials" || fs::is_directory(folder, error)) check_writable_folder(folder, bytes);
+  }
+  const fs::path log_path = path_ / "log.jsonl";
+  if (::access(log_path.c_str(), W_OK) != 0) {
+    throw DataError(log_path.string() + ": cannot write the session log: " + std::strerror(errno) +
+                    " (checked before the first trial; nothing was written)");
+  }
 }
 
 void SessionFolder::log(std::string_view event, std::string_view details_json) {

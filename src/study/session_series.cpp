@@ -22,7 +22,7 @@ namespace {
 
 std::string manifest_sha256(const fs::path& folder) {
   return sha256_hex(
-      study_detail::read_small_file(folder / "session.json", study_detail::kMaxRecordBytes, "session manifest"));
+      study_detail::read_small_file(folder / "session.json", kMaxSessionManifestBytes, "session manifest"));
 }
 
 // Session `number` (> 1) must follow the folder found for the session before it: by name, and by content
@@ -144,8 +144,35 @@ SessionSeries session_series(const fs::path& root, const std::string& subject_id
   return series;
 }
 
+void check_protocol_unchanged(const fs::path& root, const LoadedProtocol& protocol) {
+  std::error_code error;
+  if (!fs::is_directory(root, error)) return;
+  std::vector<fs::path> folders;
+  try {
+    folders = find_session_folders(root);
+  } catch (const DataError&) {
+    return;  // the series' reader lists the folder again and names what is wrong
+  }
+  for (const fs::path& folder : folders) {
+    SessionManifest manifest;
+    try {
+      manifest = study_detail::read_session_manifest(folder);
+    } catch (const DataError&) {
+      continue;  // another session's damage is its readers' to report; the subject's own, the series'
+    }
+    if (!study_detail::protocols_conflict(manifest.protocol, protocol)) continue;
+    throw DataError(
+        protocol.path.string() + ": the protocol '" + protocol.protocol.name +
+        "' differs from the one the session " + folder.string() + " was run with (SHA-256 " +
+        protocol.sha256 + " here, " + manifest.protocol.sha256 +
+        " there: edited since?); its sessions and this run's would be one design of two "
+        "protocols: restore that protocol, or give the edited one another name or a new --out folder");
+  }
+}
+
 SeriesLock::SeriesLock(const fs::path& root, const std::string& subject_id,
-                       const std::function<void(const fs::path&)>& waiting)
+                       const std::function<void(const fs::path&)>& waiting,
+                       const std::function<bool()>& should_stop)
     : path_(root / subject_id) {
   // The subject's folder itself is locked (flock(2) takes a directory): no lock file among the sessions.
   std::error_code error;

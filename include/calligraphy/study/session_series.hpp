@@ -44,6 +44,12 @@ struct SessionSeries {
 [[nodiscard]] SessionSeries session_series(const std::filesystem::path& root, const std::string& subject_id,
                                            const LoadedProtocol& protocol);
 
+/// Refuses `protocol` when a session under the study folder `root` (any subject's) was run with another
+/// protocol of the same name (another SHA-256: the file was edited): the series would start again beside
+/// it, and every reader would pool the two as one design. Throws DataError naming the protocol's file, that
+/// session's folder and both SHA-256; a session.json that cannot be read is left to the readers that need it.
+void check_protocol_unchanged(const std::filesystem::path& root, const LoadedProtocol& protocol);
+
 /// An exclusive lock on one subject's series under `root` (flock(2) on the folder ROOT/SUBJECT), held by a
 /// run from reading the series until its session is written, so that concurrent runs of one subject take
 /// turns (the later sees what the earlier wrote) instead of starting a session twice. The system releases
