@@ -1,6 +1,7 @@
 #include "calligraphy/study/session_folder.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <sys/statvfs.h>
@@ -10,8 +11,10 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <exception>
 #include <utility>
 
 #include "calligraphy/core/atomic_file.hpp"
@@ -79,6 +82,62 @@ std::string folder_timestamp() {
   char text[32];
   std::strftime(text, sizeof text, "%Y%m%d-%H%M%S", &utc);
   return text;
+}
+
+// "PID.HOST" of this process: whose a temporary session folder is, so that only a dead run's is removed.
+std::string partial_owner() {
+  char host[256] = {};
+  if (::gethostname(host, sizeof host - 1) != 0) host[0] = '\0';
+  std::string name;
+  for (const char* c = host; *c != '\0' && name.size() < 64; ++c) {
+    const bool plain = (*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9');
+    name += plain ? *c : '-';  // no '.': it separates the fields
+  }
+  return std::to_string(::getpid()) + "." + (name.empty() ? "host" : name);
+}
+
+// Removes the temporary session folders (".partial.PID.HOST.NAME") that runs on this host left when they
+// were killed: their process is gone. Another host's, or a live process's, are left (readers skip them).
+void remove_dead_partial_folders(const fs::path& subject_folder) {
+  const std::string own = partial_owner();
+  const std::string host = own.substr(own.find('.') + 1);
+  std::error_code error;
+  for (const fs::directory_entry& entry : fs::directory_iterator(subject_folder, error)) {
+    const std::string name = entry.path().filename().string();
+    if (!is_partial_session_folder(entry.path())) continue;
+    const std::string rest = name.substr(kPartialSessionPrefix.size());
+    const std::size_t dot = rest.find('.');
+    if (dot == std::string::npos || rest.compare(dot + 1, host.size() + 1, host + ".") != 0) continue;
+    pid_t pid = 0;
+    try {
+      pid = static_cast<pid_t>(std::stol(rest.substr(0, dot)));
+    } catch (const std::exception&) {
+      continue;
+    }
+    if (pid <= 0 || (pid != ::getpid() && (::kill(pid, 0) == 0 || errno != ESRCH))) continue;
+    std::error_code ignored;
+    fs::remove_all(entry.path(), ignored);
+  }
+}
+
+// The folder as named by its own name ("S/x/" and "S/x/." are x).
+fs::path named_folder(const fs::path& folder) {
+  std::error_code error;
+  const fs::path resolved = fs::weakly_canonical(folder, error);
+  return error ? folder.lexically_normal() : resolved;
+}
+
+// rename(2) that fails with EEXIST rather than replace an (empty) folder of that name.
+int rename_no_replace(const fs::path& from, const fs::path& to) {
+  if (::renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_NOREPLACE) == 0) return 0;
+  if (errno != EINVAL && errno != ENOSYS) return -1;
+  // A file system without RENAME_NOREPLACE: a folder appearing in between is the only race left.
+  std::error_code error;
+  if (fs::exists(to, error)) {
+    errno = EEXIST;
+    return -1;
+  }
+  return ::rename(from.c_str(), to.c_str());
 }
 
 void check_setup(const SessionSetup& setup) {
@@ -236,30 +295,58 @@ SessionFolder SessionFolder::create(const fs::path& root, const SessionSetup& se
 
   const fs::path subject_folder = root / setup.subject.id;
   make_folder(subject_folder);
+  remove_dead_partial_folders(subject_folder);
   // The session id names the protocol, the subject and the second it began, so ids are keys across
   // subjects (two subjects started in the same second differ) and sort by time within a subject.
   const std::string base = protocol.protocol.name + "-" + setup.subject.id + "-" + folder_timestamp();
+  // The folder is made whole under a temporary name beside its own, session.json first, then renamed: a run
+  // killed at any moment leaves no session folder or one with its session.json, and at worst a temporary
+  // that readers skip and the next run removes.
+  const fs::path building =
+      subject_folder / (std::string(kPartialSessionPrefix) + partial_owner() + "." + base);
+  if (::mkdir(building.c_str(), 0755) != 0) fail_errno(building, "cannot create the session folder", errno);
+  int fd = -1;
+  const auto abandon = [&building, &fd] {
+    if (fd >= 0) ::close(fd);
+    std::error_code ignored;
+    fs::remove_all(building, ignored);
+  };
+  try {
+    write_file_atomically(building / "session.json", text);
+    make_folder(building / "trials");
+    fd = open_locked_log(building / "log.jsonl");
+    fsync_folder(building);
+  } catch (...) {
+    abandon();
+    throw;
+  }
   fs::path folder;
   for (int suffix = 1;; ++suffix) {
     const std::string name = suffix == 1 ? base : base + "-" + std::to_string(suffix);
     folder = subject_folder / name;
-    // mkdir fails when the folder exists: two runners never share a folder.
-    if (::mkdir(folder.c_str(), 0755) == 0) {
+    // Never onto an existing folder: two runners never share one.
+    if (rename_no_replace(building, folder) == 0) {
       manifest.session_id = name;
       break;
     }
-    if (errno != EEXIST || suffix > 1000) fail_errno(folder, "cannot create the session folder", errno);
+    const int error = errno;
+    if ((error != EEXIST && error != ENOTEMPTY) || suffix > 1000) {
+      abandon();
+      fail_errno(folder, "cannot create the session folder", error);
+    }
   }
-  make_folder(folder / "trials");
-  const int fd = open_locked_log(folder / "log.jsonl");
   SessionFolder session(folder, std::move(manifest), fd);
-  write_file_atomically(folder / "session.json", text);
   fsync_folder(subject_folder);
   session.log("session_created", study_detail::session_created_details(session.manifest_));
   return session;
 }
 
+bool is_partial_session_folder(const fs::path& folder) {
+  return folder.filename().string().starts_with(kPartialSessionPrefix);
+}
+
 SessionFolder SessionFolder::open(const fs::path& folder) {
+  if (is_partial_session_folder(named_folder(folder))) throw DataError(folder.string() + ": " + kPartialNote);
   const fs::path manifest_path = folder / "session.json";
   const std::string text =
       study_detail::read_small_file(manifest_path, kMaxSessionManifestBytes, "session manifest");
@@ -392,7 +479,10 @@ std::vector<fs::path> find_session_folders(const fs::path& root) {
   std::error_code error;
   if (!fs::is_directory(root, error))
     throw DataError(root.string() + ": not a folder (expected session folders)");
-  if (fs::is_regular_file(root / "session.json", error)) return {root};
+  if (fs::is_regular_file(root / "session.json", error)) {
+    if (is_partial_session_folder(named_folder(root))) throw DataError(root.string() + ": " + kPartialNote);
+    return {root};
+  }
   std::vector<fs::path> found;
   fs::recursive_directory_iterator it(root, fs::directory_options::skip_permission_denied, error);
   if (error) throw DataError(root.string() + ": cannot list the folder: " + error.message());
@@ -403,6 +493,10 @@ std::vector<fs::path> find_session_folders(const fs::path& root) {
       continue;
     }
     if (!it->is_directory(error)) continue;
+    if (is_partial_session_folder(it->path())) {  // a run's folder not made yet, or a killed run's
+      it.disable_recursion_pending();
+      continue;
+    }
     if (fs::is_regular_file(it->path() / "session.json", error)) {
       found.push_back(it->path());
       it.disable_recursion_pending();

@@ -179,8 +179,20 @@ class SessionFolder {
   int log_fd_ = -1;
 };
 
+/// How a session folder's name begins while `SessionFolder::create` builds it (".partial.PID.HOST.NAME",
+/// renamed to NAME once whole): a run killed before then leaves it. Readers skip it; the next `create` in the
+/// subject's folder removes one whose process (on this host) is gone.
+inline constexpr std::string_view kPartialSessionPrefix = ".partial.";
+/// What a temporary session folder is, for messages naming one.
+inline constexpr const char* kPartialNote =
+    "a session folder left half made by a run killed before its first trial (its name begins \".partial.\"); "
+    "no trial is in it: remove it (the next session run of the subject does)";
+/// True when the folder's name marks it as being made (kPartialSessionPrefix).
+[[nodiscard]] bool is_partial_session_folder(const std::filesystem::path& folder);
+
 /// The session folders under `root`: `root` itself when it holds a session.json, else every folder below it
-/// (at most 4 levels deep) that does, sorted by path. Throws DataError when `root` is not a folder.
+/// (at most 4 levels deep) that does, sorted by path; temporary folders (`is_partial_session_folder`) are
+/// skipped. Throws DataError when `root` is not a folder or is a temporary one.
 [[nodiscard]] std::vector<std::filesystem::path> find_session_folders(const std::filesystem::path& root);
 
 }  // namespace calligraphy
