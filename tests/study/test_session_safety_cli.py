@@ -24,6 +24,7 @@ import os
 import select
 import shutil
 import signal
+import socket
 import subprocess
 import tempfile
 import time
@@ -357,13 +358,22 @@ class SessionSafetyTest(unittest.TestCase):
             report = self.run_cli("report", "out", "--csv", "tables")
             self.assertEqual(report.returncode, 0, report.stderr.decode())
             self.assertNotIn(".partial.", (self.cwd / "tables" / "trials.csv").read_text(encoding="utf-8"))
-        # The next run removes those of dead runs, and makes its own whole.
+        # The next run removes those of dead runs on this host, keeps a live process's and another host's, and
+        # makes its own whole.
+        host = "".join(c if c.isascii() and c.isalnum() else "-" for c in socket.gethostname())[:64] or "host"
+        dead = subprocess.Popen(["true"])
+        dead.wait()
+        subject.mkdir(parents=True, exist_ok=True)
+        for owner in (f"{dead.pid}.{host}", f"{os.getpid()}.{host}", "1.elsewhere"):
+            (subject / f".partial.{owner}.small-P1-20000101-000000" / "trials").mkdir(parents=True)
         done = self.run_cli("session", "run", "p.json", "--subject", "P1", "--out", "out")
         self.assertEqual(done.returncode, 0, done.stderr.decode())
-        self.assertEqual([p.name for p in subject.iterdir() if p.name.startswith(".")], [])
+        self.assertEqual(sorted(p.name for p in subject.iterdir() if p.name.startswith(".")),
+                         sorted([f".partial.{os.getpid()}.{host}.small-P1-20000101-000000",
+                                 ".partial.1.elsewhere.small-P1-20000101-000000"]))
         self.assertEqual(len(self.session_folders("out")), len(whole) + 1)
         # A temporary named as a session is refused by the commands that read one folder.
-        temporary = subject / ".partial.1.elsewhere.small-P1-20000101-000000"
+        temporary = subject / ".partial.1.elsewhere.small-P1-20000101-000001"
         shutil.copytree(self.session_folders("out")[-1], temporary)
         self.assert_refused(self.run_cli("session", "resume", temporary), "half made")
         self.assert_refused(self.run_cli("report", temporary, "--csv", "tables"), "half made")
