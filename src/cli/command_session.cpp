@@ -8,10 +8,13 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
+#include "calligraphy/core/unicode.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/study/cohort.hpp"
 #include "calligraphy/study/protocol.hpp"
@@ -26,7 +29,6 @@
 #include "cli/signals.hpp"
 #include "cli/study_inputs.hpp"
 #include "cli/writer_options.hpp"
-#include "calligraphy/core/unicode.hpp"
 #ifdef CALLIGRAPHY_WITH_TRAINER
 #include "trainer/trainer.hpp"
 #endif
@@ -157,6 +159,19 @@ SessionRunResult run_one(SessionFolder& session, const SessionRunOptions& option
   return run_session(session, options);
 }
 
+// Runs the session (run_one); a write that fails mid-run (the disk filled meanwhile, the log cannot be
+// written) leaves every saved trial as it was, so its message says how to go on.
+SessionRunResult run_resumable(SessionFolder& session, const SessionRunOptions& options,
+                               const SessionDisplay& display, const LibraryOptions& library) {
+  try {
+    return run_one(session, options, display, library);
+  } catch (const DataError& e) {
+    throw DataError(std::string(e.what()) +
+                    "; every trial saved before is kept; resume with: calligraphy session resume " +
+                    session.path().string());
+  }
+}
+
 // Prints one line per session; returns the exit status: 0 when complete, 128 + the signal when stopped
 // by one, 1 after a device fault.
 int report_run(const SessionFolder& session, const SessionRunResult& result, double seconds) {
@@ -164,6 +179,13 @@ int report_run(const SessionFolder& session, const SessionRunResult& result, dou
               session.manifest().setup.subject.id.c_str(), result.saved_before + result.saved_now,
               result.planned, result.saved_now, result.attempts_kept, session.path().c_str(), seconds);
   std::fflush(stdout);
+  if (result.save_failed) {
+    print_error_line("calligraphy session", "error",
+                     result.failure +
+                         "; every trial saved before is kept; resume with: calligraphy session resume " +
+                         session.path().string());
+    return 1;
+  }
   if (result.device_failed) {
     std::fprintf(
         stderr,
@@ -255,12 +277,52 @@ int run_sessions(const SessionRunCommand& command) {
   }
 
   const LoadedProtocol resolved = resolved_protocol(protocol, characters);
+  const int sessions = resolved.protocol.session_count();
+  const auto setup_for = [&](std::size_t i, int session_number) {
+    SessionSetup setup;
+    setup.subject = subjects[i];
+    setup.device = command.device;
+    setup.writer = writer;
+    setup.writer_profile = profiles[i % profiles.size()];
+    setup.writer_seed = subject_seed(setup.subject.id);
+    setup.writer_learning = person ? "none" : command.writer_learning;
+    setup.individual_differences = !person && command.individual_differences == "on";
+    setup.pacing = command.pacing;
+    setup.session_number = session_number;
+    return setup;
+  };
+
+  // Before any session folder is made, what would otherwise stop the run after some of them:
+  // an edited protocol beside sessions of its earlier text (a second series would start beside the first),
+  check_protocol_unchanged(command.out, resolved);
+  // a session.json larger than its readers take (its size depends on the session and the subject's group
+  // only: permutations of one plan are as long),
+  std::set<std::pair<int, std::string>> sized;
+  for (std::size_t i = 0; i < subjects.size(); ++i) {
+    for (int number = 1; number <= sessions; ++number) {
+      if (sized.emplace(number, subject_group(resolved.protocol, subjects[i])).second)
+        check_session_manifest_size(setup_for(i, number), resolved);
+    }
+  }
+  // and a folder where no trial could be saved (read-only, full).
+  for (const SubjectAssignment& subject : subjects) {
+    std::filesystem::path existing = std::filesystem::path(command.out) / subject.id;
+    std::error_code error;
+    while (!std::filesystem::exists(existing, error)) {  // the folder the first write makes a folder in
+      if (!existing.has_parent_path()) {
+        existing = ".";
+        break;
+      }
+      existing = existing.parent_path();
+    }
+    if (std::filesystem::is_directory(existing, error))
+      check_writable_folder(existing, trial_files_bytes(resolved.protocol.trial));
+  }
 
   install_stop_handlers();
   TerminalHost host;
   std::shared_ptr<CharacterSource> source;
   const SessionRunOptions options = run_options(command.library, person ? &host : nullptr, source);
-  const int sessions = resolved.protocol.session_count();
   for (std::size_t i = 0; i < subjects.size(); ++i) {
     // The subject's series: a simulated subject writes every remaining session in a row (the delays taken
     // as passed), a person the next one, when its delay has passed.
@@ -269,10 +331,19 @@ int run_sessions(const SessionRunCommand& command) {
       // Held until this session is written: another run of the subject waits, then sees it.
       std::optional<SeriesLock> lock;
       if (sessions > 1) {
-        lock.emplace(command.out, subjects[i].id, [&](const std::filesystem::path& path) {
-          std::fprintf(stderr, "%s: waiting for another run of this subject to end (%s)\n",
-                       subjects[i].id.c_str(), path.c_str());
-        });
+        lock.emplace(
+            command.out, subjects[i].id,
+            [&](const std::filesystem::path& path) {
+              std::fprintf(stderr, "%s: waiting for another run of this subject to end (%s)\n",
+                           subjects[i].id.c_str(), path.c_str());
+            },
+            [] { return stop_requested(); });
+        if (!lock->held()) {
+          print_error_line("calligraphy session run", "error",
+                           subjects[i].id + ": stopped by " + signal_name(stop_signal()) +
+                               " while waiting for another run of this subject; nothing written for it");
+          return 128 + stop_signal();
+        }
       }
       // A protocol of one session starts a new one on every run, as before sessions were linked.
       const SessionSeries series =
@@ -310,19 +381,10 @@ int run_sessions(const SessionRunCommand& command) {
                            " s to go. --ignore-delay starts it now (recorded as overridden)");
         }
       }
-      SessionSetup setup;
-      setup.subject = subjects[i];
-      setup.device = command.device;
-      setup.writer = writer;
-      setup.writer_profile = profiles[i % profiles.size()];
-      setup.writer_seed = subject_seed(setup.subject.id);
-      setup.writer_learning = person ? "none" : command.writer_learning;
-      setup.individual_differences = !person && command.individual_differences == "on";
-      setup.pacing = command.pacing;
-      setup.session_number = series.next;
-      SessionFolder session = SessionFolder::create(command.out, setup, resolved, previous);
+      SessionFolder session =
+          SessionFolder::create(command.out, setup_for(i, series.next), resolved, previous);
       const auto start = std::chrono::steady_clock::now();
-      const SessionRunResult result = run_one(session, options, command.display, command.library);
+      const SessionRunResult result = run_resumable(session, options, command.display, command.library);
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       const int status = report_run(session, result, seconds);
       if (status != 0) return status;
@@ -348,6 +410,7 @@ int resume_session(const SessionResumeCommand& command) {
                 session.path().c_str());
     return 0;
   }
+  session.check_writable();  // before the first trial: a folder no trial could be saved in
   install_stop_handlers();
   TerminalHost host;
   std::shared_ptr<CharacterSource> source;
@@ -357,7 +420,7 @@ int resume_session(const SessionResumeCommand& command) {
     options.pacing = parse_trial_pacing(command.pacing, "--pacing");
   }
   const auto start = std::chrono::steady_clock::now();
-  const SessionRunResult result = run_one(session, options, command.display, command.library);
+  const SessionRunResult result = run_resumable(session, options, command.display, command.library);
   return report_run(session, result,
                     std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
 }

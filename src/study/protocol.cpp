@@ -291,6 +291,17 @@ void read_trial_settings(ObjectReader& reader, StudyProtocol& protocol) {
   protocol.trial.max_duration_s =
       trial.number_or("max_duration_s", protocol.trial.max_duration_s, 1e-3, 3600.0);
   protocol.trial.rate_hz = trial.number_or("rate_hz", protocol.trial.rate_hz, 100.0, 10000.0);
+  // Checked here, so that a session is refused before its folder is made, naming the protocol's fields
+  // rather than the trial runner's options.
+  const double ticks = protocol.trial.max_duration_s * protocol.trial.rate_hz;
+  if (ticks > kMaxTrialTicks) {
+    std::ostringstream message;
+    message << protocol.trial.max_duration_s << " s at " << protocol.trial.rate_hz << " Hz ("
+            << trial.pointer("rate_hz") << ") is " << std::llround(ticks)
+            << " servo ticks a trial, more than the 10000000 a trial may have (its trace is held in memory): "
+               "lower max_duration_s or rate_hz";
+    fail(reader.source(), trial.pointer("max_duration_s"), message.str());
+  }
   trial.finish();
 }
 

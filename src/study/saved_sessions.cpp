@@ -30,7 +30,7 @@ std::vector<fs::path> session_folders_under(const std::vector<fs::path>& roots) 
 SessionManifest read_session_manifest(const fs::path& folder) {
   const fs::path path = folder / "session.json";
   SessionManifest manifest =
-      manifest_from_json(read_small_file(path, kMaxRecordBytes, "session manifest"), path.string());
+      manifest_from_json(read_small_file(path, kMaxSessionManifestBytes, "session manifest"), path.string());
   manifest.session_id = folder.filename().string();
   return manifest;
 }
@@ -39,7 +39,7 @@ SessionManifest read_previous_session(const fs::path& folder, const SessionManif
   const PreviousSession& link = manifest.previous.value();
   const fs::path before = folder.parent_path() / link.session_id;
   const fs::path path = before / "session.json";
-  const std::string text = read_small_file(path, kMaxRecordBytes, "session manifest");
+  const std::string text = read_small_file(path, kMaxSessionManifestBytes, "session manifest");
   if (!link.session_sha256.empty() && sha256_hex(text) != link.session_sha256) {
     fail((folder / "session.json").string(), "/previous_session/session_sha256",
          path.string() +
@@ -49,6 +49,11 @@ SessionManifest read_previous_session(const fs::path& folder, const SessionManif
   SessionManifest previous = manifest_from_json(text, path.string());
   previous.session_id = before.filename().string();
   return previous;
+}
+
+bool protocols_conflict(const LoadedProtocol& a, const LoadedProtocol& b) {
+  const auto practice = [](const LoadedProtocol& p) { return p.path == "calligraphy-train"; };
+  return a.protocol.name == b.protocol.name && a.sha256 != b.sha256 && !(practice(a) && practice(b));
 }
 
 bool DistinctSessions::add(const fs::path& folder, const SessionManifest& manifest) {

@@ -12,7 +12,7 @@
 
 namespace calligraphy::study_detail {
 
-/// Largest session manifest or trial record read: 64 MiB.
+/// Largest trial record read: 64 MiB (a session manifest: kMaxSessionManifestBytes, session_folder.hpp).
 inline constexpr std::uintmax_t kMaxRecordBytes = std::uintmax_t{64} << 20;
 
 /// The session folders under `roots` (each a session folder or a folder holding some), sorted by path within
@@ -27,6 +27,11 @@ SessionManifest read_session_manifest(const std::filesystem::path& folder);
 /// Throws DataError naming the file when it cannot be read or its session.json is not the one the link
 /// recorded (another SHA-256: replaced or edited).
 SessionManifest read_previous_session(const std::filesystem::path& folder, const SessionManifest& manifest);
+
+/// True when `a` and `b` are two different protocols (another SHA-256) under one name, whose sessions a
+/// reader would pool as one design. The trainer's free practice (`calligraphy train`, protocol "train" made
+/// for each run from its characters) is one design whatever characters a run practised.
+[[nodiscard]] bool protocols_conflict(const LoadedProtocol& a, const LoadedProtocol& b);
 
 /// The session folders already read, by what makes a session itself (subject, protocol, session number and
 /// creation time), so that a copy of one is refused rather than counted twice.

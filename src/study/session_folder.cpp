@@ -1,22 +1,27 @@
 #include "calligraphy/study/session_folder.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/file.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <exception>
 #include <utility>
 
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/trial/options.hpp"
-#include "calligraphy/core/unicode.hpp"
 #include "report/compressed_text.hpp"
 #include "study/json_reader.hpp"
 #include "study/manifest_json.hpp"
@@ -25,8 +30,6 @@
 namespace calligraphy {
 namespace fs = std::filesystem;
 namespace {
-
-constexpr std::uintmax_t kMaxManifestBytes = std::uintmax_t{16} << 20;
 
 [[noreturn]] void fail_errno(const fs::path& path, const std::string& what, int error) {
   throw DataError(path.string() + ": " + what + ": " + std::strerror(error));
@@ -81,6 +84,62 @@ std::string folder_timestamp() {
   return text;
 }
 
+// "PID.HOST" of this process: whose a temporary session folder is, so that only a dead run's is removed.
+std::string partial_owner() {
+  char host[256] = {};
+  if (::gethostname(host, sizeof host - 1) != 0) host[0] = '\0';
+  std::string name;
+  for (const char* c = host; *c != '\0' && name.size() < 64; ++c) {
+    const bool plain = (*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9');
+    name += plain ? *c : '-';  // no '.': it separates the fields
+  }
+  return std::to_string(::getpid()) + "." + (name.empty() ? "host" : name);
+}
+
+// Removes the temporary session folders (".partial.PID.HOST.NAME") that runs on this host left when they
+// were killed: their process is gone. Another host's, or a live process's, are left (readers skip them).
+void remove_dead_partial_folders(const fs::path& subject_folder) {
+  const std::string own = partial_owner();
+  const std::string host = own.substr(own.find('.') + 1);
+  std::error_code error;
+  for (const fs::directory_entry& entry : fs::directory_iterator(subject_folder, error)) {
+    const std::string name = entry.path().filename().string();
+    if (!is_partial_session_folder(entry.path())) continue;
+    const std::string rest = name.substr(kPartialSessionPrefix.size());
+    const std::size_t dot = rest.find('.');
+    if (dot == std::string::npos || rest.compare(dot + 1, host.size() + 1, host + ".") != 0) continue;
+    pid_t pid = 0;
+    try {
+      pid = static_cast<pid_t>(std::stol(rest.substr(0, dot)));
+    } catch (const std::exception&) {
+      continue;
+    }
+    if (pid <= 0 || (pid != ::getpid() && (::kill(pid, 0) == 0 || errno != ESRCH))) continue;
+    std::error_code ignored;
+    fs::remove_all(entry.path(), ignored);
+  }
+}
+
+// The folder as named by its own name ("S/x/" and "S/x/." are x).
+fs::path named_folder(const fs::path& folder) {
+  std::error_code error;
+  const fs::path resolved = fs::weakly_canonical(folder, error);
+  return error ? folder.lexically_normal() : resolved;
+}
+
+// rename(2) that fails with EEXIST rather than replace an (empty) folder of that name.
+int rename_no_replace(const fs::path& from, const fs::path& to) {
+  if (::renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_NOREPLACE) == 0) return 0;
+  if (errno != EINVAL && errno != ENOSYS) return -1;
+  // A file system without RENAME_NOREPLACE: a folder appearing in between is the only race left.
+  std::error_code error;
+  if (fs::exists(to, error)) {
+    errno = EEXIST;
+    return -1;
+  }
+  return ::rename(from.c_str(), to.c_str());
+}
+
 void check_setup(const SessionSetup& setup) {
   if (!study_detail::is_label(setup.subject.id, 64)) {
     throw InvalidArgument("subject id '" + setup.subject.id +
@@ -101,7 +160,83 @@ void check_setup(const SessionSetup& setup) {
   }
 }
 
+SessionManifest make_manifest(const SessionSetup& setup, const LoadedProtocol& protocol,
+                              const std::optional<PreviousSession>& previous) {
+  SessionManifest manifest;
+  manifest.setup = setup;
+  manifest.protocol = protocol;
+  manifest.library = library_build();
+  manifest.created_utc = study_detail::utc_now_iso8601();
+  manifest.plan = plan_session(protocol.protocol, setup.subject, setup.session_number);
+  manifest.previous = previous;
+  manifest.group = subject_group(protocol.protocol, setup.subject);
+  return manifest;
+}
+
+// session.json's text, refused when a reader would refuse it (kMaxSessionManifestBytes).
+std::string manifest_text(const SessionManifest& manifest) {
+  std::string text = study_detail::manifest_to_json(manifest);
+  if (text.size() > kMaxSessionManifestBytes) {
+    char size[32];
+    std::snprintf(size, sizeof size, "%.1f MiB", static_cast<double>(text.size()) / (1 << 20));
+    throw DataError(
+        manifest.protocol.path.string() + ": session " + std::to_string(manifest.setup.session_number) +
+        " of subject " + manifest.setup.subject.id + " plans " + std::to_string(manifest.plan.size()) +
+        " trials, a session.json of " + size + ", more than the " +
+        std::to_string(kMaxSessionManifestBytes >> 20) +
+        " MiB a session's reader takes: fewer characters, conditions or repetitions a session, or "
+        "the phases over more sessions");
+  }
+  return text;
+}
+
 }  // namespace
+
+std::uintmax_t trial_files_bytes(const ProtocolTrialSettings& trial) {
+  const double ticks = std::ceil(trial.max_duration_s * trial.rate_hz);
+  return static_cast<std::uintmax_t>(ticks) * 64 + (std::uintmax_t{1} << 20);
+}
+
+void check_writable_folder(const fs::path& folder, std::uintmax_t free_bytes) {
+  const auto refuse = [&folder](const std::string& why) {
+    throw DataError(folder.string() + ": " + why + " (checked before the first trial; nothing was written)");
+  };
+  if (::access(folder.c_str(), W_OK) != 0)
+    refuse(std::string("cannot write in the folder: ") + std::strerror(errno));
+  // access(2) lets a privileged user pass a read-only or immutable folder: a file made and removed does not.
+  const fs::path probe = folder / (".calligraphy-write-probe-" + std::to_string(::getpid()));
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) refuse(std::string("cannot create a file in the folder: ") + std::strerror(errno));
+  ::close(fd);
+  if (::unlink(probe.c_str()) != 0)
+    refuse("cannot remove a file from the folder (" + probe.filename().string() +
+           "): " + std::strerror(errno));
+  struct statvfs space {};
+  if (::statvfs(folder.c_str(), &space) != 0)
+    refuse(std::string("cannot read its free space: ") + std::strerror(errno));
+  const std::uintmax_t available = static_cast<std::uintmax_t>(space.f_bavail) * space.f_frsize;
+  if (available < free_bytes) {
+    char text[96];
+    std::snprintf(text, sizeof text, "%.1f MiB free, less than the %.1f MiB one trial's files may take",
+                  static_cast<double>(available) / (1 << 20), static_cast<double>(free_bytes) / (1 << 20));
+    refuse(text);
+  }
+  // A file system that counts inodes (f_files > 0) may run out of them before its bytes.
+  if (space.f_files > 0 && space.f_favail < 16)
+    refuse(std::to_string(space.f_favail) + " inodes free, fewer than the 16 a trial's files may take");
+}
+
+void check_session_manifest_size(const SessionSetup& setup, const LoadedProtocol& protocol) {
+  std::optional<PreviousSession> previous;
+  if (setup.session_number > 1) {  // a link as long as a real one (its size counts too)
+    previous.emplace();
+    previous->session_id = protocol.protocol.name + "-" + setup.subject.id + "-YYYYMMDD-HHMMSS-1000";
+    previous->ended_utc = study_detail::utc_now_iso8601();
+    previous->session_sha256 = std::string(64, '0');
+    previous->delay = "overridden";
+  }
+  (void)manifest_text(make_manifest(setup, protocol, previous));
+}
 
 std::uint64_t subject_seed(std::string_view subject_id) {
   return study_detail::mix64(study_detail::fnv1a_64(subject_id));
@@ -155,44 +290,66 @@ SessionFolder SessionFolder::create(const fs::path& root, const SessionSetup& se
         "': " +
         (previous ? "the first session has no previous one" : "a later session needs the previous one"));
   }
-  SessionManifest manifest;
-  manifest.setup = setup;
-  manifest.protocol = protocol;
-  manifest.library = library_build();
-  manifest.created_utc = study_detail::utc_now_iso8601();
-  manifest.plan = plan_session(protocol.protocol, setup.subject, setup.session_number);
-  manifest.previous = previous;
-  manifest.group = subject_group(protocol.protocol, setup.subject);
+  SessionManifest manifest = make_manifest(setup, protocol, previous);
+  const std::string text = manifest_text(manifest);  // refused before any folder is made
 
   const fs::path subject_folder = root / setup.subject.id;
   make_folder(subject_folder);
+  remove_dead_partial_folders(subject_folder);
   // The session id names the protocol, the subject and the second it began, so ids are keys across
   // subjects (two subjects started in the same second differ) and sort by time within a subject.
   const std::string base = protocol.protocol.name + "-" + setup.subject.id + "-" + folder_timestamp();
+  // The folder is made whole under a temporary name beside its own, session.json first, then renamed: a run
+  // killed at any moment leaves no session folder or one with its session.json, and at worst a temporary
+  // that readers skip and the next run removes.
+  const fs::path building =
+      subject_folder / (std::string(kPartialSessionPrefix) + partial_owner() + "." + base);
+  if (::mkdir(building.c_str(), 0755) != 0) fail_errno(building, "cannot create the session folder", errno);
+  int fd = -1;
+  const auto abandon = [&building, &fd] {
+    if (fd >= 0) ::close(fd);
+    std::error_code ignored;
+    fs::remove_all(building, ignored);
+  };
+  try {
+    write_file_atomically(building / "session.json", text);
+    make_folder(building / "trials");
+    fd = open_locked_log(building / "log.jsonl");
+    fsync_folder(building);
+  } catch (...) {
+    abandon();
+    throw;
+  }
   fs::path folder;
   for (int suffix = 1;; ++suffix) {
     const std::string name = suffix == 1 ? base : base + "-" + std::to_string(suffix);
     folder = subject_folder / name;
-    // mkdir fails when the folder exists: two runners never share a folder.
-    if (::mkdir(folder.c_str(), 0755) == 0) {
+    // Never onto an existing folder: two runners never share one.
+    if (rename_no_replace(building, folder) == 0) {
       manifest.session_id = name;
       break;
     }
-    if (errno != EEXIST || suffix > 1000) fail_errno(folder, "cannot create the session folder", errno);
+    const int error = errno;
+    if ((error != EEXIST && error != ENOTEMPTY) || suffix > 1000) {
+      abandon();
+      fail_errno(folder, "cannot create the session folder", error);
+    }
   }
-  make_folder(folder / "trials");
-  const int fd = open_locked_log(folder / "log.jsonl");
   SessionFolder session(folder, std::move(manifest), fd);
-  write_file_atomically(folder / "session.json", study_detail::manifest_to_json(session.manifest_));
   fsync_folder(subject_folder);
   session.log("session_created", study_detail::session_created_details(session.manifest_));
   return session;
 }
 
+bool is_partial_session_folder(const fs::path& folder) {
+  return folder.filename().string().starts_with(kPartialSessionPrefix);
+}
+
 SessionFolder SessionFolder::open(const fs::path& folder) {
+  if (is_partial_session_folder(named_folder(folder))) throw DataError(folder.string() + ": " + kPartialNote);
   const fs::path manifest_path = folder / "session.json";
   const std::string text =
-      study_detail::read_small_file(manifest_path, kMaxManifestBytes, "session manifest");
+      study_detail::read_small_file(manifest_path, kMaxSessionManifestBytes, "session manifest");
   SessionManifest manifest = study_detail::manifest_from_json(text, manifest_path.string());
   manifest.session_id = folder.filename().string();
   if (manifest.session_id.empty()) manifest.session_id = folder.parent_path().filename().string();
@@ -297,6 +454,20 @@ fs::path SessionFolder::save_attempt(const PlannedTrial& trial, std::string_view
   throw DataError(folder.string() + ": too many attempts of trial " + trial_stem(trial));
 }
 
+void SessionFolder::check_writable() const {
+  const std::uintmax_t bytes = trial_files_bytes(manifest_.protocol.protocol.trial);
+  check_writable_folder(path_, bytes);  // teachers/ and trials/attempts/ are made here when first needed
+  for (const fs::path& folder : {path_ / "trials", path_ / "trials" / "attempts", path_ / "teachers"}) {
+    std::error_code error;
+    if (folder == path_ / "trials" || fs::is_directory(folder, error)) check_writable_folder(folder, bytes);
+  }
+  const fs::path log_path = path_ / "log.jsonl";
+  if (::access(log_path.c_str(), W_OK) != 0) {
+    throw DataError(log_path.string() + ": cannot write the session log: " + std::strerror(errno) +
+                    " (checked before the first trial; nothing was written)");
+  }
+}
+
 void SessionFolder::log(std::string_view event, std::string_view details_json) {
   const std::string line = study_detail::log_line(study_detail::utc_now_iso8601(), event, details_json);
   const fs::path log_path = path_ / "log.jsonl";
@@ -308,7 +479,10 @@ std::vector<fs::path> find_session_folders(const fs::path& root) {
   std::error_code error;
   if (!fs::is_directory(root, error))
     throw DataError(root.string() + ": not a folder (expected session folders)");
-  if (fs::is_regular_file(root / "session.json", error)) return {root};
+  if (fs::is_regular_file(root / "session.json", error)) {
+    if (is_partial_session_folder(named_folder(root))) throw DataError(root.string() + ": " + kPartialNote);
+    return {root};
+  }
   std::vector<fs::path> found;
   fs::recursive_directory_iterator it(root, fs::directory_options::skip_permission_denied, error);
   if (error) throw DataError(root.string() + ": cannot list the folder: " + error.message());
@@ -319,6 +493,10 @@ std::vector<fs::path> find_session_folders(const fs::path& root) {
       continue;
     }
     if (!it->is_directory(error)) continue;
+    if (is_partial_session_folder(it->path())) {  // a run's folder not made yet, or a killed run's
+      it.disable_recursion_pending();
+      continue;
+    }
     if (fs::is_regular_file(it->path() / "session.json", error)) {
       found.push_back(it->path());
       it.disable_recursion_pending();

@@ -2,12 +2,14 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 #include <set>
 #include <string>
+#include <utility>
 
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/report/pen_trace_csv.hpp"
 #include "calligraphy/core/unicode.hpp"
+#include "calligraphy/report/pen_trace_csv.hpp"
 #include "study/json_reader.hpp"
 #include "study/names.hpp"
 #include "study/saved_sessions.hpp"
@@ -173,9 +175,24 @@ StudyReportSessions list_report_sessions(const std::vector<fs::path>& roots) {
   study_detail::DistinctSessions distinct;
   StudyReportSessions found;
   std::set<std::string> protocols, protocol_names, learning;
+  // The first session of each protocol name, and its protocol.
+  std::map<std::string, std::pair<fs::path, LoadedProtocol>> by_name;
   for (const fs::path& folder : folders) {
     SessionManifest manifest = study_detail::read_session_manifest(folder);
     if (!distinct.add(folder, manifest)) continue;
+    // Sessions are grouped by protocol name (the tables' `protocol`): two protocols under one name would be
+    // pooled as one design, a wrong result rather than a warning.
+    const auto [first, inserted] =
+        by_name.try_emplace(manifest.protocol.protocol.name, folder, manifest.protocol);
+    if (!inserted && study_detail::protocols_conflict(first->second.second, manifest.protocol)) {
+      study_detail::fail(
+          (folder / "session.json").string(), "/protocol/sha256",
+          "protocol '" + manifest.protocol.protocol.name + "' here has SHA-256 " + manifest.protocol.sha256 +
+              ", but in " + (first->second.first / "session.json").string() + " SHA-256 " +
+              first->second.second.sha256 +
+              ": two different protocols under one name would be pooled as one design; read them "
+              "apart (report each study folder on its own)");
+    }
     protocols.insert(manifest.protocol.sha256);
     protocol_names.insert(manifest.protocol.protocol.name);
     if (manifest.setup.writer == "simulated") learning.insert(manifest.setup.writer_learning);

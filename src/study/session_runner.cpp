@@ -192,7 +192,7 @@ class SessionRun {
       if (!rest_before(trial)) break;
       if (options_.host) options_.host->before_trial(trial, result_.planned);
       run_trial(trial);
-      if (result_.interrupted || result_.device_failed) break;
+      if (result_.interrupted || result_.device_failed || result_.save_failed) break;
     }
     end();
     return result_;
@@ -209,6 +209,8 @@ class SessionRun {
   };
 
   void begin() {
+    // Refused before the first trial rather than found when a trial cannot be saved.
+    session_.check_writable();
     result_.planned = session_.plan().size();
     result_.saved_before = session_.saved_count();
     const std::optional<std::size_t> first = session_.next_unsaved();
@@ -385,7 +387,11 @@ class SessionRun {
     if (keep_as_trial) {
       const std::string record = study_detail::trial_record_json(context, scene, trial_result, writing,
                                                                  quiz.empty() ? nullptr : &quiz);
-      session_.save_trial(trial, record, trial_csv(trial_result.trace), trial_svg(scene, trial_result));
+      try {
+        session_.save_trial(trial, record, trial_csv(trial_result.trace), trial_svg(scene, trial_result));
+      } catch (const DataError& e) {
+        return save_failed(trial, e, outcome);
+      }
       // Learned from as the record says, the same as when the memory is rebuilt on a resume.
       if (learning_)
         study_detail::practise_record(memory_, json::parse(record), session_.trial_file(trial, "json").string(),
@@ -399,7 +405,12 @@ class SessionRun {
       context.svg_file.clear();
       const std::string record = study_detail::trial_record_json(context, scene, trial_result, writing,
                                                                  quiz.empty() ? nullptr : &quiz);
-      const auto kept = session_.save_attempt(trial, record, trial_csv(trial_result.trace));
+      std::filesystem::path kept;
+      try {
+        kept = session_.save_attempt(trial, record, trial_csv(trial_result.trace));
+      } catch (const DataError& e) {
+        return save_failed(trial, e, outcome);
+      }
       outcome.json_file = kept.string();
       details["attempt"] = kept.filename().string();
       details["abort_reason"] = trial_result.abort_reason;
@@ -417,7 +428,32 @@ class SessionRun {
     return outcome;
   }
 
+  // A trial that could not be saved (the disk filled meanwhile) stops the run: reported, logged where the
+  // log can still be written, and left unsaved, so that a resume runs it again; nothing saved is touched.
+  TrialOutcome save_failed(const PlannedTrial& trial, const DataError& e, TrialOutcome outcome) {
+    result_.save_failed = true;
+    result_.failure = "trial " + std::to_string(trial.index + 1) + " (" + SessionFolder::trial_stem(trial) +
+                      ") could not be saved: " + e.what();
+    json details = trial_details(trial);
+    details["error"] = e.what();
+    try {
+      session_.log("trial_failed", details.dump());
+    } catch (const DataError&) {  // the same full disk: the failure is reported by the result
+    }
+    return outcome;
+  }
+
   void end() {
+    if (result_.save_failed) {
+      try {
+        session_.log("session_stopped", json{{"saved_trials", result_.saved_before + result_.saved_now},
+                                             {"planned", result_.planned},
+                                             {"reason", "save_failed"}}
+                                            .dump());
+      } catch (const DataError&) {  // as above
+      }
+      return;
+    }
     if (result_.complete()) {
       session_.log("session_completed", json{{"trials", result_.planned}}.dump());
     } else {

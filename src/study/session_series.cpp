@@ -5,8 +5,11 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <map>
+#include <thread>
+#include <vector>
 
 #include "calligraphy/core/errors.hpp"
 #include "study/json_reader.hpp"
@@ -19,7 +22,7 @@ namespace {
 
 std::string manifest_sha256(const fs::path& folder) {
   return sha256_hex(
-      study_detail::read_small_file(folder / "session.json", study_detail::kMaxRecordBytes, "session manifest"));
+      study_detail::read_small_file(folder / "session.json", kMaxSessionManifestBytes, "session manifest"));
 }
 
 // Session `number` (> 1) must follow the folder found for the session before it: by name, and by content
@@ -103,8 +106,20 @@ SessionSeries session_series(const fs::path& root, const std::string& subject_id
     previous.session_id = manifest.session_id;
     previous.session_sha256 = manifest_sha256(folder);
     const nlohmann::json record = study_detail::read_trial_record(last_record);
-    previous.ended_utc = study_detail::JsonView(record, "", last_record.string())
-                             .string_or("end_time_utc", manifest.created_utc);
+    // Every saved record has its end; one without (null or missing: the run was killed as it wrote, or the
+    // record was edited) gives no time to measure the delay from. The session's creation is not its end.
+    const study_detail::JsonView view(record, "", last_record.string());
+    if (!view.has("end_time_utc")) {
+      study_detail::fail(last_record.string(), "/end_time_utc",
+                         std::string(record.contains("end_time_utc") ? "null" : "missing") + ": session " +
+                             std::to_string(number) + " of " + protocol.protocol.name + " (" +
+                             folder.string() +
+                             ") did not end: its last trial has no end time, so the delay before session " +
+                             std::to_string(number + 1) +
+                             " cannot be measured; restore this trial record (a saved trial is never written "
+                             "again, so resume cannot)");
+    }
+    previous.ended_utc = view.string_or("end_time_utc", "");
     double ended_s = 0.0;
     try {
       ended_s = study_detail::utc_seconds(previous.ended_utc);
@@ -129,8 +144,35 @@ SessionSeries session_series(const fs::path& root, const std::string& subject_id
   return series;
 }
 
+void check_protocol_unchanged(const fs::path& root, const LoadedProtocol& protocol) {
+  std::error_code error;
+  if (!fs::is_directory(root, error)) return;
+  std::vector<fs::path> folders;
+  try {
+    folders = find_session_folders(root);
+  } catch (const DataError&) {
+    return;  // the series' reader lists the folder again and names what is wrong
+  }
+  for (const fs::path& folder : folders) {
+    SessionManifest manifest;
+    try {
+      manifest = study_detail::read_session_manifest(folder);
+    } catch (const DataError&) {
+      continue;  // another session's damage is its readers' to report; the subject's own, the series'
+    }
+    if (!study_detail::protocols_conflict(manifest.protocol, protocol)) continue;
+    throw DataError(
+        protocol.path.string() + ": the protocol '" + protocol.protocol.name +
+        "' differs from the one the session " + folder.string() + " was run with (SHA-256 " +
+        protocol.sha256 + " here, " + manifest.protocol.sha256 +
+        " there: edited since?); its sessions and this run's would be one design of two "
+        "protocols: restore that protocol, or give the edited one another name or a new --out folder");
+  }
+}
+
 SeriesLock::SeriesLock(const fs::path& root, const std::string& subject_id,
-                       const std::function<void(const fs::path&)>& waiting)
+                       const std::function<void(const fs::path&)>& waiting,
+                       const std::function<bool()>& should_stop)
     : path_(root / subject_id) {
   // The subject's folder itself is locked (flock(2) takes a directory): no lock file among the sessions.
   std::error_code error;
@@ -138,13 +180,25 @@ SeriesLock::SeriesLock(const fs::path& root, const std::string& subject_id,
   if (error) throw DataError(path_.string() + ": cannot create the folder: " + error.message());
   fd_ = ::open(path_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (fd_ < 0) throw DataError(path_.string() + ": cannot open the lock: " + std::strerror(errno));
-  if (::flock(fd_, LOCK_EX | LOCK_NB) == 0) return;
-  if (errno == EWOULDBLOCK && waiting) waiting(path_);
-  while (::flock(fd_, LOCK_EX) != 0) {
-    if (errno == EINTR) continue;
+  // A blocking flock restarts after a caught signal (SA_RESTART), so the wait polls instead: a stop request
+  // ends it within one interval.
+  bool told = false;
+  while (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
     const int reason = errno;
-    ::close(fd_);
-    throw DataError(path_.string() + ": cannot lock: " + std::strerror(reason));
+    if (reason == EINTR) continue;
+    if (reason != EWOULDBLOCK) {
+      ::close(fd_);
+      fd_ = -1;
+      throw DataError(path_.string() + ": cannot lock: " + std::strerror(reason));
+    }
+    if (!told && waiting) waiting(path_);
+    told = true;
+    if (should_stop && should_stop()) {
+      ::close(fd_);
+      fd_ = -1;
+      return;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
 }
 

@@ -8,11 +8,12 @@
 #include <cstdlib>
 #include <nlohmann/json.hpp>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
-#include "calligraphy/core/decimal_number.hpp"
-#include "calligraphy/core/unicode.hpp"
+#include "calligraphy/study/protocol.hpp"
 #include "study/json_reader.hpp"
 
 namespace calligraphy {
@@ -344,7 +345,7 @@ void TrialSpec::validate(TeacherSource teacher_from) const {
     refuse("max_duration_s", number_text(max_duration_s) + " is outside (0, 86400]");
   }
   // A trace longer than this would not fit a trial's memory (one sample per tick).
-  if (rate_hz * max_duration_s > 1e7) {
+  if (rate_hz * max_duration_s > kMaxTrialTicks) {
     refuse("max_duration_s", number_text(max_duration_s) + " s at " + number_text(rate_hz) +
                                  " Hz is more than 10^7 servo ticks");
   }

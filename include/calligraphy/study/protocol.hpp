@@ -169,10 +169,14 @@ struct BreakRules {
   double duration_s = 0.0;
 };
 
+/// The most servo ticks a trial may last (max_duration_s x rate_hz): its trace, one sample a tick, is held
+/// in memory. The trial runner refuses more (TrialSpec::validate); a protocol is refused at reading.
+inline constexpr double kMaxTrialTicks = 1e7;
+
 /// Settings of every trial of the study.
 struct ProtocolTrialSettings {
   double max_duration_s = 120.0;  ///< a trial ends after this much device time [s], (0, 3600]
-  double rate_hz = 1000.0;        ///< servo rate [Hz], [100, 10000]
+  double rate_hz = 1000.0;        ///< servo rate [Hz], [100, 10000]; x max_duration_s <= kMaxTrialTicks
 };
 
 /// A whole protocol.

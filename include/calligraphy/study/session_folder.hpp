@@ -87,6 +87,27 @@ struct SessionManifest {
   std::string group;  ///< the subject's group (`subject_group`): "" when every phase is within subjects
 };
 
+/// The largest session.json: every reader of a session (resume, the series, the report and the tables)
+/// refuses a larger one, so `SessionFolder::create` refuses to write one. Its plan makes it big: about 250
+/// bytes a planned trial, so some 250,000 trials a session.
+inline constexpr std::uintmax_t kMaxSessionManifestBytes = std::uintmax_t{64} << 20;
+
+/// Throws DataError naming the protocol's file, the subject, the session and the size when the session.json
+/// `SessionFolder::create` would write for `setup` (the plan of `protocol` for its subject and session) is
+/// larger than kMaxSessionManifestBytes. A front end checks this before its first session folder is made.
+void check_session_manifest_size(const SessionSetup& setup, const LoadedProtocol& protocol);
+
+/// The free space kept for one trial's files (its compressed trace, SVG and record, and their temporaries):
+/// 64 bytes a servo tick of a trial at its time limit (`max_duration_s` x `rate_hz`; the trace's CSV before
+/// compression takes about that, the compressed trace, SVG and record together far less) plus 1 MiB.
+[[nodiscard]] std::uintmax_t trial_files_bytes(const ProtocolTrialSettings& trial);
+
+/// Checks, before anything is written there, that files can be written in `folder` now: access(2) for
+/// writing, then a probe file created and removed (which also catches a read-only or immutable folder of a
+/// privileged user), and at least `free_bytes` and 16 inodes free on its file system (statvfs). Throws
+/// DataError naming the folder and the reason.
+void check_writable_folder(const std::filesystem::path& folder, std::uintmax_t free_bytes);
+
 /// A session folder, opened by one process at a time. Move-only; the lock is released on destruction.
 class SessionFolder {
  public:
@@ -96,7 +117,8 @@ class SessionFolder {
   /// ("session_created"). A transfer choice of the protocol must be resolved (`resolve_transfer_choices`).
   /// Throws InvalidArgument for a bad setup (subject id, writer, profile, pacing, a session number the
   /// protocol does not have, `previous` missing for a later session or given for the first), DataError
-  /// naming the path when a folder or file cannot be made.
+  /// naming the path when a folder or file cannot be made, and as `check_session_manifest_size` (before
+  /// any folder is made).
   static SessionFolder create(const std::filesystem::path& root, const SessionSetup& setup,
                               const LoadedProtocol& protocol,
                               const std::optional<PreviousSession>& previous = std::nullopt);
@@ -139,6 +161,12 @@ class SessionFolder {
   /// JSON's path.
   std::filesystem::path save_attempt(const PlannedTrial& trial, std::string_view json, std::string_view csv);
 
+  /// Checks every folder and file a run of the session writes (the session folder, trials/, trials/attempts/,
+  /// teachers/, log.jsonl) with `check_writable_folder`, the free space for one trial's files
+  /// (`trial_files_bytes` of the protocol). `run_session` calls it before its first trial. Throws DataError
+  /// naming the folder or file.
+  void check_writable() const;
+
   /// Appends {"time_utc": ..., "event": EVENT, ...details} as one line to log.jsonl and fsyncs it.
   /// `details_json` is a JSON object (its members are added) or empty. Throws InvalidArgument when it is
   /// not an object, DataError naming the log when the write or fsync fails.
@@ -151,8 +179,20 @@ class SessionFolder {
   int log_fd_ = -1;
 };
 
+/// How a session folder's name begins while `SessionFolder::create` builds it (".partial.PID.HOST.NAME",
+/// renamed to NAME once whole): a run killed before then leaves it. Readers skip it; the next `create` in the
+/// subject's folder removes one whose process (on this host) is gone.
+inline constexpr std::string_view kPartialSessionPrefix = ".partial.";
+/// What a temporary session folder is, for messages naming one.
+inline constexpr const char* kPartialNote =
+    "a session folder left half made by a run killed before its first trial (its name begins \".partial.\"); "
+    "no trial is in it: remove it (the next session run of the subject does)";
+/// True when the folder's name marks it as being made (kPartialSessionPrefix).
+[[nodiscard]] bool is_partial_session_folder(const std::filesystem::path& folder);
+
 /// The session folders under `root`: `root` itself when it holds a session.json, else every folder below it
-/// (at most 4 levels deep) that does, sorted by path. Throws DataError when `root` is not a folder.
+/// (at most 4 levels deep) that does, sorted by path; temporary folders (`is_partial_session_folder`) are
+/// skipped. Throws DataError when `root` is not a folder or is a temporary one.
 [[nodiscard]] std::vector<std::filesystem::path> find_session_folders(const std::filesystem::path& root);
 
 }  // namespace calligraphy

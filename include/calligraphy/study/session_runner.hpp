@@ -78,7 +78,10 @@ struct SessionRunResult {
   std::size_t attempts_kept = 0;
   bool interrupted = false;  ///< should_stop ended the run
   bool device_failed = false;
-  std::string failure;  ///< the device's message when it failed
+  /// A trial's files could not be written (a disk filled meanwhile): the run stopped there, every trial saved
+  /// before stays saved and the session can be resumed.
+  bool save_failed = false;
+  std::string failure;  ///< the device's message when it failed; what could not be saved, and why
   [[nodiscard]] bool complete() const { return saved_before + saved_now == planned; }
 };
 
@@ -117,7 +120,9 @@ struct TrialGuidance {
 /// when the protocol names none), each named with its SHA-256 in the trial's record. Throws
 /// InvalidArgument before any trial when a planned condition cannot run or a simulated writer is asked to
 /// move a device a person holds, DeviceNotFound when the device is not in the registry, CharacterNotFound for
-/// a missing character, and DataError when a file cannot be saved; what was saved before stays saved.
+/// a missing character, DataError before any trial when the session cannot be written
+/// (`SessionFolder::check_writable`), and DataError when the log cannot be written. A trial whose files
+/// cannot be saved ends the run with `save_failed`; what was saved before stays saved.
 SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& options = {});
 
 }  // namespace calligraphy

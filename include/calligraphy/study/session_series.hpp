@@ -44,6 +44,12 @@ struct SessionSeries {
 [[nodiscard]] SessionSeries session_series(const std::filesystem::path& root, const std::string& subject_id,
                                            const LoadedProtocol& protocol);
 
+/// Refuses `protocol` when a session under the study folder `root` (any subject's) was run with another
+/// protocol of the same name (another SHA-256: the file was edited): the series would start again beside
+/// it, and every reader would pool the two as one design. Throws DataError naming the protocol's file, that
+/// session's folder and both SHA-256; a session.json that cannot be read is left to the readers that need it.
+void check_protocol_unchanged(const std::filesystem::path& root, const LoadedProtocol& protocol);
+
 /// An exclusive lock on one subject's series under `root` (flock(2) on the folder ROOT/SUBJECT), held by a
 /// run from reading the series until its session is written, so that concurrent runs of one subject take
 /// turns (the later sees what the earlier wrote) instead of starting a session twice. The system releases
@@ -51,13 +57,18 @@ struct SessionSeries {
 class SeriesLock {
  public:
   /// Creates the subject's folder when missing and waits until the lock is free, calling `waiting` with the
-  /// folder's path once when it is not free at first. Throws DataError naming the folder when it cannot be
-  /// created or locked.
+  /// folder's path once when it is not free at first. While it waits it polls `should_stop` (every 50 ms):
+  /// true ends the wait without the lock (`held()` false), so that a stop signal is not ignored behind
+  /// another run. Throws DataError naming the folder when it cannot be created or locked.
   SeriesLock(const std::filesystem::path& root, const std::string& subject_id,
-             const std::function<void(const std::filesystem::path&)>& waiting = {});
+             const std::function<void(const std::filesystem::path&)>& waiting = {},
+             const std::function<bool()>& should_stop = {});
   SeriesLock(const SeriesLock&) = delete;
   SeriesLock& operator=(const SeriesLock&) = delete;
   ~SeriesLock();
+
+  /// True when the lock is held (false only when `should_stop` ended the wait).
+  [[nodiscard]] bool held() const noexcept { return fd_ >= 0; }
 
  private:
   std::filesystem::path path_;
