@@ -199,7 +199,11 @@ class OpenHapticsTestCase(unittest.TestCase):
                   "survey = calligraphy.list_devices()\n"
                   "print([d.name for d in survey.devices])\n"
                   "print(survey.notes)\n")
-        if not PYTHONPATH or subprocess.run([sys.executable, "-c", "from calligraphy import list_devices"], env=env,
+        # The build's own package, never one installed elsewhere (an earlier `cmake --install` in /usr/local).
+        from_build = ("import pathlib, sys, calligraphy\n"
+                      "sys.exit(0 if pathlib.Path(calligraphy.__file__).resolve().is_relative_to("
+                      "pathlib.Path(sys.argv[1]).resolve()) else 3)\n")
+        if not PYTHONPATH or subprocess.run([sys.executable, "-c", from_build, PYTHONPATH], env=env,
                                             capture_output=True, timeout=TIMEOUT_S).returncode != 0:
             self.skipTest(f"the calligraphy Python package does not import from {PYTHONPATH!r}")
         result = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, timeout=TIMEOUT_S)

@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include <csignal>
+#include <initializer_list>
 #include <cstdio>
 #include <cstring>
 
@@ -41,6 +42,9 @@ void report(const char* line) {
 int main(int argc, char** argv) {
   // The caller may die while a driver hangs here: this process must not outlive it.
   ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+  // A driver's crash must end this process by its signal, which the caller names: a sanitizer's runtime
+  // (in a sanitizer build) would catch it and exit with a status instead.
+  for (const int fatal : {SIGSEGV, SIGBUS, SIGFPE, SIGILL}) std::signal(fatal, SIG_DFL);
   if (argc < 2) return 64;
   report("loading\n");
   void* library = ::dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
