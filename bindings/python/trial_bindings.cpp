@@ -16,16 +16,17 @@
 #include "arguments.hpp"
 #include "bindings.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/unicode.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/render/guidance_law.hpp"
 #include "calligraphy/render/passivity.hpp"
 #include "calligraphy/render/safety_chain.hpp"
-#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/sim/simulated_hand.hpp"
+#include "calligraphy/study/recorded_trial.hpp"
 #include "calligraphy/study/trial_spec_runner.hpp"
 #include "calligraphy/trial/trial.hpp"
 #include "character_source.hpp"
-#include "calligraphy/core/unicode.hpp"
 #include "log_forwarding.hpp"
 #include "model_bindings.hpp"
 #include "numpy_arrays.hpp"
@@ -270,6 +271,11 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
       spec.amplification_gain = amplify->gain;
     if (const auto* timing = std::get_if<TimingGuidance>(&law)) spec.timing_speed_m_s = timing->speed_m_s;
   }
+  // The profile it starts from, by name, when it is one of the named ones (the record states it; the
+  // profile itself, with writer_params applied, is an input below).
+  const std::string& profile_name = simulation.writer.name;
+  if (profile_name == "novice" || profile_name == "skilled" || profile_name == "foreign")
+    spec.writer_profile = profile_name;
   spec.seed = simulation.seed;
   spec.rate_hz = options.rate_hz;
   spec.pacing = options.pacing;
@@ -323,6 +329,11 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
                                               py::repr(value).cast<std::string>());
     }
   }
+  // The whole specification that ran, with a simulated device's own physics: rerun_trial runs it again.
+  RecordedTrial recorded = recorded_trial(spec, run, scene);
+  // Only physics of the caller's own: without `device=` the simulated device is the registry's.
+  if (device) recorded.simulated_device = simulation.device;
+  description.specification_json = recorded_trial_json(recorded);
   const WritingMetrics& writing = run.metrics;
   if (!keep_trace) result.trace = {};
   PyTrialResult out = to_python(result, trial_metrics(description, result, writing), scene_object);
@@ -348,6 +359,67 @@ PyTrialResult run_trial_py(
   if (name.empty()) throw InvalidArgument("device: a device name of list_devices() is needed");
   const TrialPacing chosen = parse_trial_pacing(take(pacing, "pacing"));
   return trial_py(name, chosen, characters, arguments, std::nullopt, std::nullopt, std::nullopt);
+}
+
+// The trial a record states (a TrialResult's metrics, a trial record as a dict, or a record's file), run
+// again as it ran.
+PyTrialResult rerun_trial_py(const py::object& record, const std::optional<Checked<CharacterSource>>& library,
+                             const std::optional<Annotated<TeacherTag>>& teacher) {
+  RecordedTrial recorded;
+  if (py::isinstance<py::dict>(record)) {
+    const std::string text = py::module_::import("json").attr("dumps")(record).cast<std::string>();
+    recorded = read_recorded_trial(text, "record");
+  } else if (py::isinstance<py::str>(record) ||
+             py::isinstance(record, py::module_::import("os").attr("PathLike"))) {
+    recorded = read_recorded_trial_file(convert_named<std::filesystem::path>(record, "record").string());
+  } else {
+    throw_type_error("record", "a dict (TrialResult.metrics, a trial record) or a record's path", record);
+  }
+  const CharacterSource source = library ? take(*library, "library") : CharacterSource::embedded();
+  py::object scene_object = py::cast(
+      Scene::lay_out(characters_from(py::str(recorded.spec.characters), source, "record"), recorded.layout));
+  const Scene& scene = scene_object.cast<const Scene&>();
+  TrialRunInputs inputs;
+  inputs.registry = &python_device_registry();
+  inputs.host_process = true;
+  if (recorded.spec.guidance_mode == GuidanceMode::replay && recorded.spec.guidance) {
+    if (!teacher) {
+      throw InvalidArgument(
+          "teacher: the record's trial is a replay; give its teacher (a TeacherRecording or a "
+          "list of TeacherSample)");
+    }
+    inputs.teacher = teacher_samples(teacher->object, recorded.spec.characters);
+    recorded.spec.teacher.clear();  // the samples are the teacher
+  }
+  SignalPoll poll;
+  inputs.should_stop = [&poll] { return poll.interrupted(); };
+  TrialRun run;
+  {
+    py::gil_scoped_release release;
+    run = rerun_trial(recorded, scene, inputs);
+  }
+  poll.raise_if_interrupted();
+  TrialDescription description;
+  description.characters = recorded.spec.characters;
+  description.guidance = recorded.spec.guidance;
+  description.writer = run.simulated_writer ? run.writer.name : "human";
+  description.seed = recorded.spec.seed;
+  description.rate_hz = recorded.spec.rate_hz;
+  description.device = recorded.spec.device;
+  description.guidance_mode = mode_of(run.options.force.guidance_law);
+  if (const auto* fading = std::get_if<FadingGuidance>(&run.options.force.guidance_law))
+    description.guidance_gain = fading->gain;
+  if (description.guidance_mode == GuidanceMode::replay)
+    description.teacher_characters = recorded.spec.characters;
+  if (run.simulated_writer) description.writer_profile = run.writer.name;
+  RecordedTrial ran = recorded_trial(recorded.spec, run, scene);
+  ran.simulated_device = recorded.simulated_device;
+  description.specification_json = recorded_trial_json(ran);
+  PyTrialResult out =
+      to_python(run.result, trial_metrics(description, run.result, run.metrics), scene_object);
+  out.writer = run.writer;
+  out.writer_log = std::move(run.writer_log);
+  return out;
 }
 
 // A teacher's recording of a finished trial (teacher_recording_from_trace): its trace's times and pen
@@ -460,6 +532,20 @@ pacing: 'auto' (lock-step for a device a simulated writer moves, real time other
 'real-time' (the spellings of `calligraphy trial --pacing` and of protocols). rate_hz: servo rate [Hz] (at most 10000 in real time). The other arguments as for
 simulate_trial. Returns a TrialResult whose metrics carry `end_reason`. Raises DeviceNotFound (a
 LookupError) naming the devices there are, InvalidArgument, RealtimeError, CommunicationError.)");
+  m.def("rerun_trial", &rerun_trial_py, py::arg("record"), py::arg("library") = py::none(),
+        py::arg("teacher") = py::none(), py::call_guard<ForwardLog>(),
+        R"(Runs again the trial a record states (include/calligraphy/study/recorded_trial.hpp): its whole
+specification, the force law with its guidance law's values, the safety chain, the passivity controller,
+the simulated writer's profile and seed and a simulated device's physics, on the characters of `library`
+(default the embedded set) laid out as recorded. On the simulated device the trace is the same bit for bit.
+
+record: a TrialResult's `metrics` (simulate_trial, run_trial), a trial record read as a dict (`calligraphy
+trial --json`, a study session's trials/*.json), or the path of such a file. teacher: a replay's teacher (a
+TeacherRecording or a list of TeacherSample), which records name but do not hold. Returns a TrialResult.
+Raises DataError naming the record and the JSON pointer of a value at fault, a record without a
+specification (written before records held one) or of another version; InvalidArgument when the
+characters placed are not the recorded ones (other character data), or a replay without its teacher;
+CharacterNotFound; TypeError for a record of another type.)");
   m.def("record_teacher", &record_teacher_py, py::arg("result"), py::arg("path") = py::none(),
         R"(A teacher's recording of a trial (teacher_recording_from_trace,
 include/calligraphy/report/teacher_recording.hpp): the pen's times [s] and positions [m] of every tick,

@@ -8,16 +8,18 @@
 #include <map>
 #include <memory>
 #include <new>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "calligraphy/devices/device_registry.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/report/teacher_recording.hpp"
 #include "calligraphy/report/trial_report.hpp"
-#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/study/recorded_trial.hpp"
 #include "calligraphy/study/trial_spec.hpp"
 #include "calligraphy/study/trial_spec_runner.hpp"
 #include "calligraphy/trial/trial.hpp"
@@ -55,7 +57,52 @@ struct TrialCommand {
   const CLI::Option* watchdog_option = nullptr;  // given on the command line when its count() > 0
   LibraryOptions library;
   std::string json, svg, csv;
+  std::string spec_file;          // --spec: a trial record (or its specification) to run again
+  const CLI::App* app = nullptr;  // to ask which options were given
 };
+
+// The options that state a trial: with --spec the record states it, and each of these would be ignored.
+constexpr const char* kSpecificationOptions[] = {"--device",        "--guidance",    "--guidance-mode",
+                                                 "--guidance-gain", "--assist-band", "--amplification-gain",
+                                                 "--timing-speed",  "--writer",      "--writer-profile",
+                                                 "--writer-param",  "--seed",        "--rate",
+                                                 "--max-duration",  "--pacing",      "--realtime",
+                                                 "--watchdog-ms",   "--record"};
+
+// --spec: the record's specification, with this command's outputs (and a replay's --teacher when given).
+RecordedTrial recorded_from(const TrialCommand& command) {
+  if (command.app->count("CHARS") > 0) {
+    throw UsageError("CHARS: the characters come from --spec " + command.spec_file +
+                     "; give one or the other");
+  }
+  for (const char* option : kSpecificationOptions) {
+    if (command.app->count(option) > 0) {
+      throw UsageError(std::string(option) + ": the trial is stated by --spec " + command.spec_file +
+                       "; with it go only --json, --csv, --svg, --teacher and the character data options");
+    }
+  }
+  RecordedTrial recorded = read_recorded_trial_file(command.spec_file);
+  if (!command.teacher.empty()) {
+    if (recorded.spec.guidance_mode != GuidanceMode::replay) {
+      throw UsageError("--teacher: the trial in --spec " + command.spec_file +
+                       " is not a replay (guidance mode " + to_string(recorded.spec.guidance_mode) + ")");
+    }
+    recorded.spec.teacher = command.teacher;
+  }
+  recorded.spec.json_file = command.json;
+  recorded.spec.csv_file = command.csv;
+  recorded.spec.svg_file = command.svg;
+  try {
+    recorded.spec.validate();
+  } catch (const InvalidArgument& e) {
+    // A session's replay ran on its teacher's samples: the record names no file.
+    throw UsageError(std::string("--spec ") + command.spec_file + ": " + e.what() +
+                     (recorded.spec.guidance_mode == GuidanceMode::replay
+                          ? " (give the teacher's recording with --teacher)"
+                          : ""));
+  }
+  return recorded;
+}
 
 // The listing of `name`. A name no backend knows is a UsageError (exit 2) naming the devices there are; a
 // known device that cannot be used now (DeviceUnavailable: no arm, a damaged driver library) keeps its
@@ -171,8 +218,16 @@ bool write_teacher_recording(const TrialSpec& spec, const TrialDescription& desc
 int run_trial(const TrialCommand& command) {
   require_one_standard_output(
       {{"--json", command.json == "-"}, {"--svg", command.svg == "-"}, {"--csv", command.csv == "-"}});
-  check_scene_size(characters_from(command.characters, "CHARS").size(), "CHARS");  // before any is loaded
-  const TrialSpec spec = spec_from(command);
+  std::optional<RecordedTrial> recorded;
+  if (!command.spec_file.empty()) {
+    recorded = recorded_from(command);
+  } else if (command.app->count("CHARS") == 0) {
+    throw UsageError("CHARS is required (or --spec RECORD)");
+  }
+  // Before any character is loaded.
+  check_scene_size(characters_from(recorded ? recorded->spec.characters : command.characters, "CHARS").size(),
+                   "CHARS");
+  const TrialSpec spec = recorded ? recorded->spec : spec_from(command);
   const std::u32string chars = characters_from(spec.characters, "CHARS");
   const DeviceListing device = find_device(spec.device);
   bool simulated = false;
@@ -198,6 +253,7 @@ int run_trial(const TrialCommand& command) {
   // Every input and output is checked before the trial: no output replaces an input or another output.
   FilePlan files;
   files.input("--teacher", spec.teacher);
+  files.input("--spec", command.spec_file);
   add_library_inputs(files, command.library);
   files.output("--json", spec.json_file);
   files.output("--csv", spec.csv_file);
@@ -212,7 +268,7 @@ int run_trial(const TrialCommand& command) {
     const auto [at, added] = loaded.try_emplace(c, characters.size());
     characters.push_back(added ? source.load(c) : characters[at->second]);
   }
-  const Scene scene = Scene::lay_out(characters);
+  const Scene scene = Scene::lay_out(characters, recorded ? recorded->layout : SceneLayout{});
   // A signal while the characters were read: nothing recorded yet, no device opened, no file written.
   if (const int signal = StopSignals::received()) {
     std::fprintf(stderr, "calligraphy trial: stopped by %s before the trial started; nothing written\n",
@@ -223,9 +279,16 @@ int run_trial(const TrialCommand& command) {
   TrialRunInputs inputs;
   inputs.registry = &cli_device_registry();
   inputs.should_stop = StopSignals::stop_requested();
-  TrialRun run = run_trial_spec(spec, scene, inputs);
+  TrialRun run;
+  try {
+    run = recorded ? rerun_trial(*recorded, scene, inputs) : run_trial_spec(spec, scene, inputs);
+  } catch (const InvalidArgument& e) {
+    if (!recorded) throw;
+    throw DataError("--spec " + command.spec_file + ": " + e.what());  // e.g. other character data
+  }
   TrialResult& result = run.result;
-  const TrialDescription description = describe(spec, run, device);
+  TrialDescription description = describe(spec, run, device);
+  description.specification_json = recorded_trial_json(recorded_trial(spec, run, scene));
   const int signal = StopSignals::received();
   if (result.end == TrialEnd::interrupted && result.abort_reason.empty() && signal != 0) {
     result.abort_reason = std::string("stopped by ") + signal_name(signal);
@@ -268,7 +331,14 @@ void add_trial_command(CLI::App& root, Commands& commands) {
   auto command = std::make_shared<TrialCommand>();
   CLI::App* app = commands.add(root, "trial", "Run a guided writing trial of CHARS on a haptic device",
                                [command] { return run_trial(*command); });
-  add_positional(*app, "CHARS", command->characters, "the characters to write, left to right (UTF-8)");
+  command->app = app;
+  add_positional(*app, "CHARS", command->characters, "the characters to write, left to right (UTF-8)")
+      ->required(false);
+  add_input_path(*app, "--spec", command->spec_file, "RECORD",
+                 "run again the trial a record states (a trial --json file or a study trial record, its "
+                 "\"specification\"): identical on the simulated device; CHARS and the trial's options then "
+                 "come from it",
+                 "none");
   add_text(*app, "--device", command->device, "NAME", "the device, by its name in `calligraphy devices`");
   add_choice(*app, "--guidance", command->guidance, {"on", "off"}, "guiding force towards the stroke");
   add_choice(

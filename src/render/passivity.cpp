@@ -1,6 +1,7 @@
 #include "calligraphy/render/passivity.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -26,16 +27,25 @@ double colgate_stiffness_bound(double device_damping_n_s_per_m, double rate_hz,
   return std::max(0.0, 2.0 * (device_damping_n_s_per_m - virtual_damping_n_s_per_m) * rate_hz);
 }
 
-void PassivityParameters::validate() const {
-  if (!std::isfinite(max_damping_n_s_per_m) || !(max_damping_n_s_per_m > 0.0)) {
-    throw InvalidArgument("PassivityParameters.max_damping_n_s_per_m = " +
-                          std::to_string(max_damping_n_s_per_m) + " must be finite and > 0");
-  }
-  if (!std::isfinite(min_speed_m_s) || !(min_speed_m_s > 0.0)) {
-    throw InvalidArgument("PassivityParameters.min_speed_m_s = " + std::to_string(min_speed_m_s) +
-                          " must be finite and > 0");
-  }
+namespace {
+
+using PassivityField = ParameterField<PassivityParameters>;
+constexpr ParameterRange kPositive{.low_open = true};
+
+constexpr std::array kPassivityFields{
+    PassivityField{"max_damping_n_s_per_m", "N s/m", kPositive, "cap on the variable damper alpha",
+                   &PassivityParameters::max_damping_n_s_per_m},
+    PassivityField{"min_speed_m_s", "m/s", kPositive, "speed below which no damping is added",
+                   &PassivityParameters::min_speed_m_s},
+};
+
+}  // namespace
+
+std::span<const ParameterField<PassivityParameters>> ParameterTable<PassivityParameters>::fields() noexcept {
+  return kPassivityFields;
 }
+
+void PassivityParameters::validate() const { check_parameters(*this); }
 
 PassivityController::PassivityController(const PassivityParameters& parameters, double rate_hz)
     : parameters_(parameters) {

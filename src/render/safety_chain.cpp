@@ -1,6 +1,7 @@
 #include "calligraphy/render/safety_chain.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -21,20 +22,40 @@ bool shorten(Vec3& v, double limit) noexcept {
 
 }  // namespace
 
+namespace {
+
+using SafetyField = ParameterField<SafetyChainParameters>;
+using S = SafetyChainParameters;
+constexpr ParameterRange kNonNegative{};
+constexpr ParameterRange kPositive{.low_open = true};
+
+// In declaration order; a stage at 0 is off, except the peak force and the time constant.
+constexpr std::array kSafetyFields{
+    SafetyField{"max_force_n", "N", kNonNegative,
+                "peak clamp; 0 = the device's max force (the renderer fills it in)", &S::max_force_n},
+    SafetyField{"max_continuous_force_n", "N", kNonNegative,
+                "continuous-force limit; 0 = the device's under a renderer, off in a bare chain",
+                &S::max_continuous_force_n},
+    SafetyField{"continuous_time_constant_s", "s", kPositive, "tau of the RMS (thermal) force estimate",
+                &S::continuous_time_constant_s},
+    SafetyField{"start_ramp_n_per_s", "N/s", kNonNegative, "force ramp after start or reset; 0 = off",
+                &S::start_ramp_n_per_s},
+    SafetyField{"max_force_change_n_per_tick", "N", kNonNegative, "per-tick force change limit; 0 = off",
+                &S::max_force_change_n_per_tick},
+    SafetyField{"low_pass_cutoff_hz", "Hz", kNonNegative, "first-order low-pass cutoff; 0 = off",
+                &S::low_pass_cutoff_hz},
+};
+
+}  // namespace
+
+std::span<const ParameterField<SafetyChainParameters>>
+ParameterTable<SafetyChainParameters>::fields() noexcept {
+  return kSafetyFields;
+}
+
 void SafetyChainParameters::validate() const {
-  const auto check = [](double value, const char* name, bool positive) {
-    if (!std::isfinite(value) || value < 0.0 || (positive && value == 0.0)) {
-      throw InvalidArgument(std::string("SafetyChainParameters.") + name + " = " + std::to_string(value) +
-                            (positive ? " must be finite and > 0" : " must be finite and >= 0"));
-    }
-  };
-  check(max_force_n, "max_force_n", true);
-  check(max_continuous_force_n, "max_continuous_force_n", false);
-  check(continuous_time_constant_s, "continuous_time_constant_s", true);
-  check(start_ramp_n_per_s, "start_ramp_n_per_s", false);
-  check(max_force_change_n_per_tick, "max_force_change_n_per_tick", false);
-  check(low_pass_cutoff_hz, "low_pass_cutoff_hz", false);
-  if (max_continuous_force_n > max_force_n) {
+  check_parameters(*this);
+  if (max_force_n > 0.0 && max_continuous_force_n > max_force_n) {
     throw InvalidArgument(
         "SafetyChainParameters.max_continuous_force_n = " + std::to_string(max_continuous_force_n) +
         " must not exceed max_force_n = " + std::to_string(max_force_n));
@@ -43,6 +64,10 @@ void SafetyChainParameters::validate() const {
 
 SafetyChain::SafetyChain(const SafetyChainParameters& parameters, double rate_hz) : parameters_(parameters) {
   parameters_.validate();
+  if (!(parameters_.max_force_n > 0.0)) {  // 0 stands for the device's peak, which only a renderer knows
+    throw InvalidArgument(
+        "SafetyChain: SafetyChainParameters.max_force_n = 0 N: a chain needs its peak force > 0");
+  }
   if (!std::isfinite(rate_hz) || !(rate_hz > 0.0)) {
     throw InvalidArgument("SafetyChain: rate_hz = " + detail::rate_text(rate_hz) + " must be finite and > 0");
   }

@@ -146,6 +146,8 @@ std::string trial_json(const TrialDescription& d, const TrialResult& result, con
     doc["teacher"] = {{"file", d.teacher_file}, {"characters", d.teacher_characters}};
   if (!d.writer_profile.empty()) doc["writer_profile"] = d.writer_profile;
   if (!d.writer_parameters.empty()) doc["writer_parameters"] = d.writer_parameters;
+  // Made by its one writer above this module: parsed whole (a JSON number reads back to the same double).
+  if (!d.specification_json.empty()) doc["specification"] = nlohmann::json::parse(d.specification_json);
   return doc.dump(2) + "\n";
 }
 

@@ -112,6 +112,7 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
   context.writer_skills = skills;
   context.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   context.options = &run.options;
+  context.spec = &spec;
   context.simulation.writer = run.writer;
   context.simulation.seed = spec.seed;
   context.writer_log = run.writer_log;

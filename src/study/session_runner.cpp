@@ -353,6 +353,7 @@ class SessionRun {
     context.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     context.end_utc = study_detail::utc_now_iso8601();
     context.options = &run.options;
+    context.spec = &prepared.spec;
     context.simulation.writer = run.writer;
     context.simulation.seed = prepared.spec.seed;
     context.writer_log = run.writer_log;

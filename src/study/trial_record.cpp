@@ -3,14 +3,15 @@
 #include <algorithm>
 #include <nlohmann/json.hpp>
 
+#include "calligraphy/core/unicode.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/legibility/legibility.hpp"
+#include "calligraphy/model/polyline.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
 #include "calligraphy/report/pen_trace_csv.hpp"
-#include "calligraphy/devices/simulated_device.hpp"
-#include "calligraphy/core/unicode.hpp"
-#include "calligraphy/model/polyline.hpp"
 #include "report/trial_outcome.hpp"
 #include "study/manifest_json.hpp"
+#include "study/recorded_trial_object.hpp"
 #include "study/remembered_writer.hpp"
 #include "study/saved_sessions.hpp"
 
@@ -341,6 +342,11 @@ nlohmann::json trial_record(const TrialRecordContext& c, const Scene& scene, con
   if (json legibility = legibility_json(scene, result); !legibility.is_null())
     document["legibility"] = legibility;
   if (c.device_name == "simulated") document["device"]["simulated_device"] = simulated_device_json();
+  // The whole specification that ran, which `calligraphy trial --spec` runs again (recorded_trial.hpp).
+  if (c.spec != nullptr) {
+    document["specification"] = recorded_trial_object(
+        recorded_trial(*c.spec, *c.options, c.simulated_writer ? &c.simulation.writer : nullptr, scene));
+  }
   if (!c.condition->guidance_parameters.empty())
     document["guidance_parameters"] = c.condition->guidance_parameters;
   if (!c.guidance.is_null()) document["guidance"] = c.guidance;

@@ -14,6 +14,7 @@
 #include "calligraphy/sim/writer_memory.hpp"
 #include "calligraphy/study/quiz.hpp"
 #include "calligraphy/study/session_folder.hpp"
+#include "calligraphy/study/trial_spec.hpp"
 #include "calligraphy/trial/options.hpp"
 #include "calligraphy/trial/result.hpp"
 
@@ -25,6 +26,9 @@ struct TrialRecordContext {
   const PlannedTrial* trial = nullptr;
   const StudyCondition* condition = nullptr;
   const TrialOptions* options = nullptr;
+  /// The specification that ran (with `options` and the writer, the record's "specification":
+  /// recorded_trial.hpp); nullptr: the record holds none.
+  const TrialSpec* spec = nullptr;
   std::string device_name;
   DeviceInfo device_info;
   bool hardware = false;

@@ -72,6 +72,7 @@ std::pair<std::filesystem::path, bool> PracticeSession::save(const PracticeTrial
   context.trial = &planned;
   context.condition = &condition;
   context.options = trial.options;
+  context.spec = trial.spec;
   context.device_name = setup_.device;
   context.device_info = setup_.device_info;
   context.hardware = setup_.hardware;

@@ -15,6 +15,7 @@
 #include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/session_folder.hpp"
+#include "calligraphy/study/trial_spec.hpp"
 #include "calligraphy/trial/options.hpp"
 #include "calligraphy/trial/result.hpp"
 
@@ -53,6 +54,7 @@ struct PracticeTrial {
   std::string condition;         ///< one of the three conditions
   const Scene* scene = nullptr;  ///< the trial's scene
   const TrialOptions* options = nullptr;
+  const TrialSpec* spec = nullptr;  ///< the trial's specification, recorded whole; nullptr: not recorded
   SimulationOptions simulation;  ///< the simulated writer, when the setup has one
   std::string start_utc, end_utc;
   double wall_time_s = 0.0;

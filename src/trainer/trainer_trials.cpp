@@ -170,6 +170,7 @@ void TrainerApp::finish_trial() {
     trial.condition = view.condition;
     trial.scene = &worker_.scene();
     trial.options = &trial_options_;
+    trial.spec = &worker_.spec();
     trial.simulation = trial_simulation_;
     trial.start_utc = trial_start_utc_;
     trial.end_utc = study_detail::utc_now_iso8601();

@@ -17,6 +17,7 @@ void TrialWorker::start(Scene scene, TrialSpec spec, TrialRunInputs inputs) {
     thread_.join();
   }
   scene_ = std::move(scene);
+  spec_ = spec;
   stop_.store(false);
   done_.store(false);
   result_.reset();

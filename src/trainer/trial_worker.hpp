@@ -31,9 +31,12 @@ class TrialWorker {
   /// Joins the thread and returns what ran; rethrows what run_trial_spec threw.
   TrialRun take();
   [[nodiscard]] const Scene& scene() const noexcept { return scene_; }
+  /// The specification of the trial last started (recorded whole with its result).
+  [[nodiscard]] const TrialSpec& spec() const noexcept { return spec_; }
 
  private:
   Scene scene_;
+  TrialSpec spec_;
   std::thread thread_;
   std::atomic<bool> stop_{false};
   std::atomic<bool> done_{false};

@@ -17,7 +17,8 @@ Main entry points:
   ``resistance_force``, ``friction_force``, ``constraint_taper``, ``clamp_force``
 * ``Renderer(scene, force_law).tick(DeviceState(...))`` -> ``RenderOutput``
 * ``simulate_trial(chars, writer="novice", guidance=True, rate_hz=1000, seed=0)`` -> ``TrialResult``
-  (``.to_dataframe()``, ``.per_stroke_dataframe()`` with pandas; ``calligraphy.plot`` with matplotlib)
+  (``.to_dataframe()``, ``.per_stroke_dataframe()`` with pandas; ``calligraphy.plot`` with matplotlib);
+  ``rerun_trial(result.metrics)`` (or a trial record, or its file) runs it again, bit for bit
 * ``calligraphy.experiments.sweep(chars, grid, seeds)``: one trial per grid combination x character x
   seed on every core or a Dask cluster -> a pandas DataFrame, one row per trial
 * ``SimulatedDevice(SimulatedDeviceParameters(...))``, ``WriterProfile``, ``list_devices()``
@@ -109,6 +110,7 @@ from ._calligraphy import (  # noqa: F401
     run_trial,
     score,
     simulate_trial,
+    rerun_trial,
     trace_applies,
     typical_stroke,
     AttemptEnd,
@@ -196,6 +198,7 @@ __all__ = [
     "run_trial",
     "score",
     "simulate_trial",
+    "rerun_trial",
     "trace_applies",
     "typical_stroke",
     "AttemptEnd",

@@ -11,6 +11,7 @@
 ///    damper -alpha v with alpha = -E / (T |v|^2) (capped) dissipates it.
 /// Servo path: noexcept, no allocation.
 #include "calligraphy/core/geometry.hpp"
+#include "calligraphy/render/parameter_table.hpp"
 
 namespace calligraphy {
 
@@ -25,8 +26,16 @@ struct PassivityParameters {
   bool enabled = false;                 ///< observer and controller on
   double max_damping_n_s_per_m = 20.0;  ///< cap on the variable damper alpha [N s/m], > 0
   double min_speed_m_s = 1e-4;          ///< below this speed no damping is added [m/s], > 0
-  /// Throws InvalidArgument naming the field when a value is out of range.
+  /// Throws InvalidArgument naming the field when a value is outside its table's range
+  /// (`ParameterTable<PassivityParameters>`).
   void validate() const;
+};
+
+/// The numeric fields of PassivityParameters (parameter_table.hpp); `enabled` is not in it.
+template <>
+struct ParameterTable<PassivityParameters> {
+  static constexpr std::string_view name = "PassivityParameters";
+  [[nodiscard]] static std::span<const ParameterField<PassivityParameters>> fields() noexcept;
 };
 
 class PassivityController {

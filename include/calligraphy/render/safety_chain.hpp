@@ -19,22 +19,33 @@
 #include <cstdint>
 
 #include "calligraphy/core/geometry.hpp"
+#include "calligraphy/render/parameter_table.hpp"
 
 namespace calligraphy {
 
 /// Parameters of the chain. A stage set to 0 is off (except the peak force, which is required).
 struct SafetyChainParameters {
-  double max_force_n = 0.0;                   ///< peak clamp [N], > 0 (the device's max force)
-  double max_continuous_force_n = 0.0;        ///< continuous-force limit [N], 0 = off
+  /// Peak clamp [N] >= 0; 0 = the device's max force, filled in by the renderer (a bare `SafetyChain`
+  /// needs it > 0).
+  double max_force_n = 0.0;
+  /// Continuous-force limit [N] >= 0; 0 = the device's under a renderer, off in a bare chain.
+  double max_continuous_force_n = 0.0;
   double continuous_time_constant_s = 10.0;   ///< tau of the RMS (thermal) estimate [s], > 0
   double start_ramp_n_per_s = 20.0;           ///< force ramp after start or reset [N/s], 0 = off
   double max_force_change_n_per_tick = 0.25;  ///< per-tick change limit [N per tick], 0 = off
   double low_pass_cutoff_hz = 0.0;            ///< first-order low-pass cutoff [Hz], 0 = off
 
-  /// Throws InvalidArgument naming the field when a value is negative or not finite, when
-  /// `max_force_n` or `continuous_time_constant_s` is not positive, or when the continuous force
-  /// exceeds the peak force.
+  /// Throws InvalidArgument naming the field when a value is outside its table's range
+  /// (`ParameterTable<SafetyChainParameters>`: negative or not finite, `continuous_time_constant_s` not
+  /// positive), or when the continuous force exceeds a peak force that is set.
   void validate() const;
+};
+
+/// The fields of SafetyChainParameters (parameter_table.hpp): the one definition of their units and ranges.
+template <>
+struct ParameterTable<SafetyChainParameters> {
+  static constexpr std::string_view name = "SafetyChainParameters";
+  [[nodiscard]] static std::span<const ParameterField<SafetyChainParameters>> fields() noexcept;
 };
 
 /// Bits of `SafetyResult::limits`: which stages changed the force this tick.

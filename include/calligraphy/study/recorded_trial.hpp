@@ -1,0 +1,87 @@
+#pragma once
+/// \file recorded_trial.hpp
+/// A trial as it ran, whole: its specification (trial_spec.hpp) and every part a front-end may give instead
+/// of the defaults: the force law (every field, the active guidance law with its values, the stroke
+/// acceptance and the nearest-point search), the safety chain, the passivity controller, the simulated
+/// writer's profile after every parameter (its traits and what it had learned folded in), with the scene's
+/// layout and a SHA-256 of the characters placed. Every trial record (`calligraphy trial --json`, study
+/// sessions and cohorts) holds one as its "specification" object (format: docs/cli.md, "Re-running a trial");
+/// `calligraphy trial --spec RECORD` and `rerun_trial` run it again, and on the simulated device the trace is
+/// the same bit for bit.
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "calligraphy/devices/simulated_device.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/render/force_law.hpp"
+#include "calligraphy/render/passivity.hpp"
+#include "calligraphy/render/safety_chain.hpp"
+#include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/study/trial_spec.hpp"
+#include "calligraphy/study/trial_spec_runner.hpp"
+
+namespace calligraphy {
+
+/// The "format" of the specification object, and its version; a reader refuses any other.
+inline constexpr std::string_view kRecordedTrialFormat = "calligraphy-trial-specification";
+inline constexpr int kRecordedTrialVersion = 1;
+
+/// Everything that decides what a trial does, as it ran. Lengths in m, forces in N, times in s.
+struct RecordedTrial {
+  /// As stated, its output files cleared (a re-run names its own), `writer` the one who wrote and `pacing`
+  /// the one it ran with (never `automatic`).
+  TrialSpec spec;
+  /// The force law the renderer ran. A replay's teacher trajectory is not kept here: `spec.teacher` names its
+  /// file, or the re-run is given the teacher's samples.
+  ForceLawParameters force_law;
+  SafetyChainParameters safety;  ///< 0 peak and continuous forces stand for the device's
+  PassivityParameters passivity;
+  /// The profile the simulated writer wrote with; nullopt when a person wrote.
+  std::optional<WriterProfile> writer;
+  /// The physics of a simulated device its caller made with its own parameters (Python's
+  /// `simulate_trial(device=...)`; its DeviceInfo stays the default's); nullopt: the device the registry
+  /// makes of `spec.device`.
+  std::optional<SimulatedDeviceParameters> simulated_device;
+  SceneLayout layout;           ///< where the characters were placed
+  std::string scene_sha256;     ///< `scene_sha256` of the placed characters
+  std::string library_version;  ///< the library that ran it (said, not checked)
+};
+
+/// What ran for `spec` on `scene` with the options `ran` (TrialRun::options) and, when the simulated writer
+/// wrote, its profile `writer` (nullptr: a person).
+[[nodiscard]] RecordedTrial recorded_trial(const TrialSpec& spec, const TrialOptions& ran,
+                                           const WriterProfile* writer, const Scene& scene);
+/// What `run` ran for `spec` on `scene`.
+[[nodiscard]] RecordedTrial recorded_trial(const TrialSpec& spec, const TrialRun& run, const Scene& scene);
+
+/// Lower-case hex SHA-256 (FIPS 180-4) of the placed characters: each character's code point and, stroke by
+/// stroke, its typical stroke ID, attraction factors and elements' control points [m] (bit patterns): equal
+/// for equal character data and layout, whatever the data's source.
+[[nodiscard]] std::string scene_sha256(const Scene& scene);
+
+/// `recorded` as a JSON object (2-space indent): "format", "version", "trial" (trial_spec_json's keys),
+/// "force_law", "safety", "passivity", "writer" (null for a person), "simulated_device" (null: the
+/// registry's), "scene" {"layout", "sha256"} and "library_version". Numbers are JSON numbers that read back
+/// to the same doubles.
+[[nodiscard]] std::string recorded_trial_json(const RecordedTrial& recorded);
+
+/// The specification in `text`: a trial record holding a "specification" object, or that object itself.
+/// Every part is required; each is validated as its struct validates it. Throws DataError naming `source` and
+/// the JSON pointer of a value at fault, a record with no specification (written before records held one), or
+/// a format or version this library does not read.
+[[nodiscard]] RecordedTrial read_recorded_trial(std::string_view text, const std::string& source);
+
+/// `read_recorded_trial` of the regular file `path` (at most 64 MiB, a trial record's bound). Throws
+/// DataError naming the path when it cannot be read, and what `read_recorded_trial` throws.
+[[nodiscard]] RecordedTrial read_recorded_trial_file(const std::string& path);
+
+/// Runs `recorded` again on `scene` (laid out by the caller with `recorded.layout`) with `inputs` (the
+/// registry, a stop flag, a replay's teacher samples); its force law, safety chain, passivity controller,
+/// writer and simulated device (made here when recorded) replace any in `inputs`. Throws InvalidArgument when
+/// `scene` is not the recorded one (its SHA-256 differs: other character data), and what `run_trial_spec`
+/// throws.
+[[nodiscard]] TrialRun rerun_trial(const RecordedTrial& recorded, const Scene& scene,
+                                   TrialRunInputs inputs = {});
+
+}  // namespace calligraphy

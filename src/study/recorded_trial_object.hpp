@@ -1,0 +1,12 @@
+#pragma once
+// The specification object of a trial record (recorded_trial.hpp) as JSON, for the record's writer. Internal.
+#include <nlohmann/json.hpp>
+
+#include "calligraphy/study/recorded_trial.hpp"
+
+namespace calligraphy::study_detail {
+
+/// `recorded_trial_json`'s object.
+nlohmann::json recorded_trial_object(const RecordedTrial& recorded);
+
+}  // namespace calligraphy::study_detail

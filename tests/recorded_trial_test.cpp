@@ -1,0 +1,224 @@
+// The record is the specification (recorded_trial.hpp): random valid specifications, every part away from
+// its defaults, survive JSON both ways with every double's bits; a trial run again from its record's JSON
+// gives the same trace bit for bit on the simulated device; a record that is not one is refused by name.
+#include "calligraphy/study/recorded_trial.hpp"
+
+#include <bit>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/render/parameter_table.hpp"
+
+using namespace calligraphy;
+
+namespace {
+
+// A value drawn inside `range`, with full-precision digits (so that the JSON must keep every bit).
+double draw(const ParameterRange& range, std::mt19937_64& random) {
+  const double low = range.low;
+  const double high = std::isinf(range.high) ? low + 1000.0 : range.high;
+  std::uniform_real_distribution<double> uniform(low, high);
+  for (;;) {
+    const double value = uniform(random);
+    if (range.contains(value)) return value;
+  }
+}
+
+template <typename S>
+void randomise(S& object, std::mt19937_64& random) {
+  for (const ParameterField<S>& field : ParameterTable<S>::fields())
+    object.*field.member = draw(field.range, random);
+}
+
+// Every table field of two objects, compared by bit pattern.
+template <typename S>
+void require_same_bits(const S& a, const S& b) {
+  for (const ParameterField<S>& field : ParameterTable<S>::fields()) {
+    INFO(ParameterTable<S>::name << "." << field.name);
+    CHECK(std::bit_cast<std::uint64_t>(a.*field.member) == std::bit_cast<std::uint64_t>(b.*field.member));
+  }
+}
+
+RecordedTrial random_recorded_trial(std::mt19937_64& random, GuidanceMode mode) {
+  RecordedTrial r;
+  r.spec.characters = "永";
+  r.spec.guidance_mode = mode;
+  r.spec.seed = random();
+  r.spec.rate_hz = 100.0 + std::uniform_real_distribution<double>(0.0, 4900.0)(random);
+  r.spec.max_duration_s = 1.0 + std::uniform_real_distribution<double>(0.0, 100.0)(random);
+  r.spec.writer_profile = "foreign";
+  r.spec.writer_parameters = {"hesitation_s=0.25"};
+  if (mode == GuidanceMode::replay) r.spec.teacher = "teacher.json";
+  randomise(r.force_law, random);
+  r.force_law.constraint_taper_m = r.force_law.constraint_radius_m * 0.5;  // a cross-field rule
+  r.force_law.guidance_law = default_guidance_law(mode);
+  std::visit(
+      [&](auto& law) {
+        randomise(law, random);
+        if constexpr (requires { law.max_lead_m; }) law.max_lead_m = r.force_law.constraint_radius_m * 0.5;
+      },
+      r.force_law.guidance_law);
+  if (auto* fading = std::get_if<FadingGuidance>(&r.force_law.guidance_law))
+    r.spec.guidance_gain = fading->gain;
+  r.force_law.acceptance.corridor_m = 0.0071234567890123;
+  r.force_law.acceptance.shortfall_fraction = 0.41;
+  r.force_law.nearest.method = NearestPointMethod::newton;
+  r.force_law.nearest.newton_starts = 5;
+  randomise(r.safety, random);
+  r.safety.max_continuous_force_n = r.safety.max_force_n * 0.5;
+  r.passivity.enabled = true;
+  randomise(r.passivity, random);
+  WriterProfile writer = WriterProfile::foreign();
+  writer.bias_offset_m = 0.0031234567890123;
+  writer.max_attempts_per_stroke = 3;
+  r.writer = writer;
+  r.layout.centre_m = {0.001, -0.002};
+  r.scene_sha256 = std::string(64, 'a');
+  r.library_version = "test";
+  return r;
+}
+
+std::string error_of(const std::function<void()>& action) {
+  try {
+    action();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+}  // namespace
+
+TEST_CASE("A recorded trial survives JSON both ways, every double to the bit", "[recorded_trial]") {
+  std::mt19937_64 random(20261125);
+  for (int round = 0; round < 50; ++round) {
+    for (GuidanceMode mode : guidance_modes()) {
+      const RecordedTrial r = random_recorded_trial(random, mode);
+      const std::string text = recorded_trial_json(r);
+      INFO(text);
+      const RecordedTrial back = read_recorded_trial(text, "spec.json");
+      CHECK(back.spec == r.spec);
+      require_same_bits(back.force_law, r.force_law);
+      CHECK(back.force_law.guidance_law.index() == r.force_law.guidance_law.index());
+      CHECK(back.force_law.acceptance.corridor_m == r.force_law.acceptance.corridor_m);
+      CHECK(back.force_law.nearest.method == NearestPointMethod::newton);
+      CHECK(back.force_law.nearest.newton_starts == 5);
+      require_same_bits(back.safety, r.safety);
+      require_same_bits(back.passivity, r.passivity);
+      CHECK(back.passivity.enabled);
+      REQUIRE(back.writer.has_value());
+      for (const std::string& key : writer_parameter_names())
+        CHECK(writer_parameter(*back.writer, key) == writer_parameter(*r.writer, key));
+      CHECK(back.layout.centre_m == r.layout.centre_m);
+      // Written again, the same text: nothing is lost or reordered.
+      CHECK(recorded_trial_json(back) == text);
+    }
+  }
+}
+
+TEST_CASE("A trial run again from its record gives the same trace, bit for bit", "[recorded_trial]") {
+  const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'十')});
+  TrialSpec spec;
+  spec.characters = "十";
+  spec.guidance_mode = GuidanceMode::assist_as_needed;
+  spec.assist_band_m = 0.0007;
+  spec.writer_profile = "novice";
+  spec.writer_parameters = {"bias_offset_m=0.003", "stroke_jitter_m=0.0013"};
+  spec.seed = 99;
+  spec.rate_hz = 800.0;
+  spec.max_duration_s = 30.0;
+  TrialRunInputs inputs;
+  ForceLawParameters force;
+  force.guidance_law = AssistAsNeededGuidance{.band_m = 0.0007};
+  force.off_stroke_force_n = 0.35;  // parts a specification alone does not state
+  force.friction_coefficient = 0.21;
+  force.guidance_stiffness_n_per_m = 333.0;
+  inputs.force_law = force;
+  SafetyChainParameters safety;
+  safety.max_force_change_n_per_tick = 0.125;
+  inputs.safety = safety;
+  const TrialRun first = run_trial_spec(spec, scene, inputs);
+  REQUIRE(first.result.trace.size() > 100);
+
+  const RecordedTrial recorded =
+      read_recorded_trial(recorded_trial_json(recorded_trial(spec, first, scene)), "r.json");
+  const TrialRun again = rerun_trial(recorded, scene);
+  REQUIRE(again.result.trace.size() == first.result.trace.size());
+  std::size_t different = 0;
+  for (std::size_t i = 0; i < first.result.trace.size(); ++i) {
+    const TrialSample& a = first.result.trace[i];
+    const TrialSample& b = again.result.trace[i];
+    different += (a.time_s != b.time_s || a.position_m != b.position_m || a.force_n != b.force_n) ? 1 : 0;
+  }
+  CHECK(different == 0);
+
+  // Without the record's force law, the same specification renders another force: the record carried it.
+  const TrialRun plain = run_trial_spec(spec, scene);
+  bool same = plain.result.trace.size() == first.result.trace.size();
+  for (std::size_t i = 0; same && i < first.result.trace.size(); ++i)
+    same = plain.result.trace[i].force_n == first.result.trace[i].force_n;
+  CHECK_FALSE(same);
+}
+
+TEST_CASE("A record run on other characters is refused", "[recorded_trial]") {
+  const Scene ten = Scene::lay_out({CharacterLibrary::embedded().load(U'十')});
+  const Scene person = Scene::lay_out({CharacterLibrary::embedded().load(U'人')});
+  TrialSpec spec;
+  spec.characters = "十";
+  spec.max_duration_s = 1.0;
+  RecordedTrial recorded = recorded_trial(spec, TrialOptions{}, nullptr, ten);
+  CHECK(recorded.scene_sha256 == scene_sha256(ten));
+  CHECK(scene_sha256(person) != scene_sha256(ten));
+  CHECK_THAT(error_of([&] { (void)rerun_trial(recorded, person); }),
+             Catch::Contains("not the recorded ones") && Catch::Contains("SHA-256"));
+}
+
+TEST_CASE("What is not a recorded trial is refused naming the file and the place", "[recorded_trial]") {
+  std::mt19937_64 random(7);
+  const std::string good = recorded_trial_json(random_recorded_trial(random, GuidanceMode::fixed));
+  const auto edited = [&](const std::function<void(nlohmann::json&)>& edit) {
+    nlohmann::json document = nlohmann::json::parse(good);
+    edit(document);
+    return document.dump();
+  };
+  const auto refusal = [](const std::string& text) {
+    return error_of([&] { (void)read_recorded_trial(text, "r.json"); });
+  };
+  CHECK_THAT(refusal(R"({"version": 2, "end_reason": "completed"})"),
+             Catch::Contains("r.json") && Catch::Contains("no trial specification"));
+  CHECK_THAT(refusal(R"({"specification": null})"), Catch::Contains("r.json: /specification"));
+  CHECK_THAT(refusal(edited([](auto& d) { d["version"] = 2; })),
+             Catch::Contains("/version") && Catch::Contains("version 2"));
+  CHECK_THAT(refusal(edited([](auto& d) { d["format"] = "other"; })),
+             Catch::Contains("r.json: /") && Catch::Contains("format 'other'"));
+  CHECK_THAT(refusal(edited([](auto& d) { d["force_law"].erase("off_stroke_force_n"); })),
+             Catch::Contains("/force_law") && Catch::Contains("off_stroke_force_n"));
+  CHECK_THAT(refusal(edited([](auto& d) { d["force_law"]["crossfade_s"] = -1.0; })),
+             Catch::Contains("/force_law") && Catch::Contains("crossfade_s"));
+  CHECK_THAT(refusal(edited([](auto& d) { d["force_law"]["guidance_law"]["mode"] = "fading"; })),
+             Catch::Contains("/force_law/guidance_law/gain"));
+  CHECK_THAT(refusal(edited([](auto& d) {
+               d["force_law"]["guidance_law"] = {{"mode", "fading"}, {"gain", 0.5}};
+             })),
+             Catch::Contains("not the specification's"));
+  CHECK_THAT(refusal(edited([](auto& d) { d["safety"]["start_ramp_n_per_s"] = "fast"; })),
+             Catch::Contains("/safety/start_ramp_n_per_s"));
+  CHECK_THAT(refusal(edited([](auto& d) { d["writer"]["noise_fraction"] = 3.0; })),
+             Catch::Contains("/writer/noise_fraction"));
+  CHECK_THAT(refusal(edited([](auto& d) { d["trial"]["rate_hz"] = 5.0; })), Catch::Contains("rate"));
+  CHECK_THAT(refusal(edited([](auto& d) { d["passivity"]["surprise"] = 1; })), Catch::Contains("surprise"));
+  // Inside a trial record, the pointers name the record's member.
+  const std::string record =
+      "{\"version\": 2, \"specification\": " + edited([](auto& d) { d["safety"]["max_force_n"] = -1.0; }) +
+      "}";
+  CHECK_THAT(refusal(record), Catch::Contains("r.json: /specification/safety"));
+}
