@@ -345,6 +345,27 @@ bool is_partial_session_folder(const fs::path& folder) {
   return folder.filename().string().starts_with(kPartialSessionPrefix);
 }
 
+namespace {
+
+// Removes from `folder` what a killed run of this session left half saved: the temporaries of its atomic
+// writes (".NAME.tmp-PID-N") and a record's ".part" (written whole, then linked to its name: a kill between
+// the link and the unlink leaves it beside the saved record, a kill before the link leaves a trial that is
+// run again). Called with the session's lock held, when no other run can be writing there.
+void remove_unsaved_leftovers(const fs::path& folder) {
+  std::error_code error;
+  std::vector<fs::path> leftovers;
+  for (fs::directory_iterator entry(folder, error), end; !error && entry != end; entry.increment(error)) {
+    const std::string name = entry->path().filename().string();
+    const bool temporary = name.starts_with(".") && name.find(".tmp-") != std::string::npos;
+    const bool part = name.ends_with(".json.part");
+    if ((temporary || part) && entry->is_regular_file(error)) leftovers.push_back(entry->path());
+  }
+  for (const fs::path& path : leftovers) ::unlink(path.c_str());
+  if (!leftovers.empty()) fsync_folder(folder);
+}
+
+}  // namespace
+
 SessionFolder SessionFolder::open(const fs::path& folder) {
   if (is_partial_session_folder(named_folder(folder))) throw DataError(folder.string() + ": " + kPartialNote);
   const fs::path manifest_path = folder / "session.json";
@@ -356,6 +377,9 @@ SessionFolder SessionFolder::open(const fs::path& folder) {
   const fs::path log_path = folder / "log.jsonl";
   const int fd = open_locked_log(log_path);
   SessionFolder session(folder, std::move(manifest), fd);
+  // The lock says no other run writes here: what a killed run left half written is nobody's.
+  remove_unsaved_leftovers(folder / "trials");
+  remove_unsaved_leftovers(folder / "trials" / "attempts");
   // A crash in the middle of a log line leaves it torn: end it, so that the next line stands alone.
   std::error_code error;
   const std::uintmax_t size = fs::file_size(log_path, error);

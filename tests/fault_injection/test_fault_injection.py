@@ -14,8 +14,13 @@ subject) by a new one (the report after a second subject joined). What must hold
 - a clean run afterwards writes the new set and leaves no temporary, second name or journal behind.
 
 Commands: `report --csv --out` (the tables, the pages and the index as one set), `report --csv` (the pair of
-tables), and the Python report's writer of its set of files (study_report, through the library's writer). CALLIGRAPHY_CLI names the program, CALLIGRAPHY_FAULT_SHIM the shim. Standard library only.
+tables), and the Python report's writer of its set of files (study_report, through the library's writer).
+`session cohort` is swept as the report's tables are; `session run`, and `session resume` of a session whose run
+was killed after its first trial, are swept with their own check: every trial saved before the fault stays whole and
+readable, `report` reads the study as it is, and `session resume` (or a new run when no session folder
+appeared) completes the session without rewriting a saved trial or leaving a temporary behind. CALLIGRAPHY_CLI names the program, CALLIGRAPHY_FAULT_SHIM the shim. Standard library only.
 """
+import gzip
 import hashlib
 import json
 import os
@@ -176,6 +181,114 @@ class FaultInjection(unittest.TestCase):
     def test_report_tables_alone(self):
         self.sweep(lambda study: ["report", study, "--csv", "out"])
 
+    def saved_trials(self, out):
+        """{record path: SHA-256 of the record, its trace and its drawing} of every trial saved in a whole
+        session folder under `out`; each record must read as JSON and each trace as whole gzip."""
+        saved = {}
+        for record in sorted(out.glob("*/*/trials/*.json")):
+            if any(part.startswith(".") for part in record.relative_to(out).parts):
+                continue
+            json.loads(record.read_text(encoding="utf-8"))
+            trace = record.with_suffix(".csv.gz")
+            gzip.decompress(trace.read_bytes())
+            digest = hashlib.sha256()
+            for path in (record, trace, record.with_suffix(".svg")):
+                digest.update(path.read_bytes())
+            saved[str(record.relative_to(out))] = digest.hexdigest()
+        return saved
+
+    def session_folders(self, out):
+        return sorted(path for path in out.glob("*/*") if path.is_dir() and not path.name.startswith("."))
+
+    def test_session_run_then_resume(self):
+        """Every fault at every step of `session run` writing a session: what was saved before the fault stays
+        whole and readable, the study reads, and `session resume` (or a new run, when no session folder
+        appeared) completes the session without rewriting what was saved."""
+        run = ["session", "run", self.protocol, "--writer", "simulated", "--subject", "S01", "--out", "out"]
+        self.sweep_session("session run then resume", run, lambda work: None)
+
+    def test_session_resume(self):
+        """The same for `session resume` of a session whose first trial was saved before its run was killed."""
+        run = ["session", "run", self.protocol, "--writer", "simulated", "--subject", "S01", "--out", "out"]
+
+        def first_trial_saved(work):
+            # Killed at the second trial's link (the first trial's record is linked to its name first).
+            killed = self.run_cli(run, work, {"CALLIGRAPHY_FAULT_CALL": "link", "CALLIGRAPHY_FAULT_AT": "2",
+                                              "CALLIGRAPHY_FAULT_KILL": "1"})
+            self.assertEqual(killed.returncode, -9, killed.stderr.decode())
+            self.assertEqual(len(self.saved_trials(work / "out")), 1)
+            return ["session", "resume", self.session_folders(work / "out")[0]]
+
+        self.sweep_session("session resume", None, first_trial_saved)
+
+    def sweep_session(self, name, command, prepare):
+        """Every fault at every step of `command` (or of what `prepare(work)` returns, after it made the
+        session it resumes) writing a session under work/out."""
+        work = Path(self.scratch.name) / "session"
+
+        def fresh():
+            shutil.rmtree(work, ignore_errors=True)
+            (work / "out").mkdir(parents=True)
+            return prepare(work) or command
+
+        counts_file = Path(self.scratch.name) / "session-counts.txt"
+        counted = self.run_cli(fresh(), work, {"CALLIGRAPHY_FAULT_COUNTS": str(counts_file)})
+        self.assertEqual(counted.returncode, 0, counted.stderr.decode())
+        counts = {kind: int(n) for kind, n in (line.split() for line in counts_file.read_text().splitlines())}
+        planned = len(self.saved_trials(work / "out"))
+        self.assertEqual(planned, 3)
+        tried = 0
+        for kind in KINDS:
+            for n in range(1, counts[kind] + 1):
+                for kill in (False, True):
+                    fault = {"CALLIGRAPHY_FAULT_CALL": kind, "CALLIGRAPHY_FAULT_AT": str(n),
+                             "CALLIGRAPHY_FAULT_ERRNO": ERRNOS[tried % len(ERRNOS)],
+                             "CALLIGRAPHY_FAULT_KILL": "1" if kill else "0"}
+                    with self.subTest(kind=kind, n=n, errno=fault["CALLIGRAPHY_FAULT_ERRNO"], kill=kill):
+                        arguments = fresh()
+                        before = self.saved_trials(work / "out")
+                        result = self.run_cli(arguments, work, fault)
+                        stderr = result.stderr.decode(errors="replace")
+                        if kill:
+                            self.assertEqual(result.returncode, -9, stderr)
+                        else:
+                            self.assertIn(result.returncode, (0, 1), stderr)
+                            self.assertNotIn("internal error", stderr)
+                            if result.returncode == 1:
+                                self.assertIn(": error: ", stderr.strip().splitlines()[-1], stderr)
+                        saved = self.saved_trials(work / "out")
+                        for record, digest in before.items():
+                            self.assertEqual(saved.get(record), digest, f"{record} was lost or rewritten")
+                        folders = self.session_folders(work / "out")
+                        self.assertLessEqual(len(folders), 1, folders)
+                        # The study reads as it is, whatever was saved.
+                        tables = work / "tables"
+                        shutil.rmtree(tables, ignore_errors=True)
+                        tables.mkdir()
+                        read = self.run_cli(["report", "out", "--csv", "tables"], work)
+                        self.assertEqual(read.returncode, 0 if folders else 1, read.stderr.decode())
+                        # Completed: resumed, or run again when no session folder appeared.
+                        completed = self.run_cli(["session", "resume", folders[0]] if folders else arguments, work)
+                        self.assertEqual(completed.returncode, 0, completed.stderr.decode())
+                        after = self.saved_trials(work / "out")
+                        self.assertEqual(len(after), planned, sorted(after))
+                        for record, digest in saved.items():
+                            self.assertEqual(after.get(record), digest, f"{record} was lost or rewritten")
+                        self.assertEqual(leftovers(work / "out"), [])
+                        self.assertEqual([p.name for p in (work / "out").rglob(".partial.*")], [])
+                        self.assertEqual([p.name for p in (work / "out").rglob("*.part")], [])
+                        again = self.run_cli(["report", "out", "--csv", "tables"], work)
+                        self.assertEqual(again.returncode, 0, again.stderr.decode())
+                    tried += 1
+        print(f"{name}: {tried} faults at every step "
+              f"({', '.join(f'{kind} {counts[kind]}' for kind in KINDS)})", flush=True)
+
+    def test_cohort_tables(self):
+        """`session cohort` replacing its tables of one subject with those of two."""
+        def cohort(study):
+            subjects = "1" if study == self.one_subject / "study" else "2"
+            return ["session", "cohort", self.protocol, "--subjects", subjects, "--csv", "out", "--jobs", "1"]
+        self.sweep(cohort)
 
 if __name__ == "__main__":
     unittest.main(verbosity=2)
