@@ -374,13 +374,6 @@ void bind_interaction_state(py::module_& m) {
       .def("__hash__", [](InteractionState a) { return static_cast<int>(a); });
 }
 
-void check_safety(const SafetyChainParameters& p) {
-  // max_force_n = 0 means "the device's figure" in a RendererOptions or a trial; check the rest.
-  SafetyChainParameters copy = p;
-  if (copy.max_force_n == 0.0) copy.max_force_n = std::max(copy.max_continuous_force_n, 1.0);
-  copy.validate();
-}
-
 std::vector<std::string> limit_names(std::uint8_t limits) {
   static const std::pair<std::uint8_t, const char*> names[] = {
       {safety_non_finite, "non_finite"}, {safety_low_pass, "low_pass"},
@@ -400,18 +393,13 @@ void bind_renderer(py::module_& m) {
       "instability), applied each tick: non-finite check, low-pass, continuous-force limit, peak clamp, "
       "start ramp, per-tick change limit (include/calligraphy/render/safety_chain.hpp). A stage set to 0 is "
       "off; max_force_n and max_continuous_force_n left at 0 take the device's figures.",
-      check_safety)
-      .field("max_force_n", &SafetyChainParameters::max_force_n, "peak clamp [N]; 0 = the device's max force")
-      .field("max_continuous_force_n", &SafetyChainParameters::max_continuous_force_n,
-             "continuous-force limit [N]; 0 = the device's figure (renderer) or off")
-      .field("continuous_time_constant_s", &SafetyChainParameters::continuous_time_constant_s,
-             "tau of the RMS (thermal) force estimate [s], > 0")
-      .field("start_ramp_n_per_s", &SafetyChainParameters::start_ramp_n_per_s,
-             "force ramp after start or reset [N/s]; 0 = off")
-      .field("max_force_change_n_per_tick", &SafetyChainParameters::max_force_change_n_per_tick,
-             "per-tick change limit [N per tick]; 0 = off")
-      .field("low_pass_cutoff_hz", &SafetyChainParameters::low_pass_cutoff_hz,
-             "first-order low-pass cutoff [Hz]; 0 = off")
+      [](const SafetyChainParameters& p) { p.validate(); })
+      .field(&SafetyChainParameters::max_force_n)
+      .field(&SafetyChainParameters::max_continuous_force_n)
+      .field(&SafetyChainParameters::continuous_time_constant_s)
+      .field(&SafetyChainParameters::start_ramp_n_per_s)
+      .field(&SafetyChainParameters::max_force_change_n_per_tick)
+      .field(&SafetyChainParameters::low_pass_cutoff_hz)
       .finish();
 
   ParameterClass<PassivityParameters>(
@@ -420,10 +408,8 @@ void bind_renderer(py::module_& m) {
       "dissipates the energy the rendered force has produced (include/calligraphy/render/passivity.hpp).",
       [](const PassivityParameters& p) { p.validate(); })
       .field("enabled", &PassivityParameters::enabled, "observer and controller on")
-      .field("max_damping_n_s_per_m", &PassivityParameters::max_damping_n_s_per_m,
-             "cap on the variable damper alpha [N s/m], > 0")
-      .field("min_speed_m_s", &PassivityParameters::min_speed_m_s,
-             "below this speed no damping is added [m/s], > 0")
+      .field(&PassivityParameters::max_damping_n_s_per_m)
+      .field(&PassivityParameters::min_speed_m_s)
       .finish();
 
   ParameterClass<RendererOptions>(m, "RendererOptions",
@@ -431,7 +417,7 @@ void bind_renderer(py::module_& m) {
                                   "(include/calligraphy/render/renderer.hpp).",
                                   [](const RendererOptions& o) {
                                     o.validate();
-                                    check_safety(o.safety);
+                                    o.safety.validate();
                                   })
       .field("rate_hz", &RendererOptions::rate_hz, "servo rate [Hz], in [100, 100000]")
       .field("safety", &RendererOptions::safety, "SafetyChainParameters")

@@ -40,36 +40,6 @@ const DeviceRegistry& python_device_registry() {
 
 namespace {
 
-// WriterProfile::validate leaves some fields unchecked (tremor frequency, infinities of the offsets);
-// a non-finite value would make the writer's hand force NaN and the trial meaningless.
-void check_writer(const WriterProfile& w) {
-  w.validate();
-  const std::pair<double, const char*> values[] = {
-      {w.hand_stiffness_n_per_m, "hand_stiffness_n_per_m"},
-      {w.hand_damping_n_s_per_m, "hand_damping_n_s_per_m"},
-      {w.writing_speed_m_s, "writing_speed_m_s"},
-      {w.travel_speed_m_s, "travel_speed_m_s"},
-      {w.press_depth_m, "press_depth_m"},
-      {w.lift_height_m, "lift_height_m"},
-      {w.bias_offset_m, "bias_offset_m"},
-      {w.scale_error, "scale_error"},
-      {w.stroke_jitter_m, "stroke_jitter_m"},
-      {w.noise_fraction, "noise_fraction"},
-      {w.tremor_amplitude_n, "tremor_amplitude_n"},
-      {w.tremor_frequency_hz, "tremor_frequency_hz"},
-      {w.corner_cut_m, "corner_cut_m"},
-      {w.end_short_m, "end_short_m"},
-      {w.end_past_m, "end_past_m"},
-      {w.follow_through_m, "follow_through_m"},
-      {w.correction_per_attempt, "correction_per_attempt"},
-  };
-  for (const auto& [value, name] : values) {
-    if (!std::isfinite(value))
-      throw InvalidArgument(std::string("WriterProfile.") + name + " must be finite");
-  }
-  if (w.tremor_frequency_hz < 0.0) throw InvalidArgument("WriterProfile.tremor_frequency_hz must be >= 0");
-}
-
 void bind_writer_profile(py::module_& m) {
   ParameterClass<WriterProfile>(
       m, "WriterProfile",
@@ -79,74 +49,45 @@ void bind_writer_profile(py::module_& m) {
       "timing (Flash & Hogan 1985) along a biased copy of the reference; force noise grows with the force "
       "(Harris & Wolpert 1998). Units as named. WriterProfile.novice(), .skilled() and .foreign() are the "
       "presets.",
-      check_writer)
+      [](const WriterProfile& w) { w.validate(); })
       .field("name", &WriterProfile::name, "a label, reported as the trial's 'writer'")
-      .field("hand_stiffness_n_per_m", &WriterProfile::hand_stiffness_n_per_m,
-             "k [N/m], > 0 (a relaxed grip; assumed)")
-      .field("hand_damping_n_s_per_m", &WriterProfile::hand_damping_n_s_per_m, "b [N s/m], >= 0")
-      .field("noise_fraction", &WriterProfile::noise_fraction,
-             "signal-dependent force noise, std dev / |F| (Harris & Wolpert 1998)")
-      .field("tremor_amplitude_n", &WriterProfile::tremor_amplitude_n,
-             "in-plane tremor force amplitude [N], >= 0")
-      .field("tremor_frequency_hz", &WriterProfile::tremor_frequency_hz,
-             "tremor frequency [Hz], > 0 (8-12 Hz physiological)")
-      .field("writing_speed_m_s", &WriterProfile::writing_speed_m_s,
-             "mean writing speed with the pen on the stroke [m/s], > 0")
-      .field("travel_speed_m_s", &WriterProfile::travel_speed_m_s, "mean speed of pen-up moves [m/s], > 0")
-      .field("press_depth_m", &WriterProfile::press_depth_m,
-             "how far below the paper the hand aims while writing [m], >= 0")
-      .field("lift_height_m", &WriterProfile::lift_height_m, "pen-up height above the paper [m], > 0")
-      .field("corner_cut_m", &WriterProfile::corner_cut_m,
-             "most the writer cuts inside a corner of the stroke [m], >= 0 (uniform per corner)")
-      .field("end_short_m", &WriterProfile::end_short_m,
-             "the pen lifts uniformly between end_short_m short of the seen end and end_past_m past it [m]")
-      .field("end_past_m", &WriterProfile::end_past_m, "see end_short_m [m], >= 0")
-      .field("follow_through_m", &WriterProfile::follow_through_m,
-             "a run past the end added to the end draw (a brush's exit) [m], >= 0; 0 by default")
-      .field("bias_offset_m", &WriterProfile::bias_offset_m, "offset of the whole copy [m], >= 0")
-      .field("scale_error", &WriterProfile::scale_error,
-             "relative mis-scale of the copy about the character centre, in (-0.5, 0.5)")
-      .field("stroke_jitter_m", &WriterProfile::stroke_jitter_m,
-             "std dev of a per-attempt random offset [m], >= 0")
-      .field("visual_delay_s", &WriterProfile::visual_delay_s,
-             "visuomotor delay [s], in [0, 0.5] (Miall et al. 1993; Saunders & Knill 2005)")
-      .field("vision_period_s", &WriterProfile::vision_period_s,
-             "interval between visual updates [s], in [0.001, 0.1]")
-      .field("correction_rate_per_s", &WriterProfile::correction_rate_per_s,
-             "rate at which a seen error beyond the tolerance is removed [1/s], >= 0")
-      .field("error_tolerance_m", &WriterProfile::error_tolerance_m,
-             "seen error the writer leaves uncorrected [m], >= 0")
-      .field("steering_width_m", &WriterProfile::steering_width_m,
-             "width W of the tunnel in the steering law v = (W - 2|e|) / tau [m], > 0")
-      .field("min_speed_fraction", &WriterProfile::min_speed_fraction,
-             "least share of `writing_speed_m_s` however large the error, in (0, 1]")
-      .field("error_filter_s", &WriterProfile::error_filter_s,
-             "time constant of the seen error that sets the speed [s], > 0")
-      .field("speed_time_constant_s", &WriterProfile::speed_time_constant_s,
-             "time constant of the speed command [s], > 0")
-      .field("reaction_time_s", &WriterProfile::reaction_time_s,
-             "how long a resistance lasts before the writer reacts [s], > 0")
-      .field("resistance_threshold_n", &WriterProfile::resistance_threshold_n,
-             "in-plane force against the intended motion that counts as resistance [N], > 0")
-      .field("expected_drag_ratio", &WriterProfile::expected_drag_ratio,
-             "paper drag the writer takes as normal, share of the normal force, >= 0")
-      .field("correction_per_attempt", &WriterProfile::correction_per_attempt,
-             "share of the bias and error rates removed on each re-attempt, in [0, 1]")
+      .field(&WriterProfile::hand_stiffness_n_per_m)
+      .field(&WriterProfile::hand_damping_n_s_per_m)
+      .field(&WriterProfile::noise_fraction)
+      .field(&WriterProfile::tremor_amplitude_n)
+      .field(&WriterProfile::tremor_frequency_hz)
+      .field(&WriterProfile::writing_speed_m_s)
+      .field(&WriterProfile::travel_speed_m_s)
+      .field(&WriterProfile::press_depth_m)
+      .field(&WriterProfile::lift_height_m)
+      .field(&WriterProfile::corner_cut_m)
+      .field(&WriterProfile::end_short_m)
+      .field(&WriterProfile::end_past_m)
+      .field(&WriterProfile::follow_through_m)
+      .field(&WriterProfile::bias_offset_m)
+      .field(&WriterProfile::scale_error)
+      .field(&WriterProfile::stroke_jitter_m)
+      .field(&WriterProfile::visual_delay_s)
+      .field(&WriterProfile::vision_period_s)
+      .field(&WriterProfile::correction_rate_per_s)
+      .field(&WriterProfile::error_tolerance_m)
+      .field(&WriterProfile::steering_width_m)
+      .field(&WriterProfile::min_speed_fraction)
+      .field(&WriterProfile::error_filter_s)
+      .field(&WriterProfile::speed_time_constant_s)
+      .field(&WriterProfile::reaction_time_s)
+      .field(&WriterProfile::resistance_threshold_n)
+      .field(&WriterProfile::expected_drag_ratio)
+      .field(&WriterProfile::correction_per_attempt)
       .field("max_attempts_per_stroke", &WriterProfile::max_attempts_per_stroke,
              "attempts at one stroke before the writer gives up, >= 1")
-      .field("order_error_probability", &WriterProfile::order_error_probability,
-             "a stroke is swapped with the next one in the writer's order")
-      .field("backwards_probability", &WriterProfile::backwards_probability,
-             "a stroke is written from its end to its start")
-      .field("mid_stroke_lift_probability", &WriterProfile::mid_stroke_lift_probability,
-             "the pen is lifted in the middle of a stroke")
-      .field("outside_touch_probability", &WriterProfile::outside_touch_probability,
-             "the pen touches the paper outside the character's box (AS)")
-      .field("hesitation_probability", &WriterProfile::hesitation_probability,
-             "the writer pauses before a stroke or at a corner")
-      .field("hesitation_s", &WriterProfile::hesitation_s, "mean length of a pause [s], >= 0")
-      .field("learning_rate", &WriterProfile::learning_rate,
-             "lambda of the exponential practice law per repetition, >= 0; 0 = no learning")
+      .field(&WriterProfile::order_error_probability)
+      .field(&WriterProfile::backwards_probability)
+      .field(&WriterProfile::mid_stroke_lift_probability)
+      .field(&WriterProfile::outside_touch_probability)
+      .field(&WriterProfile::hesitation_probability)
+      .field(&WriterProfile::hesitation_s)
+      .field(&WriterProfile::learning_rate)
       .finish()
       .def_static(
           "novice", &WriterProfile::novice,

@@ -12,48 +12,90 @@
 namespace calligraphy {
 namespace {
 
-struct Field {
-  const char* name;
-  double WriterProfile::*member;
-};
+using Field = ParameterField<WriterProfile>;
+using W = WriterProfile;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// [low, high]; open ends where a value of the bound itself would be meaningless (no stiffness, no speed).
+constexpr ParameterRange closed(double low, double high) { return {.low = low, .high = high}; }
+constexpr ParameterRange above(double low, double high) {
+  return {.low = low, .high = high, .low_open = true};
+}
+constexpr ParameterRange kProbability = closed(0.0, 1.0);
 
-// Every numeric field but `max_attempts_per_stroke` (an int, handled on its own).
-constexpr std::array kFields = {
-    Field{"hand_stiffness_n_per_m", &WriterProfile::hand_stiffness_n_per_m},
-    Field{"hand_damping_n_s_per_m", &WriterProfile::hand_damping_n_s_per_m},
-    Field{"noise_fraction", &WriterProfile::noise_fraction},
-    Field{"tremor_amplitude_n", &WriterProfile::tremor_amplitude_n},
-    Field{"tremor_frequency_hz", &WriterProfile::tremor_frequency_hz},
-    Field{"writing_speed_m_s", &WriterProfile::writing_speed_m_s},
-    Field{"travel_speed_m_s", &WriterProfile::travel_speed_m_s},
-    Field{"press_depth_m", &WriterProfile::press_depth_m},
-    Field{"lift_height_m", &WriterProfile::lift_height_m},
-    Field{"corner_cut_m", &WriterProfile::corner_cut_m},
-    Field{"end_short_m", &WriterProfile::end_short_m},
-    Field{"end_past_m", &WriterProfile::end_past_m},
-    Field{"follow_through_m", &WriterProfile::follow_through_m},
-    Field{"bias_offset_m", &WriterProfile::bias_offset_m},
-    Field{"scale_error", &WriterProfile::scale_error},
-    Field{"stroke_jitter_m", &WriterProfile::stroke_jitter_m},
-    Field{"visual_delay_s", &WriterProfile::visual_delay_s},
-    Field{"vision_period_s", &WriterProfile::vision_period_s},
-    Field{"correction_rate_per_s", &WriterProfile::correction_rate_per_s},
-    Field{"error_tolerance_m", &WriterProfile::error_tolerance_m},
-    Field{"steering_width_m", &WriterProfile::steering_width_m},
-    Field{"min_speed_fraction", &WriterProfile::min_speed_fraction},
-    Field{"error_filter_s", &WriterProfile::error_filter_s},
-    Field{"speed_time_constant_s", &WriterProfile::speed_time_constant_s},
-    Field{"reaction_time_s", &WriterProfile::reaction_time_s},
-    Field{"resistance_threshold_n", &WriterProfile::resistance_threshold_n},
-    Field{"expected_drag_ratio", &WriterProfile::expected_drag_ratio},
-    Field{"correction_per_attempt", &WriterProfile::correction_per_attempt},
-    Field{"order_error_probability", &WriterProfile::order_error_probability},
-    Field{"backwards_probability", &WriterProfile::backwards_probability},
-    Field{"mid_stroke_lift_probability", &WriterProfile::mid_stroke_lift_probability},
-    Field{"outside_touch_probability", &WriterProfile::outside_touch_probability},
-    Field{"hesitation_probability", &WriterProfile::hesitation_probability},
-    Field{"hesitation_s", &WriterProfile::hesitation_s},
-    Field{"learning_rate", &WriterProfile::learning_rate},
+// Every numeric field but `max_attempts_per_stroke` (an int, handled on its own), in declaration order: the
+// one definition of each range (docs/writer.md has the sources of the defaults).
+constexpr std::array kFields{
+    Field{"hand_stiffness_n_per_m", "N/m", above(0.0, 1e4), "k, the hand's stiffness holding the stylus",
+          &W::hand_stiffness_n_per_m},
+    Field{"hand_damping_n_s_per_m", "N s/m", closed(0.0, 1e3), "b, the hand's damping",
+          &W::hand_damping_n_s_per_m},
+    Field{"noise_fraction", "", closed(0.0, 1.0),
+          "signal-dependent force noise, std dev over |F| (Harris & Wolpert 1998)", &W::noise_fraction},
+    Field{"tremor_amplitude_n", "N", closed(0.0, 10.0), "in-plane tremor force amplitude",
+          &W::tremor_amplitude_n},
+    Field{"tremor_frequency_hz", "Hz", above(0.0, 100.0), "tremor frequency (8-12 Hz physiological)",
+          &W::tremor_frequency_hz},
+    Field{"writing_speed_m_s", "m/s", above(0.0, 10.0), "mean writing speed with the pen on the stroke",
+          &W::writing_speed_m_s},
+    Field{"travel_speed_m_s", "m/s", above(0.0, 10.0), "mean speed of pen-up moves", &W::travel_speed_m_s},
+    Field{"press_depth_m", "m", closed(0.0, 0.1), "how far below the paper the hand aims while writing",
+          &W::press_depth_m},
+    Field{"lift_height_m", "m", above(0.0, 0.2), "pen-up height above the paper", &W::lift_height_m},
+    Field{"corner_cut_m", "m", closed(0.0, 0.02), "most the writer cuts inside a corner (uniform per corner)",
+          &W::corner_cut_m},
+    Field{"end_short_m", "m", closed(0.0, 0.02),
+          "the pen lifts uniformly between this short of the seen end and end_past_m past it",
+          &W::end_short_m},
+    Field{"end_past_m", "m", closed(0.0, 0.02), "see end_short_m", &W::end_past_m},
+    Field{"follow_through_m", "m", closed(0.0, 0.05),
+          "a run past the end added to the end draw (a brush's exit)", &W::follow_through_m},
+    Field{"bias_offset_m", "m", closed(0.0, 0.05), "offset of the writer's whole copy", &W::bias_offset_m},
+    Field{"scale_error",
+          "",
+          {.low = -0.5, .high = 0.5, .low_open = true, .high_open = true},
+          "relative mis-scale of the copy about the character centre",
+          &W::scale_error},
+    Field{"stroke_jitter_m", "m", closed(0.0, 0.05), "std dev of a per-attempt random offset",
+          &W::stroke_jitter_m},
+    Field{"visual_delay_s", "s", closed(0.0, 0.5),
+          "visuomotor delay (Miall et al. 1993; Saunders & Knill 2005)", &W::visual_delay_s},
+    Field{"vision_period_s", "s", closed(0.001, 0.1), "interval between visual updates", &W::vision_period_s},
+    Field{"correction_rate_per_s", "1/s", closed(0.0, 100.0),
+          "rate at which a seen error beyond the tolerance is removed", &W::correction_rate_per_s},
+    Field{"error_tolerance_m", "m", closed(0.0, 0.05), "seen error the writer leaves uncorrected",
+          &W::error_tolerance_m},
+    Field{"steering_width_m", "m", above(0.0, 0.1),
+          "width W of the tunnel in the steering law v = (W - 2|e|) / tau", &W::steering_width_m},
+    Field{"min_speed_fraction",
+          "",
+          {.low = 0.0, .high = 1.0, .low_open = true},
+          "least share of writing_speed_m_s however large the error",
+          &W::min_speed_fraction},
+    Field{"error_filter_s", "s", above(0.0, 10.0), "time constant of the seen error that sets the speed",
+          &W::error_filter_s},
+    Field{"speed_time_constant_s", "s", above(0.0, 10.0), "time constant of the speed command",
+          &W::speed_time_constant_s},
+    Field{"reaction_time_s", "s", above(0.0, 10.0), "how long a resistance lasts before the writer reacts",
+          &W::reaction_time_s},
+    Field{"resistance_threshold_n", "N", above(0.0, 100.0),
+          "in-plane force against the intended motion that counts as resistance", &W::resistance_threshold_n},
+    Field{"expected_drag_ratio", "", closed(0.0, 10.0),
+          "paper drag the writer takes as normal, share of the normal force", &W::expected_drag_ratio},
+    Field{"correction_per_attempt", "", closed(0.0, 1.0),
+          "share of the bias and error rates removed on each re-attempt", &W::correction_per_attempt},
+    Field{"order_error_probability", "", kProbability,
+          "a stroke is swapped with the next one in the writer's order", &W::order_error_probability},
+    Field{"backwards_probability", "", kProbability, "a stroke is written from its end to its start",
+          &W::backwards_probability},
+    Field{"mid_stroke_lift_probability", "", kProbability, "the pen is lifted in the middle of a stroke",
+          &W::mid_stroke_lift_probability},
+    Field{"outside_touch_probability", "", kProbability,
+          "the pen touches the paper outside the character's box (AS)", &W::outside_touch_probability},
+    Field{"hesitation_probability", "", kProbability, "the writer pauses before a stroke or at a corner",
+          &W::hesitation_probability},
+    Field{"hesitation_s", "s", closed(0.0, 60.0), "mean length of a pause", &W::hesitation_s},
+    Field{"learning_rate", "", closed(0.0, kInf),
+          "lambda of the exponential practice law per repetition; 0 = no learning", &W::learning_rate},
 };
 constexpr const char* kAttemptsKey = "max_attempts_per_stroke";
 
@@ -74,22 +116,11 @@ const Field* find_field(std::string_view key) {
   throw InvalidArgument("unknown writer parameter '" + std::string(key) + "'; known: " + known_keys());
 }
 
-// Throws naming the field when `value` is not finite or outside [low, high] (open ends when asked).
-void check_range(const char* field, double value, double low, double high, bool low_open = false,
-                 bool high_open = false) {
-  const bool above = low_open ? value > low : value >= low;
-  const bool below = high_open ? value < high : value <= high;
-  if (std::isfinite(value) && above && below) return;
-  const std::string range = std::string(low_open ? "(" : "[") + std::to_string(low) + ", " +
-                            (std::isinf(high) ? std::string("inf") : std::to_string(high)) +
-                            (high_open || std::isinf(high) ? ")" : "]");
-  throw InvalidArgument("WriterProfile." + std::string(field) + " = " + std::to_string(value) +
-                        " must be finite and in " + range);
-}
-
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
 }  // namespace
+
+std::span<const ParameterField<WriterProfile>> ParameterTable<WriterProfile>::fields() noexcept {
+  return kFields;
+}
 
 WriterProfile WriterProfile::novice() { return WriterProfile{}; }
 
@@ -129,41 +160,7 @@ WriterProfile WriterProfile::foreign() {
 }
 
 void WriterProfile::validate() const {
-  check_range("hand_stiffness_n_per_m", hand_stiffness_n_per_m, 0.0, 1e4, true);
-  check_range("hand_damping_n_s_per_m", hand_damping_n_s_per_m, 0.0, 1e3);
-  check_range("noise_fraction", noise_fraction, 0.0, 1.0);
-  check_range("tremor_amplitude_n", tremor_amplitude_n, 0.0, 10.0);
-  check_range("tremor_frequency_hz", tremor_frequency_hz, 0.0, 100.0, true);
-  check_range("writing_speed_m_s", writing_speed_m_s, 0.0, 10.0, true);
-  check_range("travel_speed_m_s", travel_speed_m_s, 0.0, 10.0, true);
-  check_range("press_depth_m", press_depth_m, 0.0, 0.1);
-  check_range("lift_height_m", lift_height_m, 0.0, 0.2, true);
-  check_range("corner_cut_m", corner_cut_m, 0.0, 0.02);
-  check_range("end_short_m", end_short_m, 0.0, 0.02);
-  check_range("end_past_m", end_past_m, 0.0, 0.02);
-  check_range("follow_through_m", follow_through_m, 0.0, 0.05);
-  check_range("bias_offset_m", bias_offset_m, 0.0, 0.05);
-  check_range("scale_error", scale_error, -0.5, 0.5, true, true);
-  check_range("stroke_jitter_m", stroke_jitter_m, 0.0, 0.05);
-  check_range("visual_delay_s", visual_delay_s, 0.0, 0.5);
-  check_range("vision_period_s", vision_period_s, 0.001, 0.1);
-  check_range("correction_rate_per_s", correction_rate_per_s, 0.0, 100.0);
-  check_range("error_tolerance_m", error_tolerance_m, 0.0, 0.05);
-  check_range("steering_width_m", steering_width_m, 0.0, 0.1, true);
-  check_range("min_speed_fraction", min_speed_fraction, 0.0, 1.0, true);
-  check_range("error_filter_s", error_filter_s, 0.0, 10.0, true);
-  check_range("speed_time_constant_s", speed_time_constant_s, 0.0, 10.0, true);
-  check_range("reaction_time_s", reaction_time_s, 0.0, 10.0, true);
-  check_range("resistance_threshold_n", resistance_threshold_n, 0.0, 100.0, true);
-  check_range("expected_drag_ratio", expected_drag_ratio, 0.0, 10.0);
-  check_range("correction_per_attempt", correction_per_attempt, 0.0, 1.0);
-  check_range("order_error_probability", order_error_probability, 0.0, 1.0);
-  check_range("backwards_probability", backwards_probability, 0.0, 1.0);
-  check_range("mid_stroke_lift_probability", mid_stroke_lift_probability, 0.0, 1.0);
-  check_range("outside_touch_probability", outside_touch_probability, 0.0, 1.0);
-  check_range("hesitation_probability", hesitation_probability, 0.0, 1.0);
-  check_range("hesitation_s", hesitation_s, 0.0, 60.0);
-  check_range("learning_rate", learning_rate, 0.0, kInf);
+  check_parameters(*this);
   if (max_attempts_per_stroke < 1 || max_attempts_per_stroke > 1000) {
     throw InvalidArgument("WriterProfile.max_attempts_per_stroke = " +
                           std::to_string(max_attempts_per_stroke) + " must be in [1, 1000]");

@@ -4,9 +4,12 @@
 /// learns. Plain fields, settable one by one from C++ (then `validate()`), or by name with
 /// `set_writer_parameter` (for a command line or Python). Every constant and its source:
 /// docs/writer.md.
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "calligraphy/render/parameter_table.hpp"
 
 namespace calligraphy {
 
@@ -84,8 +87,16 @@ struct WriterProfile {
   /// The paper's foreign student (section 7): larger bias, strokes out of order and backwards, slower.
   static WriterProfile foreign();
   /// Throws InvalidArgument naming the field, its value and its range when a value is out of range or
-  /// not finite.
+  /// not finite (`ParameterTable<WriterProfile>`; `max_attempts_per_stroke` in [1, 1000]).
   void validate() const;
+};
+
+/// The numeric fields of WriterProfile but `max_attempts_per_stroke` (parameter_table.hpp): the one
+/// definition of their units and ranges, read by `validate`, `set_writer_parameter` and Python.
+template <>
+struct ParameterTable<WriterProfile> {
+  static constexpr std::string_view name = "WriterProfile";
+  [[nodiscard]] static std::span<const ParameterField<WriterProfile>> fields() noexcept;
 };
 
 /// The profile called `name`: "novice", "skilled" or "foreign". Throws InvalidArgument naming the
