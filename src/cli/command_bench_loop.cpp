@@ -5,6 +5,7 @@
 #include <memory>
 #include <string>
 
+#include "calligraphy/core/servo_rate.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 #include "cli/output.hpp"
@@ -69,8 +70,9 @@ void add_bench_loop_command(CLI::App& bench, Commands& commands) {
   CLI::App* app =
       commands.add(bench, "loop", "Period jitter and missed deadlines of the real-time servo loop",
                    [command] { return run_loop(*command); });
-  add_number(*app, "--rate", command->rate_hz, "HZ", "servo rate [Hz]", "a number of Hz in [100, 10000]",
-             [](double hz) { return hz >= 100.0 && hz <= 10000.0; });
+  add_number(*app, "--rate", command->rate_hz, "HZ", "servo rate [Hz]",
+             "a rate in " + servo_rate_range_text(true),
+             [](double hz) { return servo_rate_allowed(hz, true); });
   add_number(*app, "--seconds", command->seconds, "S", "how long to run; the trial's time limit [s]",
              "a number of seconds > 0", [](double s) { return s > 0.0; });
   add_choice(

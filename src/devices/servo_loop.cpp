@@ -13,6 +13,7 @@
 #include <exception>
 #include <thread>
 
+#include "calligraphy/core/servo_rate.hpp"
 #include "calligraphy/devices/device_servo_clock.hpp"
 #include "core/library_log.hpp"
 #include "core/rate_text.hpp"
@@ -28,8 +29,8 @@ using devices::LogRecord;
 
 namespace {
 
-constexpr double kMinRateHz = 100.0;
-constexpr double kMaxRateHz = 10000.0;
+constexpr double kMinRateHz = kMinServoRateHz;
+constexpr double kMaxRateHz = kMaxRealTimeServoRateHz;
 
 std::int64_t monotonic_ns() noexcept {
   timespec ts{};
@@ -115,7 +116,8 @@ const char* to_string(LoopFaultKind kind) noexcept {
 
 void ServoLoopOptions::validate() const {
   if (!(rate_hz >= kMinRateHz && rate_hz <= kMaxRateHz)) {
-    throw InvalidArgument("ServoLoopOptions.rate_hz = " + detail::rate_text(rate_hz) + " must be in [100, 10000] Hz");
+    throw InvalidArgument("ServoLoopOptions.rate_hz = " + detail::rate_text(rate_hz) + " must be in " +
+                          servo_rate_range_text(true));
   }
   if (priority < 0 || priority > 99) {
     throw InvalidArgument("ServoLoopOptions.priority = " + std::to_string(priority) + " must be in [0, 99]");

@@ -8,6 +8,7 @@
 
 #include "calligraphy/collision/constraint_space.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/servo_rate.hpp"
 #include "core/library_log.hpp"
 #include "core/rate_text.hpp"
 
@@ -58,8 +59,9 @@ const RendererOptions& checked(const RendererOptions& options) {
 }  // namespace
 
 void RendererOptions::validate() const {
-  if (!(rate_hz >= 100.0 && rate_hz <= 100000.0)) {
-    throw InvalidArgument("RendererOptions.rate_hz = " + detail::rate_text(rate_hz) + " must be in [100, 100000] Hz");
+  if (!servo_rate_allowed(rate_hz, false)) {
+    throw InvalidArgument("RendererOptions.rate_hz = " + detail::rate_text(rate_hz) + " must be in " +
+                          servo_rate_range_text(false));
   }
   passivity.validate();
 }

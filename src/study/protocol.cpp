@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/servo_rate.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "study/json_reader.hpp"
 #include "study/names.hpp"
@@ -290,7 +291,9 @@ void read_trial_settings(ObjectReader& reader, StudyProtocol& protocol) {
   ObjectReader trial(*value, reader.pointer("trial"), reader.source());
   protocol.trial.max_duration_s =
       trial.number_or("max_duration_s", protocol.trial.max_duration_s, 1e-3, 3600.0);
-  protocol.trial.rate_hz = trial.number_or("rate_hz", protocol.trial.rate_hz, 100.0, 10000.0);
+  // A protocol's trials may run in real time with a person: the real-time range.
+  protocol.trial.rate_hz =
+      trial.number_or("rate_hz", protocol.trial.rate_hz, kMinServoRateHz, kMaxRealTimeServoRateHz);
   // Checked here, so that a session is refused before its folder is made, naming the protocol's fields
   // rather than the trial runner's options.
   const double ticks = protocol.trial.max_duration_s * protocol.trial.rate_hz;

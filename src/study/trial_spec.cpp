@@ -10,6 +10,7 @@
 
 #include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/servo_rate.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
@@ -329,9 +330,8 @@ void TrialSpec::validate(TeacherSource teacher_from) const {
     }
   }
   const bool real_time = pacing == TrialPacing::real_time;
-  const double max_rate_hz = real_time ? 10000.0 : 100000.0;
-  if (!(rate_hz >= 100.0 && rate_hz <= max_rate_hz)) {
-    refuse("rate_hz", number_text(rate_hz) + " Hz is outside [100, " + number_text(max_rate_hz) + "]" +
+  if (!servo_rate_allowed(rate_hz, real_time)) {
+    refuse("rate_hz", number_text(rate_hz) + " Hz is outside " + servo_rate_range_text(real_time) +
                           (real_time ? " (real-time pacing)" : ""));
   }
   if (!(watchdog_s >= 0.0 && watchdog_s <= 60.0) ||

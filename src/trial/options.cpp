@@ -5,6 +5,7 @@
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/servo_rate.hpp"
 #include "core/rate_text.hpp"
 
 namespace calligraphy {
@@ -12,11 +13,10 @@ namespace calligraphy {
 void TrialOptions::validate() const {
   // Lock-step has no wall clock, so it may run faster than any loop thread; real time is the ServoLoop's
   // range.
-  const double max_rate_hz = pacing == TrialPacing::real_time ? 10000.0 : 100000.0;
-  if (!(rate_hz >= 100.0 && rate_hz <= max_rate_hz)) {
-    throw InvalidArgument("TrialOptions.rate_hz = " + detail::rate_text(rate_hz) + " must be in [100, " +
-                          std::to_string(static_cast<int>(max_rate_hz)) + "] Hz" +
-                          (pacing == TrialPacing::real_time ? " in real time" : ""));
+  const bool real_time = pacing == TrialPacing::real_time;
+  if (!servo_rate_allowed(rate_hz, real_time)) {
+    throw InvalidArgument("TrialOptions.rate_hz = " + detail::rate_text(rate_hz) + " must be in " +
+                          servo_rate_range_text(real_time) + (real_time ? " in real time" : ""));
   }
   if (!(max_duration_s > 0.0) || !std::isfinite(max_duration_s)) {
     throw InvalidArgument("TrialOptions.max_duration_s = " + std::to_string(max_duration_s) + " must be > 0");
@@ -24,7 +24,8 @@ void TrialOptions::validate() const {
   force.validate();
   passivity.validate();
   ServoLoopOptions paced = loop;
-  paced.rate_hz = std::min(rate_hz, 10000.0);  // the loop's other fields; its rate is the trial's
+  paced.rate_hz =
+      std::min(rate_hz, kMaxRealTimeServoRateHz);  // the loop's other fields; its rate is the trial's
   paced.validate();
 }
 

@@ -7,8 +7,10 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/force_limits.hpp"
+#include "calligraphy/core/servo_rate.hpp"
 #include "calligraphy/core/stop_signals.hpp"
 #include "core/library_log.hpp"
+#include "core/rate_text.hpp"
 #include "devices/openhaptics/hd_conversions.hpp"
 #include "devices/openhaptics/hd_errors.hpp"
 
@@ -37,9 +39,9 @@ OpenHapticsDevice::OpenHapticsDevice(std::string configuration_name, double watc
       watchdog_timeout_s_(watchdog_timeout_s),
       servo_rate_hz_(servo_rate_hz) {
   if (!(watchdog_timeout_s > 0.0)) throw InvalidArgument("OpenHapticsDevice: watchdog timeout must be > 0 s");
-  if (!(servo_rate_hz >= 100.0 && servo_rate_hz <= 10000.0)) {
-    throw InvalidArgument("OpenHapticsDevice: servo rate " + std::to_string(servo_rate_hz) +
-                          " Hz must be in [100, 10000] Hz");
+  if (!servo_rate_allowed(servo_rate_hz, true)) {
+    throw InvalidArgument("OpenHapticsDevice: servo rate " + detail::rate_text(servo_rate_hz) +
+                          " must be in " + servo_rate_range_text(true));
   }
   info_.model = "OpenHaptics device (not opened)";
   info_.manufacturer = "unknown";
