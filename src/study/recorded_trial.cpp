@@ -3,6 +3,7 @@
 #include <array>
 #include <bit>
 #include <cstdint>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -329,7 +330,11 @@ RecordedTrial read_recorded_trial(std::string_view text, const std::string& sour
   // The specification's own reader checks its fields (trial_spec.hpp); its pointers are prefixed here.
   const json& trial = reader.required("trial");
   try {
-    r.spec = trial_spec_from_json(trial.dump(), source + " " + reader.pointer("trial"));
+    // A replay whose teacher was given as samples (a session's, kept in its folder) names no file.
+    const bool teacher_named = trial.is_object() && trial.contains("teacher") &&
+                               trial["teacher"].is_string() && !trial["teacher"].get<std::string>().empty();
+    r.spec = trial_spec_from_json(trial.dump(), source + " " + reader.pointer("trial"),
+                                  teacher_named ? TeacherSource::file : TeacherSource::samples);
   } catch (const InvalidArgument& e) {
     study_detail::fail(source, reader.pointer("trial"), e.what());
   }
@@ -378,7 +383,30 @@ RecordedTrial read_recorded_trial(std::string_view text, const std::string& sour
 }
 
 RecordedTrial read_recorded_trial_file(const std::string& path) {
-  return read_recorded_trial(read_regular_file(path, study_detail::kMaxRecordBytes), path);
+  const std::string text = read_regular_file(path, study_detail::kMaxRecordBytes);
+  RecordedTrial recorded = read_recorded_trial(text, path);
+  if (recorded.spec.guidance && recorded.spec.guidance_mode == GuidanceMode::replay &&
+      recorded.spec.teacher.empty()) {
+    // A session's replay ran on the teacher kept in its folder (trials/ is beside teachers/): the record
+    // names the file and its SHA-256 under /guidance/teacher (trial_guidance.hpp); taken when it is still the
+    // same.
+    const json document = study_detail::parse_json(text, path);
+    const json* teacher = document.contains("guidance") && document["guidance"].is_object() &&
+                                  document["guidance"].contains("teacher") &&
+                                  document["guidance"]["teacher"].is_object()
+                              ? &document["guidance"]["teacher"]
+                              : nullptr;
+    if (teacher != nullptr && (*teacher)["file"].is_string() && (*teacher)["sha256"].is_string()) {
+      const std::filesystem::path file =
+          std::filesystem::path(path).parent_path().parent_path() / (*teacher)["file"].get<std::string>();
+      std::error_code error;
+      if (std::filesystem::is_regular_file(file, error) &&
+          sha256_hex(read_regular_file(file, study_detail::kMaxRecordBytes)) ==
+              (*teacher)["sha256"].get<std::string>())
+        recorded.spec.teacher = file.string();
+    }
+  }
+  return recorded;
 }
 
 TrialRun rerun_trial(const RecordedTrial& recorded, const Scene& scene, TrialRunInputs inputs) {

@@ -387,7 +387,7 @@ std::vector<std::string> trial_spec_args(const TrialSpec& spec) {
   return args;
 }
 
-TrialSpec trial_spec_from_json(std::string_view text, const std::string& source) {
+TrialSpec trial_spec_from_json(std::string_view text, const std::string& source, TeacherSource teacher_from) {
   const json document = study_detail::parse_json(text, source);
   study_detail::ObjectReader reader(document, "", source);
   TrialSpec spec;
@@ -440,7 +440,7 @@ TrialSpec trial_spec_from_json(std::string_view text, const std::string& source)
     }
   }
   reader.finish();
-  spec.validate();
+  spec.validate(teacher_from);
   return spec;
 }
 

@@ -28,10 +28,12 @@ PROTOCOL = {
         {"name": "amplify", "mode": "error-amplification", "guidance_stiffness_n_per_m": 250,
          "parameters": {"amplification_gain": 0.2, "max_force_n": 0.21}},
         {"name": "quiz", "mode": "quiz", "quiz": {"acceptance": {"corridor_m": 0.007}}},
+        {"name": "replay", "mode": "replay", "parameters": {"max_lead_m": 0.0025}},
     ],
     "phases": [
         {"phase": "training", "condition": "fade", "characters": ["十"], "repetitions": 2},
         {"phase": "training", "condition": "amplify", "characters": ["人"]},
+        {"phase": "training", "condition": "replay", "characters": ["十"]},
         {"phase": "post-test", "condition": "quiz", "characters": ["十"]},
     ],
     "trial": {"max_duration_s": 20, "rate_hz": 800},
@@ -92,7 +94,7 @@ class ReplayTest(unittest.TestCase):
         self.ok("session", "run", "p.json", "--subject", "S01", "--out", "out", "--writer-profile", "foreign",
                 "--writer-learning", "two-state")
         records = sorted((self.cwd / "out").rglob("trials/*.json"))
-        self.assertEqual(len(records), 4, [str(r) for r in records])
+        self.assertEqual(len(records), 5, [str(r) for r in records])
         profiles = {json.dumps(json.loads(r.read_text())["specification"]["writer"], sort_keys=True) for r in records}
         self.assertGreater(len(profiles), 1, "the learning subject wrote every trial with one profile")
         modes = set()
@@ -110,7 +112,8 @@ class ReplayTest(unittest.TestCase):
         for force in amplified:
             self.assertEqual(force["guidance_stiffness_n_per_m"], 250)
             self.assertEqual(force["guidance_law"], {"mode": "error-amplification", "gain": 0.2, "max_force_n": 0.21})
-        self.assertTrue({"fading", "error-amplification", "off"} <= modes, modes)
+        # A replay re-runs on the teacher kept in the session folder (the record names it and its SHA-256).
+        self.assertTrue({"fading", "error-amplification", "replay", "off"} <= modes, modes)
 
     def test_what_cannot_be_run_again_is_refused_by_name(self):
         self.ok("trial", "十", "--json", "r.json", "--max-duration", "60")

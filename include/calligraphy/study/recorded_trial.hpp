@@ -72,8 +72,10 @@ struct RecordedTrial {
 /// a format or version this library does not read.
 [[nodiscard]] RecordedTrial read_recorded_trial(std::string_view text, const std::string& source);
 
-/// `read_recorded_trial` of the regular file `path` (at most 64 MiB, a trial record's bound). Throws
-/// DataError naming the path when it cannot be read, and what `read_recorded_trial` throws.
+/// `read_recorded_trial` of the regular file `path` (at most 64 MiB, a trial record's bound). A study
+/// session's replay, which ran on the teacher kept in its session folder, names that file as its teacher when
+/// it is still there with the SHA-256 the record gives (/guidance/teacher). Throws DataError naming the path
+/// when it cannot be read, and what `read_recorded_trial` throws.
 [[nodiscard]] RecordedTrial read_recorded_trial_file(const std::string& path);
 
 /// Runs `recorded` again on `scene` (laid out by the caller with `recorded.layout`) with `inputs` (the

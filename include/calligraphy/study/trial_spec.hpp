@@ -110,8 +110,9 @@ void set_trial_spec_field(TrialSpec& spec, std::string_view name, std::string_vi
 /// The specification from a JSON object whose keys are the fields' keys (numbers as numbers, `guidance` a
 /// boolean, `writer_parameters` an array of strings); a missing key keeps its default. Throws DataError
 /// naming `source` and the JSON pointer of a value at fault or an unknown key, then validates
-/// (InvalidArgument naming the field).
-[[nodiscard]] TrialSpec trial_spec_from_json(std::string_view text, const std::string& source);
+/// (InvalidArgument naming the field) with a replay's teacher from `teacher_from` (TrialSpec::validate).
+[[nodiscard]] TrialSpec trial_spec_from_json(std::string_view text, const std::string& source,
+                                             TeacherSource teacher_from = TeacherSource::file);
 /// The JSON object `trial_spec_from_json` reads back as `spec` (every field, keys in field order).
 [[nodiscard]] std::string trial_spec_json(const TrialSpec& spec);
 
