@@ -20,7 +20,7 @@ using nlohmann::json;
 void practise_session(WriterMemory& memory, const fs::path& folder, const SessionManifest& manifest) {
   const TwoStateRates rates = subject_traits(manifest.setup).learning;
   for (const PlannedTrial& trial : manifest.plan) {
-    const fs::path file = folder / "trials" / (SessionFolder::trial_stem(trial) + ".json");
+    const fs::path file = SessionLayout::record(folder, trial);
     std::error_code error;
     if (!fs::exists(file, error)) break;  // trials are saved in order: the rest are not yet
     practise_record(memory, read_trial_record(file), file.string(), rates);

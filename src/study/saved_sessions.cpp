@@ -28,7 +28,7 @@ std::vector<fs::path> session_folders_under(const std::vector<fs::path>& roots) 
 }
 
 SessionManifest read_session_manifest(const fs::path& folder) {
-  const fs::path path = folder / "session.json";
+  const fs::path path = SessionLayout::manifest(folder);
   SessionManifest manifest =
       manifest_from_json(read_small_file(path, kMaxSessionManifestBytes, "session manifest"), path.string());
   manifest.session_id = folder.filename().string();
@@ -38,10 +38,10 @@ SessionManifest read_session_manifest(const fs::path& folder) {
 SessionManifest read_previous_session(const fs::path& folder, const SessionManifest& manifest) {
   const PreviousSession& link = manifest.previous.value();
   const fs::path before = folder.parent_path() / link.session_id;
-  const fs::path path = before / "session.json";
+  const fs::path path = SessionLayout::manifest(before);
   const std::string text = read_small_file(path, kMaxSessionManifestBytes, "session manifest");
   if (!link.session_sha256.empty() && sha256_hex(text) != link.session_sha256) {
-    fail((folder / "session.json").string(), "/previous_session/session_sha256",
+    fail((SessionLayout::manifest(folder)).string(), "/previous_session/session_sha256",
          path.string() +
              " is not the session this one follows (its SHA-256 differs: replaced or edited?): restore the "
              "original folder");
@@ -63,8 +63,8 @@ bool DistinctSessions::add(const fs::path& folder, const SessionManifest& manife
   if (inserted) return true;
   std::error_code error;
   if (fs::equivalent(at->second, folder, error)) return false;
-  throw DataError((folder / "session.json").string() + ": the same session as " + at->second.string() +
-                  " (subject " + manifest.setup.subject.id + ", session " +
+  throw DataError((SessionLayout::manifest(folder)).string() + ": the same session as " +
+                  at->second.string() + " (subject " + manifest.setup.subject.id + ", session " +
                   std::to_string(manifest.setup.session_number) + ", created " + manifest.created_utc +
                   "): a copy; remove one so that its trials are not counted twice");
 }

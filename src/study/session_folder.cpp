@@ -312,9 +312,9 @@ SessionFolder SessionFolder::create(const fs::path& root, const SessionSetup& se
     fs::remove_all(building, ignored);
   };
   try {
-    write_file_atomically(building / "session.json", text);
-    make_folder(building / "trials");
-    fd = open_locked_log(building / "log.jsonl");
+    write_file_atomically(SessionLayout::manifest(building), text);
+    make_folder(SessionLayout::trials(building));
+    fd = open_locked_log(SessionLayout::log(building));
     fsync_folder(building);
   } catch (...) {
     abandon();
@@ -366,20 +366,29 @@ void remove_unsaved_leftovers(const fs::path& folder) {
 
 }  // namespace
 
+fs::path SessionLayout::manifest(const fs::path& folder) { return folder / "session.json"; }
+fs::path SessionLayout::log(const fs::path& folder) { return folder / "log.jsonl"; }
+fs::path SessionLayout::trials(const fs::path& folder) { return folder / "trials"; }
+fs::path SessionLayout::attempts(const fs::path& folder) { return trials(folder) / "attempts"; }
+fs::path SessionLayout::teachers(const fs::path& folder) { return folder / "teachers"; }
+fs::path SessionLayout::record(const fs::path& folder, const PlannedTrial& trial) {
+  return trials(folder) / (SessionFolder::trial_stem(trial) + ".json");
+}
+
 SessionFolder SessionFolder::open(const fs::path& folder) {
   if (is_partial_session_folder(named_folder(folder))) throw DataError(folder.string() + ": " + kPartialNote);
-  const fs::path manifest_path = folder / "session.json";
+  const fs::path manifest_path = SessionLayout::manifest(folder);
   const std::string text =
       study_detail::read_small_file(manifest_path, kMaxSessionManifestBytes, "session manifest");
   SessionManifest manifest = study_detail::manifest_from_json(text, manifest_path.string());
   manifest.session_id = folder.filename().string();
   if (manifest.session_id.empty()) manifest.session_id = folder.parent_path().filename().string();
-  const fs::path log_path = folder / "log.jsonl";
+  const fs::path log_path = SessionLayout::log(folder);
   const int fd = open_locked_log(log_path);
   SessionFolder session(folder, std::move(manifest), fd);
   // The lock says no other run writes here: what a killed run left half written is nobody's.
-  remove_unsaved_leftovers(folder / "trials");
-  remove_unsaved_leftovers(folder / "trials" / "attempts");
+  remove_unsaved_leftovers(SessionLayout::trials(folder));
+  remove_unsaved_leftovers(SessionLayout::attempts(folder));
   // A crash in the middle of a log line leaves it torn: end it, so that the next line stands alone.
   std::error_code error;
   const std::uintmax_t size = fs::file_size(log_path, error);
@@ -413,7 +422,7 @@ std::string SessionFolder::trial_stem(const PlannedTrial& trial) {
 }
 
 fs::path SessionFolder::trial_file(const PlannedTrial& trial, std::string_view extension) const {
-  return path_ / "trials" / (trial_stem(trial) + "." + std::string(extension));
+  return SessionLayout::trials(path_) / (trial_stem(trial) + "." + std::string(extension));
 }
 
 bool SessionFolder::is_saved(const PlannedTrial& trial) const {
@@ -456,7 +465,7 @@ void SessionFolder::save_trial(const PlannedTrial& trial, std::string_view json,
 }
 
 fs::path SessionFolder::save_attempt(const PlannedTrial& trial, std::string_view json, std::string_view csv) {
-  const fs::path folder = path_ / "trials" / "attempts";
+  const fs::path folder = SessionLayout::attempts(path_);
   make_folder(folder);
   for (int k = 1; k < 100000; ++k) {
     const std::string stem = trial_stem(trial) + ".attempt-" + std::to_string(k);
@@ -481,11 +490,13 @@ fs::path SessionFolder::save_attempt(const PlannedTrial& trial, std::string_view
 void SessionFolder::check_writable() const {
   const std::uintmax_t bytes = trial_files_bytes(manifest_.protocol.protocol.trial);
   check_writable_folder(path_, bytes);  // teachers/ and trials/attempts/ are made here when first needed
-  for (const fs::path& folder : {path_ / "trials", path_ / "trials" / "attempts", path_ / "teachers"}) {
+  for (const fs::path& folder :
+       {SessionLayout::trials(path_), SessionLayout::attempts(path_), SessionLayout::teachers(path_)}) {
     std::error_code error;
-    if (folder == path_ / "trials" || fs::is_directory(folder, error)) check_writable_folder(folder, bytes);
+    if (folder == SessionLayout::trials(path_) || fs::is_directory(folder, error))
+      check_writable_folder(folder, bytes);
   }
-  const fs::path log_path = path_ / "log.jsonl";
+  const fs::path log_path = SessionLayout::log(path_);
   if (::access(log_path.c_str(), W_OK) != 0) {
     throw DataError(log_path.string() + ": cannot write the session log: " + std::strerror(errno) +
                     " (checked before the first trial; nothing was written)");
@@ -494,7 +505,7 @@ void SessionFolder::check_writable() const {
 
 void SessionFolder::log(std::string_view event, std::string_view details_json) {
   const std::string line = study_detail::log_line(study_detail::utc_now_iso8601(), event, details_json);
-  const fs::path log_path = path_ / "log.jsonl";
+  const fs::path log_path = SessionLayout::log(path_);
   write_all(log_fd_, line, log_path);
   if (::fsync(log_fd_) != 0) fail_errno(log_path, "cannot sync the session log", errno);
 }
@@ -503,7 +514,7 @@ std::vector<fs::path> find_session_folders(const fs::path& root) {
   std::error_code error;
   if (!fs::is_directory(root, error))
     throw DataError(root.string() + ": not a folder (expected session folders)");
-  if (fs::is_regular_file(root / "session.json", error)) {
+  if (fs::is_regular_file(SessionLayout::manifest(root), error)) {
     if (is_partial_session_folder(named_folder(root))) throw DataError(root.string() + ": " + kPartialNote);
     return {root};
   }
@@ -521,7 +532,7 @@ std::vector<fs::path> find_session_folders(const fs::path& root) {
       it.disable_recursion_pending();
       continue;
     }
-    if (fs::is_regular_file(it->path() / "session.json", error)) {
+    if (fs::is_regular_file(SessionLayout::manifest(it->path()), error)) {
       found.push_back(it->path());
       it.disable_recursion_pending();
     } else if (it.depth() >= 3) {

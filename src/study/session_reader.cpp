@@ -144,7 +144,7 @@ std::string session_line(const SessionManifest& m, const fs::path& folder, std::
 }
 
 fs::path trial_record_file(const fs::path& folder, const PlannedTrial& plan) {
-  return folder / "trials" / (SessionFolder::trial_stem(plan) + ".json");
+  return SessionLayout::record(folder, plan);
 }
 
 bool is_saved(const fs::path& folder, const PlannedTrial& plan) {
@@ -186,9 +186,9 @@ StudyReportSessions list_report_sessions(const std::vector<fs::path>& roots) {
         by_name.try_emplace(manifest.protocol.protocol.name, folder, manifest.protocol);
     if (!inserted && study_detail::protocols_conflict(first->second.second, manifest.protocol)) {
       study_detail::fail(
-          (folder / "session.json").string(), "/protocol/sha256",
+          SessionLayout::manifest(folder).string(), "/protocol/sha256",
           "protocol '" + manifest.protocol.protocol.name + "' here has SHA-256 " + manifest.protocol.sha256 +
-              ", but in " + (first->second.first / "session.json").string() + " SHA-256 " +
+              ", but in " + SessionLayout::manifest(first->second.first).string() + " SHA-256 " +
               first->second.second.sha256 +
               ": two different protocols under one name would be pooled as one design; read them "
               "apart (report each study folder on its own)");

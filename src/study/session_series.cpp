@@ -21,14 +21,14 @@ namespace fs = std::filesystem;
 namespace {
 
 std::string manifest_sha256(const fs::path& folder) {
-  return sha256_hex(
-      study_detail::read_small_file(folder / "session.json", kMaxSessionManifestBytes, "session manifest"));
+  return sha256_hex(study_detail::read_small_file(SessionLayout::manifest(folder), kMaxSessionManifestBytes,
+                                                  "session manifest"));
 }
 
 // Session `number` (> 1) must follow the folder found for the session before it: by name, and by content
 // where the link recorded it.
 void check_link(const fs::path& folder, const SessionManifest& manifest, const fs::path& before, int number) {
-  const std::string source = (folder / "session.json").string();
+  const std::string source = (SessionLayout::manifest(folder)).string();
   const PreviousSession& previous = *manifest.previous;
   if (previous.session_id != before.filename().string()) {
     study_detail::fail(source, "/previous_session/session_id",
@@ -44,7 +44,7 @@ void check_link(const fs::path& folder, const SessionManifest& manifest, const f
 bool has_unsaved_trial(const fs::path& folder, const SessionManifest& manifest) {
   for (const PlannedTrial& trial : manifest.plan) {
     std::error_code error;
-    if (!fs::exists(folder / "trials" / (SessionFolder::trial_stem(trial) + ".json"), error)) return true;
+    if (!fs::exists(SessionLayout::record(folder, trial), error)) return true;
   }
   return false;
 }
@@ -63,9 +63,10 @@ SessionSeries session_series(const fs::path& root, const std::string& subject_id
       SessionManifest manifest = study_detail::read_session_manifest(folder);
       if (manifest.protocol.sha256 != protocol.sha256) continue;
       if (manifest.setup.subject.id != subject_id) {
-        study_detail::fail((folder / "session.json").string(), "/subject/id",
+        study_detail::fail((SessionLayout::manifest(folder)).string(), "/subject/id",
                            "a session of subject '" + manifest.setup.subject.id + "' in the folder of '" +
-                               subject_id + "': move it back to " + (root / manifest.setup.subject.id).string());
+                               subject_id + "': move it back to " +
+                               (root / manifest.setup.subject.id).string());
       }
       const int number = manifest.setup.session_number;
       const auto known = by_number.find(number);
@@ -101,7 +102,7 @@ SessionSeries session_series(const fs::path& root, const std::string& subject_id
     }
     if (number == series.sessions) continue;
     // What links the next session to this one: its last trial's end, its content and the next session's delay.
-    const fs::path last_record = folder / "trials" / (SessionFolder::trial_stem(manifest.plan.back()) + ".json");
+    const fs::path last_record = SessionLayout::record(folder, manifest.plan.back());
     PreviousSession previous;
     previous.session_id = manifest.session_id;
     previous.session_sha256 = manifest_sha256(folder);

@@ -20,9 +20,9 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-// "teachers/CONDITION-U5341_U4EBA.json": one teacher per condition and item.
+// "teachers/CONDITION-U5341_U4EBA.json" (relative to the session folder): one teacher per condition and item.
 std::string teacher_file_name(const StudyCondition& condition, const std::u32string& characters) {
-  std::string name = "teachers/" + condition.name + "-";
+  std::string name = (SessionLayout::teachers({}) / (condition.name + "-")).string();
   for (std::size_t i = 0; i < characters.size(); ++i) {
     char code[16];
     std::snprintf(code, sizeof code, "%sU%04X", i == 0 ? "" : "_", static_cast<unsigned>(characters[i]));

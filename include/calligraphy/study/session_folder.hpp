@@ -108,6 +108,25 @@ void check_session_manifest_size(const SessionSetup& setup, const LoadedProtocol
 /// DataError naming the folder and the reason.
 void check_writable_folder(const std::filesystem::path& folder, std::uintmax_t free_bytes);
 
+/// Where each file of a session folder lives: the one definition its writer (SessionFolder) and every reader
+/// (the report, the tidy tables, the series of sessions, a learning writer's memory) take paths from.
+///   FOLDER/session.json            the manifest (the plan, the setup, the protocol's copy)
+///   FOLDER/log.jsonl               the event log, locked while a run works on the session
+///   FOLDER/trials/STEM.json        a saved trial's record (its existence marks the trial saved)
+///   FOLDER/trials/STEM.csv.gz      its pen trace; FOLDER/trials/STEM.svg its drawing
+///   FOLDER/trials/attempts/        attempts that did not become the trial
+///   FOLDER/teachers/               a replay condition's teachers
+struct SessionLayout {
+  [[nodiscard]] static std::filesystem::path manifest(const std::filesystem::path& folder);
+  [[nodiscard]] static std::filesystem::path log(const std::filesystem::path& folder);
+  [[nodiscard]] static std::filesystem::path trials(const std::filesystem::path& folder);
+  [[nodiscard]] static std::filesystem::path attempts(const std::filesystem::path& folder);
+  [[nodiscard]] static std::filesystem::path teachers(const std::filesystem::path& folder);
+  /// FOLDER/trials/STEM.json of `trial` (SessionFolder::trial_stem).
+  [[nodiscard]] static std::filesystem::path record(const std::filesystem::path& folder,
+                                                    const PlannedTrial& trial);
+};
+
 /// A session folder, opened by one process at a time. Move-only; the lock is released on destruction.
 class SessionFolder {
  public:
