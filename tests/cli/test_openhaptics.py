@@ -250,6 +250,19 @@ class OpenHapticsTestCase(unittest.TestCase):
         self.assertIn(STAND_IN, message)
         self.assertIn("ran no callback within 5 s", message)
 
+    def test_a_driver_stuck_stopping_its_scheduler_still_gives_the_trial_its_outputs(self):
+        out = self.dir / "stuck.json"
+        trace = self.dir / "stuck.csv"
+        started = time.monotonic()
+        result = self.run_cli("trial", YONG, "--device", "openhaptics", "--json", out, "--csv", trace,
+                              CALLIGRAPHY_LIBHD=STAND_IN, HD_STAND_IN_PATH=str(self.path), HD_STAND_IN_STOP="hang")
+        message = result.stderr.decode()
+        self.assertEqual(result.returncode, 0, message)
+        self.assertLess(time.monotonic() - started, TIMEOUT_S)
+        self.assertIn("did not stop within 5 s", message)
+        self.assertEqual(json.loads(out.read_text())["end_reason"], "completed")
+        self.assertGreater(len(trace.read_text().splitlines()), 100)
+
     def test_a_named_library_refused_for_missing_symbols_is_not_replaced(self):
         if not PARTIAL or not Path(PARTIAL).exists():
             self.skipTest(f"CALLIGRAPHY_HD_PARTIAL={PARTIAL!r} is not the partial libHD")

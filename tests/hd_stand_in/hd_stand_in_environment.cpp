@@ -8,6 +8,7 @@
 //   HD_STAND_IN_EXIT_ON_LOAD=STATUS  the library's constructor calls exit(STATUS)
 //   HD_STAND_IN_INIT=crash|hang|exit:STATUS  hdInitDevice raises SIGSEGV, never returns, or calls exit
 //   HD_STAND_IN_SCHEDULER_STALLED=1  hdStartScheduler succeeds but its thread never runs a tick
+//   HD_STAND_IN_STOP=hang        hdStopScheduler never returns (a driver stuck stopping its servo thread)
 // A value that cannot be read is reported on stderr and ignored.
 #include <cstdio>
 #include <cstdlib>
@@ -51,6 +52,13 @@ void read_faults() {
   }
   if (const char* stalled = std::getenv("HD_STAND_IN_SCHEDULER_STALLED"); stalled != nullptr && *stalled) {
     faults.scheduler_stalled = std::strcmp(stalled, "0") != 0;
+  }
+  if (const char* stop = std::getenv("HD_STAND_IN_STOP"); stop != nullptr && *stop) {
+    if (std::strcmp(stop, "hang") == 0) {
+      faults.stop_hangs = true;
+    } else {
+      std::fprintf(stderr, "hd_stand_in: HD_STAND_IN_STOP=%s is not hang; ignored\n", stop);
+    }
   }
 }
 

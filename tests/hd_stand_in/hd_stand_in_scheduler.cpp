@@ -2,8 +2,10 @@
 // tick timing, hand playback, injected faults, callback scheduling and the
 // per-tick frame log.
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <ctime>
+#include <thread>
 
 #include "hd_stand_in_state.h"
 
@@ -402,6 +404,9 @@ void hdStopScheduler(void) {
   if (tl_on_servo) {
     violation(HD_STAND_IN_VIOLATION_BLOCKING_ON_SERVO, HD_INVALID_OPERATION);
     return;
+  }
+  if (environment_faults().stop_hangs) {  // HD_STAND_IN_STOP=hang: stuck for good, as a wedged driver is
+    for (;;) std::this_thread::sleep_for(std::chrono::seconds(1));
   }
   stop_scheduler_internal();
 }

@@ -185,6 +185,7 @@ struct EnvironmentFaults {
   InitMisbehaviour init = InitMisbehaviour::none;  // in hdInitDevice
   int exit_status = 0;                             // for InitMisbehaviour::exit
   bool scheduler_stalled = false;                  // hdStartScheduler succeeds, no tick ever runs
+  bool stop_hangs = false;                         // hdStopScheduler never returns
 };
 const EnvironmentFaults& environment_faults();
 extern thread_local bool tl_on_servo;

@@ -1,7 +1,9 @@
 #include "devices/openhaptics/openhaptics_device.hpp"
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <thread>
 #include <utility>
 
@@ -129,13 +131,74 @@ void OpenHapticsDevice::close() noexcept {
   }
   forces_enabled_.store(false);
   detach();
-  library_->stop_scheduler();
-  if (servo_callback_ != 0) library_->unschedule(servo_callback_);
+  stop_driver_bounded();
   servo_callback_ = 0;
-  if (handle_ != hd::HD_INVALID_HANDLE) library_->disable_device(handle_);
   handle_ = hd::HD_INVALID_HANDLE;
-  library_.reset();
+  library_.reset();  // the library stays loaded while a stop left running still holds it
   open_ = false;
+}
+
+namespace {
+
+// What closing hands to the thread that stops the driver: copies, never the device (which may be gone by the
+// time a stuck driver returns).
+struct DriverStop {
+  std::shared_ptr<const HdLibrary> library;
+  hd::HDSchedulerHandle servo_callback = 0;
+  hd::HHD handle = hd::HD_INVALID_HANDLE;
+  std::atomic<bool> unscheduled{false};  // the driver calls the device's servo callback no more
+  std::atomic<bool> done{false};
+};
+
+// The servo callback first (hdUnschedule returns once it is not running), so that a driver stuck in what
+// follows never calls into a device that is gone.
+void stop_driver(DriverStop& stop) noexcept {
+  if (stop.servo_callback != 0) stop.library->unschedule(stop.servo_callback);
+  stop.unscheduled.store(true, std::memory_order_release);
+  stop.library->stop_scheduler();
+  if (stop.handle != hd::HD_INVALID_HANDLE) stop.library->disable_device(stop.handle);
+  stop.done.store(true, std::memory_order_release);
+}
+
+}  // namespace
+
+// hdStopScheduler waits for the driver's servo thread and hdDisableDevice for the device: a driver stuck
+// there would hold close() for ever, and with it a trial's outputs, which are written once the device is
+// closed. The calls run on a thread of their own, waited for at most kSchedulerCallTimeoutS; past that the
+// thread and the library it holds are left to the process, and the log says so. Only hdUnschedule of the
+// servo callback is waited for without a bound: until it returns the driver may call into the device.
+void OpenHapticsDevice::stop_driver_bounded() noexcept {
+  auto stop = std::make_shared<DriverStop>();
+  stop->library = library_;
+  stop->servo_callback = servo_callback_;
+  stop->handle = handle_;
+  try {
+    std::thread([stop] { stop_driver(*stop); }).detach();
+  } catch (...) {  // no thread to be had: stopped here, unbounded, as before
+    stop_driver(*stop);
+    return;
+  }
+  const double give_up = monotonic_seconds() + kSchedulerCallTimeoutS;
+  while (!stop->done.load(std::memory_order_acquire) && monotonic_seconds() < give_up)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  if (stop->done.load(std::memory_order_acquire)) return;
+  const auto warn = [this](const char* what) noexcept {
+    try {
+      calligraphy::detail::library_log().warn("OpenHaptics: {} did not stop within {} s ({}){}",
+                                              library_->path, static_cast<int>(kSchedulerCallTimeoutS), what,
+                                              "; the trial's ticks are kept");
+    } catch (...) {
+      // Logging must not turn close() into a throwing call.
+    }
+  };
+  if (stop->unscheduled.load(std::memory_order_acquire)) {
+    warn("hdStopScheduler, hdDisableDevice: the device was left to the driver");
+    return;
+  }
+  // The driver still holds the servo callback: the device cannot go while it may be called, so this waits.
+  warn("hdUnschedule: waiting until the driver lets go of the servo callback");
+  while (!stop->unscheduled.load(std::memory_order_acquire))
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
 }
 
 namespace {

@@ -70,6 +70,8 @@ class OpenHapticsDevice final : public HapticDevice, public DeviceServoClock {
   /// Runs `function(this)` once in the HD scheduler's thread and waits for it: at most 5 s, and not past a
   /// stop signal (stop_signals.hpp). Throws DeviceError naming the library when it did not run.
   void call_in_scheduler(hd::SchedulerCallback function, const char* what);
+  // Stops the driver's scheduler and disables the device, waiting at most kSchedulerCallTimeoutS.
+  void stop_driver_bounded() noexcept;
 
   void publish_frame_state() noexcept;  // frame_state_ for readers on other threads
 
