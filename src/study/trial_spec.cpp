@@ -171,6 +171,28 @@ const char* to_string(TrialWriter writer) noexcept {
   return "auto";
 }
 
+namespace {
+
+// The numeric fields by key: the JSON form reads and writes them as JSON numbers (no text in between), the
+// command line parses their text; validate() checks their ranges either way.
+constexpr std::array<std::pair<std::string_view, double TrialSpec::*>, 6> kNumberFields{{
+    {"guidance_gain", &TrialSpec::guidance_gain},
+    {"assist_band_m", &TrialSpec::assist_band_m},
+    {"amplification_gain", &TrialSpec::amplification_gain},
+    {"timing_speed_m_s", &TrialSpec::timing_speed_m_s},
+    {"rate_hz", &TrialSpec::rate_hz},
+    {"max_duration_s", &TrialSpec::max_duration_s},
+}};
+
+double TrialSpec::*number_member(std::string_view key) {
+  for (const auto& [name, member] : kNumberFields) {
+    if (name == key) return member;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
 std::span<const TrialSpecField> trial_spec_fields() { return fields_in_order(); }
 
 void set_trial_spec_field(TrialSpec& spec, std::string_view name, std::string_view text) {
@@ -187,14 +209,8 @@ void set_trial_spec_field(TrialSpec& spec, std::string_view name, std::string_vi
         key, text,
         std::array{GuidanceMode::fixed, GuidanceMode::fading, GuidanceMode::replay,
                    GuidanceMode::assist_as_needed, GuidanceMode::error_amplification, GuidanceMode::timing});
-  } else if (key == "guidance_gain") {
-    spec.guidance_gain = parse_number(key, text);
-  } else if (key == "assist_band_m") {
-    spec.assist_band_m = parse_number(key, text);
-  } else if (key == "amplification_gain") {
-    spec.amplification_gain = parse_number(key, text);
-  } else if (key == "timing_speed_m_s") {
-    spec.timing_speed_m_s = parse_number(key, text);
+  } else if (double TrialSpec::*number = number_member(key)) {
+    spec.*number = parse_number(key, text);
   } else if (key == "teacher") {
     spec.teacher = text;
   } else if (key == "writer") {
@@ -206,8 +222,6 @@ void set_trial_spec_field(TrialSpec& spec, std::string_view name, std::string_vi
     spec.writer_parameters.emplace_back(text);
   } else if (key == "seed") {
     spec.seed = parse_unsigned(key, text);
-  } else if (key == "rate_hz") {
-    spec.rate_hz = parse_number(key, text);
   } else if (key == "pacing") {
     spec.pacing = parse_choice(
         key, text, std::array{TrialPacing::automatic, TrialPacing::lock_step, TrialPacing::real_time});
@@ -218,8 +232,6 @@ void set_trial_spec_field(TrialSpec& spec, std::string_view name, std::string_vi
     const std::uint64_t ms = parse_unsigned(key, text);
     if (ms > 60000) refuse(key, "'" + std::string(text) + "' ms is outside 0..60000");
     spec.watchdog_s = static_cast<double>(ms) / 1000.0;
-  } else if (key == "max_duration_s") {
-    spec.max_duration_s = parse_number(key, text);
   } else if (key == "json_file") {
     spec.json_file = text;
   } else if (key == "csv_file") {
@@ -396,38 +408,36 @@ TrialSpec trial_spec_from_json(std::string_view text, const std::string& source,
     const json* value = reader.optional(key);
     if (value == nullptr) continue;
     const std::string pointer = reader.pointer(key);
-    // Each JSON value becomes the text the command line would give, so that both forms share one parser.
+    // Numbers, booleans and the seed are taken as the JSON values they are; text fields go through the one
+    // parser of the text forms (choices checked there).
     const auto set = [&](const json& item, const std::string& at) {
-      std::string item_text;
+      const auto expect = [&](bool ok, const char* what) {
+        if (!ok)
+          study_detail::fail(source, at,
+                             std::string("expected ") + what + ", got " + study_detail::describe(item));
+      };
       if (key == "guidance") {
-        if (!item.is_boolean())
-          study_detail::fail(source, at, "expected true or false, got " + study_detail::describe(item));
-        item_text = item.get<bool>() ? "on" : "off";
+        expect(item.is_boolean(), "true or false");
+        spec.guidance = item.get<bool>();
       } else if (key == "seed") {
-        if (!item.is_number_unsigned()) {
-          study_detail::fail(source, at, "expected an integer >= 0, got " + study_detail::describe(item));
-        }
-        item_text = std::to_string(item.get<std::uint64_t>());
+        expect(item.is_number_unsigned(), "an integer >= 0");
+        spec.seed = item.get<std::uint64_t>();
       } else if (key == "watchdog_s") {
-        if (!item.is_number())
-          study_detail::fail(source, at, "expected a number, got " + study_detail::describe(item));
-        const double ms = item.get<double>() * 1000.0;
-        if (!(ms >= 0.0 && ms <= 60000.0) || std::abs(ms - std::round(ms)) > 1e-6) {
+        expect(item.is_number(), "a number");
+        const double s = item.get<double>();
+        if (!(s >= 0.0 && s <= 60.0) || std::abs(s * 1000.0 - std::round(s * 1000.0)) > 1e-6) {
           study_detail::fail(source, at, "expected a whole number of milliseconds in [0, 60] s");
         }
-        item_text = std::to_string(std::llround(ms));
-      } else if (key == "guidance_gain" || key == "assist_band_m" || key == "amplification_gain" ||
-                 key == "timing_speed_m_s" || key == "rate_hz" || key == "max_duration_s") {
-        if (!item.is_number())
-          study_detail::fail(source, at, "expected a number, got " + study_detail::describe(item));
-        item_text = number_text(item.get<double>());
+        spec.watchdog_s = s;
+      } else if (double TrialSpec::*number = number_member(key)) {
+        expect(item.is_number(), "a number");
+        spec.*number = item.get<double>();
       } else {
-        item_text = study_detail::as_string(item, at, source);
-      }
-      try {
-        set_trial_spec_field(spec, key, item_text);
-      } catch (const InvalidArgument& e) {
-        study_detail::fail(source, at, e.what());
+        try {
+          set_trial_spec_field(spec, key, study_detail::as_string(item, at, source));
+        } catch (const InvalidArgument& e) {
+          study_detail::fail(source, at, e.what());
+        }
       }
     };
     if (field.repeated) {
@@ -452,20 +462,10 @@ std::string trial_spec_json(const TrialSpec& spec) {
       document[key] = spec.guidance;
     } else if (key == "seed") {
       document[key] = spec.seed;
-    } else if (key == "guidance_gain") {
-      document[key] = spec.guidance_gain;
-    } else if (key == "assist_band_m") {
-      document[key] = spec.assist_band_m;
-    } else if (key == "amplification_gain") {
-      document[key] = spec.amplification_gain;
-    } else if (key == "timing_speed_m_s") {
-      document[key] = spec.timing_speed_m_s;
-    } else if (key == "rate_hz") {
-      document[key] = spec.rate_hz;
     } else if (key == "watchdog_s") {
       document[key] = spec.watchdog_s;
-    } else if (key == "max_duration_s") {
-      document[key] = spec.max_duration_s;
+    } else if (double TrialSpec::*number = number_member(key)) {
+      document[key] = spec.*number;
     } else if (field.repeated) {
       document[key] = trial_spec_field_text(spec, key);
     } else {
