@@ -150,16 +150,6 @@ Vec3 read_vec3(ObjectReader& reader, const std::string& key) {
   return v;
 }
 
-json simulated_device_json(const SimulatedDeviceParameters& p) {
-  return {{"moving_mass_kg", p.moving_mass_kg},
-          {"damping_n_s_per_m", p.damping_n_s_per_m},
-          {"encoder_resolution_m", p.encoder_resolution_m},
-          {"velocity_cutoff_hz", p.velocity_cutoff_hz},
-          {"physics_substeps", p.physics_substeps},
-          {"physics_rate_hz", p.physics_rate_hz},
-          {"initial_position_m", vec3_json(p.initial_position_m)}};
-}
-
 SimulatedDeviceParameters read_simulated_device(ObjectReader reader) {
   SimulatedDeviceParameters p;
   p.moving_mass_kg = reader.number("moving_mass_kg", -kLargest, kLargest);
@@ -270,6 +260,16 @@ std::string scene_sha256(const Scene& scene) {
 
 namespace study_detail {
 
+nlohmann::json simulated_device_object(const SimulatedDeviceParameters& p) {
+  return {{"moving_mass_kg", p.moving_mass_kg},
+          {"damping_n_s_per_m", p.damping_n_s_per_m},
+          {"encoder_resolution_m", p.encoder_resolution_m},
+          {"velocity_cutoff_hz", p.velocity_cutoff_hz},
+          {"physics_substeps", p.physics_substeps},
+          {"physics_rate_hz", p.physics_rate_hz},
+          {"initial_position_m", vec3_json(p.initial_position_m)}};
+}
+
 nlohmann::json recorded_trial_object(const RecordedTrial& r) {
   json out = {
       {"format", kRecordedTrialFormat},
@@ -278,7 +278,7 @@ nlohmann::json recorded_trial_object(const RecordedTrial& r) {
       {"force_law", force_law_json(r.force_law)},
       {"passivity", {{"enabled", r.passivity.enabled}}},
       {"writer", r.writer ? writer_json(*r.writer) : json(nullptr)},
-      {"simulated_device", r.simulated_device ? simulated_device_json(*r.simulated_device) : json(nullptr)},
+      {"simulated_device", r.simulated_device ? simulated_device_object(*r.simulated_device) : json(nullptr)},
       {"scene", {{"layout", layout_json(r.layout)}, {"sha256", r.scene_sha256}}},
       {"library_version", r.library_version}};
   json safety = json::object();

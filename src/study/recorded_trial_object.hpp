@@ -9,4 +9,8 @@ namespace calligraphy::study_detail {
 /// `recorded_trial_json`'s object.
 nlohmann::json recorded_trial_object(const RecordedTrial& recorded);
 
+/// A simulated device's physics by field name (the specification's "simulated_device", a record's
+/// device.simulated_device).
+nlohmann::json simulated_device_object(const SimulatedDeviceParameters& parameters);
+
 }  // namespace calligraphy::study_detail

@@ -171,17 +171,6 @@ json writer_json(const TrialRecordContext& c) {
   return writer;
 }
 
-json simulated_device_json() {
-  const SimulatedDeviceParameters p{};  // the registry's "simulated" device is made with the defaults
-  return {{"moving_mass_kg", p.moving_mass_kg},
-          {"damping_n_s_per_m", p.damping_n_s_per_m},
-          {"encoder_resolution_m", p.encoder_resolution_m},
-          {"velocity_cutoff_hz", p.velocity_cutoff_hz},
-          {"physics_substeps", p.physics_substeps},
-          {"physics_rate_hz", p.physics_rate_hz},
-          {"initial_position_m", vec(p.initial_position_m)}};
-}
-
 json scene_json(const Scene& scene) {
   json characters = json::array();
   for (const PlacedCharacter& c : scene.characters) {
@@ -341,7 +330,9 @@ nlohmann::json trial_record(const TrialRecordContext& c, const Scene& scene, con
                    {"files", {{"csv", c.csv_file}, {"svg", c.svg_file}}}});
   if (json legibility = legibility_json(scene, result); !legibility.is_null())
     document["legibility"] = legibility;
-  if (c.device_name == "simulated") document["device"]["simulated_device"] = simulated_device_json();
+  if (c.device_name == "simulated")
+    document["device"]["simulated_device"] =
+        simulated_device_object(SimulatedDeviceParameters{});  // the registry's
   // The whole specification that ran, which `calligraphy trial --spec` runs again (recorded_trial.hpp).
   if (c.spec != nullptr) {
     document["specification"] = recorded_trial_object(

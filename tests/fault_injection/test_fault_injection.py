@@ -75,6 +75,19 @@ def snapshot(folder):
     return files
 
 
+def every_fault(counts):
+    """(kind, N, kill, the shim's environment) for every N of every kind counted, failing and killed, the errno
+    taken in turn from ERRNOS."""
+    tried = 0
+    for kind in KINDS:
+        for n in range(1, counts[kind] + 1):
+            for kill in (False, True):
+                yield kind, n, kill, {"CALLIGRAPHY_FAULT_CALL": kind, "CALLIGRAPHY_FAULT_AT": str(n),
+                                      "CALLIGRAPHY_FAULT_ERRNO": ERRNOS[tried % len(ERRNOS)],
+                                      "CALLIGRAPHY_FAULT_KILL": "1" if kill else "0"}
+                tried += 1
+
+
 def leftovers(folder):
     return sorted(str(path.relative_to(folder)) for path in folder.rglob("*")
                   if any(mark in path.name for mark in LEFTOVER_MARKS))
@@ -140,34 +153,29 @@ class FaultInjection(unittest.TestCase):
         self.assertGreaterEqual(counts["rename"], 2, counts)  # the set's files are renamed into place
         self.assertGreaterEqual(counts["fsync"], 2, counts)
         tried = 0
-        for kind in KINDS:
-            for n in range(1, counts[kind] + 1):
-                for kill in (False, True):
-                    fault = {"CALLIGRAPHY_FAULT_CALL": kind, "CALLIGRAPHY_FAULT_AT": str(n),
-                             "CALLIGRAPHY_FAULT_ERRNO": ERRNOS[tried % len(ERRNOS)],
-                             "CALLIGRAPHY_FAULT_KILL": "1" if kill else "0"}
-                    with self.subTest(kind=kind, n=n, errno=fault["CALLIGRAPHY_FAULT_ERRNO"], kill=kill):
-                        self.assertEqual(fresh(), earlier)
-                        result = self.run_cli(arguments_for(self.two_subjects / "study"), work, fault)
-                        stderr = result.stderr.decode(errors="replace")
-                        after = snapshot(work / "out")
-                        if kill:
-                            self.assertEqual(result.returncode, -9, stderr)
-                            journals = [name for name in leftovers(work / "out") if ".calligraphy-set-" in name]
-                            self.assertTrue(after in (earlier, new) or journals,
-                                            f"a mix of the sets and no journal: {sorted(after)}")
-                        else:
-                            self.assertIn(result.returncode, (0, 1), stderr)
-                            self.assertNotIn("internal error", stderr)
-                            self.assertIn(after, (earlier, new), "a mix of the earlier and the new set")
-                            if result.returncode == 1:
-                                self.assertEqual(len(stderr.strip().splitlines()), 1, stderr)
-                                self.assertIn(": error: ", stderr)
-                        again = self.run_cli(arguments_for(self.two_subjects / "study"), work)
-                        self.assertEqual(again.returncode, 0, again.stderr.decode())
-                        self.assertEqual(snapshot(work / "out"), new)
-                        self.assertEqual(leftovers(work / "out"), [])
-                    tried += 1
+        for kind, n, kill, fault in every_fault(counts):
+            with self.subTest(kind=kind, n=n, errno=fault["CALLIGRAPHY_FAULT_ERRNO"], kill=kill):
+                self.assertEqual(fresh(), earlier)
+                result = self.run_cli(arguments_for(self.two_subjects / "study"), work, fault)
+                stderr = result.stderr.decode(errors="replace")
+                after = snapshot(work / "out")
+                if kill:
+                    self.assertEqual(result.returncode, -9, stderr)
+                    journals = [name for name in leftovers(work / "out") if ".calligraphy-set-" in name]
+                    self.assertTrue(after in (earlier, new) or journals,
+                                    f"a mix of the sets and no journal: {sorted(after)}")
+                else:
+                    self.assertIn(result.returncode, (0, 1), stderr)
+                    self.assertNotIn("internal error", stderr)
+                    self.assertIn(after, (earlier, new), "a mix of the earlier and the new set")
+                    if result.returncode == 1:
+                        self.assertEqual(len(stderr.strip().splitlines()), 1, stderr)
+                        self.assertIn(": error: ", stderr)
+                again = self.run_cli(arguments_for(self.two_subjects / "study"), work)
+                self.assertEqual(again.returncode, 0, again.stderr.decode())
+                self.assertEqual(snapshot(work / "out"), new)
+                self.assertEqual(leftovers(work / "out"), [])
+            tried += 1
         print(f"{' '.join(map(str, arguments_for(Path('STUDY'))))}: {tried} faults at every step "
               f"({', '.join(f'{kind} {counts[kind]}' for kind in KINDS)})", flush=True)
 
@@ -238,48 +246,43 @@ class FaultInjection(unittest.TestCase):
         planned = len(self.saved_trials(work / "out"))
         self.assertEqual(planned, 3)
         tried = 0
-        for kind in KINDS:
-            for n in range(1, counts[kind] + 1):
-                for kill in (False, True):
-                    fault = {"CALLIGRAPHY_FAULT_CALL": kind, "CALLIGRAPHY_FAULT_AT": str(n),
-                             "CALLIGRAPHY_FAULT_ERRNO": ERRNOS[tried % len(ERRNOS)],
-                             "CALLIGRAPHY_FAULT_KILL": "1" if kill else "0"}
-                    with self.subTest(kind=kind, n=n, errno=fault["CALLIGRAPHY_FAULT_ERRNO"], kill=kill):
-                        arguments = fresh()
-                        before = self.saved_trials(work / "out")
-                        result = self.run_cli(arguments, work, fault)
-                        stderr = result.stderr.decode(errors="replace")
-                        if kill:
-                            self.assertEqual(result.returncode, -9, stderr)
-                        else:
-                            self.assertIn(result.returncode, (0, 1), stderr)
-                            self.assertNotIn("internal error", stderr)
-                            if result.returncode == 1:
-                                self.assertIn(": error: ", stderr.strip().splitlines()[-1], stderr)
-                        saved = self.saved_trials(work / "out")
-                        for record, digest in before.items():
-                            self.assertEqual(saved.get(record), digest, f"{record} was lost or rewritten")
-                        folders = self.session_folders(work / "out")
-                        self.assertLessEqual(len(folders), 1, folders)
-                        # The study reads as it is, whatever was saved.
-                        tables = work / "tables"
-                        shutil.rmtree(tables, ignore_errors=True)
-                        tables.mkdir()
-                        read = self.run_cli(["report", "out", "--csv", "tables"], work)
-                        self.assertEqual(read.returncode, 0 if folders else 1, read.stderr.decode())
-                        # Completed: resumed, or run again when no session folder appeared.
-                        completed = self.run_cli(["session", "resume", folders[0]] if folders else arguments, work)
-                        self.assertEqual(completed.returncode, 0, completed.stderr.decode())
-                        after = self.saved_trials(work / "out")
-                        self.assertEqual(len(after), planned, sorted(after))
-                        for record, digest in saved.items():
-                            self.assertEqual(after.get(record), digest, f"{record} was lost or rewritten")
-                        self.assertEqual(leftovers(work / "out"), [])
-                        self.assertEqual([p.name for p in (work / "out").rglob(".partial.*")], [])
-                        self.assertEqual([p.name for p in (work / "out").rglob("*.part")], [])
-                        again = self.run_cli(["report", "out", "--csv", "tables"], work)
-                        self.assertEqual(again.returncode, 0, again.stderr.decode())
-                    tried += 1
+        for kind, n, kill, fault in every_fault(counts):
+            with self.subTest(kind=kind, n=n, errno=fault["CALLIGRAPHY_FAULT_ERRNO"], kill=kill):
+                arguments = fresh()
+                before = self.saved_trials(work / "out")
+                result = self.run_cli(arguments, work, fault)
+                stderr = result.stderr.decode(errors="replace")
+                if kill:
+                    self.assertEqual(result.returncode, -9, stderr)
+                else:
+                    self.assertIn(result.returncode, (0, 1), stderr)
+                    self.assertNotIn("internal error", stderr)
+                    if result.returncode == 1:
+                        self.assertIn(": error: ", stderr.strip().splitlines()[-1], stderr)
+                saved = self.saved_trials(work / "out")
+                for record, digest in before.items():
+                    self.assertEqual(saved.get(record), digest, f"{record} was lost or rewritten")
+                folders = self.session_folders(work / "out")
+                self.assertLessEqual(len(folders), 1, folders)
+                # The study reads as it is, whatever was saved.
+                tables = work / "tables"
+                shutil.rmtree(tables, ignore_errors=True)
+                tables.mkdir()
+                read = self.run_cli(["report", "out", "--csv", "tables"], work)
+                self.assertEqual(read.returncode, 0 if folders else 1, read.stderr.decode())
+                # Completed: resumed, or run again when no session folder appeared.
+                completed = self.run_cli(["session", "resume", folders[0]] if folders else arguments, work)
+                self.assertEqual(completed.returncode, 0, completed.stderr.decode())
+                after = self.saved_trials(work / "out")
+                self.assertEqual(len(after), planned, sorted(after))
+                for record, digest in saved.items():
+                    self.assertEqual(after.get(record), digest, f"{record} was lost or rewritten")
+                self.assertEqual(leftovers(work / "out"), [])
+                self.assertEqual([p.name for p in (work / "out").rglob(".partial.*")], [])
+                self.assertEqual([p.name for p in (work / "out").rglob("*.part")], [])
+                again = self.run_cli(["report", "out", "--csv", "tables"], work)
+                self.assertEqual(again.returncode, 0, again.stderr.decode())
+            tried += 1
         print(f"{name}: {tried} faults at every step "
               f"({', '.join(f'{kind} {counts[kind]}' for kind in KINDS)})", flush=True)
 
@@ -289,6 +292,7 @@ class FaultInjection(unittest.TestCase):
             subjects = "1" if study == self.one_subject / "study" else "2"
             return ["session", "cohort", self.protocol, "--subjects", subjects, "--csv", "out", "--jobs", "1"]
         self.sweep(cohort)
+
 
 if __name__ == "__main__":
     unittest.main(verbosity=2)
