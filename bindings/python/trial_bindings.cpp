@@ -128,6 +128,22 @@ class SignalPoll {
   std::unique_ptr<py::error_already_set> error_;
 };
 
+// Runs `trial` (which runs with `inputs`) without the GIL. Ctrl-C: every 50 ms of wall clock the runner's
+// thread takes the GIL and lets Python run its signal handlers; a KeyboardInterrupt (or any exception a
+// handler raises) ends the trial at the next tick and is raised once the device is shut down.
+template <typename Trial>
+TrialRun run_interruptible(TrialRunInputs& inputs, Trial&& trial) {
+  SignalPoll poll;
+  inputs.should_stop = [&poll] { return poll.interrupted(); };
+  TrialRun run;
+  {
+    py::gil_scoped_release release;
+    run = trial();
+  }
+  poll.raise_if_interrupted();
+  return run;
+}
+
 // One description of the arguments simulate_trial and run_trial share, in their Python order after each
 // function's own leading arguments: X(C++ type, Python name, default). It makes the TrialArguments
 // fields, the C++ parameters and the py::arg list of both functions.
@@ -295,17 +311,7 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   inputs.force_law = options.force;  // the force law as given (no stiffness fitted to the device)
   inputs.safety = options.safety;
   inputs.passivity = options.passivity;
-  // Ctrl-C: the trial runs without the GIL; every 50 ms of wall clock the runner's thread takes the GIL
-  // and lets Python run its signal handlers. A KeyboardInterrupt (or any exception a handler raises)
-  // ends the trial at the next tick and is raised once the device is shut down.
-  SignalPoll poll;
-  inputs.should_stop = [&poll] { return poll.interrupted(); };
-  TrialRun run;
-  {
-    py::gil_scoped_release release;
-    run = run_trial_spec(spec, scene, inputs);
-  }
-  poll.raise_if_interrupted();
+  TrialRun run = run_interruptible(inputs, [&] { return run_trial_spec(spec, scene, inputs); });
   TrialResult& result = run.result;
   std::optional<WriterLog>& writer_log = run.writer_log;
   TrialDescription description;
@@ -391,14 +397,7 @@ PyTrialResult rerun_trial_py(const py::object& record, const std::optional<Check
     inputs.teacher = teacher_samples(teacher->object, recorded.spec.characters);
     recorded.spec.teacher.clear();  // the samples are the teacher
   }
-  SignalPoll poll;
-  inputs.should_stop = [&poll] { return poll.interrupted(); };
-  TrialRun run;
-  {
-    py::gil_scoped_release release;
-    run = rerun_trial(recorded, scene, inputs);
-  }
-  poll.raise_if_interrupted();
+  TrialRun run = run_interruptible(inputs, [&] { return rerun_trial(recorded, scene, inputs); });
   TrialDescription description;
   description.characters = recorded.spec.characters;
   description.guidance = recorded.spec.guidance;
