@@ -254,8 +254,12 @@ class OpenHapticsTestCase(unittest.TestCase):
         out = self.dir / "stuck.json"
         trace = self.dir / "stuck.csv"
         started = time.monotonic()
+        # The driver's thread is still stuck at exit, on purpose: LeakSanitizer cannot stop it to look for
+        # leaks (its tracer faults), so leaks are not checked in this one run of a sanitized build.
+        asan = ":".join(filter(None, [os.environ.get("ASAN_OPTIONS", ""), "detect_leaks=0"]))
         result = self.run_cli("trial", YONG, "--device", "openhaptics", "--json", out, "--csv", trace,
-                              CALLIGRAPHY_LIBHD=STAND_IN, HD_STAND_IN_PATH=str(self.path), HD_STAND_IN_STOP="hang")
+                              CALLIGRAPHY_LIBHD=STAND_IN, HD_STAND_IN_PATH=str(self.path), HD_STAND_IN_STOP="hang",
+                              ASAN_OPTIONS=asan)
         message = result.stderr.decode()
         self.assertEqual(result.returncode, 0, message)
         self.assertLess(time.monotonic() - started, TIMEOUT_S)
