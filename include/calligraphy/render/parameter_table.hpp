@@ -67,6 +67,8 @@ void check_parameter(std::string_view qualified_name, double value, std::string_
 template <typename S>
 void check_parameters(const S& object) {
   for (const ParameterField<S>& field : ParameterTable<S>::fields()) {
+    // The name is built only for an error: a profile is checked for every trial a study plans.
+    if (field.range.contains(object.*field.member)) continue;
     check_parameter(std::string(ParameterTable<S>::name) + "." + std::string(field.name),
                     object.*field.member, field.unit, field.range);
   }
@@ -86,6 +88,7 @@ template <typename S>
 template <typename S>
 void check_parameter(double S::*member, double value) {
   const ParameterField<S>& field = parameter_field(member);
+  if (field.range.contains(value)) return;
   check_parameter(std::string(ParameterTable<S>::name) + "." + std::string(field.name), value, field.unit,
                   field.range);
 }
