@@ -17,6 +17,7 @@
 #include "study/parameter_json.hpp"
 #include "study/recorded_trial_object.hpp"
 #include "study/saved_sessions.hpp"
+#include "study/trial_record.hpp"
 
 namespace calligraphy {
 namespace {
@@ -24,19 +25,9 @@ namespace {
 using nlohmann::json;
 using study_detail::ObjectReader;
 
-// The stroke acceptance and the nearest-point search have no parameter table of their own (they live below
-// the force law); their fields by name, checked by their struct's validate().
-constexpr std::array<std::pair<const char*, double StrokeAcceptance::*>, 8> kAcceptanceFields{{
-    {"corridor_m", &StrokeAcceptance::corridor_m},
-    {"mean_deviation_m", &StrokeAcceptance::mean_deviation_m},
-    {"shortfall_m", &StrokeAcceptance::shortfall_m},
-    {"shortfall_fraction", &StrokeAcceptance::shortfall_fraction},
-    {"displacement_m", &StrokeAcceptance::displacement_m},
-    {"lookahead_m", &StrokeAcceptance::lookahead_m},
-    {"max_gain_ratio", &StrokeAcceptance::max_gain_ratio},
-    {"follow_through_m", &StrokeAcceptance::follow_through_m},
-}};
-
+// The nearest-point search has no parameter table of its own (it lives below the force law); its methods by
+// name. The stroke acceptance's fields are named as every record names them
+// (study_detail::acceptance_fields).
 constexpr std::array<std::pair<const char*, NearestPointMethod>, 3> kNearestMethods{{
     {"exact", NearestPointMethod::exact},
     {"newton", NearestPointMethod::newton},
@@ -67,9 +58,7 @@ json force_law_json(const ForceLawParameters& f) {
   study_detail::put_parameters(out, f);
   out["guidance"] = f.guidance;
   out["guidance_law"] = guidance_law_json(f.guidance_law);
-  json acceptance = json::object();
-  for (const auto& [name, member] : kAcceptanceFields) acceptance[name] = f.acceptance.*member;
-  out["acceptance"] = acceptance;
+  out["acceptance"] = study_detail::acceptance_json(f.acceptance);
   const char* method = "exact";
   for (const auto& [name, value] : kNearestMethods) {
     if (value == f.nearest.method) method = name;
@@ -93,8 +82,8 @@ ForceLawParameters read_force_law(ObjectReader reader) {
   f.guidance_law = read_guidance_law(
       ObjectReader(reader.required("guidance_law"), reader.pointer("guidance_law"), reader.source()));
   ObjectReader acceptance(reader.required("acceptance"), reader.pointer("acceptance"), reader.source());
-  for (const auto& [name, member] : kAcceptanceFields)
-    f.acceptance.*member = acceptance.number(name, -kLargest, kLargest);
+  for (const auto& [name, member] : study_detail::acceptance_fields())
+    f.acceptance.*member = acceptance.number(std::string(name), -kLargest, kLargest);
   acceptance.finish();
   ObjectReader nearest(reader.required("nearest"), reader.pointer("nearest"), reader.source());
   const std::string method = nearest.string("method");
@@ -294,8 +283,9 @@ std::string recorded_trial_json(const RecordedTrial& r) {
   return study_detail::recorded_trial_object(r).dump(2) + "\n";
 }
 
-RecordedTrial read_recorded_trial(std::string_view text, const std::string& source) {
-  const json document = study_detail::parse_json(text, source);
+namespace {
+
+RecordedTrial read_recorded_document(const json& document, const std::string& source) {
   std::string at;  // the specification object's pointer in the document
   const json* object = &document;
   const bool is_specification =
@@ -382,15 +372,21 @@ RecordedTrial read_recorded_trial(std::string_view text, const std::string& sour
   return r;
 }
 
+}  // namespace
+
+RecordedTrial read_recorded_trial(std::string_view text, const std::string& source) {
+  return read_recorded_document(study_detail::parse_json(text, source), source);
+}
+
 RecordedTrial read_recorded_trial_file(const std::string& path) {
-  const std::string text = read_regular_file(path, study_detail::kMaxRecordBytes);
-  RecordedTrial recorded = read_recorded_trial(text, path);
+  const json document =
+      study_detail::parse_json(read_regular_file(path, study_detail::kMaxRecordBytes), path);
+  RecordedTrial recorded = read_recorded_document(document, path);
   if (recorded.spec.guidance && recorded.spec.guidance_mode == GuidanceMode::replay &&
       recorded.spec.teacher.empty()) {
     // A session's replay ran on the teacher kept in its folder (trials/ is beside teachers/): the record
     // names the file and its SHA-256 under /guidance/teacher (trial_guidance.hpp); taken when it is still the
     // same.
-    const json document = study_detail::parse_json(text, path);
     const json* teacher = document.contains("guidance") && document["guidance"].is_object() &&
                                   document["guidance"].contains("teacher") &&
                                   document["guidance"]["teacher"].is_object()

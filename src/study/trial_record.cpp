@@ -1,6 +1,7 @@
 #include "study/trial_record.hpp"
 
 #include <algorithm>
+#include <array>
 #include <nlohmann/json.hpp>
 
 #include "calligraphy/core/unicode.hpp"
@@ -219,11 +220,24 @@ json loop_json(const ServoLoopStats& s) {
 
 }  // namespace
 
+std::span<const std::pair<std::string_view, double StrokeAcceptance::*>> acceptance_fields() {
+  static constexpr std::array<std::pair<std::string_view, double StrokeAcceptance::*>, 8> kFields{{
+      {"corridor_m", &StrokeAcceptance::corridor_m},
+      {"mean_deviation_m", &StrokeAcceptance::mean_deviation_m},
+      {"shortfall_m", &StrokeAcceptance::shortfall_m},
+      {"shortfall_fraction", &StrokeAcceptance::shortfall_fraction},
+      {"displacement_m", &StrokeAcceptance::displacement_m},
+      {"follow_through_m", &StrokeAcceptance::follow_through_m},
+      {"max_gain_ratio", &StrokeAcceptance::max_gain_ratio},
+      {"lookahead_m", &StrokeAcceptance::lookahead_m},
+  }};
+  return kFields;
+}
+
 json acceptance_json(const StrokeAcceptance& a) {
-  return {{"corridor_m", a.corridor_m},         {"mean_deviation_m", a.mean_deviation_m},
-          {"shortfall_m", a.shortfall_m},       {"shortfall_fraction", a.shortfall_fraction},
-          {"displacement_m", a.displacement_m}, {"follow_through_m", a.follow_through_m},
-          {"max_gain_ratio", a.max_gain_ratio}, {"lookahead_m", a.lookahead_m}};
+  json out = json::object();
+  for (const auto& [name, member] : acceptance_fields()) out[std::string(name)] = a.*member;
+  return out;
 }
 
 std::vector<PenSample> pen_samples_of_character(const Scene& scene, const std::vector<TrialSample>& trace,

@@ -3,7 +3,10 @@
 // Internal.
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <span>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "calligraphy/analysis/score.hpp"
@@ -46,8 +49,12 @@ struct TrialRecordContext {
   std::string svg_file;
 };
 
-/// The stroke matcher's tolerances as a JSON object, by the names a protocol's quiz condition reads them
-/// by (corridor_m, mean_deviation_m, ...): the record's force.acceptance and quiz.acceptance.
+/// The stroke matcher's tolerances by the names a protocol's quiz condition reads them by (corridor_m,
+/// mean_deviation_m, ...), each with its member.
+std::span<const std::pair<std::string_view, double StrokeAcceptance::*>> acceptance_fields();
+
+/// The stroke matcher's tolerances as a JSON object by those names: the record's force.acceptance and
+/// quiz.acceptance, and its specification's force_law.acceptance.
 nlohmann::json acceptance_json(const StrokeAcceptance& acceptance);
 
 /// The pen samples of `trace` while character `character` of `scene` was the active one: pen down when
