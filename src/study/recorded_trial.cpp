@@ -18,6 +18,7 @@
 #include "study/recorded_trial_object.hpp"
 #include "study/saved_sessions.hpp"
 #include "study/trial_record.hpp"
+#include "study/trial_spec_object.hpp"
 
 namespace calligraphy {
 namespace {
@@ -323,8 +324,8 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
     // A replay whose teacher was given as samples (a session's, kept in its folder) names no file.
     const bool teacher_named = trial.is_object() && trial.contains("teacher") &&
                                trial["teacher"].is_string() && !trial["teacher"].get<std::string>().empty();
-    r.spec = trial_spec_from_json(trial.dump(), source + " " + reader.pointer("trial"),
-                                  teacher_named ? TeacherSource::file : TeacherSource::samples);
+    r.spec = study_detail::trial_spec_from_object(
+        trial, reader.pointer("trial"), source, teacher_named ? TeacherSource::file : TeacherSource::samples);
   } catch (const InvalidArgument& e) {
     study_detail::fail(source, reader.pointer("trial"), e.what());
   }

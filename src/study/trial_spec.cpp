@@ -16,6 +16,7 @@
 #include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/study/protocol.hpp"
 #include "study/json_reader.hpp"
+#include "study/trial_spec_object.hpp"
 
 namespace calligraphy {
 namespace {
@@ -399,9 +400,11 @@ std::vector<std::string> trial_spec_args(const TrialSpec& spec) {
   return args;
 }
 
-TrialSpec trial_spec_from_json(std::string_view text, const std::string& source, TeacherSource teacher_from) {
-  const json document = study_detail::parse_json(text, source);
-  study_detail::ObjectReader reader(document, "", source);
+namespace study_detail {
+
+TrialSpec trial_spec_from_object(const json& document, const std::string& at_pointer,
+                                 const std::string& source, TeacherSource teacher_from) {
+  ObjectReader reader(document, at_pointer, source);
   TrialSpec spec;
   for (const TrialSpecField& field : fields_in_order()) {
     const std::string key(field.key);
@@ -452,6 +455,13 @@ TrialSpec trial_spec_from_json(std::string_view text, const std::string& source,
   reader.finish();
   spec.validate(teacher_from);
   return spec;
+}
+
+}  // namespace study_detail
+
+TrialSpec trial_spec_from_json(std::string_view text, const std::string& source, TeacherSource teacher_from) {
+  return study_detail::trial_spec_from_object(study_detail::parse_json(text, source), "", source,
+                                              teacher_from);
 }
 
 std::string trial_spec_json(const TrialSpec& spec) {
