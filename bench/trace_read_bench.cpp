@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "calligraphy/report/pen_trace_csv.hpp"
+#include "calligraphy/report/trace_hdf5.hpp"
 #include "calligraphy/report/trial_report.hpp"
 #include "report/compressed_text.hpp"
 
@@ -28,8 +29,8 @@ constexpr double kPaperZ = 0.01;
 // A pen writing at 1 kHz: loops of a few centimetres on the 0.023 mm encoder steps of a Phantom Desktop,
 // lifted now and then, with guidance forces of tenths of a newton, so that the fields have the lengths and
 // signs of a session's trials (about 64 bytes a row; times drift from k ms as a device clock's sum does).
-const std::string& trace_text() {
-  static const std::string text = [] {
+const std::vector<TrialSample>& trace_samples() {
+  static const std::vector<TrialSample> samples = [] {
     std::vector<TrialSample> trace(kRows);
     double t = 0.0;
     for (std::size_t i = 0; i < kRows; ++i) {
@@ -46,8 +47,13 @@ const std::string& trace_text() {
       s.element = (i / 100) % 20;
       s.attempt = 1;
     }
-    return trial_csv(trace);
+    return trace;
   }();
+  return samples;
+}
+
+const std::string& trace_text() {
+  static const std::string text = trial_csv(trace_samples());
   return text;
 }
 
@@ -61,14 +67,21 @@ PenTraceCsvOptions report_options() {
   return options;
 }
 
-// The trace written to a file of its own under the temporary directory (gzip or plain), removed at exit.
-const std::filesystem::path& trace_file(bool gzip) {
+enum class Format { plain, gzip, hdf5, hdf5_trial };
+constexpr std::size_t kTrialRows = 10'000;  // a trial of 10 s at 1 kHz, as a session saves
+
+// The trace written to a file of its own under the temporary directory (CSV plain or gzip, HDF5 whole or
+// its first 10 s), removed at exit.
+const std::filesystem::path& trace_file(Format format) {
   static const std::filesystem::path folder = [] {
     const auto made = std::filesystem::temp_directory_path() /
                       ("calligraphy_trace_read_bench_" + std::to_string(::getpid()));
     std::filesystem::create_directories(made);
     std::ofstream(made / "trace.csv", std::ios::binary) << trace_text();
     std::ofstream(made / "trace.csv.gz", std::ios::binary) << gzip_text(trace_text());
+    std::ofstream(made / "trace.trace.h5", std::ios::binary) << trial_trace_hdf5(trace_samples());
+    const std::vector<TrialSample> trial(trace_samples().begin(), trace_samples().begin() + kTrialRows);
+    std::ofstream(made / "trial.trace.h5", std::ios::binary) << trial_trace_hdf5(trial);
     std::atexit([] {
       std::error_code ignored;
       std::filesystem::remove_all(std::filesystem::temp_directory_path() /
@@ -77,8 +90,9 @@ const std::filesystem::path& trace_file(bool gzip) {
     });
     return made;
   }();
-  static const std::filesystem::path plain = folder / "trace.csv", compressed = folder / "trace.csv.gz";
-  return gzip ? compressed : plain;
+  static const std::filesystem::path files[] = {folder / "trace.csv", folder / "trace.csv.gz",
+                                                folder / "trace.trace.h5", folder / "trial.trace.h5"};
+  return files[static_cast<int>(format)];
 }
 
 void trace_parse_memory(benchmark::State& state) {
@@ -90,8 +104,9 @@ void trace_parse_memory(benchmark::State& state) {
 }
 
 // A file streamed row by row into the columns the per-trial pages keep, as the report does.
-void read_file(benchmark::State& state, bool gzip) {
-  const std::filesystem::path& file = trace_file(gzip);
+void read_file(benchmark::State& state, Format format) {
+  const std::filesystem::path& file = trace_file(format);
+  const std::size_t rows = format == Format::hdf5_trial ? kTrialRows : kRows;
   const PenTraceCsvOptions options = report_options();
   std::vector<double> time_s, force_n;
   std::vector<Vec2> position_m;
@@ -109,18 +124,29 @@ void read_file(benchmark::State& state, bool gzip) {
     });
     benchmark::DoNotOptimize(time_s.data());
   }
-  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * kRows));
-  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * trace_text().size()));  // of text
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * rows));
   state.counters["file_bytes"] = static_cast<double>(std::filesystem::file_size(file));
 }
 
-void trace_read_plain_file(benchmark::State& state) { read_file(state, false); }
-void trace_read_gzip_file(benchmark::State& state) { read_file(state, true); }
+void trace_read_plain_file(benchmark::State& state) { read_file(state, Format::plain); }
+void trace_read_gzip_file(benchmark::State& state) { read_file(state, Format::gzip); }
+void trace_read_hdf5_file(benchmark::State& state) { read_file(state, Format::hdf5); }
+void trace_read_hdf5_trial_file(benchmark::State& state) { read_file(state, Format::hdf5_trial); }
+
+// Every column of the HDF5 file into memory (read_trace_hdf5), as Python's Study.samples reads it.
+void trace_read_hdf5_columns(benchmark::State& state) {
+  const std::filesystem::path& file = trace_file(Format::hdf5);
+  for (auto _ : state) benchmark::DoNotOptimize(read_trace_hdf5(file).size());
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * kRows));
+}
 
 }  // namespace
 
 BENCHMARK(trace_parse_memory)->Unit(benchmark::kMillisecond);
 BENCHMARK(trace_read_plain_file)->Unit(benchmark::kMillisecond);
 BENCHMARK(trace_read_gzip_file)->Unit(benchmark::kMillisecond);
+BENCHMARK(trace_read_hdf5_file)->Unit(benchmark::kMillisecond);
+BENCHMARK(trace_read_hdf5_trial_file)->Unit(benchmark::kMillisecond);
+BENCHMARK(trace_read_hdf5_columns)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

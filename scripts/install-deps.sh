@@ -9,6 +9,7 @@ packages=(
   clang libclang-rt-14-dev            # sanitizer and fuzzer builds
   libeigen3-dev libspdlog-dev catch2 nlohmann-json3-dev libbenchmark-dev
   libcli11-dev zlib1g-dev libssl-dev # command-line parsing, CRC-32, SHA-256
+  libhdf5-dev libdeflate-dev python3-h5py  # trial traces as HDF5, inflated by libdeflate (h5py: tests read them as others do)
   libusb-1.0-0-dev libhidapi-dev     # Phantom backend (optional at configure time)
   pkg-config lib2geom-dev            # lib2geom column of `bench nearest` (optional at configure time)
   pybind11-dev python3-dev python3-numpy python3-pytest

@@ -1,7 +1,6 @@
 // Study sessions end to end in the library: folders, the runner with a simulated writer, interruption and
 // resumption without losing or overwriting a saved trial, the records, the report read back.
 #include <unistd.h>
-#include <zlib.h>
 
 #include <algorithm>
 #include <catch2/catch.hpp>
@@ -17,6 +16,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/report/study_report_html.hpp"
+#include "calligraphy/report/trace_hdf5.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/study/session_reader.hpp"
 #include "calligraphy/study/session_runner.hpp"
@@ -69,7 +69,7 @@ TEST_CASE("a session stopped mid-trial resumes without losing or overwriting a s
   TempFolder temp;
   const LoadedProtocol protocol = small_protocol();
   fs::path folder;
-  std::string first_json, first_csv;
+  std::string first_json, first_trace;
   {
     SessionFolder session = SessionFolder::create(temp.path, simulated("S01"), protocol);
     folder = session.path();
@@ -93,7 +93,8 @@ TEST_CASE("a session stopped mid-trial resumes without losing or overwriting a s
     REQUIRE(session.is_saved(first));
     CHECK_FALSE(session.is_saved(session.plan()[1]));
     first_json = read(session.trial_file(first, "json"));
-    first_csv = read(session.trial_file(first, "csv"));
+    first_trace = read(session.trial_file(first, SessionFolder::kTraceExtension));
+    REQUIRE_FALSE(first_trace.empty());
     // A saved trial is never overwritten.
     CHECK_THROWS_AS(session.save_trial(first, "{}", "", ""), StateError);
     CHECK(read(session.trial_file(first, "json")) == first_json);
@@ -107,7 +108,7 @@ TEST_CASE("a session stopped mid-trial resumes without losing or overwriting a s
   CHECK(result.saved_before == 1);
   CHECK(result.saved_now == 2);
   CHECK(read(resumed.trial_file(resumed.plan()[0], "json")) == first_json);
-  CHECK(read(resumed.trial_file(resumed.plan()[0], "csv")) == first_csv);
+  CHECK(read(resumed.trial_file(resumed.plan()[0], SessionFolder::kTraceExtension)) == first_trace);
 
   // The log: created, started, the interruption, resumed, completed; every line a JSON object.
   std::ifstream log(folder / "log.jsonl");
@@ -235,14 +236,8 @@ TEST_CASE("a device lost mid-trial keeps the attempt and stops the session namin
       session.path() / "trials" / "attempts" / (SessionFolder::trial_stem(session.plan()[0]) + ".attempt-1");
   const auto record = nlohmann::json::parse(read(fs::path(attempt.string() + ".json")));
   CHECK(record["end_reason"] == "device_fault");
-  // The attempt's trace, gzip-compressed as a saved trial's.
-  gzFile csv = gzopen((attempt.string() + ".csv.gz").c_str(), "rb");
-  REQUIRE(csv != nullptr);
-  std::size_t rows = 0;
-  char line[1024];
-  while (gzgets(csv, line, sizeof line) != nullptr) ++rows;
-  gzclose(csv);
-  CHECK(rows == 700 + 1);  // every tick before the lost read, and the header
+  // The attempt's trace, saved as a trial's: every tick before the lost read.
+  CHECK(read_trace_hdf5(attempt.string() + "." + std::string(SessionFolder::kTraceExtension)).size() == 700);
 }
 
 TEST_CASE("a device that does not open is logged with the session's stop before the error ends the run",

@@ -3,6 +3,7 @@
 // a teacher's recording for replay guidance (teacher_recording.hpp).
 #include "report_bindings.hpp"
 
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
@@ -13,13 +14,14 @@
 #include "arguments.hpp"
 #include "bindings.hpp"
 #include "calligraphy/core/atomic_file.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "calligraphy/report/teacher_recording.hpp"
+#include "calligraphy/report/trace_hdf5.hpp"
 #include "calligraphy/study/cohort.hpp"
 #include "calligraphy/study/curriculum.hpp"
 #include "calligraphy/study/study_tables.hpp"
 #include "calligraphy/study/transfer_set.hpp"
 #include "character_source.hpp"
-#include "calligraphy/core/unicode.hpp"
 
 namespace calligraphy::python {
 
@@ -36,7 +38,49 @@ void write_teacher_recording(const TeacherRecording& recording, const std::files
   write_file_atomically(path, teacher_recording_json(recording));
 }
 
+namespace {
+
+// A column as a new numpy array (its values copied once, from the vector the reader filled).
+template <typename T>
+py::array_t<T> column_array(const std::vector<T>& values) {
+  py::array_t<T> array(static_cast<py::ssize_t>(values.size()));
+  std::copy(values.begin(), values.end(), array.mutable_data());
+  return array;
+}
+
+}  // namespace
+
 void bind_report(py::module_& m) {
+  m.def(
+      "_read_trace_columns",
+      [](const std::filesystem::path& path, std::uintmax_t max_file_bytes) {
+        TraceColumns c;
+        {
+          py::gil_scoped_release release;  // the file read and decoded in C++, beside other Python threads
+          c = read_trace_hdf5(path, max_file_bytes);
+        }
+        py::dict columns;
+        columns["t_s"] = column_array(c.time_s);
+        columns["x_m"] = column_array(c.x_m);
+        columns["y_m"] = column_array(c.y_m);
+        columns["z_m"] = column_array(c.z_m);
+        columns["fx_n"] = column_array(c.fx_n);
+        columns["fy_n"] = column_array(c.fy_n);
+        columns["fz_n"] = column_array(c.fz_n);
+        columns["state"] = column_array(c.state);
+        columns["stroke"] = column_array(c.stroke);
+        columns["element"] = column_array(c.element);
+        columns["attempt"] = column_array(c.attempt);
+        columns["rewritten"] = column_array(c.rewritten);
+        return columns;
+      },
+      py::arg("path"), py::arg("max_file_bytes"),
+      "Every column of a trial's HDF5 trace (read_trace_hdf5, include/calligraphy/report/trace_hdf5.hpp) as "
+      "numpy arrays of N samples: t_s [s], x_m, y_m, z_m [m], fx_n, fy_n, fz_n [N] (float64), state (uint8: "
+      "0 SS, 1 AS, 2 CS, 3 WS), stroke, element (uint32), attempt (int32), rewritten (uint8). Raises "
+      "DataError "
+      "naming the file for a damaged, cut, foreign or too large file. calligraphy.study reads traces with "
+      "it.");
   m.def(
       "_study_tables_csv",
       [](const py::list& roots) {

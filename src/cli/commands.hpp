@@ -9,6 +9,7 @@ namespace calligraphy::cli {
 void add_trial_command(CLI::App& root, Commands& commands);     // trial CHARS [...]
 void add_train_command(CLI::App& root, Commands& commands);     // train CHARS [...] (the trainer window)
 void add_score_command(CLI::App& root, Commands& commands);     // score TRACE.csv --character C [...]
+void add_trace_command(CLI::App& root, Commands& commands);     // trace TRACE.trace.h5 [--csv FILE]
 void add_model_command(CLI::App& root, Commands& commands);     // model CHAR [...]
 void add_strokes_command(CLI::App& root, Commands& commands);   // strokes [--markdown FILE] [--json]
 void add_devices_command(CLI::App& root, Commands& commands);   // devices [--json]

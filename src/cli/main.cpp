@@ -65,6 +65,7 @@ int main(int argc, char** argv) {
   add_score_command(root, commands);
   add_model_command(root, commands);
   add_strokes_command(root, commands);
+  add_trace_command(root, commands);
   add_devices_command(root, commands);
   add_corpus_commands(root, commands);
   add_bench_commands(root, commands);

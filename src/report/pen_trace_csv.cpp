@@ -11,6 +11,7 @@
 
 #include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/report/trace_hdf5.hpp"
 #include "report/compressed_text.hpp"
 
 namespace calligraphy {
@@ -316,6 +317,55 @@ void check_options(const PenTraceCsvOptions& options, const Placement& placement
   }
 }
 
+// True when `file` starts as a trace saved in HDF5 (trace_hdf5.hpp) rather than CSV text.
+bool is_trace_hdf5_file(const std::filesystem::path& file) {
+  // Only a regular file is opened: a FIFO or a device would block or never end (the CSV reader refuses them).
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(file, error)) return false;
+  std::ifstream in(file, std::ios::binary);
+  char head[32] = {};
+  in.read(head, sizeof head);
+  return is_trace_hdf5(std::string_view(head, static_cast<std::size_t>(in.gcount())));
+}
+
+// The rows of an HDF5 trace with the CSV reader's checks and limits; errors name the sample (1-based).
+void for_each_trace_hdf5_row(const std::filesystem::path& file, const Placement& placement,
+                             const PenTraceCsvOptions& options,
+                             const std::function<void(const PenTraceRow&)>& row) {
+  const std::string source = file.string();
+  const TraceColumns c = read_trace_hdf5(file, options.max_file_bytes, TraceColumnSet::pen);
+  const auto fail = [&source](std::size_t i, const std::string& what) {
+    throw DataError(source + ": sample " + std::to_string(i + 1) + ": " + what);
+  };
+  if (c.size() > options.max_samples) {
+    fail(options.max_samples,
+         "more than " + std::to_string(options.max_samples) + " samples, the limit of one trace");
+  }
+  std::size_t segments = 0;
+  PenTraceRow r;
+  PenSample& s = r.sample;
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    const bool was_down = s.pen_down;
+    if (i > 0 && c.time_s[i] < s.time_s)
+      fail(i, "time goes backwards (previous sample at " + std::to_string(s.time_s) + " s)");
+    s.time_s = c.time_s[i];
+    const Vec2 xy(c.x_m[i], c.y_m[i]);
+    s.position_m = options.units == TraceUnits::data ? placement.to_paper(xy) : xy;
+    if (!s.position_m.allFinite()) fail(i, "position not finite once converted to metres");
+    s.pen_down = c.z_m[i] - options.paper_z_m <= options.contact_threshold_m;
+    if (s.pen_down && (i == 0 || !was_down) && ++segments > options.max_pen_down_segments) {
+      fail(i, "more than " + std::to_string(options.max_pen_down_segments) +
+                  " pen-down segments, the limit of one scored trace");
+    }
+    if (options.read_force) {
+      if (!std::isfinite(c.fx_n[i]) || !std::isfinite(c.fy_n[i])) fail(i, "force not finite");
+      r.in_plane_force_n = Vec2(c.fx_n[i], c.fy_n[i]).norm();
+    }
+    row(r);
+  }
+  if (options.progress) options.progress(c.size(), c.size());
+}
+
 }  // namespace
 
 TraceUnits parse_trace_units(std::string_view name) {
@@ -341,6 +391,10 @@ void for_each_pen_trace_row(const std::filesystem::path& file, const Placement& 
                             const PenTraceCsvOptions& options,
                             const std::function<void(const PenTraceRow&)>& row) {
   check_options(options, placement);
+  if (is_trace_hdf5_file(file)) {
+    for_each_trace_hdf5_row(file, placement, options, row);
+    return;
+  }
   // Streamed a block at a time (decompressed on the way for a gzip file), so that memory holds a block, not
   // the file: a trace over a limit is refused at its line without the rest being read.
   const std::string name = file.string();

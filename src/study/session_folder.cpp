@@ -442,12 +442,12 @@ std::optional<std::size_t> SessionFolder::next_unsaved() const {
   return std::nullopt;
 }
 
-void SessionFolder::save_trial(const PlannedTrial& trial, std::string_view json, std::string_view csv,
+void SessionFolder::save_trial(const PlannedTrial& trial, std::string_view json, std::string_view trace,
                                std::string_view svg) {
   const fs::path target = trial_file(trial, "json");
   if (is_saved(trial))
     throw StateError(target.string() + ": the trial is saved already; it is never overwritten");
-  write_file_atomically(trial_file(trial, kTraceExtension), gzip_text(csv));
+  write_file_atomically(trial_file(trial, kTraceExtension), trace);
   write_file_atomically(trial_file(trial, "svg"), svg);
   // The JSON marks the trial saved: written whole to a temporary, then linked to its name, which fails
   // (EEXIST) instead of replacing a file that appeared meanwhile.
@@ -464,7 +464,8 @@ void SessionFolder::save_trial(const PlannedTrial& trial, std::string_view json,
   fsync_folder(target.parent_path());
 }
 
-fs::path SessionFolder::save_attempt(const PlannedTrial& trial, std::string_view json, std::string_view csv) {
+fs::path SessionFolder::save_attempt(const PlannedTrial& trial, std::string_view json,
+                                     std::string_view trace) {
   const fs::path folder = SessionLayout::attempts(path_);
   make_folder(folder);
   for (int k = 1; k < 100000; ++k) {
@@ -473,7 +474,7 @@ fs::path SessionFolder::save_attempt(const PlannedTrial& trial, std::string_view
     const fs::path temporary = json_path.string() + ".part";
     std::error_code error;
     if (fs::exists(json_path, error)) continue;
-    write_file_atomically(folder / (stem + "." + std::string(kTraceExtension)), gzip_text(csv));
+    write_file_atomically(folder / (stem + "." + std::string(kTraceExtension)), trace);
     write_file_atomically(temporary, json);
     const int linked = ::link(temporary.c_str(), json_path.c_str());
     const int link_error = errno;

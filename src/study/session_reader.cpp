@@ -48,16 +48,20 @@ void read_scene(const study_detail::JsonView& record, ReportTrial& trial) {
   }
 }
 
-// The name of the trace file a record names beside it (files.csv): a plain name, never a path.
+// The name of the trace file a record names beside it: files.trace (HDF5), or files.csv in a record of an
+// older folder (gzip or plain CSV); a plain name, never a path.
 std::string trace_file_name(const study_detail::JsonView& record) {
-  const std::string csv = record.object("files").string_or("csv", "");
-  if (csv.empty() || csv.find('/') != std::string::npos)
-    fail(record.source(), "/files/csv", "expected a file name");
-  return csv;
+  const study_detail::JsonView files = record.object("files");
+  const char* const key = files.has("trace") ? "trace" : "csv";
+  const std::string name = files.string_or(key, "");
+  if (name.empty() || name.find('/') != std::string::npos || name == "." || name == "..")
+    fail(record.source(), std::string("/files/") + key, "expected a file name");
+  return name;
 }
 
-// The trial's trace (trial_csv: t,x,y,z,fx,fy,fz,state,stroke,element[,attempt,rewritten], gzip or plain CSV)
-// through the one trace parser, streamed: times, positions, pen down, in-plane force.
+// The trial's trace (HDF5, trace_hdf5.hpp; or trial_csv's t,x,y,z,fx,fy,fz,state,stroke,element[,attempt,
+// rewritten], gzip or plain, in older folders) through the one trace reader: times, positions, pen down,
+// in-plane force.
 void read_trace(const fs::path& file, double paper_z_m, ReportTrial& trial) {
   PenTraceCsvOptions options;
   options.paper_z_m = paper_z_m;
@@ -123,11 +127,12 @@ ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifes
     trial.strokes.push_back({i, *start_s, *end_s, stroke.boolean_or("completed", false)});
   }
   const double paper_z = record.object("scene").object("layout").number_or("paper_z_m", 0.0, -1e6, 1e6);
-  const std::string csv = trace_file_name(record);
+  const std::string trace = trace_file_name(record);
   try {
-    read_trace(json_file.parent_path() / csv, paper_z, trial);
+    read_trace(json_file.parent_path() / trace, paper_z, trial);
   } catch (const DataError& e) {  // the record names the trace: it is the record that is at fault
-    fail(source, "/files/csv", "names the trace '" + csv + "', which cannot be read: " + e.what());
+    fail(source, record.object("files").has("trace") ? "/files/trace" : "/files/csv",
+         "names the trace '" + trace + "', which cannot be read: " + e.what());
   }
   return trial;
 }

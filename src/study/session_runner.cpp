@@ -10,15 +10,16 @@
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/unicode.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/render/guidance_law.hpp"
 #include "calligraphy/render/parameter_table.hpp"
+#include "calligraphy/report/trace_hdf5.hpp"
 #include "calligraphy/report/trial_report.hpp"
-#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/study/trial_spec_runner.hpp"
-#include "calligraphy/core/unicode.hpp"
 #include "study/names.hpp"
 #include "study/remembered_writer.hpp"
 #include "study/trial_guidance.hpp"
@@ -369,7 +370,7 @@ class SessionRun {
                     study_detail::TrialRecordContext& context) {
     const TrialResult& trial_result = run.result;
     const std::string stem = SessionFolder::trial_stem(trial);
-    context.csv_file = stem + "." + std::string(SessionFolder::kTraceExtension);
+    context.trace_file = stem + "." + std::string(SessionFolder::kTraceExtension);
     context.svg_file = stem + ".svg";
     const WritingMetrics& writing = run.metrics;
     std::vector<std::vector<QuizEvent>> quiz;
@@ -389,7 +390,8 @@ class SessionRun {
       const std::string record = study_detail::trial_record_json(context, scene, trial_result, writing,
                                                                  quiz.empty() ? nullptr : &quiz);
       try {
-        session_.save_trial(trial, record, trial_csv(trial_result.trace), trial_svg(scene, trial_result));
+        session_.save_trial(trial, record, trial_trace_hdf5(trial_result.trace),
+                            trial_svg(scene, trial_result));
       } catch (const DataError& e) {
         return save_failed(trial, e, outcome);
       }
@@ -408,7 +410,7 @@ class SessionRun {
                                                                  quiz.empty() ? nullptr : &quiz);
       std::filesystem::path kept;
       try {
-        kept = session_.save_attempt(trial, record, trial_csv(trial_result.trace));
+        kept = session_.save_attempt(trial, record, trial_trace_hdf5(trial_result.trace));
       } catch (const DataError& e) {
         return save_failed(trial, e, outcome);
       }

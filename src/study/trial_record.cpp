@@ -172,6 +172,16 @@ json writer_json(const TrialRecordContext& c) {
   return writer;
 }
 
+// The files written beside the record: `trace` (HDF5) for a saved trial, `csv` for trial --csv (kept, empty,
+// when neither was written, as records always had it), `svg`.
+json files_json(const TrialRecordContext& c) {
+  json files = json::object();
+  if (!c.csv_file.empty() || c.trace_file.empty()) files["csv"] = c.csv_file;
+  if (!c.trace_file.empty()) files["trace"] = c.trace_file;
+  files["svg"] = c.svg_file;
+  return files;
+}
+
 json scene_json(const Scene& scene) {
   json characters = json::array();
   for (const PlacedCharacter& c : scene.characters) {
@@ -341,7 +351,7 @@ nlohmann::json trial_record(const TrialRecordContext& c, const Scene& scene, con
                    {"scene", scene_json(scene)},
                    {"per_stroke", per_stroke},
                    {"samples", result.trace.size()},
-                   {"files", {{"csv", c.csv_file}, {"svg", c.svg_file}}}});
+                   {"files", files_json(c)}});
   if (json legibility = legibility_json(scene, result); !legibility.is_null())
     document["legibility"] = legibility;
   if (c.device_name == "simulated")

@@ -45,8 +45,9 @@ struct TrialRecordContext {
   std::optional<WriterSkills> writer_skills;
   /// What the simulated writer did (its log): attempts, refusals, strokes not taken, strokes given up.
   std::optional<WriterLog> writer_log;
-  std::string csv_file;  ///< file names beside the JSON
-  std::string svg_file;
+  std::string csv_file;    ///< file names beside the JSON, each empty when not written: the trace as CSV,
+  std::string trace_file;  ///< the trace as HDF5 (trace_hdf5.hpp),
+  std::string svg_file;    ///< the drawing
 };
 
 /// The stroke matcher's tolerances by the names a protocol's quiz condition reads them by (corridor_m,

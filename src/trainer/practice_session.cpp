@@ -2,9 +2,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "calligraphy/core/unicode.hpp"
+#include "calligraphy/report/trace_hdf5.hpp"
 #include "calligraphy/report/trial_report.hpp"
 #include "calligraphy/study/protocol.hpp"
-#include "calligraphy/core/unicode.hpp"
 #include "study/trial_record.hpp"
 
 namespace calligraphy::trainer {
@@ -82,7 +83,7 @@ std::pair<std::filesystem::path, bool> PracticeSession::save(const PracticeTrial
   context.end_utc = trial.end_utc;
   context.wall_time_s = trial.wall_time_s;
   const std::string stem = SessionFolder::trial_stem(planned);
-  context.csv_file = stem + "." + std::string(SessionFolder::kTraceExtension);
+  context.trace_file = stem + "." + std::string(SessionFolder::kTraceExtension);
   context.svg_file = stem + ".svg";
   const Scene& scene = *trial.scene;
   const WritingMetrics writing = trial_writing_metrics(scene, result, trial.options->force.acceptance);
@@ -99,14 +100,14 @@ std::pair<std::filesystem::path, bool> PracticeSession::save(const PracticeTrial
   if (keep_as_trial) {
     const std::string record =
         study_detail::trial_record_json(context, scene, result, writing, quiz.empty() ? nullptr : &quiz);
-    folder_.save_trial(planned, record, trial_csv(result.trace), trial_svg(scene, result));
+    folder_.save_trial(planned, record, trial_trace_hdf5(result.trace), trial_svg(scene, result));
     folder_.log("trial_saved", details.dump());
     return {folder_.trial_file(planned, "json"), true};
   }
   context.svg_file.clear();
   const std::string record =
       study_detail::trial_record_json(context, scene, result, writing, quiz.empty() ? nullptr : &quiz);
-  const std::filesystem::path kept = folder_.save_attempt(planned, record, trial_csv(result.trace));
+  const std::filesystem::path kept = folder_.save_attempt(planned, record, trial_trace_hdf5(result.trace));
   details["abort_reason"] = result.abort_reason;
   folder_.log(result.end == TrialEnd::interrupted ? "trial_interrupted" : "trial_failed", details.dump());
   return {kept, false};

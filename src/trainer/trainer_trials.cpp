@@ -179,7 +179,7 @@ void TrainerApp::finish_trial() {
       const auto [path, as_trial] = practice_->save(trial, result);
       view.saved_as = (as_trial ? "" : "attempts/") + path.filename().string();
       std::fprintf(stderr, "calligraphy train: saved %s (%s)\n", path.c_str(),
-                   as_trial ? "the trial, .csv.gz, .svg" : "an attempt, .csv.gz");
+                   as_trial ? "the trial, .trace.h5, .svg" : "an attempt, .trace.h5");
     } catch (const std::exception& e) {
       view.save_error = std::string("not saved: ") + e.what();
       std::fprintf(stderr, "calligraphy train: error: the trial was not saved: %s\n", e.what());

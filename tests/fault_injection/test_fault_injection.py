@@ -20,7 +20,6 @@ was killed after its first trial, are swept with their own check: every trial sa
 readable, `report` reads the study as it is, and `session resume` (or a new run when no session folder
 appeared) completes the session without rewriting a saved trial or leaving a temporary behind. CALLIGRAPHY_CLI names the program, CALLIGRAPHY_FAULT_SHIM the shim. Standard library only.
 """
-import gzip
 import hashlib
 import json
 import os
@@ -29,6 +28,7 @@ import subprocess
 import sys
 import tempfile
 import unittest
+import zlib
 from pathlib import Path
 
 CLI = os.environ.get("CALLIGRAPHY_CLI", "")
@@ -63,6 +63,17 @@ except OSError as error:
     print(f"study_report: error: {error}", file=sys.stderr)
     sys.exit(1)
 """
+
+
+def check_whole_trace(trace):
+    """A saved trace (HDF5 after a 512-byte header, include/calligraphy/report/trace_hdf5.hpp) is whole: the
+    header's length and CRC-32 match the bytes after it. Raises AssertionError otherwise."""
+    data = trace.read_bytes()
+    header = dict(line.split(" ", 1) for line in data[:512].rstrip(b"\0").decode().splitlines()[1:])
+    body = data[512:]
+    assert data.startswith(b"calligraphy-trace\n"), f"{trace}: not a trace file"
+    assert len(body) == int(header["bytes"]), f"{trace}: {len(body)} bytes, header says {header['bytes']}"
+    assert zlib.crc32(body) == int(header["crc32"], 16), f"{trace}: CRC-32 differs"
 
 
 def snapshot(folder):
@@ -203,14 +214,15 @@ class FaultInjection(unittest.TestCase):
 
     def saved_trials(self, out):
         """{record path: SHA-256 of the record, its trace and its drawing} of every trial saved in a whole
-        session folder under `out`; each record must read as JSON and each trace as whole gzip."""
+        session folder under `out`; each record must read as JSON and each trace must be whole (its header's
+        length and CRC-32)."""
         saved = {}
         for record in sorted(out.glob("*/*/trials/*.json")):
             if any(part.startswith(".") for part in record.relative_to(out).parts):
                 continue
             json.loads(record.read_text(encoding="utf-8"))
-            trace = record.with_suffix(".csv.gz")
-            gzip.decompress(trace.read_bytes())
+            trace = record.with_suffix(".trace.h5")
+            check_whole_trace(trace)
             digest = hashlib.sha256()
             for path in (record, trace, record.with_suffix(".svg")):
                 digest.update(path.read_bytes())

@@ -69,8 +69,8 @@ def test_a_session_record_is_the_score_of_its_own_trace(cli, tmp_path):
     (session,) = (tmp_path / "study" / "S01").iterdir()
     (record_file,) = (session / "trials").glob("*.json")
     record = json.loads(record_file.read_text(encoding="utf-8"))
-    csv = record_file.parent / record["files"]["csv"]  # the trace, gzip-compressed
-    assert csv.name.endswith(".csv.gz")
+    csv = record_file.parent / record["files"]["trace"]  # the trace, HDF5 (score reads it as a CSV trace)
+    assert csv.name.endswith(".trace.h5")
     assert record["strokes_written"] > 0
     scored = cli_json(cli, tmp_path, "score", str(csv), "--character", "永")
     assert record_of(scored) == approx_record(record)

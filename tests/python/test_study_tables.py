@@ -13,9 +13,26 @@ pd = pytest.importorskip("pandas")
 import calligraphy.study  # noqa: E402
 
 def record_path(trace_file):
-    """The trial record beside a trace: STEM.json for STEM.csv.gz (or an older folder's STEM.csv)."""
+    """The trial record beside a trace: STEM.json for STEM.trace.h5 (or an older folder's STEM.csv.gz or
+    STEM.csv)."""
     trace = Path(trace_file)
-    return trace.with_name(trace.name.removesuffix(".gz").removesuffix(".csv") + ".json")
+    stem = trace.name.removesuffix(".h5").removesuffix(".trace").removesuffix(".gz").removesuffix(".csv")
+    return trace.with_name(stem + ".json")
+
+
+def as_older_folder(cli, trace, compress):
+    """Makes the trial of `trace` as a folder written before traces were HDF5 holds it: its CSV (`calligraphy
+    trace`), gzip-compressed or plain, named by the record's files.csv. Returns the CSV trace's path."""
+    text = subprocess.run([cli, "trace", str(trace)], capture_output=True, check=True).stdout
+    older = trace.with_name(record_path(trace).stem + (".csv.gz" if compress else ".csv"))
+    older.write_bytes(gzip.compress(text) if compress else text)
+    trace.unlink()
+    record_file = record_path(trace)
+    record = json.loads(record_file.read_text(encoding="utf-8"))
+    del record["files"]["trace"]
+    record["files"]["csv"] = older.name
+    record_file.write_text(json.dumps(record), encoding="utf-8")
+    return older
 
 
 @pytest.fixture(scope="module")
@@ -118,50 +135,56 @@ def test_a_damaged_record_is_a_data_error_naming_the_file_and_pointer(study_fold
     record.write_text(text, encoding="utf-8")
 
 
-def test_a_damaged_trace_is_a_data_error_naming_the_file_and_line(study_folder, tmp_path):
+def test_a_damaged_trace_is_a_data_error_naming_the_file_and_line(cli, study_folder, tmp_path):
     import shutil
 
     copy = tmp_path / "study"
     shutil.copytree(study_folder / "study", copy)
     study = calligraphy.study.load(copy)
     trace = Path(study.trials.iloc[0]["trace_file"])
-    assert trace.name.endswith(".csv.gz")  # stored compressed
-    lines = gzip.decompress(trace.read_bytes()).decode("utf-8").splitlines()
+    assert trace.name.endswith(".trace.h5")
+    # A byte changed anywhere in the HDF5 file: refused by its CRC-32, naming the file.
+    data = bytearray(trace.read_bytes())
+    data[len(data) // 3] ^= 0x40
+    trace.write_bytes(bytes(data))
+    with pytest.raises(calligraphy.DataError, match=f"{trace.name}: damaged"):
+        study.samples(study.trials.iloc[0])
+    # An older folder's gzip CSV: its line and column are named.
+    shutil.rmtree(copy)
+    shutil.copytree(study_folder / "study", copy)
+    csv = as_older_folder(cli, trace, compress=True)
+    study = calligraphy.study.load(copy)
+    lines = gzip.decompress(csv.read_bytes()).decode("utf-8").splitlines()
     for line, damaged, column in [(3, lines[2].replace(",", ",1e999x", 1), "x"), (4, "inf" + lines[3][1:], "t"),
                                   (1, "t,x,y", None)]:
         text = "\n".join(lines[:line - 1] + [damaged] + lines[line:]) + "\n"
-        trace.write_bytes(gzip.compress(text.encode("utf-8")))
-        expected = f"{trace.name}:{line}: column {column}" if column else f"{trace.name}:1: expected the header"
+        csv.write_bytes(gzip.compress(text.encode("utf-8")))
+        expected = f"{csv.name}:{line}: column {column}" if column else f"{csv.name}:1: expected the header"
         with pytest.raises(calligraphy.DataError, match=expected):
             study.samples(study.trials.iloc[0])
 
 
-def test_a_plain_csv_trace_of_an_older_folder_reads_as_the_compressed_one(cli, study_folder, tmp_path):
-    """Folders written before traces were compressed name a plain .csv trace in their records."""
+@pytest.mark.parametrize("compress", [True, False])
+def test_the_csv_trace_of_an_older_folder_reads_as_the_hdf5_one(cli, study_folder, tmp_path, compress):
+    """Folders written before traces were HDF5 name a gzip CSV trace (or, earlier still, a plain .csv) in their
+    records: the same samples, column for column and bit for bit."""
     import shutil
 
     copy = tmp_path / "study"
     shutil.copytree(study_folder / "study", copy)
-    compressed = calligraphy.study.load(copy)
-    expected = compressed.samples(compressed.trials.iloc[0])
-    trace = Path(compressed.trials.iloc[0]["trace_file"])
-    record_file = record_path(trace)
-    plain = trace.with_name(trace.name.removesuffix(".gz"))
-    plain.write_bytes(gzip.decompress(trace.read_bytes()))
-    trace.unlink()
-    record = json.loads(record_file.read_text(encoding="utf-8"))
-    record["files"]["csv"] = plain.name
-    record_file.write_text(json.dumps(record), encoding="utf-8")
+    current = calligraphy.study.load(copy)
+    expected = current.samples(current.trials.iloc[0])
+    older_trace = as_older_folder(cli, Path(current.trials.iloc[0]["trace_file"]), compress)
     older = calligraphy.study.load(copy)
-    assert older.trials.iloc[0]["trace_file"] == str(plain)
-    pd.testing.assert_frame_equal(older.samples(older.trials.iloc[0]), expected)
+    assert older.trials.iloc[0]["trace_file"] == str(older_trace)
+    pd.testing.assert_frame_equal(older.samples(older.trials.iloc[0]), expected, check_exact=True)
     # The C++ readers take it too: the per-trial pages.
     run = subprocess.run([cli, "report", str(copy), "--out", str(tmp_path / "t.html")],
                          capture_output=True)
     assert run.returncode == 0, run.stderr.decode()
 
 
-def test_a_truncated_compressed_trace_is_a_data_error_naming_the_file(study_folder, tmp_path):
+def test_a_truncated_or_foreign_trace_is_a_data_error_naming_the_file(study_folder, tmp_path):
     import shutil
 
     copy = tmp_path / "study"
@@ -170,8 +193,35 @@ def test_a_truncated_compressed_trace_is_a_data_error_naming_the_file(study_fold
     trace = Path(study.trials.iloc[0]["trace_file"])
     data = trace.read_bytes()
     trace.write_bytes(data[: len(data) // 2])
-    with pytest.raises(calligraphy.DataError, match=trace.name):
+    with pytest.raises(calligraphy.DataError, match=f"{trace.name}: .*cut short"):
         study.samples(study.trials.iloc[0])
-    trace.write_bytes(b"\x1f\x8b" + b"not deflate at all" * 10)
-    with pytest.raises(calligraphy.DataError, match=trace.name):
+    trace.write_bytes(b"\x89HDF\r\n\x1a\n" + b"another program's HDF5 file" * 10)
+    with pytest.raises(calligraphy.DataError, match=f"{trace.name}: not a calligraphy trace"):
         study.samples(study.trials.iloc[0])
+    trace.unlink()
+    with pytest.raises(FileNotFoundError, match=trace.name):
+        study.samples(study.trials.iloc[0])
+
+
+def test_h5py_reads_a_saved_trace_to_the_same_values(study_folder):
+    """The trace is HDF5 as any reader sees it: h5py (another HDF5 reader, as MATLAB's and R's are) gives the
+    columns, and integer / 10**decimals is, bit for bit, what the library reads."""
+    h5py = pytest.importorskip("h5py")
+    import numpy as np
+
+    study = calligraphy.study.load(study_folder / "study")
+    row = study.trials.iloc[0]
+    ours = study.samples(row)
+    with h5py.File(row["trace_file"], "r") as trace:
+        assert trace.attrs["format"] == b"calligraphy-trace" or trace.attrs["format"] == "calligraphy-trace"
+        assert int(trace.attrs["samples"]) == len(ours)
+        for name, column, unit in [("t", "t_s", "s"), ("x", "x_m", "m"), ("y", "y_m", "m"), ("z", "z_m", "m"),
+                                   ("fx", "fx_n", "N"), ("fy", "fy_n", "N"), ("fz", "fz_n", "N")]:
+            dataset = trace[name]
+            assert dataset.attrs["unit"] in (unit, unit.encode())
+            values = dataset[()] / 10.0 ** int(dataset.attrs["decimals"])
+            np.testing.assert_array_equal(values, ours[column].to_numpy(), err_msg=name)
+        names = {value: key for key, value in h5py.check_enum_dtype(trace["state"].dtype).items()}
+        assert [names[v] for v in trace["state"][()]] == list(ours["state"])
+        for name in ("stroke", "element", "attempt", "rewritten"):
+            np.testing.assert_array_equal(trace[name][()], ours[name].to_numpy(), err_msg=name)

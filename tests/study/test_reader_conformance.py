@@ -4,8 +4,11 @@
 
 A study of one subject is made once; for each file kind (a trial record, session.json, a trace) and each
 damage (cut after a line and in the middle of one, at several places; a NUL byte; CRLF line ends; a byte-order
-mark; a value of the wrong type; a newer version; a huge field; an empty file) a copy of the study holds the
-damaged file, and every reader of that kind reads it: the command line's (`report --csv`, `report --out`,
+mark; a value of the wrong type; a newer version; a huge field; an empty file; for a trace, saved as HDF5 after a
+header with its length and CRC-32: cuts, changed bytes, a newer version, another program's HDF5 file, and bytes
+changed inside the HDF5 file's structure with the CRC-32 made to match, which HDF5 itself then parses; and
+an older folder's gzip CSV trace with the CSV damages) a copy of the study holds the damaged file, and every
+reader of that kind reads it: the command line's (`report --csv`, `report --out`,
 `curriculum`, `session resume`, `trial --spec`, `score`) and Python's (`calligraphy.study.load`,
 `Study.samples`, `rerun_trial`). Each must read the file or refuse it: a command exits 0, or 1 with one error
 line naming the file (never a crash, a signal, a hang or an internal error); Python returns, or raises one of
@@ -23,6 +26,7 @@ import subprocess
 import sys
 import tempfile
 import unittest
+import zlib
 from pathlib import Path
 
 CLI = os.environ.get("CALLIGRAPHY_CLI", "")
@@ -84,6 +88,34 @@ def csv_damages(text):
     return damages
 
 
+def trace_file(hdf5):
+    """A trace file of the HDF5 file `hdf5` (include/calligraphy/report/trace_hdf5.hpp): the 512-byte header
+    with its length and CRC-32, then the file."""
+    header = b"calligraphy-trace\nversion 1\nbytes %d\ncrc32 %08x\n" % (len(hdf5), zlib.crc32(hdf5))
+    return header + b"\0" * (512 - len(header)) + hdf5
+
+
+def trace_damages(data):
+    """Damages of a saved HDF5 trace: damage the header checks find, and damage inside the HDF5 file (its
+    superblock, object headers, chunk index and data) under a matching CRC-32, which reaches HDF5's parser."""
+    hdf5 = data[512:]
+    damages = {f"cut at {share:.0%}": data[: int(share * len(data))] for share in (0.01, 0.3, 0.5, 0.9)}
+    damages["cut by a byte"] = data[:-1]
+    damages["NUL byte"] = data[:700] + b"\0" + data[700:]
+    damages["byte changed"] = data[:2000] + bytes([data[2000] ^ 0x10]) + data[2001:]
+    damages["header changed"] = data.replace(b"version 1", b"versioN 1", 1)
+    damages["newer version"] = data.replace(b"version 1", b"version 2", 1)
+    damages["another program's HDF5 file"] = hdf5
+    damages["huge field"] = data[:512] + b"x" * 200_000
+    damages["empty"] = b""
+    for offset in (0, 8, 13, 40, 60, 100, 200, 400, 800, len(hdf5) // 2, len(hdf5) - 600, len(hdf5) - 40):
+        for value in (0x00, 0xFF):
+            tampered = bytearray(hdf5)
+            tampered[offset] = value if tampered[offset] != value else value ^ 0x55
+            damages[f"HDF5 byte {offset} set to {value:#x}, CRC-32 matching"] = trace_file(bytes(tampered))
+    return damages
+
+
 class ReaderConformance(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -98,7 +130,7 @@ class ReaderConformance(unittest.TestCase):
         cls.study = root / "study"
         cls.session = next(p for p in (root / "study" / "S01").iterdir() if not p.name.startswith("."))
         cls.record = sorted((cls.session / "trials").glob("*.json"))[1]  # a fading trial
-        cls.trace = cls.record.with_suffix(".csv.gz")
+        cls.trace = cls.record.with_suffix(".trace.h5")
         import calligraphy  # noqa: F401  (imported once: pandas and the module take a second)
         import calligraphy.study  # noqa: F401
 
@@ -165,28 +197,46 @@ class ReaderConformance(unittest.TestCase):
                 self.check_cli(["session", "resume", damaged.parent], copy, damaged, what)
                 self.check_python(lambda: calligraphy.study.load(copy / "study"), damaged, what)
 
-    def test_traces(self):
+    def check_trace_readers(self, copy, damaged, what):
         import calligraphy.study
 
-        text = gzip.decompress(self.trace.read_bytes())
+        self.check_cli(["report", "study", "--out", "report.html"], copy, damaged, what)
+        self.check_cli(["score", damaged, "--character", "十"], copy, damaged, what)
+
+        def samples():
+            study = calligraphy.study.load(copy / "study")
+            row = study.trials[study.trials["trace_file"].str.endswith(damaged.name)].iloc[0]
+            study.samples(row)
+
+        self.check_python(samples, damaged, what)
+
+    def test_traces(self):
+        for what, content in trace_damages(self.trace.read_bytes()).items():
+            with self.subTest(damage=what):
+                copy, damaged = self.damaged_copy(self.trace, content)
+                self.check_cli(["trace", damaged, "--csv", "trace.csv"], copy, damaged, what)
+                self.check_trace_readers(copy, damaged, what)
+
+    def test_older_csv_traces(self):
+        """A folder written before traces were HDF5: its record names a gzip CSV trace (files.csv)."""
+        text = subprocess.run([CLI, "trace", self.trace], capture_output=True, check=True).stdout
+        older = self.trace.with_name(self.record.stem + ".csv.gz")
         damages = {what: (content, True) for what, content in csv_damages(text).items()}
-        compressed = self.trace.read_bytes()
+        compressed = gzip.compress(text)
         damages["gzip cut"] = (compressed[: len(compressed) // 2], False)
         damages["not gzip"] = (text, False)
         for what, (content, compress) in damages.items():
             with self.subTest(damage=what):
                 copy, damaged = self.damaged_copy(self.trace, content, compress)
-                self.check_cli(["report", "study", "--out", "report.html"], copy, damaged, what)
-                plain = damaged.with_suffix("")  # score reads a plain CSV
+                damaged = damaged.rename(damaged.with_name(older.name))
+                record = damaged.with_name(self.record.name)
+                document = json.loads(record.read_text(encoding="utf-8"))
+                document["files"] = {"csv": older.name, "svg": document["files"]["svg"]}
+                record.write_text(json.dumps(document, ensure_ascii=False), encoding="utf-8")
+                self.check_trace_readers(copy, damaged, what)
+                plain = damaged.with_suffix("")  # score reads a plain CSV too
                 plain.write_bytes(gzip.decompress(damaged.read_bytes()) if compress else content)
                 self.check_cli(["score", plain, "--character", "十"], copy, plain, what)
-
-                def samples():
-                    study = calligraphy.study.load(copy / "study")
-                    row = study.trials[study.trials["trace_file"].str.endswith(damaged.name)].iloc[0]
-                    study.samples(row)
-
-                self.check_python(samples, damaged, what)
 
 
 if __name__ == "__main__":

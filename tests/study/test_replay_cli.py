@@ -6,7 +6,6 @@ trace, byte for byte, on the simulated device; what cannot be re-run is refused 
 
 CALLIGRAPHY_CLI names the program. Standard library only.
 """
-import gzip
 import json
 import os
 import subprocess
@@ -102,7 +101,8 @@ class ReplayTest(unittest.TestCase):
             document = json.loads(record.read_text())
             spec = document["specification"]
             modes.add(spec["force_law"]["guidance_law"]["mode"] if spec["force_law"]["guidance"] else "off")
-            saved = gzip.decompress(record.with_suffix(".csv.gz").read_bytes())
+            # The saved HDF5 trace as trial --csv's text (`calligraphy trace`), byte for byte.
+            saved = self.ok("trace", record.with_suffix(".trace.h5")).stdout
             with self.subTest(record=str(record.relative_to(self.cwd))):
                 self.assertEqual(self.rerun_to(record, f"r{number}.csv"), saved)
         # The conditions' own values reached the record: stiffness and bound from the protocol.

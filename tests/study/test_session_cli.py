@@ -84,8 +84,8 @@ class SessionCliTest(unittest.TestCase):
         self.assertEqual(len(self.saved(session)), len(planned))
         for name, value in before.items():  # every trial saved before the signal is unchanged
             self.assertEqual(digest(session / "trials" / name), value, name)
-        for trial in planned:  # every planned trial has its JSON, trace (compressed CSV) and SVG
-            for extension in ("json", "csv.gz", "svg"):
+        for trial in planned:  # every planned trial has its JSON, trace (HDF5) and SVG
+            for extension in ("json", "trace.h5", "svg"):
                 self.assertTrue((session / "trials" / f"{trial['file']}.{extension}").is_file(), trial["file"])
         events, torn = [], 0
         for line in (session / "log.jsonl").read_text(encoding="utf-8").splitlines():

@@ -8,7 +8,6 @@ exit status (4 after a lost display, 128 + the signal's number).
 
 Environment: CALLIGRAPHY_CLI (the program), CALLIGRAPHY_SOURCE_DIR (the source tree)."""
 import csv
-import gzip
 import json
 import math
 import os
@@ -128,6 +127,13 @@ class Trainer:
         self.stderr.close()
 
 
+def saved_trace_rows(record_path):
+    """The rows of the trace saved beside a record (STEM.trace.h5), as `calligraphy trace` writes its CSV."""
+    text = subprocess.run([CLI, "trace", record_path.with_suffix(".trace.h5")], capture_output=True,
+                          check=True, timeout=60).stdout.decode("utf-8")
+    return list(csv.DictReader(text.splitlines()))
+
+
 def saved_trials(folder, subject="anonymous"):
     """The saved trials of the one session folder `train --session FOLDER` made (FOLDER/SUBJECT/train-*)."""
     (session,) = sorted(pathlib.Path(folder).glob(f"{subject}/train-*"))
@@ -240,8 +246,7 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual(record["renderer"]["loop"]["stall_timeout_s"], 2.0)  # --watchdog-ms, in s
         for key in ("start_time_utc", "library", "mean_deviation_mm", "per_stroke", "loop", "per_character"):
             self.assertIn(key, record)
-        with gzip.open(record_path.with_suffix(".csv.gz"), "rt", newline="") as f:
-            trace = list(csv.DictReader(f))
+        trace = saved_trace_rows(record_path)
         self.assertEqual(len(trace), record["loop"]["ticks"])  # every tick kept
         self.assertTrue(record_path.with_suffix(".svg").read_text().startswith("<svg"))
 
@@ -304,8 +309,7 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual((record["strokes_completed"], record["strokes_total"]), (5, 5))
         self.assertTrue(record["loop"]["device_clock"])
         self.assertGreater(record["device"]["time_at_start_s"], 100.0)  # the stand-in's own clock
-        with gzip.open(record_path.with_suffix(".csv.gz"), "rt", newline="") as f:
-            trace = list(csv.DictReader(f))
+        trace = saved_trace_rows(record_path)
         self.assertEqual(float(trace[0]["t"]), 0.0)
         self.assertEqual(len(trace), record["loop"]["ticks"])
         keep_artifact(folder / "out" / "openhaptics.png")
@@ -574,8 +578,7 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual(record["end_reason"], "interrupted")
         self.assertTrue(record["aborted"])
         self.assertLess(record["strokes_completed"], 5)
-        with gzip.open(record_path.with_suffix(".csv.gz"), "rt", newline="") as f:
-            rows = sum(1 for _ in csv.DictReader(f))
+        rows = len(saved_trace_rows(record_path))
         self.assertGreater(rows, 3000)  # about 4 s at 1 kHz
         self.assertEqual(rows, record["loop"]["ticks"])
         return record
@@ -756,8 +759,7 @@ def records_and_rows(attempts):
     """The one interrupted attempt's record and its CSV's row count."""
     (record_path,) = attempts
     record = json.loads(record_path.read_text(encoding="utf-8"))
-    with gzip.open(record_path.with_suffix(".csv.gz"), "rt", newline="") as f:
-        rows = sum(1 for _ in csv.DictReader(f))
+    rows = len(saved_trace_rows(record_path))
     return record, rows
 
 

@@ -6,7 +6,8 @@ include/calligraphy/study/study_tables.hpp): the same code, so R, spreadsheet an
 numbers. Metrics are each trial record's one metrics record (docs/metrics.md) in SI units, the unit in every
 column name; indices (trial, block, item, repetition, character, stroke) count from 1, as the trial files'
 numbers (001-..., r1) do. Traces are never read by ``load``: ``Study.samples(trial)`` reads one trial's
-trace (its CSV, gzip-compressed: ``.csv.gz``; a plain ``.csv`` in older folders) when asked, and
+trace (its HDF5 file, ``.trace.h5``, read by the library's C++ reader; the gzip CSV ``.csv.gz`` or plain
+``.csv`` of older folders) when asked, and
 ``Study.iter_samples()`` streams them one at a time. Columns: docs/experiments.md ("Tidy
 tables"). Tidy data: Wickham 2014, J Stat Softw 59(10).
 """
@@ -50,9 +51,31 @@ _MARKED_TRACE_HEADER = _TRACE_HEADER + ["attempt", "rewritten"]
 _WHOLE_NUMBER_COLUMNS = ("stroke", "element", "attempt", "rewritten")
 
 
+_STATES = ("SS", "AS", "CS", "WS")  # InteractionState's numbers in an HDF5 trace (render/interaction_state.hpp)
+# A trace file over this is refused unread (read_trace_hdf5's default, PenTraceCsvOptions::max_file_bytes).
+_MAX_TRACE_FILE_BYTES = 256 << 20
+
+
 def _read_trace(path: str) -> "pandas.DataFrame":
-    """A trial's trace as samples: its CSV, gzip-compressed (``.csv.gz``, decompressed as it is read) or plain
-    (``.csv``, older session folders); DataError naming the file and line for damage."""
+    """A trial's trace as samples, the same columns from either format: its HDF5 file (``.trace.h5``, read
+    whole by the C++ reader, trace_hdf5.hpp) or, in older session folders, its CSV, gzip-compressed
+    (``.csv.gz``) or plain (``.csv``); DataError naming the file (and line) for damage."""
+    if str(path).endswith(".h5"):
+        import numpy as np
+
+        if not os.path.exists(path):
+            raise FileNotFoundError(f"{path}: no such trace file")
+        columns = _calligraphy._read_trace_columns(os.fspath(path), _MAX_TRACE_FILE_BYTES)
+        columns["state"] = np.array(_STATES, dtype=object)[columns["state"]]
+        for column in _WHOLE_NUMBER_COLUMNS:
+            columns[column] = columns[column].astype(np.int64)
+        return _pandas().DataFrame(columns)
+    return _read_csv_trace(path)
+
+
+def _read_csv_trace(path: str) -> "pandas.DataFrame":
+    """An older trial's trace as samples: its CSV, gzip-compressed (``.csv.gz``, decompressed as it is read)
+    or plain (``.csv``); DataError naming the file and line for damage."""
     import gzip
     import zlib
 
@@ -137,9 +160,12 @@ class Study:
 
     def samples(self, trial: typing.Union[int, "pandas.Series"]) -> "pandas.DataFrame":
         """One trial's trace, read now: a DataFrame of N ticks with t_s [s], x_m, y_m, z_m [m] (device frame),
-        fx_n, fy_n, fz_n [N], state, stroke, element (positions in the scene's arrays, 0-based). `trial` is a row of `trials` or its index
+        fx_n, fy_n, fz_n [N], state ("SS", "AS", "CS", "WS"), stroke, element (positions in the scene's arrays,
+        0-based), attempt (1-based, 0 outside any; traces of older folders may lack it) and rewritten (1: part
+        of an attempt written again later). `trial` is a row of `trials` or its index
         label. Raises KeyError for an unknown label, FileNotFoundError when the trace is gone, DataError naming
-        the file and the line of a damaged trace (another header, a field that is not a finite number)."""
+        the file of a damaged trace (and the line of an older CSV trace: another header, a field that is not a
+        finite number)."""
         row = self.trials.loc[trial] if not hasattr(trial, "trace_file") else trial
         return _read_trace(row["trace_file"])
 

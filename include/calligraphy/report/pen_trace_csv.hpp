@@ -80,12 +80,15 @@ struct PenTraceRow {
 
 /// Reads a CSV file as `read_pen_trace_csv` does (the same format, limits and errors), calling `row` with
 /// each sample in turn instead of keeping them: memory holds a block of the file, not its samples. `row` may
-/// throw to stop the reading.
+/// throw to stop the reading. A trace saved as HDF5 (a session's `STEM.trace.h5`, trace_hdf5.hpp, by its
+/// first bytes) is read whole, its columns `t`, `x`, `y`, `z` (and `fx`, `fy`), with the same limits and
+/// checks; its errors name the sample (1-based) instead of the line.
 void for_each_pen_trace_row(const std::filesystem::path& file, const Placement& placement,
                             const PenTraceCsvOptions& options, const std::function<void(const PenTraceRow&)>& row);
 
 /// Reads and parses a CSV file, a block at a time (memory holds the samples, not the file). A gzip file
-/// (RFC 1952, by its first bytes: a saved trial's `.csv.gz`) is decompressed on the way. Throws DataError
+/// (RFC 1952, by its first bytes: an older saved trial's `.csv.gz`) is decompressed on the way; an HDF5
+/// trace is read as `for_each_pen_trace_row` reads it. Throws DataError
 /// naming the file when it does not exist, is not a regular file, is larger than options.max_file_bytes
 /// (on disk or decompressed), is damaged or truncated gzip or
 /// cannot be read, and as `parse_pen_trace_csv`.

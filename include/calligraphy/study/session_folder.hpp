@@ -113,7 +113,7 @@ void check_writable_folder(const std::filesystem::path& folder, std::uintmax_t f
 ///   FOLDER/session.json            the manifest (the plan, the setup, the protocol's copy)
 ///   FOLDER/log.jsonl               the event log, locked while a run works on the session
 ///   FOLDER/trials/STEM.json        a saved trial's record (its existence marks the trial saved)
-///   FOLDER/trials/STEM.csv.gz      its pen trace; FOLDER/trials/STEM.svg its drawing
+///   FOLDER/trials/STEM.trace.h5    its trace (HDF5, trace_hdf5.hpp); FOLDER/trials/STEM.svg its drawing
 ///   FOLDER/trials/attempts/        attempts that did not become the trial
 ///   FOLDER/teachers/               a replay condition's teachers
 struct SessionLayout {
@@ -158,10 +158,10 @@ class SessionFolder {
 
   /// "003-test-vision-r1-U5927": the file name of a trial without extension.
   [[nodiscard]] static std::string trial_stem(const PlannedTrial& trial);
-  /// The extension of a saved trial's pen trace: its CSV compressed with gzip (RFC 1952; `zcat` and pandas
-  /// read it). Folders written before hold plain `.csv` traces, which readers still read: a trial record's
-  /// `files.csv` names its trace.
-  static constexpr std::string_view kTraceExtension = "csv.gz";
+  /// The extension of a saved trial's trace: the columnar HDF5 file of `trial_trace_hdf5` (trace_hdf5.hpp;
+  /// h5py, MATLAB and R read it). A record's `files.trace` names it. Folders written before hold gzip CSV
+  /// (`.csv.gz`) or plain `.csv` traces, named by `files.csv`, which readers still read.
+  static constexpr std::string_view kTraceExtension = "trace.h5";
   /// trials/STEM.EXTENSION
   [[nodiscard]] std::filesystem::path trial_file(const PlannedTrial& trial, std::string_view extension) const;
   /// True when the trial's JSON exists.
@@ -170,15 +170,15 @@ class SessionFolder {
   /// The first planned trial not saved yet, or nullopt when every trial is saved.
   [[nodiscard]] std::optional<std::size_t> next_unsaved() const;
 
-  /// Saves a finished trial: `csv` (the trace's text, stored gzip-compressed as STEM.csv.gz) and `svg`
-  /// atomically, then `json` with link(2), so it never replaces a file. Throws StateError naming the file
-  /// when the trial was saved already, DataError when a write fails.
-  void save_trial(const PlannedTrial& trial, std::string_view json, std::string_view csv,
+  /// Saves a finished trial: `trace` (the bytes of its trace file, `trial_trace_hdf5`, as STEM.trace.h5) and
+  /// `svg` atomically, then `json` with link(2), so it never replaces a file. Throws StateError naming the
+  /// file when the trial was saved already, DataError when a write fails.
+  void save_trial(const PlannedTrial& trial, std::string_view json, std::string_view trace,
                   std::string_view svg);
   /// Keeps an attempt that did not become the saved trial (interrupted, failed) in trials/attempts/ as
-  /// STEM.attempt-K.json and .csv.gz (compressed as save_trial's) with the first free K. Returns the
-  /// JSON's path.
-  std::filesystem::path save_attempt(const PlannedTrial& trial, std::string_view json, std::string_view csv);
+  /// STEM.attempt-K.json and .trace.h5 (as save_trial's) with the first free K. Returns the JSON's path.
+  std::filesystem::path save_attempt(const PlannedTrial& trial, std::string_view json,
+                                     std::string_view trace);
 
   /// Checks every folder and file a run of the session writes (the session folder, trials/, trials/attempts/,
   /// teachers/, log.jsonl) with `check_writable_folder`, the free space for one trial's files

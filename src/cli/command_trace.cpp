@@ -1,0 +1,45 @@
+// `calligraphy trace TRACE [--csv FILE]`: a saved trial's trace (a session's STEM.trace.h5) as the CSV that
+// `trial --csv` writes (t,x,y,z,fx,fy,fz,state,stroke,element,attempt,rewritten; s, m, N): the export for
+// spreadsheets and scripts that read no HDF5.
+#include <memory>
+#include <string>
+
+#include "calligraphy/report/trace_hdf5.hpp"
+#include "calligraphy/report/trial_report.hpp"
+#include "cli/commands.hpp"
+#include "cli/output.hpp"
+
+namespace calligraphy::cli {
+namespace {
+
+struct TraceCommand {
+  std::string trace;
+  std::string csv = "-";
+};
+
+int run_trace(const TraceCommand& command) {
+  FilePlan files;
+  files.output("--csv", command.csv);
+  const std::string csv = trial_csv(trial_samples(read_trace_hdf5(command.trace)));
+  if (command.csv == "-") {
+    write_standard_output(csv);
+  } else {
+    write_output(command.csv, csv);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_trace_command(CLI::App& root, Commands& commands) {
+  auto command = std::make_shared<TraceCommand>();
+  CLI::App* app = commands.add(root, "trace",
+                               "Write a saved trial's trace (.trace.h5) as CSV, the columns of trial --csv",
+                               [command] { return run_trace(*command); });
+  app->add_option("TRACE", command->trace, "the trace file (HDF5: a session folder's trials/STEM.trace.h5)")
+      ->required();
+  add_output_path(*app, "--csv", command->csv, "write the CSV here ('-', the default: standard output)",
+                  StandardOutput::allowed);
+}
+
+}  // namespace calligraphy::cli

@@ -1,0 +1,608 @@
+#include "calligraphy/report/trace_hdf5.hpp"
+
+#include <hdf5.h>
+#include <libdeflate.h>
+#include <zlib.h>
+
+#include <array>
+#include <atomic>
+#include <bit>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <system_error>
+
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/report/trial_report.hpp"
+
+namespace calligraphy {
+namespace {
+
+constexpr std::string_view kMagic = "calligraphy-trace\n";
+constexpr int kVersion = 1;
+// HDF5 looks for its superblock at 0, 512, 1024, ...: the smallest user block is 512 bytes.
+constexpr std::size_t kUserBlockBytes = 512;
+constexpr hsize_t kChunkSamples = hsize_t{1} << 16;
+constexpr int kDeflateLevel = 6;
+
+// One HDF5 identifier, closed with its own close function when it goes.
+class Handle {
+ public:
+  Handle(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
+  Handle(Handle&& other) noexcept : id_(other.id_), close_(other.close_) { other.id_ = -1; }
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  Handle& operator=(Handle&&) = delete;
+  ~Handle() {
+    if (id_ >= 0) close_(id_);
+  }
+  [[nodiscard]] hid_t get() const noexcept { return id_; }
+  [[nodiscard]] bool ok() const noexcept { return id_ >= 0; }
+
+ private:
+  hid_t id_;
+  herr_t (*close_)(hid_t);
+};
+
+// HDF5 prints its error stack to stderr unless told not to, per thread in a thread-safe build: errors here
+// become exceptions that name the file instead.
+void silence_hdf5() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
+
+// The core driver keeps files in memory; HDF5 refuses a second open file of the same name, so each gets its
+// own.
+std::string image_name() {
+  static std::atomic<unsigned long long> counter{0};
+  return "calligraphy-trace-image-" + std::to_string(counter.fetch_add(1));
+}
+
+Handle memory_file_access() {
+  Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  if (!fapl.ok() || H5Pset_fapl_core(fapl.get(), std::size_t{1} << 20, /*backing_store=*/0) < 0)
+    throw DataError("trace file: HDF5 cannot make an in-memory file (out of memory?)");
+  return fapl;
+}
+
+// ---- writing ----
+
+void write_string_attribute(hid_t object, const char* name, std::string_view value) {
+  Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+  if (!type.ok() || !space.ok() || H5Tset_size(type.get(), value.size()) < 0)
+    throw DataError(std::string("trace file: HDF5 cannot make attribute ") + name);
+  Handle attribute(H5Acreate2(object, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  if (!attribute.ok() || H5Awrite(attribute.get(), type.get(), value.data()) < 0)
+    throw DataError(std::string("trace file: HDF5 cannot write attribute ") + name);
+}
+
+template <typename T>
+void write_number_attribute(hid_t object, const char* name, hid_t file_type, hid_t memory_type, T value) {
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+  Handle attribute(H5Acreate2(object, name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  if (!attribute.ok() || H5Awrite(attribute.get(), memory_type, &value) < 0)
+    throw DataError(std::string("trace file: HDF5 cannot write attribute ") + name);
+}
+
+hid_t write_column(hid_t file, const char* name, hid_t file_type, hid_t memory_type, const void* data,
+                   std::size_t count) {
+  const hsize_t dims[1] = {count};
+  const hsize_t chunk[1] = {std::max<hsize_t>(1, std::min<hsize_t>(count, kChunkSamples))};
+  Handle space(H5Screate_simple(1, dims, nullptr), H5Sclose);
+  Handle create(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  // No creation time in the object's header: the same trace gives the same bytes.
+  if (!space.ok() || !create.ok() || H5Pset_chunk(create.get(), 1, chunk) < 0 ||
+      H5Pset_shuffle(create.get()) < 0 || H5Pset_deflate(create.get(), kDeflateLevel) < 0 ||
+      H5Pset_obj_track_times(create.get(), 0) < 0)
+    throw DataError(std::string("trace file: HDF5 cannot lay out column ") + name);
+  const hid_t dataset =
+      H5Dcreate2(file, name, file_type, space.get(), H5P_DEFAULT, create.get(), H5P_DEFAULT);
+  if (dataset < 0) throw DataError(std::string("trace file: HDF5 cannot make column ") + name);
+  if (count > 0 && H5Dwrite(dataset, memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
+    H5Dclose(dataset);
+    throw DataError(std::string("trace file: HDF5 cannot write column ") + name);
+  }
+  return dataset;
+}
+
+// `value` to `decimals` decimals as the CSV writes it (std::to_chars, fixed), as the integer of its digits:
+// the column then reads back, as integer / 10^decimals, to the double the CSV's text parses to.
+bool scaled_integer(double value, int decimals, std::int64_t& out) {
+  if (!std::isfinite(value) || !(std::abs(value) < 1e15)) return false;
+  char text[64];
+  const auto [end, error] =
+      std::to_chars(text, text + sizeof text, value, std::chars_format::fixed, decimals);
+  if (error != std::errc{}) return false;
+  std::int64_t digits = 0;
+  bool negative = false;
+  for (const char* at = text; at != end; ++at) {
+    if (*at == '-')
+      negative = true;
+    else if (*at != '.')
+      digits = digits * 10 + (*at - '0');
+  }
+  if (digits >= (std::int64_t{1} << 53)) return false;  // beyond an exact double
+  out = negative ? -digits : digits;
+  return true;
+}
+
+void write_scaled_column(hid_t file, const char* name, const char* unit, int decimals,
+                         const std::vector<TrialSample>& trace, double (*get)(const TrialSample&)) {
+  std::vector<std::int64_t> integers(trace.size());
+  bool exact = true;
+  bool fits_32 = true;
+  for (std::size_t i = 0; i < trace.size() && exact; ++i) {
+    exact = scaled_integer(get(trace[i]), decimals, integers[i]);
+    fits_32 = fits_32 && integers[i] >= std::numeric_limits<std::int32_t>::min() &&
+              integers[i] <= std::numeric_limits<std::int32_t>::max();
+  }
+  hid_t dataset = -1;
+  if (!exact) {  // a value no integer holds: the column as doubles, exactly as recorded
+    std::vector<double> values(trace.size());
+    for (std::size_t i = 0; i < trace.size(); ++i) values[i] = get(trace[i]);
+    dataset = write_column(file, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, values.data(), values.size());
+  } else if (fits_32) {
+    std::vector<std::int32_t> narrow(integers.begin(), integers.end());
+    dataset = write_column(file, name, H5T_STD_I32LE, H5T_NATIVE_INT32, narrow.data(), narrow.size());
+  } else {
+    dataset = write_column(file, name, H5T_STD_I64LE, H5T_NATIVE_INT64, integers.data(), integers.size());
+  }
+  Handle closer(dataset, H5Dclose);
+  write_string_attribute(dataset, "unit", unit);
+  if (exact) write_number_attribute(dataset, "decimals", H5T_STD_I32LE, H5T_NATIVE_INT, decimals);
+}
+
+Handle state_type(hid_t base) {
+  Handle type(H5Tenum_create(base), H5Tclose);
+  for (std::uint8_t value = 0; value < 4; ++value) {
+    if (!type.ok() || H5Tenum_insert(type.get(), to_string(static_cast<InteractionState>(value)), &value) < 0)
+      throw DataError("trace file: HDF5 cannot make the state type");
+  }
+  return type;
+}
+
+// CRC-32 (ISO 3309, as zlib computes it) of `bytes`.
+unsigned long crc32_of(std::string_view bytes) {
+  return crc32(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(bytes.data()),
+               static_cast<uInt>(bytes.size()));
+}
+
+// The user block: what the file is, its version, the length and CRC-32 of the HDF5 file after it, then zeros.
+std::string user_block(int version, std::size_t length, unsigned long crc) {
+  char text[kUserBlockBytes] = {};
+  std::snprintf(text, sizeof text, "%.*sversion %d\nbytes %zu\ncrc32 %08lx\n",
+                static_cast<int>(kMagic.size()), kMagic.data(), version, length, crc);
+  return {text, sizeof text};
+}
+
+}  // namespace
+
+std::string trial_trace_hdf5(const std::vector<TrialSample>& trace) {
+  silence_hdf5();
+  Handle access = memory_file_access();
+  Handle create(H5Pcreate(H5P_FILE_CREATE), H5Pclose);
+  if (!create.ok() || H5Pset_userblock(create.get(), kUserBlockBytes) < 0 ||
+      H5Pset_obj_track_times(create.get(), 0) < 0)
+    throw DataError("trace file: HDF5 cannot set up a file");
+  Handle file(H5Fcreate(image_name().c_str(), H5F_ACC_TRUNC, create.get(), access.get()), H5Fclose);
+  if (!file.ok()) throw DataError("trace file: HDF5 cannot make an in-memory file");
+  const hid_t root = file.get();
+  write_string_attribute(root, "format", "calligraphy-trace");
+  write_number_attribute(root, "version", H5T_STD_I32LE, H5T_NATIVE_INT, kVersion);
+  write_number_attribute(root, "samples", H5T_STD_U64LE, H5T_NATIVE_UINT64, std::uint64_t{trace.size()});
+
+  write_scaled_column(root, "t", "s", kTraceTimeDecimals, trace,
+                      [](const TrialSample& s) { return s.time_s; });
+  write_scaled_column(root, "x", "m", kTracePositionDecimals, trace,
+                      [](const TrialSample& s) { return s.position_m.x(); });
+  write_scaled_column(root, "y", "m", kTracePositionDecimals, trace,
+                      [](const TrialSample& s) { return s.position_m.y(); });
+  write_scaled_column(root, "z", "m", kTracePositionDecimals, trace,
+                      [](const TrialSample& s) { return s.position_m.z(); });
+  write_scaled_column(root, "fx", "N", kTraceForceDecimals, trace,
+                      [](const TrialSample& s) { return s.force_n.x(); });
+  write_scaled_column(root, "fy", "N", kTraceForceDecimals, trace,
+                      [](const TrialSample& s) { return s.force_n.y(); });
+  write_scaled_column(root, "fz", "N", kTraceForceDecimals, trace,
+                      [](const TrialSample& s) { return s.force_n.z(); });
+
+  const std::size_t n = trace.size();
+  std::vector<std::uint8_t> states(n), rewritten(n);
+  std::vector<std::uint32_t> strokes(n), elements(n);
+  std::vector<std::int32_t> attempts(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const TrialSample& s = trace[i];
+    if (s.stroke > std::numeric_limits<std::uint32_t>::max() ||
+        s.element > std::numeric_limits<std::uint32_t>::max())
+      throw InvalidArgument("trial_trace_hdf5: sample " + std::to_string(i) +
+                            " has a stroke or element index beyond 2^32 - 1");
+    states[i] = static_cast<std::uint8_t>(s.state);
+    strokes[i] = static_cast<std::uint32_t>(s.stroke);
+    elements[i] = static_cast<std::uint32_t>(s.element);
+    attempts[i] = s.attempt;
+    rewritten[i] = s.rewritten ? 1 : 0;
+  }
+  {
+    Handle file_states = state_type(H5T_STD_U8LE);
+    Handle memory_states = state_type(H5T_NATIVE_UINT8);
+    Handle(write_column(root, "state", file_states.get(), memory_states.get(), states.data(), n), H5Dclose);
+  }
+  Handle(write_column(root, "stroke", H5T_STD_U32LE, H5T_NATIVE_UINT32, strokes.data(), n), H5Dclose);
+  Handle(write_column(root, "element", H5T_STD_U32LE, H5T_NATIVE_UINT32, elements.data(), n), H5Dclose);
+  Handle(write_column(root, "attempt", H5T_STD_I32LE, H5T_NATIVE_INT32, attempts.data(), n), H5Dclose);
+  Handle(write_column(root, "rewritten", H5T_STD_U8LE, H5T_NATIVE_UINT8, rewritten.data(), n), H5Dclose);
+
+  if (H5Fflush(root, H5F_SCOPE_GLOBAL) < 0) throw DataError("trace file: HDF5 cannot finish the file");
+  const ssize_t size = H5Fget_file_image(root, nullptr, 0);
+  if (size <= 0) throw DataError("trace file: HDF5 gave no file image");
+  std::string image(static_cast<std::size_t>(size), '\0');
+  if (H5Fget_file_image(root, image.data(), image.size()) != size)
+    throw DataError("trace file: HDF5 cannot copy the file image");
+  // HDF5's image starts at its superblock: the user block it left room for goes before it.
+  return user_block(kVersion, image.size(), crc32_of(image)) + image;
+}
+
+bool is_trace_hdf5(std::string_view first_bytes) noexcept { return first_bytes.starts_with(kMagic); }
+
+namespace {
+
+// ---- reading ----
+
+[[noreturn]] void refuse(const std::string& source, const std::string& what) {
+  throw DataError(source + ": " + what);
+}
+
+// The user block's checks: what the file is, its version, then that it is byte for byte the block this
+// library writes for the rest's length and CRC-32.
+void check_user_block(std::string_view bytes, const std::string& source) {
+  if (!is_trace_hdf5(bytes))
+    refuse(source, "not a calligraphy trace file (it does not start 'calligraphy-trace')");
+  if (bytes.size() < kUserBlockBytes)
+    refuse(source, "cut short (" + std::to_string(bytes.size()) + " bytes)");
+  const std::string head(bytes.data(), strnlen(bytes.data(), kUserBlockBytes));
+  int version = 0;
+  if (std::sscanf(head.c_str() + kMagic.size(), "version %d\n", &version) != 1)
+    refuse(source, "damaged header (no version)");
+  if (version != kVersion) {
+    refuse(source, "trace file version " + std::to_string(version) + ", this library reads version " +
+                       std::to_string(kVersion) + (version > kVersion ? " (a newer library wrote it)" : ""));
+  }
+  unsigned long long length = 0;
+  unsigned long crc = 0;
+  if (std::sscanf(head.c_str() + kMagic.size(), "version %*d\nbytes %llu\ncrc32 %lx\n", &length, &crc) != 2)
+    refuse(source, "damaged header (no bytes and crc32)");
+  const std::string_view rest = bytes.substr(kUserBlockBytes);
+  if (rest.size() != length) {
+    refuse(source, std::to_string(rest.size()) + " bytes after its header where it says " +
+                       std::to_string(length) + (rest.size() < length ? " (cut short)" : " (bytes added)"));
+  }
+  if (bytes.substr(0, kUserBlockBytes) != user_block(version, static_cast<std::size_t>(length), crc))
+    refuse(source, "damaged header");
+  if (crc32_of(rest) != crc) refuse(source, "damaged (its CRC-32 does not match its contents)");
+}
+
+std::string read_string_attribute(hid_t object, const char* name, const std::string& source) {
+  if (H5Aexists(object, name) <= 0) refuse(source, std::string("no attribute '") + name + "'");
+  Handle attribute(H5Aopen(object, name, H5P_DEFAULT), H5Aclose);
+  Handle type(H5Aget_type(attribute.get()), H5Tclose);
+  if (!type.ok() || H5Tget_class(type.get()) != H5T_STRING || H5Tis_variable_str(type.get()) != 0)
+    refuse(source, std::string("attribute '") + name + "' is not a fixed-length string");
+  const std::size_t size = H5Tget_size(type.get());
+  if (size == 0 || size > 4096) refuse(source, std::string("attribute '") + name + "' has a bad length");
+  std::string value(size, '\0');
+  if (H5Aread(attribute.get(), type.get(), value.data()) < 0)
+    refuse(source, std::string("attribute '") + name + "' cannot be read");
+  value.resize(strnlen(value.c_str(), value.size()));
+  return value;
+}
+
+long long read_integer_attribute(hid_t object, const char* name, const std::string& source) {
+  if (H5Aexists(object, name) <= 0) refuse(source, std::string("no attribute '") + name + "'");
+  Handle attribute(H5Aopen(object, name, H5P_DEFAULT), H5Aclose);
+  Handle type(H5Aget_type(attribute.get()), H5Tclose);
+  Handle space(H5Aget_space(attribute.get()), H5Sclose);
+  if (!type.ok() || H5Tget_class(type.get()) != H5T_INTEGER || H5Sget_simple_extent_npoints(space.get()) != 1)
+    refuse(source, std::string("attribute '") + name + "' is not one integer");
+  long long value = 0;
+  if (H5Aread(attribute.get(), H5T_NATIVE_LLONG, &value) < 0)
+    refuse(source, std::string("attribute '") + name + "' cannot be read");
+  return value;
+}
+
+// A dataset's chunks read raw (H5Dread_chunk) and decoded here: inflated by libdeflate (the same zlib
+// stream, RFC 1950, that HDF5's deflate filter writes, at about three times zlib's speed) and unshuffled.
+// HDF5's own pipeline would do the same under its global lock; this way the decoding of one file runs
+// beside another thread's. Returns false, having read nothing, for any layout but the one this library
+// writes (chunked, shuffle then deflate, an integer or float64 little-endian column), which HDF5 then reads.
+class DirectChunks {
+ public:
+  DirectChunks() : inflater_(libdeflate_alloc_decompressor()) {}
+  ~DirectChunks() { libdeflate_free_decompressor(inflater_); }
+  DirectChunks(const DirectChunks&) = delete;
+  DirectChunks& operator=(const DirectChunks&) = delete;
+
+  // `out` (`samples` values) as doubles: integers over `power` (1 for a float column).
+  bool read_measured(hid_t dataset, std::size_t samples, double power, double* out) {
+    Handle type(H5Dget_type(dataset), H5Tclose);
+    const bool i32 = H5Tequal(type.get(), H5T_STD_I32LE) > 0;
+    const bool i64 = !i32 && H5Tequal(type.get(), H5T_STD_I64LE) > 0;
+    const bool f64 = !i32 && !i64 && H5Tequal(type.get(), H5T_IEEE_F64LE) > 0;
+    if (f64) return read_bytes(dataset, samples, 8, reinterpret_cast<unsigned char*>(out));
+    if (!i32 && !i64) return false;
+    const std::size_t element = i32 ? 4 : 8;
+    values_.resize(samples * element);
+    if (!read_bytes(dataset, samples, element, values_.data())) return false;
+    const unsigned char* const from = values_.data();
+    if (i32) {
+      for (std::size_t i = 0; i < samples; ++i) {
+        std::int32_t v;
+        std::memcpy(&v, from + 4 * i, 4);
+        out[i] = static_cast<double>(v) / power;
+      }
+    } else {
+      for (std::size_t i = 0; i < samples; ++i) {
+        std::int64_t v;
+        std::memcpy(&v, from + 8 * i, 8);
+        out[i] = static_cast<double>(v) / power;
+      }
+    }
+    return true;
+  }
+
+  // `samples` elements of `element` bytes each, little-endian as stored, into `out`.
+  bool read_bytes(hid_t dataset, std::size_t samples, std::size_t element, unsigned char* out) {
+    if (inflater_ == nullptr || samples == 0 || std::endian::native != std::endian::little) return false;
+    hsize_t chunk_samples = 0;
+    if (!shuffled_deflate_chunks(dataset, chunk_samples)) return false;
+    const std::size_t chunk_bytes = static_cast<std::size_t>(chunk_samples) * element;
+    raw_.resize(chunk_bytes);
+    plain_.resize(chunk_bytes);
+    for (hsize_t first = 0; first < samples; first += chunk_samples) {
+      hsize_t stored = 0;
+      const hsize_t offset[1] = {first};
+      if (H5Dget_chunk_storage_size(dataset, offset, &stored) < 0 || stored == 0 ||
+          stored > 2 * chunk_bytes + 1024)
+        return false;
+      compressed_.resize(static_cast<std::size_t>(stored));
+      std::uint32_t skipped_filters = 0;
+      if (H5Dread_chunk(dataset, H5P_DEFAULT, offset, &skipped_filters, compressed_.data()) < 0 ||
+          skipped_filters != 0)
+        return false;
+      std::size_t inflated = 0;
+      if (libdeflate_zlib_decompress(inflater_, compressed_.data(), compressed_.size(), raw_.data(),
+                                     chunk_bytes, &inflated) != LIBDEFLATE_SUCCESS ||
+          inflated != chunk_bytes)
+        return false;
+      const std::size_t count =
+          std::min<std::size_t>(static_cast<std::size_t>(chunk_samples), samples - first);
+      if (element == 1) {
+        std::memcpy(out + first, raw_.data(), count);
+      } else {
+        unshuffle(raw_.data(), plain_.data(), element, static_cast<std::size_t>(chunk_samples));
+        std::memcpy(out + first * element, plain_.data(), count * element);
+      }
+    }
+    return true;
+  }
+
+ private:
+  // Chunked in one dimension, filters exactly shuffle then deflate.
+  static bool shuffled_deflate_chunks(hid_t dataset, hsize_t& chunk_samples) {
+    Handle create(H5Dget_create_plist(dataset), H5Pclose);
+    if (!create.ok() || H5Pget_layout(create.get()) != H5D_CHUNKED) return false;
+    hsize_t chunk[1] = {0};
+    if (H5Pget_chunk(create.get(), 1, chunk) != 1 || chunk[0] == 0 || chunk[0] > (hsize_t{1} << 24))
+      return false;
+    if (H5Pget_nfilters(create.get()) != 2) return false;
+    const H5Z_filter_t expected[2] = {H5Z_FILTER_SHUFFLE, H5Z_FILTER_DEFLATE};
+    for (unsigned i = 0; i < 2; ++i) {
+      unsigned flags = 0;
+      std::size_t values = 0;
+      unsigned int filter_info = 0;
+      if (H5Pget_filter2(create.get(), i, &flags, &values, nullptr, 0, nullptr, &filter_info) != expected[i])
+        return false;
+    }
+    chunk_samples = chunk[0];
+    return true;
+  }
+
+  // HDF5's shuffle (byte k of every element, then byte k + 1, ...) undone: each element's bytes gathered
+  // from the byte planes in turn, so that reads and writes both run forwards (a store a byte at a stride is
+  // several times slower).
+  template <std::size_t kElement>
+  static void unshuffle_fixed(const unsigned char* in, unsigned char* out, std::size_t count) {
+    for (std::size_t i = 0; i < count; ++i) {
+      for (std::size_t byte = 0; byte < kElement; ++byte) out[i * kElement + byte] = in[byte * count + i];
+    }
+  }
+  static void unshuffle(const unsigned char* in, unsigned char* out, std::size_t element, std::size_t count) {
+    if (element == 4) return unshuffle_fixed<4>(in, out, count);
+    if (element == 8) return unshuffle_fixed<8>(in, out, count);
+    for (std::size_t i = 0; i < count; ++i) {
+      for (std::size_t byte = 0; byte < element; ++byte) out[i * element + byte] = in[byte * count + i];
+    }
+  }
+
+  libdeflate_decompressor* inflater_;
+  std::vector<unsigned char> compressed_, raw_, plain_, values_;
+};
+
+class TraceFileReader {
+ public:
+  TraceFileReader(hid_t file, std::size_t samples, const std::string& source)
+      : file_(file), samples_(samples), source_(source) {}
+
+  // A dataset of `samples_` elements whose type is of `type_class`.
+  Handle open(const char* name, H5T_class_t type_class) const {
+    if (H5Lexists(file_, name, H5P_DEFAULT) <= 0) refuse(source_, std::string("no column '") + name + "'");
+    Handle dataset(H5Dopen2(file_, name, H5P_DEFAULT), H5Dclose);
+    if (!dataset.ok()) refuse(source_, std::string("column '") + name + "' is not a dataset");
+    Handle space(H5Dget_space(dataset.get()), H5Sclose);
+    hsize_t dims[1] = {0};
+    if (!space.ok() || H5Sget_simple_extent_ndims(space.get()) != 1 ||
+        H5Sget_simple_extent_dims(space.get(), dims, nullptr) != 1 || dims[0] != samples_) {
+      refuse(source_, std::string("column '") + name + "' does not hold " + std::to_string(samples_) +
+                          " samples (the file's 'samples')");
+    }
+    Handle type(H5Dget_type(dataset.get()), H5Tclose);
+    const H5T_class_t actual = type.ok() ? H5Tget_class(type.get()) : H5T_NO_CLASS;
+    if (actual != type_class && !(type_class == H5T_FLOAT && actual == H5T_INTEGER))
+      refuse(source_, std::string("column '") + name + "' has the wrong type");
+    return dataset;
+  }
+
+  void read(const Handle& dataset, const char* name, hid_t memory_type, void* out) const {
+    if (samples_ > 0 && H5Dread(dataset.get(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out) < 0)
+      refuse(source_, std::string("column '") + name + "' cannot be read (damaged or of another type)");
+  }
+
+  // A measured column: integers over 10^decimals, or doubles; every value finite when `finite`.
+  std::vector<double> measured(const char* name, bool finite) {
+    Handle dataset = open(name, H5T_FLOAT);
+    Handle type(H5Dget_type(dataset.get()), H5Tclose);
+    double power = 1.0;
+    if (H5Tget_class(type.get()) == H5T_INTEGER) {
+      const long long decimals =
+          read_integer_attribute(dataset.get(), "decimals", source_ + ": column '" + name + "'");
+      if (decimals < 0 || decimals > 15)
+        refuse(source_, std::string("column '") + name + "': decimals " + std::to_string(decimals) +
+                            " not in [0, 15]");
+      // The integer (exact in a double) over an exact power of ten, one correctly rounded division: the
+      // value the CSV's text of the same digits parses to.
+      power = std::pow(10.0, static_cast<double>(decimals));
+    }
+    std::vector<double> values(samples_);
+    if (!direct_.read_measured(dataset.get(), samples_, power, values.data())) {
+      read(dataset, name, H5T_NATIVE_DOUBLE, values.data());
+      if (power != 1.0) {
+        for (double& v : values) v /= power;
+      }
+    }
+    if (finite) {
+      for (std::size_t i = 0; i < values.size(); ++i) {
+        if (!std::isfinite(values[i]))
+          refuse(source_,
+                 std::string("column '") + name + "', sample " + std::to_string(i + 1) + ": not finite");
+      }
+    }
+    return values;
+  }
+
+  // A column of whole numbers; `stored`: the file type this library writes it as, read without conversion.
+  template <typename T>
+  std::vector<T> whole(const char* name, hid_t stored, hid_t memory_type) {
+    Handle dataset = open(name, H5T_INTEGER);
+    std::vector<T> values(samples_);
+    Handle type(H5Dget_type(dataset.get()), H5Tclose);
+    if (H5Tequal(type.get(), stored) <= 0 ||
+        !direct_.read_bytes(dataset.get(), samples_, sizeof(T),
+                            reinterpret_cast<unsigned char*>(values.data())))
+      read(dataset, name, memory_type, values.data());
+    return values;
+  }
+
+  std::vector<std::uint8_t> states() {
+    Handle dataset = open("state", H5T_ENUM);
+    Handle memory = state_type(H5T_NATIVE_UINT8);
+    std::vector<std::uint8_t> values(samples_);
+    Handle type(H5Dget_type(dataset.get()), H5Tclose);
+    Handle stored = state_type(H5T_STD_U8LE);
+    if (H5Tequal(type.get(), stored.get()) <= 0 ||
+        !direct_.read_bytes(dataset.get(), samples_, 1, values.data()))
+      read(dataset, "state", memory.get(), values.data());
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      if (values[i] > static_cast<std::uint8_t>(InteractionState::writing))
+        refuse(source_, "column 'state', sample " + std::to_string(i + 1) + ": not SS, AS, CS or WS");
+    }
+    return values;
+  }
+
+ private:
+  hid_t file_;
+  std::size_t samples_;
+  const std::string& source_;
+  DirectChunks direct_;
+};
+
+}  // namespace
+
+TraceColumns parse_trace_hdf5(std::string_view bytes, const std::string& source, TraceColumnSet columns) {
+  check_user_block(bytes, source);
+  silence_hdf5();
+  Handle access = memory_file_access();
+  // HDF5 copies the image (it may not keep a caller's buffer); a trace is a few hundred kilobytes.
+  if (H5Pset_file_image(access.get(), const_cast<char*>(bytes.data()), bytes.size()) < 0)
+    refuse(source, "HDF5 cannot take the file's image (out of memory?)");
+  Handle file(H5Fopen(image_name().c_str(), H5F_ACC_RDONLY, access.get()), H5Fclose);
+  if (!file.ok()) refuse(source, "HDF5 cannot open it (damaged)");
+  if (read_string_attribute(file.get(), "format", source) != "calligraphy-trace")
+    refuse(source, "its 'format' attribute is not 'calligraphy-trace'");
+  const long long version = read_integer_attribute(file.get(), "version", source);
+  if (version != kVersion)
+    refuse(source, "its 'version' attribute is " + std::to_string(version) + ", not 1");
+  const long long samples = read_integer_attribute(file.get(), "samples", source);
+  // A sample takes at least a byte a column stored: more than the file's bytes is a damaged count.
+  if (samples < 0 || static_cast<unsigned long long>(samples) > std::uint64_t{1} << 40)
+    refuse(source, "its 'samples' attribute " + std::to_string(samples) + " is out of range");
+  TraceFileReader in(file.get(), static_cast<std::size_t>(samples), source);
+  TraceColumns c;
+  c.time_s = in.measured("t", true);
+  c.x_m = in.measured("x", true);
+  c.y_m = in.measured("y", true);
+  c.z_m = in.measured("z", true);
+  c.fx_n = in.measured("fx", false);
+  c.fy_n = in.measured("fy", false);
+  if (columns == TraceColumnSet::pen) return c;
+  c.fz_n = in.measured("fz", false);
+  c.state = in.states();
+  c.stroke = in.whole<std::uint32_t>("stroke", H5T_STD_U32LE, H5T_NATIVE_UINT32);
+  c.element = in.whole<std::uint32_t>("element", H5T_STD_U32LE, H5T_NATIVE_UINT32);
+  c.attempt = in.whole<std::int32_t>("attempt", H5T_STD_I32LE, H5T_NATIVE_INT32);
+  c.rewritten = in.whole<std::uint8_t>("rewritten", H5T_STD_U8LE, H5T_NATIVE_UINT8);
+  for (std::size_t i = 0; i < c.rewritten.size(); ++i) {
+    if (c.rewritten[i] > 1)
+      refuse(source, "column 'rewritten', sample " + std::to_string(i + 1) + ": not 0 or 1");
+  }
+  return c;
+}
+
+TraceColumns read_trace_hdf5(const std::filesystem::path& file, std::uintmax_t max_file_bytes,
+                             TraceColumnSet columns) {
+  const std::string source = file.string();
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(file, error)) refuse(source, "no such file");
+  const std::uintmax_t size = std::filesystem::file_size(file, error);
+  if (error) refuse(source, "cannot be read (" + error.message() + ")");
+  if (size > max_file_bytes)
+    refuse(source, std::to_string(size) + " bytes, over the limit of " + std::to_string(max_file_bytes));
+  std::ifstream in(file, std::ios::binary);
+  std::string bytes(static_cast<std::size_t>(size), '\0');
+  if (!in || !in.read(bytes.data(), static_cast<std::streamsize>(bytes.size())))
+    refuse(source, "cannot be read");
+  return parse_trace_hdf5(bytes, source, columns);
+}
+
+std::vector<TrialSample> trial_samples(const TraceColumns& c) {
+  const std::size_t n = c.size();
+  for (const std::size_t size :
+       {c.x_m.size(), c.y_m.size(), c.z_m.size(), c.fx_n.size(), c.fy_n.size(), c.fz_n.size(), c.state.size(),
+        c.stroke.size(), c.element.size(), c.attempt.size(), c.rewritten.size()}) {
+    if (size != n) throw InvalidArgument("trial_samples: the columns differ in length (read them all)");
+  }
+  std::vector<TrialSample> trace(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    TrialSample& s = trace[i];
+    s.time_s = c.time_s[i];
+    s.position_m = Vec3(c.x_m[i], c.y_m[i], c.z_m[i]);
+    s.force_n = Vec3(c.fx_n[i], c.fy_n[i], c.fz_n[i]);
+    s.state = static_cast<InteractionState>(c.state[i]);
+    s.stroke = c.stroke[i];
+    s.element = c.element[i];
+    s.attempt = c.attempt[i];
+    s.rewritten = c.rewritten[i] != 0;
+  }
+  return trace;
+}
+
+}  // namespace calligraphy
