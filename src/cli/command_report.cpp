@@ -112,7 +112,8 @@ int run_report(const ReportCommand& command) {
     tables_line = line;
   };
   // The tables alone read the records only; with the pages they come from the pages' read of each record.
-  if (!command.csv.empty() && command.out.empty()) add_tables(read_study_tables(roots));
+  if (!command.csv.empty() && command.out.empty())
+    add_tables(read_study_tables(roots, static_cast<unsigned>(command.jobs)));
   std::string pages_line;
   if (!command.out.empty()) {
     const StudyReportSessions study = list_report_sessions(roots);
@@ -179,7 +180,7 @@ void add_report_command(CLI::App& root, Commands& commands) {
   add_output_folder(*app, "--csv", command->csv,
                     "an existing folder for the tidy tables trials.csv and strokes.csv (docs/experiments.md)",
                     "not written");
-  add_integer(*app, "--jobs", command->jobs, "N", "threads reading sessions for the pages", 1, 256,
+  add_integer(*app, "--jobs", command->jobs, "N", "threads reading sessions (one a core by default)", 1, 256,
               "every core");
 }
 

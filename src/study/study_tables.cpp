@@ -1,11 +1,17 @@
 #include "calligraphy/study/study_tables.hpp"
 
+#include <algorithm>
+#include <atomic>
 #include <cstdio>
+#include <exception>
+#include <iterator>
+#include <mutex>
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/study/session_reader.hpp"
 #include "calligraphy/core/unicode.hpp"
+#include "calligraphy/study/session_reader.hpp"
 #include "study/json_reader.hpp"
 #include "study/names.hpp"
 #include "study/trial_row.hpp"
@@ -175,9 +181,46 @@ void line(std::string& out, const Fields&... fields) {
 
 }  // namespace
 
-StudyTables read_study_tables(const std::vector<fs::path>& roots) {
-  StudyTables tables;  // the folders read by the one reader of sessions, its records only
-  for (const ReportedSession& session : list_report_sessions(roots).sessions) read_session_rows(session, tables);
+StudyTables read_study_tables(const std::vector<fs::path>& roots, unsigned threads) {
+  // The folders read by the one reader of sessions, its records only: sessions in turn on `threads` threads,
+  // each into its own rows, joined in the sessions' order.
+  const std::vector<ReportedSession> sessions = list_report_sessions(roots).sessions;
+  std::vector<StudyTables> rows(sessions.size());
+  std::atomic<std::size_t> next{0};
+  std::atomic<bool> failed{false};
+  std::mutex failure_mutex;
+  std::exception_ptr failure;
+  std::size_t failed_session = 0;
+  const auto work = [&] {
+    for (std::size_t i = next++; i < sessions.size() && !failed; i = next++) {
+      try {
+        read_session_rows(sessions[i], rows[i]);
+      } catch (...) {
+        const std::lock_guard lock(failure_mutex);
+        // The first session in order that failed, as reading them in turn would name it: sessions are taken
+        // in order and each one taken is read to its end, so every earlier one is read.
+        if (!failure || i < failed_session) {
+          failure = std::current_exception();
+          failed_session = i;
+        }
+        failed = true;
+      }
+    }
+  };
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const std::size_t count =
+      std::min<std::size_t>(threads > 0 ? threads : cores, std::max<std::size_t>(1, sessions.size()));
+  std::vector<std::thread> pool;
+  for (std::size_t t = 1; t < count; ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& thread : pool) thread.join();
+  if (failure) std::rethrow_exception(failure);
+  StudyTables tables;
+  for (StudyTables& session : rows) {
+    std::move(session.trials.begin(), session.trials.end(), std::back_inserter(tables.trials));
+    std::move(session.strokes.begin(), session.strokes.end(), std::back_inserter(tables.strokes));
+    session = StudyTables{};
+  }
   return tables;
 }
 

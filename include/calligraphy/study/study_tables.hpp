@@ -111,9 +111,11 @@ struct StudyTables {
 };
 
 /// The tables of every saved trial in the session folders under `roots` (each a session folder or a folder
-/// holding some). Reads session.json and each trial's JSON record, never the traces. Throws DataError naming
-/// the file (and JSON pointer) for a root without a session folder, a damaged manifest or record.
-[[nodiscard]] StudyTables read_study_tables(const std::vector<std::filesystem::path>& roots);
+/// holding some). Reads session.json and each trial's JSON record, never the traces, sessions on `threads`
+/// threads at once (0: one a core); the rows are in the same order whatever the threads. Throws DataError
+/// naming the file (and JSON pointer) for a root without a session folder, a damaged manifest or record.
+[[nodiscard]] StudyTables read_study_tables(const std::vector<std::filesystem::path>& roots,
+                                            unsigned threads = 0);
 
 /// The trials table as CSV (RFC 4180): a header of the column names, one line per row; absent values empty.
 [[nodiscard]] std::string trials_csv(const StudyTables& tables);
