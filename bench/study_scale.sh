@@ -47,7 +47,7 @@ EOF
 fi
 
 files=$(find "$work/study" -type f | wc -l)
-traces=$(find "$work/study" -name '*.csv.gz' -printf '%s\n' | awk '{s += $1} END {print s + 0}')
+traces=$(find "$work/study" -name '*.trace.h5' -printf '%s\n' | awk '{s += $1} END {print s + 0}')
 records=$(find "$work/study" -path '*/trials/*.json' -printf '%s\n' | awk '{s += $1} END {print s + 0}')
 figures=$(find "$work/study" -name '*.svg' -printf '%s\n' | awk '{s += $1} END {print s + 0}')
 printf 'on disk: %s bytes in blocks (du), %s bytes of files (%d files: traces %s, records %s, SVGs %s)\n' \

@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -140,6 +141,52 @@ void trace_read_hdf5_columns(benchmark::State& state) {
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * kRows));
 }
 
+// Every trace file under the folder CALLIGRAPHY_BENCH_STUDY (a study made by bench/study_scale.sh: real
+// simulated writing, with its motor noise; HDF5, or the gzip CSV of a study made before), read as the report
+// reads them; skipped when it is not set.
+void trace_read_study_files(benchmark::State& state) {
+  const char* folder = std::getenv("CALLIGRAPHY_BENCH_STUDY");
+  if (folder == nullptr) {
+    state.SkipWithError(
+        "set CALLIGRAPHY_BENCH_STUDY to a study folder (bench/study_scale.sh) to time its traces");
+    return;
+  }
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(folder)) {
+    const std::string name = entry.path().string();
+    // a study's traces, HDF5 or, in a folder of before, gzip CSV (not its tables)
+    if (name.ends_with(".trace.h5") ||
+        (name.ends_with(".csv.gz") && name.find("/trials/") != std::string::npos))
+      files.push_back(entry.path());
+  }
+  PenTraceCsvOptions options = report_options();
+  options.paper_z_m = 0.0;  // pen contact is not what is timed
+  std::vector<double> time_s, force_n;
+  std::vector<Vec2> position_m;
+  std::vector<bool> pen_down;
+  std::size_t samples = 0;
+  for (auto _ : state) {
+    for (const std::filesystem::path& file : files) {
+      time_s.clear();
+      force_n.clear();
+      position_m.clear();
+      pen_down.clear();
+      for_each_pen_trace_row(file, Placement{}, options, [&](const PenTraceRow& row) {
+        time_s.push_back(row.sample.time_s);
+        position_m.push_back(row.sample.position_m);
+        pen_down.push_back(row.sample.pen_down);
+        force_n.push_back(row.in_plane_force_n);
+      });
+      samples += time_s.size();
+    }
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(samples));
+  state.counters["files"] = static_cast<double>(files.size());
+  state.counters["samples_per_file"] =
+      files.empty() ? 0.0
+                    : static_cast<double>(samples) / static_cast<double>(state.iterations() * files.size());
+}
+
 }  // namespace
 
 BENCHMARK(trace_parse_memory)->Unit(benchmark::kMillisecond);
@@ -148,5 +195,6 @@ BENCHMARK(trace_read_gzip_file)->Unit(benchmark::kMillisecond);
 BENCHMARK(trace_read_hdf5_file)->Unit(benchmark::kMillisecond);
 BENCHMARK(trace_read_hdf5_trial_file)->Unit(benchmark::kMillisecond);
 BENCHMARK(trace_read_hdf5_columns)->Unit(benchmark::kMillisecond);
+BENCHMARK(trace_read_study_files)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

@@ -16,9 +16,9 @@
 ///   stroke, element   uint32, 0-based     attempt int32 (1-based, 0 outside any)     rewritten uint8 0/1
 /// Chunks of at most 65,536 samples, byte shuffle then deflate (RFC 1950/1951; HDF5's built-in filters, so
 /// any HDF5 reader decodes them). The file's first 512 bytes are an HDF5 user block that readers skip; it
-/// holds "calligraphy-trace" and the CRC-32 (ISO 3309, through zlib) and length of the rest, which this
-/// library checks before HDF5 parses anything: a damaged or truncated file is refused by name, never handed
-/// to HDF5.
+/// holds "calligraphy-trace" and the CRC-32 (ISO 3309, as zlib and gzip compute it) and length of the rest,
+/// which this library checks before HDF5 parses anything: a damaged or truncated file is refused by name,
+/// never handed to HDF5.
 #include <cstdint>
 #include <filesystem>
 #include <string>
