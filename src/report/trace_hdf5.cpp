@@ -179,6 +179,11 @@ std::string user_block(int version, std::size_t length, unsigned long crc) {
 }  // namespace
 
 std::string trial_trace_hdf5(const std::vector<TrialSample>& trace) {
+  if (trace.size() > kMaxTraceSamples) {
+    throw InvalidArgument("trial_trace_hdf5: " + std::to_string(trace.size()) +
+                          " samples, more than a trace file holds (" + std::to_string(kMaxTraceSamples) +
+                          ")");
+  }
   silence_hdf5();
   Handle access = memory_file_access(std::size_t{1} << 20);
   Handle create(H5Pcreate(H5P_FILE_CREATE), H5Pclose);
@@ -282,32 +287,17 @@ void check_user_block(std::string_view bytes, const std::string& source) {
   if (crc32_of(rest) != crc) refuse(source, "damaged (its CRC-32 does not match its contents)");
 }
 
-std::string read_string_attribute(hid_t object, const char* name, const std::string& source) {
-  Handle attribute(H5Aopen(object, name, H5P_DEFAULT), H5Aclose);
-  if (!attribute.ok()) refuse(source, std::string("no attribute '") + name + "'");
-  Handle type(H5Aget_type(attribute.get()), H5Tclose);
-  if (!type.ok() || H5Tget_class(type.get()) != H5T_STRING || H5Tis_variable_str(type.get()) != 0)
-    refuse(source, std::string("attribute '") + name + "' is not a fixed-length string");
-  const std::size_t size = H5Tget_size(type.get());
-  if (size == 0 || size > 4096) refuse(source, std::string("attribute '") + name + "' has a bad length");
-  std::string value(size, '\0');
-  if (H5Aread(attribute.get(), type.get(), value.data()) < 0)
-    refuse(source, std::string("attribute '") + name + "' cannot be read");
-  value.resize(strnlen(value.c_str(), value.size()));
-  return value;
-}
-
-long long read_integer_attribute(hid_t object, const char* name, const std::string& source) {
-  Handle attribute(H5Aopen(object, name, H5P_DEFAULT), H5Aclose);
-  if (!attribute.ok()) refuse(source, std::string("no attribute '") + name + "'");
-  Handle type(H5Aget_type(attribute.get()), H5Tclose);
-  Handle space(H5Aget_space(attribute.get()), H5Sclose);
-  if (!type.ok() || H5Tget_class(type.get()) != H5T_INTEGER || H5Sget_simple_extent_npoints(space.get()) != 1)
-    refuse(source, std::string("attribute '") + name + "' is not one integer");
-  long long value = 0;
-  if (H5Aread(attribute.get(), H5T_NATIVE_LLONG, &value) < 0)
-    refuse(source, std::string("attribute '") + name + "' cannot be read");
-  return value;
+// The length of the one-dimensional dataset `name`, at most 2^40 (a damaged size is refused, never
+// allocated).
+std::size_t dataset_length(hid_t file, const char* name, const std::string& source) {
+  Handle dataset(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose);
+  if (!dataset.ok()) refuse(source, std::string("no column '") + name + "'");
+  Handle space(H5Dget_space(dataset.get()), H5Sclose);
+  hsize_t dims[1] = {0};
+  if (!space.ok() || H5Sget_simple_extent_ndims(space.get()) != 1 ||
+      H5Sget_simple_extent_dims(space.get(), dims, nullptr) != 1 || dims[0] > (hsize_t{1} << 40))
+    refuse(source, std::string("column '") + name + "' is not one-dimensional or has a bad length");
+  return static_cast<std::size_t>(dims[0]);
 }
 
 // A dataset's chunks read raw (H5Dread_chunk) and decoded here: inflated by libdeflate (the same zlib
@@ -446,7 +436,7 @@ class TraceFileReader {
     if (!space.ok() || H5Sget_simple_extent_ndims(space.get()) != 1 ||
         H5Sget_simple_extent_dims(space.get(), dims, nullptr) != 1 || dims[0] != samples_) {
       refuse(source_, std::string("column '") + name + "' does not hold " + std::to_string(samples_) +
-                          " samples (the file's 'samples')");
+                          " samples (as the time column does)");
     }
     Handle type(H5Dget_type(dataset.get()), H5Tclose);
     const bool known = type.ok() && std::any_of(types.begin(), types.end(),
@@ -461,22 +451,16 @@ class TraceFileReader {
   }
 
   // A measured column: integers over 10^decimals, or doubles; every value finite when `finite`.
-  std::vector<double> measured(const char* name, bool finite) {
+  // A measured column: integers over 10^`decimals` (the version's, which the column's attribute repeats for
+  // other readers), or doubles; every value finite when `finite`.
+  std::vector<double> measured(const char* name, int decimals, bool finite) {
     Handle dataset = open(name, {H5T_STD_I32LE, H5T_STD_I64LE, H5T_IEEE_F64LE});
     Handle type(H5Dget_type(dataset.get()), H5Tclose);
-    double power = 1.0;
-    if (H5Tget_class(type.get()) == H5T_INTEGER) {
-      const long long decimals =
-          read_integer_attribute(dataset.get(), "decimals", source_ + ": column '" + name + "'");
-      if (decimals < 0 || decimals > 15)
-        refuse(source_, std::string("column '") + name + "': decimals " + std::to_string(decimals) +
-                            " not in [0, 15]");
-      // The integer (exact in a double) over an exact power of ten, one correctly rounded division: the
-      // value the CSV's text of the same digits parses to.
-      static constexpr double kPowers[] = {1e0, 1e1, 1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
-                                           1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15};  // each exact
-      power = kPowers[decimals];
-    }
+    // The integer (exact in a double) over an exact power of ten, one correctly rounded division: the value
+    // the CSV's text of the same digits parses to.
+    static constexpr double kPowers[] = {1e0, 1e1, 1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                         1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15};  // each exact
+    const double power = H5Tget_class(type.get()) == H5T_INTEGER ? kPowers[decimals] : 1.0;
     std::vector<double> values(samples_);
     if (!direct_.read_measured(dataset.get(), samples_, power, values.data())) {
       read(dataset, name, H5T_NATIVE_DOUBLE, values.data());
@@ -544,25 +528,29 @@ TraceColumns parse_trace_hdf5(std::string_view bytes, const std::string& source,
     refuse(source, "HDF5 cannot take the file's image (out of memory?)");
   Handle file(H5Fopen(image_name().c_str(), H5F_ACC_RDONLY, access.get()), H5Fclose);
   if (!file.ok()) refuse(source, "HDF5 cannot open it (damaged)");
-  if (read_string_attribute(file.get(), "format", source) != "calligraphy-trace")
-    refuse(source, "its 'format' attribute is not 'calligraphy-trace'");
-  const long long version = read_integer_attribute(file.get(), "version", source);
-  if (version != kVersion)
-    refuse(source, "its 'version' attribute is " + std::to_string(version) + ", not 1");
-  const long long samples = read_integer_attribute(file.get(), "samples", source);
-  // A sample takes at least a byte a column stored: more than the file's bytes is a damaged count.
-  if (samples < 0 || static_cast<unsigned long long>(samples) > std::uint64_t{1} << 40)
-    refuse(source, "its 'samples' attribute " + std::to_string(samples) + " is out of range");
-  TraceFileReader in(file.get(), static_cast<std::size_t>(samples), source);
+  // What the file is, its version and so its layout, are in the header checked above. HDF5's attributes (the
+  // root's format, version and samples, a column's unit and decimals) say the same to other readers and are
+  // never read here: decoding an attribute message is where HDF5 1.10 crashes on a damaged header, and a
+  // file that reads must not depend on them. The samples are the time column's length.
+  const std::size_t samples = dataset_length(file.get(), "t", source);
+  // Bounded before any column is allocated: by what the file's bytes could hold (deflate inflates at most
+  // 1032-fold, a sample takes at least 4 bytes of the time column) and by kMaxTraceSamples.
+  if (samples > kMaxTraceSamples || samples / 1032 > bytes.size() / 4) {
+    refuse(source,
+           std::to_string(samples) + " samples, more than " +
+               (samples > kMaxTraceSamples ? "a trace file holds (" + std::to_string(kMaxTraceSamples) + ")"
+                                           : "its " + std::to_string(bytes.size()) + " bytes can hold"));
+  }
+  TraceFileReader in(file.get(), samples, source);
   TraceColumns c;
-  c.time_s = in.measured("t", true);
-  c.x_m = in.measured("x", true);
-  c.y_m = in.measured("y", true);
-  c.z_m = in.measured("z", true);
-  c.fx_n = in.measured("fx", false);
-  c.fy_n = in.measured("fy", false);
+  c.time_s = in.measured("t", kTraceTimeDecimals, true);
+  c.x_m = in.measured("x", kTracePositionDecimals, true);
+  c.y_m = in.measured("y", kTracePositionDecimals, true);
+  c.z_m = in.measured("z", kTracePositionDecimals, true);
+  c.fx_n = in.measured("fx", kTraceForceDecimals, false);
+  c.fy_n = in.measured("fy", kTraceForceDecimals, false);
   if (columns == TraceColumnSet::pen) return c;
-  c.fz_n = in.measured("fz", false);
+  c.fz_n = in.measured("fz", kTraceForceDecimals, false);
   c.state = in.states();
   c.stroke = in.whole<std::uint32_t>("stroke", H5T_STD_U32LE, H5T_NATIVE_UINT32);
   c.element = in.whole<std::uint32_t>("element", H5T_STD_U32LE, H5T_NATIVE_UINT32);

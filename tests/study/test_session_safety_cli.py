@@ -249,6 +249,8 @@ class SessionSafetyTest(unittest.TestCase):
 
     # 4. session.json: one cap for its writer and its readers.
 
+    @unittest.skipIf(os.environ.get("CALLIGRAPHY_SANITIZED"),
+                     "a 25 MB manifest built and read takes minutes under the sanitizers; the Release run reads it")
     def test_a_manifest_the_run_writes_is_read_by_resume(self):
         # 100,000 planned trials: a session.json of about 25 MB, over the 16 MiB resume once took.
         self.write_protocol(many_trials("big", ["十", "人", "口", "大", "山"], 20, 1000))

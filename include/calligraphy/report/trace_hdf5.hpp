@@ -18,7 +18,9 @@
 /// any HDF5 reader decodes them). The file's first 512 bytes are an HDF5 user block that readers skip; it
 /// holds "calligraphy-trace" and the CRC-32 (ISO 3309, as zlib and gzip compute it) and length of the rest,
 /// which this library checks before HDF5 parses anything: a damaged or truncated file is refused by name,
-/// never handed to HDF5.
+/// never handed to HDF5. The header's version fixes the layout and the decimals, so this library reads no
+/// HDF5 attribute (they are for other readers) and only the exact column types above. A file whose CRC-32
+/// was made to match a changed HDF5 structure reaches HDF5's parser, which (1.10.8) may still crash on it.
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -28,6 +30,10 @@
 #include "calligraphy/trial/recorder.hpp"
 
 namespace calligraphy {
+
+/// The most samples a trace file is read with: 2^24, over 4.6 hours at 1 kHz (a protocol's trial holds at
+/// most 10^7 ticks, kMaxTrialTicks), so that a damaged length never asks for gigabytes.
+inline constexpr std::size_t kMaxTraceSamples = std::size_t{1} << 24;
 
 /// A trace's columns as stored, each of length N (`size()`), in SI units.
 struct TraceColumns {
@@ -49,8 +55,8 @@ enum class TraceColumnSet {
 
 /// The bytes of `trace`'s HDF5 file (see above), the same bytes for the same trace. Values are rounded to
 /// the CSV's decimals (kTraceTimeDecimals, kTracePositionDecimals, kTraceForceDecimals, trial_report.hpp).
-/// Throws InvalidArgument when a stroke or element index exceeds 2^32 - 1, DataError when HDF5 fails (out of
-/// memory).
+/// Throws InvalidArgument for more than kMaxTraceSamples samples or a stroke or element index beyond 2^32 -
+/// 1, DataError when HDF5 fails (out of memory).
 [[nodiscard]] std::string trial_trace_hdf5(const std::vector<TrialSample>& trace);
 
 /// True when `first_bytes` (at least the first 32 bytes of a file) start as a calligraphy trace file.
@@ -58,7 +64,8 @@ enum class TraceColumnSet {
 
 /// Reads every column of a trace file. Refuses, with DataError naming `file`: a missing file, one over
 /// `max_file_bytes`, one that is not a calligraphy trace, a damaged or cut file (its CRC-32 or length), a
-/// newer version, a missing or mistyped column, columns of different lengths, a non-finite time or
+/// newer version, more than kMaxTraceSamples samples (or more than its bytes could hold), a missing or
+/// mistyped column, columns of different lengths, a non-finite time or
 /// position, a state beyond WS, a `rewritten` beyond 1.
 [[nodiscard]] TraceColumns read_trace_hdf5(const std::filesystem::path& file,
                                            std::uintmax_t max_file_bytes = std::uintmax_t{256} << 20,
