@@ -3,7 +3,7 @@
 
 Runs one simulated subject through a protocol of TRIALS trials for real (`calligraphy session run`), then
 copies that session folder for SUBJECTS - 1 more subjects (subject ids and per-subject metrics changed in the
-copies; the traces hard-linked: neither the tables nor the report read them), and times, each in a fresh
+copies; the traces hard-linked: neither the tables nor the Python page read them), and times, each in a fresh
 process, `calligraphy.study.load` and `calligraphy.study_report.write_report` over the whole study. Prints the
 wall time and the peak resident memory of each step (getrusage of the child).
 

@@ -1,6 +1,6 @@
 #pragma once
 // Text files stored gzip-compressed (RFC 1952, through zlib) or plain, read a block at a time: the pen
-// traces of saved trials (`NNN-....csv.gz`; older folders hold plain `.csv`). Internal.
+// traces of trials saved before traces were HDF5 (`NNN-....csv.gz`, or plain `.csv` earlier still). Internal.
 #include <cstdint>
 #include <filesystem>
 #include <functional>
