@@ -104,26 +104,34 @@ void trace_parse_memory(benchmark::State& state) {
   state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * text.size()));
 }
 
-// A file streamed row by row into the columns the per-trial pages keep, as the report does.
-void read_file(benchmark::State& state, Format format) {
-  const std::filesystem::path& file = trace_file(format);
-  const std::size_t rows = format == Format::hdf5_trial ? kTrialRows : kRows;
-  const PenTraceCsvOptions options = report_options();
+// The columns a per-trial page keeps of a trace (study/session_reader.cpp), kept between reads.
+struct PageColumns {
   std::vector<double> time_s, force_n;
   std::vector<Vec2> position_m;
   std::vector<bool> pen_down;
-  for (auto _ : state) {
+  void read(const std::filesystem::path& file, const PenTraceCsvOptions& options) {
     time_s.clear();
     force_n.clear();
     position_m.clear();
     pen_down.clear();
-    for_each_pen_trace_row(file, Placement{}, options, [&](const PenTraceRow& row) {
+    for_each_pen_trace_row(file, Placement{}, options, [this](const PenTraceRow& row) {
       time_s.push_back(row.sample.time_s);
       position_m.push_back(row.sample.position_m);
       pen_down.push_back(row.sample.pen_down);
       force_n.push_back(row.in_plane_force_n);
     });
-    benchmark::DoNotOptimize(time_s.data());
+  }
+};
+
+// A file streamed row by row into the columns the per-trial pages keep, as the report does.
+void read_file(benchmark::State& state, Format format) {
+  const std::filesystem::path& file = trace_file(format);
+  const std::size_t rows = format == Format::hdf5_trial ? kTrialRows : kRows;
+  const PenTraceCsvOptions options = report_options();
+  PageColumns columns;
+  for (auto _ : state) {
+    columns.read(file, options);
+    benchmark::DoNotOptimize(columns.time_s.data());
   }
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * rows));
   state.counters["file_bytes"] = static_cast<double>(std::filesystem::file_size(file));
@@ -161,23 +169,12 @@ void trace_read_study_files(benchmark::State& state) {
   }
   PenTraceCsvOptions options = report_options();
   options.paper_z_m = 0.0;  // pen contact is not what is timed
-  std::vector<double> time_s, force_n;
-  std::vector<Vec2> position_m;
-  std::vector<bool> pen_down;
+  PageColumns columns;
   std::size_t samples = 0;
   for (auto _ : state) {
     for (const std::filesystem::path& file : files) {
-      time_s.clear();
-      force_n.clear();
-      position_m.clear();
-      pen_down.clear();
-      for_each_pen_trace_row(file, Placement{}, options, [&](const PenTraceRow& row) {
-        time_s.push_back(row.sample.time_s);
-        position_m.push_back(row.sample.position_m);
-        pen_down.push_back(row.sample.pen_down);
-        force_n.push_back(row.in_plane_force_n);
-      });
-      samples += time_s.size();
+      columns.read(file, options);
+      samples += columns.time_s.size();
     }
   }
   state.SetItemsProcessed(static_cast<std::int64_t>(samples));
