@@ -20,12 +20,8 @@ struct TraceCommand {
 int run_trace(const TraceCommand& command) {
   FilePlan files;
   files.output("--csv", command.csv);
-  const std::string csv = trial_csv(trial_samples(read_trace_hdf5(command.trace)));
-  if (command.csv == "-") {
-    write_standard_output(csv);
-  } else {
-    write_output(command.csv, csv);
-  }
+  write_output(command.csv,
+               trial_csv(trial_samples(read_trace_hdf5(command.trace))));  // "-": standard output
   return 0;
 }
 

@@ -312,12 +312,12 @@ class DirectChunks {
   DirectChunks(const DirectChunks&) = delete;
   DirectChunks& operator=(const DirectChunks&) = delete;
 
-  // `out` (`samples` values) as doubles: integers over `power` (1 for a float column).
-  bool read_measured(hid_t dataset, std::size_t samples, double power, double* out) {
-    Handle type(H5Dget_type(dataset), H5Tclose);
-    const bool i32 = H5Tequal(type.get(), H5T_STD_I32LE) > 0;
-    const bool i64 = !i32 && H5Tequal(type.get(), H5T_STD_I64LE) > 0;
-    const bool f64 = !i32 && !i64 && H5Tequal(type.get(), H5T_IEEE_F64LE) > 0;
+  // `out` (`samples` values) as doubles: integers over `power` (1 for a float column); `type` is the
+  // dataset's.
+  bool read_measured(hid_t dataset, hid_t type, std::size_t samples, double power, double* out) {
+    const bool i32 = H5Tequal(type, H5T_STD_I32LE) > 0;
+    const bool i64 = !i32 && H5Tequal(type, H5T_STD_I64LE) > 0;
+    const bool f64 = !i32 && !i64 && H5Tequal(type, H5T_IEEE_F64LE) > 0;
     if (f64) return read_bytes(dataset, samples, 8, reinterpret_cast<unsigned char*>(out));
     if (!i32 && !i64) return false;
     const std::size_t element = i32 ? 4 : 8;
@@ -462,7 +462,7 @@ class TraceFileReader {
                                          1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15};  // each exact
     const double power = H5Tget_class(type.get()) == H5T_INTEGER ? kPowers[decimals] : 1.0;
     std::vector<double> values(samples_);
-    if (!direct_.read_measured(dataset.get(), samples_, power, values.data())) {
+    if (!direct_.read_measured(dataset.get(), type.get(), samples_, power, values.data())) {
       read(dataset, name, H5T_NATIVE_DOUBLE, values.data());
       if (power != 1.0) {
         for (double& v : values) v /= power;
