@@ -33,10 +33,14 @@ void require_characters(const LoadedProtocol& loaded, const CharacterSource& sou
     }
   };
   const StudyProtocol& protocol = loaded.protocol;
+  // A phase's sets' items are named where the set lists them.
+  for (std::size_t i = 0; i < protocol.item_sets.size(); ++i) {
+    check(protocol.item_sets[i].items, "/item_sets/" + std::to_string(i) + "/characters");
+  }
   for (const ProtocolPhase& phase : protocol.phases) {
     if (phase.choice) {
       check(phase.choice->candidates, phase.pointer + "/characters/from");
-    } else {
+    } else if (phase.sets.empty()) {
       check(phase.items, phase.pointer + "/characters");
     }
   }

@@ -1,5 +1,7 @@
 #include "study/manifest_json.hpp"
 
+#include <algorithm>
+
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "study/json_reader.hpp"
@@ -14,6 +16,31 @@ constexpr const char* kFormat = "calligraphy-study-session";
 // Version 2 counts a planned trial's block and item from 1, as its index and repetition; version 1 (older
 // folders) counted them from 0.
 constexpr std::int64_t kVersion = 2;
+
+// A label (as item set and condition names) or nothing: plans made before item sets lack these keys.
+std::string optional_label(ObjectReader& reader, const std::string& key) {
+  std::string text = reader.string_or(key, "");
+  if (reader.has(key) && !is_label(text, 32)) {
+    fail(reader.source(), reader.pointer(key),
+         "expected 1 to 32 letters, digits, '_' or '-', got " + describe(json(text)));
+  }
+  return text;
+}
+
+// The item set and crossover of a planned trial, each written only when it has a value (plan_session).
+void read_crossover_keys(ObjectReader& reader, PlannedTrial& trial) {
+  trial.item_set = optional_label(reader, "item_set");
+  trial.sequence = reader.string_or("sequence", "");
+  const bool letters =
+      std::all_of(trial.sequence.begin(), trial.sequence.end(), [](char c) { return c >= 'A' && c <= 'Z'; });
+  if (reader.has("sequence") && (trial.sequence.empty() || trial.sequence.size() > 26 || !letters)) {
+    fail(reader.source(), reader.pointer("sequence"),
+         "expected 1 to 26 letters A-Z (the crossover's conditions in period order), got " +
+             describe(json(trial.sequence)));
+  }
+  trial.period = static_cast<int>(reader.integer_or("period", 0, 1, 26));
+  trial.trained_condition = optional_label(reader, "trained_condition");
+}
 
 PlannedTrial planned_trial_from(const json& value, const std::string& pointer, const std::string& source,
                                 std::size_t expected_index, std::int64_t version) {
@@ -37,6 +64,7 @@ PlannedTrial planned_trial_from(const json& value, const std::string& pointer, c
   trial.item = static_cast<std::size_t>(reader.integer("item", first, 1000000) - first);
   trial.repetition = static_cast<int>(reader.integer("repetition", 1, 1000000));
   trial.break_before_s = reader.number_or("break_before_s", 0.0, 0.0, 86400.0);
+  read_crossover_keys(reader, trial);
   reader.optional("file");
   reader.finish();
   return trial;
@@ -54,15 +82,21 @@ json library_build_json(const LibraryBuild& build) {
 json planned_trial_json(const PlannedTrial& trial) {
   std::string characters;
   for (const char32_t c : trial.characters) characters += encode_utf8(c);
-  return {{"index", trial.index + 1},
-          {"phase", to_string(trial.phase)},
-          {"block", trial.block + 1},
-          {"condition", trial.condition},
-          {"characters", characters},
-          {"item", trial.item + 1},
-          {"repetition", trial.repetition},
-          {"break_before_s", trial.break_before_s},
-          {"file", SessionFolder::trial_stem(trial)}};
+  json out = {{"index", trial.index + 1},
+              {"phase", to_string(trial.phase)},
+              {"block", trial.block + 1},
+              {"condition", trial.condition},
+              {"characters", characters},
+              {"item", trial.item + 1},
+              {"repetition", trial.repetition},
+              {"break_before_s", trial.break_before_s},
+              {"file", SessionFolder::trial_stem(trial)}};
+  // Only with a value: a protocol without item sets writes the plan it wrote before them, byte for byte.
+  if (!trial.item_set.empty()) out["item_set"] = trial.item_set;
+  if (!trial.sequence.empty()) out["sequence"] = trial.sequence;
+  if (trial.period != 0) out["period"] = trial.period;
+  if (!trial.trained_condition.empty()) out["trained_condition"] = trial.trained_condition;
+  return out;
 }
 
 std::string manifest_to_json(const SessionManifest& manifest) {
@@ -172,12 +206,18 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
   if (!plan.is_array() || plan.empty()) fail(source, "/plan", "expected a list of planned trials");
   for (std::size_t i = 0; i < plan.size(); ++i) {
     PlannedTrial trial = planned_trial_from(plan[i], child_pointer("/plan", i), source, i, version);
-    // Only conditions of the protocol can run.
-    bool known = false;
-    for (const StudyCondition& c : manifest.protocol.protocol.conditions)
-      known = known || c.name == trial.condition;
-    if (!known)
+    // Only conditions of the protocol can run, or have trained an item.
+    const auto known = [&](const std::string& condition) {
+      const std::vector<StudyCondition>& conditions = manifest.protocol.protocol.conditions;
+      return std::any_of(conditions.begin(), conditions.end(),
+                         [&](const StudyCondition& c) { return c.name == condition; });
+    };
+    if (!known(trial.condition))
       fail(source, child_pointer(child_pointer("/plan", i), "condition"), "not a condition of the protocol");
+    if (!trial.trained_condition.empty() && !known(trial.trained_condition)) {
+      fail(source, child_pointer(child_pointer("/plan", i), "trained_condition"),
+           "not a condition of the protocol");
+    }
     manifest.plan.push_back(std::move(trial));
   }
   root.finish();

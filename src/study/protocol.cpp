@@ -374,7 +374,15 @@ const char* to_string(StudyPhase phase) noexcept {
 }
 
 const char* to_string(ConditionAssignment assignment) noexcept {
-  return assignment == ConditionAssignment::between_subjects ? "between-subjects" : "within-subjects";
+  switch (assignment) {
+    case ConditionAssignment::within_subjects:
+      return "within-subjects";
+    case ConditionAssignment::between_subjects:
+      return "between-subjects";
+    case ConditionAssignment::crossover:
+      return "crossover";
+  }
+  return "unknown";
 }
 
 const char* to_string(ConditionMode mode) noexcept {
@@ -475,6 +483,10 @@ StudyProtocol parse_study_protocol(std::string_view json_text, const std::string
   }
 
   read_order(root, protocol);
+  // Before the phases, which name the sets.
+  if (const json* sets = root.optional("item_sets")) {
+    study_detail::read_item_sets(*sets, "/item_sets", source, protocol);
+  }
   const bool paper_format = root.has("test") || root.has("practice");
   if (paper_format && root.has("phases")) {
     fail(source, "/phases",
@@ -504,8 +516,9 @@ std::uint64_t planned_trial_count(const StudyProtocol& protocol) noexcept {
   // overflow.
   std::map<int, std::uint64_t> per_session;
   for (const ProtocolPhase& phase : protocol.phases) {
+    // Between subjects a subject writes one condition; in a crossover each set is written in one.
     const std::uint64_t conditions =
-        phase.assignment == ConditionAssignment::between_subjects ? 1 : phase.conditions.size();
+        phase.assignment == ConditionAssignment::within_subjects ? phase.conditions.size() : std::uint64_t{1};
     per_session[phase.session] += static_cast<std::uint64_t>(phase.item_count()) * conditions *
                                   static_cast<std::uint64_t>(std::max(phase.repetitions, 0));
   }

@@ -72,6 +72,52 @@ void read_characters(ObjectReader& reader, ProtocolPhase& phase) {
   phase.choice = std::move(chosen);
 }
 
+// "characters" or "sets" (names of the protocol's item sets), exactly one of them.
+void read_phase_items(ObjectReader& reader, const StudyProtocol& protocol, ProtocolPhase& phase) {
+  if (reader.has("characters") == reader.has("sets")) {
+    fail(reader.source(), reader.pointer("characters"),
+         "give either \"characters\" or \"sets\" (names of the protocol's \"item_sets\")");
+  }
+  if (reader.has("characters")) {
+    read_characters(reader, phase);
+  } else {
+    read_phase_sets(reader.required("sets"), reader.pointer("sets"), reader.source(), protocol, phase);
+  }
+}
+
+// A crossover phase trains each of its conditions on another of its sets: one set per condition, each a set
+// that is trained (not a transfer set), once in a protocol, so that an item has one training condition.
+void check_crossover(const ObjectReader& reader, const StudyProtocol& protocol, const ProtocolPhase& phase) {
+  const std::string& source = reader.source();
+  const std::string at = reader.pointer("assignment");
+  if (phase.kind == StudyPhase::practice) {
+    fail(source, at, "a practice phase is written as listed: crossover is for the phases compared");
+  }
+  if (phase.conditions.size() < 2) fail(source, at, "crossover needs two or more \"conditions\"");
+  if (phase.sets.empty()) {
+    fail(source, at, "crossover needs \"sets\": one item set per condition, each trained under one of them");
+  }
+  if (phase.sets.size() != phase.conditions.size()) {
+    fail(source, reader.pointer("sets"),
+         "crossover trains each of the " + std::to_string(phase.conditions.size()) +
+             " conditions on its own set: expected " + std::to_string(phase.conditions.size()) +
+             " sets, got " + std::to_string(phase.sets.size()));
+  }
+  for (std::size_t i = 0; i < phase.sets.size(); ++i) {
+    const ItemSet* set = protocol.item_set(phase.sets[i]);
+    if (set != nullptr && !set->transfer_of.empty()) {
+      fail(source, child_pointer(reader.pointer("sets"), i),
+           "\"" + set->name + "\" is a transfer set (of \"" + set->transfer_of +
+               "\"): its items are tested, not trained");
+    }
+  }
+  if (const ProtocolPhase* first = protocol.crossover_phase()) {
+    fail(source, at,
+         "a second crossover phase (the first: " + first->pointer +
+             "): a protocol has at most one, so that each item set is trained under one condition");
+  }
+}
+
 ProtocolPhase read_phase(const json& value, const std::string& pointer, const std::string& source,
                          const StudyProtocol& protocol) {
   ObjectReader reader(value, pointer, source);
@@ -79,17 +125,20 @@ ProtocolPhase read_phase(const json& value, const std::string& pointer, const st
   phase.pointer = pointer;
   phase.kind = choice(reader, "phase", kStudyPhases);
   phase.conditions = read_conditions(reader, protocol.conditions);
-  constexpr std::array<ConditionAssignment, 2> kAssignments{ConditionAssignment::within_subjects,
-                                                            ConditionAssignment::between_subjects};
+  constexpr std::array<ConditionAssignment, 3> kAssignments{ConditionAssignment::within_subjects,
+                                                            ConditionAssignment::between_subjects,
+                                                            ConditionAssignment::crossover};
   phase.assignment = choice(reader, "assignment", kAssignments, ConditionAssignment::within_subjects);
   if (phase.assignment == ConditionAssignment::between_subjects && phase.conditions.size() < 2) {
     fail(source, reader.pointer("assignment"), "between-subjects needs two or more \"conditions\"");
   }
-  read_characters(reader, phase);
+  read_phase_items(reader, protocol, phase);
+  if (phase.assignment == ConditionAssignment::crossover) check_crossover(reader, protocol, phase);
   phase.repetitions = static_cast<int>(reader.integer_or("repetitions", 1, 1, kMaxRepetitions));
   phase.session = static_cast<int>(reader.integer_or("session", 1, 1, static_cast<std::int64_t>(kMaxPhases)));
   phase.delay_s = reader.number_or("delay_s", 0.0, 0.0, kMaxDelay_s);
   reader.finish();
+  // A crossover phase has its own order (crossover_assignment): `abba` does not split it.
   const bool ordered = phase.assignment == ConditionAssignment::within_subjects &&
                        protocol.condition_order == ConditionOrder::abba;
   if (ordered && phase.repetitions % 2 != 0) {
@@ -153,7 +202,7 @@ void check_design(const StudyProtocol& protocol, const std::string& pointer, con
         for (const char32_t c : phase.items[k]) {
           if (trained.find(c) != std::u32string::npos) continue;
           // Appended, not concatenated: GCC 12 warns falsely on "x" + string (-Wrestrict).
-          fail(source, child_pointer(at(i, "characters"), k),
+          fail(source, item_pointer(protocol, phase, k),
                quoted(encode_utf8(c)) + " is not trained: a test on it is a transfer test");
         }
       }
@@ -164,7 +213,7 @@ void check_design(const StudyProtocol& protocol, const std::string& pointer, con
         if (!shares_a_character(listed[k], trained)) continue;
         fail(source,
              phase.choice ? child_pointer(child_pointer(at(i, "characters"), "from"), k)
-                          : child_pointer(at(i, "characters"), k),
+                          : item_pointer(protocol, phase, k),
              quoted(encode_utf8(listed[k])) + " is trained: a transfer test is on characters not trained");
       }
     }

@@ -68,8 +68,22 @@ std::vector<std::u32string> read_items(const nlohmann::json& value, const std::s
 std::string condition_name(const nlohmann::json& value, const std::string& pointer, const std::string& source,
                            const std::vector<StudyCondition>& conditions);
 
+/// The "item_sets" list of a protocol (format: docs/experiments.md), into `protocol.item_sets`: names unique
+/// labels, no character in two sets, `transfer_of` naming another set that is no transfer set itself.
+void read_item_sets(const nlohmann::json& value, const std::string& pointer, const std::string& source,
+                    StudyProtocol& protocol);
+
+/// A phase's "sets" (`pointer`): names of `protocol.item_sets`, none twice, into `phase.sets`, with the sets'
+/// items concatenated in `phase.items` and each one's set in `phase.item_sets`.
+void read_phase_sets(const nlohmann::json& value, const std::string& pointer, const std::string& source,
+                     const StudyProtocol& protocol, ProtocolPhase& phase);
+
+/// The JSON pointer the protocol file gives item `index` of `phase` by: in the phase's "characters", or in
+/// its item set's "characters" ("/item_sets/1/characters/0") when the phase gives "sets".
+std::string item_pointer(const StudyProtocol& protocol, const ProtocolPhase& phase, std::size_t index);
+
 /// The "phases" list of a protocol (format: docs/experiments.md), checked for order and sense; appended
-/// to `protocol.phases`. `protocol.conditions` and the order must be read already.
+/// to `protocol.phases`. `protocol.conditions`, `protocol.item_sets` and the order must be read already.
 void read_phases(const nlohmann::json& value, const std::string& pointer, const std::string& source,
                  StudyProtocol& protocol);
 

@@ -49,6 +49,55 @@ std::uint64_t subject_seed(const StudyProtocol& protocol, const SubjectAssignmen
   return study_detail::mix64(protocol.seed ^ study_detail::fnv1a_64(subject.id));
 }
 
+// The indices in `phase.items` of the items of set `name`, in listed order.
+std::vector<std::size_t> items_of_set(const ProtocolPhase& phase, const std::string& name) {
+  std::vector<std::size_t> items;
+  for (std::size_t i = 0; i < phase.item_sets.size(); ++i) {
+    if (phase.item_sets[i] == name) items.push_back(i);
+  }
+  return items;
+}
+
+// The trial's item set and how the subject's crossover trains it, so that every phase's trial (a pre-test's
+// too) names the condition its item is or was trained under.
+void describe_crossover(PlannedTrial& trial, const ProtocolPhase& phase,
+                        const CrossoverAssignment& crossover) {
+  if (trial.item < phase.item_sets.size()) trial.item_set = phase.item_sets[trial.item];
+  trial.sequence = crossover.sequence;
+  const auto trained = crossover.trained.find(trial.item_set);
+  if (trial.item_set.empty() || trained == crossover.trained.end()) return;
+  trial.period = trained->second.period;
+  trial.trained_condition = trained->second.condition;
+}
+
+// One block of a phase: a condition, the items it writes (indices in the phase's list, listed order), rounds.
+struct BlockPlan {
+  std::string condition;
+  std::vector<std::size_t> items;
+  int rounds = 1;
+};
+
+// The phase's blocks for the subject: a crossover phase one a period, its condition on its set's items; any
+// other a block per condition of `block_conditions` on every item (ABBA: half the repetitions each).
+std::vector<BlockPlan> phase_blocks(const StudyProtocol& protocol, const ProtocolPhase& phase,
+                                    const SubjectAssignment& subject, const CrossoverAssignment& crossover) {
+  std::vector<BlockPlan> blocks;
+  if (phase.assignment == ConditionAssignment::crossover && phase.kind != StudyPhase::practice) {
+    for (std::size_t p = 0; p < crossover.conditions.size(); ++p) {
+      blocks.push_back({crossover.conditions[p], items_of_set(phase, crossover.sets[p]), phase.repetitions});
+    }
+    return blocks;
+  }
+  const bool split = phase.assignment == ConditionAssignment::within_subjects &&
+                     protocol.condition_order == ConditionOrder::abba && phase.kind != StudyPhase::practice;
+  std::vector<std::size_t> every(phase.items.size());
+  for (std::size_t i = 0; i < every.size(); ++i) every[i] = i;
+  for (const std::string& condition : block_conditions(protocol, phase, subject)) {
+    blocks.push_back({condition, every, split ? phase.repetitions / 2 : phase.repetitions});
+  }
+  return blocks;
+}
+
 void check_subject(const SubjectAssignment& subject) {
   if (!study_detail::is_label(subject.id, 64)) {
     throw InvalidArgument("subject id '" + subject.id + "': expected 1 to 64 letters, digits, '_' or '-'");
@@ -68,12 +117,57 @@ std::size_t trailing_number(std::string_view subject_id) noexcept {
   return number;
 }
 
+CrossoverAssignment crossover_assignment(const StudyProtocol& protocol, const SubjectAssignment& subject) {
+  check_subject(subject);
+  CrossoverAssignment out;
+  const ProtocolPhase* phase = protocol.crossover_phase();
+  if (phase == nullptr) return out;
+  if (subject.number == 0) {
+    throw InvalidArgument("subject '" + subject.id + "': the crossover " + to_string(phase->kind) +
+                          " phase counterbalances its sequence and sets by the subject's number (1, 2, ...)");
+  }
+  const std::vector<std::string>& listed = phase->conditions;
+  const std::size_t k = listed.size();
+  // The protocol's reader refuses this; a protocol made in code may not.
+  if (k == 0 || phase->sets.size() != k) {
+    throw InvalidArgument("protocol '" + protocol.name + "': the crossover phase " + phase->pointer +
+                          " needs one item set per condition");
+  }
+  // Rows of the balanced Latin square (Williams 1949) balance the order: each condition in each period, and
+  // after each other one, equally often. The rotation, advanced once per full set of rows, moves every
+  // condition over every set, so that condition and set are balanced every rows x k subjects.
+  const std::size_t rows = k % 2 == 0 ? k : 2 * k;
+  const std::size_t row = (subject.number - 1) % rows;
+  out.rotation = ((subject.number - 1) / rows) % k;
+  const std::vector<std::size_t> order = williams_row(k, row);
+  for (std::size_t p = 0; p < k; ++p) {
+    const std::size_t listed_index = order[p];
+    const std::string& set = phase->sets[(listed_index + out.rotation) % k];
+    out.sequence.push_back(static_cast<char>('A' + listed_index));
+    out.conditions.push_back(listed[listed_index]);
+    out.sets.push_back(set);
+    out.trained[set] = {listed[listed_index], static_cast<int>(p + 1)};
+  }
+  // A transfer set is attributed to the condition its source set is trained under.
+  for (const ItemSet& set : protocol.item_sets) {
+    const auto source = out.trained.find(set.transfer_of);
+    if (!set.transfer_of.empty() && source != out.trained.end()) out.trained[set.name] = source->second;
+  }
+  return out;
+}
+
 std::vector<std::string> block_conditions(const StudyProtocol& protocol, const ProtocolPhase& phase,
                                           const SubjectAssignment& subject) {
   check_subject(subject);
   const std::vector<std::string>& listed = phase.conditions;
   // Familiarisation is written as listed: the order counterbalances what is compared.
   if (phase.kind == StudyPhase::practice) return listed;
+  if (phase.assignment == ConditionAssignment::crossover) {
+    // The protocol's one crossover phase: its own counterbalanced order.
+    if (protocol.crossover_phase() == &phase) return crossover_assignment(protocol, subject).conditions;
+    throw InvalidArgument("protocol '" + protocol.name + "': the crossover phase " + phase.pointer +
+                          " is not the protocol's");
+  }
   const std::size_t n = listed.size();
   const bool between = phase.assignment == ConditionAssignment::between_subjects;
   const bool needs_number = protocol.condition_order == ConditionOrder::latin_square ||
@@ -142,16 +236,17 @@ std::vector<PlannedTrial> plan_session(const StudyProtocol& protocol, const Subj
                           std::to_string(protocol.session_count()) + ", not " + std::to_string(session));
   }
   check_subject(subject);
+  const CrossoverAssignment crossover = crossover_assignment(protocol, subject);
   std::vector<PlannedTrial> trials;
   std::map<std::string, int> written;  // phase/condition/item -> times planned so far
   std::size_t block = 0;
-  const auto add_block = [&](const ProtocolPhase& phase, const std::string& condition, int rounds,
-                             double rest_before_s) {
+  // `items`: the indices in the phase's list the block writes, in listed order.
+  const auto add_block = [&](const ProtocolPhase& phase, const std::string& condition,
+                             const std::vector<std::size_t>& items, int rounds, double rest_before_s) {
     const std::size_t first = trials.size();
     const bool shuffled = phase.kind != StudyPhase::practice && protocol.item_order == ItemOrder::random;
     for (int round = 0; round < rounds; ++round) {
-      std::vector<std::size_t> order(phase.items.size());
-      for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+      std::vector<std::size_t> order = items;
       if (shuffled) {
         shuffle(order, study_detail::mix64(
                            subject_seed(protocol, subject) ^
@@ -167,6 +262,7 @@ std::vector<PlannedTrial> plan_session(const StudyProtocol& protocol, const Subj
         trial.item = item;
         trial.repetition =
             ++written[std::string(to_string(phase.kind)) + "/" + condition + "/" + std::to_string(item)];
+        describe_crossover(trial, phase, crossover);
         trials.push_back(std::move(trial));
       }
     }
@@ -187,11 +283,8 @@ std::vector<PlannedTrial> plan_session(const StudyProtocol& protocol, const Subj
     }
     // The first phase of a later session waits in the session's link (session_series.hpp), not as a rest.
     double rest_before_s = first_phase ? 0.0 : phase.delay_s;
-    const std::vector<std::string> blocks = block_conditions(protocol, phase, subject);
-    const bool split = phase.assignment == ConditionAssignment::within_subjects &&
-                       protocol.condition_order == ConditionOrder::abba && phase.kind != StudyPhase::practice;
-    for (const std::string& condition : blocks) {
-      add_block(phase, condition, split ? phase.repetitions / 2 : phase.repetitions, rest_before_s);
+    for (const BlockPlan& planned_block : phase_blocks(protocol, phase, subject, crossover)) {
+      add_block(phase, planned_block.condition, planned_block.items, planned_block.rounds, rest_before_s);
       rest_before_s = 0.0;
     }
     first_phase = false;

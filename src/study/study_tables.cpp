@@ -103,6 +103,10 @@ TrialRow study_detail::trial_row(const json& document, const std::string& source
   row.trial = plan.index + 1;
   row.item = plan.item + 1;
   row.repetition = static_cast<std::size_t>(plan.repetition);
+  row.item_set = plan.item_set;
+  row.sequence = plan.sequence;
+  if (plan.period > 0) row.period = plan.period;
+  row.trained_condition = plan.trained_condition;
   row.writer = manifest.setup.writer;
   if (row.writer == "simulated") {
     row.writer_profile = manifest.setup.writer_profile;
@@ -168,6 +172,7 @@ std::string field(double value) {
 }
 
 std::string field(const std::optional<double>& value) { return value ? field(*value) : std::string(); }
+std::string field(const std::optional<int>& value) { return value ? std::to_string(*value) : std::string(); }
 std::string field(std::size_t value) { return std::to_string(value); }
 std::string field(int value) { return std::to_string(value); }
 std::string field(bool value) { return value ? "true" : "false"; }
@@ -227,7 +232,8 @@ StudyTables read_study_tables(const std::vector<fs::path>& roots, unsigned threa
 std::string trials_csv(const StudyTables& tables) {
   std::string out =
       "subject,session,protocol,session_number,group,phase,block,condition,mode,characters,trial,item,"
-      "repetition,writer,writer_profile,writer_learning,end_reason,"
+      "repetition,item_set,sequence,period,trained_condition,writer,writer_profile,writer_learning,end_"
+      "reason,"
       "start_utc,completed_in_order,strokes_total,strokes_written,strokes_accepted,order_errors,"
       "backwards_strokes,unmatched_segments,mean_deviation_m,max_deviation_m,rms_deviation_m,frechet_m,dtw_m,"
       "total_time_s,pen_down_time_s,velocity_peaks,normalised_jerk,shape_skill,order_skill,timing_skill,"
@@ -237,13 +243,14 @@ std::string trials_csv(const StudyTables& tables) {
       "legibility_top5,trace_file\n";
   for (const TrialRow& r : tables.trials) {
     line(out, r.subject, r.session, r.protocol, r.session_number, r.group, r.phase, r.block, r.condition,
-         r.mode, r.characters, r.trial, r.item, r.repetition, r.writer, r.writer_profile, r.writer_learning,
-         r.end_reason, r.start_utc, r.completed_in_order, r.strokes_total, r.strokes_written,
-         r.strokes_accepted, r.order_errors, r.backwards_strokes, r.unmatched_segments, r.mean_deviation_m,
-         r.max_deviation_m, r.rms_deviation_m, r.frechet_m, r.dtw_m, r.total_time_s, r.pen_down_time_s,
-         r.velocity_peaks, r.normalised_jerk, r.shape_skill, r.order_skill, r.timing_skill,
-         r.subject_writing_speed_factor, r.subject_spatial_error_factor, r.subject_error_rate_factor,
-         r.subject_motor_noise_factor, r.subject_fast_learning_per_trial, r.subject_slow_learning_per_trial,
+         r.mode, r.characters, r.trial, r.item, r.repetition, r.item_set, r.sequence, r.period,
+         r.trained_condition, r.writer, r.writer_profile, r.writer_learning, r.end_reason, r.start_utc,
+         r.completed_in_order, r.strokes_total, r.strokes_written, r.strokes_accepted, r.order_errors,
+         r.backwards_strokes, r.unmatched_segments, r.mean_deviation_m, r.max_deviation_m, r.rms_deviation_m,
+         r.frechet_m, r.dtw_m, r.total_time_s, r.pen_down_time_s, r.velocity_peaks, r.normalised_jerk,
+         r.shape_skill, r.order_skill, r.timing_skill, r.subject_writing_speed_factor,
+         r.subject_spatial_error_factor, r.subject_error_rate_factor, r.subject_motor_noise_factor,
+         r.subject_fast_learning_per_trial, r.subject_slow_learning_per_trial,
          r.subject_fast_retention_per_trial, r.subject_slow_retention_per_trial, r.strokes_given_up,
          r.legibility_top1, r.legibility_top5, r.trace_file.string());
   }

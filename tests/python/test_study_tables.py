@@ -225,3 +225,39 @@ def test_h5py_reads_a_saved_trace_to_the_same_values(study_folder):
         assert [names[v] for v in trace["state"][()]] == list(ours["state"])
         for name in ("stroke", "element", "attempt", "rewritten"):
             np.testing.assert_array_equal(trace[name][()], ours[name].to_numpy(), err_msg=name)
+
+
+def test_a_crossover_gives_each_trials_set_sequence_period_and_trained_condition(cli, tmp_path):
+    """examples/protocols/crossover.json with one training round: the four crossover columns follow
+    `repetition`, as categoricals and a float period, and agree with the training blocks in every phase."""
+    source = Path(__file__).resolve().parents[2] / "examples" / "protocols" / "crossover.json"
+    protocol = json.loads(source.read_text(encoding="utf-8"))
+    protocol["phases"][1]["repetitions"] = 1
+    (tmp_path / "p.json").write_text(json.dumps(protocol), encoding="utf-8")
+    run = subprocess.run([cli, "session", "run", "p.json", "--writer", "simulated", "--subjects", "4", "--out",
+                          "study"], cwd=tmp_path, capture_output=True)
+    assert run.returncode == 0, run.stderr.decode()
+    trials = calligraphy.study.load(tmp_path / "study").trials
+    columns = list(trials.columns)
+    at = columns.index("repetition")
+    assert columns[at + 1:at + 5] == ["item_set", "sequence", "period", "trained_condition"]
+    for column in ("item_set", "sequence", "trained_condition"):
+        assert isinstance(trials[column].dtype, pd.CategoricalDtype), column
+    assert trials["period"].dtype == "float64"
+    sequences = trials.groupby("subject", observed=True)["sequence"].agg(lambda s: set(s.astype(str)))
+    assert [next(iter(s)) for s in sequences] == ["AB", "BA", "AB", "BA"]
+    training = trials[trials["phase"] == "training"]
+    assert (training["trained_condition"].astype(str) == training["condition"].astype(str)).all()
+    for subject, rows in trials.groupby("subject", observed=True):
+        trained = training[training["subject"] == subject].drop_duplicates("item_set").set_index("item_set")
+        assert sorted(trained["period"]) == [1.0, 2.0]
+        for _, row in rows.iterrows():
+            assert row["trained_condition"] == trained.loc[row["item_set"], "condition"]
+            assert row["period"] == trained.loc[row["item_set"], "period"]
+
+
+def test_a_study_without_item_sets_has_empty_crossover_columns(study_folder):
+    trials = calligraphy.study.load(study_folder / "study").trials
+    assert trials["period"].dtype == "float64" and trials["period"].isna().all()
+    for column in ("item_set", "sequence", "trained_condition"):
+        assert set(trials[column].astype(str)) == {""}, column

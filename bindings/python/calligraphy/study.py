@@ -28,18 +28,21 @@ PathLike = typing.Union[str, "os.PathLike[str]"]
 
 # Columns whose empty fields are absent values (NaN); every other empty field is an empty string.
 _NUMERIC_TRIAL_COLUMNS = (
-    "session_number", "block", "trial", "item", "repetition", "strokes_total", "strokes_written", "strokes_accepted",
+    "session_number", "block", "trial", "item", "repetition", "period", "strokes_total", "strokes_written", "strokes_accepted",
     "order_errors", "backwards_strokes", "unmatched_segments", "mean_deviation_m", "max_deviation_m",
     "rms_deviation_m", "frechet_m", "dtw_m", "total_time_s", "pen_down_time_s", "velocity_peaks",
     "normalised_jerk", "shape_skill", "order_skill", "timing_skill", "subject_writing_speed_factor",
     "subject_spatial_error_factor", "subject_error_rate_factor", "subject_motor_noise_factor",
     "subject_fast_learning_per_trial", "subject_slow_learning_per_trial", "subject_fast_retention_per_trial",
     "subject_slow_retention_per_trial", "strokes_given_up", "legibility_top1", "legibility_top5")
+# Numeric columns kept float64 even without a gap: a crossover period is NaN where the item's set is not
+# trained, and one dtype in every study spares an analysis a column whose type follows the data.
+_FLOAT_COLUMNS = ("period",)
 _NUMERIC_STROKE_COLUMNS = (
     "trial", "character", "stroke", "typical_id", "segments", "refused_segments", "mean_deviation_m",
     "max_deviation_m", "rms_deviation_m", "frechet_m", "dtw_m", "time_s", "path_length_m")
-_CATEGORIES = ("subject", "session", "protocol", "group", "phase", "condition", "mode", "writer", "writer_profile",
-               "writer_learning", "end_reason")
+_CATEGORIES = ("subject", "session", "protocol", "group", "phase", "condition", "mode", "item_set", "sequence",
+               "trained_condition", "writer", "writer_profile", "writer_learning", "end_reason")
 # The trace CSV's columns (calligraphy trial --csv) with their SI units named.
 _SAMPLE_COLUMNS = {"t": "t_s", "x": "x_m", "y": "y_m", "z": "z_m", "fx": "fx_n", "fy": "fy_n", "fz": "fz_n"}
 
@@ -126,6 +129,8 @@ def _read_table(text: str, numeric: tuple[str, ...], booleans: tuple[str, ...]) 
         if frame[column].dtype != bool:
             frame[column] = frame[column].astype(str) == "true"
     for column in numeric:  # counts and indices without a gap are integers
+        if column in _FLOAT_COLUMNS:
+            continue
         if frame[column].notna().all() and (frame[column] % 1 == 0).all():
             frame[column] = frame[column].astype("int64")
     for column in _CATEGORIES:
@@ -140,7 +145,11 @@ class Study:
 
     trials: one row per saved trial (subject, session, protocol, session_number (1-based: which of the
         protocol's sessions), group (the subject's between-subjects group, '' when none), phase, block,
-        condition, mode, characters, trial, item, repetition (1-based), writer, end_reason, start_utc,
+        condition, mode, characters, trial, item, repetition (1-based), item_set (the item's set, '' when the
+        phase lists characters), sequence (the subject's crossover sequence, 'AB', 'BA', ...; '' without a
+        crossover), period (the 1-based crossover period the item's set is trained in, NaN when none),
+        trained_condition (the condition the item is or was trained under in the crossover, '' when none),
+        writer, end_reason, start_utc,
         completed_in_order, stroke counts, order_errors, backwards_strokes, unmatched_segments, mean/max/rms_deviation_m, frechet_m, dtw_m [m],
         total_time_s, pen_down_time_s [s], velocity_peaks, normalised_jerk, shape_skill, order_skill and
         timing_skill (a learning simulated writer's skills before the trial, NaN otherwise), the simulated

@@ -130,14 +130,28 @@ enum class StudyPhase {
 enum class ConditionAssignment {
   within_subjects,   ///< every subject writes every condition, in blocks ordered by the protocol's order
   between_subjects,  ///< each subject writes one: the group of `subject_group`
+  /// every subject writes every condition, each on another of the phase's item sets, in an order and with
+  /// a pairing of conditions and sets counterbalanced by subject number (`crossover_assignment`,
+  /// schedule.hpp): a within-subjects comparison of learning, in which no item is trained twice
+  crossover,
 };
-/// "within-subjects", "between-subjects".
+/// "within-subjects", "between-subjects", "crossover".
 [[nodiscard]] const char* to_string(ConditionAssignment assignment) noexcept;
 
 /// A transfer set chosen by typical-stroke coverage (`choose_transfer_characters`) when a session is made.
 struct TransferChoice {
   std::size_t count = 1;                   ///< characters chosen, >= 1
   std::vector<std::u32string> candidates;  ///< single characters to choose from, in order of preference
+};
+
+/// A named set of items (a protocol's "item_sets"): the unit a crossover phase trains under one condition, so
+/// that every item is attributed to one condition (format: docs/experiments.md, "Crossover designs").
+struct ItemSet {
+  std::string name;                   ///< unique label: [A-Za-z0-9_-], 1..32 characters
+  std::vector<std::u32string> items;  ///< as a phase's items; no character is in two sets
+  /// "" or the name of another set (itself without `transfer_of`) whose transfer items these are: they
+  /// take that set's condition and period in the tables (PlannedTrial::trained_condition).
+  std::string transfer_of;
 };
 
 /// One phase of a protocol: its characters written in one or more conditions, a number of rounds each.
@@ -148,6 +162,11 @@ struct ProtocolPhase {
   /// Each item is written in one trial (one or more characters); empty while `choice` is not resolved.
   std::vector<std::u32string> items;
   std::optional<TransferChoice> choice;  ///< `transfer` only: items chosen when a session is made
+  /// The item sets the phase gives ("sets", names of StudyProtocol::item_sets, in listed order), whose items
+  /// concatenated are `items`; empty when the phase lists its characters.
+  std::vector<std::string> sets;
+  /// Parallel to `items` when `sets` is given: the set of each item; empty otherwise.
+  std::vector<std::string> item_sets;
   int repetitions = 1;                   ///< times each item is written in each condition, >= 1
   /// 1-based: the session (a sitting, usually a day) the phase is written in. A later session is its own
   /// folder, linked to the subject's previous one (session_series.hpp).
@@ -186,6 +205,8 @@ struct StudyProtocol {
   std::vector<StudyCondition> conditions;
   /// In order. The paper's format ("practice" and "test") reads as a `practice` and a `test` phase.
   std::vector<ProtocolPhase> phases;
+  /// The protocol's "item_sets", in listed order (0 to 26); empty when it gives none.
+  std::vector<ItemSet> item_sets;
   ConditionOrder condition_order = ConditionOrder::fixed;
   ItemOrder item_order = ItemOrder::fixed;
   std::uint64_t seed = 0;  ///< seeds the random orders
@@ -194,6 +215,10 @@ struct StudyProtocol {
 
   /// The condition called `name`; throws InvalidArgument naming it when there is none.
   [[nodiscard]] const StudyCondition& condition(std::string_view name) const;
+  /// The item set called `name`, or nullptr when there is none.
+  [[nodiscard]] const ItemSet* item_set(std::string_view name) const noexcept;
+  /// The protocol's crossover phase (ConditionAssignment::crossover; at most one), or nullptr.
+  [[nodiscard]] const ProtocolPhase* crossover_phase() const noexcept;
   /// Sessions the phases span (the largest `ProtocolPhase::session`), >= 1.
   [[nodiscard]] int session_count() const noexcept;
   /// The characters of the `training` phases, or of every phase when there is none (each once, in order).
@@ -207,7 +232,8 @@ struct StudyProtocol {
 inline constexpr std::uint64_t kMaxPlannedTrials = 1'000'000;
 
 /// The number of trials the largest session of `protocol` plans: per phase, strings x conditions (one when
-/// between subjects) x repetitions, computed without allocating anything per trial.
+/// between subjects) x repetitions, a crossover phase its items (each set once) x repetitions, computed
+/// without allocating anything per trial.
 [[nodiscard]] std::uint64_t planned_trial_count(const StudyProtocol& protocol) noexcept;
 
 /// `count` with thousands separators ("26,000,000").
@@ -221,7 +247,10 @@ inline constexpr std::uint64_t kMaxPlannedTrials = 1'000'000;
 /// trials (the message states the plan's size, e.g. "26,000,000 trials planned"); for "phases": sessions
 /// out of order, a pre-test after training, a post-test, retention or transfer test before it, a retention
 /// test without a delay or on characters not trained, a transfer test on characters trained, a
-/// between-subjects phase of one condition.
+/// between-subjects phase of one condition; for "item_sets": a name twice, a character in two sets, a
+/// `transfer_of` that names no set, itself or a transfer set, a phase naming an unknown set or giving both
+/// or neither of "characters" and "sets"; a crossover phase in practice, without one set per condition (two
+/// or more), on a transfer set, or after another crossover phase.
 [[nodiscard]] StudyProtocol parse_study_protocol(std::string_view json_text, const std::string& source);
 
 /// A protocol read from a file, with the exact text and its SHA-256 (so that a trial names the protocol

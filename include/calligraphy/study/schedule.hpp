@@ -5,6 +5,7 @@
 /// protocol, subject id and number give the same schedule, so an interrupted session resumes on the same
 /// plan.
 #include <cstddef>
+#include <map>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -23,6 +24,17 @@ struct PlannedTrial {
   std::size_t item = 0;  ///< index of `characters` in its phase's list (the paper's C1 is 0)
   int repetition = 1;    ///< 1-based: the how-many-th time this item is written in this phase and condition
   double break_before_s = 0.0;  ///< rest before this trial [s]
+  /// The item's set (ProtocolPhase::item_sets); "" when the phase lists its characters.
+  std::string item_set;
+  /// The subject's crossover sequence (CrossoverAssignment::sequence: "AB", "BA", "ACB", ...), the same on
+  /// every trial of the subject; "" when the protocol has no crossover phase.
+  std::string sequence;
+  /// The 1-based crossover period in which the item's set is trained (a transfer set: its source set's);
+  /// 0 when the set is not trained in the crossover phase.
+  int period = 0;
+  /// The condition the item is or was trained under in the crossover phase, on every phase's trial (a
+  /// pre-test's too); a transfer set's: its source set's; "" when none.
+  std::string trained_condition;
 };
 
 /// Who is planned for: the id names the session folder and seeds random orders; the number (1-based)
@@ -39,11 +51,41 @@ struct SubjectAssignment {
 /// 2n for odd n); `abba`: the listed order then its reverse for odd numbers, the reversed order then the
 /// listed one for even numbers; `random`: a Fisher-Yates shuffle seeded from the protocol's seed and the
 /// subject id. Between subjects, the one condition of the subject's group: the (number - 1) mod n-th listed
-/// (groups balanced in turn), or under a `random` order a seeded draw. Throws InvalidArgument naming the
-/// subject when the id is not a label, or when the order or the groups need a number and it is 0.
+/// (groups balanced in turn), or under a `random` order a seeded draw. A crossover phase: its conditions in
+/// the subject's period order (`crossover_assignment`), whatever the protocol's order. Throws InvalidArgument
+/// naming the subject when the id is not a label, or when the order or the groups need a number and it is 0.
 [[nodiscard]] std::vector<std::string> block_conditions(const StudyProtocol& protocol,
                                                         const ProtocolPhase& phase,
                                                         const SubjectAssignment& subject);
+
+/// How a crossover phase trains one of its item sets for a subject.
+struct SetTraining {
+  std::string condition;  ///< the condition the set is trained under
+  int period = 0;         ///< 1-based: the block of the crossover phase in which it is trained
+};
+
+/// A subject's crossover (`crossover_assignment`).
+struct CrossoverAssignment {
+  /// The conditions in period order as letters of the crossover phase's listed conditions (A the first):
+  /// "AB", "BA", "ACB", ...; "" when the protocol has no crossover phase.
+  std::string sequence;
+  std::size_t rotation = 0;             ///< q: listed condition i is trained on listed set (i + q) mod k
+  std::vector<std::string> conditions;  ///< the condition of each period, in period order
+  std::vector<std::string> sets;        ///< the set trained in each period, in period order
+  /// By name: every set the crossover trains, and every `transfer_of` set of one (its source's training).
+  std::map<std::string, SetTraining> trained;
+};
+
+/// The subject's sequence and set of each condition in the protocol's crossover phase (k listed conditions
+/// and sets): row r = (number - 1) mod rows of the balanced Latin square `latin_square` uses (Williams 1949;
+/// rows = k for even k, 2k for odd k) orders the conditions, and the rotation q = ((number - 1) / rows) mod k
+/// pairs listed condition i with listed set (i + q) mod k. Period p trains condition listed[row[p - 1]] on
+/// its set. Two conditions give subjects 1, 2, 3, 4: AB and BA with rotation 0, then AB and BA with rotation
+/// 1, and again: sequence, period and set are balanced every rows x k subjects (4 for two conditions, 18 for
+/// three, 16 for four). An empty assignment when the protocol has no crossover phase. Throws InvalidArgument
+/// naming the subject when its id is not a label or, with a crossover phase, its number is 0.
+[[nodiscard]] CrossoverAssignment crossover_assignment(const StudyProtocol& protocol,
+                                                       const SubjectAssignment& subject);
 
 /// The subject's group: the conditions `block_conditions` gives it in the protocol's between-subjects
 /// phases, joined by "/" in phase order; "" when every phase is within subjects. Throws as
@@ -52,7 +94,9 @@ struct SubjectAssignment {
 
 /// Every trial of session `session` (1-based, up to `protocol.session_count()`): its phases in order, each
 /// phase a block per condition of `block_conditions` (two per condition for `abba`, practice excepted), each
-/// block a number of rounds through the phase's characters. Rests: `between_blocks_s` before the first
+/// block a number of rounds through the phase's characters (a crossover phase's block: through the items of
+/// its period's set). Every trial names its item's set and the subject's crossover (`item_set`, `sequence`,
+/// `period`, `trained_condition`). Rests: `between_blocks_s` before the first
 /// trial of each block after the first, a phase's `delay_s` before its first trial when it is not the
 /// session's first phase, `duration_s` after every `every_trials` trials (the longest when several fall on
 /// one trial). Throws InvalidArgument for a session the protocol does not have, a transfer choice not

@@ -31,6 +31,15 @@ struct TrialRow {
   std::size_t trial = 1;       ///< 1-based position in the session's plan (the NNN of its files)
   std::size_t item = 1;        ///< 1-based position of `characters` in the phase's list
   std::size_t repetition = 1;  ///< 1-based repetition of the item in the condition (the rN of its files)
+  std::string item_set;        ///< the item's set (`item_sets`); "" when the phase lists characters
+  /// The subject's crossover sequence ("AB", "BA", ...; A the crossover phase's first listed condition); ""
+  /// when the protocol has no crossover phase.
+  std::string sequence;
+  /// The 1-based crossover period in which the item's set is trained (a transfer set: its source's); absent
+  /// when the set is not trained in the crossover.
+  std::optional<int> period;
+  /// The condition the item is or was trained under in the crossover, on every phase's row; "" when none.
+  std::string trained_condition;
   std::string writer;          ///< "simulated" or "human"
   /// A simulated writer's profile ("novice", "skilled", "foreign") and learning model ("none", "two-state");
   /// "" for a person.

@@ -1,0 +1,176 @@
+// A protocol's "item_sets" and a phase's "sets" (docs/experiments.md, "Crossover designs"): named sets
+// of items, so that a crossover phase can train each condition on its own set and every item, in every
+// phase, is attributed to the one condition it was trained under.
+#include <algorithm>
+#include <map>
+
+#include "calligraphy/core/unicode.hpp"
+#include "study/names.hpp"
+#include "study/protocol_reading.hpp"
+
+namespace calligraphy {
+namespace study_detail {
+namespace {
+
+using nlohmann::json;
+
+// As many sets as conditions may be compared in one crossover: 26, the conditions' limit.
+constexpr std::size_t kMaxItemSets = 26;
+
+std::string defined_sets(const std::vector<ItemSet>& sets) {
+  std::string names;
+  for (const ItemSet& set : sets) names += (names.empty() ? "" : ", ") + set.name;
+  return names;
+}
+
+std::string in_quotes(const std::string& text) {
+  std::string out = "\"";
+  out += text;
+  out += '"';
+  return out;
+}
+
+// A character in two sets could not be attributed to one condition: the second occurrence is the error.
+void check_disjoint(const std::vector<ItemSet>& sets, const std::string& pointer, const std::string& source) {
+  std::map<char32_t, std::size_t> owner;  // character -> the first set holding it
+  for (std::size_t i = 0; i < sets.size(); ++i) {
+    for (std::size_t k = 0; k < sets[i].items.size(); ++k) {
+      for (const char32_t c : sets[i].items[k]) {
+        const auto [first, added] = owner.emplace(c, i);
+        if (added || first->second == i) continue;
+        fail(source, child_pointer(child_pointer(child_pointer(pointer, i), "characters"), k),
+             in_quotes(encode_utf8(c)) + " is also in the item set " + in_quotes(sets[first->second].name) +
+                 ": a character in two sets cannot be attributed to one condition");
+      }
+    }
+  }
+}
+
+// `transfer_of` names another set, one that is not a transfer set itself (checked once every set is read:
+// it may name a later one).
+void check_transfer_sources(const std::vector<ItemSet>& sets, const std::string& pointer,
+                            const std::string& source) {
+  for (std::size_t i = 0; i < sets.size(); ++i) {
+    const std::string& wanted = sets[i].transfer_of;
+    if (wanted.empty()) continue;
+    const std::string at = child_pointer(child_pointer(pointer, i), "transfer_of");
+    if (wanted == sets[i].name) fail(source, at, "a set is not a transfer set of itself");
+    const auto found =
+        std::find_if(sets.begin(), sets.end(), [&](const ItemSet& set) { return set.name == wanted; });
+    if (found == sets.end()) {
+      fail(source, at, "no item set " + in_quotes(wanted) + "; defined: " + defined_sets(sets));
+    }
+    if (!found->transfer_of.empty()) {
+      fail(source, at,
+           in_quotes(wanted) + " is itself a transfer set (of " + in_quotes(found->transfer_of) +
+               "): transfer_of names a set that is trained");
+    }
+  }
+}
+
+ItemSet read_item_set(const json& value, const std::string& pointer, const std::string& source) {
+  ObjectReader reader(value, pointer, source);
+  ItemSet set;
+  set.name = reader.string("name");
+  if (!is_label(set.name, 32)) {
+    fail(source, reader.pointer("name"),
+         "expected 1 to 32 letters, digits, '_' or '-', got " + in_quotes(set.name));
+  }
+  set.items = read_items(reader.required("characters"), reader.pointer("characters"), source);
+  set.transfer_of = reader.string_or("transfer_of", "");
+  if (reader.has("transfer_of") && !is_label(set.transfer_of, 32)) {
+    fail(source, reader.pointer("transfer_of"),
+         "expected the name of an item set (1 to 32 letters, digits, '_' or '-'), got " +
+             in_quotes(set.transfer_of));
+  }
+  reader.finish();
+  return set;
+}
+
+}  // namespace
+
+void read_item_sets(const json& value, const std::string& pointer, const std::string& source,
+                    StudyProtocol& protocol) {
+  if (!value.is_array() || value.empty() || value.size() > kMaxItemSets) {
+    fail(source, pointer,
+         "expected a list of 1 to " + std::to_string(kMaxItemSets) + " item sets, got " + describe(value));
+  }
+  std::vector<ItemSet> sets;
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    ItemSet set = read_item_set(value[i], child_pointer(pointer, i), source);
+    const bool named =
+        std::any_of(sets.begin(), sets.end(), [&](const ItemSet& s) { return s.name == set.name; });
+    if (named) {
+      fail(source, child_pointer(child_pointer(pointer, i), "name"),
+           "the item set " + in_quotes(set.name) + " is defined twice");
+    }
+    sets.push_back(std::move(set));
+  }
+  check_disjoint(sets, pointer, source);
+  check_transfer_sources(sets, pointer, source);
+  protocol.item_sets = std::move(sets);
+}
+
+void read_phase_sets(const json& value, const std::string& pointer, const std::string& source,
+                     const StudyProtocol& protocol, ProtocolPhase& phase) {
+  if (!value.is_array() || value.empty() || value.size() > kMaxItemSets) {
+    fail(source, pointer,
+         "expected a list of 1 to " + std::to_string(kMaxItemSets) + " item set names, got " +
+             describe(value));
+  }
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    const std::string at = child_pointer(pointer, i);
+    const std::string name = as_string(value[i], at, source);
+    const ItemSet* set = protocol.item_set(name);
+    if (set == nullptr) {
+      fail(source, at,
+           "no item set " + in_quotes(name) + "; defined: " +
+               (protocol.item_sets.empty() ? std::string("none (\"item_sets\")")
+                                           : defined_sets(protocol.item_sets)));
+    }
+    if (std::find(phase.sets.begin(), phase.sets.end(), name) != phase.sets.end()) {
+      fail(source, at, "the item set " + in_quotes(name) + " is listed twice");
+    }
+    if (phase.items.size() + set->items.size() > kMaxItems) {
+      fail(source, at,
+           "the sets hold more than the " + std::to_string(kMaxItems) + " items a phase may write");
+    }
+    phase.sets.push_back(name);
+    for (const std::u32string& item : set->items) {
+      phase.items.push_back(item);
+      phase.item_sets.push_back(name);
+    }
+  }
+}
+
+std::string item_pointer(const StudyProtocol& protocol, const ProtocolPhase& phase, std::size_t index) {
+  if (phase.item_sets.empty() || index >= phase.item_sets.size()) {
+    return child_pointer(child_pointer(phase.pointer, "characters"), index);
+  }
+  const std::string& name = phase.item_sets[index];
+  const auto first = std::find(phase.item_sets.begin(), phase.item_sets.end(), name);
+  const auto set = std::find_if(protocol.item_sets.begin(), protocol.item_sets.end(),
+                                [&](const ItemSet& s) { return s.name == name; });
+  const auto position = index - static_cast<std::size_t>(first - phase.item_sets.begin());
+  return child_pointer(
+      child_pointer(child_pointer("/item_sets", static_cast<std::size_t>(set - protocol.item_sets.begin())),
+                    "characters"),
+      position);
+}
+
+}  // namespace study_detail
+
+const ItemSet* StudyProtocol::item_set(std::string_view wanted) const noexcept {
+  const auto found = std::find_if(item_sets.begin(), item_sets.end(),
+                                  [&](const ItemSet& set) { return set.name == wanted; });
+  return found == item_sets.end() ? nullptr : &*found;
+}
+
+const ProtocolPhase* StudyProtocol::crossover_phase() const noexcept {
+  const auto found = std::find_if(phases.begin(), phases.end(), [](const ProtocolPhase& phase) {
+    return phase.assignment == ConditionAssignment::crossover;
+  });
+  return found == phases.end() ? nullptr : &*found;
+}
+
+}  // namespace calligraphy
