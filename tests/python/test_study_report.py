@@ -221,14 +221,15 @@ def test_the_statistics_name_their_test_and_n_and_find_the_planted_effect(report
         # p with 3 significant digits or "< 0.001"; the planted effect is large against its noise.
         assert t_test["p"] == "< 0.001" or (len(t_test["p"].replace(".", "").lstrip("0")) == 3
                                              and float(t_test["p"]) < 0.05)
-        assert t_test["comparison"] == "vision - haptic"  # the control (vision, no guidance) first
+        # One direction on the whole page: treatment - control, as the design's questions.
+        assert t_test["comparison"] == "haptic - vision"
         assert t_test["effect"].startswith("mean difference [")
-        assert float(t_test["effect"].split("=")[1]) > 0  # guidance is faster and closer
+        assert float(t_test["effect"].split("=")[1]) < 0  # guidance is faster and closer
     statistics = pandas.read_csv(index.parent / "tables" / "statistics.csv")
     assert list(statistics.columns[:4]) == ["value", "unit", "quantity", "comparison"]
     paired = statistics[statistics.test.str.startswith("paired t-test")].set_index("value")
-    assert paired.loc["total_time_s", "effect"] == pytest.approx(-HAPTIC_TIME_S, abs=1.0)  # SI units: s
-    assert paired.loc["mean_deviation_m", "effect"] == pytest.approx(-HAPTIC_DEVIATION_M, abs=0.3e-3)  # m
+    assert paired.loc["total_time_s", "effect"] == pytest.approx(HAPTIC_TIME_S, abs=1.0)  # SI units: s
+    assert paired.loc["mean_deviation_m", "effect"] == pytest.approx(HAPTIC_DEVIATION_M, abs=0.3e-3)  # m
 
 
 def test_every_figure_is_an_svg_and_a_decodable_png(report):

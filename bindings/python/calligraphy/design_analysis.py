@@ -20,9 +20,14 @@ outcomes in SI units). The functions here:
   - after training (post-test, retention, transfer), between subjects: an ANCOVA on subject means,
     ``post ~ pre + group`` (ordinary least squares, statsmodels; the same model as R's ``lm``), i.e. the
     groups compared adjusted for the pre-test (Vickers & Altman 2001, BMJ 323:1123; Van Breukelen 2006);
-  - within subjects: paired t-tests on subject means (``calligraphy.statistics.paired_comparison``).
+  - within subjects: paired t-tests on subject means (``calligraphy.statistics.paired_comparison``);
+  - a crossover (each condition trained on its own item set, in counterbalanced sequences): the models of
+    ``calligraphy.crossover_analysis``, with period fixed and each later test by the condition the item's
+    set was trained under, adjusted for the same set's pre-test; its carry-over and Hills-Armitage checks
+    are reported apart, unadjusted.
 
-  Holm (1979) adjusts the p values within a family: one outcome's comparisons against the control.
+  Holm (1979) adjusts the p values within a family: one outcome's comparisons against the control, one test
+  per comparison.
   Effect sizes: the difference (adjusted for the pre-test in an ANCOVA) with its 95 % interval in the
   outcome's unit, and Hedges' g with an approximate 95 % interval (Hedges & Olkin 1985, eq. 5.14).
 * ``retention_ratios`` gives each group's share of its gain kept at retention, only where the gain is
@@ -40,7 +45,7 @@ import typing
 
 import numpy as np
 
-from . import mixed_models, statistics
+from . import crossover_analysis, mixed_models, statistics
 
 if typing.TYPE_CHECKING:  # pragma: no cover
     import pandas
@@ -90,7 +95,11 @@ class StudyDesign:
     design). ``control``: the reference every other condition is compared with. ``compared_phase``: where
     the conditions differ ('training', or the within-subjects phase). ``n_per_condition``: subjects per
     group (between) or subjects writing each condition (within). ``pre_test``: the pre-test phase or None.
-    ``after_training``: the post-test, retention and transfer phases present, in order."""
+    ``after_training``: the post-test, retention and transfer phases present, in order. For a 'crossover' (every
+    subject trains every condition, each on its own item set, in counterbalanced sequences): ``sequences``
+    (sequence -> subjects), ``periods`` (1, 2, ...), ``item_sets`` (set -> its characters) and ``pairing``
+    ((condition, set) -> subjects who trained that set under that condition) and ``letters`` (a sequence's
+    letter -> its condition)."""
 
     kind: str
     phases: tuple[str, ...]
@@ -100,6 +109,11 @@ class StudyDesign:
     n_per_condition: dict[str, int]
     pre_test: typing.Optional[str]
     after_training: tuple[str, ...]
+    sequences: dict[str, int] = dataclasses.field(default_factory=dict)
+    periods: tuple[int, ...] = ()
+    item_sets: dict[str, str] = dataclasses.field(default_factory=dict)
+    pairing: dict[tuple[str, str], int] = dataclasses.field(default_factory=dict)
+    letters: dict[str, str] = dataclasses.field(default_factory=dict)
 
     def sentence(self) -> str:
         """The design in one sentence, for a report's method section."""
@@ -109,10 +123,23 @@ class StudyDesign:
         if self.kind == "between-subjects":
             return (f"Between-subjects: {len(self.conditions)} groups trained in {self.compared_phase} "
                     f"({counts} subjects); phases in order: {phases}.")
+        if self.kind == "crossover":
+            return self._crossover_sentence(counts, phases)
         if self.kind == "within-subjects":
             return (f"Within-subjects: every subject wrote {len(self.conditions)} conditions in "
                     f"{self.compared_phase} ({counts} subjects); phases in order: {phases}.")
         return f"One condition ({counts} subjects); phases in order: {phases}."
+
+    def _crossover_sentence(self, counts: str, phases: str) -> str:
+        n = max(self.n_per_condition.values(), default=0)
+        sequences = ", ".join(f"{s} n = {k}" for s, k in self.sequences.items())
+        letters = ", ".join(f"{letter} = {c}" for letter, c in self.letters.items())
+        sets = "; ".join(f"{name}: {chars}" for name, chars in self.item_sets.items())
+        pairing = "; ".join(f"{c} on {k} n = {m}" for (c, k), m in self.pairing.items())
+        return (f"Crossover (within subjects): each of {n} subjects trained {len(self.conditions)} conditions in "
+                f"{self.compared_phase} ({counts} subjects), each on its own item set, one per period "
+                f"(periods {', '.join(str(p) for p in self.periods)}); sequences {sequences} ({letters}); item sets "
+                f"{sets}; which set each condition trained: {pairing}; phases in order: {phases}.")
 
 
 def _first_appearance(trials: pandas.DataFrame, column: str) -> list[str]:
@@ -146,6 +173,36 @@ def _condition_order(trials: pandas.DataFrame, column: str, reference: typing.Op
     return [reference] + [level for level in levels if level != reference]
 
 
+def _crossover_parts(trials: pandas.DataFrame, compared: pandas.DataFrame) -> typing.Optional[dict]:
+    """The crossover's sequences, periods, item sets, condition-set pairing and sequence letters when the
+    compared phase's trials name the period and the condition their set is trained under (the tables'
+    ``period`` and ``trained_condition``) and every subject trains two or more conditions; else None."""
+    if compared.empty or not {"period", "trained_condition", "sequence", "item_set"} <= set(compared.columns):
+        return None
+    period = compared["period"].astype(float)
+    named = compared[(period >= 1) & (compared["trained_condition"].astype(str).replace({"nan": ""}) != "")]
+    if named.empty or (named.groupby("subject", observed=True)["condition"].nunique() < 2).any():
+        return None
+    named = named.assign(period=named["period"].astype(float).astype(int), subject=named["subject"].astype(str),
+                         condition=named["condition"].astype(str), item_set=named["item_set"].astype(str),
+                         sequence=named["sequence"].astype(str))
+    per_subject = named.drop_duplicates(["subject", "period"])
+    sequences = per_subject.drop_duplicates("subject")["sequence"].value_counts().sort_index()
+    letters: dict[str, str] = {}
+    for row in per_subject.itertuples(index=False):
+        if 1 <= row.period <= len(row.sequence):
+            letters.setdefault(row.sequence[row.period - 1], row.condition)
+    sets: dict[str, str] = {}
+    for name in _first_appearance(trials[trials["item_set"].astype(str).replace({"nan": ""}) != ""], "item_set"):
+        items = trials.loc[trials["item_set"].astype(str) == name, "characters"].astype(str)
+        sets[name] = " ".join(dict.fromkeys(items))
+    pairs = per_subject.groupby(["condition", "item_set"])["subject"].nunique()
+    return {"sequences": {str(k): int(v) for k, v in sequences.items()},
+            "periods": tuple(sorted(int(p) for p in named["period"].unique())), "item_sets": sets,
+            "pairing": {(str(c), str(k)): int(n) for (c, k), n in pairs.items()},
+            "letters": dict(sorted(letters.items()))}
+
+
 def study_design(trials: pandas.DataFrame, reference: typing.Optional[str] = None) -> StudyDesign:
     """Reads the design from ``trials`` (see the module's docstring). ``reference`` names the control (a group
     or condition); by default the one condition without guidance ('vision' mode), else the first in protocol
@@ -160,6 +217,15 @@ def study_design(trials: pandas.DataFrame, reference: typing.Optional[str] = Non
     compared_phase = varied[0] if varied else None
     data = trials[trials["phase"].astype(str) == compared_phase] if compared_phase else trials
     groups = data["group"].astype(str) if "group" in data.columns else None
+    crossover = _crossover_parts(trials, data)
+    if crossover is not None:
+        conditions = _condition_order(data, "condition", reference)
+        counts = data.groupby(data["condition"].astype(str))["subject"].nunique()
+        return StudyDesign(kind="crossover", phases=tuple(phases), conditions=tuple(conditions),
+                           control=conditions[0], compared_phase=compared_phase,
+                           n_per_condition={c: int(counts.get(c, 0)) for c in conditions},
+                           pre_test=PRE_TEST if PRE_TEST in phases else None,
+                           after_training=tuple(p for p in AFTER_TRAINING if p in phases), **crossover)
     if groups is not None and (groups != "").any() and (data.groupby("subject", observed=True)["condition"].nunique()
                                                         == 1).all():
         data = data[groups != ""]
@@ -209,12 +275,13 @@ class ExclusionPolicy:
         if self.keep_end_reasons is None:
             return "Every trial is analysed, however it ended."
         return (f"Only trials that ended {' or '.join(repr(r) for r in self.keep_end_reasons)} are analysed; the "
-                "others are counted below, by phase and group.")
+                "others are counted below.")
 
 
 def apply_exclusions(trials: pandas.DataFrame, policy: ExclusionPolicy = ExclusionPolicy()
                      ) -> tuple[pandas.DataFrame, pandas.DataFrame]:
-    """The trials the policy keeps, and a count table: one row per phase and group (or condition) with
+    """The trials the policy keeps, and a count table: one row per phase and group (or condition; in a
+    crossover the condition each trial's item set is trained under, ``trained_condition``) with
     ``trials``, ``kept`` and one column per end reason excluded. Raises ValueError naming a missing
     ``end_reason`` column when the policy needs it."""
     pandas = _pandas()
@@ -223,8 +290,13 @@ def apply_exclusions(trials: pandas.DataFrame, policy: ExclusionPolicy = Exclusi
     else:
         statistics._require_columns(trials, ["end_reason"], "apply_exclusions")
         kept = trials[trials["end_reason"].astype(str).isin(policy.keep_end_reasons)]
-    by = ["phase", "group"] if "group" in trials.columns and (trials["group"].astype(str) != "").any() else [
-        "phase", "condition"]
+    if "trained_condition" in trials.columns and (trials["trained_condition"].astype(str).replace(
+            {"nan": ""}) != "").any():
+        by = ["phase", "trained_condition"]  # a crossover: a test trial counts for the condition its set trained
+    elif "group" in trials.columns and (trials["group"].astype(str) != "").any():
+        by = ["phase", "group"]
+    else:
+        by = ["phase", "condition"]
     reasons = trials["end_reason"].astype(str) if "end_reason" in trials.columns else pandas.Series(
         "", index=trials.index)
     excluded = pandas.Series(~trials.index.isin(kept.index), index=trials.index)
@@ -406,7 +478,8 @@ def _ancova_rows(data: pandas.DataFrame, value: str, design: StudyDesign, phase:
 def _paired_rows(data: pandas.DataFrame, value: str, design: StudyDesign) -> list[dict]:
     phase = design.compared_phase
     rows_of = data[data["phase"].astype(str) == phase]
-    base = {"value": value, "unit": _unit(value), "family": value, "phase": phase,
+    # The same comparison as the mixed model's: a check beside it, not a second test in its Holm family.
+    base = {"value": value, "unit": _unit(value), "family": f"{value} (checks)", "phase": phase,
             "model": "subject means per condition", "question": f"{phase}: condition against the control "
             "(paired, within subjects)"}
     rows = []
@@ -447,18 +520,27 @@ def design_questions(trials: pandas.DataFrame, value: str, design: typing.Option
     design = design or study_design(trials)
     data, _ = apply_exclusions(trials, policy)
     rows: list[dict] = []
-    if design.kind != "single-condition" and design.compared_phase is not None:
+    if design.kind == "crossover":
+        rows += crossover_analysis.questions(data, value, design, ddf)
+    elif design.kind != "single-condition" and design.compared_phase is not None:
         rows += _training_rows(data, value, design, ddf)
     if design.kind == "between-subjects" and design.pre_test is not None:
         for phase in design.after_training:
             rows += _ancova_rows(data, value, design, phase)
     elif design.kind == "within-subjects":
         rows += _paired_rows(data, value, design)
-    adjusted = _holm([float(r["p"]) for r in rows])
-    for row, p_holm in zip(rows, adjusted):
-        row["p_holm"] = p_holm
-        row["apa"] = apa_sentence(row["df"], row["statistic"], row["p"], row["g"],
-                                  (row["ci95_low"], row["ci95_high"]), display_unit, scale)
+    # Holm within each family: the outcome's comparisons against the control. A design's checks (a crossover's
+    # carry-over test and Hills-Armitage) are their own family and are not adjusted.
+    for family in dict.fromkeys(r["family"] for r in rows):
+        members = [r for r in rows if r["family"] == family]
+        checks = family.endswith("(checks)")
+        adjusted = [math.nan] * len(members) if checks else _holm([float(r["p"]) for r in members])
+        for row, p_holm in zip(members, adjusted):
+            row["p_holm"] = p_holm
+    for row in rows:
+        if not row["apa"]:
+            row["apa"] = apa_sentence(row["df"], row["statistic"], row["p"], row["g"],
+                                      (row["ci95_low"], row["ci95_high"]), display_unit, scale)
     return pandas.DataFrame(rows, columns=QUESTION_COLUMNS)
 
 
@@ -477,6 +559,8 @@ def retention_ratios(trials: pandas.DataFrame, value: str, design: StudyDesign,
         return pandas.DataFrame(columns=["group", "n", "gain", "gain_ci95_low", "gain_ci95_high",
                                          "retention_ratio", "note"])
     data, _ = apply_exclusions(statistics._finite_outcome(trials, value, "retention_ratios"), policy)
+    if design.kind == "crossover":
+        return crossover_analysis.retention_ratios(data, value, design)
     table = statistics.learning(data, value, design.pre_test, "post-test", retention="retention")
     column = "group" if "group" in table.columns else None
     rows = []

@@ -4,7 +4,8 @@
 # Run by calligraphy.mixed_models (python), never by hand:
 #   Rscript lmer_fit.R FOLDER FORMULA DDF
 # FOLDER holds data.csv (UTF-8) and levels.csv (factor, level: each factor's levels in order, reference
-# first); the script writes fixed.csv, random.csv and fit.csv (key, value) there.
+# first); the script writes fixed.csv, random.csv, anova.csv (one F test per term) and fit.csv (key, value)
+# there.
 # Exit status 0 when the results were written (a fit that did not converge or is singular says so in
 # fit.csv), 1 with a message on standard error otherwise.
 arguments <- commandArgs(trailingOnly = TRUE)
@@ -54,6 +55,13 @@ fixed <- data.frame(term = rownames(coefficients), estimate = coefficients[, "Es
                     p = coefficients[, "Pr(>|t|)"], ci95_low = coefficients[, "Estimate"] - half_width,
                     ci95_high = coefficients[, "Estimate"] + half_width)
 utils::write.csv(fixed, file.path(folder, "fixed.csv"), row.names = FALSE, fileEncoding = "UTF-8")
+
+# One F test per term (lmerTest's type III table, the same df method): a factor of several levels, such as a
+# crossover's sequence, is tested as a whole.
+terms <- stats::anova(fit, ddf = ddf)
+anova_table <- data.frame(term = rownames(terms), num_df = terms[, "NumDF"], den_df = terms[, "DenDF"],
+                          f = terms[, "F value"], p = terms[, "Pr(>F)"])
+utils::write.csv(anova_table, file.path(folder, "anova.csv"), row.names = FALSE, fileEncoding = "UTF-8")
 
 components <- as.data.frame(lme4::VarCorr(fit))
 # One row per variance or covariance: "subject" for a random intercept alone, "subject (Intercept)" and

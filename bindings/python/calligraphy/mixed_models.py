@@ -41,7 +41,9 @@ class LmerFit:
     '(Intercept)' or 'groupfixture'), ``factor`` and ``level`` (the factor level a treatment-coded term
     compares with the factor's reference; '' for other terms), ``estimate``, ``std_error``, ``df``
     (Satterthwaite or Kenward-Roger), ``t``, ``p`` (two-sided), ``ci95_low``, ``ci95_high`` (estimate +- t(.975,
-    df) SE), in the outcome's unit. ``variances``: the variance of each random effect and of the residual
+    df) SE), in the outcome's unit. ``terms``: one F test per model term (lmerTest's type III table, the same
+    df method): ``term`` (the formula's name, e.g. 'sequence'), ``num_df``, ``den_df``, ``f``, ``p``.
+    ``variances``: the variance of each random effect and of the residual
     [outcome unit squared], keyed by R's group name ('subject', 'item', 'Residual'). ``singular``: lme4's
     isSingular (a variance estimated as 0 or a correlation as +-1); ``converged``: lme4 reported no
     convergence problem; ``messages``: every warning and message of the fit; ``ddf``; ``formula``;
@@ -50,6 +52,7 @@ class LmerFit:
     formula: str
     ddf: str
     fixed: "pandas.DataFrame"
+    terms: "pandas.DataFrame"
     variances: dict[str, float]
     singular: bool
     converged: bool
@@ -127,6 +130,7 @@ def lmer(frame: "pandas.DataFrame", formula: str, factors: typing.Mapping[str, t
             raise RuntimeError(f"lmer: R could not fit {formula}: {detail}")
         fixed = pandas.read_csv(os.path.join(folder, "fixed.csv"), encoding="utf-8")
         random = pandas.read_csv(os.path.join(folder, "random.csv"), encoding="utf-8")
+        terms = pandas.read_csv(os.path.join(folder, "anova.csv"), encoding="utf-8")
         info = dict(pandas.read_csv(os.path.join(folder, "fit.csv"), encoding="utf-8", dtype=str,
                                     keep_default_na=False).itertuples(index=False, name=None))
     owners = {}
@@ -136,7 +140,7 @@ def lmer(frame: "pandas.DataFrame", formula: str, factors: typing.Mapping[str, t
     fixed.insert(1, "factor", [owners.get(term, ("", ""))[0] for term in fixed["term"]])
     fixed.insert(2, "level", [owners.get(term, ("", ""))[1] for term in fixed["term"]])
     variances = {str(group): float(variance) for group, variance in zip(random["group"], random["variance"])}
-    return LmerFit(formula=formula, ddf=ddf, fixed=fixed, variances=variances,
+    return LmerFit(formula=formula, ddf=ddf, fixed=fixed, terms=terms, variances=variances,
                    singular=info.get("singular") == "TRUE", converged=info.get("converged") == "TRUE",
                    messages=info.get("messages", ""), n_observations=int(info.get("n_observations", "0") or 0),
                    versions=(f"R {info.get('r_version', '?')}, lme4 {info.get('lme4_version', '?')}, lmerTest "

@@ -843,10 +843,11 @@ def _paired_rows(comparison: PairedComparison) -> list[dict[str, typing.Any]]:
 
 
 def statistics_table(trials: pandas.DataFrame, value: str, by: str = "condition", phase: Phase = None,
-                     *, with_mixed_model: bool = True) -> pandas.DataFrame:
+                     *, with_mixed_model: bool = True, reference: typing.Any = None) -> pandas.DataFrame:
     """One tidy table of ``value`` for a report: per condition (value of ``by``) its mean over subjects
     (``describe(..., unit="subject")``), every pairwise ``paired_comparison`` between the conditions
-    present (in sorted order or a categorical column's order, a - b), and the fixed effects of
+    present (in sorted order or a categorical column's order, a - b; a pair with ``reference``, the control, is
+    the other condition - reference, the direction of ``design_analysis``'s questions), and the fixed effects of
     ``mixed_model(trials, value, fixed=by)`` (left out with ``with_mixed_model=False``; the small-sample
     model with subjects and items crossed is ``calligraphy.design_analysis.design_questions``). ``phase`` (a name, several, or None for every row)
     restricts the trials first; without it, trials of all phases are pooled.
@@ -877,6 +878,8 @@ def statistics_table(trials: pandas.DataFrame, value: str, by: str = "condition"
                          effect=described["mean"], effect_name=f"mean [{value}]", ci95_low=described["ci95_low"],
                          ci95_high=described["ci95_high"], assumptions=described["assumptions"]))
     for a, b in itertools.combinations(_levels(data[by]), 2):
+        if reference is not None and a == reference:
+            a, b = b, a
         try:
             comparison = paired_comparison(data, value, a, b, by=by)
         except _TooFewData as error:

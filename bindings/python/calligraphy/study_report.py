@@ -294,14 +294,14 @@ def _summary_rows(table: _Table5) -> list[dict]:
     return rows
 
 
-def _statistics(data: "pandas.DataFrame", value: str) -> "pandas.DataFrame":
+def _statistics(data: "pandas.DataFrame", value: str, control: typing.Any) -> "pandas.DataFrame":
     """statistics_table of one value, or one row saying why it could not be computed (e.g. a constant
     outcome, which the mixed model refuses)."""
     from . import statistics
 
     pandas = _pandas()
     try:
-        table = statistics.statistics_table(data, value, by="condition", with_mixed_model=False)
+        table = statistics.statistics_table(data, value, by="condition", with_mixed_model=False, reference=control)
     except ValueError as error:
         row: dict[str, typing.Any] = {column: math.nan for column in statistics.TABLE_COLUMNS}
         row.update(quantity=value, comparison="condition", test=f"not computed: {error}", assumptions="")
@@ -598,9 +598,13 @@ def _subjects_html(trials: "pandas.DataFrame", values: typing.Sequence[str], per
 
 def _phase_means(data: "pandas.DataFrame", value: str, design: "design_analysis.StudyDesign") -> "pandas.DataFrame":
     """Per phase and condition (group), the mean over subjects of each subject's mean, its SD over subjects,
-    n = subjects and the 95 % t interval (the one definition of a summary on this page), in SI units."""
-    from . import statistics
+    n = subjects and the 95 % t interval (the one definition of a summary on this page), in SI units. In a
+    crossover, per phase and the condition each trial's set was trained under, with Cousineau-Morey
+    within-subject intervals (``crossover_analysis.within_subject_means``)."""
+    from . import crossover_analysis, statistics
 
+    if design.kind == "crossover":
+        return crossover_analysis.within_subject_means(data, value, design)
     by = "group" if design.kind == "between-subjects" else "condition"
     rows = data[data[value].notna()]
     described = statistics.describe(rows.assign(phase=rows["phase"].astype(str), **{by: rows[by].astype(str)}),
@@ -653,9 +657,22 @@ def phase_figure(means: "pandas.DataFrame", value: str, design: "design_analysis
         ax.yaxis.set_major_locator(MaxNLocator(nbins=5, steps=[1, 2, 2.5, 5, 10]))
         ax.grid(axis="y", color="#dddddd", lw=0.6)
         ax.spines[["top", "right"]].set_visible(False)
-        ax.legend(title="group" if design.kind == "between-subjects" else "condition", fontsize=8, title_fontsize=8,
+        ax.legend(title=_factor_name(design), fontsize=8, title_fontsize=8,
                   frameon=False, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     return figure
+
+
+def _factor_name(design: "design_analysis.StudyDesign") -> str:
+    """What a line or column of the page is: a group, a condition, or in a crossover the condition a set was
+    trained under."""
+    return {"between-subjects": "group", "crossover": "condition trained"}.get(design.kind, "condition")
+
+
+def _interval_words(design: "design_analysis.StudyDesign") -> str:
+    if design.kind == "crossover":
+        return ("the mean over subjects with its within-subject 95 % interval (Cousineau-Morey: subject means "
+                "normalised to remove each subject's level)")
+    return "the mean over subjects with its 95 % t interval"
 
 
 def _subjects_sentence(trials: "pandas.DataFrame") -> str:
@@ -683,17 +700,24 @@ def _subjects_sentence(trials: "pandas.DataFrame") -> str:
 def _exclusions_html(counts: "pandas.DataFrame", policy: "design_analysis.ExclusionPolicy") -> str:
     if counts.empty:
         return ""
-    key = "group" if "group" in counts.columns else "condition"
+    key = next(c for c in ("trained_condition", "group", "condition") if c in counts.columns)
     reasons = [c for c in counts.columns if c.startswith("excluded_")]
     total, kept = int(counts["trials"].sum()), int(counts["kept"].sum())
-    head = "".join(f"<th>{_e(c)}</th>" for c in ["phase", key, "trials", "analysed", *(r[9:] for r in reasons)])
+    label = "condition trained" if key == "trained_condition" else key
+    head = "".join(f"<th>{_e(c)}</th>" for c in ["phase", label, "trials", "analysed", *(r[9:] for r in reasons)])
     body = "".join(
         "<tr>" + "".join(f"<td>{_e(row[c])}</td>" for c in ("phase", key))
         + "".join(f"<td class=\"num\">{int(row[c])}</td>" for c in ("trials", "kept", *reasons)) + "</tr>\n"
         for row in counts.to_dict("records"))
     return (f"<p>Completion: {kept} of {total} trials analysed ({100.0 * kept / total:.0f} %). {_e(policy.sentence())}"
-            "</p>\n<details id=\"exclusions\"><summary>Trials analysed and excluded, by phase</summary>\n"
+            f"</p>\n<details id=\"exclusions\"><summary>Trials analysed and excluded, by phase and {_e(label)}"
+            "</summary>\n"
             f"<table class=\"exclusions\"><thead><tr>{head}</tr></thead><tbody>\n{body}</tbody></table></details>\n")
+
+
+def _model_html(model: typing.Any) -> str:
+    """The model as fitted (a formula with '~'), under the test's name; nothing for a descriptive label."""
+    return f"<br><code>{_e(model)}</code>" if isinstance(model, str) and "~" in model else ""
 
 
 def _questions_html(questions: "pandas.DataFrame", value: str) -> str:
@@ -713,7 +737,8 @@ def _questions_html(questions: "pandas.DataFrame", value: str) -> str:
         note = str(row["note"]) if isinstance(row["note"], str) else ""
         css = " class=\"not-tested\"" if note.startswith(("not tested", "not computed")) else ""
         out.append(f"<tr{css}><td>{_e(row['phase'])}</td><td>{_e(row['comparison'])}</td>"
-                   f"<td class=\"test\">{_e(row['test'] or '–')}</td><td>{_e(row['apa'] or '–')}</td>"
+                   f"<td class=\"test\">{_e(row['test'] or '–')}{_model_html(row['model'])}</td>"
+                   f"<td>{_e(row['apa'] or '–')}</td>"
                    f"<td class=\"num\">{_p_value(row['p_holm'])}</td><td class=\"num\">{difference}</td>"
                    f"<td class=\"test\">{_e(note)}</td></tr>\n")
     out.append("</tbody></table>\n")
@@ -742,14 +767,14 @@ def _phase_means_html(means: "pandas.DataFrame", value: str, design: "design_ana
             f"<tbody>\n{''.join(body)}</tbody></table>\n")
 
 
-def _retention_html(ratios: "pandas.DataFrame") -> str:
+def _retention_html(ratios: "pandas.DataFrame", factor: str) -> str:
     if ratios.empty:
         return ""
     rows = "".join(f"<tr><td>{_e(r['group'])}</td><td class=\"num\">{_integer(r['n'])}</td><td class=\"num\">"
                    f"{_significant(r['retention_ratio'])}</td><td class=\"test\">{_e(r['note'])}</td></tr>\n"
                    for r in ratios.to_dict("records"))
     return ("<table class=\"retention\"><caption>Share of the gain kept at retention, mean(pre - retention) / "
-            "mean(pre - post) per group</caption><thead><tr><th>group</th><th>n</th><th>ratio</th><th>note</th></tr>"
+            f"mean(pre - post) per {_e(factor)}</caption><thead><tr><th>{_e(factor)}</th><th>n</th><th>ratio</th><th>note</th></tr>"
             f"</thead><tbody>\n{rows}</tbody></table>\n")
 
 
@@ -835,8 +860,8 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
         width_px = round(figure.get_figwidth() * 96)
         summary_html.append(
             f"<figure><img src=\"figures/{_e(stem)}.svg\" width=\"{width_px}\" alt=\"{_e(display.label.capitalize())} "
-            f"by phase and {'group' if not within else 'condition'}\"><figcaption>{_e(display.label.capitalize())} by "
-            "phase: the mean over subjects with its 95 % t interval (each subject's analysed trials averaged first; "
+            f"by phase and {_factor_name(design)}\"><figcaption>{_e(display.label.capitalize())} by phase and "
+            f"{_factor_name(design)}: {_interval_words(design)} (each subject's analysed trials averaged first; "
             "n = subjects).</figcaption></figure>\n")
         questions = design_analysis.design_questions(trials, value, design, policy=policy, ddf=ddf,
                                                      scale=display.scale, display_unit=display.unit)
@@ -846,7 +871,7 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
         ratios = design_analysis.retention_ratios(trials, value, design, policy)
         if not ratios.empty:
             all_ratios.append(ratios.assign(value=value, unit=_si_unit(value)))
-            means_html.append(_retention_html(ratios))
+            means_html.append(_retention_html(ratios, _factor_name(design)))
         if phase is not None and not data.empty:
             stem = f"learning_{_file_name(value)}"
             figure = learning_figure(data, value, phase=None)
@@ -867,7 +892,7 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
     statistics_html = ""
     if within and not data.empty:
         table5s = [_table5(data, value) for value in values]
-        statistics_tables = [_statistics(data, value) for value in values]
+        statistics_tables = [_statistics(data, value, design.control) for value in values]
         files[tables / "summary.csv"] = pandas.DataFrame(
             [row for t in table5s for row in _summary_rows(t)]).to_csv(index=False)
         files[tables / "statistics.csv"] = pandas.concat(statistics_tables, ignore_index=True).to_csv(index=False)
@@ -890,7 +915,7 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
             _exclusions_html(exclusions, policy),
             "<section id=\"summary\">\n<h2>Summary</h2>\n<div class=\"figures\">\n", *summary_html, "</div>\n</section>\n",
             "<section id=\"questions\">\n<h2>The design's questions</h2>\n<p class=\"files\">",
-            _e(_methods_sentence(design, ddf)), "</p>\n", *question_html, "</section>\n",
+            _e(_methods_sentence(design, ddf, pandas.concat(all_questions, ignore_index=True))), "</p>\n", *question_html, "</section>\n",
             "<section id=\"phases\">\n<h2>Means by phase</h2>\n", *means_html,
             f"<p>{_e(transfer)}</p>\n" if transfer else "", "</section>\n",
             table5_html, statistics_html,
@@ -919,22 +944,60 @@ def _power_basis(trials: "pandas.DataFrame") -> str:
             "their trial-to-trial noise: the power is far too high for people")
 
 
-def _methods_sentence(design: "design_analysis.StudyDesign", ddf: str) -> str:
+_RANDOM_TERM = re.compile(r"\(([^()|]+)\|\s*([A-Za-z_.:]+)\s*\)")
+_GROUPING_WORDS = {"subject": "subject", "item": "character",
+                   "subject:item_set": "subject and item set (in a crossover: per subject and condition)"}
+
+
+def _model_words(formula: str) -> str:
+    """A fitted lme4 formula in words: its fixed effects and, from its random terms, what varies by subject and
+    by character, so that the methods sentence says what was fitted, not a template."""
+    outcome, _, right = formula.partition("~")
+    fixed = [t.strip() for t in _RANDOM_TERM.sub("", right).split("+") if t.strip()]
+    names = {"condition": "condition", "group": "group", "period": "period", "pre": "the same set's pre-test mean",
+             "sequence": "sequence"}
+    words = [f"fixed effects of {', '.join(names.get(t, t) for t in fixed)}"]
+    for inside, grouping in _RANDOM_TERM.findall(right):
+        slopes = [t.strip() for t in inside.split("+") if t.strip() not in ("1", "")]
+        who = _GROUPING_WORDS.get(grouping, grouping)
+        words.append(f"a random intercept{' and ' + ', '.join(slopes) + ' slope' if slopes else ''} per {who}")
+    return f"{outcome.strip()} ~ {right.strip()}: " + "; ".join(words)
+
+
+def _methods_sentence(design: "design_analysis.StudyDesign", ddf: str, questions: "pandas.DataFrame") -> str:
+    """The analysis as fitted: each mixed model's formula (as it was given to R) in words, then the tests and
+    the adjustment."""
     control = design.control or "the first condition"
-    parts = [f"Each {'group' if design.kind == 'between-subjects' else 'condition'} is compared with the control, "
-             f"{control}."]
-    if design.compared_phase:
-        parts.append(f"In {design.compared_phase}: a linear mixed model with subjects and characters crossed as "
-                     f"random intercepts, fitted by REML with R's lme4, t tests with {ddf} df (lmerTest); a singular "
-                     "or non-converged fit is reported without a test.")
+    parts = [f"Each {_factor_name(design)} is compared with the control, {control} (differences are "
+             f"{_factor_name(design)} - control)."]
+    mixed = questions[questions["test"].astype(str).str.startswith("linear mixed model")]
+    by_model: dict[str, list[str]] = {}
+    for row in mixed.drop_duplicates(["phase", "model"]).to_dict("records"):
+        by_model.setdefault(str(row["model"]), []).append(str(row["phase"]))
+    for model, phases in by_model.items():
+        parts.append(f"{_display(model.split(' ~ ', 1)[0].strip()).label.capitalize()} in "
+                     f"{', '.join(dict.fromkeys(phases))}: a linear mixed model, {_model_words(model)}, fitted by REML "
+                     f"with R's lme4, t tests with {ddf} df (lmerTest).")
+    if design.kind == "crossover":
+        parts.append("Each model is the one fitted: the crossover's full model has a random intercept and condition "
+                     "slope per subject and a random intercept per character; a singular fit was refitted with the "
+                     "slope's compound-symmetry form (intercepts per subject and per subject and item set), then "
+                     "without the term of the smallest variance while still singular (the table's notes say which).")
+    if by_model:
+        parts.append("A fit that stays singular, or does not converge, is reported without a test.")
+    if design.kind == "crossover":
+        parts.append("After training each test trial counts for the condition its item set was trained under, "
+                     "and period is the period that set was trained in. Checks, not adjusted: the carry-over F test "
+                     "(sequence added to the training model) and, for two conditions in two periods, Hills-Armitage's "
+                     "t test on each subject's half period difference.")
     if design.kind == "between-subjects" and design.pre_test and design.after_training:
         parts.append(f"After training ({', '.join(design.after_training)}): an ANCOVA on subject means, the phase's "
                      "mean adjusted for the pre-test mean (statsmodels OLS).")
     if design.kind == "within-subjects":
-        parts.append("Paired t-tests on subject means.")
-    parts.append("p values are Holm-adjusted within each outcome (all its comparisons against the control); g is "
-                 "Hedges' g with an approximate 95 % interval; the difference and its 95 % interval are in the "
-                 "unit of the table.")
+        parts.append("Paired t-tests on subject means, a check of the same comparison (not adjusted).")
+    parts.append("p values are Holm-adjusted within each outcome (one test per comparison against the control); g "
+                 "is Hedges' g (g_av within subjects) with an approximate 95 % interval; the difference and its 95 % "
+                 "interval are in the unit of the table.")
     return " ".join(parts)
 
 

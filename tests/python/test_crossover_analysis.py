@@ -1,0 +1,266 @@
+"""A crossover study's questions (calligraphy.crossover_analysis through design_analysis) on planted data:
+the design read with its sequences, periods and sets; every mixed-model row equal to R's lme4/lmerTest fitted
+here from the raw table by its own R code (pre-test means per subject and set, period and condition as
+factors); Hills-Armitage equal to R's t.test on half period differences; one test per comparison in the
+Holm family; n counted as subjects; a planted effect recovered, a planted null not found more often than
+chance would allow in one seed."""
+
+import math
+import os
+import shutil
+import subprocess
+import tempfile
+
+import numpy as np
+import pandas
+import pytest
+
+from calligraphy import design_analysis, mixed_models
+
+needs_r = pytest.mark.skipif(not mixed_models.r_available(), reason="R with lme4, lmerTest and pbkrtest is not "
+                             "installed (Debian: r-base-core r-cran-lme4 r-cran-lmertest r-cran-pbkrtest)")
+
+CONDITIONS = ("unguided", "amplify")  # listed order: A = unguided, B = amplify
+SETS = {"left": ("十", "人", "口"), "right": ("山", "中", "日")}
+
+
+def crossover_study(seed, subjects=16, effect_m=-0.4e-3, period_m=-0.2e-3, subject_sd_m=0.5e-3,
+                    subject_condition_sd_m=0.15e-3, item_sd_m=0.3e-3, noise_m=0.4e-3, gave_up_every=23):
+    """Subjects in sequences AB, BA and both set pairings in turn (the protocol's rule): a pre-test on both sets,
+    training by period, post-test and retention on both sets by the condition each set trained. The condition
+    effect carries to the later tests at half its size; period 2 is easier."""
+    rng = np.random.default_rng(seed)
+    items = {c: rng.normal(0.0, item_sd_m) for chars in SETS.values() for c in chars}
+    rows = []
+    for number in range(1, subjects + 1):
+        subject = f"S{number:02d}"
+        order = (0, 1) if (number - 1) % 2 == 0 else (1, 0)
+        rotation = ((number - 1) // 2) % 2
+        set_of = {CONDITIONS[k]: list(SETS)[(k + rotation) % 2] for k in range(2)}
+        period_of = {CONDITIONS[k]: p + 1 for p, k in enumerate(order)}
+        sequence = "".join("AB"[k] for k in order)
+        skill = rng.normal(0.0, subject_sd_m)
+        by_condition = {c: rng.normal(0.0, subject_condition_sd_m) for c in CONDITIONS}
+        trial = 0
+
+        def add(phase, written, item_set, character, shift, repetition=1):
+            nonlocal trial
+            trained = next(c for c in CONDITIONS if set_of[c] == item_set)
+            mean = 3e-3 + skill + items[character] + shift
+            if phase != "pre-test":
+                mean += by_condition[trained] + (period_m if period_of[trained] == 2 else 0.0)
+                if trained == "amplify":
+                    mean += effect_m if phase == "training" else effect_m / 2
+            trial += 1
+            rows.append({"subject": subject, "session_number": 1 if phase != "retention" else 2,
+                         "block": trial, "trial": trial, "phase": phase, "condition": written,
+                         "mode": "vision" if written == "unguided" else "error-amplification",
+                         "characters": character, "repetition": repetition, "item_set": item_set,
+                         "sequence": sequence, "period": float(period_of[trained]), "trained_condition": trained,
+                         "group": "", "end_reason": "given_up" if trial % gave_up_every == 0 else "completed",
+                         "mean_deviation_m": mean + rng.normal(0.0, noise_m)})
+
+        for item_set, characters in SETS.items():
+            for character in characters:
+                add("pre-test", "unguided", item_set, character, 0.0)
+        for k in order:
+            condition = CONDITIONS[k]
+            for repetition in range(1, 5):
+                for character in SETS[set_of[condition]]:
+                    add("training", condition, set_of[condition], character, -0.25e-3 * repetition, repetition)
+        for phase, shift in (("post-test", -0.9e-3), ("retention", -0.6e-3)):
+            for item_set, characters in SETS.items():
+                for character in characters:
+                    add(phase, "unguided", item_set, character, shift)
+    return pandas.DataFrame(rows)
+
+
+_R_REFERENCE = r"""
+suppressPackageStartupMessages(library(lmerTest))
+arguments <- commandArgs(trailingOnly = TRUE)
+trials <- read.csv(arguments[1], encoding = "UTF-8")
+models <- read.csv(arguments[2], encoding = "UTF-8", stringsAsFactors = FALSE)
+trials <- subset(trials, end_reason == "completed")
+pre <- aggregate(mean_deviation_m ~ subject + item_set, data = subset(trials, phase == "pre-test"), FUN = mean)
+names(pre)[3] <- "pre"
+out <- data.frame()
+for (k in seq_len(nrow(models))) {
+  data <- subset(trials, phase == models$phase[k])
+  data$outcome <- data$mean_deviation_m
+  data$condition <- factor(data$trained_condition, levels = c("unguided", "amplify"))
+  data$period <- factor(data$period)
+  data$sequence <- factor(data$sequence)
+  data$item <- data$characters
+  if (models$phase[k] != "training") {
+    data <- merge(data, pre, by = c("subject", "item_set"))
+    data$pre <- data$pre - mean(data$pre)
+  }
+  fit <- lmer(as.formula(models$formula[k]), data = data, REML = TRUE)
+  if (grepl("sequence", models$formula[k])) {
+    a <- anova(fit)
+    out <- rbind(out, data.frame(phase = models$phase[k], term = "sequence", estimate = NA,
+                                 df = a["sequence", "DenDF"], statistic = a["sequence", "F value"],
+                                 p = a["sequence", "Pr(>F)"]))
+  } else {
+    s <- summary(fit)$coefficients
+    out <- rbind(out, data.frame(phase = models$phase[k], term = "conditionamplify",
+                                 estimate = s["conditionamplify", "Estimate"], df = s["conditionamplify", "df"],
+                                 statistic = s["conditionamplify", "t value"], p = s["conditionamplify", "Pr(>|t|)"]))
+  }
+}
+# Hills-Armitage on the training means: half period differences compared between sequences.
+training <- subset(trials, phase == "training")
+means <- aggregate(mean_deviation_m ~ subject + period + sequence, data = training, FUN = mean)
+wide <- reshape(means, idvar = c("subject", "sequence"), timevar = "period", direction = "wide")
+wide$half <- (wide$mean_deviation_m.1 - wide$mean_deviation_m.2) / 2
+test <- t.test(wide$half[wide$sequence == "BA"], wide$half[wide$sequence == "AB"], var.equal = TRUE)
+out <- rbind(out, data.frame(phase = "training", term = "hills-armitage", estimate = unname(test$estimate[1] -
+                             test$estimate[2]), df = unname(test$parameter), statistic = unname(test$statistic),
+                             p = test$p.value))
+write.csv(out, arguments[3], row.names = FALSE)
+"""
+
+
+def _r_reference(trials, rows):
+    """R's answers for the models the rows name, fitted from the raw table by the script above."""
+    with tempfile.TemporaryDirectory() as folder:
+        trials.to_csv(os.path.join(folder, "trials.csv"), index=False, encoding="utf-8")
+        models = pandas.DataFrame({"phase": rows["phase"],
+                                   "formula": [m.replace("mean_deviation_m", "outcome", 1) for m in rows["model"]]})
+        models.to_csv(os.path.join(folder, "models.csv"), index=False, encoding="utf-8")
+        with open(os.path.join(folder, "reference.R"), "w", encoding="utf-8") as script:
+            script.write(_R_REFERENCE)
+        subprocess.run([shutil.which("Rscript"), "--vanilla", os.path.join(folder, "reference.R"),
+                        os.path.join(folder, "trials.csv"), os.path.join(folder, "models.csv"),
+                        os.path.join(folder, "out.csv")], check=True, capture_output=True, timeout=300)
+        return pandas.read_csv(os.path.join(folder, "out.csv"))
+
+
+def test_the_crossover_design_is_read_with_sequences_periods_and_sets():
+    design = design_analysis.study_design(crossover_study(1))
+    assert design.kind == "crossover"
+    assert design.conditions == ("unguided", "amplify") and design.control == "unguided"
+    assert design.sequences == {"AB": 8, "BA": 8}
+    assert design.periods == (1, 2)
+    assert design.letters == {"A": "unguided", "B": "amplify"}
+    assert design.item_sets == {"left": "十 人 口", "right": "山 中 日"}
+    assert design.pairing == {("amplify", "left"): 8, ("amplify", "right"): 8, ("unguided", "left"): 8,
+                              ("unguided", "right"): 8}
+    sentence = design.sentence()
+    assert "sequences AB n = 8, BA n = 8" in sentence and "left: 十 人 口" in sentence
+
+
+def test_without_the_crossover_columns_it_is_an_ordinary_within_subjects_design():
+    trials = crossover_study(1).drop(columns=["trained_condition", "period", "sequence", "item_set"])
+    assert design_analysis.study_design(trials).kind == "within-subjects"
+
+
+@needs_r
+def test_every_question_is_r_lmertest_on_the_raw_table():
+    trials = crossover_study(7)
+    questions = design_analysis.design_questions(trials, "mean_deviation_m")
+    family = questions[questions["family"] == "mean_deviation_m"]
+    checks = questions[questions["family"] == "mean_deviation_m (checks)"]
+    assert list(family["phase"]) == ["training", "post-test", "retention"]
+    assert set(family["comparison"]) == {"amplify - unguided"}
+    assert (questions["n"].dropna() == 16).all(), "n counts subjects"
+    assert family["p"].notna().all()
+    for model in family["model"]:
+        assert " + period" in model
+    assert all(" + pre + " in m for m in family["model"][1:])
+    carry = checks[checks["comparison"] == "sequence"]
+    reference = _r_reference(trials, pandas.concat([family, carry])[["phase", "model"]])
+    ours = pandas.concat([family, carry]).reset_index(drop=True)
+    for k in range(len(ours)):
+        if math.isfinite(reference.loc[k, "estimate"]):
+            assert ours.loc[k, "estimate"] == pytest.approx(reference.loc[k, "estimate"], rel=1e-6)
+        assert ours.loc[k, "df"] == pytest.approx(reference.loc[k, "df"], rel=1e-4)
+        assert ours.loc[k, "statistic"] == pytest.approx(reference.loc[k, "statistic"], rel=1e-5)
+        assert ours.loc[k, "p"] == pytest.approx(reference.loc[k, "p"], rel=1e-4)
+    hills = checks[checks["question"].str.contains("Hills-Armitage") & (checks["phase"] == "training")].iloc[0]
+    r_hills = reference[reference["term"] == "hills-armitage"].iloc[0]
+    assert hills["estimate"] == pytest.approx(r_hills["estimate"], rel=1e-9)
+    assert hills["statistic"] == pytest.approx(r_hills["statistic"], rel=1e-9)
+    assert hills["p"] == pytest.approx(r_hills["p"], rel=1e-9)
+    assert hills["df"] == 14
+
+
+@needs_r
+def test_holm_holds_one_test_per_comparison_and_the_checks_stay_raw():
+    questions = design_analysis.design_questions(crossover_study(3), "mean_deviation_m")
+    family = questions[questions["family"] == "mean_deviation_m"]
+    p = family["p"].to_numpy()
+    order = np.argsort(p)
+    expected = np.minimum(1.0, np.maximum.accumulate((len(p) - np.arange(len(p))) * p[order]))
+    assert family["p_holm"].to_numpy()[order] == pytest.approx(expected)
+    checks = questions[questions["family"].str.endswith("(checks)")]
+    assert checks["p_holm"].isna().all() and len(checks) == 4  # carry-over and three Hills-Armitage rows
+
+
+@needs_r
+def test_a_planted_effect_is_found_with_its_sign_and_size():
+    questions = design_analysis.design_questions(crossover_study(11, subjects=24), "mean_deviation_m")
+    training = questions[(questions["family"] == "mean_deviation_m") & (questions["phase"] == "training")].iloc[0]
+    assert training["ci95_low"] < -0.4e-3 < training["ci95_high"]
+    assert training["p"] < 0.05 and training["estimate"] < 0
+    post = questions[(questions["family"] == "mean_deviation_m") & (questions["phase"] == "post-test")].iloc[0]
+    assert post["ci95_low"] < -0.2e-3 < post["ci95_high"]
+
+
+@needs_r
+def test_a_planted_null_gives_no_carry_over_and_an_interval_around_zero():
+    questions = design_analysis.design_questions(crossover_study(5, effect_m=0.0), "mean_deviation_m")
+    family = questions[questions["family"] == "mean_deviation_m"]
+    assert ((family["ci95_low"] < 0) & (family["ci95_high"] > 0)).all()
+    carry = questions[questions["comparison"] == "sequence"].iloc[0]
+    assert carry["p"] > 0.05
+
+
+def test_exclusions_are_counted_by_phase_and_the_condition_each_set_trained():
+    trials = crossover_study(2)
+    _, counts = design_analysis.apply_exclusions(trials)
+    assert list(counts.columns[:2]) == ["phase", "trained_condition"]
+    training = counts[counts["phase"] == "training"].set_index("trained_condition")
+    expected = trials[trials["phase"] == "training"].groupby("trained_condition")["end_reason"].apply(
+        lambda r: int((r != "completed").sum()))
+    assert training["excluded_given_up"].to_dict() == expected.to_dict()
+
+
+def test_retention_ratios_are_per_condition_on_its_own_sets():
+    trials = crossover_study(4)
+    design = design_analysis.study_design(trials)
+    ratios = design_analysis.retention_ratios(trials, "mean_deviation_m", design)
+    assert list(ratios["group"]) == ["unguided", "amplify"]
+    assert (ratios["n"] == 16).all()
+
+
+@needs_r
+def test_a_crossover_run_by_session_run_gets_a_page_that_states_its_design(cli, tmp_path):
+    """The example protocol, 4 simulated subjects (one full rotation), through session run and the page."""
+    import pathlib
+    import re
+
+    from calligraphy import study, study_report
+
+    protocol = pathlib.Path(__file__).resolve().parents[2] / "examples" / "protocols" / "crossover.json"
+    subprocess.run([cli, "session", "run", str(protocol), "--writer", "simulated", "--subjects", "4", "--out",
+                    str(tmp_path / "xo")], check=True, capture_output=True, timeout=600)
+    loaded = study.load(tmp_path / "xo")
+    trials = loaded.trials
+    # Each subject trains each condition once, on one set, and its tests name that set's condition and period.
+    training = trials[trials["phase"] == "training"]
+    assert (training["condition"].astype(str) == training["trained_condition"].astype(str)).all()
+    per_set = trials.groupby(["subject", "item_set"], observed=True)["trained_condition"].nunique()
+    assert (per_set == 1).all()
+    assert sorted(trials.drop_duplicates("subject")["sequence"].astype(str)) == ["AB", "AB", "BA", "BA"]
+    index = study_report.write_report(loaded, tmp_path / "paper")
+    text = re.sub(r"<[^>]+>", " ", index.read_text(encoding="utf-8"))
+    assert "Crossover (within subjects)" in text and "sequences AB n = 2, BA n = 2" in text
+    assert "set1: 十 口 山" in text and "periods 1, 2" in text
+    assert "by phase and condition trained" in text
+    questions = pandas.read_csv(tmp_path / "paper" / "tables" / "questions.csv")
+    assert (questions["n"].dropna() <= 4).all(), "n counts subjects"
+    assert set(questions["comparison"]) <= {"amplify - unguided", "sequence", "condition"}
+    means = pandas.read_csv(tmp_path / "paper" / "tables" / "phase_means.csv")
+    assert set(means["condition"]) == {"unguided", "amplify"} and set(means["phase"]) == {
+        "pre-test", "training", "post-test", "retention"}
