@@ -155,15 +155,21 @@ def test_without_the_crossover_columns_it_is_an_ordinary_within_subjects_design(
     assert design_analysis.study_design(trials).kind == "within-subjects"
 
 
+@pytest.fixture(scope="module")
+def planted():
+    """One planted study and its questions, shared: each question is a few R processes."""
+    trials = crossover_study(7, subjects=20)
+    return trials, design_analysis.design_questions(trials, "mean_deviation_m")
+
+
 @needs_r
-def test_every_question_is_r_lmertest_on_the_raw_table():
-    trials = crossover_study(7)
-    questions = design_analysis.design_questions(trials, "mean_deviation_m")
+def test_every_question_is_r_lmertest_on_the_raw_table(planted):
+    trials, questions = planted
     family = questions[questions["family"] == "mean_deviation_m"]
     checks = questions[questions["family"] == "mean_deviation_m (checks)"]
     assert list(family["phase"]) == ["training", "post-test", "retention"]
     assert set(family["comparison"]) == {"amplify - unguided"}
-    assert (questions["n"].dropna() == 16).all(), "n counts subjects"
+    assert (questions["n"].dropna() == 20).all(), "n counts subjects"
     assert family["p"].notna().all()
     for model in family["model"]:
         assert " + period" in model
@@ -182,12 +188,12 @@ def test_every_question_is_r_lmertest_on_the_raw_table():
     assert hills["estimate"] == pytest.approx(r_hills["estimate"], rel=1e-9)
     assert hills["statistic"] == pytest.approx(r_hills["statistic"], rel=1e-9)
     assert hills["p"] == pytest.approx(r_hills["p"], rel=1e-9)
-    assert hills["df"] == 14
+    assert hills["df"] == 18
 
 
 @needs_r
-def test_holm_holds_one_test_per_comparison_and_the_checks_stay_raw():
-    questions = design_analysis.design_questions(crossover_study(3), "mean_deviation_m")
+def test_holm_holds_one_test_per_comparison_and_the_checks_stay_raw(planted):
+    _, questions = planted
     family = questions[questions["family"] == "mean_deviation_m"]
     p = family["p"].to_numpy()
     order = np.argsort(p)
@@ -198,8 +204,8 @@ def test_holm_holds_one_test_per_comparison_and_the_checks_stay_raw():
 
 
 @needs_r
-def test_a_planted_effect_is_found_with_its_sign_and_size():
-    questions = design_analysis.design_questions(crossover_study(11, subjects=24), "mean_deviation_m")
+def test_a_planted_effect_is_found_with_its_sign_and_size(planted):
+    _, questions = planted
     training = questions[(questions["family"] == "mean_deviation_m") & (questions["phase"] == "training")].iloc[0]
     assert training["ci95_low"] < -0.4e-3 < training["ci95_high"]
     assert training["p"] < 0.05 and training["estimate"] < 0
@@ -253,7 +259,7 @@ def test_a_crossover_run_by_session_run_gets_a_page_that_states_its_design(cli, 
     per_set = trials.groupby(["subject", "item_set"], observed=True)["trained_condition"].nunique()
     assert (per_set == 1).all()
     assert sorted(trials.drop_duplicates("subject")["sequence"].astype(str)) == ["AB", "AB", "BA", "BA"]
-    index = study_report.write_report(loaded, tmp_path / "paper")
+    index = study_report.write_report(loaded, tmp_path / "paper", values=("mean_deviation_m",))
     text = re.sub(r"<[^>]+>", " ", index.read_text(encoding="utf-8"))
     assert "Crossover (within subjects)" in text and "sequences AB n = 2, BA n = 2" in text
     assert "set1: 十 口 山" in text and "periods 1, 2" in text
@@ -264,3 +270,26 @@ def test_a_crossover_run_by_session_run_gets_a_page_that_states_its_design(cli, 
     means = pandas.read_csv(tmp_path / "paper" / "tables" / "phase_means.csv")
     assert set(means["condition"]) == {"unguided", "amplify"} and set(means["phase"]) == {
         "pre-test", "training", "post-test", "retention"}
+
+
+@needs_r
+def test_a_transfer_test_of_one_character_per_set_is_fitted_with_what_lme4_can_estimate():
+    """One transfer character per set: one trial per subject and condition, as many random slopes as trials.
+    lme4 refuses that model; the row names what it dropped, shows the formula fitted and is still a test,
+    with the pre-test of the set each transfer set comes from as covariate."""
+    trials = crossover_study(8)
+    rng = np.random.default_rng(8)
+    extra = []
+    for subject, rows in trials[trials["phase"] == "training"].groupby("subject"):
+        for condition, source in rows.groupby("trained_condition"):
+            source_set = source["item_set"].iloc[0]
+            extra.append({**source.iloc[0].to_dict(), "phase": "transfer", "item_set": f"t{source_set}",
+                          "characters": "土" if source_set == "left" else "八", "condition": "unguided",
+                          "end_reason": "completed", "mean_deviation_m": 2.5e-3 + rng.normal(0.0, 0.4e-3)})
+    trials = pandas.concat([trials, pandas.DataFrame(extra)], ignore_index=True)
+    questions = design_analysis.design_questions(trials, "mean_deviation_m")
+    transfer = questions[(questions["family"] == "mean_deviation_m") & (questions["phase"] == "transfer")].iloc[0]
+    assert "could not fit" in transfer["note"]
+    assert "(1 + condition | subject)" not in transfer["model"] and " + pre" in transfer["model"]
+    assert math.isfinite(transfer["p"]) or transfer["note"].startswith("not tested")
+    assert transfer["n"] == 16

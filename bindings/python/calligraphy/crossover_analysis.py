@@ -16,7 +16,8 @@ here, called by ``calligraphy.design_analysis`` for a design of kind 'crossover'
   lmerTest's Satterthwaite df (Jones & Kenward 2014, Design and Analysis of Cross-Over Trials, 3rd ed., ch. 2).
   The random condition slope per subject tests the condition against how much its effect varies between
   subjects (Barr, Levy, Scheepers & Tily 2013). With few subjects that fit is often singular (a variance at 0
-  or a correlation at +-1); it is then refitted with the slope's compound-symmetry form, ``(1 | subject) +
+  or a correlation at +-1), or cannot be made at all (as many random effects as trials, e.g. a transfer test
+  of one character per set); it is then refitted with the slope's compound-symmetry form, ``(1 | subject) +
   (1 | subject:item_set)`` (a subject trains each set under one condition, so subject:item_set is the
   subject's own condition effect, one variance instead of two and a correlation), and while still singular
   without the term of the smallest variance (Matuschek, Kliegl, Vasishth, Baayen & Bates 2017, J Mem Lang
@@ -112,25 +113,42 @@ _TERM_GROUP = {"(1 | subject)": "subject", "(1 | subject:item_set)": "subject:it
 def _fit(frame: "pandas.DataFrame", fixed: list[str], factors: dict, ddf: str
          ) -> tuple["mixed_models.LmerFit", list[str]]:
     """Fits ``outcome ~ fixed + random`` with the random effects the data can estimate: first the maximal
-    structure, a random condition slope per subject and an intercept per item; when that fit is singular, the
-    slope's compound-symmetry form (an intercept per subject and one per subject and item set: in a crossover
-    each subject trains a set under one condition); while singular, without the term of the smallest variance.
-    Returns the last fit and what was reduced. Raises as ``mixed_models.lmer``."""
+    structure, a random condition slope per subject and an intercept per item; when that fit is singular or
+    cannot be made (lme4 refuses as many random effects as observations, e.g. one trial per subject and
+    set), the slope's compound-symmetry form (an intercept per subject and one per subject and item set: in
+    a crossover each subject trains a set under one condition); while singular, without the term of the
+    smallest variance (while refused, without subject:item_set, then item). Returns the last fit and what
+    was reduced. Raises RUnavailable, and RuntimeError when even one random intercept cannot be fitted."""
     items = ["(1 | item)"] if frame["item"].nunique() >= 2 else []
-    maximal = "outcome ~ " + " + ".join(fixed) + " + " + " + ".join(["(1 + condition | subject)"] + items)
-    fit = mixed_models.lmer(frame, maximal, factors, ddf=ddf)
-    if not fit.singular:
-        return fit, []
-    terms = [t for t in _RANDOM_TERMS if t != "(1 | item)" or items]
-    dropped = ["the random condition slope per subject (1 + condition | subject)"]
-    while True:
-        fit = mixed_models.lmer(frame, "outcome ~ " + " + ".join(fixed) + " + " + " + ".join(terms), factors,
+    formula = "outcome ~ " + " + ".join(fixed) + " + "
+    try:
+        fit = mixed_models.lmer(frame, formula + " + ".join(["(1 + condition | subject)"] + items), factors,
                                 ddf=ddf)
+        if not fit.singular:
+            return fit, []
+        dropped = ["the random condition slope per subject (1 + condition | subject), singular"]
+    except mixed_models.RUnavailable:
+        raise
+    except RuntimeError:
+        dropped = ["the random condition slope per subject (1 + condition | subject), which lme4 could not fit"]
+    terms = [t for t in _RANDOM_TERMS if t != "(1 | item)" or items]
+    while True:
+        try:
+            fit = mixed_models.lmer(frame, formula + " + ".join(terms), factors, ddf=ddf)
+        except mixed_models.RUnavailable:
+            raise
+        except RuntimeError:
+            if len(terms) == 1:
+                raise
+            refused = next(t for t in ("(1 | subject:item_set)", "(1 | item)", "(1 | subject)") if t in terms)
+            terms.remove(refused)
+            dropped.append(f"{refused}, which lme4 could not fit")
+            continue
         if not fit.singular or len(terms) == 1:
             return fit, dropped
         smallest = min(terms, key=lambda t: fit.variances.get(_TERM_GROUP[t], 0.0))
         terms.remove(smallest)
-        dropped.append(f"{smallest} (variance {fit.variances.get(_TERM_GROUP[smallest], 0.0):.3g})")
+        dropped.append(f"{smallest}, singular (variance {fit.variances.get(_TERM_GROUP[smallest], 0.0):.3g})")
 
 
 def _factors(frame: "pandas.DataFrame", design: "StudyDesign") -> dict[str, list]:
@@ -166,7 +184,7 @@ def _fit_rows(frame: "pandas.DataFrame", fixed: list[str], base: dict, design: "
         problems.append("did not converge: " + fit.messages)
     note = ("not tested: " + "; ".join(problems)) if problems else f"variances: {variances}"
     if dropped:
-        note += "; singular with " + ", ".join(dropped) + ": refitted without"
+        note += "; refitted without " + "; ".join(dropped)
     rows = []
     for effect in fit.fixed.itertuples(index=False):
         if effect.factor != "condition":
@@ -265,7 +283,7 @@ def _carry_over_row(data: "pandas.DataFrame", value: str, design: "StudyDesign",
                  test=f"F test of sequence, lme4 {fit.ddf} ({fit.versions})", df=den_df, statistic=f, p=p,
                  apa=_f_sentence(num_df, den_df, f, p),
                  note=f"F with {num_df:.0f} and {den_df:.1f} df; a check of the design, not in the Holm family" +
-                 ("; singular with " + ", ".join(dropped) + ": refitted without" if dropped else ""))]
+                 ("; refitted without " + "; ".join(dropped) if dropped else ""))]
 
 
 def _hills_armitage_row(frame: "pandas.DataFrame", value: str, design: "StudyDesign", phase: str, what: str
@@ -307,6 +325,10 @@ def _hills_armitage_row(frame: "pandas.DataFrame", value: str, design: "StudyDes
 
 
 def _hills_armitage_rows(data: "pandas.DataFrame", value: str, design: "StudyDesign") -> list[dict]:
+    if len(design.conditions) != 2 or len(design.periods) != 2:  # one row says why, not one per phase
+        return [_row(value=value, unit=_unit(value), family=f"{value} (checks)", phase=design.compared_phase,
+                     comparison="condition", question=f"{design.compared_phase}: Hills-Armitage",
+                     note="not computed: Hills-Armitage is for 2 conditions in 2 periods")]
     rows = []
     training = _frame(trained(data[(data["phase"].astype(str) == design.compared_phase) & data[value].notna()]),
                       value)
