@@ -358,16 +358,21 @@ def questions(data: "pandas.DataFrame", value: str, design: "StudyDesign", ddf: 
     return rows
 
 
-def within_subject_means(data: "pandas.DataFrame", value: str, design: "StudyDesign") -> "pandas.DataFrame":
-    """Per phase and trained condition: n subjects, the mean of subject means, their SD (between subjects) and
-    the Cousineau-Morey within-subject 95 % interval: subject means normalised by removing each subject's mean
-    over the phase's conditions, t interval widened by sqrt(J / (J - 1)) for J conditions (Morey 2008). A
-    phase with one condition (none trained) gets the between-subjects t interval."""
+def within_subject_means(data: "pandas.DataFrame", value: str, design: "StudyDesign", by: str = "trained_condition"
+                         ) -> "pandas.DataFrame":
+    """Per phase and condition (``by``: in a crossover the condition each trial's set trained under; in another
+    within-subjects design the condition written): n subjects, the mean of subject means, their SD (between
+    subjects) and the Cousineau-Morey within-subject 95 % interval: subject means normalised by removing each
+    subject's mean over the phase's conditions, t interval widened by sqrt(J / (J - 1)) for J conditions
+    (Morey 2008). In a phase of two or more conditions only the subjects with analysed trials in every one of
+    them count (``n`` says how many): the comparison within subjects is of those subjects, and means over
+    different subjects would show who completed, not what the condition did. A phase of one condition gets
+    the between-subjects t interval."""
     from scipy import stats
 
     pandas = statistics._pandas()
     rows_of = data[data[value].notna()]
-    rows_of = rows_of.assign(arm=_text(rows_of["trained_condition"]))
+    rows_of = rows_of.assign(arm=_text(rows_of[by]))
     rows_of = rows_of[rows_of["arm"] != ""]
     out = []
     for phase in design.phases:
@@ -375,19 +380,17 @@ def within_subject_means(data: "pandas.DataFrame", value: str, design: "StudyDes
         if phase_rows.empty:
             continue
         means = phase_rows.groupby(["subject", "arm"], observed=True)[value].mean().unstack("arm")
-        conditions = [c for c in design.conditions if c in means.columns]
-        complete = means[conditions].dropna()
+        conditions = [c for c in design.conditions if c in means.columns] + [
+            c for c in means.columns if c not in design.conditions]
         j = len(conditions)
-        normalised = complete.sub(complete.mean(axis=1), axis=0) + float(complete.to_numpy().mean()) \
-            if j >= 2 else complete
+        complete = means[conditions].dropna()
+        normalised = complete.sub(complete.mean(axis=1), axis=0) if j >= 2 else complete
+        n = len(complete)
         for condition in conditions:
-            column = means[condition].dropna()
-            n = len(column)
+            column = complete[condition]
             sd = float(column.std(ddof=1)) if n > 1 else math.nan
-            spread = float(normalised[condition].std(ddof=1)) * math.sqrt(j / (j - 1)) if j >= 2 and len(
-                complete) > 1 else sd
-            count = len(complete) if j >= 2 else n
-            half = float(stats.t.ppf(0.975, count - 1)) * spread / math.sqrt(count) if count > 1 else math.nan
+            spread = float(normalised[condition].std(ddof=1)) * math.sqrt(j / (j - 1)) if j >= 2 else sd
+            half = float(stats.t.ppf(0.975, n - 1)) * spread / math.sqrt(n) if n > 1 else math.nan
             mean = float(column.mean()) if n else math.nan
             out.append({"value": value, "unit": _unit(value), "phase": phase, "condition": condition, "n": n,
                         "mean": mean, "sd": sd, "ci95_low": mean - half, "ci95_high": mean + half})

@@ -599,12 +599,14 @@ def _subjects_html(trials: "pandas.DataFrame", values: typing.Sequence[str], per
 def _phase_means(data: "pandas.DataFrame", value: str, design: "design_analysis.StudyDesign") -> "pandas.DataFrame":
     """Per phase and condition (group), the mean over subjects of each subject's mean, its SD over subjects,
     n = subjects and the 95 % t interval (the one definition of a summary on this page), in SI units. In a
-    crossover, per phase and the condition each trial's set was trained under, with Cousineau-Morey
-    within-subject intervals (``crossover_analysis.within_subject_means``)."""
+    crossover, per phase and the condition each trial's set was trained under, and in any within-subjects
+    design with Cousineau-Morey within-subject intervals (``crossover_analysis.within_subject_means``)."""
     from . import crossover_analysis, statistics
 
     if design.kind == "crossover":
         return crossover_analysis.within_subject_means(data, value, design)
+    if design.kind == "within-subjects":
+        return crossover_analysis.within_subject_means(data, value, design, by="condition")
     by = "group" if design.kind == "between-subjects" else "condition"
     rows = data[data[value].notna()]
     described = statistics.describe(rows.assign(phase=rows["phase"].astype(str), **{by: rows[by].astype(str)}),
@@ -669,9 +671,10 @@ def _factor_name(design: "design_analysis.StudyDesign") -> str:
 
 
 def _interval_words(design: "design_analysis.StudyDesign") -> str:
-    if design.kind == "crossover":
+    if design.kind in ("crossover", "within-subjects"):
         return ("the mean over subjects with its within-subject 95 % interval (Cousineau-Morey: subject means "
-                "normalised to remove each subject's level)")
+                "normalised to remove each subject's level; where a phase has several conditions, over the subjects "
+                "with analysed trials in each)")
     return "the mean over subjects with its 95 % t interval"
 
 
