@@ -424,3 +424,29 @@ TEST_CASE("crossover protocol: the tidy tables give each trial's set, sequence, 
   // S1's first row: pre-test on 人 (s2), trained first under A.
   CHECK_THAT(csv, Catch::Contains(",pre-test,1,A,vision,人,1,1,1,s2,AB,1,A,"));
 }
+
+TEST_CASE("a mixed design counts the crossover's subjects within their between-subjects group",
+          "[study][crossover]") {
+  const StudyProtocol protocol = parse_study_protocol(
+      R"({"name": "mixed", "conditions": [{"name": "A", "mode": "vision"}, {"name": "B", "mode": "haptic"},
+           {"name": "F", "mode": "haptic"}, {"name": "G", "mode": "vision"}],
+          "item_sets": [{"name": "one", "characters": ["十", "口"]}, {"name": "two", "characters": ["人", "又"]}],
+          "phases": [
+            {"phase": "training", "conditions": ["F", "G"], "assignment": "between-subjects", "characters": ["大"]},
+            {"phase": "training", "conditions": ["A", "B"], "assignment": "crossover", "sets": ["one", "two"]}]})",
+      "mixed.json");
+  // Per group, every (sequence, rotation) equally often: counted over all subjects, group and sequence would
+  // both alternate with the subject's parity and coincide.
+  std::map<std::string, std::map<std::pair<std::string, std::size_t>, int>> seen;
+  for (std::size_t number = 1; number <= 16; ++number) {
+    const SubjectAssignment subject{subject_id(number), number};
+    const CrossoverAssignment crossover = crossover_assignment(protocol, subject);
+    ++seen[subject_group(protocol, subject)][{crossover.sequence, crossover.rotation}];
+  }
+  REQUIRE(seen.size() == 2);
+  for (const auto& [group, counts] : seen) {
+    INFO("group " << group);
+    CHECK(counts.size() == 4);
+    for (const auto& [key, count] : counts) CHECK(count == 2);
+  }
+}

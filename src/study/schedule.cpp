@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <numeric>
 #include <utility>
 
 #include "calligraphy/core/errors.hpp"
@@ -117,6 +118,23 @@ std::size_t trailing_number(std::string_view subject_id) noexcept {
   return number;
 }
 
+namespace {
+
+// Subjects after which the between-subjects groups repeat: groups go in turn by number in each between phase
+// (`block_conditions`), so the pattern repeats every lcm of their sizes; under a random order they are drawn,
+// not in turn, and there is no cycle to count within.
+std::size_t between_subjects_cycle(const StudyProtocol& protocol) {
+  if (protocol.condition_order == ConditionOrder::random) return 1;
+  std::size_t cycle = 1;
+  for (const ProtocolPhase& phase : protocol.phases) {
+    if (phase.assignment == ConditionAssignment::between_subjects)
+      cycle = std::lcm(cycle, phase.conditions.size());
+  }
+  return cycle;
+}
+
+}  // namespace
+
 CrossoverAssignment crossover_assignment(const StudyProtocol& protocol, const SubjectAssignment& subject) {
   check_subject(subject);
   CrossoverAssignment out;
@@ -137,8 +155,11 @@ CrossoverAssignment crossover_assignment(const StudyProtocol& protocol, const Su
   // after each other one, equally often. The rotation, advanced once per full set of rows, moves every
   // condition over every set, so that condition and set are balanced every rows x k subjects.
   const std::size_t rows = k % 2 == 0 ? k : 2 * k;
-  const std::size_t row = (subject.number - 1) % rows;
-  out.rotation = ((subject.number - 1) / rows) % k;
+  // In a mixed design the groups of the between-subjects phases take turns by number: counted within its
+  // group, every group gets every sequence and rotation (counted over all subjects, a group would get one).
+  const std::size_t within_group = (subject.number - 1) / between_subjects_cycle(protocol);
+  const std::size_t row = within_group % rows;
+  out.rotation = (within_group / rows) % k;
   const std::vector<std::size_t> order = williams_row(k, row);
   for (std::size_t p = 0; p < k; ++p) {
     const std::size_t listed_index = order[p];

@@ -293,3 +293,39 @@ def test_a_transfer_test_of_one_character_per_set_is_fitted_with_what_lme4_can_e
     assert "(1 + condition | subject)" not in transfer["model"] and " + pre" in transfer["model"]
     assert math.isfinite(transfer["p"]) or transfer["note"].startswith("not tested")
     assert transfer["n"] == 16
+
+
+@needs_r
+def test_a_mixed_design_has_its_group_in_every_model_and_tests_the_interaction():
+    """A between-subjects group beside the crossover (each group every sequence and rotation): group is a fixed
+    effect of every model, the condition x group interaction a check, and R gives its F the same."""
+    trials = crossover_study(12)
+    number = trials["subject"].str[1:].astype(int)
+    trials["group"] = np.where(((number - 1) // 4) % 2 == 0, "early", "late")
+    design = design_analysis.study_design(trials)
+    assert design.kind == "crossover" and design.groups == {"early": 8, "late": 8}
+    assert "groups early n = 8, late n = 8" in design.sentence()
+    questions = design_analysis.design_questions(trials, "mean_deviation_m", design)
+    family = questions[questions["family"] == "mean_deviation_m"]
+    assert all(" + group" in model for model in family["model"])
+    interaction = questions[questions["comparison"] == "condition:group"].iloc[0]
+    assert interaction["family"] == "mean_deviation_m (checks)" and math.isnan(interaction["p_holm"])
+    with tempfile.TemporaryDirectory() as folder:
+        kept = trials[trials["end_reason"] == "completed"]
+        frame = kept[kept["phase"] == "training"].assign(
+            outcome=lambda t: t["mean_deviation_m"], condition=lambda t: t["trained_condition"],
+            period=lambda t: t["period"].astype(int), item=lambda t: t["characters"])
+        frame.to_csv(os.path.join(folder, "training.csv"), index=False, encoding="utf-8")
+        script = (
+            "suppressPackageStartupMessages(library(lmerTest))\n"
+            f"d <- read.csv('{folder}/training.csv', encoding = 'UTF-8')\n"
+            "d$condition <- factor(d$condition, levels = c('unguided', 'amplify')); d$period <- factor(d$period)\n"
+            "d$group <- factor(d$group, levels = c('early', 'late'))\n"
+            f"fit <- lmer({interaction['model'].replace('mean_deviation_m', 'outcome', 1)}, data = d)\n"
+            "a <- anova(fit)['condition:group', ]; cat(a[['F value']], a[['DenDF']], a[['Pr(>F)']])\n")
+        run = subprocess.run([shutil.which("Rscript"), "--vanilla", "-e", script], capture_output=True, text=True,
+                             check=True, timeout=300)
+    f, den_df, p = (float(x) for x in run.stdout.split())
+    assert interaction["statistic"] == pytest.approx(f, rel=1e-5)
+    assert interaction["df"] == pytest.approx(den_df, rel=1e-4)
+    assert interaction["p"] == pytest.approx(p, rel=1e-4)

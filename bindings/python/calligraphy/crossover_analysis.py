@@ -23,6 +23,8 @@ here, called by ``calligraphy.design_analysis`` for a design of kind 'crossover'
   without the term of the smallest variance (Matuschek, Kliegl, Vasishth, Baayen & Bates 2017, J Mem Lang
   94:305). Each row shows the formula fitted and says what was reduced. These rows form one Holm family per
   outcome.
+  A mixed design (a between-subjects phase gives each subject a ``group`` beside the crossover) has ``group``
+  as a fixed effect in every model and, as a check, the F test of the condition x group interaction.
   Checks, reported apart and not adjusted: the carry-over (sequence) F test, ``sequence`` added to the
   training model (Grizzle 1965, Biometrics 21:467: in a 2 x 2 design it is the carry-over contrast), and for
   two conditions in two periods Hills & Armitage's (1979, Br J Clin Pharmacol 8:7) two-sample t test on each
@@ -79,7 +81,8 @@ def _frame(rows: "pandas.DataFrame", value: str) -> "pandas.DataFrame":
         "sequence": _text(rows["sequence"]).to_numpy() if "sequence" in rows.columns else "",
         "subject": rows["subject"].astype(str).to_numpy(),
         "item_set": _text(rows["item_set"]).to_numpy() if "item_set" in rows.columns else "",
-        "item": rows["characters"].astype(str).to_numpy()}, index=rows.index)
+        "item": rows["characters"].astype(str).to_numpy(),
+        "group": _text(rows["group"]).to_numpy() if "group" in rows.columns else ""}, index=rows.index)
 
 
 def _row(**entries: typing.Any) -> dict[str, typing.Any]:
@@ -157,7 +160,15 @@ def _factors(frame: "pandas.DataFrame", design: "StudyDesign") -> dict[str, list
     sequences = sorted(set(frame["sequence"]) - {""})
     if sequences:
         factors["sequence"] = sequences
+    if design.groups:
+        factors["group"] = list(design.groups)
     return factors
+
+
+def _between(design: "StudyDesign") -> list[str]:
+    """A mixed design's between-subjects factor as a fixed term: the groups differ in level, which is not the
+    question but is the model's to account for."""
+    return ["group"] if design.groups else []
 
 
 def _fit_rows(frame: "pandas.DataFrame", fixed: list[str], base: dict, design: "StudyDesign", ddf: str,
@@ -206,7 +217,7 @@ def _training_rows(data: "pandas.DataFrame", value: str, design: "StudyDesign", 
     phase = design.compared_phase
     rows_of = trained(data[(data["phase"].astype(str) == phase) & data[value].notna()])
     frame = _frame(rows_of, value)
-    terms = ["condition"] + (["period"] if frame["period"].nunique() >= 2 else [])
+    terms = ["condition"] + (["period"] if frame["period"].nunique() >= 2 else []) + _between(design)
     base = {"value": value, "unit": _unit(value), "family": value, "phase": phase,
             "question": f"{phase}: condition against the control (crossover: mixed model, subjects x items "
                         "crossed, period fixed)"}
@@ -244,7 +255,8 @@ def _after_training_rows(data: "pandas.DataFrame", value: str, design: "StudyDes
     adjusted = design.pre_test is not None
     if adjusted:
         frame = _with_pre_test(frame, _pre_test_means(data, value, design), training)
-    terms = ["condition"] + (["period"] if frame["period"].nunique() >= 2 else []) + (["pre"] if adjusted else [])
+    terms = ["condition"] + (["period"] if frame["period"].nunique() >= 2 else []) + (["pre"] if adjusted else []) \
+        + _between(design)
     base = {"value": value, "unit": _unit(value), "family": value, "phase": phase,
             "question": f"{phase}: by the condition each set was trained under" +
                         (", adjusted for the same set's pre-test" if adjusted else "") + " (crossover)"}
@@ -259,31 +271,49 @@ def _f_sentence(num_df: float, den_df: float, f: float, p: float) -> str:
     return f"F({num_df:.0f}, {den}) = {f:.2f}, {p_text}"
 
 
-def _carry_over_row(data: "pandas.DataFrame", value: str, design: "StudyDesign", ddf: str) -> list[dict]:
-    """The sequence (carry-over) F test: ``sequence`` added to the training model."""
+def _f_test_row(data: "pandas.DataFrame", value: str, design: "StudyDesign", ddf: str, term: str,
+                question: str, what: str) -> list[dict]:
+    """A check of the design: ``term`` added to the training model and tested as a whole (lmerTest's F)."""
     phase = design.compared_phase
     frame = _frame(trained(data[(data["phase"].astype(str) == phase) & data[value].notna()]), value)
-    sequences = sorted(set(frame["sequence"]) - {""})
     base = {"value": value, "unit": _unit(value), "family": f"{value} (checks)", "phase": phase,
-            "comparison": "sequence", "question": f"{phase}: carry-over (do the sequences differ?)"}
-    if len(sequences) < 2 or frame["period"].nunique() < 2:
-        return [_row(**base, note="not computed: fewer than 2 sequences or periods")]
+            "comparison": term, "question": f"{phase}: {question}"}
+    if frame["period"].nunique() < 2:
+        return [_row(**base, note="not computed: fewer than 2 periods")]
     try:
-        fit, dropped = _fit(frame, ["condition", "period", "sequence"], _factors(frame, design), ddf)
+        fit, dropped = _fit(frame, ["condition", "period"] + _between(design) + [term], _factors(frame, design),
+                            ddf)
     except RuntimeError as error:
         return [_row(**base, note=f"not computed: {error}")]
     model = fit.formula.replace("outcome", value, 1)
-    term = fit.terms[fit.terms["term"] == "sequence"]
-    if term.empty or not fit.trustworthy:
-        return [_row(**base, model=model, note="not computed: no sequence term" if fit.trustworthy else
+    tested = fit.terms[fit.terms["term"] == term]
+    if tested.empty or not fit.trustworthy:
+        return [_row(**base, model=model, note=f"not computed: no {term} term" if fit.trustworthy else
                      "not tested: " + ("singular fit" if fit.singular else "did not converge"))]
-    num_df, den_df = float(term["num_df"].iloc[0]), float(term["den_df"].iloc[0])
-    f, p = float(term["f"].iloc[0]), float(term["p"].iloc[0])
+    num_df, den_df = float(tested["num_df"].iloc[0]), float(tested["den_df"].iloc[0])
+    f, p = float(tested["f"].iloc[0]), float(tested["p"].iloc[0])
     return [_row(**base, model=model, n=int(frame["subject"].nunique()),
-                 test=f"F test of sequence, lme4 {fit.ddf} ({fit.versions})", df=den_df, statistic=f, p=p,
+                 test=f"F test of {what}, lme4 {fit.ddf} ({fit.versions})", df=den_df, statistic=f, p=p,
                  apa=_f_sentence(num_df, den_df, f, p),
                  note=f"F with {num_df:.0f} and {den_df:.1f} df; a check of the design, not in the Holm family" +
                  ("; refitted without " + "; ".join(dropped) if dropped else ""))]
+
+
+def _carry_over_row(data: "pandas.DataFrame", value: str, design: "StudyDesign", ddf: str) -> list[dict]:
+    """The sequence (carry-over) F test: ``sequence`` added to the training model."""
+    if len(design.sequences) < 2:
+        return [_row(value=value, unit=_unit(value), family=f"{value} (checks)", phase=design.compared_phase,
+                     comparison="sequence", question=f"{design.compared_phase}: carry-over",
+                     note="not computed: fewer than 2 sequences")]
+    return _f_test_row(data, value, design, ddf, "sequence", "carry-over (do the sequences differ?)",
+                       "sequence (carry-over)")
+
+
+def _interaction_row(data: "pandas.DataFrame", value: str, design: "StudyDesign", ddf: str) -> list[dict]:
+    """A mixed design's question beside the condition's: does the condition's effect differ between groups?"""
+    return _f_test_row(data, value, design, ddf, "condition:group",
+                       "does the condition's effect differ between the groups? (mixed design)",
+                       "the condition x group interaction")
 
 
 def _hills_armitage_row(frame: "pandas.DataFrame", value: str, design: "StudyDesign", phase: str, what: str
@@ -354,6 +384,8 @@ def questions(data: "pandas.DataFrame", value: str, design: "StudyDesign", ddf: 
     for phase in design.after_training:
         rows += _after_training_rows(data, value, design, phase, ddf)
     rows += _carry_over_row(data, value, design, ddf)
+    if design.groups:
+        rows += _interaction_row(data, value, design, ddf)
     rows += _hills_armitage_rows(data, value, design)
     return rows
 

@@ -98,8 +98,9 @@ class StudyDesign:
     ``after_training``: the post-test, retention and transfer phases present, in order. For a 'crossover' (every
     subject trains every condition, each on its own item set, in counterbalanced sequences): ``sequences``
     (sequence -> subjects), ``periods`` (1, 2, ...), ``item_sets`` (set -> its characters) and ``pairing``
-    ((condition, set) -> subjects who trained that set under that condition) and ``letters`` (a sequence's
-    letter -> its condition)."""
+    ((condition, set) -> subjects who trained that set under that condition), ``letters`` (a sequence's
+    letter -> its condition) and, in a mixed design (a between-subjects phase beside the crossover),
+    ``groups`` (the subjects' group -> subjects)."""
 
     kind: str
     phases: tuple[str, ...]
@@ -114,6 +115,7 @@ class StudyDesign:
     item_sets: dict[str, str] = dataclasses.field(default_factory=dict)
     pairing: dict[tuple[str, str], int] = dataclasses.field(default_factory=dict)
     letters: dict[str, str] = dataclasses.field(default_factory=dict)
+    groups: dict[str, int] = dataclasses.field(default_factory=dict)
 
     def sentence(self) -> str:
         """The design in one sentence, for a report's method section."""
@@ -139,7 +141,9 @@ class StudyDesign:
         return (f"Crossover (within subjects): each of {n} subjects trained {len(self.conditions)} conditions in "
                 f"{self.compared_phase} ({counts} subjects), each on its own item set, one per period "
                 f"(periods {', '.join(str(p) for p in self.periods)}); sequences {sequences} ({letters}); item sets "
-                f"{sets}; which set each condition trained: {pairing}; phases in order: {phases}.")
+                f"{sets}; which set each condition trained: {pairing}"
+                + (f"; and between subjects, a mixed design: groups {', '.join(f'{g} n = {k}' for g, k in self.groups.items())}"
+                   if self.groups else "") + f"; phases in order: {phases}.")
 
 
 def _first_appearance(trials: pandas.DataFrame, column: str) -> list[str]:
@@ -197,7 +201,12 @@ def _crossover_parts(trials: pandas.DataFrame, compared: pandas.DataFrame) -> ty
         items = trials.loc[trials["item_set"].astype(str) == name, "characters"].astype(str)
         sets[name] = " ".join(dict.fromkeys(items))
     pairs = per_subject.groupby(["condition", "item_set"])["subject"].nunique()
-    return {"sequences": {str(k): int(v) for k, v in sequences.items()},
+    # A mixed design: the subjects' between-subjects group (from another phase of the protocol) beside it.
+    group_of = named.drop_duplicates("subject").set_index("subject")["group"].astype(str) if "group" in named.columns \
+        else None
+    groups = group_of[group_of != ""].value_counts().sort_index() if group_of is not None else None
+    return {"groups": {str(k): int(v) for k, v in groups.items()} if groups is not None and len(groups) >= 2 else {},
+            "sequences": {str(k): int(v) for k, v in sequences.items()},
             "periods": tuple(sorted(int(p) for p in named["period"].unique())), "item_sets": sets,
             "pairing": {(str(c), str(k)): int(n) for (c, k), n in pairs.items()},
             "letters": dict(sorted(letters.items()))}
@@ -215,10 +224,18 @@ def study_design(trials: pandas.DataFrame, reference: typing.Optional[str] = Non
     per_phase = trials.groupby(trials["phase"].astype(str))["condition"].nunique()
     varied = [p for p in phases if per_phase.get(p, 0) >= 2]
     compared_phase = varied[0] if varied else None
+    # A crossover is compared in its crossover phase, which a between-subjects phase (a mixed design) may precede.
+    crossover = None
+    for phase in varied:
+        crossover = _crossover_parts(trials, trials[trials["phase"].astype(str) == phase])
+        if crossover is not None:
+            compared_phase = phase
+            break
     data = trials[trials["phase"].astype(str) == compared_phase] if compared_phase else trials
     groups = data["group"].astype(str) if "group" in data.columns else None
-    crossover = _crossover_parts(trials, data)
     if crossover is not None:
+        # The crossover's own trials: a between-subjects phase of the same kind (a mixed design) is not compared.
+        data = data[data["trained_condition"].astype(str).replace({"nan": ""}) != ""]
         conditions = _condition_order(data, "condition", reference)
         counts = data.groupby(data["condition"].astype(str))["subject"].nunique()
         return StudyDesign(kind="crossover", phases=tuple(phases), conditions=tuple(conditions),

@@ -82,8 +82,11 @@ struct CrossoverAssignment {
 /// pairs listed condition i with listed set (i + q) mod k. Period p trains condition listed[row[p - 1]] on
 /// its set. Two conditions give subjects 1, 2, 3, 4: AB and BA with rotation 0, then AB and BA with rotation
 /// 1, and again: sequence, period and set are balanced every rows x k subjects (4 for two conditions, 18 for
-/// three, 16 for four). An empty assignment when the protocol has no crossover phase. Throws InvalidArgument
-/// naming the subject when its id is not a label or, with a crossover phase, its number is 0.
+/// three, 16 for four). In a mixed design (between-subjects phases beside the crossover, their groups in turn
+/// by number) the number is counted within the subject's group, m = (number - 1) / G with G the least common
+/// multiple of those phases' condition counts (1 under a random order), so that every group gets every
+/// sequence and rotation. An empty assignment when the protocol has no crossover phase. Throws
+/// InvalidArgument naming the subject when its id is not a label or, with a crossover phase, its number is 0.
 [[nodiscard]] CrossoverAssignment crossover_assignment(const StudyProtocol& protocol,
                                                        const SubjectAssignment& subject);
 
