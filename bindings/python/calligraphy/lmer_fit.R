@@ -1,83 +1,105 @@
-# Fits one linear mixed model with lme4 (Bates, Maechler, Bolker & Walker 2015, J Stat Softw 67(1)) and tests
-# its fixed effects with lmerTest's small-sample degrees of freedom (Kuznetsova, Brockhoff & Christensen 2017,
+# Fits linear mixed models with lme4 (Bates, Maechler, Bolker & Walker 2015, J Stat Softw 67(1)) and tests
+# their fixed effects with lmerTest's small-sample degrees of freedom (Kuznetsova, Brockhoff & Christensen 2017,
 # J Stat Softw 82(13)): Satterthwaite (1946) or Kenward & Roger (1997, through pbkrtest).
-# Run by calligraphy.mixed_models (python), never by hand:
-#   Rscript lmer_fit.R FOLDER FORMULA DDF
+# Run by calligraphy.mixed_models (python), never by hand, in one of two ways:
+#   Rscript lmer_fit.R FOLDER FORMULA DDF    one fit; exit status 0 when its results were written, 1 with a
+#                                            message on standard error otherwise
+#   Rscript lmer_fit.R --serve               fits one request a line from standard input, FOLDER<TAB>FORMULA<TAB>
+#                                            DDF, until end of input; after each it writes one line,
+#                                            "@@calligraphy ok" or "@@calligraphy error MESSAGE" (the marker
+#                                            tells the reply from anything a package prints). Loading lme4 and
+#                                            lmerTest takes longer than most fits, so a report loads them once.
 # FOLDER holds data.csv (UTF-8) and levels.csv (factor, level: each factor's levels in order, reference
-# first); the script writes fixed.csv, random.csv, anova.csv (one F test per term) and fit.csv (key, value)
-# there.
-# Exit status 0 when the results were written (a fit that did not converge or is singular says so in
-# fit.csv), 1 with a message on standard error otherwise.
-arguments <- commandArgs(trailingOnly = TRUE)
-if (length(arguments) != 3) stop("usage: Rscript lmer_fit.R FOLDER FORMULA DDF")
-folder <- arguments[1]
-model_formula <- stats::as.formula(arguments[2])
-ddf <- arguments[3]
-
+# first); a fit writes fixed.csv, random.csv, anova.csv (one F test per term) and fit.csv (key, value) there
+# (a fit that did not converge or is singular says so in fit.csv).
 suppressPackageStartupMessages({
   library(lme4)
   library(lmerTest)
 })
 
-data <- utils::read.csv(file.path(folder, "data.csv"), encoding = "UTF-8", stringsAsFactors = FALSE,
-                        check.names = FALSE)
-levels_table <- utils::read.csv(file.path(folder, "levels.csv"), encoding = "UTF-8", stringsAsFactors = FALSE,
-                                colClasses = "character")
-for (factor_name in unique(levels_table$factor)) {
-  ordered_levels <- levels_table$level[levels_table$factor == factor_name]
-  # An unordered factor gets R's default treatment coding, the first level (the control) the reference: each
-  # other level's coefficient, named factor followed by level, is its difference from the control.
-  data[[factor_name]] <- factor(as.character(data[[factor_name]]), levels = ordered_levels)
+fit_model <- function(folder, formula_text, ddf) {
+  model_formula <- stats::as.formula(formula_text)
+  data <- utils::read.csv(file.path(folder, "data.csv"), encoding = "UTF-8", stringsAsFactors = FALSE,
+                          check.names = FALSE)
+  levels_table <- utils::read.csv(file.path(folder, "levels.csv"), encoding = "UTF-8", stringsAsFactors = FALSE,
+                                  colClasses = "character")
+  for (factor_name in unique(levels_table$factor)) {
+    ordered_levels <- levels_table$level[levels_table$factor == factor_name]
+    # An unordered factor gets R's default treatment coding, the first level (the control) the reference: each
+    # other level's coefficient, named factor followed by level, is its difference from the control.
+    data[[factor_name]] <- factor(as.character(data[[factor_name]]), levels = ordered_levels)
+  }
+
+  messages <- character(0)
+  fit <- withCallingHandlers(
+    lmerTest::lmer(model_formula, data = data, REML = TRUE),
+    warning = function(w) {
+      messages <<- c(messages, conditionMessage(w))
+      invokeRestart("muffleWarning")
+    },
+    message = function(m) {
+      messages <<- c(messages, trimws(conditionMessage(m)))
+      invokeRestart("muffleMessage")
+    })
+  # lme4 files its "boundary (singular) fit" note with the convergence messages; singularity is reported apart.
+  convergence <- fit@optinfo$conv$lme4$messages
+  convergence <- convergence[!grepl("singular", convergence)]
+  messages <- unique(c(messages, convergence))
+  singular <- lme4::isSingular(fit)
+
+  coefficients <- summary(fit, ddf = ddf)$coefficients
+  df <- coefficients[, "df"]
+  half_width <- stats::qt(0.975, df) * coefficients[, "Std. Error"]
+  fixed <- data.frame(term = rownames(coefficients), estimate = coefficients[, "Estimate"],
+                      std_error = coefficients[, "Std. Error"], df = df, t = coefficients[, "t value"],
+                      p = coefficients[, "Pr(>|t|)"], ci95_low = coefficients[, "Estimate"] - half_width,
+                      ci95_high = coefficients[, "Estimate"] + half_width)
+  utils::write.csv(fixed, file.path(folder, "fixed.csv"), row.names = FALSE, fileEncoding = "UTF-8")
+
+  # One F test per term (lmerTest's type III table, the same df method): a factor of several levels, such as a
+  # crossover's sequence, is tested as a whole.
+  terms <- stats::anova(fit, ddf = ddf)
+  anova_table <- data.frame(term = rownames(terms), num_df = terms[, "NumDF"], den_df = terms[, "DenDF"],
+                            f = terms[, "F value"], p = terms[, "Pr(>F)"])
+  utils::write.csv(anova_table, file.path(folder, "anova.csv"), row.names = FALSE, fileEncoding = "UTF-8")
+
+  components <- as.data.frame(lme4::VarCorr(fit))
+  # One row per variance or covariance: "subject" for a random intercept alone, "subject (Intercept)" and
+  # "subject factorB" with random slopes, "subject cov (Intercept) factorB" for their covariance.
+  component_name <- ifelse(is.na(components$var1), components$grp,
+                           ifelse(is.na(components$var2),
+                                  ifelse(table(components$grp)[components$grp] > 1,
+                                         paste(components$grp, components$var1), components$grp),
+                                  paste(components$grp, "cov", components$var1, components$var2)))
+  random <- data.frame(group = component_name, variance = components$vcov)
+  utils::write.csv(random, file.path(folder, "random.csv"), row.names = FALSE, fileEncoding = "UTF-8")
+
+  info <- data.frame(
+    key = c("n_observations", "singular", "converged", "messages", "ddf", "lme4_version", "lmertest_version",
+            "r_version"),
+    value = c(stats::nobs(fit), singular, length(convergence) == 0, paste(messages, collapse = "; "), ddf,
+              as.character(utils::packageVersion("lme4")), as.character(utils::packageVersion("lmerTest")),
+              paste(R.version$major, R.version$minor, sep = ".")))
+  utils::write.csv(info, file.path(folder, "fit.csv"), row.names = FALSE, fileEncoding = "UTF-8")
 }
 
-messages <- character(0)
-fit <- withCallingHandlers(
-  lmerTest::lmer(model_formula, data = data, REML = TRUE),
-  warning = function(w) {
-    messages <<- c(messages, conditionMessage(w))
-    invokeRestart("muffleWarning")
-  },
-  message = function(m) {
-    messages <<- c(messages, trimws(conditionMessage(m)))
-    invokeRestart("muffleMessage")
-  })
-# lme4 files its "boundary (singular) fit" note with the convergence messages; singularity is reported apart.
-convergence <- fit@optinfo$conv$lme4$messages
-convergence <- convergence[!grepl("singular", convergence)]
-messages <- unique(c(messages, convergence))
-singular <- lme4::isSingular(fit)
-
-coefficients <- summary(fit, ddf = ddf)$coefficients
-df <- coefficients[, "df"]
-half_width <- stats::qt(0.975, df) * coefficients[, "Std. Error"]
-fixed <- data.frame(term = rownames(coefficients), estimate = coefficients[, "Estimate"],
-                    std_error = coefficients[, "Std. Error"], df = df, t = coefficients[, "t value"],
-                    p = coefficients[, "Pr(>|t|)"], ci95_low = coefficients[, "Estimate"] - half_width,
-                    ci95_high = coefficients[, "Estimate"] + half_width)
-utils::write.csv(fixed, file.path(folder, "fixed.csv"), row.names = FALSE, fileEncoding = "UTF-8")
-
-# One F test per term (lmerTest's type III table, the same df method): a factor of several levels, such as a
-# crossover's sequence, is tested as a whole.
-terms <- stats::anova(fit, ddf = ddf)
-anova_table <- data.frame(term = rownames(terms), num_df = terms[, "NumDF"], den_df = terms[, "DenDF"],
-                          f = terms[, "F value"], p = terms[, "Pr(>F)"])
-utils::write.csv(anova_table, file.path(folder, "anova.csv"), row.names = FALSE, fileEncoding = "UTF-8")
-
-components <- as.data.frame(lme4::VarCorr(fit))
-# One row per variance or covariance: "subject" for a random intercept alone, "subject (Intercept)" and
-# "subject factorB" with random slopes, "subject cov (Intercept) factorB" for their covariance.
-component_name <- ifelse(is.na(components$var1), components$grp,
-                         ifelse(is.na(components$var2),
-                                ifelse(table(components$grp)[components$grp] > 1,
-                                       paste(components$grp, components$var1), components$grp),
-                                paste(components$grp, "cov", components$var1, components$var2)))
-random <- data.frame(group = component_name, variance = components$vcov)
-utils::write.csv(random, file.path(folder, "random.csv"), row.names = FALSE, fileEncoding = "UTF-8")
-
-info <- data.frame(
-  key = c("n_observations", "singular", "converged", "messages", "ddf", "lme4_version", "lmertest_version",
-          "r_version"),
-  value = c(stats::nobs(fit), singular, length(convergence) == 0, paste(messages, collapse = "; "), ddf,
-            as.character(utils::packageVersion("lme4")), as.character(utils::packageVersion("lmerTest")),
-            paste(R.version$major, R.version$minor, sep = ".")))
-utils::write.csv(info, file.path(folder, "fit.csv"), row.names = FALSE, fileEncoding = "UTF-8")
+arguments <- commandArgs(trailingOnly = TRUE)
+if (length(arguments) == 1 && arguments[1] == "--serve") {
+  requests <- file("stdin", open = "r")
+  repeat {
+    line <- readLines(requests, n = 1, encoding = "UTF-8")
+    if (length(line) == 0) break
+    request <- strsplit(line, "\t", fixed = TRUE)[[1]]
+    reply <- tryCatch({
+      if (length(request) != 3) stop("expected FOLDER, FORMULA and DDF separated by tabs")
+      fit_model(request[1], request[2], request[3])
+      "ok"
+    }, error = function(e) paste("error", gsub("[\r\n\t]+", " ", conditionMessage(e))))
+    cat("@@calligraphy ", reply, "\n", sep = "")
+    flush(stdout())
+  }
+} else if (length(arguments) == 3) {
+  fit_model(arguments[1], arguments[2], arguments[3])
+} else {
+  stop("usage: Rscript lmer_fit.R FOLDER FORMULA DDF, or Rscript lmer_fit.R --serve")
+}

@@ -3,8 +3,9 @@ Walker 2015, J Stat Softw 67(1)) with lmerTest's small-sample degrees of freedom
 Christensen 2017, J Stat Softw 82(13)): Satterthwaite (1946) by default, Kenward & Roger (1997, Biometrics
 53:983) through pbkrtest.
 
-``lmer(frame, formula, factors)`` writes ``frame`` to a temporary folder and runs ``Rscript`` on the
-package's ``lmer_fit.R``; nothing is re-implemented in Python. R and its packages come from Debian:
+``lmer(frame, formula, factors)`` writes ``frame`` to a temporary folder and has R fit it with the package's
+``lmer_fit.R``; nothing is re-implemented in Python. One R process per Python process serves every fit (loading
+lme4 takes longer than most fits), started on the first and ended at exit. R and its packages come from Debian:
 ``apt-get install r-base-core r-cran-lme4 r-cran-lmertest r-cran-pbkrtest`` (scripts/install-deps.sh).
 Without them ``lmer`` raises ``RUnavailable``, which callers report as "not computed" and never replace
 with a large-sample Wald test.
@@ -12,12 +13,15 @@ with a large-sample Wald test.
 
 from __future__ import annotations
 
+import atexit
 import dataclasses
 import os
 import pathlib
 import shutil
 import subprocess
 import tempfile
+import threading
+import time
 import typing
 
 if typing.TYPE_CHECKING:  # pragma: no cover
@@ -78,6 +82,93 @@ def r_available() -> bool:
 _R_CHECKED: list[bool] = []
 
 
+class _RServer:
+    """``Rscript lmer_fit.R --serve``: one request a line, one marked reply a line. Owned by the process that
+    started it (a forked child starts its own rather than share the pipes) and used under a lock."""
+
+    _MARK = "@@calligraphy "
+
+    def __init__(self, rscript: str) -> None:
+        self.pid = os.getpid()
+        self.log = tempfile.TemporaryFile(mode="w+", encoding="utf-8")
+        self.process = subprocess.Popen([rscript, "--vanilla", str(_SCRIPT), "--serve"], stdin=subprocess.PIPE,
+                                        stdout=subprocess.PIPE, stderr=self.log, text=True, encoding="utf-8",
+                                        bufsize=1)
+
+    def fit(self, folder: str, formula: str, ddf: str, timeout_s: float) -> str:
+        """R's reply ('ok' or 'error MESSAGE'); raises TimeoutError or EOFError when R hangs or ends."""
+        import selectors
+
+        assert self.process.stdin is not None and self.process.stdout is not None
+        self.process.stdin.write(f"{folder}\t{formula}\t{ddf}\n")
+        self.process.stdin.flush()
+        deadline = time.monotonic() + timeout_s
+        with selectors.DefaultSelector() as selector:
+            selector.register(self.process.stdout, selectors.EVENT_READ)
+            while True:
+                if not selector.select(max(0.0, deadline - time.monotonic())):
+                    raise TimeoutError
+                line = self.process.stdout.readline()
+                if not line:
+                    raise EOFError(self.stderr_tail())
+                if line.startswith(self._MARK):
+                    return line[len(self._MARK):].strip()
+
+    def stderr_tail(self) -> str:
+        self.log.seek(0)
+        return " ".join(self.log.read().split())[-600:]
+
+    def close(self) -> None:
+        if self.process.poll() is None:
+            try:
+                assert self.process.stdin is not None
+                self.process.stdin.close()
+                self.process.wait(timeout=5)
+            except (OSError, subprocess.TimeoutExpired):
+                self.process.kill()
+                self.process.wait()
+        self.log.close()
+
+
+_SERVER: list[_RServer] = []
+_SERVER_LOCK = threading.Lock()
+
+
+def _close_server() -> None:
+    with _SERVER_LOCK:
+        while _SERVER:
+            server = _SERVER.pop()
+            if server.pid == os.getpid():
+                server.close()
+
+
+atexit.register(_close_server)
+
+
+def _fit_in_r(rscript: str, folder: str, formula: str, ddf: str) -> None:
+    """Has the process's R server fit the model in ``folder``; raises RuntimeError naming the formula and R's
+    message when the fit fails, R hangs past the timeout (it is then stopped) or R ends."""
+    with _SERVER_LOCK:
+        if _SERVER and (_SERVER[0].pid != os.getpid() or _SERVER[0].process.poll() is not None):
+            _SERVER.pop()  # a parent's (after fork) or one that ended: start another
+        if not _SERVER:
+            _SERVER.append(_RServer(rscript))
+        server = _SERVER[0]
+        try:
+            reply = server.fit(folder, formula, ddf, _TIMEOUT_S)
+        except TimeoutError as error:
+            _SERVER.pop()
+            server.process.kill()
+            server.close()
+            raise RuntimeError(f"lmer: R did not finish fitting {formula} in {_TIMEOUT_S:.0f} s") from error
+        except (EOFError, OSError) as error:
+            _SERVER.pop()
+            server.close()
+            raise RuntimeError(f"lmer: R ended while fitting {formula}: {error}") from error
+    if reply != "ok":
+        raise RuntimeError(f"lmer: R could not fit {formula}: {reply.removeprefix('error').strip()[-600:]}")
+
+
 def _check_r() -> str:
     rscript = shutil.which("Rscript")
     if rscript is None:
@@ -120,14 +211,7 @@ def lmer(frame: "pandas.DataFrame", formula: str, factors: typing.Mapping[str, t
         levels = [{"factor": name, "level": str(level)} for name, values in factors.items() for level in values]
         pandas.DataFrame(levels, columns=["factor", "level"]).to_csv(os.path.join(folder, "levels.csv"),
                                                                     index=False, encoding="utf-8")
-        try:
-            run = subprocess.run([rscript, "--vanilla", str(_SCRIPT), folder, formula, ddf], capture_output=True,
-                                 text=True, timeout=_TIMEOUT_S)
-        except subprocess.TimeoutExpired as error:
-            raise RuntimeError(f"lmer: R did not finish fitting {formula} in {_TIMEOUT_S:.0f} s") from error
-        if run.returncode != 0:
-            detail = " ".join(run.stderr.split())[-600:]
-            raise RuntimeError(f"lmer: R could not fit {formula}: {detail}")
+        _fit_in_r(rscript, folder, formula, ddf)
         fixed = pandas.read_csv(os.path.join(folder, "fixed.csv"), encoding="utf-8")
         random = pandas.read_csv(os.path.join(folder, "random.csv"), encoding="utf-8")
         terms = pandas.read_csv(os.path.join(folder, "anova.csv"), encoding="utf-8")

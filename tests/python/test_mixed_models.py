@@ -1,0 +1,76 @@
+"""calligraphy.mixed_models' one R process: a failed fit is an error naming the formula and R's message and
+leaves the process serving; a hung fit is stopped at the timeout and the next fit gets a new process; a forked
+child fits with its own process; every answer is the one-shot script's."""
+
+import multiprocessing
+import os
+import shutil
+import subprocess
+import tempfile
+
+import numpy as np
+import pandas
+import pytest
+
+from calligraphy import mixed_models
+
+pytestmark = pytest.mark.skipif(not mixed_models.r_available(), reason="R with lme4, lmerTest and pbkrtest is not "
+                                "installed (Debian: r-base-core r-cran-lme4 r-cran-lmertest r-cran-pbkrtest)")
+
+FORMULA = "outcome ~ condition + (1 | subject)"
+
+
+def frame(seed=1, subjects=8):
+    rng = np.random.default_rng(seed)
+    rows = [{"subject": f"S{s}", "condition": c, "outcome": 1.0 + 0.3 * (c == "b") + level + rng.normal(0, 0.2)}
+            for s, level in enumerate(rng.normal(0, 0.5, subjects)) for c in ("a", "b") for _ in range(3)]
+    return pandas.DataFrame(rows)
+
+
+def estimate(fit):
+    return float(fit.fixed.set_index("term").loc["conditionb", "estimate"])
+
+
+def test_the_served_fit_is_the_one_shot_scripts():
+    data = frame()
+    served = mixed_models.lmer(data, FORMULA, {"condition": ["a", "b"]})
+    with tempfile.TemporaryDirectory() as folder:
+        data.to_csv(os.path.join(folder, "data.csv"), index=False)
+        pandas.DataFrame({"factor": ["condition", "condition"], "level": ["a", "b"]}).to_csv(
+            os.path.join(folder, "levels.csv"), index=False)
+        subprocess.run([shutil.which("Rscript"), "--vanilla", str(mixed_models._SCRIPT), folder, FORMULA,
+                        "Satterthwaite"], check=True, capture_output=True, timeout=120)
+        fixed = pandas.read_csv(os.path.join(folder, "fixed.csv")).set_index("term")
+    assert estimate(served) == pytest.approx(float(fixed.loc["conditionb", "estimate"]), rel=1e-9)
+    assert float(served.fixed.set_index("term").loc["conditionb", "p"]) == pytest.approx(
+        float(fixed.loc["conditionb", "p"]), rel=1e-9)
+
+
+def test_a_failed_fit_names_the_formula_and_the_process_serves_on():
+    with pytest.raises(RuntimeError, match="could not fit outcome ~ condition \\+ missing_column"):
+        mixed_models.lmer(frame(), "outcome ~ condition + missing_column + (1 | subject)", {"condition": ["a", "b"]})
+    assert estimate(mixed_models.lmer(frame(), FORMULA, {"condition": ["a", "b"]})) > 0
+
+
+def test_a_fit_past_the_timeout_is_stopped_and_the_next_gets_a_new_process(monkeypatch):
+    monkeypatch.setattr(mixed_models, "_TIMEOUT_S", 1e-6)
+    with pytest.raises(RuntimeError, match="did not finish"):
+        mixed_models.lmer(frame(subjects=40), FORMULA, {"condition": ["a", "b"]})
+    monkeypatch.setattr(mixed_models, "_TIMEOUT_S", 600.0)
+    assert estimate(mixed_models.lmer(frame(), FORMULA, {"condition": ["a", "b"]})) > 0
+
+
+def _fit_in_child(queue):
+    queue.put(estimate(mixed_models.lmer(frame(), FORMULA, {"condition": ["a", "b"]})))
+
+
+def test_a_forked_child_fits_with_its_own_process():
+    parent = estimate(mixed_models.lmer(frame(), FORMULA, {"condition": ["a", "b"]}))  # the parent's process runs
+    context = multiprocessing.get_context("fork")
+    queue = context.Queue()
+    child = context.Process(target=_fit_in_child, args=(queue,))
+    child.start()
+    child.join(120)
+    assert child.exitcode == 0
+    assert queue.get(timeout=5) == pytest.approx(parent, rel=1e-12)
+    assert estimate(mixed_models.lmer(frame(), FORMULA, {"condition": ["a", "b"]})) == pytest.approx(parent)
