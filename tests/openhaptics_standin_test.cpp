@@ -28,7 +28,6 @@ namespace {
 constexpr unsigned kCommConfigError = 0x0303;    // HD_COMM_CONFIG_ERROR (hdDefines.h)
 constexpr unsigned kCalibrationManual = 0x5002;  // HD_CALIBRATION_NEEDS_MANUAL_INPUT
 constexpr unsigned kCalibrationNeedsUpdate = 0x5001;
-constexpr unsigned kCalibrationOk = 0x5000;
 constexpr int kStyleAuto = 2, kStyleInkwell = 4;
 
 // The stand-in's control API, from the same libHD.so the backend loads (CALLIGRAPHY_LIBHD).

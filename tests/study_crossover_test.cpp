@@ -17,10 +17,13 @@
 #include "calligraphy/study/schedule.hpp"
 #include "calligraphy/study/session_runner.hpp"
 #include "calligraphy/study/study_tables.hpp"
+#include "protocol_checks.hpp"
 #include "study/manifest_json.hpp"
 #include "temp_folder.hpp"
 
 using namespace calligraphy;
+using protocol_checks::check_error;
+using protocol_checks::subject_id;
 namespace fs = std::filesystem;
 
 namespace {
@@ -53,23 +56,6 @@ std::string design(int k) {
       {"phase": "retention", "condition": "A", "sets": )" +
                         sets + R"(, "session": 2, "delay_s": 86400},
       {"phase": "transfer", "condition": "A", "sets": ["t1"], "session": 2}])");
-}
-
-void check_error(const std::string& text, const std::string& pointer, const std::string& words) {
-  try {
-    (void)parse_study_protocol(text, "p.json");
-    FAIL("no error for " << text);
-  } catch (const DataError& e) {
-    const std::string message = e.what();
-    CHECK_THAT(message, Catch::StartsWith("p.json: " + pointer + ": "));
-    CHECK_THAT(message, Catch::Contains(words));
-  }
-}
-
-std::string subject_id(std::size_t number) {
-  std::string id = "S";
-  id.append(std::to_string(number));
-  return id;
 }
 
 std::vector<PlannedTrial> whole_plan(const StudyProtocol& protocol, std::size_t number) {
@@ -385,8 +371,10 @@ TEST_CASE("crossover protocol: session.json keeps each trial's set and crossover
   const LoadedProtocol plain = protocol_from_text(
       crossover_text(R"([{"phase": "test", "conditions": ["A", "B"], "characters": ["大"]}])"), "plain.json");
   SessionFolder plain_session = SessionFolder::create(temp.path / "S1", setup, plain);
-  for (const nlohmann::json& entry :
-       nlohmann::json::parse(read_text(plain_session.path() / "session.json"))["plan"]) {
+  // Parsed into a variable: a range-for over a member of a temporary would read it after its end.
+  const nlohmann::json plain_manifest =
+      nlohmann::json::parse(read_text(plain_session.path() / "session.json"));
+  for (const nlohmann::json& entry : plain_manifest["plan"]) {
     for (const char* key : {"item_set", "sequence", "period", "trained_condition"})
       CHECK_FALSE(entry.contains(key));
   }

@@ -12,8 +12,11 @@
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/schedule.hpp"
 #include "calligraphy/study/transfer_set.hpp"
+#include "protocol_checks.hpp"
 
 using namespace calligraphy;
+using protocol_checks::check_error;
+using protocol_checks::subject_id;
 
 namespace {
 
@@ -29,24 +32,6 @@ std::string protocol_text(const std::string& order = "fixed", int repetitions = 
          order + R"(", "characters": "random", "seed": 5},
     "breaks": {"between_blocks_s": 30, "every_trials": 4, "duration_s": 10})" +
          extra + "}";
-}
-
-void check_error(const std::string& text, const std::string& pointer, const std::string& words) {
-  try {
-    (void)parse_study_protocol(text, "p.json");
-    FAIL("no error for " << text);
-  } catch (const DataError& e) {
-    const std::string message = e.what();
-    CHECK_THAT(message, Catch::StartsWith("p.json: " + pointer + ": "));
-    CHECK_THAT(message, Catch::Contains(words));
-  }
-}
-
-// "S" followed by the number (appended: GCC 12 warns wrongly about `"S" + std::to_string(n)` at -O3).
-std::string subject_id(std::size_t number) {
-  std::string id = "S";
-  id.append(std::to_string(number));
-  return id;
 }
 
 }  // namespace

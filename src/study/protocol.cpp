@@ -205,7 +205,8 @@ std::map<std::u32string, std::string> read_teachers(const json& value, const std
 // Every item a replay condition names a teacher for is one the protocol writes.
 void check_teacher_items(const StudyProtocol& protocol, const std::string& source) {
   for (std::size_t i = 0; i < protocol.conditions.size(); ++i) {
-    for (const auto& [item, path] : protocol.conditions[i].teachers) {
+    for (const auto& teacher : protocol.conditions[i].teachers) {
+      const std::u32string& item = teacher.first;
       const bool written =
           std::any_of(protocol.phases.begin(), protocol.phases.end(), [&](const ProtocolPhase& p) {
             return std::find(p.items.begin(), p.items.end(), item) != p.items.end();

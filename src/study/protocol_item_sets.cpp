@@ -23,13 +23,6 @@ std::string defined_sets(const std::vector<ItemSet>& sets) {
   return names;
 }
 
-std::string in_quotes(const std::string& text) {
-  std::string out = "\"";
-  out += text;
-  out += '"';
-  return out;
-}
-
 // A character in two sets could not be attributed to one condition: the second occurrence is the error.
 void check_disjoint(const std::vector<ItemSet>& sets, const std::string& pointer, const std::string& source) {
   std::map<char32_t, std::size_t> owner;  // character -> the first set holding it

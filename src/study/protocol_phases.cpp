@@ -149,13 +149,6 @@ ProtocolPhase read_phase(const json& value, const std::string& pointer, const st
   return phase;
 }
 
-std::string quoted(const std::string& text) {
-  std::string out = "\"";
-  out += text;
-  out += '"';
-  return out;
-}
-
 bool shares_a_character(const std::u32string& item, const std::u32string& characters) {
   return std::any_of(item.begin(), item.end(),
                      [&](char32_t c) { return characters.find(c) != std::u32string::npos; });
@@ -203,7 +196,7 @@ void check_design(const StudyProtocol& protocol, const std::string& pointer, con
           if (trained.find(c) != std::u32string::npos) continue;
           // Appended, not concatenated: GCC 12 warns falsely on "x" + string (-Wrestrict).
           fail(source, item_pointer(protocol, phase, k),
-               quoted(encode_utf8(c)) + " is not trained: a test on it is a transfer test");
+               in_quotes(encode_utf8(c)) + " is not trained: a test on it is a transfer test");
         }
       }
     }
@@ -214,7 +207,7 @@ void check_design(const StudyProtocol& protocol, const std::string& pointer, con
         fail(source,
              phase.choice ? child_pointer(child_pointer(at(i, "characters"), "from"), k)
                           : item_pointer(protocol, phase, k),
-             quoted(encode_utf8(listed[k])) + " is trained: a transfer test is on characters not trained");
+             in_quotes(encode_utf8(listed[k])) + " is trained: a transfer test is on characters not trained");
       }
     }
   }

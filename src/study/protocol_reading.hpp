@@ -59,6 +59,16 @@ Enum choice(ObjectReader& reader, const std::string& key, const std::array<Enum,
   return choice_of(reader.required(key), reader.pointer(key), reader.source(), values);
 }
 
+/// `text` in double quotes, for messages ("\"x\" is trained"); not `quoted`, which argument-dependent lookup
+/// would confuse with std::quoted. Appended, not concatenated: GCC 12 warns
+/// falsely on "x" + string (-Wrestrict).
+inline std::string in_quotes(const std::string& text) {
+  std::string out = "\"";
+  out += text;
+  out += '"';
+  return out;
+}
+
 /// A list of 1 to kMaxItems strings of 1 to kMaxCharactersPerItem characters each, none a space or control
 /// character; DataError naming the pointer of the one at fault.
 std::vector<std::u32string> read_items(const nlohmann::json& value, const std::string& pointer,

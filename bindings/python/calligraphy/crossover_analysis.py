@@ -188,12 +188,7 @@ def _fit_rows(frame: "pandas.DataFrame", fixed: list[str], base: dict, design: "
     model = fit.formula.replace("outcome", value, 1)
     trusted = fit.trustworthy
     variances = ", ".join(f"{k} {v:.3g}" for k, v in fit.variances.items()) + f" [{_unit(value)}^2]"
-    problems = []
-    if fit.singular:
-        problems.append(f"singular fit (a variance estimated at 0: {variances})")
-    if not fit.converged:
-        problems.append("did not converge: " + fit.messages)
-    note = ("not tested: " + "; ".join(problems)) if problems else f"variances: {variances}"
+    note = fit.note(variances)
     if dropped:
         note += "; refitted without " + "; ".join(dropped)
     rows = []

@@ -422,12 +422,7 @@ def _training_rows(data: pandas.DataFrame, value: str, design: StudyDesign, ddf:
     trusted = fit.trustworthy
     variances = ", ".join(f"{k.lower().replace('factor', column + ' ')} {v:.3g}" for k, v in fit.variances.items())
     variances += f" [{_unit(value)}^2]"
-    problems = []
-    if fit.singular:
-        problems.append(f"singular fit (a variance estimated at 0 or a correlation at +-1: {variances})")
-    if not fit.converged:
-        problems.append("did not converge: " + fit.messages)
-    note = ("not tested: " + "; ".join(problems)) if problems else f"variances: {variances}"
+    note = fit.note(variances)
     counts = frame.groupby("factor")["subject"].nunique()
     subject_means = frame.groupby(["factor", "subject"])["outcome"].mean()
     rows = []

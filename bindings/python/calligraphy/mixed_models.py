@@ -69,6 +69,16 @@ class LmerFit:
         """Converged and not singular: only then are its tests reported as tests."""
         return self.converged and not self.singular
 
+    def note(self, variances: str) -> str:
+        """What a report says of the fit: "not tested: ..." with why (singular, with ``variances``, the variances
+        as the caller writes them; not converged, with lme4's messages), else "variances: ..."."""
+        problems = []
+        if self.singular:
+            problems.append(f"singular fit (a variance estimated at 0 or a correlation at +-1: {variances})")
+        if not self.converged:
+            problems.append("did not converge: " + self.messages)
+        return ("not tested: " + "; ".join(problems)) if problems else f"variances: {variances}"
+
 
 def r_available() -> bool:
     """Whether Rscript with lme4, lmerTest and pbkrtest can be run here."""
