@@ -1,4 +1,4 @@
-# calligraphy_module(NAME PACKAGE haptics|research|none [DEPENDS module...] [SOURCE_DIR dir] [SOURCES extra...])
+# calligraphy_module(NAME PACKAGE haptics|research|own|none [DEPENDS module...] [SOURCE_DIR dir] [SOURCES extra...])
 #
 # Declares the static library calligraphy_NAME from src/<SOURCE_DIR or NAME>/*.cpp. Its public headers
 # are include/calligraphy/NAME/; the target sees them through a folder of its own in the build tree
@@ -7,7 +7,8 @@
 # Private headers stay under src/ (PRIVATE include path); scripts/check-layering.py checks their
 # include lines too. PACKAGE names the installed package the module belongs to (docs/architecture.md,
 # "Packages"): `haptics` (what a haptic application needs), `research` (simulated writers, studies,
-# reports), or `none` (not installed).
+# reports), `own` (a component of its own, installed only when asked for by name: the USB transports, the
+# emulator), or `none` (not installed).
 set(CALLIGRAPHY_HAPTICS_MODULES "" CACHE INTERNAL "")
 set(CALLIGRAPHY_RESEARCH_MODULES "" CACHE INTERNAL "")
 
@@ -67,8 +68,8 @@ endfunction()
 
 function(calligraphy_module name)
   cmake_parse_arguments(module "" "SOURCE_DIR;PACKAGE" "DEPENDS;SOURCES" ${ARGN})
-  if(NOT module_PACKAGE MATCHES "^(haptics|research|none)$")
-    message(FATAL_ERROR "calligraphy_module(${name}): PACKAGE must be haptics, research or none")
+  if(NOT module_PACKAGE MATCHES "^(haptics|research|own|none)$")
+    message(FATAL_ERROR "calligraphy_module(${name}): PACKAGE must be haptics, research, own or none")
   endif()
   if(NOT module_SOURCE_DIR)
     set(module_SOURCE_DIR ${name})

@@ -4,8 +4,11 @@
 The modules and what each depends on directly (docs/architecture.md) are MODULE_DEPENDS below, the same graph
 as the `calligraphy_module(NAME DEPENDS ...)` lines of CMakeLists.txt (checked when that file is there, so
 the two cannot drift apart). A module may include itself and every module it reaches through the graph. The
-testing part (the emulator) is a side branch only eval and programs use. Programs (cli, bindings, tests,
-bench, examples, fuzz, trainer) may include any module. A file's module is the folder after src/ or
+testing part (the emulator) is a side branch only eval and programs use. The front-ends (PROGRAMS: the command
+line, the trainer, the Python module, the examples) stand on public headers: any module's `calligraphy/...`,
+their own folder's headers, and the private parts PROGRAMS names for each (the command line runs eval's jobs
+and opens the trainer's window); a module's private header is refused. Tests, benchmarks and fuzzers may
+include anything (they test the internals). A file's module is the folder after src/ or
 include/calligraphy/; an include's module is the folder after calligraphy/ (a public header) or the first
 folder of a private header under src/. Usage: check-layering.py [ROOT] -> exit 1 listing each bad include
 as file:line: message.
@@ -41,6 +44,14 @@ def reachable(module):
                 todo.append(dependency)
     return seen
 
+
+# Each front-end's folder, and the private parts (folders under src/) it may include besides its own.
+PROGRAMS = {
+    "src/cli": {"cli", "eval", "trainer"},
+    "src/trainer": {"trainer"},
+    "bindings/python": set(),
+    "examples": set(),
+}
 
 REACHES = {name: reachable(name) for name in MODULE_DEPENDS}
 RANK = REACHES  # the modules the checker knows
@@ -116,18 +127,40 @@ def check(root: pathlib.Path):
     return problems
 
 
+def check_programs(root: pathlib.Path):
+    """Front-ends include public headers, their own, and the private parts PROGRAMS allows them."""
+    problems = []
+    for folder, allowed in PROGRAMS.items():
+        for file in sorted((root / folder).rglob("*")):
+            if file.suffix not in (".hpp", ".cpp", ".h"):
+                continue
+            relative = pathlib.PurePosixPath(file.relative_to(root).as_posix())
+            for number, line in enumerate(file.read_text(encoding="utf-8").splitlines(), 1):
+                match = INCLUDE.match(line)
+                if not match:
+                    continue
+                parts = pathlib.PurePosixPath(match.group(1)).parts
+                if parts[0] == "calligraphy" or len(parts) == 1 or parts[0] in allowed:
+                    continue  # public, the folder's own (by name), or allowed
+                if (root / "src" / parts[0]).is_dir():
+                    problems.append(f"{relative}:{number}: the front-end {folder} includes '{match.group(1)}', "
+                                    f"a private header of src/{parts[0]}: it stands on public headers")
+    return problems
+
+
 def main():
     root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else ".").resolve()
     if not (root / "src").is_dir():
         print(f"check-layering: {root} has no src/ folder", file=sys.stderr)
         return 2
-    problems = cmake_graph_problems(root) + check(root)
+    problems = cmake_graph_problems(root) + check(root) + check_programs(root)
     for problem in problems:
         print(problem)
     if problems:
         print(f"check-layering: {len(problems)} problem(s)", file=sys.stderr)
         return 1
-    print("check-layering: every include points to the same module or one it depends on")
+    print("check-layering: every include points to the same module or one it depends on, and the front-ends "
+          "to public headers")
     return 0
 
 

@@ -59,10 +59,11 @@ TEST_CASE("Force-law parameters are validated", "[force]") {
 
 namespace {
 
-// The force-law parameters holding `law` (a replay with a teacher, so that only the table is at stake).
+// What validates `object`: the force-law parameters holding it when it is a guidance law (a replay with a
+// teacher, so that only the table is at stake), else the object itself.
 template <typename S>
-ForceLawParameters holding(const S& object) {
-  if constexpr (std::is_same_v<S, ForceLawParameters>) {
+auto holding(const S& object) {
+  if constexpr (!std::is_constructible_v<GuidanceLaw, S>) {
     return object;
   } else {
     ForceLawParameters p;
@@ -119,6 +120,10 @@ TEST_CASE("Each parameter table holds its defaults, and validation refuses just 
   check_table<ErrorAmplificationGuidance>();
   check_table<TimingGuidance>();
   CHECK(ParameterTable<FixedGuidance>::fields().empty());
+  check_table<FadingRule>();
+  check_table<AssistBandRule>();
+  check_table<SkillAdaptiveRule>();
+  check_table<StrokeAcceptance>();
 }
 
 TEST_CASE("A parameter's error names the field, its value with the unit and the range", "[force]") {

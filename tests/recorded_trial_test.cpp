@@ -15,8 +15,9 @@
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/parameter_table.hpp"
 #include "calligraphy/model/character_library.hpp"
-#include "calligraphy/render/parameter_table.hpp"
+#include "study_test_devices.hpp"
 
 using namespace calligraphy;
 
@@ -64,7 +65,11 @@ RecordedTrial random_recorded_trial(std::mt19937_64& random, GuidanceMode mode) 
   std::visit(
       [&](auto& law) {
         randomise(law, random);
-        if constexpr (requires { law.max_lead_m; }) law.max_lead_m = r.force_law.constraint_radius_m * 0.5;
+        using Law = std::decay_t<decltype(law)>;
+        if constexpr (requires { law.max_lead_m; }) {  // at most R_res: a cross-struct rule
+          law.max_lead_m =
+              0.5 * std::min(r.force_law.constraint_radius_m, parameter_field(&Law::max_lead_m).range.high);
+        }
       },
       r.force_law.guidance_law);
   if (auto* fading = std::get_if<FadingGuidance>(&r.force_law.guidance_law))
@@ -136,7 +141,7 @@ TEST_CASE("A trial run again from its record gives the same trace, bit for bit",
   spec.seed = 99;
   spec.rate_hz = 800.0;
   spec.max_duration_s = 30.0;
-  TrialRunInputs inputs;
+  TrialRunInputs inputs = study_test::trial_inputs();
   ForceLawParameters force;
   force.guidance_law = AssistAsNeededGuidance{.band_m = 0.0007};
   force.off_stroke_force_n = 0.35;  // parts a specification alone does not state
@@ -151,7 +156,7 @@ TEST_CASE("A trial run again from its record gives the same trace, bit for bit",
 
   const RecordedTrial recorded =
       read_recorded_trial(recorded_trial_json(recorded_trial(spec, first, scene)), "r.json");
-  const TrialRun again = rerun_trial(recorded, scene);
+  const TrialRun again = rerun_trial(recorded, scene, study_test::trial_inputs());
   REQUIRE(again.result.trace.size() == first.result.trace.size());
   std::size_t different = 0;
   for (std::size_t i = 0; i < first.result.trace.size(); ++i) {
@@ -162,7 +167,7 @@ TEST_CASE("A trial run again from its record gives the same trace, bit for bit",
   CHECK(different == 0);
 
   // Without the record's force law, the same specification renders another force: the record carried it.
-  const TrialRun plain = run_trial_spec(spec, scene);
+  const TrialRun plain = run_trial_spec(spec, scene, study_test::trial_inputs());
   bool same = plain.result.trace.size() == first.result.trace.size();
   for (std::size_t i = 0; same && i < first.result.trace.size(); ++i)
     same = plain.result.trace[i].force_n == first.result.trace[i].force_n;
@@ -178,7 +183,7 @@ TEST_CASE("A record run on other characters is refused", "[recorded_trial]") {
   RecordedTrial recorded = recorded_trial(spec, TrialOptions{}, nullptr, ten);
   CHECK(recorded.scene_sha256 == scene_sha256(ten));
   CHECK(scene_sha256(person) != scene_sha256(ten));
-  CHECK_THAT(error_of([&] { (void)rerun_trial(recorded, person); }),
+  CHECK_THAT(error_of([&] { (void)rerun_trial(recorded, person, study_test::trial_inputs()); }),
              Catch::Contains("not the recorded ones") && Catch::Contains("SHA-256"));
 }
 

@@ -15,6 +15,7 @@
 #include "calligraphy/study/session_runner.hpp"
 #include "calligraphy/study/session_series.hpp"
 #include "calligraphy/study/study_tables.hpp"
+#include "study_test_devices.hpp"
 #include "temp_folder.hpp"
 
 using namespace calligraphy;
@@ -56,7 +57,7 @@ StudyTables through_folders(const std::filesystem::path& root, const LoadedProto
       std::optional<PreviousSession> previous = session_series(root, subject.id, protocol).previous;
       if (previous) previous->delay = "simulated";
       SessionFolder session = SessionFolder::create(root, setup, protocol, previous);
-      REQUIRE(run_session(session).complete());
+      REQUIRE(run_session(session, study_test::run_options()).complete());
     }
   }
   return read_study_tables({root});

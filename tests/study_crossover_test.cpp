@@ -19,6 +19,7 @@
 #include "calligraphy/study/study_tables.hpp"
 #include "protocol_checks.hpp"
 #include "study/manifest_json.hpp"
+#include "study_test_devices.hpp"
 #include "temp_folder.hpp"
 
 using namespace calligraphy;
@@ -393,7 +394,7 @@ TEST_CASE("crossover protocol: the tidy tables give each trial's set, sequence, 
     setup.subject = {subject_id(number), number};
     setup.writer_seed = subject_seed(setup.subject.id);
     SessionFolder session = SessionFolder::create(temp.path / setup.subject.id, setup, protocol);
-    (void)run_session(session);
+    (void)run_session(session, study_test::run_options());
   }
   const StudyTables tables = read_study_tables({temp.path});
   REQUIRE(tables.trials.size() == 2 * 6);

@@ -1,11 +1,14 @@
 // Study protocols: parsing, errors naming the file and JSON pointer, SHA-256, schedules.
 #include <algorithm>
 #include <catch2/catch.hpp>
+#include <charconv>
+#include <cmath>
 #include <map>
 #include <optional>
 #include <random>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/study/curriculum.hpp"
@@ -195,7 +198,7 @@ TEST_CASE("fading and replay parameters and teachers are checked naming the JSON
   check_error(with_condition(R"({"name": "A", "mode": "replay", "parameters": {"start_gain": 1}})"),
               "/conditions/0/parameters/start_gain", "unknown key");
   check_error(with_condition(R"({"name": "A", "mode": "replay", "parameters": {"max_lead_m": 0}})"),
-              "/conditions/0/parameters/max_lead_m", "> 0");
+              "/conditions/0/parameters/max_lead_m", "in (0, 0.1] m (ReplayGuidance.max_lead_m)");
   check_error(with_condition(R"({"name": "A", "mode": "haptic", "teachers": {"大": "t.json"}})"),
               "/conditions/0/teachers", "replay");
   check_error(with_condition(R"({"name": "A", "mode": "replay", "teachers": {"山": "t.json"}})"),
@@ -240,9 +243,9 @@ TEST_CASE("the other guidance schedules are read with their parameters, checked 
                   R"({"name": "A", "mode": "error-amplification", "parameters": {"amplification_gain": 2}})"),
               "/conditions/0/parameters/amplification_gain", "2");
   check_error(with_condition(R"({"name": "A", "mode": "skill-adaptive", "parameters": {"threshold_m": 0}})"),
-              "/conditions/0/parameters/threshold_m", "> 0");
+              "/conditions/0/parameters/threshold_m", "in (0, 0.1] m (SkillAdaptiveRule.threshold_m)");
   check_error(with_condition(R"({"name": "A", "mode": "timing", "parameters": {"speed_m_s": 0}})"),
-              "/conditions/0/parameters/speed_m_s", "> 0");
+              "/conditions/0/parameters/speed_m_s", "in (0, 1] m/s (TimingGuidance.speed_m_s)");
   check_error(with_condition(R"({"name": "A", "mode": "haptic", "parameters": {"speed_m_s": 0.1}})"),
               "/conditions/0/parameters", "takes no parameters");
   check_error(with_condition(R"({"name": "A", "mode": "vision", "parameters": {}})"),
@@ -259,7 +262,7 @@ TEST_CASE("a quiz condition's acceptance is checked naming the key, and leniency
   check_error(with_quiz(R"({"acceptance": {"corridor": 0.005}})"), "/conditions/0/quiz/acceptance/corridor",
               "unknown key");
   check_error(with_quiz(R"({"acceptance": {"mean_deviation_m": 0}})"),
-              "/conditions/0/quiz/acceptance/mean_deviation_m", "> 0");
+              "/conditions/0/quiz/acceptance/mean_deviation_m", "in (0, 0.1] m");
   check_error(with_quiz(R"({"acceptance": {"corridor_m": 2}})"), "/conditions/0/quiz/acceptance/corridor_m",
               "2");
   check_error(with_quiz(R"({"acceptance": {"shortfall_fraction": 1}})"),
@@ -556,4 +559,71 @@ TEST_CASE("a curriculum proposes new typical strokes first, then weak ones, over
   CHECK(read[1].written == 0);
   CHECK_FALSE(read[1].mean_deviation_m);
   CHECK_THROWS_WITH(typical_stroke_record(tables, "S2"), Catch::Contains("'S2' has no saved trial"));
+}
+
+namespace {
+
+// A protocol's guidance parameter and the table entry (parameter_table.hpp) whose range it is read with.
+struct TabledKey {
+  std::string mode;
+  std::string key;
+  ParameterRange range;
+  std::string unit;
+  std::string field;  ///< "Struct.field", which an error names
+};
+
+template <typename S>
+TabledKey tabled(std::string mode, std::string key, double S::*member) {
+  const ParameterField<S>& entry = parameter_field(member);
+  return {std::move(mode), std::move(key), entry.range, std::string(entry.unit),
+          std::string(ParameterTable<S>::name) + "." + std::string(entry.name)};
+}
+
+std::string number_text(double value) {
+  char text[32];
+  const auto end = std::to_chars(text, text + sizeof text, value).ptr;
+  return std::string(text, end);
+}
+
+}  // namespace
+
+TEST_CASE("a protocol's guidance parameters are read with their laws' and rules' ranges, defined once",
+          "[study][protocol]") {
+  const std::vector<TabledKey> keys{
+      tabled("fading", "start_gain", &FadingGuidance::gain),
+      tabled("fading", "forgetting_factor", &FadingRule::forgetting_factor),
+      tabled("fading", "error_gain_per_m", &FadingRule::error_gain_per_m),
+      tabled("replay", "max_lead_m", &ReplayGuidance::max_lead_m),
+      tabled("assist-as-needed", "start_band_m", &AssistAsNeededGuidance::band_m),
+      tabled("assist-as-needed", "target_error_m", &AssistBandRule::target_error_m),
+      tabled("assist-as-needed", "band_rate", &AssistBandRule::rate),
+      tabled("assist-as-needed", "min_band_m", &AssistBandRule::min_band_m),
+      tabled("assist-as-needed", "max_band_m", &AssistBandRule::max_band_m),
+      tabled("error-amplification", "amplification_gain", &ErrorAmplificationGuidance::gain),
+      tabled("error-amplification", "max_force_n", &ErrorAmplificationGuidance::max_force_n),
+      tabled("skill-adaptive", "threshold_m", &SkillAdaptiveRule::threshold_m),
+      tabled("skill-adaptive", "max_force_n", &ErrorAmplificationGuidance::max_force_n),
+      tabled("timing", "speed_m_s", &TimingGuidance::speed_m_s),
+  };
+  for (const TabledKey& k : keys) {
+    INFO(k.mode << " " << k.key);
+    const auto protocol = [&](double value) {
+      // The widest band alongside, so that the narrowest may take its whole range (max >= min).
+      const std::string widest = k.key == "min_band_m" ? R"(, "max_band_m": 0.1)" : "";
+      return R"({"name": "t", "conditions": [{"name": "A", "mode": ")" + k.mode + R"(", "parameters": {")" +
+             k.key + R"(": )" + number_text(value) + widest +
+             R"(}}], "test": {"characters": ["大"], "conditions": ["A"], "repetitions": 1}})";
+    };
+    const ParameterRange& r = k.range;
+    const double lowest = r.low_open ? std::nextafter(r.low, INFINITY) : r.low;
+    CHECK_NOTHROW(parse_study_protocol(protocol(lowest), "p.json"));
+    check_error(protocol(r.low_open ? r.low : std::nextafter(r.low, -INFINITY)),
+                "/conditions/0/parameters/" + k.key, k.field);
+    if (std::isfinite(r.high)) {
+      const double highest = r.high_open ? std::nextafter(r.high, -INFINITY) : r.high;
+      CHECK_NOTHROW(parse_study_protocol(protocol(highest), "p.json"));
+      check_error(protocol(r.high_open ? r.high : std::nextafter(r.high, INFINITY)),
+                  "/conditions/0/parameters/" + k.key, r.text(k.unit));
+    }
+  }
 }

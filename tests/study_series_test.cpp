@@ -13,6 +13,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/study/session_runner.hpp"
 #include "calligraphy/study/session_series.hpp"
+#include "study_test_devices.hpp"
 #include "temp_folder.hpp"
 
 using namespace calligraphy;
@@ -64,7 +65,7 @@ TEST_CASE("a predecessor that ended after now is recorded as measured and read b
   fs::path first_folder;
   {
     SessionFolder first = SessionFolder::create(temp.path, setup, protocol);
-    REQUIRE(run_session(first).complete());
+    REQUIRE(run_session(first, study_test::run_options()).complete());
     first_folder = first.path();
   }
   // The last record's end from a clock 40 years ahead.

@@ -23,6 +23,7 @@
 #include "calligraphy/study/session_series.hpp"
 #include "calligraphy/study/study_tables.hpp"
 #include "probe_device.hpp"
+#include "study_test_devices.hpp"
 #include "temp_folder.hpp"
 
 using namespace calligraphy;
@@ -81,7 +82,7 @@ TEST_CASE("a session stopped mid-trial resumes without losing or overwriting a s
     // Stop 2000 ticks into the second trial.
     StopAfter host(1);
     std::size_t polls = 0;
-    SessionRunOptions options;
+    SessionRunOptions options = study_test::run_options();
     options.host = &host;
     options.should_stop = [&] { return host.ended >= 1 && ++polls > 2000; };
     const SessionRunResult result = run_session(session, options);
@@ -103,7 +104,7 @@ TEST_CASE("a session stopped mid-trial resumes without losing or overwriting a s
   }
   SessionFolder resumed = SessionFolder::open(folder);
   CHECK(resumed.next_unsaved() == std::optional<std::size_t>(1));
-  const SessionRunResult result = run_session(resumed);
+  const SessionRunResult result = run_session(resumed, study_test::run_options());
   CHECK(result.complete());
   CHECK(result.saved_before == 1);
   CHECK(result.saved_now == 2);
@@ -143,7 +144,7 @@ TEST_CASE("a session stopped between trials starts no further trial", "[study][s
   TempFolder temp;
   SessionFolder session = SessionFolder::create(temp.path, simulated("S02"), small_protocol());
   StopAfter host(1);
-  SessionRunOptions options;
+  SessionRunOptions options = study_test::run_options();
   options.host = &host;
   options.should_stop = [&] { return host.ended >= 1; };
   const SessionRunResult result = run_session(session, options);
@@ -174,7 +175,7 @@ TEST_CASE("a session stopped mid-trial logs why, and the attempt says it", "[stu
   TempFolder temp;
   SessionFolder session = SessionFolder::create(temp.path, simulated("S05"), small_protocol());
   std::size_t polls = 0;
-  SessionRunOptions options;
+  SessionRunOptions options = study_test::run_options();
   options.should_stop = [&] { return ++polls > 500; };
   options.stop_reason = [] { return std::string("display_lost"); };
   const SessionRunResult result = run_session(session, options);
@@ -201,7 +202,7 @@ TEST_CASE("a character that cannot be loaded mid-session is logged before the er
           "[study][session]") {
   TempFolder temp;
   SessionFolder session = SessionFolder::create(temp.path, simulated("S07"), small_protocol());
-  SessionRunOptions options;
+  SessionRunOptions options = study_test::run_options();
   options.load_character = [](char32_t) -> Character { throw DataError("no such character in the data"); };
   CHECK_THROWS_WITH(run_session(session, options), Catch::Contains("no such character"));
   const std::vector<nlohmann::json> events = log_events(session.path());
@@ -222,7 +223,7 @@ TEST_CASE("a device lost mid-trial keeps the attempt and stops the session namin
   registry.register_device("probe", test::ProbeDevice().info(),
                            [] { return std::make_unique<test::ProbeDevice>(/*fail_on_read=*/700); },
                            DeviceCapabilities{.moved_by_simulated_hand = true});
-  SessionRunOptions options;
+  SessionRunOptions options = study_test::run_options();
   options.registry = &registry;
   const SessionRunResult result = run_session(session, options);
   CHECK(result.device_failed);
@@ -250,7 +251,7 @@ TEST_CASE("a device that does not open is logged with the session's stop before 
   registry.register_device("unplugged", test::ProbeDevice().info(), []() -> std::unique_ptr<HapticDevice> {
     throw DeviceError("the device is not connected");
   });
-  SessionRunOptions options;
+  SessionRunOptions options = study_test::run_options();
   options.registry = &registry;
   CHECK_THROWS_WITH(run_session(session, options), Catch::Contains("not connected"));
   const std::vector<nlohmann::json> events = log_events(session.path());
@@ -266,7 +267,7 @@ TEST_CASE("a simulated subject writes the same for the same id and differently f
   std::vector<std::string> times;
   for (const char* id : {"A1", "A1", "B1"}) {
     SessionFolder session = SessionFolder::create(temp.path, simulated(id), protocol);
-    run_session(session);
+    run_session(session, study_test::run_options());
     const auto record = nlohmann::json::parse(read(session.trial_file(session.plan()[0], "json")));
     times.push_back(record["per_stroke"].dump() + record["total_time_s"].dump());
   }
@@ -297,19 +298,19 @@ TEST_CASE("a fading gain follows the previous repetition of the item, the same a
   const LoadedProtocol protocol = fading_protocol();
   // One session run straight through, one stopped after two trials and resumed: the same subject.
   SessionFolder whole = SessionFolder::create(temp.path / "whole", simulated("F1"), protocol);
-  REQUIRE(run_session(whole).complete());
+  REQUIRE(run_session(whole, study_test::run_options()).complete());
   fs::path folder;
   {
     SessionFolder session = SessionFolder::create(temp.path / "resumed", simulated("F1"), protocol);
     folder = session.path();
     StopAfter host(2);
-    SessionRunOptions options;
+    SessionRunOptions options = study_test::run_options();
     options.host = &host;
     options.should_stop = [&] { return host.ended >= 2; };
     REQUIRE(run_session(session, options).saved_now == 2);
   }
   SessionFolder resumed = SessionFolder::open(folder);
-  REQUIRE(run_session(resumed).complete());
+  REQUIRE(run_session(resumed, study_test::run_options()).complete());
 
   const StudyCondition& fade = protocol.protocol.condition("fade");
   std::map<std::u32string, std::pair<double, double>> previous;  // item -> (gain, mean deviation [mm])
@@ -343,19 +344,19 @@ TEST_CASE("an assist band and a skill-adaptive mode follow the previous repetiti
           "trial": {"max_duration_s": 40}})",
       "a.json");
   SessionFolder whole = SessionFolder::create(temp.path / "whole", simulated("A1"), protocol);
-  REQUIRE(run_session(whole).complete());
+  REQUIRE(run_session(whole, study_test::run_options()).complete());
   fs::path folder;
   {
     SessionFolder session = SessionFolder::create(temp.path / "resumed", simulated("A1"), protocol);
     folder = session.path();
     StopAfter host(4);
-    SessionRunOptions options;
+    SessionRunOptions options = study_test::run_options();
     options.host = &host;
     options.should_stop = [&] { return host.ended >= 4; };
     REQUIRE(run_session(session, options).saved_now == 4);
   }
   SessionFolder resumed = SessionFolder::open(folder);
-  REQUIRE(run_session(resumed).complete());
+  REQUIRE(run_session(resumed, study_test::run_options()).complete());
 
   const StudyCondition& band = protocol.protocol.condition("band");
   const StudyCondition& adapt = protocol.protocol.condition("adapt");
@@ -412,7 +413,7 @@ TEST_CASE("a replay condition follows a teacher kept in the session folder and n
   };
   // No teacher in the protocol: a skilled simulated writer records one into the session folder.
   SessionFolder recorded = SessionFolder::create(temp.path / "a", simulated("R1"), protocol_with(""));
-  REQUIRE(run_session(recorded).complete());
+  REQUIRE(run_session(recorded, study_test::run_options()).complete());
   const fs::path teacher_file = recorded.path() / "teachers" / "play-U5341.json";
   REQUIRE(fs::exists(teacher_file));
   const auto record = record_of(recorded, recorded.plan()[0]);
@@ -427,7 +428,7 @@ TEST_CASE("a replay condition follows a teacher kept in the session folder and n
   fs::copy_file(teacher_file, temp.path / "protocols" / "t" / "shi.json");
   SessionFolder given = SessionFolder::create(temp.path / "b", simulated("R1"),
                                               protocol_with(R"(, "teachers": {"十": "t/shi.json"})"));
-  REQUIRE(run_session(given).complete());
+  REQUIRE(run_session(given, study_test::run_options()).complete());
   const auto given_record = record_of(given, given.plan()[0]);
   CHECK(given_record["guidance"]["teacher"]["source"] == "t/shi.json");
   CHECK(given_record["guidance"]["teacher"]["sha256"] == sha256_hex(read(teacher_file)));
@@ -439,7 +440,8 @@ TEST_CASE("a replay condition follows a teacher kept in the session folder and n
   std::ofstream(temp.path / "protocols" / "t" / "ren.json") << other;
   SessionFolder wrong = SessionFolder::create(temp.path / "c", simulated("R1"),
                                               protocol_with(R"(, "teachers": {"十": "t/ren.json"})"));
-  CHECK_THROWS_WITH(run_session(wrong), Catch::Contains("condition 'play'") && Catch::Contains("人"));
+  CHECK_THROWS_WITH(run_session(wrong, study_test::run_options()),
+                    Catch::Contains("condition 'play'") && Catch::Contains("人"));
   CHECK(wrong.saved_count() == 0);
 }
 
@@ -486,7 +488,7 @@ TEST_CASE("the per-trial pages of saved sessions: a trajectory and a force figur
   const LoadedProtocol protocol = small_protocol();
   for (const char* id : {"S01", "S02"}) {
     SessionFolder session = SessionFolder::create(temp.path / "study", simulated(id), protocol);
-    run_session(session);
+    run_session(session, study_test::run_options());
   }
   const StudyReportSessions study = list_report_sessions({temp.path / "study"});
   REQUIRE(study.sessions.size() == 2);
@@ -579,7 +581,7 @@ TEST_CASE("a crash between saving a trial and logging it, or in a log line, is m
     SessionFolder session = SessionFolder::create(temp.path, simulated("S05"), small_protocol());
     folder = session.path();
     StopAfter host(1);
-    SessionRunOptions options;
+    SessionRunOptions options = study_test::run_options();
     options.host = &host;
     options.should_stop = [&] { return host.ended >= 1; };
     REQUIRE(run_session(session, options).saved_now == 1);
@@ -595,7 +597,7 @@ TEST_CASE("a crash between saving a trial and logging it, or in a log line, is m
   }
   std::ofstream(folder / "log.jsonl", std::ios::trunc) << kept << "{\"event\": \"tri";
   SessionFolder resumed = SessionFolder::open(folder);
-  REQUIRE(run_session(resumed).complete());
+  REQUIRE(run_session(resumed, study_test::run_options()).complete());
   std::ifstream log(folder / "log.jsonl");
   std::size_t saved = 0, recovered = 0, torn = 0;
   for (std::string line; std::getline(log, line);) {
@@ -619,7 +621,7 @@ TEST_CASE("a session's simulated writer is any known profile", "[study][session]
   SessionSetup setup = simulated("W1");
   setup.writer_profile = "foreign";
   SessionFolder session = SessionFolder::create(temp.path, setup, small_protocol());
-  run_session(session);
+  run_session(session, study_test::run_options());
   REQUIRE(session.is_saved(session.plan()[0]));
   CHECK(record_of(session, session.plan()[0])["writer"]["profile"]["name"] == "foreign");
   setup.writer_profile = "expert";
@@ -658,7 +660,7 @@ TEST_CASE("a protocol over two days: sessions linked, the delay recorded, groups
     first_id = first.manifest().session_id;
     CHECK(first.manifest().group == "fixture");
     StopAfter host(1);
-    SessionRunOptions options;
+    SessionRunOptions options = study_test::run_options();
     options.host = &host;
     options.should_stop = [&host] { return host.ended >= 1; };
     REQUIRE_FALSE(run_session(first, options).complete());
@@ -668,7 +670,7 @@ TEST_CASE("a protocol over two days: sessions linked, the delay recorded, groups
   CHECK(series.next == 1);
   {
     SessionFolder first = SessionFolder::open(*series.unfinished);
-    REQUIRE(run_session(first).complete());
+    REQUIRE(run_session(first, study_test::run_options()).complete());
   }
   series = session_series(temp.path, "S1", protocol);
   CHECK_FALSE(series.unfinished);
@@ -688,7 +690,7 @@ TEST_CASE("a protocol over two days: sessions linked, the delay recorded, groups
     SessionFolder second = SessionFolder::create(temp.path, setup, protocol, previous);
     second_folder = second.path();
     REQUIRE(second.plan().size() == 2);
-    REQUIRE(run_session(second).complete());
+    REQUIRE(run_session(second, study_test::run_options()).complete());
   }
   const SessionFolder reopened = SessionFolder::open(second_folder);
   REQUIRE(reopened.manifest().previous);
@@ -732,21 +734,21 @@ TEST_CASE("a learning simulated subject writes with what it learned, the same af
       first_folder = first.path();
       if (stop_after > 0) {
         StopAfter host(stop_after);
-        SessionRunOptions options;
+        SessionRunOptions options = study_test::run_options();
         options.host = &host;
         options.should_stop = [&host] { return host.ended >= host.after; };
         REQUIRE_FALSE(run_session(first, options).complete());
       }
     }
     SessionFolder first = SessionFolder::open(first_folder);
-    REQUIRE(run_session(first).complete());
+    REQUIRE(run_session(first, study_test::run_options()).complete());
     const SessionSeries series = session_series(root, "L1", protocol);
     REQUIRE(series.previous);
     PreviousSession previous = *series.previous;
     previous.delay = "simulated";
     setup.session_number = 2;
     SessionFolder second = SessionFolder::create(root, setup, protocol, previous);
-    REQUIRE(run_session(second).complete());
+    REQUIRE(run_session(second, study_test::run_options()).complete());
     // Each saved trial's bias, as its record's writer profile says, in order.
     std::vector<double> bias;
     for (const TrialRow& row : read_study_tables({root}).trials) {
@@ -787,7 +789,7 @@ TEST_CASE("a learning subject's guidance takes shape and timing apart: the fixtu
     SessionSetup setup = simulated("A1");
     setup.writer_learning = "two-state";
     SessionFolder session = SessionFolder::create(temp.path, setup, protocol);
-    REQUIRE(run_session(session).complete());
+    REQUIRE(run_session(session, study_test::run_options()).complete());
     const TrialRow last = read_study_tables({temp.path}).trials.back();
     REQUIRE(last.shape_skill);
     REQUIRE(last.timing_skill);

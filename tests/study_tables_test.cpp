@@ -14,6 +14,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/study/session_runner.hpp"
+#include "study_test_devices.hpp"
 #include "temp_folder.hpp"
 
 using namespace calligraphy;
@@ -46,7 +47,7 @@ TEST_CASE("a study's tidy tables hold every saved trial with its record's metric
     setup.subject = {id, 1};
     setup.writer_seed = subject_seed(id);
     SessionFolder session = SessionFolder::create(temp.path / id, setup, protocol);
-    (void)run_session(session);
+    (void)run_session(session, study_test::run_options());
   }
   const StudyTables tables = read_study_tables({temp.path});
   REQUIRE(tables.trials.size() == 2 * 2 * 2 * 2);  // subjects x characters x conditions x repetitions

@@ -11,6 +11,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/study/trial_spec_runner.hpp"
+#include "study_test_devices.hpp"
 
 using namespace calligraphy;
 
@@ -242,7 +243,7 @@ TEST_CASE("the runner of a specification gives the simulated writer to the trial
   spec.characters = "十";
   spec.seed = 4;
   const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'十')});
-  const TrialRun run = run_trial_spec(spec, scene);
+  const TrialRun run = run_trial_spec(spec, scene, study_test::trial_inputs());
   CHECK(run.simulated_writer);
   CHECK(run.writer_log.has_value());
   CHECK(run.result.end == TrialEnd::completed);
@@ -255,11 +256,14 @@ TEST_CASE("the runner of a specification gives the simulated writer to the trial
 
   TrialSpec person = spec;
   person.writer = TrialWriter::person;
-  CHECK_THAT(error_of([&] { (void)run_trial_spec(person, scene); }),
+  CHECK_THAT(error_of([&] { (void)run_trial_spec(person, scene, study_test::trial_inputs()); }),
              Catch::Contains("writer (--writer): 'person'"));
   TrialSpec nowhere = spec;
   nowhere.device = "no-such-device";
-  CHECK_THROWS_AS(run_trial_spec(nowhere, scene), DeviceNotFound);
+  CHECK_THROWS_AS(run_trial_spec(nowhere, scene, study_test::trial_inputs()), DeviceNotFound);
+  // The library makes no registry of its own: the caller passes one, or a device.
+  CHECK_THAT(error_of([&] { (void)run_trial_spec(spec, scene); }),
+             Catch::Contains("no device and no registry to create \"simulated\""));
 }
 
 TEST_CASE("the runner takes a force law made before the trial, whose guidance must be the specification's") {
@@ -268,7 +272,7 @@ TEST_CASE("the runner takes a force law made before the trial, whose guidance mu
   spec.seed = 4;
   spec.max_duration_s = 0.05;
   const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'十')});
-  TrialRunInputs inputs;
+  TrialRunInputs inputs = study_test::trial_inputs();
   ForceLawParameters force;
   force.guidance_stiffness_n_per_m = 250.0;
   inputs.force_law = force;

@@ -143,22 +143,14 @@ void bind_collision(py::module_& m) {
       "corridor, with a bounded mean distance, far enough along it. Lengths in m; defaults for a "
       "60 mm character from people's distances to hanzi-writer-data's medians (docs/stroke-acceptance.md).",
       [](const StrokeAcceptance& a) { a.validate(); })
-      .field("corridor_m", &StrokeAcceptance::corridor_m,
-             "farthest from the centre line that makes progress [m]")
-      .field("mean_deviation_m", &StrokeAcceptance::mean_deviation_m,
-             "largest mean distance from the centre line over the pen's path [m]")
-      .field("shortfall_m", &StrokeAcceptance::shortfall_m,
-             "how much shorter than the stroke the pen's way along it may be [m]")
-      .field("shortfall_fraction", &StrokeAcceptance::shortfall_fraction,
-             "the same as a fraction of the stroke's length, in (0, 1); the smaller applies")
-      .field("displacement_m", &StrokeAcceptance::displacement_m,
-             "how far a copy may be displaced along the stroke [m]")
-      .field("max_gain_ratio", &StrokeAcceptance::max_gain_ratio,
-             "most arc credited per length of pen motion, >= 1")
-      .field("follow_through_m", &StrokeAcceptance::follow_through_m,
-             "radius of the end neighbourhood a pen past the end may move in before it lifts [m]")
-      .field("lookahead_m", &StrokeAcceptance::lookahead_m,
-             "how far along the line the foot point is looked for around the progress [m]")
+      .field(&StrokeAcceptance::corridor_m)
+      .field(&StrokeAcceptance::mean_deviation_m)
+      .field(&StrokeAcceptance::shortfall_m)
+      .field(&StrokeAcceptance::shortfall_fraction)
+      .field(&StrokeAcceptance::displacement_m)
+      .field(&StrokeAcceptance::max_gain_ratio)
+      .field(&StrokeAcceptance::follow_through_m)
+      .field(&StrokeAcceptance::lookahead_m)
       .finish();
 
   py::enum_<StrokeRefusal>(m, "StrokeRefusal",

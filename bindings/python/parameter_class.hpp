@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "arguments.hpp"
-#include "calligraphy/render/parameter_table.hpp"
+#include "calligraphy/core/parameter_table.hpp"
 #include "numpy_arrays.hpp"
 
 namespace calligraphy::python {

@@ -65,9 +65,8 @@ void bind_guidance(py::module_& m) {
       "error-based controller with a forgetting factor of Emken, Benitez & Reinkensmeyer 2007 (J NeuroEng "
       "Rehabil 4:8), applied once per repetition.",
       [](const FadingRule& rule) { rule.validate(); })
-      .field("forgetting_factor", &FadingRule::forgetting_factor, "f in [0, 1]")
-      .field("error_gain_per_m", &FadingRule::error_gain_per_m,
-             "k [1/m], >= 0, so that 1 mm of mean deviation adds k / 1000 to the gain")
+      .field(&FadingRule::forgetting_factor)
+      .field(&FadingRule::error_gain_per_m)
       .finish();
   m.def(
       "next_guidance_gain",
@@ -90,10 +89,10 @@ rule; TypeError naming the argument for a value of the wrong type.)");
       "an error below the target widens the band (less help), above it narrows it (Emken, Bobrow & "
       "Reinkensmeyer 2005; Banala et al. 2009).",
       [](const AssistBandRule& rule) { rule.validate(); })
-      .field("target_error_m", &AssistBandRule::target_error_m, "e* [m] > 0")
-      .field("rate", &AssistBandRule::rate, "k >= 0, dimensionless")
-      .field("min_band_m", &AssistBandRule::min_band_m, "b_min [m] >= 0")
-      .field("max_band_m", &AssistBandRule::max_band_m, "b_max [m] >= b_min")
+      .field(&AssistBandRule::target_error_m)
+      .field(&AssistBandRule::rate)
+      .field(&AssistBandRule::min_band_m)
+      .field(&AssistBandRule::max_band_m)
       .finish();
   m.def(
       "next_assist_band",
@@ -112,7 +111,7 @@ negative or non-finite band or error or a bad rule.)");
       "Skill-adaptive selection (Milot et al. 2010): fixed guidance at or above threshold_m of error, error "
       "amplification below.",
       [](const SkillAdaptiveRule& rule) { rule.validate(); })
-      .field("threshold_m", &SkillAdaptiveRule::threshold_m, "error [m] > 0 from which the writer is guided")
+      .field(&SkillAdaptiveRule::threshold_m)
       .finish();
   m.def(
       "skill_adaptive_mode",

@@ -7,20 +7,16 @@
 
 namespace calligraphy::cli {
 
-DeviceRegistry& cli_device_registry() {
-  // The program's one registry: built once; the window commands add the trainer's pointer devices.
-  static DeviceRegistry registry = [] {
-    DeviceRegistry built = standard_device_registry();
-    register_phantom_usb_backends(built);
-    testing::register_emulated_phantom(built);
-    return built;
-  }();
-  return registry;
+DeviceRegistry make_cli_device_registry() {
+  DeviceRegistry devices = standard_device_registry();
+  register_phantom_usb_backends(devices);
+  testing::register_emulated_phantom(devices);
+  return devices;
 }
 
-DeviceListing find_cli_device(const char* option, const std::string& name) {
+DeviceListing find_cli_device(const DeviceRegistry& devices, const char* option, const std::string& name) {
   try {
-    return cli_device_registry().find(name);
+    return devices.find(name);
   } catch (const DeviceUnavailable&) {
     throw;
   } catch (const DeviceNotFound& e) {

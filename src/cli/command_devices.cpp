@@ -10,13 +10,13 @@
 
 namespace calligraphy::cli {
 
-void add_devices_command(CLI::App& root, Commands& commands) {
+void add_devices_command(CLI::App& root, Commands& commands, DeviceRegistry& devices) {
   auto json = std::make_shared<bool>(false);
   CLI::App* app = commands.add(root, "devices",
                                "List the haptic devices that can be opened by name, with their "
                                "limits in SI units",
-                               [json] {
-                                 const DeviceSurvey survey = cli_device_registry().survey();
+                               [json, &devices] {
+                                 const DeviceSurvey survey = devices.survey();
                                  if (*json) {
                                    write_standard_output(device_survey_json(survey));
                                  } else {

@@ -103,12 +103,12 @@ class TerminalHost final : public SessionHost {
   }
 };
 
-SessionRunOptions run_options(const LibraryOptions& library, SessionHost* host,
+SessionRunOptions run_options(const DeviceRegistry& devices, const LibraryOptions& library, SessionHost* host,
                               std::shared_ptr<CharacterSource>& source) {
   source = std::make_shared<CharacterSource>(library);
   SessionRunOptions options;
   // The force law's default stiffness is fitted to the device by the trial's runner (trial_options).
-  options.registry = &cli_device_registry();
+  options.registry = &devices;
   options.load_character = [source](char32_t c) { return source->load(c); };
   options.should_stop = [] { return stop_requested(); };
   options.stop_reason = [] {
@@ -221,12 +221,12 @@ std::vector<std::string> split_profiles(const std::string& text) {
   }
 }
 
-int run_sessions(const SessionRunCommand& command) {
+int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
 #ifdef CALLIGRAPHY_WITH_TRAINER
-  if (command.display.display == "window") trainer::register_trainer_devices(cli_device_registry());  // mouse, mouse-hand
+  if (command.display.display == "window") trainer::register_trainer_devices(devices);  // mouse, mouse-hand
 #endif
   const LoadedProtocol protocol = load_study_protocol(command.protocol);
-  const DeviceListing found_device = find_cli_device("--device", command.device);
+  const DeviceListing found_device = find_cli_device(devices, "--device", command.device);
   const DeviceListing* device = &found_device;
   // Simulated subjects rule out a person before the device is looked at.
   if (command.subjects > 0 && command.writer == kPersonWriter) {
@@ -322,7 +322,7 @@ int run_sessions(const SessionRunCommand& command) {
   install_stop_handlers();
   TerminalHost host;
   std::shared_ptr<CharacterSource> source;
-  const SessionRunOptions options = run_options(command.library, person ? &host : nullptr, source);
+  const SessionRunOptions options = run_options(devices, command.library, person ? &host : nullptr, source);
   for (std::size_t i = 0; i < subjects.size(); ++i) {
     // The subject's series: a simulated subject writes every remaining session in a row (the delays taken
     // as passed), a person the next one, when its delay has passed.
@@ -394,9 +394,9 @@ int run_sessions(const SessionRunCommand& command) {
   return 0;
 }
 
-int resume_session(const SessionResumeCommand& command) {
+int resume_session(const SessionResumeCommand& command, DeviceRegistry& devices) {
 #ifdef CALLIGRAPHY_WITH_TRAINER
-  if (command.display.display == "window") trainer::register_trainer_devices(cli_device_registry());
+  if (command.display.display == "window") trainer::register_trainer_devices(devices);
 #endif
   // Saved records are inputs: no output may replace one.
   FilePlan files;
@@ -414,8 +414,8 @@ int resume_session(const SessionResumeCommand& command) {
   install_stop_handlers();
   TerminalHost host;
   std::shared_ptr<CharacterSource> source;
-  SessionRunOptions options =
-      run_options(command.library, session.manifest().setup.writer == "human" ? &host : nullptr, source);
+  SessionRunOptions options = run_options(
+      devices, command.library, session.manifest().setup.writer == "human" ? &host : nullptr, source);
   if (!command.pacing.empty()) {
     options.pacing = parse_trial_pacing(command.pacing, "--pacing");
   }
@@ -439,7 +439,7 @@ void add_display_options(CLI::App& app, SessionDisplay& display) {
              "a number of seconds > 0", [](double s) { return s > 0.0 && s <= 86400.0; });
 }
 
-void add_session_commands(CLI::App& root, Commands& commands) {
+void add_session_commands(CLI::App& root, Commands& commands, DeviceRegistry& devices) {
   CLI::App* group = commands.add_group(
       root, "session", "Study sessions: run a protocol, resume a stopped session, simulate a cohort");
 
@@ -448,7 +448,7 @@ void add_session_commands(CLI::App& root, Commands& commands) {
       *group, "run",
       "Run a study protocol for one subject, or for N simulated subjects; SIGINT or SIGTERM stops it "
       "after keeping the running trial (exit status 128 + the signal)",
-      [run] { return run_sessions(*run); });
+      [run, &devices] { return run_sessions(*run, devices); });
   add_positional(*app, "PROTOCOL", run->protocol, "the study protocol (JSON; docs/experiments.md)", "FILE");
   add_text(*app, "--subject", run->subject, "ID",
            "the subject's id (letters, digits, '_', '-'); with --subjects, the prefix of the simulated ids",
@@ -496,7 +496,7 @@ void add_session_commands(CLI::App& root, Commands& commands) {
   auto resume = std::make_shared<SessionResumeCommand>();
   CLI::App* resume_app =
       commands.add(*group, "resume", "Go on with a stopped or crashed session from its first unsaved trial",
-                   [resume] { return resume_session(*resume); });
+                   [resume, &devices] { return resume_session(*resume, devices); });
   add_positional(*resume_app, "DIR", resume->folder, "the session folder (the one holding session.json)",
                  "DIR");
   add_choice(*resume_app, "--pacing", resume->pacing, {"auto", "lock-step", "real-time"},

@@ -7,16 +7,16 @@
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "calligraphy/devices/device_registry.hpp"
-#include "calligraphy/report/teacher_recording.hpp"
 #include "calligraphy/devices/hand_port.hpp"
+#include "calligraphy/report/teacher_recording.hpp"
+#include "calligraphy/study/schedule.hpp"
 #include "cli/cli_devices.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 #include "cli/output.hpp"
 #include "cli/writer_options.hpp"
-#include "calligraphy/core/unicode.hpp"
-#include "study/names.hpp"
 #ifdef CALLIGRAPHY_WITH_TRAINER
 #include "trainer/trainer.hpp"
 #endif
@@ -79,21 +79,19 @@ std::pair<int, int> window_size(const std::string& text) {
   return {width, height};
 }
 
-void require_device(const std::string& name) { static_cast<void>(find_cli_device("--device", name)); }
-
-int run_train(const TrainCommand& command) {
+int run_train(const TrainCommand& command, DeviceRegistry& devices) {
   check_train_files(command);
-  trainer::register_trainer_devices(cli_device_registry());
+  trainer::register_trainer_devices(devices);
   const std::u32string chars = characters_from(command.characters, "CHARS");
   trainer::TrainerOptions options;
   options.simulated_writer = command.writer == "simulated";
   options.device = !command.device.empty()    ? command.device
                    : options.simulated_writer ? "simulated"
                                               : "mouse-hand";
-  options.registry = &cli_device_registry();  // the command line's devices, the mouse ones included
-  require_device(options.device);
+  options.registry = &devices;  // the command line's devices, the mouse ones included
+  static_cast<void>(find_cli_device(devices, "--device", options.device));
   {  // a simulated writer moves only a device with a hand port; a person moves any other
-    const bool hand_port = cli_device_registry().find(options.device).capabilities.moved_by_simulated_hand;
+    const bool hand_port = devices.find(options.device).capabilities.moved_by_simulated_hand;
     if (options.simulated_writer && !hand_port) {
       throw UsageError(
           "--writer simulated needs a device a simulated writer can move (simulated, "
@@ -130,7 +128,7 @@ int run_train(const TrainCommand& command) {
   options.seed = command.seed;
   options.session_dir = command.session;
   options.subject = command.subject;
-  if (!study_detail::is_label(command.subject, 64)) {
+  if (!is_subject_id(command.subject)) {
     throw UsageError("--subject: '" + command.subject +
                      "' must be 1-64 characters of A-Z a-z 0-9 _ - (it names the session folder)");
   }
@@ -156,7 +154,7 @@ int run_train(const TrainCommand& command) {
   return trainer::run_trainer(options);
 }
 #else
-int run_train(const TrainCommand& command) {
+int run_train(const TrainCommand& command, DeviceRegistry&) {
   check_train_files(command);  // wrong options are reported as such in this build too
   throw Error(
       "this calligraphy was built without the trainer window (CALLIGRAPHY_BUILD_TRAINER=OFF; it needs GLFW 3 "
@@ -166,10 +164,10 @@ int run_train(const TrainCommand& command) {
 
 }  // namespace
 
-void add_train_command(CLI::App& root, Commands& commands) {
+void add_train_command(CLI::App& root, Commands& commands, DeviceRegistry& devices) {
   auto command = std::make_shared<TrainCommand>();
   CLI::App* app = commands.add(root, "train", "Practise CHARS in a window: a live guided trial in real time",
-                               [command] { return run_train(*command); });
+                               [command, &devices] { return run_train(*command, devices); });
   add_positional(*app, "CHARS", command->characters, "the characters to practise, left to right (UTF-8)");
   add_text(*app, "--device", command->device, "NAME",
            "the device: mouse, mouse-hand (docs/devices.md), a haptic device, or simulated with --writer "

@@ -107,7 +107,9 @@ RecordedTrial recorded_from(const TrialCommand& command) {
 // The listing of `name`. A name no backend knows is a UsageError (exit 2) naming the devices there are; a
 // known device that cannot be used now (DeviceUnavailable: no arm, a damaged driver library) keeps its
 // own error, with its reason (exit 1).
-DeviceListing find_device(const std::string& name) { return find_cli_device("--device", name); }
+DeviceListing find_device(const DeviceRegistry& devices, const std::string& name) {
+  return find_cli_device(devices, "--device", name);
+}
 
 // The trial specification of the command line: every option given goes through the specification's one
 // parser (trial_spec.hpp) and its validate(); an error there is a usage error naming the option.
@@ -215,7 +217,7 @@ bool write_teacher_recording(const TrialSpec& spec, const TrialDescription& desc
   return false;
 }
 
-int run_trial(const TrialCommand& command) {
+int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
   require_one_standard_output(
       {{"--json", command.json == "-"}, {"--svg", command.svg == "-"}, {"--csv", command.csv == "-"}});
   std::optional<RecordedTrial> recorded;
@@ -229,7 +231,7 @@ int run_trial(const TrialCommand& command) {
                    "CHARS");
   const TrialSpec spec = recorded ? recorded->spec : spec_from(command);
   const std::u32string chars = characters_from(spec.characters, "CHARS");
-  const DeviceListing device = find_device(spec.device);
+  const DeviceListing device = find_device(devices, spec.device);
   bool simulated = false;
   try {
     simulated = simulated_writer_writes(spec, simulated_writer_moves(device));
@@ -277,7 +279,7 @@ int run_trial(const TrialCommand& command) {
   }
 
   TrialRunInputs inputs;
-  inputs.registry = &cli_device_registry();
+  inputs.registry = &devices;
   inputs.should_stop = StopSignals::stop_requested();
   TrialRun run;
   try {
@@ -327,10 +329,10 @@ std::string spec_help(std::string_view key) {
 
 }  // namespace
 
-void add_trial_command(CLI::App& root, Commands& commands) {
+void add_trial_command(CLI::App& root, Commands& commands, DeviceRegistry& devices) {
   auto command = std::make_shared<TrialCommand>();
   CLI::App* app = commands.add(root, "trial", "Run a guided writing trial of CHARS on a haptic device",
-                               [command] { return run_trial(*command); });
+                               [command, &devices] { return run_trial(*command, devices); });
   command->app = app;
   add_positional(*app, "CHARS", command->characters, "the characters to write, left to right (UTF-8)")
       ->required(false);

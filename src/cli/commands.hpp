@@ -2,20 +2,22 @@
 // The commands of the `calligraphy` program. Each adds its subcommand (options, help) to the root and
 // registers what runs it; the run writes its report to stdout or to files and returns the exit status.
 // Errors are thrown (calligraphy::Error, UsageError) and turned into one line and a status by main().
+#include "calligraphy/devices/device_registry.hpp"
 #include "cli/app.hpp"
 
 namespace calligraphy::cli {
 
-void add_trial_command(CLI::App& root, Commands& commands);     // trial CHARS [...]
-void add_train_command(CLI::App& root, Commands& commands);     // train CHARS [...] (the trainer window)
+void add_trial_command(CLI::App& root, Commands& commands, DeviceRegistry& devices);  // trial CHARS [...]
+void add_train_command(CLI::App& root, Commands& commands,
+                       DeviceRegistry& devices);                // train CHARS [...] (the trainer window)
 void add_score_command(CLI::App& root, Commands& commands);     // score TRACE.csv --character C [...]
 void add_trace_command(CLI::App& root, Commands& commands);     // trace TRACE.trace.h5 [--csv FILE]
 void add_model_command(CLI::App& root, Commands& commands);     // model CHAR [...]
 void add_strokes_command(CLI::App& root, Commands& commands);   // strokes [--markdown FILE] [--json]
-void add_devices_command(CLI::App& root, Commands& commands);   // devices [--json]
+void add_devices_command(CLI::App& root, Commands& commands, DeviceRegistry& devices);  // devices [--json]
 void add_corpus_commands(CLI::App& root, Commands& commands);   // corpus build|stats|fidelity|validate
 void add_bench_commands(CLI::App& root, Commands& commands);    // bench nearest|jumps|tick|loop|acceptance
-void add_session_commands(CLI::App& root, Commands& commands);  // session run|resume
+void add_session_commands(CLI::App& root, Commands& commands, DeviceRegistry& devices);  // session run|resume
 void add_report_command(CLI::App& root, Commands& commands);
 void add_curriculum_command(
     CLI::App& root,

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
+#include "cli/cli_devices.hpp"
 #include "cli/commands.hpp"
 #include "cli/output.hpp"
 #include "cli/suggest.hpp"
@@ -60,16 +61,18 @@ int main(int argc, char** argv) {
                 "calligraphy");
   configure_root(root);
   Commands commands;
-  add_trial_command(root, commands);
-  add_train_command(root, commands);
+  // The program's devices: one registry, owned here and passed to the commands that open a device.
+  calligraphy::DeviceRegistry devices = make_cli_device_registry();
+  add_trial_command(root, commands, devices);
+  add_train_command(root, commands, devices);
   add_score_command(root, commands);
   add_model_command(root, commands);
   add_strokes_command(root, commands);
   add_trace_command(root, commands);
-  add_devices_command(root, commands);
+  add_devices_command(root, commands, devices);
   add_corpus_commands(root, commands);
   add_bench_commands(root, commands);
-  add_session_commands(root, commands);
+  add_session_commands(root, commands, devices);
   add_report_command(root, commands);
   add_curriculum_command(root, commands);
 

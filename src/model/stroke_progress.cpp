@@ -1,6 +1,7 @@
 #include "calligraphy/model/stroke_progress.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -9,28 +10,47 @@
 
 namespace calligraphy {
 
-void StrokeAcceptance::validate() const {
-  const auto check = [](double value, const char* name) {
-    if (!std::isfinite(value) || !(value > 0.0)) {
-      throw InvalidArgument(std::string("StrokeAcceptance.") + name + " = " + std::to_string(value) +
-                            " must be finite and > 0");
-    }
-  };
-  check(corridor_m, "corridor_m");
-  check(mean_deviation_m, "mean_deviation_m");
-  check(shortfall_m, "shortfall_m");
-  check(displacement_m, "displacement_m");
-  check(lookahead_m, "lookahead_m");
-  check(follow_through_m, "follow_through_m");
-  if (!std::isfinite(max_gain_ratio) || !(max_gain_ratio >= 1.0)) {
-    throw InvalidArgument("StrokeAcceptance.max_gain_ratio = " + std::to_string(max_gain_ratio) +
-                          " must be finite and >= 1");
-  }
-  if (!(shortfall_fraction > 0.0 && shortfall_fraction < 1.0)) {
-    throw InvalidArgument("StrokeAcceptance.shortfall_fraction = " + std::to_string(shortfall_fraction) +
-                          " must be in (0, 1)");
-  }
+namespace {
+
+constexpr ParameterRange kLength{.low = 0.0, .high = 0.1, .low_open = true};
+
+// In the order a trial record has always written them.
+constexpr std::array kAcceptanceFields{
+    ParameterField<StrokeAcceptance>{"corridor_m", "m", kLength,
+                                     "farthest the pen may be from the centre line and still make progress",
+                                     &StrokeAcceptance::corridor_m},
+    ParameterField<StrokeAcceptance>{"mean_deviation_m", "m", kLength,
+                                     "largest mean distance of the pen from the centre line",
+                                     &StrokeAcceptance::mean_deviation_m},
+    ParameterField<StrokeAcceptance>{"shortfall_m", "m", kLength,
+                                     "how much shorter than the stroke the way along it may be",
+                                     &StrokeAcceptance::shortfall_m},
+    ParameterField<StrokeAcceptance>{
+        "shortfall_fraction", "",
+        ParameterRange{.low = 0.0, .high = 1.0, .low_open = true, .high_open = true},
+        "the shortfall as a fraction of the stroke's length, the smaller applying",
+        &StrokeAcceptance::shortfall_fraction},
+    ParameterField<StrokeAcceptance>{"displacement_m", "m", kLength,
+                                     "how far a copy of the stroke may be displaced along it",
+                                     &StrokeAcceptance::displacement_m},
+    ParameterField<StrokeAcceptance>{"follow_through_m", "m", kLength,
+                                     "radius of the end neighbourhood a pen past the end may move in",
+                                     &StrokeAcceptance::follow_through_m},
+    ParameterField<StrokeAcceptance>{"max_gain_ratio", "", ParameterRange{.low = 1.0, .high = 100.0},
+                                     "most arc credited per length of pen motion",
+                                     &StrokeAcceptance::max_gain_ratio},
+    ParameterField<StrokeAcceptance>{"lookahead_m", "m", kLength,
+                                     "how far along the centre line the foot point is looked for",
+                                     &StrokeAcceptance::lookahead_m},
+};
+
+}  // namespace
+
+std::span<const ParameterField<StrokeAcceptance>> ParameterTable<StrokeAcceptance>::fields() noexcept {
+  return kAcceptanceFields;
 }
+
+void StrokeAcceptance::validate() const { check_parameters(*this); }
 
 double StrokeAcceptance::allowed_shortfall_m(double length_m) const noexcept {
   return std::min(shortfall_m, shortfall_fraction * length_m);

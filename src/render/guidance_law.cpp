@@ -8,15 +8,18 @@
 namespace calligraphy {
 namespace {
 
-// A moving target's attraction point must stay within R_res of the pen: the table's (0, inf) narrowed.
+// A moving target's attraction point must stay within R_res of the pen: the table's range narrowed.
 void check_max_lead(std::string_view law_name, double max_lead_m, double constraint_radius_m) {
   check_parameter(std::string(law_name) + ".max_lead_m (at most constraint_radius_m)", max_lead_m, "m",
                   ParameterRange{.low = 0.0, .high = constraint_radius_m, .low_open = true});
 }
 
 constexpr ParameterRange kShare{.low = 0.0, .high = 1.0};
-constexpr ParameterRange kNonNegative{};
-constexpr ParameterRange kPositive{.low_open = true};
+constexpr ParameterRange kBand{.low = 0.0, .high = 0.1};
+// The upper bounds are what a protocol has always accepted: a lead beyond 0.1 m (more than the 60 mm
+// character box) and a pen pace beyond 1 m/s mean nothing for handwriting; a repulsive force beyond 10 N is
+// three times the largest a Phantom-class device makes.
+constexpr ParameterRange kLead{.low = 0.0, .high = 0.1, .low_open = true};
 constexpr std::string_view kMaxLeadDoc =
     "the distance at which the pull towards the moving point saturates, at most constraint_radius_m";
 
@@ -25,24 +28,25 @@ constexpr std::array kFadingFields{
                                    &FadingGuidance::gain},
 };
 constexpr std::array kReplayFields{
-    ParameterField<ReplayGuidance>{"max_lead_m", "m", kPositive, kMaxLeadDoc, &ReplayGuidance::max_lead_m},
+    ParameterField<ReplayGuidance>{"max_lead_m", "m", kLead, kMaxLeadDoc, &ReplayGuidance::max_lead_m},
 };
 constexpr std::array kAssistFields{
-    ParameterField<AssistAsNeededGuidance>{"band_m", "m", kNonNegative,
+    ParameterField<AssistAsNeededGuidance>{"band_m", "m", kBand,
                                            "half-width of the band without force around the active element",
                                            &AssistAsNeededGuidance::band_m},
 };
 constexpr std::array kAmplificationFields{
     ParameterField<ErrorAmplificationGuidance>{
         "gain", "", kShare, "the repulsive stiffness as a share of K_et", &ErrorAmplificationGuidance::gain},
-    ParameterField<ErrorAmplificationGuidance>{"max_force_n", "N", kNonNegative,
+    ParameterField<ErrorAmplificationGuidance>{"max_force_n", "N", ParameterRange{.low = 0.0, .high = 10.0},
                                                "bound of the repulsive force",
                                                &ErrorAmplificationGuidance::max_force_n},
 };
 constexpr std::array kTimingFields{
-    ParameterField<TimingGuidance>{"speed_m_s", "m/s", kPositive,
+    ParameterField<TimingGuidance>{"speed_m_s", "m/s",
+                                   ParameterRange{.low = 0.0, .high = 1.0, .low_open = true},
                                    "mean speed of the target along each stroke", &TimingGuidance::speed_m_s},
-    ParameterField<TimingGuidance>{"max_lead_m", "m", kPositive, kMaxLeadDoc, &TimingGuidance::max_lead_m},
+    ParameterField<TimingGuidance>{"max_lead_m", "m", kLead, kMaxLeadDoc, &TimingGuidance::max_lead_m},
 };
 
 struct Validator {

@@ -9,6 +9,49 @@
 
 namespace calligraphy {
 
+namespace {
+
+constexpr ParameterRange kShortLength{.low = 0.0, .high = 0.1};
+constexpr ParameterRange kPositiveShortLength{.low = 0.0, .high = 0.1, .low_open = true};
+
+constexpr std::array kFadingRuleFields{
+    ParameterField<FadingRule>{"forgetting_factor", "", ParameterRange{.low = 0.0, .high = 1.0},
+                               "f, the share of this repetition's gain the next one keeps",
+                               &FadingRule::forgetting_factor},
+    ParameterField<FadingRule>{"error_gain_per_m", "1/m", ParameterRange{.low = 0.0, .high = 1e6},
+                               "k, the gain added per metre of mean deviation",
+                               &FadingRule::error_gain_per_m},
+};
+constexpr std::array kAssistRuleFields{
+    ParameterField<AssistBandRule>{"target_error_m", "m", kPositiveShortLength,
+                                   "e*, the deviation the band adapts towards",
+                                   &AssistBandRule::target_error_m},
+    ParameterField<AssistBandRule>{"rate", "", ParameterRange{.low = 0.0, .high = 100.0},
+                                   "k, the band's change per metre of error below the target",
+                                   &AssistBandRule::rate},
+    ParameterField<AssistBandRule>{"min_band_m", "m", kShortLength, "b_min, the narrowest band",
+                                   &AssistBandRule::min_band_m},
+    ParameterField<AssistBandRule>{"max_band_m", "m", kShortLength, "b_max, the widest band, at least b_min",
+                                   &AssistBandRule::max_band_m},
+};
+constexpr std::array kSkillRuleFields{
+    ParameterField<SkillAdaptiveRule>{"threshold_m", "m", kPositiveShortLength,
+                                      "the error at or above which the writer is guided",
+                                      &SkillAdaptiveRule::threshold_m},
+};
+
+}  // namespace
+
+std::span<const ParameterField<FadingRule>> ParameterTable<FadingRule>::fields() noexcept {
+  return kFadingRuleFields;
+}
+std::span<const ParameterField<AssistBandRule>> ParameterTable<AssistBandRule>::fields() noexcept {
+  return kAssistRuleFields;
+}
+std::span<const ParameterField<SkillAdaptiveRule>> ParameterTable<SkillAdaptiveRule>::fields() noexcept {
+  return kSkillRuleFields;
+}
+
 const char* to_string(GuidanceMode mode) noexcept {
   switch (mode) {
     case GuidanceMode::fixed:
@@ -66,16 +109,7 @@ void validate_teacher_trajectory(std::span<const TeacherSample> samples) {
   }
 }
 
-void FadingRule::validate() const {
-  if (!(forgetting_factor >= 0.0 && forgetting_factor <= 1.0)) {
-    throw InvalidArgument("FadingRule.forgetting_factor = " + std::to_string(forgetting_factor) +
-                          " must be in [0, 1]");
-  }
-  if (!(error_gain_per_m >= 0.0) || !std::isfinite(error_gain_per_m)) {
-    throw InvalidArgument("FadingRule.error_gain_per_m = " + std::to_string(error_gain_per_m) +
-                          " must be finite and >= 0");
-  }
-}
+void FadingRule::validate() const { check_parameters(*this); }
 
 double next_guidance_gain(double gain, double error_m, const FadingRule& rule) {
   rule.validate();
@@ -101,10 +135,7 @@ void check_length(double value, const char* name, bool positive) {
 }  // namespace
 
 void AssistBandRule::validate() const {
-  check_length(target_error_m, "AssistBandRule.target_error_m", true);
-  check_length(rate, "AssistBandRule.rate", false);
-  check_length(min_band_m, "AssistBandRule.min_band_m", false);
-  check_length(max_band_m, "AssistBandRule.max_band_m", false);
+  check_parameters(*this);
   if (max_band_m < min_band_m) {
     throw InvalidArgument("AssistBandRule.max_band_m = " + std::to_string(max_band_m) +
                           " must be >= min_band_m = " + std::to_string(min_band_m));
@@ -118,7 +149,7 @@ double next_assist_band(double band_m, double error_m, const AssistBandRule& rul
   return std::clamp(band_m + rule.rate * (rule.target_error_m - error_m), rule.min_band_m, rule.max_band_m);
 }
 
-void SkillAdaptiveRule::validate() const { check_length(threshold_m, "SkillAdaptiveRule.threshold_m", true); }
+void SkillAdaptiveRule::validate() const { check_parameters(*this); }
 
 GuidanceMode skill_adaptive_mode(double previous_error_m, const SkillAdaptiveRule& rule) {
   rule.validate();

@@ -117,8 +117,7 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
   context.simulation.seed = spec.seed;
   context.writer_log = run.writer_log;
   std::vector<std::vector<QuizEvent>> quiz;
-  if (condition.mode == ConditionMode::quiz)
-    quiz = study_detail::quiz_characters(scene, result.trace, condition.quiz);
+  if (condition.mode == ConditionMode::quiz) quiz = quiz_characters(scene, result.trace, condition.quiz);
   json record =
       study_detail::trial_record(context, scene, result, run.metrics, quiz.empty() ? nullptr : &quiz);
   // Learned from as a session learns from its saved record.

@@ -15,9 +15,6 @@ bool is_label(std::string_view text, std::size_t max_length);
 std::string read_small_file(const std::filesystem::path& path, std::uintmax_t max_bytes,
                             const std::string& what);
 
-/// The current time in UTC, ISO 8601 with milliseconds: "2024-05-01T12:34:56.789Z".
-std::string utc_now_iso8601();
-
 /// Seconds since 1970-01-01T00:00:00Z of a time `utc_now_iso8601` wrote ("2024-05-01T12:34:56.789Z"; the
 /// fraction optional). Throws InvalidArgument quoting the text when it is not such a time.
 double utc_seconds(std::string_view iso8601);

@@ -14,6 +14,7 @@
 #include "calligraphy/core/unicode.hpp"
 #include "study/json_reader.hpp"
 #include "study/names.hpp"
+#include "study/parameter_json.hpp"
 #include "study/protocol_reading.hpp"
 
 namespace calligraphy {
@@ -76,32 +77,18 @@ using study_detail::fail;
 using study_detail::kMaxRepetitions;
 using study_detail::ObjectReader;
 using study_detail::read_items;
+using study_detail::table_number_or;
+using study_detail::take_table_number;
 
 constexpr const char* kFormat = "calligraphy-study-protocol";
 
-// Largest length tolerance a protocol may give [m]: beyond the 60 mm character box it means nothing.
-constexpr double kMaxAcceptanceLength_m = 0.1;
-
-// "acceptance": the stroke matcher's tolerances by name, the keys a trial record writes (trial_record.cpp);
-// a key left out keeps its default.
+// "acceptance": the stroke matcher's tolerances by name, the keys a trial record writes and the ranges of
+// StrokeAcceptance's table; a key left out keeps its default.
 StrokeAcceptance read_acceptance(const json& value, const std::string& pointer, const std::string& source) {
   ObjectReader reader(value, pointer, source);
   StrokeAcceptance a;
-  const auto length = [&](const char* key, double& field) {
-    field = reader.number_or(key, field, 0.0, kMaxAcceptanceLength_m);
-    if (!(field > 0.0)) fail(source, reader.pointer(key), "expected a length > 0 [m]");
-  };
-  length("corridor_m", a.corridor_m);
-  length("mean_deviation_m", a.mean_deviation_m);
-  length("shortfall_m", a.shortfall_m);
-  length("displacement_m", a.displacement_m);
-  length("follow_through_m", a.follow_through_m);
-  length("lookahead_m", a.lookahead_m);
-  a.shortfall_fraction = reader.number_or("shortfall_fraction", a.shortfall_fraction, 0.0, 1.0);
-  if (!(a.shortfall_fraction > 0.0 && a.shortfall_fraction < 1.0)) {
-    fail(source, reader.pointer("shortfall_fraction"), "expected a number in (0, 1)");
-  }
-  a.max_gain_ratio = reader.number_or("max_gain_ratio", a.max_gain_ratio, 1.0, 100.0);
+  for (const ParameterField<StrokeAcceptance>& field : ParameterTable<StrokeAcceptance>::fields())
+    a.*field.member = table_number_or(reader, std::string(field.name), a.*field.member, field.member);
   reader.finish();  // any other key: an error naming it
   return a;
 }
@@ -124,50 +111,51 @@ QuizOptions read_quiz(const json& value, const std::string& pointer, const std::
   return quiz;
 }
 
-// The documented parameters of the guidance modes (docs/experiments.md); an unknown key or a value out of
-// range is an error naming its pointer.
+// The documented parameters of the guidance modes (docs/experiments.md), each checked against its guidance
+// law's or rule's table; an unknown key or a value out of range is an error naming its pointer.
 void read_guidance_parameters(const json& parameters, const std::string& pointer, const std::string& source,
                               StudyCondition& condition) {
   ObjectReader reader(parameters, pointer, source);
-  const auto positive = [&](const char* key, double high) {
-    const double value = reader.number(key, 0.0, high);
-    if (!(value > 0.0)) fail(source, reader.pointer(key), "expected a number > 0");
-    return value;
-  };
   switch (condition.mode) {
-    case ConditionMode::fading:
-      condition.start_gain = reader.number_or("start_gain", condition.start_gain, 0.0, 1.0);
-      condition.fading_rule.forgetting_factor =
-          reader.number_or("forgetting_factor", condition.fading_rule.forgetting_factor, 0.0, 1.0);
-      condition.fading_rule.error_gain_per_m =
-          reader.number_or("error_gain_per_m", condition.fading_rule.error_gain_per_m, 0.0, 1e6);
+    case ConditionMode::fading: {
+      FadingRule& rule = condition.fading_rule;
+      condition.start_gain =
+          table_number_or(reader, "start_gain", condition.start_gain, &FadingGuidance::gain);
+      rule.forgetting_factor = table_number_or(reader, "forgetting_factor", rule.forgetting_factor,
+                                               &FadingRule::forgetting_factor);
+      rule.error_gain_per_m =
+          table_number_or(reader, "error_gain_per_m", rule.error_gain_per_m, &FadingRule::error_gain_per_m);
       break;
+    }
     case ConditionMode::replay:
-      if (reader.has("max_lead_m")) condition.replay_max_lead_m = positive("max_lead_m", 0.1);
+      take_table_number(reader, "max_lead_m", condition.replay_max_lead_m, &ReplayGuidance::max_lead_m);
       break;
     case ConditionMode::assist_as_needed: {
       AssistBandRule& rule = condition.assist_rule;
-      condition.start_band_m = reader.number_or("start_band_m", condition.start_band_m, 0.0, 0.1);
-      if (reader.has("target_error_m")) rule.target_error_m = positive("target_error_m", 0.1);
-      rule.rate = reader.number_or("band_rate", rule.rate, 0.0, 100.0);
-      rule.min_band_m = reader.number_or("min_band_m", rule.min_band_m, 0.0, 0.1);
-      rule.max_band_m = reader.number_or("max_band_m", rule.max_band_m, 0.0, 0.1);
+      condition.start_band_m =
+          table_number_or(reader, "start_band_m", condition.start_band_m, &AssistAsNeededGuidance::band_m);
+      rule.target_error_m =
+          table_number_or(reader, "target_error_m", rule.target_error_m, &AssistBandRule::target_error_m);
+      rule.rate = table_number_or(reader, "band_rate", rule.rate, &AssistBandRule::rate);
+      rule.min_band_m = table_number_or(reader, "min_band_m", rule.min_band_m, &AssistBandRule::min_band_m);
+      rule.max_band_m = table_number_or(reader, "max_band_m", rule.max_band_m, &AssistBandRule::max_band_m);
       if (rule.max_band_m < rule.min_band_m) {
         fail(source, reader.pointer("max_band_m"), "expected a band at least min_band_m");
       }
       break;
     }
     case ConditionMode::skill_adaptive:
-      if (reader.has("threshold_m")) condition.skill_rule.threshold_m = positive("threshold_m", 0.1);
+      condition.skill_rule.threshold_m = table_number_or(
+          reader, "threshold_m", condition.skill_rule.threshold_m, &SkillAdaptiveRule::threshold_m);
       [[fallthrough]];
     case ConditionMode::error_amplification:
-      if (reader.has("amplification_gain"))
-        condition.amplification_gain = reader.number("amplification_gain", 0.0, 1.0);
-      if (reader.has("max_force_n"))
-        condition.amplification_max_force_n = reader.number("max_force_n", 0.0, 10.0);
+      take_table_number(reader, "amplification_gain", condition.amplification_gain,
+                        &ErrorAmplificationGuidance::gain);
+      take_table_number(reader, "max_force_n", condition.amplification_max_force_n,
+                        &ErrorAmplificationGuidance::max_force_n);
       break;
     case ConditionMode::timing:
-      if (reader.has("speed_m_s")) condition.timing_speed_m_s = positive("speed_m_s", 1.0);
+      take_table_number(reader, "speed_m_s", condition.timing_speed_m_s, &TimingGuidance::speed_m_s);
       break;
     default:
       break;

@@ -6,6 +6,7 @@
 
 #include "analysis/segmentation.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/report/pen_trace_csv.hpp"
 
 namespace calligraphy {
 
@@ -118,5 +119,38 @@ std::vector<QuizEvent> QuizSession::feed(const PenSample& sample) {
 }
 
 std::vector<QuizEvent> QuizSession::finish() { return judge_segment(); }
+
+namespace {
+
+// The pen samples of character `character` of `scene` in `trace` (quiz_characters).
+std::vector<PenSample> pen_samples_of_character(const Scene& scene, const std::vector<TrialSample>& trace,
+                                                std::size_t character) {
+  std::size_t first = 0;
+  for (std::size_t c = 0; c < character; ++c) first += scene.characters[c].strokes.size();
+  const std::size_t last = first + scene.characters[character].strokes.size();  // one past
+  const double contact_m = PenTraceCsvOptions{}.contact_threshold_m;
+  std::vector<PenSample> samples;
+  for (const TrialSample& s : trace) {
+    const bool active = s.stroke >= first && (s.stroke < last || character + 1 == scene.characters.size());
+    if (!active) continue;
+    samples.push_back(
+        {s.time_s, s.position_m.head<2>(), s.position_m.z() - scene.layout.paper_z_m <= contact_m});
+  }
+  return samples;
+}
+
+}  // namespace
+
+std::vector<std::vector<QuizEvent>> quiz_characters(const Scene& scene, const std::vector<TrialSample>& trace,
+                                                    const QuizOptions& options) {
+  std::vector<std::vector<QuizEvent>> events;
+  for (std::size_t c = 0; c < scene.characters.size(); ++c) {
+    QuizSession quiz(scene.characters[c], options);
+    for (const PenSample& s : pen_samples_of_character(scene, trace, c)) quiz.feed(s);
+    quiz.finish();
+    events.push_back(quiz.events());
+  }
+  return events;
+}
 
 }  // namespace calligraphy

@@ -27,8 +27,7 @@ using nlohmann::json;
 using study_detail::ObjectReader;
 
 // The nearest-point search has no parameter table of its own (it lives below the force law); its methods by
-// name. The stroke acceptance's fields are named as every record names them
-// (study_detail::acceptance_fields).
+// name.
 constexpr std::array<std::pair<const char*, NearestPointMethod>, 3> kNearestMethods{{
     {"exact", NearestPointMethod::exact},
     {"newton", NearestPointMethod::newton},
@@ -83,8 +82,7 @@ ForceLawParameters read_force_law(ObjectReader reader) {
   f.guidance_law = read_guidance_law(
       ObjectReader(reader.required("guidance_law"), reader.pointer("guidance_law"), reader.source()));
   ObjectReader acceptance(reader.required("acceptance"), reader.pointer("acceptance"), reader.source());
-  for (const auto& [name, member] : study_detail::acceptance_fields())
-    f.acceptance.*member = acceptance.number(std::string(name), -kLargest, kLargest);
+  study_detail::take_parameters(acceptance, f.acceptance);
   acceptance.finish();
   ObjectReader nearest(reader.required("nearest"), reader.pointer("nearest"), reader.source());
   const std::string method = nearest.string("method");

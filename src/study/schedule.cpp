@@ -9,6 +9,9 @@
 #include "study/names.hpp"
 
 namespace calligraphy {
+
+bool is_subject_id(std::string_view id) { return study_detail::is_label(id, 64); }
+
 namespace {
 
 // A reproducible stream of 64-bit numbers (SplitMix64), the same on every platform (std::shuffle and
@@ -100,7 +103,7 @@ std::vector<BlockPlan> phase_blocks(const StudyProtocol& protocol, const Protoco
 }
 
 void check_subject(const SubjectAssignment& subject) {
-  if (!study_detail::is_label(subject.id, 64)) {
+  if (!is_subject_id(subject.id)) {
     throw InvalidArgument("subject id '" + subject.id + "': expected 1 to 64 letters, digits, '_' or '-'");
   }
 }

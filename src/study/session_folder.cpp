@@ -166,7 +166,7 @@ SessionManifest make_manifest(const SessionSetup& setup, const LoadedProtocol& p
   manifest.setup = setup;
   manifest.protocol = protocol;
   manifest.library = library_build();
-  manifest.created_utc = study_detail::utc_now_iso8601();
+  manifest.created_utc = utc_now_iso8601();
   manifest.plan = plan_session(protocol.protocol, setup.subject, setup.session_number);
   manifest.previous = previous;
   manifest.group = subject_group(protocol.protocol, setup.subject);
@@ -231,7 +231,7 @@ void check_session_manifest_size(const SessionSetup& setup, const LoadedProtocol
   if (setup.session_number > 1) {  // a link as long as a real one (its size counts too)
     previous.emplace();
     previous->session_id = protocol.protocol.name + "-" + setup.subject.id + "-YYYYMMDD-HHMMSS-1000";
-    previous->ended_utc = study_detail::utc_now_iso8601();
+    previous->ended_utc = utc_now_iso8601();
     previous->session_sha256 = std::string(64, '0');
     previous->delay = "overridden";
   }
@@ -505,7 +505,7 @@ void SessionFolder::check_writable() const {
 }
 
 void SessionFolder::log(std::string_view event, std::string_view details_json) {
-  const std::string line = study_detail::log_line(study_detail::utc_now_iso8601(), event, details_json);
+  const std::string line = study_detail::log_line(utc_now_iso8601(), event, details_json);
   const fs::path log_path = SessionLayout::log(path_);
   write_all(log_fd_, line, log_path);
   if (::fsync(log_fd_) != 0) fail_errno(log_path, "cannot sync the session log", errno);

@@ -10,12 +10,12 @@
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/parameter_table.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/render/guidance_law.hpp"
-#include "calligraphy/render/parameter_table.hpp"
 #include "calligraphy/report/trace_hdf5.hpp"
 #include "calligraphy/report/trial_report.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
@@ -346,13 +346,13 @@ class SessionRun {
     context.simulated_writer = simulated_writer_;
     context.guidance = study_detail::guidance_record_json(condition, prepared.guidance);
     context.writer_skills = prepared.skills;
-    context.start_utc = study_detail::utc_now_iso8601();
+    context.start_utc = utc_now_iso8601();
     const auto wall_start = std::chrono::steady_clock::now();
     TrialRun run = run_trial_spec(prepared.spec, prepared.scene, inputs);
     if (run.result.end == TrialEnd::interrupted && run.result.abort_reason.empty())
       run.result.abort_reason = "stopped by " + stop_reason(options_);
     context.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-    context.end_utc = study_detail::utc_now_iso8601();
+    context.end_utc = utc_now_iso8601();
     context.options = &run.options;
     context.spec = &prepared.spec;
     context.simulation.writer = run.writer;
@@ -375,7 +375,7 @@ class SessionRun {
     const WritingMetrics& writing = run.metrics;
     std::vector<std::vector<QuizEvent>> quiz;
     if (condition.mode == ConditionMode::quiz) {
-      quiz = study_detail::quiz_characters(scene, trial_result.trace, condition.quiz);
+      quiz = quiz_characters(scene, trial_result.trace, condition.quiz);
     }
     const bool keep_as_trial =
         trial_result.end == TrialEnd::completed || trial_result.end == TrialEnd::time_limit ||
@@ -486,8 +486,13 @@ class SessionRun {
 }  // namespace
 
 SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& run_options) {
-  const DeviceRegistry standard = run_options.registry ? DeviceRegistry{} : standard_device_registry();
-  return SessionRun(session, run_options, run_options.registry ? *run_options.registry : standard).run();
+  if (run_options.registry == nullptr) {
+    throw InvalidArgument(
+        "run_session: no device registry (SessionRunOptions::registry) to create the session's "
+        "device \"" +
+        session.manifest().setup.device + "\" from");
+  }
+  return SessionRun(session, run_options, *run_options.registry).run();
 }
 
 }  // namespace calligraphy

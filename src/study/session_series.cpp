@@ -134,7 +134,7 @@ SessionSeries session_series(const fs::path& root, const std::string& subject_id
       }
     }
     // Negative when the previous session's clock was ahead of this one's: recorded as measured.
-    previous.elapsed_s = study_detail::utc_seconds(study_detail::utc_now_iso8601()) - ended_s;
+    previous.elapsed_s = study_detail::utc_seconds(utc_now_iso8601()) - ended_s;
     series.previous = std::move(previous);
     series.previous_record = last_record;
   }

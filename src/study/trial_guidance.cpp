@@ -7,6 +7,7 @@
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
 #include "calligraphy/render/guidance_schedule.hpp"
 #include "calligraphy/study/trial_spec_runner.hpp"
@@ -44,7 +45,11 @@ std::string record_teacher(const SessionFolder& session, const Scene& scene,
   teacher.rate_hz = settings.rate_hz;
   teacher.max_duration_s = settings.max_duration_s;
   teacher.pacing = TrialPacing::lock_step;
-  const TrialResult result = run_trial_spec(teacher, scene).result;
+  // The simulated device, made here: the teacher's trial is the library's, on no device of the session's.
+  SimulatedDevice device;
+  TrialRunInputs inputs;
+  inputs.device = &device;
+  const TrialResult result = run_trial_spec(teacher, scene, inputs).result;
   if (result.aborted || !result.metrics.completed_in_order) {
     throw StateError("the simulated teacher of \"" + encode_utf8(characters) + "\" wrote " +
                      std::to_string(result.metrics.strokes_completed) + " of " +

@@ -12,6 +12,7 @@
 #include "calligraphy/report/pen_trace_csv.hpp"
 #include "report/trial_outcome.hpp"
 #include "study/manifest_json.hpp"
+#include "study/parameter_json.hpp"
 #include "study/recorded_trial_object.hpp"
 #include "study/remembered_writer.hpp"
 #include "study/saved_sessions.hpp"
@@ -230,52 +231,10 @@ json loop_json(const ServoLoopStats& s) {
 
 }  // namespace
 
-std::span<const std::pair<std::string_view, double StrokeAcceptance::*>> acceptance_fields() {
-  static constexpr std::array<std::pair<std::string_view, double StrokeAcceptance::*>, 8> kFields{{
-      {"corridor_m", &StrokeAcceptance::corridor_m},
-      {"mean_deviation_m", &StrokeAcceptance::mean_deviation_m},
-      {"shortfall_m", &StrokeAcceptance::shortfall_m},
-      {"shortfall_fraction", &StrokeAcceptance::shortfall_fraction},
-      {"displacement_m", &StrokeAcceptance::displacement_m},
-      {"follow_through_m", &StrokeAcceptance::follow_through_m},
-      {"max_gain_ratio", &StrokeAcceptance::max_gain_ratio},
-      {"lookahead_m", &StrokeAcceptance::lookahead_m},
-  }};
-  return kFields;
-}
-
 json acceptance_json(const StrokeAcceptance& a) {
   json out = json::object();
-  for (const auto& [name, member] : acceptance_fields()) out[std::string(name)] = a.*member;
+  put_parameters(out, a);
   return out;
-}
-
-std::vector<PenSample> pen_samples_of_character(const Scene& scene, const std::vector<TrialSample>& trace,
-                                                std::size_t character) {
-  std::size_t first = 0;
-  for (std::size_t c = 0; c < character; ++c) first += scene.characters[c].strokes.size();
-  const std::size_t last = first + scene.characters[character].strokes.size();  // one past
-  const double contact_m = PenTraceCsvOptions{}.contact_threshold_m;
-  std::vector<PenSample> samples;
-  for (const TrialSample& s : trace) {
-    const bool active = s.stroke >= first && (s.stroke < last || character + 1 == scene.characters.size());
-    if (!active) continue;
-    samples.push_back(
-        {s.time_s, s.position_m.head<2>(), s.position_m.z() - scene.layout.paper_z_m <= contact_m});
-  }
-  return samples;
-}
-
-std::vector<std::vector<QuizEvent>> quiz_characters(const Scene& scene, const std::vector<TrialSample>& trace,
-                                                    const QuizOptions& options) {
-  std::vector<std::vector<QuizEvent>> events;
-  for (std::size_t c = 0; c < scene.characters.size(); ++c) {
-    QuizSession quiz(scene.characters[c], options);
-    for (const PenSample& s : pen_samples_of_character(scene, trace, c)) quiz.feed(s);
-    quiz.finish();
-    events.push_back(quiz.events());
-  }
-  return events;
 }
 
 namespace {

@@ -50,22 +50,10 @@ struct TrialRecordContext {
   std::string svg_file;    ///< the drawing
 };
 
-/// The stroke matcher's tolerances by the names a protocol's quiz condition reads them by (corridor_m,
-/// mean_deviation_m, ...), each with its member.
-std::span<const std::pair<std::string_view, double StrokeAcceptance::*>> acceptance_fields();
-
-/// The stroke matcher's tolerances as a JSON object by those names: the record's force.acceptance and
-/// quiz.acceptance, and its specification's force_law.acceptance.
+/// The stroke matcher's tolerances as a JSON object by their table's names (corridor_m, mean_deviation_m,
+/// ...; ParameterTable<StrokeAcceptance>), the names a protocol's quiz condition reads them by: the record's
+/// force.acceptance and quiz.acceptance, and its specification's force_law.acceptance.
 nlohmann::json acceptance_json(const StrokeAcceptance& acceptance);
-
-/// The pen samples of `trace` while character `character` of `scene` was the active one: pen down when
-/// the tip is within the contact threshold of `calligraphy score` (PenTraceCsvOptions) above the paper.
-std::vector<PenSample> pen_samples_of_character(const Scene& scene, const std::vector<TrialSample>& trace,
-                                                std::size_t character);
-
-/// The quiz events of each character, the trace fed through a `QuizSession` per character.
-std::vector<std::vector<QuizEvent>> quiz_characters(const Scene& scene, const std::vector<TrialSample>& trace,
-                                                    const QuizOptions& options);
 
 /// The record: the context, the renderer's figures and every key of the one metrics record `writing`
 /// (trial_writing_metrics). `quiz` is given for quiz conditions.

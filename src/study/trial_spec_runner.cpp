@@ -112,7 +112,11 @@ TrialRun run_trial_spec(const TrialSpec& spec, const Scene& scene, const TrialRu
   std::unique_ptr<HapticDevice> created;
   HapticDevice* device = inputs.device;
   if (device == nullptr) {
-    created = inputs.registry ? inputs.registry->create(spec.device) : standard_device_registry().create(spec.device);
+    if (inputs.registry == nullptr) {
+      throw InvalidArgument("run_trial_spec: no device and no registry to create \"" + spec.device +
+                            "\" from (TrialRunInputs::device, TrialRunInputs::registry)");
+    }
+    created = inputs.registry->create(spec.device);
     device = created.get();
   }
   run.device = device->info();

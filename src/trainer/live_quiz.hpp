@@ -4,7 +4,7 @@
 // character of the trial's scene judges each stroke the moment the pen lifts, and the window shows the
 // verdicts at once. Never on the servo thread: a judgement takes up to milliseconds.
 //
-// The samples are the ones the saved record judges after the trial (study_detail::quiz_characters): the
+// The samples are the ones the saved record judges after the trial (quiz_characters): the
 // same time and HIP per tick, pen down within `calligraphy score`'s contact threshold above the paper
 // (PenTraceCsvOptions), each routed to its character by the stroke active at that tick. The verdicts agree
 // with the saved ones as long as no trace point was dropped (`dropped_points`).
@@ -43,7 +43,7 @@ class LiveQuiz {
   void note_dropped(std::uint64_t dropped) noexcept { dropped_points_ = dropped; }
 
   [[nodiscard]] const std::vector<QuizSession>& sessions() const noexcept { return sessions_; }
-  /// Every character's events so far, as `study_detail::quiz_characters` returns them.
+  /// Every character's events so far, as `quiz_characters` returns them.
   [[nodiscard]] std::vector<std::vector<QuizEvent>> events() const;
   /// The pen-down run being written (for drawing), and the character it is routed to.
   [[nodiscard]] const std::vector<Vec2>& open_run() const noexcept { return open_run_; }

@@ -25,8 +25,8 @@ struct TrainerCharacter {
 struct TrainerOptions {
   std::vector<TrainerCharacter> characters;  ///< the row, practised left to right
   std::string device = "mouse-hand";         ///< a name in `registry`
-  /// Where `device` is created (not owned; outlives the run). nullptr: a standard registry
-  /// (`standard_device_registry()`) with the trainer's pointer devices (`register_trainer_devices`).
+  /// Where `device` is created (not owned; outlives the run): the program's registry, with the trainer's
+  /// pointer devices added (`register_trainer_devices`). Required.
   const DeviceRegistry* registry = nullptr;
   bool simulated_writer = false;             ///< the simulated writer writes (device with a hand port)
   std::string writer_profile = "novice";     ///< novice or skilled

@@ -19,10 +19,10 @@
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/stop_signals.hpp"
 #include "calligraphy/devices/device_registry.hpp"
 #include "calligraphy/devices/hand_port.hpp"
-#include "calligraphy/core/stop_signals.hpp"
-#include "study/names.hpp"
+#include "calligraphy/study/session_folder.hpp"
 #include "trainer/pointer_devices.hpp"
 #include "trainer/x11_errors.hpp"
 
@@ -270,13 +270,9 @@ void TrainerApp::update_pointer() {
 
 int run_trainer(const TrainerOptions& given) {
   if (given.characters.empty()) throw InvalidArgument("calligraphy train: no characters to practise");
-  TrainerOptions options = given;
-  DeviceRegistry standard;
-  if (options.registry == nullptr) {
-    standard = standard_device_registry();
-    register_trainer_devices(standard);
-    options.registry = &standard;
-  }
+  if (given.registry == nullptr)
+    throw InvalidArgument("calligraphy train: no device registry (TrainerOptions::registry)");
+  const TrainerOptions& options = given;
   // The device must exist, and a simulated writer can move only a device with a hand port.
   const DeviceListing listing = options.registry->find(options.device);
   const bool hand_port = listing.capabilities.moved_by_simulated_hand;

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "study/trial_record.hpp"
+#include "calligraphy/study/quiz.hpp"
 #include "trainer/panel.hpp"
 #include "trainer/trainer_app.hpp"
 
@@ -53,11 +53,11 @@ std::string TrainerApp::character_utf8(const TrialView& view, std::size_t charac
   return options_.characters[index_of_.at(c)].utf8;
 }
 
-// The saved record judges the whole trace after the trial (study_detail::quiz_characters): the verdicts
+// The saved record judges the whole trace after the trial (quiz_characters): the verdicts
 // shown live must be the same ones.
 void TrainerApp::check_quiz_against_trace(const LiveQuiz& quiz, const TrialResult& result) {
   const std::vector<std::vector<QuizEvent>> saved =
-      study_detail::quiz_characters(worker_.scene(), result.trace, options_.quiz_options);
+      quiz_characters(worker_.scene(), result.trace, options_.quiz_options);
   const std::vector<std::vector<QuizEvent>> live = quiz.events();
   bool same = saved.size() == live.size();
   std::size_t count = 0;

@@ -14,7 +14,7 @@
 #include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/render/guidance_schedule.hpp"
 #include "calligraphy/report/teacher_recording.hpp"
-#include "study/names.hpp"
+#include "calligraphy/study/session_folder.hpp"
 #include "trainer/trainer_app.hpp"
 
 namespace calligraphy::trainer {
@@ -61,7 +61,7 @@ void TrainerApp::start_trial(std::size_t character) {
   trial_options_ = trial_options(spec, DeviceInfo{});  // what the view needs before the device is open
   trial_simulation_.writer = writer_profile(spec.writer_profile);
   trial_simulation_.seed = spec.seed;
-  trial_start_utc_ = study_detail::utc_now_iso8601();
+  trial_start_utc_ = utc_now_iso8601();
   trial_wall_start_ = Clock::now();
   worker_.start(std::move(scene), std::move(spec), std::move(inputs));
   view_->scene = &worker_.scene();
@@ -173,7 +173,7 @@ void TrainerApp::finish_trial() {
     trial.spec = &worker_.spec();
     trial.simulation = trial_simulation_;
     trial.start_utc = trial_start_utc_;
-    trial.end_utc = study_detail::utc_now_iso8601();
+    trial.end_utc = utc_now_iso8601();
     trial.wall_time_s = std::chrono::duration<double>(Clock::now() - trial_wall_start_).count();
     try {
       const auto [path, as_trial] = practice_->save(trial, result);

@@ -30,6 +30,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "calligraphy/core/parameter_table.hpp"
 #include "calligraphy/model/scene.hpp"
 
 namespace calligraphy {
@@ -73,10 +74,22 @@ struct StrokeAcceptance {
   /// before lifting and off the stroke loses the stroke.
   double follow_through_m = 0.008;
 
-  /// Throws InvalidArgument naming the field when a value is not finite and > 0 (the fraction in (0, 1)).
+  /// Throws InvalidArgument naming the field when a value is outside its range
+  /// (`ParameterTable<StrokeAcceptance>`: each length in (0, 0.1] m, the fraction in (0, 1), the gain ratio
+  /// in [1, 100]).
   void validate() const;
   /// The most a stroke of `length_m` may be written short by [m].
   [[nodiscard]] double allowed_shortfall_m(double length_m) const noexcept;
+  bool operator==(const StrokeAcceptance&) const = default;
+};
+
+/// The fields of StrokeAcceptance (parameter_table.hpp): the one definition of their units and ranges, which
+/// its validate(), a protocol's "acceptance" and a trial record read. A length beyond 0.1 m, more than the
+/// 60 mm character box, would accept anything.
+template <>
+struct ParameterTable<StrokeAcceptance> {
+  static constexpr std::string_view name = "StrokeAcceptance";
+  [[nodiscard]] static std::span<const ParameterField<StrokeAcceptance>> fields() noexcept;
 };
 
 /// Why a stroke attempt was not accepted, in the learner's terms.

@@ -6,8 +6,8 @@
 #include <variant>
 #include <vector>
 
+#include "calligraphy/core/parameter_table.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
-#include "calligraphy/render/parameter_table.hpp"
 
 namespace calligraphy {
 

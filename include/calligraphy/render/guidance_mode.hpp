@@ -26,6 +26,7 @@
 #include <string_view>
 
 #include "calligraphy/core/geometry.hpp"
+#include "calligraphy/core/parameter_table.hpp"
 
 namespace calligraphy {
 
@@ -67,9 +68,10 @@ void validate_teacher_trajectory(std::span<const TeacherSample> samples);
 /// (J NeuroEng Rehabil 4:8), applied once per repetition.
 struct FadingRule {
   double forgetting_factor = 0.8;   ///< f in [0, 1]
-  double error_gain_per_m = 200.0;  ///< k [1/m], >= 0: 1 mm of mean deviation adds 0.2 to the gain
-  /// Throws InvalidArgument naming the field when a value is out of range or not finite.
+  double error_gain_per_m = 200.0;  ///< k [1/m] in [0, 10^6]: 1 mm of mean deviation adds 0.2 to the gain
+  /// Throws InvalidArgument naming the field when a value is out of range or not finite (its table).
   void validate() const;
+  bool operator==(const FadingRule&) const = default;
 };
 
 /// The next repetition's gain from this repetition's gain g(n) in [0, 1] and error e(n) >= 0 [m] (for
@@ -82,12 +84,14 @@ struct FadingRule {
 /// of assistance of Emken, Bobrow & Reinkensmeyer (2005, Proc. IEEE ICORR) applied to the width of a
 /// force tunnel (Banala et al. 2009, IEEE TNSRE 17:2), once per repetition.
 struct AssistBandRule {
-  double target_error_m = 0.0015;  ///< e* [m] > 0: the deviation the band adapts towards
-  double rate = 1.0;               ///< k >= 0 (dimensionless): 1 mm of error below e* widens the band 1 mm
-  double min_band_m = 0.0;         ///< b_min [m] >= 0
-  double max_band_m = 0.004;       ///< b_max [m] >= b_min
-  /// Throws InvalidArgument naming the field when a value is out of range or not finite.
+  double target_error_m = 0.0015;  ///< e* [m] in (0, 0.1]: the deviation the band adapts towards
+  double rate = 1.0;          ///< k in [0, 100] (dimensionless): 1 mm of error below e* widens the band 1 mm
+  double min_band_m = 0.0;    ///< b_min [m] in [0, 0.1]
+  double max_band_m = 0.004;  ///< b_max [m] in [b_min, 0.1]
+  /// Throws InvalidArgument naming the field when a value is out of range or not finite (its table), or
+  /// when max_band_m < min_band_m.
   void validate() const;
+  bool operator==(const AssistBandRule&) const = default;
 };
 
 /// The next repetition's band [m] from this repetition's band b(n) >= 0 and error e(n) >= 0 [m]. Throws
@@ -97,15 +101,35 @@ struct AssistBandRule {
 /// Skill-adaptive selection (Milot, Marchal-Crespo, Green, Cramer & Reinkensmeyer 2010, Exp Brain Res
 /// 201:119: haptic guidance helped the less skilled learn, error amplification the more skilled).
 struct SkillAdaptiveRule {
-  /// Error [m] > 0 at or above which the writer counts as less skilled and is guided.
+  /// Error [m] in (0, 0.1] at or above which the writer counts as less skilled and is guided.
   double threshold_m = 0.002;
-  /// Throws InvalidArgument naming the field when the threshold is not finite and > 0.
+  /// Throws InvalidArgument naming the field when the threshold is outside its table's range.
   void validate() const;
+  bool operator==(const SkillAdaptiveRule&) const = default;
 };
 
 /// The mode of the next repetition from the error of the previous one [m] >= 0 (NaN: no stroke written,
 /// the least skilled): `fixed` when the error is at or above the threshold, else `error_amplification`.
 /// Throws InvalidArgument for a negative error or a bad rule.
 [[nodiscard]] GuidanceMode skill_adaptive_mode(double previous_error_m, const SkillAdaptiveRule& rule = {});
+
+// Each rule's table (parameter_table.hpp): the one definition of its fields' ranges, which its validate(),
+// a protocol's guidance "parameters" and a trial record read. A length beyond 0.1 m (the 60 mm character box
+// and more) means nothing here.
+template <>
+struct ParameterTable<FadingRule> {
+  static constexpr std::string_view name = "FadingRule";
+  [[nodiscard]] static std::span<const ParameterField<FadingRule>> fields() noexcept;
+};
+template <>
+struct ParameterTable<AssistBandRule> {
+  static constexpr std::string_view name = "AssistBandRule";
+  [[nodiscard]] static std::span<const ParameterField<AssistBandRule>> fields() noexcept;
+};
+template <>
+struct ParameterTable<SkillAdaptiveRule> {
+  static constexpr std::string_view name = "SkillAdaptiveRule";
+  [[nodiscard]] static std::span<const ParameterField<SkillAdaptiveRule>> fields() noexcept;
+};
 
 }  // namespace calligraphy

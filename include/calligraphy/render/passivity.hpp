@@ -11,7 +11,7 @@
 ///    damper -alpha v with alpha = -E / (T |v|^2) (capped) dissipates it.
 /// Servo path: noexcept, no allocation.
 #include "calligraphy/core/geometry.hpp"
-#include "calligraphy/render/parameter_table.hpp"
+#include "calligraphy/core/parameter_table.hpp"
 
 namespace calligraphy {
 

@@ -19,7 +19,7 @@
 #include <cstdint>
 
 #include "calligraphy/core/geometry.hpp"
-#include "calligraphy/render/parameter_table.hpp"
+#include "calligraphy/core/parameter_table.hpp"
 
 namespace calligraphy {
 

@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-#include "calligraphy/render/parameter_table.hpp"
+#include "calligraphy/core/parameter_table.hpp"
 
 namespace calligraphy {
 

@@ -18,6 +18,7 @@
 #include "calligraphy/analysis/stroke_matcher.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/study/protocol.hpp"
+#include "calligraphy/trial/result.hpp"
 
 namespace calligraphy {
 
@@ -84,5 +85,14 @@ class QuizSession {
   double last_time_s_ = 0.0;
   std::vector<QuizEvent> events_;
 };
+
+/// The quiz events of each character of a trial's trace [`scene.characters.size()` lists]: the trace's
+/// samples of each character (a tick belongs to the character whose strokes hold the active stroke; after
+/// the last stroke, to the last character), pen down within PenTraceCsvOptions' contact threshold of the
+/// paper, fed through a `QuizSession` per character. The verdicts a saved quiz trial's record holds; a
+/// window judging live must show the same ones.
+[[nodiscard]] std::vector<std::vector<QuizEvent>> quiz_characters(const Scene& scene,
+                                                                  const std::vector<TrialSample>& trace,
+                                                                  const QuizOptions& options);
 
 }  // namespace calligraphy

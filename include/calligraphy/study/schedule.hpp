@@ -107,6 +107,9 @@ struct CrossoverAssignment {
 [[nodiscard]] std::vector<PlannedTrial> plan_session(const StudyProtocol& protocol,
                                                      const SubjectAssignment& subject, int session = 1);
 
+/// True for a valid subject id: 1..64 characters of [A-Za-z0-9_-] (it names the subject's folder).
+[[nodiscard]] bool is_subject_id(std::string_view id);
+
 /// The number at the end of a subject id ("S07" -> 7), or 0 when it does not end in digits.
 [[nodiscard]] std::size_t trailing_number(std::string_view subject_id) noexcept;
 

@@ -26,6 +26,10 @@
 
 namespace calligraphy {
 
+/// The current time in UTC as the study's files write it: ISO 8601 with milliseconds,
+/// "2024-05-01T12:34:56.789Z" (a record's start_utc and end_utc, the log's time_utc).
+[[nodiscard]] std::string utc_now_iso8601();
+
 /// The library that ran a session: version, build type, compiler and C++ standard.
 struct LibraryBuild {
   std::string version;       ///< the project's version, e.g. "0.1.0"

@@ -48,7 +48,8 @@ class SessionHost {
 
 /// Options of `run_session`.
 struct SessionRunOptions {
-  /// Where the device named in the session is created (not owned); nullptr: a `standard_device_registry()`.
+  /// Where the device named in the session is created (not owned): its owner's registry (the command
+  /// line's, Python's, a test's). Required: run_session throws InvalidArgument without one.
   const DeviceRegistry* registry = nullptr;
   /// Loads a character's model; empty: the embedded characters (CharacterLibrary::embedded()).
   std::function<Character(char32_t)> load_character;
@@ -118,11 +119,12 @@ struct TrialGuidance {
 /// previous saved repetition of its item in the condition; a `replay` trial follows the teacher kept in
 /// the session folder's teachers/ (copied from the protocol, or recorded by a skilled simulated writer
 /// when the protocol names none), each named with its SHA-256 in the trial's record. Throws
-/// InvalidArgument before any trial when a planned condition cannot run or a simulated writer is asked to
-/// move a device a person holds, DeviceNotFound when the device is not in the registry, CharacterNotFound for
-/// a missing character, DataError before any trial when the session cannot be written
+/// InvalidArgument before any trial when `options` gives no registry, a planned condition cannot run or a
+/// simulated writer is asked to move a device a person holds, DeviceNotFound when the device is not in the
+/// registry, CharacterNotFound for a missing character, DataError before any trial when the session cannot be
+/// written
 /// (`SessionFolder::check_writable`), and DataError when the log cannot be written. A trial whose files
 /// cannot be saved ends the run with `save_failed`; what was saved before stays saved.
-SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& options = {});
+SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& options);
 
 }  // namespace calligraphy

@@ -21,7 +21,8 @@ namespace calligraphy {
 
 /// What a trial needs beyond its specification: what only its caller has. Every member may stay empty.
 struct TrialRunInputs {
-  /// Where `TrialSpec::device` is created (not owned); nullptr: a `standard_device_registry()`.
+  /// Where `TrialSpec::device` is created (not owned): its owner's registry, filled with the backends it
+  /// offers (standard_device_registry() and its own). Required unless `device` is given.
   const DeviceRegistry* registry = nullptr;
   /// A device the caller made (not owned; opened here when it is not open, closed at the end), used
   /// instead of creating `TrialSpec::device` (e.g. a simulated device with the caller's parameters).
@@ -82,8 +83,9 @@ struct TrialRun {
 /// `inputs.teacher` when given, `spec.teacher` then empty); creates the device (unless given), reads the
 /// teacher (unless given), makes the simulated writer's hand when it writes, runs `run_trial`, and scores the
 /// trace. Writes none of `spec`'s output files (the caller's: they depend on its front-end). Throws what
-/// `validate` throws, DeviceNotFound, DataError for a teacher that cannot be read, InvalidArgument for one
-/// of other characters, and what `run_trial` throws.
+/// `validate` throws, InvalidArgument when `inputs` gives neither a device nor a registry, DeviceNotFound,
+/// DataError for a teacher that cannot be read, InvalidArgument for one of other characters, and what
+/// `run_trial` throws.
 [[nodiscard]] TrialRun run_trial_spec(const TrialSpec& spec, const Scene& scene,
                                       const TrialRunInputs& inputs = {});
 

@@ -1,9 +1,11 @@
 #pragma once
-// `calligraphy train --session DIR`: free practice saved as a study session folder
-// (study/session_folder.hpp), so that practice and study sessions share one layout, one record format and the
-// same never-overwrite rules. The practice has no fixed plan (R repeats, N moves on, G toggles guidance): the
-// folder is created for a protocol named "train" that lists the row's characters once under the starting
-// condition, and each trial the window runs is saved as the next trial of the session, whatever it is.
+/// \file practice_session.hpp
+/// `calligraphy train --session DIR`: free practice saved as a study session folder
+/// (study/session_folder.hpp), so that practice and study sessions share one layout, one record format and
+/// the same never-overwrite rules. The practice has no fixed plan (R repeats, N moves on, G toggles
+/// guidance): the folder is created for a protocol named "train" that lists the row's characters once under
+/// the starting condition, and each trial the window runs is saved as the next trial of the session, whatever
+/// it is.
 #include <cstddef>
 #include <filesystem>
 #include <map>
@@ -19,7 +21,7 @@
 #include "calligraphy/trial/options.hpp"
 #include "calligraphy/trial/result.hpp"
 
-namespace calligraphy::trainer {
+namespace calligraphy {
 
 /// The practice's conditions, as named in its session folder: "haptic" (guidance on), "vision" (off),
 /// "quiz" (off, each stroke judged as the pen lifts).
@@ -55,7 +57,7 @@ struct PracticeTrial {
   const Scene* scene = nullptr;  ///< the trial's scene
   const TrialOptions* options = nullptr;
   const TrialSpec* spec = nullptr;  ///< the trial's specification, recorded whole; nullptr: not recorded
-  SimulationOptions simulation;  ///< the simulated writer, when the setup has one
+  SimulationOptions simulation;     ///< the simulated writer, when the setup has one
   std::string start_utc, end_utc;
   double wall_time_s = 0.0;
 };
@@ -86,4 +88,4 @@ class PracticeSession {
   std::map<std::pair<std::size_t, std::string>, int> repetitions_;
 };
 
-}  // namespace calligraphy::trainer
+}  // namespace calligraphy

@@ -1,4 +1,4 @@
-#include "calligraphy/render/parameter_table.hpp"
+#include "calligraphy/core/parameter_table.hpp"
 
 #include <charconv>
 #include <cmath>

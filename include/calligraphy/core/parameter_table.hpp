@@ -1,10 +1,12 @@
 #pragma once
 /// \file parameter_table.hpp
-/// One table per parameter struct (ForceLawParameters, each guidance law): every numeric field's name,
+/// One table per parameter struct (the force law, each guidance law and per-repetition rule, the stroke
+/// acceptance, the safety chain, passivity, the simulated writer's profile): every numeric field's name,
 /// unit, range and one-line documentation, next to a pointer to the member. The table is the one
-/// definition of a field's range: the struct's validation walks it, the trial specification checks its
-/// per-mode values against the same entries, and Python's documentation of the fields is read from it
-/// (docs/force-rendering.md, "Parameter tables"). Defaults stay the struct's own member initialisers.
+/// definition of a field's range: the struct's validation walks it, the trial specification and a study
+/// protocol read their values against the same entries, and Python's documentation of the fields is read
+/// from it (docs/force-rendering.md, "Parameter tables"). Defaults stay the struct's own member
+/// initialisers. In `core` because structs of every layer from `model` up have one.
 #include <limits>
 #include <span>
 #include <string>

@@ -1,4 +1,4 @@
-#include "trainer/practice_session.hpp"
+#include "calligraphy/study/practice_session.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -8,7 +8,7 @@
 #include "calligraphy/study/protocol.hpp"
 #include "study/trial_record.hpp"
 
-namespace calligraphy::trainer {
+namespace calligraphy {
 namespace {
 
 // The "train" protocol: the row once under the first condition; the other conditions are defined so that
@@ -88,8 +88,7 @@ std::pair<std::filesystem::path, bool> PracticeSession::save(const PracticeTrial
   const Scene& scene = *trial.scene;
   const WritingMetrics writing = trial_writing_metrics(scene, result, trial.options->force.acceptance);
   std::vector<std::vector<QuizEvent>> quiz;
-  if (condition.mode == ConditionMode::quiz)
-    quiz = study_detail::quiz_characters(scene, result.trace, condition.quiz);
+  if (condition.mode == ConditionMode::quiz) quiz = quiz_characters(scene, result.trace, condition.quiz);
   const bool keep_as_trial = result.end == TrialEnd::completed || result.end == TrialEnd::time_limit ||
                              result.end == TrialEnd::gave_up || result.end == TrialEnd::writer_finished;
   nlohmann::json details = {{"trial", planned.index + 1},
@@ -117,4 +116,4 @@ void PracticeSession::log_stop(const std::string& reason) {
   folder_.log("session_stopped", nlohmann::json{{"reason", reason}, {"trials", trials_}}.dump());
 }
 
-}  // namespace calligraphy::trainer
+}  // namespace calligraphy
