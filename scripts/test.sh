@@ -116,8 +116,10 @@ end_stage
 # interpreter is not instrumented) and the benchmarks are left to the Release stage: here they would test
 # other programs' code or nothing of their own. The sweeps run on random subsets sized
 # for the sanitizer (tests/test_sizing.hpp prints the seed).
-start_background "AddressSanitizer + UndefinedBehaviorSanitizer: build" "
-  cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG='-O1 -g1' \
+# Built with clang: its instrumented files compile in 70-100 % of GCC's time, and this build is the stage's
+# longest path. (The Release and ThreadSanitizer stages stay on GCC, so both compilers keep building.)
+start_background "AddressSanitizer + UndefinedBehaviorSanitizer: build (clang)" "
+  cmake -S . -B build-asan -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG='-O1 -g1' \
     -DCALLIGRAPHY_SANITIZE=address,undefined -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_BENCH=OFF \
     -DCALLIGRAPHY_BUILD_TESTS=ON -DCALLIGRAPHY_BUILD_EXAMPLES=ON -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_TRAINER=OFF >/dev/null &&
   cmake --build build-asan -j $jobs"
@@ -157,7 +159,7 @@ build-fuzz/bin/corpus_store_fuzzer -runs=0 fuzz/seeds tests/data/store_regressio
 end_stage
 
 begin_stage "install + find_package(calligraphy) from another project"
-rm -rf build/stage build/consumer build/consumer-haptics
+rm -rf build/stage build/consumer build/consumer-haptics build/consumer-emulator
 touch build/install-started
 cmake --install build --prefix build/stage >/dev/null
 # A staging install writes only under its prefix (no .pth into another interpreter's site-packages).
@@ -183,5 +185,19 @@ bash tests/consumer/check_link_line.sh build/consumer-haptics build/consumer-hap
 build/consumer-haptics/own_loop
 build/consumer-haptics/custom_device_loop
 build/consumer-haptics/log_redirect
+# The USB transports and the emulator are components of their own: absent from the plain install above,
+# installed when asked for by name, and then found by an application's tests that name the emulator.
+if find build/stage -name 'libcalligraphy_phantom_usb.a' -o -name 'libcalligraphy_testing.a' | grep -q .; then
+  echo "the plain install carries the USB transports or the emulator, which were not asked for" >&2
+  exit 1
+fi
+cmake --install build --prefix build/stage --component testing >/dev/null
+cmake --install build --prefix build/stage --component phantom_usb >/dev/null
+cmake --no-warn-unused-cli -S tests/consumer/emulator -B build/consumer-emulator -G Ninja \
+  -DCMAKE_PREFIX_PATH="$PWD/build/stage" \
+  -DCMAKE_DISABLE_FIND_PACKAGE_spdlog=ON -DCMAKE_DISABLE_FIND_PACKAGE_fmt=ON \
+  -DCMAKE_DISABLE_FIND_PACKAGE_OpenSSL=ON >/dev/null
+cmake --build build/consumer-emulator
+build/consumer-emulator/emulated_phantom
 end_stage
 echo "== all tests passed"

@@ -159,7 +159,7 @@ HoldRun hold_in_writing(GuidanceMode mode, Hand hand, double rate_hz, double sti
   return run;
 }
 
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#if defined(CALLIGRAPHY_TEST_SANITIZED)
 constexpr double kHoldSeconds = 20.0;
 #else
 constexpr double kHoldSeconds = 60.0;

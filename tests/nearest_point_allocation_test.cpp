@@ -15,7 +15,7 @@
 
 // AddressSanitizer owns operator new/delete; replacing them there mixes its allocator with ours
 // (alloc-dealloc-mismatch at exit). The Release build runs this test; the ASan build leaves it out.
-#if !defined(__SANITIZE_ADDRESS__)
+#if !defined(CALLIGRAPHY_TEST_SANITIZED)
 namespace {
 std::atomic<long> allocations{0};
 }  // namespace
@@ -75,4 +75,4 @@ TEST_CASE("Renderer ticks (smoothing, passivity controller, safety chain) do not
   CHECK(allocations.load() == before);
   CHECK(sum > 0.0);
 }
-#endif  // !defined(__SANITIZE_ADDRESS__)
+#endif  // !defined(CALLIGRAPHY_TEST_SANITIZED)

@@ -5,7 +5,7 @@
 // test out.
 #include <catch2/catch.hpp>
 
-#if !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__) && defined(__GLIBC__)
+#if !defined(CALLIGRAPHY_TEST_SANITIZED) && defined(__GLIBC__)
 #include <atomic>
 #include <chrono>
 #include <cmath>

@@ -16,7 +16,7 @@
 
 namespace calligraphy::testing {
 
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#if defined(CALLIGRAPHY_TEST_SANITIZED)  // tests/CMakeLists.txt
 inline constexpr bool kSanitizedBuild = true;
 #else
 inline constexpr bool kSanitizedBuild = false;
