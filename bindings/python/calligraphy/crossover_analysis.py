@@ -431,7 +431,7 @@ def retention_ratios(data: "pandas.DataFrame", value: str, design: "StudyDesign"
     (its 95 % t interval excludes 0). Columns as ``design_analysis.retention_ratios`` (``group`` holds the
     condition)."""
     pandas = statistics._pandas()
-    columns = ["group", "n", "gain", "gain_ci95_low", "gain_ci95_high", "retention_ratio", "note"]
+    columns = statistics.RETENTION_COLUMNS
     phases = {design.pre_test, "post-test", "retention"}
     if design.pre_test is None or not {"post-test", "retention"} <= set(design.after_training):
         return pandas.DataFrame(columns=columns)
@@ -444,18 +444,10 @@ def retention_ratios(data: "pandas.DataFrame", value: str, design: "StudyDesign"
     for condition in design.conditions:
         subset = table.loc[condition].dropna() if condition in table.index.get_level_values(0) else table.iloc[0:0]
         subset = subset.dropna(subset=[p for p in phases if p in subset.columns])
-        n = len(subset) if {design.pre_test, "post-test", "retention"} <= set(subset.columns) else 0
-        gains = (subset[design.pre_test] - subset["post-test"]).to_numpy(dtype=float) if n else np.array([])
-        low, high = statistics._t_interval(np.array([gains.mean() if n else math.nan]),
-                                           np.array([gains.std(ddof=1) if n > 1 else math.nan]), np.array([n]))
-        ratio, note = math.nan, ""
-        if n < 2:
-            note = "not computed: fewer than 2 subjects with pre-test, post-test and retention on the condition's set"
-        elif not low[0] > 0:
-            note = f"not computed: the gain is not reliably above 0 (95 % CI [{low[0]:.3g}, {high[0]:.3g}])"
-        else:
-            ratio = float((subset[design.pre_test] - subset["retention"]).mean() / gains.mean())
-        out.append({"group": condition, "n": n, "gain": float(gains.mean()) if n else math.nan,
-                    "gain_ci95_low": float(low[0]), "gain_ci95_high": float(high[0]), "retention_ratio": ratio,
-                    "note": note})
+        if not {design.pre_test, "post-test", "retention"} <= set(subset.columns):
+            subset = subset.iloc[0:0].reindex(columns=[design.pre_test, "post-test", "retention"])
+        out.append(statistics.retention_row(
+            condition, subset[design.pre_test], subset["post-test"], subset["retention"],
+            "not computed: fewer than 2 subjects with pre-test, post-test and retention on the condition's set",
+            "the gain"))
     return pandas.DataFrame(out, columns=columns)

@@ -568,8 +568,7 @@ def retention_ratios(trials: pandas.DataFrame, value: str, design: StudyDesign,
     (NaN when not computed) and ``note``. Empty without pre-test, post-test and retention phases."""
     pandas = _pandas()
     if design.pre_test is None or not {"post-test", "retention"} <= set(design.after_training):
-        return pandas.DataFrame(columns=["group", "n", "gain", "gain_ci95_low", "gain_ci95_high",
-                                         "retention_ratio", "note"])
+        return pandas.DataFrame(columns=statistics.RETENTION_COLUMNS)
     data, _ = apply_exclusions(statistics._finite_outcome(trials, value, "retention_ratios"), policy)
     if design.kind == "crossover":
         return crossover_analysis.retention_ratios(data, value, design)
@@ -579,22 +578,10 @@ def retention_ratios(trials: pandas.DataFrame, value: str, design: StudyDesign,
     for group in (design.conditions if column else ("all",)):
         subset = table[table[column].astype(str) == group] if column else table
         both = subset.dropna(subset=["pre", "post", "retention"])
-        gains = (both["pre"] - both["post"]).to_numpy(dtype=float)
-        n = len(gains)
-        low, high = statistics._t_interval(np.array([gains.mean() if n else math.nan]),
-                                           np.array([gains.std(ddof=1) if n > 1 else math.nan]), np.array([n]))
-        ratio, note = math.nan, ""
-        if n < 2:
-            note = "not computed: fewer than 2 subjects with pre-test, post-test and retention"
-        elif not low[0] > 0:
-            note = (f"not computed: the group's gain is not reliably above 0 (95 % CI [{low[0]:.3g}, "
-                    f"{high[0]:.3g}])")
-        else:
-            ratio = float((both["pre"] - both["retention"]).mean() / gains.mean())
-        rows.append({"group": group, "n": n, "gain": float(gains.mean()) if n else math.nan,
-                     "gain_ci95_low": float(low[0]), "gain_ci95_high": float(high[0]), "retention_ratio": ratio,
-                     "note": note})
-    return pandas.DataFrame(rows)
+        rows.append(statistics.retention_row(
+            group, both["pre"], both["post"], both["retention"],
+            "not computed: fewer than 2 subjects with pre-test, post-test and retention", "the group's gain"))
+    return pandas.DataFrame(rows, columns=statistics.RETENTION_COLUMNS)
 
 
 def transfer_baseline(trials: pandas.DataFrame, design: StudyDesign) -> str:

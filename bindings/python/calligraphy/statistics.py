@@ -175,6 +175,33 @@ def _column_names(columns: str | typing.Sequence[str], argument: str, caller: st
     return list(columns)
 
 
+RETENTION_COLUMNS = ["group", "n", "gain", "gain_ci95_low", "gain_ci95_high", "retention_ratio", "note"]
+
+
+def retention_row(group: str, pre, post, retention, too_few: str, whose_gain: str) -> dict:
+    """One row of a retention-ratio table (columns RETENTION_COLUMNS) from per-subject means of the same
+    subjects [n] (errors and times: lower is better): the gain pre - post with its 95 % t interval, and
+    mean(pre - retention) / mean(pre - post), computed only when the mean gain is reliably above 0 (its
+    interval excludes 0), as a ratio of a gain near 0 is unbounded. ``too_few`` is the note when fewer than 2
+    subjects have all three means; ``whose_gain`` names the gain in the note when it is not reliable ("the
+    group's gain")."""
+    pre, post, retention = (np.asarray(x, dtype=float) for x in (pre, post, retention))
+    gains = pre - post
+    n = len(gains)
+    low, high = _t_interval(np.array([gains.mean() if n else math.nan]),
+                            np.array([gains.std(ddof=1) if n > 1 else math.nan]), np.array([n]))
+    ratio, note = math.nan, ""
+    if n < 2:
+        note = too_few
+    elif not low[0] > 0:
+        note = f"not computed: {whose_gain} is not reliably above 0 (95 % CI [{low[0]:.3g}, {high[0]:.3g}])"
+    else:
+        ratio = float((pre - retention).mean() / gains.mean())
+    return {"group": group, "n": n, "gain": float(gains.mean()) if n else math.nan,
+            "gain_ci95_low": float(low[0]), "gain_ci95_high": float(high[0]), "retention_ratio": ratio,
+            "note": note}
+
+
 def _t_interval(mean: np.ndarray, sd: np.ndarray, n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The 95 % t interval of a mean from its sample's sd and size (Student 1908, scipy.stats.t); NaN where
     n < 2."""
