@@ -57,7 +57,7 @@ RecordedTrial random_recorded_trial(std::mt19937_64& random, GuidanceMode mode) 
   r.spec.rate_hz = 100.0 + std::uniform_real_distribution<double>(0.0, 4900.0)(random);
   r.spec.max_duration_s = 1.0 + std::uniform_real_distribution<double>(0.0, 100.0)(random);
   r.spec.writer_profile = "foreign";
-  r.spec.writer_parameters = {"hesitation_s=0.25"};
+  r.spec.writer_parameters = {{"hesitation_s", 0.25}};
   if (mode == GuidanceMode::replay) r.spec.teacher = "teacher.json";
   randomise(r.force_law, random);
   r.force_law.constraint_taper_m = r.force_law.constraint_radius_m * 0.5;  // a cross-field rule
@@ -137,7 +137,7 @@ TEST_CASE("A trial run again from its record gives the same trace, bit for bit",
   spec.guidance_mode = GuidanceMode::assist_as_needed;
   spec.assist_band_m = 0.0007;
   spec.writer_profile = "novice";
-  spec.writer_parameters = {"bias_offset_m=0.003", "stroke_jitter_m=0.0013"};
+  spec.writer_parameters = {{"bias_offset_m", 0.003}, {"stroke_jitter_m", 0.0013}};
   spec.seed = 99;
   spec.rate_hz = 800.0;
   spec.max_duration_s = 30.0;

@@ -27,7 +27,7 @@ TrialSpec everything_set() {
   spec.guidance_gain = 0.3;
   spec.writer = TrialWriter::simulated;
   spec.writer_profile = "skilled";
-  spec.writer_parameters = {"bias_offset_m=0.0005", "stroke_jitter_m=0"};
+  spec.writer_parameters = {{"bias_offset_m", 0.0005}, {"stroke_jitter_m", 0.0}};
   spec.seed = 18446744073709551615ULL;
   spec.rate_hz = 2000.0 / 3.0;  // no short decimal: the text must keep every bit
   spec.pacing = TrialPacing::real_time;
@@ -70,7 +70,7 @@ TrialSpec random_spec(std::mt19937_64& random) {
   spec.writer = static_cast<TrialWriter>(random() % 3);
   if (spec.writer != TrialWriter::person && random() % 2) {
     spec.writer_profile = "foreign";
-    spec.writer_parameters.push_back("stroke_jitter_m=" + std::to_string(unit(random) * 1e-4));
+    spec.writer_parameters.push_back({"stroke_jitter_m", unit(random) * 1e-4});  // every bit must survive
   }
   spec.seed = random();
   spec.pacing = static_cast<TrialPacing>(random() % 3);
@@ -134,6 +134,30 @@ TEST_CASE("a trial specification round-trips through its JSON and its command-li
       CHECK(trial_spec_from_json(trial_spec_json(spec), "spec.json") == spec);
     }
   }
+}
+
+TEST_CASE("the writer's settings are numbers in the JSON, and a record's older \"key=value\" text is read") {
+  TrialSpec spec;
+  spec.characters = "十";
+  spec.writer_parameters = {{"bias_offset_m", 0.01 / 3.0}, {"stroke_jitter_m", 1.0 / 3.0 * 1e-4}};
+  const std::string text = trial_spec_json(spec);
+  CHECK_THAT(text, Catch::Contains("\"key\": \"bias_offset_m\"") && !Catch::Contains("bias_offset_m="));
+  CHECK(trial_spec_from_json(text, "spec.json") == spec);
+  const TrialSpec older = trial_spec_from_json(
+      R"({"characters": "十", "writer_parameters": ["bias_offset_m=0.004", "stroke_jitter_m=1e-5"]})",
+      "old.json");
+  CHECK(older.writer_parameters ==
+        std::vector<WriterSetting>{{"bias_offset_m", 0.004}, {"stroke_jitter_m", 1e-5}});
+  CHECK_THAT(error_of([] {
+               (void)trial_spec_from_json(
+                   R"({"characters": "十", "writer_parameters": [{"key": "bias_offset_m"}]})", "s.json");
+             }),
+             Catch::Contains("s.json: /writer_parameters/0") && Catch::Contains("value"));
+  CHECK_THAT(error_of([] {
+               (void)trial_spec_from_json(R"({"characters": "十", "writer_parameters": ["bias_offset_m"]})",
+                                          "s.json");
+             }),
+             Catch::Contains("s.json: /writer_parameters/0") && Catch::Contains("key=value"));
 }
 
 TEST_CASE("every field of the specification has both names and a parser") {
@@ -203,7 +227,7 @@ TEST_CASE("a specification's errors name the field in both its forms") {
   bad.writer_profile = "expert";
   fails_naming(bad, "writer_profile (--writer-profile)");
   bad = spec;
-  bad.writer_parameters = {"no_such_key=1"};
+  bad.writer_parameters = {{"no_such_key", 1.0}};
   fails_naming(bad, "writer_parameters (--writer-param): 'no_such_key=1'");
   bad = spec;
   bad.pacing = TrialPacing::real_time;

@@ -69,15 +69,16 @@ TEST_CASE("Writer parameters are set by name, and an unknown name is refused nam
   }
 }
 
-TEST_CASE("A key=value setting as given on a command line", "[writer]") {
+TEST_CASE("A key=value setting as given on a command line is read once into a typed setting", "[writer]") {
+  CHECK(parse_writer_setting("order_error_probability=0.3") == WriterSetting{"order_error_probability", 0.3});
+  CHECK(parse_writer_setting("visual_delay_s=1.5e-1") == WriterSetting{"visual_delay_s", 0.15});
+  CHECK_THROWS_WITH(parse_writer_setting("order_error_probability"), Catch::Contains("key=value"));
+  CHECK_THROWS_WITH(parse_writer_setting("visual_delay_s=fast"), Catch::Contains("'fast' is not a number"));
+  CHECK_THROWS_WITH(parse_writer_setting("visual_delay_s=0.1s"), Catch::Contains("not a number"));
   WriterProfile p;
-  apply_writer_setting(p, "order_error_probability=0.3");
-  CHECK(p.order_error_probability == 0.3);
-  apply_writer_setting(p, "visual_delay_s=1.5e-1");
-  CHECK(p.visual_delay_s == 0.15);
-  CHECK_THROWS_WITH(apply_writer_setting(p, "order_error_probability"), Catch::Contains("key=value"));
-  CHECK_THROWS_WITH(apply_writer_setting(p, "visual_delay_s=fast"),
-                    Catch::Contains("'fast' is not a number"));
-  CHECK_THROWS_WITH(apply_writer_setting(p, "visual_delay_s=0.1s"), Catch::Contains("not a number"));
-  CHECK_THROWS_WITH(apply_writer_setting(p, "delay=0.1"), Catch::Contains("'delay'"));
+  CHECK_THROWS_WITH(set_writer_parameter(p, parse_writer_setting("delay=0.1").key, 0.1),
+                    Catch::Contains("'delay'"));
+  // Its text reads back to the same bits.
+  const WriterSetting third{"stroke_jitter_m", 1.0 / 3.0 * 1e-4};
+  CHECK(parse_writer_setting(writer_setting_text(third)) == third);
 }

@@ -162,7 +162,8 @@ TrialDescription describe(const TrialSpec& spec, const TrialRun& run, const Devi
   }
   if (run.simulated_writer) {
     description.writer_profile = run.writer.name;
-    description.writer_parameters = spec.writer_parameters;
+    for (const WriterSetting& setting : spec.writer_parameters)
+      description.writer_parameters.push_back(writer_setting_text(setting));
   }
   return description;
 }

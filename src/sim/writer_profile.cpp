@@ -206,19 +206,24 @@ void set_writer_parameter(WriterProfile& profile, std::string_view key, double v
   profile = std::move(changed);
 }
 
-void apply_writer_setting(WriterProfile& profile, std::string_view setting) {
-  const std::size_t equals = setting.find('=');
+WriterSetting parse_writer_setting(std::string_view text) {
+  const std::size_t equals = text.find('=');
   if (equals == std::string_view::npos) {
-    throw InvalidArgument("writer setting '" + std::string(setting) + "' must be key=value");
+    throw InvalidArgument("writer setting '" + std::string(text) + "' must be key=value");
   }
-  const std::string_view key = setting.substr(0, equals);
-  const std::string_view text = setting.substr(equals + 1);
-  const std::optional<double> value = parse_finite_double(text);
+  const std::string_view number = text.substr(equals + 1);
+  const std::optional<double> value = parse_finite_double(number);
   if (!value) {
-    throw InvalidArgument("writer setting '" + std::string(setting) + "': '" + std::string(text) +
+    throw InvalidArgument("writer setting '" + std::string(text) + "': '" + std::string(number) +
                           "' is not a number (a finite decimal within the range of a double is expected)");
   }
-  set_writer_parameter(profile, key, *value);
+  return WriterSetting{std::string(text.substr(0, equals)), *value};
+}
+
+std::string writer_setting_text(const WriterSetting& setting) {
+  char digits[32];
+  const auto end = std::to_chars(digits, digits + sizeof digits, setting.value).ptr;
+  return setting.key + "=" + std::string(digits, end);
 }
 
 }  // namespace calligraphy

@@ -36,12 +36,6 @@ void remember(WriterMemory& memory, const fs::path& folder, const SessionManifes
   practise_session(memory, folder, manifest);
 }
 
-std::string setting(const std::string& key, double value) {
-  char text[40];
-  std::snprintf(text, sizeof text, "%.17g", value);
-  return key + "=" + text;
-}
-
 }  // namespace
 
 SubjectTraits subject_traits(const SessionSetup& setup) {
@@ -53,13 +47,13 @@ WriterProfile subject_profile(const SessionSetup& setup) {
   return individual_profile(writer_profile(setup.writer_profile), subject_traits(setup));
 }
 
-std::vector<std::string> individual_parameters(const SessionSetup& setup) {
+std::vector<WriterSetting> individual_parameters(const SessionSetup& setup) {
   const SubjectTraits traits = subject_traits(setup);
   if (!traits.drawn) return {};
   const WriterProfile own = individual_profile(writer_profile(setup.writer_profile), traits);
-  std::vector<std::string> parameters;
+  std::vector<WriterSetting> parameters;
   for (const std::string& field : individual_profile_fields())
-    parameters.push_back(setting(field, writer_parameter(own, field)));
+    parameters.push_back(WriterSetting{field, writer_parameter(own, field)});
   return parameters;
 }
 
@@ -147,20 +141,20 @@ std::vector<int> typical_ids(const Scene& scene) {
   return ids;
 }
 
-std::vector<std::string> learned_parameters(const WriterMemory& memory, const WriterProfile& own,
-                                            const std::vector<int>& ids, const std::u32string& characters) {
+std::vector<WriterSetting> learned_parameters(const WriterMemory& memory, const WriterProfile& own,
+                                              const std::vector<int>& ids, const std::u32string& characters) {
   const WriterProfile learned =
       learned_profile(own, WriterProfile::skilled(), writer_skills(memory, ids, characters));
-  std::vector<std::string> parameters;
+  std::vector<WriterSetting> parameters;
   for (const std::string& field : learned_profile_fields())
-    parameters.push_back(setting(field, writer_parameter(learned, field)));
+    parameters.push_back(WriterSetting{field, writer_parameter(learned, field)});
   return parameters;
 }
 
 WriterSkills learn_into(TrialSpec& spec, const WriterMemory& memory, const WriterProfile& own,
                         const Scene& scene, const std::u32string& characters) {
   const std::vector<int> ids = typical_ids(scene);
-  for (std::string& parameter : learned_parameters(memory, own, ids, characters))
+  for (WriterSetting& parameter : learned_parameters(memory, own, ids, characters))
     spec.writer_parameters.push_back(std::move(parameter));
   return writer_skills(memory, ids, characters);
 }

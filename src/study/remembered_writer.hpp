@@ -22,9 +22,9 @@ SubjectTraits subject_traits(const SessionSetup& setup);
 /// traits.
 WriterProfile subject_profile(const SessionSetup& setup);
 
-/// "key=value" writer parameters that make the profile `setup`'s subject (`individual_profile_fields`);
-/// empty when its traits are not drawn.
-std::vector<std::string> individual_parameters(const SessionSetup& setup);
+/// The writer settings that make the profile `setup`'s subject (`individual_profile_fields`); empty when its
+/// traits are not drawn.
+std::vector<WriterSetting> individual_parameters(const SessionSetup& setup);
 
 /// One saved trial as practice with the subject's `rates`: the typical strokes of its scene, its characters,
 /// and the shares of the correction its guidance took from the hand (the record's force law and writer
@@ -39,10 +39,10 @@ WriterMemory remembered(const SessionFolder& session);
 /// The typical stroke IDs of a scene, stroke by stroke.
 std::vector<int> typical_ids(const Scene& scene);
 
-/// "key=value" writer parameters of the subject's own profile `own` learned to `memory`'s skill for a trial
-/// of `characters` with strokes `ids` (learned_profile, towards the skilled profile).
-std::vector<std::string> learned_parameters(const WriterMemory& memory, const WriterProfile& own,
-                                            const std::vector<int>& ids, const std::u32string& characters);
+/// The writer settings of the subject's own profile `own` learned to `memory`'s skill for a trial of
+/// `characters` with strokes `ids` (learned_profile, towards the skilled profile).
+std::vector<WriterSetting> learned_parameters(const WriterMemory& memory, const WriterProfile& own,
+                                              const std::vector<int>& ids, const std::u32string& characters);
 
 /// Makes `spec` the trial of a learning subject: appends its writer parameters `learned_parameters` for the
 /// strokes of `scene` and `characters` (after the subject's own, so that they win). Returns the skills

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "calligraphy/core/decimal_number.hpp"
@@ -20,6 +21,13 @@
 
 namespace calligraphy {
 namespace {
+
+// The writer's setting names, for an error about one: "hand_stiffness_n_per_m, ...".
+std::string writer_keys() {
+  std::string keys;
+  for (const std::string& key : writer_parameter_names()) keys += (keys.empty() ? "" : ", ") + key;
+  return keys;
+}
 
 using nlohmann::json;
 
@@ -220,7 +228,11 @@ void set_trial_spec_field(TrialSpec& spec, std::string_view name, std::string_vi
   } else if (key == "writer_profile") {
     spec.writer_profile = text;
   } else if (key == "writer_parameters") {
-    spec.writer_parameters.emplace_back(text);
+    try {
+      spec.writer_parameters.push_back(parse_writer_setting(text));
+    } catch (const InvalidArgument& e) {
+      refuse(key, std::string(e.what()) + "; known keys: " + writer_keys());
+    }
   } else if (key == "seed") {
     spec.seed = parse_unsigned(key, text);
   } else if (key == "pacing") {
@@ -257,7 +269,11 @@ std::vector<std::string> trial_spec_field_text(const TrialSpec& spec, std::strin
   if (key == "teacher") return {spec.teacher};
   if (key == "writer") return {to_string(spec.writer)};
   if (key == "writer_profile") return {spec.writer_profile};
-  if (key == "writer_parameters") return spec.writer_parameters;
+  if (key == "writer_parameters") {
+    std::vector<std::string> texts;
+    for (const WriterSetting& setting : spec.writer_parameters) texts.push_back(writer_setting_text(setting));
+    return texts;
+  }
   if (key == "seed") return {std::to_string(spec.seed)};
   if (key == "rate_hz") return {number_text(spec.rate_hz)};
   if (key == "pacing") return {to_string(spec.pacing)};
@@ -329,17 +345,13 @@ void TrialSpec::validate(TeacherSource teacher_from) const {
   } catch (const InvalidArgument& e) {
     refuse("writer_profile", e.what());
   }
-  for (const std::string& setting : writer_parameters) {
+  for (const WriterSetting& setting : writer_parameters) {
     try {
-      apply_writer_setting(profile, setting);
+      set_writer_parameter(profile, setting.key, setting.value);
     } catch (const InvalidArgument& e) {
       std::string message = e.what();
-      if (message.find("known:") == std::string::npos) {
-        std::string keys;
-        for (const std::string& key : writer_parameter_names()) keys += (keys.empty() ? "" : ", ") + key;
-        message += "; known keys: " + keys;
-      }
-      refuse("writer_parameters", "'" + setting + "': " + message);
+      if (message.find("known:") == std::string::npos) message += "; known keys: " + writer_keys();
+      refuse("writer_parameters", "'" + writer_setting_text(setting) + "': " + message);
     }
   }
   const bool real_time = pacing == TrialPacing::real_time;
@@ -435,7 +447,13 @@ TrialSpec trial_spec_from_object(const json& document, const std::string& at_poi
       } else if (double TrialSpec::*number = number_member(key)) {
         expect(item.is_number(), "a number");
         spec.*number = item.get<double>();
-      } else {
+      } else if (key == "writer_parameters" && item.is_object()) {  // {"key": name, "value": number}
+        ObjectReader setting(item, at, source);
+        constexpr double kLargest = std::numeric_limits<double>::max();
+        spec.writer_parameters.push_back(
+            WriterSetting{setting.string("key"), setting.number("value", -kLargest, kLargest)});
+        setting.finish();
+      } else {  // text fields, and a setting written as "key=value" (records before settings were typed)
         try {
           set_trial_spec_field(spec, key, study_detail::as_string(item, at, source));
         } catch (const InvalidArgument& e) {
@@ -476,8 +494,10 @@ std::string trial_spec_json(const TrialSpec& spec) {
       document[key] = spec.watchdog_s;
     } else if (double TrialSpec::*number = number_member(key)) {
       document[key] = spec.*number;
-    } else if (field.repeated) {
-      document[key] = trial_spec_field_text(spec, key);
+    } else if (field.repeated) {  // the writer's settings, numbers as numbers
+      document[key] = nlohmann::ordered_json::array();
+      for (const WriterSetting& setting : spec.writer_parameters)
+        document[key].push_back({{"key", setting.key}, {"value", setting.value}});
     } else {
       document[key] = trial_spec_field_text(spec, key).front();
     }

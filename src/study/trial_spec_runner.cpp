@@ -49,7 +49,8 @@ GuidanceLaw guidance_law_of(const TrialSpec& spec) {
 
 WriterProfile profile_of(const TrialSpec& spec) {
   WriterProfile profile = writer_profile(spec.writer_profile);
-  for (const std::string& setting : spec.writer_parameters) apply_writer_setting(profile, setting);
+  for (const WriterSetting& setting : spec.writer_parameters)
+    set_writer_parameter(profile, setting.key, setting.value);
   return profile;
 }
 

@@ -114,9 +114,21 @@ struct ParameterTable<WriterProfile> {
 /// is not a whole number for `max_attempts_per_stroke`, or the field `validate` refuses.
 void set_writer_parameter(WriterProfile& profile, std::string_view key, double value);
 
-/// Applies a "key=value" setting as given on a command line (`--writer-param key=value`). Throws
-/// InvalidArgument naming the setting when there is no '=' or the value is not a number, and what
-/// `set_writer_parameter` throws.
-void apply_writer_setting(WriterProfile& profile, std::string_view setting);
+/// One numeric field of a profile set to a value: what `--writer-param key=value` states, typed. A trial
+/// specification holds these (applied in turn with `set_writer_parameter`), so that no number passes
+/// through text inside the program.
+struct WriterSetting {
+  std::string key;     ///< a name of `writer_parameter_names()`
+  double value = 0.0;  ///< in the field's unit and range (ParameterTable<WriterProfile>)
+  bool operator==(const WriterSetting&) const = default;
+};
+
+/// The setting "key=value" as a command line gives it. Throws InvalidArgument naming the setting when
+/// there is no '=' or the value is not a finite decimal number (the key is checked where it is applied).
+[[nodiscard]] WriterSetting parse_writer_setting(std::string_view text);
+
+/// "key=value", the value in the shortest digits that read back to the same double: the command line's
+/// form of `setting`, which `parse_writer_setting` reads back equal.
+[[nodiscard]] std::string writer_setting_text(const WriterSetting& setting);
 
 }  // namespace calligraphy

@@ -15,6 +15,7 @@
 #include "calligraphy/devices/servo_loop.hpp"
 #include "calligraphy/render/force_law.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
+#include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/trial/options.hpp"
 
 namespace calligraphy {
@@ -45,7 +46,7 @@ struct TrialSpec {
   std::string teacher;                           ///< replay only: a teacher's recording (JSON file)
   TrialWriter writer = TrialWriter::automatic;   ///< who writes
   std::string writer_profile = "novice";         ///< the simulated writer's profile (docs/writer.md)
-  std::vector<std::string> writer_parameters;    ///< "key=value" settings applied to the profile in turn
+  std::vector<WriterSetting> writer_parameters;  ///< settings applied to the profile in turn (typed)
   std::uint64_t seed = 0;                        ///< the simulated writer's seed
   double rate_hz = 1000.0;                       ///< servo rate [Hz]: [100, 100000], real time [100, 10000]
   TrialPacing pacing = TrialPacing::automatic;   ///< lock-step, real time, or the device's own
@@ -108,7 +109,8 @@ void set_trial_spec_field(TrialSpec& spec, std::string_view name, std::string_vi
 [[nodiscard]] std::vector<std::string> trial_spec_args(const TrialSpec& spec);
 
 /// The specification from a JSON object whose keys are the fields' keys (numbers as numbers, `guidance` a
-/// boolean, `writer_parameters` an array of strings); a missing key keeps its default. Throws DataError
+/// boolean, `writer_parameters` an array of {"key": name, "value": number}, or of "key=value" strings as
+/// records before it wrote); a missing key keeps its default. Throws DataError
 /// naming `source` and the JSON pointer of a value at fault or an unknown key, then validates
 /// (InvalidArgument naming the field) with a replay's teacher from `teacher_from` (TrialSpec::validate).
 [[nodiscard]] TrialSpec trial_spec_from_json(std::string_view text, const std::string& source,
