@@ -38,12 +38,6 @@ bool parse_number(const std::string& text, double& value) {
   return parsed.has_value();
 }
 
-std::string shortest(double value) {
-  char text[32];
-  const auto result = std::to_chars(text, text + sizeof text, value);
-  return std::string(text, result.ptr);
-}
-
 // An option taking exactly one value, handed to `parse` (which stores it or throws ValidationError).
 CLI::Option* add_single(CLI::App& app, const std::string& name, const std::string& value_name,
                         const std::string& description, const std::string& default_text,
@@ -141,7 +135,7 @@ CLI::Option* add_unsigned(CLI::App& app, const std::string& name, std::uint64_t&
 CLI::Option* add_number(CLI::App& app, const std::string& name, double& target, const std::string& value_name,
                         const std::string& description, const std::string& expectation,
                         std::function<bool(double)> valid) {
-  return add_single(app, name, value_name, description, shortest(target),
+  return add_single(app, name, value_name, description, shortest_decimal(target),
                     [=, &target](const std::string& text) {
                       double value = 0.0;
                       if (!parse_number(text, value) || !valid(value)) invalid(name, expectation, text);
@@ -153,7 +147,7 @@ CLI::Option* add_number_list(CLI::App& app, const std::string& name, std::vector
                              const std::string& value_name, const std::string& description,
                              const std::string& expectation, std::function<bool(double)> valid) {
   std::string default_text;
-  for (double value : target) default_text += (default_text.empty() ? "" : ",") + shortest(value);
+  for (double value : target) default_text += (default_text.empty() ? "" : ",") + shortest_decimal(value);
   return add_single(app, name, value_name, description, default_text, [=, &target](const std::string& text) {
     std::vector<double> values;
     std::size_t start = 0;

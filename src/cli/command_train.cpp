@@ -89,9 +89,9 @@ int run_train(const TrainCommand& command, DeviceRegistry& devices) {
                    : options.simulated_writer ? "simulated"
                                               : "mouse-hand";
   options.registry = &devices;  // the command line's devices, the mouse ones included
-  static_cast<void>(find_cli_device(devices, "--device", options.device));
   {  // a simulated writer moves only a device with a hand port; a person moves any other
-    const bool hand_port = devices.find(options.device).capabilities.moved_by_simulated_hand;
+    const bool hand_port =
+        find_cli_device(devices, "--device", options.device).capabilities.moved_by_simulated_hand;
     if (options.simulated_writer && !hand_port) {
       throw UsageError(
           "--writer simulated needs a device a simulated writer can move (simulated, "

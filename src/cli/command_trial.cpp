@@ -104,13 +104,6 @@ RecordedTrial recorded_from(const TrialCommand& command) {
   return recorded;
 }
 
-// The listing of `name`. A name no backend knows is a UsageError (exit 2) naming the devices there are; a
-// known device that cannot be used now (DeviceUnavailable: no arm, a damaged driver library) keeps its
-// own error, with its reason (exit 1).
-DeviceListing find_device(const DeviceRegistry& devices, const std::string& name) {
-  return find_cli_device(devices, "--device", name);
-}
-
 // The trial specification of the command line: every option given goes through the specification's one
 // parser (trial_spec.hpp) and its validate(); an error there is a usage error naming the option.
 TrialSpec spec_from(const TrialCommand& command) {
@@ -162,8 +155,7 @@ TrialDescription describe(const TrialSpec& spec, const TrialRun& run, const Devi
   }
   if (run.simulated_writer) {
     description.writer_profile = run.writer.name;
-    for (const WriterSetting& setting : spec.writer_parameters)
-      description.writer_parameters.push_back(writer_setting_text(setting));
+    description.writer_parameters = trial_spec_field_text(spec, "writer_parameters");
   }
   return description;
 }
@@ -232,7 +224,7 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
                    "CHARS");
   const TrialSpec spec = recorded ? recorded->spec : spec_from(command);
   const std::u32string chars = characters_from(spec.characters, "CHARS");
-  const DeviceListing device = find_device(devices, spec.device);
+  const DeviceListing device = find_cli_device(devices, "--device", spec.device);
   bool simulated = false;
   try {
     simulated = simulated_writer_writes(spec, simulated_writer_moves(device));

@@ -9,6 +9,11 @@
 
 namespace calligraphy {
 
+std::string shortest_decimal(double value) {
+  char text[32];  // a double's shortest form needs at most 24 characters
+  return std::string(text, std::to_chars(text, text + sizeof text, value).ptr);
+}
+
 std::optional<double> parse_finite_double(std::string_view text) {
   double value = 0.0;
   const char* last = text.data() + text.size();

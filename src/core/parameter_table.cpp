@@ -1,20 +1,12 @@
 #include "calligraphy/core/parameter_table.hpp"
 
-#include <charconv>
 #include <cmath>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
 namespace {
-
-// The shortest text that reads back as the same double, so that a value just outside a bound does not
-// print as the bound itself.
-std::string number_text(double value) {
-  char text[32];
-  const auto [end, error] = std::to_chars(text, text + sizeof text, value);
-  return error == std::errc() ? std::string(text, end) : std::string("?");
-}
 
 std::string with_unit(const std::string& number, std::string_view unit) {
   return unit.empty() ? number : number + " " + std::string(unit);
@@ -30,16 +22,16 @@ bool ParameterRange::contains(double value) const noexcept {
 }
 
 std::string ParameterRange::text(std::string_view unit) const {
-  if (std::isinf(high)) return with_unit((low_open ? "> " : ">= ") + number_text(low), unit);
-  return with_unit(std::string("in ") + (low_open ? "(" : "[") + number_text(low) + ", " + number_text(high) +
-                       (high_open ? ")" : "]"),
+  if (std::isinf(high)) return with_unit((low_open ? "> " : ">= ") + shortest_decimal(low), unit);
+  return with_unit(std::string("in ") + (low_open ? "(" : "[") + shortest_decimal(low) + ", " +
+                       shortest_decimal(high) + (high_open ? ")" : "]"),
                    unit);
 }
 
 void check_parameter(std::string_view qualified_name, double value, std::string_view unit,
                      const ParameterRange& range) {
   if (range.contains(value)) return;
-  throw InvalidArgument(std::string(qualified_name) + " = " + with_unit(number_text(value), unit) +
+  throw InvalidArgument(std::string(qualified_name) + " = " + with_unit(shortest_decimal(value), unit) +
                         " must be " + (std::isinf(range.high) ? "finite and " : "") + range.text(unit));
 }
 

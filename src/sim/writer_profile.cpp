@@ -1,13 +1,12 @@
 #include "calligraphy/sim/writer_profile.hpp"
 
 #include <array>
-#include <charconv>
 #include <cmath>
 #include <limits>
 #include <string>
 
-#include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/decimal_number.hpp"
+#include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
 namespace {
@@ -221,9 +220,7 @@ WriterSetting parse_writer_setting(std::string_view text) {
 }
 
 std::string writer_setting_text(const WriterSetting& setting) {
-  char digits[32];
-  const auto end = std::to_chars(digits, digits + sizeof digits, setting.value).ptr;
-  return setting.key + "=" + std::string(digits, end);
+  return setting.key + "=" + shortest_decimal(setting.value);
 }
 
 }  // namespace calligraphy

@@ -268,11 +268,10 @@ void TrainerApp::update_pointer() {
   pointer_input().set(trial_m.x(), trial_m.y(), pressed);
 }
 
-int run_trainer(const TrainerOptions& given) {
-  if (given.characters.empty()) throw InvalidArgument("calligraphy train: no characters to practise");
-  if (given.registry == nullptr)
+int run_trainer(const TrainerOptions& options) {
+  if (options.characters.empty()) throw InvalidArgument("calligraphy train: no characters to practise");
+  if (options.registry == nullptr)
     throw InvalidArgument("calligraphy train: no device registry (TrainerOptions::registry)");
-  const TrainerOptions& options = given;
   // The device must exist, and a simulated writer can move only a device with a hand port.
   const DeviceListing listing = options.registry->find(options.device);
   const bool hand_port = listing.capabilities.moved_by_simulated_hand;

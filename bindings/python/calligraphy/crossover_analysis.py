@@ -432,20 +432,20 @@ def retention_ratios(data: "pandas.DataFrame", value: str, design: "StudyDesign"
     condition)."""
     pandas = statistics._pandas()
     columns = statistics.RETENTION_COLUMNS
-    phases = {design.pre_test, "post-test", "retention"}
+    needed = [design.pre_test, "post-test", "retention"]
     if design.pre_test is None or not {"post-test", "retention"} <= set(design.after_training):
         return pandas.DataFrame(columns=columns)
-    rows_of = data[data[value].notna() & data["phase"].astype(str).isin(phases)]
+    rows_of = data[data[value].notna() & data["phase"].astype(str).isin(needed)]
     rows_of = rows_of.assign(arm=_text(rows_of["trained_condition"]))
     means = rows_of[rows_of["arm"] != ""].groupby(
         ["arm", rows_of["subject"].astype(str), rows_of["phase"].astype(str)], observed=True)[value].mean()
     table = means.unstack()
     out = []
     for condition in design.conditions:
-        subset = table.loc[condition].dropna() if condition in table.index.get_level_values(0) else table.iloc[0:0]
-        subset = subset.dropna(subset=[p for p in phases if p in subset.columns])
-        if not {design.pre_test, "post-test", "retention"} <= set(subset.columns):
-            subset = subset.iloc[0:0].reindex(columns=[design.pre_test, "post-test", "retention"])
+        if condition in table.index.get_level_values(0) and set(needed) <= set(table.columns):
+            subset = table.loc[condition].dropna(subset=needed)
+        else:  # no subject has all three on the condition's set
+            subset = pandas.DataFrame(columns=needed, dtype=float)
         out.append(statistics.retention_row(
             condition, subset[design.pre_test], subset["post-test"], subset["retention"],
             "not computed: fewer than 2 subjects with pre-test, post-test and retention on the condition's set",

@@ -1,9 +1,11 @@
 #pragma once
 /// \file decimal_number.hpp
-/// Reading a decimal number from text (options, CSV fields, writer settings): one rule for every reader.
+/// Reading a decimal number from text (options, CSV fields, writer settings): one rule for every reader;
+/// and writing one back in the fewest digits that read back to it.
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 
 namespace calligraphy {
@@ -12,6 +14,10 @@ namespace calligraphy {
 /// text, trailing characters, "inf", "nan" or a magnitude beyond a double's range (1e999). A value below the
 /// smallest normal double is finite: it is kept as the nearest subnormal (or zero), never refused.
 [[nodiscard]] std::optional<double> parse_finite_double(std::string_view text);
+
+/// The shortest decimal text that reads back (parse_finite_double) as the same double: "0.1", "1e-05",
+/// "0.30000000000000004". Not for the servo path (allocates).
+[[nodiscard]] std::string shortest_decimal(double value);
 
 /// A plain decimal ("-0.011845", "2.998", "0": an optional '-', at most 15 digits, at most one '.') at the
 /// start of [first, last): sets `value` and returns where it ends; nullptr for anything else (an exponent,
