@@ -151,12 +151,13 @@ TEST_CASE("A trial run again from its record gives the same trace, bit for bit",
   SafetyChainParameters safety;
   safety.max_force_change_n_per_tick = 0.125;
   inputs.safety = safety;
-  const TrialRun first = run_trial_spec(spec, scene, inputs);
+  const TrialRun first = run_trial_spec(Checked<TrialSpec>::check(spec), scene, inputs);
   REQUIRE(first.result.trace.size() > 100);
 
   const RecordedTrial recorded =
       read_recorded_trial(recorded_trial_json(recorded_trial(spec, first, scene)), "r.json");
-  const TrialRun again = rerun_trial(recorded, scene, study_test::trial_inputs());
+  const TrialRun again =
+      rerun_trial(recorded, Checked<TrialSpec>::check(recorded.spec), scene, study_test::trial_inputs());
   REQUIRE(again.result.trace.size() == first.result.trace.size());
   std::size_t different = 0;
   for (std::size_t i = 0; i < first.result.trace.size(); ++i) {
@@ -167,7 +168,7 @@ TEST_CASE("A trial run again from its record gives the same trace, bit for bit",
   CHECK(different == 0);
 
   // Without the record's force law, the same specification renders another force: the record carried it.
-  const TrialRun plain = run_trial_spec(spec, scene, study_test::trial_inputs());
+  const TrialRun plain = run_trial_spec(Checked<TrialSpec>::check(spec), scene, study_test::trial_inputs());
   bool same = plain.result.trace.size() == first.result.trace.size();
   for (std::size_t i = 0; same && i < first.result.trace.size(); ++i)
     same = plain.result.trace[i].force_n == first.result.trace[i].force_n;
@@ -183,7 +184,10 @@ TEST_CASE("A record run on other characters is refused", "[recorded_trial]") {
   RecordedTrial recorded = recorded_trial(spec, TrialOptions{}, nullptr, ten);
   CHECK(recorded.scene_sha256 == scene_sha256(ten));
   CHECK(scene_sha256(person) != scene_sha256(ten));
-  CHECK_THAT(error_of([&] { (void)rerun_trial(recorded, person, study_test::trial_inputs()); }),
+  CHECK_THAT(error_of([&] {
+               (void)rerun_trial(recorded, Checked<TrialSpec>::check(recorded.spec), person,
+                                 study_test::trial_inputs());
+             }),
              Catch::Contains("not the recorded ones") && Catch::Contains("SHA-256"));
 }
 

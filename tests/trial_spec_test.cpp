@@ -3,12 +3,15 @@
 #include "calligraphy/study/trial_spec.hpp"
 
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <limits>
 #include <random>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/parameter_table.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/study/trial_spec_runner.hpp"
 #include "study_test_devices.hpp"
@@ -98,16 +101,16 @@ TEST_CASE("a trial specification round-trips through its JSON and its command-li
     TrialSpec spec;
     spec.characters = "永";
     CHECK(trial_spec_args(spec) == std::vector<std::string>{"永"});
-    CHECK(trial_spec_from_args(trial_spec_args(spec)) == spec);
-    CHECK(trial_spec_from_json(trial_spec_json(spec), "spec.json") == spec);
+    CHECK(*trial_spec_from_args(trial_spec_args(spec)) == spec);
+    CHECK(*trial_spec_from_json(trial_spec_json(spec), "spec.json") == spec);
   }
   SECTION("every field set") {
     const TrialSpec spec = everything_set();
     spec.validate();
-    CHECK(trial_spec_from_args(trial_spec_args(spec)) == spec);
-    CHECK(trial_spec_from_json(trial_spec_json(spec), "spec.json") == spec);
+    CHECK(*trial_spec_from_args(trial_spec_args(spec)) == spec);
+    CHECK(*trial_spec_from_json(trial_spec_json(spec), "spec.json") == spec);
     // and the two forms meet: JSON -> spec -> words -> spec
-    CHECK(trial_spec_from_args(trial_spec_args(trial_spec_from_json(trial_spec_json(spec), "x"))) == spec);
+    CHECK(*trial_spec_from_args(trial_spec_args(*trial_spec_from_json(trial_spec_json(spec), "x"))) == spec);
   }
   SECTION("subnormal values are finite numbers like any other") {
     TrialSpec spec;
@@ -115,14 +118,14 @@ TEST_CASE("a trial specification round-trips through its JSON and its command-li
     spec.guidance_mode = GuidanceMode::assist_as_needed;
     spec.assist_band_m = 1e-310;
     REQUIRE_NOTHROW(spec.validate());
-    CHECK(trial_spec_from_args(trial_spec_args(spec)) == spec);
-    CHECK(trial_spec_from_json(trial_spec_json(spec), "spec.json") == spec);
+    CHECK(*trial_spec_from_args(trial_spec_args(spec)) == spec);
+    CHECK(*trial_spec_from_json(trial_spec_json(spec), "spec.json") == spec);
     spec.guidance_mode = GuidanceMode::fading;
     spec.assist_band_m = TrialSpec{}.assist_band_m;
     spec.guidance_gain = std::numeric_limits<double>::denorm_min();
     REQUIRE_NOTHROW(spec.validate());
-    CHECK(trial_spec_from_args(trial_spec_args(spec)) == spec);
-    CHECK(trial_spec_from_json(trial_spec_json(spec), "spec.json") == spec);
+    CHECK(*trial_spec_from_args(trial_spec_args(spec)) == spec);
+    CHECK(*trial_spec_from_json(trial_spec_json(spec), "spec.json") == spec);
   }
   SECTION("200 random specifications") {
     std::mt19937_64 random(20261123);
@@ -130,8 +133,8 @@ TEST_CASE("a trial specification round-trips through its JSON and its command-li
       const TrialSpec spec = random_spec(random);
       INFO(trial_spec_json(spec));
       REQUIRE_NOTHROW(spec.validate());
-      CHECK(trial_spec_from_args(trial_spec_args(spec)) == spec);
-      CHECK(trial_spec_from_json(trial_spec_json(spec), "spec.json") == spec);
+      CHECK(*trial_spec_from_args(trial_spec_args(spec)) == spec);
+      CHECK(*trial_spec_from_json(trial_spec_json(spec), "spec.json") == spec);
     }
   }
 }
@@ -142,20 +145,20 @@ TEST_CASE("the writer's settings are numbers in the JSON, and a record's older \
   spec.writer_parameters = {{"bias_offset_m", 0.01 / 3.0}, {"stroke_jitter_m", 1.0 / 3.0 * 1e-4}};
   const std::string text = trial_spec_json(spec);
   CHECK_THAT(text, Catch::Contains("\"key\": \"bias_offset_m\"") && !Catch::Contains("bias_offset_m="));
-  CHECK(trial_spec_from_json(text, "spec.json") == spec);
-  const TrialSpec older = trial_spec_from_json(
+  CHECK(*trial_spec_from_json(text, "spec.json") == spec);
+  const TrialSpec older = *trial_spec_from_json(
       R"({"characters": "十", "writer_parameters": ["bias_offset_m=0.004", "stroke_jitter_m=1e-5"]})",
       "old.json");
   CHECK(older.writer_parameters ==
         std::vector<WriterSetting>{{"bias_offset_m", 0.004}, {"stroke_jitter_m", 1e-5}});
   CHECK_THAT(error_of([] {
-               (void)trial_spec_from_json(
+               (void)*trial_spec_from_json(
                    R"({"characters": "十", "writer_parameters": [{"key": "bias_offset_m"}]})", "s.json");
              }),
              Catch::Contains("s.json: /writer_parameters/0") && Catch::Contains("value"));
   CHECK_THAT(error_of([] {
-               (void)trial_spec_from_json(R"({"characters": "十", "writer_parameters": ["bias_offset_m"]})",
-                                          "s.json");
+               (void)*trial_spec_from_json(R"({"characters": "十", "writer_parameters": ["bias_offset_m"]})",
+                                           "s.json");
              }),
              Catch::Contains("s.json: /writer_parameters/0") && Catch::Contains("key=value"));
 }
@@ -242,23 +245,23 @@ TEST_CASE("a specification's errors name the field in both its forms") {
 
   CHECK_THAT(
       error_of([] {
-        (void)trial_spec_from_args(std::vector<std::string>{"永", "--pacing", "lock_step"});
+        (void)*trial_spec_from_args(std::vector<std::string>{"永", "--pacing", "lock_step"});
       }),
       Catch::Contains("pacing (--pacing): 'lock_step' is not one of 'auto', 'lock-step', 'real-time'"));
   CHECK_THAT(error_of([] {
-               (void)trial_spec_from_args(std::vector<std::string>{"永", "--guidence", "on"});
+               (void)*trial_spec_from_args(std::vector<std::string>{"永", "--guidence", "on"});
              }),
              Catch::Contains("no field '--guidence'"));
   CHECK_THAT(error_of([] {
-               (void)trial_spec_from_args(std::vector<std::string>{"永", "--seed"});
+               (void)*trial_spec_from_args(std::vector<std::string>{"永", "--seed"});
              }),
              Catch::Contains("--seed: needs a value"));
-  CHECK_THAT(error_of([] { (void)trial_spec_from_json(R"({"characters": "永", "sede": 3})", "s.json"); }),
+  CHECK_THAT(error_of([] { (void)*trial_spec_from_json(R"({"characters": "永", "sede": 3})", "s.json"); }),
              Catch::Contains("s.json") && Catch::Contains("sede"));
-  CHECK_THAT(error_of([] { (void)trial_spec_from_json(R"({"characters": "永", "seed": -3})", "s.json"); }),
+  CHECK_THAT(error_of([] { (void)*trial_spec_from_json(R"({"characters": "永", "seed": -3})", "s.json"); }),
              Catch::Contains("s.json: /seed"));
   CHECK_THAT(
-      error_of([] { (void)trial_spec_from_json(R"({"characters": "永", "guidance": "on"})", "s.json"); }),
+      error_of([] { (void)*trial_spec_from_json(R"({"characters": "永", "guidance": "on"})", "s.json"); }),
       Catch::Contains("s.json: /guidance: expected true or false"));
 }
 
@@ -267,7 +270,7 @@ TEST_CASE("the runner of a specification gives the simulated writer to the trial
   spec.characters = "十";
   spec.seed = 4;
   const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'十')});
-  const TrialRun run = run_trial_spec(spec, scene, study_test::trial_inputs());
+  const TrialRun run = run_trial_spec(Checked<TrialSpec>::check(spec), scene, study_test::trial_inputs());
   CHECK(run.simulated_writer);
   CHECK(run.writer_log.has_value());
   CHECK(run.result.end == TrialEnd::completed);
@@ -280,13 +283,16 @@ TEST_CASE("the runner of a specification gives the simulated writer to the trial
 
   TrialSpec person = spec;
   person.writer = TrialWriter::person;
-  CHECK_THAT(error_of([&] { (void)run_trial_spec(person, scene, study_test::trial_inputs()); }),
+  CHECK_THAT(error_of([&] {
+               (void)run_trial_spec(Checked<TrialSpec>::check(person), scene, study_test::trial_inputs());
+             }),
              Catch::Contains("writer (--writer): 'person'"));
   TrialSpec nowhere = spec;
   nowhere.device = "no-such-device";
-  CHECK_THROWS_AS(run_trial_spec(nowhere, scene, study_test::trial_inputs()), DeviceNotFound);
+  CHECK_THROWS_AS(run_trial_spec(Checked<TrialSpec>::check(nowhere), scene, study_test::trial_inputs()),
+                  DeviceNotFound);
   // The library makes no registry of its own: the caller passes one, or a device.
-  CHECK_THAT(error_of([&] { (void)run_trial_spec(spec, scene); }),
+  CHECK_THAT(error_of([&] { (void)run_trial_spec(Checked<TrialSpec>::check(spec), scene); }),
              Catch::Contains("no device and no registry to create \"simulated\""));
 }
 
@@ -301,10 +307,98 @@ TEST_CASE("the runner takes a force law made before the trial, whose guidance mu
   force.guidance_stiffness_n_per_m = 250.0;
   inputs.force_law = force;
   inputs.lock_memory = false;
-  const TrialRun run = run_trial_spec(spec, scene, inputs);
+  const TrialRun run = run_trial_spec(Checked<TrialSpec>::check(spec), scene, inputs);
   CHECK(run.options.force.guidance_stiffness_n_per_m == 250.0);
   CHECK_FALSE(run.options.loop.lock_memory);
   inputs.force_law->guidance_law = FadingGuidance{.gain = 0.5};
-  CHECK_THAT(error_of([&] { (void)run_trial_spec(spec, scene, inputs); }),
+  CHECK_THAT(error_of([&] { (void)run_trial_spec(Checked<TrialSpec>::check(spec), scene, inputs); }),
              Catch::Contains("the force law's guidance (fading) is not the specification's (fixed)"));
+}
+
+namespace {
+
+// One of a range's ends or a value inside it, drawn at random: the derivation must hold at the bounds too.
+double bound_or_inside(std::mt19937_64& random, const ParameterRange& range, double inside) {
+  switch (random() % 3) {
+    case 0:
+      return range.low_open ? std::nextafter(range.low, range.high) : range.low;
+    case 1:
+      return std::isfinite(range.high)
+                 ? (range.high_open ? std::nextafter(range.high, range.low) : range.high)
+                 : inside;
+    default:
+      return inside;
+  }
+}
+
+// A valid specification with its numbers often at their bounds.
+TrialSpec spec_at_bounds(std::mt19937_64& random) {
+  TrialSpec spec = random_spec(random);
+  switch (spec.guidance_mode) {
+    case GuidanceMode::fading:
+      spec.guidance_gain =
+          bound_or_inside(random, parameter_field(&FadingGuidance::gain).range, spec.guidance_gain);
+      break;
+    case GuidanceMode::assist_as_needed:
+      spec.assist_band_m =
+          bound_or_inside(random, parameter_field(&AssistAsNeededGuidance::band_m).range, spec.assist_band_m);
+      break;
+    case GuidanceMode::error_amplification:
+      spec.amplification_gain = bound_or_inside(
+          random, parameter_field(&ErrorAmplificationGuidance::gain).range, spec.amplification_gain);
+      break;
+    case GuidanceMode::timing:
+      spec.timing_speed_m_s =
+          bound_or_inside(random, parameter_field(&TimingGuidance::speed_m_s).range, spec.timing_speed_m_s);
+      break;
+    default:
+      break;
+  }
+  const bool real_time = spec.pacing == TrialPacing::real_time;
+  if (random() % 3 == 0) spec.rate_hz = random() % 2 ? 100.0 : (real_time ? 10000.0 : 100000.0);
+  if (random() % 3 == 0) spec.max_duration_s = std::min(86400.0, std::nextafter(1e7 / spec.rate_hz, 0.0));
+  if (spec.pacing != TrialPacing::lock_step && random() % 3 == 0) spec.watchdog_s = random() % 2 ? 0.0 : 60.0;
+  return spec;
+}
+
+}  // namespace
+
+TEST_CASE("the options a checked specification states are valid on any device, unchecked again") {
+  // trial_options derives them from the checked specification without a second check (checked.hpp): this is
+  // the promise that lets it, on specifications at their bounds and devices of every stiffness limit.
+  std::mt19937_64 random(20261126);
+  const double limits[] = {0.0, 1e-9, 1.0, 300.0, 700.0, 1e9, std::numeric_limits<double>::quiet_NaN()};
+  for (int i = 0; i < 500; ++i) {
+    const TrialSpec spec = spec_at_bounds(random);
+    INFO(trial_spec_json(spec));
+    const auto checked = Checked<TrialSpec>::check(spec);
+    DeviceInfo device;
+    device.max_stiffness_n_per_m = limits[random() % std::size(limits)];
+    const TrialOptions options = *trial_options(checked, device);
+    REQUIRE_NOTHROW(options.validate());
+    CHECK(options.rate_hz == spec.rate_hz);
+    CHECK(options.max_duration_s == spec.max_duration_s);
+    CHECK(options.force.guidance == spec.guidance);
+  }
+}
+
+TEST_CASE("a specification reaches the runner checked: it takes no unchecked one") {
+  static_assert(!std::is_constructible_v<Checked<TrialSpec>, TrialSpec>);
+  static_assert(!std::is_convertible_v<TrialSpec, Checked<TrialSpec>>);
+  static_assert(
+      !std::is_invocable_v<decltype(&run_trial_spec), TrialSpec, const Scene&, const TrialRunInputs&>);
+  static_assert(std::is_invocable_v<decltype(&run_trial_spec), Checked<TrialSpec>, const Scene&,
+                                    const TrialRunInputs&>);
+  TrialSpec spec;
+  spec.characters = "十";
+  spec.guidance_mode = GuidanceMode::fading;
+  spec.guidance_gain = 1.5;
+  CHECK_THAT(error_of([&] { (void)Checked<TrialSpec>::check(spec); }), Catch::Contains("guidance_gain"));
+  // A checked replay runs on one teacher: its file or the caller's samples, named when neither is there.
+  spec.guidance_gain = 1.0;
+  spec.guidance_mode = GuidanceMode::replay;
+  const auto replay = Checked<TrialSpec>::check(spec, TeacherSource::samples);
+  const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'十')});
+  CHECK_THAT(error_of([&] { (void)run_trial_spec(replay, scene, study_test::trial_inputs()); }),
+             Catch::Contains("teacher (--teacher): required with guidance mode 'replay'"));
 }

@@ -3,7 +3,7 @@
 // integers and unknown enum names InvalidArgument, a ValueError) naming the argument, instead of pybind11's
 // "incompatible function arguments" or "Unable to cast Python instance to C++ type".
 //
-// `Checked<T>` accepts any Python object at call time and shows T's Python type in signatures and
+// `PyArgument<T>` accepts any Python object at call time and shows T's Python type in signatures and
 // stubs ("rate_hz: float = 1000.0"); `take(arg, "rate_hz")` converts it. `Annotated<Tag>` takes any object
 // for arguments of several types (ArrayLike: numpy-convertible, shown as numpy.typing.ArrayLike).
 #include <pybind11/pybind11.h>
@@ -20,7 +20,7 @@ namespace py = pybind11;
 
 /// An argument converted to T in the function body by `take`, so that errors can name it.
 template <typename T>
-struct Checked {
+struct PyArgument {
   py::object object;
 };
 
@@ -135,7 +135,7 @@ T convert_named(py::handle value, const std::string& name) {
 }
 
 template <typename T>
-T take(const Checked<T>& argument, const std::string& name) {
+T take(const PyArgument<T>& argument, const std::string& name) {
   return convert_named<T>(argument.object, name);
 }
 
@@ -144,8 +144,8 @@ T take(const Checked<T>& argument, const std::string& name) {
 namespace pybind11::detail {
 
 template <typename T>
-struct type_caster<calligraphy::python::Checked<T>> {
-  using Value = calligraphy::python::Checked<T>;
+struct type_caster<calligraphy::python::PyArgument<T>> {
+  using Value = calligraphy::python::PyArgument<T>;
   PYBIND11_TYPE_CASTER(Value, make_caster<T>::name);
   bool load(handle source, bool /*convert*/) {
     if (!source) return false;

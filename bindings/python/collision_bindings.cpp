@@ -46,8 +46,8 @@ StrokeElement element_from(py::handle object) {
 }
 
 py::tuple nearest_point_py(const ElementLike& element_object, const ArrayLike& point,
-                           const Checked<NearestPointMethod>& method, const Checked<double>& tolerance,
-                           const Checked<int>& newton_starts, const Checked<int>& newton_iterations) {
+                           const PyArgument<NearestPointMethod>& method, const PyArgument<double>& tolerance,
+                           const PyArgument<int>& newton_starts, const PyArgument<int>& newton_iterations) {
   const StrokeElement element = element_from(element_object.object);
   NearestPointOptions options;
   options.method = take(method, "method");
@@ -94,9 +94,10 @@ std::vector<Vec2> path_from(py::handle object) {
   return path;
 }
 
-StrokeMatch match_stroke_py(const Checked<Scene>& scene_object, const Checked<long long>& character_index,
-                            const Checked<long long>& stroke_index, const ArrayLike& path_object,
-                            const std::optional<Checked<StrokeAcceptance>>& acceptance_object) {
+StrokeMatch match_stroke_py(const PyArgument<Scene>& scene_object,
+                            const PyArgument<long long>& character_index,
+                            const PyArgument<long long>& stroke_index, const ArrayLike& path_object,
+                            const std::optional<PyArgument<StrokeAcceptance>>& acceptance_object) {
   const StrokeOfScene target = stroke_of_scene(scene_object, character_index, stroke_index);
   const PlacedCharacter& character = target.character;
   const std::size_t stroke = target.stroke;

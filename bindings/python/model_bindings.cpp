@@ -309,7 +309,7 @@ void bind_library(py::module_& m) {
           "offset for a missing, truncated, corrupted or foreign file.")
       .def(
           "load",
-          [](const CharacterSource& lib, const Checked<std::string>& c) {
+          [](const CharacterSource& lib, const PyArgument<std::string>& c) {
             return lib.load(one_character(take(c, "char"), "char"));
           },
           py::arg("char"),
@@ -493,8 +493,8 @@ void bind_scene(py::module_& m) {
       "writing order (median_m (M, 2) [m], start_m and end_m (2,) [m], length_m [m]). Immutable: a "
       "Renderer keeps a reference to it.")
       .def(py::init([](const Annotated<CharactersTag>& characters,
-                       const std::optional<Checked<SceneLayout>>& layout,
-                       const std::optional<Checked<CharacterSource>>& library) {
+                       const std::optional<PyArgument<SceneLayout>>& layout,
+                       const std::optional<PyArgument<CharacterSource>>& library) {
              const CharacterSource source = library ? take(*library, "library") : CharacterSource::embedded();
              const SceneLayout chosen = layout ? take(*layout, "layout") : SceneLayout{};
              return Scene::lay_out(characters_from(characters.object, source, "characters"), chosen);
@@ -535,7 +535,7 @@ void bind_model(py::module_& m) {
 
 namespace {
 
-std::size_t index_below(const Checked<long long>& index, std::size_t count, const std::string& name,
+std::size_t index_below(const PyArgument<long long>& index, std::size_t count, const std::string& name,
                         const std::string& what) {
   // Any int, however large, is compared with the range (2**70 is as much out of it as 5).
   const py::handle value = index.object;
@@ -553,8 +553,9 @@ std::size_t index_below(const Checked<long long>& index, std::size_t count, cons
 
 }  // namespace
 
-StrokeOfScene stroke_of_scene(const Checked<Scene>& scene_object, const Checked<long long>& character_index,
-                              const Checked<long long>& stroke_index) {
+StrokeOfScene stroke_of_scene(const PyArgument<Scene>& scene_object,
+                              const PyArgument<long long>& character_index,
+                              const PyArgument<long long>& stroke_index) {
   if (!py::isinstance<Scene>(scene_object.object)) throw_type_error("scene", "Scene", scene_object.object);
   const Scene& scene = scene_object.object.cast<const Scene&>();
   const PlacedCharacter& character = scene.characters[index_below(

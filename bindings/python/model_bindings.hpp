@@ -30,7 +30,7 @@ struct StrokeOfScene {
   const PlacedCharacter& character;
   std::size_t stroke;
 };
-StrokeOfScene stroke_of_scene(const Checked<Scene>& scene, const Checked<long long>& character_index,
-                              const Checked<long long>& stroke_index);
+StrokeOfScene stroke_of_scene(const PyArgument<Scene>& scene, const PyArgument<long long>& character_index,
+                              const PyArgument<long long>& stroke_index);
 
 }  // namespace calligraphy::python

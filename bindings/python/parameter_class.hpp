@@ -78,7 +78,7 @@ class ParameterClass {
       f.equal = [member](const S& a, const S& b) { return a.*member == b.*member; };
       cls_.def_property(
           name, [member](const S& s) { return s.*member; },
-          [member, qualified, shared](S& s, const Checked<T>& v) {
+          [member, qualified, shared](S& s, const PyArgument<T>& v) {
             S copy = s;
             copy.*member = take(v, qualified);
             shared->validate(copy);
@@ -104,7 +104,7 @@ class ParameterClass {
           name,
           py::cpp_function([member](S& s) -> T& { return s.*member; },
                            py::return_value_policy::reference_internal),
-          [member, qualified, shared](S& s, const Checked<T>& v) {
+          [member, qualified, shared](S& s, const PyArgument<T>& v) {
             S copy = s;
             copy.*member = take(v, qualified);
             shared->validate(copy);

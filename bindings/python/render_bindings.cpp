@@ -70,8 +70,8 @@ void bind_guidance(py::module_& m) {
       .finish();
   m.def(
       "next_guidance_gain",
-      [](const Checked<double>& gain, const Checked<double>& error_m,
-         const std::optional<Checked<FadingRule>>& rule) {
+      [](const PyArgument<double>& gain, const PyArgument<double>& error_m,
+         const std::optional<PyArgument<FadingRule>>& rule) {
         return next_guidance_gain(take(gain, "gain"), take(error_m, "error_m"),
                                   rule ? take(*rule, "rule") : FadingRule{});
       },
@@ -96,8 +96,8 @@ rule; TypeError naming the argument for a value of the wrong type.)");
       .finish();
   m.def(
       "next_assist_band",
-      [](const Checked<double>& band_m, const Checked<double>& error_m,
-         const std::optional<Checked<AssistBandRule>>& rule) {
+      [](const PyArgument<double>& band_m, const PyArgument<double>& error_m,
+         const std::optional<PyArgument<AssistBandRule>>& rule) {
         return next_assist_band(take(band_m, "band_m"), take(error_m, "error_m"),
                                 rule ? take(*rule, "rule") : AssistBandRule{});
       },
@@ -115,7 +115,7 @@ negative or non-finite band or error or a bad rule.)");
       .finish();
   m.def(
       "skill_adaptive_mode",
-      [](double previous_error_m, const std::optional<Checked<SkillAdaptiveRule>>& rule) {
+      [](double previous_error_m, const std::optional<PyArgument<SkillAdaptiveRule>>& rule) {
         return skill_adaptive_mode(previous_error_m, rule ? take(*rule, "rule") : SkillAdaptiveRule{});
       },
       py::arg("previous_error_m"), py::arg("rule") = py::none(),
@@ -178,7 +178,7 @@ void bind_guidance_laws(py::module_& m) {
       .finish();
   m.def(
       "default_guidance_law",
-      [](const Checked<GuidanceMode>& mode) {
+      [](const PyArgument<GuidanceMode>& mode) {
         return std::visit([](const auto& law) { return py::cast(law); },
                           default_guidance_law(take(mode, "mode")));
       },
@@ -226,7 +226,7 @@ void bind_force_law_parameters(py::module_& m) {
           "The GuidanceMode of guidance_law.");
 }
 
-double number(const Checked<double>& value, const char* name) { return take(value, name); }
+double number(const PyArgument<double>& value, const char* name) { return take(value, name); }
 
 struct FloatOrArrayTag {
   static constexpr auto name = py::detail::const_name("Union[float, numpy.ndarray[numpy.float64]]");
@@ -235,7 +235,7 @@ struct FloatOrArrayTag {
 void bind_force_functions(py::module_& m) {
   m.def(
       "paper_force",
-      [](const ArrayLike& z_object, const Checked<double>& paper_z, const Checked<double>& stiffness) {
+      [](const ArrayLike& z_object, const PyArgument<double>& paper_z, const PyArgument<double>& stiffness) {
         const Scalars z = as_scalars(z_object.object, "tip_z_m");
         const double z0 = number(paper_z, "paper_z_m");
         const double k = number(stiffness, "stiffness_n_per_m");
@@ -253,8 +253,8 @@ void bind_force_functions(py::module_& m) {
       "stiffness_n_per_m K_en [N/m].");
   m.def(
       "attraction_force",
-      [](const ArrayLike& tip_object, const ArrayLike& foot_object, const Checked<double>& stiffness,
-         const Checked<double>& factor) {
+      [](const ArrayLike& tip_object, const ArrayLike& foot_object, const PyArgument<double>& stiffness,
+         const PyArgument<double>& factor) {
         const Vectors tip = as_vectors(tip_object.object, 2, "tip_m");
         const Vectors foot = as_vectors(foot_object.object, 2, "foot_m");
         check_broadcast(tip, foot, "tip_m", "foot_m");
@@ -269,7 +269,7 @@ void bind_force_functions(py::module_& m) {
       "[m]; foot_m, the foot point X_S, the same shape or (2,) [m]; returns the tip's shape, float64.");
   m.def(
       "resistance_force",
-      [](const ArrayLike& v_object, const ArrayLike& tangent_object, const Checked<double>& damping) {
+      [](const ArrayLike& v_object, const ArrayLike& tangent_object, const PyArgument<double>& damping) {
         const Vectors v = as_vectors(v_object.object, 2, "velocity_m_s");
         const Vectors tangent = as_vectors(tangent_object.object, 2, "tangent");
         check_broadcast(v, tangent, "velocity_m_s", "tangent");
@@ -284,8 +284,8 @@ void bind_force_functions(py::module_& m) {
       "returns the velocity's shape, float64.");
   m.def(
       "friction_force",
-      [](const ArrayLike& v_object, const ArrayLike& normal_object, const Checked<double>& coefficient,
-         const Checked<double>& stick_speed) {
+      [](const ArrayLike& v_object, const ArrayLike& normal_object, const PyArgument<double>& coefficient,
+         const PyArgument<double>& stick_speed) {
         const Vectors v = as_vectors(v_object.object, 2, "velocity_m_s");
         const Scalars normal = as_scalars(normal_object.object, "normal_force_n");
         if (!normal.single && normal.count != v.count) {
@@ -304,8 +304,8 @@ void bind_force_functions(py::module_& m) {
       "(N,) [N]; returns the velocity's shape, float64.");
   m.def(
       "constraint_taper",
-      [](const ArrayLike& d_object, const Checked<double>& radius,
-         const Checked<double>& band) -> Annotated<FloatOrArrayTag> {
+      [](const ArrayLike& d_object, const PyArgument<double>& radius,
+         const PyArgument<double>& band) -> Annotated<FloatOrArrayTag> {
         const Scalars d = as_scalars(d_object.object, "distance_m");
         const double r = number(radius, "radius_m");
         const double w = number(band, "band_m");
@@ -320,7 +320,7 @@ void bind_force_functions(py::module_& m) {
       "a smoothstep between (lengths [m]). distance_m: a number -> float, (N,) -> (N,) float64.");
   m.def(
       "clamp_force",
-      [](const ArrayLike& force_object, const Checked<double>& max_force) {
+      [](const ArrayLike& force_object, const PyArgument<double>& max_force) {
         const Vectors f = as_vectors(force_object.object, 3, "force_n");
         const double limit = number(max_force, "max_force_n");
         return map_rows<3>(f, [&](py::ssize_t i) { return clamp_force(f.vec3(i), limit); });
@@ -467,10 +467,10 @@ void bind_renderer(py::module_& m) {
       "smoothing of section 6 and paper friction -> optional passivity controller -> safety chain. Not "
       "thread-safe; keeps its Scene alive.")
       .def(
-          py::init([](const Checked<Scene>& scene,
-                      const std::optional<Checked<ForceLawParameters>>& force_law,
-                      const std::optional<Checked<DeviceInfo>>& device,
-                      const std::optional<Checked<RendererOptions>>& options) {
+          py::init([](const PyArgument<Scene>& scene,
+                      const std::optional<PyArgument<ForceLawParameters>>& force_law,
+                      const std::optional<PyArgument<DeviceInfo>>& device,
+                      const std::optional<PyArgument<RendererOptions>>& options) {
             if (!py::isinstance<Scene>(scene.object)) throw_type_error("scene", "Scene", scene.object);
             return std::make_unique<Renderer>(
                 scene.object.cast<const Scene&>(),
@@ -486,7 +486,8 @@ void bind_renderer(py::module_& m) {
           "RendererOptions. Raises InvalidArgument (a ValueError) for values out of range or a device with "
           "max_force_n <= 0; logs a warning when a stiffness exceeds the device's stable maximum.")
       .def(
-          "tick", [](Renderer& r, const Checked<DeviceState>& state) { return r.tick(take(state, "state")); },
+          "tick",
+          [](Renderer& r, const PyArgument<DeviceState>& state) { return r.tick(take(state, "state")); },
           py::arg("state"),
           "One servo tick: the DeviceState read from the device (SI units) -> RenderOutput. Never raises "
           "for any state values: a non-finite state gives zero force (input_rejected).")

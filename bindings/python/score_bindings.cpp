@@ -83,8 +83,8 @@ std::vector<PenSample> samples_from_columns(const py::object& columns, TraceUnit
 }
 
 py::dict score_py(const py::object& trace, const py::object& character, const std::string& units_name,
-                  const std::optional<Checked<CharacterSource>>& library, double contact_threshold_m,
-                  const std::optional<Checked<StrokeAcceptance>>& acceptance, double start_radius_m) {
+                  const std::optional<PyArgument<CharacterSource>>& library, double contact_threshold_m,
+                  const std::optional<PyArgument<StrokeAcceptance>>& acceptance, double start_radius_m) {
   const TraceUnits units = parse_trace_units(units_name == "m" ? "metres" : units_name);
   Character model;
   if (py::isinstance<Character>(character)) {

@@ -123,11 +123,12 @@ void bind_simulated_device(py::module_& m) {
       .field("info", &SimulatedDeviceParameters::info, "the DeviceInfo it reports (Phantom Desktop figures)")
       .finish();
 
-  py::class_<SimulatedDevice>(m, "SimulatedDevice",
-                              "A simulated Phantom Desktop (include/calligraphy/devices/simulated_device.hpp), "
-                              "no hand attached: it moves only under the commanded force. Deterministic; no "
-                              "wall clock.")
-      .def(py::init([](const std::optional<Checked<SimulatedDeviceParameters>>& parameters) {
+  py::class_<SimulatedDevice>(
+      m, "SimulatedDevice",
+      "A simulated Phantom Desktop (include/calligraphy/devices/simulated_device.hpp), "
+      "no hand attached: it moves only under the commanded force. Deterministic; no "
+      "wall clock.")
+      .def(py::init([](const std::optional<PyArgument<SimulatedDeviceParameters>>& parameters) {
              auto device = std::make_unique<SimulatedDevice>(parameters ? take(*parameters, "parameters")
                                                                         : SimulatedDeviceParameters{});
              device->open();
@@ -158,13 +159,13 @@ void bind_simulated_device(py::module_& m) {
           "Commands a force (3,) [N], held until the next command, saturated at info.max_force_n. A device "
           "fault raises CommunicationError or SafetyFault (the simulated device has none).")
       .def(
-          "advance", [](SimulatedDevice& d, const Checked<double>& dt) { d.advance(take(dt, "dt_s")); },
+          "advance", [](SimulatedDevice& d, const PyArgument<double>& dt) { d.advance(take(dt, "dt_s")); },
           py::arg("dt_s"),
           "Integrates the physics over dt_s [s] (stable for any finite dt_s >= 0; InvalidArgument "
           "otherwise).")
       .def(
           "enable_forces",
-          [](SimulatedDevice& d, const Checked<bool>& on) { d.enable_forces(take(on, "enabled")); },
+          [](SimulatedDevice& d, const PyArgument<bool>& on) { d.enable_forces(take(on, "enabled")); },
           py::arg("enabled"), "Forces on or off (off: the commanded force is not applied).")
       .def_property_readonly("forces_enabled", &SimulatedDevice::forces_enabled)
       .def_property_readonly("is_open", &SimulatedDevice::is_open)
@@ -256,15 +257,15 @@ void bind_person_traces(py::module_& m) {
       .value("scribble", TraceKind::scribble, "negative: a zig-zag from the stroke's start");
 
   m.def(
-      "is_positive", [](const Checked<TraceKind>& kind) { return is_positive(take(kind, "kind")); },
+      "is_positive", [](const PyArgument<TraceKind>& kind) { return is_positive(take(kind, "kind")); },
       py::arg("kind"),
       "True for the TraceKinds that write the stroke (median .. pointer), False for those a matcher must "
       "refuse. kind: a TraceKind or its name. Raises InvalidArgument (a ValueError) for an unknown name, "
       "TypeError naming `kind` for another type.");
   m.def(
       "trace_applies",
-      [](const Checked<Scene>& scene, const Checked<long long>& character_index,
-         const Checked<long long>& stroke_index, const Checked<TraceKind>& kind) {
+      [](const PyArgument<Scene>& scene, const PyArgument<long long>& character_index,
+         const PyArgument<long long>& stroke_index, const PyArgument<TraceKind>& kind) {
         const StrokeOfScene target = stroke_of_scene(scene, character_index, stroke_index);
         return trace_applies(target.character, target.stroke, take(kind, "kind"));
       },
@@ -274,9 +275,9 @@ void bind_person_traces(py::module_& m) {
       "stroke_index out of range, InvalidArgument or TypeError naming `kind`.");
   m.def(
       "person_trace",
-      [](const Checked<Scene>& scene, const Checked<long long>& character_index,
-         const Checked<long long>& stroke_index, const Checked<TraceKind>& kind,
-         const Checked<std::uint64_t>& seed) {
+      [](const PyArgument<Scene>& scene, const PyArgument<long long>& character_index,
+         const PyArgument<long long>& stroke_index, const PyArgument<TraceKind>& kind,
+         const PyArgument<std::uint64_t>& seed) {
         const StrokeOfScene target = stroke_of_scene(scene, character_index, stroke_index);
         const TraceKind chosen = take(kind, "kind");
         std::mt19937_64 random(take(seed, "seed"));

@@ -149,16 +149,16 @@ TrialRun run_interruptible(TrialRunInputs& inputs, Trial&& trial) {
 // fields, the C++ parameters and the py::arg list of both functions.
 #define CALLIGRAPHY_TRIAL_ARGUMENTS(X)                                    \
   X(Annotated<WriterTag>, writer, "novice")                               \
-  X(Checked<bool>, guidance, true)                                        \
-  X(Checked<double>, rate_hz, 1000.0)                                     \
-  X(Checked<std::uint64_t>, seed, 0)                                      \
-  X(std::optional<Checked<CharacterSource>>, library, py::none())         \
-  X(std::optional<Checked<ForceLawParameters>>, force_law, py::none())    \
-  X(Checked<double>, max_duration_s, 300.0)                               \
-  X(Checked<bool>, keep_trace, true)                                      \
+  X(PyArgument<bool>, guidance, true)                                     \
+  X(PyArgument<double>, rate_hz, 1000.0)                                  \
+  X(PyArgument<std::uint64_t>, seed, 0)                                   \
+  X(std::optional<PyArgument<CharacterSource>>, library, py::none())      \
+  X(std::optional<PyArgument<ForceLawParameters>>, force_law, py::none()) \
+  X(PyArgument<double>, max_duration_s, 300.0)                            \
+  X(PyArgument<bool>, keep_trace, true)                                   \
   X(std::optional<Annotated<WriterParamsTag>>, writer_params, py::none()) \
-  X(std::optional<Checked<GuidanceMode>>, guidance_mode, py::none())      \
-  X(std::optional<Checked<double>>, guidance_gain, py::none())            \
+  X(std::optional<PyArgument<GuidanceMode>>, guidance_mode, py::none())   \
+  X(std::optional<PyArgument<double>>, guidance_gain, py::none())         \
   X(std::optional<Annotated<TeacherTag>>, teacher, py::none())
 
 #define CALLIGRAPHY_TRIAL_FIELD(type, name, default_value) type name;
@@ -231,9 +231,9 @@ void apply_guidance(const TrialArguments& a, const std::string& label, ForceLawP
 // `device`; else on the registry's device of that name, paced by `pacing`.
 PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
                        const Annotated<TrialCharactersTag>& characters, const TrialArguments& a,
-                       const std::optional<Checked<SimulatedDeviceParameters>>& device,
-                       const std::optional<Checked<SafetyChainParameters>>& safety,
-                       const std::optional<Checked<PassivityParameters>>& passivity) {
+                       const std::optional<PyArgument<SimulatedDeviceParameters>>& device,
+                       const std::optional<PyArgument<SafetyChainParameters>>& safety,
+                       const std::optional<PyArgument<PassivityParameters>>& passivity) {
   TrialOptions options;
   options.pacing = pacing;
   if (a.force_law) options.force = take(*a.force_law, "force_law");
@@ -297,7 +297,8 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   spec.pacing = options.pacing;
   spec.max_duration_s = options.max_duration_s;
   // A replay's teacher is given as samples (TrialRunInputs::teacher), below.
-  spec.validate(spec.guidance_mode == GuidanceMode::replay ? TeacherSource::samples : TeacherSource::file);
+  const auto checked = calligraphy::Checked<TrialSpec>::check(
+      spec, spec.guidance_mode == GuidanceMode::replay ? TeacherSource::samples : TeacherSource::file);
   std::unique_ptr<SimulatedDevice> simulated_device;
   TrialRunInputs inputs;
   inputs.registry = &python_device_registry();
@@ -311,7 +312,7 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   inputs.force_law = options.force;  // the force law as given (no stiffness fitted to the device)
   inputs.safety = options.safety;
   inputs.passivity = options.passivity;
-  TrialRun run = run_interruptible(inputs, [&] { return run_trial_spec(spec, scene, inputs); });
+  TrialRun run = run_interruptible(inputs, [&] { return run_trial_spec(checked, scene, inputs); });
   TrialResult& result = run.result;
   std::optional<WriterLog>& writer_log = run.writer_log;
   TrialDescription description;
@@ -350,16 +351,16 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
 
 PyTrialResult simulate_trial_py(const Annotated<TrialCharactersTag>& characters
                                     CALLIGRAPHY_TRIAL_ARGUMENTS(CALLIGRAPHY_TRIAL_PARAMETER),
-                                const std::optional<Checked<SimulatedDeviceParameters>>& device,
-                                const std::optional<Checked<SafetyChainParameters>>& safety,
-                                const std::optional<Checked<PassivityParameters>>& passivity) {
+                                const std::optional<PyArgument<SimulatedDeviceParameters>>& device,
+                                const std::optional<PyArgument<SafetyChainParameters>>& safety,
+                                const std::optional<PyArgument<PassivityParameters>>& passivity) {
   const TrialArguments arguments{CALLIGRAPHY_TRIAL_ARGUMENTS(CALLIGRAPHY_TRIAL_VALUE)};
   return trial_py({}, TrialPacing::lock_step, characters, arguments, device, safety, passivity);
 }
 
 PyTrialResult run_trial_py(
-    const Annotated<TrialCharactersTag>& characters, const Checked<std::string>& device,
-    const Checked<std::string>& pacing CALLIGRAPHY_TRIAL_ARGUMENTS(CALLIGRAPHY_TRIAL_PARAMETER)) {
+    const Annotated<TrialCharactersTag>& characters, const PyArgument<std::string>& device,
+    const PyArgument<std::string>& pacing CALLIGRAPHY_TRIAL_ARGUMENTS(CALLIGRAPHY_TRIAL_PARAMETER)) {
   const TrialArguments arguments{CALLIGRAPHY_TRIAL_ARGUMENTS(CALLIGRAPHY_TRIAL_VALUE)};
   const std::string name = take(device, "device");
   if (name.empty()) throw InvalidArgument("device: a device name of list_devices() is needed");
@@ -369,7 +370,8 @@ PyTrialResult run_trial_py(
 
 // The trial a record states (a TrialResult's metrics, a trial record as a dict, or a record's file), run
 // again as it ran.
-PyTrialResult rerun_trial_py(const py::object& record, const std::optional<Checked<CharacterSource>>& library,
+PyTrialResult rerun_trial_py(const py::object& record,
+                             const std::optional<PyArgument<CharacterSource>>& library,
                              const std::optional<Annotated<TeacherTag>>& teacher) {
   RecordedTrial recorded;
   if (py::isinstance<py::dict>(record)) {
@@ -397,7 +399,9 @@ PyTrialResult rerun_trial_py(const py::object& record, const std::optional<Check
     inputs.teacher = teacher_samples(teacher->object, recorded.spec.characters);
     recorded.spec.teacher.clear();  // the samples are the teacher
   }
-  TrialRun run = run_interruptible(inputs, [&] { return rerun_trial(recorded, scene, inputs); });
+  const auto checked = calligraphy::Checked<TrialSpec>::check(
+      recorded.spec, inputs.teacher.empty() ? TeacherSource::file : TeacherSource::samples);
+  TrialRun run = run_interruptible(inputs, [&] { return rerun_trial(recorded, checked, scene, inputs); });
   TrialDescription description;
   description.characters = recorded.spec.characters;
   description.guidance = recorded.spec.guidance;

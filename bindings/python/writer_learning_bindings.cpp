@@ -95,7 +95,7 @@ void bind_learning(py::module_& m) {
       .finish()
       .def_static(
           "from_log",
-          [](const WriterLog& log, const Checked<double>& guidance_share) {
+          [](const WriterLog& log, const PyArgument<double>& guidance_share) {
             const RepetitionOutcome outcome =
                 RepetitionOutcome::from_log(log, take(guidance_share, "guidance_share"));
             outcome.validate();

@@ -92,8 +92,13 @@ RecordedTrial recorded_from(const TrialCommand& command) {
   recorded.spec.json_file = command.json;
   recorded.spec.csv_file = command.csv;
   recorded.spec.svg_file = command.svg;
+  return recorded;
+}
+
+// The specification of a record with this command's outputs, checked once: it is what runs.
+Checked<TrialSpec> checked_spec(const TrialCommand& command, const RecordedTrial& recorded) {
   try {
-    recorded.spec.validate();
+    return Checked<TrialSpec>::check(recorded.spec);
   } catch (const InvalidArgument& e) {
     // A session's replay ran on its teacher's samples: the record names no file.
     throw UsageError(std::string("--spec ") + command.spec_file + ": " + e.what() +
@@ -101,12 +106,11 @@ RecordedTrial recorded_from(const TrialCommand& command) {
                           ? " (give the teacher's recording with --teacher)"
                           : ""));
   }
-  return recorded;
 }
 
 // The trial specification of the command line: every option given goes through the specification's one
-// parser (trial_spec.hpp) and its validate(); an error there is a usage error naming the option.
-TrialSpec spec_from(const TrialCommand& command) {
+// parser (trial_spec.hpp) and its one check; an error there is a usage error naming the option.
+Checked<TrialSpec> spec_from(const TrialCommand& command) {
   std::vector<std::string> args{command.characters};
   const auto add = [&args](const char* option, const std::string& value) {
     args.emplace_back(option);
@@ -222,7 +226,9 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
   // Before any character is loaded.
   check_scene_size(characters_from(recorded ? recorded->spec.characters : command.characters, "CHARS").size(),
                    "CHARS");
-  const TrialSpec spec = recorded ? recorded->spec : spec_from(command);
+  // Checked once, here; the runner and the renderer take it as it is.
+  const Checked<TrialSpec> checked = recorded ? checked_spec(command, *recorded) : spec_from(command);
+  const TrialSpec& spec = *checked;
   const std::u32string chars = characters_from(spec.characters, "CHARS");
   const DeviceListing device = find_cli_device(devices, "--device", spec.device);
   bool simulated = false;
@@ -276,7 +282,7 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
   inputs.should_stop = StopSignals::stop_requested();
   TrialRun run;
   try {
-    run = recorded ? rerun_trial(*recorded, scene, inputs) : run_trial_spec(spec, scene, inputs);
+    run = recorded ? rerun_trial(*recorded, checked, scene, inputs) : run_trial_spec(checked, scene, inputs);
   } catch (const InvalidArgument& e) {
     if (!recorded) throw;
     throw DataError("--spec " + command.spec_file + ": " + e.what());  // e.g. other character data

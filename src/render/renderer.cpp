@@ -51,11 +51,6 @@ const DeviceInfo& checked(const DeviceInfo& device) {
   return device;
 }
 
-const RendererOptions& checked(const RendererOptions& options) {
-  options.validate();
-  return options;
-}
-
 }  // namespace
 
 void RendererOptions::validate() const {
@@ -68,14 +63,18 @@ void RendererOptions::validate() const {
 
 Renderer::Renderer(const Scene& scene, const ForceLawParameters& parameters, const DeviceInfo& device,
                    const RendererOptions& options)
+    : Renderer(scene, Checked<ForceLawParameters>::check(parameters), device,
+               Checked<RendererOptions>::check(options)) {}
+
+Renderer::Renderer(const Scene& scene, const Checked<ForceLawParameters>& parameters,
+                   const DeviceInfo& device, const Checked<RendererOptions>& options)
     : scene_(&scene),
-      parameters_(parameters),
-      options_(checked(options)),
-      period_s_(1.0 / options.rate_hz),
-      active_(scene, parameters.acceptance),
-      chain_(chain_parameters(options, checked(device)), options.rate_hz),
-      passivity_(options.passivity, options.rate_hz) {
-  parameters_.validate();
+      parameters_(*parameters),
+      options_(*options),
+      period_s_(1.0 / options->rate_hz),
+      active_(scene, parameters->acceptance),
+      chain_(chain_parameters(*options, checked(device)), options->rate_hz),
+      passivity_(options->passivity, options->rate_hz) {
   const GuidanceLaw& law = parameters_.guidance_law;
   mode_ = mode_of(law);
   guidance_reach_m_ = parameters_.constraint_radius_m;

@@ -91,10 +91,11 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
   const auto device = std::make_unique<SimulatedDevice>();
   TrialRunInputs inputs;
   inputs.device = device.get();
+  const auto checked = Checked<TrialSpec>::check(std::move(spec), study_teacher_source(condition));
   inputs.force_law = study_detail::condition_force_law(condition, guidance.guidance,
-                                                       trial_options(spec, device->info()).force);
+                                                       trial_options(checked, device->info())->force);
   const auto wall_start = std::chrono::steady_clock::now();
-  const TrialRun run = run_trial_spec(spec, scene, inputs);
+  const TrialRun run = run_trial_spec(checked, scene, inputs);
   const TrialResult& result = run.result;
   if (result.end != TrialEnd::completed && result.end != TrialEnd::time_limit &&
       result.end != TrialEnd::gave_up && result.end != TrialEnd::writer_finished) {
@@ -112,9 +113,9 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
   context.writer_skills = skills;
   context.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   context.options = &run.options;
-  context.spec = &spec;
+  context.spec = &*checked;
   context.simulation.writer = run.writer;
-  context.simulation.seed = spec.seed;
+  context.simulation.seed = checked->seed;
   context.writer_log = run.writer_log;
   std::vector<std::vector<QuizEvent>> quiz;
   if (condition.mode == ConditionMode::quiz) quiz = quiz_characters(scene, result.trace, condition.quiz);

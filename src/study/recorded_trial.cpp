@@ -322,7 +322,7 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
     // A replay whose teacher was given as samples (a session's, kept in its folder) names no file.
     const bool teacher_named = trial.is_object() && trial.contains("teacher") &&
                                trial["teacher"].is_string() && !trial["teacher"].get<std::string>().empty();
-    r.spec = study_detail::trial_spec_from_object(
+    r.spec = *study_detail::trial_spec_from_object(
         trial, reader.pointer("trial"), source, teacher_named ? TeacherSource::file : TeacherSource::samples);
   } catch (const InvalidArgument& e) {
     study_detail::fail(source, reader.pointer("trial"), e.what());
@@ -404,7 +404,8 @@ RecordedTrial read_recorded_trial_file(const std::string& path) {
   return recorded;
 }
 
-TrialRun rerun_trial(const RecordedTrial& recorded, const Scene& scene, TrialRunInputs inputs) {
+TrialRun rerun_trial(const RecordedTrial& recorded, const Checked<TrialSpec>& spec, const Scene& scene,
+                     TrialRunInputs inputs) {
   const std::string here = scene_sha256(scene);
   if (here != recorded.scene_sha256) {
     throw InvalidArgument("the characters placed here are not the recorded ones (scene SHA-256 " +
@@ -421,7 +422,7 @@ TrialRun rerun_trial(const RecordedTrial& recorded, const Scene& scene, TrialRun
     device = std::make_unique<SimulatedDevice>(*recorded.simulated_device);
     inputs.device = device.get();
   }
-  return run_trial_spec(recorded.spec, scene, inputs);
+  return run_trial_spec(spec, scene, inputs);
 }
 
 }  // namespace calligraphy

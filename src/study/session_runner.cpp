@@ -155,16 +155,16 @@ TrialSpec study_trial_spec(const SessionManifest& session, const StudyCondition&
   spec.rate_hz = protocol.trial.rate_hz;
   spec.max_duration_s = protocol.trial.max_duration_s;
   spec.pacing = parse_trial_pacing(session.setup.pacing, "session pacing");
-  spec.validate(condition.mode == ConditionMode::replay ? TeacherSource::samples : TeacherSource::file);
   return spec;
 }
 
 TrialOptions study_trial_options(const SessionManifest& session, const StudyCondition& condition,
                                  const PlannedTrial& trial, const TrialGuidance& guidance) {
-  TrialOptions options = trial_options(study_trial_spec(session, condition, trial, guidance), DeviceInfo{});
+  const auto spec = Checked<TrialSpec>::check(study_trial_spec(session, condition, trial, guidance),
+                                              study_teacher_source(condition));
+  TrialOptions options = *trial_options(spec, DeviceInfo{});
   options.force = study_detail::condition_force_law(condition, guidance, std::move(options.force));
-  options.validate();
-  return options;
+  return *Checked<TrialOptions>::check(std::move(options));
 }
 
 namespace {
@@ -204,7 +204,7 @@ class SessionRun {
   struct PreparedTrial {
     Scene scene;
     study_detail::PreparedGuidance guidance;
-    TrialSpec spec;
+    Checked<TrialSpec> spec;  // checked once, when the runner has added what it knows
     json started;
     std::optional<WriterSkills> skills;
   };
@@ -281,23 +281,28 @@ class SessionRun {
 
   // The trial's guidance, specification and (a learning subject's) skills, before its device is opened.
   PreparedTrial prepare(const PlannedTrial& trial, const StudyCondition& condition) {
-    PreparedTrial prepared{scene_of(trial), {}, {}, trial_details(trial), std::nullopt};
+    Scene scene = scene_of(trial);
+    study_detail::PreparedGuidance guidance;
     if (study_detail::adapts_by_repetition(condition.mode))
-      prepared.guidance = study_detail::repetition_guidance(session_, condition, trial);
+      guidance = study_detail::repetition_guidance(session_, condition, trial);
     if (condition.mode == ConditionMode::replay)
-      prepared.guidance = study_detail::replay_guidance(session_, condition, trial, prepared.scene);
-    prepared.spec = study_trial_spec(manifest_, condition, trial, prepared.guidance.guidance);
-    if (options_.pacing) prepared.spec.pacing = *options_.pacing;
-    if (!simulated_writer_ && prepared.spec.pacing != TrialPacing::lock_step)  // a person, in real time
-      prepared.spec.watchdog_s = default_watchdog_s(listing_.capabilities.hardware);
+      guidance = study_detail::replay_guidance(session_, condition, trial, scene);
+    TrialSpec spec = study_trial_spec(manifest_, condition, trial, guidance.guidance);
+    if (options_.pacing) spec.pacing = *options_.pacing;
+    if (!simulated_writer_ && spec.pacing != TrialPacing::lock_step)  // a person, in real time
+      spec.watchdog_s = default_watchdog_s(listing_.capabilities.hardware);
+    json started = trial_details(trial);
+    std::optional<WriterSkills> skills;
     if (learning_) {
-      prepared.skills = study_detail::learn_into(prepared.spec, memory_, study_detail::subject_profile(manifest_.setup),
-                                                 prepared.scene, trial.characters);
-      prepared.started["shape_skill"] = prepared.skills->shape;
-      prepared.started["order_skill"] = prepared.skills->order;
-      prepared.started["timing_skill"] = prepared.skills->timing;
+      skills = study_detail::learn_into(spec, memory_, study_detail::subject_profile(manifest_.setup), scene,
+                                        trial.characters);
+      started["shape_skill"] = skills->shape;
+      started["order_skill"] = skills->order;
+      started["timing_skill"] = skills->timing;
     }
-    return prepared;
+    Checked<TrialSpec> checked = Checked<TrialSpec>::check(std::move(spec), study_teacher_source(condition));
+    return PreparedTrial{std::move(scene), std::move(guidance), std::move(checked), std::move(started),
+                         std::move(skills)};
   }
 
   std::unique_ptr<HapticDevice> create_device(const PlannedTrial& trial) {
@@ -319,7 +324,7 @@ class SessionRun {
     inputs.device = &device;
     inputs.teacher = prepared.guidance.guidance.teacher;
     inputs.should_stop = options_.should_stop;
-    TrialOptions planned = trial_options(prepared.spec, device.info());
+    TrialOptions planned = *trial_options(prepared.spec, device.info());
     planned.force = study_detail::condition_force_law(condition, prepared.guidance.guidance, std::move(planned.force));
     planned.loop.lock_memory = inputs.lock_memory;  // a session's program locks memory unless its host says not
     if (options_.prepare_trial) options_.prepare_trial(trial, planned);
@@ -354,9 +359,9 @@ class SessionRun {
     context.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     context.end_utc = utc_now_iso8601();
     context.options = &run.options;
-    context.spec = &prepared.spec;
+    context.spec = &*prepared.spec;
     context.simulation.writer = run.writer;
-    context.simulation.seed = prepared.spec.seed;
+    context.simulation.seed = prepared.spec->seed;
     context.writer_log = run.writer_log;
     device.reset();
     ran_one_ = true;

@@ -49,7 +49,7 @@ std::string record_teacher(const SessionFolder& session, const Scene& scene,
   SimulatedDevice device;
   TrialRunInputs inputs;
   inputs.device = &device;
-  const TrialResult result = run_trial_spec(teacher, scene, inputs).result;
+  const TrialResult result = run_trial_spec(Checked<TrialSpec>::check(teacher), scene, inputs).result;
   if (result.aborted || !result.metrics.completed_in_order) {
     throw StateError("the simulated teacher of \"" + encode_utf8(characters) + "\" wrote " +
                      std::to_string(result.metrics.strokes_completed) + " of " +

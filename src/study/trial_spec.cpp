@@ -379,7 +379,7 @@ void TrialSpec::validate(TeacherSource teacher_from) const {
     refuse("record_file", "a teacher's recording goes to a file, not to standard output");
 }
 
-TrialSpec trial_spec_from_args(std::span<const std::string> args) {
+Checked<TrialSpec> trial_spec_from_args(std::span<const std::string> args) {
   TrialSpec spec;
   std::size_t i = 0;
   if (i < args.size() && !args[i].starts_with("--")) set_trial_spec_field(spec, "characters", args[i++]);
@@ -393,8 +393,7 @@ TrialSpec trial_spec_from_args(std::span<const std::string> args) {
     if (i + 1 >= args.size()) throw InvalidArgument("trial specification: " + word + ": needs a value");
     set_trial_spec_field(spec, word, args[++i]);
   }
-  spec.validate();
-  return spec;
+  return Checked<TrialSpec>::check(std::move(spec));
 }
 
 std::vector<std::string> trial_spec_args(const TrialSpec& spec) {
@@ -414,8 +413,8 @@ std::vector<std::string> trial_spec_args(const TrialSpec& spec) {
 
 namespace study_detail {
 
-TrialSpec trial_spec_from_object(const json& document, const std::string& at_pointer,
-                                 const std::string& source, TeacherSource teacher_from) {
+Checked<TrialSpec> trial_spec_from_object(const json& document, const std::string& at_pointer,
+                                          const std::string& source, TeacherSource teacher_from) {
   ObjectReader reader(document, at_pointer, source);
   TrialSpec spec;
   for (const TrialSpecField& field : fields_in_order()) {
@@ -471,13 +470,13 @@ TrialSpec trial_spec_from_object(const json& document, const std::string& at_poi
     }
   }
   reader.finish();
-  spec.validate(teacher_from);
-  return spec;
+  return Checked<TrialSpec>::check(std::move(spec), teacher_from);
 }
 
 }  // namespace study_detail
 
-TrialSpec trial_spec_from_json(std::string_view text, const std::string& source, TeacherSource teacher_from) {
+Checked<TrialSpec> trial_spec_from_json(std::string_view text, const std::string& source,
+                                        TeacherSource teacher_from) {
   return study_detail::trial_spec_from_object(study_detail::parse_json(text, source), "", source,
                                               teacher_from);
 }

@@ -10,7 +10,7 @@ namespace calligraphy::study_detail {
 
 /// `trial_spec_from_json` of the object at `pointer` in a document read from `source`: DataError naming the
 /// source and the value's pointer, then InvalidArgument naming the field (TrialSpec::validate).
-TrialSpec trial_spec_from_object(const nlohmann::json& object, const std::string& pointer,
-                                 const std::string& source, TeacherSource teacher_from);
+Checked<TrialSpec> trial_spec_from_object(const nlohmann::json& object, const std::string& pointer,
+                                          const std::string& source, TeacherSource teacher_from);
 
 }  // namespace calligraphy::study_detail

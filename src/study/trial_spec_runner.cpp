@@ -54,11 +54,11 @@ WriterProfile profile_of(const TrialSpec& spec) {
   return profile;
 }
 
-}  // namespace
-
-TrialOptions trial_options(const TrialSpec& spec, const DeviceInfo& device) {
-  // The teacher is the caller's to read or give: a replay without a file is not an error here.
-  spec.validate(spec.teacher.empty() ? TeacherSource::samples : TeacherSource::file);
+// The options `spec` states on `device`. Every value comes from the checked specification (its rate, duration
+// and watchdog in the ranges TrialOptions::validate reads, its guidance law's parameter in the law's table)
+// or is a default, and a default stiffness is only lowered to the device's positive limit: valid by
+// construction, which tests/trial_spec_test.cpp shows on random specifications.
+TrialOptions options_stated(const TrialSpec& spec, const DeviceInfo& device) {
   TrialOptions options;
   options.force.guidance = spec.guidance;
   options.force.guidance_law = guidance_law_of(spec);
@@ -70,6 +70,26 @@ TrialOptions trial_options(const TrialSpec& spec, const DeviceInfo& device) {
   options.max_duration_s = spec.max_duration_s;
   options.keep_trace = true;  // the metrics are taken from the trace (writing_metrics)
   return options;
+}
+
+// The teacher a checked replay runs on: its file when it names one, else the caller's samples; one or the
+// other, never both (TrialSpec::validate's rule for the source the caller checked with).
+void require_one_teacher(const TrialSpec& spec, const TrialRunInputs& inputs) {
+  if (!spec.guidance || spec.guidance_mode != GuidanceMode::replay) return;
+  if (spec.teacher.empty() && inputs.teacher.empty()) {
+    throw InvalidArgument(
+        "teacher (--teacher): required with guidance mode 'replay' (a recording made with --record, or the "
+        "teacher's samples in TrialRunInputs::teacher)");
+  }
+  if (!spec.teacher.empty() && !inputs.teacher.empty()) {
+    throw InvalidArgument("teacher (--teacher): the teacher is given as samples; the file would not be read");
+  }
+}
+
+}  // namespace
+
+Checked<TrialOptions> trial_options(const Checked<TrialSpec>& spec, const DeviceInfo& device) {
+  return spec.derive([&](const TrialSpec& stated) { return options_stated(stated, device); });
 }
 
 bool simulated_writer_writes(const TrialSpec& spec, bool simulated_writer_can_move) {
@@ -94,8 +114,9 @@ bool simulated_writer_writes(const TrialSpec& spec, bool simulated_writer_can_mo
   return false;
 }
 
-TrialRun run_trial_spec(const TrialSpec& spec, const Scene& scene, const TrialRunInputs& inputs) {
-  spec.validate(inputs.teacher.empty() ? TeacherSource::file : TeacherSource::samples);
+TrialRun run_trial_spec(const Checked<TrialSpec>& checked, const Scene& scene, const TrialRunInputs& inputs) {
+  const TrialSpec& spec = *checked;
+  require_one_teacher(spec, inputs);
   TrialRun run;
   run.writer = inputs.writer ? *inputs.writer : profile_of(spec);
   run.writer.validate();
@@ -124,34 +145,46 @@ TrialRun run_trial_spec(const TrialSpec& spec, const Scene& scene, const TrialRu
   // Found once, here: the trial never asks what its device is.
   run.simulated_writer = simulated_writer_writes(spec, device->hand_port() != nullptr);
 
-  run.options = trial_options(spec, run.device);
-  if (inputs.force_law) {
-    const bool same_guidance =
-        inputs.force_law->guidance == spec.guidance &&
-        (!spec.guidance || mode_of(inputs.force_law->guidance_law) == spec.guidance_mode);
-    if (!same_guidance) {
-      throw InvalidArgument(
-          std::string("trial inputs: the force law's guidance (") +
-          (inputs.force_law->guidance ? to_string(mode_of(inputs.force_law->guidance_law)) : "off") +
-          ") is not the specification's (" + (spec.guidance ? to_string(spec.guidance_mode) : "off") + ")");
+  // The specification's values were checked with it; what the caller gives instead (a force law, a safety
+  // chain, a passivity controller) and a replay's teacher are new values, checked here once.
+  Checked<TrialOptions> options = trial_options(checked, run.device);
+  const bool replay = std::holds_alternative<ReplayGuidance>(options->force.guidance_law);
+  if (inputs.force_law || inputs.safety || inputs.passivity || replay) {
+    TrialOptions given = *options;
+    if (inputs.force_law) {
+      const bool same_guidance =
+          inputs.force_law->guidance == spec.guidance &&
+          (!spec.guidance || mode_of(inputs.force_law->guidance_law) == spec.guidance_mode);
+      if (!same_guidance) {
+        throw InvalidArgument(
+            std::string("trial inputs: the force law's guidance (") +
+            (inputs.force_law->guidance ? to_string(mode_of(inputs.force_law->guidance_law)) : "off") +
+            ") is not the specification's (" + (spec.guidance ? to_string(spec.guidance_mode) : "off") + ")");
+      }
+      given.force = *inputs.force_law;
     }
-    run.options.force = *inputs.force_law;
+    if (auto* law = std::get_if<ReplayGuidance>(&given.force.guidance_law))
+      law->teacher_trajectory = std::move(teacher);
+    if (inputs.safety) given.safety = *inputs.safety;
+    if (inputs.passivity) given.passivity = *inputs.passivity;
+    options = Checked<TrialOptions>::check(std::move(given));
   }
-  if (auto* replay = std::get_if<ReplayGuidance>(&run.options.force.guidance_law))
-    replay->teacher_trajectory = std::move(teacher);
-  if (inputs.safety) run.options.safety = *inputs.safety;
-  if (inputs.passivity) run.options.passivity = *inputs.passivity;
-  run.options.display = inputs.display;
-  run.options.should_stop = inputs.should_stop;
-  if (!inputs.host_process) {  // a program that exists to run the trial asks for the real-time settings
-    run.options.loop.priority = kDedicatedServoPriority;
-    run.options.loop.lock_memory = inputs.lock_memory;
-  }
-  run.options.validate();
+  // Where the trial runs from (a stop flag, a display, the process's real-time settings): no parameter of
+  // the force, and nothing TrialOptions::validate refuses (the priority is the loop's valid constant).
+  options = options.derive([&](TrialOptions running) {
+    running.display = inputs.display;
+    running.should_stop = inputs.should_stop;
+    if (!inputs.host_process) {  // a program that exists to run the trial asks for the real-time settings
+      running.loop.priority = kDedicatedServoPriority;
+      running.loop.lock_memory = inputs.lock_memory;
+    }
+    return running;
+  });
 
   std::unique_ptr<SimulatedHand> hand;
   if (run.simulated_writer) hand = simulated_hand_for(*device, scene, run.writer, spec.seed);
-  run.result = run_trial(*device, scene, run.options, hand.get());
+  run.result = run_trial(*device, scene, options, hand.get());
+  run.options = *options;
   if (hand) {
     run.writer_log = hand->log();
     // The writer knows which stroke each pen-down segment meant, and which it wrote again.

@@ -58,12 +58,15 @@ void TrainerApp::start_trial(std::size_t character) {
   inputs.teacher = options_.teacher;
   inputs.display = channel_.get();
   inputs.lock_memory = false;                          // a window process (TrialRunInputs::lock_memory)
-  trial_options_ = trial_options(spec, DeviceInfo{});  // what the view needs before the device is open
-  trial_simulation_.writer = writer_profile(spec.writer_profile);
-  trial_simulation_.seed = spec.seed;
+  // Checked once, here; the runner and the renderer take it as it is.
+  auto checked = Checked<TrialSpec>::check(
+      std::move(spec), inputs.teacher.empty() ? TeacherSource::file : TeacherSource::samples);
+  trial_options_ = *trial_options(checked, DeviceInfo{});  // what the view needs before the device is open
+  trial_simulation_.writer = writer_profile(checked->writer_profile);
+  trial_simulation_.seed = checked->seed;
   trial_start_utc_ = utc_now_iso8601();
   trial_wall_start_ = Clock::now();
-  worker_.start(std::move(scene), std::move(spec), std::move(inputs));
+  worker_.start(std::move(scene), std::move(checked), std::move(inputs));
   view_->scene = &worker_.scene();
   view_->acceptance = trial_options_.force.acceptance;
   // The quiz and the renderer judge a stroke alike (the live quiz, and the saved record's quiz through the

@@ -11,13 +11,13 @@ TrialWorker::~TrialWorker() {
   }
 }
 
-void TrialWorker::start(Scene scene, TrialSpec spec, TrialRunInputs inputs) {
+void TrialWorker::start(Scene scene, Checked<TrialSpec> spec, TrialRunInputs inputs) {
   if (thread_.joinable()) {
     request_stop();
     thread_.join();
   }
   scene_ = std::move(scene);
-  spec_ = spec;
+  spec_ = *spec;
   stop_.store(false);
   done_.store(false);
   result_.reset();

@@ -22,7 +22,7 @@ class TrialWorker {
 
   /// Starts the trial `spec` of `scene` (kept here) with `inputs`, whose `should_stop` is replaced by this
   /// worker's stop flag.
-  void start(Scene scene, TrialSpec spec, TrialRunInputs inputs);
+  void start(Scene scene, Checked<TrialSpec> spec, TrialRunInputs inputs);
   [[nodiscard]] bool active() const noexcept { return thread_.joinable(); }
   /// True once the trial thread has finished (its result is ready).
   [[nodiscard]] bool done() const noexcept { return done_.load(std::memory_order_acquire); }

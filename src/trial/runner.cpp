@@ -143,7 +143,12 @@ TrialResult run_real_time(HapticDevice& device, TrialHand* hand, TrialSession& s
 
 TrialResult run_trial(HapticDevice& device, const Scene& scene, const TrialOptions& options,
                       TrialHand* hand) {
-  options.validate();
+  return run_trial(device, scene, Checked<TrialOptions>::check(options), hand);
+}
+
+TrialResult run_trial(HapticDevice& device, const Scene& scene, const Checked<TrialOptions>& checked,
+                      TrialHand* hand) {
+  const TrialOptions& options = *checked;
   if (hand == nullptr && options.pacing == TrialPacing::lock_step) {
     throw InvalidArgument("lock-step pacing needs a hand that moves the device (a simulated writer); '" +
                           device.info().model + "' is moved by a person: use real-time pacing");
@@ -157,11 +162,11 @@ TrialResult run_trial(HapticDevice& device, const Scene& scene, const TrialOptio
     // A stop asked for while the device was opening (a driver waited for, e.g. OpenHaptics' scheduler,
     // gives up on it): an interrupted trial with nothing recorded, written like any other, not an error.
     if (!options.should_stop || !options.should_stop()) throw;
-    TrialSession stopped(scene, device.info(), options);
+    TrialSession stopped(scene, device.info(), checked);
     return stopped.finish(TrialEnd::interrupted);
   }
   // After open(): some devices know their limits only then (OpenHaptics reads them from the driver).
-  TrialSession session(scene, device.info(), options);
+  TrialSession session(scene, device.info(), checked);
   if (real_time) return run_real_time(device, hand, session, options);
   device.enable_forces(true);
   return run_lock_step(device, *hand, session, options);

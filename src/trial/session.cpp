@@ -10,12 +10,17 @@
 namespace calligraphy {
 namespace {
 
-RendererOptions renderer_options(const TrialOptions& options) {
-  RendererOptions render;
-  render.rate_hz = options.rate_hz;
-  render.safety = options.safety;
-  render.passivity = options.passivity;
-  return render;
+// The renderer's options of checked trial options: its rate within the trial's range (inside the renderer's)
+// and the passivity controller TrialOptions::validate checked; the safety chain is the renderer's to check,
+// once the device's figures fill it.
+Checked<RendererOptions> renderer_options(const Checked<TrialOptions>& options) {
+  return options.derive([](const TrialOptions& trial) {
+    RendererOptions render;
+    render.rate_hz = trial.rate_hz;
+    render.safety = trial.safety;
+    render.passivity = trial.passivity;
+    return render;
+  });
 }
 
 // Most ticks of trace room reserved before the trial, untouched: 2^19, 42 MB of address space.
@@ -24,16 +29,19 @@ constexpr std::size_t kUntouchedTraceTicks = std::size_t{1} << 19;
 }  // namespace
 
 TrialSession::TrialSession(const Scene& scene, const DeviceInfo& device, const TrialOptions& options)
-    : options_((options.validate(), options)),
-      renderer_(scene, options.force, device, renderer_options(options)),
-      recorder_(scene, options.keep_trace),
-      max_ticks_(static_cast<std::size_t>(std::ceil(options.max_duration_s * options.rate_hz))) {
+    : TrialSession(scene, device, Checked<TrialOptions>::check(options)) {}
+
+TrialSession::TrialSession(const Scene& scene, const DeviceInfo& device, const Checked<TrialOptions>& checked)
+    : options_(*checked),
+      renderer_(scene, checked.part(&TrialOptions::force), device, renderer_options(checked)),
+      recorder_(scene, options_.keep_trace),
+      max_ticks_(static_cast<std::size_t>(std::ceil(options_.max_duration_s * options_.rate_hz))) {
   // Room for the whole trace, untouched (pages are touched as samples are written): the trace never moves
   // while it grows, which a lock-step trial would otherwise pay for in copies and page faults. Capped, so
   // that a long fast trial does not reserve gigabytes of address space up front.
-  if (options.keep_trace)
+  if (options_.keep_trace)
     recorder_.reserve_untouched(std::min<std::size_t>(max_ticks_, kUntouchedTraceTicks));
-  attach_display(options.display);
+  attach_display(options_.display);
 }
 
 void TrialSession::attach_display(DisplayChannel* channel) {

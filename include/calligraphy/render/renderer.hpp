@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "calligraphy/collision/active_stroke.hpp"
+#include "calligraphy/core/checked.hpp"
 #include "calligraphy/core/device_types.hpp"
 #include "calligraphy/model/nearest_point_tracker.hpp"
 #include "calligraphy/model/scene.hpp"
@@ -61,6 +62,10 @@ class Renderer {
   /// when a stiffness exceeds the device's stable maximum or Colgate's bound 2 (b - B) rate.
   Renderer(const Scene& scene, const ForceLawParameters& parameters, const DeviceInfo& device,
            const RendererOptions& options = {});
+  /// The same with values already checked (checked.hpp): neither is validated again. What a trial session
+  /// gives the renderer; the constructor above checks its arguments and comes here.
+  Renderer(const Scene& scene, const Checked<ForceLawParameters>& parameters, const DeviceInfo& device,
+           const Checked<RendererOptions>& options);
 
   /// One servo tick. Never throws, never allocates.
   RenderOutput tick(const DeviceState& state) noexcept;

@@ -79,11 +79,12 @@ struct RecordedTrial {
 [[nodiscard]] RecordedTrial read_recorded_trial_file(const std::string& path);
 
 /// Runs `recorded` again on `scene` (laid out by the caller with `recorded.layout`) with `inputs` (the
-/// registry, a stop flag, a replay's teacher samples); its force law, safety chain, passivity controller,
-/// writer and simulated device (made here when recorded) replace any in `inputs`. Throws InvalidArgument when
-/// `scene` is not the recorded one (its SHA-256 differs: other character data), and what `run_trial_spec`
-/// throws.
-[[nodiscard]] TrialRun rerun_trial(const RecordedTrial& recorded, const Scene& scene,
-                                   TrialRunInputs inputs = {});
+/// registry, a stop flag, a replay's teacher samples). `spec` is the specification that runs: `recorded.spec`
+/// as the caller checked it (`Checked<TrialSpec>::check`), its output files and a replay's teacher file the
+/// caller's. The record's force law, safety chain, passivity controller, writer and simulated device (made
+/// here when recorded) replace any in `inputs`. Throws InvalidArgument when `scene` is not the recorded one
+/// (its SHA-256 differs: other character data), and what `run_trial_spec` throws.
+[[nodiscard]] TrialRun rerun_trial(const RecordedTrial& recorded, const Checked<TrialSpec>& spec,
+                                   const Scene& scene, TrialRunInputs inputs = {});
 
 }  // namespace calligraphy

@@ -102,15 +102,23 @@ struct TrialGuidance {
 /// session's device, writer, profile and pacing, a seed of the simulated subject's own per trial (from the
 /// subject's seed, the trial's index and the session's number), servo rate and duration from the protocol,
 /// guidance on for `haptic`, `fading` and `replay` (the gain or the teacher's file from `guidance`), off for
-/// `vision` and `quiz`. Throws InvalidArgument naming the condition for a `replay` condition without a
-/// teacher in `guidance` or a gain outside [0, 1], and what `TrialSpec::validate` throws.
+/// `vision` and `quiz`. Not checked yet: its runner adds what it knows (a pacing, a learning subject's
+/// skills) and checks it once, with a replay's teacher from `study_teacher_source(condition)`. Throws
+/// InvalidArgument naming the condition for a `replay` condition without a teacher in `guidance`.
 [[nodiscard]] TrialSpec study_trial_spec(const SessionManifest& session, const StudyCondition& condition,
                                          const PlannedTrial& trial, const TrialGuidance& guidance = {});
 
+/// Where a study trial's replay teacher comes from: the samples kept in the session folder
+/// (TrialRunInputs::teacher), never a file the specification names.
+[[nodiscard]] constexpr TeacherSource study_teacher_source(const StudyCondition& condition) noexcept {
+  return condition.mode == ConditionMode::replay ? TeacherSource::samples : TeacherSource::file;
+}
+
 /// The runner's options of that specification on a device stating no limits (`trial_options`), with what
 /// the condition sets beyond it: the quiz's acceptance, the replay's teacher and lead, the condition's
-/// guidance stiffness. Throws InvalidArgument
-/// naming the condition for a `replay` condition without a teacher in `guidance`, or a gain outside [0, 1].
+/// guidance stiffness; checked (the check of a plan before its first trial). Throws InvalidArgument naming
+/// the condition for a `replay` condition without a teacher in `guidance`, and what `TrialSpec::validate` and
+/// `TrialOptions::validate` throw.
 [[nodiscard]] TrialOptions study_trial_options(const SessionManifest& session,
                                                const StudyCondition& condition, const PlannedTrial& trial,
                                                const TrialGuidance& guidance = {});

@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "calligraphy/core/checked.hpp"
 #include "calligraphy/devices/servo_loop.hpp"
 #include "calligraphy/render/force_law.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
@@ -101,9 +102,9 @@ void set_trial_spec_field(TrialSpec& spec, std::string_view name, std::string_vi
 [[nodiscard]] std::vector<std::string> trial_spec_field_text(const TrialSpec& spec, std::string_view name);
 
 /// The specification from command-line words: CHARS first, then "--option value" pairs (each option as
-/// `trial_spec_fields()` names it). Throws InvalidArgument naming the word or the option at fault, then
-/// validates.
-[[nodiscard]] TrialSpec trial_spec_from_args(std::span<const std::string> args);
+/// `trial_spec_fields()` names it), checked (`TrialSpec::validate`, with a replay's teacher from its file).
+/// Throws InvalidArgument naming the word or the option at fault, then what `validate` throws.
+[[nodiscard]] Checked<TrialSpec> trial_spec_from_args(std::span<const std::string> args);
 /// The words `trial_spec_from_args` reads back as `spec`: CHARS, then every field that differs from a
 /// default `TrialSpec`.
 [[nodiscard]] std::vector<std::string> trial_spec_args(const TrialSpec& spec);
@@ -111,10 +112,10 @@ void set_trial_spec_field(TrialSpec& spec, std::string_view name, std::string_vi
 /// The specification from a JSON object whose keys are the fields' keys (numbers as numbers, `guidance` a
 /// boolean, `writer_parameters` an array of {"key": name, "value": number}, or of "key=value" strings as
 /// records before it wrote); a missing key keeps its default. Throws DataError
-/// naming `source` and the JSON pointer of a value at fault or an unknown key, then validates
+/// naming `source` and the JSON pointer of a value at fault or an unknown key, then checks it
 /// (InvalidArgument naming the field) with a replay's teacher from `teacher_from` (TrialSpec::validate).
-[[nodiscard]] TrialSpec trial_spec_from_json(std::string_view text, const std::string& source,
-                                             TeacherSource teacher_from = TeacherSource::file);
+[[nodiscard]] Checked<TrialSpec> trial_spec_from_json(std::string_view text, const std::string& source,
+                                                      TeacherSource teacher_from = TeacherSource::file);
 /// The JSON object `trial_spec_from_json` reads back as `spec` (every field, keys in field order).
 [[nodiscard]] std::string trial_spec_json(const TrialSpec& spec);
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "calligraphy/analysis/writing_metrics.hpp"
+#include "calligraphy/core/checked.hpp"
 #include "calligraphy/devices/device_registry.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/sim/writer_log.hpp"
@@ -65,12 +66,12 @@ struct TrialRun {
   WritingMetrics metrics;               ///< the one metrics record of the trace (writing_metrics.hpp)
 };
 
-/// The runner's options for `spec` on a device with figures `device`: guidance, mode, gain, rate, pacing,
-/// real-time settings and duration from `spec`; the force law's default stiffnesses capped at the device's
-/// stable maximum (`DeviceInfo::max_stiffness_n_per_m`), so that defaults never draw the renderer's
-/// over-limit warning. The teacher's trajectory is not read here, and a replay need not name its file (the
-/// caller reads it or gives its samples). Throws what `TrialSpec::validate` throws.
-[[nodiscard]] TrialOptions trial_options(const TrialSpec& spec, const DeviceInfo& device);
+/// The runner's options for the checked `spec` on a device with figures `device`, checked with it (derived:
+/// no value is validated again): guidance, mode, gain, rate, pacing, real-time settings and duration from
+/// `spec`; the force law's default stiffnesses capped at the device's stable maximum
+/// (`DeviceInfo::max_stiffness_n_per_m`), so that defaults never draw the renderer's over-limit warning. The
+/// teacher's trajectory is not read here (the runner reads it or is given its samples).
+[[nodiscard]] Checked<TrialOptions> trial_options(const Checked<TrialSpec>& spec, const DeviceInfo& device);
 
 /// Who writes `spec` on a device: `TrialWriter::simulated` or `person` as stated, else the simulated writer
 /// when `simulated_writer_can_move` (the device has a hand port), a person otherwise. Throws
@@ -79,14 +80,17 @@ struct TrialRun {
 [[nodiscard]] bool simulated_writer_writes(const TrialSpec& spec, bool simulated_writer_can_move);
 
 /// Runs the trial `spec` states on `scene` (laid out from `spec.characters` by the caller, who knows where
-/// characters come from). Validates first (a replay's teacher from the file `spec.teacher`, or from
-/// `inputs.teacher` when given, `spec.teacher` then empty); creates the device (unless given), reads the
-/// teacher (unless given), makes the simulated writer's hand when it writes, runs `run_trial`, and scores the
-/// trace. Writes none of `spec`'s output files (the caller's: they depend on its front-end). Throws what
-/// `validate` throws, InvalidArgument when `inputs` gives neither a device nor a registry, DeviceNotFound,
-/// DataError for a teacher that cannot be read, InvalidArgument for one of other characters, and what
-/// `run_trial` throws.
-[[nodiscard]] TrialRun run_trial_spec(const TrialSpec& spec, const Scene& scene,
+/// characters come from). `spec` was checked once by its front-end (`Checked<TrialSpec>::check`, or the
+/// parsers of trial_spec.hpp), with a replay's teacher from the file `spec.teacher` or, `spec.teacher` empty,
+/// from `inputs.teacher`; nothing of it is validated again down to the renderer. Creates the device (unless
+/// given), reads the teacher (unless given), makes the simulated writer's hand when it writes, runs
+/// `run_trial`, and scores the trace. What `inputs` gives instead of the specification's (a force law, a
+/// safety chain, a passivity controller) is checked here. Writes none of `spec`'s output files (the caller's:
+/// they depend on its front-end). Throws InvalidArgument when `inputs` gives neither a device nor a registry,
+/// or a replay neither or both of a teacher file and samples, DeviceNotFound, DataError for a teacher that
+/// cannot be read, InvalidArgument for one of other characters or for a part of `inputs` out of range, and
+/// what `run_trial` throws.
+[[nodiscard]] TrialRun run_trial_spec(const Checked<TrialSpec>& spec, const Scene& scene,
                                       const TrialRunInputs& inputs = {});
 
 }  // namespace calligraphy

@@ -16,6 +16,7 @@
 /// stall of the loop) ends the trial with `aborted` set, the code in `TrialResult::device_fault` and its
 /// message (`device_fault_message`) in `abort_reason`; every tick recorded before it is kept. Any
 /// exception (from `open()`, `calibrate()`, a hand) turns forces off, closes the device, and propagates.
+#include "calligraphy/core/checked.hpp"
 #include "calligraphy/devices/haptic_device.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/trial/hand.hpp"
@@ -31,6 +32,10 @@ namespace calligraphy {
 /// (DeviceNotFound, CommunicationError, CalibrationNeeded, RealtimeError): no tick was recorded then, and
 /// the device is closed.
 TrialResult run_trial(HapticDevice& device, const Scene& scene, const TrialOptions& options,
+                      TrialHand* hand = nullptr);
+/// The same with options already checked (checked.hpp): the one check was the caller's, and nothing of
+/// them is validated again down to the renderer. What `run_trial_spec` calls.
+TrialResult run_trial(HapticDevice& device, const Scene& scene, const Checked<TrialOptions>& options,
                       TrialHand* hand = nullptr);
 
 }  // namespace calligraphy

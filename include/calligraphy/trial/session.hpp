@@ -28,6 +28,7 @@
 #include <optional>
 #include <string>
 
+#include "calligraphy/core/checked.hpp"
 #include "calligraphy/core/device_types.hpp"
 #include "calligraphy/devices/servo_loop.hpp"
 #include "calligraphy/model/scene.hpp"
@@ -51,6 +52,9 @@ class TrialSession {
   /// (`DeviceInfo::damping_n_s_per_m`, for the stiffness bound) from `device`. Throws InvalidArgument for
   /// bad options or a device whose info is unusable (max force <= 0).
   TrialSession(const Scene& scene, const DeviceInfo& device, const TrialOptions& options);
+  /// The same with options already checked (checked.hpp: `run_trial`'s, or an application's
+  /// `Checked<TrialOptions>::check`): nothing of them is validated again, down to the renderer.
+  TrialSession(const Scene& scene, const DeviceInfo& device, const Checked<TrialOptions>& options);
 
   /// Allocates (and touches) the trace for `max_duration_s` x `rate_hz` ticks, about 80 bytes a tick,
   /// so that `step` never allocates: for a real-time loop. Nothing when the trace is not kept.
