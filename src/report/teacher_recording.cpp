@@ -4,8 +4,8 @@
 #include <nlohmann/json.hpp>
 
 #include "calligraphy/core/errors.hpp"
+#include "core/json_document.hpp"
 #include "core/whole_file.hpp"
-#include "report/json_document.hpp"
 
 namespace calligraphy {
 namespace {
@@ -83,7 +83,7 @@ std::string teacher_recording_json(const TeacherRecording& recording) {
 }
 
 TeacherRecording parse_teacher_recording(std::string_view json_text, const std::string& source) {
-  const nlohmann::json document = report_detail::parse_json_document(json_text, source);
+  const nlohmann::json document = json_detail::parse_json_document(json_text, source);
   if (!document.is_object()) fail(source, "expected a JSON object");
   const nlohmann::json& format = member(document, "format", source, "/");
   if (format != kFormat) fail(source, std::string("/format: expected \"") + kFormat + "\"");

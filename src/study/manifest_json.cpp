@@ -4,7 +4,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
-#include "study/json_reader.hpp"
+#include "core/json_reader.hpp"
 #include "study/names.hpp"
 #include "study/protocol_reading.hpp"
 
@@ -18,25 +18,26 @@ constexpr const char* kFormat = "calligraphy-study-session";
 constexpr std::int64_t kVersion = 2;
 
 // A label (as item set and condition names) or nothing: plans made before item sets lack these keys.
-std::string optional_label(ObjectReader& reader, const std::string& key) {
+std::string optional_label(json_detail::ObjectReader& reader, const std::string& key) {
   std::string text = reader.string_or(key, "");
   if (reader.has(key) && !is_label(text, 32)) {
-    fail(reader.source(), reader.pointer(key),
-         "expected 1 to 32 letters, digits, '_' or '-', got " + describe(json(text)));
+    json_detail::fail(
+        reader.source(), reader.pointer(key),
+        "expected 1 to 32 letters, digits, '_' or '-', got " + json_detail::describe(json(text)));
   }
   return text;
 }
 
 // The item set and crossover of a planned trial, each written only when it has a value (plan_session).
-void read_crossover_keys(ObjectReader& reader, PlannedTrial& trial) {
+void read_crossover_keys(json_detail::ObjectReader& reader, PlannedTrial& trial) {
   trial.item_set = optional_label(reader, "item_set");
   trial.sequence = reader.string_or("sequence", "");
   const bool letters =
       std::all_of(trial.sequence.begin(), trial.sequence.end(), [](char c) { return c >= 'A' && c <= 'Z'; });
   if (reader.has("sequence") && (trial.sequence.empty() || trial.sequence.size() > 26 || !letters)) {
-    fail(reader.source(), reader.pointer("sequence"),
-         "expected 1 to 26 letters A-Z (the crossover's conditions in period order), got " +
-             describe(json(trial.sequence)));
+    json_detail::fail(reader.source(), reader.pointer("sequence"),
+                      "expected 1 to 26 letters A-Z (the crossover's conditions in period order), got " +
+                          json_detail::describe(json(trial.sequence)));
   }
   trial.period = static_cast<int>(reader.integer_or("period", 0, 1, 26));
   trial.trained_condition = optional_label(reader, "trained_condition");
@@ -45,12 +46,12 @@ void read_crossover_keys(ObjectReader& reader, PlannedTrial& trial) {
 PlannedTrial planned_trial_from(const json& value, const std::string& pointer, const std::string& source,
                                 std::size_t expected_index, std::int64_t version) {
   const std::int64_t first = version >= 2 ? 1 : 0;  // the first block and item
-  ObjectReader reader(value, pointer, source);
+  json_detail::ObjectReader reader(value, pointer, source);
   PlannedTrial trial;
   trial.index = static_cast<std::size_t>(reader.integer("index", 1, 1000000)) - 1;
   if (trial.index != expected_index) {
-    fail(source, reader.pointer("index"),
-         "expected " + std::to_string(expected_index + 1) + " (trials in order)");
+    json_detail::fail(source, reader.pointer("index"),
+                      "expected " + std::to_string(expected_index + 1) + " (trials in order)");
   }
   trial.phase = choice(reader, "phase", kStudyPhases);
   trial.block = static_cast<std::size_t>(reader.integer("block", first, 1000000) - first);
@@ -58,9 +59,9 @@ PlannedTrial planned_trial_from(const json& value, const std::string& pointer, c
   try {
     trial.characters = decode_utf8(reader.string("characters"));
   } catch (const InvalidArgument& e) {
-    fail(source, reader.pointer("characters"), std::string("not UTF-8: ") + e.what());
+    json_detail::fail(source, reader.pointer("characters"), std::string("not UTF-8: ") + e.what());
   }
-  if (trial.characters.empty()) fail(source, reader.pointer("characters"), "empty");
+  if (trial.characters.empty()) json_detail::fail(source, reader.pointer("characters"), "empty");
   trial.item = static_cast<std::size_t>(reader.integer("item", first, 1000000) - first);
   trial.repetition = static_cast<int>(reader.integer("repetition", 1, 1000000));
   trial.break_before_s = reader.number_or("break_before_s", 0.0, 0.0, 86400.0);
@@ -136,18 +137,19 @@ std::string manifest_to_json(const SessionManifest& manifest) {
 }
 
 SessionManifest manifest_from_json(std::string_view text, const std::string& source) {
-  const json document = parse_json(text, source);
-  ObjectReader root(document, "", source);
-  if (root.string("format") != kFormat) fail(source, "/format", std::string("expected \"") + kFormat + "\"");
+  const json document = json_detail::parse_json(text, source);
+  json_detail::ObjectReader root(document, "", source);
+  if (root.string("format") != kFormat)
+    json_detail::fail(source, "/format", std::string("expected \"") + kFormat + "\"");
   const std::int64_t version = root.integer("version", 1, kVersion);
   SessionManifest manifest;
   manifest.created_utc = root.string("created_utc");
-  ObjectReader subject(root.required("subject"), "/subject", source);
+  json_detail::ObjectReader subject(root.required("subject"), "/subject", source);
   manifest.setup.subject.id = subject.string("id");
   if (!is_label(manifest.setup.subject.id, 64)) {  // as check_setup refuses it when a session is made
-    fail(source, "/subject/id",
-         "expected 1 to 64 letters, digits, '_' or '-', got " +
-             study_detail::describe(nlohmann::json(manifest.setup.subject.id)));
+    json_detail::fail(source, "/subject/id",
+                      "expected 1 to 64 letters, digits, '_' or '-', got " +
+                          json_detail::describe(nlohmann::json(manifest.setup.subject.id)));
   }
   manifest.setup.subject.number = static_cast<std::size_t>(subject.integer("number", 0, 1000000000));
   subject.finish();
@@ -158,7 +160,7 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
   manifest.setup.writer_learning =
       root.string_or("writer_learning", "none");  // "none" before writers learned
   if (manifest.setup.writer_learning != "none" && manifest.setup.writer_learning != "two-state") {
-    fail(source, "/writer_learning", "expected \"none\" or \"two-state\"");
+    json_detail::fail(source, "/writer_learning", "expected \"none\" or \"two-state\"");
   }
   // Sessions made before subjects differed: every subject was its profile.
   manifest.setup.individual_differences = root.boolean_or("individual_differences", false);
@@ -167,7 +169,7 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
   manifest.setup.session_number = static_cast<int>(root.integer_or("session_number", 1, 1, 20));
   manifest.group = root.string_or("group", "");
   if (const json* previous = root.optional("previous_session")) {
-    ObjectReader reader(*previous, "/previous_session", source);
+    json_detail::ObjectReader reader(*previous, "/previous_session", source);
     PreviousSession p;
     p.session_id = reader.string("session_id");
     p.ended_utc = reader.string("ended_utc");
@@ -180,13 +182,13 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
     manifest.previous = std::move(p);
   }
   if (manifest.previous.has_value() != (manifest.setup.session_number > 1)) {
-    fail(source, "/previous_session", "expected exactly for a session after the first");
+    json_detail::fail(source, "/previous_session", "expected exactly for a session after the first");
   }
-  ObjectReader library(root.required("library"), "/library", source);
+  json_detail::ObjectReader library(root.required("library"), "/library", source);
   manifest.library = {library.string("version"), library.string("build_type"), library.string("compiler"),
                       library.string("cxx_standard")};
   library.finish();
-  ObjectReader protocol(root.required("protocol"), "/protocol", source);
+  json_detail::ObjectReader protocol(root.required("protocol"), "/protocol", source);
   const std::string name = protocol.string("name");
   const std::string path = protocol.string("path");
   const std::string sha256 = protocol.string("sha256");
@@ -195,17 +197,20 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
   try {
     manifest.protocol = protocol_from_text(std::move(protocol_text), path);
   } catch (const DataError& e) {
-    fail(source, "/protocol/text", std::string("the protocol copy is not valid: ") + e.what());
+    json_detail::fail(source, "/protocol/text", std::string("the protocol copy is not valid: ") + e.what());
   }
   if (manifest.protocol.sha256 != sha256) {
-    fail(source, "/protocol/text", "the protocol copy does not match its recorded SHA-256 " + sha256);
+    json_detail::fail(source, "/protocol/text",
+                      "the protocol copy does not match its recorded SHA-256 " + sha256);
   }
   if (manifest.protocol.protocol.name != name)
-    fail(source, "/protocol/name", "not the name in the protocol copy");
+    json_detail::fail(source, "/protocol/name", "not the name in the protocol copy");
   const json& plan = root.required("plan");
-  if (!plan.is_array() || plan.empty()) fail(source, "/plan", "expected a list of planned trials");
+  if (!plan.is_array() || plan.empty())
+    json_detail::fail(source, "/plan", "expected a list of planned trials");
   for (std::size_t i = 0; i < plan.size(); ++i) {
-    PlannedTrial trial = planned_trial_from(plan[i], child_pointer("/plan", i), source, i, version);
+    PlannedTrial trial =
+        planned_trial_from(plan[i], json_detail::child_pointer("/plan", i), source, i, version);
     // Only conditions of the protocol can run, or have trained an item.
     const auto known = [&](const std::string& condition) {
       const std::vector<StudyCondition>& conditions = manifest.protocol.protocol.conditions;
@@ -213,10 +218,13 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
                          [&](const StudyCondition& c) { return c.name == condition; });
     };
     if (!known(trial.condition))
-      fail(source, child_pointer(child_pointer("/plan", i), "condition"), "not a condition of the protocol");
+      json_detail::fail(source,
+                        json_detail::child_pointer(json_detail::child_pointer("/plan", i), "condition"),
+                        "not a condition of the protocol");
     if (!trial.trained_condition.empty() && !known(trial.trained_condition)) {
-      fail(source, child_pointer(child_pointer("/plan", i), "trained_condition"),
-           "not a condition of the protocol");
+      json_detail::fail(
+          source, json_detail::child_pointer(json_detail::child_pointer("/plan", i), "trained_condition"),
+          "not a condition of the protocol");
     }
     manifest.plan.push_back(std::move(trial));
   }

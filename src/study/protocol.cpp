@@ -12,7 +12,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/servo_rate.hpp"
 #include "calligraphy/core/unicode.hpp"
-#include "study/json_reader.hpp"
+#include "core/json_reader.hpp"
 #include "study/names.hpp"
 #include "study/parameter_json.hpp"
 #include "study/protocol_reading.hpp"
@@ -25,27 +25,28 @@ using nlohmann::json;
 std::vector<std::u32string> read_items(const json& value, const std::string& pointer,
                                        const std::string& source) {
   if (!value.is_array() || value.empty() || value.size() > kMaxItems) {
-    fail(source, pointer,
-         "expected a list of 1 to " + std::to_string(kMaxItems) + " strings of characters, got " +
-             study_detail::describe(value));
+    json_detail::fail(source, pointer,
+                      "expected a list of 1 to " + std::to_string(kMaxItems) +
+                          " strings of characters, got " + json_detail::describe(value));
   }
   std::vector<std::u32string> items;
   for (std::size_t i = 0; i < value.size(); ++i) {
-    const std::string at = child_pointer(pointer, i);
-    const std::string text = as_string(value[i], at, source);
+    const std::string at = json_detail::child_pointer(pointer, i);
+    const std::string text = json_detail::as_string(value[i], at, source);
     std::u32string characters;
     try {
       characters = decode_utf8(text);
     } catch (const InvalidArgument& e) {
-      fail(source, at, std::string("not UTF-8: ") + e.what());
+      json_detail::fail(source, at, std::string("not UTF-8: ") + e.what());
     }
     if (characters.empty() || characters.size() > kMaxCharactersPerItem) {
-      fail(source, at,
-           "expected 1 to " + std::to_string(kMaxCharactersPerItem) + " characters, got " +
-               std::to_string(characters.size()));
+      json_detail::fail(source, at,
+                        "expected 1 to " + std::to_string(kMaxCharactersPerItem) + " characters, got " +
+                            std::to_string(characters.size()));
     }
     for (const char32_t c : characters) {
-      if (c <= U' ' || c == 0x3000) fail(source, at, "a space or control character cannot be written");
+      if (c <= U' ' || c == 0x3000)
+        json_detail::fail(source, at, "a space or control character cannot be written");
     }
     items.push_back(characters);
   }
@@ -55,13 +56,13 @@ std::vector<std::u32string> read_items(const json& value, const std::string& poi
 // The name of a condition the protocol defines, or an error naming `pointer`.
 std::string condition_name(const json& value, const std::string& pointer, const std::string& source,
                            const std::vector<StudyCondition>& conditions) {
-  const std::string name = as_string(value, pointer, source);
+  const std::string name = json_detail::as_string(value, pointer, source);
   std::string names;
   for (const StudyCondition& c : conditions) {
     if (c.name == name) return name;
     names += (names.empty() ? "" : ", ") + c.name;
   }
-  fail(source, pointer, "no condition is called \"" + name + "\" (defined: " + names + ")");
+  json_detail::fail(source, pointer, "no condition is called \"" + name + "\" (defined: " + names + ")");
 }
 
 }  // namespace study_detail
@@ -69,13 +70,9 @@ std::string condition_name(const json& value, const std::string& pointer, const 
 namespace {
 
 using nlohmann::json;
-using study_detail::as_string;
-using study_detail::child_pointer;
 using study_detail::choice;
 using study_detail::condition_name;
-using study_detail::fail;
 using study_detail::kMaxRepetitions;
-using study_detail::ObjectReader;
 using study_detail::read_items;
 using study_detail::table_number_or;
 using study_detail::take_table_number;
@@ -85,7 +82,7 @@ constexpr const char* kFormat = "calligraphy-study-protocol";
 // "acceptance": the stroke matcher's tolerances by name, the keys a trial record writes and the ranges of
 // StrokeAcceptance's table; a key left out keeps its default.
 StrokeAcceptance read_acceptance(const json& value, const std::string& pointer, const std::string& source) {
-  ObjectReader reader(value, pointer, source);
+  json_detail::ObjectReader reader(value, pointer, source);
   StrokeAcceptance a;
   for (const ParameterField<StrokeAcceptance>& field : ParameterTable<StrokeAcceptance>::fields())
     a.*field.member = table_number_or(reader, std::string(field.name), a.*field.member, field.member);
@@ -94,12 +91,12 @@ StrokeAcceptance read_acceptance(const json& value, const std::string& pointer, 
 }
 
 QuizOptions read_quiz(const json& value, const std::string& pointer, const std::string& source) {
-  ObjectReader reader(value, pointer, source);
+  json_detail::ObjectReader reader(value, pointer, source);
   QuizOptions quiz;
   if (reader.has("leniency")) {
-    fail(source, reader.pointer("leniency"),
-         "replaced by \"acceptance\": the quiz judges with the stroke matcher's tolerances "
-         "(corridor_m, mean_deviation_m, ...; docs/stroke-acceptance.md)");
+    json_detail::fail(source, reader.pointer("leniency"),
+                      "replaced by \"acceptance\": the quiz judges with the stroke matcher's tolerances "
+                      "(corridor_m, mean_deviation_m, ...; docs/stroke-acceptance.md)");
   }
   if (const json* acceptance = reader.optional("acceptance")) {
     quiz.acceptance = read_acceptance(*acceptance, reader.pointer("acceptance"), source);
@@ -115,7 +112,7 @@ QuizOptions read_quiz(const json& value, const std::string& pointer, const std::
 // law's or rule's table; an unknown key or a value out of range is an error naming its pointer.
 void read_guidance_parameters(const json& parameters, const std::string& pointer, const std::string& source,
                               StudyCondition& condition) {
-  ObjectReader reader(parameters, pointer, source);
+  json_detail::ObjectReader reader(parameters, pointer, source);
   switch (condition.mode) {
     case ConditionMode::fading: {
       FadingRule& rule = condition.fading_rule;
@@ -140,7 +137,7 @@ void read_guidance_parameters(const json& parameters, const std::string& pointer
       rule.min_band_m = table_number_or(reader, "min_band_m", rule.min_band_m, &AssistBandRule::min_band_m);
       rule.max_band_m = table_number_or(reader, "max_band_m", rule.max_band_m, &AssistBandRule::max_band_m);
       if (rule.max_band_m < rule.min_band_m) {
-        fail(source, reader.pointer("max_band_m"), "expected a band at least min_band_m");
+        json_detail::fail(source, reader.pointer("max_band_m"), "expected a band at least min_band_m");
       }
       break;
     }
@@ -171,20 +168,21 @@ void read_guidance_parameters(const json& parameters, const std::string& pointer
 std::map<std::u32string, std::string> read_teachers(const json& value, const std::string& pointer,
                                                     const std::string& source) {
   if (!value.is_object()) {
-    fail(source, pointer,
-         "expected an object of items and recording files, got " + study_detail::describe(value));
+    json_detail::fail(source, pointer,
+                      "expected an object of items and recording files, got " + json_detail::describe(value));
   }
   std::map<std::u32string, std::string> teachers;
   for (const auto& item : value.items()) {
-    const std::string at = child_pointer(pointer, item.key());
+    const std::string at = json_detail::child_pointer(pointer, item.key());
     std::u32string characters;
     try {
       characters = decode_utf8(item.key());
     } catch (const InvalidArgument& e) {
-      fail(source, at, std::string("not UTF-8: ") + e.what());
+      json_detail::fail(source, at, std::string("not UTF-8: ") + e.what());
     }
-    const std::string path = as_string(item.value(), at, source);
-    if (path.empty()) fail(source, at, "expected the path of a teacher's recording, got an empty string");
+    const std::string path = json_detail::as_string(item.value(), at, source);
+    if (path.empty())
+      json_detail::fail(source, at, "expected the path of a teacher's recording, got an empty string");
     teachers[characters] = path;
   }
   return teachers;
@@ -201,46 +199,50 @@ void check_teacher_items(const StudyProtocol& protocol, const std::string& sourc
           });
       if (written) continue;
       const std::string text = encode_utf8(item);
-      fail(source, child_pointer(child_pointer(child_pointer("/conditions", i), "teachers"), text),
-           "\"" + text + "\" is not an item of the protocol (the characters of its phases)");
+      json_detail::fail(
+          source,
+          json_detail::child_pointer(
+              json_detail::child_pointer(json_detail::child_pointer("/conditions", i), "teachers"), text),
+          "\"" + text + "\" is not an item of the protocol (the characters of its phases)");
     }
   }
 }
 
 StudyCondition read_condition(const json& value, const std::string& pointer, const std::string& source) {
-  ObjectReader reader(value, pointer, source);
+  json_detail::ObjectReader reader(value, pointer, source);
   StudyCondition condition;
   condition.name = reader.string("name");
   if (!study_detail::is_label(condition.name, 32)) {
-    fail(source, reader.pointer("name"),
-         "expected 1 to 32 letters, digits, '_' or '-', got \"" + condition.name + "\"");
+    json_detail::fail(source, reader.pointer("name"),
+                      "expected 1 to 32 letters, digits, '_' or '-', got \"" + condition.name + "\"");
   }
   condition.mode = choice(reader, "mode", study_detail::kConditionModes);
   const bool guided = renders_guidance(condition.mode);
   if (const json* stiffness = reader.optional("guidance_stiffness_n_per_m")) {
     if (!guided) {
-      fail(source, reader.pointer("guidance_stiffness_n_per_m"),
-           std::string("mode \"") + to_string(condition.mode) + "\" renders no guidance");
+      json_detail::fail(source, reader.pointer("guidance_stiffness_n_per_m"),
+                        std::string("mode \"") + to_string(condition.mode) + "\" renders no guidance");
     }
     condition.guidance_stiffness_n_per_m =
-        study_detail::as_number(*stiffness, reader.pointer("guidance_stiffness_n_per_m"), source, 0.0, 1e5);
+        json_detail::as_number(*stiffness, reader.pointer("guidance_stiffness_n_per_m"), source, 0.0, 1e5);
   }
   if (const json* parameters = reader.optional("parameters")) {
     const std::string at = reader.pointer("parameters");
     if (!guided || condition.mode == ConditionMode::haptic) {
-      fail(source, at, std::string("mode \"") + to_string(condition.mode) + "\" takes no parameters");
+      json_detail::fail(source, at,
+                        std::string("mode \"") + to_string(condition.mode) + "\" takes no parameters");
     }
     read_guidance_parameters(*parameters, at, source, condition);
   }
   if (const json* teachers = reader.optional("teachers")) {
     if (condition.mode != ConditionMode::replay) {
-      fail(source, reader.pointer("teachers"), "only the mode \"replay\" takes teachers");
+      json_detail::fail(source, reader.pointer("teachers"), "only the mode \"replay\" takes teachers");
     }
     condition.teachers = read_teachers(*teachers, reader.pointer("teachers"), source);
   }
   if (const json* quiz = reader.optional("quiz")) {
     if (condition.mode != ConditionMode::quiz) {
-      fail(source, reader.pointer("quiz"), "only the mode \"quiz\" takes quiz options");
+      json_detail::fail(source, reader.pointer("quiz"), "only the mode \"quiz\" takes quiz options");
     }
     condition.quiz = read_quiz(*quiz, reader.pointer("quiz"), source);
   }
@@ -248,10 +250,10 @@ StudyCondition read_condition(const json& value, const std::string& pointer, con
   return condition;
 }
 
-void read_order(ObjectReader& reader, StudyProtocol& protocol) {
+void read_order(json_detail::ObjectReader& reader, StudyProtocol& protocol) {
   const json* value = reader.optional("order");
   if (!value) return;
-  ObjectReader order(*value, reader.pointer("order"), reader.source());
+  json_detail::ObjectReader order(*value, reader.pointer("order"), reader.source());
   constexpr std::array<ConditionOrder, 4> kConditionOrders{
       ConditionOrder::fixed, ConditionOrder::latin_square, ConditionOrder::abba, ConditionOrder::random};
   constexpr std::array<ItemOrder, 2> kItemOrders{ItemOrder::fixed, ItemOrder::random};
@@ -261,23 +263,24 @@ void read_order(ObjectReader& reader, StudyProtocol& protocol) {
   order.finish();
 }
 
-void read_breaks(ObjectReader& reader, StudyProtocol& protocol) {
+void read_breaks(json_detail::ObjectReader& reader, StudyProtocol& protocol) {
   const json* value = reader.optional("breaks");
   if (!value) return;
-  ObjectReader breaks(*value, reader.pointer("breaks"), reader.source());
+  json_detail::ObjectReader breaks(*value, reader.pointer("breaks"), reader.source());
   protocol.breaks.between_blocks_s = breaks.number_or("between_blocks_s", 0.0, 0.0, 86400.0);
   protocol.breaks.every_trials = static_cast<int>(breaks.integer_or("every_trials", 0, 0, 100000));
   protocol.breaks.duration_s = breaks.number_or("duration_s", 0.0, 0.0, 86400.0);
   if (protocol.breaks.every_trials > 0 && !breaks.has("duration_s")) {
-    fail(reader.source(), breaks.pointer("duration_s"), "missing: every_trials needs a duration_s");
+    json_detail::fail(reader.source(), breaks.pointer("duration_s"),
+                      "missing: every_trials needs a duration_s");
   }
   breaks.finish();
 }
 
-void read_trial_settings(ObjectReader& reader, StudyProtocol& protocol) {
+void read_trial_settings(json_detail::ObjectReader& reader, StudyProtocol& protocol) {
   const json* value = reader.optional("trial");
   if (!value) return;
-  ObjectReader trial(*value, reader.pointer("trial"), reader.source());
+  json_detail::ObjectReader trial(*value, reader.pointer("trial"), reader.source());
   protocol.trial.max_duration_s =
       trial.number_or("max_duration_s", protocol.trial.max_duration_s, 1e-3, 3600.0);
   // A protocol's trials may run in real time with a person: the real-time range.
@@ -292,16 +295,16 @@ void read_trial_settings(ObjectReader& reader, StudyProtocol& protocol) {
             << trial.pointer("rate_hz") << ") is " << std::llround(ticks)
             << " servo ticks a trial, more than the 10000000 a trial may have (its trace is held in memory): "
                "lower max_duration_s or rate_hz";
-    fail(reader.source(), trial.pointer("max_duration_s"), message.str());
+    json_detail::fail(reader.source(), trial.pointer("max_duration_s"), message.str());
   }
   trial.finish();
 }
 
 // The paper's format: an optional "practice" block, then "test" blocks of every condition (section 7.1).
-void read_paper_phases(ObjectReader& root, StudyProtocol& protocol) {
+void read_paper_phases(json_detail::ObjectReader& root, StudyProtocol& protocol) {
   const std::string& source = root.source();
   if (const json* practice = root.optional("practice")) {
-    ObjectReader reader(*practice, "/practice", source);
+    json_detail::ObjectReader reader(*practice, "/practice", source);
     ProtocolPhase phase;
     phase.pointer = "/practice";
     phase.kind = StudyPhase::practice;
@@ -312,30 +315,31 @@ void read_paper_phases(ObjectReader& root, StudyProtocol& protocol) {
     reader.finish();
     protocol.phases.push_back(std::move(phase));
   }
-  ObjectReader test(root.required("test"), "/test", source);
+  json_detail::ObjectReader test(root.required("test"), "/test", source);
   ProtocolPhase phase;
   phase.pointer = "/test";
   phase.kind = StudyPhase::test;
   phase.items = read_items(test.required("characters"), test.pointer("characters"), source);
   const json& tested = test.required("conditions");
   if (!tested.is_array() || tested.empty()) {
-    fail(source, "/test/conditions",
-         "expected a list of condition names, got " + study_detail::describe(tested));
+    json_detail::fail(source, "/test/conditions",
+                      "expected a list of condition names, got " + json_detail::describe(tested));
   }
   for (std::size_t i = 0; i < tested.size(); ++i) {
-    const std::string at = child_pointer("/test/conditions", i);
+    const std::string at = json_detail::child_pointer("/test/conditions", i);
     std::string name = condition_name(tested[i], at, source, protocol.conditions);
     if (std::find(phase.conditions.begin(), phase.conditions.end(), name) != phase.conditions.end()) {
-      fail(source, at, "the condition \"" + name + "\" is listed twice");
+      json_detail::fail(source, at, "the condition \"" + name + "\" is listed twice");
     }
     phase.conditions.push_back(std::move(name));
   }
   phase.repetitions = static_cast<int>(test.integer("repetitions", 1, kMaxRepetitions));
   test.finish();
   if (protocol.condition_order == ConditionOrder::abba && phase.repetitions % 2 != 0) {
-    fail(source, "/test/repetitions",
-         "order \"abba\" splits each condition's repetitions over two blocks: expected an even number, got " +
-             std::to_string(phase.repetitions));
+    json_detail::fail(
+        source, "/test/repetitions",
+        "order \"abba\" splits each condition's repetitions over two blocks: expected an even number, got " +
+            std::to_string(phase.repetitions));
   }
   protocol.phases.push_back(std::move(phase));
 }
@@ -442,31 +446,34 @@ const StudyCondition& StudyProtocol::condition(std::string_view wanted) const {
 }
 
 StudyProtocol parse_study_protocol(std::string_view json_text, const std::string& source) {
-  const json document = study_detail::parse_json(json_text, source);
-  ObjectReader root(document, "", source);
+  const json document = json_detail::parse_json(json_text, source);
+  json_detail::ObjectReader root(document, "", source);
   StudyProtocol protocol;
   const std::string format = root.string_or("format", kFormat);
   if (format != kFormat) {
-    fail(source, "/format", std::string("expected \"") + kFormat + "\", got \"" + format + "\"");
+    json_detail::fail(source, "/format", std::string("expected \"") + kFormat + "\", got \"" + format + "\"");
   }
   root.integer_or("version", 1, 1, 1);
   protocol.name = root.string("name");
   if (!study_detail::is_label(protocol.name, 64)) {
-    fail(source, "/name", "expected 1 to 64 letters, digits, '_' or '-', got \"" + protocol.name + "\"");
+    json_detail::fail(source, "/name",
+                      "expected 1 to 64 letters, digits, '_' or '-', got \"" + protocol.name + "\"");
   }
   protocol.description = root.string_or("description", "");
 
   const json& conditions = root.required("conditions");
   if (!conditions.is_array() || conditions.empty() || conditions.size() > 26) {
-    fail(source, "/conditions",
-         "expected a list of 1 to 26 conditions, got " + study_detail::describe(conditions));
+    json_detail::fail(source, "/conditions",
+                      "expected a list of 1 to 26 conditions, got " + json_detail::describe(conditions));
   }
   std::set<std::string> names;
   for (std::size_t i = 0; i < conditions.size(); ++i) {
-    StudyCondition condition = read_condition(conditions[i], child_pointer("/conditions", i), source);
+    StudyCondition condition =
+        read_condition(conditions[i], json_detail::child_pointer("/conditions", i), source);
     if (!names.insert(condition.name).second) {
-      fail(source, child_pointer(child_pointer("/conditions", i), "name"),
-           "the condition \"" + condition.name + "\" is defined twice");
+      json_detail::fail(source,
+                        json_detail::child_pointer(json_detail::child_pointer("/conditions", i), "name"),
+                        "the condition \"" + condition.name + "\" is defined twice");
     }
     protocol.conditions.push_back(std::move(condition));
   }
@@ -478,8 +485,9 @@ StudyProtocol parse_study_protocol(std::string_view json_text, const std::string
   }
   const bool paper_format = root.has("test") || root.has("practice");
   if (paper_format && root.has("phases")) {
-    fail(source, "/phases",
-         "a protocol gives either \"phases\" or the paper's \"practice\" and \"test\", not both");
+    json_detail::fail(
+        source, "/phases",
+        "a protocol gives either \"phases\" or the paper's \"practice\" and \"test\", not both");
   }
   if (paper_format) {
     read_paper_phases(root, protocol);
@@ -493,9 +501,9 @@ StudyProtocol parse_study_protocol(std::string_view json_text, const std::string
 
   const std::uint64_t planned = planned_trial_count(protocol);
   if (planned > kMaxPlannedTrials) {
-    fail(source, paper_format ? "/test" : "/phases",
-         thousands(planned) + " trials planned in one session, more than the limit of " +
-             thousands(kMaxPlannedTrials) + " trials per session");
+    json_detail::fail(source, paper_format ? "/test" : "/phases",
+                      thousands(planned) + " trials planned in one session, more than the limit of " +
+                          thousands(kMaxPlannedTrials) + " trials per session");
   }
   return protocol;
 }

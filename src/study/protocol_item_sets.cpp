@@ -31,9 +31,12 @@ void check_disjoint(const std::vector<ItemSet>& sets, const std::string& pointer
       for (const char32_t c : sets[i].items[k]) {
         const auto [first, added] = owner.emplace(c, i);
         if (added || first->second == i) continue;
-        fail(source, child_pointer(child_pointer(child_pointer(pointer, i), "characters"), k),
-             in_quotes(encode_utf8(c)) + " is also in the item set " + in_quotes(sets[first->second].name) +
-                 ": a character in two sets cannot be attributed to one condition");
+        json_detail::fail(
+            source,
+            json_detail::child_pointer(
+                json_detail::child_pointer(json_detail::child_pointer(pointer, i), "characters"), k),
+            in_quotes(encode_utf8(c)) + " is also in the item set " + in_quotes(sets[first->second].name) +
+                ": a character in two sets cannot be attributed to one condition");
       }
     }
   }
@@ -46,35 +49,35 @@ void check_transfer_sources(const std::vector<ItemSet>& sets, const std::string&
   for (std::size_t i = 0; i < sets.size(); ++i) {
     const std::string& wanted = sets[i].transfer_of;
     if (wanted.empty()) continue;
-    const std::string at = child_pointer(child_pointer(pointer, i), "transfer_of");
-    if (wanted == sets[i].name) fail(source, at, "a set is not a transfer set of itself");
+    const std::string at = json_detail::child_pointer(json_detail::child_pointer(pointer, i), "transfer_of");
+    if (wanted == sets[i].name) json_detail::fail(source, at, "a set is not a transfer set of itself");
     const auto found =
         std::find_if(sets.begin(), sets.end(), [&](const ItemSet& set) { return set.name == wanted; });
     if (found == sets.end()) {
-      fail(source, at, "no item set " + in_quotes(wanted) + "; defined: " + defined_sets(sets));
+      json_detail::fail(source, at, "no item set " + in_quotes(wanted) + "; defined: " + defined_sets(sets));
     }
     if (!found->transfer_of.empty()) {
-      fail(source, at,
-           in_quotes(wanted) + " is itself a transfer set (of " + in_quotes(found->transfer_of) +
-               "): transfer_of names a set that is trained");
+      json_detail::fail(source, at,
+                        in_quotes(wanted) + " is itself a transfer set (of " + in_quotes(found->transfer_of) +
+                            "): transfer_of names a set that is trained");
     }
   }
 }
 
 ItemSet read_item_set(const json& value, const std::string& pointer, const std::string& source) {
-  ObjectReader reader(value, pointer, source);
+  json_detail::ObjectReader reader(value, pointer, source);
   ItemSet set;
   set.name = reader.string("name");
   if (!is_label(set.name, 32)) {
-    fail(source, reader.pointer("name"),
-         "expected 1 to 32 letters, digits, '_' or '-', got " + in_quotes(set.name));
+    json_detail::fail(source, reader.pointer("name"),
+                      "expected 1 to 32 letters, digits, '_' or '-', got " + in_quotes(set.name));
   }
   set.items = read_items(reader.required("characters"), reader.pointer("characters"), source);
   set.transfer_of = reader.string_or("transfer_of", "");
   if (reader.has("transfer_of") && !is_label(set.transfer_of, 32)) {
-    fail(source, reader.pointer("transfer_of"),
-         "expected the name of an item set (1 to 32 letters, digits, '_' or '-'), got " +
-             in_quotes(set.transfer_of));
+    json_detail::fail(source, reader.pointer("transfer_of"),
+                      "expected the name of an item set (1 to 32 letters, digits, '_' or '-'), got " +
+                          in_quotes(set.transfer_of));
   }
   reader.finish();
   return set;
@@ -85,17 +88,18 @@ ItemSet read_item_set(const json& value, const std::string& pointer, const std::
 void read_item_sets(const json& value, const std::string& pointer, const std::string& source,
                     StudyProtocol& protocol) {
   if (!value.is_array() || value.empty() || value.size() > kMaxItemSets) {
-    fail(source, pointer,
-         "expected a list of 1 to " + std::to_string(kMaxItemSets) + " item sets, got " + describe(value));
+    json_detail::fail(source, pointer,
+                      "expected a list of 1 to " + std::to_string(kMaxItemSets) + " item sets, got " +
+                          json_detail::describe(value));
   }
   std::vector<ItemSet> sets;
   for (std::size_t i = 0; i < value.size(); ++i) {
-    ItemSet set = read_item_set(value[i], child_pointer(pointer, i), source);
+    ItemSet set = read_item_set(value[i], json_detail::child_pointer(pointer, i), source);
     const bool named =
         std::any_of(sets.begin(), sets.end(), [&](const ItemSet& s) { return s.name == set.name; });
     if (named) {
-      fail(source, child_pointer(child_pointer(pointer, i), "name"),
-           "the item set " + in_quotes(set.name) + " is defined twice");
+      json_detail::fail(source, json_detail::child_pointer(json_detail::child_pointer(pointer, i), "name"),
+                        "the item set " + in_quotes(set.name) + " is defined twice");
     }
     sets.push_back(std::move(set));
   }
@@ -107,26 +111,27 @@ void read_item_sets(const json& value, const std::string& pointer, const std::st
 void read_phase_sets(const json& value, const std::string& pointer, const std::string& source,
                      const StudyProtocol& protocol, ProtocolPhase& phase) {
   if (!value.is_array() || value.empty() || value.size() > kMaxItemSets) {
-    fail(source, pointer,
-         "expected a list of 1 to " + std::to_string(kMaxItemSets) + " item set names, got " +
-             describe(value));
+    json_detail::fail(source, pointer,
+                      "expected a list of 1 to " + std::to_string(kMaxItemSets) + " item set names, got " +
+                          json_detail::describe(value));
   }
   for (std::size_t i = 0; i < value.size(); ++i) {
-    const std::string at = child_pointer(pointer, i);
-    const std::string name = as_string(value[i], at, source);
+    const std::string at = json_detail::child_pointer(pointer, i);
+    const std::string name = json_detail::as_string(value[i], at, source);
     const ItemSet* set = protocol.item_set(name);
     if (set == nullptr) {
-      fail(source, at,
-           "no item set " + in_quotes(name) + "; defined: " +
-               (protocol.item_sets.empty() ? std::string("none (\"item_sets\")")
-                                           : defined_sets(protocol.item_sets)));
+      json_detail::fail(source, at,
+                        "no item set " + in_quotes(name) + "; defined: " +
+                            (protocol.item_sets.empty() ? std::string("none (\"item_sets\")")
+                                                        : defined_sets(protocol.item_sets)));
     }
     if (std::find(phase.sets.begin(), phase.sets.end(), name) != phase.sets.end()) {
-      fail(source, at, "the item set " + in_quotes(name) + " is listed twice");
+      json_detail::fail(source, at, "the item set " + in_quotes(name) + " is listed twice");
     }
     if (phase.items.size() + set->items.size() > kMaxItems) {
-      fail(source, at,
-           "the sets hold more than the " + std::to_string(kMaxItems) + " items a phase may write");
+      json_detail::fail(
+          source, at,
+          "the sets hold more than the " + std::to_string(kMaxItems) + " items a phase may write");
     }
     phase.sets.push_back(name);
     for (const std::u32string& item : set->items) {
@@ -138,16 +143,18 @@ void read_phase_sets(const json& value, const std::string& pointer, const std::s
 
 std::string item_pointer(const StudyProtocol& protocol, const ProtocolPhase& phase, std::size_t index) {
   if (phase.item_sets.empty() || index >= phase.item_sets.size()) {
-    return child_pointer(child_pointer(phase.pointer, "characters"), index);
+    return json_detail::child_pointer(json_detail::child_pointer(phase.pointer, "characters"), index);
   }
   const std::string& name = phase.item_sets[index];
   const auto first = std::find(phase.item_sets.begin(), phase.item_sets.end(), name);
   const auto set = std::find_if(protocol.item_sets.begin(), protocol.item_sets.end(),
                                 [&](const ItemSet& s) { return s.name == name; });
   const auto position = index - static_cast<std::size_t>(first - phase.item_sets.begin());
-  return child_pointer(
-      child_pointer(child_pointer("/item_sets", static_cast<std::size_t>(set - protocol.item_sets.begin())),
-                    "characters"),
+  return json_detail::child_pointer(
+      json_detail::child_pointer(
+          json_detail::child_pointer("/item_sets",
+                                     static_cast<std::size_t>(set - protocol.item_sets.begin())),
+          "characters"),
       position);
 }
 

@@ -18,24 +18,26 @@ constexpr std::size_t kMaxPhases = 20;
 constexpr double kMaxDelay_s = 366.0 * 86400.0;
 
 // "condition": "name" or "conditions": ["a", "b"].
-std::vector<std::string> read_conditions(ObjectReader& reader, const std::vector<StudyCondition>& defined) {
+std::vector<std::string> read_conditions(json_detail::ObjectReader& reader,
+                                         const std::vector<StudyCondition>& defined) {
   const std::string& source = reader.source();
   if (reader.has("condition") == reader.has("conditions")) {
-    fail(source, reader.pointer("condition"), "give either \"condition\" or \"conditions\"");
+    json_detail::fail(source, reader.pointer("condition"), "give either \"condition\" or \"conditions\"");
   }
   if (reader.has("condition")) {
     return {condition_name(reader.required("condition"), reader.pointer("condition"), source, defined)};
   }
   const json& listed = reader.required("conditions");
   if (!listed.is_array() || listed.empty()) {
-    fail(source, reader.pointer("conditions"), "expected a list of condition names, got " + describe(listed));
+    json_detail::fail(source, reader.pointer("conditions"),
+                      "expected a list of condition names, got " + json_detail::describe(listed));
   }
   std::vector<std::string> names;
   for (std::size_t i = 0; i < listed.size(); ++i) {
-    const std::string at = child_pointer(reader.pointer("conditions"), i);
+    const std::string at = json_detail::child_pointer(reader.pointer("conditions"), i);
     std::string name = condition_name(listed[i], at, source, defined);
     if (std::find(names.begin(), names.end(), name) != names.end()) {
-      fail(source, at, "the condition \"" + name + "\" is listed twice");
+      json_detail::fail(source, at, "the condition \"" + name + "\" is listed twice");
     }
     names.push_back(std::move(name));
   }
@@ -43,7 +45,7 @@ std::vector<std::string> read_conditions(ObjectReader& reader, const std::vector
 }
 
 // "characters": a list of strings, or {"choose": N, "from": [...]} (transfer only).
-void read_characters(ObjectReader& reader, ProtocolPhase& phase) {
+void read_characters(json_detail::ObjectReader& reader, ProtocolPhase& phase) {
   const std::string& source = reader.source();
   const json& value = reader.required("characters");
   const std::string at = reader.pointer("characters");
@@ -52,31 +54,33 @@ void read_characters(ObjectReader& reader, ProtocolPhase& phase) {
     return;
   }
   if (phase.kind != StudyPhase::transfer) {
-    fail(source, at, "only a transfer phase chooses its characters; expected a list of strings");
+    json_detail::fail(source, at, "only a transfer phase chooses its characters; expected a list of strings");
   }
-  ObjectReader choice(value, at, source);
+  json_detail::ObjectReader choice(value, at, source);
   TransferChoice chosen;
   chosen.count = static_cast<std::size_t>(choice.integer("choose", 1, static_cast<std::int64_t>(kMaxItems)));
   chosen.candidates = read_items(choice.required("from"), choice.pointer("from"), source);
   for (std::size_t i = 0; i < chosen.candidates.size(); ++i) {
     if (chosen.candidates[i].size() != 1) {
-      fail(source, child_pointer(choice.pointer("from"), i), "expected one character per candidate");
+      json_detail::fail(source, json_detail::child_pointer(choice.pointer("from"), i),
+                        "expected one character per candidate");
     }
   }
   if (chosen.count > chosen.candidates.size()) {
-    fail(source, choice.pointer("choose"),
-         "more characters to choose (" + std::to_string(chosen.count) + ") than candidates (" +
-             std::to_string(chosen.candidates.size()) + ")");
+    json_detail::fail(source, choice.pointer("choose"),
+                      "more characters to choose (" + std::to_string(chosen.count) + ") than candidates (" +
+                          std::to_string(chosen.candidates.size()) + ")");
   }
   choice.finish();
   phase.choice = std::move(chosen);
 }
 
 // "characters" or "sets" (names of the protocol's item sets), exactly one of them.
-void read_phase_items(ObjectReader& reader, const StudyProtocol& protocol, ProtocolPhase& phase) {
+void read_phase_items(json_detail::ObjectReader& reader, const StudyProtocol& protocol,
+                      ProtocolPhase& phase) {
   if (reader.has("characters") == reader.has("sets")) {
-    fail(reader.source(), reader.pointer("characters"),
-         "give either \"characters\" or \"sets\" (names of the protocol's \"item_sets\")");
+    json_detail::fail(reader.source(), reader.pointer("characters"),
+                      "give either \"characters\" or \"sets\" (names of the protocol's \"item_sets\")");
   }
   if (reader.has("characters")) {
     read_characters(reader, phase);
@@ -87,40 +91,45 @@ void read_phase_items(ObjectReader& reader, const StudyProtocol& protocol, Proto
 
 // A crossover phase trains each of its conditions on another of its sets: one set per condition, each a set
 // that is trained (not a transfer set), once in a protocol, so that an item has one training condition.
-void check_crossover(const ObjectReader& reader, const StudyProtocol& protocol, const ProtocolPhase& phase) {
+void check_crossover(const json_detail::ObjectReader& reader, const StudyProtocol& protocol,
+                     const ProtocolPhase& phase) {
   const std::string& source = reader.source();
   const std::string at = reader.pointer("assignment");
   if (phase.kind == StudyPhase::practice) {
-    fail(source, at, "a practice phase is written as listed: crossover is for the phases compared");
+    json_detail::fail(source, at,
+                      "a practice phase is written as listed: crossover is for the phases compared");
   }
-  if (phase.conditions.size() < 2) fail(source, at, "crossover needs two or more \"conditions\"");
+  if (phase.conditions.size() < 2)
+    json_detail::fail(source, at, "crossover needs two or more \"conditions\"");
   if (phase.sets.empty()) {
-    fail(source, at, "crossover needs \"sets\": one item set per condition, each trained under one of them");
+    json_detail::fail(source, at,
+                      "crossover needs \"sets\": one item set per condition, each trained under one of them");
   }
   if (phase.sets.size() != phase.conditions.size()) {
-    fail(source, reader.pointer("sets"),
-         "crossover trains each of the " + std::to_string(phase.conditions.size()) +
-             " conditions on its own set: expected " + std::to_string(phase.conditions.size()) +
-             " sets, got " + std::to_string(phase.sets.size()));
+    json_detail::fail(source, reader.pointer("sets"),
+                      "crossover trains each of the " + std::to_string(phase.conditions.size()) +
+                          " conditions on its own set: expected " + std::to_string(phase.conditions.size()) +
+                          " sets, got " + std::to_string(phase.sets.size()));
   }
   for (std::size_t i = 0; i < phase.sets.size(); ++i) {
     const ItemSet* set = protocol.item_set(phase.sets[i]);
     if (set != nullptr && !set->transfer_of.empty()) {
-      fail(source, child_pointer(reader.pointer("sets"), i),
-           "\"" + set->name + "\" is a transfer set (of \"" + set->transfer_of +
-               "\"): its items are tested, not trained");
+      json_detail::fail(source, json_detail::child_pointer(reader.pointer("sets"), i),
+                        "\"" + set->name + "\" is a transfer set (of \"" + set->transfer_of +
+                            "\"): its items are tested, not trained");
     }
   }
   if (const ProtocolPhase* first = protocol.crossover_phase()) {
-    fail(source, at,
-         "a second crossover phase (the first: " + first->pointer +
-             "): a protocol has at most one, so that each item set is trained under one condition");
+    json_detail::fail(
+        source, at,
+        "a second crossover phase (the first: " + first->pointer +
+            "): a protocol has at most one, so that each item set is trained under one condition");
   }
 }
 
 ProtocolPhase read_phase(const json& value, const std::string& pointer, const std::string& source,
                          const StudyProtocol& protocol) {
-  ObjectReader reader(value, pointer, source);
+  json_detail::ObjectReader reader(value, pointer, source);
   ProtocolPhase phase;
   phase.pointer = pointer;
   phase.kind = choice(reader, "phase", kStudyPhases);
@@ -130,7 +139,8 @@ ProtocolPhase read_phase(const json& value, const std::string& pointer, const st
                                                             ConditionAssignment::crossover};
   phase.assignment = choice(reader, "assignment", kAssignments, ConditionAssignment::within_subjects);
   if (phase.assignment == ConditionAssignment::between_subjects && phase.conditions.size() < 2) {
-    fail(source, reader.pointer("assignment"), "between-subjects needs two or more \"conditions\"");
+    json_detail::fail(source, reader.pointer("assignment"),
+                      "between-subjects needs two or more \"conditions\"");
   }
   read_phase_items(reader, protocol, phase);
   if (phase.assignment == ConditionAssignment::crossover) check_crossover(reader, protocol, phase);
@@ -142,9 +152,10 @@ ProtocolPhase read_phase(const json& value, const std::string& pointer, const st
   const bool ordered = phase.assignment == ConditionAssignment::within_subjects &&
                        protocol.condition_order == ConditionOrder::abba;
   if (ordered && phase.repetitions % 2 != 0) {
-    fail(source, reader.pointer("repetitions"),
-         "order \"abba\" splits each condition's repetitions over two blocks: expected an even number, got " +
-             std::to_string(phase.repetitions));
+    json_detail::fail(
+        source, reader.pointer("repetitions"),
+        "order \"abba\" splits each condition's repetitions over two blocks: expected an even number, got " +
+            std::to_string(phase.repetitions));
   }
   return phase;
 }
@@ -159,7 +170,7 @@ bool shares_a_character(const std::u32string& item, const std::u32string& charac
 void check_design(const StudyProtocol& protocol, const std::string& pointer, const std::string& source) {
   const auto& phases = protocol.phases;
   const auto at = [&](std::size_t i, const std::string& key) {
-    return child_pointer(child_pointer(pointer, i), key);
+    return json_detail::child_pointer(json_detail::child_pointer(pointer, i), key);
   };
   const auto first_training = std::find_if(
       phases.begin(), phases.end(), [](const ProtocolPhase& p) { return p.kind == StudyPhase::training; });
@@ -169,34 +180,36 @@ void check_design(const StudyProtocol& protocol, const std::string& pointer, con
     const ProtocolPhase& phase = phases[i];
     const int previous_session = i == 0 ? 1 : phases[i - 1].session;
     if (phase.session != previous_session && phase.session != previous_session + 1) {
-      fail(source, at(i, "session"),
-           "expected session " + std::to_string(previous_session) + " or " +
-               std::to_string(previous_session + 1) +
-               " (phases in order, sessions numbered from 1 without gaps), got " +
-               std::to_string(phase.session));
+      json_detail::fail(source, at(i, "session"),
+                        "expected session " + std::to_string(previous_session) + " or " +
+                            std::to_string(previous_session + 1) +
+                            " (phases in order, sessions numbered from 1 without gaps), got " +
+                            std::to_string(phase.session));
     }
     const char* name = to_string(phase.kind);
     if (phase.kind == StudyPhase::pre_test && i > training) {
-      fail(source, at(i, "phase"), "a pre-test comes before the training");
+      json_detail::fail(source, at(i, "phase"), "a pre-test comes before the training");
     }
     const bool after_training = phase.kind == StudyPhase::post_test || phase.kind == StudyPhase::retention ||
                                 phase.kind == StudyPhase::transfer;
     const std::string test =
         phase.kind == StudyPhase::post_test ? std::string("a post-test") : std::string("a ") + name + " test";
     if (after_training && training == phases.size()) {
-      fail(source, at(i, "phase"), test + " needs a training phase before it");
+      json_detail::fail(source, at(i, "phase"), test + " needs a training phase before it");
     }
-    if (after_training && i < training) fail(source, at(i, "phase"), test + " comes after the training");
+    if (after_training && i < training)
+      json_detail::fail(source, at(i, "phase"), test + " comes after the training");
     if (phase.kind == StudyPhase::retention) {
       if (!(phase.delay_s > 0.0)) {
-        fail(source, at(i, "delay_s"), "a retention test comes after a stated delay: expected delay_s > 0");
+        json_detail::fail(source, at(i, "delay_s"),
+                          "a retention test comes after a stated delay: expected delay_s > 0");
       }
       for (std::size_t k = 0; k < phase.items.size(); ++k) {
         for (const char32_t c : phase.items[k]) {
           if (trained.find(c) != std::u32string::npos) continue;
           // Appended, not concatenated: GCC 12 warns falsely on "x" + string (-Wrestrict).
-          fail(source, item_pointer(protocol, phase, k),
-               in_quotes(encode_utf8(c)) + " is not trained: a test on it is a transfer test");
+          json_detail::fail(source, item_pointer(protocol, phase, k),
+                            in_quotes(encode_utf8(c)) + " is not trained: a test on it is a transfer test");
         }
       }
     }
@@ -204,10 +217,12 @@ void check_design(const StudyProtocol& protocol, const std::string& pointer, con
       const std::vector<std::u32string>& listed = phase.choice ? phase.choice->candidates : phase.items;
       for (std::size_t k = 0; k < listed.size(); ++k) {
         if (!shares_a_character(listed[k], trained)) continue;
-        fail(source,
-             phase.choice ? child_pointer(child_pointer(at(i, "characters"), "from"), k)
-                          : item_pointer(protocol, phase, k),
-             in_quotes(encode_utf8(listed[k])) + " is trained: a transfer test is on characters not trained");
+        json_detail::fail(
+            source,
+            phase.choice
+                ? json_detail::child_pointer(json_detail::child_pointer(at(i, "characters"), "from"), k)
+                : item_pointer(protocol, phase, k),
+            in_quotes(encode_utf8(listed[k])) + " is trained: a transfer test is on characters not trained");
       }
     }
   }
@@ -218,15 +233,17 @@ void check_design(const StudyProtocol& protocol, const std::string& pointer, con
 void read_phases(const json& value, const std::string& pointer, const std::string& source,
                  StudyProtocol& protocol) {
   if (!value.is_array() || value.empty() || value.size() > kMaxPhases) {
-    fail(source, pointer,
-         "expected a list of 1 to " + std::to_string(kMaxPhases) + " phases, got " + describe(value));
+    json_detail::fail(source, pointer,
+                      "expected a list of 1 to " + std::to_string(kMaxPhases) + " phases, got " +
+                          json_detail::describe(value));
   }
   for (std::size_t i = 0; i < value.size(); ++i) {
-    protocol.phases.push_back(read_phase(value[i], child_pointer(pointer, i), source, protocol));
+    protocol.phases.push_back(read_phase(value[i], json_detail::child_pointer(pointer, i), source, protocol));
   }
   if (protocol.phases.front().session != 1) {
-    fail(source, child_pointer(child_pointer(pointer, std::size_t{0}), "session"),
-         "the first phase is in session 1");
+    json_detail::fail(
+        source, json_detail::child_pointer(json_detail::child_pointer(pointer, std::size_t{0}), "session"),
+        "the first phase is in session 1");
   }
   check_design(protocol, pointer, source);
 }

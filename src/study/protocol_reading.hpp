@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "calligraphy/study/protocol.hpp"
-#include "study/json_reader.hpp"
+#include "core/json_reader.hpp"
 
 namespace calligraphy::study_detail {
 
@@ -37,25 +37,26 @@ inline constexpr std::array<ConditionMode, 9> kConditionModes{ConditionMode::vis
 template <typename Enum, std::size_t N>
 Enum choice_of(const nlohmann::json& value, const std::string& pointer, const std::string& source,
                const std::array<Enum, N>& values) {
-  const std::string text = as_string(value, pointer, source);
+  const std::string text = json_detail::as_string(value, pointer, source);
   std::string names;
   for (const Enum candidate : values) {
     if (text == to_string(candidate)) return candidate;
     names += (names.empty() ? "" : ", ") + std::string(to_string(candidate));
   }
-  fail(source, pointer, "expected one of " + names + "; got \"" + text + "\"");
+  json_detail::fail(source, pointer, "expected one of " + names + "; got \"" + text + "\"");
 }
 
 /// Member `key` as `choice_of`; `fallback` when it is missing.
 template <typename Enum, std::size_t N>
-Enum choice(ObjectReader& reader, const std::string& key, const std::array<Enum, N>& values, Enum fallback) {
+Enum choice(json_detail::ObjectReader& reader, const std::string& key, const std::array<Enum, N>& values,
+            Enum fallback) {
   const nlohmann::json* value = reader.optional(key);
   return value ? choice_of(*value, reader.pointer(key), reader.source(), values) : fallback;
 }
 
 /// Member `key` as `choice_of`; DataError naming it when it is missing.
 template <typename Enum, std::size_t N>
-Enum choice(ObjectReader& reader, const std::string& key, const std::array<Enum, N>& values) {
+Enum choice(json_detail::ObjectReader& reader, const std::string& key, const std::array<Enum, N>& values) {
   return choice_of(reader.required(key), reader.pointer(key), reader.source(), values);
 }
 

@@ -12,8 +12,8 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/session_folder.hpp"
+#include "core/json_reader.hpp"
 #include "core/whole_file.hpp"
-#include "study/json_reader.hpp"
 #include "study/parameter_json.hpp"
 #include "study/recorded_trial_object.hpp"
 #include "study/saved_sessions.hpp"
@@ -24,7 +24,6 @@ namespace calligraphy {
 namespace {
 
 using nlohmann::json;
-using study_detail::ObjectReader;
 
 // The nearest-point search has no parameter table of its own (it lives below the force law); its methods by
 // name.
@@ -42,11 +41,11 @@ json guidance_law_json(const GuidanceLaw& law) {
   return out;
 }
 
-GuidanceLaw read_guidance_law(ObjectReader reader) {
+GuidanceLaw read_guidance_law(json_detail::ObjectReader reader) {
   const std::string name = reader.string("mode");
   const std::optional<GuidanceMode> mode = guidance_mode_from_string(name);
   if (!mode)
-    study_detail::fail(reader.source(), reader.pointer("mode"), "unknown guidance mode '" + name + "'");
+    json_detail::fail(reader.source(), reader.pointer("mode"), "unknown guidance mode '" + name + "'");
   GuidanceLaw law = default_guidance_law(*mode);
   std::visit([&reader](auto& alternative) { study_detail::take_parameters(reader, alternative); }, law);
   reader.finish();
@@ -70,21 +69,22 @@ json force_law_json(const ForceLawParameters& f) {
   return out;
 }
 
-ForceLawParameters read_force_law(ObjectReader reader) {
+ForceLawParameters read_force_law(json_detail::ObjectReader reader) {
   ForceLawParameters f;
   study_detail::take_parameters(reader, f);
   const json* guidance = &reader.required("guidance");
   if (!guidance->is_boolean()) {
-    study_detail::fail(reader.source(), reader.pointer("guidance"),
-                       "expected true or false, got " + study_detail::describe(*guidance));
+    json_detail::fail(reader.source(), reader.pointer("guidance"),
+                      "expected true or false, got " + json_detail::describe(*guidance));
   }
   f.guidance = guidance->get<bool>();
-  f.guidance_law = read_guidance_law(
-      ObjectReader(reader.required("guidance_law"), reader.pointer("guidance_law"), reader.source()));
-  ObjectReader acceptance(reader.required("acceptance"), reader.pointer("acceptance"), reader.source());
+  f.guidance_law = read_guidance_law(json_detail::ObjectReader(
+      reader.required("guidance_law"), reader.pointer("guidance_law"), reader.source()));
+  json_detail::ObjectReader acceptance(reader.required("acceptance"), reader.pointer("acceptance"),
+                                       reader.source());
   study_detail::take_parameters(acceptance, f.acceptance);
   acceptance.finish();
-  ObjectReader nearest(reader.required("nearest"), reader.pointer("nearest"), reader.source());
+  json_detail::ObjectReader nearest(reader.required("nearest"), reader.pointer("nearest"), reader.source());
   const std::string method = nearest.string("method");
   bool known = false;
   for (const auto& [name, value] : kNearestMethods) {
@@ -94,7 +94,7 @@ ForceLawParameters read_force_law(ObjectReader reader) {
     }
   }
   if (!known)
-    study_detail::fail(reader.source(), nearest.pointer("method"), "unknown method '" + method + "'");
+    json_detail::fail(reader.source(), nearest.pointer("method"), "unknown method '" + method + "'");
   f.nearest.tolerance = nearest.number("tolerance", -kLargest, kLargest);
   f.nearest.newton_starts = static_cast<int>(nearest.integer("newton_starts", 1, 1000));
   f.nearest.newton_iterations = static_cast<int>(nearest.integer("newton_iterations", 1, 1000));
@@ -109,7 +109,7 @@ json writer_json(const WriterProfile& w) {
   return out;
 }
 
-WriterProfile read_writer(ObjectReader reader) {
+WriterProfile read_writer(json_detail::ObjectReader reader) {
   WriterProfile w;
   w.name = reader.string("name");
   for (const std::string& key : writer_parameter_names()) {
@@ -117,7 +117,7 @@ WriterProfile read_writer(ObjectReader reader) {
     try {
       set_writer_parameter(w, key, value);  // the profile's own ranges (per field)
     } catch (const InvalidArgument& e) {
-      study_detail::fail(reader.source(), reader.pointer(key), e.what());
+      json_detail::fail(reader.source(), reader.pointer(key), e.what());
     }
   }
   reader.finish();
@@ -126,19 +126,19 @@ WriterProfile read_writer(ObjectReader reader) {
 
 json vec3_json(const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
 
-Vec3 read_vec3(ObjectReader& reader, const std::string& key) {
+Vec3 read_vec3(json_detail::ObjectReader& reader, const std::string& key) {
   const json& value = reader.required(key);
   if (!value.is_array() || value.size() != 3)
-    study_detail::fail(reader.source(), reader.pointer(key), "expected [x, y, z] in metres");
+    json_detail::fail(reader.source(), reader.pointer(key), "expected [x, y, z] in metres");
   Vec3 v;
   for (std::size_t i = 0; i < 3; ++i) {
-    v[static_cast<Eigen::Index>(i)] = study_detail::as_number(
-        value[i], study_detail::child_pointer(reader.pointer(key), i), reader.source(), -kLargest, kLargest);
+    v[static_cast<Eigen::Index>(i)] = json_detail::as_number(
+        value[i], json_detail::child_pointer(reader.pointer(key), i), reader.source(), -kLargest, kLargest);
   }
   return v;
 }
 
-SimulatedDeviceParameters read_simulated_device(ObjectReader reader) {
+SimulatedDeviceParameters read_simulated_device(json_detail::ObjectReader reader) {
   SimulatedDeviceParameters p;
   p.moving_mass_kg = reader.number("moving_mass_kg", -kLargest, kLargest);
   p.damping_n_s_per_m = reader.number("damping_n_s_per_m", -kLargest, kLargest);
@@ -161,18 +161,18 @@ json layout_json(const SceneLayout& l) {
           {"start_radius_m", l.start_radius_m}};
 }
 
-SceneLayout read_layout(ObjectReader reader) {
+SceneLayout read_layout(json_detail::ObjectReader reader) {
   SceneLayout l;
   l.character_size_m = reader.number("character_size_m", 0.0, kLargest);
   l.spacing_m = reader.number("spacing_m", 0.0, kLargest);
   const json& centre = reader.required("centre_m");
   if (!centre.is_array() || centre.size() != 2) {
-    study_detail::fail(reader.source(), reader.pointer("centre_m"), "expected [x, y] in metres");
+    json_detail::fail(reader.source(), reader.pointer("centre_m"), "expected [x, y] in metres");
   }
   for (std::size_t i = 0; i < 2; ++i) {
     l.centre_m[static_cast<Eigen::Index>(i)] =
-        study_detail::as_number(centre[i], study_detail::child_pointer(reader.pointer("centre_m"), i),
-                                reader.source(), -kLargest, kLargest);
+        json_detail::as_number(centre[i], json_detail::child_pointer(reader.pointer("centre_m"), i),
+                               reader.source(), -kLargest, kLargest);
   }
   l.paper_z_m = reader.number("paper_z_m", -kLargest, kLargest);
   l.box_margin_m = reader.number("box_margin_m", 0.0, kLargest);
@@ -187,7 +187,7 @@ void checked(const std::string& source, const std::string& pointer, Check&& chec
   try {
     check();
   } catch (const InvalidArgument& e) {
-    study_detail::fail(source, pointer, e.what());
+    json_detail::fail(source, pointer, e.what());
   }
 }
 
@@ -295,25 +295,25 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
   } else if (!is_specification) {
     const bool has_format =
         document.is_object() && document.contains("format") && document["format"].is_string();
-    study_detail::fail(
+    json_detail::fail(
         source, "/",
         "no trial specification" +
             (has_format ? " (format '" + document["format"].get<std::string>() + "')" : std::string()) +
             ": a record written before records held one (\"specification\"), or not a trial record");
   }
   if (object->is_null())
-    study_detail::fail(source, at.empty() ? "/" : at, "the record holds no specification");
-  ObjectReader reader(*object, at, source);
+    json_detail::fail(source, at.empty() ? "/" : at, "the record holds no specification");
+  json_detail::ObjectReader reader(*object, at, source);
   const std::string format = reader.string("format");
   if (format != kRecordedTrialFormat) {
-    study_detail::fail(source, reader.pointer("format"),
-                       "format '" + format + "' is not '" + std::string(kRecordedTrialFormat) + "'");
+    json_detail::fail(source, reader.pointer("format"),
+                      "format '" + format + "' is not '" + std::string(kRecordedTrialFormat) + "'");
   }
   const std::int64_t version = reader.integer("version", 0, std::numeric_limits<std::int64_t>::max());
   if (version != kRecordedTrialVersion) {
-    study_detail::fail(source, reader.pointer("version"),
-                       "version " + std::to_string(version) + " is not " +
-                           std::to_string(kRecordedTrialVersion) + ", the one this library reads");
+    json_detail::fail(source, reader.pointer("version"),
+                      "version " + std::to_string(version) + " is not " +
+                          std::to_string(kRecordedTrialVersion) + ", the one this library reads");
   }
   RecordedTrial r;
   // The specification's own reader checks its fields (trial_spec.hpp); its pointers are prefixed here.
@@ -325,10 +325,10 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
     r.spec = *study_detail::trial_spec_from_object(
         trial, reader.pointer("trial"), source, teacher_named ? TeacherSource::file : TeacherSource::samples);
   } catch (const InvalidArgument& e) {
-    study_detail::fail(source, reader.pointer("trial"), e.what());
+    json_detail::fail(source, reader.pointer("trial"), e.what());
   }
-  r.force_law =
-      read_force_law(ObjectReader(reader.required("force_law"), reader.pointer("force_law"), source));
+  r.force_law = read_force_law(
+      json_detail::ObjectReader(reader.required("force_law"), reader.pointer("force_law"), source));
   checked(source, reader.pointer("force_law"), [&] {
     // A replay's teacher is not in the record (the run is given it, and checks it then): its law's own
     // values are checked here with a stand-in trajectory of two samples.
@@ -343,27 +343,28 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
     }
   });
   {
-    ObjectReader safety(reader.required("safety"), reader.pointer("safety"), source);
+    json_detail::ObjectReader safety(reader.required("safety"), reader.pointer("safety"), source);
     study_detail::take_parameters(safety, r.safety);
     safety.finish();
     checked(source, reader.pointer("safety"), [&] { r.safety.validate(); });
   }
   {
-    ObjectReader passivity(reader.required("passivity"), reader.pointer("passivity"), source);
+    json_detail::ObjectReader passivity(reader.required("passivity"), reader.pointer("passivity"), source);
     r.passivity.enabled = passivity.boolean_or("enabled", false);
     study_detail::take_parameters(passivity, r.passivity);
     passivity.finish();
     checked(source, reader.pointer("passivity"), [&] { r.passivity.validate(); });
   }
   if (const json* writer = reader.optional("writer"))
-    r.writer = read_writer(ObjectReader(*writer, reader.pointer("writer"), source));
+    r.writer = read_writer(json_detail::ObjectReader(*writer, reader.pointer("writer"), source));
   if (const json* device = reader.optional("simulated_device")) {
     r.simulated_device =
-        read_simulated_device(ObjectReader(*device, reader.pointer("simulated_device"), source));
+        read_simulated_device(json_detail::ObjectReader(*device, reader.pointer("simulated_device"), source));
     checked(source, reader.pointer("simulated_device"), [&] { r.simulated_device->validate(); });
   }
-  ObjectReader scene(reader.required("scene"), reader.pointer("scene"), source);
-  r.layout = read_layout(ObjectReader(scene.required("layout"), scene.pointer("layout"), source));
+  json_detail::ObjectReader scene(reader.required("scene"), reader.pointer("scene"), source);
+  r.layout =
+      read_layout(json_detail::ObjectReader(scene.required("layout"), scene.pointer("layout"), source));
   r.scene_sha256 = scene.string("sha256");
   scene.finish();
   r.library_version = reader.string_or("library_version", "");
@@ -374,12 +375,11 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
 }  // namespace
 
 RecordedTrial read_recorded_trial(std::string_view text, const std::string& source) {
-  return read_recorded_document(study_detail::parse_json(text, source), source);
+  return read_recorded_document(json_detail::parse_json(text, source), source);
 }
 
 RecordedTrial read_recorded_trial_file(const std::string& path) {
-  const json document =
-      study_detail::parse_json(read_regular_file(path, study_detail::kMaxRecordBytes), path);
+  const json document = json_detail::parse_json(read_regular_file(path, study_detail::kMaxRecordBytes), path);
   RecordedTrial recorded = read_recorded_document(document, path);
   if (recorded.spec.guidance && recorded.spec.guidance_mode == GuidanceMode::replay &&
       recorded.spec.teacher.empty()) {

@@ -5,9 +5,9 @@
 #include <optional>
 
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/study/guidance_share.hpp"
 #include "calligraphy/core/unicode.hpp"
-#include "study/json_reader.hpp"
+#include "calligraphy/study/guidance_share.hpp"
+#include "core/json_reader.hpp"
 #include "study/saved_sessions.hpp"
 
 namespace calligraphy::study_detail {
@@ -59,32 +59,35 @@ std::vector<WriterSetting> individual_parameters(const SessionSetup& setup) {
 
 void practise_record(WriterMemory& memory, const json& document, const std::string& source,
                      const TwoStateRates& rates) {
-  const JsonView record(document, "", source);
+  const json_detail::JsonView record(document, "", source);
   std::vector<int> ids;
   std::u32string characters;
-  const JsonView placed = record.object("scene").array("characters");
+  const json_detail::JsonView placed = record.object("scene").array("characters");
   for (std::size_t c = 0; c < placed.size(); ++c) {
-    const JsonView character = placed.object_at(c);
+    const json_detail::JsonView character = placed.object_at(c);
     const std::u32string decoded = decode_utf8(character.string_or("character", ""));
-    if (decoded.size() != 1) fail(source, character.pointer() + "/character", "expected one character");
+    if (decoded.size() != 1)
+      json_detail::fail(source, character.pointer() + "/character", "expected one character");
     characters += decoded;
-    const JsonView strokes = character.array("strokes");
+    const json_detail::JsonView strokes = character.array("strokes");
     for (std::size_t s = 0; s < strokes.size(); ++s)
       ids.push_back(static_cast<int>(strokes.object_at(s).integer_or("typical_id", 0, 0, 39)));
   }
-  if (ids.empty()) fail(source, "/scene", "no strokes: the trial's characters are not recorded");
-  const JsonView force_law = record.object("force_law");
+  if (ids.empty()) json_detail::fail(source, "/scene", "no strokes: the trial's characters are not recorded");
+  const json_detail::JsonView force_law = record.object("force_law");
   AssistanceShares shares;
   if (force_law.boolean_or("guidance", false)) {
     const double hand =
         record.object("writer").object("profile").number_or("hand_stiffness_n_per_m", 0.0, -1e12, 1e12);
     if (!(hand > 0.0))
-      fail(source, "/writer/profile/hand_stiffness_n_per_m", "expected the hand's stiffness > 0");
+      json_detail::fail(source, "/writer/profile/hand_stiffness_n_per_m",
+                        "expected the hand's stiffness > 0");
     // The mode's parameters as recorded (records from before a mode existed hold the defaults).
     ForceLawParameters force;
     const std::string mode = force_law.string_or("guidance_mode", "fixed");
     const std::optional<GuidanceMode> parsed = guidance_mode_from_string(mode);
-    if (!parsed) fail(source, "/force_law/guidance_mode", "unknown guidance mode \"" + mode + "\"");
+    if (!parsed)
+      json_detail::fail(source, "/force_law/guidance_mode", "unknown guidance mode \"" + mode + "\"");
     constexpr double kLimit = 1e12;  // far beyond any parameter; the force law's validation bounds each
     const auto number = [&](const char* key, double fallback) {
       return force_law.number_or(key, fallback, -kLimit, kLimit);
@@ -121,7 +124,7 @@ void practise_record(WriterMemory& memory, const json& document, const std::stri
     try {
       shares = guidance_shares(force, hand, deviation_m);
     } catch (const InvalidArgument& e) {
-      fail(source, "/force_law", e.what());
+      json_detail::fail(source, "/force_law", e.what());
     }
   }
   practise(memory, ids, characters, shares, rates);

@@ -1,7 +1,7 @@
 #include "study/saved_sessions.hpp"
 
 #include "calligraphy/core/errors.hpp"
-#include "study/json_reader.hpp"
+#include "core/json_reader.hpp"
 #include "study/manifest_json.hpp"
 #include "study/names.hpp"
 
@@ -41,10 +41,11 @@ SessionManifest read_previous_session(const fs::path& folder, const SessionManif
   const fs::path path = SessionLayout::manifest(before);
   const std::string text = read_small_file(path, kMaxSessionManifestBytes, "session manifest");
   if (!link.session_sha256.empty() && sha256_hex(text) != link.session_sha256) {
-    fail((SessionLayout::manifest(folder)).string(), "/previous_session/session_sha256",
-         path.string() +
-             " is not the session this one follows (its SHA-256 differs: replaced or edited?): restore the "
-             "original folder");
+    json_detail::fail(
+        (SessionLayout::manifest(folder)).string(), "/previous_session/session_sha256",
+        path.string() +
+            " is not the session this one follows (its SHA-256 differs: replaced or edited?): restore the "
+            "original folder");
   }
   SessionManifest previous = manifest_from_json(text, path.string());
   previous.session_id = before.filename().string();
@@ -72,20 +73,20 @@ bool DistinctSessions::add(const fs::path& folder, const SessionManifest& manife
 nlohmann::json read_trial_record(const fs::path& json_file) {
   const std::string source = json_file.string();
   nlohmann::json record =
-      parse_json(read_small_file(json_file, kMaxRecordBytes, "trial record (JSON)"), source);
+      json_detail::parse_json(read_small_file(json_file, kMaxRecordBytes, "trial record (JSON)"), source);
   if (!record.is_object() || !record.contains("format") || record["format"] != kTrialRecordFormat) {
-    fail(source, "/format", std::string("expected \"") + kTrialRecordFormat + "\"");
+    json_detail::fail(source, "/format", std::string("expected \"") + kTrialRecordFormat + "\"");
   }
   const auto version = record.find("version");
   if (version == record.end() || !version->is_number_integer() || version->get<std::int64_t>() < 1 ||
       version->get<std::int64_t>() > kTrialRecordVersion) {
-    fail(source, "/version",
-         "expected a trial record version from 1 to " + std::to_string(kTrialRecordVersion) + ", got " +
-             (version == record.end() ? std::string("none") : version->dump()) +
-             (version != record.end() && version->is_number_integer() &&
-                      version->get<std::int64_t>() > kTrialRecordVersion
-                  ? " (written by a newer calligraphy: read it with that version)"
-                  : ""));
+    json_detail::fail(source, "/version",
+                      "expected a trial record version from 1 to " + std::to_string(kTrialRecordVersion) +
+                          ", got " + (version == record.end() ? std::string("none") : version->dump()) +
+                          (version != record.end() && version->is_number_integer() &&
+                                   version->get<std::int64_t>() > kTrialRecordVersion
+                               ? " (written by a newer calligraphy: read it with that version)"
+                               : ""));
   }
   return record;
 }

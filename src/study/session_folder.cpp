@@ -22,8 +22,8 @@
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/trial/options.hpp"
+#include "core/json_reader.hpp"
 #include "report/compressed_text.hpp"
-#include "study/json_reader.hpp"
 #include "study/manifest_json.hpp"
 #include "study/names.hpp"
 

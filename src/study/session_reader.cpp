@@ -10,7 +10,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/report/pen_trace_csv.hpp"
-#include "study/json_reader.hpp"
+#include "core/json_reader.hpp"
 #include "study/names.hpp"
 #include "study/saved_sessions.hpp"
 #include "study/trial_row.hpp"
@@ -20,42 +20,42 @@ namespace fs = std::filesystem;
 namespace {
 
 using nlohmann::json;
-using study_detail::fail;
-using study_detail::ObjectReader;
 
-Vec2 vec2(const study_detail::JsonView& value) {
-  if (!value.json().is_array() || value.size() < 2) fail(value.source(), value.pointer(), "expected [x, y]");
-  return {study_detail::as_number(value.json()[0], value.pointer() + "/0", value.source(), -1e6, 1e6),
-          study_detail::as_number(value.json()[1], value.pointer() + "/1", value.source(), -1e6, 1e6)};
+Vec2 vec2(const json_detail::JsonView& value) {
+  if (!value.json().is_array() || value.size() < 2)
+    json_detail::fail(value.source(), value.pointer(), "expected [x, y]");
+  return {json_detail::as_number(value.json()[0], value.pointer() + "/0", value.source(), -1e6, 1e6),
+          json_detail::as_number(value.json()[1], value.pointer() + "/1", value.source(), -1e6, 1e6)};
 }
 
 // The reference strokes and start points from the record's scene.
-void read_scene(const study_detail::JsonView& record, ReportTrial& trial) {
-  if (!record.object("scene").has("characters")) fail(record.source(), "/scene", "missing (required)");
-  const study_detail::JsonView characters = record.object("scene").array("characters");
+void read_scene(const json_detail::JsonView& record, ReportTrial& trial) {
+  if (!record.object("scene").has("characters"))
+    json_detail::fail(record.source(), "/scene", "missing (required)");
+  const json_detail::JsonView characters = record.object("scene").array("characters");
   for (std::size_t c = 0; c < characters.size(); ++c) {
-    const study_detail::JsonView strokes = characters.object_at(c).array("strokes");
+    const json_detail::JsonView strokes = characters.object_at(c).array("strokes");
     for (std::size_t s = 0; s < strokes.size(); ++s) {
-      const study_detail::JsonView stroke = strokes.object_at(s);
+      const json_detail::JsonView stroke = strokes.object_at(s);
       std::vector<Vec2> polyline;
-      const study_detail::JsonView points = stroke.array("polyline_m");
+      const json_detail::JsonView points = stroke.array("polyline_m");
       for (std::size_t i = 0; i < points.size(); ++i) polyline.push_back(vec2(points.at(i)));
       trial.reference_m.push_back(std::move(polyline));
       trial.stroke_starts_m.push_back(
-          vec2(study_detail::JsonView(stroke.has("start_m") ? stroke.json()["start_m"] : json(),
-                                      stroke.pointer() + "/start_m", stroke.source())));
+          vec2(json_detail::JsonView(stroke.has("start_m") ? stroke.json()["start_m"] : json(),
+                                     stroke.pointer() + "/start_m", stroke.source())));
     }
   }
 }
 
 // The name of the trace file a record names beside it: files.trace (HDF5), or files.csv in a record of an
 // older folder (gzip or plain CSV); a plain name, never a path.
-std::string trace_file_name(const study_detail::JsonView& record) {
-  const study_detail::JsonView files = record.object("files");
+std::string trace_file_name(const json_detail::JsonView& record) {
+  const json_detail::JsonView files = record.object("files");
   const char* const key = files.has("trace") ? "trace" : "csv";
   const std::string name = files.string_or(key, "");
   if (name.empty() || name.find('/') != std::string::npos || name == "." || name == "..")
-    fail(record.source(), std::string("/files/") + key, "expected a file name");
+    json_detail::fail(record.source(), std::string("/files/") + key, "expected a file name");
   return name;
 }
 
@@ -84,7 +84,7 @@ void append_trial_rows(const json& document, const fs::path& json_file, const Se
                        const PlannedTrial& plan, StudyTables& rows) {
   const std::string source = json_file.string();
   TrialRow row = study_detail::trial_row(document, source, manifest, plan, rows.strokes);
-  row.trace_file = json_file.parent_path() / trace_file_name(study_detail::JsonView(document, "", source));
+  row.trace_file = json_file.parent_path() / trace_file_name(json_detail::JsonView(document, "", source));
   rows.trials.push_back(std::move(row));
 }
 
@@ -92,7 +92,7 @@ ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifes
                        StudyTables* rows) {
   const std::string source = json_file.string();
   const json document = study_detail::read_trial_record(json_file);
-  const study_detail::JsonView record(document, "", source);
+  const json_detail::JsonView record(document, "", source);
   // the tidy tables' rows from the same parse of the record
   if (rows != nullptr) append_trial_rows(document, json_file, manifest, plan, *rows);
   ReportTrial trial;
@@ -118,9 +118,9 @@ ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifes
   if (record.has("quiz"))
     trial.quiz_misses = static_cast<int>(record.object("quiz").integer_or("misses", 0, 0, 1 << 30));
   read_scene(record, trial);
-  const study_detail::JsonView per_stroke = record.array("per_stroke");
+  const json_detail::JsonView per_stroke = record.array("per_stroke");
   for (std::size_t i = 0; i < per_stroke.size(); ++i) {
-    const study_detail::JsonView stroke = per_stroke.object_at(i);
+    const json_detail::JsonView stroke = per_stroke.object_at(i);
     const std::optional<double> start_s = stroke.optional_number("start_s", -1e12, 1e12);
     const std::optional<double> end_s = stroke.optional_number("end_s", -1e12, 1e12);
     if (!start_s || !end_s) continue;  // a stroke never written
@@ -131,8 +131,8 @@ ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifes
   try {
     read_trace(json_file.parent_path() / trace, paper_z, trial);
   } catch (const DataError& e) {  // the record names the trace: it is the record that is at fault
-    fail(source, record.object("files").has("trace") ? "/files/trace" : "/files/csv",
-         "names the trace '" + trace + "', which cannot be read: " + e.what());
+    json_detail::fail(source, record.object("files").has("trace") ? "/files/trace" : "/files/csv",
+                      "names the trace '" + trace + "', which cannot be read: " + e.what());
   }
   return trial;
 }
@@ -190,7 +190,7 @@ StudyReportSessions list_report_sessions(const std::vector<fs::path>& roots) {
     const auto [first, inserted] =
         by_name.try_emplace(manifest.protocol.protocol.name, folder, manifest.protocol);
     if (!inserted && study_detail::protocols_conflict(first->second.second, manifest.protocol)) {
-      study_detail::fail(
+      json_detail::fail(
           SessionLayout::manifest(folder).string(), "/protocol/sha256",
           "protocol '" + manifest.protocol.protocol.name + "' here has SHA-256 " + manifest.protocol.sha256 +
               ", but in " + SessionLayout::manifest(first->second.first).string() + " SHA-256 " +

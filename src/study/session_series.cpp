@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
-#include "study/json_reader.hpp"
+#include "core/json_reader.hpp"
 #include "study/names.hpp"
 #include "study/saved_sessions.hpp"
 
@@ -31,11 +31,11 @@ void check_link(const fs::path& folder, const SessionManifest& manifest, const f
   const std::string source = (SessionLayout::manifest(folder)).string();
   const PreviousSession& previous = *manifest.previous;
   if (previous.session_id != before.filename().string()) {
-    study_detail::fail(source, "/previous_session/session_id",
-                       "session " + std::to_string(number) + " follows '" + previous.session_id + "', but session " +
-                           std::to_string(number - 1) + " is " + before.string() +
-                           " (moved, renamed or copied from elsewhere?): put the session it follows back in " +
-                           folder.parent_path().string());
+    json_detail::fail(source, "/previous_session/session_id",
+                      "session " + std::to_string(number) + " follows '" + previous.session_id +
+                          "', but session " + std::to_string(number - 1) + " is " + before.string() +
+                          " (moved, renamed or copied from elsewhere?): put the session it follows back in " +
+                          folder.parent_path().string());
   }
   (void)study_detail::read_previous_session(folder, manifest);  // its content, where the link recorded it
 }
@@ -63,10 +63,10 @@ SessionSeries session_series(const fs::path& root, const std::string& subject_id
       SessionManifest manifest = study_detail::read_session_manifest(folder);
       if (manifest.protocol.sha256 != protocol.sha256) continue;
       if (manifest.setup.subject.id != subject_id) {
-        study_detail::fail((SessionLayout::manifest(folder)).string(), "/subject/id",
-                           "a session of subject '" + manifest.setup.subject.id + "' in the folder of '" +
-                               subject_id + "': move it back to " +
-                               (root / manifest.setup.subject.id).string());
+        json_detail::fail((SessionLayout::manifest(folder)).string(), "/subject/id",
+                          "a session of subject '" + manifest.setup.subject.id + "' in the folder of '" +
+                              subject_id + "': move it back to " +
+                              (root / manifest.setup.subject.id).string());
       }
       const int number = manifest.setup.session_number;
       const auto known = by_number.find(number);
@@ -109,23 +109,23 @@ SessionSeries session_series(const fs::path& root, const std::string& subject_id
     const nlohmann::json record = study_detail::read_trial_record(last_record);
     // Every saved record has its end; one without (null or missing: the run was killed as it wrote, or the
     // record was edited) gives no time to measure the delay from. The session's creation is not its end.
-    const study_detail::JsonView view(record, "", last_record.string());
+    const json_detail::JsonView view(record, "", last_record.string());
     if (!view.has("end_time_utc")) {
-      study_detail::fail(last_record.string(), "/end_time_utc",
-                         std::string(record.contains("end_time_utc") ? "null" : "missing") + ": session " +
-                             std::to_string(number) + " of " + protocol.protocol.name + " (" +
-                             folder.string() +
-                             ") did not end: its last trial has no end time, so the delay before session " +
-                             std::to_string(number + 1) +
-                             " cannot be measured; restore this trial record (a saved trial is never written "
-                             "again, so resume cannot)");
+      json_detail::fail(last_record.string(), "/end_time_utc",
+                        std::string(record.contains("end_time_utc") ? "null" : "missing") + ": session " +
+                            std::to_string(number) + " of " + protocol.protocol.name + " (" +
+                            folder.string() +
+                            ") did not end: its last trial has no end time, so the delay before session " +
+                            std::to_string(number + 1) +
+                            " cannot be measured; restore this trial record (a saved trial is never written "
+                            "again, so resume cannot)");
     }
     previous.ended_utc = view.string_or("end_time_utc", "");
     double ended_s = 0.0;
     try {
       ended_s = study_detail::utc_seconds(previous.ended_utc);
     } catch (const InvalidArgument& e) {
-      study_detail::fail(last_record.string(), "/end_time_utc", e.what());
+      json_detail::fail(last_record.string(), "/end_time_utc", e.what());
     }
     for (const ProtocolPhase& phase : protocol.protocol.phases) {
       if (phase.session == number + 1) {

@@ -12,7 +12,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/study/session_reader.hpp"
-#include "study/json_reader.hpp"
+#include "core/json_reader.hpp"
 #include "study/names.hpp"
 #include "study/trial_row.hpp"
 
@@ -21,29 +21,27 @@ namespace fs = std::filesystem;
 namespace {
 
 using nlohmann::json;
-using study_detail::fail;
-
-using study_detail::JsonView;
 
 // A record's length in mm as metres; absent when missing or null.
-std::optional<double> metres(const JsonView& object, const char* key_mm) {
+std::optional<double> metres(const json_detail::JsonView& object, const char* key_mm) {
   const std::optional<double> millimetres = object.optional_number(key_mm, -1e12, 1e12);
   return millimetres ? std::optional<double>(*millimetres * 1e-3) : std::nullopt;
 }
 
-std::size_t count(const JsonView& object, const char* key) {
-  if (!object.has(key)) fail(object.source(), object.pointer() + "/" + key, "missing (required)");
+std::size_t count(const json_detail::JsonView& object, const char* key) {
+  if (!object.has(key))
+    json_detail::fail(object.source(), object.pointer() + "/" + key, "missing (required)");
   return static_cast<std::size_t>(object.integer_or(key, 0, 0, 1LL << 40));
 }
 
 // The strokes of one character of a record: its per-stroke metrics and the verdicts of the segments the
 // matcher gave each stroke.
-void add_strokes(const JsonView& character, std::size_t index, const TrialRow& trial,
+void add_strokes(const json_detail::JsonView& character, std::size_t index, const TrialRow& trial,
                  std::vector<StrokeRow>& strokes) {
-  const JsonView per_stroke = character.array("per_stroke");
+  const json_detail::JsonView per_stroke = character.array("per_stroke");
   const std::size_t first = strokes.size();
   for (std::size_t s = 0; s < per_stroke.size(); ++s) {
-    const JsonView metrics = per_stroke.object_at(s);
+    const json_detail::JsonView metrics = per_stroke.object_at(s);
     StrokeRow row;
     row.subject = trial.subject;
     row.session = trial.session;
@@ -65,9 +63,9 @@ void add_strokes(const JsonView& character, std::size_t index, const TrialRow& t
     row.time_s = metrics.optional_number("time_s", -1e12, 1e12);
     strokes.push_back(std::move(row));
   }
-  const JsonView segments = character.array("segments");
+  const json_detail::JsonView segments = character.array("segments");
   for (std::size_t i = 0; i < segments.size(); ++i) {
-    const JsonView verdict = segments.object_at(i).object("verdict");
+    const json_detail::JsonView verdict = segments.object_at(i).object("verdict");
     if (verdict.json().empty()) continue;  // an ignored segment (a dot, a touch) has no verdict
     // The stroke the segment was written for: the one it matched, else the one expected then.
     const char* key = verdict.has("matched_stroke") ? "matched_stroke" : "expected_stroke";
@@ -87,7 +85,7 @@ void add_strokes(const JsonView& character, std::size_t index, const TrialRow& t
 TrialRow study_detail::trial_row(const json& document, const std::string& source,
                                  const SessionManifest& manifest, const PlannedTrial& plan,
                                  std::vector<StrokeRow>& strokes) {
-  const JsonView record(document, "", source);
+  const json_detail::JsonView record(document, "", source);
   TrialRow row;
   row.subject = manifest.setup.subject.id;
   row.session = manifest.session_id;
@@ -130,11 +128,11 @@ TrialRow study_detail::trial_row(const json& document, const std::string& source
   row.pen_down_time_s = record.number("pen_down_time_s", -1e12, 1e12);
   row.velocity_peaks = static_cast<int>(count(record, "velocity_peaks"));
   row.normalised_jerk = record.optional_number("normalised_jerk", -1e12, 1e12);
-  const JsonView memory = record.object("writer").object("memory");
+  const json_detail::JsonView memory = record.object("writer").object("memory");
   row.shape_skill = memory.optional_number("shape_skill", -1e12, 1e12);
   row.order_skill = memory.optional_number("order_skill", -1e12, 1e12);
   row.timing_skill = memory.optional_number("timing_skill", -1e12, 1e12);
-  const JsonView traits = record.object("writer").object("subject_traits");
+  const json_detail::JsonView traits = record.object("writer").object("subject_traits");
   row.subject_writing_speed_factor = traits.optional_number("writing_speed_factor", 0.0, 1e6);
   row.subject_spatial_error_factor = traits.optional_number("spatial_error_factor", 0.0, 1e6);
   row.subject_error_rate_factor = traits.optional_number("error_rate_factor", 0.0, 1e6);
@@ -144,10 +142,10 @@ TrialRow study_detail::trial_row(const json& document, const std::string& source
   row.subject_fast_retention_per_trial = traits.optional_number("fast_retention_per_trial", 0.0, 1.0);
   row.subject_slow_retention_per_trial = traits.optional_number("slow_retention_per_trial", 0.0, 1.0);
   row.strokes_given_up = record.object("writer").object("log").optional_number("strokes_given_up", 0.0, 1e9);
-  const JsonView legibility = record.object("legibility");
+  const json_detail::JsonView legibility = record.object("legibility");
   row.legibility_top1 = legibility.optional_number("top1", 0.0, 1.0);
   row.legibility_top5 = legibility.optional_number("top5", 0.0, 1.0);
-  const JsonView characters = record.array("per_character");
+  const json_detail::JsonView characters = record.array("per_character");
   for (std::size_t c = 0; c < characters.size(); ++c) add_strokes(characters.object_at(c), c, row, strokes);
   return row;
 }

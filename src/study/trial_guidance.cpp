@@ -11,7 +11,7 @@
 #include "calligraphy/render/guidance_mode.hpp"
 #include "calligraphy/render/guidance_schedule.hpp"
 #include "calligraphy/study/trial_spec_runner.hpp"
-#include "study/json_reader.hpp"
+#include "core/json_reader.hpp"
 #include "study/names.hpp"
 #include "study/saved_sessions.hpp"
 
@@ -94,16 +94,16 @@ PreparedGuidance repetition_guidance(const StudyCondition& condition, const Plan
   prepared.guidance.band_m = first.band_m;
   if (condition.mode == ConditionMode::skill_adaptive) prepared.guidance.mode = first.mode;
   if (!previous || !previous_record) return prepared;
-  const study_detail::JsonView record(*previous_record, "", source);
+  const json_detail::JsonView record(*previous_record, "", source);
   prepared.previous_trial = SessionFolder::trial_stem(*previous);
   if (!record.has("guidance"))
-    study_detail::fail(source, "/guidance", "missing (required): no guidance to adapt from");
-  const study_detail::JsonView guidance = record.object("guidance");
+    json_detail::fail(source, "/guidance", "missing (required): no guidance to adapt from");
+  const json_detail::JsonView guidance = record.object("guidance");
   if (condition.mode == ConditionMode::fading) prepared.previous_gain = guidance.number("gain", 0.0, 1e6);
   if (condition.mode == ConditionMode::assist_as_needed)
     prepared.previous_band_m = guidance.number("band_m", 0.0, 1e6);
   if (!record.json().contains("mean_deviation_mm"))
-    study_detail::fail(source, "/mean_deviation_mm", "missing (required): no mean deviation to adapt from");
+    json_detail::fail(source, "/mean_deviation_mm", "missing (required): no mean deviation to adapt from");
   // null when the repetition wrote nothing
   const std::optional<double> deviation_mm = record.optional_number("mean_deviation_mm", -1e12, 1e12);
   prepared.previous_deviation_mm = deviation_mm ? json(*deviation_mm) : json(nullptr);

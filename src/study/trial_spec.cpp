@@ -16,7 +16,7 @@
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/study/protocol.hpp"
-#include "study/json_reader.hpp"
+#include "core/json_reader.hpp"
 #include "study/trial_spec_object.hpp"
 
 namespace calligraphy {
@@ -415,7 +415,7 @@ namespace study_detail {
 
 Checked<TrialSpec> trial_spec_from_object(const json& document, const std::string& at_pointer,
                                           const std::string& source, TeacherSource teacher_from) {
-  ObjectReader reader(document, at_pointer, source);
+  json_detail::ObjectReader reader(document, at_pointer, source);
   TrialSpec spec;
   for (const TrialSpecField& field : fields_in_order()) {
     const std::string key(field.key);
@@ -427,8 +427,8 @@ Checked<TrialSpec> trial_spec_from_object(const json& document, const std::strin
     const auto set = [&](const json& item, const std::string& at) {
       const auto expect = [&](bool ok, const char* what) {
         if (!ok)
-          study_detail::fail(source, at,
-                             std::string("expected ") + what + ", got " + study_detail::describe(item));
+          json_detail::fail(source, at,
+                            std::string("expected ") + what + ", got " + json_detail::describe(item));
       };
       if (key == "guidance") {
         expect(item.is_boolean(), "true or false");
@@ -440,31 +440,31 @@ Checked<TrialSpec> trial_spec_from_object(const json& document, const std::strin
         expect(item.is_number(), "a number");
         const double s = item.get<double>();
         if (!(s >= 0.0 && s <= 60.0) || std::abs(s * 1000.0 - std::round(s * 1000.0)) > 1e-6) {
-          study_detail::fail(source, at, "expected a whole number of milliseconds in [0, 60] s");
+          json_detail::fail(source, at, "expected a whole number of milliseconds in [0, 60] s");
         }
         spec.watchdog_s = s;
       } else if (double TrialSpec::*number = number_member(key)) {
         expect(item.is_number(), "a number");
         spec.*number = item.get<double>();
       } else if (key == "writer_parameters" && item.is_object()) {  // {"key": name, "value": number}
-        ObjectReader setting(item, at, source);
+        json_detail::ObjectReader setting(item, at, source);
         constexpr double kLargest = std::numeric_limits<double>::max();
         spec.writer_parameters.push_back(
             WriterSetting{setting.string("key"), setting.number("value", -kLargest, kLargest)});
         setting.finish();
       } else {  // text fields, and a setting written as "key=value" (records before settings were typed)
         try {
-          set_trial_spec_field(spec, key, study_detail::as_string(item, at, source));
+          set_trial_spec_field(spec, key, json_detail::as_string(item, at, source));
         } catch (const InvalidArgument& e) {
-          study_detail::fail(source, at, e.what());
+          json_detail::fail(source, at, e.what());
         }
       }
     };
     if (field.repeated) {
       if (!value->is_array())
-        study_detail::fail(source, pointer, "expected an array, got " + study_detail::describe(*value));
+        json_detail::fail(source, pointer, "expected an array, got " + json_detail::describe(*value));
       for (std::size_t i = 0; i < value->size(); ++i)
-        set((*value)[i], study_detail::child_pointer(pointer, i));
+        set((*value)[i], json_detail::child_pointer(pointer, i));
     } else {
       set(*value, pointer);
     }
@@ -477,7 +477,7 @@ Checked<TrialSpec> trial_spec_from_object(const json& document, const std::strin
 
 Checked<TrialSpec> trial_spec_from_json(std::string_view text, const std::string& source,
                                         TeacherSource teacher_from) {
-  return study_detail::trial_spec_from_object(study_detail::parse_json(text, source), "", source,
+  return study_detail::trial_spec_from_object(json_detail::parse_json(text, source), "", source,
                                               teacher_from);
 }
 

@@ -1,6 +1,7 @@
 #pragma once
-// Strict reading of JSON documents for the study files (protocols, session manifests, trial records):
-// every error names the source (a file) and the JSON pointer (RFC 6901) of the value at fault. Internal.
+// Strict reading of the JSON documents the library reads (trial specifications, protocols, session manifests,
+// trial records): every error names the source (a file) and the JSON pointer (RFC 6901) of the value at
+// fault. In `core` because the trial's specification and the study's files read alike. Internal.
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -8,12 +9,12 @@
 #include <string>
 #include <string_view>
 
-namespace calligraphy::study_detail {
+namespace calligraphy::json_detail {
 
 /// Throws DataError "SOURCE: POINTER: MESSAGE" (the pointer "/" for the document itself).
 [[noreturn]] void fail(const std::string& source, const std::string& pointer, const std::string& message);
 
-/// Parses `text` (report_detail::parse_json_document); throws DataError naming the source and the byte
+/// Parses `text` (parse_json_document); throws DataError naming the source and the byte
 /// offset of malformed JSON, or the JSON pointer of a number beyond a double's range.
 nlohmann::json parse_json(std::string_view text, const std::string& source);
 
@@ -81,7 +82,8 @@ class JsonView {
   /// The member as a number in [minimum, maximum], or nullopt when missing or null.
   [[nodiscard]] std::optional<double> optional_number(const std::string& key, double minimum,
                                                       double maximum) const;
-  [[nodiscard]] double number_or(const std::string& key, double fallback, double minimum, double maximum) const;
+  [[nodiscard]] double number_or(const std::string& key, double fallback, double minimum,
+                                 double maximum) const;
   /// The member as a number in [minimum, maximum]; throws DataError when it is missing.
   [[nodiscard]] double number(const std::string& key, double minimum, double maximum) const;
   [[nodiscard]] std::int64_t integer_or(const std::string& key, std::int64_t fallback, std::int64_t minimum,
@@ -107,4 +109,4 @@ std::int64_t as_integer(const nlohmann::json& value, const std::string& pointer,
 std::string child_pointer(const std::string& pointer, const std::string& key);
 std::string child_pointer(const std::string& pointer, std::size_t index);
 
-}  // namespace calligraphy::study_detail
+}  // namespace calligraphy::json_detail

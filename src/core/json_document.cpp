@@ -1,11 +1,11 @@
-#include "report/json_document.hpp"
+#include "core/json_document.hpp"
 
 #include <functional>
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
 
-namespace calligraphy::report_detail {
+namespace calligraphy::json_detail {
 namespace {
 
 // A key as a JSON pointer token (RFC 6901: "~" as "~0", "/" as "~1").
@@ -83,10 +83,11 @@ nlohmann::json parse_json_document(std::string_view text, const std::string& sou
     // A number beyond a double's range (1e999): the parser's only error without a byte offset.
     const std::string pointer = tracker.pointer();
     std::string reason = e.what();  // "[json.exception.out_of_range.406] number overflow parsing '1e999'"
-    if (const std::size_t bracket = reason.find("] "); bracket != std::string::npos) reason.erase(0, bracket + 2);
+    if (const std::size_t bracket = reason.find("] "); bracket != std::string::npos)
+      reason.erase(0, bracket + 2);
     throw DataError(source + ": " + (pointer.empty() ? "/" : pointer) +
                     ": not a finite number (beyond the range of a double): " + reason);
   }
 }
 
-}  // namespace calligraphy::report_detail
+}  // namespace calligraphy::json_detail

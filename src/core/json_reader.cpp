@@ -1,20 +1,20 @@
-#include "study/json_reader.hpp"
+#include "core/json_reader.hpp"
 
 #include <cmath>
 #include <limits>
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
-#include "report/json_document.hpp"
+#include "core/json_document.hpp"
 
-namespace calligraphy::study_detail {
+namespace calligraphy::json_detail {
 
 void fail(const std::string& source, const std::string& pointer, const std::string& message) {
   throw DataError(source + ": " + (pointer.empty() ? "/" : pointer) + ": " + message);
 }
 
 nlohmann::json parse_json(std::string_view text, const std::string& source) {
-  return report_detail::parse_json_document(text, source);
+  return parse_json_document(text, source);
 }
 
 std::string describe(const nlohmann::json& value) {
@@ -284,4 +284,4 @@ std::int64_t JsonView::integer_or(const std::string& key, std::int64_t fallback,
   return value ? as_integer(*value, child_pointer(pointer_, key), source_, minimum, maximum) : fallback;
 }
 
-}  // namespace calligraphy::study_detail
+}  // namespace calligraphy::json_detail
