@@ -141,7 +141,8 @@ TEST_CASE("A trial run again from its record gives the same trace, bit for bit",
   spec.seed = 99;
   spec.rate_hz = 800.0;
   spec.max_duration_s = 30.0;
-  TrialRunInputs inputs = study_test::trial_inputs();
+  SimulatedWriting writing(spec);
+  TrialRunInputs inputs = study_test::trial_inputs(&writing);
   ForceLawParameters force;
   force.guidance_law = AssistAsNeededGuidance{.band_m = 0.0007};
   force.off_stroke_force_n = 0.35;  // parts a specification alone does not state
@@ -155,9 +156,10 @@ TEST_CASE("A trial run again from its record gives the same trace, bit for bit",
   REQUIRE(first.result.trace.size() > 100);
 
   const RecordedTrial recorded =
-      read_recorded_trial(recorded_trial_json(recorded_trial(spec, first, scene)), "r.json");
-  const TrialRun again =
-      rerun_trial(recorded, Checked<TrialSpec>::check(recorded.spec), scene, study_test::trial_inputs());
+      read_recorded_trial(recorded_trial_json(recorded_trial(spec, first, writing, scene)), "r.json");
+  SimulatedWriting again_writing = recorded_writing(recorded);  // the writer as the record states it
+  const TrialRun again = rerun_trial(recorded, Checked<TrialSpec>::check(recorded.spec), scene,
+                                     study_test::trial_inputs(&again_writing));
   REQUIRE(again.result.trace.size() == first.result.trace.size());
   std::size_t different = 0;
   for (std::size_t i = 0; i < first.result.trace.size(); ++i) {
@@ -168,7 +170,8 @@ TEST_CASE("A trial run again from its record gives the same trace, bit for bit",
   CHECK(different == 0);
 
   // Without the record's force law, the same specification renders another force: the record carried it.
-  const TrialRun plain = run_trial_spec(Checked<TrialSpec>::check(spec), scene, study_test::trial_inputs());
+  const TrialRun plain =
+      run_trial_spec(Checked<TrialSpec>::check(spec), scene, study_test::trial_inputs(&writing));
   bool same = plain.result.trace.size() == first.result.trace.size();
   for (std::size_t i = 0; same && i < first.result.trace.size(); ++i)
     same = plain.result.trace[i].force_n == first.result.trace[i].force_n;

@@ -3,7 +3,7 @@
 // the test runs (the library never makes a registry of its own).
 #include "calligraphy/devices/device_registry.hpp"
 #include "calligraphy/study/session_runner.hpp"
-#include "calligraphy/study/trial_spec_runner.hpp"
+#include "calligraphy/trial/trial_spec_runner.hpp"
 
 namespace study_test {
 
@@ -20,10 +20,12 @@ inline calligraphy::SessionRunOptions run_options() {
   return options;
 }
 
-/// Trial inputs whose device comes from `registry()`.
-inline calligraphy::TrialRunInputs trial_inputs() {
+/// Trial inputs whose device comes from `registry()`, with `writing` (not owned) as the simulated writer's
+/// hand maker.
+inline calligraphy::TrialRunInputs trial_inputs(calligraphy::TrialHandMaker* writing = nullptr) {
   calligraphy::TrialRunInputs inputs;
   inputs.registry = &registry();
+  inputs.hand_maker = writing;
   return inputs;
 }
 

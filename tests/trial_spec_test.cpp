@@ -1,7 +1,8 @@
 // The one trial specification: both forms (JSON, command-line words) round-trip, errors name the field,
 // and its runner writes a trial with the simulated writer as an input.
-#include "calligraphy/study/trial_spec.hpp"
+#include "calligraphy/trial/trial_spec.hpp"
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
@@ -13,7 +14,8 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/parameter_table.hpp"
 #include "calligraphy/model/character_library.hpp"
-#include "calligraphy/study/trial_spec_runner.hpp"
+#include "calligraphy/sim/simulated_writing.hpp"
+#include "calligraphy/trial/trial_spec_runner.hpp"
 #include "study_test_devices.hpp"
 
 using namespace calligraphy;
@@ -227,11 +229,24 @@ TEST_CASE("a specification's errors name the field in both its forms") {
   bad.writer_profile = "skilled";
   fails_naming(bad, "writer_profile (--writer-profile)");
   bad = spec;
+  bad.writer_profile = "";
+  fails_naming(bad, "writer_profile (--writer-profile): no profile named");
+  // The profile's name and its settings are the simulated writer's to check, naming the same fields.
+  bad = spec;
   bad.writer_profile = "expert";
-  fails_naming(bad, "writer_profile (--writer-profile)");
+  CHECK_NOTHROW(bad.validate());
+  CHECK_THAT(error_of([&] { (void)writer_profile_of(bad); }),
+             Catch::Contains("writer_profile (--writer-profile)") && Catch::Contains("expert"));
+  CHECK_THAT(error_of([&] { SimulatedWriting refused(bad); }),
+             Catch::Contains("writer_profile (--writer-profile)"));
   bad = spec;
   bad.writer_parameters = {{"no_such_key", 1.0}};
-  fails_naming(bad, "writer_parameters (--writer-param): 'no_such_key=1'");
+  CHECK_THAT(error_of([&] { (void)writer_profile_of(bad); }),
+             Catch::Contains("writer_parameters (--writer-param): 'no_such_key=1'") &&
+                 Catch::Contains("known: hand_stiffness_n_per_m"));
+  bad.writer_parameters = {{"bias_offset_m", -1.0}};
+  CHECK_THAT(error_of([&] { (void)writer_profile_of(bad); }),
+             Catch::Contains("writer_parameters (--writer-param): 'bias_offset_m=-1'"));
   bad = spec;
   bad.pacing = TrialPacing::real_time;
   bad.rate_hz = 20000.0;
@@ -270,9 +285,20 @@ TEST_CASE("the runner of a specification gives the simulated writer to the trial
   spec.characters = "十";
   spec.seed = 4;
   const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'十')});
-  const TrialRun run = run_trial_spec(Checked<TrialSpec>::check(spec), scene, study_test::trial_inputs());
+  SimulatedWriting writing(spec);
+  const TrialRun run =
+      run_trial_spec(Checked<TrialSpec>::check(spec), scene, study_test::trial_inputs(&writing));
   CHECK(run.simulated_writer);
-  CHECK(run.writer_log.has_value());
+  REQUIRE(writing.log().has_value());
+  CHECK_FALSE(writing.log()->attempts.empty());
+  // The writer marked its attempts in the trace (mark_writer_attempts), after the hand let go.
+  CHECK(std::any_of(run.result.trace.begin(), run.result.trace.end(),
+                    [](const TrialSample& sample) { return sample.attempt > 0; }));
+  // Without a hand maker, the runner names what is missing instead of running no writer.
+  CHECK_THAT(error_of([&] {
+               (void)run_trial_spec(Checked<TrialSpec>::check(spec), scene, study_test::trial_inputs());
+             }),
+             Catch::Contains("no hand maker") && Catch::Contains("TrialRunInputs::hand_maker"));
   CHECK(run.result.end == TrialEnd::completed);
   CHECK(run.metrics.strokes_total == 2);
   CHECK(run.metrics.strokes_accepted == 2);
@@ -289,8 +315,9 @@ TEST_CASE("the runner of a specification gives the simulated writer to the trial
              Catch::Contains("writer (--writer): 'person'"));
   TrialSpec nowhere = spec;
   nowhere.device = "no-such-device";
-  CHECK_THROWS_AS(run_trial_spec(Checked<TrialSpec>::check(nowhere), scene, study_test::trial_inputs()),
-                  DeviceNotFound);
+  CHECK_THROWS_AS(
+      run_trial_spec(Checked<TrialSpec>::check(nowhere), scene, study_test::trial_inputs(&writing)),
+      DeviceNotFound);
   // The library makes no registry of its own: the caller passes one, or a device.
   CHECK_THAT(error_of([&] { (void)run_trial_spec(Checked<TrialSpec>::check(spec), scene); }),
              Catch::Contains("no device and no registry to create \"simulated\""));
@@ -302,7 +329,8 @@ TEST_CASE("the runner takes a force law made before the trial, whose guidance mu
   spec.seed = 4;
   spec.max_duration_s = 0.05;
   const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'十')});
-  TrialRunInputs inputs = study_test::trial_inputs();
+  SimulatedWriting writing(spec);
+  TrialRunInputs inputs = study_test::trial_inputs(&writing);
   ForceLawParameters force;
   force.guidance_stiffness_n_per_m = 250.0;
   inputs.force_law = force;
@@ -400,5 +428,5 @@ TEST_CASE("a specification reaches the runner checked: it takes no unchecked one
   const auto replay = Checked<TrialSpec>::check(spec, TeacherSource::samples);
   const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'十')});
   CHECK_THAT(error_of([&] { (void)run_trial_spec(replay, scene, study_test::trial_inputs()); }),
-             Catch::Contains("teacher (--teacher): required with guidance mode 'replay'"));
+             Catch::Contains("teacher (--teacher): a replay runs on the teacher's samples"));
 }

@@ -23,9 +23,10 @@
 #include "calligraphy/render/passivity.hpp"
 #include "calligraphy/render/safety_chain.hpp"
 #include "calligraphy/sim/simulated_hand.hpp"
+#include "calligraphy/sim/simulated_writing.hpp"
 #include "calligraphy/study/recorded_trial.hpp"
-#include "calligraphy/study/trial_spec_runner.hpp"
 #include "calligraphy/trial/trial.hpp"
+#include "calligraphy/trial/trial_spec_runner.hpp"
 #include "character_source.hpp"
 #include "log_forwarding.hpp"
 #include "model_bindings.hpp"
@@ -59,10 +60,6 @@ struct PyTrialResult {
   WriterProfile writer;                 // the profile the simulated writer wrote with
   std::optional<WriterLog> writer_log;  // what it did; empty on a device a person moves
 };
-
-// The most servo ticks one call may simulate (rate_hz * max_duration_s): 10^7 ticks keep about 0.8 GB of
-// trace, about 3 hours at 1 kHz; the default 300 s at 1 kHz is 3 * 10^5.
-constexpr double kMaxTicks = 1e7;
 
 PyTrialResult to_python(const TrialResult& result, py::dict metrics, py::object scene) {
   const auto n = static_cast<py::ssize_t>(result.trace.size());
@@ -265,7 +262,7 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   apply_guidance(a, label, options.force);
   options.validate();
   simulation.validate();
-  if (!(options.rate_hz * options.max_duration_s <= kMaxTicks)) {
+  if (!(options.rate_hz * options.max_duration_s <= kMaxTrialTicks)) {
     throw InvalidArgument(fmt::format("max_duration_s: {} s at {} Hz is more than 10^7 servo ticks",
                                       options.max_duration_s, options.rate_hz));
   }
@@ -307,14 +304,14 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
     simulated_device = std::make_unique<SimulatedDevice>(simulation.device);
     inputs.device = simulated_device.get();
   }
-  inputs.writer = simulation.writer;
+  SimulatedWriting writing(spec, simulation.writer);
+  inputs.hand_maker = &writing;
   if (const auto* replay = std::get_if<ReplayGuidance>(&law)) inputs.teacher = replay->teacher_trajectory;
   inputs.force_law = options.force;  // the force law as given (no stiffness fitted to the device)
   inputs.safety = options.safety;
   inputs.passivity = options.passivity;
   TrialRun run = run_interruptible(inputs, [&] { return run_trial_spec(checked, scene, inputs); });
   TrialResult& result = run.result;
-  std::optional<WriterLog>& writer_log = run.writer_log;
   TrialDescription description;
   description.characters = label;
   description.guidance = options.force.guidance;
@@ -337,15 +334,14 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
     }
   }
   // The whole specification that ran, with a simulated device's own physics: rerun_trial runs it again.
-  RecordedTrial recorded = recorded_trial(spec, run, scene);
+  RecordedTrial recorded = recorded_trial(spec, run, writing, scene);
   // Only physics of the caller's own: without `device=` the simulated device is the registry's.
   if (device) recorded.simulated_device = simulation.device;
   description.specification_json = recorded_trial_json(recorded);
-  const WritingMetrics& writing = run.metrics;
   if (!keep_trace) result.trace = {};
-  PyTrialResult out = to_python(result, trial_metrics(description, result, writing), scene_object);
+  PyTrialResult out = to_python(result, trial_metrics(description, result, run.metrics), scene_object);
   out.writer = simulation.writer;
-  out.writer_log = std::move(writer_log);
+  out.writer_log = writing.log();
   return out;
 }
 
@@ -401,11 +397,13 @@ PyTrialResult rerun_trial_py(const py::object& record,
   }
   const auto checked = calligraphy::Checked<TrialSpec>::check(
       recorded.spec, inputs.teacher.empty() ? TeacherSource::file : TeacherSource::samples);
+  SimulatedWriting writing = recorded_writing(recorded);
+  inputs.hand_maker = &writing;
   TrialRun run = run_interruptible(inputs, [&] { return rerun_trial(recorded, checked, scene, inputs); });
   TrialDescription description;
   description.characters = recorded.spec.characters;
   description.guidance = recorded.spec.guidance;
-  description.writer = run.simulated_writer ? run.writer.name : "human";
+  description.writer = run.simulated_writer ? writing.profile().name : "human";
   description.seed = recorded.spec.seed;
   description.rate_hz = recorded.spec.rate_hz;
   description.device = recorded.spec.device;
@@ -414,14 +412,14 @@ PyTrialResult rerun_trial_py(const py::object& record,
     description.guidance_gain = fading->gain;
   if (description.guidance_mode == GuidanceMode::replay)
     description.teacher_characters = recorded.spec.characters;
-  if (run.simulated_writer) description.writer_profile = run.writer.name;
-  RecordedTrial ran = recorded_trial(recorded.spec, run, scene);
+  if (run.simulated_writer) description.writer_profile = writing.profile().name;
+  RecordedTrial ran = recorded_trial(recorded.spec, run, writing, scene);
   ran.simulated_device = recorded.simulated_device;
   description.specification_json = recorded_trial_json(ran);
   PyTrialResult out =
       to_python(run.result, trial_metrics(description, run.result, run.metrics), scene_object);
-  out.writer = run.writer;
-  out.writer_log = std::move(run.writer_log);
+  out.writer = writing.profile();
+  out.writer_log = writing.log();
   return out;
 }
 

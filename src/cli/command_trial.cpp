@@ -18,11 +18,12 @@
 #include "calligraphy/report/teacher_recording.hpp"
 #include "calligraphy/report/trial_report.hpp"
 #include "calligraphy/sim/simulated_hand.hpp"
+#include "calligraphy/sim/simulated_writing.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/study/recorded_trial.hpp"
-#include "calligraphy/study/trial_spec.hpp"
-#include "calligraphy/study/trial_spec_runner.hpp"
 #include "calligraphy/trial/trial.hpp"
+#include "calligraphy/trial/trial_spec.hpp"
+#include "calligraphy/trial/trial_spec_runner.hpp"
 #include "cli/cli_devices.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
@@ -145,7 +146,8 @@ Checked<TrialSpec> spec_from(const TrialCommand& command) {
 }
 
 // What the trial's JSON and table say of it: the specification and the device it ran on.
-TrialDescription describe(const TrialSpec& spec, const TrialRun& run, const DeviceListing& device) {
+TrialDescription describe(const TrialSpec& spec, const TrialRun& run, const SimulatedWriting& writing,
+                          const DeviceListing& device) {
   // The report calls a person "human"; the simulated writer by its profile.
   TrialDescription description{
       spec.characters,  spec.guidance, run.simulated_writer ? spec.writer_profile : "human",
@@ -158,10 +160,21 @@ TrialDescription describe(const TrialSpec& spec, const TrialRun& run, const Devi
     description.teacher_characters = spec.characters;  // the runner refuses a recording of others
   }
   if (run.simulated_writer) {
-    description.writer_profile = run.writer.name;
+    description.writer_profile = writing.profile().name;
     description.writer_parameters = trial_spec_field_text(spec, "writer_parameters");
   }
   return description;
+}
+
+// A replay's teacher: the recording --teacher names, of these characters.
+std::vector<TeacherSample> teacher_samples(const TrialSpec& spec) {
+  TeacherRecording recording = read_teacher_recording(spec.teacher);
+  try {
+    require_teacher_for(recording, spec.characters);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument("teacher (--teacher) " + spec.teacher + ": " + e.what());
+  }
+  return std::move(recording.samples);
 }
 
 // Writes each output given; one that fails is reported on stderr and does not keep the others from being
@@ -244,6 +257,15 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
   if (!simulated && !spec.writer_parameters.empty()) {
     throw UsageError("--writer-param applies to the simulated writer, not to a person (--writer person)");
   }
+  // The simulated writer, its profile and settings checked here (a record's writer as it wrote).
+  const auto writing = [&] {
+    try {
+      return recorded ? std::make_unique<SimulatedWriting>(recorded->spec, recorded->writer)
+                      : std::make_unique<SimulatedWriting>(spec);
+    } catch (const InvalidArgument& e) {
+      throw UsageError(e.what());
+    }
+  }();
   // Lock-step pacing has no wall clock, so no stall can be bounded: the option would be ignored.
   const bool real_time =
       spec.pacing == TrialPacing::real_time || (spec.pacing == TrialPacing::automatic && device.capabilities.hardware);
@@ -280,16 +302,18 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
   TrialRunInputs inputs;
   inputs.registry = &devices;
   inputs.should_stop = StopSignals::stop_requested();
+  inputs.hand_maker = writing.get();
   TrialRun run;
   try {
+    if (spec.guidance && spec.guidance_mode == GuidanceMode::replay) inputs.teacher = teacher_samples(spec);
     run = recorded ? rerun_trial(*recorded, checked, scene, inputs) : run_trial_spec(checked, scene, inputs);
   } catch (const InvalidArgument& e) {
     if (!recorded) throw;
     throw DataError("--spec " + command.spec_file + ": " + e.what());  // e.g. other character data
   }
   TrialResult& result = run.result;
-  TrialDescription description = describe(spec, run, device);
-  description.specification_json = recorded_trial_json(recorded_trial(spec, run, scene));
+  TrialDescription description = describe(spec, run, *writing, device);
+  description.specification_json = recorded_trial_json(recorded_trial(spec, run, *writing, scene));
   const int signal = StopSignals::received();
   if (result.end == TrialEnd::interrupted && result.abort_reason.empty() && signal != 0) {
     result.abort_reason = std::string("stopped by ") + signal_name(signal);

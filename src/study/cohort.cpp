@@ -14,13 +14,14 @@
 #include <utility>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/model/scene.hpp"
-#include "calligraphy/devices/simulated_device.hpp"
+#include "calligraphy/sim/simulated_writing.hpp"
 #include "calligraphy/sim/writer_memory.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/study/session_runner.hpp"
-#include "calligraphy/study/trial_spec_runner.hpp"
+#include "calligraphy/trial/trial_spec_runner.hpp"
 #include "study/names.hpp"
 #include "study/remembered_writer.hpp"
 #include "study/trial_guidance.hpp"
@@ -94,6 +95,8 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
   const auto checked = Checked<TrialSpec>::check(std::move(spec), study_teacher_source(condition));
   inputs.force_law = study_detail::condition_force_law(condition, guidance.guidance,
                                                        trial_options(checked, device->info())->force);
+  SimulatedWriting writing(*checked);
+  inputs.hand_maker = &writing;
   const auto wall_start = std::chrono::steady_clock::now();
   const TrialRun run = run_trial_spec(checked, scene, inputs);
   const TrialResult& result = run.result;
@@ -114,9 +117,9 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
   context.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   context.options = &run.options;
   context.spec = &*checked;
-  context.simulation.writer = run.writer;
+  context.simulation.writer = writing.profile();
   context.simulation.seed = checked->seed;
-  context.writer_log = run.writer_log;
+  context.writer_log = writing.log();
   std::vector<std::vector<QuizEvent>> quiz;
   if (condition.mode == ConditionMode::quiz) quiz = quiz_characters(scene, result.trace, condition.quiz);
   json record =

@@ -18,7 +18,7 @@
 #include "study/recorded_trial_object.hpp"
 #include "study/saved_sessions.hpp"
 #include "study/trial_record.hpp"
-#include "study/trial_spec_object.hpp"
+#include "trial/trial_spec_object.hpp"
 
 namespace calligraphy {
 namespace {
@@ -198,8 +198,9 @@ void append_bits(std::string& bytes, double value) {
 
 }  // namespace
 
-RecordedTrial recorded_trial(const TrialSpec& spec, const TrialRun& run, const Scene& scene) {
-  return recorded_trial(spec, run.options, run.simulated_writer ? &run.writer : nullptr, scene);
+RecordedTrial recorded_trial(const TrialSpec& spec, const TrialRun& run, const SimulatedWriting& writing,
+                             const Scene& scene) {
+  return recorded_trial(spec, run.options, run.simulated_writer ? &writing.profile() : nullptr, scene);
 }
 
 RecordedTrial recorded_trial(const TrialSpec& spec, const TrialOptions& ran, const WriterProfile* writer,
@@ -322,7 +323,7 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
     // A replay whose teacher was given as samples (a session's, kept in its folder) names no file.
     const bool teacher_named = trial.is_object() && trial.contains("teacher") &&
                                trial["teacher"].is_string() && !trial["teacher"].get<std::string>().empty();
-    r.spec = *study_detail::trial_spec_from_object(
+    r.spec = *trial_detail::trial_spec_from_object(
         trial, reader.pointer("trial"), source, teacher_named ? TeacherSource::file : TeacherSource::samples);
   } catch (const InvalidArgument& e) {
     json_detail::fail(source, reader.pointer("trial"), e.what());
@@ -404,6 +405,10 @@ RecordedTrial read_recorded_trial_file(const std::string& path) {
   return recorded;
 }
 
+SimulatedWriting recorded_writing(const RecordedTrial& recorded) {
+  return SimulatedWriting(recorded.spec, recorded.writer);
+}
+
 TrialRun rerun_trial(const RecordedTrial& recorded, const Checked<TrialSpec>& spec, const Scene& scene,
                      TrialRunInputs inputs) {
   const std::string here = scene_sha256(scene);
@@ -416,7 +421,6 @@ TrialRun rerun_trial(const RecordedTrial& recorded, const Checked<TrialSpec>& sp
   inputs.force_law = recorded.force_law;
   inputs.safety = recorded.safety;
   inputs.passivity = recorded.passivity;
-  if (recorded.writer) inputs.writer = *recorded.writer;
   std::unique_ptr<SimulatedDevice> device;
   if (recorded.simulated_device) {
     device = std::make_unique<SimulatedDevice>(*recorded.simulated_device);

@@ -10,7 +10,7 @@
 #include "calligraphy/sim/subject_traits.hpp"
 #include "calligraphy/sim/writer_memory.hpp"
 #include "calligraphy/study/session_folder.hpp"
-#include "calligraphy/study/trial_spec.hpp"
+#include "calligraphy/trial/trial_spec.hpp"
 
 namespace calligraphy::study_detail {
 

@@ -18,8 +18,9 @@
 #include "calligraphy/render/guidance_law.hpp"
 #include "calligraphy/report/trace_hdf5.hpp"
 #include "calligraphy/report/trial_report.hpp"
+#include "calligraphy/sim/simulated_writing.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
-#include "calligraphy/study/trial_spec_runner.hpp"
+#include "calligraphy/trial/trial_spec_runner.hpp"
 #include "study/names.hpp"
 #include "study/remembered_writer.hpp"
 #include "study/trial_guidance.hpp"
@@ -339,7 +340,10 @@ class SessionRun {
     PreparedTrial prepared = prepare(trial, condition);
     std::unique_ptr<HapticDevice> device = create_device(trial);
     session_.log("trial_started", prepared.started.dump());
-    const TrialRunInputs inputs = inputs_for(trial, condition, prepared, *device);
+    // The simulated subject, with its traits and what it learned (the specification's writer part).
+    SimulatedWriting writing(*prepared.spec);
+    TrialRunInputs inputs = inputs_for(trial, condition, prepared, *device);
+    inputs.hand_maker = &writing;
 
     study_detail::TrialRecordContext context;
     context.session = &manifest_;
@@ -360,9 +364,9 @@ class SessionRun {
     context.end_utc = utc_now_iso8601();
     context.options = &run.options;
     context.spec = &*prepared.spec;
-    context.simulation.writer = run.writer;
+    context.simulation.writer = writing.profile();
     context.simulation.seed = prepared.spec->seed;
-    context.writer_log = run.writer_log;
+    context.writer_log = writing.log();
     device.reset();
     ran_one_ = true;
 

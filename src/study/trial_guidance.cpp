@@ -10,7 +10,8 @@
 #include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
 #include "calligraphy/render/guidance_schedule.hpp"
-#include "calligraphy/study/trial_spec_runner.hpp"
+#include "calligraphy/sim/simulated_writing.hpp"
+#include "calligraphy/trial/trial_spec_runner.hpp"
 #include "core/json_reader.hpp"
 #include "study/names.hpp"
 #include "study/saved_sessions.hpp"
@@ -47,9 +48,12 @@ std::string record_teacher(const SessionFolder& session, const Scene& scene,
   teacher.pacing = TrialPacing::lock_step;
   // The simulated device, made here: the teacher's trial is the library's, on no device of the session's.
   SimulatedDevice device;
+  const auto checked = Checked<TrialSpec>::check(teacher);
+  SimulatedWriting writing(*checked);
   TrialRunInputs inputs;
   inputs.device = &device;
-  const TrialResult result = run_trial_spec(Checked<TrialSpec>::check(teacher), scene, inputs).result;
+  inputs.hand_maker = &writing;
+  const TrialResult result = run_trial_spec(checked, scene, inputs).result;
   if (result.aborted || !result.metrics.completed_in_order) {
     throw StateError("the simulated teacher of \"" + encode_utf8(characters) + "\" wrote " +
                      std::to_string(result.metrics.strokes_completed) + " of " +

@@ -17,9 +17,9 @@
 #include "calligraphy/sim/writer_memory.hpp"
 #include "calligraphy/study/quiz.hpp"
 #include "calligraphy/study/session_folder.hpp"
-#include "calligraphy/study/trial_spec.hpp"
 #include "calligraphy/trial/options.hpp"
 #include "calligraphy/trial/result.hpp"
+#include "calligraphy/trial/trial_spec.hpp"
 
 namespace calligraphy::study_detail {
 

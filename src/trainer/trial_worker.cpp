@@ -22,6 +22,8 @@ void TrialWorker::start(Scene scene, Checked<TrialSpec> spec, TrialRunInputs inp
   done_.store(false);
   result_.reset();
   failure_ = nullptr;
+  writing_ = std::make_unique<SimulatedWriting>(*spec);
+  inputs.hand_maker = writing_.get();
   inputs.should_stop = [this] { return stop_.load(std::memory_order_relaxed); };
   thread_ = std::thread([this, spec = std::move(spec), inputs = std::move(inputs)] {
     try {

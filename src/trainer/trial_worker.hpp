@@ -4,12 +4,14 @@
 // and takes the result only once it is done, so it never waits on the servo side (except when quitting).
 #include <atomic>
 #include <exception>
+#include <memory>
 #include <optional>
 #include <string>
 #include <thread>
 
 #include "calligraphy/model/scene.hpp"
-#include "calligraphy/study/trial_spec_runner.hpp"
+#include "calligraphy/sim/simulated_writing.hpp"
+#include "calligraphy/trial/trial_spec_runner.hpp"
 
 namespace calligraphy::trainer {
 
@@ -21,7 +23,8 @@ class TrialWorker {
   ~TrialWorker();
 
   /// Starts the trial `spec` of `scene` (kept here) with `inputs`, whose `should_stop` is replaced by this
-  /// worker's stop flag.
+  /// worker's stop flag and whose hand maker is the specification's simulated writer (made here: throws
+  /// InvalidArgument for its profile).
   void start(Scene scene, Checked<TrialSpec> spec, TrialRunInputs inputs);
   [[nodiscard]] bool active() const noexcept { return thread_.joinable(); }
   /// True once the trial thread has finished (its result is ready).
@@ -37,6 +40,7 @@ class TrialWorker {
  private:
   Scene scene_;
   TrialSpec spec_;
+  std::unique_ptr<SimulatedWriting> writing_;  // used by the trial thread while it runs
   std::thread thread_;
   std::atomic<bool> stop_{false};
   std::atomic<bool> done_{false};

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "calligraphy/core/parameter_table.hpp"
+#include "calligraphy/trial/writer_setting.hpp"
 
 namespace calligraphy {
 
@@ -113,22 +114,5 @@ struct ParameterTable<WriterProfile> {
 /// unchanged. Throws InvalidArgument naming an unknown key (and listing the known ones), a value that
 /// is not a whole number for `max_attempts_per_stroke`, or the field `validate` refuses.
 void set_writer_parameter(WriterProfile& profile, std::string_view key, double value);
-
-/// One numeric field of a profile set to a value: what `--writer-param key=value` states, typed. A trial
-/// specification holds these (applied in turn with `set_writer_parameter`), so that no number passes
-/// through text inside the program.
-struct WriterSetting {
-  std::string key;     ///< a name of `writer_parameter_names()`
-  double value = 0.0;  ///< in the field's unit and range (ParameterTable<WriterProfile>)
-  bool operator==(const WriterSetting&) const = default;
-};
-
-/// The setting "key=value" as a command line gives it. Throws InvalidArgument naming the setting when
-/// there is no '=' or the value is not a finite decimal number (the key is checked where it is applied).
-[[nodiscard]] WriterSetting parse_writer_setting(std::string_view text);
-
-/// "key=value", the value in the shortest digits that read back to the same double: the command line's
-/// form of `setting`, which `parse_writer_setting` reads back equal.
-[[nodiscard]] std::string writer_setting_text(const WriterSetting& setting);
 
 }  // namespace calligraphy

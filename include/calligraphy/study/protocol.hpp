@@ -16,6 +16,7 @@
 #include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/render/force_law.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
+#include "calligraphy/trial/options.hpp"
 
 namespace calligraphy {
 
@@ -187,10 +188,6 @@ struct BreakRules {
   int every_trials = 0;           ///< a rest of `duration_s` after every this many trials; 0: none
   double duration_s = 0.0;
 };
-
-/// The most servo ticks a trial may last (max_duration_s x rate_hz): its trace, one sample a tick, is held
-/// in memory. The trial runner refuses more (TrialSpec::validate); a protocol is refused at reading.
-inline constexpr double kMaxTrialTicks = 1e7;
 
 /// Settings of every trial of the study.
 struct ProtocolTrialSettings {

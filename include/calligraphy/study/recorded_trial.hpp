@@ -17,9 +17,10 @@
 #include "calligraphy/render/force_law.hpp"
 #include "calligraphy/render/passivity.hpp"
 #include "calligraphy/render/safety_chain.hpp"
+#include "calligraphy/sim/simulated_writing.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
-#include "calligraphy/study/trial_spec.hpp"
-#include "calligraphy/study/trial_spec_runner.hpp"
+#include "calligraphy/trial/trial_spec.hpp"
+#include "calligraphy/trial/trial_spec_runner.hpp"
 
 namespace calligraphy {
 
@@ -52,8 +53,9 @@ struct RecordedTrial {
 /// wrote, its profile `writer` (nullptr: a person).
 [[nodiscard]] RecordedTrial recorded_trial(const TrialSpec& spec, const TrialOptions& ran,
                                            const WriterProfile* writer, const Scene& scene);
-/// What `run` ran for `spec` on `scene`.
-[[nodiscard]] RecordedTrial recorded_trial(const TrialSpec& spec, const TrialRun& run, const Scene& scene);
+/// What `run` ran for `spec` on `scene`, written (when the simulated writer wrote) by `writing`.
+[[nodiscard]] RecordedTrial recorded_trial(const TrialSpec& spec, const TrialRun& run,
+                                           const SimulatedWriting& writing, const Scene& scene);
 
 /// Lower-case hex SHA-256 (FIPS 180-4) of the placed characters: each character's code point and, stroke by
 /// stroke, its typical stroke ID, attraction factors and elements' control points [m] (bit patterns): equal
@@ -78,12 +80,17 @@ struct RecordedTrial {
 /// when it cannot be read, and what `read_recorded_trial` throws.
 [[nodiscard]] RecordedTrial read_recorded_trial_file(const std::string& path);
 
+/// The simulated writer of `recorded` as it wrote (`RecordedTrial::writer`, its traits and what it had
+/// learned folded in): `rerun_trial`'s hand maker. Throws InvalidArgument for a profile out of range.
+[[nodiscard]] SimulatedWriting recorded_writing(const RecordedTrial& recorded);
+
 /// Runs `recorded` again on `scene` (laid out by the caller with `recorded.layout`) with `inputs` (the
-/// registry, a stop flag, a replay's teacher samples). `spec` is the specification that runs: `recorded.spec`
-/// as the caller checked it (`Checked<TrialSpec>::check`), its output files and a replay's teacher file the
-/// caller's. The record's force law, safety chain, passivity controller, writer and simulated device (made
-/// here when recorded) replace any in `inputs`. Throws InvalidArgument when `scene` is not the recorded one
-/// (its SHA-256 differs: other character data), and what `run_trial_spec` throws.
+/// registry, a stop flag, a replay's teacher samples, and `recorded_writing(recorded)` as the hand maker).
+/// `spec` is the specification that runs: `recorded.spec` as the caller checked it
+/// (`Checked<TrialSpec>::check`), its output files and a replay's teacher file the caller's. The record's
+/// force law, safety chain, passivity controller and simulated device (made here when recorded) replace any
+/// in `inputs`. Throws InvalidArgument when `scene` is not the recorded one (its SHA-256 differs: other
+/// character data), and what `run_trial_spec` throws.
 [[nodiscard]] TrialRun rerun_trial(const RecordedTrial& recorded, const Checked<TrialSpec>& spec,
                                    const Scene& scene, TrialRunInputs inputs = {});
 

@@ -18,8 +18,8 @@
 #include "calligraphy/render/guidance_law.hpp"
 #include "calligraphy/study/schedule.hpp"
 #include "calligraphy/study/session_folder.hpp"
-#include "calligraphy/study/trial_spec.hpp"
 #include "calligraphy/trial/options.hpp"
+#include "calligraphy/trial/trial_spec.hpp"
 
 namespace calligraphy {
 

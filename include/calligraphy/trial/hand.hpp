@@ -3,8 +3,14 @@
 /// Who moves a device a person does not hold: the hand a lock-step trial is given (a simulated writer,
 /// `SimulatedHand` in calligraphy/sim/simulated_hand.hpp). The trial knows only this interface; what the
 /// hand is, how it writes and what it logs belong to the caller that made it.
+#include <cstdint>
+#include <memory>
+
 #include "calligraphy/core/device_types.hpp"
+#include "calligraphy/devices/haptic_device.hpp"
+#include "calligraphy/model/scene.hpp"
 #include "calligraphy/render/renderer.hpp"
+#include "calligraphy/trial/result.hpp"
 
 namespace calligraphy {
 
@@ -31,6 +37,24 @@ class TrialHand {
   virtual void advance(double dt_s) = 0;
   /// Lets go of the stylus; called once on every way out of the trial. Never throws.
   virtual void release() noexcept = 0;
+};
+
+/// What makes the hand when a trial specification's simulated writer writes (TrialRunInputs::hand_maker):
+/// the caller's, from calligraphy/sim (`SimulatedWriting`), so that the trial layer makes no writer and
+/// keeps none of its state. Used by one trial at a time.
+class TrialHandMaker {
+ public:
+  virtual ~TrialHandMaker() = default;
+  TrialHandMaker() = default;
+  TrialHandMaker(const TrialHandMaker&) = delete;
+  TrialHandMaker& operator=(const TrialHandMaker&) = delete;
+
+  /// A hand that moves `device` (one with a hand port) to write `scene`, drawing at random from `seed`.
+  [[nodiscard]] virtual std::unique_ptr<TrialHand> make_hand(HapticDevice& device, const Scene& scene,
+                                                             std::uint64_t seed) = 0;
+  /// After the trial of the hand last made, which has let go and is not yet destroyed: marks in `result`'s
+  /// trace what the hand knows (which stroke each of its pen-down segments meant) and keeps what it did.
+  virtual void after_trial(TrialResult& result) = 0;
 };
 
 }  // namespace calligraphy

@@ -12,6 +12,11 @@
 
 namespace calligraphy {
 
+/// The most servo ticks a trial may last (max_duration_s x rate_hz): its trace, one sample a tick, is held
+/// in memory. A trial specification (TrialSpec::validate) and Python refuse more; a protocol is refused at
+/// reading.
+inline constexpr double kMaxTrialTicks = 1e7;
+
 /// How a trial's ticks are paced.
 enum class TrialPacing {
   automatic,  ///< lock-step when the trial is given a hand (hand.hpp), real time otherwise

@@ -3,9 +3,12 @@
 /// The one trial specification: what to write, on which device, with which guidance, pacing, writer and
 /// recording. A value type with one parser and one serialiser for each of its two forms, JSON and the
 /// command line's option strings (`calligraphy trial CHARS --guidance off ...`), which round-trip, and one
-/// `validate()` whose errors name the field. The one runner of a specification is `run_trial_spec`
-/// (trial_spec_runner.hpp); `calligraphy trial`, the trainer, study sessions and Python all go through it.
-/// The fields, their JSON keys, options and meaning: docs/cli.md ("The trial specification").
+/// `validate()` whose errors name the field; a checked specification is a `Checked<TrialSpec>`
+/// (checked.hpp), which its runner `run_trial_spec` (trial_spec_runner.hpp) takes as it is. `calligraphy
+/// trial`, the trainer, study sessions and Python all go through it. The simulated writer's profile and
+/// settings are named here and checked by the simulated writer (calligraphy/sim's `writer_profile_of`); a
+/// replay's teacher file is read by the front-end (calligraphy/report's teacher_recording.hpp). The fields,
+/// their JSON keys, options and meaning: docs/cli.md ("The trial specification").
 #include <cstdint>
 #include <span>
 #include <string>
@@ -16,8 +19,8 @@
 #include "calligraphy/devices/servo_loop.hpp"
 #include "calligraphy/render/force_law.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
-#include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/trial/options.hpp"
+#include "calligraphy/trial/writer_setting.hpp"
 
 namespace calligraphy {
 
@@ -60,13 +63,14 @@ struct TrialSpec {
   std::string record_file;        ///< the trial as a teacher's recording (only "" or a file)
 
   /// Throws InvalidArgument naming the field (its JSON key and its option) when a value is out of range or
-  /// two fields contradict each other: characters empty or over 1,000, an unknown writer profile or
-  /// parameter, a guidance mode or gain without the guidance it needs, a replay without a teacher or a
-  /// teacher without a replay, a profile for a person, a rate outside the pacing's range, more than 10^7
-  /// ticks, a teacher's recording on standard output. Outputs on one file are the front-end's to refuse
-  /// (it resolves links: the CLI's file plan). `teacher_from`: where a replay's teacher comes from, the file
-  /// `teacher` (required then) or samples the runner is given (TrialRunInputs::teacher; `teacher` must then
-  /// be empty: nothing would read it).
+  /// two fields contradict each other: characters empty or over 1,000, a guidance mode or gain without the
+  /// guidance it needs, a replay without a teacher or a teacher without a replay, a profile or settings for a
+  /// person, an empty profile name or a setting without a key, a rate outside the pacing's range, more than
+  /// 10^7 ticks, a teacher's recording on standard output. The profile's name and its settings' keys and
+  /// ranges are the simulated writer's to check (sim's `writer_profile_of`); outputs on one file are the
+  /// front-end's to refuse (it resolves links: the CLI's file plan). `teacher_from`: where a replay's teacher
+  /// comes from, the file `teacher` (required then; its front-end reads it) or samples the runner is given
+  /// with no file named (`teacher` must then be empty: nothing would read it).
   void validate(TeacherSource teacher_from = TeacherSource::file) const;
 
   bool operator==(const TrialSpec&) const = default;

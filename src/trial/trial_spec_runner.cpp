@@ -1,14 +1,10 @@
-#include "calligraphy/study/trial_spec_runner.hpp"
+#include "calligraphy/trial/trial_spec_runner.hpp"
 
 #include <algorithm>
 #include <memory>
 
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/report/teacher_recording.hpp"
 #include "calligraphy/devices/hand_port.hpp"
-#include "calligraphy/devices/simulated_device.hpp"
-#include "calligraphy/sim/simulated_hand.hpp"
-#include "calligraphy/sim/trace_attempts.hpp"
 #include "calligraphy/trial/runner.hpp"
 
 namespace calligraphy {
@@ -47,13 +43,6 @@ GuidanceLaw guidance_law_of(const TrialSpec& spec) {
   return FixedGuidance{};
 }
 
-WriterProfile profile_of(const TrialSpec& spec) {
-  WriterProfile profile = writer_profile(spec.writer_profile);
-  for (const WriterSetting& setting : spec.writer_parameters)
-    set_writer_parameter(profile, setting.key, setting.value);
-  return profile;
-}
-
 // The options `spec` states on `device`. Every value comes from the checked specification (its rate, duration
 // and watchdog in the ranges TrialOptions::validate reads, its guidance law's parameter in the law's table)
 // or is a default, and a default stiffness is only lowered to the device's positive limit: valid by
@@ -72,17 +61,13 @@ TrialOptions options_stated(const TrialSpec& spec, const DeviceInfo& device) {
   return options;
 }
 
-// The teacher a checked replay runs on: its file when it names one, else the caller's samples; one or the
-// other, never both (TrialSpec::validate's rule for the source the caller checked with).
-void require_one_teacher(const TrialSpec& spec, const TrialRunInputs& inputs) {
-  if (!spec.guidance || spec.guidance_mode != GuidanceMode::replay) return;
-  if (spec.teacher.empty() && inputs.teacher.empty()) {
+// A replay runs on the teacher's samples, which the caller reads from the specification's file or has.
+void require_teacher(const TrialSpec& spec, const TrialRunInputs& inputs) {
+  if (spec.guidance && spec.guidance_mode == GuidanceMode::replay && inputs.teacher.empty()) {
     throw InvalidArgument(
-        "teacher (--teacher): required with guidance mode 'replay' (a recording made with --record, or the "
-        "teacher's samples in TrialRunInputs::teacher)");
-  }
-  if (!spec.teacher.empty() && !inputs.teacher.empty()) {
-    throw InvalidArgument("teacher (--teacher): the teacher is given as samples; the file would not be read");
+        "teacher (--teacher): a replay runs on the teacher's samples (TrialRunInputs::teacher), read from " +
+        (spec.teacher.empty() ? std::string("a teacher's recording") : spec.teacher) +
+        " by its front-end (read_teacher_recording)");
   }
 }
 
@@ -116,21 +101,8 @@ bool simulated_writer_writes(const TrialSpec& spec, bool simulated_writer_can_mo
 
 TrialRun run_trial_spec(const Checked<TrialSpec>& checked, const Scene& scene, const TrialRunInputs& inputs) {
   const TrialSpec& spec = *checked;
-  require_one_teacher(spec, inputs);
+  require_teacher(spec, inputs);
   TrialRun run;
-  run.writer = inputs.writer ? *inputs.writer : profile_of(spec);
-  run.writer.validate();
-  std::vector<TeacherSample> teacher = inputs.teacher;
-  if (spec.guidance_mode == GuidanceMode::replay && teacher.empty()) {
-    TeacherRecording recording = read_teacher_recording(spec.teacher);
-    try {
-      require_teacher_for(recording, spec.characters);
-    } catch (const InvalidArgument& e) {
-      throw InvalidArgument("teacher (--teacher) " + spec.teacher + ": " + e.what());
-    }
-    teacher = std::move(recording.samples);
-  }
-
   std::unique_ptr<HapticDevice> created;
   HapticDevice* device = inputs.device;
   if (device == nullptr) {
@@ -144,6 +116,11 @@ TrialRun run_trial_spec(const Checked<TrialSpec>& checked, const Scene& scene, c
   run.device = device->info();
   // Found once, here: the trial never asks what its device is.
   run.simulated_writer = simulated_writer_writes(spec, device->hand_port() != nullptr);
+  if (run.simulated_writer && inputs.hand_maker == nullptr) {
+    throw InvalidArgument("run_trial_spec: the simulated writer writes on \"" + spec.device +
+                          "\" and no hand maker makes its hand (TrialRunInputs::hand_maker: sim's "
+                          "SimulatedWriting)");
+  }
 
   // The specification's values were checked with it; what the caller gives instead (a force law, a safety
   // chain, a passivity controller) and a replay's teacher are new values, checked here once.
@@ -164,7 +141,7 @@ TrialRun run_trial_spec(const Checked<TrialSpec>& checked, const Scene& scene, c
       given.force = *inputs.force_law;
     }
     if (auto* law = std::get_if<ReplayGuidance>(&given.force.guidance_law))
-      law->teacher_trajectory = std::move(teacher);
+      law->teacher_trajectory = inputs.teacher;
     if (inputs.safety) given.safety = *inputs.safety;
     if (inputs.passivity) given.passivity = *inputs.passivity;
     options = Checked<TrialOptions>::check(std::move(given));
@@ -181,16 +158,12 @@ TrialRun run_trial_spec(const Checked<TrialSpec>& checked, const Scene& scene, c
     return running;
   });
 
-  std::unique_ptr<SimulatedHand> hand;
-  if (run.simulated_writer) hand = simulated_hand_for(*device, scene, run.writer, spec.seed);
+  std::unique_ptr<TrialHand> hand;
+  if (run.simulated_writer) hand = inputs.hand_maker->make_hand(*device, scene, spec.seed);
   run.result = run_trial(*device, scene, options, hand.get());
   run.options = *options;
-  if (hand) {
-    run.writer_log = hand->log();
-    // The writer knows which stroke each pen-down segment meant, and which it wrote again.
-    mark_writer_attempts(run.result.trace, *run.writer_log);
-  }
-  hand.reset();  // lets go of the device before it goes
+  if (hand) inputs.hand_maker->after_trial(run.result);  // the hand has let go (run_trial), and still is
+  hand.reset();                                          // before the device goes
   run.options.should_stop = nullptr;
   run.options.display = nullptr;
   run.metrics = trial_writing_metrics(scene, run.result, run.options.force.acceptance);

@@ -1,10 +1,11 @@
 #pragma once
 /// \file trial_spec_runner.hpp
 /// The one runner of a trial specification (trial_spec.hpp), which `calligraphy trial`, the trainer, study
-/// sessions and Python call: the specification becomes the runner's `TrialOptions` (`trial_options`), its
-/// device is created from a registry (or given), and when the simulated writer writes, a `SimulatedHand` on
-/// the device is made and given to `run_trial` (runner.hpp) as its hand: simulation is an input to the
-/// trial, never part of it. The result carries the one metrics record (writing_metrics.hpp).
+/// sessions and Python call: the checked specification becomes the runner's `TrialOptions`
+/// (`trial_options`), its device is created from a registry (or given), and when the simulated writer writes,
+/// the caller's hand maker (TrialRunInputs::hand_maker: sim's `SimulatedWriting`) makes the hand that
+/// `run_trial` (runner.hpp) is given: simulation is an input to the trial, never part of it. The result
+/// carries the one metrics record (writing_metrics.hpp).
 #include <functional>
 #include <optional>
 #include <vector>
@@ -13,10 +14,10 @@
 #include "calligraphy/core/checked.hpp"
 #include "calligraphy/devices/device_registry.hpp"
 #include "calligraphy/model/scene.hpp"
-#include "calligraphy/sim/writer_log.hpp"
-#include "calligraphy/sim/writer_profile.hpp"
-#include "calligraphy/study/trial_spec.hpp"
+#include "calligraphy/render/guidance_mode.hpp"
+#include "calligraphy/trial/hand.hpp"
 #include "calligraphy/trial/result.hpp"
+#include "calligraphy/trial/trial_spec.hpp"
 
 namespace calligraphy {
 
@@ -28,11 +29,14 @@ struct TrialRunInputs {
   /// A device the caller made (not owned; opened here when it is not open, closed at the end), used
   /// instead of creating `TrialSpec::device` (e.g. a simulated device with the caller's parameters).
   HapticDevice* device = nullptr;
-  /// A teacher's pen read by the caller (a session keeps its teacher in its folder), used instead of
-  /// reading the file `TrialSpec::teacher`; device frame [m], times [s].
+  /// A replay's teacher pen, device frame [m], times [s]; required for a replay. The front-end reads it from
+  /// the file `TrialSpec::teacher` (report's `read_teacher_recording`, `require_teacher_for`), or has it (a
+  /// session keeps its teacher in its folder; Python passes a TeacherRecording).
   std::vector<TeacherSample> teacher;
-  /// A profile for the simulated writer used instead of `TrialSpec::writer_profile` and its parameters.
-  std::optional<WriterProfile> writer;
+  /// Makes the simulated writer's hand (not owned): required when the simulated writer writes, i.e. on a
+  /// device it can move (`simulated_writer_writes`). sim's `SimulatedWriting` of the specification, which
+  /// checks its profile and settings and keeps what the writer did.
+  TrialHandMaker* hand_maker = nullptr;
   /// Polled by the thread that runs the trial (TrialOptions::should_stop); may be empty.
   std::function<bool()> should_stop;
   /// False (the command line, study sessions): a real-time trial asks for SCHED_FIFO at
@@ -48,22 +52,20 @@ struct TrialRunInputs {
   std::optional<PassivityParameters> passivity;  ///< instead of the defaults
   /// Where the trial publishes what a window shows (TrialOptions::display; not owned); nullptr: nowhere.
   DisplayChannel* display = nullptr;
-  /// With `host_process` false: lock the process's memory in a real-time trial (ServoLoopOptions::lock_memory).
-  /// A window process maps memory all the time (the GL driver): mlockall(MCL_FUTURE) would lock all of it,
-  /// or make its allocations fail under a memory-lock limit, so it sets false (the trace is touched in
-  /// advance instead) and keeps the real-time priority.
+  /// With `host_process` false: lock the process's memory in a real-time trial
+  /// (ServoLoopOptions::lock_memory). A window process maps memory all the time (the GL driver):
+  /// mlockall(MCL_FUTURE) would lock all of it, or make its allocations fail under a memory-lock limit, so it
+  /// sets false (the trace is touched in advance instead) and keeps the real-time priority.
   bool lock_memory = true;
 };
 
 /// What ran, and what it gave.
 struct TrialRun {
   TrialResult result;
-  TrialOptions options;                 ///< the options the trial ran with (should_stop and display cleared)
-  DeviceInfo device;                    ///< the device's figures
-  bool simulated_writer = false;        ///< the simulated writer wrote (else a person)
-  WriterProfile writer;                 ///< the profile it wrote with (after the parameters)
-  std::optional<WriterLog> writer_log;  ///< what it did, attempt by attempt; nullopt for a person
-  WritingMetrics metrics;               ///< the one metrics record of the trace (writing_metrics.hpp)
+  TrialOptions options;           ///< the options the trial ran with (should_stop and display cleared)
+  DeviceInfo device;              ///< the device's figures
+  bool simulated_writer = false;  ///< the simulated writer wrote (the hand maker's hand; else a person)
+  WritingMetrics metrics;         ///< the one metrics record of the trace (writing_metrics.hpp)
 };
 
 /// The runner's options for the checked `spec` on a device with figures `device`, checked with it (derived:
@@ -81,15 +83,14 @@ struct TrialRun {
 
 /// Runs the trial `spec` states on `scene` (laid out from `spec.characters` by the caller, who knows where
 /// characters come from). `spec` was checked once by its front-end (`Checked<TrialSpec>::check`, or the
-/// parsers of trial_spec.hpp), with a replay's teacher from the file `spec.teacher` or, `spec.teacher` empty,
-/// from `inputs.teacher`; nothing of it is validated again down to the renderer. Creates the device (unless
-/// given), reads the teacher (unless given), makes the simulated writer's hand when it writes, runs
-/// `run_trial`, and scores the trace. What `inputs` gives instead of the specification's (a force law, a
-/// safety chain, a passivity controller) is checked here. Writes none of `spec`'s output files (the caller's:
-/// they depend on its front-end). Throws InvalidArgument when `inputs` gives neither a device nor a registry,
-/// or a replay neither or both of a teacher file and samples, DeviceNotFound, DataError for a teacher that
-/// cannot be read, InvalidArgument for one of other characters or for a part of `inputs` out of range, and
-/// what `run_trial` throws.
+/// parsers of trial_spec.hpp); nothing of it is validated again down to the renderer. Creates the device
+/// (unless given), asks `inputs.hand_maker` for the simulated writer's hand when it writes, runs `run_trial`,
+/// lets the hand maker mark the trace, and scores the trace. What `inputs` gives instead of the
+/// specification's (a force law, a safety chain, a passivity controller) and a replay's teacher are checked
+/// here. Writes none of `spec`'s output files (the caller's: they depend on its front-end). Throws
+/// InvalidArgument when `inputs` gives neither a device nor a registry, no teacher for a replay, or no hand
+/// maker when the simulated writer writes, or a part of `inputs` out of range; DeviceNotFound; and what
+/// `run_trial` throws.
 [[nodiscard]] TrialRun run_trial_spec(const Checked<TrialSpec>& spec, const Scene& scene,
                                       const TrialRunInputs& inputs = {});
 

@@ -1,4 +1,4 @@
-#include "calligraphy/study/trial_spec.hpp"
+#include "calligraphy/trial/trial_spec.hpp"
 
 #include <array>
 #include <cerrno>
@@ -14,20 +14,11 @@
 #include "calligraphy/core/servo_rate.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/scene.hpp"
-#include "calligraphy/sim/writer_profile.hpp"
-#include "calligraphy/study/protocol.hpp"
 #include "core/json_reader.hpp"
-#include "study/trial_spec_object.hpp"
+#include "trial/trial_spec_object.hpp"
 
 namespace calligraphy {
 namespace {
-
-// The writer's setting names, for an error about one: "hand_stiffness_n_per_m, ...".
-std::string writer_keys() {
-  std::string keys;
-  for (const std::string& key : writer_parameter_names()) keys += (keys.empty() ? "" : ", ") + key;
-  return keys;
-}
 
 using nlohmann::json;
 
@@ -231,7 +222,7 @@ void set_trial_spec_field(TrialSpec& spec, std::string_view name, std::string_vi
     try {
       spec.writer_parameters.push_back(parse_writer_setting(text));
     } catch (const InvalidArgument& e) {
-      refuse(key, std::string(e.what()) + "; known keys: " + writer_keys());
+      refuse(key, e.what());
     }
   } else if (key == "seed") {
     spec.seed = parse_unsigned(key, text);
@@ -339,20 +330,12 @@ void TrialSpec::validate(TeacherSource teacher_from) const {
   if (writer == TrialWriter::person && !writer_parameters.empty()) {
     refuse("writer_parameters", "apply to the simulated writer, not to a person (writer 'person')");
   }
-  WriterProfile profile;
-  try {
-    profile = calligraphy::writer_profile(writer_profile);
-  } catch (const InvalidArgument& e) {
-    refuse("writer_profile", e.what());
-  }
+  // The profile's name and its settings' keys and ranges are the simulated writer's to check (sim's
+  // writer_profile_of, when it is made); here, only what any writer needs.
+  if (writer_profile.empty()) refuse("writer_profile", "no profile named");
   for (const WriterSetting& setting : writer_parameters) {
-    try {
-      set_writer_parameter(profile, setting.key, setting.value);
-    } catch (const InvalidArgument& e) {
-      std::string message = e.what();
-      if (message.find("known:") == std::string::npos) message += "; known keys: " + writer_keys();
-      refuse("writer_parameters", "'" + writer_setting_text(setting) + "': " + message);
-    }
+    if (setting.key.empty() || !std::isfinite(setting.value))
+      refuse("writer_parameters", "'" + writer_setting_text(setting) + "' is not a key and a finite number");
   }
   const bool real_time = pacing == TrialPacing::real_time;
   if (!servo_rate_allowed(rate_hz, real_time)) {
@@ -411,7 +394,7 @@ std::vector<std::string> trial_spec_args(const TrialSpec& spec) {
   return args;
 }
 
-namespace study_detail {
+namespace trial_detail {
 
 Checked<TrialSpec> trial_spec_from_object(const json& document, const std::string& at_pointer,
                                           const std::string& source, TeacherSource teacher_from) {
@@ -473,11 +456,11 @@ Checked<TrialSpec> trial_spec_from_object(const json& document, const std::strin
   return Checked<TrialSpec>::check(std::move(spec), teacher_from);
 }
 
-}  // namespace study_detail
+}  // namespace trial_detail
 
 Checked<TrialSpec> trial_spec_from_json(std::string_view text, const std::string& source,
                                         TeacherSource teacher_from) {
-  return study_detail::trial_spec_from_object(json_detail::parse_json(text, source), "", source,
+  return trial_detail::trial_spec_from_object(json_detail::parse_json(text, source), "", source,
                                               teacher_from);
 }
 

@@ -4,13 +4,13 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "calligraphy/study/trial_spec.hpp"
+#include "calligraphy/trial/trial_spec.hpp"
 
-namespace calligraphy::study_detail {
+namespace calligraphy::trial_detail {
 
 /// `trial_spec_from_json` of the object at `pointer` in a document read from `source`: DataError naming the
 /// source and the value's pointer, then InvalidArgument naming the field (TrialSpec::validate).
 Checked<TrialSpec> trial_spec_from_object(const nlohmann::json& object, const std::string& pointer,
                                           const std::string& source, TeacherSource teacher_from);
 
-}  // namespace calligraphy::study_detail
+}  // namespace calligraphy::trial_detail
