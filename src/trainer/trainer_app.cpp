@@ -35,12 +35,6 @@ constexpr auto kSaveAfterLostDisplay = std::chrono::seconds(5);
 
 }  // namespace
 
-std::string stop_reason() {
-  if (display_lost()) return "display_lost";
-  if (StopSignals::received() != 0) return signal_name(StopSignals::received());
-  return {};
-}
-
 TrainerApp::TrainerApp(const TrainerOptions& options, DeviceInfo device_info, bool hardware,
                        const SessionLink* session)
     : options_(options), device_info_(std::move(device_info)), hardware_(hardware), session_(session) {
@@ -267,33 +261,5 @@ void TrainerApp::update_pointer() {
       view_->whole_row ? layout_->screen_to_row(Vec2(x, y)) : layout_->to_trial(view_->character, Vec2(x, y));
   pointer_input().set(trial_m.x(), trial_m.y(), pressed);
 }
-
-int run_trainer(const TrainerOptions& options) {
-  if (options.characters.empty()) throw InvalidArgument("calligraphy train: no characters to practise");
-  if (options.registry == nullptr)
-    throw InvalidArgument("calligraphy train: no device registry (TrainerOptions::registry)");
-  // The device must exist, and a simulated writer can move only a device with a hand port.
-  const DeviceListing listing = options.registry->find(options.device);
-  const bool hand_port = listing.capabilities.moved_by_simulated_hand;
-  if (options.simulated_writer && !hand_port) {
-    throw InvalidArgument(
-        "--writer simulated needs a device a simulated writer can move (simulated, "
-        "emulated-phantom); '" +
-        options.device + "' is moved by a person");
-  }
-  if (!options.simulated_writer && hand_port) {
-    throw InvalidArgument("device '" + options.device +
-                          "' is moved by the simulated writer: pass --writer simulated, or use mouse, "
-                          "mouse-hand or a haptic device");
-  }
-  // SIGINT, SIGTERM and SIGHUP only set a flag; the window loop ends the trial safely. A command that
-  // installed the handlers already (a study session) keeps them.
-  std::optional<StopSignals> signals;
-  if (!StopSignals::installed()) signals.emplace();
-  TrainerApp app(options, options.registry->create(options.device)->info(), listing.capabilities.hardware);
-  return app.run();
-}
-
-void register_trainer_devices(DeviceRegistry& registry) { register_pointer_devices(registry); }
 
 }  // namespace calligraphy::trainer

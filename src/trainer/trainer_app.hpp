@@ -27,6 +27,7 @@
 #include "trainer/panel.hpp"
 #include "trainer/scene_view.hpp"
 #include "trainer/session_host.hpp"
+#include "trainer/stop_reason.hpp"
 #include "trainer/trainer.hpp"
 #include "trainer/trial_view.hpp"
 #include "trainer/trial_worker.hpp"
@@ -41,10 +42,6 @@ constexpr double kAdvanceDelayS = 1.0;  // unattended: pause on a trial's summar
 using Clock = std::chrono::steady_clock;
 
 enum class NextAction { none, repeat, next, quit };
-
-/// Why the window ends its trial early: "display_lost" after a lost X connection, the stop signal's name
-/// ("SIGINT", "SIGTERM", "SIGHUP"), or empty (a key, the window closed).
-[[nodiscard]] std::string stop_reason();
 
 // A study session the window hosts (run_trainer_session): the host and whether its thread is done.
 struct SessionLink {
