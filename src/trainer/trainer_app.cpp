@@ -37,7 +37,11 @@ constexpr auto kSaveAfterLostDisplay = std::chrono::seconds(5);
 
 TrainerApp::TrainerApp(const TrainerOptions& options, DeviceInfo device_info, bool hardware,
                        const SessionLink* session)
-    : options_(options), device_info_(std::move(device_info)), hardware_(hardware), session_(session) {
+    : options_(options),
+      device_info_(std::move(device_info)),
+      hardware_(hardware),
+      session_(session),
+      quiz_log_(session ? "calligraphy session" : "calligraphy train", options.quiz_screenshots) {
   for (const TrainerCharacter& c : options.characters) {
     art_.push_back(prepare_art(c));
     std::vector<int> ids;
@@ -157,6 +161,11 @@ std::string TrainerApp::condition_name() const {
   return kHapticCondition;
 }
 
+std::span<const std::string> TrainerApp::characters_utf8(const TrialView& view) const {
+  if (session_ != nullptr) return session_utf8_;
+  return {&options_.characters[view.character].utf8, 1};  // a practice trial's scene: its one character
+}
+
 bool TrainerApp::unattended() const { return options_.exit_after_s > 0.0; }
 
 // ---- The loop.
@@ -181,8 +190,8 @@ void TrainerApp::loop() {
     if (pending_ != NextAction::none && worker_.active() && !worker_.done()) worker_.request_stop();
     if (view_ && worker_.active()) {
       view_->consume(*channel_, typical_ids_[view_->character]);
-      log_quiz(*view_);
-      log_refusal(*view_);
+      quiz_log_.log_verdicts(*view_, characters_utf8(*view_));
+      quiz_log_.log_refusal(*view_, characters_utf8(*view_));
       // The quiz asks for every stroke in order, judged its own way: once each is accepted the trial has
       // done its job and ends (saved as completed, see finish_trial), whatever the renderer counted.
       if (view_->quiz && view_->quiz->complete() && !worker_.done()) worker_.request_stop();
@@ -206,7 +215,7 @@ void TrainerApp::loop() {
   // The last character's trial ended in this very iteration: its summary, after the last stroke.
   if (!options_.screenshot.empty() && !screenshot_taken_ && !x11_error_seen() && view_) render(true);
   // A stroke judged as the trial ended (the pen still down): the frame that shows it.
-  if (!quiz_screenshot_.empty() && !x11_error_seen() && view_) render(false);
+  if (quiz_log_.screenshot_requested() && !x11_error_seen() && view_) render(false);
 }
 
 double TrainerApp::seconds_since_start() const {

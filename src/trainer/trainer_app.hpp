@@ -2,8 +2,8 @@
 // TrainerApp: the window of `calligraphy train` and of a study session in the window (trainer.hpp). Its
 // methods live in files by job: trainer_app.cpp (construction, the loop, keys, pointer), trainer_window.cpp
 // (window, fonts, drawing, screenshots), trainer_trials.cpp (a trial's start and end, measurements),
-// trainer_session_view.cpp (a study session's view), trainer_quiz_log.cpp (the quiz's verdicts, refused
-// strokes).
+// trainer_session_view.cpp (a study session's view); the quiz's verdicts and refused strokes go to its
+// QuizLog.
 #include <imgui.h>
 
 #include <atomic>
@@ -13,6 +13,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,7 @@
 #include "trainer/layout.hpp"
 #include "trainer/live_quiz.hpp"
 #include "trainer/panel.hpp"
+#include "trainer/quiz_log.hpp"
 #include "trainer/scene_view.hpp"
 #include "trainer/session_host.hpp"
 #include "trainer/stop_reason.hpp"
@@ -86,11 +88,8 @@ class TrainerApp {
   Scene session_scene(const PlannedTrial& trial) const;
   void session_panel(PanelInput& panel) const;
 
-  // the quiz's verdicts and the refused strokes (trainer_quiz_log.cpp)
-  void log_quiz(TrialView& view);
-  void log_refusal(TrialView& view);
-  [[nodiscard]] std::string character_utf8(const TrialView& view, std::size_t character) const;
-  void check_quiz_against_trace(const LiveQuiz& quiz, const TrialResult& result);
+  // the characters of the trial `view` shows, in its scene's order, for the quiz log
+  [[nodiscard]] std::span<const std::string> characters_utf8(const TrialView& view) const;
 
   TrainerOptions options_;
   DeviceInfo device_info_;
@@ -101,6 +100,7 @@ class TrainerApp {
   std::uint64_t shown_generation_ = 0;
   std::shared_ptr<DisplayChannel> session_channel_;
   Scene session_scene_;
+  std::vector<std::string> session_utf8_;  // the shown trial's characters
   std::vector<CharacterArt> all_art_;
   std::vector<std::vector<int>> all_typical_ids_;
   std::map<char32_t, std::size_t> index_of_;
@@ -130,8 +130,7 @@ class TrainerApp {
   NextAction pending_ = NextAction::none;
   std::optional<Clock::time_point> advance_at_;
   bool screenshot_due_ = false;
-  std::size_t quiz_verdicts_ = 0;
-  std::string quiz_screenshot_;  // written at the next frame
+  QuizLog quiz_log_;
   bool screenshot_taken_ = false;
   Clock::time_point started_;
   std::size_t frames_ = 0;

@@ -62,8 +62,8 @@ void TrainerApp::follow_session() {
     view_->acceptance = s.acceptance;
   }
   if (session_channel_) view_->consume(*session_channel_, typical_ids_.front());
-  log_quiz(*view_);
-  log_refusal(*view_);
+  quiz_log_.log_verdicts(*view_, session_utf8_);
+  quiz_log_.log_refusal(*view_, session_utf8_);
   if (s.outcome && !view_->have_result) {
     view_->have_result = true;
     view_->ended = true;
@@ -89,10 +89,12 @@ void TrainerApp::follow_session() {
 void TrainerApp::show_session_trial(const SessionView& s) {
   art_.clear();
   typical_ids_.clear();
+  session_utf8_.clear();
   for (const char32_t c : s.trial.characters) {
     const std::size_t k = index_of_.at(c);
     art_.push_back(all_art_[k]);
     typical_ids_.push_back(all_typical_ids_[k]);
+    session_utf8_.push_back(options_.characters[k].utf8);
   }
   // Stroke events count strokes within their character; a one-character trial (the usual) names its own.
   layout_.emplace(art_.size(), options_.width_px, options_.height_px, kPanelWidthPx);

@@ -94,9 +94,9 @@ void TrainerApp::finish_trial() {
   trial_options_ = run.options;  // what the trial ran with (the stiffness fitted to the device)
   TrialResult& result = run.result;
   view.consume(*channel_, typical_ids_[view.character]);
-  log_quiz(view);
-  log_refusal(view);
-  if (view.quiz) check_quiz_against_trace(*view.quiz, result);
+  quiz_log_.log_verdicts(view, characters_utf8(view));
+  quiz_log_.log_refusal(view, characters_utf8(view));
+  if (view.quiz) check_quiz_against_trace(*view.quiz, worker_.scene(), result.trace, options_.quiz_options);
   if (view.quiz && view.quiz->complete() && result.end == TrialEnd::interrupted) {
     // Stopped once the quiz was complete (by the loop, or a key in the same moment): the quiz's task is
     // done, so the trial is complete, and saved as a trial rather than an attempt.

@@ -130,15 +130,15 @@ void TrainerApp::render(bool take_screenshot) {
   glClearColor(1.0f, 1.0f, 1.0f, 1.0f);
   glClear(GL_COLOR_BUFFER_BIT);
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-  if (!quiz_screenshot_.empty()) {  // the first frame that shows the latest judged stroke
+  if (quiz_log_.screenshot_requested()) {  // the first frame that shows the latest judged stroke
+    const std::string quiz_screenshot = quiz_log_.take_screenshot_request();
     try {
-      write_framebuffer_png(quiz_screenshot_, width, height);
-      std::fprintf(stderr, "calligraphy train: quiz screenshot %s\n", quiz_screenshot_.c_str());
+      write_framebuffer_png(quiz_screenshot, width, height);
+      std::fprintf(stderr, "calligraphy train: quiz screenshot %s\n", quiz_screenshot.c_str());
     } catch (const std::exception& e) {
       std::fprintf(stderr, "calligraphy train: error: %s\n", e.what());
       status_ = 1;
     }
-    quiz_screenshot_.clear();
   }
   if (take_screenshot) {
     try {
