@@ -40,7 +40,6 @@ TrainerApp::TrainerApp(const TrainerOptions& options, DeviceInfo device_info, bo
     : options_(options),
       device_info_(std::move(device_info)),
       hardware_(hardware),
-      session_(session),
       quiz_log_(session ? "calligraphy session" : "calligraphy train", options.quiz_screenshots) {
   for (const TrainerCharacter& c : options.characters) {
     art_.push_back(prepare_art(c));
@@ -56,11 +55,9 @@ TrainerApp::TrainerApp(const TrainerOptions& options, DeviceInfo device_info, bo
   guidance_mode_ = options.guidance_mode;
   guidance_gain_ = options.guidance_gain;
   condition_outputs_force_ = options.device != "mouse";
-  if (session_ != nullptr) {
-    all_art_ = art_;
-    all_typical_ids_ = typical_ids_;
-    for (std::size_t k = 0; k < options.characters.size(); ++k)
-      index_of_[options.characters[k].model.code_point] = k;
+  if (session != nullptr) {
+    session_.emplace(*session, options_.characters, unattended());
+    every_character_art_ = art_;
   }
 }
 
@@ -86,20 +83,20 @@ int TrainerApp::run() {
   layout_.emplace(session_ ? 1 : options_.characters.size(), options_.width_px, options_.height_px,
                   kPanelWidthPx);
   if (session_) art_.resize(1);
-  for (std::size_t k = 0; k < layout_->count() && session_ == nullptr; ++k) {
+  for (std::size_t k = 0; k < layout_->count() && !session_; ++k) {
     const ScreenBox& b = layout_->box(k);
     std::printf("box %zu %s x=%.0f y=%.0f size=%.0f\n", k, options_.characters[k].utf8.c_str(), b.x_px,
                 b.y_px, b.size_px);
   }
   std::fflush(stdout);
   started_ = Clock::now();
-  if (session_ == nullptr) start_trial(0);
+  if (!session_) start_trial(0);
   loop();
   close_window();
   set_display_lost_ending({});
   print_measurements();
   const int signal = StopSignals::received();
-  if (signal != 0 && session_ == nullptr) {
+  if (signal != 0 && !session_) {
     std::fprintf(stderr, "calligraphy train: stopped by %s\n", signal_name(signal));
     log_stop(signal_name(signal));
     if (status_ == 0) status_ = exit_status_after(signal);
@@ -116,9 +113,9 @@ void TrainerApp::end_after_lost_display() {
     while (!done() && Clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(2));
     return done();
   };
-  if (session_ != nullptr) {
-    session_->host->request_stop();
-    if (wait_until([this] { return session_->done->load(); })) {
+  if (session_) {
+    session_->request_stop();
+    if (wait_until([this] { return session_->finished(); })) {
       std::fprintf(stderr,
                    "calligraphy session: stopped: the display was lost; the running trial is kept as an "
                    "attempt; resume with: calligraphy session resume SESSION_FOLDER\n");
@@ -162,8 +159,29 @@ std::string TrainerApp::condition_name() const {
 }
 
 std::span<const std::string> TrainerApp::characters_utf8(const TrialView& view) const {
-  if (session_ != nullptr) return session_utf8_;
   return {&options_.characters[view.character].utf8, 1};  // a practice trial's scene: its one character
+}
+
+const TrialView* TrainerApp::trial_view() const {
+  if (session_) return session_->view();
+  return view_ ? &*view_ : nullptr;
+}
+
+void TrainerApp::follow_session() {
+  session_->follow(quiz_log_, [this](const std::vector<std::size_t>& characters) { show_row(characters); });
+}
+
+// A session's trial: the row becomes its characters.
+void TrainerApp::show_row(const std::vector<std::size_t>& characters) {
+  art_.clear();
+  for (const std::size_t k : characters) art_.push_back(every_character_art_[k]);
+  layout_.emplace(art_.size(), options_.width_px, options_.height_px, kPanelWidthPx);
+  for (std::size_t k = 0; k < layout_->count(); ++k) {
+    const ScreenBox& b = layout_->box(k);
+    std::printf("box %zu %s x=%.0f y=%.0f size=%.0f\n", k, options_.characters[characters[k]].utf8.c_str(),
+                b.x_px, b.y_px, b.size_px);
+  }
+  std::fflush(stdout);
 }
 
 bool TrainerApp::unattended() const { return options_.exit_after_s > 0.0; }
@@ -178,13 +196,14 @@ void TrainerApp::loop() {
     if (unattended() && seconds_since_start() >= options_.exit_after_s) quit_ = true;
     handle_keys();
     if (quit_ && !quit_seen_) {  // the picture at exit shows the window as it was when the exit came
-      if (!options_.screenshot.empty() && !screenshot_taken_ && !x11_error_seen() && view_) render(true);
+      if (!options_.screenshot.empty() && !screenshot_taken_ && !x11_error_seen() && trial_view())
+        render(true);
       quit_seen_ = true;
     }
-    if (session_ != nullptr) {
-      if (quit_) session_->host->request_stop();
+    if (session_) {
+      if (quit_) session_->request_stop();
       follow_session();
-      if (session_->done->load() && (quit_ || unattended())) break;
+      if (session_->finished() && (quit_ || unattended())) break;
     }
     if (quit_ && worker_.active() && !worker_.done()) worker_.request_stop();
     if (pending_ != NextAction::none && worker_.active() && !worker_.done()) worker_.request_stop();
@@ -197,7 +216,7 @@ void TrainerApp::loop() {
       if (view_->quiz && view_->quiz->complete() && !worker_.done()) worker_.request_stop();
     }
     if (worker_.active() && worker_.done()) finish_trial();
-    if (!worker_.active() && session_ == nullptr) {
+    if (!worker_.active() && !session_) {
       if (quit_) break;
       if (pending_ == NextAction::repeat) start_trial(view_->character);
       if (pending_ == NextAction::next) start_trial((view_->character + 1) % options_.characters.size());
@@ -206,16 +225,18 @@ void TrainerApp::loop() {
     }
     update_pointer();
     if (x11_error_seen()) continue;  // the window is gone: no drawing, only the ending above
-    const bool take_screenshot = !options_.screenshot.empty() && !screenshot_taken_ && screenshot_due_;
+    // After the last character's trial, or the last planned trial's outcome.
+    const bool screenshot_due = screenshot_due_ || (session_ && session_->last_trial_ended());
+    const bool take_screenshot = !options_.screenshot.empty() && !screenshot_taken_ && screenshot_due;
     render(take_screenshot);
     next_frame += std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kFramePeriodS));
     if (next_frame < Clock::now()) next_frame = Clock::now();
     std::this_thread::sleep_until(next_frame);
   }
   // The last character's trial ended in this very iteration: its summary, after the last stroke.
-  if (!options_.screenshot.empty() && !screenshot_taken_ && !x11_error_seen() && view_) render(true);
+  if (!options_.screenshot.empty() && !screenshot_taken_ && !x11_error_seen() && trial_view()) render(true);
   // A stroke judged as the trial ended (the pen still down): the frame that shows it.
-  if (quiz_log_.screenshot_requested() && !x11_error_seen() && view_) render(false);
+  if (quiz_log_.screenshot_requested() && !x11_error_seen() && trial_view()) render(false);
 }
 
 double TrainerApp::seconds_since_start() const {
@@ -230,19 +251,19 @@ void TrainerApp::handle_keys() {
         quit_ = true;
         break;
       case GLFW_KEY_SPACE:
-        if (session_ != nullptr) session_->host->start_trial();
+        if (session_) session_->start_trial();
         break;
       case GLFW_KEY_R:
-        if (session_ == nullptr) pending_ = NextAction::repeat;
+        if (!session_) pending_ = NextAction::repeat;
         break;
       case GLFW_KEY_N:
-        if (session_ == nullptr) pending_ = NextAction::next;
+        if (!session_) pending_ = NextAction::next;
         break;
       case GLFW_KEY_G:  // a quiz has no guidance
-        if (session_ == nullptr && !options_.quiz) guidance_ = !guidance_;
+        if (!session_ && !options_.quiz) guidance_ = !guidance_;
         break;
       case GLFW_KEY_M:  // the guidance mode of the next trial, in turn (replay only with a teacher)
-        if (session_ == nullptr && !options_.quiz) {
+        if (!session_ && !options_.quiz) {
           const std::span<const GuidanceMode> modes = guidance_modes();
           auto at = std::find(modes.begin(), modes.end(), guidance_mode_);
           do {
@@ -260,14 +281,15 @@ void TrainerApp::handle_keys() {
 
 // The pointer in the running trial's metres, for the mouse devices (lock-free; read by the servo thread).
 void TrainerApp::update_pointer() {
-  if (!view_ || !layout_) return;
+  const TrialView* view = trial_view();
+  if (view == nullptr || !layout_) return;
   double x = 0.0;
   double y = 0.0;
   glfwGetCursorPos(window_, &x, &y);
   const bool in_area = x >= 0.0 && x < layout_->area_width_px() && y >= 0.0 && y < layout_->height_px();
   const bool pressed = in_area && glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
   const Vec2 trial_m =
-      view_->whole_row ? layout_->screen_to_row(Vec2(x, y)) : layout_->to_trial(view_->character, Vec2(x, y));
+      view->whole_row ? layout_->screen_to_row(Vec2(x, y)) : layout_->to_trial(view->character, Vec2(x, y));
   pointer_input().set(trial_m.x(), trial_m.y(), pressed);
 }
 

@@ -2,7 +2,7 @@
 // TrainerApp: the window of `calligraphy train` and of a study session in the window (trainer.hpp). Its
 // methods live in files by job: trainer_app.cpp (construction, the loop, keys, pointer), trainer_window.cpp
 // (window, fonts, drawing, screenshots), trainer_trials.cpp (a trial's start and end, measurements),
-// trainer_session_view.cpp (a study session's view); the quiz's verdicts and refused strokes go to its
+// a study session is followed by a HostedSessionView, the quiz's verdicts and refused strokes go to a
 // QuizLog.
 #include <imgui.h>
 
@@ -23,6 +23,7 @@
 #include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/study/practice_session.hpp"
 #include "calligraphy/trial/trial.hpp"
+#include "trainer/hosted_session_view.hpp"
 #include "trainer/layout.hpp"
 #include "trainer/live_quiz.hpp"
 #include "trainer/panel.hpp"
@@ -44,13 +45,6 @@ constexpr double kAdvanceDelayS = 1.0;  // unattended: pause on a trial's summar
 using Clock = std::chrono::steady_clock;
 
 enum class NextAction { none, repeat, next, quit };
-
-// A study session the window hosts (run_trainer_session): the host and whether its thread is done.
-struct SessionLink {
-  WindowSessionHost* host = nullptr;
-  const std::atomic<bool>* done = nullptr;
-  const SessionManifest* manifest = nullptr;
-};
 
 class TrainerApp {
  public:
@@ -82,28 +76,20 @@ class TrainerApp {
   void log_stop(const std::string& reason);
   void print_measurements() const;
 
-  // a study session's view (trainer_session_view.cpp)
+  // a study session's trials, each shown as its row
   void follow_session();
-  void show_session_trial(const SessionView& s);
-  Scene session_scene(const PlannedTrial& trial) const;
-  void session_panel(PanelInput& panel) const;
+  void show_row(const std::vector<std::size_t>& characters);
+  [[nodiscard]] const TrialView* trial_view() const;
 
-  // the characters of the trial `view` shows, in its scene's order, for the quiz log
+  // the characters of the practice trial `view` shows, in its scene's order, for the quiz log
   [[nodiscard]] std::span<const std::string> characters_utf8(const TrialView& view) const;
 
   TrainerOptions options_;
   DeviceInfo device_info_;
   bool hardware_ = false;
   std::optional<PracticeSession> practice_;
-  const SessionLink* session_ = nullptr;
-  SessionView session_view_;
-  std::uint64_t shown_generation_ = 0;
-  std::shared_ptr<DisplayChannel> session_channel_;
-  Scene session_scene_;
-  std::vector<std::string> session_utf8_;  // the shown trial's characters
-  std::vector<CharacterArt> all_art_;
-  std::vector<std::vector<int>> all_typical_ids_;
-  std::map<char32_t, std::size_t> index_of_;
+  std::optional<HostedSessionView> session_;
+  std::vector<CharacterArt> every_character_art_;  // a session's: each trial's row is drawn from it
   TrialOptions trial_options_;
   SimulationOptions trial_simulation_;  ///< the simulated writer of the trial (a hand-port device only)
   Clock::time_point trial_wall_start_;

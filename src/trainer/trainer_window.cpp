@@ -105,12 +105,13 @@ void TrainerApp::render(bool take_screenshot) {
   ImGui_ImplOpenGL3_NewFrame();
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();
-  const Scene& scene = session_ ? session_scene_ : worker_.scene();
-  draw_scene(*ImGui::GetBackgroundDrawList(), *layout_, art_, scene, view_ ? &*view_ : nullptr);
+  const Scene& scene = session_ ? session_->scene() : worker_.scene();
+  const TrialView* view = trial_view();
+  draw_scene(*ImGui::GetBackgroundDrawList(), *layout_, art_, scene, view);
   PanelInput panel;
-  panel.view = view_ ? &*view_ : nullptr;
-  if (view_ && session_ == nullptr) panel.character = options_.characters[view_->character].utf8;
-  if (session_ != nullptr) session_panel(panel);
+  panel.view = view;
+  if (view_ && !session_) panel.character = options_.characters[view_->character].utf8;
+  if (session_) session_->fill_panel(panel);
   panel.device = options_.device;
   panel.characters = options_.characters.size();
   panel.next_guidance = guidance_;
@@ -153,10 +154,9 @@ void TrainerApp::render(bool take_screenshot) {
   glfwSwapBuffers(window_);
   ++frames_;
   // Display latency: from the servo tick that published the snapshot to the frame that shows it.
-  const bool live = (worker_.active() && !worker_.done()) ||
-                    (session_ != nullptr && session_view_.phase == SessionPhase::running);
-  if (view_ && live && view_->snapshot.tick > 0) {
-    latencies_ms_.push_back(static_cast<double>(steady_ns() - view_->snapshot.published_ns) * 1e-6);
+  const bool live = (worker_.active() && !worker_.done()) || (session_ && session_->trial_running());
+  if (view != nullptr && live && view->snapshot.tick > 0) {
+    latencies_ms_.push_back(static_cast<double>(steady_ns() - view->snapshot.published_ns) * 1e-6);
   }
 }
 

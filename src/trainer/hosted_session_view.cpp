@@ -1,22 +1,14 @@
-// A study session in the trainer's window (run_trainer_session): the session runs on its own thread, the
-// window follows its host and shows each planned trial.
+// A study session in the trainer's window (hosted_session_view.hpp).
+#include "trainer/hosted_session_view.hpp"
+
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <exception>
 #include <filesystem>
 #include <functional>
-#include <map>
-#include <optional>
 #include <string>
-#include <thread>
 #include <vector>
-
-#include "calligraphy/core/errors.hpp"
-#include "calligraphy/core/stop_signals.hpp"
-#include "trainer/trainer_app.hpp"
 
 namespace calligraphy::trainer {
 namespace {
@@ -47,23 +39,29 @@ const char* mode_meaning(ConditionMode mode) {
 
 }  // namespace
 
-// ---- A study session (run_trainer_session): the window follows the session thread's host.
-void TrainerApp::follow_session() {
-  session_view_ = session_->host->view();
-  const SessionView& s = session_view_;
+HostedSessionView::HostedSessionView(const SessionLink& link, const std::vector<TrainerCharacter>& characters,
+                                     bool unattended)
+    : link_(link), characters_(characters), unattended_(unattended) {
+  for (std::size_t k = 0; k < characters.size(); ++k) index_of_[characters[k].model.code_point] = k;
+}
+
+void HostedSessionView::follow(QuizLog& quiz_log,
+                               const std::function<void(const std::vector<std::size_t>&)>& show_row) {
+  state_ = link_.host->view();
+  const SessionView& s = state_;
   if (s.phase != SessionPhase::waiting && s.trial_generation != shown_generation_) {
     shown_generation_ = s.trial_generation;
-    show_session_trial(s);
+    show_trial(s, show_row);
   }
   if (!view_ || s.trial_generation != shown_generation_) return;
-  if (s.channel && s.channel != session_channel_) {
-    session_channel_ = s.channel;
-    view_->scene = &session_scene_;  // laid out as the session runner lays out the trial's scene
+  if (s.channel && s.channel != channel_) {
+    channel_ = s.channel;
+    view_->scene = &scene_;  // laid out as the session runner lays out the trial's scene
     view_->acceptance = s.acceptance;
   }
-  if (session_channel_) view_->consume(*session_channel_, typical_ids_.front());
-  quiz_log_.log_verdicts(*view_, session_utf8_);
-  quiz_log_.log_refusal(*view_, session_utf8_);
+  if (channel_) view_->consume(*channel_, shown_typical_ids_);
+  quiz_log.log_verdicts(*view_, shown_utf8_);
+  quiz_log.log_refusal(*view_, shown_utf8_);
   if (s.outcome && !view_->have_result) {
     view_->have_result = true;
     view_->ended = true;
@@ -81,70 +79,67 @@ void TrainerApp::follow_session() {
     std::fprintf(stderr, "calligraphy session: trial %zu/%zu %s: %s, %.1f s, mean %.2f mm%s\n",
                  s.trial.index + 1, s.total, s.trial.condition.c_str(), s.outcome->end_reason.c_str(),
                  s.outcome->time_s, s.outcome->mean_deviation_mm, s.outcome->saved ? "" : " (attempt)");
-    if (s.trial.index + 1 == s.total) screenshot_due_ = true;  // the last planned trial's outcome
+    if (s.trial.index + 1 == s.total) last_trial_ended_ = true;
   }
 }
 
 // A new trial: the row becomes its characters, the view a fresh one.
-void TrainerApp::show_session_trial(const SessionView& s) {
-  art_.clear();
-  typical_ids_.clear();
-  session_utf8_.clear();
+void HostedSessionView::show_trial(const SessionView& s,
+                                   const std::function<void(const std::vector<std::size_t>&)>& show_row) {
+  std::vector<std::size_t> row;
+  shown_utf8_.clear();
   for (const char32_t c : s.trial.characters) {
-    const std::size_t k = index_of_.at(c);
-    art_.push_back(all_art_[k]);
-    typical_ids_.push_back(all_typical_ids_[k]);
-    session_utf8_.push_back(options_.characters[k].utf8);
+    row.push_back(index_of_.at(c));
+    shown_utf8_.push_back(characters_[row.back()].utf8);
   }
   // Stroke events count strokes within their character; a one-character trial (the usual) names its own.
-  layout_.emplace(art_.size(), options_.width_px, options_.height_px, kPanelWidthPx);
-  for (std::size_t k = 0; k < layout_->count(); ++k) {
-    const ScreenBox& b = layout_->box(k);
-    std::printf("box %zu %s x=%.0f y=%.0f size=%.0f\n", k,
-                options_.characters[index_of_.at(s.trial.characters[k])].utf8.c_str(), b.x_px, b.y_px,
-                b.size_px);
-  }
-  std::fflush(stdout);
+  shown_typical_ids_ = typical_ids_of(characters_[row.front()].model);
+  show_row(row);
   view_.emplace();
   view_->whole_row = true;
   view_->number = s.trial.index + 1;
   view_->guidance = s.guidance;
   view_->condition = s.trial.condition;
-  session_channel_.reset();
-  session_scene_ = session_scene(s.trial);
+  channel_.reset();
+  scene_ = trial_scene(s.trial);
   if (s.mode == ConditionMode::quiz) {
-    view_->quiz.emplace(session_scene_,
-                        session_->manifest->protocol.protocol.condition(s.trial.condition).quiz);
+    view_->quiz.emplace(scene_, link_.manifest->protocol.protocol.condition(s.trial.condition).quiz);
   }
 }
 
-Scene TrainerApp::session_scene(const PlannedTrial& trial) const {
+Scene HostedSessionView::trial_scene(const PlannedTrial& trial) const {
   std::vector<Character> models;
-  for (const char32_t c : trial.characters) models.push_back(options_.characters[index_of_.at(c)].model);
+  for (const char32_t c : trial.characters) models.push_back(characters_[index_of_.at(c)].model);
   return Scene::lay_out(models);
 }
 
-void TrainerApp::session_panel(PanelInput& panel) const {
-  const SessionView& s = session_view_;
-  const SessionSetup& setup = session_->manifest->setup;
+void HostedSessionView::start_trial() { link_.host->start_trial(); }
+
+void HostedSessionView::request_stop() { link_.host->request_stop(); }
+
+bool HostedSessionView::finished() const { return link_.done->load(); }
+
+void HostedSessionView::fill_panel(PanelInput& panel) const {
+  const SessionView& s = state_;
+  const SessionSetup& setup = link_.manifest->setup;
   std::string characters;
-  for (const char32_t c : s.trial.characters) characters += options_.characters[index_of_.at(c)].utf8;
+  for (const char32_t c : s.trial.characters) characters += characters_[index_of_.at(c)].utf8;
   panel.character = characters;
   char line[256];
   std::snprintf(line, sizeof line, "Session %s, subject %s\ntrial %zu of %zu (%s), condition %s: %s",
-                session_->manifest->protocol.protocol.name.c_str(), setup.subject.id.c_str(),
-                s.trial.index + 1, s.total, to_string(s.trial.phase), s.trial.condition.c_str(),
-                mode_meaning(s.mode));
-  panel.session = s.phase == SessionPhase::waiting ? "Session " + session_->manifest->session_id : line;
+                link_.manifest->protocol.protocol.name.c_str(), setup.subject.id.c_str(), s.trial.index + 1,
+                s.total, to_string(s.trial.phase), s.trial.condition.c_str(), mode_meaning(s.mode));
+  panel.session = s.phase == SessionPhase::waiting ? "Session " + link_.manifest->session_id : line;
   switch (s.phase) {
     case SessionPhase::waiting:
       panel.prompt = "starting...";
       break;
     case SessionPhase::announced:
-      panel.prompt = "Next: write " + characters + (unattended() ? "" : "\npress Space to start");
+      panel.prompt = "Next: write " + characters + (unattended_ ? "" : "\npress Space to start");
       break;
     case SessionPhase::resting: {
-      const double left = std::chrono::duration<double>(s.rest_until - Clock::now()).count();
+      const double left =
+          std::chrono::duration<double>(s.rest_until - std::chrono::steady_clock::now()).count();
       char rest[64];
       std::snprintf(rest, sizeof rest, "Rest: %.0f s", std::max(0.0, std::ceil(left)));
       panel.prompt = rest;
@@ -157,7 +152,7 @@ void TrainerApp::session_panel(PanelInput& panel) const {
       panel.prompt = s.outcome && s.outcome->saved ? "Trial saved" : "Trial kept as an attempt";
       break;
     case SessionPhase::finished:
-      panel.prompt = "Session over" + std::string(unattended() ? "" : "\nEsc closes the window");
+      panel.prompt = "Session over" + std::string(unattended_ ? "" : "\nEsc closes the window");
       break;
   }
   panel.characters = s.trial.characters.size();
