@@ -13,10 +13,12 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/stop_signals.hpp"
 #include "calligraphy/devices/device_registry.hpp"
+#include "trainer/hosted_session_view.hpp"
 #include "trainer/pointer_devices.hpp"
+#include "trainer/practice_controller.hpp"
 #include "trainer/session_host.hpp"
 #include "trainer/stop_reason.hpp"
-#include "trainer/trainer_app.hpp"
+#include "trainer/trainer_window.hpp"
 
 namespace calligraphy::trainer {
 
