@@ -1,4 +1,7 @@
-// The trainer's window: GLFW and Dear ImGui set up and torn down, the fonts, one frame drawn, screenshots.
+// The trainer's window (trainer_window.hpp): GLFW and Dear ImGui set up and torn down, the fonts, one frame
+// drawn, screenshots, and the window's measurements (frame rate, display latency).
+#include "trainer/trainer_window.hpp"
+
 #define GLFW_INCLUDE_NONE
 #include <GL/gl.h>
 #include <GLFW/glfw3.h>
@@ -6,7 +9,9 @@
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -16,7 +21,6 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "trainer/screenshot.hpp"
-#include "trainer/trainer_app.hpp"
 #include "trainer/x11_errors.hpp"
 
 namespace calligraphy::trainer {
@@ -29,7 +33,16 @@ void print_glfw_error(int code, const char* description) {
 }
 
 std::int64_t steady_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count();
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+double percentile(std::vector<double> values, double p) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const auto k = static_cast<std::size_t>(std::ceil(p * static_cast<double>(values.size())));
+  return values[std::min(values.size() - 1, k == 0 ? 0 : k - 1)];
 }
 
 // Keys pressed since the last frame (GLFW's key callback, on the window thread).
@@ -105,22 +118,20 @@ void TrainerApp::render(bool take_screenshot) {
   ImGui_ImplOpenGL3_NewFrame();
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();
-  const Scene& scene = session_ ? session_scene_ : worker_.scene();
-  draw_scene(*ImGui::GetBackgroundDrawList(), *layout_, art_, scene, view_ ? &*view_ : nullptr);
+  const Scene& scene = practice_ ? practice_->scene() : session_->scene();
+  const TrialView* view = trial_view();
+  draw_scene(*ImGui::GetBackgroundDrawList(), *layout_, art_, scene, view);
   PanelInput panel;
-  panel.view = view_ ? &*view_ : nullptr;
-  if (view_ && session_ == nullptr) panel.character = options_.characters[view_->character].utf8;
-  if (session_ != nullptr) session_panel(panel);
+  panel.view = view;
+  if (practice_) practice_->fill_panel(panel);
+  if (session_) session_->fill_panel(panel);
   panel.device = options_.device;
   panel.characters = options_.characters.size();
-  panel.next_guidance = guidance_;
   panel.quiz = options_.quiz;
-  panel.next_mode = to_string(guidance_mode_);
-  panel.next_gain = guidance_gain_;
   panel.unattended = unattended();
   panel.frame_rate_hz = ImGui::GetIO().Framerate;
   panel.large_font = large_font_;
-  if (quit_seen_ && worker_.active() && !worker_.done()) panel.status = "ending the trial...";
+  if (quit_seen_ && practice_ && practice_->trial_running()) panel.status = "ending the trial...";
   draw_panel(*layout_, kPanelWidthPx, panel);
   ImGui::Render();
   int width = 0;
@@ -130,15 +141,15 @@ void TrainerApp::render(bool take_screenshot) {
   glClearColor(1.0f, 1.0f, 1.0f, 1.0f);
   glClear(GL_COLOR_BUFFER_BIT);
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-  if (!quiz_screenshot_.empty()) {  // the first frame that shows the latest judged stroke
+  if (quiz_log_.screenshot_requested()) {  // the first frame that shows the latest judged stroke
+    const std::string quiz_screenshot = quiz_log_.take_screenshot_request();
     try {
-      write_framebuffer_png(quiz_screenshot_, width, height);
-      std::fprintf(stderr, "calligraphy train: quiz screenshot %s\n", quiz_screenshot_.c_str());
+      write_framebuffer_png(quiz_screenshot, width, height);
+      std::fprintf(stderr, "calligraphy train: quiz screenshot %s\n", quiz_screenshot.c_str());
     } catch (const std::exception& e) {
       std::fprintf(stderr, "calligraphy train: error: %s\n", e.what());
-      status_ = 1;
+      screenshot_failed_ = true;
     }
-    quiz_screenshot_.clear();
   }
   if (take_screenshot) {
     try {
@@ -146,18 +157,28 @@ void TrainerApp::render(bool take_screenshot) {
       std::fprintf(stderr, "calligraphy train: screenshot %s\n", options_.screenshot.c_str());
     } catch (const std::exception& e) {
       std::fprintf(stderr, "calligraphy train: error: %s\n", e.what());
-      status_ = 1;
+      screenshot_failed_ = true;
     }
     screenshot_taken_ = true;
   }
   glfwSwapBuffers(window_);
   ++frames_;
   // Display latency: from the servo tick that published the snapshot to the frame that shows it.
-  const bool live = (worker_.active() && !worker_.done()) ||
-                    (session_ != nullptr && session_view_.phase == SessionPhase::running);
-  if (view_ && live && view_->snapshot.tick > 0) {
-    latencies_ms_.push_back(static_cast<double>(steady_ns() - view_->snapshot.published_ns) * 1e-6);
+  const bool live = (practice_ && practice_->trial_running()) || (session_ && session_->trial_running());
+  if (view != nullptr && live && view->snapshot.tick > 0) {
+    latencies_ms_.push_back(static_cast<double>(steady_ns() - view->snapshot.published_ns) * 1e-6);
   }
+}
+
+void TrainerApp::print_measurements() const {
+  const double seconds = seconds_since_start();
+  std::fprintf(
+      stderr,
+      "calligraphy train: %zu frames in %.1f s (%.1f frames/s); display latency, servo tick to frame "
+      "shown: p50 %.2f ms, p99 %.2f ms, max %.2f ms over %zu frames\n",
+      frames_, seconds, static_cast<double>(frames_) / std::max(seconds, 1e-9),
+      percentile(latencies_ms_, 0.5), percentile(latencies_ms_, 0.99), percentile(latencies_ms_, 1.0),
+      latencies_ms_.size());
 }
 
 }  // namespace calligraphy::trainer

@@ -15,6 +15,12 @@ void append_thinned(std::vector<Vec2>& points, const Vec2& point) {
 
 }  // namespace
 
+std::vector<int> typical_ids_of(const Character& character) {
+  std::vector<int> ids;
+  for (const Stroke& s : character.strokes) ids.push_back(s.typical_id);
+  return ids;
+}
+
 void TrialView::consume(DisplayChannel& channel, const std::vector<int>& typical_ids) {
   channel.try_latest(snapshot);
   drain_trace(channel);

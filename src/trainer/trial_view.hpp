@@ -7,8 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "calligraphy/model/stroke_progress.hpp"
+#include "calligraphy/model/character.hpp"
 #include "calligraphy/model/scene.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/trial/display.hpp"
 #include "calligraphy/trial/result.hpp"
 #include "trainer/live_quiz.hpp"
@@ -93,5 +94,8 @@ struct TrialView {
   std::uint32_t pen_down_stroke_index_ = 0;
   std::vector<Vec2> pen_down_path_m_;
 };
+
+/// Each stroke's typical id, by stroke index in `character`: what TrialView::consume takes.
+[[nodiscard]] std::vector<int> typical_ids_of(const Character& character);
 
 }  // namespace calligraphy::trainer

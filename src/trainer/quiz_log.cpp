@@ -1,23 +1,26 @@
-// The trainer's quiz log: each live verdict on stderr (and a screenshot when asked), and the live verdicts
-// checked against those the saved record gives for the whole trace; each refused stroke on stderr.
+// The trainer's quiz log (quiz_log.hpp).
+#include "trainer/quiz_log.hpp"
+
 #include <cstdio>
 #include <filesystem>
+#include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "calligraphy/study/quiz.hpp"
 #include "trainer/panel.hpp"
-#include "trainer/trainer_app.hpp"
 
 namespace calligraphy::trainer {
 
-// The quiz's new verdicts: one stderr line each (the test harness and logs read them), and a screenshot
-// of the frame that first shows a judged stroke when asked.
-void TrainerApp::log_quiz(TrialView& view) {
+QuizLog::QuizLog(std::string program, std::string screenshot_folder)
+    : program_(std::move(program)), screenshot_folder_(std::move(screenshot_folder)) {}
+
+void QuizLog::log_verdicts(TrialView& view, std::span<const std::string> characters_utf8) {
   if (!view.quiz) return;
-  const char* who = session_ ? "calligraphy session" : "calligraphy train";
+  const char* who = program_.c_str();
   for (const auto& [character, event] : view.quiz_unlogged) {
-    const std::string utf8 = character_utf8(view, character);
+    const std::string& utf8 = characters_utf8[character];
     std::fprintf(stderr, "%s: quiz %s %s\n", who, utf8.c_str(), describe(event).c_str());
     if (event.kind == QuizEvent::Kind::character_completed) {
       std::fprintf(stderr, "%s: quiz %s complete, %d misses\n", who, utf8.c_str(), event.total_misses);
@@ -25,39 +28,31 @@ void TrainerApp::log_quiz(TrialView& view) {
     const bool judged = event.kind == QuizEvent::Kind::stroke_accepted ||
                         event.kind == QuizEvent::Kind::stroke_missed ||
                         event.kind == QuizEvent::Kind::too_short;
-    if (judged && !options_.quiz_screenshots.empty()) {
+    if (judged && !screenshot_folder_.empty()) {
       char name[64];
-      std::snprintf(name, sizeof name, "quiz-%02zu-%s.png", ++quiz_verdicts_, to_string(event.kind));
-      quiz_screenshot_ = (std::filesystem::path(options_.quiz_screenshots) / name).string();
+      std::snprintf(name, sizeof name, "quiz-%02zu-%s.png", ++verdicts_, to_string(event.kind));
+      screenshot_ = (std::filesystem::path(screenshot_folder_) / name).string();
     }
   }
   view.quiz_unlogged.clear();
 }
 
-// A refused attempt, as the panel words it, once on stderr (the test harness and logs read it).
-void TrainerApp::log_refusal(TrialView& view) {
+void QuizLog::log_refusal(TrialView& view, std::span<const std::string> characters_utf8) {
   if (view.refusals == view.refusals_logged) return;
   view.refusals_logged = view.refusals;
   if (!view.refused) return;  // already replaced by a touch-down in the same frame
   const RefusedStroke& r = *view.refused;
   const RefusalWords words = learner_words(r.refusal);
-  std::fprintf(stderr, "%s: %s stroke %u not written: %s: %s (%s; %s)\n",
-               session_ ? "calligraphy session" : "calligraphy train",
-               character_utf8(view, r.character).c_str(), r.stroke + 1, words.what, words.advice,
+  std::fprintf(stderr, "%s: %s stroke %u not written: %s: %s (%s; %s)\n", program_.c_str(),
+               characters_utf8[r.character].c_str(), r.stroke + 1, words.what, words.advice,
                to_string(r.refusal), r.judged_from_path ? "judged from the pen-down path" : "judged in WS");
 }
 
-std::string TrainerApp::character_utf8(const TrialView& view, std::size_t character) const {
-  if (session_ == nullptr) return options_.characters[view.character].utf8;
-  const char32_t c = session_view_.trial.characters.at(character);
-  return options_.characters[index_of_.at(c)].utf8;
-}
+std::string QuizLog::take_screenshot_request() { return std::exchange(screenshot_, {}); }
 
-// The saved record judges the whole trace after the trial (quiz_characters): the verdicts
-// shown live must be the same ones.
-void TrainerApp::check_quiz_against_trace(const LiveQuiz& quiz, const TrialResult& result) {
-  const std::vector<std::vector<QuizEvent>> saved =
-      quiz_characters(worker_.scene(), result.trace, options_.quiz_options);
+void check_quiz_against_trace(const LiveQuiz& quiz, const Scene& scene, const std::vector<TrialSample>& trace,
+                              const QuizOptions& options) {
+  const std::vector<std::vector<QuizEvent>> saved = quiz_characters(scene, trace, options);
   const std::vector<std::vector<QuizEvent>> live = quiz.events();
   bool same = saved.size() == live.size();
   std::size_t count = 0;
