@@ -441,13 +441,16 @@ void ServoLoop::Impl::stop_device_clock() noexcept {
   }
 }
 
-ServoLoop::ServoLoop(HapticDevice& device, ServoCallback callback, const ServoLoopOptions& options)
-    : ServoLoop(device, Prepared{std::move(callback), 0.0, ""}, options) {}
+ServoLoop::ServoLoop(HapticDevice& device, ServoCallback callback, const ServoLoopOptions& options,
+                     AfterForceWrite after_write)
+    : ServoLoop(device, Prepared{std::move(callback), 0.0, ""}, options, std::move(after_write)) {}
 
-ServoLoop::ServoLoop(HapticDevice& device, Prepared prepared, const ServoLoopOptions& options) {
+ServoLoop::ServoLoop(HapticDevice& device, Prepared prepared, const ServoLoopOptions& options,
+                     AfterForceWrite after_write) {
   options.validate();
   if (!prepared.callback) throw InvalidArgument("ServoLoop: the callback is empty");
   impl_ = std::make_unique<Impl>(device, std::move(prepared.callback), options);
+  impl_->after_write = std::move(after_write);
   impl_->callback_rate_hz = prepared.rate_hz;
   impl_->callback_rate_name = prepared.rate_name != nullptr ? prepared.rate_name : "";
 }
@@ -608,13 +611,6 @@ bool ServoLoop::running() const noexcept {
 }
 
 const ServoLoopOptions& ServoLoop::options() const noexcept { return impl_->options; }
-
-void ServoLoop::set_after_write(std::function<void()> hook) {
-  if (impl_->running.load(std::memory_order_acquire)) {
-    throw StateError("ServoLoop::set_after_write: the loop is running");
-  }
-  impl_->after_write = std::move(hook);
-}
 
 ServoLoopStats ServoLoop::stats() const {
   const Impl& m = *impl_;

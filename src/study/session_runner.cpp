@@ -92,6 +92,7 @@ void log_unlogged_saves(SessionFolder& session) {
 void SessionHost::before_trial(const PlannedTrial&, std::size_t) {}
 void SessionHost::rest(double, const PlannedTrial&, const std::function<bool()>&) {}
 void SessionHost::after_trial(const PlannedTrial&, const TrialOutcome&) {}
+DisplayChannel* SessionHost::display_for(const PlannedTrial&, const StrokeAcceptance&) { return nullptr; }
 
 TrialSpec study_trial_spec(const SessionManifest& session, const StudyCondition& condition,
                            const PlannedTrial& trial, const TrialGuidance& guidance) {
@@ -316,22 +317,19 @@ class SessionRun {
   }
 
   // The one runner of a trial specification; the device (made before, so that a failure is logged), the
-  // teacher kept in the session folder and the condition's own settings are its inputs. The trial's
-  // options are complete before it runs: the specification's on this device, the condition's force law,
-  // and what the host adds (its display channel, memory locking off in a window process).
+  // teacher kept in the session folder, the condition's force law and what the host gives (its display
+  // channel) are its inputs, all values: nothing changes the trial's options once the runner made them.
   TrialRunInputs inputs_for(const PlannedTrial& trial, const StudyCondition& condition, const PreparedTrial& prepared,
                             HapticDevice& device) const {
     TrialRunInputs inputs;
     inputs.device = &device;
     inputs.teacher = prepared.guidance.guidance.teacher;
     inputs.should_stop = options_.should_stop;
-    TrialOptions planned = *trial_options(prepared.spec, device.info());
-    planned.force = study_detail::condition_force_law(condition, prepared.guidance.guidance, std::move(planned.force));
-    planned.loop.lock_memory = inputs.lock_memory;  // a session's program locks memory unless its host says not
-    if (options_.prepare_trial) options_.prepare_trial(trial, planned);
-    inputs.force_law = std::move(planned.force);
-    inputs.display = planned.display;
-    inputs.lock_memory = planned.loop.lock_memory;
+    inputs.force_law = study_detail::condition_force_law(condition, prepared.guidance.guidance,
+                                                         trial_options(prepared.spec, device.info())->force);
+    inputs.lock_memory = options_.lock_memory;
+    if (options_.host != nullptr)
+      inputs.display = options_.host->display_for(trial, inputs.force_law->acceptance);
     return inputs;
   }
 

@@ -49,15 +49,15 @@ void WindowSessionHost::after_trial(const PlannedTrial& /*trial*/, const TrialOu
   view_.outcome = outcome;
 }
 
-void WindowSessionHost::prepare_trial(const PlannedTrial& /*trial*/, TrialOptions& options) {
-  // A window process maps memory all the time (the GL driver): mlockall(MCL_FUTURE) would lock all of it.
-  options.loop.lock_memory = false;
+DisplayChannel* WindowSessionHost::display_for(const PlannedTrial& /*trial*/,
+                                               const StrokeAcceptance& acceptance) {
   auto channel = std::make_shared<DisplayChannel>();
-  options.display = channel.get();
+  DisplayChannel* published = channel.get();
   const std::lock_guard lock(mutex_);
   view_.channel = std::move(channel);  // kept alive here and by the window's copies
-  view_.acceptance = options.force.acceptance;
+  view_.acceptance = acceptance;
   view_.phase = SessionPhase::running;
+  return published;
 }
 
 void WindowSessionHost::start_trial() {

@@ -41,8 +41,8 @@ class WindowSessionHost final : public SessionHost {
   void before_trial(const PlannedTrial& trial, std::size_t total) override;
   void rest(double seconds, const PlannedTrial& trial, const std::function<bool()>& should_stop) override;
   void after_trial(const PlannedTrial& trial, const TrialOutcome& outcome) override;
-  /// SessionRunOptions::prepare_trial: a new display channel, memory locking off (a window process).
-  void prepare_trial(const PlannedTrial& trial, TrialOptions& options);
+  /// A new display channel for each trial, kept in the view with the acceptance its strokes are judged by.
+  DisplayChannel* display_for(const PlannedTrial& trial, const StrokeAcceptance& acceptance) override;
 
   /// Window thread: the person asked to start the announced trial.
   void start_trial();

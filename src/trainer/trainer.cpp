@@ -77,9 +77,8 @@ SessionRunResult run_trainer_session(const TrainerSessionOptions& options) {
   WindowSessionHost host(manifest, options.exit_after_s > 0.0, kAdvanceDelayS);
   SessionRunOptions run = options.run;
   run.host = &host;
-  run.prepare_trial = [&host](const PlannedTrial& trial, TrialOptions& trial_options) {
-    host.prepare_trial(trial, trial_options);
-  };
+  // A window process maps memory all the time (the GL driver): mlockall(MCL_FUTURE) would lock all of it.
+  run.lock_memory = false;
   const std::function<bool()> outer_stop = options.run.should_stop;
   run.should_stop = [&host, outer_stop] {
     return host.stop_requested() || StopSignals::received() != 0 || (outer_stop && outer_stop());

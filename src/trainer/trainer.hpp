@@ -69,7 +69,7 @@ int run_trainer(const TrainerOptions& options);
 struct TrainerSessionOptions {
   SessionFolder* session = nullptr;  ///< the session to run (its unsaved trials)
   /// registry, load_character, should_stop (e.g. the process's stop signals), pacing; the trainer sets
-  /// host and prepare_trial.
+  /// host (which gives each trial its display channel) and lock_memory (off).
   SessionRunOptions run;
   /// A character to draw (its model and outlines), for every character of the plan.
   std::function<TrainerCharacter(char32_t)> load_character;

@@ -106,8 +106,10 @@ TrialResult run_real_time(HapticDevice& device, TrialHand* hand, TrialSession& s
                            }
                            return command;
                          }),
-                 loop_options);
-  if (hand != nullptr) loop.set_after_write([hand, period_s] { hand->advance(period_s); });
+                 loop_options,
+                 // A hand's world steps right after each force write, so that the force acts during the step.
+                 hand != nullptr ? ServoLoop::AfterForceWrite([hand, period_s] { hand->advance(period_s); })
+                                 : ServoLoop::AfterForceWrite());
 
   loop.start();
   bool interrupted = false;

@@ -209,15 +209,23 @@ struct ServoLoopStats {
 /// thread's start and join, or the clock's attach and detach, order the accesses).
 class ServoLoop {
  public:
+  /// Optional, given at construction: called on the loop thread right after each tick's force write (the
+  /// callback's force or the zero force that replaced it), except after a tick that asked to stop or ended
+  /// the run. A simulation steps its world here, so the force acts during the step; its time counts towards
+  /// the stall bound. Same rules as the callback; its exceptions are contained like the callback's.
+  using AfterForceWrite = std::function<void()>;
+
   /// `device` must outlive the loop. Throws InvalidArgument for bad options or an empty callback.
-  ServoLoop(HapticDevice& device, ServoCallback callback, const ServoLoopOptions& options = {});
+  ServoLoop(HapticDevice& device, ServoCallback callback, const ServoLoopOptions& options = {},
+            AfterForceWrite after_write = {});
   /// The same from any callable (a lambda) callable as `ServoCommand(const DeviceState&, double dt_s)`. A
   /// callable that says the rate it was built for (`BuiltForServoRate`: what `ticking` and
   /// `TrialSession::servo_callback` return) has it checked by `start()`.
   template <typename Callback>
   requires(!std::is_same_v<std::decay_t<Callback>, ServoCallback> && servo_callback_for<Callback>)
-      ServoLoop(HapticDevice& device, Callback&& callback, const ServoLoopOptions& options = {})
-      : ServoLoop(device, prepare(std::forward<Callback>(callback)), options) {}
+      ServoLoop(HapticDevice& device, Callback&& callback, const ServoLoopOptions& options = {},
+                AfterForceWrite after_write = {})
+      : ServoLoop(device, prepare(std::forward<Callback>(callback)), options, std::move(after_write)) {}
   /// Any other callable is refused at compile time with one message saying what is wrong (e.g. one that
   /// returns a bare force, a Vec3). The constraint keeps such a callable away from std::function, whose
   /// own errors would otherwise follow the message by some fifty lines.
@@ -251,12 +259,6 @@ class ServoLoop {
   /// or from each other: both named), or StateError when the loop is already running. A loop that ended
   /// (stopped by its callback, by `stop()` or by a fault) can be started again.
   void start();
-  /// Optional: called on the loop thread right after each tick's force write (the callback's force or
-  /// the zero force that replaced it), except after a tick that asked to stop or ended the run. A
-  /// simulation steps its world here, so the force acts during the step; its time counts towards the
-  /// stall bound. Same rules as the callback; its exceptions are contained like the callback's.
-  /// Throws StateError while the loop runs.
-  void set_after_write(std::function<void()> hook);
   /// Asks the loop to stop, waits for the thread to end (or for the device clock's next frame, then
   /// detaches from it; a clock that stopped calling is detached after 100 ms) and returns the fault that
   /// ended the run, if any (none when it was stopped or ended by its callback). Forces are zero and disabled
@@ -285,7 +287,8 @@ class ServoLoop {
     double rate_hz = 0.0;
     const char* rate_name = "";
   };
-  ServoLoop(HapticDevice& device, Prepared prepared, const ServoLoopOptions& options);
+  ServoLoop(HapticDevice& device, Prepared prepared, const ServoLoopOptions& options,
+            AfterForceWrite after_write);
 
   template <typename Callback>
   static Prepared prepare(Callback&& callback) {

@@ -15,9 +15,11 @@
 
 #include "calligraphy/devices/device_registry.hpp"
 #include "calligraphy/model/character.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/render/guidance_law.hpp"
 #include "calligraphy/study/schedule.hpp"
 #include "calligraphy/study/session_folder.hpp"
+#include "calligraphy/trial/display.hpp"
 #include "calligraphy/trial/options.hpp"
 #include "calligraphy/trial/trial_spec.hpp"
 
@@ -44,6 +46,11 @@ class SessionHost {
   virtual void rest(double seconds, const PlannedTrial& trial, const std::function<bool()>& should_stop);
   /// After a trial ended (saved or kept as an attempt).
   virtual void after_trial(const PlannedTrial& trial, const TrialOutcome& outcome);
+  /// Just before `trial` runs, on the runner's thread: where it publishes what a window shows
+  /// (TrialRunInputs::display; not owned: the host keeps it alive until it is asked again or the session
+  /// ends). `acceptance` is how its strokes are judged (the condition's), for a window that shows pen-downs
+  /// the trial never reaches. nullptr (the default): nowhere.
+  virtual DisplayChannel* display_for(const PlannedTrial& trial, const StrokeAcceptance& acceptance);
 };
 
 /// Options of `run_session`.
@@ -64,11 +71,9 @@ struct SessionRunOptions {
   /// Overrides the session's pacing for this run (e.g. a session begun in real time resumed lock-step);
   /// nullopt: the pacing in session.json.
   std::optional<TrialPacing> pacing;
-  /// The one per-trial host hook: called with each trial's options (the specification's on the session's
-  /// device, with the condition's force law) before the trial runs, on the runner's thread, to add what only
-  /// the host has: a window's display channel (TrialOptions::display) and memory locking off in a window
-  /// process (ServoLoopOptions::lock_memory); these two are taken from it. Empty: neither.
-  std::function<void(const PlannedTrial&, TrialOptions&)> prepare_trial;
+  /// Lock the process's memory in a real-time trial (TrialRunInputs::lock_memory): a session's program does;
+  /// a window process sets false (its GL driver maps memory all the time).
+  bool lock_memory = true;
 };
 
 /// What `run_session` did.
