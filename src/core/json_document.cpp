@@ -4,24 +4,10 @@
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
+#include "core/json_reader.hpp"
 
 namespace calligraphy::json_detail {
 namespace {
-
-// A key as a JSON pointer token (RFC 6901: "~" as "~0", "/" as "~1").
-std::string escaped(const std::string& key) {
-  std::string token;
-  for (const char c : key) {
-    if (c == '~') {
-      token += "~0";
-    } else if (c == '/') {
-      token += "~1";
-    } else {
-      token += c;
-    }
-  }
-  return token;
-}
 
 // Where the parser is, as a JSON pointer, for errors the parser reports without a position (a number
 // that overflows a double): one frame per open object (its last key) or array (elements finished).
@@ -54,7 +40,7 @@ class PointerTracker {
   [[nodiscard]] std::string pointer() const {
     std::string at;
     for (const Frame& frame : frames_) {
-      at = frame.array ? at + "/" + std::to_string(frame.elements) : at + "/" + escaped(frame.key);
+      at = frame.array ? child_pointer(at, frame.elements) : child_pointer(at, frame.key);
     }
     return at;
   }

@@ -24,7 +24,7 @@ std::string describe(const nlohmann::json& value);
 /// The members of one JSON object, read by key; `finish` refuses keys nobody read (typos).
 class ObjectReader {
  public:
-  /// Throws DataError when `value` is not an object.
+  /// `value` must outlive the reader; `source` is copied. Throws DataError when `value` is not an object.
   ObjectReader(const nlohmann::json& value, std::string pointer, const std::string& source);
   [[nodiscard]] bool has(const std::string& key) const;
   /// The member; throws DataError naming the key when it is missing.
@@ -51,7 +51,7 @@ class ObjectReader {
  private:
   const nlohmann::json& value_;
   std::string pointer_;
-  const std::string& source_;
+  std::string source_;  // a copy: a caller may pass a temporary
   std::set<std::string> read_;
 };
 

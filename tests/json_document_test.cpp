@@ -1,0 +1,48 @@
+// The one parse and strict reader of JSON documents (src/core/json_document.hpp, json_reader.hpp): an error
+// names the source and the RFC 6901 pointer of the value, keys escaped ("~" as "~0", "/" as "~1").
+#include "core/json_document.hpp"
+
+#include <catch2/catch.hpp>
+#include <string>
+
+#include "calligraphy/core/errors.hpp"
+#include "core/json_reader.hpp"
+
+using namespace calligraphy;
+
+namespace {
+
+std::string error_of(const std::string& text) {
+  try {
+    (void)json_detail::parse_json_document(text, "doc.json");
+  } catch (const DataError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("a number beyond a double is named by its pointer, keys escaped", "[json]") {
+  CHECK(error_of(R"({"a/b": {"c~d": [0, 1e999]}})").starts_with("doc.json: /a~1b/c~0d/1: "));
+  CHECK(error_of(R"([[1, 2], {"x": -1e400}])").starts_with("doc.json: /1/x: "));
+  CHECK_THAT(error_of(R"({"a": 1,)"), Catch::StartsWith("doc.json: not valid JSON at byte"));
+  CHECK(error_of(R"({"a": [1e300]})").empty());
+}
+
+TEST_CASE("the reader's pointers escape keys the same way", "[json]") {
+  CHECK(json_detail::child_pointer("/a~1b", "c~d") == "/a~1b/c~0d");
+  CHECK(json_detail::child_pointer("", std::size_t{3}) == "/3");
+  const nlohmann::json document = json_detail::parse_json(R"({"x/y": "text"})", "doc.json");
+  json_detail::ObjectReader reader(document, "", "doc.json");
+  CHECK_THAT(
+      [&] {
+        try {
+          (void)reader.number("x/y", 0.0, 1.0);
+        } catch (const DataError& e) {
+          return std::string(e.what());
+        }
+        return std::string();
+      }(),
+      Catch::StartsWith("doc.json: /x~1y: "));
+}
