@@ -208,8 +208,18 @@ TEST_CASE("What is not a recorded trial is refused naming the file and the place
   CHECK_THAT(refusal(R"({"version": 2, "end_reason": "completed"})"),
              Catch::Contains("r.json") && Catch::Contains("no trial specification"));
   CHECK_THAT(refusal(R"({"specification": null})"), Catch::Contains("r.json: /specification"));
-  CHECK_THAT(refusal(edited([](auto& d) { d["version"] = 2; })),
-             Catch::Contains("/version") && Catch::Contains("version 2"));
+  CHECK_THAT(
+      refusal(edited([](auto& d) { d["version"] = 3; })),
+      Catch::Contains("/version") && Catch::Contains("version 3 is not one this library reads (1 to 2)"));
+  CHECK_THAT(refusal(edited([](auto& d) { d["version"] = 0; })), Catch::Contains("version 0"));
+  // Version 1, written before the writer's settings were typed: its "key=value" strings are read.
+  const RecordedTrial older = read_recorded_trial(edited([](auto& d) {
+                                                    d["version"] = 1;
+                                                    d["trial"]["writer_parameters"] = {"bias_offset_m=0.003"};
+                                                  }),
+                                                  "r.json");
+  REQUIRE(older.spec.writer_parameters.size() == 1);
+  CHECK(older.spec.writer_parameters[0] == WriterSetting{"bias_offset_m", 0.003});
   CHECK_THAT(refusal(edited([](auto& d) { d["format"] = "other"; })),
              Catch::Contains("r.json: /") && Catch::Contains("format 'other'"));
   CHECK_THAT(refusal(edited([](auto& d) { d["force_law"].erase("off_stroke_force_n"); })),

@@ -311,10 +311,11 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
                       "format '" + format + "' is not '" + std::string(kRecordedTrialFormat) + "'");
   }
   const std::int64_t version = reader.integer("version", 0, std::numeric_limits<std::int64_t>::max());
-  if (version != kRecordedTrialVersion) {
+  if (version < kOldestRecordedTrialVersion || version > kRecordedTrialVersion) {
     json_detail::fail(source, reader.pointer("version"),
-                      "version " + std::to_string(version) + " is not " +
-                          std::to_string(kRecordedTrialVersion) + ", the one this library reads");
+                      "version " + std::to_string(version) + " is not one this library reads (" +
+                          std::to_string(kOldestRecordedTrialVersion) + " to " +
+                          std::to_string(kRecordedTrialVersion) + ")");
   }
   RecordedTrial r;
   // The specification's own reader checks its fields (trial_spec.hpp); its pointers are prefixed here.

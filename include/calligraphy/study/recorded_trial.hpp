@@ -24,9 +24,12 @@
 
 namespace calligraphy {
 
-/// The "format" of the specification object, and its version; a reader refuses any other.
+/// The "format" of the specification object, and the version written: 2 since the simulated writer's
+/// settings are {"key", "value"} objects (version 1 wrote "key=value" strings). A reader reads versions 1 and
+/// 2 and refuses any other by its number.
 inline constexpr std::string_view kRecordedTrialFormat = "calligraphy-trial-specification";
-inline constexpr int kRecordedTrialVersion = 1;
+inline constexpr int kRecordedTrialVersion = 2;
+inline constexpr int kOldestRecordedTrialVersion = 1;
 
 /// Everything that decides what a trial does, as it ran. Lengths in m, forces in N, times in s.
 struct RecordedTrial {
