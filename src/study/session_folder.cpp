@@ -204,7 +204,9 @@ void check_writable_folder(const fs::path& folder, std::uintmax_t free_bytes) {
   if (::access(folder.c_str(), W_OK) != 0)
     refuse(std::string("cannot write in the folder: ") + std::strerror(errno));
   // access(2) lets a privileged user pass a read-only or immutable folder: a file made and removed does not.
-  const fs::path probe = folder / (".calligraphy-write-probe-" + std::to_string(::getpid()));
+  // Named as this run's temporary, so that one left by a run killed between the two is skipped by readers
+  // and removed by the next run in a subject's folder, as a killed run's session folder is.
+  const fs::path probe = folder / (std::string(kPartialSessionPrefix) + partial_owner() + ".write-probe");
   const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
   if (fd < 0) refuse(std::string("cannot create a file in the folder: ") + std::strerror(errno));
   ::close(fd);
