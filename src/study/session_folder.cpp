@@ -203,16 +203,23 @@ void check_writable_folder(const fs::path& folder, std::uintmax_t free_bytes) {
   };
   if (::access(folder.c_str(), W_OK) != 0)
     refuse(std::string("cannot write in the folder: ") + std::strerror(errno));
-  // access(2) lets a privileged user pass a read-only or immutable folder: a file made and removed does not.
-  // Named as this run's temporary, so that one left by a run killed between the two is skipped by readers
-  // and removed by the next run in a subject's folder, as a killed run's session folder is.
-  const fs::path probe = folder / (std::string(kPartialSessionPrefix) + partial_owner() + ".write-probe");
-  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-  if (fd < 0) refuse(std::string("cannot create a file in the folder: ") + std::strerror(errno));
-  ::close(fd);
-  if (::unlink(probe.c_str()) != 0)
-    refuse("cannot remove a file from the folder (" + probe.filename().string() +
-           "): " + std::strerror(errno));
+  // access(2) lets a privileged user pass a read-only or immutable folder: a file made there does not. An
+  // unnamed file (O_TMPFILE) needs the same rights and leaves nothing behind when the run is killed; a file
+  // system without it gets a named probe, made and removed.
+  int fd = ::open(folder.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0600);
+  if (fd >= 0) {
+    ::close(fd);
+  } else if (errno == EOPNOTSUPP || errno == EISDIR || errno == EINVAL) {
+    const fs::path probe = folder / (".calligraphy-write-probe-" + std::to_string(::getpid()));
+    fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    if (fd < 0) refuse(std::string("cannot create a file in the folder: ") + std::strerror(errno));
+    ::close(fd);
+    if (::unlink(probe.c_str()) != 0)
+      refuse("cannot remove a file from the folder (" + probe.filename().string() +
+             "): " + std::strerror(errno));
+  } else {
+    refuse(std::string("cannot create a file in the folder: ") + std::strerror(errno));
+  }
   struct statvfs space {};
   if (::statvfs(folder.c_str(), &space) != 0)
     refuse(std::string("cannot read its free space: ") + std::strerror(errno));

@@ -353,8 +353,6 @@ class SessionSafetyTest(unittest.TestCase):
             process.wait()
             for folder in subject.iterdir() if subject.exists() else []:
                 whole = (folder / "session.json").is_file()
-                # A temporary may be a file: the write check's probe of a run killed between making and
-                # removing it.
                 inside = sorted(p.name for p in folder.iterdir()) if folder.is_dir() else "a file"
                 self.assertTrue(whole or folder.name.startswith(".partial."),
                                 f"{folder}: neither whole nor a temporary: {inside}")
@@ -373,7 +371,6 @@ class SessionSafetyTest(unittest.TestCase):
         subject.mkdir(parents=True, exist_ok=True)
         for owner in (f"{dead.pid}.{host}", f"{os.getpid()}.{host}", "1.elsewhere"):
             (subject / f".partial.{owner}.small-P1-20000101-000000" / "trials").mkdir(parents=True)
-        (subject / f".partial.{dead.pid}.{host}.write-probe").touch()  # a dead run's write check, a file
         done = self.run_cli("session", "run", "p.json", "--subject", "P1", "--out", "out")
         self.assertEqual(done.returncode, 0, done.stderr.decode())
         self.assertEqual(sorted(p.name for p in subject.iterdir() if p.name.startswith(".")),
