@@ -402,7 +402,7 @@ TEST_CASE("the options a checked specification states are valid on any device, u
     const auto checked = Checked<TrialSpec>::check(spec);
     DeviceInfo device;
     device.max_stiffness_n_per_m = limits[random() % std::size(limits)];
-    const TrialOptions options = *trial_options(checked, device);
+    const TrialOptions options = trial_options(checked, device);
     REQUIRE_NOTHROW(options.validate());
     CHECK(options.rate_hz == spec.rate_hz);
     CHECK(options.max_duration_s == spec.max_duration_s);

@@ -94,7 +94,7 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
   inputs.device = device.get();
   const auto checked = Checked<TrialSpec>::check(std::move(spec), study_teacher_source(condition));
   inputs.force_law = study_detail::condition_force_law(condition, guidance.guidance,
-                                                       trial_options(checked, device->info())->force);
+                                                       trial_options(checked, device->info()).force);
   SimulatedWriting writing(*checked);
   inputs.hand_maker = &writing;
   const auto wall_start = std::chrono::steady_clock::now();

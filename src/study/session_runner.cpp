@@ -164,7 +164,7 @@ TrialOptions study_trial_options(const SessionManifest& session, const StudyCond
                                  const PlannedTrial& trial, const TrialGuidance& guidance) {
   const auto spec = Checked<TrialSpec>::check(study_trial_spec(session, condition, trial, guidance),
                                               study_teacher_source(condition));
-  TrialOptions options = *trial_options(spec, DeviceInfo{});
+  TrialOptions options = trial_options(spec, DeviceInfo{});
   options.force = study_detail::condition_force_law(condition, guidance, std::move(options.force));
   return *Checked<TrialOptions>::check(std::move(options));
 }
@@ -326,7 +326,7 @@ class SessionRun {
     inputs.teacher = prepared.guidance.guidance.teacher;
     inputs.should_stop = options_.should_stop;
     inputs.force_law = study_detail::condition_force_law(condition, prepared.guidance.guidance,
-                                                         trial_options(prepared.spec, device.info())->force);
+                                                         trial_options(prepared.spec, device.info()).force);
     inputs.lock_memory = options_.lock_memory;
     if (options_.host != nullptr)
       inputs.display = options_.host->display_for(trial, inputs.force_law->acceptance);

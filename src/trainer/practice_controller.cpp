@@ -108,7 +108,7 @@ void PracticeController::start_trial(std::size_t character) {
   // Checked once, here; the runner and the renderer take it as it is.
   auto checked = Checked<TrialSpec>::check(
       std::move(spec), inputs.teacher.empty() ? TeacherSource::file : TeacherSource::samples);
-  trial_options_ = *trial_options(checked, DeviceInfo{});  // what the view needs before the device is open
+  trial_options_ = trial_options(checked, DeviceInfo{});  // what the view needs before the device is open
   trial_simulation_.writer = writer_profile_of(*checked);
   trial_simulation_.seed = checked->seed;
   trial_start_utc_ = utc_now_iso8601();

@@ -71,10 +71,32 @@ void require_teacher(const TrialSpec& spec, const TrialRunInputs& inputs) {
   }
 }
 
+// The options of `spec` with what `inputs` gives instead, and a replay's teacher: to be checked.
+TrialOptions given_options(const TrialSpec& spec, const DeviceInfo& device, const TrialRunInputs& inputs) {
+  TrialOptions given = options_stated(spec, device);
+  if (inputs.force_law) {
+    const bool same_guidance =
+        inputs.force_law->guidance == spec.guidance &&
+        (!spec.guidance || mode_of(inputs.force_law->guidance_law) == spec.guidance_mode);
+    if (!same_guidance) {
+      throw InvalidArgument(
+          std::string("trial inputs: the force law's guidance (") +
+          (inputs.force_law->guidance ? to_string(mode_of(inputs.force_law->guidance_law)) : "off") +
+          ") is not the specification's (" + (spec.guidance ? to_string(spec.guidance_mode) : "off") + ")");
+    }
+    given.force = *inputs.force_law;
+  }
+  if (auto* law = std::get_if<ReplayGuidance>(&given.force.guidance_law))
+    law->teacher_trajectory = inputs.teacher;
+  if (inputs.safety) given.safety = *inputs.safety;
+  if (inputs.passivity) given.passivity = *inputs.passivity;
+  return given;
+}
+
 }  // namespace
 
-Checked<TrialOptions> trial_options(const Checked<TrialSpec>& spec, const DeviceInfo& device) {
-  return spec.derive([&](const TrialSpec& stated) { return options_stated(stated, device); });
+TrialOptions trial_options(const Checked<TrialSpec>& spec, const DeviceInfo& device) {
+  return options_stated(*spec, device);
 }
 
 bool simulated_writer_writes(const TrialSpec& spec, bool simulated_writer_can_move) {
@@ -122,30 +144,14 @@ TrialRun run_trial_spec(const Checked<TrialSpec>& checked, const Scene& scene, c
                           "SimulatedWriting)");
   }
 
-  // The specification's values were checked with it; what the caller gives instead (a force law, a safety
-  // chain, a passivity controller) and a replay's teacher are new values, checked here once.
-  Checked<TrialOptions> options = trial_options(checked, run.device);
-  const bool replay = std::holds_alternative<ReplayGuidance>(options->force.guidance_law);
-  if (inputs.force_law || inputs.safety || inputs.passivity || replay) {
-    TrialOptions given = *options;
-    if (inputs.force_law) {
-      const bool same_guidance =
-          inputs.force_law->guidance == spec.guidance &&
-          (!spec.guidance || mode_of(inputs.force_law->guidance_law) == spec.guidance_mode);
-      if (!same_guidance) {
-        throw InvalidArgument(
-            std::string("trial inputs: the force law's guidance (") +
-            (inputs.force_law->guidance ? to_string(mode_of(inputs.force_law->guidance_law)) : "off") +
-            ") is not the specification's (" + (spec.guidance ? to_string(spec.guidance_mode) : "off") + ")");
-      }
-      given.force = *inputs.force_law;
-    }
-    if (auto* law = std::get_if<ReplayGuidance>(&given.force.guidance_law))
-      law->teacher_trajectory = inputs.teacher;
-    if (inputs.safety) given.safety = *inputs.safety;
-    if (inputs.passivity) given.passivity = *inputs.passivity;
-    options = Checked<TrialOptions>::check(std::move(given));
-  }
+  // The specification's values were checked with it: its options are derived, unchecked. What the caller
+  // gives instead (a force law, a safety chain, a passivity controller) and a replay's teacher are new
+  // values: the options holding them are checked here once.
+  const bool replay = spec.guidance && spec.guidance_mode == GuidanceMode::replay;
+  const bool given = inputs.force_law || inputs.safety || inputs.passivity || replay;
+  Checked<TrialOptions> options =
+      given ? Checked<TrialOptions>::check(given_options(spec, run.device, inputs))
+            : checked.derive([&](const TrialSpec& stated) { return options_stated(stated, run.device); });
   // Where the trial runs from (a stop flag, a display, the process's real-time settings): no parameter of
   // the force, and nothing TrialOptions::validate refuses (the priority is the loop's valid constant).
   options = options.derive([&](TrialOptions running) {

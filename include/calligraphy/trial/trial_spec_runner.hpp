@@ -68,12 +68,12 @@ struct TrialRun {
   WritingMetrics metrics;         ///< the one metrics record of the trace (writing_metrics.hpp)
 };
 
-/// The runner's options for the checked `spec` on a device with figures `device`, checked with it (derived:
-/// no value is validated again): guidance, mode, gain, rate, pacing, real-time settings and duration from
-/// `spec`; the force law's default stiffnesses capped at the device's stable maximum
-/// (`DeviceInfo::max_stiffness_n_per_m`), so that defaults never draw the renderer's over-limit warning. The
-/// teacher's trajectory is not read here (the runner reads it or is given its samples).
-[[nodiscard]] Checked<TrialOptions> trial_options(const Checked<TrialSpec>& spec, const DeviceInfo& device);
+/// The runner's options for the checked `spec` on a device with figures `device`: guidance, mode, gain, rate,
+/// pacing, real-time settings and duration from `spec`; the force law's default stiffnesses capped at the
+/// device's stable maximum (`DeviceInfo::max_stiffness_n_per_m`), so that defaults never draw the renderer's
+/// over-limit warning. Valid as they are, but for a replay, whose teacher the runner adds (it then checks
+/// them); `run_trial_spec` takes them unchecked otherwise (tests/trial_spec_test.cpp walks that promise).
+[[nodiscard]] TrialOptions trial_options(const Checked<TrialSpec>& spec, const DeviceInfo& device);
 
 /// Who writes `spec` on a device: `TrialWriter::simulated` or `person` as stated, else the simulated writer
 /// when `simulated_writer_can_move` (the device has a hand port), a person otherwise. Throws
