@@ -109,11 +109,11 @@ void PracticeController::start_trial(std::size_t character) {
   auto checked = Checked<TrialSpec>::check(
       std::move(spec), inputs.teacher.empty() ? TeacherSource::file : TeacherSource::samples);
   trial_options_ = trial_options(checked, DeviceInfo{});  // what the view needs before the device is open
-  trial_simulation_.writer = writer_profile_of(*checked);
   trial_simulation_.seed = checked->seed;
   trial_start_utc_ = utc_now_iso8601();
   trial_wall_start_ = Clock::now();
   worker_.start(std::move(scene), std::move(checked), std::move(inputs));
+  trial_simulation_.writer = worker_.writer_profile();  // the profile the worker's writer checked and writes
   view_->scene = &worker_.scene();
   view_->acceptance = trial_options_.force.acceptance;
   // The quiz and the renderer judge a stroke alike (the live quiz, and the saved record's quiz through the

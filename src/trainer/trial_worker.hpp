@@ -36,6 +36,8 @@ class TrialWorker {
   [[nodiscard]] const Scene& scene() const noexcept { return scene_; }
   /// The specification of the trial last started (recorded whole with its result).
   [[nodiscard]] const TrialSpec& spec() const noexcept { return spec_; }
+  /// The simulated writer's profile of the trial last started (set before its thread, never changed by it).
+  [[nodiscard]] const WriterProfile& writer_profile() const noexcept { return writing_->profile(); }
 
  private:
   Scene scene_;
