@@ -9,10 +9,12 @@
 #include <pybind11/pybind11.h>
 
 #include <limits>
+#include <optional>
 #include <string>
 #include <type_traits>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/schema.hpp"
 
 namespace calligraphy::python {
 
@@ -93,6 +95,12 @@ template <typename T>
 /// Converts `value` to T, naming `name` in the TypeError (or, for an int out of T's range, ValueError).
 /// Numbers: int or float (not bool) for double, int for integers; an enum takes a member or its name;
 /// None is refused for every T.
+/// Whether enumeration T has an EnumTable (calligraphy/core/schema.hpp): one spelling per value.
+template <typename T>
+inline constexpr bool kHasEnumTable = requires {
+  EnumTable<T>::entries;
+};
+
 template <typename T>
 T convert_named(py::handle value, const std::string& name) {
   if (value.is_none()) throw_type_error(name, python_type_name<T>(), value);
@@ -100,14 +108,31 @@ T convert_named(py::handle value, const std::string& name) {
     if (PyBool_Check(value.ptr())) throw_type_error(name, python_type_name<T>(), value);
   }
   if constexpr (std::is_enum_v<T>) {
-    // An enum also takes its member's name: "newton" for NearestPointMethod.newton.
+    // An enum also takes its one spelling, as the command line, the files and the library's own output write
+    // it ("assist-as-needed": EnumTable), or else its member's name: "newton" for NearestPointMethod.newton.
     if (py::isinstance<py::str>(value)) {
+      if constexpr (kHasEnumTable<T>) {
+        if (const std::optional<T> spelled = enum_from_spelling<T>(std::string(py::str(value))))
+          return *spelled;
+      }
       const py::dict members = py::type::of<T>().attr("__members__");
       if (!members.contains(value)) {
         std::string known;
-        for (const auto& item : members)
-          known += (known.empty() ? "'" : ", '") + std::string(py::str(item.first)) + "'";
+        if constexpr (kHasEnumTable<T>) {
+          known = join_spellings(enum_spellings<T>(), ", ", "'");
+        } else {
+          for (const auto& item : members)
+            known += (known.empty() ? "'" : ", '") + std::string(py::str(item.first)) + "'";
+        }
         throw InvalidArgument(name + ": expected one of " + known + ", got " + short_repr(value));
+      }
+      if constexpr (kHasEnumTable<T>) {
+        // A member's name that is not the spelling ("assist_as_needed"): read for one version, with a note.
+        const std::string old_name = py::str(value);
+        const std::string spelling(enum_spelling(members[value].template cast<T>()));
+        const std::string note = name + ": '" + old_name + "' is spelled '" + spelling +
+                                 "' (the old spelling is read for one more version)";
+        if (PyErr_WarnEx(PyExc_DeprecationWarning, note.c_str(), 1) != 0) throw py::error_already_set();
       }
       return members[value].template cast<T>();
     }

@@ -8,6 +8,7 @@
 #include <system_error>
 
 #include "calligraphy/core/decimal_number.hpp"
+#include "calligraphy/core/errors.hpp"
 
 namespace calligraphy::cli {
 namespace {
@@ -185,6 +186,39 @@ CLI::Option* add_choice(CLI::App& app, const std::string& name, std::string& tar
     }
     invalid(name, list, text);
   });
+}
+
+CLI::Option* add_schema_option(CLI::App& app, const SchemaField& field, void* object, const void* defaults) {
+  const std::string name(field.option);
+  std::string description(field.doc);
+  const std::string_view unit = field.option_unit.empty() ? field.unit : field.option_unit;
+  if (!unit.empty()) description += " [" + std::string(unit) + "]";
+  ParameterRange range = field.range;  // in the option's unit
+  range.low *= field.option_factor;
+  range.high *= field.option_factor;
+  if (field.kind == FieldKind::number) {
+    description += ", " + range.text(unit);
+  } else if (field.kind == FieldKind::integer) {
+    description += ", " + field.range_text();
+  }
+  const std::string value_name =
+      field.option_value_name.empty() ? field.range_text() : std::string(field.option_value_name);
+  return add_single(app, name, value_name, description, field_text(field, defaults),
+                    [name, value_name, unit, range, &field, object](const std::string& text) {
+                      // A number may be negative; other values that start with '-' are an option in their
+                      // place.
+                      if (field.kind != FieldKind::number && field.kind != FieldKind::integer)
+                        require_not_option_like(name, text, value_name);
+                      try {
+                        set_field_from_text(field, object, text);
+                        if (field.kind == FieldKind::number)  // its range, in the option's unit
+                          check_parameter(field.name,
+                                          field.get_number(field, object, 0) * field.option_factor, unit,
+                                          range);
+                      } catch (const InvalidArgument& e) {
+                        throw CLI::ValidationError(name, e.what());
+                      }
+                    });
 }
 
 CLI::Option* add_text(CLI::App& app, const std::string& name, std::string& target,

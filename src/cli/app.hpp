@@ -12,6 +12,8 @@
 #include <utility>
 #include <vector>
 
+#include "calligraphy/core/schema.hpp"
+
 namespace calligraphy::cli {
 
 /// Wrong usage found after parsing (a device no backend knows, options that cannot go together):
@@ -91,6 +93,13 @@ CLI::Option* add_output_path(CLI::App& app, const std::string& name, std::string
 /// A folder that is written in (DIR in --help; "-" refused).
 CLI::Option* add_output_folder(CLI::App& app, const std::string& name, std::string& target,
                                const std::string& description, const std::string& default_text);
+
+/// The option of schema field `field` (calligraphy/core/schema.hpp) of the struct at `object`, which must
+/// outlive the parse: its name, value name, help (doc, unit, range) and default (from `defaults`, the
+/// struct's default instance) from the schema; its text set once by the schema's parser
+/// (`set_field_from_text`), an error naming the option. The range is the struct's check to apply
+/// (`check_schema`, `validate`).
+CLI::Option* add_schema_option(CLI::App& app, const SchemaField& field, void* object, const void* defaults);
 
 /// Makes an option required and says so in --help.
 CLI::Option* required(CLI::Option* option);

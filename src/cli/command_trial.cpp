@@ -35,40 +35,23 @@ namespace calligraphy::cli {
 namespace {
 
 struct TrialCommand {
-  std::string characters;
-  std::string device = "simulated";
-  std::string guidance = "on";
+  // The options made from the specification's schema set their field here, each parsed once by the
+  // schema's parser; the others are this command's own (who writes, the profile, the settings, --spec).
+  TrialSpec spec;
   std::string writer;  // person or simulated; empty: the device's own (writer_for_device)
-  std::string writer_profile = "novice";
-  const CLI::Option* profile_option = nullptr;
+  std::string writer_profile = TrialSpec{}.writer_profile;
   std::vector<std::string> writer_parameters;  // "key=value", applied in turn
-  std::string guidance_mode = "fixed";
-  std::string guidance_gain_text;       // "": the specification's default
-  std::string assist_band_text;         // "": the specification's default
-  std::string amplification_gain_text;  // "": the specification's default
-  std::string timing_speed_text;        // "": the specification's default
-  std::string teacher;                  // replay: the recording's path
-  std::string record;                   // write the trial as a teacher's recording
-  std::uint64_t seed = 0;
-  std::string rate_text = "1000";  // given to the specification's parser as it was typed
-  std::string max_duration_text;   // "": the specification's default
-  std::string pacing = "auto";
-  std::string realtime = "ignore";
-  std::int64_t watchdog_ms = std::llround(ServoLoopOptions{}.stall_timeout_s * 1000.0);
-  const CLI::Option* watchdog_option = nullptr;  // given on the command line when its count() > 0
   LibraryOptions library;
-  std::string json, svg, csv;
   std::string spec_file;          // --spec: a trial record (or its specification) to run again
   const CLI::App* app = nullptr;  // to ask which options were given
 };
 
-// The options that state a trial: with --spec the record states it, and each of these would be ignored.
-constexpr const char* kSpecificationOptions[] = {"--device",        "--guidance",    "--guidance-mode",
-                                                 "--guidance-gain", "--assist-band", "--amplification-gain",
-                                                 "--timing-speed",  "--writer",      "--writer-profile",
-                                                 "--writer-param",  "--seed",        "--rate",
-                                                 "--max-duration",  "--pacing",      "--realtime",
-                                                 "--watchdog-ms",   "--record"};
+// The options taken from --spec's record with it: every option of the specification but its outputs and a
+// replay's --teacher.
+bool stated_by_record(std::string_view option) {
+  return option.starts_with("--") && option != "--json" && option != "--csv" && option != "--svg" &&
+         option != "--teacher";
+}
 
 // --spec: the record's specification, with this command's outputs (and a replay's --teacher when given).
 RecordedTrial recorded_from(const TrialCommand& command) {
@@ -76,23 +59,29 @@ RecordedTrial recorded_from(const TrialCommand& command) {
     throw UsageError("CHARS: the characters come from --spec " + command.spec_file +
                      "; give one or the other");
   }
-  for (const char* option : kSpecificationOptions) {
-    if (command.app->count(option) > 0) {
-      throw UsageError(std::string(option) + ": the trial is stated by --spec " + command.spec_file +
+  for (const SchemaField& field : SchemaOf<TrialSpec>::get().fields) {
+    const std::string option(field.option);
+    if (stated_by_record(option) && command.app->count(option) > 0) {
+      throw UsageError(option + ": the trial is stated by --spec " + command.spec_file +
                        "; with it go only --json, --csv, --svg, --teacher and the character data options");
     }
   }
   RecordedTrial recorded = read_recorded_trial_file(command.spec_file);
-  if (!command.teacher.empty()) {
+  for (const std::string& pointer : recorded.defaulted) {
+    print_error_line("calligraphy trial", "note",
+                     "--spec " + command.spec_file + ": " + pointer +
+                         " is not in this earlier version of the record; it takes its default");
+  }
+  if (!command.spec.teacher.empty()) {
     if (recorded.spec.guidance_mode != GuidanceMode::replay) {
       throw UsageError("--teacher: the trial in --spec " + command.spec_file +
                        " is not a replay (guidance mode " + to_string(recorded.spec.guidance_mode) + ")");
     }
-    recorded.spec.teacher = command.teacher;
+    recorded.spec.teacher = command.spec.teacher;
   }
-  recorded.spec.json_file = command.json;
-  recorded.spec.csv_file = command.csv;
-  recorded.spec.svg_file = command.svg;
+  recorded.spec.json_file = command.spec.json_file;
+  recorded.spec.csv_file = command.spec.csv_file;
+  recorded.spec.svg_file = command.spec.svg_file;
   return recorded;
 }
 
@@ -109,37 +98,17 @@ Checked<TrialSpec> checked_spec(const TrialCommand& command, const RecordedTrial
   }
 }
 
-// The trial specification of the command line: every option given goes through the specification's one
-// parser (trial_spec.hpp) and its one check; an error there is a usage error naming the option.
+// The trial specification of the command line: the schema's options set their fields as they were parsed;
+// the writer's options are added through the specification's parser; one check, an error there a usage error
+// naming the option.
 Checked<TrialSpec> spec_from(const TrialCommand& command) {
-  std::vector<std::string> args{command.characters};
-  const auto add = [&args](const char* option, const std::string& value) {
-    args.emplace_back(option);
-    args.push_back(value);
-  };
-  add("--device", command.device);
-  add("--guidance", command.guidance);
-  add("--guidance-mode", command.guidance_mode);
-  if (!command.guidance_gain_text.empty()) add("--guidance-gain", command.guidance_gain_text);
-  if (!command.assist_band_text.empty()) add("--assist-band", command.assist_band_text);
-  if (!command.amplification_gain_text.empty()) add("--amplification-gain", command.amplification_gain_text);
-  if (!command.timing_speed_text.empty()) add("--timing-speed", command.timing_speed_text);
-  if (!command.teacher.empty()) add("--teacher", command.teacher);
-  if (!command.writer.empty()) add("--writer", command.writer);
-  if (command.profile_option->count() > 0) add("--writer-profile", command.writer_profile);
-  for (const std::string& setting : command.writer_parameters) add("--writer-param", setting);
-  add("--seed", std::to_string(command.seed));
-  add("--rate", command.rate_text);
-  add("--pacing", command.pacing);
-  add("--realtime", command.realtime);
-  if (command.watchdog_option->count() > 0) add("--watchdog-ms", std::to_string(command.watchdog_ms));
-  if (!command.max_duration_text.empty()) add("--max-duration", command.max_duration_text);
-  if (!command.json.empty()) add("--json", command.json);
-  if (!command.csv.empty()) add("--csv", command.csv);
-  if (!command.svg.empty()) add("--svg", command.svg);
-  if (!command.record.empty()) add("--record", command.record);
+  TrialSpec spec = command.spec;
   try {
-    return trial_spec_from_args(args);
+    if (!command.writer.empty()) set_trial_spec_field(spec, "writer", command.writer);
+    if (command.app->count("--writer-profile") > 0) spec.writer_profile = command.writer_profile;
+    for (const std::string& setting : command.writer_parameters)
+      set_trial_spec_field(spec, "--writer-param", setting);
+    return Checked<TrialSpec>::check(std::move(spec));
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());
   }
@@ -228,8 +197,9 @@ bool write_teacher_recording(const TrialSpec& spec, const TrialDescription& desc
 }
 
 int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
-  require_one_standard_output(
-      {{"--json", command.json == "-"}, {"--svg", command.svg == "-"}, {"--csv", command.csv == "-"}});
+  require_one_standard_output({{"--json", command.spec.json_file == "-"},
+                               {"--svg", command.spec.svg_file == "-"},
+                               {"--csv", command.spec.csv_file == "-"}});
   std::optional<RecordedTrial> recorded;
   if (!command.spec_file.empty()) {
     recorded = recorded_from(command);
@@ -237,8 +207,9 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
     throw UsageError("CHARS is required (or --spec RECORD)");
   }
   // Before any character is loaded.
-  check_scene_size(characters_from(recorded ? recorded->spec.characters : command.characters, "CHARS").size(),
-                   "CHARS");
+  check_scene_size(
+      characters_from(recorded ? recorded->spec.characters : command.spec.characters, "CHARS").size(),
+      "CHARS");
   // Checked once, here; the runner and the renderer take it as it is.
   const Checked<TrialSpec> checked = recorded ? checked_spec(command, *recorded) : spec_from(command);
   const TrialSpec& spec = *checked;
@@ -251,7 +222,7 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
     throw UsageError(e.what());
   }
   // A profile or its settings describe the simulated writer: with a person writing they would be ignored.
-  if (!simulated && command.profile_option->count() > 0) {
+  if (!simulated && command.app->count("--writer-profile") > 0) {
     throw UsageError("--writer-profile applies to the simulated writer, not to a person (--writer person)");
   }
   if (!simulated && !spec.writer_parameters.empty()) {
@@ -267,9 +238,9 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
     }
   }();
   // Lock-step pacing has no wall clock, so no stall can be bounded: the option would be ignored.
-  const bool real_time =
-      spec.pacing == TrialPacing::real_time || (spec.pacing == TrialPacing::automatic && device.capabilities.hardware);
-  if (command.watchdog_option->count() > 0 && !real_time) {
+  const bool real_time = spec.pacing == TrialPacing::real_time ||
+                         (spec.pacing == TrialPacing::automatic && device.capabilities.hardware);
+  if (command.app->count("--watchdog-ms") > 0 && !real_time) {
     throw UsageError(
         "--watchdog-ms applies to real-time pacing only (--pacing real-time, or a hardware device)");
   }
@@ -341,14 +312,8 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
   return 0;
 }
 
-// The specification's help of field `key`: for a guidance law's parameter, its table's doc, unit and range,
-// the range the specification checks.
-std::string spec_help(std::string_view key) {
-  for (const TrialSpecField& field : trial_spec_fields()) {
-    if (field.key == key) return std::string(field.help);
-  }
-  return {};
-}
+// The specification's help of field `key` (its schema's doc, unit and range).
+std::string spec_help(std::string_view key) { return SchemaOf<TrialSpec>::get().field(key)->description(); }
 
 }  // namespace
 
@@ -357,60 +322,34 @@ void add_trial_command(CLI::App& root, Commands& commands, DeviceRegistry& devic
   CLI::App* app = commands.add(root, "trial", "Run a guided writing trial of CHARS on a haptic device",
                                [command, &devices] { return run_trial(*command, devices); });
   command->app = app;
-  add_positional(*app, "CHARS", command->characters, "the characters to write, left to right (UTF-8)")
-      ->required(false);
+  add_positional(*app, "CHARS", command->spec.characters, spec_help("characters"))->required(false);
   add_input_path(*app, "--spec", command->spec_file, "RECORD",
                  "run again the trial a record states (a trial --json file or a study trial record, its "
                  "\"specification\"): identical on the simulated device; CHARS and the trial's options then "
                  "come from it",
                  "none");
-  add_text(*app, "--device", command->device, "NAME", "the device, by its name in `calligraphy devices`");
-  add_choice(*app, "--guidance", command->guidance, {"on", "off"}, "guiding force towards the stroke");
-  add_choice(
-      *app, "--guidance-mode", command->guidance_mode, guidance_mode_choices(),
-      "how the guidance acts: the paper's fixture, faded by --guidance-gain, replaying --teacher, only "
-      "beyond --assist-band, pushing off the stroke (--amplification-gain), or pulling along it at "
-      "--timing-speed");
-  add_text(*app, "--guidance-gain", command->guidance_gain_text, "G", spec_help("guidance_gain"), "1");
-  add_text(*app, "--assist-band", command->assist_band_text, "M", spec_help("assist_band_m"), "0.001");
-  add_text(*app, "--amplification-gain", command->amplification_gain_text, "G",
-           spec_help("amplification_gain"), "0.25");
-  add_text(*app, "--timing-speed", command->timing_speed_text, "M/S", spec_help("timing_speed_m_s"), "0.04");
-  add_input_path(*app, "--teacher", command->teacher, "FILE",
-                 "replay: the teacher's recording of CHARS (made with --record)", "none");
-  add_writer_option(*app, command->writer,
-                    "who writes: the simulated writer (on the simulated and emulated devices it moves) or a "
-                    "person (on a hardware device)",
+  // Every field of the specification with an option of its own, typed, its unit, range and default from
+  // the schema; files, who writes and the writer's profile and settings are declared below.
+  const TrialSpec defaults;
+  for (const SchemaField& field : SchemaOf<TrialSpec>::get().fields) {
+    const std::string_view option = field.option;
+    const bool own_declaration = field.kind == FieldKind::object_list || option == "--writer" ||
+                                 (field.kind == FieldKind::string && option != "--device");
+    if (!option.starts_with("--") || own_declaration) continue;
+    add_schema_option(*app, field, &command->spec, &defaults);
+  }
+  add_input_path(*app, "--teacher", command->spec.teacher, "FILE", spec_help("teacher"), "none");
+  add_writer_option(*app, command->writer, spec_help("writer"),
                     "simulated on a simulated or emulated device, person on hardware");
-  command->profile_option =
-      add_choice(*app, "--writer-profile", command->writer_profile, {"novice", "skilled", "foreign"},
-                 "the simulated writer's profile (docs/writer.md)");
+  add_choice(*app, "--writer-profile", command->writer_profile, {"novice", "skilled", "foreign"},
+             spec_help("writer_profile"));
   add_repeated_text(*app, "--writer-param", command->writer_parameters, "KEY=VALUE",
-                    "set a field of the simulated writer's profile (repeatable; keys: docs/writer.md)");
-  add_unsigned(*app, "--seed", command->seed, "N", "seed of the simulated writer (a 64-bit integer)");
-  add_text(*app, "--rate", command->rate_text, "HZ",
-           "servo rate [Hz], in [100, 100000] (real time: at most 10000)");
-  add_text(*app, "--max-duration", command->max_duration_text, "S", "the trial ends after this much time [s]",
-           "300");
-  add_choice(*app, "--pacing", command->pacing, {"auto", "lock-step", "real-time"},
-             "auto: lock-step for devices a simulated writer moves, real time for any other");
-  add_choice(
-      *app, "--realtime", command->realtime, {"enforce", "ignore"},
-      "real-time pacing: fail unless SCHED_FIFO, CPU pinning and locked memory are obtained (enforce)");
-  command->watchdog_option = add_integer(
-      *app, "--watchdog-ms", command->watchdog_ms, "MS",
-      "real-time pacing: end the trial when the device holds one force longer than this [ms]; 0: off", 0,
-      60000);
+                    spec_help("writer_parameters") + " (repeatable)");
   add_library_options(*app, command->library, true);
-  add_output_path(*app, "--json", command->json, "write the metrics as JSON", StandardOutput::allowed);
-  add_output_path(*app, "--svg", command->svg, "draw the reference and the pen trace as SVG",
-                  StandardOutput::allowed);
-  add_output_path(*app, "--csv", command->csv,
-                  "write the trace (t,x,y,z,fx,fy,fz,state,stroke,element; s, m, N) as CSV",
-                  StandardOutput::allowed);
-  add_output_path(*app, "--record", command->record,
-                  "write the trial as a teacher's recording for --guidance-mode replay (a trial that wrote "
-                  "every stroke in order)",
+  add_output_path(*app, "--json", command->spec.json_file, spec_help("json_file"), StandardOutput::allowed);
+  add_output_path(*app, "--svg", command->spec.svg_file, spec_help("svg_file"), StandardOutput::allowed);
+  add_output_path(*app, "--csv", command->spec.csv_file, spec_help("csv_file"), StandardOutput::allowed);
+  add_output_path(*app, "--record", command->spec.record_file, spec_help("record_file"),
                   StandardOutput::refused);
 }
 

@@ -12,6 +12,13 @@ std::string with_unit(const std::string& number, std::string_view unit) {
   return unit.empty() ? number : number + " " + std::string(unit);
 }
 
+// A bound as people write it: whole numbers in digits (100000, not 1e+05), others in their shortest form.
+std::string bound_text(double value) {
+  if (std::abs(value) < 1e15 && value == std::trunc(value))
+    return std::to_string(static_cast<long long>(value));
+  return shortest_decimal(value);
+}
+
 }  // namespace
 
 bool ParameterRange::contains(double value) const noexcept {
@@ -22,9 +29,9 @@ bool ParameterRange::contains(double value) const noexcept {
 }
 
 std::string ParameterRange::text(std::string_view unit) const {
-  if (std::isinf(high)) return with_unit((low_open ? "> " : ">= ") + shortest_decimal(low), unit);
-  return with_unit(std::string("in ") + (low_open ? "(" : "[") + shortest_decimal(low) + ", " +
-                       shortest_decimal(high) + (high_open ? ")" : "]"),
+  if (std::isinf(high)) return with_unit((low_open ? "> " : ">= ") + bound_text(low), unit);
+  return with_unit(std::string("in ") + (low_open ? "(" : "[") + bound_text(low) + ", " + bound_text(high) +
+                       (high_open ? ")" : "]"),
                    unit);
 }
 

@@ -60,16 +60,18 @@ enum LogCode : std::uint16_t {
 void log_sink(const LogRecord& r) {
   switch (r.code) {
     case kDeadlineMissed:
-      calligraphy::detail::library_log().warn("servo loop: tick {} missed its deadline by {:.1f} us ({} late so far)", r.count,
-                   r.values[0], static_cast<std::uint64_t>(r.values[1]));
+      calligraphy::detail::library_log().warn(
+          "servo loop: tick {} missed its deadline by {:.1f} us ({} late so far)", r.count, r.values[0],
+          static_cast<std::uint64_t>(r.values[1]));
       break;
     case kForceWithheld:
-      calligraphy::detail::library_log().warn("servo loop: tick {} withheld a force computed from a state {:.1f} us old ({} so far)",
-                   r.count, r.values[0], static_cast<std::uint64_t>(r.values[1]));
+      calligraphy::detail::library_log().warn(
+          "servo loop: tick {} withheld a force computed from a state {:.1f} us old ({} so far)", r.count,
+          r.values[0], static_cast<std::uint64_t>(r.values[1]));
       break;
     case kWatchdog:
-      calligraphy::detail::library_log().error("servo loop: watchdog at tick {}: stall of {:.1f} ms: {}", r.count, r.values[0],
-                    r.text.data());
+      calligraphy::detail::library_log().error("servo loop: watchdog at tick {}: stall of {:.1f} ms: {}",
+                                               r.count, r.values[0], r.text.data());
       break;
     case kFault:
       calligraphy::detail::library_log().error("servo loop: fault at tick {}: {}", r.count, r.text.data());
@@ -81,8 +83,9 @@ void log_sink(const LogRecord& r) {
           static_cast<std::uint64_t>(r.values[2]));
       break;
     case kStoppedGrid:
-      calligraphy::detail::library_log().info("servo loop: deadlines re-anchored {} times, {} deadlines skipped", r.count,
-                   static_cast<std::uint64_t>(r.values[0]));
+      calligraphy::detail::library_log().info(
+          "servo loop: deadlines re-anchored {} times, {} deadlines skipped", r.count,
+          static_cast<std::uint64_t>(r.values[0]));
       break;
     default:
       calligraphy::detail::library_log().debug("servo loop: log record {}", r.code);
@@ -94,7 +97,6 @@ void log_sink(const LogRecord& r) {
 bool worth_logging(std::uint64_t count) noexcept { return (count & (count - 1)) == 0; }
 
 constexpr double kMaxForceAgeLimitS = 1.0;
-constexpr double kMaxStallTimeoutS = 60.0;
 
 constexpr std::size_t kFaultMessageBytes = 128;
 
@@ -457,8 +459,8 @@ ServoLoop::ServoLoop(HapticDevice& device, Prepared prepared, const ServoLoopOpt
 
 ServoLoop::~ServoLoop() { stop(); }
 
-// A loop, a device clock and a callback built for one rate must agree: a renderer stepped at another rate runs
-// its time-based parts (fades, filters, a replay) at the wrong speed, which no measurement after the run
+// A loop, a device clock and a callback built for one rate must agree: a renderer stepped at another rate
+// runs its time-based parts (fades, filters, a replay) at the wrong speed, which no measurement after the run
 // could tell from a loaded machine.
 void ServoLoop::Impl::check_rates(const DeviceServoClock* device_clock) const {
   const auto differ = [](double a, double b) { return std::abs(a - b) > 1e-6 * b; };
@@ -466,21 +468,23 @@ void ServoLoop::Impl::check_rates(const DeviceServoClock* device_clock) const {
   if (device_clock != nullptr) {
     const double clock_hz = device_clock->servo_rate_hz();
     if (says_rate && differ(callback_rate_hz, clock_hz)) {
-      throw InvalidArgument("ServoLoop::start: the callback was built for " + detail::rate_text(callback_rate_hz) +
-                            " (" + callback_rate_name + "), but '" + device.info().model +
-                            "' runs its own servo clock at " + detail::rate_text(clock_hz) + ": set " +
-                            callback_rate_name + " to " + detail::rate_text(clock_hz));
+      throw InvalidArgument(
+          "ServoLoop::start: the callback was built for " + detail::rate_text(callback_rate_hz) + " (" +
+          callback_rate_name + "), but '" + device.info().model + "' runs its own servo clock at " +
+          detail::rate_text(clock_hz) + ": set " + callback_rate_name + " to " + detail::rate_text(clock_hz));
     }
     if (differ(options.rate_hz, clock_hz)) {
-      throw InvalidArgument("ServoLoop::start: ServoLoopOptions::rate_hz is " + detail::rate_text(options.rate_hz) +
-                            ", but '" + device.info().model + "' runs its own servo clock at " +
-                            detail::rate_text(clock_hz) + ": ask for that rate");
+      throw InvalidArgument("ServoLoop::start: ServoLoopOptions::rate_hz is " +
+                            detail::rate_text(options.rate_hz) + ", but '" + device.info().model +
+                            "' runs its own servo clock at " + detail::rate_text(clock_hz) +
+                            ": ask for that rate");
     }
   }
   if (says_rate && differ(callback_rate_hz, options.rate_hz)) {
-    throw InvalidArgument("ServoLoop::start: the callback was built for " + detail::rate_text(callback_rate_hz) +
-                          " (" + callback_rate_name + "), but the loop runs at " +
-                          detail::rate_text(options.rate_hz) + " (ServoLoopOptions::rate_hz): set both to one rate");
+    throw InvalidArgument("ServoLoop::start: the callback was built for " +
+                          detail::rate_text(callback_rate_hz) + " (" + callback_rate_name +
+                          "), but the loop runs at " + detail::rate_text(options.rate_hz) +
+                          " (ServoLoopOptions::rate_hz): set both to one rate");
   }
 }
 
@@ -561,11 +565,12 @@ void ServoLoop::start() {
     throw RealtimeError("ServoLoop::start: realtime required but " + m.realtime.problems);
   }
   // Debug, not info: an application that starts a loop per trial would get a line per trial.
-  calligraphy::detail::library_log().debug("servo loop: started at {} Hz; SCHED_FIFO {}, CPU {}, memory locked {}{}{}", m.options.rate_hz,
-               m.realtime.fifo_scheduling ? std::to_string(m.realtime.priority) : "no",
-               m.realtime.cpu >= 0 ? std::to_string(m.realtime.cpu) : "not pinned",
-               m.realtime.memory_locked ? "yes" : "no",
-               m.realtime.problems.empty() ? "" : "; not obtained: ", m.realtime.problems);
+  calligraphy::detail::library_log().debug(
+      "servo loop: started at {} Hz; SCHED_FIFO {}, CPU {}, memory locked {}{}{}", m.options.rate_hz,
+      m.realtime.fifo_scheduling ? std::to_string(m.realtime.priority) : "no",
+      m.realtime.cpu >= 0 ? std::to_string(m.realtime.cpu) : "not pinned",
+      m.realtime.memory_locked ? "yes" : "no",
+      m.realtime.problems.empty() ? "" : "; not obtained: ", m.realtime.problems);
 }
 
 LoopFault ServoLoop::stop() noexcept {

@@ -52,43 +52,24 @@ std::span<const ParameterField<SkillAdaptiveRule>> ParameterTable<SkillAdaptiveR
   return kSkillRuleFields;
 }
 
-const char* to_string(GuidanceMode mode) noexcept {
-  switch (mode) {
-    case GuidanceMode::fixed:
-      return "fixed";
-    case GuidanceMode::fading:
-      return "fading";
-    case GuidanceMode::replay:
-      return "replay";
-    case GuidanceMode::assist_as_needed:
-      return "assist-as-needed";
-    case GuidanceMode::error_amplification:
-      return "error-amplification";
-    case GuidanceMode::timing:
-      return "timing";
-  }
-  return "?";
-}
+const char* to_string(GuidanceMode mode) noexcept { return enum_spelling(mode).data(); }
 
 std::span<const GuidanceMode> guidance_modes() noexcept {
-  static constexpr std::array<GuidanceMode, 6> kModes{GuidanceMode::fixed,
-                                                      GuidanceMode::fading,
-                                                      GuidanceMode::replay,
-                                                      GuidanceMode::assist_as_needed,
-                                                      GuidanceMode::error_amplification,
-                                                      GuidanceMode::timing};
+  static constexpr auto kModes = [] {
+    std::array<GuidanceMode, EnumTable<GuidanceMode>::entries.size()> out{};
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = EnumTable<GuidanceMode>::entries[i].value;
+    return out;
+  }();
   return kModes;
 }
 
 const char* guidance_mode_names() noexcept {
-  return "fixed|fading|replay|assist-as-needed|error-amplification|timing";
+  static const std::string names = join_spellings(enum_spellings<GuidanceMode>(), "|");
+  return names.c_str();
 }
 
 std::optional<GuidanceMode> guidance_mode_from_string(std::string_view name) noexcept {
-  for (const GuidanceMode mode : guidance_modes()) {
-    if (name == to_string(mode)) return mode;
-  }
-  return std::nullopt;
+  return enum_from_spelling<GuidanceMode>(name);
 }
 
 void validate_teacher_trajectory(std::span<const TeacherSample> samples) {

@@ -29,22 +29,10 @@ void TrialOptions::validate() const {
   paced.validate();
 }
 
-const char* to_string(TrialPacing pacing) noexcept {
-  switch (pacing) {
-    case TrialPacing::lock_step:
-      return "lock-step";
-    case TrialPacing::real_time:
-      return "real-time";
-    case TrialPacing::automatic:
-      break;
-  }
-  return "auto";
-}
+const char* to_string(TrialPacing pacing) noexcept { return enum_spelling(pacing).data(); }
 
 TrialPacing parse_trial_pacing(std::string_view text, std::string_view what) {
-  for (const TrialPacing pacing : {TrialPacing::automatic, TrialPacing::lock_step, TrialPacing::real_time}) {
-    if (text == to_string(pacing)) return pacing;
-  }
+  if (const std::optional<TrialPacing> pacing = enum_from_spelling<TrialPacing>(text)) return *pacing;
   throw InvalidArgument(std::string(what) + ": '" + std::string(text) +
                         "' is not a pacing: expected 'auto', 'lock-step' or 'real-time'");
 }

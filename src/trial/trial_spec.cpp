@@ -15,6 +15,7 @@
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "core/json_reader.hpp"
+#include "core/schema_json.hpp"
 #include "trial/trial_spec_object.hpp"
 
 namespace calligraphy {
@@ -22,68 +23,166 @@ namespace {
 
 using nlohmann::json;
 
-// A guidance law's parameter's help: its mode, then the law's table entry (doc, unit and range), so that
-// the help states the range the check applies.
+// The range of a guidance law's or the force law's parameter held by the specification: the law's table
+// entry, the one definition of that range.
 template <typename Law>
-std::string law_help(std::string_view mode, double Law::*member) {
-  return std::string(mode) + ": " + parameter_field(member).description();
+ParameterRange law_range(double Law::*member) {
+  return parameter_field(member).range;
 }
 
-// The fields in both forms. The keys are the JSON names; the options those of `calligraphy trial`. Built
-// once, on first use: four helps come from the guidance laws' tables.
-const auto& fields_in_order() {
-  static const std::string gain_help = law_help("fading", &FadingGuidance::gain);
-  static const std::string band_help = law_help("assist-as-needed", &AssistAsNeededGuidance::band_m);
-  static const std::string amplification_help =
-      law_help("error-amplification", &ErrorAmplificationGuidance::gain);
-  static const std::string speed_help = law_help("timing", &TimingGuidance::speed_m_s);
-  static const std::array fields{
-      TrialSpecField{"characters", "CHARS", "CHARS", "the characters to write, left to right (UTF-8)"},
-      TrialSpecField{"device", "--device", "NAME", "the device, by its name in `calligraphy devices`"},
-      TrialSpecField{"guidance", "--guidance", "on|off", "guiding force towards the stroke"},
-      TrialSpecField{
-          "guidance_mode", "--guidance-mode",
-          "fixed|fading|replay|assist-as-needed|error-amplification|timing",
-          "how the guidance acts: the paper's fixture, faded by --guidance-gain, replaying --teacher, "
-          "only beyond --assist-band, pushing off the stroke (--amplification-gain), or pulling "
-          "along it at --timing-speed"},
-      TrialSpecField{"guidance_gain", "--guidance-gain", "G", gain_help},
-      TrialSpecField{"assist_band_m", "--assist-band", "M", band_help},
-      TrialSpecField{"amplification_gain", "--amplification-gain", "G", amplification_help},
-      TrialSpecField{"timing_speed_m_s", "--timing-speed", "M/S", speed_help},
-      TrialSpecField{"teacher", "--teacher", "FILE",
-                     "replay: the teacher's recording of CHARS (made with --record)"},
-      TrialSpecField{"writer", "--writer", "auto|person|simulated",
-                     "who writes: the simulated writer (on the simulated and emulated devices it moves) or a "
-                     "person (on a hardware device); auto: the device's own"},
-      TrialSpecField{"writer_profile", "--writer-profile", "novice|skilled|foreign",
-                     "the simulated writer's profile (docs/writer.md)"},
-      TrialSpecField{"writer_parameters", "--writer-param", "KEY=VALUE",
-                     "set a field of the simulated writer's profile (repeatable; keys: docs/writer.md)",
-                     true},
-      TrialSpecField{"seed", "--seed", "N", "seed of the simulated writer (a 64-bit integer)"},
-      TrialSpecField{"rate_hz", "--rate", "HZ",
-                     "servo rate [Hz], in [100, 100000] (real time: at most 10000)"},
-      TrialSpecField{"pacing", "--pacing", "auto|lock-step|real-time",
-                     "auto: lock-step for devices a simulated writer moves, real time for any other"},
-      TrialSpecField{"realtime", "--realtime", "enforce|ignore",
-                     "real-time pacing: fail unless SCHED_FIFO, CPU pinning and locked memory are obtained "
-                     "(enforce)"},
-      TrialSpecField{"watchdog_s", "--watchdog-ms", "MS",
-                     "real-time pacing: end the trial when the device holds one force longer than this [ms], "
-                     "0..60000; 0: off (JSON: watchdog_s in s)"},
-      TrialSpecField{"max_duration_s", "--max-duration", "S", "the trial ends after this much time [s]"},
-      TrialSpecField{"json_file", "--json", "FILE", "write the metrics as JSON ('-': standard output)"},
-      TrialSpecField{"csv_file", "--csv", "FILE",
-                     "write the trace (t,x,y,z,fx,fy,fz,state,stroke,element; s, m, N) as CSV ('-': standard "
-                     "output)"},
-      TrialSpecField{"svg_file", "--svg", "FILE",
-                     "draw the reference and the pen trace as SVG ('-': standard output)"},
-      TrialSpecField{
-          "record_file", "--record", "FILE",
-          "write the trial as a teacher's recording for --guidance-mode replay (a trial that wrote "
-          "every stroke in order)"},
+constexpr double kLargest = std::numeric_limits<double>::max();
+
+const std::vector<SchemaField>& writer_setting_fields() {
+  static const std::vector<SchemaField> fields{
+      string_field<&WriterSetting::key>(
+          "key", {.doc = "a field of the simulated writer's profile (docs/writer.md)"}),
+      number_field<&WriterSetting::value>("value", {.low = -kLargest, .high = kLargest},
+                                          {.doc = "its value, in the field's unit and range"}),
   };
+  return fields;
+}
+
+// The fields in both forms, in the order the forms list them: the JSON key, the option of `calligraphy
+// trial`, the unit, the range and the doc. Built once, on first use: ranges come from the laws' tables.
+const std::vector<SchemaField>& spec_fields() {
+  static const std::vector<SchemaField> fields{
+      string_field<&TrialSpec::characters>("characters",
+                                           {.doc = "the characters to write, left to right (UTF-8)",
+                                            .option = "CHARS",
+                                            .option_value_name = "CHARS"}),
+      string_field<&TrialSpec::device>("device", {.doc = "the device, by its name in `calligraphy devices`",
+                                                  .option = "--device",
+                                                  .option_value_name = "NAME"}),
+      boolean_field<&TrialSpec::guidance>(
+          "guidance", {.doc = "guiding force towards the stroke", .option = "--guidance"}),
+      enum_field<&TrialSpec::guidance_mode>(
+          "guidance_mode",
+          {.doc =
+               "how the guidance acts: the paper's fixture, faded by --guidance-gain, replaying --teacher, "
+               "only beyond --assist-band, pushing off the stroke (--amplification-gain), or pulling along "
+               "it at --timing-speed",
+           .option = "--guidance-mode"}),
+      // Version 3 of a trial record (calligraphy/study/recorded_trial.hpp) is the first to state it.
+      since(
+          3,
+          number_field<&TrialSpec::guidance_stiffness_n_per_m>(
+              "guidance_stiffness_n_per_m", law_range(&ForceLawParameters::guidance_stiffness_n_per_m),
+              {.unit = "N/m",
+               .doc =
+                   "K_et, the guidance stiffness per unit attraction factor; at its default it is capped at "
+                   "the device's stable maximum",
+               .option = "--guidance-stiffness",
+               .option_value_name = "N/M",
+               .source = "Wang, Zhang & Yao 2006, eq. (8)"})),
+      number_field<&TrialSpec::guidance_gain>(
+          "guidance_gain", law_range(&FadingGuidance::gain),
+          {.doc = "fading: the guidance's gain", .option = "--guidance-gain", .option_value_name = "G"}),
+      number_field<&TrialSpec::assist_band_m>(
+          "assist_band_m", law_range(&AssistAsNeededGuidance::band_m),
+          {.unit = "m",
+           .doc = "assist-as-needed: half-width of the band in which the writer corrects alone",
+           .option = "--assist-band",
+           .option_value_name = "M"}),
+      number_field<&TrialSpec::amplification_gain>(
+          "amplification_gain", law_range(&ErrorAmplificationGuidance::gain),
+          {.doc = "error-amplification: the repulsive stiffness's share of K_et",
+           .option = "--amplification-gain",
+           .option_value_name = "G"}),
+      number_field<&TrialSpec::timing_speed_m_s>("timing_speed_m_s", law_range(&TimingGuidance::speed_m_s),
+                                                 {.unit = "m/s",
+                                                  .doc = "timing: the target's mean speed along each stroke",
+                                                  .option = "--timing-speed",
+                                                  .option_value_name = "M/S"}),
+      string_field<&TrialSpec::teacher>(
+          "teacher", {.doc = "replay: the teacher's recording of the characters (made with --record)",
+                      .option = "--teacher",
+                      .option_value_name = "FILE"}),
+      enum_field<&TrialSpec::writer>(
+          "writer",
+          {.doc = "who writes: the simulated writer (on the simulated and emulated devices it moves) "
+                  "or a person (on a hardware device); auto: the device's own",
+           .option = "--writer"}),
+      string_field<&TrialSpec::writer_profile>(
+          "writer_profile",
+          {.doc = "the simulated writer's profile: novice, skilled or foreign (docs/writer.md)",
+           .option = "--writer-profile",
+           .option_value_name = "NAME"}),
+      object_list_field<&TrialSpec::writer_parameters>(
+          "writer_parameters",
+          {.doc = "settings of the simulated writer's profile, applied in turn (keys: docs/writer.md)",
+           .option = "--writer-param",
+           .option_value_name = "KEY=VALUE"}),
+      unsigned_field<&TrialSpec::seed>(
+          "seed", {.doc = "seed of the simulated writer", .option = "--seed", .option_value_name = "N"}),
+      number_field<&TrialSpec::rate_hz>("rate_hz", {.low = kMinServoRateHz, .high = kMaxServoRateHz},
+                                        {.unit = "Hz",
+                                         .doc = "servo rate (real-time pacing: at most 10000 Hz)",
+                                         .option = "--rate",
+                                         .option_value_name = "HZ"}),
+      enum_field<&TrialSpec::pacing>("pacing",
+                                     {.doc = "how the trial's ticks are paced", .option = "--pacing"}),
+      enum_field<&TrialSpec::realtime>(
+          "realtime", {.doc = "real-time pacing: fail unless SCHED_FIFO, CPU pinning and locked memory are "
+                              "obtained (enforce)",
+                       .option = "--realtime"}),
+      option_in(
+          "ms", 1000.0,
+          number_field<&TrialSpec::watchdog_s>(
+              "watchdog_s", {.low = 0.0, .high = kMaxStallTimeoutS},
+              {.unit = "s",
+               .doc = "real-time pacing: end the trial when the device holds one force longer than this, "
+                      "in whole milliseconds; 0: off",
+               .option = "--watchdog-ms",
+               .option_value_name = "MS"})),
+      number_field<&TrialSpec::max_duration_s>("max_duration_s",
+                                               {.low = 0.0, .high = kMaxTrialDurationS, .low_open = true},
+                                               {.unit = "s",
+                                                .doc = "the trial ends after this much time",
+                                                .option = "--max-duration",
+                                                .option_value_name = "S"}),
+      string_field<&TrialSpec::json_file>("json_file",
+                                          {.doc = "write the metrics as JSON ('-': standard output)",
+                                           .option = "--json",
+                                           .option_value_name = "FILE"}),
+      string_field<&TrialSpec::csv_file>(
+          "csv_file", {.doc = "write the trace (t,x,y,z,fx,fy,fz,state,stroke,element; s, m, N) as CSV ('-': "
+                              "standard output)",
+                       .option = "--csv",
+                       .option_value_name = "FILE"}),
+      string_field<&TrialSpec::svg_file>(
+          "svg_file", {.doc = "draw the reference and the pen trace as SVG ('-': standard output)",
+                       .option = "--svg",
+                       .option_value_name = "FILE"}),
+      string_field<&TrialSpec::record_file>(
+          "record_file",
+          {.doc = "write the trial as a teacher's recording for --guidance-mode replay (a trial "
+                  "that wrote every stroke in order)",
+           .option = "--record",
+           .option_value_name = "FILE"}),
+  };
+  return fields;
+}
+
+// The public view of the fields (key, option, value name, help), made from the schema.
+const std::vector<TrialSpecField>& fields_in_order() {
+  static const std::vector<TrialSpecField> fields = [] {
+    static std::vector<std::string> helps;  // owns the texts the views point into
+    static std::vector<std::string> value_names;
+    const auto& schema_fields = spec_fields();
+    helps.reserve(schema_fields.size());
+    value_names.reserve(schema_fields.size());
+    std::vector<TrialSpecField> out;
+    for (const SchemaField& field : schema_fields) {
+      std::string help = field.description();
+      if (!field.option_unit.empty()) help += " (the option in " + std::string(field.option_unit) + ")";
+      helps.push_back(std::move(help));
+      value_names.push_back(field.option_value_name.empty() ? field.range_text()
+                                                            : std::string(field.option_value_name));
+      out.push_back(TrialSpecField{field.name, field.option, value_names.back(), helps.back(),
+                                   field.kind == FieldKind::object_list});
+    }
+    return out;
+  }();
   return fields;
 }
 
@@ -107,174 +206,59 @@ std::string field_label(std::string_view key) {
   throw InvalidArgument(field_label(key) + ": " + message);
 }
 
-double parse_number(std::string_view key, std::string_view text) {
-  const std::optional<double> value = parse_finite_double(text);
-  if (!value) refuse(key, "'" + std::string(text) + "' is not a finite number");
-  return *value;
-}
-
-std::uint64_t parse_unsigned(std::string_view key, std::string_view text) {
-  std::uint64_t value = 0;
-  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (text.empty() || error != std::errc() || end != text.data() + text.size()) {
-    refuse(key, "'" + std::string(text) + "' is not an integer in 0..18446744073709551615");
-  }
-  return value;
-}
-
-std::string number_text(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.17g", value);
-  return text;
-}
-
-const char* to_string(RealtimeMode mode) noexcept {
-  return mode == RealtimeMode::enforce ? "enforce" : "ignore";
-}
-
-// A guidance law's parameter held by the specification, checked by the law's own table entry (one
-// definition of each range), the error naming both the specification's field and the law's.
-template <typename Law>
-void check_law_parameter(std::string_view key, double Law::*member, double value) {
-  try {
-    check_parameter(member, value);
-  } catch (const InvalidArgument& e) {
-    refuse(key, e.what());
-  }
-}
-
-template <typename Enum, std::size_t N>
-Enum parse_choice(std::string_view key, std::string_view text, const std::array<Enum, N>& choices) {
-  std::string spellings;
-  for (const Enum choice : choices) {
-    if (text == to_string(choice)) return choice;
-    spellings += (spellings.empty() ? "'" : ", '") + std::string(to_string(choice)) + "'";
-  }
-  refuse(key, "'" + std::string(text) + "' is not one of " + spellings);
-}
+std::string number_text(double value) { return shortest_decimal(value); }
 
 }  // namespace
+
+const Schema& SchemaOf<WriterSetting>::get() {
+  static const Schema schema{.name = "WriterSetting",
+                             .doc = "one setting of the simulated writer's profile",
+                             .fields = writer_setting_fields(),
+                             .defaults = default_of<WriterSetting>};
+  return schema;
+}
+
+const Schema& SchemaOf<TrialSpec>::get() {
+  static const Schema schema{
+      .name = "TrialSpec",
+      .doc =
+          "one trial: what to write, on which device, with which guidance, pacing, writer and outputs; "
+          "lengths in m, times in s, rates in Hz, stiffnesses in N/m",
+      .fields = spec_fields(),
+      .defaults = default_of<TrialSpec>,
+      // Its rules between fields are TrialSpec::validate, which needs to know where a replay's teacher comes
+      // from: the readers run it after the fields are read.
+      .check_rules = nullptr};
+  return schema;
+}
 
 double default_watchdog_s(bool hardware_device) noexcept {
   return hardware_device ? TrialSpec{}.watchdog_s : 0.0;
 }
 
-const char* to_string(TrialWriter writer) noexcept {
-  switch (writer) {
-    case TrialWriter::person:
-      return "person";
-    case TrialWriter::simulated:
-      return "simulated";
-    case TrialWriter::automatic:
-      break;
-  }
-  return "auto";
-}
-
-namespace {
-
-// The numeric fields by key: the JSON form reads and writes them as JSON numbers (no text in between), the
-// command line parses their text; validate() checks their ranges either way.
-constexpr std::array<std::pair<std::string_view, double TrialSpec::*>, 6> kNumberFields{{
-    {"guidance_gain", &TrialSpec::guidance_gain},
-    {"assist_band_m", &TrialSpec::assist_band_m},
-    {"amplification_gain", &TrialSpec::amplification_gain},
-    {"timing_speed_m_s", &TrialSpec::timing_speed_m_s},
-    {"rate_hz", &TrialSpec::rate_hz},
-    {"max_duration_s", &TrialSpec::max_duration_s},
-}};
-
-double TrialSpec::*number_member(std::string_view key) {
-  for (const auto& [name, member] : kNumberFields) {
-    if (name == key) return member;
-  }
-  return nullptr;
-}
-
-}  // namespace
+const char* to_string(TrialWriter writer) noexcept { return enum_spelling(writer).data(); }
 
 std::span<const TrialSpecField> trial_spec_fields() { return fields_in_order(); }
 
 void set_trial_spec_field(TrialSpec& spec, std::string_view name, std::string_view text) {
-  const std::string_view key = field_named(name).key;
-  if (key == "characters") {
-    spec.characters = text;
-  } else if (key == "device") {
-    spec.device = text;
-  } else if (key == "guidance") {
-    if (text != "on" && text != "off") refuse(key, "'" + std::string(text) + "' is not one of 'on', 'off'");
-    spec.guidance = text == "on";
-  } else if (key == "guidance_mode") {
-    spec.guidance_mode = parse_choice(
-        key, text,
-        std::array{GuidanceMode::fixed, GuidanceMode::fading, GuidanceMode::replay,
-                   GuidanceMode::assist_as_needed, GuidanceMode::error_amplification, GuidanceMode::timing});
-  } else if (double TrialSpec::*number = number_member(key)) {
-    spec.*number = parse_number(key, text);
-  } else if (key == "teacher") {
-    spec.teacher = text;
-  } else if (key == "writer") {
-    spec.writer = parse_choice(
-        key, text, std::array{TrialWriter::automatic, TrialWriter::person, TrialWriter::simulated});
-  } else if (key == "writer_profile") {
-    spec.writer_profile = text;
-  } else if (key == "writer_parameters") {
-    try {
+  const SchemaField& field = *SchemaOf<TrialSpec>::get().field(field_named(name).key);
+  try {
+    if (field.kind == FieldKind::object_list) {  // a writer's setting, "key=value"
       spec.writer_parameters.push_back(parse_writer_setting(text));
-    } catch (const InvalidArgument& e) {
-      refuse(key, e.what());
+    } else {
+      set_field_from_text(field, &spec, text);
     }
-  } else if (key == "seed") {
-    spec.seed = parse_unsigned(key, text);
-  } else if (key == "pacing") {
-    spec.pacing = parse_choice(
-        key, text, std::array{TrialPacing::automatic, TrialPacing::lock_step, TrialPacing::real_time});
-  } else if (key == "realtime") {
-    spec.realtime = parse_choice(key, text, std::array{RealtimeMode::enforce, RealtimeMode::ignore});
-  } else if (key == "watchdog_s") {
-    // Whole milliseconds on the command line, as the servo loop's stall bound has always been given there.
-    const std::uint64_t ms = parse_unsigned(key, text);
-    if (ms > 60000) refuse(key, "'" + std::string(text) + "' ms is outside 0..60000");
-    spec.watchdog_s = static_cast<double>(ms) / 1000.0;
-  } else if (key == "json_file") {
-    spec.json_file = text;
-  } else if (key == "csv_file") {
-    spec.csv_file = text;
-  } else if (key == "svg_file") {
-    spec.svg_file = text;
-  } else if (key == "record_file") {
-    spec.record_file = text;
+  } catch (const InvalidArgument& e) {
+    refuse(field.name, e.what());
   }
 }
 
 std::vector<std::string> trial_spec_field_text(const TrialSpec& spec, std::string_view name) {
-  const std::string_view key = field_named(name).key;
-  if (key == "characters") return {spec.characters};
-  if (key == "device") return {spec.device};
-  if (key == "guidance") return {spec.guidance ? "on" : "off"};
-  if (key == "guidance_mode") return {to_string(spec.guidance_mode)};
-  if (key == "guidance_gain") return {number_text(spec.guidance_gain)};
-  if (key == "assist_band_m") return {number_text(spec.assist_band_m)};
-  if (key == "amplification_gain") return {number_text(spec.amplification_gain)};
-  if (key == "timing_speed_m_s") return {number_text(spec.timing_speed_m_s)};
-  if (key == "teacher") return {spec.teacher};
-  if (key == "writer") return {to_string(spec.writer)};
-  if (key == "writer_profile") return {spec.writer_profile};
-  if (key == "writer_parameters") {
-    std::vector<std::string> texts;
-    for (const WriterSetting& setting : spec.writer_parameters) texts.push_back(writer_setting_text(setting));
-    return texts;
-  }
-  if (key == "seed") return {std::to_string(spec.seed)};
-  if (key == "rate_hz") return {number_text(spec.rate_hz)};
-  if (key == "pacing") return {to_string(spec.pacing)};
-  if (key == "realtime") return {to_string(spec.realtime)};
-  if (key == "watchdog_s") return {std::to_string(std::llround(spec.watchdog_s * 1000.0))};
-  if (key == "max_duration_s") return {number_text(spec.max_duration_s)};
-  if (key == "json_file") return {spec.json_file};
-  if (key == "csv_file") return {spec.csv_file};
-  if (key == "svg_file") return {spec.svg_file};
-  return {spec.record_file};
+  const SchemaField& field = *SchemaOf<TrialSpec>::get().field(field_named(name).key);
+  if (field.kind != FieldKind::object_list) return {field_text(field, &spec)};
+  std::vector<std::string> texts;
+  for (const WriterSetting& setting : spec.writer_parameters) texts.push_back(writer_setting_text(setting));
+  return texts;
 }
 
 void TrialSpec::validate(TeacherSource teacher_from) const {
@@ -291,27 +275,35 @@ void TrialSpec::validate(TeacherSource teacher_from) const {
     refuse("characters", e.what());
   }
   if (device.empty()) refuse("device", "no device named");
+  // Every field in its range (the schema's, from the laws' tables), the error naming both its forms.
+  const Schema& schema = SchemaOf<TrialSpec>::get();
+  for (const SchemaField& field : schema.fields) {
+    try {
+      check_field(schema, field, this);
+    } catch (const InvalidArgument& e) {
+      refuse(field.name, e.what());
+    }
+  }
   if (!guidance && guidance_mode != GuidanceMode::fixed) {
     refuse("guidance_mode", std::string("'") + calligraphy::to_string(guidance_mode) +
                                 "' needs guidance on (guidance is off)");
   }
-  check_law_parameter("guidance_gain", &FadingGuidance::gain, guidance_gain);
+  if (!guidance && guidance_stiffness_n_per_m != TrialSpec{}.guidance_stiffness_n_per_m) {
+    refuse("guidance_stiffness_n_per_m", "applies to guidance on (guidance is off)");
+  }
   if (guidance_gain != 1.0 && guidance_mode != GuidanceMode::fading) {
     refuse("guidance_gain", "applies to guidance mode 'fading' only");
   }
   // Each mode's own parameter: in its law's range, and given only with its mode (a value nothing reads is
   // a mistake).
   const TrialSpec defaults;
-  check_law_parameter("assist_band_m", &AssistAsNeededGuidance::band_m, assist_band_m);
   if (assist_band_m != defaults.assist_band_m && guidance_mode != GuidanceMode::assist_as_needed) {
     refuse("assist_band_m", "applies to guidance mode 'assist-as-needed' only");
   }
-  check_law_parameter("amplification_gain", &ErrorAmplificationGuidance::gain, amplification_gain);
   if (amplification_gain != defaults.amplification_gain &&
       guidance_mode != GuidanceMode::error_amplification) {
     refuse("amplification_gain", "applies to guidance mode 'error-amplification' only");
   }
-  check_law_parameter("timing_speed_m_s", &TimingGuidance::speed_m_s, timing_speed_m_s);
   if (timing_speed_m_s != defaults.timing_speed_m_s && guidance_mode != GuidanceMode::timing) {
     refuse("timing_speed_m_s", "applies to guidance mode 'timing' only");
   }
@@ -342,15 +334,10 @@ void TrialSpec::validate(TeacherSource teacher_from) const {
     refuse("rate_hz", number_text(rate_hz) + " Hz is outside " + servo_rate_range_text(real_time) +
                           (real_time ? " (real-time pacing)" : ""));
   }
-  if (!(watchdog_s >= 0.0 && watchdog_s <= 60.0) ||
-      watchdog_s != static_cast<double>(std::llround(watchdog_s * 1000.0)) / 1000.0) {
-    refuse("watchdog_s", number_text(watchdog_s) + " s is not a whole number of milliseconds in [0, 60] s");
-  }
+  if (watchdog_s != static_cast<double>(std::llround(watchdog_s * 1000.0)) / 1000.0)
+    refuse("watchdog_s", number_text(watchdog_s) + " s is not a whole number of milliseconds");
   if (pacing == TrialPacing::lock_step && watchdog_s != TrialSpec{}.watchdog_s) {
     refuse("watchdog_s", "applies to real-time pacing only (lock-step has no wall clock to bound)");
-  }
-  if (!(max_duration_s > 0.0 && max_duration_s <= 86400.0)) {
-    refuse("max_duration_s", number_text(max_duration_s) + " is outside (0, 86400]");
   }
   // A trace longer than this would not fit a trial's memory (one sample per tick).
   if (rate_hz * max_duration_s > kMaxTrialTicks) {
@@ -396,63 +383,32 @@ std::vector<std::string> trial_spec_args(const TrialSpec& spec) {
 
 namespace trial_detail {
 
-Checked<TrialSpec> trial_spec_from_object(const json& document, const std::string& at_pointer,
-                                          const std::string& source, TeacherSource teacher_from) {
-  json_detail::ObjectReader reader(document, at_pointer, source);
-  TrialSpec spec;
-  for (const TrialSpecField& field : fields_in_order()) {
-    const std::string key(field.key);
-    const json* value = reader.optional(key);
-    if (value == nullptr) continue;
-    const std::string pointer = reader.pointer(key);
-    // Numbers, booleans and the seed are taken as the JSON values they are; text fields go through the one
-    // parser of the text forms (choices checked there).
-    const auto set = [&](const json& item, const std::string& at) {
-      const auto expect = [&](bool ok, const char* what) {
-        if (!ok)
-          json_detail::fail(source, at,
-                            std::string("expected ") + what + ", got " + json_detail::describe(item));
-      };
-      if (key == "guidance") {
-        expect(item.is_boolean(), "true or false");
-        spec.guidance = item.get<bool>();
-      } else if (key == "seed") {
-        expect(item.is_number_unsigned(), "an integer >= 0");
-        spec.seed = item.get<std::uint64_t>();
-      } else if (key == "watchdog_s") {
-        expect(item.is_number(), "a number");
-        const double s = item.get<double>();
-        if (!(s >= 0.0 && s <= 60.0) || std::abs(s * 1000.0 - std::round(s * 1000.0)) > 1e-6) {
-          json_detail::fail(source, at, "expected a whole number of milliseconds in [0, 60] s");
-        }
-        spec.watchdog_s = s;
-      } else if (double TrialSpec::*number = number_member(key)) {
-        expect(item.is_number(), "a number");
-        spec.*number = item.get<double>();
-      } else if (key == "writer_parameters" && item.is_object()) {  // {"key": name, "value": number}
-        json_detail::ObjectReader setting(item, at, source);
-        constexpr double kLargest = std::numeric_limits<double>::max();
-        spec.writer_parameters.push_back(
-            WriterSetting{setting.string("key"), setting.number("value", -kLargest, kLargest)});
-        setting.finish();
-      } else {  // text fields, and a setting written as "key=value" (records before settings were typed)
-        try {
-          set_trial_spec_field(spec, key, json_detail::as_string(item, at, source));
-        } catch (const InvalidArgument& e) {
-          json_detail::fail(source, at, e.what());
-        }
-      }
-    };
-    if (field.repeated) {
-      if (!value->is_array())
-        json_detail::fail(source, pointer, "expected an array, got " + json_detail::describe(*value));
-      for (std::size_t i = 0; i < value->size(); ++i)
-        set((*value)[i], json_detail::child_pointer(pointer, i));
-    } else {
-      set(*value, pointer);
+void type_writer_settings(json& trial, const std::string& pointer, const std::string& source) {
+  if (!trial.is_object()) return;
+  const auto settings = trial.find("writer_parameters");
+  if (settings == trial.end() || !settings->is_array()) return;
+  for (std::size_t i = 0; i < settings->size(); ++i) {
+    json& item = (*settings)[i];
+    if (!item.is_string()) continue;
+    try {
+      const WriterSetting setting = parse_writer_setting(item.get<std::string>());
+      item = {{"key", setting.key}, {"value", setting.value}};
+    } catch (const InvalidArgument& e) {
+      json_detail::fail(
+          source, json_detail::child_pointer(json_detail::child_pointer(pointer, "writer_parameters"), i),
+          e.what());
     }
   }
-  reader.finish();
+}
+
+Checked<TrialSpec> trial_spec_from_object(const json& document, const std::string& at_pointer,
+                                          const std::string& source, TeacherSource teacher_from,
+                                          const SchemaReadOptions& options) {
+  json object = document;
+  type_writer_settings(object, at_pointer, source);
+  TrialSpec spec;
+  SchemaReadResult read;
+  schema_detail::from_json(SchemaOf<TrialSpec>::get(), &spec, object, at_pointer, source, options, read);
   return Checked<TrialSpec>::check(std::move(spec), teacher_from);
 }
 
@@ -464,27 +420,6 @@ Checked<TrialSpec> trial_spec_from_json(std::string_view text, const std::string
                                               teacher_from);
 }
 
-std::string trial_spec_json(const TrialSpec& spec) {
-  nlohmann::ordered_json document = nlohmann::ordered_json::object();  // in field order
-  for (const TrialSpecField& field : fields_in_order()) {
-    const std::string key(field.key);
-    if (key == "guidance") {
-      document[key] = spec.guidance;
-    } else if (key == "seed") {
-      document[key] = spec.seed;
-    } else if (key == "watchdog_s") {
-      document[key] = spec.watchdog_s;
-    } else if (double TrialSpec::*number = number_member(key)) {
-      document[key] = spec.*number;
-    } else if (field.repeated) {  // the writer's settings, numbers as numbers
-      document[key] = nlohmann::ordered_json::array();
-      for (const WriterSetting& setting : spec.writer_parameters)
-        document[key].push_back({{"key", setting.key}, {"value", setting.value}});
-    } else {
-      document[key] = trial_spec_field_text(spec, key).front();
-    }
-  }
-  return document.dump(2) + "\n";
-}
+std::string trial_spec_json(const TrialSpec& spec) { return schema_json(spec); }
 
 }  // namespace calligraphy

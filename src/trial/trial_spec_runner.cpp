@@ -51,6 +51,7 @@ TrialOptions options_stated(const TrialSpec& spec, const DeviceInfo& device) {
   TrialOptions options;
   options.force.guidance = spec.guidance;
   options.force.guidance_law = guidance_law_of(spec);
+  options.force.guidance_stiffness_n_per_m = spec.guidance_stiffness_n_per_m;
   fit_default_stiffness(options.force, device);
   options.rate_hz = spec.rate_hz;
   options.pacing = spec.pacing;

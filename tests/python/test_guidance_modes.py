@@ -114,3 +114,19 @@ def test_next_guidance_gain_refuses_bad_input():
         calligraphy.next_guidance_gain(0.5, "small")
     with pytest.raises(calligraphy.InvalidArgument, match="forgetting_factor"):
         calligraphy.FadingRule(forgetting_factor=2.0)
+
+
+@pytest.mark.parametrize("mode", [m for m in calligraphy.GuidanceMode.__members__ if m != "replay"])
+def test_the_library_reads_back_the_mode_it_writes(mode):
+    """The metrics spell a mode as the command line and the files do ("assist-as-needed"); Python takes that
+    spelling back, and the member's name ("assist_as_needed") for one more version with a DeprecationWarning."""
+    first = trial(guidance_mode=getattr(calligraphy.GuidanceMode, mode), seed=1)
+    spelled = first.metrics["guidance_mode"]
+    assert spelled == mode.replace("_", "-")
+    again = trial(guidance_mode=spelled, seed=1)
+    assert again.metrics["guidance_mode"] == spelled
+    if spelled != mode:
+        with pytest.warns(DeprecationWarning, match=spelled):
+            trial(guidance_mode=mode, seed=1)
+    with pytest.raises(calligraphy.InvalidArgument, match="assist-as-needed"):
+        trial(guidance_mode="assist as needed")

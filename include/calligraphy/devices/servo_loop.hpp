@@ -23,6 +23,7 @@
 /// exception). Statistics are atomics, readable from any thread while the loop runs. Log records go
 /// through a lock-free queue to a normal thread that calls spdlog. Linux only (clock_nanosleep,
 /// SCHED_FIFO).
+#include <array>
 #include <concepts>
 #include <cstdint>
 #include <functional>
@@ -33,6 +34,7 @@
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/schema.hpp"
 #include "calligraphy/devices/haptic_device.hpp"
 
 namespace calligraphy {
@@ -42,9 +44,23 @@ namespace calligraphy {
 /// settings, runs anyway, and records what was obtained in `ServoLoopStats::realtime`.
 enum class RealtimeMode { enforce, ignore };
 
+/// The one spelling of each real-time mode.
+template <>
+struct EnumTable<RealtimeMode> {
+  static constexpr std::string_view name = "RealtimeMode";
+  static constexpr std::array<EnumEntry<RealtimeMode>, 2> entries{{
+      {RealtimeMode::enforce, "enforce",
+       "fail unless SCHED_FIFO, CPU pinning and locked memory are obtained"},
+      {RealtimeMode::ignore, "ignore", "run with what the process is given"},
+  }};
+};
+
 /// The SCHED_FIFO priority a program that exists to run the haptic loop asks for (the command line's trials
 /// and study sessions): above the kernel's threaded interrupts (50), below its watchdogs (99).
 inline constexpr int kDedicatedServoPriority = 80;
+
+/// The longest stall bound a loop takes (`ServoLoopOptions::stall_timeout_s`) [s]: longer is no watchdog.
+inline constexpr double kMaxStallTimeoutS = 60.0;
 
 /// The defaults suit a library inside a larger program: normal scheduling, no CPU pinning and no memory
 /// locking, nothing that changes the process. A program that exists to run the loop asks for them

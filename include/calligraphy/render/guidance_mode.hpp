@@ -20,6 +20,7 @@
 ///    shape.
 /// Skill-adaptive selection (Milot et al. 2010: guidance for the less skilled, amplification for the
 /// more skilled) chooses one of these per repetition: `skill_adaptive_mode`.
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -27,6 +28,7 @@
 
 #include "calligraphy/core/geometry.hpp"
 #include "calligraphy/core/parameter_table.hpp"
+#include "calligraphy/core/schema.hpp"
 
 namespace calligraphy {
 
@@ -39,7 +41,22 @@ enum class GuidanceMode : std::uint8_t {
   timing,               ///< a minimum-jerk target along the stroke, pulled towards along the stroke only
 };
 
-/// "fixed", "fading", "replay", "assist-as-needed", "error-amplification" or "timing".
+/// The one spelling of each mode, in every file, option and Python argument.
+template <>
+struct EnumTable<GuidanceMode> {
+  static constexpr std::string_view name = "GuidanceMode";
+  static constexpr std::array<EnumEntry<GuidanceMode>, 6> entries{{
+      {GuidanceMode::fixed, "fixed", "the paper's virtual fixture, eq. (8)"},
+      {GuidanceMode::fading, "fading", "the fixture scaled by a gain in [0, 1]"},
+      {GuidanceMode::replay, "replay", "the attraction point follows a teacher's recording in time"},
+      {GuidanceMode::assist_as_needed, "assist-as-needed", "the fixture on the deviation beyond a band only"},
+      {GuidanceMode::error_amplification, "error-amplification", "a bounded field pushing off the stroke"},
+      {GuidanceMode::timing, "timing",
+       "a minimum-jerk target along the stroke, pulled towards along it only"},
+  }};
+};
+
+/// "fixed", "fading", "replay", "assist-as-needed", "error-amplification" or "timing" (EnumTable).
 const char* to_string(GuidanceMode mode) noexcept;
 /// Every mode, in declaration order.
 [[nodiscard]] std::span<const GuidanceMode> guidance_modes() noexcept;

@@ -2,9 +2,11 @@
 /// \file options.hpp
 /// The options of a guided writing trial, one struct for every device and pacing (validated once, in
 /// `TrialOptions::validate`).
+#include <array>
 #include <functional>
 #include <string_view>
 
+#include "calligraphy/core/schema.hpp"
 #include "calligraphy/devices/servo_loop.hpp"
 #include "calligraphy/render/force_law.hpp"
 #include "calligraphy/render/renderer.hpp"
@@ -16,6 +18,8 @@ namespace calligraphy {
 /// in memory. A trial specification (TrialSpec::validate) and Python refuse more; a protocol is refused at
 /// reading.
 inline constexpr double kMaxTrialTicks = 1e7;
+/// The longest a trial may be stated to last [s] (one day): `TrialSpec::max_duration_s` is in (0, this].
+inline constexpr double kMaxTrialDurationS = 86400.0;
 
 /// How a trial's ticks are paced.
 enum class TrialPacing {
@@ -24,8 +28,19 @@ enum class TrialPacing {
   real_time,  ///< the `ServoLoop` at `rate_hz` on its own thread, with `loop`'s realtime settings
 };
 
-/// "auto", "lock-step" or "real-time": the one spelling of a pacing in the CLI, protocols, session folders,
-/// records and Python.
+/// The one spelling of a pacing in the CLI, protocols, session folders, records and Python.
+template <>
+struct EnumTable<TrialPacing> {
+  static constexpr std::string_view name = "TrialPacing";
+  static constexpr std::array<EnumEntry<TrialPacing>, 3> entries{{
+      {TrialPacing::automatic, "auto",
+       "lock-step for devices a simulated writer moves, real time for any other"},
+      {TrialPacing::lock_step, "lock-step", "no wall clock: a tick as soon as the last is done"},
+      {TrialPacing::real_time, "real-time", "the servo loop on its own thread at the rate"},
+  }};
+};
+
+/// "auto", "lock-step" or "real-time" (EnumTable).
 [[nodiscard]] const char* to_string(TrialPacing pacing) noexcept;
 /// The pacing spelled `text` (as `to_string` spells it). Throws InvalidArgument naming `what` (the option or
 /// field) and the three spellings otherwise.

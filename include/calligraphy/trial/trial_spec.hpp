@@ -9,6 +9,7 @@
 /// settings are named here and checked by the simulated writer (calligraphy/sim's `writer_profile_of`); a
 /// replay's teacher file is read by the front-end (calligraphy/report's teacher_recording.hpp). The fields,
 /// their JSON keys, options and meaning: docs/cli.md ("The trial specification").
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "calligraphy/core/checked.hpp"
+#include "calligraphy/core/schema.hpp"
 #include "calligraphy/devices/servo_loop.hpp"
 #include "calligraphy/render/force_law.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
@@ -28,6 +30,18 @@ namespace calligraphy {
 /// other), a person, or the simulated writer. Spelled "auto", "person", "simulated".
 enum class TrialWriter : std::uint8_t { automatic, person, simulated };
 
+template <>
+struct EnumTable<TrialWriter> {
+  static constexpr std::string_view name = "TrialWriter";
+  static constexpr std::array<EnumEntry<TrialWriter>, 3> entries{{
+      {TrialWriter::automatic, "auto",
+       "the device's own: the simulated writer on a device it moves, else a person"},
+      {TrialWriter::person, "person", "a person holds the device"},
+      {TrialWriter::simulated, "simulated", "the simulated writer moves the device"},
+  }};
+};
+
+/// "auto", "person" or "simulated" (EnumTable).
 [[nodiscard]] const char* to_string(TrialWriter writer) noexcept;
 
 /// Where a replay's teacher comes from: the recording file `TrialSpec::teacher`, or the teacher's samples
@@ -40,7 +54,10 @@ struct TrialSpec {
   std::string device = "simulated";                  ///< a device name of `calligraphy devices`
   bool guidance = true;                              ///< in-plane guidance (the paper force stays)
   GuidanceMode guidance_mode = GuidanceMode::fixed;  ///< the paper's fixture or another mode
-  double guidance_gain = 1.0;                        ///< fading only: gain in [0, 1]
+  /// K_et [N/m] per unit attraction factor (eq. 8), in ForceLawParameters' range; at its default, capped at
+  /// the device's stable maximum (trial_options)
+  double guidance_stiffness_n_per_m = ForceLawParameters{}.guidance_stiffness_n_per_m;
+  double guidance_gain = 1.0;  ///< fading only: gain in [0, 1]
   /// assist-as-needed only: the band's half-width [m] >= 0 (AssistAsNeededGuidance::band_m)
   double assist_band_m = AssistAsNeededGuidance{}.band_m;
   /// error-amplification only: the repulsive stiffness's share of K_et, in [0, 1]
@@ -55,8 +72,9 @@ struct TrialSpec {
   double rate_hz = 1000.0;                       ///< servo rate [Hz]: [100, 100000], real time [100, 10000]
   TrialPacing pacing = TrialPacing::automatic;   ///< lock-step, real time, or the device's own
   RealtimeMode realtime = RealtimeMode::ignore;  ///< real time: require SCHED_FIFO, pinning, locked memory
-  double watchdog_s = ServoLoopOptions{}.stall_timeout_s;  ///< real time: longest stall [s] in [0, 60]; 0 off
-  double max_duration_s = 300.0;  ///< the trial ends after this much time [s], (0, 86400]
+  /// real time: longest stall [s] in [0, kMaxStallTimeoutS], whole milliseconds; 0 off
+  double watchdog_s = ServoLoopOptions{}.stall_timeout_s;
+  double max_duration_s = 300.0;  ///< the trial ends after this much time [s], (0, kMaxTrialDurationS]
   std::string json_file;          ///< the metrics as JSON ("-": standard output; "": none)
   std::string csv_file;           ///< the trace as CSV
   std::string svg_file;           ///< the reference and the trace as SVG
@@ -74,6 +92,17 @@ struct TrialSpec {
   void validate(TeacherSource teacher_from = TeacherSource::file) const;
 
   bool operator==(const TrialSpec&) const = default;
+};
+
+/// The specification's schema (schema.hpp): every field's key, option, unit, range, default and doc; its JSON
+/// and command-line forms, the checks of ranges and `calligraphy schema specification` come from it.
+template <>
+struct SchemaOf<TrialSpec> {
+  static const Schema& get();
+};
+template <>
+struct SchemaOf<WriterSetting> {
+  static const Schema& get();
 };
 
 /// The stall bound [s] a front-end sets when its user gives none: `TrialSpec::watchdog_s` (50 ms, the

@@ -1,0 +1,266 @@
+// The generic half of the schema (schema.hpp): range checks, the command line's text, docs tables. JSON
+// reading and writing and the JSON Schema are in schema_json.cpp.
+#include "calligraphy/core/schema.hpp"
+
+#include <charconv>
+#include <cmath>
+
+#include "calligraphy/core/decimal_number.hpp"
+#include "calligraphy/core/errors.hpp"
+
+namespace calligraphy {
+namespace {
+
+std::string quoted(std::string_view text) {
+  std::string out(1, '\'');
+  out.append(text);
+  out.push_back('\'');
+  return out;
+}
+
+std::string integer_range_text(const SchemaField& field) {
+  if (field.integer_unsigned) return "0..18446744073709551615";
+  return std::to_string(field.integer_low) + ".." + std::to_string(field.integer_high);
+}
+
+// A whole number as the command line writes it: digits, '-' first only for a negative value; no '+', no
+// spaces, no "-0" (which would say a sign the value does not have).
+template <typename T>
+std::optional<T> parse_whole(std::string_view text) {
+  if (text.empty() || text.starts_with("-0")) return std::nullopt;
+  T value{};
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (error != std::errc() || end != text.data() + text.size()) return std::nullopt;
+  return value;
+}
+
+}  // namespace
+
+std::string join_spellings(std::span<const std::string_view> spellings, std::string_view separator,
+                           std::string_view quote) {
+  std::string out;
+  for (const std::string_view spelling : spellings) {
+    if (!out.empty()) out += separator;
+    out += std::string(quote) + std::string(spelling) + std::string(quote);
+  }
+  return out;
+}
+
+void throw_not_a_spelling(std::string_view text, std::span<const std::string_view> spellings) {
+  throw InvalidArgument(quoted(text) + " is not one of " + join_spellings(spellings, ", ", "'"));
+}
+
+std::string_view to_string(FieldKind kind) noexcept {
+  switch (kind) {
+    case FieldKind::number:
+      return "number";
+    case FieldKind::integer:
+      return "integer";
+    case FieldKind::boolean:
+      return "boolean";
+    case FieldKind::enumeration:
+      return "enumeration";
+    case FieldKind::string:
+      return "string";
+    case FieldKind::object:
+      return "object";
+    case FieldKind::object_list:
+      return "object list";
+    case FieldKind::variant:
+      return "variant";
+    case FieldKind::number_array:
+      return "number array";
+  }
+  return "?";
+}
+
+std::string SchemaField::range_text() const {
+  switch (kind) {
+    case FieldKind::number:
+    case FieldKind::number_array:
+      return range.text(unit);
+    case FieldKind::integer:
+      return integer_range_text(*this);
+    case FieldKind::boolean:
+      return "true|false";
+    case FieldKind::enumeration:
+    case FieldKind::variant:
+      return join_spellings(spellings(), "|");
+    default:
+      return "";
+  }
+}
+
+std::string SchemaField::description() const {
+  std::string out(doc);
+  if (!unit.empty()) out += " [" + std::string(unit) + "]";
+  const std::string range_words = range_text();
+  if (!range_words.empty() && kind != FieldKind::enumeration && kind != FieldKind::boolean)
+    out += ", " + range_words;
+  return out;
+}
+
+const SchemaField* Schema::field(std::string_view wanted) const noexcept {
+  for (const SchemaField& f : fields) {
+    if (f.name == wanted || (!f.option.empty() && f.option == wanted)) return &f;
+  }
+  return nullptr;
+}
+
+void check_field(const Schema& schema, const SchemaField& field, const void* object) {
+  const std::string qualified = std::string(schema.name) + "." + std::string(field.name);
+  switch (field.kind) {
+    case FieldKind::number:
+      check_parameter(qualified, field.get_number(field, object, 0), field.unit, field.range);
+      break;
+    case FieldKind::number_array:
+      for (std::size_t i = 0; i < field.array_size; ++i) {
+        check_parameter(qualified + "[" + std::to_string(i) + "]", field.get_number(field, object, i),
+                        field.unit, field.range);
+      }
+      break;
+    case FieldKind::integer:
+      if (!field.integer_unsigned) {
+        const std::int64_t value = field.get_integer(object);
+        if (value < field.integer_low || value > field.integer_high) {
+          throw InvalidArgument(qualified + " = " + std::to_string(value) + " must be in " +
+                                integer_range_text(field));
+        }
+      }
+      break;
+    case FieldKind::object:
+      if (const void* nested = field.get_object(object)) check_schema(*field.nested(), nested);
+      break;
+    case FieldKind::variant:
+      check_schema(*field.variant_schema(field.variant_index(object)), field.variant_get(object));
+      break;
+    case FieldKind::object_list:
+      for (std::size_t i = 0; i < field.list_size(object); ++i)
+        check_schema(*field.nested(), field.list_at(object, i));
+      break;
+    case FieldKind::boolean:
+    case FieldKind::enumeration:
+    case FieldKind::string:
+      break;
+  }
+}
+
+void check_schema(const Schema& schema, const void* object) {
+  for (const SchemaField& field : schema.fields) check_field(schema, field, object);
+  if (schema.check_rules != nullptr) schema.check_rules(object);
+}
+
+void set_field_from_text(const SchemaField& field, void* object, std::string_view text) {
+  switch (field.kind) {
+    case FieldKind::number: {
+      const std::optional<double> value = parse_finite_double(text);
+      if (!value) throw InvalidArgument(quoted(text) + " is not a finite number");
+      field.set_number(field, object, 0, *value / field.option_factor);
+      return;
+    }
+    case FieldKind::integer: {
+      if (field.integer_unsigned) {
+        const std::optional<std::uint64_t> value = parse_whole<std::uint64_t>(text);
+        if (!value)
+          throw InvalidArgument(quoted(text) + " is not an integer in " + integer_range_text(field));
+        field.set_unsigned(object, *value);
+        return;
+      }
+      const std::optional<std::int64_t> value = parse_whole<std::int64_t>(text);
+      if (!value || *value < field.integer_low || *value > field.integer_high)
+        throw InvalidArgument(quoted(text) + " is not an integer in " + integer_range_text(field));
+      field.set_integer(object, *value);
+      return;
+    }
+    case FieldKind::boolean:
+      if (text == "on" || text == "true") {
+        field.set_boolean(object, true);
+      } else if (text == "off" || text == "false") {
+        field.set_boolean(object, false);
+      } else {
+        throw InvalidArgument(quoted(text) + " is not one of 'on', 'off'");
+      }
+      return;
+    case FieldKind::enumeration: {
+      const auto spellings = field.spellings();
+      for (std::size_t i = 0; i < spellings.size(); ++i) {
+        if (spellings[i] == text) {
+          field.set_choice(object, i);
+          return;
+        }
+      }
+      throw_not_a_spelling(text, spellings);
+    }
+    case FieldKind::string:
+      field.set_string(object, std::string(text));
+      return;
+    default:
+      throw InvalidArgument(std::string(field.name) + ": a " + std::string(to_string(field.kind)) +
+                            " has no text form");
+  }
+}
+
+std::string field_text(const SchemaField& field, const void* object) {
+  switch (field.kind) {
+    case FieldKind::number:
+      return shortest_decimal(field.get_number(field, object, 0) * field.option_factor);
+    case FieldKind::integer:
+      return field.integer_unsigned ? std::to_string(field.get_unsigned(object))
+                                    : std::to_string(field.get_integer(object));
+    case FieldKind::boolean:
+      return field.get_boolean(object) ? "on" : "off";
+    case FieldKind::enumeration:
+      return std::string(field.spellings()[field.get_choice(object)]);
+    case FieldKind::string:
+      return field.get_string(object);
+    default:
+      throw InvalidArgument(std::string(field.name) + ": a " + std::string(to_string(field.kind)) +
+                            " has no text form");
+  }
+}
+
+std::string schema_markdown(const Schema& schema) {
+  std::string out =
+      "| field | kind | unit | range | default | meaning |\n| --- | --- | --- | --- | --- | --- |\n";
+  const void* defaults = schema.defaults();
+  for (const SchemaField& field : schema.fields) {
+    std::string default_text;
+    switch (field.kind) {
+      case FieldKind::number:
+        default_text = shortest_decimal(field.get_number(field, defaults, 0));
+        break;
+      case FieldKind::integer:
+      case FieldKind::boolean:
+      case FieldKind::enumeration:
+        default_text = field_text(field, defaults);
+        if (field.kind == FieldKind::boolean) default_text = field.get_boolean(defaults) ? "true" : "false";
+        break;
+      case FieldKind::string:
+        default_text = "\"" + field.get_string(defaults) + "\"";
+        break;
+      case FieldKind::object:
+        default_text = field.get_object(defaults) ? std::string(field.nested()->name) : "null";
+        break;
+      case FieldKind::variant:
+        default_text = std::string(field.spellings()[field.variant_index(defaults)]);
+        break;
+      case FieldKind::object_list:
+        default_text = "[]";
+        break;
+      case FieldKind::number_array:
+        for (std::size_t i = 0; i < field.array_size; ++i)
+          default_text += (i ? ", " : "[") + shortest_decimal(field.get_number(field, defaults, i));
+        default_text += "]";
+        break;
+    }
+    std::string range = field.range_text();
+    for (std::size_t at = range.find('|'); at != std::string::npos; at = range.find('|', at + 2))
+      range.replace(at, 1, "\\|");  // a bar inside a Markdown table cell
+    out += "| `" + std::string(field.name) + "` | " + std::string(to_string(field.kind)) + " | " +
+           std::string(field.unit) + " | " + range + " | `" + default_text + "` | " + std::string(field.doc) +
+           " |\n";
+  }
+  return out;
+}
+
+}  // namespace calligraphy

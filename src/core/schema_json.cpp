@@ -1,0 +1,365 @@
+// The JSON half of the schema (schema.hpp): a struct to JSON and back, strictly, and its JSON Schema.
+#include "core/schema_json.hpp"
+
+#include <cmath>
+#include <limits>
+#include <nlohmann/json.hpp>
+
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/schema.hpp"
+#include "core/json_reader.hpp"
+
+namespace calligraphy {
+namespace {
+
+using nlohmann::json;
+using nlohmann::ordered_json;
+
+ordered_json value_json(const SchemaField& field, const void* object) {
+  switch (field.kind) {
+    case FieldKind::number:
+      return field.get_number(field, object, 0);
+    case FieldKind::number_array: {
+      ordered_json out = ordered_json::array();
+      for (std::size_t i = 0; i < field.array_size; ++i) out.push_back(field.get_number(field, object, i));
+      return out;
+    }
+    case FieldKind::integer:
+      if (field.integer_unsigned) return field.get_unsigned(object);
+      return field.get_integer(object);
+    case FieldKind::boolean:
+      return field.get_boolean(object);
+    case FieldKind::enumeration:
+      return std::string(field.spellings()[field.get_choice(object)]);
+    case FieldKind::string:
+      return field.get_string(object);
+    case FieldKind::object: {
+      const void* nested = field.get_object(object);
+      if (nested == nullptr) return nullptr;
+      return schema_detail::to_json(*field.nested(), nested);
+    }
+    case FieldKind::variant: {
+      const std::size_t index = field.variant_index(object);
+      ordered_json out = ordered_json::object();
+      out[std::string(field.variant_tag)] = std::string(field.spellings()[index]);
+      const ordered_json alternative =
+          schema_detail::to_json(*field.variant_schema(index), field.variant_get(object));
+      for (auto item = alternative.begin(); item != alternative.end(); ++item) out[item.key()] = item.value();
+      return out;
+    }
+    case FieldKind::object_list: {
+      ordered_json out = ordered_json::array();
+      for (std::size_t i = 0; i < field.list_size(object); ++i)
+        out.push_back(schema_detail::to_json(*field.nested(), field.list_at(object, i)));
+      return out;
+    }
+  }
+  return nullptr;
+}
+
+// A number member: finite, in the field's range; the error names the pointer and the field as "Struct.field".
+double read_number(const SchemaField& field, const std::string& owner, const json& value,
+                   const std::string& pointer, const std::string& source) {
+  if (!value.is_number())
+    json_detail::fail(source, pointer, "expected a number, got " + json_detail::describe(value));
+  const double number = value.get<double>();
+  if (!field.range.contains(number)) {
+    json_detail::fail(source, pointer,
+                      "expected a number " + field.range.text(field.unit) + " (" + owner + "." +
+                          std::string(field.name) + "), got " + json_detail::describe(value));
+  }
+  return number;
+}
+
+void read_value(const SchemaField& field, const std::string& owner, void* object, const json& value,
+                const std::string& pointer, const std::string& source, const SchemaReadOptions& options,
+                SchemaReadResult& result) {
+  const auto expect = [&](bool ok, const std::string& what) {
+    if (!ok) json_detail::fail(source, pointer, "expected " + what + ", got " + json_detail::describe(value));
+  };
+  switch (field.kind) {
+    case FieldKind::number:
+      field.set_number(field, object, 0, read_number(field, owner, value, pointer, source));
+      return;
+    case FieldKind::number_array:
+      expect(value.is_array() && value.size() == field.array_size,
+             "an array of " + std::to_string(field.array_size) + " numbers");
+      for (std::size_t i = 0; i < field.array_size; ++i) {
+        field.set_number(field, object, i,
+                         read_number(field, owner, value[i], json_detail::child_pointer(pointer, i), source));
+      }
+      return;
+    case FieldKind::integer:
+      if (field.integer_unsigned) {
+        expect(value.is_number_unsigned(), "an integer in 0..18446744073709551615");
+        field.set_unsigned(object, value.get<std::uint64_t>());
+        return;
+      }
+      field.set_integer(
+          object, json_detail::as_integer(value, pointer, source, field.integer_low, field.integer_high));
+      return;
+    case FieldKind::boolean:
+      expect(value.is_boolean(), "true or false");
+      field.set_boolean(object, value.get<bool>());
+      return;
+    case FieldKind::enumeration: {
+      const auto spellings = field.spellings();
+      expect(value.is_string(), "one of " + join_spellings(spellings, ", ", "\""));
+      const auto& text = value.get_ref<const std::string&>();
+      for (std::size_t i = 0; i < spellings.size(); ++i) {
+        if (spellings[i] == text) {
+          field.set_choice(object, i);
+          return;
+        }
+      }
+      expect(false, "one of " + join_spellings(spellings, ", ", "\""));
+      return;
+    }
+    case FieldKind::string:
+      field.set_string(object, json_detail::as_string(value, pointer, source));
+      return;
+    case FieldKind::object: {
+      if (field.nullable && value.is_null()) {
+        field.reset_object(object);
+        return;
+      }
+      void* nested = field.nullable ? field.emplace_object(object) : field.mutable_object(object);
+      schema_detail::from_json(*field.nested(), nested, value, pointer, source, options, result);
+      return;
+    }
+    case FieldKind::variant: {
+      const std::string tag(field.variant_tag);
+      const auto spellings = field.spellings();
+      expect(value.is_object() && value.contains(tag) && value[tag].is_string(),
+             "an object with \"" + tag + "\" one of " + join_spellings(spellings, ", ", "\""));
+      const auto& name = value[tag].get_ref<const std::string&>();
+      std::size_t index = spellings.size();
+      for (std::size_t i = 0; i < spellings.size(); ++i) {
+        if (spellings[i] == name) index = i;
+      }
+      if (index == spellings.size()) {
+        json_detail::fail(source, json_detail::child_pointer(pointer, tag),
+                          "expected one of " + join_spellings(spellings, ", ", "\"") + ", got " +
+                              json_detail::describe(value[tag]));
+      }
+      json rest = value;
+      rest.erase(tag);
+      schema_detail::from_json(*field.variant_schema(index), field.variant_emplace(object, index), rest,
+                               pointer, source, options, result);
+      return;
+    }
+    case FieldKind::object_list:
+      expect(value.is_array(), "an array of objects");
+      field.list_clear(object);
+      for (std::size_t i = 0; i < value.size(); ++i) {
+        schema_detail::from_json(*field.nested(), field.list_append(object), value[i],
+                                 json_detail::child_pointer(pointer, i), source, options, result);
+      }
+      return;
+  }
+}
+
+// The JSON Schema of one field's value; nested structs as references into `defs`.
+ordered_json field_schema(const SchemaField& field, const void* defaults, ordered_json& defs,
+                          bool all_required);
+
+ordered_json number_schema(const ParameterRange& range) {
+  ordered_json out = {{"type", "number"}};
+  if (range.low_open) {
+    out["exclusiveMinimum"] = range.low;
+  } else {
+    out["minimum"] = range.low;
+  }
+  if (std::isfinite(range.high)) {
+    if (range.high_open) {
+      out["exclusiveMaximum"] = range.high;
+    } else {
+      out["maximum"] = range.high;
+    }
+  }
+  return out;
+}
+
+std::string describe_field(const SchemaField& field) {
+  std::string out(field.doc);
+  if (!field.unit.empty()) out += " [" + std::string(field.unit) + "]";
+  if (!field.source.empty()) out += " (" + std::string(field.source) + ")";
+  return out;
+}
+
+ordered_json struct_schema(const Schema& schema, ordered_json& defs, bool all_required) {
+  ordered_json out = {{"type", "object"}, {"description", std::string(schema.doc)}};
+  ordered_json properties = ordered_json::object();
+  ordered_json required = ordered_json::array();
+  const void* defaults = schema.defaults();
+  for (const SchemaField& field : schema.fields) {
+    properties[std::string(field.name)] = field_schema(field, defaults, defs, all_required);
+    if (all_required && field.since_version == 0) required.push_back(std::string(field.name));
+  }
+  out["properties"] = std::move(properties);
+  out["additionalProperties"] = false;
+  // A record holds every field (SchemaReadOptions::require_all); a file a person writes may leave out what
+  // keeps its default.
+  if (all_required) out["required"] = std::move(required);
+  return out;
+}
+
+std::string def_reference(const Schema& schema, ordered_json& defs, bool all_required) {
+  const std::string name(schema.name);
+  if (!defs.contains(name)) {
+    defs[name] = nullptr;  // placed first: a struct met again inside itself refers to it
+    defs[name] = struct_schema(schema, defs, all_required);
+  }
+  return "#/$defs/" + name;
+}
+
+ordered_json field_schema(const SchemaField& field, const void* defaults, ordered_json& defs,
+                          bool all_required) {
+  ordered_json out;
+  switch (field.kind) {
+    case FieldKind::number:
+      out = number_schema(field.range);
+      break;
+    case FieldKind::number_array:
+      out = {{"type", "array"},
+             {"items", number_schema(field.range)},
+             {"minItems", field.array_size},
+             {"maxItems", field.array_size}};
+      break;
+    case FieldKind::integer:
+      out = {{"type", "integer"}};
+      if (field.integer_unsigned) {
+        out["minimum"] = 0;
+        out["maximum"] = std::numeric_limits<std::uint64_t>::max();
+      } else {
+        out["minimum"] = field.integer_low;
+        out["maximum"] = field.integer_high;
+      }
+      break;
+    case FieldKind::boolean:
+      out = {{"type", "boolean"}};
+      break;
+    case FieldKind::enumeration: {
+      out = {{"type", "string"}};
+      ordered_json values = ordered_json::array();
+      for (const std::string_view spelling : field.spellings()) values.push_back(std::string(spelling));
+      out["enum"] = std::move(values);
+      break;
+    }
+    case FieldKind::string:
+      out = {{"type", "string"}};
+      break;
+    case FieldKind::object:
+      out = {{"$ref", def_reference(*field.nested(), defs, all_required)}};
+      if (field.nullable) out = {{"anyOf", ordered_json::array({out, {{"type", "null"}}})}};
+      break;
+    case FieldKind::variant: {
+      ordered_json choices = ordered_json::array();
+      const auto spellings = field.spellings();
+      for (std::size_t i = 0; i < spellings.size(); ++i) {
+        ordered_json alternative = struct_schema(*field.variant_schema(i), defs, all_required);
+        ordered_json properties = {{std::string(field.variant_tag), {{"const", std::string(spellings[i])}}}};
+        for (auto& [key, value] : alternative["properties"].items()) properties[key] = value;
+        alternative["properties"] = std::move(properties);
+        ordered_json required = ordered_json::array({std::string(field.variant_tag)});
+        if (alternative.contains("required")) {
+          for (const auto& key : alternative["required"]) required.push_back(key);
+        }
+        alternative["required"] = std::move(required);
+        choices.push_back(std::move(alternative));
+      }
+      out = {{"oneOf", std::move(choices)}};
+      break;
+    }
+    case FieldKind::object_list:
+      out = {{"type", "array"}, {"items", {{"$ref", def_reference(*field.nested(), defs, all_required)}}}};
+      break;
+  }
+  out["description"] = describe_field(field);
+  if (field.kind != FieldKind::object_list && field.kind != FieldKind::variant &&
+      (field.kind != FieldKind::object || field.nullable))
+    out["default"] = value_json(field, defaults);
+  if (field.kind == FieldKind::object_list) out["default"] = ordered_json::array();
+  return out;
+}
+
+}  // namespace
+
+namespace schema_detail {
+
+ordered_json to_json(const Schema& schema, const void* object) {
+  ordered_json out = ordered_json::object();
+  for (const SchemaField& field : schema.fields) out[std::string(field.name)] = value_json(field, object);
+  return out;
+}
+
+void from_json(const Schema& schema, void* object, const json& document, const std::string& pointer,
+               const std::string& source, const SchemaReadOptions& options, SchemaReadResult& result) {
+  if (!document.is_object()) {
+    json_detail::fail(
+        source, pointer.empty() ? "/" : pointer,
+        "expected an object (" + std::string(schema.name) + "), got " + json_detail::describe(document));
+  }
+  const std::string owner(schema.name);
+  for (const auto& [key, value] : document.items()) {
+    if (schema.field(key) == nullptr || schema.field(key)->name != key) {
+      std::string names;
+      for (const SchemaField& field : schema.fields)
+        names += (names.empty() ? "" : ", ") + std::string(field.name);
+      json_detail::fail(source, json_detail::child_pointer(pointer, key),
+                        "unknown key (" + owner + " has " + names + ")");
+    }
+  }
+  for (const SchemaField& field : schema.fields) {
+    const std::string key(field.name);
+    const std::string at = json_detail::child_pointer(pointer, key);
+    const auto found = document.find(key);
+    if (found == document.end()) {
+      if (options.require_all && field.since_version <= options.version) {
+        json_detail::fail(source, at, "missing (" + owner + "." + key + ": " + field.description() + ")");
+      }
+      if (options.require_all) result.defaulted.push_back(at);
+      continue;
+    }
+    if (found->is_null() && !field.nullable) {
+      json_detail::fail(source, at,
+                        "null is not a value (" + owner + "." + key + ": " + field.description() + ")");
+    }
+    read_value(field, owner, object, *found, at, source, options, result);
+  }
+  if (schema.check_rules != nullptr) {
+    try {
+      schema.check_rules(object);
+    } catch (const InvalidArgument& e) {
+      json_detail::fail(source, pointer.empty() ? "/" : pointer, e.what());
+    }
+  }
+}
+
+}  // namespace schema_detail
+
+std::string schema_json(const Schema& schema, const void* object) {
+  return schema_detail::to_json(schema, object).dump(2) + "\n";
+}
+
+SchemaReadResult schema_from_json(const Schema& schema, void* object, std::string_view text,
+                                  const std::string& source, const SchemaReadOptions& options) {
+  SchemaReadResult result;
+  schema_detail::from_json(schema, object, json_detail::parse_json(text, source), "", source, options,
+                           result);
+  return result;
+}
+
+std::string json_schema_text(const Schema& schema, std::string_view id, std::string_view title,
+                             bool all_required) {
+  ordered_json defs = ordered_json::object();
+  ordered_json root = {{"$schema", "https://json-schema.org/draft/2020-12/schema"},
+                       {"$id", std::string(id)},
+                       {"title", std::string(title)}};
+  ordered_json body = struct_schema(schema, defs, all_required);
+  for (auto& [key, value] : body.items()) root[key] = value;
+  if (!defs.empty()) root["$defs"] = std::move(defs);
+  return root.dump(2) + "\n";
+}
+
+}  // namespace calligraphy
