@@ -17,6 +17,7 @@ packages=(
   python3-pandas python3-matplotlib python3-tqdm python3-mypy   # Python tables, figures, stubgen
   python3-scipy python3-statsmodels   # calligraphy.statistics: tests, intervals, mixed models, power
   python3-dask python3-distributed    # parallel experiments from Python
+  python3-jsonschema                  # tests: the published JSON Schemas checked by an independent validator
   r-base-core r-cran-lme4 r-cran-lmertest r-cran-emmeans r-cran-pbkrtest  # the study's mixed models and ANCOVA (R, run by calligraphy.statistics)
   zinnia-utils libzinnia-dev tegaki-zinnia-simplified-chinese     # an independent handwriting recogniser (legibility metric; optional)
   fonts-arphic-ukai                   # a CJK font for calligraphy.plot

@@ -9,16 +9,17 @@ namespace calligraphy::cli {
 
 void add_trial_command(CLI::App& root, Commands& commands, DeviceRegistry& devices);  // trial CHARS [...]
 void add_train_command(CLI::App& root, Commands& commands,
-                       DeviceRegistry& devices);                // train CHARS [...] (the trainer window)
-void add_score_command(CLI::App& root, Commands& commands);     // score TRACE.csv --character C [...]
-void add_trace_command(CLI::App& root, Commands& commands);     // trace TRACE.trace.h5 [--csv FILE]
-void add_model_command(CLI::App& root, Commands& commands);     // model CHAR [...]
-void add_strokes_command(CLI::App& root, Commands& commands);   // strokes [--markdown FILE] [--json]
+                       DeviceRegistry& devices);               // train CHARS [...] (the trainer window)
+void add_score_command(CLI::App& root, Commands& commands);    // score TRACE.csv --character C [...]
+void add_trace_command(CLI::App& root, Commands& commands);    // trace TRACE.trace.h5 [--csv FILE]
+void add_model_command(CLI::App& root, Commands& commands);    // model CHAR [...]
+void add_strokes_command(CLI::App& root, Commands& commands);  // strokes [--markdown FILE] [--json]
 void add_devices_command(CLI::App& root, Commands& commands, DeviceRegistry& devices);  // devices [--json]
-void add_corpus_commands(CLI::App& root, Commands& commands);   // corpus build|stats|fidelity|validate
-void add_bench_commands(CLI::App& root, Commands& commands);    // bench nearest|jumps|tick|loop|acceptance
+void add_corpus_commands(CLI::App& root, Commands& commands);  // corpus build|stats|fidelity|validate
+void add_bench_commands(CLI::App& root, Commands& commands);   // bench nearest|jumps|tick|loop|acceptance
 void add_session_commands(CLI::App& root, Commands& commands, DeviceRegistry& devices);  // session run|resume
 void add_report_command(CLI::App& root, Commands& commands);
+void add_schema_command(CLI::App& root, Commands& commands);  // schema specification|record [--markdown]
 void add_curriculum_command(
     CLI::App& root,
     Commands& commands);  // curriculum DIR... --subject ID --from CHARS    // report DIR... --out FILE

@@ -11,7 +11,9 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
+#include "calligraphy/core/schema.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/render/force_law.hpp"
@@ -24,11 +26,12 @@
 
 namespace calligraphy {
 
-/// The "format" of the specification object, and the version written: 2 since the simulated writer's
-/// settings are {"key", "value"} objects (version 1 wrote "key=value" strings). A reader reads versions 1 and
-/// 2 and refuses any other by its number.
+/// The "format" of the specification object, and the version written: 3 since the trial states its guidance
+/// stiffness (`TrialSpec::guidance_stiffness_n_per_m`; earlier records take its default), 2 since the
+/// simulated writer's settings are {"key", "value"} objects (version 1 wrote "key=value" strings). A reader
+/// reads versions 1 to 3 and refuses any other by its number.
 inline constexpr std::string_view kRecordedTrialFormat = "calligraphy-trial-specification";
-inline constexpr int kRecordedTrialVersion = 2;
+inline constexpr int kRecordedTrialVersion = 3;
 inline constexpr int kOldestRecordedTrialVersion = 1;
 
 /// Everything that decides what a trial does, as it ran. Lengths in m, forces in N, times in s.
@@ -50,7 +53,15 @@ struct RecordedTrial {
   SceneLayout layout;           ///< where the characters were placed
   std::string scene_sha256;     ///< `scene_sha256` of the placed characters
   std::string library_version;  ///< the library that ran it (said, not checked)
+  /// Read from a record of an earlier version: the JSON pointers of fields added since, which took their
+  /// documented defaults (empty for a record written by this version). Not written.
+  std::vector<std::string> defaulted;
 };
+
+/// The schema of the specification object a trial record holds (format, version, trial, force_law, safety,
+/// passivity, writer, simulated_device, scene, library_version), every part required: what
+/// `calligraphy schema record` prints as JSON Schema (schema.hpp, `json_schema_text`).
+[[nodiscard]] const Schema& recorded_trial_schema();
 
 /// What ran for `spec` on `scene` with the options `ran` (TrialRun::options) and, when the simulated writer
 /// wrote, its profile `writer` (nullptr: a person).
@@ -72,9 +83,11 @@ struct RecordedTrial {
 [[nodiscard]] std::string recorded_trial_json(const RecordedTrial& recorded);
 
 /// The specification in `text`: a trial record holding a "specification" object, or that object itself.
-/// Every part is required; each is validated as its struct validates it. Throws DataError naming `source` and
-/// the JSON pointer of a value at fault, a record with no specification (written before records held one), or
-/// a format or version this library does not read.
+/// Every part is required (null only for "writer" and "simulated_device"), no key is unknown and every value
+/// is in its field's range (the schema, `recorded_trial_schema`); each part is validated as its struct
+/// validates it. A field added in a later version than the record's takes its default (`defaulted`). Throws
+/// DataError naming `source` and the JSON pointer of a value at fault, a record with no specification
+/// (written before records held one), or a format or version this library does not read.
 [[nodiscard]] RecordedTrial read_recorded_trial(std::string_view text, const std::string& source);
 
 /// `read_recorded_trial` of the regular file `path` (at most 64 MiB, a trial record's bound). A study

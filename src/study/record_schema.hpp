@@ -1,0 +1,77 @@
+#pragma once
+// The schema of a trial record's specification object (recorded_trial.hpp: format, version, the trial, the
+// force law with its guidance law, the safety chain, passivity, the writer, the simulated device and the
+// scene), from which `calligraphy schema record` prints its JSON Schema. Internal.
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "calligraphy/core/schema.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/render/force_law.hpp"
+#include "calligraphy/render/passivity.hpp"
+#include "calligraphy/render/safety_chain.hpp"
+#include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/trial/trial_spec.hpp"
+
+namespace calligraphy {
+
+namespace study_detail {
+
+/// The scene as a record states it.
+struct RecordedScene {
+  SceneLayout layout;
+  std::string sha256;  ///< scene_sha256 of the placed characters
+};
+
+/// The specification object of a trial record as its JSON lays it out.
+struct RecordDocument {
+  std::string format;
+  std::int64_t version = 0;
+  TrialSpec trial;
+  ForceLawParameters force_law;
+  SafetyChainParameters safety;
+  PassivityParameters passivity;
+  std::optional<WriterProfile> writer;
+  std::optional<SimulatedDeviceParameters> simulated_device;
+  RecordedScene scene;
+  std::string library_version;
+};
+
+}  // namespace study_detail
+
+template <>
+struct EnumTable<NearestPointMethod> {
+  static constexpr std::string_view name = "NearestPointMethod";
+  static constexpr std::array<EnumEntry<NearestPointMethod>, 3> entries{{
+      {NearestPointMethod::exact, "exact", "Bernstein root isolation (Schneider 1990): the global minimum"},
+      {NearestPointMethod::newton, "newton", "Newton's method from several starts"},
+      {NearestPointMethod::subdivision, "subdivision", "the paper's greedy subdivision (section 4.3)"},
+  }};
+};
+
+#define CALLIGRAPHY_SCHEMA_OF(Type) \
+  template <>                       \
+  struct SchemaOf<Type> {           \
+    static const Schema& get();     \
+  };
+CALLIGRAPHY_SCHEMA_OF(FixedGuidance)
+CALLIGRAPHY_SCHEMA_OF(FadingGuidance)
+CALLIGRAPHY_SCHEMA_OF(ReplayGuidance)
+CALLIGRAPHY_SCHEMA_OF(AssistAsNeededGuidance)
+CALLIGRAPHY_SCHEMA_OF(ErrorAmplificationGuidance)
+CALLIGRAPHY_SCHEMA_OF(TimingGuidance)
+CALLIGRAPHY_SCHEMA_OF(StrokeAcceptance)
+CALLIGRAPHY_SCHEMA_OF(NearestPointOptions)
+CALLIGRAPHY_SCHEMA_OF(ForceLawParameters)
+CALLIGRAPHY_SCHEMA_OF(SafetyChainParameters)
+CALLIGRAPHY_SCHEMA_OF(PassivityParameters)
+CALLIGRAPHY_SCHEMA_OF(WriterProfile)
+CALLIGRAPHY_SCHEMA_OF(SimulatedDeviceParameters)
+CALLIGRAPHY_SCHEMA_OF(SceneLayout)
+CALLIGRAPHY_SCHEMA_OF(study_detail::RecordedScene)
+CALLIGRAPHY_SCHEMA_OF(study_detail::RecordDocument)
+#undef CALLIGRAPHY_SCHEMA_OF
+
+}  // namespace calligraphy

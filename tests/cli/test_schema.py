@@ -1,0 +1,176 @@
+#!/usr/bin/env python3
+"""The published schemas (`calligraphy schema specification|record`, docs/cli.md) held against the program's
+real documents by an independent validator (the jsonschema package, draft 2020-12), and against the program's
+own reader: a value the schema refuses is refused by `trial --spec` naming the file and the JSON pointer, and a
+value at a closed bound is valid to both. Run by CTest as `cli_schema_tests`; CALLIGRAPHY_CLI names the program.
+"""
+import copy
+import json
+import math
+import os
+import subprocess
+import tempfile
+import unittest
+from pathlib import Path
+
+import jsonschema
+
+CLI = os.environ.get("CALLIGRAPHY_CLI", "")
+
+
+class SchemaTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        if not CLI or not Path(CLI).exists():
+            raise unittest.SkipTest(f"CALLIGRAPHY_CLI={CLI!r} is not the calligraphy program: run through ctest")
+        cls.folder = tempfile.TemporaryDirectory(prefix="calligraphy-schema-")
+        cls.cwd = Path(cls.folder.name)
+        cls.schemas = {name: json.loads(cls.run_cli("schema", name).stdout) for name in ("specification", "record")}
+        # Records of trials in every guidance mode but replay (which needs a teacher: tests/study), made here.
+        cls.records = {}
+        for name, extra in {
+            "fixed": [],
+            "fading": ["--guidance-mode", "fading", "--guidance-gain", "0.5"],
+            "assist": ["--guidance-mode", "assist-as-needed", "--assist-band", "0.002"],
+            "amplify": ["--guidance-mode", "error-amplification", "--amplification-gain", "0.3"],
+            "timing": ["--guidance-mode", "timing", "--timing-speed", "0.05"],
+            "stiff": ["--guidance-stiffness", "250", "--writer-param", "bias_offset_m=0.002"],
+            "off": ["--guidance", "off", "--writer-profile", "skilled"],
+        }.items():
+            result = cls.run_cli("trial", "十", "--seed", "3", "--json", f"{name}.json", *extra)
+            if result.returncode != 0:
+                raise AssertionError(f"trial {extra}: {result.stderr.decode()}")
+            cls.records[name] = json.loads((cls.cwd / f"{name}.json").read_text())
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.folder.cleanup()
+
+    @classmethod
+    def run_cli(cls, *args):
+        return subprocess.run([CLI, *map(str, args)], cwd=cls.cwd, capture_output=True, timeout=120)
+
+    def validator(self, name):
+        return jsonschema.Draft202012Validator(self.schemas[name])
+
+    def test_the_schemas_are_json_schema_2020_12(self):
+        for name, schema in self.schemas.items():
+            jsonschema.Draft202012Validator.check_schema(schema)
+            self.assertEqual(schema["$schema"], "https://json-schema.org/draft/2020-12/schema", name)
+            self.assertFalse(schema["additionalProperties"], name)
+
+    def test_real_records_and_specifications_validate(self):
+        for name, record in self.records.items():
+            with self.subTest(name):
+                self.validator("record").validate(record["specification"])
+                self.validator("specification").validate(record["specification"]["trial"])
+        # A specification a person writes may leave out what keeps its default.
+        self.validator("specification").validate({"characters": "永", "rate_hz": 500})
+
+    def test_the_new_parameter_reaches_the_record(self):
+        stiff = self.records["stiff"]["specification"]
+        self.assertEqual(stiff["trial"]["guidance_stiffness_n_per_m"], 250)
+        self.assertEqual(stiff["force_law"]["guidance_stiffness_n_per_m"], 250)
+        help_text = self.run_cli("trial", "--help").stdout.decode()
+        self.assertRegex(help_text, r"--guidance-stiffness N/M .*\[N/m\]")
+        refused = self.run_cli("trial", "十", "--guidance-stiffness", "-1")
+        self.assertEqual(refused.returncode, 2)
+        self.assertIn("--guidance-stiffness", refused.stderr.decode())
+        refused = self.run_cli("trial", "十", "--guidance", "off", "--guidance-stiffness", "300")
+        self.assertEqual(refused.returncode, 2)
+        self.assertIn("--guidance-stiffness", refused.stderr.decode())
+
+    def test_invalid_documents_are_refused_by_both(self):
+        """Each value the schema refuses, put into a real record, is refused by the reader naming its pointer."""
+        base = self.records["fixed"]
+        cases = []
+        trial = self.schemas["record"]["$defs"]["TrialSpec"]["properties"]
+        for key, prop in trial.items():
+            cases.extend(self.past_bounds(["trial", key], prop))
+        for part in ("force_law", "safety", "passivity", "writer"):
+            definition = {"force_law": "ForceLawParameters", "safety": "SafetyChainParameters",
+                          "passivity": "PassivityParameters", "writer": "WriterProfile"}[part]
+            for key, prop in self.schemas["record"]["$defs"][definition]["properties"].items():
+                cases.extend(self.past_bounds([part, key], prop))
+        cases.append((["trial", "guidance_mode"], "assist_as_needed"))
+        cases.append((["trial", "surprise"], 1))
+        cases.append((["trial", "seed"], None))
+        cases.append((["library_version"], None))
+        self.assertGreater(len(cases), 40)
+        for path, value in cases:
+            with self.subTest(path=path, value=value):
+                document = copy.deepcopy(base)
+                target = document["specification"]
+                for key in path[:-1]:
+                    target = target[key]
+                target[path[-1]] = value
+                errors = list(self.validator("record").iter_errors(document["specification"]))
+                self.assertTrue(errors, f"the schema takes {path} = {value}")
+                (self.cwd / "bad.json").write_text(json.dumps(document))
+                result = self.run_cli("trial", "--spec", "bad.json", "--json", "again.json")
+                stderr = result.stderr.decode()
+                self.assertEqual(result.returncode, 1, stderr)
+                self.assertIn("bad.json: /specification/" + "/".join(path), stderr)
+                self.assertEqual(len(stderr.strip().splitlines()), 1, stderr)
+
+    def test_values_at_closed_bounds_are_valid(self):
+        trial = self.schemas["record"]["$defs"]["TrialSpec"]["properties"]
+        validator = self.validator("record")
+        for key, prop in trial.items():
+            for bound in ("minimum", "maximum"):
+                if bound not in prop or prop["type"] != "number":
+                    continue
+                document = copy.deepcopy(self.records["fixed"]["specification"])
+                document["trial"][key] = prop[bound]
+                self.assertEqual(list(validator.iter_errors(document)), [], f"{key} at its {bound}")
+
+    def test_an_earlier_record_reads_and_runs_to_the_same_trace(self):
+        document = copy.deepcopy(self.records["fixed"])
+        document["specification"]["version"] = 2
+        del document["specification"]["trial"]["guidance_stiffness_n_per_m"]
+        (self.cwd / "v2.json").write_text(json.dumps(document))
+        for name, record in (("now", "fixed.json"), ("v2", "v2.json")):
+            result = self.run_cli("trial", "--spec", record, "--csv", f"{name}.csv")
+            self.assertEqual(result.returncode, 0, result.stderr.decode())
+            if name == "v2":
+                self.assertIn("/specification/trial/guidance_stiffness_n_per_m", result.stderr.decode())
+                self.assertIn("takes its default", result.stderr.decode())
+        self.assertEqual((self.cwd / "now.csv").read_bytes(), (self.cwd / "v2.csv").read_bytes())
+
+    def test_enum_spellings_are_the_options_spellings(self):
+        help_text = self.run_cli("trial", "--help").stdout.decode()
+        trial = self.schemas["specification"]["properties"]
+        for key, option in (("guidance_mode", "--guidance-mode"), ("pacing", "--pacing"),
+                            ("realtime", "--realtime")):
+            self.assertIn(f"{option} {'|'.join(trial[key]['enum'])}", help_text)
+
+    def test_the_docs_table_is_the_schemas(self):
+        source = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
+        text = (source / "docs" / "cli.md").read_text(encoding="utf-8")
+        start = text.index("<!-- schema specification -->\n") + len("<!-- schema specification -->\n")
+        end = text.index("<!-- end schema specification -->")
+        printed = self.run_cli("schema", "specification", "--markdown").stdout.decode()
+        self.assertEqual(text[start:end], printed, "docs/cli.md: paste `calligraphy schema specification --markdown`")
+
+    @staticmethod
+    def past_bounds(path, prop):
+        """Values just outside a numeric property's range, and a string where a number belongs."""
+        if prop.get("type") not in ("number", "integer"):
+            return []
+        out = [(path, "1")]
+        if prop["type"] == "number":
+            if "minimum" in prop and prop["minimum"] > -1e300:
+                out.append((path, math.nextafter(prop["minimum"], -math.inf)))
+            if "exclusiveMinimum" in prop:
+                out.append((path, prop["exclusiveMinimum"]))
+            if "maximum" in prop and prop["maximum"] < 1e300:
+                out.append((path, math.nextafter(prop["maximum"], math.inf)))
+            if "exclusiveMaximum" in prop:
+                out.append((path, prop["exclusiveMaximum"]))
+        elif "minimum" in prop and prop["minimum"] > -(2**63):
+            out.append((path, prop["minimum"] - 1))
+        return out
+
+
+if __name__ == "__main__":
+    unittest.main()
