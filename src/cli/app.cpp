@@ -72,6 +72,10 @@ CLI::App* Commands::add(CLI::App& parent, const std::string& name, const std::st
                         std::function<int()> run) {
   CLI::App* app = parent.add_subcommand(name, description);
   app->set_version_flag("--version", kVersion, "Print the program's version and exit");
+  app->add_flag(
+      "--verbose", verbose_,
+      "Also show the library's info lines (device start-up, the servo loop's statistics) on standard "
+      "error; without it only its warnings");
   commands_.emplace_back(app, std::move(run));
   return app;
 }

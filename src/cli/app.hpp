@@ -31,9 +31,13 @@ class Commands {
   CLI::App* add_group(CLI::App& parent, const std::string& name, const std::string& description);
   /// Runs the subcommand given on the command line; throws UsageError when there is none.
   [[nodiscard]] int run_selected() const;
+  /// Whether `--verbose` was given: the library's info lines (device start-up, the servo loop's statistics)
+  /// are shown too, not only its warnings. Every command takes it.
+  [[nodiscard]] bool verbose() const noexcept { return verbose_; }
 
  private:
   std::vector<std::pair<CLI::App*, std::function<int()>>> commands_;
+  bool verbose_ = false;
 };
 
 /// Sets up the program's root: version flag, help layout, one subcommand required.

@@ -1,0 +1,105 @@
+#!/usr/bin/env python3
+"""What a person reads from the `calligraphy` program (docs/cli.md), run by CTest as `cli_people_tests`:
+written from the documentation, as a newcomer would try the program.
+
+- standard output carries the command's own lines only; the library's log is shown on standard error as the
+  command's own lines (`calligraphy COMMAND: warning: ...`), its info lines only with `--verbose`;
+
+CALLIGRAPHY_CLI names the program and CALLIGRAPHY_SOURCE_DIR the source tree. Standard library only.
+"""
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import unittest
+from pathlib import Path
+
+CLI = os.environ.get("CALLIGRAPHY_CLI", "")
+SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
+DATA = SOURCE / "data" / "hanzi-writer-data"
+
+# spdlog's own pattern: "[2026-11-26 12:00:00.000] [calligraphy] [info] ..."
+SPDLOG_LINE = re.compile(r"^\[\d{4}-\d\d-\d\d |\[calligraphy\]|\[(trace|debug|info|warning|error|critical)\]")
+
+
+class PeopleTestCase(unittest.TestCase):
+    def setUp(self):
+        if not CLI or not Path(CLI).exists():
+            self.fail(f"CALLIGRAPHY_CLI={CLI!r} is not the calligraphy program: run these tests through ctest")
+        self.folder = tempfile.TemporaryDirectory(prefix="calligraphy-people-")
+        self.cwd = Path(self.folder.name)
+
+    def tearDown(self):
+        self.folder.cleanup()
+
+    def run_cli(self, *args, timeout=120):
+        result = subprocess.run([CLI, *map(str, args)], cwd=self.cwd, stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, timeout=timeout)
+        return result.returncode, result.stdout.decode(), result.stderr.decode()
+
+    def assert_no_spdlog_line(self, text, where):
+        for line in text.splitlines():
+            self.assertNotRegex(line, SPDLOG_LINE, f"{where}: a log line of the library's own format")
+
+
+def commands_of(run_cli, command=()):
+    """Every command of the program, found by walking each group's --help ("Subcommands:")."""
+    _, text, _ = run_cli(*command, "--help")
+    found = []
+    if "Subcommands:" in text:
+        block = text.split("Subcommands:", 1)[1]
+        for line in block.splitlines()[1:] if block.startswith("\n") else block.splitlines():
+            match = re.match(r"^  ([a-z][a-z-]*)\b", line)
+            if match:
+                found += commands_of(run_cli, (*command, match.group(1)))
+            elif line.strip() and not line.startswith(" "):
+                break
+    return found or [command]
+
+
+class TheLibrarysLog(PeopleTestCase):
+    def test_a_library_warning_is_one_line_of_the_command(self):
+        # The emulated Phantom's driver warns at every open() what was never checked on hardware.
+        status, out, err = self.run_cli("trial", "乙", "--device", "emulated-phantom")
+        self.assertEqual(status, 0, err)
+        self.assert_no_spdlog_line(out, "stdout")
+        self.assert_no_spdlog_line(err, "stderr")
+        warnings = [l for l in err.splitlines() if "NOT verified" in l]
+        self.assertEqual(len(warnings), 1, err)
+        self.assertTrue(warnings[0].startswith("calligraphy trial: warning: Phantom: "), warnings[0])
+        # Info lines (the driver opening the arm) are quiet unless asked for.
+        self.assertNotIn("opening", err)
+        status, _, verbose = self.run_cli("trial", "乙", "--device", "emulated-phantom", "--verbose")
+        self.assertEqual(status, 0, verbose)
+        self.assert_no_spdlog_line(verbose, "stderr with --verbose")
+        self.assertTrue(any(l.startswith("calligraphy trial: info: Phantom: opening") for l in verbose.splitlines()),
+                        verbose)
+
+    def test_the_servo_loop_statistics_only_when_asked(self):
+        status, out, err = self.run_cli("bench", "loop", "--seconds", "0.2")
+        self.assertEqual(status, 0, err)
+        self.assert_no_spdlog_line(out + err, "bench loop")
+        self.assertNotIn("servo loop: ", err)
+        status, out, err = self.run_cli("bench", "loop", "--seconds", "0.2", "--verbose")
+        self.assertEqual(status, 0, err)
+        self.assert_no_spdlog_line(out + err, "bench loop --verbose")
+        self.assertIn("calligraphy bench loop: info: servo loop: ", err)
+
+    def test_every_command_takes_verbose(self):
+        for command in commands_of(self.run_cli):
+            _, text, _ = self.run_cli(*command, "--help")
+            self.assertRegex(text, r"(?m)^  --verbose\b", f"{command}: no --verbose in its help")
+
+    def test_json_on_standard_output_stays_json(self):
+        status, out, err = self.run_cli("trial", "乙", "--device", "emulated-phantom", "--verbose", "--json", "-")
+        self.assertEqual(status, 0, err)
+        json.loads(out)  # nothing else on standard output
+
+
+
+if __name__ == "__main__":
+    program = unittest.main(exit=False, verbosity=2)
+    result = program.result
+    sys.exit(0 if result.wasSuccessful() and result.testsRun > 0 else 1)
