@@ -261,6 +261,14 @@ CLI::Option* required(CLI::Option* option) {
   return option;
 }
 
+CLI::Option* with_default(CLI::Option* option, const std::string& default_text) {
+  std::string description = option->get_description();
+  const auto default_start = description.rfind(" (default: ");
+  if (default_start != std::string::npos) description.erase(default_start);
+  option->description(description + " (default: " + default_text + ")");
+  return option;
+}
+
 CLI::Option* add_positional(CLI::App& app, const std::string& name, std::string& target,
                             const std::string& description, const std::string& value_name) {
   CLI::Option* option = app.add_option(name, target, description);

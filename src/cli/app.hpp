@@ -99,6 +99,10 @@ CLI::Option* add_output_folder(CLI::App& app, const std::string& name, std::stri
 /// Makes an option required and says so in --help.
 CLI::Option* required(CLI::Option* option);
 
+/// Replaces the default an option's help states, "(default: ...)", with `default_text`: each option states
+/// its default once, there (e.g. `trace --csv`, whose default is standard output, not "not written").
+CLI::Option* with_default(CLI::Option* option, const std::string& default_text);
+
 /// A required positional argument; --help shows `value_name` after its name (FILE, DIR, TEXT).
 CLI::Option* add_positional(CLI::App& app, const std::string& name, std::string& target,
                             const std::string& description, const std::string& value_name = "TEXT");

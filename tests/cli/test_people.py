@@ -4,6 +4,7 @@ written from the documentation, as a newcomer would try the program.
 
 - standard output carries the command's own lines only; the library's log is shown on standard error as the
   command's own lines (`calligraphy COMMAND: warning: ...`), its info lines only with `--verbose`;
+- every option's help states its default once;
 
 CALLIGRAPHY_CLI names the program and CALLIGRAPHY_SOURCE_DIR the source tree. Standard library only.
 """
@@ -96,6 +97,20 @@ class TheLibrarysLog(PeopleTestCase):
         status, out, err = self.run_cli("trial", "乙", "--device", "emulated-phantom", "--verbose", "--json", "-")
         self.assertEqual(status, 0, err)
         json.loads(out)  # nothing else on standard output
+
+
+class OneDefaultPerOption(PeopleTestCase):
+    def test_every_option_states_its_default_once(self):
+        commands = commands_of(self.run_cli)
+        self.assertGreater(len(commands), 15, commands)
+        for command in commands:
+            status, text, err = self.run_cli(*command, "--help")
+            self.assertEqual(status, 0, f"{command}: {err}")
+            entries = re.findall(r"^  (-[-a-zA-Z]+.*(?:\n {10,}.*)*)", text, flags=re.M)
+            for entry in entries:
+                flat = " ".join(entry.split())
+                defaults = re.findall(r"\bdefaults?\b", flat, flags=re.I)
+                self.assertLessEqual(len(defaults), 1, f"{' '.join(command)}: two defaults in: {flat}")
 
 
 
