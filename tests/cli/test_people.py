@@ -5,6 +5,7 @@ written from the documentation, as a newcomer would try the program.
 - standard output carries the command's own lines only; the library's log is shown on standard error as the
   command's own lines (`calligraphy COMMAND: warning: ...`), its info lines only with `--verbose`;
 - every option's help states its default once;
+- `devices` lists every kind of device and the commands that take it, as a table and in `--json`;
 
 CALLIGRAPHY_CLI names the program and CALLIGRAPHY_SOURCE_DIR the source tree. Standard library only.
 """
@@ -111,6 +112,54 @@ class OneDefaultPerOption(PeopleTestCase):
                 flat = " ".join(entry.split())
                 defaults = re.findall(r"\bdefaults?\b", flat, flags=re.I)
                 self.assertLessEqual(len(defaults), 1, f"{' '.join(command)}: two defaults in: {flat}")
+
+
+class EveryKindOfDevice(PeopleTestCase):
+    KINDS = ("simulated", "emulated-phantom", "mouse", "mouse-hand")
+
+    def kinds(self):
+        status, out, err = self.run_cli("devices", "--json")
+        self.assertEqual(status, 0, err)
+        listing = json.loads(out)
+        self.assertIn("kinds", listing)
+        return {kind["name"]: kind for kind in listing["kinds"]}
+
+    def test_json_names_every_kind_and_the_commands_that_take_it(self):
+        kinds = self.kinds()
+        for name in self.KINDS:
+            self.assertIn(name, kinds)
+            self.assertTrue(kinds[name]["commands"], name)
+            self.assertTrue(kinds[name]["what"], name)
+        for name in ("mouse", "mouse-hand"):
+            self.assertIn("train", kinds[name]["commands"])
+            self.assertIn("session run", kinds[name]["commands"])
+            self.assertNotIn("trial", kinds[name]["commands"])
+        for name in ("simulated", "emulated-phantom"):
+            for command in ("trial", "train", "session run"):
+                self.assertIn(command, kinds[name]["commands"], name)
+        # Every backend of the registry is a kind, whether or not a device of it is found here.
+        for backend in ("phantom-hid", "phantom-usb", "openhaptics"):
+            self.assertTrue(any(k["backend"] == backend for k in kinds.values()), backend)
+
+    def test_the_table_names_the_same_kinds(self):
+        status, out, err = self.run_cli("devices")
+        self.assertEqual(status, 0, err)
+        self.assertIn("Kinds of device", out)
+        table = out.split("Kinds of device", 1)[1]
+        for name, kind in self.kinds().items():
+            row = [l for l in table.splitlines() if l.split()[:1] == [name]]
+            self.assertEqual(len(row), 1, f"{name}: no one row in\n{out}")
+            for command in kind["commands"]:
+                self.assertIn(command, row[0], name)
+
+    def test_what_the_listing_says_trial_takes_it_takes(self):
+        kinds = self.kinds()
+        for name in ("mouse", "mouse-hand", "simulated"):
+            status, _, err = self.run_cli("trial", "乙", "--device", name, "--max-duration", "0.05")
+            if "trial" in kinds[name]["commands"]:
+                self.assertNotEqual(status, 2, f"{name}: {err}")
+            else:
+                self.assertEqual(status, 2, f"{name}: {err}")
 
 
 
