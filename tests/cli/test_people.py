@@ -6,6 +6,7 @@ written from the documentation, as a newcomer would try the program.
   command's own lines (`calligraphy COMMAND: warning: ...`), its info lines only with `--verbose`;
 - every option's help states its default once;
 - `devices` lists every kind of device and the commands that take it, as a table and in `--json`;
+- `score` gives each stroke one verdict, numbers strokes from 1 in its table, and counts that agree.
 
 CALLIGRAPHY_CLI names the program and CALLIGRAPHY_SOURCE_DIR the source tree. Standard library only.
 """
@@ -24,6 +25,7 @@ DATA = SOURCE / "data" / "hanzi-writer-data"
 
 # spdlog's own pattern: "[2026-11-26 12:00:00.000] [calligraphy] [info] ..."
 SPDLOG_LINE = re.compile(r"^\[\d{4}-\d\d-\d\d |\[calligraphy\]|\[(trace|debug|info|warning|error|critical)\]")
+CHARACTER_SIZE_M = 0.06  # a character's box on the paper (SceneLayout)
 
 
 class PeopleTestCase(unittest.TestCase):
@@ -161,6 +163,93 @@ class EveryKindOfDevice(PeopleTestCase):
             else:
                 self.assertEqual(status, 2, f"{name}: {err}")
 
+
+def median_trace(medians, offsets):
+    """A CSV pen trace in data units along the medians (pen down along each stroke in order, lifted between),
+    each stroke moved by its (dx, dy) in `offsets`."""
+    rows, t = ["t,x,y,pen"], 0.0
+    for index, median in enumerate(medians):
+        dx, dy = offsets.get(index, (0.0, 0.0))
+        points = []
+        for (ax, ay), (bx, by) in zip(median, median[1:]):
+            steps = max(1, int(((bx - ax) ** 2 + (by - ay) ** 2) ** 0.5 / 4))
+            points += [(ax + (bx - ax) * k / steps, ay + (by - ay) * k / steps) for k in range(steps)]
+        points.append(tuple(median[-1]))
+        for x, y in points:
+            rows.append(f"{t:.3f},{x + dx:.4f},{y + dy:.4f},1")
+            t += 0.01
+        rows.append(f"{t:.3f},{points[-1][0] + dx:.4f},{points[-1][1] + dy:.4f},0")
+        t += 0.3
+    return "\n".join(rows) + "\n"
+
+
+class TheTeachersScore(PeopleTestCase):
+    """十: a horizontal stroke written 4 mm too high, then its vertical stroke well."""
+
+    def score(self):
+        medians = json.loads((DATA / "十.json").read_text(encoding="utf-8"))["medians"]
+        four_mm = 4e-3 * 1024 / CHARACTER_SIZE_M
+        (self.cwd / "t.csv").write_text(median_trace(medians, {0: (0.0, four_mm)}))
+        status, out, err = self.run_cli("score", "t.csv", "--character", "十", "--units", "data",
+                                        "--json", "s.json")
+        self.assertEqual(status, 0, err)
+        return out, json.loads((self.cwd / "s.json").read_text())
+
+    def stroke_rows(self, text):
+        """The rows of the per-stroke table: lines starting with a stroke number."""
+        return [l for l in text.splitlines() if re.match(r"^\s*\d+\s", l)]
+
+    def test_each_stroke_has_one_verdict_numbered_from_one(self):
+        text, score = self.score()
+        rows = self.stroke_rows(text)
+        self.assertEqual([int(r.split()[0]) for r in rows], [1, 2], text)
+        # Stroke 1: refused for its place, with how far off it was; never "not written" beside that.
+        self.assertRegex(rows[0], r"refused", text)
+        self.assertRegex(rows[0], r"wrong place", text)
+        off = re.search(r"\((\d+\.\d) mm off\)", rows[0])
+        self.assertIsNotNone(off, text)
+        self.assertLess(abs(float(off.group(1)) - 4.0), 0.5, text)  # the median is not the fitted stroke
+        # The same deviation as the JSON's verdict on that pen-down.
+        (first,) = [s for s in score["per_character"][0]["segments"] if s["verdict"]][:1]
+        self.assertEqual(off.group(1), "%.1f" % first["verdict"]["mean_deviation_mm"])
+        self.assertNotRegex(rows[0], r"\bno\b", text)
+        # Stroke 2: refused, written before stroke 1 was accepted.
+        self.assertRegex(rows[1], r"refused", text)
+        self.assertRegex(rows[1], r"wrong order", text)
+        # The JSON keeps its documented numbering from 0.
+        strokes = score["per_character"][0]["per_stroke"]
+        self.assertEqual([s["index"] for s in strokes], [0, 1])
+
+    def test_the_counts_agree(self):
+        text, score = self.score()
+        rows = self.stroke_rows(text)
+        refused_rows = sum("refused" in r for r in rows)
+        accepted_rows = sum("accepted" in r for r in rows)
+        accepted = re.search(r"(?m)^\s*strokes accepted\s+(\d+) of (\d+)", text)
+        refused = re.search(r"(?m)^\s*strokes refused\s+(\d+)", text)
+        self.assertIsNotNone(accepted, text)
+        self.assertIsNotNone(refused, text)
+        self.assertEqual(int(accepted.group(1)), accepted_rows, text)
+        self.assertEqual(int(accepted.group(2)), len(rows), text)
+        self.assertEqual(int(refused.group(1)), refused_rows, text)
+        self.assertEqual(score["strokes_accepted"], accepted_rows)
+        # No line says there was no order error while a stroke was refused for its order.
+        for line in text.splitlines():
+            if re.match(r"^\s*order errors\s+0\b", line):
+                self.assertFalse(any("wrong order" in r for r in rows), text)
+
+    def test_a_good_trace_is_accepted_stroke_by_stroke(self):
+        medians = json.loads((DATA / "十.json").read_text(encoding="utf-8"))["medians"]
+        (self.cwd / "t.csv").write_text(median_trace(medians, {}))
+        status, text, err = self.run_cli("score", "t.csv", "--character", "十", "--units", "data")
+        self.assertEqual(status, 0, err)
+        rows = self.stroke_rows(text)
+        self.assertEqual(len(rows), 2, text)
+        for row in rows:
+            self.assertIn("accepted", row)
+            self.assertNotIn("refused", row)
+        self.assertRegex(text, r"(?m)^\s*strokes accepted\s+2 of 2")
+        self.assertRegex(text, r"(?m)^\s*strokes refused\s+0")
 
 
 if __name__ == "__main__":
