@@ -54,12 +54,18 @@ class Box:
         return self.data_to_px((x_m * units + 512, y_m * units + 388))
 
 
+def boxes_environment(environment=None):
+    """The environment (this process's, as it is now, by default) asking the window to print its character
+    boxes on stderr (docs/trainer.md); standard output never has them."""
+    return dict(environment or os.environ, CALLIGRAPHY_PRINT_BOXES="1")
+
+
 def box_lines(folder, process, who, timeout=30):
-    """The character boxes the window printed on stdout (folder/stdout.txt) once it has drawn; fails when
-    `process` ends first (naming `who` and its stderr, folder/stderr.txt) or after `timeout` s."""
+    """The character boxes the window printed on stderr (folder/stderr.txt, asked for by boxes_environment)
+    once it has drawn; fails when `process` ends first (naming `who` and its stderr) or after `timeout` s."""
     deadline = time.time() + timeout
     while time.time() < deadline:
-        lines = [l for l in (folder / "stdout.txt").read_text().splitlines() if l.startswith("box ")]
+        lines = [l for l in (folder / "stderr.txt").read_text().splitlines() if l.startswith("box ")]
         if lines:
             return [Box(l) for l in lines]
         if process.poll() is not None:
@@ -88,12 +94,15 @@ def program_window(pid, tool=None, timeout=10):
 class Trainer:
     """`calligraphy train` running in the background."""
 
-    def __init__(self, *args, folder):
+    def __init__(self, *args, folder, environment=None):
         self.folder = pathlib.Path(folder)
         self.stdout = open(self.folder / "stdout.txt", "w+")
         self.stderr = open(self.folder / "stderr.txt", "w+")
         self.process = subprocess.Popen([CLI, "train", *args], stdout=self.stdout, stderr=self.stderr,
-                                        cwd=self.folder)
+                                        cwd=self.folder, env=environment or boxes_environment())
+
+    def output(self):
+        return (self.folder / "stdout.txt").read_text()
 
     def boxes(self, timeout=30):
         return box_lines(self.folder, self.process, "the trainer", timeout)
@@ -660,7 +669,8 @@ class SessionWindowTest(unittest.TestCase):
     def run_session(self, *extra):
         self.process = subprocess.Popen(
             [CLI, "session", "run", "tiny.json", "--subject", "S01", "--device", "mouse-hand", "--writer", "person",
-             "--out", "out", "--data", SAMPLE, *extra], stdout=self.stdout, stderr=self.stderr, cwd=self.folder)
+             "--out", "out", "--data", SAMPLE, *extra], stdout=self.stdout, stderr=self.stderr, cwd=self.folder,
+            env=boxes_environment())
 
     def errors(self):
         return (self.folder / "stderr.txt").read_text()
@@ -798,7 +808,7 @@ class EndingTest(unittest.TestCase):
 
     def start(self, command, environment=None):
         self.process = subprocess.Popen([CLI, *command], stdout=self.stdout, stderr=self.stderr, cwd=self.folder,
-                                        env=environment)
+                                        env=boxes_environment(environment))
 
     def first_box(self, timeout=30):
         return box_lines(self.folder, self.process, "the program", timeout)[0]
