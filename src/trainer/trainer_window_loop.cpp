@@ -124,7 +124,11 @@ void TrainerApp::loop() {
     glfwPollEvents();
     const bool closed = glfwWindowShouldClose(window_) != 0 || x11_error_seen();
     if (closed || StopSignals::received() != 0) quit_ = true;
-    if (unattended() && seconds_since_start() >= options_.exit_after_s) quit_ = true;
+    if (closed && practice_) practice_->note_stop_cause("closing the window");
+    if (unattended() && seconds_since_start() >= options_.exit_after_s) {
+      quit_ = true;
+      if (practice_) practice_->note_stop_cause("--exit-after");
+    }
     handle_keys();
     if (quit_ && !quit_seen_) {  // the picture at exit shows the window as it was when the exit came
       if (!options_.screenshot.empty() && !screenshot_taken_ && !x11_error_seen() && trial_view())
@@ -174,6 +178,7 @@ void TrainerApp::handle_keys() {
       case GLFW_KEY_Q:
       case GLFW_KEY_ESCAPE:
         quit_ = true;
+        if (practice_) practice_->note_stop_cause("Q or Esc");
         break;
       case GLFW_KEY_SPACE:
         if (session_) session_->start_trial();
