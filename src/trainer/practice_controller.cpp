@@ -290,8 +290,8 @@ std::string PracticeController::trial_summary(const TrialView& view, const Trial
       line += text;
     }
   }
-  if (!saved.empty()) {
-    line += result.end == TrialEnd::completed ? "; saved as " : "; kept as an attempt: ";
+  if (!saved.empty()) {  // the session folder keeps a trial that did not end well as an attempt
+    line += view.saved_as.rfind("attempts/", 0) == 0 ? "; kept as an attempt: " : "; saved as ";
     line += saved;
   } else if (!view.save_error.empty()) {
     line += "; " + view.save_error;
