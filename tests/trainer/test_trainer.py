@@ -775,6 +775,10 @@ class SessionWindowTest(unittest.TestCase):
         self.assertFalse(first["force_law"]["guidance"])
         self.assertEqual((second["condition"], second["end_reason"]), ("haptic", "time_limit"))
         self.assertTrue(second["force_law"]["guidance"])
+        # The second trial wrote nothing: its line says so, with no deviation ("nan") of strokes never written.
+        (line,) = [l for l in self.errors().splitlines() if l.startswith("calligraphy session: trial 2/2 ")]
+        self.assertIn("no stroke written", line)
+        self.assertNotRegex(self.errors(), r"\bnan\b")
         for record in (first, second):
             self.assertEqual(record["device"]["name"], "mouse-hand")
             self.assertEqual(record["writer"]["kind"], "human")
