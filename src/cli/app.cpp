@@ -73,6 +73,10 @@ CLI::App* Commands::add(CLI::App& parent, const std::string& name, const std::st
                         std::function<int()> run) {
   CLI::App* app = parent.add_subcommand(name, description);
   app->set_version_flag("--version", kVersion, "Print the program's version and exit");
+  app->add_flag(
+      "--verbose", verbose_,
+      "Also show the library's info lines (device start-up, the servo loop's statistics) on standard "
+      "error; without it only its warnings");
   commands_.emplace_back(app, std::move(run));
   return app;
 }
@@ -288,6 +292,14 @@ CLI::Option* required(CLI::Option* option) {
   const auto default_start = description.rfind(" (default: ");
   if (default_start != std::string::npos) description.erase(default_start);  // a required option has none
   option->description(description + " (required)");
+  return option;
+}
+
+CLI::Option* with_default(CLI::Option* option, const std::string& default_text) {
+  std::string description = option->get_description();
+  const auto default_start = description.rfind(" (default: ");
+  if (default_start != std::string::npos) description.erase(default_start);
+  option->description(description + " (default: " + default_text + ")");
   return option;
 }
 

@@ -33,9 +33,13 @@ class Commands {
   CLI::App* add_group(CLI::App& parent, const std::string& name, const std::string& description);
   /// Runs the subcommand given on the command line; throws UsageError when there is none.
   [[nodiscard]] int run_selected() const;
+  /// Whether `--verbose` was given: the library's info lines (device start-up, the servo loop's statistics)
+  /// are shown too, not only its warnings. Every command takes it.
+  [[nodiscard]] bool verbose() const noexcept { return verbose_; }
 
  private:
   std::vector<std::pair<CLI::App*, std::function<int()>>> commands_;
+  bool verbose_ = false;
 };
 
 /// Sets up the program's root: version flag, help layout, one subcommand required.
@@ -103,6 +107,10 @@ CLI::Option* add_schema_option(CLI::App& app, const SchemaField& field, void* ob
 
 /// Makes an option required and says so in --help.
 CLI::Option* required(CLI::Option* option);
+
+/// Replaces the default an option's help states, "(default: ...)", with `default_text`: each option states
+/// its default once, there (e.g. `trace --csv`, whose default is standard output, not "not written").
+CLI::Option* with_default(CLI::Option* option, const std::string& default_text);
 
 /// A required positional argument; --help shows `value_name` after its name (FILE, DIR, TEXT).
 CLI::Option* add_positional(CLI::App& app, const std::string& name, std::string& target,

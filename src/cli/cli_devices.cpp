@@ -20,6 +20,11 @@ DeviceListing find_cli_device(const DeviceRegistry& devices, const char* option,
   } catch (const DeviceUnavailable&) {
     throw;
   } catch (const DeviceNotFound& e) {
+    if (name == "mouse" || name == "mouse-hand") {  // the window's devices: only its commands have a pointer
+      throw UsageError(std::string(option) + " " + name +
+                       ": the pointer devices are taken by commands with the trainer window (train, session "
+                       "run); `calligraphy devices` lists the commands that take each device");
+    }
     throw UsageError(std::string(option) + ": unknown device '" + name + "': " + e.what());
   }
 }

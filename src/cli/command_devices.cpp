@@ -1,6 +1,11 @@
-// `calligraphy devices [--json]`: every haptic device the registered backends find, with its DeviceInfo.
+// `calligraphy devices [--json]`: every haptic device the registered backends find, with its DeviceInfo, and
+// every kind of device the commands take (the registry's backends, the emulator, the pointer devices of the
+// window) with the commands that take each.
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "calligraphy/devices/device_registry.hpp"
 #include "calligraphy/report/device_survey_json.hpp"
@@ -9,24 +14,115 @@
 #include "cli/output.hpp"
 
 namespace calligraphy::cli {
+namespace {
+
+// What a kind of device is and which commands take it with --device. The commands are those that open a
+// device by name: `trial`, `train` and `session run` (`session resume` goes on on the session's device).
+struct DeviceKind {
+  std::string name;     // what --device takes, or its pattern ("phantom-hid:PATH")
+  std::string backend;  // the registry backend that makes it (the window adds "mouse" and "mouse-hand")
+  std::string writer;   // who writes with it: "simulated" or "person"
+  std::vector<std::string> commands;
+  std::string what;
+};
+
+const std::vector<std::string> kEveryCommand = {"trial", "train", "session run"};
+
+std::vector<DeviceKind> device_kinds(const DeviceRegistry& devices) {
+  std::vector<DeviceKind> kinds = {
+      {"simulated", "simulated", "simulated", kEveryCommand,
+       "the simulated device, moved by the simulated writer (train: --writer simulated)"},
+      {"emulated-phantom", "emulated-phantom", "simulated", kEveryCommand,
+       "the Phantom emulator behind the real Phantom driver, moved by the simulated writer (train: --writer "
+       "simulated)"},
+      {"mouse",
+       "mouse",
+       "person",
+       {"train", "session run"},
+       "the pointer is the pen (no force), in the trainer window"},
+      {"mouse-hand",
+       "mouse-hand",
+       "person",
+       {"train", "session run"},
+       "the pointer through a simulated hand on a simulated Phantom Desktop: guidance pulls, in the trainer "
+       "window"},
+      {"openhaptics", "openhaptics", "person", kEveryCommand,
+       "the default OpenHaptics device (a Phantom through libHD.so)"},
+      {"phantom-hid:PATH", "phantom-hid", "person", kEveryCommand,
+       "a Phantom over hidraw (PATH: /dev/hidrawN)"},
+      {"phantom-usb:BUS-ADDRESS", "phantom-usb", "person", kEveryCommand, "a Phantom over libusb"},
+  };
+#ifndef CALLIGRAPHY_WITH_TRAINER
+  for (DeviceKind& kind : kinds) {
+    if (kind.backend == "mouse" || kind.backend == "mouse-hand") {
+      kind.commands.clear();
+      kind.what += " (not in this build: no trainer window)";
+    }
+  }
+#endif
+  // A backend registered besides these (an application's own) is a device a person holds.
+  for (const std::string& backend : devices.backend_names()) {
+    bool known = false;
+    for (const DeviceKind& kind : kinds) known = known || kind.backend == backend;
+    if (!known)
+      kinds.push_back({backend, backend, "person", kEveryCommand, "a device of the backend " + backend});
+  }
+  return kinds;
+}
+
+std::string joined(const std::vector<std::string>& items) {
+  std::string text;
+  for (const std::string& item : items) text += (text.empty() ? "" : ", ") + item;
+  return text.empty() ? "none" : text;
+}
+
+void print_device_kinds(std::ostream& out, const std::vector<DeviceKind>& kinds) {
+  out << "\nKinds of device (--device NAME) and the commands that take them:\n";
+  const auto padded = [](const std::string& text, std::size_t width) {
+    return text + std::string(text.size() < width ? width - text.size() : 1, ' ');
+  };
+  out << "  " << padded("NAME", 25) << padded("WRITER", 11) << padded("COMMANDS", 28) << "WHAT\n";
+  for (const DeviceKind& kind : kinds) {
+    out << "  " << padded(kind.name, 25) << padded(kind.writer, 11) << padded(joined(kind.commands), 28)
+        << kind.what << "\n";
+  }
+}
+
+std::string survey_and_kinds_json(const DeviceSurvey& survey, const std::vector<DeviceKind>& kinds) {
+  nlohmann::ordered_json document = nlohmann::ordered_json::parse(device_survey_json(survey));
+  nlohmann::ordered_json list = nlohmann::ordered_json::array();
+  for (const DeviceKind& kind : kinds) {
+    list.push_back({{"name", kind.name},
+                    {"backend", kind.backend},
+                    {"writer", kind.writer},
+                    {"commands", kind.commands},
+                    {"what", kind.what}});
+  }
+  document["kinds"] = std::move(list);
+  return document.dump(2) + "\n";
+}
+
+}  // namespace
 
 void add_devices_command(CLI::App& root, Commands& commands, DeviceRegistry& devices) {
   auto json = std::make_shared<bool>(false);
   CLI::App* app = commands.add(root, "devices",
-                               "List the haptic devices that can be opened by name, with their "
-                               "limits in SI units",
+                               "List the haptic devices that can be opened by name, with their limits in SI "
+                               "units, and every kind of device with the commands that take it",
                                [json, &devices] {
                                  const DeviceSurvey survey = devices.survey();
+                                 const std::vector<DeviceKind> kinds = device_kinds(devices);
                                  if (*json) {
-                                   write_standard_output(device_survey_json(survey));
+                                   write_standard_output(survey_and_kinds_json(survey, kinds));
                                  } else {
                                    std::ostringstream text;
                                    print_device_survey(text, survey);
+                                   print_device_kinds(text, kinds);
                                    write_standard_output(text.str());
                                  }
                                  return 0;
                                });
-  add_flag(*app, "--json", *json, "print the survey as JSON (SI units)");
+  add_flag(*app, "--json", *json, "print the survey and the kinds of device as JSON (SI units)");
 }
 
 }  // namespace calligraphy::cli

@@ -180,8 +180,7 @@ void add_report_command(CLI::App& root, Commands& commands) {
   add_output_folder(*app, "--csv", command->csv,
                     "an existing folder for the tidy tables trials.csv and strokes.csv (docs/experiments.md)",
                     "not written");
-  add_integer(*app, "--jobs", command->jobs, "N", "threads reading sessions (one a core by default)", 1, 256,
-              "every core");
+  add_integer(*app, "--jobs", command->jobs, "N", "threads reading sessions", 1, 256, "every core");
 }
 
 }  // namespace calligraphy::cli

@@ -500,7 +500,7 @@ void add_session_commands(CLI::App& root, Commands& commands, DeviceRegistry& de
   add_positional(*resume_app, "DIR", resume->folder, "the session folder (the one holding session.json)",
                  "DIR");
   add_choice(*resume_app, "--pacing", resume->pacing, {"auto", "lock-step", "real-time"},
-             "overrides the pacing the session was started with (default: that pacing)");
+             "overrides the pacing the session was started with", "the session's own pacing");
   add_library_options(*resume_app, resume->library, true);
   add_display_options(*resume_app, resume->display);
 }

@@ -34,8 +34,8 @@ void add_trace_command(CLI::App& root, Commands& commands) {
                                [command] { return run_trace(*command); });
   app->add_option("TRACE", command->trace, "the trace file (HDF5: a session folder's trials/STEM.trace.h5)")
       ->required();
-  add_output_path(*app, "--csv", command->csv, "write the CSV here ('-', the default: standard output)",
-                  StandardOutput::allowed);
+  with_default(add_output_path(*app, "--csv", command->csv, "write the CSV here", StandardOutput::allowed),
+               "standard output");
 }
 
 }  // namespace calligraphy::cli

@@ -218,9 +218,9 @@ void add_train_command(CLI::App& root, Commands& commands, DeviceRegistry& devic
              "a number of seconds > 0", [](double s) { return s > 0.0 && s <= 86400.0; });
   command->watchdog_option = add_integer(
       *app, "--watchdog-ms", command->watchdog_ms, "MS",
-      "end the trial when the device holds one force longer than this [ms]; 0: off (default: 50 on a haptic "
-      "device, off on mouse, mouse-hand and simulated, which hold no force against a hand)",
-      0, 60000);
+      "end the trial when the device holds one force longer than this [ms]; 0: off (mouse, mouse-hand and "
+      "simulated hold no force against a hand)",
+      0, 60000, "50 on a haptic device, 0 on mouse, mouse-hand and simulated");
 }
 
 }  // namespace calligraphy::cli

@@ -1,13 +1,12 @@
 // The `calligraphy` program: guided writing trials on any device, scoring of pen traces, models, the
 // corpus store, benchmarks. docs/cli.md describes every command.
-#include <spdlog/sinks/stdout_color_sinks.h>
-#include <spdlog/spdlog.h>
-
 #include <cstdio>
 #include <exception>
 #include <string>
+#include <string_view>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/logging.hpp"
 #include "cli/cli_devices.hpp"
 #include "cli/commands.hpp"
 #include "cli/output.hpp"
@@ -30,6 +29,18 @@ std::pair<std::string, const CLI::App*> given_command(const CLI::App& root) {
 
 void print_error(const std::string& command, const std::string& message) {
   print_error_line(command, "error", message);
+}
+
+// The library's log as the command's own lines on standard error, one line each in the error lines' form:
+// "calligraphy trial: warning: Phantom: ...". Its errors (a servo loop's watchdog) are warnings of the
+// command, which says itself how it ended; info lines only with --verbose. Standard output carries reports.
+void show_library_log(const std::string& command, bool verbose) {
+  calligraphy::set_log_handler([command](calligraphy::LogLevel level, std::string_view message) {
+    using calligraphy::LogLevel;
+    const char* kind = level >= LogLevel::warning ? "warning" : level == LogLevel::info ? "info" : "debug";
+    print_error_line(command, kind, message);
+  });
+  calligraphy::set_log_level(verbose ? calligraphy::LogLevel::info : calligraphy::LogLevel::warning);
 }
 
 }  // namespace
@@ -100,8 +111,7 @@ int main(int argc, char** argv) {
       print_error(name, message);
       return 2;
     }
-    // The library's log (device start-up, warnings) goes to stderr: stdout carries reports only.
-    spdlog::set_default_logger(spdlog::stderr_color_mt("calligraphy"));
+    show_library_log(given_command(root).first, commands.verbose());
     status = commands.run_selected();
   } catch (const UsageError& e) {
     print_error(given_command(root).first, e.what());

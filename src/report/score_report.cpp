@@ -3,9 +3,11 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <string>
+#include <vector>
 
-#include "calligraphy/model/typical_strokes.hpp"
 #include "calligraphy/core/unicode.hpp"
+#include "calligraphy/model/typical_strokes.hpp"
 #include "report/appendf.hpp"
 #include "report/metrics_object.hpp"
 
@@ -89,39 +91,142 @@ nlohmann::json segments_json(const CharacterScore& score) {
 
 namespace {
 
+// One verdict per reference stroke, from the renderer's verdicts on the pen-downs in writing order: accepted
+// when a pen-down was accepted as it; else refused, by the last refusal about it (a wrong order or a wrong
+// stroke is about the stroke the pen wrote; any other refusal about the stroke that was due); else not
+// written.
+struct StrokeVerdict {
+  enum class State { not_written, accepted, refused } state = State::not_written;
+  StrokeRefusal refusal = StrokeRefusal::none;
+  std::size_t due = 0;            // the stroke due when it was refused (0-based)
+  double deviation_m = 0.0;       // the refused pen-down's mean distance from the stroke that was due
+  double covered_fraction = 0.0;  // how far along the stroke that was due it went
+};
+
+std::vector<StrokeVerdict> stroke_verdicts(const CharacterScore& score) {
+  std::vector<StrokeVerdict> verdicts(score.strokes.size());
+  std::size_t due = 0;
+  for (const WrittenSegment& segment : score.segments) {
+    if (!segment.verdict) continue;
+    const StrokeMatch& match = *segment.verdict;
+    if (match.accepted) {
+      if (due < verdicts.size())
+        verdicts[due] = {StrokeVerdict::State::accepted, StrokeRefusal::none, due, 0.0, 1.0};
+      ++due;
+      continue;
+    }
+    const bool other_stroke =
+        match.refusal == StrokeRefusal::wrong_order || match.refusal == StrokeRefusal::wrong_stroke;
+    const std::size_t about = other_stroke ? match.matched_stroke : due;
+    if (about >= verdicts.size() || verdicts[about].state == StrokeVerdict::State::accepted) continue;
+    verdicts[about] = {StrokeVerdict::State::refused, match.refusal, due, match.mean_deviation_m,
+                       match.covered_fraction};
+  }
+  return verdicts;
+}
+
+// "too_short" -> "too short".
+std::string reason_words(StrokeRefusal refusal) {
+  std::string words = to_string(refusal);
+  for (char& c : words)
+    if (c == '_') c = ' ';
+  return words;
+}
+
+std::string verdict_text(const StrokeVerdict& v, std::size_t stroke) {
+  char text[160];
+  switch (v.state) {
+    case StrokeVerdict::State::accepted:
+      return "accepted";
+    case StrokeVerdict::State::not_written:
+      return "not written";
+    case StrokeVerdict::State::refused:
+      break;
+  }
+  const std::string why = "refused: " + reason_words(v.refusal);
+  switch (v.refusal) {
+    case StrokeRefusal::wrong_order:
+      std::snprintf(text, sizeof text, " (written while stroke %zu was due)", v.due + 1);
+      return why + text;
+    case StrokeRefusal::wrong_stroke:
+      if (v.due == stroke) return why;
+      std::snprintf(text, sizeof text, " (written again while stroke %zu was due)", v.due + 1);
+      return why + text;
+    case StrokeRefusal::too_short:
+      std::snprintf(text, sizeof text, " (%.0f %% of it, %.1f mm off)", v.covered_fraction * 100.0,
+                    v.deviation_m * 1e3);
+      return why + text;
+    default:
+      std::snprintf(text, sizeof text, " (%.1f mm off)", v.deviation_m * 1e3);
+      return why + text;
+  }
+}
+
+// The verdicts' counts: accepted, refused (by reason), not written; they add up to the strokes.
+struct VerdictCounts {
+  std::size_t strokes = 0;
+  std::size_t accepted = 0;
+  std::size_t not_written = 0;
+  RefusalCounts refused;
+  void add(const std::vector<StrokeVerdict>& verdicts) {
+    for (const StrokeVerdict& v : verdicts) {
+      ++strokes;
+      if (v.state == StrokeVerdict::State::accepted) ++accepted;
+      if (v.state == StrokeVerdict::State::not_written) ++not_written;
+      if (v.state == StrokeVerdict::State::refused) refused.add(v.refusal);
+    }
+  }
+};
+
+std::string by_reason(const RefusalCounts& counts) {
+  std::string text;
+  for (const StrokeRefusal r : kRefusals) {
+    if (counts.of(r) > 0)
+      appendf(text, "%s%s %zu", text.empty() ? "" : ", ", reason_words(r).c_str(), counts.of(r));
+  }
+  return text.empty() ? "" : "  (" + text + ")";
+}
+
+void append_verdict_counts(std::string& out, const VerdictCounts& c) {
+  appendf(out, "  strokes accepted           %zu of %zu  (in turn, as the renderer judges each pen lift)\n",
+          c.accepted, c.strokes);
+  appendf(out, "  strokes refused            %zu%s\n", c.refused.total(), by_reason(c.refused).c_str());
+  appendf(out, "  strokes not written        %zu\n", c.not_written);
+}
+
 void append_character_table(std::string& out, const CharacterScore& score) {
   const CharacterWritingMetrics& t = score.totals;
-  appendf(out, "\n  %-6s %-6s %-4s %-7s %-9s %9s %9s %11s %9s %9s\n", "stroke", "type", "ID", "written",
-          "backwards", "mean[mm]", "max[mm]", "Frechet[mm]", "DTW[mm]", "time[s]");
+  const std::vector<StrokeVerdict> verdicts = stroke_verdicts(score);
+  appendf(out, "\n  %-6s %-6s %-4s %9s %9s %11s %9s %9s  %s\n", "stroke", "type", "ID", "mean[mm]", "max[mm]",
+          "Frechet[mm]", "DTW[mm]", "time[s]", "verdict");
   for (const StrokeScore& s : score.strokes) {
     const auto& m = s.metrics;
     const auto mm = [&](auto member) { return m ? std::optional<double>(member(*m)) : std::nullopt; };
-    appendf(out, "  %-6zu %-6s %-4d %-7s %-9s %9s %9s %11s %9s %9s\n", s.index,
-            std::string(typical_stroke(s.typical_id).acronym).c_str(), s.typical_id, s.written ? "yes" : "no",
-            s.backwards ? "yes" : "no",
+    std::string verdict = verdict_text(verdicts[s.index], s.index);
+    if (s.backwards && verdicts[s.index].refusal != StrokeRefusal::backwards)
+      verdict += "; matched backwards";
+    appendf(out, "  %-6zu %-6s %-4d %9s %9s %11s %9s %9s  %s\n", s.index + 1,
+            std::string(typical_stroke(s.typical_id).acronym).c_str(), s.typical_id,
             fixed(mm([](auto& x) { return x.deviation.mean_m; }), 1e3, "%.2f").c_str(),
             fixed(mm([](auto& x) { return x.deviation.max_m; }), 1e3, "%.2f").c_str(),
             fixed(mm([](auto& x) { return x.curves.frechet_m; }), 1e3, "%.2f").c_str(),
             fixed(mm([](auto& x) { return x.curves.dtw_m; }), 1e3, "%.2f").c_str(),
-            fixed(mm([](auto& x) { return x.kinematics.writing_time_s; }), 1.0, "%.2f").c_str());
+            fixed(mm([](auto& x) { return x.kinematics.writing_time_s; }), 1.0, "%.2f").c_str(),
+            verdict.c_str());
   }
   const auto deviation = [&](double DeviationSummary::*member) {
     return t.deviation ? std::optional<double>((*t.deviation).*member) : std::nullopt;
   };
-  appendf(out, "\n  strokes written            %zu / %zu%s\n", score.strokes_written, score.strokes.size(),
-          score.completed_in_order ? "  (complete, in order)" : "");
-  appendf(out, "  accepted in turn           %zu / %zu  (the renderer's verdicts, pen lift by pen lift)\n",
-          score.strokes_accepted, score.strokes.size());
-  std::string refused;
-  for (const StrokeRefusal r : kRefusals) {
-    if (score.refusals.of(r) > 0)
-      appendf(refused, "%s%s %zu", refused.empty() ? "" : ", ", to_string(r), score.refusals.of(r));
-  }
-  appendf(out, "  refused                    %s\n", refused.empty() ? "-" : refused.c_str());
-  appendf(out, "  order errors               %zu\n", score.order_errors);
-  appendf(out, "  backwards strokes          %zu\n", score.backwards_strokes);
-  appendf(out, "  unmatched / ignored        %zu / %zu segments\n", score.unmatched_strokes,
+  VerdictCounts counts;
+  counts.add(verdicts);
+  out += "\n";
+  append_verdict_counts(out, counts);
+  appendf(out, "  pen-downs refused          %zu%s\n", score.refusals.total(),
+          by_reason(score.refusals).c_str());
+  appendf(out, "  pen-downs unmatched        %zu, too short to score %zu\n", score.unmatched_strokes,
           score.ignored_segments);
+  appendf(out, "  strokes matched            %zu  (the deviations and times below are theirs)\n",
+          score.strokes_written);
   appendf(out, "  mean deviation             %s mm\n",
           fixed(deviation(&DeviationSummary::mean_m), 1e3, "%.3f").c_str());
   appendf(out, "  max deviation              %s mm\n",
@@ -142,20 +247,24 @@ void append_character_table(std::string& out, const CharacterScore& score) {
 
 std::string score_table(const ScoreDescription& d, const WritingMetrics& metrics) {
   std::string out;
-  appendf(out, "Score of %s against %s (%zu samples, x and y in %s; strokes numbered from 0)\n", d.trace.c_str(),
-          d.character.c_str(), d.samples, d.units.c_str());
+  appendf(out,
+          "Score of %s against %s (%zu samples, x and y in %s; strokes numbered from 1 here, from 0 in the "
+          "JSON)\n",
+          d.trace.c_str(), d.character.c_str(), d.samples, d.units.c_str());
+  VerdictCounts all;
   for (const CharacterScore& score : metrics.characters) {
     if (metrics.characters.size() > 1) appendf(out, "\n%s\n", encode_utf8(score.code_point).c_str());
     append_character_table(out, score);
+    all.add(stroke_verdicts(score));
   }
   if (metrics.characters.size() > 1) {
     const auto mm = [](const std::optional<double>& v) { return fixed(v, 1e3, "%.3f"); };
     appendf(out, "\nAll %zu characters\n", metrics.characters.size());
-    appendf(out, "  strokes written            %zu / %zu%s\n", metrics.strokes_written, metrics.strokes_total,
-            metrics.completed_in_order ? "  (complete, in order)" : "");
-    appendf(out, "  accepted in turn           %zu / %zu\n", metrics.strokes_accepted, metrics.strokes_total);
-    appendf(out, "  order errors               %zu\n", metrics.order_errors);
-    appendf(out, "  backwards strokes          %zu\n", metrics.backwards_strokes);
+    append_verdict_counts(out, all);
+    appendf(out, "  pen-downs refused          %zu%s\n", metrics.refusals.total(),
+            by_reason(metrics.refusals).c_str());
+    appendf(out, "  strokes matched            %zu  (the deviations and times below are theirs)\n",
+            metrics.strokes_written);
     appendf(out, "  mean deviation             %s mm\n",
             mm(metrics.deviation ? std::optional<double>(metrics.deviation->mean_m) : std::nullopt).c_str());
     appendf(out, "  Frechet (worst stroke)     %s mm\n", mm(metrics.frechet_m).c_str());

@@ -76,9 +76,14 @@ void HostedSessionView::follow(QuizLog& quiz_log,
     const std::filesystem::path file(s.outcome->json_file);
     view_->saved_as = s.outcome->saved ? file.filename().string() : "";
     if (!s.outcome->saved) view_->end_reason = "kept as an attempt: " + file.filename().string();
-    std::fprintf(stderr, "calligraphy session: trial %zu/%zu %s: %s, %.1f s, mean %.2f mm%s\n",
+    // A trial that wrote no stroke has no deviation (NaN in the outcome): said in words, not as "nan".
+    char deviation[64] = "no stroke written";
+    if (std::isfinite(s.outcome->mean_deviation_mm))
+      std::snprintf(deviation, sizeof deviation, "mean deviation %.2f mm", s.outcome->mean_deviation_mm);
+    std::fprintf(stderr, "calligraphy session: trial %zu/%zu %s: %s after %.1f s, %s; %s %s\n",
                  s.trial.index + 1, s.total, s.trial.condition.c_str(), s.outcome->end_reason.c_str(),
-                 s.outcome->time_s, s.outcome->mean_deviation_mm, s.outcome->saved ? "" : " (attempt)");
+                 s.outcome->time_s, deviation,
+                 s.outcome->saved ? "saved as" : "kept as an attempt:", file.filename().c_str());
     if (s.trial.index + 1 == s.total) last_trial_ended_ = true;
   }
 }

@@ -106,11 +106,15 @@ std::string describe(const QuizEvent& event) {
   } else if (event.refusal != StrokeRefusal::none) {
     why = std::string(", ") + to_string(event.refusal);
   }
-  if (event.written_stroke) why += ", wrote stroke " + std::to_string(*event.written_stroke);
+  if (event.written_stroke) why += ", wrote stroke " + std::to_string(*event.written_stroke + 1);
   char line[160];
-  std::snprintf(line, sizeof line, "stroke %zu: %s (misses %d on the stroke, %d in all%s)", event.stroke,
+  std::snprintf(line, sizeof line, "stroke %zu: %s (misses %d on the stroke, %d in all%s)", event.stroke + 1,
                 to_string(event.kind), event.misses_on_stroke, event.total_misses, why.c_str());
   return line;
+}
+
+std::string count_of(std::size_t count, std::string_view one, std::string_view many) {
+  return std::to_string(count) + " " + std::string(count == 1 ? one : many);
 }
 
 }  // namespace calligraphy::trainer

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -85,5 +86,8 @@ class LiveQuiz {
 /// "stroke 2: stroke_missed (misses 1 on the stroke, 1 in all, backwards)", "stroke 2: stroke_missed (misses
 /// 2 on the stroke, 2 in all, wrong_order, wrote stroke 3)": one line for logs; strokes 1-based.
 [[nodiscard]] std::string describe(const QuizEvent& event);
+
+/// "0 misses", "1 miss", "2 misses": a count and the noun that agrees with it.
+[[nodiscard]] std::string count_of(std::size_t count, std::string_view one, std::string_view many);
 
 }  // namespace calligraphy::trainer

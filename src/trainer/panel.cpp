@@ -113,7 +113,9 @@ void quiz_state(const TrialView& view, const PanelInput& input) {
     const std::string label = quiz.sessions().size() > 1 ? "character " + std::to_string(c + 1) + ": " : "";
     if (input.large_font != nullptr) ImGui::PushFont(input.large_font);
     if (session.complete()) {
-      ImGui::TextColored(kGood, "%scomplete, %d misses", label.c_str(), session.total_misses());
+      ImGui::TextColored(
+          kGood, "%scomplete, %s", label.c_str(),
+          count_of(static_cast<std::size_t>(session.total_misses()), "miss", "misses").c_str());
     } else {
       ImGui::Text("%sstroke %zu of %zu", label.c_str(), session.current_stroke() + 1, n);
     }

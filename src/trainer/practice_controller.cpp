@@ -84,6 +84,7 @@ void PracticeController::start_trial(std::size_t character) {
   view_.emplace();
   view_->character = character;
   view_->number = ++trials_started_;
+  stop_cause_.clear();
   view_->guidance = guidance_;
   view_->condition = condition_name();
   // The trial specification of this trial; the teacher (read once, as samples), the display channel and what
@@ -126,7 +127,10 @@ void PracticeController::start_trial(std::size_t character) {
 
 void PracticeController::follow_trial(bool quitting, QuizLog& quiz_log) {
   if (quitting && worker_.active() && !worker_.done()) worker_.request_stop();
-  if (pending_ != NextAction::none && worker_.active() && !worker_.done()) worker_.request_stop();
+  if (pending_ != NextAction::none && worker_.active() && !worker_.done()) {
+    note_stop_cause(pending_ == NextAction::repeat ? "R (repeat)" : "N (next character)");
+    worker_.request_stop();
+  }
   if (view_ && worker_.active()) {
     view_->consume(*channel_, typical_ids_[view_->character]);
     quiz_log.log_verdicts(*view_, characters_utf8(*view_));
@@ -170,7 +174,9 @@ void PracticeController::finish_trial(QuizLog& quiz_log) {
   view.consume(*channel_, typical_ids_[view.character]);
   quiz_log.log_verdicts(view, characters_utf8(view));
   quiz_log.log_refusal(view, characters_utf8(view));
-  if (view.quiz) check_quiz_against_trace(*view.quiz, worker_.scene(), result.trace, quiz_options_);
+  if (view.quiz)
+    check_quiz_against_trace(*view.quiz, worker_.scene(), result.trace, quiz_options_,
+                             practice_folder_.has_value());
   if (view.quiz && view.quiz->complete() && result.end == TrialEnd::interrupted) {
     // Stopped once the quiz was complete (by the loop, or a key in the same moment): the quiz's task is
     // done, so the trial is complete, and saved as a trial rather than an attempt.
@@ -200,12 +206,8 @@ void PracticeController::finish_trial(QuizLog& quiz_log) {
   if (!options_.record.empty() && result.end == TrialEnd::completed &&
       result.metrics.strokes_completed == result.metrics.strokes_total)
     save_recording(view, result);
-  const std::string& utf8 = options_.characters[view.character].utf8;
-  std::fprintf(stderr,
-               "calligraphy train: trial %zu %s: %s, %zu/%zu strokes in order, mean %.2f mm, %.1f s\n",
-               view.number, utf8.c_str(), to_string(result.end), result.metrics.strokes_completed,
-               result.metrics.strokes_total, view.metrics.mean_deviation_m.value_or(std::nan("")) * 1e3,
-               view.metrics.time_s);
+  const std::string saved = practice_folder_ ? save_trial(view, result) : std::string();
+  std::fprintf(stderr, "calligraphy train: %s\n", trial_summary(view, result, writing, saved).c_str());
   if (result.loop) {
     const ServoLoopStats& loop = *result.loop;
     std::fprintf(stderr,
@@ -216,7 +218,6 @@ void PracticeController::finish_trial(QuizLog& quiz_log) {
                  static_cast<unsigned long long>(loop.forces_withheld), loop.period_jitter_us_p50,
                  loop.period_jitter_us_p99, loop.period_jitter_us_max, loop.longest_stall_s * 1e3);
   }
-  if (practice_folder_) save_trial(view, result);
   if (result.end == TrialEnd::device_fault) {  // the device is lost: no further trial can run on it
     std::fprintf(stderr, "calligraphy train: error: the device failed (%s); the window closes\n",
                  result.abort_reason.c_str());
@@ -258,8 +259,51 @@ void PracticeController::adapt_guidance(const TrialView& view) {
   }
 }
 
-// The trial into the practice folder: as a trial, or as an attempt when it did not complete.
-void PracticeController::save_trial(TrialView& view, const TrialResult& result) {
+// One line a person reads of the trial that ended: how it ended and why, what the pen wrote (no deviation
+// of strokes never written), and what was kept of it.
+std::string PracticeController::trial_summary(const TrialView& view, const TrialResult& result,
+                                              const WritingMetrics& writing, const std::string& saved) const {
+  std::string line = "trial " + std::to_string(view.number) + " " + options_.characters[view.character].utf8 +
+                     ": " + to_string(result.end);
+  if (result.end == TrialEnd::interrupted) {
+    const std::string stopped_by = "stopped by ";
+    if (result.abort_reason.rfind(stopped_by, 0) == 0) {
+      line += " by " + result.abort_reason.substr(stopped_by.size());
+    } else if (!stop_cause_.empty()) {
+      line += " by " + stop_cause_;
+    }
+  } else if (result.end != TrialEnd::completed && !result.abort_reason.empty()) {
+    line += " (" + result.abort_reason + ")";
+  }
+  char text[160];
+  std::snprintf(text, sizeof text, " after %.1f s; ", result.metrics.time_s);
+  line += text;
+  const std::size_t total = result.metrics.strokes_total;
+  if (writing.strokes_written == 0 && result.metrics.strokes_completed == 0) {
+    line += "no stroke written";
+  } else {
+    line += std::to_string(result.metrics.strokes_completed) + " of " + count_of(total, "stroke", "strokes") +
+            " accepted in order";
+    if (writing.deviation) {
+      std::snprintf(text, sizeof text, ", mean deviation %.2f mm over %zu written",
+                    writing.deviation->mean_m * 1e3, writing.strokes_written);
+      line += text;
+    }
+  }
+  if (!saved.empty()) {  // the session folder keeps a trial that did not end well as an attempt
+    line += view.saved_as.rfind("attempts/", 0) == 0 ? "; kept as an attempt: " : "; saved as ";
+    line += saved;
+  } else if (!view.save_error.empty()) {
+    line += "; " + view.save_error;
+  } else {
+    line += "; not saved (no --session)";
+  }
+  return line;
+}
+
+// The trial into the practice folder: as a trial, or as an attempt when it did not complete. Returns the
+// record's path, or "" when it could not be saved (view.save_error says why).
+std::string PracticeController::save_trial(TrialView& view, const TrialResult& result) {
   PracticeTrial trial;
   trial.item = view.character;
   trial.character = options_.characters[view.character].model.code_point;
@@ -274,13 +318,13 @@ void PracticeController::save_trial(TrialView& view, const TrialResult& result) 
   try {
     const auto [path, as_trial] = practice_folder_->save(trial, result);
     view.saved_as = (as_trial ? "" : "attempts/") + path.filename().string();
-    std::fprintf(stderr, "calligraphy train: saved %s (%s)\n", path.c_str(),
-                 as_trial ? "the trial, .trace.h5, .svg" : "an attempt, .trace.h5");
+    return path.string();
   } catch (const std::exception& e) {
     view.save_error = std::string("not saved: ") + e.what();
     std::fprintf(stderr, "calligraphy train: error: the trial was not saved: %s\n", e.what());
     failed_ = true;
   }
+  return {};
 }
 
 // A lost display, a stop signal, a lost device: logged once.

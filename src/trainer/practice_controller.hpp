@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "calligraphy/analysis/writing_metrics.hpp"
 #include "calligraphy/core/device_types.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/render/guidance_law.hpp"
@@ -60,6 +61,11 @@ class PracticeController {
   void stop_trial();
   /// The practice's session_stopped event (once), when the window ends early.
   void log_stop(const std::string& reason);
+  /// What is about to stop the running trial, for its summary line ("--exit-after", "Q or Esc"): the first
+  /// cause given since the trial started is kept. A stop signal or a lost display names itself.
+  void note_stop_cause(std::string cause) {
+    if (stop_cause_.empty()) stop_cause_ = std::move(cause);
+  }
 
   // The keys: R and N ask for a trial once this one ends; G and M set the next trial's guidance.
   void ask_for(NextAction action) noexcept { pending_ = action; }
@@ -92,7 +98,9 @@ class PracticeController {
   [[nodiscard]] std::span<const std::string> characters_utf8(const TrialView& view) const;
   void adapt_guidance(const TrialView& view);
   void save_recording(TrialView& view, const TrialResult& result);
-  void save_trial(TrialView& view, const TrialResult& result);
+  std::string save_trial(TrialView& view, const TrialResult& result);
+  [[nodiscard]] std::string trial_summary(const TrialView& view, const TrialResult& result,
+                                          const WritingMetrics& writing, const std::string& saved) const;
 
   const TrainerOptions& options_;
   DeviceInfo device_info_;
@@ -117,6 +125,7 @@ class PracticeController {
   SimulationOptions trial_simulation_;  ///< the simulated writer of the trial (a hand-port device only)
   std::string trial_start_utc_;
   Clock::time_point trial_wall_start_;
+  std::string stop_cause_;  ///< what stopped the running trial, when not a signal or a lost display
   // What comes after it.
   NextAction pending_ = NextAction::none;
   std::optional<Clock::time_point> advance_at_;

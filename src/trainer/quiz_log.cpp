@@ -23,7 +23,8 @@ void QuizLog::log_verdicts(TrialView& view, std::span<const std::string> charact
     const std::string& utf8 = characters_utf8[character];
     std::fprintf(stderr, "%s: quiz %s %s\n", who, utf8.c_str(), describe(event).c_str());
     if (event.kind == QuizEvent::Kind::character_completed) {
-      std::fprintf(stderr, "%s: quiz %s complete, %d misses\n", who, utf8.c_str(), event.total_misses);
+      std::fprintf(stderr, "%s: quiz %s complete, %s\n", who, utf8.c_str(),
+                   count_of(static_cast<std::size_t>(event.total_misses), "miss", "misses").c_str());
     }
     const bool judged = event.kind == QuizEvent::Kind::stroke_accepted ||
                         event.kind == QuizEvent::Kind::stroke_missed ||
@@ -51,30 +52,40 @@ void QuizLog::log_refusal(TrialView& view, std::span<const std::string> characte
 std::string QuizLog::take_screenshot_request() { return std::exchange(screenshot_, {}); }
 
 void check_quiz_against_trace(const LiveQuiz& quiz, const Scene& scene, const std::vector<TrialSample>& trace,
-                              const QuizOptions& options) {
-  const std::vector<std::vector<QuizEvent>> saved = quiz_characters(scene, trace, options);
+                              const QuizOptions& options, bool saved_record) {
+  const std::vector<std::vector<QuizEvent>> again = quiz_characters(scene, trace, options);
   const std::vector<std::vector<QuizEvent>> live = quiz.events();
-  bool same = saved.size() == live.size();
-  std::size_t count = 0;
-  for (std::size_t c = 0; same && c < saved.size(); ++c) {
-    same = saved[c].size() == live[c].size();
-    for (std::size_t k = 0; same && k < saved[c].size(); ++k) {
-      const QuizEvent& a = saved[c][k];
+  bool same = again.size() == live.size();
+  std::size_t count = 0;  // the verdicts
+  for (std::size_t c = 0; same && c < again.size(); ++c) {
+    same = again[c].size() == live[c].size();
+    for (std::size_t k = 0; same && k < again[c].size(); ++k) {
+      const QuizEvent& a = again[c][k];
       const QuizEvent& b = live[c][k];
       same = a.kind == b.kind && a.stroke == b.stroke && a.backwards == b.backwards &&
              a.misses_on_stroke == b.misses_on_stroke && a.total_misses == b.total_misses &&
              a.time_s == b.time_s && a.samples == b.samples && a.refusal == b.refusal &&
              a.written_stroke == b.written_stroke;
-      ++count;
+      // Verdicts are the judged strokes; a hint and a completion are events beside them (compared too).
+      if (a.kind == QuizEvent::Kind::stroke_accepted || a.kind == QuizEvent::Kind::stroke_missed ||
+          a.kind == QuizEvent::Kind::too_short)
+        ++count;
     }
   }
-  if (same) {
-    std::fprintf(stderr, "calligraphy train: quiz: the %zu live verdicts are the saved record's\n", count);
+  // What the whole trace, judged again, is: the saved record's verdicts with --session, else nothing kept.
+  const char* judged_again = saved_record ? "the saved record" : "the whole trace judged after the trial";
+  if (same && count == 0) {
+    std::fprintf(stderr, "calligraphy train: quiz: no stroke was judged, live or in %s\n", judged_again);
+  } else if (same) {
+    std::fprintf(stderr, "calligraphy train: quiz: %s, the same as in %s\n",
+                 count_of(count, "live verdict", "live verdicts").c_str(), judged_again);
   } else {
-    std::fprintf(stderr,
-                 "calligraphy train: warning: quiz: the live verdicts differ from the saved record's, which "
-                 "judges the whole trace (%llu trace points did not reach the window)\n",
-                 static_cast<unsigned long long>(quiz.dropped_points()));
+    std::fprintf(
+        stderr,
+        "calligraphy train: warning: quiz: the live verdicts differ from those of %s, which judges "
+        "the whole trace (%s did not reach the window)\n",
+        judged_again,
+        count_of(static_cast<std::size_t>(quiz.dropped_points()), "trace point", "trace points").c_str());
   }
 }
 

@@ -39,8 +39,9 @@ class QuizLog {
 };
 
 /// The saved record judges the whole trace after the trial (quiz_characters, with `options`, on `scene`):
-/// prints whether the verdicts `quiz` gave live are the same ones.
+/// prints whether the verdicts `quiz` gave live are the same ones, in words true for none, one and many;
+/// `saved_record` says whether the trial is saved (`--session`) or only judged again for this line.
 void check_quiz_against_trace(const LiveQuiz& quiz, const Scene& scene, const std::vector<TrialSample>& trace,
-                              const QuizOptions& options);
+                              const QuizOptions& options, bool saved_record);
 
 }  // namespace calligraphy::trainer

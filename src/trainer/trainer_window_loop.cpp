@@ -6,8 +6,10 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -21,6 +23,14 @@ namespace calligraphy::trainer {
 namespace {
 
 constexpr double kFramePeriodS = 1.0 / 60.0;
+
+// The character boxes in window pixels ("box 0 永 x=64 y=24 size=752"), for tests and tools that move the
+// pointer over a character: on standard error, only when CALLIGRAPHY_PRINT_BOXES is set (docs/trainer.md).
+// Standard output carries none of them.
+bool print_boxes() {
+  const char* value = std::getenv("CALLIGRAPHY_PRINT_BOXES");
+  return value != nullptr && *value != '\0' && std::string_view(value) != "0";
+}
 // After a lost display: how long the trial (or the session's thread) may take to stop and be saved.
 constexpr auto kSaveAfterLostDisplay = std::chrono::seconds(5);
 
@@ -46,12 +56,12 @@ int TrainerApp::run() {
   layout_.emplace(session_ ? 1 : options_.characters.size(), options_.width_px, options_.height_px,
                   kPanelWidthPx);
   if (session_) art_.resize(1);
-  for (std::size_t k = 0; k < layout_->count() && !session_; ++k) {
+  for (std::size_t k = 0; k < layout_->count() && !session_ && print_boxes(); ++k) {
     const ScreenBox& b = layout_->box(k);
-    std::printf("box %zu %s x=%.0f y=%.0f size=%.0f\n", k, options_.characters[k].utf8.c_str(), b.x_px,
-                b.y_px, b.size_px);
+    std::fprintf(stderr, "box %zu %s x=%.0f y=%.0f size=%.0f\n", k, options_.characters[k].utf8.c_str(),
+                 b.x_px, b.y_px, b.size_px);
   }
-  std::fflush(stdout);
+  std::fflush(stderr);
   started_ = Clock::now();
   if (practice_) practice_->start_trial(0);
   loop();
@@ -114,7 +124,11 @@ void TrainerApp::loop() {
     glfwPollEvents();
     const bool closed = glfwWindowShouldClose(window_) != 0 || x11_error_seen();
     if (closed || StopSignals::received() != 0) quit_ = true;
-    if (unattended() && seconds_since_start() >= options_.exit_after_s) quit_ = true;
+    if (closed && practice_) practice_->note_stop_cause("closing the window");
+    if (unattended() && seconds_since_start() >= options_.exit_after_s) {
+      quit_ = true;
+      if (practice_) practice_->note_stop_cause("--exit-after");
+    }
     handle_keys();
     if (quit_ && !quit_seen_) {  // the picture at exit shows the window as it was when the exit came
       if (!options_.screenshot.empty() && !screenshot_taken_ && !x11_error_seen() && trial_view())
@@ -164,6 +178,7 @@ void TrainerApp::handle_keys() {
       case GLFW_KEY_Q:
       case GLFW_KEY_ESCAPE:
         quit_ = true;
+        if (practice_) practice_->note_stop_cause("Q or Esc");
         break;
       case GLFW_KEY_SPACE:
         if (session_) session_->start_trial();
@@ -208,12 +223,12 @@ void TrainerApp::show_row(const std::vector<std::size_t>& characters) {
   art_.clear();
   for (const std::size_t k : characters) art_.push_back(every_character_art_[k]);
   layout_.emplace(art_.size(), options_.width_px, options_.height_px, kPanelWidthPx);
-  for (std::size_t k = 0; k < layout_->count(); ++k) {
+  for (std::size_t k = 0; k < layout_->count() && print_boxes(); ++k) {
     const ScreenBox& b = layout_->box(k);
-    std::printf("box %zu %s x=%.0f y=%.0f size=%.0f\n", k, options_.characters[characters[k]].utf8.c_str(),
-                b.x_px, b.y_px, b.size_px);
+    std::fprintf(stderr, "box %zu %s x=%.0f y=%.0f size=%.0f\n", k,
+                 options_.characters[characters[k]].utf8.c_str(), b.x_px, b.y_px, b.size_px);
   }
-  std::fflush(stdout);
+  std::fflush(stderr);
 }
 
 }  // namespace calligraphy::trainer

@@ -406,7 +406,7 @@ class Score(CliTestCase):
             metrics = json.loads((self.cwd / "t.json").read_text())
             result = self.run_cli("score", "t.csv", "--character", characters, "--json", "s.json")
             self.assertEqual(result.returncode, 0, result.stderr.decode())
-            self.assertIn("strokes written", result.stdout.decode())  # the table
+            self.assertIn("strokes accepted", result.stdout.decode())  # the table
             score = json.loads((self.cwd / "s.json").read_text())
             for key in self.METRIC_KEYS:
                 assert_same_record(self, score[key], metrics[key], f"{characters}: {key}")

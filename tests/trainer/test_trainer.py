@@ -54,12 +54,18 @@ class Box:
         return self.data_to_px((x_m * units + 512, y_m * units + 388))
 
 
+def boxes_environment(environment=None):
+    """The environment (this process's, as it is now, by default) asking the window to print its character
+    boxes on stderr (docs/trainer.md); standard output never has them."""
+    return dict(environment or os.environ, CALLIGRAPHY_PRINT_BOXES="1")
+
+
 def box_lines(folder, process, who, timeout=30):
-    """The character boxes the window printed on stdout (folder/stdout.txt) once it has drawn; fails when
-    `process` ends first (naming `who` and its stderr, folder/stderr.txt) or after `timeout` s."""
+    """The character boxes the window printed on stderr (folder/stderr.txt, asked for by boxes_environment)
+    once it has drawn; fails when `process` ends first (naming `who` and its stderr) or after `timeout` s."""
     deadline = time.time() + timeout
     while time.time() < deadline:
-        lines = [l for l in (folder / "stdout.txt").read_text().splitlines() if l.startswith("box ")]
+        lines = [l for l in (folder / "stderr.txt").read_text().splitlines() if l.startswith("box ")]
         if lines:
             return [Box(l) for l in lines]
         if process.poll() is not None:
@@ -88,12 +94,15 @@ def program_window(pid, tool=None, timeout=10):
 class Trainer:
     """`calligraphy train` running in the background."""
 
-    def __init__(self, *args, folder):
+    def __init__(self, *args, folder, environment=None):
         self.folder = pathlib.Path(folder)
         self.stdout = open(self.folder / "stdout.txt", "w+")
         self.stderr = open(self.folder / "stderr.txt", "w+")
         self.process = subprocess.Popen([CLI, "train", *args], stdout=self.stdout, stderr=self.stderr,
-                                        cwd=self.folder)
+                                        cwd=self.folder, env=environment or boxes_environment())
+
+    def output(self):
+        return (self.folder / "stdout.txt").read_text()
 
     def boxes(self, timeout=30):
         return box_lines(self.folder, self.process, "the trainer", timeout)
@@ -366,16 +375,16 @@ class TrainerTest(unittest.TestCase):
         deadline = time.time() + 20
         while "stroke_missed" not in trainer.errors() and time.time() < deadline:
             time.sleep(0.1)
-        self.assertIn("quiz 一 stroke 0: stroke_missed (misses 1 on the stroke, 1 in all, backwards)",
+        self.assertIn("quiz 一 stroke 1: stroke_missed (misses 1 on the stroke, 1 in all, backwards)",
                       trainer.errors())
         time.sleep(0.8)
         self.write_with_the_mouse(window, forwards + [box.data_to_px((median[-1][0] + 15, median[-1][1]))],
                                   trainer=trainer)
         self.assertEqual(trainer.wait(), 0, trainer.errors())
         errors = trainer.errors()
-        self.assertIn("quiz 一 stroke 0: stroke_accepted (misses 0 on the stroke, 1 in all)", errors)
-        self.assertIn("quiz 一 complete, 1 misses", errors)
-        self.assertIn("live verdicts are the saved record's", errors)
+        self.assertIn("quiz 一 stroke 1: stroke_accepted (misses 0 on the stroke, 1 in all)", errors)
+        self.assertIn("quiz 一 complete, 1 miss\n", errors)
+        self.assertIn("quiz: 2 live verdicts, the same as in the saved record", errors)
 
         (record_path,) = saved_trials(pathlib.Path(self.folder) / "out")
         record = json.loads(record_path.read_text(encoding="utf-8"))
@@ -387,10 +396,11 @@ class TrainerTest(unittest.TestCase):
         events = quiz["characters"][0]["events"]
         self.assertEqual([e["kind"] for e in events], ["stroke_missed", "hint", "stroke_accepted", "character_completed"])
         self.assertTrue(events[0]["backwards"])
-        # The stderr lines the window printed as each verdict came are the saved record's events.
+        # The stderr lines the window printed as each verdict came are the saved record's events (strokes
+        # numbered from 1 on stderr, from 0 in the record).
         logged = [l.split("quiz 一 ", 1)[1] for l in errors.splitlines() if "quiz 一 stroke" in l]
         expected = ["stroke %d: %s (misses %d on the stroke, %d in all%s)"
-                    % (e["stroke"], e["kind"], e["misses_on_stroke"], e["total_misses"],
+                    % (e["stroke"] + 1, e["kind"], e["misses_on_stroke"], e["total_misses"],
                        ", backwards" if e["backwards"] else
                        "" if e["refusal"] == "none" else ", " + e["refusal"]) for e in events]
         self.assertEqual(events[0]["refusal"], "backwards")
@@ -639,6 +649,73 @@ TINY_PROTOCOL = {
 }
 
 
+SPDLOG_LINE = r"^\[\d{4}-\d\d-\d\d |\[calligraphy\] \[(trace|debug|info|warning|error|critical)\]"
+
+
+class PeopleOutputTest(unittest.TestCase):
+    """What a person reads from `train` (docs/cli.md, "train"): standard output carries no box line and no log
+    line of the library; a trial stopped early is summarised truthfully (no "nan"), saying what was kept; the
+    quiz's sentences are true for no verdict as for one and many."""
+
+    def setUp(self):
+        self.folder = tempfile.mkdtemp(prefix="calligraphy-people-")
+        self.trainer = None
+
+    def tearDown(self):
+        if self.trainer is not None:
+            self.trainer.close()
+        shutil.rmtree(self.folder, ignore_errors=True)
+
+    def run_train(self, *args):
+        """`train ARGS` to its end, as a person runs it: without asking for the box lines."""
+        self.trainer = Trainer(*args, folder=self.folder, environment=dict(os.environ))
+        status = self.trainer.wait(timeout=60)
+        return status, self.trainer.output(), self.trainer.errors()
+
+    def assert_for_people(self, out, err):
+        for line in (out + err).splitlines():
+            self.assertNotRegex(line, SPDLOG_LINE, "a log line in the library's own format")
+            self.assertFalse(line.startswith("box "), "a box line without CALLIGRAPHY_PRINT_BOXES: " + line)
+            self.assertNotRegex(line, r"\bnan\b", line)
+        self.assertEqual(out, "", "train prints nothing on standard output")
+
+    def test_a_trial_stopped_by_exit_after_says_what_it_wrote_and_kept(self):
+        status, out, err = self.run_train("永", "--writer", "simulated", "--session", "out", "--exit-after", "4")
+        self.assertEqual(status, 0, err)
+        self.assert_for_people(out, err)
+        (line,) = [l for l in err.splitlines() if l.startswith("calligraphy train: trial 1 永: ")]
+        self.assertIn("interrupted", line)
+        self.assertIn("--exit-after", line)
+        self.assertRegex(line, r"\b[0-5] of 5 strokes\b")
+        (attempt,) = kept_attempts(pathlib.Path(self.folder) / "out")
+        self.assertIn("kept as an attempt", line)
+        self.assertIn(attempt.name, line)
+
+    def test_a_trial_stopped_before_any_stroke_says_nothing_was_written(self):
+        status, out, err = self.run_train("一", "--device", "mouse", "--data", SAMPLE, "--exit-after", "1.5")
+        self.assertEqual(status, 0, err)
+        self.assert_for_people(out, err)
+        (line,) = [l for l in err.splitlines() if l.startswith("calligraphy train: trial 1 一: ")]
+        self.assertIn("no stroke written", line)
+        self.assertNotIn("mm", line)  # no deviation of strokes never written
+        self.assertIn("not saved", line)
+
+    def test_a_quiz_stopped_before_any_stroke_claims_no_verdict(self):
+        status, out, err = self.run_train("一", "--device", "mouse", "--data", SAMPLE, "--quiz", "--session", "out",
+                                          "--exit-after", "1.5")
+        self.assertEqual(status, 0, err)
+        self.assert_for_people(out, err)
+        self.assertNotRegex(err, r"\b0 live verdicts?\b")
+        self.assertNotRegex(err, r"\b1 (live verdicts|misses)\b")
+        self.assertIn("no stroke was judged", err)
+
+    def test_the_box_lines_go_to_stderr_when_asked_for(self):
+        self.trainer = Trainer("一", "--device", "mouse", "--data", SAMPLE, "--exit-after", "1", folder=self.folder)
+        self.assertEqual(self.trainer.wait(timeout=60), 0, self.trainer.errors())
+        self.assertEqual(self.trainer.output(), "")
+        self.assertEqual(len([l for l in self.trainer.errors().splitlines() if l.startswith("box 0 一 ")]), 1)
+
+
 class SessionWindowTest(unittest.TestCase):
     """`calligraphy session run` with a device a person moves runs the session in the trainer window."""
 
@@ -660,7 +737,8 @@ class SessionWindowTest(unittest.TestCase):
     def run_session(self, *extra):
         self.process = subprocess.Popen(
             [CLI, "session", "run", "tiny.json", "--subject", "S01", "--device", "mouse-hand", "--writer", "person",
-             "--out", "out", "--data", SAMPLE, *extra], stdout=self.stdout, stderr=self.stderr, cwd=self.folder)
+             "--out", "out", "--data", SAMPLE, *extra], stdout=self.stdout, stderr=self.stderr, cwd=self.folder,
+            env=boxes_environment())
 
     def errors(self):
         return (self.folder / "stderr.txt").read_text()
@@ -697,6 +775,10 @@ class SessionWindowTest(unittest.TestCase):
         self.assertFalse(first["force_law"]["guidance"])
         self.assertEqual((second["condition"], second["end_reason"]), ("haptic", "time_limit"))
         self.assertTrue(second["force_law"]["guidance"])
+        # The second trial wrote nothing: its line says so, with no deviation ("nan") of strokes never written.
+        (line,) = [l for l in self.errors().splitlines() if l.startswith("calligraphy session: trial 2/2 ")]
+        self.assertIn("no stroke written", line)
+        self.assertNotRegex(self.errors(), r"\bnan\b")
         for record in (first, second):
             self.assertEqual(record["device"]["name"], "mouse-hand")
             self.assertEqual(record["writer"]["kind"], "human")
@@ -798,7 +880,7 @@ class EndingTest(unittest.TestCase):
 
     def start(self, command, environment=None):
         self.process = subprocess.Popen([CLI, *command], stdout=self.stdout, stderr=self.stderr, cwd=self.folder,
-                                        env=environment)
+                                        env=boxes_environment(environment))
 
     def first_box(self, timeout=30):
         return box_lines(self.folder, self.process, "the program", timeout)[0]
@@ -906,6 +988,8 @@ class EndingTest(unittest.TestCase):
 # CTest runs the tests in these groups (tests/CMakeLists.txt), so that no one CTest test runs for minutes.
 # A test is in the first group whose pattern its id contains; a test in no group fails the run.
 GROUPS = {
+    # What a person reads; first, so that its quiz case is not taken by "quiz" below.
+    "people": ("PeopleOutputTest",),
     "writing": ("test_simulated_writer", "test_the_real_pointer", "test_guidance_pulls", "test_a_refused_stroke"),
     # A person's hand on each pointer device, its own group each (about 30 s): the first match wins, so the
     # longer name comes first.

@@ -18,12 +18,16 @@ struct ScoreDescription {
   std::size_t samples = 0;  ///< samples in the trace
 };
 
-/// Per character, one row per reference stroke (type, written or not, backwards, mean and max deviation,
-/// Frechet and DTW [mm], writing time [s]) and its totals: strokes written, strokes accepted in turn and
-/// refusals by reason (the renderer's verdicts), order errors, backwards strokes, pen lifts, deviation,
-/// Frechet, DTW [mm], writing, in-air and total time [s], mean speed [m/s], velocity peaks and normalised
-/// jerk; then, for several characters, the scene's totals. Strokes are numbered from 0. Values that do not
-/// exist (no stroke matched) print as "-".
+/// A table for people. Per character, one row per reference stroke, numbered from 1 (the JSON counts from 0):
+/// type, the mean and max deviation, Frechet and DTW [mm] and writing time [s] of the segment matched to it,
+/// and one verdict from the renderer's verdicts in writing order: "accepted" (in turn), "refused: REASON"
+/// with how far the refused pen-down was from the stroke due ("refused: wrong place (4.0 mm off)"; a wrong
+/// order or a wrong stroke is the verdict of the stroke the pen wrote), or "not written". Then its totals:
+/// strokes accepted, refused (by reason) and not written, which add up to the strokes; pen-downs refused by
+/// reason (the JSON's `refusals`), unmatched and too short; the strokes matched, and the deviation, Frechet,
+/// DTW [mm], writing, in-air and total time [s], mean speed [m/s], velocity peaks and normalised jerk they
+/// pool; then, for several characters, the scene's totals. Values that do not exist (no stroke matched)
+/// print as "-".
 std::string score_table(const ScoreDescription& description, const WritingMetrics& metrics);
 
 /// The one metrics record (writing_metrics.hpp) as a JSON object (2-space indent, newline-terminated), the
