@@ -16,6 +16,7 @@
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/report/teacher_recording.hpp"
+#include "calligraphy/report/trace_columns.hpp"
 #include "calligraphy/report/trace_hdf5.hpp"
 #include "calligraphy/study/cohort.hpp"
 #include "calligraphy/study/curriculum.hpp"
@@ -51,6 +52,24 @@ py::array_t<T> column_array(const std::vector<T>& values) {
 }  // namespace
 
 void bind_report(py::module_& m) {
+  m.def(
+      "trace_columns",
+      [] {
+        py::list out;
+        for (const TraceColumnInfo& column : trace_columns()) {
+          py::dict row;
+          row["name"] = std::string(column.name);
+          row["file_name"] = std::string(column.file_name);
+          row["unit"] = std::string(column.unit);
+          row["doc"] = std::string(column.doc);
+          out.append(row);
+        }
+        return out;
+      },
+      R"(The one table of a pen trace's columns (include/calligraphy/report/trace_columns.hpp), in the CSV's
+order: a list of dicts with ``name`` (its SI unit in it, as the library's DataFrames name it: "t_s", "x_m"),
+``file_name`` (the CSV header's and the HDF5 trace's: "t", "x"), ``unit`` ("s", "m", "N" or "") and ``doc``.
+``score`` reads a column by either name.)");
   m.def(
       "_read_trace_columns",
       [](const std::filesystem::path& path, std::uintmax_t max_file_bytes) {

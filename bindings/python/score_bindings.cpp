@@ -1,9 +1,11 @@
 // score: a pen trace from any source (a CSV file, or columns from numpy or pandas) scored against a
-// character, as `calligraphy score` does (analysis/score.hpp, report/score_report.hpp), with the same JSON keys.
+// character, as `calligraphy score` does (analysis/score.hpp, report/score_report.hpp), with the same JSON
+// keys.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -12,14 +14,15 @@
 
 #include "arguments.hpp"
 #include "bindings.hpp"
-#include "calligraphy/model/stroke_progress.hpp"
+#include "calligraphy/analysis/writing_metrics.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/scene.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/report/pen_trace_csv.hpp"
 #include "calligraphy/report/score_report.hpp"
-#include "calligraphy/analysis/writing_metrics.hpp"
+#include "calligraphy/report/trace_columns.hpp"
 #include "character_source.hpp"
-#include "calligraphy/core/unicode.hpp"
 
 namespace calligraphy::python {
 namespace {
@@ -44,21 +47,47 @@ bool has_column(const py::object& columns, const char* key) {
   return py::bool_(columns.attr("__contains__")(py::str(key)));
 }
 
-// The samples of a mapping with columns t, x, y and pen (1/0) or z [m] (pen_trace_csv.hpp's columns).
+// The key under which `columns` holds the trace column whose file name is `file_name` ("t"): its name with
+// its unit ("t_s", as the library's DataFrames name it: trace_columns.hpp) or its file name; "time_s", the
+// name TrialResult.to_dataframe gave the time before, is read for one more version with a note. Empty when
+// none is there.
+std::string column_key(const py::object& columns, const char* file_name) {
+  const std::optional<TraceColumnInfo> info = trace_column(file_name);
+  if (info && has_column(columns, std::string(info->name).c_str())) return std::string(info->name);
+  if (has_column(columns, file_name)) return file_name;
+  if (std::string_view(file_name) == "t" && has_column(columns, "time_s")) {
+    if (PyErr_WarnEx(PyExc_DeprecationWarning,
+                     "trace: column 'time_s' is named 't_s' now (read for one more version)", 1) != 0)
+      throw py::error_already_set();
+    return "time_s";
+  }
+  return {};
+}
+
+// The samples of a mapping with columns t, x, y and pen (1/0) or z [m] (pen_trace_csv.hpp's columns), each by
+// its file name or its name with its unit (t_s, x_m, y_m, z_m).
 std::vector<PenSample> samples_from_columns(const py::object& columns, TraceUnits units,
                                             const Placement& placement, double contact_threshold_m) {
   if (!py::hasattr(columns, "__getitem__") || !py::hasattr(columns, "__contains__")) {
     throw py::type_error(
         "trace: expected a CSV file's path or a mapping of columns (a dict of arrays, a "
-        "pandas DataFrame) with t, x, y and pen or z");
+        "pandas DataFrame) with t, x, y and pen or z (or t_s, x_m, y_m, z_m)");
   }
-  for (const char* key : {"t", "x", "y"}) {
-    if (!has_column(columns, key)) throw InvalidArgument(std::string("trace: no column '") + key + "'");
+  std::string keys[3];
+  for (int i = 0; i < 3; ++i) {
+    const char* file_name = std::array{"t", "x", "y"}[static_cast<std::size_t>(i)];
+    keys[i] = column_key(columns, file_name);
+    if (keys[i].empty()) {
+      throw InvalidArgument(std::string("trace: no column '") + file_name + "' or '" +
+                            std::string(trace_column(file_name)->name) + "'");
+    }
   }
   const bool pen_column = has_column(columns, "pen");
-  if (!pen_column && !has_column(columns, "z")) throw InvalidArgument("trace: no column 'pen' or 'z'");
-  const Column t = column(columns, "t"), x = column(columns, "x"), y = column(columns, "y");
-  const Column contact = column(columns, pen_column ? "pen" : "z");
+  const std::string z_key = column_key(columns, "z");
+  if (!pen_column && z_key.empty()) throw InvalidArgument("trace: no column 'pen' or 'z' (or 'z_m')");
+  const Column t = column(columns, keys[0].c_str()), x = column(columns, keys[1].c_str()),
+               y = column(columns, keys[2].c_str());
+  const Column contact = column(columns, pen_column ? "pen" : z_key.c_str());
   const py::ssize_t n = t.shape(0);
   if (x.shape(0) != n || y.shape(0) != n || contact.shape(0) != n) {
     throw InvalidArgument("trace: the columns have different lengths");

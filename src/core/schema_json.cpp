@@ -151,9 +151,11 @@ void read_value(const SchemaField& field, const std::string& owner, void* object
     case FieldKind::object_list:
       expect(value.is_array(), "an array of objects");
       field.list_clear(object);
+      // An element of a list has no default to fall back on: each states every field.
       for (std::size_t i = 0; i < value.size(); ++i) {
         schema_detail::from_json(*field.nested(), field.list_append(object), value[i],
-                                 json_detail::child_pointer(pointer, i), source, options, result);
+                                 json_detail::child_pointer(pointer, i), source,
+                                 {.require_all = true, .version = options.version}, result);
       }
       return;
   }

@@ -10,9 +10,10 @@
 
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/model/typical_strokes.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/polyline.hpp"
+#include "calligraphy/model/typical_strokes.hpp"
+#include "calligraphy/report/trace_columns.hpp"
 #include "report/trial_outcome.hpp"
 
 namespace calligraphy {
@@ -232,7 +233,12 @@ char* fixed(char* out, char* end, double value, int decimals) {
 }  // namespace
 
 std::string trial_csv(const std::vector<TrialSample>& trace) {
-  std::string csv = "t,x,y,z,fx,fy,fz,state,stroke,element,attempt,rewritten\n";
+  std::string csv;
+  for (const TraceColumnInfo& column : trace_columns()) {  // the one table's file names, in its order
+    csv += csv.empty() ? "" : ",";
+    csv += column.file_name;
+  }
+  csv += '\n';
   csv.reserve(csv.size() + trace.size() * 64);
   char line[512];
   for (const TrialSample& s : trace) {

@@ -92,6 +92,9 @@ const Schema& SchemaOf<WriterProfile>::get() {
   static const std::vector<SchemaField> fields = [] {
     std::vector<SchemaField> out{string_field<&WriterProfile::name>("name", {.doc = "the profile's name"})};
     for (const SchemaField& field : table_fields<WriterProfile>()) out.push_back(field);
+    // The one whole number of the profile, outside its table of numbers (writer_profile.hpp).
+    out.push_back(integer_field<&WriterProfile::max_attempts_per_stroke>(
+        "max_attempts_per_stroke", 1, 1000, {.doc = "attempts at one stroke before the writer gives up"}));
     return out;
   }();
   static const Schema schema{.name = "WriterProfile",

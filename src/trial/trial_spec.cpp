@@ -63,17 +63,16 @@ const std::vector<SchemaField>& spec_fields() {
                "it at --timing-speed",
            .option = "--guidance-mode"}),
       // Version 3 of a trial record (calligraphy/study/recorded_trial.hpp) is the first to state it.
-      since(
-          3,
-          number_field<&TrialSpec::guidance_stiffness_n_per_m>(
-              "guidance_stiffness_n_per_m", law_range(&ForceLawParameters::guidance_stiffness_n_per_m),
-              {.unit = "N/m",
-               .doc =
-                   "K_et, the guidance stiffness per unit attraction factor; at its default it is capped at "
-                   "the device's stable maximum",
-               .option = "--guidance-stiffness",
-               .option_value_name = "N/M",
-               .source = "Wang, Zhang & Yao 2006, eq. (8)"})),
+      since(3,
+            number_field<&TrialSpec::guidance_stiffness_n_per_m>(
+                "guidance_stiffness_n_per_m", law_range(&ForceLawParameters::guidance_stiffness_n_per_m),
+                {.unit = "N/m",
+                 .doc =
+                     "K_et, the guidance stiffness per unit attraction factor; when not given, capped at the "
+                     "device's stable maximum",
+                 .option = "--guidance-stiffness",
+                 .option_value_name = "N/M",
+                 .source = "Wang, Zhang & Yao 2006, eq. (8)"})),
       number_field<&TrialSpec::guidance_gain>(
           "guidance_gain", law_range(&FadingGuidance::gain),
           {.doc = "fading: the guidance's gain", .option = "--guidance-gain", .option_value_name = "G"}),

@@ -18,10 +18,10 @@ def result():
 
 def test_one_row_per_tick_with_units_in_the_column_names(result):
     frame = result.to_dataframe()
-    assert list(frame.columns) == ["time_s", "x_m", "y_m", "z_m", "fx_n", "fy_n", "fz_n", "state", "stroke",
+    assert list(frame.columns) == ["t_s", "x_m", "y_m", "z_m", "fx_n", "fy_n", "fz_n", "state", "stroke",
                                    "element"]
     assert len(frame) == result.time_s.size
-    np.testing.assert_array_equal(frame["time_s"], result.time_s)
+    np.testing.assert_array_equal(frame["t_s"], result.time_s)
     np.testing.assert_array_equal(frame[["x_m", "y_m", "z_m"]].to_numpy(), result.position_m)
     np.testing.assert_array_equal(frame[["fx_n", "fy_n", "fz_n"]].to_numpy(), result.force_n)
     np.testing.assert_array_equal(frame["stroke"], result.stroke)
@@ -70,3 +70,18 @@ def test_import_does_not_load_pandas_or_matplotlib_and_says_what_is_missing():
     )
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert "pandas" in run.stdout and "python3-pandas" in run.stdout
+
+
+def test_the_librarys_own_frames_are_scored(tmp_path):
+    """A trial's DataFrame names its columns as the one trace column table does, and score reads it as it is,
+    and by the files' names, alike; the old time column's name is read for one more version with a note."""
+    trial = calligraphy.simulate_trial("十", seed=4)
+    frame = trial.to_dataframe()
+    table = calligraphy.trace_columns()
+    assert [c["name"] for c in table][:10] == list(frame.columns)
+    from_frame = calligraphy.score(frame, "十")
+    by_file_names = {c["file_name"]: frame[c["name"]].to_numpy() for c in table[:4]}
+    assert calligraphy.score(by_file_names, "十") == from_frame
+    assert from_frame["strokes_accepted"] == trial.metrics["strokes_accepted"] == 2
+    with pytest.warns(DeprecationWarning, match="t_s"):
+        assert calligraphy.score(frame.rename(columns={"t_s": "time_s"}), "十") == from_frame

@@ -38,7 +38,8 @@ def _pandas():
 def trial_dataframe(result: TrialResult) -> pandas.DataFrame:
     """One row per servo tick of ``result`` (empty when the trial ran with ``keep_trace=False``).
 
-    Columns, SI units in their names: ``time_s`` [s]; ``x_m``, ``y_m``, ``z_m``, the pen tip as read
+    Columns, SI units in their names, as ``calligraphy.trace_columns()`` names them and ``Study.samples()``
+    does (``calligraphy.score`` takes this frame as it is): ``t_s`` [s]; ``x_m``, ``y_m``, ``z_m``, the pen tip as read
     from the device [m]; ``fx_n``, ``fy_n``, ``fz_n``, the commanded force [N]; ``state``, the
     interaction state as a categorical of 'SS', 'AS', 'CS', 'WS' (paper Table 1); ``stroke``, the active
     stroke over the scene (0-based, as ``result.scene.strokes``); ``element``, the active element
@@ -50,7 +51,7 @@ def trial_dataframe(result: TrialResult) -> pandas.DataFrame:
     state = pandas.Categorical.from_codes(np.asarray(result.state, dtype=np.int8), categories=_state_names())
     return pandas.DataFrame(
         {
-            "time_s": np.asarray(result.time_s),
+            "t_s": np.asarray(result.time_s),
             "x_m": position[:, 0],
             "y_m": position[:, 1],
             "z_m": position[:, 2],

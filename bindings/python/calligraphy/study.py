@@ -44,13 +44,15 @@ _NUMERIC_STROKE_COLUMNS = (
 _CATEGORIES = ("subject", "session", "protocol", "group", "phase", "condition", "mode", "item_set", "sequence",
                "trained_condition", "writer", "writer_profile", "writer_learning", "end_reason")
 # The trace CSV's columns (calligraphy trial --csv) with their SI units named.
-_SAMPLE_COLUMNS = {"t": "t_s", "x": "x_m", "y": "y_m", "z": "z_m", "fx": "fx_n", "fy": "fy_n", "fz": "fz_n"}
+_trace_columns = _calligraphy.trace_columns
+# From the one table of a trace's columns (trace_columns(), include/calligraphy/report/trace_columns.hpp).
+_SAMPLE_COLUMNS = {c["file_name"]: c["name"] for c in _trace_columns() if c["file_name"] != c["name"]}
 
 
-_TRACE_HEADER = ["t", "x", "y", "z", "fx", "fy", "fz", "state", "stroke", "element"]
 # Traces saved since attempts were marked add the attempt at the stroke (1-based, 0 outside any) and whether
 # it was written again later (1: not the final writing); older traces lack both.
-_MARKED_TRACE_HEADER = _TRACE_HEADER + ["attempt", "rewritten"]
+_MARKED_TRACE_HEADER = [c["file_name"] for c in _trace_columns()]
+_TRACE_HEADER = _MARKED_TRACE_HEADER[:-2]
 _WHOLE_NUMBER_COLUMNS = ("stroke", "element", "attempt", "rewritten")
 
 

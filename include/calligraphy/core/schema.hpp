@@ -220,6 +220,7 @@ void set_field_from_text(const SchemaField& field, void* object, std::string_vie
 /// How `schema_from_json` treats a missing member.
 struct SchemaReadOptions {
   /// Every field is required (a record); false: a missing member keeps its default (a file a person wrote).
+  /// An element of a list always states every field.
   bool require_all = false;
   /// With require_all: the document's version; a field whose `since_version` is newer may be missing and
   /// takes its default (listed in `SchemaReadResult::defaulted`).
