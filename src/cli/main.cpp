@@ -7,6 +7,7 @@
 #include <exception>
 #include <string>
 
+#include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "cli/cli_devices.hpp"
 #include "cli/commands.hpp"
@@ -57,6 +58,9 @@ void add_bench_commands(CLI::App& root, Commands& commands) {
 
 int main(int argc, char** argv) {
   using namespace calligraphy::cli;
+  // Before any thread and any file: a file size limit, a closed pipe and a stop signal while a file is
+  // written each end as an error line or a signal with the temporary removed, never a silent death.
+  calligraphy::guard_output_files();
   CLI::App root("Haptic training of Chinese handwriting: guided trials, scoring, character models",
                 "calligraphy");
   configure_root(root);
