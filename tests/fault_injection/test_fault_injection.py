@@ -24,6 +24,7 @@ import hashlib
 import json
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -41,6 +42,7 @@ KINDS = ("open", "write", "fsync", "rename", "link", "mkdir", "unlink", "flock")
 ERRNOS = ("ENOSPC", "EIO", "EROFS", "ENOLCK")
 TIMEOUT_S = 120
 LEFTOVER_MARKS = (".tmp-", ".kept-", ".calligraphy-set-")
+SIGNALS = ("TERM", "INT", "HUP")  # the stop signals raised at a step (fault_shim.c, CALLIGRAPHY_FAULT_KILL)
 
 # The Python side: study_report's writer of its set of files (the library's AtomicFileSet), given a study
 # folder whose files it writes, scaled, into out/ (a report's page, tables and figures stand in).
@@ -147,9 +149,11 @@ class FaultInjection(unittest.TestCase):
         return subprocess.run([*program, *map(str, arguments[1:] if program[0] != CLI else arguments)], cwd=cwd,
                               capture_output=True, env=environment, timeout=TIMEOUT_S)
 
-    def sweep(self, arguments_for):
+    def sweep(self, arguments_for, signals=False, files=2):
         """Every fault at every step of `arguments_for(study)` writing over the output of the one-subject
-        study with the output of the two-subject study."""
+        study with the output of the two-subject study; with `signals`, also SIGTERM, SIGINT or SIGHUP (in
+        turn) raised at every step, after which the run has ended by that signal leaving the earlier or the
+        new set and nothing else: no temporary, second name or journal."""
         work = Path(self.scratch.name) / "work"
 
         def fresh():
@@ -173,8 +177,8 @@ class FaultInjection(unittest.TestCase):
                                {"CALLIGRAPHY_FAULT_COUNTS": str(counts_file)})
         self.assertEqual(counted.returncode, 0, counted.stderr.decode())
         counts = {kind: int(n) for kind, n in (line.split() for line in counts_file.read_text().splitlines())}
-        self.assertGreaterEqual(counts["rename"], 2, counts)  # the set's files are renamed into place
-        self.assertGreaterEqual(counts["fsync"], 2, counts)
+        self.assertGreaterEqual(counts["rename"], files, counts)  # the set's files are renamed into place
+        self.assertGreaterEqual(counts["fsync"], files, counts)
         tried = 0
         for kind, n, kill, fault in every_fault(counts):
             with self.subTest(kind=kind, n=n, errno=fault["CALLIGRAPHY_FAULT_ERRNO"], kill=kill):
@@ -199,6 +203,19 @@ class FaultInjection(unittest.TestCase):
                 self.assertEqual(snapshot(work / "out"), new)
                 self.assertEqual(leftovers(work / "out"), [])
             tried += 1
+        for kind in KINDS if signals else ():
+            for n in range(1, counts[kind] + 1):
+                name = SIGNALS[tried % len(SIGNALS)]
+                number = getattr(signal, "SIG" + name)
+                with self.subTest(kind=kind, n=n, signal=name):
+                    self.assertEqual(fresh(), earlier)
+                    result = self.run_cli(arguments_for(self.two_subjects / "study"), work,
+                                          {"CALLIGRAPHY_FAULT_CALL": kind, "CALLIGRAPHY_FAULT_AT": str(n),
+                                           "CALLIGRAPHY_FAULT_KILL": name})
+                    self.assertIn(result.returncode, (-number, 128 + number), result.stderr.decode())
+                    self.assertIn(snapshot(work / "out"), (earlier, new), "a mix of the earlier and the new set")
+                    self.assertEqual(leftovers(work / "out"), [], f"left behind by {name} at {kind} {n}")
+                tried += 1
         print(f"{' '.join(map(str, arguments_for(Path('STUDY'))))}: {tried} faults at every step "
               f"({', '.join(f'{kind} {counts[kind]}' for kind in KINDS)})", flush=True)
 
@@ -210,7 +227,16 @@ class FaultInjection(unittest.TestCase):
         self.sweep(lambda study: [PYTHON_WRITER, study])
 
     def test_report_tables_alone(self):
-        self.sweep(lambda study: ["report", study, "--csv", "out"])
+        self.sweep(lambda study: ["report", study, "--csv", "out"], signals=True)
+
+    def test_trace_output(self):
+        """`trace TRACE --csv out/trace.csv` replacing an earlier export: every fault and stop signal at every
+        step."""
+        def arguments_for(study):
+            traces = sorted(study.rglob("*.trace.h5"))
+            trace = (traces[0] if study == self.one_subject / "study" else traces[-1]) if traces else study
+            return ["trace", trace, "--csv", "out/trace.csv"]
+        self.sweep(arguments_for, signals=True, files=1)
 
     def saved_trials(self, out):
         """{record path: SHA-256 of the record, its trace and its drawing} of every trial saved in a whole
