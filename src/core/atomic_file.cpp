@@ -557,9 +557,18 @@ void complete_interrupted_sets(const std::set<fs::path>& folders) {
     }
     std::sort(journals.begin(), journals.end());
     for (const fs::path& journal : journals) {
-      for (const JournalEntry& entry : read_journal(journal, folder)) {
-        if (::access(entry.temporary.c_str(), F_OK) == 0)
-          ::rename(entry.temporary.c_str(), entry.target.c_str());
+      const std::vector<JournalEntry> entries = read_journal(journal, folder);
+      for (const JournalEntry& entry : entries) {
+        // A temporary already renamed is gone (ENOENT); any other failure keeps the journal, so that the set
+        // is completed by a later write rather than left half replaced with no record of it.
+        if (::rename(entry.temporary.c_str(), entry.target.c_str()) != 0 && errno != ENOENT) {
+          const int rename_error = errno;
+          std::string what("cannot complete the set it records (the journal is kept for the next write): ");
+          what.append(entry.target.string());
+          fail(journal, what, rename_error);
+        }
+      }
+      for (const JournalEntry& entry : entries) {
         if (!entry.kept.empty()) ::unlink(entry.kept.c_str());
       }
       ::unlink(journal.c_str());

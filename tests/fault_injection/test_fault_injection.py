@@ -238,6 +238,63 @@ class FaultInjection(unittest.TestCase):
             return ["trace", trace, "--csv", "out/trace.csv"]
         self.sweep(arguments_for, signals=True, files=1)
 
+    def test_journal_recovery(self):
+        """A `report --csv` killed between its two renames leaves a journal and a mix of the two sets; the next
+        run completes that set first. Every fault and kill at every step of that next run: a failed run exits 1
+        with one line, the visible files are the new set or the mix with its journal still there (never a mix
+        without one), and a clean run afterwards writes the new set and leaves nothing behind."""
+        work = Path(self.scratch.name) / "journal"
+        arguments = ["report", self.two_subjects / "study", "--csv", "out", "--jobs", "1"]
+
+        def killed_between_renames():
+            shutil.rmtree(work, ignore_errors=True)
+            (work / "out").mkdir(parents=True)
+            done = self.run_cli(["report", self.one_subject / "study", "--csv", "out", "--jobs", "1"], work)
+            self.assertEqual(done.returncode, 0, done.stderr.decode())
+            killed = self.run_cli(arguments, work, {"CALLIGRAPHY_FAULT_CALL": "rename", "CALLIGRAPHY_FAULT_AT": "2",
+                                                    "CALLIGRAPHY_FAULT_KILL": "1"})
+            self.assertEqual(killed.returncode, -9, killed.stderr.decode())
+            self.assertEqual(len([n for n in leftovers(work / "out") if ".calligraphy-set-" in n]), 1)
+            return snapshot(work / "out")
+
+        mix = killed_between_renames()
+        done = self.run_cli(arguments, work)
+        self.assertEqual(done.returncode, 0, done.stderr.decode())
+        new = snapshot(work / "out")
+        self.assertNotEqual(mix, new)
+        self.assertEqual(leftovers(work / "out"), [])
+        killed_between_renames()
+        counts_file = Path(self.scratch.name) / "journal-counts.txt"
+        counted = self.run_cli(arguments, work, {"CALLIGRAPHY_FAULT_COUNTS": str(counts_file)})
+        self.assertEqual(counted.returncode, 0, counted.stderr.decode())
+        counts = {kind: int(n) for kind, n in (line.split() for line in counts_file.read_text().splitlines())}
+        # The calls that change what the folder holds (the completion's renames and removals); the new set's own
+        # writes and syncs are swept by test_report_tables_alone.
+        swept = {kind: (n if kind in ("open", "rename", "link", "unlink") else 0) for kind, n in counts.items()}
+        tried = 0
+        for kind, n, kill, fault in every_fault(swept):
+            with self.subTest(kind=kind, n=n, errno=fault["CALLIGRAPHY_FAULT_ERRNO"], kill=kill):
+                self.assertEqual(killed_between_renames(), mix)
+                result = self.run_cli(arguments, work, fault)
+                stderr = result.stderr.decode(errors="replace")
+                after = snapshot(work / "out")
+                journals = [name for name in leftovers(work / "out") if ".calligraphy-set-" in name]
+                if kill:
+                    self.assertEqual(result.returncode, -9, stderr)
+                else:
+                    self.assertIn(result.returncode, (0, 1), stderr)
+                    self.assertNotIn("internal error", stderr)
+                    if result.returncode == 1:
+                        self.assertEqual(len(stderr.strip().splitlines()), 1, stderr)
+                self.assertTrue(after == new or journals, f"a mix of the sets and no journal: {sorted(after)}")
+                again = self.run_cli(arguments, work)
+                self.assertEqual(again.returncode, 0, again.stderr.decode())
+                self.assertEqual(snapshot(work / "out"), new)
+                self.assertEqual(leftovers(work / "out"), [])
+            tried += 1
+        print(f"report --csv completing a killed set's journal: {tried} faults at every step "
+              f"({', '.join(f'{kind} {counts[kind]}' for kind in KINDS)})", flush=True)
+
     def saved_trials(self, out):
         """{record path: SHA-256 of the record, its trace and its drawing} of every trial saved in a whole
         session folder under `out`; each record must read as JSON and each trace must be whole (its header's
