@@ -265,6 +265,22 @@ class OneWayOut(unittest.TestCase):
         self.assert_one_error(result, 1, "tables")
         self.assertEqual(sorted(os.listdir(tables)), [])
 
+    def test_study_report_onto_a_symbolic_link_to_session_json(self):
+        try:
+            import pandas  # noqa: F401  (the study report needs it)
+        except ImportError:
+            self.skipTest("the study report needs pandas (Debian: python3-pandas)")
+        study = self.cwd / "study"
+        shutil.copytree(self.session.parent.parent, study, symlinks=True)
+        (manifest,) = study.glob("S01/*/session.json")
+        (self.cwd / "report").mkdir()
+        os.symlink(manifest, self.cwd / "report" / "index.html")
+        before = digest(manifest)
+        result = subprocess.run([sys.executable, "-m", "calligraphy.study_report", "study", "--out", "report"],
+                                cwd=self.cwd, capture_output=True, timeout=TIMEOUT_S)
+        self.assert_one_error(result, 2, "index.html", "session.json")
+        self.assertEqual(digest(manifest), before)
+
     # --- the journal of a set (report --csv, study_report) ---------------------------------------------------
 
     def killed_between_renames(self, tables):
