@@ -10,7 +10,10 @@ run by CTest as `cli_one_way_out_tests`: hostile cases written from the document
   command exits 1 with one line naming the file, leaves no temporary and keeps the earlier file.
 - Cut: standard output closed by its reader (`calligraphy trace T | head -1`, SIGPIPE at its default) is one
   error line and exit 1, not a silent death by SIGPIPE.
-- Race: two runs writing one output at once leave one whole file and no temporary.
+- Race: runs writing one output (or one pair of tables) at once leave whole files and no temporary.
+- The journal of a set killed between its renames (Release builds, with the fault shim): copied with its folder,
+  it completes the copy only; planted in another folder, it changes nothing outside that folder, for `report
+  --csv` and for the Python report's writer. And the Python study report onto a link to a session's file.
 
 CALLIGRAPHY_CLI names the program and CALLIGRAPHY_SOURCE_DIR the source tree. Standard library only.
 """
@@ -257,6 +260,17 @@ class OneWayOut(unittest.TestCase):
         result = self.run_cli("report", "study", "--csv", "tables")
         self.assert_one_error(result, 2, "strokes.csv", "session.json")
         self.assertEqual(digest(manifest), before)
+
+    def test_reports_racing_onto_one_tables_folder(self):
+        tables = self.cwd / "tables"
+        tables.mkdir()
+        study = str(self.session.parent.parent)
+        runs = [subprocess.Popen([CLI, "report", study, "--csv", str(tables)], stdout=subprocess.DEVNULL,
+                                 stderr=subprocess.PIPE) for _ in range(4)]
+        for run in runs:
+            _, stderr = run.communicate(timeout=TIMEOUT_S)
+            self.assertEqual(run.returncode, 0, stderr.decode())
+        self.assertEqual(sorted(os.listdir(tables)), ["strokes.csv", "trials.csv"])
 
     def test_report_tables_under_a_file_size_limit(self):
         tables = self.cwd / "tables"
