@@ -694,15 +694,15 @@ void guard_output_files() noexcept {
   sigemptyset(&ignore.sa_mask);
   sigaction(SIGXFSZ, &ignore, nullptr);
   sigaction(SIGPIPE, &ignore, nullptr);
-  struct sigaction remove {};
-  remove.sa_handler = remove_temporaries_then_die;
-  sigemptyset(&remove.sa_mask);
-  for (const int signal : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&remove.sa_mask, signal);
-  remove.sa_flags = SA_RESTART;
+  struct sigaction cleanup {};
+  cleanup.sa_handler = remove_temporaries_then_die;
+  sigemptyset(&cleanup.sa_mask);
+  for (const int signal : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&cleanup.sa_mask, signal);
+  cleanup.sa_flags = SA_RESTART;
   for (const int signal : {SIGINT, SIGTERM, SIGHUP}) {
     struct sigaction current {};
     if (sigaction(signal, nullptr, &current) == 0 && current.sa_handler == SIG_DFL) {
-      sigaction(signal, &remove, nullptr);
+      sigaction(signal, &cleanup, nullptr);
     }
   }
 }
