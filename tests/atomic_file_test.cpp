@@ -111,7 +111,8 @@ TEST_CASE("read_file_for_update reads regular files only, within a bound", "[ato
   CHECK_THROWS_WITH(read_file_for_update(document, 4), Catch::Contains(document.string()));
 }
 
-TEST_CASE("write_files_atomically replaces a set together, or leaves the earlier set whole", "[atomic_file]") {
+TEST_CASE("write_files_atomically replaces a set together, or leaves the earlier set whole",
+          "[atomic_file]") {
   TemporaryFolder folder;
   const fs::path trials = folder.path / "trials.csv";
   const fs::path strokes = folder.path / "strokes.csv";
@@ -148,7 +149,8 @@ TEST_CASE("write_files_atomically replaces a set together, or leaves the earlier
   }
 }
 
-TEST_CASE("write_files_atomically replaces a set only while no other writer holds its folder", "[atomic_file]") {
+TEST_CASE("write_files_atomically replaces a set only while no other writer holds its folder",
+          "[atomic_file]") {
   // Another writer in the middle of its renames holds the folder's lock: this set waits, so the two sets
   // are never interleaved file by file.
   TemporaryFolder folder;
@@ -182,7 +184,7 @@ namespace {
 // "TARGET\tKEPT\tTEMPORARY" per file, and the FNV-1a checksum of what precedes it. What a forger who read
 // the format would write.
 std::string journal_text(const std::vector<std::string>& lines, bool good_checksum = true) {
-  std::string text = "calligraphy-set-journal 2\n";
+  std::string text = "calligraphy-set-journal 3\n";
   for (const std::string& line : lines) text.append(line).append("\n");
   std::uint64_t hash = 14695981039346656037ULL;
   for (const char c : text) {
@@ -282,4 +284,49 @@ TEST_CASE("a journal that is not the writer's own is refused, named, and left as
   CHECK_FALSE(fs::exists(tables / "trials.csv"));
   CHECK(names_in(tables) ==
         std::vector<std::string>{journal.filename().string(), temporary, "link", "victim-link.csv"});
+}
+
+TEST_CASE("a set over several folders keeps a journal in each, and a killed one completes folder by folder",
+          "[atomic_file]") {
+  TemporaryFolder folder;
+  const fs::path tables = folder.path / "tables";
+  const fs::path figures = folder.path / "figures";
+  fs::create_directory(tables);
+  fs::create_directory(figures);
+  SECTION("a set over two sibling folders leaves no journal, temporary or second name in either") {
+    plant(tables / "trials.csv", "old trials\n");
+    const FileContent files[] = {{tables / "trials.csv", "new trials\n"}, {figures / "plot.svg", "<svg/>\n"}};
+    write_files_atomically(files);
+    CHECK(names_in(tables) == std::vector<std::string>{"trials.csv"});
+    CHECK(names_in(figures) == std::vector<std::string>{"plot.svg"});
+    CHECK(names_in(folder.path) == std::vector<std::string>{"figures", "tables"});
+  }
+  SECTION("killed between the folders: each folder's journal is completed by the next set in that folder") {
+    // figures/ was replaced and its journal removed; tables/ holds its own journal, a whole temporary and a
+    // file not yet replaced (as a writer killed after its first folder and a rename of the next leaves them).
+    plant(figures / "plot.svg", "new plot\n");
+    killed_between_renames(tables);
+    const FileContent in_figures[] = {{figures / "other.svg", "x\n"}};
+    write_files_atomically(in_figures);  // another folder: tables/ stays as it was, journal and all
+    CHECK(contents(tables / "strokes.csv") == "old strokes\n");
+    CHECK(fs::exists(tables / ".calligraphy-set-4999999-1.journal"));
+    const FileContent in_tables[] = {{tables / "other.csv", "y\n"}};
+    write_files_atomically(in_tables);
+    CHECK(contents(tables / "trials.csv") == "new trials\n");
+    CHECK(contents(tables / "strokes.csv") == "new strokes\n");
+    CHECK(names_in(tables) == std::vector<std::string>{"other.csv", "strokes.csv", "trials.csv"});
+    CHECK(contents(figures / "plot.svg") == "new plot\n");
+  }
+  SECTION("a journal naming a file in a subfolder is refused, even one below its own folder") {
+    const fs::path sub = tables / "sub";
+    fs::create_directory(sub);
+    plant(sub / "victim.csv", "precious\n");
+    plant(sub / (std::string(".victim.csv.tmp-") + kDead), "forged\n");
+    const std::string forged = journal_text({std::string("sub/victim.csv\t\t.victim.csv.tmp-") + kDead});
+    plant(tables / ".calligraphy-set-4999999-1.journal", forged);
+    const FileContent next[] = {{tables / "trials.csv", "new trials\n"}};
+    CHECK_THROWS_WITH(write_files_atomically(next), Catch::Contains("refused"));
+    CHECK(contents(sub / "victim.csv") == "precious\n");
+    CHECK(contents(tables / ".calligraphy-set-4999999-1.journal") == forged);
+  }
 }

@@ -17,7 +17,6 @@
 #include <memory>
 #include <mutex>
 #include <optional>
-#include <set>
 #include <string>
 #include <system_error>
 #include <utility>
@@ -225,39 +224,24 @@ fs::path resolved_folder(const fs::path& folder) {
   return error ? fs::absolute(folder).lexically_normal() : resolved;
 }
 
-// True when `path` is `folder` or below it (both resolved).
-bool within(const fs::path& path, const fs::path& folder) {
-  const fs::path relative = path.lexically_relative(folder);
-  return !relative.empty() && *relative.begin() != "..";
-}
+// The folders of a set, each (resolved) with the indices of its targets in the order they were added, in the
+// sorted order of the folders: a set is committed folder by folder, each folder under its own journal.
+struct SetFolder {
+  fs::path folder;
+  std::vector<std::size_t> files;
+};
 
-// The folder a set's journal lives in: the deepest folder that holds every target's (resolved) folder, so
-// that the journal names each target below itself.
-fs::path journal_folder_of(const std::vector<fs::path>& targets) {
-  std::optional<fs::path> common;
-  for (const fs::path& target : targets) {
-    const fs::path folder = resolved_folder(folder_of(target));
-    if (!common) {
-      common = folder;
-      continue;
-    }
-    fs::path shared;
-    for (auto a = common->begin(), b = folder.begin(); a != common->end() && b != folder.end() && *a == *b;
-         ++a, ++b)
-      shared /= *a;
-    common = shared;
+std::vector<SetFolder> folders_of_set(const std::vector<fs::path>& targets) {
+  std::vector<SetFolder> folders;
+  for (std::size_t i = 0; i < targets.size(); ++i) {
+    const fs::path folder = resolved_folder(folder_of(targets[i]));
+    auto found =
+        std::find_if(folders.begin(), folders.end(), [&](const SetFolder& f) { return f.folder == folder; });
+    if (found == folders.end()) found = folders.insert(folders.end(), SetFolder{folder, {}});
+    found->files.push_back(i);
   }
-  return common ? *common : resolved_folder(".");
-}
-
-// The folders a set touches: each target's folder and every folder between it and the journal's.
-std::set<fs::path> folders_of_set(const std::vector<fs::path>& targets, const fs::path& journal_folder) {
-  std::set<fs::path> folders{journal_folder};
-  for (const fs::path& target : targets) {
-    for (fs::path folder = resolved_folder(folder_of(target));
-         folder != journal_folder && within(folder, journal_folder); folder = folder.parent_path())
-      folders.insert(folder);
-  }
+  std::sort(folders.begin(), folders.end(),
+            [](const SetFolder& a, const SetFolder& b) { return a.folder < b.folder; });
   return folders;
 }
 
@@ -265,9 +249,9 @@ std::set<fs::path> folders_of_set(const std::vector<fs::path>& targets, const fs
 // A folder that cannot be opened or locked is left unlocked: the renames go on as before.
 class FolderLocks {
  public:
-  explicit FolderLocks(const std::set<fs::path>& folders) {
-    for (const fs::path& folder : folders) {
-      const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  explicit FolderLocks(const std::vector<SetFolder>& folders) {
+    for (const SetFolder& set_folder : folders) {
+      const int fd = ::open(set_folder.folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
       if (fd < 0) continue;
       while (::flock(fd, LOCK_EX) != 0 && errno == EINTR) {
       }
@@ -284,26 +268,27 @@ class FolderLocks {
   std::vector<int> fds_;
 };
 
-// The journal of a set being replaced, `.calligraphy-set-PID-N.journal` in the deepest folder holding every
-// target (journal_folder_of):
+// The journal of a set's files in one folder, `.calligraphy-set-PID-N.journal` in that folder (a set whose
+// targets are in several folders has one journal in each, and needs no other folder):
 //
-//   calligraphy-set-journal 2
-//   TARGET<tab>KEPT<tab>TEMPORARY      one line per file
+//   calligraphy-set-journal 3
+//   TARGET<tab>KEPT<tab>TEMPORARY      one line per file of the set in this folder
 //   checksum HHHHHHHHHHHHHHHH           FNV-1a (64 bits) of every byte before this line, in hex
 //
-// TARGET is the target's path relative to the journal's folder (no "..", no "." and no empty component,
-// never absolute); KEPT (the earlier file's second name, empty for a new file) and TEMPORARY are file names
-// in the target's folder, of the forms this writer gives them (".NAME.kept-...", ".NAME.tmp-..."). The
-// journal is written whole under a temporary name, synced and renamed into place before the first rename of
-// the set, and removed after the last, so that a writer killed between two renames leaves a record of what
-// was under way; the next writer of a set in that folder, under the same folder locks, completes it from the
-// temporaries, which were whole and synced before the journal was written. Because every name is relative,
-// a journal copied with its folder completes the copy only; a journal that is not this writer's (another
-// tag or version, a checksum that differs, a name that is absolute, climbs out with "..", or reaches outside
-// the folder through a symbolic link) is refused and left as it is.
+// TARGET, KEPT (the earlier file's second name, empty for a new file) and TEMPORARY are file names in the
+// journal's own folder: no "/", never "." or ".."; KEPT and TEMPORARY of the forms this writer gives them
+// (".NAME.kept-...", ".NAME.tmp-..."). Every journal of a set is written whole under a temporary name, synced
+// and renamed into place before the set's first rename; the set is then replaced folder by folder, and each
+// folder's journal is removed once that folder's renames are done. So a writer killed part way leaves each
+// folder of the set either replaced, or holding a journal of what was under way there; the next writer of a
+// set in that folder, under the same folder lock, completes it from the temporaries, which were whole and
+// synced before any journal was written. Because every name is a name in the journal's folder, a journal
+// copied with its folder completes the copy only; a journal that is not this writer's (another tag or
+// version, a checksum that differs, a name with a "/" or that is "." or "..", a file it names that is a
+// symbolic link or not a regular file) is refused and left as it is.
 constexpr const char* kJournalPrefix = ".calligraphy-set-";
 constexpr const char* kJournalSuffix = ".journal";
-constexpr std::string_view kJournalHeader = "calligraphy-set-journal 2\n";
+constexpr std::string_view kJournalHeader = "calligraphy-set-journal 3\n";
 constexpr std::string_view kJournalChecksum = "checksum ";
 
 std::string unique_suffix() {
@@ -343,36 +328,54 @@ class SetReplacement {
   SetReplacement& operator=(const SetReplacement&) = delete;
   ~SetReplacement() {
     remove_kept();
-    if (!journal_.empty()) ::unlink(journal_.c_str());
+    for (const fs::path& journal : journals_) {
+      if (!journal.empty()) ::unlink(journal.c_str());
+    }
   }
 
   void add_temporary(std::size_t i, const fs::path& temporary) { temporaries_[i] = temporary; }
 
-  void write_journal(const fs::path& folder) {
-    if (targets_.empty()) return;
-    std::string text(kJournalHeader);
-    for (std::size_t i = 0; i < targets_.size(); ++i) {
-      const fs::path target = resolved_folder(folder_of(targets_[i])) / targets_[i].filename();
-      text.append(target.lexically_relative(folder).string()).append("\t");
-      text.append(kept_[i].filename().string()).append("\t");
-      text.append(temporaries_[i].filename().string()).append("\n");
+  // One journal in each folder of the set, naming that folder's files only; all are in place before the
+  // first rename. A folder that cannot take its journal throws before any target changes.
+  void write_journals(const std::vector<SetFolder>& folders) {
+    journals_.assign(folders.size(), fs::path());
+    for (std::size_t f = 0; f < folders.size(); ++f) {
+      std::string text(kJournalHeader);
+      for (const std::size_t i : folders[f].files) {
+        text.append(targets_[i].filename().string()).append("\t");
+        text.append(kept_[i].filename().string()).append("\t");
+        text.append(temporaries_[i].filename().string()).append("\n");
+      }
+      const std::string checksum = journal_checksum(text);  // of every byte before the checksum line
+      text.append(kJournalChecksum).append(checksum).append("\n");
+      std::string name(kJournalPrefix);
+      name.append(unique_suffix()).append(kJournalSuffix);
+      const fs::path journal = folders[f].folder / name;
+      // Whole or absent: a writer killed while writing it leaves a temporary, which is no journal.
+      TemporaryFile temporary(journal, journal, 0600, true);
+      temporary.write(text);
+      temporary.rename_to(journal);
+      journals_[f] = journal;
+      sync_folder(journal, journal);
     }
-    const std::string checksum = journal_checksum(text);  // of every byte before the checksum line
-    text.append(kJournalChecksum).append(checksum).append("\n");
-    std::string name(kJournalPrefix);
-    name.append(unique_suffix()).append(kJournalSuffix);
-    const fs::path journal = folder / name;
-    // Whole or absent: a writer killed while writing it leaves a temporary, which is no journal.
-    TemporaryFile temporary(journal, journal, 0600, true);
-    temporary.write(text);
-    temporary.rename_to(journal);
-    journal_ = journal;
-    sync_folder(journal, journal);
   }
 
-  // Targets [0, renamed) were replaced: each gets its earlier file back (a new one is removed).
-  void roll_back(std::size_t renamed) noexcept {
-    for (std::size_t i = 0; i < renamed; ++i) {
+  // The renames of folder `f` are done: they are made durable (as far as the file system allows) before its
+  // journal goes, so that the folder is never left changed without a record.
+  void folder_done(std::size_t f) noexcept {
+    if (f >= journals_.size() || journals_[f].empty()) return;
+    const int fd = ::open(journals_[f].parent_path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd >= 0) {
+      ::fsync(fd);
+      ::close(fd);
+    }
+    ::unlink(journals_[f].c_str());
+    journals_[f].clear();
+  }
+
+  // The targets in `renamed` were replaced: each gets its earlier file back (a new one is removed).
+  void roll_back(const std::vector<std::size_t>& renamed) noexcept {
+    for (const std::size_t i : renamed) {
       if (!existed_[i]) {
         ::unlink(targets_[i].c_str());
       } else if (kept_[i].empty()) {
@@ -385,8 +388,10 @@ class SetReplacement {
 
   void commit() noexcept {
     remove_kept();
-    if (!journal_.empty()) ::unlink(journal_.c_str());
-    journal_.clear();
+    for (fs::path& journal : journals_) {
+      if (!journal.empty()) ::unlink(journal.c_str());
+      journal.clear();
+    }
   }
 
  private:
@@ -401,7 +406,7 @@ class SetReplacement {
   std::vector<bool> existed_;
   std::vector<fs::path> kept_;
   std::vector<fs::path> temporaries_;
-  fs::path journal_;
+  std::vector<fs::path> journals_;  // one per folder of the set, cleared once that folder is done
 };
 
 // The process id in a temporary's or a second name's file name (".NAME.tmp-PID-N", ".NAME.kept-PID-N"), or 0.
@@ -489,7 +494,7 @@ std::vector<JournalEntry> read_journal(const fs::path& journal, const fs::path& 
   }
   if (!text) return {};
   if (!text->starts_with(kJournalHeader)) {
-    refuse_journal(journal, "does not begin with the format tag \"calligraphy-set-journal 2\"");
+    refuse_journal(journal, "does not begin with the format tag \"calligraphy-set-journal 3\"");
   }
   if (!text->ends_with("\n")) refuse_journal(journal, "cut short (no checksum line)");
   const std::size_t checksum_line = text->rfind('\n', text->size() - 2) + 1;
@@ -512,27 +517,18 @@ std::vector<JournalEntry> read_journal(const fs::path& journal, const fs::path& 
         line.find('\0') != std::string::npos) {
       refuse_journal(journal, "a line is not TARGET, KEPT and TEMPORARY");
     }
-    const fs::path target(line.substr(0, first_tab));
+    const std::string target = line.substr(0, first_tab);
     const std::string kept = line.substr(first_tab + 1, second_tab - first_tab - 1);
     const std::string temporary = line.substr(second_tab + 1);
     std::string quoted("the name \"");
-    quoted.append(target.string()).append("\"");
-    if (target.empty() || target.is_absolute())
-      refuse_journal(journal, quoted + " is not relative to its folder");
-    for (const fs::path& part : target) {
-      if (part.empty() || part == "." || part == "..") refuse_journal(journal, quoted + " leaves its folder");
-    }
+    quoted.append(target).append("\"");
+    if (target.empty() || target == "." || target == ".." || target.find('/') != std::string::npos)
+      refuse_journal(journal, quoted + " is not the name of a file in the journal's own folder");
     if (!sibling_name(temporary, target, ".tmp-") ||
         (!kept.empty() && !sibling_name(kept, target, ".kept-"))) {
       refuse_journal(journal, quoted + ": its temporary or second name is not one this writer gives");
     }
-    std::error_code error;
-    const fs::path target_folder = fs::canonical(folder / target.parent_path(), error);
-    if (error || !within(target_folder, folder)) {
-      refuse_journal(journal, quoted + " is not in a folder inside the journal's (a symbolic link, or gone)");
-    }
-    JournalEntry entry{target_folder / target.filename(), kept.empty() ? fs::path() : target_folder / kept,
-                       target_folder / temporary};
+    JournalEntry entry{folder / target, kept.empty() ? fs::path() : folder / kept, folder / temporary};
     if (!regular_or_absent(entry.target) || !regular_or_absent(entry.temporary) ||
         (!kept.empty() && !regular_or_absent(entry.kept))) {
       refuse_journal(journal, quoted + ": a file it names is a symbolic link or not a regular file");
@@ -546,8 +542,9 @@ std::vector<JournalEntry> read_journal(const fs::path& journal, const fs::path& 
 // and checked whole (read_journal), then each temporary it names that is still there is renamed over its
 // target, and the earlier files' second names and the journal are removed. The lock says no live writer is
 // between its renames. A journal refused throws, naming it, before anything of it is done.
-void complete_interrupted_sets(const std::set<fs::path>& folders) {
-  for (const fs::path& folder : folders) {
+void complete_interrupted_sets(const std::vector<SetFolder>& folders) {
+  for (const SetFolder& set_folder : folders) {
+    const fs::path& folder = set_folder.folder;
     std::error_code error;
     std::vector<fs::path> journals;
     for (fs::directory_iterator entry(folder, error), end; !error && entry != end; entry.increment(error)) {
@@ -661,25 +658,32 @@ void AtomicFileSet::commit() {
   impl_->committed = true;
   const std::vector<fs::path>& targets = impl_->targets;
   // Renames need no data blocks: once every temporary is whole, the set is replaced in one short run, under
-  // an exclusive lock of each folder, so that two writers of one set never interleave their renames. A set
-  // that a killed writer left half replaced is completed first (its journal, above).
+  // an exclusive lock of each of its folders, so that two writers of one set never interleave their renames.
+  // A set that a killed writer left half replaced in one of these folders is completed first (its journal,
+  // above). Then every folder gets its journal, and the set is replaced folder by folder, each folder's
+  // journal removed once its renames are done.
   {
-    const fs::path journal_folder = journal_folder_of(targets);
-    const std::set<fs::path> folders = folders_of_set(targets, journal_folder);
+    const std::vector<SetFolder> folders = folders_of_set(targets);
     const FolderLocks locks(folders);
     complete_interrupted_sets(folders);
     const RenamesUnderWay renaming;  // a stop signal from here on ends the process once the set is whole
     SetReplacement replacement(targets, impl_->existed);
     for (std::size_t i = 0; i < targets.size(); ++i)
       replacement.add_temporary(i, impl_->temporaries[i]->path());
-    replacement.write_journal(journal_folder);
-    for (std::size_t i = 0; i < targets.size(); ++i) {
-      try {
-        impl_->temporaries[i]->rename_to(targets[i]);
-      } catch (const DataError&) {
-        replacement.roll_back(i);  // the earlier set again, then the error naming the file at fault
-        throw;
+    replacement.write_journals(folders);
+    std::vector<std::size_t> renamed;
+    renamed.reserve(targets.size());
+    for (std::size_t f = 0; f < folders.size(); ++f) {
+      for (const std::size_t i : folders[f].files) {
+        try {
+          impl_->temporaries[i]->rename_to(targets[i]);
+        } catch (const DataError&) {
+          replacement.roll_back(renamed);  // the earlier set again, then the error naming the file at fault
+          throw;
+        }
+        renamed.push_back(i);
       }
+      replacement.folder_done(f);
     }
     replacement.commit();
   }
