@@ -14,12 +14,16 @@ run by CTest as `cli_one_way_out_tests`: hostile cases written from the document
 - The journal of a set killed between its renames (Release builds, with the fault shim): copied with its folder,
   it completes the copy only; planted in another folder, it changes nothing outside that folder, for `report
   --csv` and for the Python report's writer. And the Python study report onto a link to a session's file.
+- A set over sibling folders its user owns under a folder that user cannot write (as nobody through setpriv or
+  runuser when run as root): written with no journal or temporary left, and an output in the folder it cannot
+  write refused before any work.
 
 CALLIGRAPHY_CLI names the program and CALLIGRAPHY_SOURCE_DIR the source tree. Standard library only.
 """
 import hashlib
 import json
 import os
+import pwd
 import resource
 import shutil
 import sys
@@ -352,6 +356,66 @@ class OneWayOut(unittest.TestCase):
         self.assertIn(result.returncode, (0, 1), result.stderr.decode())  # ran: the module was found
         self.assertEqual(self.files_under(tables), original, "a journal planted in figures/ changed tables/")
 
+
+    # --- a set over folders that share no folder the user can write -----------------------------------------
+
+    def as_a_user_who_is_not_root(self):
+        """(command prefix, uid, gid) running a program as a user who is not root: this process's own user when
+        it is not root, else nobody through setpriv or runuser. Skips, saying why, when neither works."""
+        if os.geteuid() != 0:
+            return [], os.geteuid(), os.getegid()
+        try:
+            nobody = pwd.getpwnam("nobody")
+        except KeyError:
+            self.skipTest("running as root, and there is no user nobody to run as")
+        uid, gid = nobody.pw_uid, nobody.pw_gid
+        tried = []
+        for prefix in (["setpriv", f"--reuid={uid}", f"--regid={gid}", "--clear-groups"],
+                       ["runuser", "-u", "nobody", "--"]):
+            if shutil.which(prefix[0]) is None:
+                tried.append(f"{prefix[0]}: not installed")
+                continue
+            probe = subprocess.run([*prefix, "id", "-u"], capture_output=True, timeout=TIMEOUT_S)
+            if probe.returncode == 0 and probe.stdout.strip() == str(uid).encode():
+                return prefix, uid, gid
+            tried.append(f"{prefix[0]}: {probe.stderr.decode(errors='replace').strip()[:200]}")
+        self.skipTest("running as root, and cannot run a program as nobody (" + "; ".join(tried) + ")")
+
+    def test_a_set_over_sibling_folders_under_a_folder_the_user_cannot_write(self):
+        """`report --csv BASE/tables --out BASE/site/report.html`, run by a user who owns tables/ and site/ but
+        cannot write BASE (nor /): the set is written, twice (the second replacing the first), and no journal,
+        temporary or second name is left anywhere. An --out in BASE itself is refused before any work (exit 1,
+        one line naming the folder), and nothing changes."""
+        prefix, uid, gid = self.as_a_user_who_is_not_root()
+        base = Path(tempfile.mkdtemp(prefix="calligraphy-one-way-base-"))
+        self.addCleanup(shutil.rmtree, base, ignore_errors=True)
+        self.addCleanup(os.chmod, base, 0o755)
+        study = base / "study"
+        shutil.copytree(self.session.parent.parent, study, symlinks=True)
+        for path in [study, *study.rglob("*")]:
+            if not path.is_symlink():
+                path.chmod(0o755 if path.is_dir() else 0o644)
+        for name in ("tables", "site"):
+            (base / name).mkdir()
+            os.chown(base / name, uid, gid)
+        base.chmod(0o555)  # readable, not writable: a user who is not root cannot make a file in it
+
+        def report(out):
+            return subprocess.run([*prefix, CLI, "report", study, "--csv", base / "tables", "--out", out],
+                                  cwd=base, capture_output=True, timeout=TIMEOUT_S)
+
+        for attempt in ("first", "second"):
+            result = report(base / "site" / "report.html")
+            self.assertEqual(result.returncode, 0, f"{attempt} run: {result.stderr.decode(errors='replace')}")
+            self.assertEqual(sorted(os.listdir(base / "tables")), ["strokes.csv", "trials.csv"])
+            self.assertTrue((base / "site" / "report.html").is_file())
+            self.assertEqual(temporaries(base), [], f"left behind by the {attempt} run")
+        before = self.files_under(base)
+        refused = report(base / "report.html")
+        self.assert_one_error(refused, 1, str(base))
+        self.assertIn("not writable", refused.stderr.decode())
+        self.assertEqual(self.files_under(base), before)
+        self.assertEqual(temporaries(base), [])
 
 if __name__ == "__main__":
     unittest.main(verbosity=2)
