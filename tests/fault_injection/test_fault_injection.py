@@ -295,6 +295,91 @@ class FaultInjection(unittest.TestCase):
         print(f"report --csv completing a killed set's journal: {tried} faults at every step "
               f"({', '.join(f'{kind} {counts[kind]}' for kind in KINDS)})", flush=True)
 
+    def test_set_over_two_folders(self):
+        """`report --csv out/tables --out out/site/report.html` is one set over sibling folders (the tables, the
+        index, the pages' folders below it), each folder with its own journal. SIGKILL at every rename: every
+        folder holds its earlier files, its new ones, or a journal of its own (a kill between two folders leaves
+        each folder earlier or new); a later set written into each journalled folder completes that folder on
+        its own, and once every journal was written before the kill, that gives the whole new set; a clean run
+        afterwards leaves nothing behind."""
+        work = Path(self.scratch.name) / "folders"
+        later_code = ("import pathlib, sys\nfrom calligraphy import study_report\n"
+                      "study_report._write_together({pathlib.Path(f) / 'later.txt': b'later' for f in sys.argv[1:]})\n")
+
+        def arguments_for(study):
+            return ["report", study, "--csv", "out/tables", "--out", "out/site/report.html", "--jobs", "1"]
+
+        def by_folder(files):
+            folders = {}
+            for name, digest in files.items():
+                folder, _, base = name.rpartition("/")
+                if base != "later.txt":
+                    folders.setdefault(folder, {})[base] = digest
+            return folders
+
+        def journals():  # a journal's own temporary ("..calligraphy-set-...journal.tmp-...") is none
+            return [name for name in leftovers(work / "out")
+                    if Path(name).name.startswith(".calligraphy-set-") and name.endswith(".journal")]
+
+        def fresh():
+            shutil.rmtree(work, ignore_errors=True)
+            for folder in ("out/tables", "out/site"):
+                (work / folder).mkdir(parents=True)
+            done = self.run_cli(arguments_for(self.one_subject / "study"), work)
+            self.assertEqual(done.returncode, 0, done.stderr.decode())
+            return by_folder(snapshot(work / "out"))
+
+        earlier = fresh()
+        done = self.run_cli(arguments_for(self.two_subjects / "study"), work)
+        self.assertEqual(done.returncode, 0, done.stderr.decode())
+        new = by_folder(snapshot(work / "out"))
+        self.assertGreaterEqual(len(new), 3, sorted(new))  # tables, site and the pages' folders
+        self.assertEqual(fresh(), earlier)
+        counts_file = Path(self.scratch.name) / "folders-counts.txt"
+        counted = self.run_cli(arguments_for(self.two_subjects / "study"), work,
+                               {"CALLIGRAPHY_FAULT_COUNTS": str(counts_file)})
+        self.assertEqual(counted.returncode, 0, counted.stderr.decode())
+        renames = {kind: int(n) for kind, n in (line.split() for line in counts_file.read_text().splitlines())}["rename"]
+        files = sum(len(folder) for folder in new.values())
+        journals_written = renames - files  # the first renames put each folder's journal in place
+        between_folders = 0
+        for n in range(1, renames + 1):
+            with self.subTest(rename=n):
+                self.assertEqual(fresh(), earlier)
+                killed = self.run_cli(arguments_for(self.two_subjects / "study"), work,
+                                      {"CALLIGRAPHY_FAULT_CALL": "rename", "CALLIGRAPHY_FAULT_AT": str(n),
+                                       "CALLIGRAPHY_FAULT_KILL": "1"})
+                self.assertEqual(killed.returncode, -9, killed.stderr.decode())
+                after = by_folder(snapshot(work / "out"))
+                journalled = sorted({str(Path(name).parent) for name in journals()})
+                for folder in set(earlier) | set(new):
+                    if folder not in journalled:
+                        self.assertIn(after.get(folder, {}), (earlier.get(folder, {}), new.get(folder, {})),
+                                      f"{folder}: a mix of the sets and no journal in it (rename {n})")
+                if all(after.get(f, {}) in (earlier.get(f, {}), new.get(f, {})) for f in set(earlier) | set(new)) \
+                        and after != earlier and after != new:
+                    between_folders += 1
+                if journalled:
+                    later = subprocess.run([sys.executable, "-c", later_code, *[Path("out") / f for f in journalled]],
+                                           cwd=work, capture_output=True, timeout=TIMEOUT_S)
+                    self.assertEqual(later.returncode, 0, later.stderr.decode())
+                completed = by_folder(snapshot(work / "out"))
+                for folder in set(earlier) | set(new):
+                    self.assertIn(completed.get(folder, {}), (earlier.get(folder, {}), new.get(folder, {})),
+                                  f"{folder}: a mix of the sets after the later set (rename {n})")
+                    if folder in journalled:
+                        self.assertEqual(completed.get(folder, {}), new.get(folder, {}), folder)
+                if n > journals_written:
+                    self.assertEqual(completed, new, f"killed at rename {n}, after every journal was written")
+                self.assertEqual(journals(), [])
+                again = self.run_cli(arguments_for(self.two_subjects / "study"), work)
+                self.assertEqual(again.returncode, 0, again.stderr.decode())
+                self.assertEqual(by_folder(snapshot(work / "out")), new)
+                self.assertEqual(leftovers(work / "out"), [])
+        self.assertGreater(between_folders, 0, "no kill fell between two folders")
+        print(f"report over {len(new)} folders: SIGKILL at each of {renames} renames ({journals_written} journals, "
+              f"{between_folders} kills between folders)", flush=True)
+
     def saved_trials(self, out):
         """{record path: SHA-256 of the record, its trace and its drawing} of every trial saved in a whole
         session folder under `out`; each record must read as JSON and each trace must be whole (its header's
