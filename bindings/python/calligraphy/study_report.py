@@ -224,10 +224,14 @@ def _refuse_outputs_on_inputs(outputs: typing.Iterable[pathlib.Path], trace_file
 
 
 def _make_folder(folder: pathlib.Path) -> None:
+    """Makes `folder` (and its parents) and checks that files can be made in it, before the report's work: the
+    set of files is written with a journal in each of its folders, and needs no other folder."""
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as error:
         raise OSError(error.errno, f"cannot create the folder {folder}: {error.strerror or error}") from error
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise OSError(errno.EACCES, f"cannot write in the folder {folder}: {os.strerror(errno.EACCES)}")
 
 
 # ---------------------------------------------------------------------------------------------- data
