@@ -8,10 +8,14 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <catch2/catch.hpp>
 #include <chrono>
+#include <cstdint>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -107,7 +111,8 @@ TEST_CASE("read_file_for_update reads regular files only, within a bound", "[ato
   CHECK_THROWS_WITH(read_file_for_update(document, 4), Catch::Contains(document.string()));
 }
 
-TEST_CASE("write_files_atomically replaces a set together, or leaves the earlier set whole", "[atomic_file]") {
+TEST_CASE("write_files_atomically replaces a set together, or leaves the earlier set whole",
+          "[atomic_file]") {
   TemporaryFolder folder;
   const fs::path trials = folder.path / "trials.csv";
   const fs::path strokes = folder.path / "strokes.csv";
@@ -144,7 +149,8 @@ TEST_CASE("write_files_atomically replaces a set together, or leaves the earlier
   }
 }
 
-TEST_CASE("write_files_atomically replaces a set only while no other writer holds its folder", "[atomic_file]") {
+TEST_CASE("write_files_atomically replaces a set only while no other writer holds its folder",
+          "[atomic_file]") {
   // Another writer in the middle of its renames holds the folder's lock: this set waits, so the two sets
   // are never interleaved file by file.
   TemporaryFolder folder;
@@ -170,4 +176,157 @@ TEST_CASE("write_files_atomically replaces a set only while no other writer hold
   CHECK(done);
   CHECK(contents(trials) == "new trials\n");
   CHECK(contents(strokes) == "new strokes\n");
+}
+
+namespace {
+
+// A journal as the set writer words it (include/calligraphy/core/atomic_file.hpp): the format tag, one line
+// "TARGET\tKEPT\tTEMPORARY" per file, and the FNV-1a checksum of what precedes it. What a forger who read
+// the format would write.
+std::string journal_text(const std::vector<std::string>& lines, bool good_checksum = true) {
+  std::string text = "calligraphy-set-journal 3\n";
+  for (const std::string& line : lines) text.append(line).append("\n");
+  std::uint64_t hash = 14695981039346656037ULL;
+  for (const char c : text) {
+    hash ^= static_cast<unsigned char>(c);
+    hash *= 1099511628211ULL;
+  }
+  if (!good_checksum) hash ^= 1;
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
+  return text + "checksum " + hex + "\n";
+}
+
+std::vector<std::string> names_in(const fs::path& folder) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(folder)) names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+void plant(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+// A writer that no longer runs (a process id above Linux's largest) left "trials.csv" replaced and
+// "strokes.csv" not yet: its temporary and the journal naming both are in `folder`.
+const char* const kDead = "4999999-0";
+
+void killed_between_renames(const fs::path& folder) {
+  plant(folder / "trials.csv", "new trials\n");
+  plant(folder / "strokes.csv", "old strokes\n");
+  plant(folder / (std::string(".strokes.csv.tmp-") + kDead), "new strokes\n");
+  plant(folder / ".calligraphy-set-4999999-1.journal",
+        journal_text({std::string("trials.csv\t\t.trials.csv.tmp-") + kDead,
+                      std::string("strokes.csv\t\t.strokes.csv.tmp-") + kDead}));
+}
+
+}  // namespace
+
+TEST_CASE("a killed set's journal completes its own set, in its own folder only", "[atomic_file]") {
+  TemporaryFolder folder;
+  const fs::path original = folder.path / "tables";
+  fs::create_directory(original);
+  killed_between_renames(original);
+  SECTION("the next set in the folder completes it first") {
+    write_file_atomically(original / "other.csv", std::string_view("x\n"));  // one file: no set, no journal
+    CHECK(contents(original / "strokes.csv") == "old strokes\n");
+    const FileContent next[] = {{original / "other.csv", "y\n"}};
+    write_files_atomically(next);
+    CHECK(contents(original / "strokes.csv") == "new strokes\n");
+    CHECK(contents(original / "trials.csv") == "new trials\n");
+    CHECK(names_in(original) == std::vector<std::string>{"other.csv", "strokes.csv", "trials.csv"});
+  }
+  SECTION("a copy of the folder completes the copy, and the original stays as it was") {
+    const fs::path copy = folder.path / "copy";
+    fs::copy(original, copy);
+    const FileContent next[] = {{copy / "other.csv", "y\n"}};
+    write_files_atomically(next);
+    CHECK(contents(copy / "strokes.csv") == "new strokes\n");
+    CHECK(contents(original / "strokes.csv") == "old strokes\n");
+    CHECK(contents(original / (std::string(".strokes.csv.tmp-") + kDead)) == "new strokes\n");
+    CHECK(fs::exists(original / ".calligraphy-set-4999999-1.journal"));
+  }
+}
+
+TEST_CASE("a journal that is not the writer's own is refused, named, and left as it is", "[atomic_file]") {
+  TemporaryFolder folder;
+  const fs::path tables = folder.path / "tables";
+  const fs::path outside = folder.path / "outside";
+  fs::create_directory(tables);
+  fs::create_directory(outside);
+  plant(outside / "victim.csv", "precious\n");
+  plant(outside / (std::string(".victim.csv.tmp-") + kDead), "forged\n");
+  plant(tables / (std::string(".victim.csv.tmp-") + kDead), "forged\n");
+  const fs::path journal = tables / ".calligraphy-set-4999999-1.journal";
+  const std::string victim = (outside / "victim.csv").string();
+  const std::string temporary = std::string(".victim.csv.tmp-") + kDead;
+  const std::string forged = GENERATE_COPY(
+      journal_text({"../outside/victim.csv\t\t" + temporary}),  // climbs out
+      journal_text({victim + "\t\t" + temporary}),              // absolute
+      journal_text({"link/victim.csv\t\t" + temporary}),        // a folder link leaving
+      journal_text({"victim-link.csv\t\t" + temporary}),        // a target that is a link
+      journal_text({"victim.csv\t\t../outside/" + temporary}),  // a temporary elsewhere
+      journal_text({"victim.csv\t\t.other.tmp-1-0"}),           // not this writer's name
+      journal_text({"victim.csv\t\t" + temporary}, false),      // checksum differs
+      victim + "\t\t" + (outside / temporary).string() + "\n",  // the old format
+      std::string("calligraphy-set-journal 9\nvictim.csv\t\t" + temporary + "\n"));  // another version
+  fs::create_directory_symlink(outside, tables / "link");
+  fs::create_symlink(outside / "victim.csv", tables / "victim-link.csv");
+  plant(journal, forged);
+  const FileContent next[] = {{tables / "trials.csv", "new trials\n"},
+                              {tables / "strokes.csv", "new strokes\n"}};
+  CHECK_THROWS_WITH(write_files_atomically(next),
+                    Catch::Contains(journal.string()) && Catch::Contains("refused"));
+  CHECK(contents(outside / "victim.csv") == "precious\n");
+  CHECK(contents(journal) == forged);
+  CHECK_FALSE(fs::exists(tables / "trials.csv"));
+  CHECK(names_in(tables) ==
+        std::vector<std::string>{journal.filename().string(), temporary, "link", "victim-link.csv"});
+}
+
+TEST_CASE("a set over several folders keeps a journal in each, and a killed one completes folder by folder",
+          "[atomic_file]") {
+  TemporaryFolder folder;
+  const fs::path tables = folder.path / "tables";
+  const fs::path figures = folder.path / "figures";
+  fs::create_directory(tables);
+  fs::create_directory(figures);
+  SECTION("a set over two sibling folders leaves no journal, temporary or second name in either") {
+    plant(tables / "trials.csv", "old trials\n");
+    const FileContent files[] = {{tables / "trials.csv", "new trials\n"}, {figures / "plot.svg", "<svg/>\n"}};
+    write_files_atomically(files);
+    CHECK(names_in(tables) == std::vector<std::string>{"trials.csv"});
+    CHECK(names_in(figures) == std::vector<std::string>{"plot.svg"});
+    CHECK(names_in(folder.path) == std::vector<std::string>{"figures", "tables"});
+  }
+  SECTION("killed between the folders: each folder's journal is completed by the next set in that folder") {
+    // figures/ was replaced and its journal removed; tables/ holds its own journal, a whole temporary and a
+    // file not yet replaced (as a writer killed after its first folder and a rename of the next leaves them).
+    plant(figures / "plot.svg", "new plot\n");
+    killed_between_renames(tables);
+    const FileContent in_figures[] = {{figures / "other.svg", "x\n"}};
+    write_files_atomically(in_figures);  // another folder: tables/ stays as it was, journal and all
+    CHECK(contents(tables / "strokes.csv") == "old strokes\n");
+    CHECK(fs::exists(tables / ".calligraphy-set-4999999-1.journal"));
+    const FileContent in_tables[] = {{tables / "other.csv", "y\n"}};
+    write_files_atomically(in_tables);
+    CHECK(contents(tables / "trials.csv") == "new trials\n");
+    CHECK(contents(tables / "strokes.csv") == "new strokes\n");
+    CHECK(names_in(tables) == std::vector<std::string>{"other.csv", "strokes.csv", "trials.csv"});
+    CHECK(contents(figures / "plot.svg") == "new plot\n");
+  }
+  SECTION("a journal naming a file in a subfolder is refused, even one below its own folder") {
+    const fs::path sub = tables / "sub";
+    fs::create_directory(sub);
+    plant(sub / "victim.csv", "precious\n");
+    plant(sub / (std::string(".victim.csv.tmp-") + kDead), "forged\n");
+    const std::string forged = journal_text({std::string("sub/victim.csv\t\t.victim.csv.tmp-") + kDead});
+    plant(tables / ".calligraphy-set-4999999-1.journal", forged);
+    const FileContent next[] = {{tables / "trials.csv", "new trials\n"}};
+    CHECK_THROWS_WITH(write_files_atomically(next), Catch::Contains("refused"));
+    CHECK(contents(sub / "victim.csv") == "precious\n");
+    CHECK(contents(tables / ".calligraphy-set-4999999-1.journal") == forged);
+  }
 }

@@ -75,7 +75,7 @@ int run_build(const BuildCommand& command) {
   const auto write_start = Clock::now();
   // Encoded in memory and then written whole: an earlier store survives any failure to write this one.
   const std::vector<std::uint8_t> bytes = encode_corpus_store(fit.characters, store_options);
-  write_file_atomically(command.out, bytes);
+  write_output(command.out, bytes);
   const CorpusBuildTimes times{seconds_since(start), seconds_since(write_start)};
   write_standard_output(
       corpus_build_text(command.out, library.description(), fit, store_options, bytes.size(), times));

@@ -53,7 +53,7 @@ class PagesWriter {
   std::atomic<std::size_t> trials{0};
   std::atomic<std::uintmax_t> bytes{0};
   std::vector<StudyTables>* tables = nullptr;  // one per session, when the tables are wanted too
-  AtomicFileSet* files = nullptr;              // the report's files, replaced together at the end
+  OutputSet* files = nullptr;                  // the report's files, replaced together at the end
 
   void work() {
     while (!failed) {
@@ -101,7 +101,7 @@ int run_report(const ReportCommand& command) {
   };
   // Everything this run writes (the tables, the pages, the index) is one set: replaced together at the end,
   // or, on any failure, none of it, the earlier report and tables left whole.
-  AtomicFileSet report_files;
+  OutputSet report_files;
   std::string tables_line;
   const auto add_tables = [&](const StudyTables& tables) {
     report_files.add(tables_folder / "trials.csv", trials_csv(tables));

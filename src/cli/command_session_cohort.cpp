@@ -66,9 +66,10 @@ int run_session_cohort(const SessionCohortCommand& command) {
   });
   // Both tables or neither: a failure leaves the previous pair whole.
   const std::string trials_text = trials_csv(tables), strokes_text = strokes_csv(tables);
-  const FileContent table_files[] = {{tables_folder / "trials.csv", trials_text},
-                                     {tables_folder / "strokes.csv", strokes_text}};
-  write_files_atomically(table_files);
+  OutputSet table_files;
+  table_files.add(tables_folder / "trials.csv", trials_text);
+  table_files.add(tables_folder / "strokes.csv", strokes_text);
+  table_files.commit();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf(
       "%s: %zu subjects, %zu trials on %u threads in %.1f s: trials.csv (%zu rows), strokes.csv (%zu rows)\n",

@@ -19,6 +19,7 @@ struct TraceCommand {
 
 int run_trace(const TraceCommand& command) {
   FilePlan files;
+  files.input("TRACE", command.trace);
   files.output("--csv", command.csv);
   write_output(command.csv,
                trial_csv(trial_samples(read_trace_hdf5(command.trace))));  // "-": standard output

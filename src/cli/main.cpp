@@ -5,6 +5,7 @@
 #include <string>
 #include <string_view>
 
+#include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/logging.hpp"
 #include "cli/cli_devices.hpp"
@@ -68,6 +69,9 @@ void add_bench_commands(CLI::App& root, Commands& commands) {
 
 int main(int argc, char** argv) {
   using namespace calligraphy::cli;
+  // Before any thread and any file: a file size limit, a closed pipe and a stop signal while a file is
+  // written each end as an error line or a signal with the temporary removed, never a silent death.
+  calligraphy::guard_output_files();
   CLI::App root("Haptic training of Chinese handwriting: guided trials, scoring, character models",
                 "calligraphy");
   configure_root(root);

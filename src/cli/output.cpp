@@ -9,6 +9,8 @@
 #include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <mutex>
+#include <set>
 
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
@@ -17,6 +19,39 @@
 #include "cli/app.hpp"
 
 namespace calligraphy::cli {
+
+namespace {
+
+// Every file a FilePlan of this process checked as an output, absolute and normal: the only files
+// write_output and OutputSet write.
+struct PlannedOutputs {
+  std::mutex mutex;
+  std::set<std::filesystem::path> paths;
+};
+PlannedOutputs& planned_outputs() {
+  static PlannedOutputs planned;
+  return planned;
+}
+
+std::filesystem::path normal_path(const std::filesystem::path& path) {
+  return std::filesystem::absolute(path).lexically_normal();
+}
+
+void note_planned(const std::string& path) {
+  PlannedOutputs& planned = planned_outputs();
+  const std::lock_guard lock(planned.mutex);
+  planned.paths.insert(normal_path(path));
+}
+
+void require_planned(const std::filesystem::path& path) {
+  PlannedOutputs& planned = planned_outputs();
+  const std::lock_guard lock(planned.mutex);
+  if (planned.paths.count(normal_path(path)) == 0) {
+    throw StateError(path.string() + ": written without being checked as an output first (FilePlan::output)");
+  }
+}
+
+}  // namespace
 
 void write_standard_output(std::string_view text) {
   std::cout.flush();  // keep the order of anything written through std::cout before
@@ -29,9 +64,21 @@ void write_output(const std::string& path, std::string_view text) {
   if (path == "-") {
     write_standard_output(text);
   } else {
+    require_planned(path);
     write_file_atomically(path, text);
   }
 }
+
+void write_output(const std::string& path, std::span<const std::uint8_t> bytes) {
+  write_output(path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+}
+
+void OutputSet::add(const std::filesystem::path& path, std::string_view content) {
+  require_planned(path);
+  set_.add(path, content);
+}
+
+void OutputSet::commit() { set_.commit(); }
 
 std::string read_input_file(const std::string& path, const std::string& what) {
   std::optional<std::string> text = read_file_for_update(path);
@@ -169,7 +216,10 @@ void FilePlan::output(const std::string& what, const std::string& path) {
                                                fs::path(path).filename() == "."))) {
     throw DataError(named(what, path) + ": is a folder, not a file");
   }
-  if (identity.exists && !identity.regular) return;  // a device or FIFO: written in place, never replaced
+  if (identity.exists && !identity.regular) {  // a device or FIFO: written in place, never replaced
+    note_planned(path);
+    return;
+  }
   for (const Entry& input : inputs_) {
     if (!same_file(identity, input.identity)) continue;
     throw UsageError(named(what, path) + " is the same file as " + input.what + " (" + identity.path +
@@ -195,6 +245,7 @@ void FilePlan::output(const std::string& what, const std::string& path) {
   std::error_code error;
   if (!in_output_folder || fs::exists(folder, error)) require_writable_folder(what, path, folder);
   outputs_.push_back({what, path, identity});
+  note_planned(path);
 }
 
 void FilePlan::output_folder(const std::string& what, const std::string& path) {

@@ -1,10 +1,16 @@
 #pragma once
 // Where the command line's outputs go: a file, written whole or not at all (write_file_atomically), or
-// standard output for the path "-"; every write is checked.
+// standard output for the path "-"; every write is checked. The one way a command's files leave it: each
+// file is checked by a FilePlan before anything runs, then written by write_output or an OutputSet, which
+// refuse a file no plan checked.
+#include <cstdint>
 #include <filesystem>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "calligraphy/core/atomic_file.hpp"
 
 namespace calligraphy::cli {
 
@@ -13,8 +19,23 @@ namespace calligraphy::cli {
 void write_standard_output(std::string_view text);
 
 /// Writes `text` to the file `path` (atomically, see calligraphy/core/atomic_file.hpp) or, when `path` is
-/// "-", to standard output. Throws DataError naming the path when it cannot.
+/// "-", to standard output. Throws DataError naming the path when it cannot, StateError (a program error)
+/// when no FilePlan of this process checked `path` as an output first.
 void write_output(const std::string& path, std::string_view text);
+/// The same for binary content (a corpus store).
+void write_output(const std::string& path, std::span<const std::uint8_t> bytes);
+
+/// Files of one command replaced together (AtomicFileSet: the earlier set or the whole new one), each
+/// checked first by a FilePlan as write_output requires. `add` may be called from several threads. Throws
+/// as AtomicFileSet does, and StateError for a file no plan checked.
+class OutputSet {
+ public:
+  void add(const std::filesystem::path& path, std::string_view content);
+  void commit();
+
+ private:
+  AtomicFileSet set_;
+};
 
 /// The text of an input file (a regular file of at most 64 MiB). Throws DataError naming the path and
 /// `what` it should hold when it does not exist, is not a regular file, is too large or cannot be read.

@@ -1,17 +1,22 @@
 #include "calligraphy/core/atomic_file.hpp"
 
 #include <fcntl.h>
+#include <limits.h>
+#include <pthread.h>
 #include <signal.h>
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <cinttypes>
+#include <cstdio>
+#include <cstring>
 #include <memory>
 #include <mutex>
 #include <optional>
-#include <set>
 #include <string>
 #include <system_error>
 #include <utility>
@@ -59,6 +64,80 @@ void write_in_place(const fs::path& path, std::string_view content) {
   if (close_error != 0) fail(path, "cannot write (on close)", close_error);
 }
 
+// The temporaries this process has open, for the stop-signal handler (guard_output_files): fixed slots of
+// fixed size, claimed and released with atomics, so that the handler reads them without a lock or an
+// allocation. A path too long for a slot, or a 65th temporary at once, is not removed by a signal (it is on
+// every other path, and a later writer in that folder removes it, below: remove_dead_writers_files).
+struct TemporarySlot {
+  std::atomic<int> state{0};  // 0 free, 1 being filled, 2 holds a live temporary's path
+  char path[PATH_MAX];
+};
+TemporarySlot temporary_slots[64];
+std::atomic<int> committing_sets{0};  // sets between their first and last rename: a signal waits for them
+std::atomic<int> deferred_signal{0};  // the stop signal that came during a set's renames
+std::atomic<bool> signals_guarded{false};
+
+int register_temporary(const fs::path& path) noexcept {
+  const std::string& text = path.native();
+  if (text.size() >= PATH_MAX) return -1;
+  for (int i = 0; i < static_cast<int>(std::size(temporary_slots)); ++i) {
+    int free_slot = 0;
+    if (!temporary_slots[i].state.compare_exchange_strong(free_slot, 1)) continue;
+    std::memcpy(temporary_slots[i].path, text.c_str(), text.size() + 1);
+    temporary_slots[i].state.store(2);
+    return i;
+  }
+  return -1;
+}
+
+void release_temporary(int slot) noexcept {
+  if (slot >= 0) temporary_slots[slot].state.store(0);
+}
+
+// Async-signal-safe: unlink(2) of every live temporary.
+void remove_live_temporaries() noexcept {
+  for (TemporarySlot& slot : temporary_slots) {
+    if (slot.state.load() == 2) ::unlink(slot.path);
+  }
+}
+
+// Ends the process by `signal` as its default action would, once the temporaries are gone.
+void die_by(int signal) noexcept {
+  remove_live_temporaries();
+  struct sigaction action {};
+  action.sa_handler = SIG_DFL;
+  sigemptyset(&action.sa_mask);
+  sigaction(signal, &action, nullptr);
+  sigset_t unblock;
+  sigemptyset(&unblock);
+  sigaddset(&unblock, signal);
+  pthread_sigmask(SIG_UNBLOCK, &unblock, nullptr);
+  ::raise(signal);
+}
+
+extern "C" void remove_temporaries_then_die(int signal) {
+  if (committing_sets.load() > 0) {  // a set is between its renames: it finishes them, then dies
+    int none = 0;
+    deferred_signal.compare_exchange_strong(none, signal);
+    return;
+  }
+  die_by(signal);
+}
+
+// Marks a set's renames: a stop signal meanwhile waits until the last one is done (or undone).
+class RenamesUnderWay {
+ public:
+  RenamesUnderWay() noexcept { committing_sets.fetch_add(1); }
+  RenamesUnderWay(const RenamesUnderWay&) = delete;
+  RenamesUnderWay& operator=(const RenamesUnderWay&) = delete;
+  ~RenamesUnderWay() {
+    if (committing_sets.fetch_sub(1) == 1) {
+      const int signal = deferred_signal.exchange(0);
+      if (signal != 0) die_by(signal);
+    }
+  }
+};
+
 // The temporary file beside the target, removed on destruction unless committed.
 class TemporaryFile {
  public:
@@ -75,6 +154,7 @@ class TemporaryFile {
       if (fd_ >= 0 || errno != EEXIST) break;
     }
     if (fd_ < 0) fail(reported_, "cannot create a temporary file in " + folder.string(), errno);
+    slot_ = register_temporary(path_);
     if (set_mode && ::fchmod(fd_, mode) != 0) fail_and_remove("cannot set the permissions", errno);
   }
   TemporaryFile(const TemporaryFile&) = delete;
@@ -92,6 +172,8 @@ class TemporaryFile {
   void rename_to(const fs::path& target) {
     if (::rename(path_.c_str(), target.c_str()) != 0) fail_and_remove("cannot replace the file", errno);
     committed_ = true;
+    release_temporary(slot_);
+    slot_ = -1;
   }
 
  private:
@@ -100,6 +182,8 @@ class TemporaryFile {
     fd_ = -1;
     if (!committed_) ::unlink(path_.c_str());
     committed_ = true;
+    release_temporary(slot_);
+    slot_ = -1;
   }
   [[noreturn]] void fail_and_remove(const std::string& what, int error) {
     remove();
@@ -109,6 +193,7 @@ class TemporaryFile {
   fs::path reported_;
   fs::path path_;
   int fd_ = -1;
+  int slot_ = -1;
   bool committed_ = false;
 };
 
@@ -127,17 +212,46 @@ void sync_folder(const fs::path& target, const fs::path& reported) {
   }
 }
 
-// flock(2) on the folders of a set's targets, taken in sorted order (no two writers deadlock) and released
-// on destruction. A folder that cannot be opened or locked is left unlocked: the renames go on as before.
+// The folder a target is in ("." for a bare name).
+fs::path folder_of(const fs::path& target) {
+  return target.parent_path().empty() ? fs::path(".") : target.parent_path();
+}
+
+// A folder resolved through symbolic links (as it is, made absolute, when it cannot be).
+fs::path resolved_folder(const fs::path& folder) {
+  std::error_code error;
+  fs::path resolved = fs::canonical(folder, error);
+  return error ? fs::absolute(folder).lexically_normal() : resolved;
+}
+
+// The folders of a set, each (resolved) with the indices of its targets in the order they were added, in the
+// sorted order of the folders: a set is committed folder by folder, each folder under its own journal.
+struct SetFolder {
+  fs::path folder;
+  std::vector<std::size_t> files;
+};
+
+std::vector<SetFolder> folders_of_set(const std::vector<fs::path>& targets) {
+  std::vector<SetFolder> folders;
+  for (std::size_t i = 0; i < targets.size(); ++i) {
+    const fs::path folder = resolved_folder(folder_of(targets[i]));
+    auto found =
+        std::find_if(folders.begin(), folders.end(), [&](const SetFolder& f) { return f.folder == folder; });
+    if (found == folders.end()) found = folders.insert(folders.end(), SetFolder{folder, {}});
+    found->files.push_back(i);
+  }
+  std::sort(folders.begin(), folders.end(),
+            [](const SetFolder& a, const SetFolder& b) { return a.folder < b.folder; });
+  return folders;
+}
+
+// flock(2) on a set's folders, taken in sorted order (no two writers deadlock) and released on destruction.
+// A folder that cannot be opened or locked is left unlocked: the renames go on as before.
 class FolderLocks {
  public:
-  explicit FolderLocks(const std::vector<fs::path>& targets) {
-    std::set<fs::path> folders;
-    for (const fs::path& target : targets) {
-      folders.insert(target.parent_path().empty() ? fs::path(".") : target.parent_path());
-    }
-    for (const fs::path& folder : folders) {
-      const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  explicit FolderLocks(const std::vector<SetFolder>& folders) {
+    for (const SetFolder& set_folder : folders) {
+      const int fd = ::open(set_folder.folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
       if (fd < 0) continue;
       while (::flock(fd, LOCK_EX) != 0 && errno == EINTR) {
       }
@@ -154,13 +268,28 @@ class FolderLocks {
   std::vector<int> fds_;
 };
 
-// The journal of a set being replaced, in the folder of its first file: one line per file, "target\tkept\t
-// temporary" (kept: the earlier file's second name, empty for a new file). Written and synced before the
-// first rename and removed after the last, so that a writer killed between two renames leaves a record of
-// what was under way; the next writer of a file in that folder, under the same folder lock, completes the
-// set from the temporaries, which were whole and synced before the journal was written.
+// The journal of a set's files in one folder, `.calligraphy-set-PID-N.journal` in that folder (a set whose
+// targets are in several folders has one journal in each, and needs no other folder):
+//
+//   calligraphy-set-journal 3
+//   TARGET<tab>KEPT<tab>TEMPORARY      one line per file of the set in this folder
+//   checksum HHHHHHHHHHHHHHHH           FNV-1a (64 bits) of every byte before this line, in hex
+//
+// TARGET, KEPT (the earlier file's second name, empty for a new file) and TEMPORARY are file names in the
+// journal's own folder: no "/", never "." or ".."; KEPT and TEMPORARY of the forms this writer gives them
+// (".NAME.kept-...", ".NAME.tmp-..."). Every journal of a set is written whole under a temporary name, synced
+// and renamed into place before the set's first rename; the set is then replaced folder by folder, and each
+// folder's journal is removed once that folder's renames are done. So a writer killed part way leaves each
+// folder of the set either replaced, or holding a journal of what was under way there; the next writer of a
+// set in that folder, under the same folder lock, completes it from the temporaries, which were whole and
+// synced before any journal was written. Because every name is a name in the journal's folder, a journal
+// copied with its folder completes the copy only; a journal that is not this writer's (another tag or
+// version, a checksum that differs, a name with a "/" or that is "." or "..", a file it names that is a
+// symbolic link or not a regular file) is refused and left as it is.
 constexpr const char* kJournalPrefix = ".calligraphy-set-";
 constexpr const char* kJournalSuffix = ".journal";
+constexpr std::string_view kJournalHeader = "calligraphy-set-journal 3\n";
+constexpr std::string_view kJournalChecksum = "checksum ";
 
 std::string unique_suffix() {
   static std::atomic<unsigned> counter{0};
@@ -169,17 +298,15 @@ std::string unique_suffix() {
   return suffix;
 }
 
-void write_whole(const fs::path& path, std::string_view content) {
-  int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-  if (fd < 0) fail(path, "cannot write the journal of a set of files", errno);
-  int error = write_all(fd, content);
-  if (error == 0 && ::fsync(fd) != 0) error = errno;
-  const int close_error = close_checked(fd);
-  if (error == 0) error = close_error;
-  if (error != 0) {
-    ::unlink(path.c_str());
-    fail(path, "cannot write the journal of a set of files", error);
+std::string journal_checksum(std::string_view text) {
+  std::uint64_t hash = 14695981039346656037ULL;  // FNV-1a, 64 bits
+  for (const char c : text) {
+    hash ^= static_cast<unsigned char>(c);
+    hash *= 1099511628211ULL;
   }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016" PRIx64, hash);
+  return hex;
 }
 
 // Replaces a set of files with their temporaries so that a failure part way restores the earlier set: each
@@ -190,10 +317,9 @@ class SetReplacement {
       : targets_(targets), existed_(existed), kept_(targets.size()), temporaries_(targets.size()) {
     for (std::size_t i = 0; i < targets.size(); ++i) {
       if (!existed[i]) continue;
-      const fs::path folder = targets[i].parent_path().empty() ? fs::path(".") : targets[i].parent_path();
       std::string name(1, '.');  // built by appends: GCC 12 warns wrongly on a + chain
       name.append(targets[i].filename().string()).append(".kept-").append(unique_suffix());
-      kept_[i] = folder / name;
+      kept_[i] = folder_of(targets[i]) / name;
       // A file system without hard links (FAT) keeps no second name: that file alone cannot be put back.
       if (::link(targets[i].c_str(), kept_[i].c_str()) != 0) kept_[i].clear();
     }
@@ -202,31 +328,54 @@ class SetReplacement {
   SetReplacement& operator=(const SetReplacement&) = delete;
   ~SetReplacement() {
     remove_kept();
-    if (!journal_.empty()) ::unlink(journal_.c_str());
+    for (const fs::path& journal : journals_) {
+      if (!journal.empty()) ::unlink(journal.c_str());
+    }
   }
 
   void add_temporary(std::size_t i, const fs::path& temporary) { temporaries_[i] = temporary; }
 
-  void write_journal() {
-    if (targets_.empty()) return;
-    std::string text;
-    for (std::size_t i = 0; i < targets_.size(); ++i) {
-      text.append(fs::absolute(targets_[i]).string()).append("\t");
-      text.append(kept_[i].empty() ? std::string() : fs::absolute(kept_[i]).string()).append("\t");
-      text.append(fs::absolute(temporaries_[i]).string()).append("\n");
+  // One journal in each folder of the set, naming that folder's files only; all are in place before the
+  // first rename. A folder that cannot take its journal throws before any target changes.
+  void write_journals(const std::vector<SetFolder>& folders) {
+    journals_.assign(folders.size(), fs::path());
+    for (std::size_t f = 0; f < folders.size(); ++f) {
+      std::string text(kJournalHeader);
+      for (const std::size_t i : folders[f].files) {
+        text.append(targets_[i].filename().string()).append("\t");
+        text.append(kept_[i].filename().string()).append("\t");
+        text.append(temporaries_[i].filename().string()).append("\n");
+      }
+      const std::string checksum = journal_checksum(text);  // of every byte before the checksum line
+      text.append(kJournalChecksum).append(checksum).append("\n");
+      std::string name(kJournalPrefix);
+      name.append(unique_suffix()).append(kJournalSuffix);
+      const fs::path journal = folders[f].folder / name;
+      // Whole or absent: a writer killed while writing it leaves a temporary, which is no journal.
+      TemporaryFile temporary(journal, journal, 0600, true);
+      temporary.write(text);
+      temporary.rename_to(journal);
+      journals_[f] = journal;
+      sync_folder(journal, journal);
     }
-    const fs::path folder = targets_[0].parent_path().empty() ? fs::path(".") : targets_[0].parent_path();
-    std::string name(kJournalPrefix);
-    name.append(unique_suffix()).append(kJournalSuffix);
-    const fs::path journal = folder / name;
-    write_whole(journal, text);
-    journal_ = journal;
-    sync_folder(journal, journal);
   }
 
-  // Targets [0, renamed) were replaced: each gets its earlier file back (a new one is removed).
-  void roll_back(std::size_t renamed) noexcept {
-    for (std::size_t i = 0; i < renamed; ++i) {
+  // The renames of folder `f` are done: they are made durable (as far as the file system allows) before its
+  // journal goes, so that the folder is never left changed without a record.
+  void folder_done(std::size_t f) noexcept {
+    if (f >= journals_.size() || journals_[f].empty()) return;
+    const int fd = ::open(journals_[f].parent_path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd >= 0) {
+      ::fsync(fd);
+      ::close(fd);
+    }
+    ::unlink(journals_[f].c_str());
+    journals_[f].clear();
+  }
+
+  // The targets in `renamed` were replaced: each gets its earlier file back (a new one is removed).
+  void roll_back(const std::vector<std::size_t>& renamed) noexcept {
+    for (const std::size_t i : renamed) {
       if (!existed_[i]) {
         ::unlink(targets_[i].c_str());
       } else if (kept_[i].empty()) {
@@ -239,8 +388,10 @@ class SetReplacement {
 
   void commit() noexcept {
     remove_kept();
-    if (!journal_.empty()) ::unlink(journal_.c_str());
-    journal_.clear();
+    for (fs::path& journal : journals_) {
+      if (!journal.empty()) ::unlink(journal.c_str());
+      journal.clear();
+    }
   }
 
  private:
@@ -255,7 +406,7 @@ class SetReplacement {
   std::vector<bool> existed_;
   std::vector<fs::path> kept_;
   std::vector<fs::path> temporaries_;
-  fs::path journal_;
+  std::vector<fs::path> journals_;  // one per folder of the set, cleared once that folder is done
 };
 
 // The process id in a temporary's or a second name's file name (".NAME.tmp-PID-N", ".NAME.kept-PID-N"), or 0.
@@ -285,38 +436,140 @@ void remove_dead_writers_files(const fs::path& folder) {
   for (const fs::path& path : dead) ::unlink(path.c_str());
 }
 
-// Completes every set a killed writer left half replaced in the folders of `targets` (held locked): each
-// temporary the journal names that is still there is renamed over its target, then the earlier files'
-// second names and the journal are removed. The lock says no live writer is between its renames.
-void complete_interrupted_sets(const std::vector<fs::path>& targets) {
-  std::set<fs::path> folders;
-  for (const fs::path& target : targets)
-    folders.insert(target.parent_path().empty() ? fs::path(".") : target.parent_path());
-  for (const fs::path& folder : folders) {
+// Removes the temporaries of `target` that a killed writer left beside it (".NAME.tmp-PID-N", its process
+// gone): a writer killed by SIGKILL cannot remove its own.
+void remove_dead_writers_temporaries(const fs::path& target) {
+  std::string prefix(1, '.');  // built by appends: GCC 12 warns wrongly on a + chain
+  prefix.append(target.filename().string()).append(".tmp-");
+  std::error_code error;
+  std::vector<fs::path> dead;
+  for (fs::directory_iterator entry(folder_of(target), error), end; !error && entry != end;
+       entry.increment(error)) {
+    const std::string name = entry->path().filename().string();
+    if (!name.starts_with(prefix)) continue;
+    const pid_t pid = writer_of(name);
+    if (pid != 0 && pid != ::getpid() && ::kill(pid, 0) != 0 && errno == ESRCH) dead.push_back(entry->path());
+  }
+  for (const fs::path& path : dead) ::unlink(path.c_str());
+}
+
+// One file of a journal, resolved: its target, the earlier file's second name (empty: none), the temporary.
+struct JournalEntry {
+  fs::path target;
+  fs::path kept;
+  fs::path temporary;
+};
+
+[[noreturn]] void refuse_journal(const fs::path& journal, const std::string& why) {
+  throw DataError(journal.string() + ": " + why +
+                  ": not the journal of a set this writer left in this folder; refused and left as it is "
+                  "(nothing was written; remove it once the files it names are checked)");
+}
+
+// A name of a file in the target's folder, of the form this writer gives it (".NAME" + mark + "...").
+bool sibling_name(const std::string& name, const fs::path& target, const char* mark) {
+  std::string prefix(1, '.');  // built by appends: GCC 12 warns wrongly on a + chain
+  prefix.append(target.filename().string()).append(mark);
+  return name.size() > prefix.size() && name.starts_with(prefix) && name.find('/') == std::string::npos;
+}
+
+// A regular file, not there, or neither (a link, a folder, ...): refused.
+bool regular_or_absent(const fs::path& path) {
+  struct stat status {};
+  if (::lstat(path.c_str(), &status) != 0) return errno == ENOENT;
+  return S_ISREG(status.st_mode);
+}
+
+// The files a journal in `folder` (resolved) names, every one checked as the journal's comment says before
+// any is touched. Throws DataError naming the journal when anything differs.
+std::vector<JournalEntry> read_journal(const fs::path& journal, const fs::path& folder) {
+  struct stat status {};
+  if (::lstat(journal.c_str(), &status) != 0) return {};  // completed meanwhile
+  if (!S_ISREG(status.st_mode)) refuse_journal(journal, "not a regular file");
+  std::optional<std::string> text;
+  try {
+    text = read_file_for_update(journal, std::uintmax_t{1} << 20);
+  } catch (const DataError& e) {
+    refuse_journal(journal, e.what());
+  }
+  if (!text) return {};
+  if (!text->starts_with(kJournalHeader)) {
+    refuse_journal(journal, "does not begin with the format tag \"calligraphy-set-journal 3\"");
+  }
+  if (!text->ends_with("\n")) refuse_journal(journal, "cut short (no checksum line)");
+  const std::size_t checksum_line = text->rfind('\n', text->size() - 2) + 1;
+  const std::string_view body(text->data(), checksum_line);
+  const std::string_view last(text->data() + checksum_line, text->size() - checksum_line - 1);
+  if (!last.starts_with(kJournalChecksum) || checksum_line <= kJournalHeader.size() ||
+      last.substr(kJournalChecksum.size()) != journal_checksum(body)) {
+    refuse_journal(journal, "its checksum does not match its contents");
+  }
+  std::vector<JournalEntry> entries;
+  std::size_t start = kJournalHeader.size();
+  while (start < checksum_line) {
+    const std::size_t end_of_line = text->find('\n', start);
+    const std::string line = text->substr(start, end_of_line - start);
+    start = end_of_line + 1;
+    const std::size_t first_tab = line.find('\t');
+    const std::size_t second_tab =
+        first_tab == std::string::npos ? first_tab : line.find('\t', first_tab + 1);
+    if (second_tab == std::string::npos || line.find('\t', second_tab + 1) != std::string::npos ||
+        line.find('\0') != std::string::npos) {
+      refuse_journal(journal, "a line is not TARGET, KEPT and TEMPORARY");
+    }
+    const std::string target = line.substr(0, first_tab);
+    const std::string kept = line.substr(first_tab + 1, second_tab - first_tab - 1);
+    const std::string temporary = line.substr(second_tab + 1);
+    std::string quoted("the name \"");
+    quoted.append(target).append("\"");
+    if (target.empty() || target == "." || target == ".." || target.find('/') != std::string::npos)
+      refuse_journal(journal, quoted + " is not the name of a file in the journal's own folder");
+    if (!sibling_name(temporary, target, ".tmp-") ||
+        (!kept.empty() && !sibling_name(kept, target, ".kept-"))) {
+      refuse_journal(journal, quoted + ": its temporary or second name is not one this writer gives");
+    }
+    JournalEntry entry{folder / target, kept.empty() ? fs::path() : folder / kept, folder / temporary};
+    if (!regular_or_absent(entry.target) || !regular_or_absent(entry.temporary) ||
+        (!kept.empty() && !regular_or_absent(entry.kept))) {
+      refuse_journal(journal, quoted + ": a file it names is a symbolic link or not a regular file");
+    }
+    entries.push_back(std::move(entry));
+  }
+  return entries;
+}
+
+// Completes every set a killed writer left half replaced in `folders` (held locked): each journal is read
+// and checked whole (read_journal), then each temporary it names that is still there is renamed over its
+// target, and the earlier files' second names and the journal are removed. The lock says no live writer is
+// between its renames. A journal refused throws, naming it, before anything of it is done.
+void complete_interrupted_sets(const std::vector<SetFolder>& folders) {
+  for (const SetFolder& set_folder : folders) {
+    const fs::path& folder = set_folder.folder;
     std::error_code error;
+    std::vector<fs::path> journals;
     for (fs::directory_iterator entry(folder, error), end; !error && entry != end; entry.increment(error)) {
       const std::string name = entry->path().filename().string();
-      if (!name.starts_with(kJournalPrefix) || !name.ends_with(kJournalSuffix)) continue;
-      const std::optional<std::string> text = read_file_for_update(entry->path(), std::uintmax_t{1} << 20);
-      if (!text) continue;
-      std::size_t start = 0;
-      while (start < text->size()) {
-        std::size_t end_of_line = text->find('\n', start);
-        if (end_of_line == std::string::npos) end_of_line = text->size();
-        const std::string line = text->substr(start, end_of_line - start);
-        start = end_of_line + 1;
-        const std::size_t first_tab = line.find('\t');
-        const std::size_t second_tab =
-            first_tab == std::string::npos ? first_tab : line.find('\t', first_tab + 1);
-        if (second_tab == std::string::npos) continue;
-        const std::string target = line.substr(0, first_tab);
-        const std::string kept = line.substr(first_tab + 1, second_tab - first_tab - 1);
-        const std::string temporary = line.substr(second_tab + 1);
-        if (::access(temporary.c_str(), F_OK) == 0) ::rename(temporary.c_str(), target.c_str());
-        if (!kept.empty()) ::unlink(kept.c_str());
+      if (name.starts_with(kJournalPrefix) && name.ends_with(kJournalSuffix))
+        journals.push_back(entry->path());
+    }
+    std::sort(journals.begin(), journals.end());
+    for (const fs::path& journal : journals) {
+      const std::vector<JournalEntry> entries = read_journal(journal, folder);
+      for (const JournalEntry& entry : entries) {
+        // A temporary already renamed is gone (ENOENT); any other failure keeps the journal, so that the set
+        // is completed by a later write rather than left half replaced with no record of it.
+        if (::rename(entry.temporary.c_str(), entry.target.c_str()) != 0 && errno != ENOENT) {
+          const int rename_error = errno;
+          std::string what("cannot complete the set it records (the journal is kept for the next write): ");
+          what.append(entry.target.string());
+          fail(journal, what, rename_error);
+        }
       }
-      ::unlink(entry->path().c_str());
-      sync_folder(entry->path(), entry->path());
+      for (const JournalEntry& entry : entries) {
+        if (!entry.kept.empty()) ::unlink(entry.kept.c_str());
+      }
+      ::unlink(journal.c_str());
+      sync_folder(journal, journal);
     }
     remove_dead_writers_files(folder);
   }
@@ -357,6 +610,7 @@ void write_file_atomically(const fs::path& path, std::string_view content) {
   temporary.write(content);
   temporary.rename_to(target);
   sync_folder(target, path);
+  remove_dead_writers_temporaries(target);
 }
 
 struct AtomicFileSet::Impl {
@@ -404,27 +658,57 @@ void AtomicFileSet::commit() {
   impl_->committed = true;
   const std::vector<fs::path>& targets = impl_->targets;
   // Renames need no data blocks: once every temporary is whole, the set is replaced in one short run, under
-  // an exclusive lock of each folder, so that two writers of one set never interleave their renames. A set
-  // that a killed writer left half replaced is completed first (its journal, above).
+  // an exclusive lock of each of its folders, so that two writers of one set never interleave their renames.
+  // A set that a killed writer left half replaced in one of these folders is completed first (its journal,
+  // above). Then every folder gets its journal, and the set is replaced folder by folder, each folder's
+  // journal removed once its renames are done.
   {
-    const FolderLocks locks(targets);
-    complete_interrupted_sets(targets);
+    const std::vector<SetFolder> folders = folders_of_set(targets);
+    const FolderLocks locks(folders);
+    complete_interrupted_sets(folders);
+    const RenamesUnderWay renaming;  // a stop signal from here on ends the process once the set is whole
     SetReplacement replacement(targets, impl_->existed);
     for (std::size_t i = 0; i < targets.size(); ++i)
       replacement.add_temporary(i, impl_->temporaries[i]->path());
-    replacement.write_journal();
-    for (std::size_t i = 0; i < targets.size(); ++i) {
-      try {
-        impl_->temporaries[i]->rename_to(targets[i]);
-      } catch (const DataError&) {
-        replacement.roll_back(i);  // the earlier set again, then the error naming the file at fault
-        throw;
+    replacement.write_journals(folders);
+    std::vector<std::size_t> renamed;
+    renamed.reserve(targets.size());
+    for (std::size_t f = 0; f < folders.size(); ++f) {
+      for (const std::size_t i : folders[f].files) {
+        try {
+          impl_->temporaries[i]->rename_to(targets[i]);
+        } catch (const DataError&) {
+          replacement.roll_back(renamed);  // the earlier set again, then the error naming the file at fault
+          throw;
+        }
+        renamed.push_back(i);
       }
+      replacement.folder_done(f);
     }
     replacement.commit();
   }
   for (const fs::path& target : targets) sync_folder(target, target);
   for (const auto& [path, content] : impl_->in_place) write_in_place(path, content);
+}
+
+void guard_output_files() noexcept {
+  if (signals_guarded.exchange(true)) return;
+  struct sigaction ignore {};
+  ignore.sa_handler = SIG_IGN;
+  sigemptyset(&ignore.sa_mask);
+  sigaction(SIGXFSZ, &ignore, nullptr);
+  sigaction(SIGPIPE, &ignore, nullptr);
+  struct sigaction cleanup {};
+  cleanup.sa_handler = remove_temporaries_then_die;
+  sigemptyset(&cleanup.sa_mask);
+  for (const int signal : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&cleanup.sa_mask, signal);
+  cleanup.sa_flags = SA_RESTART;
+  for (const int signal : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction current {};
+    if (sigaction(signal, nullptr, &current) == 0 && current.sa_handler == SIG_DFL) {
+      sigaction(signal, &cleanup, nullptr);
+    }
+  }
 }
 
 void write_files_atomically(std::span<const FileContent> files) {

@@ -6,7 +6,8 @@
 //   CALLIGRAPHY_FAULT_CALL    open | write | fsync | rename | link | mkdir | unlink | flock: the kind that fails
 //   CALLIGRAPHY_FAULT_AT      N >= 1: the Nth call of that kind fails (0 or unset: none; the shim only counts)
 //   CALLIGRAPHY_FAULT_ERRNO   ENOSPC | EIO | EROFS | ENOLCK | EPERM | EDQUOT (default EIO)
-//   CALLIGRAPHY_FAULT_KILL    1: SIGKILL the process at that call instead of failing it
+//   CALLIGRAPHY_FAULT_KILL    1: SIGKILL the process at that call instead of failing it; TERM, INT or HUP:
+//                             raise that signal just before the call, which then goes on as it would
 //   CALLIGRAPHY_FAULT_COUNTS  a file that receives, at exit, one line "kind count" per kind counted
 //
 // Calls on descriptors (write, fsync, flock) count when the descriptor's path (/proc/self/fd) is under the
@@ -35,7 +36,7 @@ static size_t under_length = 0;
 static int fault_kind = -1;
 static long fault_at = 0;
 static int fault_errno = EIO;
-static int fault_kill = 0;
+static int fault_kill = 0;  // the signal raised at the call (SIGKILL for "1"), or 0
 static const char* counts_file = NULL;
 
 static void configure(void) {
@@ -63,7 +64,10 @@ static void configure(void) {
     }
   }
   const char* kill_it = getenv("CALLIGRAPHY_FAULT_KILL");
-  fault_kill = kill_it != NULL && strcmp(kill_it, "1") == 0;
+  if (kill_it != NULL && strcmp(kill_it, "1") == 0) fault_kill = SIGKILL;
+  if (kill_it != NULL && strcmp(kill_it, "TERM") == 0) fault_kill = SIGTERM;
+  if (kill_it != NULL && strcmp(kill_it, "INT") == 0) fault_kill = SIGINT;
+  if (kill_it != NULL && strcmp(kill_it, "HUP") == 0) fault_kill = SIGHUP;
   counts_file = getenv("CALLIGRAPHY_FAULT_COUNTS");
 }
 
@@ -96,7 +100,11 @@ static int fault(enum kind kind, int under_folder) {
   if (!under_folder) return 0;
   const long n = __atomic_add_fetch(&counts[kind], 1, __ATOMIC_SEQ_CST);
   if ((int)kind != fault_kind || n != fault_at) return 0;
-  if (fault_kill) raise(SIGKILL);
+  if (fault_kill == SIGKILL) raise(SIGKILL);
+  if (fault_kill != 0) {  // the program's own handler decides what comes of it; the call goes on
+    raise(fault_kill);
+    return 0;
+  }
   errno = fault_errno;
   return -1;
 }

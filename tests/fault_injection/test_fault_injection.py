@@ -24,6 +24,7 @@ import hashlib
 import json
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -41,6 +42,7 @@ KINDS = ("open", "write", "fsync", "rename", "link", "mkdir", "unlink", "flock")
 ERRNOS = ("ENOSPC", "EIO", "EROFS", "ENOLCK")
 TIMEOUT_S = 120
 LEFTOVER_MARKS = (".tmp-", ".kept-", ".calligraphy-set-")
+SIGNALS = ("TERM", "INT", "HUP")  # the stop signals raised at a step (fault_shim.c, CALLIGRAPHY_FAULT_KILL)
 
 # The Python side: study_report's writer of its set of files (the library's AtomicFileSet), given a study
 # folder whose files it writes, scaled, into out/ (a report's page, tables and figures stand in).
@@ -147,9 +149,11 @@ class FaultInjection(unittest.TestCase):
         return subprocess.run([*program, *map(str, arguments[1:] if program[0] != CLI else arguments)], cwd=cwd,
                               capture_output=True, env=environment, timeout=TIMEOUT_S)
 
-    def sweep(self, arguments_for):
+    def sweep(self, arguments_for, signals=False, files=2):
         """Every fault at every step of `arguments_for(study)` writing over the output of the one-subject
-        study with the output of the two-subject study."""
+        study with the output of the two-subject study; with `signals`, also SIGTERM, SIGINT or SIGHUP (in
+        turn) raised at every step, after which the run has ended by that signal leaving the earlier or the
+        new set and nothing else: no temporary, second name or journal."""
         work = Path(self.scratch.name) / "work"
 
         def fresh():
@@ -173,8 +177,8 @@ class FaultInjection(unittest.TestCase):
                                {"CALLIGRAPHY_FAULT_COUNTS": str(counts_file)})
         self.assertEqual(counted.returncode, 0, counted.stderr.decode())
         counts = {kind: int(n) for kind, n in (line.split() for line in counts_file.read_text().splitlines())}
-        self.assertGreaterEqual(counts["rename"], 2, counts)  # the set's files are renamed into place
-        self.assertGreaterEqual(counts["fsync"], 2, counts)
+        self.assertGreaterEqual(counts["rename"], files, counts)  # the set's files are renamed into place
+        self.assertGreaterEqual(counts["fsync"], files, counts)
         tried = 0
         for kind, n, kill, fault in every_fault(counts):
             with self.subTest(kind=kind, n=n, errno=fault["CALLIGRAPHY_FAULT_ERRNO"], kill=kill):
@@ -199,6 +203,19 @@ class FaultInjection(unittest.TestCase):
                 self.assertEqual(snapshot(work / "out"), new)
                 self.assertEqual(leftovers(work / "out"), [])
             tried += 1
+        for kind in KINDS if signals else ():
+            for n in range(1, counts[kind] + 1):
+                name = SIGNALS[tried % len(SIGNALS)]
+                number = getattr(signal, "SIG" + name)
+                with self.subTest(kind=kind, n=n, signal=name):
+                    self.assertEqual(fresh(), earlier)
+                    result = self.run_cli(arguments_for(self.two_subjects / "study"), work,
+                                          {"CALLIGRAPHY_FAULT_CALL": kind, "CALLIGRAPHY_FAULT_AT": str(n),
+                                           "CALLIGRAPHY_FAULT_KILL": name})
+                    self.assertIn(result.returncode, (-number, 128 + number), result.stderr.decode())
+                    self.assertIn(snapshot(work / "out"), (earlier, new), "a mix of the earlier and the new set")
+                    self.assertEqual(leftovers(work / "out"), [], f"left behind by {name} at {kind} {n}")
+                tried += 1
         print(f"{' '.join(map(str, arguments_for(Path('STUDY'))))}: {tried} faults at every step "
               f"({', '.join(f'{kind} {counts[kind]}' for kind in KINDS)})", flush=True)
 
@@ -210,7 +227,158 @@ class FaultInjection(unittest.TestCase):
         self.sweep(lambda study: [PYTHON_WRITER, study])
 
     def test_report_tables_alone(self):
-        self.sweep(lambda study: ["report", study, "--csv", "out"])
+        self.sweep(lambda study: ["report", study, "--csv", "out"], signals=True)
+
+    def test_trace_output(self):
+        """`trace TRACE --csv out/trace.csv` replacing an earlier export: every fault and stop signal at every
+        step."""
+        def arguments_for(study):
+            traces = sorted(study.rglob("*.trace.h5"))
+            trace = (traces[0] if study == self.one_subject / "study" else traces[-1]) if traces else study
+            return ["trace", trace, "--csv", "out/trace.csv"]
+        self.sweep(arguments_for, signals=True, files=1)
+
+    def test_journal_recovery(self):
+        """A `report --csv` killed between its two renames leaves a journal and a mix of the two sets; the next
+        run completes that set first. Every fault and kill at every step of that next run: a failed run exits 1
+        with one line, the visible files are the new set or the mix with its journal still there (never a mix
+        without one), and a clean run afterwards writes the new set and leaves nothing behind."""
+        work = Path(self.scratch.name) / "journal"
+        arguments = ["report", self.two_subjects / "study", "--csv", "out", "--jobs", "1"]
+
+        def killed_between_renames():
+            shutil.rmtree(work, ignore_errors=True)
+            (work / "out").mkdir(parents=True)
+            done = self.run_cli(["report", self.one_subject / "study", "--csv", "out", "--jobs", "1"], work)
+            self.assertEqual(done.returncode, 0, done.stderr.decode())
+            killed = self.run_cli(arguments, work, {"CALLIGRAPHY_FAULT_CALL": "rename", "CALLIGRAPHY_FAULT_AT": "2",
+                                                    "CALLIGRAPHY_FAULT_KILL": "1"})
+            self.assertEqual(killed.returncode, -9, killed.stderr.decode())
+            self.assertEqual(len([n for n in leftovers(work / "out") if ".calligraphy-set-" in n]), 1)
+            return snapshot(work / "out")
+
+        mix = killed_between_renames()
+        done = self.run_cli(arguments, work)
+        self.assertEqual(done.returncode, 0, done.stderr.decode())
+        new = snapshot(work / "out")
+        self.assertNotEqual(mix, new)
+        self.assertEqual(leftovers(work / "out"), [])
+        killed_between_renames()
+        counts_file = Path(self.scratch.name) / "journal-counts.txt"
+        counted = self.run_cli(arguments, work, {"CALLIGRAPHY_FAULT_COUNTS": str(counts_file)})
+        self.assertEqual(counted.returncode, 0, counted.stderr.decode())
+        counts = {kind: int(n) for kind, n in (line.split() for line in counts_file.read_text().splitlines())}
+        # The calls that change what the folder holds (the completion's renames and removals); the new set's own
+        # writes and syncs are swept by test_report_tables_alone.
+        swept = {kind: (n if kind in ("open", "rename", "link", "unlink") else 0) for kind, n in counts.items()}
+        tried = 0
+        for kind, n, kill, fault in every_fault(swept):
+            with self.subTest(kind=kind, n=n, errno=fault["CALLIGRAPHY_FAULT_ERRNO"], kill=kill):
+                self.assertEqual(killed_between_renames(), mix)
+                result = self.run_cli(arguments, work, fault)
+                stderr = result.stderr.decode(errors="replace")
+                after = snapshot(work / "out")
+                journals = [name for name in leftovers(work / "out") if ".calligraphy-set-" in name]
+                if kill:
+                    self.assertEqual(result.returncode, -9, stderr)
+                else:
+                    self.assertIn(result.returncode, (0, 1), stderr)
+                    self.assertNotIn("internal error", stderr)
+                    if result.returncode == 1:
+                        self.assertEqual(len(stderr.strip().splitlines()), 1, stderr)
+                self.assertTrue(after == new or journals, f"a mix of the sets and no journal: {sorted(after)}")
+                again = self.run_cli(arguments, work)
+                self.assertEqual(again.returncode, 0, again.stderr.decode())
+                self.assertEqual(snapshot(work / "out"), new)
+                self.assertEqual(leftovers(work / "out"), [])
+            tried += 1
+        print(f"report --csv completing a killed set's journal: {tried} faults at every step "
+              f"({', '.join(f'{kind} {counts[kind]}' for kind in KINDS)})", flush=True)
+
+    def test_set_over_two_folders(self):
+        """`report --csv out/tables --out out/site/report.html` is one set over sibling folders (the tables, the
+        index, the pages' folders below it), each folder with its own journal. SIGKILL at every rename: every
+        folder holds its earlier files, its new ones, or a journal of its own (a kill between two folders leaves
+        each folder earlier or new); a later set written into each journalled folder completes that folder on
+        its own, and once every journal was written before the kill, that gives the whole new set; a clean run
+        afterwards leaves nothing behind."""
+        work = Path(self.scratch.name) / "folders"
+        later_code = ("import pathlib, sys\nfrom calligraphy import study_report\n"
+                      "study_report._write_together({pathlib.Path(f) / 'later.txt': b'later' for f in sys.argv[1:]})\n")
+
+        def arguments_for(study):
+            return ["report", study, "--csv", "out/tables", "--out", "out/site/report.html", "--jobs", "1"]
+
+        def by_folder(files):
+            folders = {}
+            for name, digest in files.items():
+                folder, _, base = name.rpartition("/")
+                if base != "later.txt":
+                    folders.setdefault(folder, {})[base] = digest
+            return folders
+
+        def journals():  # a journal's own temporary ("..calligraphy-set-...journal.tmp-...") is none
+            return [name for name in leftovers(work / "out")
+                    if Path(name).name.startswith(".calligraphy-set-") and name.endswith(".journal")]
+
+        def fresh():
+            shutil.rmtree(work, ignore_errors=True)
+            for folder in ("out/tables", "out/site"):
+                (work / folder).mkdir(parents=True)
+            done = self.run_cli(arguments_for(self.one_subject / "study"), work)
+            self.assertEqual(done.returncode, 0, done.stderr.decode())
+            return by_folder(snapshot(work / "out"))
+
+        earlier = fresh()
+        done = self.run_cli(arguments_for(self.two_subjects / "study"), work)
+        self.assertEqual(done.returncode, 0, done.stderr.decode())
+        new = by_folder(snapshot(work / "out"))
+        self.assertGreaterEqual(len(new), 3, sorted(new))  # tables, site and the pages' folders
+        self.assertEqual(fresh(), earlier)
+        counts_file = Path(self.scratch.name) / "folders-counts.txt"
+        counted = self.run_cli(arguments_for(self.two_subjects / "study"), work,
+                               {"CALLIGRAPHY_FAULT_COUNTS": str(counts_file)})
+        self.assertEqual(counted.returncode, 0, counted.stderr.decode())
+        renames = {kind: int(n) for kind, n in (line.split() for line in counts_file.read_text().splitlines())}["rename"]
+        files = sum(len(folder) for folder in new.values())
+        journals_written = renames - files  # the first renames put each folder's journal in place
+        between_folders = 0
+        for n in range(1, renames + 1):
+            with self.subTest(rename=n):
+                self.assertEqual(fresh(), earlier)
+                killed = self.run_cli(arguments_for(self.two_subjects / "study"), work,
+                                      {"CALLIGRAPHY_FAULT_CALL": "rename", "CALLIGRAPHY_FAULT_AT": str(n),
+                                       "CALLIGRAPHY_FAULT_KILL": "1"})
+                self.assertEqual(killed.returncode, -9, killed.stderr.decode())
+                after = by_folder(snapshot(work / "out"))
+                journalled = sorted({str(Path(name).parent) for name in journals()})
+                for folder in set(earlier) | set(new):
+                    if folder not in journalled:
+                        self.assertIn(after.get(folder, {}), (earlier.get(folder, {}), new.get(folder, {})),
+                                      f"{folder}: a mix of the sets and no journal in it (rename {n})")
+                if all(after.get(f, {}) in (earlier.get(f, {}), new.get(f, {})) for f in set(earlier) | set(new)) \
+                        and after != earlier and after != new:
+                    between_folders += 1
+                if journalled:
+                    later = subprocess.run([sys.executable, "-c", later_code, *[Path("out") / f for f in journalled]],
+                                           cwd=work, capture_output=True, timeout=TIMEOUT_S)
+                    self.assertEqual(later.returncode, 0, later.stderr.decode())
+                completed = by_folder(snapshot(work / "out"))
+                for folder in set(earlier) | set(new):
+                    self.assertIn(completed.get(folder, {}), (earlier.get(folder, {}), new.get(folder, {})),
+                                  f"{folder}: a mix of the sets after the later set (rename {n})")
+                    if folder in journalled:
+                        self.assertEqual(completed.get(folder, {}), new.get(folder, {}), folder)
+                if n > journals_written:
+                    self.assertEqual(completed, new, f"killed at rename {n}, after every journal was written")
+                self.assertEqual(journals(), [])
+                again = self.run_cli(arguments_for(self.two_subjects / "study"), work)
+                self.assertEqual(again.returncode, 0, again.stderr.decode())
+                self.assertEqual(by_folder(snapshot(work / "out")), new)
+                self.assertEqual(leftovers(work / "out"), [])
+        self.assertGreater(between_folders, 0, "no kill fell between two folders")
+        print(f"report over {len(new)} folders: SIGKILL at each of {renames} renames ({journals_written} journals, "
+              f"{between_folders} kills between folders)", flush=True)
 
     def saved_trials(self, out):
         """{record path: SHA-256 of the record, its trace and its drawing} of every trial saved in a whole

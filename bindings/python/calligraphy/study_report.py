@@ -35,6 +35,7 @@ import math
 import os
 import pathlib
 import re
+import stat
 import sys
 import time
 import typing
@@ -191,11 +192,46 @@ def _write_together(files: dict[pathlib.Path, typing.Union[bytes, str]]) -> None
         raise OSError(str(error)) from error  # "PATH: cannot write: REASON"
 
 
+class OutputOnInput(ValueError):
+    """A file the report would write is a file of a session folder it reads (the same path, or a symbolic or
+    hard link to it)."""
+
+
+def _refuse_outputs_on_inputs(outputs: typing.Iterable[pathlib.Path], trace_files: typing.Iterable[str]) -> None:
+    """Raises OutputOnInput naming both files when any of `outputs` is, by (device, inode) after following
+    symbolic links, a file of the session folders that hold `trace_files` (each trace is
+    SESSION/trials/STEM.trace.h5): their records, traces, session.json and log, which the report reads. A
+    report never replaces a saved trial, as `calligraphy report` never does (docs/cli.md, "Output identity")."""
+    folders = {pathlib.Path(trace).resolve().parent.parent for trace in trace_files if trace}
+    inputs = {}
+    for folder in folders:
+        for path in folder.rglob("*"):
+            try:
+                status = path.stat()
+            except OSError:
+                continue
+            if stat.S_ISREG(status.st_mode):
+                inputs[(status.st_dev, status.st_ino)] = path
+    for output in outputs:
+        try:
+            status = os.stat(output)  # through symbolic links: the file a write would replace
+        except OSError:
+            continue  # not there yet (or a dangling link): not a file the report reads
+        found = inputs.get((status.st_dev, status.st_ino))
+        if found is not None:
+            raise OutputOnInput(f"--out: {output} is the same file as {found}, a file of a session folder this "
+                                f"report reads: refused, nothing written")
+
+
 def _make_folder(folder: pathlib.Path) -> None:
+    """Makes `folder` (and its parents) and checks that files can be made in it, before the report's work: the
+    set of files is written with a journal in each of its folders, and needs no other folder."""
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as error:
         raise OSError(error.errno, f"cannot create the folder {folder}: {error.strerror or error}") from error
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise OSError(errno.EACCES, f"cannot write in the folder {folder}: {os.strerror(errno.EACCES)}")
 
 
 # ---------------------------------------------------------------------------------------------- data
@@ -817,8 +853,9 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
     tables/statistics.csv (``statistics.statistics_table``). docs/experiments.md lists every column.
 
     Raises TypeError when `study` has no trials DataFrame; ValueError naming a missing or non-numeric column,
-    an unknown reference or an empty `out_dir`; OSError naming a file or folder that could not be written;
-    ImportError without pandas, matplotlib, SciPy or statsmodels. Without R (lme4, lmerTest) the mixed
+    an unknown reference or an empty `out_dir`; OutputOnInput (a ValueError) naming both files when a file it
+    would write is a file of a session folder it reads (through a symbolic or hard link), before anything is
+    written; OSError naming a file or folder that could not be written; ImportError without pandas, matplotlib, SciPy or statsmodels. Without R (lme4, lmerTest) the mixed
     models' rows say "not computed" and name the packages.
     """
     from . import design_analysis
@@ -928,6 +965,7 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
             "</body></html>\n"]
     index = out / "index.html"
     files[index] = "".join(page)
+    _refuse_outputs_on_inputs(files, study.trials["trace_file"] if "trace_file" in study.trials else ())
     _write_together(files)
     return index
 
@@ -1050,6 +1088,9 @@ def main(argv: typing.Optional[typing.Sequence[str]] = None) -> int:
         study = _study.load(arguments.folders)
         index = write_report(study, arguments.out, title=arguments.title, per_trial_page=arguments.per_trial_page,
                              reference=arguments.reference, keep_end_reasons=keep, ddf=arguments.ddf)
+    except OutputOnInput as error:  # wrong usage, as the command line's exit 2
+        print(f"calligraphy.study_report: error: {error}", file=sys.stderr)
+        return 2
     except (DataError, ValueError, TypeError, OSError, ImportError) as error:
         print(f"calligraphy.study_report: {error}", file=sys.stderr)
         return 1

@@ -47,13 +47,26 @@ struct FileContent {
 ///  - `add` writes one file's temporary beside its target, whole (fsync'ed and closed), so that a large set
 ///    need not be held in memory; a failure (a full disk) throws and, once the set is destroyed, leaves every
 ///    earlier file as it was. `add` may be called from several threads.
-///  - `commit` replaces the targets, one rename each in the order added, under an exclusive flock(2) of their
-///    folders (two writers of one set never interleave). Before the first rename each earlier file gets a
-///    second name (a hard link beside it), so that a rename failing part way (EIO, an immutable file) puts
-///    every replaced file back and throws naming the file at fault. A journal written and synced before the
-///    first rename (`.calligraphy-set-*.journal` in the first file's folder) records the set: a writer killed
-///    between two renames leaves it, and the next set committed in that folder first completes it from the
-///    whole temporaries, so the killed set ends whole.
+///  - `commit` replaces the targets under an exclusive flock(2) of each of their folders (two writers of one
+///    set never interleave), folder by folder in the sorted order of the folders, one rename each in the
+///    order added within a folder. Before the first rename each earlier file gets a second name (a hard link
+///    beside it), so that a rename failing part way (EIO, an immutable file) puts every replaced file back,
+///    in every folder, and throws naming the file at fault. Each folder of the set gets its own journal
+///    (`.calligraphy-set-*.journal`), written whole and synced before the set's first rename and removed once
+///    that folder's renames are done; it names only files in its own folder. A writer killed part way leaves
+///    each folder either replaced or holding its journal, and the next set committed in a folder first
+///    completes that folder's journal from the whole temporaries. So "replaced together" means: within one
+///    folder, the earlier files, the new ones, or a mix its journal records and the next set there completes;
+///    across folders, a set killed part way (also while its journals were being written) may leave some
+///    folders new and others earlier, each folder whole or journalled on its own, until a later set in each
+///    (the same command run again) completes it. The
+///    journal holds its format tag and version, file names and a checksum of its contents; one that differs
+///    in any of them, names a file with a "/" (or ".", ".."), or names a symbolic link, is refused before
+///    anything is done: the commit throws DataError naming the journal, which is left as it is. So a journal
+///    copied with its folder completes the copy only, and one planted in a folder changes nothing outside it.
+///    A set needs no folder but its targets' own (in which `add` already made the temporaries); a stop
+///    signal (guard_output_files) that comes between the first and the last rename ends the process once
+///    the set is whole.
 ///  - destroyed without `commit`: the temporaries are removed and no target changes.
 /// Throws DataError naming the file at fault (as `write_file_atomically`), StateError for `add` after
 /// `commit` or a second `commit`. A device or FIFO among the targets is written in place after the renames.
@@ -72,6 +85,17 @@ class AtomicFileSet {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// Makes a program's file outputs safe from the signals that would otherwise end it mid-write; call once at
+/// start-up, before any thread is made (the command line's main does):
+///  - SIGXFSZ is ignored, so a write over the file size limit (RLIMIT_FSIZE, `ulimit -f`) fails with EFBIG,
+///    which the writers report (DataError naming the file) after removing their temporary;
+///  - SIGPIPE is ignored, so a closed pipe is the write error EPIPE, reported, not a silent death;
+///  - SIGINT, SIGTERM and SIGHUP, where they are at their default action, first remove every temporary
+///    file the writers of this file have open, then end the process as the default action would (a set
+///    between its renames is finished first). A program that catches them itself (StopSignals, while it
+///    lives) is not changed. Never throws.
+void guard_output_files() noexcept;
 
 /// The files of `files` as one `AtomicFileSet`, committed.
 void write_files_atomically(std::span<const FileContent> files);
