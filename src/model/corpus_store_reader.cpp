@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 
 #include "calligraphy/core/errors.hpp"
@@ -84,7 +85,9 @@ void CorpusStore::Data::validate() {
                                std::to_string(kVersionMajor) + ".x)");
   }
   if (get_u32(bytes + kOffHeaderSize) != kHeaderBytes) fail(kOffHeaderSize, "unexpected header size");
-  if (get_u32(bytes + kOffFlags) != 0) fail(kOffFlags, "unknown flags");
+  const std::uint32_t flags = get_u32(bytes + kOffFlags);
+  if ((flags & ~kKnownFlags) != 0) fail(kOffFlags, "unknown flags");
+  info.medians = (flags & kFlagMedians) != 0;
   info.character_count = get_u32(bytes + kOffCount);
   info.steps_per_unit = static_cast<int>(get_u32(bytes + kOffSteps));
   const int s = info.steps_per_unit;
@@ -157,6 +160,7 @@ Character CorpusStore::Data::decode(std::size_t k) const {
   character.strokes.resize(stroke_count);
   std::int64_t x = 0;
   std::int64_t y = 0;
+  std::vector<std::array<std::int64_t, 2>> median_origins(stroke_count);
   for (std::size_t s = 0; s < stroke_count; ++s) {
     Stroke& stroke = character.strokes[s];
     stroke.typical_id = static_cast<int>(get(6));
@@ -178,6 +182,7 @@ Character CorpusStore::Data::decode(std::size_t k) const {
     };
     const int start_width = static_cast<int>(get(5));
     Vec2 previous = next_point(start_width);
+    median_origins[s] = {x / info.steps_per_unit, y / info.steps_per_unit};
     const int width = static_cast<int>(get(5));
     stroke.elements.resize(n);
     for (std::size_t e = 0; e < n; ++e) {
@@ -205,6 +210,39 @@ Character CorpusStore::Data::decode(std::size_t k) const {
     } else {
       stroke.attraction_factors.assign(n + 1,
                                        default_factors[static_cast<std::size_t>(stroke.typical_id - 1)]);
+    }
+  }
+  if (info.medians) {
+    for (std::size_t s = 0; s < stroke_count; ++s) {
+      std::size_t n = get(5);
+      if (n == kMedianCountEscape) {
+        n = get(kMedianCountExtensionBits);
+        if (n < kMedianCountEscape) bad("stroke " + std::to_string(s + 1) + ": median count not minimal");
+      }
+      if (n == 0) continue;
+      std::vector<Vec2>& median = character.strokes[s].median;
+      median.reserve(n);
+      const int shift = static_cast<int>(get(2));
+      const double unit = 1.0 / static_cast<double>(1 << shift);
+      std::int64_t mx = median_origins[s][0] * (std::int64_t{1} << shift);
+      std::int64_t my = median_origins[s][1] * (std::int64_t{1} << shift);
+      const auto add_point = [&] {
+        if (std::abs(mx) > kMaxMedianCoordinate || std::abs(my) > kMaxMedianCoordinate)
+          bad("stroke " + std::to_string(s + 1) + ": median point out of range");
+        median.emplace_back(static_cast<double>(mx) * unit, static_cast<double>(my) * unit);
+      };
+      const int start_width = static_cast<int>(get(5));
+      mx += unzigzag(get(start_width));
+      my += unzigzag(get(start_width));
+      add_point();
+      if (n == 1) continue;
+      const int width_x = static_cast<int>(get(5));
+      const int width_y = static_cast<int>(get(5));
+      for (std::size_t i = 1; i < n; ++i) {
+        mx += unzigzag(get(width_x));
+        my += unzigzag(get(width_y));
+        add_point();
+      }
     }
   }
   // The writer pads the last byte with zero bits and writes nothing after.

@@ -118,12 +118,13 @@ def test_from_store_matches_the_fitted_characters(store_path, library):
     assert len(store) == len(library)
     info = store.store_info
     assert info["character_count"] == len(library)
+    assert info["version"] == "1.1" and info["medians"]
     assert library.store_info is None
     for ch in ("永", "我"):
         stored, fitted = store.load(ch), library.load(ch)
         assert stored.typical_stroke_ids == fitted.typical_stroke_ids
         for s_stored, s_fitted in zip(stored.strokes, fitted.strokes):
-            assert s_stored.median.shape == (0, 2)  # a store keeps no medians
+            np.testing.assert_array_equal(s_stored.median, s_fitted.median)  # kept exactly (integers)
             np.testing.assert_allclose(s_stored.attraction_factors, s_fitted.attraction_factors)
             # Control points are quantised to 1 / steps_per_unit data units.
             error = np.abs(s_stored.feature_points - s_fitted.feature_points).max()
