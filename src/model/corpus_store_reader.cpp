@@ -12,8 +12,9 @@
 #include <cstring>
 
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/model/corpus_store.hpp"
 #include "calligraphy/core/unicode.hpp"
+#include "calligraphy/model/corpus_store.hpp"
+#include "model/bundled_corpus_store.hpp"
 #include "model/corpus_store_format.hpp"
 
 namespace calligraphy {
@@ -292,6 +293,22 @@ CorpusStore CorpusStore::from_bytes(std::span<const std::uint8_t> bytes, const s
   data->validate();
   return CorpusStore(std::move(data));
 }
+
+const CorpusStore& CorpusStore::bundled() {
+  // Checked once; a failure is thrown again to every caller (static initialisation is retried).
+  static const CorpusStore store = [] {
+    const detail::BundledCorpusStore bundled = detail::bundled_corpus_store();
+    auto data = std::make_shared<Data>();
+    data->name = std::string("bundled:") + bundled.name;
+    data->bytes = bundled.bytes.data();
+    data->size = bundled.bytes.size();
+    data->validate();
+    return CorpusStore(std::move(data));
+  }();
+  return store;
+}
+
+const char* CorpusStore::bundled_sha256() { return detail::bundled_corpus_store().sha256; }
 
 const CorpusStoreInfo& CorpusStore::info() const { return data_->info; }
 const std::string& CorpusStore::name() const { return data_->name; }

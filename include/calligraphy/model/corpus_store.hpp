@@ -84,6 +84,16 @@ class CorpusStore {
   static CorpusStore open(const std::filesystem::path& path);
   /// The same over a copy of `bytes` (tests, fuzzing); `name` stands for the file in errors.
   static CorpusStore from_bytes(std::span<const std::uint8_t> bytes, const std::string& name);
+  /// The store compiled into the library: every character of hanzi-writer-data 2.0.1 (9,574) fitted by
+  /// `calligraphy corpus build` at the default tolerance and quantisation, with the medians (format
+  /// 1.1), from data/corpus/hanzi-writer-data-2.0.1.clg (Arphic Public License: data/corpus/ARPHICPL.TXT
+  /// and NOTICE.md, installed under share/calligraphy/corpus). Checked when first asked for (header,
+  /// index and their checksums; each record when loaded, as `open`), then shared, without a copy. Its
+  /// `name()` is "bundled:hanzi-writer-data-2.0.1.clg". Throws DataError as `open` if the compiled-in
+  /// bytes fail the checks.
+  static const CorpusStore& bundled();
+  /// SHA-256 of the bundled store's file, lower-case hex (64 characters).
+  static const char* bundled_sha256();
 
   [[nodiscard]] const CorpusStoreInfo& info() const;
   [[nodiscard]] std::size_t size() const { return info().character_count; }
