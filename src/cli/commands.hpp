@@ -14,6 +14,8 @@ void add_score_command(CLI::App& root, Commands& commands);     // score TRACE.c
 void add_trace_command(CLI::App& root, Commands& commands);     // trace TRACE.trace.h5 [--csv FILE]
 void add_model_command(CLI::App& root, Commands& commands);     // model CHAR [...]
 void add_strokes_command(CLI::App& root, Commands& commands);   // strokes [--markdown FILE] [--json]
+// characters [--strokes N] [--typical STROKE] [--text TEXT] [--json]
+void add_characters_command(CLI::App& root, Commands& commands);
 void add_devices_command(CLI::App& root, Commands& commands, DeviceRegistry& devices);  // devices [--json]
 void add_corpus_commands(CLI::App& root, Commands& commands);   // corpus build|stats|fidelity|validate
 void add_bench_commands(CLI::App& root, Commands& commands);    // bench nearest|jumps|tick|loop|acceptance
