@@ -13,6 +13,7 @@
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/model/corpus_store.hpp"
 #include "calligraphy/model/scene.hpp"
+#include "corpus_folder.hpp"
 
 using namespace calligraphy;
 
@@ -130,4 +131,24 @@ TEST_CASE("A copy of the store file truncated or damaged is refused naming the f
   write(damaged);
   CHECK_THROWS_WITH(CorpusStore::open(path), Catch::Contains(path.string()) && Catch::Contains("checksum"));
   std::filesystem::remove(path);
+}
+
+TEST_CASE("The bundled store's medians are hanzi-writer-data's, exactly, for every character of the package",
+          "[store][bundled]") {
+  // The whole package where scripts/test.sh fetched it, else the sample in tests/data (said on stdout).
+  const CharacterLibrary package = CharacterLibrary::from_directory(testing::corpus_folder());
+  const CorpusStore& store = CorpusStore::bundled();
+  std::size_t compared = 0;
+  for (char32_t c : package.characters()) {
+    INFO(describe_character(c));
+    REQUIRE(store.contains(c));
+    const CharacterData data = package.load_data(c);
+    const Character stored = store.load(c);
+    REQUIRE(stored.strokes.size() == data.medians.size());
+    for (std::size_t s = 0; s < data.medians.size(); ++s) {
+      if (stored.strokes[s].median != data.medians[s]) FAIL("stroke " << s + 1 << ": the median differs");
+    }
+    ++compared;
+  }
+  CHECK(compared >= 100);
 }

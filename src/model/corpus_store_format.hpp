@@ -34,7 +34,8 @@ inline constexpr std::uint32_t kKnownFlags = kFlagMedians;
 inline constexpr std::uint64_t kMedianCountEscape = 31;
 inline constexpr int kMedianCountExtensionBits = 14;
 inline constexpr std::int64_t kMaxMedianCoordinate = std::int64_t{1} << 23;  // |x| in 2^-shift units
-inline constexpr int kMaxMedianShift = 3;  // a median's coordinates in units of 2^-shift data units, 0-3
+inline constexpr int kMaxMedianShift = 2;  // a median's coordinates in units of 2^-shift data units, 0-2
+inline constexpr int kMedianRawMode = 3;   // else: each coordinate a float64 (data units, |x| <= 2^23)
 
 // Per-stroke flags.
 // Not every factor is the file's default for the ID: a 1-bit mode follows. Mode 1 (palette): one bit per

@@ -224,6 +224,19 @@ Character CorpusStore::Data::decode(std::size_t k) const {
       std::vector<Vec2>& median = character.strokes[s].median;
       median.reserve(n);
       const int shift = static_cast<int>(get(2));
+      if (shift == kMedianRawMode) {
+        for (std::size_t i = 0; i < n; ++i) {
+          std::array<double, 2> xy{};
+          for (double& v : xy) {
+            const std::uint64_t bits = get(64);
+            std::memcpy(&v, &bits, sizeof v);
+            if (!std::isfinite(v) || std::abs(v) > static_cast<double>(kMaxMedianCoordinate))
+              bad("stroke " + std::to_string(s + 1) + ": median coordinate not finite or out of range");
+          }
+          median.emplace_back(xy[0], xy[1]);
+        }
+        continue;
+      }
       const double unit = 1.0 / static_cast<double>(1 << shift);
       std::int64_t mx = median_origins[s][0] * (std::int64_t{1} << shift);
       std::int64_t my = median_origins[s][1] * (std::int64_t{1} << shift);

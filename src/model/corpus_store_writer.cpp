@@ -135,9 +135,10 @@ class RecordEncoder {
     median_origins_.push_back({points[0].x / steps_, points[0].y / steps_});
   }
 
-  // The median in units of 2^-shift data units, shift 0-3 the smallest that holds every coordinate exactly
-  // (hanzi-writer-data: whole units, in 32 characters quarter units), else 3 and rounded. Its first point
-  // relative to the stroke's start, the others to the point before, x and y each in its own width.
+  // The median in units of 2^-shift data units, shift 0-2 the smallest that holds every coordinate exactly
+  // (hanzi-writer-data: whole units, in 31 characters quarter units): its first point relative to the
+  // stroke's start, the others to the point before, x and y each in its own width. Else (2 strokes of
+  // hanzi-writer-data, in ninths of a unit) mode 3: each coordinate as a float64, so that none is changed.
   void encode_median(std::size_t s) {
     const std::vector<Vec2>& median = character_.strokes[s].median;
     const std::string where = "stroke " + std::to_string(s + 1) + ": median";
@@ -158,8 +159,18 @@ class RecordEncoder {
                std::nearbyint(p.y() * scale) == p.y() * scale;
       });
     };
-    while (shift < kMaxMedianShift && !exact(shift)) ++shift;
+    while (shift <= kMaxMedianShift && !exact(shift)) ++shift;
     out_.put(static_cast<std::uint64_t>(shift), 2);
+    if (shift == kMedianRawMode) {
+      for (const Vec2& p : median) {
+        for (double v : {p.x(), p.y()}) {
+          if (!std::isfinite(v) || std::abs(v) > static_cast<double>(kMaxMedianCoordinate))
+            fail(where + ": coordinate " + std::to_string(v) + " out of range");
+          out_.put(double_bits(v), 64);
+        }
+      }
+      return;
+    }
     std::vector<QPoint> points;
     for (const Vec2& p : median) {
       const auto round = [&](double v) {

@@ -9,7 +9,7 @@
 /// points quantised to 1/steps_per_unit data units, joints shared) and the attraction factors at the
 /// feature points (exact float64; a stroke whose factors all equal its typical stroke's default
 /// stores none) and, in a 1.1 store written with `CorpusStoreOptions::medians` (the default), the
-/// source medians (exact down to 1/8 data unit), which stroke acceptance and scoring follow
+/// source medians, exactly, which stroke acceptance and scoring follow
 /// (docs/stroke-acceptance.md). A 1.0 store has no medians: a loaded `Stroke::median` is then empty
 /// and the centre line is the elements (`StrokeCentreLine`). `Character::source` is
 /// "<store path>#<char> (U+XXXX)". Fidelity of the models against the medians is measured when the
@@ -34,11 +34,10 @@ struct CorpusStoreOptions {
   int steps_per_unit = 2;
   /// The fitting tolerance the characters were fitted with [data units]; recorded in the header only.
   double fit_tolerance = 10.0;
-  /// Also store each stroke's source median (`Stroke::median`) in units of 1, 1/2, 1/4 or 1/8 data
-  /// unit, the coarsest that holds it exactly (hanzi-writer-data's medians are whole units, 46 of their
-  /// 1,258,516 coordinates quarter units: all exact), else rounded to 1/8 unit (at most sqrt(2)/16 units
-  /// from the original): format 1.1 with the medians flag. False writes a 1.0 store of the models only,
-  /// which every 1.x reader reads.
+  /// Also store each stroke's source median (`Stroke::median`), exactly: in units of 1, 1/2 or 1/4 data
+  /// unit, the coarsest that holds it (hanzi-writer-data's medians are whole units, in 31 characters
+  /// quarter units), else as float64 coordinates (2 strokes of hanzi-writer-data): format 1.1 with the
+  /// medians flag. False writes a 1.0 store of the models only, which every 1.x reader reads.
   bool medians = true;
 };
 
@@ -62,8 +61,8 @@ struct CorpusStoreInfo {
 /// Throws InvalidArgument for duplicate code points, an empty character, more than 255 strokes, a stroke
 /// without elements, a typical ID outside 1-39, degrees outside 1-4, attraction factors not one per
 /// feature point, non-finite or out-of-range coordinates (|x| * steps_per_unit > 2^23, a median's
-/// coordinate beyond 2^23 units of its resolution: 2^23 data units when whole, 2^20 at 1/8 unit), a
-/// median of more than 16,383 points, or bad options.
+/// coordinate not finite or beyond 2^23 units of its resolution: 2^23 data units when whole, 2^21 in
+/// quarter units and as float64), a median of more than 16,383 points, or bad options.
 std::vector<std::uint8_t> encode_corpus_store(std::span<const Character> characters,
                                               const CorpusStoreOptions& options = {});
 
