@@ -15,7 +15,10 @@ namespace calligraphy::python {
 
 class CharacterSource {
  public:
+  /// The standard set: the embedded characters, then the bundled corpus store (every character).
   static CharacterSource embedded();
+  /// The 58 embedded characters only.
+  static CharacterSource embedded_only();
   static CharacterSource hanzi_writer_folder(const std::filesystem::path& folder);
   static CharacterSource store(const std::filesystem::path& path);
 

@@ -292,6 +292,9 @@ void bind_library(py::module_& m) {
           "The default set: the embedded subset of hanzi-writer-data 2.0.1 (fitted when loaded), then "
           "every other character of it from the corpus store compiled into the library (9,574 in "
           "all, fitted when the store was built, with their medians). Reads no file.")
+      .def_static("embedded", &CharacterSource::embedded_only,
+                  "The 58 characters embedded as hanzi-writer-data 2.0.1 JSON files (fitted when loaded), "
+                  "without the bundled corpus store: a small set for quick examples and sweeps.")
       .def_static(
           "from_hanzi_writer",
           [](const PathLike& folder) {

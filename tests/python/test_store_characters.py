@@ -24,6 +24,9 @@ def test_the_default_library_holds_every_character():
     assert len(library) == 9574
     assert "(9574: 58 embedded, the others from the bundled corpus store)" in library.description
     assert "龘" not in library  # not in hanzi-writer-data either
+    embedded = calligraphy.CharacterLibrary.embedded()  # the small set alone, for quick sweeps
+    assert set(embedded.characters()) == EMBEDDED
+    assert all(c in library for c in EMBEDDED)
 
 
 def test_a_store_character_is_modelled_with_its_medians(store_characters):
