@@ -182,6 +182,7 @@ cmake --no-warn-unused-cli -S tests/consumer/haptics -B build/consumer-haptics -
 cmake --build build/consumer-haptics
 bash tests/consumer/check_link_line.sh build/consumer-haptics build/consumer-haptics/own_loop \
   build/consumer-haptics/custom_device_loop build/consumer-haptics/log_redirect
+build/consumer-haptics/bundled_store "$PWD/build/stage"
 build/consumer-haptics/own_loop
 build/consumer-haptics/custom_device_loop
 build/consumer-haptics/log_redirect

@@ -65,7 +65,7 @@ TEST_CASE("Store round trip of the embedded characters", "[store]") {
         const Stroke& b = loaded.strokes[s];
         CHECK(b.typical_id == a.typical_id);
         CHECK(b.attraction_factors == a.attraction_factors);
-        CHECK(b.median.empty());
+        CHECK(b.median == a.median);  // hanzi-writer-data's medians are integers: stored exactly
         REQUIRE(b.elements.size() == a.elements.size());
         for (std::size_t e = 0; e < a.elements.size(); ++e) {
           CHECK(b.elements[e].kind == a.elements[e].kind);
@@ -79,6 +79,82 @@ TEST_CASE("Store round trip of the embedded characters", "[store]") {
       }
     }
   }
+}
+
+TEST_CASE("A 1.0 store without medians is written on request and still read", "[store]") {
+  const auto set = small_set();
+  CorpusStoreOptions options;
+  options.medians = false;
+  const auto without = encode_corpus_store(set, options);
+  const auto with = encode_corpus_store(set);
+  const CorpusStore old_store = CorpusStore::from_bytes(without, "1.0");
+  CHECK(old_store.info().version_minor == 0);
+  CHECK_FALSE(old_store.info().medians);
+  const CorpusStore new_store = CorpusStore::from_bytes(with, "1.1");
+  CHECK(new_store.info().version_minor == 1);
+  CHECK(new_store.info().medians);
+  CHECK(with.size() > without.size());
+  for (const Character& original : set) {
+    const Character a = old_store.load(original.code_point);
+    const Character b = new_store.load(original.code_point);
+    REQUIRE(a.strokes.size() == b.strokes.size());
+    for (std::size_t s = 0; s < a.strokes.size(); ++s) {
+      CHECK(a.strokes[s].median.empty());
+      CHECK(b.strokes[s].median == original.strokes[s].median);
+      CHECK(a.strokes[s].elements.size() == b.strokes[s].elements.size());  // the same models
+    }
+  }
+  // A store written before medians were stored (the fuzzer's seed, format 1.0) reads as it did.
+  std::ifstream in(std::filesystem::path(CALLIGRAPHY_SOURCE_DIR) / "fuzz/seeds/three_characters.clg",
+                   std::ios::binary);
+  const std::vector<std::uint8_t> seed((std::istreambuf_iterator<char>(in)),
+                                       std::istreambuf_iterator<char>());
+  const CorpusStore seed_store = CorpusStore::from_bytes(seed, "three_characters.clg");
+  CHECK(seed_store.info().version_minor == 0);
+  CHECK(seed_store.size() == 3);
+  for (char32_t c : seed_store.characters()) {
+    for (const Stroke& stroke : seed_store.load(c).strokes) CHECK(stroke.median.empty());
+  }
+}
+
+TEST_CASE("Store medians: exact in any unit, every count coded, bounds refused", "[store]") {
+  Character c = CharacterLibrary::embedded().load(U'十');
+  c.strokes[0].median = {{100.4, 200.6}, {101.0, 199.0}};  // not in quarter units: float64
+  c.strokes[1].median.clear();                             // a stroke without one
+  std::vector<Vec2> long_median;
+  for (int i = 0; i < 40; ++i) long_median.emplace_back(500 + i, -100 + 3 * i);  // past the 5-bit count
+  Character d = CharacterLibrary::embedded().load(U'永');
+  d.strokes[0].median = long_median;
+  d.strokes[1].median = {{-50000.0, 90000.0}};                                // one point, far away
+  d.strokes[2].median = {{388.25, 656.75}, {404.5, 372.75}, {400.0, 300.0}};  // quarter units: exact
+  const std::vector<Character> set{c, d};
+  const CorpusStore store = CorpusStore::from_bytes(encode_corpus_store(set), "memory");
+  const Character lc = store.load(U'十');
+  CHECK(lc.strokes[0].median == c.strokes[0].median);
+  CHECK(lc.strokes[1].median.empty());
+  const Character ld = store.load(U'永');
+  CHECK(ld.strokes[0].median == long_median);
+  CHECK(ld.strokes[1].median == std::vector<Vec2>{{-50000.0, 90000.0}});
+  CHECK(ld.strokes[2].median == d.strokes[2].median);
+
+  Character bad = c;
+  bad.strokes[0].median[0].x() = std::nan("");
+  CHECK_THROWS_WITH(encode_corpus_store(std::vector{bad}), Catch::Contains("median"));
+  bad = c;
+  bad.strokes[0].median[0].y() = 1e9;
+  CHECK_THROWS_WITH(encode_corpus_store(std::vector{bad}), Catch::Contains("out of range"));
+  bad = c;
+  bad.strokes[0].median.assign(16384, Vec2(1.0, 2.0));
+  CHECK_THROWS_WITH(encode_corpus_store(std::vector{bad}), Catch::Contains("16383"));
+}
+
+TEST_CASE("Store with an unknown header flag is refused naming the file and the offset", "[store]") {
+  auto bytes = encode_corpus_store(small_set());
+  store::put_u32(bytes.data() + store::kOffFlags, store::kFlagMedians | 2u);
+  store::put_u32(bytes.data() + store::kOffHeaderCrc,
+                 store::crc32(std::span(bytes).first(store::kOffHeaderCrc)));
+  CHECK_THROWS_WITH(CorpusStore::from_bytes(bytes, "flags.clg"),
+                    Catch::Contains("flags.clg: offset 28") && Catch::Contains("unknown flags"));
 }
 
 TEST_CASE("Store keeps explicit attraction factors and detached elements exactly", "[store]") {
@@ -144,7 +220,8 @@ TEST_CASE("Store: missing, empty, foreign and newer-version files are DataErrors
   store::put_u16(bytes.data() + store::kOffVersionMajor, 2);  // a future format, header CRC fixed up
   store::put_u32(bytes.data() + store::kOffHeaderCrc,
                  store::crc32(std::span(bytes).first(store::kOffHeaderCrc)));
-  CHECK_THROWS_WITH(CorpusStore::from_bytes(bytes, "v2"), Catch::Contains("version 2.0 is not supported"));
+  CHECK_THROWS_WITH(CorpusStore::from_bytes(bytes, "v2"),
+                    Catch::Contains("format version 2.1 is not supported"));
 }
 
 TEST_CASE("Store truncated at every byte offset is a DataError", "[store]") {

@@ -7,6 +7,12 @@ namespace calligraphy::python {
 
 CharacterSource CharacterSource::embedded() { return {}; }
 
+CharacterSource CharacterSource::embedded_only() {
+  CharacterSource source;
+  source.library_ = CharacterLibrary::embedded();
+  return source;
+}
+
 CharacterSource CharacterSource::hanzi_writer_folder(const std::filesystem::path& folder) {
   CharacterSource source;
   source.library_ = CharacterLibrary::from_directory(folder);

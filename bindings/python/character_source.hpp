@@ -1,5 +1,6 @@
 #pragma once
-// What Python's `CharacterLibrary` is: the embedded default set, a folder of hanzi-writer-data files
+// What Python's `CharacterLibrary` is: the standard set (the embedded characters, then the corpus store
+// compiled into the library: every hanzi-writer-data character), a folder of hanzi-writer-data files
 // (both fitted on load, model/character_library.hpp) or a binary corpus store of fitted characters
 // (model/corpus_store.hpp). Cheap to copy.
 #include <filesystem>
@@ -14,7 +15,10 @@ namespace calligraphy::python {
 
 class CharacterSource {
  public:
+  /// The standard set: the embedded characters, then the bundled corpus store (every character).
   static CharacterSource embedded();
+  /// The 58 embedded characters only.
+  static CharacterSource embedded_only();
   static CharacterSource hanzi_writer_folder(const std::filesystem::path& folder);
   static CharacterSource store(const std::filesystem::path& path);
 
@@ -26,7 +30,7 @@ class CharacterSource {
   [[nodiscard]] const std::optional<CorpusStore>& corpus_store() const { return store_; }
 
  private:
-  CharacterLibrary library_ = CharacterLibrary::embedded();
+  CharacterLibrary library_ = CharacterLibrary::standard();
   std::optional<CorpusStore> store_;
   bool embedded_ = true;
 };

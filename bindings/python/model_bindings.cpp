@@ -283,11 +283,18 @@ void bind_character(py::module_& m) {
 
 void bind_library(py::module_& m) {
   py::class_<CharacterSource>(m, "CharacterLibrary",
-                              "A set of characters to load: the embedded default set, a folder of "
+                              "A set of characters to load: the default set (every hanzi-writer-data "
+                              "2.0.1 character, compiled into the module), a folder of "
                               "hanzi-writer-data files (fitted when loaded) or a corpus store of fitted "
                               "characters. Cheap to copy.")
-      .def_static("default", &CharacterSource::embedded,
-                  "The embedded default set: a subset of hanzi-writer-data 2.0.1 compiled into the library.")
+      .def_static(
+          "default", &CharacterSource::embedded,
+          "The default set: the embedded subset of hanzi-writer-data 2.0.1 (fitted when loaded), then "
+          "every other character of it from the corpus store compiled into the library (9,574 in "
+          "all, fitted when the store was built, with their medians). Reads no file.")
+      .def_static("embedded", &CharacterSource::embedded_only,
+                  "The 58 characters embedded as hanzi-writer-data 2.0.1 JSON files (fitted when loaded), "
+                  "without the bundled corpus store: a small set for quick examples and sweeps.")
       .def_static(
           "from_hanzi_writer",
           [](const PathLike& folder) {
@@ -344,10 +351,12 @@ void bind_library(py::module_& m) {
             d["fit_tolerance"] = i.fit_tolerance;
             d["max_quantisation_error"] = i.max_quantisation_error();
             d["file_bytes"] = i.file_bytes;
+            d["medians"] = i.medians;
             return {d};
           },
           "For a corpus store, its header as a dict (version, character_count, steps_per_unit, "
-          "fit_tolerance and max_quantisation_error in data units, file_bytes); else None.")
+          "fit_tolerance and max_quantisation_error in data units, file_bytes, medians: whether it holds "
+          "the strokes' medians); else None.")
       .def("__repr__",
            [](const CharacterSource& lib) { return "<CharacterLibrary " + lib.description() + ">"; });
 }

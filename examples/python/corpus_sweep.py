@@ -50,7 +50,7 @@ def choose_characters(store, data, every, limit):
     elif data:
         library = calligraphy.CharacterLibrary.from_hanzi_writer(data)
     else:
-        library = calligraphy.CharacterLibrary.default()
+        library = calligraphy.CharacterLibrary.embedded()  # the 58 embedded characters
     characters = sorted(library.characters())[::every]
     return characters[:limit] if limit else characters
 

@@ -55,7 +55,7 @@ def main(argv):
     one_trial(keep_trace=False)
     one_trial(keep_trace=True)
 
-    characters = calligraphy.CharacterLibrary.default().characters()
+    characters = calligraphy.CharacterLibrary.embedded().characters()
     print(f"sweep: {len(characters)} embedded characters x guidance off/on x {args.seeds} seeds")
     start = time.perf_counter()
     for guidance in (False, True):

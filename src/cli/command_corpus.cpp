@@ -50,6 +50,7 @@ struct BuildCommand {
   CorpusFitCommand fit;
   std::string out;
   double tolerance = FitOptions{}.tolerance;
+  std::string medians = "on";
 };
 
 int run_build(const BuildCommand& command) {
@@ -63,6 +64,7 @@ int run_build(const BuildCommand& command) {
   CorpusStoreOptions store_options;
   store_options.steps_per_unit = std::stoi(command.fit.steps);
   store_options.fit_tolerance = fit_options.tolerance;
+  store_options.medians = command.medians == "on";
 
   const auto start = Clock::now();
   const CorpusFit fit =
@@ -128,6 +130,8 @@ void add_corpus_build_command(CLI::App& corpus, Commands& commands) {
   add_number(*app, "--tolerance", command->tolerance, "UNITS",
              "largest deviation of the fitted elements from the median [data units, 1024 per character]",
              "a number of data units > 0", positive);
+  add_choice(*app, "--medians", command->medians, {"on", "off"},
+             "store the strokes' medians too (format 1.1; off: a 1.0 store of the models only)");
   add_fit_options(*app, command->fit);
 }
 

@@ -9,11 +9,13 @@ namespace calligraphy::cli {
 
 void add_trial_command(CLI::App& root, Commands& commands, DeviceRegistry& devices);  // trial CHARS [...]
 void add_train_command(CLI::App& root, Commands& commands,
-                       DeviceRegistry& devices);               // train CHARS [...] (the trainer window)
-void add_score_command(CLI::App& root, Commands& commands);    // score TRACE.csv --character C [...]
-void add_trace_command(CLI::App& root, Commands& commands);    // trace TRACE.trace.h5 [--csv FILE]
-void add_model_command(CLI::App& root, Commands& commands);    // model CHAR [...]
-void add_strokes_command(CLI::App& root, Commands& commands);  // strokes [--markdown FILE] [--json]
+                       DeviceRegistry& devices);                // train CHARS [...] (the trainer window)
+void add_score_command(CLI::App& root, Commands& commands);     // score TRACE.csv --character C [...]
+void add_trace_command(CLI::App& root, Commands& commands);     // trace TRACE.trace.h5 [--csv FILE]
+void add_model_command(CLI::App& root, Commands& commands);     // model CHAR [...]
+void add_strokes_command(CLI::App& root, Commands& commands);   // strokes [--markdown FILE] [--json]
+// characters [--strokes N] [--typical STROKE] [--text TEXT] [--json]
+void add_characters_command(CLI::App& root, Commands& commands);
 void add_devices_command(CLI::App& root, Commands& commands, DeviceRegistry& devices);  // devices [--json]
 void add_corpus_commands(CLI::App& root, Commands& commands);  // corpus build|stats|fidelity|validate
 void add_bench_commands(CLI::App& root, Commands& commands);   // bench nearest|jumps|tick|loop|acceptance

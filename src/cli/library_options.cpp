@@ -1,15 +1,16 @@
 #include "cli/library_options.hpp"
 
 #include "calligraphy/core/errors.hpp"
-#include "cli/output.hpp"
 #include "calligraphy/core/unicode.hpp"
+#include "cli/output.hpp"
 
 namespace calligraphy::cli {
 
 void add_library_options(CLI::App& app, LibraryOptions& options, bool with_store) {
   CLI::Option* data = add_input_path(
       app, "--data", options.data_folder, "DIR",
-      "read characters from this hanzi-writer-data folder (one JSON file each)", "the embedded characters");
+      "read characters from this hanzi-writer-data folder (one JSON file each)",
+      "the embedded characters, then the bundled corpus store (every hanzi-writer-data character)");
   if (with_store) {
     CLI::Option* store =
         add_input_path(app, "--store", options.store_file, "FILE",
@@ -25,10 +26,10 @@ void add_library_inputs(FilePlan& plan, const LibraryOptions& options) {
 
 CharacterLibrary library_from(const LibraryOptions& options) {
   if (!options.data_folder.empty()) return CharacterLibrary::from_directory(options.data_folder);
-  return CharacterLibrary::embedded();
+  return CharacterLibrary::standard();
 }
 
-CharacterSource::CharacterSource(const LibraryOptions& options) : library_(CharacterLibrary::embedded()) {
+CharacterSource::CharacterSource(const LibraryOptions& options) : library_(CharacterLibrary::standard()) {
   if (!options.store_file.empty()) {
     store_ = CorpusStore::open(options.store_file);
   } else {
@@ -45,6 +46,20 @@ Character CharacterSource::load(char32_t code_point) const {
   } catch (const CharacterNotFound& e) {  // the library's message is neutral; the flags are ours
     throw CharacterNotFound(std::string(e.what()) + ": pass --data DIR or --store FILE");
   }
+}
+
+bool CharacterSource::contains(char32_t code_point) const {
+  return store_ ? store_->contains(code_point) : library_.contains(code_point);
+}
+
+std::vector<char32_t> CharacterSource::characters() const {
+  return store_ ? store_->characters() : library_.characters();
+}
+
+std::string CharacterSource::description() const {
+  if (store_)
+    return "corpus store " + store_->name() + " (" + std::to_string(store_->size()) + " characters)";
+  return library_.description();
 }
 
 std::u32string characters_from(const std::string& text, const std::string& what) {

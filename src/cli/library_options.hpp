@@ -1,8 +1,9 @@
 #pragma once
-// Shared options: which character library to read (--store FILE, else --data DIR, else the embedded
-// default) and which characters were asked for.
+// Shared options: which character library to read (--store FILE, else --data DIR, else the standard set:
+// the embedded characters, then the bundled corpus store) and which characters were asked for.
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/model/corpus_store.hpp"
@@ -13,14 +14,14 @@ namespace calligraphy::cli {
 class FilePlan;
 
 struct LibraryOptions {
-  std::string data_folder;  ///< --data DIR; empty: the embedded characters
+  std::string data_folder;  ///< --data DIR; empty: CharacterLibrary::standard()
   std::string store_file;   ///< --store FILE; empty: none
 };
 
 /// Adds --data DIR and, when `with_store`, --store FILE (the two exclude each other).
 void add_library_options(CLI::App& app, LibraryOptions& options, bool with_store);
 
-/// --data DIR, else the embedded characters.
+/// --data DIR, else the standard set (the embedded characters, then the bundled corpus store).
 CharacterLibrary library_from(const LibraryOptions& options);
 
 /// Characters from a corpus store (--store FILE: fitted models, each materialised on demand) or else
@@ -31,11 +32,17 @@ class CharacterSource {
   /// The character's model; throws CharacterNotFound (for the embedded set naming --data and --store)
   /// or DataError.
   [[nodiscard]] Character load(char32_t code_point) const;
+  /// True when the character is there.
+  [[nodiscard]] bool contains(char32_t code_point) const;
+  /// Every character there, sorted by code point (DataError for a folder without character files).
+  [[nodiscard]] std::vector<char32_t> characters() const;
+  /// The store's name and size, or the library's description.
+  [[nodiscard]] std::string description() const;
 
  private:
   std::optional<CorpusStore> store_;
   CharacterLibrary library_;
-  bool embedded_ = false;  // the embedded default set: a missing character gets the --data hint
+  bool embedded_ = false;  // the standard set: a missing character gets the --data/--store hint
 };
 
 /// Registers --store FILE and --data DIR (every file in it) as inputs of `plan`: no output may replace them.

@@ -84,6 +84,7 @@ int main(int argc, char** argv) {
   add_model_command(root, commands);
   add_strokes_command(root, commands);
   add_schema_command(root, commands);
+  add_characters_command(root, commands);
   add_trace_command(root, commands);
   add_devices_command(root, commands, devices);
   add_corpus_commands(root, commands);

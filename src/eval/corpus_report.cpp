@@ -50,6 +50,7 @@ std::string corpus_stats_json(const CorpusStore& store, const CorpusStoreStats& 
   const nlohmann::json doc = {
       {"file", store.name()},
       {"format_version", std::to_string(info.version_major) + "." + std::to_string(info.version_minor)},
+      {"medians", info.medians},
       {"characters", info.character_count},
       {"strokes", stats.strokes},
       {"elements", stats.elements},
@@ -69,7 +70,8 @@ std::string corpus_stats_text(const CorpusStore& store, const CorpusStoreStats& 
                                                      : std::to_string(stats.errors.size()) + " bad records";
   std::string out;
   appendf(out, "corpus store %s\n", store.name().c_str());
-  appendf(out, "  format version      %d.%d\n", info.version_major, info.version_minor);
+  appendf(out, "  format version      %d.%d (%s)\n", info.version_major, info.version_minor,
+          info.medians ? "models and medians" : "models only, no medians");
   appendf(out, "  characters          %zu\n", info.character_count);
   appendf(out, "  strokes             %zu\n", stats.strokes);
   appendf(out, "  elements            %zu (%.2f per stroke)\n", stats.elements,

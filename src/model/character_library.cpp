@@ -5,6 +5,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
+#include "calligraphy/model/corpus_store.hpp"
 #include "model/character_file.hpp"
 #include "model/embedded_characters.hpp"
 #include "model/median_json_reader.hpp"
@@ -67,6 +68,12 @@ CharacterData parse_hanzi_writer_json(std::string_view json, char32_t cp, const 
 
 CharacterLibrary CharacterLibrary::embedded() { return CharacterLibrary{}; }
 
+CharacterLibrary CharacterLibrary::standard() {
+  CharacterLibrary library;
+  library.bundled_store_ = true;
+  return library;
+}
+
 CharacterLibrary CharacterLibrary::from_directory(const std::filesystem::path& folder) {
   std::error_code ec;
   if (!std::filesystem::is_directory(folder, ec)) {
@@ -84,12 +91,25 @@ CharacterLibrary CharacterLibrary::from_directory(const std::filesystem::path& f
 }
 
 bool CharacterLibrary::contains(char32_t cp) const {
-  if (folder_.empty()) return find_embedded(cp) != nullptr;
+  if (folder_.empty())
+    return find_embedded(cp) != nullptr || (bundled_store_ && CorpusStore::bundled().contains(cp));
   std::error_code ec;
   return std::filesystem::is_regular_file(folder_ / (encode_utf8(cp) + ".json"), ec);
 }
 
+bool CharacterLibrary::from_bundled_store(char32_t cp) const {
+  return bundled_store_ && folder_.empty() && find_embedded(cp) == nullptr;
+}
+
 CharacterData CharacterLibrary::load_data(char32_t cp) const {
+  if (from_bundled_store(cp)) {
+    const Character character = CorpusStore::bundled().load(cp);
+    CharacterData data;
+    data.code_point = cp;
+    data.source = character.source;
+    for (const Stroke& stroke : character.strokes) data.medians.push_back(stroke.median);
+    return data;
+  }
   const Document document = read_document(folder_, cp);
   return parse_hanzi_writer_json(document.text, cp, document.source);
 }
@@ -98,6 +118,13 @@ CharacterOutlines CharacterLibrary::load_outlines(char32_t cp, double tolerance)
   if (!(tolerance > 0.0)) {
     throw InvalidArgument("load_outlines: tolerance " + std::to_string(tolerance) +
                           " must be > 0 data units");
+  }
+  if (from_bundled_store(cp)) {
+    const CorpusStore& store = CorpusStore::bundled();
+    if (!store.contains(cp)) (void)store.load(cp);  // CharacterNotFound naming the character and the store
+    throw DataError(store.name() + ": character " + describe_character(cp) +
+                    ": no stroke outlines (the corpus store holds the models and medians; the outlines are "
+                    "in the hanzi-writer-data package, scripts/fetch-hanzi-writer-data.sh)");
   }
   const Document document = read_document(folder_, cp);
   if (document.text.size() > kMaxCharacterFileBytes) {
@@ -125,6 +152,7 @@ CharacterOutlines CharacterLibrary::load_outlines(char32_t cp, double tolerance)
 }
 
 Character CharacterLibrary::load(char32_t cp, const FitOptions& options) const {
+  if (from_bundled_store(cp)) return CorpusStore::bundled().load(cp);
   CharacterData data = load_data(cp);
   try {
     return fit_character(cp, data.medians, data.source, options);
@@ -137,6 +165,11 @@ std::vector<char32_t> CharacterLibrary::characters() const {
   std::vector<char32_t> out;
   if (folder_.empty()) {
     for (const auto& e : detail::embedded_characters()) out.push_back(decode_utf8(e.name).at(0));
+    if (bundled_store_) {
+      for (char32_t cp : CorpusStore::bundled().characters()) {
+        if (find_embedded(cp) == nullptr) out.push_back(cp);
+      }
+    }
   } else {
     std::error_code ec;
     std::filesystem::directory_iterator entries(folder_, ec);
@@ -164,7 +197,12 @@ std::vector<char32_t> CharacterLibrary::characters() const {
 
 std::string CharacterLibrary::description() const {
   if (folder_.empty()) {
-    return "embedded default (" + std::to_string(detail::embedded_characters().size()) + " characters)";
+    const std::string embedded = std::to_string(detail::embedded_characters().size());
+    if (bundled_store_) {
+      return "every hanzi-writer-data 2.0.1 character (" + std::to_string(characters().size()) + ": " +
+             embedded + " embedded, the others from the bundled corpus store)";
+    }
+    return "embedded default (" + embedded + " characters)";
   }
   return folder_.string();
 }

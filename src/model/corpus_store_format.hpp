@@ -11,7 +11,10 @@ namespace calligraphy::store {
 
 inline constexpr std::array<std::uint8_t, 8> kMagic = {'C', 'L', 'G', 'S', 'T', 'O', 'R', 'E'};
 inline constexpr std::uint16_t kVersionMajor = 1;  // readers reject another major version
-inline constexpr std::uint16_t kVersionMinor = 0;  // added fields only; readers accept any minor
+// Minor 0: the models only. Minor 1: header flag kFlagMedians may be set (the records then end with the
+// strokes' medians). Readers accept any minor and refuse flags they do not know.
+inline constexpr std::uint16_t kVersionMinor = 1;
+inline constexpr std::uint16_t kVersionMinorWithoutMedians = 0;
 inline constexpr std::size_t kHeaderBytes = 64;
 inline constexpr std::size_t kTypicalStrokeCount = 39;
 // Two float64 per typical ID: the default attraction factor, then the corner attraction factor.
@@ -23,6 +26,16 @@ inline constexpr std::int64_t kMaxCoordinate = std::int64_t{1} << 23;   // quant
 inline constexpr std::size_t kOffVersionMajor = 8, kOffVersionMinor = 10, kOffHeaderSize = 12, kOffCount = 16,
                              kOffSteps = 20, kOffTolerance = 24, kOffFlags = 28, kOffIndex = 32,
                              kOffRecords = 40, kOffRecordsSize = 48, kOffTablesCrc = 56, kOffHeaderCrc = 60;
+
+// Header flags (u32 at kOffFlags).
+inline constexpr std::uint32_t kFlagMedians = 1;  // every record ends with its strokes' medians (minor 1)
+inline constexpr std::uint32_t kKnownFlags = kFlagMedians;
+// Median points: a count of points per stroke in 5 bits; 31 means a 14-bit count follows.
+inline constexpr std::uint64_t kMedianCountEscape = 31;
+inline constexpr int kMedianCountExtensionBits = 14;
+inline constexpr std::int64_t kMaxMedianCoordinate = std::int64_t{1} << 23;  // |x| in 2^-shift units
+inline constexpr int kMaxMedianShift = 2;  // a median's coordinates in units of 2^-shift data units, 0-2
+inline constexpr int kMedianRawMode = 3;   // else: each coordinate a float64 (data units, |x| <= 2^23)
 
 // Per-stroke flags.
 // Not every factor is the file's default for the ID: a 1-bit mode follows. Mode 1 (palette): one bit per

@@ -8,11 +8,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/model/corpus_store.hpp"
 #include "calligraphy/core/unicode.hpp"
+#include "calligraphy/model/corpus_store.hpp"
+#include "model/bundled_corpus_store.hpp"
 #include "model/corpus_store_format.hpp"
 
 namespace calligraphy {
@@ -84,7 +86,9 @@ void CorpusStore::Data::validate() {
                                std::to_string(kVersionMajor) + ".x)");
   }
   if (get_u32(bytes + kOffHeaderSize) != kHeaderBytes) fail(kOffHeaderSize, "unexpected header size");
-  if (get_u32(bytes + kOffFlags) != 0) fail(kOffFlags, "unknown flags");
+  const std::uint32_t flags = get_u32(bytes + kOffFlags);
+  if ((flags & ~kKnownFlags) != 0) fail(kOffFlags, "unknown flags");
+  info.medians = (flags & kFlagMedians) != 0;
   info.character_count = get_u32(bytes + kOffCount);
   info.steps_per_unit = static_cast<int>(get_u32(bytes + kOffSteps));
   const int s = info.steps_per_unit;
@@ -157,6 +161,7 @@ Character CorpusStore::Data::decode(std::size_t k) const {
   character.strokes.resize(stroke_count);
   std::int64_t x = 0;
   std::int64_t y = 0;
+  std::vector<std::array<std::int64_t, 2>> median_origins(stroke_count);
   for (std::size_t s = 0; s < stroke_count; ++s) {
     Stroke& stroke = character.strokes[s];
     stroke.typical_id = static_cast<int>(get(6));
@@ -178,6 +183,7 @@ Character CorpusStore::Data::decode(std::size_t k) const {
     };
     const int start_width = static_cast<int>(get(5));
     Vec2 previous = next_point(start_width);
+    median_origins[s] = {x / info.steps_per_unit, y / info.steps_per_unit};
     const int width = static_cast<int>(get(5));
     stroke.elements.resize(n);
     for (std::size_t e = 0; e < n; ++e) {
@@ -205,6 +211,52 @@ Character CorpusStore::Data::decode(std::size_t k) const {
     } else {
       stroke.attraction_factors.assign(n + 1,
                                        default_factors[static_cast<std::size_t>(stroke.typical_id - 1)]);
+    }
+  }
+  if (info.medians) {
+    for (std::size_t s = 0; s < stroke_count; ++s) {
+      std::size_t n = get(5);
+      if (n == kMedianCountEscape) {
+        n = get(kMedianCountExtensionBits);
+        if (n < kMedianCountEscape) bad("stroke " + std::to_string(s + 1) + ": median count not minimal");
+      }
+      if (n == 0) continue;
+      std::vector<Vec2>& median = character.strokes[s].median;
+      median.reserve(n);
+      const int shift = static_cast<int>(get(2));
+      if (shift == kMedianRawMode) {
+        for (std::size_t i = 0; i < n; ++i) {
+          std::array<double, 2> xy{};
+          for (double& v : xy) {
+            const std::uint64_t bits = get(64);
+            std::memcpy(&v, &bits, sizeof v);
+            if (!std::isfinite(v) || std::abs(v) > static_cast<double>(kMaxMedianCoordinate))
+              bad("stroke " + std::to_string(s + 1) + ": median coordinate not finite or out of range");
+          }
+          median.emplace_back(xy[0], xy[1]);
+        }
+        continue;
+      }
+      const double unit = 1.0 / static_cast<double>(1 << shift);
+      std::int64_t mx = median_origins[s][0] * (std::int64_t{1} << shift);
+      std::int64_t my = median_origins[s][1] * (std::int64_t{1} << shift);
+      const auto add_point = [&] {
+        if (std::abs(mx) > kMaxMedianCoordinate || std::abs(my) > kMaxMedianCoordinate)
+          bad("stroke " + std::to_string(s + 1) + ": median point out of range");
+        median.emplace_back(static_cast<double>(mx) * unit, static_cast<double>(my) * unit);
+      };
+      const int start_width = static_cast<int>(get(5));
+      mx += unzigzag(get(start_width));
+      my += unzigzag(get(start_width));
+      add_point();
+      if (n == 1) continue;
+      const int width_x = static_cast<int>(get(5));
+      const int width_y = static_cast<int>(get(5));
+      for (std::size_t i = 1; i < n; ++i) {
+        mx += unzigzag(get(width_x));
+        my += unzigzag(get(width_y));
+        add_point();
+      }
     }
   }
   // The writer pads the last byte with zero bits and writes nothing after.
@@ -254,6 +306,22 @@ CorpusStore CorpusStore::from_bytes(std::span<const std::uint8_t> bytes, const s
   data->validate();
   return CorpusStore(std::move(data));
 }
+
+const CorpusStore& CorpusStore::bundled() {
+  // Checked once; a failure is thrown again to every caller (static initialisation is retried).
+  static const CorpusStore store = [] {
+    const detail::BundledCorpusStore bundled = detail::bundled_corpus_store();
+    auto data = std::make_shared<Data>();
+    data->name = std::string("bundled:") + bundled.name;
+    data->bytes = bundled.bytes.data();
+    data->size = bundled.bytes.size();
+    data->validate();
+    return CorpusStore(std::move(data));
+  }();
+  return store;
+}
+
+const char* CorpusStore::bundled_sha256() { return detail::bundled_corpus_store().sha256; }
 
 const CorpusStoreInfo& CorpusStore::info() const { return data_->info; }
 const std::string& CorpusStore::name() const { return data_->name; }

@@ -6,9 +6,9 @@
 
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/corpus_store.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
-#include "calligraphy/core/unicode.hpp"
 #include "model/corpus_store_format.hpp"
 
 namespace calligraphy {
@@ -24,7 +24,8 @@ struct QPoint {
 
 class RecordEncoder {
  public:
-  RecordEncoder(const Character& character, int steps) : character_(character), steps_(steps) {}
+  RecordEncoder(const Character& character, int steps, bool medians)
+      : character_(character), steps_(steps), medians_(medians) {}
 
   std::vector<std::uint8_t> encode() {
     const auto& strokes = character_.strokes;
@@ -32,6 +33,9 @@ class RecordEncoder {
       fail("has " + std::to_string(strokes.size()) + " strokes (1-255)");
     out_.put(strokes.size(), 8);
     for (std::size_t s = 0; s < strokes.size(); ++s) encode_stroke(s);
+    if (medians_) {
+      for (std::size_t s = 0; s < strokes.size(); ++s) encode_median(s);
+    }
     return out_.take();
   }
 
@@ -127,12 +131,84 @@ class RecordEncoder {
       }
     }
     previous_ = points.back();
+    // The median's reference: the stroke's start in whole data units (truncated towards zero).
+    median_origins_.push_back({points[0].x / steps_, points[0].y / steps_});
+  }
+
+  // The median in units of 2^-shift data units, shift 0-2 the smallest that holds every coordinate exactly
+  // (hanzi-writer-data: whole units, in 31 characters quarter units): its first point relative to the
+  // stroke's start, the others to the point before, x and y each in its own width. Else (2 strokes of
+  // hanzi-writer-data, in ninths of a unit) mode 3: each coordinate as a float64, so that none is changed.
+  void encode_median(std::size_t s) {
+    const std::vector<Vec2>& median = character_.strokes[s].median;
+    const std::string where = "stroke " + std::to_string(s + 1) + ": median";
+    if (median.size() >= (std::size_t{1} << kMedianCountExtensionBits))
+      fail(where + " has " + std::to_string(median.size()) + " points (at most 16383)");
+    if (median.size() < kMedianCountEscape) {
+      out_.put(median.size(), 5);
+    } else {
+      out_.put(kMedianCountEscape, 5);
+      out_.put(median.size(), kMedianCountExtensionBits);
+    }
+    if (median.empty()) return;
+    int shift = 0;
+    const auto exact = [&](int k) {
+      return std::all_of(median.begin(), median.end(), [k](const Vec2& p) {
+        const double scale = static_cast<double>(1 << k);
+        return std::nearbyint(p.x() * scale) == p.x() * scale &&
+               std::nearbyint(p.y() * scale) == p.y() * scale;
+      });
+    };
+    while (shift <= kMaxMedianShift && !exact(shift)) ++shift;
+    out_.put(static_cast<std::uint64_t>(shift), 2);
+    if (shift == kMedianRawMode) {
+      for (const Vec2& p : median) {
+        for (double v : {p.x(), p.y()}) {
+          if (!std::isfinite(v) || std::abs(v) > static_cast<double>(kMaxMedianCoordinate))
+            fail(where + ": coordinate " + std::to_string(v) + " out of range");
+          out_.put(double_bits(v), 64);
+        }
+      }
+      return;
+    }
+    std::vector<QPoint> points;
+    for (const Vec2& p : median) {
+      const auto round = [&](double v) {
+        const double r = std::round(v * static_cast<double>(1 << shift));
+        if (!std::isfinite(r) || std::abs(r) > static_cast<double>(kMaxMedianCoordinate))
+          fail(where + ": coordinate " + std::to_string(v) + " out of range");
+        return static_cast<std::int64_t>(r);
+      };
+      points.push_back({round(p.x()), round(p.y())});
+    }
+    const QPoint origin{median_origins_[s].x * (std::int64_t{1} << shift),
+                        median_origins_[s].y * (std::int64_t{1} << shift)};
+    const int start_width =
+        std::max(bit_width(zigzag(points[0].x - origin.x)), bit_width(zigzag(points[0].y - origin.y)));
+    out_.put(static_cast<std::uint64_t>(start_width), 5);
+    out_.put(zigzag(points[0].x - origin.x), start_width);
+    out_.put(zigzag(points[0].y - origin.y), start_width);
+    if (points.size() < 2) return;
+    int width_x = 0;
+    int width_y = 0;
+    for (std::size_t i = 1; i < points.size(); ++i) {
+      width_x = std::max(width_x, bit_width(zigzag(points[i].x - points[i - 1].x)));
+      width_y = std::max(width_y, bit_width(zigzag(points[i].y - points[i - 1].y)));
+    }
+    out_.put(static_cast<std::uint64_t>(width_x), 5);
+    out_.put(static_cast<std::uint64_t>(width_y), 5);
+    for (std::size_t i = 1; i < points.size(); ++i) {
+      out_.put(zigzag(points[i].x - points[i - 1].x), width_x);
+      out_.put(zigzag(points[i].y - points[i - 1].y), width_y);
+    }
   }
 
   const Character& character_;
   int steps_;
+  bool medians_;
   BitWriter out_;
   QPoint previous_;
+  std::vector<QPoint> median_origins_;
 };
 
 }  // namespace
@@ -165,7 +241,7 @@ std::vector<std::uint8_t> encode_corpus_store(std::span<const Character> charact
     if (c->code_point > 0x10FFFF) throw InvalidArgument("corpus store: code point out of Unicode range");
     const std::size_t offset = file.size() - records_offset;
     if (offset > 0xFFFFFFFFu) throw InvalidArgument("corpus store: records exceed 4 GiB");
-    const std::vector<std::uint8_t> record = RecordEncoder(*c, steps).encode();
+    const std::vector<std::uint8_t> record = RecordEncoder(*c, steps, options.medians).encode();
     file.insert(file.end(), record.begin(), record.end());
     std::uint8_t* entry = file.data() + index_offset + kIndexEntryBytes * k;
     put_u32(entry, static_cast<std::uint32_t>(c->code_point));
@@ -176,12 +252,12 @@ std::vector<std::uint8_t> encode_corpus_store(std::span<const Character> charact
   std::uint8_t* h = file.data();
   std::copy(kMagic.begin(), kMagic.end(), h);
   put_u16(h + kOffVersionMajor, kVersionMajor);
-  put_u16(h + kOffVersionMinor, kVersionMinor);
+  put_u16(h + kOffVersionMinor, options.medians ? kVersionMinor : kVersionMinorWithoutMedians);
   put_u32(h + kOffHeaderSize, static_cast<std::uint32_t>(kHeaderBytes));
   put_u32(h + kOffCount, static_cast<std::uint32_t>(sorted.size()));
   put_u32(h + kOffSteps, static_cast<std::uint32_t>(steps));
   put_u32(h + kOffTolerance, float_bits(static_cast<float>(options.fit_tolerance)));
-  put_u32(h + kOffFlags, 0);
+  put_u32(h + kOffFlags, options.medians ? kFlagMedians : 0u);
   put_u64(h + kOffIndex, index_offset);
   put_u64(h + kOffRecords, records_offset);
   put_u64(h + kOffRecordsSize, file.size() - records_offset);

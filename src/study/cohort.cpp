@@ -169,12 +169,12 @@ StudyTables simulate_subject(const LoadedProtocol& protocol, const SubjectAssign
                              const CohortSetup& setup) {
   setup.validate();
   refuse_replay(protocol.protocol);
-  const CharacterLibrary embedded = CharacterLibrary::embedded();
+  const CharacterLibrary standard = CharacterLibrary::standard();
   std::map<char32_t, Character> characters;  // fitted once per subject
   const auto character = [&](char32_t code_point) -> const Character& {
     auto found = characters.find(code_point);
     if (found == characters.end()) {
-      Character model = setup.load_character ? setup.load_character(code_point) : embedded.load(code_point);
+      Character model = setup.load_character ? setup.load_character(code_point) : standard.load(code_point);
       found = characters.emplace(code_point, std::move(model)).first;
     }
     return found->second;
@@ -211,14 +211,14 @@ StudyTables simulate_cohort(const LoadedProtocol& protocol, const std::vector<Su
   setup.validate();
   refuse_replay(protocol.protocol);
   // Every character of every subject's plan, loaded here once: the workers only read the map.
-  const CharacterLibrary embedded = CharacterLibrary::embedded();
+  const CharacterLibrary standard = CharacterLibrary::standard();
   std::map<char32_t, Character> characters;
   for (const SubjectAssignment& subject : subjects) {
     for (int number = 1; number <= protocol.protocol.session_count(); ++number) {
       for (const PlannedTrial& trial : plan_session(protocol.protocol, subject, number)) {
         for (const char32_t c : trial.characters) {
           if (characters.count(c) == 0)
-            characters.emplace(c, setup.load_character ? setup.load_character(c) : embedded.load(c));
+            characters.emplace(c, setup.load_character ? setup.load_character(c) : standard.load(c));
         }
       }
     }

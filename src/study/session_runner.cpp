@@ -184,7 +184,7 @@ class SessionRun {
         simulated_writer_(manifest_.setup.writer == "simulated"),
         // A learning simulated subject remembers its saved trials, of this session and the ones before it.
         learning_(simulated_writer_ && manifest_.setup.writer_learning == "two-state"),
-        embedded_(CharacterLibrary::embedded()) {
+        standard_(CharacterLibrary::standard()) {
     check_plan(manifest_, listing_);
   }
 
@@ -264,7 +264,8 @@ class SessionRun {
   const Character& character(char32_t code_point) {
     auto found = characters_.find(code_point);
     if (found == characters_.end()) {
-      Character model = options_.load_character ? options_.load_character(code_point) : embedded_.load(code_point);
+      Character model =
+          options_.load_character ? options_.load_character(code_point) : standard_.load(code_point);
       found = characters_.emplace(code_point, std::move(model)).first;
     }
     return found->second;
@@ -483,7 +484,7 @@ class SessionRun {
   const DeviceListing listing_;
   const bool simulated_writer_;
   const bool learning_;
-  CharacterLibrary embedded_;
+  CharacterLibrary standard_;
   std::map<char32_t, Character> characters_;
   WriterMemory memory_;
   SessionRunResult result_;

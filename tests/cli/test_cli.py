@@ -7,6 +7,7 @@ folder, so that a stray output file (one named `-` or `--seed`) would show.
 """
 import json
 import os
+import random
 import re
 import resource
 import shutil
@@ -24,7 +25,7 @@ SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().
 DATA = SOURCE / "data" / "hanzi-writer-data"
 
 COMMANDS = [
-    [], ["trial"], ["train"], ["score"], ["model"], ["strokes"], ["devices"],
+    [], ["trial"], ["train"], ["score"], ["model"], ["strokes"], ["characters"], ["devices"],
     ["corpus"], ["corpus", "build"], ["corpus", "stats"], ["corpus", "fidelity"], ["corpus", "validate"],
     ["bench"], ["bench", "nearest"], ["bench", "jumps"], ["bench", "tick"], ["bench", "loop"],
 ]
@@ -440,6 +441,79 @@ class Score(CliTestCase):
         self.assert_usage_error(["score", "t.csv", "--character", "永我", "--units", "data"], "--character")
         self.assert_usage_error(["score", "t.csv"], "--character")
         self.assert_usage_error(["score", "t.csv", "--character", "永", "--units", "metres"], "--units")
+
+
+class EveryCharacterOffline(CliTestCase):
+    """Any hanzi-writer-data character with no fetched data, no --data and no --store: the default lookup
+    falls back to the corpus store compiled into the program (docs/corpus.md)."""
+
+    def run_offline(self, *args):
+        environment = {k: v for k, v in os.environ.items() if k != "CALLIGRAPHY_CORPUS_DIR"}
+        environment["HOME"] = environment["XDG_CACHE_HOME"] = str(self.cwd)  # no fetched package to find
+        return subprocess.run([CLI, *map(str, args)], cwd=self.cwd, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, timeout=120, env=environment)
+
+    def json_of(self, *args):
+        result = self.run_offline(*args)
+        self.assertEqual(result.returncode, 0, f"{args}: {result.stderr.decode()}")
+        return json.loads(result.stdout)
+
+    def store_characters(self, count):
+        """Characters beyond the embedded ones, drawn at random (seeded): none is named in any test."""
+        listed = self.json_of("characters", "--json")
+        self.assertEqual(listed["count"], 9574)
+        embedded = {p.stem for p in DATA.glob("*.json")}
+        pool = [entry for entry in listed["characters"] if entry["character"] not in embedded]
+        return random.Random(20261126).sample(pool, count)
+
+    def test_a_store_character_is_modelled_written_in_order_scored_and_listed(self):
+        for entry in self.store_characters(3):
+            char = entry["character"]
+            model = self.json_of("model", char, "--json")
+            strokes = len(model["strokes"])
+            self.assertEqual(strokes, entry["strokes"], char)
+            trial = self.run_offline("trial", char, "--seed", "5", "--writer-profile", "skilled",
+                                     "--csv", "t.csv", "--json", "t.json")
+            self.assertEqual(trial.returncode, 0, f"{char}: {trial.stderr.decode()}")
+            metrics = json.loads((self.cwd / "t.json").read_text())
+            self.assertEqual(metrics["strokes_total"], strokes, char)
+            self.assertEqual(metrics["strokes_accepted"], strokes, char)  # every stroke, in order
+            self.assertTrue(metrics["completed_in_order"], char)
+            score = self.json_of("score", "t.csv", "--character", char, "--json", "-")
+            for key in Score.METRIC_KEYS:
+                assert_same_record(self, score[key], metrics[key], f"{char}: {key}")
+            # Listed by its stroke count, by each of its typical strokes (acronym, ID), and from a text.
+            by_count = self.json_of("characters", "--strokes", strokes, "--json")
+            self.assertIn(char, [e["character"] for e in by_count["characters"]])
+            self.assertTrue(all(e["strokes"] == strokes for e in by_count["characters"]))
+            acronym, typical_id = entry["typical_strokes"][-1], entry["typical_ids"][-1]
+            for value in (acronym, acronym.lower(), typical_id):
+                by_stroke = self.json_of("characters", "--typical", value, "--json")
+                self.assertIn(char, [e["character"] for e in by_stroke["characters"]], value)
+                self.assertTrue(all(typical_id in e["typical_ids"] for e in by_stroke["characters"]))
+            text = self.json_of("characters", "--text", f"{char}，{char} 龘", "--json")
+            self.assertEqual([e["character"] for e in text["characters"]], [char])
+            self.assertEqual(text["not_found"], ["，", "龘"])
+
+    def test_characters_table_and_usage(self):
+        table = self.run_offline("characters", "--text", "永字八法", "--strokes", "2")
+        self.assertEqual(table.returncode, 0, table.stderr.decode())
+        lines = table.stdout.decode().splitlines()
+        self.assertTrue(lines[0].startswith("char"), lines)
+        self.assertEqual([line.split()[0] for line in lines[1:-1]], ["八"])
+        self.assertTrue(lines[-1].startswith("1 character; library: every hanzi-writer-data"), lines)
+        for name in ("横折钩", "㇆"):  # HZG by its Chinese name and by its CJK stroke character
+            listed = self.json_of("characters", "--typical", name, "--text", "一永月", "--json")
+            self.assertEqual([e["character"] for e in listed["characters"]], ["永", "月"], name)
+        self.assert_usage_error(["characters", "--typical", "HZZZZZ"], "--typical")
+        self.assertIn("did you mean", self.assert_usage_error(["characters", "--typical", "HZGG"], "--typical"))
+        self.assert_usage_error(["characters", "--typical", "40"], "--typical")
+        self.assert_usage_error(["characters", "--strokes", "0"], "--strokes")
+        self.assert_usage_error(["characters", "--strokes", "x"], "--strokes")
+        self.assert_usage_error(["characters", "--text", ""], "--text")
+        missing = self.run_cli("characters", "--store", "missing.clg")
+        self.assertEqual(missing.returncode, 1)
+        self.assertIn("missing.clg", missing.stderr.decode())
 
 
 class Determinism(CliTestCase):

@@ -11,7 +11,7 @@ from calligraphy.experiments import DASK_WORKER_ENVIRONMENT, dask_worker_config,
 
 pandas = pytest.importorskip("pandas")
 
-# Short characters, the last one missing from the embedded set; 2 x 3 x 2 = 12 trials.
+# Short characters, the last one not in hanzi-writer-data (so in no library); 2 x 3 x 2 = 12 trials.
 CHARACTERS = "口十\u00e9"
 GRID = {"guidance": [True, False], "guidance_stiffness_n_per_m": [250.0]}
 SEEDS = [0, 7]

@@ -7,8 +7,8 @@ trial: the trial's parameters and the flat metrics of ``calligraphy trial --json
 Trials run in batches on a process pool (the 'forkserver' or 'spawn' start method) or on the workers
 of a ``distributed.Client``; both go through one path (``concurrent.futures`` submit and
 as_completed, the client through ``Client.get_executor``). A batch carries only names and numbers:
-each worker opens the character source (the embedded set, a corpus store or a hanzi-writer-data
-folder) once by its path and loads characters by name. A trial is deterministic for its parameters,
+each worker opens the character source (the default set of every character, a corpus store or a
+hanzi-writer-data folder) once by its path and loads characters by name. A trial is deterministic for its parameters,
 and the rows are sorted by the trial's position in the sweep, so the table does not depend on the
 executor, the number of workers or the batch size.
 
@@ -317,8 +317,8 @@ def sweep(characters: typing.Union[str, typing.Sequence[str], None],
     client: None runs on a local process pool; a distributed.Client runs on its cluster; any
         concurrent.futures.Executor is used as it is.
     store / data: load characters from a corpus store (CharacterLibrary.from_store) or a
-        hanzi-writer-data folder (CharacterLibrary.from_hanzi_writer) instead of the embedded set;
-        the path must be readable by every worker.
+        hanzi-writer-data folder (CharacterLibrary.from_hanzi_writer) instead of the default set (every
+        hanzi-writer-data character); the path must be readable by every worker.
     batch_size: trials per task (default: at most 32, at least 4 tasks per worker).
     progress: a tqdm progress bar (when tqdm is installed). workers: local processes (default:
         every core this process may run on); ignored with a client.

@@ -57,6 +57,13 @@ class CharacterLibrary {
   /// The embedded default set: a verbatim subset of hanzi-writer-data 2.0.1 compiled into the library
   /// (data/hanzi-writer-data, Arphic Public License).
   static CharacterLibrary embedded();
+  /// The default lookup of the command line, the Python module and the study runner: the embedded
+  /// set, and every other character of hanzi-writer-data 2.0.1 (9,574 in all) from the corpus store
+  /// compiled into the library (`CorpusStore::bundled()`). An embedded character is fitted from its JSON
+  /// file as `embedded()` does; another is loaded from the store as fitted when the store was built
+  /// (elements within its quantisation, the medians exact). A store character has no outlines
+  /// (`load_outlines` throws DataError saying so). Nothing is read from disk.
+  static CharacterLibrary standard();
   /// A folder of `<char>.json` files. Throws DataError when the folder does not exist. Only regular
   /// files of at most kMaxCharacterFileBytes are read (a FIFO or a device named like a character file
   /// is refused without blocking: DataError naming the file).
@@ -64,9 +71,11 @@ class CharacterLibrary {
 
   /// True when the character is available.
   [[nodiscard]] bool contains(char32_t code_point) const;
-  /// The raw medians. Throws CharacterNotFound (naming the character and where it looked) or DataError.
+  /// The raw medians (for a character of the bundled store, its stored medians). Throws
+  /// CharacterNotFound (naming the character and where it looked) or DataError.
   [[nodiscard]] CharacterData load_data(char32_t code_point) const;
-  /// The fitted model (elements, feature points, typical IDs). Throws as `load_data`.
+  /// The fitted model (elements, feature points, typical IDs). A character of the bundled store is the
+  /// stored model, fitted when the store was built (`options` do not apply to it). Throws as `load_data`.
   [[nodiscard]] Character load(char32_t code_point, const FitOptions& options = {}) const;
   /// The filled outlines of the character's strokes, in stroke order: hanzi-writer-data's `strokes` SVG
   /// paths flattened within `tolerance` data units (stroke_outline.hpp), for drawing. Throws as
@@ -76,11 +85,15 @@ class CharacterLibrary {
   /// Every available character, sorted by code point. Throws DataError naming the folder when a folder
   /// holds no `<char>.json` file or cannot be listed.
   [[nodiscard]] std::vector<char32_t> characters() const;
-  /// "embedded default (58 characters)" or the folder's path.
+  /// "embedded default (58 characters)", the standard set's "every hanzi-writer-data 2.0.1 character
+  /// (9574: 58 embedded, the others from the bundled corpus store)", or the folder's path.
   [[nodiscard]] std::string description() const;
 
  private:
+  [[nodiscard]] bool from_bundled_store(char32_t code_point) const;
+
   std::filesystem::path folder_;  // empty: embedded
+  bool bundled_store_ = false;    // embedded, then the bundled corpus store (standard())
 };
 
 }  // namespace calligraphy

@@ -8,9 +8,12 @@
 /// What a stored character holds: per stroke the typical-stroke ID, the elements (kind, degree, control
 /// points quantised to 1/steps_per_unit data units, joints shared) and the attraction factors at the
 /// feature points (exact float64; a stroke whose factors all equal its typical stroke's default
-/// stores none). It does not hold the source medians: a loaded `Stroke::median` is
-/// empty, and `Character::source` is "<store path>#U+XXXX". Fidelity against the medians is measured
-/// when the store is built (`calligraphy corpus fidelity`, docs/corpus.md).
+/// stores none) and, in a 1.1 store written with `CorpusStoreOptions::medians` (the default), the
+/// source medians, exactly, which stroke acceptance and scoring follow
+/// (docs/stroke-acceptance.md). A 1.0 store has no medians: a loaded `Stroke::median` is then empty
+/// and the centre line is the elements (`StrokeCentreLine`). `Character::source` is
+/// "<store path>#<char> (U+XXXX)". Fidelity of the models against the medians is measured when the
+/// store is built (`calligraphy corpus fidelity`, docs/corpus.md).
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -31,12 +34,18 @@ struct CorpusStoreOptions {
   int steps_per_unit = 2;
   /// The fitting tolerance the characters were fitted with [data units]; recorded in the header only.
   double fit_tolerance = 10.0;
+  /// Also store each stroke's source median (`Stroke::median`), exactly: in units of 1, 1/2 or 1/4 data
+  /// unit, the coarsest that holds it (hanzi-writer-data's medians are whole units, in 31 characters
+  /// quarter units), else as float64 coordinates (2 strokes of hanzi-writer-data): format 1.1 with the
+  /// medians flag. False writes a 1.0 store of the models only, which every 1.x reader reads.
+  bool medians = true;
 };
 
 /// What a store's header says, plus sizes.
 struct CorpusStoreInfo {
   int version_major = 0;
   int version_minor = 0;
+  bool medians = false;  ///< the records hold the strokes' medians (format 1.1, header flag 1)
   std::size_t character_count = 0;
   int steps_per_unit = 0;
   double fit_tolerance = 0.0;  ///< data units, as recorded by the writer
@@ -51,7 +60,9 @@ struct CorpusStoreInfo {
 /// Encodes characters into the store format in memory. Characters are sorted by code point.
 /// Throws InvalidArgument for duplicate code points, an empty character, more than 255 strokes, a stroke
 /// without elements, a typical ID outside 1-39, degrees outside 1-4, attraction factors not one per
-/// feature point, non-finite or out-of-range coordinates (|x| * steps_per_unit > 2^23), or bad options.
+/// feature point, non-finite or out-of-range coordinates (|x| * steps_per_unit > 2^23, a median's
+/// coordinate not finite or beyond 2^23 units of its resolution: 2^23 data units when whole, 2^21 in
+/// quarter units and as float64), a median of more than 16,383 points, or bad options.
 std::vector<std::uint8_t> encode_corpus_store(std::span<const Character> characters,
                                               const CorpusStoreOptions& options = {});
 
@@ -72,6 +83,16 @@ class CorpusStore {
   static CorpusStore open(const std::filesystem::path& path);
   /// The same over a copy of `bytes` (tests, fuzzing); `name` stands for the file in errors.
   static CorpusStore from_bytes(std::span<const std::uint8_t> bytes, const std::string& name);
+  /// The store compiled into the library: every character of hanzi-writer-data 2.0.1 (9,574) fitted by
+  /// `calligraphy corpus build` at the default tolerance and quantisation, with the medians (format
+  /// 1.1), from data/corpus/hanzi-writer-data-2.0.1.clg (Arphic Public License: data/corpus/ARPHICPL.TXT
+  /// and NOTICE.md, installed under share/calligraphy/corpus). Checked when first asked for (header,
+  /// index and their checksums; each record when loaded, as `open`), then shared, without a copy. Its
+  /// `name()` is "bundled:hanzi-writer-data-2.0.1.clg". Throws DataError as `open` if the compiled-in
+  /// bytes fail the checks.
+  static const CorpusStore& bundled();
+  /// SHA-256 of the bundled store's file, lower-case hex (64 characters).
+  static const char* bundled_sha256();
 
   [[nodiscard]] const CorpusStoreInfo& info() const;
   [[nodiscard]] std::size_t size() const { return info().character_count; }

@@ -30,7 +30,8 @@ struct CohortSetup {
   /// Whether the subjects differ from one another (SessionSetup::individual_differences, sim/
   /// subject_traits.hpp); false: every subject is the profile itself.
   bool individual_differences = true;
-  /// Loads a character's model; empty: the embedded characters. Called from one thread at a time.
+  /// Loads a character's model; empty: the standard set (CharacterLibrary::standard(): every
+  /// hanzi-writer-data character). Called from one thread at a time.
   std::function<Character(char32_t)> load_character;
   /// Throws InvalidArgument naming the field for an unknown profile or learning.
   void validate() const;

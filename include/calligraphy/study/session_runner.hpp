@@ -58,7 +58,8 @@ struct SessionRunOptions {
   /// Where the device named in the session is created (not owned): its owner's registry (the command
   /// line's, Python's, a test's). Required: run_session throws InvalidArgument without one.
   const DeviceRegistry* registry = nullptr;
-  /// Loads a character's model; empty: the embedded characters (CharacterLibrary::embedded()).
+  /// Loads a character's model; empty: the standard set (CharacterLibrary::standard(): every
+  /// hanzi-writer-data character).
   std::function<Character(char32_t)> load_character;
   /// Polled between trials and during each trial (TrialOptions::should_stop); true ends the session after
   /// keeping the running trial as an attempt.
