@@ -378,7 +378,11 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
   }
 
   // What is about to run (stderr: stdout carries one line per session run).
-  std::fputs(session_plan_text(resolved, subjects).c_str(), stderr);
+  // After --new-subjects, the balance is the whole study's: subjects 1 to the last one of this run.
+  std::vector<SubjectAssignment> study;
+  if (command.new_subjects && command.subjects > 0 && subjects.front().number > 1)
+    study = numbered_subjects(subjects.back().number, prefix);
+  std::fputs(session_plan_text(resolved, subjects, study).c_str(), stderr);
   std::fflush(stderr);
 
   install_stop_handlers();

@@ -111,7 +111,8 @@ std::string phase_line(const PlannedPhase& planned) {
 
 }  // namespace
 
-std::string session_plan_text(const LoadedProtocol& loaded, std::span<const SubjectAssignment> subjects) {
+std::string session_plan_text(const LoadedProtocol& loaded, std::span<const SubjectAssignment> subjects,
+                              std::span<const SubjectAssignment> balanced) {
   const StudyProtocol& protocol = loaded.protocol;
   const double per_trial_s = protocol.trial.max_duration_s;
   std::string text =
@@ -137,8 +138,10 @@ std::string session_plan_text(const LoadedProtocol& loaded, std::span<const Subj
       for (const PlannedPhase& phase : session.phases) text += "    " + phase_line(phase) + "\n";
     }
   }
-  const Counterbalancing balance = counterbalancing(protocol, subjects);
+  const Counterbalancing balance = counterbalancing(protocol, balanced.empty() ? subjects : balanced);
   text += "balance: ";
+  if (!balanced.empty())
+    text += "with the " + std::to_string(balanced.size() - subjects.size()) + " subjects before them, ";
   if (balance.drawn) {
     text +=
         "a random order draws each subject's orders and groups from its id; nothing is balanced by number";

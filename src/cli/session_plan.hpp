@@ -12,9 +12,11 @@
 namespace calligraphy::cli {
 
 /// The plan as text, one block of lines per subject, then the balance line and, when the subjects do not
-/// fill the square, a line beginning "warning: ".
+/// fill the square, a line beginning "warning: ". The balance counts `balanced` (the whole study: the
+/// subjects already run and these), or `subjects` when it is empty.
 [[nodiscard]] std::string session_plan_text(const LoadedProtocol& protocol,
-                                            std::span<const SubjectAssignment> subjects);
+                                            std::span<const SubjectAssignment> subjects,
+                                            std::span<const SubjectAssignment> balanced = {});
 
 /// The plan as one JSON document (docs/cli.md, "session plan").
 [[nodiscard]] std::string session_plan_json(const LoadedProtocol& protocol,

@@ -189,6 +189,9 @@ class SessionPlanCliTest(unittest.TestCase):
         # --new-subjects goes on with S03, numbered 3 (the next group), and leaves S01 and S02 as they were.
         more = self.run_subjects(protocol, 1, "--new-subjects")
         self.assertEqual(more.returncode, 0, more.stderr.decode())
+        # The balance is the study's: S01 to S03, one in each of the three groups.
+        self.assertIn("balance: with the 2 subjects before them", more.stderr.decode())
+        self.assertNotIn("warning", more.stderr.decode())
         manifest = self.session_json("S03")
         self.assertEqual(manifest["subject"]["number"], 3)
         self.assertEqual({t["condition"] for t in manifest["plan"] if t["phase"] == "training"}, {"C"})
