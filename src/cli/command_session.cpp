@@ -3,6 +3,7 @@
 // SIGTERM stop the session after keeping the running trial as an attempt; `resume` goes on from there.
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -26,6 +27,7 @@
 #include "cli/interrupt.hpp"
 #include "cli/library_options.hpp"
 #include "cli/output.hpp"
+#include "cli/session_plan.hpp"
 #include "cli/signals.hpp"
 #include "cli/study_inputs.hpp"
 #include "cli/writer_options.hpp"
@@ -61,6 +63,7 @@ struct SessionRunCommand {
   std::string pacing = "auto";
   std::string out;
   bool ignore_delay = false;
+  bool new_subjects = false;
   LibraryOptions library;
   SessionDisplay display;
 };
@@ -143,7 +146,8 @@ SessionRunResult run_one(SessionFolder& session, const SessionRunOptions& option
       try {
         character.outlines = outlines->load_outlines(c);
       } catch (const DataError& e) {  // drawn without outlines
-        print_error_line("calligraphy session", "warning", "no stroke outlines for " + character.utf8 + ": " + e.what());
+        print_error_line("calligraphy session", "warning",
+                         "no stroke outlines for " + character.utf8 + ": " + e.what());
       }
       return character;
     };
@@ -199,6 +203,30 @@ int report_run(const SessionFolder& session, const SessionRunResult& result, dou
     return stop_signal() != 0 ? 128 + stop_signal() : 1;
   }
   return 0;
+}
+
+// The subjects under the study folder `out` that hold a session of `protocol` (its series begun), by id.
+std::vector<std::string> subjects_with_sessions(const std::filesystem::path& out,
+                                                const LoadedProtocol& protocol) {
+  std::vector<std::string> found;
+  std::error_code error;
+  if (!std::filesystem::is_directory(out, error)) return found;
+  for (const auto& entry : std::filesystem::directory_iterator(out, error)) {
+    const std::string name = entry.path().filename().string();
+    if (!entry.is_directory(error) || !is_subject_id(name)) continue;
+    if (!session_series(out, name, protocol).folders.empty()) found.push_back(name);
+  }
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
+// "S01, S02, S03" (the first ten, then how many more).
+std::string subject_list(const std::vector<std::string>& ids) {
+  constexpr std::size_t kNamed = 10;
+  std::string text;
+  for (std::size_t i = 0; i < ids.size() && i < kNamed; ++i) text += (i == 0 ? "" : ", ") + ids[i];
+  if (ids.size() > kNamed) text += " and " + std::to_string(ids.size() - kNamed) + " more";
+  return text;
 }
 
 std::vector<std::string> split_profiles(const std::string& text) {
@@ -261,11 +289,26 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
   const CharacterSource characters(command.library);
   require_characters(protocol, characters);
 
+  const LoadedProtocol resolved = resolved_protocol(protocol, characters);
+  const int sessions = resolved.protocol.session_count();
+  // The subjects already holding this protocol's sessions under --out: a protocol of one session run again
+  // would start their session 1 a second time, and every reader would pool the two.
+  const std::vector<std::string> begun = subjects_with_sessions(command.out, resolved);
+  const std::string prefix = command.subject.empty() ? "S" : command.subject;
   std::vector<SubjectAssignment> subjects;
   if (command.subjects > 0) {
     try {
-      subjects = numbered_subjects(static_cast<std::size_t>(command.subjects),
-                                   command.subject.empty() ? "S" : command.subject);
+      // --new-subjects: numbered after the highest number of this prefix already there.
+      std::size_t after = 0;
+      if (command.new_subjects) {
+        for (const std::string& id : begun) {
+          if (id.size() > prefix.size() && id.starts_with(prefix) &&
+              id.find_first_not_of("0123456789", prefix.size()) == std::string::npos)
+            after = std::max(after, trailing_number(id));
+        }
+      }
+      subjects = numbered_subjects(after + static_cast<std::size_t>(command.subjects), prefix);
+      subjects.erase(subjects.begin(), subjects.begin() + static_cast<std::ptrdiff_t>(after));
     } catch (const InvalidArgument& e) {
       throw UsageError(std::string("--subject: ") + e.what());
     }
@@ -275,9 +318,24 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
                                    : trailing_number(command.subject);
     subjects.push_back({command.subject, number});
   }
-
-  const LoadedProtocol resolved = resolved_protocol(protocol, characters);
-  const int sessions = resolved.protocol.session_count();
+  std::vector<std::string> again;  // subjects of this run whose series is begun under --out
+  for (const SubjectAssignment& subject : subjects) {
+    if (std::binary_search(begun.begin(), begun.end(), subject.id)) again.push_back(subject.id);
+  }
+  if (!again.empty() && command.new_subjects) {
+    throw UsageError("--new-subjects: " + subject_list(again) + " already holds sessions of '" +
+                     resolved.protocol.name + "' under --out " + command.out + ": give a new --subject");
+  }
+  if (!again.empty() && sessions == 1) {
+    throw UsageError("--out " + command.out + " already holds the session of '" + resolved.protocol.name +
+                     "' for " + subject_list(again) + ": a run would start " +
+                     (again.size() == 1 ? "its" : "their") + " session 1 again; " +
+                     (command.subjects > 0
+                          ? std::string("--new-subjects runs ") + std::to_string(command.subjects) +
+                                " new subjects numbered after those there"
+                          : std::string("give a new --subject")) +
+                     ", and `calligraphy session resume DIR` goes on with an unfinished session");
+  }
   const auto setup_for = [&](std::size_t i, int session_number) {
     SessionSetup setup;
     setup.subject = subjects[i];
@@ -319,6 +377,14 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
       check_writable_folder(existing, trial_files_bytes(resolved.protocol.trial));
   }
 
+  // What is about to run (stderr: stdout carries one line per session run).
+  // After --new-subjects, the balance is the whole study's: subjects 1 to the last one of this run.
+  std::vector<SubjectAssignment> study;
+  if (command.new_subjects && command.subjects > 0 && subjects.front().number > 1)
+    study = numbered_subjects(subjects.back().number, prefix);
+  std::fputs(session_plan_text(resolved, subjects, study).c_str(), stderr);
+  std::fflush(stderr);
+
   install_stop_handlers();
   TerminalHost host;
   std::shared_ptr<CharacterSource> source;
@@ -330,7 +396,7 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
       if (stop_requested()) return 128 + stop_signal();
       // Held until this session is written: another run of the subject waits, then sees it.
       std::optional<SeriesLock> lock;
-      if (sessions > 1) {
+      {
         lock.emplace(
             command.out, subjects[i].id,
             [&](const std::filesystem::path& path) {
@@ -345,9 +411,8 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
           return 128 + stop_signal();
         }
       }
-      // A protocol of one session starts a new one on every run, as before sessions were linked.
-      const SessionSeries series =
-          sessions > 1 ? session_series(command.out, subjects[i].id, resolved) : SessionSeries{};
+      // A protocol of one session is a series of one: a subject whose session is there is done.
+      const SessionSeries series = session_series(command.out, subjects[i].id, resolved);
       if (series.unfinished) {
         throw StateError(
             subjects[i].id + ": session " + std::to_string(series.next) + " of " + protocol.protocol.name +
@@ -485,6 +550,9 @@ void add_session_commands(CLI::App& root, Commands& commands, DeviceRegistry& de
       add_text(*app, "--out", run->out, "DIR",
                "the study folder: sessions go to DIR/SUBJECT/PROTOCOL-SUBJECT-TIME/; a protocol of several "
                "sessions goes on with the subject's next one there"));
+  add_flag(*app, "--new-subjects", run->new_subjects,
+           "with --subjects N: run N new subjects, numbered after the highest of the --subject prefix that "
+           "holds sessions of the protocol under --out; a subject given by --subject must be new");
   add_flag(*app, "--ignore-delay", run->ignore_delay,
            "start a person's next session before the protocol's delay has passed, or after a session that "
            "ended later than now by this computer's clock (recorded as overridden)");
@@ -492,6 +560,7 @@ void add_session_commands(CLI::App& root, Commands& commands, DeviceRegistry& de
   add_display_options(*app, run->display);
 
   add_session_cohort_command(*group, commands);
+  add_session_plan_command(*group, commands);
 
   auto resume = std::make_shared<SessionResumeCommand>();
   CLI::App* resume_app =

@@ -37,5 +37,6 @@ void add_bench_tick_command(CLI::App& bench, Commands& commands);
 void add_bench_loop_command(CLI::App& bench, Commands& commands);
 void add_bench_acceptance_command(CLI::App& bench, Commands& commands);
 void add_session_cohort_command(CLI::App& session, Commands& commands);
+void add_session_plan_command(CLI::App& session, Commands& commands);
 
 }  // namespace calligraphy::cli

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <map>
 #include <numeric>
+#include <span>
 #include <utility>
 
 #include "calligraphy/core/errors.hpp"
@@ -247,8 +248,11 @@ std::string subject_group(const StudyProtocol& protocol, const SubjectAssignment
   return group;
 }
 
-std::vector<PlannedTrial> plan_session(const StudyProtocol& protocol, const SubjectAssignment& subject,
-                                       int session) {
+namespace {
+
+// The one planning of a session: its trials and, when asked, where each phase's trials are.
+std::vector<PlannedTrial> plan_trials(const StudyProtocol& protocol, const SubjectAssignment& subject,
+                                      int session, std::vector<PlannedPhase>* phases) {
   const std::uint64_t planned = planned_trial_count(protocol);  // before anything per trial is allocated
   if (planned > kMaxPlannedTrials) {
     throw InvalidArgument("protocol '" + protocol.name + "': " + thousands(planned) +
@@ -307,10 +311,18 @@ std::vector<PlannedTrial> plan_session(const StudyProtocol& protocol, const Subj
     }
     // The first phase of a later session waits in the session's link (session_series.hpp), not as a rest.
     double rest_before_s = first_phase ? 0.0 : phase.delay_s;
+    PlannedPhase shown{&phase, {}, {}, trials.size(), 0};
     for (const BlockPlan& planned_block : phase_blocks(protocol, phase, subject, crossover)) {
       add_block(phase, planned_block.condition, planned_block.items, planned_block.rounds, rest_before_s);
       rest_before_s = 0.0;
+      shown.blocks.push_back(planned_block.condition);
+      shown.block_sets.push_back(phase.assignment == ConditionAssignment::crossover &&
+                                         phase.kind != StudyPhase::practice
+                                     ? crossover.sets[shown.blocks.size() - 1]
+                                     : std::string());
     }
+    shown.trials = trials.size() - shown.first_trial;
+    if (phases != nullptr) phases->push_back(std::move(shown));
     first_phase = false;
   }
   const auto every = static_cast<std::size_t>(protocol.breaks.every_trials);
@@ -320,6 +332,156 @@ std::vector<PlannedTrial> plan_session(const StudyProtocol& protocol, const Subj
     }
   }
   return trials;
+}
+
+}  // namespace
+
+std::vector<PlannedTrial> plan_session(const StudyProtocol& protocol, const SubjectAssignment& subject,
+                                       int session) {
+  return plan_trials(protocol, subject, session, nullptr);
+}
+
+std::vector<PlannedPhase> plan_session_phases(const StudyProtocol& protocol, const SubjectAssignment& subject,
+                                              int session) {
+  std::vector<PlannedPhase> phases;
+  (void)plan_trials(protocol, subject, session, &phases);
+  return phases;
+}
+
+std::size_t counterbalancing_square(const StudyProtocol& protocol) {
+  const std::size_t groups = between_subjects_cycle(protocol);
+  std::size_t square = groups;
+  for (const ProtocolPhase& phase : protocol.phases) {
+    if (phase.kind == StudyPhase::practice || phase.assignment == ConditionAssignment::between_subjects)
+      continue;
+    const std::size_t n = phase.conditions.size();
+    const std::size_t rows = n % 2 == 0 ? n : 2 * n;
+    if (phase.assignment == ConditionAssignment::crossover) {
+      square = std::lcm(square, groups * rows * n);  // counted within the group (crossover_assignment)
+    } else if (n > 1 && protocol.condition_order == ConditionOrder::latin_square) {
+      square = std::lcm(square, rows);
+    } else if (n > 1 && protocol.condition_order == ConditionOrder::abba) {
+      square = std::lcm(square, std::size_t{2});
+    }
+  }
+  return square;
+}
+
+namespace {
+
+// The level of each factor the protocol counterbalances, for one subject, by the assignment functions above.
+std::vector<std::pair<std::string, std::string>> balance_levels(const StudyProtocol& protocol,
+                                                                const SubjectAssignment& subject) {
+  std::vector<std::pair<std::string, std::string>> levels;
+  bool between = false;
+  for (const ProtocolPhase& phase : protocol.phases)
+    between |= phase.assignment == ConditionAssignment::between_subjects;
+  if (between) levels.emplace_back("group", subject_group(protocol, subject));
+  if (const ProtocolPhase* crossover = protocol.crossover_phase(); crossover != nullptr) {
+    const CrossoverAssignment assignment = crossover_assignment(protocol, subject);
+    levels.emplace_back("sequence", assignment.sequence);
+    std::string pairing;
+    for (std::size_t i = 0; i < crossover->conditions.size(); ++i) {
+      for (std::size_t p = 0; p < assignment.conditions.size(); ++p) {
+        if (assignment.conditions[p] != crossover->conditions[i]) continue;
+        if (!pairing.empty()) pairing.push_back(' ');
+        pairing.push_back(static_cast<char>('A' + i));
+        pairing.push_back(':');
+        pairing.append(assignment.sets[p]);
+      }
+    }
+    levels.emplace_back("set pairing", pairing);
+  }
+  if (protocol.condition_order != ConditionOrder::fixed) {
+    for (const ProtocolPhase& phase : protocol.phases) {
+      if (phase.kind == StudyPhase::practice || phase.assignment != ConditionAssignment::within_subjects ||
+          phase.conditions.size() < 2)
+        continue;
+      std::string order;
+      for (const std::string& condition : block_conditions(protocol, phase, subject))
+        order += (order.empty() ? "" : " ") + condition;
+      levels.emplace_back(std::string("order of ") + to_string(phase.kind) + " (" + phase.pointer + ")",
+                          order);
+    }
+  }
+  return levels;
+}
+
+}  // namespace
+
+Counterbalancing counterbalancing(const StudyProtocol& protocol,
+                                  std::span<const SubjectAssignment> subjects) {
+  Counterbalancing out;
+  out.square = counterbalancing_square(protocol);
+  out.subjects = subjects.size();
+  out.drawn = protocol.condition_order == ConditionOrder::random;
+  const auto add = [&out](const std::vector<std::pair<std::string, std::string>>& levels, bool count) {
+    for (std::size_t f = 0; f < levels.size(); ++f) {
+      if (out.factors.size() <= f) out.factors.push_back({levels[f].first, {}, {}});
+      BalanceFactor& factor = out.factors[f];
+      auto at = std::find(factor.levels.begin(), factor.levels.end(), levels[f].second);
+      if (at == factor.levels.end()) {
+        factor.levels.push_back(levels[f].second);
+        factor.subjects.push_back(0);
+        at = factor.levels.end() - 1;
+      }
+      if (count) ++factor.subjects[static_cast<std::size_t>(at - factor.levels.begin())];
+    }
+  };
+  // Every level a full square gives (numbers 1..square; ids matter only to a random order, whose levels are
+  // the drawn ones), then the subjects counted on them.
+  if (!out.drawn) {
+    const std::size_t shown = std::min<std::size_t>(out.square, kMaxBalanceSquareShown);
+    for (std::size_t n = 1; n <= shown; ++n)
+      add(balance_levels(protocol, {"S" + std::to_string(n), n}), false);
+  }
+  for (const SubjectAssignment& subject : subjects) add(balance_levels(protocol, subject), true);
+  return out;
+}
+
+bool Counterbalancing::filled() const noexcept {
+  if (subjects % square != 0) return false;
+  for (const BalanceFactor& factor : factors) {
+    for (const std::size_t count : factor.subjects) {
+      if (count != factor.subjects.front()) return false;
+    }
+  }
+  return true;
+}
+
+std::string Counterbalancing::warning() const {
+  if (filled() || subjects == 0) return {};
+  std::string text = "N=" + std::to_string(subjects);
+  std::string parts;
+  for (const BalanceFactor& factor : factors) {
+    bool even = true;
+    for (const std::size_t count : factor.subjects) even &= count == factor.subjects.front();
+    if (even) continue;
+    std::vector<std::size_t> order(factor.levels.size());
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    std::stable_sort(order.begin(), order.end(), [&factor](std::size_t a, std::size_t b) {
+      return factor.subjects[a] < factor.subjects[b];
+    });
+    std::string part = factor.name + " ";
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      const std::size_t count = factor.subjects[order[i]];
+      part += (i == 0                  ? ""
+               : i + 1 == order.size() ? " and "
+                                       : ", ") +
+              factor.levels[order[i]] + " with " + std::to_string(count) +
+              (i == 0 ? (count == 1 ? " subject" : " subjects") : "");
+    }
+    parts += (parts.empty() ? "" : "; ") + part;
+  }
+  if (drawn) {
+    text += parts.empty() ? " (orders or groups drawn per subject id, not balanced by number)"
+                          : " leaves " + parts + " (drawn per subject id, not balanced by number)";
+    return text;
+  }
+  text += " does not fill the counterbalancing square of " + std::to_string(square) +
+          " subjects (recruit a multiple of " + std::to_string(square) + ")";
+  text += parts.empty() ? ": its cells are filled unevenly" : ": it leaves " + parts;
+  return text;
 }
 
 }  // namespace calligraphy

@@ -182,9 +182,27 @@ StudyReportSessions list_report_sessions(const std::vector<fs::path>& roots) {
   std::set<std::string> protocols, protocol_names, learning;
   // The first session of each protocol name, and its protocol.
   std::map<std::string, std::pair<fs::path, LoadedProtocol>> by_name;
+  // Each subject's session of each number of each protocol, so that a session run twice (two folders of one
+  // subject's session 1) is refused rather than pooled as one subject's trials.
+  std::map<std::string, fs::path> by_session;
   for (const fs::path& folder : folders) {
     SessionManifest manifest = study_detail::read_session_manifest(folder);
     if (!distinct.add(folder, manifest)) continue;
+    // The trainer's free practice saves a session 1 on every run: those are not one design's sessions.
+    if (manifest.protocol.path != "calligraphy-train") {
+      const std::string key = manifest.setup.subject.id + '\n' + manifest.protocol.protocol.name + '\n' +
+                              std::to_string(manifest.setup.session_number);
+      const auto [other, first_time] = by_session.try_emplace(key, folder);
+      if (!first_time) {
+        throw DataError("subject " + manifest.setup.subject.id + " has session " +
+                        std::to_string(manifest.setup.session_number) + " of protocol '" +
+                        manifest.protocol.protocol.name + "' twice, in " + other->second.string() + " and " +
+                        folder.string() +
+                        " (the session was run twice): its trials would be pooled as one session; move one "
+                        "of the folders "
+                        "out of the study folder, or read each on its own");
+      }
+    }
     // Sessions are grouped by protocol name (the tables' `protocol`): two protocols under one name would be
     // pooled as one design, a wrong result rather than a warning.
     const auto [first, inserted] =

@@ -180,8 +180,8 @@ class SavedRecords(OutputTestCase):
         first = self.run_cli("report", "study", "--out", "report.html")
         self.assertEqual(first.returncode, 0, first.stderr.decode())
         protocol = self.cwd / "small.json"
-        joined = self.run_cli("session", "run", protocol, "--writer", "simulated", "--subjects", "2", "--out",
-                              "study")
+        joined = self.run_cli("session", "run", protocol, "--writer", "simulated", "--subjects", "1",
+                              "--new-subjects", "--out", "study")
         self.assertEqual(joined.returncode, 0, joined.stderr.decode())
         again = self.run_cli("report", "study", "--out", "report.html")
         self.assertEqual(again.returncode, 0, again.stderr.decode())

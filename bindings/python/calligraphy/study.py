@@ -192,8 +192,9 @@ def load(paths: typing.Union[PathLike, typing.Sequence[PathLike]]) -> Study:
     session manifests and trial records are read, never the traces. ``phase`` is an ordered categorical in
     the protocol's order and ``condition`` and ``group`` categoricals with the control (the condition without
     guidance, ``calligraphy.design_analysis.study_design``) first. Raises DataError naming the file (and
-    JSON pointer) for a path without a session folder or a damaged record, ValueError for no path or an
-    empty one, ImportError without pandas."""
+    JSON pointer) for a path without a session folder or a damaged record, and naming the subject and both
+    folders for a subject's session of one number found twice (a session run twice: its trials are not
+    pooled), ValueError for no path or an empty one, ImportError without pandas."""
     roots = [paths] if isinstance(paths, (str, os.PathLike)) else list(paths)
     if not roots or any(not os.fspath(root) for root in roots):
         raise ValueError(f"load: paths must name session or study folders, got {paths!r}")

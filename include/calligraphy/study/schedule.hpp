@@ -6,6 +6,7 @@
 /// plan.
 #include <cstddef>
 #include <map>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -106,6 +107,64 @@ struct CrossoverAssignment {
 /// resolved (`resolve_transfer_choices`), and as `block_conditions`.
 [[nodiscard]] std::vector<PlannedTrial> plan_session(const StudyProtocol& protocol,
                                                      const SubjectAssignment& subject, int session = 1);
+
+/// Where one phase of a session is in its plan (`plan_session_phases`).
+struct PlannedPhase {
+  const ProtocolPhase* phase = nullptr;  ///< the protocol's phase (not owned: the protocol planned from)
+  std::vector<std::string> blocks;       ///< the condition of each block, in order
+  /// Parallel to `blocks`: the item set a crossover block trains (its period's); "" in any other phase.
+  std::vector<std::string> block_sets;
+  std::size_t first_trial = 0;  ///< index in `plan_session`'s trials of the phase's first trial
+  std::size_t trials = 0;       ///< how many trials the phase plans
+};
+
+/// The phases of session `session` for `subject`, in order, each with its blocks and its trials' place in
+/// `plan_session(protocol, subject, session)`, which plans them (the same call, so the two never differ).
+/// Throws as `plan_session`.
+[[nodiscard]] std::vector<PlannedPhase> plan_session_phases(const StudyProtocol& protocol,
+                                                            const SubjectAssignment& subject,
+                                                            int session = 1);
+
+/// Subjects after which every assignment the protocol makes by subject number repeats (a full
+/// counterbalancing square): the least common multiple of the between-subjects groups' cycle G (the lcm of
+/// those phases' condition counts; 1 under a random order), the crossover's G x rows x k
+/// (`crossover_assignment`), and, for within-subjects phases of two or more conditions, the Latin square's
+/// rows (`latin_square`: n for even n, 2n for odd n) or 2 (`abba`). 1 when nothing is assigned by number.
+[[nodiscard]] std::size_t counterbalancing_square(const StudyProtocol& protocol);
+
+/// One factor a protocol counterbalances, and how many of some subjects are at each of its levels.
+struct BalanceFactor {
+  /// "group", "sequence", "set pairing" (each crossover letter's set: "A:set1 B:set2"), or "order of PHASE
+  /// (POINTER)" (a within-subjects phase's block order under `latin_square`, `abba` or `random`)
+  std::string name;
+  /// Every level a full square gives, in order of subject number (under a random order: the drawn ones)
+  std::vector<std::string> levels;
+  std::vector<std::size_t> subjects;  ///< parallel to `levels`: subjects at each level (0 for some)
+};
+
+/// How some subjects fill a protocol's counterbalancing (`counterbalancing`).
+struct Counterbalancing {
+  std::size_t square = 1;    ///< `counterbalancing_square`
+  std::size_t subjects = 0;  ///< subjects counted
+  bool drawn = false;        ///< a random order: groups and orders drawn from each subject's id
+  std::vector<BalanceFactor> factors;
+  /// True when the subjects are a multiple of the square and every factor's levels hold as many subjects.
+  [[nodiscard]] bool filled() const noexcept;
+  /// "" when `filled()` (or no subject); else one sentence naming what is uneven, e.g. "N=5 does not fill the
+  /// counterbalancing square of 4 subjects (recruit a multiple of 4): it leaves sequence BA with 2 subjects
+  /// and AB with 3; set pairing A:set2 B:set1 with 2 subjects and A:set1 B:set2 with 3".
+  [[nodiscard]] std::string warning() const;
+};
+
+/// Most subjects of a square whose levels `counterbalancing` lists (beyond it, the levels the subjects have).
+inline constexpr std::size_t kMaxBalanceSquareShown = 100000;
+
+/// How `subjects` fill the protocol's counterbalancing: each factor's levels from `subject_group`,
+/// `crossover_assignment` and `block_conditions` (the assignment itself, not a model of it), and the
+/// subjects at each. Throws as those functions (a subject id that is not a label, a number 0 where one is
+/// needed).
+[[nodiscard]] Counterbalancing counterbalancing(const StudyProtocol& protocol,
+                                                std::span<const SubjectAssignment> subjects);
 
 /// True for a valid subject id: 1..64 characters of [A-Za-z0-9_-] (it names the subject's folder).
 [[nodiscard]] bool is_subject_id(std::string_view id);

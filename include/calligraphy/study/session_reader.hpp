@@ -35,7 +35,10 @@ struct StudyReportSessions {
 
 /// Every session under `roots` (each a session folder or a folder holding some), its manifest read and its
 /// saved trials counted; no trial is read. Throws DataError naming the file (and JSON pointer) for a root
-/// that is not a folder, no session found, a damaged session.json.
+/// that is not a folder, no session found, a damaged session.json, and for one subject's session of one
+/// protocol found twice (two folders of its session 1: the session was run twice; the message names the
+/// subject and both folders), whose trials would otherwise be pooled as one session (the trainer's free
+/// practice, a session 1 on every run, excepted).
 [[nodiscard]] StudyReportSessions list_report_sessions(const std::vector<std::filesystem::path>& roots);
 
 /// Calls `trial` with each saved trial of `session` in planned order, its record and trace read just
