@@ -29,7 +29,10 @@ struct CurriculumCommand {
 
 std::string acronyms(const std::vector<int>& ids) {
   std::string out;
-  for (const int id : ids) out += (out.empty() ? "" : " ") + std::string(typical_stroke(id).acronym);
+  for (const int id : ids) {
+    if (!out.empty()) out += ' ';
+    out += typical_stroke(id).acronym;
+  }
   return out.empty() ? "-" : out;
 }
 

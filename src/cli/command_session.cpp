@@ -139,15 +139,19 @@ SessionRunResult run_one(SessionFolder& session, const SessionRunOptions& option
     window.run.host = nullptr;
     const auto source = std::make_shared<CharacterSource>(library);
     const auto outlines = std::make_shared<CharacterLibrary>(library_from(library));
-    window.load_character = [source, outlines](char32_t c) {
+    // The bundled store holds no outlines by design (docs/corpus.md): only a folder or store the user named is
+    // expected to have them.
+    const bool outlines_expected = !library.data_folder.empty() || !library.store_file.empty();
+    window.load_character = [source, outlines, outlines_expected](char32_t c) {
       trainer::TrainerCharacter character;
       character.model = source->load(c);
       character.utf8 = encode_utf8(c);
       try {
         character.outlines = outlines->load_outlines(c);
       } catch (const DataError& e) {  // drawn without outlines
-        print_error_line("calligraphy session", "warning",
-                         "no stroke outlines for " + character.utf8 + ": " + e.what());
+        if (outlines_expected)
+          print_error_line("calligraphy session", "warning",
+                           "no stroke outlines for " + character.utf8 + ": " + e.what());
       }
       return character;
     };
