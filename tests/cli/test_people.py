@@ -85,7 +85,8 @@ class TheLibrarysLog(PeopleTestCase):
         status, out, err = self.run_cli("bench", "loop", "--seconds", "0.2")
         self.assertEqual(status, 0, err)
         self.assert_no_spdlog_line(out + err, "bench loop")
-        self.assertNotIn("servo loop: ", err)
+        # Its statistics are info lines; a late tick on a busy machine is a warning, and may be said.
+        self.assertNotIn(": info: ", err)
         status, out, err = self.run_cli("bench", "loop", "--seconds", "0.2", "--verbose")
         self.assertEqual(status, 0, err)
         self.assert_no_spdlog_line(out + err, "bench loop --verbose")

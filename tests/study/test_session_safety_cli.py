@@ -153,10 +153,12 @@ class SessionSafetyTest(unittest.TestCase):
         self.assert_refused(refused, str(session / "trials"), "checked before the first trial")
         self.assertEqual(before, {p.name: digest(p) for p in session.rglob("*") if p.is_file()},
                          "no trial ran and the log is as it was")
-        # A session run into a subject folder no session folder can be made in is refused the same way.
-        self.make_read_only(self.cwd / "out" / "P1")
-        run = self.run_cli("session", "run", "p.json", "--subject", "P1", "--out", "out")
-        self.assert_refused(run, str(Path("out") / "P1"))
+        # A session run into a subject folder no session folder can be made in is refused the same way (another
+        # subject: a second run of P1's one session would be refused as doubling the study).
+        (self.cwd / "out" / "P2").mkdir()
+        self.make_read_only(self.cwd / "out" / "P2")
+        run = self.run_cli("session", "run", "p.json", "--subject", "P2", "--out", "out")
+        self.assert_refused(run, str(Path("out") / "P2"))
         self.assertEqual(self.session_folders("out"), [session])
         # Writable again: the resume completes the session.
         for path in self.immutable:
@@ -325,7 +327,11 @@ class SessionSafetyTest(unittest.TestCase):
                                            cwd=self.cwd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
                 ready, _, _ = select.select([process.stderr], [], [], 300)
                 self.assertTrue(ready, "the run did not say it waits")
-                self.assertIn(b"waiting for another run of this subject", process.stderr.readline())
+                # The run prints its plan first, then that it waits.
+                lines = []
+                while not lines or (b"waiting for another run" not in lines[-1] and lines[-1] and len(lines) < 200):
+                    lines.append(process.stderr.readline())
+                self.assertIn(b"waiting for another run of this subject", lines[-1], lines)
                 process.send_signal(signal_number)
                 try:
                     _, stderr = process.communicate(timeout=60)
@@ -368,6 +374,9 @@ class SessionSafetyTest(unittest.TestCase):
         host = "".join(c if c.isascii() and c.isalnum() else "-" for c in socket.gethostname())[:64] or "host"
         dead = subprocess.Popen(["true"])
         dead.wait()
+        # A whole session of P1 would make the next run a second session 1, which is refused: moved out.
+        for folder in whole:
+            shutil.rmtree(folder)
         subject.mkdir(parents=True, exist_ok=True)
         for owner in (f"{dead.pid}.{host}", f"{os.getpid()}.{host}", "1.elsewhere"):
             (subject / f".partial.{owner}.small-P1-20000101-000000" / "trials").mkdir(parents=True)
@@ -376,7 +385,7 @@ class SessionSafetyTest(unittest.TestCase):
         self.assertEqual(sorted(p.name for p in subject.iterdir() if p.name.startswith(".")),
                          sorted([f".partial.{os.getpid()}.{host}.small-P1-20000101-000000",
                                  ".partial.1.elsewhere.small-P1-20000101-000000"]))
-        self.assertEqual(len(self.session_folders("out")), len(whole) + 1)
+        self.assertEqual(len(self.session_folders("out")), 1)
         # A temporary named as a session is refused by the commands that read one folder.
         temporary = subject / ".partial.1.elsewhere.small-P1-20000101-000001"
         shutil.copytree(self.session_folders("out")[-1], temporary)
