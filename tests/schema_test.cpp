@@ -299,6 +299,8 @@ TEST_CASE("The JSON Schema and the docs' table come from the same fields", "[sch
   CHECK_THAT(rate["description"].get<std::string>(), Catch::Contains("[Hz]"));
   CHECK(schema["$defs"]["Inner"]["properties"]["width_m"]["exclusiveMinimum"] == 0.0);
   CHECK(schema["properties"]["colour"]["enum"] == nlohmann::json{"red", "light-blue"});
+  CHECK(schema["properties"]["colour"]["title"] == "Colour");  // the enumeration's table names it
+  CHECK(schema["properties"]["shape"]["title"] == "Shape");
   CHECK(schema["properties"]["seed"]["maximum"].get<std::uint64_t>() == 18446744073709551615ULL);
   CHECK(schema["properties"]["shape"]["oneOf"].size() == 2);
   CHECK(schema["properties"]["maybe"]["anyOf"][1] == nlohmann::json{{"type", "null"}});

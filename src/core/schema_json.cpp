@@ -104,7 +104,9 @@ void read_value(const SchemaField& field, const std::string& owner, void* object
       return;
     case FieldKind::enumeration: {
       const auto spellings = field.spellings();
-      expect(value.is_string(), "one of " + join_spellings(spellings, ", ", "\""));
+      const std::string choices =
+          "one of " + join_spellings(spellings, ", ", "\"") + " (" + std::string(field.enum_name) + ")";
+      expect(value.is_string(), choices);
       const auto& text = value.get_ref<const std::string&>();
       for (std::size_t i = 0; i < spellings.size(); ++i) {
         if (spellings[i] == text) {
@@ -112,7 +114,7 @@ void read_value(const SchemaField& field, const std::string& owner, void* object
           return;
         }
       }
-      expect(false, "one of " + join_spellings(spellings, ", ", "\""));
+      expect(false, choices);
       return;
     }
     case FieldKind::string:
@@ -242,7 +244,7 @@ ordered_json field_schema(const SchemaField& field, const void* defaults, ordere
       out = {{"type", "boolean"}};
       break;
     case FieldKind::enumeration: {
-      out = {{"type", "string"}};
+      out = {{"type", "string"}, {"title", std::string(field.enum_name)}};
       ordered_json values = ordered_json::array();
       for (const std::string_view spelling : field.spellings()) values.push_back(std::string(spelling));
       out["enum"] = std::move(values);
@@ -270,7 +272,7 @@ ordered_json field_schema(const SchemaField& field, const void* defaults, ordere
         alternative["required"] = std::move(required);
         choices.push_back(std::move(alternative));
       }
-      out = {{"oneOf", std::move(choices)}};
+      out = {{"title", std::string(field.enum_name)}, {"oneOf", std::move(choices)}};
       break;
     }
     case FieldKind::object_list:

@@ -41,16 +41,6 @@ struct RecordDocument {
 
 }  // namespace study_detail
 
-template <>
-struct EnumTable<NearestPointMethod> {
-  static constexpr std::string_view name = "NearestPointMethod";
-  static constexpr std::array<EnumEntry<NearestPointMethod>, 3> entries{{
-      {NearestPointMethod::exact, "exact", "Bernstein root isolation (Schneider 1990): the global minimum"},
-      {NearestPointMethod::newton, "newton", "Newton's method from several starts"},
-      {NearestPointMethod::subdivision, "subdivision", "the paper's greedy subdivision (section 4.3)"},
-  }};
-};
-
 #define CALLIGRAPHY_SCHEMA_OF(Type) \
   template <>                       \
   struct SchemaOf<Type> {           \

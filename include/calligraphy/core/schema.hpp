@@ -124,6 +124,7 @@ struct SchemaField {
   std::size_t array_size = 0;           ///< number_array: how many numbers
   const Schema* (*nested)() = nullptr;  ///< object, object_list: the nested struct's schema
   std::span<const std::string_view> (*spellings)() = nullptr;  ///< enumeration: spellings in table order
+  std::string_view enum_name = {};  ///< enumeration, variant: the enumeration's name ("GuidanceMode")
   /// object: std::optional of the struct; JSON null when empty
   bool nullable = false;
   /// variant: the key naming the alternative ("mode"), spelled by the enumeration `spellings`, whose i-th
@@ -392,6 +393,7 @@ template <auto Member>
   f.option = text.option;
   f.option_value_name = text.option_value_name;
   f.spellings = [] { return enum_spellings<E>(); };
+  f.enum_name = EnumTable<E>::name;
   f.get_choice = [](const void* o) -> std::size_t {
     const E value = schema_detail::cref<Member>(o);
     for (std::size_t i = 0; i < EnumTable<E>::entries.size(); ++i) {
@@ -461,6 +463,7 @@ template <auto Member, typename E>
       .name = name, .kind = FieldKind::variant, .unit = text.unit, .doc = text.doc, .source = text.source};
   f.variant_tag = tag;
   f.spellings = [] { return enum_spellings<E>(); };
+  f.enum_name = EnumTable<E>::name;
   f.variant_schema = [](std::size_t index) { return schema_detail::alternative_schema<V>(index); };
   f.variant_index = [](const void* o) -> std::size_t { return schema_detail::cref<Member>(o).index(); };
   f.variant_get = [](const void* o) -> const void* {

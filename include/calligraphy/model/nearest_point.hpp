@@ -9,8 +9,10 @@
 /// projection of `nearest_point_on_segment` with every method, as the paper does (section 4.3.1).
 /// Measured accuracy and speed of every method: docs/nearest-point.md.
 
+#include <array>
 #include <span>
 
+#include "calligraphy/core/schema.hpp"
 #include "calligraphy/model/element.hpp"
 
 namespace calligraphy {
@@ -35,6 +37,17 @@ enum class NearestPointMethod {
   /// tolerance (a length, m). Guarantee: none; it can keep the wrong half (errors of several mm
   /// on 50 mm curves, measured in docs/nearest-point.md). Kept to reproduce the paper.
   subdivision,
+};
+
+/// The one spelling of each method (records, Python).
+template <>
+struct EnumTable<NearestPointMethod> {
+  static constexpr std::string_view name = "NearestPointMethod";
+  static constexpr std::array<EnumEntry<NearestPointMethod>, 3> entries{{
+      {NearestPointMethod::exact, "exact", "Bernstein root isolation (Schneider 1990): the global minimum"},
+      {NearestPointMethod::newton, "newton", "Newton's method from several starts"},
+      {NearestPointMethod::subdivision, "subdivision", "the paper's greedy subdivision (section 4.3)"},
+  }};
 };
 
 /// Options of `nearest_point`. Lengths are in the element's units (m for a placed element).
