@@ -229,11 +229,12 @@ std::string schema_markdown(const Schema& schema) {
       case FieldKind::number:
         default_text = shortest_decimal(field.get_number(field, defaults, 0));
         break;
+      case FieldKind::boolean:  // as JSON writes it, not as the command line does ("on")
+        default_text = field.get_boolean(defaults) ? "true" : "false";
+        break;
       case FieldKind::integer:
-      case FieldKind::boolean:
       case FieldKind::enumeration:
         default_text = field_text(field, defaults);
-        if (field.kind == FieldKind::boolean) default_text = field.get_boolean(defaults) ? "true" : "false";
         break;
       case FieldKind::string:
         default_text = "\"" + field.get_string(defaults) + "\"";

@@ -1,6 +1,5 @@
 #include "calligraphy/study/recorded_trial.hpp"
 
-#include <array>
 #include <bit>
 #include <cstdint>
 #include <filesystem>
@@ -15,7 +14,6 @@
 #include "core/json_reader.hpp"
 #include "core/schema_json.hpp"
 #include "core/whole_file.hpp"
-#include "study/parameter_json.hpp"
 #include "study/record_schema.hpp"
 #include "study/recorded_trial_object.hpp"
 #include "study/saved_sessions.hpp"

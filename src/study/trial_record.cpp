@@ -10,9 +10,10 @@
 #include "calligraphy/model/polyline.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
 #include "calligraphy/report/pen_trace_csv.hpp"
+#include "core/schema_json.hpp"
 #include "report/trial_outcome.hpp"
 #include "study/manifest_json.hpp"
-#include "study/parameter_json.hpp"
+#include "study/record_schema.hpp"
 #include "study/recorded_trial_object.hpp"
 #include "study/remembered_writer.hpp"
 #include "study/saved_sessions.hpp"
@@ -21,7 +22,6 @@ namespace calligraphy::study_detail {
 namespace {
 
 using nlohmann::json;
-
 
 json vec(const Vec2& v) { return json::array({v.x(), v.y()}); }
 json vec(const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
@@ -232,9 +232,7 @@ json loop_json(const ServoLoopStats& s) {
 }  // namespace
 
 json acceptance_json(const StrokeAcceptance& a) {
-  json out = json::object();
-  put_parameters(out, a);
-  return out;
+  return schema_detail::to_json(SchemaOf<StrokeAcceptance>::get(), &a);
 }
 
 namespace {
