@@ -4,11 +4,18 @@
 # Run by calligraphy.mixed_models (python), never by hand, in one of two ways:
 #   Rscript lmer_fit.R FOLDER FORMULA DDF    one fit; exit status 0 when its results were written, 1 with a
 #                                            message on standard error otherwise
-#   Rscript lmer_fit.R --serve               fits one request a line from standard input, FOLDER<TAB>FORMULA<TAB>
-#                                            DDF, until end of input; after each it writes one line,
-#                                            "@@calligraphy ok" or "@@calligraphy error MESSAGE" (the marker
-#                                            tells the reply from anything a package prints). Loading lme4 and
-#                                            lmerTest takes longer than most fits, so a report loads them once.
+#   Rscript lmer_fit.R --serve               fits one request a line from standard input until end of input
+#                                            (loading lme4 and lmerTest takes longer than most fits, so a report
+#                                            loads them once). The protocol is framed so that no text can break
+#                                            it: every field is UTF-8 written as lower-case hex, so a formula
+#                                            with a line break or a tab is one field. A request is the line
+#                                              @@calligraphy-request ID FOLDER FORMULA DDF
+#                                            and its one reply the line
+#                                              @@calligraphy-reply ID ok FILES      (FILES: name=bytes;... of
+#                                                                                   the result files written)
+#                                              @@calligraphy-reply ID error MESSAGE
+#                                            where ID is the request's (decimal) and FILES and MESSAGE are hex.
+#                                            Other lines (a package's chatter) carry no marker and are ignored.
 # FOLDER holds data.csv (UTF-8) and levels.csv (factor, level: each factor's levels in order, reference
 # first); a fit writes fixed.csv, random.csv, anova.csv (one F test per term) and fit.csv (key, value) there
 # (a fit that did not converge or is singular says so in fit.csv).
@@ -83,19 +90,33 @@ fit_model <- function(folder, formula_text, ddf) {
   utils::write.csv(info, file.path(folder, "fit.csv"), row.names = FALSE, fileEncoding = "UTF-8")
 }
 
+# The serve protocol's fields: UTF-8 text as lower-case hex, which has no space, tab or line break.
+text_to_hex <- function(text) paste(as.character(charToRaw(enc2utf8(text))), collapse = "")
+hex_to_text <- function(hex) {
+  if (nchar(hex) %% 2 != 0 || grepl("[^0-9a-f]", hex)) stop("a request field is not hex")
+  if (!nzchar(hex)) return("")
+  text <- rawToChar(as.raw(strtoi(substring(hex, seq(1, nchar(hex), 2), seq(2, nchar(hex), 2)), 16L)))
+  Encoding(text) <- "UTF-8"
+  if (!validUTF8(text)) stop("a request field is not UTF-8")
+  text
+}
+
 arguments <- commandArgs(trailingOnly = TRUE)
 if (length(arguments) == 1 && arguments[1] == "--serve") {
   requests <- file("stdin", open = "r")
   repeat {
     line <- readLines(requests, n = 1, encoding = "UTF-8")
     if (length(line) == 0) break
-    request <- strsplit(line, "\t", fixed = TRUE)[[1]]
+    request <- strsplit(line, " ", fixed = TRUE)[[1]]
+    if (length(request) < 2 || request[1] != "@@calligraphy-request" || !grepl("^[0-9]+$", request[2])) next
     reply <- tryCatch({
-      if (length(request) != 3) stop("expected FOLDER, FORMULA and DDF separated by tabs")
-      fit_model(request[1], request[2], request[3])
-      "ok"
-    }, error = function(e) paste("error", gsub("[\r\n\t]+", " ", conditionMessage(e))))
-    cat("@@calligraphy ", reply, "\n", sep = "")
+      if (length(request) != 5) stop("expected ID, FOLDER, FORMULA and DDF")
+      folder <- hex_to_text(request[3])
+      fit_model(folder, hex_to_text(request[4]), hex_to_text(request[5]))
+      files <- c("fixed.csv", "random.csv", "anova.csv", "fit.csv")
+      paste("ok", text_to_hex(paste0(files, "=", file.size(file.path(folder, files)), collapse = ";")))
+    }, error = function(e) paste("error", text_to_hex(conditionMessage(e))))
+    cat("@@calligraphy-reply ", request[2], " ", reply, "\n", sep = "")
     flush(stdout())
   }
 } else if (length(arguments) == 3) {

@@ -8,7 +8,10 @@ Christensen 2017, J Stat Softw 82(13)): Satterthwaite (1946) by default, Kenward
 lme4 takes longer than most fits), started on the first and ended at exit. R and its packages come from Debian:
 ``apt-get install r-base-core r-cran-lme4 r-cran-lmertest r-cran-pbkrtest`` (scripts/install-deps.sh).
 Without them ``lmer`` raises ``RUnavailable``, which callers report as "not computed" and never replace
-with a large-sample Wald test.
+with a large-sample Wald test. R speaks a framed protocol (each request and reply one line of hex fields
+carrying the request's number) and its result files are read only when whole, so a formula, a package's
+output or a broken R spoils at most the one fit (``RAnswerError``); R ends with the Python process, on a
+signal too.
 """
 
 from __future__ import annotations
@@ -27,7 +30,7 @@ import typing
 if typing.TYPE_CHECKING:  # pragma: no cover
     import pandas
 
-__all__ = ["LmerFit", "RUnavailable", "lmer", "r_available"]
+__all__ = ["LmerFit", "RAnswerError", "RUnavailable", "lmer", "r_available"]
 
 _SCRIPT = pathlib.Path(__file__).with_name("lmer_fit.R")
 # A fit of a few thousand trials takes seconds; a hung R is stopped instead of hanging a report.
@@ -92,44 +95,121 @@ def r_available() -> bool:
 _R_CHECKED: list[bool] = []
 
 
-class _RServer:
-    """``Rscript lmer_fit.R --serve``: one request a line, one marked reply a line. Owned by the process that
-    started it (a forked child starts its own rather than share the pipes) and used under a lock."""
+class RAnswerError(RUnavailable):
+    """R could not answer one fit as a whole: it ended, hung past the timeout, or answered with something
+    other than its one framed reply and the result files that reply names (missing, cut, not UTF-8, or
+    columns that are not the script's). Like ``RUnavailable`` the fit is "not computed": a caller never
+    takes it for lme4 refusing a model, and so never reduces the model because of it. The next fit gets a
+    new R process."""
 
-    _MARK = "@@calligraphy "
+
+def _hex(text: str) -> str:
+    return text.encode("utf-8").hex()
+
+
+def _keep_with_parent() -> None:  # pragma: no cover - runs in the child between fork and exec
+    """Linux: the child gets SIGTERM when the thread that started it ends, so R never outlives a Python
+    killed by a signal (prctl PR_SET_PDEATHSIG). Elsewhere R ends when its standard input closes."""
+    import ctypes
+    import signal
+
+    try:
+        ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGTERM), 0, 0, 0)
+    except (OSError, AttributeError):
+        pass
+
+
+class _RServer:
+    """``Rscript lmer_fit.R --serve``: one framed request a line, one framed reply a line carrying the
+    request's number (lmer_fit.R describes the protocol). Owned by the process that started it (a forked child
+    starts its own rather than share the pipes) and used under a lock. R is started from a thread of its own
+    that lives as long as R, so that R is ended with the process (``_keep_with_parent``) and not with whichever
+    thread asked for the first fit."""
+
+    _REPLY = "@@calligraphy-reply "
 
     def __init__(self, rscript: str) -> None:
         self.pid = os.getpid()
-        self.log = tempfile.TemporaryFile(mode="w+", encoding="utf-8")
-        self.process = subprocess.Popen([rscript, "--vanilla", str(_SCRIPT), "--serve"], stdin=subprocess.PIPE,
-                                        stdout=subprocess.PIPE, stderr=self.log, text=True, encoding="utf-8",
-                                        bufsize=1)
+        self.log = tempfile.TemporaryFile(mode="w+", encoding="utf-8", errors="replace")
+        self.requests = 0
+        self.unread = b""  # what R wrote after the last line taken
+        started: list[typing.Any] = []
+        ready = threading.Event()
 
-    def fit(self, folder: str, formula: str, ddf: str, timeout_s: float) -> str:
-        """R's reply ('ok' or 'error MESSAGE'); raises TimeoutError or EOFError when R hangs or ends."""
+        def keep() -> None:
+            try:
+                started.append(subprocess.Popen(
+                    [rscript, "--vanilla", str(_SCRIPT), "--serve"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                    stderr=self.log, bufsize=0, preexec_fn=_keep_with_parent if os.name == "posix" else None))
+            except OSError as error:
+                started.append(error)
+            ready.set()
+            if isinstance(started[0], subprocess.Popen):
+                started[0].wait()
+
+        threading.Thread(target=keep, name="calligraphy-r", daemon=True).start()
+        ready.wait()
+        if isinstance(started[0], OSError):
+            raise RAnswerError(f"lmer: R could not be started: {started[0]}")
+        self.process: subprocess.Popen = started[0]
+
+    def running(self) -> bool:
+        return self.process.returncode is None and self.process.poll() is None
+
+    def fit(self, folder: str, formula: str, ddf: str, timeout_s: float) -> tuple[str, str]:
+        """R's reply to one request: ('ok', FILES) or ('error', MESSAGE). Raises TimeoutError when R hangs,
+        EOFError when it ends, and ValueError when its reply to this request is not one framed reply."""
         import selectors
 
         assert self.process.stdin is not None and self.process.stdout is not None
-        self.process.stdin.write(f"{folder}\t{formula}\t{ddf}\n")
+        self.requests += 1
+        number = str(self.requests)
+        request = f"@@calligraphy-request {number} {_hex(folder)} {_hex(formula)} {_hex(ddf)}\n"
+        self.process.stdin.write(request.encode("ascii"))
         self.process.stdin.flush()
         deadline = time.monotonic() + timeout_s
+        while True:
+            line = self._line(deadline)
+            if not line.startswith(self._REPLY):
+                continue  # a package's chatter
+            fields = line[len(self._REPLY):].split(" ")
+            if fields[0] != number:
+                if fields[0].isdigit() and int(fields[0]) < self.requests:
+                    continue  # a second reply to an earlier request: that request was already answered
+                raise ValueError(f"a reply to request {fields[0]!r}, not {number}")
+            if len(fields) != 3 or fields[1] not in ("ok", "error"):
+                raise ValueError(f"a reply that is not 'ok' or 'error' with one field: {line[:200]!r}")
+            try:
+                return fields[1], bytes.fromhex(fields[2]).decode("utf-8")
+            except (ValueError, UnicodeDecodeError) as error:
+                raise ValueError(f"a reply whose field is not hex UTF-8 ({error})") from error
+
+    def _line(self, deadline: float) -> str:
+        """The next line R writes, without its line break (bytes that are not UTF-8 replaced: only the
+        marked lines matter, and they are ASCII). Reads the pipe unbuffered, so that a line R wrote with an
+        earlier one is never left in a buffer that the wait for the pipe cannot see."""
+        import selectors
+
+        assert self.process.stdout is not None
+        descriptor = self.process.stdout.fileno()
         with selectors.DefaultSelector() as selector:
-            selector.register(self.process.stdout, selectors.EVENT_READ)
-            while True:
+            selector.register(descriptor, selectors.EVENT_READ)
+            while b"\n" not in self.unread:
                 if not selector.select(max(0.0, deadline - time.monotonic())):
                     raise TimeoutError
-                line = self.process.stdout.readline()
-                if not line:
+                chunk = os.read(descriptor, 65536)
+                if not chunk:
                     raise EOFError(self.stderr_tail())
-                if line.startswith(self._MARK):
-                    return line[len(self._MARK):].strip()
+                self.unread += chunk
+        line, _, self.unread = self.unread.partition(b"\n")
+        return line.decode("utf-8", errors="replace").rstrip("\r")
 
     def stderr_tail(self) -> str:
         self.log.seek(0)
         return " ".join(self.log.read().split())[-600:]
 
     def close(self) -> None:
-        if self.process.poll() is None:
+        if self.running():
             try:
                 assert self.process.stdin is not None
                 self.process.stdin.close()
@@ -155,28 +235,85 @@ def _close_server() -> None:
 atexit.register(_close_server)
 
 
-def _fit_in_r(rscript: str, folder: str, formula: str, ddf: str) -> None:
-    """Has the process's R server fit the model in ``folder``; raises RuntimeError naming the formula and R's
-    message when the fit fails, R hangs past the timeout (it is then stopped) or R ends."""
+def _fit_in_r(rscript: str, folder: str, formula: str, ddf: str) -> dict[str, int]:
+    """Has the process's R server fit the model in ``folder`` and returns the result files its reply names,
+    with their sizes in bytes. Raises RuntimeError naming the formula and R's message when lme4 cannot fit
+    it; RAnswerError when R hangs past the timeout, ends or answers out of protocol (the server is then
+    stopped, and the next fit starts another)."""
+    one_line = " ".join(formula.split())
     with _SERVER_LOCK:
-        if _SERVER and (_SERVER[0].pid != os.getpid() or _SERVER[0].process.poll() is not None):
+        if _SERVER and (_SERVER[0].pid != os.getpid() or not _SERVER[0].running()):
             _SERVER.pop()  # a parent's (after fork) or one that ended: start another
         if not _SERVER:
             _SERVER.append(_RServer(rscript))
         server = _SERVER[0]
         try:
-            reply = server.fit(folder, formula, ddf, _TIMEOUT_S)
-        except TimeoutError as error:
+            status, text = server.fit(folder, formula, ddf, _TIMEOUT_S)
+        except (TimeoutError, EOFError, OSError, ValueError) as error:
             _SERVER.pop()
             server.process.kill()
             server.close()
-            raise RuntimeError(f"lmer: R did not finish fitting {formula} in {_TIMEOUT_S:.0f} s") from error
-        except (EOFError, OSError) as error:
-            _SERVER.pop()
-            server.close()
-            raise RuntimeError(f"lmer: R ended while fitting {formula}: {error}") from error
-    if reply != "ok":
-        raise RuntimeError(f"lmer: R could not fit {formula}: {reply.removeprefix('error').strip()[-600:]}")
+            if isinstance(error, TimeoutError):
+                why = f"did not finish fitting {one_line} in {_TIMEOUT_S:.0f} s"
+            elif isinstance(error, ValueError):
+                why = f"answered the fit of {one_line} out of protocol: {error}"
+            else:
+                why = f"ended while fitting {one_line}: {error}"
+            raise RAnswerError("lmer: R " + why) from error
+    if status != "ok":
+        raise RuntimeError(f"lmer: R could not fit {one_line}: {' '.join(text.split())[-600:]}")
+    files: dict[str, int] = {}
+    for entry in text.split(";"):
+        name, _, size = entry.partition("=")
+        if not size.isdigit():
+            raise RAnswerError(f"lmer: R answered the fit of {one_line} with an unreadable file list {text[:200]!r}")
+        files[name] = int(size)
+    return files
+
+
+_RESULT_COLUMNS = {
+    "fixed.csv": ("term", "estimate", "std_error", "df", "t", "p", "ci95_low", "ci95_high"),
+    "random.csv": ("group", "variance"),
+    "anova.csv": ("term", "num_df", "den_df", "f", "p"),
+    "fit.csv": ("key", "value"),
+}
+
+
+def _read_answer(folder: str, formula: str, files: typing.Mapping[str, int]) -> dict[str, "pandas.DataFrame"]:
+    """The result files of one fit, checked whole: each named by R's reply at the size it gave, UTF-8, with the
+    script's columns, and numbers where numbers belong. Raises RAnswerError naming the file otherwise."""
+    import pandas
+
+    one_line = " ".join(formula.split())
+    tables = {}
+    for name, columns in _RESULT_COLUMNS.items():
+        path = os.path.join(folder, name)
+        problem = None
+        try:
+            size = os.path.getsize(path)
+            if name not in files:
+                problem = "not named in R's reply"
+            elif size != files[name]:
+                problem = f"{size} bytes where R's reply says {files[name]}"
+            else:
+                with open(path, encoding="utf-8", errors="strict") as stream:
+                    table = pandas.read_csv(stream, dtype=str if name == "fit.csv" else None,
+                                            keep_default_na=name != "fit.csv")
+                if tuple(table.columns) != columns:
+                    problem = f"columns {list(table.columns)} where {list(columns)} belong"
+                elif name != "fit.csv" and len(table) and any(not pandas.api.types.is_numeric_dtype(table[c])
+                                               for c in columns[1:]):
+                    problem = "a value that is not a number"
+                tables[name] = table
+        except FileNotFoundError:
+            problem = "missing"
+        except UnicodeDecodeError:
+            problem = "not UTF-8"
+        except (OSError, ValueError, pandas.errors.ParserError) as error:
+            problem = f"unreadable ({error})"
+        if problem is not None:
+            raise RAnswerError(f"lmer: R's answer to the fit of {one_line} is not whole: {name} {problem}")
+    return tables
 
 
 def _check_r() -> str:
@@ -207,7 +344,8 @@ def lmer(frame: "pandas.DataFrame", formula: str, factors: typing.Mapping[str, t
     outcome must be dropped by the caller. factors: for each categorical column, its levels in order, the
     reference (the control) first; those columns are R factors with treatment coding. Returns an
     ``LmerFit``. Raises ValueError for an unknown ``ddf`` or an empty frame; RUnavailable without R and its
-    packages; RuntimeError naming R's message when the fit fails (e.g. a factor with one level).
+    packages; RuntimeError naming R's message when lme4 cannot fit it (e.g. a factor with one level);
+    RAnswerError (an RUnavailable) when R ends, hangs or does not answer the fit whole.
     """
     import pandas
 
@@ -221,12 +359,9 @@ def lmer(frame: "pandas.DataFrame", formula: str, factors: typing.Mapping[str, t
         levels = [{"factor": name, "level": str(level)} for name, values in factors.items() for level in values]
         pandas.DataFrame(levels, columns=["factor", "level"]).to_csv(os.path.join(folder, "levels.csv"),
                                                                     index=False, encoding="utf-8")
-        _fit_in_r(rscript, folder, formula, ddf)
-        fixed = pandas.read_csv(os.path.join(folder, "fixed.csv"), encoding="utf-8")
-        random = pandas.read_csv(os.path.join(folder, "random.csv"), encoding="utf-8")
-        terms = pandas.read_csv(os.path.join(folder, "anova.csv"), encoding="utf-8")
-        info = dict(pandas.read_csv(os.path.join(folder, "fit.csv"), encoding="utf-8", dtype=str,
-                                    keep_default_na=False).itertuples(index=False, name=None))
+        answer = _read_answer(folder, formula, _fit_in_r(rscript, folder, formula, ddf))
+    fixed, random, terms = answer["fixed.csv"], answer["random.csv"], answer["anova.csv"]
+    info = dict(answer["fit.csv"].itertuples(index=False, name=None))
     owners = {}
     for name, values in factors.items():
         for level in list(values)[1:]:
