@@ -17,6 +17,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/report/study_report_html.hpp"
 #include "calligraphy/report/trace_hdf5.hpp"
+#include "calligraphy/study/protocol.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/study/session_reader.hpp"
 #include "calligraphy/study/session_runner.hpp"
@@ -99,8 +100,16 @@ TEST_CASE("a session stopped mid-trial resumes without losing or overwriting a s
     // A saved trial is never overwritten.
     CHECK_THROWS_AS(session.save_trial(first, "{}", "", ""), StateError);
     CHECK(read(session.trial_file(first, "json")) == first_json);
-    CHECK(fs::exists(folder / "trials" / "attempts" /
-                     (SessionFolder::trial_stem(session.plan()[1]) + ".attempt-1.json")));
+    const fs::path attempt =
+        folder / "trials" / "attempts" / (SessionFolder::trial_stem(session.plan()[1]) + ".attempt-1.json");
+    REQUIRE(fs::exists(attempt));
+    // The attempt's record names the trace kept beside it, by name and SHA-256, not the trial's own name.
+    const nlohmann::json attempt_record = nlohmann::json::parse(read(attempt));
+    const std::string attempt_trace = attempt_record["files"]["trace"].get<std::string>();
+    CHECK(attempt_trace == SessionFolder::trial_stem(session.plan()[1]) + ".attempt-1." +
+                               std::string(SessionFolder::kTraceExtension));
+    CHECK(attempt_record["files"]["trace_sha256"].get<std::string>() ==
+          sha256_hex(read(attempt.parent_path() / attempt_trace)));
   }
   SessionFolder resumed = SessionFolder::open(folder);
   CHECK(resumed.next_unsaved() == std::optional<std::size_t>(1));

@@ -13,6 +13,8 @@
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/study/protocol.hpp"
+#include "core/whole_file.hpp"
 #include "calligraphy/study/session_runner.hpp"
 #include "study_test_devices.hpp"
 #include "temp_folder.hpp"
@@ -70,6 +72,9 @@ TEST_CASE("a study's tidy tables hold every saved trial with its record's metric
     CHECK(*row.mean_deviation_m == Approx(record["mean_deviation_mm"].get<double>() * 1e-3).epsilon(1e-12));
     CHECK(row.total_time_s == record["total_time_s"].get<double>());
     CHECK(fs::exists(row.trace_file));
+    // The record binds its trace: the SHA-256 of the file's bytes as saved.
+    CHECK(row.trace_sha256 == record["files"]["trace_sha256"].get<std::string>());
+    CHECK(row.trace_sha256 == sha256_hex(read_regular_file(row.trace_file, 64u << 20)));
     strokes += row.strokes_total;
   }
   REQUIRE(tables.strokes.size() == strokes);

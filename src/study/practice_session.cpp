@@ -96,17 +96,22 @@ std::pair<std::filesystem::path, bool> PracticeSession::save(const PracticeTrial
                             {"characters", encode_utf8(trial.character)},
                             {"file", stem},
                             {"end_reason", to_string(result.end)}};
+  // The trace's bytes first: the record names them by their SHA-256.
+  const std::string trace = trial_trace_hdf5(result.trace);
+  context.trace_sha256 = sha256_hex(trace);
   if (keep_as_trial) {
     const std::string record =
         study_detail::trial_record_json(context, scene, result, writing, quiz.empty() ? nullptr : &quiz);
-    folder_.save_trial(planned, record, trial_trace_hdf5(result.trace), trial_svg(scene, result));
+    folder_.save_trial(planned, record, trace, trial_svg(scene, result));
     folder_.log("trial_saved", details.dump());
     return {folder_.trial_file(planned, "json"), true};
   }
   context.svg_file.clear();
-  const std::string record =
-      study_detail::trial_record_json(context, scene, result, writing, quiz.empty() ? nullptr : &quiz);
-  const std::filesystem::path kept = folder_.save_attempt(planned, record, trial_trace_hdf5(result.trace));
+  const auto record = [&](const std::string& trace_file) {
+    context.trace_file = trace_file;  // the attempt's own, beside its record
+    return study_detail::trial_record_json(context, scene, result, writing, quiz.empty() ? nullptr : &quiz);
+  };
+  const std::filesystem::path kept = folder_.save_attempt(planned, record, trace);
   details["abort_reason"] = result.abort_reason;
   folder_.log(result.end == TrialEnd::interrupted ? "trial_interrupted" : "trial_failed", details.dump());
   return {kept, false};

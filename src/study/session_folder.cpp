@@ -473,7 +473,8 @@ void SessionFolder::save_trial(const PlannedTrial& trial, std::string_view json,
   fsync_folder(target.parent_path());
 }
 
-fs::path SessionFolder::save_attempt(const PlannedTrial& trial, std::string_view json,
+fs::path SessionFolder::save_attempt(const PlannedTrial& trial,
+                                     const std::function<std::string(const std::string&)>& record,
                                      std::string_view trace) {
   const fs::path folder = SessionLayout::attempts(path_);
   make_folder(folder);
@@ -483,8 +484,9 @@ fs::path SessionFolder::save_attempt(const PlannedTrial& trial, std::string_view
     const fs::path temporary = json_path.string() + ".part";
     std::error_code error;
     if (fs::exists(json_path, error)) continue;
-    write_file_atomically(folder / (stem + "." + std::string(kTraceExtension)), trace);
-    write_file_atomically(temporary, json);
+    const std::string trace_name = stem + "." + std::string(kTraceExtension);
+    write_file_atomically(folder / trace_name, trace);
+    write_file_atomically(temporary, record(trace_name));
     const int linked = ::link(temporary.c_str(), json_path.c_str());
     const int link_error = errno;
     ::unlink(temporary.c_str());

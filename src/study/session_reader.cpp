@@ -10,6 +10,8 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/report/pen_trace_csv.hpp"
+#include "calligraphy/study/protocol.hpp"
+#include "core/whole_file.hpp"
 #include "core/json_reader.hpp"
 #include "study/names.hpp"
 #include "study/saved_sessions.hpp"
@@ -59,6 +61,27 @@ std::string trace_file_name(const json_detail::JsonView& record) {
   return name;
 }
 
+// The trace beside the record is the one the record names by its SHA-256 (files.trace_sha256, written since
+// traces are bound to their records; an older record names none and its trace is read as it is): a trace
+// copied or renamed from another trial is refused, naming both.
+void check_trace_is_the_records(const json_detail::JsonView& record, const fs::path& trace) {
+  const json_detail::JsonView files = record.object("files");
+  if (!files.has("trace_sha256")) return;
+  const std::string expected = files.string_or("trace_sha256", "");
+  std::string bytes;
+  try {
+    bytes = read_regular_file(trace, kMaxTrialCsvBytes);
+  } catch (const DataError&) {
+    return;  // missing or unreadable: the trace reader says so, naming the record's /files/trace
+  }
+  const std::string actual = sha256_hex(bytes);
+  if (actual != expected) {
+    json_detail::fail(record.source(), "/files/trace_sha256",
+                      "names a trace of SHA-256 " + expected + ", but " + trace.string() + " has SHA-256 " +
+                          actual + ": it is not this trial's trace");
+  }
+}
+
 // The trial's trace (HDF5, trace_hdf5.hpp; or trial_csv's t,x,y,z,fx,fy,fz,state,stroke,element[,attempt,
 // rewritten], gzip or plain, in older folders) through the one trace reader: times, positions, pen down,
 // in-plane force.
@@ -84,7 +107,9 @@ void append_trial_rows(const json& document, const fs::path& json_file, const Se
                        const PlannedTrial& plan, StudyTables& rows) {
   const std::string source = json_file.string();
   TrialRow row = study_detail::trial_row(document, source, manifest, plan, rows.strokes);
-  row.trace_file = json_file.parent_path() / trace_file_name(json_detail::JsonView(document, "", source));
+  const json_detail::JsonView record(document, "", source);
+  row.trace_file = json_file.parent_path() / trace_file_name(record);
+  row.trace_sha256 = record.object("files").string_or("trace_sha256", "");
   rows.trials.push_back(std::move(row));
 }
 
@@ -134,6 +159,7 @@ ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifes
     json_detail::fail(source, record.object("files").has("trace") ? "/files/trace" : "/files/csv",
                       "names the trace '" + trace + "', which cannot be read: " + e.what());
   }
+  check_trace_is_the_records(record, json_file.parent_path() / trace);  // read whole: not damaged, another's?
   return trial;
 }
 

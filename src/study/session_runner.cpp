@@ -394,12 +394,14 @@ class SessionRun {
     outcome.mean_deviation_mm = writing.deviation ? writing.deviation->mean_m * 1e3 : std::nan("");
     json details = trial_details(trial);
     details["end_reason"] = outcome.end_reason;
+    // The trace's bytes first: the record names them by their SHA-256.
+    const std::string trace = trial_trace_hdf5(trial_result.trace);
+    context.trace_sha256 = sha256_hex(trace);
     if (keep_as_trial) {
       const std::string record = study_detail::trial_record_json(context, scene, trial_result, writing,
                                                                  quiz.empty() ? nullptr : &quiz);
       try {
-        session_.save_trial(trial, record, trial_trace_hdf5(trial_result.trace),
-                            trial_svg(scene, trial_result));
+        session_.save_trial(trial, record, trace, trial_svg(scene, trial_result));
       } catch (const DataError& e) {
         return save_failed(trial, e, outcome);
       }
@@ -414,11 +416,14 @@ class SessionRun {
       ++result_.saved_now;
     } else {
       context.svg_file.clear();
-      const std::string record = study_detail::trial_record_json(context, scene, trial_result, writing,
-                                                                 quiz.empty() ? nullptr : &quiz);
+      const auto record = [&](const std::string& trace_file) {
+        context.trace_file = trace_file;  // the attempt's own, beside its record
+        return study_detail::trial_record_json(context, scene, trial_result, writing,
+                                               quiz.empty() ? nullptr : &quiz);
+      };
       std::filesystem::path kept;
       try {
-        kept = session_.save_attempt(trial, record, trial_trace_hdf5(trial_result.trace));
+        kept = session_.save_attempt(trial, record, trace);
       } catch (const DataError& e) {
         return save_failed(trial, e, outcome);
       }

@@ -238,7 +238,7 @@ std::string trials_csv(const StudyTables& tables) {
       "subject_writing_speed_factor,subject_spatial_error_factor,subject_error_rate_factor,"
       "subject_motor_noise_factor,subject_fast_learning_per_trial,subject_slow_learning_per_trial,"
       "subject_fast_retention_per_trial,subject_slow_retention_per_trial,strokes_given_up,legibility_top1,"
-      "legibility_top5,trace_file\n";
+      "legibility_top5,trace_file,trace_sha256\n";
   for (const TrialRow& r : tables.trials) {
     line(out, r.subject, r.session, r.protocol, r.session_number, r.group, r.phase, r.block, r.condition,
          r.mode, r.characters, r.trial, r.item, r.repetition, r.item_set, r.sequence, r.period,
@@ -250,7 +250,7 @@ std::string trials_csv(const StudyTables& tables) {
          r.subject_spatial_error_factor, r.subject_error_rate_factor, r.subject_motor_noise_factor,
          r.subject_fast_learning_per_trial, r.subject_slow_learning_per_trial,
          r.subject_fast_retention_per_trial, r.subject_slow_retention_per_trial, r.strokes_given_up,
-         r.legibility_top1, r.legibility_top5, r.trace_file.string());
+         r.legibility_top1, r.legibility_top5, r.trace_file.string(), r.trace_sha256);
   }
   return out;
 }

@@ -179,6 +179,7 @@ json files_json(const TrialRecordContext& c) {
   json files = json::object();
   if (!c.csv_file.empty() || c.trace_file.empty()) files["csv"] = c.csv_file;
   if (!c.trace_file.empty()) files["trace"] = c.trace_file;
+  if (!c.trace_sha256.empty()) files["trace_sha256"] = c.trace_sha256;
   files["svg"] = c.svg_file;
   return files;
 }

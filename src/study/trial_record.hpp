@@ -48,6 +48,9 @@ struct TrialRecordContext {
   std::string csv_file;    ///< file names beside the JSON, each empty when not written: the trace as CSV,
   std::string trace_file;  ///< the trace as HDF5 (trace_hdf5.hpp),
   std::string svg_file;    ///< the drawing
+  /// Lower-case hex SHA-256 (FIPS 180-4) of the trace file's bytes as saved, so that a reader draws and
+  /// analyses this trial's trace and no other (files.trace_sha256); empty: not written.
+  std::string trace_sha256;
 };
 
 /// The stroke matcher's tolerances as a JSON object by their table's names (corridor_m, mean_deviation_m,

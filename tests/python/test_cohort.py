@@ -28,7 +28,7 @@ PROTOCOL = {
 }
 SUBJECTS = 4
 # What only a session folder has.
-FOLDER_ONLY = ["session", "start_utc", "trace_file"]
+FOLDER_ONLY = ["session", "start_utc", "trace_file", "trace_sha256"]
 
 
 @pytest.fixture(scope="module")

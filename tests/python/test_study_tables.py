@@ -30,6 +30,7 @@ def as_older_folder(cli, trace, compress):
     record_file = record_path(trace)
     record = json.loads(record_file.read_text(encoding="utf-8"))
     del record["files"]["trace"]
+    del record["files"]["trace_sha256"]  # older folders did not bind the trace to its record
     record["files"]["csv"] = older.name
     record_file.write_text(json.dumps(record), encoding="utf-8")
     return older
@@ -261,3 +262,27 @@ def test_a_study_without_item_sets_has_empty_crossover_columns(study_folder):
     assert trials["period"].dtype == "float64" and trials["period"].isna().all()
     for column in ("item_set", "sequence", "trained_condition"):
         assert set(trials[column].astype(str)) == {""}, column
+
+
+def test_a_trace_swapped_with_another_trials_is_refused(cli, study_folder, tmp_path):
+    """Each record names its trace by SHA-256: a trace copied over from another trial (intact, readable) is
+    not drawn or analysed as this trial's, by Python and by the C++ report alike, naming both."""
+    import shutil
+
+    copy = tmp_path / "study"
+    shutil.copytree(study_folder / "study", copy)
+    study = calligraphy.study.load(copy)
+    first, second = (Path(study.trials.iloc[k]["trace_file"]) for k in (0, 1))
+    assert study.trials.iloc[0]["trace_sha256"] != study.trials.iloc[1]["trace_sha256"]
+    assert len(study.trials.iloc[0]["trace_sha256"]) == 64
+    first.write_bytes(second.read_bytes())
+    with pytest.raises(calligraphy.DataError, match=f"{first.name}: SHA-256 .* not this trial's trace"):
+        study.samples(study.trials.iloc[0])
+    original = calligraphy.study.load(study_folder / "study")
+    pd.testing.assert_frame_equal(study.samples(study.trials.iloc[1]), original.samples(original.trials.iloc[1]),
+                                  check_exact=True)
+    run = subprocess.run([cli, "report", str(copy), "--out", str(tmp_path / "t.html")], capture_output=True)
+    assert run.returncode != 0
+    message = run.stderr.decode()
+    assert "/files/trace_sha256" in message and "not this trial's trace" in message and first.name in message
+    assert not (tmp_path / "t.html").exists()

@@ -61,6 +61,23 @@ _STATES = ("SS", "AS", "CS", "WS")  # InteractionState's numbers in an HDF5 trac
 _MAX_TRACE_FILE_BYTES = 256 << 20
 
 
+def _check_trace_sha256(path: str, expected: str) -> None:
+    """DataError when the trace file at `path` is not the one its record names by SHA-256 (FIPS 180-4): a
+    trace copied or renamed from another trial. A missing file is left to the reader to name."""
+    import hashlib
+
+    digest = hashlib.sha256()
+    try:
+        with open(path, "rb") as stream:
+            for block in iter(lambda: stream.read(1 << 20), b""):
+                digest.update(block)
+    except FileNotFoundError:
+        return
+    if digest.hexdigest() != expected:
+        raise _calligraphy.DataError(f"{path}: SHA-256 {digest.hexdigest()}, but its record names a trace of "
+                                     f"SHA-256 {expected} (files.trace_sha256): it is not this trial's trace")
+
+
 def _read_trace(path: str) -> "pandas.DataFrame":
     """A trial's trace as samples, the same columns from either format: its HDF5 file (``.trace.h5``, read
     whole by the C++ reader, trace_hdf5.hpp) or, in older session folders, its CSV, gzip-compressed
@@ -126,7 +143,7 @@ def _read_table(text: str, numeric: tuple[str, ...], booleans: tuple[str, ...]) 
     # round_trip: every double as the C++ side wrote it (the default parser may differ in the last bit).
     frame = pd.read_csv(io.StringIO(text), keep_default_na=False, na_values={c: [""] for c in numeric},
                         float_precision="round_trip",
-                        dtype={c: "float64" for c in numeric})
+                        dtype={**{c: "float64" for c in numeric}, "trace_sha256": str})
     for column in booleans:  # pandas may have read "true"/"false" as booleans already
         if frame[column].dtype != bool:
             frame[column] = frame[column].astype(str) == "true"
@@ -178,7 +195,11 @@ class Study:
         the file of a damaged trace (and the line of an older CSV trace: another header, a field that is not a
         finite number)."""
         row = self.trials.loc[trial] if not hasattr(trial, "trace_file") else trial
-        return _read_trace(row["trace_file"])
+        samples = _read_trace(row["trace_file"])  # a damaged trace is named as damaged
+        expected = row.get("trace_sha256", "")
+        if isinstance(expected, str) and expected:
+            _check_trace_sha256(row["trace_file"], expected)
+        return samples
 
     def iter_samples(self) -> typing.Iterator[tuple[typing.Any, "pandas.DataFrame"]]:
         """(index label, samples) for every trial in turn, one trace in memory at a time."""

@@ -16,6 +16,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -180,8 +181,11 @@ class SessionFolder {
   void save_trial(const PlannedTrial& trial, std::string_view json, std::string_view trace,
                   std::string_view svg);
   /// Keeps an attempt that did not become the saved trial (interrupted, failed) in trials/attempts/ as
-  /// STEM.attempt-K.json and .trace.h5 (as save_trial's) with the first free K. Returns the JSON's path.
-  std::filesystem::path save_attempt(const PlannedTrial& trial, std::string_view json,
+  /// STEM.attempt-K.json and .trace.h5 (as save_trial's) with the first free K; `json` is made by
+  /// `record(trace_file_name)`, so that the attempt's record names the trace kept beside it. Returns the
+  /// JSON's path.
+  std::filesystem::path save_attempt(const PlannedTrial& trial,
+                                     const std::function<std::string(const std::string&)>& record,
                                      std::string_view trace);
 
   /// Checks every folder and file a run of the session writes (the session folder, trials/, trials/attempts/,

@@ -85,7 +85,10 @@ struct TrialRow {
   /// first five, reading the final writing (legibility/legibility.hpp); absent without a recogniser.
   std::optional<double> legibility_top1;
   std::optional<double> legibility_top5;
-  std::filesystem::path trace_file;  ///< the trial's CSV trace (t,x,y,z,fx,fy,fz,state,stroke,element)
+  std::filesystem::path trace_file;  ///< the trial's trace (HDF5; a CSV in folders written before it)
+  /// Lower-case hex SHA-256 of the trace file as saved (the record's files.trace_sha256): a reader of the
+  /// trace checks it. Empty for records written before traces were bound to them.
+  std::string trace_sha256;
 };
 
 /// One reference stroke of one saved trial.
