@@ -51,7 +51,11 @@ class LmerFit:
     [outcome unit squared], keyed by R's group name ('subject', 'item', 'Residual'). ``singular``: lme4's
     isSingular (a variance estimated as 0 or a correlation as +-1); ``converged``: lme4 reported no
     convergence problem; ``messages``: every warning and message of the fit; ``ddf``; ``formula``;
-    ``n_observations``; ``versions`` of R, lme4 and lmerTest."""
+    ``n_observations``; ``versions`` of R, lme4 and lmerTest. ``pairs``: when the first factor of ``factors``
+    has three or more levels, every pairwise contrast of its estimated marginal means (R's emmeans, the same
+    df method), ``contrast`` ('later - earlier' in the factor's order), ``estimate``, ``std_error``, ``df``,
+    ``t``, ``p``, ``p_holm`` (Holm among these contrasts), ``ci95_low``, ``ci95_high``; else None, and
+    ``pairs_note`` says why."""
 
     formula: str
     ddf: str
@@ -63,6 +67,8 @@ class LmerFit:
     messages: str
     n_observations: int
     versions: str
+    pairs: typing.Optional["pandas.DataFrame"] = None
+    pairs_note: str = ""
 
     @property
     def trustworthy(self) -> bool:
@@ -227,6 +233,9 @@ def lmer(frame: "pandas.DataFrame", formula: str, factors: typing.Mapping[str, t
         terms = pandas.read_csv(os.path.join(folder, "anova.csv"), encoding="utf-8")
         info = dict(pandas.read_csv(os.path.join(folder, "fit.csv"), encoding="utf-8", dtype=str,
                                     keep_default_na=False).itertuples(index=False, name=None))
+        pairs_file = os.path.join(folder, "pairs.csv")
+        pairs = (pandas.read_csv(pairs_file, encoding="utf-8", dtype={"contrast": str})
+                 if os.path.exists(pairs_file) else None)
     owners = {}
     for name, values in factors.items():
         for level in list(values)[1:]:
@@ -236,6 +245,7 @@ def lmer(frame: "pandas.DataFrame", formula: str, factors: typing.Mapping[str, t
     variances = {str(group): float(variance) for group, variance in zip(random["group"], random["variance"])}
     return LmerFit(formula=formula, ddf=ddf, fixed=fixed, terms=terms, variances=variances,
                    singular=info.get("singular") == "TRUE", converged=info.get("converged") == "TRUE",
-                   messages=info.get("messages", ""), n_observations=int(info.get("n_observations", "0") or 0),
+                   messages=info.get("messages", ""), pairs=pairs, pairs_note=info.get("pairs", ""),
+                   n_observations=int(info.get("n_observations", "0") or 0),
                    versions=(f"R {info.get('r_version', '?')}, lme4 {info.get('lme4_version', '?')}, lmerTest "
                              f"{info.get('lmertest_version', '?')}"))
