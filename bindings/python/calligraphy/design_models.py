@@ -186,7 +186,10 @@ def lmer_scaled(frame: "pandas.DataFrame", formula: str, factors: dict, ddf: str
     results converted back to the outcome's unit: estimates, SEs and intervals of every fixed effect but a
     covariate in the outcome's unit (whose slope has no unit), variances, the pairwise contrasts."""
     factor = outcome_factor(frame)
-    scaled = frame.assign(**{c: frame[c] * factor for c in _OUTCOME_COLUMNS if c in frame.columns})
+    # Rounded to 10 decimals (SD 1 to 10: 11 or more significant digits): the same data in two units give R
+    # the same numbers, not numbers that differ in the last bit and a fit that ends on the other side of a
+    # convergence tolerance.
+    scaled = frame.assign(**{c: (frame[c] * factor).round(10) for c in _OUTCOME_COLUMNS if c in frame.columns})
     fit = mixed_models.lmer(scaled, formula, factors, ddf=ddf)
     if factor == 1.0:
         return fit
