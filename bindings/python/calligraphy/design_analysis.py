@@ -91,6 +91,24 @@ def _first_appearance(trials: pandas.DataFrame, column: str) -> list[str]:
     return [str(v) for v in dict.fromkeys(rows[column].astype(str)) if str(v) != ""]
 
 
+def _set_order(trials: pandas.DataFrame) -> list[str]:
+    """The item sets in the protocol's order: by the first phase that writes each, then by the set's first
+    ``item`` (its place in the phase's list of items, which lists the sets in the protocol's order), else by
+    first appearance; the trials' order within a phase (random character orders) says nothing."""
+    named = trials[trials["item_set"].astype(str).replace({"nan": ""}) != ""]
+    if named.empty:
+        return []
+    phases = {p: k for k, p in enumerate(_phase_order(trials))}
+    first = _first_appearance(named, "item_set")
+    keys = {}
+    for name, rows in named.groupby(named["item_set"].astype(str), observed=True):
+        phase_rank = min(phases.get(str(p), len(phases)) for p in rows["phase"].astype(str).unique())
+        in_phase = rows[rows["phase"].astype(str).map(phases) == phase_rank]
+        item = float(in_phase["item"].min()) if "item" in rows.columns and in_phase["item"].notna().any() else 0.0
+        keys[str(name)] = (phase_rank, item, first.index(str(name)) if str(name) in first else len(first))
+    return sorted(keys, key=keys.get)
+
+
 def _phase_order(trials: pandas.DataFrame) -> list[str]:
     return _first_appearance(trials, "phase")
 
@@ -134,10 +152,12 @@ def _crossover_parts(trials: pandas.DataFrame, compared: pandas.DataFrame) -> ty
         if 1 <= row.period <= len(row.sequence):
             letters.setdefault(row.sequence[row.period - 1], row.condition)
     sets: dict[str, str] = {}
-    for name in _first_appearance(trials[trials["item_set"].astype(str).replace({"nan": ""}) != ""], "item_set"):
+    for name in _set_order(trials):
         items = trials.loc[trials["item_set"].astype(str) == name, "characters"].astype(str)
         sets[name] = " ".join(dict.fromkeys(items))
-    pairs = per_subject.groupby(["condition", "item_set"])["subject"].nunique()
+    counted = per_subject.groupby(["condition", "item_set"])["subject"].nunique()
+    conditions = _first_appearance(named, "condition")
+    pairs = {(c, k): counted[(c, k)] for c in conditions for k in sets if (c, k) in counted.index}
     # A mixed design: the subjects' between-subjects group (from another phase of the protocol) beside it.
     group_of = named.drop_duplicates("subject").set_index("subject")["group"].astype(str) if "group" in named.columns \
         else None
@@ -145,7 +165,7 @@ def _crossover_parts(trials: pandas.DataFrame, compared: pandas.DataFrame) -> ty
     return {"groups": {str(k): int(v) for k, v in groups.items()} if groups is not None and len(groups) >= 2 else {},
             "sequences": {str(k): int(v) for k, v in sequences.items()},
             "periods": tuple(sorted(int(p) for p in named["period"].unique())), "item_sets": sets,
-            "pairing": {(str(c), str(k)): int(n) for (c, k), n in pairs.items()},
+            "pairing": {(str(c), str(k)): int(n) for (c, k), n in pairs.items()},  # conditions, sets in order
             "letters": dict(sorted(letters.items()))}
 
 

@@ -572,7 +572,7 @@ def _statistics_html(table: "pandas.DataFrame", value: str, phase: typing.Option
                    f"<td class=\"test\">{_e(row['test'])}</td><td class=\"num\">{_integer(row['n'])}</td>"
                    f"<td class=\"num\">{_significant(row['statistic'])}</td>"
                    f"<td class=\"num\">{_integer(row['df'])}</td>"
-                   f"<td class=\"num\">{_p_value(row['p'])}</td><td class=\"num\">{effect}</td>"
+                   f"<td class=\"num\">{_e(_p_value(row['p']))}</td><td class=\"num\">{effect}</td>"
                    f"<td class=\"num\">{interval}</td><td>{note}</td></tr>\n")
     out.append("</tbody>\n</table>\n<ol class=\"assumptions\" type=\"a\">")
     for assumptions, letter in notes.items():
@@ -700,6 +700,56 @@ def phase_figure(means: "pandas.DataFrame", value: str, design: "design_analysis
     return figure
 
 
+_PHASE_WORDS = {"practice": "familiarisation (practice)", "familiarisation": "familiarisation"}
+
+
+def _words_html(design: "design_analysis.StudyDesign") -> str:
+    """What the page's words mean, once: condition, group and (in a crossover) the condition trained."""
+    words = ["a <b>condition</b> is how a trial is written: its guidance (mode), named by the protocol",
+             "a <b>group</b> is the subjects a between-subjects phase assigns to one of its conditions, for the "
+             "whole study"]
+    if design.kind == "crossover":
+        words.append("the <b>condition trained</b> of a trial is the condition its item set was trained under in "
+                     "the crossover (a test trial written without guidance counts for it)")
+    used = {"between-subjects": "groups (in training, each group wrote its own condition)",
+            "crossover": "conditions trained", "within-subjects": "conditions"}.get(design.kind, "conditions")
+    return (f"<p class=\"files\">Words: {'; '.join(words)}. The figures' lines and the tables' columns are "
+            f"{_e(used)}.</p>\n")
+
+
+def _protocol_html(trials: "pandas.DataFrame", design: "design_analysis.StudyDesign") -> str:
+    """Every phase (block) of the protocol in its order, the familiarisation too: its session, the conditions
+    written, the items (by set, the sets in the protocol's order), the repetitions and the trials per subject."""
+    rows = []
+    for phase in design.phases:
+        of = trials[trials["phase"].astype(str) == phase]
+        if of.empty:
+            continue
+        sessions = sorted({int(x) for x in of["session_number"].dropna()}) if "session_number" in of else []
+        conditions = [str(c) for c in dict.fromkeys(of["condition"].astype(str))]
+        conditions = [c for c in design.conditions if c in conditions] + [c for c in conditions
+                                                                          if c not in design.conditions]
+        if "item_set" in of and (of["item_set"].astype(str).replace({"nan": ""}) != "").any():
+            present = set(of["item_set"].astype(str))
+            sets = [k for k in design.item_sets if k in present] + sorted(present - set(design.item_sets) - {"", "nan"})
+            items = "; ".join(f"{k}: " + " ".join(dict.fromkeys(of.loc[of["item_set"].astype(str) == k, "characters"]
+                                                                 .astype(str))) for k in sets)
+        else:
+            items = " ".join(_characters_in_order(of))
+        repetitions = int(of["repetition"].max()) if of["repetition"].notna().any() else 0
+        per_subject = of.groupby(of["subject"].astype(str), observed=True).size()
+        trials_text = (f"{int(per_subject.min())}" if per_subject.min() == per_subject.max()
+                       else f"{int(per_subject.min())}-{int(per_subject.max())}")
+        rows.append(f"<tr><td>{_e(_PHASE_WORDS.get(phase, phase))}</td><td class=\"num\">"
+                    f"{_e(', '.join(str(x) for x in sessions) or '–')}</td><td>{_e(', '.join(conditions))}</td>"
+                    f"<td class=\"glyph\">{_e(items)}</td><td class=\"num\">{repetitions}</td>"
+                    f"<td class=\"num\">{_e(trials_text)}</td><td class=\"num\">{len(per_subject)}</td></tr>\n")
+    return ("<details id=\"protocol\" open><summary>The protocol, phase by phase</summary>\n<table class=\"protocol\">"
+            "<thead><tr><th>phase</th><th>session</th><th>conditions written</th><th>items</th><th>repetitions</th>"
+            "<th>trials per subject</th><th>subjects</th></tr></thead><tbody>\n" + "".join(rows)
+            + "</tbody></table></details>\n")
+
+
 def _factor_name(design: "design_analysis.StudyDesign") -> str:
     """What a line or column of the page is: a group, a condition, or in a crossover the condition a set was
     trained under."""
@@ -759,11 +809,12 @@ def _model_html(model: typing.Any) -> str:
     return f"<br><code>{_e(model)}</code>" if isinstance(model, str) and "~" in model else ""
 
 
-def _questions_html(questions: "pandas.DataFrame", value: str) -> str:
+def _questions_html(questions: "pandas.DataFrame", value: str, factor: str = "condition") -> str:
     display = _display(value)
     unit = f" [{display.unit}]" if display.unit else ""
     out = [f"<table class=\"questions\" data-value=\"{_e(value)}\">\n<caption>{_e(display.label.capitalize())}"
-           f"{_e(unit)}: each condition against the control</caption>\n<thead><tr><th>phase</th><th>comparison</th>"
+           f"{_e(unit)}: each {_e(factor)} against the control, and with three or more every other pair (Holm "
+           "within each phase)</caption>\n<thead><tr><th>phase</th><th>comparison</th>"
            "<th>model</th><th>result</th><th>p (Holm)</th><th>difference [95 % CI]</th><th>note</th></tr></thead>"
            "\n<tbody>\n"]
     for row in questions.to_dict("records"):
@@ -778,7 +829,7 @@ def _questions_html(questions: "pandas.DataFrame", value: str) -> str:
         out.append(f"<tr{css}><td>{_e(row['phase'])}</td><td>{_e(row['comparison'])}</td>"
                    f"<td class=\"test\">{_e(row['test'] or '–')}{_model_html(row['model'])}</td>"
                    f"<td>{_e(row['apa'] or '–')}</td>"
-                   f"<td class=\"num\">{_p_value(row['p_holm'])}</td><td class=\"num\">{difference}</td>"
+                   f"<td class=\"num\">{_e(_p_value(row['p_holm']))}</td><td class=\"num\">{difference}</td>"
                    f"<td class=\"test\">{_e(note)}</td></tr>\n")
     out.append("</tbody></table>\n")
     return "".join(out)
@@ -806,12 +857,23 @@ def _phase_means_html(means: "pandas.DataFrame", value: str, design: "design_ana
             f"<tbody>\n{''.join(body)}</tbody></table>\n")
 
 
-def _retention_html(ratios: "pandas.DataFrame", factor: str) -> str:
+def _retention_note(row: dict, display: _Display) -> str:
+    """A retention row's note with its gain interval in the table's unit (the tables keep SI units)."""
+    note = str(row["note"]) if isinstance(row["note"], str) else ""
+    if not (_finite(row["gain_ci95_low"]) and _finite(row["gain_ci95_high"])):
+        return note
+    interval = (f"95 % CI [{_significant(row['gain_ci95_low'] * display.scale)}, "
+                f"{_significant(row['gain_ci95_high'] * display.scale)}]" + (f" {display.unit}" if display.unit else ""))
+    return re.sub(r"95 % CI \[[^\]]*\]", lambda _: interval, note)
+
+
+def _retention_html(ratios: "pandas.DataFrame", factor: str, display: typing.Optional[_Display] = None) -> str:
     if ratios.empty:
         return ""
+    display = display or _Display("", "", 1.0, 2)
     rows = "".join(f"<tr><td>{_e(r['group'])}</td><td class=\"num\">{_integer(r['n'])}</td><td class=\"num\">"
-                   f"{_significant(r['retention_ratio'])}</td><td class=\"test\">{_e(r['note'])}</td></tr>\n"
-                   for r in ratios.to_dict("records"))
+                   f"{_significant(r['retention_ratio'])}</td><td class=\"test\">{_e(_retention_note(r, display))}"
+                   "</td></tr>\n" for r in ratios.to_dict("records"))
     return ("<table class=\"retention\"><caption>Share of the gain kept at retention, mean(pre - retention) / "
             f"mean(pre - post) per {_e(factor)}</caption><thead><tr><th>{_e(factor)}</th><th>n</th><th>ratio</th><th>note</th></tr>"
             f"</thead><tbody>\n{rows}</tbody></table>\n")
@@ -906,12 +968,12 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
         questions = design_analysis.design_questions(trials, value, design, policy=policy, ddf=ddf,
                                                      scale=display.scale, display_unit=display.unit)
         all_questions.append(questions)
-        question_html.append(_questions_html(questions, value))
+        question_html.append(_questions_html(questions, value, _factor_name(design)))
         means_html.append(_phase_means_html(means, value, design))
         ratios = design_analysis.retention_ratios(trials, value, design, policy)
         if not ratios.empty:
             all_ratios.append(ratios.assign(value=value, unit=_si_unit(value)))
-            means_html.append(_retention_html(ratios, _factor_name(design)))
+            means_html.append(_retention_html(ratios, _factor_name(design), display))
         if phase is not None and not data.empty:
             stem = f"learning_{_file_name(value)}"
             figure = learning_figure(data, value, phase=None)
@@ -952,6 +1014,7 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
             "<meta name=\"viewport\" content=\"width=device-width\">"
             f"<title>{_e(title)}</title>\n{_STYLE}</head><body>\n",
             _header_html(trials, title, design, per_trial_link, tables, files),
+            _words_html(design), _protocol_html(trials, design),
             _exclusions_html(exclusions, policy),
             "<section id=\"summary\">\n<h2>Summary</h2>\n<div class=\"figures\">\n", *summary_html, "</div>\n</section>\n",
             "<section id=\"questions\">\n<h2>The design's questions</h2>\n<p class=\"files\">",
