@@ -258,3 +258,60 @@ def test_the_shared_parts_keep_their_public_names():
     import calligraphy.crossover_analysis as crossover
 
     assert "design_analysis" not in crossover.__dict__  # no import circle
+
+
+@needs_r
+def test_the_page_keeps_one_unit_per_table_and_escapes_what_it_shows(tmp_path):
+    import calligraphy.study
+    from calligraphy import study_report
+
+    hostile = "fading<script>alert(1)</script>"
+    trials = between_study(13, subject_sd_m=0.1e-3, training_effect_m=(0.0, -0.4e-3, 0.1e-3))
+    trials = trials.replace({"group": {"fading": hostile}, "condition": {"fading": hostile}})
+    index = study_report.write_report(calligraphy.study.Study(trials=trials, strokes=pandas.DataFrame()), tmp_path,
+                                      values=("mean_deviation_m",))
+    page = index.read_text(encoding="utf-8")
+    assert "<script" not in page and "fading&lt;script&gt;alert(1)&lt;/script&gt;" in page
+    # A p below 0.001 is text, escaped; never a bare '<' in a cell.
+    assert "&lt; 0.001" in page and ">< 0.001<" not in page
+    # The questions of a table in mm write their variances in mm^2 and nothing in metres.
+    questions = page[page.index("<table class=\"questions\""):]
+    questions = questions[:questions.index("</table>")]
+    assert "[mm^2]" in questions and "[m^2]" not in questions
+    assert f"{hostile.replace('<', '&lt;').replace('>', '&gt;')} - fixture" in questions
+    # Words defined once, the table's word used: groups here.
+    assert "Words: a <b>condition</b>" in page and "each group against the control" in page
+    # Every phase of the protocol described, in order.
+    protocol = page[page.index("id=\"protocol\""):]
+    protocol = protocol[:protocol.index("</table>")]
+    positions = [protocol.index(f"<tr><td>{phase}</td>") for phase in ("pre-test", "training", "post-test",
+                                                                        "retention", "transfer")]
+    assert positions == sorted(positions)
+
+
+def test_retention_notes_on_the_page_are_in_its_unit():
+    from calligraphy import study_report
+
+    row = {"group": "x", "n": 6, "retention_ratio": math.nan, "gain_ci95_low": -5.88e-05, "gain_ci95_high": 8.2e-05,
+           "note": "not computed: the group's gain is not reliably above 0 (95 % CI [-5.88e-05, 8.2e-05])"}
+    html = study_report._retention_html(pandas.DataFrame([row]), "group", study_report._display("mean_deviation_m"))
+    assert "95 % CI [-0.0588, 0.0820] mm" in html and "e-05" not in html
+
+
+def test_item_sets_are_in_the_protocols_order_and_every_phase_is_on_the_page():
+    from calligraphy import study_report
+
+    trials = crossover3_study(24)
+    trials["item_set"] = trials["item_set"].map({"s1": "zeta", "s2": "alpha", "s3": "mid"})
+    practice = trials[trials["phase"] == "pre-test"].head(3).assign(
+        phase="practice", condition="unguided", item_set="", period=math.nan, trained_condition="", block=0, trial=0,
+        characters="一")
+    trials = pandas.concat([practice, trials], ignore_index=True)
+    design = design_analysis.study_design(trials)
+    assert list(design.item_sets) == ["zeta", "alpha", "mid"]  # the pre-test lists them so, not the alphabet
+    assert [k for _, k in design.pairing][:3] == [k for k in ("zeta", "alpha", "mid")
+                                                  if ("unguided", k) in design.pairing]
+    assert "item sets zeta: 十 人 口; alpha: 山 中 日; mid: 大 木 土" in design.sentence()
+    html = study_report._protocol_html(trials, design)
+    assert "familiarisation (practice)" in html
+    assert "zeta: 十 人 口; alpha: 山 中 日; mid: 大 木 土" in html

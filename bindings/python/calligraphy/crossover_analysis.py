@@ -6,7 +6,8 @@ under (``trained_condition``, also on pre-test and later test trials), the cross
 trained in (``period``), the subject's ``sequence`` ('AB', 'BA', ...) and the ``item_set``. The functions
 here, called by ``calligraphy.design_analysis`` for a design of kind 'crossover':
 
-* ``questions``: for one outcome, each condition against the control
+* ``questions``: for one outcome, each condition against the control and, with three or more, every other
+  pair (R's emmeans contrasts of the same fit)
   - in training: ``outcome ~ condition + period + (1 + condition | subject) + (1 | item)``;
   - in each later test (post-test, retention, transfer), by the condition the item's set was trained under:
     ``outcome ~ condition + period + pre + (1 + condition | subject) + (1 | item)``, ``pre`` the subject's
@@ -15,14 +16,16 @@ here, called by ``calligraphy.design_analysis`` for a design of kind 'crossover'
   both linear mixed models with subjects and items (characters) crossed, fitted by R's lme4 (REML) with
   lmerTest's Satterthwaite df (Jones & Kenward 2014, Design and Analysis of Cross-Over Trials, 3rd ed., ch. 2).
   The random condition slope per subject tests the condition against how much its effect varies between
-  subjects (Barr, Levy, Scheepers & Tily 2013). With few subjects that fit is often singular (a variance at 0
-  or a correlation at +-1), or cannot be made at all (as many random effects as trials, e.g. a transfer test
+  subjects (Barr, Levy, Scheepers & Tily 2013). Where the sets rotate across sequences (the protocol's
+  rule), set is separable from condition and period and ``item_set`` is a fixed effect of every model; where
+  it is not, the rows' note says why. With few subjects that fit is often singular (a variance at 0
+  or a correlation at +-1), does not converge, or cannot be made at all (as many random effects as trials, e.g. a transfer test
   of one character per set); it is then refitted with the slope's compound-symmetry form, ``(1 | subject) +
   (1 | subject:item_set)`` (a subject trains each set under one condition, so subject:item_set is the
   subject's own condition effect, one variance instead of two and a correlation), and while still singular
-  without the term of the smallest variance (Matuschek, Kliegl, Vasishth, Baayen & Bates 2017, J Mem Lang
+  or not converged without the term of the smallest variance (``calligraphy.design_models.fit_reduced``) (Matuschek, Kliegl, Vasishth, Baayen & Bates 2017, J Mem Lang
   94:305). Each row shows the formula fitted and says what was reduced. These rows form one Holm family per
-  outcome.
+  outcome and phase.
   A mixed design (a between-subjects phase gives each subject a ``group`` beside the crossover) has ``group``
   as a fixed effect in every model and, as a check, the F test of the condition x group interaction.
   Checks, reported apart and not adjusted: the carry-over (sequence) F test, ``sequence`` added to the

@@ -10,13 +10,17 @@ outcomes in SI units). The functions here:
 * ``apply_exclusions`` applies a stated exclusion policy (by default only trials that ended ``completed``
   are analysed) and counts what it left out, per phase and group;
 * ``design_questions`` answers the design's questions for one outcome, each guided condition against the
-  control, Holm-adjusted within the outcome's family:
+  control and, with three or more conditions, every other pair, Holm-adjusted within the family of the
+  outcome in one phase:
 
   - during training (or, within subjects, in the conditions' phase): a linear mixed model with subjects and
     items (the characters) crossed, ``outcome ~ condition + (1 | subject) + (1 | item)`` (within subjects
     ``(1 + condition | subject)``, a random slope per subject), fitted by R's lme4
-    with Satterthwaite degrees of freedom from lmerTest (``calligraphy.mixed_models``); a fit that is
-    singular or did not converge is reported as such and its tests are not given as tests;
+    with Satterthwaite degrees of freedom from lmerTest (``calligraphy.mixed_models``), the other pairs as
+    R's emmeans contrasts of the same fit; fitted in a well-scaled unit and, when singular or not converged,
+    reduced by the rule of ``calligraphy.design_models`` (within subjects the slope's compound-symmetry form
+    ``(1 | subject) + (1 | subject:condition)`` first); a fit still singular or not converged is reported as
+    such and its tests are not given as tests;
   - after training (post-test, retention, transfer), between subjects: an ANCOVA on subject means,
     ``post ~ pre + group`` (ordinary least squares, statsmodels; the same model as R's ``lm``), i.e. the
     groups compared adjusted for the pre-test (Vickers & Altman 2001, BMJ 323:1123; Van Breukelen 2006);
@@ -26,8 +30,8 @@ outcomes in SI units). The functions here:
     set was trained under, adjusted for the same set's pre-test; its carry-over and Hills-Armitage checks
     are reported apart, unadjusted.
 
-  Holm (1979) adjusts the p values within a family: one outcome's comparisons against the control, one test
-  per comparison.
+  Holm (1979) adjusts the p values within a family: one outcome's comparisons in one phase, each pair of
+  conditions once.
   Effect sizes: the difference (adjusted for the pre-test in an ANCOVA) with its 95 % interval in the
   outcome's unit, and Hedges' g with an approximate 95 % interval (Hedges & Olkin 1985, eq. 5.14).
 * ``retention_ratios`` gives each group's share of its gain kept at retention, only where the gain is

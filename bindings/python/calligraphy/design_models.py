@@ -142,8 +142,8 @@ class StudyDesign:
                            for c in self.conditions)
         phases = ", ".join(self.phases)
         if self.kind == "between-subjects":
-            return (f"Between-subjects: {len(self.conditions)} groups trained in {self.compared_phase}, each "
-                    f"group under its own condition ({counts} subjects); phases in order: {phases}.")
+            return (f"Between-subjects: {len(self.conditions)} groups trained in {self.compared_phase} "
+                    f"({counts} subjects); phases in order: {phases}.")
         if self.kind == "crossover":
             return self._crossover_sentence(counts, phases)
         if self.kind == "within-subjects":

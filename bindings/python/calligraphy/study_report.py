@@ -744,10 +744,10 @@ def _protocol_html(trials: "pandas.DataFrame", design: "design_analysis.StudyDes
                     f"{_e(', '.join(str(x) for x in sessions) or '–')}</td><td>{_e(', '.join(conditions))}</td>"
                     f"<td class=\"glyph\">{_e(items)}</td><td class=\"num\">{repetitions}</td>"
                     f"<td class=\"num\">{_e(trials_text)}</td><td class=\"num\">{len(per_subject)}</td></tr>\n")
-    return ("<details id=\"protocol\" open><summary>The protocol, phase by phase</summary>\n<table class=\"protocol\">"
+    return ("<table class=\"protocol\" id=\"protocol\"><caption>The protocol, phase by phase</caption>\n"
             "<thead><tr><th>phase</th><th>session</th><th>conditions written</th><th>items</th><th>repetitions</th>"
             "<th>trials per subject</th><th>subjects</th></tr></thead><tbody>\n" + "".join(rows)
-            + "</tbody></table></details>\n")
+            + "</tbody></table>\n")
 
 
 def _factor_name(design: "design_analysis.StudyDesign") -> str:
@@ -1049,7 +1049,7 @@ def _power_basis(trials: "pandas.DataFrame") -> str:
 
 
 _RANDOM_TERM = re.compile(r"\(([^()|]+)\|\s*([A-Za-z_.:]+)\s*\)")
-_GROUPING_WORDS = {"subject": "subject", "item": "character",
+_GROUPING_WORDS = {"subject": "subject", "item": "character", "subject:condition": "subject and condition",
                    "subject:item_set": "subject and item set (in a crossover: per subject and condition)"}
 
 
@@ -1059,7 +1059,7 @@ def _model_words(formula: str) -> str:
     outcome, _, right = formula.partition("~")
     fixed = [t.strip() for t in _RANDOM_TERM.sub("", right).split("+") if t.strip()]
     names = {"condition": "condition", "group": "group", "period": "period", "pre": "the same set's pre-test mean",
-             "sequence": "sequence"}
+             "sequence": "sequence", "item_set": "item set"}
     words = [f"fixed effects of {', '.join(names.get(t, t) for t in fixed)}"]
     for inside, grouping in _RANDOM_TERM.findall(right):
         slopes = [t.strip() for t in inside.split("+") if t.strip() not in ("1", "")]
@@ -1073,7 +1073,8 @@ def _methods_sentence(design: "design_analysis.StudyDesign", ddf: str, questions
     the adjustment."""
     control = design.control or "the first condition"
     parts = [f"Each {_factor_name(design)} is compared with the control, {control} (differences are "
-             f"{_factor_name(design)} - control)."]
+             f"{_factor_name(design)} - control), and with three or more each other pair (later - earlier in the "
+             "order of the tables' columns, the control first)."]
     mixed = questions[questions["test"].astype(str).str.startswith("linear mixed model")]
     by_model: dict[str, list[str]] = {}
     for row in mixed.drop_duplicates(["phase", "model"]).to_dict("records"):
@@ -1082,13 +1083,21 @@ def _methods_sentence(design: "design_analysis.StudyDesign", ddf: str, questions
         parts.append(f"{_display(model.split(' ~ ', 1)[0].strip()).label.capitalize()} in "
                      f"{', '.join(dict.fromkeys(phases))}: a linear mixed model, {_model_words(model)}, fitted by REML "
                      f"with R's lme4, t tests with {ddf} df (lmerTest).")
-    if design.kind == "crossover":
-        parts.append("Each model is the one fitted: the crossover's full model has a random intercept and condition "
-                     "slope per subject and a random intercept per character; a singular fit was refitted with the "
-                     "slope's compound-symmetry form (intercepts per subject and per subject and item set), then "
-                     "without the term of the smallest variance while still singular (the table's notes say which).")
     if by_model:
-        parts.append("A fit that stays singular, or does not converge, is reported without a test.")
+        slope = {"crossover": "; the full model's random condition slope per subject is first replaced by its "
+                              "compound-symmetry form (intercepts per subject and per subject and item set)",
+                 "within-subjects": "; the full model's random condition slope per subject is first replaced by its "
+                                    "compound-symmetry form (intercepts per subject and per subject and condition)"
+                 }.get(design.kind, "")
+        parts.append("Each model is the one fitted, by the documented reduction: a fit that is singular or does not "
+                     f"converge is refitted{slope}; then, while still singular or not converged, without the random "
+                     "term of the smallest variance (the row's note names each step). The outcome is fitted in the "
+                     "power of ten of its unit that brings its SD between 1 and 10, so that the fit does not depend on "
+                     "the unit; the tables show the results in their unit. A fit that stays singular, or does not "
+                     "converge, is reported without a test.")
+    if design.kind == "crossover":
+        parts.append("The item set is a fixed effect where the design separates it from condition and period (sets "
+                     "rotating across sequences); where it does not, the row's note says so.")
     if design.kind == "crossover":
         parts.append("After training each test trial counts for the condition its item set was trained under, "
                      "and period is the period that set was trained in. Checks, not adjusted: the carry-over F test "
@@ -1099,7 +1108,8 @@ def _methods_sentence(design: "design_analysis.StudyDesign", ddf: str, questions
                      "mean adjusted for the pre-test mean (statsmodels OLS).")
     if design.kind == "within-subjects":
         parts.append("Paired t-tests on subject means, a check of the same comparison (not adjusted).")
-    parts.append("p values are Holm-adjusted within each outcome (one test per comparison against the control); g "
+    parts.append("p values are Holm-adjusted within each outcome and phase (each comparison with the control and, "
+                 "with three or more, every other pair of them once: R's emmeans for a mixed model); g "
                  "is Hedges' g (g_av within subjects) with an approximate 95 % interval; the difference and its 95 % "
                  "interval are in the unit of the table.")
     return " ".join(parts)
