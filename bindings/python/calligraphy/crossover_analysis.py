@@ -18,12 +18,13 @@ here, called by ``calligraphy.design_analysis`` for a design of kind 'crossover'
   The random condition slope per subject tests the condition against how much its effect varies between
   subjects (Barr, Levy, Scheepers & Tily 2013). Where the sets rotate across sequences (the protocol's
   rule), set is separable from condition and period and ``item_set`` is a fixed effect of every model; where
-  it is not, the rows' note says why. With few subjects that fit is often singular (a variance at 0
-  or a correlation at +-1), does not converge, or cannot be made at all (as many random effects as trials, e.g. a transfer test
-  of one character per set); it is then refitted with the slope's compound-symmetry form, ``(1 | subject) +
-  (1 | subject:item_set)`` (a subject trains each set under one condition, so subject:item_set is the
-  subject's own condition effect, one variance instead of two and a correlation), and while still singular
-  or not converged without the term of the smallest variance (``calligraphy.design_models.fit_reduced``) (Matuschek, Kliegl, Vasishth, Baayen & Bates 2017, J Mem Lang
+  it is not, the rows' note says why. With few subjects that fit is often singular (a variance at 0 or a
+  correlation at +-1), does not converge, or cannot be made at all (as many random effects as trials, e.g. a
+  transfer test of one character per set); it is then refitted with the slope's compound-symmetry form,
+  ``(1 | subject) + (1 | subject:item_set)`` (a subject trains each set under one condition, so
+  subject:item_set is the subject's own condition effect, one variance instead of two and a correlation),
+  and while still singular or not converged without the term of the smallest variance
+  (``calligraphy.design_models.fit_reduced``; Matuschek, Kliegl, Vasishth, Baayen & Bates 2017, J Mem Lang
   94:305). Each row shows the formula fitted and says what was reduced. These rows form one Holm family per
   outcome and phase.
   A mixed design (a between-subjects phase gives each subject a ``group`` beside the crossover) has ``group``
@@ -87,7 +88,8 @@ def _frame(rows: "pandas.DataFrame", value: str) -> "pandas.DataFrame":
         "group": _text(rows["group"]).to_numpy() if "group" in rows.columns else ""}, index=rows.index)
 
 
-def _g_av(difference: float, frame: "pandas.DataFrame", level: str, control: str) -> tuple[float, float, float]:
+def _g_av(difference: float, frame: "pandas.DataFrame", level: str, control: typing.Optional[str]
+          ) -> tuple[float, float, float]:
     """Hedges' g_av: the difference over the mean of the two conditions' SDs of subject means, small-sample
     corrected (Lakens 2013, Front Psychol 4:863, eq. 10), with the paired normal-approximation interval."""
     means = frame.groupby(["condition", "subject"])["outcome"].mean()
@@ -218,7 +220,7 @@ def _fit_rows(frame: "pandas.DataFrame", fixed: list[str], base: dict, design: "
         lambda d, later, earlier: _g_av(d, frame[frame["condition"].isin([later, earlier])], later, earlier))
 
 
-def _family(value: str, phase: str) -> str:
+def _family(value: str, phase: typing.Optional[str]) -> str:
     """Holm's family: one outcome in one phase."""
     return f"{value}, {phase}"
 

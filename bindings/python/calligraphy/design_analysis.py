@@ -49,7 +49,7 @@ import typing
 
 import numpy as np
 
-from . import crossover_analysis, design_models, mixed_models, statistics
+from . import crossover_analysis, design_models, statistics
 from .design_models import QUESTION_COLUMNS, StudyDesign
 
 if typing.TYPE_CHECKING:  # pragma: no cover
@@ -110,7 +110,7 @@ def _set_order(trials: pandas.DataFrame) -> list[str]:
         in_phase = rows[rows["phase"].astype(str).map(phases) == phase_rank]
         item = float(in_phase["item"].min()) if "item" in rows.columns and in_phase["item"].notna().any() else 0.0
         keys[str(name)] = (phase_rank, item, first.index(str(name)) if str(name) in first else len(first))
-    return sorted(keys, key=keys.get)
+    return sorted(keys, key=lambda name: keys[name])
 
 
 def _phase_order(trials: pandas.DataFrame) -> list[str]:
@@ -359,11 +359,12 @@ def _training_rows(data: pandas.DataFrame, value: str, design: StudyDesign, ddf:
         return [_row(**base, comparison=column, note=f"not computed: {error}")]
     # One fit: whether it is a test, its note, subjects per level and subject means hold for every row.
     trusted = fit.trustworthy
-    words = {"factor": column, "subject:factor": f"subject:{column}"}
     base["model"] = fit.formula.replace("outcome", value, 1).replace("factor", column)
-    name = (lambda k: k.lower().replace("factor", column + " ").replace(column + " :", column + ":")
-            .replace("subject:" + column + " ", "subject:" + column))
-    note = design_models.fit_note(fit, [d.replace("factor", words["factor"]) for d in dropped], units, name)
+
+    def name(group: str) -> str:  # R's names of the variances: 'subject factorfixture' -> 'subject group fixture'
+        return group.replace("subject:factor", f"subject:{column}").replace("factor", column + " ").lower()
+
+    note = design_models.fit_note(fit, [d.replace("factor", column) for d in dropped], units, name)
     counts = frame.groupby("factor")["subject"].nunique()
     subject_means = frame.groupby(["factor", "subject"])["outcome"].mean()
     rows = []

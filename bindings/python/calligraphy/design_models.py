@@ -245,7 +245,7 @@ def fit_reduced(frame: "pandas.DataFrame", fixed: list[str], factors: dict, ddf:
         except RuntimeError:
             if len(terms) == 1:
                 raise
-            refused = next(t for t in terms[1:] + terms[:1])
+            refused = terms[1]  # the subject's intercept last
             terms.remove(refused)
             dropped.append(f"{refused}, which lme4 could not fit")
             continue
@@ -253,8 +253,8 @@ def fit_reduced(frame: "pandas.DataFrame", fixed: list[str], factors: dict, ddf:
             return fit, dropped
         smallest = min(terms, key=lambda t: fit.variances.get(_group(t), 0.0))
         terms.remove(smallest)
-        dropped.append(f"{smallest}, {_problem(fit)} (variance {units.variance(fit.variances.get(_group(smallest), 0.0))}"
-                       f"{units.variance_unit()})")
+        variance = units.variance(fit.variances.get(_group(smallest), 0.0))
+        dropped.append(f"{smallest}, {_problem(fit)} (variance {variance}{units.variance_unit()})")
 
 
 def fit_note(fit: "mixed_models.LmerFit", dropped: list[str], units: Units, name: typing.Callable[[str], str] = str
@@ -270,19 +270,20 @@ def fit_note(fit: "mixed_models.LmerFit", dropped: list[str], units: Units, name
     return note
 
 
-def pair_rows(fit: "mixed_models.LmerFit", levels: list[str], control: str, base: dict, note: str,
+def pair_rows(fit: "mixed_models.LmerFit", levels: list[str], control: typing.Optional[str], base: dict, note: str,
               counts: typing.Callable[[str, str], int],
               g: typing.Optional[typing.Callable[[float, str, str], tuple[float, float, float]]] = None
               ) -> list[dict]:
     """The pairwise contrasts of a fit that do not involve the control (those are the fixed effects' rows):
     'later - earlier' in the levels' order, from R's emmeans; no test when the fit is none. ``counts(a, b)``:
-    the subjects in the two levels; ``g(difference, later, earlier)``: the effect size and its interval. Empty for fewer than three levels; one row saying why when emmeans gave
-    none."""
+    the subjects in the two levels; ``g(difference, later, earlier)``: the effect size and its interval.
+    Empty for fewer than three levels; one row per pair saying why when emmeans gave none."""
     if len(levels) < 3:
         return []
     pairs = [(levels[i], levels[j]) for i in range(len(levels)) for j in range(i + 1, len(levels))]
     if fit.pairs is None or len(fit.pairs) != len(pairs):
-        return [row(**base, comparison=f"{b} - {a}", note=f"not computed: the pairwise contrast ({fit.pairs_note or 'emmeans gave none'})")
+        why = fit.pairs_note or "emmeans gave none"
+        return [row(**base, comparison=f"{b} - {a}", note=f"not computed: the pairwise contrast ({why})")
                 for a, b in pairs if control not in (a, b)]
     trusted = fit.trustworthy
     out = []

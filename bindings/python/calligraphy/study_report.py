@@ -354,8 +354,8 @@ def _condition_colour(conditions: list, condition: typing.Any) -> str:
     return _CONDITION_COLOURS[conditions.index(condition) % len(_CONDITION_COLOURS)]
 
 
-def learning_figure(trials: "pandas.DataFrame", value: str, phase: typing.Optional[str] = "test"
-                    ) -> "matplotlib.figure.Figure":
+def learning_figure(trials: "pandas.DataFrame", value: str, phase: typing.Optional[str] = "test",
+                    legend_title: str = "condition") -> "matplotlib.figure.Figure":
     """Learning curves of `value` over repetitions: per condition the mean over subjects with its 95 % t
     interval (``calligraphy.statistics.describe(..., unit="subject")``: each subject's trials averaged
     first, n = subjects; Student 1908). Panels: all characters (each subject's mean over them), then one per
@@ -363,7 +363,8 @@ def learning_figure(trials: "pandas.DataFrame", value: str, phase: typing.Option
     display unit (mm for lengths, s for times). The x axis is the tables' ``repetition``, counted from 1.
 
     trials: one row per trial with subject, condition, characters, repetition, `value` and, for a `phase`,
-    phase (None: every row). Returns a matplotlib Figure (not registered with pyplot; Agg canvas).
+    phase (None: every row). legend_title: what a line is ('group' on a between-subjects report, whose
+    groups each train under their own condition). Returns a matplotlib Figure (not registered with pyplot; Agg canvas).
     Raises ValueError for a missing column or phase, ImportError without matplotlib, pandas or SciPy.
     """
     import numpy
@@ -422,7 +423,7 @@ def learning_figure(trials: "pandas.DataFrame", value: str, phase: typing.Option
             ax.spines[["top", "right"]].set_visible(False)
         axes[0].set_ylabel(display.axis_label())
         if conditions:  # outside the panels, so that it hides no point
-            axes[-1].legend(title="condition", fontsize=8, title_fontsize=8, frameon=False, loc="upper left",
+            axes[-1].legend(title=legend_title, fontsize=8, title_fontsize=8, frameon=False, loc="upper left",
                             bbox_to_anchor=(1.02, 1.0))
     return figure
 
@@ -976,13 +977,15 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
             means_html.append(_retention_html(ratios, _factor_name(design), display))
         if phase is not None and not data.empty:
             stem = f"learning_{_file_name(value)}"
-            figure = learning_figure(data, value, phase=None)
+            figure = learning_figure(data, value, phase=None,
+                                     legend_title="group" if design.kind == "between-subjects" else "condition")
             _save_figure(figure, figures, stem, files)
             width_px = round(figure.get_figwidth() * 96)
             learning_html.append(
                 f"<figure><img src=\"figures/{_e(stem)}.svg\" width=\"{width_px}\" "
                 f"alt=\"Learning curves of {_e(display.label)}\"><figcaption>{_e(display.label.capitalize())} over "
-                f"repetitions in {_e(phase)} (counted from 1): per condition the mean over subjects "
+                f"repetitions in {_e(phase)} (counted from 1): per "
+                f"{'group' if design.kind == 'between-subjects' else 'condition'} the mean over subjects "
                 "with its 95 % t interval (n = subjects). Left: all characters; then each character. One y axis for "
                 "all panels.</figcaption></figure>\n")
     files[tables / "phase_means.csv"] = pandas.concat(all_means, ignore_index=True).to_csv(index=False)
