@@ -719,8 +719,9 @@ def _words_html(design: "design_analysis.StudyDesign") -> str:
 
 
 def _protocol_html(trials: "pandas.DataFrame", design: "design_analysis.StudyDesign") -> str:
-    """Every phase (block) of the protocol in its order, the familiarisation too: its session, the conditions
-    written, the items (by set, the sets in the protocol's order), the repetitions and the trials per subject."""
+    """Every phase of the protocol in its order, the familiarisation too: its session, the conditions written,
+    the items (by set, the sets in the protocol's order), the repetitions, the blocks (a crossover's training:
+    one per period) and the trials per subject, and the subjects."""
     rows = []
     for phase in design.phases:
         of = trials[trials["phase"].astype(str) == phase]
@@ -730,6 +731,10 @@ def _protocol_html(trials: "pandas.DataFrame", design: "design_analysis.StudyDes
         conditions = [str(c) for c in dict.fromkeys(of["condition"].astype(str))]
         conditions = [c for c in design.conditions if c in conditions] + [c for c in conditions
                                                                           if c not in design.conditions]
+        conditions_text = ", ".join(conditions)
+        if "group" in of and of["group"].astype(str).replace({"nan": ""}).ne("").any() and len(conditions) >= 2 and (
+                of.groupby(of["subject"].astype(str), observed=True)["condition"].nunique() == 1).all():
+            conditions_text += " (each group its own)"
         if "item_set" in of and (of["item_set"].astype(str).replace({"nan": ""}) != "").any():
             present = set(of["item_set"].astype(str))
             sets = [k for k in design.item_sets if k in present] + sorted(present - set(design.item_sets) - {"", "nan"})
@@ -739,15 +744,23 @@ def _protocol_html(trials: "pandas.DataFrame", design: "design_analysis.StudyDes
             items = " ".join(_characters_in_order(of))
         repetitions = int(of["repetition"].max()) if of["repetition"].notna().any() else 0
         per_subject = of.groupby(of["subject"].astype(str), observed=True).size()
+        blocks = (of.groupby(of["subject"].astype(str), observed=True)["block"].nunique()
+                  if "block" in of else per_subject * 0 + 1)
+        blocks_text = (f"{int(blocks.min())}" if blocks.min() == blocks.max()
+                       else f"{int(blocks.min())}-{int(blocks.max())}")
+        if design.kind == "crossover" and phase == design.compared_phase and blocks.min() == blocks.max() == len(
+                design.periods):
+            blocks_text += f" (one per period, {len(design.periods)} periods)"
         trials_text = (f"{int(per_subject.min())}" if per_subject.min() == per_subject.max()
                        else f"{int(per_subject.min())}-{int(per_subject.max())}")
         rows.append(f"<tr><td>{_e(_PHASE_WORDS.get(phase, phase))}</td><td class=\"num\">"
-                    f"{_e(', '.join(str(x) for x in sessions) or '–')}</td><td>{_e(', '.join(conditions))}</td>"
+                    f"{_e(', '.join(str(x) for x in sessions) or '–')}</td><td>{_e(conditions_text)}</td>"
                     f"<td class=\"glyph\">{_e(items)}</td><td class=\"num\">{repetitions}</td>"
-                    f"<td class=\"num\">{_e(trials_text)}</td><td class=\"num\">{len(per_subject)}</td></tr>\n")
+                    f"<td class=\"num\">{_e(blocks_text)}</td><td class=\"num\">{_e(trials_text)}</td>"
+                    f"<td class=\"num\">{len(per_subject)}</td></tr>\n")
     return ("<table class=\"protocol\" id=\"protocol\"><caption>The protocol, phase by phase</caption>\n"
             "<thead><tr><th>phase</th><th>session</th><th>conditions written</th><th>items</th><th>repetitions</th>"
-            "<th>trials per subject</th><th>subjects</th></tr></thead><tbody>\n" + "".join(rows)
+            "<th>blocks per subject</th><th>trials per subject</th><th>subjects</th></tr></thead><tbody>\n" + "".join(rows)
             + "</tbody></table>\n")
 
 
