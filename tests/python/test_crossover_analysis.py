@@ -165,9 +165,11 @@ def planted():
 @needs_r
 def test_every_question_is_r_lmertest_on_the_raw_table(planted):
     trials, questions = planted
-    family = questions[questions["family"] == "mean_deviation_m"]
+    family = questions[questions["family"].str.startswith("mean_deviation_m, ")]
     checks = questions[questions["family"] == "mean_deviation_m (checks)"]
     assert list(family["phase"]) == ["training", "post-test", "retention"]
+    assert list(family["family"]) == [f"mean_deviation_m, {p}" for p in family["phase"]]
+    assert all(" + item_set" in m for m in family["model"]), "the sets rotate across sequences: set is a term"
     assert set(family["comparison"]) == {"amplify - unguided"}
     assert (questions["n"].dropna() == 20).all(), "n counts subjects"
     assert family["p"].notna().all()
@@ -194,11 +196,11 @@ def test_every_question_is_r_lmertest_on_the_raw_table(planted):
 @needs_r
 def test_holm_holds_one_test_per_comparison_and_the_checks_stay_raw(planted):
     _, questions = planted
-    family = questions[questions["family"] == "mean_deviation_m"]
-    p = family["p"].to_numpy()
-    order = np.argsort(p)
-    expected = np.minimum(1.0, np.maximum.accumulate((len(p) - np.arange(len(p))) * p[order]))
-    assert family["p_holm"].to_numpy()[order] == pytest.approx(expected)
+    for _, family in questions[~questions["family"].str.endswith("(checks)")].groupby("family"):
+        p = family["p"].to_numpy()
+        order = np.argsort(p)
+        expected = np.minimum(1.0, np.maximum.accumulate((len(p) - np.arange(len(p))) * p[order]))
+        assert family["p_holm"].to_numpy()[order] == pytest.approx(expected)
     checks = questions[questions["family"].str.endswith("(checks)")]
     assert checks["p_holm"].isna().all() and len(checks) == 4  # carry-over and three Hills-Armitage rows
 
@@ -206,17 +208,17 @@ def test_holm_holds_one_test_per_comparison_and_the_checks_stay_raw(planted):
 @needs_r
 def test_a_planted_effect_is_found_with_its_sign_and_size(planted):
     _, questions = planted
-    training = questions[(questions["family"] == "mean_deviation_m") & (questions["phase"] == "training")].iloc[0]
+    training = questions[(questions["family"].str.startswith("mean_deviation_m, ")) & (questions["phase"] == "training")].iloc[0]
     assert training["ci95_low"] < -0.4e-3 < training["ci95_high"]
     assert training["p"] < 0.05 and training["estimate"] < 0
-    post = questions[(questions["family"] == "mean_deviation_m") & (questions["phase"] == "post-test")].iloc[0]
+    post = questions[(questions["family"].str.startswith("mean_deviation_m, ")) & (questions["phase"] == "post-test")].iloc[0]
     assert post["ci95_low"] < -0.2e-3 < post["ci95_high"]
 
 
 @needs_r
 def test_a_planted_null_gives_no_carry_over_and_an_interval_around_zero():
     questions = design_analysis.design_questions(crossover_study(5, effect_m=0.0), "mean_deviation_m")
-    family = questions[questions["family"] == "mean_deviation_m"]
+    family = questions[questions["family"].str.startswith("mean_deviation_m, ")]
     assert ((family["ci95_low"] < 0) & (family["ci95_high"] > 0)).all()
     carry = questions[questions["comparison"] == "sequence"].iloc[0]
     assert carry["p"] > 0.05
@@ -288,7 +290,7 @@ def test_a_transfer_test_of_one_character_per_set_is_fitted_with_what_lme4_can_e
                           "end_reason": "completed", "mean_deviation_m": 2.5e-3 + rng.normal(0.0, 0.4e-3)})
     trials = pandas.concat([trials, pandas.DataFrame(extra)], ignore_index=True)
     questions = design_analysis.design_questions(trials, "mean_deviation_m")
-    transfer = questions[(questions["family"] == "mean_deviation_m") & (questions["phase"] == "transfer")].iloc[0]
+    transfer = questions[(questions["family"].str.startswith("mean_deviation_m, ")) & (questions["phase"] == "transfer")].iloc[0]
     assert "could not fit" in transfer["note"]
     assert "(1 + condition | subject)" not in transfer["model"] and " + pre" in transfer["model"]
     assert math.isfinite(transfer["p"]) or transfer["note"].startswith("not tested")
@@ -306,7 +308,7 @@ def test_a_mixed_design_has_its_group_in_every_model_and_tests_the_interaction()
     assert design.kind == "crossover" and design.groups == {"early": 8, "late": 8}
     assert "groups early n = 8, late n = 8" in design.sentence()
     questions = design_analysis.design_questions(trials, "mean_deviation_m", design)
-    family = questions[questions["family"] == "mean_deviation_m"]
+    family = questions[questions["family"].str.startswith("mean_deviation_m, ")]
     assert all(" + group" in model for model in family["model"])
     interaction = questions[questions["comparison"] == "condition:group"].iloc[0]
     assert interaction["family"] == "mean_deviation_m (checks)" and math.isnan(interaction["p_holm"])

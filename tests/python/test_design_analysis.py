@@ -138,7 +138,9 @@ def test_the_crossed_mixed_model_gives_the_split_plot_test_on_a_balanced_design(
     design = design_analysis.study_design(trials)
     questions = design_analysis.design_questions(trials, "mean_deviation_m", design, ddf=ddf)
     training = questions[questions.phase == "training"].set_index("comparison")
-    assert len(training) == 2 and (training.note.str.startswith("variances: subject")).all()
+    # Each group against the control, and the two treatments against each other (three groups).
+    assert len(training) == 3 and (training.note.str.startswith("variances: subject")).all()
+    assert "fading - fixture" in training.index
     data = trials[trials.phase == "training"]
     means = data.groupby(["subject", "group"], observed=True).mean_deviation_m.mean().reset_index()
     means["group"] = pandas.Categorical(means["group"], categories=list(GROUPS))
@@ -157,6 +159,7 @@ def test_the_crossed_mixed_model_gives_the_split_plot_test_on_a_balanced_design(
 @needs_r
 def test_a_singular_fit_keeps_its_estimate_but_is_no_test():
     trials = between_study(5, subject_sd_m=0.0)  # all subjects alike: the subject variance is 0
+    trials = trials[trials.characters == "十"]  # one character: no item term to keep, nothing left to reduce
     questions = design_analysis.design_questions(trials, "mean_deviation_m")
     training = questions[questions.phase == "training"]
     assert (training.note.str.startswith("not tested: singular fit")).all()
@@ -166,14 +169,18 @@ def test_a_singular_fit_keeps_its_estimate_but_is_no_test():
 
 
 @needs_r
-def test_holm_adjusts_every_comparison_of_an_outcome_together():
+def test_holm_adjusts_every_comparison_of_an_outcome_in_a_phase_together():
     questions = design_analysis.design_questions(between_study(6), "mean_deviation_m")
-    assert len(questions) == 2 * 4  # two groups against the control: training, post-test, retention, transfer
-    finite = questions.p.notna()
-    _, expected, _, _ = multipletests(questions.p[finite], method="holm")
-    assert questions.p_holm[finite].to_numpy() == pytest.approx(expected)
-    assert (questions.p_holm[finite] >= questions.p[finite]).all()
-    assert set(questions.family) == {"mean_deviation_m"} and set(questions.unit) == {"m"}
+    # Three pairs of groups (two against the control, one between the treatments) in training, post-test,
+    # retention and transfer: one family per phase.
+    assert len(questions) == 3 * 4
+    assert set(questions.family) == {f"mean_deviation_m, {p}" for p in PHASES[1:]} and set(questions.unit) == {"m"}
+    for _, family in questions.groupby("family"):
+        finite = family.p.notna()
+        assert finite.sum() == 3
+        _, expected, _, _ = multipletests(family.p[finite], method="holm")
+        assert family.p_holm[finite].to_numpy() == pytest.approx(expected)
+        assert (family.p_holm[finite] >= family.p[finite]).all()
 
 
 def test_the_exclusion_policy_is_applied_and_counted():

@@ -6,7 +6,8 @@ under (``trained_condition``, also on pre-test and later test trials), the cross
 trained in (``period``), the subject's ``sequence`` ('AB', 'BA', ...) and the ``item_set``. The functions
 here, called by ``calligraphy.design_analysis`` for a design of kind 'crossover':
 
-* ``questions``: for one outcome, each condition against the control
+* ``questions``: for one outcome, each condition against the control and, with three or more, every other
+  pair (R's emmeans contrasts of the same fit)
   - in training: ``outcome ~ condition + period + (1 + condition | subject) + (1 | item)``;
   - in each later test (post-test, retention, transfer), by the condition the item's set was trained under:
     ``outcome ~ condition + period + pre + (1 + condition | subject) + (1 | item)``, ``pre`` the subject's
@@ -15,14 +16,17 @@ here, called by ``calligraphy.design_analysis`` for a design of kind 'crossover'
   both linear mixed models with subjects and items (characters) crossed, fitted by R's lme4 (REML) with
   lmerTest's Satterthwaite df (Jones & Kenward 2014, Design and Analysis of Cross-Over Trials, 3rd ed., ch. 2).
   The random condition slope per subject tests the condition against how much its effect varies between
-  subjects (Barr, Levy, Scheepers & Tily 2013). With few subjects that fit is often singular (a variance at 0
-  or a correlation at +-1), or cannot be made at all (as many random effects as trials, e.g. a transfer test
-  of one character per set); it is then refitted with the slope's compound-symmetry form, ``(1 | subject) +
-  (1 | subject:item_set)`` (a subject trains each set under one condition, so subject:item_set is the
-  subject's own condition effect, one variance instead of two and a correlation), and while still singular
-  without the term of the smallest variance (Matuschek, Kliegl, Vasishth, Baayen & Bates 2017, J Mem Lang
+  subjects (Barr, Levy, Scheepers & Tily 2013). Where the sets rotate across sequences (the protocol's
+  rule), set is separable from condition and period and ``item_set`` is a fixed effect of every model; where
+  it is not, the rows' note says why. With few subjects that fit is often singular (a variance at 0 or a
+  correlation at +-1), does not converge, or cannot be made at all (as many random effects as trials, e.g. a
+  transfer test of one character per set); it is then refitted with the slope's compound-symmetry form,
+  ``(1 | subject) + (1 | subject:item_set)`` (a subject trains each set under one condition, so
+  subject:item_set is the subject's own condition effect, one variance instead of two and a correlation),
+  and while still singular or not converged without the term of the smallest variance
+  (``calligraphy.design_models.fit_reduced``; Matuschek, Kliegl, Vasishth, Baayen & Bates 2017, J Mem Lang
   94:305). Each row shows the formula fitted and says what was reduced. These rows form one Holm family per
-  outcome.
+  outcome and phase.
   A mixed design (a between-subjects phase gives each subject a ``group`` beside the crossover) has ``group``
   as a fixed effect in every model and, as a check, the F test of the condition x group interaction.
   Checks, reported apart and not adjusted: the carry-over (sequence) F test, ``sequence`` added to the
@@ -43,20 +47,19 @@ import typing
 
 import numpy as np
 
-from . import mixed_models, statistics
+from . import design_models, mixed_models, statistics
+from .design_models import StudyDesign
 
 if typing.TYPE_CHECKING:  # pragma: no cover
     import pandas
-
-    from .design_analysis import StudyDesign
 
 __all__ = ["questions", "retention_ratios", "within_subject_means"]
 
 _Z975 = 1.959963984540054
 
 
-def _unit(value: str) -> str:
-    return "m" if value.endswith("_m") else "s" if value.endswith("_s") else ""
+_unit = design_models.unit
+_row = design_models.row
 
 
 def _text(column: "pandas.Series") -> "pandas.Series":
@@ -85,13 +88,8 @@ def _frame(rows: "pandas.DataFrame", value: str) -> "pandas.DataFrame":
         "group": _text(rows["group"]).to_numpy() if "group" in rows.columns else ""}, index=rows.index)
 
 
-def _row(**entries: typing.Any) -> dict[str, typing.Any]:
-    from .design_analysis import _row as design_row
-
-    return design_row(**entries)
-
-
-def _g_av(difference: float, frame: "pandas.DataFrame", level: str, control: str) -> tuple[float, float, float]:
+def _g_av(difference: float, frame: "pandas.DataFrame", level: str, control: typing.Optional[str]
+          ) -> tuple[float, float, float]:
     """Hedges' g_av: the difference over the mean of the two conditions' SDs of subject means, small-sample
     corrected (Lakens 2013, Front Psychol 4:863, eq. 10), with the paired normal-approximation interval."""
     means = frame.groupby(["condition", "subject"])["outcome"].mean()
@@ -109,49 +107,22 @@ def _g_av(difference: float, frame: "pandas.DataFrame", level: str, control: str
 
 # The slope's compound-symmetry form and the items' intercept, for a fit the maximal structure cannot make.
 _RANDOM_TERMS = ("(1 | subject)", "(1 | subject:item_set)", "(1 | item)")
-# R's names of the terms' variances (lme4's VarCorr groups).
-_TERM_GROUP = {"(1 | subject)": "subject", "(1 | subject:item_set)": "subject:item_set", "(1 | item)": "item"}
 
 
-def _fit(frame: "pandas.DataFrame", fixed: list[str], factors: dict, ddf: str
-         ) -> tuple["mixed_models.LmerFit", list[str]]:
-    """Fits ``outcome ~ fixed + random`` with the random effects the data can estimate: first the maximal
-    structure, a random condition slope per subject and an intercept per item; when that fit is singular or
-    cannot be made (lme4 refuses as many random effects as observations, e.g. one trial per subject and
-    set), the slope's compound-symmetry form (an intercept per subject and one per subject and item set: in
-    a crossover each subject trains a set under one condition); while singular, without the term of the
-    smallest variance (while refused, without subject:item_set, then item). Returns the last fit and what
-    was reduced. Raises RUnavailable, and RuntimeError when even one random intercept cannot be fitted."""
+def _fit(frame: "pandas.DataFrame", fixed: list[str], factors: dict, ddf: str,
+         units: design_models.Units = design_models.Units("")) -> tuple["mixed_models.LmerFit", list[str]]:
+    """Fits ``outcome ~ fixed + random`` with the random effects the data can estimate
+    (``design_models.fit_reduced``): first the maximal structure, a random condition slope per subject and an
+    intercept per item; when that fit is singular, does not converge or cannot be made (lme4 refuses as many
+    random effects as observations, e.g. one trial per subject and set), the slope's compound-symmetry form
+    (an intercept per subject and one per subject and item set: in a crossover each subject trains a set under
+    one condition); while singular or not converged, without the term of the smallest variance (while
+    refused, without subject:item_set, then item). Returns the last fit and what was reduced. Raises
+    RUnavailable, and RuntimeError when even one random intercept cannot be fitted."""
     items = ["(1 | item)"] if frame["item"].nunique() >= 2 else []
-    formula = "outcome ~ " + " + ".join(fixed) + " + "
-    try:
-        fit = mixed_models.lmer(frame, formula + " + ".join(["(1 + condition | subject)"] + items), factors,
-                                ddf=ddf)
-        if not fit.singular:
-            return fit, []
-        dropped = ["the random condition slope per subject (1 + condition | subject), singular"]
-    except mixed_models.RUnavailable:
-        raise
-    except RuntimeError:
-        dropped = ["the random condition slope per subject (1 + condition | subject), which lme4 could not fit"]
     terms = [t for t in _RANDOM_TERMS if t != "(1 | item)" or items]
-    while True:
-        try:
-            fit = mixed_models.lmer(frame, formula + " + ".join(terms), factors, ddf=ddf)
-        except mixed_models.RUnavailable:
-            raise
-        except RuntimeError:
-            if len(terms) == 1:
-                raise
-            refused = next(t for t in ("(1 | subject:item_set)", "(1 | item)", "(1 | subject)") if t in terms)
-            terms.remove(refused)
-            dropped.append(f"{refused}, which lme4 could not fit")
-            continue
-        if not fit.singular or len(terms) == 1:
-            return fit, dropped
-        smallest = min(terms, key=lambda t: fit.variances.get(_TERM_GROUP[t], 0.0))
-        terms.remove(smallest)
-        dropped.append(f"{smallest}, singular (variance {fit.variances.get(_TERM_GROUP[smallest], 0.0):.3g})")
+    return design_models.fit_reduced(frame, fixed, factors, ddf, terms, ["(1 + condition | subject)"] + items,
+                                     units)
 
 
 def _factors(frame: "pandas.DataFrame", design: "StudyDesign") -> dict[str, list]:
@@ -162,6 +133,10 @@ def _factors(frame: "pandas.DataFrame", design: "StudyDesign") -> dict[str, list
         factors["sequence"] = sequences
     if design.groups:
         factors["group"] = list(design.groups)
+    sets = [k for k in design.item_sets if k in set(frame["item_set"])]
+    sets += sorted(set(frame["item_set"]) - set(sets) - {""})
+    if sets:
+        factors["item_set"] = sets
     return factors
 
 
@@ -171,26 +146,60 @@ def _between(design: "StudyDesign") -> list[str]:
     return ["group"] if design.groups else []
 
 
+def _rank(frame: "pandas.DataFrame", terms: list[str]) -> int:
+    """The rank of the fixed effects' model matrix (intercept, treatment-coded factors, numeric covariates)."""
+    pandas = statistics._pandas()
+    columns = [np.ones(len(frame))]
+    for term in terms:
+        if term == "pre":
+            columns.append(frame["pre"].to_numpy(dtype=float))
+        else:
+            dummies = pandas.get_dummies(frame[term].astype(str), drop_first=True, dtype=float)
+            columns += [dummies[c].to_numpy() for c in dummies.columns]
+    return int(np.linalg.matrix_rank(np.column_stack(columns)))
+
+
+def _set_terms(frame: "pandas.DataFrame", fixed: list[str]) -> tuple[list[str], str]:
+    """``['item_set']`` when the item sets are separable from the model's other fixed effects (the sets rotate
+    across sequences, so that each set is trained under every condition and in every period), with '' ; else
+    no term and why, for the row's note: the sets' difficulty is then part of the condition's (or period's)
+    effect, which only the protocol's counterbalancing can average out."""
+    sets = sorted(set(frame["item_set"]) - {""})
+    if len(sets) < 2:
+        return [], ""
+    with_sets = _rank(frame, fixed + ["item_set"])
+    if with_sets == _rank(frame, fixed) + len(sets) - 1:
+        return ["item_set"], ""
+    per_set = frame.groupby("item_set")["condition"].nunique()
+    if (per_set <= 1).all():
+        why = "each set was trained under one condition, so set is not separable from condition"
+    else:
+        why = "set is not separable from condition and period in these data (the sets do not rotate across sequences)"
+    return [], f"item set not a term of the model: {why}"
+
+
 def _fit_rows(frame: "pandas.DataFrame", fixed: list[str], base: dict, design: "StudyDesign", ddf: str,
-              value: str) -> list[dict]:
-    """Each condition against the control from one fitted model; a fit that is still singular or did not
-    converge keeps its estimate and gives no test."""
+              value: str, units: design_models.Units) -> list[dict]:
+    """Each condition against the control from one fitted model, and with three or more conditions every
+    other pair of conditions (emmeans); a fit that is still singular or did not converge keeps its estimates
+    and gives no test. The item set is a term where the design separates it."""
     factors = _factors(frame, design)
     levels = factors["condition"]
+    sets, no_set = _set_terms(frame, fixed)
+    fixed = fixed + sets
     model = f"{value} ~ " + " + ".join(fixed)
     if design.control not in levels or len(levels) < 2 or frame["subject"].nunique() < 3:
         return [_row(**base, model=model, comparison="condition",
                      note="not computed: fewer than 2 conditions with values or fewer than 3 subjects")]
     try:
-        fit, dropped = _fit(frame, fixed, factors, ddf)
+        fit, dropped = _fit(frame, fixed, factors, ddf, units)
     except RuntimeError as error:  # RUnavailable among them: R or its packages missing
         return [_row(**base, model=model, comparison="condition", note=f"not computed: {error}")]
     model = fit.formula.replace("outcome", value, 1)
     trusted = fit.trustworthy
-    variances = ", ".join(f"{k} {v:.3g}" for k, v in fit.variances.items()) + f" [{_unit(value)}^2]"
-    note = fit.note(variances)
-    if dropped:
-        note += "; refitted without " + "; ".join(dropped)
+    note = design_models.fit_note(fit, dropped, units)
+    if no_set:
+        note += "; " + no_set
     rows = []
     for effect in fit.fixed.itertuples(index=False):
         if effect.factor != "condition":
@@ -205,18 +214,27 @@ def _fit_rows(frame: "pandas.DataFrame", fixed: list[str], base: dict, design: "
             estimate=float(effect.estimate), ci95_low=float(effect.ci95_low) if trusted else math.nan,
             ci95_high=float(effect.ci95_high) if trusted else math.nan, g=g, g_ci95_low=g_low, g_ci95_high=g_high,
             note=note))
-    return rows
+    return rows + design_models.pair_rows(
+        fit, levels, design.control, {**base, "model": model}, note,
+        lambda a, b: int(frame.loc[frame["condition"].isin([a, b]), "subject"].nunique()),
+        lambda d, later, earlier: _g_av(d, frame[frame["condition"].isin([later, earlier])], later, earlier))
 
 
-def _training_rows(data: "pandas.DataFrame", value: str, design: "StudyDesign", ddf: str) -> list[dict]:
+def _family(value: str, phase: typing.Optional[str]) -> str:
+    """Holm's family: one outcome in one phase."""
+    return f"{value}, {phase}"
+
+
+def _training_rows(data: "pandas.DataFrame", value: str, design: "StudyDesign", ddf: str,
+                   units: design_models.Units) -> list[dict]:
     phase = design.compared_phase
     rows_of = trained(data[(data["phase"].astype(str) == phase) & data[value].notna()])
     frame = _frame(rows_of, value)
     terms = ["condition"] + (["period"] if frame["period"].nunique() >= 2 else []) + _between(design)
-    base = {"value": value, "unit": _unit(value), "family": value, "phase": phase,
-            "question": f"{phase}: condition against the control (crossover: mixed model, subjects x items "
-                        "crossed, period fixed)"}
-    return _fit_rows(frame, terms, base, design, ddf, value)
+    base = {"value": value, "unit": _unit(value), "family": _family(value, phase), "phase": phase,
+            "question": f"{phase}: conditions compared (crossover: mixed model, subjects x items crossed, period "
+                        "fixed)"}
+    return _fit_rows(frame, terms, base, design, ddf, value, units)
 
 
 def _pre_test_means(data: "pandas.DataFrame", value: str, design: "StudyDesign") -> "pandas.Series":
@@ -242,8 +260,8 @@ def _with_pre_test(frame: "pandas.DataFrame", pre: "pandas.Series", training: "p
     return out.assign(pre=out["pre_raw"] - out["pre_raw"].mean())  # centred: the intercept at the average pre-test
 
 
-def _after_training_rows(data: "pandas.DataFrame", value: str, design: "StudyDesign", phase: str, ddf: str
-                         ) -> list[dict]:
+def _after_training_rows(data: "pandas.DataFrame", value: str, design: "StudyDesign", phase: str, ddf: str,
+                         units: design_models.Units) -> list[dict]:
     rows_of = trained(data[(data["phase"].astype(str) == phase) & data[value].notna()])
     frame = _frame(rows_of, value)
     training = _frame(trained(data[data["phase"].astype(str) == design.compared_phase]), value)
@@ -252,10 +270,10 @@ def _after_training_rows(data: "pandas.DataFrame", value: str, design: "StudyDes
         frame = _with_pre_test(frame, _pre_test_means(data, value, design), training)
     terms = ["condition"] + (["period"] if frame["period"].nunique() >= 2 else []) + (["pre"] if adjusted else []) \
         + _between(design)
-    base = {"value": value, "unit": _unit(value), "family": value, "phase": phase,
+    base = {"value": value, "unit": _unit(value), "family": _family(value, phase), "phase": phase,
             "question": f"{phase}: by the condition each set was trained under" +
                         (", adjusted for the same set's pre-test" if adjusted else "") + " (crossover)"}
-    return _fit_rows(frame, terms, base, design, ddf, value)
+    return _fit_rows(frame, terms, base, design, ddf, value, units)
 
 
 def _f_sentence(num_df: float, den_df: float, f: float, p: float) -> str:
@@ -267,7 +285,7 @@ def _f_sentence(num_df: float, den_df: float, f: float, p: float) -> str:
 
 
 def _f_test_row(data: "pandas.DataFrame", value: str, design: "StudyDesign", ddf: str, term: str,
-                question: str, what: str) -> list[dict]:
+                question: str, what: str, units: design_models.Units) -> list[dict]:
     """A check of the design: ``term`` added to the training model and tested as a whole (lmerTest's F)."""
     phase = design.compared_phase
     frame = _frame(trained(data[(data["phase"].astype(str) == phase) & data[value].notna()]), value)
@@ -275,9 +293,10 @@ def _f_test_row(data: "pandas.DataFrame", value: str, design: "StudyDesign", ddf
             "comparison": term, "question": f"{phase}: {question}"}
     if frame["period"].nunique() < 2:
         return [_row(**base, note="not computed: fewer than 2 periods")]
+    fixed = ["condition", "period"] + _between(design)
+    fixed += _set_terms(frame, fixed)[0]
     try:
-        fit, dropped = _fit(frame, ["condition", "period"] + _between(design) + [term], _factors(frame, design),
-                            ddf)
+        fit, dropped = _fit(frame, fixed + [term], _factors(frame, design), ddf, units)
     except RuntimeError as error:
         return [_row(**base, note=f"not computed: {error}")]
     model = fit.formula.replace("outcome", value, 1)
@@ -291,24 +310,26 @@ def _f_test_row(data: "pandas.DataFrame", value: str, design: "StudyDesign", ddf
                  test=f"F test of {what}, lme4 {fit.ddf} ({fit.versions})", df=den_df, statistic=f, p=p,
                  apa=_f_sentence(num_df, den_df, f, p),
                  note=f"F with {num_df:.0f} and {den_df:.1f} df; a check of the design, not in the Holm family" +
-                 ("; refitted without " + "; ".join(dropped) if dropped else ""))]
+                 ("; reduced: refitted without " + "; ".join(dropped) if dropped else ""))]
 
 
-def _carry_over_row(data: "pandas.DataFrame", value: str, design: "StudyDesign", ddf: str) -> list[dict]:
+def _carry_over_row(data: "pandas.DataFrame", value: str, design: "StudyDesign", ddf: str,
+                    units: design_models.Units) -> list[dict]:
     """The sequence (carry-over) F test: ``sequence`` added to the training model."""
     if len(design.sequences) < 2:
         return [_row(value=value, unit=_unit(value), family=f"{value} (checks)", phase=design.compared_phase,
                      comparison="sequence", question=f"{design.compared_phase}: carry-over",
                      note="not computed: fewer than 2 sequences")]
     return _f_test_row(data, value, design, ddf, "sequence", "carry-over (do the sequences differ?)",
-                       "sequence (carry-over)")
+                       "sequence (carry-over)", units)
 
 
-def _interaction_row(data: "pandas.DataFrame", value: str, design: "StudyDesign", ddf: str) -> list[dict]:
+def _interaction_row(data: "pandas.DataFrame", value: str, design: "StudyDesign", ddf: str,
+                     units: design_models.Units) -> list[dict]:
     """A mixed design's question beside the condition's: does the condition's effect differ between groups?"""
     return _f_test_row(data, value, design, ddf, "condition:group",
                        "does the condition's effect differ between the groups? (mixed design)",
-                       "the condition x group interaction")
+                       "the condition x group interaction", units)
 
 
 def _hills_armitage_row(frame: "pandas.DataFrame", value: str, design: "StudyDesign", phase: str, what: str
@@ -371,16 +392,19 @@ def _hills_armitage_rows(data: "pandas.DataFrame", value: str, design: "StudyDes
     return rows
 
 
-def questions(data: "pandas.DataFrame", value: str, design: "StudyDesign", ddf: str) -> list[dict]:
+def questions(data: "pandas.DataFrame", value: str, design: "StudyDesign", ddf: str,
+              units: typing.Optional[design_models.Units] = None) -> list[dict]:
     """The crossover's rows of ``design_analysis.design_questions`` for ``value`` on the analysed trials
-    ``data`` (see the module's docstring): the Holm family (family = ``value``) and the checks (family =
-    ``value + ' (checks)'``)."""
-    rows = _training_rows(data, value, design, ddf)
+    ``data`` (see the module's docstring): one Holm family per phase (family = ``'VALUE, PHASE'``) and the
+    checks (family = ``value + ' (checks)'``). ``units``: how the notes write variances (default the SI
+    unit)."""
+    units = units or design_models.Units(_unit(value))
+    rows = _training_rows(data, value, design, ddf, units)
     for phase in design.after_training:
-        rows += _after_training_rows(data, value, design, phase, ddf)
-    rows += _carry_over_row(data, value, design, ddf)
+        rows += _after_training_rows(data, value, design, phase, ddf, units)
+    rows += _carry_over_row(data, value, design, ddf, units)
     if design.groups:
-        rows += _interaction_row(data, value, design, ddf)
+        rows += _interaction_row(data, value, design, ddf, units)
     rows += _hills_armitage_rows(data, value, design)
     return rows
 

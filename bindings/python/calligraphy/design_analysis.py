@@ -10,13 +10,17 @@ outcomes in SI units). The functions here:
 * ``apply_exclusions`` applies a stated exclusion policy (by default only trials that ended ``completed``
   are analysed) and counts what it left out, per phase and group;
 * ``design_questions`` answers the design's questions for one outcome, each guided condition against the
-  control, Holm-adjusted within the outcome's family:
+  control and, with three or more conditions, every other pair, Holm-adjusted within the family of the
+  outcome in one phase:
 
   - during training (or, within subjects, in the conditions' phase): a linear mixed model with subjects and
     items (the characters) crossed, ``outcome ~ condition + (1 | subject) + (1 | item)`` (within subjects
     ``(1 + condition | subject)``, a random slope per subject), fitted by R's lme4
-    with Satterthwaite degrees of freedom from lmerTest (``calligraphy.mixed_models``); a fit that is
-    singular or did not converge is reported as such and its tests are not given as tests;
+    with Satterthwaite degrees of freedom from lmerTest (``calligraphy.mixed_models``), the other pairs as
+    R's emmeans contrasts of the same fit; fitted in a well-scaled unit and, when singular or not converged,
+    reduced by the rule of ``calligraphy.design_models`` (within subjects the slope's compound-symmetry form
+    ``(1 | subject) + (1 | subject:condition)`` first); a fit still singular or not converged is reported as
+    such and its tests are not given as tests;
   - after training (post-test, retention, transfer), between subjects: an ANCOVA on subject means,
     ``post ~ pre + group`` (ordinary least squares, statsmodels; the same model as R's ``lm``), i.e. the
     groups compared adjusted for the pre-test (Vickers & Altman 2001, BMJ 323:1123; Van Breukelen 2006);
@@ -26,8 +30,8 @@ outcomes in SI units). The functions here:
     set was trained under, adjusted for the same set's pre-test; its carry-over and Hills-Armitage checks
     are reported apart, unadjusted.
 
-  Holm (1979) adjusts the p values within a family: one outcome's comparisons against the control, one test
-  per comparison.
+  Holm (1979) adjusts the p values within a family: one outcome's comparisons in one phase, each pair of
+  conditions once.
   Effect sizes: the difference (adjusted for the pre-test in an ANCOVA) with its 95 % interval in the
   outcome's unit, and Hedges' g with an approximate 95 % interval (Hedges & Olkin 1985, eq. 5.14).
 * ``retention_ratios`` gives each group's share of its gain kept at retention, only where the gain is
@@ -45,7 +49,8 @@ import typing
 
 import numpy as np
 
-from . import crossover_analysis, mixed_models, statistics
+from . import crossover_analysis, design_models, statistics
+from .design_models import QUESTION_COLUMNS, StudyDesign
 
 if typing.TYPE_CHECKING:  # pragma: no cover
     import pandas
@@ -69,81 +74,17 @@ AFTER_TRAINING = ("post-test", "retention", "transfer")
 # Modes that give no guidance: a condition in one of them is the natural control.
 _UNGUIDED_MODES = ("vision",)
 
-QUESTION_COLUMNS = ["value", "unit", "family", "question", "phase", "comparison", "model", "test", "n", "df",
-                    "statistic", "p", "p_holm", "estimate", "ci95_low", "ci95_high", "g", "g_ci95_low",
-                    "g_ci95_high", "apa", "note"]
-
-
 def _pandas():
     return statistics._pandas()
 
 
-def _unit(value: str) -> str:
-    return "m" if value.endswith("_m") else "s" if value.endswith("_s") else ""
+_unit = design_models.unit
+_row = design_models.row
+_holm = design_models.holm
+_hedges_g_interval = design_models.hedges_g_interval
 
 
 # ---------------------------------------------------------------------------------------------- design
-
-
-@dataclasses.dataclass(frozen=True)
-class StudyDesign:
-    """What a study's table says about its design.
-
-    ``kind``: 'between-subjects' (each subject in one ``group``), 'within-subjects' (every subject writes
-    every condition of a phase) or 'single-condition'. ``phases``: in protocol order (by session, then
-    block). ``conditions``: the compared conditions, the control first (the groups for a between-subjects
-    design). ``control``: the reference every other condition is compared with. ``compared_phase``: where
-    the conditions differ ('training', or the within-subjects phase). ``n_per_condition``: subjects per
-    group (between) or subjects writing each condition (within). ``pre_test``: the pre-test phase or None.
-    ``after_training``: the post-test, retention and transfer phases present, in order. For a 'crossover' (every
-    subject trains every condition, each on its own item set, in counterbalanced sequences): ``sequences``
-    (sequence -> subjects), ``periods`` (1, 2, ...), ``item_sets`` (set -> its characters) and ``pairing``
-    ((condition, set) -> subjects who trained that set under that condition), ``letters`` (a sequence's
-    letter -> its condition) and, in a mixed design (a between-subjects phase beside the crossover),
-    ``groups`` (the subjects' group -> subjects)."""
-
-    kind: str
-    phases: tuple[str, ...]
-    conditions: tuple[str, ...]
-    control: typing.Optional[str]
-    compared_phase: typing.Optional[str]
-    n_per_condition: dict[str, int]
-    pre_test: typing.Optional[str]
-    after_training: tuple[str, ...]
-    sequences: dict[str, int] = dataclasses.field(default_factory=dict)
-    periods: tuple[int, ...] = ()
-    item_sets: dict[str, str] = dataclasses.field(default_factory=dict)
-    pairing: dict[tuple[str, str], int] = dataclasses.field(default_factory=dict)
-    letters: dict[str, str] = dataclasses.field(default_factory=dict)
-    groups: dict[str, int] = dataclasses.field(default_factory=dict)
-
-    def sentence(self) -> str:
-        """The design in one sentence, for a report's method section."""
-        counts = ", ".join(f"{c} {'(control) ' if c == self.control else ''}n = {self.n_per_condition.get(c, 0)}"
-                           for c in self.conditions)
-        phases = ", ".join(self.phases)
-        if self.kind == "between-subjects":
-            return (f"Between-subjects: {len(self.conditions)} groups trained in {self.compared_phase} "
-                    f"({counts} subjects); phases in order: {phases}.")
-        if self.kind == "crossover":
-            return self._crossover_sentence(counts, phases)
-        if self.kind == "within-subjects":
-            return (f"Within-subjects: every subject wrote {len(self.conditions)} conditions in "
-                    f"{self.compared_phase} ({counts} subjects); phases in order: {phases}.")
-        return f"One condition ({counts} subjects); phases in order: {phases}."
-
-    def _crossover_sentence(self, counts: str, phases: str) -> str:
-        n = max(self.n_per_condition.values(), default=0)
-        sequences = ", ".join(f"{s} n = {k}" for s, k in self.sequences.items())
-        letters = ", ".join(f"{letter} = {c}" for letter, c in self.letters.items())
-        sets = "; ".join(f"{name}: {chars}" for name, chars in self.item_sets.items())
-        pairing = "; ".join(f"{c} on {k} n = {m}" for (c, k), m in self.pairing.items())
-        return (f"Crossover (within subjects): each of {n} subjects trained {len(self.conditions)} conditions in "
-                f"{self.compared_phase} ({counts} subjects), each on its own item set, one per period "
-                f"(periods {', '.join(str(p) for p in self.periods)}); sequences {sequences} ({letters}); item sets "
-                f"{sets}; which set each condition trained: {pairing}"
-                + (f"; and between subjects, a mixed design: groups {', '.join(f'{g} n = {k}' for g, k in self.groups.items())}"
-                   if self.groups else "") + f"; phases in order: {phases}.")
 
 
 def _first_appearance(trials: pandas.DataFrame, column: str) -> list[str]:
@@ -152,6 +93,24 @@ def _first_appearance(trials: pandas.DataFrame, column: str) -> list[str]:
     keys = [c for c in ("session_number", "block", "trial", "subject") if c in trials.columns]
     rows = trials.sort_values(keys, kind="stable") if keys else trials
     return [str(v) for v in dict.fromkeys(rows[column].astype(str)) if str(v) != ""]
+
+
+def _set_order(trials: pandas.DataFrame) -> list[str]:
+    """The item sets in the protocol's order: by the first phase that writes each, then by the set's first
+    ``item`` (its place in the phase's list of items, which lists the sets in the protocol's order), else by
+    first appearance; the trials' order within a phase (random character orders) says nothing."""
+    named = trials[trials["item_set"].astype(str).replace({"nan": ""}) != ""]
+    if named.empty:
+        return []
+    phases = {p: k for k, p in enumerate(_phase_order(trials))}
+    first = _first_appearance(named, "item_set")
+    keys = {}
+    for name, rows in named.groupby(named["item_set"].astype(str), observed=True):
+        phase_rank = min(phases.get(str(p), len(phases)) for p in rows["phase"].astype(str).unique())
+        in_phase = rows[rows["phase"].astype(str).map(phases) == phase_rank]
+        item = float(in_phase["item"].min()) if "item" in rows.columns and in_phase["item"].notna().any() else 0.0
+        keys[str(name)] = (phase_rank, item, first.index(str(name)) if str(name) in first else len(first))
+    return sorted(keys, key=lambda name: keys[name])
 
 
 def _phase_order(trials: pandas.DataFrame) -> list[str]:
@@ -197,10 +156,12 @@ def _crossover_parts(trials: pandas.DataFrame, compared: pandas.DataFrame) -> ty
         if 1 <= row.period <= len(row.sequence):
             letters.setdefault(row.sequence[row.period - 1], row.condition)
     sets: dict[str, str] = {}
-    for name in _first_appearance(trials[trials["item_set"].astype(str).replace({"nan": ""}) != ""], "item_set"):
+    for name in _set_order(trials):
         items = trials.loc[trials["item_set"].astype(str) == name, "characters"].astype(str)
         sets[name] = " ".join(dict.fromkeys(items))
-    pairs = per_subject.groupby(["condition", "item_set"])["subject"].nunique()
+    counted = per_subject.groupby(["condition", "item_set"])["subject"].nunique()
+    conditions = _first_appearance(named, "condition")
+    pairs = {(c, k): counted[(c, k)] for c in conditions for k in sets if (c, k) in counted.index}
     # A mixed design: the subjects' between-subjects group (from another phase of the protocol) beside it.
     group_of = named.drop_duplicates("subject").set_index("subject")["group"].astype(str) if "group" in named.columns \
         else None
@@ -208,7 +169,7 @@ def _crossover_parts(trials: pandas.DataFrame, compared: pandas.DataFrame) -> ty
     return {"groups": {str(k): int(v) for k, v in groups.items()} if groups is not None and len(groups) >= 2 else {},
             "sequences": {str(k): int(v) for k, v in sequences.items()},
             "periods": tuple(sorted(int(p) for p in named["period"].unique())), "item_sets": sets,
-            "pairing": {(str(c), str(k)): int(n) for (c, k), n in pairs.items()},
+            "pairing": {(str(c), str(k)): int(n) for (c, k), n in pairs.items()},  # conditions, sets in order
             "letters": dict(sorted(letters.items()))}
 
 
@@ -351,40 +312,6 @@ def apa_sentence(df: float, t: float, p: float, g: float = math.nan, ci: tuple[f
     return ", ".join(parts)
 
 
-def _holm(p_values: list[float]) -> list[float]:
-    """Holm's (1979) step-down adjusted p values; NaN entries stay NaN and are not counted."""
-    from statsmodels.stats.multitest import multipletests
-
-    finite = [k for k, p in enumerate(p_values) if isinstance(p, float) and math.isfinite(p)]
-    adjusted = [math.nan] * len(p_values)
-    if finite:
-        _, corrected, _, _ = multipletests([p_values[k] for k in finite], alpha=statistics.ALPHA, method="holm")
-        for k, value in zip(finite, corrected):
-            adjusted[k] = float(value)
-    return adjusted
-
-
-def _hedges_g_interval(difference: float, sd_a: float, sd_b: float, n_a: int, n_b: int
-                       ) -> tuple[float, float, float]:
-    """Hedges' g (``statistics._hedges_g``: the difference over the pooled SD, small-sample corrected) with
-    the normal approximation of its 95 % interval, SE = sqrt((n_a + n_b) / (n_a n_b) + g^2 / (2 (n_a + n_b))) (Hedges &
-    Olkin 1985, eq. 5.14)."""
-    if n_a < 2 or n_b < 2:
-        return math.nan, math.nan, math.nan
-    g = statistics._hedges_g(difference, sd_a ** 2, sd_b ** 2, n_a, n_b)
-    if not math.isfinite(g):
-        return math.nan, math.nan, math.nan
-    se = math.sqrt((n_a + n_b) / (n_a * n_b) + g * g / (2.0 * (n_a + n_b)))
-    return g, g - 1.959963984540054 * se, g + 1.959963984540054 * se
-
-
-def _row(**entries: typing.Any) -> dict[str, typing.Any]:
-    row: dict[str, typing.Any] = dict.fromkeys(QUESTION_COLUMNS, math.nan)
-    row.update(note="", apa="", model="", test="")
-    row.update(entries)
-    return row
-
-
 def _subject_means(data: pandas.DataFrame, value: str) -> pandas.Series:
     return data.groupby(data["subject"].astype(str), observed=True)[value].mean().dropna()
 
@@ -392,20 +319,28 @@ def _subject_means(data: pandas.DataFrame, value: str) -> pandas.Series:
 # ---------------------------------------------------------------------------------------------- training
 
 
-def _training_rows(data: pandas.DataFrame, value: str, design: StudyDesign, ddf: str) -> list[dict]:
-    """The crossed mixed model of the compared phase: each condition against the control."""
+def _family(value: str, phase: typing.Optional[str]) -> str:
+    """Holm's family: one outcome in one phase."""
+    return f"{value}, {phase}"
+
+
+def _training_rows(data: pandas.DataFrame, value: str, design: StudyDesign, ddf: str,
+                   units: design_models.Units) -> list[dict]:
+    """The crossed mixed model of the compared phase: each condition against the control and, with three or
+    more, every other pair (emmeans); reduced by the documented rule when singular or not converged."""
     pandas = _pandas()
     column = "group" if design.kind == "between-subjects" else "condition"
     phase = design.compared_phase
     rows_of = data[(data["phase"].astype(str) == phase) & data[value].notna()]
     # Within subjects the condition's effect varies by subject: a random slope keeps its test at the subjects'
     # level (Barr, Levy, Scheepers & Tily 2013, J Mem Lang 68:255); without it the df are the trials'.
-    subject_term = "(1 + factor | subject)" if design.kind == "within-subjects" else "(1 | subject)"
+    within = design.kind == "within-subjects"
+    subject_term = "(1 + factor | subject)" if within else "(1 | subject)"
     model = f"{value} ~ {column} + {subject_term.replace('factor', column)} + (1 | item)"
-    base = {"value": value, "unit": _unit(value), "family": value, "phase": phase, "model": model,
-            "question": f"{phase}: {column} against the control (mixed model, subjects x items crossed)"}
+    base = {"value": value, "unit": _unit(value), "family": _family(value, phase), "phase": phase, "model": model,
+            "question": f"{phase}: {column}s compared (mixed model, subjects x items crossed)"}
     n_items = rows_of["characters"].nunique()
-    formula = f"outcome ~ factor + {subject_term}" + (" + (1 | item)" if n_items >= 2 else "")
+    items = ["(1 | item)"] if n_items >= 2 else []
     frame = pandas.DataFrame({"outcome": rows_of[value].to_numpy(dtype=float),
                               "factor": rows_of[column].astype(str).to_numpy(),
                               "subject": rows_of["subject"].astype(str).to_numpy(),
@@ -414,36 +349,48 @@ def _training_rows(data: pandas.DataFrame, value: str, design: StudyDesign, ddf:
     if len(levels) < 2 or design.control not in levels or frame["subject"].nunique() < 3:
         return [_row(**base, comparison=f"{column}", note="not computed: fewer than 2 conditions with values "
                      "or fewer than 3 subjects")]
+    # The documented reduction (design_models.fit_reduced): within subjects the slope's compound-symmetry form
+    # is an intercept per subject and one per subject and condition.
+    terms = ["(1 | subject)"] + (["(1 | subject:factor)"] if within else []) + items
     try:
-        fit = mixed_models.lmer(frame, formula, {"factor": levels}, ddf=ddf)
+        fit, dropped = design_models.fit_reduced(frame, ["factor"], {"factor": levels}, ddf, terms,
+                                                 ([subject_term] + items) if within else None, units)
     except RuntimeError as error:  # RUnavailable among them: R or its packages missing
         return [_row(**base, comparison=column, note=f"not computed: {error}")]
     # One fit: whether it is a test, its note, subjects per level and subject means hold for every row.
     trusted = fit.trustworthy
-    variances = ", ".join(f"{k.lower().replace('factor', column + ' ')} {v:.3g}" for k, v in fit.variances.items())
-    variances += f" [{_unit(value)}^2]"
-    note = fit.note(variances)
+    base["model"] = fit.formula.replace("outcome", value, 1).replace("factor", column)
+
+    def name(group: str) -> str:  # R's names of the variances: 'subject factorfixture' -> 'subject group fixture'
+        return group.replace("subject:factor", f"subject:{column}").replace("factor", column + " ").lower()
+
+    note = design_models.fit_note(fit, [d.replace("factor", column) for d in dropped], units, name)
     counts = frame.groupby("factor")["subject"].nunique()
     subject_means = frame.groupby(["factor", "subject"])["outcome"].mean()
     rows = []
+
+    def g_between(estimate: float, level: str, control: str) -> tuple[float, float, float]:
+        if design.kind != "between-subjects":
+            return math.nan, math.nan, math.nan
+        a, b = subject_means.loc[level], subject_means.loc[control]
+        return _hedges_g_interval(estimate, float(a.std(ddof=1)), float(b.std(ddof=1)), len(a), len(b))
+
+    test = f"linear mixed model (REML), lme4 {fit.ddf} t ({fit.versions})"
     for effect in fit.fixed.itertuples(index=False):
         if effect.factor != "factor":
             continue
-        g, g_low, g_high = math.nan, math.nan, math.nan
-        if design.kind == "between-subjects":
-            a, b = subject_means.loc[effect.level], subject_means.loc[design.control]
-            g, g_low, g_high = _hedges_g_interval(float(effect.estimate), float(a.std(ddof=1)),
-                                                  float(b.std(ddof=1)), len(a), len(b))
+        g, g_low, g_high = g_between(float(effect.estimate), effect.level, design.control)
         rows.append(_row(
-            **base, comparison=f"{effect.level} - {design.control}",
-            test=f"linear mixed model (REML), lme4 {fit.ddf} t ({fit.versions})",
+            **base, comparison=f"{effect.level} - {design.control}", test=test,
             n=int(counts.get(effect.level, 0) + counts.get(design.control, 0)),
             df=float(effect.df) if trusted else math.nan, statistic=float(effect.t) if trusted else math.nan,
             p=float(effect.p) if trusted else math.nan, estimate=float(effect.estimate),
             ci95_low=float(effect.ci95_low) if trusted else math.nan,
             ci95_high=float(effect.ci95_high) if trusted else math.nan, g=g, g_ci95_low=g_low, g_ci95_high=g_high,
             note=note))
-    return rows
+    return rows + design_models.pair_rows(
+        fit, levels, design.control, base, note,
+        lambda a, b: int(frame.loc[frame["factor"].isin([a, b]), "subject"].nunique()), g_between)
 
 
 # ---------------------------------------------------------------------------------------------- after training
@@ -454,9 +401,9 @@ def _ancova_rows(data: pandas.DataFrame, value: str, design: StudyDesign, phase:
     import statsmodels.formula.api as smf
 
     pandas = _pandas()
-    base = {"value": value, "unit": _unit(value), "family": value, "phase": phase,
+    base = {"value": value, "unit": _unit(value), "family": _family(value, phase), "phase": phase,
             "model": f"{phase} mean ~ pre-test mean + group (subject means, OLS)",
-            "question": f"{phase}: group against the control, adjusted for the pre-test (ANCOVA)"}
+            "question": f"{phase}: groups compared, adjusted for the pre-test (ANCOVA)"}
     groups = data.groupby(data["subject"].astype(str), observed=True)["group"].agg(lambda g: str(g.iloc[0]))
     pre = _subject_means(data[data["phase"].astype(str) == design.pre_test], value)
     post = _subject_means(data[data["phase"].astype(str) == phase], value)
@@ -484,6 +431,25 @@ def _ancova_rows(data: pandas.DataFrame, value: str, design: StudyDesign, phase:
                          ci95_high=float(interval.loc[name, 1]), g=g, g_ci95_low=g_low, g_ci95_high=g_high,
                          note=f"pre-test slope {float(fit.params['pre']):.3g}; n per group "
                               + ", ".join(f"{lv} {int((frame['group'] == lv).sum())}" for lv in levels)))
+    # With three or more groups every other pair: the difference of their adjusted means (the contrast of
+    # their coefficients, as R's emmeans(lm(...), "group") |> pairs() gives it).
+    for i, earlier in enumerate(levels[1:], start=1):
+        for later in levels[i + 1:]:
+            weights = np.zeros(len(fit.params))
+            weights[list(fit.params.index).index(f"C(group, Treatment(reference=0))[T.{later}]")] = 1.0
+            weights[list(fit.params.index).index(f"C(group, Treatment(reference=0))[T.{earlier}]")] = -1.0
+            contrast = fit.t_test(weights)
+            estimate = float(np.squeeze(contrast.effect))
+            low, high = (float(x) for x in np.squeeze(contrast.conf_int(alpha=statistics.ALPHA)))
+            a = frame.loc[frame["group"] == later, "post"]
+            b = frame.loc[frame["group"] == earlier, "post"]
+            g, g_low, g_high = _hedges_g_interval(estimate, float(a.std(ddof=1)), float(b.std(ddof=1)), len(a),
+                                                  len(b))
+            rows.append(_row(**base, comparison=f"{later} - {earlier}",
+                             test="ANCOVA (OLS on subject means, statsmodels); t of the contrast of adjusted means",
+                             n=len(a) + len(b), df=float(fit.df_resid), statistic=float(np.squeeze(contrast.tvalue)),
+                             p=float(np.squeeze(contrast.pvalue)), estimate=estimate, ci95_low=low, ci95_high=high,
+                             g=g, g_ci95_low=g_low, g_ci95_high=g_high, note=rows[0]["note"]))
     return rows
 
 
@@ -515,16 +481,19 @@ def design_questions(trials: pandas.DataFrame, value: str, design: typing.Option
                      scale: float = 1.0, display_unit: str = "") -> pandas.DataFrame:
     """The design's questions for the outcome ``value`` (see the module's docstring), one row per comparison
     against the control, with the columns of ``QUESTION_COLUMNS``: ``value``, ``unit`` (the SI unit of
-    ``estimate`` and its interval), ``family`` (Holm's family: the outcome), ``question``, ``phase``,
-    ``comparison`` ('level - control'), ``model``, ``test``, ``n`` (subjects), ``df``, ``statistic`` (t),
+    ``estimate`` and its interval), ``family`` (Holm's family: the outcome in one phase, 'VALUE, PHASE'; a
+    design's checks 'VALUE (checks)', not adjusted), ``question``, ``phase``, ``comparison`` ('level -
+    control', and with three or more conditions 'later - earlier' for every other pair), ``model``, ``test``, ``n`` (subjects), ``df``, ``statistic`` (t),
     ``p`` (two-sided), ``p_holm`` (Holm-adjusted within the family), ``estimate`` with ``ci95_low`` and
     ``ci95_high`` [SI unit], ``g`` with ``g_ci95_low``/``g_ci95_high`` (Hedges' g; g_av within subjects),
     ``apa`` (the sentence, its interval multiplied by ``scale`` into ``display_unit``) and ``note`` (why a
-    row is not computed or not tested, or the variances). A model that is singular or did not converge keeps
-    its estimate but has no df, statistic, p or interval: it is no test.
+    row is not computed or not tested, or the variances, written times ``scale`` in ``display_unit`` when
+    given, and what the documented reduction dropped). A model that is still singular or did not converge
+    after the reduction keeps its estimate but has no df, statistic, p or interval: it is no test.
 
     ``trials`` are filtered by ``policy`` first. Raises ValueError naming a missing column."""
     pandas = _pandas()
+    units = design_models.Units(_unit(value), scale if display_unit else 1.0, display_unit)
     statistics._check_frame(trials, "design_questions")
     statistics._require_columns(trials, ["subject", "phase", "condition", "characters", value], "design_questions")
     statistics._require_groups(trials, ["subject", "phase", "condition", "characters"], "design_questions")
@@ -533,16 +502,16 @@ def design_questions(trials: pandas.DataFrame, value: str, design: typing.Option
     data, _ = apply_exclusions(trials, policy)
     rows: list[dict] = []
     if design.kind == "crossover":
-        rows += crossover_analysis.questions(data, value, design, ddf)
+        rows += crossover_analysis.questions(data, value, design, ddf, units)
     elif design.kind != "single-condition" and design.compared_phase is not None:
-        rows += _training_rows(data, value, design, ddf)
+        rows += _training_rows(data, value, design, ddf, units)
     if design.kind == "between-subjects" and design.pre_test is not None:
         for phase in design.after_training:
             rows += _ancova_rows(data, value, design, phase)
     elif design.kind == "within-subjects":
         rows += _paired_rows(data, value, design)
-    # Holm within each family: the outcome's comparisons against the control. A design's checks (a crossover's
-    # carry-over test and Hills-Armitage) are their own family and are not adjusted.
+    # Holm within each family: the outcome's comparisons in one phase, each pair of conditions once. A design's
+    # checks (a crossover's carry-over test and Hills-Armitage) are their own family and are not adjusted.
     for family in dict.fromkeys(r["family"] for r in rows):
         members = [r for r in rows if r["family"] == family]
         checks = family.endswith("(checks)")

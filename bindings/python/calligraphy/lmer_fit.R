@@ -18,11 +18,15 @@
 #                                            Other lines (a package's chatter) carry no marker and are ignored.
 # FOLDER holds data.csv (UTF-8) and levels.csv (factor, level: each factor's levels in order, reference
 # first); a fit writes fixed.csv, random.csv, anova.csv (one F test per term) and fit.csv (key, value) there
-# (a fit that did not converge or is singular says so in fit.csv).
+# (a fit that did not converge or is singular says so in fit.csv). When the first factor of levels.csv (the
+# compared one) has three or more levels and is a term of the model, pairs.csv holds every pairwise contrast
+# of its estimated marginal means (emmeans, Lenth 2024; the same df method), later level - earlier level, with
+# p raw and Holm-adjusted among them; fit.csv's "pairs" says why there are none.
 suppressPackageStartupMessages({
   library(lme4)
   library(lmerTest)
 })
+has_emmeans <- requireNamespace("emmeans", quietly = TRUE)
 
 fit_model <- function(folder, formula_text, ddf) {
   model_formula <- stats::as.formula(formula_text)
@@ -81,13 +85,36 @@ fit_model <- function(folder, formula_text, ddf) {
   random <- data.frame(group = component_name, variance = components$vcov)
   utils::write.csv(random, file.path(folder, "random.csv"), row.names = FALSE, fileEncoding = "UTF-8")
 
+  pairs_status <- write_pairs(fit, folder, levels_table, ddf)
+
   info <- data.frame(
     key = c("n_observations", "singular", "converged", "messages", "ddf", "lme4_version", "lmertest_version",
-            "r_version"),
+            "r_version", "pairs"),
     value = c(stats::nobs(fit), singular, length(convergence) == 0, paste(messages, collapse = "; "), ddf,
               as.character(utils::packageVersion("lme4")), as.character(utils::packageVersion("lmerTest")),
-              paste(R.version$major, R.version$minor, sep = ".")))
+              paste(R.version$major, R.version$minor, sep = "."), pairs_status))
   utils::write.csv(info, file.path(folder, "fit.csv"), row.names = FALSE, fileEncoding = "UTF-8")
+}
+
+# Every pairwise contrast of the compared factor's estimated marginal means (emmeans, averaged over the other
+# factors with equal weights), with the fit's df method; "ok", or why there are none.
+write_pairs <- function(fit, folder, levels_table, ddf) {
+  if (nrow(levels_table) == 0) return("no factor")
+  compared <- levels_table$factor[1]
+  if (sum(levels_table$factor == compared) < 3) return("fewer than 3 levels")
+  if (!(compared %in% all.vars(stats::formula(fit, fixed.only = TRUE)))) return("not a fixed term")
+  if (!has_emmeans) return("emmeans is not installed (Debian: r-cran-emmeans)")
+  tryCatch({
+    means <- suppressMessages(emmeans::emmeans(fit, specs = compared,
+                                               lmer.df = if (ddf == "Kenward-Roger") "kenward-roger" else "satterthwaite"))
+    raw <- as.data.frame(summary(graphics::pairs(means, reverse = TRUE, adjust = "none"), infer = c(TRUE, TRUE)))
+    holm <- as.data.frame(summary(graphics::pairs(means, reverse = TRUE, adjust = "holm"), infer = c(FALSE, TRUE)))
+    utils::write.csv(data.frame(contrast = raw$contrast, estimate = raw$estimate, std_error = raw$SE, df = raw$df,
+                                t = raw$t.ratio, p = raw$p.value, p_holm = holm$p.value, ci95_low = raw$lower.CL,
+                                ci95_high = raw$upper.CL),
+                     file.path(folder, "pairs.csv"), row.names = FALSE, fileEncoding = "UTF-8")
+    "ok"
+  }, error = function(e) paste("emmeans failed:", gsub("[\r\n\t]+", " ", conditionMessage(e))))
 }
 
 # The serve protocol's fields: UTF-8 text as lower-case hex, which has no space, tab or line break.
@@ -114,6 +141,7 @@ if (length(arguments) == 1 && arguments[1] == "--serve") {
       folder <- hex_to_text(request[3])
       fit_model(folder, hex_to_text(request[4]), hex_to_text(request[5]))
       files <- c("fixed.csv", "random.csv", "anova.csv", "fit.csv")
+      if (file.exists(file.path(folder, "pairs.csv"))) files <- c(files, "pairs.csv")
       paste("ok", text_to_hex(paste0(files, "=", file.size(file.path(folder, files)), collapse = ";")))
     }, error = function(e) paste("error", text_to_hex(conditionMessage(e))))
     cat("@@calligraphy-reply ", request[2], " ", reply, "\n", sep = "")

@@ -54,7 +54,11 @@ class LmerFit:
     [outcome unit squared], keyed by R's group name ('subject', 'item', 'Residual'). ``singular``: lme4's
     isSingular (a variance estimated as 0 or a correlation as +-1); ``converged``: lme4 reported no
     convergence problem; ``messages``: every warning and message of the fit; ``ddf``; ``formula``;
-    ``n_observations``; ``versions`` of R, lme4 and lmerTest."""
+    ``n_observations``; ``versions`` of R, lme4 and lmerTest. ``pairs``: when the first factor of ``factors``
+    has three or more levels, every pairwise contrast of its estimated marginal means (R's emmeans, the same
+    df method), ``contrast`` ('later - earlier' in the factor's order), ``estimate``, ``std_error``, ``df``,
+    ``t``, ``p``, ``p_holm`` (Holm among these contrasts), ``ci95_low``, ``ci95_high``; else None, and
+    ``pairs_note`` says why."""
 
     formula: str
     ddf: str
@@ -66,6 +70,8 @@ class LmerFit:
     messages: str
     n_observations: int
     versions: str
+    pairs: typing.Optional["pandas.DataFrame"] = None
+    pairs_note: str = ""
 
     @property
     def trustworthy(self) -> bool:
@@ -276,7 +282,10 @@ _RESULT_COLUMNS = {
     "random.csv": ("group", "variance"),
     "anova.csv": ("term", "num_df", "den_df", "f", "p"),
     "fit.csv": ("key", "value"),
+    # only when the compared factor has three or more levels (lmer_fit.R)
+    "pairs.csv": ("contrast", "estimate", "std_error", "df", "t", "p", "p_holm", "ci95_low", "ci95_high"),
 }
+_OPTIONAL_RESULTS = ("pairs.csv",)
 
 
 def _read_answer(folder: str, formula: str, files: typing.Mapping[str, int]) -> dict[str, "pandas.DataFrame"]:
@@ -288,6 +297,8 @@ def _read_answer(folder: str, formula: str, files: typing.Mapping[str, int]) -> 
     tables = {}
     for name, columns in _RESULT_COLUMNS.items():
         path = os.path.join(folder, name)
+        if name in _OPTIONAL_RESULTS and name not in files and not os.path.exists(path):
+            continue
         problem = None
         try:
             size = os.path.getsize(path)
@@ -297,7 +308,7 @@ def _read_answer(folder: str, formula: str, files: typing.Mapping[str, int]) -> 
                 problem = f"{size} bytes where R's reply says {files[name]}"
             else:
                 with open(path, encoding="utf-8", errors="strict") as stream:
-                    table = pandas.read_csv(stream, dtype=str if name == "fit.csv" else None,
+                    table = pandas.read_csv(stream, dtype={"fit.csv": str, "pairs.csv": {"contrast": str}}.get(name),
                                             keep_default_na=name != "fit.csv")
                 if tuple(table.columns) != columns:
                     problem = f"columns {list(table.columns)} where {list(columns)} belong"
@@ -362,6 +373,7 @@ def lmer(frame: "pandas.DataFrame", formula: str, factors: typing.Mapping[str, t
         answer = _read_answer(folder, formula, _fit_in_r(rscript, folder, formula, ddf))
     fixed, random, terms = answer["fixed.csv"], answer["random.csv"], answer["anova.csv"]
     info = dict(answer["fit.csv"].itertuples(index=False, name=None))
+    pairs = answer.get("pairs.csv")
     owners = {}
     for name, values in factors.items():
         for level in list(values)[1:]:
@@ -371,6 +383,7 @@ def lmer(frame: "pandas.DataFrame", formula: str, factors: typing.Mapping[str, t
     variances = {str(group): float(variance) for group, variance in zip(random["group"], random["variance"])}
     return LmerFit(formula=formula, ddf=ddf, fixed=fixed, terms=terms, variances=variances,
                    singular=info.get("singular") == "TRUE", converged=info.get("converged") == "TRUE",
-                   messages=info.get("messages", ""), n_observations=int(info.get("n_observations", "0") or 0),
+                   messages=info.get("messages", ""), pairs=pairs, pairs_note=info.get("pairs", ""),
+                   n_observations=int(info.get("n_observations", "0") or 0),
                    versions=(f"R {info.get('r_version', '?')}, lme4 {info.get('lme4_version', '?')}, lmerTest "
                              f"{info.get('lmertest_version', '?')}"))

@@ -354,8 +354,8 @@ def _condition_colour(conditions: list, condition: typing.Any) -> str:
     return _CONDITION_COLOURS[conditions.index(condition) % len(_CONDITION_COLOURS)]
 
 
-def learning_figure(trials: "pandas.DataFrame", value: str, phase: typing.Optional[str] = "test"
-                    ) -> "matplotlib.figure.Figure":
+def learning_figure(trials: "pandas.DataFrame", value: str, phase: typing.Optional[str] = "test",
+                    legend_title: str = "condition") -> "matplotlib.figure.Figure":
     """Learning curves of `value` over repetitions: per condition the mean over subjects with its 95 % t
     interval (``calligraphy.statistics.describe(..., unit="subject")``: each subject's trials averaged
     first, n = subjects; Student 1908). Panels: all characters (each subject's mean over them), then one per
@@ -363,7 +363,8 @@ def learning_figure(trials: "pandas.DataFrame", value: str, phase: typing.Option
     display unit (mm for lengths, s for times). The x axis is the tables' ``repetition``, counted from 1.
 
     trials: one row per trial with subject, condition, characters, repetition, `value` and, for a `phase`,
-    phase (None: every row). Returns a matplotlib Figure (not registered with pyplot; Agg canvas).
+    phase (None: every row). legend_title: what a line is ('group' on a between-subjects report, whose
+    groups each train under their own condition). Returns a matplotlib Figure (not registered with pyplot; Agg canvas).
     Raises ValueError for a missing column or phase, ImportError without matplotlib, pandas or SciPy.
     """
     import numpy
@@ -422,7 +423,7 @@ def learning_figure(trials: "pandas.DataFrame", value: str, phase: typing.Option
             ax.spines[["top", "right"]].set_visible(False)
         axes[0].set_ylabel(display.axis_label())
         if conditions:  # outside the panels, so that it hides no point
-            axes[-1].legend(title="condition", fontsize=8, title_fontsize=8, frameon=False, loc="upper left",
+            axes[-1].legend(title=legend_title, fontsize=8, title_fontsize=8, frameon=False, loc="upper left",
                             bbox_to_anchor=(1.02, 1.0))
     return figure
 
@@ -572,7 +573,7 @@ def _statistics_html(table: "pandas.DataFrame", value: str, phase: typing.Option
                    f"<td class=\"test\">{_e(row['test'])}</td><td class=\"num\">{_integer(row['n'])}</td>"
                    f"<td class=\"num\">{_significant(row['statistic'])}</td>"
                    f"<td class=\"num\">{_integer(row['df'])}</td>"
-                   f"<td class=\"num\">{_p_value(row['p'])}</td><td class=\"num\">{effect}</td>"
+                   f"<td class=\"num\">{_e(_p_value(row['p']))}</td><td class=\"num\">{effect}</td>"
                    f"<td class=\"num\">{interval}</td><td>{note}</td></tr>\n")
     out.append("</tbody>\n</table>\n<ol class=\"assumptions\" type=\"a\">")
     for assumptions, letter in notes.items():
@@ -700,6 +701,69 @@ def phase_figure(means: "pandas.DataFrame", value: str, design: "design_analysis
     return figure
 
 
+_PHASE_WORDS = {"practice": "familiarisation (practice)", "familiarisation": "familiarisation"}
+
+
+def _words_html(design: "design_analysis.StudyDesign") -> str:
+    """What the page's words mean, once: condition, group and (in a crossover) the condition trained."""
+    words = ["a <b>condition</b> is how a trial is written: its guidance (mode), named by the protocol",
+             "a <b>group</b> is the subjects a between-subjects phase assigns to one of its conditions, for the "
+             "whole study"]
+    if design.kind == "crossover":
+        words.append("the <b>condition trained</b> of a trial is the condition its item set was trained under in "
+                     "the crossover (a test trial written without guidance counts for it)")
+    used = {"between-subjects": "groups (in training, each group wrote its own condition)",
+            "crossover": "conditions trained", "within-subjects": "conditions"}.get(design.kind, "conditions")
+    return (f"<p class=\"files\">Words: {'; '.join(words)}. The figures' lines and the tables' columns are "
+            f"{_e(used)}.</p>\n")
+
+
+def _protocol_html(trials: "pandas.DataFrame", design: "design_analysis.StudyDesign") -> str:
+    """Every phase of the protocol in its order, the familiarisation too: its session, the conditions written,
+    the items (by set, the sets in the protocol's order), the repetitions, the blocks (a crossover's training:
+    one per period) and the trials per subject, and the subjects."""
+    rows = []
+    for phase in design.phases:
+        of = trials[trials["phase"].astype(str) == phase]
+        if of.empty:
+            continue
+        sessions = sorted({int(x) for x in of["session_number"].dropna()}) if "session_number" in of else []
+        conditions = [str(c) for c in dict.fromkeys(of["condition"].astype(str))]
+        conditions = [c for c in design.conditions if c in conditions] + [c for c in conditions
+                                                                          if c not in design.conditions]
+        conditions_text = ", ".join(conditions)
+        if "group" in of and of["group"].astype(str).replace({"nan": ""}).ne("").any() and len(conditions) >= 2 and (
+                of.groupby(of["subject"].astype(str), observed=True)["condition"].nunique() == 1).all():
+            conditions_text += " (each group its own)"
+        if "item_set" in of and (of["item_set"].astype(str).replace({"nan": ""}) != "").any():
+            present = set(of["item_set"].astype(str))
+            sets = [k for k in design.item_sets if k in present] + sorted(present - set(design.item_sets) - {"", "nan"})
+            items = "; ".join(f"{k}: " + " ".join(dict.fromkeys(of.loc[of["item_set"].astype(str) == k, "characters"]
+                                                                 .astype(str))) for k in sets)
+        else:
+            items = " ".join(_characters_in_order(of))
+        repetitions = int(of["repetition"].max()) if of["repetition"].notna().any() else 0
+        per_subject = of.groupby(of["subject"].astype(str), observed=True).size()
+        blocks = (of.groupby(of["subject"].astype(str), observed=True)["block"].nunique()
+                  if "block" in of else per_subject * 0 + 1)
+        blocks_text = (f"{int(blocks.min())}" if blocks.min() == blocks.max()
+                       else f"{int(blocks.min())}-{int(blocks.max())}")
+        if design.kind == "crossover" and phase == design.compared_phase and blocks.min() == blocks.max() == len(
+                design.periods):
+            blocks_text += f" (one per period, {len(design.periods)} periods)"
+        trials_text = (f"{int(per_subject.min())}" if per_subject.min() == per_subject.max()
+                       else f"{int(per_subject.min())}-{int(per_subject.max())}")
+        rows.append(f"<tr><td>{_e(_PHASE_WORDS.get(phase, phase))}</td><td class=\"num\">"
+                    f"{_e(', '.join(str(x) for x in sessions) or '–')}</td><td>{_e(conditions_text)}</td>"
+                    f"<td class=\"glyph\">{_e(items)}</td><td class=\"num\">{repetitions}</td>"
+                    f"<td class=\"num\">{_e(blocks_text)}</td><td class=\"num\">{_e(trials_text)}</td>"
+                    f"<td class=\"num\">{len(per_subject)}</td></tr>\n")
+    return ("<table class=\"protocol\" id=\"protocol\"><caption>The protocol, phase by phase</caption>\n"
+            "<thead><tr><th>phase</th><th>session</th><th>conditions written</th><th>items</th><th>repetitions</th>"
+            "<th>blocks per subject</th><th>trials per subject</th><th>subjects</th></tr></thead><tbody>\n" + "".join(rows)
+            + "</tbody></table>\n")
+
+
 def _factor_name(design: "design_analysis.StudyDesign") -> str:
     """What a line or column of the page is: a group, a condition, or in a crossover the condition a set was
     trained under."""
@@ -759,11 +823,12 @@ def _model_html(model: typing.Any) -> str:
     return f"<br><code>{_e(model)}</code>" if isinstance(model, str) and "~" in model else ""
 
 
-def _questions_html(questions: "pandas.DataFrame", value: str) -> str:
+def _questions_html(questions: "pandas.DataFrame", value: str, factor: str = "condition") -> str:
     display = _display(value)
     unit = f" [{display.unit}]" if display.unit else ""
     out = [f"<table class=\"questions\" data-value=\"{_e(value)}\">\n<caption>{_e(display.label.capitalize())}"
-           f"{_e(unit)}: each condition against the control</caption>\n<thead><tr><th>phase</th><th>comparison</th>"
+           f"{_e(unit)}: each {_e(factor)} against the control, and with three or more every other pair (Holm "
+           "within each phase)</caption>\n<thead><tr><th>phase</th><th>comparison</th>"
            "<th>model</th><th>result</th><th>p (Holm)</th><th>difference [95 % CI]</th><th>note</th></tr></thead>"
            "\n<tbody>\n"]
     for row in questions.to_dict("records"):
@@ -778,7 +843,7 @@ def _questions_html(questions: "pandas.DataFrame", value: str) -> str:
         out.append(f"<tr{css}><td>{_e(row['phase'])}</td><td>{_e(row['comparison'])}</td>"
                    f"<td class=\"test\">{_e(row['test'] or '–')}{_model_html(row['model'])}</td>"
                    f"<td>{_e(row['apa'] or '–')}</td>"
-                   f"<td class=\"num\">{_p_value(row['p_holm'])}</td><td class=\"num\">{difference}</td>"
+                   f"<td class=\"num\">{_e(_p_value(row['p_holm']))}</td><td class=\"num\">{difference}</td>"
                    f"<td class=\"test\">{_e(note)}</td></tr>\n")
     out.append("</tbody></table>\n")
     return "".join(out)
@@ -806,12 +871,23 @@ def _phase_means_html(means: "pandas.DataFrame", value: str, design: "design_ana
             f"<tbody>\n{''.join(body)}</tbody></table>\n")
 
 
-def _retention_html(ratios: "pandas.DataFrame", factor: str) -> str:
+def _retention_note(row: dict, display: _Display) -> str:
+    """A retention row's note with its gain interval in the table's unit (the tables keep SI units)."""
+    note = str(row["note"]) if isinstance(row["note"], str) else ""
+    if not (_finite(row["gain_ci95_low"]) and _finite(row["gain_ci95_high"])):
+        return note
+    interval = (f"95 % CI [{_significant(row['gain_ci95_low'] * display.scale)}, "
+                f"{_significant(row['gain_ci95_high'] * display.scale)}]" + (f" {display.unit}" if display.unit else ""))
+    return re.sub(r"95 % CI \[[^\]]*\]", lambda _: interval, note)
+
+
+def _retention_html(ratios: "pandas.DataFrame", factor: str, display: typing.Optional[_Display] = None) -> str:
     if ratios.empty:
         return ""
+    display = display or _Display("", "", 1.0, 2)
     rows = "".join(f"<tr><td>{_e(r['group'])}</td><td class=\"num\">{_integer(r['n'])}</td><td class=\"num\">"
-                   f"{_significant(r['retention_ratio'])}</td><td class=\"test\">{_e(r['note'])}</td></tr>\n"
-                   for r in ratios.to_dict("records"))
+                   f"{_significant(r['retention_ratio'])}</td><td class=\"test\">{_e(_retention_note(r, display))}"
+                   "</td></tr>\n" for r in ratios.to_dict("records"))
     return ("<table class=\"retention\"><caption>Share of the gain kept at retention, mean(pre - retention) / "
             f"mean(pre - post) per {_e(factor)}</caption><thead><tr><th>{_e(factor)}</th><th>n</th><th>ratio</th><th>note</th></tr>"
             f"</thead><tbody>\n{rows}</tbody></table>\n")
@@ -906,21 +982,23 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
         questions = design_analysis.design_questions(trials, value, design, policy=policy, ddf=ddf,
                                                      scale=display.scale, display_unit=display.unit)
         all_questions.append(questions)
-        question_html.append(_questions_html(questions, value))
+        question_html.append(_questions_html(questions, value, _factor_name(design)))
         means_html.append(_phase_means_html(means, value, design))
         ratios = design_analysis.retention_ratios(trials, value, design, policy)
         if not ratios.empty:
             all_ratios.append(ratios.assign(value=value, unit=_si_unit(value)))
-            means_html.append(_retention_html(ratios, _factor_name(design)))
+            means_html.append(_retention_html(ratios, _factor_name(design), display))
         if phase is not None and not data.empty:
             stem = f"learning_{_file_name(value)}"
-            figure = learning_figure(data, value, phase=None)
+            figure = learning_figure(data, value, phase=None,
+                                     legend_title="group" if design.kind == "between-subjects" else "condition")
             _save_figure(figure, figures, stem, files)
             width_px = round(figure.get_figwidth() * 96)
             learning_html.append(
                 f"<figure><img src=\"figures/{_e(stem)}.svg\" width=\"{width_px}\" "
                 f"alt=\"Learning curves of {_e(display.label)}\"><figcaption>{_e(display.label.capitalize())} over "
-                f"repetitions in {_e(phase)} (counted from 1): per condition the mean over subjects "
+                f"repetitions in {_e(phase)} (counted from 1): per "
+                f"{'group' if design.kind == 'between-subjects' else 'condition'} the mean over subjects "
                 "with its 95 % t interval (n = subjects). Left: all characters; then each character. One y axis for "
                 "all panels.</figcaption></figure>\n")
     files[tables / "phase_means.csv"] = pandas.concat(all_means, ignore_index=True).to_csv(index=False)
@@ -952,6 +1030,7 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
             "<meta name=\"viewport\" content=\"width=device-width\">"
             f"<title>{_e(title)}</title>\n{_STYLE}</head><body>\n",
             _header_html(trials, title, design, per_trial_link, tables, files),
+            _words_html(design), _protocol_html(trials, design),
             _exclusions_html(exclusions, policy),
             "<section id=\"summary\">\n<h2>Summary</h2>\n<div class=\"figures\">\n", *summary_html, "</div>\n</section>\n",
             "<section id=\"questions\">\n<h2>The design's questions</h2>\n<p class=\"files\">",
@@ -986,7 +1065,7 @@ def _power_basis(trials: "pandas.DataFrame") -> str:
 
 
 _RANDOM_TERM = re.compile(r"\(([^()|]+)\|\s*([A-Za-z_.:]+)\s*\)")
-_GROUPING_WORDS = {"subject": "subject", "item": "character",
+_GROUPING_WORDS = {"subject": "subject", "item": "character", "subject:condition": "subject and condition",
                    "subject:item_set": "subject and item set (in a crossover: per subject and condition)"}
 
 
@@ -996,7 +1075,7 @@ def _model_words(formula: str) -> str:
     outcome, _, right = formula.partition("~")
     fixed = [t.strip() for t in _RANDOM_TERM.sub("", right).split("+") if t.strip()]
     names = {"condition": "condition", "group": "group", "period": "period", "pre": "the same set's pre-test mean",
-             "sequence": "sequence"}
+             "sequence": "sequence", "item_set": "item set"}
     words = [f"fixed effects of {', '.join(names.get(t, t) for t in fixed)}"]
     for inside, grouping in _RANDOM_TERM.findall(right):
         slopes = [t.strip() for t in inside.split("+") if t.strip() not in ("1", "")]
@@ -1010,7 +1089,8 @@ def _methods_sentence(design: "design_analysis.StudyDesign", ddf: str, questions
     the adjustment."""
     control = design.control or "the first condition"
     parts = [f"Each {_factor_name(design)} is compared with the control, {control} (differences are "
-             f"{_factor_name(design)} - control)."]
+             f"{_factor_name(design)} - control), and with three or more each other pair (later - earlier in the "
+             "order of the tables' columns, the control first)."]
     mixed = questions[questions["test"].astype(str).str.startswith("linear mixed model")]
     by_model: dict[str, list[str]] = {}
     for row in mixed.drop_duplicates(["phase", "model"]).to_dict("records"):
@@ -1019,13 +1099,21 @@ def _methods_sentence(design: "design_analysis.StudyDesign", ddf: str, questions
         parts.append(f"{_display(model.split(' ~ ', 1)[0].strip()).label.capitalize()} in "
                      f"{', '.join(dict.fromkeys(phases))}: a linear mixed model, {_model_words(model)}, fitted by REML "
                      f"with R's lme4, t tests with {ddf} df (lmerTest).")
-    if design.kind == "crossover":
-        parts.append("Each model is the one fitted: the crossover's full model has a random intercept and condition "
-                     "slope per subject and a random intercept per character; a singular fit was refitted with the "
-                     "slope's compound-symmetry form (intercepts per subject and per subject and item set), then "
-                     "without the term of the smallest variance while still singular (the table's notes say which).")
     if by_model:
-        parts.append("A fit that stays singular, or does not converge, is reported without a test.")
+        slope = {"crossover": "; the full model's random condition slope per subject is first replaced by its "
+                              "compound-symmetry form (intercepts per subject and per subject and item set)",
+                 "within-subjects": "; the full model's random condition slope per subject is first replaced by its "
+                                    "compound-symmetry form (intercepts per subject and per subject and condition)"
+                 }.get(design.kind, "")
+        parts.append("Each model is the one fitted, by the documented reduction: a fit that is singular or does not "
+                     f"converge is refitted{slope}; then, while still singular or not converged, without the random "
+                     "term of the smallest variance (the row's note names each step). The outcome is fitted in the "
+                     "power of ten of its unit that brings its SD between 1 and 10, so that the fit does not depend on "
+                     "the unit; the tables show the results in their unit. A fit that stays singular, or does not "
+                     "converge, is reported without a test.")
+    if design.kind == "crossover":
+        parts.append("The item set is a fixed effect where the design separates it from condition and period (sets "
+                     "rotating across sequences); where it does not, the row's note says so.")
     if design.kind == "crossover":
         parts.append("After training each test trial counts for the condition its item set was trained under, "
                      "and period is the period that set was trained in. Checks, not adjusted: the carry-over F test "
@@ -1036,7 +1124,8 @@ def _methods_sentence(design: "design_analysis.StudyDesign", ddf: str, questions
                      "mean adjusted for the pre-test mean (statsmodels OLS).")
     if design.kind == "within-subjects":
         parts.append("Paired t-tests on subject means, a check of the same comparison (not adjusted).")
-    parts.append("p values are Holm-adjusted within each outcome (one test per comparison against the control); g "
+    parts.append("p values are Holm-adjusted within each outcome and phase (each comparison with the control and, "
+                 "with three or more, every other pair of them once: R's emmeans for a mixed model); g "
                  "is Hedges' g (g_av within subjects) with an approximate 95 % interval; the difference and its 95 % "
                  "interval are in the unit of the table.")
     return " ".join(parts)
