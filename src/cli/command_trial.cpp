@@ -135,15 +135,18 @@ TrialDescription describe(const TrialSpec& spec, const TrialRun& run, const Simu
   return description;
 }
 
-// A replay's teacher: the recording --teacher names, of these characters.
-std::vector<TeacherSample> teacher_samples(const TrialSpec& spec) {
-  TeacherRecording recording = read_teacher_recording(spec.teacher);
+// A replay's teacher: the recording --teacher (or the record) names, of these characters and, for a record
+// that names its teacher's SHA-256, that recording; `sha256` is set to its file's.
+std::vector<TeacherSample> teacher_samples(const TrialSpec& spec, const std::optional<RecordedTrial>& recorded,
+                                           std::string& sha256) {
+  TeacherFile teacher = read_recorded_teacher(recorded ? *recorded : RecordedTrial{}, spec.teacher);
   try {
-    require_teacher_for(recording, spec.characters);
+    require_teacher_for(teacher.recording, spec.characters);
   } catch (const InvalidArgument& e) {
     throw InvalidArgument("teacher (--teacher) " + spec.teacher + ": " + e.what());
   }
-  return std::move(recording.samples);
+  sha256 = std::move(teacher.sha256);
+  return std::move(teacher.recording.samples);
 }
 
 // Writes each output given; one that fails is reported on stderr and does not keep the others from being
@@ -275,8 +278,10 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
   inputs.should_stop = StopSignals::stop_requested();
   inputs.hand_maker = writing.get();
   TrialRun run;
+  std::string teacher_sha256;
   try {
-    if (spec.guidance && spec.guidance_mode == GuidanceMode::replay) inputs.teacher = teacher_samples(spec);
+    if (spec.guidance && spec.guidance_mode == GuidanceMode::replay)
+      inputs.teacher = teacher_samples(spec, recorded, teacher_sha256);
     run = recorded ? rerun_trial(*recorded, checked, scene, inputs) : run_trial_spec(checked, scene, inputs);
   } catch (const InvalidArgument& e) {
     if (!recorded) throw;
@@ -284,7 +289,9 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
   }
   TrialResult& result = run.result;
   TrialDescription description = describe(spec, run, *writing, device);
-  description.specification_json = recorded_trial_json(recorded_trial(spec, run, *writing, scene));
+  RecordedTrial ran = recorded_trial(spec, run, *writing, scene);
+  ran.teacher_sha256 = teacher_sha256;  // the replay's teacher, bound to the record
+  description.specification_json = recorded_trial_json(ran);
   const int signal = StopSignals::received();
   if (result.end == TrialEnd::interrupted && result.abort_reason.empty() && signal != 0) {
     result.abort_reason = std::string("stopped by ") + signal_name(signal);

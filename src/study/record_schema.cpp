@@ -184,6 +184,10 @@ const Schema& SchemaOf<study_detail::RecordDocument>::get() {
           "simulated_device", {.doc = "a simulated device's physics; null: the registry's device"}),
       object_field<&R::scene>("scene", {.doc = "the scene's layout and the characters' SHA-256"}),
       string_field<&R::library_version>("library_version", {.doc = "the library that ran it"}),
+      since(4, string_field<&R::teacher_sha256>(
+                   "teacher_sha256", {.doc = "lower-case hex SHA-256 of the teacher's recording a replay ran on, "
+                                             "checked when it is re-run; empty: no file was read",
+                                      .source = "FIPS 180-4"})),
   };
   static const Schema schema{.name = "RecordedTrial",
                              .doc = "a trial as it ran, whole: what `calligraphy trial --spec` runs again",

@@ -37,6 +37,7 @@ struct RecordDocument {
   std::optional<SimulatedDeviceParameters> simulated_device;
   RecordedScene scene;
   std::string library_version;
+  std::string teacher_sha256;  ///< a replay's teacher recording's SHA-256; empty: none read
 };
 
 }  // namespace study_detail

@@ -109,6 +109,7 @@ nlohmann::json recorded_trial_object(const RecordedTrial& r) {
   document.simulated_device = r.simulated_device;
   document.scene = {r.layout, r.scene_sha256};
   document.library_version = r.library_version;
+  document.teacher_sha256 = r.teacher_sha256;
   return schema_detail::to_json(recorded_trial_schema(), &document);
 }
 
@@ -193,6 +194,15 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
   r.layout = parts.scene.layout;
   r.scene_sha256 = std::move(parts.scene.sha256);
   r.library_version = std::move(parts.library_version);
+  if (!parts.teacher_sha256.empty() &&
+      (parts.teacher_sha256.size() != 64 ||
+       parts.teacher_sha256.find_first_not_of("0123456789abcdef") != std::string::npos)) {
+    json_detail::fail(source, reader.pointer("teacher_sha256"),
+                      "expected 64 lower-case hex digits (a SHA-256) or \"\"");
+  }
+  if (!parts.teacher_sha256.empty() && !(r.spec.guidance && r.spec.guidance_mode == GuidanceMode::replay))
+    json_detail::fail(source, reader.pointer("teacher_sha256"), "names a teacher, but the trial is not a replay");
+  r.teacher_sha256 = std::move(parts.teacher_sha256);
   r.defaulted = std::move(read.defaulted);
   return r;
 }
@@ -227,6 +237,17 @@ RecordedTrial read_recorded_trial_file(const std::string& path) {
     }
   }
   return recorded;
+}
+
+TeacherFile read_recorded_teacher(const RecordedTrial& recorded, const std::filesystem::path& path) {
+  const std::string bytes = read_regular_file(path, kMaxTeacherRecordingBytes);
+  const std::string sha256 = sha256_hex(bytes);
+  if (!recorded.teacher_sha256.empty() && sha256 != recorded.teacher_sha256) {
+    throw DataError(path.string() + ": SHA-256 " + sha256 + ", but the replay ran on a teacher's recording of SHA-256 " +
+                    recorded.teacher_sha256 +
+                    " (the record's teacher_sha256): give the recording it ran on (--teacher)");
+  }
+  return {parse_teacher_recording(bytes, path.string()), sha256};
 }
 
 SimulatedWriting recorded_writing(const RecordedTrial& recorded) {

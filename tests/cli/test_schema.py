@@ -137,6 +137,51 @@ class SchemaTest(unittest.TestCase):
                 self.assertIn("takes its default", result.stderr.decode())
         self.assertEqual((self.cwd / "now.csv").read_bytes(), (self.cwd / "v2.csv").read_bytes())
 
+    def test_a_replay_record_is_bound_to_its_teacher(self):
+        """A replay's record names its teacher's recording by SHA-256: re-run with that recording it gives the
+        same trace; with another recording at the same path (the folder it is re-run in holds another
+        teacher.json) it is refused, naming the file and both SHA-256; a version-3 record names none."""
+        import hashlib
+
+        for seed, name in ((3, "teacher.json"), (4, "other-teacher.json")):
+            made = self.run_cli("trial", "十", "--seed", seed, "--record", name)
+            self.assertEqual(made.returncode, 0, made.stderr.decode())
+        ran = self.run_cli("trial", "十", "--seed", "4", "--guidance-mode", "replay", "--teacher", "teacher.json",
+                           "--json", "replay.json", "--csv", "replay.csv")
+        self.assertEqual(ran.returncode, 0, ran.stderr.decode())
+        record = json.loads((self.cwd / "replay.json").read_text())
+        teacher_sha = hashlib.sha256((self.cwd / "teacher.json").read_bytes()).hexdigest()
+        self.assertEqual(record["specification"]["teacher_sha256"], teacher_sha)
+        self.assertEqual(list(self.validator("record").iter_errors(record["specification"])), [])
+        again = self.run_cli("trial", "--spec", "replay.json", "--csv", "again.csv")
+        self.assertEqual(again.returncode, 0, again.stderr.decode())
+        self.assertEqual((self.cwd / "again.csv").read_bytes(), (self.cwd / "replay.csv").read_bytes())
+        for given in (["--teacher", "other-teacher.json"], []):
+            if not given:  # the file the record names, replaced by another teacher's recording
+                (self.cwd / "teacher.json").write_bytes((self.cwd / "other-teacher.json").read_bytes())
+            refused = self.run_cli("trial", "--spec", "replay.json", "--csv", "wrong.csv", *given)
+            message = refused.stderr.decode()
+            self.assertEqual(refused.returncode, 1, message)
+            self.assertIn(teacher_sha, message)
+            self.assertIn("teacher_sha256", message)
+            self.assertFalse((self.cwd / "wrong.csv").exists())
+        # An earlier record named no teacher's SHA-256: it reads, says so, and runs on the file it names.
+        earlier = copy.deepcopy(record)
+        earlier["specification"]["version"] = 3
+        del earlier["specification"]["teacher_sha256"]
+        (self.cwd / "replay-v3.json").write_text(json.dumps(earlier))
+        old = self.run_cli("trial", "--spec", "replay-v3.json", "--csv", "v3.csv")
+        self.assertEqual(old.returncode, 0, old.stderr.decode())
+        self.assertIn("/specification/teacher_sha256", old.stderr.decode())
+        # A forged SHA-256, or one on a trial that is no replay, is refused by the reader, naming the pointer.
+        for document, value in ((record, "ABC"), (self.records["fixed"], teacher_sha)):
+            forged = copy.deepcopy(document)
+            forged["specification"]["teacher_sha256"] = value
+            (self.cwd / "forged.json").write_text(json.dumps(forged))
+            refused = self.run_cli("trial", "--spec", "forged.json", "--csv", "forged.csv")
+            self.assertNotEqual(refused.returncode, 0)
+            self.assertIn("/specification/teacher_sha256", refused.stderr.decode())
+
     def test_enum_spellings_are_the_options_spellings(self):
         help_text = self.run_cli("trial", "--help").stdout.decode()
         trial = self.schemas["specification"]["properties"]

@@ -19,6 +19,7 @@
 #include "calligraphy/render/force_law.hpp"
 #include "calligraphy/render/passivity.hpp"
 #include "calligraphy/render/safety_chain.hpp"
+#include "calligraphy/report/teacher_recording.hpp"
 #include "calligraphy/sim/simulated_writing.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/trial/trial_spec.hpp"
@@ -26,12 +27,13 @@
 
 namespace calligraphy {
 
-/// The "format" of the specification object, and the version written: 3 since the trial states its guidance
+/// The "format" of the specification object, and the version written: 4 since a replay's record names its
+/// teacher's recording by SHA-256 (`teacher_sha256`; earlier records name none and are not checked), 3 since the trial states its guidance
 /// stiffness (`TrialSpec::guidance_stiffness_n_per_m`; earlier records take its default), 2 since the
 /// simulated writer's settings are {"key", "value"} objects (version 1 wrote "key=value" strings). A reader
-/// reads versions 1 to 3 and refuses any other by its number.
+/// reads versions 1 to 4 and refuses any other by its number.
 inline constexpr std::string_view kRecordedTrialFormat = "calligraphy-trial-specification";
-inline constexpr int kRecordedTrialVersion = 3;
+inline constexpr int kRecordedTrialVersion = 4;
 inline constexpr int kOldestRecordedTrialVersion = 1;
 
 /// Everything that decides what a trial does, as it ran. Lengths in m, forces in N, times in s.
@@ -53,6 +55,10 @@ struct RecordedTrial {
   SceneLayout layout;           ///< where the characters were placed
   std::string scene_sha256;     ///< `scene_sha256` of the placed characters
   std::string library_version;  ///< the library that ran it (said, not checked)
+  /// Lower-case hex SHA-256 (FIPS 180-4) of the teacher's recording file a replay ran on, as its front-end
+  /// read it (`calligraphy trial --teacher`); empty when no file was read (not a replay, or a teacher given
+  /// as samples). A re-run reads the teacher through `read_recorded_teacher`, which refuses another file.
+  std::string teacher_sha256;
   /// Read from a record of an earlier version: the JSON pointers of fields added since, which took their
   /// documented defaults (empty for a record written by this version). Not written.
   std::vector<std::string> defaulted;
@@ -95,6 +101,19 @@ struct RecordedTrial {
 /// it is still there with the SHA-256 the record gives (/guidance/teacher). Throws DataError naming the path
 /// when it cannot be read, and what `read_recorded_trial` throws.
 [[nodiscard]] RecordedTrial read_recorded_trial_file(const std::string& path);
+
+/// A teacher's recording as read from its file, with the file's lower-case hex SHA-256 (what a record names).
+struct TeacherFile {
+  TeacherRecording recording;
+  std::string sha256;
+};
+
+/// The teacher's recording at `path` (a file named by `recorded.spec.teacher` or given instead; for a new
+/// trial, a default `RecordedTrial`) for running the replay `recorded`: read whole as
+/// `read_teacher_recording` reads it, and, when the record names the SHA-256 of the recording it ran on
+/// (`teacher_sha256`), checked to be that one. Throws DataError naming the file and both SHA-256 when it is
+/// another recording, and what `read_teacher_recording` throws.
+[[nodiscard]] TeacherFile read_recorded_teacher(const RecordedTrial& recorded, const std::filesystem::path& path);
 
 /// The simulated writer of `recorded` as it wrote (`RecordedTrial::writer`, its traits and what it had
 /// learned folded in): `rerun_trial`'s hand maker. Throws InvalidArgument for a profile out of range.
