@@ -47,7 +47,8 @@ std::vector<Vec2> polyline_head(const std::vector<Vec2>& points, double fraction
   for (std::size_t i = 1; i < points.size(); ++i) {
     const double step = (points[i] - points[i - 1]).norm();
     if (step >= left) {
-      if (step > 0.0 && left > 0.0) head.push_back(points[i - 1] + (points[i] - points[i - 1]) * (left / step));
+      if (step > 0.0 && left > 0.0)
+        head.push_back(points[i - 1] + (points[i] - points[i - 1]) * (left / step));
       return head;
     }
     left -= step;

@@ -3,10 +3,10 @@
 // person's pace, one after the other with a pause between them, as Hanzi Writer animates a character.
 //
 // Pace: a mean speed of 80 mm/s along the median, inside the 60-110 mm/s of the pointer traces that stroke
-// acceptance is measured with (docs/stroke-acceptance.md), each stroke timed as a minimum-jerk motion (Flash &
-// Hogan 1985: the arc length goes as 10 t^3 - 15 t^4 + 6 t^5 of the normalised time, slow at both ends, peak
-// speed 1.875 times the mean), so the pen is seen to start, run and stop as a hand does. A dot is given at
-// least kMinStrokeS to be seen. Between strokes the pen is lifted for `pause_s` (0.5 s: about a stroke's
+// acceptance is measured with (docs/stroke-acceptance.md), each stroke timed as a minimum-jerk motion (Flash
+// & Hogan 1985: the arc length goes as 10 t^3 - 15 t^4 + 6 t^5 of the normalised time, slow at both ends,
+// peak speed 1.875 times the mean), so the pen is seen to start, run and stop as a hand does. A dot is given
+// at least kMinStrokeS to be seen. Between strokes the pen is lifted for `pause_s` (0.5 s: about a stroke's
 // time, shorter than Hanzi Writer's default one second between strokes, delayBetweenStrokes).
 #include <cstddef>
 #include <vector>

@@ -8,7 +8,7 @@
 namespace calligraphy::trainer {
 namespace {
 
-// Millimetres as a person reads them: whole above 2 mm, one decimal below.
+// A distance as a person reads it: whole millimetres from 2 mm, one decimal below.
 std::string millimetres(double metres) {
   const double mm = std::abs(metres) * 1e3;
   char text[32];
@@ -37,15 +37,17 @@ std::string device_line(LearnerDevice device, bool guidance) {
     case LearnerDevice::mouse:
       return "Hold the left mouse button and draw each stroke; a mouse cannot push back, so nothing is felt.";
     case LearnerDevice::mouse_hand:
-      return guidance ? "Hold the left mouse button and draw each stroke; the mouse moves a simulated pen that is "
-                        "pulled towards the stroke on screen, but a mouse cannot push back, so nothing is felt."
-                      : "Hold the left mouse button and draw each stroke; the mouse moves a simulated pen, and "
-                        "a mouse cannot push back, so nothing is felt.";
+      return guidance
+                 ? "Hold the left mouse button and draw each stroke; the mouse moves a simulated pen that is "
+                   "pulled towards the stroke on screen, but a mouse cannot push back, so nothing is felt."
+                 : "Hold the left mouse button and draw each stroke; the mouse moves a simulated pen, and "
+                   "a mouse cannot push back, so nothing is felt.";
     case LearnerDevice::haptic:
-      return guidance ? "Press the pen to the paper at the red circle and draw each stroke; you feel the paper, "
-                        "and the pen guides your hand along the stroke."
-                      : "Press the pen to the paper at the red circle and draw each stroke; you feel the paper "
-                        "only: no guidance in this trial.";
+      return guidance
+                 ? "Press the pen to the paper at the red circle and draw each stroke; you feel the paper, "
+                   "and the pen guides your hand along the stroke."
+                 : "Press the pen to the paper at the red circle and draw each stroke; you feel the paper "
+                   "only: no guidance in this trial.";
     case LearnerDevice::simulated_writer:
       return "A simulated writer writes this trial: watch it write; nothing is needed from you.";
     case LearnerDevice::simulated_device:
@@ -74,7 +76,8 @@ std::string offset_words(const Vec2& offset_m) {
   return text;
 }
 
-Feedback stroke_written(std::size_t stroke_1based, double mean_deviation_m, const StrokeAcceptance& acceptance) {
+Feedback stroke_written(std::size_t stroke_1based, double mean_deviation_m,
+                        const StrokeAcceptance& acceptance) {
   Feedback f;
   f.text = stroke_label(stroke_1based);
   if (!std::isfinite(mean_deviation_m)) {
@@ -84,7 +87,9 @@ Feedback stroke_written(std::size_t stroke_1based, double mean_deviation_m, cons
   }
   const bool good = mean_deviation_m <= 0.5 * acceptance.mean_deviation_m;
   f.text += good ? ": good, " : ": written, ";
-  f.text += millimetres(mean_deviation_m);
+  char mm[32];  // an average to a tenth of a millimetre
+  std::snprintf(mm, sizeof mm, "%.1f mm", mean_deviation_m * 1e3);
+  f.text += mm;
   f.text += " off on average";
   if (!good) f.text += "; keep to the middle of the stroke";
   f.tone = good ? FeedbackTone::good : FeedbackTone::fix;
@@ -104,7 +109,10 @@ Feedback stroke_refused(const RefusedAttempt& attempt) {
       return f;
     case StrokeRefusal::wrong_place:
       if (attempt.start_offset_m && attempt.start_offset_m->norm() > attempt.start_radius_m) {
-        f.text = stroke + ": started " + offset_words(*attempt.start_offset_m) + " of the start";
+        // "left of the start", "right of the start"; "above the start", "... and 2 mm below the start"
+        const std::string where = offset_words(*attempt.start_offset_m);
+        const bool vertical_last = where.ends_with("above") || where.ends_with("below");
+        f.text = stroke + ": started " + where + (vertical_last ? " the start" : " of the start");
       } else {
         f.text = stroke + ": off the stroke; follow the outline";
       }
@@ -119,8 +127,8 @@ Feedback stroke_refused(const RefusedAttempt& attempt) {
       return f;
     case StrokeRefusal::wrong_stroke:
       if (attempt.written_instead_1based && *attempt.written_instead_1based != attempt.stroke_1based) {
-        f.text = "That was stroke " + std::to_string(*attempt.written_instead_1based) + "; now write stroke " +
-                 std::to_string(attempt.stroke_1based);
+        f.text = "That was stroke " + std::to_string(*attempt.written_instead_1based) +
+                 "; now write stroke " + std::to_string(attempt.stroke_1based);
       } else {
         f.text = stroke + ": that was another stroke's shape";
       }

@@ -14,11 +14,11 @@ namespace calligraphy::trainer {
 
 /// The kind of device a learner holds, as far as what they feel is concerned.
 enum class LearnerDevice {
-  mouse,              ///< "mouse": a pointer, no force output
-  mouse_hand,         ///< "mouse-hand": the mouse moves a simulated pen that guidance pulls; nothing is felt
-  haptic,             ///< a haptic device (hardware): the paper and the guidance are felt through the pen
-  simulated_writer,   ///< the simulated writer writes on a simulated device: nothing to do but watch
-  simulated_device,   ///< a simulated or emulated device without a hand on it (nothing is felt)
+  mouse,             ///< "mouse": a pointer, no force output
+  mouse_hand,        ///< "mouse-hand": the mouse moves a simulated pen that guidance pulls; nothing is felt
+  haptic,            ///< a haptic device (hardware): the paper and the guidance are felt through the pen
+  simulated_writer,  ///< the simulated writer writes on a simulated device: nothing to do but watch
+  simulated_device,  ///< a simulated or emulated device without a hand on it (nothing is felt)
 };
 
 /// The kind of `device` (a registry name): `hardware` from the registry's listing, `simulated_writer` from

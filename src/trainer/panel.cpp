@@ -324,8 +324,7 @@ void learner_panel(const PanelInput& input) {
   ImGui::PopStyleColor();
   ImGui::Separator();
   if (input.demonstrating) {
-    large(input, kHintColour,
-          "Watch: " + stroke_of(input.demonstrating->first, input.demonstrating->second));
+    large(input, kHintColour, "Watch: " + stroke_of(input.demonstrating->first, input.demonstrating->second));
     ImGui::TextWrapped("Each stroke is drawn in order, from its start; writing starts after the last one.");
   } else if (view != nullptr) {
     const DisplaySnapshot& s = view->snapshot;
@@ -379,7 +378,8 @@ PanelAction draw_panel(const WindowLayout& layout, double panel_width_px, const 
   PanelAction action = PanelAction::none;
   if (input.practice_buttons) {
     ImGui::Separator();
-    if (ImGui::Button(input.demonstrating ? "Skip (D)" : "Demonstrate (D)")) action = PanelAction::demonstrate;
+    if (ImGui::Button(input.demonstrating ? "Skip (D)" : "Demonstrate (D)"))
+      action = PanelAction::demonstrate;
     ImGui::SameLine();
     if (ImGui::Button("Restart (R)")) action = PanelAction::restart;
     ImGui::SameLine();

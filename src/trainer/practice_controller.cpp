@@ -291,7 +291,7 @@ void PracticeController::finish_trial(QuizLog& quiz_log) {
     log_stop("device_fault");
   }
   const bool last = view.character + 1 == options_.characters.size();
-  if (last) last_character_ended_ = true;  // after the last character's last stroke
+  if (last) last_character_ended_ = true;                     // after the last character's last stroke
   if (unattended() && pending_ != NextAction::demonstrate) {  // a demonstration asked for comes first
     if (last) {
       close_window_ = true;

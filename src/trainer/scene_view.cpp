@@ -157,7 +157,8 @@ void draw_quiz_ink(ImDrawList& draw, const WindowLayout& layout, const TrialView
 }
 
 // Screen area [px^2] of a stroke's outline polygons (shoelace), to size the demonstration's ink.
-double outline_area_px2(const WindowLayout& layout, const CharacterArt& art, std::size_t box, std::size_t stroke) {
+double outline_area_px2(const WindowLayout& layout, const CharacterArt& art, std::size_t box,
+                        std::size_t stroke) {
   double area = 0.0;
   for (std::size_t p = 0; p < art.polygons.size(); ++p) {
     if (art.polygon_stroke[p] != stroke) continue;
@@ -237,7 +238,8 @@ void draw_demonstration(ImDrawList& draw, const WindowLayout& layout, const std:
     const PlacedStroke& stroke = demo.placed->strokes[k];
     const double fraction = k < demo.frame.stroke ? 1.0 : demo.frame.fraction;
     if (fraction > 0.0)
-      draw_stroke_drawn(draw, layout, character_art, demo.box, k, stroke.median_m, fraction, kDemoInk, to_screen);
+      draw_stroke_drawn(draw, layout, character_art, demo.box, k, stroke.median_m, fraction, kDemoInk,
+                        to_screen);
   }
   for (std::size_t k = 0; k < shown; ++k) {
     const PlacedStroke& stroke = demo.placed->strokes[k];
@@ -267,7 +269,8 @@ void draw_shown_strokes(ImDrawList& draw, const WindowLayout& layout, const std:
     const DemoFrame frame = once.at(std::chrono::duration<double>(now - shown.at).count());
     draw_stroke_drawn(draw, layout, character_art, box, shown.stroke, stroke.median_m,
                       frame.done ? 1.0 : frame.fraction, colour, to_screen);
-    if (number && !stroke.median_m.empty()) draw_number(draw, to_screen(stroke.median_m.front()), shown.stroke + 1);
+    if (number && !stroke.median_m.empty())
+      draw_number(draw, to_screen(stroke.median_m.front()), shown.stroke + 1);
   };
   if (view.assisted) draw_once(*view.assisted, kDemoInk, true);
   const DisplaySnapshot& s = view.snapshot;

@@ -28,8 +28,8 @@ struct TrainerOptions {
   /// Where `device` is created (not owned; outlives the run): the program's registry, with the trainer's
   /// pointer devices added (`register_trainer_devices`). Required.
   const DeviceRegistry* registry = nullptr;
-  bool simulated_writer = false;             ///< the simulated writer writes (device with a hand port)
-  std::string writer_profile = "novice";     ///< novice or skilled
+  bool simulated_writer = false;          ///< the simulated writer writes (device with a hand port)
+  std::string writer_profile = "novice";  ///< novice or skilled
   std::uint64_t seed = 0;
   bool guidance = true;
   GuidanceMode guidance_mode = GuidanceMode::fixed;  ///< how guidance attracts (M cycles it)

@@ -17,8 +17,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <optional>
-#include <utility>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
@@ -145,7 +145,8 @@ void TrainerApp::render(bool take_screenshot) {
   panel.force_felt = learner_device_ == LearnerDevice::haptic;
   panel.device_line = device_line(learner_device_, view != nullptr ? view->guidance : panel.next_guidance);
   if (quit_seen_ && practice_ && practice_->trial_running()) panel.status = "ending the trial...";
-  // The panel's text of the picture at the end, for tests and tools (CALLIGRAPHY_PANEL_TEXT, docs/trainer.md).
+  // The panel's text of the picture at the end, for tests and tools (CALLIGRAPHY_PANEL_TEXT,
+  // docs/trainer.md).
   const char* panel_text = std::getenv("CALLIGRAPHY_PANEL_TEXT");
   const bool log_panel = take_screenshot && panel_text != nullptr && *panel_text != '\0';
   if (log_panel) {

@@ -15,8 +15,8 @@
 
 #include "calligraphy/core/device_types.hpp"
 #include "trainer/hosted_session_view.hpp"
-#include "trainer/learner_text.hpp"
 #include "trainer/layout.hpp"
+#include "trainer/learner_text.hpp"
 #include "trainer/practice_controller.hpp"
 #include "trainer/quiz_log.hpp"
 #include "trainer/scene_view.hpp"

@@ -77,7 +77,7 @@ struct TrialView {
   std::optional<Shown> assisted;
   /// The active stroke's hint (DisplaySnapshot::hint_shown), drawn once from `at` and then kept as a path.
   std::optional<Shown> hint;
-  bool ended = false;               ///< the trial_ended event arrived
+  bool ended = false;  ///< the trial_ended event arrived
   TrialEnd end = TrialEnd::completed;
   // Filled in when the worker's result is taken.
   bool have_result = false;

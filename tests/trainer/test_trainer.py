@@ -515,7 +515,7 @@ class TrainerTest(unittest.TestCase):
         self.write_like_a_person("mouse-hand", settle_s=0.45, press_s=0.3)
 
     def test_a_refused_stroke_stays_faded_and_the_panel_says_why(self):
-        trainer = self.start("十", "--device", "mouse", "--screenshot", "refused.png")
+        trainer = self.start("十", "--device", "mouse", "--no-demo", "--screenshot", "refused.png")
         (box,) = trainer.boxes()
         hand = trainer.hand(box, seed=11)
         across, down = medians("十")
@@ -678,6 +678,66 @@ class PeopleOutputTest(unittest.TestCase):
             self.assertFalse(line.startswith("box "), "a box line without CALLIGRAPHY_PRINT_BOXES: " + line)
             self.assertNotRegex(line, r"\bnan\b", line)
         self.assertEqual(out, "", "train prints nothing on standard output")
+
+    def panel_text(self, *args):
+        """`train ARGS --screenshot` to its end, with the panel's text of the picture at the end written to a file
+        (CALLIGRAPHY_PANEL_TEXT, docs/trainer.md); returns that text, stdout and stderr."""
+        text = pathlib.Path(self.folder) / "panel.txt"
+        environment = dict(os.environ, CALLIGRAPHY_PANEL_TEXT=str(text))
+        self.trainer = Trainer(*args, "--screenshot", "panel.png", folder=self.folder, environment=environment)
+        status = self.trainer.wait(timeout=60)
+        self.assertEqual(status, 0, self.trainer.errors())
+        self.assertTrue(text.exists(), "no panel text: " + self.trainer.errors())
+        return text.read_text(encoding="utf-8"), self.trainer.output(), self.trainer.errors()
+
+    def test_the_learner_view_speaks_to_a_learner_and_says_what_to_do_with_a_mouse(self):
+        panel, out, err = self.panel_text("一", "--device", "mouse", "--data", SAMPLE, "--exit-after", "1.5")
+        self.assert_for_people(out, err)
+        self.assertIn("Hold the left mouse button and draw each stroke; a mouse cannot push back, so nothing is "
+                      "felt.", panel)
+        self.assertIn("Stroke 1 of 1", panel)
+        for word in (r"\bSS\b", r"\bAS\b", r"\bCS\b", r"\bWS\b", r"\btick\b", r"\belement\b",
+                     r"guidance on", r"\bN\b.*\bnormal\b"):
+            self.assertNotRegex(panel, word, "an engineer's term in the learner's view:\n" + panel)
+
+    def test_the_engineer_view_shows_states_ticks_elements_and_forces(self):
+        panel, out, err = self.panel_text("一", "--device", "mouse", "--data", SAMPLE, "--exit-after", "1.5",
+                                          "--engineer")
+        self.assert_for_people(out, err)
+        self.assertRegex(panel, r"\b(SS|AS|CS|WS)\b")
+        self.assertRegex(panel, r"\btick \d+")
+        self.assertRegex(panel, r"\belement \d+")
+        self.assertIn("force in plane", panel)
+        self.assertNotRegex(panel, r"guidance on\b(?!, not felt)", "a mouse feels no guidance:\n" + panel)
+
+    def test_the_stroke_order_is_shown_before_writing_and_no_trial_runs_meanwhile(self):
+        self.trainer = Trainer("十", "--device", "mouse", folder=self.folder)
+        self.trainer.wait_for("calligraphy train: demonstrating the stroke order of 十 (2 strokes")
+        window = self.trainer.window()
+        xdotool("windowfocus", "--sync", window)
+        xdotool("key", "--window", window, "q")
+        self.assertEqual(self.trainer.wait(timeout=30), 0, self.trainer.errors())
+        self.assertNotIn("trial 1", self.trainer.errors(), "a trial ran during the demonstration")
+        self.assertEqual(self.trainer.output(), "")
+
+    def test_d_ends_the_trial_and_demonstrates_the_stroke_order(self):
+        text = pathlib.Path(self.folder) / "panel.txt"
+        environment = boxes_environment(dict(os.environ, CALLIGRAPHY_PANEL_TEXT=str(text)))
+        self.trainer = Trainer("十", "--device", "mouse", "--no-demo", "--screenshot", "demo.png", folder=self.folder,
+                               environment=environment)
+        self.trainer.boxes()
+        self.assertNotIn("demonstrating", self.trainer.errors(), "--no-demo: writing starts at once")
+        window = self.trainer.window()
+        xdotool("windowfocus", "--sync", window)
+        xdotool("key", "--window", window, "d")
+        self.trainer.wait_for("trial 1 十: interrupted by D (demonstration)")
+        self.trainer.wait_for("calligraphy train: demonstrating the stroke order of 十")
+        xdotool("key", "--window", window, "q")
+        self.assertEqual(self.trainer.wait(timeout=30), 0, self.trainer.errors())
+        keep_artifact(pathlib.Path(self.folder) / "demo.png")
+        panel = text.read_text(encoding="utf-8")
+        self.assertRegex(panel, r"Watch: Stroke [12] of 2")
+        self.assertNotIn("trial 2", self.trainer.errors(), "no trial runs during the demonstration")
 
     def test_a_trial_stopped_by_exit_after_says_what_it_wrote_and_kept(self):
         status, out, err = self.run_train("永", "--writer", "simulated", "--session", "out", "--exit-after", "4")
