@@ -56,6 +56,22 @@ std::string device_line(LearnerDevice device, bool guidance) {
   return {};
 }
 
+std::string guidance_words(LearnerDevice device, bool guidance) {
+  if (!guidance) return "guidance off";
+  switch (device) {
+    case LearnerDevice::haptic:
+      return "guidance on";
+    case LearnerDevice::mouse_hand:
+      return "guidance on the simulated pen, not felt";
+    case LearnerDevice::simulated_writer:
+      return "guidance on the simulated writer's pen";
+    case LearnerDevice::mouse:
+    case LearnerDevice::simulated_device:
+      break;
+  }
+  return "no force output: guidance not felt";
+}
+
 std::string stroke_of(std::size_t stroke_1based, std::size_t strokes) {
   if (stroke_1based > strokes) return "Every stroke written";
   return stroke_label(stroke_1based) + " of " + std::to_string(strokes);
@@ -65,7 +81,7 @@ std::string offset_words(const Vec2& offset_m) {
   const double ax = std::abs(offset_m.x());
   const double ay = std::abs(offset_m.y());
   const double larger = std::max(ax, ay);
-  const auto named = [&](double a) { return a >= larger / 3.0 || a >= 0.001; };
+  const auto named = [&](double a) { return a >= larger / 3.0; };
   std::string text;
   if (ax > 0.0 && named(ax)) text += millimetres(ax) + (offset_m.x() < 0.0 ? " left" : " right");
   if (ay > 0.0 && named(ay)) {

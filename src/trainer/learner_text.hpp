@@ -30,13 +30,18 @@ enum class LearnerDevice {
 /// trial's guidance (on a haptic device it is felt; elsewhere nothing is, and no line says "guidance on").
 [[nodiscard]] std::string device_line(LearnerDevice device, bool guidance);
 
+/// The guidance as the engineer's panel names it, true to what acts on whom: "guidance on" (felt) on a
+/// haptic device only; "guidance on the simulated pen, not felt" (mouse-hand), "guidance on the simulated
+/// writer's pen", "no force output: guidance not felt" (mouse, another device nothing moves); "guidance off".
+[[nodiscard]] std::string guidance_words(LearnerDevice device, bool guidance);
+
 /// "Stroke k of n" (k 1-based), or "Every stroke written" once k > n.
 [[nodiscard]] std::string stroke_of(std::size_t stroke_1based, std::size_t strokes);
 
 /// Where a point lies from a target, in millimetres and the paper's directions as the learner sees them
 /// (x right, y away from the writer: "above"): "3 mm left", "2 mm left and 4 mm above", "0.5 mm right".
-/// `offset_m` is the point minus the target [m]. A component less than a third of the larger one (and under
-/// 1 mm) is left out.
+/// `offset_m` is the point minus the target [m]. A component less than a third of the larger one is left
+/// out.
 [[nodiscard]] std::string offset_words(const Vec2& offset_m);
 
 /// How a line of feedback reads: praise, a correction, or a hint.

@@ -227,11 +227,12 @@ void engineer_panel(const PanelInput& input) {
   ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(0.35f, 0.35f, 0.35f, 1));
   ImGui::TextWrapped("%s", input.device_line.c_str());
   ImGui::PopStyleColor();
-  // "guidance on" only where it is felt: the mouse outputs no force, mouse-hand's pulls a simulated pen.
-  const char* felt = input.force_felt ? "on" : "on, not felt (no force output)";
-  ImGui::Text("%s, guidance %s", view->condition.c_str(), view->guidance ? felt : "off");
+  // "guidance on" only where it is felt (guidance_words): the mouse outputs no force, mouse-hand's pulls a
+  // simulated pen.
+  ImGui::TextWrapped("%s, %s", view->condition.c_str(),
+                     guidance_words(input.device_kind, view->guidance).c_str());
   if (input.session.empty() && !input.quiz)
-    ImGui::TextWrapped("next: guidance %s, %s", input.next_guidance ? felt : "off",
+    ImGui::TextWrapped("next: %s, %s", guidance_words(input.device_kind, input.next_guidance).c_str(),
                        next_mode_text(input).c_str());
   ImGui::Separator();
   if (input.large_font != nullptr) ImGui::PushFont(input.large_font);

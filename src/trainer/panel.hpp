@@ -10,6 +10,7 @@
 
 #include "calligraphy/model/stroke_progress.hpp"
 #include "trainer/layout.hpp"
+#include "trainer/learner_text.hpp"
 #include "trainer/trial_view.hpp"
 
 struct ImFont;
@@ -31,9 +32,9 @@ struct PanelInput {
   std::string prompt;   ///< what the person is asked to do now (start, rest), shown large; may be empty
   double frame_rate_hz = 0.0;
   ImFont* large_font = nullptr;
-  bool engineer = false;    ///< the engineer's panel; else the learner's
-  std::string device_line;  ///< what to do with the device (learner_text.hpp)
-  bool force_felt = true;   ///< the device pushes back (a haptic device): guidance can be felt
+  bool engineer = false;                              ///< the engineer's panel; else the learner's
+  std::string device_line;                            ///< what to do with the device (learner_text.hpp)
+  LearnerDevice device_kind = LearnerDevice::haptic;  ///< what the guidance acts on (guidance_words)
   /// A demonstration runs: the stroke being drawn (1-based) and the character's strokes.
   std::optional<std::pair<std::size_t, std::size_t>> demonstrating;
   bool practice_buttons = false;  ///< `train`: the demonstrate, restart and next buttons

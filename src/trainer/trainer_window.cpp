@@ -142,7 +142,7 @@ void TrainerApp::render(bool take_screenshot) {
   panel.frame_rate_hz = ImGui::GetIO().Framerate;
   panel.large_font = large_font_;
   if (demo) panel.character = options_.characters[demo->box].utf8;
-  panel.force_felt = learner_device_ == LearnerDevice::haptic;
+  panel.device_kind = learner_device_;
   panel.device_line = device_line(learner_device_, view != nullptr ? view->guidance : panel.next_guidance);
   if (quit_seen_ && practice_ && practice_->trial_running()) panel.status = "ending the trial...";
   // The panel's text of the picture at the end, for tests and tools (CALLIGRAPHY_PANEL_TEXT,

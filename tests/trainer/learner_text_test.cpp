@@ -1,13 +1,18 @@
 // The trainer's words for a learner and the demonstration's timing (src/trainer/learner_text.hpp,
-// demonstration.hpp): pure functions, tested without a window.
+// demonstration.hpp): pure functions, tested without a window; and the trial's view (trial_view.hpp), which
+// turns the display channel's events into those words.
 #include "trainer/learner_text.hpp"
 
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <vector>
 
+#include "calligraphy/model/character_library.hpp"
+#include "embedded_scenes.hpp"
 #include "trainer/demonstration.hpp"
+#include "trainer/trial_view.hpp"
 
 using namespace calligraphy;
 using namespace calligraphy::trainer;
@@ -151,4 +156,83 @@ TEST_CASE("a start above or below reads without 'of'") {
   CHECK(stroke_refused(a).text == "Stroke 2: started 7 mm above the start");
   a.start_offset_m = Vec2(0.009, 0.0);
   CHECK(stroke_refused(a).text == "Stroke 2: started 9 mm right of the start");
+}
+
+TEST_CASE("the engineer's guidance words say 'guidance on' only on a haptic device") {
+  CHECK(guidance_words(LearnerDevice::haptic, true) == "guidance on");
+  CHECK(guidance_words(LearnerDevice::mouse, true) == "no force output: guidance not felt");
+  CHECK(guidance_words(LearnerDevice::mouse_hand, true) == "guidance on the simulated pen, not felt");
+  CHECK(guidance_words(LearnerDevice::simulated_writer, true) == "guidance on the simulated writer's pen");
+  for (const LearnerDevice d : {LearnerDevice::mouse, LearnerDevice::mouse_hand, LearnerDevice::haptic,
+                                LearnerDevice::simulated_writer, LearnerDevice::simulated_device})
+    CHECK(guidance_words(d, false) == "guidance off");
+}
+
+// ---- The trial's view turns the display channel's events into the learner's lines (trial_view.cpp).
+
+namespace {
+TracePoint trace_point(std::uint64_t tick, const Vec2& at_m, InteractionState state) {
+  TracePoint p;
+  p.tick = tick;
+  p.hip_m = DisplayPoint3{at_m.x(), at_m.y(), state == InteractionState::separation ? 0.005 : -0.001};
+  p.state = state;
+  return p;
+}
+}  // namespace
+
+TEST_CASE("a refused attempt's line names where it started against the stroke's start") {
+  const Scene& scene = calligraphy::testing::embedded_scene(U'十');
+  DisplayChannel channel;
+  TrialView view;
+  view.scene = &scene;
+  const std::vector<int> ids = typical_ids_of(CharacterLibrary::embedded().load(U'十'));
+  const PlacedStroke& first = scene.characters[0].strokes[0];
+  // The pen lands 6 mm left of stroke 1's start and 1 mm above, comes to the start and writes a little.
+  const Vec2 landing = first.start() + Vec2(-0.006, 0.001);
+  std::uint64_t tick = 1;
+  channel.push_trace(trace_point(tick++, landing, InteractionState::adjusting));
+  channel.push_trace(trace_point(tick++, first.start(), InteractionState::writing));
+  channel.push_trace(trace_point(tick++, first.start() + Vec2(0.002, 0.0), InteractionState::writing));
+  channel.push_trace(trace_point(tick, first.start() + Vec2(0.002, 0.0), InteractionState::separation));
+  DisplayEvent abandoned;
+  abandoned.kind = DisplayEventKind::stroke_abandoned;
+  abandoned.tick = tick;
+  abandoned.refusal = StrokeRefusal::wrong_place;
+  channel.push_event(abandoned);
+  view.consume(channel, ids);
+  REQUIRE(view.feedback);
+  CHECK(view.feedback->text == "Stroke 1: started 6 mm left of the start");
+  CHECK(view.feedback->tone == FeedbackTone::fix);
+
+  DisplayEvent written;
+  written.kind = DisplayEventKind::stroke_completed;
+  written.tick = ++tick;
+  written.mean_deviation_m = 0.0004;
+  channel.push_event(written);
+  view.consume(channel, ids);
+  CHECK(view.feedback->text == "Stroke 1: good, 0.4 mm off on average");
+
+  DisplaySnapshot hinted;
+  hinted.tick = ++tick;
+  hinted.stroke = 1;
+  hinted.stroke_index = 1;
+  hinted.strokes_total = 2;
+  hinted.misses = 3;
+  hinted.hint_shown = true;
+  channel.publish(hinted);
+  view.consume(channel, ids);
+  CHECK(view.feedback->text == "Here is stroke 2: follow the blue path from its start");
+  REQUIRE(view.hint);
+  CHECK(view.hint->stroke == 1);
+
+  DisplayEvent assisted;
+  assisted.kind = DisplayEventKind::stroke_assisted;
+  assisted.tick = ++tick;
+  assisted.stroke = 1;
+  assisted.stroke_index = 1;
+  channel.push_event(assisted);
+  view.consume(channel, ids);
+  CHECK(view.feedback->text == "Stroke 2 shown and counted as assisted");
+  REQUIRE(view.assisted);
+  CHECK(view.assisted->stroke == 1);
 }
