@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 
 #include "calligraphy/model/polyline.hpp"
@@ -156,24 +157,6 @@ void draw_quiz_ink(ImDrawList& draw, const WindowLayout& layout, const TrialView
   draw_ink(draw, layout, view, view.quiz->open_run(), kQuizInk);
 }
 
-// Screen area [px^2] of a stroke's outline polygons (shoelace), to size the demonstration's ink.
-double outline_area_px2(const WindowLayout& layout, const CharacterArt& art, std::size_t box,
-                        std::size_t stroke) {
-  double area = 0.0;
-  for (std::size_t p = 0; p < art.polygons.size(); ++p) {
-    if (art.polygon_stroke[p] != stroke) continue;
-    const OutlinePolygon& polygon = art.polygons[p];
-    double twice = 0.0;
-    for (std::size_t i = 0; i < polygon.size(); ++i) {
-      const Vec2 a = layout.data_to_screen(box, polygon[i]);
-      const Vec2 b = layout.data_to_screen(box, polygon[(i + 1) % polygon.size()]);
-      twice += a.x() * b.y() - b.x() * a.y();
-    }
-    area += std::abs(twice) / 2.0;
-  }
-  return area;
-}
-
 void fill_stroke(ImDrawList& draw, const WindowLayout& layout, const CharacterArt& art, std::size_t box,
                  std::size_t stroke, ImU32 colour) {
   const ImDrawListFlags flags = draw.Flags;
@@ -187,32 +170,91 @@ void fill_stroke(ImDrawList& draw, const WindowLayout& layout, const CharacterAr
   draw.Flags = flags;
 }
 
-// A stroke being drawn by a demonstration: the first `fraction` of its median (mapped to the screen by
-// `to_screen`) as ink about as wide as the stroke (its outline's area over the median's length); the whole
-// outline filled once drawn.
+// Arc length along `line` (screen points) of the point of it nearest to `p`.
+double arc_of_nearest(const std::vector<Vec2>& line, const Vec2& p) {
+  double best_distance = std::numeric_limits<double>::infinity();
+  double best_arc = 0.0;
+  double arc = 0.0;
+  for (std::size_t i = 1; i < line.size(); ++i) {
+    const Vec2 d = line[i] - line[i - 1];
+    const double length = d.norm();
+    const double t = length > 0.0 ? std::clamp((p - line[i - 1]).dot(d) / (length * length), 0.0, 1.0) : 0.0;
+    const double distance = (line[i - 1] + t * d - p).norm();
+    if (distance < best_distance) {
+      best_distance = distance;
+      best_arc = arc + t * length;
+    }
+    arc += length;
+  }
+  return best_arc;
+}
+
+// Fills the part of triangle (a, b, c) whose pieces lie, along `median`, at most `reached` from its start:
+// the triangle is split at its longest edge until the pieces are smaller than kPiecePx, so that the ink
+// reveals the outline along the median as a brush would, never leaving it.
+constexpr double kPiecePx = 5.0;
+void fill_reached(ImDrawList& draw, const Vec2& a, const Vec2& b, const Vec2& c,
+                  const std::vector<Vec2>& median, double reached, ImU32 colour, int depth) {
+  const double ab = (b - a).norm();
+  const double bc = (c - b).norm();
+  const double ca = (a - c).norm();
+  if (std::max({ab, bc, ca}) <= kPiecePx || depth > 14) {
+    if (arc_of_nearest(median, (a + b + c) / 3.0) <= reached)
+      draw.AddTriangleFilled(im(a), im(b), im(c), colour);
+    return;
+  }
+  if (ab >= bc && ab >= ca) {
+    const Vec2 m = (a + b) / 2.0;
+    fill_reached(draw, a, m, c, median, reached, colour, depth + 1);
+    fill_reached(draw, m, b, c, median, reached, colour, depth + 1);
+  } else if (bc >= ca) {
+    const Vec2 m = (b + c) / 2.0;
+    fill_reached(draw, a, b, m, median, reached, colour, depth + 1);
+    fill_reached(draw, a, m, c, median, reached, colour, depth + 1);
+  } else {
+    const Vec2 m = (c + a) / 2.0;
+    fill_reached(draw, a, b, m, median, reached, colour, depth + 1);
+    fill_reached(draw, m, b, c, median, reached, colour, depth + 1);
+  }
+}
+
+// A stroke being drawn by a demonstration: its outline filled as far as the first `fraction` of its median
+// (mapped to the screen by `to_screen`) reaches, as Hanzi Writer reveals a stroke through the outline; the
+// whole outline once drawn. Without an outline, ink along the median.
 template <typename ToScreen>
 void draw_stroke_drawn(ImDrawList& draw, const WindowLayout& layout, const CharacterArt* art, std::size_t box,
                        std::size_t stroke, const std::vector<Vec2>& median_m, double fraction, ImU32 colour,
                        const ToScreen& to_screen) {
-  if (fraction >= 1.0 && art != nullptr && stroke < art->reference.size()) {
+  const bool outlined = art != nullptr && std::find(art->polygon_stroke.begin(), art->polygon_stroke.end(),
+                                                    stroke) != art->polygon_stroke.end();
+  if (fraction >= 1.0 && outlined) {
     fill_stroke(draw, layout, *art, box, stroke, colour);
     return;
   }
   std::vector<Vec2> screen;
   for (const Vec2& p : median_m) screen.push_back(to_screen(p));
-  const double length_px = polyline_length(screen);
-  double width_px = 10.0;
-  if (art != nullptr && length_px > 0.0)
-    width_px = std::clamp(0.85 * outline_area_px2(layout, *art, box, stroke) / length_px, 4.0, 60.0);
+  if (outlined && screen.size() > 1) {
+    const double reached = fraction * polyline_length(screen);
+    const ImDrawListFlags flags = draw.Flags;
+    draw.Flags &= ~ImDrawListFlags_AntiAliasedFill;  // no seams between the pieces
+    for (std::size_t p = 0; p < art->polygons.size(); ++p) {
+      if (art->polygon_stroke[p] != stroke) continue;
+      std::vector<Vec2> points;
+      for (const Vec2& v : art->polygons[p]) points.push_back(layout.data_to_screen(box, v));
+      for (const auto& t : art->triangles[p]) {
+        fill_reached(draw, points[static_cast<std::size_t>(t[0])], points[static_cast<std::size_t>(t[1])],
+                     points[static_cast<std::size_t>(t[2])], screen, reached, colour, 0);
+      }
+    }
+    draw.Flags = flags;
+    return;
+  }
   const std::vector<Vec2> head = polyline_head(screen, fraction);
   std::vector<ImVec2> points;
   for (const Vec2& p : head) points.push_back(im(p));
-  const auto r = static_cast<float>(width_px / 2.0);
-  if (!points.empty()) draw.AddCircleFilled(points.front(), r, colour, 24);
-  if (points.size() > 1) {
-    draw.AddPolyline(points.data(), static_cast<int>(points.size()), colour, 0, static_cast<float>(width_px));
-    for (std::size_t i = 1; i < points.size(); ++i) draw.AddCircleFilled(points[i], r, colour, 24);  // joins
-  }
+  constexpr float kInkPx = 10.0f;
+  if (!points.empty()) draw.AddCircleFilled(points.front(), kInkPx / 2, colour, 24);
+  if (points.size() > 1) draw.AddPolyline(points.data(), static_cast<int>(points.size()), colour, 0, kInkPx);
 }
 
 // A stroke's number (1-based) in a red-ringed white disc beside its start.
