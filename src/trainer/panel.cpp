@@ -382,8 +382,10 @@ PanelAction draw_panel(const WindowLayout& layout, double panel_width_px, const 
     if (ImGui::Button(input.demonstrating ? "Skip (D)" : "Demonstrate (D)"))
       action = PanelAction::demonstrate;
     ImGui::SameLine();
-    if (ImGui::Button("Restart (R)")) action = PanelAction::restart;
-    ImGui::SameLine();
+    if (!input.demonstrating) {  // a demonstration is followed by the character's trial anyway
+      if (ImGui::Button("Restart (R)")) action = PanelAction::restart;
+      ImGui::SameLine();
+    }
     if (ImGui::Button("Next (N)")) action = PanelAction::next;
     if (!input.engineer) ImGui::TextDisabled("Q / Esc  quit");
   }

@@ -195,12 +195,17 @@ void PracticeController::follow_trial(bool quitting, QuizLog& quiz_log) {
 }
 
 void PracticeController::start_next_trial() {
-  if (demo_) {  // the trial waits for the demonstration's end
+  if (demo_) {  // the trial waits for the demonstration's end; N meanwhile goes on to the next character
     if (demo_view()->frame.done) {
       const std::size_t character = demo_->character;
+      const bool next = pending_ == NextAction::next;
       demo_.reset();
       pending_ = NextAction::none;
-      launch_trial(character);
+      if (next) {
+        start_trial((character + 1) % options_.characters.size());
+      } else {
+        launch_trial(character);
+      }
     }
     return;
   }

@@ -129,10 +129,8 @@ void TrainerApp::render(bool take_screenshot) {
   panel.view = view;
   panel.engineer = options_.engineer;
   panel.practice_buttons = practice_.has_value() && !unattended();
-  if (demo) {
+  if (demo)
     panel.demonstrating = std::make_pair(std::min(demo->frame.stroke + 1, demo->strokes), demo->strokes);
-    panel.character = options_.characters[demo->box].utf8;
-  }
   if (practice_) practice_->fill_panel(panel);
   if (session_) session_->fill_panel(panel);
   panel.device = options_.device;
@@ -141,7 +139,7 @@ void TrainerApp::render(bool take_screenshot) {
   panel.unattended = unattended();
   panel.frame_rate_hz = ImGui::GetIO().Framerate;
   panel.large_font = large_font_;
-  if (demo) panel.character = options_.characters[demo->box].utf8;
+  if (demo) panel.character = options_.characters[demo->box].utf8;  // before its character's first trial
   panel.device_kind = learner_device_;
   panel.device_line = device_line(learner_device_, view != nullptr ? view->guidance : panel.next_guidance);
   if (quit_seen_ && practice_ && practice_->trial_running()) panel.status = "ending the trial...";

@@ -25,7 +25,6 @@ std::vector<int> typical_ids_of(const Character& character) {
 
 void TrialView::consume(DisplayChannel& channel, const std::vector<int>& typical_ids) {
   channel.try_latest(snapshot);
-  follow_hint();
   drain_trace(channel);
   for (DisplayEvent e; channel.poll_event(e);) {
     switch (e.kind) {
@@ -81,6 +80,8 @@ void TrialView::consume(DisplayChannel& channel, const std::vector<int>& typical
         break;
     }
   }
+  // After the events: the miss that brought the hint is said first, then the hint.
+  follow_hint();
 }
 
 void TrialView::drain_trace(DisplayChannel& channel) {

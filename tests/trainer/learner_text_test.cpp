@@ -236,3 +236,32 @@ TEST_CASE("a refused attempt's line names where it started against the stroke's 
   REQUIRE(view.assisted);
   CHECK(view.assisted->stroke == 1);
 }
+
+TEST_CASE("the miss that brings a hint is said before the hint, which stays the last line") {
+  const Scene& scene = calligraphy::testing::embedded_scene(U'十');
+  DisplayChannel channel;
+  TrialView view;
+  view.scene = &scene;
+  const std::vector<int> ids = typical_ids_of(CharacterLibrary::embedded().load(U'十'));
+  const PlacedStroke& first = scene.characters[0].strokes[0];
+  channel.push_trace(trace_point(1, first.start(), InteractionState::writing));
+  channel.push_trace(trace_point(2, first.start() + Vec2(0.003, 0.0), InteractionState::writing));
+  channel.push_trace(trace_point(3, first.start() + Vec2(0.003, 0.0), InteractionState::separation));
+  DisplayEvent abandoned;
+  abandoned.kind = DisplayEventKind::stroke_abandoned;
+  abandoned.tick = 3;
+  abandoned.refusal = StrokeRefusal::too_short;
+  channel.push_event(abandoned);
+  DisplaySnapshot hinted;
+  hinted.tick = 3;
+  hinted.strokes_total = 2;
+  hinted.misses = 1;
+  hinted.hint_shown = true;
+  channel.publish(hinted);
+  view.consume(channel, ids);
+  REQUIRE(view.feedback);
+  CHECK(view.feedback->text == "Here is stroke 1: follow the blue path from its start");
+  CHECK(view.refused);         // the refused attempt is still drawn, greyed
+  view.consume(channel, ids);  // the same hint again: said once
+  CHECK(view.feedback->text == "Here is stroke 1: follow the blue path from its start");
+}
