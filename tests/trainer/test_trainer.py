@@ -204,6 +204,10 @@ def is_accepted(r, g, b):  # the quiz's accepted stroke (20, 150, 60)
     return g > 120 and r < 60 and b < 100
 
 
+def is_demo_ink(r, g, b):  # the demonstration's ink, Hanzi Writer's stroke colour #555
+    return all(abs(c - 85) <= 6 for c in (r, g, b))
+
+
 def is_hint(r, g, b):  # the quiz's hint, Hanzi Writer's highlight colour #AAF
     return b > 230 and 140 < r < 200 and 140 < g < 200
 
@@ -712,14 +716,31 @@ class PeopleOutputTest(unittest.TestCase):
         self.assertIn("vision, no force output: guidance not felt", panel)
 
     def test_the_stroke_order_is_shown_before_writing_and_no_trial_runs_meanwhile(self):
-        self.trainer = Trainer("十", "--device", "mouse", folder=self.folder)
-        self.trainer.wait_for("calligraphy train: demonstrating the stroke order of 十 (2 strokes")
+        self.trainer = Trainer("永", "--device", "mouse", "--screenshot", "demo.png", folder=self.folder,
+                               environment=boxes_environment())
+        (box,) = self.trainer.boxes()
+        self.trainer.wait_for("calligraphy train: demonstrating the stroke order of 永 (5 strokes")
+        # 0.5 s pause, the dot (at least 0.25 s), 0.5 s pause, then stroke 2 for over a second: at 1.2 s the dot
+        # is drawn and the demonstration still runs (4.6 s in all).
+        time.sleep(1.2)
         window = self.trainer.window()
         xdotool("windowfocus", "--sync", window)
         xdotool("key", "--window", window, "q")
         self.assertEqual(self.trainer.wait(timeout=30), 0, self.trainer.errors())
         self.assertNotIn("trial 1", self.trainer.errors(), "a trial ran during the demonstration")
         self.assertEqual(self.trainer.output(), "")
+        picture = pathlib.Path(self.folder) / "demo.png"
+        keep_artifact(picture)
+        image = read_png(picture)
+        dot = medians("永")[0]
+        ink = [near(image, box.data_to_px(p), 4, is_demo_ink) for p in along(dot, [i / 10 for i in range(2, 9)])]
+        self.assertGreater(fraction(ink), 0.9, "stroke 1 drawn in the demonstration's ink")
+        x, y = box.data_to_px(dot[0])
+        self.assertTrue(near(image, (x - 16, y - 16), 12, is_red), "stroke 1 numbered at its start")
+        inside = [(x, y) for x in range(int(box.x), int(box.x + box.size), 6)
+                  for y in range(int(box.y), int(box.y + box.size), 6)]
+        self.assertFalse(any(is_blue(*image.pixel(x, y)) for x, y in inside),
+                         "no reference and no trial drawn during the demonstration")
 
     def test_d_ends_the_trial_and_demonstrates_the_stroke_order(self):
         text = pathlib.Path(self.folder) / "panel.txt"
