@@ -115,6 +115,9 @@ int main(int argc, char** argv) {
             std::printf("          trial ended: %s\n", to_string(e.end));
             ended = true;
             break;
+          case DisplayEventKind::stroke_assisted:
+            std::printf("          stroke %u shown and counted as assisted\n", e.stroke_index + 1);
+            break;
         }
       }
     }

@@ -43,6 +43,7 @@ struct SessionDisplay {
   std::string display = "window";
   std::string screenshot;
   double exit_after_s = 0.0;
+  bool engineer = false;
 };
 
 struct SessionRunCommand {
@@ -157,6 +158,7 @@ SessionRunResult run_one(SessionFolder& session, const SessionRunOptions& option
     };
     window.screenshot = display.screenshot;
     window.exit_after_s = display.exit_after_s;
+    window.engineer = display.engineer;
     window.library_version = CALLIGRAPHY_VERSION;
     return trainer::run_trainer_session(window);
   }
@@ -506,6 +508,9 @@ void add_display_options(CLI::App& app, SessionDisplay& display) {
   add_number(app, "--exit-after", display.exit_after_s, "SECONDS",
              "window, unattended: trials start by themselves; quit after this long [s] or at the end",
              "a number of seconds > 0", [](double s) { return s > 0.0 && s <= 86400.0; });
+  add_flag(app, "--engineer", display.engineer,
+           "window: the engineer's panel (interaction state, ticks, elements, pen and force); without it the "
+           "learner's view (docs/trainer.md)");
 }
 
 void add_session_commands(CLI::App& root, Commands& commands, DeviceRegistry& devices) {

@@ -43,6 +43,8 @@ struct TrainCommand {
   std::int64_t watchdog_ms = 0;
   const CLI::Option* watchdog_option = nullptr;  // given on the command line when its count() > 0
   bool quiz = false;
+  bool engineer = false;
+  bool no_demo = false;
   std::int64_t hint_after = 3;
   std::string quiz_screenshots;
 };
@@ -106,6 +108,8 @@ int run_train(const TrainCommand& command, DeviceRegistry& devices) {
   }
   options.guidance = command.guidance == "on";
   options.quiz = command.quiz;
+  options.engineer = command.engineer;
+  options.demonstrate = !command.no_demo;
   options.quiz_options.hint_after_misses = static_cast<int>(command.hint_after);
   options.quiz_screenshots = command.quiz_screenshots;
   if (command.quiz && command.guidance_mode != "fixed")
@@ -217,6 +221,12 @@ void add_train_command(CLI::App& root, Commands& commands, DeviceRegistry& devic
                     "quiz: write the window as DIR/quiz-NN-VERDICT.png on the first frame after each judged "
                     "stroke (an existing folder)",
                     "not written");
+  add_flag(*app, "--engineer", command->engineer,
+           "the engineer's panel (docs/trainer.md): interaction state, ticks, elements, pen and force, the "
+           "per-stroke table; without it the learner's view");
+  add_flag(*app, "--no-demo", command->no_demo,
+           "start writing at once: no stroke-order demonstration before each character's first trial (D "
+           "still demonstrates)");
   add_number(*app, "--exit-after", command->exit_after_s, "SECONDS",
              "unattended: quit after this long [s], or once every character had its trial",
              "a number of seconds > 0", [](double s) { return s > 0.0 && s <= 86400.0; });

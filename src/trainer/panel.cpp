@@ -9,6 +9,7 @@
 #include <string_view>
 
 #include "calligraphy/model/typical_strokes.hpp"
+#include "trainer/learner_text.hpp"
 
 namespace calligraphy::trainer {
 namespace {
@@ -208,35 +209,30 @@ RefusalWords learner_words(StrokeRefusal refusal) noexcept {
   return {"not written", "try it again"};
 }
 
-void draw_panel(const WindowLayout& layout, double panel_width_px, const PanelInput& input) {
-  ImGui::SetNextWindowPos(ImVec2(static_cast<float>(layout.area_width_px()), 0));
-  ImGui::SetNextWindowSize(
-      ImVec2(static_cast<float>(panel_width_px), static_cast<float>(layout.height_px())));
-  ImGui::Begin("trainer", nullptr,
-               ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
-                   ImGuiWindowFlags_NoBringToFrontOnFocus);
-  if (!input.session.empty()) {
-    ImGui::TextWrapped("%s", input.session.c_str());
-    if (!input.prompt.empty()) {
-      if (input.large_font != nullptr) ImGui::PushFont(input.large_font);
-      ImGui::TextColored(ImVec4(0.1f, 0.35f, 0.8f, 1.0f), "%s", input.prompt.c_str());
-      if (input.large_font != nullptr) ImGui::PopFont();
-    }
-    ImGui::Separator();
+namespace {
+
+// The engineer's panel (--engineer): the trial as the library sees it.
+void engineer_panel(const PanelInput& input) {
+  if (input.demonstrating) {
+    ImGui::Text("demonstration: stroke %zu / %zu (no trial runs)", input.demonstrating->first,
+                input.demonstrating->second);
+    ImGui::TextWrapped("device %s: %s", input.device.c_str(), input.device_line.c_str());
+    if (input.view == nullptr) return;
   }
   const TrialView* view = input.view;
-  if (view == nullptr) {
-    ImGui::TextWrapped("%s", input.status.c_str());
-    ImGui::End();
-    return;
-  }
   const DisplaySnapshot& s = view->snapshot;
   ImGui::Text("Trial %zu: %s  (%zu of %zu)", view->number, input.character.c_str(), view->character + 1,
               input.characters);
   ImGui::Text("device %s", input.device.c_str());
-  ImGui::Text("%s, guidance %s", view->condition.c_str(), view->guidance ? "on" : "off");
+  ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(0.35f, 0.35f, 0.35f, 1));
+  ImGui::TextWrapped("%s", input.device_line.c_str());
+  ImGui::PopStyleColor();
+  // "guidance on" only where it is felt (guidance_words): the mouse outputs no force, mouse-hand's pulls a
+  // simulated pen.
+  ImGui::TextWrapped("%s, %s", view->condition.c_str(),
+                     guidance_words(input.device_kind, view->guidance).c_str());
   if (input.session.empty() && !input.quiz)
-    ImGui::TextWrapped("next: guidance %s, %s", input.next_guidance ? "on" : "off",
+    ImGui::TextWrapped("next: %s, %s", guidance_words(input.device_kind, input.next_guidance).c_str(),
                        next_mode_text(input).c_str());
   ImGui::Separator();
   if (input.large_font != nullptr) ImGui::PushFont(input.large_font);
@@ -271,10 +267,135 @@ void draw_panel(const WindowLayout& layout, double panel_width_px, const PanelIn
     ImGui::Spacing();
     ImGui::TextDisabled(input.quiz ? "R repeat  N next  Q quit" : "R repeat  N next  G guidance  Q quit");
   }
+}
+
+}  // namespace
+
+namespace {
+
+const ImVec4 kHintColour(0.3f, 0.3f, 0.85f, 1);
+const ImVec4 kQuiet(0.35f, 0.35f, 0.35f, 1);
+
+ImVec4 tone_colour(FeedbackTone tone) {
+  switch (tone) {
+    case FeedbackTone::good:
+      return kGood;
+    case FeedbackTone::fix:
+      return kBad;
+    case FeedbackTone::hint:
+      return kHintColour;
+  }
+  return kQuiet;
+}
+
+void large(const PanelInput& input, const ImVec4& colour, const std::string& text) {
+  if (input.large_font != nullptr) ImGui::PushFont(input.large_font);
+  ImGui::PushStyleColor(ImGuiCol_Text, colour);
+  ImGui::TextWrapped("%s", text.c_str());
+  ImGui::PopStyleColor();
+  if (input.large_font != nullptr) ImGui::PopFont();
+}
+
+// The end of a trial in the learner's words: strokes in order, how far off on average, how long.
+void learner_summary(const TrialView& view) {
+  const TrialMetrics& m = view.metrics;
+  const bool complete = view.end == TrialEnd::completed;
+  ImGui::TextColored(complete ? kGood : kBad, "%s: %zu of %zu strokes in order",
+                     complete ? "Done" : "Stopped", m.strokes_completed, m.strokes_total);
+  if (m.mean_deviation_m) {
+    ImGui::Text("%.1f mm off on average, %.1f s", *m.mean_deviation_m * 1e3, m.time_s);
+  } else {
+    ImGui::Text("nothing written, %.1f s", m.time_s);
+  }
+  if (!view.saved_as.empty()) ImGui::TextDisabled("saved");
+  if (!view.save_error.empty()) ImGui::TextColored(kBad, "%s", view.save_error.c_str());
+}
+
+void learner_panel(const PanelInput& input) {
+  const TrialView* view = input.view;
+  if (input.large_font != nullptr) ImGui::PushFont(input.large_font);
+  ImGui::Text("%s", input.character.c_str());
+  if (input.large_font != nullptr) ImGui::PopFont();
+  if (input.characters > 1 && view != nullptr && input.session.empty()) {
+    ImGui::SameLine();
+    ImGui::TextDisabled("character %zu of %zu", view->character + 1, input.characters);
+  }
+  ImGui::PushStyleColor(ImGuiCol_Text, kQuiet);
+  ImGui::TextWrapped("%s", input.device_line.c_str());
+  ImGui::PopStyleColor();
+  ImGui::Separator();
+  if (input.demonstrating) {
+    large(input, kHintColour, "Watch: " + stroke_of(input.demonstrating->first, input.demonstrating->second));
+    ImGui::TextWrapped("Each stroke is drawn in order, from its start; writing starts after the last one.");
+  } else if (view != nullptr) {
+    const DisplaySnapshot& s = view->snapshot;
+    if (view->quiz) {
+      quiz_state(*view, input);
+    } else if (s.strokes_total > 0) {
+      const std::size_t k = s.finished ? s.strokes_total + 1u : s.stroke_index + 1u;
+      large(input, ImVec4(0.1f, 0.1f, 0.1f, 1), stroke_of(k, s.strokes_total));
+      if (!s.finished && !view->ended)
+        ImGui::TextWrapped("Start at the red circle; the stroke to write is the darker yellow one.");
+    }
+    if (view->feedback && !view->quiz) {
+      ImGui::Spacing();
+      large(input, tone_colour(view->feedback->tone), view->feedback->text);
+    }
+    if (view->have_result) {
+      ImGui::Separator();
+      learner_summary(*view);
+    }
+  }
+}
+
+}  // namespace
+
+PanelAction draw_panel(const WindowLayout& layout, double panel_width_px, const PanelInput& input) {
+  ImGui::SetNextWindowPos(ImVec2(static_cast<float>(layout.area_width_px()), 0));
+  ImGui::SetNextWindowSize(
+      ImVec2(static_cast<float>(panel_width_px), static_cast<float>(layout.height_px())));
+  ImGui::Begin("trainer", nullptr,
+               ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
+                   ImGuiWindowFlags_NoBringToFrontOnFocus);
+  if (!input.session.empty()) {
+    ImGui::TextWrapped("%s", input.session.c_str());
+    if (!input.prompt.empty()) {
+      if (input.large_font != nullptr) ImGui::PushFont(input.large_font);
+      ImGui::TextColored(ImVec4(0.1f, 0.35f, 0.8f, 1.0f), "%s", input.prompt.c_str());
+      if (input.large_font != nullptr) ImGui::PopFont();
+    }
+    ImGui::Separator();
+  }
+  if (input.view == nullptr && !input.demonstrating) {
+    ImGui::TextWrapped("%s", input.status.c_str());
+    ImGui::End();
+    return PanelAction::none;
+  }
+  if (input.engineer) {
+    engineer_panel(input);
+  } else {
+    learner_panel(input);
+  }
+  PanelAction action = PanelAction::none;
+  if (input.practice_buttons) {
+    ImGui::Separator();
+    if (ImGui::Button(input.demonstrating ? "Skip (D)" : "Demonstrate (D)"))
+      action = PanelAction::demonstrate;
+    ImGui::SameLine();
+    if (!input.demonstrating) {  // a demonstration is followed by the character's trial anyway
+      if (ImGui::Button("Restart (R)")) action = PanelAction::restart;
+      ImGui::SameLine();
+    }
+    if (ImGui::Button("Next (N)")) action = PanelAction::next;
+    if (!input.engineer) ImGui::TextDisabled("Q / Esc  quit");
+  }
   if (!input.status.empty()) ImGui::TextWrapped("%s", input.status.c_str());
-  ImGui::SetCursorPosY(static_cast<float>(layout.height_px()) - 30.0f);
-  ImGui::TextDisabled("%.0f frames/s", input.frame_rate_hz);
+  if (input.engineer) {
+    ImGui::SetCursorPosY(static_cast<float>(layout.height_px()) - 30.0f);
+    ImGui::TextDisabled("%.0f frames/s", input.frame_rate_hz);
+  }
   ImGui::End();
+  return action;
 }
 
 }  // namespace calligraphy::trainer

@@ -36,6 +36,7 @@ PracticeController::PracticeController(const TrainerOptions& options, DeviceInfo
   guidance_mode_ = options.guidance_mode;
   guidance_gain_ = options.guidance_gain;
   condition_outputs_force_ = options.device != "mouse";
+  demonstrated_.assign(options.characters.size(), false);
 }
 
 void PracticeController::open_practice_folder() {
@@ -78,6 +79,55 @@ std::string PracticeController::condition_name() const {
 }
 
 void PracticeController::start_trial(std::size_t character) {
+  // Shown once per character before its first trial, to a person who writes it (not a quiz, which asks
+  // what is remembered, nor the simulated writer, nor an unattended run).
+  const bool first_look = options_.demonstrate && !unattended() && !options_.quiz &&
+                          !options_.simulated_writer && !demonstrated_[character];
+  if (first_look) {
+    begin_demonstration(character);
+  } else {
+    launch_trial(character);
+  }
+}
+
+void PracticeController::begin_demonstration(std::size_t character) {
+  std::vector<Character> one{options_.characters[character].model};
+  Demonstration demo;
+  demo.character = character;
+  demo.scene = Scene::lay_out(one);  // as start_trial lays the trial out: the same median on the paper
+  std::vector<double> lengths_m;
+  for (const PlacedStroke& stroke : demo.scene.characters.front().strokes)
+    lengths_m.push_back(stroke.median_m.size() > 1 ? polyline_length(stroke.median_m) : stroke.length_m());
+  demo.schedule = DemoSchedule(std::move(lengths_m), DemoPace{});
+  demo.started = Clock::now();
+  std::fprintf(stderr, "calligraphy train: demonstrating the stroke order of %s (%zu strokes, %.1f s)\n",
+               options_.characters[character].utf8.c_str(), demo.schedule.strokes(),
+               demo.schedule.duration_s());
+  demo_ = std::move(demo);
+  demonstrated_[character] = true;
+  advance_at_.reset();
+}
+
+void PracticeController::demonstrate() {
+  if (demo_) {  // again during one: the rest is skipped, and the trial starts
+    demo_->started = Clock::now() - std::chrono::duration_cast<Clock::duration>(
+                                        std::chrono::duration<double>(demo_->schedule.duration_s() + 1.0));
+    return;
+  }
+  pending_ = NextAction::demonstrate;
+}
+
+std::optional<DemoView> PracticeController::demo_view() const {
+  if (!demo_) return std::nullopt;
+  DemoView view;
+  view.box = demo_->character;
+  view.placed = &demo_->scene.characters.front();
+  view.frame = demo_->schedule.at(std::chrono::duration<double>(Clock::now() - demo_->started).count());
+  view.strokes = demo_->schedule.strokes();
+  return view;
+}
+
+void PracticeController::launch_trial(std::size_t character) {
   std::vector<Character> one{options_.characters[character].model};
   Scene scene = Scene::lay_out(one);  // at the device's centre; the row shows it at its place
   channel_ = std::make_unique<DisplayChannel>();
@@ -128,7 +178,9 @@ void PracticeController::start_trial(std::size_t character) {
 void PracticeController::follow_trial(bool quitting, QuizLog& quiz_log) {
   if (quitting && worker_.active() && !worker_.done()) worker_.request_stop();
   if (pending_ != NextAction::none && worker_.active() && !worker_.done()) {
-    note_stop_cause(pending_ == NextAction::repeat ? "R (repeat)" : "N (next character)");
+    note_stop_cause(pending_ == NextAction::repeat        ? "R (repeat)"
+                    : pending_ == NextAction::demonstrate ? "D (demonstration)"
+                                                          : "N (next character)");
     worker_.request_stop();
   }
   if (view_ && worker_.active()) {
@@ -143,6 +195,25 @@ void PracticeController::follow_trial(bool quitting, QuizLog& quiz_log) {
 }
 
 void PracticeController::start_next_trial() {
+  if (demo_) {  // the trial waits for the demonstration's end; N meanwhile goes on to the next character
+    if (demo_view()->frame.done) {
+      const std::size_t character = demo_->character;
+      const bool next = pending_ == NextAction::next;
+      demo_.reset();
+      pending_ = NextAction::none;
+      if (next) {
+        start_trial((character + 1) % options_.characters.size());
+      } else {
+        launch_trial(character);
+      }
+    }
+    return;
+  }
+  if (pending_ == NextAction::demonstrate) {
+    pending_ = NextAction::none;
+    begin_demonstration(view_ ? view_->character : 0);
+    return;
+  }
   if (pending_ == NextAction::repeat) start_trial(view_->character);
   if (pending_ == NextAction::next) start_trial((view_->character + 1) % options_.characters.size());
   pending_ = NextAction::none;
@@ -225,8 +296,8 @@ void PracticeController::finish_trial(QuizLog& quiz_log) {
     log_stop("device_fault");
   }
   const bool last = view.character + 1 == options_.characters.size();
-  if (last) last_character_ended_ = true;  // after the last character's last stroke
-  if (unattended()) {
+  if (last) last_character_ended_ = true;                     // after the last character's last stroke
+  if (unattended() && pending_ != NextAction::demonstrate) {  // a demonstration asked for comes first
     if (last) {
       close_window_ = true;
     } else {

@@ -22,6 +22,7 @@
 #include "calligraphy/study/quiz.hpp"
 #include "calligraphy/trial/display.hpp"
 #include "calligraphy/trial/trial.hpp"
+#include "trainer/demonstration.hpp"
 #include "trainer/panel.hpp"
 #include "trainer/quiz_log.hpp"
 #include "trainer/trainer.hpp"
@@ -33,8 +34,9 @@ namespace calligraphy::trainer {
 /// Unattended: the pause on a trial's summary before the next (a session's host waits as long).
 constexpr double kAdvanceDelayS = 1.0;
 
-/// What a key asked for once the trial ends: the same character again, or the next one.
-enum class NextAction { none, repeat, next };
+/// What a key asked for once the trial ends: the same character again, the next one, or the stroke order
+/// demonstrated and then the same character again.
+enum class NextAction { none, repeat, next, demonstrate };
 
 class PracticeController {
  public:
@@ -47,8 +49,17 @@ class PracticeController {
   /// With options.session_dir: creates the practice folder the trials are saved into (and says where).
   void open_practice_folder();
 
-  /// Starts the trial of character `character` of the row on the worker thread.
+  /// Starts the trial of character `character` of the row on the worker thread; first, when attended and
+  /// not yet shown, the demonstration of its stroke order (the trial starts once it ends: no trial, so
+  /// no force, while it runs).
   void start_trial(std::size_t character);
+  /// D or the panel's button: the running trial ends (kept as R keeps it) and the stroke order of its
+  /// character is demonstrated, then its trial starts again; during a demonstration, skips the rest of it.
+  void demonstrate();
+  /// A demonstration runs (no trial does).
+  [[nodiscard]] bool demonstrating() const noexcept { return demo_.has_value(); }
+  /// The demonstration as it is now, to draw; nullopt when none runs.
+  [[nodiscard]] std::optional<DemoView> demo_view() const;
   /// Once a frame: stops the running trial when the window quits (`quitting`), a key asked for another
   /// trial or its quiz is complete; drains its display channel into the view, logging the quiz's verdicts
   /// and refusals; finishes it once the worker is done.
@@ -93,6 +104,8 @@ class PracticeController {
 
  private:
   [[nodiscard]] std::string condition_name() const;
+  void launch_trial(std::size_t character);
+  void begin_demonstration(std::size_t character);
   [[nodiscard]] bool unattended() const noexcept { return options_.exit_after_s > 0.0; }
   // The characters of the practice trial `view` shows, in its scene's order: its one character.
   [[nodiscard]] std::span<const std::string> characters_utf8(const TrialView& view) const;
@@ -126,6 +139,15 @@ class PracticeController {
   std::string trial_start_utc_;
   Clock::time_point trial_wall_start_;
   std::string stop_cause_;  ///< what stopped the running trial, when not a signal or a lost display
+  // The stroke-order demonstration, when one runs: the character laid out as its trial lays it out.
+  struct Demonstration {
+    std::size_t character = 0;
+    Scene scene;
+    DemoSchedule schedule;
+    Clock::time_point started;
+  };
+  std::optional<Demonstration> demo_;
+  std::vector<bool> demonstrated_;  // per character of the row: its stroke order was shown
   // What comes after it.
   NextAction pending_ = NextAction::none;
   std::optional<Clock::time_point> advance_at_;

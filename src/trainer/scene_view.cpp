@@ -6,6 +6,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <string>
 
 #include "calligraphy/model/polyline.hpp"
 #include "trainer/triangulate.hpp"
@@ -34,6 +36,11 @@ constexpr ImU32 kQuizInk = IM_COL32(51, 51, 51, 255);
 constexpr ImU32 kQuizMiss = IM_COL32(230, 0, 0, 255);
 constexpr ImU32 kQuizHint = IM_COL32(170, 170, 255, 255);
 constexpr double kMissFlashS = 0.5;
+// The demonstration's ink (Hanzi Writer's stroke colour #555) and its stroke numbers; the active stroke of
+// the learner's view (a deeper yellow than its character's).
+constexpr ImU32 kDemoInk = IM_COL32(85, 85, 85, 255);
+constexpr ImU32 kNumber = IM_COL32(200, 30, 30, 255);
+constexpr ImU32 kActiveStroke = IM_COL32(250, 186, 0, 255);
 
 // Window pixel of a point of the view's trial [m].
 Vec2 trial_to_screen(const WindowLayout& layout, const TrialView& view, const Vec2& trial_m) {
@@ -150,10 +157,176 @@ void draw_quiz_ink(ImDrawList& draw, const WindowLayout& layout, const TrialView
   draw_ink(draw, layout, view, view.quiz->open_run(), kQuizInk);
 }
 
+void fill_stroke(ImDrawList& draw, const WindowLayout& layout, const CharacterArt& art, std::size_t box,
+                 std::size_t stroke, ImU32 colour) {
+  const ImDrawListFlags flags = draw.Flags;
+  draw.Flags &= ~ImDrawListFlags_AntiAliasedFill;
+  for (std::size_t p = 0; p < art.polygons.size(); ++p) {
+    if (art.polygon_stroke[p] != stroke) continue;
+    std::vector<ImVec2> points;
+    for (const Vec2& v : art.polygons[p]) points.push_back(im(layout.data_to_screen(box, v)));
+    fill_polygon(draw, points, art.triangles[p], colour);
+  }
+  draw.Flags = flags;
+}
+
+// Arc length along `line` (screen points) of the point of it nearest to `p`.
+double arc_of_nearest(const std::vector<Vec2>& line, const Vec2& p) {
+  double best_distance = std::numeric_limits<double>::infinity();
+  double best_arc = 0.0;
+  double arc = 0.0;
+  for (std::size_t i = 1; i < line.size(); ++i) {
+    const Vec2 d = line[i] - line[i - 1];
+    const double length = d.norm();
+    const double t = length > 0.0 ? std::clamp((p - line[i - 1]).dot(d) / (length * length), 0.0, 1.0) : 0.0;
+    const double distance = (line[i - 1] + t * d - p).norm();
+    if (distance < best_distance) {
+      best_distance = distance;
+      best_arc = arc + t * length;
+    }
+    arc += length;
+  }
+  return best_arc;
+}
+
+// Fills the part of triangle (a, b, c) whose pieces lie, along `median`, at most `reached` from its start:
+// the triangle is split at its longest edge until the pieces are smaller than kPiecePx, so that the ink
+// reveals the outline along the median as a brush would, never leaving it.
+constexpr double kPiecePx = 5.0;
+void fill_reached(ImDrawList& draw, const Vec2& a, const Vec2& b, const Vec2& c,
+                  const std::vector<Vec2>& median, double reached, ImU32 colour, int depth) {
+  const double ab = (b - a).norm();
+  const double bc = (c - b).norm();
+  const double ca = (a - c).norm();
+  if (std::max({ab, bc, ca}) <= kPiecePx || depth > 14) {
+    if (arc_of_nearest(median, (a + b + c) / 3.0) <= reached)
+      draw.AddTriangleFilled(im(a), im(b), im(c), colour);
+    return;
+  }
+  if (ab >= bc && ab >= ca) {
+    const Vec2 m = (a + b) / 2.0;
+    fill_reached(draw, a, m, c, median, reached, colour, depth + 1);
+    fill_reached(draw, m, b, c, median, reached, colour, depth + 1);
+  } else if (bc >= ca) {
+    const Vec2 m = (b + c) / 2.0;
+    fill_reached(draw, a, b, m, median, reached, colour, depth + 1);
+    fill_reached(draw, a, m, c, median, reached, colour, depth + 1);
+  } else {
+    const Vec2 m = (c + a) / 2.0;
+    fill_reached(draw, a, b, m, median, reached, colour, depth + 1);
+    fill_reached(draw, m, b, c, median, reached, colour, depth + 1);
+  }
+}
+
+// A stroke being drawn by a demonstration: its outline filled as far as the first `fraction` of its median
+// (mapped to the screen by `to_screen`) reaches, as Hanzi Writer reveals a stroke through the outline; the
+// whole outline once drawn. Without an outline, ink along the median.
+template <typename ToScreen>
+void draw_stroke_drawn(ImDrawList& draw, const WindowLayout& layout, const CharacterArt* art, std::size_t box,
+                       std::size_t stroke, const std::vector<Vec2>& median_m, double fraction, ImU32 colour,
+                       const ToScreen& to_screen) {
+  const bool outlined = art != nullptr && std::find(art->polygon_stroke.begin(), art->polygon_stroke.end(),
+                                                    stroke) != art->polygon_stroke.end();
+  if (fraction >= 1.0 && outlined) {
+    fill_stroke(draw, layout, *art, box, stroke, colour);
+    return;
+  }
+  std::vector<Vec2> screen;
+  for (const Vec2& p : median_m) screen.push_back(to_screen(p));
+  if (outlined && screen.size() > 1) {
+    const double reached = fraction * polyline_length(screen);
+    const ImDrawListFlags flags = draw.Flags;
+    draw.Flags &= ~ImDrawListFlags_AntiAliasedFill;  // no seams between the pieces
+    for (std::size_t p = 0; p < art->polygons.size(); ++p) {
+      if (art->polygon_stroke[p] != stroke) continue;
+      std::vector<Vec2> points;
+      for (const Vec2& v : art->polygons[p]) points.push_back(layout.data_to_screen(box, v));
+      for (const auto& t : art->triangles[p]) {
+        fill_reached(draw, points[static_cast<std::size_t>(t[0])], points[static_cast<std::size_t>(t[1])],
+                     points[static_cast<std::size_t>(t[2])], screen, reached, colour, 0);
+      }
+    }
+    draw.Flags = flags;
+    return;
+  }
+  const std::vector<Vec2> head = polyline_head(screen, fraction);
+  std::vector<ImVec2> points;
+  for (const Vec2& p : head) points.push_back(im(p));
+  constexpr float kInkPx = 10.0f;
+  if (!points.empty()) draw.AddCircleFilled(points.front(), kInkPx / 2, colour, 24);
+  if (points.size() > 1) draw.AddPolyline(points.data(), static_cast<int>(points.size()), colour, 0, kInkPx);
+}
+
+// A stroke's number (1-based) in a red-ringed white disc beside its start.
+void draw_number(ImDrawList& draw, const Vec2& start_px, std::size_t number_1based) {
+  const std::string text = std::to_string(number_1based);
+  const float size = 22.0f;
+  ImFont* font = ImGui::GetFont();
+  const ImVec2 extent = font->CalcTextSizeA(size, 1000.0f, 0.0f, text.c_str());
+  const ImVec2 centre(static_cast<float>(start_px.x()) - 16.0f, static_cast<float>(start_px.y()) - 16.0f);
+  draw.AddCircleFilled(centre, 13.0f, IM_COL32(255, 255, 255, 235), 24);
+  draw.AddCircle(centre, 13.0f, kNumber, 24, 2.0f);
+  draw.AddText(font, size, ImVec2(centre.x - extent.x / 2, centre.y - extent.y / 2), kNumber, text.c_str());
+}
+
+// The stroke-order demonstration over the row's character demo.box.
+void draw_demonstration(ImDrawList& draw, const WindowLayout& layout, const std::vector<CharacterArt>& art,
+                        const DemoView& demo) {
+  if (demo.placed == nullptr) return;
+  const CharacterArt* character_art = demo.box < art.size() ? &art[demo.box] : nullptr;
+  const auto to_screen = [&](const Vec2& p) { return layout.to_screen(demo.box, p); };
+  const std::size_t shown = std::min(demo.frame.stroke + 1, demo.placed->strokes.size());
+  for (std::size_t k = 0; k < shown; ++k) {
+    const PlacedStroke& stroke = demo.placed->strokes[k];
+    const double fraction = k < demo.frame.stroke ? 1.0 : demo.frame.fraction;
+    if (fraction > 0.0)
+      draw_stroke_drawn(draw, layout, character_art, demo.box, k, stroke.median_m, fraction, kDemoInk,
+                        to_screen);
+  }
+  for (std::size_t k = 0; k < shown; ++k) {
+    const PlacedStroke& stroke = demo.placed->strokes[k];
+    if (!stroke.median_m.empty()) draw_number(draw, to_screen(stroke.median_m.front()), k + 1);
+  }
+}
+
+// Over a running trial: a stroke the trial demonstrated and credited (drawn once at the demonstration's pace,
+// then kept filled), and the active stroke's hint after misses (drawn once in the hint colour, then kept as
+// the outline in that colour with its median).
+void draw_shown_strokes(ImDrawList& draw, const WindowLayout& layout, const std::vector<CharacterArt>& art,
+                        const TrialView& view) {
+  if (view.scene == nullptr) return;
+  const auto box_of = [&](std::uint32_t character) {
+    return view.whole_row ? static_cast<std::size_t>(character) : view.character;
+  };
+  const auto to_screen = [&](const Vec2& p) { return trial_to_screen(layout, view, p); };
+  const auto now = std::chrono::steady_clock::now();
+  const auto draw_once = [&](const TrialView::Shown& shown, ImU32 colour, bool number) {
+    if (shown.character >= view.scene->characters.size()) return;
+    const PlacedCharacter& placed = view.scene->characters[shown.character];
+    if (shown.stroke >= placed.strokes.size()) return;
+    const PlacedStroke& stroke = placed.strokes[shown.stroke];
+    const std::size_t box = box_of(shown.character);
+    const CharacterArt* character_art = box < art.size() ? &art[box] : nullptr;
+    const DemoSchedule once({polyline_length(stroke.median_m)}, DemoPace{0.08, 0.0});
+    const DemoFrame frame = once.at(std::chrono::duration<double>(now - shown.at).count());
+    draw_stroke_drawn(draw, layout, character_art, box, shown.stroke, stroke.median_m,
+                      frame.done ? 1.0 : frame.fraction, colour, to_screen);
+    if (number && !stroke.median_m.empty())
+      draw_number(draw, to_screen(stroke.median_m.front()), shown.stroke + 1);
+  };
+  if (view.assisted) draw_once(*view.assisted, kDemoInk, true);
+  const DisplaySnapshot& s = view.snapshot;
+  if (view.hint && !s.finished && view.hint->character == s.character && view.hint->stroke == s.stroke) {
+    draw_once(*view.hint, kQuizHint, true);
+  }
+}
+
 }  // namespace
 
 void draw_scene(ImDrawList& draw, const WindowLayout& layout, const std::vector<CharacterArt>& art,
-                const Scene& trial_scene, const TrialView* view) {
+                const Scene& trial_scene, const TrialView* trial_view, const DemoView* demo, bool learner) {
+  // A demonstration shows nothing of the trial, and a trial that has ended keeps its look for the summary.
+  const TrialView* view = demo != nullptr ? nullptr : trial_view;
   const bool quiz = view != nullptr && view->quiz.has_value();
   draw.AddRectFilled(
       ImVec2(0, 0),
@@ -176,7 +349,10 @@ void draw_scene(ImDrawList& draw, const WindowLayout& layout, const std::vector<
     for (std::size_t p = 0; p < art[c].polygons.size(); ++p) {
       std::vector<ImVec2> points;
       for (const Vec2& v : art[c].polygons[p]) points.push_back(im(layout.data_to_screen(c, v)));
-      const ImU32 colour = quiz ? quiz_fill(*view, c, art[c].polygon_stroke[p]) : active ? kActive : kOutline;
+      ImU32 colour = quiz ? quiz_fill(*view, c, art[c].polygon_stroke[p]) : active ? kActive : kOutline;
+      if (learner && active && !quiz && !view->snapshot.finished && !view->ended &&
+          art[c].polygon_stroke[p] == view->snapshot.stroke)
+        colour = kActiveStroke;
       fill_polygon(draw, points, art[c].triangles[p], colour);
     }
     draw.Flags = flags;
@@ -194,6 +370,11 @@ void draw_scene(ImDrawList& draw, const WindowLayout& layout, const std::vector<
         draw.AddPolyline(points.data(), static_cast<int>(points.size()), kTrace, 0, 5.0f);
     }
   }
+  if (demo != nullptr) {
+    draw_demonstration(draw, layout, art, *demo);
+    return;
+  }
+  if (view != nullptr && !quiz) draw_shown_strokes(draw, layout, art, *view);
   for (std::size_t c = 0; c < art.size() && !quiz; ++c) {
     for (const std::vector<Vec2>& stroke : art[c].reference) {
       std::vector<ImVec2> points;
@@ -216,9 +397,12 @@ void draw_scene(ImDrawList& draw, const WindowLayout& layout, const std::vector<
   }
   if (s.tick == 0) return;
   const Vec2 tip = trial_to_screen(layout, *view, Vec2(s.hip_m.x, s.hip_m.y));
-  Vec2 in_plane_px = Vec2(s.force_n.x, -s.force_n.y) * 150.0;  // 150 px per newton, at most 220 px
-  if (in_plane_px.norm() > 220.0) in_plane_px *= 220.0 / in_plane_px.norm();
-  draw_arrow(draw, tip, tip + in_plane_px, kForce);
+  // The force arrow and the height gauge are the engineer's: a learner sees the pen only.
+  if (!learner) {
+    Vec2 in_plane_px = Vec2(s.force_n.x, -s.force_n.y) * 150.0;  // 150 px per newton, at most 220 px
+    if (in_plane_px.norm() > 220.0) in_plane_px *= 220.0 / in_plane_px.norm();
+    draw_arrow(draw, tip, tip + in_plane_px, kForce);
+  }
   if (s.pen_height_m <= 0.0) {
     draw.AddCircleFilled(im(tip), 6.0f, kPen);
     if (s.hip_m.z != s.vtp_m.z)
@@ -229,7 +413,7 @@ void draw_scene(ImDrawList& draw, const WindowLayout& layout, const std::vector<
     draw.AddCircle(im(tip), radius, kPen, 24, 2.0f);
     draw.AddCircleFilled(im(tip), 2.0f, kPen);
   }
-  draw_height_gauge(draw, layout, s);
+  if (!learner) draw_height_gauge(draw, layout, s);
 }
 
 }  // namespace calligraphy::trainer

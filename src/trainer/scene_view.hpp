@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "calligraphy/model/scene.hpp"
+#include "trainer/demonstration.hpp"
 #include "trainer/layout.hpp"
 #include "trainer/trainer.hpp"
 #include "trainer/trial_view.hpp"
@@ -28,8 +29,12 @@ struct CharacterArt {
 
 CharacterArt prepare_art(const TrainerCharacter& character);
 
-/// Draws everything but the panel. `view` may be null (no trial yet).
+/// Draws everything but the panel. `view` may be null (no trial yet). `demo`, when given, is a stroke-order
+/// demonstration: the paper shows the outlines and the strokes drawn so far, numbered, and nothing of the
+/// trial. `learner`: the active stroke is highlighted in a deeper yellow than its character, and the force
+/// arrow and the pen's height gauge (the engineer's) are left out.
 void draw_scene(ImDrawList& draw, const WindowLayout& layout, const std::vector<CharacterArt>& art,
-                const Scene& trial_scene, const TrialView* view);
+                const Scene& trial_scene, const TrialView* view, const DemoView* demo = nullptr,
+                bool learner = false);
 
 }  // namespace calligraphy::trainer

@@ -92,7 +92,16 @@ SessionRunResult run_trainer_session(const TrainerSessionOptions& options) {
   std::optional<SessionRunResult> result;
   std::exception_ptr failure;
   const SessionLink link{&host, &done, &manifest};
-  TrainerApp app(window, DeviceInfo{}, false, &link);
+  // Whether the session's device is felt (a haptic device), for the learner's device line.
+  bool hardware = false;
+  if (options.run.registry != nullptr) {
+    try {
+      hardware = options.run.registry->find(window.device).capabilities.hardware;
+    } catch (const std::exception&) {  // run_session names an unknown device itself
+    }
+  }
+  window.engineer = options.engineer;
+  TrainerApp app(window, DeviceInfo{}, hardware, &link);
   std::thread runner([&] {
     try {
       result = run_session(folder, run);

@@ -28,8 +28,8 @@ struct TrainerOptions {
   /// Where `device` is created (not owned; outlives the run): the program's registry, with the trainer's
   /// pointer devices added (`register_trainer_devices`). Required.
   const DeviceRegistry* registry = nullptr;
-  bool simulated_writer = false;             ///< the simulated writer writes (device with a hand port)
-  std::string writer_profile = "novice";     ///< novice or skilled
+  bool simulated_writer = false;          ///< the simulated writer writes (device with a hand port)
+  std::string writer_profile = "novice";  ///< novice or skilled
   std::uint64_t seed = 0;
   bool guidance = true;
   GuidanceMode guidance_mode = GuidanceMode::fixed;  ///< how guidance attracts (M cycles it)
@@ -47,6 +47,12 @@ struct TrainerOptions {
   std::string subject = "anonymous";
   int width_px = 1280;
   int height_px = 800;
+  /// Attended: each character's stroke order is demonstrated before its first trial (not in a quiz nor with
+  /// the simulated writer); D demonstrates it again in any case.
+  bool demonstrate = true;
+  /// The engineer's panel: interaction state, ticks, elements, forces, the per-stroke table; else the
+  /// learner's (docs/trainer.md).
+  bool engineer = false;
   std::string screenshot;     ///< PNG written after the last character's trial, or at exit
   double exit_after_s = 0.0;  ///< > 0: unattended; quit after this long or once every character had its trial
   /// The servo loop's stall bound [s] in [0, 60] (ServoLoopOptions::stall_timeout_s; 0: off). Unset: 50 ms on
@@ -77,6 +83,7 @@ struct TrainerSessionOptions {
   int height_px = 800;
   std::string screenshot;        ///< PNG written after the last planned trial's outcome, or at exit
   std::string quiz_screenshots;  ///< non-empty: a folder where a PNG is written after each judged stroke
+  bool engineer = false;         ///< the engineer's panel (TrainerOptions::engineer); else the learner's
   double exit_after_s = 0.0;     ///< > 0: unattended (trials start by themselves); quit after this long
   std::string library_version;
 };

@@ -16,7 +16,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
@@ -120,9 +122,15 @@ void TrainerApp::render(bool take_screenshot) {
   ImGui::NewFrame();
   const Scene& scene = practice_ ? practice_->scene() : session_->scene();
   const TrialView* view = trial_view();
-  draw_scene(*ImGui::GetBackgroundDrawList(), *layout_, art_, scene, view);
+  const std::optional<DemoView> demo = practice_ ? practice_->demo_view() : std::nullopt;
+  draw_scene(*ImGui::GetBackgroundDrawList(), *layout_, art_, scene, view, demo ? &*demo : nullptr,
+             !options_.engineer);
   PanelInput panel;
   panel.view = view;
+  panel.engineer = options_.engineer;
+  panel.practice_buttons = practice_.has_value() && !unattended();
+  if (demo)
+    panel.demonstrating = std::make_pair(std::min(demo->frame.stroke + 1, demo->strokes), demo->strokes);
   if (practice_) practice_->fill_panel(panel);
   if (session_) session_->fill_panel(panel);
   panel.device = options_.device;
@@ -131,8 +139,21 @@ void TrainerApp::render(bool take_screenshot) {
   panel.unattended = unattended();
   panel.frame_rate_hz = ImGui::GetIO().Framerate;
   panel.large_font = large_font_;
+  if (demo) panel.character = options_.characters[demo->box].utf8;  // before its character's first trial
+  panel.device_kind = learner_device_;
+  panel.device_line = device_line(learner_device_, view != nullptr ? view->guidance : panel.next_guidance);
   if (quit_seen_ && practice_ && practice_->trial_running()) panel.status = "ending the trial...";
-  draw_panel(*layout_, kPanelWidthPx, panel);
+  // The panel's text of the picture at the end, for tests and tools (CALLIGRAPHY_PANEL_TEXT,
+  // docs/trainer.md).
+  const char* panel_text = std::getenv("CALLIGRAPHY_PANEL_TEXT");
+  const bool log_panel = take_screenshot && panel_text != nullptr && *panel_text != '\0';
+  if (log_panel) {
+    std::remove(panel_text);
+    ImGui::LogToFile(-1, panel_text);
+  }
+  const PanelAction action = draw_panel(*layout_, kPanelWidthPx, panel);
+  if (log_panel) ImGui::LogFinish();
+  if (action != PanelAction::none) action_ = action;
   ImGui::Render();
   int width = 0;
   int height = 0;

@@ -16,6 +16,7 @@
 #include "calligraphy/core/device_types.hpp"
 #include "trainer/hosted_session_view.hpp"
 #include "trainer/layout.hpp"
+#include "trainer/learner_text.hpp"
 #include "trainer/practice_controller.hpp"
 #include "trainer/quiz_log.hpp"
 #include "trainer/scene_view.hpp"
@@ -50,6 +51,7 @@ class TrainerApp {
   void update_pointer();
   void end_after_lost_display();
   void show_row(const std::vector<std::size_t>& characters);
+  void act(PanelAction action);
   [[nodiscard]] const TrialView* trial_view() const;
   [[nodiscard]] bool screenshot_due() const;
   [[nodiscard]] int exit_status() const;
@@ -66,6 +68,7 @@ class TrainerApp {
   std::optional<PracticeController> practice_;
   std::optional<HostedSessionView> session_;
   QuizLog quiz_log_;
+  LearnerDevice learner_device_ = LearnerDevice::mouse;  // what the device line says
   // The window and what it draws.
   GLFWwindow* window_ = nullptr;
   ImFont* large_font_ = nullptr;
@@ -78,6 +81,7 @@ class TrainerApp {
   bool quit_seen_ = false;
   bool screenshot_taken_ = false;
   bool screenshot_failed_ = false;
+  PanelAction action_ = PanelAction::none;  // a panel button pressed in the last frame
   // Measurements.
   Clock::time_point started_;
   std::size_t frames_ = 0;

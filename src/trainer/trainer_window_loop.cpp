@@ -39,7 +39,8 @@ constexpr auto kSaveAfterLostDisplay = std::chrono::seconds(5);
 TrainerApp::TrainerApp(const TrainerOptions& options, DeviceInfo device_info, bool hardware,
                        const SessionLink* session)
     : options_(options),
-      quiz_log_(session ? "calligraphy session" : "calligraphy train", options.quiz_screenshots) {
+      quiz_log_(session ? "calligraphy session" : "calligraphy train", options.quiz_screenshots),
+      learner_device_(learner_device(options.device, hardware, options.simulated_writer)) {
   for (const TrainerCharacter& c : options.characters) art_.push_back(prepare_art(c));
   if (session != nullptr) {
     session_.emplace(*session, options_.characters, unattended());
@@ -131,7 +132,8 @@ void TrainerApp::loop() {
     }
     handle_keys();
     if (quit_ && !quit_seen_) {  // the picture at exit shows the window as it was when the exit came
-      if (!options_.screenshot.empty() && !screenshot_taken_ && !x11_error_seen() && trial_view())
+      const bool shows_something = trial_view() != nullptr || (practice_ && practice_->demonstrating());
+      if (!options_.screenshot.empty() && !screenshot_taken_ && !x11_error_seen() && shows_something)
         render(true);
       quit_seen_ = true;
     }
@@ -172,7 +174,27 @@ double TrainerApp::seconds_since_start() const {
   return std::chrono::duration<double>(Clock::now() - started_).count();
 }
 
+// A panel button: as its key.
+void TrainerApp::act(PanelAction action) {
+  if (!practice_) return;
+  switch (action) {
+    case PanelAction::demonstrate:
+      practice_->demonstrate();
+      break;
+    case PanelAction::restart:
+      practice_->ask_for(NextAction::repeat);
+      break;
+    case PanelAction::next:
+      practice_->ask_for(NextAction::next);
+      break;
+    case PanelAction::none:
+      break;
+  }
+}
+
 void TrainerApp::handle_keys() {
+  act(action_);
+  action_ = PanelAction::none;
   for (const int key : keys_) {
     switch (key) {
       case GLFW_KEY_Q:
@@ -188,6 +210,9 @@ void TrainerApp::handle_keys() {
         break;
       case GLFW_KEY_N:
         if (practice_) practice_->ask_for(NextAction::next);
+        break;
+      case GLFW_KEY_D:
+        if (practice_) practice_->demonstrate();
         break;
       case GLFW_KEY_G:
         if (practice_) practice_->toggle_guidance();

@@ -1,5 +1,7 @@
 #include "trainer/trial_view.hpp"
 
+#include <exception>
+
 #include "calligraphy/analysis/stroke_matcher.hpp"
 
 namespace calligraphy::trainer {
@@ -35,6 +37,7 @@ void TrialView::consume(DisplayChannel& channel, const std::vector<int>& typical
         r.time_s = e.stroke_time_s;
         r.attempts = e.attempts;
         results.push_back(r);
+        if (!quiz) feedback = stroke_written(e.stroke + 1, e.mean_deviation_m, acceptance);
         break;
       }
       case DisplayEventKind::stroke_abandoned: {
@@ -60,6 +63,11 @@ void TrialView::consume(DisplayChannel& channel, const std::vector<int>& typical
       }
       case DisplayEventKind::character_completed:
         break;
+      case DisplayEventKind::stroke_assisted:
+        // The trial demonstrated the stroke and credited it: drawn once over the paper, and said so.
+        assisted = Shown{e.character, e.stroke, std::chrono::steady_clock::now()};
+        feedback = stroke_assisted(e.stroke + 1);
+        break;
       case DisplayEventKind::trial_ended:
         ended = true;
         end = e.end;
@@ -72,6 +80,8 @@ void TrialView::consume(DisplayChannel& channel, const std::vector<int>& typical
         break;
     }
   }
+  // After the events: the miss that brought the hint is said first, then the hint.
+  follow_hint();
 }
 
 void TrialView::drain_trace(DisplayChannel& channel) {
@@ -153,6 +163,36 @@ void TrialView::refuse(RefusedStroke refused_stroke) {
   if (quiz) return;  // the quiz judges every stroke itself and shows its own verdicts
   refused = std::move(refused_stroke);
   ++refusals;
+  // The learner's line: where the attempt started against the stroke's start, and which stroke it wrote
+  // instead (the matcher's reading of the same path; off the servo thread).
+  RefusedAttempt attempt;
+  attempt.stroke_1based = refused->stroke + 1;
+  attempt.refusal = refused->refusal;
+  if (scene != nullptr && refused->character < scene->characters.size()) {
+    const PlacedCharacter& placed = scene->characters[refused->character];
+    attempt.start_radius_m = scene->layout.start_radius_m;
+    if (refused->stroke < placed.strokes.size() && !refused->points_m.empty()) {
+      attempt.start_offset_m = refused->points_m.front() - placed.strokes[refused->stroke].start();
+      if (refused->refusal == StrokeRefusal::wrong_order || refused->refusal == StrokeRefusal::wrong_stroke) {
+        try {
+          const StrokeMatch match = match_stroke(placed, refused->stroke, refused->points_m,
+                                                 scene->layout.start_radius_m, acceptance);
+          if (match.refusal == StrokeRefusal::wrong_order || match.refusal == StrokeRefusal::wrong_stroke)
+            attempt.written_instead_1based = match.matched_stroke + 1;
+        } catch (const std::exception&) {  // a path the matcher cannot read: the line names no stroke
+        }
+      }
+    }
+  }
+  feedback = stroke_refused(attempt);
+}
+
+// The trial shows the active stroke as a hint after misses (DisplaySnapshot::hint_shown): once per stroke.
+void TrialView::follow_hint() {
+  if (!snapshot.hint_shown || snapshot.finished || quiz) return;
+  if (hint && hint->character == snapshot.character && hint->stroke == snapshot.stroke) return;
+  hint = Shown{snapshot.character, snapshot.stroke, std::chrono::steady_clock::now()};
+  feedback = stroke_hint(snapshot.stroke + 1);
 }
 
 }  // namespace calligraphy::trainer

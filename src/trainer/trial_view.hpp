@@ -2,6 +2,7 @@
 // What the window shows of the trial that runs (or just ended), built on the window thread from the
 // display channel: the latest snapshot, the pen's trace per stroke, the per-stroke results, and the last
 // refused attempt with the library's reason.
+#include <chrono>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -12,6 +13,7 @@
 #include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/trial/display.hpp"
 #include "calligraphy/trial/result.hpp"
+#include "trainer/learner_text.hpp"
 #include "trainer/live_quiz.hpp"
 
 namespace calligraphy::trainer {
@@ -63,7 +65,19 @@ struct TrialView {
   std::optional<RefusedStroke> refused;
   std::size_t refusals = 0;         ///< attempts refused so far (abandoned in WS or judged from the path)
   std::size_t refusals_logged = 0;  ///< of which the window has printed
-  bool ended = false;               ///< the trial_ended event arrived
+  /// The last line of feedback for the learner (learner_text.hpp): the last stroke written, refused,
+  /// hinted or assisted; empty before the first.
+  std::optional<Feedback> feedback;
+  /// A stroke the trial demonstrated and credited (stroke_assisted), shown drawn once from `at`.
+  struct Shown {
+    std::uint32_t character = 0;  ///< index into the scene
+    std::uint32_t stroke = 0;     ///< within that character
+    std::chrono::steady_clock::time_point at;
+  };
+  std::optional<Shown> assisted;
+  /// The active stroke's hint (DisplaySnapshot::hint_shown), drawn once from `at` and then kept as a path.
+  std::optional<Shown> hint;
+  bool ended = false;  ///< the trial_ended event arrived
   TrialEnd end = TrialEnd::completed;
   // Filled in when the worker's result is taken.
   bool have_result = false;
@@ -86,6 +100,7 @@ struct TrialView {
   void follow_pen(const TracePoint& point);
   void judge_pen_down_path();
   void refuse(RefusedStroke refused_stroke);
+  void follow_hint();
 
   // The pen-down in progress (from touch-down to lift), for judging one that never enters WS.
   bool pen_down_ = false;

@@ -27,6 +27,8 @@ const char* to_string(DisplayEventKind kind) noexcept {
       return "character_completed";
     case DisplayEventKind::trial_ended:
       return "trial_ended";
+    case DisplayEventKind::stroke_assisted:
+      return "stroke_assisted";
   }
   return "unknown";
 }

@@ -204,6 +204,10 @@ def is_accepted(r, g, b):  # the quiz's accepted stroke (20, 150, 60)
     return g > 120 and r < 60 and b < 100
 
 
+def is_demo_ink(r, g, b):  # the demonstration's ink, Hanzi Writer's stroke colour #555
+    return all(abs(c - 85) <= 6 for c in (r, g, b))
+
+
 def is_hint(r, g, b):  # the quiz's hint, Hanzi Writer's highlight colour #AAF
     return b > 230 and 140 < r < 200 and 140 < g < 200
 
@@ -515,7 +519,7 @@ class TrainerTest(unittest.TestCase):
         self.write_like_a_person("mouse-hand", settle_s=0.45, press_s=0.3)
 
     def test_a_refused_stroke_stays_faded_and_the_panel_says_why(self):
-        trainer = self.start("十", "--device", "mouse", "--screenshot", "refused.png")
+        trainer = self.start("十", "--device", "mouse", "--no-demo", "--screenshot", "refused.png")
         (box,) = trainer.boxes()
         hand = trainer.hand(box, seed=11)
         across, down = medians("十")
@@ -678,6 +682,84 @@ class PeopleOutputTest(unittest.TestCase):
             self.assertFalse(line.startswith("box "), "a box line without CALLIGRAPHY_PRINT_BOXES: " + line)
             self.assertNotRegex(line, r"\bnan\b", line)
         self.assertEqual(out, "", "train prints nothing on standard output")
+
+    def panel_text(self, *args):
+        """`train ARGS --screenshot` to its end, with the panel's text of the picture at the end written to a file
+        (CALLIGRAPHY_PANEL_TEXT, docs/trainer.md); returns that text, stdout and stderr."""
+        text = pathlib.Path(self.folder) / "panel.txt"
+        environment = dict(os.environ, CALLIGRAPHY_PANEL_TEXT=str(text))
+        self.trainer = Trainer(*args, "--screenshot", "panel.png", folder=self.folder, environment=environment)
+        status = self.trainer.wait(timeout=60)
+        self.assertEqual(status, 0, self.trainer.errors())
+        self.assertTrue(text.exists(), "no panel text: " + self.trainer.errors())
+        return text.read_text(encoding="utf-8"), self.trainer.output(), self.trainer.errors()
+
+    def test_the_learner_view_speaks_to_a_learner_and_says_what_to_do_with_a_mouse(self):
+        panel, out, err = self.panel_text("一", "--device", "mouse", "--data", SAMPLE, "--exit-after", "1.5")
+        self.assert_for_people(out, err)
+        self.assertIn("Hold the left mouse button and draw each stroke; a mouse cannot push back, so nothing is "
+                      "felt.", panel)
+        self.assertIn("Stroke 1 of 1", panel)
+        for word in (r"\bSS\b", r"\bAS\b", r"\bCS\b", r"\bWS\b", r"\btick\b", r"\belement\b",
+                     r"guidance on", r"\bN\b.*\bnormal\b"):
+            self.assertNotRegex(panel, word, "an engineer's term in the learner's view:\n" + panel)
+
+    def test_the_engineer_view_shows_states_ticks_elements_and_forces(self):
+        panel, out, err = self.panel_text("一", "--device", "mouse", "--data", SAMPLE, "--exit-after", "1.5",
+                                          "--engineer")
+        self.assert_for_people(out, err)
+        self.assertRegex(panel, r"\b(SS|AS|CS|WS)\b")
+        self.assertRegex(panel, r"\btick \d+")
+        self.assertRegex(panel, r"\belement \d+")
+        self.assertIn("force in plane", panel)
+        self.assertNotIn("guidance on", panel, "a mouse feels no guidance:\n" + panel)
+        self.assertIn("vision, no force output: guidance not felt", panel)
+
+    def test_the_stroke_order_is_shown_before_writing_and_no_trial_runs_meanwhile(self):
+        self.trainer = Trainer("永", "--device", "mouse", "--screenshot", "demo.png", folder=self.folder,
+                               environment=boxes_environment())
+        (box,) = self.trainer.boxes()
+        self.trainer.wait_for("calligraphy train: demonstrating the stroke order of 永 (5 strokes")
+        # 0.5 s pause, the dot (at least 0.25 s), 0.5 s pause, then stroke 2 for over a second: at 1.2 s the dot
+        # is drawn and the demonstration still runs (4.6 s in all).
+        time.sleep(1.2)
+        window = self.trainer.window()
+        xdotool("windowfocus", "--sync", window)
+        xdotool("key", "--window", window, "q")
+        self.assertEqual(self.trainer.wait(timeout=30), 0, self.trainer.errors())
+        self.assertNotIn("trial 1", self.trainer.errors(), "a trial ran during the demonstration")
+        self.assertEqual(self.trainer.output(), "")
+        picture = pathlib.Path(self.folder) / "demo.png"
+        keep_artifact(picture)
+        image = read_png(picture)
+        dot = medians("永")[0]
+        ink = [near(image, box.data_to_px(p), 4, is_demo_ink) for p in along(dot, [i / 10 for i in range(2, 9)])]
+        self.assertGreater(fraction(ink), 0.9, "stroke 1 drawn in the demonstration's ink")
+        x, y = box.data_to_px(dot[0])
+        self.assertTrue(near(image, (x - 16, y - 16), 12, is_red), "stroke 1 numbered at its start")
+        inside = [(x, y) for x in range(int(box.x), int(box.x + box.size), 6)
+                  for y in range(int(box.y), int(box.y + box.size), 6)]
+        self.assertFalse(any(is_blue(*image.pixel(x, y)) for x, y in inside),
+                         "no reference and no trial drawn during the demonstration")
+
+    def test_d_ends_the_trial_and_demonstrates_the_stroke_order(self):
+        text = pathlib.Path(self.folder) / "panel.txt"
+        environment = boxes_environment(dict(os.environ, CALLIGRAPHY_PANEL_TEXT=str(text)))
+        self.trainer = Trainer("十", "--device", "mouse", "--no-demo", "--screenshot", "demo.png", folder=self.folder,
+                               environment=environment)
+        self.trainer.boxes()
+        self.assertNotIn("demonstrating", self.trainer.errors(), "--no-demo: writing starts at once")
+        window = self.trainer.window()
+        xdotool("windowfocus", "--sync", window)
+        xdotool("key", "--window", window, "d")
+        self.trainer.wait_for("trial 1 十: interrupted by D (demonstration)")
+        self.trainer.wait_for("calligraphy train: demonstrating the stroke order of 十")
+        xdotool("key", "--window", window, "q")
+        self.assertEqual(self.trainer.wait(timeout=30), 0, self.trainer.errors())
+        keep_artifact(pathlib.Path(self.folder) / "demo.png")
+        panel = text.read_text(encoding="utf-8")
+        self.assertRegex(panel, r"Watch: Stroke [12] of 2")
+        self.assertNotIn("trial 2", self.trainer.errors(), "no trial runs during the demonstration")
 
     def test_a_trial_stopped_by_exit_after_says_what_it_wrote_and_kept(self):
         status, out, err = self.run_train("永", "--writer", "simulated", "--session", "out", "--exit-after", "4")

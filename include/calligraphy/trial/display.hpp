@@ -73,6 +73,8 @@ struct DisplaySnapshot {
   DisplayPoint3 vtp_m;
   DisplayPoint3 force_n;      ///< the force commanded this tick [N]
   double pen_height_m = 0.0;  ///< HIP z minus the paper's z [m]; negative: depth below the paper
+  std::uint32_t misses = 0;  ///< refused attempts on the active stroke
+  bool hint_shown = false;  ///< the active stroke is shown as a hint (misses >= hint_after_misses)
 };
 
 enum class DisplayEventKind : std::uint8_t {
@@ -80,9 +82,10 @@ enum class DisplayEventKind : std::uint8_t {
   stroke_abandoned,     ///< the pen left the paper in WS unwritten (4.3.3); `refusal` says why
   character_completed,  ///< the last stroke of a character was written
   trial_ended,          ///< `TrialSession::finish` was called; `end` says how
+  stroke_assisted,  ///< the stroke was demonstrated and credited after assist_after_misses misses
 };
 
-/// "stroke_completed", "stroke_abandoned", "character_completed" or "trial_ended".
+/// "stroke_completed", "stroke_abandoned", "character_completed", "trial_ended" or "stroke_assisted".
 [[nodiscard]] const char* to_string(DisplayEventKind kind) noexcept;
 
 /// Something that happened at one tick, for the display to show once.
