@@ -14,7 +14,9 @@ the session.json `session run` wrote. Run by CTest as `study_designs_cli`:
   day 2 and a transfer set;
 - a Williams crossover of three conditions;
 - a mixed design: a between-subjects familiarisation beside a crossover (each subject its group's one
-  condition in practice, every group every sequence);
+  condition in practice, every group every sequence), and a between-subjects training on other characters
+  beside one;
+- random orders of conditions and characters, and groups drawn, run as the plan drew them;
 - what is refused when the protocol is read (exit 1, one line naming the JSON pointer, nothing written): a
   second training of a crossover's set, a tested character of no set or of two, a transfer chosen by coverage
   beside a crossover;
@@ -332,6 +334,67 @@ class DesignsCliTest(unittest.TestCase):
             self.assertEqual(row["group"], "A" if int(row["subject"][1:]) % 2 == 1 else "B")
             if row["phase"] == "practice":
                 self.assertEqual(row["condition"], row["group"])
+
+    def test_a_mixed_design_a_between_subjects_training_on_other_characters_beside_a_crossover(self):
+        protocol = self.crossover_protocol(2, "mixed-training")
+        protocol["conditions"] += [{"name": "F", "mode": "haptic"}, {"name": "G", "mode": "fading"},
+                                   {"name": "H", "mode": "vision"}]
+        protocol["phases"].insert(1, {"phase": "training", "conditions": ["F", "G", "H"],
+                                      "assignment": "between-subjects", "characters": ["大"]})
+        plan, written = self.run_design(protocol, 6)
+        self.assertEqual([s["group"] for s in plan["subjects"]], ["F", "G", "H"] * 2)
+        characters = {"s1": "十", "s2": "人"}
+
+        def expected(number):
+            trials = self.crossover_trials(["A", "B"], ["s1", "s2"], characters, number, groups=3)
+            group = "FGH"[(number - 1) % 3]
+            # After the pre-test (2 trials), the group's training on a character of no set.
+            return [trials[:2] + [{"phase": "training", "condition": group, "characters": "大", "item_set": "",
+                                   "trained_condition": "", "period": None}] + trials[2:]]
+
+        self.check_run(plan, written, expected)
+        # G = 3 groups beside a 2x2 crossover: every 12 subjects; the first 6 alternate the sequences.
+        self.assertEqual(plan["balance"]["square"], 12)
+        self.assertEqual([s["sequence"] for s in plan["subjects"]].count("AB"), 3)
+
+    def test_random_orders_and_drawn_groups_are_run_as_planned(self):
+        protocol = {"name": "drawn", "conditions": [{"name": "A", "mode": "vision"}, {"name": "B", "mode": "haptic"},
+                                                    {"name": "C", "mode": "fading"}],
+                    "phases": [{"phase": "pre-test", "conditions": ["A", "B", "C"], "characters": ["十", "人"]},
+                               {"phase": "training", "conditions": ["B", "C"], "assignment": "between-subjects",
+                                "characters": ["十"]}],
+                    "order": {"conditions": "random", "characters": "random", "seed": 7}, "trial": TRIAL}
+        plan, written = self.run_design(protocol, 3)
+        self.assertTrue(plan["balance"]["drawn"])
+        # The orders and groups are drawn per subject; what ran is what the plan drew, each condition once, each
+        # round every character once, the training in the subject's group.
+        orders = []
+        for subject in plan["subjects"]:
+            self.assertIn(subject["group"], ("B", "C"))
+            pre_test = subject["sessions"][0]["phases"][0]
+            order = [b["condition"] for b in pre_test["blocks"]]
+            self.assertEqual(sorted(order), ["A", "B", "C"])
+            orders.append(order)
+
+            def expected(number, order=order, group=subject["group"], id=subject["id"]):
+                manifest, _ = written[id][0]
+                characters = [t["characters"] for t in manifest["plan"]]
+                trials = []
+                for b, condition in enumerate(order):
+                    self.assertEqual(sorted(characters[2 * b:2 * b + 2]), ["人", "十"])
+                    trials += [{"phase": "pre-test", "condition": condition, "block": b + 1,
+                                "characters": characters[2 * b + i]} for i in (0, 1)]
+                return [trials + [{"phase": "training", "condition": group, "characters": "十"}]]
+
+            self.check_run({**plan, "subjects": [subject]}, written, expected)
+        # Drawn again for the same ids, the same orders.
+        self.assertEqual([[b["condition"] for b in s["sessions"][0]["phases"][0]["blocks"]]
+                          for s in self.plan_again("drawn.json", 3)["subjects"]], orders)
+
+    def plan_again(self, name, subjects):
+        again = self.run_cli("session", "plan", self.cwd / name, "--subjects", subjects, "--json")
+        self.assertEqual(again.returncode, 0, again.stderr.decode())
+        return json.loads(again.stdout)
 
     # ----------------------------------------------------------------------------------------- refusals
 
