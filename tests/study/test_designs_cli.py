@@ -23,7 +23,8 @@ the session.json `session run` wrote. Run by CTest as `study_designs_cli`:
 - a balance no study can reach, said in the plan `session run` prints and in `session plan --json`, and the
   sequences still balanced subject by subject;
 - a second `session run` of a two-session protocol into the same folder: it neither doubles nor loses a
-  session, and `--new-subjects` goes on with the counterbalancing.
+  session, and `--new-subjects` goes on with the counterbalancing; a series whose first session was planned
+  by another assignment rule is refused before its next session.
 
 CALLIGRAPHY_CLI names the program. Standard library only.
 """
@@ -507,6 +508,33 @@ class DesignsCliTest(unittest.TestCase):
                 for trial in manifest["plan"]:
                     self.assertEqual(trial["sequence"], sequence)
                     self.assertEqual(trial["trained_condition"], trained[trial["item_set"]][0])
+
+    def test_a_series_planned_by_another_assignment_is_refused_before_its_next_session(self):
+        # Session 1 of a two-day mixed design as an earlier rule planned it (every subject of the first G in
+        # sequence AB): its session 2 would put S02 in another sequence, and is refused naming session 1.
+        protocol = self.crossover_protocol(2, "earlier", practice_groups=["A", "B"])
+        protocol["phases"].append({"phase": "retention", "condition": "A", "sets": ["s1", "s2"], "session": 2,
+                                   "delay_s": 86400})
+        self.run_design(protocol, 2)
+        (first, second) = sorted(p for p in (self.cwd / "out" / "S02").iterdir() if p.is_dir())
+        for file in sorted(second.rglob("*"), reverse=True):
+            file.unlink() if file.is_file() else file.rmdir()
+        second.rmdir()
+        manifest_file = first / "session.json"
+        manifest = json.loads(manifest_file.read_text(encoding="utf-8"))
+        self.assertEqual({t["sequence"] for t in manifest["plan"]}, {"BA"})
+        for trial in manifest["plan"]:
+            trial["sequence"] = "AB"
+        manifest_file.write_text(json.dumps(manifest, ensure_ascii=False), encoding="utf-8")
+        before = digest_tree(self.cwd / "out")
+        again = self.run_cli("session", "run", self.cwd / "earlier.json", "--writer", "simulated", "--subjects", 2,
+                             "--writer-learning", "none", "--out", "out")
+        self.assertEqual(again.returncode, 1, again.stderr.decode())
+        message = again.stderr.decode()
+        self.assertIn(str(Path("out") / "S02" / first.name / "session.json"), message)
+        self.assertIn("was planned with group 'B' and sequence 'AB', but the protocol now assigns subject number 2 "
+                      "group 'B' and sequence 'BA'", message)
+        self.assertEqual(digest_tree(self.cwd / "out"), before)
 
 
 if __name__ == "__main__":
