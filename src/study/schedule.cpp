@@ -461,15 +461,17 @@ bool Counterbalancing::reachable() const noexcept { return drawn || square <= kM
 
 namespace {
 
-// "group: 14,942 of its 14,950 levels with 0 subjects, 8 with 1": a factor of many levels, counted.
-std::string counted_levels(const BalanceFactor& factor) {
+// "group: 14,942 of its 14,950 levels with 0 subjects, 8 with 1": a factor of many levels, counted. Beyond
+// kMaxBalanceSquareShown only the levels the subjects have are known: "8 levels with 1 subject".
+std::string counted_levels(const BalanceFactor& factor, bool every_level) {
   std::map<std::size_t, std::size_t> levels_with;  // subjects -> levels with that many
   for (const std::size_t count : factor.subjects) ++levels_with[count];
   std::string text = factor.name + ": ";
   bool first = true;
   for (const auto& [count, levels] : levels_with) {
-    text += first ? thousands(levels) + " of its " + thousands(factor.levels.size()) + " levels with " +
-                        std::to_string(count) + (count == 1 ? " subject" : " subjects")
+    text += first ? thousands(levels) +
+                        (every_level ? " of its " + thousands(factor.levels.size()) + " levels" : " levels") +
+                        " with " + std::to_string(count) + (count == 1 ? " subject" : " subjects")
                   : ", " + thousands(levels) + " with " + std::to_string(count);
     first = false;
   }
@@ -495,7 +497,8 @@ std::string Counterbalancing::warning() const {
     for (const std::size_t count : factor.subjects) even &= count == factor.subjects.front();
     if (even) continue;
     if (factor.levels.size() > kListedLevels) {
-      parts += (parts.empty() ? "" : "; ") + counted_levels(factor);
+      parts +=
+          (parts.empty() ? "" : "; ") + counted_levels(factor, !drawn && square <= kMaxBalanceSquareShown);
       continue;
     }
     std::vector<std::size_t> order(factor.levels.size());
