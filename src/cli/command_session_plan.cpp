@@ -40,13 +40,8 @@ SubjectShown show_subject(const StudyProtocol& protocol, const SubjectAssignment
   shown.group = subject_group(protocol, subject);
   const CrossoverAssignment crossover = crossover_assignment(protocol, subject);
   shown.sequence = crossover.sequence;
-  const SubjectAssignment one[] = {subject};
-  for (const BalanceFactor& factor : counterbalancing(protocol, one).factors) {
-    if (factor.name != "set pairing") continue;
-    for (std::size_t i = 0; i < factor.levels.size(); ++i) {
-      if (factor.subjects[i] == 1) shown.pairing = factor.levels[i];
-    }
-  }
+  // From the assignment itself: counting a one-subject balance would walk the whole square per subject.
+  shown.pairing = set_pairing(protocol, crossover);
   for (int number = 1; number <= protocol.session_count(); ++number) {
     SessionShown session;
     session.number = number;

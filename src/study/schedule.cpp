@@ -374,6 +374,22 @@ std::size_t counterbalancing_square(const StudyProtocol& protocol) {
   return square;
 }
 
+std::string set_pairing(const StudyProtocol& protocol, const CrossoverAssignment& assignment) {
+  const ProtocolPhase* crossover = protocol.crossover_phase();
+  std::string pairing;
+  if (crossover == nullptr) return pairing;
+  for (std::size_t i = 0; i < crossover->conditions.size(); ++i) {
+    for (std::size_t p = 0; p < assignment.conditions.size(); ++p) {
+      if (assignment.conditions[p] != crossover->conditions[i]) continue;
+      if (!pairing.empty()) pairing.push_back(' ');
+      pairing.push_back(static_cast<char>('A' + i));
+      pairing.push_back(':');
+      pairing.append(assignment.sets[p]);
+    }
+  }
+  return pairing;
+}
+
 namespace {
 
 // The level of each factor the protocol counterbalances, for one subject, by the assignment functions above.
@@ -387,17 +403,7 @@ std::vector<std::pair<std::string, std::string>> balance_levels(const StudyProto
   if (const ProtocolPhase* crossover = protocol.crossover_phase(); crossover != nullptr) {
     const CrossoverAssignment assignment = crossover_assignment(protocol, subject);
     levels.emplace_back("sequence", assignment.sequence);
-    std::string pairing;
-    for (std::size_t i = 0; i < crossover->conditions.size(); ++i) {
-      for (std::size_t p = 0; p < assignment.conditions.size(); ++p) {
-        if (assignment.conditions[p] != crossover->conditions[i]) continue;
-        if (!pairing.empty()) pairing.push_back(' ');
-        pairing.push_back(static_cast<char>('A' + i));
-        pairing.push_back(':');
-        pairing.append(assignment.sets[p]);
-      }
-    }
-    levels.emplace_back("set pairing", pairing);
+    levels.emplace_back("set pairing", set_pairing(protocol, assignment));
   }
   if (protocol.condition_order != ConditionOrder::fixed) {
     for (const ProtocolPhase& phase : protocol.phases) {

@@ -94,6 +94,11 @@ struct CrossoverAssignment {
 [[nodiscard]] CrossoverAssignment crossover_assignment(const StudyProtocol& protocol,
                                                        const SubjectAssignment& subject);
 
+/// The crossover's pairing of conditions and sets in `assignment` (of `protocol`'s crossover phase): each
+/// listed condition's letter and the set it trains, in listed order ("A:set1 B:set2"); "" without a
+/// crossover phase.
+[[nodiscard]] std::string set_pairing(const StudyProtocol& protocol, const CrossoverAssignment& assignment);
+
 /// The subject's group: the conditions `block_conditions` gives it in the protocol's between-subjects
 /// phases, joined by "/" in phase order; "" when every phase is within subjects. Throws as
 /// `block_conditions`.
