@@ -144,3 +144,56 @@ TEST_CASE("each phase's trials are where plan_session puts them", "[study][balan
       CHECK(trials[i].phase == phases[1].phase->kind);
   }
 }
+
+TEST_CASE("a square no study reaches is said, and a mixed design's sequences alternate subject by subject",
+          "[study][balance]") {
+  // Between-subjects phases of 23, 25 and 26 conditions: the groups repeat every 14,950 subjects, the square
+  // beside a 2x2 crossover is 59,800.
+  // The first n conditions as a JSON list, and every condition defined (appended: GCC 12 at -O3 warns wrongly
+  // about "x" + std::string).
+  const auto first = [](int n) {
+    std::string listed = "[";
+    for (int i = 1; i <= n; ++i)
+      listed.append(i == 1 ? "\"c" : ", \"c").append(std::to_string(i)).append("\"");
+    return listed.append("]");
+  };
+  std::string conditions;
+  for (int i = 1; i <= 26; ++i) {
+    conditions.append(i == 1 ? "" : ", ").append(R"({"name": "c)").append(std::to_string(i));
+    conditions.append(R"(", "mode": "vision"})");
+  }
+  const std::string names = first(26);
+  const StudyProtocol protocol =
+      parse_study_protocol(R"({"name": "huge", "conditions": [)" + conditions + R"(],
+          "item_sets": [{"name": "s1", "characters": ["十"]}, {"name": "s2", "characters": ["人"]}],
+          "phases": [
+            {"phase": "practice", "conditions": )" +
+                               names + R"(, "assignment": "between-subjects", "characters": ["口"]},
+            {"phase": "training", "conditions": )" +
+                               first(23) + R"(, "assignment": "between-subjects", "characters": ["大"]},
+            {"phase": "training", "conditions": )" +
+                               first(25) + R"(, "assignment": "between-subjects", "characters": ["山"]},
+            {"phase": "training", "conditions": ["c1", "c2"], "assignment": "crossover", "sets": ["s1", "s2"]}]})",
+                           "huge.json");
+  CHECK(counterbalancing_square(protocol) == 59800);
+  const Counterbalancing eight = counterbalancing(protocol, subjects(8));
+  CHECK_FALSE(eight.reachable());
+  CHECK(eight.groups == 14950);
+  const std::string warning = eight.warning();
+  CHECK_THAT(warning, Catch::StartsWith("a full counterbalancing square is 59,800 subjects (the "
+                                        "between-subjects groups alone repeat every 14,950), more than any "
+                                        "study can recruit (at most 1,000): no N balances this design; N=8"));
+  CHECK_THAT(warning, Catch::Contains("group: 14,942 of its 14,950 levels with 0 subjects, 8 with 1"));
+  CHECK(warning.size() < 400);
+  // Every subject its own group, and the crossover's cells in turn: sequence and pairing balanced over 4.
+  CHECK(factor(eight, "sequence").subjects == std::vector<std::size_t>{4, 4});
+  CHECK(factor(eight, "set pairing").subjects == std::vector<std::size_t>{4, 4});
+  for (std::size_t n = 1; n <= 8; ++n) {
+    const auto [group, sequence, rotation] = assignment(protocol, n);
+    CHECK(sequence == (n % 2 == 1 ? "AB" : "BA"));
+    CHECK(rotation == ((n - 1) / 2) % 2);
+  }
+  // A square a study can reach is not said to be beyond one.
+  CHECK(counterbalancing(crossover(2), subjects(5)).reachable());
+  CHECK_THAT(counterbalancing(crossover(2), subjects(5)).warning(), Catch::StartsWith("N=5 does not fill"));
+}

@@ -439,3 +439,94 @@ TEST_CASE("a mixed design counts the crossover's subjects within their between-s
     for (const auto& [key, count] : counts) CHECK(count == 2);
   }
 }
+
+TEST_CASE("a between-subjects familiarisation beside a crossover gives each subject its group's condition",
+          "[study][crossover]") {
+  const StudyProtocol protocol = parse_study_protocol(crossover_text(R"([
+      {"phase": "practice", "conditions": ["A", "B"], "assignment": "between-subjects", "characters": ["大"]},
+      {"phase": "pre-test", "condition": "A", "sets": ["s1", "s2"]},
+      {"phase": "training", "conditions": ["A", "B"], "assignment": "crossover", "sets": ["s1", "s2"]}])"),
+                                                      "mixed.json");
+  std::map<std::string, std::set<std::string>> cells;  // group -> sequence and rotation
+  for (std::size_t number = 1; number <= 8; ++number) {
+    const SubjectAssignment subject{subject_id(number), number};
+    const std::string group = number % 2 == 1 ? "A" : "B";
+    INFO("subject " << number);
+    CHECK(subject_group(protocol, subject) == group);
+    CHECK(block_conditions(protocol, protocol.phases[0], subject) == std::vector<std::string>{group});
+    const std::vector<PlannedTrial> trials = plan_session(protocol, subject);
+    REQUIRE(trials.size() == 1 + 3 + 3);
+    CHECK(trials[0].phase == StudyPhase::practice);
+    CHECK(trials[0].condition == group);
+    const CrossoverAssignment crossover = crossover_assignment(protocol, subject);
+    for (const PlannedTrial& trial : trials) CHECK(trial.sequence == crossover.sequence);
+    cells[group].insert(crossover.sequence + std::to_string(crossover.rotation));
+  }
+  // Each group gets every sequence and rotation over its 4 subjects.
+  CHECK(cells["A"] == std::set<std::string>{"AB0", "BA0", "AB1", "BA1"});
+  CHECK(cells["B"] == cells["A"]);
+  CHECK(counterbalancing_square(protocol) == 8);
+}
+
+TEST_CASE("a second training of a crossover's set is refused naming its pointer", "[study][crossover]") {
+  const std::string crossover =
+      R"({"phase": "training", "conditions": ["A", "B"], "assignment": "crossover", "sets": ["s1", "s2"]})";
+  // Between subjects on a set, within subjects on a character of one, before or after the crossover.
+  check_error(crossover_text("[" + crossover + R"(,
+      {"phase": "training", "conditions": ["A", "B"], "assignment": "between-subjects", "sets": ["s3", "s2"]}])"),
+              "/phases/1/sets/1", R"(the item set "s2" is trained in the crossover phase /phases/0)");
+  check_error(crossover_text(R"([{"phase": "training", "condition": "C", "characters": ["山", "十口"]}, )" +
+                             crossover + "]"),
+              "/phases/0/characters/1", R"("十" is in the item set "s1", trained in the crossover phase)");
+  check_error(
+      crossover_text("[" + crossover + R"(, {"phase": "training", "condition": "C", "sets": ["t1"]}])"),
+      "/phases/1/sets/0", R"(the item set "t1" is the transfer items of "s1")");
+  // A set the crossover does not train may be trained elsewhere, and practised anywhere.
+  const StudyProtocol other = parse_study_protocol(
+      crossover_text(R"([{"phase": "practice", "condition": "B", "characters": ["十"]}, )" + crossover + R"(,
+      {"phase": "training", "conditions": ["A", "B"], "assignment": "between-subjects", "sets": ["s3"]}])"),
+      "p.json");
+  CHECK(plan_session(other, {"S1", 1}).back().trained_condition.empty());
+}
+
+TEST_CASE("a crossover's tests that list characters are attributed to their sets, or refused by the item",
+          "[study][crossover]") {
+  const std::string head = R"([{"phase": "pre-test", "condition": "A", )";
+  const std::string tail = R"(},
+      {"phase": "training", "conditions": ["A", "B"], "assignment": "crossover", "sets": ["s1", "s2"]},
+      {"phase": "transfer", "condition": "A", "characters": ["中"]}])";
+  const StudyProtocol by_sets =
+      parse_study_protocol(crossover_text(head + R"("sets": ["s1", "s2"])" + tail), "p.json");
+  const StudyProtocol by_characters =
+      parse_study_protocol(crossover_text(head + R"("characters": ["十", "人", "口十"])" + tail), "p.json");
+  CHECK(by_characters.phases[0].item_sets == std::vector<std::string>{"s1", "s2", "s1"});
+  CHECK(by_characters.phases[2].item_sets == std::vector<std::string>{"t1"});
+  for (std::size_t number = 1; number <= 4; ++number) {
+    const SubjectAssignment subject{subject_id(number), number};
+    const CrossoverAssignment crossover = crossover_assignment(by_characters, subject);
+    for (const PlannedTrial& trial : plan_session(by_characters, subject)) {
+      if (trial.phase == StudyPhase::training) continue;
+      INFO("subject " << number << " trial " << trial.index);
+      REQUIRE_FALSE(trial.item_set.empty());
+      CHECK(trial.trained_condition == crossover.trained.at(trial.item_set).condition);
+      CHECK(trial.period == crossover.trained.at(trial.item_set).period);
+    }
+    // The same attribution as the phase given by its sets.
+    const std::vector<PlannedTrial> listed = plan_session(by_sets, subject);
+    const std::vector<PlannedTrial> named = plan_session(by_characters, subject);
+    CHECK(listed[0].trained_condition == named[0].trained_condition);
+    CHECK(listed[2].trained_condition == named[1].trained_condition);
+  }
+  check_error(crossover_text(head + R"("characters": ["十", "大"])" + tail), "/phases/0/characters/1",
+              R"("大" is in no item set)");
+  check_error(crossover_text(head + R"("characters": ["十人"])" + tail), "/phases/0/characters/0",
+              R"("十人" holds characters of the item sets "s1" and "s2")");
+  check_error(crossover_text(head + R"("sets": ["s1"]},
+      {"phase": "training", "conditions": ["A", "B"], "assignment": "crossover", "sets": ["s1", "s2"]},
+      {"phase": "transfer", "condition": "A", "characters": {"choose": 1, "from": ["大", "山"]}}])"),
+              "/phases/2/characters", "chosen by coverage are in no set");
+  // Without a crossover, characters of no set stay as they were.
+  const StudyProtocol plain = parse_study_protocol(
+      crossover_text(R"([{"phase": "training", "condition": "A", "characters": ["大"]}])"), "p.json");
+  CHECK(plain.phases[0].item_sets.empty());
+}

@@ -1,5 +1,6 @@
 // `calligraphy session plan PROTOCOL --subjects N [--json]`: what `session run` would run, subject by
 // subject, and how N subjects fill the protocol's counterbalancing, without running or writing anything.
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -39,13 +40,8 @@ SubjectShown show_subject(const StudyProtocol& protocol, const SubjectAssignment
   shown.group = subject_group(protocol, subject);
   const CrossoverAssignment crossover = crossover_assignment(protocol, subject);
   shown.sequence = crossover.sequence;
-  const SubjectAssignment one[] = {subject};
-  for (const BalanceFactor& factor : counterbalancing(protocol, one).factors) {
-    if (factor.name != "set pairing") continue;
-    for (std::size_t i = 0; i < factor.levels.size(); ++i) {
-      if (factor.subjects[i] == 1) shown.pairing = factor.levels[i];
-    }
-  }
+  // From the assignment itself: counting a one-subject balance would walk the whole square per subject.
+  shown.pairing = set_pairing(protocol, crossover);
   for (int number = 1; number <= protocol.session_count(); ++number) {
     SessionShown session;
     session.number = number;
@@ -91,13 +87,23 @@ std::string phase_items(const ProtocolPhase& phase) {
   for (std::size_t i = 0; i < phase.items.size() && i < kShown; ++i)
     text += (i == 0 ? "" : " ") + encode_utf8(phase.items[i]);
   if (phase.items.size() > kShown) text += " and " + std::to_string(phase.items.size() - kShown) + " more";
+  // Characters a crossover protocol attributes to the sets holding them.
+  std::vector<std::string> sets;
+  for (const std::string& set : phase.item_sets) {
+    if (std::find(sets.begin(), sets.end(), set) == sets.end()) sets.push_back(set);
+  }
+  for (std::size_t i = 0; i < sets.size(); ++i)
+    text += (i == 0 ? (sets.size() == 1 ? " (of set " : " (of sets ") : ", ") + sets[i];
+  if (!sets.empty()) text += ")";
   return text;
 }
 
 std::string phase_line(const PlannedPhase& planned) {
   const ProtocolPhase& phase = *planned.phase;
-  std::string line =
-      std::string(to_string(phase.kind)) + " (" + phase.pointer + ", " + to_string(phase.assignment) + "): ";
+  // A practice phase is the familiarisation: written first and not among the phases compared.
+  std::string line = std::string(to_string(phase.kind)) + " (" + phase.pointer + ", " +
+                     to_string(phase.assignment) +
+                     (phase.kind == StudyPhase::practice ? ", familiarisation" : "") + "): ";
   for (std::size_t b = 0; b < planned.blocks.size(); ++b) {
     line += (b == 0 ? "" : ", then ") + planned.blocks[b];
     if (!planned.block_sets[b].empty()) line += " on " + planned.block_sets[b];
@@ -148,12 +154,12 @@ std::string session_plan_text(const LoadedProtocol& loaded, std::span<const Subj
   } else if (balance.square == 1) {
     text += "nothing is counterbalanced by subject number (every subject has the same plan)";
   } else {
-    text += "a full counterbalancing square is " + std::to_string(balance.square) + " subjects";
+    text += "a full counterbalancing square is " + thousands(balance.square) + " subjects";
     std::string factors;
     for (const BalanceFactor& factor : balance.factors)
-      factors +=
-          (factors.empty() ? "" : " x ") + factor.name + " (" + std::to_string(factor.levels.size()) + ")";
+      factors += (factors.empty() ? "" : " x ") + factor.name + " (" + thousands(factor.levels.size()) + ")";
     if (!factors.empty()) text += " over " + factors;
+    if (!balance.reachable()) text += ", more than any study can recruit";
   }
   text += "\n";
   if (const std::string warning = balance.warning(); !warning.empty()) text += "warning: " + warning + "\n";
@@ -203,6 +209,7 @@ std::string session_plan_json(const LoadedProtocol& loaded, std::span<const Subj
         Json items = Json::array();
         for (const std::u32string& item : planned.phase->items) items.push_back(encode_utf8(item));
         phase["items"] = items;
+        phase["item_sets"] = planned.phase->item_sets;
         phase["repetitions"] = planned.phase->repetitions;
         phase["first_trial"] = planned.first_trial;
         phase["trials"] = planned.trials;
@@ -223,9 +230,10 @@ std::string session_plan_json(const LoadedProtocol& loaded, std::span<const Subj
       levels.push_back({{"level", factor.levels[i]}, {"subjects", factor.subjects[i]}});
     factors.push_back({{"name", factor.name}, {"levels", levels}});
   }
-  document["balance"] = {{"square", balance.square},   {"subjects", balance.subjects},
-                         {"filled", balance.filled()}, {"drawn", balance.drawn},
-                         {"factors", factors},         {"warning", balance.warning()}};
+  document["balance"] = {{"square", balance.square},    {"subjects", balance.subjects},
+                         {"filled", balance.filled()},  {"reachable", balance.reachable()},
+                         {"drawn", balance.drawn},      {"factors", factors},
+                         {"warning", balance.warning()}};
   return document.dump(2) + "\n";
 }
 

@@ -142,7 +142,9 @@ void read_phase_sets(const json& value, const std::string& pointer, const std::s
 }
 
 std::string item_pointer(const StudyProtocol& protocol, const ProtocolPhase& phase, std::size_t index) {
-  if (phase.item_sets.empty() || index >= phase.item_sets.size()) {
+  // A phase that lists its characters is named there, its items mapped to sets (check_crossover_items) or
+  // not.
+  if (phase.sets.empty() || index >= phase.item_sets.size()) {
     return json_detail::child_pointer(json_detail::child_pointer(phase.pointer, "characters"), index);
   }
   const std::string& name = phase.item_sets[index];
@@ -156,6 +158,86 @@ std::string item_pointer(const StudyProtocol& protocol, const ProtocolPhase& pha
                                      static_cast<std::size_t>(set - protocol.item_sets.begin())),
           "characters"),
       position);
+}
+
+void check_crossover_items(StudyProtocol& protocol, const std::string& source) {
+  const ProtocolPhase* crossover = protocol.crossover_phase();
+  if (crossover == nullptr) return;
+  // Each character's set, and whether the crossover trains it (its own sets and their transfer sets).
+  std::map<char32_t, const ItemSet*> set_of;
+  for (const ItemSet& set : protocol.item_sets) {
+    for (const std::u32string& item : set.items) {
+      for (const char32_t c : item) set_of.emplace(c, &set);
+    }
+  }
+  const auto trained_by_crossover = [&](const ItemSet& set) {
+    const std::string& trained = set.transfer_of.empty() ? set.name : set.transfer_of;
+    return std::find(crossover->sets.begin(), crossover->sets.end(), trained) != crossover->sets.end();
+  };
+  for (ProtocolPhase& phase : protocol.phases) {
+    if (&phase == crossover || phase.kind == StudyPhase::practice) continue;
+    const std::string characters = json_detail::child_pointer(phase.pointer, "characters");
+    if (phase.kind == StudyPhase::training) {
+      // A second training of a crossover set would train it under another condition than its one.
+      for (std::size_t k = 0; k < phase.items.size(); ++k) {
+        for (const char32_t c : phase.items[k]) {
+          const auto found = set_of.find(c);
+          if (found == set_of.end() || !trained_by_crossover(*found->second)) continue;
+          const ItemSet& set = *found->second;
+          // A phase's set by its place in "sets", a listed character by its place in "characters".
+          std::string at = json_detail::child_pointer(characters, k);
+          std::string what = in_quotes(encode_utf8(c)) + " is in the item set " + in_quotes(set.name) + ", ";
+          if (!phase.sets.empty()) {
+            const auto listed = std::find(phase.sets.begin(), phase.sets.end(), phase.item_sets[k]);
+            at = json_detail::child_pointer(json_detail::child_pointer(phase.pointer, "sets"),
+                                            static_cast<std::size_t>(listed - phase.sets.begin()));
+            what = "the item set " + in_quotes(set.name) + " is ";
+          }
+          what += set.transfer_of.empty() ? std::string("trained in the crossover phase ")
+                                          : "the transfer items of " + in_quotes(set.transfer_of) +
+                                                ", trained in the crossover phase ";
+          json_detail::fail(source, at,
+                            what + crossover->pointer +
+                                " under one condition a subject; a second training phase on it would "
+                                "train it under another, and its trials could not be attributed to one "
+                                "condition: train other characters here, or list this phase's conditions "
+                                "in the crossover");
+        }
+      }
+      continue;
+    }
+    if (!phase.sets.empty()) continue;
+    // A test phase that lists its characters: each item is attributed by the one set holding it.
+    if (phase.choice) {
+      json_detail::fail(source, characters,
+                        "a crossover attributes each tested item to the condition its set is trained under, "
+                        "and characters chosen by coverage are in no set: give the transfer items as an "
+                        "item set with \"transfer_of\" and this phase \"sets\"");
+    }
+    std::vector<std::string> mapped;
+    for (std::size_t k = 0; k < phase.items.size(); ++k) {
+      const ItemSet* set = nullptr;
+      for (const char32_t c : phase.items[k]) {
+        const auto found = set_of.find(c);
+        if (found == set_of.end()) {
+          json_detail::fail(source, json_detail::child_pointer(characters, k),
+                            in_quotes(encode_utf8(c)) +
+                                " is in no item set: in a protocol with a crossover phase each tested item "
+                                "is attributed to the condition its set is trained under; list it in a set "
+                                "of \"item_sets\" or give this phase \"sets\"");
+        }
+        if (set != nullptr && set != found->second) {
+          json_detail::fail(source, json_detail::child_pointer(characters, k),
+                            in_quotes(encode_utf8(phase.items[k])) + " holds characters of the item sets " +
+                                in_quotes(set->name) + " and " + in_quotes(found->second->name) +
+                                ": a tested item is attributed to one set's condition");
+        }
+        set = found->second;
+      }
+      mapped.push_back(set->name);
+    }
+    phase.item_sets = std::move(mapped);
+  }
 }
 
 }  // namespace study_detail

@@ -246,6 +246,7 @@ void read_phases(const json& value, const std::string& pointer, const std::strin
         "the first phase is in session 1");
   }
   check_design(protocol, pointer, source);
+  check_crossover_items(protocol, source);
 }
 
 }  // namespace calligraphy::study_detail

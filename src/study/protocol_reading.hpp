@@ -93,6 +93,12 @@ void read_phase_sets(const nlohmann::json& value, const std::string& pointer, co
 /// its item set's "characters" ("/item_sets/1/characters/0") when the phase gives "sets".
 std::string item_pointer(const StudyProtocol& protocol, const ProtocolPhase& phase, std::size_t index);
 
+/// With a crossover phase: refuses another training phase on an item of a set the crossover trains (or of
+/// its transfer set), naming the item's pointer, and attributes every item of a test phase that lists its
+/// characters to the one set holding all of them (`phase.item_sets`), refusing, by its pointer, an item of
+/// no set or of two, and a transfer test chosen by coverage. Practice phases are left as they are.
+void check_crossover_items(StudyProtocol& protocol, const std::string& source);
+
 /// The "phases" list of a protocol (format: docs/experiments.md), checked for order and sense; appended
 /// to `protocol.phases`. `protocol.conditions`, `protocol.item_sets` and the order must be read already.
 void read_phases(const nlohmann::json& value, const std::string& pointer, const std::string& source,

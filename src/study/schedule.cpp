@@ -159,11 +159,16 @@ CrossoverAssignment crossover_assignment(const StudyProtocol& protocol, const Su
   // after each other one, equally often. The rotation, advanced once per full set of rows, moves every
   // condition over every set, so that condition and set are balanced every rows x k subjects.
   const std::size_t rows = k % 2 == 0 ? k : 2 * k;
-  // In a mixed design the groups of the between-subjects phases take turns by number: counted within its
-  // group, every group gets every sequence and rotation (counted over all subjects, a group would get one).
-  const std::size_t within_group = (subject.number - 1) / between_subjects_cycle(protocol);
-  const std::size_t row = within_group % rows;
-  out.rotation = (within_group / rows) % k;
+  // In a mixed design the groups of the between-subjects phases take turns by number, g = (n - 1) mod G, and
+  // j = (n - 1) / G counts the subject within its group. The cell m = j + g (a cyclic Latin square of groups
+  // by subjects within the group) gives every group every sequence and rotation over its first rows x k
+  // subjects, and consecutive subjects consecutive cells, so that the sequences stay balanced over all
+  // subjects too: counted over all subjects alone, group and sequence could coincide (two groups, two
+  // sequences); counted within the group alone (m = j), G subjects in a row would share one sequence.
+  const std::size_t cycle = between_subjects_cycle(protocol);
+  const std::size_t cell = (subject.number - 1) / cycle + (subject.number - 1) % cycle;
+  const std::size_t row = cell % rows;
+  out.rotation = (cell / rows) % k;
   const std::vector<std::size_t> order = williams_row(k, row);
   for (std::size_t p = 0; p < k; ++p) {
     const std::size_t listed_index = order[p];
@@ -185,8 +190,10 @@ std::vector<std::string> block_conditions(const StudyProtocol& protocol, const P
                                           const SubjectAssignment& subject) {
   check_subject(subject);
   const std::vector<std::string>& listed = phase.conditions;
-  // Familiarisation is written as listed: the order counterbalances what is compared.
-  if (phase.kind == StudyPhase::practice) return listed;
+  // Familiarisation within subjects is written as listed: the order counterbalances what is compared. A
+  // between-subjects familiarisation gives the subject its group's one condition, as any between phase.
+  if (phase.kind == StudyPhase::practice && phase.assignment != ConditionAssignment::between_subjects)
+    return listed;
   if (phase.assignment == ConditionAssignment::crossover) {
     // The protocol's one crossover phase: its own counterbalanced order.
     if (protocol.crossover_phase() == &phase) return crossover_assignment(protocol, subject).conditions;
@@ -367,6 +374,22 @@ std::size_t counterbalancing_square(const StudyProtocol& protocol) {
   return square;
 }
 
+std::string set_pairing(const StudyProtocol& protocol, const CrossoverAssignment& assignment) {
+  const ProtocolPhase* crossover = protocol.crossover_phase();
+  std::string pairing;
+  if (crossover == nullptr) return pairing;
+  for (std::size_t i = 0; i < crossover->conditions.size(); ++i) {
+    for (std::size_t p = 0; p < assignment.conditions.size(); ++p) {
+      if (assignment.conditions[p] != crossover->conditions[i]) continue;
+      if (!pairing.empty()) pairing.push_back(' ');
+      pairing.push_back(static_cast<char>('A' + i));
+      pairing.push_back(':');
+      pairing.append(assignment.sets[p]);
+    }
+  }
+  return pairing;
+}
+
 namespace {
 
 // The level of each factor the protocol counterbalances, for one subject, by the assignment functions above.
@@ -380,17 +403,7 @@ std::vector<std::pair<std::string, std::string>> balance_levels(const StudyProto
   if (const ProtocolPhase* crossover = protocol.crossover_phase(); crossover != nullptr) {
     const CrossoverAssignment assignment = crossover_assignment(protocol, subject);
     levels.emplace_back("sequence", assignment.sequence);
-    std::string pairing;
-    for (std::size_t i = 0; i < crossover->conditions.size(); ++i) {
-      for (std::size_t p = 0; p < assignment.conditions.size(); ++p) {
-        if (assignment.conditions[p] != crossover->conditions[i]) continue;
-        if (!pairing.empty()) pairing.push_back(' ');
-        pairing.push_back(static_cast<char>('A' + i));
-        pairing.push_back(':');
-        pairing.append(assignment.sets[p]);
-      }
-    }
-    levels.emplace_back("set pairing", pairing);
+    levels.emplace_back("set pairing", set_pairing(protocol, assignment));
   }
   if (protocol.condition_order != ConditionOrder::fixed) {
     for (const ProtocolPhase& phase : protocol.phases) {
@@ -413,6 +426,7 @@ Counterbalancing counterbalancing(const StudyProtocol& protocol,
                                   std::span<const SubjectAssignment> subjects) {
   Counterbalancing out;
   out.square = counterbalancing_square(protocol);
+  out.groups = between_subjects_cycle(protocol);
   out.subjects = subjects.size();
   out.drawn = protocol.condition_order == ConditionOrder::random;
   const auto add = [&out](const std::vector<std::pair<std::string, std::string>>& levels, bool count) {
@@ -449,14 +463,50 @@ bool Counterbalancing::filled() const noexcept {
   return true;
 }
 
+bool Counterbalancing::reachable() const noexcept { return drawn || square <= kMaxReachableSquare; }
+
+namespace {
+
+// "group: 14,942 of its 14,950 levels with 0 subjects, 8 with 1": a factor of many levels, counted. Beyond
+// kMaxBalanceSquareShown only the levels the subjects have are known: "8 levels with 1 subject".
+std::string counted_levels(const BalanceFactor& factor, bool every_level) {
+  std::map<std::size_t, std::size_t> levels_with;  // subjects -> levels with that many
+  for (const std::size_t count : factor.subjects) ++levels_with[count];
+  std::string text = factor.name + ": ";
+  bool first = true;
+  for (const auto& [count, levels] : levels_with) {
+    text += first ? thousands(levels) +
+                        (every_level ? " of its " + thousands(factor.levels.size()) + " levels" : " levels") +
+                        " with " + std::to_string(count) + (count == 1 ? " subject" : " subjects")
+                  : ", " + thousands(levels) + " with " + std::to_string(count);
+    first = false;
+  }
+  return text;
+}
+
+}  // namespace
+
 std::string Counterbalancing::warning() const {
   if (filled() || subjects == 0) return {};
-  std::string text = "N=" + std::to_string(subjects);
+  std::string text;
+  if (!reachable()) {
+    text = "a full counterbalancing square is " + thousands(square) + " subjects";
+    if (groups > 1) text += " (the between-subjects groups alone repeat every " + thousands(groups) + ")";
+    text += ", more than any study can recruit (at most " + thousands(kMaxReachableSquare) +
+            "): no N balances this design; ";
+  }
+  text += "N=" + std::to_string(subjects);
   std::string parts;
+  constexpr std::size_t kListedLevels = 6;
   for (const BalanceFactor& factor : factors) {
     bool even = true;
     for (const std::size_t count : factor.subjects) even &= count == factor.subjects.front();
     if (even) continue;
+    if (factor.levels.size() > kListedLevels) {
+      parts +=
+          (parts.empty() ? "" : "; ") + counted_levels(factor, !drawn && square <= kMaxBalanceSquareShown);
+      continue;
+    }
     std::vector<std::size_t> order(factor.levels.size());
     std::iota(order.begin(), order.end(), std::size_t{0});
     std::stable_sort(order.begin(), order.end(), [&factor](std::size_t a, std::size_t b) {
@@ -478,8 +528,8 @@ std::string Counterbalancing::warning() const {
                           : " leaves " + parts + " (drawn per subject id, not balanced by number)";
     return text;
   }
-  text += " does not fill the counterbalancing square of " + std::to_string(square) +
-          " subjects (recruit a multiple of " + std::to_string(square) + ")";
+  text += " does not fill the counterbalancing square of " + thousands(square) + " subjects";
+  if (reachable()) text += " (recruit a multiple of " + thousands(square) + ")";
   text += parts.empty() ? ": its cells are filled unevenly" : ": it leaves " + parts;
   return text;
 }

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/study/schedule.hpp"
 #include "core/json_reader.hpp"
 #include "study/names.hpp"
 #include "study/saved_sessions.hpp"
@@ -41,6 +42,42 @@ void check_link(const fs::path& folder, const SessionManifest& manifest, const f
 }
 
 // Whether any planned trial of the session has no record (not only its last: a record may be lost).
+// A session planned before by another assignment (an earlier build of the library) than the protocol now
+// gives its subject: the next session would put the subject in another group or crossover sequence than the
+// sessions before it, and its trials would be attributed to other conditions.
+void check_assignment(const fs::path& folder, const SessionManifest& manifest,
+                      const StudyProtocol& protocol) {
+  const SubjectAssignment& subject = manifest.setup.subject;
+  std::string group;
+  CrossoverAssignment crossover;
+  try {
+    group = subject_group(protocol, subject);
+    crossover = crossover_assignment(protocol, subject);
+  } catch (const InvalidArgument&) {
+    return;  // no number to assign by: the next session's plan refuses it, naming the subject
+  }
+  std::string recorded_sequence;
+  bool pairing_differs = false;
+  for (const PlannedTrial& trial : manifest.plan) {
+    if (!trial.sequence.empty()) recorded_sequence = trial.sequence;
+    const auto trained = crossover.trained.find(trial.item_set);
+    if (!trial.trained_condition.empty() &&
+        (trained == crossover.trained.end() || trained->second.condition != trial.trained_condition))
+      pairing_differs = true;
+  }
+  if (manifest.group == group && (recorded_sequence.empty() || recorded_sequence == crossover.sequence) &&
+      !pairing_differs)
+    return;
+  throw DataError(SessionLayout::manifest(folder).string() + ": session " +
+                  std::to_string(manifest.setup.session_number) + " of subject " + subject.id +
+                  " was planned with group '" + manifest.group + "' and sequence '" + recorded_sequence +
+                  "', but the protocol now assigns subject number " + std::to_string(subject.number) +
+                  " group '" + group + "' and sequence '" + crossover.sequence + "'" +
+                  (pairing_differs ? " with another pairing of conditions and sets" : "") +
+                  " (this build assigns by another rule than the one that planned it): finish the "
+                  "subject's series with the build that began it (session.json names it under library)");
+}
+
 bool has_unsaved_trial(const fs::path& folder, const SessionManifest& manifest) {
   for (const PlannedTrial& trial : manifest.plan) {
     std::error_code error;
@@ -79,11 +116,12 @@ SessionSeries session_series(const fs::path& root, const std::string& subject_id
   int expected = 1;
   for (const auto& [number, entry] : by_number) {
     if (number != expected) {
-      throw DataError(subject_folder.string() + ": session " + std::to_string(expected) + " of " +
-                      protocol.protocol.name + " is missing, but session " + std::to_string(number) + " is " +
-                      entry.first.string() +
-                      (entry.second.previous ? " (it follows '" + entry.second.previous->session_id + "')" : "") +
-                      ": put the missing session folder back before running the next session");
+      throw DataError(
+          subject_folder.string() + ": session " + std::to_string(expected) + " of " +
+          protocol.protocol.name + " is missing, but session " + std::to_string(number) + " is " +
+          entry.first.string() +
+          (entry.second.previous ? " (it follows '" + entry.second.previous->session_id + "')" : "") +
+          ": put the missing session folder back before running the next session");
     }
     ++expected;
   }
@@ -101,7 +139,8 @@ SessionSeries session_series(const fs::path& root, const std::string& subject_id
       return series;
     }
     if (number == series.sessions) continue;
-    // What links the next session to this one: its last trial's end, its content and the next session's delay.
+    // What links the next session to this one: its last trial's end, its content and the next session's
+    // delay.
     const fs::path last_record = SessionLayout::record(folder, manifest.plan.back());
     PreviousSession previous;
     previous.session_id = manifest.session_id;
@@ -141,6 +180,11 @@ SessionSeries session_series(const fs::path& root, const std::string& subject_id
   if (series.next > series.sessions) {
     series.previous.reset();
     series.previous_record.clear();
+  } else if (!series.unfinished && !series.folders.empty()) {
+    // The next session is planned now: by the assignment its sessions before it were planned with.
+    for (const auto& [number, found] : by_number) {
+      if (number < series.next) check_assignment(found.first, found.second, protocol.protocol);
+    }
   }
   return series;
 }

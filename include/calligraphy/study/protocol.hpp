@@ -166,9 +166,10 @@ struct ProtocolPhase {
   /// The item sets the phase gives ("sets", names of StudyProtocol::item_sets, in listed order), whose items
   /// concatenated are `items`; empty when the phase lists its characters.
   std::vector<std::string> sets;
-  /// Parallel to `items` when `sets` is given: the set of each item; empty otherwise.
+  /// Parallel to `items` when `sets` is given, or when a test phase beside a crossover lists characters (the
+  /// set holding each item's characters): the set of each item; empty otherwise.
   std::vector<std::string> item_sets;
-  int repetitions = 1;                   ///< times each item is written in each condition, >= 1
+  int repetitions = 1;  ///< times each item is written in each condition, >= 1
   /// 1-based: the session (a sitting, usually a day) the phase is written in. A later session is its own
   /// folder, linked to the subject's previous one (session_series.hpp).
   int session = 1;
@@ -247,7 +248,10 @@ inline constexpr std::uint64_t kMaxPlannedTrials = 1'000'000;
 /// between-subjects phase of one condition; for "item_sets": a name twice, a character in two sets, a
 /// `transfer_of` that names no set, itself or a transfer set, a phase naming an unknown set or giving both
 /// or neither of "characters" and "sets"; a crossover phase in practice, without one set per condition (two
-/// or more), on a transfer set, or after another crossover phase.
+/// or more), on a transfer set, or after another crossover phase; beside a crossover phase, another training
+/// phase on an item of a set it trains (or of their transfer sets), a test phase's listed character in no set
+/// or an item of two sets, and a transfer test chosen by coverage. A test phase beside a crossover that lists
+/// its characters gets each item's set in `ProtocolPhase::item_sets` (`sets` stays empty).
 [[nodiscard]] StudyProtocol parse_study_protocol(std::string_view json_text, const std::string& source);
 
 /// A protocol read from a file, with the exact text and its SHA-256 (so that a trial names the protocol

@@ -25,7 +25,7 @@ struct PlannedTrial {
   std::size_t item = 0;  ///< index of `characters` in its phase's list (the paper's C1 is 0)
   int repetition = 1;    ///< 1-based: the how-many-th time this item is written in this phase and condition
   double break_before_s = 0.0;  ///< rest before this trial [s]
-  /// The item's set (ProtocolPhase::item_sets); "" when the phase lists its characters.
+  /// The item's set (ProtocolPhase::item_sets); "" when the phase lists characters of no set.
   std::string item_set;
   /// The subject's crossover sequence (CrossoverAssignment::sequence: "AB", "BA", "ACB", ...), the same on
   /// every trial of the subject; "" when the protocol has no crossover phase.
@@ -45,7 +45,8 @@ struct SubjectAssignment {
   std::size_t number = 0;  ///< 1-based; 0: unknown (allowed unless the order needs it)
 };
 
-/// The conditions of `phase`'s blocks in order for `subject`. A practice phase's as listed. Within subjects,
+/// The conditions of `phase`'s blocks in order for `subject`. A practice phase's as listed (between subjects:
+/// the group's one condition, as below). Within subjects,
 /// by the protocol's order:
 /// `latin_square`: row (number - 1) mod rows of a balanced Latin square (Williams 1949, Aust. J. Sci. Res. A
 /// 2:149-168: every condition follows every other equally often; n rows for an even number n of conditions,
@@ -84,12 +85,19 @@ struct CrossoverAssignment {
 /// its set. Two conditions give subjects 1, 2, 3, 4: AB and BA with rotation 0, then AB and BA with rotation
 /// 1, and again: sequence, period and set are balanced every rows x k subjects (4 for two conditions, 18 for
 /// three, 16 for four). In a mixed design (between-subjects phases beside the crossover, their groups in turn
-/// by number) the number is counted within the subject's group, m = (number - 1) / G with G the least common
-/// multiple of those phases' condition counts (1 under a random order), so that every group gets every
-/// sequence and rotation. An empty assignment when the protocol has no crossover phase. Throws
+/// by number) the row and rotation come from the cell m = j + g instead of number - 1: g = (number - 1) mod G
+/// the subject's group and j = (number - 1) / G its place in the group, G the least common multiple of those
+/// phases' condition counts (1 under a random order). So every group gets every sequence and rotation over
+/// its first rows x k subjects, and consecutive subjects consecutive cells (balanced over all subjects even
+/// when G is larger than any study). An empty assignment when the protocol has no crossover phase. Throws
 /// InvalidArgument naming the subject when its id is not a label or, with a crossover phase, its number is 0.
 [[nodiscard]] CrossoverAssignment crossover_assignment(const StudyProtocol& protocol,
                                                        const SubjectAssignment& subject);
+
+/// The crossover's pairing of conditions and sets in `assignment` (of `protocol`'s crossover phase): each
+/// listed condition's letter and the set it trains, in listed order ("A:set1 B:set2"); "" without a
+/// crossover phase.
+[[nodiscard]] std::string set_pairing(const StudyProtocol& protocol, const CrossoverAssignment& assignment);
 
 /// The subject's group: the conditions `block_conditions` gives it in the protocol's between-subjects
 /// phases, joined by "/" in phase order; "" when every phase is within subjects. Throws as
@@ -142,17 +150,30 @@ struct BalanceFactor {
   std::vector<std::size_t> subjects;  ///< parallel to `levels`: subjects at each level (0 for some)
 };
 
+/// Most subjects a counterbalancing square may need and still be reached: the subjects `session run
+/// --subjects` and `session plan` take (1,000), beyond any laboratory's recruitment. A protocol whose square
+/// is larger (between-subjects phases of 23, 25 and 26 conditions repeat their groups every 14,950 subjects)
+/// is balanced by no N a study can run: `Counterbalancing::warning` says so whatever N.
+inline constexpr std::size_t kMaxReachableSquare = 1000;
+
 /// How some subjects fill a protocol's counterbalancing (`counterbalancing`).
 struct Counterbalancing {
-  std::size_t square = 1;    ///< `counterbalancing_square`
+  std::size_t square = 1;  ///< `counterbalancing_square`
+  std::size_t groups = 1;  ///< G: subjects after which the between-subjects groups repeat (1: none, or drawn)
   std::size_t subjects = 0;  ///< subjects counted
   bool drawn = false;        ///< a random order: groups and orders drawn from each subject's id
   std::vector<BalanceFactor> factors;
   /// True when the subjects are a multiple of the square and every factor's levels hold as many subjects.
   [[nodiscard]] bool filled() const noexcept;
+  /// False when the square needs more than kMaxReachableSquare subjects (and is not drawn).
+  [[nodiscard]] bool reachable() const noexcept;
   /// "" when `filled()` (or no subject); else one sentence naming what is uneven, e.g. "N=5 does not fill the
   /// counterbalancing square of 4 subjects (recruit a multiple of 4): it leaves sequence BA with 2 subjects
-  /// and AB with 3; set pairing A:set2 B:set1 with 2 subjects and A:set1 B:set2 with 3".
+  /// and AB with 3; set pairing A:set2 B:set1 with 2 subjects and A:set1 B:set2 with 3". A factor of more
+  /// than six levels is counted, not listed ("group: 14,942 of its 14,950 levels with 0 subjects, 8 with
+  /// 1"). A square beyond `reachable()` is said first: "a full counterbalancing square is 59,800 subjects
+  /// (the between-subjects groups alone repeat every 14,950), more than any study can recruit (at most
+  /// 1,000): no N balances this design; N=8 ...".
   [[nodiscard]] std::string warning() const;
 };
 
