@@ -108,6 +108,13 @@ Checked<TrialSpec> spec_from(const TrialCommand& command) {
     if (command.app->count("--writer-profile") > 0) spec.writer_profile = command.writer_profile;
     for (const std::string& setting : command.writer_parameters)
       set_trial_spec_field(spec, "--writer-param", setting);
+    // An option given for a guidance setting the trial does not have is refused at its default value too.
+    std::vector<std::string> given;
+    for (const SchemaField& field : SchemaOf<TrialSpec>::get().fields) {
+      if (!field.option.empty() && command.app->count(std::string(field.option)) > 0)
+        given.emplace_back(field.name);
+    }
+    refuse_inapplicable_fields(spec, given);
     return Checked<TrialSpec>::check(std::move(spec));
   } catch (const InvalidArgument& e) {
     throw UsageError(e.what());

@@ -1,5 +1,6 @@
 #include "calligraphy/trial/trial_spec.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <charconv>
@@ -207,7 +208,45 @@ std::string field_label(std::string_view key) {
 
 std::string number_text(double value) { return shortest_decimal(value); }
 
+// The fields that only one guidance setting reads: stated with another (a value nothing would read), they are
+// a mistake. `validate` knows a field as stated when it is not at its default; a front-end that knows what
+// was given (the command line) asks `refuse_inapplicable_fields` of every field given, default or not.
+struct ConditionalField {
+  std::string_view name;
+  bool (*stated)(const TrialSpec&);   // not at its default
+  bool (*applies)(const TrialSpec&);  // read by this specification's guidance
+  const char* when;                   // what it applies to, for the error
+};
+constexpr bool replaying(const TrialSpec& s) { return s.guidance_mode == GuidanceMode::replay; }
+const ConditionalField kConditionalFields[] = {
+    {"guidance_stiffness_n_per_m",
+     [](const TrialSpec& s) { return s.guidance_stiffness_n_per_m != TrialSpec{}.guidance_stiffness_n_per_m; },
+     [](const TrialSpec& s) { return s.guidance; }, "applies to guidance on (guidance is off)"},
+    {"guidance_gain", [](const TrialSpec& s) { return s.guidance_gain != TrialSpec{}.guidance_gain; },
+     [](const TrialSpec& s) { return s.guidance_mode == GuidanceMode::fading; },
+     "applies to guidance mode 'fading' only"},
+    {"assist_band_m", [](const TrialSpec& s) { return s.assist_band_m != TrialSpec{}.assist_band_m; },
+     [](const TrialSpec& s) { return s.guidance_mode == GuidanceMode::assist_as_needed; },
+     "applies to guidance mode 'assist-as-needed' only"},
+    {"amplification_gain",
+     [](const TrialSpec& s) { return s.amplification_gain != TrialSpec{}.amplification_gain; },
+     [](const TrialSpec& s) { return s.guidance_mode == GuidanceMode::error_amplification; },
+     "applies to guidance mode 'error-amplification' only"},
+    {"timing_speed_m_s", [](const TrialSpec& s) { return s.timing_speed_m_s != TrialSpec{}.timing_speed_m_s; },
+     [](const TrialSpec& s) { return s.guidance_mode == GuidanceMode::timing; },
+     "applies to guidance mode 'timing' only"},
+    {"teacher", [](const TrialSpec& s) { return !s.teacher.empty(); }, replaying,
+     "applies to guidance mode 'replay' only"},
+};
+
 }  // namespace
+
+void refuse_inapplicable_fields(const TrialSpec& spec, const std::vector<std::string>& given) {
+  for (const ConditionalField& field : kConditionalFields) {
+    if (std::find(given.begin(), given.end(), field.name) != given.end() && !field.applies(spec))
+      refuse(field.name, std::string(field.when) + " (given explicitly, at any value)");
+  }
+}
 
 const Schema& SchemaOf<WriterSetting>::get() {
   static const Schema schema{.name = "WriterSetting",
@@ -287,24 +326,10 @@ void TrialSpec::validate(TeacherSource teacher_from) const {
     refuse("guidance_mode", std::string("'") + calligraphy::to_string(guidance_mode) +
                                 "' needs guidance on (guidance is off)");
   }
-  if (!guidance && guidance_stiffness_n_per_m != TrialSpec{}.guidance_stiffness_n_per_m) {
-    refuse("guidance_stiffness_n_per_m", "applies to guidance on (guidance is off)");
-  }
-  if (guidance_gain != 1.0 && guidance_mode != GuidanceMode::fading) {
-    refuse("guidance_gain", "applies to guidance mode 'fading' only");
-  }
-  // Each mode's own parameter: in its law's range, and given only with its mode (a value nothing reads is
-  // a mistake).
-  const TrialSpec defaults;
-  if (assist_band_m != defaults.assist_band_m && guidance_mode != GuidanceMode::assist_as_needed) {
-    refuse("assist_band_m", "applies to guidance mode 'assist-as-needed' only");
-  }
-  if (amplification_gain != defaults.amplification_gain &&
-      guidance_mode != GuidanceMode::error_amplification) {
-    refuse("amplification_gain", "applies to guidance mode 'error-amplification' only");
-  }
-  if (timing_speed_m_s != defaults.timing_speed_m_s && guidance_mode != GuidanceMode::timing) {
-    refuse("timing_speed_m_s", "applies to guidance mode 'timing' only");
+  // Each mode's own parameter: in its law's range, and stated only with its mode (a value nothing reads is
+  // a mistake). The teacher is checked below, where it comes from matters.
+  for (const ConditionalField& field : kConditionalFields) {
+    if (field.name != "teacher" && field.stated(*this) && !field.applies(*this)) refuse(field.name, field.when);
   }
   if (guidance_mode == GuidanceMode::replay && teacher.empty() && teacher_from == TeacherSource::file) {
     refuse("teacher", "required with guidance mode 'replay' (a recording made with --record)");

@@ -182,6 +182,27 @@ class SchemaTest(unittest.TestCase):
             self.assertNotEqual(refused.returncode, 0)
             self.assertIn("/specification/teacher_sha256", refused.stderr.decode())
 
+    def test_an_option_of_another_guidance_is_refused_at_its_default_too(self):
+        """An option read only by another guidance mode (or by guidance on) is a mistake at any value: given at
+        its default it is refused as it is at any other value, exit 2, naming the option."""
+        trial = self.schemas["specification"]["properties"]
+        cases = [(["--guidance-mode", "fading"], "--assist-band", "assist_band_m"),
+                 (["--guidance-mode", "assist-as-needed"], "--guidance-gain", "guidance_gain"),
+                 (["--guidance-mode", "fixed"], "--amplification-gain", "amplification_gain"),
+                 (["--guidance-mode", "fading"], "--timing-speed", "timing_speed_m_s"),
+                 (["--guidance", "off"], "--guidance-stiffness", "guidance_stiffness_n_per_m")]
+        for mode, option, key in cases:
+            default = trial[key]["default"]
+            for value in (default, default * 0.5 if default else 0.5):
+                refused = self.run_cli("trial", "十", *mode, option, value, "--json", "never.json")
+                self.assertEqual(refused.returncode, 2, f"{mode} {option} {value}: {refused.stderr.decode()}")
+                self.assertIn(option, refused.stderr.decode())
+                self.assertFalse((self.cwd / "never.json").exists())
+        # The same option with its own mode, at its default, is taken.
+        taken = self.run_cli("trial", "十", "--guidance-mode", "assist-as-needed", "--assist-band",
+                             trial["assist_band_m"]["default"])
+        self.assertEqual(taken.returncode, 0, taken.stderr.decode())
+
     def test_enum_spellings_are_the_options_spellings(self):
         help_text = self.run_cli("trial", "--help").stdout.decode()
         trial = self.schemas["specification"]["properties"]

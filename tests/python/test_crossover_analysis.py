@@ -234,6 +234,22 @@ def test_exclusions_are_counted_by_phase_and_the_condition_each_set_trained():
     assert training["excluded_given_up"].to_dict() == expected.to_dict()
 
 
+def test_a_practice_block_beside_a_crossover_is_counted_under_its_own_condition():
+    """A block outside the crossover (practice, familiarisation) trained no item set: its trials are counted
+    under the condition they were written in, never under an empty one."""
+    trials = crossover_study(2)
+    practice = trials[trials["phase"] == "training"].head(6).copy()
+    practice["phase"] = "practice"
+    practice["trained_condition"] = ""
+    practice["condition"] = "unguided"
+    practice["end_reason"] = ["completed", "given_up"] * 3
+    _, counts = design_analysis.apply_exclusions(pandas.concat([trials, practice], ignore_index=True))
+    rows = counts[counts["phase"] == "practice"]
+    assert list(rows["trained_condition"]) == ["unguided"]
+    assert int(rows["trials"].iloc[0]) == 6 and int(rows["excluded_given_up"].iloc[0]) == 3
+    assert (counts["trained_condition"].astype(str) != "").all()
+
+
 def test_retention_ratios_are_per_condition_on_its_own_sets():
     trials = crossover_study(4)
     design = design_analysis.study_design(trials)

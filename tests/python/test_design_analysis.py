@@ -127,6 +127,21 @@ def test_the_ancova_is_r_lm_of_the_subject_means():
     assert post.loc["fading - vision-only", "ci95_high"] < 0
 
 
+def test_an_ancova_with_no_residual_variance_is_not_computed():
+    """A post-test whose subject means are all equal (or that the pre-test predicts exactly) leaves the ANCOVA
+    no residual variance: no t and no p, where OLS would print 0/0 or x/0 as numbers."""
+    for make in (lambda t: 2e-3, lambda t: 1e-3 + 0.5 * t["pre"]):
+        trials = between_study(4)
+        pre = trials[trials["phase"] == "pre-test"].groupby("subject")["mean_deviation_m"].mean()
+        post = trials["phase"] == "post-test"
+        trials.loc[post, "mean_deviation_m"] = make({"pre": trials.loc[post, "subject"].map(pre)})
+        questions = design_analysis.design_questions(trials, "mean_deviation_m")
+        rows = questions[(questions.phase == "post-test") & questions.question.str.contains("ANCOVA")]
+        assert len(rows) == 1 and rows.iloc[0]["note"].startswith("not computed: the post-test means leave no "
+                                                                  "residual variance")
+        assert math.isnan(rows.iloc[0]["p"])
+
+
 @needs_r
 @pytest.mark.parametrize("ddf", ["Satterthwaite", "Kenward-Roger"])
 def test_the_crossed_mixed_model_gives_the_split_plot_test_on_a_balanced_design(ddf):

@@ -268,9 +268,14 @@ def apply_exclusions(trials: pandas.DataFrame, policy: ExclusionPolicy = Exclusi
     else:
         statistics._require_columns(trials, ["end_reason"], "apply_exclusions")
         kept = trials[trials["end_reason"].astype(str).isin(policy.keep_end_reasons)]
-    if "trained_condition" in trials.columns and (trials["trained_condition"].astype(str).replace(
-            {"nan": ""}) != "").any():
+    trained = (trials["trained_condition"].astype(str).replace({"nan": ""}) if "trained_condition" in trials.columns
+               else None)
+    if trained is not None and (trained != "").any():
         by = ["phase", "trained_condition"]  # a crossover: a test trial counts for the condition its set trained
+        # A block outside the crossover (a practice or familiarisation, or a between-subjects phase beside it)
+        # trained no set: its trials count for the condition they were written under.
+        if "condition" in trials.columns:
+            trials = trials.assign(trained_condition=trained.where(trained != "", trials["condition"].astype(str)))
     elif "group" in trials.columns and (trials["group"].astype(str) != "").any():
         by = ["phase", "group"]
     else:
@@ -416,6 +421,17 @@ def _ancova_rows(data: pandas.DataFrame, value: str, design: StudyDesign, phase:
                      f"{phase} value in {len(levels)} group(s)")]
     frame["group"] = pandas.Categorical(frame["group"], categories=levels)
     fit = smf.ols("post ~ pre + C(group, Treatment(reference=0))", data=frame).fit()
+    # No residual variance (every subject's mean the same, or fitted exactly): t and p would be 0/0 or x/0,
+    # numbers that are no test. R's lm warns of "essentially perfect fit" in the same case.
+    # Rounding leaves ~1e-16 of the values' size where the exact answer is 0: below a part in 1e9 is none.
+    rounding = (1e-9 * float(frame["post"].abs().max())) ** 2 * len(frame)
+    spread = float(((frame["post"] - frame["post"].mean()) ** 2).sum())
+    residual = float(fit.ssr)
+    if not math.isfinite(residual) or residual <= max(rounding, 1e-12 * spread):
+        return [_row(**base, comparison="group",
+                     note=f"not computed: the {phase} means leave no residual variance "
+                          + ("(the outcome is the same for every subject)" if spread <= rounding
+                             else "(the model fits them exactly)"))]
     interval = fit.conf_int(alpha=statistics.ALPHA)
     rows = []
     for k, level in enumerate(levels[1:], start=1):

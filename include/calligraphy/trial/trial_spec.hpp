@@ -94,6 +94,13 @@ struct TrialSpec {
   bool operator==(const TrialSpec&) const = default;
 };
 
+/// Throws InvalidArgument naming the field when one of `given` (JSON keys of fields a front-end was given
+/// explicitly, whatever their value: the command line's options) is read only by a guidance setting `spec`
+/// does not have: the guidance stiffness with guidance off, `guidance_gain` but for fading, `assist_band_m`,
+/// `amplification_gain`, `timing_speed_m_s` but for their modes, `teacher` but for a replay. `validate` can
+/// only refuse such a field when it is not at its default.
+void refuse_inapplicable_fields(const TrialSpec& spec, const std::vector<std::string>& given);
+
 /// The specification's schema (schema.hpp): every field's key, option, unit, range, default and doc; its JSON
 /// and command-line forms, the checks of ranges and `calligraphy schema specification` come from it.
 template <>
