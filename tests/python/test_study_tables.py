@@ -286,3 +286,32 @@ def test_a_trace_swapped_with_another_trials_is_refused(cli, study_folder, tmp_p
     message = run.stderr.decode()
     assert "/files/trace_sha256" in message and "not this trial's trace" in message and first.name in message
     assert not (tmp_path / "t.html").exists()
+
+
+@pytest.mark.parametrize("samples", [16_000_000, 10_000_002])
+def test_a_small_trace_declaring_more_samples_than_any_trial_is_refused_unread(cli, tmp_path, samples):
+    """A trace file of a few kilobytes whose columns declare millions of samples (chunks never written read as
+    their fill value, and constant chunks compress 1000-fold) is refused by its length before a column is
+    allocated: no trial has more ticks than 10^7 (kMaxTrialTicks), so no trace file has more samples. Built
+    with h5py as a forger would, with a valid header (format, version, length and CRC-32)."""
+    import zlib
+
+    h5py = pytest.importorskip("h5py")
+    body = tmp_path / "body.h5"
+    with h5py.File(body, "w", userblock_size=512) as forged:
+        for column in ("t", "x", "y", "z", "fx", "fy", "fz"):
+            forged.create_dataset(column, shape=(samples,), dtype="<i8", chunks=(65536,), compression="gzip")
+        # Some bytes that do not compress, so that the file is large enough to hold that many samples at the
+        # deflate's best ratio: only the samples' bound refuses it.
+        forged["t"][:30000] = __import__("numpy").random.default_rng(1).integers(0, 2**62, 30000)
+    hdf5 = body.read_bytes()[512:]
+    header = f"calligraphy-trace\nversion 1\nbytes {len(hdf5)}\ncrc32 {zlib.crc32(hdf5):08x}\n".encode()
+    trace = tmp_path / "forged.trace.h5"
+    trace.write_bytes(header + bytes(512 - len(header)) + hdf5)
+    assert 4 * samples / 1032 < trace.stat().st_size < 1_000_000
+    run = subprocess.run([cli, "trace", str(trace)], capture_output=True, timeout=60)
+    assert run.returncode == 1, run.stderr.decode()
+    assert f"{samples} samples, more than a trace file holds" in run.stderr.decode()
+    assert "forged.trace.h5" in run.stderr.decode()
+    with pytest.raises(calligraphy.DataError, match=f"{samples} samples, more than"):
+        calligraphy.study._read_trace(str(trace))

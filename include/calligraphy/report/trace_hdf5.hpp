@@ -27,13 +27,15 @@
 #include <string_view>
 #include <vector>
 
+#include "calligraphy/trial/options.hpp"
 #include "calligraphy/trial/recorder.hpp"
 
 namespace calligraphy {
 
-/// The most samples a trace file is read with: 2^24, over 4.6 hours at 1 kHz (a protocol's trial holds at
-/// most 10^7 ticks, kMaxTrialTicks), so that a damaged length never asks for gigabytes.
-inline constexpr std::size_t kMaxTraceSamples = std::size_t{1} << 24;
+/// The most samples a trace file is written or read with: the ticks a trial can have (kMaxTrialTicks, 10^7:
+/// 2.8 hours at 1 kHz), so that a forged length (a small file whose constant columns compress 1000-fold,
+/// declaring more samples than any trial) is refused before its columns are allocated.
+inline constexpr std::size_t kMaxTraceSamples = static_cast<std::size_t>(kMaxTrialTicks) + 1;
 
 /// A trace's columns as stored, each of length N (`size()`), in SI units.
 struct TraceColumns {
