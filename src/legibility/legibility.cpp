@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <mutex>
@@ -15,6 +17,8 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/trial/result.hpp"
+#include "core/library_log.hpp"
+#include "core/whole_file.hpp"
 
 #ifdef CALLIGRAPHY_WITH_ZINNIA
 #include <zinnia.h>
@@ -38,25 +42,71 @@ struct Recogniser {
   }
 };
 
+// Debian's zh_CN model is 26 MB; a file far larger is not one.
+constexpr std::uintmax_t kMaxModelBytes = std::uintmax_t{256} << 20;
+
 std::string model_file() {
   if (const char* path = std::getenv("CALLIGRAPHY_ZINNIA_MODEL"); path != nullptr && *path != '\0')
     return path;
   return "/usr/share/tegaki/models/zinnia/handwriting-zh_CN.model";
 }
 
-// Opened once, on first use; nullptr when the model cannot be opened.
-Recogniser* recogniser() {
-  static std::unique_ptr<Recogniser> shared = [] {
-    auto made = std::make_unique<Recogniser>();
-    std::error_code error;
-    const std::string file = model_file();
-    if (!std::filesystem::is_regular_file(file, error)) return std::unique_ptr<Recogniser>();
-    made->recogniser = zinnia_recognizer_new();
-    if (made->recogniser == nullptr || zinnia_recognizer_open(made->recogniser, file.c_str()) == 0) {
-      return std::unique_ptr<Recogniser>();
+// Why a zinnia model file cannot be used, "" when its layout is whole. zinnia trusts the file: a damaged
+// count makes it allocate gigabytes (std::bad_alloc) and a damaged length read past the end. Its layout
+// (zinnia 0.06, recognizer.cpp): a magic number, a version, the number of characters, then per character a
+// 16-byte name, a float bias and (int index, float weight) pairs, the last of index -1. Walked here, bounded by the
+// file's size, before zinnia sees it.
+std::string model_damage(const std::string& bytes) {
+  const auto word = [&](std::size_t at) {
+    std::int32_t value = 0;
+    std::memcpy(&value, bytes.data() + at, sizeof value);
+    return value;
+  };
+  constexpr std::int32_t kMagic = 0x0f6e6fa1;
+  if (bytes.size() < 12 || word(0) != kMagic) return "not a zinnia model (its magic number)";
+  const std::int32_t characters = word(8);
+  if (characters <= 0 || static_cast<std::size_t>(characters) > bytes.size() / 24)
+    return "damaged: it declares " + std::to_string(characters) + " characters";
+  std::size_t at = 12;
+  for (std::int32_t c = 0; c < characters; ++c) {
+    at += 16 + 4;  // name, bias
+    while (true) {
+      if (at + 8 > bytes.size()) return "damaged: cut in character " + std::to_string(c + 1);
+      const std::int32_t index = word(at);
+      at += 8;
+      if (index == -1) break;
+      if (index < 0) return "damaged: a feature index " + std::to_string(index);
     }
-    made->model = file;
-    return made;
+  }
+  if (at != bytes.size()) return "damaged: " + std::to_string(bytes.size() - at) + " bytes after its last character";
+  return "";
+}
+
+// Opened once, on first use; nullptr when the model cannot be opened, said once in the library's log.
+Recogniser* recogniser() {
+  static std::unique_ptr<Recogniser> shared = []() -> std::unique_ptr<Recogniser> {
+    const std::string file = model_file();
+    std::error_code error;
+    if (!std::filesystem::is_regular_file(file, error)) return nullptr;  // none installed: not a fault
+    std::string problem;
+    try {
+      problem = model_damage(read_regular_file(file, kMaxModelBytes));
+      if (problem.empty()) {
+        auto made = std::make_unique<Recogniser>();
+        made->recogniser = zinnia_recognizer_new();
+        if (made->recogniser != nullptr && zinnia_recognizer_open(made->recogniser, file.c_str()) != 0) {
+          made->model = file;
+          return made;
+        }
+        problem = "zinnia cannot open it";
+      }
+    } catch (const std::exception& e) {  // unreadable, over the bound, or zinnia's own allocation failing
+      problem = e.what();
+    }
+    detail::library_log().warn("legibility: the recogniser's model {} cannot be used ({}); trials are kept without "
+                       "legibility",
+                       file, problem);
+    return nullptr;
   }();
   return shared.get();
 }

@@ -301,5 +301,47 @@ class DamagedStudyTest(unittest.TestCase):
         return self._cohort_seconds
 
 
+class DamagedRecogniserModelTest(unittest.TestCase):
+    """A damaged zinnia model (the legibility recogniser's, CALLIGRAPHY_ZINNIA_MODEL) never costs a trial: each
+    forged model below (a character count of 2^31 - 1 that makes zinnia allocate gigabytes, a file cut inside
+    a character, a foreign file, an empty one) leaves the trials saved without legibility, exit 0, and one
+    warning naming the model and what is wrong with it."""
+
+    def test_a_damaged_model_keeps_every_trial_and_says_why(self):
+        import struct
+
+        magic = 0x0F6E6FA1
+        character = "一".encode("utf-8").ljust(16, b"\0") + struct.pack("<f", 0.5)
+        models = {
+            "count": (struct.pack("<iii", magic, 1, 2**31 - 1) + character + struct.pack("<if", -1, 0.0),
+                      "declares 2147483647 characters"),
+            "cut": (struct.pack("<iii", magic, 1, 2) + character + struct.pack("<if", 3, 0.25) * 8, "cut in character 1"),
+            "foreign": (b"%PDF-1.4 not a model at all" * 10, "not a zinnia model"),
+            "empty": (b"", "not a zinnia model"),
+        }
+        protocol = {"name": "legible", "conditions": [{"name": "free", "mode": "vision"}],
+                    "test": {"characters": ["十"], "conditions": ["free"], "repetitions": 1},
+                    "trial": {"max_duration_s": 30}}
+        with tempfile.TemporaryDirectory(prefix="calligraphy-zinnia-") as folder:
+            cwd = Path(folder)
+            (cwd / "p.json").write_text(json.dumps(protocol, ensure_ascii=False), encoding="utf-8")
+            for name, (data, why) in models.items():
+                with self.subTest(model=name):
+                    model = cwd / f"{name}.model"
+                    model.write_bytes(data)
+                    run = subprocess.run([CLI, "session", "run", "p.json", "--writer", "simulated", "--subjects", "1",
+                                          "--out", f"S-{name}"], cwd=cwd, capture_output=True, timeout=300,
+                                         env={**os.environ, "CALLIGRAPHY_ZINNIA_MODEL": str(model)})
+                    stderr = run.stderr.decode()
+                    self.assertEqual(run.returncode, 0, stderr)
+                    warnings = [line for line in stderr.splitlines() if "legibility" in line]
+                    self.assertEqual(len(warnings), 1, stderr)
+                    self.assertIn(str(model), warnings[0])
+                    self.assertIn(why, warnings[0])
+                    records = [p for p in (cwd / f"S-{name}").rglob("trials/*.json")]
+                    self.assertEqual(len(records), 1)
+                    self.assertNotIn("legibility", json.loads(records[0].read_text(encoding="utf-8")))
+
+
 if __name__ == "__main__":
     unittest.main()
