@@ -74,11 +74,45 @@ struct StrokeAcceptance {
   /// before lifting and off the stroke loses the stroke.
   double follow_through_m = 0.008;
 
+  // Tolerances that grow with the movement, as people's accuracy falls with it: the end-point scatter of
+  // an aimed movement grows in proportion to its amplitude at a given movement time (Schmidt, Zelaznik,
+  // Hawkins, Frank & Quinn 1979, "Motor-output variability: a theory for the accuracy of rapid motor
+  // acts", Psychological Review 86:415-451; Fitts 1954). Another hand's strokes (KanjiVG's centre lines,
+  // aligned to the medians) end within 3.5 mm of the medians' on 5-8 mm strokes at the 90th percentile,
+  // within 6.6 mm on strokes of 48 mm and more (docs/stroke-acceptance.md). Each tolerance is its value
+  // above (the floor) plus its growth times the stroke's length L, up to its cap.
+
+  /// Growth of the shortfall with the stroke's length, dimensionless: the shortfall allowed is
+  /// min(`shortfall_fraction` L, `shortfall_m` + this L, `shortfall_cap_m`).
+  double shortfall_per_length = 0.15;
+  /// Most shortfall allowed on any stroke [m].
+  double shortfall_cap_m = 0.013;
+  /// Growth of the mean deviation allowed with the stroke's length, dimensionless: the limit is
+  /// min(`mean_deviation_m` + this L, `mean_deviation_cap_m`).
+  double deviation_per_length = 0.01;
+  /// Most mean deviation allowed on any stroke [m]: well under the smallest parallel shift refused, 4 mm
+  /// (3.5 mm credited 1.9 % of shifted strokes on KanjiVG's lines, 3.2 mm 1.3 %).
+  double mean_deviation_cap_m = 0.0032;
+  /// The character size the lengths above are for [m]: in a character of another size
+  /// (`SceneLayout::character_size_m`) every length scales by size / this. 0: lengths are absolute
+  /// (records before version 4).
+  double reference_character_size_m = 0.06;
+
+  /// The values of the fields above as records before version 4 ran them: no growth with the stroke's
+  /// length, no cap, no scaling with the character size.
+  void use_fixed_tolerances() noexcept;
+  /// This acceptance for a character of side `character_size_m` [m]: every length scaled by size /
+  /// `reference_character_size_m` (unchanged when that is 0).
+  [[nodiscard]] StrokeAcceptance for_character_size(double character_size_m) const noexcept;
+  /// The largest mean deviation allowed on a stroke of `length_m` [m].
+  [[nodiscard]] double allowed_mean_deviation_m(double length_m) const noexcept;
+
   /// Throws InvalidArgument naming the field when a value is outside its range
   /// (`ParameterTable<StrokeAcceptance>`: each length in (0, 0.1] m, the fraction in (0, 1), the gain ratio
   /// in [1, 100]).
   void validate() const;
-  /// The most a stroke of `length_m` may be written short by [m].
+  /// The most a stroke of `length_m` may be written short by [m]: min(`shortfall_fraction` L,
+  /// `shortfall_m` + `shortfall_per_length` L, `shortfall_cap_m`).
   [[nodiscard]] double allowed_shortfall_m(double length_m) const noexcept;
   bool operator==(const StrokeAcceptance&) const = default;
 };
