@@ -57,6 +57,13 @@ constexpr std::array kAcceptanceFields{
     ParameterField<StrokeAcceptance>{"reference_character_size_m", "m", ParameterRange{.low = 0.0, .high = 1.0},
                                      "the character size the lengths are for (0: absolute lengths)",
                                      &StrokeAcceptance::reference_character_size_m},
+    ParameterField<StrokeAcceptance>{"hint_after_misses", "", ParameterRange{.low = 0.0, .high = 1000.0},
+                                     "refused attempts at a stroke after which it is shown as a hint (0: never)",
+                                     &StrokeAcceptance::hint_after_misses},
+    ParameterField<StrokeAcceptance>{
+        "assist_after_misses", "", ParameterRange{.low = 0.0, .high = 1000.0},
+        "refused attempts at a stroke after which it is demonstrated and credited assisted (0: never)",
+        &StrokeAcceptance::assist_after_misses},
 };
 
 }  // namespace
@@ -65,7 +72,16 @@ std::span<const ParameterField<StrokeAcceptance>> ParameterTable<StrokeAcceptanc
   return kAcceptanceFields;
 }
 
-void StrokeAcceptance::validate() const { check_parameters(*this); }
+void StrokeAcceptance::validate() const {
+  check_parameters(*this);
+  for (const double count : {hint_after_misses, assist_after_misses}) {
+    if (count != std::floor(count)) {
+      throw InvalidArgument("StrokeAcceptance." +
+                            std::string(count == hint_after_misses ? "hint_after_misses" : "assist_after_misses") +
+                            " = " + std::to_string(count) + " must be a whole number");
+    }
+  }
+}
 
 double StrokeAcceptance::allowed_shortfall_m(double length_m) const noexcept {
   return std::min({shortfall_m + shortfall_per_length * length_m, shortfall_cap_m, shortfall_fraction * length_m});
@@ -81,6 +97,7 @@ void StrokeAcceptance::use_fixed_tolerances() noexcept {
   deviation_per_length = 0.0;
   mean_deviation_cap_m = kLength.high;
   reference_character_size_m = 0.0;
+  assist_after_misses = 0.0;
 }
 
 StrokeAcceptance StrokeAcceptance::for_character_size(double character_size_m) const noexcept {

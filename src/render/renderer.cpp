@@ -246,6 +246,7 @@ RenderOutput Renderer::tick(const DeviceState& device) noexcept {
     out.stroke_completed = lifted.stroke_completed;
     out.stroke_abandoned = !lifted.stroke_completed;
     out.refusal = lifted.refusal;
+    out.stroke_assisted = lifted.stroke_assisted;
   }
   if (next == InteractionState::writing) {
     if (state_ != InteractionState::writing) active_.begin(tip);
@@ -351,6 +352,8 @@ void Renderer::command(const Vec3& force, RenderOutput& out) noexcept {
   out.finished = active_.finished();
   out.character = active_.character_index();
   out.stroke = active_.stroke_index();
+  out.misses = active_.misses();
+  out.hint_shown = active_.hint_shown();
   out.element = active_.element_index();
 }
 

@@ -11,6 +11,7 @@ nlohmann::json trial_outcome_object(const TrialResult& result, const WritingMetr
   record["aborted"] = result.aborted;
   record["abort_reason"] = result.abort_reason;
   record["strokes_completed"] = m.strokes_completed;
+  record["strokes_assisted"] = m.strokes_assisted;
   record["trial_time_s"] = m.time_s;
   record["max_force_n"] = m.max_force_n;
   record["max_force_step_n"] = m.max_force_step_n;
@@ -23,6 +24,7 @@ nlohmann::json renderer_stroke_object(const StrokeMetrics& stroke) {
           {"character", stroke.character},
           {"typical_id", stroke.typical_id},
           {"completed", stroke.completed},
+          {"assisted", stroke.assisted},
           {"attempts", stroke.attempts}};
 }
 

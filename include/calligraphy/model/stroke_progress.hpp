@@ -98,8 +98,17 @@ struct StrokeAcceptance {
   /// (records before version 4).
   double reference_character_size_m = 0.06;
 
+  /// Refused attempts at one stroke after which it is shown as a hint (a whole number; 0: never). Hanzi
+  /// Writer's `showHintAfterMisses` is 3, as is the quiz's (QuizOptions::hint_after_misses).
+  double hint_after_misses = 3.0;
+  /// Refused attempts at one stroke after which it is demonstrated and credited as assisted, and the
+  /// next stroke is active (a whole number; 0: never, a learner may stay on a stroke for ever). Hanzi
+  /// Writer's `markStrokeCorrectAfterMisses`. 5: two more tries after the hint, so that a stroke refused
+  /// on 1 % of attempts is almost never assisted (1e-10) while a learner never stays stuck.
+  double assist_after_misses = 5.0;
+
   /// The values of the fields above as records before version 4 ran them: no growth with the stroke's
-  /// length, no cap, no scaling with the character size.
+  /// length, no cap, no scaling with the character size, no assisted credit.
   void use_fixed_tolerances() noexcept;
   /// This acceptance for a character of side `character_size_m` [m]: every length scaled by size /
   /// `reference_character_size_m` (unchanged when that is 0).
@@ -109,7 +118,7 @@ struct StrokeAcceptance {
 
   /// Throws InvalidArgument naming the field when a value is outside its range
   /// (`ParameterTable<StrokeAcceptance>`: each length in (0, 0.1] m, the fraction in (0, 1), the gain ratio
-  /// in [1, 100]).
+  /// in [1, 100], the miss counts in [0, 1000]) or a miss count is not a whole number.
   void validate() const;
   /// The most a stroke of `length_m` may be written short by [m]: min(`shortfall_fraction` L,
   /// `shortfall_m` + `shortfall_per_length` L, `shortfall_cap_m`).

@@ -48,6 +48,11 @@ struct RenderOutput {
   bool stroke_completed = false;     ///< this tick wrote a stroke (passed its end, or lifted near it)
   bool stroke_abandoned = false;     ///< the pen was lifted in WS short of the tolerances: reloaded
   StrokeRefusal refusal = StrokeRefusal::none;  ///< why an abandoned stroke was refused (stroke_progress.hpp)
+  /// The abandoned stroke was refused for the `assist_after_misses`-th time (StrokeAcceptance): credited
+  /// as assisted, not written; the next stroke is active.
+  bool stroke_assisted = false;
+  std::uint32_t misses = 0;  ///< refused attempts at the active stroke (after this tick)
+  bool hint_shown = false;   ///< the active stroke is to be shown as a hint (misses >= hint_after_misses)
   bool input_rejected = false;                  ///< the device state was not finite: zero force
   bool force_error = false;                     ///< the force law gave a non-finite force: zero force
   std::uint8_t limits = safety_none;            ///< SafetyLimit bits: which safety stages acted
