@@ -96,7 +96,7 @@ std::vector<std::vector<Vec2>> align_to_medians(const std::vector<std::vector<Ve
                           std::to_string(character.strokes.size()));
   }
   // Least squares of q = s p + t over the paired points, p flipped to y up: s = sum (p - p0).(q - q0) /
-  // sum |p - p0|^2, t = q0 - s p0 (Umeyama 1991 without the rotation).
+  // sum |p - p0|^2, t = q0 - s p0 (ordinary least squares in the scale, the shift following).
   std::vector<Vec2> from;
   std::vector<Vec2> to;
   for (std::size_t i = 0; i < strokes.size(); ++i) {

@@ -50,6 +50,9 @@ struct TrialRow {
   bool completed_in_order = false;
   std::size_t strokes_total = 0;
   std::size_t strokes_written = 0;
+  /// Strokes the renderer credited as assisted after assist_after_misses refused attempts (written apart
+  /// from strokes_written: none of them was written).
+  std::size_t strokes_assisted = 0;
   std::size_t strokes_accepted = 0;
   std::size_t order_errors = 0;
   std::size_t backwards_strokes = 0;
