@@ -16,8 +16,9 @@
 ///
 ///   a stroke of length L (along the centre line, from its first feature point to its last) is written
 ///   when the pen entered it in the start neighbourhood (WS) and, within `corridor_m` of it and with a
-///   mean distance of at most `mean_deviation_m`, went along it for at least L - min(`shortfall_m`,
-///   `shortfall_fraction` L), leaving at most max(that, `displacement_m`) unwritten at either end. The
+///   mean distance of at most `allowed_mean_deviation_m(L)`, went along it for at least L - S(L), S(L) =
+///   `allowed_shortfall_m(L)`, leaving at most max(S(L), `displacement_m`) unwritten at either end. The
+///   tolerances grow with L up to a cap and scale with the character's size (StrokeAcceptance). The
 ///   way along counts the arc the pen gained, plus up to `displacement_m` of run before the start and past
 ///   the end, so that a copy displaced along the stroke is written and a half stroke is not.
 ///
@@ -41,7 +42,8 @@ namespace calligraphy {
 /// largest 6.1 mm, and end points within 3.5 mm of the medians' (measured with Hanzi Writer's own
 /// matcher, chanind/hanzi-writer 3.7.3 `strokeMatches.ts`, whose end-point tolerance is 250/1024 of the
 /// box, 14.6 mm here, and whose length test accepts 35 % of a stroke: both too lenient to refuse half
-/// strokes). Scale them with the character size. docs/stroke-acceptance.md has the measured acceptance.
+/// strokes). They scale with the character's size (`reference_character_size_m`; an attempt applies
+/// `for_character_size`). docs/stroke-acceptance.md has the measured acceptance.
 struct StrokeAcceptance {
   /// Farthest a pen may be from the centre line and still make progress [m]: people's largest Frechet
   /// distance, 6.1 mm, plus 0.4 mm.
