@@ -12,10 +12,9 @@
 #include <filesystem>
 #include <iostream>
 
-#include "eval/other_hand.hpp"
-
 #include "calligraphy/model/character_library.hpp"
 #include "corpus_folder.hpp"
+#include "eval/other_hand.hpp"
 #include "test_sizing.hpp"
 
 using namespace calligraphy;
@@ -97,8 +96,9 @@ TEST_CASE("Another hand's strokes (KanjiVG) written by a position-only pen are a
       random_shared_characters(library, folder, 500, seed, CharacterLibrary::embedded().characters());
   characters = testing::sanitizer_subset(characters, 60, "characters of the KanjiVG sweep");
   if (characters.size() < 20) {
-    WARN("skipped: fewer than 20 characters shared with KanjiVG in the same order and form (the sample "
-         "library; set CALLIGRAPHY_CORPUS_DIR to the whole hanzi-writer-data package)");
+    WARN(
+        "skipped: fewer than 20 characters shared with KanjiVG in the same order and form (the sample "
+        "library; set CALLIGRAPHY_CORPUS_DIR to the whole hanzi-writer-data package)");
     return;
   }
   const OtherHandMeasurement m = measure_other_hand(library, folder, characters, seed, 5);
@@ -119,7 +119,8 @@ TEST_CASE("Another hand's strokes (KanjiVG) written by a position-only pen are a
   for (const KindAcceptance& k : m.kinds) {
     if (is_positive(k.kind) || k.paths == 0) continue;
     INFO(to_string(k.kind) << ": " << k.accepted << " of " << k.paths << " accepted");
-    const bool harder = k.kind == TraceKind::half || k.kind == TraceKind::shifted || k.kind == TraceKind::scribble;
+    const bool harder =
+        k.kind == TraceKind::half || k.kind == TraceKind::shifted || k.kind == TraceKind::scribble;
     const double rate = harder ? 0.035 : kNegativeRate;
     CHECK(share(k.accepted, k.paths) <= rate + slack(rate, k.paths));
   }

@@ -35,9 +35,10 @@ void whole_attempt(ActiveStroke& active) {
 
 }  // namespace
 
-TEST_CASE("Refused attempts are counted per stroke; a hint after hint_after_misses, assisted credit after "
-          "assist_after_misses",
-          "[stroke_assistance]") {
+TEST_CASE(
+    "Refused attempts are counted per stroke; a hint after hint_after_misses, assisted credit after "
+    "assist_after_misses",
+    "[stroke_assistance]") {
   const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'人')});
   StrokeAcceptance acceptance;
   acceptance.hint_after_misses = 2;
@@ -122,9 +123,10 @@ TEST_CASE("The recorder counts an assisted stroke apart from the strokes written
   CHECK_FALSE(m.completed_in_order);
 }
 
-TEST_CASE("A trial whose writer always lifts mid-stroke ends with its strokes assisted, and its record "
-          "replays the same credits",
-          "[stroke_assistance]") {
+TEST_CASE(
+    "A trial whose writer always lifts mid-stroke ends with its strokes assisted, and its record "
+    "replays the same credits",
+    "[stroke_assistance]") {
   // 人: every element is 20 mm or longer, so a lift at 30-70 % of a stroke is refused (too short); with no
   // correction between attempts the writer does that every time.
   const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'人')});
@@ -165,9 +167,9 @@ TEST_CASE("A trial whose writer always lifts mid-stroke ends with its strokes as
   // A version-3 record (no miss counts, no growing tolerances) runs as it ran: no stroke is assisted.
   nlohmann::json old = nlohmann::json::parse(json);
   old["version"] = 3;
-  for (const char* key : {"shortfall_per_length", "shortfall_cap_m", "deviation_per_length",
-                          "mean_deviation_cap_m", "reference_character_size_m", "hint_after_misses",
-                          "assist_after_misses"}) {
+  for (const char* key :
+       {"shortfall_per_length", "shortfall_cap_m", "deviation_per_length", "mean_deviation_cap_m",
+        "reference_character_size_m", "hint_after_misses", "assist_after_misses"}) {
     old["force_law"]["acceptance"].erase(key);
   }
   const RecordedTrial v3 = read_recorded_trial(old.dump(), "v3.json");

@@ -49,17 +49,18 @@ int run_acceptance(const AcceptanceCommand& command) {
     const std::vector<char32_t> chosen = random_shared_characters(
         library, command.kanjivg, count, command.seed, CharacterLibrary::embedded().characters());
     if (chosen.empty()) {
-      throw UsageError("bench acceptance: --kanjivg " + command.kanjivg +
-                       ": no character of the library (beyond the embedded ones) has a KanjiVG file there with "
-                       "as many strokes (give the folder scripts/fetch-kanjivg.sh prints)");
+      throw UsageError(
+          "bench acceptance: --kanjivg " + command.kanjivg +
+          ": no character of the library (beyond the embedded ones) has a KanjiVG file there with "
+          "as many strokes (give the folder scripts/fetch-kanjivg.sh prints)");
     }
     const OtherHandMeasurement measurement =
         measure_other_hand(library, command.kanjivg, chosen, command.seed,
                            static_cast<std::uint32_t>(command.assist_after_misses));
     invocation += " --assist-after-misses " + std::to_string(command.assist_after_misses);
     begin_marker = kOtherHandGeneratedBegin;
-    section = std::string(begin_marker) + "\n" + other_hand_markdown(measurement, invocation) + kGeneratedEnd +
-              "\n";
+    section = std::string(begin_marker) + "\n" + other_hand_markdown(measurement, invocation) +
+              kGeneratedEnd + "\n";
   } else {
     const std::vector<char32_t> chosen =
         random_characters(library, count, command.seed, CharacterLibrary::embedded().characters());
@@ -69,8 +70,8 @@ int run_acceptance(const AcceptanceCommand& command) {
           "such as the folder scripts/fetch-hanzi-writer-data.sh prints)");
     }
     const AcceptanceMeasurement measurement = measure_acceptance(library, chosen, command.seed);
-    section = std::string(begin_marker) + "\n" + acceptance_markdown(measurement, invocation) + kGeneratedEnd +
-              "\n";
+    section = std::string(begin_marker) + "\n" + acceptance_markdown(measurement, invocation) +
+              kGeneratedEnd + "\n";
   }
   if (command.markdown.empty() || command.markdown == "-") {
     write_standard_output(section);
@@ -96,9 +97,10 @@ void add_bench_acceptance_command(CLI::App& bench, Commands& commands) {
                  "another hand's strokes: KanjiVG's SVG files (the folder scripts/fetch-kanjivg.sh prints), "
                  "written by a position-only pen on the characters both data sets have with as many strokes",
                  "the library's own medians, as labelled person-like paths");
-  add_integer(*app, "--assist-after-misses", command->assist_after_misses, "N",
-              "with --kanjivg: refusals of a stroke before it is credited assisted, as in the trial (0: never)",
-              0, 1000);
+  add_integer(
+      *app, "--assist-after-misses", command->assist_after_misses, "N",
+      "with --kanjivg: refusals of a stroke before it is credited assisted, as in the trial (0: never)", 0,
+      1000);
   add_integer(*app, "--characters", command->characters, "N",
               "characters drawn at random (not the embedded ones)", 1, 100000);
   add_unsigned(*app, "--seed", command->seed, "S", "seed of the draw and the paths (a 64-bit integer)");

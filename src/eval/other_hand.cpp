@@ -92,8 +92,8 @@ std::vector<std::vector<Vec2>> read_kanjivg_strokes(const std::filesystem::path&
 std::vector<std::vector<Vec2>> align_to_medians(const std::vector<std::vector<Vec2>>& strokes,
                                                 const PlacedCharacter& character) {
   if (strokes.size() != character.strokes.size()) {
-    throw InvalidArgument("align_to_medians: " + std::to_string(strokes.size()) + " strokes for a character of " +
-                          std::to_string(character.strokes.size()));
+    throw InvalidArgument("align_to_medians: " + std::to_string(strokes.size()) +
+                          " strokes for a character of " + std::to_string(character.strokes.size()));
   }
   // Least squares of q = s p + t over the paired points, p flipped to y up: s = sum (p - p0).(q - q0) /
   // sum |p - p0|^2, t = q0 - s p0 (ordinary least squares in the scale, the shift following).
@@ -169,8 +169,8 @@ bool same_order_and_form(const std::vector<std::vector<Vec2>>& lines, const Plac
     const double own = distance(line, medians[i]);
     std::vector<Vec2> reversed(medians[i].rbegin(), medians[i].rend());
     if (distance(line, reversed) < own) return false;
-    if (discrete_frechet_m(resampled(lines[i], kFormPoints), resampled(character.strokes[i].median_m, kFormPoints)) >
-        kSameFormFrechet_m) {
+    if (discrete_frechet_m(resampled(lines[i], kFormPoints),
+                           resampled(character.strokes[i].median_m, kFormPoints)) > kSameFormFrechet_m) {
       return false;
     }
     for (std::size_t j = 0; j < medians.size(); ++j) {
@@ -186,7 +186,8 @@ std::vector<char32_t> random_shared_characters(const CharacterLibrary& library,
   const std::set<char32_t> left_out(excluded.begin(), excluded.end());
   std::vector<char32_t> pool;
   for (char32_t c : library.characters()) {
-    if (left_out.count(c) == 0 && std::filesystem::is_regular_file(kanjivg_file(folder, c))) pool.push_back(c);
+    if (left_out.count(c) == 0 && std::filesystem::is_regular_file(kanjivg_file(folder, c)))
+      pool.push_back(c);
   }
   std::mt19937_64 random(seed);
   std::shuffle(pool.begin(), pool.end(), random);
@@ -212,7 +213,8 @@ std::vector<char32_t> random_shared_characters(const CharacterLibrary& library,
 
 OtherHandMeasurement measure_other_hand(const CharacterLibrary& library, const std::filesystem::path& folder,
                                         const std::vector<char32_t>& characters, std::uint64_t seed,
-                                        std::uint32_t assist_after_misses, const StrokeAcceptance& acceptance) {
+                                        std::uint32_t assist_after_misses,
+                                        const StrokeAcceptance& acceptance) {
   OtherHandMeasurement m;
   m.characters = characters;
   m.seed = seed;
@@ -271,14 +273,13 @@ OtherHandMeasurement measure_other_hand(const CharacterLibrary& library, const s
 
 std::string other_hand_markdown(const OtherHandMeasurement& m, const std::string& invocation) {
   const std::size_t n = m.characters.size();
-  std::string out = "Made by `" + invocation + "`: " + std::to_string(n) + " characters, " +
-                    std::to_string(m.strokes) +
-                    " strokes, each written along its KanjiVG line by a position-only pen; a refused stroke "
-                    "is written again until " +
-                    (m.assist_after_misses > 0
-                         ? "it has been refused " + std::to_string(m.assist_after_misses) +
-                               " times (`assist_after_misses`), when it is credited assisted.\n\n"
-                         : "it has been refused 5 times (no assisted credit).\n\n");
+  std::string out =
+      "Made by `" + invocation + "`: " + std::to_string(n) + " characters, " + std::to_string(m.strokes) +
+      " strokes, each written along its KanjiVG line by a position-only pen; a refused stroke "
+      "is written again until " +
+      (m.assist_after_misses > 0 ? "it has been refused " + std::to_string(m.assist_after_misses) +
+                                       " times (`assist_after_misses`), when it is credited assisted.\n\n"
+                                 : "it has been refused 5 times (no assisted credit).\n\n");
   out += "| measure | count | of | share |\n| --- | ---: | ---: | ---: |\n";
   const auto row = [&out](const std::string& what, std::size_t part, std::size_t whole) {
     out += "| " + what + " | " + std::to_string(part) + " | " + std::to_string(whole) + " | " +

@@ -53,15 +53,16 @@ namespace calligraphy {
 struct OtherHandMeasurement {
   std::vector<char32_t> characters;
   std::uint64_t seed = 0;
-  std::uint32_t assist_after_misses = 0;  ///< attempts a stroke gets before it is credited assisted (0: never)
+  std::uint32_t assist_after_misses =
+      0;  ///< attempts a stroke gets before it is credited assisted (0: never)
   std::size_t strokes = 0;
-  std::size_t strokes_first_attempt = 0;       ///< accepted at the first attempt
-  std::size_t characters_first_attempt = 0;    ///< every stroke accepted at its first attempt
-  std::size_t strokes_unassisted = 0;          ///< accepted within the attempts before assistance
-  std::size_t characters_unassisted = 0;       ///< every stroke so
-  std::size_t strokes_assisted = 0;            ///< credited assisted after assist_after_misses misses
-  std::size_t characters_completed = 0;        ///< completed, assisted strokes included
-  std::vector<std::string> refused;            ///< first examples of strokes refused at the first attempt
+  std::size_t strokes_first_attempt = 0;     ///< accepted at the first attempt
+  std::size_t characters_first_attempt = 0;  ///< every stroke accepted at its first attempt
+  std::size_t strokes_unassisted = 0;        ///< accepted within the attempts before assistance
+  std::size_t characters_unassisted = 0;     ///< every stroke so
+  std::size_t strokes_assisted = 0;          ///< credited assisted after assist_after_misses misses
+  std::size_t characters_completed = 0;      ///< completed, assisted strokes included
+  std::vector<std::string> refused;          ///< first examples of strokes refused at the first attempt
   /// Every kind of sim/person_traces.hpp made from the aligned KanjiVG lines instead of the medians.
   std::vector<KindAcceptance> kinds;
 };

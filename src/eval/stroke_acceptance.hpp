@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/model/character_library.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/sim/person_traces.hpp"
 
 namespace calligraphy {

@@ -54,12 +54,14 @@ constexpr std::array kAcceptanceFields{
     ParameterField<StrokeAcceptance>{"mean_deviation_cap_m", "m", kLength,
                                      "most mean deviation allowed on any stroke",
                                      &StrokeAcceptance::mean_deviation_cap_m},
-    ParameterField<StrokeAcceptance>{"reference_character_size_m", "m", ParameterRange{.low = 0.0, .high = 1.0},
+    ParameterField<StrokeAcceptance>{"reference_character_size_m", "m",
+                                     ParameterRange{.low = 0.0, .high = 1.0},
                                      "the character size the lengths are for (0: absolute lengths)",
                                      &StrokeAcceptance::reference_character_size_m},
-    ParameterField<StrokeAcceptance>{"hint_after_misses", "", ParameterRange{.low = 0.0, .high = 1000.0},
-                                     "refused attempts at a stroke after which it is shown as a hint (0: never)",
-                                     &StrokeAcceptance::hint_after_misses},
+    ParameterField<StrokeAcceptance>{
+        "hint_after_misses", "", ParameterRange{.low = 0.0, .high = 1000.0},
+        "refused attempts at a stroke after which it is shown as a hint (0: never)",
+        &StrokeAcceptance::hint_after_misses},
     ParameterField<StrokeAcceptance>{
         "assist_after_misses", "", ParameterRange{.low = 0.0, .high = 1000.0},
         "refused attempts at a stroke after which it is demonstrated and credited assisted (0: never)",
@@ -76,15 +78,17 @@ void StrokeAcceptance::validate() const {
   check_parameters(*this);
   for (const double count : {hint_after_misses, assist_after_misses}) {
     if (count != std::floor(count)) {
-      throw InvalidArgument("StrokeAcceptance." +
-                            std::string(count == hint_after_misses ? "hint_after_misses" : "assist_after_misses") +
-                            " = " + std::to_string(count) + " must be a whole number");
+      throw InvalidArgument(
+          "StrokeAcceptance." +
+          std::string(count == hint_after_misses ? "hint_after_misses" : "assist_after_misses") + " = " +
+          std::to_string(count) + " must be a whole number");
     }
   }
 }
 
 double StrokeAcceptance::allowed_shortfall_m(double length_m) const noexcept {
-  return std::min({shortfall_m + shortfall_per_length * length_m, shortfall_cap_m, shortfall_fraction * length_m});
+  return std::min(
+      {shortfall_m + shortfall_per_length * length_m, shortfall_cap_m, shortfall_fraction * length_m});
 }
 
 double StrokeAcceptance::allowed_mean_deviation_m(double length_m) const noexcept {
@@ -106,8 +110,9 @@ StrokeAcceptance StrokeAcceptance::for_character_size(double character_size_m) c
   StrokeAcceptance out = *this;
   for (double StrokeAcceptance::*length :
        {&StrokeAcceptance::corridor_m, &StrokeAcceptance::mean_deviation_m, &StrokeAcceptance::shortfall_m,
-        &StrokeAcceptance::displacement_m, &StrokeAcceptance::lookahead_m, &StrokeAcceptance::follow_through_m,
-        &StrokeAcceptance::shortfall_cap_m, &StrokeAcceptance::mean_deviation_cap_m}) {
+        &StrokeAcceptance::displacement_m, &StrokeAcceptance::lookahead_m,
+        &StrokeAcceptance::follow_through_m, &StrokeAcceptance::shortfall_cap_m,
+        &StrokeAcceptance::mean_deviation_cap_m}) {
     out.*length *= k;
   }
   return out;

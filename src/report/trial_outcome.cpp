@@ -20,12 +20,8 @@ nlohmann::json trial_outcome_object(const TrialResult& result, const WritingMetr
 }
 
 nlohmann::json renderer_stroke_object(const StrokeMetrics& stroke) {
-  return {{"index", stroke.index},
-          {"character", stroke.character},
-          {"typical_id", stroke.typical_id},
-          {"completed", stroke.completed},
-          {"assisted", stroke.assisted},
-          {"attempts", stroke.attempts}};
+  return {{"index", stroke.index},         {"character", stroke.character}, {"typical_id", stroke.typical_id},
+          {"completed", stroke.completed}, {"assisted", stroke.assisted},   {"attempts", stroke.attempts}};
 }
 
 }  // namespace calligraphy::report_detail

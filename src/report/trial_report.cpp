@@ -92,7 +92,8 @@ void print_trial_table(const TrialDescription& d, const Scene& scene, const Tria
                   millimetres(value([](auto& x) { return x.deviation.max_m; }), 2).c_str(),
                   millimetres(value([](auto& x) { return x.curves.frechet_m; }), 2).c_str(),
                   millimetres(value([](auto& x) { return x.curves.dtw_m; }), 2).c_str(), time_text,
-                  live ? live->attempts : 0, live && live->completed ? "yes" : (live && live->assisted ? "assisted" : "no"));
+                  live ? live->attempts : 0,
+                  live && live->completed ? "yes" : (live && live->assisted ? "assisted" : "no"));
       ++scene_stroke;
     }
   }

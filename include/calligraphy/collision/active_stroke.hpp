@@ -8,8 +8,8 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/model/scene.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 
 namespace calligraphy {
 

@@ -58,7 +58,7 @@ struct TrialMetrics {
   std::size_t strokes_completed = 0;  ///< strokes written by the pen
   std::size_t strokes_assisted = 0;   ///< strokes credited as assisted (StrokeMetrics::assisted), apart
   bool completed_in_order = false;    ///< every stroke written, each in its turn (none assisted)
-  double time_s = 0.0;              ///< from the start to the last stroke written (or the end of the trial)
+  double time_s = 0.0;                ///< from the start to the last stroke written (or the end of the trial)
   /// Over all WS ticks of the strokes' last attempts [m]; nullopt when no stroke has one (nothing was
   /// written).
   std::optional<double> mean_deviation_m;
