@@ -28,14 +28,14 @@
 #include <cstdint>
 #include <vector>
 
-#include "calligraphy/core/device_types.hpp"
-#include "calligraphy/core/seqlock.hpp"
-#include "calligraphy/core/spsc_queue.hpp"
-#include "calligraphy/model/scene.hpp"
 #include "calligraphy/model/stroke_progress.hpp"
+#include "calligraphy/core/device_types.hpp"
+#include "calligraphy/model/scene.hpp"
 #include "calligraphy/render/renderer.hpp"
 #include "calligraphy/trial/recorder.hpp"
 #include "calligraphy/trial/result.hpp"
+#include "calligraphy/core/seqlock.hpp"
+#include "calligraphy/core/spsc_queue.hpp"
 
 namespace calligraphy {
 
@@ -67,9 +67,9 @@ struct DisplaySnapshot {
   std::uint32_t strokes_completed = 0;
   std::uint32_t strokes_total = 0;
   std::uint32_t misses = 0;  ///< refused attempts on the active stroke
-  bool hint_shown = false;   ///< the active stroke is shown as a hint (misses >= hint_after_misses)
-  DisplayPoint2 hint_m;      ///< the active stroke's start, where the red ellipse goes [m]
-  DisplayPoint3 hip_m;       ///< haptic interface point, as read from the device [m]
+  bool hint_shown = false;  ///< the active stroke is shown as a hint (misses >= hint_after_misses)
+  DisplayPoint2 hint_m;  ///< the active stroke's start, where the red ellipse goes [m]
+  DisplayPoint3 hip_m;   ///< haptic interface point, as read from the device [m]
   /// Virtual pen tip: the HIP projected onto the paper when it is below the paper, else the HIP [m]
   /// (section 4.2: the VTP stays on the surface the HIP penetrates).
   DisplayPoint3 vtp_m;
@@ -80,7 +80,7 @@ struct DisplaySnapshot {
 enum class DisplayEventKind : std::uint8_t {
   stroke_completed,     ///< the last feature point of a stroke was written; its metrics are set
   stroke_abandoned,     ///< the pen left the paper in WS unwritten (4.3.3); `refusal` says why
-  stroke_assisted,      ///< the stroke was demonstrated and credited after assist_after_misses misses
+  stroke_assisted,  ///< the stroke was demonstrated and credited after assist_after_misses misses
   character_completed,  ///< the last stroke of a character was written
   trial_ended,          ///< `TrialSession::finish` was called; `end` says how
 };
