@@ -1,6 +1,7 @@
 // No dead end: refused attempts at a stroke are counted; after hint_after_misses the stroke is shown as a
 // hint, after assist_after_misses it is credited as assisted (not written) and the next stroke is active
 // (StrokeAcceptance, active_stroke.hpp). The recorder, a trial's record and its replay keep the credits.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -17,21 +18,29 @@ using namespace calligraphy;
 
 namespace {
 
-// An attempt that enters the stroke at its start and lifts a fifth of the way along: too short.
-void short_attempt(ActiveStroke& active) {
-  const PlacedStroke& stroke = *active.stroke();
+// The stroke's centre line from its start up to `fraction` of its points, in steps of at most 0.25 mm.
+std::vector<Vec2> along_line(const PlacedStroke& stroke, double fraction) {
   const std::vector<Vec2>& line = stroke.centre_line.points_m;
-  active.begin(line.front());
-  const Vec2 towards = line.front() + 0.2 * (line.back() - line.front());
-  for (int i = 1; i <= 20; ++i) active.advance(line.front() + (towards - line.front()) * (i / 20.0));
+  const auto last = static_cast<std::size_t>(fraction * static_cast<double>(line.size() - 1));
+  std::vector<Vec2> out{line.front()};
+  for (std::size_t k = 1; k <= last; ++k) {
+    const int steps = std::max(1, static_cast<int>((line[k] - line[k - 1]).norm() / 0.25e-3));
+    for (int i = 1; i <= steps; ++i) out.push_back(line[k - 1] + (line[k] - line[k - 1]) * (i / double(steps)));
+  }
+  return out;
 }
 
-// The whole stroke along its centre line.
-void whole_attempt(ActiveStroke& active) {
-  const std::vector<Vec2>& line = active.stroke()->centre_line.points_m;
-  active.begin(line.front());
-  for (const Vec2& p : line) active.advance(p);
+void attempt(ActiveStroke& active, double fraction) {
+  const std::vector<Vec2> path = along_line(*active.stroke(), fraction);
+  active.begin(path.front());
+  for (const Vec2& p : path) active.advance(p);
 }
+
+// An attempt that enters the stroke at its start and lifts a fifth of the way along: too short.
+void short_attempt(ActiveStroke& active) { attempt(active, 0.2); }
+
+// The whole stroke along its centre line.
+void whole_attempt(ActiveStroke& active) { attempt(active, 1.0); }
 
 }  // namespace
 

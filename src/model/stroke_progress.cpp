@@ -56,15 +56,15 @@ constexpr std::array kAcceptanceFields{
                                      &StrokeAcceptance::mean_deviation_cap_m},
     ParameterField<StrokeAcceptance>{"reference_character_size_m", "m",
                                      ParameterRange{.low = 0.0, .high = 1.0},
-                                     "the character size the lengths are for (0: absolute lengths)",
+                                     "the character size the lengths are for, 0 for absolute lengths",
                                      &StrokeAcceptance::reference_character_size_m},
     ParameterField<StrokeAcceptance>{
         "hint_after_misses", "", ParameterRange{.low = 0.0, .high = 1000.0},
-        "refused attempts at a stroke after which it is shown as a hint (0: never)",
+        "refused attempts at a stroke after which it is shown as a hint, 0 never",
         &StrokeAcceptance::hint_after_misses},
     ParameterField<StrokeAcceptance>{
         "assist_after_misses", "", ParameterRange{.low = 0.0, .high = 1000.0},
-        "refused attempts at a stroke after which it is demonstrated and credited assisted (0: never)",
+        "refused attempts at a stroke after which it is demonstrated and credited assisted, 0 never",
         &StrokeAcceptance::assist_after_misses},
 };
 
