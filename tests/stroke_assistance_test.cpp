@@ -25,7 +25,8 @@ std::vector<Vec2> along_line(const PlacedStroke& stroke, double fraction) {
   std::vector<Vec2> out{line.front()};
   for (std::size_t k = 1; k <= last; ++k) {
     const int steps = std::max(1, static_cast<int>((line[k] - line[k - 1]).norm() / 0.25e-3));
-    for (int i = 1; i <= steps; ++i) out.push_back(line[k - 1] + (line[k] - line[k - 1]) * (i / double(steps)));
+    for (int i = 1; i <= steps; ++i)
+      out.push_back(line[k - 1] + (line[k] - line[k - 1]) * (i / double(steps)));
   }
   return out;
 }
