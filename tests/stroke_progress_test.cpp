@@ -121,8 +121,13 @@ TEST_CASE("A stroke is written when the pen lifts short of its end or past it, n
   const Fed half = feed(h, along({a, (a + b) / 2}));
   CHECK_FALSE(half.lifted_written);
   CHECK(half.refusal == StrokeRefusal::too_short);
-  const Fed short_by_8 = feed(h, along({a, b - mm(8, 0)}));
-  CHECK_FALSE(short_by_8.lifted_written);
+  // Short by more than the shortfall the stroke's length allows (it grows with the length: 12 mm on this
+  // 40 mm stroke, so 8 mm short is written).
+  const double allowed_mm = 1e3 * StrokeAcceptance{}.allowed_shortfall_m((b - a).norm());
+  CHECK(feed(h, along({a, b - mm(allowed_mm - 1.5, 0)})).lifted_written);
+  const Fed too_short = feed(h, along({a, b - mm(allowed_mm + 1.5, 0)}));
+  CHECK_FALSE(too_short.lifted_written);
+  CHECK(too_short.refusal == StrokeRefusal::too_short);
   // Moved 4 mm across: in the start neighbourhood, but in the wrong place.
   const Fed moved = feed(h, along({a + mm(0, 4), b + mm(0, 4)}));
   CHECK_FALSE(moved.lifted_written);

@@ -286,6 +286,7 @@ TEST_CASE("The stroke acceptance decides how far a stroke may stray", "[score]")
   CHECK(strict.refusals.wrong_place == 1);
   ScoreOptions lenient;
   lenient.acceptance.mean_deviation_m = 0.005;
+  lenient.acceptance.mean_deviation_cap_m = 0.005;
   const CharacterScore written = score_trace(yong, trace.samples, lenient);
   CHECK(written.strokes[3].written);
   REQUIRE(written.strokes[3].metrics);

@@ -130,12 +130,18 @@ TEST_CASE("A writer that stops early ends the trial as writer_finished, a hand t
   const Scene scene = scene_of(U"口");
   TrialOptions options;
   options.rate_hz = 100.0;  // too coarse a tick for this writer: the display takes none of its strokes
+  options.force.acceptance.assist_after_misses = 0;  // no stroke credited as assisted
   const TrialResult result = run_simulated_trial(scene, options);
   CHECK(result.metrics.strokes_completed == 0);
   // It gave up on each stroke in turn, moved on, and stopped having written them all.
   CHECK(result.end == TrialEnd::writer_finished);
   CHECK(std::string(to_string(result.end)) == "writer_finished");
   CHECK(result.aborted);
+  // With the assisted credit (the default) the strokes it cannot write are credited, not left: no dead end.
+  options.force.acceptance.assist_after_misses = StrokeAcceptance{}.assist_after_misses;
+  const TrialResult assisted = run_simulated_trial(scene, options);
+  CHECK(assisted.metrics.strokes_completed == 0);
+  CHECK(assisted.metrics.strokes_assisted > 0);
 
   SimulatedDevice device;
   QuittingHand quitter;

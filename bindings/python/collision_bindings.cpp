@@ -141,8 +141,10 @@ void bind_collision(py::module_& m) {
   ParameterClass<StrokeAcceptance>(
       m, "StrokeAcceptance",
       "When a stroke counts as written: progress along its centre line (the data's median) within a "
-      "corridor, with a bounded mean distance, far enough along it. Lengths in m; defaults for a "
-      "60 mm character from people's distances to hanzi-writer-data's medians (docs/stroke-acceptance.md).",
+      "corridor, with a bounded mean distance, far enough along it; tolerances that grow with the stroke's "
+      "length up to a cap, and the misses after which a stroke is hinted and credited as assisted. Lengths "
+      "in m; defaults for a 60 mm character, scaled with the character's size, from people's distances to "
+      "hanzi-writer-data's medians (docs/stroke-acceptance.md).",
       [](const StrokeAcceptance& a) { a.validate(); })
       .field(&StrokeAcceptance::corridor_m)
       .field(&StrokeAcceptance::mean_deviation_m)
@@ -152,6 +154,13 @@ void bind_collision(py::module_& m) {
       .field(&StrokeAcceptance::max_gain_ratio)
       .field(&StrokeAcceptance::follow_through_m)
       .field(&StrokeAcceptance::lookahead_m)
+      .field(&StrokeAcceptance::shortfall_per_length)
+      .field(&StrokeAcceptance::shortfall_cap_m)
+      .field(&StrokeAcceptance::deviation_per_length)
+      .field(&StrokeAcceptance::mean_deviation_cap_m)
+      .field(&StrokeAcceptance::reference_character_size_m)
+      .field(&StrokeAcceptance::hint_after_misses)
+      .field(&StrokeAcceptance::assist_after_misses)
       .finish();
 
   py::enum_<StrokeRefusal>(m, "StrokeRefusal",

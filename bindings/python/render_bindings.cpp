@@ -442,6 +442,12 @@ void bind_renderer(py::module_& m) {
                     "this tick wrote the last feature point of a stroke")
       .def_readonly("stroke_abandoned", &RenderOutput::stroke_abandoned,
                     "the pen was lifted in WS: the stroke was reloaded")
+      .def_readonly("stroke_assisted", &RenderOutput::stroke_assisted,
+                    "the abandoned stroke was refused assist_after_misses times: credited as assisted, the "
+                    "next stroke is active")
+      .def_readonly("misses", &RenderOutput::misses, "refused attempts at the active stroke")
+      .def_readonly("hint_shown", &RenderOutput::hint_shown,
+                    "the active stroke is to be shown as a hint (misses >= hint_after_misses)")
       .def_readonly("input_rejected", &RenderOutput::input_rejected,
                     "the device state was not finite: zero force")
       .def_readonly("force_error", &RenderOutput::force_error,

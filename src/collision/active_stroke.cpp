@@ -14,6 +14,8 @@ void ActiveStroke::reset() noexcept {
   stroke_ = 0;
   element_ = 0;
   written_ = 0;
+  assisted_ = 0;
+  misses_ = 0;
   attempt_ = StrokeProgressTracker{};
   attempt_open_ = false;
   // Skip characters without strokes so that the active stroke always exists until finished.
@@ -22,7 +24,7 @@ void ActiveStroke::reset() noexcept {
 }
 
 void ActiveStroke::next_stroke() noexcept {
-  ++written_;
+  misses_ = 0;
   element_ = 0;
   ++stroke_;
   while (character_ < scene_->characters.size() && stroke_ >= scene_->characters[character_].strokes.size()) {
@@ -50,6 +52,7 @@ StrokeProgress ActiveStroke::advance(const Vec2& tip_m) noexcept {
   if (completed) {
     progress.stroke_completed = true;
     attempt_open_ = false;
+    ++written_;
     next_stroke();
   } else if (!attempt_.in_attempt()) {
     element_ = 0;  // the pen left the stroke's end across it: nothing of this attempt counts
@@ -65,11 +68,25 @@ StrokeProgress ActiveStroke::lift() noexcept {
   if (attempt_.lift()) {
     progress.stroke_completed = true;
     progress.refusal = StrokeRefusal::none;
+    ++written_;
     next_stroke();
-  } else {
-    element_ = 0;  // the stroke's feature points are loaded again (section 4.3.3)
+    return progress;
+  }
+  element_ = 0;  // the stroke's feature points are loaded again (section 4.3.3)
+  ++misses_;
+  const double assist = acceptance_.assist_after_misses;
+  if (assist > 0.0 && static_cast<double>(misses_) >= assist) {
+    // Demonstrated and credited as assisted (Hanzi Writer's markStrokeCorrectAfterMisses): no dead end.
+    progress.stroke_assisted = true;
+    ++assisted_;
+    next_stroke();
   }
   return progress;
+}
+
+bool ActiveStroke::hint_shown() const noexcept {
+  const double hint = acceptance_.hint_after_misses;
+  return hint > 0.0 && !finished() && static_cast<double>(misses_) >= hint;
 }
 
 const PlacedCharacter* ActiveStroke::character() const noexcept {

@@ -24,17 +24,40 @@ std::vector<char32_t> random_characters(const CharacterLibrary& library, std::si
   return pool;
 }
 
+std::vector<KindAcceptance> empty_kind_table() {
+  std::vector<KindAcceptance> kinds;
+  for (TraceKind kind : kTraceKinds) {
+    KindAcceptance k;
+    k.kind = kind;
+    kinds.push_back(k);
+  }
+  return kinds;
+}
+
+void add_kind_verdicts(std::vector<KindAcceptance>& kinds, const PlacedCharacter& character,
+                       const PlacedCharacter& source, std::size_t stroke, std::mt19937_64& random,
+                       double start_radius_m, const StrokeAcceptance& acceptance) {
+  for (KindAcceptance& k : kinds) {
+    if (!trace_applies(source, stroke, k.kind)) continue;
+    const std::vector<Vec2> path = person_trace(source, stroke, k.kind, random);
+    const StrokeMatch match = match_stroke(character, stroke, path, start_radius_m, acceptance);
+    ++k.paths;
+    if (match.accepted) ++k.accepted;
+    ++k.by_refusal[static_cast<std::size_t>(match.refusal)];
+    if (match.accepted != is_positive(k.kind) && k.examples.size() < 5) {
+      k.examples.push_back(encode_utf8(character.code_point) + " stroke " + std::to_string(stroke + 1) +
+                           (match.accepted ? "" : std::string(" (") + to_string(match.refusal) + ")"));
+    }
+  }
+}
+
 AcceptanceMeasurement measure_acceptance(const CharacterLibrary& library,
                                          const std::vector<char32_t>& characters, std::uint64_t seed,
                                          const StrokeAcceptance& acceptance) {
   AcceptanceMeasurement m;
   m.characters = characters;
   m.seed = seed;
-  for (TraceKind kind : kTraceKinds) {
-    KindAcceptance k;
-    k.kind = kind;
-    m.kinds.push_back(k);
-  }
+  m.kinds = empty_kind_table();
   SceneLayout layout;
   for (std::size_t c = 0; c < characters.size(); ++c) {
     const Scene scene = Scene::lay_out({library.load(characters[c])}, layout);
@@ -43,32 +66,19 @@ AcceptanceMeasurement measure_acceptance(const CharacterLibrary& library,
     std::mt19937_64 random(seed * 0x9e3779b97f4a7c15ULL + characters[c]);
     for (std::size_t s = 0; s < character.strokes.size(); ++s) {
       ++m.strokes;
-      for (KindAcceptance& k : m.kinds) {
-        if (!trace_applies(character, s, k.kind)) continue;
-        const std::vector<Vec2> path = person_trace(character, s, k.kind, random);
-        const StrokeMatch match = match_stroke(character, s, path, layout.start_radius_m, acceptance);
-        ++k.paths;
-        if (match.accepted) ++k.accepted;
-        ++k.by_refusal[static_cast<std::size_t>(match.refusal)];
-        if (match.accepted != is_positive(k.kind) && k.examples.size() < 5) {
-          k.examples.push_back(encode_utf8(characters[c]) + " stroke " + std::to_string(s + 1) +
-                               (match.accepted ? "" : std::string(" (") + to_string(match.refusal) + ")"));
-        }
-      }
+      add_kind_verdicts(m.kinds, character, character, s, random, layout.start_radius_m, acceptance);
     }
   }
   return m;
 }
 
-std::string acceptance_markdown(const AcceptanceMeasurement& m, const std::string& invocation) {
-  std::string out = "Made by `" + invocation + "`: " + std::to_string(m.characters.size()) + " characters, " +
-                    std::to_string(m.strokes) + " strokes, one path of each kind per stroke.\n\n";
-  out +=
+std::string kind_table_markdown(const std::vector<KindAcceptance>& kinds) {
+  std::string out =
       "| kind | label | paths | accepted | too short | backwards | wrong place | wrong stroke | wrong order "
       "| "
       "verdict right |\n| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
   char line[400];
-  for (const KindAcceptance& k : m.kinds) {
+  for (const KindAcceptance& k : kinds) {
     const bool positive = is_positive(k.kind);
     const std::size_t right = positive ? k.accepted : k.paths - k.accepted;
     const auto& r = k.by_refusal;
@@ -79,13 +89,20 @@ std::string acceptance_markdown(const AcceptanceMeasurement& m, const std::strin
     out += line;
   }
   std::string examples;
-  for (const KindAcceptance& k : m.kinds) {
+  for (const KindAcceptance& k : kinds) {
     if (k.examples.empty()) continue;
     examples += "- " + std::string(to_string(k.kind)) + (is_positive(k.kind) ? " refused: " : " accepted: ");
     for (std::size_t i = 0; i < k.examples.size(); ++i) examples += (i > 0 ? ", " : "") + k.examples[i];
     examples += "\n";
   }
   if (!examples.empty()) out += "\nWrong verdicts, first examples:\n\n" + examples;
+  return out;
+}
+
+std::string acceptance_markdown(const AcceptanceMeasurement& m, const std::string& invocation) {
+  std::string out = "Made by `" + invocation + "`: " + std::to_string(m.characters.size()) + " characters, " +
+                    std::to_string(m.strokes) + " strokes, one path of each kind per stroke.\n\n";
+  out += kind_table_markdown(m.kinds);
   return out;
 }
 

@@ -4,11 +4,12 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <random>
 #include <string>
 #include <vector>
 
-#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/model/character_library.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/sim/person_traces.hpp"
 
 namespace calligraphy {
@@ -41,6 +42,19 @@ struct AcceptanceMeasurement {
                                                        const std::vector<char32_t>& characters,
                                                        std::uint64_t seed,
                                                        const StrokeAcceptance& acceptance = {});
+
+/// One empty row per kind of kTraceKinds.
+[[nodiscard]] std::vector<KindAcceptance> empty_kind_table();
+
+/// One path of every applicable kind for stroke `stroke`, made from the medians of `source` (the
+/// character itself, or another hand's lines in its place) and matched against that stroke of
+/// `character`, added to `kinds` (empty_kind_table's rows).
+void add_kind_verdicts(std::vector<KindAcceptance>& kinds, const PlacedCharacter& character,
+                       const PlacedCharacter& source, std::size_t stroke, std::mt19937_64& random,
+                       double start_radius_m, const StrokeAcceptance& acceptance);
+
+/// The markdown confusion table of `kinds`, with the first wrong verdicts.
+[[nodiscard]] std::string kind_table_markdown(const std::vector<KindAcceptance>& kinds);
 
 /// The markdown confusion table, with the command that made it.
 [[nodiscard]] std::string acceptance_markdown(const AcceptanceMeasurement& measurement,

@@ -60,6 +60,7 @@ Scene Scene::lay_out(const std::vector<Character>& characters, const SceneLayout
       }
       for (const Vec2& p : stroke.median) ps.median_m.push_back(placed.placement.to_paper(p));
       ps.centre_line = StrokeCentreLine::of(ps.median_m, ps.elements);
+      ps.character_size_m = layout.character_size_m;
       placed.strokes.push_back(std::move(ps));
     }
     placed.bounding_box.min().array() -= layout.box_margin_m;

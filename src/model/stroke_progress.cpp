@@ -42,6 +42,30 @@ constexpr std::array kAcceptanceFields{
     ParameterField<StrokeAcceptance>{"lookahead_m", "m", kLength,
                                      "how far along the centre line the foot point is looked for",
                                      &StrokeAcceptance::lookahead_m},
+    // Added with version 4 of a trial record; older records run with use_fixed_tolerances().
+    ParameterField<StrokeAcceptance>{"shortfall_per_length", "", ParameterRange{.low = 0.0, .high = 1.0},
+                                     "growth of the shortfall allowed with the stroke's length",
+                                     &StrokeAcceptance::shortfall_per_length},
+    ParameterField<StrokeAcceptance>{"shortfall_cap_m", "m", kLength, "most shortfall allowed on any stroke",
+                                     &StrokeAcceptance::shortfall_cap_m},
+    ParameterField<StrokeAcceptance>{"deviation_per_length", "", ParameterRange{.low = 0.0, .high = 1.0},
+                                     "growth of the mean deviation allowed with the stroke's length",
+                                     &StrokeAcceptance::deviation_per_length},
+    ParameterField<StrokeAcceptance>{"mean_deviation_cap_m", "m", kLength,
+                                     "most mean deviation allowed on any stroke",
+                                     &StrokeAcceptance::mean_deviation_cap_m},
+    ParameterField<StrokeAcceptance>{"reference_character_size_m", "m",
+                                     ParameterRange{.low = 0.0, .high = 1.0},
+                                     "the character size the lengths are for, 0 for absolute lengths",
+                                     &StrokeAcceptance::reference_character_size_m},
+    ParameterField<StrokeAcceptance>{
+        "hint_after_misses", "", ParameterRange{.low = 0.0, .high = 1000.0},
+        "refused attempts at a stroke after which it is shown as a hint, 0 never",
+        &StrokeAcceptance::hint_after_misses},
+    ParameterField<StrokeAcceptance>{
+        "assist_after_misses", "", ParameterRange{.low = 0.0, .high = 1000.0},
+        "refused attempts at a stroke after which it is demonstrated and credited assisted, 0 never",
+        &StrokeAcceptance::assist_after_misses},
 };
 
 }  // namespace
@@ -50,10 +74,48 @@ std::span<const ParameterField<StrokeAcceptance>> ParameterTable<StrokeAcceptanc
   return kAcceptanceFields;
 }
 
-void StrokeAcceptance::validate() const { check_parameters(*this); }
+void StrokeAcceptance::validate() const {
+  check_parameters(*this);
+  for (const double count : {hint_after_misses, assist_after_misses}) {
+    if (count != std::floor(count)) {
+      throw InvalidArgument(
+          "StrokeAcceptance." +
+          std::string(count == hint_after_misses ? "hint_after_misses" : "assist_after_misses") + " = " +
+          std::to_string(count) + " must be a whole number");
+    }
+  }
+}
 
 double StrokeAcceptance::allowed_shortfall_m(double length_m) const noexcept {
-  return std::min(shortfall_m, shortfall_fraction * length_m);
+  return std::min(
+      {shortfall_m + shortfall_per_length * length_m, shortfall_cap_m, shortfall_fraction * length_m});
+}
+
+double StrokeAcceptance::allowed_mean_deviation_m(double length_m) const noexcept {
+  return std::min(mean_deviation_m + deviation_per_length * length_m, mean_deviation_cap_m);
+}
+
+void StrokeAcceptance::use_fixed_tolerances() noexcept {
+  shortfall_per_length = 0.0;
+  shortfall_cap_m = kLength.high;
+  deviation_per_length = 0.0;
+  mean_deviation_cap_m = kLength.high;
+  reference_character_size_m = 0.0;
+  assist_after_misses = 0.0;
+}
+
+StrokeAcceptance StrokeAcceptance::for_character_size(double character_size_m) const noexcept {
+  if (!(reference_character_size_m > 0.0) || !(character_size_m > 0.0)) return *this;
+  const double k = character_size_m / reference_character_size_m;
+  StrokeAcceptance out = *this;
+  for (double StrokeAcceptance::*length :
+       {&StrokeAcceptance::corridor_m, &StrokeAcceptance::mean_deviation_m, &StrokeAcceptance::shortfall_m,
+        &StrokeAcceptance::displacement_m, &StrokeAcceptance::lookahead_m,
+        &StrokeAcceptance::follow_through_m, &StrokeAcceptance::shortfall_cap_m,
+        &StrokeAcceptance::mean_deviation_cap_m}) {
+    out.*length *= k;
+  }
+  return out;
 }
 
 const char* to_string(StrokeRefusal refusal) noexcept {
@@ -105,7 +167,7 @@ StrokeProgressTracker::Foot StrokeProgressTracker::foot_near(const Vec2& tip_m, 
 void StrokeProgressTracker::begin(const PlacedStroke& stroke, const Vec2& tip_m,
                                   const StrokeAcceptance& acceptance) noexcept {
   stroke_ = &stroke;
-  acceptance_ = acceptance;
+  acceptance_ = acceptance.for_character_size(stroke.character_size_m);
   const StrokeCentreLine& line = stroke.centre_line;
   const Foot foot = foot_near(tip_m, 0.0, line.start_arc_m + acceptance_.lookahead_m);
   entry_arc_m_ = foot.arc_m;
@@ -202,7 +264,7 @@ bool StrokeProgressTracker::written() const noexcept {
   const double start_gap = entry_arc_m_ - line.start_arc_m;
   const double end_gap = line.element_end_arc_m.back() - progress_m_;
   return way_along_m() >= length - shortfall && start_gap <= end_gap_limit && end_gap <= end_gap_limit &&
-         mean_deviation_m() <= acceptance_.mean_deviation_m;
+         mean_deviation_m() <= acceptance_.allowed_mean_deviation_m(length);
 }
 
 std::size_t StrokeProgressTracker::element_index() const noexcept {
@@ -218,7 +280,8 @@ StrokeRefusal StrokeProgressTracker::refusal() const noexcept {
   if (stroke_ == nullptr) return StrokeRefusal::wrong_place;
   if (lost_) return StrokeRefusal::wrong_stroke;
   if (passed_end_ || written()) return StrokeRefusal::none;
-  if (mean_deviation_m() > acceptance_.mean_deviation_m) return StrokeRefusal::wrong_place;
+  if (mean_deviation_m() > acceptance_.allowed_mean_deviation_m(stroke_length_m()))
+    return StrokeRefusal::wrong_place;
   const double forward = progress_m_ - entry_arc_m_;
   if (backward_m_ > forward && backward_m_ > 0.25 * acceptance_.corridor_m) return StrokeRefusal::backwards;
   if (outside_corridor_) return StrokeRefusal::wrong_stroke;

@@ -1,4 +1,5 @@
-// SVG path data (M, L, Q, C, Z and their relative forms) to closed polygons (stroke_outline.hpp).
+// SVG path data (M, L, Q, C, S, Z and their relative forms) to closed polygons or open polylines
+// (stroke_outline.hpp).
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -13,7 +14,8 @@ namespace {
 
 class PathParser {
  public:
-  PathParser(std::string_view text, double tolerance) : text_(text), tolerance_(tolerance) {}
+  PathParser(std::string_view text, double tolerance, bool closed)
+      : text_(text), tolerance_(tolerance), closed_(closed) {}
 
   std::vector<OutlinePolygon> parse() {
     char command = 0;
@@ -23,15 +25,17 @@ class PathParser {
         command = c;
         ++position_;
         if (command == 'Z' || command == 'z') {
+          if (!closed_ && open_) add(start_);
           close_subpath();
           continue;
         }
       } else if (command == 0) {
-        fail("expected a command (M, L, Q, C or Z), got '" + std::string(1, c) + "'");
+        fail("expected a command (M, L, Q, C, S or Z), got '" + std::string(1, c) + "'");
       } else if (command == 'Z' || command == 'z') {
         fail("a number after Z");
       }
       run(command);
+      previous_ = command;
       // After a moveto, further coordinate pairs are implicit linetos (SVG 1.1, 8.3.2).
       if (command == 'M') command = 'L';
       if (command == 'm') command = 'l';
@@ -78,22 +82,37 @@ class PathParser {
         require_subpath();
         const Vec2 c1 = origin + point();
         const Vec2 c2 = origin + point();
-        const Vec2 end = origin + point();
-        const Vec2 p0 = current_;
-        const double second = std::max((p0 - 2.0 * c1 + c2).norm(), (c1 - 2.0 * c2 + end).norm());
-        const int n = segments(0.75 * second);
-        for (int i = 1; i <= n; ++i) {
-          const double t = static_cast<double>(i) / n;
-          const double u = 1 - t;
-          add(u * u * u * p0 + 3 * u * u * t * c1 + 3 * u * t * t * c2 + t * t * t * end);
-        }
-        current_ = end;
+        cubic(c1, c2, origin + point());
+        break;
+      }
+      case 'S':
+      case 's': {
+        // The first control point is the previous cubic's second one reflected about the current point,
+        // or the current point after any other command (SVG 1.1, 8.3.6).
+        require_subpath();
+        const bool after_cubic = previous_ == 'C' || previous_ == 'c' || previous_ == 'S' || previous_ == 's';
+        const Vec2 c1 = after_cubic ? Vec2(2.0 * current_ - last_control_) : current_;
+        const Vec2 c2 = origin + point();
+        cubic(c1, c2, origin + point());
         break;
       }
       default:
         --position_;
-        fail(std::string("unsupported path command '") + command + "' (only M, L, Q, C and Z)");
+        fail(std::string("unsupported path command '") + command + "' (only M, L, Q, C, S and Z)");
     }
+  }
+
+  void cubic(const Vec2& c1, const Vec2& c2, const Vec2& end) {
+    const Vec2 p0 = current_;
+    const double second = std::max((p0 - 2.0 * c1 + c2).norm(), (c1 - 2.0 * c2 + end).norm());
+    const int n = segments(0.75 * second);
+    for (int i = 1; i <= n; ++i) {
+      const double t = static_cast<double>(i) / n;
+      const double u = 1 - t;
+      add(u * u * u * p0 + 3 * u * u * t * c1 + 3 * u * t * t * c2 + t * t * t * end);
+    }
+    last_control_ = c2;
+    current_ = end;
   }
 
   // Segments for a curve whose linear-interpolation error over step h = 1/n is `bound` h^2.
@@ -122,8 +141,12 @@ class PathParser {
     if (!open_) return;
     open_ = false;
     OutlinePolygon& polygon = polygons_.back();
-    if (polygon.size() > 1 && polygon.back() == polygon.front()) polygon.pop_back();
-    if (polygon.size() < 3) fail("a subpath of fewer than 3 distinct vertices");
+    if (closed_) {
+      if (polygon.size() > 1 && polygon.back() == polygon.front()) polygon.pop_back();
+      if (polygon.size() < 3) fail("a subpath of fewer than 3 distinct vertices");
+    } else if (polygon.size() < 2) {
+      fail("a subpath of fewer than 2 distinct vertices");
+    }
     current_ = start_;
   }
 
@@ -164,6 +187,9 @@ class PathParser {
 
   std::string_view text_;
   double tolerance_;
+  bool closed_;
+  char previous_ = 0;
+  Vec2 last_control_ = Vec2::Zero();
   std::size_t position_ = 0;
   std::size_t vertices_ = 0;
   bool open_ = false;
@@ -178,7 +204,14 @@ std::vector<OutlinePolygon> parse_svg_path(std::string_view path, double toleran
   if (!(tolerance > 0.0) || !std::isfinite(tolerance)) {
     throw InvalidArgument("parse_svg_path: tolerance " + std::to_string(tolerance) + " must be > 0");
   }
-  return PathParser(path, tolerance).parse();
+  return PathParser(path, tolerance, true).parse();
+}
+
+std::vector<std::vector<Vec2>> parse_svg_polylines(std::string_view path, double tolerance) {
+  if (!(tolerance > 0.0) || !std::isfinite(tolerance)) {
+    throw InvalidArgument("parse_svg_polylines: tolerance " + std::to_string(tolerance) + " must be > 0");
+  }
+  return PathParser(path, tolerance, false).parse();
 }
 
 bool polygon_contains(const OutlinePolygon& polygon, const Vec2& point) {

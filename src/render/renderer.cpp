@@ -98,8 +98,9 @@ Renderer::Renderer(const Scene& scene, const Checked<ForceLawParameters>& parame
   const double k_guidance = parameters_.guidance_stiffness_n_per_m;
   const double k_max = device.max_stiffness_n_per_m;
   if (k_max > 0.0 && (k_paper > k_max || k_guidance > k_max)) {
-    calligraphy::detail::library_log().warn("stiffness above the device's stable maximum of {} N/m ({}): paper {} N/m, guidance {} N/m",
-                 k_max, device.model, k_paper, k_guidance);
+    calligraphy::detail::library_log().warn(
+        "stiffness above the device's stable maximum of {} N/m ({}): paper {} N/m, guidance {} N/m", k_max,
+        device.model, k_paper, k_guidance);
   }
   const double b_device = device.intrinsic_damping_n_s_per_m;
   if (!std::isfinite(b_device) || b_device < 0.0) {
@@ -246,6 +247,7 @@ RenderOutput Renderer::tick(const DeviceState& device) noexcept {
     out.stroke_completed = lifted.stroke_completed;
     out.stroke_abandoned = !lifted.stroke_completed;
     out.refusal = lifted.refusal;
+    out.stroke_assisted = lifted.stroke_assisted;
   }
   if (next == InteractionState::writing) {
     if (state_ != InteractionState::writing) active_.begin(tip);
@@ -351,6 +353,8 @@ void Renderer::command(const Vec3& force, RenderOutput& out) noexcept {
   out.finished = active_.finished();
   out.character = active_.character_index();
   out.stroke = active_.stroke_index();
+  out.misses = active_.misses();
+  out.hint_shown = active_.hint_shown();
   out.element = active_.element_index();
 }
 

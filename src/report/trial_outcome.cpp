@@ -11,6 +11,7 @@ nlohmann::json trial_outcome_object(const TrialResult& result, const WritingMetr
   record["aborted"] = result.aborted;
   record["abort_reason"] = result.abort_reason;
   record["strokes_completed"] = m.strokes_completed;
+  record["strokes_assisted"] = m.strokes_assisted;
   record["trial_time_s"] = m.time_s;
   record["max_force_n"] = m.max_force_n;
   record["max_force_step_n"] = m.max_force_step_n;
@@ -19,11 +20,8 @@ nlohmann::json trial_outcome_object(const TrialResult& result, const WritingMetr
 }
 
 nlohmann::json renderer_stroke_object(const StrokeMetrics& stroke) {
-  return {{"index", stroke.index},
-          {"character", stroke.character},
-          {"typical_id", stroke.typical_id},
-          {"completed", stroke.completed},
-          {"attempts", stroke.attempts}};
+  return {{"index", stroke.index},         {"character", stroke.character}, {"typical_id", stroke.typical_id},
+          {"completed", stroke.completed}, {"assisted", stroke.assisted},   {"attempts", stroke.attempts}};
 }
 
 }  // namespace calligraphy::report_detail

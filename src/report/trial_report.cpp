@@ -92,7 +92,8 @@ void print_trial_table(const TrialDescription& d, const Scene& scene, const Tria
                   millimetres(value([](auto& x) { return x.deviation.max_m; }), 2).c_str(),
                   millimetres(value([](auto& x) { return x.curves.frechet_m; }), 2).c_str(),
                   millimetres(value([](auto& x) { return x.curves.dtw_m; }), 2).c_str(), time_text,
-                  live ? live->attempts : 0, live && live->completed ? "yes" : "no");
+                  live ? live->attempts : 0,
+                  live && live->completed ? "yes" : (live && live->assisted ? "assisted" : "no"));
       ++scene_stroke;
     }
   }
@@ -102,6 +103,7 @@ void print_trial_table(const TrialDescription& d, const Scene& scene, const Tria
       writing.deviation ? std::optional<double>(writing.deviation->max_m) : std::nullopt;
   std::printf("\n  strokes completed in order  %zu / %zu%s\n", m.strokes_completed, m.strokes_total,
               m.completed_in_order ? "" : "  (incomplete)");
+  if (m.strokes_assisted > 0) std::printf("  strokes assisted           %zu\n", m.strokes_assisted);
   std::printf("  accepted in turn           %zu / %zu (order errors %zu, backwards %zu)\n",
               writing.strokes_accepted, writing.strokes_total, writing.order_errors,
               writing.backwards_strokes);

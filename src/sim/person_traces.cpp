@@ -160,14 +160,9 @@ Path human_path(const Path& median, const HumanStyle& style, std::mt19937_64& ra
   return out;
 }
 
-// A mouse: the `human` path with more wobble, moved along it with a minimum-jerk profile (Flash & Hogan
-// 1985) at 60-110 mm/s, sampled at 60 Hz, on 0.15 mm pixels (a 60 mm character on 400 pixels), released
-// 0.2-1.5 mm short of the end.
-Path pointer_path(const Path& median, std::mt19937_64& random) {
-  HumanStyle style = human_style(random, length_of(median));
-  style.end_delta = -std::min(uniform(random, 0.2, 1.5) * kMm, 0.12 * length_of(median));
-  style.drift = uniform(random, 0.3, 0.9) * kMm;
-  const Path path = human_path(median, style, random);
+// `path` written by a mouse: moved along it with a minimum-jerk profile (Flash & Hogan 1985) at 60-110
+// mm/s, sampled at 60 Hz, on 0.15 mm pixels (a 60 mm character on 400 pixels).
+Path pointer_samples(const Path& path, std::mt19937_64& random) {
   const std::vector<double> arc = arcs(path);
   const double speed = uniform(random, 0.06, 0.11);
   const double duration = std::max(arc.back() / speed, 1.0 / 60.0);
@@ -181,6 +176,19 @@ Path pointer_path(const Path& median, std::mt19937_64& random) {
     if (tau >= 1.0) break;
   }
   return out;
+}
+
+// How far short of the end a mouse is released: 0.2-1.5 mm, at most 12 % of the stroke.
+double pointer_release_short(std::mt19937_64& random, double length) {
+  return std::min(uniform(random, 0.2, 1.5) * kMm, 0.12 * length);
+}
+
+// A mouse: the `human` path with more wobble, written by pointer_samples, released short.
+Path pointer_path(const Path& median, std::mt19937_64& random) {
+  HumanStyle style = human_style(random, length_of(median));
+  style.end_delta = -pointer_release_short(random, length_of(median));
+  style.drift = uniform(random, 0.3, 0.9) * kMm;
+  return pointer_samples(human_path(median, style, random), random);
 }
 
 Path scribble_path(const PlacedCharacter& character, const Path& median, std::mt19937_64& random) {
@@ -333,6 +341,14 @@ std::vector<Vec2> person_trace(const PlacedCharacter& character, std::size_t str
     path = moved;
   }
   return path;
+}
+
+std::vector<Vec2> pointer_trace(const std::vector<Vec2>& line_m, std::mt19937_64& random) {
+  if (line_m.size() < 2 || !(length_of(line_m) > 0.0)) {
+    throw InvalidArgument("pointer_trace: the line has fewer than 2 distinct points");
+  }
+  const double length = length_of(line_m);
+  return pointer_samples(resampled(line_m, 0.0, length - pointer_release_short(random, length)), random);
 }
 
 }  // namespace calligraphy

@@ -27,7 +27,19 @@ const Schema& SchemaOf<ErrorAmplificationGuidance>::get() {
 }
 const Schema& SchemaOf<TimingGuidance>::get() { return table_schema<TimingGuidance>("timing guidance"); }
 const Schema& SchemaOf<StrokeAcceptance>::get() {
-  return table_schema<StrokeAcceptance>("when a stroke counts as written", validate_of<StrokeAcceptance>);
+  // The fields after the eighth came with version 4 of a trial record: an older record lacks them and
+  // runs with the fixed tolerances it ran with (StrokeAcceptance::use_fixed_tolerances, recorded_trial.cpp).
+  static const std::vector<SchemaField> fields = [] {
+    std::vector<SchemaField> out = table_fields<StrokeAcceptance>();
+    for (std::size_t i = 8; i < out.size(); ++i) out[i] = since(4, out[i]);
+    return out;
+  }();
+  static const Schema schema{.name = ParameterTable<StrokeAcceptance>::name,
+                             .doc = "when a stroke counts as written",
+                             .fields = fields,
+                             .defaults = default_of<StrokeAcceptance>,
+                             .check_rules = validate_of<StrokeAcceptance>};
+  return schema;
 }
 const Schema& SchemaOf<SafetyChainParameters>::get() {
   return table_schema<SafetyChainParameters>("the renderer's safety chain",

@@ -174,6 +174,9 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
     json_detail::fail(source, reader.pointer("trial"), e.what());
   }
   r.force_law = std::move(parts.force_law);
+  // Before version 4 a stroke's tolerances did not grow with its length or scale with the character, and
+  // no stroke was credited as assisted: an older record runs again as it ran.
+  if (version < 4) r.force_law.acceptance.use_fixed_tolerances();
   checked(source, reader.pointer("force_law"), [&] {
     // A replay's teacher is not in the record (the run is given it, and checks it then): its law's own
     // values are checked here with a stand-in trajectory of two samples.

@@ -116,6 +116,8 @@ TrialRow study_detail::trial_row(const json& document, const std::string& source
   row.strokes_total = count(record, "strokes_total");
   row.strokes_written = count(record, "strokes_written");
   row.strokes_accepted = count(record, "strokes_accepted");
+  // 0 in records written before the assisted credit
+  row.strokes_assisted = static_cast<std::size_t>(record.integer_or("strokes_assisted", 0, 0, 1LL << 40));
   row.order_errors = count(record, "order_errors");
   row.backwards_strokes = count(record, "backwards_strokes");
   row.unmatched_segments = count(record, "unmatched_segments");
@@ -232,7 +234,8 @@ std::string trials_csv(const StudyTables& tables) {
       "subject,session,protocol,session_number,group,phase,block,condition,mode,characters,trial,item,"
       "repetition,item_set,sequence,period,trained_condition,writer,writer_profile,writer_learning,end_"
       "reason,"
-      "start_utc,completed_in_order,strokes_total,strokes_written,strokes_accepted,order_errors,"
+      "start_utc,completed_in_order,strokes_total,strokes_written,strokes_accepted,strokes_assisted,order_"
+      "errors,"
       "backwards_strokes,unmatched_segments,mean_deviation_m,max_deviation_m,rms_deviation_m,frechet_m,dtw_m,"
       "total_time_s,pen_down_time_s,velocity_peaks,normalised_jerk,shape_skill,order_skill,timing_skill,"
       "subject_writing_speed_factor,subject_spatial_error_factor,subject_error_rate_factor,"
@@ -243,10 +246,10 @@ std::string trials_csv(const StudyTables& tables) {
     line(out, r.subject, r.session, r.protocol, r.session_number, r.group, r.phase, r.block, r.condition,
          r.mode, r.characters, r.trial, r.item, r.repetition, r.item_set, r.sequence, r.period,
          r.trained_condition, r.writer, r.writer_profile, r.writer_learning, r.end_reason, r.start_utc,
-         r.completed_in_order, r.strokes_total, r.strokes_written, r.strokes_accepted, r.order_errors,
-         r.backwards_strokes, r.unmatched_segments, r.mean_deviation_m, r.max_deviation_m, r.rms_deviation_m,
-         r.frechet_m, r.dtw_m, r.total_time_s, r.pen_down_time_s, r.velocity_peaks, r.normalised_jerk,
-         r.shape_skill, r.order_skill, r.timing_skill, r.subject_writing_speed_factor,
+         r.completed_in_order, r.strokes_total, r.strokes_written, r.strokes_accepted, r.strokes_assisted,
+         r.order_errors, r.backwards_strokes, r.unmatched_segments, r.mean_deviation_m, r.max_deviation_m,
+         r.rms_deviation_m, r.frechet_m, r.dtw_m, r.total_time_s, r.pen_down_time_s, r.velocity_peaks,
+         r.normalised_jerk, r.shape_skill, r.order_skill, r.timing_skill, r.subject_writing_speed_factor,
          r.subject_spatial_error_factor, r.subject_error_rate_factor, r.subject_motor_noise_factor,
          r.subject_fast_learning_per_trial, r.subject_slow_learning_per_trial,
          r.subject_fast_retention_per_trial, r.subject_slow_retention_per_trial, r.strokes_given_up,

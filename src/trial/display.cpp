@@ -23,12 +23,12 @@ const char* to_string(DisplayEventKind kind) noexcept {
       return "stroke_completed";
     case DisplayEventKind::stroke_abandoned:
       return "stroke_abandoned";
+    case DisplayEventKind::stroke_assisted:
+      return "stroke_assisted";
     case DisplayEventKind::character_completed:
       return "character_completed";
     case DisplayEventKind::trial_ended:
       return "trial_ended";
-    case DisplayEventKind::stroke_assisted:
-      return "stroke_assisted";
   }
   return "unknown";
 }
@@ -79,6 +79,8 @@ void DisplayPublisher::publish_tick(std::uint64_t tick, const DeviceState& state
   s.finished = output.finished;
   s.in_constraint_space = output.in_constraint_space;
   s.strokes_completed = narrow(metrics.strokes_completed);
+  s.misses = output.misses;
+  s.hint_shown = output.hint_shown;
   if (!output.finished && output.character < scene_->characters.size()) {
     const PlacedCharacter& character = scene_->characters[output.character];
     s.character = narrow(output.character);
@@ -103,39 +105,60 @@ void DisplayPublisher::publish_tick(std::uint64_t tick, const DeviceState& state
   const std::uint32_t every = channel_->options().trace_every_ticks;
   if (every == 1 || tick % every == 0) {
     // The tick that completes a stroke still belongs to it (as in the recorder's trace).
+    const std::size_t done = metrics.strokes_completed + metrics.strokes_assisted;
     const std::uint32_t stroke_written =
-        output.stroke_completed && s.strokes_completed > 0 ? s.strokes_completed - 1 : s.stroke_index;
+        (output.stroke_completed || output.stroke_assisted) && done > 0 ? narrow(done - 1) : s.stroke_index;
     channel_->push_trace(TracePoint{tick, state.time_s, s.hip_m, output.state, stroke_written});
   }
 
-  if (output.stroke_abandoned) {
+  // The recorder closes strokes in order, written or assisted: the one closed this tick is the last one.
+  const std::size_t closed = metrics.strokes_completed + metrics.strokes_assisted;
+  const StrokeMetrics* last_closed =
+      closed > 0 && closed <= metrics.per_stroke.size() ? &metrics.per_stroke[closed - 1] : nullptr;
+  const auto stroke_event = [&](DisplayEventKind kind, const StrokeMetrics& m) {
     DisplayEvent e;
-    e.kind = DisplayEventKind::stroke_abandoned;
-    e.tick = tick;
-    e.time_s = state.time_s;
-    e.character = s.character;
-    e.stroke = s.stroke;
-    e.stroke_index = s.stroke_index;
-    e.strokes_completed = s.strokes_completed;
-    e.refusal = output.refusal;
-    channel_->push_event(e);
-  }
-  // The recorder completes strokes in order, so the one completed this tick is the last one counted.
-  if (output.stroke_completed && metrics.strokes_completed > 0 &&
-      metrics.strokes_completed <= metrics.per_stroke.size()) {
-    const StrokeMetrics& m = metrics.per_stroke[metrics.strokes_completed - 1];
-    DisplayEvent e;
-    e.kind = DisplayEventKind::stroke_completed;
+    e.kind = kind;
     e.tick = tick;
     e.time_s = state.time_s;
     e.character = narrow(m.character);
     e.stroke_index = narrow(m.index);
     e.stroke = e.stroke_index - first_stroke_[m.character];
     e.strokes_completed = s.strokes_completed;
+    e.attempts = m.attempts;
+    return e;
+  };
+  if (output.stroke_abandoned) {
+    DisplayEvent e;
+    if (output.stroke_assisted && last_closed != nullptr) {
+      e = stroke_event(DisplayEventKind::stroke_abandoned, *last_closed);
+    } else {
+      e.kind = DisplayEventKind::stroke_abandoned;
+      e.tick = tick;
+      e.time_s = state.time_s;
+      e.character = s.character;
+      e.stroke = s.stroke;
+      e.stroke_index = s.stroke_index;
+      e.strokes_completed = s.strokes_completed;
+    }
+    e.refusal = output.refusal;
+    channel_->push_event(e);
+  }
+  if (output.stroke_assisted && last_closed != nullptr) {
+    DisplayEvent e = stroke_event(DisplayEventKind::stroke_assisted, *last_closed);
+    e.mean_deviation_m = std::numeric_limits<double>::quiet_NaN();
+    e.max_deviation_m = std::numeric_limits<double>::quiet_NaN();
+    channel_->push_event(e);
+    if (e.stroke + 1 == scene_->characters[last_closed->character].strokes.size()) {
+      e.kind = DisplayEventKind::character_completed;
+      channel_->push_event(e);
+    }
+  }
+  if (output.stroke_completed && last_closed != nullptr) {
+    const StrokeMetrics& m = *last_closed;
+    DisplayEvent e = stroke_event(DisplayEventKind::stroke_completed, m);
     e.mean_deviation_m = m.mean_deviation_m.value_or(std::numeric_limits<double>::quiet_NaN());
     e.max_deviation_m = m.max_deviation_m.value_or(std::numeric_limits<double>::quiet_NaN());
     e.stroke_time_s = m.time_s;
-    e.attempts = m.attempts;
     channel_->push_event(e);
     if (e.stroke + 1 == scene_->characters[m.character].strokes.size()) {
       e.kind = DisplayEventKind::character_completed;

@@ -61,7 +61,13 @@ void TrialRecorder::record(const DeviceState& state, const RenderOutput& out) {
     m.trace_end = m.trace_begin;
     attempt_ = {};
   }
-  if (out.stroke_completed) {
+  if (out.stroke_assisted) {  // credited after the last miss: the next stroke is active
+    m.assisted = true;
+    ++metrics_.strokes_assisted;
+    metrics_.time_s = state.time_s;
+    attempt_ = {};
+    ++current_;
+  } else if (out.stroke_completed) {
     m.completed = true;
     m.time_s = state.time_s - attempt_.start_time;
     close_attempt(m);

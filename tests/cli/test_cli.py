@@ -533,6 +533,25 @@ class GuidanceModesAndWriters(CliTestCase):
         self.assertEqual(metrics["guidance_mode"], "fixed")
         self.assertGreater(metrics["total_time_s"], 0.0)
 
+    def test_a_stroke_always_written_wrongly_is_assisted_and_the_trial_goes_on(self):
+        # Lifted in the middle of every stroke, every attempt (no correction between attempts): each stroke
+        # of 人 is refused until assist_after_misses (5) refusals credit it as assisted (docs/stroke-acceptance.md).
+        metrics = self.trial_json("人", "--seed", "3", "--writer-param", "mid_stroke_lift_probability=1",
+                                  "--writer-param", "correction_per_attempt=0",
+                                  "--writer-param", "max_attempts_per_stroke=20")
+        self.assertEqual(metrics["end_reason"], "completed")
+        self.assertEqual(metrics["strokes_assisted"], 2)
+        self.assertEqual(metrics["strokes_completed"], 0)
+        self.assertFalse(metrics["completed_in_order"])
+        for stroke in metrics["renderer_strokes"]:
+            self.assertTrue(stroke["assisted"])
+            self.assertFalse(stroke["completed"])
+            self.assertEqual(stroke["attempts"], 5)
+        # The same writer lifting only at the end: written, never assisted.
+        careful = self.trial_json("人", "--seed", "3", "--writer-param", "mid_stroke_lift_probability=0")
+        self.assertEqual(careful["strokes_assisted"], 0)
+        self.assertTrue(all(not s["assisted"] for s in careful["renderer_strokes"]))
+
     def test_writer_param_changes_the_trial_and_a_bad_key_is_refused(self):
         plain = self.trial_json("十", "--seed", "4")
         biased = self.trial_json("十", "--seed", "4", "--writer-param", "bias_offset_m=0.004",

@@ -81,7 +81,7 @@ def test_acceptance_and_start_radius_decide_the_verdicts():
     strict = calligraphy.score(beside, "木")
     assert strict["strokes_written"] == 0
     assert strict["strokes_accepted"] == 0
-    wider = calligraphy.StrokeAcceptance(mean_deviation_m=0.005)
+    wider = calligraphy.StrokeAcceptance(mean_deviation_m=0.005, mean_deviation_cap_m=0.005)
     lenient = calligraphy.score(beside, "木", acceptance=wider)
     assert lenient["strokes_written"] == 4
     assert lenient["strokes_accepted"] == 4

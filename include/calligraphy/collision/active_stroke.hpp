@@ -6,9 +6,10 @@
 /// element and the stroke's completion follow the pen's progress along the stroke
 /// (stroke_progress.hpp), not the feature planes alone. Servo path: no allocation, noexcept.
 #include <cstddef>
+#include <cstdint>
 
-#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/model/scene.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 
 namespace calligraphy {
 
@@ -17,6 +18,9 @@ struct StrokeProgress {
   int elements_passed = 0;                      ///< corners (feature points) the pen went round this tick
   bool stroke_completed = false;                ///< the stroke is written; the next stroke is now active
   StrokeRefusal refusal = StrokeRefusal::none;  ///< `lift` of a stroke not written: why
+  /// `lift` of a stroke refused for the `assist_after_misses`-th time: it is credited as assisted (not
+  /// written) and the next stroke is now active.
+  bool stroke_assisted = false;
 };
 
 class ActiveStroke {
@@ -35,7 +39,9 @@ class ActiveStroke {
   /// nothing outside an attempt.
   StrokeProgress advance(const Vec2& tip_m) noexcept;
   /// Pen lifted in WS: the stroke is written when the attempt meets the tolerances (short of the end or
-  /// past it); otherwise its feature points are loaded again (section 4.3.3) and `refusal` says why.
+  /// past it); otherwise its feature points are loaded again (section 4.3.3), `refusal` says why and the
+  /// refusal counts as a miss; at `assist_after_misses` misses the stroke is credited as assisted and the
+  /// next stroke is active.
   StrokeProgress lift() noexcept;
 
   [[nodiscard]] bool finished() const noexcept { return character_ >= scene_->characters.size(); }
@@ -43,8 +49,14 @@ class ActiveStroke {
   [[nodiscard]] std::size_t character_index() const noexcept { return character_; }
   [[nodiscard]] std::size_t stroke_index() const noexcept { return stroke_; }
   [[nodiscard]] std::size_t element_index() const noexcept { return element_; }
-  /// Strokes written so far, over all characters.
+  /// Strokes written so far, over all characters (not those credited as assisted).
   [[nodiscard]] std::size_t strokes_written() const noexcept { return written_; }
+  /// Strokes credited as assisted so far, over all characters.
+  [[nodiscard]] std::size_t strokes_assisted() const noexcept { return assisted_; }
+  /// Refused attempts at the active stroke.
+  [[nodiscard]] std::uint32_t misses() const noexcept { return misses_; }
+  /// The active stroke is to be shown as a hint: misses >= `hint_after_misses` (> 0).
+  [[nodiscard]] bool hint_shown() const noexcept;
 
   [[nodiscard]] const PlacedCharacter* character() const noexcept;
   [[nodiscard]] const PlacedStroke* stroke() const noexcept;
@@ -56,7 +68,7 @@ class ActiveStroke {
   [[nodiscard]] const StrokeAcceptance& acceptance() const noexcept { return acceptance_; }
 
  private:
-  void next_stroke() noexcept;
+  void next_stroke() noexcept;  // the active stroke is done (written or assisted)
 
   const Scene* scene_;
   StrokeAcceptance acceptance_;
@@ -66,6 +78,8 @@ class ActiveStroke {
   std::size_t stroke_ = 0;
   std::size_t element_ = 0;  // top of the feature-point stack: the element being written
   std::size_t written_ = 0;
+  std::size_t assisted_ = 0;
+  std::uint32_t misses_ = 0;  // refused attempts at the active stroke
 };
 
 }  // namespace calligraphy

@@ -53,6 +53,7 @@ struct PlacedStroke {
   std::vector<double> attraction_factors;  ///< one per feature point, dimensionless
   std::vector<Vec2> median_m;              ///< the source median in metres, for drawing
   StrokeCentreLine centre_line;            ///< what progress is measured along (set by Scene::lay_out)
+  double character_size_m = 0.06;          ///< side of its character's data box on paper [m] (Scene::lay_out)
   [[nodiscard]] const Vec2& start() const { return elements.front().start(); }
   [[nodiscard]] const Vec2& end() const { return elements.back().end(); }
   [[nodiscard]] double length_m() const;

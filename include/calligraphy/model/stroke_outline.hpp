@@ -22,14 +22,19 @@ inline constexpr std::size_t kMaxOutlineVertices = 200'000;
 /// Most segments one curve is flattened into.
 inline constexpr int kMaxCurveSegments = 256;
 
-/// Parses SVG path data (SVG 1.1, section 8.3 "path data") of the commands M, L, Q, C and Z, absolute or
-/// relative (m, l, q, c, z), with implicit repetition of a command's coordinates, into closed
+/// Parses SVG path data (SVG 1.1, section 8.3 "path data") of the commands M, L, Q, C, S and Z, absolute or
+/// relative (m, l, q, c, s, z), with implicit repetition of a command's coordinates, into closed
 /// polygons (one per subpath). Quadratic and cubic Bezier curves are flattened into uniform segments,
 /// as many as keep the chord within `tolerance` of the curve: the error of a linear interpolant over a
 /// step h is at most h^2 max|B''| / 8. Throws DataError naming the byte position for another command,
 /// a missing or malformed number, a coordinate beyond +-1e5, a subpath of fewer than 3 vertices, or
 /// more than kMaxOutlineVertices vertices; InvalidArgument when tolerance is not > 0.
 std::vector<OutlinePolygon> parse_svg_path(std::string_view path, double tolerance = 1.0);
+
+/// The same path data read as open polylines, one per subpath (a pen's line, such as KanjiVG's stroke
+/// centre lines, rather than an outline): Z joins the subpath's start. Throws as parse_svg_path, but for
+/// a subpath of fewer than 2 distinct vertices.
+std::vector<std::vector<Vec2>> parse_svg_polylines(std::string_view path, double tolerance = 1.0);
 
 /// The outlines of a character's strokes, in stroke order (as the medians), data units.
 struct CharacterOutlines {

@@ -16,8 +16,9 @@
 ///
 ///   a stroke of length L (along the centre line, from its first feature point to its last) is written
 ///   when the pen entered it in the start neighbourhood (WS) and, within `corridor_m` of it and with a
-///   mean distance of at most `mean_deviation_m`, went along it for at least L - min(`shortfall_m`,
-///   `shortfall_fraction` L), leaving at most max(that, `displacement_m`) unwritten at either end. The
+///   mean distance of at most `allowed_mean_deviation_m(L)`, went along it for at least L - S(L), S(L) =
+///   `allowed_shortfall_m(L)`, leaving at most max(S(L), `displacement_m`) unwritten at either end. The
+///   tolerances grow with L up to a cap and scale with the character's size (StrokeAcceptance). The
 ///   way along counts the arc the pen gained, plus up to `displacement_m` of run before the start and past
 ///   the end, so that a copy displaced along the stroke is written and a half stroke is not.
 ///
@@ -41,7 +42,8 @@ namespace calligraphy {
 /// largest 6.1 mm, and end points within 3.5 mm of the medians' (measured with Hanzi Writer's own
 /// matcher, chanind/hanzi-writer 3.7.3 `strokeMatches.ts`, whose end-point tolerance is 250/1024 of the
 /// box, 14.6 mm here, and whose length test accepts 35 % of a stroke: both too lenient to refuse half
-/// strokes). Scale them with the character size. docs/stroke-acceptance.md has the measured acceptance.
+/// strokes). They scale with the character's size (`reference_character_size_m`; an attempt applies
+/// `for_character_size`). docs/stroke-acceptance.md has the measured acceptance.
 struct StrokeAcceptance {
   /// Farthest a pen may be from the centre line and still make progress [m]: people's largest Frechet
   /// distance, 6.1 mm, plus 0.4 mm.
@@ -74,11 +76,54 @@ struct StrokeAcceptance {
   /// before lifting and off the stroke loses the stroke.
   double follow_through_m = 0.008;
 
+  // Tolerances that grow with the movement, as people's accuracy falls with it: the end-point scatter of
+  // an aimed movement grows in proportion to its amplitude at a given movement time (Schmidt, Zelaznik,
+  // Hawkins, Frank & Quinn 1979, "Motor-output variability: a theory for the accuracy of rapid motor
+  // acts", Psychological Review 86:415-451; Fitts 1954). Another hand's strokes (KanjiVG's centre lines,
+  // aligned to the medians) end within 3.5 mm of the medians' on 5-8 mm strokes at the 90th percentile,
+  // within 6.6 mm on strokes of 48 mm and more (docs/stroke-acceptance.md). Each tolerance is its value
+  // above (the floor) plus its growth times the stroke's length L, up to its cap.
+
+  /// Growth of the shortfall with the stroke's length, dimensionless: the shortfall allowed is
+  /// min(`shortfall_fraction` L, `shortfall_m` + this L, `shortfall_cap_m`).
+  double shortfall_per_length = 0.15;
+  /// Most shortfall allowed on any stroke [m].
+  double shortfall_cap_m = 0.013;
+  /// Growth of the mean deviation allowed with the stroke's length, dimensionless: the limit is
+  /// min(`mean_deviation_m` + this L, `mean_deviation_cap_m`).
+  double deviation_per_length = 0.01;
+  /// Most mean deviation allowed on any stroke [m]: well under the smallest parallel shift refused, 4 mm
+  /// (3.5 mm credited 1.9 % of shifted strokes on KanjiVG's lines, 3.2 mm 1.3 %).
+  double mean_deviation_cap_m = 0.0032;
+  /// The character size the lengths above are for [m]: in a character of another size
+  /// (`SceneLayout::character_size_m`) every length scales by size / this. 0: lengths are absolute
+  /// (records before version 4).
+  double reference_character_size_m = 0.06;
+
+  /// Refused attempts at one stroke after which it is shown as a hint (a whole number; 0: never). Hanzi
+  /// Writer's `showHintAfterMisses` is 3, as is the quiz's (QuizOptions::hint_after_misses).
+  double hint_after_misses = 3.0;
+  /// Refused attempts at one stroke after which it is demonstrated and credited as assisted, and the
+  /// next stroke is active (a whole number; 0: never, a learner may stay on a stroke for ever). Hanzi
+  /// Writer's `markStrokeCorrectAfterMisses`. 5: two more tries after the hint, so that a stroke refused
+  /// on 1 % of attempts is almost never assisted (1e-10) while a learner never stays stuck.
+  double assist_after_misses = 5.0;
+
+  /// The values of the fields above as records before version 4 ran them: no growth with the stroke's
+  /// length, no cap, no scaling with the character size, no assisted credit.
+  void use_fixed_tolerances() noexcept;
+  /// This acceptance for a character of side `character_size_m` [m]: every length scaled by size /
+  /// `reference_character_size_m` (unchanged when that is 0).
+  [[nodiscard]] StrokeAcceptance for_character_size(double character_size_m) const noexcept;
+  /// The largest mean deviation allowed on a stroke of `length_m` [m].
+  [[nodiscard]] double allowed_mean_deviation_m(double length_m) const noexcept;
+
   /// Throws InvalidArgument naming the field when a value is outside its range
   /// (`ParameterTable<StrokeAcceptance>`: each length in (0, 0.1] m, the fraction in (0, 1), the gain ratio
-  /// in [1, 100]).
+  /// in [1, 100], the miss counts in [0, 1000]) or a miss count is not a whole number.
   void validate() const;
-  /// The most a stroke of `length_m` may be written short by [m].
+  /// The most a stroke of `length_m` may be written short by [m]: min(`shortfall_fraction` L,
+  /// `shortfall_m` + `shortfall_per_length` L, `shortfall_cap_m`).
   [[nodiscard]] double allowed_shortfall_m(double length_m) const noexcept;
   bool operator==(const StrokeAcceptance&) const = default;
 };

@@ -48,10 +48,15 @@ struct RenderOutput {
   bool stroke_completed = false;     ///< this tick wrote a stroke (passed its end, or lifted near it)
   bool stroke_abandoned = false;     ///< the pen was lifted in WS short of the tolerances: reloaded
   StrokeRefusal refusal = StrokeRefusal::none;  ///< why an abandoned stroke was refused (stroke_progress.hpp)
-  bool input_rejected = false;                  ///< the device state was not finite: zero force
-  bool force_error = false;                     ///< the force law gave a non-finite force: zero force
-  std::uint8_t limits = safety_none;            ///< SafetyLimit bits: which safety stages acted
-  double passivity_damping_n_s_per_m = 0.0;     ///< damper added by the passivity controller [N s/m]
+  /// The abandoned stroke was refused for the `assist_after_misses`-th time (StrokeAcceptance): credited
+  /// as assisted, not written; the next stroke is active.
+  bool stroke_assisted = false;
+  std::uint32_t misses = 0;     ///< refused attempts at the active stroke (after this tick)
+  bool hint_shown = false;      ///< the active stroke is to be shown as a hint (misses >= hint_after_misses)
+  bool input_rejected = false;  ///< the device state was not finite: zero force
+  bool force_error = false;     ///< the force law gave a non-finite force: zero force
+  std::uint8_t limits = safety_none;         ///< SafetyLimit bits: which safety stages acted
+  double passivity_damping_n_s_per_m = 0.0;  ///< damper added by the passivity controller [N s/m]
 };
 
 class Renderer {
@@ -102,7 +107,7 @@ class Renderer {
   PassivityController passivity_;
   NearestPointTracker tracker_;
   TeacherReplay replay_;
-  TimingTarget timing_;           // the `timing` mode's moving target
+  TimingTarget timing_;  // the `timing` mode's moving target
   // The guidance law's numbers, read from its variant once at construction so that a tick reads plain values.
   GuidanceMode mode_ = GuidanceMode::fixed;
   double guidance_gain_ = 1.0;     // the fading or repulsive gain; 1 in the other modes

@@ -40,7 +40,7 @@ struct TrialRow {
   std::optional<int> period;
   /// The condition the item is or was trained under in the crossover, on every phase's row; "" when none.
   std::string trained_condition;
-  std::string writer;          ///< "simulated" or "human"
+  std::string writer;  ///< "simulated" or "human"
   /// A simulated writer's profile ("novice", "skilled", "foreign") and learning model ("none", "two-state");
   /// "" for a person.
   std::string writer_profile;
@@ -50,6 +50,9 @@ struct TrialRow {
   bool completed_in_order = false;
   std::size_t strokes_total = 0;
   std::size_t strokes_written = 0;
+  /// Strokes the renderer credited as assisted after assist_after_misses refused attempts (written apart
+  /// from strokes_written: none of them was written).
+  std::size_t strokes_assisted = 0;
   std::size_t strokes_accepted = 0;
   std::size_t order_errors = 0;
   std::size_t backwards_strokes = 0;

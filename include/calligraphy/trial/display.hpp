@@ -66,6 +66,8 @@ struct DisplaySnapshot {
   std::uint32_t stroke_index = 0;    ///< active stroke counted over the scene (0-based)
   std::uint32_t strokes_completed = 0;
   std::uint32_t strokes_total = 0;
+  std::uint32_t misses = 0;  ///< refused attempts on the active stroke
+  bool hint_shown = false;  ///< the active stroke is shown as a hint (misses >= hint_after_misses)
   DisplayPoint2 hint_m;  ///< the active stroke's start, where the red ellipse goes [m]
   DisplayPoint3 hip_m;   ///< haptic interface point, as read from the device [m]
   /// Virtual pen tip: the HIP projected onto the paper when it is below the paper, else the HIP [m]
@@ -73,19 +75,17 @@ struct DisplaySnapshot {
   DisplayPoint3 vtp_m;
   DisplayPoint3 force_n;      ///< the force commanded this tick [N]
   double pen_height_m = 0.0;  ///< HIP z minus the paper's z [m]; negative: depth below the paper
-  std::uint32_t misses = 0;  ///< refused attempts on the active stroke
-  bool hint_shown = false;  ///< the active stroke is shown as a hint (misses >= hint_after_misses)
 };
 
 enum class DisplayEventKind : std::uint8_t {
   stroke_completed,     ///< the last feature point of a stroke was written; its metrics are set
   stroke_abandoned,     ///< the pen left the paper in WS unwritten (4.3.3); `refusal` says why
+  stroke_assisted,  ///< the stroke was demonstrated and credited after assist_after_misses misses
   character_completed,  ///< the last stroke of a character was written
   trial_ended,          ///< `TrialSession::finish` was called; `end` says how
-  stroke_assisted,  ///< the stroke was demonstrated and credited after assist_after_misses misses
 };
 
-/// "stroke_completed", "stroke_abandoned", "character_completed", "trial_ended" or "stroke_assisted".
+/// "stroke_completed", "stroke_abandoned", "stroke_assisted", "character_completed" or "trial_ended".
 [[nodiscard]] const char* to_string(DisplayEventKind kind) noexcept;
 
 /// Something that happened at one tick, for the display to show once.
@@ -101,7 +101,7 @@ struct DisplayEvent {
   double mean_deviation_m = 0.0;  ///< mean distance from the stroke over its last attempt [m]; NaN: none
   double max_deviation_m = 0.0;   ///< largest such distance [m]
   double stroke_time_s = 0.0;     ///< from entering WS to the last feature point [s]
-  std::int32_t attempts = 0;      ///< times WS was entered on the stroke
+  std::int32_t attempts = 0;      ///< times WS was entered on the stroke (also stroke_assisted)
   // stroke_abandoned: why the attempt was refused (the renderer's `RenderOutput::refusal`)
   StrokeRefusal refusal = StrokeRefusal::none;
   // trial_ended

@@ -40,7 +40,10 @@ struct StrokeMetrics {
   std::size_t index = 0;  ///< over the whole scene, 0-based
   std::size_t character = 0;
   int typical_id = 0;
-  bool completed = false;
+  bool completed = false;  ///< written by the pen
+  /// Credited as assisted after `assist_after_misses` refused attempts (StrokeAcceptance): demonstrated,
+  /// not written; `completed` stays false.
+  bool assisted = false;
   int attempts = 0;                        ///< times WS was entered on this stroke
   std::optional<double> mean_deviation_m;  ///< [m]; nullopt without a WS tick (see above)
   std::optional<double> max_deviation_m;   ///< [m]; nullopt without a WS tick
@@ -52,9 +55,10 @@ struct StrokeMetrics {
 /// Metrics of a whole trial.
 struct TrialMetrics {
   std::size_t strokes_total = 0;
-  std::size_t strokes_completed = 0;
-  bool completed_in_order = false;  ///< every stroke written, each in its turn
-  double time_s = 0.0;              ///< from the start to the last stroke written (or the end of the trial)
+  std::size_t strokes_completed = 0;  ///< strokes written by the pen
+  std::size_t strokes_assisted = 0;   ///< strokes credited as assisted (StrokeMetrics::assisted), apart
+  bool completed_in_order = false;    ///< every stroke written, each in its turn (none assisted)
+  double time_s = 0.0;                ///< from the start to the last stroke written (or the end of the trial)
   /// Over all WS ticks of the strokes' last attempts [m]; nullopt when no stroke has one (nothing was
   /// written).
   std::optional<double> mean_deviation_m;

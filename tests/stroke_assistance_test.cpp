@@ -1,0 +1,188 @@
+// No dead end: refused attempts at a stroke are counted; after hint_after_misses the stroke is shown as a
+// hint, after assist_after_misses it is credited as assisted (not written) and the next stroke is active
+// (StrokeAcceptance, active_stroke.hpp). The recorder, a trial's record and its replay keep the credits.
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "calligraphy/collision/active_stroke.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/study/recorded_trial.hpp"
+#include "calligraphy/trial/recorder.hpp"
+#include "study_test_devices.hpp"
+
+using namespace calligraphy;
+
+namespace {
+
+// The stroke's centre line from its start up to `fraction` of its points, in steps of at most 0.25 mm.
+std::vector<Vec2> along_line(const PlacedStroke& stroke, double fraction) {
+  const std::vector<Vec2>& line = stroke.centre_line.points_m;
+  const auto last = static_cast<std::size_t>(fraction * static_cast<double>(line.size() - 1));
+  std::vector<Vec2> out{line.front()};
+  for (std::size_t k = 1; k <= last; ++k) {
+    const int steps = std::max(1, static_cast<int>((line[k] - line[k - 1]).norm() / 0.25e-3));
+    for (int i = 1; i <= steps; ++i)
+      out.push_back(line[k - 1] + (line[k] - line[k - 1]) * (i / double(steps)));
+  }
+  return out;
+}
+
+void attempt(ActiveStroke& active, double fraction) {
+  const std::vector<Vec2> path = along_line(*active.stroke(), fraction);
+  active.begin(path.front());
+  for (const Vec2& p : path) active.advance(p);
+}
+
+// An attempt that enters the stroke at its start and lifts a fifth of the way along: too short.
+void short_attempt(ActiveStroke& active) { attempt(active, 0.2); }
+
+// The whole stroke along its centre line.
+void whole_attempt(ActiveStroke& active) { attempt(active, 1.0); }
+
+}  // namespace
+
+TEST_CASE(
+    "Refused attempts are counted per stroke; a hint after hint_after_misses, assisted credit after "
+    "assist_after_misses",
+    "[stroke_assistance]") {
+  const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'人')});
+  StrokeAcceptance acceptance;
+  acceptance.hint_after_misses = 2;
+  acceptance.assist_after_misses = 4;
+  ActiveStroke active(scene, acceptance);
+  for (std::uint32_t miss = 1; miss <= 3; ++miss) {
+    short_attempt(active);
+    const StrokeProgress lifted = active.lift();
+    CHECK_FALSE(lifted.stroke_completed);
+    CHECK_FALSE(lifted.stroke_assisted);
+    CHECK(lifted.refusal == StrokeRefusal::too_short);
+    CHECK(active.misses() == miss);
+    CHECK(active.hint_shown() == (miss >= 2));
+    CHECK(active.stroke_index() == 0);
+  }
+  short_attempt(active);
+  const StrokeProgress fourth = active.lift();
+  CHECK(fourth.stroke_assisted);
+  CHECK_FALSE(fourth.stroke_completed);
+  CHECK(active.stroke_index() == 1);  // the next stroke is active, with no misses and no hint
+  CHECK(active.misses() == 0);
+  CHECK_FALSE(active.hint_shown());
+  CHECK(active.strokes_assisted() == 1);
+  CHECK(active.strokes_written() == 0);
+  // A written stroke is written, not assisted; its misses are forgotten with it.
+  short_attempt(active);
+  (void)active.lift();
+  CHECK(active.misses() == 1);
+  whole_attempt(active);
+  (void)active.lift();
+  CHECK(active.finished());
+  CHECK(active.strokes_written() == 1);
+  CHECK(active.strokes_assisted() == 1);
+}
+
+TEST_CASE("With assist_after_misses 0 a stroke is never credited, with hint_after_misses 0 never hinted",
+          "[stroke_assistance]") {
+  const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'人')});
+  StrokeAcceptance acceptance;
+  acceptance.hint_after_misses = 0;
+  acceptance.assist_after_misses = 0;
+  ActiveStroke active(scene, acceptance);
+  for (int miss = 1; miss <= 50; ++miss) {
+    short_attempt(active);
+    CHECK_FALSE(active.lift().stroke_assisted);
+  }
+  CHECK(active.misses() == 50);
+  CHECK_FALSE(active.hint_shown());
+  CHECK(active.stroke_index() == 0);
+}
+
+TEST_CASE("A miss count that is not a whole number is refused by name", "[stroke_assistance]") {
+  StrokeAcceptance acceptance;
+  acceptance.assist_after_misses = 2.5;
+  CHECK_THROWS_WITH(acceptance.validate(), Catch::Contains("assist_after_misses"));
+  acceptance.assist_after_misses = 5;
+  acceptance.hint_after_misses = -1;
+  CHECK_THROWS_WITH(acceptance.validate(), Catch::Contains("hint_after_misses"));
+}
+
+TEST_CASE("The recorder counts an assisted stroke apart from the strokes written", "[stroke_assistance]") {
+  const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'人')});
+  TrialRecorder recorder(scene);
+  DeviceState state;
+  RenderOutput out;
+  out.state = InteractionState::writing;
+  out.state_changed = true;
+  state.time_s = 0.1;
+  recorder.record(state, out);
+  out.state = InteractionState::separation;
+  out.stroke_abandoned = true;
+  out.stroke_assisted = true;
+  state.time_s = 0.2;
+  recorder.record(state, out);
+  recorder.finish(0.3);
+  const TrialMetrics& m = recorder.metrics();
+  CHECK(m.strokes_assisted == 1);
+  CHECK(m.strokes_completed == 0);
+  CHECK(m.per_stroke[0].assisted);
+  CHECK_FALSE(m.per_stroke[0].completed);
+  CHECK_FALSE(m.per_stroke[1].assisted);
+  CHECK_FALSE(m.completed_in_order);
+}
+
+TEST_CASE(
+    "A trial whose writer always lifts mid-stroke ends with its strokes assisted, and its record "
+    "replays the same credits",
+    "[stroke_assistance]") {
+  // 人: every element is 20 mm or longer, so a lift at 30-70 % of a stroke is refused (too short); with no
+  // correction between attempts the writer does that every time.
+  const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'人')});
+  TrialSpec spec;
+  spec.characters = "人";
+  spec.writer_parameters = {
+      {"mid_stroke_lift_probability", 1.0}, {"correction_per_attempt", 0.0}, {"max_attempts_per_stroke", 20}};
+  spec.seed = 3;
+  spec.max_duration_s = 120.0;
+  SimulatedWriting writing(spec);
+  const TrialRun first =
+      run_trial_spec(Checked<TrialSpec>::check(spec), scene, study_test::trial_inputs(&writing));
+  const TrialMetrics& m = first.result.metrics;
+  REQUIRE(m.strokes_total == 2);
+  CHECK(m.strokes_assisted == 2);
+  CHECK(m.strokes_completed == 0);
+  for (const StrokeMetrics& s : m.per_stroke) {
+    CHECK(s.assisted);
+    CHECK(s.attempts == static_cast<int>(StrokeAcceptance{}.assist_after_misses));
+  }
+  CHECK(first.result.end == TrialEnd::completed);  // no dead end: the trial went on to its end
+
+  const std::string json = recorded_trial_json(recorded_trial(spec, first, writing, scene));
+  CHECK(nlohmann::json::parse(json)["version"] == kRecordedTrialVersion);
+  const RecordedTrial recorded = read_recorded_trial(json, "r.json");
+  CHECK(recorded.force_law.acceptance == first.options.force.acceptance);
+  SimulatedWriting again_writing = recorded_writing(recorded);
+  const TrialRun again = rerun_trial(recorded, Checked<TrialSpec>::check(recorded.spec), scene,
+                                     study_test::trial_inputs(&again_writing));
+  REQUIRE(again.result.metrics.per_stroke.size() == m.per_stroke.size());
+  CHECK(again.result.metrics.strokes_assisted == m.strokes_assisted);
+  for (std::size_t i = 0; i < m.per_stroke.size(); ++i) {
+    CHECK(again.result.metrics.per_stroke[i].assisted == m.per_stroke[i].assisted);
+    CHECK(again.result.metrics.per_stroke[i].attempts == m.per_stroke[i].attempts);
+  }
+  CHECK(again.result.trace.size() == first.result.trace.size());
+
+  // A version-3 record (no miss counts, no growing tolerances) runs as it ran: no stroke is assisted.
+  nlohmann::json old = nlohmann::json::parse(json);
+  old["version"] = 3;
+  for (const char* key :
+       {"shortfall_per_length", "shortfall_cap_m", "deviation_per_length", "mean_deviation_cap_m",
+        "reference_character_size_m", "hint_after_misses", "assist_after_misses"}) {
+    old["force_law"]["acceptance"].erase(key);
+  }
+  const RecordedTrial v3 = read_recorded_trial(old.dump(), "v3.json");
+  CHECK(v3.force_law.acceptance.assist_after_misses == 0.0);
+  CHECK(v3.force_law.acceptance.shortfall_per_length == 0.0);
+}
