@@ -83,7 +83,7 @@ double share(std::size_t part, std::size_t whole) {
 
 }  // namespace
 
-TEST_CASE("Another hand's strokes (KanjiVG) written by a position-only pen are accepted; none is a dead end",
+TEST_CASE("Another hand's strokes (KanjiVG) written by a position-only pen are accepted and none is a dead end",
           "[stroke_progress][acceptance][kanjivg]") {
   const std::filesystem::path folder = kanjivg_folder();
   if (folder.empty()) {

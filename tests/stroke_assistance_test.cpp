@@ -46,7 +46,7 @@ void whole_attempt(ActiveStroke& active) { attempt(active, 1.0); }
 }  // namespace
 
 TEST_CASE(
-    "Refused attempts are counted per stroke; a hint after hint_after_misses, assisted credit after "
+    "Refused attempts are counted per stroke: a hint after hint_after_misses, assisted credit after "
     "assist_after_misses",
     "[stroke_assistance]") {
   const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'人')});

@@ -1,4 +1,45 @@
-"""Protocols the study tests run: small enough to run in seconds, with the phases over two sessions."""
+"""Protocols the study tests run (small enough to run in seconds, with the phases over two sessions), and the
+scaffold of a test that runs `calligraphy` in a folder of its own (CALLIGRAPHY_CLI names the program)."""
+
+import hashlib
+import json
+import os
+import subprocess
+import tempfile
+import unittest
+from pathlib import Path
+
+CLI = os.environ.get("CALLIGRAPHY_CLI", "")
+
+
+def digest_tree(folder):
+    """SHA-256 of every file under `folder`, by its relative path: what a refused run must leave unchanged."""
+    return {str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+class StudyCliTest(unittest.TestCase):
+    """Runs the program in a temporary folder of its own (`self.cwd`), removed after each test."""
+
+    folder_prefix = "calligraphy-study-"
+
+    def setUp(self):
+        if not CLI or not Path(CLI).exists():
+            self.fail(f"CALLIGRAPHY_CLI={CLI!r} is not the calligraphy program: run these tests through ctest")
+        self.folder = tempfile.TemporaryDirectory(prefix=self.folder_prefix)
+        self.cwd = Path(self.folder.name)
+
+    def tearDown(self):
+        self.folder.cleanup()
+
+    def run_cli(self, *args):
+        return subprocess.run([CLI, *map(str, args)], cwd=self.cwd, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, timeout=600)
+
+    def write_protocol(self, protocol):
+        path = self.cwd / f"{protocol['name']}.json"
+        path.write_text(json.dumps(protocol, ensure_ascii=False), encoding="utf-8")
+        return path
 
 
 def two_session_protocol(name):

@@ -28,15 +28,12 @@ the session.json `session run` wrote. Run by CTest as `study_designs_cli`:
 
 CALLIGRAPHY_CLI names the program. Standard library only.
 """
-import hashlib
 import json
-import os
-import subprocess
-import tempfile
 import unittest
 from pathlib import Path
 
-CLI = os.environ.get("CALLIGRAPHY_CLI", "")
+from study_protocols import StudyCliTest, digest_tree
+
 
 TRIAL = {"max_duration_s": 10}
 
@@ -69,29 +66,8 @@ def crossover_of(conditions, sets, number, groups=1):
     return "".join(chr(ord("A") + i) for i in order), [conditions[i] for i in order], period_sets, trained
 
 
-def digest_tree(folder):
-    return {str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()
-            for p in sorted(folder.rglob("*")) if p.is_file()}
-
-
-class DesignsCliTest(unittest.TestCase):
-    def setUp(self):
-        if not CLI or not Path(CLI).exists():
-            self.fail(f"CALLIGRAPHY_CLI={CLI!r} is not the calligraphy program: run these tests through ctest")
-        self.folder = tempfile.TemporaryDirectory(prefix="calligraphy-designs-")
-        self.cwd = Path(self.folder.name)
-
-    def tearDown(self):
-        self.folder.cleanup()
-
-    def run_cli(self, *args):
-        return subprocess.run([CLI, *map(str, args)], cwd=self.cwd, stdout=subprocess.PIPE,
-                              stderr=subprocess.PIPE, timeout=600)
-
-    def write_protocol(self, protocol):
-        path = self.cwd / f"{protocol['name']}.json"
-        path.write_text(json.dumps(protocol, ensure_ascii=False), encoding="utf-8")
-        return path
+class DesignsCliTest(StudyCliTest):
+    folder_prefix = "calligraphy-designs-"
 
     def run_design(self, protocol, subjects, out="out"):
         """`session plan --json`, then `session run`; returns the plan and, per subject id, its sessions in

@@ -14,16 +14,14 @@
 CALLIGRAPHY_CLI names the program, CALLIGRAPHY_SOURCE_DIR the source tree. Standard library only (the
 Python module is optional).
 """
-import hashlib
 import json
 import os
 import shutil
-import subprocess
-import tempfile
 import unittest
 from pathlib import Path
 
-CLI = os.environ.get("CALLIGRAPHY_CLI", "")
+from study_protocols import StudyCliTest, digest_tree
+
 SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 
 CONDITIONS = [{"name": "A", "mode": "vision"}, {"name": "B", "mode": "haptic"}, {"name": "C", "mode": "vision"}]
@@ -73,29 +71,8 @@ def expected_crossover(k, number):
     return sequence, pairing
 
 
-def digest_tree(folder):
-    return {str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()
-            for p in sorted(folder.rglob("*")) if p.is_file()}
-
-
-class SessionPlanCliTest(unittest.TestCase):
-    def setUp(self):
-        if not CLI or not Path(CLI).exists():
-            self.fail(f"CALLIGRAPHY_CLI={CLI!r} is not the calligraphy program: run these tests through ctest")
-        self.folder = tempfile.TemporaryDirectory(prefix="calligraphy-plan-")
-        self.cwd = Path(self.folder.name)
-
-    def tearDown(self):
-        self.folder.cleanup()
-
-    def run_cli(self, *args):
-        return subprocess.run([CLI, *map(str, args)], cwd=self.cwd, stdout=subprocess.PIPE,
-                              stderr=subprocess.PIPE, timeout=600)
-
-    def write_protocol(self, protocol):
-        path = self.cwd / f"{protocol['name']}.json"
-        path.write_text(json.dumps(protocol, ensure_ascii=False), encoding="utf-8")
-        return path
+class SessionPlanCliTest(StudyCliTest):
+    folder_prefix = "calligraphy-plan-"
 
     def plan(self, protocol, subjects):
         result = self.run_cli("session", "plan", protocol, "--subjects", subjects, "--json")
