@@ -33,7 +33,16 @@ using Column = py::array_t<double, py::array::c_style | py::array::forcecast>;
 Column column(const py::object& columns, const char* key) {
   Column values;
   try {
-    values = Column::ensure(columns[py::str(key)]);
+    const py::object given = columns[py::str(key)];
+    // forcecast takes a complex column's real part (numpy's ComplexWarning aside) and parses text: refused
+    // instead, as neither is a column of real numbers.
+    const py::array as_array = py::array::ensure(given);
+    if (as_array && (as_array.dtype().kind() == 'c' || as_array.dtype().kind() == 'U' ||
+                     as_array.dtype().kind() == 'S')) {
+      throw InvalidArgument(std::string("trace: column '") + key + "' holds " +
+                            std::string(py::str(as_array.dtype())) + " values, not real numbers");
+    }
+    values = Column::ensure(given);
   } catch (const py::error_already_set&) {
     values = Column();
   }

@@ -131,3 +131,8 @@ def test_bad_input_names_the_column_or_sample():
         calligraphy.score("/nonexistent/trace.csv", "大")
     with pytest.raises(TypeError):
         calligraphy.score(42, "大")
+    # A complex column is not scored as its real part, nor a column of text parsed as numbers.
+    with pytest.raises(calligraphy.InvalidArgument, match="column 'x' holds complex128 values"):
+        calligraphy.score(dict(columns, x=columns["x"] + 0j), "大")
+    with pytest.raises(calligraphy.InvalidArgument, match="column 'y' holds <U"):
+        calligraphy.score(dict(columns, y=columns["y"].astype(str)), "大")
