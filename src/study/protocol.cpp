@@ -270,11 +270,9 @@ void read_order(json_detail::ObjectReader& reader, StudyProtocol& protocol) {
   const json* value = reader.optional("order");
   if (!value) return;
   json_detail::ObjectReader order(*value, reader.pointer("order"), reader.source());
-  constexpr std::array<ConditionOrder, 4> kConditionOrders{
-      ConditionOrder::fixed, ConditionOrder::latin_square, ConditionOrder::abba, ConditionOrder::random};
-  constexpr std::array<ItemOrder, 2> kItemOrders{ItemOrder::fixed, ItemOrder::random};
-  protocol.condition_order = choice(order, "conditions", kConditionOrders, ConditionOrder::fixed);
-  protocol.item_order = choice(order, "characters", kItemOrders, ItemOrder::fixed);
+  protocol.condition_order =
+      choice(order, "conditions", study_detail::kConditionOrders, ConditionOrder::fixed);
+  protocol.item_order = choice(order, "characters", study_detail::kItemOrders, ItemOrder::fixed);
   protocol.seed = order.unsigned_or("seed", 0);
   order.finish();
 }
@@ -475,9 +473,10 @@ StudyProtocol parse_study_protocol(std::string_view json_text, const std::string
   protocol.description = root.string_or("description", "");
 
   const json& conditions = root.required("conditions");
-  if (!conditions.is_array() || conditions.empty() || conditions.size() > 26) {
+  if (!conditions.is_array() || conditions.empty() || conditions.size() > study_detail::kMaxConditions) {
     json_detail::fail(source, "/conditions",
-                      "expected a list of 1 to 26 conditions, got " + json_detail::describe(conditions));
+                      "expected a list of 1 to " + std::to_string(study_detail::kMaxConditions) +
+                          " conditions, got " + json_detail::describe(conditions));
   }
   std::set<std::string> names;
   for (std::size_t i = 0; i < conditions.size(); ++i) {

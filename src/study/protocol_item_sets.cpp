@@ -14,9 +14,6 @@ namespace {
 
 using nlohmann::json;
 
-// As many sets as conditions may be compared in one crossover: 26, the conditions' limit.
-constexpr std::size_t kMaxItemSets = 26;
-
 std::string defined_sets(const std::vector<ItemSet>& sets) {
   std::string names;
   for (const ItemSet& set : sets) names += (names.empty() ? "" : ", ") + set.name;

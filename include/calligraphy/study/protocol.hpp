@@ -213,6 +213,14 @@ struct SchemaOf<BreakRules> {
 /// checks (guidance_law.hpp), so that a protocol a trial would refuse is refused when read.
 [[nodiscard]] ParameterRange protocol_max_lead_range() noexcept;
 
+/// The JSON Schema (draft 2020-12) of a protocol file (`calligraphy schema protocol`): the trial settings
+/// and breaks from their schemas, every guidance parameter, the guidance stiffness, the quiz's tolerances
+/// from their laws' and rules' tables, and the counts and names from the reader's own limits. Rules between
+/// values (names defined, sets disjoint, phases in order, the plan's size) are the reader's alone.
+[[nodiscard]] std::string protocol_json_schema_text();
+/// The trial settings and breaks as the documentation's Markdown tables.
+[[nodiscard]] std::string protocol_schema_markdown();
+
 /// A whole protocol.
 struct StudyProtocol {
   std::string name;  ///< [A-Za-z0-9_-], 1..64 characters; names session folders
