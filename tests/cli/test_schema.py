@@ -349,6 +349,32 @@ class ProtocolSchemaTest(unittest.TestCase):
                                         capture_output=True, timeout=60)
                 self.assertEqual(result.returncode, 0, result.stderr.decode())
 
+    def test_structure_the_reader_refuses_the_schema_refuses(self):
+        cases = {
+            "/surprise": _protocol(surprise=1),
+            "/trial/rate": _protocol(trial={"rate": 1000}),
+            "/trial/rate_hz": _protocol(trial={"rate_hz": None}),
+            "/conditions/0/parameters": _protocol(conditions=[{"name": "A", "mode": "vision", "parameters": {}}]),
+            "/conditions/0/guidance_stiffness_n_per_m": _protocol(
+                conditions=[{"name": "A", "mode": "quiz", "guidance_stiffness_n_per_m": 100}]),
+            "/conditions/0/parameters/end_gain": _protocol(
+                conditions=[{"name": "A", "mode": "fading", "parameters": {"end_gain": 0}}]),
+            "/conditions/0/quiz": _protocol(conditions=[{"name": "A", "mode": "haptic", "quiz": {}}]),
+            "/conditions/0/teachers": _protocol(conditions=[{"name": "A", "mode": "haptic", "teachers": {}}]),
+            "/conditions/0/mode": _protocol(conditions=[{"name": "A", "mode": "telepathy"}]),
+            "/conditions/0/name": _protocol(conditions=[{"name": "A B", "mode": "haptic"}]),
+            "/order/conditions": _protocol(order={"conditions": "latin"}),
+            "/test/characters/0": _protocol(test={"characters": [""], "conditions": ["A"], "repetitions": 1}),
+            "/phases": {**_phased({"phase": "test", "conditions": ["A"], "characters": ["十"]}),
+                        "test": {"characters": ["十"], "conditions": ["A"], "repetitions": 1}},
+        }
+        for pointer, document in cases.items():
+            with self.subTest(pointer=pointer):
+                self.assertFalse(self.validator.is_valid(document))
+                result = self.plan(document)
+                self.assertEqual(result.returncode, 1, result.stderr.decode())
+                self.assertIn(f"p.json: {pointer}", result.stderr.decode())
+
     def test_each_bound_is_refused_past_it_and_accepted_at_it_by_both(self):
         checked = 0
         for base, prefix, properties, not_at in self.sites():
