@@ -102,8 +102,8 @@ QuizOptions read_quiz(const json& value, const std::string& pointer, const std::
   if (const json* acceptance = reader.optional("acceptance")) {
     quiz.acceptance = read_acceptance(*acceptance, reader.pointer("acceptance"), source);
   }
-  quiz.hint_after_misses =
-      static_cast<int>(reader.integer_or("hint_after_misses", quiz.hint_after_misses, 0, 1000));
+  quiz.hint_after_misses = static_cast<int>(
+      reader.integer_or("hint_after_misses", quiz.hint_after_misses, 0, study_detail::kMaxHintAfterMisses));
   quiz.accept_backwards = reader.boolean_or("accept_backwards", quiz.accept_backwards);
   reader.finish();
   return quiz;
@@ -227,7 +227,7 @@ StudyCondition read_condition(const json& value, const std::string& pointer, con
   json_detail::ObjectReader reader(value, pointer, source);
   StudyCondition condition;
   condition.name = reader.string("name");
-  if (!study_detail::is_label(condition.name, 32)) {
+  if (!study_detail::is_label(condition.name, study_detail::kMaxLabelLength)) {
     json_detail::fail(source, reader.pointer("name"),
                       "expected 1 to 32 letters, digits, '_' or '-', got \"" + condition.name + "\"");
   }
@@ -466,7 +466,7 @@ StudyProtocol parse_study_protocol(std::string_view json_text, const std::string
   }
   root.integer_or("version", 1, 1, 1);
   protocol.name = root.string("name");
-  if (!study_detail::is_label(protocol.name, 64)) {
+  if (!study_detail::is_label(protocol.name, study_detail::kMaxProtocolNameLength)) {
     json_detail::fail(source, "/name",
                       "expected 1 to 64 letters, digits, '_' or '-', got \"" + protocol.name + "\"");
   }

@@ -16,6 +16,9 @@ inline constexpr std::size_t kMaxItems = 1000;
 inline constexpr std::size_t kMaxCharactersPerItem = 16;
 inline constexpr std::int64_t kMaxRepetitions = 1000;
 inline constexpr std::size_t kMaxPhases = 20;
+inline constexpr std::size_t kMaxLabelLength = 32;         ///< a condition's or an item set's name
+inline constexpr std::size_t kMaxProtocolNameLength = 64;  ///< a protocol's name (it names folders)
+inline constexpr std::int64_t kMaxHintAfterMisses = 1000;  ///< a quiz's hint_after_misses
 inline constexpr std::size_t kMaxConditions = 26;
 // As many sets as conditions may be compared in one crossover: the conditions' limit.
 inline constexpr std::size_t kMaxItemSets = kMaxConditions;

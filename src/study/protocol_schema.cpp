@@ -88,7 +88,7 @@ ordered_json enum_schema(const std::array<E, N>& values, std::string_view doc) {
   return {{"type", "string"}, {"description", std::string(doc)}, {"enum", names}};
 }
 
-ordered_json label_schema(int longest, std::string_view doc) {
+ordered_json label_schema(std::size_t longest, std::string_view doc) {
   return {{"type", "string"},
           {"description", std::string(doc)},
           {"pattern", "^[A-Za-z0-9_-]{1," + std::to_string(longest) + "}$"}};
@@ -173,7 +173,8 @@ ordered_json guidance_parameters(ConditionMode mode) {
 
 ordered_json condition_schema() {
   ordered_json properties = ordered_json::object();
-  properties["name"] = label_schema(32, "unique label of the condition, used in file names and reports");
+  properties["name"] = label_schema(study_detail::kMaxLabelLength,
+                                    "unique label of the condition, used in file names and reports");
   properties["mode"] = enum_schema(study_detail::kConditionModes, "what the writer gets");
   put_table_field(properties, "guidance_stiffness_n_per_m", &ForceLawParameters::guidance_stiffness_n_per_m);
   properties["guidance_stiffness_n_per_m"]["description"] =
@@ -215,7 +216,8 @@ ordered_json quiz_schema() {
   properties["acceptance"] =
       object_schema(std::move(acceptance), "the stroke matcher's tolerances (docs/stroke-acceptance.md)");
   properties["hint_after_misses"] =
-      integer_schema(0, 1000, "a hint after this many misses on one stroke, and each further one; 0: never");
+      integer_schema(0, study_detail::kMaxHintAfterMisses,
+                     "a hint after this many misses on one stroke, and each further one; 0: never");
   properties["accept_backwards"] = {
       {"type", "boolean"}, {"description", "a stroke written from its end to its start is accepted"}};
   return object_schema(std::move(properties), "how a quiz judges strokes");
@@ -224,12 +226,12 @@ ordered_json quiz_schema() {
 ordered_json phase_schema() {
   ordered_json properties = ordered_json::object();
   properties["phase"] = enum_schema(study_detail::kStudyPhases, "the phase of a motor-learning study");
-  properties["condition"] = label_schema(32, "the one condition of the phase");
+  properties["condition"] = label_schema(study_detail::kMaxLabelLength, "the one condition of the phase");
   properties["conditions"] = {{"type", "array"},
                               {"description", "the conditions of the phase, in listed order"},
                               {"minItems", 1},
                               {"uniqueItems", true},
-                              {"items", label_schema(32, "a condition's name")}};
+                              {"items", label_schema(study_detail::kMaxLabelLength, "a condition's name")}};
   properties["assignment"] =
       enum_schema(study_detail::kAssignments, "how the conditions are given to subjects");
   properties["characters"] = {
@@ -243,7 +245,7 @@ ordered_json phase_schema() {
   properties["sets"] = {{"type", "array"},
                         {"description", "names of item sets whose items the phase writes"},
                         {"minItems", 1},
-                        {"items", label_schema(32, "an item set's name")}};
+                        {"items", label_schema(study_detail::kMaxLabelLength, "an item set's name")}};
   properties["repetitions"] =
       integer_schema(1, study_detail::kMaxRepetitions, "times each item is written in each condition");
   properties["session"] = integer_schema(1, static_cast<std::int64_t>(study_detail::kMaxPhases),
@@ -264,17 +266,19 @@ std::string protocol_json_schema_text() {
   defs["QuizOptions"] = quiz_schema();
   defs["StudyCondition"] = condition_schema();
   defs["ProtocolPhase"] = phase_schema();
-  defs["ItemSet"] =
-      object_schema({{"name", label_schema(32, "unique name of the set")},
-                     {"characters", items_schema("the set's items")},
-                     {"transfer_of", label_schema(32, "the trained set whose transfer items these are")}},
-                    "a named set of items");
+  defs["ItemSet"] = object_schema(
+      {{"name", label_schema(study_detail::kMaxLabelLength, "unique name of the set")},
+       {"characters", items_schema("the set's items")},
+       {"transfer_of",
+        label_schema(study_detail::kMaxLabelLength, "the trained set whose transfer items these are")}},
+      "a named set of items");
   defs["ItemSet"]["required"] = ordered_json::array({"name", "characters"});
 
   ordered_json properties = ordered_json::object();
   properties["format"] = {{"const", "calligraphy-study-protocol"}};
   properties["version"] = integer_schema(1, 1, "the format's version");
-  properties["name"] = label_schema(64, "the protocol's name; names session folders");
+  properties["name"] =
+      label_schema(study_detail::kMaxProtocolNameLength, "the protocol's name; names session folders");
   properties["description"] = {{"type", "string"}};
   properties["conditions"] = {{"type", "array"},
                               {"minItems", 1},
@@ -290,7 +294,7 @@ std::string protocol_json_schema_text() {
                              {"items", ref("ItemSet")}};
   properties["practice"] = object_schema(
       {{"characters", items_schema("the familiarisation block's strings")},
-       {"condition", label_schema(32, "the practice condition")},
+       {"condition", label_schema(study_detail::kMaxLabelLength, "the practice condition")},
        {"repetitions", integer_schema(1, study_detail::kMaxRepetitions, "times each string is written")}},
       "the paper's familiarisation block, written first");
   properties["practice"]["required"] = ordered_json::array({"characters", "condition"});
@@ -300,7 +304,7 @@ std::string protocol_json_schema_text() {
         {{"type", "array"},
          {"minItems", 1},
          {"uniqueItems", true},
-         {"items", label_schema(32, "a condition")}}},
+         {"items", label_schema(study_detail::kMaxLabelLength, "a condition")}}},
        {"repetitions",
         integer_schema(1, study_detail::kMaxRepetitions, "times each string is written in each condition")}},
       "the paper's test blocks");
