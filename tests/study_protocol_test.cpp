@@ -15,6 +15,7 @@
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/schedule.hpp"
 #include "calligraphy/study/transfer_set.hpp"
+#include "calligraphy/trial/trial_spec.hpp"
 #include "protocol_checks.hpp"
 
 using namespace calligraphy;
@@ -198,7 +199,10 @@ TEST_CASE("fading and replay parameters and teachers are checked naming the JSON
   check_error(with_condition(R"({"name": "A", "mode": "replay", "parameters": {"start_gain": 1}})"),
               "/conditions/0/parameters/start_gain", "unknown key");
   check_error(with_condition(R"({"name": "A", "mode": "replay", "parameters": {"max_lead_m": 0}})"),
-              "/conditions/0/parameters/max_lead_m", "in (0, 0.1] m (ReplayGuidance.max_lead_m)");
+              "/conditions/0/parameters/max_lead_m", "in (0, 0.006] m (ReplayGuidance.max_lead_m");
+  // A lead the table allows but a trial refuses (beyond R_res) is refused when the protocol is read.
+  check_error(with_condition(R"({"name": "A", "mode": "replay", "parameters": {"max_lead_m": 0.05}})"),
+              "/conditions/0/parameters/max_lead_m", "at most ForceLawParameters.constraint_radius_m");
   check_error(with_condition(R"({"name": "A", "mode": "haptic", "teachers": {"大": "t.json"}})"),
               "/conditions/0/teachers", "replay");
   check_error(with_condition(R"({"name": "A", "mode": "replay", "teachers": {"山": "t.json"}})"),
@@ -605,8 +609,10 @@ TEST_CASE("a protocol's guidance parameters are read with their laws' and rules'
       tabled("skill-adaptive", "max_force_n", &ErrorAmplificationGuidance::max_force_n),
       tabled("timing", "speed_m_s", &TimingGuidance::speed_m_s),
   };
-  for (const TabledKey& k : keys) {
+  for (TabledKey k : keys) {
     INFO(k.mode << " " << k.key);
+    // A replay's lead: the table's range narrowed to the trial's R_res, as the trial checks it.
+    if (k.key == "max_lead_m") k.range = protocol_max_lead_range();
     const auto protocol = [&](double value) {
       // The widest band alongside, so that the narrowest may take its whole range (max >= min).
       const std::string widest = k.key == "min_band_m" ? R"(, "max_band_m": 0.1)" : "";
@@ -626,4 +632,42 @@ TEST_CASE("a protocol's guidance parameters are read with their laws' and rules'
                   "/conditions/0/parameters/" + k.key, r.text(k.unit));
     }
   }
+}
+
+TEST_CASE("a protocol's trial settings, breaks and guidance stiffness take the trial's ranges when read",
+          "[study][protocol]") {
+  const auto with = [](const std::string& condition, const std::string& tail) {
+    return R"({"name": "t", "conditions": [)" + condition +
+           R"(], "test": {"characters": ["大"], "conditions": ["A"], "repetitions": 1})" + tail + "}";
+  };
+  const std::string haptic = R"({"name": "A", "mode": "haptic"})";
+  // max_duration_s: TrialSpec's range, (0, 86400] s; a trial of 1 h 40 min at 1000 Hz is 6,000,000 ticks.
+  const ParameterRange duration = SchemaOf<TrialSpec>::get().field("max_duration_s")->range;
+  CHECK(SchemaOf<ProtocolTrialSettings>::get().field("max_duration_s")->range.high == duration.high);
+  CHECK(parse_study_protocol(with(haptic, R"(, "trial": {"max_duration_s": 6000})"), "p.json")
+            .trial.max_duration_s == 6000.0);
+  CHECK(parse_study_protocol(with(haptic, R"(, "trial": {"max_duration_s": 0.0001, "rate_hz": 10000})"),
+                             "p.json")
+            .trial.max_duration_s == 0.0001);
+  check_error(with(haptic, R"(, "trial": {"max_duration_s": 0})"), "/trial/max_duration_s", "(0, 86400]");
+  check_error(with(haptic, R"(, "trial": {"max_duration_s": 86401, "rate_hz": 100})"),
+              "/trial/max_duration_s", "(0, 86400]");
+  check_error(with(haptic, R"(, "trial": {"rate_hz": 10001})"), "/trial/rate_hz", "[100, 10000]");
+  check_error(with(haptic, R"(, "trial": {"rate": 1000})"), "/trial/rate", "unknown key");
+  check_error(with(haptic, R"(, "trial": {"rate_hz": null})"), "/trial/rate_hz", "null");
+  check_error(with(haptic, R"(, "trial": {"rate_hz": "1000"})"), "/trial/rate_hz", "number");
+  check_error(with(haptic, R"(, "breaks": {"every_trials": -1, "duration_s": 1})"), "/breaks/every_trials",
+              "0");
+  check_error(with(haptic, R"(, "breaks": {"every_trials": 2})"), "/breaks/duration_s", "missing");
+  check_error(with(haptic, R"(, "breaks": {"pause_s": 2})"), "/breaks/pause_s", "unknown key");
+  // The guidance stiffness: the force law's range (>= 0 N/m), not a copy of it.
+  const auto stiff = [&](const std::string& value) {
+    return with(R"({"name": "A", "mode": "haptic", "guidance_stiffness_n_per_m": )" + value + "}", "");
+  };
+  CHECK(parse_study_protocol(stiff("0"), "p.json").conditions[0].guidance_stiffness_n_per_m ==
+        std::optional<double>(0.0));
+  CHECK(parse_study_protocol(stiff("2e5"), "p.json").conditions[0].guidance_stiffness_n_per_m ==
+        std::optional<double>(2e5));
+  check_error(stiff("-1"), "/conditions/0/guidance_stiffness_n_per_m",
+              "ForceLawParameters.guidance_stiffness_n_per_m");
 }

@@ -1,9 +1,11 @@
-// `calligraphy schema specification|record`: the JSON Schema (draft 2020-12) of a trial specification or of a
-// trial record's specification object, made from the one schema the readers and writers use (schema.hpp), or
-// with --markdown the fields as the documentation's table.
+// `calligraphy schema specification|record|protocol`: the JSON Schema (draft 2020-12) of a trial
+// specification, of a trial record's specification object or of a study protocol, made from the one schema
+// and the tables the readers and writers use (schema.hpp), or with --markdown the fields as the
+// documentation's table.
 #include <string>
 
 #include "calligraphy/core/schema.hpp"
+#include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/recorded_trial.hpp"
 #include "calligraphy/trial/trial_spec.hpp"
 #include "cli/app.hpp"
@@ -19,6 +21,10 @@ struct SchemaCommand {
 };
 
 int run_schema(const SchemaCommand& command) {
+  if (command.document == "protocol") {
+    write_output("-", command.markdown ? protocol_schema_markdown() : protocol_json_schema_text());
+    return 0;
+  }
   // A specification a person writes may leave out what keeps its default; a record holds every part.
   const bool record = command.document == "record";
   const Schema& schema = record ? recorded_trial_schema() : SchemaOf<TrialSpec>::get();
@@ -38,13 +44,15 @@ int run_schema(const SchemaCommand& command) {
 
 void add_schema_command(CLI::App& root, Commands& commands) {
   auto command = std::make_shared<SchemaCommand>();
-  CLI::App* app = commands.add(root, "schema",
-                               "Print the JSON Schema (2020-12) of a trial specification or a trial record",
-                               [command] { return run_schema(*command); });
-  required(
-      add_choice(*app, "DOCUMENT", command->document, {"specification", "record"},
-                 "specification: a trial as `trial --spec` and Python state it (keys left out keep their "
-                 "defaults); record: the \"specification\" object of a trial record (every part required)"));
+  CLI::App* app = commands.add(
+      root, "schema",
+      "Print the JSON Schema (2020-12) of a trial specification, a trial record or a study protocol",
+      [command] { return run_schema(*command); });
+  required(add_choice(
+      *app, "DOCUMENT", command->document, {"specification", "record", "protocol"},
+      "specification: a trial as `trial --spec` and Python state it (keys left out keep their "
+      "defaults); record: the \"specification\" object of a trial record (every part required); protocol: a "
+      "study protocol file (docs/experiments.md)"));
   add_flag(*app, "--markdown", command->markdown, "the fields as a Markdown table instead");
 }
 

@@ -13,6 +13,7 @@
 #include "calligraphy/core/servo_rate.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "core/json_reader.hpp"
+#include "core/schema_json.hpp"
 #include "study/names.hpp"
 #include "study/parameter_json.hpp"
 #include "study/protocol_reading.hpp"
@@ -101,8 +102,8 @@ QuizOptions read_quiz(const json& value, const std::string& pointer, const std::
   if (const json* acceptance = reader.optional("acceptance")) {
     quiz.acceptance = read_acceptance(*acceptance, reader.pointer("acceptance"), source);
   }
-  quiz.hint_after_misses =
-      static_cast<int>(reader.integer_or("hint_after_misses", quiz.hint_after_misses, 0, 1000));
+  quiz.hint_after_misses = static_cast<int>(
+      reader.integer_or("hint_after_misses", quiz.hint_after_misses, 0, study_detail::kMaxHintAfterMisses));
   quiz.accept_backwards = reader.boolean_or("accept_backwards", quiz.accept_backwards);
   reader.finish();
   return quiz;
@@ -125,7 +126,21 @@ void read_guidance_parameters(const json& parameters, const std::string& pointer
       break;
     }
     case ConditionMode::replay:
-      take_table_number(reader, "max_lead_m", condition.replay_max_lead_m, &ReplayGuidance::max_lead_m);
+      // The table's range narrowed to the trial's R_res: the bound a trial checks.
+      if (reader.has("max_lead_m")) {
+        const ParameterRange range = protocol_max_lead_range();
+        const double lead = reader.number("max_lead_m", -std::numeric_limits<double>::max(),
+                                          std::numeric_limits<double>::max());
+        if (!range.contains(lead)) {
+          json_detail::fail(
+              source, reader.pointer("max_lead_m"),
+              "expected a number " + range.text("m") +
+                  " (ReplayGuidance.max_lead_m, at most ForceLawParameters.constraint_radius_m), "
+                  "got " +
+                  json(lead).dump());
+        }
+        condition.replay_max_lead_m = lead;
+      }
       break;
     case ConditionMode::assist_as_needed: {
       AssistBandRule& rule = condition.assist_rule;
@@ -212,19 +227,20 @@ StudyCondition read_condition(const json& value, const std::string& pointer, con
   json_detail::ObjectReader reader(value, pointer, source);
   StudyCondition condition;
   condition.name = reader.string("name");
-  if (!study_detail::is_label(condition.name, 32)) {
+  if (!study_detail::is_label(condition.name, study_detail::kMaxLabelLength)) {
     json_detail::fail(source, reader.pointer("name"),
                       "expected 1 to 32 letters, digits, '_' or '-', got \"" + condition.name + "\"");
   }
   condition.mode = choice(reader, "mode", study_detail::kConditionModes);
   const bool guided = renders_guidance(condition.mode);
-  if (const json* stiffness = reader.optional("guidance_stiffness_n_per_m")) {
+  if (reader.optional("guidance_stiffness_n_per_m") != nullptr) {
     if (!guided) {
       json_detail::fail(source, reader.pointer("guidance_stiffness_n_per_m"),
                         std::string("mode \"") + to_string(condition.mode) + "\" renders no guidance");
     }
-    condition.guidance_stiffness_n_per_m =
-        json_detail::as_number(*stiffness, reader.pointer("guidance_stiffness_n_per_m"), source, 0.0, 1e5);
+    // The force law's range (ParameterTable<ForceLawParameters>), which the trial checks.
+    condition.guidance_stiffness_n_per_m = table_number_or(reader, "guidance_stiffness_n_per_m", 0.0,
+                                                           &ForceLawParameters::guidance_stiffness_n_per_m);
   }
   if (const json* parameters = reader.optional("parameters")) {
     const std::string at = reader.pointer("parameters");
@@ -254,50 +270,45 @@ void read_order(json_detail::ObjectReader& reader, StudyProtocol& protocol) {
   const json* value = reader.optional("order");
   if (!value) return;
   json_detail::ObjectReader order(*value, reader.pointer("order"), reader.source());
-  constexpr std::array<ConditionOrder, 4> kConditionOrders{
-      ConditionOrder::fixed, ConditionOrder::latin_square, ConditionOrder::abba, ConditionOrder::random};
-  constexpr std::array<ItemOrder, 2> kItemOrders{ItemOrder::fixed, ItemOrder::random};
-  protocol.condition_order = choice(order, "conditions", kConditionOrders, ConditionOrder::fixed);
-  protocol.item_order = choice(order, "characters", kItemOrders, ItemOrder::fixed);
+  protocol.condition_order =
+      choice(order, "conditions", study_detail::kConditionOrders, ConditionOrder::fixed);
+  protocol.item_order = choice(order, "characters", study_detail::kItemOrders, ItemOrder::fixed);
   protocol.seed = order.unsigned_or("seed", 0);
   order.finish();
 }
 
+// "breaks" and "trial" are read through their schemas (protocol_schema.cpp): unknown keys, null, wrong types
+// and values out of range refused with the JSON pointer.
 void read_breaks(json_detail::ObjectReader& reader, StudyProtocol& protocol) {
   const json* value = reader.optional("breaks");
   if (!value) return;
-  json_detail::ObjectReader breaks(*value, reader.pointer("breaks"), reader.source());
-  protocol.breaks.between_blocks_s = breaks.number_or("between_blocks_s", 0.0, 0.0, 86400.0);
-  protocol.breaks.every_trials = static_cast<int>(breaks.integer_or("every_trials", 0, 0, 100000));
-  protocol.breaks.duration_s = breaks.number_or("duration_s", 0.0, 0.0, 86400.0);
-  if (protocol.breaks.every_trials > 0 && !breaks.has("duration_s")) {
-    json_detail::fail(reader.source(), breaks.pointer("duration_s"),
+  SchemaReadResult unused;
+  schema_detail::from_json(SchemaOf<BreakRules>::get(), &protocol.breaks, *value, reader.pointer("breaks"),
+                           reader.source(), {}, unused);
+  if (protocol.breaks.every_trials > 0 && !value->contains("duration_s")) {
+    json_detail::fail(reader.source(), json_detail::child_pointer(reader.pointer("breaks"), "duration_s"),
                       "missing: every_trials needs a duration_s");
   }
-  breaks.finish();
 }
 
 void read_trial_settings(json_detail::ObjectReader& reader, StudyProtocol& protocol) {
   const json* value = reader.optional("trial");
   if (!value) return;
-  json_detail::ObjectReader trial(*value, reader.pointer("trial"), reader.source());
-  protocol.trial.max_duration_s =
-      trial.number_or("max_duration_s", protocol.trial.max_duration_s, 1e-3, 3600.0);
-  // A protocol's trials may run in real time with a person: the real-time range.
-  protocol.trial.rate_hz =
-      trial.number_or("rate_hz", protocol.trial.rate_hz, kMinServoRateHz, kMaxRealTimeServoRateHz);
+  const std::string at = reader.pointer("trial");
+  SchemaReadResult unused;
+  schema_detail::from_json(SchemaOf<ProtocolTrialSettings>::get(), &protocol.trial, *value, at,
+                           reader.source(), {}, unused);
   // Checked here, so that a session is refused before its folder is made, naming the protocol's fields
   // rather than the trial runner's options.
   const double ticks = protocol.trial.max_duration_s * protocol.trial.rate_hz;
   if (ticks > kMaxTrialTicks) {
     std::ostringstream message;
     message << protocol.trial.max_duration_s << " s at " << protocol.trial.rate_hz << " Hz ("
-            << trial.pointer("rate_hz") << ") is " << std::llround(ticks)
+            << json_detail::child_pointer(at, "rate_hz") << ") is " << std::llround(ticks)
             << " servo ticks a trial, more than the 10000000 a trial may have (its trace is held in memory): "
                "lower max_duration_s or rate_hz";
-    json_detail::fail(reader.source(), trial.pointer("max_duration_s"), message.str());
+    json_detail::fail(reader.source(), json_detail::child_pointer(at, "max_duration_s"), message.str());
   }
-  trial.finish();
 }
 
 // The paper's format: an optional "practice" block, then "test" blocks of every condition (section 7.1).
@@ -455,16 +466,17 @@ StudyProtocol parse_study_protocol(std::string_view json_text, const std::string
   }
   root.integer_or("version", 1, 1, 1);
   protocol.name = root.string("name");
-  if (!study_detail::is_label(protocol.name, 64)) {
+  if (!study_detail::is_label(protocol.name, study_detail::kMaxProtocolNameLength)) {
     json_detail::fail(source, "/name",
                       "expected 1 to 64 letters, digits, '_' or '-', got \"" + protocol.name + "\"");
   }
   protocol.description = root.string_or("description", "");
 
   const json& conditions = root.required("conditions");
-  if (!conditions.is_array() || conditions.empty() || conditions.size() > 26) {
+  if (!conditions.is_array() || conditions.empty() || conditions.size() > study_detail::kMaxConditions) {
     json_detail::fail(source, "/conditions",
-                      "expected a list of 1 to 26 conditions, got " + json_detail::describe(conditions));
+                      "expected a list of 1 to " + std::to_string(study_detail::kMaxConditions) +
+                          " conditions, got " + json_detail::describe(conditions));
   }
   std::set<std::string> names;
   for (std::size_t i = 0; i < conditions.size(); ++i) {

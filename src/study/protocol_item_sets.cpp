@@ -14,9 +14,6 @@ namespace {
 
 using nlohmann::json;
 
-// As many sets as conditions may be compared in one crossover: 26, the conditions' limit.
-constexpr std::size_t kMaxItemSets = 26;
-
 std::string defined_sets(const std::vector<ItemSet>& sets) {
   std::string names;
   for (const ItemSet& set : sets) names += (names.empty() ? "" : ", ") + set.name;
@@ -68,13 +65,13 @@ ItemSet read_item_set(const json& value, const std::string& pointer, const std::
   json_detail::ObjectReader reader(value, pointer, source);
   ItemSet set;
   set.name = reader.string("name");
-  if (!is_label(set.name, 32)) {
+  if (!is_label(set.name, kMaxLabelLength)) {
     json_detail::fail(source, reader.pointer("name"),
                       "expected 1 to 32 letters, digits, '_' or '-', got " + in_quotes(set.name));
   }
   set.items = read_items(reader.required("characters"), reader.pointer("characters"), source);
   set.transfer_of = reader.string_or("transfer_of", "");
-  if (reader.has("transfer_of") && !is_label(set.transfer_of, 32)) {
+  if (reader.has("transfer_of") && !is_label(set.transfer_of, kMaxLabelLength)) {
     json_detail::fail(source, reader.pointer("transfer_of"),
                       "expected the name of an item set (1 to 32 letters, digits, '_' or '-'), got " +
                           in_quotes(set.transfer_of));

@@ -13,10 +13,6 @@ namespace {
 
 using nlohmann::json;
 
-constexpr std::size_t kMaxPhases = 20;
-// A delay longer than a year is a typo, not a design.
-constexpr double kMaxDelay_s = 366.0 * 86400.0;
-
 // "condition": "name" or "conditions": ["a", "b"].
 std::vector<std::string> read_conditions(json_detail::ObjectReader& reader,
                                          const std::vector<StudyCondition>& defined) {
@@ -134,9 +130,6 @@ ProtocolPhase read_phase(const json& value, const std::string& pointer, const st
   phase.pointer = pointer;
   phase.kind = choice(reader, "phase", kStudyPhases);
   phase.conditions = read_conditions(reader, protocol.conditions);
-  constexpr std::array<ConditionAssignment, 3> kAssignments{ConditionAssignment::within_subjects,
-                                                            ConditionAssignment::between_subjects,
-                                                            ConditionAssignment::crossover};
   phase.assignment = choice(reader, "assignment", kAssignments, ConditionAssignment::within_subjects);
   if (phase.assignment == ConditionAssignment::between_subjects && phase.conditions.size() < 2) {
     json_detail::fail(source, reader.pointer("assignment"),

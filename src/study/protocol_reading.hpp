@@ -15,6 +15,21 @@ namespace calligraphy::study_detail {
 inline constexpr std::size_t kMaxItems = 1000;
 inline constexpr std::size_t kMaxCharactersPerItem = 16;
 inline constexpr std::int64_t kMaxRepetitions = 1000;
+inline constexpr std::size_t kMaxPhases = 20;
+inline constexpr std::size_t kMaxLabelLength = 32;         ///< a condition's or an item set's name
+inline constexpr std::size_t kMaxProtocolNameLength = 64;  ///< a protocol's name (it names folders)
+inline constexpr std::int64_t kMaxHintAfterMisses = 1000;  ///< a quiz's hint_after_misses
+inline constexpr std::size_t kMaxConditions = 26;
+// As many sets as conditions may be compared in one crossover: the conditions' limit.
+inline constexpr std::size_t kMaxItemSets = kMaxConditions;
+// A delay longer than a year is a typo, not a design.
+inline constexpr double kMaxDelay_s = 366.0 * 86400.0;
+inline constexpr std::array<ConditionAssignment, 3> kAssignments{ConditionAssignment::within_subjects,
+                                                                 ConditionAssignment::between_subjects,
+                                                                 ConditionAssignment::crossover};
+inline constexpr std::array<ConditionOrder, 4> kConditionOrders{
+    ConditionOrder::fixed, ConditionOrder::latin_square, ConditionOrder::abba, ConditionOrder::random};
+inline constexpr std::array<ItemOrder, 2> kItemOrders{ItemOrder::fixed, ItemOrder::random};
 
 /// Every phase, in the order the docs list them.
 inline constexpr std::array<StudyPhase, 7> kStudyPhases{

@@ -238,5 +238,170 @@ class SchemaTest(unittest.TestCase):
         return out
 
 
+SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
+
+
+def _protocol(**parts):
+    """A minimal protocol of the paper's format, with `parts` added or replacing its own."""
+    document = {
+        "name": "bounds",
+        "conditions": [{"name": "A", "mode": "haptic"}],
+        "test": {"characters": ["十"], "conditions": ["A"], "repetitions": 1},
+    }
+    document.update(parts)
+    return document
+
+
+def _phased(phase):
+    return {"name": "bounds", "conditions": [{"name": "A", "mode": "haptic"}], "phases": [phase]}
+
+
+class ProtocolSchemaTest(unittest.TestCase):
+    """`calligraphy schema protocol` against the protocol reader: the files shipped validate, and every bounded
+    field is refused just past its bound and accepted at a closed bound by both jsonschema and `session plan`."""
+
+    @classmethod
+    def setUpClass(cls):
+        if not CLI or not Path(CLI).exists():
+            raise unittest.SkipTest(f"CALLIGRAPHY_CLI={CLI!r} is not the calligraphy program: run through ctest")
+        cls.folder = tempfile.TemporaryDirectory(prefix="calligraphy-protocol-schema-")
+        cls.cwd = Path(cls.folder.name)
+        cls.schema = json.loads(SchemaTest.run_cli.__func__(cls, "schema", "protocol").stdout)
+        cls.validator = jsonschema.Draft202012Validator(cls.schema)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.folder.cleanup()
+
+    def plan(self, document):
+        path = self.cwd / "p.json"
+        path.write_text(json.dumps(document, ensure_ascii=False), encoding="utf-8")
+        return subprocess.run([CLI, "session", "plan", str(path), "--subjects", "2"], cwd=self.cwd,
+                              capture_output=True, timeout=60)
+
+    def sites(self):
+        """(base document, JSON pointer of the object, its properties, bounds not to accept there) for every
+        object a bound sits in."""
+        defs = self.schema["$defs"]
+        props = self.schema["properties"]
+        out = [
+            (_protocol(), "", props),
+            (_protocol(trial={"rate_hz": 100}), "/trial", defs["ProtocolTrialSettings"]["properties"]),
+            (_protocol(breaks={"duration_s": 1}), "/breaks", defs["BreakRules"]["properties"]),
+            (_protocol(order={}), "/order", props["order"]["properties"]),
+            (_protocol(practice={"characters": ["十"], "condition": "A"}), "/practice",
+             props["practice"]["properties"]),
+            (_protocol(), "/test", props["test"]["properties"]),
+            (_protocol(), "/conditions/0", defs["StudyCondition"]["properties"]),
+            (_phased({"phase": "test", "conditions": ["A"], "characters": ["十"]}), "/phases/0",
+             defs["ProtocolPhase"]["properties"]),
+        ]
+        out = [(*site, set()) for site in out]
+        # Sessions are numbered from 1 without gaps: the last session is the 20th phase's.
+        out[-1][3].add(("session", "maximum"))
+        phases = [{"phase": "test", "conditions": ["A"], "characters": ["十"], "session": i + 1} for i in range(20)]
+        twenty = {"name": "bounds", "conditions": [{"name": "A", "mode": "haptic"}], "phases": phases}
+        session = {"session": defs["ProtocolPhase"]["properties"]["session"]}
+        out.append((twenty, "/phases/19", session, {("session", "minimum")}))
+        quiz = [{"name": "A", "mode": "quiz", "quiz": {}}]
+        out.append((_protocol(conditions=quiz), "/conditions/0/quiz", defs["QuizOptions"]["properties"], set()))
+        quiz = [{"name": "A", "mode": "quiz", "quiz": {"acceptance": {}}}]
+        out.append((_protocol(conditions=quiz), "/conditions/0/quiz/acceptance",
+                    defs["QuizOptions"]["properties"]["acceptance"]["properties"], set()))
+        for rule in defs["StudyCondition"]["allOf"]:
+            parameters = rule["then"].get("properties", {}).get("parameters")
+            if not parameters:
+                continue
+            mode = rule["if"]["properties"]["mode"]["const"]
+            # The widest band, so that the narrowest may take its whole range (max_band_m >= min_band_m).
+            base = {"max_band_m": 0.1} if mode == "assist-as-needed" else {}
+            condition = [{"name": "A", "mode": mode, "parameters": base}]
+            out.append((_protocol(conditions=condition), "/conditions/0/parameters", parameters["properties"], set()))
+        return out
+
+    @staticmethod
+    def with_value(document, pointer, value):
+        document = copy.deepcopy(document)
+        keys = pointer.strip("/").split("/")
+        node = document
+        for key in keys[:-1]:
+            node = node[int(key)] if isinstance(node, list) else node.setdefault(key, {})
+        node[keys[-1]] = value
+        return document
+
+    def test_the_schema_is_json_schema_2020_12(self):
+        jsonschema.Draft202012Validator.check_schema(self.schema)
+        self.assertFalse(self.schema["additionalProperties"])
+
+    def test_every_protocol_shipped_validates_and_plans(self):
+        shipped = []
+        for folder in ("docs", "examples", "tests"):
+            for path in sorted((SOURCE / folder).rglob("*.json")):
+                text = path.read_text(encoding="utf-8-sig")
+                if '"calligraphy-study-protocol"' in text or ('"conditions"' in text and '"name"' in text):
+                    shipped.append(path)
+        self.assertGreaterEqual(len(shipped), 7, shipped)
+        for path in shipped:
+            with self.subTest(path=path.name):
+                errors = [e.message for e in self.validator.iter_errors(json.loads(path.read_text("utf-8-sig")))]
+                self.assertEqual(errors, [])
+                result = subprocess.run([CLI, "session", "plan", str(path), "--subjects", "2"], cwd=self.cwd,
+                                        capture_output=True, timeout=60)
+                self.assertEqual(result.returncode, 0, result.stderr.decode())
+
+    def test_structure_the_reader_refuses_the_schema_refuses(self):
+        cases = {
+            "/surprise": _protocol(surprise=1),
+            "/trial/rate": _protocol(trial={"rate": 1000}),
+            "/trial/rate_hz": _protocol(trial={"rate_hz": None}),
+            "/conditions/0/parameters": _protocol(conditions=[{"name": "A", "mode": "vision", "parameters": {}}]),
+            "/conditions/0/guidance_stiffness_n_per_m": _protocol(
+                conditions=[{"name": "A", "mode": "quiz", "guidance_stiffness_n_per_m": 100}]),
+            "/conditions/0/parameters/end_gain": _protocol(
+                conditions=[{"name": "A", "mode": "fading", "parameters": {"end_gain": 0}}]),
+            "/conditions/0/quiz": _protocol(conditions=[{"name": "A", "mode": "haptic", "quiz": {}}]),
+            "/conditions/0/teachers": _protocol(conditions=[{"name": "A", "mode": "haptic", "teachers": {}}]),
+            "/conditions/0/mode": _protocol(conditions=[{"name": "A", "mode": "telepathy"}]),
+            "/conditions/0/name": _protocol(conditions=[{"name": "A B", "mode": "haptic"}]),
+            "/order/conditions": _protocol(order={"conditions": "latin"}),
+            "/test/characters/0": _protocol(test={"characters": [""], "conditions": ["A"], "repetitions": 1}),
+            "/phases": {**_phased({"phase": "test", "conditions": ["A"], "characters": ["十"]}),
+                        "test": {"characters": ["十"], "conditions": ["A"], "repetitions": 1}},
+        }
+        for pointer, document in cases.items():
+            with self.subTest(pointer=pointer):
+                self.assertFalse(self.validator.is_valid(document))
+                result = self.plan(document)
+                self.assertEqual(result.returncode, 1, result.stderr.decode())
+                self.assertIn(f"p.json: {pointer}", result.stderr.decode())
+
+    def test_each_bound_is_refused_past_it_and_accepted_at_it_by_both(self):
+        checked = 0
+        for base, prefix, properties, not_at in self.sites():
+            for key, prop in properties.items():
+                pointer = f"{prefix}/{key}"
+                for _, value in SchemaTest.past_bounds(pointer, prop):
+                    document = self.with_value(base, pointer, value)
+                    with self.subTest(pointer=pointer, value=value, expect="refused"):
+                        self.assertFalse(self.validator.is_valid(document))
+                        result = self.plan(document)
+                        # A protocol is data: refused as every bad file is (exit 1, docs/cli.md), by pointer.
+                        self.assertEqual(result.returncode, 1, result.stderr.decode())
+                        self.assertIn(f"p.json: {pointer}:", result.stderr.decode())
+                        checked += 1
+                for bound in ("minimum", "maximum"):
+                    if bound not in prop or abs(prop[bound]) > 1e300 or (key, bound) in not_at:
+                        continue
+                    document = self.with_value(base, pointer, prop[bound])
+                    with self.subTest(pointer=pointer, value=prop[bound], expect="accepted"):
+                        self.assertEqual([e.message for e in self.validator.iter_errors(document)], [])
+                        result = self.plan(document)
+                        self.assertEqual(result.returncode, 0, result.stderr.decode())
+                        checked += 1
+        # trial 2, breaks 3, guidance stiffness, every mode's parameters, the quiz's tolerances, the phases'.
+        self.assertGreaterEqual(checked, 100)
+        print(f"protocol bounds checked: {checked}")
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "calligraphy/core/schema.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/render/force_law.hpp"
@@ -190,11 +191,35 @@ struct BreakRules {
   double duration_s = 0.0;
 };
 
-/// Settings of every trial of the study.
+/// Settings of every trial of the study (ranges: `SchemaOf<ProtocolTrialSettings>`).
 struct ProtocolTrialSettings {
-  double max_duration_s = 120.0;  ///< a trial ends after this much device time [s], (0, 3600]
-  double rate_hz = 1000.0;        ///< servo rate [Hz], [100, 10000]; x max_duration_s <= kMaxTrialTicks
+  double max_duration_s = 120.0;  ///< a trial ends after this much device time [s]: TrialSpec's range
+  double rate_hz = 1000.0;  ///< servo rate [Hz], the real-time range; x max_duration_s <= kMaxTrialTicks
 };
+
+/// The schemas of a protocol's "trial" and "breaks" objects (schema.hpp), read with `schema_from_json`:
+/// `max_duration_s` takes TrialSpec's range, `rate_hz` the real-time servo range (a person may write).
+template <>
+struct SchemaOf<ProtocolTrialSettings> {
+  static const Schema& get();
+};
+template <>
+struct SchemaOf<BreakRules> {
+  static const Schema& get();
+};
+
+/// The range of a replay condition's "max_lead_m": ReplayGuidance's table narrowed to the trial's
+/// R_res (ForceLawParameters::constraint_radius_m, which a protocol does not change), the bound a trial
+/// checks (guidance_law.hpp), so that a protocol a trial would refuse is refused when read.
+[[nodiscard]] ParameterRange protocol_max_lead_range() noexcept;
+
+/// The JSON Schema (draft 2020-12) of a protocol file (`calligraphy schema protocol`): the trial settings
+/// and breaks from their schemas, every guidance parameter, the guidance stiffness, the quiz's tolerances
+/// from their laws' and rules' tables, and the counts and names from the reader's own limits. Rules between
+/// values (names defined, sets disjoint, phases in order, the plan's size) are the reader's alone.
+[[nodiscard]] std::string protocol_json_schema_text();
+/// The trial settings and breaks as the documentation's Markdown tables.
+[[nodiscard]] std::string protocol_schema_markdown();
 
 /// A whole protocol.
 struct StudyProtocol {

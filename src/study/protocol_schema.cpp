@@ -1,0 +1,353 @@
+// The schemas of a protocol's parts (schema.hpp): each range is the trial's, the force law's or the guidance
+// law's own where the protocol's value becomes one of theirs, so that a protocol a trial would refuse is
+// refused when it is read, naming its file and JSON pointer.
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "calligraphy/core/servo_rate.hpp"
+#include "calligraphy/render/force_law.hpp"
+#include "calligraphy/render/guidance_law.hpp"
+#include "calligraphy/study/protocol.hpp"
+#include "calligraphy/trial/trial_spec.hpp"
+#include "study/protocol_reading.hpp"
+
+namespace calligraphy {
+
+const Schema& SchemaOf<ProtocolTrialSettings>::get() {
+  using T = ProtocolTrialSettings;
+  // TrialSpec's range of the same value: a session's trials are TrialSpecs.
+  static const std::array fields{
+      number_field<&T::max_duration_s>("max_duration_s",
+                                       SchemaOf<TrialSpec>::get().field("max_duration_s")->range,
+                                       {.unit = "s", .doc = "every trial ends after this much device time"}),
+      // A protocol's trials may run in real time with a person: the real-time range.
+      number_field<&T::rate_hz>("rate_hz", {.low = kMinServoRateHz, .high = kMaxRealTimeServoRateHz},
+                                {.unit = "Hz", .doc = "servo rate of every trial (real-time range)"}),
+  };
+  static const Schema schema{.name = "ProtocolTrialSettings",
+                             .doc = "settings of every trial of the study",
+                             .fields = fields,
+                             .defaults = default_of<T>};
+  return schema;
+}
+
+const Schema& SchemaOf<BreakRules>::get() {
+  using B = BreakRules;
+  static const std::array fields{
+      number_field<&B::between_blocks_s>("between_blocks_s", {.low = 0.0, .high = 86400.0},
+                                         {.unit = "s", .doc = "rest before every block after the first"}),
+      integer_field<&B::every_trials>("every_trials", 0, 100000,
+                                      {.doc = "a rest of duration_s after every this many trials; 0: none"}),
+      number_field<&B::duration_s>("duration_s", {.low = 0.0, .high = 86400.0},
+                                   {.unit = "s", .doc = "the rest taken every every_trials trials"}),
+  };
+  static const Schema schema{.name = "BreakRules",
+                             .doc = "rests between trials (taken by a person; a simulated writer logs them)",
+                             .fields = fields,
+                             .defaults = default_of<B>};
+  return schema;
+}
+
+ParameterRange protocol_max_lead_range() noexcept {
+  ParameterRange range = parameter_field(&ReplayGuidance::max_lead_m).range;
+  const double radius = ForceLawParameters{}.constraint_radius_m;
+  if (radius < range.high) {
+    range.high = radius;
+    range.high_open = false;
+  }
+  return range;
+}
+
+namespace {
+
+using nlohmann::ordered_json;
+
+// A number field of the JSON Schema: the range as minimum / maximum, exclusive where open.
+ordered_json number_schema(const ParameterRange& range, std::string_view unit, std::string_view doc) {
+  ordered_json out = {{"type", "number"}};
+  std::string text(doc);
+  if (!unit.empty()) text.append(" [").append(unit).append("]");
+  out["description"] = text;
+  if (std::isfinite(range.low)) out[range.low_open ? "exclusiveMinimum" : "minimum"] = range.low;
+  if (std::isfinite(range.high)) out[range.high_open ? "exclusiveMaximum" : "maximum"] = range.high;
+  return out;
+}
+
+ordered_json integer_schema(std::int64_t low, std::int64_t high, std::string_view doc) {
+  return {{"type", "integer"}, {"description", std::string(doc)}, {"minimum", low}, {"maximum", high}};
+}
+
+template <typename E, std::size_t N>
+ordered_json enum_schema(const std::array<E, N>& values, std::string_view doc) {
+  ordered_json names = ordered_json::array();
+  for (const E value : values) names.push_back(to_string(value));
+  return {{"type", "string"}, {"description", std::string(doc)}, {"enum", names}};
+}
+
+ordered_json label_schema(std::size_t longest, std::string_view doc) {
+  return {{"type", "string"},
+          {"description", std::string(doc)},
+          {"pattern", "^[A-Za-z0-9_-]{1," + std::to_string(longest) + "}$"}};
+}
+
+ordered_json object_schema(ordered_json properties, std::string_view doc) {
+  return {{"type", "object"},
+          {"description", std::string(doc)},
+          {"properties", std::move(properties)},
+          {"additionalProperties", false}};
+}
+
+ordered_json ref(std::string_view name) { return {{"$ref", "#/$defs/" + std::string(name)}}; }
+
+// The strings a phase writes: each 1 to kMaxCharactersPerItem characters (code points, as JSON Schema
+// counts).
+ordered_json items_schema(std::string_view doc) {
+  return {
+      {"type", "array"},
+      {"description", std::string(doc)},
+      {"minItems", 1},
+      {"maxItems", study_detail::kMaxItems},
+      {"items", {{"type", "string"}, {"minLength", 1}, {"maxLength", study_detail::kMaxCharactersPerItem}}}};
+}
+
+// A schema's JSON Schema body (its $defs moved into `defs`).
+ordered_json described(const Schema& schema, ordered_json& defs) {
+  ordered_json body = ordered_json::parse(json_schema_text(schema, "x", "x", false));
+  if (body.contains("$defs")) {
+    for (auto& [key, value] : body["$defs"].items()) defs[key] = value;
+  }
+  for (const char* key : {"$schema", "$id", "title", "$defs"}) body.erase(key);
+  return body;
+}
+
+template <typename S>
+void put_table_field(ordered_json& properties, std::string_view key, double S::*member,
+                     const ParameterRange* narrowed = nullptr) {
+  const ParameterField<S>& field = parameter_field(member);
+  std::string doc =
+      std::string(ParameterTable<S>::name) + "." + std::string(field.name) + ": " + std::string(field.doc);
+  properties[std::string(key)] = number_schema(narrowed ? *narrowed : field.range, field.unit, doc);
+}
+
+// The "parameters" a condition of each guidance mode takes (protocol.cpp, read_guidance_parameters): each
+// key its law's or rule's table range.
+ordered_json guidance_parameters(ConditionMode mode) {
+  ordered_json p = ordered_json::object();
+  switch (mode) {
+    case ConditionMode::fading:
+      put_table_field(p, "start_gain", &FadingGuidance::gain);
+      put_table_field(p, "forgetting_factor", &FadingRule::forgetting_factor);
+      put_table_field(p, "error_gain_per_m", &FadingRule::error_gain_per_m);
+      break;
+    case ConditionMode::replay: {
+      const ParameterRange lead = protocol_max_lead_range();
+      put_table_field(p, "max_lead_m", &ReplayGuidance::max_lead_m, &lead);
+      break;
+    }
+    case ConditionMode::assist_as_needed:
+      put_table_field(p, "start_band_m", &AssistAsNeededGuidance::band_m);
+      put_table_field(p, "target_error_m", &AssistBandRule::target_error_m);
+      put_table_field(p, "band_rate", &AssistBandRule::rate);
+      put_table_field(p, "min_band_m", &AssistBandRule::min_band_m);
+      put_table_field(p, "max_band_m", &AssistBandRule::max_band_m);
+      break;
+    case ConditionMode::skill_adaptive:
+      put_table_field(p, "threshold_m", &SkillAdaptiveRule::threshold_m);
+      [[fallthrough]];
+    case ConditionMode::error_amplification:
+      put_table_field(p, "amplification_gain", &ErrorAmplificationGuidance::gain);
+      put_table_field(p, "max_force_n", &ErrorAmplificationGuidance::max_force_n);
+      break;
+    case ConditionMode::timing:
+      put_table_field(p, "speed_m_s", &TimingGuidance::speed_m_s);
+      break;
+    default:
+      break;
+  }
+  return p;
+}
+
+ordered_json condition_schema() {
+  ordered_json properties = ordered_json::object();
+  properties["name"] = label_schema(study_detail::kMaxLabelLength,
+                                    "unique label of the condition, used in file names and reports");
+  properties["mode"] = enum_schema(study_detail::kConditionModes, "what the writer gets");
+  put_table_field(properties, "guidance_stiffness_n_per_m", &ForceLawParameters::guidance_stiffness_n_per_m);
+  properties["guidance_stiffness_n_per_m"]["description"] =
+      "K_et, the guidance stiffness (paper eq. 8), modes that render guidance only [N/m]";
+  properties["parameters"] = {{"type", "object"}, {"description", "the guidance mode's parameters"}};
+  properties["teachers"] = {
+      {"type", "object"},
+      {"description", "replay: a teacher's recording file by item, relative to the protocol"},
+      {"additionalProperties", {{"type", "string"}, {"minLength", 1}}}};
+  properties["quiz"] = ref("QuizOptions");
+  ordered_json out = object_schema(std::move(properties), "a feedback condition");
+  out["required"] = ordered_json::array({"name", "mode"});
+  // Per mode: the parameters it takes, each with its table's range.
+  ordered_json rules = ordered_json::array();
+  for (const ConditionMode mode : study_detail::kConditionModes) {
+    ordered_json then = ordered_json::object();
+    if (renders_guidance(mode) && mode != ConditionMode::haptic) {
+      then["properties"]["parameters"] = object_schema(guidance_parameters(mode), "");
+      then["properties"]["parameters"].erase("description");
+    } else {
+      then["not"] = {{"required", {"parameters"}}};
+    }
+    if (!renders_guidance(mode)) {
+      then["properties"]["guidance_stiffness_n_per_m"] = false;
+    }
+    if (mode != ConditionMode::replay) then["properties"]["teachers"] = false;
+    if (mode != ConditionMode::quiz) then["properties"]["quiz"] = false;
+    rules.push_back({{"if", {{"properties", {{"mode", {{"const", to_string(mode)}}}}}}}, {"then", then}});
+  }
+  out["allOf"] = rules;
+  return out;
+}
+
+ordered_json quiz_schema() {
+  ordered_json acceptance = ordered_json::object();
+  for (const ParameterField<StrokeAcceptance>& field : ParameterTable<StrokeAcceptance>::fields())
+    put_table_field(acceptance, field.name, field.member);
+  ordered_json properties = ordered_json::object();
+  properties["acceptance"] =
+      object_schema(std::move(acceptance), "the stroke matcher's tolerances (docs/stroke-acceptance.md)");
+  properties["hint_after_misses"] =
+      integer_schema(0, study_detail::kMaxHintAfterMisses,
+                     "a hint after this many misses on one stroke, and each further one; 0: never");
+  properties["accept_backwards"] = {
+      {"type", "boolean"}, {"description", "a stroke written from its end to its start is accepted"}};
+  return object_schema(std::move(properties), "how a quiz judges strokes");
+}
+
+ordered_json phase_schema() {
+  ordered_json properties = ordered_json::object();
+  properties["phase"] = enum_schema(study_detail::kStudyPhases, "the phase of a motor-learning study");
+  properties["condition"] = label_schema(study_detail::kMaxLabelLength, "the one condition of the phase");
+  properties["conditions"] = {{"type", "array"},
+                              {"description", "the conditions of the phase, in listed order"},
+                              {"minItems", 1},
+                              {"uniqueItems", true},
+                              {"items", label_schema(study_detail::kMaxLabelLength, "a condition's name")}};
+  properties["assignment"] =
+      enum_schema(study_detail::kAssignments, "how the conditions are given to subjects");
+  properties["characters"] = {
+      {"description", "the strings written, or (transfer) a choice by typical-stroke coverage"},
+      {"oneOf",
+       {items_schema("each string written in one trial"),
+        object_schema({{"choose", integer_schema(1, static_cast<std::int64_t>(study_detail::kMaxItems),
+                                                 "characters chosen")},
+                       {"from", items_schema("single characters to choose from, in order of preference")}},
+                      "characters chosen when a session is made")}}};
+  properties["sets"] = {{"type", "array"},
+                        {"description", "names of item sets whose items the phase writes"},
+                        {"minItems", 1},
+                        {"items", label_schema(study_detail::kMaxLabelLength, "an item set's name")}};
+  properties["repetitions"] =
+      integer_schema(1, study_detail::kMaxRepetitions, "times each item is written in each condition");
+  properties["session"] = integer_schema(1, static_cast<std::int64_t>(study_detail::kMaxPhases),
+                                         "1-based: the sitting the phase is written in");
+  properties["delay_s"] = number_schema({.low = 0.0, .high = study_detail::kMaxDelay_s}, "s",
+                                        "the phase starts at least this long after the previous one ended");
+  ordered_json out = object_schema(std::move(properties), "a phase of the study");
+  out["required"] = ordered_json::array({"phase"});
+  return out;
+}
+
+}  // namespace
+
+std::string protocol_json_schema_text() {
+  ordered_json defs = ordered_json::object();
+  defs["ProtocolTrialSettings"] = described(SchemaOf<ProtocolTrialSettings>::get(), defs);
+  defs["BreakRules"] = described(SchemaOf<BreakRules>::get(), defs);
+  defs["QuizOptions"] = quiz_schema();
+  defs["StudyCondition"] = condition_schema();
+  defs["ProtocolPhase"] = phase_schema();
+  defs["ItemSet"] = object_schema(
+      {{"name", label_schema(study_detail::kMaxLabelLength, "unique name of the set")},
+       {"characters", items_schema("the set's items")},
+       {"transfer_of",
+        label_schema(study_detail::kMaxLabelLength, "the trained set whose transfer items these are")}},
+      "a named set of items");
+  defs["ItemSet"]["required"] = ordered_json::array({"name", "characters"});
+
+  ordered_json properties = ordered_json::object();
+  properties["format"] = {{"const", "calligraphy-study-protocol"}};
+  properties["version"] = integer_schema(1, 1, "the format's version");
+  properties["name"] =
+      label_schema(study_detail::kMaxProtocolNameLength, "the protocol's name; names session folders");
+  properties["description"] = {{"type", "string"}};
+  properties["conditions"] = {{"type", "array"},
+                              {"minItems", 1},
+                              {"maxItems", study_detail::kMaxConditions},
+                              {"items", ref("StudyCondition")}};
+  properties["phases"] = {{"type", "array"},
+                          {"minItems", 1},
+                          {"maxItems", study_detail::kMaxPhases},
+                          {"items", ref("ProtocolPhase")}};
+  properties["item_sets"] = {{"type", "array"},
+                             {"minItems", 1},
+                             {"maxItems", study_detail::kMaxItemSets},
+                             {"items", ref("ItemSet")}};
+  properties["practice"] = object_schema(
+      {{"characters", items_schema("the familiarisation block's strings")},
+       {"condition", label_schema(study_detail::kMaxLabelLength, "the practice condition")},
+       {"repetitions", integer_schema(1, study_detail::kMaxRepetitions, "times each string is written")}},
+      "the paper's familiarisation block, written first");
+  properties["practice"]["required"] = ordered_json::array({"characters", "condition"});
+  properties["test"] = object_schema(
+      {{"characters", items_schema("each string written in one trial")},
+       {"conditions",
+        {{"type", "array"},
+         {"minItems", 1},
+         {"uniqueItems", true},
+         {"items", label_schema(study_detail::kMaxLabelLength, "a condition")}}},
+       {"repetitions",
+        integer_schema(1, study_detail::kMaxRepetitions, "times each string is written in each condition")}},
+      "the paper's test blocks");
+  properties["test"]["required"] = ordered_json::array({"characters", "conditions", "repetitions"});
+  properties["order"] = object_schema(
+      {{"conditions",
+        enum_schema(study_detail::kConditionOrders, "order of the condition blocks per subject")},
+       {"characters", enum_schema(study_detail::kItemOrders, "order of the strings within each round")},
+       {"seed",
+        {{"type", "integer"},
+         {"minimum", 0},
+         {"maximum", std::numeric_limits<std::uint64_t>::max()},
+         {"description", "seeds the random orders (with the subject id)"}}}},
+      "orders");
+  properties["breaks"] = ref("BreakRules");
+  properties["trial"] = ref("ProtocolTrialSettings");
+
+  ordered_json root = ordered_json::object();
+  root["$schema"] = "https://json-schema.org/draft/2020-12/schema";
+  root["$id"] = "https://calligraphy.invalid/schema/protocol.json";
+  root["title"] = "calligraphy study protocol (docs/experiments.md)";
+  root["type"] = "object";
+  root["properties"] = properties;
+  root["additionalProperties"] = false;
+  root["required"] = ordered_json::array({"name", "conditions"});
+  // The paper's "practice" and "test", or "phases": one of them.
+  ordered_json paper = ordered_json::object();
+  paper["required"] = ordered_json::array({"test"});
+  paper["not"]["required"] = ordered_json::array({"phases"});
+  ordered_json phased = ordered_json::object();
+  phased["required"] = ordered_json::array({"phases"});
+  ordered_json either = ordered_json::array();
+  either.push_back({{"required", {"test"}}});
+  either.push_back({{"required", {"practice"}}});
+  phased["not"]["anyOf"] = either;
+  root["oneOf"] = ordered_json::array({paper, phased});
+  root["$defs"] = defs;
+  return root.dump(2) + "\n";
+}
+
+std::string protocol_schema_markdown() {
+  return "### trial\n\n" + schema_markdown(SchemaOf<ProtocolTrialSettings>::get()) + "\n### breaks\n\n" +
+         schema_markdown(SchemaOf<BreakRules>::get());
+}
+
+}  // namespace calligraphy
