@@ -221,16 +221,17 @@ void check_protocol_unchanged(const fs::path& root, const LoadedProtocol& protoc
 // resuming would extend the session under the one that follows it.
 void check_not_followed(const SessionFolder& session) {
   const fs::path folder = session.path();
-  const std::string name = fs::path(folder).lexically_normal().filename().string().empty()
-                               ? folder.parent_path().filename().string()
-                               : fs::path(folder).lexically_normal().filename().string();
+  fs::path base = fs::absolute(folder).lexically_normal();
+  if (base.filename().empty()) base = base.parent_path();  // "S/x/" is x
+  const std::string name = base.filename().string();
   std::vector<fs::path> siblings;
   try {
-    siblings = find_session_folders(fs::absolute(folder).lexically_normal().parent_path());
+    siblings = find_session_folders(base.parent_path());
   } catch (const Error&) {
     return;  // the subject's folder cannot be listed: no later session to find
   }
   for (const fs::path& later : siblings) {
+    if (later.filename().string() == name) continue;  // the session itself (its manifest is read already)
     SessionManifest manifest;
     try {
       manifest = study_detail::read_session_manifest(later);
