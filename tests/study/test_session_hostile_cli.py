@@ -19,6 +19,10 @@ from pathlib import Path
 from study_protocols import two_session_protocol
 
 CLI = os.environ.get("CALLIGRAPHY_CLI", "")
+try:
+    from calligraphy import study
+except ImportError:
+    study = None
 
 SMALL = {
     "name": "small",
@@ -84,6 +88,8 @@ class HostileSessionTest(unittest.TestCase):
                 self.assertEqual(report.returncode, 0, report.stderr.decode())
                 rows = (tables / "trials.csv").read_text(encoding="utf-8").strip().splitlines()
                 self.assertEqual(len(rows), 1 + 2 * 4, rows)  # header + 2 subjects x 4 trials, once each
+                if study is not None:  # Python's reader, where the module is built (CTest's PYTHONPATH)
+                    self.assertEqual(len(study.load(self.cwd / out).trials), 2 * 4)
 
 
     # 4. A day 1 edited after day 2 began.
