@@ -321,7 +321,13 @@ StudyRunLock::StudyRunLock(const fs::path& root, const std::string& command) {
 }
 
 StudyRunLock::~StudyRunLock() {
-  if (fd_ >= 0) ::close(fd_);  // closing the descriptor releases the lock; the file stays
+  if (fd_ < 0) return;
+  // The note goes with the run (an ended run leaves an empty file, the same after every run); closing the
+  // descriptor releases the lock. A killed run leaves its note, which the next run replaces.
+  if (::ftruncate(fd_, 0) != 0) {
+    // Left as it was: a note naming an ended run misleads no one while no lock is held.
+  }
+  ::close(fd_);
 }
 
 SeriesLock::~SeriesLock() {

@@ -83,7 +83,8 @@ class SeriesLock {
 /// An exclusive lock on a study folder for one run of `session run` (flock(2) on ROOT/.calligraphy-run.lock,
 /// created when missing with ROOT), taken without waiting: a second run into the study folder while one runs
 /// (the same protocol, or another file of the same name) is refused, so that no session is started twice.
-/// The lock file holds the holder's process id and command line, which the refusal names. The system
+/// While held, the lock file holds the holder's process id and command line, which the refusal names; a run
+/// that ends empties it. The system
 /// releases the lock when the holder ends, however it ends (a killed run leaves a file, not a lock).
 class StudyRunLock {
  public:
