@@ -140,8 +140,8 @@ SessionRunResult run_one(SessionFolder& session, const SessionRunOptions& option
     window.run.host = nullptr;
     const auto source = std::make_shared<CharacterSource>(library);
     const auto outlines = std::make_shared<CharacterLibrary>(library_from(library));
-    // The bundled store holds no outlines by design (docs/corpus.md): only a folder or store the user named is
-    // expected to have them.
+    // The bundled store holds no outlines by design (docs/corpus.md): only a folder or store the user named
+    // is expected to have them.
     const bool outlines_expected = !library.data_folder.empty() || !library.store_file.empty();
     window.load_character = [source, outlines, outlines_expected](char32_t c) {
       trainer::TrainerCharacter character;
@@ -383,6 +383,25 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
       check_writable_folder(existing, trial_files_bytes(resolved.protocol.trial));
   }
 
+  // One run into a study folder at a time: the lock is held until this run ends. Another run that was here
+  // before it, or ended since the checks above, is seen by checking again under the lock.
+  const StudyRunLock study_lock(command.out,
+                                "calligraphy session run " + command.protocol + " --out " + command.out);
+  check_protocol_unchanged(command.out, resolved);
+  if (command.new_subjects || sessions == 1) {
+    std::vector<std::string> meanwhile;
+    for (const std::string& id : subjects_with_sessions(command.out, resolved)) {
+      const bool ours = std::any_of(subjects.begin(), subjects.end(),
+                                    [&id](const SubjectAssignment& s) { return s.id == id; });
+      if (ours && !std::binary_search(begun.begin(), begun.end(), id)) meanwhile.push_back(id);
+    }
+    if (!meanwhile.empty()) {
+      throw StateError("--out " + command.out + ": another run started the session of '" +
+                       resolved.protocol.name + "' for " + subject_list(meanwhile) +
+                       " as this one began; nothing was run");
+    }
+  }
+
   // What is about to run (stderr: stdout carries one line per session run).
   // After --new-subjects, the balance is the whole study's: subjects 1 to the last one of this run.
   std::vector<SubjectAssignment> study;
@@ -481,6 +500,7 @@ int resume_session(const SessionResumeCommand& command, DeviceRegistry& devices)
                 session.path().c_str());
     return 0;
   }
+  check_not_followed(session);
   session.check_writable();  // before the first trial: a folder no trial could be saved in
   install_stop_handlers();
   TerminalHost host;

@@ -60,6 +60,14 @@ class PointerTracker {
 }  // namespace
 
 nlohmann::json parse_json_document(std::string_view text, const std::string& source) {
+  // The plain parser first: linear in the text. A parser with a callback is not (nlohmann/json 3.11's
+  // callback parser scans an object's parent for a discarded value at every object's end, so an array of n
+  // objects, a session plan, takes n^2 steps); it runs only to name where a document that failed fails.
+  try {
+    return nlohmann::json::parse(text.begin(), text.end());
+  } catch (const nlohmann::json::exception&) {
+    // Parsed again below, with the pointer tracked, for the error's words.
+  }
   PointerTracker tracker;
   try {
     return nlohmann::json::parse(text.begin(), text.end(), std::ref(tracker));

@@ -13,6 +13,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/study/schedule.hpp"
+#include "calligraphy/study/session_folder.hpp"
 #include "core/json_reader.hpp"
 #include "study/names.hpp"
 #include "study/saved_sessions.hpp"
@@ -215,6 +216,38 @@ void check_protocol_unchanged(const fs::path& root, const LoadedProtocol& protoc
   }
 }
 
+// A session with unsaved trials that a later session already follows: the later one began from it as it was
+// then, whole (a series goes on only after every trial is saved), so a trial missing now was removed since;
+// resuming would extend the session under the one that follows it.
+void check_not_followed(const SessionFolder& session) {
+  const fs::path folder = session.path();
+  fs::path base = fs::absolute(folder).lexically_normal();
+  if (base.filename().empty()) base = base.parent_path();  // "S/x/" is x
+  const std::string name = base.filename().string();
+  std::vector<fs::path> siblings;
+  try {
+    siblings = find_session_folders(base.parent_path());
+  } catch (const Error&) {
+    return;  // the subject's folder cannot be listed: no later session to find
+  }
+  for (const fs::path& later : siblings) {
+    if (later.filename().string() == name) continue;  // the session itself (its manifest is read already)
+    SessionManifest manifest;
+    try {
+      manifest = study_detail::read_session_manifest(later);
+    } catch (const Error&) {
+      continue;
+    }
+    if (!manifest.previous || manifest.previous->session_id != name) continue;
+    const PlannedTrial& missing = session.manifest().plan[*session.next_unsaved()];
+    throw DataError(SessionLayout::record(folder, missing).string() + ": missing, but session " +
+                    std::to_string(manifest.setup.session_number) + " (" + later.string() +
+                    ") already follows this session and began from it with every trial "
+                    "saved: the record was removed since; restore it (a session a later one follows is not "
+                    "resumed)");
+  }
+}
+
 SeriesLock::SeriesLock(const fs::path& root, const std::string& subject_id,
                        const std::function<void(const fs::path&)>& waiting,
                        const std::function<bool()>& should_stop)
@@ -245,6 +278,56 @@ SeriesLock::SeriesLock(const fs::path& root, const std::string& subject_id,
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
+}
+
+StudyRunLock::StudyRunLock(const fs::path& root, const std::string& command) {
+  std::error_code error;
+  fs::create_directories(root, error);
+  if (error) throw DataError(root.string() + ": cannot create the folder: " + error.message());
+  const fs::path path = root / kFileName;
+  // O_NOFOLLOW: a link planted under the lock's name is refused, not followed and truncated.
+  fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
+  if (fd_ < 0) throw DataError(path.string() + ": cannot open the study's run lock: " + std::strerror(errno));
+  while (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int reason = errno;
+    if (reason == EINTR) continue;
+    std::string holder;
+    if (reason == EWOULDBLOCK) {
+      // The holder writes who it is just after it locks: a run refused in between reads again, briefly.
+      for (int attempt = 0; attempt < 40 && holder.empty(); ++attempt) {
+        if (attempt > 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        char text[512] = {};
+        const ssize_t got = ::pread(fd_, text, sizeof text - 1, 0);
+        if (got > 0) holder.assign(text, static_cast<std::size_t>(got));
+      }
+      while (!holder.empty() && (holder.back() == '\n' || holder.back() == '\0')) holder.pop_back();
+    }
+    ::close(fd_);
+    fd_ = -1;
+    if (reason != EWOULDBLOCK) throw DataError(path.string() + ": cannot lock: " + std::strerror(reason));
+    throw StateError(root.string() + ": another run is writing this study folder (" +
+                     (holder.empty() ? std::string("pid unknown: it has not yet written its note") : holder) +
+                     ", lock " + path.string() +
+                     "): runs into one study folder take turns; run again when it has ended, or give "
+                     "another --out");
+  }
+  // Who holds it, for the refusal of the next run.
+  std::string who = "pid ";
+  who.append(std::to_string(::getpid())).append(": ").append(command).append("\n");
+  // Written, then cut to its length: a reader never sees it empty when a note was there before.
+  if (::pwrite(fd_, who.data(), who.size(), 0) < 0 || ::ftruncate(fd_, static_cast<off_t>(who.size())) != 0) {
+    // The lock holds without the note; the refusal then says the process is starting.
+  }
+}
+
+StudyRunLock::~StudyRunLock() {
+  if (fd_ < 0) return;
+  // The note goes with the run (an ended run leaves an empty file, the same after every run); closing the
+  // descriptor releases the lock. A killed run leaves its note, which the next run replaces.
+  if (::ftruncate(fd_, 0) != 0) {
+    // Left as it was: a note naming an ended run misleads no one while no lock is held.
+  }
+  ::close(fd_);
 }
 
 SeriesLock::~SeriesLock() {

@@ -50,6 +50,11 @@ struct SessionSeries {
 /// session's folder and both SHA-256; a session.json that cannot be read is left to the readers that need it.
 void check_protocol_unchanged(const std::filesystem::path& root, const LoadedProtocol& protocol);
 
+/// Refuses to resume `session` (one with unsaved trials) when a later session in its subject's folder
+/// follows it: that session began from this one with every trial saved, so a record missing now was removed
+/// since. Throws DataError naming the missing record and the later session's folder.
+void check_not_followed(const SessionFolder& session);
+
 /// An exclusive lock on one subject's series under `root` (flock(2) on the folder ROOT/SUBJECT), held by a
 /// run from reading the series until its session is written, so that concurrent runs of one subject take
 /// turns (the later sees what the earlier wrote) instead of starting a session twice. The system releases
@@ -72,6 +77,28 @@ class SeriesLock {
 
  private:
   std::filesystem::path path_;
+  int fd_ = -1;
+};
+
+/// An exclusive lock on a study folder for one run of `session run` (flock(2) on ROOT/.calligraphy-run.lock,
+/// created when missing with ROOT), taken without waiting: a second run into the study folder while one runs
+/// (the same protocol, or another file of the same name) is refused, so that no session is started twice.
+/// While held, the lock file holds the holder's process id and command line, which the refusal names; a run
+/// that ends empties it. The system
+/// releases the lock when the holder ends, however it ends (a killed run leaves a file, not a lock).
+class StudyRunLock {
+ public:
+  /// Throws StateError naming the folder and the run that holds it when another process holds the lock,
+  /// DataError naming the folder when it cannot be created or locked. `command` is this run's command line.
+  StudyRunLock(const std::filesystem::path& root, const std::string& command);
+  StudyRunLock(const StudyRunLock&) = delete;
+  StudyRunLock& operator=(const StudyRunLock&) = delete;
+  ~StudyRunLock();
+
+  /// The lock file's name in a study folder; readers skip it (not a folder).
+  static constexpr const char* kFileName = ".calligraphy-run.lock";
+
+ private:
   int fd_ = -1;
 };
 
