@@ -32,12 +32,13 @@ class StudyCliTest(unittest.TestCase):
     def tearDown(self):
         self.folder.cleanup()
 
-    def run_cli(self, *args):
+    def run_cli(self, *args, timeout=600):
         return subprocess.run([CLI, *map(str, args)], cwd=self.cwd, stdout=subprocess.PIPE,
-                              stderr=subprocess.PIPE, timeout=600)
+                              stderr=subprocess.PIPE, timeout=timeout)
 
-    def write_protocol(self, protocol):
-        path = self.cwd / f"{protocol['name']}.json"
+    def write_protocol(self, protocol, name=None):
+        """Writes `protocol` as `name` (default: its own name with .json) in the test's folder."""
+        path = self.cwd / (name or f"{protocol['name']}.json")
         path.write_text(json.dumps(protocol, ensure_ascii=False), encoding="utf-8")
         return path
 

@@ -9,16 +9,11 @@
 
 CALLIGRAPHY_CLI names the program. Standard library only.
 """
-import json
-import os
 import subprocess
-import tempfile
 import unittest
-from pathlib import Path
 
-from study_protocols import two_session_protocol
+from study_protocols import CLI, StudyCliTest, two_session_protocol
 
-CLI = os.environ.get("CALLIGRAPHY_CLI", "")
 try:
     from calligraphy import study
 except ImportError:
@@ -32,23 +27,8 @@ SMALL = {
 }
 
 
-class HostileSessionTest(unittest.TestCase):
-    def setUp(self):
-        if not CLI or not Path(CLI).exists():
-            self.fail(f"CALLIGRAPHY_CLI={CLI!r} is not the calligraphy program: run these tests through ctest")
-        self.folder = tempfile.TemporaryDirectory(prefix="calligraphy-hostile-")
-        self.cwd = Path(self.folder.name)
-
-    def tearDown(self):
-        self.folder.cleanup()
-
-    def run_cli(self, *args, timeout=600):
-        return subprocess.run([CLI, *map(str, args)], cwd=self.cwd, capture_output=True, timeout=timeout)
-
-    def write_protocol(self, protocol, name="p.json"):
-        path = self.cwd / name
-        path.write_text(json.dumps(protocol, ensure_ascii=False), encoding="utf-8")
-        return path
+class HostileSessionTest(StudyCliTest):
+    folder_prefix = "calligraphy-hostile-"
 
     def race(self, *commands):
         """Starts every command at once; their CompletedProcess-like (returncode, stderr) in order."""
@@ -95,7 +75,7 @@ class HostileSessionTest(unittest.TestCase):
     # 4. A day 1 edited after day 2 began.
 
     def test_a_day_one_edited_after_day_two_began_is_not_resumed(self):
-        self.write_protocol(two_session_protocol("days"))
+        self.write_protocol(two_session_protocol("days"), "p.json")
         done = self.run_cli("session", "run", "p.json", "--subjects", "1", "--out", "out")
         self.assertEqual(done.returncode, 0, done.stderr.decode())
         day1, day2 = sorted((self.cwd / "out" / "S01").iterdir())
