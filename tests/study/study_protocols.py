@@ -12,6 +12,20 @@ from pathlib import Path
 CLI = os.environ.get("CALLIGRAPHY_CLI", "")
 
 
+def williams_row(n, row):
+    """Row `row` of the balanced Latin square of n conditions (Williams 1949) as condition indices, written out
+    as docs/experiments.md states it: first row 0, 1, n-1, 2, n-2, ...; row r adds r mod n; for odd n, rows n
+    to 2n-1 are rows 0 to n-1 reversed. The tests' own reading of the docs, not the library's code."""
+    first, low, high = [0], 1, n - 1
+    for k in range(1, n):
+        first.append(low if k % 2 == 1 else high)
+        low, high = (low + 1, high) if k % 2 == 1 else (low, high - 1)
+    out = [(f + row) % n for f in first]
+    if n % 2 == 1 and (row // n) % 2 == 1:
+        out.reverse()
+    return out
+
+
 def digest_tree(folder):
     """SHA-256 of every file under `folder`, by its relative path: what a refused run must leave unchanged."""
     return {str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()

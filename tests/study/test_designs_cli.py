@@ -32,24 +32,10 @@ import json
 import unittest
 from pathlib import Path
 
-from study_protocols import StudyCliTest, digest_tree
+from study_protocols import StudyCliTest, digest_tree, williams_row
 
 
 TRIAL = {"max_duration_s": 10}
-
-
-def williams_row(n, row):
-    """Row `row` of the balanced Latin square of n conditions (Williams 1949) as listed indices, as
-    docs/experiments.md states it: first row 0, 1, n-1, 2, n-2, ...; row r adds r mod n; for odd n rows n to
-    2n-1 are rows 0 to n-1 reversed."""
-    first, low, high = [0], 1, n - 1
-    for k in range(1, n):
-        first.append(low if k % 2 == 1 else high)
-        low, high = (low + 1, high) if k % 2 == 1 else (low, high - 1)
-    out = [(f + row) % n for f in first]
-    if n % 2 == 1 and (row // n) % 2 == 1:
-        out.reverse()
-    return out
 
 
 def crossover_of(conditions, sets, number, groups=1):

@@ -20,7 +20,7 @@ import shutil
 import unittest
 from pathlib import Path
 
-from study_protocols import StudyCliTest, digest_tree
+from study_protocols import StudyCliTest, digest_tree, williams_row
 
 SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 
@@ -48,24 +48,15 @@ def crossover_protocol(k):
             "trial": {"max_duration_s": 10}}
 
 
-def williams_row(n, row):
-    """Row `row` of the balanced Latin square of n conditions (Williams 1949) as letters, written out as
-    docs/experiments.md states it: first row 0, 1, n-1, 2, n-2, ...; row r adds r mod n; for odd n, rows n to
-    2n-1 are rows 0 to n-1 reversed."""
-    first, low, high = [0], 1, n - 1
-    for k in range(1, n):
-        first.append(low if k % 2 == 1 else high)
-        low, high = (low + 1, high) if k % 2 == 1 else (low, high - 1)
-    out = [(f + row) % n for f in first]
-    if n % 2 == 1 and (row // n) % 2 == 1:
-        out.reverse()
-    return "".join(chr(ord("A") + i) for i in out)
+def williams_letters(n, row):
+    """Row `row` of the balanced Latin square of n conditions as letters (A the first condition)."""
+    return "".join(chr(ord("A") + i) for i in williams_row(n, row))
 
 
 def expected_crossover(k, number):
     """Sequence and each letter's set for subject `number` (docs/experiments.md, "Crossover designs")."""
     rows = k if k % 2 == 0 else 2 * k
-    sequence = williams_row(k, (number - 1) % rows)
+    sequence = williams_letters(k, (number - 1) % rows)
     rotation = ((number - 1) // rows) % k
     pairing = " ".join(f"{chr(ord('A') + i)}:s{(i + rotation) % k + 1}" for i in range(k))
     return sequence, pairing
