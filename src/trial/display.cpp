@@ -102,17 +102,17 @@ void DisplayPublisher::publish_tick(std::uint64_t tick, const DeviceState& state
   s.pen_height_m = state.position_m.z() - paper_z;
   channel_->publish(s);
 
+  // The recorder closes strokes in order, written or assisted: the one closed this tick is the last one.
+  const std::size_t closed = metrics.strokes_completed + metrics.strokes_assisted;
   const std::uint32_t every = channel_->options().trace_every_ticks;
   if (every == 1 || tick % every == 0) {
     // The tick that completes a stroke still belongs to it (as in the recorder's trace).
-    const std::size_t done = metrics.strokes_completed + metrics.strokes_assisted;
-    const std::uint32_t stroke_written =
-        (output.stroke_completed || output.stroke_assisted) && done > 0 ? narrow(done - 1) : s.stroke_index;
+    const std::uint32_t stroke_written = (output.stroke_completed || output.stroke_assisted) && closed > 0
+                                             ? narrow(closed - 1)
+                                             : s.stroke_index;
     channel_->push_trace(TracePoint{tick, state.time_s, s.hip_m, output.state, stroke_written});
   }
 
-  // The recorder closes strokes in order, written or assisted: the one closed this tick is the last one.
-  const std::size_t closed = metrics.strokes_completed + metrics.strokes_assisted;
   const StrokeMetrics* last_closed =
       closed > 0 && closed <= metrics.per_stroke.size() ? &metrics.per_stroke[closed - 1] : nullptr;
   const auto stroke_event = [&](DisplayEventKind kind, const StrokeMetrics& m) {
