@@ -79,7 +79,7 @@ void bind_guidance(py::module_& m) {
       R"(The fading guidance gain of the next repetition (include/calligraphy/render/guidance_mode.hpp):
 clamp(f gain + k error_m, 0, 1) with f, k of `rule` (a FadingRule, default f = 0.8, k = 200 1/m; Emken,
 Benitez & Reinkensmeyer 2007). gain: this repetition's gain in [0, 1]; error_m: its error [m] >= 0, for
-example the trial's mean deviation (metrics['mean_deviation_mm'] / 1000). Returns a float in [0, 1].
+example the trial's mean deviation (metrics['mean_deviation_m']). Returns a float in [0, 1].
 Raises InvalidArgument (a ValueError) for a gain outside [0, 1], a negative or non-finite error or a bad
 rule; TypeError naming the argument for a value of the wrong type.)");
   ParameterClass<AssistBandRule>(

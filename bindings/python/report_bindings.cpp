@@ -13,6 +13,7 @@
 
 #include "arguments.hpp"
 #include "bindings.hpp"
+#include "calligraphy/analysis/metric_table.hpp"
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/report/teacher_recording.hpp"
@@ -26,10 +27,14 @@
 
 namespace calligraphy::python {
 
+py::dict metrics_from_json(const std::string& text) {
+  return py::module_::import("calligraphy.metrics").attr("loads")(py::str(text));
+}
+
 py::dict trial_metrics(const TrialDescription& description, const TrialResult& result,
                        const WritingMetrics& writing) {
   const std::string text = trial_json(description, result, writing);
-  return py::module_::import("json").attr("loads")(py::str(text));
+  return metrics_from_json(text);
 }
 
 void write_teacher_recording(const TeacherRecording& recording, const std::filesystem::path& path) {
@@ -52,6 +57,32 @@ py::array_t<T> column_array(const std::vector<T>& values) {
 }  // namespace
 
 void bind_report(py::module_& m) {
+  m.def(
+      "metric_table",
+      [] {
+        py::list out;
+        for (const MetricInfo& info : metric_table()) {
+          py::dict row;
+          row["name"] = std::string(info.name);
+          row["kind"] = info.kind == MetricKind::count  ? "count"
+                        : info.kind == MetricKind::flag ? "flag"
+                                                        : "number";
+          row["unit"] = std::string(info.unit);
+          row["doc"] = std::string(info.doc);
+          row["definition"] = std::string(info.definition);
+          row["source"] = std::string(info.source);
+          row["levels"] = metric_levels_text(info.levels);
+          row["legacy_name"] = std::string(info.legacy_name);
+          row["legacy_factor"] = info.legacy_factor;
+          out.append(row);
+        }
+        return out;
+      },
+      R"(The one table of a trial's results (include/calligraphy/analysis/metric_table.hpp): a list of dicts
+with ``name`` (its SI unit in it: "mean_deviation_m", "frechet_m", "total_time_s"; the key of every metrics
+dict and DataFrame column), ``kind`` ("number", "count", "flag"), ``unit``, ``doc``, ``definition``,
+``source``, ``levels`` ("scene, character, stroke", "run"), and ``legacy_name`` / ``legacy_factor``: the name
+the metric had before (in mm: value x 1000), still readable from a metrics dict with a DeprecationWarning.)");
   m.def(
       "trace_columns",
       [] {

@@ -3,6 +3,7 @@
 #include <pybind11/pybind11.h>
 
 #include <filesystem>
+#include <string>
 
 #include "calligraphy/report/teacher_recording.hpp"
 #include "calligraphy/report/trial_report.hpp"
@@ -10,6 +11,10 @@
 namespace calligraphy::python {
 
 namespace py = pybind11;
+
+/// A metrics record's JSON text as Python dicts (`calligraphy.metrics.loads`): every object a
+/// `calligraphy.metrics.Metrics`, which still reads a metric's old millimetre name with a DeprecationWarning.
+py::dict metrics_from_json(const std::string& text);
 
 /// The trial's metrics as a dict with the keys of `calligraphy trial --json`.
 py::dict trial_metrics(const TrialDescription& description, const TrialResult& result,

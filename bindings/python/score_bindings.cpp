@@ -23,6 +23,7 @@
 #include "calligraphy/report/score_report.hpp"
 #include "calligraphy/report/trace_columns.hpp"
 #include "character_source.hpp"
+#include "report_bindings.hpp"
 
 namespace calligraphy::python {
 namespace {
@@ -156,7 +157,7 @@ py::dict score_py(const py::object& trace, const py::object& character, const st
   const WritingMetrics metrics = writing_metrics(scene, samples, options);
   const ScoreDescription description{encode_utf8(placed.code_point), trace_name,
                                      units == TraceUnits::data ? "data" : "m", samples.size()};
-  return py::module_::import("json").attr("loads")(py::str(score_json(description, metrics)));
+  return metrics_from_json(score_json(description, metrics));
 }
 
 }  // namespace
@@ -182,7 +183,7 @@ acceptance: a StrokeAcceptance (default: the C++ defaults, the renderer's).
 start_radius_m: radius of the start neighbourhood a segment must enter a stroke in [m], > 0 (default the
                 scene's, 0.005).
 Returns a dict with the keys of `calligraphy score --json` (per_stroke, order_errors, backwards_strokes,
-mean_deviation_mm, frechet_mm, dtw_mm, strokes_accepted, refusals: {reason: count}, segments: one dict per
+mean_deviation_m, frechet_m, dtw_m [m], strokes_accepted, refusals: {reason: count}, segments: one dict per
 pen-down segment with begin/end sample indices (0-based, end exclusive), matched_stroke and a verdict dict
 (accepted, refusal name, expected_stroke, matched_stroke) or None; stroke numbers 1-based as in
 per_stroke's index, ...); a value that does not exist is None.

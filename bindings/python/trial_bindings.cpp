@@ -493,8 +493,8 @@ void bind_trial(py::module_& m) {
                 py::module_::import("calligraphy.frames").attr("per_stroke_dataframe")(self)};
           },
           "A pandas.DataFrame with one row per stroke, indexed by the stroke over the scene (0-based): "
-          "character, acronym, typical_id, completed, attempts, mean_deviation_mm, max_deviation_mm [mm], "
-          "time_s [s]. Raises ImportError without pandas.");
+          "character, acronym, typical_id, written, backwards, mean_deviation_m, max_deviation_m, frechet_m, "
+          "dtw_m [m], time_s [s], completed, attempts. Raises ImportError without pandas.");
 
   m.def("simulate_trial", &simulate_trial_py,
         py::arg("characters") CALLIGRAPHY_TRIAL_ARGUMENTS(CALLIGRAPHY_TRIAL_PY_ARG),

@@ -1,9 +1,10 @@
-// `calligraphy schema specification|record|protocol`: the JSON Schema (draft 2020-12) of a trial
-// specification, of a trial record's specification object or of a study protocol, made from the one schema
-// and the tables the readers and writers use (schema.hpp), or with --markdown the fields as the
-// documentation's table.
+// `calligraphy schema specification|record|protocol|metrics`: the JSON Schema (draft 2020-12) of a trial
+// specification, of a trial record's specification object, of a study protocol or of a record's metrics,
+// made from the one schema and the tables the readers and writers use (schema.hpp, metric_table.hpp), or with
+// --markdown the fields as the documentation's table.
 #include <string>
 
+#include "calligraphy/analysis/metric_table.hpp"
 #include "calligraphy/core/schema.hpp"
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/recorded_trial.hpp"
@@ -21,6 +22,11 @@ struct SchemaCommand {
 };
 
 int run_schema(const SchemaCommand& command) {
+  if (command.document == "metrics") {
+    // the metric keys of a record's scene level; the table as a whole with --markdown
+    write_output("-", command.markdown ? metric_markdown() : metric_json_schema(metric_level_scene));
+    return 0;
+  }
   if (command.document == "protocol") {
     write_output("-", command.markdown ? protocol_schema_markdown() : protocol_json_schema_text());
     return 0;
@@ -46,13 +52,15 @@ void add_schema_command(CLI::App& root, Commands& commands) {
   auto command = std::make_shared<SchemaCommand>();
   CLI::App* app = commands.add(
       root, "schema",
-      "Print the JSON Schema (2020-12) of a trial specification, a trial record or a study protocol",
+      "Print the JSON Schema (2020-12) of a trial specification, a trial record, a study protocol or a "
+      "record's metrics",
       [command] { return run_schema(*command); });
   required(add_choice(
-      *app, "DOCUMENT", command->document, {"specification", "record", "protocol"},
+      *app, "DOCUMENT", command->document, {"specification", "record", "protocol", "metrics"},
       "specification: a trial as `trial --spec` and Python state it (keys left out keep their "
       "defaults); record: the \"specification\" object of a trial record (every part required); protocol: a "
-      "study protocol file (docs/experiments.md)"));
+      "study protocol file (docs/experiments.md); metrics: the metric keys of a trial's metrics record "
+      "(docs/metrics.md; with --markdown the whole metric table)"));
   add_flag(*app, "--markdown", command->markdown, "the fields as a Markdown table instead");
 }
 

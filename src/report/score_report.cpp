@@ -14,15 +14,6 @@
 namespace calligraphy {
 namespace {
 
-nlohmann::json value_or_null(const std::optional<double>& value, double scale = 1.0) {
-  return value ? nlohmann::json(*value * scale) : nlohmann::json(nullptr);
-}
-
-// One member of a deviation summary in millimetres; null without a summary (nothing matched).
-nlohmann::json deviation_mm(const std::optional<DeviationSummary>& summary, double DeviationSummary::*member) {
-  return value_or_null(summary ? std::optional<double>((*summary).*member) : std::nullopt, 1e3);
-}
-
 std::string fixed(const std::optional<double>& value, double scale, const char* pattern) {
   if (!value) return "-";
   char text[64];
@@ -31,26 +22,9 @@ std::string fixed(const std::optional<double>& value, double scale, const char* 
 }
 
 nlohmann::json stroke_json(const StrokeScore& stroke) {
-  const auto& m = stroke.metrics;
-  const auto get = [&](auto member) -> std::optional<double> {
-    if (!m) return std::nullopt;
-    return static_cast<double>(member(*m));
-  };
-  return {{"index", stroke.index},
-          {"typical_id", stroke.typical_id},
-          {"written", stroke.written},
-          {"backwards", stroke.backwards},
-          {"mean_deviation_mm", value_or_null(get([](auto& x) { return x.deviation.mean_m; }), 1e3)},
-          {"max_deviation_mm", value_or_null(get([](auto& x) { return x.deviation.max_m; }), 1e3)},
-          {"rms_deviation_mm", value_or_null(get([](auto& x) { return x.deviation.rms_m; }), 1e3)},
-          {"outside_tube_share", value_or_null(get([](auto& x) { return x.deviation.outside_tube_share; }))},
-          {"frechet_mm", value_or_null(get([](auto& x) { return x.curves.frechet_m; }), 1e3)},
-          {"dtw_mm", value_or_null(get([](auto& x) { return x.curves.dtw_m; }), 1e3)},
-          {"time_s", value_or_null(get([](auto& x) { return x.kinematics.writing_time_s; }))},
-          {"path_length_mm", value_or_null(get([](auto& x) { return x.kinematics.path_length_m; }), 1e3)},
-          {"mean_speed_m_s", value_or_null(get([](auto& x) { return x.kinematics.mean_speed_m_per_s; }))},
-          {"velocity_peaks", m ? nlohmann::json(m->kinematics.velocity_peaks) : nlohmann::json(nullptr)},
-          {"normalised_jerk", value_or_null(get([](auto& x) { return x.kinematics.normalised_jerk; }))}};
+  nlohmann::json out = {{"index", stroke.index}, {"typical_id", stroke.typical_id}};
+  report_detail::add_metrics(out, metric_level_stroke, stroke);
+  return out;
 }
 
 constexpr StrokeRefusal kRefusals[] = {StrokeRefusal::too_short, StrokeRefusal::backwards,
@@ -72,9 +46,12 @@ nlohmann::json segments_json(const CharacterScore& score) {
     nlohmann::json verdict = nullptr;
     if (s.verdict) {
       const StrokeMatch& v = *s.verdict;
-      verdict = {{"expected_stroke", expected},        {"accepted", v.accepted},
-                 {"refusal", to_string(v.refusal)},        {"matched_stroke", v.matched_stroke},
-                 {"covered_fraction", v.covered_fraction}, {"mean_deviation_mm", v.mean_deviation_m * 1e3}};
+      verdict = {{"expected_stroke", expected},
+                 {"accepted", v.accepted},
+                 {"refusal", to_string(v.refusal)},
+                 {"matched_stroke", v.matched_stroke},
+                 {"covered_fraction", v.covered_fraction},
+                 {"mean_deviation_m", v.mean_deviation_m}};
       if (v.accepted) ++expected;
     }
     out.push_back({{"begin", s.begin},
@@ -279,36 +256,15 @@ namespace {
 
 // One character's score: every key of docs/metrics.md's per-character record.
 nlohmann::json character_object(const CharacterScore& score) {
-  const CharacterWritingMetrics& t = score.totals;
   nlohmann::json per_stroke = nlohmann::json::array();
   for (const StrokeScore& s : score.strokes) per_stroke.push_back(stroke_json(s));
-  return {{"character", encode_utf8(score.code_point)},
-          {"strokes_total", score.strokes.size()},
-          {"strokes_written", score.strokes_written},
-          {"strokes_accepted", score.strokes_accepted},
-          {"refusals", refusals_json(score.refusals)},
-          {"completed_in_order", score.completed_in_order},
-          {"strokes_in_order", score.strokes_in_order},
-          {"order_errors", score.order_errors},
-          {"backwards_strokes", score.backwards_strokes},
-          {"missing_strokes", score.missing_strokes},
-          {"unmatched_segments", score.unmatched_strokes},
-          {"ignored_segments", score.ignored_segments},
-          {"pen_lifts", t.pen_lifts},
-          {"total_time_s", t.total_time_s},
-          {"pen_down_time_s", t.writing_time_s},
-          {"in_air_time_s", t.in_air_time_s},
-          {"mean_deviation_mm", deviation_mm(t.deviation, &DeviationSummary::mean_m)},
-          {"max_deviation_mm", deviation_mm(t.deviation, &DeviationSummary::max_m)},
-          {"rms_deviation_mm", deviation_mm(t.deviation, &DeviationSummary::rms_m)},
-          {"frechet_mm", value_or_null(t.frechet_m, 1e3)},
-          {"dtw_mm", value_or_null(t.dtw_m, 1e3)},
-          {"path_length_mm", t.path_length_m * 1e3},
-          {"mean_speed_m_s", value_or_null(t.mean_speed_m_per_s)},
-          {"velocity_peaks", t.velocity_peaks},
-          {"normalised_jerk", value_or_null(t.normalised_jerk)},
-          {"per_stroke", per_stroke},
-          {"segments", segments_json(score)}};
+  nlohmann::json out = {{"character", encode_utf8(score.code_point)},
+                        {"refusals", refusals_json(score.refusals)},
+                        {"missing_strokes", score.missing_strokes},
+                        {"per_stroke", per_stroke},
+                        {"segments", segments_json(score)}};
+  report_detail::add_metrics(out, metric_level_character, score);
+  return out;
 }
 
 }  // namespace
@@ -316,24 +272,9 @@ nlohmann::json character_object(const CharacterScore& score) {
 nlohmann::json report_detail::writing_metrics_object(const WritingMetrics& m) {
   nlohmann::json characters = nlohmann::json::array();
   for (const CharacterScore& score : m.characters) characters.push_back(character_object(score));
-  return {{"strokes_total", m.strokes_total},
-          {"strokes_written", m.strokes_written},
-          {"strokes_accepted", m.strokes_accepted},
-          {"refusals", refusals_json(m.refusals)},
-          {"completed_in_order", m.completed_in_order},
-          {"order_errors", m.order_errors},
-          {"backwards_strokes", m.backwards_strokes},
-          {"unmatched_segments", m.unmatched_segments},
-          {"mean_deviation_mm", deviation_mm(m.deviation, &DeviationSummary::mean_m)},
-          {"max_deviation_mm", deviation_mm(m.deviation, &DeviationSummary::max_m)},
-          {"rms_deviation_mm", deviation_mm(m.deviation, &DeviationSummary::rms_m)},
-          {"frechet_mm", value_or_null(m.frechet_m, 1e3)},
-          {"dtw_mm", value_or_null(m.dtw_m, 1e3)},
-          {"total_time_s", m.total_time_s},
-          {"pen_down_time_s", m.pen_down_time_s},
-          {"velocity_peaks", m.velocity_peaks},
-          {"normalised_jerk", value_or_null(m.normalised_jerk)},
-          {"per_character", characters}};
+  nlohmann::json out = {{"refusals", refusals_json(m.refusals)}, {"per_character", characters}};
+  report_detail::add_metrics(out, metric_level_scene, m);
+  return out;
 }
 
 std::string writing_metrics_json(const WritingMetrics& metrics) {
@@ -341,7 +282,8 @@ std::string writing_metrics_json(const WritingMetrics& metrics) {
 }
 
 std::string score_json(const ScoreDescription& d, const WritingMetrics& metrics) {
-  nlohmann::json doc = {{"character", d.character}, {"trace", d.trace}, {"units", d.units}, {"samples", d.samples}};
+  nlohmann::json doc = {
+      {"character", d.character}, {"trace", d.trace}, {"units", d.units}, {"samples", d.samples}};
   doc.update(report_detail::writing_metrics_object(metrics));
   return doc.dump(2) + "\n";
 }

@@ -230,9 +230,9 @@ void append_trial(std::string& out, const std::vector<std::string>& conditions, 
       out,
       "<p class=\"metrics\">%s s &middot; deviation %s mm &middot; Fr&eacute;chet %s mm &middot; DTW %s mm "
       "&middot; order errors %zu &middot; backwards %zu",
-      number(trial.time_total_s, 1).c_str(), number(trial.mean_deviation_mm, 2).c_str(),
-      trial.frechet_mm ? number(*trial.frechet_mm, 2).c_str() : "&ndash;",
-      trial.dtw_mm ? number(*trial.dtw_mm, 2).c_str() : "&ndash;", trial.order_errors,
+      number(trial.time_total_s, 1).c_str(), number(trial.mean_deviation_m * 1e3, 2).c_str(),
+      trial.frechet_m ? number(*trial.frechet_m * 1e3, 2).c_str() : "&ndash;",
+      trial.dtw_m ? number(*trial.dtw_m * 1e3, 2).c_str() : "&ndash;", trial.order_errors,
       trial.backwards_strokes);
   if (trial.quiz_misses) appendf(out, " &middot; quiz misses %d", *trial.quiz_misses);
   if (!trial.completed) appendf(out, " &middot; <b>%s</b>", escape(trial.end_reason).c_str());

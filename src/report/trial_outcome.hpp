@@ -4,14 +4,19 @@
 // Internal.
 #include <nlohmann/json.hpp>
 
+#include "calligraphy/analysis/metric_table.hpp"
 #include "calligraphy/analysis/writing_metrics.hpp"
 #include "calligraphy/trial/result.hpp"
 
 namespace calligraphy::report_detail {
 
+/// The value of the run-level metric `info` (metric_level_run of the metric table) from the renderer's
+/// figures; null for a metric that is not the run's.
+MetricValue run_metric_value(const MetricInfo& info, const TrialMetrics& metrics);
+
 /// How the trial ended (`end_reason`, `aborted`, `abort_reason`), the renderer's figures
-/// (`strokes_completed`, `trial_time_s` [s], `max_force_n`, `max_force_step_n` [N], `state_transitions`) and
-/// every key of the one metrics record `writing` (metrics_object.hpp).
+/// (the metric table's run level: `strokes_completed`, `strokes_assisted`, `trial_time_s` [s], `max_force_n`,
+/// ...) and every key of the one metrics record `writing` (metrics_object.hpp).
 nlohmann::json trial_outcome_object(const TrialResult& result, const WritingMetrics& writing);
 
 /// The renderer's view of one stroke: `index`, `character`, `typical_id`, `completed` (in turn) and

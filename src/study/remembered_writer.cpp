@@ -8,6 +8,7 @@
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/study/guidance_share.hpp"
 #include "core/json_reader.hpp"
+#include "study/record_metrics.hpp"
 #include "study/saved_sessions.hpp"
 
 namespace calligraphy::study_detail {
@@ -120,7 +121,7 @@ void practise_record(WriterMemory& memory, const json& document, const std::stri
             TimingGuidance{.speed_m_s = number("timing_speed_m_s", TimingGuidance{}.speed_m_s)};
         break;
     }
-    const double deviation_m = record.number_or("mean_deviation_mm", std::nan(""), -kLimit, kLimit) * 1e-3;
+    const double deviation_m = study_detail::record_metric(record, "mean_deviation_m").value_or(std::nan(""));
     try {
       shares = guidance_shares(force, hand, deviation_m);
     } catch (const InvalidArgument& e) {

@@ -11,9 +11,10 @@
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/report/pen_trace_csv.hpp"
 #include "calligraphy/study/protocol.hpp"
-#include "core/whole_file.hpp"
 #include "core/json_reader.hpp"
+#include "core/whole_file.hpp"
 #include "study/names.hpp"
+#include "study/record_metrics.hpp"
 #include "study/saved_sessions.hpp"
 #include "study/trial_row.hpp"
 
@@ -134,9 +135,9 @@ ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifes
   trial.repetition = plan.repetition;
   trial.time_total_s = record.number("total_time_s", -1e12, 1e12);
   // null for a trial in which no stroke was written (the time ran out first): shown as such, not refused
-  trial.mean_deviation_mm = record.number_or("mean_deviation_mm", std::nan(""), -1e12, 1e12);
-  trial.frechet_mm = record.optional_number("frechet_mm", -1e12, 1e12);
-  trial.dtw_mm = record.optional_number("dtw_mm", -1e12, 1e12);
+  trial.mean_deviation_m = study_detail::record_metric(record, "mean_deviation_m").value_or(std::nan(""));
+  trial.frechet_m = study_detail::record_metric(record, "frechet_m");
+  trial.dtw_m = study_detail::record_metric(record, "dtw_m");
   trial.order_errors = static_cast<std::size_t>(record.number("order_errors", 0.0, 1e12));
   trial.backwards_strokes = static_cast<std::size_t>(record.number("backwards_strokes", 0.0, 1e12));
   trial.completed = trial.end_reason == "completed";

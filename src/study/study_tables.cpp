@@ -14,6 +14,7 @@
 #include "calligraphy/study/session_reader.hpp"
 #include "core/json_reader.hpp"
 #include "study/names.hpp"
+#include "study/record_metrics.hpp"
 #include "study/trial_row.hpp"
 
 namespace calligraphy {
@@ -22,11 +23,7 @@ namespace {
 
 using nlohmann::json;
 
-// A record's length in mm as metres; absent when missing or null.
-std::optional<double> metres(const json_detail::JsonView& object, const char* key_mm) {
-  const std::optional<double> millimetres = object.optional_number(key_mm, -1e12, 1e12);
-  return millimetres ? std::optional<double>(*millimetres * 1e-3) : std::nullopt;
-}
+using study_detail::record_metric;
 
 std::size_t count(const json_detail::JsonView& object, const char* key) {
   if (!object.has(key))
@@ -54,13 +51,13 @@ void add_strokes(const json_detail::JsonView& character, std::size_t index, cons
     row.typical_id = static_cast<int>(metrics.integer_or("typical_id", 0, 0, 39));
     row.written = metrics.boolean_or("written", false);
     row.backwards = metrics.boolean_or("backwards", false);
-    row.mean_deviation_m = metres(metrics, "mean_deviation_mm");
-    row.max_deviation_m = metres(metrics, "max_deviation_mm");
-    row.rms_deviation_m = metres(metrics, "rms_deviation_mm");
-    row.frechet_m = metres(metrics, "frechet_mm");
-    row.dtw_m = metres(metrics, "dtw_mm");
-    row.path_length_m = metres(metrics, "path_length_mm");
-    row.time_s = metrics.optional_number("time_s", -1e12, 1e12);
+    row.mean_deviation_m = record_metric(metrics, "mean_deviation_m");
+    row.max_deviation_m = record_metric(metrics, "max_deviation_m");
+    row.rms_deviation_m = record_metric(metrics, "rms_deviation_m");
+    row.frechet_m = record_metric(metrics, "frechet_m");
+    row.dtw_m = record_metric(metrics, "dtw_m");
+    row.path_length_m = record_metric(metrics, "path_length_m");
+    row.time_s = record_metric(metrics, "time_s");
     strokes.push_back(std::move(row));
   }
   const json_detail::JsonView segments = character.array("segments");
@@ -121,11 +118,11 @@ TrialRow study_detail::trial_row(const json& document, const std::string& source
   row.order_errors = count(record, "order_errors");
   row.backwards_strokes = count(record, "backwards_strokes");
   row.unmatched_segments = count(record, "unmatched_segments");
-  row.mean_deviation_m = metres(record, "mean_deviation_mm");
-  row.max_deviation_m = metres(record, "max_deviation_mm");
-  row.rms_deviation_m = metres(record, "rms_deviation_mm");
-  row.frechet_m = metres(record, "frechet_mm");
-  row.dtw_m = metres(record, "dtw_mm");
+  row.mean_deviation_m = record_metric(record, "mean_deviation_m");
+  row.max_deviation_m = record_metric(record, "max_deviation_m");
+  row.rms_deviation_m = record_metric(record, "rms_deviation_m");
+  row.frechet_m = record_metric(record, "frechet_m");
+  row.dtw_m = record_metric(record, "dtw_m");
   row.total_time_s = record.number("total_time_s", -1e12, 1e12);
   row.pen_down_time_s = record.number("pen_down_time_s", -1e12, 1e12);
   row.velocity_peaks = static_cast<int>(count(record, "velocity_peaks"));

@@ -14,6 +14,7 @@
 #include "calligraphy/trial/trial_spec_runner.hpp"
 #include "core/json_reader.hpp"
 #include "study/names.hpp"
+#include "study/record_metrics.hpp"
 #include "study/saved_sessions.hpp"
 
 namespace calligraphy::study_detail {
@@ -106,17 +107,16 @@ PreparedGuidance repetition_guidance(const StudyCondition& condition, const Plan
   if (condition.mode == ConditionMode::fading) prepared.previous_gain = guidance.number("gain", 0.0, 1e6);
   if (condition.mode == ConditionMode::assist_as_needed)
     prepared.previous_band_m = guidance.number("band_m", 0.0, 1e6);
-  if (!record.json().contains("mean_deviation_mm"))
-    json_detail::fail(source, "/mean_deviation_mm", "missing (required): no mean deviation to adapt from");
-  // null when the repetition wrote nothing
-  const std::optional<double> deviation_mm = record.optional_number("mean_deviation_mm", -1e12, 1e12);
-  prepared.previous_deviation_mm = deviation_mm ? json(*deviation_mm) : json(nullptr);
+  if (!study_detail::contains_metric(record, "mean_deviation_m"))
+    json_detail::fail(source, "/mean_deviation_m", "missing (required): no mean deviation to adapt from");
+  // null when the repetition wrote nothing; a record older than the metric table gives it in mm
+  const std::optional<double> deviation_m = study_detail::record_metric(record, "mean_deviation_m");
+  prepared.previous_deviation_m = deviation_m ? json(*deviation_m) : json(nullptr);
   if (!adapts_by_repetition(condition.mode)) return prepared;
   RepetitionGuidance before = first;
   before.gain = condition.mode == ConditionMode::fading ? prepared.previous_gain : first.gain;
   before.band_m = condition.mode == ConditionMode::assist_as_needed ? prepared.previous_band_m : first.band_m;
-  const RepetitionGuidance following =
-      schedule.next(before, deviation_mm ? std::optional<double>(*deviation_mm * 1e-3) : std::nullopt);
+  const RepetitionGuidance following = schedule.next(before, deviation_m);
   prepared.guidance.gain = following.gain;
   prepared.guidance.band_m = following.band_m;
   if (condition.mode == ConditionMode::skill_adaptive) prepared.guidance.mode = following.mode;
@@ -220,7 +220,7 @@ json guidance_record_json(const StudyCondition& condition, const PreparedGuidanc
       if (condition.mode == ConditionMode::fading) guidance["previous_gain"] = prepared.previous_gain;
       if (condition.mode == ConditionMode::assist_as_needed)
         guidance["previous_band_m"] = prepared.previous_band_m;
-      guidance["previous_mean_deviation_mm"] = prepared.previous_deviation_mm;
+      guidance["previous_mean_deviation_m"] = prepared.previous_deviation_m;
     }
   }
   return guidance;

@@ -25,8 +25,8 @@ struct PreparedGuidance {
   // fading, assist-as-needed, skill-adaptive
   std::string previous_trial;  ///< file stem of the repetition the guidance follows from; empty for the first
   double previous_gain = 0.0;  ///< fading
-  double previous_band_m = 0.0;          ///< assist-as-needed
-  nlohmann::json previous_deviation_mm;  ///< null when the previous repetition wrote no stroke
+  double previous_band_m = 0.0;         ///< assist-as-needed
+  nlohmann::json previous_deviation_m;  ///< [m]; null when the previous repetition wrote no stroke
   // replay
   std::string teacher_file;    ///< relative to the session folder: "teachers/....json"
   std::string teacher_sha256;  ///< of the file's bytes

@@ -28,6 +28,7 @@ import os
 import typing
 
 from ._calligraphy import CharacterLibrary, ForceLawParameters, WriterProfile, simulate_trial
+from .metrics import metric_frame
 
 if typing.TYPE_CHECKING:  # pragma: no cover
     import pandas
@@ -396,7 +397,8 @@ def sweep(characters: typing.Union[str, typing.Sequence[str], None],
         record["error"] = row.get("error")
         records.append(record)
     table = pandas.DataFrame.from_records(records, columns=parameter_columns + metric_columns + ["error"])
-    return table.astype(_nullable_types(sample, metric_columns))
+    # old millimetre columns (mean_deviation_mm) still read, with a DeprecationWarning, for one version
+    return metric_frame(table.astype(_nullable_types(sample, metric_columns)))
 
 
 def _nullable_types(sample: dict[str, typing.Any], columns: list[str]) -> dict[str, str]:

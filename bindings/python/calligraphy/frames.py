@@ -10,6 +10,9 @@ import typing
 
 import numpy as np
 
+from ._calligraphy import metric_table
+from .metrics import metric_frame
+
 if typing.TYPE_CHECKING:  # pragma: no cover
     import pandas
 
@@ -65,6 +68,10 @@ def trial_dataframe(result: TrialResult) -> pandas.DataFrame:
     )
 
 
+# Every stroke-level metric of the metric table, in its order: the per-stroke table's metric columns.
+_STROKE_METRICS = [row["name"] for row in metric_table() if "stroke" in row["levels"].split(", ")]
+
+
 def per_stroke_dataframe(result: TrialResult) -> pandas.DataFrame:
     """One row per stroke of the scene, indexed by the stroke over the scene (0-based, named
     ``stroke`` as in ``trial_dataframe``): what was written, from the one metrics record
@@ -72,8 +79,11 @@ def per_stroke_dataframe(result: TrialResult) -> pandas.DataFrame:
     (``result.metrics['renderer_strokes']``).
 
     Columns: ``character`` (str), ``acronym`` of its typical stroke, ``typical_id`` (1..39),
-    ``written`` and ``backwards`` (bool), ``mean_deviation_mm``, ``max_deviation_mm``, ``frechet_mm`` and
-    ``dtw_mm`` [mm] (NaN for a stroke not written), ``time_s`` [s] (its pen-down writing time),
+    then every stroke-level metric of the metric table (``calligraphy.metric_table()``, docs/metrics.md) under
+    its name, in SI units: ``written`` and ``backwards`` (bool), ``mean_deviation_m``, ``max_deviation_m``,
+    ``rms_deviation_m``, ``outside_tube_share``, ``frechet_m``, ``dtw_m``, ``path_length_m`` [m], ``time_s``
+    [s] (its pen-down writing time), ``mean_speed_m_s``, ``velocity_peaks``, ``normalised_jerk`` (None for a
+    stroke not written; the old ``*_mm`` columns still read, in mm, with a DeprecationWarning), then
     ``completed`` (bool, the renderer completed it in turn) and ``attempts`` (int). Raises ImportError when
     pandas is missing.
     """
@@ -93,16 +103,11 @@ def per_stroke_dataframe(result: TrialResult) -> pandas.DataFrame:
                     "typical_id": entry["typical_id"],
                     "written": entry["written"],
                     "backwards": entry["backwards"],
-                    "mean_deviation_mm": entry["mean_deviation_mm"],
-                    "max_deviation_mm": entry["max_deviation_mm"],
-                    "frechet_mm": entry["frechet_mm"],
-                    "dtw_mm": entry["dtw_mm"],
-                    "time_s": entry["time_s"],
+                    **{name: entry[name] for name in _STROKE_METRICS},
                     "completed": live["completed"],
                     "attempts": live["attempts"],
                 }
             )
             stroke += 1
-    columns = ["stroke", "character", "acronym", "typical_id", "written", "backwards", "mean_deviation_mm",
-               "max_deviation_mm", "frechet_mm", "dtw_mm", "time_s", "completed", "attempts"]
-    return pandas.DataFrame(rows, columns=columns).set_index("stroke")
+    columns = ["stroke", "character", "acronym", "typical_id", *_STROKE_METRICS, "completed", "attempts"]
+    return metric_frame(pandas.DataFrame(rows, columns=columns).set_index("stroke"))

@@ -152,7 +152,7 @@ def trial(result: TrialResult, scene: Scene | None = None, ax: matplotlib.axes.A
     ax.set_xlabel("x [mm]")
     ax.set_ylabel("y [mm]")
     m = result.metrics
-    deviation = "-" if m["mean_deviation_mm"] is None else f"{m['mean_deviation_mm']:.2f} mm"
+    deviation = "-" if m["mean_deviation_m"] is None else f"{m['mean_deviation_m'] * 1e3:.2f} mm"
     title = (f"{m['character']}: {m['strokes_completed']}/{m['strokes_total']} strokes, mean deviation "
              f"{deviation}, {m['total_time_s']:.1f} s")
     ax.set_title(title, **_text_font(title))

@@ -1,8 +1,8 @@
 #pragma once
 /// \file score_report.hpp
-/// Reports of a scored pen trace (`writing_metrics`, analysis/writing_metrics.hpp): a table for people and the
-/// one metrics record as JSON, which `trial_json` (trial_report.hpp) and study records also carry. What `calligraphy score` prints
-/// and writes; definitions of the metrics: docs/metrics.md.
+/// Reports of a scored pen trace (`writing_metrics`, analysis/writing_metrics.hpp): a table for people and
+/// the one metrics record as JSON, which `trial_json` (trial_report.hpp) and study records also carry. What
+/// `calligraphy score` prints and writes; definitions of the metrics: docs/metrics.md.
 #include <cstddef>
 #include <string>
 
@@ -31,11 +31,10 @@ struct ScoreDescription {
 std::string score_table(const ScoreDescription& description, const WritingMetrics& metrics);
 
 /// The one metrics record (writing_metrics.hpp) as a JSON object (2-space indent, newline-terminated), the
-/// keys docs/metrics.md lists: the scene's totals (`strokes_total`, `strokes_written`, `strokes_accepted`,
-/// `refusals`, `completed_in_order`, `order_errors`, `backwards_strokes`, `unmatched_segments`,
-/// `mean_deviation_mm`, `max_deviation_mm`, `rms_deviation_mm`, `frechet_mm`, `dtw_mm`, `total_time_s`,
-/// `pen_down_time_s`, `velocity_peaks`, `normalised_jerk`) and `per_character`, one object per character with
-/// its own totals, `per_stroke` and `segments`. Every index is 0-based; a value that does not exist (nothing
+/// keys docs/metrics.md lists: the scene's totals (every metric of the metric table at the scene level,
+/// analysis/metric_table.hpp, under its name and in its SI unit, and `refusals`) and `per_character`, one
+/// object per character with its own metrics, `refusals`, `missing_strokes`, `per_stroke` (each stroke's
+/// metrics) and `segments`. Every index is 0-based; a value that does not exist (nothing
 /// matched) is null. `calligraphy trial --json`, `calligraphy score --json`, study trial records and Python
 /// all carry these keys with these values.
 std::string writing_metrics_json(const WritingMetrics& metrics);

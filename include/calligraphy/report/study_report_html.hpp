@@ -49,10 +49,10 @@ struct ReportTrial {
   std::vector<bool> pen_down;                  ///< the tip touched the paper
   std::vector<double> in_plane_force_n;        ///< |(Fx, Fy)| commanded [N]
   std::vector<ReportStrokeSpan> strokes;
-  double time_total_s = 0.0;       ///< the trial's writing time [s]
-  double mean_deviation_mm = 0.0;  ///< the trial's mean deviation [mm]; NaN when it wrote no stroke
-  std::optional<double> frechet_mm;
-  std::optional<double> dtw_mm;
+  double time_total_s = 0.0;        ///< the trial's writing time [s]
+  double mean_deviation_m = 0.0;    ///< the trial's mean deviation [m]; NaN when it wrote no stroke
+  std::optional<double> frechet_m;  ///< [m]
+  std::optional<double> dtw_m;      ///< [m]
   std::size_t order_errors = 0;
   std::size_t backwards_strokes = 0;
   bool completed = false;
