@@ -17,8 +17,8 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/report/study_report_html.hpp"
 #include "calligraphy/report/trace_hdf5.hpp"
-#include "calligraphy/study/protocol.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/session_reader.hpp"
 #include "calligraphy/study/session_runner.hpp"
 #include "calligraphy/study/session_series.hpp"
@@ -134,11 +134,11 @@ TEST_CASE("a session stopped mid-trial resumes without losing or overwriting a s
   for (const PlannedTrial& trial : resumed.plan()) {
     const auto record = nlohmann::json::parse(read(resumed.trial_file(trial, "json")));
     for (const char* key :
-         {"frechet_mm", "dtw_mm", "order_errors", "backwards_strokes", "total_time_s", "mean_deviation_mm",
+         {"frechet_m", "dtw_m", "order_errors", "backwards_strokes", "total_time_s", "mean_deviation_m",
           "start_time_utc", "force_law", "renderer", "scene", "writer"}) {
       CHECK(record.contains(key));
     }
-    CHECK(record["frechet_mm"].is_number());
+    CHECK(record["frechet_m"].is_number());
     CHECK(record["protocol"]["sha256"] == protocol.sha256);
     CHECK(record["device"]["info"]["max_force_n"].get<double>() > 0.0);
     CHECK(record["force_law"]["guidance"] == (trial.condition == "haptic"));
@@ -229,9 +229,10 @@ TEST_CASE("a device lost mid-trial keeps the attempt and stops the session namin
   setup.device = "probe";
   SessionFolder session = SessionFolder::create(temp.path, setup, small_protocol());
   DeviceRegistry registry;
-  registry.register_device("probe", test::ProbeDevice().info(),
-                           [] { return std::make_unique<test::ProbeDevice>(/*fail_on_read=*/700); },
-                           DeviceCapabilities{.moved_by_simulated_hand = true});
+  registry.register_device(
+      "probe", test::ProbeDevice().info(),
+      [] { return std::make_unique<test::ProbeDevice>(/*fail_on_read=*/700); },
+      DeviceCapabilities{.moved_by_simulated_hand = true});
   SessionRunOptions options = study_test::run_options();
   options.registry = &registry;
   const SessionRunResult result = run_session(session, options);
@@ -333,9 +334,9 @@ TEST_CASE("a fading gain follows the previous repetition of the item, the same a
       CHECK(gain == fade.start_gain);
       CHECK(record["guidance"]["previous_trial"].is_null());
     } else {
-      CHECK(gain == next_guidance_gain(before->second.first, before->second.second * 1e-3, fade.fading_rule));
+      CHECK(gain == next_guidance_gain(before->second.first, before->second.second, fade.fading_rule));
     }
-    previous[trial.characters] = {gain, record["mean_deviation_mm"].get<double>()};
+    previous[trial.characters] = {gain, record["mean_deviation_m"].get<double>()};
     CHECK(record_of(resumed, trial)["guidance"] == record["guidance"]);
   }
 }
@@ -369,33 +370,31 @@ TEST_CASE("an assist band and a skill-adaptive mode follow the previous repetiti
 
   const StudyCondition& band = protocol.protocol.condition("band");
   const StudyCondition& adapt = protocol.protocol.condition("adapt");
-  // condition and item -> (band [m], mean deviation [mm]) of the previous repetition
+  // condition and item -> (band [m], mean deviation [m]) of the previous repetition
   std::map<std::pair<std::string, std::u32string>, std::pair<double, double>> previous;
   std::set<std::string> adaptive_modes;
   for (const PlannedTrial& trial : whole.plan()) {
     const auto record = record_of(whole, trial);
     const auto key = std::make_pair(trial.condition, trial.characters);
     const auto before = previous.find(key);
-    const double deviation_mm = record["mean_deviation_mm"].get<double>();
+    const double deviation_m = record["mean_deviation_m"].get<double>();
     if (trial.condition == "band") {
       const double b = record["guidance"]["band_m"].get<double>();
       CHECK(record["force_law"]["guidance_mode"] == "assist-as-needed");
       CHECK(record["force_law"]["assist_band_m"].get<double>() == b);
-      CHECK(b ==
-            (before == previous.end()
-                 ? band.start_band_m
-                 : next_assist_band(before->second.first, before->second.second * 1e-3, band.assist_rule)));
-      previous[key] = {b, deviation_mm};
+      CHECK(b == (before == previous.end()
+                      ? band.start_band_m
+                      : next_assist_band(before->second.first, before->second.second, band.assist_rule)));
+      previous[key] = {b, deviation_m};
     } else if (trial.condition == "adapt") {
       const std::string selected = record["guidance"]["selected_mode"].get<std::string>();
       CHECK(record["force_law"]["guidance_mode"] == selected);
       const std::string expected =
-          before == previous.end()
-              ? "fixed"
-              : to_string(skill_adaptive_mode(before->second.second * 1e-3, adapt.skill_rule));
+          before == previous.end() ? "fixed"
+                                   : to_string(skill_adaptive_mode(before->second.second, adapt.skill_rule));
       CHECK(selected == expected);
       adaptive_modes.insert(selected);
-      previous[key] = {0.0, deviation_mm};
+      previous[key] = {0.0, deviation_m};
     } else {
       CHECK(record["force_law"]["guidance_mode"] == "timing");
       CHECK(record["force_law"]["timing_speed_m_s"].get<double>() == 0.03);

@@ -12,10 +12,11 @@
 #include <sstream>
 #include <string>
 
+#include "calligraphy/analysis/metric_table.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/study/protocol.hpp"
-#include "core/whole_file.hpp"
 #include "calligraphy/study/session_runner.hpp"
+#include "core/whole_file.hpp"
 #include "study_test_devices.hpp"
 #include "temp_folder.hpp"
 
@@ -69,7 +70,7 @@ TEST_CASE("a study's tidy tables hold every saved trial with its record's metric
     CHECK(row.item >= 1);
     CHECK(row.strokes_total == record["strokes_total"].get<std::size_t>());
     REQUIRE(row.mean_deviation_m.has_value());
-    CHECK(*row.mean_deviation_m == Approx(record["mean_deviation_mm"].get<double>() * 1e-3).epsilon(1e-12));
+    CHECK(*row.mean_deviation_m == record["mean_deviation_m"].get<double>());
     CHECK(row.total_time_s == record["total_time_s"].get<double>());
     CHECK(fs::exists(row.trace_file));
     // The record binds its trace: the SHA-256 of the file's bytes as saved.
@@ -101,6 +102,113 @@ TEST_CASE("a table field with a comma or a quote is quoted, and a missing metric
   const std::string csv = trials_csv(tables);
   CHECK(csv.find("\"/data/a,b \"\"c\"\".csv\"") != std::string::npos);
   CHECK(csv.find(",,,,,") != std::string::npos);  // the five absent deviations
+}
+
+namespace {
+
+// Every metric of `value` (at any depth) under its name moved to its legacy name in its legacy unit, as a
+// record written before the metric table held it.
+void to_legacy(nlohmann::json& value, std::size_t& moved) {
+  if (value.is_array()) {
+    for (nlohmann::json& element : value) to_legacy(element, moved);
+    return;
+  }
+  if (!value.is_object()) return;
+  for (const MetricInfo& info : metric_table()) {
+    const std::string name(info.name);
+    if (info.legacy_name.empty() || !value.contains(name)) continue;
+    const nlohmann::json v = value[name];
+    value.erase(name);
+    value[std::string(info.legacy_name)] =
+        v.is_null() ? v : nlohmann::json(v.get<double>() * info.legacy_factor);
+    ++moved;
+  }
+  for (auto& member : value.items()) to_legacy(member.value(), moved);
+}
+
+std::vector<std::string> header(const std::string& csv) {
+  std::vector<std::string> out;
+  std::istringstream line(csv.substr(0, csv.find('\n')));
+  for (std::string column; std::getline(line, column, ',');) out.push_back(column);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("a record written before the metric table, its lengths in mm, gives the same rows",
+          "[study][tables]") {
+  TempFolder temp;
+  const LoadedProtocol protocol = protocol_from_text(
+      R"({"name": "legacy", "conditions": [{"name": "haptic", "mode": "haptic"}],
+          "test": {"characters": ["十"], "conditions": ["haptic"], "repetitions": 1},
+          "trial": {"max_duration_s": 40}})",
+      "legacy.json");
+  SessionSetup setup;
+  setup.subject = {"S01", 1};
+  setup.writer_seed = subject_seed("S01");
+  SessionFolder session = SessionFolder::create(temp.path / "S01", setup, protocol);
+  (void)run_session(session, study_test::run_options());
+  const StudyTables now = read_study_tables({temp.path});
+  REQUIRE(now.trials.size() == 1);
+  const fs::path record_file =
+      fs::path(now.trials[0].trace_file).replace_extension().replace_extension(".json");
+  nlohmann::json record = read_json(record_file);
+  std::size_t moved = 0;
+  to_legacy(record, moved);
+  REQUIRE(moved > 10);
+  REQUIRE(record.contains("mean_deviation_mm"));
+  REQUIRE_FALSE(record.contains("mean_deviation_m"));
+  std::ofstream(record_file, std::ios::binary | std::ios::trunc) << record.dump(2);
+  const StudyTables before = read_study_tables({temp.path});
+  REQUIRE(before.trials.size() == 1);
+  const auto same = [](const std::optional<double>& a, const std::optional<double>& b) {
+    REQUIRE(a.has_value() == b.has_value());
+    if (a) CHECK(*a == Approx(*b).epsilon(1e-15));
+  };
+  const TrialRow& a = now.trials[0];
+  const TrialRow& b = before.trials[0];
+  REQUIRE(a.mean_deviation_m.has_value());
+  same(a.mean_deviation_m, b.mean_deviation_m);
+  same(a.max_deviation_m, b.max_deviation_m);
+  same(a.rms_deviation_m, b.rms_deviation_m);
+  same(a.frechet_m, b.frechet_m);
+  same(a.dtw_m, b.dtw_m);
+  REQUIRE(now.strokes.size() == before.strokes.size());
+  for (std::size_t i = 0; i < now.strokes.size(); ++i) {
+    same(now.strokes[i].mean_deviation_m, before.strokes[i].mean_deviation_m);
+    same(now.strokes[i].path_length_m, before.strokes[i].path_length_m);
+    same(now.strokes[i].frechet_m, before.strokes[i].frechet_m);
+  }
+}
+
+TEST_CASE("the tables' metric columns are the metric table's names", "[study][tables][metric]") {
+  const StudyTables empty;
+  const std::vector<std::string> trials = header(trials_csv(empty));
+  const std::vector<std::string> strokes = header(strokes_csv(empty));
+  const auto has = [](const std::vector<std::string>& columns, std::string_view name) {
+    return std::find(columns.begin(), columns.end(), name) != columns.end();
+  };
+  for (const MetricInfo& info : metric_table()) {
+    INFO(info.name);
+    // every total of the scene is a column of the trials' table
+    if (info.at(metric_level_scene)) CHECK(has(trials, info.name));
+    // no column keeps a name the table retired
+    if (!info.legacy_name.empty()) {
+      CHECK_FALSE(has(trials, info.legacy_name));
+      CHECK_FALSE(has(strokes, info.legacy_name));
+    }
+  }
+  // every column with a unit suffix that names a metric names it as the table does, at the table's level
+  for (const std::string& column : strokes) {
+    const std::optional<MetricInfo> found = find_metric(column);
+    if (found) {
+      INFO(column);
+      CHECK(found->name == column);
+      CHECK(found->at(metric_level_stroke));
+    }
+  }
+  CHECK(has(strokes, "mean_deviation_m"));
+  CHECK(has(trials, "strokes_assisted"));
 }
 
 TEST_CASE("a folder without a session is named", "[study][tables]") {

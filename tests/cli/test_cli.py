@@ -170,7 +170,7 @@ class StrictOptions(CliTestCase):
         rounded = self.trial_json("乙", "--seed", seed - 1)
         self.assertEqual(exact["seed"], seed)
         self.assertEqual(rounded["seed"], seed - 1)
-        self.assertNotEqual(exact["mean_deviation_mm"], rounded["mean_deviation_mm"],
+        self.assertNotEqual(exact["mean_deviation_m"], rounded["mean_deviation_m"],
                             "neighbouring seeds gave the same trial")
 
     def test_watchdog_only_with_real_time_pacing(self):
@@ -395,8 +395,8 @@ class Score(CliTestCase):
 
     # The keys of the one metrics record (docs/metrics.md): `trial`, `score` and a session's records carry them.
     METRIC_KEYS = ("strokes_total", "strokes_written", "strokes_accepted", "refusals", "completed_in_order",
-                   "order_errors", "backwards_strokes", "unmatched_segments", "mean_deviation_mm",
-                   "max_deviation_mm", "rms_deviation_mm", "frechet_mm", "dtw_mm", "total_time_s",
+                   "order_errors", "backwards_strokes", "unmatched_segments", "mean_deviation_m",
+                   "max_deviation_m", "rms_deviation_m", "frechet_m", "dtw_m", "total_time_s",
                    "pen_down_time_s", "velocity_peaks", "normalised_jerk", "per_character")
 
     def test_a_trials_csv_scores_to_the_trials_own_metrics(self):
@@ -413,7 +413,7 @@ class Score(CliTestCase):
                 assert_same_record(self, score[key], metrics[key], f"{characters}: {key}")
             self.assertEqual(len(score["per_character"]), len(characters))
             self.assertGreater(score["strokes_written"], 0)
-            self.assertLessEqual(score["mean_deviation_mm"], score["max_deviation_mm"])
+            self.assertLessEqual(score["mean_deviation_m"], score["max_deviation_m"])
             # Indices count from 0 everywhere.
             self.assertEqual([s["index"] for s in score["per_character"][0]["per_stroke"]],
                              list(range(score["per_character"][0]["strokes_total"])))
@@ -424,7 +424,7 @@ class Score(CliTestCase):
         self.assertEqual(score["strokes_written"], len(model["strokes"]))
         self.assertTrue(score["completed_in_order"])
         # Samples on the elements themselves: only rounding to 1e-4 data units (6e-6 mm) remains.
-        self.assertLess(score["max_deviation_mm"], 1e-3)
+        self.assertLess(score["max_deviation_m"], 1e-6)
         self.assertEqual(score["per_character"][0]["pen_lifts"], len(model["strokes"]) - 1)
 
     def test_order_and_direction_errors_are_counted(self):
@@ -598,7 +598,7 @@ class GuidanceModesAndWriters(CliTestCase):
             faded = self.trial_json(character, "--seed", "5", "--guidance-mode", "fading", "--guidance-gain", "0")
             full = self.trial_json(character, "--seed", "5", "--guidance-mode", "fading", "--guidance-gain", "1")
             self.assertEqual((faded["guidance_gain"], full["guidance_gain"]), (0.0, 1.0))
-            self.assertGreater(faded["mean_deviation_mm"], full["mean_deviation_mm"], character)
+            self.assertGreater(faded["mean_deviation_m"], full["mean_deviation_m"], character)
 
     def test_usage_errors(self):
         self.assert_usage_error(["trial", "十", "--guidance", "off", "--guidance-mode", "fading"], "--guidance-mode")

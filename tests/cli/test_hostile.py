@@ -255,10 +255,10 @@ class HonestResults(HostileTestCase):
         self.assertEqual(doc["strokes_completed"], 0)
         self.assertEqual(doc["strokes_assisted"], 5)
         self.assertFalse(doc["completed_in_order"])
-        self.assertIsNone(doc["mean_deviation_mm"])
-        self.assertIsNone(doc["max_deviation_mm"])
+        self.assertIsNone(doc["mean_deviation_m"])
+        self.assertIsNone(doc["max_deviation_m"])
         for stroke in doc["per_character"][0]["per_stroke"]:
-            self.assertIsNone(stroke["mean_deviation_mm"])
+            self.assertIsNone(stroke["mean_deviation_m"])
             self.assertIsNone(stroke["time_s"])
 
 

@@ -220,7 +220,7 @@ class TheTeachersScore(PeopleTestCase):
         self.assertLess(abs(float(off.group(1)) - 4.0), 0.5, text)  # the median is not the fitted stroke
         # The same deviation as the JSON's verdict on that pen-down.
         (first,) = [s for s in score["per_character"][0]["segments"] if s["verdict"]][:1]
-        self.assertEqual(off.group(1), "%.1f" % first["verdict"]["mean_deviation_mm"])
+        self.assertEqual(off.group(1), "%.1f" % (first["verdict"]["mean_deviation_m"] * 1e3))
         self.assertNotRegex(rows[0], r"\bno\b", text)
         # Stroke 2: refused, written before stroke 1 was accepted.
         self.assertRegex(rows[1], r"refused", text)

@@ -42,7 +42,7 @@ def test_one_row_per_stroke(result):
     assert list(frame["acronym"]) == [s.acronym for s in scene.strokes]
     written = [entry for character in result.metrics["per_character"] for entry in character["per_stroke"]]
     for stroke, entry, live in zip(frame.itertuples(), written, result.metrics["renderer_strokes"]):
-        assert stroke.mean_deviation_mm == entry["mean_deviation_mm"]
+        assert stroke.mean_deviation_m == entry["mean_deviation_m"]
         assert stroke.completed == live["completed"] and stroke.attempts == live["attempts"]
     # The renderer's last attempt at each stroke, which stroke_trace_range locates in the trace: its ticks are
     # all of that stroke.

@@ -73,7 +73,7 @@ def test_fading_gain_scales_the_guidance():
     """Less guidance, more deviation: on average over seeds, gain 0 deviates more than gain 1."""
     def mean_deviation(gain):
         return statistics.mean(
-            trial(guidance_mode="fading", guidance_gain=gain, seed=seed).metrics["mean_deviation_mm"]
+            trial(guidance_mode="fading", guidance_gain=gain, seed=seed).metrics["mean_deviation_m"]
             for seed in range(4))
 
     assert mean_deviation(0.0) > mean_deviation(1.0)

@@ -12,8 +12,8 @@ import calligraphy
 
 # The keys of the one metrics record.
 RECORD_KEYS = ("strokes_total", "strokes_written", "strokes_accepted", "refusals", "completed_in_order",
-               "order_errors", "backwards_strokes", "unmatched_segments", "mean_deviation_mm", "max_deviation_mm",
-               "rms_deviation_mm", "frechet_mm", "dtw_mm", "total_time_s", "pen_down_time_s", "velocity_peaks",
+               "order_errors", "backwards_strokes", "unmatched_segments", "mean_deviation_m", "max_deviation_m",
+               "rms_deviation_m", "frechet_m", "dtw_m", "total_time_s", "pen_down_time_s", "velocity_peaks",
                "normalised_jerk", "per_character")
 SOURCE = Path(__file__).resolve().parents[2]
 

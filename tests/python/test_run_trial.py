@@ -7,7 +7,7 @@ import calligraphy
 def test_run_trial_on_the_simulated_device_is_simulate_trial():
     by_name = calligraphy.run_trial("九", device="simulated", seed=2, keep_trace=False)
     simulated = calligraphy.simulate_trial("九", seed=2, keep_trace=False)
-    for key in ("mean_deviation_mm", "total_time_s", "strokes_completed", "end_reason"):
+    for key in ("mean_deviation_m", "total_time_s", "strokes_completed", "end_reason"):
         assert by_name.metrics[key] == simulated.metrics[key]
     assert by_name.metrics["device"] == "simulated"
 

@@ -40,13 +40,13 @@ def test_reference_scores_complete_in_order_near_zero():
     result = calligraphy.score(reference_trace("木"), "木")
     assert result["completed_in_order"] is True
     assert result["order_errors"] == 0
-    assert result["mean_deviation_mm"] < 0.05
+    assert result["mean_deviation_m"] < 0.05e-3
 
 
 def test_offset_of_one_millimetre_is_measured():
     result = calligraphy.score(reference_trace("木", offset_m=0.001), "木")
-    assert result["mean_deviation_mm"] == pytest.approx(1.0, abs=0.1)
-    assert result["frechet_mm"] == pytest.approx(1.0, abs=0.15)
+    assert result["mean_deviation_m"] == pytest.approx(1e-3, abs=0.1e-3)
+    assert result["frechet_m"] == pytest.approx(1e-3, abs=0.15e-3)
 
 
 def test_swapped_and_reversed_strokes_are_found():
@@ -106,8 +106,8 @@ def test_dataframe_and_csv_give_the_dict_result(tmp_path):
     path = tmp_path / "trace.csv"
     frame.to_csv(path, index=False, float_format="%.17g")
     by_file = calligraphy.score(path, "大")
-    assert by_frame["mean_deviation_mm"] == by_dict["mean_deviation_mm"]
-    assert by_file["mean_deviation_mm"] == pytest.approx(by_dict["mean_deviation_mm"], rel=1e-12)
+    assert by_frame["mean_deviation_m"] == by_dict["mean_deviation_m"]
+    assert by_file["mean_deviation_m"] == pytest.approx(by_dict["mean_deviation_m"], rel=1e-12)
     assert by_file["trace"] == str(path)
 
 

@@ -23,7 +23,7 @@ def test_a_custom_writer_changes_the_trial_and_is_named():
     novice = calligraphy.simulate_trial("九", writer="novice", seed=4, guidance=False, keep_trace=False)
     assert result.metrics["writer"] == "steady"
     # Without the systematic bias the unguided writer stays closer to the reference.
-    assert result.metrics["mean_deviation_mm"] < novice.metrics["mean_deviation_mm"]
+    assert result.metrics["mean_deviation_m"] < novice.metrics["mean_deviation_m"]
 
 
 def test_device_parameters_reach_the_trial():

@@ -51,7 +51,7 @@ def test_the_tables_are_the_cli_tables_and_the_records(cli, study_folder):
     assert set(study.trials["subject"]) == {"S01", "S02"}
     for _, row in study.trials.iterrows():
         record = json.loads(record_path(row["trace_file"]).read_text(encoding="utf-8"))
-        assert row["mean_deviation_m"] == pytest.approx(record["mean_deviation_mm"] * 1e-3, rel=1e-12)
+        assert row["mean_deviation_m"] == record["mean_deviation_m"]
         assert row["total_time_s"] == record["total_time_s"]
         # Indices count from 1, as the record's and the file's (001-..., r1).
         assert row["repetition"] == record["repetition"] == record["trial"]["repetition"]
@@ -126,7 +126,7 @@ def test_a_damaged_record_is_a_data_error_naming_the_file_and_pointer(study_fold
     text = record.read_text(encoding="utf-8")
     for old, new, pointer in [('"format": "calligraphy-study-trial"', '"format": 5', "/format"),
                               ('"per_character": [', '"per_character": "x", "was": [', "/per_character"),
-                              ('"mean_deviation_mm": ', '"mean_deviation_mm": 1e999, "was": ', "/mean_deviation_mm"),
+                              ('"mean_deviation_m": ', '"mean_deviation_m": 1e999, "was": ', "/mean_deviation_m"),
                               ('"end_reason": "', '"end_reason": [], "was": "', "/end_reason")]:
         compact = json.dumps(json.loads(text))  # one spelling of the separators for the replacements
         assert old in compact, old

@@ -54,7 +54,7 @@ def test_rows_are_the_trials_metrics(local_table):
     for _, row in local_table[local_table.character != "\u00e9"].iterrows():
         metrics = calligraphy.simulate_trial(row.character, guidance=bool(row.guidance), seed=int(row.seed),
                                              force_law=law, keep_trace=False).metrics
-        for key in ("mean_deviation_mm", "max_deviation_mm", "total_time_s", "completed_in_order", "strokes_total"):
+        for key in ("mean_deviation_m", "max_deviation_m", "total_time_s", "completed_in_order", "strokes_total"):
             assert row[key] == metrics[key], key
         assert row.attempts_total == sum(stroke["attempts"] for stroke in metrics["renderer_strokes"])
         assert row.error is None
@@ -65,7 +65,7 @@ def test_a_missing_character_is_an_error_row(local_table):
     assert len(failed) == 4
     for text in failed.error:
         assert text.startswith("CharacterNotFound: ") and "U+00E9" in text
-    assert failed.mean_deviation_mm.isna().all() and failed.completed_in_order.isna().all()
+    assert failed.mean_deviation_m.isna().all() and failed.completed_in_order.isna().all()
     # The other trials are untouched, and integer and bool columns stay so next to the missing values.
     assert local_table[local_table.character != "\u00e9"].error.isna().all()
     assert str(local_table.strokes_total.dtype) == "Int64"
@@ -85,7 +85,7 @@ def test_writer_and_nested_fields_reach_the_trial():
     writer = calligraphy.WriterProfile.skilled().replace(bias_offset_m=0.0)
     expected = calligraphy.simulate_trial("口", writer=writer, force_law=law, seed=3, keep_trace=False).metrics
     assert table.error.isna().all()
-    assert table.mean_deviation_mm[0] == expected["mean_deviation_mm"]
+    assert table.mean_deviation_m[0] == expected["mean_deviation_m"]
     assert table.total_time_s[0] == expected["total_time_s"]
     assert table.writer[0] == "skilled"
 

@@ -89,7 +89,7 @@ def test_deterministic_for_a_seed_and_seed_matters():
     b = calligraphy.simulate_trial("心", seed=5, keep_trace=False).metrics
     c = calligraphy.simulate_trial("心", seed=6, keep_trace=False).metrics
     assert a == b
-    assert a["mean_deviation_mm"] != c["mean_deviation_mm"]
+    assert a["mean_deviation_m"] != c["mean_deviation_m"]
 
 
 def test_simulated_device_moves_with_the_force():

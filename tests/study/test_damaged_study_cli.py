@@ -221,7 +221,7 @@ class DamagedStudyTest(unittest.TestCase):
     def test_a_trial_that_wrote_no_stroke_is_shown_on_the_page(self):
         record = sorted((self.first_session() / "trials").glob("*.json"))[0]
         document = json.loads(record.read_text(encoding="utf-8"))
-        for key in ("mean_deviation_mm", "max_deviation_mm", "rms_deviation_mm", "frechet_mm", "dtw_mm",
+        for key in ("mean_deviation_m", "max_deviation_m", "rms_deviation_m", "frechet_m", "dtw_m",
                     "normalised_jerk"):
             document[key] = None
         document["end_reason"] = "time_limit"

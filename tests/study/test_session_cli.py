@@ -241,7 +241,7 @@ class SessionCliTest(unittest.TestCase):
         for session in sessions:
             self.assertIn(f"-{session.parent.name}-", session.name)
         record = json.loads(self.saved(sessions[0])[0].read_text(encoding="utf-8"))
-        for key in ("frechet_mm", "dtw_mm", "order_errors", "backwards_strokes"):
+        for key in ("frechet_m", "dtw_m", "order_errors", "backwards_strokes"):
             self.assertIn(key, record)
 
     def test_guidance_retention_protocol_with_simulated_subjects(self):
@@ -273,7 +273,7 @@ class SessionCliTest(unittest.TestCase):
             for gains in by_item.values():
                 self.assertEqual(gains[0]["gain"], fading["start_gain"])
                 for before, after in zip(gains, gains[1:]):
-                    deviation_m = after["previous_mean_deviation_mm"] * 1e-3
+                    deviation_m = after["previous_mean_deviation_m"]
                     # g' = f g + k e falls below g exactly when e < (1 - f) g / k.
                     if deviation_m < (1 - fading["forgetting_factor"]) * before["gain"] / fading["error_gain_per_m"]:
                         small_deviations += 1
