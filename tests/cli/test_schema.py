@@ -218,6 +218,29 @@ class SchemaTest(unittest.TestCase):
         printed = self.run_cli("schema", "specification", "--markdown").stdout.decode()
         self.assertEqual(text[start:end], printed, "docs/cli.md: paste `calligraphy schema specification --markdown`")
 
+    def test_the_metrics_docs_table_is_the_metric_tables(self):
+        source = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
+        text = (source / "docs" / "metrics.md").read_text(encoding="utf-8")
+        start = text.index("<!-- schema metrics -->\n") + len("<!-- schema metrics -->\n")
+        end = text.index("<!-- end schema metrics -->")
+        printed = self.run_cli("schema", "metrics", "--markdown").stdout.decode()
+        self.assertEqual(text[start:end], printed, "docs/metrics.md: paste `calligraphy schema metrics --markdown`")
+
+    def test_a_trials_metrics_validate_against_the_metrics_schema(self):
+        """`calligraphy schema metrics` against a real trial's record: every scene-level metric is there, of its
+        type, and a length in mm would not be."""
+        schema = json.loads(self.run_cli("schema", "metrics").stdout.decode())
+        out = self.cwd / "metrics-trial.json"
+        result = self.run_cli("trial", "十", "--json", str(out))
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
+        record = json.loads(out.read_text(encoding="utf-8"))
+        metrics = {key: record[key] for key in schema["properties"]}
+        jsonschema.validate(metrics, schema)
+        self.assertIn("mean_deviation_m", schema["required"])
+        self.assertFalse(any(key.endswith("_mm") for key in record))
+        with self.assertRaises(jsonschema.ValidationError):
+            jsonschema.validate(dict(metrics, strokes_total=1.5), schema)
+
     @staticmethod
     def past_bounds(path, prop):
         """Values just outside a numeric property's range, and a string where a number belongs."""
