@@ -10,7 +10,7 @@ core (or a Dask cluster with --scheduler), then:
   off and on, and the trials that failed (their error text);
 * a figure: the character whose mean deviation guidance reduces most, written without and with
   guidance (``calligraphy.plot.trial``, the paper's Fig. 31), and histograms of the per-trial
-  differences (off - on) of the mean deviation [mm] and the writing time [s].
+  differences (off - on) of the mean deviation (shown in mm) and the writing time [s].
 
 Characters come from the embedded set (58, runs anywhere), a hanzi-writer-data folder (--data, all
 9,574 characters; ``scripts/fetch-hanzi-writer-data.sh`` prints it) or a corpus store (--store,
@@ -36,7 +36,7 @@ import time
 import calligraphy
 import calligraphy.experiments
 
-METRICS = ("mean_deviation_mm", "total_time_s")
+METRICS = ("mean_deviation_m", "total_time_s")  # names of the metric table, SI units
 
 
 # %% [markdown]
@@ -98,7 +98,7 @@ def summarise(table):
     for guidance, group in ran.groupby("guidance"):
         share = group.completed_in_order.astype(bool).mean()
         print(f"guidance {'on ' if guidance else 'off'}: {share:6.1%} of {len(group)} trials completed in order; "
-              f"mean deviation {group.mean_deviation_mm.mean():.2f} mm, writing time {group.total_time_s.mean():.1f} s")
+              f"mean deviation {group.mean_deviation_m.mean() * 1e3:.2f} mm, writing time {group.total_time_s.mean():.1f} s")
     failed = table[table.error.notna()]
     if len(failed):
         print(f"{len(failed)} trials failed ({failed.character.nunique()} characters), e.g.:")
@@ -131,7 +131,7 @@ def draw_figure(diffs, args, folder):
     except ImportError:
         print("matplotlib is not installed: no figure")
         return
-    deviation = diffs["mean_deviation_mm"]
+    deviation = diffs["mean_deviation_m"]
     if deviation.empty:
         print("no character ran with guidance off and on: no figure")
         return
@@ -145,8 +145,8 @@ def draw_figure(diffs, args, folder):
         calligraphy.plot.trial(result, ax=ax)
         ax.set_title(f"guidance {'on' if guidance else 'off'}: " + ax.get_title(), fontsize=9,
                      fontproperties=calligraphy.plot.cjk_font())
-    for ax, metric, unit in zip(axes[1], METRICS, ("mm", "s")):
-        values = diffs[metric]
+    for ax, metric, unit, scale in zip(axes[1], METRICS, ("mm", "s"), (1e3, 1.0)):
+        values = diffs[metric] * scale  # shown in mm for people
         ax.hist(values, bins=40, color="tab:blue")
         ax.axvline(0.0, color="black", lw=0.8)
         ax.set_xlabel(f"{metric} off - on [{unit}]")

@@ -71,7 +71,7 @@ def trial_cell(character, writer, guidance, seeds):
         result = calligraphy.simulate_trial(character, writer=writer, guidance=guidance, seed=seed,
                                             keep_trace=False)
         times.append(result.metrics["total_time_s"])
-        deviations.append(result.metrics["mean_deviation_mm"])
+        deviations.append(result.metrics["mean_deviation_m"] * 1e3)
         in_order += bool(result.metrics["completed_in_order"])
         order_errors.append(result.writer_log.out_of_order_attempts())
     return {"time_s": times, "deviation_mm": deviations, "in_order": in_order, "order_errors": order_errors}
@@ -136,17 +136,17 @@ def train_and_retain(mode, seed, characters, repetitions, learning_rate, teacher
                 kwargs["teacher"] = teacher_of[char]
             result = calligraphy.simulate_trial(char, writer=profile, seed=seed * 1000 + repetition * 10 + index,
                                                 keep_trace=False, **kwargs)
-            practice_deviations.append(result.metrics["mean_deviation_mm"])
+            practice_deviations.append(result.metrics["mean_deviation_m"] * 1e3)
             outcome = calligraphy.RepetitionOutcome.from_log(result.writer_log, share)
             profile = calligraphy.next_repetition_profile(profile, outcome)
             if mode == "fading":
-                gain = calligraphy.next_guidance_gain(gain, result.metrics["mean_deviation_mm"] * 1e-3)
+                gain = calligraphy.next_guidance_gain(gain, result.metrics["mean_deviation_m"])
     times, deviations, order_errors = [], [], 0
     for index, char in enumerate(characters):
         result = calligraphy.simulate_trial(char, writer=profile, guidance=False, seed=seed * 1000 + 900 + index,
                                             keep_trace=False)
         times.append(result.metrics["total_time_s"])
-        deviations.append(result.metrics["mean_deviation_mm"])
+        deviations.append(result.metrics["mean_deviation_m"] * 1e3)
         order_errors += result.writer_log.out_of_order_attempts()
     return (statistics.mean(times), mean_of_known(deviations), order_errors, profile, gain,
             mean_of_known(practice_deviations))
