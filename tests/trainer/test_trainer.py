@@ -257,7 +257,7 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual(record["condition"], "haptic")
         self.assertEqual(record["device"]["name"], "simulated")
         self.assertEqual(record["renderer"]["loop"]["stall_timeout_s"], 2.0)  # --watchdog-ms, in s
-        for key in ("start_time_utc", "library", "mean_deviation_mm", "per_stroke", "loop", "per_character"):
+        for key in ("start_time_utc", "library", "mean_deviation_m", "per_stroke", "loop", "per_character"):
             self.assertIn(key, record)
         trace = saved_trace_rows(record_path)
         self.assertEqual(len(trace), record["loop"]["ticks"])  # every tick kept
@@ -343,7 +343,7 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual(record["condition"], "vision")
         self.assertEqual((record["strokes_completed"], record["strokes_total"]), (1, 1))
         self.assertEqual(record["end_reason"], "completed")
-        self.assertLess(record["per_character"][0]["per_stroke"][0]["mean_deviation_mm"], 1.5)
+        self.assertLess(record["per_character"][0]["per_stroke"][0]["mean_deviation_m"], 1.5e-3)
 
     def write_with_the_mouse(self, window, points, pause=0.12, trainer=None):
         """Presses at the first point, moves through the others, and lifts the pen. With `trainer`, a stroke
@@ -479,7 +479,7 @@ class TrainerTest(unittest.TestCase):
             self.assertEqual(record["strokes_completed"], 1, record)
         self.assertEqual(guided["condition"], "haptic")
         self.assertEqual(free["condition"], "vision")
-        self.assertLess(guided["mean_deviation_mm"], 0.7 * free["mean_deviation_mm"])
+        self.assertLess(guided["mean_deviation_m"], 0.7 * free["mean_deviation_m"])
 
     def write_like_a_person(self, device, **timing):
         """Writes 十口人永, one trial each, moving the pointer as a person moves a pen (hand.py): minimum-jerk
