@@ -126,7 +126,7 @@ def test_a_damaged_record_is_a_data_error_naming_the_file_and_pointer(study_fold
     text = record.read_text(encoding="utf-8")
     for old, new, pointer in [('"format": "calligraphy-study-trial"', '"format": 5', "/format"),
                               ('"per_character": [', '"per_character": "x", "was": [', "/per_character"),
-                              ('"mean_deviation_m": ', '"mean_deviation_m": 1e999, "was": ', "/mean_deviation_m"),
+                              ('"frechet_m": ', '"frechet_m": 1e999, "was": ', "/frechet_m"),
                               ('"end_reason": "', '"end_reason": [], "was": "', "/end_reason")]:
         compact = json.dumps(json.loads(text))  # one spelling of the separators for the replacements
         assert old in compact, old
