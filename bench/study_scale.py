@@ -48,7 +48,7 @@ def copy_subject(template: pathlib.Path, target: pathlib.Path, subject: str, fac
             text = text.replace("-S01-", f"-{subject}-")
             if source.parent.name == "trials":
                 record = json.loads(text)
-                for key in ("mean_deviation_mm", "max_deviation_mm", "rms_deviation_mm", "total_time_s"):
+                for key in ("mean_deviation_m", "max_deviation_m", "rms_deviation_m", "total_time_s"):
                     if isinstance(record.get(key), (int, float)):
                         record[key] *= factor
                 text = json.dumps(record)
