@@ -63,8 +63,9 @@ std::string trace_file_name(const json_detail::JsonView& record) {
 
 // The trial's trace (HDF5, trace_hdf5.hpp; or trial_csv's t,x,y,z,fx,fy,fz,state,stroke,element[,attempt,
 // rewritten], gzip or plain, in older folders) through the one trace reader: times, positions, pen down,
-// in-plane force. The file is read once, whole: its rows are parsed from the bytes that are hashed.
-// Returns the SHA-256 of those bytes when `hash` is set, else "".
+// in-plane force. With `hash` (a record that names its trace by SHA-256) the file is read once, whole: its
+// rows are parsed from the bytes that are hashed, and their SHA-256 returned. Without (an older record, whose
+// trace may be a long gzip CSV) it is streamed a block at a time, as ever, and "" returned.
 std::string read_trace(const fs::path& file, double paper_z_m, bool hash, ReportTrial& trial) {
   PenTraceCsvOptions options;
   options.paper_z_m = paper_z_m;
@@ -73,15 +74,19 @@ std::string read_trace(const fs::path& file, double paper_z_m, bool hash, Report
   // A study trial's trace is drawn, not scored: no limit on samples or segments beside the size's.
   options.max_samples = std::numeric_limits<std::size_t>::max();
   options.max_pen_down_segments = std::numeric_limits<std::size_t>::max();
+  const auto keep = [&trial](const PenTraceRow& row) {
+    trial.time_s.push_back(row.sample.time_s);
+    trial.position_m.push_back(row.sample.position_m);
+    trial.pen_down.push_back(row.sample.pen_down);
+    trial.in_plane_force_n.push_back(row.in_plane_force_n);
+  };
+  if (!hash) {
+    for_each_pen_trace_row(file, Placement{}, options, keep);
+    return {};
+  }
   const std::string bytes = read_regular_file(file, kMaxTrialCsvBytes);
-  for_each_pen_trace_row_of_bytes(bytes, file.string(), Placement{}, options,
-                                  [&trial](const PenTraceRow& row) {
-                                    trial.time_s.push_back(row.sample.time_s);
-                                    trial.position_m.push_back(row.sample.position_m);
-                                    trial.pen_down.push_back(row.sample.pen_down);
-                                    trial.in_plane_force_n.push_back(row.in_plane_force_n);
-                                  });
-  return hash ? sha256_hex(bytes) : std::string();
+  for_each_pen_trace_row_of_bytes(bytes, file.string(), Placement{}, options, keep);
+  return sha256_hex(bytes);
 }
 
 // The trace beside the record is the one the record names by its SHA-256 (files.trace_sha256, written since
