@@ -10,12 +10,14 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/report/trace_hdf5.hpp"
 #include "calligraphy/report/trial_report.hpp"
 
 using namespace calligraphy;
@@ -440,4 +442,88 @@ TEST_CASE("A row the fast way cannot take is refused as before, naming its line 
   CHECK_FALSE(samples[1].pen_down);
   CHECK(samples[2].position_m.x() == 0.1234567890123456);
   CHECK(samples[2].position_m.y() == 5.0);
+}
+
+namespace {
+
+// Every row `for_each_pen_trace_row` gives of `file`, and of its bytes read whole.
+std::vector<PenTraceRow> rows_of_file(const std::filesystem::path& file, const PenTraceCsvOptions& options) {
+  std::vector<PenTraceRow> rows;
+  for_each_pen_trace_row(file, Placement{}, options, [&rows](const PenTraceRow& r) { rows.push_back(r); });
+  return rows;
+}
+
+std::vector<PenTraceRow> rows_of_bytes(const std::string& bytes, const PenTraceCsvOptions& options) {
+  std::vector<PenTraceRow> rows;
+  for_each_pen_trace_row_of_bytes(bytes, "the trace", Placement{}, options,
+                                  [&rows](const PenTraceRow& r) { rows.push_back(r); });
+  return rows;
+}
+
+std::string file_bytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+}  // namespace
+
+TEST_CASE("A trace's bytes read whole give the rows its file gives, in each of its formats",
+          "[pen_trace_csv]") {
+  std::vector<TrialSample> trace(3000);
+  for (std::size_t i = 0; i < trace.size(); ++i) {
+    const double t = 0.001 * static_cast<double>(i);
+    trace[i].time_s = t;
+    trace[i].position_m = Vec3(0.01 * std::sin(t), 0.01 * std::cos(3 * t), i % 700 < 500 ? 0.0 : 0.004);
+    trace[i].force_n = Vec3(0.2 * std::cos(t), -0.1, 1.0);
+  }
+  PenTraceCsvOptions options;
+  options.read_force = true;
+  const std::string csv = trial_csv(trace);
+  const TemporaryFile plain(csv);
+  const TemporaryFile hdf5(trial_trace_hdf5(trace), "trace.trace.h5");
+  const TemporaryFile gzip("", "trace.csv.gz");
+  write_gzip(gzip.path, csv);
+  // Two gzip members one after the other (as `cat a.gz b.gz` makes): one text, as zlib's file reader reads
+  // it.
+  const TemporaryFile members("", "members.csv.gz");
+  write_gzip(members.path, csv.substr(0, csv.size() / 2));
+  {
+    const TemporaryFile second("", "second.gz");
+    write_gzip(second.path, csv.substr(csv.size() / 2));
+    std::ofstream(members.path, std::ios::binary | std::ios::app) << file_bytes(second.path);
+  }
+  const std::vector<PenTraceRow> expected = rows_of_file(plain.path, options);
+  REQUIRE(expected.size() == trace.size());
+  std::size_t lifted = 0;
+  for (const std::filesystem::path& file : {plain.path, hdf5.path, gzip.path, members.path}) {
+    INFO(file.filename().string());
+    const std::vector<PenTraceRow> from_file = rows_of_file(file, options);
+    const std::vector<PenTraceRow> from_bytes = rows_of_bytes(file_bytes(file), options);
+    REQUIRE(from_file.size() == expected.size());
+    REQUIRE(from_bytes.size() == expected.size());
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+      CHECK(from_bytes[i].sample.time_s == from_file[i].sample.time_s);
+      CHECK(from_bytes[i].sample.position_m == from_file[i].sample.position_m);
+      CHECK(from_bytes[i].sample.pen_down == from_file[i].sample.pen_down);
+      CHECK(from_bytes[i].in_plane_force_n == from_file[i].in_plane_force_n);
+      CHECK(from_file[i].sample.time_s ==
+            Approx(expected[i].sample.time_s).margin(1e-9));  // the formats agree
+      lifted += from_bytes[i].sample.pen_down ? 0 : 1;
+    }
+  }
+  CHECK(lifted > 0);  // both pen states were read
+  // Damage is named by the source given: a cut gzip stream, a cut HDF5 trace, a text over the limit.
+  const std::string compressed = file_bytes(gzip.path);
+  CHECK_THROWS_WITH(rows_of_bytes(compressed.substr(0, compressed.size() / 2), options),
+                    Catch::Contains("the trace") && Catch::Contains("gzip"));
+  const std::string h5 = file_bytes(hdf5.path);
+  CHECK_THROWS_WITH(rows_of_bytes(h5.substr(0, h5.size() - 100), options), Catch::Contains("the trace"));
+  PenTraceCsvOptions small = options;
+  small.max_file_bytes = compressed.size() + 1;  // the gzip file is under it, its text is not
+  REQUIRE(csv.size() > small.max_file_bytes);
+  CHECK_THROWS_WITH(rows_of_bytes(compressed, small),
+                    Catch::Contains("the trace") && Catch::Contains("the limit"));
+  small.max_file_bytes = h5.size() - 1;
+  CHECK_THROWS_WITH(rows_of_bytes(h5, small),
+                    Catch::Contains("the trace") && Catch::Contains("over the limit"));
 }

@@ -21,6 +21,7 @@
 #include "calligraphy/report/trace_hdf5.hpp"
 #include "calligraphy/study/cohort.hpp"
 #include "calligraphy/study/curriculum.hpp"
+#include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/study_tables.hpp"
 #include "calligraphy/study/transfer_set.hpp"
 #include "character_source.hpp"
@@ -103,11 +104,21 @@ order: a list of dicts with ``name`` (its SI unit in it, as the library's DataFr
 ``score`` reads a column by either name.)");
   m.def(
       "_read_trace_columns",
-      [](const std::filesystem::path& path, std::uintmax_t max_file_bytes) {
+      [](const std::filesystem::path& path, std::uintmax_t max_file_bytes, const std::string& sha256) {
         TraceColumns c;
         {
           py::gil_scoped_release release;  // the file read and decoded in C++, beside other Python threads
-          c = read_trace_hdf5(path, max_file_bytes);
+          // Read once: the bytes parsed are the bytes hashed.
+          const std::string bytes = read_trace_hdf5_bytes(path, max_file_bytes);
+          c = parse_trace_hdf5(bytes, path.string());
+          if (!sha256.empty()) {
+            const std::string actual = sha256_hex(bytes);
+            if (actual != sha256) {
+              throw DataError(path.string() + ": SHA-256 " + actual +
+                              ", but its record names a trace of SHA-256 " + sha256 +
+                              " (files.trace_sha256): it is not this trial's trace");
+            }
+          }
         }
         py::dict columns;
         columns["t_s"] = column_array(c.time_s);
@@ -124,13 +135,14 @@ order: a list of dicts with ``name`` (its SI unit in it, as the library's DataFr
         columns["rewritten"] = column_array(c.rewritten);
         return columns;
       },
-      py::arg("path"), py::arg("max_file_bytes"),
+      py::arg("path"), py::arg("max_file_bytes"), py::arg("sha256") = std::string(),
       "Every column of a trial's HDF5 trace (read_trace_hdf5, include/calligraphy/report/trace_hdf5.hpp) as "
       "numpy arrays of N samples: t_s [s], x_m, y_m, z_m [m], fx_n, fy_n, fz_n [N] (float64), state (uint8: "
       "0 SS, 1 AS, 2 CS, 3 WS), stroke, element (uint32), attempt (int32), rewritten (uint8). Raises "
       "DataError "
-      "naming the file for a damaged, cut, foreign or too large file. calligraphy.study reads traces with "
-      "it.");
+      "naming the file for a damaged, cut, foreign or too large file, and, given `sha256` (its record's "
+      "files.trace_sha256), for a file of another SHA-256 (another trial's trace), hashed from the bytes "
+      "parsed: the file is read once. calligraphy.study reads traces with it.");
   m.def(
       "_study_tables_csv",
       [](const py::list& roots) {

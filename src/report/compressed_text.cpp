@@ -36,6 +36,54 @@ std::string gzip_text(std::string_view text) {
   return out;
 }
 
+std::string gunzip_text(std::string_view bytes, const std::string& source, std::uintmax_t max_text_bytes) {
+  const auto is_gzip = [](std::string_view b) { return b.size() >= 2 && b[0] == '\x1f' && b[1] == '\x8b'; };
+  if (!is_gzip(bytes)) {
+    if (bytes.size() > max_text_bytes) {
+      throw DataError(source + ": more than " + std::to_string(max_text_bytes) +
+                      " bytes of text, the limit (the rest is not read)");
+    }
+    return std::string(bytes);
+  }
+  std::string text;
+  constexpr std::size_t kBlockBytes = std::size_t{1} << 18;
+  while (is_gzip(bytes)) {  // one gzip member a turn
+    z_stream stream{};
+    if (inflateInit2(&stream, 15 + 16) != Z_OK)
+      throw DataError(source + ": cannot be read (gzip: out of memory)");
+    stream.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(bytes.data()));
+    stream.avail_in = static_cast<uInt>(std::min<std::size_t>(bytes.size(), UINT_MAX));
+    int result = Z_OK;
+    while (result != Z_STREAM_END) {
+      const std::size_t kept = text.size();
+      text.resize(kept + kBlockBytes);
+      stream.next_out = reinterpret_cast<Bytef*>(text.data() + kept);
+      stream.avail_out = static_cast<uInt>(kBlockBytes);
+      result = inflate(&stream, Z_NO_FLUSH);
+      text.resize(kept + kBlockBytes - stream.avail_out);
+      const bool stuck =
+          result == Z_BUF_ERROR || (result == Z_OK && stream.avail_in == 0 && stream.avail_out != 0);
+      if (result != Z_OK && result != Z_STREAM_END && !stuck) {
+        const std::string message = stream.msg != nullptr ? stream.msg : "damaged stream";
+        inflateEnd(&stream);
+        throw DataError(source + ": cannot be read (gzip: " + message + ")");
+      }
+      if (stuck) {  // the input ended inside the member
+        inflateEnd(&stream);
+        throw DataError(source + ": cannot be read (gzip: unexpected end of file)");
+      }
+      if (text.size() > max_text_bytes) {
+        inflateEnd(&stream);
+        throw DataError(source + ": more than " + std::to_string(max_text_bytes) +
+                        " bytes of text, the limit (the rest is not read)");
+      }
+    }
+    bytes.remove_prefix(bytes.size() - stream.avail_in);
+    inflateEnd(&stream);
+  }
+  return text;
+}
+
 TextFileReader::TextFileReader(const std::filesystem::path& file, std::uintmax_t max_file_bytes,
                                std::uintmax_t max_text_bytes)
     : name_(file.string()), max_text_bytes_(max_text_bytes) {

@@ -14,6 +14,14 @@ namespace calligraphy {
 /// Throws DataError when zlib fails (out of memory).
 [[nodiscard]] std::string gzip_text(std::string_view text);
 
+/// The text of gzip `bytes` (RFC 1952; members one after another are one text, as `gzread` reads them, and
+/// bytes after the last member that start no other are ignored, as it ignores them), or `bytes` as they are
+/// when they do not start as gzip (1f 8b). For a file already read whole: the same text as TextFileReader
+/// gives. Throws DataError naming `source` for a damaged or truncated stream, or text longer than
+/// `max_text_bytes` (refused as soon as the inflated text passes it).
+[[nodiscard]] std::string gunzip_text(std::string_view bytes, const std::string& source,
+                                      std::uintmax_t max_text_bytes);
+
 /// A text file read a block at a time, decompressed on the way when it is gzip (by its first two bytes,
 /// 1f 8b), as it is otherwise. Memory holds one block, never the file.
 class TextFileReader {

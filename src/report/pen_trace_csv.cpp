@@ -328,12 +328,11 @@ bool is_trace_hdf5_file(const std::filesystem::path& file) {
   return is_trace_hdf5(std::string_view(head, static_cast<std::size_t>(in.gcount())));
 }
 
-// The rows of an HDF5 trace with the CSV reader's checks and limits; errors name the sample (1-based).
-void for_each_trace_hdf5_row(const std::filesystem::path& file, const Placement& placement,
+// The rows of an HDF5 trace's columns with the CSV reader's checks and limits; errors name the sample
+// (1-based) of `source`.
+void for_each_trace_hdf5_row(const TraceColumns& c, const std::string& source, const Placement& placement,
                              const PenTraceCsvOptions& options,
                              const std::function<void(const PenTraceRow&)>& row) {
-  const std::string source = file.string();
-  const TraceColumns c = read_trace_hdf5(file, options.max_file_bytes, TraceColumnSet::pen);
   const auto fail = [&source](std::size_t i, const std::string& what) {
     throw DataError(source + ": sample " + std::to_string(i + 1) + ": " + what);
   };
@@ -392,7 +391,8 @@ void for_each_pen_trace_row(const std::filesystem::path& file, const Placement& 
                             const std::function<void(const PenTraceRow&)>& row) {
   check_options(options, placement);
   if (is_trace_hdf5_file(file)) {
-    for_each_trace_hdf5_row(file, placement, options, row);
+    const TraceColumns columns = read_trace_hdf5(file, options.max_file_bytes, TraceColumnSet::pen);
+    for_each_trace_hdf5_row(columns, file.string(), placement, options, row);
     return;
   }
   // Streamed a block at a time (decompressed on the way for a gzip file), so that memory holds a block, not
@@ -415,6 +415,23 @@ void for_each_pen_trace_row(const std::filesystem::path& file, const Placement& 
   }
   if (!buffer.empty()) reader.line(buffer);
   reader.finish(size);
+}
+
+void for_each_pen_trace_row_of_bytes(std::string_view bytes, const std::string& source,
+                                     const Placement& placement, const PenTraceCsvOptions& options,
+                                     const std::function<void(const PenTraceRow&)>& row) {
+  check_options(options, placement);
+  if (bytes.size() > options.max_file_bytes) {
+    throw DataError(source + ": " + std::to_string(bytes.size()) + " bytes, over the limit of " +
+                    std::to_string(options.max_file_bytes));
+  }
+  if (is_trace_hdf5(bytes.substr(0, 32))) {
+    const TraceColumns columns = parse_trace_hdf5(bytes, source, TraceColumnSet::pen);
+    for_each_trace_hdf5_row(columns, source, placement, options, row);
+    return;
+  }
+  const std::string text = gunzip_text(bytes, source, options.max_file_bytes);
+  Reader(source, placement, options, row).parse(text);
 }
 
 std::vector<PenSample> read_pen_trace_csv(const std::filesystem::path& file, const Placement& placement,

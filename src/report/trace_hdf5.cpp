@@ -563,8 +563,7 @@ TraceColumns parse_trace_hdf5(std::string_view bytes, const std::string& source,
   return c;
 }
 
-TraceColumns read_trace_hdf5(const std::filesystem::path& file, std::uintmax_t max_file_bytes,
-                             TraceColumnSet columns) {
+std::string read_trace_hdf5_bytes(const std::filesystem::path& file, std::uintmax_t max_file_bytes) {
   const std::string source = file.string();
   std::error_code error;
   if (!std::filesystem::is_regular_file(file, error)) refuse(source, "no such file");
@@ -576,7 +575,12 @@ TraceColumns read_trace_hdf5(const std::filesystem::path& file, std::uintmax_t m
   std::string bytes(static_cast<std::size_t>(size), '\0');
   if (!in || !in.read(bytes.data(), static_cast<std::streamsize>(bytes.size())))
     refuse(source, "cannot be read");
-  return parse_trace_hdf5(bytes, source, columns);
+  return bytes;
+}
+
+TraceColumns read_trace_hdf5(const std::filesystem::path& file, std::uintmax_t max_file_bytes,
+                             TraceColumnSet columns) {
+  return parse_trace_hdf5(read_trace_hdf5_bytes(file, max_file_bytes), file.string(), columns);
 }
 
 std::vector<TrialSample> trial_samples(const TraceColumns& c) {

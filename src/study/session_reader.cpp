@@ -62,31 +62,12 @@ std::string trace_file_name(const json_detail::JsonView& record) {
   return name;
 }
 
-// The trace beside the record is the one the record names by its SHA-256 (files.trace_sha256, written since
-// traces are bound to their records; an older record names none and its trace is read as it is): a trace
-// copied or renamed from another trial is refused, naming both.
-void check_trace_is_the_records(const json_detail::JsonView& record, const fs::path& trace) {
-  const json_detail::JsonView files = record.object("files");
-  if (!files.has("trace_sha256")) return;
-  const std::string expected = files.string_or("trace_sha256", "");
-  std::string bytes;
-  try {
-    bytes = read_regular_file(trace, kMaxTrialCsvBytes);
-  } catch (const DataError&) {
-    return;  // missing or unreadable: the trace reader says so, naming the record's /files/trace
-  }
-  const std::string actual = sha256_hex(bytes);
-  if (actual != expected) {
-    json_detail::fail(record.source(), "/files/trace_sha256",
-                      "names a trace of SHA-256 " + expected + ", but " + trace.string() + " has SHA-256 " +
-                          actual + ": it is not this trial's trace");
-  }
-}
-
 // The trial's trace (HDF5, trace_hdf5.hpp; or trial_csv's t,x,y,z,fx,fy,fz,state,stroke,element[,attempt,
 // rewritten], gzip or plain, in older folders) through the one trace reader: times, positions, pen down,
-// in-plane force.
-void read_trace(const fs::path& file, double paper_z_m, ReportTrial& trial) {
+// in-plane force. With `hash` (a record that names its trace by SHA-256) the file is read once, whole: its
+// rows are parsed from the bytes that are hashed, and their SHA-256 returned. Without (an older record, whose
+// trace may be a long gzip CSV) it is streamed a block at a time, as ever, and "" returned.
+std::string read_trace(const fs::path& file, double paper_z_m, bool hash, ReportTrial& trial) {
   PenTraceCsvOptions options;
   options.paper_z_m = paper_z_m;
   options.read_force = true;
@@ -94,12 +75,34 @@ void read_trace(const fs::path& file, double paper_z_m, ReportTrial& trial) {
   // A study trial's trace is drawn, not scored: no limit on samples or segments beside the size's.
   options.max_samples = std::numeric_limits<std::size_t>::max();
   options.max_pen_down_segments = std::numeric_limits<std::size_t>::max();
-  for_each_pen_trace_row(file, Placement{}, options, [&trial](const PenTraceRow& row) {
+  const auto keep = [&trial](const PenTraceRow& row) {
     trial.time_s.push_back(row.sample.time_s);
     trial.position_m.push_back(row.sample.position_m);
     trial.pen_down.push_back(row.sample.pen_down);
     trial.in_plane_force_n.push_back(row.in_plane_force_n);
-  });
+  };
+  if (!hash) {
+    for_each_pen_trace_row(file, Placement{}, options, keep);
+    return {};
+  }
+  const std::string bytes = read_regular_file(file, kMaxTrialCsvBytes);
+  for_each_pen_trace_row_of_bytes(bytes, file.string(), Placement{}, options, keep);
+  return sha256_hex(bytes);
+}
+
+// The trace beside the record is the one the record names by its SHA-256 (files.trace_sha256, written since
+// traces are bound to their records; an older record names none and its trace is read as it is): a trace
+// copied or renamed from another trial is refused, naming both. `actual`: the SHA-256 of the bytes read.
+void check_trace_is_the_records(const json_detail::JsonView& record, const fs::path& trace,
+                                const std::string& actual) {
+  const json_detail::JsonView files = record.object("files");
+  if (!files.has("trace_sha256")) return;
+  const std::string expected = files.string_or("trace_sha256", "");
+  if (actual != expected) {
+    json_detail::fail(record.source(), "/files/trace_sha256",
+                      "names a trace of SHA-256 " + expected + ", but " + trace.string() + " has SHA-256 " +
+                          actual + ": it is not this trial's trace");
+  }
 }
 
 // The tidy tables' rows of the saved trial whose record `document` was read from `json_file`: the one
@@ -154,13 +157,16 @@ ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifes
   }
   const double paper_z = record.object("scene").object("layout").number_or("paper_z_m", 0.0, -1e6, 1e6);
   const std::string trace = trace_file_name(record);
+  const bool bound = record.object("files").has("trace_sha256");
+  std::string sha256;
   try {
-    read_trace(json_file.parent_path() / trace, paper_z, trial);
+    sha256 = read_trace(json_file.parent_path() / trace, paper_z, bound, trial);
   } catch (const DataError& e) {  // the record names the trace: it is the record that is at fault
     json_detail::fail(source, record.object("files").has("trace") ? "/files/trace" : "/files/csv",
                       "names the trace '" + trace + "', which cannot be read: " + e.what());
   }
-  check_trace_is_the_records(record, json_file.parent_path() / trace);  // read whole: not damaged, another's?
+  // read whole and not damaged: is it another trial's?
+  if (bound) check_trace_is_the_records(record, json_file.parent_path() / trace, sha256);
   return trial;
 }
 

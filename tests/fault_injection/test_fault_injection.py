@@ -109,6 +109,22 @@ def every_fault(counts, repeated_step_stride=1):
                 tried += 1
 
 
+def scratch_parent():
+    """Where the sweeps work: /dev/shm when it is a writable folder (tmpfs), else the default temporary folder.
+    Every fsync the program makes is still called, counted and faulted by the shim; on tmpfs it returns at
+    once instead of waiting for a disk, which no assertion here can see (a SIGKILL loses nothing the kernel
+    holds: durability against a power cut is not what the sweeps test)."""
+    shm = Path("/dev/shm")
+    return str(shm) if shm.is_dir() and os.access(shm, os.W_OK | os.X_OK) else None
+
+
+def restore(pristine, work):
+    """`work` made again as a copy of `pristine` (the state a sweep starts each fault from, made once by the
+    program itself), hidden files and all."""
+    shutil.rmtree(work, ignore_errors=True)
+    shutil.copytree(pristine, work, symlinks=True)
+
+
 def leftovers(folder):
     return sorted(str(path.relative_to(folder)) for path in folder.rglob("*")
                   if any(mark in path.name for mark in LEFTOVER_MARKS))
@@ -120,7 +136,7 @@ class FaultInjection(unittest.TestCase):
         if not CLI or not Path(CLI).exists() or not SHIM or not Path(SHIM).exists():
             raise unittest.SkipTest("run through ctest: CALLIGRAPHY_CLI and CALLIGRAPHY_FAULT_SHIM name the "
                                     "program and the shim")
-        cls.scratch = tempfile.TemporaryDirectory(prefix="calligraphy-faults-")
+        cls.scratch = tempfile.TemporaryDirectory(prefix="calligraphy-faults-", dir=scratch_parent())
         root = Path(cls.scratch.name)
         protocol = two_session_protocol("faults")
         protocol["phases"] = protocol["phases"][:3]  # one session
@@ -155,13 +171,19 @@ class FaultInjection(unittest.TestCase):
         turn) raised at every step, after which the run has ended by that signal leaving the earlier or the
         new set and nothing else: no temporary, second name or journal."""
         work = Path(self.scratch.name) / "work"
+        pristine = Path(self.scratch.name) / "work-earlier"
 
         def fresh():
-            """The work folder holding the earlier set only."""
+            """The work folder holding the earlier set only: written by the program the first time, then a copy
+            of that folder (the same bytes as a run writes again, checked below)."""
+            if pristine.exists():
+                restore(pristine, work)
+                return snapshot(work / "out")
             shutil.rmtree(work, ignore_errors=True)
             (work / "out").mkdir(parents=True)
             done = self.run_cli(arguments_for(self.one_subject / "study"), work)
             self.assertEqual(done.returncode, 0, done.stderr.decode())
+            shutil.copytree(work, pristine, symlinks=True)
             return snapshot(work / "out")
 
         earlier = fresh()
@@ -171,6 +193,13 @@ class FaultInjection(unittest.TestCase):
         self.assertEqual(done.returncode, 0, done.stderr.decode())
         new = snapshot(work / "out")
         self.assertNotEqual(earlier, new)
+        # The program writes the earlier set again as it wrote it the first time: the copy stands for a run.
+        shutil.rmtree(work)
+        (work / "out").mkdir(parents=True)
+        done = self.run_cli(arguments_for(self.one_subject / "study"), work)
+        self.assertEqual(done.returncode, 0, done.stderr.decode())
+        self.assertEqual(snapshot(work / "out"), earlier)
+        self.assertEqual(leftovers(work / "out"), [])
         self.assertEqual(fresh(), earlier)
         counts_file = Path(self.scratch.name) / "counts.txt"
         counted = self.run_cli(arguments_for(self.two_subjects / "study"), work,
@@ -218,6 +247,7 @@ class FaultInjection(unittest.TestCase):
                 tried += 1
         print(f"{' '.join(map(str, arguments_for(Path('STUDY'))))}: {tried} faults at every step "
               f"({', '.join(f'{kind} {counts[kind]}' for kind in KINDS)})", flush=True)
+        shutil.rmtree(pristine)
 
     def test_report_tables_and_pages(self):
         # One thread: the Nth call of a kind is then the same step in every run.
@@ -244,13 +274,22 @@ class FaultInjection(unittest.TestCase):
         with one line, the visible files are the new set or the mix with its journal still there (never a mix
         without one), and a clean run afterwards writes the new set and leaves nothing behind."""
         work = Path(self.scratch.name) / "journal"
+        pristine = Path(self.scratch.name) / "journal-earlier"
         arguments = ["report", self.two_subjects / "study", "--csv", "out", "--jobs", "1"]
 
         def killed_between_renames():
-            shutil.rmtree(work, ignore_errors=True)
-            (work / "out").mkdir(parents=True)
-            done = self.run_cli(["report", self.one_subject / "study", "--csv", "out", "--jobs", "1"], work)
-            self.assertEqual(done.returncode, 0, done.stderr.decode())
+            """The earlier set (written by the program the first time, then a copy of that folder, which holds
+            no temporary or journal), then a run killed between its renames. The kill is made each time: the
+            names of what it leaves carry its process id, which must be one that just died."""
+            if pristine.exists():
+                restore(pristine, work)
+            else:
+                shutil.rmtree(work, ignore_errors=True)
+                (work / "out").mkdir(parents=True)
+                done = self.run_cli(["report", self.one_subject / "study", "--csv", "out", "--jobs", "1"], work)
+                self.assertEqual(done.returncode, 0, done.stderr.decode())
+                self.assertEqual(leftovers(work / "out"), [])
+                shutil.copytree(work, pristine, symlinks=True)
             killed = self.run_cli(arguments, work, {"CALLIGRAPHY_FAULT_CALL": "rename", "CALLIGRAPHY_FAULT_AT": "2",
                                                     "CALLIGRAPHY_FAULT_KILL": "1"})
             self.assertEqual(killed.returncode, -9, killed.stderr.decode())
@@ -321,12 +360,20 @@ class FaultInjection(unittest.TestCase):
             return [name for name in leftovers(work / "out")
                     if Path(name).name.startswith(".calligraphy-set-") and name.endswith(".journal")]
 
+        pristine = Path(self.scratch.name) / "folders-earlier"
+
         def fresh():
+            """The earlier set: written by the program the first time, then a copy of that folder."""
+            if pristine.exists():
+                restore(pristine, work)
+                return by_folder(snapshot(work / "out"))
             shutil.rmtree(work, ignore_errors=True)
             for folder in ("out/tables", "out/site"):
                 (work / folder).mkdir(parents=True)
             done = self.run_cli(arguments_for(self.one_subject / "study"), work)
             self.assertEqual(done.returncode, 0, done.stderr.decode())
+            self.assertEqual(leftovers(work / "out"), [])
+            shutil.copytree(work, pristine, symlinks=True)
             return by_folder(snapshot(work / "out"))
 
         earlier = fresh()
@@ -410,12 +457,20 @@ class FaultInjection(unittest.TestCase):
     def test_session_resume(self):
         """The same for `session resume` of a session whose first trial was saved before its run was killed."""
         run = ["session", "run", self.session_protocol, "--writer", "simulated", "--subject", "S01", "--out", "out"]
+        pristine = Path(self.scratch.name) / "session-killed"
 
         def first_trial_saved(work):
-            # Killed at the second trial's link (the first trial's record is linked to its name first).
-            killed = self.run_cli(run, work, {"CALLIGRAPHY_FAULT_CALL": "link", "CALLIGRAPHY_FAULT_AT": "2",
-                                              "CALLIGRAPHY_FAULT_KILL": "1"})
-            self.assertEqual(killed.returncode, -9, killed.stderr.decode())
+            """The session as a run killed at the second trial's link left it (the first trial's record is
+            linked to its name first): made by the program the first time, then a copy of that folder. What the
+            kill leaves names no process (a `.part` record, the study lock's note, which only informs): the copy
+            is the same state."""
+            if not pristine.exists():
+                killed = self.run_cli(run, work, {"CALLIGRAPHY_FAULT_CALL": "link", "CALLIGRAPHY_FAULT_AT": "2",
+                                                  "CALLIGRAPHY_FAULT_KILL": "1"})
+                self.assertEqual(killed.returncode, -9, killed.stderr.decode())
+                shutil.copytree(work, pristine, symlinks=True)
+            else:
+                restore(pristine, work)
             self.assertEqual(len(self.saved_trials(work / "out")), 1)
             return ["session", "resume", self.session_folders(work / "out")[0]]
 

@@ -20,11 +20,17 @@ from pathlib import Path
 CLI = os.environ.get("CALLIGRAPHY_CLI", "")
 SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 
-# Many short trials, so that a signal sent after the first saved trials arrives while the session runs.
+# Under the sanitizers a trial takes ten times as long: the cases run fewer trials and subjects there (the
+# Release run has them all); what they check holds trial by trial and subject by subject.
+SANITIZED = bool(os.environ.get("CALLIGRAPHY_SANITIZED"))
+
+# Many short trials, so that a signal sent after the first saved trials arrives while the session runs: 48,
+# or 16 under the sanitizers (where the fourteen after the second saved one still run for seconds; ABBA
+# takes an even number of repetitions).
 LONG_PROTOCOL = {
     "name": "long",
     "conditions": [{"name": "vision", "mode": "vision"}, {"name": "haptic", "mode": "haptic"}],
-    "test": {"characters": ["十", "人"], "conditions": ["vision", "haptic"], "repetitions": 12},
+    "test": {"characters": ["十", "人"], "conditions": ["vision", "haptic"], "repetitions": 4 if SANITIZED else 12},
     "order": {"conditions": "abba"},
     "trial": {"max_duration_s": 30},
 }
@@ -207,7 +213,9 @@ class SessionCliTest(unittest.TestCase):
                     self.assertRegex(entry, r"\((default: .+|required)\)", f"{command}: {entry}")
 
     def test_simulated_subjects_and_their_report(self):
-        protocol = dict(LONG_PROTOCOL, test=dict(LONG_PROTOCOL["test"], repetitions=2),
+        # Two repetitions of each item, one under the sanitizers: three subjects all the same (the square's
+        # alternation and the profiles' are by subject).
+        protocol = dict(LONG_PROTOCOL, test=dict(LONG_PROTOCOL["test"], repetitions=1 if SANITIZED else 2),
                         order={"conditions": "latin_square"})
         path = self.write_protocol(protocol)
         result = self.run_cli("session", "run", path, "--subjects", "3", "--writer-profile", "novice,skilled",
@@ -250,10 +258,11 @@ class SessionCliTest(unittest.TestCase):
         protocol_path = SOURCE / "examples" / "protocols" / "guidance-retention.json"
         protocol = json.loads(protocol_path.read_text(encoding="utf-8"))
         fading = next(c for c in protocol["conditions"] if c["mode"] == "fading")["parameters"]
-        result = self.run_cli("session", "run", protocol_path, "--subjects", "2", "--out", "study")
+        subjects = 1 if SANITIZED else 2  # 24 trials of up to a minute each
+        result = self.run_cli("session", "run", protocol_path, "--subjects", str(subjects), "--out", "study")
         self.assertEqual(result.returncode, 0, result.stderr.decode())
         sessions = sorted((self.cwd / "study").glob("S0*/guidance-retention-*"))
-        self.assertEqual(len(sessions), 2)
+        self.assertEqual(len(sessions), subjects)
         small_deviations = 0
         for session in sessions:
             planned = json.loads((session / "session.json").read_text(encoding="utf-8"))["plan"]

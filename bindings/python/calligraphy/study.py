@@ -78,21 +78,26 @@ def _check_trace_sha256(path: str, expected: str) -> None:
                                      f"SHA-256 {expected} (files.trace_sha256): it is not this trial's trace")
 
 
-def _read_trace(path: str) -> "pandas.DataFrame":
+def _read_trace(path: str, sha256: str = "") -> "pandas.DataFrame":
     """A trial's trace as samples, the same columns from either format: its HDF5 file (``.trace.h5``, read
     whole by the C++ reader, trace_hdf5.hpp) or, in older session folders, its CSV, gzip-compressed
-    (``.csv.gz``) or plain (``.csv``); DataError naming the file (and line) for damage."""
+    (``.csv.gz``) or plain (``.csv``); DataError naming the file (and line) for damage, and, given `sha256`
+    (its record's files.trace_sha256), for a trace of another SHA-256. An HDF5 trace is read once: the C++
+    reader hashes the bytes it parses."""
     if str(path).endswith(".h5"):
         import numpy as np
 
         if not os.path.exists(path):
             raise FileNotFoundError(f"{path}: no such trace file")
-        columns = _calligraphy._read_trace_columns(os.fspath(path), _MAX_TRACE_FILE_BYTES)
+        columns = _calligraphy._read_trace_columns(os.fspath(path), _MAX_TRACE_FILE_BYTES, sha256)
         columns["state"] = np.array(_STATES, dtype=object)[columns["state"]]
         for column in _WHOLE_NUMBER_COLUMNS:
             columns[column] = columns[column].astype(np.int64)
         return _pandas().DataFrame(columns)
-    return _read_csv_trace(path)
+    samples = _read_csv_trace(path)  # a damaged trace is named as damaged
+    if sha256:
+        _check_trace_sha256(path, sha256)
+    return samples
 
 
 def _read_csv_trace(path: str) -> "pandas.DataFrame":
@@ -195,11 +200,8 @@ class Study:
         the file of a damaged trace (and the line of an older CSV trace: another header, a field that is not a
         finite number)."""
         row = self.trials.loc[trial] if not hasattr(trial, "trace_file") else trial
-        samples = _read_trace(row["trace_file"])  # a damaged trace is named as damaged
         expected = row.get("trace_sha256", "")
-        if isinstance(expected, str) and expected:
-            _check_trace_sha256(row["trace_file"], expected)
-        return samples
+        return _read_trace(row["trace_file"], expected if isinstance(expected, str) else "")
 
     def iter_samples(self) -> typing.Iterator[tuple[typing.Any, "pandas.DataFrame"]]:
         """(index label, samples) for every trial in turn, one trace in memory at a time."""

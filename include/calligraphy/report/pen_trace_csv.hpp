@@ -86,6 +86,14 @@ struct PenTraceRow {
 void for_each_pen_trace_row(const std::filesystem::path& file, const Placement& placement,
                             const PenTraceCsvOptions& options, const std::function<void(const PenTraceRow&)>& row);
 
+/// As `for_each_pen_trace_row`, from the bytes of a trace file already read whole (an HDF5 trace, gzip or
+/// plain CSV, by their first bytes), with the same limits, checks and errors; `source` names the file in
+/// them. For a reader that also hashes the bytes (a saved trial's trace against its record's SHA-256): the
+/// file is read once. Memory holds the bytes and, for gzip, the text.
+void for_each_pen_trace_row_of_bytes(std::string_view bytes, const std::string& source,
+                                     const Placement& placement, const PenTraceCsvOptions& options,
+                                     const std::function<void(const PenTraceRow&)>& row);
+
 /// Reads and parses a CSV file, a block at a time (memory holds the samples, not the file). A gzip file
 /// (RFC 1952, by its first bytes: an older saved trial's `.csv.gz`) is decompressed on the way; an HDF5
 /// trace is read as `for_each_pen_trace_row` reads it. Throws DataError

@@ -73,6 +73,12 @@ enum class TraceColumnSet {
                                            std::uintmax_t max_file_bytes = std::uintmax_t{256} << 20,
                                            TraceColumnSet columns = TraceColumnSet::all);
 
+/// The bytes of a trace file, unparsed, with read_trace_hdf5's refusals of the file itself (missing, not a
+/// regular file, over `max_file_bytes`, unreadable): for a reader that hashes the bytes it parses
+/// (parse_trace_hdf5), reading the file once.
+[[nodiscard]] std::string read_trace_hdf5_bytes(const std::filesystem::path& file,
+                                                std::uintmax_t max_file_bytes = std::uintmax_t{256} << 20);
+
 /// As read_trace_hdf5, from the file's bytes; `source` names it in errors.
 [[nodiscard]] TraceColumns parse_trace_hdf5(std::string_view bytes, const std::string& source,
                                             TraceColumnSet columns = TraceColumnSet::all);
