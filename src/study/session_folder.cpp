@@ -430,27 +430,50 @@ std::string StudyIdentity::obtain(const fs::path& root) {
   }
   std::string text = R"({"format": "calligraphy-study", "version": 1, "study_id": ")";
   text.append(id).append("\"}\n");
-  // Written whole under a name of its own, then linked to its name: link(2) never replaces a file, so of two
-  // runs making it at once, the second reads the first one's id.
+  // Written whole, then linked to its name: link(2) never replaces a file, so of two runs making it at once,
+  // the second reads the first one's id. An unnamed file (O_TMPFILE, linked through /proc/self/fd) leaves
+  // nothing behind whatever stops the run; where the file system has none, a temporary named by its process
+  // (removed above once that process is gone).
   const fs::path path = root / kFileName;
-  std::string temporary_name = temporary_prefix;
-  temporary_name.append(own).append("-").append(id, 0, 8);
-  const fs::path temporary = root / temporary_name;
-  const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0644);
-  if (fd < 0) fail_errno(temporary, "cannot write the study folder's identity", errno);
-  try {
-    write_all(fd, text, temporary);
-    if (::fsync(fd) != 0) fail_errno(temporary, "cannot sync the study folder's identity", errno);
-  } catch (...) {
-    ::close(fd);
-    ::unlink(temporary.c_str());
-    throw;
+  int linked = -1;
+  int error = 0;
+  const int unnamed = ::open(root.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0644);
+  if (unnamed >= 0) {
+    try {
+      write_all(unnamed, text, path);
+      if (::fsync(unnamed) != 0) fail_errno(path, "cannot sync the study folder's identity", errno);
+    } catch (...) {
+      ::close(unnamed);
+      throw;
+    }
+    std::string proc = "/proc/self/fd/";
+    proc.append(std::to_string(unnamed));
+    linked = ::linkat(AT_FDCWD, proc.c_str(), AT_FDCWD, path.c_str(), AT_SYMLINK_FOLLOW);
+    error = errno;
+    ::close(unnamed);
+    if (linked != 0 && error != EEXIST && error != ENOENT)
+      fail_errno(path, "cannot write the study folder's identity", error);
   }
-  ::close(fd);
-  const int linked = ::link(temporary.c_str(), path.c_str());
-  const int error = errno;
-  ::unlink(temporary.c_str());
-  if (linked != 0 && error != EEXIST) fail_errno(path, "cannot write the study folder's identity", error);
+  if (unnamed < 0 || (linked != 0 && error == ENOENT)) {  // no O_TMPFILE here, or no /proc
+    std::string temporary_name = temporary_prefix;
+    temporary_name.append(own).append("-").append(id, 0, 8);
+    const fs::path temporary = root / temporary_name;
+    const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0644);
+    if (fd < 0) fail_errno(temporary, "cannot write the study folder's identity", errno);
+    try {
+      write_all(fd, text, temporary);
+      if (::fsync(fd) != 0) fail_errno(temporary, "cannot sync the study folder's identity", errno);
+    } catch (...) {
+      ::close(fd);
+      ::unlink(temporary.c_str());
+      throw;
+    }
+    ::close(fd);
+    linked = ::link(temporary.c_str(), path.c_str());
+    error = errno;
+    ::unlink(temporary.c_str());
+    if (linked != 0 && error != EEXIST) fail_errno(path, "cannot write the study folder's identity", error);
+  }
   fsync_folder(root);
   if (linked != 0) return read(root).value_or(id);
   return id;

@@ -448,7 +448,7 @@ class FileSurfaces(Hostile):
         block = b"1" * (1 << 20)
         with gzip.open(path, "wb", compresslevel=1) as f:
             f.write(b"t,x,y,z\n")
-            for _ in range(300):  # 300 MiB of one line, no line break
+            for _ in range(40):  # 40 MiB of one line, no line break (past 256 MiB the size limit refuses it)
                 f.write(block)
 
         def limit():
