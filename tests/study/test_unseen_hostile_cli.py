@@ -132,11 +132,6 @@ class Hostile(unittest.TestCase):
     def study_copy(self):
         return self.copy(self.fx.study, "study")
 
-    def edit_json(self, path, change):
-        doc = json.loads(Path(path).read_text(encoding="utf-8"))
-        change(doc)
-        Path(path).write_text(json.dumps(doc, ensure_ascii=False), encoding="utf-8")
-
     def first_record(self, study):
         return sorted(study.rglob("trials/*.json"))[0]
 
@@ -578,19 +573,20 @@ class StudySurfaces(Hostile):
         tables.mkdir()
         victim = self.cwd / "victim.txt"
         victim.write_text("keep me\n")
-        journals_before = set()
         out = self.cli("report", self.fx.study, "--csv", tables)
         self.assertEqual(out.returncode, 0, out.stderr)
-        journals_before = {p.name for p in tables.iterdir()}
-        forged = tables / ".calligraphy-journal"
-        # whatever the journal's name is, a forged file beside the tables that names ../victim.txt must not
-        # make the next report touch it
-        forged.write_text(json.dumps({"format": "calligraphy-journal", "version": 1,
-                                      "files": [{"target": "../victim.txt", "earlier": "trials.csv"}]}))
+        before = digest_tree(tables)
+        # a journal this program did not write, naming a file outside its folder (docs/cli.md, "Outputs")
+        forged = tables / ".calligraphy-set-forged.journal"
+        forged.write_text(json.dumps({"format": "calligraphy-set-journal", "version": 1, "checksum": "0",
+                                      "files": [{"target": "../victim.txt", "kept": "trials.csv"}]}))
+        text = forged.read_text()
         out = self.cli("report", self.fx.study, "--csv", tables)
+        self.refused(out, 1, ".calligraphy-set-forged.journal")
         self.assertEqual(victim.read_text(), "keep me\n")
-        self.assertIn(out.returncode, (0, 1), out.stderr)
-        self.assertTrue(journals_before <= {p.name for p in tables.iterdir()})
+        self.assertEqual(forged.read_text(), text)
+        forged.unlink()
+        self.assertEqual(digest_tree(tables), before)
 
     def test_resume_waits_for_no_one_while_a_run_holds_the_study_lock(self):
         study = self.study_copy()
