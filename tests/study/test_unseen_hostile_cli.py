@@ -603,7 +603,7 @@ class StudySurfaces(Hostile):
 
     def test_a_resume_holding_the_study_refuses_a_second_resume(self):
         protocol = one_session_protocol("slow")
-        protocol["phases"][1]["repetitions"] = 12
+        protocol["phases"][1]["repetitions"] = 6
         path = self.cwd / "slow.json"
         path.write_text(json.dumps(protocol, ensure_ascii=False), encoding="utf-8")
         study = self.cwd / "study"
