@@ -46,3 +46,13 @@ TEST_CASE("the reader's pointers escape keys the same way", "[json]") {
       }(),
       Catch::StartsWith("doc.json: /x~1y: "));
 }
+
+TEST_CASE("a key given twice in one object is refused by its pointer", "[json]") {
+  // nlohmann/json would keep the last and drop the first without a word.
+  CHECK(error_of(R"({"seed": 1, "seed": 2})").starts_with("doc.json: /seed: the key is given twice"));
+  CHECK(error_of(R"({"a": [{"x": 1}, {"y": 2, "y": 3}]})").starts_with("doc.json: /a/1/y: "));
+  CHECK(error_of(R"({"a~b": {"c/d": 0, "c/d": 0}})").starts_with("doc.json: /a~0b/c~1d: "));
+  // The same key in two objects, or at two depths, is no duplicate.
+  CHECK(error_of(R"({"x": {"x": 1}, "y": [{"x": 1}, {"x": 2}]})").empty());
+  CHECK(error_of(R"([{"k": 1}, {"k": 1}])").empty());
+}

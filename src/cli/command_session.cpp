@@ -493,7 +493,22 @@ int resume_session(const SessionResumeCommand& command, DeviceRegistry& devices)
   files.input_folder("DIR", command.folder);
   add_library_inputs(files, command.library);
   files.output("--screenshot", command.display.screenshot);
+  // One run writes into a study folder at a time: a resume takes the study's run lock as `session run`
+  // does (DIR/../..), so that a run and a resume, or two resumes, never write one study at once.
+  std::error_code resolved_error;
+  std::filesystem::path folder = std::filesystem::weakly_canonical(command.folder, resolved_error);
+  if (resolved_error || folder.empty()) folder = std::filesystem::absolute(command.folder).lexically_normal();
+  if (!folder.has_filename()) folder = folder.parent_path();
+  const std::filesystem::path study_root = folder.parent_path().parent_path();
+  // Only over a session folder that is there: a missing one is SessionFolder::open's error, and no folder is
+  // made for it.
+  std::optional<StudyRunLock> study_lock;
+  if (std::filesystem::is_directory(folder, resolved_error) &&
+      std::filesystem::is_directory(study_root, resolved_error))
+    study_lock.emplace(study_root, "calligraphy session resume " + command.folder);
   SessionFolder session = SessionFolder::open(command.folder);
+  // A session of another study, copied into this study folder, is not this study's to go on with.
+  StudyIdentity::check(StudyIdentity::read(study_root), study_root, session.path(), session.manifest());
   require_characters(session.manifest().protocol, CharacterSource(command.library));
   if (!session.next_unsaved()) {
     std::printf("%s: every trial of %s is saved already\n", session.manifest().setup.subject.id.c_str(),

@@ -1,6 +1,9 @@
 #include "core/json_document.hpp"
 
 #include <functional>
+#include <optional>
+#include <string>
+#include <unordered_set>
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
@@ -57,6 +60,72 @@ class PointerTracker {
   std::vector<Frame> frames_;
 };
 
+// Refuses a key given twice in one object: nlohmann/json keeps the last and drops the other without a word,
+// so `{"seed": 1, "seed": 2}` would run a trial, or read a session, other than the one its reader sees first
+// (RFC 8259, section 4: "The names within an object SHOULD be unique"; software differs on which it takes).
+// A SAX pass over a document already parsed: linear in the text, and it builds nothing.
+class DuplicateKeys : public nlohmann::json_sax<nlohmann::json> {
+ public:
+  bool null() override { return value(); }
+  bool boolean(bool /*val*/) override { return value(); }
+  bool number_integer(number_integer_t /*val*/) override { return value(); }
+  bool number_unsigned(number_unsigned_t /*val*/) override { return value(); }
+  bool number_float(number_float_t /*val*/, const string_t& /*s*/) override { return value(); }
+  bool string(string_t& /*val*/) override { return value(); }
+  bool binary(binary_t& /*val*/) override { return value(); }
+  bool start_object(std::size_t /*elements*/) override {
+    frames_.push_back({false, 0, {}, {}});
+    return true;
+  }
+  bool key(string_t& val) override {
+    Frame& frame = frames_.back();
+    frame.key = val;
+    if (!frame.keys.insert(val).second) {
+      duplicate_ = pointer();
+      return false;
+    }
+    return true;
+  }
+  bool end_object() override { return end(); }
+  bool start_array(std::size_t /*elements*/) override {
+    frames_.push_back({true, 0, {}, {}});
+    return true;
+  }
+  bool end_array() override { return end(); }
+  bool parse_error(std::size_t /*position*/, const std::string& /*last_token*/,
+                   const nlohmann::detail::exception& /*ex*/) override {
+    return false;
+  }
+
+  /// The pointer of the first key given twice; nullopt when every key is given once.
+  [[nodiscard]] const std::optional<std::string>& duplicate() const { return duplicate_; }
+
+ private:
+  struct Frame {
+    bool array;
+    std::size_t elements;
+    std::string key;
+    std::unordered_set<std::string> keys;
+  };
+  bool value() {
+    if (!frames_.empty() && frames_.back().array) ++frames_.back().elements;
+    return true;
+  }
+  bool end() {
+    frames_.pop_back();
+    return value();
+  }
+  [[nodiscard]] std::string pointer() const {
+    std::string at;
+    for (const Frame& frame : frames_) {
+      at = frame.array ? child_pointer(at, frame.elements) : child_pointer(at, frame.key);
+    }
+    return at;
+  }
+  std::vector<Frame> frames_;
+  std::optional<std::string> duplicate_;
+};
+
 }  // namespace
 
 nlohmann::json parse_json_document(std::string_view text, const std::string& source) {
@@ -64,7 +133,15 @@ nlohmann::json parse_json_document(std::string_view text, const std::string& sou
   // callback parser scans an object's parent for a discarded value at every object's end, so an array of n
   // objects, a session plan, takes n^2 steps); it runs only to name where a document that failed fails.
   try {
-    return nlohmann::json::parse(text.begin(), text.end());
+    nlohmann::json document = nlohmann::json::parse(text.begin(), text.end());
+    DuplicateKeys keys;
+    (void)nlohmann::json::sax_parse(text.begin(), text.end(), &keys);
+    if (const std::optional<std::string>& at = keys.duplicate()) {
+      throw DataError(source + ": " + *at +
+                      ": the key is given twice in its object (a reader would take one " +
+                      "and silently drop the other)");
+    }
+    return document;
   } catch (const nlohmann::json::exception&) {
     // Parsed again below, with the pointer tracked, for the error's words.
   }

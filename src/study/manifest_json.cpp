@@ -133,6 +133,7 @@ std::string manifest_to_json(const SessionManifest& manifest) {
                                     {"delay", p.delay}};
     if (!p.session_sha256.empty()) document["previous_session"]["session_sha256"] = p.session_sha256;
   }
+  if (!manifest.study_id.empty()) document["study_id"] = manifest.study_id;
   return document.dump(2) + "\n";
 }
 
@@ -168,6 +169,13 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
   // Sessions made before protocols had phases are each the first of their series.
   manifest.setup.session_number = static_cast<int>(root.integer_or("session_number", 1, 1, 20));
   manifest.group = root.string_or("group", "");
+  // Sessions made before study folders had an identity have none (StudyIdentity).
+  manifest.study_id = root.string_or("study_id", "");
+  if (!manifest.study_id.empty() && !is_study_id(manifest.study_id)) {
+    json_detail::fail(
+        source, "/study_id",
+        "expected 32 lower-case hex digits, got " + json_detail::describe(json(manifest.study_id)));
+  }
   if (const json* previous = root.optional("previous_session")) {
     json_detail::ObjectReader reader(*previous, "/previous_session", source);
     PreviousSession p;

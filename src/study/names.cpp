@@ -20,6 +20,14 @@ bool is_label(std::string_view text, std::size_t max_length) {
   return true;
 }
 
+bool is_study_id(std::string_view text) {
+  if (text.size() != 32) return false;
+  for (const char c : text) {
+    if (!((c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'))) return false;
+  }
+  return true;
+}
+
 std::string read_small_file(const std::filesystem::path& path, std::uintmax_t max_bytes,
                             const std::string& what) {
   std::error_code error;

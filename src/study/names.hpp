@@ -10,6 +10,9 @@ namespace calligraphy::study_detail {
 /// True for 1..max_length characters from [A-Za-z0-9_-] (safe in file names on every system).
 bool is_label(std::string_view text, std::size_t max_length);
 
+/// True for a study folder's id (StudyIdentity): 32 lower-case hex digits.
+bool is_study_id(std::string_view text);
+
 /// The bytes of a regular file of at most `max_bytes`. Throws DataError naming the path and `what` it
 /// should hold when it does not exist, is not a regular file, is larger or cannot be read.
 std::string read_small_file(const std::filesystem::path& path, std::uintmax_t max_bytes,

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/file.h>
+#include <sys/random.h>
 #include <sys/stat.h>
 #include <sys/statvfs.h>
 #include <unistd.h>
@@ -61,7 +62,14 @@ void write_all(int fd, std::string_view bytes, const fs::path& path) {
 
 // Opens (creating it) the log for appending and takes its exclusive lock.
 int open_locked_log(const fs::path& log_path) {
-  const int fd = ::open(log_path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
+  // O_NOFOLLOW: a link planted under the log's name is refused, not followed (the log is the session's own
+  // file; a run appends to it).
+  const int fd = ::open(log_path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
+  if (fd < 0 && errno == ELOOP) {
+    throw DataError(log_path.string() +
+                    ": the session log is a symbolic link: a session's log is a file of its own folder; put "
+                    "the log back");
+  }
   if (fd < 0) fail_errno(log_path, "cannot open the session log", errno);
   if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
     const int error = errno;
@@ -300,7 +308,11 @@ SessionFolder SessionFolder::create(const fs::path& root, const SessionSetup& se
         (previous ? "the first session has no previous one" : "a later session needs the previous one"));
   }
   SessionManifest manifest = make_manifest(setup, protocol, previous);
-  const std::string text = manifest_text(manifest);  // refused before any folder is made
+  (void)manifest_text(manifest);  // refused before any folder is made
+  // The study folder's identity, made by its first session; a later session of the subject's series
+  // follows only a session of the same study (session_series).
+  manifest.study_id = StudyIdentity::obtain(root);
+  const std::string text = manifest_text(manifest);
 
   const fs::path subject_folder = root / setup.subject.id;
   make_folder(subject_folder);
@@ -348,6 +360,132 @@ SessionFolder SessionFolder::create(const fs::path& root, const SessionSetup& se
   fsync_folder(subject_folder);
   session.log("session_created", study_detail::session_created_details(session.manifest_));
   return session;
+}
+
+std::optional<std::string> StudyIdentity::read(const fs::path& root) {
+  const fs::path path = root / kFileName;
+  struct stat status {};
+  if (::lstat(path.c_str(), &status) != 0) {
+    if (errno == ENOENT) return std::nullopt;
+    fail_errno(path, "cannot read the study folder's identity", errno);
+  }
+  if (!S_ISREG(status.st_mode)) {
+    throw DataError(path.string() +
+                    ": the study folder's identity is not a regular file (a link or a folder " +
+                    "in its place): restore the file this study's first session made");
+  }
+  const std::string source = path.string();
+  const nlohmann::json document =
+      json_detail::parse_json(study_detail::read_small_file(path, 4096, "study folder identity"), source);
+  json_detail::ObjectReader reader(document, "", source);
+  if (reader.string("format") != "calligraphy-study")
+    json_detail::fail(source, "/format", "expected \"calligraphy-study\"");
+  (void)reader.integer("version", 1, 1);
+  std::string id = reader.string("study_id");
+  if (!study_detail::is_study_id(id))
+    json_detail::fail(source, "/study_id", "expected 32 lower-case hex digits");
+  reader.finish();
+  return id;
+}
+
+std::string StudyIdentity::obtain(const fs::path& root) {
+  // What a run on this host killed while it made the identity left: its temporary, named by its process.
+  const std::string temporary_prefix = std::string(kFileName) + ".tmp-";
+  const std::string own = partial_owner();
+  const std::string host = own.substr(own.find('.') + 1);
+  std::error_code listed;
+  for (const fs::directory_entry& entry : fs::directory_iterator(root, listed)) {
+    const std::string name = entry.path().filename().string();
+    if (!name.starts_with(temporary_prefix)) continue;
+    const std::string owner = name.substr(temporary_prefix.size());  // PID.HOST-RANDOM
+    const std::size_t dot = owner.find('.');
+    const std::size_t dash = owner.rfind('-');
+    if (dot == std::string::npos || dash == std::string::npos || dash < dot ||
+        owner.substr(dot + 1, dash - dot - 1) != host)
+      continue;
+    pid_t pid = 0;
+    try {
+      pid = static_cast<pid_t>(std::stol(owner.substr(0, dot)));
+    } catch (const std::exception&) {
+      continue;
+    }
+    if (pid <= 0 || pid == ::getpid() || ::kill(pid, 0) == 0 || errno != ESRCH) continue;
+    ::unlink(entry.path().c_str());
+  }
+  if (std::optional<std::string> id = read(root)) return *std::move(id);
+  make_folder(root);
+  unsigned char bytes[16] = {};
+  std::size_t got = 0;
+  while (got < sizeof bytes) {
+    const ssize_t n = ::getrandom(bytes + got, sizeof bytes - got, 0);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) fail_errno(root, "cannot draw the study folder's id (getrandom)", n < 0 ? errno : EIO);
+    got += static_cast<std::size_t>(n);
+  }
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string id;
+  for (const unsigned char b : bytes) {
+    id.push_back(kHex[b >> 4]);
+    id.push_back(kHex[b & 0xF]);
+  }
+  std::string text = R"({"format": "calligraphy-study", "version": 1, "study_id": ")";
+  text.append(id).append("\"}\n");
+  // Written whole, then linked to its name: link(2) never replaces a file, so of two runs making it at once,
+  // the second reads the first one's id. An unnamed file (O_TMPFILE, linked through /proc/self/fd) leaves
+  // nothing behind whatever stops the run; where the file system has none, a temporary named by its process
+  // (removed above once that process is gone).
+  const fs::path path = root / kFileName;
+  int linked = -1;
+  int error = 0;
+  const int unnamed = ::open(root.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0644);
+  if (unnamed >= 0) {
+    try {
+      write_all(unnamed, text, path);
+      if (::fsync(unnamed) != 0) fail_errno(path, "cannot sync the study folder's identity", errno);
+    } catch (...) {
+      ::close(unnamed);
+      throw;
+    }
+    std::string proc = "/proc/self/fd/";
+    proc.append(std::to_string(unnamed));
+    linked = ::linkat(AT_FDCWD, proc.c_str(), AT_FDCWD, path.c_str(), AT_SYMLINK_FOLLOW);
+    error = errno;
+    ::close(unnamed);
+    if (linked != 0 && error != EEXIST && error != ENOENT)
+      fail_errno(path, "cannot write the study folder's identity", error);
+  }
+  if (unnamed < 0 || (linked != 0 && error == ENOENT)) {  // no O_TMPFILE here, or no /proc
+    std::string temporary_name = temporary_prefix;
+    temporary_name.append(own).append("-").append(id, 0, 8);
+    const fs::path temporary = root / temporary_name;
+    const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0644);
+    if (fd < 0) fail_errno(temporary, "cannot write the study folder's identity", errno);
+    try {
+      write_all(fd, text, temporary);
+      if (::fsync(fd) != 0) fail_errno(temporary, "cannot sync the study folder's identity", errno);
+    } catch (...) {
+      ::close(fd);
+      ::unlink(temporary.c_str());
+      throw;
+    }
+    ::close(fd);
+    linked = ::link(temporary.c_str(), path.c_str());
+    error = errno;
+    ::unlink(temporary.c_str());
+    if (linked != 0 && error != EEXIST) fail_errno(path, "cannot write the study folder's identity", error);
+  }
+  fsync_folder(root);
+  if (linked != 0) return read(root).value_or(id);
+  return id;
+}
+
+void StudyIdentity::check(const std::optional<std::string>& root_id, const fs::path& root,
+                          const fs::path& folder, const SessionManifest& manifest) {
+  if (!root_id || manifest.study_id.empty() || manifest.study_id == *root_id) return;
+  json_detail::fail(SessionLayout::manifest(folder).string(), "/study_id",
+                    "this session belongs to study " + manifest.study_id + ", not to the study of " +
+                        root.string() + " (" + *root_id + ", " + (root / kFileName).string() +
+                        "): copied in from another study folder? move it back to the study it was run in");
 }
 
 bool is_partial_session_folder(const fs::path& folder) {

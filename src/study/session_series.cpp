@@ -97,9 +97,21 @@ SessionSeries session_series(const fs::path& root, const std::string& subject_id
   std::error_code error;
   std::map<int, std::pair<fs::path, SessionManifest>> by_number;  // the newest folder of each number
   if (fs::is_directory(subject_folder, error)) {
+    // The study's identity: a session of another study (copied in) is not followed.
+    const std::optional<std::string> study_id = StudyIdentity::read(root);
     for (const fs::path& folder : find_session_folders(subject_folder)) {
       SessionManifest manifest = study_detail::read_session_manifest(folder);
       if (manifest.protocol.sha256 != protocol.sha256) continue;
+      if (!study_id && !manifest.study_id.empty()) {
+        // Its study folder made an identity with its first session: this one has none, so the session
+        // came from elsewhere (or the identity was removed); the next session would take a new one.
+        json_detail::fail((SessionLayout::manifest(folder)).string(), "/study_id",
+                          "this session belongs to study " + manifest.study_id + ", but " + root.string() +
+                              " has no study identity (" + (root / StudyIdentity::kFileName).string() +
+                              "): copied in from another study folder? move it back to the study it was run "
+                              "in, or restore that file");
+      }
+      StudyIdentity::check(study_id, root, folder, manifest);
       if (manifest.setup.subject.id != subject_id) {
         json_detail::fail((SessionLayout::manifest(folder)).string(), "/subject/id",
                           "a session of subject '" + manifest.setup.subject.id + "' in the folder of '" +

@@ -268,6 +268,16 @@ class FaultInjection(unittest.TestCase):
             return ["trace", trace, "--csv", "out/trace.csv"]
         self.sweep(arguments_for, signals=True, files=1)
 
+    def test_trial_spec_output(self):
+        """`trial --spec RECORD --csv out/trial.csv` (a session's trial run again) replacing an earlier trace:
+        every fault at every step of the write. No stop signals: one that comes while a trial's outputs are
+        written is ignored (docs/cli.md, "Stopping a trial"), so the run ends as a clean one."""
+        def arguments_for(study):
+            records = sorted(study.rglob("trials/*.json"))
+            record = (records[0] if study == self.one_subject / "study" else records[-1]) if records else study
+            return ["trial", "--spec", record, "--csv", "out/trial.csv"]
+        self.sweep(arguments_for, files=1)
+
     def test_journal_recovery(self):
         """A `report --csv` killed between its two renames leaves a journal and a mix of the two sets; the next
         run completes that set first. Every fault and kill at every step of that next run: a failed run exits 1

@@ -217,7 +217,8 @@ def load(paths: typing.Union[PathLike, typing.Sequence[PathLike]]) -> Study:
     guidance, ``calligraphy.design_analysis.study_design``) first. Raises DataError naming the file (and
     JSON pointer) for a path without a session folder or a damaged record, and naming the subject and both
     folders for a subject's session of one number found twice (a session run twice: its trials are not
-    pooled), ValueError for no path or an empty one, ImportError without pandas."""
+    pooled), naming session.json and /study_id for a session of another study (copied in from another study
+    folder: its study_id is not the folder's, docs/experiments.md "Phases"), ValueError for no path or an empty one, ImportError without pandas."""
     roots = [paths] if isinstance(paths, (str, os.PathLike)) else list(paths)
     if not roots or any(not os.fspath(root) for root in roots):
         raise ValueError(f"load: paths must name session or study folders, got {paths!r}")

@@ -90,6 +90,33 @@ struct SessionManifest {
   std::vector<PlannedTrial> plan;
   std::optional<PreviousSession> previous;  ///< sessions after the first: the one before
   std::string group;  ///< the subject's group (`subject_group`): "" when every phase is within subjects
+  /// The study folder's identity (`study_id`, the random id of ROOT/.calligraphy-study.json) when the session
+  /// was made: a session copied in from another study folder names another. "" in sessions made before
+  /// studies had one (read as before).
+  std::string study_id;
+};
+
+/// A study folder's identity: ROOT/.calligraphy-study.json holds a random id (32 lower-case hex digits,
+/// 128 bits from getrandom(2)), made by the first session created under ROOT; every session.json made there
+/// records it (`study_id`), so that a session copied in from another study folder, of the same subject and
+/// protocol, is not taken as this study's (the series refuses to follow it, the readers to pool it). The file
+/// is JSON: {"format": "calligraphy-study", "version": 1, "study_id": ID}.
+struct StudyIdentity {
+  static constexpr const char* kFileName = ".calligraphy-study.json";
+  /// The id of the study folder `root`; nullopt when it has no identity file (a folder made before studies
+  /// had one, or none yet). Throws DataError naming the file when it is damaged, not a regular file, or not
+  /// this program's.
+  [[nodiscard]] static std::optional<std::string> read(const std::filesystem::path& root);
+  /// The id of `root`, made when it has none (written whole to a temporary file, fsync'ed and linked to its
+  /// name, so two runs that make it at once agree on the one linked first). Throws DataError as `read`, and
+  /// naming the file when it cannot be written.
+  [[nodiscard]] static std::string obtain(const std::filesystem::path& root);
+  /// Refuses the session in `folder` (its session.json read as `manifest`) when it names another study than
+  /// `root_id`, the id of the study folder it lies in: copied in from another study folder. A session
+  /// without an id (made before studies had one) and a folder without one are accepted. Throws DataError
+  /// naming the session.json, its /study_id and both ids.
+  static void check(const std::optional<std::string>& root_id, const std::filesystem::path& root,
+                    const std::filesystem::path& folder, const SessionManifest& manifest);
 };
 
 /// The largest session.json: every reader of a session (resume, the series, the report and the tables)
