@@ -304,6 +304,17 @@ class VocabularyTest(unittest.TestCase):
                     if unknown:
                         disagreements.append(f"{key} '{spelling}': {option} does not know it: {unknown[0]}")
                     context = self.contexts[0]
+                    # A record stating it where no trial here can take it is refused as data: exit 1, naming
+                    # the file and the field's pointer.
+                    record = self.record_in(context)
+                    record["specification"]["trial"][key] = spelling
+                    (self.cwd / "untaken.json").write_text(json.dumps(record), encoding="utf-8")
+                    refused = self.run_cli("trial", "--spec", "untaken.json", "--check")
+                    if refused.returncode != 0 and (
+                            refused.returncode != 1
+                            or f"untaken.json: /specification/trial/{key}" not in refused.stderr.decode()):
+                        disagreements.append(f"{key} '{spelling}' in a record: exit {refused.returncode}, "
+                                             f"{refused.stderr.decode().strip()}")
                 # Written back in the record of a trial that runs here (a device a person holds does not).
                 record = self.record_in(self.contexts[0])
                 record["specification"]["trial"][key] = spelling
