@@ -69,6 +69,24 @@ TEST_CASE("A metres trace with a pen column is read by header name", "[pen_trace
   CHECK(samples[2].position_m == Vec2(0.002, 0.004));
 }
 
+TEST_CASE("A column is read by its name in the trace column table as by its file name", "[pen_trace_csv]") {
+  // Python's DataFrames name the columns with their units (trace_columns.hpp): the same samples.
+  const std::string rows = "0,0.001,0.002,0\n0.001,0.0015,0.003,0\n0.002,0.002,0.004,0.001\n";
+  const auto by_file_name = parse_pen_trace_csv("t,x,y,z\n" + rows, "files", test_placement());
+  const auto by_name = parse_pen_trace_csv("t_s,x_m,y_m,z_m\n" + rows, "names", test_placement());
+  REQUIRE(by_name.size() == 3);
+  REQUIRE(by_name.size() == by_file_name.size());
+  for (std::size_t i = 0; i < by_name.size(); ++i) {
+    CHECK(by_name[i].time_s == by_file_name[i].time_s);
+    CHECK(by_name[i].position_m == by_file_name[i].position_m);
+    CHECK(by_name[i].pen_down == by_file_name[i].pen_down);
+  }
+  CHECK_FALSE(by_name[2].pen_down);
+  // One column named both ways is named twice.
+  CHECK_THROWS_WITH(parse_pen_trace_csv("t,x,y,z,t_s\n0,0,0,0,0\n", "both.csv", test_placement()),
+                    Catch::Contains("both.csv:1") && Catch::Contains("'t_s' appears twice"));
+}
+
 TEST_CASE("A z column sets pen contact by the threshold", "[pen_trace_csv]") {
   const std::string text = "t,x,y,z\n0,0,0,0.0004\n0.001,0,0,0.0005\n0.002,0,0,0.0006\n0.003,0,0,-0.001\n";
   const auto samples = parse_pen_trace_csv(text, "inline", test_placement());

@@ -54,7 +54,10 @@ struct TeacherTag {
 struct PyTrialResult {
   py::array_t<double> time_s, position_m, force_n;
   py::array_t<std::uint8_t> state;
-  py::array_t<std::int64_t> stroke, element, stroke_trace_range;
+  py::array_t<std::int64_t> stroke, element;
+  py::array_t<std::int64_t> attempt;    // 1-based attempt at the stroke, 0 outside any
+  py::array_t<std::uint8_t> rewritten;  // 1: part of an attempt written again later
+  py::array_t<std::int64_t> stroke_trace_range;
   py::dict metrics;
   py::object scene;
   WriterProfile writer;                 // the profile the simulated writer wrote with
@@ -69,12 +72,16 @@ PyTrialResult to_python(const TrialResult& result, py::dict metrics, py::object 
   py::array_t<std::uint8_t> state({n});
   py::array_t<std::int64_t> stroke({n});
   py::array_t<std::int64_t> element({n});
+  py::array_t<std::int64_t> attempt({n});
+  py::array_t<std::uint8_t> rewritten({n});
   auto tw = time.mutable_unchecked<1>();
   auto pw = position.mutable_unchecked<2>();
   auto fw = force.mutable_unchecked<2>();
   auto sw = state.mutable_unchecked<1>();
   auto aw = stroke.mutable_unchecked<1>();
   auto ew = element.mutable_unchecked<1>();
+  auto tw_attempt = attempt.mutable_unchecked<1>();
+  auto rw_rewritten = rewritten.mutable_unchecked<1>();
   for (py::ssize_t i = 0; i < n; ++i) {
     const TrialSample& s = result.trace[static_cast<std::size_t>(i)];
     tw(i) = s.time_s;
@@ -85,6 +92,8 @@ PyTrialResult to_python(const TrialResult& result, py::dict metrics, py::object 
     sw(i) = static_cast<std::uint8_t>(s.state);
     aw(i) = static_cast<std::int64_t>(s.stroke);
     ew(i) = static_cast<std::int64_t>(s.element);
+    tw_attempt(i) = static_cast<std::int64_t>(s.attempt);
+    rw_rewritten(i) = s.rewritten ? 1 : 0;
   }
   const auto strokes = static_cast<py::ssize_t>(result.metrics.per_stroke.size());
   py::array_t<std::int64_t> ranges({strokes, py::ssize_t{2}});
@@ -95,8 +104,19 @@ PyTrialResult to_python(const TrialResult& result, py::dict metrics, py::object 
     rw(i, 0) = n > 0 ? static_cast<std::int64_t>(m.trace_begin) : 0;
     rw(i, 1) = n > 0 ? static_cast<std::int64_t>(m.trace_end) : 0;
   }
-  return PyTrialResult{
-      time, position, force, state, stroke, element, ranges, std::move(metrics), std::move(scene), {}, {}};
+  return PyTrialResult{time,
+                       position,
+                       force,
+                       state,
+                       stroke,
+                       element,
+                       attempt,
+                       rewritten,
+                       ranges,
+                       std::move(metrics),
+                       std::move(scene),
+                       {},
+                       {}};
 }
 
 // Polls Python's signal handlers from a thread that does not hold the GIL, at most every 50 ms.
@@ -366,19 +386,30 @@ PyTrialResult run_trial_py(
 
 // The trial a record states (a TrialResult's metrics, a trial record as a dict, or a record's file), run
 // again as it ran.
+// The record `record` names (a dict or a path), read and checked by the one reader (recorded_trial.hpp).
+RecordedTrial read_record_py(const py::object& record) {
+  if (py::isinstance<py::dict>(record)) {
+    const std::string text = py::module_::import("json").attr("dumps")(record).cast<std::string>();
+    return read_recorded_trial(text, "record");
+  }
+  if (py::isinstance<py::str>(record) || py::isinstance(record, py::module_::import("os").attr("PathLike")))
+    return read_recorded_trial_file(convert_named<std::filesystem::path>(record, "record").string());
+  throw_type_error("record", "a dict (TrialResult.metrics, a trial record) or a record's path", record);
+}
+
+// The specification a record states, checked as a re-run checks it, as the library writes it back.
+py::dict check_trial_record_py(const py::object& record) {
+  RecordedTrial recorded = read_record_py(record);
+  // A replay's teacher is given when it runs (the file the record names, or samples): it is not read here.
+  (void)calligraphy::Checked<TrialSpec>::check(
+      recorded.spec, recorded.spec.teacher.empty() ? TeacherSource::samples : TeacherSource::file);
+  return py::module_::import("json").attr("loads")(recorded_trial_json(recorded)).cast<py::dict>();
+}
+
 PyTrialResult rerun_trial_py(const py::object& record,
                              const std::optional<PyArgument<CharacterSource>>& library,
                              const std::optional<Annotated<TeacherTag>>& teacher) {
-  RecordedTrial recorded;
-  if (py::isinstance<py::dict>(record)) {
-    const std::string text = py::module_::import("json").attr("dumps")(record).cast<std::string>();
-    recorded = read_recorded_trial(text, "record");
-  } else if (py::isinstance<py::str>(record) ||
-             py::isinstance(record, py::module_::import("os").attr("PathLike"))) {
-    recorded = read_recorded_trial_file(convert_named<std::filesystem::path>(record, "record").string());
-  } else {
-    throw_type_error("record", "a dict (TrialResult.metrics, a trial record) or a record's path", record);
-  }
+  RecordedTrial recorded = read_record_py(record);
   const CharacterSource source = library ? take(*library, "library") : CharacterSource::embedded();
   py::object scene_object = py::cast(
       Scene::lay_out(characters_from(py::str(recorded.spec.characters), source, "record"), recorded.layout));
@@ -461,6 +492,11 @@ void bind_trial(py::module_& m) {
       .def_readonly("stroke", &PyTrialResult::stroke, "(N,) int64, active stroke over the scene, 0-based")
       .def_readonly("element", &PyTrialResult::element,
                     "(N,) int64, active element within the stroke, 0-based")
+      .def_readonly("attempt", &PyTrialResult::attempt,
+                    "(N,) int64, the attempt at the stroke this tick belongs to, 1-based; 0 outside any")
+      .def_readonly(
+          "rewritten", &PyTrialResult::rewritten,
+          "(N,) uint8, 1: part of an attempt at the stroke written again later (not the final writing)")
       .def_readonly("stroke_trace_range", &PyTrialResult::stroke_trace_range,
                     "(S, 2) int64, one row per stroke of the scene: [begin, end) of its last attempt in the "
                     "trace, the ticks its deviations are measured over (empty when not written or no trace)")
@@ -483,9 +519,10 @@ void bind_trial(py::module_& m) {
             return Annotated<DataFrameTag>{
                 py::module_::import("calligraphy.frames").attr("trial_dataframe")(self)};
           },
-          "A pandas.DataFrame with one row per servo tick: time_s [s], x_m, y_m, z_m [m], fx_n, fy_n, fz_n "
-          "[N], state (categorical 'SS', 'AS', 'CS', 'WS'), stroke, element (0-based). Raises ImportError "
-          "without pandas.")
+          "A pandas.DataFrame with one row per servo tick, its columns named as trace_columns() names them: "
+          "t_s [s], x_m, y_m, z_m [m], fx_n, fy_n, fz_n [N], state (categorical 'SS', 'AS', 'CS', 'WS'), "
+          "stroke, element (0-based), attempt (1-based, 0 outside any), rewritten (1: written again later). "
+          "Raises ImportError without pandas.")
       .def(
           "per_stroke_dataframe",
           [](const py::object& self) {
@@ -547,6 +584,15 @@ Raises DataError naming the record and the JSON pointer of a value at fault, a r
 specification (written before records held one) or of another version; InvalidArgument when the
 characters placed are not the recorded ones (other character data), or a replay without its teacher;
 CharacterNotFound; TypeError for a record of another type.)");
+  m.def(
+      "check_trial_record", &check_trial_record_py, py::arg("record"),
+      R"(Checks the trial a record states, as rerun_trial and `calligraphy trial --spec RECORD --check` check
+it, without running it: every field in its range (the one schema, `calligraphy schema record`), every
+contradiction refused. record: as rerun_trial takes it. Returns the record's specification as the library
+writes it back (a dict: "format", "version", "trial", "force_law", ...; enumerations by their one spelling),
+which check_trial_record and rerun_trial take again. Raises DataError naming the record and the JSON pointer
+of a value at fault; InvalidArgument naming the field of a contradiction; TypeError for a record of another
+type.)");
   m.def("record_teacher", &record_teacher_py, py::arg("result"), py::arg("path") = py::none(),
         R"(A teacher's recording of a trial (teacher_recording_from_trace,
 include/calligraphy/report/teacher_recording.hpp): the pen's times [s] and positions [m] of every tick,

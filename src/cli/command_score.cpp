@@ -4,10 +4,10 @@
 #include <memory>
 #include <string>
 
+#include "calligraphy/analysis/writing_metrics.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/report/pen_trace_csv.hpp"
 #include "calligraphy/report/score_report.hpp"
-#include "calligraphy/analysis/writing_metrics.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 #include "cli/output.hpp"
@@ -35,7 +35,8 @@ int run_score(const ScoreCommand& command) {
   files.input("TRACE", command.trace);
   add_library_inputs(files, command.library);
   files.output("--json", command.json);
-  // Several characters are placed as a trial places them (Scene::lay_out), so a trial's CSV scores as written.
+  // Several characters are placed as a trial places them (Scene::lay_out), so a trial's CSV scores as
+  // written.
   std::vector<Character> models;
   const CharacterSource source(command.library);
   for (const char32_t c : chars) models.push_back(source.load(c));
@@ -63,11 +64,13 @@ int run_score(const ScoreCommand& command) {
 
 void add_score_command(CLI::App& root, Commands& commands) {
   auto command = std::make_shared<ScoreCommand>();
-  CLI::App* app = commands.add(root, "score", "Score a pen trace (CSV) against a character or a row of characters",
-                               [command] { return run_score(*command); });
+  CLI::App* app =
+      commands.add(root, "score", "Score a pen trace (CSV) against a character or a row of characters",
+                   [command] { return run_score(*command); });
   add_positional(*app, "TRACE", command->trace,
-                 "CSV with a header naming t [s], x, y and pen (1/0) or z [m]; other columns are ignored, "
-                 "so `trial --csv` output is read as it is",
+                 "CSV with a header naming t [s], x, y and pen (1/0) or z [m] (or t_s, x_m, y_m, z_m as "
+                 "Python's DataFrames name them); other columns are ignored, so `trial --csv` output is read "
+                 "as it is",
                  "FILE");
   required(add_text(*app, "--character", command->character, "CHARS",
                     "the character(s) the trace writes, placed as a trial places them"));

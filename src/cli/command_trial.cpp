@@ -43,6 +43,7 @@ struct TrialCommand {
   std::vector<std::string> writer_parameters;  // "key=value", applied in turn
   LibraryOptions library;
   std::string spec_file;          // --spec: a trial record (or its specification) to run again
+  bool check = false;             // --check: validate the trial as stated, run nothing, write nothing
   const CLI::App* app = nullptr;  // to ask which options were given
 };
 
@@ -144,7 +145,8 @@ TrialDescription describe(const TrialSpec& spec, const TrialRun& run, const Simu
 
 // A replay's teacher: the recording --teacher (or the record) names, of these characters and, for a record
 // that names its teacher's SHA-256, that recording; `sha256` is set to its file's.
-std::vector<TeacherSample> teacher_samples(const TrialSpec& spec, const std::optional<RecordedTrial>& recorded,
+std::vector<TeacherSample> teacher_samples(const TrialSpec& spec,
+                                           const std::optional<RecordedTrial>& recorded,
                                            std::string& sha256) {
   TeacherFile teacher = read_recorded_teacher(recorded ? *recorded : RecordedTrial{}, spec.teacher);
   try {
@@ -229,6 +231,8 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
   try {
     simulated = simulated_writer_writes(spec, simulated_writer_moves(device));
   } catch (const InvalidArgument& e) {
+    // A record is data: its writer that cannot hold its device is named as every bad value of it is.
+    if (recorded) throw DataError(command.spec_file + ": /specification/trial/writer: " + e.what());
     throw UsageError(e.what());
   }
   // A profile or its settings describe the simulated writer: with a person writing they would be ignored.
@@ -253,6 +257,12 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
   if (command.app->count("--watchdog-ms") > 0 && !real_time) {
     throw UsageError(
         "--watchdog-ms applies to real-time pacing only (--pacing real-time, or a hardware device)");
+  }
+  // --check: everything a trial's statement is checked for is checked above; no character is read, no
+  // device opened, no file written.
+  if (command.check) {
+    std::printf("%s: a valid trial specification\n", recorded ? command.spec_file.c_str() : "the options");
+    return 0;
   }
   // Every input and output is checked before the trial: no output replaces an input or another output.
   FilePlan files;
@@ -342,6 +352,10 @@ void add_trial_command(CLI::App& root, Commands& commands, DeviceRegistry& devic
                  "\"specification\"): identical on the simulated device; CHARS and the trial's options then "
                  "come from it",
                  "none");
+  add_flag(*app, "--check", command->check,
+           "check the trial as stated (--spec RECORD, or CHARS and the options) and exit: 0 when it is "
+           "valid, as a trial would refuse it otherwise; no character is read, no device opened, nothing "
+           "written");
   // Every field of the specification with an option of its own, typed, its unit, range and default from
   // the schema; files, who writes and the writer's profile and settings are declared below.
   const TrialSpec defaults;
@@ -354,7 +368,7 @@ void add_trial_command(CLI::App& root, Commands& commands, DeviceRegistry& devic
   }
   add_input_path(*app, "--teacher", command->spec.teacher, "FILE", spec_help("teacher"), "none");
   add_writer_option(*app, command->writer, spec_help("writer"),
-                    "simulated on a simulated or emulated device, person on hardware");
+                    "simulated on a simulated or emulated device, person on hardware", true);
   add_choice(*app, "--writer-profile", command->writer_profile, {"novice", "skilled", "foreign"},
              spec_help("writer_profile"));
   add_repeated_text(*app, "--writer-param", command->writer_parameters, "KEY=VALUE",

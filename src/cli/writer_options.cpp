@@ -2,14 +2,15 @@
 
 #include <map>
 
-#include "calligraphy/render/guidance_mode.hpp"
 #include "calligraphy/devices/hand_port.hpp"
+#include "calligraphy/render/guidance_mode.hpp"
+#include "calligraphy/trial/trial_spec.hpp"
 #include "cli/cli_devices.hpp"
 
 namespace calligraphy::cli {
 
 CLI::Option* add_writer_option(CLI::App& app, std::string& target, const std::string& description,
-                               const std::string& default_text) {
+                               const std::string& default_text, bool every_spelling) {
   // --writer's values from before it meant who writes (trial: the profile; session run: human) are
   // refused saying what to write now, so an old command line is not read as something else.
   const std::string meaning = "--writer is who writes (person or simulated); ";
@@ -19,8 +20,12 @@ CLI::Option* add_writer_option(CLI::App& app, std::string& target, const std::st
       {"foreign", meaning + "the profile is --writer-profile foreign"},
       {"human", meaning + "a person writing is --writer person"},
   };
-  return add_choice(app, "--writer", target, {kPersonWriter, kSimulatedWriter}, description, default_text,
-                    retired);
+  std::vector<std::string> choices{kPersonWriter, kSimulatedWriter};
+  if (every_spelling) {
+    choices.clear();
+    for (const std::string_view spelling : enum_spellings<TrialWriter>()) choices.emplace_back(spelling);
+  }
+  return add_choice(app, "--writer", target, choices, description, default_text, retired);
 }
 
 bool simulated_writer_moves(const DeviceListing& device) {

@@ -16,10 +16,11 @@ inline constexpr const char* kPersonWriter = "person";
 inline constexpr const char* kSimulatedWriter = "simulated";
 
 /// --writer person|simulated into `target` (left as it is when not given: "" lets the device decide, see
-/// `writer_for_device`); `default_text` is the default --help shows. The values --writer took before
-/// (novice, skilled, foreign, human) are usage errors saying what to write instead.
+/// `writer_for_device`); `default_text` is the default --help shows. `every_spelling`: every spelling of
+/// TrialWriter's table, "auto" (the device's own) too, as a trial specification takes them. The values
+/// --writer took before (novice, skilled, foreign, human) are usage errors saying what to write instead.
 CLI::Option* add_writer_option(CLI::App& app, std::string& target, const std::string& description,
-                               const std::string& default_text);
+                               const std::string& default_text, bool every_spelling = false);
 
 /// Whether the simulated writer can move `device` (it has a hand port); else a person moves it.
 bool simulated_writer_moves(const DeviceListing& device);

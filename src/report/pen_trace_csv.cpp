@@ -11,6 +11,7 @@
 
 #include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/report/trace_columns.hpp"
 #include "calligraphy/report/trace_hdf5.hpp"
 #include "report/compressed_text.hpp"
 
@@ -192,18 +193,24 @@ class Reader {
     Columns c;
     c.count = names.size();
     std::optional<std::size_t> t, x, y, fx, fy;
+    // A trace column by its name in the table or its file name ("t_s" or "t": trace_columns.hpp).
+    const auto file_name = [](std::string_view name) {
+      const std::optional<TraceColumnInfo> info = trace_column(name);
+      return info ? info->file_name : name;
+    };
     for (std::size_t i = 0; i < names.size(); ++i) {
+      const std::string_view name = file_name(names[i]);
       for (std::size_t j = 0; j < i; ++j) {
-        if (!names[i].empty() && names[i] == names[j])
+        if (!names[i].empty() && name == file_name(names[j]))
           fail("column name '" + std::string(names[i]) + "' appears twice");
       }
-      if (names[i] == "t") t = i;
-      if (names[i] == "x") x = i;
-      if (names[i] == "y") y = i;
-      if (names[i] == "pen") c.pen = i;
-      if (names[i] == "z") c.z = i;
-      if (names[i] == "fx") fx = i;
-      if (names[i] == "fy") fy = i;
+      if (name == "t") t = i;
+      if (name == "x") x = i;
+      if (name == "y") y = i;
+      if (name == "pen") c.pen = i;
+      if (name == "z") c.z = i;
+      if (name == "fx") fx = i;
+      if (name == "fy") fy = i;
     }
     for (const auto& [column, name] : {std::pair{t, "t"}, std::pair{x, "x"}, std::pair{y, "y"}}) {
       if (!column) fail(std::string("header has no column '") + name + "' (expected t, x, y and pen or z)");

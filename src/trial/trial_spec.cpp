@@ -145,8 +145,8 @@ const std::vector<SchemaField>& spec_fields() {
                                            .option = "--json",
                                            .option_value_name = "FILE"}),
       string_field<&TrialSpec::csv_file>(
-          "csv_file", {.doc = "write the trace (t,x,y,z,fx,fy,fz,state,stroke,element; s, m, N) as CSV ('-': "
-                              "standard output)",
+          "csv_file", {.doc = "write the trace (t,x,y,z,fx,fy,fz,state,stroke,element,attempt,rewritten; "
+                              "s, m, N) as CSV ('-': standard output)",
                        .option = "--csv",
                        .option_value_name = "FILE"}),
       string_field<&TrialSpec::svg_file>(

@@ -646,8 +646,11 @@ class OneCommandLine(CliTestCase):
         message = self.assert_usage_error(["session", "run", "p.json", "--writer", "human", "--out", "o"],
                                           "--writer")
         self.assertIn("--writer person", message)
-        for command in (["trial"], ["train"], ["session", "run"]):
+        for command in (["train"], ["session", "run"]):
             self.assertIn("--writer person|simulated", self.run_cli(*command, "--help").stdout.decode(), command)
+        # trial takes every spelling of the specification's TrialWriter, "auto" (the device's own) too.
+        self.assertIn("--writer auto|person|simulated", self.run_cli("trial", "--help").stdout.decode())
+        self.assertEqual(self.trial_json("十", "--writer", "auto", "--seed", "1"), self.trial_json("十", "--seed", "1"))
         # The new spellings: the simulated writer with a profile; a person cannot hold the simulated device.
         metrics = self.trial_json("十", "--writer", "simulated", "--writer-profile", "skilled", "--seed", "1")
         self.assertEqual((metrics["writer"], metrics["writer_profile"]), ("skilled", "skilled"))

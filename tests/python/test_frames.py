@@ -19,12 +19,17 @@ def result():
 def test_one_row_per_tick_with_units_in_the_column_names(result):
     frame = result.to_dataframe()
     assert list(frame.columns) == ["t_s", "x_m", "y_m", "z_m", "fx_n", "fy_n", "fz_n", "state", "stroke",
-                                   "element"]
+                                   "element", "attempt", "rewritten"]
     assert len(frame) == result.time_s.size
     np.testing.assert_array_equal(frame["t_s"], result.time_s)
     np.testing.assert_array_equal(frame[["x_m", "y_m", "z_m"]].to_numpy(), result.position_m)
     np.testing.assert_array_equal(frame[["fx_n", "fy_n", "fz_n"]].to_numpy(), result.force_n)
     np.testing.assert_array_equal(frame["stroke"], result.stroke)
+    np.testing.assert_array_equal(frame["attempt"], result.attempt)
+    np.testing.assert_array_equal(frame["rewritten"], result.rewritten)
+    # Every tick of a written stroke belongs to an attempt at it (1-based); rewritten is 0 or 1.
+    assert frame.loc[frame["state"] == "WS", "attempt"].min() >= 1
+    assert set(frame["rewritten"].unique()) <= {0, 1}
     # The state column names the states as the paper does, in InteractionState's order.
     names = [s.short_name for s in calligraphy.InteractionState.__members__.values()]
     assert list(frame["state"].cat.categories) == names
@@ -78,7 +83,7 @@ def test_the_librarys_own_frames_are_scored(tmp_path):
     trial = calligraphy.simulate_trial("十", seed=4)
     frame = trial.to_dataframe()
     table = calligraphy.trace_columns()
-    assert [c["name"] for c in table][:10] == list(frame.columns)
+    assert [c["name"] for c in table] == list(frame.columns)
     from_frame = calligraphy.score(frame, "十")
     by_file_names = {c["file_name"]: frame[c["name"]].to_numpy() for c in table[:4]}
     assert calligraphy.score(by_file_names, "十") == from_frame

@@ -10,7 +10,7 @@ import typing
 
 import numpy as np
 
-from ._calligraphy import metric_table
+from ._calligraphy import metric_table, trace_columns
 from .metrics import metric_frame
 
 if typing.TYPE_CHECKING:  # pragma: no cover
@@ -46,26 +46,29 @@ def trial_dataframe(result: TrialResult) -> pandas.DataFrame:
     from the device [m]; ``fx_n``, ``fy_n``, ``fz_n``, the commanded force [N]; ``state``, the
     interaction state as a categorical of 'SS', 'AS', 'CS', 'WS' (paper Table 1); ``stroke``, the active
     stroke over the scene (0-based, as ``result.scene.strokes``); ``element``, the active element
-    within it (0-based). Raises ImportError when pandas is missing.
+    within it (0-based); ``attempt``, the attempt at the stroke (1-based, 0 outside any); ``rewritten``, 1 for
+    a tick of an attempt written again later. Raises ImportError when pandas is missing.
     """
     pandas = _pandas()
     position = np.asarray(result.position_m)
     force = np.asarray(result.force_n)
     state = pandas.Categorical.from_codes(np.asarray(result.state, dtype=np.int8), categories=_state_names())
-    return pandas.DataFrame(
-        {
-            "t_s": np.asarray(result.time_s),
-            "x_m": position[:, 0],
-            "y_m": position[:, 1],
-            "z_m": position[:, 2],
-            "fx_n": force[:, 0],
-            "fy_n": force[:, 1],
-            "fz_n": force[:, 2],
-            "state": state,
-            "stroke": np.asarray(result.stroke),
-            "element": np.asarray(result.element),
-        }
-    )
+    columns = {
+        "t_s": np.asarray(result.time_s),
+        "x_m": position[:, 0],
+        "y_m": position[:, 1],
+        "z_m": position[:, 2],
+        "fx_n": force[:, 0],
+        "fy_n": force[:, 1],
+        "fz_n": force[:, 2],
+        "state": state,
+        "stroke": np.asarray(result.stroke),
+        "element": np.asarray(result.element),
+        "attempt": np.asarray(result.attempt),
+        "rewritten": np.asarray(result.rewritten, dtype=np.int64),
+    }
+    # In the table's order, each column by its name there (a column the table lacks is an error here).
+    return pandas.DataFrame({column["name"]: columns[column["name"]] for column in trace_columns()})
 
 
 # Every stroke-level metric of the metric table, in its order: the per-stroke table's metric columns.
