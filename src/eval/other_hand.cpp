@@ -315,7 +315,7 @@ std::string other_hand_markdown(const OtherHandMeasurement& m, const std::string
       (m.assist_after_misses > 0 ? "it has been refused " + std::to_string(m.assist_after_misses) +
                                        " times (`assist_after_misses`), when it is credited assisted.\n\n"
                                  : "it has been refused 5 times (no assisted credit).\n\n");
-  {
+  if (m.draw.with_file > 0) {  // said when the draw's counts were kept
     const SharedCharacters& d = m.draw;
     char text[400];
     std::snprintf(
