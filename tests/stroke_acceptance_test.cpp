@@ -22,7 +22,7 @@ using namespace calligraphy;
 namespace {
 
 // Rates the matcher reaches on these paths (docs/stroke-acceptance.md): at least 98 % of each positive
-// kind accepted (99.3 % or more but for strokes lifted short, 98.0-98.7 %), at most 1 % of each negative
+// kind accepted (99.4 % or more but for strokes lifted short, 99.1 %), at most 1 % of each negative
 // kind credited. A kind may fall short of that by three standard deviations of its sample, counted with a
 // design effect of 3: the strokes of one character are not independent (a dense character has many
 // short strokes, where the misses are), so 100 characters drawn at random vary more than 1,150
@@ -92,8 +92,11 @@ TEST_CASE("Another hand's strokes (KanjiVG) written by a position-only pen are a
   }
   const CharacterLibrary library = CharacterLibrary::from_directory(testing::corpus_folder());
   const std::uint64_t seed = 2026;
-  std::vector<char32_t> characters =
-      random_shared_characters(library, folder, 500, seed, CharacterLibrary::embedded().characters());
+  // The held-out half: the characters the rule's tolerances were not tuned on (KanjivgHalf).
+  const SharedCharacters draw =
+      draw_shared_characters(library, folder, 500, seed, CharacterLibrary::embedded().characters(),
+                             kSameFormFrechet_m, KanjivgHalf::held_out);
+  std::vector<char32_t> characters = draw.chosen;
   characters = testing::sanitizer_subset(characters, 60, "characters of the KanjiVG sweep");
   if (characters.size() < 20) {
     WARN(
@@ -101,27 +104,30 @@ TEST_CASE("Another hand's strokes (KanjiVG) written by a position-only pen are a
         "library; set CALLIGRAPHY_CORPUS_DIR to the whole hanzi-writer-data package)");
     return;
   }
-  const OtherHandMeasurement m = measure_other_hand(library, folder, characters, seed, 5);
+  OtherHandMeasurement m = measure_other_hand(library, folder, characters, seed, 5);
+  m.half = KanjivgHalf::held_out;
+  m.draw = draw;
   std::cout << other_hand_markdown(m, "the KanjiVG acceptance test, seed 2026") << "\n";
   const std::size_t n = m.characters.size();
   // No dead end: with the assisted credit every character is completed.
   CHECK(m.characters_completed == n);
   CHECK(m.strokes_unassisted + m.strokes_assisted == m.strokes);
-  // What the rule reaches on these lines (docs/stroke-acceptance.md): 98.7 % of strokes and 90 % of
+  // What the rule reaches on the held-out half (docs/stroke-acceptance.md): 98.3 % of strokes and 89 % of
   // characters without assistance. Short of the goals (99 % and 97 %): the misses are dots and ticks whose
-  // KanjiVG ends lie 2-3 mm from the medians', as far as a half stroke's (see the docs).
+  // KanjiVG lines cover the middle of the median, as little of it as a half stroke does (see the docs).
   const double strokes = share(m.strokes_unassisted, m.strokes);
   const double whole = share(m.characters_unassisted, n);
   CHECK(strokes >= 0.98 - slack(0.98, m.strokes));
   CHECK(whole >= 0.88 - slack(0.88, n));
-  // Negatives made from the same lines: reversed, another stroke and the next stroke are refused as on the
-  // medians; half, shifted and scribble are credited more often than on the medians (docs).
+  // Negatives made from the same lines: reversed, another stroke, the next stroke and a shift of exactly
+  // 8 mm are refused as on the medians; half, shifted by 4-8 mm and scribble are credited more often than
+  // on the medians (halves of 3-6 mm strokes, shifts of a line itself up to 4 mm off; docs).
   for (const KindAcceptance& k : m.kinds) {
     if (is_positive(k.kind) || k.paths == 0) continue;
     INFO(to_string(k.kind) << ": " << k.accepted << " of " << k.paths << " accepted");
     const bool harder =
         k.kind == TraceKind::half || k.kind == TraceKind::shifted || k.kind == TraceKind::scribble;
-    const double rate = harder ? 0.035 : kNegativeRate;
+    const double rate = harder ? 0.04 : kNegativeRate;
     CHECK(share(k.accepted, k.paths) <= rate + slack(rate, k.paths));
   }
 }

@@ -185,4 +185,19 @@ TEST_CASE(
   const RecordedTrial v3 = read_recorded_trial(old.dump(), "v3.json");
   CHECK(v3.force_law.acceptance.assist_after_misses == 0.0);
   CHECK(v3.force_law.acceptance.shortfall_per_length == 0.0);
+  CHECK(v3.force_law.acceptance.end_gap_m == 0.0);
+
+  // A version-4 record (no floor of the end gap) runs as it ran: without the floor, the rest as recorded.
+  nlohmann::json v4_json = nlohmann::json::parse(json);
+  v4_json["version"] = 4;
+  for (const char* key : {"end_gap_m", "end_gap_fraction"}) v4_json["force_law"]["acceptance"].erase(key);
+  const RecordedTrial v4 = read_recorded_trial(v4_json.dump(), "v4.json");
+  StrokeAcceptance as_v4 = first.options.force.acceptance;
+  as_v4.use_version_4_end_gaps();
+  CHECK(v4.force_law.acceptance == as_v4);
+  CHECK(v4.force_law.acceptance.end_gap_m == 0.0);
+  CHECK(recorded.force_law.acceptance.end_gap_m == StrokeAcceptance{}.end_gap_m);
+  // Without the floor, a stroke left 4 mm short at one end of a 10 mm stroke is refused; with it, accepted.
+  CHECK(as_v4.allowed_end_gap_m(0.010) < 0.004);
+  CHECK(StrokeAcceptance{}.allowed_end_gap_m(0.010) >= 0.004);
 }

@@ -275,3 +275,40 @@ TEST_CASE("Bad input to the stroke matcher is refused naming it", "[stroke_progr
   bad.max_gain_ratio = 0.5;
   CHECK_THROWS_WITH(bad.validate(), Catch::Contains("max_gain_ratio"));
 }
+
+TEST_CASE("Either end of a short stroke may be left unwritten by the end-point scatter, but not half of it",
+          "[stroke_progress]") {
+  // A 10 mm stroke: the shortfall allowed is 3.5 mm (0.35 of it); the end gap's floor lets either end be
+  // 4 mm unwritten (0.4 of it, under the 4.5 mm floor), as another hand's short strokes end.
+  Character c;
+  c.code_point = U'丶';
+  Stroke s;
+  s.typical_id = 1;
+  s.elements = {StrokeElement::line({400, 500}, {400 + 10 * kMmUnits, 500})};
+  s.attraction_factors = {1.0, 1.0};
+  c.strokes = {s};
+  const Scene scene = Scene::lay_out({c});
+  const PlacedStroke& stroke = scene.characters[0].strokes[0];
+  const Vec2 a = stroke.start();
+  const Vec2 b = stroke.end();
+  StrokeAcceptance version_4;
+  version_4.use_version_4_end_gaps();
+  const StrokeAcceptance now;
+  REQUIRE(now.allowed_end_gap_m(0.010) == Approx(0.004));
+  REQUIRE(version_4.allowed_end_gap_m(0.010) == Approx(0.0035));
+  // Begun 1 mm before the start, lifted 3.8 mm short of the end: 7.2 mm along, 6.5 needed.
+  const std::vector<Vec2> end_short = along({a - mm(1, 0), b - mm(3.8, 0)});
+  CHECK(attempt_stroke(stroke, end_short, kStartRadius, now).written);
+  const StrokeAttempt refused_before = attempt_stroke(stroke, end_short, kStartRadius, version_4);
+  CHECK_FALSE(refused_before.written);
+  CHECK(refused_before.refusal == StrokeRefusal::too_short);
+  // Begun 3.8 mm in, carried 1 mm past the end.
+  const std::vector<Vec2> start_late = along({a + mm(3.8, 0), b + mm(1, 0)});
+  CHECK(attempt_stroke(stroke, start_late, kStartRadius, now).written);
+  CHECK_FALSE(attempt_stroke(stroke, start_late, kStartRadius, version_4).written);
+  // Either half, and 4.5 mm short at one end: refused with the floor too.
+  for (const std::vector<Vec2>& wrong :
+       {along({a, (a + b) / 2}), along({(a + b) / 2, b}), along({a - mm(1, 0), b - mm(4.5, 0)})}) {
+    CHECK_FALSE(attempt_stroke(stroke, wrong, kStartRadius, now).written);
+  }
+}

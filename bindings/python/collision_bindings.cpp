@@ -161,6 +161,8 @@ void bind_collision(py::module_& m) {
       .field(&StrokeAcceptance::reference_character_size_m)
       .field(&StrokeAcceptance::hint_after_misses)
       .field(&StrokeAcceptance::assist_after_misses)
+      .field(&StrokeAcceptance::end_gap_m)
+      .field(&StrokeAcceptance::end_gap_fraction)
       .finish();
 
   py::enum_<StrokeRefusal>(m, "StrokeRefusal",

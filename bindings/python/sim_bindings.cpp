@@ -254,7 +254,9 @@ void bind_person_traces(py::module_& m) {
              "negative: a 'human' path of another stroke of the character")
       .value("swapped_order", TraceKind::swapped_order,
              "negative: a 'human' path of the next stroke, written first")
-      .value("scribble", TraceKind::scribble, "negative: a zig-zag from the stroke's start");
+      .value("scribble", TraceKind::scribble, "negative: a zig-zag from the stroke's start")
+      .value("shifted_8mm", TraceKind::shifted_8mm,
+             "negative: as 'shifted', every point moved exactly 8 mm across (the acceptance target's shift)");
 
   m.def(
       "is_positive", [](const PyArgument<TraceKind>& kind) { return is_positive(take(kind, "kind")); },

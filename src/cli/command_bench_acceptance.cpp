@@ -2,6 +2,7 @@
 // the embedded ones), matched by the stroke matcher; the confusion table per kind
 // (docs/stroke-acceptance.md). With --markdown FILE the generated section of that document is replaced and
 // the rest kept.
+#include <cstdio>
 #include <memory>
 #include <string>
 
@@ -26,6 +27,8 @@ struct AcceptanceCommand {
   std::string markdown;
   std::string kanjivg;
   std::int64_t assist_after_misses = 5;
+  std::string half = "held-out";
+  double form_tolerance_mm = kSameFormFrechet_m * 1000.0;
   std::int64_t characters = 500;
   std::uint64_t seed = 1;
 };
@@ -45,22 +48,42 @@ int run_acceptance(const AcceptanceCommand& command) {
   std::string section;
   const char* begin_marker = kAcceptanceGeneratedBegin;
   if (!command.kanjivg.empty()) {
-    // Another hand's strokes: the characters KanjiVG and the library share with as many strokes.
-    const std::vector<char32_t> chosen = random_shared_characters(
-        library, command.kanjivg, count, command.seed, CharacterLibrary::embedded().characters());
-    if (chosen.empty()) {
-      throw UsageError(
-          "bench acceptance: --kanjivg " + command.kanjivg +
-          ": no character of the library (beyond the embedded ones) has a KanjiVG file there with "
-          "as many strokes (give the folder scripts/fetch-kanjivg.sh prints)");
+    // Another hand's strokes: the characters KanjiVG and the library share with as many strokes, in the
+    // same order and form, from the half asked for (both: each half, the tuning one first).
+    invocation +=
+        " --assist-after-misses " + std::to_string(command.assist_after_misses) + " --half " + command.half;
+    if (command.form_tolerance_mm != kSameFormFrechet_m * 1000.0) {
+      char tolerance[32];
+      std::snprintf(tolerance, sizeof tolerance, "%g", command.form_tolerance_mm);
+      invocation.append(" --form-tolerance-mm ").append(tolerance);
     }
-    const OtherHandMeasurement measurement =
-        measure_other_hand(library, command.kanjivg, chosen, command.seed,
-                           static_cast<std::uint32_t>(command.assist_after_misses));
-    invocation += " --assist-after-misses " + std::to_string(command.assist_after_misses);
+    std::vector<KanjivgHalf> halves;
+    if (command.half != "held-out") halves.push_back(KanjivgHalf::tuning);
+    if (command.half != "tuning") halves.push_back(KanjivgHalf::held_out);
     begin_marker = kOtherHandGeneratedBegin;
-    section = std::string(begin_marker) + "\n" + other_hand_markdown(measurement, invocation) +
-              kGeneratedEnd + "\n";
+    section = std::string(begin_marker) + "\n";
+    for (const KanjivgHalf half : halves) {
+      const double tolerance_m = command.form_tolerance_mm / 1000.0;
+      const SharedCharacters draw =
+          draw_shared_characters(library, command.kanjivg, count, command.seed,
+                                 CharacterLibrary::embedded().characters(), tolerance_m, half);
+      if (draw.chosen.empty()) {
+        throw UsageError(
+            "bench acceptance: --kanjivg " + command.kanjivg + ": no character of the " + to_string(half) +
+            " half of the library (beyond the embedded ones) has a KanjiVG file there with as many strokes "
+            "in the same order and form (give the folder scripts/fetch-kanjivg.sh prints, or a wider "
+            "--form-tolerance-mm)");
+      }
+      OtherHandMeasurement measurement =
+          measure_other_hand(library, command.kanjivg, draw.chosen, command.seed,
+                             static_cast<std::uint32_t>(command.assist_after_misses));
+      measurement.half = half;
+      measurement.form_tolerance_m = tolerance_m;
+      measurement.draw = draw;
+      section += other_hand_markdown(measurement, invocation);
+      if (half != halves.back()) section += "\n";
+    }
+    section += std::string(kGeneratedEnd) + "\n";
   } else {
     const std::vector<char32_t> chosen =
         random_characters(library, count, command.seed, CharacterLibrary::embedded().characters());
@@ -101,6 +124,13 @@ void add_bench_acceptance_command(CLI::App& bench, Commands& commands) {
       *app, "--assist-after-misses", command->assist_after_misses, "N",
       "with --kanjivg: refusals of a stroke before it is credited assisted, as in the trial (0: never)", 0,
       1000);
+  add_choice(*app, "--half", command->half, {"tuning", "held-out", "both"},
+             "with --kanjivg: which half of the shared characters (split by a hash of the code point): the "
+             "one the rule's tolerances were tuned on, the one held out from tuning, or each in turn");
+  add_number(*app, "--form-tolerance-mm", command->form_tolerance_mm, "MM",
+             "with --kanjivg: the same form: each KanjiVG line within this discrete Frechet distance of its "
+             "median [mm, 60 mm box]; wider admits more characters, and lines farther from the medians",
+             "a number in (0, 60]", [](double v) { return v > 0.0 && v <= 60.0; });
   add_integer(*app, "--characters", command->characters, "N",
               "characters drawn at random (not the embedded ones)", 1, 100000);
   add_unsigned(*app, "--seed", command->seed, "S", "seed of the draw and the paths (a 64-bit integer)");

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <set>
 #include <sstream>
@@ -21,12 +22,6 @@ namespace {
 constexpr int kAlignmentPoints = 32;
 // Points per stroke of the form test's discrete Frechet distance.
 constexpr int kFormPoints = 64;
-// A stroke of KanjiVG farther than this from its median after alignment (discrete Frechet distance) is
-// another form of the stroke (the Japanese glyph, another component shape), not another hand's copy of
-// it: the smallest parallel shift a matcher must refuse (the `shifted` kind) is 4 mm, so no rule could
-// accept such a copy and refuse that shift.
-constexpr double kSameFormFrechet_m = 0.004;
-
 std::vector<Vec2> resampled(const std::vector<Vec2>& line, int points) {
   std::vector<double> arc(line.size(), 0.0);
   for (std::size_t i = 1; i < line.size(); ++i) arc[i] = arc[i - 1] + (line[i] - line[i - 1]).norm();
@@ -153,7 +148,8 @@ double discrete_frechet_m(const std::vector<Vec2>& a, const std::vector<Vec2>& b
   return previous.back();
 }
 
-bool same_order_and_form(const std::vector<std::vector<Vec2>>& lines, const PlacedCharacter& character) {
+bool same_order_and_form(const std::vector<std::vector<Vec2>>& lines, const PlacedCharacter& character,
+                         double form_tolerance_m) {
   // Mean distance between the resampled line and the resampled median, point by point.
   const auto distance = [](const std::vector<Vec2>& a, const std::vector<Vec2>& b) {
     double sum = 0.0;
@@ -170,7 +166,7 @@ bool same_order_and_form(const std::vector<std::vector<Vec2>>& lines, const Plac
     std::vector<Vec2> reversed(medians[i].rbegin(), medians[i].rend());
     if (distance(line, reversed) < own) return false;
     if (discrete_frechet_m(resampled(lines[i], kFormPoints),
-                           resampled(character.strokes[i].median_m, kFormPoints)) > kSameFormFrechet_m) {
+                           resampled(character.strokes[i].median_m, kFormPoints)) > form_tolerance_m) {
       return false;
     }
     for (std::size_t j = 0; j < medians.size(); ++j) {
@@ -180,21 +176,46 @@ bool same_order_and_form(const std::vector<std::vector<Vec2>>& lines, const Plac
   return true;
 }
 
-std::vector<char32_t> random_shared_characters(const CharacterLibrary& library,
-                                               const std::filesystem::path& folder, std::size_t count,
-                                               std::uint64_t seed, const std::vector<char32_t>& excluded) {
+const char* to_string(KanjivgHalf half) noexcept {
+  switch (half) {
+    case KanjivgHalf::tuning:
+      return "tuning";
+    case KanjivgHalf::held_out:
+      return "held-out";
+    case KanjivgHalf::whole:
+      return "whole";
+  }
+  return "?";
+}
+
+KanjivgHalf kanjivg_half_of(char32_t code_point) noexcept {
+  // SplitMix64's finaliser (Steele, Lea & Flood 2014): every bit of the code point moves the low bit.
+  std::uint64_t z = static_cast<std::uint64_t>(code_point) + 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30U)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27U)) * 0x94d049bb133111ebULL;
+  z ^= z >> 31U;
+  return (z & 1U) == 0U ? KanjivgHalf::tuning : KanjivgHalf::held_out;
+}
+
+SharedCharacters draw_shared_characters(const CharacterLibrary& library, const std::filesystem::path& folder,
+                                        std::size_t count, std::uint64_t seed,
+                                        const std::vector<char32_t>& excluded, double form_tolerance_m,
+                                        KanjivgHalf half) {
   const std::set<char32_t> left_out(excluded.begin(), excluded.end());
+  SharedCharacters out;
   std::vector<char32_t> pool;
   for (char32_t c : library.characters()) {
-    if (left_out.count(c) == 0 && std::filesystem::is_regular_file(kanjivg_file(folder, c)))
+    if (left_out.count(c) == 0 && (half == KanjivgHalf::whole || kanjivg_half_of(c) == half) &&
+        std::filesystem::is_regular_file(kanjivg_file(folder, c)))
       pool.push_back(c);
   }
+  out.with_file = pool.size();
   std::mt19937_64 random(seed);
   std::shuffle(pool.begin(), pool.end(), random);
   // Drawn in the shuffled order, kept when the stroke counts match: a uniform draw from the intersection.
-  std::vector<char32_t> chosen;
   for (char32_t c : pool) {
-    if (chosen.size() >= count) break;
+    if (out.chosen.size() >= count) break;
+    ++out.looked_at;
     std::vector<std::vector<Vec2>> strokes;
     try {
       strokes = read_kanjivg_strokes(kanjivg_file(folder, c));
@@ -203,12 +224,26 @@ std::vector<char32_t> random_shared_characters(const CharacterLibrary& library,
     }
     const Character character = library.load(c);
     if (strokes.size() != character.strokes.size()) continue;
+    ++out.same_count;
     const Scene scene = Scene::lay_out({character});
-    if (same_order_and_form(align_to_medians(strokes, scene.characters.front()), scene.characters.front())) {
-      chosen.push_back(c);
+    const std::vector<std::vector<Vec2>> lines = align_to_medians(strokes, scene.characters.front());
+    // The order alone: any form passes a tolerance as wide as the box.
+    if (!same_order_and_form(lines, scene.characters.front(), std::numeric_limits<double>::infinity()))
+      continue;
+    ++out.same_order;
+    if (same_order_and_form(lines, scene.characters.front(), form_tolerance_m)) {
+      ++out.same_form;
+      out.chosen.push_back(c);
     }
   }
-  return chosen;
+  return out;
+}
+
+std::vector<char32_t> random_shared_characters(const CharacterLibrary& library,
+                                               const std::filesystem::path& folder, std::size_t count,
+                                               std::uint64_t seed, const std::vector<char32_t>& excluded,
+                                               double form_tolerance_m, KanjivgHalf half) {
+  return draw_shared_characters(library, folder, count, seed, excluded, form_tolerance_m, half).chosen;
 }
 
 OtherHandMeasurement measure_other_hand(const CharacterLibrary& library, const std::filesystem::path& folder,
@@ -280,6 +315,27 @@ std::string other_hand_markdown(const OtherHandMeasurement& m, const std::string
       (m.assist_after_misses > 0 ? "it has been refused " + std::to_string(m.assist_after_misses) +
                                        " times (`assist_after_misses`), when it is credited assisted.\n\n"
                                  : "it has been refused 5 times (no assisted credit).\n\n");
+  if (m.draw.with_file > 0) {  // said when the draw's counts were kept
+    const SharedCharacters& d = m.draw;
+    char text[400];
+    std::snprintf(
+        text, sizeof text,
+        "Drawn from the %s half (a hash of the code point; the rule is tuned on the other) with the "
+        "same form within %g mm: of the %zu characters of the half that KanjiVG has, %zu looked at, "
+        "%zu with as many strokes, %zu of those in the same order, %zu of those in the same form.\n\n",
+        to_string(m.half), m.form_tolerance_m * 1000.0, d.with_file, d.looked_at, d.same_count, d.same_order,
+        d.same_form);
+    if (m.half != KanjivgHalf::held_out) {
+      std::snprintf(
+          text, sizeof text,
+          "Drawn from the %s half (a hash of the code point) with the same form within %g mm: of the "
+          "%zu characters of the half that KanjiVG has, %zu looked at, %zu with as many strokes, "
+          "%zu of those in the same order, %zu of those in the same form.\n\n",
+          to_string(m.half), m.form_tolerance_m * 1000.0, d.with_file, d.looked_at, d.same_count,
+          d.same_order, d.same_form);
+    }
+    out += text;
+  }
   out += "| measure | count | of | share |\n| --- | ---: | ---: | ---: |\n";
   const auto row = [&out](const std::string& what, std::size_t part, std::size_t whole) {
     out += "| " + what + " | " + std::to_string(part) + " | " + std::to_string(whole) + " | " +

@@ -34,25 +34,66 @@ namespace calligraphy {
 [[nodiscard]] std::vector<std::vector<Vec2>> align_to_medians(const std::vector<std::vector<Vec2>>& strokes,
                                                               const PlacedCharacter& character);
 
+/// The same form's default tolerance: a KanjiVG line farther than this from its median (discrete Frechet
+/// distance, 60 mm box) is another form of the stroke, as far as the smallest parallel shift a matcher must
+/// refuse (4 mm).
+inline constexpr double kSameFormFrechet_m = 0.004;
+
 /// True when every aligned line (align_to_medians) of `lines` lies nearer its own stroke's median, in the
 /// same direction, than any other stroke's (the same order: KanjiVG follows the Japanese order, which
 /// differs from the Chinese for some characters), and within a discrete Frechet distance (Eiter & Mannila
-/// 1994) of 4 mm of it in a 60 mm box (the same form: farther is another glyph's stroke, as far as the
-/// smallest shift a matcher must refuse).
+/// 1994) of `form_tolerance_m` of it in a 60 mm box (the same form: farther is another glyph's stroke).
 [[nodiscard]] bool same_order_and_form(const std::vector<std::vector<Vec2>>& lines,
-                                       const PlacedCharacter& character);
+                                       const PlacedCharacter& character,
+                                       double form_tolerance_m = kSameFormFrechet_m);
 
-/// Up to `count` characters drawn at random with `seed` from the whole intersection: those `library`
-/// has (but not `excluded`) whose KanjiVG file in `folder` exists, has as many strokes, and is in the
-/// same order and form (same_order_and_form).
+/// Which half of the intersection: the rule's tolerances are tuned on one and measured on the other, so
+/// that a measured rate is not one the tuning has fitted.
+enum class KanjivgHalf : std::uint8_t { tuning, held_out, whole };
+
+/// "tuning", "held-out", "whole".
+[[nodiscard]] const char* to_string(KanjivgHalf half) noexcept;
+
+/// The half a character belongs to: a fixed hash of its code point (SplitMix64, Steele, Lea & Flood 2014),
+/// even to `tuning`, odd to `held_out`; the same whatever is drawn, seeded or measured.
+[[nodiscard]] KanjivgHalf kanjivg_half_of(char32_t code_point) noexcept;
+
+/// The characters drawn from the intersection, and how many passed each filter (over the whole pool
+/// looked at: the draw stops once `count` characters are chosen, so the counts are of the pool drawn).
+struct SharedCharacters {
+  std::vector<char32_t> chosen;
+  std::size_t with_file = 0;   ///< in the library (not excluded), in the half, with a KanjiVG file
+  std::size_t looked_at = 0;   ///< of those, looked at before `count` were chosen
+  std::size_t same_count = 0;  ///< of those, with as many strokes
+  std::size_t same_order = 0;  ///< of those, in the same order
+  std::size_t same_form = 0;   ///< of those, every line within the form tolerance: `chosen`
+};
+
+/// Up to `count` characters drawn at random with `seed` from `half` of the whole intersection: those
+/// `library` has (but not `excluded`) whose KanjiVG file in `folder` exists, has as many strokes, and is
+/// in the same order and form (same_order_and_form with `form_tolerance_m`).
+[[nodiscard]] SharedCharacters draw_shared_characters(const CharacterLibrary& library,
+                                                      const std::filesystem::path& folder, std::size_t count,
+                                                      std::uint64_t seed,
+                                                      const std::vector<char32_t>& excluded,
+                                                      double form_tolerance_m = kSameFormFrechet_m,
+                                                      KanjivgHalf half = KanjivgHalf::whole);
+
+/// draw_shared_characters' characters alone.
 [[nodiscard]] std::vector<char32_t> random_shared_characters(const CharacterLibrary& library,
                                                              const std::filesystem::path& folder,
                                                              std::size_t count, std::uint64_t seed,
-                                                             const std::vector<char32_t>& excluded);
+                                                             const std::vector<char32_t>& excluded,
+                                                             double form_tolerance_m = kSameFormFrechet_m,
+                                                             KanjivgHalf half = KanjivgHalf::whole);
 
 struct OtherHandMeasurement {
   std::vector<char32_t> characters;
   std::uint64_t seed = 0;
+  /// How the characters were drawn (said in the markdown): the half, the form tolerance and the counts.
+  KanjivgHalf half = KanjivgHalf::whole;
+  double form_tolerance_m = kSameFormFrechet_m;
+  SharedCharacters draw;
   std::uint32_t assist_after_misses =
       0;  ///< attempts a stroke gets before it is credited assisted (0: never)
   std::size_t strokes = 0;

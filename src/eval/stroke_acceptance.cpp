@@ -39,7 +39,11 @@ void add_kind_verdicts(std::vector<KindAcceptance>& kinds, const PlacedCharacter
                        double start_radius_m, const StrokeAcceptance& acceptance) {
   for (KindAcceptance& k : kinds) {
     if (!trace_applies(source, stroke, k.kind)) continue;
-    const std::vector<Vec2> path = person_trace(source, stroke, k.kind, random);
+    // A kind added after the first thirteen draws from a copy of the generator, so that the other kinds'
+    // paths stay the ones they were before it came.
+    std::mt19937_64 copy = random;
+    const bool added_later = k.kind == TraceKind::shifted_8mm;
+    const std::vector<Vec2> path = person_trace(source, stroke, k.kind, added_later ? copy : random);
     const StrokeMatch match = match_stroke(character, stroke, path, start_radius_m, acceptance);
     ++k.paths;
     if (match.accepted) ++k.accepted;

@@ -66,6 +66,15 @@ constexpr std::array kAcceptanceFields{
         "assist_after_misses", "", ParameterRange{.low = 0.0, .high = 1000.0},
         "refused attempts at a stroke after which it is demonstrated and credited assisted, 0 never",
         &StrokeAcceptance::assist_after_misses},
+    // Added with version 5 of a trial record; older records run with use_version_4_end_gaps().
+    ParameterField<StrokeAcceptance>{"end_gap_m", "m", ParameterRange{.low = 0.0, .high = 0.1},
+                                     "least either end may be left unwritten by on a stroke long enough, 0 "
+                                     "for none",
+                                     &StrokeAcceptance::end_gap_m},
+    ParameterField<StrokeAcceptance>{
+        "end_gap_fraction", "", ParameterRange{.low = 0.0, .high = 1.0, .high_open = true},
+        "the end gap's floor as a fraction of the stroke's length, the smaller applying",
+        &StrokeAcceptance::end_gap_fraction},
 };
 
 }  // namespace
@@ -91,6 +100,11 @@ double StrokeAcceptance::allowed_shortfall_m(double length_m) const noexcept {
       {shortfall_m + shortfall_per_length * length_m, shortfall_cap_m, shortfall_fraction * length_m});
 }
 
+double StrokeAcceptance::allowed_end_gap_m(double length_m) const noexcept {
+  return std::max(
+      {allowed_shortfall_m(length_m), displacement_m, std::min(end_gap_m, end_gap_fraction * length_m)});
+}
+
 double StrokeAcceptance::allowed_mean_deviation_m(double length_m) const noexcept {
   return std::min(mean_deviation_m + deviation_per_length * length_m, mean_deviation_cap_m);
 }
@@ -102,6 +116,7 @@ void StrokeAcceptance::use_fixed_tolerances() noexcept {
   mean_deviation_cap_m = kLength.high;
   reference_character_size_m = 0.0;
   assist_after_misses = 0.0;
+  use_version_4_end_gaps();
 }
 
 StrokeAcceptance StrokeAcceptance::for_character_size(double character_size_m) const noexcept {
@@ -112,7 +127,7 @@ StrokeAcceptance StrokeAcceptance::for_character_size(double character_size_m) c
        {&StrokeAcceptance::corridor_m, &StrokeAcceptance::mean_deviation_m, &StrokeAcceptance::shortfall_m,
         &StrokeAcceptance::displacement_m, &StrokeAcceptance::lookahead_m,
         &StrokeAcceptance::follow_through_m, &StrokeAcceptance::shortfall_cap_m,
-        &StrokeAcceptance::mean_deviation_cap_m}) {
+        &StrokeAcceptance::mean_deviation_cap_m, &StrokeAcceptance::end_gap_m}) {
     out.*length *= k;
   }
   return out;
@@ -260,7 +275,7 @@ bool StrokeProgressTracker::written() const noexcept {
   const StrokeCentreLine& line = stroke_->centre_line;
   const double length = stroke_length_m();
   const double shortfall = acceptance_.allowed_shortfall_m(length);
-  const double end_gap_limit = std::max(shortfall, acceptance_.displacement_m);
+  const double end_gap_limit = acceptance_.allowed_end_gap_m(length);
   const double start_gap = entry_arc_m_ - line.start_arc_m;
   const double end_gap = line.element_end_arc_m.back() - progress_m_;
   return way_along_m() >= length - shortfall && start_gap <= end_gap_limit && end_gap <= end_gap_limit &&

@@ -257,6 +257,8 @@ const char* to_string(TraceKind kind) noexcept {
       return "swapped_order";
     case TraceKind::scribble:
       return "scribble";
+    case TraceKind::shifted_8mm:
+      return "shifted_8mm";
   }
   return "?";
 }
@@ -289,6 +291,7 @@ std::vector<Vec2> person_trace(const PlacedCharacter& character, std::size_t str
       style.end_delta = 0.0;
       break;
     case TraceKind::shifted:  // the shift is the offset of the copy
+    case TraceKind::shifted_8mm:
       style.offset = 0.0;
       break;
     case TraceKind::corners_cut:
@@ -326,12 +329,14 @@ std::vector<Vec2> person_trace(const PlacedCharacter& character, std::size_t str
     path = first ? Path(path.begin(), path.begin() + static_cast<long>(middle) + 1)
                  : Path(path.begin() + static_cast<long>(middle), path.end());
   }
-  if (kind == TraceKind::shifted) {
+  if (kind == TraceKind::shifted || kind == TraceKind::shifted_8mm) {
     // Every point moved the same distance across the stroke (along the normal over +-1 mm of the path): a
     // parallel copy, so that no part of it lies on the stroke (a translation would move an L-shaped
     // stroke's legs along themselves).
     const double shift =
-        (std::bernoulli_distribution(0.5)(random) ? 1.0 : -1.0) * uniform(random, 4.0, 8.0) * kMm;
+        kind == TraceKind::shifted_8mm
+            ? (std::bernoulli_distribution(0.5)(random) ? 1.0 : -1.0) * 8.0 * kMm
+            : (std::bernoulli_distribution(0.5)(random) ? 1.0 : -1.0) * uniform(random, 4.0, 8.0) * kMm;
     const std::size_t reach = 5;
     Path moved(path.size());
     for (std::size_t i = 0; i < path.size(); ++i) {

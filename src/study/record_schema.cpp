@@ -29,9 +29,14 @@ const Schema& SchemaOf<TimingGuidance>::get() { return table_schema<TimingGuidan
 const Schema& SchemaOf<StrokeAcceptance>::get() {
   // The fields after the eighth came with version 4 of a trial record: an older record lacks them and
   // runs with the fixed tolerances it ran with (StrokeAcceptance::use_fixed_tolerances, recorded_trial.cpp).
+  // The end gap's floor (the last two) came with version 5: a version-4 record runs without it
+  // (StrokeAcceptance::use_version_4_end_gaps).
   static const std::vector<SchemaField> fields = [] {
     std::vector<SchemaField> out = table_fields<StrokeAcceptance>();
-    for (std::size_t i = 8; i < out.size(); ++i) out[i] = since(4, out[i]);
+    for (std::size_t i = 8; i < out.size(); ++i) {
+      const bool end_gap = out[i].name == "end_gap_m" || out[i].name == "end_gap_fraction";
+      out[i] = since(end_gap ? 5 : 4, out[i]);
+    }
     return out;
   }();
   static const Schema schema{.name = ParameterTable<StrokeAcceptance>::name,

@@ -177,6 +177,9 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
   // Before version 4 a stroke's tolerances did not grow with its length or scale with the character, and
   // no stroke was credited as assisted: an older record runs again as it ran.
   if (version < 4) r.force_law.acceptance.use_fixed_tolerances();
+  // Before version 5 either end of a stroke could be left unwritten by no more than its shortfall or
+  // displacement: no floor of the end gap.
+  if (version < 5) r.force_law.acceptance.use_version_4_end_gaps();
   checked(source, reader.pointer("force_law"), [&] {
     // A replay's teacher is not in the record (the run is given it, and checks it then): its law's own
     // values are checked here with a stand-in trajectory of two samples.

@@ -17,7 +17,7 @@
 ///   a stroke of length L (along the centre line, from its first feature point to its last) is written
 ///   when the pen entered it in the start neighbourhood (WS) and, within `corridor_m` of it and with a
 ///   mean distance of at most `allowed_mean_deviation_m(L)`, went along it for at least L - S(L), S(L) =
-///   `allowed_shortfall_m(L)`, leaving at most max(S(L), `displacement_m`) unwritten at either end. The
+///   `allowed_shortfall_m(L)`, leaving at most `allowed_end_gap_m(L)` unwritten at either end. The
 ///   tolerances grow with L up to a cap and scale with the character's size (StrokeAcceptance). The
 ///   way along counts the arc the pen gained, plus up to `displacement_m` of run before the start and past
 ///   the end, so that a copy displaced along the stroke is written and a half stroke is not.
@@ -95,6 +95,16 @@ struct StrokeAcceptance {
   /// Most mean deviation allowed on any stroke [m]: well under the smallest parallel shift refused, 4 mm
   /// (3.5 mm credited 1.9 % of shifted strokes on KanjiVG's lines, 3.2 mm 1.3 %).
   double mean_deviation_cap_m = 0.0032;
+  /// Least either end may be left unwritten by on a stroke long enough [m], beside the shortfall and the
+  /// displacement: the end-point scatter of an aimed movement has a floor that does not shrink with its
+  /// amplitude (the intercept of Schmidt et al. 1979's linear law), and a pen released by a person stops
+  /// short of where it aimed. Another hand's ends (KanjiVG's lines aligned to the medians) lie up to 3.5 mm
+  /// from the medians' on 5-8 mm strokes (90th percentile), and a pointer is released up to 1.5 mm shorter
+  /// still. 0: no such floor (records before version 5).
+  double end_gap_m = 0.0045;
+  /// The same floor as a fraction of the stroke's length, the smaller applying, dimensionless: a half
+  /// stroke leaves one end unwritten by half the stroke (0.5), so 0.4 keeps it refused on a dot.
+  double end_gap_fraction = 0.4;
   /// The character size the lengths above are for [m]: in a character of another size
   /// (`SceneLayout::character_size_m`) every length scales by size / this. 0: lengths are absolute
   /// (records before version 4).
@@ -110,8 +120,10 @@ struct StrokeAcceptance {
   double assist_after_misses = 5.0;
 
   /// The values of the fields above as records before version 4 ran them: no growth with the stroke's
-  /// length, no cap, no scaling with the character size, no assisted credit.
+  /// length, no cap, no scaling with the character size, no assisted credit, no floor of the end gap.
   void use_fixed_tolerances() noexcept;
+  /// The rule as records of version 4 ran it: no floor of the end gap (`end_gap_m` 0).
+  void use_version_4_end_gaps() noexcept { end_gap_m = 0.0; }
   /// This acceptance for a character of side `character_size_m` [m]: every length scaled by size /
   /// `reference_character_size_m` (unchanged when that is 0).
   [[nodiscard]] StrokeAcceptance for_character_size(double character_size_m) const noexcept;
@@ -119,12 +131,16 @@ struct StrokeAcceptance {
   [[nodiscard]] double allowed_mean_deviation_m(double length_m) const noexcept;
 
   /// Throws InvalidArgument naming the field when a value is outside its range
-  /// (`ParameterTable<StrokeAcceptance>`: each length in (0, 0.1] m, the fraction in (0, 1), the gain ratio
+  /// (`ParameterTable<StrokeAcceptance>`: each length in (0, 0.1] m (`end_gap_m` [0, 0.1]), the fractions in
+  /// (0, 1) and [0, 1), the gain ratio
   /// in [1, 100], the miss counts in [0, 1000]) or a miss count is not a whole number.
   void validate() const;
   /// The most a stroke of `length_m` may be written short by [m]: min(`shortfall_fraction` L,
   /// `shortfall_m` + `shortfall_per_length` L, `shortfall_cap_m`).
   [[nodiscard]] double allowed_shortfall_m(double length_m) const noexcept;
+  /// The most either end of a stroke of `length_m` may be left unwritten by [m]: max(S(L),
+  /// `displacement_m`, min(`end_gap_m`, `end_gap_fraction` L)), S(L) = allowed_shortfall_m(L).
+  [[nodiscard]] double allowed_end_gap_m(double length_m) const noexcept;
   bool operator==(const StrokeAcceptance&) const = default;
 };
 

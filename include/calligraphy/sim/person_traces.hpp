@@ -32,14 +32,15 @@ enum class TraceKind {
   other_stroke,   ///< a `human` path of another stroke of the character
   swapped_order,  ///< a `human` path of the next stroke, written first
   scribble,       ///< a zig-zag from the stroke's start
+  shifted_8mm,    ///< as `shifted`, moved exactly 8 mm across: the acceptance target's own shift
 };
 
-/// Every kind, positives first.
+/// Every kind, positives first (a kind added later comes last, so that the others draw the same paths).
 inline constexpr TraceKind kTraceKinds[] = {
-    TraceKind::median,     TraceKind::human,     TraceKind::corners_cut,  TraceKind::corners_overshot,
-    TraceKind::ends_short, TraceKind::ends_past, TraceKind::pointer,      TraceKind::reversed,
-    TraceKind::half,       TraceKind::shifted,   TraceKind::other_stroke, TraceKind::swapped_order,
-    TraceKind::scribble};
+    TraceKind::median,     TraceKind::human,      TraceKind::corners_cut,  TraceKind::corners_overshot,
+    TraceKind::ends_short, TraceKind::ends_past,  TraceKind::pointer,      TraceKind::reversed,
+    TraceKind::half,       TraceKind::shifted,    TraceKind::other_stroke, TraceKind::swapped_order,
+    TraceKind::scribble,   TraceKind::shifted_8mm};
 
 /// True for the kinds that write the stroke.
 [[nodiscard]] bool is_positive(TraceKind kind) noexcept;
