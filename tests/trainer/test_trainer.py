@@ -28,6 +28,7 @@ CLI = os.environ.get("CALLIGRAPHY_CLI", "calligraphy")
 SOURCE = pathlib.Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", pathlib.Path(__file__).resolve().parents[2]))
 EMBEDDED = SOURCE / "data" / "hanzi-writer-data"
 SAMPLE = SOURCE / "tests" / "data" / "hanzi-writer-sample"
+SHI_STROKE_ONE_TOO_SHORT = "十 stroke 1 not written: too short: carry the stroke to its end (too_short; judged in WS)"
 CHARACTER_SIZE_M = 0.06  # SceneLayout's default side of a character box on paper
 START_RADIUS_M = 0.005   # SceneLayout's default start neighbourhood
 
@@ -551,6 +552,45 @@ class TrainerTest(unittest.TestCase):
         lower = along(down, [i / 20 for i in range(13, 19)])
         self.assertEqual(fraction([near(image, box.data_to_px(p), 5, is_refused) for p in lower]), 0.0)
 
+    def refuse_half_of_shi_stroke_one(self, trainer, hand, box, count):
+        """Writes the first half of 十's stroke 1 from its start (refused as too short as the pen lifts in WS)
+        and waits until the trainer has said so `count` times in all."""
+        hand.write([box.data_to_px(p) for p in along(medians("十")[0], [i / 10 for i in range(6)])])
+        deadline = time.time() + 20
+        while trainer.errors().count(SHI_STROKE_ONE_TOO_SHORT) < count:
+            self.assertLess(time.time(), deadline, f"no miss {count}:\n" + trainer.errors())
+            self.assertIsNone(trainer.process.poll(), trainer.errors())
+            time.sleep(0.05)
+
+    def test_the_panel_names_the_hinted_stroke_by_its_colour(self):
+        """After three misses the learner's panel says the hint and that the stroke to write is the light
+        blue one (it is no longer drawn yellow); the picture at exit (Q) is docs/images/trainer-hint.png."""
+        text = pathlib.Path(self.folder) / "panel.txt"
+        environment = boxes_environment(dict(os.environ, CALLIGRAPHY_PANEL_TEXT=str(text)))
+        trainer = self.trainer = Trainer("十", "--device", "mouse", "--no-demo", "--screenshot", "hint.png",
+                                         folder=self.folder, environment=environment)
+        (box,) = trainer.boxes()
+        hand = trainer.hand(box, seed=5)
+        time.sleep(0.5)
+        for count in (1, 2, 3):
+            self.refuse_half_of_shi_stroke_one(trainer, hand, box, count)
+        time.sleep(1.0)  # the hint drawn in full
+        window = trainer.window()
+        corner = box.data_to_px((980, 880))  # the pointer off the strokes, for the picture
+        xdotool("mousemove", "--window", window, round(corner[0]), round(corner[1]))
+        xdotool("windowfocus", "--sync", window)
+        xdotool("key", "--window", window, "q")
+        self.assertEqual(trainer.wait(timeout=30), 0, trainer.errors())
+        keep_artifact(pathlib.Path(self.folder) / "hint.png")
+        panel = text.read_text(encoding="utf-8")
+        self.assertIn("Stroke 1 of 2", panel)
+        self.assertIn("Here is stroke 1", panel)
+        self.assertIn("the stroke to write is the light blue one", panel)
+        self.assertNotIn("yellow", panel, panel)
+        image = read_png(pathlib.Path(self.folder) / "hint.png")
+        inner = along(medians("十")[0], [i / 20 for i in range(2, 19)])
+        self.assertGreater(fraction([near(image, box.data_to_px(p), 4, is_hint) for p in inner]), 0.9)
+
     def test_misses_bring_the_hint_then_the_assisted_credit_and_the_trial_goes_on(self):
         """`train 十` on the mouse: stroke 1 started at its start and lifted half way (too short) is refused;
         from the third miss the window fills it in the hint colour, at the fifth it is credited assisted
@@ -569,15 +609,8 @@ class TrainerTest(unittest.TestCase):
         hand = trainer.hand(box, seed=3)
         across, down = medians("十")
         inner = along(across, [i / 20 for i in range(2, 19)])
-        refused = "十 stroke 1 not written: too short: carry the stroke to its end (too_short; judged in WS)"
-
         def miss(count, look=True):
-            hand.write([box.data_to_px(p) for p in along(across, [i / 10 for i in range(6)])])
-            deadline = time.time() + 20
-            while trainer.errors().count(refused) < count:
-                self.assertLess(time.time(), deadline, f"no miss {count}:\n" + trainer.errors())
-                self.assertIsNone(trainer.process.poll(), trainer.errors())
-                time.sleep(0.05)
+            self.refuse_half_of_shi_stroke_one(trainer, hand, box, count)
             if not look:
                 return None
             time.sleep(1.0)  # the window draws what the miss brought at the demonstration's pace (0.6 s)
@@ -608,7 +641,7 @@ class TrainerTest(unittest.TestCase):
                          "no hint once the stroke is credited")
         hand.write([box.data_to_px(p) for p in down])
         self.assertEqual(trainer.wait(timeout=30), 0, trainer.errors())
-        self.assertEqual(trainer.errors().count(refused), 5, trainer.errors())
+        self.assertEqual(trainer.errors().count(SHI_STROKE_ONE_TOO_SHORT), 5, trainer.errors())
         (record_path,) = saved_trials(pathlib.Path(self.folder) / "out")
         record = json.loads(record_path.read_text(encoding="utf-8"))
         self.assertEqual(record["end_reason"], "completed")
@@ -1178,7 +1211,7 @@ GROUPS = {
     "lost_display": ("test_a_lost_display",),
     "stop_signals": ("EndingTest",),
     "openhaptics": ("test_a_haptic_device_writes_yong_through_the_stand_in_libhd",),
-    "hint_assist": ("test_misses_bring_the_hint",),
+    "hint_assist": ("test_misses_bring_the_hint", "test_the_panel_names_the_hinted_stroke"),
 }
 
 
