@@ -334,8 +334,12 @@ void learner_panel(const PanelInput& input) {
     } else if (s.strokes_total > 0) {
       const std::size_t k = s.finished ? s.strokes_total + 1u : s.stroke_index + 1u;
       large(input, ImVec4(0.1f, 0.1f, 0.1f, 1), stroke_of(k, s.strokes_total));
+      // A hinted stroke is filled in the hint colour over its yellow (scene_view.cpp): the line names that.
+      const bool hinted =
+          view->hint && view->hint->character == s.character && view->hint->stroke == s.stroke;
       if (!s.finished && !view->ended)
-        ImGui::TextWrapped("Start at the red circle; the stroke to write is the darker yellow one.");
+        ImGui::TextWrapped(hinted ? "Start at the red circle; the stroke to write is the light blue one."
+                                  : "Start at the red circle; the stroke to write is the darker yellow one.");
     }
     if (view->feedback && !view->quiz) {
       ImGui::Spacing();

@@ -1,5 +1,7 @@
-"""A minimal PNG reader (8-bit RGB or RGBA, not interlaced: what stb_image_write writes), after the PNG
-specification (ISO/IEC 15948:2004, sections 9 and 11), so that the tests need no imaging library."""
+"""A minimal PNG reader (8-bit RGB or RGBA, not interlaced: what stb_image_write writes) and writer (8-bit
+RGB), after the PNG specification (ISO/IEC 15948:2004, sections 9 and 11), and a reader of the XWD screen
+file Xvfb keeps with -fbdir (X11's XWDFile.h: a header of 25 big-endian 32-bit fields, the colour map, then
+the pixels), so that the tests need no imaging library."""
 import struct
 import zlib
 
@@ -21,6 +23,12 @@ class Image:
         row = self.rows[y]
         i = x * self.channels
         return row[i], row[i + 1], row[i + 2]
+
+    def crop(self, x, y, width, height):
+        """The part from column x, row y, `width` by `height` pixels (within the image)."""
+        width, height = min(width, self.width - x), min(height, self.height - y)
+        c = self.channels
+        return Image(width, height, c, [row[x * c:(x + width) * c] for row in self.rows[y:y + height]])
 
 
 def read_png(path):
@@ -65,3 +73,39 @@ def read_png(path):
         rows.append(line)
         previous = line
     return Image(width, height, channels, rows)
+
+
+def write_png(path, image):
+    """`image` as an 8-bit RGB PNG, every row unfiltered."""
+    raw = b"".join(b"\x00" + bytes(v for x in range(image.width) for v in image.pixel(x, y))
+                   for y in range(image.height))
+
+    def chunk(kind, body):
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", image.width, image.height, 8, 2, 0, 0, 0))
+                + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+
+
+def read_xwd(path):
+    """The screen in an XWD file of 24-bit TrueColor, 32 bits a pixel (Xvfb's -screen WxHx24)."""
+    with open(path, "rb") as f:
+        data = f.read()
+    header = struct.unpack(">25I", data[:100])
+    header_size, version, pixmap_format, _, width, height = header[:6]
+    byte_order, bits_per_pixel, bytes_per_line = header[7], header[11], header[12]
+    masks, colours = header[14:17], header[19]
+    if version != 7 or pixmap_format != 2 or bits_per_pixel != 32 or masks != (0xFF0000, 0xFF00, 0xFF):
+        raise ValueError(f"{path}: not a 32-bit TrueColor XWD file")
+    start = header_size + 12 * colours
+    # Pixels 0x00RRGGBB: in memory B, G, R, 0 when least significant byte first (byte_order 0).
+    order = (2, 1, 0) if byte_order == 0 else (1, 2, 3)
+    rows = []
+    for y in range(height):
+        line = data[start + y * bytes_per_line:start + y * bytes_per_line + 4 * width]
+        row = bytearray(3 * width)
+        for k, o in enumerate(order):
+            row[k::3] = line[o::4]
+        rows.append(row)
+    return Image(width, height, 3, rows)

@@ -22,12 +22,13 @@ import unittest
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from hand import Hand  # noqa: E402
-from png import read_png  # noqa: E402
+from png import read_png, read_xwd, write_png  # noqa: E402
 
 CLI = os.environ.get("CALLIGRAPHY_CLI", "calligraphy")
 SOURCE = pathlib.Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", pathlib.Path(__file__).resolve().parents[2]))
 EMBEDDED = SOURCE / "data" / "hanzi-writer-data"
 SAMPLE = SOURCE / "tests" / "data" / "hanzi-writer-sample"
+SHI_STROKE_ONE_TOO_SHORT = "十 stroke 1 not written: too short: carry the stroke to its end (too_short; judged in WS)"
 CHARACTER_SIZE_M = 0.06  # SceneLayout's default side of a character box on paper
 START_RADIUS_M = 0.005   # SceneLayout's default start neighbourhood
 
@@ -551,6 +552,113 @@ class TrainerTest(unittest.TestCase):
         lower = along(down, [i / 20 for i in range(13, 19)])
         self.assertEqual(fraction([near(image, box.data_to_px(p), 5, is_refused) for p in lower]), 0.0)
 
+    def refuse_half_of_shi_stroke_one(self, trainer, hand, box, count):
+        """Writes the first half of 十's stroke 1 from its start (refused as too short as the pen lifts in WS)
+        and waits until the trainer has said so `count` times in all."""
+        hand.write([box.data_to_px(p) for p in along(medians("十")[0], [i / 10 for i in range(6)])])
+        deadline = time.time() + 20
+        while trainer.errors().count(SHI_STROKE_ONE_TOO_SHORT) < count:
+            self.assertLess(time.time(), deadline, f"no miss {count}:\n" + trainer.errors())
+            self.assertIsNone(trainer.process.poll(), trainer.errors())
+            time.sleep(0.05)
+
+    def test_the_panel_names_the_hinted_stroke_by_its_colour(self):
+        """After three misses the learner's panel says the hint and that the stroke to write is the light
+        blue one (it is no longer drawn yellow); the picture at exit (Q) is docs/images/trainer-hint.png."""
+        text = pathlib.Path(self.folder) / "panel.txt"
+        environment = boxes_environment(dict(os.environ, CALLIGRAPHY_PANEL_TEXT=str(text)))
+        trainer = self.trainer = Trainer("十", "--device", "mouse", "--no-demo", "--screenshot", "hint.png",
+                                         folder=self.folder, environment=environment)
+        (box,) = trainer.boxes()
+        hand = trainer.hand(box, seed=5)
+        time.sleep(0.5)
+        for count in (1, 2, 3):
+            self.refuse_half_of_shi_stroke_one(trainer, hand, box, count)
+        time.sleep(1.0)  # the hint drawn in full
+        window = trainer.window()
+        corner = box.data_to_px((980, 880))  # the pointer off the strokes, for the picture
+        xdotool("mousemove", "--window", window, round(corner[0]), round(corner[1]))
+        xdotool("windowfocus", "--sync", window)
+        xdotool("key", "--window", window, "q")
+        self.assertEqual(trainer.wait(timeout=30), 0, trainer.errors())
+        keep_artifact(pathlib.Path(self.folder) / "hint.png")
+        panel = text.read_text(encoding="utf-8")
+        self.assertIn("Stroke 1 of 2", panel)
+        self.assertIn("Here is stroke 1", panel)
+        self.assertIn("the stroke to write is the light blue one", panel)
+        self.assertNotIn("yellow", panel, panel)
+        image = read_png(pathlib.Path(self.folder) / "hint.png")
+        inner = along(medians("十")[0], [i / 20 for i in range(2, 19)])
+        self.assertGreater(fraction([near(image, box.data_to_px(p), 4, is_hint) for p in inner]), 0.9)
+
+    def test_misses_bring_the_hint_then_the_assisted_credit_and_the_trial_goes_on(self):
+        """`train 十` on the mouse: stroke 1 started at its start and lifted half way (too short) is refused;
+        from the third miss the window fills it in the hint colour, at the fifth it is credited assisted
+        (drawn in the demonstration's ink) and stroke 2, written, completes the trial. What the window shows
+        is read from its own X server's framebuffer (Xvfb -fbdir) while the trial runs."""
+        try:
+            display = OwnDisplay(framebuffer=True)
+        except OSError as e:
+            self.skipTest(f"no Xvfb of the test's own: {e}")
+        self.addCleanup(display.kill)
+        saved = os.environ.get("DISPLAY")  # the trainer, the hand and xdotool below use the test's own display
+        os.environ["DISPLAY"] = display.name
+        self.addCleanup(lambda: os.environ.__setitem__("DISPLAY", saved) if saved else os.environ.pop("DISPLAY"))
+        trainer = self.start("十", "--device", "mouse", "--no-demo", "--session", "out", "--exit-after", "60")
+        (box,) = trainer.boxes()
+        hand = trainer.hand(box, seed=3)
+        across, down = medians("十")
+        inner = along(across, [i / 20 for i in range(2, 19)])
+        def miss(count, look=True):
+            self.refuse_half_of_shi_stroke_one(trainer, hand, box, count)
+            if not look:
+                return None
+            time.sleep(1.0)  # the window draws what the miss brought at the demonstration's pace (0.6 s)
+            return display.window_image(trainer.window())
+
+        time.sleep(0.5)
+        miss(1, look=False)
+        before = miss(2)
+        self.assertEqual(fraction([near(before, box.data_to_px(p), 4, is_hint) for p in inner]), 0.0,
+                         "no hint after two misses")
+        hinted = miss(3)
+        keep_artifact(display.save_png(hinted, pathlib.Path(self.folder) / "trainer-hint.png"))
+        self.assertGreater(fraction([near(hinted, box.data_to_px(p), 4, is_hint) for p in inner]), 0.9,
+                           "stroke 1 filled in the hint colour after three misses")
+        across_densely = along(across, [i / 100 for i in range(101)])
+        clear = [p for p in along(down, [i / 20 for i in range(2, 19)])  # stroke 2 away from the crossing
+                 if min(math.dist(p, q) for q in across_densely) > 80]
+        self.assertGreater(len(clear), 10)
+        self.assertEqual(fraction([near(hinted, box.data_to_px(p), 4, is_hint) for p in clear]), 0.0,
+                         "the hint is the active stroke only")
+        self.assertTrue(near(hinted, box.data_to_px(across[0]), 20, is_red), "the hint numbered at its start")
+        miss(4, look=False)
+        assisted = miss(5)
+        keep_artifact(display.save_png(assisted, pathlib.Path(self.folder) / "trainer-assisted.png"))
+        self.assertGreater(fraction([near(assisted, box.data_to_px(p), 4, is_demo_ink) for p in inner]), 0.9,
+                           "stroke 1 shown in the demonstration's ink once credited")
+        self.assertEqual(fraction([near(assisted, box.data_to_px(p), 4, is_hint) for p in inner]), 0.0,
+                         "no hint once the stroke is credited")
+        hand.write([box.data_to_px(p) for p in down])
+        self.assertEqual(trainer.wait(timeout=30), 0, trainer.errors())
+        self.assertEqual(trainer.errors().count(SHI_STROKE_ONE_TOO_SHORT), 5, trainer.errors())
+        (record_path,) = saved_trials(pathlib.Path(self.folder) / "out")
+        record = json.loads(record_path.read_text(encoding="utf-8"))
+        self.assertEqual(record["end_reason"], "completed")
+        # The assisted stroke is credited, not written: stroke 2 is the one written.
+        self.assertEqual((record["strokes_assisted"], record["strokes_completed"], record["strokes_written"]),
+                         (1, 1, 1))
+        (character,) = record["per_character"]
+        self.assertEqual(character["strokes_written"], 1)
+        self.assertEqual([s["written"] for s in character["per_stroke"]], [False, True])
+        self.assertFalse(record["completed_in_order"])
+        first, second = record["per_stroke"]
+        self.assertTrue(first["assisted"])
+        self.assertFalse(first["completed"])
+        self.assertEqual(first["attempts"], 5)
+        self.assertTrue(second["completed"])
+        self.assertFalse(second["assisted"])
+
     def test_a_quiz_ends_completed_once_every_stroke_is_accepted(self):
         # 一 written along its median: the quiz accepts it as the renderer completes it (one stroke matcher,
         # the renderer's tolerances), and the trial ends at once. On mouse-hand, where the pen landing on the
@@ -895,10 +1003,14 @@ class OwnDisplay:
     """A virtual X server of a test's own (Xvfb), to be killed under the program; None where Xvfb cannot
     start."""
 
-    def __init__(self):
+    def __init__(self, framebuffer=False):
+        """With `framebuffer`, the screen is also kept as an XWD file in a folder of its own (Xvfb -fbdir),
+        read by window_image."""
+        self.framebuffer = pathlib.Path(tempfile.mkdtemp(prefix="calligraphy-xvfb-")) if framebuffer else None
+        extra = ["-fbdir", str(self.framebuffer)] if framebuffer else []
         read, write = os.pipe()
         self.process = subprocess.Popen(["Xvfb", "-displayfd", str(write), "-screen", "0", "1400x900x24",
-                                         "-nolisten", "tcp"], pass_fds=(write,), stdout=subprocess.DEVNULL,
+                                         "-nolisten", "tcp", *extra], pass_fds=(write,), stdout=subprocess.DEVNULL,
                                         stderr=subprocess.DEVNULL)
         os.close(write)
         with os.fdopen(read) as f:
@@ -913,10 +1025,25 @@ class OwnDisplay:
         return subprocess.run(["xdotool", *map(str, args)], check=True, capture_output=True, text=True,
                               env=self.environment).stdout
 
+    def window_image(self, window):
+        """What the screen shows of `window` now (window pixels), from the framebuffer file."""
+        position = dict(line.strip().split(": ", 1) for line in
+                        self.xdotool("getwindowgeometry", window).splitlines()[1:] if ": " in line)
+        x, y = (int(v) for v in position["Position"].split()[0].split(","))
+        width, height = (int(v) for v in position["Geometry"].split("x"))
+        return read_xwd(self.framebuffer / "Xvfb_screen0").crop(x, y, width, height)
+
+    @staticmethod
+    def save_png(image, path):
+        write_png(path, image)
+        return path
+
     def kill(self):
         if self.process.poll() is None:
             self.process.kill()
             self.process.wait()
+        if self.framebuffer is not None:
+            shutil.rmtree(self.framebuffer, ignore_errors=True)
 
 
 def records_and_rows(attempts):
@@ -1084,6 +1211,7 @@ GROUPS = {
     "lost_display": ("test_a_lost_display",),
     "stop_signals": ("EndingTest",),
     "openhaptics": ("test_a_haptic_device_writes_yong_through_the_stand_in_libhd",),
+    "hint_assist": ("test_misses_bring_the_hint", "test_the_panel_names_the_hinted_stroke"),
 }
 
 
