@@ -454,7 +454,7 @@ TEST_CASE("a protocol of phases that makes no sense is refused, naming the phase
       "/phases/1/characters", "only a transfer phase chooses");
   check_error(phases_text(R"("delay_s": 1)", R"(["大"])",
                           R"({"phase": "warm-up", "condition": "free", "characters": ["十"]},)"),
-              "/phases/1/phase", "expected one of practice, test, pre-test");
+              "/phases/1/phase", R"(expected one of "practice", "test", "pre-test")");
   const std::string both = R"({"name": "b", "conditions": [{"name": "A", "mode": "vision"}],
       "test": {"characters": ["十"], "conditions": ["A"], "repetitions": 1},
       "phases": [{"phase": "test", "condition": "A", "characters": ["十"]}]})";

@@ -372,7 +372,7 @@ class ProtocolSchemaTest(unittest.TestCase):
             with self.subTest(pointer=pointer):
                 self.assertFalse(self.validator.is_valid(document))
                 result = self.plan(document)
-                self.assertEqual(result.returncode, 1, result.stderr.decode())
+                self.assertEqual(result.returncode, 2, result.stderr.decode())
                 self.assertIn(f"p.json: {pointer}", result.stderr.decode())
 
     def test_each_bound_is_refused_past_it_and_accepted_at_it_by_both(self):
@@ -385,8 +385,8 @@ class ProtocolSchemaTest(unittest.TestCase):
                     with self.subTest(pointer=pointer, value=value, expect="refused"):
                         self.assertFalse(self.validator.is_valid(document))
                         result = self.plan(document)
-                        # A protocol is data: refused as every bad file is (exit 1, docs/cli.md), by pointer.
-                        self.assertEqual(result.returncode, 1, result.stderr.decode())
+                        # A protocol's content refused: a usage error (exit 2, docs/cli.md), by pointer.
+                        self.assertEqual(result.returncode, 2, result.stderr.decode())
                         self.assertIn(f"p.json: {pointer}:", result.stderr.decode())
                         checked += 1
                 for bound in ("minimum", "maximum"):
