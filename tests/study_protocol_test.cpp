@@ -472,7 +472,7 @@ TEST_CASE("a protocol of phases that makes no sense is refused, naming the phase
               "/conditions/0/mode", "expected a string");
   check_error(R"({"name": "b", "conditions": [{"name": "A", "mode": "vision"}],
       "phases": [{"phase": null, "condition": "A", "characters": ["十"]}]})",
-              "/phases/0/phase", "expected a string");
+              "/phases/0/phase", "(StudyPhase), got null");
 }
 
 TEST_CASE("a transfer set: untrained characters made of trained typical strokes, most coverage first",
