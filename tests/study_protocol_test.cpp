@@ -292,6 +292,34 @@ TEST_CASE("a quiz condition's acceptance is checked naming the key, and leniency
   CHECK(p.conditions[0].quiz.accept_backwards);
 }
 
+TEST_CASE("a quiz condition's hint is its acceptance's hint_after_misses unless the quiz overrides it",
+          "[study][protocol][quiz]") {
+  const auto quiz_of = [](const std::string& quiz) {
+    return parse_study_protocol(
+               R"({"name": "t", "conditions": [{"name": "A", "mode": "quiz", "quiz": )" + quiz +
+                   R"(}], "test": {"characters": ["大"], "conditions": ["A"], "repetitions": 1}})",
+               "p.json")
+        .conditions[0]
+        .quiz;
+  };
+  CHECK(quiz_of("{}").hint_after() == static_cast<int>(StrokeAcceptance{}.hint_after_misses));
+  CHECK(!quiz_of("{}").hint_after_misses.has_value());
+  CHECK(quiz_of(R"({"acceptance": {"hint_after_misses": 5}})").hint_after() == 5);
+  CHECK(quiz_of(R"({"acceptance": {"hint_after_misses": 5}, "hint_after_misses": 1})").hint_after() == 1);
+  CHECK(quiz_of(R"({"hint_after_misses": 0})").hint_after() == 0);
+  // The override's range is the acceptance table's, as the acceptance's own key.
+  const auto high = static_cast<long long>(parameter_field(&StrokeAcceptance::hint_after_misses).range.high);
+  CHECK(quiz_of(R"({"hint_after_misses": )" + std::to_string(high) + "}").hint_after() == high);
+  const auto with_quiz = [](const std::string& quiz) {
+    return R"({"name": "t", "conditions": [{"name": "A", "mode": "quiz", "quiz": )" + quiz +
+           R"(}], "test": {"characters": ["大"], "conditions": ["A"], "repetitions": 1}})";
+  };
+  check_error(with_quiz(R"({"hint_after_misses": )" + std::to_string(high + 1) + "}"),
+              "/conditions/0/quiz/hint_after_misses", "[0, 1000]");
+  check_error(with_quiz(R"({"acceptance": {"hint_after_misses": )" + std::to_string(high + 1) + "}}"),
+              "/conditions/0/quiz/acceptance/hint_after_misses", "[0, 1000]");
+}
+
 TEST_CASE("a balanced Latin square: each condition once per row, every ordered pair equally often",
           "[study][schedule]") {
   for (const int n : {2, 3, 4, 5}) {
