@@ -375,6 +375,84 @@ class ProtocolSchemaTest(unittest.TestCase):
                 self.assertEqual(result.returncode, 2, result.stderr.decode())
                 self.assertIn(f"p.json: {pointer}", result.stderr.decode())
 
+    def test_every_part_refused_is_a_usage_error_of_plan_run_and_cohort_alike(self):
+        """A protocol's content refused exits 2 with one line `FILE: /pointer: ...` and writes nothing, from
+        each part of the file; a protocol file that cannot be read at all exits 1."""
+        training = {"phase": "training", "condition": "A", "characters": ["十"]}
+        sets = [{"name": "one", "characters": ["十"]}, {"name": "two", "characters": ["大"]}]
+        cases = {
+            "/format": _protocol(format="calligraphy-protocol"),
+            "/version": _protocol(version=2),
+            "/name": _protocol(name="two words"),
+            "/description": _protocol(description=3),
+            "/conditions": _protocol(conditions=[]),
+            "/conditions/1/name": _protocol(conditions=[{"name": "A", "mode": "haptic"},
+                                                        {"name": "A", "mode": "vision"}]),
+            "/conditions/0/mode": _protocol(conditions=[{"name": "A", "mode": "Haptic"}]),
+            "/conditions/0/parameters/start_gain": _protocol(
+                conditions=[{"name": "A", "mode": "fading", "parameters": {"start_gain": 2}}]),
+            "/conditions/0/quiz/hint_after_misses": _protocol(
+                conditions=[{"name": "A", "mode": "quiz", "quiz": {"hint_after_misses": 1001}}]),
+            "/conditions/0/teachers/大": _protocol(
+                conditions=[{"name": "A", "mode": "replay", "teachers": {"大": "t.json"}}]),
+            "/item_sets/1/characters/0": _protocol(
+                item_sets=[{"name": "one", "characters": ["十"]}, {"name": "two", "characters": ["十"]}]),
+            "/item_sets/0/transfer_of": _protocol(
+                item_sets=[{"name": "one", "characters": ["十"], "transfer_of": "none"}]),
+            "/phases/0/phase": _phased({"phase": "warm-up", "condition": "A", "characters": ["十"]}),
+            "/phases/0/assignment": _phased({**training, "assignment": "crossed"}),
+            "/phases/0/repetitions": _phased({**training, "repetitions": 0}),
+            "/phases/0/delay_s": _phased({**training, "delay_s": -1}),
+            "/phases/0/sets/0": _phased({"phase": "training", "condition": "A", "sets": ["three"]}),
+            "/phases/1/session": {**_phased(training), "phases": [training, {**training, "session": 3}]},
+            "/phases/1/delay_s": {**_phased(training), "phases": [training, {**training, "phase": "retention"}]},
+            "/phases/0/characters/0": {**_phased({"phase": "training", "conditions": ["A", "B"],
+                                                   "assignment": "crossover", "sets": ["one", "two"]}),
+                                       "conditions": [{"name": "A", "mode": "haptic"},
+                                                      {"name": "B", "mode": "vision"}],
+                                       "item_sets": sets,
+                                       "phases": [{**training, "characters": ["十"]},
+                                                  {"phase": "training", "conditions": ["A", "B"],
+                                                   "assignment": "crossover", "sets": ["one", "two"]}]},
+            "/order/conditions": _protocol(order={"conditions": "latin"}),
+            "/order/seed": _protocol(order={"seed": -1}),
+            "/test/repetitions": _protocol(order={"conditions": "abba"}),
+            "/practice/condition": _protocol(practice={"characters": ["十"], "condition": "B"}),
+            "/breaks/duration_s": _protocol(breaks={"every_trials": 3}),
+            "/trial/rate_hz": _protocol(trial={"rate_hz": 10}),
+            "/test/characters/0": _protocol(test={"characters": ["\u9f98"], "conditions": ["A"], "repetitions": 1}),
+        }
+        cases["/test/characters/0"]["test"]["characters"] = ["龘"]  # not in the library: no data to write it
+        path = self.cwd / "p.json"
+        commands = (["session", "plan", path, "--subjects", 2],
+                    ["session", "run", path, "--writer", "simulated", "--subjects", 2, "--out", "out"],
+                    ["session", "cohort", path, "--subjects", 2, "--csv", "."])
+        for pointer, document in cases.items():
+            path.write_text(json.dumps(document, ensure_ascii=False), encoding="utf-8")
+            for command in commands:
+                with self.subTest(pointer=pointer, command=command[1]):
+                    result = subprocess.run([CLI, *map(str, command)], cwd=self.cwd, capture_output=True,
+                                            timeout=120)
+                    lines = result.stderr.decode().strip().splitlines()
+                    self.assertEqual(result.returncode, 2, lines)
+                    self.assertEqual(len(lines), 1, lines)
+                    self.assertIn(f"p.json: {pointer}: ", lines[0])
+                    self.assertFalse((self.cwd / "out").exists())
+                    self.assertFalse((self.cwd / "trials.csv").exists())
+        # Malformed JSON is refused as the content, by its byte offset.
+        path.write_text('{"name": "x",', encoding="utf-8")
+        for command in commands:
+            result = subprocess.run([CLI, *map(str, command)], cwd=self.cwd, capture_output=True, timeout=120)
+            self.assertEqual(result.returncode, 2, result.stderr.decode())
+            self.assertIn("p.json", result.stderr.decode())
+        # A file that cannot be read is no usage error: missing, or a folder.
+        for unreadable in (self.cwd / "missing.json", self.cwd):
+            for command in commands:
+                command = [unreadable if part == path else part for part in command]
+                result = subprocess.run([CLI, *map(str, command)], cwd=self.cwd, capture_output=True, timeout=120)
+                self.assertEqual(result.returncode, 1, result.stderr.decode())
+                self.assertEqual(len(result.stderr.decode().strip().splitlines()), 1, result.stderr.decode())
+
     def test_each_bound_is_refused_past_it_and_accepted_at_it_by_both(self):
         checked = 0
         for base, prefix, properties, not_at in self.sites():
