@@ -453,6 +453,91 @@ class ProtocolSchemaTest(unittest.TestCase):
                 self.assertEqual(result.returncode, 1, result.stderr.decode())
                 self.assertEqual(len(result.stderr.decode().strip().splitlines()), 1, result.stderr.decode())
 
+    def test_a_field_shared_with_the_trial_record_has_its_range_and_is_refused_past_it_by_both(self):
+        """Where a protocol's value becomes a trial's, the protocol's schema states the record's range, and each
+        value past it is refused by `session plan` (exit 2) and by `trial --spec` (a record: exit 1), each
+        naming its pointer."""
+        record_schema = json.loads(SchemaTest.run_cli.__func__(self.__class__, "schema", "record").stdout)
+        records = {}
+        for name, extra in {"fixed": [], "fading": ["--guidance-mode", "fading"],
+                            "assist": ["--guidance-mode", "assist-as-needed"],
+                            "amplify": ["--guidance-mode", "error-amplification"],
+                            "timing": ["--guidance-mode", "timing"]}.items():
+            made = subprocess.run([CLI, "trial", "十", "--seed", "3", "--json", f"{name}.json", *extra],
+                                  cwd=self.cwd, capture_output=True, timeout=120)
+            self.assertEqual(made.returncode, 0, made.stderr.decode())
+            records[name] = json.loads((self.cwd / f"{name}.json").read_text())
+        defs = record_schema["$defs"]
+
+        def law(mode):
+            for alternative in defs["ForceLawParameters"]["properties"]["guidance_law"]["oneOf"]:
+                if alternative["properties"]["mode"]["const"] == mode:
+                    return alternative["properties"]
+            raise AssertionError(mode)
+
+        def condition(mode, **extra):
+            return _protocol(conditions=[{"name": "A", "mode": mode, **extra}])
+
+        quiz = {"quiz": {"acceptance": {}}}
+        pairs = [
+            (_protocol(trial={}), "/trial/max_duration_s", "fixed", ["trial", "max_duration_s"],
+             defs["TrialSpec"]["properties"]["max_duration_s"]),
+            (condition("haptic"), "/conditions/0/guidance_stiffness_n_per_m", "fixed",
+             ["force_law", "guidance_stiffness_n_per_m"],
+             defs["ForceLawParameters"]["properties"]["guidance_stiffness_n_per_m"]),
+            (condition("fading", parameters={}), "/conditions/0/parameters/start_gain", "fading",
+             ["force_law", "guidance_law", "gain"], law("fading")["gain"]),
+            (condition("assist-as-needed", parameters={"max_band_m": 0.1}), "/conditions/0/parameters/start_band_m",
+             "assist", ["force_law", "guidance_law", "band_m"], law("assist-as-needed")["band_m"]),
+            (condition("error-amplification", parameters={}), "/conditions/0/parameters/amplification_gain",
+             "amplify", ["force_law", "guidance_law", "gain"], law("error-amplification")["gain"]),
+            (condition("error-amplification", parameters={}), "/conditions/0/parameters/max_force_n", "amplify",
+             ["force_law", "guidance_law", "max_force_n"], law("error-amplification")["max_force_n"]),
+            (condition("timing", parameters={}), "/conditions/0/parameters/speed_m_s", "timing",
+             ["force_law", "guidance_law", "speed_m_s"], law("timing")["speed_m_s"]),
+        ]
+        for key, prop in defs["StrokeAcceptance"]["properties"].items():
+            pairs.append((condition("quiz", **quiz), f"/conditions/0/quiz/acceptance/{key}", "fixed",
+                          ["force_law", "acceptance", key], prop))
+        self.assertGreaterEqual(len(pairs), 20)
+        bounds = ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum")
+        refused = 0
+        for base, pointer, record, path, record_prop in pairs:
+            parts = pointer.strip("/").split("/")
+            # The protocol schema's property: through $defs, the mode's parameters, the quiz's acceptance.
+            if parts[0] == "trial":
+                prop = self.schema["$defs"]["ProtocolTrialSettings"]["properties"][parts[1]]
+            elif parts[2] == "parameters":
+                mode = base["conditions"][0]["mode"]
+                rule = next(r for r in self.schema["$defs"]["StudyCondition"]["allOf"]
+                            if r["if"]["properties"]["mode"]["const"] == mode)
+                prop = rule["then"]["properties"]["parameters"]["properties"][parts[3]]
+            elif parts[2] == "quiz":
+                prop = self.schema["$defs"]["QuizOptions"]["properties"]["acceptance"]["properties"][parts[4]]
+            else:
+                prop = self.schema["$defs"]["StudyCondition"]["properties"][parts[2]]
+            with self.subTest(pointer=pointer):
+                self.assertEqual({b: prop[b] for b in bounds if b in prop},
+                                 {b: record_prop[b] for b in bounds if b in record_prop})
+            for _, value in SchemaTest.past_bounds(pointer, prop):
+                with self.subTest(pointer=pointer, value=value):
+                    result = self.plan(self.with_value(base, pointer, value))
+                    self.assertEqual(result.returncode, 2, result.stderr.decode())
+                    self.assertIn(f"p.json: {pointer}:", result.stderr.decode())
+                    document = copy.deepcopy(records[record])
+                    target = document["specification"]
+                    for key in path[:-1]:
+                        target = target[key]
+                    target[path[-1]] = value
+                    (self.cwd / "bad.json").write_text(json.dumps(document))
+                    spec = subprocess.run([CLI, "trial", "--spec", "bad.json", "--json", "again.json"],
+                                          cwd=self.cwd, capture_output=True, timeout=120)
+                    self.assertEqual(spec.returncode, 1, spec.stderr.decode())
+                    self.assertIn("bad.json: /specification/" + "/".join(path), spec.stderr.decode())
+                    refused += 1
+        self.assertGreaterEqual(refused, 40)
+        print(f"protocol fields shared with the trial record, values refused by both: {refused}")
+
     def test_each_bound_is_refused_past_it_and_accepted_at_it_by_both(self):
         checked = 0
         for base, prefix, properties, not_at in self.sites():
