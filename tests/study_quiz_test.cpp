@@ -2,10 +2,10 @@
 #include <catch2/catch.hpp>
 #include <vector>
 
+#include "calligraphy/analysis/metrics.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/study/quiz.hpp"
-#include "calligraphy/analysis/metrics.hpp"
 #include "embedded_scenes.hpp"
 
 using namespace calligraphy;

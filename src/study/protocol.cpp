@@ -73,8 +73,8 @@ namespace {
 using nlohmann::json;
 using study_detail::choice;
 using study_detail::condition_name;
-using study_detail::read_member;
 using study_detail::read_items;
+using study_detail::read_member;
 using study_detail::table_number_or;
 using study_detail::take_table_number;
 
