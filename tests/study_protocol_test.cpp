@@ -497,7 +497,7 @@ TEST_CASE("a protocol of phases that makes no sense is refused, naming the phase
   // A null is not a missing value that falls back to a default.
   check_error(R"({"name": "b", "conditions": [{"name": "A", "mode": null}],
       "phases": [{"phase": "test", "condition": "A", "characters": ["十"]}]})",
-              "/conditions/0/mode", "expected a string");
+              "/conditions/0/mode", "(ConditionMode), got null");
   check_error(R"({"name": "b", "conditions": [{"name": "A", "mode": "vision"}],
       "phases": [{"phase": null, "condition": "A", "characters": ["十"]}]})",
               "/phases/0/phase", "(StudyPhase), got null");

@@ -71,7 +71,6 @@ std::string condition_name(const json& value, const std::string& pointer, const 
 namespace {
 
 using nlohmann::json;
-using study_detail::choice;
 using study_detail::condition_name;
 using study_detail::read_items;
 using study_detail::read_member;
@@ -235,7 +234,7 @@ StudyCondition read_condition(const json& value, const std::string& pointer, con
     json_detail::fail(source, reader.pointer("name"),
                       "expected 1 to 32 letters, digits, '_' or '-', got \"" + condition.name + "\"");
   }
-  condition.mode = choice(reader, "mode", study_detail::kConditionModes);
+  read_member(reader, SchemaOf<StudyCondition>::get(), "mode", &condition, true);
   const bool guided = renders_guidance(condition.mode);
   if (reader.optional("guidance_stiffness_n_per_m") != nullptr) {
     if (!guided) {

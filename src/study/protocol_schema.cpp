@@ -72,6 +72,16 @@ const Schema& SchemaOf<ProtocolPhase>::get() {
   return schema;
 }
 
+const Schema& SchemaOf<StudyCondition>::get() {
+  using C = StudyCondition;
+  static const std::array fields{
+      enum_field<&C::mode>("mode", {.doc = "what the writer gets"}),
+  };
+  static const Schema schema{
+      .name = "StudyCondition", .doc = "a feedback condition", .fields = fields, .defaults = default_of<C>};
+  return schema;
+}
+
 const Schema& protocol_order_schema() {
   using S = StudyProtocol;
   static const std::array fields{
@@ -113,13 +123,6 @@ ordered_json integer_schema(std::int64_t low, std::int64_t high, std::string_vie
   return {{"type", "integer"}, {"description", std::string(doc)}, {"minimum", low}, {"maximum", high}};
 }
 
-template <typename E, std::size_t N>
-ordered_json enum_schema(const std::array<E, N>& values, std::string_view doc) {
-  ordered_json names = ordered_json::array();
-  for (const E value : values) names.push_back(to_string(value));
-  return {{"type", "string"}, {"description", std::string(doc)}, {"enum", names}};
-}
-
 ordered_json label_schema(std::size_t longest, std::string_view doc) {
   return {{"type", "string"},
           {"description", std::string(doc)},
@@ -131,6 +134,11 @@ ordered_json object_schema(ordered_json properties, std::string_view doc) {
           {"description", std::string(doc)},
           {"properties", std::move(properties)},
           {"additionalProperties", false}};
+}
+
+// Field `key` of `schema` as a JSON Schema property (range, spellings, default from the one table).
+ordered_json schema_property(const Schema& schema, std::string_view key) {
+  return schema_detail::field_json_schema(*schema.field(key), schema.defaults());
 }
 
 ordered_json ref(std::string_view name) { return {{"$ref", "#/$defs/" + std::string(name)}}; }
@@ -207,7 +215,8 @@ ordered_json condition_schema() {
   ordered_json properties = ordered_json::object();
   properties["name"] = label_schema(study_detail::kMaxLabelLength,
                                     "unique label of the condition, used in file names and reports");
-  properties["mode"] = enum_schema(study_detail::kConditionModes, "what the writer gets");
+  properties["mode"] = schema_property(SchemaOf<StudyCondition>::get(), "mode");
+  properties["mode"].erase("default");  // required
   put_table_field(properties, "guidance_stiffness_n_per_m", &ForceLawParameters::guidance_stiffness_n_per_m);
   properties["guidance_stiffness_n_per_m"]["description"] =
       "K_et, the guidance stiffness (paper eq. 8), modes that render guidance only [N/m]";
@@ -258,11 +267,6 @@ ordered_json quiz_schema() {
   return object_schema(std::move(properties), "how a quiz judges strokes");
 }
 
-// Field `key` of `schema` as a JSON Schema property (range, spellings, default from the one table).
-ordered_json schema_property(const Schema& schema, std::string_view key) {
-  return schema_detail::field_json_schema(*schema.field(key), schema.defaults());
-}
-
 ordered_json phase_schema() {
   const Schema& settings = SchemaOf<ProtocolPhase>::get();
   ordered_json properties = ordered_json::object();
@@ -287,7 +291,8 @@ ordered_json phase_schema() {
                         {"description", "names of item sets whose items the phase writes"},
                         {"minItems", 1},
                         {"items", label_schema(study_detail::kMaxLabelLength, "an item set's name")}};
-  for (const char* key : {"repetitions", "session", "delay_s"}) properties[key] = schema_property(settings, key);
+  for (const char* key : {"repetitions", "session", "delay_s"})
+    properties[key] = schema_property(settings, key);
   ordered_json out = object_schema(std::move(properties), "a phase of the study");
   out["required"] = ordered_json::array({"phase"});
   return out;
@@ -328,21 +333,21 @@ std::string protocol_json_schema_text() {
                              {"minItems", 1},
                              {"maxItems", study_detail::kMaxItemSets},
                              {"items", ref("ItemSet")}};
-  properties["practice"] = object_schema(
-      {{"characters", items_schema("the familiarisation block's strings")},
-       {"condition", label_schema(study_detail::kMaxLabelLength, "the practice condition")},
-       {"repetitions", schema_property(SchemaOf<ProtocolPhase>::get(), "repetitions")}},
-      "the paper's familiarisation block, written first");
+  properties["practice"] =
+      object_schema({{"characters", items_schema("the familiarisation block's strings")},
+                     {"condition", label_schema(study_detail::kMaxLabelLength, "the practice condition")},
+                     {"repetitions", schema_property(SchemaOf<ProtocolPhase>::get(), "repetitions")}},
+                    "the paper's familiarisation block, written first");
   properties["practice"]["required"] = ordered_json::array({"characters", "condition"});
-  properties["test"] = object_schema(
-      {{"characters", items_schema("each string written in one trial")},
-       {"conditions",
-        {{"type", "array"},
-         {"minItems", 1},
-         {"uniqueItems", true},
-         {"items", label_schema(study_detail::kMaxLabelLength, "a condition")}}},
-       {"repetitions", schema_property(SchemaOf<ProtocolPhase>::get(), "repetitions")}},
-      "the paper's test blocks");
+  properties["test"] =
+      object_schema({{"characters", items_schema("each string written in one trial")},
+                     {"conditions",
+                      {{"type", "array"},
+                       {"minItems", 1},
+                       {"uniqueItems", true},
+                       {"items", label_schema(study_detail::kMaxLabelLength, "a condition")}}},
+                     {"repetitions", schema_property(SchemaOf<ProtocolPhase>::get(), "repetitions")}},
+                    "the paper's test blocks");
   properties["test"]["required"] = ordered_json::array({"characters", "conditions", "repetitions"});
   properties["order"] = described(protocol_order_schema(), defs);
   properties["breaks"] = ref("BreakRules");

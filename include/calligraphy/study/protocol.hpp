@@ -43,7 +43,8 @@ struct EnumTable<ConditionMode> {
   static constexpr std::array<EnumEntry<ConditionMode>, 9> entries{{
       {ConditionMode::vision, "vision", "vision only: the paper force, no in-plane guidance"},
       {ConditionMode::haptic, "haptic", "vision and the guiding force of the paper's section 5"},
-      {ConditionMode::fading, "fading", "guidance whose gain follows the writer's deviation over repetitions"},
+      {ConditionMode::fading, "fading",
+       "guidance whose gain follows the writer's deviation over repetitions"},
       {ConditionMode::replay, "replay", "guidance that replays a teacher's recorded trial of the item"},
       {ConditionMode::quiz, "quiz", "vision only, each stroke judged when the pen lifts"},
       {ConditionMode::assist_as_needed, "assist-as-needed",
@@ -124,6 +125,14 @@ struct StudyCondition {
   std::map<std::u32string, std::string> teachers{};
 };
 
+/// A condition's "mode" (its spelling from EnumTable<ConditionMode>), read through this schema by the
+/// protocol reader and described by `calligraphy schema protocol`; its parameters are read by its mode's
+/// laws' and rules' tables, its name as a label.
+template <>
+struct SchemaOf<StudyCondition> {
+  static const Schema& get();
+};
+
 /// How the blocks of conditions are ordered for a subject.
 enum class ConditionOrder {
   fixed,         ///< as listed, for every subject
@@ -141,7 +150,8 @@ struct EnumTable<ConditionOrder> {
   static constexpr std::string_view name = "ConditionOrder";
   static constexpr std::array<EnumEntry<ConditionOrder>, 4> entries{{
       {ConditionOrder::fixed, "fixed", "as listed, for every subject"},
-      {ConditionOrder::latin_square, "latin_square", "a balanced Latin square (Williams 1949), row by subject"},
+      {ConditionOrder::latin_square, "latin_square",
+       "a balanced Latin square (Williams 1949), row by subject"},
       {ConditionOrder::abba, "abba", "forwards then backwards, reversed for every second subject"},
       {ConditionOrder::random, "random", "shuffled per subject from the protocol's seed and the subject id"},
   }};
