@@ -349,6 +349,34 @@ class ProtocolSchemaTest(unittest.TestCase):
                                         capture_output=True, timeout=60)
                 self.assertEqual(result.returncode, 0, result.stderr.decode())
 
+    def test_the_docs_protocol_fragments_and_phase_table_are_the_schemas(self):
+        """The protocol parts docs/ shows (```json blocks of "phases" and "item_sets") validate against the
+        schema's definitions, and the docs' table of a phase's keys states the ranges of its schema."""
+        import re
+
+        defs = self.schema["$defs"]
+        checked = 0
+        for name in ("experiments.md", "learning-study.md"):
+            text = (SOURCE / "docs" / name).read_text(encoding="utf-8")
+            for block in re.findall(r"```json\n(.*?)```", text, re.S):
+                body = block.strip()
+                document = json.loads(body if body.startswith("{") else "{" + body + "}")
+                for key, definition in (("phases", "ProtocolPhase"), ("item_sets", "ItemSet")):
+                    validator = jsonschema.Draft202012Validator({"$defs": defs, "$ref": f"#/$defs/{definition}"})
+                    for element in document.get(key, []):
+                        with self.subTest(doc=name, element=element):
+                            self.assertEqual([e.message for e in validator.iter_errors(element)], [])
+                            checked += 1
+        self.assertGreaterEqual(checked, 10)
+        phase = defs["ProtocolPhase"]["properties"]
+        table = (SOURCE / "docs" / "experiments.md").read_text(encoding="utf-8")
+        for key in ("repetitions", "session"):
+            self.assertIn(f"| `{key}` | {phase[key]['minimum']}-{phase[key]['maximum']} |", table)
+        self.assertEqual(phase["delay_s"]["maximum"], 366 * 86400)
+        self.assertIn("| `delay_s` | [0, 366 days] s |", table)
+        for key, enum in (("phase", phase["phase"]["enum"]), ("assignment", phase["assignment"]["enum"])):
+            self.assertIn(f"| `{key}` | " + ", ".join(f"`{value}`" for value in enum) + " |", table)
+
     def test_structure_the_reader_refuses_the_schema_refuses(self):
         cases = {
             "/surprise": _protocol(surprise=1),
