@@ -481,6 +481,34 @@ class ProtocolSchemaTest(unittest.TestCase):
                 self.assertEqual(result.returncode, 1, result.stderr.decode())
                 self.assertEqual(len(result.stderr.decode().strip().splitlines()), 1, result.stderr.decode())
 
+    def test_resume_refuses_a_character_of_its_protocol_the_library_lacks_as_run_does(self):
+        """`session resume` looks up its protocol's characters as `session run` does: one the library given
+        lacks is a usage error (exit 2) naming the protocol's pointer; a library that cannot be opened is 1."""
+        path = self.cwd / "r.json"
+        path.write_text(json.dumps(_protocol(name="resumed", test={"characters": ["十", "人"], "conditions": ["A"],
+                                                                   "repetitions": 1}), ensure_ascii=False),
+                        encoding="utf-8")
+        run = [CLI, "session", "run", path, "--writer", "simulated", "--subject", "S1", "--out", "resumed"]
+        made = subprocess.run(run, cwd=self.cwd, capture_output=True, timeout=300)
+        self.assertEqual(made.returncode, 0, made.stderr.decode())
+        (folder,) = (self.cwd / "resumed" / "S1").iterdir()
+        sorted((folder / "trials").glob("002-*.json"))[0].unlink()  # its last trial unsaved: to be resumed
+        (self.cwd / "empty").mkdir()
+        for library, status, words in ((["--data", "empty"], 2, "r.json: /test/characters/0: the character 十"),
+                                       (["--data", "nowhere"], 1, "nowhere")):
+            result = subprocess.run([CLI, "session", "resume", folder, *library], cwd=self.cwd,
+                                    capture_output=True, timeout=300)
+            lines = result.stderr.decode().strip().splitlines()
+            self.assertEqual(result.returncode, status, lines)
+            self.assertEqual(len(lines), 1, lines)
+            self.assertIn(words, lines[0])
+        self.assertEqual(len(list((folder / "trials").glob("*.json"))), 1)
+        # The same library given to `session run` is refused the same way.
+        result = subprocess.run(run[:-2] + ["--out", "again", "--data", "empty"], cwd=self.cwd,
+                                capture_output=True, timeout=300)
+        self.assertEqual(result.returncode, 2, result.stderr.decode())
+        self.assertIn("r.json: /test/characters/0: the character 十", result.stderr.decode())
+
     def test_a_field_shared_with_the_trial_record_has_its_range_and_is_refused_past_it_by_both(self):
         """Where a protocol's value becomes a trial's, the protocol's schema states the record's range, and each
         value past it is refused by `session plan` (exit 2) and by `trial --spec` (a record: exit 1), each
