@@ -9,12 +9,13 @@
 
 namespace protocol_checks {
 
-/// Parsing `text` as "p.json" fails with a DataError at `pointer` whose message contains `words`.
+/// Parsing `text` as "p.json" fails with a ProtocolError (the command line's usage error) at `pointer` whose
+/// message contains `words`.
 inline void check_error(const std::string& text, const std::string& pointer, const std::string& words) {
   try {
     (void)calligraphy::parse_study_protocol(text, "p.json");
     FAIL("no error for " << text);
-  } catch (const calligraphy::DataError& e) {
+  } catch (const calligraphy::ProtocolError& e) {
     const std::string message = e.what();
     CHECK_THAT(message, Catch::StartsWith("p.json: " + pointer + ": "));
     CHECK_THAT(message, Catch::Contains(words));

@@ -292,6 +292,34 @@ TEST_CASE("a quiz condition's acceptance is checked naming the key, and leniency
   CHECK(p.conditions[0].quiz.accept_backwards);
 }
 
+TEST_CASE("a quiz condition's hint is its acceptance's hint_after_misses unless the quiz overrides it",
+          "[study][protocol][quiz]") {
+  const auto quiz_of = [](const std::string& quiz) {
+    return parse_study_protocol(
+               R"({"name": "t", "conditions": [{"name": "A", "mode": "quiz", "quiz": )" + quiz +
+                   R"(}], "test": {"characters": ["大"], "conditions": ["A"], "repetitions": 1}})",
+               "p.json")
+        .conditions[0]
+        .quiz;
+  };
+  CHECK(quiz_of("{}").hint_after() == static_cast<int>(StrokeAcceptance{}.hint_after_misses));
+  CHECK(!quiz_of("{}").hint_after_misses.has_value());
+  CHECK(quiz_of(R"({"acceptance": {"hint_after_misses": 5}})").hint_after() == 5);
+  CHECK(quiz_of(R"({"acceptance": {"hint_after_misses": 5}, "hint_after_misses": 1})").hint_after() == 1);
+  CHECK(quiz_of(R"({"hint_after_misses": 0})").hint_after() == 0);
+  // The override's range is the acceptance table's, as the acceptance's own key.
+  const auto high = static_cast<long long>(parameter_field(&StrokeAcceptance::hint_after_misses).range.high);
+  CHECK(quiz_of(R"({"hint_after_misses": )" + std::to_string(high) + "}").hint_after() == high);
+  const auto with_quiz = [](const std::string& quiz) {
+    return R"({"name": "t", "conditions": [{"name": "A", "mode": "quiz", "quiz": )" + quiz +
+           R"(}], "test": {"characters": ["大"], "conditions": ["A"], "repetitions": 1}})";
+  };
+  check_error(with_quiz(R"({"hint_after_misses": )" + std::to_string(high + 1) + "}"),
+              "/conditions/0/quiz/hint_after_misses", "[0, 1000]");
+  check_error(with_quiz(R"({"acceptance": {"hint_after_misses": )" + std::to_string(high + 1) + "}}"),
+              "/conditions/0/quiz/acceptance/hint_after_misses", "[0, 1000]");
+}
+
 TEST_CASE("a balanced Latin square: each condition once per row, every ordered pair equally often",
           "[study][schedule]") {
   for (const int n : {2, 3, 4, 5}) {
@@ -454,7 +482,7 @@ TEST_CASE("a protocol of phases that makes no sense is refused, naming the phase
       "/phases/1/characters", "only a transfer phase chooses");
   check_error(phases_text(R"("delay_s": 1)", R"(["大"])",
                           R"({"phase": "warm-up", "condition": "free", "characters": ["十"]},)"),
-              "/phases/1/phase", "expected one of practice, test, pre-test");
+              "/phases/1/phase", R"(expected one of "practice", "test", "pre-test")");
   const std::string both = R"({"name": "b", "conditions": [{"name": "A", "mode": "vision"}],
       "test": {"characters": ["十"], "conditions": ["A"], "repetitions": 1},
       "phases": [{"phase": "test", "condition": "A", "characters": ["十"]}]})";
@@ -469,10 +497,10 @@ TEST_CASE("a protocol of phases that makes no sense is refused, naming the phase
   // A null is not a missing value that falls back to a default.
   check_error(R"({"name": "b", "conditions": [{"name": "A", "mode": null}],
       "phases": [{"phase": "test", "condition": "A", "characters": ["十"]}]})",
-              "/conditions/0/mode", "expected a string");
+              "/conditions/0/mode", "(ConditionMode), got null");
   check_error(R"({"name": "b", "conditions": [{"name": "A", "mode": "vision"}],
       "phases": [{"phase": null, "condition": "A", "characters": ["十"]}]})",
-              "/phases/0/phase", "expected a string");
+              "/phases/0/phase", "(StudyPhase), got null");
 }
 
 TEST_CASE("a transfer set: untrained characters made of trained typical strokes, most coverage first",

@@ -2,10 +2,10 @@
 #include <catch2/catch.hpp>
 #include <vector>
 
+#include "calligraphy/analysis/metrics.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/study/quiz.hpp"
-#include "calligraphy/analysis/metrics.hpp"
 #include "embedded_scenes.hpp"
 
 using namespace calligraphy;
@@ -89,6 +89,40 @@ TEST_CASE("quiz misses a stroke written out of order and hints after the set num
   CHECK(has(right, QuizEvent::Kind::stroke_accepted));
   CHECK(writer.quiz.misses_on_stroke() == 0);
   CHECK(writer.quiz.total_misses() == 3);
+}
+
+TEST_CASE("quiz hints after the stroke acceptance's hint_after_misses unless an option overrides it",
+          "[study][quiz]") {
+  const PlacedCharacter& shi = character_of(U'十');
+  // Misses (the vertical before the horizontal) until the first hint; 0 when none came in `most` misses.
+  const auto misses_to_hint = [&](const QuizOptions& options, int most) {
+    Writer writer{QuizSession(shi, options)};
+    for (int miss = 1; miss <= most; ++miss) {
+      if (has(writer.write(stroke_points(shi.strokes[1])), QuizEvent::Kind::hint)) return miss;
+    }
+    return 0;
+  };
+  QuizOptions options;
+  // One definition: without an override the quiz takes the acceptance's value and its default.
+  CHECK(!options.hint_after_misses.has_value());
+  CHECK(options.hint_after() == static_cast<int>(StrokeAcceptance{}.hint_after_misses));
+  CHECK(misses_to_hint(options, 6) == static_cast<int>(StrokeAcceptance{}.hint_after_misses));
+  options.acceptance.hint_after_misses = 4;
+  CHECK(misses_to_hint(options, 6) == 4);
+  options.acceptance.hint_after_misses = 0;  // never
+  CHECK(misses_to_hint(options, 6) == 0);
+  // The option overrides the acceptance's, whatever it is.
+  options.hint_after_misses = 1;
+  CHECK(options.hint_after() == 1);
+  CHECK(misses_to_hint(options, 6) == 1);
+  // Its range is the acceptance's table's.
+  const ParameterRange range = parameter_field(&StrokeAcceptance::hint_after_misses).range;
+  options.hint_after_misses = static_cast<int>(range.high);
+  CHECK_NOTHROW(options.validate());
+  options.hint_after_misses = static_cast<int>(range.high) + 1;
+  CHECK_THROWS_AS(options.validate(), InvalidArgument);
+  options.hint_after_misses = -1;
+  CHECK_THROWS_AS(options.validate(), InvalidArgument);
 }
 
 TEST_CASE("quiz reports a stroke written backwards and accepts it only when asked to", "[study][quiz]") {

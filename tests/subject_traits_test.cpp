@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
@@ -89,4 +90,49 @@ TEST_CASE("an individual profile scales the profile's fields and stays valid", "
   SubjectSpread bad;
   bad.learning_rate = -0.1;
   CHECK_THROWS_AS(draw_subject_traits(1, bad), InvalidArgument);
+}
+
+TEST_CASE("the spreads' and the two-state rates' ranges are their tables', refused just past each bound",
+          "[sim][subject_traits]") {
+  // Every spread at each bound of its table range is accepted, just past it refused naming the field.
+  for (const ParameterField<SubjectSpread>& field : ParameterTable<SubjectSpread>::fields()) {
+    for (const double bound : {field.range.low, field.range.high}) {
+      SubjectSpread spread;
+      spread.*field.member = bound;
+      CHECK_NOTHROW(spread.validate());
+      spread.*field.member = std::nextafter(bound, bound == field.range.low ? -1.0 : 3.0);
+      CHECK_THROWS_WITH(spread.validate(), Catch::Contains(std::string(field.name)));
+    }
+  }
+  // The two-state rates: each field past its table bound is refused naming it; the closed bounds the rules
+  // between fields allow are accepted.
+  for (const ParameterField<TwoStateRates>& field : ParameterTable<TwoStateRates>::fields()) {
+    for (const double bound : {field.range.low, field.range.high}) {
+      TwoStateRates rates;
+      const bool open = bound == field.range.low ? field.range.low_open : field.range.high_open;
+      rates.*field.member = open ? bound : std::nextafter(bound, bound == field.range.low ? -1.0 : 2.0);
+      CHECK_THROWS_WITH(rates.validate(), Catch::Contains(std::string(field.name)));
+    }
+  }
+  TwoStateRates rates;
+  rates.fast_retention = 0.0;
+  rates.fast_learning = 1.0;
+  CHECK_NOTHROW(rates.validate());
+  // The rules between fields: the slow state keeps more and learns less than the fast one.
+  rates = TwoStateRates{};
+  rates.slow_retention = rates.fast_retention;
+  CHECK_THROWS_WITH(rates.validate(), Catch::Contains("slow_retention"));
+  rates = TwoStateRates{};
+  rates.slow_learning = rates.fast_learning;
+  CHECK_THROWS_WITH(rates.validate(), Catch::Contains("slow_learning"));
+  // Their schemas read JSON by the same tables and rules, naming the pointer.
+  CHECK(schema_from_json<TwoStateRates>("{}", "r.json").slow_learning == TwoStateRates{}.slow_learning);
+  CHECK_THROWS_WITH(schema_from_json<TwoStateRates>(R"({"fast_retention": 1})", "r.json"),
+                    Catch::StartsWith("r.json: /fast_retention: "));
+  CHECK_THROWS_WITH(schema_from_json<TwoStateRates>(R"({"slow_learning": 0.5})", "r.json"),
+                    Catch::Contains("slow_learning"));
+  CHECK_THROWS_WITH(schema_from_json<SubjectSpread>(R"({"motor_noise": 2.5})", "s.json"),
+                    Catch::StartsWith("s.json: /motor_noise: "));
+  CHECK(schema_from_json<SubjectSpread>(schema_json(SubjectSpread{}), "s.json").learning_rate ==
+        SubjectSpread{}.learning_rate);
 }

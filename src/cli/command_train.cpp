@@ -45,7 +45,9 @@ struct TrainCommand {
   bool quiz = false;
   bool engineer = false;
   bool no_demo = false;
-  std::int64_t hint_after = 3;
+  // The acceptance's (StrokeAcceptance::hint_after_misses, its one definition) unless --hint-after is given.
+  std::int64_t hint_after = static_cast<std::int64_t>(StrokeAcceptance{}.hint_after_misses);
+  const CLI::Option* hint_after_option = nullptr;
   std::string quiz_screenshots;
 };
 
@@ -110,7 +112,9 @@ int run_train(const TrainCommand& command, DeviceRegistry& devices) {
   options.quiz = command.quiz;
   options.engineer = command.engineer;
   options.demonstrate = !command.no_demo;
-  options.quiz_options.hint_after_misses = static_cast<int>(command.hint_after);
+  // An override of the acceptance's (StrokeAcceptance::hint_after_misses) only when given.
+  if (command.hint_after_option->count() > 0)
+    options.quiz_options.hint_after_misses = static_cast<int>(command.hint_after);
   options.quiz_screenshots = command.quiz_screenshots;
   if (command.quiz && command.guidance_mode != "fixed")
     throw UsageError("--quiz: a quiz has no guidance; drop --guidance-mode " + command.guidance_mode);
@@ -213,10 +217,14 @@ void add_train_command(CLI::App& root, Commands& commands, DeviceRegistry& devic
       add_flag(*app, "--quiz", command->quiz,
                "a quiz (docs/trainer.md): no guidance; each stroke is judged as the pen lifts, "
                "accepted or missed by the stroke matcher the renderer uses (docs/stroke-acceptance.md)");
-  add_integer(*app, "--hint-after", command->hint_after, "N",
-              "quiz: show the expected stroke after N misses on it, and after each further miss; 0: never", 0,
-              1000)
-      ->needs(quiz);
+  const ParameterRange hint_range = parameter_field(&StrokeAcceptance::hint_after_misses).range;
+  command->hint_after_option =
+      add_integer(
+          *app, "--hint-after", command->hint_after, "N",
+          "quiz: show the expected stroke after N misses on it, and after each further miss; 0: never "
+          "(overrides the stroke acceptance's hint_after_misses)",
+          static_cast<std::int64_t>(hint_range.low), static_cast<std::int64_t>(hint_range.high))
+          ->needs(quiz);
   add_output_folder(*app, "--quiz-screenshots", command->quiz_screenshots,
                     "quiz: write the window as DIR/quiz-NN-VERDICT.png on the first frame after each judged "
                     "stroke (an existing folder)",

@@ -8,6 +8,7 @@
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/logging.hpp"
+#include "calligraphy/study/protocol.hpp"
 #include "cli/cli_devices.hpp"
 #include "cli/commands.hpp"
 #include "cli/output.hpp"
@@ -119,6 +120,9 @@ int main(int argc, char** argv) {
     show_library_log(given_command(root).first, commands.verbose());
     status = commands.run_selected();
   } catch (const UsageError& e) {
+    print_error(given_command(root).first, e.what());
+    status = 2;
+  } catch (const calligraphy::ProtocolError& e) {  // a protocol's content: bad input, as a bad option
     print_error(given_command(root).first, e.what());
     status = 2;
   } catch (const calligraphy::Error& e) {

@@ -12,8 +12,9 @@
 namespace calligraphy::cli {
 
 // Every character the protocol names is looked up (read and modelled) before any folder is made or trial
-// run: one the library lacks is a DataError naming the protocol file, the string's JSON pointer and the
-// character, not a failure in the middle of a study.
+// run: one the library lacks is a ProtocolError (a usage error) naming the protocol file, the string's JSON
+// pointer and the character, not a failure in the middle of a study; a library that cannot be read is a
+// DataError naming the same.
 void require_characters(const LoadedProtocol& loaded, const CharacterSource& source) {
   std::set<char32_t> checked;
   const auto check = [&](const std::vector<std::u32string>& items, const std::string& pointer) {
@@ -25,9 +26,11 @@ void require_characters(const LoadedProtocol& loaded, const CharacterSource& sou
         } catch (const Error& e) {
           char code[16];
           std::snprintf(code, sizeof code, "U+%04X", static_cast<unsigned>(c));
-          throw DataError(loaded.path.string() + ": " + pointer + "/" + std::to_string(i) +
-                          ": the character " + encode_utf8(c) + " (" + code +
-                          ") cannot be written: " + e.what() + "; nothing was run or written");
+          const std::string message = loaded.path.string() + ": " + pointer + "/" + std::to_string(i) +
+                                      ": the character " + encode_utf8(c) + " (" + code +
+                                      ") cannot be written: " + e.what() + "; nothing was run or written";
+          if (dynamic_cast<const CharacterNotFound*>(&e) != nullptr) throw ProtocolError(message);
+          throw DataError(message);
         }
       }
     }
@@ -50,8 +53,8 @@ LoadedProtocol resolved_protocol(const LoadedProtocol& loaded, const CharacterSo
   LoadedProtocol resolved = loaded;
   try {
     resolve_transfer_choices(resolved.protocol, [&source](char32_t c) { return source.load(c); });
-  } catch (const InvalidArgument& e) {
-    throw DataError(loaded.path.string() + ": " + e.what());
+  } catch (const InvalidArgument& e) {  // the protocol's transfer choice cannot be made: its content
+    throw ProtocolError(loaded.path.string() + ": " + e.what());
   }
   return resolved;
 }

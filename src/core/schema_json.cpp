@@ -297,6 +297,17 @@ ordered_json to_json(const Schema& schema, const void* object) {
   return out;
 }
 
+void read_field(const Schema& schema, const SchemaField& field, void* object, const json& value,
+                const std::string& pointer, const std::string& source) {
+  SchemaReadResult unused;
+  read_value(field, std::string(schema.name), object, value, pointer, source, {}, unused);
+}
+
+ordered_json field_json_schema(const SchemaField& field, const void* defaults) {
+  ordered_json defs = ordered_json::object();  // a scalar refers to no struct
+  return field_schema(field, defaults, defs, false);
+}
+
 void from_json(const Schema& schema, void* object, const json& document, const std::string& pointer,
                const std::string& source, const SchemaReadOptions& options, SchemaReadResult& result) {
   if (!document.is_object()) {

@@ -1,6 +1,7 @@
 #include "calligraphy/sim/subject_traits.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -37,17 +38,41 @@ void check_factor(double value, const char* name) {
 
 }  // namespace
 
-void SubjectSpread::validate() const {
-  const std::pair<const char*, double> spreads[] = {
-      {"writing_speed", writing_speed}, {"spatial_error", spatial_error}, {"error_rate", error_rate},
-      {"motor_noise", motor_noise},     {"learning_rate", learning_rate}, {"retention_time", retention_time}};
-  for (const auto& [name, value] : spreads) {
-    if (!std::isfinite(value) || value < 0.0 || value > 2.0) {
-      throw InvalidArgument(std::string("SubjectSpread.") + name + " = " + std::to_string(value) +
-                            " must be in [0, 2] (a log-SD)");
-    }
-  }
+namespace {
+
+// A log-SD of 2 spreads a trait's middle 95 % over a factor of about 2,500 (e^(2 x 1.96 x 2)): far past the
+// spreads docs/writer.md ("Individual differences") takes, 0.2 to 0.5.
+constexpr ParameterRange kLogSd{.low = 0.0, .high = 2.0};
+constexpr std::array kSpreadFields{
+    ParameterField<SubjectSpread>{"writing_speed", "", kLogSd, "log-SD of the writing speed factor",
+                                  &SubjectSpread::writing_speed},
+    ParameterField<SubjectSpread>{"spatial_error", "", kLogSd,
+                                  "log-SD of bias, scale error, jitter, corner cut and error tolerance",
+                                  &SubjectSpread::spatial_error},
+    ParameterField<SubjectSpread>{"error_rate", "", kLogSd, "log-SD of the error probabilities",
+                                  &SubjectSpread::error_rate},
+    ParameterField<SubjectSpread>{"motor_noise", "", kLogSd,
+                                  "log-SD of the force noise fraction and the tremor amplitude",
+                                  &SubjectSpread::motor_noise},
+    ParameterField<SubjectSpread>{"learning_rate", "", kLogSd,
+                                  "log-SD of the two-state learning rates B_f and B_s (one factor)",
+                                  &SubjectSpread::learning_rate},
+    ParameterField<SubjectSpread>{"retention_time", "", kLogSd,
+                                  "log-SD of the retention time constants 1 / (1 - A) (one factor)",
+                                  &SubjectSpread::retention_time},
+};
+
+}  // namespace
+
+std::span<const ParameterField<SubjectSpread>> ParameterTable<SubjectSpread>::fields() noexcept {
+  return kSpreadFields;
 }
+
+const Schema& SchemaOf<SubjectSpread>::get() {
+  return table_schema<SubjectSpread>("log-normal spreads of a simulated subject's traits about its profile");
+}
+
+void SubjectSpread::validate() const { check_parameters(*this); }
 
 SubjectTraits draw_subject_traits(std::uint64_t subject_seed, const SubjectSpread& spread) {
   spread.validate();

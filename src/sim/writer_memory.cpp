@@ -1,6 +1,7 @@
 #include "calligraphy/sim/writer_memory.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <string>
@@ -49,19 +50,49 @@ void check_skill(double skill, const char* name) {
 
 }  // namespace
 
+namespace {
+
+// Smith, Ghazizadeh & Shadmehr (2006): a retention factor is a share kept per trial, a learning rate a share
+// of the error learned per trial.
+constexpr std::array kTwoStateFields{
+    ParameterField<TwoStateRates>{
+        "fast_retention", "", ParameterRange{.low = 0.0, .high = 1.0, .high_open = true},
+        "A_f, share of the fast state kept per trial", &TwoStateRates::fast_retention},
+    ParameterField<TwoStateRates>{
+        "fast_learning", "", ParameterRange{.low = 0.0, .high = 1.0, .low_open = true},
+        "B_f, share of the error the fast state learns per trial", &TwoStateRates::fast_learning},
+    ParameterField<TwoStateRates>{
+        "slow_retention", "", ParameterRange{.low = 0.0, .high = 1.0, .high_open = true},
+        "A_s, share of the slow state kept per trial (above A_f)", &TwoStateRates::slow_retention},
+    ParameterField<TwoStateRates>{
+        "slow_learning", "", ParameterRange{.low = 0.0, .high = 1.0, .low_open = true},
+        "B_s, share of the error the slow state learns per trial (below B_f)", &TwoStateRates::slow_learning},
+};
+
+}  // namespace
+
+std::span<const ParameterField<TwoStateRates>> ParameterTable<TwoStateRates>::fields() noexcept {
+  return kTwoStateFields;
+}
+
+const Schema& SchemaOf<TwoStateRates>::get() {
+  return table_schema<TwoStateRates>(
+      "the two-state model's retention factors and learning rates per trial (Smith, Ghazizadeh & Shadmehr "
+      "2006)",
+      validate_of<TwoStateRates>);
+}
+
 void TwoStateRates::validate() const {
-  const auto check = [](double value, bool ok, const char* name, const char* range) {
-    if (!std::isfinite(value) || !ok) {
-      throw InvalidArgument(std::string("TwoStateRates.") + name + " = " + std::to_string(value) +
-                            " must be " + range);
-    }
-  };
-  check(fast_retention, fast_retention >= 0.0 && fast_retention < 1.0, "fast_retention", "in [0, 1)");
-  check(slow_retention, slow_retention > fast_retention && slow_retention < 1.0, "slow_retention",
-        "in (fast_retention, 1)");
-  check(fast_learning, fast_learning > 0.0 && fast_learning <= 1.0, "fast_learning", "in (0, 1]");
-  check(slow_learning, slow_learning > 0.0 && slow_learning < fast_learning, "slow_learning",
-        "in (0, fast_learning)");
+  check_parameters(*this);
+  // The rules between fields: the slow state retains more and learns less than the fast one.
+  if (!(slow_retention > fast_retention)) {
+    throw InvalidArgument("TwoStateRates.slow_retention = " + std::to_string(slow_retention) +
+                          " must be in (fast_retention, 1)");
+  }
+  if (!(slow_learning < fast_learning)) {
+    throw InvalidArgument("TwoStateRates.slow_learning = " + std::to_string(slow_learning) +
+                          " must be in (0, fast_learning)");
+  }
 }
 
 double SkillMemory::skill() const noexcept { return std::clamp(fast + slow, 0.0, 1.0); }

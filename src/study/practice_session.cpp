@@ -11,6 +11,15 @@
 namespace calligraphy {
 namespace {
 
+// The quiz condition's options as a protocol gives them: the hint's override only when there is one (the
+// acceptance's otherwise).
+nlohmann::json practice_quiz_json(const QuizOptions& quiz) {
+  nlohmann::json out = {{"acceptance", study_detail::acceptance_json(quiz.acceptance)}};
+  if (quiz.hint_after_misses) out["hint_after_misses"] = *quiz.hint_after_misses;
+  out["accept_backwards"] = quiz.accept_backwards;
+  return out;
+}
+
 // The "train" protocol: the row once under the first condition; the other conditions are defined so that
 // the trials the window runs under them name a condition of the session's own protocol.
 LoadedProtocol practice_protocol(const PracticeSetup& setup) {
@@ -24,12 +33,7 @@ LoadedProtocol practice_protocol(const PracticeSetup& setup) {
       {"conditions",
        {{{"name", kHapticCondition}, {"mode", "haptic"}},
         {{"name", kVisionCondition}, {"mode", "vision"}},
-        {{"name", kQuizCondition},
-         {"mode", "quiz"},
-         {"quiz",
-          {{"acceptance", study_detail::acceptance_json(setup.quiz.acceptance)},
-           {"hint_after_misses", setup.quiz.hint_after_misses},
-           {"accept_backwards", setup.quiz.accept_backwards}}}},
+        {{"name", kQuizCondition}, {"mode", "quiz"}, {"quiz", practice_quiz_json(setup.quiz)}},
         {{"name", kFadingCondition}, {"mode", "fading"}},
         {{"name", kReplayCondition}, {"mode", "replay"}},
         {{"name", kAssistCondition}, {"mode", "assist-as-needed"}},

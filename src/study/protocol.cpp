@@ -71,10 +71,9 @@ std::string condition_name(const json& value, const std::string& pointer, const 
 namespace {
 
 using nlohmann::json;
-using study_detail::choice;
 using study_detail::condition_name;
-using study_detail::kMaxRepetitions;
 using study_detail::read_items;
+using study_detail::read_member;
 using study_detail::table_number_or;
 using study_detail::take_table_number;
 
@@ -102,8 +101,12 @@ QuizOptions read_quiz(const json& value, const std::string& pointer, const std::
   if (const json* acceptance = reader.optional("acceptance")) {
     quiz.acceptance = read_acceptance(*acceptance, reader.pointer("acceptance"), source);
   }
-  quiz.hint_after_misses = static_cast<int>(
-      reader.integer_or("hint_after_misses", quiz.hint_after_misses, 0, study_detail::kMaxHintAfterMisses));
+  // Overrides the acceptance's, in its table's range (StrokeAcceptance, the one definition).
+  if (reader.optional("hint_after_misses") != nullptr) {
+    const ParameterRange range = parameter_field(&StrokeAcceptance::hint_after_misses).range;
+    quiz.hint_after_misses = static_cast<int>(reader.integer(
+        "hint_after_misses", static_cast<std::int64_t>(range.low), static_cast<std::int64_t>(range.high)));
+  }
   quiz.accept_backwards = reader.boolean_or("accept_backwards", quiz.accept_backwards);
   reader.finish();
   return quiz;
@@ -231,7 +234,7 @@ StudyCondition read_condition(const json& value, const std::string& pointer, con
     json_detail::fail(source, reader.pointer("name"),
                       "expected 1 to 32 letters, digits, '_' or '-', got \"" + condition.name + "\"");
   }
-  condition.mode = choice(reader, "mode", study_detail::kConditionModes);
+  read_member(reader, SchemaOf<StudyCondition>::get(), "mode", &condition, true);
   const bool guided = renders_guidance(condition.mode);
   if (reader.optional("guidance_stiffness_n_per_m") != nullptr) {
     if (!guided) {
@@ -269,11 +272,12 @@ StudyCondition read_condition(const json& value, const std::string& pointer, con
 void read_order(json_detail::ObjectReader& reader, StudyProtocol& protocol) {
   const json* value = reader.optional("order");
   if (!value) return;
+  // Through its schema (protocol_order_schema: the enumerations' one spelling each); null keeps the default.
   json_detail::ObjectReader order(*value, reader.pointer("order"), reader.source());
-  protocol.condition_order =
-      choice(order, "conditions", study_detail::kConditionOrders, ConditionOrder::fixed);
-  protocol.item_order = choice(order, "characters", study_detail::kItemOrders, ItemOrder::fixed);
-  protocol.seed = order.unsigned_or("seed", 0);
+  for (const char* key : {"conditions", "characters"})
+    study_detail::read_member(order, protocol_order_schema(), key, &protocol);
+  // Every value of a std::uint64_t (the schema's range), also in exponent form when exact (1e3).
+  protocol.seed = order.unsigned_or("seed", protocol.seed);
   order.finish();
 }
 
@@ -322,7 +326,7 @@ void read_paper_phases(json_detail::ObjectReader& root, StudyProtocol& protocol)
     phase.items = read_items(reader.required("characters"), reader.pointer("characters"), source);
     phase.conditions = {condition_name(reader.required("condition"), reader.pointer("condition"), source,
                                        protocol.conditions)};
-    phase.repetitions = static_cast<int>(reader.integer_or("repetitions", 1, 1, kMaxRepetitions));
+    read_member(reader, SchemaOf<ProtocolPhase>::get(), "repetitions", &phase);
     reader.finish();
     protocol.phases.push_back(std::move(phase));
   }
@@ -344,7 +348,7 @@ void read_paper_phases(json_detail::ObjectReader& root, StudyProtocol& protocol)
     }
     phase.conditions.push_back(std::move(name));
   }
-  phase.repetitions = static_cast<int>(test.integer("repetitions", 1, kMaxRepetitions));
+  read_member(test, SchemaOf<ProtocolPhase>::get(), "repetitions", &phase, true);
   test.finish();
   if (protocol.condition_order == ConditionOrder::abba && phase.repetitions % 2 != 0) {
     json_detail::fail(
@@ -357,61 +361,12 @@ void read_paper_phases(json_detail::ObjectReader& root, StudyProtocol& protocol)
 
 }  // namespace
 
-const char* to_string(StudyPhase phase) noexcept {
-  switch (phase) {
-    case StudyPhase::practice:
-      return "practice";
-    case StudyPhase::test:
-      return "test";
-    case StudyPhase::pre_test:
-      return "pre-test";
-    case StudyPhase::training:
-      return "training";
-    case StudyPhase::post_test:
-      return "post-test";
-    case StudyPhase::retention:
-      return "retention";
-    case StudyPhase::transfer:
-      return "transfer";
-  }
-  return "unknown";
-}
+// The spellings are the enumerations' tables' (protocol.hpp): each a string literal, so null-terminated.
+const char* to_string(StudyPhase phase) noexcept { return enum_spelling(phase).data(); }
 
-const char* to_string(ConditionAssignment assignment) noexcept {
-  switch (assignment) {
-    case ConditionAssignment::within_subjects:
-      return "within-subjects";
-    case ConditionAssignment::between_subjects:
-      return "between-subjects";
-    case ConditionAssignment::crossover:
-      return "crossover";
-  }
-  return "unknown";
-}
+const char* to_string(ConditionAssignment assignment) noexcept { return enum_spelling(assignment).data(); }
 
-const char* to_string(ConditionMode mode) noexcept {
-  switch (mode) {
-    case ConditionMode::vision:
-      return "vision";
-    case ConditionMode::haptic:
-      return "haptic";
-    case ConditionMode::fading:
-      return "fading";
-    case ConditionMode::replay:
-      return "replay";
-    case ConditionMode::quiz:
-      return "quiz";
-    case ConditionMode::assist_as_needed:
-      return "assist-as-needed";
-    case ConditionMode::error_amplification:
-      return "error-amplification";
-    case ConditionMode::skill_adaptive:
-      return "skill-adaptive";
-    case ConditionMode::timing:
-      return "timing";
-  }
-  return "unknown";
-}
+const char* to_string(ConditionMode mode) noexcept { return enum_spelling(mode).data(); }
 
 std::span<const ConditionMode> condition_modes() noexcept { return study_detail::kConditionModes; }
 
@@ -419,23 +374,9 @@ bool renders_guidance(ConditionMode mode) noexcept {
   return mode != ConditionMode::vision && mode != ConditionMode::quiz;
 }
 
-const char* to_string(ConditionOrder order) noexcept {
-  switch (order) {
-    case ConditionOrder::fixed:
-      return "fixed";
-    case ConditionOrder::latin_square:
-      return "latin_square";
-    case ConditionOrder::abba:
-      return "abba";
-    case ConditionOrder::random:
-      return "random";
-  }
-  return "unknown";
-}
+const char* to_string(ConditionOrder order) noexcept { return enum_spelling(order).data(); }
 
-const char* to_string(ItemOrder order) noexcept {
-  return order == ItemOrder::fixed ? "fixed" : order == ItemOrder::random ? "random" : "unknown";
-}
+const char* to_string(ItemOrder order) noexcept { return enum_spelling(order).data(); }
 
 void QuizOptions::validate() const {
   acceptance.validate();
@@ -443,9 +384,10 @@ void QuizOptions::validate() const {
     throw InvalidArgument("QuizOptions::start_radius_m must be finite and > 0, got " +
                           std::to_string(start_radius_m));
   }
-  if (hint_after_misses < 0) {
-    throw InvalidArgument("QuizOptions::hint_after_misses must be >= 0, got " +
-                          std::to_string(hint_after_misses));
+  const ParameterRange range = parameter_field(&StrokeAcceptance::hint_after_misses).range;
+  if (hint_after_misses && !range.contains(static_cast<double>(*hint_after_misses))) {
+    throw InvalidArgument("QuizOptions::hint_after_misses must be " + range.text("") + ", got " +
+                          std::to_string(*hint_after_misses));
   }
 }
 
@@ -456,7 +398,9 @@ const StudyCondition& StudyProtocol::condition(std::string_view wanted) const {
   throw InvalidArgument("protocol '" + name + "' has no condition '" + std::string(wanted) + "'");
 }
 
-StudyProtocol parse_study_protocol(std::string_view json_text, const std::string& source) {
+namespace {
+
+StudyProtocol read_protocol_document(std::string_view json_text, const std::string& source) {
   const json document = json_detail::parse_json(json_text, source);
   json_detail::ObjectReader root(document, "", source);
   StudyProtocol protocol;
@@ -518,6 +462,20 @@ StudyProtocol parse_study_protocol(std::string_view json_text, const std::string
                           thousands(kMaxPlannedTrials) + " trials per session");
   }
   return protocol;
+}
+
+}  // namespace
+
+StudyProtocol parse_study_protocol(std::string_view json_text, const std::string& source) {
+  // Every refusal of the text names the source and the JSON pointer (json_detail::fail): the protocol's
+  // content, a usage error, not a failure to read a file.
+  try {
+    return read_protocol_document(json_text, source);
+  } catch (const ProtocolError&) {
+    throw;
+  } catch (const DataError& e) {
+    throw ProtocolError(e.what());
+  }
 }
 
 std::uint64_t planned_trial_count(const StudyProtocol& protocol) noexcept {

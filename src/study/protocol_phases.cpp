@@ -128,18 +128,18 @@ ProtocolPhase read_phase(const json& value, const std::string& pointer, const st
   json_detail::ObjectReader reader(value, pointer, source);
   ProtocolPhase phase;
   phase.pointer = pointer;
-  phase.kind = choice(reader, "phase", kStudyPhases);
+  // The settings through their schema (SchemaOf<ProtocolPhase>: spellings and ranges written once).
+  const Schema& settings = SchemaOf<ProtocolPhase>::get();
+  read_member(reader, settings, "phase", &phase, true);
   phase.conditions = read_conditions(reader, protocol.conditions);
-  phase.assignment = choice(reader, "assignment", kAssignments, ConditionAssignment::within_subjects);
+  read_member(reader, settings, "assignment", &phase);
   if (phase.assignment == ConditionAssignment::between_subjects && phase.conditions.size() < 2) {
     json_detail::fail(source, reader.pointer("assignment"),
                       "between-subjects needs two or more \"conditions\"");
   }
   read_phase_items(reader, protocol, phase);
   if (phase.assignment == ConditionAssignment::crossover) check_crossover(reader, protocol, phase);
-  phase.repetitions = static_cast<int>(reader.integer_or("repetitions", 1, 1, kMaxRepetitions));
-  phase.session = static_cast<int>(reader.integer_or("session", 1, 1, static_cast<std::int64_t>(kMaxPhases)));
-  phase.delay_s = reader.number_or("delay_s", 0.0, 0.0, kMaxDelay_s);
+  for (const char* key : {"repetitions", "session", "delay_s"}) read_member(reader, settings, key, &phase);
   reader.finish();
   // A crossover phase has its own order (crossover_assignment): `abba` does not split it.
   const bool ordered = phase.assignment == ConditionAssignment::within_subjects &&

@@ -9,6 +9,7 @@
 
 #include "calligraphy/study/protocol.hpp"
 #include "core/json_reader.hpp"
+#include "core/schema_json.hpp"
 
 namespace calligraphy::study_detail {
 
@@ -18,34 +19,25 @@ inline constexpr std::int64_t kMaxRepetitions = 1000;
 inline constexpr std::size_t kMaxPhases = 20;
 inline constexpr std::size_t kMaxLabelLength = 32;         ///< a condition's or an item set's name
 inline constexpr std::size_t kMaxProtocolNameLength = 64;  ///< a protocol's name (it names folders)
-inline constexpr std::int64_t kMaxHintAfterMisses = 1000;  ///< a quiz's hint_after_misses
 inline constexpr std::size_t kMaxConditions = 26;
 // As many sets as conditions may be compared in one crossover: the conditions' limit.
 inline constexpr std::size_t kMaxItemSets = kMaxConditions;
 // A delay longer than a year is a typo, not a design.
 inline constexpr double kMaxDelay_s = 366.0 * 86400.0;
-inline constexpr std::array<ConditionAssignment, 3> kAssignments{ConditionAssignment::within_subjects,
-                                                                 ConditionAssignment::between_subjects,
-                                                                 ConditionAssignment::crossover};
-inline constexpr std::array<ConditionOrder, 4> kConditionOrders{
-    ConditionOrder::fixed, ConditionOrder::latin_square, ConditionOrder::abba, ConditionOrder::random};
-inline constexpr std::array<ItemOrder, 2> kItemOrders{ItemOrder::fixed, ItemOrder::random};
-
+/// Every value of enumeration `E`, in its table's order (EnumTable, protocol.hpp: the one list).
+template <typename E>
+inline constexpr auto kEnumValues = [] {
+  std::array<E, EnumTable<E>::entries.size()> out{};
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = EnumTable<E>::entries[i].value;
+  return out;
+}();
+inline constexpr const auto& kAssignments = kEnumValues<ConditionAssignment>;
+inline constexpr const auto& kConditionOrders = kEnumValues<ConditionOrder>;
+inline constexpr const auto& kItemOrders = kEnumValues<ItemOrder>;
 /// Every phase, in the order the docs list them.
-inline constexpr std::array<StudyPhase, 7> kStudyPhases{
-    StudyPhase::practice,  StudyPhase::test,      StudyPhase::pre_test, StudyPhase::training,
-    StudyPhase::post_test, StudyPhase::retention, StudyPhase::transfer};
-
+inline constexpr const auto& kStudyPhases = kEnumValues<StudyPhase>;
 /// Every condition mode, in declaration order (condition_modes()).
-inline constexpr std::array<ConditionMode, 9> kConditionModes{ConditionMode::vision,
-                                                              ConditionMode::haptic,
-                                                              ConditionMode::fading,
-                                                              ConditionMode::replay,
-                                                              ConditionMode::quiz,
-                                                              ConditionMode::assist_as_needed,
-                                                              ConditionMode::error_amplification,
-                                                              ConditionMode::skill_adaptive,
-                                                              ConditionMode::timing};
+inline constexpr const auto& kConditionModes = kEnumValues<ConditionMode>;
 
 /// `value` among `values` by their `to_string` names; DataError naming `pointer` and listing the names for
 /// anything else.
@@ -73,6 +65,17 @@ Enum choice(json_detail::ObjectReader& reader, const std::string& key, const std
 template <typename Enum, std::size_t N>
 Enum choice(json_detail::ObjectReader& reader, const std::string& key, const std::array<Enum, N>& values) {
   return choice_of(reader.required(key), reader.pointer(key), reader.source(), values);
+}
+
+/// Member `key` of the object `reader` reads, through the field of that name of `schema` into `object`:
+/// its type, range or spellings as the schema checks them (schema_detail::read_field), the error naming the
+/// member's pointer. Missing or null: `object` keeps its value; with `required`, missing is an error.
+inline void read_member(json_detail::ObjectReader& reader, const Schema& schema, const std::string& key,
+                        void* object, bool required = false) {
+  const SchemaField* field = schema.field(key);
+  const nlohmann::json* value = required ? &reader.required(key) : reader.optional(key);
+  if (field == nullptr || value == nullptr) return;
+  schema_detail::read_field(schema, *field, object, *value, reader.pointer(key), reader.source());
 }
 
 /// `text` in double quotes, for messages ("\"x\" is trained"); not `quoted`, which argument-dependent lookup

@@ -52,6 +52,48 @@ const Schema& SchemaOf<BreakRules>::get() {
   return schema;
 }
 
+const Schema& SchemaOf<ProtocolPhase>::get() {
+  using P = ProtocolPhase;
+  static const std::array fields{
+      enum_field<&P::kind>("phase", {.doc = "the phase of a motor-learning study"}),
+      enum_field<&P::assignment>("assignment", {.doc = "how the conditions are given to subjects"}),
+      integer_field<&P::repetitions>("repetitions", 1, study_detail::kMaxRepetitions,
+                                     {.doc = "times each item is written in each condition"}),
+      integer_field<&P::session>("session", 1, static_cast<std::int64_t>(study_detail::kMaxPhases),
+                                 {.doc = "1-based: the sitting the phase is written in"}),
+      number_field<&P::delay_s>(
+          "delay_s", {.low = 0.0, .high = study_detail::kMaxDelay_s},
+          {.unit = "s", .doc = "the phase starts at least this long after the previous one ended"}),
+  };
+  static const Schema schema{.name = "ProtocolPhase",
+                             .doc = "a phase's settings besides its conditions and items",
+                             .fields = fields,
+                             .defaults = default_of<P>};
+  return schema;
+}
+
+const Schema& SchemaOf<StudyCondition>::get() {
+  using C = StudyCondition;
+  static const std::array fields{
+      enum_field<&C::mode>("mode", {.doc = "what the writer gets"}),
+  };
+  static const Schema schema{
+      .name = "StudyCondition", .doc = "a feedback condition", .fields = fields, .defaults = default_of<C>};
+  return schema;
+}
+
+const Schema& protocol_order_schema() {
+  using S = StudyProtocol;
+  static const std::array fields{
+      enum_field<&S::condition_order>("conditions", {.doc = "order of the condition blocks per subject"}),
+      enum_field<&S::item_order>("characters", {.doc = "order of the strings within each round"}),
+      unsigned_field<&S::seed>("seed", {.doc = "seeds the random orders (with the subject id)"}),
+  };
+  static const Schema schema{
+      .name = "ProtocolOrder", .doc = "orders", .fields = fields, .defaults = default_of<S>};
+  return schema;
+}
+
 ParameterRange protocol_max_lead_range() noexcept {
   ParameterRange range = parameter_field(&ReplayGuidance::max_lead_m).range;
   const double radius = ForceLawParameters{}.constraint_radius_m;
@@ -81,13 +123,6 @@ ordered_json integer_schema(std::int64_t low, std::int64_t high, std::string_vie
   return {{"type", "integer"}, {"description", std::string(doc)}, {"minimum", low}, {"maximum", high}};
 }
 
-template <typename E, std::size_t N>
-ordered_json enum_schema(const std::array<E, N>& values, std::string_view doc) {
-  ordered_json names = ordered_json::array();
-  for (const E value : values) names.push_back(to_string(value));
-  return {{"type", "string"}, {"description", std::string(doc)}, {"enum", names}};
-}
-
 ordered_json label_schema(std::size_t longest, std::string_view doc) {
   return {{"type", "string"},
           {"description", std::string(doc)},
@@ -99,6 +134,11 @@ ordered_json object_schema(ordered_json properties, std::string_view doc) {
           {"description", std::string(doc)},
           {"properties", std::move(properties)},
           {"additionalProperties", false}};
+}
+
+// Field `key` of `schema` as a JSON Schema property (range, spellings, default from the one table).
+ordered_json schema_property(const Schema& schema, std::string_view key) {
+  return schema_detail::field_json_schema(*schema.field(key), schema.defaults());
 }
 
 ordered_json ref(std::string_view name) { return {{"$ref", "#/$defs/" + std::string(name)}}; }
@@ -175,7 +215,8 @@ ordered_json condition_schema() {
   ordered_json properties = ordered_json::object();
   properties["name"] = label_schema(study_detail::kMaxLabelLength,
                                     "unique label of the condition, used in file names and reports");
-  properties["mode"] = enum_schema(study_detail::kConditionModes, "what the writer gets");
+  properties["mode"] = schema_property(SchemaOf<StudyCondition>::get(), "mode");
+  properties["mode"].erase("default");  // required
   put_table_field(properties, "guidance_stiffness_n_per_m", &ForceLawParameters::guidance_stiffness_n_per_m);
   properties["guidance_stiffness_n_per_m"]["description"] =
       "K_et, the guidance stiffness (paper eq. 8), modes that render guidance only [N/m]";
@@ -215,25 +256,29 @@ ordered_json quiz_schema() {
   ordered_json properties = ordered_json::object();
   properties["acceptance"] =
       object_schema(std::move(acceptance), "the stroke matcher's tolerances (docs/stroke-acceptance.md)");
+  // An override of the acceptance's, in its table's range (StrokeAcceptance: the one definition).
+  const ParameterRange hint = parameter_field(&StrokeAcceptance::hint_after_misses).range;
   properties["hint_after_misses"] =
-      integer_schema(0, study_detail::kMaxHintAfterMisses,
-                     "a hint after this many misses on one stroke, and each further one; 0: never");
+      integer_schema(static_cast<std::int64_t>(hint.low), static_cast<std::int64_t>(hint.high),
+                     "a hint after this many misses on one stroke, and each further one; 0: never; overrides "
+                     "acceptance.hint_after_misses (default: the acceptance's)");
   properties["accept_backwards"] = {
       {"type", "boolean"}, {"description", "a stroke written from its end to its start is accepted"}};
   return object_schema(std::move(properties), "how a quiz judges strokes");
 }
 
 ordered_json phase_schema() {
+  const Schema& settings = SchemaOf<ProtocolPhase>::get();
   ordered_json properties = ordered_json::object();
-  properties["phase"] = enum_schema(study_detail::kStudyPhases, "the phase of a motor-learning study");
+  properties["phase"] = schema_property(settings, "phase");
+  properties["phase"].erase("default");  // required
   properties["condition"] = label_schema(study_detail::kMaxLabelLength, "the one condition of the phase");
   properties["conditions"] = {{"type", "array"},
                               {"description", "the conditions of the phase, in listed order"},
                               {"minItems", 1},
                               {"uniqueItems", true},
                               {"items", label_schema(study_detail::kMaxLabelLength, "a condition's name")}};
-  properties["assignment"] =
-      enum_schema(study_detail::kAssignments, "how the conditions are given to subjects");
+  properties["assignment"] = schema_property(settings, "assignment");
   properties["characters"] = {
       {"description", "the strings written, or (transfer) a choice by typical-stroke coverage"},
       {"oneOf",
@@ -246,12 +291,8 @@ ordered_json phase_schema() {
                         {"description", "names of item sets whose items the phase writes"},
                         {"minItems", 1},
                         {"items", label_schema(study_detail::kMaxLabelLength, "an item set's name")}};
-  properties["repetitions"] =
-      integer_schema(1, study_detail::kMaxRepetitions, "times each item is written in each condition");
-  properties["session"] = integer_schema(1, static_cast<std::int64_t>(study_detail::kMaxPhases),
-                                         "1-based: the sitting the phase is written in");
-  properties["delay_s"] = number_schema({.low = 0.0, .high = study_detail::kMaxDelay_s}, "s",
-                                        "the phase starts at least this long after the previous one ended");
+  for (const char* key : {"repetitions", "session", "delay_s"})
+    properties[key] = schema_property(settings, key);
   ordered_json out = object_schema(std::move(properties), "a phase of the study");
   out["required"] = ordered_json::array({"phase"});
   return out;
@@ -292,33 +333,23 @@ std::string protocol_json_schema_text() {
                              {"minItems", 1},
                              {"maxItems", study_detail::kMaxItemSets},
                              {"items", ref("ItemSet")}};
-  properties["practice"] = object_schema(
-      {{"characters", items_schema("the familiarisation block's strings")},
-       {"condition", label_schema(study_detail::kMaxLabelLength, "the practice condition")},
-       {"repetitions", integer_schema(1, study_detail::kMaxRepetitions, "times each string is written")}},
-      "the paper's familiarisation block, written first");
+  properties["practice"] =
+      object_schema({{"characters", items_schema("the familiarisation block's strings")},
+                     {"condition", label_schema(study_detail::kMaxLabelLength, "the practice condition")},
+                     {"repetitions", schema_property(SchemaOf<ProtocolPhase>::get(), "repetitions")}},
+                    "the paper's familiarisation block, written first");
   properties["practice"]["required"] = ordered_json::array({"characters", "condition"});
-  properties["test"] = object_schema(
-      {{"characters", items_schema("each string written in one trial")},
-       {"conditions",
-        {{"type", "array"},
-         {"minItems", 1},
-         {"uniqueItems", true},
-         {"items", label_schema(study_detail::kMaxLabelLength, "a condition")}}},
-       {"repetitions",
-        integer_schema(1, study_detail::kMaxRepetitions, "times each string is written in each condition")}},
-      "the paper's test blocks");
+  properties["test"] =
+      object_schema({{"characters", items_schema("each string written in one trial")},
+                     {"conditions",
+                      {{"type", "array"},
+                       {"minItems", 1},
+                       {"uniqueItems", true},
+                       {"items", label_schema(study_detail::kMaxLabelLength, "a condition")}}},
+                     {"repetitions", schema_property(SchemaOf<ProtocolPhase>::get(), "repetitions")}},
+                    "the paper's test blocks");
   properties["test"]["required"] = ordered_json::array({"characters", "conditions", "repetitions"});
-  properties["order"] = object_schema(
-      {{"conditions",
-        enum_schema(study_detail::kConditionOrders, "order of the condition blocks per subject")},
-       {"characters", enum_schema(study_detail::kItemOrders, "order of the strings within each round")},
-       {"seed",
-        {{"type", "integer"},
-         {"minimum", 0},
-         {"maximum", std::numeric_limits<std::uint64_t>::max()},
-         {"description", "seeds the random orders (with the subject id)"}}}},
-      "orders");
+  properties["order"] = described(protocol_order_schema(), defs);
   properties["breaks"] = ref("BreakRules");
   properties["trial"] = ref("ProtocolTrialSettings");
 

@@ -83,7 +83,7 @@ std::vector<QuizEvent> QuizSession::judge_segment() {
       event.misses_on_stroke = ++misses_on_stroke_;
       event.total_misses = ++total_misses_;
       out.push_back(event);
-      if (options_.hint_after_misses > 0 && misses_on_stroke_ >= options_.hint_after_misses) {
+      if (const int hint_after = options_.hint_after(); hint_after > 0 && misses_on_stroke_ >= hint_after) {
         QuizEvent hint = event;
         hint.kind = QuizEvent::Kind::hint;
         hint.backwards = false;

@@ -229,7 +229,10 @@ json guidance_record_json(const StudyCondition& condition, const PreparedGuidanc
 ForceLawParameters condition_force_law(const StudyCondition& condition, const TrialGuidance& guidance,
                                        ForceLawParameters force) {
   // The renderer judges strokes as the quiz does.
-  if (condition.mode == ConditionMode::quiz) force.acceptance = condition.quiz.acceptance;
+  if (condition.mode == ConditionMode::quiz) {
+    force.acceptance = condition.quiz.acceptance;
+    force.acceptance.hint_after_misses = condition.quiz.hint_after();
+  }
   if (auto* replay = std::get_if<ReplayGuidance>(&force.guidance_law)) {
     replay->teacher_trajectory = guidance.teacher;
     if (condition.replay_max_lead_m) replay->max_lead_m = *condition.replay_max_lead_m;

@@ -351,7 +351,7 @@ nlohmann::json trial_record(const TrialRecordContext& c, const Scene& scene, con
     const QuizOptions& q = c.condition->quiz;
     document["quiz"] = {{"acceptance", acceptance_json(q.acceptance)},
                         {"start_radius_m", q.start_radius_m},
-                        {"hint_after_misses", q.hint_after_misses},
+                        {"hint_after_misses", q.hint_after()},
                         {"accept_backwards", q.accept_backwards},
                         {"strokes_accepted", accepted},
                         {"misses", misses},

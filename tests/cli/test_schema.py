@@ -372,6 +372,34 @@ class ProtocolSchemaTest(unittest.TestCase):
                                         capture_output=True, timeout=60)
                 self.assertEqual(result.returncode, 0, result.stderr.decode())
 
+    def test_the_docs_protocol_fragments_and_phase_table_are_the_schemas(self):
+        """The protocol parts docs/ shows (```json blocks of "phases" and "item_sets") validate against the
+        schema's definitions, and the docs' table of a phase's keys states the ranges of its schema."""
+        import re
+
+        defs = self.schema["$defs"]
+        checked = 0
+        for name in ("experiments.md", "learning-study.md"):
+            text = (SOURCE / "docs" / name).read_text(encoding="utf-8")
+            for block in re.findall(r"```json\n(.*?)```", text, re.S):
+                body = block.strip()
+                document = json.loads(body if body.startswith("{") else "{" + body + "}")
+                for key, definition in (("phases", "ProtocolPhase"), ("item_sets", "ItemSet")):
+                    validator = jsonschema.Draft202012Validator({"$defs": defs, "$ref": f"#/$defs/{definition}"})
+                    for element in document.get(key, []):
+                        with self.subTest(doc=name, element=element):
+                            self.assertEqual([e.message for e in validator.iter_errors(element)], [])
+                            checked += 1
+        self.assertGreaterEqual(checked, 10)
+        phase = defs["ProtocolPhase"]["properties"]
+        table = (SOURCE / "docs" / "experiments.md").read_text(encoding="utf-8")
+        for key in ("repetitions", "session"):
+            self.assertIn(f"| `{key}` | {phase[key]['minimum']}-{phase[key]['maximum']} |", table)
+        self.assertEqual(phase["delay_s"]["maximum"], 366 * 86400)
+        self.assertIn("| `delay_s` | [0, 366 days] s |", table)
+        for key, enum in (("phase", phase["phase"]["enum"]), ("assignment", phase["assignment"]["enum"])):
+            self.assertIn(f"| `{key}` | " + ", ".join(f"`{value}`" for value in enum) + " |", table)
+
     def test_structure_the_reader_refuses_the_schema_refuses(self):
         cases = {
             "/surprise": _protocol(surprise=1),
@@ -395,8 +423,199 @@ class ProtocolSchemaTest(unittest.TestCase):
             with self.subTest(pointer=pointer):
                 self.assertFalse(self.validator.is_valid(document))
                 result = self.plan(document)
-                self.assertEqual(result.returncode, 1, result.stderr.decode())
+                self.assertEqual(result.returncode, 2, result.stderr.decode())
                 self.assertIn(f"p.json: {pointer}", result.stderr.decode())
+
+    def test_every_part_refused_is_a_usage_error_of_plan_run_and_cohort_alike(self):
+        """A protocol's content refused exits 2 with one line `FILE: /pointer: ...` and writes nothing, from
+        each part of the file; a protocol file that cannot be read at all exits 1."""
+        training = {"phase": "training", "condition": "A", "characters": ["十"]}
+        sets = [{"name": "one", "characters": ["十"]}, {"name": "two", "characters": ["大"]}]
+        cases = {
+            "/format": _protocol(format="calligraphy-protocol"),
+            "/version": _protocol(version=2),
+            "/name": _protocol(name="two words"),
+            "/description": _protocol(description=3),
+            "/conditions": _protocol(conditions=[]),
+            "/conditions/1/name": _protocol(conditions=[{"name": "A", "mode": "haptic"},
+                                                        {"name": "A", "mode": "vision"}]),
+            "/conditions/0/mode": _protocol(conditions=[{"name": "A", "mode": "Haptic"}]),
+            "/conditions/0/parameters/start_gain": _protocol(
+                conditions=[{"name": "A", "mode": "fading", "parameters": {"start_gain": 2}}]),
+            "/conditions/0/quiz/hint_after_misses": _protocol(
+                conditions=[{"name": "A", "mode": "quiz", "quiz": {"hint_after_misses": 1001}}]),
+            "/conditions/0/teachers/大": _protocol(
+                conditions=[{"name": "A", "mode": "replay", "teachers": {"大": "t.json"}}]),
+            "/item_sets/1/characters/0": _protocol(
+                item_sets=[{"name": "one", "characters": ["十"]}, {"name": "two", "characters": ["十"]}]),
+            "/item_sets/0/transfer_of": _protocol(
+                item_sets=[{"name": "one", "characters": ["十"], "transfer_of": "none"}]),
+            "/phases/0/phase": _phased({"phase": "warm-up", "condition": "A", "characters": ["十"]}),
+            "/phases/0/assignment": _phased({**training, "assignment": "crossed"}),
+            "/phases/0/repetitions": _phased({**training, "repetitions": 0}),
+            "/phases/0/delay_s": _phased({**training, "delay_s": -1}),
+            "/phases/0/sets/0": _phased({"phase": "training", "condition": "A", "sets": ["three"]}),
+            "/phases/1/session": {**_phased(training), "phases": [training, {**training, "session": 3}]},
+            "/phases/1/delay_s": {**_phased(training), "phases": [training, {**training, "phase": "retention"}]},
+            "/phases/0/characters/0": {**_phased({"phase": "training", "conditions": ["A", "B"],
+                                                   "assignment": "crossover", "sets": ["one", "two"]}),
+                                       "conditions": [{"name": "A", "mode": "haptic"},
+                                                      {"name": "B", "mode": "vision"}],
+                                       "item_sets": sets,
+                                       "phases": [{**training, "characters": ["十"]},
+                                                  {"phase": "training", "conditions": ["A", "B"],
+                                                   "assignment": "crossover", "sets": ["one", "two"]}]},
+            "/order/conditions": _protocol(order={"conditions": "latin"}),
+            "/order/seed": _protocol(order={"seed": -1}),
+            "/test/repetitions": _protocol(order={"conditions": "abba"}),
+            "/practice/condition": _protocol(practice={"characters": ["十"], "condition": "B"}),
+            "/breaks/duration_s": _protocol(breaks={"every_trials": 3}),
+            "/trial/rate_hz": _protocol(trial={"rate_hz": 10}),
+            # A character the library lacks (no data to write it with).
+            "/test/characters/0": _protocol(test={"characters": ["龘"], "conditions": ["A"], "repetitions": 1}),
+        }
+        path = self.cwd / "p.json"
+        commands = (["session", "plan", path, "--subjects", 2],
+                    ["session", "run", path, "--writer", "simulated", "--subjects", 2, "--out", "out"],
+                    ["session", "cohort", path, "--subjects", 2, "--csv", "."])
+        for pointer, document in cases.items():
+            path.write_text(json.dumps(document, ensure_ascii=False), encoding="utf-8")
+            for command in commands:
+                with self.subTest(pointer=pointer, command=command[1]):
+                    result = subprocess.run([CLI, *map(str, command)], cwd=self.cwd, capture_output=True,
+                                            timeout=120)
+                    lines = result.stderr.decode().strip().splitlines()
+                    self.assertEqual(result.returncode, 2, lines)
+                    self.assertEqual(len(lines), 1, lines)
+                    self.assertIn(f"p.json: {pointer}: ", lines[0])
+                    self.assertFalse((self.cwd / "out").exists())
+                    self.assertFalse((self.cwd / "trials.csv").exists())
+        # Malformed JSON is refused as the content, by its byte offset.
+        path.write_text('{"name": "x",', encoding="utf-8")
+        for command in commands:
+            result = subprocess.run([CLI, *map(str, command)], cwd=self.cwd, capture_output=True, timeout=120)
+            self.assertEqual(result.returncode, 2, result.stderr.decode())
+            self.assertIn("p.json", result.stderr.decode())
+        # A file that cannot be read is no usage error: missing, or a folder.
+        for unreadable in (self.cwd / "missing.json", self.cwd):
+            for command in commands:
+                command = [unreadable if part == path else part for part in command]
+                result = subprocess.run([CLI, *map(str, command)], cwd=self.cwd, capture_output=True, timeout=120)
+                self.assertEqual(result.returncode, 1, result.stderr.decode())
+                self.assertEqual(len(result.stderr.decode().strip().splitlines()), 1, result.stderr.decode())
+
+    def test_resume_refuses_a_character_of_its_protocol_the_library_lacks_as_run_does(self):
+        """`session resume` looks up its protocol's characters as `session run` does: one the library given
+        lacks is a usage error (exit 2) naming the protocol's pointer; a library that cannot be opened is 1."""
+        path = self.cwd / "r.json"
+        path.write_text(json.dumps(_protocol(name="resumed", test={"characters": ["十", "人"], "conditions": ["A"],
+                                                                   "repetitions": 1}), ensure_ascii=False),
+                        encoding="utf-8")
+        run = [CLI, "session", "run", path, "--writer", "simulated", "--subject", "S1", "--out", "resumed"]
+        made = subprocess.run(run, cwd=self.cwd, capture_output=True, timeout=300)
+        self.assertEqual(made.returncode, 0, made.stderr.decode())
+        (folder,) = (self.cwd / "resumed" / "S1").iterdir()
+        sorted((folder / "trials").glob("002-*.json"))[0].unlink()  # its last trial unsaved: to be resumed
+        (self.cwd / "empty").mkdir()
+        for library, status, words in ((["--data", "empty"], 2, "r.json: /test/characters/0: the character 十"),
+                                       (["--data", "nowhere"], 1, "nowhere")):
+            result = subprocess.run([CLI, "session", "resume", folder, *library], cwd=self.cwd,
+                                    capture_output=True, timeout=300)
+            lines = result.stderr.decode().strip().splitlines()
+            self.assertEqual(result.returncode, status, lines)
+            self.assertEqual(len(lines), 1, lines)
+            self.assertIn(words, lines[0])
+        self.assertEqual(len(list((folder / "trials").glob("*.json"))), 1)
+        # The same library given to `session run` is refused the same way.
+        result = subprocess.run(run[:-2] + ["--out", "again", "--data", "empty"], cwd=self.cwd,
+                                capture_output=True, timeout=300)
+        self.assertEqual(result.returncode, 2, result.stderr.decode())
+        self.assertIn("r.json: /test/characters/0: the character 十", result.stderr.decode())
+
+    def test_a_field_shared_with_the_trial_record_has_its_range_and_is_refused_past_it_by_both(self):
+        """Where a protocol's value becomes a trial's, the protocol's schema states the record's range, and each
+        value past it is refused by `session plan` (exit 2) and by `trial --spec` (a record: exit 1), each
+        naming its pointer."""
+        record_schema = json.loads(SchemaTest.run_cli.__func__(self.__class__, "schema", "record").stdout)
+        records = {}
+        for name, extra in {"fixed": [], "fading": ["--guidance-mode", "fading"],
+                            "assist": ["--guidance-mode", "assist-as-needed"],
+                            "amplify": ["--guidance-mode", "error-amplification"],
+                            "timing": ["--guidance-mode", "timing"]}.items():
+            made = subprocess.run([CLI, "trial", "十", "--seed", "3", "--json", f"{name}.json", *extra],
+                                  cwd=self.cwd, capture_output=True, timeout=120)
+            self.assertEqual(made.returncode, 0, made.stderr.decode())
+            records[name] = json.loads((self.cwd / f"{name}.json").read_text())
+        defs = record_schema["$defs"]
+
+        def law(mode):
+            for alternative in defs["ForceLawParameters"]["properties"]["guidance_law"]["oneOf"]:
+                if alternative["properties"]["mode"]["const"] == mode:
+                    return alternative["properties"]
+            raise AssertionError(mode)
+
+        def condition(mode, **extra):
+            return _protocol(conditions=[{"name": "A", "mode": mode, **extra}])
+
+        quiz = {"quiz": {"acceptance": {}}}
+        pairs = [
+            (_protocol(trial={}), "/trial/max_duration_s", "fixed", ["trial", "max_duration_s"],
+             defs["TrialSpec"]["properties"]["max_duration_s"]),
+            (condition("haptic"), "/conditions/0/guidance_stiffness_n_per_m", "fixed",
+             ["force_law", "guidance_stiffness_n_per_m"],
+             defs["ForceLawParameters"]["properties"]["guidance_stiffness_n_per_m"]),
+            (condition("fading", parameters={}), "/conditions/0/parameters/start_gain", "fading",
+             ["force_law", "guidance_law", "gain"], law("fading")["gain"]),
+            (condition("assist-as-needed", parameters={"max_band_m": 0.1}), "/conditions/0/parameters/start_band_m",
+             "assist", ["force_law", "guidance_law", "band_m"], law("assist-as-needed")["band_m"]),
+            (condition("error-amplification", parameters={}), "/conditions/0/parameters/amplification_gain",
+             "amplify", ["force_law", "guidance_law", "gain"], law("error-amplification")["gain"]),
+            (condition("error-amplification", parameters={}), "/conditions/0/parameters/max_force_n", "amplify",
+             ["force_law", "guidance_law", "max_force_n"], law("error-amplification")["max_force_n"]),
+            (condition("timing", parameters={}), "/conditions/0/parameters/speed_m_s", "timing",
+             ["force_law", "guidance_law", "speed_m_s"], law("timing")["speed_m_s"]),
+        ]
+        for key, prop in defs["StrokeAcceptance"]["properties"].items():
+            pairs.append((condition("quiz", **quiz), f"/conditions/0/quiz/acceptance/{key}", "fixed",
+                          ["force_law", "acceptance", key], prop))
+        self.assertGreaterEqual(len(pairs), 20)
+        bounds = ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum")
+        refused = 0
+        for base, pointer, record, path, record_prop in pairs:
+            parts = pointer.strip("/").split("/")
+            # The protocol schema's property: through $defs, the mode's parameters, the quiz's acceptance.
+            if parts[0] == "trial":
+                prop = self.schema["$defs"]["ProtocolTrialSettings"]["properties"][parts[1]]
+            elif parts[2] == "parameters":
+                mode = base["conditions"][0]["mode"]
+                rule = next(r for r in self.schema["$defs"]["StudyCondition"]["allOf"]
+                            if r["if"]["properties"]["mode"]["const"] == mode)
+                prop = rule["then"]["properties"]["parameters"]["properties"][parts[3]]
+            elif parts[2] == "quiz":
+                prop = self.schema["$defs"]["QuizOptions"]["properties"]["acceptance"]["properties"][parts[4]]
+            else:
+                prop = self.schema["$defs"]["StudyCondition"]["properties"][parts[2]]
+            with self.subTest(pointer=pointer):
+                self.assertEqual({b: prop[b] for b in bounds if b in prop},
+                                 {b: record_prop[b] for b in bounds if b in record_prop})
+            for _, value in SchemaTest.past_bounds(pointer, prop):
+                with self.subTest(pointer=pointer, value=value):
+                    result = self.plan(self.with_value(base, pointer, value))
+                    self.assertEqual(result.returncode, 2, result.stderr.decode())
+                    self.assertIn(f"p.json: {pointer}:", result.stderr.decode())
+                    document = copy.deepcopy(records[record])
+                    target = document["specification"]
+                    for key in path[:-1]:
+                        target = target[key]
+                    target[path[-1]] = value
+                    (self.cwd / "bad.json").write_text(json.dumps(document))
+                    spec = subprocess.run([CLI, "trial", "--spec", "bad.json", "--json", "again.json"],
+                                          cwd=self.cwd, capture_output=True, timeout=120)
+                    self.assertEqual(spec.returncode, 1, spec.stderr.decode())
+                    self.assertIn("bad.json: /specification/" + "/".join(path), spec.stderr.decode())
+                    refused += 1
+        self.assertGreaterEqual(refused, 40)
+        print(f"protocol fields shared with the trial record, values refused by both: {refused}")
 
     def test_each_bound_is_refused_past_it_and_accepted_at_it_by_both(self):
         checked = 0
@@ -408,8 +627,8 @@ class ProtocolSchemaTest(unittest.TestCase):
                     with self.subTest(pointer=pointer, value=value, expect="refused"):
                         self.assertFalse(self.validator.is_valid(document))
                         result = self.plan(document)
-                        # A protocol is data: refused as every bad file is (exit 1, docs/cli.md), by pointer.
-                        self.assertEqual(result.returncode, 1, result.stderr.decode())
+                        # A protocol's content refused: a usage error (exit 2, docs/cli.md), by pointer.
+                        self.assertEqual(result.returncode, 2, result.stderr.decode())
                         self.assertIn(f"p.json: {pointer}:", result.stderr.decode())
                         checked += 1
                 for bound in ("minimum", "maximum"):

@@ -84,6 +84,14 @@ class DamagedStudyTest(unittest.TestCase):
         self.assertNotIn("internal error", stderr, what)
         self.assertIn(file_name, stderr, what)
 
+    def assert_protocol_error(self, result, file_name, what):
+        """A protocol's content refused: a usage error (exit 2), one line naming the file."""
+        stderr = result.stderr.decode()
+        self.assertEqual(result.returncode, 2, f"{what}: exit {result.returncode}: {stderr}")
+        self.assertNotIn("internal error", stderr, what)
+        self.assertEqual(len(stderr.strip().splitlines()), 1, stderr)
+        self.assertIn(file_name, stderr, what)
+
     def damaged_copies(self, path):
         """(description, text) for the JSON file at `path` with one value replaced by a wrong one: every
         member at any depth (every element of an array of up to 3, else the first), each top-level one by
@@ -206,7 +214,7 @@ class DamagedStudyTest(unittest.TestCase):
                                       "--out", "T")
                 shutil.rmtree(self.cwd / "T", ignore_errors=True)
                 if result.returncode != 0:
-                    self.assert_data_error(result, "bad.json", what)
+                    self.assert_protocol_error(result, "bad.json", what)
 
     def test_protocol_numbers_beyond_a_double_name_the_pointer(self):
         for wrong in ["1e999", "-1e999", "1e400"]:
@@ -215,7 +223,7 @@ class DamagedStudyTest(unittest.TestCase):
                 (self.cwd / "bad.json").write_text(text, encoding="utf-8")
                 result = self.run_cli("session", "run", "bad.json", "--writer", "simulated", "--subjects", "1",
                                       "--out", "T")
-                self.assert_data_error(result, "bad.json", wrong)
+                self.assert_protocol_error(result, "bad.json", wrong)
                 self.assertIn("/trial/max_duration_s", result.stderr.decode())
 
     def test_a_trial_that_wrote_no_stroke_is_shown_on_the_page(self):

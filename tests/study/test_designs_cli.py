@@ -17,7 +17,7 @@ the session.json `session run` wrote. Run by CTest as `study_designs_cli`:
   condition in practice, every group every sequence), and a between-subjects training on other characters
   beside one;
 - random orders of conditions and characters, and groups drawn, run as the plan drew them;
-- what is refused when the protocol is read (exit 1, one line naming the JSON pointer, nothing written): a
+- what is refused when the protocol is read (exit 2, one line naming the JSON pointer, nothing written): a
   second training of a crossover's set, a tested character of no set or of two, a transfer chosen by coverage
   beside a crossover;
 - a balance no study can reach, said in the plan `session run` prints and in `session plan --json`, and the
@@ -370,7 +370,7 @@ class DesignsCliTest(StudyCliTest):
         for command in (["session", "plan", path, "--subjects", 2],
                         ["session", "run", path, "--writer", "simulated", "--subjects", 2, "--out", "out"]):
             result = self.run_cli(*command)
-            self.assertEqual(result.returncode, 1, result.stderr.decode())
+            self.assertEqual(result.returncode, 2, result.stderr.decode())
             lines = result.stderr.decode().strip().splitlines()
             self.assertEqual(len(lines), 1, lines)
             self.assertIn(f"{path.name}: {pointer}: ", lines[0])

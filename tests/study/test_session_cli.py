@@ -174,14 +174,14 @@ class SessionCliTest(unittest.TestCase):
     def test_protocol_errors_name_file_and_pointer(self):
         bad = dict(LONG_PROTOCOL, order={"conditions": "latin"})
         result = self.run_cli("session", "run", self.write_protocol(bad), "--subject", "P1", "--out", "out")
-        self.assertEqual(result.returncode, 1)
-        self.assertRegex(result.stderr.decode(), r"p\.json: /order/conditions: expected one of fixed, latin_square")
+        self.assertEqual(result.returncode, 2)
+        self.assertRegex(result.stderr.decode(), r'p\.json: /order/conditions: expected one of "fixed", "latin_square"')
         self.assertFalse((self.cwd / "out").exists())
         fading = dict(LONG_PROTOCOL, conditions=[{"name": "vision", "mode": "vision"},
                                                  {"name": "haptic", "mode": "fading",
                                                   "parameters": {"end_gain": 0}}])
         result = self.run_cli("session", "run", self.write_protocol(fading), "--subject", "P1", "--out", "out")
-        self.assertEqual(result.returncode, 1)
+        self.assertEqual(result.returncode, 2)
         self.assertIn("p.json: /conditions/1/parameters/end_gain: unknown key", result.stderr.decode())
         self.assertFalse((self.cwd / "out").exists())
 

@@ -111,7 +111,8 @@ struct StrokeAcceptance {
   double reference_character_size_m = 0.06;
 
   /// Refused attempts at one stroke after which it is shown as a hint (a whole number; 0: never). Hanzi
-  /// Writer's `showHintAfterMisses` is 3, as is the quiz's (QuizOptions::hint_after_misses).
+  /// Writer's `showHintAfterMisses` is 3. The one definition of the quiz's too (QuizOptions::hint_after(),
+  /// unless its option overrides it).
   double hint_after_misses = 3.0;
   /// Refused attempts at one stroke after which it is demonstrated and credited as assisted, and the
   /// next stroke is active (a whole number; 0: never, a learner may stay on a stroke for ever). Hanzi

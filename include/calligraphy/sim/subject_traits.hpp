@@ -18,7 +18,8 @@
 namespace calligraphy {
 
 /// The log-normal spreads (standard deviation of the natural log, dimensionless) of a subject's traits
-/// about its profile. All 0: every subject is its profile (no individual differences).
+/// about its profile. All 0: every subject is its profile (no individual differences). Ranges:
+/// `ParameterTable<SubjectSpread>`, the one definition.
 struct SubjectSpread {
   double writing_speed = 0.2;   ///< log-SD of the writing speed factor
   double spatial_error = 0.3;   ///< log-SD of bias, scale error, jitter, corner cut and error tolerance
@@ -28,6 +29,17 @@ struct SubjectSpread {
   double retention_time = 0.3;  ///< log-SD of the retention time constants 1 / (1 - A) (one factor)
   /// Throws InvalidArgument naming the field for a spread that is negative, not finite or above 2.
   void validate() const;
+};
+
+template <>
+struct ParameterTable<SubjectSpread> {
+  static constexpr std::string_view name = "SubjectSpread";
+  [[nodiscard]] static std::span<const ParameterField<SubjectSpread>> fields() noexcept;
+};
+/// The table's schema (schema.hpp).
+template <>
+struct SchemaOf<SubjectSpread> {
+  static const Schema& get();
 };
 
 /// One subject's traits: factors on its profile's fields (1 = the profile) and its own two-state rates.

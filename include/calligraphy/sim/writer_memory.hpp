@@ -24,19 +24,34 @@
 #include <string>
 #include <vector>
 
+#include "calligraphy/core/parameter_table.hpp"
+#include "calligraphy/core/schema.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
 
 namespace calligraphy {
 
 /// The retention factors A and learning rates B of the two-state model, per trial. Defaults: the values
-/// Smith, Ghazizadeh & Shadmehr (2006) simulate force-field adaptation with.
+/// Smith, Ghazizadeh & Shadmehr (2006) simulate force-field adaptation with. Ranges:
+/// `ParameterTable<TwoStateRates>`, the one definition.
 struct TwoStateRates {
   double fast_retention = 0.92;   ///< A_f, in [0, 1)
   double fast_learning = 0.03;    ///< B_f, in (0, 1]
   double slow_retention = 0.996;  ///< A_s, in [0, 1), > A_f
   double slow_learning = 0.004;   ///< B_s, in (0, 1], < B_f
-  /// Throws InvalidArgument naming the field when a value is out of its range.
+  /// Throws InvalidArgument naming the field when a value is out of its table range, or the slow state
+  /// retains no more than the fast one (A_s <= A_f) or learns no slower (B_s >= B_f).
   void validate() const;
+};
+
+template <>
+struct ParameterTable<TwoStateRates> {
+  static constexpr std::string_view name = "TwoStateRates";
+  [[nodiscard]] static std::span<const ParameterField<TwoStateRates>> fields() noexcept;
+};
+/// The table's schema (schema.hpp), its rules `validate`'s.
+template <>
+struct SchemaOf<TwoStateRates> {
+  static const Schema& get();
 };
 
 /// One skill: a fast and a slow state; the skill is their sum, in [0, 1].

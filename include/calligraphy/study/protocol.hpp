@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/schema.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/model/stroke_progress.hpp"
@@ -35,8 +36,28 @@ enum class ConditionMode {
   timing,               ///< a minimum-jerk target along the stroke, no shape guidance (GuidanceMode::timing)
 };
 
+/// The modes' one spelling each, in a protocol's "mode", the records and the tables.
+template <>
+struct EnumTable<ConditionMode> {
+  static constexpr std::string_view name = "ConditionMode";
+  static constexpr std::array<EnumEntry<ConditionMode>, 9> entries{{
+      {ConditionMode::vision, "vision", "vision only: the paper force, no in-plane guidance"},
+      {ConditionMode::haptic, "haptic", "vision and the guiding force of the paper's section 5"},
+      {ConditionMode::fading, "fading",
+       "guidance whose gain follows the writer's deviation over repetitions"},
+      {ConditionMode::replay, "replay", "guidance that replays a teacher's recorded trial of the item"},
+      {ConditionMode::quiz, "quiz", "vision only, each stroke judged when the pen lifts"},
+      {ConditionMode::assist_as_needed, "assist-as-needed",
+       "force only beyond a band that adapts to the writer's error"},
+      {ConditionMode::error_amplification, "error-amplification", "a bounded repulsive field"},
+      {ConditionMode::skill_adaptive, "skill-adaptive",
+       "per repetition: fixed guidance or error amplification by the previous error"},
+      {ConditionMode::timing, "timing", "a minimum-jerk target along the stroke, no shape guidance"},
+  }};
+};
+
 /// "vision", "haptic", "fading", "replay", "quiz", "assist-as-needed", "error-amplification",
-/// "skill-adaptive", "timing".
+/// "skill-adaptive", "timing" (EnumTable).
 [[nodiscard]] const char* to_string(ConditionMode mode) noexcept;
 /// Every mode, in declaration order.
 [[nodiscard]] std::span<const ConditionMode> condition_modes() noexcept;
@@ -54,9 +75,14 @@ struct QuizOptions {
   /// Radius of the start neighbourhood (WS) a run must enter the stroke in [m]: the scene's
   /// (SceneLayout::start_radius_m). Finite, > 0.
   double start_radius_m = SceneLayout{}.start_radius_m;
-  /// A hint (the expected stroke shown) after this many misses on one stroke, and after each further
-  /// miss; 0: never. Hanzi Writer's default is 3.
-  int hint_after_misses = 3;
+  /// Overrides the acceptance's `hint_after_misses` (StrokeAcceptance, its one definition: default and
+  /// range) when given: a hint (the expected stroke shown) after this many misses on one stroke, and after
+  /// each further miss; 0: never. Empty: the acceptance's.
+  std::optional<int> hint_after_misses{};
+  /// The misses on one stroke after which the quiz shows a hint: the override, or the acceptance's.
+  [[nodiscard]] int hint_after() const noexcept {
+    return hint_after_misses ? *hint_after_misses : static_cast<int>(acceptance.hint_after_misses);
+  }
   /// A stroke written from its end to its start is accepted (and still reported as backwards).
   bool accept_backwards = false;
   /// Throws InvalidArgument naming the field when a value is out of range.
@@ -99,6 +125,14 @@ struct StudyCondition {
   std::map<std::u32string, std::string> teachers{};
 };
 
+/// A condition's "mode" (its spelling from EnumTable<ConditionMode>), read through this schema by the
+/// protocol reader and described by `calligraphy schema protocol`; its parameters are read by its mode's
+/// laws' and rules' tables, its name as a label.
+template <>
+struct SchemaOf<StudyCondition> {
+  static const Schema& get();
+};
+
 /// How the blocks of conditions are ordered for a subject.
 enum class ConditionOrder {
   fixed,         ///< as listed, for every subject
@@ -111,6 +145,26 @@ enum class ItemOrder {
   fixed,   ///< as listed
   random,  ///< shuffled per subject, block and round from the protocol's seed
 };
+template <>
+struct EnumTable<ConditionOrder> {
+  static constexpr std::string_view name = "ConditionOrder";
+  static constexpr std::array<EnumEntry<ConditionOrder>, 4> entries{{
+      {ConditionOrder::fixed, "fixed", "as listed, for every subject"},
+      {ConditionOrder::latin_square, "latin_square",
+       "a balanced Latin square (Williams 1949), row by subject"},
+      {ConditionOrder::abba, "abba", "forwards then backwards, reversed for every second subject"},
+      {ConditionOrder::random, "random", "shuffled per subject from the protocol's seed and the subject id"},
+  }};
+};
+template <>
+struct EnumTable<ItemOrder> {
+  static constexpr std::string_view name = "ItemOrder";
+  static constexpr std::array<EnumEntry<ItemOrder>, 2> entries{{
+      {ItemOrder::fixed, "fixed", "as listed"},
+      {ItemOrder::random, "random", "shuffled per subject, block and round from the protocol's seed"},
+  }};
+};
+/// The spellings of EnumTable.
 [[nodiscard]] const char* to_string(ConditionOrder order) noexcept;
 [[nodiscard]] const char* to_string(ItemOrder order) noexcept;
 
@@ -125,7 +179,20 @@ enum class StudyPhase {
   retention,  ///< after a stated delay, on trained characters
   transfer,   ///< on characters not trained
 };
-/// "practice", "test", "pre-test", "training", "post-test", "retention", "transfer".
+template <>
+struct EnumTable<StudyPhase> {
+  static constexpr std::string_view name = "StudyPhase";
+  static constexpr std::array<EnumEntry<StudyPhase>, 7> entries{{
+      {StudyPhase::practice, "practice", "familiarisation with the system"},
+      {StudyPhase::test, "test", "the paper's test blocks: conditions compared within one sitting"},
+      {StudyPhase::pre_test, "pre-test", "performance before any training"},
+      {StudyPhase::training, "training", "acquisition: practice under the training condition(s)"},
+      {StudyPhase::post_test, "post-test", "right after training"},
+      {StudyPhase::retention, "retention", "after a stated delay, on trained characters"},
+      {StudyPhase::transfer, "transfer", "on characters not trained"},
+  }};
+};
+/// "practice", "test", "pre-test", "training", "post-test", "retention", "transfer" (EnumTable).
 [[nodiscard]] const char* to_string(StudyPhase phase) noexcept;
 
 /// How the conditions of a phase are given to subjects.
@@ -137,7 +204,17 @@ enum class ConditionAssignment {
   /// schedule.hpp): a within-subjects comparison of learning, in which no item is trained twice
   crossover,
 };
-/// "within-subjects", "between-subjects", "crossover".
+template <>
+struct EnumTable<ConditionAssignment> {
+  static constexpr std::string_view name = "ConditionAssignment";
+  static constexpr std::array<EnumEntry<ConditionAssignment>, 3> entries{{
+      {ConditionAssignment::within_subjects, "within-subjects", "every subject writes every condition"},
+      {ConditionAssignment::between_subjects, "between-subjects", "each subject writes its group's one"},
+      {ConditionAssignment::crossover, "crossover",
+       "every subject writes every condition, each on another item set, counterbalanced"},
+  }};
+};
+/// "within-subjects", "between-subjects", "crossover" (EnumTable).
 [[nodiscard]] const char* to_string(ConditionAssignment assignment) noexcept;
 
 /// A transfer set chosen by typical-stroke coverage (`choose_transfer_characters`) when a session is made.
@@ -182,6 +259,14 @@ struct ProtocolPhase {
   [[nodiscard]] std::size_t item_count() const noexcept {
     return choice && items.empty() ? choice->count : items.size();
   }
+};
+
+/// A phase's settings besides its conditions and items: "phase", "assignment", "repetitions", "session" and
+/// "delay_s", their spellings and ranges written once here (schema.hpp), read by the protocol reader (the
+/// paper's "practice" and "test" take its "repetitions") and described by `calligraphy schema protocol`.
+template <>
+struct SchemaOf<ProtocolPhase> {
+  static const Schema& get();
 };
 
 /// Rests between trials [s]. Breaks are taken by a person; a simulated writer only logs them.
@@ -248,6 +333,10 @@ struct StudyProtocol {
   [[nodiscard]] std::u32string trained_characters() const;
 };
 
+/// The schema of a protocol's "order" object, on StudyProtocol's members: "conditions" (condition_order),
+/// "characters" (item_order) and "seed".
+[[nodiscard]] const Schema& protocol_order_schema();
+
 /// Most trials one session of a protocol may plan: 1,000,000 (at 10 s a trial, 116 days of writing; the
 /// paper's study plans 26). A session's plan is held in memory and in its session.json, so a protocol within
 /// every other bound (1,000 strings x 26 conditions x 1,000 repetitions: 26,000,000 trials) is refused
@@ -262,7 +351,15 @@ inline constexpr std::uint64_t kMaxPlannedTrials = 1'000'000;
 /// `count` with thousands separators ("26,000,000").
 [[nodiscard]] std::string thousands(std::uint64_t count);
 
-/// Parses a protocol. `source` names the text in errors (a file name). Throws DataError naming the
+/// A protocol's content refused by its reader: one line "SOURCE: /json/pointer: what is wrong" (malformed
+/// JSON by its byte offset). A usage error of the command line (exit 2), unlike a protocol file that cannot
+/// be read at all (a DataError: missing, not a regular file, too large, an I/O error; exit 1).
+class ProtocolError : public DataError {
+ public:
+  using DataError::DataError;
+};
+
+/// Parses a protocol. `source` names the text in errors (a file name). Throws ProtocolError naming the
 /// source and the JSON pointer of the offending value (e.g. "paper.json: /test/repetitions: expected an
 /// integer >= 1, got 0"): malformed JSON (with the byte offset), a missing or unknown key, a value of
 /// the wrong type or out of range, a condition named twice or not defined, a character list that is
@@ -292,7 +389,8 @@ struct LoadedProtocol {
 inline constexpr std::uintmax_t kMaxProtocolBytes = std::uintmax_t{1} << 20;
 
 /// Reads and parses a protocol file. Throws DataError naming the path when it does not exist, is not a
-/// regular file, is larger than kMaxProtocolBytes or cannot be read, and as `parse_study_protocol`.
+/// regular file, is larger than kMaxProtocolBytes or cannot be read, and ProtocolError as
+/// `parse_study_protocol`.
 [[nodiscard]] LoadedProtocol load_study_protocol(const std::filesystem::path& path);
 
 /// The protocol from its text (e.g. the copy a session folder keeps): parses it and hashes it.
