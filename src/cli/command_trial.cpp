@@ -231,8 +231,8 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
   try {
     simulated = simulated_writer_writes(spec, simulated_writer_moves(device));
   } catch (const InvalidArgument& e) {
-    // A record is data: its writer that cannot hold its device is named as every bad value of it is.
-    if (recorded) throw DataError(command.spec_file + ": /specification/trial/writer: " + e.what());
+    // A record's writer that cannot hold its device is named as every bad value of it is (exit 2).
+    if (recorded) throw InputError(command.spec_file + ": /specification/trial/writer: " + e.what());
     throw UsageError(e.what());
   }
   // A profile or its settings describe the simulated writer: with a person writing they would be ignored.

@@ -122,7 +122,7 @@ int main(int argc, char** argv) {
   } catch (const UsageError& e) {
     print_error(given_command(root).first, e.what());
     status = 2;
-  } catch (const calligraphy::ProtocolError& e) {  // a protocol's content: bad input, as a bad option
+  } catch (const calligraphy::InputError& e) {  // a protocol's or a record's content: as a bad option
     print_error(given_command(root).first, e.what());
     status = 2;
   } catch (const calligraphy::Error& e) {

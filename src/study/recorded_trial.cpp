@@ -207,7 +207,8 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
                       "expected 64 lower-case hex digits (a SHA-256) or \"\"");
   }
   if (!parts.teacher_sha256.empty() && !(r.spec.guidance && r.spec.guidance_mode == GuidanceMode::replay))
-    json_detail::fail(source, reader.pointer("teacher_sha256"), "names a teacher, but the trial is not a replay");
+    json_detail::fail(source, reader.pointer("teacher_sha256"),
+                      "names a teacher, but the trial is not a replay");
   r.teacher_sha256 = std::move(parts.teacher_sha256);
   r.defaulted = std::move(read.defaulted);
   return r;
@@ -220,8 +221,18 @@ RecordedTrial read_recorded_trial(std::string_view text, const std::string& sour
 }
 
 RecordedTrial read_recorded_trial_file(const std::string& path) {
-  const json document = json_detail::parse_json(read_regular_file(path, study_detail::kMaxRecordBytes), path);
-  RecordedTrial recorded = read_recorded_document(document, path);
+  const std::string text = read_regular_file(path, study_detail::kMaxRecordBytes);
+  // Read whole: what is refused now is the record's content, the input the command was given.
+  json document;
+  RecordedTrial recorded;
+  try {
+    document = json_detail::parse_json(text, path);
+    recorded = read_recorded_document(document, path);
+  } catch (const InputError&) {
+    throw;
+  } catch (const DataError& e) {
+    throw InputError(e.what());
+  }
   if (recorded.spec.guidance && recorded.spec.guidance_mode == GuidanceMode::replay &&
       recorded.spec.teacher.empty()) {
     // A session's replay ran on the teacher kept in its folder (trials/ is beside teachers/): the record
@@ -249,8 +260,8 @@ TeacherFile read_recorded_teacher(const RecordedTrial& recorded, const std::file
   const std::string bytes = read_regular_file(path, kMaxTeacherRecordingBytes);
   const std::string sha256 = sha256_hex(bytes);
   if (!recorded.teacher_sha256.empty() && sha256 != recorded.teacher_sha256) {
-    throw DataError(path.string() + ": SHA-256 " + sha256 + ", but the replay ran on a teacher's recording of SHA-256 " +
-                    recorded.teacher_sha256 +
+    throw DataError(path.string() + ": SHA-256 " + sha256 +
+                    ", but the replay ran on a teacher's recording of SHA-256 " + recorded.teacher_sha256 +
                     " (the record's teacher_sha256): give the recording it ran on (--teacher)");
   }
   return {parse_teacher_recording(bytes, path.string()), sha256};

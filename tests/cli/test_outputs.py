@@ -211,7 +211,7 @@ class Protocols(OutputTestCase):
                                  lambda document: document["test"].update({"characters": ["大", "山", ABSENT, "中"]}))
         result = self.run_cli("session", "run", protocol, "--writer", "simulated", "--subjects", "1", "--out",
                               "study")
-        self.assert_refused(result, 1, "absent.json: /test/characters/2", ABSENT, "U+9F98")
+        self.assert_refused(result, 2, "absent.json: /test/characters/2", ABSENT, "U+9F98")
         self.assertFalse((self.cwd / "study").exists())
 
     def test_a_character_not_in_the_practice_is_named_by_its_pointer(self):
@@ -219,7 +219,7 @@ class Protocols(OutputTestCase):
                                  lambda document: document["practice"].update({"characters": [ABSENT + "永"]}))
         result = self.run_cli("session", "run", protocol, "--writer", "simulated", "--subject", "S1", "--out",
                               "study")
-        self.assert_refused(result, 1, "/practice/characters/0", ABSENT)
+        self.assert_refused(result, 2, "/practice/characters/0", ABSENT)
         self.assertFalse((self.cwd / "study").exists())
 
     def test_a_plan_over_the_limit_is_refused_quickly_with_its_size(self):
@@ -234,7 +234,7 @@ class Protocols(OutputTestCase):
         result = self.run_cli("session", "run", protocol, "--writer", "simulated", "--subjects", "1", "--out",
                               "study")
         self.assertLess(time.monotonic() - start, 10.0)
-        self.assert_refused(result, 1, "huge.json: /test: 26,000,002 trials planned",
+        self.assert_refused(result, 2, "huge.json: /test: 26,000,002 trials planned",
                             "limit of 1,000,000 trials per session")
         self.assertFalse((self.cwd / "study").exists())
 

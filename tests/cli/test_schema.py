@@ -109,7 +109,7 @@ class SchemaTest(unittest.TestCase):
                 (self.cwd / "bad.json").write_text(json.dumps(document))
                 result = self.run_cli("trial", "--spec", "bad.json", "--json", "again.json")
                 stderr = result.stderr.decode()
-                self.assertEqual(result.returncode, 1, stderr)
+                self.assertEqual(result.returncode, 2, stderr)  # the content of --spec: a usage error
                 self.assertIn("bad.json: /specification/" + "/".join(path), stderr)
                 self.assertEqual(len(stderr.strip().splitlines()), 1, stderr)
 
@@ -534,7 +534,7 @@ class ProtocolSchemaTest(unittest.TestCase):
 
     def test_a_field_shared_with_the_trial_record_has_its_range_and_is_refused_past_it_by_both(self):
         """Where a protocol's value becomes a trial's, the protocol's schema states the record's range, and each
-        value past it is refused by `session plan` (exit 2) and by `trial --spec` (a record: exit 1), each
+        value past it is refused by `session plan` and by `trial --spec` (exit 2 both: their content), each
         naming its pointer."""
         record_schema = json.loads(SchemaTest.run_cli.__func__(self.__class__, "schema", "record").stdout)
         records = {}
@@ -611,7 +611,7 @@ class ProtocolSchemaTest(unittest.TestCase):
                     (self.cwd / "bad.json").write_text(json.dumps(document))
                     spec = subprocess.run([CLI, "trial", "--spec", "bad.json", "--json", "again.json"],
                                           cwd=self.cwd, capture_output=True, timeout=120)
-                    self.assertEqual(spec.returncode, 1, spec.stderr.decode())
+                    self.assertEqual(spec.returncode, 2, spec.stderr.decode())
                     self.assertIn("bad.json: /specification/" + "/".join(path), spec.stderr.decode())
                     refused += 1
         self.assertGreaterEqual(refused, 40)

@@ -5,7 +5,7 @@ include/calligraphy/report/trace_columns.hpp) hold identically for a record re-r
 command line's typed options and for Python.
 
 (a) Every bounded field is taken at each closed bound and refused just past each bound (the next double, the
-    next integer, an open bound itself) by `trial --spec RECORD --check` (refused: exit 1, one line naming the
+    next integer, an open bound itself) by `trial --spec RECORD --check` (refused: exit 2, one line naming the
     file and the JSON pointer), by its option (`trial CHARS --OPTION V --check`; refused: exit 2 naming the
     option), by `calligraphy.check_trial_record` (refused: DataError naming the pointer) and by the keyword
     argument of `calligraphy.simulate_trial` of the same name (refused: InvalidArgument naming it). The
@@ -243,7 +243,7 @@ class VocabularyTest(unittest.TestCase):
             stderr = result.stderr.decode()
             verdicts["trial --spec"] = result.returncode == 0
             if result.returncode != 0:
-                self.assertEqual(result.returncode, 1, f"{key}={value!r}: {stderr}")
+                self.assertEqual(result.returncode, 2, f"{key}={value!r}: {stderr}")
                 self.assertIn(f"{path.name}: {pointer}", stderr)
                 self.assertEqual(len(stderr.strip().splitlines()), 1, stderr)
             # The option.
@@ -304,14 +304,14 @@ class VocabularyTest(unittest.TestCase):
                     if unknown:
                         disagreements.append(f"{key} '{spelling}': {option} does not know it: {unknown[0]}")
                     context = self.contexts[0]
-                    # A record stating it where no trial here can take it is refused as data: exit 1, naming
+                    # A record stating it where no trial here can take it is refused as its content: exit 2, naming
                     # the file and the field's pointer.
                     record = self.record_in(context)
                     record["specification"]["trial"][key] = spelling
                     (self.cwd / "untaken.json").write_text(json.dumps(record), encoding="utf-8")
                     refused = self.run_cli("trial", "--spec", "untaken.json", "--check")
                     if refused.returncode != 0 and (
-                            refused.returncode != 1
+                            refused.returncode != 2
                             or f"untaken.json: /specification/trial/{key}" not in refused.stderr.decode()):
                         disagreements.append(f"{key} '{spelling}' in a record: exit {refused.returncode}, "
                                              f"{refused.stderr.decode().strip()}")

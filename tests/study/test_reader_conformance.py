@@ -148,15 +148,17 @@ class ReaderConformance(unittest.TestCase):
         target.write_bytes(gzip.compress(content) if compress else content)
         return copy, target
 
-    def check_cli(self, arguments, cwd, damaged, what):
+    def check_cli(self, arguments, cwd, damaged, what, refused=1):
+        """`refused`: the status of a refusal (1, damaged data; 2, the content of the file the command was given
+        as its input, `trial --spec`)."""
         try:
             result = subprocess.run([CLI, *map(str, arguments)], cwd=cwd, capture_output=True, timeout=TIMEOUT_S)
         except subprocess.TimeoutExpired:
             self.fail(f"{arguments[0]} hung on {what}")
         stderr = result.stderr.decode(errors="replace")
-        self.assertIn(result.returncode, (0, 1), f"{arguments[0]} on {what}: {stderr[-2000:]}")
+        self.assertIn(result.returncode, (0, refused), f"{arguments[0]} on {what}: {stderr[-2000:]}")
         self.assertNotIn("internal error", stderr)
-        if result.returncode == 1:
+        if result.returncode == refused:
             errors = [line for line in stderr.splitlines() if ": error: " in line]
             self.assertEqual(len(errors), 1, stderr[-2000:])
             self.assertIn(damaged.name, errors[0], f"{arguments[0]} on {what} does not name the file")
@@ -181,7 +183,7 @@ class ReaderConformance(unittest.TestCase):
                 self.check_cli(["report", "study", "--csv", "tables"], copy, damaged, what)
                 self.check_cli(["report", "study", "--out", "report.html"], copy, damaged, what)
                 self.check_cli(["curriculum", "study", "--subject", "S01", "--from", "十人大"], copy, damaged, what)
-                self.check_cli(["trial", "--spec", damaged, "--json", "again.json"], copy, damaged, what)
+                self.check_cli(["trial", "--spec", damaged, "--json", "again.json"], copy, damaged, what, refused=2)
                 self.check_python(lambda: calligraphy.study.load(copy / "study"), damaged, what)
                 self.check_python(lambda: calligraphy.rerun_trial(damaged), damaged, what)
 

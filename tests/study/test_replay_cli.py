@@ -127,14 +127,14 @@ class ReplayTest(unittest.TestCase):
         del document["specification"]
         (self.cwd / "old.json").write_text(json.dumps(document))
         old = self.run_cli("trial", "--spec", "old.json")
-        self.assertEqual(old.returncode, 1)
+        self.assertEqual(old.returncode, 2)
         self.assertIn("old.json", old.stderr.decode())
         self.assertIn("no trial specification", old.stderr.decode())
         document = json.loads((self.cwd / "r.json").read_text())
         document["specification"]["version"] = 9
         (self.cwd / "newer.json").write_text(json.dumps(document))
         newer = self.run_cli("trial", "--spec", "newer.json")
-        self.assertEqual(newer.returncode, 1)
+        self.assertEqual(newer.returncode, 2)
         self.assertIn("newer.json: /specification/version", newer.stderr.decode())
         document = json.loads((self.cwd / "r.json").read_text())
         document["specification"]["scene"]["sha256"] = "0" * 64

@@ -87,9 +87,9 @@ class SessionSafetyTest(unittest.TestCase):
         path.write_text(json.dumps(protocol, ensure_ascii=False), encoding="utf-8")
         return path
 
-    def assert_refused(self, result, *named):
+    def assert_refused(self, result, *named, status=1):
         stderr = result.stderr.decode()
-        self.assertEqual(result.returncode, 1, stderr)
+        self.assertEqual(result.returncode, status, stderr)
         self.assertNotIn("internal error", stderr)
         self.assertEqual(len(stderr.strip().splitlines()), 1, stderr)
         for text in named:
@@ -288,7 +288,8 @@ class SessionSafetyTest(unittest.TestCase):
     def test_a_trial_over_the_tick_bound_is_refused_by_its_protocol_field_before_any_folder(self):
         self.write_protocol(dict(SMALL, trial={"max_duration_s": 3600, "rate_hz": 10000}))
         refused = self.run_cli("session", "run", "p.json", "--subject", "P1", "--out", "out")
-        stderr = self.assert_refused(refused, "p.json: /trial/max_duration_s", "/trial/rate_hz", "10000000")
+        stderr = self.assert_refused(refused, "p.json: /trial/max_duration_s", "/trial/rate_hz", "10000000",
+                                     status=2)  # the protocol's content: a usage error
         self.assertNotIn("--max-duration", stderr)
         self.assertFalse((self.cwd / "out").exists())
 

@@ -283,20 +283,20 @@ class FileSurfaces(Hostile):
         doc = json.loads(self.record_text())
         doc["specification"]["trial"]["rate_hz"] = float("nan")
         path = self.spec_with(json.dumps(doc))  # Python writes NaN, which is not JSON
-        self.refused(self.cli("trial", "--spec", path), 1, "r.json")
+        self.refused(self.cli("trial", "--spec", path), 2, "r.json")
 
     def test_spec_with_1e999_names_the_pointer(self):
         text = self.record_text()
         doc = json.loads(text)
         doc["specification"]["trial"]["rate_hz"] = 12345.5
         path = self.spec_with(json.dumps(doc).replace("12345.5", "1e999"))
-        self.refused(self.cli("trial", "--spec", path), 1, "r.json", "/specification/trial/rate_hz")
+        self.refused(self.cli("trial", "--spec", path), 2, "r.json", "/specification/trial/rate_hz")
 
     def test_spec_with_minus_zero_duration_names_the_pointer(self):
         doc = json.loads(self.record_text())
         doc["specification"]["trial"]["max_duration_s"] = 777.25
         path = self.spec_with(json.dumps(doc).replace("777.25", "-0.0"))
-        self.refused(self.cli("trial", "--spec", path), 1, "r.json", "/specification/trial/max_duration_s")
+        self.refused(self.cli("trial", "--spec", path), 2, "r.json", "/specification/trial/max_duration_s")
 
     def test_spec_with_a_duplicated_key_is_refused(self):
         doc = json.loads(self.record_text())
@@ -304,7 +304,7 @@ class FileSurfaces(Hostile):
         text = json.dumps(doc).replace(f'"seed": {seed}', f'"seed": {seed}, "seed": {seed + 1}', 1)
         self.assertIn(f'"seed": {seed + 1}', text)
         path = self.spec_with(text)
-        line = self.refused(self.cli("trial", "--spec", path), 1, "r.json")
+        line = self.refused(self.cli("trial", "--spec", path), 2, "r.json")
         self.assertIn("seed", line)
 
     def test_spec_with_a_byte_order_mark_runs(self):
@@ -316,12 +316,12 @@ class FileSurfaces(Hostile):
     def test_spec_cut_in_half_is_named(self):
         data = self.fx.record.read_bytes()
         path = self.spec_with(data[: len(data) // 2])
-        self.refused(self.cli("trial", "--spec", path), 1, "r.json")
+        self.refused(self.cli("trial", "--spec", path), 2, "r.json")
 
     def test_spec_of_a_future_version_is_refused(self):
         doc = json.loads(self.record_text())
         doc["specification"]["version"] = 99
-        self.refused(self.cli("trial", "--spec", self.spec_with(json.dumps(doc))), 1, "r.json")
+        self.refused(self.cli("trial", "--spec", self.spec_with(json.dumps(doc))), 2, "r.json")
 
     def test_spec_with_a_forged_scene_digest_is_refused(self):
         doc = json.loads(self.record_text())
@@ -333,23 +333,23 @@ class FileSurfaces(Hostile):
     def test_spec_with_a_seed_of_two_to_the_64_names_the_pointer(self):
         doc = json.loads(self.record_text())
         doc["specification"]["trial"]["seed"] = 2 ** 64
-        self.refused(self.cli("trial", "--spec", self.spec_with(json.dumps(doc))), 1, "r.json",
+        self.refused(self.cli("trial", "--spec", self.spec_with(json.dumps(doc))), 2, "r.json",
                      "/specification/trial/seed")
 
     def test_spec_with_a_fractional_seed_names_the_pointer(self):
         doc = json.loads(self.record_text())
         doc["specification"]["trial"]["seed"] = 1.5
-        self.refused(self.cli("trial", "--spec", self.spec_with(json.dumps(doc))), 1, "r.json",
+        self.refused(self.cli("trial", "--spec", self.spec_with(json.dumps(doc))), 2, "r.json",
                      "/specification/trial/seed")
 
     def test_spec_with_an_unknown_key_names_the_pointer(self):
         doc = json.loads(self.record_text())
         doc["specification"]["trial"]["sneaky"] = 1
-        self.refused(self.cli("trial", "--spec", self.spec_with(json.dumps(doc))), 1, "r.json", "sneaky")
+        self.refused(self.cli("trial", "--spec", self.spec_with(json.dumps(doc))), 2, "r.json", "sneaky")
 
     def test_spec_nested_100000_deep_is_refused_without_a_crash(self):
         path = self.spec_with("[" * 100000 + "]" * 100000)
-        self.refused(self.cli("trial", "--spec", path, timeout=60), 1, "r.json")
+        self.refused(self.cli("trial", "--spec", path, timeout=60), 2, "r.json")
 
     def test_spec_from_a_fifo_with_no_writer_does_not_hang(self):
         fifo = self.cwd / "r.json"
@@ -500,7 +500,7 @@ class FileSurfaces(Hostile):
     def test_spec_of_a_record_without_a_specification_says_so(self):
         doc = json.loads(self.record_text())
         del doc["specification"]
-        line = self.refused(self.cli("trial", "--spec", self.spec_with(json.dumps(doc))), 1, "r.json")
+        line = self.refused(self.cli("trial", "--spec", self.spec_with(json.dumps(doc))), 2, "r.json")
         self.assertIn("specification", line)
 
 
@@ -721,7 +721,7 @@ class StudySurfaces(Hostile):
         doc["trial"]["max_duration_s"] = 31.75
         p = self.cwd / "p.json"
         p.write_text(json.dumps(doc).replace("31.75", "1e999"))
-        self.refused(self.cli("session", "plan", p, "--subjects", "1"), 1, "p.json", "/trial/max_duration_s")
+        self.refused(self.cli("session", "plan", p, "--subjects", "1"), 2, "p.json", "/trial/max_duration_s")
 
     def test_plan_of_a_fifo_protocol_with_no_end_does_not_hang(self):
         fifo = self.cwd / "p.json"

@@ -37,6 +37,16 @@ class CharacterNotFound : public DataError {
   using DataError::DataError;
 };
 
+/// The content of a file a command was given as its input (a study protocol, a trial record given with
+/// `trial --spec`) refused by its reader: malformed JSON, a missing or unknown key, a value of another type
+/// or out of its range. One line "FILE: /json/pointer: what is wrong". The command line treats it as wrong
+/// usage (exit 2), as it treats an option's value out of its range; a file that cannot be read at all stays
+/// a DataError (exit 1).
+class InputError : public DataError {
+ public:
+  using DataError::DataError;
+};
+
 /// Base of haptic-device faults.
 class DeviceError : public Error {
  public:

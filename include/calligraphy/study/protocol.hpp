@@ -354,9 +354,9 @@ inline constexpr std::uint64_t kMaxPlannedTrials = 1'000'000;
 /// A protocol's content refused by its reader: one line "SOURCE: /json/pointer: what is wrong" (malformed
 /// JSON by its byte offset). A usage error of the command line (exit 2), unlike a protocol file that cannot
 /// be read at all (a DataError: missing, not a regular file, too large, an I/O error; exit 1).
-class ProtocolError : public DataError {
+class ProtocolError : public InputError {
  public:
-  using DataError::DataError;
+  using InputError::InputError;
 };
 
 /// Parses a protocol. `source` names the text in errors (a file name). Throws ProtocolError naming the

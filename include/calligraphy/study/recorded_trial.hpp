@@ -104,7 +104,8 @@ struct RecordedTrial {
 /// `read_recorded_trial` of the regular file `path` (at most 64 MiB, a trial record's bound). A study
 /// session's replay, which ran on the teacher kept in its session folder, names that file as its teacher when
 /// it is still there with the SHA-256 the record gives (/guidance/teacher). Throws DataError naming the path
-/// when it cannot be read, and what `read_recorded_trial` throws.
+/// when it cannot be read, and InputError (a DataError; the command line's exit 2) for what
+/// `read_recorded_trial` refuses in its content.
 [[nodiscard]] RecordedTrial read_recorded_trial_file(const std::string& path);
 
 /// A teacher's recording as read from its file, with the file's lower-case hex SHA-256 (what a record names).
