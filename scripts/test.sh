@@ -118,14 +118,16 @@ end_stage
 # At -O1 (-O0 made the sweeps 2-3 times slower), with line tables only (-g1: enough for the sanitizers'
 # stack traces, which name functions, files and lines; less to write and link than -g). The trainer's window (Mesa, X11), the Python module (the
 # interpreter is not instrumented) and the benchmarks are left to the Release stage: here they would test
-# other programs' code or nothing of their own. The sweeps run on random subsets sized
+# other programs' code or nothing of their own (the tests that call Python import the Release build's module,
+# never a copy installed earlier). The sweeps run on random subsets sized
 # for the sanitizer (tests/test_sizing.hpp prints the seed).
 # Built with clang: its instrumented files compile in 70-100 % of GCC's time, and this build is the stage's
 # longest path. (The Release and ThreadSanitizer stages stay on GCC, so both compilers keep building.)
 start_background "AddressSanitizer + UndefinedBehaviorSanitizer: build (clang)" "
   cmake -S . -B build-asan -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG='-O1 -g1' \
     -DCALLIGRAPHY_SANITIZE=address,undefined -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_BENCH=OFF \
-    -DCALLIGRAPHY_BUILD_TESTS=ON -DCALLIGRAPHY_BUILD_EXAMPLES=ON -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_TRAINER=OFF >/dev/null &&
+    -DCALLIGRAPHY_BUILD_TESTS=ON -DCALLIGRAPHY_BUILD_EXAMPLES=ON -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_TRAINER=OFF \
+    -DCALLIGRAPHY_TEST_PYTHONPATH=$PWD/build/python >/dev/null &&
   cmake --build build-asan -j $jobs"
 begin_stage "Release tests"
 run_ctest build

@@ -56,6 +56,9 @@ TrialOptions options_stated(const TrialSpec& spec, const DeviceInfo& device) {
   options.rate_hz = spec.rate_hz;
   options.pacing = spec.pacing;
   options.loop.realtime = spec.realtime;
+  // A real-time schedule asked for needs a priority in its range: the loop's own constant, as a program that
+  // exists to run the trial sets (below); so the options stated are valid as they are derived.
+  if (spec.realtime == RealtimeMode::enforce) options.loop.priority = kDedicatedServoPriority;
   options.loop.stall_timeout_s = spec.watchdog_s;
   options.max_duration_s = spec.max_duration_s;
   options.keep_trace = true;  // the metrics are taken from the trace (writing_metrics)

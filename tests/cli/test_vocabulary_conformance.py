@@ -321,8 +321,10 @@ class VocabularyTest(unittest.TestCase):
                 if runs:
                     path = self.cwd / "spelling.json"
                     path.unlink(missing_ok=True)
-                    self.run_cli("trial", CHARS, *context[0], option, spelling, "--max-duration",
-                                 _number_text(SHORT_S), "--json", path.name)
+                    ran = self.run_cli("trial", CHARS, *context[0], option, spelling, "--max-duration",
+                                       _number_text(SHORT_S), "--json", path.name)
+                    self.assertTrue(path.exists(), f"{option} {spelling}: exit {ran.returncode}, "
+                                                   f"{ran.stderr.decode().strip()}")
                     record = json.loads(path.read_text(encoding="utf-8"))
                     written = record["specification"]["trial"][key]
                     # "auto" is resolved: the record states what ran, in another of the table's spellings.
