@@ -127,7 +127,8 @@ start_background "AddressSanitizer + UndefinedBehaviorSanitizer: build (clang)" 
   cmake -S . -B build-asan -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG='-O1 -g1' \
     -DCALLIGRAPHY_SANITIZE=address,undefined -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_BENCH=OFF \
     -DCALLIGRAPHY_BUILD_TESTS=ON -DCALLIGRAPHY_BUILD_EXAMPLES=ON -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_TRAINER=OFF \
-    -DCALLIGRAPHY_TEST_PYTHONPATH=$PWD/build/python >/dev/null &&
+    -DCALLIGRAPHY_TEST_PYTHONPATH=$PWD/build/python \
+    -DCALLIGRAPHY_TEST_PYTHON_HD_STAND_IN=$PWD/build/lib/hd_stand_in/libHD.so >/dev/null &&
   cmake --build build-asan -j $jobs"
 begin_stage "Release tests"
 run_ctest build

@@ -18,7 +18,8 @@ set up through its environment variables:
 - a CALLIGRAPHY_LIBHD refused for missing symbols is never replaced by a libHD.so on the search path.
 
 CALLIGRAPHY_CLI names the program, CALLIGRAPHY_HD_STAND_IN the stand-in, CALLIGRAPHY_HD_PARTIAL a libHD with
-hdInitDevice only, CALLIGRAPHY_PYTHONPATH the Python package (its test is skipped when it does not import).
+hdInitDevice only, CALLIGRAPHY_PYTHONPATH the Python package (its test is skipped when it does not import) and
+CALLIGRAPHY_PYTHON_HD_STAND_IN the stand-in built as that package was (default: CALLIGRAPHY_HD_STAND_IN).
 Standard library only (unittest).
 """
 import csv
@@ -37,6 +38,8 @@ CLI = os.environ.get("CALLIGRAPHY_CLI", "")
 STAND_IN = os.environ.get("CALLIGRAPHY_HD_STAND_IN", "")
 PARTIAL = os.environ.get("CALLIGRAPHY_HD_PARTIAL", "")
 PYTHONPATH = os.environ.get("CALLIGRAPHY_PYTHONPATH", "")
+# The stand-in built as that package was: a sanitizer build's cannot be loaded into a plain interpreter.
+PYTHON_STAND_IN = os.environ.get("CALLIGRAPHY_PYTHON_HD_STAND_IN", "") or STAND_IN
 YONG = "永"
 TIMEOUT_S = 120  # a hang fails the case instead of blocking CTest
 
@@ -194,7 +197,7 @@ class OpenHapticsTestCase(unittest.TestCase):
 
     def test_python_list_devices_names_a_driver_that_crashes(self):
         env = {k: v for k, v in os.environ.items() if not k.startswith(("CALLIGRAPHY_LIBHD", "HD_STAND_IN_"))}
-        env.update(PYTHONPATH=PYTHONPATH, CALLIGRAPHY_LIBHD=STAND_IN, HD_STAND_IN_INIT="crash")
+        env.update(PYTHONPATH=PYTHONPATH, CALLIGRAPHY_LIBHD=PYTHON_STAND_IN, HD_STAND_IN_INIT="crash")
         script = ("import calligraphy\n"
                   "survey = calligraphy.list_devices()\n"
                   "print([d.name for d in survey.devices])\n"
@@ -210,7 +213,7 @@ class OpenHapticsTestCase(unittest.TestCase):
         self.assertEqual(result.returncode, 0, result.stderr.decode())
         output = result.stdout.decode()
         self.assertIn("simulated", output)
-        self.assertIn(STAND_IN, output)
+        self.assertIn(PYTHON_STAND_IN, output)
         self.assertIn("the driver crashed with SIGSEGV while initialising the device", output)
 
     def test_sigterm_ends_a_trial_whose_driver_scheduler_never_runs(self):
