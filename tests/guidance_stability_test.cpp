@@ -168,7 +168,7 @@ const std::u32string kTrialCharacters = U"永我乙";
 // Guided trials per sanitizer run, drawn from the 27 of rate x character x mode (tests/test_sizing.hpp).
 constexpr std::size_t kSanitizedTrials = 3;
 // Held pens per sanitizer run, drawn from the 72 of rate x mode x hand x stiffness.
-constexpr std::size_t kSanitizedHolds = 12;
+constexpr std::size_t kSanitizedHolds = 6;
 constexpr double kGrowthTolerance_j = 5e-4;  // as tests/passivity_test.cpp
 constexpr double kBoundedEnergy_j = 0.01;
 constexpr double kDeviceDamping = 0.5;  // SimulatedDeviceParameters' default b [N s/m]
