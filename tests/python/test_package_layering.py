@@ -194,6 +194,18 @@ def test_an_old_module_path_is_the_new_module_itself(module):
     assert new.__name__ == f"{STATS_PACKAGE}.{module}"
 
 
+def test_a_moved_module_is_an_attribute_of_the_package_without_an_import():
+    """As when the analysis imported them under their old paths: ``calligraphy.statistics`` is there once
+    ``calligraphy`` is, and a name the package lacks is still an AttributeError."""
+    probe = ("import importlib, calligraphy\n"
+             f"moved = {MOVED!r}\n"
+             "print(all(getattr(calligraphy, m) is importlib.import_module('calligraphy.stats.' + m) for m in moved))\n"
+             "print(hasattr(calligraphy, 'no_such_module'))\n")
+    done = run_python(["-c", probe])
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["True", "False"], done.stdout
+
+
 def test_the_trial_figures_and_the_report_share_one_font_lookup():
     plot = importlib.import_module(f"{ROOT}.plot")
     fonts = importlib.import_module(f"{STATS_PACKAGE}.fonts")
