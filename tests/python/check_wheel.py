@@ -17,8 +17,8 @@ import tempfile
 
 SOURCE = pathlib.Path(__file__).resolve().parents[2]
 # Binding tests that need only the installed package (no build tree, no CLI), run inside the venv.
-VENV_TESTS = ("test_sim.py", "test_scene.py", "test_force_law.py", "test_renderer.py", "test_run_trial.py", "test_logging.py",
-              "test_package_layering.py")
+VENV_TESTS = ("test_sim.py", "test_scene.py", "test_force_law.py", "test_renderer.py", "test_run_trial.py",
+              "test_logging.py", "test_package_layering.py")
 
 
 def run(command, **options):

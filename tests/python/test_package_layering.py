@@ -223,7 +223,8 @@ def test_importing_the_statistics_loads_no_bindings_module():
     probe = ("import sys, calligraphy.stats\n"
              "print(sorted(m for m in sys.modules if m.startswith('calligraphy.stats.')))\n"
              "import calligraphy.stats.study_report, calligraphy.stats.design_analysis\n"
-             "print(sorted(m for m in sys.modules if m.startswith('calligraphy.') and not m.startswith('calligraphy.stats')))\n")
+             "print(sorted(m for m in sys.modules\n"
+             "             if m.startswith('calligraphy.') and not m.startswith('calligraphy.stats')))\n")
     done = run_python(["-c", probe])
     assert done.returncode == 0, done.stderr
     alone, loaded = done.stdout.splitlines()[:2]
