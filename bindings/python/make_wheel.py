@@ -1,7 +1,7 @@
 """Packs the built Python package (``<build>/python/calligraphy``: the extension, the pure-Python modules,
-the R script, the type stubs) into a wheel (PEP 427) with setuptools and wheel (Debian python3-setuptools,
-python3-wheel), so that it installs into any environment of the same interpreter version with
-``pip install --no-index calligraphy-*.whl``: a virtual environment among them.
+the subpackage calligraphy.stats with its R script, the type stubs) into a wheel (PEP 427) with setuptools
+and wheel (Debian python3-setuptools, python3-wheel), so that it installs into any environment of the same
+interpreter version with ``pip install --no-index calligraphy-*.whl``: a virtual environment among them.
 
     python3 make_wheel.py --package BUILD/python/calligraphy --version 0.1.0 --out DIR
 
@@ -25,7 +25,8 @@ def main() -> int:
     parser.add_argument("--out", required=True, help="the folder the wheel is written to (created if missing)")
     arguments = parser.parse_args()
     package = pathlib.Path(arguments.package).resolve()
-    if not (package / "__init__.py").is_file() or not list(package.glob("_calligraphy*.so")):
+    if (not (package / "__init__.py").is_file() or not list(package.glob("_calligraphy*.so"))
+            or not (package / "stats" / "__init__.py").is_file()):
         print(f"make_wheel: {package} holds no built calligraphy package (build the calligraphy_python target)",
               file=sys.stderr)
         return 1
@@ -56,8 +57,8 @@ def main() -> int:
             setuptools.setup(
                 name="calligraphy", version=arguments.version,
                 description="Haptic training of Chinese handwriting (Wang, Zhang & Yao 2006, Virtual Reality 9)",
-                packages=["calligraphy"],
-                package_data={"calligraphy": ["*.so", "*.pyi", "py.typed", "*.R"]},
+                packages=["calligraphy", "calligraphy.stats"],
+                package_data={"calligraphy": ["*.so", "*.pyi", "py.typed"], "calligraphy.stats": ["*.R"]},
                 python_requires=f"=={sys.version_info.major}.{sys.version_info.minor}.*",
                 install_requires=["numpy"],
                 extras_require={"tables": ["pandas"], "figures": ["matplotlib"],

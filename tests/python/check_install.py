@@ -28,6 +28,11 @@ import sys, pathlib
 import calligraphy, calligraphy.experiments, numpy
 package = pathlib.Path(calligraphy.__file__).resolve().parent
 assert package.is_relative_to(pathlib.Path(sys.argv[1]).resolve()), package
+# The statistics' subpackage, its R script, and the old module paths as the same modules.
+import calligraphy.stats.study_report, calligraphy.stats.mixed_models, calligraphy.study_report
+assert pathlib.Path(calligraphy.stats.__file__).resolve().parent == package / "stats", calligraphy.stats.__file__
+assert calligraphy.stats.mixed_models._SCRIPT.is_file(), calligraphy.stats.mixed_models._SCRIPT
+assert calligraphy.study_report is calligraphy.stats.study_report
 metrics = calligraphy.simulate_trial("十", keep_trace=False, max_duration_s=20.0).metrics
 assert metrics["strokes_total"] == 2, metrics
 print(sys.executable, sys.version.split()[0], "imports calligraphy", calligraphy.__version__, "from", package,

@@ -17,7 +17,8 @@ import tempfile
 
 SOURCE = pathlib.Path(__file__).resolve().parents[2]
 # Binding tests that need only the installed package (no build tree, no CLI), run inside the venv.
-VENV_TESTS = ("test_sim.py", "test_scene.py", "test_force_law.py", "test_renderer.py", "test_run_trial.py", "test_logging.py")
+VENV_TESTS = ("test_sim.py", "test_scene.py", "test_force_law.py", "test_renderer.py", "test_run_trial.py",
+              "test_logging.py", "test_package_layering.py")
 
 
 def run(command, **options):
@@ -53,8 +54,10 @@ def main() -> int:
         installed = run([env / "bin/pip", "install", "--no-index", "--quiet", wheel])
         assert installed.returncode == 0, installed.stderr
         probe = run([env / "bin/python", "-c",
-                     "import calligraphy, calligraphy.mixed_models as m, pathlib, sys; "
-                     "print(pathlib.Path(calligraphy.__file__).resolve()); print(m._SCRIPT.is_file()); "
+                     "import calligraphy, calligraphy.stats.mixed_models as m, calligraphy.mixed_models; "
+                     "import pathlib, sys; "
+                     "print(pathlib.Path(calligraphy.__file__).resolve()); "
+                     "print(m._SCRIPT.is_file() and calligraphy.mixed_models is m); "
                      "r = calligraphy.run_trial('十'); print(r.metrics['strokes_accepted'], r.metrics['strokes_total'])"],
                     cwd=folder)
         assert probe.returncode == 0, probe.stderr

@@ -35,8 +35,12 @@ Errors carry the C++ class names: ``Error`` (the base), ``InvalidArgument`` (a V
 (a RuntimeError) with ``DeviceNotFound`` (a LookupError), ``DeviceUnavailable`` (a known device that cannot
 be used now: its backend's reason), ``CommunicationError`` (a ConnectionError), ``SafetyFault`` and
 ``CalibrationNeeded``. An argument of the wrong type raises TypeError naming it.
-See docs/python.md.
+The statistics and the study page are the subpackage ``calligraphy.stats`` (``study``, ``statistics``,
+``mixed_models``, ``design_models``, ``design_analysis``, ``crossover_analysis``, ``study_report``); their
+old paths ``calligraphy.statistics`` and so on are the same modules. See docs/python.md.
 """
+
+import typing as _typing
 
 from ._calligraphy import (  # noqa: F401
     __version__,
@@ -219,3 +223,17 @@ __all__ = [
     "writer_parameter_names",
     "writer_profile",
 ]
+
+# The modules that moved to calligraphy.stats stay attributes of the package, as they were once imported:
+# `calligraphy.statistics` is calligraphy.stats.statistics, imported when first asked for. Hidden from type
+# checkers, for which a module-level __getattr__ would make every unknown name of the package valid.
+_STATS_MODULES = frozenset({"statistics", "mixed_models", "design_models", "design_analysis", "crossover_analysis",
+                            "study", "study_report"})
+
+if not _typing.TYPE_CHECKING:
+    def __getattr__(name):
+        if name in _STATS_MODULES:
+            import importlib
+
+            return importlib.import_module(f"{__name__}.{name}")
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

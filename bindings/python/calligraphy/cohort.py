@@ -20,7 +20,7 @@ from __future__ import annotations
 import os
 import typing
 
-from . import study as _study
+from .stats import study as _study
 from ._calligraphy import _MAX_COHORT_SUBJECTS, _simulate_cohort_csv
 from .experiments import MAX_WORKERS as _MAX_WORKERS
 from .experiments import _library, _local_workers, _progress_bar, _source

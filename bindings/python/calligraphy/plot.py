@@ -13,16 +13,14 @@ fonts-arphic-ukai or fonts-noto-cjk); without one they may show as boxes. Length
 
 from __future__ import annotations
 
-import functools
-import re
 import typing
-import warnings
 
 import numpy as np
 
+from .stats.fonts import cjk_font
+
 if typing.TYPE_CHECKING:  # pragma: no cover
     import matplotlib.axes
-    import matplotlib.font_manager
 
     from ._calligraphy import Scene, TrialResult
 
@@ -30,13 +28,6 @@ REFERENCE_COLOUR = "blue"
 TRACE_COLOUR = "limegreen"
 HINT_COLOUR = "red"
 
-# Font families with the CJK Unified Ideographs, most wanted first (Kai, like the data's Arphic glyphs).
-_CJK_FAMILIES = (
-    "AR PL UKai CN", "AR PL UKai TW", "AR PL UKai HK", "AR PL UMing CN", "AR PL UMing TW",
-    "Noto Sans CJK SC", "Noto Serif CJK SC", "Noto Sans CJK JP", "Source Han Sans CN",
-    "WenQuanYi Zen Hei", "WenQuanYi Micro Hei", "Droid Sans Fallback",
-)
-_CJK_FILES = re.compile(r"ukai|uming|notosanscjk|notoserifcjk|sourcehan|wqy|droidsansfallback", re.I)
 _MM_PER_M = 1e3
 
 
@@ -49,27 +40,6 @@ def _pyplot():
             "matplotlib)"
         ) from error
     return plt
-
-
-@functools.lru_cache(maxsize=None)
-def cjk_font() -> matplotlib.font_manager.FontProperties | None:
-    """A font with Chinese characters from matplotlib's font manager, or None (with a warning) when
-    none is installed. Prefers AR PL UKai (fonts-arphic-ukai), then UMing, Noto CJK (fonts-noto-cjk),
-    Source Han, WenQuanYi, Droid Sans Fallback."""
-    _pyplot()
-    from matplotlib import font_manager
-
-    fonts = font_manager.fontManager.ttflist
-    for family in _CJK_FAMILIES:
-        for font in fonts:
-            if font.name == family:
-                return font_manager.FontProperties(fname=font.fname)
-    for font in fonts:
-        if _CJK_FILES.search(font.fname):
-            return font_manager.FontProperties(fname=font.fname)
-    warnings.warn("calligraphy.plot: no CJK font found (install fonts-arphic-ukai or fonts-noto-cjk); "
-                  "characters will not show", stacklevel=2)
-    return None
 
 
 def _text_font(text: str) -> dict:

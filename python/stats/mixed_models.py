@@ -1,0 +1,389 @@
+"""Linear mixed models fitted by the field's reference implementation: R's lme4 (Bates, Maechler, Bolker &
+Walker 2015, J Stat Softw 67(1)) with lmerTest's small-sample degrees of freedom (Kuznetsova, Brockhoff &
+Christensen 2017, J Stat Softw 82(13)): Satterthwaite (1946) by default, Kenward & Roger (1997, Biometrics
+53:983) through pbkrtest.
+
+``lmer(frame, formula, factors)`` writes ``frame`` to a temporary folder and has R fit it with the package's
+``lmer_fit.R``; nothing is re-implemented in Python. One R process per Python process serves every fit (loading
+lme4 takes longer than most fits), started on the first and ended at exit. R and its packages come from Debian:
+``apt-get install r-base-core r-cran-lme4 r-cran-lmertest r-cran-pbkrtest`` (scripts/install-deps.sh).
+Without them ``lmer`` raises ``RUnavailable``, which callers report as "not computed" and never replace
+with a large-sample Wald test. R speaks a framed protocol (each request and reply one line of hex fields
+carrying the request's number) and its result files are read only when whole, so a formula, a package's
+output or a broken R spoils at most the one fit (``RAnswerError``); R ends with the Python process, on a
+signal too.
+"""
+
+from __future__ import annotations
+
+import atexit
+import dataclasses
+import os
+import pathlib
+import shutil
+import subprocess
+import tempfile
+import threading
+import time
+import typing
+
+if typing.TYPE_CHECKING:  # pragma: no cover
+    import pandas
+
+__all__ = ["LmerFit", "RAnswerError", "RUnavailable", "lmer", "r_available"]
+
+_SCRIPT = pathlib.Path(__file__).with_name("lmer_fit.R")
+# A fit of a few thousand trials takes seconds; a hung R is stopped instead of hanging a report.
+_TIMEOUT_S = 600.0
+
+
+class RUnavailable(RuntimeError):
+    """Rscript, or one of lme4, lmerTest and pbkrtest, is not installed (the message says which and how to
+    install it)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class LmerFit:
+    """One fitted model. ``fixed``: a DataFrame with one row per fixed effect: ``term`` (R's name, e.g.
+    '(Intercept)' or 'groupfixture'), ``factor`` and ``level`` (the factor level a treatment-coded term
+    compares with the factor's reference; '' for other terms), ``estimate``, ``std_error``, ``df``
+    (Satterthwaite or Kenward-Roger), ``t``, ``p`` (two-sided), ``ci95_low``, ``ci95_high`` (estimate +- t(.975,
+    df) SE), in the outcome's unit. ``terms``: one F test per model term (lmerTest's type III table, the same
+    df method): ``term`` (the formula's name, e.g. 'sequence'), ``num_df``, ``den_df``, ``f``, ``p``.
+    ``variances``: the variance of each random effect and of the residual
+    [outcome unit squared], keyed by R's group name ('subject', 'item', 'Residual'). ``singular``: lme4's
+    isSingular (a variance estimated as 0 or a correlation as +-1); ``converged``: lme4 reported no
+    convergence problem; ``messages``: every warning and message of the fit; ``ddf``; ``formula``;
+    ``n_observations``; ``versions`` of R, lme4 and lmerTest. ``pairs``: when the first factor of ``factors``
+    has three or more levels, every pairwise contrast of its estimated marginal means (R's emmeans, the same
+    df method), ``contrast`` ('later - earlier' in the factor's order), ``estimate``, ``std_error``, ``df``,
+    ``t``, ``p``, ``p_holm`` (Holm among these contrasts), ``ci95_low``, ``ci95_high``; else None, and
+    ``pairs_note`` says why."""
+
+    formula: str
+    ddf: str
+    fixed: "pandas.DataFrame"
+    terms: "pandas.DataFrame"
+    variances: dict[str, float]
+    singular: bool
+    converged: bool
+    messages: str
+    n_observations: int
+    versions: str
+    pairs: typing.Optional["pandas.DataFrame"] = None
+    pairs_note: str = ""
+
+    @property
+    def trustworthy(self) -> bool:
+        """Converged and not singular: only then are its tests reported as tests."""
+        return self.converged and not self.singular
+
+    def note(self, variances: str) -> str:
+        """What a report says of the fit: "not tested: ..." with why (singular, with ``variances``, the variances
+        as the caller writes them; not converged, with lme4's messages), else "variances: ..."."""
+        problems = []
+        if self.singular:
+            problems.append(f"singular fit (a variance estimated at 0 or a correlation at +-1: {variances})")
+        if not self.converged:
+            problems.append("did not converge: " + self.messages)
+        return ("not tested: " + "; ".join(problems)) if problems else f"variances: {variances}"
+
+
+def r_available() -> bool:
+    """Whether Rscript with lme4, lmerTest and pbkrtest can be run here."""
+    try:
+        _check_r()
+    except RUnavailable:
+        return False
+    return True
+
+
+_R_CHECKED: list[bool] = []
+
+
+class RAnswerError(RUnavailable):
+    """R could not answer one fit as a whole: it ended, hung past the timeout, or answered with something
+    other than its one framed reply and the result files that reply names (missing, cut, not UTF-8, or
+    columns that are not the script's). Like ``RUnavailable`` the fit is "not computed": a caller never
+    takes it for lme4 refusing a model, and so never reduces the model because of it. The next fit gets a
+    new R process."""
+
+
+def _hex(text: str) -> str:
+    return text.encode("utf-8").hex()
+
+
+def _keep_with_parent() -> None:  # pragma: no cover - runs in the child between fork and exec
+    """Linux: the child gets SIGTERM when the thread that started it ends, so R never outlives a Python
+    killed by a signal (prctl PR_SET_PDEATHSIG). Elsewhere R ends when its standard input closes."""
+    import ctypes
+    import signal
+
+    try:
+        ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGTERM), 0, 0, 0)
+    except (OSError, AttributeError):
+        pass
+
+
+class _RServer:
+    """``Rscript lmer_fit.R --serve``: one framed request a line, one framed reply a line carrying the
+    request's number (lmer_fit.R describes the protocol). Owned by the process that started it (a forked child
+    starts its own rather than share the pipes) and used under a lock. R is started from a thread of its own
+    that lives as long as R, so that R is ended with the process (``_keep_with_parent``) and not with whichever
+    thread asked for the first fit."""
+
+    _REPLY = "@@calligraphy-reply "
+
+    def __init__(self, rscript: str) -> None:
+        self.pid = os.getpid()
+        self.log = tempfile.TemporaryFile(mode="w+", encoding="utf-8", errors="replace")
+        self.requests = 0
+        self.unread = b""  # what R wrote after the last line taken
+        started: list[typing.Any] = []
+        ready = threading.Event()
+
+        def keep() -> None:
+            try:
+                started.append(subprocess.Popen(
+                    [rscript, "--vanilla", str(_SCRIPT), "--serve"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                    stderr=self.log, bufsize=0, preexec_fn=_keep_with_parent if os.name == "posix" else None))
+            except OSError as error:
+                started.append(error)
+            ready.set()
+            if isinstance(started[0], subprocess.Popen):
+                started[0].wait()
+
+        threading.Thread(target=keep, name="calligraphy-r", daemon=True).start()
+        ready.wait()
+        if isinstance(started[0], OSError):
+            raise RAnswerError(f"lmer: R could not be started: {started[0]}")
+        self.process: subprocess.Popen = started[0]
+
+    def running(self) -> bool:
+        return self.process.returncode is None and self.process.poll() is None
+
+    def fit(self, folder: str, formula: str, ddf: str, timeout_s: float) -> tuple[str, str]:
+        """R's reply to one request: ('ok', FILES) or ('error', MESSAGE). Raises TimeoutError when R hangs,
+        EOFError when it ends, and ValueError when its reply to this request is not one framed reply."""
+        import selectors
+
+        assert self.process.stdin is not None and self.process.stdout is not None
+        self.requests += 1
+        number = str(self.requests)
+        request = f"@@calligraphy-request {number} {_hex(folder)} {_hex(formula)} {_hex(ddf)}\n"
+        self.process.stdin.write(request.encode("ascii"))
+        self.process.stdin.flush()
+        deadline = time.monotonic() + timeout_s
+        while True:
+            line = self._line(deadline)
+            if not line.startswith(self._REPLY):
+                continue  # a package's chatter
+            fields = line[len(self._REPLY):].split(" ")
+            if fields[0] != number:
+                if fields[0].isdigit() and int(fields[0]) < self.requests:
+                    continue  # a second reply to an earlier request: that request was already answered
+                raise ValueError(f"a reply to request {fields[0]!r}, not {number}")
+            if len(fields) != 3 or fields[1] not in ("ok", "error"):
+                raise ValueError(f"a reply that is not 'ok' or 'error' with one field: {line[:200]!r}")
+            try:
+                return fields[1], bytes.fromhex(fields[2]).decode("utf-8")
+            except (ValueError, UnicodeDecodeError) as error:
+                raise ValueError(f"a reply whose field is not hex UTF-8 ({error})") from error
+
+    def _line(self, deadline: float) -> str:
+        """The next line R writes, without its line break (bytes that are not UTF-8 replaced: only the
+        marked lines matter, and they are ASCII). Reads the pipe unbuffered, so that a line R wrote with an
+        earlier one is never left in a buffer that the wait for the pipe cannot see."""
+        import selectors
+
+        assert self.process.stdout is not None
+        descriptor = self.process.stdout.fileno()
+        with selectors.DefaultSelector() as selector:
+            selector.register(descriptor, selectors.EVENT_READ)
+            while b"\n" not in self.unread:
+                if not selector.select(max(0.0, deadline - time.monotonic())):
+                    raise TimeoutError
+                chunk = os.read(descriptor, 65536)
+                if not chunk:
+                    raise EOFError(self.stderr_tail())
+                self.unread += chunk
+        line, _, self.unread = self.unread.partition(b"\n")
+        return line.decode("utf-8", errors="replace").rstrip("\r")
+
+    def stderr_tail(self) -> str:
+        self.log.seek(0)
+        return " ".join(self.log.read().split())[-600:]
+
+    def close(self) -> None:
+        if self.running():
+            try:
+                assert self.process.stdin is not None
+                self.process.stdin.close()
+                self.process.wait(timeout=5)
+            except (OSError, subprocess.TimeoutExpired):
+                self.process.kill()
+                self.process.wait()
+        self.log.close()
+
+
+_SERVER: list[_RServer] = []
+_SERVER_LOCK = threading.Lock()
+
+
+def _close_server() -> None:
+    with _SERVER_LOCK:
+        while _SERVER:
+            server = _SERVER.pop()
+            if server.pid == os.getpid():
+                server.close()
+
+
+atexit.register(_close_server)
+
+
+def _fit_in_r(rscript: str, folder: str, formula: str, ddf: str) -> dict[str, int]:
+    """Has the process's R server fit the model in ``folder`` and returns the result files its reply names,
+    with their sizes in bytes. Raises RuntimeError naming the formula and R's message when lme4 cannot fit
+    it; RAnswerError when R hangs past the timeout, ends or answers out of protocol (the server is then
+    stopped, and the next fit starts another)."""
+    one_line = " ".join(formula.split())
+    with _SERVER_LOCK:
+        if _SERVER and (_SERVER[0].pid != os.getpid() or not _SERVER[0].running()):
+            _SERVER.pop()  # a parent's (after fork) or one that ended: start another
+        if not _SERVER:
+            _SERVER.append(_RServer(rscript))
+        server = _SERVER[0]
+        try:
+            status, text = server.fit(folder, formula, ddf, _TIMEOUT_S)
+        except (TimeoutError, EOFError, OSError, ValueError) as error:
+            _SERVER.pop()
+            server.process.kill()
+            server.close()
+            if isinstance(error, TimeoutError):
+                why = f"did not finish fitting {one_line} in {_TIMEOUT_S:.0f} s"
+            elif isinstance(error, ValueError):
+                why = f"answered the fit of {one_line} out of protocol: {error}"
+            else:
+                why = f"ended while fitting {one_line}: {error}"
+            raise RAnswerError("lmer: R " + why) from error
+    if status != "ok":
+        raise RuntimeError(f"lmer: R could not fit {one_line}: {' '.join(text.split())[-600:]}")
+    files: dict[str, int] = {}
+    for entry in text.split(";"):
+        name, _, size = entry.partition("=")
+        if not size.isdigit():
+            raise RAnswerError(f"lmer: R answered the fit of {one_line} with an unreadable file list {text[:200]!r}")
+        files[name] = int(size)
+    return files
+
+
+_RESULT_COLUMNS = {
+    "fixed.csv": ("term", "estimate", "std_error", "df", "t", "p", "ci95_low", "ci95_high"),
+    "random.csv": ("group", "variance"),
+    "anova.csv": ("term", "num_df", "den_df", "f", "p"),
+    "fit.csv": ("key", "value"),
+    # only when the compared factor has three or more levels (lmer_fit.R)
+    "pairs.csv": ("contrast", "estimate", "std_error", "df", "t", "p", "p_holm", "ci95_low", "ci95_high"),
+}
+_OPTIONAL_RESULTS = ("pairs.csv",)
+
+
+def _read_answer(folder: str, formula: str, files: typing.Mapping[str, int]) -> dict[str, "pandas.DataFrame"]:
+    """The result files of one fit, checked whole: each named by R's reply at the size it gave, UTF-8, with the
+    script's columns, and numbers where numbers belong. Raises RAnswerError naming the file otherwise."""
+    import pandas
+
+    one_line = " ".join(formula.split())
+    tables = {}
+    for name, columns in _RESULT_COLUMNS.items():
+        path = os.path.join(folder, name)
+        if name in _OPTIONAL_RESULTS and name not in files and not os.path.exists(path):
+            continue
+        problem = None
+        try:
+            size = os.path.getsize(path)
+            if name not in files:
+                problem = "not named in R's reply"
+            elif size != files[name]:
+                problem = f"{size} bytes where R's reply says {files[name]}"
+            else:
+                with open(path, encoding="utf-8", errors="strict") as stream:
+                    table = pandas.read_csv(stream, dtype={"fit.csv": str, "pairs.csv": {"contrast": str}}.get(name),
+                                            keep_default_na=name != "fit.csv")
+                if tuple(table.columns) != columns:
+                    problem = f"columns {list(table.columns)} where {list(columns)} belong"
+                elif name != "fit.csv" and len(table) and any(not pandas.api.types.is_numeric_dtype(table[c])
+                                               for c in columns[1:]):
+                    problem = "a value that is not a number"
+                tables[name] = table
+        except FileNotFoundError:
+            problem = "missing"
+        except UnicodeDecodeError:
+            problem = "not UTF-8"
+        except (OSError, ValueError, pandas.errors.ParserError) as error:
+            problem = f"unreadable ({error})"
+        if problem is not None:
+            raise RAnswerError(f"lmer: R's answer to the fit of {one_line} is not whole: {name} {problem}")
+    return tables
+
+
+def _check_r() -> str:
+    rscript = shutil.which("Rscript")
+    if rscript is None:
+        raise RUnavailable("Rscript is not installed (Debian: apt-get install r-base-core r-cran-lme4 "
+                           "r-cran-lmertest r-cran-pbkrtest)")
+    if not _R_CHECKED:
+        probe = subprocess.run(
+            [rscript, "--vanilla", "-e",
+             "for (p in c('lme4','lmerTest','pbkrtest')) if (!requireNamespace(p, quietly=TRUE)) "
+             "{cat(p); quit(status=3)}"],
+            capture_output=True, text=True, timeout=120)
+        if probe.returncode != 0:
+            missing = probe.stdout.strip() or "lme4/lmerTest/pbkrtest"
+            raise RUnavailable(f"R's package {missing} is not installed (Debian: apt-get install "
+                               f"r-cran-{missing.lower()})")
+        _R_CHECKED.append(True)
+    return rscript
+
+
+def lmer(frame: "pandas.DataFrame", formula: str, factors: typing.Mapping[str, typing.Sequence[typing.Any]],
+         *, ddf: str = "Satterthwaite") -> LmerFit:
+    """Fits ``formula`` (lme4 syntax, e.g. ``outcome ~ group + (1 | subject) + (1 | item)``) to ``frame`` by
+    REML and tests the fixed effects with ``ddf`` degrees of freedom ('Satterthwaite' or 'Kenward-Roger').
+
+    frame: a pandas DataFrame with the formula's columns (names that are R identifiers); rows with a missing
+    outcome must be dropped by the caller. factors: for each categorical column, its levels in order, the
+    reference (the control) first; those columns are R factors with treatment coding. Returns an
+    ``LmerFit``. Raises ValueError for an unknown ``ddf`` or an empty frame; RUnavailable without R and its
+    packages; RuntimeError naming R's message when lme4 cannot fit it (e.g. a factor with one level);
+    RAnswerError (an RUnavailable) when R ends, hangs or does not answer the fit whole.
+    """
+    import pandas
+
+    if ddf not in ("Satterthwaite", "Kenward-Roger"):
+        raise ValueError(f"lmer: ddf must be 'Satterthwaite' or 'Kenward-Roger', got {ddf!r}")
+    if frame.empty:
+        raise ValueError("lmer: the frame has no rows")
+    rscript = _check_r()
+    with tempfile.TemporaryDirectory(prefix="calligraphy-lmer-") as folder:
+        frame.to_csv(os.path.join(folder, "data.csv"), index=False, encoding="utf-8")
+        levels = [{"factor": name, "level": str(level)} for name, values in factors.items() for level in values]
+        pandas.DataFrame(levels, columns=["factor", "level"]).to_csv(os.path.join(folder, "levels.csv"),
+                                                                    index=False, encoding="utf-8")
+        answer = _read_answer(folder, formula, _fit_in_r(rscript, folder, formula, ddf))
+    fixed, random, terms = answer["fixed.csv"], answer["random.csv"], answer["anova.csv"]
+    info = dict(answer["fit.csv"].itertuples(index=False, name=None))
+    pairs = answer.get("pairs.csv")
+    owners = {}
+    for name, values in factors.items():
+        for level in list(values)[1:]:
+            owners[f"{name}{level}"] = (name, str(level))
+    fixed.insert(1, "factor", [owners.get(term, ("", ""))[0] for term in fixed["term"]])
+    fixed.insert(2, "level", [owners.get(term, ("", ""))[1] for term in fixed["term"]])
+    variances = {str(group): float(variance) for group, variance in zip(random["group"], random["variance"])}
+    return LmerFit(formula=formula, ddf=ddf, fixed=fixed, terms=terms, variances=variances,
+                   singular=info.get("singular") == "TRUE", converged=info.get("converged") == "TRUE",
+                   messages=info.get("messages", ""), pairs=pairs, pairs_note=info.get("pairs", ""),
+                   n_observations=int(info.get("n_observations", "0") or 0),
+                   versions=(f"R {info.get('r_version', '?')}, lme4 {info.get('lme4_version', '?')}, lmerTest "
+                             f"{info.get('lmertest_version', '?')}"))
