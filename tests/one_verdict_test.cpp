@@ -13,7 +13,7 @@
 #include "calligraphy/analysis/stroke_matcher.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/sim/person_traces.hpp"
-#include "calligraphy/study/quiz.hpp"
+#include "calligraphy/analysis/quiz.hpp"
 #include "calligraphy/analysis/score.hpp"
 #include "embedded_scenes.hpp"
 

@@ -21,6 +21,7 @@
 #include "calligraphy/sim/writer_memory.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/study/session_runner.hpp"
+#include "calligraphy/trial/quiz_trace.hpp"
 #include "calligraphy/trial/trial_spec_runner.hpp"
 #include "study/names.hpp"
 #include "study/remembered_writer.hpp"

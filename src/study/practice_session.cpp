@@ -6,6 +6,7 @@
 #include "calligraphy/report/trace_hdf5.hpp"
 #include "calligraphy/report/trial_report.hpp"
 #include "calligraphy/study/protocol.hpp"
+#include "calligraphy/trial/quiz_trace.hpp"
 #include "study/trial_record.hpp"
 
 namespace calligraphy {

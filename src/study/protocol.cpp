@@ -378,19 +378,6 @@ const char* to_string(ConditionOrder order) noexcept { return enum_spelling(orde
 
 const char* to_string(ItemOrder order) noexcept { return enum_spelling(order).data(); }
 
-void QuizOptions::validate() const {
-  acceptance.validate();
-  if (!std::isfinite(start_radius_m) || !(start_radius_m > 0.0)) {
-    throw InvalidArgument("QuizOptions::start_radius_m must be finite and > 0, got " +
-                          std::to_string(start_radius_m));
-  }
-  const ParameterRange range = parameter_field(&StrokeAcceptance::hint_after_misses).range;
-  if (hint_after_misses && !range.contains(static_cast<double>(*hint_after_misses))) {
-    throw InvalidArgument("QuizOptions::hint_after_misses must be " + range.text("") + ", got " +
-                          std::to_string(*hint_after_misses));
-  }
-}
-
 const StudyCondition& StudyProtocol::condition(std::string_view wanted) const {
   for (const StudyCondition& c : conditions) {
     if (c.name == wanted) return c;

@@ -20,6 +20,7 @@
 #include "calligraphy/report/trial_report.hpp"
 #include "calligraphy/sim/simulated_writing.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/trial/quiz_trace.hpp"
 #include "calligraphy/trial/trial_spec_runner.hpp"
 #include "study/names.hpp"
 #include "study/remembered_writer.hpp"

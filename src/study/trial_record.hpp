@@ -15,7 +15,7 @@
 #include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/sim/writer_log.hpp"
 #include "calligraphy/sim/writer_memory.hpp"
-#include "calligraphy/study/quiz.hpp"
+#include "calligraphy/analysis/quiz.hpp"
 #include "calligraphy/study/session_folder.hpp"
 #include "calligraphy/trial/options.hpp"
 #include "calligraphy/trial/result.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-// The quiz judged live in the window (study/quiz.hpp: the stroke matcher, as the renderer judges): the pen's
+// The quiz judged live in the window (analysis/quiz.hpp: the stroke matcher, as the renderer judges): the pen's
 // positions arrive on the window thread through the display channel's trace queue, one `QuizSession` per
 // character of the trial's scene judges each stroke the moment the pen lifts, and the window shows the
 // verdicts at once. Never on the servo thread: a judgement takes up to milliseconds.
@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "calligraphy/model/scene.hpp"
-#include "calligraphy/study/quiz.hpp"
+#include "calligraphy/analysis/quiz.hpp"
 #include "calligraphy/trial/display.hpp"
 
 namespace calligraphy::trainer {

@@ -19,7 +19,7 @@
 #include "calligraphy/render/guidance_mode.hpp"
 #include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/study/practice_session.hpp"
-#include "calligraphy/study/quiz.hpp"
+#include "calligraphy/analysis/quiz.hpp"
 #include "calligraphy/trial/display.hpp"
 #include "calligraphy/trial/trial.hpp"
 #include "trainer/demonstration.hpp"

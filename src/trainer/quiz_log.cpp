@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "calligraphy/study/quiz.hpp"
+#include "calligraphy/trial/quiz_trace.hpp"
 #include "trainer/panel.hpp"
 
 namespace calligraphy::trainer {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "calligraphy/study/quiz.hpp"
+#include "calligraphy/analysis/quiz.hpp"
 #include "calligraphy/trial/recorder.hpp"
 #include "trainer/live_quiz.hpp"
 #include "trainer/trial_view.hpp"

@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "calligraphy/analysis/quiz.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/schema.hpp"
 #include "calligraphy/model/scene.hpp"
@@ -28,7 +29,7 @@ enum class ConditionMode {
   haptic,  ///< vision and the guiding force of paper section 5 (the paper's "with force feedback")
   fading,  ///< guidance whose gain follows the writer's deviation over repetitions (GuidanceMode::fading)
   replay,  ///< guidance that replays a teacher's recorded trial of the item (GuidanceMode::replay)
-  quiz,    ///< vision only, each stroke judged when the pen lifts (quiz.hpp)
+  quiz,    ///< vision only, each stroke judged when the pen lifts (analysis/quiz.hpp)
   assist_as_needed,     ///< force only beyond a band that adapts to the writer's error
                         ///< (GuidanceMode::assist_as_needed)
   error_amplification,  ///< a bounded repulsive field (GuidanceMode::error_amplification)
@@ -63,31 +64,6 @@ struct EnumTable<ConditionMode> {
 [[nodiscard]] std::span<const ConditionMode> condition_modes() noexcept;
 /// Whether trials of the mode render in-plane guidance (every mode but `vision` and `quiz`).
 [[nodiscard]] bool renders_guidance(ConditionMode mode) noexcept;
-
-/// How a quiz judges strokes: each pen-down run with the stroke matcher (`match_stroke`,
-/// analysis/stroke_matcher.hpp), the rule the renderer and `score_trace` use (docs/stroke-acceptance.md);
-/// misses and hints as in Hanzi Writer's quiz (chanind/hanzi-writer src/Quiz.ts).
-struct QuizOptions {
-  /// The stroke matcher's tolerances (SI units). The trainer gives its trials' (ForceLawParameters::
-  /// acceptance) and a study session gives the renderer the quiz condition's, so that quiz and renderer
-  /// agree.
-  StrokeAcceptance acceptance{};
-  /// Radius of the start neighbourhood (WS) a run must enter the stroke in [m]: the scene's
-  /// (SceneLayout::start_radius_m). Finite, > 0.
-  double start_radius_m = SceneLayout{}.start_radius_m;
-  /// Overrides the acceptance's `hint_after_misses` (StrokeAcceptance, its one definition: default and
-  /// range) when given: a hint (the expected stroke shown) after this many misses on one stroke, and after
-  /// each further miss; 0: never. Empty: the acceptance's.
-  std::optional<int> hint_after_misses{};
-  /// The misses on one stroke after which the quiz shows a hint: the override, or the acceptance's.
-  [[nodiscard]] int hint_after() const noexcept {
-    return hint_after_misses ? *hint_after_misses : static_cast<int>(acceptance.hint_after_misses);
-  }
-  /// A stroke written from its end to its start is accepted (and still reported as backwards).
-  bool accept_backwards = false;
-  /// Throws InvalidArgument naming the field when a value is out of range.
-  void validate() const;
-};
 
 /// One feedback condition.
 struct StudyCondition {

@@ -5,7 +5,7 @@
 #include "calligraphy/analysis/metrics.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/character_library.hpp"
-#include "calligraphy/study/quiz.hpp"
+#include "calligraphy/analysis/quiz.hpp"
 #include "embedded_scenes.hpp"
 
 using namespace calligraphy;
@@ -44,7 +44,7 @@ bool has(const std::vector<QuizEvent>& events, QuizEvent::Kind kind) {
 
 }  // namespace
 
-TEST_CASE("quiz accepts the strokes written in order and completes the character", "[study][quiz]") {
+TEST_CASE("quiz accepts the strokes written in order and completes the character", "[analysis][quiz]") {
   const PlacedCharacter& shi = character_of(U'十');
   REQUIRE(shi.strokes.size() == 2);
   Writer writer{QuizSession(shi)};
@@ -66,7 +66,7 @@ TEST_CASE("quiz accepts the strokes written in order and completes the character
 }
 
 TEST_CASE("quiz misses a stroke written out of order and hints after the set number of misses",
-          "[study][quiz]") {
+          "[analysis][quiz]") {
   const PlacedCharacter& shi = character_of(U'十');
   QuizOptions options;
   options.hint_after_misses = 2;
@@ -92,7 +92,7 @@ TEST_CASE("quiz misses a stroke written out of order and hints after the set num
 }
 
 TEST_CASE("quiz hints after the stroke acceptance's hint_after_misses unless an option overrides it",
-          "[study][quiz]") {
+          "[analysis][quiz]") {
   const PlacedCharacter& shi = character_of(U'十');
   // Misses (the vertical before the horizontal) until the first hint; 0 when none came in `most` misses.
   const auto misses_to_hint = [&](const QuizOptions& options, int most) {
@@ -125,7 +125,7 @@ TEST_CASE("quiz hints after the stroke acceptance's hint_after_misses unless an 
   CHECK_THROWS_AS(options.validate(), InvalidArgument);
 }
 
-TEST_CASE("quiz reports a stroke written backwards and accepts it only when asked to", "[study][quiz]") {
+TEST_CASE("quiz reports a stroke written backwards and accepts it only when asked to", "[analysis][quiz]") {
   const PlacedCharacter& shi = character_of(U'十');
   Writer strict{QuizSession(shi)};
   const auto events = strict.write(stroke_points(shi.strokes[0], Vec2::Zero(), true));
@@ -145,7 +145,7 @@ TEST_CASE("quiz reports a stroke written backwards and accepts it only when aske
   CHECK(accepted[0].refusal == StrokeRefusal::none);
 }
 
-TEST_CASE("quiz acceptance decides a stroke written off its place", "[study][quiz]") {
+TEST_CASE("quiz acceptance decides a stroke written off its place", "[analysis][quiz]") {
   const PlacedCharacter& shi = character_of(U'十');
   // Shifted across the stroke by 4 mm: within the start neighbourhood (5 mm) and the corridor (6.5 mm),
   // beyond the default mean deviation (3 mm, capped at 3.2 mm), within a mean deviation of 5 mm.
@@ -169,7 +169,7 @@ TEST_CASE("quiz acceptance decides a stroke written off its place", "[study][qui
   CHECK(outside[0].refusal == StrokeRefusal::wrong_place);
 }
 
-TEST_CASE("quiz neither accepts nor counts a touch too short to judge", "[study][quiz]") {
+TEST_CASE("quiz neither accepts nor counts a touch too short to judge", "[analysis][quiz]") {
   const PlacedCharacter& shi = character_of(U'十');
   Writer writer{QuizSession(shi)};
   const Vec2 start = shi.strokes[0].start();
@@ -180,7 +180,7 @@ TEST_CASE("quiz neither accepts nor counts a touch too short to judge", "[study]
   CHECK(writer.quiz.current_stroke() == 0);
 }
 
-TEST_CASE("quiz judges a run still open when the input ends", "[study][quiz]") {
+TEST_CASE("quiz judges a run still open when the input ends", "[analysis][quiz]") {
   const PlacedCharacter& shi = character_of(U'十');
   QuizSession quiz(shi);
   double t = 0.0;
@@ -194,7 +194,7 @@ TEST_CASE("quiz judges a run still open when the input ends", "[study][quiz]") {
   CHECK(quiz.events().size() == 1);
 }
 
-TEST_CASE("quiz refuses samples going back in time or not finite, naming the sample", "[study][quiz]") {
+TEST_CASE("quiz refuses samples going back in time or not finite, naming the sample", "[analysis][quiz]") {
   const PlacedCharacter& shi = character_of(U'十');
   QuizSession quiz(shi);
   quiz.feed({1.0, Vec2::Zero(), false});

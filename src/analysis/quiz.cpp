@@ -1,14 +1,28 @@
-#include "calligraphy/study/quiz.hpp"
+#include "calligraphy/analysis/quiz.hpp"
 
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "analysis/segmentation.hpp"
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/report/pen_trace_csv.hpp"
+#include "calligraphy/core/parameter_table.hpp"
 
 namespace calligraphy {
+
+void QuizOptions::validate() const {
+  acceptance.validate();
+  if (!std::isfinite(start_radius_m) || !(start_radius_m > 0.0)) {
+    throw InvalidArgument("QuizOptions::start_radius_m must be finite and > 0, got " +
+                          std::to_string(start_radius_m));
+  }
+  const ParameterRange range = parameter_field(&StrokeAcceptance::hint_after_misses).range;
+  if (hint_after_misses && !range.contains(static_cast<double>(*hint_after_misses))) {
+    throw InvalidArgument("QuizOptions::hint_after_misses must be " + range.text("") + ", got " +
+                          std::to_string(*hint_after_misses));
+  }
+}
 
 const char* to_string(QuizEvent::Kind kind) noexcept {
   switch (kind) {
@@ -120,37 +134,12 @@ std::vector<QuizEvent> QuizSession::feed(const PenSample& sample) {
 
 std::vector<QuizEvent> QuizSession::finish() { return judge_segment(); }
 
-namespace {
-
-// The pen samples of character `character` of `scene` in `trace` (quiz_characters).
-std::vector<PenSample> pen_samples_of_character(const Scene& scene, const std::vector<TrialSample>& trace,
-                                                std::size_t character) {
-  std::size_t first = 0;
-  for (std::size_t c = 0; c < character; ++c) first += scene.characters[c].strokes.size();
-  const std::size_t last = first + scene.characters[character].strokes.size();  // one past
-  const double contact_m = PenTraceCsvOptions{}.contact_threshold_m;
-  std::vector<PenSample> samples;
-  for (const TrialSample& s : trace) {
-    const bool active = s.stroke >= first && (s.stroke < last || character + 1 == scene.characters.size());
-    if (!active) continue;
-    samples.push_back(
-        {s.time_s, s.position_m.head<2>(), s.position_m.z() - scene.layout.paper_z_m <= contact_m});
-  }
-  return samples;
-}
-
-}  // namespace
-
-std::vector<std::vector<QuizEvent>> quiz_characters(const Scene& scene, const std::vector<TrialSample>& trace,
-                                                    const QuizOptions& options) {
-  std::vector<std::vector<QuizEvent>> events;
-  for (std::size_t c = 0; c < scene.characters.size(); ++c) {
-    QuizSession quiz(scene.characters[c], options);
-    for (const PenSample& s : pen_samples_of_character(scene, trace, c)) quiz.feed(s);
-    quiz.finish();
-    events.push_back(quiz.events());
-  }
-  return events;
+std::vector<QuizEvent> quiz_character(const PlacedCharacter& character, std::span<const PenSample> samples,
+                                      const QuizOptions& options) {
+  QuizSession quiz(character, options);
+  for (const PenSample& s : samples) quiz.feed(s);
+  quiz.finish();
+  return quiz.events();
 }
 
 }  // namespace calligraphy

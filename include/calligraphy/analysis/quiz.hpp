@@ -9,18 +9,44 @@
 /// same trace (docs/stroke-acceptance.md). A run refused as backwards is a miss reported as backwards, or
 /// accepted (still reported as backwards) with `accept_backwards`. After `hint_after_misses` misses on
 /// one stroke, and after each further miss, a hint event asks to show the expected stroke. Not for the
-/// servo thread: judging takes up to milliseconds per pen lift.
+/// servo thread: judging takes up to milliseconds per pen lift. On the model and the stroke matcher only:
+/// a trial's trace is judged through `quiz_characters` (trial/quiz_trace.hpp).
 #include <cstddef>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "calligraphy/analysis/score.hpp"
 #include "calligraphy/analysis/stroke_matcher.hpp"
 #include "calligraphy/model/scene.hpp"
-#include "calligraphy/study/protocol.hpp"
-#include "calligraphy/trial/result.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 
 namespace calligraphy {
+
+/// How a quiz judges strokes: each pen-down run with the stroke matcher (`match_stroke`,
+/// analysis/stroke_matcher.hpp), the rule the renderer and `score_trace` use (docs/stroke-acceptance.md);
+/// misses and hints as in Hanzi Writer's quiz (chanind/hanzi-writer src/Quiz.ts).
+struct QuizOptions {
+  /// The stroke matcher's tolerances (SI units). The trainer gives its trials' (ForceLawParameters::
+  /// acceptance) and a study session gives the renderer the quiz condition's, so that quiz and renderer
+  /// agree.
+  StrokeAcceptance acceptance{};
+  /// Radius of the start neighbourhood (WS) a run must enter the stroke in [m]: the scene's
+  /// (SceneLayout::start_radius_m). Finite, > 0.
+  double start_radius_m = SceneLayout{}.start_radius_m;
+  /// Overrides the acceptance's `hint_after_misses` (StrokeAcceptance, its one definition: default and
+  /// range) when given: a hint (the expected stroke shown) after this many misses on one stroke, and after
+  /// each further miss; 0: never. Empty: the acceptance's.
+  std::optional<int> hint_after_misses{};
+  /// The misses on one stroke after which the quiz shows a hint: the override, or the acceptance's.
+  [[nodiscard]] int hint_after() const noexcept {
+    return hint_after_misses ? *hint_after_misses : static_cast<int>(acceptance.hint_after_misses);
+  }
+  /// A stroke written from its end to its start is accepted (and still reported as backwards).
+  bool accept_backwards = false;
+  /// Throws InvalidArgument naming the field when a value is out of range.
+  void validate() const;
+};
 
 /// Something the quiz tells its display.
 struct QuizEvent {
@@ -86,13 +112,11 @@ class QuizSession {
   std::vector<QuizEvent> events_;
 };
 
-/// The quiz events of each character of a trial's trace [`scene.characters.size()` lists]: the trace's
-/// samples of each character (a tick belongs to the character whose strokes hold the active stroke; after
-/// the last stroke, to the last character), pen down within PenTraceCsvOptions' contact threshold of the
-/// paper, fed through a `QuizSession` per character. The verdicts a saved quiz trial's record holds; a
-/// window judging live must show the same ones.
-[[nodiscard]] std::vector<std::vector<QuizEvent>> quiz_characters(const Scene& scene,
-                                                                  const std::vector<TrialSample>& trace,
-                                                                  const QuizOptions& options);
+/// The quiz events of one character's pen samples (time, position on the paper [m], pen down), in order: each
+/// sample fed through a `QuizSession` with `options`, then `finish`. Throws what the session throws (bad
+/// options or character, a sample named by its index in `samples`).
+[[nodiscard]] std::vector<QuizEvent> quiz_character(const PlacedCharacter& character,
+                                                    std::span<const PenSample> samples,
+                                                    const QuizOptions& options);
 
 }  // namespace calligraphy
