@@ -776,7 +776,8 @@ class StudySurfaces(Hostile):
                             encoding="utf-8")
         self.assertNotEqual(manifest.read_text(encoding="utf-8"), text)
         before = digest_tree(study)
-        self.refused(self.cli("session", "resume", session), 1, "session.json", "/pacing")
+        # the content of the session folder the command was given: refused as a protocol's is (exit 2)
+        self.refused(self.cli("session", "resume", session), 2, "session.json", "/pacing")
         self.assertEqual(digest_tree(study), before)
 
     def test_resume_of_a_session_json_that_is_a_folder_is_named(self):
