@@ -138,6 +138,34 @@ class SessionFolders(Hostile):
         self.assertEqual(out.returncode, 0, out.stderr)
         self.assertEqual(len(list(session.glob("trials/*.json"))), 2)
 
+    def test_a_session_json_of_the_first_version_reads_as_the_same_plan(self):
+        """Version 1 counted a planned trial's block and item from 0 and had no session number, group, study id,
+        writer learning or individual differences: `report` reads the same blocks and items from it."""
+        import csv
+
+        def tables(study, name):
+            folder = self.cwd / name
+            folder.mkdir()
+            out = self.cli("report", study, "--csv", folder)
+            self.assertEqual(out.returncode, 0, out.stderr)
+            with open(folder / "trials.csv", encoding="utf-8") as f:
+                return [(row["subject"], row["block"], row["item"], row["repetition"]) for row in csv.DictReader(f)]
+
+        study = self.study_copy()
+        expected = tables(study, "now")
+        (study / ".calligraphy-study.json").unlink()
+        for manifest in study.rglob("session.json"):
+            doc = json.loads(manifest.read_text(encoding="utf-8"))
+            doc["version"] = 1
+            for key in ("study_id", "writer_learning", "individual_differences", "session_number", "group"):
+                doc.pop(key, None)
+            for trial in doc["plan"]:
+                trial["block"] -= 1
+                trial["item"] -= 1
+            manifest.write_text(json.dumps(doc, ensure_ascii=False, indent=2) + "\n", encoding="utf-8")
+        self.assertEqual(tables(study, "old"), expected)
+        self.assertGreater(len(expected), 0)
+
     # -- links --------------------------------------------------------------------------------------------
 
     def test_a_symlinked_trials_folder_is_refused_and_nothing_is_written_through_it(self):
