@@ -101,6 +101,74 @@ TEST_CASE("a target that is not a regular file is written in place and checked",
   CHECK(folder.names().empty());
 }
 
+TEST_CASE("write_file_exclusively creates a file whole and never replaces anything", "[atomic_file]") {
+  TemporaryFolder folder;
+  const fs::path target = folder.path / "identity.json";
+  CHECK(write_file_exclusively(target, "first\n"));
+  CHECK(contents(target) == "first\n");
+  CHECK_FALSE(write_file_exclusively(target, "second\n"));  // there already: kept as it was
+  CHECK(contents(target) == "first\n");
+  // A symbolic link in its place (dangling or not) is not followed and not replaced.
+  const fs::path outside = folder.path / "outside.txt";
+  const fs::path link = folder.path / "link.json";
+  fs::create_symlink(outside, link);
+  CHECK_FALSE(write_file_exclusively(link, "through the link"));
+  CHECK_FALSE(fs::exists(outside));
+  CHECK(fs::is_symlink(link));
+  // Nor a folder.
+  fs::create_directory(folder.path / "a-folder");
+  CHECK_FALSE(write_file_exclusively(folder.path / "a-folder", "x"));
+  CHECK(fs::is_directory(folder.path / "a-folder"));
+  CHECK(folder.names() == std::vector<std::string>{"a-folder", "identity.json", "link.json"});
+}
+
+TEST_CASE("write_file_exclusively: a failed write is an error and leaves no file", "[atomic_file]") {
+  TemporaryFolder folder;
+  const fs::path target = folder.path / "identity.json";
+  {
+    FileSizeLimit limit(1024);
+    CHECK_THROWS_WITH(write_file_exclusively(target, std::string(1 << 16, 'x')),
+                      Catch::Contains(target.string()) && Catch::Contains("too large"));
+  }
+  CHECK(folder.names().empty());  // no partial file, no temporary
+  CHECK_THROWS_WITH(write_file_exclusively(folder.path / "missing" / "file", "x"),
+                    Catch::Contains((folder.path / "missing" / "file").string()));
+  CHECK(folder.names().empty());
+}
+
+TEST_CASE("write_file_exclusively removes the temporary a killed writer left", "[atomic_file]") {
+  TemporaryFolder folder;
+  const fs::path target = folder.path / "identity.json";
+  // What a writer stopped by SIGKILL mid-write leaves where the file system has no O_TMPFILE: its named
+  // temporary, half written, of a process that is gone (pid 2^22 + 1 is above Linux's pid_max default).
+  const fs::path left = folder.path / ".identity.json.tmp-4194305-0";
+  {
+    std::ofstream half(left);
+    half << "{\"format\": \"calli";
+  }
+  CHECK(write_file_exclusively(target, "whole\n"));
+  CHECK(contents(target) == "whole\n");
+  CHECK(folder.names() == std::vector<std::string>{"identity.json"});
+}
+
+TEST_CASE("write_file_exclusively: of writers racing for one name, exactly one makes it", "[atomic_file]") {
+  TemporaryFolder folder;
+  const fs::path target = folder.path / "identity.json";
+  std::atomic<int> made{0};
+  std::vector<std::thread> writers;
+  for (int i = 0; i < 8; ++i) {
+    writers.emplace_back([&, i] {
+      if (write_file_exclusively(target, "writer " + std::to_string(i) + "\n")) made.fetch_add(1);
+    });
+  }
+  for (std::thread& writer : writers) writer.join();
+  CHECK(made.load() == 1);
+  const std::string text = contents(target);
+  CHECK(text.starts_with("writer "));
+  CHECK(text.ends_with("\n"));
+  CHECK(folder.names() == std::vector<std::string>{"identity.json"});
+}
+
 TEST_CASE("read_file_for_update reads regular files only, within a bound", "[atomic_file]") {
   TemporaryFolder folder;
   const fs::path document = folder.path / "doc.md";

@@ -3,6 +3,7 @@
 #include "calligraphy/core/printable_text.hpp"
 
 #include <catch2/catch.hpp>
+#include <span>
 #include <string>
 
 using calligraphy::printable_one_line;
@@ -66,4 +67,10 @@ TEST_CASE("every single byte becomes printable", "[printable]") {
     CHECK_FALSE(has_control_byte(line));
     CHECK_FALSE(line.empty());
   }
+}
+
+TEST_CASE("lower_hex writes two lower-case digits a byte, most significant first", "[printable]") {
+  const unsigned char bytes[] = {0x00, 0x0f, 0xa0, 0xff, 0x5c};
+  CHECK(calligraphy::lower_hex(bytes) == "000fa0ff5c");
+  CHECK(calligraphy::lower_hex(std::span<const unsigned char>()).empty());
 }

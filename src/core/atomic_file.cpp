@@ -150,7 +150,8 @@ class TemporaryFile {
       name.append(target.filename().string()).append(".tmp-").append(std::to_string(::getpid()));
       name.append("-").append(std::to_string(counter.fetch_add(1)));
       path_ = folder / name;
-      fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, set_mode ? 0600 : 0666);
+      fd_ =
+          ::open(path_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, set_mode ? 0600 : 0666);
       if (fd_ >= 0 || errno != EEXIST) break;
     }
     if (fd_ < 0) fail(reported_, "cannot create a temporary file in " + folder.string(), errno);
@@ -168,6 +169,12 @@ class TemporaryFile {
   }
 
   [[nodiscard]] const fs::path& path() const noexcept { return path_; }
+
+  /// Gives the written temporary the name `target` too (link(2): never replaces an existing file); the
+  /// temporary's own name is removed on destruction. Returns 0 or link's errno.
+  [[nodiscard]] int link_to(const fs::path& target) noexcept {
+    return ::link(path_.c_str(), target.c_str()) == 0 ? 0 : errno;
+  }
 
   void rename_to(const fs::path& target) {
     if (::rename(path_.c_str(), target.c_str()) != 0) fail_and_remove("cannot replace the file", errno);
@@ -611,6 +618,46 @@ void write_file_atomically(const fs::path& path, std::string_view content) {
   temporary.rename_to(target);
   sync_folder(target, path);
   remove_dead_writers_temporaries(target);
+}
+
+bool write_file_exclusively(const fs::path& path, std::string_view content) {
+  if (path.empty()) throw DataError("cannot write a file with an empty name");
+  remove_dead_writers_temporaries(path);
+  // Written whole to an unnamed file of the folder (O_TMPFILE), synced, then linked to its name through
+  // /proc/self/fd: linkat(2) never replaces a name that exists (a file, a link or anything else), and a
+  // process stopped at any moment leaves nothing.
+  int fd = ::open(folder_of(path).c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);
+  if (fd >= 0) {
+    int error = write_all(fd, content);
+    if (error == 0 && ::fsync(fd) != 0) error = errno;
+    if (error != 0) {
+      ::close(fd);
+      fail(path, "cannot write", error);
+    }
+    std::string proc = "/proc/self/fd/";
+    proc.append(std::to_string(fd));
+    const int linked = ::linkat(AT_FDCWD, proc.c_str(), AT_FDCWD, path.c_str(), AT_SYMLINK_FOLLOW);
+    const int link_error = linked == 0 ? 0 : errno;
+    const int close_error = close_checked(fd);
+    if (linked == 0) {
+      if (close_error != 0) fail(path, "written, but closing it failed", close_error);
+      sync_folder(path, path);
+      return true;
+    }
+    if (link_error == EEXIST) return false;
+    if (link_error != ENOENT) fail(path, "cannot create", link_error);
+    // ENOENT: no /proc here; the named temporary below
+  }
+  // No O_TMPFILE on this file system (or no /proc): a temporary named by this process (O_EXCL | O_NOFOLLOW),
+  // written whole and synced, then linked to its name; the temporary is removed on every way out, and what a
+  // killed process left is removed by the next write of the name (remove_dead_writers_temporaries).
+  TemporaryFile temporary(path, path, 0, false);
+  temporary.write(content);
+  const int error = temporary.link_to(path);
+  if (error == EEXIST) return false;
+  if (error != 0) fail(path, "cannot create", error);
+  sync_folder(path, path);
+  return true;
 }
 
 struct AtomicFileSet::Impl {

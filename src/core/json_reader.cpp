@@ -115,6 +115,16 @@ std::int64_t as_integer(const nlohmann::json& value, const std::string& pointer,
   return number;
 }
 
+std::uint64_t as_unsigned(const nlohmann::json& value, const std::string& pointer,
+                          const std::string& source) {
+  static const std::string kRange = "[0, 18446744073709551615]";
+  if (value.is_number_unsigned()) return value.get<std::uint64_t>();
+  if (value.is_number_integer() && value.get<std::int64_t>() >= 0) return value.get<std::uint64_t>();
+  if (is_exact_integral_float(value) && value.get<double>() >= 0.0)
+    return static_cast<std::uint64_t>(value.get<double>());
+  fail_integer(value, pointer, source, kRange);
+}
+
 ObjectReader::ObjectReader(const nlohmann::json& value, std::string pointer, const std::string& source)
     : value_(value), pointer_(std::move(pointer)), source_(source) {
   if (!value_.is_object()) fail(source_, pointer_, "expected an object, got " + describe(value_));
@@ -174,14 +184,7 @@ std::int64_t ObjectReader::integer_or(const std::string& key, std::int64_t fallb
 
 std::uint64_t ObjectReader::unsigned_or(const std::string& key, std::uint64_t fallback) {
   const nlohmann::json* value = optional(key);
-  if (!value) return fallback;
-  static const std::string kRange = "[0, 18446744073709551615]";
-  if (value->is_number_unsigned()) return value->get<std::uint64_t>();
-  if (value->is_number_integer() && value->get<std::int64_t>() >= 0) return value->get<std::uint64_t>();
-  if (is_exact_integral_float(*value) && value->get<double>() >= 0.0) {
-    return static_cast<std::uint64_t>(value->get<double>());
-  }
-  fail_integer(*value, pointer(key), source_, kRange);
+  return value ? as_unsigned(*value, pointer(key), source_) : fallback;
 }
 
 bool ObjectReader::boolean_or(const std::string& key, bool fallback) {

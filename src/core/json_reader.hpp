@@ -105,6 +105,9 @@ double as_number(const nlohmann::json& value, const std::string& pointer, const 
                  double minimum, double maximum);
 std::int64_t as_integer(const nlohmann::json& value, const std::string& pointer, const std::string& source,
                         std::int64_t minimum, std::int64_t maximum);
+/// The value as an unsigned 64-bit integer: digits, or exponent form when it is an exact integer below 2^53
+/// (1e3); throws DataError naming `pointer` for anything else (a fraction, a negative, text, null).
+std::uint64_t as_unsigned(const nlohmann::json& value, const std::string& pointer, const std::string& source);
 /// `pointer` + "/" + `key` with RFC 6901 escapes.
 std::string child_pointer(const std::string& pointer, const std::string& key);
 std::string child_pointer(const std::string& pointer, std::size_t index);

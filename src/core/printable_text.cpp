@@ -72,4 +72,15 @@ std::string printable_one_line(std::string_view text, std::size_t max_bytes) {
   return line;
 }
 
+std::string lower_hex(std::span<const unsigned char> bytes) {
+  static constexpr char kDigits[] = "0123456789abcdef";
+  std::string out;
+  out.reserve(2 * bytes.size());
+  for (const unsigned char b : bytes) {
+    out.push_back(kDigits[b >> 4]);
+    out.push_back(kDigits[b & 0xF]);
+  }
+  return out;
+}
+
 }  // namespace calligraphy

@@ -91,8 +91,8 @@ void read_value(const SchemaField& field, const std::string& owner, void* object
       return;
     case FieldKind::integer:
       if (field.integer_unsigned) {
-        expect(value.is_number_unsigned(), "an integer in 0..18446744073709551615");
-        field.set_unsigned(object, value.get<std::uint64_t>());
+        // Digits, or exponent form when exact (1e3), as every integer of a file is read.
+        field.set_unsigned(object, json_detail::as_unsigned(value, pointer, source));
         return;
       }
       field.set_integer(

@@ -274,10 +274,9 @@ void read_order(json_detail::ObjectReader& reader, StudyProtocol& protocol) {
   if (!value) return;
   // Through its schema (protocol_order_schema: the enumerations' one spelling each); null keeps the default.
   json_detail::ObjectReader order(*value, reader.pointer("order"), reader.source());
-  for (const char* key : {"conditions", "characters"})
+  // The seed: every value of a std::uint64_t, also in exponent form when exact (1e3), as the schema reads it.
+  for (const char* key : {"conditions", "characters", "seed"})
     study_detail::read_member(order, protocol_order_schema(), key, &protocol);
-  // Every value of a std::uint64_t (the schema's range), also in exponent form when exact (1e3).
-  protocol.seed = order.unsigned_or("seed", protocol.seed);
   order.finish();
 }
 

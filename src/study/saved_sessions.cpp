@@ -1,5 +1,7 @@
 #include "study/saved_sessions.hpp"
 
+#include <set>
+
 #include "calligraphy/core/errors.hpp"
 #include "core/json_reader.hpp"
 #include "study/manifest_json.hpp"
@@ -32,7 +34,27 @@ SessionManifest read_session_manifest(const fs::path& folder) {
   SessionManifest manifest =
       manifest_from_json(read_small_file(path, kMaxSessionManifestBytes, "session manifest"), path.string());
   manifest.session_id = folder.filename().string();
+  check_records_planned(folder, manifest);
   return manifest;
+}
+
+void check_records_planned(const fs::path& folder, const SessionManifest& manifest) {
+  if (manifest.protocol.path == "calligraphy-train") return;
+  std::set<std::string> planned;
+  for (const PlannedTrial& trial : manifest.plan) planned.insert(SessionFolder::trial_stem(trial) + ".json");
+  std::error_code error;
+  for (fs::directory_iterator entry(SessionLayout::trials(folder), error), end; !error && entry != end;
+       entry.increment(error)) {
+    const std::string name = entry->path().filename().string();
+    if (name.starts_with(".") || !name.ends_with(".json") || planned.contains(name)) continue;
+    std::error_code kind;
+    if (entry->is_directory(kind)) continue;
+    json_detail::fail(SessionLayout::manifest(folder).string(), "/plan",
+                      "the plan has no trial " + name.substr(0, name.size() - 5) + ", but " +
+                          entry->path().string() +
+                          " is a saved record of this session: session.json was edited (its plan cut) or the "
+                          "record copied in; restore the original session.json, or move the record out");
+  }
 }
 
 SessionManifest read_previous_session(const fs::path& folder, const SessionManifest& manifest) {

@@ -4,8 +4,8 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
-#include <string>
 #include <nlohmann/json.hpp>
+#include <string>
 #include <vector>
 
 #include "calligraphy/study/session_folder.hpp"
@@ -19,9 +19,17 @@ inline constexpr std::uintmax_t kMaxRecordBytes = std::uintmax_t{64} << 20;
 /// each root. Throws DataError naming the roots when there is none.
 std::vector<std::filesystem::path> session_folders_under(const std::vector<std::filesystem::path>& roots);
 
-/// The manifest of the session folder `folder`, its `session_id` the folder's name. Throws DataError naming
-/// the file (and JSON pointer) when it cannot be read.
+/// The manifest of the session folder `folder`, its `session_id` the folder's name, its saved records checked
+/// against its plan (check_records_planned). Throws DataError naming the file (and JSON pointer) when it
+/// cannot be read.
 SessionManifest read_session_manifest(const std::filesystem::path& folder);
+
+/// Refuses a trial record in the session folder `folder` (trials/NAME.json) that `manifest`'s plan does not
+/// have: session.json was edited (its plan cut), or the record copied in. Every reader takes the trials the
+/// plan names, so such a record would be left out without a word. The trainer's free practice (its trials
+/// are made as they are practised) has no plan fixed in advance and is not checked. Throws DataError naming
+/// the record and the session.json's /plan.
+void check_records_planned(const std::filesystem::path& folder, const SessionManifest& manifest);
 
 /// The manifest of the session that `manifest` (the session in `folder`) follows, from the folder beside it.
 /// Throws DataError naming the file when it cannot be read or its session.json is not the one the link

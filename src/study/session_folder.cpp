@@ -20,6 +20,7 @@
 
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/printable_text.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/trial/options.hpp"
@@ -27,6 +28,7 @@
 #include "report/compressed_text.hpp"
 #include "study/manifest_json.hpp"
 #include "study/names.hpp"
+#include "study/saved_sessions.hpp"
 
 namespace calligraphy {
 namespace fs = std::filesystem;
@@ -389,29 +391,6 @@ std::optional<std::string> StudyIdentity::read(const fs::path& root) {
 }
 
 std::string StudyIdentity::obtain(const fs::path& root) {
-  // What a run on this host killed while it made the identity left: its temporary, named by its process.
-  const std::string temporary_prefix = std::string(kFileName) + ".tmp-";
-  const std::string own = partial_owner();
-  const std::string host = own.substr(own.find('.') + 1);
-  std::error_code listed;
-  for (const fs::directory_entry& entry : fs::directory_iterator(root, listed)) {
-    const std::string name = entry.path().filename().string();
-    if (!name.starts_with(temporary_prefix)) continue;
-    const std::string owner = name.substr(temporary_prefix.size());  // PID.HOST-RANDOM
-    const std::size_t dot = owner.find('.');
-    const std::size_t dash = owner.rfind('-');
-    if (dot == std::string::npos || dash == std::string::npos || dash < dot ||
-        owner.substr(dot + 1, dash - dot - 1) != host)
-      continue;
-    pid_t pid = 0;
-    try {
-      pid = static_cast<pid_t>(std::stol(owner.substr(0, dot)));
-    } catch (const std::exception&) {
-      continue;
-    }
-    if (pid <= 0 || pid == ::getpid() || ::kill(pid, 0) == 0 || errno != ESRCH) continue;
-    ::unlink(entry.path().c_str());
-  }
   if (std::optional<std::string> id = read(root)) return *std::move(id);
   make_folder(root);
   unsigned char bytes[16] = {};
@@ -422,61 +401,15 @@ std::string StudyIdentity::obtain(const fs::path& root) {
     if (n <= 0) fail_errno(root, "cannot draw the study folder's id (getrandom)", n < 0 ? errno : EIO);
     got += static_cast<std::size_t>(n);
   }
-  static constexpr char kHex[] = "0123456789abcdef";
-  std::string id;
-  for (const unsigned char b : bytes) {
-    id.push_back(kHex[b >> 4]);
-    id.push_back(kHex[b & 0xF]);
-  }
+  const std::string id = lower_hex(bytes);
   std::string text = R"({"format": "calligraphy-study", "version": 1, "study_id": ")";
   text.append(id).append("\"}\n");
-  // Written whole, then linked to its name: link(2) never replaces a file, so of two runs making it at once,
-  // the second reads the first one's id. An unnamed file (O_TMPFILE, linked through /proc/self/fd) leaves
-  // nothing behind whatever stops the run; where the file system has none, a temporary named by its process
-  // (removed above once that process is gone).
-  const fs::path path = root / kFileName;
-  int linked = -1;
-  int error = 0;
-  const int unnamed = ::open(root.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0644);
-  if (unnamed >= 0) {
-    try {
-      write_all(unnamed, text, path);
-      if (::fsync(unnamed) != 0) fail_errno(path, "cannot sync the study folder's identity", errno);
-    } catch (...) {
-      ::close(unnamed);
-      throw;
-    }
-    std::string proc = "/proc/self/fd/";
-    proc.append(std::to_string(unnamed));
-    linked = ::linkat(AT_FDCWD, proc.c_str(), AT_FDCWD, path.c_str(), AT_SYMLINK_FOLLOW);
-    error = errno;
-    ::close(unnamed);
-    if (linked != 0 && error != EEXIST && error != ENOENT)
-      fail_errno(path, "cannot write the study folder's identity", error);
-  }
-  if (unnamed < 0 || (linked != 0 && error == ENOENT)) {  // no O_TMPFILE here, or no /proc
-    std::string temporary_name = temporary_prefix;
-    temporary_name.append(own).append("-").append(id, 0, 8);
-    const fs::path temporary = root / temporary_name;
-    const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0644);
-    if (fd < 0) fail_errno(temporary, "cannot write the study folder's identity", errno);
-    try {
-      write_all(fd, text, temporary);
-      if (::fsync(fd) != 0) fail_errno(temporary, "cannot sync the study folder's identity", errno);
-    } catch (...) {
-      ::close(fd);
-      ::unlink(temporary.c_str());
-      throw;
-    }
-    ::close(fd);
-    linked = ::link(temporary.c_str(), path.c_str());
-    error = errno;
-    ::unlink(temporary.c_str());
-    if (linked != 0 && error != EEXIST) fail_errno(path, "cannot write the study folder's identity", error);
-  }
-  fsync_folder(root);
-  if (linked != 0) return read(root).value_or(id);
-  return id;
+  // Created whole or not at all, never replacing a file (core's exclusive writer): of two runs making it at
+  // once, the second reads the id the first one linked.
+  if (write_file_exclusively(root / kFileName, text)) return id;
+  if (std::optional<std::string> first = read(root)) return *std::move(first);
+  throw DataError((root / kFileName).string() +
+                  ": the study folder's identity was there and is gone: another program removes it?");
 }
 
 void StudyIdentity::check(const std::optional<std::string>& root_id, const fs::path& root,
@@ -527,9 +460,34 @@ SessionFolder SessionFolder::open(const fs::path& folder) {
   const fs::path manifest_path = SessionLayout::manifest(folder);
   const std::string text =
       study_detail::read_small_file(manifest_path, kMaxSessionManifestBytes, "session manifest");
-  SessionManifest manifest = study_detail::manifest_from_json(text, manifest_path.string());
+  // The session folder is what `session resume` was given: what its session.json holds is refused as a
+  // protocol's content is (InputError, "FILE: /pointer: what"); a file that cannot be read stays a DataError.
+  SessionManifest manifest;
+  try {
+    manifest = study_detail::manifest_from_json(text, manifest_path.string());
+  } catch (const InputError&) {
+    throw;
+  } catch (const DataError& e) {
+    throw InputError(e.what());
+  }
   manifest.session_id = folder.filename().string();
   if (manifest.session_id.empty()) manifest.session_id = folder.parent_path().filename().string();
+  // Trials are saved only into the session's own folders: one that is a symbolic link (or not a folder)
+  // would take the records, traces and the removal of leftovers somewhere else.
+  for (const fs::path& own :
+       {SessionLayout::trials(folder), SessionLayout::attempts(folder), SessionLayout::teachers(folder)}) {
+    struct stat status {};
+    if (::lstat(own.c_str(), &status) != 0) {
+      if (errno == ENOENT) continue;
+      fail_errno(own, "cannot read the session's folder", errno);
+    }
+    if (!S_ISDIR(status.st_mode)) {
+      throw InputError(own.string() + ": " + (S_ISLNK(status.st_mode) ? "a symbolic link" : "not a folder") +
+                       " where the session keeps its own folder: nothing is written through it; put the "
+                       "session's folder back in its place");
+    }
+  }
+  study_detail::check_records_planned(folder, manifest);
   const fs::path log_path = SessionLayout::log(folder);
   const int fd = open_locked_log(log_path);
   SessionFolder session(folder, std::move(manifest), fd);

@@ -3,10 +3,12 @@
 #include <openssl/evp.h>
 
 #include <array>
+#include <span>
 #include <string>
 #include <string_view>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/printable_text.hpp"
 #include "calligraphy/study/protocol.hpp"
 
 namespace calligraphy {
@@ -18,14 +20,7 @@ std::string sha256_hex(std::string_view bytes) {
       length != 32) {
     throw Error("SHA-256: OpenSSL's EVP_Digest failed");
   }
-  static constexpr char kHex[] = "0123456789abcdef";
-  std::string out;
-  out.reserve(2 * length);
-  for (unsigned int i = 0; i < length; ++i) {
-    out.push_back(kHex[digest[i] >> 4]);
-    out.push_back(kHex[digest[i] & 0xf]);
-  }
-  return out;
+  return lower_hex(std::span<const unsigned char>(digest.data(), length));
 }
 
 }  // namespace calligraphy

@@ -150,7 +150,7 @@ class ReaderConformance(unittest.TestCase):
 
     def check_cli(self, arguments, cwd, damaged, what, refused=1):
         """`refused`: the status of a refusal (1, damaged data; 2, the content of the file the command was given
-        as its input, `trial --spec`)."""
+        as its input: `trial --spec`, the session.json of `session resume DIR`)."""
         try:
             result = subprocess.run([CLI, *map(str, arguments)], cwd=cwd, capture_output=True, timeout=TIMEOUT_S)
         except subprocess.TimeoutExpired:
@@ -196,7 +196,8 @@ class ReaderConformance(unittest.TestCase):
                 copy, damaged = self.damaged_copy(manifest, content)
                 self.check_cli(["report", "study", "--csv", "tables"], copy, damaged, what)
                 self.check_cli(["curriculum", "study", "--subject", "S01", "--from", "十人大"], copy, damaged, what)
-                self.check_cli(["session", "resume", damaged.parent], copy, damaged, what)
+                # the session.json of the folder `session resume` is given: its content is the command's input
+                self.check_cli(["session", "resume", damaged.parent], copy, damaged, what, refused=2)
                 self.check_python(lambda: calligraphy.study.load(copy / "study"), damaged, what)
 
     def check_trace_readers(self, copy, damaged, what):

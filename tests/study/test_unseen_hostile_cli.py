@@ -748,7 +748,8 @@ class StudySurfaces(Hostile):
         if manifest.read_text(encoding="utf-8") == text:
             self.skipTest("the protocol copy is not stored as text here")
         before = digest_tree(study)
-        self.refused(self.cli("session", "resume", session), 1, "session.json")
+        # what the session.json of the folder given holds: refused as a protocol's content is (exit 2)
+        self.refused(self.cli("session", "resume", session), 2, "session.json", "/protocol/text")
         self.assertEqual(digest_tree(study), before)
 
     def test_resume_does_not_append_through_a_log_linked_outside(self):
@@ -776,7 +777,8 @@ class StudySurfaces(Hostile):
                             encoding="utf-8")
         self.assertNotEqual(manifest.read_text(encoding="utf-8"), text)
         before = digest_tree(study)
-        self.refused(self.cli("session", "resume", session), 1, "session.json", "/pacing")
+        # the content of the session folder the command was given: refused as a protocol's is (exit 2)
+        self.refused(self.cli("session", "resume", session), 2, "session.json", "/pacing")
         self.assertEqual(digest_tree(study), before)
 
     def test_resume_of_a_session_json_that_is_a_folder_is_named(self):

@@ -31,6 +31,17 @@ namespace calligraphy {
 /// fails: the folder cannot hold a temporary file, a write, fsync, close or the rename fails.
 void write_file_atomically(const std::filesystem::path& path, std::string_view content);
 
+/// Creates `path` with `content`, never replacing anything: the content is written whole and fsync'ed in an
+/// unnamed file of the folder (O_TMPFILE; where the file system has none, a temporary named by this process,
+/// created with O_EXCL | O_NOFOLLOW), then linked to its name (linkat(2), which fails rather than replace a
+/// file, a symbolic link or a folder there), and the folder is fsync'ed. Returns true when it made the file,
+/// false when `path` existed already (nothing written: a file another writer made first is kept, so of two
+/// writers racing, the second reads the first one's). A process stopped at any moment leaves no partial file
+/// under `path`: at worst a named temporary, which the next call for `path` removes once its process is gone.
+/// Permissions: 0666 less the umask. Throws DataError naming `path` and the system's reason when a step fails
+/// (the folder is missing or read-only, the disk is full): a failed write is an error, and leaves no file.
+[[nodiscard]] bool write_file_exclusively(const std::filesystem::path& path, std::string_view content);
+
 /// The path a write to `path` replaces or creates: symbolic links followed one by one (a relative target
 /// read from the link's folder), a dangling link to the path it names, any other path as it is. Throws
 /// DataError naming `path` when a link cannot be read or there are more than 40 links in a chain (ELOOP).

@@ -3,6 +3,7 @@
 /// Text from outside (a file name, a device name, a field of a damaged file) made safe to print on one line
 /// of a terminal or a log: an error message is one line that a person can read, whatever it quotes.
 #include <cstddef>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -20,5 +21,9 @@ inline constexpr std::size_t kMaxMessageBytes = 2000;
 ///  - past `max_bytes` the text is cut at a character boundary and " ... (N more bytes)" says how much.
 /// Never throws but std::bad_alloc.
 std::string printable_one_line(std::string_view text, std::size_t max_bytes = kMaxMessageBytes);
+
+/// `bytes` as lower-case hexadecimal text, two digits a byte, most significant first ({0x0f, 0xa0} ->
+/// "0fa0"): how a SHA-256 and a study folder's id are written.
+[[nodiscard]] std::string lower_hex(std::span<const unsigned char> bytes);
 
 }  // namespace calligraphy

@@ -107,9 +107,9 @@ struct StudyIdentity {
   /// had one, or none yet). Throws DataError naming the file when it is damaged, not a regular file, or not
   /// this program's.
   [[nodiscard]] static std::optional<std::string> read(const std::filesystem::path& root);
-  /// The id of `root`, made when it has none (written whole to a temporary file, fsync'ed and linked to its
-  /// name, so two runs that make it at once agree on the one linked first). Throws DataError as `read`, and
-  /// naming the file when it cannot be written.
+  /// The id of `root`, made when it has none (`write_file_exclusively`: written whole, fsync'ed and linked to
+  /// its name, never replacing one, so two runs that make it at once agree on the one linked first). Throws
+  /// DataError as `read`, and naming the file when it cannot be written.
   [[nodiscard]] static std::string obtain(const std::filesystem::path& root);
   /// Refuses the session in `folder` (its session.json read as `manifest`) when it names another study than
   /// `root_id`, the id of the study folder it lies in: copied in from another study folder. A session
@@ -174,8 +174,11 @@ class SessionFolder {
                               const LoadedProtocol& protocol,
                               const std::optional<PreviousSession>& previous = std::nullopt);
   /// Opens an existing session: reads session.json (the plan recorded there is the plan), checks the
-  /// protocol copy against its SHA-256 and locks the log. Throws DataError naming the file and JSON
-  /// pointer for a missing or damaged session.json, StateError when another process has the session open.
+  /// protocol copy against its SHA-256 and locks the log. Throws DataError naming the file when session.json
+  /// cannot be read, InputError (a DataError) naming the file and JSON pointer for what its content holds
+  /// that is refused, InputError naming `trials/`, `trials/attempts/` or `teachers/` when one is a symbolic
+  /// link or not a folder, DataError naming a saved record the plan does not have
+  /// (check_records_planned), StateError when another process has the session open.
   static SessionFolder open(const std::filesystem::path& folder);
 
   SessionFolder(SessionFolder&& other) noexcept;
