@@ -17,6 +17,21 @@
 
 namespace calligraphy {
 
+namespace {
+
+// TrialSpec's range of rate_hz up to the real-time loop's highest rate: a protocol's trials may be written
+// by a person, in real time. The one deliberate difference from the specification's range.
+ParameterRange protocol_rate_range() noexcept {
+  ParameterRange range = SchemaOf<TrialSpec>::get().field("rate_hz")->range;
+  if (kMaxRealTimeServoRateHz < range.high) {
+    range.high = kMaxRealTimeServoRateHz;
+    range.high_open = false;
+  }
+  return range;
+}
+
+}  // namespace
+
 const Schema& SchemaOf<ProtocolTrialSettings>::get() {
   using T = ProtocolTrialSettings;
   // TrialSpec's range of the same value: a session's trials are TrialSpecs.
@@ -24,8 +39,7 @@ const Schema& SchemaOf<ProtocolTrialSettings>::get() {
       number_field<&T::max_duration_s>("max_duration_s",
                                        SchemaOf<TrialSpec>::get().field("max_duration_s")->range,
                                        {.unit = "s", .doc = "every trial ends after this much device time"}),
-      // A protocol's trials may run in real time with a person: the real-time range.
-      number_field<&T::rate_hz>("rate_hz", {.low = kMinServoRateHz, .high = kMaxRealTimeServoRateHz},
+      number_field<&T::rate_hz>("rate_hz", protocol_rate_range(),
                                 {.unit = "Hz", .doc = "servo rate of every trial (real-time range)"}),
   };
   static const Schema schema{.name = "ProtocolTrialSettings",

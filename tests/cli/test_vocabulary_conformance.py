@@ -17,8 +17,16 @@ command line's typed options and for Python.
     `TrialResult.to_dataframe()` and `Study.samples()` name the columns by the table's names; `calligraphy
     score` and Python's `score` read a trace named either way to the same metrics.
 
-The cases are made only from the program's output (the schema, `trial --help`, `calligraphy devices`), never
-from a list written here. Under CALLIGRAPHY_SANITIZED=1 every third bound case is taken (deterministically).
+(d) A protocol is a reader too: every bounded number of `calligraphy schema protocol` (its trial settings,
+    breaks, order, practice and test, each phase, each condition and its mode's parameters, a quiz's
+    acceptance, a transfer test's choice) is taken by `session plan` at each closed bound and refused just past
+    each bound (exit 2, one line naming the file and the JSON pointer); and a field of the protocol's trial
+    settings or of a condition named as a specification field has the specification's type and range, but for
+    the one exception the schema states (a protocol's `rate_hz` is the real-time range).
+
+The cases are made only from the program's output (the schema, `trial --help`, `calligraphy devices`,
+`calligraphy characters`), never from a list written here; the protocol's fields are tried in two small
+protocols written here, one of each form. Under CALLIGRAPHY_SANITIZED=1 every third bound case is taken (deterministically).
 Run by CTest as `cli_vocabulary_conformance_tests`; CALLIGRAPHY_CLI names the program and PYTHONPATH the
 built Python package.
 """
@@ -68,6 +76,94 @@ def past_and_at(prop):
             if bound in prop:
                 past.append(prop[bound])
     return at, past
+
+
+
+# The protocol (`calligraphy schema protocol`, read by `session plan`) --------------------------------------------
+BOUNDS = ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum")
+
+
+def protocol_bounded_fields(schema):
+    """Every bounded numeric property of the protocol's JSON Schema as (steps, property): steps lead from the
+    document's root to it, each ("key", name), ("item",) (an array's element), ("mode", spelling) (a
+    condition's mode whose rule allows it) or ("branch", schema) (the alternative of a oneOf it is in)."""
+    found = []
+
+    def resolve(node):
+        while isinstance(node, dict) and "$ref" in node:
+            node = schema["$defs"][node["$ref"].rsplit("/", 1)[1]]
+        return node
+
+    def walk(node, steps):
+        node = resolve(node)
+        if not isinstance(node, dict):
+            return
+        if node.get("type") in ("integer", "number") and any(bound in node for bound in BOUNDS):
+            found.append((steps, node))
+        rules = [(rule["if"]["properties"]["mode"]["const"], rule["then"]) for rule in node.get("allOf", [])
+                 if "const" in rule.get("if", {}).get("properties", {}).get("mode", {}) and "then" in rule]
+        for key, child in node.get("properties", {}).items():
+            # A property some modes forbid is tried under the first mode that allows it.
+            allowed = [mode for mode, then in rules if then.get("properties", {}).get(key) is not False]
+            mode = [("mode", allowed[0])] if len(allowed) < len(rules) and allowed else []
+            walk(child, steps + mode + [("key", key)])
+        if "items" in node:
+            walk(node["items"], steps + [("item",)])
+        for alternative in node.get("oneOf", []):
+            walk(alternative, steps + [("branch", resolve(alternative))])
+        for rule in node.get("allOf", []):
+            mode = rule.get("if", {}).get("properties", {}).get("mode", {}).get("const")
+            if mode is not None and "then" in rule:
+                walk(rule["then"], steps + [("mode", mode)])
+
+    walk(schema, [])
+    return found
+
+
+def place(document, steps, value):
+    """Sets the value `steps` lead to in `document` (making the objects on the way) and gives its JSON
+    pointer and the object holding it."""
+    pointer, cursor = "", document
+    for at, step in enumerate(steps):
+        rest = steps[at + 1:]
+        if step[0] == "key":
+            if step[1] not in cursor or not isinstance(cursor[step[1]], (dict, list)) and rest:
+                cursor[step[1]] = [] if rest and rest[0][0] == "item" else {}
+            pointer += "/" + step[1]
+            if rest:
+                cursor = cursor[step[1]]
+            else:
+                cursor[step[1]] = value
+        elif step[0] == "item":
+            # The first element that already has the rest of the way (a condition of the mode, a phase whose
+            # characters are a choice), else the first.
+            index = step[1] if len(step) > 1 else next(
+                (i for i, element in enumerate(cursor) if has_way(element, rest)), 0)
+            pointer += f"/{index}"
+            cursor = cursor[index]
+        elif step[0] == "mode" and cursor.get("mode") != step[1]:
+            for key in ("parameters", "quiz", "teachers"):
+                cursor.pop(key, None)
+            cursor["mode"] = step[1]
+    return pointer, cursor
+
+
+def has_way(element, steps):
+    """Whether `element` already has the way `steps` lead (keys present, the mode and the branch's type)."""
+    for step in steps:
+        if step[0] == "key":
+            if not isinstance(element, dict) or step[1] not in element:
+                return False
+            element = element[step[1]]
+        elif step[0] == "item":
+            if not isinstance(element, list) or not element:
+                return False
+            element = element[0]
+        elif step[0] == "mode" and element.get("mode") != step[1]:
+            return False
+        elif step[0] == "branch" and (step[1].get("type") == "object") != isinstance(element, dict):
+            return False
+    return True
 
 
 class VocabularyTest(unittest.TestCase):
@@ -281,6 +377,118 @@ class VocabularyTest(unittest.TestCase):
                                      + ", ".join(f"{form} {'takes' if v else 'refuses'} it" for form, v in wrong.items()))
         print(f"bound verdicts checked: {checked} over {len(cases)} values")
         self.assertEqual(disagreements, [], "\n".join(disagreements))
+
+    # (a) for the protocol -------------------------------------------------------------------------------------
+    def base_protocols(self):
+        """Two small protocols `session plan` takes, one of each form: the paper's practice and test, and
+        phases over item sets with a transfer test chosen by coverage."""
+        paper = {"format": "calligraphy-study-protocol", "version": 1, "name": "vocabulary",
+                 "conditions": [{"name": "A", "mode": "haptic"}],
+                 "practice": {"characters": [CHARS], "condition": "A"},
+                 "test": {"characters": [CHARS], "conditions": ["A"], "repetitions": 1}}
+        phased = {"format": "calligraphy-study-protocol", "version": 1, "name": "vocabulary",
+                  "conditions": [{"name": "A", "mode": "haptic"}, {"name": "B", "mode": "vision"}],
+                  "item_sets": [{"name": "trained", "characters": [CHARS]}],
+                  "phases": [{"phase": "training", "condition": "A", "sets": ["trained"]},
+                             {"phase": "transfer", "condition": "B", "characters": {"choose": 1, "from": ["二"]}}]}
+        return paper, phased
+
+    def plan(self, document, name="protocol.json"):
+        (self.cwd / name).write_text(json.dumps(document, ensure_ascii=False), encoding="utf-8")
+        return self.run_cli("session", "plan", name, "--subjects", "1")
+
+    def test_every_protocol_bound_gets_the_schemas_verdict_from_session_plan(self):
+        """Every bounded number of `calligraphy schema protocol` (nested objects, arrays' elements, a
+        condition's mode's parameters and a transfer test's choice included) is taken by `session plan` at
+        each closed bound and refused just past each bound: exit 2, one line naming the file and the JSON
+        pointer. A value whose validity rests on another is given that other so that only the range is
+        tried (each named below)."""
+        protocol_schema = json.loads(self.run_cli("schema", "protocol").stdout)
+        bases = self.base_protocols()
+        for base in bases:
+            planned = self.plan(base)
+            self.assertEqual(planned.returncode, 0, planned.stderr.decode())
+        # A transfer test chooses among characters not trained made of trained typical strokes: for a choice
+        # of up to 1000, training on characters that have every typical stroke (`calligraphy characters`).
+        listed = json.loads(self.run_cli("characters", "--json").stdout)["characters"]
+        cover, strokes = [], set()
+        for entry in sorted(listed, key=lambda c: -len(set(c["typical_ids"]))):
+            if not set(entry["typical_ids"]) <= strokes:
+                cover.append(entry["character"])
+                strokes |= set(entry["typical_ids"])
+        candidates = [c["character"] for c in listed if c["character"] not in cover]
+        rate = protocol_schema["$defs"]["ProtocolTrialSettings"]["properties"]["rate_hz"]
+        cases = []
+        for steps, prop in protocol_bounded_fields(protocol_schema):
+            at, past = past_and_at(prop)
+            cases += [(steps, value, True) for value in at] + [(steps, value, False) for value in past]
+        if SANITIZED:
+            cases = cases[::3]
+        self.assertGreaterEqual(len(cases), 20 if SANITIZED else 60)
+        disagreements, pointers = [], set()
+        for steps, value, valid in cases:
+            base = next((b for b in bases if has_way(b, steps[:1])), bases[0])
+            document = copy.deepcopy(base)
+            key = steps[-1][1]
+            if key == "session" and steps[0] == ("key", "phases"):
+                # Sessions are numbered from 1 without gaps: the last phase is tried, after a phase in each
+                # session before it (at most 20 phases).
+                document["phases"][1:1] = [{"phase": "retention", "condition": "B", "characters": [CHARS],
+                                            "session": n, "delay_s": 86400}
+                                           for n in range(2, min(int(value), 20))]
+                steps = [steps[0], ("item", len(document["phases"]) - 1), steps[-1]]
+            pointer, holder = place(document, steps, value)
+            pointers.add(pointer)
+            if key == "max_duration_s":
+                # At most 10^7 servo ticks a trial: the longest trial at the lowest rate.
+                document.setdefault("trial", {})["rate_hz"] = rate["minimum"]
+            if key == "choose":
+                # A choice among as many candidates as it chooses (characters the library has, none trained).
+                holder["from"] = candidates[:max(1, min(int(value), 1000))]
+                document["item_sets"][0]["characters"] = cover
+            if key == "min_band_m":
+                # The widest band is at least the narrowest.
+                holder["max_band_m"] = max(value, holder.get("max_band_m", 0.0))
+            if key == "every_trials" and value > 0:
+                # A rest every so many trials has a duration.
+                holder["duration_s"] = 1.0
+            result = self.plan(document)
+            stderr = result.stderr.decode()
+            if (result.returncode == 0) != valid:
+                disagreements.append(f"{pointer} = {value!r} ({'valid' if valid else 'invalid'}): session plan "
+                                     f"{'takes' if result.returncode == 0 else 'refuses'} it: {stderr.strip()}")
+            elif not valid and (result.returncode != 2 or f"protocol.json: {pointer}:" not in stderr
+                                or len(stderr.strip().splitlines()) != 1):
+                disagreements.append(f"{pointer} = {value!r}: refused with exit {result.returncode} and "
+                                     f"not one line naming the file and the pointer: {stderr.strip()}")
+        print(f"protocol bound verdicts checked: {len(cases)} over {len(pointers)} pointers")
+        self.assertEqual(disagreements, [], "\n".join(disagreements))
+
+    def test_a_protocols_trial_fields_have_the_specifications_ranges(self):
+        """A field of a protocol's trial settings or of a condition (its parameters included) that has the
+        name of a specification field has its type and range, but for the one exception the schema states:
+        a protocol's trials may be written by a person, in real time, so its `rate_hz` (described as the
+        real-time range) ends at the real-time rate `trial --help` states for --rate."""
+        protocol_schema = json.loads(self.run_cli("schema", "protocol").stdout)
+        real_time = re.search(r"real-time pacing: at most (\d+) Hz", self.options.get("--rate", ""))
+        self.assertIsNotNone(real_time, f"trial --help, --rate: {self.options.get('--rate')}")
+        pairs, differences = [], []
+        for steps, prop in protocol_bounded_fields(protocol_schema):
+            key = steps[-1][1]
+            if key not in self.fields or steps[0][1] not in ("trial", "conditions"):
+                continue
+            pairs.append("/".join(f"({s[1]})" if s[0] == "mode" else s[1] if s[0] == "key" else "*" for s in steps))
+            spec = self.fields[key]
+            mine = {b: prop[b] for b in ("type", *BOUNDS) if b in prop}
+            theirs = {b: spec[b] for b in ("type", *BOUNDS) if b in spec}
+            if key == "rate_hz" and "real-time range" in prop.get("description", ""):
+                self.assertLess(float(real_time.group(1)), theirs["maximum"])
+                theirs["maximum"] = float(real_time.group(1))
+            if mine != theirs:
+                differences.append(f"{pairs[-1]}: protocol {mine}, specification {theirs}")
+        print("protocol fields checked against the specification's: " + ", ".join(pairs))
+        self.assertGreaterEqual(len(pairs), 3)
+        self.assertEqual(differences, [], "\n".join(differences))
 
     # (b) ------------------------------------------------------------------------------------------------
     def test_every_spelling_is_taken_and_written_back_by_every_reader(self):
