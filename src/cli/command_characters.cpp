@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "calligraphy/core/printable_text.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
 #include "cli/commands.hpp"
@@ -139,8 +140,14 @@ int run_characters(const CharactersCommand& command) {
            "; library: " + source.description() + "\n";
   if (!not_found.empty()) {
     std::string missing;
-    for (char32_t c : not_found) missing += encode_utf8(c);
-    table += "not in the library: " + missing + "\n";
+    // Each with its code point, as printable text: the text is the user's, and a control character (an
+    // escape sequence), a combining mark or a variation selector would otherwise act on the terminal or
+    // vanish into its neighbour.
+    for (char32_t c : not_found) {
+      if (!missing.empty()) missing += ", ";
+      missing.append(printable_one_line(encode_utf8(c))).append(" (").append(code_point_text(c)).append(")");
+    }
+    table.append("not in the library: ").append(printable_one_line(missing, missing.size())).append("\n");
   }
   write_standard_output(table);
   return 0;
