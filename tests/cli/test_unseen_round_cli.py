@@ -14,6 +14,7 @@ on PYTHONPATH (its cases are skipped without it). Standard library, numpy and h5
 """
 import gzip
 import json
+import math
 import os
 import resource
 import shutil
@@ -147,6 +148,11 @@ class CharactersCases(UnseenCase):
         table = self.cli("characters", "--text", "\x1b[31m" + YONG)
         self.assert_ok(table)
         self.assertNotIn(b"\x1b", table.stdout + table.stderr)
+
+    def test_white_space_of_every_kind_is_skipped(self):
+        listed = self.characters("永\u00a0我\u3000二\t\u2003八\u202f\u2028")
+        self.assertEqual([c["character"] for c in listed["characters"]], ["永", "我", "二", "八"])
+        self.assertEqual(listed["not_found"], [])
 
     def test_long_text_each_character_once(self):
         # Linux limits one argument to 128 KiB (MAX_ARG_STRLEN): a 10 MB argument never reaches the program.
@@ -299,13 +305,19 @@ class ScoreCases(UnseenCase):
 
     def test_duplicated_times_are_refused_or_scored_finite(self):
         header = self.lines[0].split(",")
-        previous_t = self.lines[300].split(",")[header.index("t")]
-        trace = self.write("dup.csv", self.replace_value(300, "t", previous_t))
+        down = [i for i, line in enumerate(self.lines[1:]) if float(line.split(",")[header.index("z")]) <= 0.0004]
+        row = down[len(down) // 2]  # while the pen writes: speeds and jerk divide by the time steps
+        previous_t = self.lines[row].split(",")[header.index("t")]
+        trace = self.write("dup.csv", self.replace_value(row, "t", previous_t))
         result, document = self.score_json(trace)
         if result.returncode == 0:
             self.assertEqual(document["samples"], len(self.lines) - 1)
+            for stroke in document["per_character"][0]["per_stroke"]:
+                for key in ("mean_speed_m_s", "normalised_jerk", "velocity_peaks", "mean_deviation_m"):
+                    value = stroke.get(key)
+                    self.assertTrue(value is None or math.isfinite(value), (key, value))
         else:
-            self.assert_error(result, 1, "dup.csv:302")
+            self.assert_error(result, 1, f"dup.csv:{row + 2}")
 
     def test_trace_over_the_size_limit_is_refused_unread(self):
         trace = self.cwd / "huge.csv"
