@@ -426,6 +426,12 @@ class TrialOptionCases(UnseenCase):
             with self.subTest(option=option, value=value):
                 self.assert_error(self.check(f"{option}={value}"), 2, option)
 
+    def test_refused_number_is_not_called_infinite(self):
+        for value in ("+400", " 400", "0x190"):
+            with self.subTest(value=value):
+                result = self.check(f"--guidance-stiffness={value}")
+                self.assert_error(result, 2, "--guidance-stiffness", "decimal")
+
     def test_repeated_option(self):
         self.assert_error(self.check("--seed", "3", "--seed", "4"), 2, "--seed")
 
