@@ -386,6 +386,12 @@ class TraceCases(UnseenCase):
         (self.cwd / "a.trace.h5").write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(200))
         self.assert_error(self.cli("trace", "a.trace.h5"), 1, "a.trace.h5")
 
+    def test_device_or_folder_is_named_as_what_it_is(self):
+        self.assert_error(self.cli("trace", "/dev/zero"), 1, "/dev/zero", "not a regular file")
+        (self.cwd / "d.trace.h5").mkdir()
+        self.assert_error(self.cli("trace", "d.trace.h5"), 1, "d.trace.h5", "not a regular file")
+        self.assert_error(self.cli("score", "/dev/zero", "--character", YONG), 1, "/dev/zero", "not a regular file")
+
     def test_empty_file(self):
         (self.cwd / "a.trace.h5").write_bytes(b"")
         self.assert_error(self.cli("trace", "a.trace.h5"), 1, "a.trace.h5")
