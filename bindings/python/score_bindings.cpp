@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "arguments.hpp"
@@ -100,7 +101,21 @@ std::vector<PenSample> samples_from_columns(const py::object& columns, TraceUnit
   const Column contact = column(columns, pen_column ? "pen" : z_key.c_str());
   const py::ssize_t n = t.shape(0);
   if (x.shape(0) != n || y.shape(0) != n || contact.shape(0) != n) {
-    throw InvalidArgument("trace: the columns have different lengths");
+    std::string lengths;
+    const std::array<std::pair<const std::string*, py::ssize_t>, 4> given{
+        {{&keys[0], n}, {&keys[1], x.shape(0)}, {&keys[2], y.shape(0)}, {nullptr, contact.shape(0)}}};
+    for (const auto& [key, length] : given) {
+      if (!lengths.empty()) lengths += ", ";
+      lengths.append("'").append(key ? *key : (pen_column ? std::string("pen") : z_key)).append("' ");
+      lengths.append(std::to_string(length));
+    }
+    throw InvalidArgument("trace: the columns have different lengths (" + lengths + ")");
+  }
+  // The limit a CSV or HDF5 trace has (docs/cli.md, "Pen traces: format and limits"), so that the same
+  // samples are scored or refused alike from a file and from columns.
+  if (const std::size_t limit = PenTraceCsvOptions{}.max_samples; static_cast<std::size_t>(n) > limit) {
+    throw InvalidArgument("trace: " + std::to_string(n) + " samples, more than " + std::to_string(limit) +
+                          " samples, the limit of one trace");
   }
   std::vector<PenSample> samples(static_cast<std::size_t>(n));
   for (py::ssize_t i = 0; i < n; ++i) {
