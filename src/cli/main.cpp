@@ -122,6 +122,11 @@ int main(int argc, char** argv) {
           message = flag.size() == 1 ? "-" : "--";
           message.append(flag).append(": a flag takes no value");
         }
+        // An option left without its value (`--svg` last, `--svg=`): CLI11 says "--svg: 1 required  missing".
+        if (const auto required = message.find(": 1 required ");
+            required != std::string::npos && message.ends_with(" missing")) {
+          message = message.substr(0, required) + ": expects a value, none was given";
+        }
       }
       print_error(name, message);
       return 2;

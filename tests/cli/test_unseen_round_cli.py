@@ -243,6 +243,14 @@ class ModelCases(UnseenCase):
         self.assertEqual(result.returncode, 1, result.stderr.decode(errors="replace"))
         self.assertIn(": error: ", result.stderr.decode(errors="replace"))
 
+    def test_svg_without_its_value(self):
+        for args in (["--svg"], ["--svg="]):
+            with self.subTest(args=args):
+                result = self.cli("model", YONG, *args)
+                self.assert_error(result, 2, "--svg", "value")
+                self.assertNotIn("  ", result.stderr.decode())
+        self.assertEqual(self.leftovers(), [])
+
     def test_repeated_svg(self):
         self.assert_error(self.cli("model", YONG, "--svg=a.svg", "--svg=b.svg"), 2, "--svg")
         self.assertEqual(self.leftovers(), [])
