@@ -139,6 +139,10 @@ std::vector<PenSample> samples_from_columns(const py::object& columns, TraceUnit
 py::dict score_py(const py::object& trace, const py::object& character, const std::string& units_name,
                   const std::optional<PyArgument<CharacterSource>>& library, double contact_threshold_m,
                   const std::optional<PyArgument<StrokeAcceptance>>& acceptance, double start_radius_m) {
+  // The spellings this function documents and the command line's --units takes: "m" or "data".
+  if (units_name != "m" && units_name != "data")
+    throw InvalidArgument("units: '" + units_name +
+                          "' is neither 'm' (metres) nor 'data' (the 1024-unit box)");
   const TraceUnits units = parse_trace_units(units_name == "m" ? "metres" : units_name);
   Character model;
   if (py::isinstance<Character>(character)) {
@@ -156,8 +160,11 @@ py::dict score_py(const py::object& trace, const py::object& character, const st
 
   std::vector<PenSample> samples;
   std::string trace_name = "<columns>";
-  if (py::isinstance<py::str>(trace) || py::isinstance(trace, py::module_::import("os").attr("PathLike"))) {
-    trace_name = py::str(py::module_::import("os").attr("fspath")(trace));
+  const py::module_ os = py::module_::import("os");
+  if (py::isinstance<py::str>(trace) || py::isinstance<py::bytes>(trace) ||
+      py::isinstance(trace, os.attr("PathLike"))) {
+    // A path as str, bytes or path-like object (os.fsdecode: the file system's encoding, as open() reads it).
+    trace_name = py::str(os.attr("fsdecode")(trace));
     PenTraceCsvOptions options;
     options.units = units;
     options.contact_threshold_m = contact_threshold_m;

@@ -607,6 +607,15 @@ class PythonCases(unittest.TestCase):
         result = cg.score(frame, YONG)
         self.assertEqual(result["strokes_accepted"], self.reference["strokes_accepted"])
 
+    def test_score_units_and_paths(self):
+        with self.assertRaises(ValueError) as caught:
+            cg.score(self.columns, YONG, units="mm")
+        self.assertIn("units", str(caught.exception))
+        self.assertIn("'m'", str(caught.exception))
+        trace = str(Shared.get())
+        by_bytes = cg.score(os.fsencode(trace), YONG)
+        self.assertEqual(by_bytes["strokes_accepted"], cg.score(Path(trace), YONG)["strokes_accepted"])
+
     def test_load_wrong_types_and_text(self):
         library = cg.CharacterLibrary.default()
         with self.assertRaises(TypeError):
