@@ -526,6 +526,14 @@ class PythonCases(unittest.TestCase):
         with self.assertRaises(TypeError):
             cg.simulate_trial(12345)
 
+    def test_simulate_trial_characters_of_wrong_kinds(self):
+        with self.assertRaises(TypeError) as caught:
+            cg.simulate_trial([YONG, 3])
+        self.assertIn("characters[0]", str(caught.exception))
+        with self.assertRaises(ValueError) as caught:
+            cg.simulate_trial("\ud800")
+        self.assertIn("characters", str(caught.exception))
+
     def test_simulate_trial_nan_and_negative(self):
         for name, value in (("rate_hz", float("nan")), ("max_duration_s", float("nan")),
                             ("max_duration_s", -1.0), ("rate_hz", float("inf"))):
