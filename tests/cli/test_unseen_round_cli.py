@@ -28,6 +28,12 @@ SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().
 DATA = SOURCE / "data" / "hanzi-writer-data"
 YONG = "永"
 TIMEOUT_S = 60
+# Under the sanitizers (ten times slower) the lists of spellings are tried one in three.
+SANITIZED = os.environ.get("CALLIGRAPHY_SANITIZED") == "1"
+
+
+def sample(cases):
+    return cases[::3] if SANITIZED else cases
 
 try:
     import numpy as np
@@ -161,7 +167,7 @@ class CharactersCases(UnseenCase):
         self.assertEqual(listed["count"], 1)
 
     def test_stroke_counts_out_of_range_or_misspelt(self):
-        for value in ("0", "256", "0x5", " 5", "5 ", "-0", "1e1", "+5", "٥"):
+        for value in sample(["0", "256", "0x5", " 5", "5 ", "-0", "1e1", "+5", "٥"]):
             with self.subTest(value=value):
                 self.assert_error(self.cli("characters", "--strokes", value), 2, "--strokes")
 
@@ -436,7 +442,7 @@ class TrialOptionCases(UnseenCase):
                  ("--max-duration", "nan"), ("--guidance-stiffness", "1,5"), ("--guidance-stiffness", " 400"),
                  ("--guidance-stiffness", "400 "), ("--guidance-stiffness", "0x1p8"), ("--rate", "99"),
                  ("--guidance-stiffness", "-1"), ("--rate", "１０００")]
-        for option, value in cases:
+        for option, value in sample(cases):
             with self.subTest(option=option, value=value):
                 self.assert_error(self.check(f"{option}={value}"), 2, option)
 
