@@ -155,6 +155,13 @@ T convert_named(py::handle value, const std::string& name) {
     if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
       if (PyLong_Check(value.ptr())) throw_out_of_range<T>(name, value);
     }
+    if constexpr (std::is_same_v<T, std::string>) {
+      // A str that UTF-8 cannot encode ('\ud800', a lone surrogate) is of the right type and a wrong value.
+      if (PyUnicode_Check(value.ptr())) {
+        throw InvalidArgument(name + ": " + short_repr(value) +
+                              " is not valid Unicode text (a lone surrogate has no UTF-8 encoding)");
+      }
+    }
     throw_type_error(name, python_type_name<T>(), value);
   }
 }

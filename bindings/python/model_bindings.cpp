@@ -13,12 +13,12 @@
 
 #include "bindings.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/model/corpus_store.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
 #include "character_source.hpp"
-#include "calligraphy/core/unicode.hpp"
 #include "numpy_arrays.hpp"
 #include "parameter_class.hpp"
 
@@ -40,7 +40,7 @@ std::vector<Character> characters_from(py::handle object, const CharacterSource&
                                        const std::string& name) {
   std::vector<Character> characters;
   if (py::isinstance<py::str>(object)) {
-    const std::u32string text = decode_utf8(object.cast<std::string>());
+    const std::u32string text = decode_utf8(convert_named<std::string>(object, name));
     check_scene_size(text.size(), name);   // before loading any
     std::map<char32_t, Character> loaded;  // each character loaded once
     for (char32_t c : text) {
@@ -52,10 +52,14 @@ std::vector<Character> characters_from(py::handle object, const CharacterSource&
     characters.push_back(object.cast<Character>());
   } else if (py::isinstance<py::sequence>(object) && !py::isinstance<py::bytes>(object)) {
     check_scene_size(py::len(object), name);
+    std::size_t index = 0;
     for (const py::handle item : object) {
+      // The item at fault, by its index: the sequence itself is of a type this argument takes.
       if (!py::isinstance<Character>(item)) {
-        throw_type_error(name, "a str, a Character or a sequence of Characters", item);
+        throw_type_error(name + "[" + std::to_string(index) + "]",
+                         "a Character (a sequence holds Characters; characters as text are one str)", item);
       }
+      ++index;
       characters.push_back(item.cast<Character>());
     }
   } else {

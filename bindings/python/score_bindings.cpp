@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "arguments.hpp"
@@ -100,7 +101,21 @@ std::vector<PenSample> samples_from_columns(const py::object& columns, TraceUnit
   const Column contact = column(columns, pen_column ? "pen" : z_key.c_str());
   const py::ssize_t n = t.shape(0);
   if (x.shape(0) != n || y.shape(0) != n || contact.shape(0) != n) {
-    throw InvalidArgument("trace: the columns have different lengths");
+    std::string lengths;
+    const std::array<std::pair<const std::string*, py::ssize_t>, 4> given{
+        {{&keys[0], n}, {&keys[1], x.shape(0)}, {&keys[2], y.shape(0)}, {nullptr, contact.shape(0)}}};
+    for (const auto& [key, length] : given) {
+      if (!lengths.empty()) lengths += ", ";
+      lengths.append("'").append(key ? *key : (pen_column ? std::string("pen") : z_key)).append("' ");
+      lengths.append(std::to_string(length));
+    }
+    throw InvalidArgument("trace: the columns have different lengths (" + lengths + ")");
+  }
+  // The limit a CSV or HDF5 trace has (docs/cli.md, "Pen traces: format and limits"), so that the same
+  // samples are scored or refused alike from a file and from columns.
+  if (const std::size_t limit = PenTraceCsvOptions{}.max_samples; static_cast<std::size_t>(n) > limit) {
+    throw InvalidArgument("trace: " + std::to_string(n) + " samples, more than " + std::to_string(limit) +
+                          " samples, the limit of one trace");
   }
   std::vector<PenSample> samples(static_cast<std::size_t>(n));
   for (py::ssize_t i = 0; i < n; ++i) {
@@ -124,6 +139,10 @@ std::vector<PenSample> samples_from_columns(const py::object& columns, TraceUnit
 py::dict score_py(const py::object& trace, const py::object& character, const std::string& units_name,
                   const std::optional<PyArgument<CharacterSource>>& library, double contact_threshold_m,
                   const std::optional<PyArgument<StrokeAcceptance>>& acceptance, double start_radius_m) {
+  // The spellings this function documents and the command line's --units takes: "m" or "data".
+  if (units_name != "m" && units_name != "data")
+    throw InvalidArgument("units: '" + units_name +
+                          "' is neither 'm' (metres) nor 'data' (the 1024-unit box)");
   const TraceUnits units = parse_trace_units(units_name == "m" ? "metres" : units_name);
   Character model;
   if (py::isinstance<Character>(character)) {
@@ -141,8 +160,11 @@ py::dict score_py(const py::object& trace, const py::object& character, const st
 
   std::vector<PenSample> samples;
   std::string trace_name = "<columns>";
-  if (py::isinstance<py::str>(trace) || py::isinstance(trace, py::module_::import("os").attr("PathLike"))) {
-    trace_name = py::str(py::module_::import("os").attr("fspath")(trace));
+  const py::module_ os = py::module_::import("os");
+  if (py::isinstance<py::str>(trace) || py::isinstance<py::bytes>(trace) ||
+      py::isinstance(trace, os.attr("PathLike"))) {
+    // A path as str, bytes or path-like object (os.fsdecode: the file system's encoding, as open() reads it).
+    trace_name = py::str(os.attr("fsdecode")(trace));
     PenTraceCsvOptions options;
     options.units = units;
     options.contact_threshold_m = contact_threshold_m;

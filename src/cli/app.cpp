@@ -96,6 +96,9 @@ int Commands::run_selected() const {
 }
 
 void configure_root(CLI::App& root) {
+  // A flag takes no value: `--json=yes` or `--verbose=0` is a usage error, not a value CLI11 reads as true
+  // or false. Every command's options inherit this default (the commands are added after it).
+  root.option_defaults()->disable_flag_override();
   root.set_version_flag("--version", kVersion, "Print the program's version and exit");
   root.require_subcommand(1);
   auto formatter = std::make_shared<CLI::Formatter>();

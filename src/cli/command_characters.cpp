@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "calligraphy/core/printable_text.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
 #include "cli/commands.hpp"
@@ -66,6 +67,15 @@ std::string code_point_text(char32_t c) {
   return text;
 }
 
+// White space as Unicode's White_Space property lists it (PropList.txt, Unicode 15.0): tabs and line ends,
+// the spaces of every width (U+00A0 no-break, U+2000-U+200A, U+3000 ideographic), the line and paragraph
+// separators. A text pasted from a page or a document holds any of them between its characters.
+bool is_white_space(char32_t c) {
+  return (c >= U'\x0009' && c <= U'\x000D') || c == U' ' || c == U'\x0085' || c == U'\x00A0' ||
+         c == U'\x1680' || (c >= U'\x2000' && c <= U'\x200A') || c == U'\x2028' || c == U'\x2029' ||
+         c == U'\x202F' || c == U'\x205F' || c == U'\x3000';
+}
+
 struct Listed {
   char32_t code_point = 0;
   std::vector<int> typical_ids;
@@ -86,8 +96,7 @@ int run_characters(const CharactersCommand& command) {
   if (!command.text.empty()) {
     std::set<char32_t> seen;
     for (char32_t c : text) {
-      if (c == U' ' || c == U'\t' || c == U'\n' || c == U'\r' || c == U'\u3000' || !seen.insert(c).second)
-        continue;
+      if (is_white_space(c) || !seen.insert(c).second) continue;
       (source.contains(c) ? candidates : not_found).push_back(c);
     }
   } else {
@@ -139,8 +148,14 @@ int run_characters(const CharactersCommand& command) {
            "; library: " + source.description() + "\n";
   if (!not_found.empty()) {
     std::string missing;
-    for (char32_t c : not_found) missing += encode_utf8(c);
-    table += "not in the library: " + missing + "\n";
+    // Each with its code point, as printable text: the text is the user's, and a control character (an
+    // escape sequence), a combining mark or a variation selector would otherwise act on the terminal or
+    // vanish into its neighbour.
+    for (char32_t c : not_found) {
+      if (!missing.empty()) missing += ", ";
+      missing.append(printable_one_line(encode_utf8(c))).append(" (").append(code_point_text(c)).append(")");
+    }
+    table.append("not in the library: ").append(printable_one_line(missing, missing.size())).append("\n");
   }
   write_standard_output(table);
   return 0;

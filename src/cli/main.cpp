@@ -114,6 +114,20 @@ int main(int argc, char** argv) {
       if (dynamic_cast<const CLI::ExtrasError*>(&e) || dynamic_cast<const CLI::RequiredError*>(&e)) {
         if (std::string unknown = unknown_argument_message(*deepest); !unknown.empty()) message = unknown;
       }
+      // CLI11 words a value given to a flag (`--json=yes`) as an "override": say what the user did.
+      if (dynamic_cast<const CLI::ArgumentMismatch*>(&e)) {
+        static constexpr std::string_view kOverride = " was given a disallowed flag override";
+        if (message.size() > kOverride.size() && message.ends_with(kOverride)) {
+          std::string flag = message.substr(0, message.size() - kOverride.size());
+          message = flag.size() == 1 ? "-" : "--";
+          message.append(flag).append(": a flag takes no value");
+        }
+        // An option left without its value (`--svg` last, `--svg=`): CLI11 says "--svg: 1 required  missing".
+        if (const auto required = message.find(": 1 required ");
+            required != std::string::npos && message.ends_with(" missing")) {
+          message = message.substr(0, required) + ": expects a value, none was given";
+        }
+      }
       print_error(name, message);
       return 2;
     }

@@ -154,7 +154,9 @@ void set_field_from_text(const SchemaField& field, void* object, std::string_vie
   switch (field.kind) {
     case FieldKind::number: {
       const std::optional<double> value = parse_finite_double(text);
-      if (!value) throw InvalidArgument(quoted(text) + " is not a finite number");
+      // '+400', ' 400' and '0x190' are numbers to some readers: say which spelling is read.
+      if (!value)
+        throw InvalidArgument(quoted(text) + " is not a finite decimal number (such as 400, -0.5 or 1e-3)");
       field.set_number(field, object, 0, *value / field.option_factor);
       return;
     }

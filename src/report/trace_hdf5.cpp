@@ -11,13 +11,13 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <initializer_list>
 #include <limits>
 #include <system_error>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/report/trial_report.hpp"
+#include "core/whole_file.hpp"
 
 namespace calligraphy {
 namespace {
@@ -564,18 +564,9 @@ TraceColumns parse_trace_hdf5(std::string_view bytes, const std::string& source,
 }
 
 std::string read_trace_hdf5_bytes(const std::filesystem::path& file, std::uintmax_t max_file_bytes) {
-  const std::string source = file.string();
-  std::error_code error;
-  if (!std::filesystem::is_regular_file(file, error)) refuse(source, "no such file");
-  const std::uintmax_t size = std::filesystem::file_size(file, error);
-  if (error) refuse(source, "cannot be read (" + error.message() + ")");
-  if (size > max_file_bytes)
-    refuse(source, std::to_string(size) + " bytes, over the limit of " + std::to_string(max_file_bytes));
-  std::ifstream in(file, std::ios::binary);
-  std::string bytes(static_cast<std::size_t>(size), '\0');
-  if (!in || !in.read(bytes.data(), static_cast<std::streamsize>(bytes.size())))
-    refuse(source, "cannot be read");
-  return bytes;
+  // The one reader of a bounded input file: a missing file, a device (/dev/zero), a FIFO or a folder is
+  // named as what it is, never read.
+  return read_regular_file(file, max_file_bytes);
 }
 
 TraceColumns read_trace_hdf5(const std::filesystem::path& file, std::uintmax_t max_file_bytes,
