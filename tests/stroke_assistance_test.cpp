@@ -177,6 +177,8 @@ TEST_CASE(
   // A version-3 record (no miss counts, no growing tolerances) runs as it ran: no stroke is assisted.
   nlohmann::json old = nlohmann::json::parse(json);
   old["version"] = 3;
+  for (const ParameterField<StrokeAcceptance>& field : ParameterTable<StrokeAcceptance>::fields())
+    old["trial"].erase(std::string(field.name));
   for (const char* key :
        {"shortfall_per_length", "shortfall_cap_m", "deviation_per_length", "mean_deviation_cap_m",
         "reference_character_size_m", "hint_after_misses", "assist_after_misses"}) {
@@ -186,10 +188,13 @@ TEST_CASE(
   CHECK(v3.force_law.acceptance.assist_after_misses == 0.0);
   CHECK(v3.force_law.acceptance.shortfall_per_length == 0.0);
   CHECK(v3.force_law.acceptance.end_gap_m == 0.0);
+  CHECK(v3.spec.acceptance == v3.force_law.acceptance);  // the specification states what ran
 
   // A version-4 record (no floor of the end gap) runs as it ran: without the floor, the rest as recorded.
   nlohmann::json v4_json = nlohmann::json::parse(json);
   v4_json["version"] = 4;
+  for (const ParameterField<StrokeAcceptance>& field : ParameterTable<StrokeAcceptance>::fields())
+    v4_json["trial"].erase(std::string(field.name));
   for (const char* key : {"end_gap_m", "end_gap_fraction"}) v4_json["force_law"]["acceptance"].erase(key);
   const RecordedTrial v4 = read_recorded_trial(v4_json.dump(), "v4.json");
   StrokeAcceptance as_v4 = first.options.force.acceptance;
@@ -200,4 +205,140 @@ TEST_CASE(
   // Without the floor, a stroke left 4 mm short at one end of a 10 mm stroke is refused; with it, accepted.
   CHECK(as_v4.allowed_end_gap_m(0.010) < 0.004);
   CHECK(StrokeAcceptance{}.allowed_end_gap_m(0.010) >= 0.004);
+}
+
+namespace {
+
+// 人 written by a writer that always lifts mid-stroke and never corrects (as above), by the options of
+// `calligraphy trial` and `extra` after them.
+TrialSpec always_missing(std::vector<std::string> extra) {
+  std::vector<std::string> args{"人",
+                                "--writer-param",
+                                "mid_stroke_lift_probability=1",
+                                "--writer-param",
+                                "correction_per_attempt=0",
+                                "--writer-param",
+                                "max_attempts_per_stroke=20",
+                                "--seed",
+                                "3",
+                                "--max-duration",
+                                "120"};
+  args.insert(args.end(), extra.begin(), extra.end());
+  return *trial_spec_from_args(args);
+}
+
+TrialRun run_spec(const TrialSpec& spec, const Scene& scene) {
+  SimulatedWriting writing(spec);
+  return run_trial_spec(Checked<TrialSpec>::check(spec), scene, study_test::trial_inputs(&writing));
+}
+
+}  // namespace
+
+TEST_CASE(
+    "The specification's miss counts reach the renderer: --assist-after-misses 1 assists each stroke after "
+    "one miss, sooner than the default",
+    "[stroke_assistance]") {
+  const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'人')});
+  const TrialSpec by_default = always_missing({});
+  const TrialSpec sooner = always_missing({"--assist-after-misses", "1", "--hint-after-misses", "0"});
+  CHECK(sooner.acceptance.assist_after_misses == 1.0);
+  CHECK(sooner.acceptance.hint_after_misses == 0.0);
+  CHECK(trial_options(Checked<TrialSpec>::check(sooner), DeviceInfo{}).force.acceptance == sooner.acceptance);
+
+  const TrialRun first = run_spec(by_default, scene);
+  const TrialRun quick = run_spec(sooner, scene);
+  CHECK(quick.options.force.acceptance.assist_after_misses == 1.0);
+  REQUIRE(quick.result.metrics.per_stroke.size() == 2);
+  REQUIRE(first.result.metrics.per_stroke.size() == 2);
+  CHECK(quick.result.metrics.strokes_assisted == 2);
+  for (std::size_t i = 0; i < 2; ++i) {
+    CHECK(quick.result.metrics.per_stroke[i].assisted);
+    CHECK(quick.result.metrics.per_stroke[i].attempts == 1);
+    CHECK(first.result.metrics.per_stroke[i].attempts ==
+          static_cast<int>(StrokeAcceptance{}.assist_after_misses));
+  }
+  CHECK(quick.result.end == TrialEnd::completed);
+  // Fewer attempts: the trial is over sooner.
+  CHECK(quick.result.trace.size() < first.result.trace.size());
+}
+
+TEST_CASE("The miss counts are fields of the specification in every form, in their table's range",
+          "[stroke_assistance]") {
+  const TrialSpec spec = always_missing({"--assist-after-misses", "2", "--hint-after-misses", "1"});
+  // The command line's words and JSON give it back.
+  CHECK(*trial_spec_from_args(trial_spec_args(spec)) == spec);
+  CHECK(*trial_spec_from_json(trial_spec_json(spec), "spec.json") == spec);
+  const nlohmann::json json = nlohmann::json::parse(trial_spec_json(spec));
+  CHECK(json.at("assist_after_misses") == 2.0);
+  CHECK(json.at("hint_after_misses") == 1.0);
+  // Every field of StrokeAcceptance's table is one of the specification, of the same key and range.
+  for (const ParameterField<StrokeAcceptance>& entry : ParameterTable<StrokeAcceptance>::fields()) {
+    const SchemaField* field = SchemaOf<TrialSpec>::get().field(entry.name);
+    REQUIRE(field != nullptr);
+    CHECK(field->range.low == entry.range.low);
+    CHECK(field->range.high == entry.range.high);
+    CHECK(field->option.starts_with("--"));
+    CHECK(json.contains(std::string(entry.name)));
+  }
+  // A JSON specification a person writes: a key left out keeps its default.
+  const TrialSpec from_file =
+      *trial_spec_from_json(R"({"characters": "人", "assist_after_misses": 1})", "s.json");
+  CHECK(from_file.acceptance.assist_after_misses == 1.0);
+  CHECK(from_file.acceptance.hint_after_misses == StrokeAcceptance{}.hint_after_misses);
+  // Out of range, or not a whole number: refused naming the field in both its forms.
+  CHECK_THROWS_WITH(trial_spec_from_args(std::vector<std::string>{"人", "--assist-after-misses", "1001"}),
+                    Catch::Contains("assist_after_misses (--assist-after-misses)"));
+  CHECK_THROWS_WITH(
+      trial_spec_from_args(std::vector<std::string>{"人", "--hint-after-misses", "2.5"}),
+      Catch::Contains("hint_after_misses (--hint-after-misses)") && Catch::Contains("whole number"));
+  CHECK_THROWS_WITH(trial_spec_from_json(R"({"characters": "人", "hint_after_misses": -1})", "s.json"),
+                    Catch::Contains("s.json") && Catch::Contains("/hint_after_misses"));
+}
+
+TEST_CASE(
+    "A record holds the miss counts the trial ran with and replays with them, and an earlier record's "
+    "specification states the acceptance it ran with",
+    "[stroke_assistance]") {
+  const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'人')});
+  const TrialSpec spec = always_missing({"--assist-after-misses", "2", "--hint-after-misses", "1"});
+  SimulatedWriting writing(spec);
+  const TrialRun first =
+      run_trial_spec(Checked<TrialSpec>::check(spec), scene, study_test::trial_inputs(&writing));
+  const std::string json = recorded_trial_json(recorded_trial(spec, first, writing, scene));
+  const nlohmann::json document = nlohmann::json::parse(json);
+  CHECK(document.at("trial").at("assist_after_misses") == 2.0);
+  CHECK(document.at("trial").at("hint_after_misses") == 1.0);
+  const RecordedTrial recorded = read_recorded_trial(json, "r.json");
+  CHECK(recorded.spec.acceptance == spec.acceptance);
+  CHECK(recorded.force_law.acceptance == spec.acceptance);
+  CHECK(recorded.defaulted.empty());
+  SimulatedWriting again_writing = recorded_writing(recorded);
+  const TrialRun again = rerun_trial(recorded, Checked<TrialSpec>::check(recorded.spec), scene,
+                                     study_test::trial_inputs(&again_writing));
+  CHECK(again.options.force.acceptance.assist_after_misses == 2.0);
+  REQUIRE(again.result.metrics.per_stroke.size() == first.result.metrics.per_stroke.size());
+  for (std::size_t i = 0; i < first.result.metrics.per_stroke.size(); ++i) {
+    CHECK(again.result.metrics.per_stroke[i].attempts == 2);
+    CHECK(again.result.metrics.per_stroke[i].assisted);
+  }
+  CHECK(again.result.trace.size() == first.result.trace.size());
+
+  // A caller's force law (a study condition's quiz) replaces the acceptance stated: the record's
+  // specification states the one that ran.
+  StrokeAcceptance given = StrokeAcceptance{};
+  given.assist_after_misses = 3;
+  TrialOptions ran = first.options;
+  ran.force.acceptance = given;
+  CHECK(recorded_trial(TrialSpec{spec}, ran, &writing.profile(), scene).spec.acceptance == given);
+
+  // A version-5 record, written before the specification stated the acceptance: its specification takes
+  // the acceptance its force law ran with, and no field of it is said to take its default.
+  nlohmann::json v5 = document;
+  v5["version"] = 5;
+  for (const ParameterField<StrokeAcceptance>& field : ParameterTable<StrokeAcceptance>::fields())
+    v5["trial"].erase(std::string(field.name));
+  const RecordedTrial earlier = read_recorded_trial(v5.dump(), "v5.json");
+  CHECK(earlier.spec.acceptance == recorded.force_law.acceptance);
+  CHECK(earlier.spec.acceptance.assist_after_misses == 2.0);
+  CHECK(earlier.defaulted.empty());
 }

@@ -176,7 +176,9 @@ TrialRun run_interruptible(TrialRunInputs& inputs, Trial&& trial) {
   X(std::optional<Annotated<WriterParamsTag>>, writer_params, py::none()) \
   X(std::optional<PyArgument<GuidanceMode>>, guidance_mode, py::none())   \
   X(std::optional<PyArgument<double>>, guidance_gain, py::none())         \
-  X(std::optional<Annotated<TeacherTag>>, teacher, py::none())
+  X(std::optional<Annotated<TeacherTag>>, teacher, py::none())            \
+  X(std::optional<PyArgument<double>>, hint_after_misses, py::none())     \
+  X(std::optional<PyArgument<double>>, assist_after_misses, py::none())
 
 #define CALLIGRAPHY_TRIAL_FIELD(type, name, default_value) type name;
 #define CALLIGRAPHY_TRIAL_PARAMETER(type, name, default_value) , const type& name
@@ -280,6 +282,11 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   for (const PlacedCharacter& c : scene.characters) label += encode_utf8(c.code_point);
 
   apply_guidance(a, label, options.force);
+  // The stroke acceptance's miss counts, the specification's fields of the same names, over force_law's.
+  if (a.hint_after_misses)
+    options.force.acceptance.hint_after_misses = take(*a.hint_after_misses, "hint_after_misses");
+  if (a.assist_after_misses)
+    options.force.acceptance.assist_after_misses = take(*a.assist_after_misses, "assist_after_misses");
   options.validate();
   simulation.validate();
   if (!(options.rate_hz * options.max_duration_s <= kMaxTrialTicks)) {
@@ -313,6 +320,7 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   spec.rate_hz = options.rate_hz;
   spec.pacing = options.pacing;
   spec.max_duration_s = options.max_duration_s;
+  spec.acceptance = options.force.acceptance;
   // A replay's teacher is given as samples (TrialRunInputs::teacher), below.
   const auto checked = calligraphy::Checked<TrialSpec>::check(
       spec, spec.guidance_mode == GuidanceMode::replay ? TeacherSource::samples : TeacherSource::file);
@@ -550,6 +558,10 @@ force stays). guidance_mode: 'fixed' (eq. 8), 'fading' (eq. 8 times guidance_gai
 teacher: a TeacherRecording of the same characters (record_teacher) or a list of TeacherSample.
 rate_hz: servo rate [Hz], 100..100000. seed: int >= 0. max_duration_s: simulated time limit [s],
 > 0, at most 10^7 ticks (rate_hz * max_duration_s).
+hint_after_misses, assist_after_misses: refused attempts at a stroke after which it is shown as a hint,
+and after which it is demonstrated and credited as assisted (whole numbers in [0, 1000], 0: never; None
+keeps force_law's acceptance's, 3 and 5 by default), as `calligraphy trial --hint-after-misses N
+--assist-after-misses N` (docs/stroke-acceptance.md).
 force_law: ForceLawParameters (its guidance fields are replaced by the arguments given). device:
 SimulatedDeviceParameters. safety: SafetyChainParameters (0 forces take the device's figures).
 passivity: PassivityParameters. keep_trace: False leaves the arrays empty (faster, metrics only).

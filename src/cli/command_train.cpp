@@ -45,7 +45,8 @@ struct TrainCommand {
   bool quiz = false;
   bool engineer = false;
   bool no_demo = false;
-  // The acceptance's (StrokeAcceptance::hint_after_misses, its one definition) unless --hint-after is given.
+  // The acceptance's (StrokeAcceptance::hint_after_misses, its one definition) unless --hint-after-misses is
+  // given.
   std::int64_t hint_after = static_cast<std::int64_t>(StrokeAcceptance{}.hint_after_misses);
   const CLI::Option* hint_after_option = nullptr;
   std::string quiz_screenshots;
@@ -220,9 +221,9 @@ void add_train_command(CLI::App& root, Commands& commands, DeviceRegistry& devic
   const ParameterRange hint_range = parameter_field(&StrokeAcceptance::hint_after_misses).range;
   command->hint_after_option =
       add_integer(
-          *app, "--hint-after", command->hint_after, "N",
+          *app, "--hint-after-misses", command->hint_after, "N",
           "quiz: show the expected stroke after N misses on it, and after each further miss; 0: never "
-          "(overrides the stroke acceptance's hint_after_misses)",
+          "(the stroke acceptance's hint_after_misses, as `trial --hint-after-misses`)",
           static_cast<std::int64_t>(hint_range.low), static_cast<std::int64_t>(hint_range.high))
           ->needs(quiz);
   add_output_folder(*app, "--quiz-screenshots", command->quiz_screenshots,

@@ -61,6 +61,9 @@ RecordedTrial recorded_trial(const TrialSpec& spec, const TrialOptions& ran, con
   if (recorded.spec.pacing == TrialPacing::automatic)
     recorded.spec.pacing = writer != nullptr ? TrialPacing::lock_step : TrialPacing::real_time;
   recorded.force_law = ran.force;
+  // The specification states the acceptance the trial ran with: a caller's force law's (a study condition's
+  // quiz) replaces the one stated.
+  recorded.spec.acceptance = ran.force.acceptance;
   if (auto* replay = std::get_if<ReplayGuidance>(&recorded.force_law.guidance_law))
     replay->teacher_trajectory.clear();  // the teacher is named by the specification, not copied
   recorded.safety = ran.safety;
@@ -180,6 +183,20 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
   // Before version 5 either end of a stroke could be left unwritten by no more than its shortfall or
   // displacement: no floor of the end gap.
   if (version < 5) r.force_law.acceptance.use_version_4_end_gaps();
+  // Before version 6 the specification did not state the acceptance: it is the one the force law ran with,
+  // not a default (its fields are not listed as defaulted).
+  if (version < 6) {
+    r.spec.acceptance = r.force_law.acceptance;
+    const std::string trial = reader.pointer("trial");
+    std::erase_if(read.defaulted, [&](const std::string& pointer) {
+      for (const ParameterField<StrokeAcceptance>& field : ParameterTable<StrokeAcceptance>::fields()) {
+        std::string stated = trial;
+        stated.append("/").append(field.name);
+        if (pointer == stated) return true;
+      }
+      return false;
+    });
+  }
   checked(source, reader.pointer("force_law"), [&] {
     // A replay's teacher is not in the record (the run is given it, and checks it then): its law's own
     // values are checked here with a stand-in trajectory of two samples.

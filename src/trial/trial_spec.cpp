@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <deque>
 #include <limits>
 #include <nlohmann/json.hpp>
 
@@ -43,10 +44,53 @@ const std::vector<SchemaField>& writer_setting_fields() {
   return fields;
 }
 
+// The stroke acceptance's fields as fields of the specification (TrialSpec::acceptance), one per entry of
+// StrokeAcceptance's table, in its order: the key, unit, range and doc are the table's (the one definition; a
+// field added to the table is a field of the specification), the option the key dashed with a length's "_m"
+// dropped (as --assist-band). Version 6 of a trial record is the first whose specification states them; an
+// older record's are the acceptance it ran with (its force law's, recorded_trial.cpp).
+std::vector<SchemaField> acceptance_fields() {
+  static std::deque<std::string> options;  // owns the texts the fields' views point into
+  std::vector<SchemaField> out;
+  const auto entries = ParameterTable<StrokeAcceptance>::fields();
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const std::string_view name = entries[i].name;
+    const bool length = entries[i].unit == std::string_view("m") && name.ends_with("_m");
+    std::string option = "--";
+    option.append(length ? name.substr(0, name.size() - 2) : name);
+    std::replace(option.begin(), option.end(), '_', '-');
+    options.push_back(std::move(option));
+    SchemaField f{.name = name, .kind = FieldKind::number, .unit = entries[i].unit, .doc = entries[i].doc};
+    f.range = entries[i].range;
+    f.table_slot = i;
+    f.option = options.back();
+    f.option_value_name = length ? "M" : name.ends_with("_misses") ? "N" : "X";
+    f.get_number = [](const SchemaField& self, const void* o, std::size_t) -> double {
+      return static_cast<const TrialSpec*>(o)->acceptance.*
+             (ParameterTable<StrokeAcceptance>::fields()[self.table_slot].member);
+    };
+    f.set_number = [](const SchemaField& self, void* o, std::size_t, double v) {
+      static_cast<TrialSpec*>(o)->acceptance.*
+          (ParameterTable<StrokeAcceptance>::fields()[self.table_slot].member) = v;
+    };
+    out.push_back(since(6, f));
+  }
+  return out;
+}
+
+// `fields` with the acceptance's after the trial's time limit, before its outputs.
+std::vector<SchemaField> with_acceptance_fields(std::vector<SchemaField> fields) {
+  const std::vector<SchemaField> acceptance = acceptance_fields();
+  const auto outputs = std::find_if(fields.begin(), fields.end(),
+                                    [](const SchemaField& field) { return field.name == "json_file"; });
+  fields.insert(outputs, acceptance.begin(), acceptance.end());
+  return fields;
+}
+
 // The fields in both forms, in the order the forms list them: the JSON key, the option of `calligraphy
 // trial`, the unit, the range and the doc. Built once, on first use: ranges come from the laws' tables.
 const std::vector<SchemaField>& spec_fields() {
-  static const std::vector<SchemaField> fields{
+  static const std::vector<SchemaField> fields = with_acceptance_fields({
       string_field<&TrialSpec::characters>("characters",
                                            {.doc = "the characters to write, left to right (UTF-8)",
                                             .option = "CHARS",
@@ -159,7 +203,7 @@ const std::vector<SchemaField>& spec_fields() {
                   "that wrote every stroke in order)",
            .option = "--record",
            .option_value_name = "FILE"}),
-  };
+  });
   return fields;
 }
 
@@ -220,7 +264,9 @@ struct ConditionalField {
 constexpr bool replaying(const TrialSpec& s) { return s.guidance_mode == GuidanceMode::replay; }
 const ConditionalField kConditionalFields[] = {
     {"guidance_stiffness_n_per_m",
-     [](const TrialSpec& s) { return s.guidance_stiffness_n_per_m != TrialSpec{}.guidance_stiffness_n_per_m; },
+     [](const TrialSpec& s) {
+       return s.guidance_stiffness_n_per_m != TrialSpec{}.guidance_stiffness_n_per_m;
+     },
      [](const TrialSpec& s) { return s.guidance; }, "applies to guidance on (guidance is off)"},
     {"guidance_gain", [](const TrialSpec& s) { return s.guidance_gain != TrialSpec{}.guidance_gain; },
      [](const TrialSpec& s) { return s.guidance_mode == GuidanceMode::fading; },
@@ -232,7 +278,8 @@ const ConditionalField kConditionalFields[] = {
      [](const TrialSpec& s) { return s.amplification_gain != TrialSpec{}.amplification_gain; },
      [](const TrialSpec& s) { return s.guidance_mode == GuidanceMode::error_amplification; },
      "applies to guidance mode 'error-amplification' only"},
-    {"timing_speed_m_s", [](const TrialSpec& s) { return s.timing_speed_m_s != TrialSpec{}.timing_speed_m_s; },
+    {"timing_speed_m_s",
+     [](const TrialSpec& s) { return s.timing_speed_m_s != TrialSpec{}.timing_speed_m_s; },
      [](const TrialSpec& s) { return s.guidance_mode == GuidanceMode::timing; },
      "applies to guidance mode 'timing' only"},
     {"teacher", [](const TrialSpec& s) { return !s.teacher.empty(); }, replaying,
@@ -322,6 +369,18 @@ void TrialSpec::validate(TeacherSource teacher_from) const {
       refuse(field.name, e.what());
     }
   }
+  // The acceptance's rules beyond its fields' ranges (a miss count is a whole number), named by the field.
+  try {
+    acceptance.validate();
+  } catch (const InvalidArgument& e) {
+    const std::string what = e.what();
+    for (const ParameterField<StrokeAcceptance>& entry : ParameterTable<StrokeAcceptance>::fields()) {
+      std::string named = ".";
+      named.append(entry.name).append(" ");
+      if (what.find(named) != std::string::npos) refuse(entry.name, what);
+    }
+    throw InvalidArgument(std::string("trial specification: ").append(what));
+  }
   if (!guidance && guidance_mode != GuidanceMode::fixed) {
     refuse("guidance_mode", std::string("'") + calligraphy::to_string(guidance_mode) +
                                 "' needs guidance on (guidance is off)");
@@ -329,7 +388,8 @@ void TrialSpec::validate(TeacherSource teacher_from) const {
   // Each mode's own parameter: in its law's range, and stated only with its mode (a value nothing reads is
   // a mistake). The teacher is checked below, where it comes from matters.
   for (const ConditionalField& field : kConditionalFields) {
-    if (field.name != "teacher" && field.stated(*this) && !field.applies(*this)) refuse(field.name, field.when);
+    if (field.name != "teacher" && field.stated(*this) && !field.applies(*this))
+      refuse(field.name, field.when);
   }
   if (guidance_mode == GuidanceMode::replay && teacher.empty() && teacher_from == TeacherSource::file) {
     refuse("teacher", "required with guidance mode 'replay' (a recording made with --record)");

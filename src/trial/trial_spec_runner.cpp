@@ -53,6 +53,8 @@ TrialOptions options_stated(const TrialSpec& spec, const DeviceInfo& device) {
   options.force.guidance_law = guidance_law_of(spec);
   options.force.guidance_stiffness_n_per_m = spec.guidance_stiffness_n_per_m;
   fit_default_stiffness(options.force, device);
+  options.force.acceptance =
+      spec.acceptance;  // checked with the specification (its table's ranges and rules)
   options.rate_hz = spec.rate_hz;
   options.pacing = spec.pacing;
   options.loop.realtime = spec.realtime;

@@ -369,7 +369,7 @@ class TrainerTest(unittest.TestCase):
     def test_the_quiz_misses_a_backwards_stroke_and_accepts_the_right_one_live(self):
         shots = pathlib.Path(self.folder) / "shots"
         shots.mkdir()
-        trainer = self.start("一", "--device", "mouse", "--data", SAMPLE, "--quiz", "--hint-after", "1",
+        trainer = self.start("一", "--device", "mouse", "--data", SAMPLE, "--quiz", "--hint-after-misses", "1",
                              "--session", "out", "--quiz-screenshots", "shots", "--exit-after", "60")
         (box,) = trainer.boxes()
         window = trainer.window()
@@ -427,7 +427,7 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual(fraction([near(missed, box.data_to_px(p), 4, is_blue) for p in inner]), 0.0)
 
     def test_the_quiz_options_need_quiz(self):
-        result = subprocess.run([CLI, "train", "一", "--hint-after", "2"], capture_output=True, text=True)
+        result = subprocess.run([CLI, "train", "一", "--hint-after-misses", "2"], capture_output=True, text=True)
         self.assertEqual(result.returncode, 2, result.stderr)
         self.assertIn("--quiz", result.stderr)
         # The quiz judges with the stroke matcher's tolerances: there is no leniency to set.

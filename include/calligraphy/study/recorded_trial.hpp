@@ -27,18 +27,21 @@
 
 namespace calligraphy {
 
-/// The "format" of the specification object, and the version written: 5 since the stroke acceptance has a
-/// floor of the gap left at either end of a stroke (`end_gap_m`, `end_gap_fraction`; earlier records run
-/// without it, StrokeAcceptance::use_version_4_end_gaps); 4 since the stroke acceptance has
-/// tolerances that grow with a stroke's length and scale with the character, and the miss counts of the
-/// hint and the assisted credit (earlier records run with StrokeAcceptance::use_fixed_tolerances), and since
-/// a replay's record names its teacher's recording by SHA-256 (`teacher_sha256`; earlier records name none
-/// and are not checked); 3 since the trial states its guidance stiffness
-/// (`TrialSpec::guidance_stiffness_n_per_m`; earlier records take its default); 2 since the simulated writer's
-/// settings are {"key", "value"} objects (version 1 wrote "key=value" strings). A reader reads versions 1 to
-/// 5 and refuses any other by its number.
+/// The "format" of the specification object, and the version written: 6 since the trial's specification
+/// states its stroke acceptance (`TrialSpec::acceptance`: the miss counts of the hint and the assisted credit
+/// among its fields; an earlier record's specification takes the acceptance its force law ran with); 5 since
+/// the stroke acceptance has a floor of the gap left at either end of a stroke (`end_gap_m`,
+/// `end_gap_fraction`; earlier records run without it, StrokeAcceptance::use_version_4_end_gaps); 4 since the
+/// stroke acceptance has tolerances that grow with a stroke's length and scale with the character, and the
+/// miss counts of the hint and the assisted credit (earlier records run with
+/// StrokeAcceptance::use_fixed_tolerances), and since a replay's record names its teacher's recording by
+/// SHA-256 (`teacher_sha256`; earlier records name none and are not checked); 3 since the trial states its
+/// guidance stiffness
+/// (`TrialSpec::guidance_stiffness_n_per_m`; earlier records take its default); 2 since the simulated
+/// writer's settings are {"key", "value"} objects (version 1 wrote "key=value" strings). A reader reads
+/// versions 1 to 6 and refuses any other by its number.
 inline constexpr std::string_view kRecordedTrialFormat = "calligraphy-trial-specification";
-inline constexpr int kRecordedTrialVersion = 5;
+inline constexpr int kRecordedTrialVersion = 6;
 inline constexpr int kOldestRecordedTrialVersion = 1;
 
 /// Everything that decides what a trial does, as it ran. Lengths in m, forces in N, times in s.
@@ -119,7 +122,8 @@ struct TeacherFile {
 /// `read_teacher_recording` reads it, and, when the record names the SHA-256 of the recording it ran on
 /// (`teacher_sha256`), checked to be that one. Throws DataError naming the file and both SHA-256 when it is
 /// another recording, and what `read_teacher_recording` throws.
-[[nodiscard]] TeacherFile read_recorded_teacher(const RecordedTrial& recorded, const std::filesystem::path& path);
+[[nodiscard]] TeacherFile read_recorded_teacher(const RecordedTrial& recorded,
+                                                const std::filesystem::path& path);
 
 /// The simulated writer of `recorded` as it wrote (`RecordedTrial::writer`, its traits and what it had
 /// learned folded in): `rerun_trial`'s hand maker. Throws InvalidArgument for a profile out of range.

@@ -19,6 +19,7 @@
 #include "calligraphy/core/checked.hpp"
 #include "calligraphy/core/schema.hpp"
 #include "calligraphy/devices/servo_loop.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/render/force_law.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
 #include "calligraphy/trial/options.hpp"
@@ -75,20 +76,26 @@ struct TrialSpec {
   /// real time: longest stall [s] in [0, kMaxStallTimeoutS], whole milliseconds; 0 off
   double watchdog_s = ServoLoopOptions{}.stall_timeout_s;
   double max_duration_s = 300.0;  ///< the trial ends after this much time [s], (0, kMaxTrialDurationS]
-  std::string json_file;          ///< the metrics as JSON ("-": standard output; "": none)
-  std::string csv_file;           ///< the trace as CSV
-  std::string svg_file;           ///< the reference and the trace as SVG
-  std::string record_file;        ///< the trial as a teacher's recording (only "" or a file)
+  /// When a stroke counts as written, and the counts of refused attempts after which it is hinted and
+  /// assisted (`hint_after_misses`, `assist_after_misses`): every field of StrokeAcceptance's table is a
+  /// field of the specification of the same key, its option the key dashed (a length's "_m" dropped:
+  /// `--hint-after-misses`, `--corridor`), in the table's range. The renderer judges strokes by it.
+  StrokeAcceptance acceptance{};
+  std::string json_file;    ///< the metrics as JSON ("-": standard output; "": none)
+  std::string csv_file;     ///< the trace as CSV
+  std::string svg_file;     ///< the reference and the trace as SVG
+  std::string record_file;  ///< the trial as a teacher's recording (only "" or a file)
 
   /// Throws InvalidArgument naming the field (its JSON key and its option) when a value is out of range or
   /// two fields contradict each other: characters empty or over 1,000, a guidance mode or gain without the
   /// guidance it needs, a replay without a teacher or a teacher without a replay, a profile or settings for a
   /// person, an empty profile name or a setting without a key, a rate outside the pacing's range, more than
-  /// 10^7 ticks, a teacher's recording on standard output. The profile's name and its settings' keys and
-  /// ranges are the simulated writer's to check (sim's `writer_profile_of`); outputs on one file are the
-  /// front-end's to refuse (it resolves links: the CLI's file plan). `teacher_from`: where a replay's teacher
-  /// comes from, the file `teacher` (required then; its front-end reads it) or samples the runner is given
-  /// with no file named (`teacher` must then be empty: nothing would read it).
+  /// 10^7 ticks, a teacher's recording on standard output, an acceptance StrokeAcceptance::validate refuses
+  /// (a miss count that is not a whole number). The profile's name and its settings' keys and ranges are the
+  /// simulated writer's to check (sim's `writer_profile_of`); outputs on one file are the front-end's to
+  /// refuse (it resolves links: the CLI's file plan). `teacher_from`: where a replay's teacher comes from,
+  /// the file `teacher` (required then; its front-end reads it) or samples the runner is given with no file
+  /// named (`teacher` must then be empty: nothing would read it).
   void validate(TeacherSource teacher_from = TeacherSource::file) const;
 
   bool operator==(const TrialSpec&) const = default;
