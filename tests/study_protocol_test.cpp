@@ -274,6 +274,11 @@ TEST_CASE("a quiz condition's acceptance is checked naming the key, and leniency
   check_error(with_quiz(R"({"acceptance": {"max_gain_ratio": 0.5}})"),
               "/conditions/0/quiz/acceptance/max_gain_ratio", "0.5");
   check_error(with_quiz(R"({"acceptance": 3})"), "/conditions/0/quiz/acceptance", "object");
+  // The miss counts are whole numbers, as the specification's and the schema's integers.
+  check_error(with_quiz(R"({"acceptance": {"hint_after_misses": 2.5}})"),
+              "/conditions/0/quiz/acceptance/hint_after_misses", "integer");
+  check_error(with_quiz(R"({"acceptance": {"assist_after_misses": 1001}})"),
+              "/conditions/0/quiz/acceptance/assist_after_misses", "[0, 1000]");
   // Every key a trial record writes is read.
   const StudyProtocol p = parse_study_protocol(
       with_quiz(R"({"acceptance": {"corridor_m": 0.007, "mean_deviation_m": 0.0035, "shortfall_m": 0.005,

@@ -84,8 +84,16 @@ constexpr const char* kFormat = "calligraphy-study-protocol";
 StrokeAcceptance read_acceptance(const json& value, const std::string& pointer, const std::string& source) {
   json_detail::ObjectReader reader(value, pointer, source);
   StrokeAcceptance a;
-  for (const ParameterField<StrokeAcceptance>& field : ParameterTable<StrokeAcceptance>::fields())
-    a.*field.member = table_number_or(reader, std::string(field.name), a.*field.member, field.member);
+  for (const ParameterField<StrokeAcceptance>& field : ParameterTable<StrokeAcceptance>::fields()) {
+    if (field.name.ends_with("_misses")) {  // a count: whole numbers only (StrokeAcceptance::validate)
+      a.*field.member =
+          static_cast<double>(reader.integer_or(std::string(field.name), std::llround(a.*field.member),
+                                                static_cast<std::int64_t>(std::ceil(field.range.low)),
+                                                static_cast<std::int64_t>(std::floor(field.range.high))));
+    } else {
+      a.*field.member = table_number_or(reader, std::string(field.name), a.*field.member, field.member);
+    }
+  }
   reader.finish();  // any other key: an error naming it
   return a;
 }

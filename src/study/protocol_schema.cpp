@@ -265,8 +265,15 @@ ordered_json condition_schema() {
 
 ordered_json quiz_schema() {
   ordered_json acceptance = ordered_json::object();
-  for (const ParameterField<StrokeAcceptance>& field : ParameterTable<StrokeAcceptance>::fields())
+  for (const ParameterField<StrokeAcceptance>& field : ParameterTable<StrokeAcceptance>::fields()) {
     put_table_field(acceptance, field.name, field.member);
+    if (field.name.ends_with("_misses")) {  // a count: whole numbers only (StrokeAcceptance::validate)
+      acceptance[std::string(field.name)]["type"] = "integer";
+      acceptance[std::string(field.name)]["minimum"] = static_cast<std::int64_t>(std::ceil(field.range.low));
+      acceptance[std::string(field.name)]["maximum"] =
+          static_cast<std::int64_t>(std::floor(field.range.high));
+    }
+  }
   ordered_json properties = ordered_json::object();
   properties["acceptance"] =
       object_schema(std::move(acceptance), "the stroke matcher's tolerances (docs/stroke-acceptance.md)");

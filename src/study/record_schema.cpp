@@ -33,6 +33,13 @@ const Schema& SchemaOf<StrokeAcceptance>::get() {
   // (StrokeAcceptance::use_version_4_end_gaps).
   static const std::vector<SchemaField> fields = [] {
     std::vector<SchemaField> out = table_fields<StrokeAcceptance>();
+    for (SchemaField& field : out) {  // the miss counts are whole numbers (StrokeAcceptance::validate)
+      if (field.name == "hint_after_misses") {
+        field = whole_number_field<&StrokeAcceptance::hint_after_misses>(field);
+      } else if (field.name == "assist_after_misses") {
+        field = whole_number_field<&StrokeAcceptance::assist_after_misses>(field);
+      }
+    }
     for (std::size_t i = 8; i < out.size(); ++i) {
       const bool end_gap = out[i].name == "end_gap_m" || out[i].name == "end_gap_fraction";
       out[i] = since(end_gap ? 5 : 4, out[i]);
@@ -202,9 +209,10 @@ const Schema& SchemaOf<study_detail::RecordDocument>::get() {
       object_field<&R::scene>("scene", {.doc = "the scene's layout and the characters' SHA-256"}),
       string_field<&R::library_version>("library_version", {.doc = "the library that ran it"}),
       since(4, string_field<&R::teacher_sha256>(
-                   "teacher_sha256", {.doc = "lower-case hex SHA-256 of the teacher's recording a replay ran on, "
-                                             "checked when it is re-run; empty: no file was read",
-                                      .source = "FIPS 180-4"})),
+                   "teacher_sha256",
+                   {.doc = "lower-case hex SHA-256 of the teacher's recording a replay ran on, "
+                           "checked when it is re-run; empty: no file was read",
+                    .source = "FIPS 180-4"})),
   };
   static const Schema schema{.name = "RecordedTrial",
                              .doc = "a trial as it ran, whole: what `calligraphy trial --spec` runs again",

@@ -44,11 +44,30 @@ const std::vector<SchemaField>& writer_setting_fields() {
   return fields;
 }
 
+// A miss count of the acceptance (a double in its table, a whole number by its rule) as an integer field of
+// the specification, so that its JSON Schema says "integer" as the protocol's quiz count does.
+template <double StrokeAcceptance::*Member>
+void make_count_field(SchemaField& field) {
+  field.kind = FieldKind::integer;
+  field.integer_low = static_cast<std::int64_t>(std::ceil(field.range.low));
+  field.integer_high = static_cast<std::int64_t>(std::floor(field.range.high));
+  field.range = {};
+  field.get_number = nullptr;
+  field.set_number = nullptr;
+  field.get_integer = [](const void* o) -> std::int64_t {
+    return std::llround(static_cast<const TrialSpec*>(o)->acceptance.*Member);
+  };
+  field.set_integer = [](void* o, std::int64_t v) {
+    static_cast<TrialSpec*>(o)->acceptance.*Member = static_cast<double>(v);
+  };
+}
+
 // The stroke acceptance's fields as fields of the specification (TrialSpec::acceptance), one per entry of
 // StrokeAcceptance's table, in its order: the key, unit, range and doc are the table's (the one definition; a
 // field added to the table is a field of the specification), the option the key dashed with a length's "_m"
-// dropped (as --assist-band). Version 6 of a trial record is the first whose specification states them; an
-// older record's are the acceptance it ran with (its force law's, recorded_trial.cpp).
+// dropped (as --assist-band); the miss counts are integers. Version 6 of a trial record is the first whose
+// specification states them; an older record's are the acceptance it ran with (its force law's,
+// recorded_trial.cpp).
 std::vector<SchemaField> acceptance_fields() {
   static std::deque<std::string> options;  // owns the texts the fields' views point into
   std::vector<SchemaField> out;
@@ -73,6 +92,11 @@ std::vector<SchemaField> acceptance_fields() {
       static_cast<TrialSpec*>(o)->acceptance.*
           (ParameterTable<StrokeAcceptance>::fields()[self.table_slot].member) = v;
     };
+    if (entries[i].member == &StrokeAcceptance::hint_after_misses) {
+      make_count_field<&StrokeAcceptance::hint_after_misses>(f);
+    } else if (entries[i].member == &StrokeAcceptance::assist_after_misses) {
+      make_count_field<&StrokeAcceptance::assist_after_misses>(f);
+    }
     out.push_back(since(6, f));
   }
   return out;

@@ -13,6 +13,7 @@
 /// lives once in `core` and holds no per-struct code; a struct's schema is built once, next to the struct,
 /// with the field makers below (`number_field<&S::member>(...)`).
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -355,6 +356,23 @@ template <auto Member>
   f.get_integer = [](const void* o) -> std::int64_t { return schema_detail::cref<Member>(o); };
   f.set_integer = [](void* o, std::int64_t v) { schema_detail::ref<Member>(o) = static_cast<T>(v); };
   return f;
+}
+
+/// `field`, a double member that holds whole numbers only (a count a ParameterTable keeps as a double), as an
+/// integer field over the whole numbers of its range: its JSON Schema then says "integer", as a count's does.
+template <auto Member>
+[[nodiscard]] SchemaField whole_number_field(SchemaField field) {
+  field.kind = FieldKind::integer;
+  field.integer_low = static_cast<std::int64_t>(std::ceil(field.range.low));
+  field.integer_high = static_cast<std::int64_t>(std::floor(field.range.high));
+  field.range = {};
+  field.get_number = nullptr;
+  field.set_number = nullptr;
+  field.get_integer = [](const void* o) -> std::int64_t {
+    return std::llround(schema_detail::cref<Member>(o));
+  };
+  field.set_integer = [](void* o, std::int64_t v) { schema_detail::ref<Member>(o) = static_cast<double>(v); };
+  return field;
 }
 
 /// A std::uint64_t member taking every value (a seed).
