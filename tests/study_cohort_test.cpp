@@ -17,14 +17,19 @@
 #include "calligraphy/study/study_tables.hpp"
 #include "study_test_devices.hpp"
 #include "temp_folder.hpp"
+#include "test_sizing.hpp"
 
 using namespace calligraphy;
 
 namespace {
 
+// Under the sanitizers the tests that compare rows run one training character and trials of at most 10 s
+// (a trial there runs ten times slower); the Release build runs the whole protocol in every test.
+constexpr bool kSmall = calligraphy::testing::kSanitizedBuild;
+
 // Two days, a group per schedule that adapts or pushes, a learning memory to carry over.
-LoadedProtocol two_day_protocol() {
-  return protocol_from_text(
+LoadedProtocol two_day_protocol(bool small = false) {
+  std::string text(
       R"({"name": "cohort", "conditions": [
             {"name": "free", "mode": "vision"},
             {"name": "fading", "mode": "fading"},
@@ -34,12 +39,16 @@ LoadedProtocol two_day_protocol() {
           "phases": [
             {"phase": "pre-test", "condition": "free", "characters": ["十"]},
             {"phase": "training", "conditions": ["fading", "band", "adapt", "push"],
-             "assignment": "between-subjects", "characters": ["十", "人"], "repetitions": 2},
+             "assignment": "between-subjects", "characters": )");
+  text.append(small ? R"(["十"])" : R"(["十", "人"])");
+  text.append(R"(, "repetitions": 2},
             {"phase": "post-test", "condition": "free", "characters": ["十"]},
             {"phase": "retention", "condition": "free", "characters": ["十"], "session": 2, "delay_s": 86400},
             {"phase": "transfer", "condition": "free", "characters": ["口"], "session": 2}],
-          "trial": {"max_duration_s": 40}})",
-      "cohort.json");
+          "trial": {"max_duration_s": )");
+  text.append(small ? "10" : "40");
+  text.append("}}");
+  return protocol_from_text(text, "cohort.json");
 }
 
 // Every session of each subject through session folders, as `calligraphy session run` does.
@@ -94,14 +103,14 @@ void check_same_trials(const TrialRow& a, const TrialRow& b) {
 
 TEST_CASE("a cohort in memory gives the rows of the same subjects' session folders", "[study][cohort]") {
   TempFolder temp;
-  LoadedProtocol protocol = two_day_protocol();
+  LoadedProtocol protocol = two_day_protocol(kSmall);
   const std::vector<SubjectAssignment> subjects = numbered_subjects(4, "C");
   CohortSetup setup;
   setup.writer_profile = "foreign";
   const StudyTables folders = through_folders(temp.path, protocol, subjects, setup);
   const StudyTables memory = simulate_cohort(protocol, subjects, setup, 2);
   REQUIRE(memory.trials.size() == folders.trials.size());
-  REQUIRE(memory.trials.size() == 4 * 8);
+  REQUIRE(memory.trials.size() == 4 * (kSmall ? 6 : 8));
   for (std::size_t i = 0; i < memory.trials.size(); ++i) {
     check_same_trials(memory.trials[i], folders.trials[i]);
     CHECK(memory.trials[i].session ==
@@ -161,7 +170,7 @@ TEST_CASE("a cohort's subjects differ, each by the traits its id draws, unless t
 }
 
 TEST_CASE("a cohort's threads change none of its rows", "[study][cohort]") {
-  LoadedProtocol protocol = two_day_protocol();
+  LoadedProtocol protocol = two_day_protocol(kSmall);
   const std::vector<SubjectAssignment> subjects = numbered_subjects(3);
   CohortSetup setup;
   setup.writer_learning = "none";

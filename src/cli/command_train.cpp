@@ -45,10 +45,9 @@ struct TrainCommand {
   bool quiz = false;
   bool engineer = false;
   bool no_demo = false;
-  // The acceptance's (StrokeAcceptance::hint_after_misses, its one definition) unless --hint-after-misses is
-  // given.
+  // The stroke acceptance's counts (StrokeAcceptance, their one definition: default and range).
   std::int64_t hint_after = static_cast<std::int64_t>(StrokeAcceptance{}.hint_after_misses);
-  const CLI::Option* hint_after_option = nullptr;
+  std::int64_t assist_after = static_cast<std::int64_t>(StrokeAcceptance{}.assist_after_misses);
   std::string quiz_screenshots;
 };
 
@@ -113,9 +112,9 @@ int run_train(const TrainCommand& command, DeviceRegistry& devices) {
   options.quiz = command.quiz;
   options.engineer = command.engineer;
   options.demonstrate = !command.no_demo;
-  // An override of the acceptance's (StrokeAcceptance::hint_after_misses) only when given.
-  if (command.hint_after_option->count() > 0)
-    options.quiz_options.hint_after_misses = static_cast<int>(command.hint_after);
+  // Every trial's and the quiz's acceptance: the hint and the assisted credit after these misses.
+  options.acceptance.hint_after_misses = static_cast<double>(command.hint_after);
+  options.acceptance.assist_after_misses = static_cast<double>(command.assist_after);
   options.quiz_screenshots = command.quiz_screenshots;
   if (command.quiz && command.guidance_mode != "fixed")
     throw UsageError("--quiz: a quiz has no guidance; drop --guidance-mode " + command.guidance_mode);
@@ -214,18 +213,19 @@ void add_train_command(CLI::App& root, Commands& commands, DeviceRegistry& devic
   add_output_path(*app, "--screenshot", command->screenshot,
                   "write the window as PNG after the last character's trial, or at exit",
                   StandardOutput::refused);
-  CLI::Option* quiz =
-      add_flag(*app, "--quiz", command->quiz,
+  add_flag(*app, "--quiz", command->quiz,
                "a quiz (docs/trainer.md): no guidance; each stroke is judged as the pen lifts, "
                "accepted or missed by the stroke matcher the renderer uses (docs/stroke-acceptance.md)");
   const ParameterRange hint_range = parameter_field(&StrokeAcceptance::hint_after_misses).range;
-  command->hint_after_option =
-      add_integer(
-          *app, "--hint-after-misses", command->hint_after, "N",
-          "quiz: show the expected stroke after N misses on it, and after each further miss; 0: never "
-          "(the stroke acceptance's hint_after_misses, as `trial --hint-after-misses`)",
-          static_cast<std::int64_t>(hint_range.low), static_cast<std::int64_t>(hint_range.high))
-          ->needs(quiz);
+  add_integer(*app, "--hint-after-misses", command->hint_after, "N",
+              "show the expected stroke after N misses on it, and after each further miss; 0: never (the "
+              "stroke acceptance's hint_after_misses, as `trial --hint-after-misses`)",
+              static_cast<std::int64_t>(hint_range.low), static_cast<std::int64_t>(hint_range.high));
+  const ParameterRange assist_range = parameter_field(&StrokeAcceptance::assist_after_misses).range;
+  add_integer(*app, "--assist-after-misses", command->assist_after, "N",
+              "after N misses on a stroke, demonstrate it and credit it as assisted, so the trial goes on; 0: "
+              "never (the stroke acceptance's assist_after_misses, as `trial --assist-after-misses`)",
+              static_cast<std::int64_t>(assist_range.low), static_cast<std::int64_t>(assist_range.high));
   add_output_folder(*app, "--quiz-screenshots", command->quiz_screenshots,
                     "quiz: write the window as DIR/quiz-NN-VERDICT.png on the first frame after each judged "
                     "stroke (an existing folder)",

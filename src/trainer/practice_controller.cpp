@@ -29,9 +29,9 @@ PracticeController::PracticeController(const TrainerOptions& options, DeviceInfo
   for (const TrainerCharacter& c : options.characters) typical_ids_.push_back(typical_ids_of(c.model));
   guidance_ = options.guidance && !options.quiz;  // a quiz is force-free but for the paper
   // The quiz judges with the renderer's tolerances and start neighbourhood: those of the trials start_trial
-  // runs (default ForceLawParameters, a default scene layout), also in the practice protocol saved first.
+  // runs (the options' acceptance, a default scene layout), also in the practice protocol saved first.
   quiz_options_ = options.quiz_options;
-  quiz_options_.acceptance = TrialOptions{}.force.acceptance;
+  quiz_options_.acceptance = options.acceptance;
   quiz_options_.start_radius_m = SceneLayout{}.start_radius_m;
   guidance_mode_ = options.guidance_mode;
   guidance_gain_ = options.guidance_gain;
@@ -151,6 +151,7 @@ void PracticeController::launch_trial(std::size_t character) {
   spec.seed = options_.seed + trials_started_ - 1;
   spec.pacing = TrialPacing::real_time;
   spec.watchdog_s = options_.watchdog_s.value_or(default_watchdog_s(hardware_));
+  spec.acceptance = options_.acceptance;  // the hint and the assisted credit after the options' misses
   TrialRunInputs inputs;
   inputs.registry = options_.registry;
   inputs.teacher = options_.teacher;

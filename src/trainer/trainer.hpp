@@ -41,6 +41,9 @@ struct TrainerOptions {
   /// trials' (the renderer's tolerances and the scene's start neighbourhood), so that quiz and renderer
   /// agree.
   QuizOptions quiz_options;
+  /// When a stroke counts as written, and the misses after which it is hinted and credited assisted: every
+  /// trial's (its specification's, TrialSpec::acceptance) and the quiz's.
+  StrokeAcceptance acceptance;
   std::string quiz_screenshots;  ///< non-empty: a folder where a PNG is written after each judged stroke
   std::string record;            ///< non-empty: each completed trial is written here as a teacher recording
   std::string session_dir;       ///< empty: trials are not saved

@@ -427,9 +427,16 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual(fraction([near(missed, box.data_to_px(p), 4, is_blue) for p in inner]), 0.0)
 
     def test_the_quiz_options_need_quiz(self):
-        result = subprocess.run([CLI, "train", "一", "--hint-after-misses", "2"], capture_output=True, text=True)
+        with tempfile.TemporaryDirectory() as folder:
+            result = subprocess.run([CLI, "train", "一", "--quiz-screenshots", folder], capture_output=True,
+                                    text=True)
         self.assertEqual(result.returncode, 2, result.stderr)
         self.assertIn("--quiz", result.stderr)
+        # The miss counts are every trial's (the stroke acceptance's), in its range, refused before a window.
+        for option in ("--hint-after-misses", "--assist-after-misses"):
+            result = subprocess.run([CLI, "train", "一", option, "1001"], capture_output=True, text=True)
+            self.assertEqual(result.returncode, 2, result.stderr)
+            self.assertIn(option, result.stderr)
         # The quiz judges with the stroke matcher's tolerances: there is no leniency to set.
         result = subprocess.run([CLI, "train", "一", "--quiz", "--leniency", "2"], capture_output=True, text=True)
         self.assertEqual(result.returncode, 2, result.stderr)
@@ -658,6 +665,32 @@ class TrainerTest(unittest.TestCase):
         self.assertEqual(first["attempts"], 5)
         self.assertTrue(second["completed"])
         self.assertFalse(second["assisted"])
+
+    def test_the_miss_counts_given_to_train_reach_its_trials_and_records(self):
+        """`train 十 --hint-after-misses 1 --assist-after-misses 2`: stroke 1 is credited assisted at its second
+        miss (not the default fifth), stroke 2 written completes the trial, and the saved record states the
+        counts it ran with (its force law's acceptance)."""
+        trainer = self.start("十", "--device", "mouse", "--no-demo", "--session", "out", "--exit-after", "60",
+                             "--hint-after-misses", "1", "--assist-after-misses", "2")
+        (box,) = trainer.boxes()
+        hand = trainer.hand(box, seed=3)
+        time.sleep(0.5)
+        for count in (1, 2):
+            self.refuse_half_of_shi_stroke_one(trainer, hand, box, count)
+        time.sleep(1.0)
+        hand.write([box.data_to_px(p) for p in medians("十")[1]])
+        self.assertEqual(trainer.wait(timeout=30), 0, trainer.errors())
+        self.assertEqual(trainer.errors().count(SHI_STROKE_ONE_TOO_SHORT), 2, trainer.errors())
+        (record_path,) = saved_trials(pathlib.Path(self.folder) / "out")
+        record = json.loads(record_path.read_text(encoding="utf-8"))
+        self.assertEqual(record["end_reason"], "completed")
+        self.assertEqual((record["strokes_assisted"], record["strokes_written"]), (1, 1))
+        first, second = record["per_stroke"]
+        self.assertTrue(first["assisted"])
+        self.assertEqual(first["attempts"], 2)
+        self.assertTrue(second["completed"])
+        acceptance = record["force_law"]["acceptance"]
+        self.assertEqual((acceptance["hint_after_misses"], acceptance["assist_after_misses"]), (1, 2))
 
     def test_a_quiz_ends_completed_once_every_stroke_is_accepted(self):
         # 一 written along its median: the quiz accepts it as the renderer completes it (one stroke matcher,
@@ -1211,7 +1244,8 @@ GROUPS = {
     "lost_display": ("test_a_lost_display",),
     "stop_signals": ("EndingTest",),
     "openhaptics": ("test_a_haptic_device_writes_yong_through_the_stand_in_libhd",),
-    "hint_assist": ("test_misses_bring_the_hint", "test_the_panel_names_the_hinted_stroke"),
+    "hint_assist": ("test_misses_bring_the_hint", "test_the_panel_names_the_hinted_stroke",
+                    "test_the_miss_counts_given_to_train"),
 }
 
 
