@@ -48,12 +48,7 @@ const std::vector<SchemaField>& writer_setting_fields() {
 // the specification, so that its JSON Schema says "integer" as the protocol's quiz count does.
 template <double StrokeAcceptance::*Member>
 void make_count_field(SchemaField& field) {
-  field.kind = FieldKind::integer;
-  field.integer_low = static_cast<std::int64_t>(std::ceil(field.range.low));
-  field.integer_high = static_cast<std::int64_t>(std::floor(field.range.high));
-  field.range = {};
-  field.get_number = nullptr;
-  field.set_number = nullptr;
+  make_whole_number_kind(field);
   field.get_integer = [](const void* o) -> std::int64_t {
     return std::llround(static_cast<const TrialSpec*>(o)->acceptance.*Member);
   };

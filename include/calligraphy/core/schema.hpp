@@ -360,14 +360,20 @@ template <auto Member>
 
 /// `field`, a double member that holds whole numbers only (a count a ParameterTable keeps as a double), as an
 /// integer field over the whole numbers of its range: its JSON Schema then says "integer", as a count's does.
-template <auto Member>
-[[nodiscard]] SchemaField whole_number_field(SchemaField field) {
+/// `field` (a number field) made an integer field over the whole numbers of its range, without accessors:
+/// the caller sets `get_integer` and `set_integer`.
+inline void make_whole_number_kind(SchemaField& field) {
   field.kind = FieldKind::integer;
   field.integer_low = static_cast<std::int64_t>(std::ceil(field.range.low));
   field.integer_high = static_cast<std::int64_t>(std::floor(field.range.high));
   field.range = {};
   field.get_number = nullptr;
   field.set_number = nullptr;
+}
+
+template <auto Member>
+[[nodiscard]] SchemaField whole_number_field(SchemaField field) {
+  make_whole_number_kind(field);
   field.get_integer = [](const void* o) -> std::int64_t {
     return std::llround(schema_detail::cref<Member>(o));
   };
