@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs every test: installs dependencies, builds with warnings as errors and runs the Catch2 and
 # pytest suites through CTest, then again under AddressSanitizer + UndefinedBehaviorSanitizer, then the
-# servo-loop tests under ThreadSanitizer, then builds the fuzzers and replays their inputs, then
+# servo-loop tests under ThreadSanitizer, then replays the fuzzers' inputs (built in the ASan stage), then
 # installs the library and builds a separate project against it with find_package(calligraphy).
 # Each stage builds only what it tests; at the end the script prints each stage's time, and after each
 # CTest run its ten slowest tests (docs/testing.md: the time budget and how to run the long sweeps).
@@ -129,7 +129,7 @@ start_background "AddressSanitizer + UndefinedBehaviorSanitizer: build (clang)" 
   cmake -S . -B build-asan -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG='-O1 -g0' \
     -DCALLIGRAPHY_SANITIZE=address,undefined -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_BENCH=OFF \
     -DCALLIGRAPHY_BUILD_TESTS=ON -DCALLIGRAPHY_BUILD_EXAMPLES=ON -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_TRAINER=OFF \
-    -DCALLIGRAPHY_TEST_PYTHONPATH=$PWD/build/python \
+    -DCALLIGRAPHY_BUILD_FUZZERS=ON -DCALLIGRAPHY_TEST_PYTHONPATH=$PWD/build/python \
     -DCALLIGRAPHY_TEST_PYTHON_HD_STAND_IN=$PWD/build/lib/hd_stand_in/libHD.so >/dev/null &&
   cmake --build build-asan -j $jobs"
 begin_stage "Release tests"
@@ -140,19 +140,14 @@ python3 scripts/build-times.py build-asan
 
 # -Wno-tsan: GCC warns that TSan does not model atomic_thread_fence (the OpenHaptics seqlock uses it);
 # the seqlock's fields are atomics, so no race is hidden. Only the servo-loop test program (with the
-# OpenHaptics stand-in it loads) and the modules it links are built, at -O1. The fuzzers: a replay, not a
-# fuzzing run (docs/corpus.md has those): it keeps the fuzz targets building as sources move, and every
-# seed and regression input passing. Both are built beside the sanitizer tests.
-start_background "ThreadSanitizer and fuzzer (clang, libFuzzer) builds" "
-  cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO='-O1 -g1' \
+# OpenHaptics stand-in it loads) and the modules it links are built, at -O1, without debug information
+# (a report's stack names the functions, as the ASan stage's do), beside the sanitizer tests.
+start_background "ThreadSanitizer build" "
+  cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO='-O1 -g0' \
     -DCALLIGRAPHY_SANITIZE=thread -DCALLIGRAPHY_BUILD_TESTS=ON \
     -DCMAKE_CXX_FLAGS=-Wno-tsan -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_TOOLS=OFF \
     -DCALLIGRAPHY_BUILD_BENCH=OFF -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_EXAMPLES=OFF >/dev/null &&
-  cmake --build build-tsan -j $jobs --target calligraphy_servo_tests &&
-  cmake -S . -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCALLIGRAPHY_BUILD_FUZZERS=ON \
-    -DCALLIGRAPHY_BUILD_TESTS=OFF -DCALLIGRAPHY_BUILD_BENCH=OFF -DCALLIGRAPHY_BUILD_PYTHON=OFF \
-    -DCALLIGRAPHY_BUILD_EXAMPLES=OFF -DCALLIGRAPHY_BUILD_TOOLS=OFF -DCALLIGRAPHY_BUILD_TRAINER=OFF >/dev/null &&
-  cmake --build build-fuzz -j $jobs --target character_data_fuzzer corpus_store_fuzzer"
+  cmake --build build-tsan -j $jobs --target calligraphy_servo_tests"
 begin_stage "AddressSanitizer + UndefinedBehaviorSanitizer: tests"
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 run_ctest build-asan -E "study_report_chromium"
 end_stage
@@ -162,9 +157,12 @@ begin_stage "ThreadSanitizer: the servo loop, its log queue and the OpenHaptics 
 TSAN_OPTIONS=halt_on_error=1 build-tsan/bin/calligraphy_servo_tests "[servo],[log_queue]"
 end_stage
 
+# The fuzzers: a replay, not a fuzzing run (docs/corpus.md has those), built in the ASan build on its own
+# instrumented libraries with libFuzzer's driver (fuzz/CMakeLists.txt): it keeps the fuzz targets building as
+# sources move, and every seed and regression input passing.
 begin_stage "Fuzzers: replay their seeds and every input that ever failed"
-build-fuzz/bin/character_data_fuzzer -runs=0 data/hanzi-writer-data tests/data/hostile
-build-fuzz/bin/corpus_store_fuzzer -runs=0 fuzz/seeds tests/data/store_regressions
+build-asan/bin/character_data_fuzzer -runs=0 data/hanzi-writer-data tests/data/hostile
+build-asan/bin/corpus_store_fuzzer -runs=0 fuzz/seeds tests/data/store_regressions
 end_stage
 
 begin_stage "install + find_package(calligraphy) from another project"
