@@ -72,12 +72,16 @@ void print_trial_table(const TrialDescription& d, const Scene& scene, const Tria
   } else {
     std::snprintf(guidance, sizeof guidance, "%s", to_string(d.guidance_mode));
   }
-  std::printf("Trial %s: guidance %s, %s writer, seed %llu, %.0f Hz, device %s (%s)\n", d.characters.c_str(),
-              guidance, d.writer.c_str(), static_cast<unsigned long long>(d.seed), d.rate_hz,
-              d.device.c_str(), d.device_model.c_str());
+  std::printf(
+      "Trial %s: guidance %s, %s writer, seed %llu, %.0f Hz, device %s (%s); strokes numbered from 1 "
+      "here, from 0 in the JSON\n",
+      d.characters.c_str(), guidance, d.writer.c_str(), static_cast<unsigned long long>(d.seed), d.rate_hz,
+      d.device.c_str(), d.device_model.c_str());
   std::printf("\n  %-6s %-5s %-6s %-4s %9s %9s %11s %9s %9s %8s %9s\n", "stroke", "char", "type", "ID",
               "mean[mm]", "max[mm]", "Frechet[mm]", "DTW[mm]", "time[s]", "attempts", "completed");
-  std::size_t scene_stroke = 0;  // strokes numbered over the scene, from 0, as the renderer counts them
+  // Strokes numbered over the scene; a person reads them from 1 (the files count from 0, as the renderer
+  // does).
+  std::size_t scene_stroke = 0;
   for (const CharacterScore& character : writing.characters) {
     for (const StrokeScore& s : character.strokes) {
       const auto& w = s.metrics;
@@ -85,7 +89,7 @@ void print_trial_table(const TrialDescription& d, const Scene& scene, const Tria
       const StrokeMetrics* live = scene_stroke < m.per_stroke.size() ? &m.per_stroke[scene_stroke] : nullptr;
       char time_text[32] = "-";
       if (w) std::snprintf(time_text, sizeof time_text, "%.2f", w->kinematics.writing_time_s);
-      std::printf("  %-6zu %-5s %-6s %-4d %9s %9s %11s %9s %9s %8d %9s\n", scene_stroke,
+      std::printf("  %-6zu %-5s %-6s %-4d %9s %9s %11s %9s %9s %8d %9s\n", scene_stroke + 1,
                   encode_utf8(character.code_point).c_str(),
                   std::string(typical_stroke(s.typical_id).acronym).c_str(), s.typical_id,
                   millimetres(value([](auto& x) { return x.deviation.mean_m; }), 2).c_str(),

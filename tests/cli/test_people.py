@@ -192,6 +192,19 @@ def median_trace(medians, offsets):
     return "\n".join(rows) + "\n"
 
 
+class TheTrialsTable(PeopleTestCase):
+    """`trial`'s table numbers strokes as `score`'s does: from 1, where the JSON counts from 0."""
+
+    def test_strokes_are_numbered_from_one_and_the_json_from_zero(self):
+        status, text, err = self.run_cli("trial", "十", "--seed", "3", "--json", "t.json")
+        self.assertEqual(status, 0, err)
+        rows = [l for l in text.splitlines() if re.match(r"^\s*\d+\s+十", l)]
+        self.assertEqual([int(r.split()[0]) for r in rows], [1, 2], text)
+        self.assertIn("strokes numbered from 1 here, from 0 in the JSON", text)
+        record = json.loads((self.cwd / "t.json").read_text())
+        self.assertEqual([s["index"] for s in record["renderer_strokes"]], [0, 1])
+
+
 class TheTeachersScore(PeopleTestCase):
     """十: a horizontal stroke written 4 mm too high, then its vertical stroke well."""
 
