@@ -200,7 +200,9 @@ StudyCondition condition_from_mode(ConditionMode mode, const std::map<std::strin
   if (mode == ConditionMode::quiz) condition.quiz = QuizOptions{};
   condition.guidance = study_detail::default_guidance(mode);
   const std::span<const study_detail::ModeParameter> taken = study_detail::mode_parameters(mode);
-  for (const auto& [key, value] : parameters) {
+  for (const auto& given : parameters) {
+    const std::string& key = given.first;
+    const double value = given.second;
     const auto parameter = std::find_if(taken.begin(), taken.end(),
                                         [&](const study_detail::ModeParameter& p) { return p.key == key; });
     if (parameter == taken.end()) {
