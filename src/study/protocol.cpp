@@ -17,6 +17,7 @@
 #include "study/names.hpp"
 #include "study/parameter_json.hpp"
 #include "study/protocol_reading.hpp"
+#include "study/record_schema.hpp"
 
 namespace calligraphy {
 namespace study_detail {
@@ -79,22 +80,13 @@ using study_detail::take_table_number;
 
 constexpr const char* kFormat = "calligraphy-study-protocol";
 
-// "acceptance": the stroke matcher's tolerances by name, the keys a trial record writes and the ranges of
-// StrokeAcceptance's table; a key left out keeps its default.
+// "acceptance": the stroke matcher's tolerances by name, read through the acceptance's one schema
+// (SchemaOf<StrokeAcceptance>, record_schema.hpp: the keys a trial record writes, each field's range, the
+// miss counts whole numbers); a key left out keeps its default.
 StrokeAcceptance read_acceptance(const json& value, const std::string& pointer, const std::string& source) {
-  json_detail::ObjectReader reader(value, pointer, source);
   StrokeAcceptance a;
-  for (const ParameterField<StrokeAcceptance>& field : ParameterTable<StrokeAcceptance>::fields()) {
-    if (field.name.ends_with("_misses")) {  // a count: whole numbers only (StrokeAcceptance::validate)
-      a.*field.member =
-          static_cast<double>(reader.integer_or(std::string(field.name), std::llround(a.*field.member),
-                                                static_cast<std::int64_t>(std::ceil(field.range.low)),
-                                                static_cast<std::int64_t>(std::floor(field.range.high))));
-    } else {
-      a.*field.member = table_number_or(reader, std::string(field.name), a.*field.member, field.member);
-    }
-  }
-  reader.finish();  // any other key: an error naming it
+  SchemaReadResult unused;
+  schema_detail::from_json(SchemaOf<StrokeAcceptance>::get(), &a, value, pointer, source, {}, unused);
   return a;
 }
 
@@ -109,11 +101,11 @@ QuizOptions read_quiz(const json& value, const std::string& pointer, const std::
   if (const json* acceptance = reader.optional("acceptance")) {
     quiz.acceptance = read_acceptance(*acceptance, reader.pointer("acceptance"), source);
   }
-  // Overrides the acceptance's, in its table's range (StrokeAcceptance, the one definition).
+  // Overrides the acceptance's, read as the acceptance's own field (SchemaOf<StrokeAcceptance>).
   if (reader.optional("hint_after_misses") != nullptr) {
-    const ParameterRange range = parameter_field(&StrokeAcceptance::hint_after_misses).range;
-    quiz.hint_after_misses = static_cast<int>(reader.integer(
-        "hint_after_misses", static_cast<std::int64_t>(range.low), static_cast<std::int64_t>(range.high)));
+    StrokeAcceptance hint;
+    read_member(reader, SchemaOf<StrokeAcceptance>::get(), "hint_after_misses", &hint);
+    quiz.hint_after_misses = static_cast<int>(hint.hint_after_misses);
   }
   quiz.accept_backwards = reader.boolean_or("accept_backwards", quiz.accept_backwards);
   reader.finish();
@@ -122,7 +114,7 @@ QuizOptions read_quiz(const json& value, const std::string& pointer, const std::
 
 // The documented parameters of the guidance modes (docs/experiments.md), each checked against its guidance
 // law's or rule's table (study_detail::mode_parameters); an unknown key or a value out of range is an error
-// naming its pointer. A null value is taken as absent.
+// naming its pointer.
 std::map<std::string, double> read_guidance_parameters(const json& parameters, const std::string& pointer,
                                                        const std::string& source, ConditionMode mode) {
   json_detail::ObjectReader reader(parameters, pointer, source);

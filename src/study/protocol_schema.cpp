@@ -14,6 +14,7 @@
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/trial/trial_spec.hpp"
 #include "study/protocol_reading.hpp"
+#include "study/record_schema.hpp"
 
 namespace calligraphy {
 
@@ -258,26 +259,34 @@ ordered_json condition_schema() {
   return out;
 }
 
+// A field of the stroke acceptance's one schema (SchemaOf<StrokeAcceptance>, as the reader reads it)
+// described by `doc`: its table's range, a miss count over the whole numbers of it.
+ordered_json acceptance_property(const SchemaField& field, std::string_view doc) {
+  if (field.kind != FieldKind::integer) return number_schema(field.range, field.unit, doc);
+  std::string text(doc);
+  if (!field.unit.empty()) text.append(" [").append(field.unit).append("]");
+  return {{"type", "integer"},
+          {"description", text},
+          {"minimum", field.integer_low},
+          {"maximum", field.integer_high}};
+}
+
 ordered_json quiz_schema() {
+  const Schema& acceptance_schema = SchemaOf<StrokeAcceptance>::get();
   ordered_json acceptance = ordered_json::object();
-  for (const ParameterField<StrokeAcceptance>& field : ParameterTable<StrokeAcceptance>::fields()) {
-    put_table_field(acceptance, field.name, field.member);
-    if (field.name.ends_with("_misses")) {  // a count: whole numbers only (StrokeAcceptance::validate)
-      acceptance[std::string(field.name)]["type"] = "integer";
-      acceptance[std::string(field.name)]["minimum"] = static_cast<std::int64_t>(std::ceil(field.range.low));
-      acceptance[std::string(field.name)]["maximum"] =
-          static_cast<std::int64_t>(std::floor(field.range.high));
-    }
+  for (const SchemaField& field : acceptance_schema.fields) {
+    std::string doc(acceptance_schema.name);
+    doc.append(".").append(field.name).append(": ").append(field.doc);
+    acceptance[std::string(field.name)] = acceptance_property(field, doc);
   }
   ordered_json properties = ordered_json::object();
   properties["acceptance"] =
       object_schema(std::move(acceptance), "the stroke matcher's tolerances (docs/stroke-acceptance.md)");
-  // An override of the acceptance's, in its table's range (StrokeAcceptance: the one definition).
-  const ParameterRange hint = parameter_field(&StrokeAcceptance::hint_after_misses).range;
-  properties["hint_after_misses"] =
-      integer_schema(static_cast<std::int64_t>(hint.low), static_cast<std::int64_t>(hint.high),
-                     "a hint after this many misses on one stroke, and each further one; 0: never; overrides "
-                     "acceptance.hint_after_misses (default: the acceptance's)");
+  // An override of the acceptance's, read as its field.
+  properties["hint_after_misses"] = acceptance_property(
+      *acceptance_schema.field("hint_after_misses"),
+      "a hint after this many misses on one stroke, and each further one; 0: never; overrides "
+      "acceptance.hint_after_misses (default: the acceptance's)");
   properties["accept_backwards"] = {
       {"type", "boolean"}, {"description", "a stroke written from its end to its start is accepted"}};
   return object_schema(std::move(properties), "how a quiz judges strokes");
