@@ -58,19 +58,22 @@ TEST_CASE("fading follows Emken's rule and a repetition with nothing written bri
 
 TEST_CASE("a study's repetition guidance from its records is the trainer's schedule in memory",
           "[guidance][schedule]") {
-  for (const ConditionMode mode :
-       {ConditionMode::fading, ConditionMode::assist_as_needed, ConditionMode::skill_adaptive}) {
-    StudyCondition condition;
-    condition.name = "c";
-    condition.mode = mode;
-    condition.start_gain = 0.6;
-    condition.start_band_m = 0.002;
-    condition.fading_rule.forgetting_factor = 0.7;
-    condition.assist_rule.target_error_m = 0.001;
-    condition.skill_rule.threshold_m = 0.0015;
-    const GuidanceSchedule schedule = study_detail::condition_schedule(condition);
-    REQUIRE(schedule.start_gain == condition.start_gain);
-    REQUIRE(schedule.fading_rule.forgetting_factor == condition.fading_rule.forgetting_factor);
+  const StudyProtocol protocol = parse_study_protocol(
+      R"({"name": "g", "conditions": [
+            {"name": "fade", "mode": "fading", "parameters": {"start_gain": 0.6, "forgetting_factor": 0.7}},
+            {"name": "band", "mode": "assist-as-needed",
+             "parameters": {"start_band_m": 0.002, "target_error_m": 0.001}},
+            {"name": "adapt", "mode": "skill-adaptive", "parameters": {"threshold_m": 0.0015}}],
+          "test": {"characters": ["十"], "conditions": ["fade", "band", "adapt"], "repetitions": 1}})",
+      "g.json");
+  for (const StudyCondition& condition : protocol.conditions) {
+    const ConditionMode mode = condition_mode(condition);
+    REQUIRE(condition.guidance);
+    REQUIRE(condition.guidance->schedule);
+    const GuidanceSchedule schedule = *condition.guidance->schedule;
+    if (mode == ConditionMode::fading) REQUIRE(schedule.start_gain == 0.6);
+    if (mode == ConditionMode::fading) REQUIRE(schedule.fading_rule.forgetting_factor == 0.7);
+    if (mode == ConditionMode::assist_as_needed) REQUIRE(schedule.start_band_m == 0.002);
     RepetitionGuidance in_memory = schedule.start();
     RepetitionGuidance from_records = in_memory;
     const study_detail::PreparedGuidance first =

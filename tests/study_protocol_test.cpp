@@ -3,11 +3,13 @@
 #include <catch2/catch.hpp>
 #include <charconv>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <optional>
 #include <random>
 #include <set>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
@@ -53,12 +55,13 @@ TEST_CASE("a protocol is read with every field", "[study][protocol]") {
   const StudyProtocol p = parse_study_protocol(protocol_text(), "p.json");
   CHECK(p.name == "t");
   REQUIRE(p.conditions.size() == 3);
-  CHECK(p.conditions[2].mode == ConditionMode::quiz);
-  CHECK(p.conditions[2].quiz.acceptance.corridor_m == 0.008);
-  CHECK(p.conditions[2].quiz.acceptance.shortfall_fraction == 0.3);
-  CHECK(p.conditions[2].quiz.acceptance.mean_deviation_m == StrokeAcceptance{}.mean_deviation_m);
-  CHECK(p.conditions[2].quiz.start_radius_m == SceneLayout{}.start_radius_m);
-  CHECK(p.conditions[2].quiz.hint_after_misses == 2);
+  CHECK(condition_mode(p.conditions[2]) == ConditionMode::quiz);
+  REQUIRE(p.conditions[2].quiz);
+  CHECK(p.conditions[2].quiz->acceptance.corridor_m == 0.008);
+  CHECK(p.conditions[2].quiz->acceptance.shortfall_fraction == 0.3);
+  CHECK(p.conditions[2].quiz->acceptance.mean_deviation_m == StrokeAcceptance{}.mean_deviation_m);
+  CHECK(p.conditions[2].quiz->start_radius_m == SceneLayout{}.start_radius_m);
+  CHECK(p.conditions[2].quiz->hint_after_misses == 2);
   REQUIRE(p.phases.size() == 2);
   CHECK(p.phases[0].kind == StudyPhase::practice);
   CHECK(p.phases[0].items == std::vector<std::u32string>{U"永"});
@@ -68,7 +71,7 @@ TEST_CASE("a protocol is read with every field", "[study][protocol]") {
   CHECK(p.item_order == ItemOrder::random);
   CHECK(p.seed == 5);
   CHECK(p.breaks.every_trials == 4);
-  CHECK(p.condition("B").mode == ConditionMode::haptic);
+  CHECK(condition_mode(p.condition("B")) == ConditionMode::haptic);
   CHECK_THROWS_AS(p.condition("D"), InvalidArgument);
 }
 
@@ -170,18 +173,24 @@ TEST_CASE("fading and replay conditions are read with their parameters", "[study
           "test": {"characters": ["大", "山"], "conditions": ["fade", "play", "fade0"], "repetitions": 1}})",
       "f.json");
   const StudyCondition& fade = p.condition("fade");
-  CHECK(fade.mode == ConditionMode::fading);
-  CHECK(fade.start_gain == 0.8);
-  CHECK(fade.fading_rule.forgetting_factor == 0.5);
-  CHECK(fade.fading_rule.error_gain_per_m == 100.0);
+  CHECK(condition_mode(fade) == ConditionMode::fading);
+  REQUIRE(fade.guidance);
+  REQUIRE(fade.guidance->schedule);
+  CHECK(std::get<FadingGuidance>(fade.guidance->law).gain == 0.8);
+  CHECK(fade.guidance->schedule->start_gain == 0.8);
+  CHECK(fade.guidance->schedule->fading_rule.forgetting_factor == 0.5);
+  CHECK(fade.guidance->schedule->fading_rule.error_gain_per_m == 100.0);
   CHECK(fade.guidance_parameters.at("start_gain") == 0.8);
   const StudyCondition& play = p.condition("play");
-  CHECK(play.replay_max_lead_m == std::optional<double>(0.002));
+  REQUIRE(play.guidance);
+  CHECK(std::get<ReplayGuidance>(play.guidance->law).max_lead_m == 0.002);
   CHECK(play.teachers.at(U"大") == "teachers/da.json");
   CHECK(play.teachers.count(U"山") == 0);  // recorded by the runner
   const StudyCondition& defaults = p.condition("fade0");
-  CHECK(defaults.start_gain == 1.0);
-  CHECK(defaults.fading_rule.forgetting_factor == FadingRule{}.forgetting_factor);
+  REQUIRE(defaults.guidance);
+  REQUIRE(defaults.guidance->schedule);
+  CHECK(defaults.guidance->schedule->start_gain == 1.0);
+  CHECK(defaults.guidance->schedule->fading_rule.forgetting_factor == FadingRule{}.forgetting_factor);
 }
 
 TEST_CASE("fading and replay parameters and teachers are checked naming the JSON pointer",
@@ -223,14 +232,16 @@ TEST_CASE("the other guidance schedules are read with their parameters, checked 
           "test": {"characters": ["大"], "conditions": ["A", "E", "S", "T"], "repetitions": 1}})",
                               "t.json")
                               .protocol;
-  CHECK(p.condition("A").start_band_m == 0.002);
-  CHECK(p.condition("A").assist_rule.target_error_m == 0.001);
-  CHECK(p.condition("A").assist_rule.rate == 0.5);
-  CHECK(p.condition("A").assist_rule.max_band_m == 0.003);
-  CHECK(p.condition("E").amplification_gain == 0.4);
-  CHECK(p.condition("E").amplification_max_force_n == 0.2);
-  CHECK(p.condition("S").skill_rule.threshold_m == 0.0015);
-  CHECK(p.condition("T").timing_speed_m_s == 0.02);
+  const GuidanceSchedule& band = p.condition("A").guidance.value().schedule.value();
+  CHECK(band.start_band_m == 0.002);
+  CHECK(band.assist_rule.target_error_m == 0.001);
+  CHECK(band.assist_rule.rate == 0.5);
+  CHECK(band.assist_rule.max_band_m == 0.003);
+  const auto& amplification = std::get<ErrorAmplificationGuidance>(p.condition("E").guidance.value().law);
+  CHECK(amplification.gain == 0.4);
+  CHECK(amplification.max_force_n == 0.2);
+  CHECK(p.condition("S").guidance.value().schedule.value().skill_rule.threshold_m == 0.0015);
+  CHECK(std::get<TimingGuidance>(p.condition("T").guidance.value().law).speed_m_s == 0.02);
   for (const ConditionMode mode : condition_modes())
     CHECK(renders_guidance(mode) == (mode != ConditionMode::vision && mode != ConditionMode::quiz));
   const auto with_condition = [](const std::string& condition) {
@@ -254,6 +265,122 @@ TEST_CASE("the other guidance schedules are read with their parameters, checked 
               "/conditions/0/parameters", "takes no parameters");
   check_error(with_condition(R"({"name": "A", "mode": "vision", "parameters": {}})"),
               "/conditions/0/parameters", "takes no parameters");
+}
+
+TEST_CASE("every mode reads as one display, guidance law and schedule, and spells itself back",
+          "[study][protocol][guidance]") {
+  struct Case {
+    std::string mode;
+    std::string fields;  // the condition's keys after its mode
+    std::function<void(const StudyCondition&)> check;
+  };
+  const auto law_of = [](const StudyCondition& c) -> const GuidanceLaw& { return c.guidance.value().law; };
+  const auto schedule_of = [](const StudyCondition& c) -> const GuidanceSchedule& {
+    return c.guidance.value().schedule.value();
+  };
+  const std::vector<Case> cases{
+      {"vision", "",
+       [](const StudyCondition& c) {
+         CHECK(!c.quiz);
+         CHECK(!c.guidance);
+       }},
+      {"quiz", R"(, "quiz": {"acceptance": {"corridor_m": 0.007}, "hint_after_misses": 3})",
+       [](const StudyCondition& c) {
+         REQUIRE(c.quiz);
+         CHECK(c.quiz->acceptance.corridor_m == 0.007);
+         CHECK(c.quiz->hint_after() == 3);
+         CHECK(!c.guidance);
+       }},
+      {"haptic", R"(, "guidance_stiffness_n_per_m": 300)",
+       [&](const StudyCondition& c) {
+         CHECK(std::holds_alternative<FixedGuidance>(law_of(c)));
+         CHECK(!c.guidance->schedule);
+         CHECK(c.guidance->stiffness_n_per_m == std::optional<double>(300.0));
+       }},
+      {"fading", R"(, "parameters": {"start_gain": 0.7, "forgetting_factor": 0.6, "error_gain_per_m": 120})",
+       [&](const StudyCondition& c) {
+         CHECK(std::get<FadingGuidance>(law_of(c)).gain == 0.7);
+         const GuidanceSchedule& s = schedule_of(c);
+         CHECK(s.adapts == AdaptiveGuidance::fading);
+         CHECK(s.start_gain == 0.7);
+         CHECK(s.fading_rule.forgetting_factor == 0.6);
+         CHECK(s.fading_rule.error_gain_per_m == 120.0);
+         CHECK(!c.guidance->stiffness_n_per_m);
+       }},
+      {"replay", R"(, "parameters": {"max_lead_m": 0.002})",
+       [&](const StudyCondition& c) {
+         const auto& replay = std::get<ReplayGuidance>(law_of(c));
+         CHECK(replay.max_lead_m == 0.002);
+         CHECK(replay.teacher_trajectory.empty());  // added per trial
+         CHECK(!c.guidance->schedule);
+         CHECK(replays_teacher(c));
+       }},
+      {"assist-as-needed", R"(, "parameters": {"start_band_m": 0.0015, "band_rate": 0.4})",
+       [&](const StudyCondition& c) {
+         CHECK(std::get<AssistAsNeededGuidance>(law_of(c)).band_m == 0.0015);
+         const GuidanceSchedule& s = schedule_of(c);
+         CHECK(s.adapts == AdaptiveGuidance::assist_as_needed);
+         CHECK(s.start_band_m == 0.0015);
+         CHECK(s.assist_rule.rate == 0.4);
+         CHECK(s.assist_rule.target_error_m == AssistBandRule{}.target_error_m);
+       }},
+      {"error-amplification", R"(, "parameters": {"amplification_gain": 0.3, "max_force_n": 0.2})",
+       [&](const StudyCondition& c) {
+         const auto& amplification = std::get<ErrorAmplificationGuidance>(law_of(c));
+         CHECK(amplification.gain == 0.3);
+         CHECK(amplification.max_force_n == 0.2);
+         CHECK(!c.guidance->schedule);
+       }},
+      {"skill-adaptive",
+       R"(, "parameters": {"threshold_m": 0.002, "amplification_gain": 0.35, "max_force_n": 0.25})",
+       [&](const StudyCondition& c) {
+         CHECK(std::holds_alternative<FixedGuidance>(law_of(c)));
+         const GuidanceSchedule& s = schedule_of(c);
+         CHECK(s.adapts == AdaptiveGuidance::skill_adaptive);
+         CHECK(s.skill_rule.threshold_m == 0.002);
+         // The error amplification it chooses carries the protocol's gain and bound.
+         RepetitionGuidance amplify = s.start();
+         amplify.mode = GuidanceMode::error_amplification;
+         const GuidanceLaw chosen = s.law_of(amplify, law_of(c));
+         REQUIRE(std::holds_alternative<ErrorAmplificationGuidance>(chosen));
+         CHECK(std::get<ErrorAmplificationGuidance>(chosen).gain == 0.35);
+         CHECK(std::get<ErrorAmplificationGuidance>(chosen).max_force_n == 0.25);
+         CHECK(std::holds_alternative<FixedGuidance>(s.law_of(s.start(), law_of(c))));
+       }},
+      {"timing", R"(, "parameters": {"speed_m_s": 0.03})",
+       [&](const StudyCondition& c) {
+         CHECK(std::get<TimingGuidance>(law_of(c)).speed_m_s == 0.03);
+         CHECK(!c.guidance->schedule);
+       }},
+  };
+  REQUIRE(cases.size() == condition_modes().size());
+  for (const ConditionMode mode : condition_modes()) {
+    const auto found =
+        std::find_if(cases.begin(), cases.end(), [&](const Case& k) { return k.mode == to_string(mode); });
+    REQUIRE(found != cases.end());
+    INFO(found->mode);
+    const StudyProtocol p = parse_study_protocol(
+        R"({"name": "t", "conditions": [{"name": "A", "mode": ")" + found->mode + "\"" + found->fields +
+            R"(}], "test": {"characters": ["大"], "conditions": ["A"], "repetitions": 1}})",
+        "p.json");
+    const StudyCondition& read = p.conditions.at(0);
+    CHECK(condition_mode(read) == mode);
+    CHECK(to_string(condition_mode(read)) == found->mode);
+    CHECK(read.guidance.has_value() == renders_guidance(mode));
+    found->check(read);
+    // The same condition from the mode and the parameters as the protocol gives them.
+    const StudyCondition made = condition_from_mode(mode, read.guidance_parameters);
+    CHECK(condition_mode(made) == mode);
+    CHECK(made.guidance.has_value() == read.guidance.has_value());
+    if (made.guidance) {
+      CHECK(made.guidance->law == read.guidance->law);
+      CHECK(made.guidance->schedule.has_value() == read.guidance->schedule.has_value());
+    }
+  }
+  CHECK_THROWS_WITH(condition_from_mode(ConditionMode::timing, {{"start_gain", 0.5}}),
+                    Catch::Contains("start_gain"));
+  CHECK_THROWS_WITH(condition_from_mode(ConditionMode::fading, {{"start_gain", 1.5}}),
+                    Catch::Contains("FadingGuidance.gain"));
 }
 
 TEST_CASE("a quiz condition's acceptance is checked naming the key, and leniency is refused",
@@ -285,7 +412,8 @@ TEST_CASE("a quiz condition's acceptance is checked naming the key, and leniency
         "shortfall_fraction": 0.4, "displacement_m": 0.002, "follow_through_m": 0.009, "max_gain_ratio": 3,
         "lookahead_m": 0.005}, "accept_backwards": true})"),
       "p.json");
-  const StrokeAcceptance& a = p.conditions[0].quiz.acceptance;
+  REQUIRE(p.conditions[0].quiz);
+  const StrokeAcceptance& a = p.conditions[0].quiz->acceptance;
   CHECK(a.corridor_m == 0.007);
   CHECK(a.mean_deviation_m == 0.0035);
   CHECK(a.shortfall_m == 0.005);
@@ -294,7 +422,7 @@ TEST_CASE("a quiz condition's acceptance is checked naming the key, and leniency
   CHECK(a.follow_through_m == 0.009);
   CHECK(a.max_gain_ratio == 3.0);
   CHECK(a.lookahead_m == 0.005);
-  CHECK(p.conditions[0].quiz.accept_backwards);
+  CHECK(p.conditions[0].quiz->accept_backwards);
 }
 
 TEST_CASE("a quiz condition's hint is its acceptance's hint_after_misses unless the quiz overrides it",
@@ -305,7 +433,7 @@ TEST_CASE("a quiz condition's hint is its acceptance's hint_after_misses unless 
                    R"(}], "test": {"characters": ["大"], "conditions": ["A"], "repetitions": 1}})",
                "p.json")
         .conditions[0]
-        .quiz;
+        .quiz.value();
   };
   CHECK(quiz_of("{}").hint_after() == static_cast<int>(StrokeAcceptance{}.hint_after_misses));
   CHECK(!quiz_of("{}").hint_after_misses.has_value());
@@ -332,7 +460,9 @@ TEST_CASE("a balanced Latin square: each condition once per row, every ordered p
     p.name = "l";
     ProtocolPhase test;
     for (int k = 0; k < n; ++k) {
-      p.conditions.push_back({std::string(1, static_cast<char>('A' + k)), ConditionMode::vision, {}, {}, {}});
+      StudyCondition condition;
+      condition.name = std::string(1, static_cast<char>('A' + k));
+      p.conditions.push_back(condition);
       test.conditions.push_back(p.conditions.back().name);
     }
     test.items = {U"大"};
@@ -697,9 +827,9 @@ TEST_CASE("a protocol's trial settings, breaks and guidance stiffness take the t
   const auto stiff = [&](const std::string& value) {
     return with(R"({"name": "A", "mode": "haptic", "guidance_stiffness_n_per_m": )" + value + "}", "");
   };
-  CHECK(parse_study_protocol(stiff("0"), "p.json").conditions[0].guidance_stiffness_n_per_m ==
+  CHECK(parse_study_protocol(stiff("0"), "p.json").conditions[0].guidance.value().stiffness_n_per_m ==
         std::optional<double>(0.0));
-  CHECK(parse_study_protocol(stiff("2e5"), "p.json").conditions[0].guidance_stiffness_n_per_m ==
+  CHECK(parse_study_protocol(stiff("2e5"), "p.json").conditions[0].guidance.value().stiffness_n_per_m ==
         std::optional<double>(2e5));
   check_error(stiff("-1"), "/conditions/0/guidance_stiffness_n_per_m",
               "ForceLawParameters.guidance_stiffness_n_per_m");

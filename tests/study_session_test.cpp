@@ -331,10 +331,11 @@ TEST_CASE("a fading gain follows the previous repetition of the item, the same a
     CHECK(record["force_law"]["guidance_mode"] == "fading");
     const auto before = previous.find(trial.characters);
     if (before == previous.end()) {
-      CHECK(gain == fade.start_gain);
+      CHECK(gain == fade.guidance.value().schedule.value().start_gain);
       CHECK(record["guidance"]["previous_trial"].is_null());
     } else {
-      CHECK(gain == next_guidance_gain(before->second.first, before->second.second, fade.fading_rule));
+      CHECK(gain == next_guidance_gain(before->second.first, before->second.second,
+                                       fade.guidance.value().schedule.value().fading_rule));
     }
     previous[trial.characters] = {gain, record["mean_deviation_m"].get<double>()};
     CHECK(record_of(resumed, trial)["guidance"] == record["guidance"]);
@@ -383,15 +384,18 @@ TEST_CASE("an assist band and a skill-adaptive mode follow the previous repetiti
       CHECK(record["force_law"]["guidance_mode"] == "assist-as-needed");
       CHECK(record["force_law"]["assist_band_m"].get<double>() == b);
       CHECK(b == (before == previous.end()
-                      ? band.start_band_m
-                      : next_assist_band(before->second.first, before->second.second, band.assist_rule)));
+                      ? band.guidance.value().schedule.value().start_band_m
+                      : next_assist_band(before->second.first, before->second.second,
+                                         band.guidance.value().schedule.value().assist_rule)));
       previous[key] = {b, deviation_m};
     } else if (trial.condition == "adapt") {
       const std::string selected = record["guidance"]["selected_mode"].get<std::string>();
       CHECK(record["force_law"]["guidance_mode"] == selected);
       const std::string expected =
-          before == previous.end() ? "fixed"
-                                   : to_string(skill_adaptive_mode(before->second.second, adapt.skill_rule));
+          before == previous.end()
+              ? "fixed"
+              : to_string(skill_adaptive_mode(before->second.second,
+                                              adapt.guidance.value().schedule.value().skill_rule));
       CHECK(selected == expected);
       adaptive_modes.insert(selected);
       previous[key] = {0.0, deviation_m};

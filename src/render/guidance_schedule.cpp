@@ -1,6 +1,7 @@
 #include "calligraphy/render/guidance_schedule.hpp"
 
 #include <limits>
+#include <variant>
 
 namespace calligraphy {
 
@@ -40,6 +41,21 @@ RepetitionGuidance GuidanceSchedule::next(const RepetitionGuidance& previous,
       break;
   }
   return following;
+}
+
+GuidanceLaw GuidanceSchedule::law_of(const RepetitionGuidance& repetition, GuidanceLaw law) const {
+  switch (adapts) {
+    case AdaptiveGuidance::fading:
+      if (auto* fading = std::get_if<FadingGuidance>(&law)) fading->gain = repetition.gain;
+      break;
+    case AdaptiveGuidance::assist_as_needed:
+      if (auto* assist = std::get_if<AssistAsNeededGuidance>(&law)) assist->band_m = repetition.band_m;
+      break;
+    case AdaptiveGuidance::skill_adaptive:
+      if (repetition.mode == GuidanceMode::error_amplification) return amplification;
+      break;
+  }
+  return law;
 }
 
 }  // namespace calligraphy

@@ -62,7 +62,7 @@ SessionManifest cohort_manifest(const LoadedProtocol& protocol, const SubjectAss
 // A replay's teacher is recorded into its session folder, which a cohort does not have.
 void refuse_replay(const StudyProtocol& protocol) {
   for (const StudyCondition& condition : protocol.conditions) {
-    if (condition.mode == ConditionMode::replay) {
+    if (replays_teacher(condition)) {
       throw InvalidArgument("condition '" + condition.name +
                             "': a replay's teacher is kept in a session folder; a simulated cohort runs "
                             "without one (run it with calligraphy session run)");
@@ -78,7 +78,7 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
                              std::to_string(manifest.setup.session_number) + ", trial " +
                              std::to_string(trial.index + 1);
   study_detail::PreparedGuidance guidance;
-  if (study_detail::adapts_by_repetition(condition.mode)) {
+  if (study_detail::adapts_by_repetition(condition)) {
     const PlannedTrial* previous = study_detail::previous_repetition(manifest.plan, trial);
     guidance = study_detail::repetition_guidance(condition, previous, previous_record, source);
   }
@@ -122,7 +122,7 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
   context.simulation.seed = checked->seed;
   context.writer_log = writing.log();
   std::vector<std::vector<QuizEvent>> quiz;
-  if (condition.mode == ConditionMode::quiz) quiz = quiz_characters(scene, result.trace, condition.quiz);
+  if (condition.quiz) quiz = quiz_characters(scene, result.trace, *condition.quiz);
   json record =
       study_detail::trial_record(context, scene, result, run.metrics, quiz.empty() ? nullptr : &quiz);
   // Learned from as a session learns from its saved record.

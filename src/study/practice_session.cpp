@@ -93,7 +93,7 @@ std::pair<std::filesystem::path, bool> PracticeSession::save(const PracticeTrial
   const Scene& scene = *trial.scene;
   const WritingMetrics writing = trial_writing_metrics(scene, result, trial.options->force.acceptance);
   std::vector<std::vector<QuizEvent>> quiz;
-  if (condition.mode == ConditionMode::quiz) quiz = quiz_characters(scene, result.trace, condition.quiz);
+  if (condition.quiz) quiz = quiz_characters(scene, result.trace, *condition.quiz);
   const bool keep_as_trial = result.end == TrialEnd::completed || result.end == TrialEnd::time_limit ||
                              result.end == TrialEnd::gave_up || result.end == TrialEnd::writer_finished;
   nlohmann::json details = {{"trial", planned.index + 1},

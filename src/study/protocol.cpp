@@ -17,6 +17,7 @@
 #include "study/names.hpp"
 #include "study/parameter_json.hpp"
 #include "study/protocol_reading.hpp"
+#include "study/record_schema.hpp"
 
 namespace calligraphy {
 namespace study_detail {
@@ -79,22 +80,13 @@ using study_detail::take_table_number;
 
 constexpr const char* kFormat = "calligraphy-study-protocol";
 
-// "acceptance": the stroke matcher's tolerances by name, the keys a trial record writes and the ranges of
-// StrokeAcceptance's table; a key left out keeps its default.
+// "acceptance": the stroke matcher's tolerances by name, read through the acceptance's one schema
+// (SchemaOf<StrokeAcceptance>, record_schema.hpp: the keys a trial record writes, each field's range, the
+// miss counts whole numbers); a key left out keeps its default.
 StrokeAcceptance read_acceptance(const json& value, const std::string& pointer, const std::string& source) {
-  json_detail::ObjectReader reader(value, pointer, source);
   StrokeAcceptance a;
-  for (const ParameterField<StrokeAcceptance>& field : ParameterTable<StrokeAcceptance>::fields()) {
-    if (field.name.ends_with("_misses")) {  // a count: whole numbers only (StrokeAcceptance::validate)
-      a.*field.member =
-          static_cast<double>(reader.integer_or(std::string(field.name), std::llround(a.*field.member),
-                                                static_cast<std::int64_t>(std::ceil(field.range.low)),
-                                                static_cast<std::int64_t>(std::floor(field.range.high))));
-    } else {
-      a.*field.member = table_number_or(reader, std::string(field.name), a.*field.member, field.member);
-    }
-  }
-  reader.finish();  // any other key: an error naming it
+  SchemaReadResult unused;
+  schema_detail::from_json(SchemaOf<StrokeAcceptance>::get(), &a, value, pointer, source, {}, unused);
   return a;
 }
 
@@ -109,11 +101,11 @@ QuizOptions read_quiz(const json& value, const std::string& pointer, const std::
   if (const json* acceptance = reader.optional("acceptance")) {
     quiz.acceptance = read_acceptance(*acceptance, reader.pointer("acceptance"), source);
   }
-  // Overrides the acceptance's, in its table's range (StrokeAcceptance, the one definition).
+  // Overrides the acceptance's, read as the acceptance's own field (SchemaOf<StrokeAcceptance>).
   if (reader.optional("hint_after_misses") != nullptr) {
-    const ParameterRange range = parameter_field(&StrokeAcceptance::hint_after_misses).range;
-    quiz.hint_after_misses = static_cast<int>(reader.integer(
-        "hint_after_misses", static_cast<std::int64_t>(range.low), static_cast<std::int64_t>(range.high)));
+    StrokeAcceptance hint;
+    read_member(reader, SchemaOf<StrokeAcceptance>::get(), "hint_after_misses", &hint);
+    quiz.hint_after_misses = static_cast<int>(hint.hint_after_misses);
   }
   quiz.accept_backwards = reader.boolean_or("accept_backwards", quiz.accept_backwards);
   reader.finish();
@@ -121,73 +113,29 @@ QuizOptions read_quiz(const json& value, const std::string& pointer, const std::
 }
 
 // The documented parameters of the guidance modes (docs/experiments.md), each checked against its guidance
-// law's or rule's table; an unknown key or a value out of range is an error naming its pointer.
-void read_guidance_parameters(const json& parameters, const std::string& pointer, const std::string& source,
-                              StudyCondition& condition) {
+// law's or rule's table (study_detail::mode_parameters); an unknown key or a value out of range is an error
+// naming its pointer.
+std::map<std::string, double> read_guidance_parameters(const json& parameters, const std::string& pointer,
+                                                       const std::string& source, ConditionMode mode) {
   json_detail::ObjectReader reader(parameters, pointer, source);
-  switch (condition.mode) {
-    case ConditionMode::fading: {
-      FadingRule& rule = condition.fading_rule;
-      condition.start_gain =
-          table_number_or(reader, "start_gain", condition.start_gain, &FadingGuidance::gain);
-      rule.forgetting_factor = table_number_or(reader, "forgetting_factor", rule.forgetting_factor,
-                                               &FadingRule::forgetting_factor);
-      rule.error_gain_per_m =
-          table_number_or(reader, "error_gain_per_m", rule.error_gain_per_m, &FadingRule::error_gain_per_m);
-      break;
-    }
-    case ConditionMode::replay:
-      // The table's range narrowed to the trial's R_res: the bound a trial checks.
-      if (reader.has("max_lead_m")) {
-        const ParameterRange range = protocol_max_lead_range();
-        const double lead = reader.number("max_lead_m", -std::numeric_limits<double>::max(),
-                                          std::numeric_limits<double>::max());
-        if (!range.contains(lead)) {
-          json_detail::fail(
-              source, reader.pointer("max_lead_m"),
-              "expected a number " + range.text("m") +
-                  " (ReplayGuidance.max_lead_m, at most ForceLawParameters.constraint_radius_m), "
-                  "got " +
-                  json(lead).dump());
-        }
-        condition.replay_max_lead_m = lead;
-      }
-      break;
-    case ConditionMode::assist_as_needed: {
-      AssistBandRule& rule = condition.assist_rule;
-      condition.start_band_m =
-          table_number_or(reader, "start_band_m", condition.start_band_m, &AssistAsNeededGuidance::band_m);
-      rule.target_error_m =
-          table_number_or(reader, "target_error_m", rule.target_error_m, &AssistBandRule::target_error_m);
-      rule.rate = table_number_or(reader, "band_rate", rule.rate, &AssistBandRule::rate);
-      rule.min_band_m = table_number_or(reader, "min_band_m", rule.min_band_m, &AssistBandRule::min_band_m);
-      rule.max_band_m = table_number_or(reader, "max_band_m", rule.max_band_m, &AssistBandRule::max_band_m);
-      if (rule.max_band_m < rule.min_band_m) {
-        json_detail::fail(source, reader.pointer("max_band_m"), "expected a band at least min_band_m");
-      }
-      break;
-    }
-    case ConditionMode::skill_adaptive:
-      condition.skill_rule.threshold_m = table_number_or(
-          reader, "threshold_m", condition.skill_rule.threshold_m, &SkillAdaptiveRule::threshold_m);
-      [[fallthrough]];
-    case ConditionMode::error_amplification:
-      take_table_number(reader, "amplification_gain", condition.amplification_gain,
-                        &ErrorAmplificationGuidance::gain);
-      take_table_number(reader, "max_force_n", condition.amplification_max_force_n,
-                        &ErrorAmplificationGuidance::max_force_n);
-      break;
-    case ConditionMode::timing:
-      take_table_number(reader, "speed_m_s", condition.timing_speed_m_s, &TimingGuidance::speed_m_s);
-      break;
-    default:
-      break;
+  std::map<std::string, double> values;
+  for (const study_detail::ModeParameter& parameter : study_detail::mode_parameters(mode)) {
+    const std::string key(parameter.key);
+    if (!reader.has(key)) continue;
+    const double value =
+        reader.number(key, -std::numeric_limits<double>::max(), std::numeric_limits<double>::max());
+    if (!parameter.range.contains(value))
+      json_detail::fail(source, reader.pointer(key), study_detail::parameter_range_message(parameter, value));
+    values[key] = value;
+  }
+  // A rule across the keys: the assist-as-needed band's bounds in order.
+  const StudyCondition condition = condition_from_mode(mode, values);
+  if (const auto& schedule = condition.guidance->schedule;
+      schedule && schedule->assist_rule.max_band_m < schedule->assist_rule.min_band_m) {
+    json_detail::fail(source, reader.pointer("max_band_m"), "expected a band at least min_band_m");
   }
   reader.finish();  // any other key: an error naming it
-  // Every key was read above as a number in range; a null one (taken as absent) is not a parameter.
-  for (const auto& item : parameters.items()) {
-    if (item.value().is_number()) condition.guidance_parameters[item.key()] = item.value().get<double>();
-  }
+  return values;
 }
 
 // "teachers": {"<item>": "path"}: keys are items (checked against the protocol's items later).
@@ -242,33 +190,37 @@ StudyCondition read_condition(const json& value, const std::string& pointer, con
     json_detail::fail(source, reader.pointer("name"),
                       "expected 1 to 32 letters, digits, '_' or '-', got \"" + condition.name + "\"");
   }
+  // The mode's condition with the parameters' defaults (SchemaOf<StudyCondition>: condition_from_mode).
   read_member(reader, SchemaOf<StudyCondition>::get(), "mode", &condition, true);
-  const bool guided = renders_guidance(condition.mode);
+  const ConditionMode mode = condition_mode(condition);
+  std::optional<double> stiffness_n_per_m;
   if (reader.optional("guidance_stiffness_n_per_m") != nullptr) {
-    if (!guided) {
+    if (!condition.guidance) {
       json_detail::fail(source, reader.pointer("guidance_stiffness_n_per_m"),
-                        std::string("mode \"") + to_string(condition.mode) + "\" renders no guidance");
+                        std::string("mode \"") + to_string(mode) + "\" renders no guidance");
     }
     // The force law's range (ParameterTable<ForceLawParameters>), which the trial checks.
-    condition.guidance_stiffness_n_per_m = table_number_or(reader, "guidance_stiffness_n_per_m", 0.0,
-                                                           &ForceLawParameters::guidance_stiffness_n_per_m);
+    stiffness_n_per_m = table_number_or(reader, "guidance_stiffness_n_per_m", 0.0,
+                                        &ForceLawParameters::guidance_stiffness_n_per_m);
   }
   if (const json* parameters = reader.optional("parameters")) {
     const std::string at = reader.pointer("parameters");
-    if (!guided || condition.mode == ConditionMode::haptic) {
-      json_detail::fail(source, at,
-                        std::string("mode \"") + to_string(condition.mode) + "\" takes no parameters");
+    if (study_detail::mode_parameters(mode).empty()) {
+      json_detail::fail(source, at, std::string("mode \"") + to_string(mode) + "\" takes no parameters");
     }
-    read_guidance_parameters(*parameters, at, source, condition);
+    std::string name = std::move(condition.name);
+    condition = condition_from_mode(mode, read_guidance_parameters(*parameters, at, source, mode));
+    condition.name = std::move(name);
   }
+  if (condition.guidance) condition.guidance->stiffness_n_per_m = stiffness_n_per_m;
   if (const json* teachers = reader.optional("teachers")) {
-    if (condition.mode != ConditionMode::replay) {
+    if (!replays_teacher(condition)) {
       json_detail::fail(source, reader.pointer("teachers"), "only the mode \"replay\" takes teachers");
     }
     condition.teachers = read_teachers(*teachers, reader.pointer("teachers"), source);
   }
   if (const json* quiz = reader.optional("quiz")) {
-    if (condition.mode != ConditionMode::quiz) {
+    if (!condition.quiz) {
       json_detail::fail(source, reader.pointer("quiz"), "only the mode \"quiz\" takes quiz options");
     }
     condition.quiz = read_quiz(*quiz, reader.pointer("quiz"), source);

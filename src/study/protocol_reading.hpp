@@ -4,7 +4,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "calligraphy/study/protocol.hpp"
@@ -38,6 +40,26 @@ inline constexpr const auto& kItemOrders = kEnumValues<ItemOrder>;
 inline constexpr const auto& kStudyPhases = kEnumValues<StudyPhase>;
 /// Every condition mode, in declaration order (condition_modes()).
 inline constexpr const auto& kConditionModes = kEnumValues<ConditionMode>;
+
+/// One key a condition mode takes in its "parameters" (docs/experiments.md): the field of a guidance law's
+/// or rule's table it is, and where its value goes in the condition's guidance.
+struct ModeParameter {
+  std::string_view key;    ///< the protocol's name ("start_gain")
+  std::string_view table;  ///< the table's name ("FadingGuidance")
+  std::string_view field;  ///< the field's name in it ("gain")
+  std::string_view unit;
+  std::string_view doc;
+  ParameterRange range;    ///< the table's, or narrowed by `bound`
+  std::string_view bound;  ///< what narrows the range, for messages ("" when nothing does)
+  void (*apply)(ConditionGuidance& guidance, double value);  ///< sets it in `condition_from_mode`'s guidance
+};
+
+/// The keys `mode` takes, in the order the documentation lists them; none for vision, quiz and haptic.
+/// With `condition_from_mode` the one place a mode's parameters are defined (study_condition.cpp).
+std::span<const ModeParameter> mode_parameters(ConditionMode mode);
+
+/// "expected a number RANGE (Table.field), got VALUE": a parameter's value out of its range.
+std::string parameter_range_message(const ModeParameter& parameter, double value);
 
 /// `value` among `values` by their `to_string` names; DataError naming `pointer` and listing the names for
 /// anything else.

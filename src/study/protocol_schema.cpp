@@ -14,6 +14,7 @@
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/trial/trial_spec.hpp"
 #include "study/protocol_reading.hpp"
+#include "study/record_schema.hpp"
 
 namespace calligraphy {
 
@@ -88,9 +89,29 @@ const Schema& SchemaOf<ProtocolPhase>::get() {
 
 const Schema& SchemaOf<StudyCondition>::get() {
   using C = StudyCondition;
-  static const std::array fields{
-      enum_field<&C::mode>("mode", {.doc = "what the writer gets"}),
-  };
+  // "mode" is no member: the spelling of the condition's display, law and schedule (condition_mode), and
+  // read, the condition of that spelling with its parameters' defaults (condition_from_mode; the name and
+  // teachers kept).
+  static const std::array fields{[] {
+    SchemaField f{.name = "mode", .kind = FieldKind::enumeration, .doc = "what the writer gets"};
+    f.spellings = [] { return enum_spellings<ConditionMode>(); };
+    f.enum_name = EnumTable<ConditionMode>::name;
+    f.get_choice = [](const void* o) -> std::size_t {
+      const ConditionMode mode = condition_mode(*static_cast<const C*>(o));
+      for (std::size_t i = 0; i < EnumTable<ConditionMode>::entries.size(); ++i) {
+        if (EnumTable<ConditionMode>::entries[i].value == mode) return i;
+      }
+      return 0;
+    };
+    f.set_choice = [](void* o, std::size_t i) {
+      C& condition = *static_cast<C*>(o);
+      C made = condition_from_mode(EnumTable<ConditionMode>::entries[i].value);
+      made.name = std::move(condition.name);
+      made.teachers = std::move(condition.teachers);
+      condition = std::move(made);
+    };
+    return f;
+  }()};
   static const Schema schema{
       .name = "StudyCondition", .doc = "a feedback condition", .fields = fields, .defaults = default_of<C>};
   return schema;
@@ -187,40 +208,14 @@ void put_table_field(ordered_json& properties, std::string_view key, double S::*
   properties[std::string(key)] = number_schema(narrowed ? *narrowed : field.range, field.unit, doc);
 }
 
-// The "parameters" a condition of each guidance mode takes (protocol.cpp, read_guidance_parameters): each
-// key its law's or rule's table range.
+// The "parameters" a condition of each guidance mode takes (study_detail::mode_parameters, as the reader
+// reads them): each key its law's or rule's table range.
 ordered_json guidance_parameters(ConditionMode mode) {
   ordered_json p = ordered_json::object();
-  switch (mode) {
-    case ConditionMode::fading:
-      put_table_field(p, "start_gain", &FadingGuidance::gain);
-      put_table_field(p, "forgetting_factor", &FadingRule::forgetting_factor);
-      put_table_field(p, "error_gain_per_m", &FadingRule::error_gain_per_m);
-      break;
-    case ConditionMode::replay: {
-      const ParameterRange lead = protocol_max_lead_range();
-      put_table_field(p, "max_lead_m", &ReplayGuidance::max_lead_m, &lead);
-      break;
-    }
-    case ConditionMode::assist_as_needed:
-      put_table_field(p, "start_band_m", &AssistAsNeededGuidance::band_m);
-      put_table_field(p, "target_error_m", &AssistBandRule::target_error_m);
-      put_table_field(p, "band_rate", &AssistBandRule::rate);
-      put_table_field(p, "min_band_m", &AssistBandRule::min_band_m);
-      put_table_field(p, "max_band_m", &AssistBandRule::max_band_m);
-      break;
-    case ConditionMode::skill_adaptive:
-      put_table_field(p, "threshold_m", &SkillAdaptiveRule::threshold_m);
-      [[fallthrough]];
-    case ConditionMode::error_amplification:
-      put_table_field(p, "amplification_gain", &ErrorAmplificationGuidance::gain);
-      put_table_field(p, "max_force_n", &ErrorAmplificationGuidance::max_force_n);
-      break;
-    case ConditionMode::timing:
-      put_table_field(p, "speed_m_s", &TimingGuidance::speed_m_s);
-      break;
-    default:
-      break;
+  for (const study_detail::ModeParameter& parameter : study_detail::mode_parameters(mode)) {
+    std::string doc(parameter.table);
+    doc.append(".").append(parameter.field).append(": ").append(parameter.doc);
+    p[std::string(parameter.key)] = number_schema(parameter.range, parameter.unit, doc);
   }
   return p;
 }
@@ -245,44 +240,53 @@ ordered_json condition_schema() {
   // Per mode: the parameters it takes, each with its table's range.
   ordered_json rules = ordered_json::array();
   for (const ConditionMode mode : study_detail::kConditionModes) {
+    const StudyCondition condition = condition_from_mode(mode);  // as the reader makes it
     ordered_json then = ordered_json::object();
-    if (renders_guidance(mode) && mode != ConditionMode::haptic) {
+    if (!study_detail::mode_parameters(mode).empty()) {
       then["properties"]["parameters"] = object_schema(guidance_parameters(mode), "");
       then["properties"]["parameters"].erase("description");
     } else {
       then["not"] = {{"required", {"parameters"}}};
     }
-    if (!renders_guidance(mode)) {
+    if (!condition.guidance) {
       then["properties"]["guidance_stiffness_n_per_m"] = false;
     }
-    if (mode != ConditionMode::replay) then["properties"]["teachers"] = false;
-    if (mode != ConditionMode::quiz) then["properties"]["quiz"] = false;
+    if (!replays_teacher(condition)) then["properties"]["teachers"] = false;
+    if (!condition.quiz) then["properties"]["quiz"] = false;
     rules.push_back({{"if", {{"properties", {{"mode", {{"const", to_string(mode)}}}}}}}, {"then", then}});
   }
   out["allOf"] = rules;
   return out;
 }
 
+// A field of the stroke acceptance's one schema (SchemaOf<StrokeAcceptance>, as the reader reads it)
+// described by `doc`: its table's range, a miss count over the whole numbers of it.
+ordered_json acceptance_property(const SchemaField& field, std::string_view doc) {
+  if (field.kind != FieldKind::integer) return number_schema(field.range, field.unit, doc);
+  std::string text(doc);
+  if (!field.unit.empty()) text.append(" [").append(field.unit).append("]");
+  return {{"type", "integer"},
+          {"description", text},
+          {"minimum", field.integer_low},
+          {"maximum", field.integer_high}};
+}
+
 ordered_json quiz_schema() {
+  const Schema& acceptance_schema = SchemaOf<StrokeAcceptance>::get();
   ordered_json acceptance = ordered_json::object();
-  for (const ParameterField<StrokeAcceptance>& field : ParameterTable<StrokeAcceptance>::fields()) {
-    put_table_field(acceptance, field.name, field.member);
-    if (field.name.ends_with("_misses")) {  // a count: whole numbers only (StrokeAcceptance::validate)
-      acceptance[std::string(field.name)]["type"] = "integer";
-      acceptance[std::string(field.name)]["minimum"] = static_cast<std::int64_t>(std::ceil(field.range.low));
-      acceptance[std::string(field.name)]["maximum"] =
-          static_cast<std::int64_t>(std::floor(field.range.high));
-    }
+  for (const SchemaField& field : acceptance_schema.fields) {
+    std::string doc(acceptance_schema.name);
+    doc.append(".").append(field.name).append(": ").append(field.doc);
+    acceptance[std::string(field.name)] = acceptance_property(field, doc);
   }
   ordered_json properties = ordered_json::object();
   properties["acceptance"] =
       object_schema(std::move(acceptance), "the stroke matcher's tolerances (docs/stroke-acceptance.md)");
-  // An override of the acceptance's, in its table's range (StrokeAcceptance: the one definition).
-  const ParameterRange hint = parameter_field(&StrokeAcceptance::hint_after_misses).range;
-  properties["hint_after_misses"] =
-      integer_schema(static_cast<std::int64_t>(hint.low), static_cast<std::int64_t>(hint.high),
-                     "a hint after this many misses on one stroke, and each further one; 0: never; overrides "
-                     "acceptance.hint_after_misses (default: the acceptance's)");
+  // An override of the acceptance's, read as its field.
+  properties["hint_after_misses"] = acceptance_property(
+      *acceptance_schema.field("hint_after_misses"),
+      "a hint after this many misses on one stroke, and each further one; 0: never; overrides "
+      "acceptance.hint_after_misses (default: the acceptance's)");
   properties["accept_backwards"] = {
       {"type", "boolean"}, {"description", "a stroke written from its end to its start is accepted"}};
   return object_schema(std::move(properties), "how a quiz judges strokes");

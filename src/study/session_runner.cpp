@@ -8,6 +8,8 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <type_traits>
+#include <variant>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/parameter_table.hpp"
@@ -46,7 +48,7 @@ void check_plan(const SessionManifest& session, const DeviceListing& device) {
   for (const PlannedTrial& trial : session.plan) {
     const StudyCondition& condition = session.protocol.protocol.condition(trial.condition);
     // A replay's teacher is read (or recorded) when its trial comes; every other setting is checked now.
-    if (condition.mode == ConditionMode::replay) continue;
+    if (replays_teacher(condition)) continue;
     (void)study_trial_options(session, condition, trial);
   }
   if (session.setup.writer == "simulated" && device.capabilities.hardware) {
@@ -100,45 +102,37 @@ TrialSpec study_trial_spec(const SessionManifest& session, const StudyCondition&
   TrialSpec spec;
   for (const char32_t c : trial.characters) spec.characters += encode_utf8(c);
   spec.device = session.setup.device;
-  spec.guidance = renders_guidance(condition.mode);
-  if (condition.mode == ConditionMode::fading) {
-    spec.guidance_mode = GuidanceMode::fading;
-    try {
-      check_parameter(&FadingGuidance::gain, guidance.gain);  // the law's own table: one range
-    } catch (const InvalidArgument& e) {
-      throw InvalidArgument("condition '" + condition.name + "': " + e.what());
-    }
-    spec.guidance_gain = guidance.gain;
-  }
-  if (condition.mode == ConditionMode::replay) {
-    if (guidance.teacher.size() < 2) {
-      throw InvalidArgument("condition '" + condition.name + "': a replay needs the teacher's recording");
-    }
-    // The session folder's copy (teachers/...), given to the runner as read (TrialRunInputs::teacher); the
-    // record names its file under "guidance".
-    spec.guidance_mode = GuidanceMode::replay;
-  }
-  if (condition.mode == ConditionMode::assist_as_needed) {
-    spec.guidance_mode = GuidanceMode::assist_as_needed;
-    spec.assist_band_m = guidance.band_m;
-  }
-  if (condition.mode == ConditionMode::error_amplification)
-    spec.guidance_mode = GuidanceMode::error_amplification;
-  if (condition.mode == ConditionMode::skill_adaptive) {
-    spec.guidance_mode = guidance.mode.value_or(GuidanceMode::fixed);
-    if (spec.guidance_mode != GuidanceMode::fixed &&
-        spec.guidance_mode != GuidanceMode::error_amplification) {
-      throw InvalidArgument("condition '" + condition.name +
-                            "': skill-adaptive chooses fixed guidance or error "
-                            "amplification, not " +
-                            to_string(spec.guidance_mode));
-    }
-  }
-  if (spec.guidance_mode == GuidanceMode::error_amplification && condition.amplification_gain)
-    spec.amplification_gain = *condition.amplification_gain;
-  if (condition.mode == ConditionMode::timing) {
-    spec.guidance_mode = GuidanceMode::timing;
-    if (condition.timing_speed_m_s) spec.timing_speed_m_s = *condition.timing_speed_m_s;
+  spec.guidance = condition.guidance.has_value();
+  if (condition.guidance) {
+    // The trial's law (the condition's, as its schedule sets it for this repetition) in the specification's
+    // fields; a replay's teacher is the runner's (TrialRunInputs::teacher, from the session folder's copy
+    // teachers/...), named by the record under "guidance".
+    const GuidanceLaw law = study_detail::trial_guidance_law(*condition.guidance, guidance);
+    spec.guidance_mode = mode_of(law);
+    std::visit(
+        [&](const auto& taken) {
+          using Law = std::decay_t<decltype(taken)>;
+          if constexpr (std::is_same_v<Law, FadingGuidance>) {
+            try {
+              check_parameter(&FadingGuidance::gain, taken.gain);  // the law's own table: one range
+            } catch (const InvalidArgument& e) {
+              throw InvalidArgument("condition '" + condition.name + "': " + e.what());
+            }
+            spec.guidance_gain = taken.gain;
+          } else if constexpr (std::is_same_v<Law, ReplayGuidance>) {
+            if (taken.teacher_trajectory.size() < 2) {
+              throw InvalidArgument("condition '" + condition.name +
+                                    "': a replay needs the teacher's recording");
+            }
+          } else if constexpr (std::is_same_v<Law, AssistAsNeededGuidance>) {
+            spec.assist_band_m = taken.band_m;
+          } else if constexpr (std::is_same_v<Law, ErrorAmplificationGuidance>) {
+            spec.amplification_gain = taken.gain;
+          } else if constexpr (std::is_same_v<Law, TimingGuidance>) {
+            spec.timing_speed_m_s = taken.speed_m_s;
+          }
+        },
+        law);
   }
   const bool simulated = session.setup.writer == "simulated";
   spec.writer = simulated ? TrialWriter::simulated : TrialWriter::person;
@@ -287,9 +281,9 @@ class SessionRun {
   PreparedTrial prepare(const PlannedTrial& trial, const StudyCondition& condition) {
     Scene scene = scene_of(trial);
     study_detail::PreparedGuidance guidance;
-    if (study_detail::adapts_by_repetition(condition.mode))
+    if (study_detail::adapts_by_repetition(condition))
       guidance = study_detail::repetition_guidance(session_, condition, trial);
-    if (condition.mode == ConditionMode::replay)
+    if (replays_teacher(condition))
       guidance = study_detail::replay_guidance(session_, condition, trial, scene);
     TrialSpec spec = study_trial_spec(manifest_, condition, trial, guidance.guidance);
     if (options_.pacing) spec.pacing = *options_.pacing;
@@ -321,8 +315,8 @@ class SessionRun {
   // The one runner of a trial specification; the device (made before, so that a failure is logged), the
   // teacher kept in the session folder, the condition's force law and what the host gives (its display
   // channel) are its inputs, all values: nothing changes the trial's options once the runner made them.
-  TrialRunInputs inputs_for(const PlannedTrial& trial, const StudyCondition& condition, const PreparedTrial& prepared,
-                            HapticDevice& device) const {
+  TrialRunInputs inputs_for(const PlannedTrial& trial, const StudyCondition& condition,
+                            const PreparedTrial& prepared, HapticDevice& device) const {
     TrialRunInputs inputs;
     inputs.device = &device;
     inputs.teacher = prepared.guidance.guidance.teacher;
@@ -360,7 +354,8 @@ class SessionRun {
     TrialRun run = run_trial_spec(prepared.spec, prepared.scene, inputs);
     if (run.result.end == TrialEnd::interrupted && run.result.abort_reason.empty())
       run.result.abort_reason = "stopped by " + stop_reason(options_);
-    context.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    context.wall_time_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     context.end_utc = utc_now_iso8601();
     context.options = &run.options;
     context.spec = &*prepared.spec;
@@ -375,17 +370,15 @@ class SessionRun {
   }
 
   // Saves the trial (or keeps it as an attempt) with its record, and logs how it ended.
-  TrialOutcome keep(const PlannedTrial& trial, const StudyCondition& condition, const Scene& scene, const TrialRun& run,
-                    study_detail::TrialRecordContext& context) {
+  TrialOutcome keep(const PlannedTrial& trial, const StudyCondition& condition, const Scene& scene,
+                    const TrialRun& run, study_detail::TrialRecordContext& context) {
     const TrialResult& trial_result = run.result;
     const std::string stem = SessionFolder::trial_stem(trial);
     context.trace_file = stem + "." + std::string(SessionFolder::kTraceExtension);
     context.svg_file = stem + ".svg";
     const WritingMetrics& writing = run.metrics;
     std::vector<std::vector<QuizEvent>> quiz;
-    if (condition.mode == ConditionMode::quiz) {
-      quiz = quiz_characters(scene, trial_result.trace, condition.quiz);
-    }
+    if (condition.quiz) quiz = quiz_characters(scene, trial_result.trace, *condition.quiz);
     const bool keep_as_trial =
         trial_result.end == TrialEnd::completed || trial_result.end == TrialEnd::time_limit ||
         trial_result.end == TrialEnd::gave_up || trial_result.end == TrialEnd::writer_finished;
@@ -408,7 +401,8 @@ class SessionRun {
       }
       // Learned from as the record says, the same as when the memory is rebuilt on a resume.
       if (learning_)
-        study_detail::practise_record(memory_, json::parse(record), session_.trial_file(trial, "json").string(),
+        study_detail::practise_record(memory_, json::parse(record),
+                                      session_.trial_file(trial, "json").string(),
                                       study_detail::subject_traits(manifest_.setup).learning);
       outcome.saved = true;
       outcome.json_file = session_.trial_file(trial, "json").string();

@@ -76,50 +76,39 @@ const PlannedTrial* previous_repetition(const std::vector<PlannedTrial>& plan, c
   return previous;
 }
 
-GuidanceSchedule condition_schedule(const StudyCondition& condition) {
-  GuidanceSchedule schedule;
-  schedule.adapts = condition.mode == ConditionMode::assist_as_needed ? AdaptiveGuidance::assist_as_needed
-                    : condition.mode == ConditionMode::skill_adaptive ? AdaptiveGuidance::skill_adaptive
-                                                                      : AdaptiveGuidance::fading;
-  schedule.start_gain = condition.start_gain;
-  schedule.start_band_m = condition.start_band_m;
-  schedule.fading_rule = condition.fading_rule;
-  schedule.assist_rule = condition.assist_rule;
-  schedule.skill_rule = condition.skill_rule;
-  return schedule;
-}
-
 PreparedGuidance repetition_guidance(const StudyCondition& condition, const PlannedTrial* previous,
                                      const json* previous_record, const std::string& source) {
-  // The one schedule (render/guidance_schedule.hpp), as the trainer and Python use it.
-  const GuidanceSchedule schedule = condition_schedule(condition);
-  const RepetitionGuidance first = schedule.start();
   PreparedGuidance prepared;
+  if (!adapts_by_repetition(condition)) return prepared;
+  // The one schedule (render/guidance_schedule.hpp), as the trainer and Python use it.
+  const GuidanceSchedule& schedule = *condition.guidance->schedule;
+  const bool fading = schedule.adapts == AdaptiveGuidance::fading;
+  const bool assist = schedule.adapts == AdaptiveGuidance::assist_as_needed;
+  const bool skill = schedule.adapts == AdaptiveGuidance::skill_adaptive;
+  const RepetitionGuidance first = schedule.start();
   prepared.guidance.gain = first.gain;
   prepared.guidance.band_m = first.band_m;
-  if (condition.mode == ConditionMode::skill_adaptive) prepared.guidance.mode = first.mode;
+  if (skill) prepared.guidance.mode = first.mode;
   if (!previous || !previous_record) return prepared;
   const json_detail::JsonView record(*previous_record, "", source);
   prepared.previous_trial = SessionFolder::trial_stem(*previous);
   if (!record.has("guidance"))
     json_detail::fail(source, "/guidance", "missing (required): no guidance to adapt from");
   const json_detail::JsonView guidance = record.object("guidance");
-  if (condition.mode == ConditionMode::fading) prepared.previous_gain = guidance.number("gain", 0.0, 1e6);
-  if (condition.mode == ConditionMode::assist_as_needed)
-    prepared.previous_band_m = guidance.number("band_m", 0.0, 1e6);
+  if (fading) prepared.previous_gain = guidance.number("gain", 0.0, 1e6);
+  if (assist) prepared.previous_band_m = guidance.number("band_m", 0.0, 1e6);
   if (!study_detail::contains_metric(record, "mean_deviation_m"))
     json_detail::fail(source, "/mean_deviation_m", "missing (required): no mean deviation to adapt from");
   // null when the repetition wrote nothing; a record older than the metric table gives it in mm
   const std::optional<double> deviation_m = study_detail::record_metric(record, "mean_deviation_m");
   prepared.previous_deviation_m = deviation_m ? json(*deviation_m) : json(nullptr);
-  if (!adapts_by_repetition(condition.mode)) return prepared;
   RepetitionGuidance before = first;
-  before.gain = condition.mode == ConditionMode::fading ? prepared.previous_gain : first.gain;
-  before.band_m = condition.mode == ConditionMode::assist_as_needed ? prepared.previous_band_m : first.band_m;
+  before.gain = fading ? prepared.previous_gain : first.gain;
+  before.band_m = assist ? prepared.previous_band_m : first.band_m;
   const RepetitionGuidance following = schedule.next(before, deviation_m);
   prepared.guidance.gain = following.gain;
   prepared.guidance.band_m = following.band_m;
-  if (condition.mode == ConditionMode::skill_adaptive) prepared.guidance.mode = following.mode;
+  if (skill) prepared.guidance.mode = following.mode;
   return prepared;
 }
 
@@ -136,9 +125,21 @@ PreparedGuidance repetition_guidance(const SessionFolder& session, const StudyCo
   return repetition_guidance(condition, previous, &record, file.string());
 }
 
-bool adapts_by_repetition(ConditionMode mode) noexcept {
-  return mode == ConditionMode::fading || mode == ConditionMode::assist_as_needed ||
-         mode == ConditionMode::skill_adaptive;
+bool adapts_by_repetition(const StudyCondition& condition) noexcept {
+  return condition.guidance && condition.guidance->schedule;
+}
+
+GuidanceLaw trial_guidance_law(const ConditionGuidance& condition, const TrialGuidance& guidance) {
+  GuidanceLaw law = condition.law;
+  if (condition.schedule) {
+    RepetitionGuidance repetition = condition.schedule->start();
+    repetition.gain = guidance.gain;
+    repetition.band_m = guidance.band_m;
+    if (guidance.mode) repetition.mode = *guidance.mode;
+    law = condition.schedule->law_of(repetition, std::move(law));
+  }
+  if (auto* replay = std::get_if<ReplayGuidance>(&law)) replay->teacher_trajectory = guidance.teacher;
+  return law;
 }
 
 PreparedGuidance replay_guidance(SessionFolder& session, const StudyCondition& condition,
@@ -188,23 +189,27 @@ PreparedGuidance replay_guidance(SessionFolder& session, const StudyCondition& c
 }
 
 json guidance_record_json(const StudyCondition& condition, const PreparedGuidance& prepared) {
-  json guidance = {{"mode", to_string(condition.mode)}};
-  if (condition.mode == ConditionMode::fading) {
+  json guidance = {{"mode", to_string(condition_mode(condition))}};
+  const GuidanceSchedule* schedule =
+      condition.guidance && condition.guidance->schedule ? &*condition.guidance->schedule : nullptr;
+  const bool fading = schedule && schedule->adapts == AdaptiveGuidance::fading;
+  const bool assist = schedule && schedule->adapts == AdaptiveGuidance::assist_as_needed;
+  if (fading) {
     guidance["gain"] = prepared.guidance.gain;
-    guidance["start_gain"] = condition.start_gain;
-    guidance["forgetting_factor"] = condition.fading_rule.forgetting_factor;
-    guidance["error_gain_per_m"] = condition.fading_rule.error_gain_per_m;
-  } else if (condition.mode == ConditionMode::assist_as_needed) {
+    guidance["start_gain"] = schedule->start_gain;
+    guidance["forgetting_factor"] = schedule->fading_rule.forgetting_factor;
+    guidance["error_gain_per_m"] = schedule->fading_rule.error_gain_per_m;
+  } else if (assist) {
     guidance["band_m"] = prepared.guidance.band_m;
-    guidance["start_band_m"] = condition.start_band_m;
-    guidance["target_error_m"] = condition.assist_rule.target_error_m;
-    guidance["band_rate"] = condition.assist_rule.rate;
-    guidance["min_band_m"] = condition.assist_rule.min_band_m;
-    guidance["max_band_m"] = condition.assist_rule.max_band_m;
-  } else if (condition.mode == ConditionMode::skill_adaptive) {
+    guidance["start_band_m"] = schedule->start_band_m;
+    guidance["target_error_m"] = schedule->assist_rule.target_error_m;
+    guidance["band_rate"] = schedule->assist_rule.rate;
+    guidance["min_band_m"] = schedule->assist_rule.min_band_m;
+    guidance["max_band_m"] = schedule->assist_rule.max_band_m;
+  } else if (schedule) {  // skill-adaptive
     guidance["selected_mode"] = to_string(prepared.guidance.mode.value_or(GuidanceMode::fixed));
-    guidance["threshold_m"] = condition.skill_rule.threshold_m;
-  } else if (condition.mode == ConditionMode::replay) {
+    guidance["threshold_m"] = schedule->skill_rule.threshold_m;
+  } else if (replays_teacher(condition)) {
     guidance["teacher"] = {
         {"file", prepared.teacher_file},
         {"sha256", prepared.teacher_sha256},
@@ -213,13 +218,12 @@ json guidance_record_json(const StudyCondition& condition, const PreparedGuidanc
         {"characters", prepared.teacher_characters},
         {"seed", prepared.teacher_source == "recorded" ? json(kRecordedTeacherSeed) : json(nullptr)}};
   }
-  if (adapts_by_repetition(condition.mode)) {
+  if (schedule) {
     guidance["previous_trial"] =
         prepared.previous_trial.empty() ? json(nullptr) : json(prepared.previous_trial);
     if (!prepared.previous_trial.empty()) {
-      if (condition.mode == ConditionMode::fading) guidance["previous_gain"] = prepared.previous_gain;
-      if (condition.mode == ConditionMode::assist_as_needed)
-        guidance["previous_band_m"] = prepared.previous_band_m;
+      if (fading) guidance["previous_gain"] = prepared.previous_gain;
+      if (assist) guidance["previous_band_m"] = prepared.previous_band_m;
       guidance["previous_mean_deviation_m"] = prepared.previous_deviation_m;
     }
   }
@@ -229,20 +233,16 @@ json guidance_record_json(const StudyCondition& condition, const PreparedGuidanc
 ForceLawParameters condition_force_law(const StudyCondition& condition, const TrialGuidance& guidance,
                                        ForceLawParameters force) {
   // The renderer judges strokes as the quiz does.
-  if (condition.mode == ConditionMode::quiz) {
-    force.acceptance = condition.quiz.acceptance;
-    force.acceptance.hint_after_misses = condition.quiz.hint_after();
+  if (condition.quiz) {
+    force.acceptance = condition.quiz->acceptance;
+    force.acceptance.hint_after_misses = condition.quiz->hint_after();
   }
-  if (auto* replay = std::get_if<ReplayGuidance>(&force.guidance_law)) {
-    replay->teacher_trajectory = guidance.teacher;
-    if (condition.replay_max_lead_m) replay->max_lead_m = *condition.replay_max_lead_m;
+  // The trial's law: the condition's, as its schedule sets it for this repetition, with the replay's teacher.
+  if (condition.guidance && force.guidance) {
+    force.guidance_law = trial_guidance_law(*condition.guidance, guidance);
+    if (condition.guidance->stiffness_n_per_m)
+      force.guidance_stiffness_n_per_m = *condition.guidance->stiffness_n_per_m;
   }
-  if (auto* amplification = std::get_if<ErrorAmplificationGuidance>(&force.guidance_law);
-      amplification && condition.amplification_max_force_n) {
-    amplification->max_force_n = *condition.amplification_max_force_n;
-  }
-  if (condition.guidance_stiffness_n_per_m && force.guidance)
-    force.guidance_stiffness_n_per_m = *condition.guidance_stiffness_n_per_m;
   return force;
 }
 

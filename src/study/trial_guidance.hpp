@@ -55,19 +55,22 @@ const PlannedTrial* previous_repetition(const std::vector<PlannedTrial>& plan, c
 PreparedGuidance repetition_guidance(const StudyCondition& condition, const PlannedTrial* previous,
                                      const nlohmann::json* previous_record, const std::string& source);
 
-/// The schedule of `condition`'s adaptive guidance (render/guidance_schedule.hpp): its mode, start and rules.
-GuidanceSchedule condition_schedule(const StudyCondition& condition);
-
 /// The force law of a trial of `condition`: `force` (made from the trial's specification, fitted to the
-/// device) with what the condition sets beyond the specification, each where the protocol gives it: the
-/// quiz's acceptance, the replay's teacher and lead, the repulsive field's bound, a guidance stiffness of
-/// its own. Made before the trial and given to the runner (TrialRunInputs::force_law).
+/// device) with what the condition sets beyond the specification: the quiz's acceptance, the guidance law
+/// (`trial_guidance_law`: the replay's teacher and lead, the repulsive field's bound, ...), a guidance
+/// stiffness of its own. Made before the trial and given to the runner (TrialRunInputs::force_law).
 [[nodiscard]] ForceLawParameters condition_force_law(const StudyCondition& condition,
                                                      const TrialGuidance& guidance, ForceLawParameters force);
 
-/// Whether a mode's guidance follows the previous repetition of the item: fading, assist-as-needed,
-/// skill-adaptive.
-[[nodiscard]] bool adapts_by_repetition(ConditionMode mode) noexcept;
+/// Whether `condition`'s guidance follows the previous repetition of the item: it has a schedule (fading,
+/// assist-as-needed, skill-adaptive).
+[[nodiscard]] bool adapts_by_repetition(const StudyCondition& condition) noexcept;
+
+/// The guidance law of a trial of a condition with `condition`'s guidance: its law as its schedule sets it
+/// for the repetition `guidance` gives (its gain, band or skill-adaptive's mode), a replay with `guidance`'s
+/// teacher.
+[[nodiscard]] GuidanceLaw trial_guidance_law(const ConditionGuidance& condition,
+                                             const TrialGuidance& guidance);
 
 /// The teacher of `trial` in the replay `condition`: the copy in the session folder's teachers/ when there
 /// is one; else the protocol's recording of the item (copied there), or one recorded there by a skilled

@@ -286,7 +286,7 @@ nlohmann::json trial_record(const TrialRecordContext& c, const Scene& scene, con
                    {"trial", planned_trial_json(t)},
                    {"phase", to_string(t.phase)},
                    {"condition", t.condition},
-                   {"mode", to_string(c.condition->mode)},
+                   {"mode", to_string(condition_mode(*c.condition))},
                    {"characters", encode_utf8(t.characters)},
                    {"repetition", t.repetition},
                    {"start_time_utc", c.start_utc},
@@ -348,7 +348,7 @@ nlohmann::json trial_record(const TrialRecordContext& c, const Scene& scene, con
       }
       characters.push_back({{"character", encode_utf8(scene.characters[i].code_point)}, {"events", events}});
     }
-    const QuizOptions& q = c.condition->quiz;
+    const QuizOptions q = c.condition->quiz.value_or(QuizOptions{});
     document["quiz"] = {{"acceptance", acceptance_json(q.acceptance)},
                         {"start_radius_m", q.start_radius_m},
                         {"hint_after_misses", q.hint_after()},

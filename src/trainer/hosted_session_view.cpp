@@ -107,9 +107,9 @@ void HostedSessionView::show_trial(const SessionView& s,
   view_->condition = s.trial.condition;
   channel_.reset();
   scene_ = trial_scene(s.trial);
-  if (s.mode == ConditionMode::quiz) {
-    view_->quiz.emplace(scene_, link_.manifest->protocol.protocol.condition(s.trial.condition).quiz);
-  }
+  if (const std::optional<QuizOptions>& quiz =
+          link_.manifest->protocol.protocol.condition(s.trial.condition).quiz)
+    view_->quiz.emplace(scene_, *quiz);
 }
 
 Scene HostedSessionView::trial_scene(const PlannedTrial& trial) const {

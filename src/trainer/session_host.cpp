@@ -14,8 +14,8 @@ void WindowSessionHost::before_trial(const PlannedTrial& trial, std::size_t tota
   ++view_.trial_generation;
   view_.trial = trial;
   view_.total = total;
-  view_.mode = condition.mode;
-  view_.guidance = renders_guidance(condition.mode);
+  view_.mode = condition_mode(condition);
+  view_.guidance = condition.guidance.has_value();
   view_.channel.reset();
   view_.outcome.reset();
   start_ = false;

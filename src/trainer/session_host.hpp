@@ -25,7 +25,7 @@ struct SessionView {
   std::uint64_t trial_generation = 0;  ///< counts before_trial calls: a new trial to show
   PlannedTrial trial;
   std::size_t total = 0;
-  ConditionMode mode = ConditionMode::vision;
+  ConditionMode mode = ConditionMode::vision;  ///< the condition's spelling (condition_mode), for the panel
   bool guidance = false;
   std::shared_ptr<DisplayChannel> channel;  ///< the running (or last) trial's
   StrokeAcceptance acceptance;  ///< the running (or last) trial's, to judge pen-downs that never reach WS

@@ -38,6 +38,8 @@ struct GuidanceSchedule {
   FadingRule fading_rule{};
   AssistBandRule assist_rule{};
   SkillAdaptiveRule skill_rule{};
+  /// skill-adaptive: the error amplification it chooses for a writer within `skill_rule`'s threshold.
+  ErrorAmplificationGuidance amplification{};
 
   /// The first repetition's guidance (skill-adaptive starts with the fixed fixture).
   [[nodiscard]] RepetitionGuidance start() const;
@@ -46,6 +48,10 @@ struct GuidanceSchedule {
   /// (a gain outside [0, 1], a negative or non-finite deviation or band, a bad rule).
   [[nodiscard]] RepetitionGuidance next(const RepetitionGuidance& previous,
                                         std::optional<double> mean_deviation_m) const;
+  /// The law a repetition with `repetition`'s guidance renders, from `law` (the one every repetition
+  /// starts from): fading sets a FadingGuidance's gain, assist-as-needed an AssistAsNeededGuidance's band;
+  /// skill-adaptive gives `amplification` when the repetition's mode is error amplification, else `law`.
+  [[nodiscard]] GuidanceLaw law_of(const RepetitionGuidance& repetition, GuidanceLaw law) const;
 };
 
 }  // namespace calligraphy

@@ -10,6 +10,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <variant>
 #include <vector>
 
 #include "calligraphy/analysis/quiz.hpp"
@@ -18,7 +19,9 @@
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/render/force_law.hpp"
+#include "calligraphy/render/guidance_law.hpp"
 #include "calligraphy/render/guidance_mode.hpp"
+#include "calligraphy/render/guidance_schedule.hpp"
 #include "calligraphy/trial/options.hpp"
 
 namespace calligraphy {
@@ -65,45 +68,70 @@ struct EnumTable<ConditionMode> {
 /// Whether trials of the mode render in-plane guidance (every mode but `vision` and `quiz`).
 [[nodiscard]] bool renders_guidance(ConditionMode mode) noexcept;
 
-/// One feedback condition.
+/// A condition's in-plane guidance: the law its trials render, and what adapts it over the repetitions of
+/// an item.
+struct ConditionGuidance {
+  /// The guidance law with the protocol's parameters (render/guidance_law.hpp). A fading law's gain and
+  /// an assist-as-needed law's band are the first repetition's; a replay's teacher is added per trial.
+  GuidanceLaw law = FixedGuidance{};
+  /// What adapts over the repetitions of an item (render/guidance_schedule.hpp): the fading law's gain,
+  /// the assist-as-needed law's band, or skill-adaptive's choice between `law` and the schedule's error
+  /// amplification. Empty: every repetition renders `law` as it is.
+  std::optional<GuidanceSchedule> schedule;
+  /// Overrides the guidance stiffness K_et (ForceLawParameters, paper eq. 8) [N/m] when given.
+  std::optional<double> stiffness_n_per_m;
+};
+
+/// One feedback condition: what the writer sees and is judged on (vision only, or the quiz), the guidance
+/// (none, or a law with an optional schedule) and a replay's teachers. A protocol's "mode" is one
+/// combination of these each (`condition_from_mode`, `condition_mode`):
+///
+/// | mode                | quiz | guidance law               | schedule         |
+/// |---------------------|------|----------------------------|------------------|
+/// | vision              | -    | -                          | -                |
+/// | quiz                | yes  | -                          | -                |
+/// | haptic              | -    | FixedGuidance              | -                |
+/// | fading              | -    | FadingGuidance             | fading           |
+/// | replay              | -    | ReplayGuidance             | -                |
+/// | assist-as-needed    | -    | AssistAsNeededGuidance     | assist_as_needed |
+/// | error-amplification | -    | ErrorAmplificationGuidance | -                |
+/// | skill-adaptive      | -    | FixedGuidance              | skill_adaptive   |
+/// | timing              | -    | TimingGuidance             | -                |
 struct StudyCondition {
   std::string name;  ///< unique label, used in file names and reports: [A-Za-z0-9_-], 1..32 characters
-  ConditionMode mode = ConditionMode::vision;
-  /// Overrides the guidance stiffness K_et (ForceLawParameters, paper eq. 8) [N/m]; haptic modes only.
-  std::optional<double> guidance_stiffness_n_per_m;
-  /// Parameters of the guidance modes, by name, as the protocol gives them (recorded with every trial);
-  /// read into the fields after `quiz`.
+  /// Each stroke judged when the pen lifts (analysis/quiz.hpp), with these options; empty: vision only.
+  std::optional<QuizOptions> quiz;
+  /// The in-plane guidance; empty: none (vision only, or the quiz): the paper force alone.
+  std::optional<ConditionGuidance> guidance;
+  /// The guidance's parameters by name as the protocol gives them (recorded with every trial), read into
+  /// `guidance` by `condition_from_mode`.
   std::map<std::string, double> guidance_parameters;
-  QuizOptions quiz;  ///< `quiz` mode only
-  /// `fading` ("start_gain", in [0, 1]): the gain of the first repetition of an item in the condition.
-  double start_gain = 1.0;
-  /// `fading` ("forgetting_factor" in [0, 1], "error_gain_per_m" >= 0): the gain of each later repetition
-  /// is `next_guidance_gain(previous gain, previous mean deviation, fading_rule)` (Emken et al. 2007).
-  FadingRule fading_rule{};
-  /// `replay` ("max_lead_m", in (0, 0.1]): ReplayGuidance::max_lead_m [m] when given.
-  std::optional<double> replay_max_lead_m{};
-  /// `assist-as-needed` ("start_band_m" in [0, 0.1]): the band of the first repetition of an item [m].
-  double start_band_m = AssistAsNeededGuidance{}.band_m;
-  /// `assist-as-needed` ("target_error_m", "band_rate", "min_band_m", "max_band_m"): each later repetition's
-  /// band is `next_assist_band(previous band, previous mean deviation, assist_rule)`.
-  AssistBandRule assist_rule{};
-  /// `error-amplification` and `skill-adaptive` ("amplification_gain" in [0, 1], "max_force_n" in [0, 10]):
-  /// ErrorAmplificationGuidance::gain and max_force_n when given.
-  std::optional<double> amplification_gain{};
-  std::optional<double> amplification_max_force_n{};
-  /// `skill-adaptive` ("threshold_m" in (0, 0.1]): `skill_adaptive_mode` of the previous repetition's mean
-  /// deviation (its first repetition is guided).
-  SkillAdaptiveRule skill_rule{};
-  /// `timing` ("speed_m_s" in (0, 1]): TimingGuidance::speed_m_s when given.
-  std::optional<double> timing_speed_m_s{};
-  /// `replay`: the teacher's recording of an item (teacher_recording.hpp), by item; the path as given,
+  /// A replay's teacher's recording of an item (teacher_recording.hpp), by item; the path as given,
   /// relative to the protocol file. An item without one gets a teacher recorded by the session runner.
   std::map<std::u32string, std::string> teachers{};
 };
 
+/// The condition a protocol's "mode" spells, with its `parameters` (the keys of docs/experiments.md, each in
+/// its law's or rule's table range) applied to the law and schedule: e.g. fading: FadingGuidance{start_gain}
+/// and a fading schedule from start_gain, forgetting_factor and error_gain_per_m. `guidance_parameters`
+/// holds `parameters`. Throws InvalidArgument naming a key the mode does not take or a value out of range.
+[[nodiscard]] StudyCondition condition_from_mode(ConditionMode mode,
+                                                 const std::map<std::string, double>& parameters = {});
+
+/// The mode that spells `condition` in a protocol, the records and the tables: `quiz` when it quizzes,
+/// `vision` without guidance, else by its schedule (fading, assist-as-needed, skill-adaptive) or, without
+/// one, by its law (FixedGuidance: haptic; each other law: its mode).
+[[nodiscard]] ConditionMode condition_mode(const StudyCondition& condition) noexcept;
+
+/// Whether trials of `condition` replay a teacher's recording (its law is a ReplayGuidance).
+[[nodiscard]] inline bool replays_teacher(const StudyCondition& condition) noexcept {
+  return condition.guidance && std::holds_alternative<ReplayGuidance>(condition.guidance->law);
+}
+
 /// A condition's "mode" (its spelling from EnumTable<ConditionMode>), read through this schema by the
-/// protocol reader and described by `calligraphy schema protocol`; its parameters are read by its mode's
-/// laws' and rules' tables, its name as a label.
+/// protocol reader and described by `calligraphy schema protocol`: reading it sets the condition to
+/// `condition_from_mode`'s, writing it gives `condition_mode`. Its parameters are read by its mode's laws'
+/// and rules' tables, its name as a label.
 template <>
 struct SchemaOf<StudyCondition> {
   static const Schema& get();

@@ -107,8 +107,9 @@ struct TrialGuidance {
 /// The trial specification (trial_spec.hpp) of `trial` of `condition` in `session`: its characters, the
 /// session's device, writer, profile and pacing, a seed of the simulated subject's own per trial (from the
 /// subject's seed, the trial's index and the session's number), servo rate and duration from the protocol,
-/// guidance on for `haptic`, `fading` and `replay` (the gain or the teacher's file from `guidance`), off for
-/// `vision` and `quiz`. Not checked yet: its runner adds what it knows (a pacing, a learning subject's
+/// the guidance mode and parameters of the condition's law as its schedule sets it for `guidance` (the
+/// repetition's gain, band or mode; a replay's teacher), guidance off without one (`vision`, `quiz`). Not
+/// checked yet: its runner adds what it knows (a pacing, a learning subject's
 /// skills) and checks it once, with a replay's teacher from `study_teacher_source(condition)`. Throws
 /// InvalidArgument naming the condition for a `replay` condition without a teacher in `guidance`.
 [[nodiscard]] TrialSpec study_trial_spec(const SessionManifest& session, const StudyCondition& condition,
@@ -116,8 +117,8 @@ struct TrialGuidance {
 
 /// Where a study trial's replay teacher comes from: the samples kept in the session folder
 /// (TrialRunInputs::teacher), never a file the specification names.
-[[nodiscard]] constexpr TeacherSource study_teacher_source(const StudyCondition& condition) noexcept {
-  return condition.mode == ConditionMode::replay ? TeacherSource::samples : TeacherSource::file;
+[[nodiscard]] inline TeacherSource study_teacher_source(const StudyCondition& condition) noexcept {
+  return replays_teacher(condition) ? TeacherSource::samples : TeacherSource::file;
 }
 
 /// The runner's options of that specification on a device stating no limits (`trial_options`), with what
