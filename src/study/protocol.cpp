@@ -11,6 +11,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/servo_rate.hpp"
+#include "calligraphy/core/sha256.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "core/json_reader.hpp"
 #include "core/schema_json.hpp"
