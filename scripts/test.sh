@@ -180,19 +180,24 @@ cmake --no-warn-unused-cli -S tests/consumer -B build/consumer -G Ninja \
 cmake --build build/consumer
 build/consumer/consumer
 # A haptic application: only the haptics component, its examples built and run, and their link lines free
-# of OpenSSL and the USB libraries; log_redirect takes the library's log through a handler and a spdlog logger
-# of its own (spdlog's headers from the system, its package not found) and silences it.
+# of libssl and the USB libraries; log_redirect takes the library's log through a handler and a spdlog logger
+# of its own (spdlog's headers from the system, its package not found) and silences it; rerun_record reads a
+# record of `calligraphy trial --json` and runs it again. The haptics package links OpenSSL's libcrypto (a
+# record names its scene and a replay's teacher by SHA-256) by its library name, so OpenSSL's package is
+# still never looked for.
 cmake --no-warn-unused-cli -S tests/consumer/haptics -B build/consumer-haptics -G Ninja \
   -DCMAKE_PREFIX_PATH="$PWD/build/stage" \
   -DCMAKE_DISABLE_FIND_PACKAGE_spdlog=ON -DCMAKE_DISABLE_FIND_PACKAGE_fmt=ON \
   -DCMAKE_DISABLE_FIND_PACKAGE_OpenSSL=ON >/dev/null
 cmake --build build/consumer-haptics
 bash tests/consumer/check_link_line.sh build/consumer-haptics build/consumer-haptics/own_loop \
-  build/consumer-haptics/custom_device_loop build/consumer-haptics/log_redirect
+  build/consumer-haptics/custom_device_loop build/consumer-haptics/log_redirect build/consumer-haptics/rerun_record
 build/consumer-haptics/bundled_store "$PWD/build/stage"
 build/consumer-haptics/own_loop
 build/consumer-haptics/custom_device_loop
 build/consumer-haptics/log_redirect
+build/bin/calligraphy trial 十 --seed 3 --json build/consumer-haptics/record.json >/dev/null
+build/consumer-haptics/rerun_record build/consumer-haptics/record.json
 # The USB transports and the emulator are components of their own: absent from the plain install above,
 # installed when asked for by name, and then found by an application's tests that name the emulator.
 if find build/stage -name 'libcalligraphy_phantom_usb.a' -o -name 'libcalligraphy_testing.a' | grep -q .; then

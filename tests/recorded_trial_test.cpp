@@ -1,7 +1,7 @@
 // The record is the specification (recorded_trial.hpp): random valid specifications, every part away from
 // its defaults, survive JSON both ways with every double's bits; a trial run again from its record's JSON
 // gives the same trace bit for bit on the simulated device; a record that is not one is refused by name.
-#include "calligraphy/study/recorded_trial.hpp"
+#include "calligraphy/trial/recorded_trial.hpp"
 
 #include <bit>
 #include <catch2/catch.hpp>
@@ -17,6 +17,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/parameter_table.hpp"
 #include "calligraphy/model/character_library.hpp"
+#include "calligraphy/sim/simulated_writing.hpp"
 #include "study_test_devices.hpp"
 
 using namespace calligraphy;
@@ -168,6 +169,13 @@ TEST_CASE("A trial run again from its record gives the same trace, bit for bit",
     different += (a.time_s != b.time_s || a.position_m != b.position_m || a.force_n != b.force_n) ? 1 : 0;
   }
   CHECK(different == 0);
+
+  // The simulated writer wrote it: without its hand maker (sim's recorded_writing) the re-run is refused,
+  // naming what to give, rather than run with another hand.
+  CHECK_THROWS_WITH(
+      (void)rerun_trial(recorded, Checked<TrialSpec>::check(recorded.spec), scene,
+                        study_test::trial_inputs()),
+      Catch::Contains("recorded_writing(recorded)") && Catch::Contains("TrialRunInputs::hand_maker"));
 
   // Without the record's force law, the same specification renders another force: the record carried it.
   const TrialRun plain =

@@ -10,7 +10,8 @@
 #include "calligraphy/collision/active_stroke.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/character_library.hpp"
-#include "calligraphy/study/recorded_trial.hpp"
+#include "calligraphy/sim/simulated_writing.hpp"
+#include "calligraphy/trial/recorded_trial.hpp"
 #include "calligraphy/trial/recorder.hpp"
 #include "study_test_devices.hpp"
 
@@ -291,7 +292,8 @@ TEST_CASE("The miss counts are fields of the specification in every form, in the
       *trial_spec_from_json(R"({"characters": "人", "assist_after_misses": 1})", "s.json");
   CHECK(from_file.acceptance.assist_after_misses == 1.0);
   CHECK(from_file.acceptance.hint_after_misses == StrokeAcceptance{}.hint_after_misses);
-  // Out of range, or not a whole number (the counts are integers): refused naming the field in both its forms.
+  // Out of range, or not a whole number (the counts are integers): refused naming the field in both its
+  // forms.
   CHECK_THROWS_WITH(trial_spec_from_args(std::vector<std::string>{"人", "--assist-after-misses", "1001"}),
                     Catch::Contains("assist_after_misses (--assist-after-misses)"));
   CHECK_THROWS_WITH(

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/sha256.hpp"
 #include "calligraphy/study/curriculum.hpp"
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/schedule.hpp"

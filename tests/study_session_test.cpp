@@ -15,14 +15,15 @@
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/sha256.hpp"
 #include "calligraphy/report/study_report_html.hpp"
 #include "calligraphy/report/trace_hdf5.hpp"
-#include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/session_reader.hpp"
 #include "calligraphy/study/session_runner.hpp"
 #include "calligraphy/study/session_series.hpp"
 #include "calligraphy/study/study_tables.hpp"
+#include "calligraphy/trial/writer_profile.hpp"
 #include "probe_device.hpp"
 #include "study_test_devices.hpp"
 #include "temp_folder.hpp"

@@ -14,6 +14,7 @@
 
 #include "calligraphy/analysis/metric_table.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/sha256.hpp"
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/session_runner.hpp"
 #include "core/whole_file.hpp"

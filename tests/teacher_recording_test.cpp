@@ -1,7 +1,6 @@
 // The teacher's recording file of the replay guidance mode: round trip through JSON and the errors of
-// a bad file (report/teacher_recording.hpp).
-#include "calligraphy/sim/simulated_hand.hpp"
-#include "calligraphy/report/teacher_recording.hpp"
+// a bad file (trial/teacher_recording.hpp).
+#include "calligraphy/trial/teacher_recording.hpp"
 
 #include <unistd.h>
 
@@ -13,6 +12,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/render/teacher_replay.hpp"
+#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/trial/trial.hpp"
 
 using namespace calligraphy;
@@ -71,7 +71,8 @@ TEST_CASE("A bad teacher recording is refused naming the file and the key", "[gu
   refused(good, R"("y_m":[0,0.001,0.002]|"y_m":[0,1e999,0.002])", "/samples/y_m/1: not a finite number");
   refused(good, R"("rate_hz":1000|"rate_hz":-1e400)", "/rate_hz: not a finite number");
   refused(good, R"("characters":"十"|"characters":[1e999])", "/characters/0: not a finite number");
-  CHECK_THROWS_WITH(parse_teacher_recording("{", "t.json"), Catch::Contains("t.json: not valid JSON at byte"));
+  CHECK_THROWS_WITH(parse_teacher_recording("{", "t.json"),
+                    Catch::Contains("t.json: not valid JSON at byte"));
   CHECK_THROWS_WITH(read_teacher_recording("/nonexistent/teacher.json"), Catch::Contains("no such file"));
   CHECK_THROWS_WITH(read_teacher_recording("/dev/zero"), Catch::Contains("not a regular file"));
   CHECK_THROWS_AS(teacher_recording_from_trace("十", "skilled", "simulated", 1000.0, {}), InvalidArgument);

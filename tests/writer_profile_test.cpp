@@ -1,5 +1,5 @@
 // Writer profiles: the three named profiles, validation naming the field, and setting fields by name.
-#include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/trial/writer_profile.hpp"
 
 #include <catch2/catch.hpp>
 #include <string>

@@ -15,8 +15,8 @@
 #include "bindings.hpp"
 #include "calligraphy/analysis/metric_table.hpp"
 #include "calligraphy/core/atomic_file.hpp"
+#include "calligraphy/core/sha256.hpp"
 #include "calligraphy/core/unicode.hpp"
-#include "calligraphy/report/teacher_recording.hpp"
 #include "calligraphy/report/trace_columns.hpp"
 #include "calligraphy/report/trace_hdf5.hpp"
 #include "calligraphy/study/cohort.hpp"
@@ -24,6 +24,7 @@
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/study_tables.hpp"
 #include "calligraphy/study/transfer_set.hpp"
+#include "calligraphy/trial/teacher_recording.hpp"
 #include "character_source.hpp"
 
 namespace calligraphy::python {

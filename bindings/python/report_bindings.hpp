@@ -5,8 +5,8 @@
 #include <filesystem>
 #include <string>
 
-#include "calligraphy/report/teacher_recording.hpp"
 #include "calligraphy/report/trial_report.hpp"
+#include "calligraphy/trial/teacher_recording.hpp"
 
 namespace calligraphy::python {
 

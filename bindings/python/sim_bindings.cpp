@@ -16,10 +16,10 @@
 #include "bindings.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/devices/device_registry.hpp"
-#include "calligraphy/phantom_usb/phantom_usb_backends.hpp"
-#include "calligraphy/model/scene.hpp"
-#include "calligraphy/sim/person_traces.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/phantom_usb/phantom_usb_backends.hpp"
+#include "calligraphy/sim/person_traces.hpp"
 #include "calligraphy/sim/simulated_writer.hpp"
 #include "log_forwarding.hpp"
 #include "model_bindings.hpp"
@@ -43,7 +43,7 @@ namespace {
 void bind_writer_profile(py::module_& m) {
   ParameterClass<WriterProfile>(
       m, "WriterProfile",
-      "How a simulated writer writes (include/calligraphy/sim/writer_profile.hpp, docs/writer.md): a hand "
+      "How a simulated writer writes (include/calligraphy/trial/writer_profile.hpp, docs/writer.md): a hand "
       "impedance "
       "F = k (x_d - x) + b (x_d' - x') + noise + tremor holding the stylus, moving x_d with minimum-jerk "
       "timing (Flash & Hogan 1985) along a biased copy of the reference; force noise grows with the force "
@@ -193,7 +193,8 @@ void bind_registry(py::module_& m) {
           "hardware", [](const DeviceListing& d) { return d.capabilities.hardware; },
           "a physical device (False for simulated and emulated)")
       .def_property_readonly(
-          "moved_by_simulated_hand", [](const DeviceListing& d) { return d.capabilities.moved_by_simulated_hand; },
+          "moved_by_simulated_hand",
+          [](const DeviceListing& d) { return d.capabilities.moved_by_simulated_hand; },
           "a simulated hand moves it and its time passes only when advanced (a simulated writer can write on "
           "it)")
       .def_property_readonly(
@@ -203,7 +204,8 @@ void bind_registry(py::module_& m) {
       .def_readonly("limits_known", &DeviceListing::limits_known,
                     "False when info's limits are read only when the device is opened (they are 0 here)")
       .def("__repr__", [](const DeviceListing& d) {
-        return "<DeviceListing " + d.name + " (" + d.info.model + (d.capabilities.hardware ? ", hardware" : "") + ")>";
+        return "<DeviceListing " + d.name + " (" + d.info.model +
+               (d.capabilities.hardware ? ", hardware" : "") + ")>";
       });
   py::class_<DeviceSurvey>(m, "DeviceSurvey", "What a scan of the device backends found.")
       .def_readonly("devices", &DeviceSurvey::devices, "list of DeviceListing")

@@ -24,7 +24,8 @@
 #include "calligraphy/render/safety_chain.hpp"
 #include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/sim/simulated_writing.hpp"
-#include "calligraphy/study/recorded_trial.hpp"
+#include "calligraphy/study/session_folder.hpp"
+#include "calligraphy/trial/recorded_trial.hpp"
 #include "calligraphy/trial/trial.hpp"
 #include "calligraphy/trial/trial_spec_runner.hpp"
 #include "character_source.hpp"
@@ -401,7 +402,7 @@ RecordedTrial read_record_py(const py::object& record) {
     return read_recorded_trial(text, "record");
   }
   if (py::isinstance<py::str>(record) || py::isinstance(record, py::module_::import("os").attr("PathLike")))
-    return read_recorded_trial_file(convert_named<std::filesystem::path>(record, "record").string());
+    return read_study_recorded_trial(convert_named<std::filesystem::path>(record, "record").string());
   throw_type_error("record", "a dict (TrialResult.metrics, a trial record) or a record's path", record);
 }
 
@@ -584,7 +585,7 @@ simulate_trial. Returns a TrialResult whose metrics carry `end_reason`. Raises D
 LookupError) naming the devices there are, InvalidArgument, RealtimeError, CommunicationError.)");
   m.def("rerun_trial", &rerun_trial_py, py::arg("record"), py::arg("library") = py::none(),
         py::arg("teacher") = py::none(), py::call_guard<ForwardLog>(),
-        R"(Runs again the trial a record states (include/calligraphy/study/recorded_trial.hpp): its whole
+        R"(Runs again the trial a record states (include/calligraphy/trial/recorded_trial.hpp): its whole
 specification, the force law with its guidance law's values, the safety chain, the passivity controller,
 the simulated writer's profile and seed and a simulated device's physics, on the characters of `library`
 (default the embedded set) laid out as recorded. On the simulated device the trace is the same bit for bit.
@@ -607,7 +608,7 @@ of a value at fault; InvalidArgument naming the field of a contradiction; TypeEr
 type.)");
   m.def("record_teacher", &record_teacher_py, py::arg("result"), py::arg("path") = py::none(),
         R"(A teacher's recording of a trial (teacher_recording_from_trace,
-include/calligraphy/report/teacher_recording.hpp): the pen's times [s] and positions [m] of every tick,
+include/calligraphy/trial/teacher_recording.hpp): the pen's times [s] and positions [m] of every tick,
 its characters, writer, device and rate, for simulate_trial(..., teacher=recording) on the same
 characters. With `path` it is also written there as JSON, atomically. Raises InvalidArgument when the
 trial kept no trace (keep_trace=False), Error naming the path when it cannot be written.)");

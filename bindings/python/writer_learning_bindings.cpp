@@ -13,7 +13,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/sim/writer_learning.hpp"
 #include "calligraphy/sim/writer_log.hpp"
-#include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/trial/writer_profile.hpp"
 #include "parameter_class.hpp"
 #include "writer_settings.hpp"
 

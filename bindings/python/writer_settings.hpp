@@ -4,7 +4,7 @@
 #include <pybind11/pybind11.h>
 
 #include "arguments.hpp"
-#include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/trial/writer_profile.hpp"
 
 namespace calligraphy::python {
 

@@ -7,7 +7,7 @@
 #include "calligraphy/analysis/metric_table.hpp"
 #include "calligraphy/core/schema.hpp"
 #include "calligraphy/study/protocol.hpp"
-#include "calligraphy/study/recorded_trial.hpp"
+#include "calligraphy/trial/recorded_trial.hpp"
 #include "calligraphy/trial/trial_spec.hpp"
 #include "cli/app.hpp"
 #include "cli/commands.hpp"

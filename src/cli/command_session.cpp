@@ -16,12 +16,12 @@
 #include <vector>
 
 #include "calligraphy/core/unicode.hpp"
-#include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/study/cohort.hpp"
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/session_folder.hpp"
 #include "calligraphy/study/session_runner.hpp"
 #include "calligraphy/study/session_series.hpp"
+#include "calligraphy/trial/writer_profile.hpp"
 #include "cli/cli_devices.hpp"
 #include "cli/commands.hpp"
 #include "cli/interrupt.hpp"

@@ -10,8 +10,8 @@
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/devices/device_registry.hpp"
 #include "calligraphy/devices/hand_port.hpp"
-#include "calligraphy/report/teacher_recording.hpp"
 #include "calligraphy/study/schedule.hpp"
+#include "calligraphy/trial/teacher_recording.hpp"
 #include "cli/cli_devices.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
@@ -214,18 +214,19 @@ void add_train_command(CLI::App& root, Commands& commands, DeviceRegistry& devic
                   "write the window as PNG after the last character's trial, or at exit",
                   StandardOutput::refused);
   add_flag(*app, "--quiz", command->quiz,
-               "a quiz (docs/trainer.md): no guidance; each stroke is judged as the pen lifts, "
-               "accepted or missed by the stroke matcher the renderer uses (docs/stroke-acceptance.md)");
+           "a quiz (docs/trainer.md): no guidance; each stroke is judged as the pen lifts, "
+           "accepted or missed by the stroke matcher the renderer uses (docs/stroke-acceptance.md)");
   const ParameterRange hint_range = parameter_field(&StrokeAcceptance::hint_after_misses).range;
   add_integer(*app, "--hint-after-misses", command->hint_after, "N",
               "show the expected stroke after N misses on it, and after each further miss; 0: never (the "
               "stroke acceptance's hint_after_misses, as `trial --hint-after-misses`)",
               static_cast<std::int64_t>(hint_range.low), static_cast<std::int64_t>(hint_range.high));
   const ParameterRange assist_range = parameter_field(&StrokeAcceptance::assist_after_misses).range;
-  add_integer(*app, "--assist-after-misses", command->assist_after, "N",
-              "after N misses on a stroke, demonstrate it and credit it as assisted, so the trial goes on; 0: "
-              "never (the stroke acceptance's assist_after_misses, as `trial --assist-after-misses`)",
-              static_cast<std::int64_t>(assist_range.low), static_cast<std::int64_t>(assist_range.high));
+  add_integer(
+      *app, "--assist-after-misses", command->assist_after, "N",
+      "after N misses on a stroke, demonstrate it and credit it as assisted, so the trial goes on; 0: "
+      "never (the stroke acceptance's assist_after_misses, as `trial --assist-after-misses`)",
+      static_cast<std::int64_t>(assist_range.low), static_cast<std::int64_t>(assist_range.high));
   add_output_folder(*app, "--quiz-screenshots", command->quiz_screenshots,
                     "quiz: write the window as DIR/quiz-NN-VERDICT.png on the first frame after each judged "
                     "stroke (an existing folder)",

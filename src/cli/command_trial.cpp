@@ -15,15 +15,16 @@
 #include "calligraphy/devices/device_registry.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/model/scene.hpp"
-#include "calligraphy/report/teacher_recording.hpp"
 #include "calligraphy/report/trial_report.hpp"
 #include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/sim/simulated_writing.hpp"
-#include "calligraphy/sim/writer_profile.hpp"
-#include "calligraphy/study/recorded_trial.hpp"
+#include "calligraphy/study/session_folder.hpp"
+#include "calligraphy/trial/recorded_trial.hpp"
+#include "calligraphy/trial/teacher_recording.hpp"
 #include "calligraphy/trial/trial.hpp"
 #include "calligraphy/trial/trial_spec.hpp"
 #include "calligraphy/trial/trial_spec_runner.hpp"
+#include "calligraphy/trial/writer_profile.hpp"
 #include "cli/cli_devices.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
@@ -67,7 +68,7 @@ RecordedTrial recorded_from(const TrialCommand& command) {
                        "; with it go only --json, --csv, --svg, --teacher and the character data options");
     }
   }
-  RecordedTrial recorded = read_recorded_trial_file(command.spec_file);
+  RecordedTrial recorded = read_study_recorded_trial(command.spec_file);
   for (const std::string& pointer : recorded.defaulted) {
     print_error_line("calligraphy trial", "note",
                      "--spec " + command.spec_file + ": " + pointer +

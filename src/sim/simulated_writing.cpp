@@ -62,4 +62,13 @@ void SimulatedWriting::after_trial(TrialResult& result) {
   mark_writer_attempts(result.trace, *log_);
 }
 
+RecordedTrial recorded_trial(const TrialSpec& spec, const TrialRun& run, const SimulatedWriting& writing,
+                             const Scene& scene) {
+  return recorded_trial(spec, run.options, run.simulated_writer ? &writing.profile() : nullptr, scene);
+}
+
+SimulatedWriting recorded_writing(const RecordedTrial& recorded) {
+  return SimulatedWriting(recorded.spec, recorded.writer);
+}
+
 }  // namespace calligraphy

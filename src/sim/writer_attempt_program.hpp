@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "calligraphy/model/scene.hpp"
-#include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/trial/writer_profile.hpp"
 #include "sim/writer_error_injector.hpp"
 #include "sim/writer_program.hpp"
 #include "sim/writer_stroke_path.hpp"

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "calligraphy/model/scene.hpp"
-#include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/trial/writer_profile.hpp"
 #include "sim/writer_program.hpp"
 
 namespace calligraphy::writer_detail {

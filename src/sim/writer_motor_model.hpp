@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/trial/writer_profile.hpp"
 #include "sim/writer_program.hpp"
 
 namespace calligraphy::writer_detail {

@@ -12,7 +12,7 @@
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/sim/simulated_writer.hpp"
 #include "calligraphy/sim/writer_log.hpp"
-#include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/trial/writer_profile.hpp"
 #include "sim/writer_error_injector.hpp"
 #include "sim/writer_program.hpp"
 #include "sim/writer_stroke_path.hpp"

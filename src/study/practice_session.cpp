@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "calligraphy/core/sha256.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/report/trace_hdf5.hpp"
 #include "calligraphy/report/trial_report.hpp"

@@ -11,13 +11,14 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/servo_rate.hpp"
+#include "calligraphy/core/sha256.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "core/json_reader.hpp"
 #include "core/schema_json.hpp"
 #include "study/names.hpp"
 #include "study/parameter_json.hpp"
 #include "study/protocol_reading.hpp"
-#include "study/record_schema.hpp"
+#include "trial/record_schema.hpp"
 
 namespace calligraphy {
 namespace study_detail {

@@ -14,7 +14,7 @@
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/trial/trial_spec.hpp"
 #include "study/protocol_reading.hpp"
-#include "study/record_schema.hpp"
+#include "trial/record_schema.hpp"
 
 namespace calligraphy {
 

@@ -3,7 +3,9 @@
 #include <set>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/sha256.hpp"
 #include "core/json_reader.hpp"
+#include "core/whole_file.hpp"
 #include "study/manifest_json.hpp"
 #include "study/names.hpp"
 
@@ -114,3 +116,34 @@ nlohmann::json read_trial_record(const fs::path& json_file) {
 }
 
 }  // namespace calligraphy::study_detail
+
+namespace calligraphy {
+
+RecordedTrial read_study_recorded_trial(const std::string& path) {
+  RecordedTrial recorded = read_recorded_trial_file(path);
+  if (recorded.spec.guidance && recorded.spec.guidance_mode == GuidanceMode::replay &&
+      recorded.spec.teacher.empty()) {
+    // A session's replay ran on the teacher kept in its folder (trials/ is beside teachers/): the record
+    // names the file and its SHA-256 under /guidance/teacher (trial_guidance.hpp); taken when it is still the
+    // same. The record was read whole above: a damaged one was refused there.
+    nlohmann::json document =
+        json_detail::parse_json(read_regular_file(path, study_detail::kMaxRecordBytes), path);
+    nlohmann::json* teacher = document.contains("guidance") && document["guidance"].is_object() &&
+                                      document["guidance"].contains("teacher") &&
+                                      document["guidance"]["teacher"].is_object()
+                                  ? &document["guidance"]["teacher"]
+                                  : nullptr;
+    if (teacher != nullptr && (*teacher)["file"].is_string() && (*teacher)["sha256"].is_string()) {
+      const std::filesystem::path file =
+          std::filesystem::path(path).parent_path().parent_path() / (*teacher)["file"].get<std::string>();
+      std::error_code error;
+      if (std::filesystem::is_regular_file(file, error) &&
+          sha256_hex(read_regular_file(file, study_detail::kMaxRecordBytes)) ==
+              (*teacher)["sha256"].get<std::string>())
+        recorded.spec.teacher = file.string();
+    }
+  }
+  return recorded;
+}
+
+}  // namespace calligraphy

@@ -9,11 +9,13 @@
 #include <vector>
 
 #include "calligraphy/study/session_folder.hpp"
+#include "calligraphy/trial/recorded_trial.hpp"
 
 namespace calligraphy::study_detail {
 
-/// Largest trial record read: 64 MiB (a session manifest: kMaxSessionManifestBytes, session_folder.hpp).
-inline constexpr std::uintmax_t kMaxRecordBytes = std::uintmax_t{64} << 20;
+/// Largest trial record read: a record's bound, 64 MiB (trial/recorded_trial.hpp; a session manifest:
+/// kMaxSessionManifestBytes, session_folder.hpp).
+inline constexpr std::uintmax_t kMaxRecordBytes = kMaxRecordedTrialBytes;
 
 /// The session folders under `roots` (each a session folder or a folder holding some), sorted by path within
 /// each root. Throws DataError naming the roots when there is none.

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/sha256.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/report/pen_trace_csv.hpp"
 #include "calligraphy/study/protocol.hpp"

@@ -13,6 +13,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/parameter_table.hpp"
+#include "calligraphy/core/sha256.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/model/character_library.hpp"
@@ -21,9 +22,9 @@
 #include "calligraphy/report/trace_hdf5.hpp"
 #include "calligraphy/report/trial_report.hpp"
 #include "calligraphy/sim/simulated_writing.hpp"
-#include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/trial/quiz_trace.hpp"
 #include "calligraphy/trial/trial_spec_runner.hpp"
+#include "calligraphy/trial/writer_profile.hpp"
 #include "study/names.hpp"
 #include "study/remembered_writer.hpp"
 #include "study/trial_guidance.hpp"

@@ -6,6 +6,7 @@
 
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/sha256.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/render/guidance_mode.hpp"

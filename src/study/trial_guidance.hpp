@@ -9,9 +9,9 @@
 
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/render/guidance_schedule.hpp"
-#include "calligraphy/report/teacher_recording.hpp"
 #include "calligraphy/study/session_folder.hpp"
 #include "calligraphy/study/session_runner.hpp"
+#include "calligraphy/trial/teacher_recording.hpp"
 
 namespace calligraphy::study_detail {
 

@@ -13,10 +13,10 @@
 #include "core/schema_json.hpp"
 #include "report/trial_outcome.hpp"
 #include "study/manifest_json.hpp"
-#include "study/record_schema.hpp"
-#include "study/recorded_trial_object.hpp"
 #include "study/remembered_writer.hpp"
 #include "study/saved_sessions.hpp"
+#include "trial/record_schema.hpp"
+#include "trial/recorded_trial_object.hpp"
 
 namespace calligraphy::study_detail {
 namespace {
@@ -314,10 +314,10 @@ nlohmann::json trial_record(const TrialRecordContext& c, const Scene& scene, con
     document["legibility"] = legibility;
   if (c.device_name == "simulated")
     document["device"]["simulated_device"] =
-        simulated_device_object(SimulatedDeviceParameters{});  // the registry's
+        trial_detail::simulated_device_object(SimulatedDeviceParameters{});  // the registry's
   // The whole specification that ran, which `calligraphy trial --spec` runs again (recorded_trial.hpp).
   if (c.spec != nullptr) {
-    document["specification"] = recorded_trial_object(
+    document["specification"] = trial_detail::recorded_trial_object(
         recorded_trial(*c.spec, *c.options, c.simulated_writer ? &c.simulation.writer : nullptr, scene));
   }
   if (!c.condition->guidance_parameters.empty())

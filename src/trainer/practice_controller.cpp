@@ -18,8 +18,8 @@
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/render/guidance_schedule.hpp"
-#include "calligraphy/report/teacher_recording.hpp"
 #include "calligraphy/study/session_folder.hpp"
+#include "calligraphy/trial/teacher_recording.hpp"
 #include "trainer/stop_reason.hpp"
 
 namespace calligraphy::trainer {

@@ -126,7 +126,7 @@ const std::vector<SchemaField>& spec_fields() {
                "only beyond --assist-band, pushing off the stroke (--amplification-gain), or pulling along "
                "it at --timing-speed",
            .option = "--guidance-mode"}),
-      // Version 3 of a trial record (calligraphy/study/recorded_trial.hpp) is the first to state it.
+      // Version 3 of a trial record (calligraphy/trial/recorded_trial.hpp) is the first to state it.
       since(3,
             number_field<&TrialSpec::guidance_stiffness_n_per_m>(
                 "guidance_stiffness_n_per_m", law_range(&ForceLawParameters::guidance_stiffness_n_per_m),

@@ -31,7 +31,7 @@ def cpp_fields(header, struct):
     [
         (calligraphy.ForceLawParameters, "render/force_law.hpp", "ForceLawParameters"),
         (calligraphy.NearestPointOptions, "model/nearest_point.hpp", "NearestPointOptions"),
-        (calligraphy.WriterProfile, "sim/writer_profile.hpp", "WriterProfile"),
+        (calligraphy.WriterProfile, "trial/writer_profile.hpp", "WriterProfile"),
         (calligraphy.SimulatedDeviceParameters, "devices/simulated_device.hpp", "SimulatedDeviceParameters"),
         (calligraphy.DeviceInfo, "core/device_types.hpp", "DeviceInfo"),
         (calligraphy.DeviceState, "core/device_types.hpp", "DeviceState"),

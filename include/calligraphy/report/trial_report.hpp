@@ -26,7 +26,7 @@ struct TrialDescription {
   std::string teacher_characters{};              ///< replay only: the characters it was recorded on
   std::string writer_profile{};                  ///< the simulated writer's profile; empty for a person
   std::vector<std::string> writer_parameters{};  ///< "key=value" settings applied to the profile
-  /// The whole specification that ran, a JSON object (recorded_trial_json, study/recorded_trial.hpp), kept
+  /// The whole specification that ran, a JSON object (recorded_trial_json, trial/recorded_trial.hpp), kept
   /// in the JSON as "specification" so that `calligraphy trial --spec` runs it again; empty: none.
   std::string specification_json{};
 };

@@ -27,12 +27,12 @@
 #include <memory>
 #include <vector>
 
-#include "calligraphy/model/scene.hpp"
-#include "calligraphy/render/renderer.hpp"
 #include "calligraphy/devices/hand_port.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/render/renderer.hpp"
 #include "calligraphy/sim/writer_log.hpp"
-#include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/trial/writer_profile.hpp"
 
 namespace calligraphy {
 

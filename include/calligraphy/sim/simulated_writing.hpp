@@ -11,9 +11,11 @@
 
 #include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/sim/writer_log.hpp"
-#include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/trial/hand.hpp"
+#include "calligraphy/trial/recorded_trial.hpp"
 #include "calligraphy/trial/trial_spec.hpp"
+#include "calligraphy/trial/trial_spec_runner.hpp"
+#include "calligraphy/trial/writer_profile.hpp"
 
 namespace calligraphy {
 
@@ -47,5 +49,15 @@ class SimulatedWriting final : public TrialHandMaker {
   SimulatedHand* hand_ = nullptr;  // the hand last made, owned by the runner until after_trial
   std::optional<WriterLog> log_;
 };
+
+/// What `run` ran for `spec` on `scene` (trial/recorded_trial.hpp), written (when the simulated writer
+/// wrote) by `writing`.
+[[nodiscard]] RecordedTrial recorded_trial(const TrialSpec& spec, const TrialRun& run,
+                                           const SimulatedWriting& writing, const Scene& scene);
+
+/// The simulated writer of `recorded` as it wrote (`RecordedTrial::writer`, its traits and what it had
+/// learned folded in): `rerun_trial`'s hand maker for a record the simulated writer wrote. Throws
+/// InvalidArgument for a profile out of range.
+[[nodiscard]] SimulatedWriting recorded_writing(const RecordedTrial& recorded);
 
 }  // namespace calligraphy

@@ -13,7 +13,7 @@
 #include <cstdint>
 
 #include "calligraphy/sim/writer_memory.hpp"
-#include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/trial/writer_profile.hpp"
 
 namespace calligraphy {
 

@@ -8,7 +8,7 @@
 #include <cstddef>
 
 #include "calligraphy/sim/writer_log.hpp"
-#include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/trial/writer_profile.hpp"
 
 namespace calligraphy {
 

@@ -26,7 +26,7 @@
 
 #include "calligraphy/core/parameter_table.hpp"
 #include "calligraphy/core/schema.hpp"
-#include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/trial/writer_profile.hpp"
 
 namespace calligraphy {
 

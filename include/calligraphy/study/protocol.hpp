@@ -400,7 +400,4 @@ inline constexpr std::uintmax_t kMaxProtocolBytes = std::uintmax_t{1} << 20;
 /// The protocol from its text (e.g. the copy a session folder keeps): parses it and hashes it.
 [[nodiscard]] LoadedProtocol protocol_from_text(std::string text, const std::filesystem::path& path);
 
-/// Lower-case hex SHA-256 of `bytes` (FIPS 180-4).
-[[nodiscard]] std::string sha256_hex(std::string_view bytes);
-
 }  // namespace calligraphy

@@ -24,6 +24,7 @@
 
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/schedule.hpp"
+#include "calligraphy/trial/recorded_trial.hpp"
 
 namespace calligraphy {
 
@@ -251,5 +252,12 @@ inline constexpr const char* kPartialNote =
 /// (at most 4 levels deep) that does, sorted by path; temporary folders (`is_partial_session_folder`) are
 /// skipped. Throws DataError when `root` is not a folder or is a temporary one.
 [[nodiscard]] std::vector<std::filesystem::path> find_session_folders(const std::filesystem::path& root);
+
+/// The trial record file `path` as `read_recorded_trial_file` reads it (trial/recorded_trial.hpp), and for a
+/// study session's replay, which ran on the teacher kept in its session folder (trials/ is beside
+/// teachers/), that file as its teacher (`spec.teacher`) when it is still there with the SHA-256 the record
+/// gives (/guidance/teacher). What `calligraphy trial --spec` and Python's `rerun_trial` read. Throws what
+/// `read_recorded_trial_file` throws.
+[[nodiscard]] RecordedTrial read_study_recorded_trial(const std::string& path);
 
 }  // namespace calligraphy

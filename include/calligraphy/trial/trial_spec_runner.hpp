@@ -30,8 +30,8 @@ struct TrialRunInputs {
   /// instead of creating `TrialSpec::device` (e.g. a simulated device with the caller's parameters).
   HapticDevice* device = nullptr;
   /// A replay's teacher pen, device frame [m], times [s]; required for a replay. The front-end reads it from
-  /// the file `TrialSpec::teacher` (report's `read_teacher_recording`, `require_teacher_for`), or has it (a
-  /// session keeps its teacher in its folder; Python passes a TeacherRecording).
+  /// the file `TrialSpec::teacher` (`read_teacher_recording`, `require_teacher_for`: teacher_recording.hpp),
+  /// or has it (a session keeps its teacher in its folder; Python passes a TeacherRecording).
   std::vector<TeacherSample> teacher;
   /// Makes the simulated writer's hand (not owned): required when the simulated writer writes, i.e. on a
   /// device it can move (`simulated_writer_writes`). sim's `SimulatedWriting` of the specification, which

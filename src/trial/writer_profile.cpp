@@ -1,4 +1,4 @@
-#include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/trial/writer_profile.hpp"
 
 #include <array>
 #include <cmath>

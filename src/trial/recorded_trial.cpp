@@ -1,4 +1,4 @@
-#include "calligraphy/study/recorded_trial.hpp"
+#include "calligraphy/trial/recorded_trial.hpp"
 
 #include <bit>
 #include <cstdint>
@@ -9,16 +9,17 @@
 #include <utility>
 
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/study/protocol.hpp"
-#include "calligraphy/study/session_folder.hpp"
+#include "calligraphy/core/sha256.hpp"
 #include "core/json_reader.hpp"
 #include "core/schema_json.hpp"
 #include "core/whole_file.hpp"
-#include "study/record_schema.hpp"
-#include "study/recorded_trial_object.hpp"
-#include "study/saved_sessions.hpp"
-#include "study/trial_record.hpp"
+#include "trial/record_schema.hpp"
+#include "trial/recorded_trial_object.hpp"
 #include "trial/trial_spec_object.hpp"
+
+#ifndef CALLIGRAPHY_VERSION
+#error "CALLIGRAPHY_VERSION must be defined (from PROJECT_VERSION)"
+#endif
 
 namespace calligraphy {
 namespace {
@@ -41,11 +42,6 @@ void append_bits(std::string& bytes, double value) {
 }
 
 }  // namespace
-
-RecordedTrial recorded_trial(const TrialSpec& spec, const TrialRun& run, const SimulatedWriting& writing,
-                             const Scene& scene) {
-  return recorded_trial(spec, run.options, run.simulated_writer ? &writing.profile() : nullptr, scene);
-}
 
 RecordedTrial recorded_trial(const TrialSpec& spec, const TrialOptions& ran, const WriterProfile* writer,
                              const Scene& scene) {
@@ -71,7 +67,7 @@ RecordedTrial recorded_trial(const TrialSpec& spec, const TrialOptions& ran, con
   if (writer != nullptr) recorded.writer = *writer;
   recorded.layout = scene.layout;
   recorded.scene_sha256 = scene_sha256(scene);
-  recorded.library_version = library_build().version;
+  recorded.library_version = CALLIGRAPHY_VERSION;
   return recorded;
 }
 
@@ -94,7 +90,7 @@ std::string scene_sha256(const Scene& scene) {
   return sha256_hex(bytes);
 }
 
-namespace study_detail {
+namespace trial_detail {
 
 nlohmann::json simulated_device_object(const SimulatedDeviceParameters& p) {
   return schema_detail::to_json(SchemaOf<SimulatedDeviceParameters>::get(), &p);
@@ -116,12 +112,12 @@ nlohmann::json recorded_trial_object(const RecordedTrial& r) {
   return schema_detail::to_json(recorded_trial_schema(), &document);
 }
 
-}  // namespace study_detail
+}  // namespace trial_detail
 
-const Schema& recorded_trial_schema() { return SchemaOf<study_detail::RecordDocument>::get(); }
+const Schema& recorded_trial_schema() { return SchemaOf<trial_detail::RecordDocument>::get(); }
 
 std::string recorded_trial_json(const RecordedTrial& r) {
-  return study_detail::recorded_trial_object(r).dump(2) + "\n";
+  return trial_detail::recorded_trial_object(r).dump(2) + "\n";
 }
 
 namespace {
@@ -164,7 +160,7 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
   json normalized = *object;
   if (normalized.contains("trial"))
     trial_detail::type_writer_settings(normalized["trial"], reader.pointer("trial"), source);
-  study_detail::RecordDocument parts;
+  trial_detail::RecordDocument parts;
   SchemaReadResult read;
   schema_detail::from_json(recorded_trial_schema(), &parts, normalized, at, source,
                            {.require_all = true, .version = static_cast<int>(version)}, read);
@@ -238,39 +234,15 @@ RecordedTrial read_recorded_trial(std::string_view text, const std::string& sour
 }
 
 RecordedTrial read_recorded_trial_file(const std::string& path) {
-  const std::string text = read_regular_file(path, study_detail::kMaxRecordBytes);
+  const std::string text = read_regular_file(path, kMaxRecordedTrialBytes);
   // Read whole: what is refused now is the record's content, the input the command was given.
-  json document;
-  RecordedTrial recorded;
   try {
-    document = json_detail::parse_json(text, path);
-    recorded = read_recorded_document(document, path);
+    return read_recorded_document(json_detail::parse_json(text, path), path);
   } catch (const InputError&) {
     throw;
   } catch (const DataError& e) {
     throw InputError(e.what());
   }
-  if (recorded.spec.guidance && recorded.spec.guidance_mode == GuidanceMode::replay &&
-      recorded.spec.teacher.empty()) {
-    // A session's replay ran on the teacher kept in its folder (trials/ is beside teachers/): the record
-    // names the file and its SHA-256 under /guidance/teacher (trial_guidance.hpp); taken when it is still the
-    // same.
-    const json* teacher = document.contains("guidance") && document["guidance"].is_object() &&
-                                  document["guidance"].contains("teacher") &&
-                                  document["guidance"]["teacher"].is_object()
-                              ? &document["guidance"]["teacher"]
-                              : nullptr;
-    if (teacher != nullptr && (*teacher)["file"].is_string() && (*teacher)["sha256"].is_string()) {
-      const std::filesystem::path file =
-          std::filesystem::path(path).parent_path().parent_path() / (*teacher)["file"].get<std::string>();
-      std::error_code error;
-      if (std::filesystem::is_regular_file(file, error) &&
-          sha256_hex(read_regular_file(file, study_detail::kMaxRecordBytes)) ==
-              (*teacher)["sha256"].get<std::string>())
-        recorded.spec.teacher = file.string();
-    }
-  }
-  return recorded;
 }
 
 TeacherFile read_recorded_teacher(const RecordedTrial& recorded, const std::filesystem::path& path) {
@@ -284,10 +256,6 @@ TeacherFile read_recorded_teacher(const RecordedTrial& recorded, const std::file
   return {parse_teacher_recording(bytes, path.string()), sha256};
 }
 
-SimulatedWriting recorded_writing(const RecordedTrial& recorded) {
-  return SimulatedWriting(recorded.spec, recorded.writer);
-}
-
 TrialRun rerun_trial(const RecordedTrial& recorded, const Checked<TrialSpec>& spec, const Scene& scene,
                      TrialRunInputs inputs) {
   const std::string here = scene_sha256(scene);
@@ -296,6 +264,11 @@ TrialRun rerun_trial(const RecordedTrial& recorded, const Checked<TrialSpec>& sp
                           here.substr(0, 12) + "... against the record's " +
                           recorded.scene_sha256.substr(0, 12) +
                           "...): other character data (--corpus, --store) or another layout");
+  }
+  if (recorded.writer && inputs.hand_maker == nullptr) {
+    throw InvalidArgument(
+        "the simulated writer wrote this record: give its hand maker, sim's recorded_writing(recorded) "
+        "(calligraphy/sim/simulated_writing.hpp), as TrialRunInputs::hand_maker");
   }
   inputs.force_law = recorded.force_law;
   inputs.safety = recorded.safety;

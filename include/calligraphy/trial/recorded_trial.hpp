@@ -7,7 +7,11 @@
 /// layout and a SHA-256 of the characters placed. Every trial record (`calligraphy trial --json`, study
 /// sessions and cohorts) holds one as its "specification" object (format: docs/cli.md, "Re-running a trial");
 /// `calligraphy trial --spec RECORD` and `rerun_trial` run it again, and on the simulated device the trace is
-/// the same bit for bit.
+/// the same bit for bit. It is part of the trial layer, so an application that links only
+/// `calligraphy::haptics` reads a record and runs it again; a record the simulated writer wrote is re-run
+/// with sim's `recorded_writing` as the hand maker (calligraphy/sim/simulated_writing.hpp).
+#include <cstdint>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -19,11 +23,10 @@
 #include "calligraphy/render/force_law.hpp"
 #include "calligraphy/render/passivity.hpp"
 #include "calligraphy/render/safety_chain.hpp"
-#include "calligraphy/report/teacher_recording.hpp"
-#include "calligraphy/sim/simulated_writing.hpp"
-#include "calligraphy/sim/writer_profile.hpp"
+#include "calligraphy/trial/teacher_recording.hpp"
 #include "calligraphy/trial/trial_spec.hpp"
 #include "calligraphy/trial/trial_spec_runner.hpp"
+#include "calligraphy/trial/writer_profile.hpp"
 
 namespace calligraphy {
 
@@ -43,6 +46,8 @@ namespace calligraphy {
 inline constexpr std::string_view kRecordedTrialFormat = "calligraphy-trial-specification";
 inline constexpr int kRecordedTrialVersion = 6;
 inline constexpr int kOldestRecordedTrialVersion = 1;
+/// Largest trial record file read: 64 MiB.
+inline constexpr std::uintmax_t kMaxRecordedTrialBytes = std::uintmax_t{64} << 20;
 
 /// Everything that decides what a trial does, as it ran. Lengths in m, forces in N, times in s.
 struct RecordedTrial {
@@ -81,9 +86,6 @@ struct RecordedTrial {
 /// wrote, its profile `writer` (nullptr: a person).
 [[nodiscard]] RecordedTrial recorded_trial(const TrialSpec& spec, const TrialOptions& ran,
                                            const WriterProfile* writer, const Scene& scene);
-/// What `run` ran for `spec` on `scene`, written (when the simulated writer wrote) by `writing`.
-[[nodiscard]] RecordedTrial recorded_trial(const TrialSpec& spec, const TrialRun& run,
-                                           const SimulatedWriting& writing, const Scene& scene);
 
 /// Lower-case hex SHA-256 (FIPS 180-4) of the placed characters: each character's code point and, stroke by
 /// stroke, its typical stroke ID, attraction factors and elements' control points [m] (bit patterns): equal
@@ -104,11 +106,10 @@ struct RecordedTrial {
 /// (written before records held one), or a format or version this library does not read.
 [[nodiscard]] RecordedTrial read_recorded_trial(std::string_view text, const std::string& source);
 
-/// `read_recorded_trial` of the regular file `path` (at most 64 MiB, a trial record's bound). A study
-/// session's replay, which ran on the teacher kept in its session folder, names that file as its teacher when
-/// it is still there with the SHA-256 the record gives (/guidance/teacher). Throws DataError naming the path
-/// when it cannot be read, and InputError (a DataError; the command line's exit 2) for what
-/// `read_recorded_trial` refuses in its content.
+/// `read_recorded_trial` of the regular file `path` (at most kMaxRecordedTrialBytes). Throws DataError naming
+/// the path when it cannot be read, and InputError (a DataError; the command line's exit 2) for what
+/// `read_recorded_trial` refuses in its content. A study session's replay names no teacher file (it ran on
+/// the one kept in its session folder): study's `read_study_recorded_trial` finds it there.
 [[nodiscard]] RecordedTrial read_recorded_trial_file(const std::string& path);
 
 /// A teacher's recording as read from its file, with the file's lower-case hex SHA-256 (what a record names).
@@ -125,17 +126,16 @@ struct TeacherFile {
 [[nodiscard]] TeacherFile read_recorded_teacher(const RecordedTrial& recorded,
                                                 const std::filesystem::path& path);
 
-/// The simulated writer of `recorded` as it wrote (`RecordedTrial::writer`, its traits and what it had
-/// learned folded in): `rerun_trial`'s hand maker. Throws InvalidArgument for a profile out of range.
-[[nodiscard]] SimulatedWriting recorded_writing(const RecordedTrial& recorded);
-
 /// Runs `recorded` again on `scene` (laid out by the caller with `recorded.layout`) with `inputs` (the
-/// registry, a stop flag, a replay's teacher samples, and `recorded_writing(recorded)` as the hand maker).
+/// registry, a stop flag, a replay's teacher samples, and, for a record the simulated writer wrote
+/// (`recorded.writer`), sim's `recorded_writing(recorded)` as the hand maker; a person's record runs with the
+/// hand `inputs` gives, if any).
 /// `spec` is the specification that runs: `recorded.spec` as the caller checked it
 /// (`Checked<TrialSpec>::check`), its output files and a replay's teacher file the caller's. The record's
 /// force law, safety chain, passivity controller and simulated device (made here when recorded) replace any
 /// in `inputs`. Throws InvalidArgument when `scene` is not the recorded one (its SHA-256 differs: other
-/// character data), and what `run_trial_spec` throws.
+/// character data), when the simulated writer wrote the record and `inputs` gives no hand maker, and what
+/// `run_trial_spec` throws.
 [[nodiscard]] TrialRun rerun_trial(const RecordedTrial& recorded, const Checked<TrialSpec>& spec,
                                    const Scene& scene, TrialRunInputs inputs = {});
 

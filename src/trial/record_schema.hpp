@@ -12,12 +12,12 @@
 #include "calligraphy/render/force_law.hpp"
 #include "calligraphy/render/passivity.hpp"
 #include "calligraphy/render/safety_chain.hpp"
-#include "calligraphy/sim/writer_profile.hpp"
 #include "calligraphy/trial/trial_spec.hpp"
+#include "calligraphy/trial/writer_profile.hpp"
 
 namespace calligraphy {
 
-namespace study_detail {
+namespace trial_detail {
 
 /// The scene as a record states it.
 struct RecordedScene {
@@ -40,7 +40,7 @@ struct RecordDocument {
   std::string teacher_sha256;  ///< a replay's teacher recording's SHA-256; empty: none read
 };
 
-}  // namespace study_detail
+}  // namespace trial_detail
 
 #define CALLIGRAPHY_SCHEMA_OF(Type) \
   template <>                       \
@@ -61,8 +61,8 @@ CALLIGRAPHY_SCHEMA_OF(PassivityParameters)
 CALLIGRAPHY_SCHEMA_OF(WriterProfile)
 CALLIGRAPHY_SCHEMA_OF(SimulatedDeviceParameters)
 CALLIGRAPHY_SCHEMA_OF(SceneLayout)
-CALLIGRAPHY_SCHEMA_OF(study_detail::RecordedScene)
-CALLIGRAPHY_SCHEMA_OF(study_detail::RecordDocument)
+CALLIGRAPHY_SCHEMA_OF(trial_detail::RecordedScene)
+CALLIGRAPHY_SCHEMA_OF(trial_detail::RecordDocument)
 #undef CALLIGRAPHY_SCHEMA_OF
 
 }  // namespace calligraphy

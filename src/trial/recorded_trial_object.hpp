@@ -2,9 +2,9 @@
 // The specification object of a trial record (recorded_trial.hpp) as JSON, for the record's writer. Internal.
 #include <nlohmann/json.hpp>
 
-#include "calligraphy/study/recorded_trial.hpp"
+#include "calligraphy/trial/recorded_trial.hpp"
 
-namespace calligraphy::study_detail {
+namespace calligraphy::trial_detail {
 
 /// `recorded_trial_json`'s object.
 nlohmann::json recorded_trial_object(const RecordedTrial& recorded);
@@ -13,4 +13,4 @@ nlohmann::json recorded_trial_object(const RecordedTrial& recorded);
 /// device.simulated_device).
 nlohmann::json simulated_device_object(const SimulatedDeviceParameters& parameters);
 
-}  // namespace calligraphy::study_detail
+}  // namespace calligraphy::trial_detail

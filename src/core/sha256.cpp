@@ -1,5 +1,7 @@
-// SHA-256 (FIPS 180-4) names a protocol file and a teacher's recording by their content. The digest is
-// OpenSSL's libcrypto (EVP interface), not our own.
+// SHA-256 (FIPS 180-4) names a file by its content (sha256.hpp). The digest is OpenSSL's libcrypto (EVP
+// interface), not our own.
+#include "calligraphy/core/sha256.hpp"
+
 #include <openssl/evp.h>
 
 #include <array>
@@ -9,7 +11,6 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/printable_text.hpp"
-#include "calligraphy/study/protocol.hpp"
 
 namespace calligraphy {
 

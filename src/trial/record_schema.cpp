@@ -1,9 +1,9 @@
-#include "study/record_schema.hpp"
+#include "trial/record_schema.hpp"
 
 #include <limits>
 #include <vector>
 
-#include "calligraphy/study/recorded_trial.hpp"
+#include "calligraphy/trial/recorded_trial.hpp"
 
 namespace calligraphy {
 namespace {
@@ -179,8 +179,8 @@ const Schema& SchemaOf<SceneLayout>::get() {
   return schema;
 }
 
-const Schema& SchemaOf<study_detail::RecordedScene>::get() {
-  using S = study_detail::RecordedScene;
+const Schema& SchemaOf<trial_detail::RecordedScene>::get() {
+  using S = trial_detail::RecordedScene;
   static const std::vector<SchemaField> fields{
       object_field<&S::layout>("layout", {.doc = "where the characters were placed"}),
       string_field<&S::sha256>("sha256", {.doc = "SHA-256 of the placed characters (hex)"}),
@@ -192,8 +192,8 @@ const Schema& SchemaOf<study_detail::RecordedScene>::get() {
   return schema;
 }
 
-const Schema& SchemaOf<study_detail::RecordDocument>::get() {
-  using R = study_detail::RecordDocument;
+const Schema& SchemaOf<trial_detail::RecordDocument>::get() {
+  using R = trial_detail::RecordDocument;
   static const std::vector<SchemaField> fields{
       string_field<&R::format>("format", {.doc = "\"calligraphy-trial-specification\""}),
       integer_field<&R::version>("version", kOldestRecordedTrialVersion, kRecordedTrialVersion,

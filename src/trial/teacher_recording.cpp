@@ -1,4 +1,4 @@
-#include "calligraphy/report/teacher_recording.hpp"
+#include "calligraphy/trial/teacher_recording.hpp"
 
 #include <cmath>
 #include <nlohmann/json.hpp>

@@ -3,7 +3,8 @@
 /// How a simulated writer writes: its hand, its closed loop, its bias, the errors it makes and how it
 /// learns. Plain fields, settable one by one from C++ (then `validate()`), or by name with
 /// `set_writer_parameter` (for a command line or Python). Every constant and its source:
-/// docs/writer.md.
+/// docs/writer.md. A value type of the trial layer (a trial record states the profile that wrote it,
+/// recorded_trial.hpp); the writer that executes it is sim's (calligraphy/sim/simulated_writer.hpp).
 #include <span>
 #include <string>
 #include <string_view>
