@@ -23,7 +23,7 @@ namespace fs = std::filesystem;
 namespace {
 
 std::string manifest_sha256(const fs::path& folder) {
-  return sha256_hex(study_detail::read_small_file(SessionLayout::manifest(folder), kMaxSessionManifestBytes,
+  return sha256_hex(study_detail::read_session_file(SessionLayout::manifest(folder), kMaxSessionManifestBytes,
                                                   "session manifest"));
 }
 
