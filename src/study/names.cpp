@@ -56,7 +56,8 @@ std::string read_small_file(const std::filesystem::path& path, std::uintmax_t ma
 
 std::string session_file_link_message(const std::filesystem::path& path) {
   return path.string() +
-         ": is a symbolic link; a session's files are its own: put the file itself back in its place (nothing "
+         ": is a symbolic link; a session's files are its own: put the file itself back in its place "
+         "(nothing "
          "is read or written through a link in a session folder)";
 }
 
@@ -77,7 +78,8 @@ std::string read_session_file(const std::filesystem::path& path, std::uintmax_t 
   std::string text;
   try {
     struct stat status {};
-    if (::fstat(fd, &status) != 0) throw DataError(path.string() + ": cannot be read (expected a " + what + ")");
+    if (::fstat(fd, &status) != 0)
+      throw DataError(path.string() + ": cannot be read (expected a " + what + ")");
     if (!S_ISREG(status.st_mode))
       throw DataError(path.string() + ": not a regular file (expected a " + what + ")");
     const auto size = static_cast<std::uintmax_t>(status.st_size);

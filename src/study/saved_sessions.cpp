@@ -33,8 +33,8 @@ std::vector<fs::path> session_folders_under(const std::vector<fs::path>& roots) 
 
 SessionManifest read_session_manifest(const fs::path& folder) {
   const fs::path path = SessionLayout::manifest(folder);
-  SessionManifest manifest =
-      manifest_from_json(read_session_file(path, kMaxSessionManifestBytes, "session manifest"), path.string());
+  SessionManifest manifest = manifest_from_json(
+      read_session_file(path, kMaxSessionManifestBytes, "session manifest"), path.string());
   manifest.session_id = folder.filename().string();
   check_records_planned(folder, manifest);
   return manifest;

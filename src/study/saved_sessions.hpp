@@ -20,8 +20,8 @@ inline constexpr std::uintmax_t kMaxRecordBytes = std::uintmax_t{64} << 20;
 std::vector<std::filesystem::path> session_folders_under(const std::vector<std::filesystem::path>& roots);
 
 /// The manifest of the session folder `folder`, its `session_id` the folder's name, its saved records checked
-/// against its plan (check_records_planned), read without following a link (read_session_file). Throws DataError naming the file (and JSON pointer) when it
-/// cannot be read.
+/// against its plan (check_records_planned), read without following a link (read_session_file). Throws
+/// DataError naming the file (and JSON pointer) when it cannot be read.
 SessionManifest read_session_manifest(const std::filesystem::path& folder);
 
 /// Refuses a file of the session folder `folder` that is a symbolic link (session.json, log.jsonl, trials/,
@@ -65,8 +65,9 @@ inline constexpr const char* kTrialRecordFormat = "calligraphy-study-trial";
 inline constexpr std::int64_t kTrialRecordVersion = 2;
 
 /// The record of a saved trial, its format and version checked, read without following a link
-/// (read_session_file): every reader of a session's records reads them through this. Throws DataError naming the file and the field: not a record, or a version this library does not
-/// know (a newer calligraphy wrote it, or the file is damaged).
+/// (read_session_file): every reader of a session's records reads them through this. Throws DataError naming
+/// the file and the field: not a record, or a version this library does not know (a newer calligraphy wrote
+/// it, or the file is damaged).
 nlohmann::json read_trial_record(const std::filesystem::path& json_file);
 
 }  // namespace calligraphy::study_detail

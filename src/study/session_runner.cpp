@@ -65,7 +65,8 @@ json trial_details(const PlannedTrial& trial) {
 // recovered, so that the log names every saved trial once.
 void log_unlogged_saves(SessionFolder& session) {
   const std::filesystem::path log_path = SessionLayout::log(session.path());
-  const std::string text = study_detail::read_session_file(log_path, std::uintmax_t{256} << 20, "session log");
+  const std::string text =
+      study_detail::read_session_file(log_path, std::uintmax_t{256} << 20, "session log");
   std::set<std::string> logged;
   std::size_t begin = 0;
   while (begin < text.size()) {
@@ -321,8 +322,8 @@ class SessionRun {
   // The one runner of a trial specification; the device (made before, so that a failure is logged), the
   // teacher kept in the session folder, the condition's force law and what the host gives (its display
   // channel) are its inputs, all values: nothing changes the trial's options once the runner made them.
-  TrialRunInputs inputs_for(const PlannedTrial& trial, const StudyCondition& condition, const PreparedTrial& prepared,
-                            HapticDevice& device) const {
+  TrialRunInputs inputs_for(const PlannedTrial& trial, const StudyCondition& condition,
+                            const PreparedTrial& prepared, HapticDevice& device) const {
     TrialRunInputs inputs;
     inputs.device = &device;
     inputs.teacher = prepared.guidance.guidance.teacher;
@@ -360,7 +361,8 @@ class SessionRun {
     TrialRun run = run_trial_spec(prepared.spec, prepared.scene, inputs);
     if (run.result.end == TrialEnd::interrupted && run.result.abort_reason.empty())
       run.result.abort_reason = "stopped by " + stop_reason(options_);
-    context.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    context.wall_time_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     context.end_utc = utc_now_iso8601();
     context.options = &run.options;
     context.spec = &*prepared.spec;
@@ -375,8 +377,8 @@ class SessionRun {
   }
 
   // Saves the trial (or keeps it as an attempt) with its record, and logs how it ended.
-  TrialOutcome keep(const PlannedTrial& trial, const StudyCondition& condition, const Scene& scene, const TrialRun& run,
-                    study_detail::TrialRecordContext& context) {
+  TrialOutcome keep(const PlannedTrial& trial, const StudyCondition& condition, const Scene& scene,
+                    const TrialRun& run, study_detail::TrialRecordContext& context) {
     const TrialResult& trial_result = run.result;
     const std::string stem = SessionFolder::trial_stem(trial);
     context.trace_file = stem + "." + std::string(SessionFolder::kTraceExtension);
@@ -408,7 +410,8 @@ class SessionRun {
       }
       // Learned from as the record says, the same as when the memory is rebuilt on a resume.
       if (learning_)
-        study_detail::practise_record(memory_, json::parse(record), session_.trial_file(trial, "json").string(),
+        study_detail::practise_record(memory_, json::parse(record),
+                                      session_.trial_file(trial, "json").string(),
                                       study_detail::subject_traits(manifest_.setup).learning);
       outcome.saved = true;
       outcome.json_file = session_.trial_file(trial, "json").string();

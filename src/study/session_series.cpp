@@ -24,7 +24,7 @@ namespace {
 
 std::string manifest_sha256(const fs::path& folder) {
   return sha256_hex(study_detail::read_session_file(SessionLayout::manifest(folder), kMaxSessionManifestBytes,
-                                                  "session manifest"));
+                                                    "session manifest"));
 }
 
 // Session `number` (> 1) must follow the folder found for the session before it: by name, and by content
