@@ -1,6 +1,8 @@
 #include "study/manifest_json.hpp"
 
 #include <algorithm>
+#include <iterator>
+#include <unordered_set>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
@@ -15,18 +17,20 @@ namespace {
 
 using nlohmann::json;
 
-// True when `pointer` was missing from the document and took its default (SchemaReadResult::defaulted).
-bool defaulted(const SchemaReadResult& result, std::string_view pointer) {
-  return std::find(result.defaulted.begin(), result.defaulted.end(), pointer) != result.defaulted.end();
-}
+// The JSON pointers of the omissible keys a document lacks (SchemaReadResult::defaulted), looked up once per
+// key of every planned trial: a set, as a plan may hold a million trials.
+using Missing = std::unordered_set<std::string>;
+
+// True when `pointer` was missing from the document and took its default.
+bool defaulted(const Missing& missing, const std::string& pointer) { return missing.contains(pointer); }
 
 // The item set and crossover of a planned trial at `at`, each written only when it has a value
 // (plan_session): their type and range are the schema's, their spelling is checked here, naming the pointer.
-void check_crossover_keys(const ManifestPlannedTrial& read, const SchemaReadResult& result,
-                          const std::string& at, const std::string& source) {
+void check_crossover_keys(const ManifestPlannedTrial& read, const Missing& missing, const std::string& at,
+                          const std::string& source) {
   const auto label = [&](const std::string& text, const char* key) {
     const std::string pointer = json_detail::child_pointer(at, key);
-    if (!defaulted(result, pointer) && !is_label(text, 32)) {
+    if (!defaulted(missing, pointer) && !is_label(text, 32)) {
       json_detail::fail(
           source, pointer,
           "expected 1 to 32 letters, digits, '_' or '-', got " + json_detail::describe(json(text)));
@@ -37,14 +41,14 @@ void check_crossover_keys(const ManifestPlannedTrial& read, const SchemaReadResu
   const std::string sequence = json_detail::child_pointer(at, "sequence");
   const bool letters =
       std::all_of(read.sequence.begin(), read.sequence.end(), [](char c) { return c >= 'A' && c <= 'Z'; });
-  if (!defaulted(result, sequence) && (read.sequence.empty() || read.sequence.size() > 26 || !letters)) {
+  if (!defaulted(missing, sequence) && (read.sequence.empty() || read.sequence.size() > 26 || !letters)) {
     json_detail::fail(source, sequence,
                       "expected 1 to 26 letters A-Z (the crossover's conditions in period order), got " +
                           json_detail::describe(json(read.sequence)));
   }
 }
 
-PlannedTrial planned_trial_from(const ManifestPlannedTrial& read, const SchemaReadResult& result,
+PlannedTrial planned_trial_from(const ManifestPlannedTrial& read, const Missing& missing,
                                 const std::string& at, const std::string& source,
                                 std::size_t expected_index) {
   PlannedTrial trial;
@@ -67,7 +71,7 @@ PlannedTrial planned_trial_from(const ManifestPlannedTrial& read, const SchemaRe
   trial.item = static_cast<std::size_t>(read.item - 1);
   trial.repetition = static_cast<int>(read.repetition);
   trial.break_before_s = read.break_before_s;
-  check_crossover_keys(read, result, at, source);
+  check_crossover_keys(read, missing, at, source);
   trial.item_set = read.item_set;
   trial.sequence = read.sequence;
   trial.period = static_cast<int>(read.period);
@@ -174,6 +178,8 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
   SchemaReadResult result;
   schema_detail::from_json(session_manifest_schema(), &read, document, "", source,
                            {.require_all = true, .version = static_cast<int>(version)}, result);
+  const Missing missing(std::make_move_iterator(result.defaulted.begin()),
+                        std::make_move_iterator(result.defaulted.end()));
   if (read.format != kSessionFormat)
     json_detail::fail(source, "/format", std::string("expected \"") + kSessionFormat + "\"");
   SessionManifest manifest;
@@ -195,12 +201,12 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
   manifest.setup.session_number = static_cast<int>(read.session_number);
   manifest.group = read.group;
   manifest.study_id = read.study_id;
-  if (!defaulted(result, "/study_id") && !is_study_id(manifest.study_id)) {
+  if (!defaulted(missing, "/study_id") && !is_study_id(manifest.study_id)) {
     json_detail::fail(
         source, "/study_id",
         "expected 32 lower-case hex digits, got " + json_detail::describe(json(manifest.study_id)));
   }
-  if (!defaulted(result, "/previous_session")) {
+  if (!defaulted(missing, "/previous_session")) {
     const PreviousSession& p = read.previous_session;
     if (p.delay != "waited" && p.delay != "simulated" && p.delay != "overridden") {
       json_detail::fail(source, "/previous_session/delay",
@@ -233,7 +239,7 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
   };
   for (std::size_t i = 0; i < read.plan.size(); ++i) {
     const std::string at = json_detail::child_pointer("/plan", i);
-    PlannedTrial trial = planned_trial_from(read.plan[i], result, at, source, i);
+    PlannedTrial trial = planned_trial_from(read.plan[i], missing, at, source, i);
     if (!known(trial.condition))
       json_detail::fail(source, json_detail::child_pointer(at, "condition"),
                         "not a condition of the protocol");
