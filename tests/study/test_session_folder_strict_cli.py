@@ -206,6 +206,22 @@ class Links(Readers):
                     if kind != "zero":
                         to.unlink()
 
+    def test_the_series_refuses_an_earlier_sessions_linked_session_json(self):
+        """A later session of a subject reads the one before it (the series): through no link either."""
+        root = self.cwd / "days"
+        day1, day2 = self.days_study(root, "P01")
+        shutil.rmtree(day2)
+        manifest = day1 / "session.json"
+        outside = self.cwd / "outside-session.json"
+        shutil.copyfile(manifest, outside)
+        manifest.unlink()
+        os.symlink(outside, manifest)
+        before = digest_tree(root)
+        out = self.cli("session", "run", self.fx.protocol2, "--subject", "P01", "--writer", "simulated",
+                       "--out", root)
+        self.assertIn("symbolic link", self.refused(out, 1, "session.json"))
+        self.assertEqual(digest_tree(root), before)
+
     def test_a_hard_linked_session_json_reads_and_is_not_written(self):
         study, session = self.unfinished()
         outside = self.cwd / "outside-session.json"
