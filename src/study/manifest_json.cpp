@@ -79,18 +79,24 @@ PlannedTrial planned_trial_from(const ManifestPlannedTrial& read, const Missing&
   return trial;
 }
 
-// Version 1 counted a planned trial's block and item from 0: they are read as version 2 counts them, from 1
-// (a value that is not a whole number from 0 is left for the schema to refuse as it is).
-void count_from_one(json& document) {
+// Version 1 counted a planned trial's block and item from 0: they are read as version 2 counts them, from 1,
+// a whole number out of version 1's range refused here in its terms (another type is the schema's to refuse).
+void count_from_one(json& document, const std::string& source) {
   const auto plan = document.find("plan");
   if (plan == document.end() || !plan->is_array()) return;
-  for (json& trial : *plan) {
+  for (std::size_t i = 0; i < plan->size(); ++i) {
+    json& trial = (*plan)[i];
     if (!trial.is_object()) continue;
     for (const char* key : {"block", "item"}) {
       const auto value = trial.find(key);
-      if (value != trial.end() && value->is_number_unsigned() &&
-          value->get<std::uint64_t>() <= kMaxPlannedTrials)
+      if (value == trial.end() || !value->is_number_integer()) continue;
+      if (value->is_number_unsigned() && value->get<std::uint64_t>() < kMaxPlannedTrials) {
         *value = value->get<std::uint64_t>() + 1;
+      } else {
+        json_detail::fail(source, json_detail::child_pointer(json_detail::child_pointer("/plan", i), key),
+                          "expected an integer in [0, " + std::to_string(kMaxPlannedTrials - 1) +
+                              "] (version 1 counts from 0), got " + json_detail::describe(*value));
+      }
     }
   }
 }
@@ -173,7 +179,7 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
         version = known;
     }
   }
-  if (version < 2) count_from_one(document);
+  if (version < 2) count_from_one(document, source);
   ManifestDocument read;
   SchemaReadResult result;
   schema_detail::from_json(session_manifest_schema(), &read, document, "", source,

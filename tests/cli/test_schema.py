@@ -730,6 +730,11 @@ class SessionSchemaTest(unittest.TestCase):
         folder, _ = self.edited(first)
         out = self.report(folder)
         self.assertEqual(out.returncode, 0, out.stderr.decode())
+        # version 1's range: from 0 to 999,999
+        for value in (-1, 1000000):
+            past = copy.deepcopy(first)
+            past["plan"][0]["item"] = value
+            self.refused_by_both(past, "/plan/0/item")
         # version 2 counts from 1: its block 0 is refused by both
         second = copy.deepcopy(first)
         second["version"] = 2
