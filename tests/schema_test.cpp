@@ -287,6 +287,44 @@ TEST_CASE("The command line's text of a field is parsed once and written back th
   CHECK(enum_spelling(Colour::light_blue) == "light-blue");
 }
 
+TEST_CASE("An omissible field may be missing from a document of any version and is not required",
+          "[schema]") {
+  const Schema& base = SchemaOf<Sample>::get();
+  static const std::vector<SchemaField> fields = [] {
+    std::vector<SchemaField> out(SchemaOf<Sample>::get().fields.begin(),
+                                 SchemaOf<Sample>::get().fields.end());
+    for (SchemaField& field : out) {
+      if (field.name == "name") field = omissible(field);
+    }
+    return out;
+  }();
+  const Schema schema{.name = base.name,
+                      .doc = base.doc,
+                      .fields = fields,
+                      .defaults = base.defaults,
+                      .check_rules = base.check_rules};
+  nlohmann::json whole = nlohmann::json::parse(schema_json(everything_set()));
+  whole.erase("name");
+  Sample read;
+  const SchemaReadResult result =
+      schema_from_json(schema, &read, whole.dump(), "s.json", {.require_all = true});
+  CHECK(result.defaulted == std::vector<std::string>{"/name"});
+  CHECK(read.name == Sample{}.name);
+  CHECK(read.count == everything_set().count);
+  // The schema that requires it refuses the same document; null is no value for either.
+  CHECK_THAT(error_of([&] { (void)schema_from_json<Sample>(whole.dump(), "s.json", {.require_all = true}); }),
+             Catch::Contains("s.json: /name") && Catch::Contains("missing"));
+  whole["name"] = nullptr;
+  CHECK_THAT(
+      error_of([&] { (void)schema_from_json(schema, &read, whole.dump(), "s.json", {.require_all = true}); }),
+      Catch::Contains("s.json: /name") && Catch::Contains("null"));
+  const nlohmann::json json_schema =
+      nlohmann::json::parse(json_schema_text(schema, "https://x.invalid/s.json", "Sample", true));
+  CHECK(json_schema["required"].size() == fields.size() - 2);  // neither the omissible nor the added field
+  for (const auto& key : json_schema["required"]) CHECK(key != "name");
+  CHECK(json_schema["properties"].contains("name"));
+}
+
 TEST_CASE("The JSON Schema and the docs' table come from the same fields", "[schema]") {
   const nlohmann::json schema = nlohmann::json::parse(
       json_schema_text(SchemaOf<Sample>::get(), "https://x.invalid/s.json", "Sample", true));

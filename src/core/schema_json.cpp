@@ -198,7 +198,8 @@ ordered_json struct_schema(const Schema& schema, ordered_json& defs, bool all_re
   const void* defaults = schema.defaults();
   for (const SchemaField& field : schema.fields) {
     properties[std::string(field.name)] = field_schema(field, defaults, defs, all_required);
-    if (all_required && field.since_version == 0) required.push_back(std::string(field.name));
+    if (all_required && field.since_version == 0 && !field.omissible)
+      required.push_back(std::string(field.name));
   }
   out["properties"] = std::move(properties);
   out["additionalProperties"] = false;
@@ -330,7 +331,7 @@ void from_json(const Schema& schema, void* object, const json& document, const s
     const std::string at = json_detail::child_pointer(pointer, key);
     const auto found = document.find(key);
     if (found == document.end()) {
-      if (options.require_all && field.since_version <= options.version) {
+      if (options.require_all && field.since_version <= options.version && !field.omissible) {
         json_detail::fail(source, at, "missing (" + owner + "." + key + ": " + field.description() + ")");
       }
       if (options.require_all) result.defaulted.push_back(at);

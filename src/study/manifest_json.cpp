@@ -1,10 +1,14 @@
 #include "study/manifest_json.hpp"
 
 #include <algorithm>
+#include <iterator>
+#include <unordered_set>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "core/json_reader.hpp"
+#include "core/schema_json.hpp"
+#include "study/manifest_schema.hpp"
 #include "study/names.hpp"
 #include "study/protocol_reading.hpp"
 
@@ -12,63 +16,89 @@ namespace calligraphy::study_detail {
 namespace {
 
 using nlohmann::json;
-constexpr const char* kFormat = "calligraphy-study-session";
-// Version 2 counts a planned trial's block and item from 1, as its index and repetition; version 1 (older
-// folders) counted them from 0.
-constexpr std::int64_t kVersion = 2;
 
-// A label (as item set and condition names) or nothing: plans made before item sets lack these keys.
-std::string optional_label(json_detail::ObjectReader& reader, const std::string& key) {
-  std::string text = reader.string_or(key, "");
-  if (reader.has(key) && !is_label(text, 32)) {
-    json_detail::fail(
-        reader.source(), reader.pointer(key),
-        "expected 1 to 32 letters, digits, '_' or '-', got " + json_detail::describe(json(text)));
-  }
-  return text;
-}
+// The JSON pointers of the omissible keys a document lacks (SchemaReadResult::defaulted), looked up once per
+// key of every planned trial: a set, as a plan may hold a million trials.
+using Missing = std::unordered_set<std::string>;
 
-// The item set and crossover of a planned trial, each written only when it has a value (plan_session).
-void read_crossover_keys(json_detail::ObjectReader& reader, PlannedTrial& trial) {
-  trial.item_set = optional_label(reader, "item_set");
-  trial.sequence = reader.string_or("sequence", "");
+// True when `pointer` was missing from the document and took its default.
+bool defaulted(const Missing& missing, const std::string& pointer) { return missing.contains(pointer); }
+
+// The item set and crossover of a planned trial at `at`, each written only when it has a value
+// (plan_session): their type and range are the schema's, their spelling is checked here, naming the pointer.
+void check_crossover_keys(const ManifestPlannedTrial& read, const Missing& missing, const std::string& at,
+                          const std::string& source) {
+  const auto label = [&](const std::string& text, const char* key) {
+    const std::string pointer = json_detail::child_pointer(at, key);
+    if (!defaulted(missing, pointer) && !is_label(text, 32)) {
+      json_detail::fail(
+          source, pointer,
+          "expected 1 to 32 letters, digits, '_' or '-', got " + json_detail::describe(json(text)));
+    }
+  };
+  label(read.item_set, "item_set");
+  label(read.trained_condition, "trained_condition");
+  const std::string sequence = json_detail::child_pointer(at, "sequence");
   const bool letters =
-      std::all_of(trial.sequence.begin(), trial.sequence.end(), [](char c) { return c >= 'A' && c <= 'Z'; });
-  if (reader.has("sequence") && (trial.sequence.empty() || trial.sequence.size() > 26 || !letters)) {
-    json_detail::fail(reader.source(), reader.pointer("sequence"),
+      std::all_of(read.sequence.begin(), read.sequence.end(), [](char c) { return c >= 'A' && c <= 'Z'; });
+  if (!defaulted(missing, sequence) && (read.sequence.empty() || read.sequence.size() > 26 || !letters)) {
+    json_detail::fail(source, sequence,
                       "expected 1 to 26 letters A-Z (the crossover's conditions in period order), got " +
-                          json_detail::describe(json(trial.sequence)));
+                          json_detail::describe(json(read.sequence)));
   }
-  trial.period = static_cast<int>(reader.integer_or("period", 0, 1, 26));
-  trial.trained_condition = optional_label(reader, "trained_condition");
 }
 
-PlannedTrial planned_trial_from(const json& value, const std::string& pointer, const std::string& source,
-                                std::size_t expected_index, std::int64_t version) {
-  const std::int64_t first = version >= 2 ? 1 : 0;  // the first block and item
-  json_detail::ObjectReader reader(value, pointer, source);
+PlannedTrial planned_trial_from(const ManifestPlannedTrial& read, const Missing& missing,
+                                const std::string& at, const std::string& source,
+                                std::size_t expected_index) {
   PlannedTrial trial;
-  trial.index = static_cast<std::size_t>(reader.integer("index", 1, 1000000)) - 1;
-  if (trial.index != expected_index) {
-    json_detail::fail(source, reader.pointer("index"),
+  if (read.index != static_cast<std::int64_t>(expected_index) + 1) {
+    json_detail::fail(source, json_detail::child_pointer(at, "index"),
                       "expected " + std::to_string(expected_index + 1) + " (trials in order)");
   }
-  trial.phase = choice(reader, "phase", kStudyPhases);
-  trial.block = static_cast<std::size_t>(reader.integer("block", first, 1000000) - first);
-  trial.condition = reader.string("condition");
+  trial.index = expected_index;
+  trial.phase = read.phase;
+  trial.block = static_cast<std::size_t>(read.block - 1);
+  trial.condition = read.condition;
   try {
-    trial.characters = decode_utf8(reader.string("characters"));
+    trial.characters = decode_utf8(read.characters);
   } catch (const InvalidArgument& e) {
-    json_detail::fail(source, reader.pointer("characters"), std::string("not UTF-8: ") + e.what());
+    json_detail::fail(source, json_detail::child_pointer(at, "characters"),
+                      std::string("not UTF-8: ") + e.what());
   }
-  if (trial.characters.empty()) json_detail::fail(source, reader.pointer("characters"), "empty");
-  trial.item = static_cast<std::size_t>(reader.integer("item", first, 1000000) - first);
-  trial.repetition = static_cast<int>(reader.integer("repetition", 1, 1000000));
-  trial.break_before_s = reader.number_or("break_before_s", 0.0, 0.0, 86400.0);
-  read_crossover_keys(reader, trial);
-  reader.optional("file");
-  reader.finish();
+  if (trial.characters.empty())
+    json_detail::fail(source, json_detail::child_pointer(at, "characters"), "empty");
+  trial.item = static_cast<std::size_t>(read.item - 1);
+  trial.repetition = static_cast<int>(read.repetition);
+  trial.break_before_s = read.break_before_s;
+  check_crossover_keys(read, missing, at, source);
+  trial.item_set = read.item_set;
+  trial.sequence = read.sequence;
+  trial.period = static_cast<int>(read.period);
+  trial.trained_condition = read.trained_condition;
   return trial;
+}
+
+// Version 1 counted a planned trial's block and item from 0: they are read as version 2 counts them, from 1,
+// a whole number out of version 1's range refused here in its terms (another type is the schema's to refuse).
+void count_from_one(json& document, const std::string& source) {
+  const auto plan = document.find("plan");
+  if (plan == document.end() || !plan->is_array()) return;
+  for (std::size_t i = 0; i < plan->size(); ++i) {
+    json& trial = (*plan)[i];
+    if (!trial.is_object()) continue;
+    for (const char* key : {"block", "item"}) {
+      const auto value = trial.find(key);
+      if (value == trial.end() || !value->is_number_integer()) continue;
+      if (value->is_number_unsigned() && value->get<std::uint64_t>() < kMaxPlannedTrials) {
+        *value = value->get<std::uint64_t>() + 1;
+      } else {
+        json_detail::fail(source, json_detail::child_pointer(json_detail::child_pointer("/plan", i), key),
+                          "expected an integer in [0, " + std::to_string(kMaxPlannedTrials - 1) +
+                              "] (version 1 counts from 0), got " + json_detail::describe(*value));
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -104,8 +134,8 @@ std::string manifest_to_json(const SessionManifest& manifest) {
   json plan = json::array();
   for (const PlannedTrial& trial : manifest.plan) plan.push_back(planned_trial_json(trial));
   const SessionSetup& setup = manifest.setup;
-  json document = {{"format", kFormat},
-                   {"version", kVersion},
+  json document = {{"format", kSessionFormat},
+                   {"version", kSessionVersion},
                    {"created_utc", manifest.created_utc},
                    {"subject", {{"id", setup.subject.id}, {"number", setup.subject.number}}},
                    {"session_number", setup.session_number},
@@ -138,105 +168,93 @@ std::string manifest_to_json(const SessionManifest& manifest) {
 }
 
 SessionManifest manifest_from_json(std::string_view text, const std::string& source) {
-  const json document = json_detail::parse_json(text, source);
-  json_detail::ObjectReader root(document, "", source);
-  if (root.string("format") != kFormat)
-    json_detail::fail(source, "/format", std::string("expected \"") + kFormat + "\"");
-  const std::int64_t version = root.integer("version", 1, kVersion);
+  json document = json_detail::parse_json(text, source);
+  // The version picks what a document may lack (SchemaReadOptions::version) and how it counts; a version
+  // that is not one is refused by the schema, naming /version.
+  std::int64_t version = kSessionVersion;
+  if (document.is_object()) {
+    const auto given = document.find("version");
+    for (std::int64_t known = 1; known <= kSessionVersion; ++known) {
+      if (given != document.end() && given->is_number() && given->get<double>() == static_cast<double>(known))
+        version = known;
+    }
+  }
+  if (version < 2) count_from_one(document, source);
+  ManifestDocument read;
+  SchemaReadResult result;
+  schema_detail::from_json(session_manifest_schema(), &read, document, "", source,
+                           {.require_all = true, .version = static_cast<int>(version)}, result);
+  const Missing missing(std::make_move_iterator(result.defaulted.begin()),
+                        std::make_move_iterator(result.defaulted.end()));
+  if (read.format != kSessionFormat)
+    json_detail::fail(source, "/format", std::string("expected \"") + kSessionFormat + "\"");
   SessionManifest manifest;
-  manifest.created_utc = root.string("created_utc");
-  json_detail::ObjectReader subject(root.required("subject"), "/subject", source);
-  manifest.setup.subject.id = subject.string("id");
+  manifest.created_utc = read.created_utc;
+  manifest.setup.subject.id = read.subject.id;
   if (!is_label(manifest.setup.subject.id, 64)) {  // as check_setup refuses it when a session is made
     json_detail::fail(source, "/subject/id",
                       "expected 1 to 64 letters, digits, '_' or '-', got " +
-                          json_detail::describe(nlohmann::json(manifest.setup.subject.id)));
+                          json_detail::describe(json(manifest.setup.subject.id)));
   }
-  manifest.setup.subject.number = static_cast<std::size_t>(subject.integer("number", 0, 1000000000));
-  subject.finish();
-  manifest.setup.device = root.string("device");
-  manifest.setup.writer = root.string("writer");
-  manifest.setup.writer_profile = root.string("writer_profile");
-  manifest.setup.writer_seed = root.unsigned_or("writer_seed", 0);
-  manifest.setup.writer_learning =
-      root.string_or("writer_learning", "none");  // "none" before writers learned
-  if (manifest.setup.writer_learning != "none" && manifest.setup.writer_learning != "two-state") {
-    json_detail::fail(source, "/writer_learning", "expected \"none\" or \"two-state\"");
-  }
-  // Sessions made before subjects differed: every subject was its profile.
-  manifest.setup.individual_differences = root.boolean_or("individual_differences", false);
-  manifest.setup.pacing = root.string("pacing");
-  // Sessions made before protocols had phases are each the first of their series.
-  manifest.setup.session_number = static_cast<int>(root.integer_or("session_number", 1, 1, 20));
-  manifest.group = root.string_or("group", "");
-  // Sessions made before study folders had an identity have none (StudyIdentity).
-  manifest.study_id = root.string_or("study_id", "");
-  if (!manifest.study_id.empty() && !is_study_id(manifest.study_id)) {
+  manifest.setup.subject.number = static_cast<std::size_t>(read.subject.number);
+  manifest.setup.device = read.device;
+  manifest.setup.writer = read.writer;
+  manifest.setup.writer_profile = read.writer_profile;
+  manifest.setup.writer_seed = read.writer_seed;
+  manifest.setup.writer_learning = std::string(enum_spelling(read.writer_learning));
+  manifest.setup.individual_differences = read.individual_differences;
+  manifest.setup.pacing = to_string(read.pacing);
+  manifest.setup.session_number = static_cast<int>(read.session_number);
+  manifest.group = read.group;
+  manifest.study_id = read.study_id;
+  if (!defaulted(missing, "/study_id") && !is_study_id(manifest.study_id)) {
     json_detail::fail(
         source, "/study_id",
         "expected 32 lower-case hex digits, got " + json_detail::describe(json(manifest.study_id)));
   }
-  if (const json* previous = root.optional("previous_session")) {
-    json_detail::ObjectReader reader(*previous, "/previous_session", source);
-    PreviousSession p;
-    p.session_id = reader.string("session_id");
-    p.ended_utc = reader.string("ended_utc");
-    p.delay_s = reader.number("delay_s", 0.0, 1e9);
-    // Any finite time: a clock that differs between the sessions is recorded as it was measured.
-    p.elapsed_s = reader.number("elapsed_s", -1e15, 1e15);
-    p.delay = reader.string("delay");
-    p.session_sha256 = reader.string_or("session_sha256", "");
-    reader.finish();
-    manifest.previous = std::move(p);
+  if (!defaulted(missing, "/previous_session")) {
+    const PreviousSession& p = read.previous_session;
+    if (p.delay != "waited" && p.delay != "simulated" && p.delay != "overridden") {
+      json_detail::fail(source, "/previous_session/delay",
+                        "expected \"waited\", \"simulated\" or \"overridden\", got " +
+                            json_detail::describe(json(p.delay)));
+    }
+    manifest.previous = p;
   }
   if (manifest.previous.has_value() != (manifest.setup.session_number > 1)) {
     json_detail::fail(source, "/previous_session", "expected exactly for a session after the first");
   }
-  json_detail::ObjectReader library(root.required("library"), "/library", source);
-  manifest.library = {library.string("version"), library.string("build_type"), library.string("compiler"),
-                      library.string("cxx_standard")};
-  library.finish();
-  json_detail::ObjectReader protocol(root.required("protocol"), "/protocol", source);
-  const std::string name = protocol.string("name");
-  const std::string path = protocol.string("path");
-  const std::string sha256 = protocol.string("sha256");
-  std::string protocol_text = protocol.string("text");
-  protocol.finish();
+  manifest.library = read.library;
   try {
-    manifest.protocol = protocol_from_text(std::move(protocol_text), path);
+    manifest.protocol = protocol_from_text(std::move(read.protocol.text), read.protocol.path);
   } catch (const DataError& e) {
     json_detail::fail(source, "/protocol/text", std::string("the protocol copy is not valid: ") + e.what());
   }
-  if (manifest.protocol.sha256 != sha256) {
+  if (manifest.protocol.sha256 != read.protocol.sha256) {
     json_detail::fail(source, "/protocol/text",
-                      "the protocol copy does not match its recorded SHA-256 " + sha256);
+                      "the protocol copy does not match its recorded SHA-256 " + read.protocol.sha256);
   }
-  if (manifest.protocol.protocol.name != name)
+  if (manifest.protocol.protocol.name != read.protocol.name)
     json_detail::fail(source, "/protocol/name", "not the name in the protocol copy");
-  const json& plan = root.required("plan");
-  if (!plan.is_array() || plan.empty())
-    json_detail::fail(source, "/plan", "expected a list of planned trials");
-  for (std::size_t i = 0; i < plan.size(); ++i) {
-    PlannedTrial trial =
-        planned_trial_from(plan[i], json_detail::child_pointer("/plan", i), source, i, version);
-    // Only conditions of the protocol can run, or have trained an item.
-    const auto known = [&](const std::string& condition) {
-      const std::vector<StudyCondition>& conditions = manifest.protocol.protocol.conditions;
-      return std::any_of(conditions.begin(), conditions.end(),
-                         [&](const StudyCondition& c) { return c.name == condition; });
-    };
+  if (read.plan.empty()) json_detail::fail(source, "/plan", "expected a list of planned trials, got none");
+  // Only conditions of the protocol can run, or have trained an item.
+  const auto known = [&](const std::string& condition) {
+    const std::vector<StudyCondition>& conditions = manifest.protocol.protocol.conditions;
+    return std::any_of(conditions.begin(), conditions.end(),
+                       [&](const StudyCondition& c) { return c.name == condition; });
+  };
+  for (std::size_t i = 0; i < read.plan.size(); ++i) {
+    const std::string at = json_detail::child_pointer("/plan", i);
+    PlannedTrial trial = planned_trial_from(read.plan[i], missing, at, source, i);
     if (!known(trial.condition))
-      json_detail::fail(source,
-                        json_detail::child_pointer(json_detail::child_pointer("/plan", i), "condition"),
+      json_detail::fail(source, json_detail::child_pointer(at, "condition"),
                         "not a condition of the protocol");
     if (!trial.trained_condition.empty() && !known(trial.trained_condition)) {
-      json_detail::fail(
-          source, json_detail::child_pointer(json_detail::child_pointer("/plan", i), "trained_condition"),
-          "not a condition of the protocol");
+      json_detail::fail(source, json_detail::child_pointer(at, "trained_condition"),
+                        "not a condition of the protocol");
     }
     manifest.plan.push_back(std::move(trial));
   }
-  root.finish();
   return manifest;
 }
 

@@ -1,7 +1,13 @@
 #include "study/names.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 
 #include "calligraphy/core/atomic_file.hpp"
@@ -46,6 +52,55 @@ std::string read_small_file(const std::filesystem::path& path, std::uintmax_t ma
   std::optional<std::string> text = read_file_for_update(path, max_bytes);
   if (!text) throw DataError(path.string() + ": cannot be read (expected a " + what + ")");
   return std::move(*text);
+}
+
+std::string session_file_link_message(const std::filesystem::path& path) {
+  return path.string() +
+         ": is a symbolic link; a session's files are its own: put the file itself back in its place "
+         "(nothing "
+         "is read or written through a link in a session folder)";
+}
+
+std::string read_session_file(const std::filesystem::path& path, std::uintmax_t max_bytes,
+                              const std::string& what) {
+  // O_NOFOLLOW: a link under the file's name is refused, not followed (open(2): ELOOP); O_NONBLOCK: a FIFO
+  // planted there is refused below without waiting for a writer.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
+    const int error = errno;
+    struct stat link {};
+    if (error == ELOOP && ::lstat(path.c_str(), &link) == 0 && S_ISLNK(link.st_mode))
+      throw DataError(session_file_link_message(path));
+    if (error == ENOENT) throw DataError(path.string() + ": no such file (expected a " + what + ")");
+    throw DataError(path.string() + ": cannot be opened (" + std::strerror(error) + "; expected a " + what +
+                    ")");
+  }
+  std::string text;
+  try {
+    struct stat status {};
+    if (::fstat(fd, &status) != 0)
+      throw DataError(path.string() + ": cannot be read (expected a " + what + ")");
+    if (!S_ISREG(status.st_mode))
+      throw DataError(path.string() + ": not a regular file (expected a " + what + ")");
+    const auto size = static_cast<std::uintmax_t>(status.st_size);
+    if (size > max_bytes) {
+      throw DataError(path.string() + ": " + std::to_string(size) + " bytes, more than the " +
+                      std::to_string(max_bytes) + " a " + what + " may have");
+    }
+    text.resize(static_cast<std::size_t>(size));
+    std::size_t done = 0;
+    while (done < text.size()) {
+      const ssize_t got = ::read(fd, text.data() + done, text.size() - done);
+      if (got < 0 && errno == EINTR) continue;
+      if (got <= 0) throw DataError(path.string() + ": could not be read whole (expected a " + what + ")");
+      done += static_cast<std::size_t>(got);
+    }
+  } catch (...) {
+    ::close(fd);
+    throw;
+  }
+  ::close(fd);
+  return text;
 }
 
 double utc_seconds(std::string_view iso8601) {

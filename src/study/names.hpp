@@ -18,6 +18,16 @@ bool is_study_id(std::string_view text);
 std::string read_small_file(const std::filesystem::path& path, std::uintmax_t max_bytes,
                             const std::string& what);
 
+/// The bytes of a regular file of a session folder (its session.json, a trial record, its log) of at most
+/// `max_bytes`, opened without following a link (O_NOFOLLOW) and without waiting on a FIFO: a file of a
+/// session is its own. Throws DataError naming the path (session_file_link_message for a symbolic link) and
+/// `what` it should hold when it does not exist, is a link, is not a regular file, is larger or cannot be
+/// read whole.
+std::string read_session_file(const std::filesystem::path& path, std::uintmax_t max_bytes,
+                              const std::string& what);
+/// "PATH: is a symbolic link; a session's files are its own: ...".
+std::string session_file_link_message(const std::filesystem::path& path);
+
 /// Seconds since 1970-01-01T00:00:00Z of a time `utc_now_iso8601` wrote ("2024-05-01T12:34:56.789Z"; the
 /// fraction optional). Throws InvalidArgument quoting the text when it is not such a time.
 double utc_seconds(std::string_view iso8601);

@@ -1,5 +1,7 @@
 #include "study/saved_sessions.hpp"
 
+#include <sys/stat.h>
+
 #include <set>
 
 #include "calligraphy/core/errors.hpp"
@@ -33,14 +35,34 @@ std::vector<fs::path> session_folders_under(const std::vector<fs::path>& roots) 
 
 SessionManifest read_session_manifest(const fs::path& folder) {
   const fs::path path = SessionLayout::manifest(folder);
-  SessionManifest manifest =
-      manifest_from_json(read_small_file(path, kMaxSessionManifestBytes, "session manifest"), path.string());
+  SessionManifest manifest = manifest_from_json(
+      read_session_file(path, kMaxSessionManifestBytes, "session manifest"), path.string());
   manifest.session_id = folder.filename().string();
   check_records_planned(folder, manifest);
   return manifest;
 }
 
+void refuse_session_links(const fs::path& folder) {
+  const auto refuse_link = [](const fs::path& path) {
+    struct stat status {};
+    if (::lstat(path.c_str(), &status) == 0 && S_ISLNK(status.st_mode))
+      throw DataError(session_file_link_message(path));
+  };
+  for (const fs::path& own : {SessionLayout::manifest(folder), SessionLayout::log(folder),
+                              SessionLayout::trials(folder), SessionLayout::teachers(folder)}) {
+    refuse_link(own);
+  }
+  for (const fs::path& own : {SessionLayout::trials(folder), SessionLayout::teachers(folder)}) {
+    std::error_code error;
+    for (fs::directory_iterator entry(own, error), end; !error && entry != end; entry.increment(error)) {
+      std::error_code kind;
+      if (entry->is_symlink(kind)) throw DataError(session_file_link_message(entry->path()));
+    }
+  }
+}
+
 void check_records_planned(const fs::path& folder, const SessionManifest& manifest) {
+  refuse_session_links(folder);
   if (manifest.protocol.path == "calligraphy-train") return;
   std::set<std::string> planned;
   for (const PlannedTrial& trial : manifest.plan) planned.insert(SessionFolder::trial_stem(trial) + ".json");
@@ -63,7 +85,7 @@ SessionManifest read_previous_session(const fs::path& folder, const SessionManif
   const PreviousSession& link = manifest.previous.value();
   const fs::path before = folder.parent_path() / link.session_id;
   const fs::path path = SessionLayout::manifest(before);
-  const std::string text = read_small_file(path, kMaxSessionManifestBytes, "session manifest");
+  const std::string text = read_session_file(path, kMaxSessionManifestBytes, "session manifest");
   if (!link.session_sha256.empty() && sha256_hex(text) != link.session_sha256) {
     json_detail::fail(
         (SessionLayout::manifest(folder)).string(), "/previous_session/session_sha256",
@@ -97,7 +119,7 @@ bool DistinctSessions::add(const fs::path& folder, const SessionManifest& manife
 nlohmann::json read_trial_record(const fs::path& json_file) {
   const std::string source = json_file.string();
   nlohmann::json record =
-      json_detail::parse_json(read_small_file(json_file, kMaxRecordBytes, "trial record (JSON)"), source);
+      json_detail::parse_json(read_session_file(json_file, kMaxRecordBytes, "trial record (JSON)"), source);
   if (!record.is_object() || !record.contains("format") || record["format"] != kTrialRecordFormat) {
     json_detail::fail(source, "/format", std::string("expected \"") + kTrialRecordFormat + "\"");
   }

@@ -22,11 +22,17 @@ inline constexpr std::uintmax_t kMaxRecordBytes = kMaxRecordedTrialBytes;
 std::vector<std::filesystem::path> session_folders_under(const std::vector<std::filesystem::path>& roots);
 
 /// The manifest of the session folder `folder`, its `session_id` the folder's name, its saved records checked
-/// against its plan (check_records_planned). Throws DataError naming the file (and JSON pointer) when it
-/// cannot be read.
+/// against its plan (check_records_planned), read without following a link (read_session_file). Throws
+/// DataError naming the file (and JSON pointer) when it cannot be read.
 SessionManifest read_session_manifest(const std::filesystem::path& folder);
 
-/// Refuses a trial record in the session folder `folder` (trials/NAME.json) that `manifest`'s plan does not
+/// Refuses a file of the session folder `folder` that is a symbolic link (session.json, log.jsonl, trials/,
+/// teachers/ and every entry of those two): a session's files are its own, and a link would have a reader
+/// take a file from elsewhere as the session's. Throws DataError naming the link (session_file_link_message).
+void refuse_session_links(const std::filesystem::path& folder);
+
+/// Refuses a file of the session that is a link (refuse_session_links), then a trial record in the session
+/// folder `folder` (trials/NAME.json) that `manifest`'s plan does not
 /// have: session.json was edited (its plan cut), or the record copied in. Every reader takes the trials the
 /// plan names, so such a record would be left out without a word. The trainer's free practice (its trials
 /// are made as they are practised) has no plan fixed in advance and is not checked. Throws DataError naming
@@ -60,9 +66,10 @@ class DistinctSessions {
 inline constexpr const char* kTrialRecordFormat = "calligraphy-study-trial";
 inline constexpr std::int64_t kTrialRecordVersion = 2;
 
-/// The record of a saved trial, its format and version checked: every reader of records reads them through
-/// this. Throws DataError naming the file and the field: not a record, or a version this library does not
-/// know (a newer calligraphy wrote it, or the file is damaged).
+/// The record of a saved trial, its format and version checked, read without following a link
+/// (read_session_file): every reader of a session's records reads them through this. Throws DataError naming
+/// the file and the field: not a record, or a version this library does not know (a newer calligraphy wrote
+/// it, or the file is damaged).
 nlohmann::json read_trial_record(const std::filesystem::path& json_file);
 
 }  // namespace calligraphy::study_detail

@@ -458,8 +458,15 @@ fs::path SessionLayout::record(const fs::path& folder, const PlannedTrial& trial
 SessionFolder SessionFolder::open(const fs::path& folder) {
   if (is_partial_session_folder(named_folder(folder))) throw DataError(folder.string() + ": " + kPartialNote);
   const fs::path manifest_path = SessionLayout::manifest(folder);
+  // A file of the folder that is a symbolic link is refused as its content would be (InputError): a
+  // session's files are its own, and nothing is read or written through a link.
+  try {
+    study_detail::refuse_session_links(folder);
+  } catch (const DataError& e) {
+    throw InputError(e.what());
+  }
   const std::string text =
-      study_detail::read_small_file(manifest_path, kMaxSessionManifestBytes, "session manifest");
+      study_detail::read_session_file(manifest_path, kMaxSessionManifestBytes, "session manifest");
   // The session folder is what `session resume` was given: what its session.json holds is refused as a
   // protocol's content is (InputError, "FILE: /pointer: what"); a file that cannot be read stays a DataError.
   SessionManifest manifest;
@@ -618,11 +625,22 @@ void SessionFolder::log(std::string_view event, std::string_view details_json) {
   if (::fsync(log_fd_) != 0) fail_errno(log_path, "cannot sync the session log", errno);
 }
 
+namespace {
+
+// A folder holding a session.json, whatever that is but a folder: a session.json that is a link (or a FIFO)
+// makes a session folder that its reader refuses by name, rather than one left out without a word.
+bool names_a_session(const fs::path& folder) {
+  struct stat status {};
+  return ::lstat(SessionLayout::manifest(folder).c_str(), &status) == 0 && !S_ISDIR(status.st_mode);
+}
+
+}  // namespace
+
 std::vector<fs::path> find_session_folders(const fs::path& root) {
   std::error_code error;
   if (!fs::is_directory(root, error))
     throw DataError(root.string() + ": not a folder (expected session folders)");
-  if (fs::is_regular_file(SessionLayout::manifest(root), error)) {
+  if (names_a_session(root)) {
     if (is_partial_session_folder(named_folder(root))) throw DataError(root.string() + ": " + kPartialNote);
     return {root};
   }
@@ -640,7 +658,7 @@ std::vector<fs::path> find_session_folders(const fs::path& root) {
       it.disable_recursion_pending();
       continue;
     }
-    if (fs::is_regular_file(SessionLayout::manifest(it->path()), error)) {
+    if (names_a_session(it->path())) {
       found.push_back(it->path());
       it.disable_recursion_pending();
     } else if (it.depth() >= 3) {

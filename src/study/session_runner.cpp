@@ -68,7 +68,8 @@ json trial_details(const PlannedTrial& trial) {
 // recovered, so that the log names every saved trial once.
 void log_unlogged_saves(SessionFolder& session) {
   const std::filesystem::path log_path = SessionLayout::log(session.path());
-  const std::string text = study_detail::read_small_file(log_path, std::uintmax_t{256} << 20, "session log");
+  const std::string text =
+      study_detail::read_session_file(log_path, std::uintmax_t{256} << 20, "session log");
   std::set<std::string> logged;
   std::size_t begin = 0;
   while (begin < text.size()) {

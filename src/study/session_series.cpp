@@ -24,8 +24,8 @@ namespace fs = std::filesystem;
 namespace {
 
 std::string manifest_sha256(const fs::path& folder) {
-  return sha256_hex(study_detail::read_small_file(SessionLayout::manifest(folder), kMaxSessionManifestBytes,
-                                                  "session manifest"));
+  return sha256_hex(study_detail::read_session_file(SessionLayout::manifest(folder), kMaxSessionManifestBytes,
+                                                    "session manifest"));
 }
 
 // Session `number` (> 1) must follow the folder found for the session before it: by name, and by content

@@ -179,7 +179,8 @@ PreparedGuidance replay_guidance(SessionFolder& session, const StudyCondition& c
                                       {"sha256", sha256_hex(text)}}
                                      .dump());
   }
-  const std::string text = read_small_file(path, kMaxTeacherRecordingBytes, "teacher's recording");
+  // The session's own copy: read without following a link, as every file of a session folder.
+  const std::string text = read_session_file(path, kMaxTeacherRecordingBytes, "teacher's recording");
   TeacherRecording teacher = checked(text, path.string());
   prepared.teacher_sha256 = sha256_hex(text);
   prepared.teacher_writer = teacher.writer;

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The published schemas (`calligraphy schema specification|record`, docs/cli.md) held against the program's
+"""The published schemas (`calligraphy schema specification|record|protocol|session`, docs/cli.md) held against the program's
 real documents by an independent validator (the jsonschema package, draft 2020-12), and against the program's
 own reader: a value the schema refuses is refused by `trial --spec` naming the file and the JSON pointer, and a
 value at a closed bound is valid to both. Run by CTest as `cli_schema_tests`; CALLIGRAPHY_CLI names the program.
@@ -10,6 +10,7 @@ import copy
 import json
 import math
 import os
+import shutil
 import subprocess
 import tempfile
 import unittest
@@ -648,6 +649,169 @@ class ProtocolSchemaTest(unittest.TestCase):
         # trial 2, breaks 3, guidance stiffness, every mode's parameters, the quiz's tolerances, the phases'.
         self.assertGreaterEqual(checked, 100)
         print(f"protocol bounds checked: {checked}")
+
+
+class SessionSchemaTest(unittest.TestCase):
+    """`calligraphy schema session` against the readers of session.json: a real one validates, as do the
+    older shapes the readers take (keys added since the first folders missing, version 1 counting from 0); a
+    value the schema refuses (past a bound, null, a key unknown or missing) is refused by `session resume`
+    naming the file and the JSON pointer (exit 2), and a value at a bound is read by `report`."""
+
+    @classmethod
+    def setUpClass(cls):
+        if not CLI or not Path(CLI).exists():
+            raise unittest.SkipTest(f"CALLIGRAPHY_CLI={CLI!r} is not the calligraphy program: run through ctest")
+        cls.folder = tempfile.TemporaryDirectory(prefix="calligraphy-session-schema-")
+        cls.cwd = Path(cls.folder.name)
+        cls.schema = json.loads(SchemaTest.run_cli.__func__(cls, "schema", "session").stdout)
+        cls.validator = jsonschema.Draft202012Validator(cls.schema)
+        protocol = {"format": "calligraphy-study-protocol", "version": 1, "name": "one",
+                    "conditions": [{"name": "vision", "mode": "vision"}, {"name": "haptic", "mode": "haptic"}],
+                    "phases": [{"phase": "pre-test", "condition": "vision", "characters": ["十"]},
+                               {"phase": "training", "condition": "haptic", "characters": ["十"]}],
+                    "trial": {"max_duration_s": 20}}
+        (cls.cwd / "one.json").write_text(json.dumps(protocol, ensure_ascii=False), encoding="utf-8")
+        out = SchemaTest.run_cli.__func__(cls, "session", "run", "one.json", "--writer", "simulated",
+                                          "--subjects", "2", "--out", "study")
+        if out.returncode != 0:
+            raise AssertionError(out.stderr.decode())
+        cls.manifests = sorted((cls.cwd / "study").rglob("session.json"))
+        cls.document = json.loads(cls.manifests[0].read_text(encoding="utf-8"))
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.folder.cleanup()
+
+    def edited(self, document):
+        """A copy of the first subject's session, its last trial unsaved, with `document` as its session.json."""
+        folder = Path(tempfile.mkdtemp(dir=self.cwd))
+        session = folder / "study" / self.manifests[0].parent.relative_to(self.cwd / "study")
+        shutil.copytree(self.manifests[0].parent, session)
+        sorted(session.glob("trials/*.json"))[-1].unlink()
+        (session / "session.json").write_text(json.dumps(document, ensure_ascii=False, indent=2) + "\n",
+                                              encoding="utf-8")
+        return folder, session
+
+    def resume(self, session):
+        return subprocess.run([CLI, "session", "resume", str(session)], cwd=self.cwd, capture_output=True,
+                              timeout=120)
+
+    def report(self, folder):
+        tables = folder / "tables"
+        tables.mkdir()
+        return subprocess.run([CLI, "report", str(folder / "study"), "--csv", str(tables)], cwd=self.cwd,
+                              capture_output=True, timeout=120)
+
+    def refused_by_both(self, document, pointer):
+        self.assertFalse(self.validator.is_valid(document), pointer)
+        folder, session = self.edited(document)
+        out = self.resume(session)
+        self.assertEqual(out.returncode, 2, out.stderr.decode())
+        self.assertIn(f"session.json: {pointer}:", out.stderr.decode())
+        shutil.rmtree(folder)
+
+    def test_the_schema_is_json_schema_2020_12(self):
+        jsonschema.Draft202012Validator.check_schema(self.schema)
+        self.assertFalse(self.schema["additionalProperties"])
+        self.assertEqual(self.schema["properties"]["format"]["const"], "calligraphy-study-session")
+
+    def test_real_session_jsons_validate(self):
+        self.assertEqual(len(self.manifests), 2)
+        for path in self.manifests:
+            with self.subTest(path.name):
+                self.validator.validate(json.loads(path.read_text(encoding="utf-8")))
+
+    def test_the_older_shapes_the_readers_take_validate(self):
+        old = copy.deepcopy(self.document)
+        for key in ("study_id", "writer_learning", "individual_differences", "session_number", "group"):
+            old.pop(key)
+        self.validator.validate(old)
+        first = copy.deepcopy(old)
+        first["version"] = 1
+        for trial in first["plan"]:
+            trial["block"] -= 1
+            trial["item"] -= 1
+        self.validator.validate(first)
+        folder, _ = self.edited(first)
+        out = self.report(folder)
+        self.assertEqual(out.returncode, 0, out.stderr.decode())
+        # version 1's range: from 0 to 999,999
+        for value in (-1, 1000000):
+            past = copy.deepcopy(first)
+            past["plan"][0]["item"] = value
+            self.refused_by_both(past, "/plan/0/item")
+        # version 2 counts from 1: its block 0 is refused by both
+        second = copy.deepcopy(first)
+        second["version"] = 2
+        self.refused_by_both(second, "/plan/0/block")
+
+    def test_unknown_null_and_missing_are_refused_by_both(self):
+        cases = []
+        for pointer in ("/colour", "/subject/colour", "/library/colour", "/protocol/colour", "/plan/0/colour"):
+            document = copy.deepcopy(self.document)
+            *parents, key = pointer.strip("/").split("/")
+            node = document
+            for part in parents:
+                node = node[int(part)] if isinstance(node, list) else node[part]
+            node[key] = 1
+            cases.append((document, pointer))
+        for pointer in ("/device", "/pacing", "/subject/number", "/plan/1/phase"):
+            document = copy.deepcopy(self.document)
+            *parents, key = pointer.strip("/").split("/")
+            node = document
+            for part in parents:
+                node = node[int(part)] if isinstance(node, list) else node[part]
+            node[key] = None
+            cases.append((document, pointer))
+        for key in self.schema["required"]:
+            document = copy.deepcopy(self.document)
+            document.pop(key)
+            cases.append((document, "/" + key))
+        for key in self.schema["$defs"]["PlannedTrial"]["required"]:
+            document = copy.deepcopy(self.document)
+            document["plan"][0].pop(key)
+            cases.append((document, "/plan/0/" + key))
+        for document, pointer in cases:
+            with self.subTest(pointer=pointer):
+                self.refused_by_both(document, pointer)
+
+    def test_each_bound_is_refused_past_it_and_accepted_at_it_by_both(self):
+        sites = [("", self.schema["properties"]),
+                 ("/subject", self.schema["$defs"]["SessionSubject"]["properties"]),
+                 ("/plan/1", self.schema["$defs"]["PlannedTrial"]["properties"])]
+        # Values at a bound that a rule between values refuses: the trials in order, a record's file name (its
+        # repetition), a session after the first with no previous one, version 1's counting.
+        rules = {"/version", "/session_number", "/plan/1/index", "/plan/1/repetition", "/plan/1/block",
+                 "/plan/1/item"}
+        checked = 0
+        for prefix, properties in sites:
+            for key, prop in properties.items():
+                if prop.get("type") not in ("number", "integer"):
+                    continue
+                pointer = f"{prefix}/{key}"
+                past = ["1"]
+                if prop["type"] == "integer":
+                    past += [prop["minimum"] - 1, prop["maximum"] + 1]
+                else:
+                    past += [math.nextafter(prop["minimum"], -math.inf), math.nextafter(prop["maximum"], math.inf)]
+                for value in past:
+                    document = ProtocolSchemaTest.with_value(self.document, pointer, value)
+                    with self.subTest(pointer=pointer, value=value, expect="refused"):
+                        self.refused_by_both(document, pointer)
+                        checked += 1
+                if pointer in rules:
+                    continue
+                for bound in ("minimum", "maximum"):
+                    document = ProtocolSchemaTest.with_value(self.document, pointer, prop[bound])
+                    with self.subTest(pointer=pointer, value=prop[bound], expect="accepted"):
+                        self.assertEqual([e.message for e in self.validator.iter_errors(document)], [])
+                        folder, _ = self.edited(document)
+                        out = self.report(folder)
+                        self.assertEqual(out.returncode, 0, out.stderr.decode())
+                        shutil.rmtree(folder)
+                        checked += 1
+        self.assertGreaterEqual(checked, 30)
+        print(f"session.json bounds checked: {checked}")
 
 
 if __name__ == "__main__":

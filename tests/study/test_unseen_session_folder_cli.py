@@ -5,8 +5,9 @@ record, as symbolic or hard links to files outside), filled, the study identity 
 of one protocol racing into one study root.
 
 A session.json whose content `session resume` refuses is refused like a protocol's: exit 2, one line
-`.../session.json: /json/pointer: what is wrong`, and nothing in the study folder changes. A `trials/` that is
-a symbolic link is refused by name (exit 2); no link takes a write outside the session folder.
+`.../session.json: /json/pointer: what is wrong`, and nothing in the study folder changes. A `trials/`, a
+session.json or a record that is a symbolic link is refused by name (exit 2); no link takes a read or a write
+outside the session folder.
 
 CALLIGRAPHY_CLI names the program."""
 
@@ -178,8 +179,8 @@ class SessionFolders(Hostile):
         self.assertIn("link", line)
         self.assertEqual(digest_tree(outside), before)
 
-    def test_a_symlinked_session_json_is_not_written_through(self):
-        """Read through the link or refused by name; never written."""
+    def test_a_symlinked_session_json_is_refused_and_not_written_through(self):
+        """Refused by name, as a link (a session's files are its own); never written."""
         study, session = self.unfinished()
         outside = self.cwd / "session-elsewhere.json"
         (session / "session.json").rename(outside)
@@ -187,11 +188,10 @@ class SessionFolders(Hostile):
         before = outside.read_bytes()
         out = self.cli("session", "resume", session)
         self.assertEqual(outside.read_bytes(), before, out.stderr)
-        if out.returncode != 0:
-            self.refused(out, 1, "session.json")
+        self.assertIn("symbolic link", self.refused(out, 2, "session.json"))
         self.assertTrue((session / "session.json").is_symlink())
 
-    def test_a_record_symlinked_outside_is_not_written_through(self):
+    def test_a_record_symlinked_outside_is_refused_and_not_written_through(self):
         study = self.study_copy()
         session = sorted(p.parent for p in study.rglob("session.json"))[0]
         first, last = sorted(session.glob("trials/*.json"))
@@ -203,10 +203,8 @@ class SessionFolders(Hostile):
         before = outside.read_bytes()
         out = self.cli("session", "resume", session)
         self.assertEqual(outside.read_bytes(), before, out.stderr)
-        if out.returncode != 0:
-            self.refused(out, 1, first.name)
-        else:
-            self.assertTrue(last.exists())
+        self.assertIn("symbolic link", self.refused(out, 2, first.name))
+        self.assertFalse(last.exists())
         self.assertTrue(first.is_symlink())
 
     def test_a_record_hard_linked_outside_is_never_written(self):

@@ -142,6 +142,9 @@ struct SchemaField {
   /// A document of a version older than this may lack the field, which then takes its default (a field
   /// added since); 0: the field was always there.
   int since_version = 0;
+  /// A document of any version may lack the field, which then takes its default: a key written only when it
+  /// has a value (a link to what may not exist), or one added to a format without a new version.
+  bool omissible = false;
 
   // Accessors; each non-null only for its kinds. An enumeration is read and set by its table index.
   /// number, number_array: element `index` (0 for a number). Given the field itself, so that a field made
@@ -224,8 +227,8 @@ struct SchemaReadOptions {
   /// Every field is required (a record); false: a missing member keeps its default (a file a person wrote).
   /// An element of a list always states every field.
   bool require_all = false;
-  /// With require_all: the document's version; a field whose `since_version` is newer may be missing and
-  /// takes its default (listed in `SchemaReadResult::defaulted`).
+  /// With require_all: the document's version; a field whose `since_version` is newer, or an omissible
+  /// field, may be missing and takes its default (listed in `SchemaReadResult::defaulted`).
   int version = std::numeric_limits<int>::max();
 };
 
@@ -260,7 +263,8 @@ template <typename S>
 /// with its type, `description` ("doc [unit]"), `default`, ranges as minimum / maximum (exclusiveMinimum /
 /// exclusiveMaximum where open), enumerations as `enum`, nested structs as `$defs` referenced by `$ref`,
 /// `additionalProperties: false` and, with `all_required` (a record, read with
-/// SchemaReadOptions::require_all), `required` listing every field but those added since the first version.
+/// SchemaReadOptions::require_all), `required` listing every field but those added since the first version
+/// and the omissible ones.
 /// `id` and `title` name the document.
 [[nodiscard]] std::string json_schema_text(const Schema& schema, std::string_view id, std::string_view title,
                                            bool all_required);
@@ -543,6 +547,12 @@ template <auto Member, std::size_t N>
 /// A field added in document version `version` (see SchemaField::since_version).
 [[nodiscard]] constexpr SchemaField since(int version, SchemaField field) {
   field.since_version = version;
+  return field;
+}
+
+/// A field any version of a document may lack (see SchemaField::omissible).
+[[nodiscard]] constexpr SchemaField omissible(SchemaField field) {
+  field.omissible = true;
   return field;
 }
 

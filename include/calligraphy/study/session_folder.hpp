@@ -81,6 +81,16 @@ struct PreviousSession {
 /// that a subject writes the same way in every session and protocol.
 [[nodiscard]] std::uint64_t subject_seed(std::string_view subject_id);
 
+struct Schema;
+
+/// The schema of session.json (its root object, SessionManifest as the file lays it out), from which every
+/// reader reads it: `calligraphy schema session --markdown` prints its fields.
+[[nodiscard]] const Schema& session_manifest_schema();
+/// The JSON Schema (draft 2020-12) of session.json (`calligraphy schema session`), made from that schema;
+/// the rules between values (the plan's indexes in order, its conditions the protocol's, the protocol copy's
+/// SHA-256, a previous session exactly after the first) are the reader's alone.
+[[nodiscard]] std::string session_manifest_json_schema_text();
+
 /// What session.json holds.
 struct SessionManifest {
   std::string session_id;  ///< the folder's name
