@@ -6,6 +6,7 @@
 #include "calligraphy/analysis/metric_table.hpp"
 
 #include <catch2/catch.hpp>
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
@@ -223,6 +224,61 @@ TEST_CASE("a metric added to the table reaches the record, the docs' table and t
   CHECK(schema["properties"].size() == table_names(metric_level_character, table).size());
   const nlohmann::json scene_schema = nlohmann::json::parse(metric_json_schema(metric_level_scene, table));
   CHECK_FALSE(scene_schema["properties"].contains("strokes_left_out"));
+}
+
+TEST_CASE("the study tables' metric columns have one place each, at their table's level", "[metric]") {
+  for (const StudyTable which : {StudyTable::trials, StudyTable::strokes}) {
+    const std::vector<MetricInfo> columns = study_metric_columns(which);
+    REQUIRE_FALSE(columns.empty());
+    for (std::size_t i = 0; i < columns.size(); ++i) {
+      INFO(columns[i].name);
+      CHECK(columns[i].column(which) == i + 1);  // places 1, 2, 3, ...: none twice, none left out
+      if (which == StudyTable::trials)
+        CHECK((columns[i].at(metric_level_scene) || columns[i].at(metric_level_run)));
+      else
+        CHECK(columns[i].at(metric_level_stroke));
+    }
+    // a row without values yet: every column, a number null, a count 0, a flag false
+    const MetricValues row(which);
+    REQUIRE(row.names().size() == columns.size());
+    for (std::size_t i = 0; i < columns.size(); ++i) {
+      CHECK(row.names()[i] == columns[i].name);
+      CHECK(row.values()[i].index() == (columns[i].kind == MetricKind::number  ? 0u
+                                        : columns[i].kind == MetricKind::count ? 2u
+                                                                               : 3u));
+    }
+  }
+  // the scoring's totals a record always holds are refused when missing; metrics added later read as null
+  CHECK(metric("total_time_s").if_missing == MetricMissing::refused);
+  CHECK(metric("mean_deviation_m").if_missing == MetricMissing::null);
+
+  // a metric added with a place among the trials columns is one of them, in its place, and a row holds it
+  std::vector<MetricInfo> table(metric_table().begin(), metric_table().end());
+  const std::size_t before = study_metric_columns(StudyTable::trials, table).size();
+  table.push_back({.name = "written_share",
+                   .doc = "share of the reference strokes written",
+                   .definition = "strokes_written / strokes_total",
+                   .levels = metric_level_scene,
+                   .of_scene =
+                       [](const WritingMetrics& m) {
+                         return MetricValue(static_cast<double>(m.strokes_written) /
+                                            static_cast<double>(m.strokes_total));
+                       },
+                   .trials_column = static_cast<std::uint8_t>(before + 1)});  // after the others
+  const std::vector<MetricInfo> columns = study_metric_columns(StudyTable::trials, table);
+  REQUIRE(columns.size() == before + 1);
+  CHECK(columns.back().name == "written_share");
+  CHECK(columns[before - 1].name == study_metric_columns(StudyTable::trials).back().name);
+  CHECK(study_metric_columns(StudyTable::strokes, table).size() ==
+        study_metric_columns(StudyTable::strokes).size());
+  MetricValues row(StudyTable::trials, table);
+  CHECK_FALSE(row.number("written_share").has_value());
+  row.set("written_share", 0.5);
+  CHECK(row.number("written_share") == 0.5);
+  row.set("strokes_total", std::int64_t{4});
+  CHECK(row.number("strokes_total") == 4.0);
+  CHECK_THROWS_WITH(row.at("no_such_metric"), Catch::Contains("no_such_metric"));
+  CHECK_THROWS_AS(MetricValues(StudyTable::trials).at("written_share"), InvalidArgument);
 }
 
 TEST_CASE(

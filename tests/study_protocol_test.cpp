@@ -711,13 +711,13 @@ TEST_CASE("a curriculum proposes new typical strokes first, then weak ones, over
   row.subject = "S1";
   row.typical_id = 7;
   row.written = true;
-  row.mean_deviation_m = 2e-3;
+  row.metrics.set("mean_deviation_m", 2e-3);
   tables.strokes.push_back(row);
-  row.mean_deviation_m = 4e-3;
+  row.metrics.set("mean_deviation_m", 4e-3);
   tables.strokes.push_back(row);
   row.typical_id = 9;
   row.written = false;
-  row.mean_deviation_m.reset();
+  row.metrics.set("mean_deviation_m", std::monostate{});
   tables.strokes.push_back(row);
   const std::vector<TypicalStrokeRecord> read = typical_stroke_record(tables, "S1");
   REQUIRE(read.size() == 2);

@@ -6,11 +6,14 @@
 
 #include <algorithm>
 #include <catch2/catch.hpp>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <variant>
+#include <vector>
 
 #include "calligraphy/analysis/metric_table.hpp"
 #include "calligraphy/core/errors.hpp"
@@ -18,6 +21,7 @@
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/session_runner.hpp"
 #include "core/whole_file.hpp"
+#include "study/trial_row.hpp"
 #include "study_test_devices.hpp"
 #include "temp_folder.hpp"
 
@@ -69,15 +73,16 @@ TEST_CASE("a study's tidy tables hold every saved trial with its record's metric
     CHECK(row.trial >= 1);
     CHECK(row.block >= 1);
     CHECK(row.item >= 1);
-    CHECK(row.strokes_total == record["strokes_total"].get<std::size_t>());
-    REQUIRE(row.mean_deviation_m.has_value());
-    CHECK(*row.mean_deviation_m == record["mean_deviation_m"].get<double>());
-    CHECK(row.total_time_s == record["total_time_s"].get<double>());
+    CHECK(row.metrics.at("strokes_total") == MetricValue(record["strokes_total"].get<std::int64_t>()));
+    REQUIRE(row.metrics.number("mean_deviation_m").has_value());
+    CHECK(*row.metrics.number("mean_deviation_m") == record["mean_deviation_m"].get<double>());
+    CHECK(row.metrics.number("total_time_s") == record["total_time_s"].get<double>());
+    CHECK(row.metrics.at("completed_in_order") == MetricValue(record["completed_in_order"].get<bool>()));
     CHECK(fs::exists(row.trace_file));
     // The record binds its trace: the SHA-256 of the file's bytes as saved.
     CHECK(row.trace_sha256 == record["files"]["trace_sha256"].get<std::string>());
     CHECK(row.trace_sha256 == sha256_hex(read_regular_file(row.trace_file, 64u << 20)));
-    strokes += row.strokes_total;
+    strokes += static_cast<std::size_t>(std::get<std::int64_t>(row.metrics.at("strokes_total")));
   }
   REQUIRE(tables.strokes.size() == strokes);
   for (const StrokeRow& row : tables.strokes) {
@@ -168,17 +173,17 @@ TEST_CASE("a record written before the metric table, its lengths in mm, gives th
   };
   const TrialRow& a = now.trials[0];
   const TrialRow& b = before.trials[0];
-  REQUIRE(a.mean_deviation_m.has_value());
-  same(a.mean_deviation_m, b.mean_deviation_m);
-  same(a.max_deviation_m, b.max_deviation_m);
-  same(a.rms_deviation_m, b.rms_deviation_m);
-  same(a.frechet_m, b.frechet_m);
-  same(a.dtw_m, b.dtw_m);
+  REQUIRE(a.metrics.number("mean_deviation_m").has_value());
+  for (const std::string_view name : a.metrics.names()) {
+    INFO(name);
+    same(a.metrics.number(name), b.metrics.number(name));
+  }
   REQUIRE(now.strokes.size() == before.strokes.size());
   for (std::size_t i = 0; i < now.strokes.size(); ++i) {
-    same(now.strokes[i].mean_deviation_m, before.strokes[i].mean_deviation_m);
-    same(now.strokes[i].path_length_m, before.strokes[i].path_length_m);
-    same(now.strokes[i].frechet_m, before.strokes[i].frechet_m);
+    for (const std::string_view name : now.strokes[i].metrics.names()) {
+      INFO(name);
+      same(now.strokes[i].metrics.number(name), before.strokes[i].metrics.number(name));
+    }
   }
 }
 
@@ -210,6 +215,85 @@ TEST_CASE("the tables' metric columns are the metric table's names", "[study][ta
   }
   CHECK(has(strokes, "mean_deviation_m"));
   CHECK(has(trials, "strokes_assisted"));
+}
+
+TEST_CASE("a metric added to the table as a trials column reaches the trials table and its rows",
+          "[study][tables][metric]") {
+  // A metric a project might add, one row of the metric table with its place among the trials table's
+  // metric columns: the share of the reference strokes written, a number of the scene's totals.
+  std::vector<MetricInfo> table(metric_table().begin(), metric_table().end());
+  const std::vector<MetricInfo> before = study_metric_columns(StudyTable::trials, table);
+  table.push_back({.name = "written_share",
+                   .doc = "share of the reference strokes written",
+                   .definition = "strokes_written / strokes_total",
+                   .levels = metric_level_scene,
+                   .of_scene =
+                       [](const WritingMetrics& m) {
+                         return MetricValue(static_cast<double>(m.strokes_written) /
+                                            static_cast<double>(m.strokes_total));
+                       },
+                   .trials_column = static_cast<std::uint8_t>(before.size() + 1)});
+  TempFolder temp;
+  const LoadedProtocol protocol = protocol_from_text(
+      R"({"name": "added", "conditions": [{"name": "haptic", "mode": "haptic"}],
+          "test": {"characters": ["十"], "conditions": ["haptic"], "repetitions": 1},
+          "trial": {"max_duration_s": 40}})",
+      "added.json");
+  SessionSetup setup;
+  setup.subject = {"S01", 1};
+  setup.writer_seed = subject_seed("S01");
+  SessionFolder session = SessionFolder::create(temp.path / "S01", setup, protocol);
+  (void)run_session(session, study_test::run_options());
+  const StudyTables saved = read_study_tables({temp.path});
+  REQUIRE(saved.trials.size() == 1);
+  // the record as one written with the extended table holds it
+  nlohmann::json record =
+      read_json(fs::path(saved.trials[0].trace_file).replace_extension().replace_extension(".json"));
+  const double share = record["strokes_written"].get<double>() / record["strokes_total"].get<double>();
+  record["written_share"] = share;
+
+  // the row read back holds it, by name
+  StudyTables tables;
+  tables.trials.push_back(study_detail::trial_row(record, "added.json", session.manifest(),
+                                                  session.plan().at(0), tables.strokes, table));
+  const TrialRow& row = tables.trials[0];
+  CHECK(row.metrics.at("written_share") == MetricValue(share));
+  CHECK(row.metrics.number("written_share") == share);
+  CHECK(row.metrics.at("strokes_total") == saved.trials[0].metrics.at("strokes_total"));
+  CHECK(tables.strokes.size() == saved.strokes.size());
+
+  // the trials table's header has it after the metric columns before it, and the row its value there
+  const std::string csv = trials_csv(tables, table);
+  const std::vector<std::string> columns = header(csv);
+  const auto at = std::find(columns.begin(), columns.end(), "written_share");
+  REQUIRE(at != columns.end());
+  CHECK(*(at - 1) == before.back().name);
+  std::vector<std::string> fields;
+  std::istringstream line(csv.substr(csv.find('\n') + 1));
+  for (std::string field; std::getline(line, field, ',');) fields.push_back(field);
+  REQUIRE(fields.size() >= columns.size());
+  CHECK(std::stod(fields[static_cast<std::size_t>(at - columns.begin())]) == share);
+  // every other column is as the library's table writes it
+  std::vector<std::string> without = columns;
+  without.erase(without.begin() + (at - columns.begin()));
+  CHECK(without == header(trials_csv(saved)));
+  // the strokes table has no place for it
+  CHECK(header(strokes_csv(tables, table)) == header(strokes_csv(saved)));
+
+  // a record written before it: an empty field (the metric table's default for a metric added later)
+  record.erase("written_share");
+  std::vector<StrokeRow> strokes;
+  const TrialRow older =
+      study_detail::trial_row(record, "older.json", session.manifest(), session.plan().at(0), strokes, table);
+  CHECK(std::holds_alternative<std::monostate>(older.metrics.at("written_share")));
+  // a record without one of the scoring's totals is damaged, and named
+  record.erase("velocity_peaks");
+  CHECK_THROWS_WITH(
+      study_detail::trial_row(record, "damaged.json", session.manifest(), session.plan().at(0), strokes),
+      Catch::Contains("damaged.json") && Catch::Contains("/velocity_peaks"));
+  // the library's own table is untouched
+  CHECK_FALSE(find_metric("written_share").has_value());
+  CHECK_THROWS_AS(saved.trials[0].metrics.at("written_share"), InvalidArgument);
 }
 
 TEST_CASE("a folder without a session is named", "[study][tables]") {

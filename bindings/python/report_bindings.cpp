@@ -76,6 +76,8 @@ void bind_report(py::module_& m) {
           row["levels"] = metric_levels_text(info.levels);
           row["legacy_name"] = std::string(info.legacy_name);
           row["legacy_factor"] = info.legacy_factor;
+          row["trials_column"] = info.trials_column;
+          row["strokes_column"] = info.strokes_column;
           out.append(row);
         }
         return out;
@@ -84,7 +86,9 @@ void bind_report(py::module_& m) {
 with ``name`` (its SI unit in it: "mean_deviation_m", "frechet_m", "total_time_s"; the key of every metrics
 dict and DataFrame column), ``kind`` ("number", "count", "flag"), ``unit``, ``doc``, ``definition``,
 ``source``, ``levels`` ("scene, character, stroke", "run"), and ``legacy_name`` / ``legacy_factor``: the name
-the metric had before (in mm: value x 1000), still readable from a metrics dict with a DeprecationWarning.)");
+the metric had before (in mm: value x 1000), still readable from a metrics dict with a DeprecationWarning;
+``trials_column`` / ``strokes_column``: its place among the metric columns of the study tables trials.csv
+and strokes.csv (and ``calligraphy.study.load``'s DataFrames), counted from 1; 0 when it is not one.)");
   m.def(
       "trace_columns",
       [] {

@@ -1,5 +1,6 @@
-"""The one door from ``calligraphy.stats`` to the C++ extension: the study folders' reader, the trace reader,
-the writer of a report's files together, the character proposal and the error they raise.
+"""The one door from ``calligraphy.stats`` to the C++ extension: the study folders' reader, the metric table
+(the study tables' metric columns), the trace reader, the writer of a report's files together, the character
+proposal and the error they raise.
 
 Every other module of the package is pure Python and imports nothing of ``calligraphy`` outside
 ``calligraphy.stats`` (tests/python/test_package_layering.py checks it): what the statistics need from the
@@ -15,6 +16,7 @@ from .._calligraphy import (  # noqa: F401
     _read_trace_columns,
     _study_tables_csv,
     _write_files_together,
+    metric_table,
     trace_columns,
 )
 
@@ -25,5 +27,6 @@ __all__ = [
     "_read_trace_columns",
     "_study_tables_csv",
     "_write_files_together",
+    "metric_table",
     "trace_columns",
 ]

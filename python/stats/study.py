@@ -28,21 +28,32 @@ PathLike = typing.Union[str, "os.PathLike[str]"]
 
 __all__ = ["PathLike", "Study", "load", "propose_characters"]
 
-# Columns whose empty fields are absent values (NaN); every other empty field is an empty string.
+
+def _metric_columns(table: str, kinds: tuple[str, ...]) -> tuple[str, ...]:
+    """The metric columns of study table `table` ("trials" or "strokes") of the given kinds, from the one
+    metric table (metric_table(), include/calligraphy/analysis/metric_table.hpp), in their columns' order."""
+    key = table + "_column"
+    rows = [row for row in _native.metric_table() if row[key] > 0 and row["kind"] in kinds]
+    return tuple(row["name"] for row in sorted(rows, key=lambda row: row[key]))
+
+
+# Columns whose empty fields are absent values (NaN); every other empty field is an empty string. The metric
+# columns (numbers and counts; flags are booleans) come from the metric table, the others are the design's.
 _NUMERIC_TRIAL_COLUMNS = (
-    "session_number", "block", "trial", "item", "repetition", "period", "strokes_total", "strokes_written", "strokes_accepted",
-    "order_errors", "backwards_strokes", "unmatched_segments", "mean_deviation_m", "max_deviation_m",
-    "rms_deviation_m", "frechet_m", "dtw_m", "total_time_s", "pen_down_time_s", "velocity_peaks",
-    "normalised_jerk", "shape_skill", "order_skill", "timing_skill", "subject_writing_speed_factor",
-    "subject_spatial_error_factor", "subject_error_rate_factor", "subject_motor_noise_factor",
-    "subject_fast_learning_per_trial", "subject_slow_learning_per_trial", "subject_fast_retention_per_trial",
-    "subject_slow_retention_per_trial", "strokes_given_up", "legibility_top1", "legibility_top5")
+    ("session_number", "block", "trial", "item", "repetition", "period")
+    + _metric_columns("trials", ("number", "count"))
+    + ("shape_skill", "order_skill", "timing_skill", "subject_writing_speed_factor",
+       "subject_spatial_error_factor", "subject_error_rate_factor", "subject_motor_noise_factor",
+       "subject_fast_learning_per_trial", "subject_slow_learning_per_trial", "subject_fast_retention_per_trial",
+       "subject_slow_retention_per_trial", "strokes_given_up", "legibility_top1", "legibility_top5"))
+_BOOLEAN_TRIAL_COLUMNS = _metric_columns("trials", ("flag",))
 # Numeric columns kept float64 even without a gap: a crossover period is NaN where the item's set is not
 # trained, and one dtype in every study spares an analysis a column whose type follows the data.
 _FLOAT_COLUMNS = ("period",)
 _NUMERIC_STROKE_COLUMNS = (
-    "trial", "character", "stroke", "typical_id", "segments", "refused_segments", "mean_deviation_m",
-    "max_deviation_m", "rms_deviation_m", "frechet_m", "dtw_m", "time_s", "path_length_m")
+    ("trial", "character", "stroke", "typical_id", "segments", "refused_segments")
+    + _metric_columns("strokes", ("number", "count")))
+_BOOLEAN_STROKE_COLUMNS = ("written", "backwards") + _metric_columns("strokes", ("flag",))
 _CATEGORIES = ("subject", "session", "protocol", "group", "phase", "condition", "mode", "item_set", "sequence",
                "trained_condition", "writer", "writer_profile", "writer_learning", "end_reason")
 # The trace CSV's columns (calligraphy trial --csv) with their SI units named.
@@ -225,8 +236,8 @@ def load(paths: typing.Union[PathLike, typing.Sequence[PathLike]]) -> Study:
     if not roots or any(not os.fspath(root) for root in roots):
         raise ValueError(f"load: paths must name session or study folders, got {paths!r}")
     trials_text, strokes_text = _native._study_tables_csv([os.fspath(root) for root in roots])
-    trials = _read_table(trials_text, _NUMERIC_TRIAL_COLUMNS, ("completed_in_order",))
-    strokes = _read_table(strokes_text, _NUMERIC_STROKE_COLUMNS, ("written", "backwards"))
+    trials = _read_table(trials_text, _NUMERIC_TRIAL_COLUMNS, _BOOLEAN_TRIAL_COLUMNS)
+    strokes = _read_table(strokes_text, _NUMERIC_STROKE_COLUMNS, _BOOLEAN_STROKE_COLUMNS)
     if not trials.empty:
         from . import design_analysis
 

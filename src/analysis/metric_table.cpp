@@ -1,6 +1,8 @@
 #include "calligraphy/analysis/metric_table.hpp"
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
+#include <utility>
 
 #include "calligraphy/core/errors.hpp"
 
@@ -42,7 +44,9 @@ const MetricInfo kMetrics[] = {
      .definition = "strokes of the scene's (or the character's) reference",
      .levels = kScene | kCharacter,
      .of_scene = [](const WritingMetrics& m) { return count(m.strokes_total); },
-     .of_character = [](const CharacterScore& c) { return count(c.strokes.size()); }},
+     .of_character = [](const CharacterScore& c) { return count(c.strokes.size()); },
+     .trials_column = 2,
+     .if_missing = MetricMissing::refused},
     {.name = "strokes_written",
      .kind = MetricKind::count,
      .doc = "reference strokes matched to a written segment",
@@ -50,21 +54,27 @@ const MetricInfo kMetrics[] = {
      .source = "Kuhn 1955; Munkres 1957",
      .levels = kScene | kCharacter,
      .of_scene = [](const WritingMetrics& m) { return count(m.strokes_written); },
-     .of_character = [](const CharacterScore& c) { return count(c.strokes_written); }},
+     .of_character = [](const CharacterScore& c) { return count(c.strokes_written); },
+     .trials_column = 3,
+     .if_missing = MetricMissing::refused},
     {.name = "strokes_accepted",
      .kind = MetricKind::count,
      .doc = "segments accepted in turn, as the renderer and the quiz judge them",
      .definition = "accepted verdicts of `match_stroke` in writing order",
      .levels = kScene | kCharacter,
      .of_scene = [](const WritingMetrics& m) { return count(m.strokes_accepted); },
-     .of_character = [](const CharacterScore& c) { return count(c.strokes_accepted); }},
+     .of_character = [](const CharacterScore& c) { return count(c.strokes_accepted); },
+     .trials_column = 4,
+     .if_missing = MetricMissing::refused},
     {.name = "completed_in_order",
      .kind = MetricKind::flag,
      .doc = "every stroke written and no order error",
      .definition = "strokes_written = strokes_total and order_errors = 0 (every character)",
      .levels = kScene | kCharacter,
      .of_scene = [](const WritingMetrics& m) { return MetricValue(m.completed_in_order); },
-     .of_character = [](const CharacterScore& c) { return MetricValue(c.completed_in_order); }},
+     .of_character = [](const CharacterScore& c) { return MetricValue(c.completed_in_order); },
+     .trials_column = 1,
+     .if_missing = MetricMissing::zero},
     {.name = "strokes_in_order",
      .kind = MetricKind::flag,
      .doc = "at least one stroke written and no order error",
@@ -77,21 +87,27 @@ const MetricInfo kMetrics[] = {
      .definition = "inversions of the matched stroke indices in writing order, summed over characters",
      .levels = kScene | kCharacter,
      .of_scene = [](const WritingMetrics& m) { return count(m.order_errors); },
-     .of_character = [](const CharacterScore& c) { return count(c.order_errors); }},
+     .of_character = [](const CharacterScore& c) { return count(c.order_errors); },
+     .trials_column = 6,
+     .if_missing = MetricMissing::refused},
     {.name = "backwards_strokes",
      .kind = MetricKind::count,
      .doc = "matched segments written from the stroke's end",
      .definition = "pairs the matcher accepted with the segment's points reversed",
      .levels = kScene | kCharacter,
      .of_scene = [](const WritingMetrics& m) { return count(m.backwards_strokes); },
-     .of_character = [](const CharacterScore& c) { return count(c.backwards_strokes); }},
+     .of_character = [](const CharacterScore& c) { return count(c.backwards_strokes); },
+     .trials_column = 7,
+     .if_missing = MetricMissing::refused},
     {.name = "unmatched_segments",
      .kind = MetricKind::count,
      .doc = "scored segments matched to no reference stroke",
      .definition = "scored segments the assignment left without a stroke",
      .levels = kScene | kCharacter,
      .of_scene = [](const WritingMetrics& m) { return count(m.unmatched_segments); },
-     .of_character = [](const CharacterScore& c) { return count(c.unmatched_strokes); }},
+     .of_character = [](const CharacterScore& c) { return count(c.unmatched_strokes); },
+     .trials_column = 8,
+     .if_missing = MetricMissing::refused},
     {.name = "ignored_segments",
      .kind = MetricKind::count,
      .doc = "pen-down segments too short to score",
@@ -131,7 +147,9 @@ const MetricInfo kMetrics[] = {
          [](const StrokeScore& s) {
            return of_written(s,
                              [](const StrokeWritingMetrics& w) { return MetricValue(w.deviation.mean_m); });
-         }},
+         },
+     .trials_column = 9,
+     .strokes_column = 1},
     {.name = "max_deviation_m",
      .unit = "m",
      .doc = "largest distance of a written sample from the reference stroke",
@@ -145,7 +163,9 @@ const MetricInfo kMetrics[] = {
      .of_stroke =
          [](const StrokeScore& s) {
            return of_written(s, [](const StrokeWritingMetrics& w) { return MetricValue(w.deviation.max_m); });
-         }},
+         },
+     .trials_column = 10,
+     .strokes_column = 2},
     {.name = "rms_deviation_m",
      .unit = "m",
      .doc = "root mean square distance of the written samples from the reference stroke",
@@ -159,7 +179,9 @@ const MetricInfo kMetrics[] = {
      .of_stroke =
          [](const StrokeScore& s) {
            return of_written(s, [](const StrokeWritingMetrics& w) { return MetricValue(w.deviation.rms_m); });
-         }},
+         },
+     .trials_column = 11,
+     .strokes_column = 3},
     {.name = "outside_tube_share",
      .doc = "share of the samples farther than the tube radius (2 mm) from the stroke",
      .definition = "#{i : d_i > r} / N",
@@ -183,7 +205,9 @@ const MetricInfo kMetrics[] = {
          [](const StrokeScore& s) {
            return of_written(s,
                              [](const StrokeWritingMetrics& w) { return MetricValue(w.curves.frechet_m); });
-         }},
+         },
+     .trials_column = 12,
+     .strokes_column = 4},
     {.name = "dtw_m",
      .unit = "m",
      .doc = "mean point distance along the optimal dynamic time warping path",
@@ -197,7 +221,9 @@ const MetricInfo kMetrics[] = {
      .of_stroke =
          [](const StrokeScore& s) {
            return of_written(s, [](const StrokeWritingMetrics& w) { return MetricValue(w.curves.dtw_m); });
-         }},
+         },
+     .trials_column = 13,
+     .strokes_column = 5},
     {.name = "path_length_m",
      .unit = "m",
      .doc = "pen-down path length",
@@ -210,7 +236,8 @@ const MetricInfo kMetrics[] = {
          [](const StrokeScore& s) {
            return of_written(
                s, [](const StrokeWritingMetrics& w) { return MetricValue(w.kinematics.path_length_m); });
-         }},
+         },
+     .strokes_column = 7},
     // ---- times and fluency
     {.name = "total_time_s",
      .unit = "s",
@@ -218,14 +245,18 @@ const MetricInfo kMetrics[] = {
      .definition = "writing time + in-air time, rounded to whole nanoseconds",
      .levels = kScene | kCharacter,
      .of_scene = [](const WritingMetrics& m) { return MetricValue(m.total_time_s); },
-     .of_character = [](const CharacterScore& c) { return MetricValue(c.totals.total_time_s); }},
+     .of_character = [](const CharacterScore& c) { return MetricValue(c.totals.total_time_s); },
+     .trials_column = 14,
+     .if_missing = MetricMissing::refused},
     {.name = "pen_down_time_s",
      .unit = "s",
      .doc = "time with the pen down",
      .definition = "sum over pen-down segments of t_last - t_first",
      .levels = kScene | kCharacter,
      .of_scene = [](const WritingMetrics& m) { return MetricValue(m.pen_down_time_s); },
-     .of_character = [](const CharacterScore& c) { return MetricValue(c.totals.writing_time_s); }},
+     .of_character = [](const CharacterScore& c) { return MetricValue(c.totals.writing_time_s); },
+     .trials_column = 15,
+     .if_missing = MetricMissing::refused},
     {.name = "in_air_time_s",
      .unit = "s",
      .doc = "time with the pen lifted between two pen-down segments",
@@ -241,7 +272,8 @@ const MetricInfo kMetrics[] = {
          [](const StrokeScore& s) {
            return of_written(
                s, [](const StrokeWritingMetrics& w) { return MetricValue(w.kinematics.writing_time_s); });
-         }},
+         },
+     .strokes_column = 6},
     {.name = "mean_speed_m_s",
      .unit = "m/s",
      .doc = "mean pen-down speed",
@@ -265,7 +297,9 @@ const MetricInfo kMetrics[] = {
          [](const StrokeScore& s) {
            return of_written(
                s, [](const StrokeWritingMetrics& w) { return count(w.kinematics.velocity_peaks); });
-         }},
+         },
+     .trials_column = 16,
+     .if_missing = MetricMissing::refused},
     {.name = "normalised_jerk",
      .doc = "dimensionless jerk of the low-passed pen path (sqrt(360) for a minimum-jerk movement)",
      .definition = "sqrt(0.5 integral |x'''|^2 dt T^5 / L^2); mean over scored segments",
@@ -277,7 +311,8 @@ const MetricInfo kMetrics[] = {
          [](const StrokeScore& s) {
            return of_written(
                s, [](const StrokeWritingMetrics& w) { return MetricValue(w.kinematics.normalised_jerk); });
-         }},
+         },
+     .trials_column = 17},
     // ---- the live run, as the renderer saw it (TrialMetrics, trial/recorder.hpp)
     {.name = "strokes_completed",
      .kind = MetricKind::count,
@@ -288,7 +323,9 @@ const MetricInfo kMetrics[] = {
      .kind = MetricKind::count,
      .doc = "strokes credited as assisted after `assist_after_misses` refused attempts (not written)",
      .definition = "`TrialMetrics::strokes_assisted`",
-     .levels = kRun},
+     .levels = kRun,
+     .trials_column = 5,
+     .if_missing = MetricMissing::zero},
     {.name = "trial_time_s",
      .unit = "s",
      .doc = "from the trial's start to the last stroke completed (or the end of the trial)",
@@ -337,6 +374,54 @@ std::string cell(std::string_view text) {
 }  // namespace
 
 std::span<const MetricInfo> metric_table() noexcept { return kMetrics; }
+
+std::vector<MetricInfo> study_metric_columns(StudyTable which, std::span<const MetricInfo> table) {
+  std::vector<MetricInfo> out;
+  for (const MetricInfo& info : table)
+    if (info.column(which) > 0) out.push_back(info);
+  std::stable_sort(out.begin(), out.end(), [which](const MetricInfo& a, const MetricInfo& b) {
+    return a.column(which) < b.column(which);
+  });
+  return out;
+}
+
+MetricValues::MetricValues(StudyTable which, std::span<const MetricInfo> table) {
+  for (const MetricInfo& info : study_metric_columns(which, table)) {
+    names_.push_back(info.name);
+    switch (info.kind) {
+      case MetricKind::count:
+        values_.emplace_back(std::int64_t{0});
+        break;
+      case MetricKind::flag:
+        values_.emplace_back(false);
+        break;
+      case MetricKind::number:
+        values_.emplace_back(std::monostate{});
+        break;
+    }
+  }
+}
+
+std::size_t MetricValues::index(std::string_view name) const {
+  for (std::size_t i = 0; i < names_.size(); ++i)
+    if (names_[i] == name) return i;
+  std::string message = "the row has no metric column '";
+  message.append(name);
+  message += "'";
+  throw InvalidArgument(message);
+}
+
+const MetricValue& MetricValues::at(std::string_view name) const { return values_[index(name)]; }
+
+std::optional<double> MetricValues::number(std::string_view name) const {
+  const MetricValue& value = at(name);
+  if (const double* x = std::get_if<double>(&value)) return *x;
+  if (const std::int64_t* n = std::get_if<std::int64_t>(&value)) return static_cast<double>(*n);
+  if (const bool* flag = std::get_if<bool>(&value)) return *flag ? 1.0 : 0.0;
+  return std::nullopt;
+}
+
+void MetricValues::set(std::string_view name, MetricValue value) { values_[index(name)] = std::move(value); }
 
 std::optional<MetricInfo> find_metric(std::string_view text, std::span<const MetricInfo> table) noexcept {
   for (const MetricInfo& info : table) {

@@ -20,8 +20,8 @@ std::vector<TypicalStrokeRecord> typical_stroke_record(const StudyTables& tables
     auto& [written, sum] = by_id[row.typical_id];
     if (!row.written) continue;
     ++written;
-    if (row.mean_deviation_m) {
-      sum += *row.mean_deviation_m;
+    if (const std::optional<double> deviation_m = row.metrics.number("mean_deviation_m")) {
+      sum += *deviation_m;
       ++with_deviation[row.typical_id];
     }
   }

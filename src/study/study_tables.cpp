@@ -8,6 +8,8 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <thread>
+#include <type_traits>
+#include <variant>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
@@ -25,20 +27,50 @@ using nlohmann::json;
 
 using study_detail::record_metric;
 
-std::size_t count(const json_detail::JsonView& object, const char* key) {
-  if (!object.has(key))
-    json_detail::fail(object.source(), object.pointer() + "/" + key, "missing (required)");
-  return static_cast<std::size_t>(object.integer_or(key, 0, 0, 1LL << 40));
+// A metric's value in `object` (a record or one of its strokes) as its kind is: a number in the metric's
+// unit (read under its legacy name too), a count, a flag. Missing, it is what the metric table says: null, 0
+// (false), or a DataError naming the file and key.
+MetricValue record_value(const json_detail::JsonView& object, const MetricInfo& info) {
+  if (!study_detail::contains_metric(object, info)) {
+    switch (info.if_missing) {
+      case MetricMissing::refused:
+        json_detail::fail(object.source(), object.pointer() + "/" + std::string(info.name),
+                          "missing (required)");
+      case MetricMissing::zero:
+        if (info.kind == MetricKind::flag) return MetricValue(false);
+        return info.kind == MetricKind::count ? MetricValue(std::int64_t{0}) : MetricValue(0.0);
+      case MetricMissing::null:
+        break;
+    }
+    return MetricValue(std::monostate{});
+  }
+  switch (info.kind) {
+    case MetricKind::count:
+      return MetricValue(object.integer_or(std::string(info.name), 0, 0, 1LL << 40));
+    case MetricKind::flag:
+      return MetricValue(object.boolean_or(std::string(info.name), false));
+    case MetricKind::number:
+      break;
+  }
+  const std::optional<double> value = record_metric(object, info);
+  return value ? MetricValue(*value) : MetricValue(std::monostate{});
 }
 
-// The strokes of one character of a record: its per-stroke metrics and the verdicts of the segments the
-// matcher gave each stroke.
+// The metric columns of `which` in `metrics`, read from `object`.
+MetricValues metric_values(const json_detail::JsonView& object, StudyTable which,
+                           std::span<const MetricInfo> metrics) {
+  MetricValues values(which, metrics);
+  for (const MetricInfo& info : study_metric_columns(which, metrics))
+    values.set(info.name, record_value(object, info));
+  return values;
+}
+
 void add_strokes(const json_detail::JsonView& character, std::size_t index, const TrialRow& trial,
-                 std::vector<StrokeRow>& strokes) {
+                 std::span<const MetricInfo> metrics, std::vector<StrokeRow>& strokes) {
   const json_detail::JsonView per_stroke = character.array("per_stroke");
   const std::size_t first = strokes.size();
   for (std::size_t s = 0; s < per_stroke.size(); ++s) {
-    const json_detail::JsonView metrics = per_stroke.object_at(s);
+    const json_detail::JsonView stroke = per_stroke.object_at(s);
     StrokeRow row;
     row.subject = trial.subject;
     row.session = trial.session;
@@ -48,16 +80,10 @@ void add_strokes(const json_detail::JsonView& character, std::size_t index, cons
     row.character = index + 1;
     row.character_text = character.string_or("character", "");
     row.stroke = s + 1;
-    row.typical_id = static_cast<int>(metrics.integer_or("typical_id", 0, 0, 39));
-    row.written = metrics.boolean_or("written", false);
-    row.backwards = metrics.boolean_or("backwards", false);
-    row.mean_deviation_m = record_metric(metrics, "mean_deviation_m");
-    row.max_deviation_m = record_metric(metrics, "max_deviation_m");
-    row.rms_deviation_m = record_metric(metrics, "rms_deviation_m");
-    row.frechet_m = record_metric(metrics, "frechet_m");
-    row.dtw_m = record_metric(metrics, "dtw_m");
-    row.path_length_m = record_metric(metrics, "path_length_m");
-    row.time_s = record_metric(metrics, "time_s");
+    row.typical_id = static_cast<int>(stroke.integer_or("typical_id", 0, 0, 39));
+    row.written = stroke.boolean_or("written", false);
+    row.backwards = stroke.boolean_or("backwards", false);
+    row.metrics = metric_values(stroke, StudyTable::strokes, metrics);
     strokes.push_back(std::move(row));
   }
   const json_detail::JsonView segments = character.array("segments");
@@ -81,7 +107,7 @@ void add_strokes(const json_detail::JsonView& character, std::size_t index, cons
 
 TrialRow study_detail::trial_row(const json& document, const std::string& source,
                                  const SessionManifest& manifest, const PlannedTrial& plan,
-                                 std::vector<StrokeRow>& strokes) {
+                                 std::vector<StrokeRow>& strokes, std::span<const MetricInfo> metrics) {
   const json_detail::JsonView record(document, "", source);
   TrialRow row;
   row.subject = manifest.setup.subject.id;
@@ -109,24 +135,7 @@ TrialRow study_detail::trial_row(const json& document, const std::string& source
   }
   row.end_reason = record.string_or("end_reason", "");
   row.start_utc = record.string_or("start_time_utc", "");
-  row.completed_in_order = record.boolean_or("completed_in_order", false);
-  row.strokes_total = count(record, "strokes_total");
-  row.strokes_written = count(record, "strokes_written");
-  row.strokes_accepted = count(record, "strokes_accepted");
-  // 0 in records written before the assisted credit
-  row.strokes_assisted = static_cast<std::size_t>(record.integer_or("strokes_assisted", 0, 0, 1LL << 40));
-  row.order_errors = count(record, "order_errors");
-  row.backwards_strokes = count(record, "backwards_strokes");
-  row.unmatched_segments = count(record, "unmatched_segments");
-  row.mean_deviation_m = record_metric(record, "mean_deviation_m");
-  row.max_deviation_m = record_metric(record, "max_deviation_m");
-  row.rms_deviation_m = record_metric(record, "rms_deviation_m");
-  row.frechet_m = record_metric(record, "frechet_m");
-  row.dtw_m = record_metric(record, "dtw_m");
-  row.total_time_s = record.number("total_time_s", -1e12, 1e12);
-  row.pen_down_time_s = record.number("pen_down_time_s", -1e12, 1e12);
-  row.velocity_peaks = static_cast<int>(count(record, "velocity_peaks"));
-  row.normalised_jerk = record.optional_number("normalised_jerk", -1e12, 1e12);
+  row.metrics = metric_values(record, StudyTable::trials, metrics);
   const json_detail::JsonView memory = record.object("writer").object("memory");
   row.shape_skill = memory.optional_number("shape_skill", -1e12, 1e12);
   row.order_skill = memory.optional_number("order_skill", -1e12, 1e12);
@@ -145,7 +154,8 @@ TrialRow study_detail::trial_row(const json& document, const std::string& source
   row.legibility_top1 = legibility.optional_number("top1", 0.0, 1.0);
   row.legibility_top5 = legibility.optional_number("top5", 0.0, 1.0);
   const json_detail::JsonView characters = record.array("per_character");
-  for (std::size_t c = 0; c < characters.size(); ++c) add_strokes(characters.object_at(c), c, row, strokes);
+  for (std::size_t c = 0; c < characters.size(); ++c)
+    add_strokes(characters.object_at(c), c, row, metrics, strokes);
   return row;
 }
 
@@ -173,12 +183,42 @@ std::string field(const std::optional<int>& value) { return value ? std::to_stri
 std::string field(std::size_t value) { return std::to_string(value); }
 std::string field(int value) { return std::to_string(value); }
 std::string field(bool value) { return value ? "true" : "false"; }
+std::string field(std::int64_t value) { return std::to_string(value); }
 
+// A metric's value as the field of its kind: a number as a double, a count, a flag; empty when null.
+std::string field(const MetricValue& value) {
+  return std::visit(
+      [](const auto& v) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::monostate>)
+          return std::string();
+        else
+          return field(v);
+      },
+      value);
+}
+
+// The fields after a first, each after a comma.
 template <typename... Fields>
-void line(std::string& out, const Fields&... fields) {
-  bool first = true;
-  ((out += (first ? "" : ","), out += field(fields), first = false), ...);
-  out += '\n';
+void fields(std::string& out, const Fields&... values) {
+  ((out += ',', out += field(values)), ...);
+}
+
+// The metric columns of a row, each after a comma, in the order of `columns`.
+void metric_fields(std::string& out, const MetricValues& values, const std::vector<MetricInfo>& columns) {
+  for (const MetricInfo& info : columns) {
+    out += ',';
+    out += field(values.at(info.name));
+  }
+}
+
+// The header's metric columns, each after a comma.
+std::string metric_header(const std::vector<MetricInfo>& columns) {
+  std::string out;
+  for (const MetricInfo& info : columns) {
+    out += ',';
+    out.append(info.name);
+  }
+  return out;
 }
 
 }  // namespace
@@ -226,44 +266,47 @@ StudyTables read_study_tables(const std::vector<fs::path>& roots, unsigned threa
   return tables;
 }
 
-std::string trials_csv(const StudyTables& tables) {
+std::string trials_csv(const StudyTables& tables, std::span<const MetricInfo> metrics) {
+  const std::vector<MetricInfo> columns = study_metric_columns(StudyTable::trials, metrics);
   std::string out =
       "subject,session,protocol,session_number,group,phase,block,condition,mode,characters,trial,item,"
       "repetition,item_set,sequence,period,trained_condition,writer,writer_profile,writer_learning,end_"
-      "reason,"
-      "start_utc,completed_in_order,strokes_total,strokes_written,strokes_accepted,strokes_assisted,order_"
-      "errors,"
-      "backwards_strokes,unmatched_segments,mean_deviation_m,max_deviation_m,rms_deviation_m,frechet_m,dtw_m,"
-      "total_time_s,pen_down_time_s,velocity_peaks,normalised_jerk,shape_skill,order_skill,timing_skill,"
-      "subject_writing_speed_factor,subject_spatial_error_factor,subject_error_rate_factor,"
-      "subject_motor_noise_factor,subject_fast_learning_per_trial,subject_slow_learning_per_trial,"
-      "subject_fast_retention_per_trial,subject_slow_retention_per_trial,strokes_given_up,legibility_top1,"
-      "legibility_top5,trace_file,trace_sha256\n";
+      "reason,start_utc";
+  out += metric_header(columns);
+  out +=
+      ",shape_skill,order_skill,timing_skill,subject_writing_speed_factor,subject_spatial_error_factor,"
+      "subject_error_rate_factor,subject_motor_noise_factor,subject_fast_learning_per_trial,subject_slow_"
+      "learning_per_trial,subject_fast_retention_per_trial,subject_slow_retention_per_trial,strokes_given_"
+      "up,legibility_top1,legibility_top5,trace_file,trace_sha256\n";
   for (const TrialRow& r : tables.trials) {
-    line(out, r.subject, r.session, r.protocol, r.session_number, r.group, r.phase, r.block, r.condition,
-         r.mode, r.characters, r.trial, r.item, r.repetition, r.item_set, r.sequence, r.period,
-         r.trained_condition, r.writer, r.writer_profile, r.writer_learning, r.end_reason, r.start_utc,
-         r.completed_in_order, r.strokes_total, r.strokes_written, r.strokes_accepted, r.strokes_assisted,
-         r.order_errors, r.backwards_strokes, r.unmatched_segments, r.mean_deviation_m, r.max_deviation_m,
-         r.rms_deviation_m, r.frechet_m, r.dtw_m, r.total_time_s, r.pen_down_time_s, r.velocity_peaks,
-         r.normalised_jerk, r.shape_skill, r.order_skill, r.timing_skill, r.subject_writing_speed_factor,
-         r.subject_spatial_error_factor, r.subject_error_rate_factor, r.subject_motor_noise_factor,
-         r.subject_fast_learning_per_trial, r.subject_slow_learning_per_trial,
-         r.subject_fast_retention_per_trial, r.subject_slow_retention_per_trial, r.strokes_given_up,
-         r.legibility_top1, r.legibility_top5, r.trace_file.string(), r.trace_sha256);
+    out += field(r.subject);
+    fields(out, r.session, r.protocol, r.session_number, r.group, r.phase, r.block, r.condition, r.mode,
+           r.characters, r.trial, r.item, r.repetition, r.item_set, r.sequence, r.period, r.trained_condition,
+           r.writer, r.writer_profile, r.writer_learning, r.end_reason, r.start_utc);
+    metric_fields(out, r.metrics, columns);
+    fields(out, r.shape_skill, r.order_skill, r.timing_skill, r.subject_writing_speed_factor,
+           r.subject_spatial_error_factor, r.subject_error_rate_factor, r.subject_motor_noise_factor,
+           r.subject_fast_learning_per_trial, r.subject_slow_learning_per_trial,
+           r.subject_fast_retention_per_trial, r.subject_slow_retention_per_trial, r.strokes_given_up,
+           r.legibility_top1, r.legibility_top5, r.trace_file.string(), r.trace_sha256);
+    out += '\n';
   }
   return out;
 }
 
-std::string strokes_csv(const StudyTables& tables) {
+std::string strokes_csv(const StudyTables& tables, std::span<const MetricInfo> metrics) {
+  const std::vector<MetricInfo> columns = study_metric_columns(StudyTable::strokes, metrics);
   std::string out =
       "subject,session,trial,phase,condition,character,character_text,stroke,typical_id,written,backwards,"
-      "segments,refused_segments,refusal,mean_deviation_m,max_deviation_m,rms_deviation_m,frechet_m,dtw_m,"
-      "time_s,path_length_m\n";
+      "segments,refused_segments,refusal";
+  out += metric_header(columns);
+  out += '\n';
   for (const StrokeRow& r : tables.strokes) {
-    line(out, r.subject, r.session, r.trial, r.phase, r.condition, r.character, r.character_text, r.stroke,
-         r.typical_id, r.written, r.backwards, r.segments, r.refused_segments, r.refusal, r.mean_deviation_m,
-         r.max_deviation_m, r.rms_deviation_m, r.frechet_m, r.dtw_m, r.time_s, r.path_length_m);
+    out += field(r.subject);
+    fields(out, r.session, r.trial, r.phase, r.condition, r.character, r.character_text, r.stroke,
+           r.typical_id, r.written, r.backwards, r.segments, r.refused_segments, r.refusal);
+    metric_fields(out, r.metrics, columns);
+    out += '\n';
   }
   return out;
 }

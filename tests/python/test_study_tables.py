@@ -84,6 +84,26 @@ def test_the_tables_are_the_cli_tables_and_the_records(cli, study_folder):
         assert (study_folder / "with_pages" / name).read_bytes() == (study_folder / "tables" / name).read_bytes()
 
 
+def test_the_metric_columns_are_the_metric_tables(study_folder):
+    """The tables' metric columns are the metric table's, in its places, typed by its kinds."""
+    study = calligraphy.study.load(study_folder / "study")
+    table = calligraphy.metric_table()
+    for frame, key in ((study.trials, "trials_column"), (study.strokes, "strokes_column")):
+        metrics = sorted((row for row in table if row[key] > 0), key=lambda row: row[key])
+        assert [row[key] for row in metrics] == list(range(1, len(metrics) + 1))
+        names = [row["name"] for row in metrics]
+        columns = list(frame.columns)
+        start = columns.index(names[0])
+        assert columns[start:start + len(names)] == names  # together, in the table's order
+        for row in metrics:
+            dtype = frame[row["name"]].dtype
+            if row["kind"] == "flag":
+                assert dtype == bool, row["name"]
+            else:
+                assert pd.api.types.is_numeric_dtype(dtype), row["name"]
+    assert study.trials["strokes_assisted"].dtype == "int64"
+
+
 def test_samples_are_read_on_demand_in_si_units(study_folder):
     study = calligraphy.study.load([study_folder / "study"])
     first = study.trials.iloc[0]

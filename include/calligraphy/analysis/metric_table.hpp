@@ -13,6 +13,7 @@
 #include <string>
 #include <string_view>
 #include <variant>
+#include <vector>
 
 #include "calligraphy/analysis/writing_metrics.hpp"
 
@@ -35,6 +36,21 @@ enum class MetricKind : std::uint8_t {
   flag,    ///< true or false (JSON boolean)
 };
 
+/// A table of a study (study_tables.hpp) a metric can be a column of.
+enum class StudyTable : std::uint8_t {
+  trials,   ///< trials.csv: one row per saved trial, the record's top-level value (scene or run level)
+  strokes,  ///< strokes.csv: one row per reference stroke, the stroke's value (stroke level)
+};
+
+/// What a study table (study_tables.hpp) reads for a metric a trial record lacks.
+enum class MetricMissing : std::uint8_t {
+  null,     ///< nothing (an empty field): a record written before the metric was kept
+  zero,     ///< 0, or false for a flag: what the metric was before it was kept (no assisted stroke before the
+            ///< assisted credit)
+  refused,  ///< none: the record is damaged (a DataError naming the file and key); the scoring's totals are
+            ///< in every record
+};
+
 /// A metric's value: nothing (JSON null), a number, a count or a flag.
 using MetricValue = std::variant<std::monostate, double, std::int64_t, bool>;
 
@@ -55,12 +71,54 @@ struct MetricInfo {
   MetricValue (*of_scene)(const WritingMetrics&) = nullptr;
   MetricValue (*of_character)(const CharacterScore&) = nullptr;
   MetricValue (*of_stroke)(const StrokeScore&) = nullptr;
+  /// Its place among the metric columns of the study tables (study_tables.hpp), counted from 1: of
+  /// trials.csv (a metric at the scene or run level) and of strokes.csv (a metric at the stroke level); 0
+  /// when it is not a column of that table. The CSV headers, the rows read back and Python's DataFrames
+  /// follow these places, so a column keeps its place when a metric is added.
+  std::uint8_t trials_column = 0;
+  std::uint8_t strokes_column = 0;
+  /// What the study tables read when a record lacks it (the default suits a metric added later).
+  MetricMissing if_missing = MetricMissing::null;
 
   [[nodiscard]] constexpr bool at(MetricLevel level) const noexcept { return (levels & level) != 0; }
+  /// Its place among the metric columns of `table`; 0 when it is not one of them.
+  [[nodiscard]] constexpr std::uint8_t column(StudyTable table) const noexcept {
+    return table == StudyTable::trials ? trials_column : strokes_column;
+  }
 };
 
 /// Every metric, in the order docs/metrics.md lists them.
 [[nodiscard]] std::span<const MetricInfo> metric_table() noexcept;
+
+/// The metrics of `table` that are columns of study table `which`, in their columns' order.
+[[nodiscard]] std::vector<MetricInfo> study_metric_columns(
+    StudyTable which, std::span<const MetricInfo> table = metric_table());
+
+/// One row's values of a study table's metric columns, in the columns' order, read by the metric's name.
+class MetricValues {
+ public:
+  MetricValues() = default;
+  /// Every metric column of `which` in `table`, without a value yet: a number null, a count 0, a flag false.
+  explicit MetricValues(StudyTable which, std::span<const MetricInfo> table = metric_table());
+
+  /// The value of metric `name`. InvalidArgument naming it when the row has no such column.
+  [[nodiscard]] const MetricValue& at(std::string_view name) const;
+  /// Metric `name` as a number (a count as its value, a flag as 0 or 1); nullopt when null.
+  /// InvalidArgument naming it when the row has no such column.
+  [[nodiscard]] std::optional<double> number(std::string_view name) const;
+  /// Sets metric `name`. InvalidArgument naming it when the row has no such column.
+  void set(std::string_view name, MetricValue value);
+
+  /// The columns' metric names, and their values in the same order.
+  [[nodiscard]] std::span<const std::string_view> names() const noexcept { return names_; }
+  [[nodiscard]] std::span<const MetricValue> values() const noexcept { return values_; }
+
+ private:
+  [[nodiscard]] std::size_t index(std::string_view name) const;
+
+  std::vector<std::string_view> names_;  // the table's names: text with static storage
+  std::vector<MetricValue> values_;
+};
 
 /// The metric of `table` called `text`, by its name or its legacy name; nullopt for any other text.
 [[nodiscard]] std::optional<MetricInfo> find_metric(

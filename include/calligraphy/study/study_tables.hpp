@@ -11,8 +11,11 @@
 #include <cstddef>
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
+
+#include "calligraphy/analysis/metric_table.hpp"
 
 namespace calligraphy {
 
@@ -47,25 +50,10 @@ struct TrialRow {
   std::string writer_learning;
   std::string end_reason;  ///< how the trial ended (TrialEnd as text)
   std::string start_utc;   ///< ISO 8601
-  bool completed_in_order = false;
-  std::size_t strokes_total = 0;
-  std::size_t strokes_written = 0;
-  /// Strokes the renderer credited as assisted after assist_after_misses refused attempts (written apart
-  /// from strokes_written: none of them was written).
-  std::size_t strokes_assisted = 0;
-  std::size_t strokes_accepted = 0;
-  std::size_t order_errors = 0;
-  std::size_t backwards_strokes = 0;
-  std::size_t unmatched_segments = 0;
-  std::optional<double> mean_deviation_m;  ///< absent when nothing was matched
-  std::optional<double> max_deviation_m;
-  std::optional<double> rms_deviation_m;
-  std::optional<double> frechet_m;
-  std::optional<double> dtw_m;
-  double total_time_s = 0.0;
-  double pen_down_time_s = 0.0;
-  int velocity_peaks = 0;
-  std::optional<double> normalised_jerk;  ///< dimensionless
+  /// The record's metrics that are columns of the trials table (the metric table's `trials_column`: the
+  /// matching's counts, completed_in_order, the deviations, times, fluency and strokes_assisted), read by
+  /// name: `metrics.number("mean_deviation_m")`; a number is null when nothing was matched.
+  MetricValues metrics{StudyTable::trials};
   /// A learning simulated writer's skills before the trial, in [0, 1] (docs/writer.md, "Memory"); absent
   /// otherwise.
   std::optional<double> shape_skill;
@@ -111,13 +99,9 @@ struct StrokeRow {
       0;  ///< pen-down segments the matcher gave this stroke as their expected or matched one
   std::size_t refused_segments = 0;  ///< those refused
   std::string refusal;               ///< the last refused one's reason ("too_short", ...); "" when none
-  std::optional<double> mean_deviation_m;
-  std::optional<double> max_deviation_m;
-  std::optional<double> rms_deviation_m;
-  std::optional<double> frechet_m;
-  std::optional<double> dtw_m;
-  std::optional<double> time_s;  ///< its segment's duration [s]
-  std::optional<double> path_length_m;
+  /// The stroke's metrics that are columns of the strokes table (the metric table's `strokes_column`: its
+  /// deviations, time_s, path_length_m), read by name; null for a stroke never written.
+  MetricValues metrics{StudyTable::strokes};
 };
 
 struct StudyTables {
@@ -127,14 +111,20 @@ struct StudyTables {
 
 /// The tables of every saved trial in the session folders under `roots` (each a session folder or a folder
 /// holding some). Reads session.json and each trial's JSON record, never the traces, sessions on `threads`
-/// threads at once (0: one a core); the rows are in the same order whatever the threads. Throws DataError
-/// naming the file (and JSON pointer) for a root without a session folder, a damaged manifest or record.
+/// threads at once (0: one a core); the rows are in the same order whatever the threads. The rows' metrics
+/// are the metric table's study-table columns. Throws DataError naming the file (and JSON pointer) for a
+/// root without a session folder, a damaged manifest or record (one without a metric of the scene's totals
+/// that is a trials column).
 [[nodiscard]] StudyTables read_study_tables(const std::vector<std::filesystem::path>& roots,
                                             unsigned threads = 0);
 
 /// The trials table as CSV (RFC 4180): a header of the column names, one line per row; absent values empty.
-[[nodiscard]] std::string trials_csv(const StudyTables& tables);
-/// The strokes table as CSV.
-[[nodiscard]] std::string strokes_csv(const StudyTables& tables);
+/// The metric columns are those of `metrics` (the metric table; another, as the rows were read with, only to
+/// try a metric added to it), in their `trials_column` order, after start_utc.
+[[nodiscard]] std::string trials_csv(const StudyTables& tables,
+                                     std::span<const MetricInfo> metrics = metric_table());
+/// The strokes table as CSV; the metric columns, in their `strokes_column` order, after refusal.
+[[nodiscard]] std::string strokes_csv(const StudyTables& tables,
+                                      std::span<const MetricInfo> metrics = metric_table());
 
 }  // namespace calligraphy
