@@ -91,8 +91,22 @@ StrokeAcceptance read_acceptance(const json& value, const std::string& pointer, 
   return a;
 }
 
+// A condition's and a quiz's keys are optional, but a key given as null is refused naming it
+// (docs/experiments.md, "Protocol files"): null is no value, and leaving the key out is how its default is
+// asked for.
+void refuse_null_members(const json& value, const std::string& pointer, const std::string& source) {
+  if (!value.is_object()) return;  // the reader names the wrong type
+  for (const auto& item : value.items()) {
+    if (item.value().is_null()) {
+      json_detail::fail(source, json_detail::child_pointer(pointer, item.key()),
+                        "null is not a value (leave the key out for its default)");
+    }
+  }
+}
+
 QuizOptions read_quiz(const json& value, const std::string& pointer, const std::string& source) {
   json_detail::ObjectReader reader(value, pointer, source);
+  refuse_null_members(value, pointer, source);
   QuizOptions quiz;
   if (reader.has("leniency")) {
     json_detail::fail(source, reader.pointer("leniency"),
@@ -185,6 +199,7 @@ void check_teacher_items(const StudyProtocol& protocol, const std::string& sourc
 
 StudyCondition read_condition(const json& value, const std::string& pointer, const std::string& source) {
   json_detail::ObjectReader reader(value, pointer, source);
+  refuse_null_members(value, pointer, source);
   StudyCondition condition;
   condition.name = reader.string("name");
   if (!study_detail::is_label(condition.name, study_detail::kMaxLabelLength)) {
