@@ -106,13 +106,13 @@ void refuse_null_members(const json& value, const std::string& pointer, const st
 
 QuizOptions read_quiz(const json& value, const std::string& pointer, const std::string& source) {
   json_detail::ObjectReader reader(value, pointer, source);
-  refuse_null_members(value, pointer, source);
   QuizOptions quiz;
   if (reader.has("leniency")) {
     json_detail::fail(source, reader.pointer("leniency"),
                       "replaced by \"acceptance\": the quiz judges with the stroke matcher's tolerances "
                       "(corridor_m, mean_deviation_m, ...; docs/stroke-acceptance.md)");
   }
+  refuse_null_members(value, pointer, source);
   if (const json* acceptance = reader.optional("acceptance")) {
     quiz.acceptance = read_acceptance(*acceptance, reader.pointer("acceptance"), source);
   }
@@ -199,7 +199,6 @@ void check_teacher_items(const StudyProtocol& protocol, const std::string& sourc
 
 StudyCondition read_condition(const json& value, const std::string& pointer, const std::string& source) {
   json_detail::ObjectReader reader(value, pointer, source);
-  refuse_null_members(value, pointer, source);
   StudyCondition condition;
   condition.name = reader.string("name");
   if (!study_detail::is_label(condition.name, study_detail::kMaxLabelLength)) {
@@ -208,6 +207,7 @@ StudyCondition read_condition(const json& value, const std::string& pointer, con
   }
   // The mode's condition with the parameters' defaults (SchemaOf<StudyCondition>: condition_from_mode).
   read_member(reader, SchemaOf<StudyCondition>::get(), "mode", &condition, true);
+  refuse_null_members(value, pointer, source);  // after name and mode, which name their own types
   const ConditionMode mode = condition_mode(condition);
   std::optional<double> stiffness_n_per_m;
   if (reader.optional("guidance_stiffness_n_per_m") != nullptr) {
