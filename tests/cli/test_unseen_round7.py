@@ -31,6 +31,10 @@ def sample(cases):
     return cases[::3] if SANITIZED else cases
 
 
+# Under the sanitizers (ten times slower) the cases that run several trials or parse megabytes are left out.
+heavy = unittest.skipIf(SANITIZED, "several trials or megabytes of JSON: left to the Release run")
+
+
 try:
     import numpy  # noqa: F401  (the package needs it)
     import calligraphy as cg
@@ -218,6 +222,7 @@ class ProtocolConditionCases(Case):
         if result.returncode == 2:
             self.assert_error(result, 2, "p.json", "/conditions/0/guidance_stiffness_n_per_m")
 
+    @heavy
     def test_each_bounded_parameter_beyond_its_schema_bounds(self):
         """The bounds `schema protocol` states for each mode's parameters, crossed on each side."""
         schema = json.loads(self.cli("schema", "protocol").stdout)
@@ -351,6 +356,7 @@ class ProtocolConditionCases(Case):
         (self.cwd / "rp.json").write_text(protocol(json.dumps(
             {"name": "c", "mode": "replay", "teachers": {SHI: teacher}})), encoding="utf-8")
 
+    @heavy
     def test_replay_teacher_that_is_no_recording_is_named_without_waiting(self):
         os.mkfifo(self.cwd / "fifo")
         shutil.copy(Shared.get() / "r.json", self.cwd / "record.json")
@@ -617,6 +623,7 @@ class TrialRecordCases(Case):
         self.assertFalse((self.cwd / "out.json").exists())
         return line
 
+    @heavy
     def test_specification_alone_runs_the_same_trial(self):
         spec = self.record()["specification"]
         (self.cwd / "spec.json").write_text(json.dumps(spec), encoding="utf-8")
@@ -687,12 +694,14 @@ class TrialRecordCases(Case):
             self.error_line(result, result.returncode)
             self.assertFalse((self.cwd / "out.csv").exists())
 
+    @heavy
     def test_huge_array(self):
         data = self.record()
         data["specification"]["scene"]["layout"] = [0.0] * 2_000_000
         line = self.spec_refused(data, 2, "/specification/scene/layout")
         self.assertLess(len(line), 2100)
 
+    @heavy
     def test_deep_nesting_and_cut_json(self):
         self.spec_refused(None, 2, raw="[" * 100000 + "]" * 100000)
         text = json.dumps(self.record())
@@ -711,6 +720,7 @@ class TrialRecordCases(Case):
         self.assertIn(result.returncode, (0, 2))
         self.assertFalse((self.cwd / "out.csv").exists())
 
+    @heavy
     def test_session_record_reruns_to_its_trace(self):
         study, (a, _) = (None, (None, None))
         session = sorted(p for p in (Shared.get() / "study").glob("S01/p-*"))[0]
@@ -720,6 +730,7 @@ class TrialRecordCases(Case):
         self.assert_ok(self.cli("trace", trace, "--csv", "saved.csv"))
         self.assertEqual((self.cwd / "again.csv").read_bytes(), (self.cwd / "saved.csv").read_bytes())
 
+    @heavy
     def test_parts_swapped_between_a_fixed_and_a_fading_record(self):
         self.assert_ok(self.cli("trial", SHI, "--guidance-mode", "fading", "--guidance-gain", "0.4", "--seed", "1",
                                 "--json", "fading.json"))
@@ -730,6 +741,7 @@ class TrialRecordCases(Case):
         fading["specification"]["trial"] = self.record()["specification"]["trial"]
         self.spec_refused(fading, 2, "/specification")
 
+    @heavy
     def test_replay_teacher_changed(self):
         for args in (["--writer-profile", "skilled", "--record", "teacher.json"],
                      ["--writer-profile", "skilled", "--seed", "5", "--record", "other-teacher.json"],
