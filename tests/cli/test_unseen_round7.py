@@ -531,6 +531,29 @@ class SessionFolderCases(Case):
         shutil.copy(theirs, mine)
         self.report_refused(study, mine.name)
 
+    def test_record_labels_forged(self):
+        """A record's own labels edited (subject, session, condition, characters): refused naming the record, or
+        the tables keep the plan's labels; the forged values never reach a row."""
+        import csv
+        forged = {"subject": "S09", "session": "p-S09-20000101-000000", "condition": "zz", "characters": "人"}
+        for key, value in sample(list(forged.items())):
+            with self.subTest(key=key):
+                study, (a, _) = self.study()
+                record = self.records(a)[0]
+                data = json.loads(record.read_text(encoding="utf-8"))
+                self.assertIn(key, data)
+                data[key] = value
+                record.write_text(json.dumps(data), encoding="utf-8")
+                (self.cwd / "tables").mkdir()
+                result = self.cli("report", study, "--csv", "tables")
+                if result.returncode != 0:
+                    self.assert_error(result, 1, record.name)
+                    continue
+                for table in ("trials.csv", "strokes.csv"):
+                    with open(self.cwd / "tables" / table, newline="", encoding="utf-8") as f:
+                        for row in csv.DictReader(f):
+                            self.assertNotIn(value, row.values(), (table, row))
+
     def test_trace_swapped_between_trials(self):
         study, (a, b) = self.study()
         traces = sorted((a / "trials").glob("*.trace.h5"))
