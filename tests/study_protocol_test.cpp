@@ -637,6 +637,14 @@ TEST_CASE("a protocol of phases that makes no sense is refused, naming the phase
   check_error(R"({"name": "b", "conditions": [{"name": "A", "mode": "vision"}],
       "phases": [{"phase": null, "condition": "A", "characters": ["十"]}]})",
               "/phases/0/phase", "(StudyPhase), got null");
+  // Nor is it for a condition's optional keys and a quiz's.
+  check_error(
+      R"({"name": "b", "conditions": [{"name": "A", "mode": "haptic", "guidance_stiffness_n_per_m": null}],
+      "phases": [{"phase": "test", "condition": "A", "characters": ["十"]}]})",
+      "/conditions/0/guidance_stiffness_n_per_m", "null");
+  check_error(R"({"name": "b", "conditions": [{"name": "A", "mode": "quiz", "quiz": {"acceptance": null}}],
+      "phases": [{"phase": "test", "condition": "A", "characters": ["十"]}]})",
+              "/conditions/0/quiz/acceptance", "null");
 }
 
 TEST_CASE("a transfer set: untrained characters made of trained typical strokes, most coverage first",

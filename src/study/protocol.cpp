@@ -91,6 +91,19 @@ StrokeAcceptance read_acceptance(const json& value, const std::string& pointer, 
   return a;
 }
 
+// A condition's and a quiz's keys are optional, but a key given as null is refused naming it
+// (docs/experiments.md, "Protocol files"): null is no value, and leaving the key out is how its default is
+// asked for.
+void refuse_null_members(const json& value, const std::string& pointer, const std::string& source) {
+  if (!value.is_object()) return;  // the reader names the wrong type
+  for (const auto& item : value.items()) {
+    if (item.value().is_null()) {
+      json_detail::fail(source, json_detail::child_pointer(pointer, item.key()),
+                        "null is not a value (leave the key out for its default)");
+    }
+  }
+}
+
 QuizOptions read_quiz(const json& value, const std::string& pointer, const std::string& source) {
   json_detail::ObjectReader reader(value, pointer, source);
   QuizOptions quiz;
@@ -99,6 +112,7 @@ QuizOptions read_quiz(const json& value, const std::string& pointer, const std::
                       "replaced by \"acceptance\": the quiz judges with the stroke matcher's tolerances "
                       "(corridor_m, mean_deviation_m, ...; docs/stroke-acceptance.md)");
   }
+  refuse_null_members(value, pointer, source);
   if (const json* acceptance = reader.optional("acceptance")) {
     quiz.acceptance = read_acceptance(*acceptance, reader.pointer("acceptance"), source);
   }
@@ -193,6 +207,7 @@ StudyCondition read_condition(const json& value, const std::string& pointer, con
   }
   // The mode's condition with the parameters' defaults (SchemaOf<StudyCondition>: condition_from_mode).
   read_member(reader, SchemaOf<StudyCondition>::get(), "mode", &condition, true);
+  refuse_null_members(value, pointer, source);  // after name and mode, which name their own types
   const ConditionMode mode = condition_mode(condition);
   std::optional<double> stiffness_n_per_m;
   if (reader.optional("guidance_stiffness_n_per_m") != nullptr) {

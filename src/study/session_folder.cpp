@@ -627,11 +627,11 @@ void SessionFolder::log(std::string_view event, std::string_view details_json) {
 
 namespace {
 
-// A folder holding a session.json, whatever that is but a folder: a session.json that is a link (or a FIFO)
-// makes a session folder that its reader refuses by name, rather than one left out without a word.
+// A folder holding a session.json, whatever that is: a session.json that is a link, a FIFO or a folder makes
+// a session folder that its reader refuses by name, rather than one left out of the tables without a word.
 bool names_a_session(const fs::path& folder) {
   struct stat status {};
-  return ::lstat(SessionLayout::manifest(folder).c_str(), &status) == 0 && !S_ISDIR(status.st_mode);
+  return ::lstat(SessionLayout::manifest(folder).c_str(), &status) == 0;
 }
 
 }  // namespace
