@@ -359,6 +359,9 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
   // Before any session folder is made, what would otherwise stop the run after some of them:
   // an edited protocol beside sessions of its earlier text (a second series would start beside the first),
   check_protocol_unchanged(command.out, resolved);
+  // a replay's teacher's recording that cannot be read or is not the item's (read again when its trial
+  // comes),
+  check_protocol_teachers(resolved);
   // a session.json larger than its readers take (its size depends on the session and the subject's group
   // only: permutations of one plan are as long),
   std::set<std::pair<int, std::string>> sized;

@@ -143,6 +143,24 @@ GuidanceLaw trial_guidance_law(const ConditionGuidance& condition, const TrialGu
   return law;
 }
 
+namespace {
+
+// A teacher's recording of `characters` in `text` read from `source`, for `condition` (whose teacher is
+// named `teacher_source`): what the replay runs on, or an error naming both.
+TeacherRecording checked_teacher(const std::string& text, const std::string& source,
+                                 const StudyCondition& condition, const std::string& teacher_source,
+                                 const std::u32string& characters) {
+  TeacherRecording teacher = parse_teacher_recording(text, source);
+  try {
+    require_teacher_for(teacher, encode_utf8(characters));
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument("condition '" + condition.name + "', teacher " + teacher_source + ": " + e.what());
+  }
+  return teacher;
+}
+
+}  // namespace
+
 PreparedGuidance replay_guidance(SessionFolder& session, const StudyCondition& condition,
                                  const PlannedTrial& trial, const Scene& scene) {
   PreparedGuidance prepared;
@@ -151,14 +169,7 @@ PreparedGuidance replay_guidance(SessionFolder& session, const StudyCondition& c
   const auto given = condition.teachers.find(trial.characters);
   prepared.teacher_source = given == condition.teachers.end() ? "recorded" : given->second;
   const auto checked = [&](const std::string& text, const std::string& source) {
-    TeacherRecording teacher = parse_teacher_recording(text, source);
-    try {
-      require_teacher_for(teacher, encode_utf8(trial.characters));
-    } catch (const InvalidArgument& e) {
-      throw InvalidArgument("condition '" + condition.name + "', teacher " + prepared.teacher_source + ": " +
-                            e.what());
-    }
-    return teacher;
+    return checked_teacher(text, source, condition, prepared.teacher_source, trial.characters);
   };
   std::error_code error;
   if (!fs::exists(path, error)) {
@@ -249,3 +260,18 @@ ForceLawParameters condition_force_law(const StudyCondition& condition, const Tr
 }
 
 }  // namespace calligraphy::study_detail
+
+namespace calligraphy {
+
+void check_protocol_teachers(const LoadedProtocol& protocol) {
+  for (const StudyCondition& condition : protocol.protocol.conditions) {
+    for (const auto& [characters, given] : condition.teachers) {
+      const std::filesystem::path source = protocol.path.parent_path() / given;
+      const std::string text =
+          study_detail::read_small_file(source, kMaxTeacherRecordingBytes, "teacher's recording");
+      (void)study_detail::checked_teacher(text, source.string(), condition, given, characters);
+    }
+  }
+}
+
+}  // namespace calligraphy

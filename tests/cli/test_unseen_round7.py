@@ -368,12 +368,16 @@ class ProtocolConditionCases(Case):
                 self.assertIn(result.returncode, (1, 2), result.stderr.decode(errors="replace"))
                 self.assertIn(teacher, self.error_line(result, result.returncode))
 
-    @unittest.expectedFailure  # a protocol's teacher files are read when the replay trial comes, after the folder is made
     def test_replay_teacher_that_is_no_recording_makes_no_folder(self):
-        self.replay_protocol("missing.json")
-        result = self.cli("session", "run", "rp.json", "--subjects", "1", "--out", "out")
-        self.assertIn(result.returncode, (1, 2), result.stderr.decode(errors="replace"))
-        self.assertFalse((self.cwd / "out").exists(), "a session folder was made for a protocol refused")
+        os.mkfifo(self.cwd / "fifo-early")
+        shutil.copy(Shared.get() / "r.json", self.cwd / "record-early.json")
+        for teacher in ["missing.json", "fifo-early", "record-early.json", "/dev/zero"]:
+            with self.subTest(teacher=teacher):
+                self.replay_protocol(teacher)
+                result = self.cli("session", "run", "rp.json", "--subjects", "1", "--out", "out")
+                self.assertIn(result.returncode, (1, 2), result.stderr.decode(errors="replace"))
+                self.assertIn(teacher, self.error_line(result, result.returncode))
+                self.assertFalse((self.cwd / "out").exists(), "a session folder was made for a protocol refused")
 
     @unittest.skipIf(cg is None, "the Python package is not built")
     def test_python_cohort_refuses_a_bad_protocol(self):

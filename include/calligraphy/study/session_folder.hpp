@@ -140,6 +140,13 @@ inline constexpr std::uintmax_t kMaxSessionManifestBytes = std::uintmax_t{64} <<
 /// larger than kMaxSessionManifestBytes. A front end checks this before its first session folder is made.
 void check_session_manifest_size(const SessionSetup& setup, const LoadedProtocol& protocol);
 
+/// Reads each teacher's recording a replay condition of `protocol` names (`StudyCondition::teachers`,
+/// relative to the protocol file) as the session runner will read it when its trial comes: a regular file of
+/// at most kMaxTeacherRecordingBytes, a teacher's recording (`parse_teacher_recording`) of its item. Throws
+/// InvalidArgument or DataError naming the condition and the file. A front end checks this before its first
+/// session folder is made, so that a protocol refused there makes none.
+void check_protocol_teachers(const LoadedProtocol& protocol);
+
 /// The free space kept for one trial's files (its compressed trace, SVG and record, and their temporaries):
 /// 64 bytes a servo tick of a trial at its time limit (`max_duration_s` x `rate_hz`; the trace's CSV before
 /// compression takes about that, the compressed trace, SVG and record together far less) plus 1 MiB.
