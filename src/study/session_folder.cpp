@@ -371,6 +371,7 @@ std::optional<std::string> StudyIdentity::read(const fs::path& root) {
     if (errno == ENOENT) return std::nullopt;
     fail_errno(path, "cannot read the study folder's identity", errno);
   }
+  // Opened without following a link below too: a link put in its place after this look is refused there.
   if (!S_ISREG(status.st_mode)) {
     throw DataError(path.string() +
                     ": the study folder's identity is not a regular file (a link or a folder " +
@@ -378,7 +379,7 @@ std::optional<std::string> StudyIdentity::read(const fs::path& root) {
   }
   const std::string source = path.string();
   const nlohmann::json document =
-      json_detail::parse_json(study_detail::read_small_file(path, 4096, "study folder identity"), source);
+      json_detail::parse_json(study_detail::read_session_file(path, 4096, "study folder identity"), source);
   json_detail::ObjectReader reader(document, "", source);
   if (reader.string("format") != "calligraphy-study")
     json_detail::fail(source, "/format", "expected \"calligraphy-study\"");
