@@ -21,6 +21,7 @@
 #include "embedded_scenes.hpp"
 #include "report/metrics_object.hpp"
 #include "report/trial_outcome.hpp"
+#include "written_share_metric.hpp"
 
 using namespace calligraphy;
 
@@ -255,16 +256,7 @@ TEST_CASE("the study tables' metric columns have one place each, at their table'
   // a metric added with a place among the trials columns is one of them, in its place, and a row holds it
   std::vector<MetricInfo> table(metric_table().begin(), metric_table().end());
   const std::size_t before = study_metric_columns(StudyTable::trials, table).size();
-  table.push_back({.name = "written_share",
-                   .doc = "share of the reference strokes written",
-                   .definition = "strokes_written / strokes_total",
-                   .levels = metric_level_scene,
-                   .of_scene =
-                       [](const WritingMetrics& m) {
-                         return MetricValue(static_cast<double>(m.strokes_written) /
-                                            static_cast<double>(m.strokes_total));
-                       },
-                   .trials_column = static_cast<std::uint8_t>(before + 1)});  // after the others
+  table.push_back(testing::written_share_metric(static_cast<std::uint8_t>(before + 1)));  // after the others
   const std::vector<MetricInfo> columns = study_metric_columns(StudyTable::trials, table);
   REQUIRE(columns.size() == before + 1);
   CHECK(columns.back().name == "written_share");

@@ -24,6 +24,7 @@
 #include "study/trial_row.hpp"
 #include "study_test_devices.hpp"
 #include "temp_folder.hpp"
+#include "written_share_metric.hpp"
 
 using namespace calligraphy;
 namespace fs = std::filesystem;
@@ -223,16 +224,7 @@ TEST_CASE("a metric added to the table as a trials column reaches the trials tab
   // metric columns: the share of the reference strokes written, a number of the scene's totals.
   std::vector<MetricInfo> table(metric_table().begin(), metric_table().end());
   const std::vector<MetricInfo> before = study_metric_columns(StudyTable::trials, table);
-  table.push_back({.name = "written_share",
-                   .doc = "share of the reference strokes written",
-                   .definition = "strokes_written / strokes_total",
-                   .levels = metric_level_scene,
-                   .of_scene =
-                       [](const WritingMetrics& m) {
-                         return MetricValue(static_cast<double>(m.strokes_written) /
-                                            static_cast<double>(m.strokes_total));
-                       },
-                   .trials_column = static_cast<std::uint8_t>(before.size() + 1)});
+  table.push_back(testing::written_share_metric(static_cast<std::uint8_t>(before.size() + 1)));
   TempFolder temp;
   const LoadedProtocol protocol = protocol_from_text(
       R"({"name": "added", "conditions": [{"name": "haptic", "mode": "haptic"}],
