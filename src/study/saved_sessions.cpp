@@ -6,6 +6,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/sha256.hpp"
+#include "calligraphy/trial/teacher_recording.hpp"
 #include "core/json_reader.hpp"
 #include "core/whole_file.hpp"
 #include "study/manifest_json.hpp"
@@ -160,7 +161,7 @@ RecordedTrial read_study_recorded_trial(const std::string& path) {
           std::filesystem::path(path).parent_path().parent_path() / (*teacher)["file"].get<std::string>();
       std::error_code error;
       if (std::filesystem::is_regular_file(file, error) &&
-          sha256_hex(read_regular_file(file, study_detail::kMaxRecordBytes)) ==
+          sha256_hex(read_regular_file(file, kMaxTeacherRecordingBytes)) ==
               (*teacher)["sha256"].get<std::string>())
         recorded.spec.teacher = file.string();
     }
