@@ -34,21 +34,11 @@ class Readers(Hostile):
         return sorted(p.parent for p in study.rglob("session.json"))[0]
 
     def unfinished(self):
-        """A copy of the study whose first session has its last trial unsaved (a resume has work to do); the
-        unsaved trial's record is kept beside the study, so a test can plant it back."""
+        """A copy of the study whose first session has its last trial unsaved (a resume has work to do)."""
         study = self.study_copy()
         session = self.session_of(study)
         last = sorted(session.glob("trials/*.json"))[-1]
         last.unlink()
-        return study, session
-
-    def forged(self, edit):
-        study, session = self.unfinished()
-        manifest = session / "session.json"
-        doc = json.loads(manifest.read_text(encoding="utf-8"))
-        text = edit(doc)
-        manifest.write_text(text if isinstance(text, str) else json.dumps(doc, ensure_ascii=False, indent=2),
-                            encoding="utf-8")
         return study, session
 
     def every_reader_refuses(self, study, session, names, resume_status=2):

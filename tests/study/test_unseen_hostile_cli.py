@@ -135,6 +135,17 @@ class Hostile(unittest.TestCase):
     def first_record(self, study):
         return sorted(study.rglob("trials/*.json"))[0]
 
+    def forged(self, edit):
+        """An unfinished session (the subclass's `unfinished()`: a copy of the study with work left) whose
+        session.json is `edit(document)`: a dict edited in place, or a text returned."""
+        study, session = self.unfinished()
+        manifest = session / "session.json"
+        doc = json.loads(manifest.read_text(encoding="utf-8"))
+        text = edit(doc)
+        manifest.write_text(text if isinstance(text, str) else json.dumps(doc, ensure_ascii=False, indent=2),
+                            encoding="utf-8")
+        return study, session
+
     def mount_small_tmpfs(self, size):
         point = self.cwd / "tmpfs"
         point.mkdir()

@@ -34,17 +34,6 @@ class SessionFolders(Hostile):
         sorted(session.glob("trials/*.json"))[-1].unlink()
         return study, session
 
-    def forged(self, edit):
-        """An unfinished session whose session.json is `edit(document)` (a dict edited in place, or a text
-        returned)."""
-        study, session = self.unfinished()
-        manifest = session / "session.json"
-        doc = json.loads(manifest.read_text(encoding="utf-8"))
-        text = edit(doc)
-        manifest.write_text(text if isinstance(text, str) else json.dumps(doc, ensure_ascii=False, indent=2),
-                            encoding="utf-8")
-        return study, session
-
     def resume_refused(self, study, session, status, *names):
         before = digest_tree(study)
         line = self.refused(self.cli("session", "resume", session), status, "session.json", *names)
