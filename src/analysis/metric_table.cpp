@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <nlohmann/json.hpp>
+#include <tuple>
 #include <utility>
+#include <vector>
 
 #include "calligraphy/core/errors.hpp"
 
@@ -385,21 +387,44 @@ std::vector<MetricInfo> study_metric_columns(StudyTable which, std::span<const M
   return out;
 }
 
-MetricValues::MetricValues(StudyTable which, std::span<const MetricInfo> table) {
+namespace {
+
+// The metric columns of study table `which` in `table`: their names and their values before any is set (a
+// number null, a count 0, a flag false).
+std::pair<std::vector<std::string_view>, std::vector<MetricValue>> empty_columns(
+    StudyTable which, std::span<const MetricInfo> table) {
+  std::pair<std::vector<std::string_view>, std::vector<MetricValue>> columns;
   for (const MetricInfo& info : study_metric_columns(which, table)) {
-    names_.push_back(info.name);
+    columns.first.push_back(info.name);
     switch (info.kind) {
       case MetricKind::count:
-        values_.emplace_back(std::int64_t{0});
+        columns.second.emplace_back(std::int64_t{0});
         break;
       case MetricKind::flag:
-        values_.emplace_back(false);
+        columns.second.emplace_back(false);
         break;
       case MetricKind::number:
-        values_.emplace_back(std::monostate{});
+        columns.second.emplace_back(std::monostate{});
         break;
     }
   }
+  return columns;
+}
+
+}  // namespace
+
+MetricValues::MetricValues(StudyTable which, std::span<const MetricInfo> table) {
+  // Every row of a study's tables starts from the library table's columns: found and sorted once, then
+  // copied.
+  if (table.data() == metric_table().data() && table.size() == metric_table().size()) {
+    static const auto trials = empty_columns(StudyTable::trials, metric_table());
+    static const auto strokes = empty_columns(StudyTable::strokes, metric_table());
+    const auto& columns = which == StudyTable::trials ? trials : strokes;
+    names_ = columns.first;
+    values_ = columns.second;
+    return;
+  }
+  std::tie(names_, values_) = empty_columns(which, table);
 }
 
 std::size_t MetricValues::index(std::string_view name) const {
