@@ -4,8 +4,8 @@ the program's own `--help`) on the surfaces the seventh round left: HDF5 traces 
 for `trace` and `score`, CSV traces with columns renamed, reordered, doubled and bytes no text holds, the
 number spellings of `characters`, `model` and `report`, a link planted in a report's table folder, a report
 killed while it writes, the study report's R process replaced by one that answers garbage or by none, a
-Python study stopped by SIGTERM while R runs, Python's `score` given values out of range, and `train`
-without a display. Run by CTest as `cli_unseen_round8_tests`.
+Python study stopped by SIGTERM while R runs, a Python sweep on a process pool stopped by SIGTERM, Python's
+`score` given values out of range, and `train` without a display. Run by CTest as `cli_unseen_round8_tests`.
 
 Each case asserts what the documentation promises: one error line naming the file (and the column, row or
 option) at fault, exit 1 for damaged data and 2 for wrong usage, never a silent wrong result, nothing written
@@ -666,6 +666,73 @@ class PythonCases(unittest.TestCase):
         broken = self.frame.copy()
         broken.loc[5, "t_s"] = float("nan")
         self.raises(cg.InvalidArgument, "sample 5", lambda: cg.score(broken, SHI))
+
+
+SWEEP_SCRIPT = """
+import os
+if __name__ == "__main__":
+    from calligraphy.experiments import sweep
+    print(os.getpid(), flush=True)
+    sweep("永我九心", {"guidance": [True, False]}, seeds=500, workers=2, progress=False)
+"""
+
+
+def descendants(pid):
+    """Every process below `pid`, by the parent ids of /proc."""
+    children = {}
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                fields = Path(f"/proc/{entry}/stat").read_text().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            children.setdefault(int(fields[1]), []).append(int(entry))
+    found, stack = [], [pid]
+    while stack:
+        for child in children.get(stack.pop(), []):
+            found.append(child)
+            stack.append(child)
+    return found
+
+
+def running(pid):
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+@unittest.skipIf(cg is None, "the Python package is not on PYTHONPATH")
+class PythonSignalCases(Case):
+    @heavy
+    def test_sigterm_to_a_sweep_on_a_process_pool_leaves_no_worker(self):
+        if not Path("/proc/self/stat").exists():
+            self.skipTest("no /proc to find the workers by")
+        (self.cwd / "sweep_run.py").write_text(SWEEP_SCRIPT, encoding="utf-8")
+        process = subprocess.Popen([sys.executable, "sweep_run.py"], cwd=self.cwd, stdout=subprocess.PIPE,
+                                   stderr=subprocess.DEVNULL)
+        try:
+            pid = int(process.stdout.readline())
+            deadline = time.monotonic() + 30
+            below = []
+            while len(below) < 3 and time.monotonic() < deadline:  # the forkserver and its two workers
+                time.sleep(0.1)
+                below = descendants(pid)
+            self.assertGreaterEqual(len(below), 3, "the sweep started no workers")
+            process.send_signal(signal.SIGTERM)
+            process.wait(timeout=TIMEOUT_S)
+        finally:
+            process.stdout.close()
+            if process.poll() is None:
+                process.kill()
+                process.wait()
+        deadline = time.monotonic() + 10
+        while any(running(p) for p in below) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        left = [p for p in below if running(p)]
+        for p in left:
+            os.kill(p, signal.SIGKILL)
+        self.assertEqual(left, [], "processes of the sweep outlived it")
 
 
 # ---------------------------------------------------------------------------------------------------------
