@@ -19,6 +19,7 @@ using a 'spawn' or 'forkserver' process pool does: the workers import the main m
 
 from __future__ import annotations
 
+import collections.abc
 import concurrent.futures
 import functools
 import itertools
@@ -236,7 +237,9 @@ def _seed_list(seeds: typing.Any) -> list[int]:
         if seeds < 1 or seeds > MAX_SWEEP_TRIALS:
             raise ValueError(f"seeds: expected a count in 1..{MAX_SWEEP_TRIALS} or a list of seeds, got {seeds}")
         return list(range(seeds))
-    values = list(typing.cast(typing.Iterable[int], seeds))
+    if isinstance(seeds, (str, bytes)) or not isinstance(seeds, collections.abc.Iterable):
+        raise TypeError(f"seeds: expected a count (int) or a list of seeds, got {type(seeds).__name__} {seeds!r}")
+    values = list(seeds)
     if not values:
         raise ValueError("seeds: no seeds")
     for seed in values:
