@@ -49,7 +49,8 @@ except ImportError:  # pragma: no cover - a build without the Python bindings
 
 
 def run(args, cwd, env=None, timeout=TIMEOUT_S):
-    return subprocess.run([CLI, *(a if isinstance(a, bytes) else str(a) for a in args)], cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+    arguments = [a if isinstance(a, bytes) else str(a) for a in args]  # bytes as they are: invalid UTF-8
+    return subprocess.run([CLI, *arguments], cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                           timeout=timeout, env=env)
 
 
@@ -660,6 +661,27 @@ class PythonCases(unittest.TestCase):
         self.raises(TypeError, "guidance", lambda: cg.simulate_trial(SHI, guidance="yes"))
         self.raises(cg.InvalidArgument, "writer", lambda: cg.simulate_trial(SHI, writer="expert"))
         self.raises(cg.InvalidArgument, "characters", lambda: cg.simulate_trial("\ud800"))
+
+    def test_study_cohort_and_sweep_arguments_of_the_wrong_type_name_themselves(self):
+        # docs/python.md: "An argument of the wrong type raises TypeError naming the argument"; the cohort's
+        # errors name subjects, workers or batch_size.
+        import calligraphy.cohort as cg_cohort
+        import calligraphy.study as cg_study
+        from calligraphy.experiments import sweep
+        protocol = Shared.get() / "p.json"
+        for paths in (None, 5, b"study", [None]):
+            with self.subTest(load=paths):
+                self.raises(TypeError, "paths", lambda: cg_study.load(paths))
+        self.raises(ValueError, "paths", lambda: cg_study.load([]))
+        self.raises(TypeError, "protocol", lambda: cg_cohort.simulate(None, 1))
+        self.raises(TypeError, "learning", lambda: cg_cohort.simulate(protocol, 1, learning=None))
+        self.raises(TypeError, "profile", lambda: cg_cohort.simulate(protocol, 1, profile=3))
+        self.raises(ValueError, "batch_size", lambda: cg_cohort.simulate(protocol, 1, batch_size=0))
+        self.raises(ValueError, "subjects", lambda: cg_cohort.simulate(protocol, 0))
+        for seeds in (float("nan"), None, "3"):
+            with self.subTest(seeds=seeds):
+                self.raises(TypeError, "seeds", lambda: sweep(SHI, {}, seeds, progress=False))
+        self.raises(ValueError, "seeds", lambda: sweep(SHI, {}, [-1], progress=False))
 
     def test_a_frame_reversed_or_with_a_nan_time_is_refused(self):
         self.raises(cg.InvalidArgument, "backwards", lambda: cg.score(self.frame.iloc[::-1], SHI))
