@@ -59,6 +59,7 @@ __all__ = [
     "ExclusionPolicy",
     "QUESTION_COLUMNS",
     "StudyDesign",
+    "UnknownReference",
     "apa_sentence",
     "apply_exclusions",
     "design_questions",
@@ -117,6 +118,11 @@ def _phase_order(trials: pandas.DataFrame) -> list[str]:
     return _first_appearance(trials, "phase")
 
 
+class UnknownReference(ValueError):
+    """The ``reference`` asked for is no condition (group) of the study: the caller's wrong usage, which
+    ``python3 -m calligraphy.study_report --reference`` answers with exit status 2, not a data error."""
+
+
 def _condition_order(trials: pandas.DataFrame, column: str, reference: typing.Optional[str]) -> list[str]:
     """The levels of ``column`` with the control first: ``reference`` when given, else the one condition in an
     unguided mode ('vision'), else the first in protocol order."""
@@ -131,7 +137,7 @@ def _condition_order(trials: pandas.DataFrame, column: str, reference: typing.Op
     if reference is None:
         return levels
     if reference not in levels:
-        raise ValueError(f"study_design: reference {reference!r} is not a {column} of the study; present: "
+        raise UnknownReference(f"study_design: reference {reference!r} is not a {column} of the study; present: "
                          f"{', '.join(repr(level) for level in levels)}")
     return [reference] + [level for level in levels if level != reference]
 

@@ -333,11 +333,20 @@ def _check_r() -> str:
         raise RUnavailable("Rscript is not installed (Debian: apt-get install r-base-core r-cran-lme4 "
                            "r-cran-lmertest r-cran-pbkrtest)")
     if not _R_CHECKED:
-        probe = subprocess.run(
-            [rscript, "--vanilla", "-e",
-             "for (p in c('lme4','lmerTest','pbkrtest')) if (!requireNamespace(p, quietly=TRUE)) "
-             "{cat(p); quit(status=3)}"],
-            capture_output=True, text=True, timeout=120)
+        # Kept with this process as the serving R is: a Python stopped by a signal while R loads its packages
+        # (a second or more) leaves no R behind.
+        try:
+            probe = subprocess.run(
+                [rscript, "--vanilla", "-e",
+                 "for (p in c('lme4','lmerTest','pbkrtest')) if (!requireNamespace(p, quietly=TRUE)) "
+                 "{cat(p); quit(status=3)}"],
+                capture_output=True, text=True, timeout=120,
+                preexec_fn=_keep_with_parent if os.name == "posix" else None)
+        except subprocess.TimeoutExpired as error:
+            raise RUnavailable(f"Rscript did not answer within {error.timeout:g} s when asked for lme4, "
+                               "lmerTest and pbkrtest") from None
+        except OSError as error:
+            raise RUnavailable(f"Rscript could not be run: {error}") from None
         if probe.returncode != 0:
             missing = probe.stdout.strip() or "lme4/lmerTest/pbkrtest"
             raise RUnavailable(f"R's package {missing} is not installed (Debian: apt-get install "

@@ -14,6 +14,7 @@ tables"). Tidy data: Wickham 2014, J Stat Softw 59(10).
 
 from __future__ import annotations
 
+import collections.abc
 import dataclasses
 import io
 import os
@@ -222,6 +223,26 @@ class Study:
             yield label, self.samples(row)
 
 
+def _folder_paths(paths: typing.Any, caller: str) -> list[str]:
+    """`paths` as a list of folder names: one path (str or path-like) or an iterable of them; a TypeError
+    naming `paths` for anything else (None, a number, bytes), a ValueError for none or an empty one."""
+    if isinstance(paths, (str, os.PathLike)):
+        roots = [paths]
+    elif not isinstance(paths, (bytes, bytearray)) and isinstance(paths, collections.abc.Iterable):
+        roots = list(paths)
+    else:
+        raise TypeError(f"{caller}: paths: expected a folder's path or a list of them, got "
+                        f"{type(paths).__name__} {paths!r}")
+    for root in roots:
+        if not isinstance(root, (str, os.PathLike)):
+            raise TypeError(f"{caller}: paths: expected a folder's path (str or path-like), got "
+                            f"{type(root).__name__} {root!r}")
+    names = [os.fspath(root) for root in roots]
+    if not names or any(not isinstance(name, str) or not name for name in names):
+        raise ValueError(f"{caller}: paths must name session or study folders, got {paths!r}")
+    return names
+
+
 def load(paths: typing.Union[PathLike, typing.Sequence[PathLike]]) -> Study:
     """Reads the saved trials of the session folders under `paths` (a session folder, a study folder made by
     ``calligraphy session run --out``, or a list of either) into a `Study` of tidy DataFrames. Only the
@@ -231,11 +252,11 @@ def load(paths: typing.Union[PathLike, typing.Sequence[PathLike]]) -> Study:
     JSON pointer) for a path without a session folder or a damaged record, and naming the subject and both
     folders for a subject's session of one number found twice (a session run twice: its trials are not
     pooled), naming session.json and /study_id for a session of another study (copied in from another study
-    folder: its study_id is not the folder's, docs/experiments.md "Phases"), ValueError for no path or an empty one, ImportError without pandas."""
-    roots = [paths] if isinstance(paths, (str, os.PathLike)) else list(paths)
-    if not roots or any(not os.fspath(root) for root in roots):
-        raise ValueError(f"load: paths must name session or study folders, got {paths!r}")
-    trials_text, strokes_text = _native._study_tables_csv([os.fspath(root) for root in roots])
+    folder: its study_id is not the folder's, docs/experiments.md "Phases"), ValueError for no path or an empty one,
+    TypeError naming `paths` for anything but a path (str or path-like) or an iterable of them, ImportError without
+    pandas."""
+    roots = _folder_paths(paths, "load")
+    trials_text, strokes_text = _native._study_tables_csv(roots)
     trials = _read_table(trials_text, _NUMERIC_TRIAL_COLUMNS, _BOOLEAN_TRIAL_COLUMNS)
     strokes = _read_table(strokes_text, _NUMERIC_STROKE_COLUMNS, _BOOLEAN_STROKE_COLUMNS)
     if not trials.empty:
@@ -258,5 +279,5 @@ def propose_characters(paths: typing.Union[PathLike, typing.Sequence[PathLike]],
     trials, CharacterNotFound for a candidate the library lacks, DataError for a damaged record."""
     if library is None:
         library = _native.CharacterLibrary.default()
-    roots = [paths] if isinstance(paths, (str, os.PathLike)) else list(paths)
-    return _native._propose_characters([os.fspath(root) for root in roots], subject, candidates, count, library)
+    return _native._propose_characters(_folder_paths(paths, "propose_characters"), subject, candidates, count,
+                                       library)

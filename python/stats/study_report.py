@@ -1171,6 +1171,7 @@ def main(argv: typing.Optional[typing.Sequence[str]] = None) -> int:
         parser.error(f"argument --out: {arguments.out} exists and is not a folder")
 
     from ._native import DataError
+    from .design_analysis import UnknownReference
 
     started = time.monotonic()
     try:
@@ -1179,6 +1180,9 @@ def main(argv: typing.Optional[typing.Sequence[str]] = None) -> int:
                              reference=arguments.reference, keep_end_reasons=keep, ddf=arguments.ddf)
     except OutputOnInput as error:  # wrong usage, as the command line's exit 2
         print(f"calligraphy.study_report: error: {error}", file=sys.stderr)
+        return 2
+    except UnknownReference as error:  # wrong usage: --reference names no condition (group)
+        print(f"calligraphy.study_report: error: argument --reference: {error}", file=sys.stderr)
         return 2
     except (DataError, ValueError, TypeError, OSError, ImportError) as error:
         print(f"calligraphy.study_report: {error}", file=sys.stderr)

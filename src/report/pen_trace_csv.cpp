@@ -11,6 +11,7 @@
 
 #include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/printable_text.hpp"
 #include "calligraphy/report/trace_columns.hpp"
 #include "calligraphy/report/trace_hdf5.hpp"
 #include "report/compressed_text.hpp"
@@ -185,8 +186,12 @@ class Reader {
     throw DataError(source_ + ":" + std::to_string(line_number_) + ": " + what);
   }
   [[noreturn]] void fail(std::size_t column, std::string_view value, const std::string& what) const {
-    fail("column " + std::to_string(column + 1) + " (" + std::string(header_[column]) + "), value '" +
-         std::string(value) + "': " + what);
+    // The field as printable text: a NUL byte would otherwise end the message where what() is read as a C
+    // string, and a control character would act on the terminal.
+    std::string message = "column " + std::to_string(column + 1);
+    message.append(" (").append(printable_one_line(header_[column], 200)).append("), value '");
+    message.append(printable_one_line(value, 200)).append("': ").append(what);
+    fail(message);
   }
 
   Columns header(const std::vector<std::string_view>& names) {
@@ -202,7 +207,7 @@ class Reader {
       const std::string_view name = file_name(names[i]);
       for (std::size_t j = 0; j < i; ++j) {
         if (!names[i].empty() && name == file_name(names[j]))
-          fail("column name '" + std::string(names[i]) + "' appears twice");
+          fail("column name '" + printable_one_line(names[i], 200) + "' appears twice");
       }
       if (name == "t") t = i;
       if (name == "x") x = i;

@@ -277,13 +277,15 @@ void check_user_block(std::string_view bytes, const std::string& source) {
   unsigned long crc = 0;
   if (std::sscanf(head.c_str() + kMagic.size(), "version %*d\nbytes %llu\ncrc32 %lx\n", &length, &crc) != 2)
     refuse(source, "damaged header (no bytes and crc32)");
+  // The block must be the one this library writes for the numbers read, before a length is reported: sscanf
+  // reads "bytes -5" as 2^64 - 5 and a number past 2^64 as 2^64 - 1, numbers the file does not say.
+  if (bytes.substr(0, kUserBlockBytes) != user_block(version, static_cast<std::size_t>(length), crc))
+    refuse(source, "damaged header");
   const std::string_view rest = bytes.substr(kUserBlockBytes);
   if (rest.size() != length) {
     refuse(source, std::to_string(rest.size()) + " bytes after its header where it says " +
                        std::to_string(length) + (rest.size() < length ? " (cut short)" : " (bytes added)"));
   }
-  if (bytes.substr(0, kUserBlockBytes) != user_block(version, static_cast<std::size_t>(length), crc))
-    refuse(source, "damaged header");
   if (crc32_of(rest) != crc) refuse(source, "damaged (its CRC-32 does not match its contents)");
 }
 

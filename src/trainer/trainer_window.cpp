@@ -30,8 +30,16 @@ namespace {
 
 constexpr const char* kChineseFont = "/usr/share/fonts/truetype/arphic/ukai.ttc";
 
+// While the window is being opened, GLFW's error is kept for the one error line that says the window could
+// not be opened (docs/cli.md: an error is one line); once it is open, each is a warning line of its own.
+std::string* glfw_start_error = nullptr;
+
 void print_glfw_error(int code, const char* description) {
-  std::fprintf(stderr, "calligraphy train: GLFW error %d: %s\n", code, description);
+  if (glfw_start_error != nullptr) {
+    glfw_start_error->assign("GLFW error ").append(std::to_string(code)).append(": ").append(description);
+    return;
+  }
+  std::fprintf(stderr, "calligraphy train: warning: GLFW error %d: %s\n", code, description);
 }
 
 std::int64_t steady_ns() {
@@ -56,10 +64,23 @@ void record_key(GLFWwindow* /*window*/, int key, int /*scancode*/, int action, i
 }  // namespace
 
 void TrainerApp::open_window() {
+  std::string start_error;
+  struct KeptWhileOpening {
+    explicit KeptWhileOpening(std::string* kept) { glfw_start_error = kept; }
+    ~KeptWhileOpening() { glfw_start_error = nullptr; }
+    KeptWhileOpening(const KeptWhileOpening&) = delete;
+    KeptWhileOpening& operator=(const KeptWhileOpening&) = delete;
+  } keep_errors(&start_error);
   glfwSetErrorCallback(print_glfw_error);
+  const auto said = [&start_error] {
+    std::string text;
+    if (!start_error.empty()) text.append(" (").append(start_error).append(")");
+    return text;
+  };
   if (glfwInit() == GLFW_FALSE) {
-    throw Error("cannot open a window: GLFW could not initialise (no X display? DISPLAY is '" +
-                std::string(std::getenv("DISPLAY") ? std::getenv("DISPLAY") : "") + "'; try xvfb-run)");
+    std::string message = "cannot open a window: GLFW could not initialise (no X display? DISPLAY is '";
+    message.append(std::getenv("DISPLAY") ? std::getenv("DISPLAY") : "").append("'; try xvfb-run)");
+    throw Error(message + said());
   }
   install_x11_error_handler();
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
@@ -70,10 +91,11 @@ void TrainerApp::open_window() {
   std::string title = "calligraphy train";
   for (const TrainerCharacter& c : options_.characters) title += " " + c.utf8;
   window_ = glfwCreateWindow(options_.width_px, options_.height_px, title.c_str(), nullptr, nullptr);
+  glfw_start_error = nullptr;  // open (or not): from here each GLFW error is a warning line
   if (window_ == nullptr) {
     glfwTerminate();
     throw Error("cannot open a window of " + std::to_string(options_.width_px) + "x" +
-                std::to_string(options_.height_px) + " with OpenGL 3.3 core");
+                std::to_string(options_.height_px) + " with OpenGL 3.3 core" + said());
   }
   glfwMakeContextCurrent(window_);
   glfwSwapInterval(1);

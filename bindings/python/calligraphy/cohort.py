@@ -82,6 +82,15 @@ def simulate(protocol: PathLike, subjects: int, *, profile: str = "novice", lear
     if not isinstance(individual_differences, bool):
         raise TypeError(f"individual_differences: expected a bool, got {individual_differences!r}")
     subject_list = _subject_list(subjects, prefix)
+    if not isinstance(protocol, (str, os.PathLike)):
+        raise TypeError(f"protocol: expected a protocol file's path (str or path-like), got "
+                        f"{type(protocol).__name__} {protocol!r}")
+    for name, value in (("profile", profile), ("learning", learning)):
+        if not isinstance(value, str):
+            raise TypeError(f"{name}: expected a str, got {type(value).__name__} {value!r}")
+    # Checked whoever runs the subjects, so that a value is refused the same with and without a client.
+    if batch_size is not None and (isinstance(batch_size, bool) or not isinstance(batch_size, int) or batch_size < 1):
+        raise ValueError(f"batch_size: expected an int >= 1, got {batch_size!r}")
     path = os.path.abspath(os.fspath(protocol))
     source = _source(store, data)
     if client is None:

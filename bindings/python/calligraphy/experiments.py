@@ -19,6 +19,7 @@ using a 'spawn' or 'forkserver' process pool does: the workers import the main m
 
 from __future__ import annotations
 
+import collections.abc
 import concurrent.futures
 import functools
 import itertools
@@ -236,7 +237,9 @@ def _seed_list(seeds: typing.Any) -> list[int]:
         if seeds < 1 or seeds > MAX_SWEEP_TRIALS:
             raise ValueError(f"seeds: expected a count in 1..{MAX_SWEEP_TRIALS} or a list of seeds, got {seeds}")
         return list(range(seeds))
-    values = list(typing.cast(typing.Iterable[int], seeds))
+    if isinstance(seeds, (str, bytes)) or not isinstance(seeds, collections.abc.Iterable):
+        raise TypeError(f"seeds: expected a count (int) or a list of seeds, got {type(seeds).__name__} {seeds!r}")
+    values = list(seeds)
     if not values:
         raise ValueError("seeds: no seeds")
     for seed in values:
@@ -252,11 +255,42 @@ def _local_workers() -> int:
         return os.cpu_count() or 1
 
 
+def _end_with(sweeper_pid: int) -> None:  # pragma: no cover - runs in each worker as it starts
+    """Ends this worker once the process that runs the sweep is gone (stopped by SIGTERM, killed), so that
+    no worker outlives it: a worker's parent is the forkserver, which lives as long as any worker does, and a
+    worker holds both ends of its own queues, so neither a parent-death signal nor an end of file tells it.
+    A thread waits on the sweeping process's pidfd (Linux 5.3), else looks for it once a second."""
+    import select
+    import threading
+    import time
+
+    def watch() -> None:
+        try:
+            descriptor: typing.Optional[int] = os.pidfd_open(sweeper_pid)
+        except (AttributeError, OSError):  # not Linux, an older kernel, or already gone
+            descriptor = None
+        if descriptor is not None:
+            select.select([descriptor], [], [])
+        else:
+            while True:
+                try:
+                    os.kill(sweeper_pid, 0)
+                except ProcessLookupError:
+                    break
+                except PermissionError:
+                    pass
+                time.sleep(1.0)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="calligraphy-sweep-watch", daemon=True).start()
+
+
 def _process_pool(workers: int) -> concurrent.futures.ProcessPoolExecutor:
     # Not 'fork': the parent may hold threads (Dask, a servo loop, BLAS) that a fork would copy mid-state.
     method = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
     return concurrent.futures.ProcessPoolExecutor(max_workers=workers,
-                                                  mp_context=multiprocessing.get_context(method))
+                                                  mp_context=multiprocessing.get_context(method),
+                                                  initializer=_end_with, initargs=(os.getpid(),))
 
 
 def _progress_bar(total: int, enabled: bool, unit: str = "trial", desc: str = "sweep") -> typing.Any:
