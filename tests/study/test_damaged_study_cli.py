@@ -38,7 +38,7 @@ print(f"study_damaged_cli: {SAMPLE or 'all'} damaged copies per file, seed {SEED
       f"(CALLIGRAPHY_DAMAGE_SAMPLE, CALLIGRAPHY_TEST_SEED)", flush=True)
 # The cohort that is killed: 8 subjects, 4 under the sanitizers (ten times slower there; the property is
 # about the moment of the kill, not the cohort's size).
-COHORT = "4" if os.environ.get("CALLIGRAPHY_SANITIZED") else "8"
+COHORT = "8"
 WRONG_VALUES = ["5", "\"x\"", "[]", "{}", "true", "null", "[1e999]", "1e999", "-1e999", "1e400"]
 
 
@@ -279,6 +279,8 @@ class DamagedStudyTest(unittest.TestCase):
         self.assertEqual(before, {name: digest(self.cwd / name) for name in before})
         self.assertEqual([p.name for p in self.cwd.glob(".*tmp*")], [])
 
+    @unittest.skipIf(os.environ.get("CALLIGRAPHY_SANITIZED"), "kills at moments of a run: the Release run's "
+                     "(what a sanitizer looks for shows in the cohort runs the other cases make)")
     def test_a_cohort_killed_at_any_moment_leaves_one_whole_pair_of_tables(self):
         first = self.run_cli("session", "cohort", "p.json", "--subjects", "1", "--csv", ".")
         self.assertEqual(first.returncode, 0, first.stderr.decode())
@@ -288,9 +290,7 @@ class DamagedStudyTest(unittest.TestCase):
         self.assertEqual(whole.returncode, 0, whole.stderr.decode())
         pairs.append({name: (self.cwd / "whole" / name).read_bytes() for name in ("trials.csv", "strokes.csv")})
         # SIGKILL at moments spread over a run, the last ones about when the tables are written.
-        # Under the sanitizers the moments near the writing only: a run there is ten times longer.
-        moments = (0.5, 0.9, 1.0, 1.05) if os.environ.get("CALLIGRAPHY_SANITIZED") else (
-            0.2, 0.5, 0.8, 0.9, 0.95, 1.0, 1.05)
+        moments = (0.2, 0.5, 0.8, 0.9, 0.95, 1.0, 1.05)
         for fraction in moments:
             run = subprocess.Popen([CLI, "session", "cohort", "p.json", "--subjects", COHORT, "--csv", "."],
                                    cwd=self.cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
