@@ -149,11 +149,11 @@ TEST_CASE("A trial run again from its record gives the same trace, bit for bit",
   force.off_stroke_force_n = 0.35;  // parts a specification alone does not state
   force.friction_coefficient = 0.21;
   force.guidance_stiffness_n_per_m = 333.0;
-  inputs.force_law = force;
   SafetyChainParameters safety;
   safety.max_force_change_n_per_tick = 0.125;
-  inputs.safety = safety;
-  const TrialRun first = run_trial_spec(Checked<TrialSpec>::check(spec), scene, inputs);
+  const TrialRun first = run_whole_trial(build_whole_trial(Checked<TrialSpec>::check(spec), DeviceInfo{},
+                                                           {.force_law = force, .safety = safety}),
+                                         scene, inputs);
   REQUIRE(first.result.trace.size() > 100);
 
   const RecordedTrial recorded =

@@ -325,21 +325,26 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   // A replay's teacher is given as samples (TrialRunInputs::teacher), below.
   const auto checked = calligraphy::Checked<TrialSpec>::check(
       spec, spec.guidance_mode == GuidanceMode::replay ? TeacherSource::samples : TeacherSource::file);
-  std::unique_ptr<SimulatedDevice> simulated_device;
+  // The device first (the registry's by name, or a simulated one of the given physics): the whole trial is
+  // built for it.
+  std::unique_ptr<HapticDevice> trial_device = device_name.empty()
+                                                   ? std::make_unique<SimulatedDevice>(simulation.device)
+                                                   : python_device_registry().create(device_name);
   TrialRunInputs inputs;
-  inputs.registry = &python_device_registry();
+  inputs.device = trial_device.get();
   inputs.host_process = true;  // the interpreter is the application: no memory locking, no SCHED_FIFO
-  if (device_name.empty()) {
-    simulated_device = std::make_unique<SimulatedDevice>(simulation.device);
-    inputs.device = simulated_device.get();
-  }
   SimulatedWriting writing(spec, simulation.writer);
   inputs.hand_maker = &writing;
   if (const auto* replay = std::get_if<ReplayGuidance>(&law)) inputs.teacher = replay->teacher_trajectory;
-  inputs.force_law = options.force;  // the force law as given (no stiffness fitted to the device)
-  inputs.safety = options.safety;
-  inputs.passivity = options.passivity;
-  TrialRun run = run_interruptible(inputs, [&] { return run_trial_spec(checked, scene, inputs); });
+  // The whole trial, through the one builder: the force law as given (no stiffness fitted to the device),
+  // the safety chain and passivity controller as given.
+  const auto whole =
+      build_whole_trial(checked, trial_device->info(),
+                        {.force_law = options.force,
+                         .safety = options.safety,
+                         .passivity = options.passivity,
+                         .simulated_device = device ? std::optional(simulation.device) : std::nullopt});
+  TrialRun run = run_interruptible(inputs, [&] { return run_whole_trial(whole, scene, inputs); });
   TrialResult& result = run.result;
   TrialDescription description;
   description.characters = label;
