@@ -1,15 +1,16 @@
 #pragma once
 /// \file recorded_trial.hpp
-/// A trial as it ran, whole: its specification (trial_spec.hpp) and every part a front-end may give instead
-/// of the defaults: the force law (every field, the active guidance law with its values, the stroke
+/// A trial as it ran: its whole trial (whole_trial.hpp: the specification and every part a front-end may
+/// give its builder: the force law (every field, the active guidance law with its values, the stroke
 /// acceptance and the nearest-point search), the safety chain, the passivity controller, the simulated
-/// writer's profile after every parameter (its traits and what it had learned folded in), with the scene's
-/// layout and a SHA-256 of the characters placed. Every trial record (`calligraphy trial --json`, study
-/// sessions and cohorts) holds one as its "specification" object (format: docs/cli.md, "Re-running a trial");
-/// `calligraphy trial --spec RECORD` and `rerun_trial` run it again, and on the simulated device the trace is
-/// the same bit for bit. It is part of the trial layer, so an application that links only
-/// `calligraphy::haptics` reads a record and runs it again; a record the simulated writer wrote is re-run
-/// with sim's `recorded_writing` as the hand maker (calligraphy/sim/simulated_writing.hpp).
+/// writer's profile after every parameter (its traits and what it had learned folded in)), with its
+/// provenance: the scene's layout, a SHA-256 of the characters placed, the library version. Every trial
+/// record (`calligraphy trial --json`, study sessions and cohorts) holds one as its "specification" object
+/// (format: docs/cli.md, "Re-running a trial"); `calligraphy trial --spec RECORD` and `rerun_trial` run it
+/// again, and on the simulated device the trace is the same bit for bit. It is part of the trial layer, so an
+/// application that links only `calligraphy::haptics` reads a record and runs it again; a record the
+/// simulated writer wrote is re-run with sim's `recorded_writing` as the hand maker
+/// (calligraphy/sim/simulated_writing.hpp).
 #include <cstdint>
 #include <filesystem>
 #include <optional>
