@@ -295,10 +295,11 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
                                       options.max_duration_s, options.rate_hz));
   }
 
-  // The trial specification of these arguments, run by its one runner (trial_spec_runner.hpp), as
-  // `calligraphy trial` runs its options. What a specification does not state (a WriterProfile object, the
-  // simulated device's parameters, force-law, safety and passivity tuning, a teacher given as samples) goes
-  // in as the runner's inputs.
+  // The trial specification of these arguments, made a whole trial by its one builder and run by its one
+  // runner (whole_trial.hpp, trial_spec_runner.hpp), as `calligraphy trial` runs its options. What a
+  // specification does not state goes to the builder as parts of the whole trial (force-law, safety and
+  // passivity tuning, the simulated device's parameters), or to the runner as its runtime inputs (the
+  // device, a WriterProfile object in the hand maker, a teacher given as samples).
   TrialSpec spec;
   spec.characters = label;
   spec.device = device_name.empty() ? std::string("simulated") : device_name;
