@@ -161,13 +161,10 @@ TrialOptions study_trial_options(const SessionManifest& session, const StudyCond
                                  const PlannedTrial& trial, const TrialGuidance& guidance) {
   const auto spec = Checked<TrialSpec>::check(study_trial_spec(session, condition, trial, guidance),
                                               study_teacher_source(condition));
-  // The trial's whole trial, as its session makes it (on a device stating no limits).
-  TrialOptions options =
-      *whole_trial_options(study_detail::study_whole_trial(condition, guidance, spec, DeviceInfo{}));
-  // A replay's teacher is its runner's input: the options it runs with hold it, checked with them.
-  if (auto* replay = std::get_if<ReplayGuidance>(&options.force.guidance_law))
-    replay->teacher_trajectory = guidance.teacher;
-  return *Checked<TrialOptions>::check(std::move(options));
+  // The trial's whole trial, as its session makes it (on a device stating no limits), with a replay's
+  // teacher, its runner's input, checked with the options holding it.
+  return *whole_trial_options(study_detail::study_whole_trial(condition, guidance, spec, DeviceInfo{}),
+                              guidance.teacher);
 }
 
 namespace {

@@ -47,11 +47,19 @@ void require_teacher(const TrialSpec& spec, const TrialRunInputs& inputs) {
 }  // namespace
 
 TrialOptions trial_options(const Checked<TrialSpec>& spec, const DeviceInfo& device) {
-  return *whole_trial_options(build_whole_trial(spec, device));
+  // Unchecked: a replay's options have no teacher yet.
+  return options_of(*build_whole_trial(spec, device));
 }
 
-Checked<TrialOptions> whole_trial_options(const Checked<WholeTrial>& trial) {
-  return trial.derive([](const WholeTrial& whole) { return options_of(whole); });
+Checked<TrialOptions> whole_trial_options(const Checked<WholeTrial>& trial,
+                                          const std::vector<TeacherSample>& teacher) {
+  const TrialSpec& spec = trial->spec;
+  if (!(spec.guidance && spec.guidance_mode == GuidanceMode::replay))
+    return trial.derive([](const WholeTrial& whole) { return options_of(whole); });
+  // A replay's teacher is a new value: the options holding it are checked once.
+  TrialOptions replay = options_of(*trial);
+  if (auto* law = std::get_if<ReplayGuidance>(&replay.force.guidance_law)) law->teacher_trajectory = teacher;
+  return Checked<TrialOptions>::check(std::move(replay));
 }
 
 bool simulated_writer_writes(const TrialSpec& spec, bool simulated_writer_can_move) {
@@ -106,13 +114,7 @@ TrialRun run_whole_trial(const Checked<WholeTrial>& checked, const Scene& scene,
 
   // The whole trial was checked once, by its builder: its options are derived, unchecked. A replay's
   // teacher is a runtime input, a new value: the options holding it are checked here once.
-  Checked<TrialOptions> options = whole_trial_options(checked);
-  if (spec.guidance && spec.guidance_mode == GuidanceMode::replay) {
-    TrialOptions replay = *options;
-    if (auto* law = std::get_if<ReplayGuidance>(&replay.force.guidance_law))
-      law->teacher_trajectory = inputs.teacher;
-    options = Checked<TrialOptions>::check(std::move(replay));
-  }
+  Checked<TrialOptions> options = whole_trial_options(checked, inputs.teacher);
   // Where the trial runs from (a stop flag, a display, the process's real-time settings): no parameter of
   // the force, and nothing TrialOptions::validate refuses (the priority is the loop's valid constant).
   options = options.derive([&](TrialOptions running) {

@@ -77,10 +77,13 @@ struct TrialRun {
 [[nodiscard]] TrialOptions trial_options(const Checked<TrialSpec>& spec, const DeviceInfo& device);
 
 /// The runner's options of the checked whole trial `trial`: its force law, safety chain and passivity
-/// controller, and the rate, pacing, real-time settings, watchdog and duration of its specification; valid
-/// as they are (derived, unchecked; tests/trial_spec_test.cpp walks that promise), but for a replay, whose
-/// teacher (a runtime input) the runner adds and checks with them.
-[[nodiscard]] Checked<TrialOptions> whole_trial_options(const Checked<WholeTrial>& trial);
+/// controller, and the rate, pacing, real-time settings, watchdog and duration of its specification. Derived,
+/// unchecked (valid by construction; tests/trial_spec_test.cpp walks that promise), but for a replay: its
+/// teacher `teacher` (a runtime input, TrialRunInputs::teacher; pen in the device frame [m], times [s]) joins
+/// the force law's replay law and the options holding it are checked (InvalidArgument naming the teacher's
+/// fault, e.g. fewer than two samples). `teacher` is not read for another mode.
+[[nodiscard]] Checked<TrialOptions> whole_trial_options(const Checked<WholeTrial>& trial,
+                                                        const std::vector<TeacherSample>& teacher = {});
 
 /// Who writes `spec` on a device: `TrialWriter::simulated` or `person` as stated, else the simulated writer
 /// when `simulated_writer_can_move` (the device has a hand port), a person otherwise. Throws
