@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <string>
@@ -16,6 +17,8 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/parameter_table.hpp"
+#include "calligraphy/devices/device_registry.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/sim/simulated_writing.hpp"
 #include "study_test_devices.hpp"
@@ -149,11 +152,11 @@ TEST_CASE("A trial run again from its record gives the same trace, bit for bit",
   force.off_stroke_force_n = 0.35;  // parts a specification alone does not state
   force.friction_coefficient = 0.21;
   force.guidance_stiffness_n_per_m = 333.0;
-  inputs.force_law = force;
   SafetyChainParameters safety;
   safety.max_force_change_n_per_tick = 0.125;
-  inputs.safety = safety;
-  const TrialRun first = run_trial_spec(Checked<TrialSpec>::check(spec), scene, inputs);
+  const TrialRun first = run_whole_trial(build_whole_trial(Checked<TrialSpec>::check(spec), DeviceInfo{},
+                                                           {.force_law = force, .safety = safety}),
+                                         scene, inputs);
   REQUIRE(first.result.trace.size() > 100);
 
   const RecordedTrial recorded =
@@ -184,6 +187,46 @@ TEST_CASE("A trial run again from its record gives the same trace, bit for bit",
   for (std::size_t i = 0; same && i < first.result.trace.size(); ++i)
     same = plain.result.trace[i].force_n == first.result.trace[i].force_n;
   CHECK_FALSE(same);
+}
+
+TEST_CASE("A record with a part out of range is refused by the builder, naming it, before a device is made",
+          "[recorded_trial]") {
+  TrialSpec spec;
+  spec.characters = "十";
+  spec.seed = 5;
+  spec.max_duration_s = 0.05;
+  const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'十')});
+  SimulatedWriting writing(spec);
+  const TrialRun ran =
+      run_trial_spec(Checked<TrialSpec>::check(spec), scene, study_test::trial_inputs(&writing));
+  RecordedTrial recorded = recorded_trial(spec, ran, writing, scene);
+  // A registry whose simulated device counts how often it is made.
+  int made = 0;
+  DeviceRegistry registry;
+  registry.register_device(
+      "simulated", SimulatedDevice().info(),
+      [&made] {
+        ++made;
+        return std::make_unique<SimulatedDevice>();
+      },
+      DeviceCapabilities{.moved_by_simulated_hand = true});
+  SimulatedWriting again = recorded_writing(recorded);
+  TrialRunInputs inputs;
+  inputs.registry = &registry;
+  inputs.hand_maker = &again;
+  const auto checked = Checked<TrialSpec>::check(recorded.spec);
+  recorded.safety.max_force_change_n_per_tick = -1.0;
+  CHECK_THROWS_WITH((void)rerun_trial(recorded, checked, scene, inputs), Catch::StartsWith("safety: "));
+  recorded.safety = ran.options.safety;
+  recorded.force_law.guidance_law = FadingGuidance{.gain = 0.5};
+  CHECK_THROWS_WITH((void)rerun_trial(recorded, checked, scene, inputs),
+                    Catch::StartsWith("force_law: its guidance (fading) is not the specification's (fixed)"));
+  CHECK(made == 0);
+  // In range again, the record runs, on the one device made for it.
+  recorded.force_law = ran.options.force;
+  const TrialRun rerun = rerun_trial(recorded, checked, scene, inputs);
+  CHECK(made == 1);
+  CHECK(rerun.result.trace.size() == ran.result.trace.size());
 }
 
 TEST_CASE("A record run on other characters is refused", "[recorded_trial]") {

@@ -23,8 +23,11 @@
 #include "calligraphy/study/session_runner.hpp"
 #include "calligraphy/study/session_series.hpp"
 #include "calligraphy/study/study_tables.hpp"
+#include "calligraphy/trial/recorded_trial.hpp"
+#include "calligraphy/trial/whole_trial.hpp"
 #include "calligraphy/trial/writer_profile.hpp"
 #include "probe_device.hpp"
+#include "study/trial_guidance.hpp"
 #include "study_test_devices.hpp"
 #include "temp_folder.hpp"
 
@@ -818,4 +821,43 @@ TEST_CASE("a learning subject's guidance takes shape and timing apart: the fixtu
   // The teacher's point at the teacher's time paces the writer and demonstrates the timing: more timing
   // learned than from vision (the direction of Feygin, Keehner & Tendick 2002).
   CHECK(replay_timing > alone_timing);
+}
+
+TEST_CASE("a condition's force law reaches the trial record through the one builder of a study trial",
+          "[study][session][whole_trial]") {
+  TempFolder temp;
+  // A guidance stiffness the specification does not state, and a quiz's acceptance: the condition's parts.
+  const LoadedProtocol protocol = protocol_from_text(
+      R"({"name": "parts", "conditions": [{"name": "vision", "mode": "vision"},
+            {"name": "stiff", "mode": "haptic", "guidance_stiffness_n_per_m": 300},
+            {"name": "quiz", "mode": "quiz", "quiz": {"hint_after_misses": 1}}],
+          "test": {"characters": ["十"], "conditions": ["vision", "stiff", "quiz"], "repetitions": 1},
+          "trial": {"max_duration_s": 40}})",
+      "parts.json");
+  SessionFolder session = SessionFolder::create(temp.path / "s", simulated("W1"), protocol);
+  const std::vector<PlannedTrial> plan = session.plan();
+  REQUIRE(plan.size() == 3);
+  REQUIRE(run_session(session, study_test::run_options()).complete());
+  const DeviceInfo figures = study_test::registry().create(session.manifest().setup.device)->info();
+  std::size_t compared = 0;
+  for (const PlannedTrial& trial : plan) {
+    const StudyCondition& condition = protocol.protocol.condition(trial.condition);
+    const auto spec = Checked<TrialSpec>::check(study_trial_spec(session.manifest(), condition, trial),
+                                                study_teacher_source(condition));
+    const Checked<WholeTrial> whole = study_detail::study_whole_trial(condition, {}, spec, figures);
+    const RecordedTrial recorded = read_study_recorded_trial(session.trial_file(trial, "json").string());
+    CHECK(recorded.force_law.guidance_stiffness_n_per_m == whole->force_law.guidance_stiffness_n_per_m);
+    CHECK(recorded.force_law.acceptance == whole->force_law.acceptance);
+    CHECK(recorded.spec.acceptance == whole->spec.acceptance);
+    CHECK(recorded.force_law.guidance == whole->force_law.guidance);
+    CHECK(recorded.force_law.paper_stiffness_n_per_m == whole->force_law.paper_stiffness_n_per_m);
+    if (trial.condition == "stiff") CHECK(recorded.force_law.guidance_stiffness_n_per_m == 300.0);
+    if (trial.condition == "quiz") {
+      // The quiz's acceptance, not the specification's default: the condition's part reached the record.
+      CHECK(recorded.force_law.acceptance.hint_after_misses == 1.0);
+      CHECK(recorded.spec.acceptance.hint_after_misses == 1.0);
+    }
+    ++compared;
+  }
+  CHECK(compared == plan.size());
 }

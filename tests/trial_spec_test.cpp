@@ -16,6 +16,7 @@
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/sim/simulated_writing.hpp"
 #include "calligraphy/trial/trial_spec_runner.hpp"
+#include "calligraphy/trial/whole_trial.hpp"
 #include "study_test_devices.hpp"
 
 using namespace calligraphy;
@@ -323,7 +324,25 @@ TEST_CASE("the runner of a specification gives the simulated writer to the trial
              Catch::Contains("no device and no registry to create \"simulated\""));
 }
 
-TEST_CASE("the runner takes a force law made before the trial, whose guidance must be the specification's") {
+namespace {
+
+// Whether `T` has a member `force_law`, `safety` or `passivity`: a part of the trial given beside it.
+template <typename T>
+concept gives_trial_parts = requires(const T& t) {
+  t.force_law;
+}
+|| requires(const T& t) { t.safety; }
+|| requires(const T& t) { t.passivity; };
+
+}  // namespace
+
+TEST_CASE("the runner runs the whole trial its one builder made, with a force law made before the trial") {
+  // The runtime handles carry no part of the trial: nothing beside the checked whole trial replaces one.
+  static_assert(!gives_trial_parts<TrialRunInputs>);
+  static_assert(gives_trial_parts<WholeTrialParts>);  // the concept sees them where they are
+  static_assert(!std::is_constructible_v<Checked<WholeTrial>, WholeTrial>);
+  static_assert(
+      !std::is_invocable_v<decltype(&run_whole_trial), WholeTrial, const Scene&, const TrialRunInputs&>);
   TrialSpec spec;
   spec.characters = "十";
   spec.seed = 4;
@@ -333,14 +352,55 @@ TEST_CASE("the runner takes a force law made before the trial, whose guidance mu
   TrialRunInputs inputs = study_test::trial_inputs(&writing);
   ForceLawParameters force;
   force.guidance_stiffness_n_per_m = 250.0;
-  inputs.force_law = force;
+  force.acceptance.hint_after_misses = 2.0;
   inputs.lock_memory = false;
-  const TrialRun run = run_trial_spec(Checked<TrialSpec>::check(spec), scene, inputs);
+  const auto checked = Checked<TrialSpec>::check(spec);
+  const Checked<WholeTrial> whole = build_whole_trial(checked, DeviceInfo{}, {.force_law = force});
+  // The given force law's acceptance is the trial's: the specification states it.
+  CHECK(whole->spec.acceptance == force.acceptance);
+  CHECK_FALSE(spec.acceptance == force.acceptance);
+  const TrialRun run = run_whole_trial(whole, scene, inputs);
   CHECK(run.options.force.guidance_stiffness_n_per_m == 250.0);
+  CHECK(run.options.force.acceptance == force.acceptance);
   CHECK_FALSE(run.options.loop.lock_memory);
-  inputs.force_law->guidance_law = FadingGuidance{.gain = 0.5};
-  CHECK_THAT(error_of([&] { (void)run_trial_spec(Checked<TrialSpec>::check(spec), scene, inputs); }),
-             Catch::Contains("the force law's guidance (fading) is not the specification's (fixed)"));
+  force.guidance_law = FadingGuidance{.gain = 0.5};
+  CHECK_THAT(error_of([&] { (void)build_whole_trial(checked, DeviceInfo{}, {.force_law = force}); }),
+             Catch::Contains("force_law: its guidance (fading) is not the specification's (fixed)"));
+}
+
+TEST_CASE("the one builder refuses a part out of range naming the part, before any device exists") {
+  TrialSpec spec;
+  spec.characters = "十";
+  spec.writer = TrialWriter::person;
+  spec.device = "emulated-phantom";
+  const auto checked = Checked<TrialSpec>::check(spec);
+  const DeviceInfo figures;  // the builder is given figures only: it can open no device
+  ForceLawParameters force;
+  force.guidance_stiffness_n_per_m = -1.0;
+  CHECK_THAT(error_of([&] { (void)build_whole_trial(checked, figures, {.force_law = force}); }),
+             Catch::StartsWith("force_law: "));
+  SafetyChainParameters safety;
+  safety.max_force_change_n_per_tick = -0.5;
+  CHECK_THAT(error_of([&] { (void)build_whole_trial(checked, figures, {.safety = safety}); }),
+             Catch::StartsWith("safety: "));
+  PassivityParameters passivity;
+  passivity.enabled = true;
+  passivity.max_damping_n_s_per_m = -2.0;
+  CHECK_THAT(error_of([&] { (void)build_whole_trial(checked, figures, {.passivity = passivity}); }),
+             Catch::StartsWith("passivity: "));
+  CHECK_THAT(error_of([&] { (void)build_whole_trial(checked, figures, {.writer = WriterProfile{}}); }),
+             Catch::StartsWith("writer: ") && Catch::Contains("a person writes"));
+  CHECK_THAT(error_of([&] {
+               (void)build_whole_trial(checked, figures, {.simulated_device = SimulatedDeviceParameters{}});
+             }),
+             Catch::StartsWith("simulated_device: ") && Catch::Contains("emulated-phantom"));
+  // The same parts in range make a whole trial; the stated force law's default stiffnesses are fitted to
+  // the figures given (the Phantom Omni's 700 N/m against the paper's 800 N/m).
+  DeviceInfo omni;
+  omni.max_stiffness_n_per_m = 700.0;
+  const Checked<WholeTrial> whole = build_whole_trial(checked, omni, {.safety = SafetyChainParameters{}});
+  CHECK(whole->force_law.paper_stiffness_n_per_m == 700.0);
+  CHECK(whole->force_law.paper_stiffness_n_per_m < ForceLawParameters{}.paper_stiffness_n_per_m);
 }
 
 namespace {

@@ -295,10 +295,11 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
                                       options.max_duration_s, options.rate_hz));
   }
 
-  // The trial specification of these arguments, run by its one runner (trial_spec_runner.hpp), as
-  // `calligraphy trial` runs its options. What a specification does not state (a WriterProfile object, the
-  // simulated device's parameters, force-law, safety and passivity tuning, a teacher given as samples) goes
-  // in as the runner's inputs.
+  // The trial specification of these arguments, made a whole trial by its one builder and run by its one
+  // runner (whole_trial.hpp, trial_spec_runner.hpp), as `calligraphy trial` runs its options. What a
+  // specification does not state goes to the builder as parts of the whole trial (force-law, safety and
+  // passivity tuning, the simulated device's parameters), or to the runner as its runtime inputs (the
+  // device, a WriterProfile object in the hand maker, a teacher given as samples).
   TrialSpec spec;
   spec.characters = label;
   spec.device = device_name.empty() ? std::string("simulated") : device_name;
@@ -325,21 +326,26 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   // A replay's teacher is given as samples (TrialRunInputs::teacher), below.
   const auto checked = calligraphy::Checked<TrialSpec>::check(
       spec, spec.guidance_mode == GuidanceMode::replay ? TeacherSource::samples : TeacherSource::file);
-  std::unique_ptr<SimulatedDevice> simulated_device;
+  // The device first (the registry's by name, or a simulated one of the given physics): the whole trial is
+  // built for it.
+  std::unique_ptr<HapticDevice> trial_device = device_name.empty()
+                                                   ? std::make_unique<SimulatedDevice>(simulation.device)
+                                                   : python_device_registry().create(device_name);
   TrialRunInputs inputs;
-  inputs.registry = &python_device_registry();
+  inputs.device = trial_device.get();
   inputs.host_process = true;  // the interpreter is the application: no memory locking, no SCHED_FIFO
-  if (device_name.empty()) {
-    simulated_device = std::make_unique<SimulatedDevice>(simulation.device);
-    inputs.device = simulated_device.get();
-  }
   SimulatedWriting writing(spec, simulation.writer);
   inputs.hand_maker = &writing;
   if (const auto* replay = std::get_if<ReplayGuidance>(&law)) inputs.teacher = replay->teacher_trajectory;
-  inputs.force_law = options.force;  // the force law as given (no stiffness fitted to the device)
-  inputs.safety = options.safety;
-  inputs.passivity = options.passivity;
-  TrialRun run = run_interruptible(inputs, [&] { return run_trial_spec(checked, scene, inputs); });
+  // The whole trial, through the one builder: the force law as given (no stiffness fitted to the device),
+  // the safety chain and passivity controller as given.
+  const auto whole =
+      build_whole_trial(checked, trial_device->info(),
+                        {.force_law = options.force,
+                         .safety = options.safety,
+                         .passivity = options.passivity,
+                         .simulated_device = device ? std::optional(simulation.device) : std::nullopt});
+  TrialRun run = run_interruptible(inputs, [&] { return run_whole_trial(whole, scene, inputs); });
   TrialResult& result = run.result;
   TrialDescription description;
   description.characters = label;

@@ -111,7 +111,8 @@ SessionRunOptions run_options(const DeviceRegistry& devices, const LibraryOption
                               std::shared_ptr<CharacterSource>& source) {
   source = std::make_shared<CharacterSource>(library);
   SessionRunOptions options;
-  // The force law's default stiffness is fitted to the device by the trial's runner (trial_options).
+  // The force law's default stiffness is fitted to the device by the builder of each whole trial
+  // (build_whole_trial, stated_force_law), given the figures of the device the session made.
   options.registry = &devices;
   options.load_character = [source](char32_t c) { return source->load(c); };
   options.should_stop = [] { return stop_requested(); };

@@ -1,7 +1,8 @@
 // `calligraphy trial CHARS ...`: a whole guided writing trial on any registered device (the simulated one
 // by default). The options are the trial specification's (trial_spec.hpp), parsed and validated by it, and
-// the trial is run by its one runner (run_trial_spec): lock-step for devices a simulated writer moves, on
-// the real-time ServoLoop otherwise or with --pacing real-time.
+// the trial is run by its one runner (run_trial_spec, which builds the whole trial; rerun_trial for --spec):
+// lock-step for devices a simulated writer moves, on the real-time ServoLoop otherwise or with --pacing
+// real-time.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

@@ -94,12 +94,12 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
   TrialRunInputs inputs;
   inputs.device = device.get();
   const auto checked = Checked<TrialSpec>::check(std::move(spec), study_teacher_source(condition));
-  inputs.force_law = study_detail::condition_force_law(condition, guidance.guidance,
-                                                       trial_options(checked, device->info()).force);
+  const Checked<WholeTrial> whole =
+      study_detail::study_whole_trial(condition, guidance.guidance, checked, device->info());
   SimulatedWriting writing(*checked);
   inputs.hand_maker = &writing;
   const auto wall_start = std::chrono::steady_clock::now();
-  const TrialRun run = run_trial_spec(checked, scene, inputs);
+  const TrialRun run = run_whole_trial(whole, scene, inputs);
   const TrialResult& result = run.result;
   if (result.end != TrialEnd::completed && result.end != TrialEnd::time_limit &&
       result.end != TrialEnd::gave_up && result.end != TrialEnd::writer_finished) {

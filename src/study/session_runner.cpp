@@ -161,9 +161,10 @@ TrialOptions study_trial_options(const SessionManifest& session, const StudyCond
                                  const PlannedTrial& trial, const TrialGuidance& guidance) {
   const auto spec = Checked<TrialSpec>::check(study_trial_spec(session, condition, trial, guidance),
                                               study_teacher_source(condition));
-  TrialOptions options = trial_options(spec, DeviceInfo{});
-  options.force = study_detail::condition_force_law(condition, guidance, std::move(options.force));
-  return *Checked<TrialOptions>::check(std::move(options));
+  // The trial's whole trial, as its session makes it (on a device stating no limits), with a replay's
+  // teacher, its runner's input, checked with the options holding it.
+  return *whole_trial_options(study_detail::study_whole_trial(condition, guidance, spec, DeviceInfo{}),
+                              guidance.teacher);
 }
 
 namespace {
@@ -314,20 +315,18 @@ class SessionRun {
     }
   }
 
-  // The one runner of a trial specification; the device (made before, so that a failure is logged), the
-  // teacher kept in the session folder, the condition's force law and what the host gives (its display
-  // channel) are its inputs, all values: nothing changes the trial's options once the runner made them.
-  TrialRunInputs inputs_for(const PlannedTrial& trial, const StudyCondition& condition,
-                            const PreparedTrial& prepared, HapticDevice& device) const {
+  // The runtime handles of the one runner: the device (made before, so that a failure is logged), the
+  // teacher kept in the session folder and what the host gives (its display channel). The trial's every
+  // parameter is its whole trial's (study_whole_trial), values made once before it runs.
+  TrialRunInputs inputs_for(const PlannedTrial& trial, const PreparedTrial& prepared, const WholeTrial& whole,
+                            HapticDevice& device) const {
     TrialRunInputs inputs;
     inputs.device = &device;
     inputs.teacher = prepared.guidance.guidance.teacher;
     inputs.should_stop = options_.should_stop;
-    inputs.force_law = study_detail::condition_force_law(condition, prepared.guidance.guidance,
-                                                         trial_options(prepared.spec, device.info()).force);
     inputs.lock_memory = options_.lock_memory;
     if (options_.host != nullptr)
-      inputs.display = options_.host->display_for(trial, inputs.force_law->acceptance);
+      inputs.display = options_.host->display_for(trial, whole.force_law.acceptance);
     return inputs;
   }
 
@@ -338,7 +337,9 @@ class SessionRun {
     session_.log("trial_started", prepared.started.dump());
     // The simulated subject, with its traits and what it learned (the specification's writer part).
     SimulatedWriting writing(*prepared.spec);
-    TrialRunInputs inputs = inputs_for(trial, condition, prepared, *device);
+    const Checked<WholeTrial> whole =
+        study_detail::study_whole_trial(condition, prepared.guidance.guidance, prepared.spec, device->info());
+    TrialRunInputs inputs = inputs_for(trial, prepared, *whole, *device);
     inputs.hand_maker = &writing;
 
     study_detail::TrialRecordContext context;
@@ -353,7 +354,7 @@ class SessionRun {
     context.writer_skills = prepared.skills;
     context.start_utc = utc_now_iso8601();
     const auto wall_start = std::chrono::steady_clock::now();
-    TrialRun run = run_trial_spec(prepared.spec, prepared.scene, inputs);
+    TrialRun run = run_whole_trial(whole, prepared.scene, inputs);
     if (run.result.end == TrialEnd::interrupted && run.result.abort_reason.empty())
       run.result.abort_reason = "stopped by " + stop_reason(options_);
     context.wall_time_s =

@@ -55,7 +55,7 @@ std::string record_teacher(const SessionFolder& session, const Scene& scene,
   TrialRunInputs inputs;
   inputs.device = &device;
   inputs.hand_maker = &writing;
-  const TrialResult result = run_trial_spec(checked, scene, inputs).result;
+  const TrialResult result = run_whole_trial(build_whole_trial(checked, device.info()), scene, inputs).result;
   if (result.aborted || !result.metrics.completed_in_order) {
     throw StateError("the simulated teacher of \"" + encode_utf8(characters) + "\" wrote " +
                      std::to_string(result.metrics.strokes_completed) + " of " +
@@ -257,6 +257,12 @@ ForceLawParameters condition_force_law(const StudyCondition& condition, const Tr
       force.guidance_stiffness_n_per_m = *condition.guidance->stiffness_n_per_m;
   }
   return force;
+}
+
+Checked<WholeTrial> study_whole_trial(const StudyCondition& condition, const TrialGuidance& guidance,
+                                      const Checked<TrialSpec>& spec, const DeviceInfo& device) {
+  return build_whole_trial(
+      spec, device, {.force_law = condition_force_law(condition, guidance, stated_force_law(*spec, device))});
 }
 
 }  // namespace calligraphy::study_detail

@@ -12,6 +12,7 @@
 #include "calligraphy/study/session_folder.hpp"
 #include "calligraphy/study/session_runner.hpp"
 #include "calligraphy/trial/teacher_recording.hpp"
+#include "calligraphy/trial/whole_trial.hpp"
 
 namespace calligraphy::study_detail {
 
@@ -58,9 +59,20 @@ PreparedGuidance repetition_guidance(const StudyCondition& condition, const Plan
 /// The force law of a trial of `condition`: `force` (made from the trial's specification, fitted to the
 /// device) with what the condition sets beyond the specification: the quiz's acceptance, the guidance law
 /// (`trial_guidance_law`: the replay's teacher and lead, the repulsive field's bound, ...), a guidance
-/// stiffness of its own. Made before the trial and given to the runner (TrialRunInputs::force_law).
+/// stiffness of its own. The part `study_whole_trial` gives the builder.
 [[nodiscard]] ForceLawParameters condition_force_law(const StudyCondition& condition,
                                                      const TrialGuidance& guidance, ForceLawParameters force);
+
+/// The whole trial of a planned study trial, the one function that makes it for sessions, cohorts and the
+/// plan's check: its checked specification `spec` (`study_trial_spec`, checked with
+/// `study_teacher_source(condition)`) with the force law of `condition` for the repetition's `guidance`
+/// (`condition_force_law` over the force law the specification states on the device of figures `device`),
+/// through the one builder (`build_whole_trial`), which checks it once. A replay's teacher samples
+/// (`guidance.teacher`) are the runner's input (TrialRunInputs::teacher), not part of it. Throws
+/// InvalidArgument naming the part at fault.
+[[nodiscard]] Checked<WholeTrial> study_whole_trial(const StudyCondition& condition,
+                                                    const TrialGuidance& guidance,
+                                                    const Checked<TrialSpec>& spec, const DeviceInfo& device);
 
 /// Whether `condition`'s guidance follows the previous repetition of the item: it has a schedule (fading,
 /// assist-as-needed, skill-adaptive).

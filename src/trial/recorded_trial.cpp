@@ -256,6 +256,16 @@ TeacherFile read_recorded_teacher(const RecordedTrial& recorded, const std::file
   return {parse_teacher_recording(bytes, path.string()), sha256};
 }
 
+Checked<WholeTrial> recorded_whole_trial(const RecordedTrial& recorded, const Checked<TrialSpec>& spec,
+                                         const DeviceInfo& device) {
+  return build_whole_trial(spec, device,
+                           {.force_law = recorded.force_law,
+                            .safety = recorded.safety,
+                            .passivity = recorded.passivity,
+                            .writer = recorded.writer,
+                            .simulated_device = recorded.simulated_device});
+}
+
 TrialRun rerun_trial(const RecordedTrial& recorded, const Checked<TrialSpec>& spec, const Scene& scene,
                      TrialRunInputs inputs) {
   const std::string here = scene_sha256(scene);
@@ -270,15 +280,9 @@ TrialRun rerun_trial(const RecordedTrial& recorded, const Checked<TrialSpec>& sp
         "the simulated writer wrote this record: give its hand maker, sim's recorded_writing(recorded) "
         "(calligraphy/sim/simulated_writing.hpp), as TrialRunInputs::hand_maker");
   }
-  inputs.force_law = recorded.force_law;
-  inputs.safety = recorded.safety;
-  inputs.passivity = recorded.passivity;
-  std::unique_ptr<SimulatedDevice> device;
-  if (recorded.simulated_device) {
-    device = std::make_unique<SimulatedDevice>(*recorded.simulated_device);
-    inputs.device = device.get();
-  }
-  return run_trial_spec(spec, scene, inputs);
+  // The record's physics make the device it ran on (the runner's, over any device `inputs` gives).
+  if (recorded.simulated_device) inputs.device = nullptr;
+  return run_whole_trial(recorded_whole_trial(recorded, spec), scene, inputs);
 }
 
 }  // namespace calligraphy

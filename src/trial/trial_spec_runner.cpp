@@ -1,60 +1,27 @@
 #include "calligraphy/trial/trial_spec_runner.hpp"
 
-#include <algorithm>
 #include <memory>
+#include <utility>
+#include <variant>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/devices/hand_port.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/trial/runner.hpp"
 
 namespace calligraphy {
 namespace {
 
-// The force law's default stiffnesses capped at the device's stable maximum (the Phantom Omni's 700 N/m
-// against the paper's K_en = 800 N/m); a stiffness set on purpose is kept, and the renderer warns about it.
-void fit_default_stiffness(ForceLawParameters& force, const DeviceInfo& device) {
-  const double limit = device.max_stiffness_n_per_m;
-  if (!(limit > 0.0)) return;  // 0: the device states no limit
-  const ForceLawParameters defaults;
-  if (force.paper_stiffness_n_per_m == defaults.paper_stiffness_n_per_m) {
-    force.paper_stiffness_n_per_m = std::min(force.paper_stiffness_n_per_m, limit);
-  }
-  if (force.guidance_stiffness_n_per_m == defaults.guidance_stiffness_n_per_m) {
-    force.guidance_stiffness_n_per_m = std::min(force.guidance_stiffness_n_per_m, limit);
-  }
-}
-
-// The specification's mode with the parameters it sets; a replay's teacher is the runner's to add.
-GuidanceLaw guidance_law_of(const TrialSpec& spec) {
-  switch (spec.guidance_mode) {
-    case GuidanceMode::fixed:
-      break;
-    case GuidanceMode::fading:
-      return FadingGuidance{.gain = spec.guidance_gain};
-    case GuidanceMode::replay:
-      return ReplayGuidance{};
-    case GuidanceMode::assist_as_needed:
-      return AssistAsNeededGuidance{.band_m = spec.assist_band_m};
-    case GuidanceMode::error_amplification:
-      return ErrorAmplificationGuidance{.gain = spec.amplification_gain};
-    case GuidanceMode::timing:
-      return TimingGuidance{.speed_m_s = spec.timing_speed_m_s};
-  }
-  return FixedGuidance{};
-}
-
-// The options `spec` states on `device`. Every value comes from the checked specification (its rate, duration
-// and watchdog in the ranges TrialOptions::validate reads, its guidance law's parameter in the law's table)
-// or is a default, and a default stiffness is only lowered to the device's positive limit: valid by
-// construction, which tests/trial_spec_test.cpp shows on random specifications.
-TrialOptions options_stated(const TrialSpec& spec, const DeviceInfo& device) {
+// The options of the whole trial `trial`. Every value comes from the checked whole trial (its
+// specification's rate, duration and watchdog in the ranges TrialOptions::validate reads; its force law,
+// safety chain and passivity controller each validated whole), or is a default: valid by construction,
+// which tests/trial_spec_test.cpp shows on random specifications.
+TrialOptions options_of(const WholeTrial& trial) {
+  const TrialSpec& spec = trial.spec;
   TrialOptions options;
-  options.force.guidance = spec.guidance;
-  options.force.guidance_law = guidance_law_of(spec);
-  options.force.guidance_stiffness_n_per_m = spec.guidance_stiffness_n_per_m;
-  fit_default_stiffness(options.force, device);
-  options.force.acceptance =
-      spec.acceptance;  // checked with the specification (its table's ranges and rules)
+  options.force = trial.force_law;
+  options.safety = trial.safety;
+  options.passivity = trial.passivity;
   options.rate_hz = spec.rate_hz;
   options.pacing = spec.pacing;
   options.loop.realtime = spec.realtime;
@@ -77,32 +44,22 @@ void require_teacher(const TrialSpec& spec, const TrialRunInputs& inputs) {
   }
 }
 
-// The options of `spec` with what `inputs` gives instead, and a replay's teacher: to be checked.
-TrialOptions given_options(const TrialSpec& spec, const DeviceInfo& device, const TrialRunInputs& inputs) {
-  TrialOptions given = options_stated(spec, device);
-  if (inputs.force_law) {
-    const bool same_guidance =
-        inputs.force_law->guidance == spec.guidance &&
-        (!spec.guidance || mode_of(inputs.force_law->guidance_law) == spec.guidance_mode);
-    if (!same_guidance) {
-      throw InvalidArgument(
-          std::string("trial inputs: the force law's guidance (") +
-          (inputs.force_law->guidance ? to_string(mode_of(inputs.force_law->guidance_law)) : "off") +
-          ") is not the specification's (" + (spec.guidance ? to_string(spec.guidance_mode) : "off") + ")");
-    }
-    given.force = *inputs.force_law;
-  }
-  if (auto* law = std::get_if<ReplayGuidance>(&given.force.guidance_law))
-    law->teacher_trajectory = inputs.teacher;
-  if (inputs.safety) given.safety = *inputs.safety;
-  if (inputs.passivity) given.passivity = *inputs.passivity;
-  return given;
-}
-
 }  // namespace
 
 TrialOptions trial_options(const Checked<TrialSpec>& spec, const DeviceInfo& device) {
-  return options_stated(*spec, device);
+  // Unchecked: a replay's options have no teacher yet.
+  return options_of(*build_whole_trial(spec, device));
+}
+
+Checked<TrialOptions> whole_trial_options(const Checked<WholeTrial>& trial,
+                                          const std::vector<TeacherSample>& teacher) {
+  const TrialSpec& spec = trial->spec;
+  if (!(spec.guidance && spec.guidance_mode == GuidanceMode::replay))
+    return trial.derive([](const WholeTrial& whole) { return options_of(whole); });
+  // A replay's teacher is a new value: the options holding it are checked once.
+  TrialOptions replay = options_of(*trial);
+  if (auto* law = std::get_if<ReplayGuidance>(&replay.force.guidance_law)) law->teacher_trajectory = teacher;
+  return Checked<TrialOptions>::check(std::move(replay));
 }
 
 bool simulated_writer_writes(const TrialSpec& spec, bool simulated_writer_can_move) {
@@ -127,15 +84,20 @@ bool simulated_writer_writes(const TrialSpec& spec, bool simulated_writer_can_mo
   return false;
 }
 
-TrialRun run_trial_spec(const Checked<TrialSpec>& checked, const Scene& scene, const TrialRunInputs& inputs) {
-  const TrialSpec& spec = *checked;
+TrialRun run_whole_trial(const Checked<WholeTrial>& checked, const Scene& scene,
+                         const TrialRunInputs& inputs) {
+  const TrialSpec& spec = checked->spec;
   require_teacher(spec, inputs);
   TrialRun run;
   std::unique_ptr<HapticDevice> created;
   HapticDevice* device = inputs.device;
+  if (device == nullptr && checked->simulated_device) {
+    created = std::make_unique<SimulatedDevice>(*checked->simulated_device);
+    device = created.get();
+  }
   if (device == nullptr) {
     if (inputs.registry == nullptr) {
-      throw InvalidArgument("run_trial_spec: no device and no registry to create \"" + spec.device +
+      throw InvalidArgument("run_whole_trial: no device and no registry to create \"" + spec.device +
                             "\" from (TrialRunInputs::device, TrialRunInputs::registry)");
     }
     created = inputs.registry->create(spec.device);
@@ -145,19 +107,14 @@ TrialRun run_trial_spec(const Checked<TrialSpec>& checked, const Scene& scene, c
   // Found once, here: the trial never asks what its device is.
   run.simulated_writer = simulated_writer_writes(spec, device->hand_port() != nullptr);
   if (run.simulated_writer && inputs.hand_maker == nullptr) {
-    throw InvalidArgument("run_trial_spec: the simulated writer writes on \"" + spec.device +
+    throw InvalidArgument("run_whole_trial: the simulated writer writes on \"" + spec.device +
                           "\" and no hand maker makes its hand (TrialRunInputs::hand_maker: sim's "
                           "SimulatedWriting)");
   }
 
-  // The specification's values were checked with it: its options are derived, unchecked. What the caller
-  // gives instead (a force law, a safety chain, a passivity controller) and a replay's teacher are new
-  // values: the options holding them are checked here once.
-  const bool replay = spec.guidance && spec.guidance_mode == GuidanceMode::replay;
-  const bool given = inputs.force_law || inputs.safety || inputs.passivity || replay;
-  Checked<TrialOptions> options =
-      given ? Checked<TrialOptions>::check(given_options(spec, run.device, inputs))
-            : checked.derive([&](const TrialSpec& stated) { return options_stated(stated, run.device); });
+  // The whole trial was checked once, by its builder: its options are derived, unchecked. A replay's
+  // teacher is a runtime input, a new value: the options holding it are checked here once.
+  Checked<TrialOptions> options = whole_trial_options(checked, inputs.teacher);
   // Where the trial runs from (a stop flag, a display, the process's real-time settings): no parameter of
   // the force, and nothing TrialOptions::validate refuses (the priority is the loop's valid constant).
   options = options.derive([&](TrialOptions running) {
@@ -180,6 +137,22 @@ TrialRun run_trial_spec(const Checked<TrialSpec>& checked, const Scene& scene, c
   run.options.display = nullptr;
   run.metrics = trial_writing_metrics(scene, run.result, run.options.force.acceptance);
   return run;
+}
+
+TrialRun run_trial_spec(const Checked<TrialSpec>& spec, const Scene& scene, const TrialRunInputs& inputs) {
+  require_teacher(*spec, inputs);  // before a device is created
+  std::unique_ptr<HapticDevice> created;
+  TrialRunInputs with_device = inputs;
+  if (with_device.device == nullptr) {
+    if (inputs.registry == nullptr) {
+      throw InvalidArgument("run_trial_spec: no device and no registry to create \"" + spec->device +
+                            "\" from (TrialRunInputs::device, TrialRunInputs::registry)");
+    }
+    created = inputs.registry->create(spec->device);
+    with_device.device = created.get();
+  }
+  // The specification's defaults on this device, through the one builder.
+  return run_whole_trial(build_whole_trial(spec, with_device.device->info()), scene, with_device);
 }
 
 }  // namespace calligraphy

@@ -121,9 +121,10 @@ struct TrialGuidance {
   return replays_teacher(condition) ? TeacherSource::samples : TeacherSource::file;
 }
 
-/// The runner's options of that specification on a device stating no limits (`trial_options`), with what
-/// the condition sets beyond it: the quiz's acceptance, the replay's teacher and lead, the condition's
-/// guidance stiffness; checked (the check of a plan before its first trial). Throws InvalidArgument naming
+/// The runner's options of that specification on a device stating no limits: those of the trial's whole
+/// trial as sessions and cohorts build it (the condition's force law over the one the specification states:
+/// the quiz's acceptance, the replay's lead, the condition's guidance stiffness), with the replay's teacher
+/// of `guidance`; checked (the check of a plan before its first trial). Throws InvalidArgument naming
 /// the condition for a `replay` condition without a teacher in `guidance`, and what `TrialSpec::validate` and
 /// `TrialOptions::validate` throw.
 [[nodiscard]] TrialOptions study_trial_options(const SessionManifest& session,

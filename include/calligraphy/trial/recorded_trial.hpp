@@ -1,15 +1,16 @@
 #pragma once
 /// \file recorded_trial.hpp
-/// A trial as it ran, whole: its specification (trial_spec.hpp) and every part a front-end may give instead
-/// of the defaults: the force law (every field, the active guidance law with its values, the stroke
+/// A trial as it ran: its whole trial (whole_trial.hpp: the specification and every part a front-end may
+/// give its builder: the force law (every field, the active guidance law with its values, the stroke
 /// acceptance and the nearest-point search), the safety chain, the passivity controller, the simulated
-/// writer's profile after every parameter (its traits and what it had learned folded in), with the scene's
-/// layout and a SHA-256 of the characters placed. Every trial record (`calligraphy trial --json`, study
-/// sessions and cohorts) holds one as its "specification" object (format: docs/cli.md, "Re-running a trial");
-/// `calligraphy trial --spec RECORD` and `rerun_trial` run it again, and on the simulated device the trace is
-/// the same bit for bit. It is part of the trial layer, so an application that links only
-/// `calligraphy::haptics` reads a record and runs it again; a record the simulated writer wrote is re-run
-/// with sim's `recorded_writing` as the hand maker (calligraphy/sim/simulated_writing.hpp).
+/// writer's profile after every parameter (its traits and what it had learned folded in)), with its
+/// provenance: the scene's layout, a SHA-256 of the characters placed, the library version. Every trial
+/// record (`calligraphy trial --json`, study sessions and cohorts) holds one as its "specification" object
+/// (format: docs/cli.md, "Re-running a trial"); `calligraphy trial --spec RECORD` and `rerun_trial` run it
+/// again, and on the simulated device the trace is the same bit for bit. It is part of the trial layer, so an
+/// application that links only `calligraphy::haptics` reads a record and runs it again; a record the
+/// simulated writer wrote is re-run with sim's `recorded_writing` as the hand maker
+/// (calligraphy/sim/simulated_writing.hpp).
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -26,6 +27,7 @@
 #include "calligraphy/trial/teacher_recording.hpp"
 #include "calligraphy/trial/trial_spec.hpp"
 #include "calligraphy/trial/trial_spec_runner.hpp"
+#include "calligraphy/trial/whole_trial.hpp"
 #include "calligraphy/trial/writer_profile.hpp"
 
 namespace calligraphy {
@@ -49,22 +51,20 @@ inline constexpr int kOldestRecordedTrialVersion = 1;
 /// Largest trial record file read: 64 MiB.
 inline constexpr std::uintmax_t kMaxRecordedTrialBytes = std::uintmax_t{64} << 20;
 
-/// Everything that decides what a trial does, as it ran. Lengths in m, forces in N, times in s.
-struct RecordedTrial {
-  /// As stated, its output files cleared (a re-run names its own), `writer` the one who wrote and `pacing`
-  /// the one it ran with (never `automatic`).
-  TrialSpec spec;
-  /// The force law the renderer ran. A replay's teacher trajectory is not kept here: `spec.teacher` names its
-  /// file, or the re-run is given the teacher's samples.
-  ForceLawParameters force_law;
-  SafetyChainParameters safety;  ///< 0 peak and continuous forces stand for the device's
-  PassivityParameters passivity;
-  /// The profile the simulated writer wrote with; nullopt when a person wrote.
-  std::optional<WriterProfile> writer;
-  /// The physics of a simulated device its caller made with its own parameters (Python's
-  /// `simulate_trial(device=...)`; its DeviceInfo stays the default's); nullopt: the device the registry
-  /// makes of `spec.device`.
-  std::optional<SimulatedDeviceParameters> simulated_device;
+/// A trial as it ran: the whole trial (whole_trial.hpp: the specification, the force law, safety chain and
+/// passivity controller it ran with, the simulated writer's profile when it wrote, a simulated device's
+/// physics of the caller's own) and its provenance (layout, scene and teacher SHA-256, library version).
+/// Lengths in m, forces in N, times in s. The whole trial's members, as recorded:
+/// - `spec`: as stated, its output files cleared (a re-run names its own), `writer` the one who wrote and
+///   `pacing` the one it ran with (never `automatic`), `acceptance` the force law's;
+/// - `force_law`: the force law the renderer ran; a replay's teacher trajectory is not kept (`spec.teacher`
+///   names its file, or the re-run is given the teacher's samples);
+/// - `writer`: the profile the simulated writer wrote with (after every parameter, its traits and what it
+///   had learned folded in); nullopt when a person wrote;
+/// - `simulated_device`: the physics of a simulated device its caller made with its own parameters
+///   (Python's `simulate_trial(device=...)`; its DeviceInfo stays the default's); nullopt: the device the
+///   registry makes of `spec.device`.
+struct RecordedTrial : WholeTrial {
   SceneLayout layout;           ///< where the characters were placed
   std::string scene_sha256;     ///< `scene_sha256` of the placed characters
   std::string library_version;  ///< the library that ran it (said, not checked)
@@ -126,16 +126,23 @@ struct TeacherFile {
 [[nodiscard]] TeacherFile read_recorded_teacher(const RecordedTrial& recorded,
                                                 const std::filesystem::path& path);
 
+/// The whole trial of `recorded` as it runs again, checked: the one builder (`build_whole_trial`) given
+/// `spec` (`recorded.spec` as the caller checked it, `Checked<TrialSpec>::check`, its output files and a
+/// replay's teacher file the caller's) and the record's force law, safety chain, passivity controller,
+/// writer profile and simulated device physics; `device` the figures of the device it runs on (not read:
+/// the force law is the record's). Throws InvalidArgument naming the part at fault (`build_whole_trial`).
+[[nodiscard]] Checked<WholeTrial> recorded_whole_trial(const RecordedTrial& recorded,
+                                                       const Checked<TrialSpec>& spec,
+                                                       const DeviceInfo& device = {});
+
 /// Runs `recorded` again on `scene` (laid out by the caller with `recorded.layout`) with `inputs` (the
 /// registry, a stop flag, a replay's teacher samples, and, for a record the simulated writer wrote
 /// (`recorded.writer`), sim's `recorded_writing(recorded)` as the hand maker; a person's record runs with the
-/// hand `inputs` gives, if any).
-/// `spec` is the specification that runs: `recorded.spec` as the caller checked it
-/// (`Checked<TrialSpec>::check`), its output files and a replay's teacher file the caller's. The record's
-/// force law, safety chain, passivity controller and simulated device (made here when recorded) replace any
-/// in `inputs`. Throws InvalidArgument when `scene` is not the recorded one (its SHA-256 differs: other
-/// character data), when the simulated writer wrote the record and `inputs` gives no hand maker, and what
-/// `run_trial_spec` throws.
+/// hand `inputs` gives, if any): `run_whole_trial` of `recorded_whole_trial(recorded, spec)`, on the
+/// simulated device of the record's physics when it states them (made by the runner), else on
+/// `inputs.device` or the registry's `spec.device`. Throws InvalidArgument when `scene` is not the recorded
+/// one (its SHA-256 differs: other character data), when the simulated writer wrote the record and `inputs`
+/// gives no hand maker, and what `recorded_whole_trial` and `run_whole_trial` throw.
 [[nodiscard]] TrialRun rerun_trial(const RecordedTrial& recorded, const Checked<TrialSpec>& spec,
                                    const Scene& scene, TrialRunInputs inputs = {});
 

@@ -34,7 +34,7 @@ namespace calligraphy {
 TrialResult run_trial(HapticDevice& device, const Scene& scene, const TrialOptions& options,
                       TrialHand* hand = nullptr);
 /// The same with options already checked (checked.hpp): the one check was the caller's, and nothing of
-/// them is validated again down to the renderer. What `run_trial_spec` calls.
+/// them is validated again down to the renderer. What `run_whole_trial` calls.
 TrialResult run_trial(HapticDevice& device, const Scene& scene, const Checked<TrialOptions>& options,
                       TrialHand* hand = nullptr);
 

@@ -56,7 +56,7 @@ struct TrialSpec {
   bool guidance = true;                              ///< in-plane guidance (the paper force stays)
   GuidanceMode guidance_mode = GuidanceMode::fixed;  ///< the paper's fixture or another mode
   /// K_et [N/m] per unit attraction factor (eq. 8), in ForceLawParameters' range; at its default, capped at
-  /// the device's stable maximum (trial_options)
+  /// the device's stable maximum (stated_force_law, whole_trial.hpp)
   double guidance_stiffness_n_per_m = ForceLawParameters{}.guidance_stiffness_n_per_m;
   double guidance_gain = 1.0;  ///< fading only: gain in [0, 1]
   /// assist-as-needed only: the band's half-width [m] >= 0 (AssistAsNeededGuidance::band_m)

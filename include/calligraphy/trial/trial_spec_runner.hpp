@@ -1,10 +1,13 @@
 #pragma once
 /// \file trial_spec_runner.hpp
-/// The one runner of a trial specification (trial_spec.hpp), which `calligraphy trial`, the trainer, study
-/// sessions and Python call: the checked specification becomes the runner's `TrialOptions`
-/// (`trial_options`), its device is created from a registry (or given), and when the simulated writer writes,
-/// the caller's hand maker (TrialRunInputs::hand_maker: sim's `SimulatedWriting`) makes the hand that
-/// `run_trial` (runner.hpp) is given: simulation is an input to the trial, never part of it. The result
+/// The one runner of a trial, which `calligraphy trial`, the trainer, study sessions, cohorts and Python
+/// call: it takes a checked whole trial (whole_trial.hpp, made by the one builder `build_whole_trial`) as
+/// it is, with the runtime handles only its caller has (`TrialRunInputs`: the device or a registry, a
+/// replay's teacher samples, the hand maker, a stop flag, a display, the process's real-time settings).
+/// When the simulated writer writes, the caller's hand maker (TrialRunInputs::hand_maker: sim's
+/// `SimulatedWriting`) makes the hand that `run_trial` (runner.hpp) is given: simulation is an input to the
+/// trial, never part of it. `run_trial_spec` is a thin wrapper for a trial of the specification's defaults:
+/// it creates the device and builds the whole trial for its figures through the same builder. The result
 /// carries the one metrics record (writing_metrics.hpp).
 #include <functional>
 #include <optional>
@@ -18,16 +21,21 @@
 #include "calligraphy/trial/hand.hpp"
 #include "calligraphy/trial/result.hpp"
 #include "calligraphy/trial/trial_spec.hpp"
+#include "calligraphy/trial/whole_trial.hpp"
 
 namespace calligraphy {
 
-/// What a trial needs beyond its specification: what only its caller has. Every member may stay empty.
+/// What a trial needs beyond the whole trial: the runtime handles only its caller has, none of them a
+/// parameter of the trial (those are the whole trial's, given to its builder). Every member may stay empty.
 struct TrialRunInputs {
   /// Where `TrialSpec::device` is created (not owned): its owner's registry, filled with the backends it
-  /// offers (standard_device_registry() and its own). Required unless `device` is given.
+  /// offers (standard_device_registry() and its own). Required unless `device` is given or the whole trial
+  /// states simulated device physics (WholeTrial::simulated_device).
   const DeviceRegistry* registry = nullptr;
   /// A device the caller made (not owned; opened here when it is not open, closed at the end), used
-  /// instead of creating `TrialSpec::device` (e.g. a simulated device with the caller's parameters).
+  /// instead of creating `TrialSpec::device`: the device whose figures the whole trial was built for
+  /// (a session's, made before its trial so that a failure is logged; a simulated device with the caller's
+  /// parameters).
   HapticDevice* device = nullptr;
   /// A replay's teacher pen, device frame [m], times [s]; required for a replay. The front-end reads it from
   /// the file `TrialSpec::teacher` (`read_teacher_recording`, `require_teacher_for`: teacher_recording.hpp),
@@ -43,13 +51,6 @@ struct TrialRunInputs {
   /// `kDedicatedServoPriority` and locked memory, as a program that exists to run it. True (a window, the
   /// Python module): nothing process-wide, the `ServoLoopOptions` defaults.
   bool host_process = false;
-  /// The force law to run with instead of the one made from the specification (its default stiffnesses
-  /// fitted to the device): a study condition's (condition_force_law), or Python's tuning; taken as given.
-  /// Its guidance switch, and with guidance on its mode, must be the specification's (InvalidArgument
-  /// otherwise); a replay's teacher is the runner's to set (above).
-  std::optional<ForceLawParameters> force_law;
-  std::optional<SafetyChainParameters> safety;   ///< instead of the defaults
-  std::optional<PassivityParameters> passivity;  ///< instead of the defaults
   /// Where the trial publishes what a window shows (TrialOptions::display; not owned); nullptr: nowhere.
   DisplayChannel* display = nullptr;
   /// With `host_process` false: lock the process's memory in a real-time trial
@@ -68,12 +69,21 @@ struct TrialRun {
   WritingMetrics metrics;         ///< the one metrics record of the trace (writing_metrics.hpp)
 };
 
-/// The runner's options for the checked `spec` on a device with figures `device`: guidance, mode, gain, rate,
-/// pacing, real-time settings and duration from `spec`; the force law's default stiffnesses capped at the
-/// device's stable maximum (`DeviceInfo::max_stiffness_n_per_m`), so that defaults never draw the renderer's
-/// over-limit warning. Valid as they are, but for a replay, whose teacher the runner adds (it then checks
-/// them); `run_trial_spec` takes them unchecked otherwise (tests/trial_spec_test.cpp walks that promise).
+/// The runner's options for the checked `spec` on a device with figures `device`: those of the whole trial
+/// `build_whole_trial(spec, device)` makes (the force law `stated_force_law` states, the default safety
+/// chain and passivity controller), with guidance, mode, gain, rate, pacing, real-time settings and duration
+/// from `spec`. Valid as they are, but for a replay, whose teacher the runner adds (it then checks them).
+/// What a front-end shows before its device is open (the trainer's view) and a plan's check read.
 [[nodiscard]] TrialOptions trial_options(const Checked<TrialSpec>& spec, const DeviceInfo& device);
+
+/// The runner's options of the checked whole trial `trial`: its force law, safety chain and passivity
+/// controller, and the rate, pacing, real-time settings, watchdog and duration of its specification. Derived,
+/// unchecked (valid by construction; tests/trial_spec_test.cpp walks that promise), but for a replay: its
+/// teacher `teacher` (a runtime input, TrialRunInputs::teacher; pen in the device frame [m], times [s]) joins
+/// the force law's replay law and the options holding it are checked (InvalidArgument naming the teacher's
+/// fault, e.g. fewer than two samples). `teacher` is not read for another mode.
+[[nodiscard]] Checked<TrialOptions> whole_trial_options(const Checked<WholeTrial>& trial,
+                                                        const std::vector<TeacherSample>& teacher = {});
 
 /// Who writes `spec` on a device: `TrialWriter::simulated` or `person` as stated, else the simulated writer
 /// when `simulated_writer_can_move` (the device has a hand port), a person otherwise. Throws
@@ -81,16 +91,26 @@ struct TrialRun {
 /// cannot move.
 [[nodiscard]] bool simulated_writer_writes(const TrialSpec& spec, bool simulated_writer_can_move);
 
-/// Runs the trial `spec` states on `scene` (laid out from `spec.characters` by the caller, who knows where
-/// characters come from). `spec` was checked once by its front-end (`Checked<TrialSpec>::check`, or the
-/// parsers of trial_spec.hpp); nothing of it is validated again down to the renderer. Creates the device
-/// (unless given), asks `inputs.hand_maker` for the simulated writer's hand when it writes, runs `run_trial`,
-/// lets the hand maker mark the trace, and scores the trace. What `inputs` gives instead of the
-/// specification's (a force law, a safety chain, a passivity controller) and a replay's teacher are checked
-/// here. Writes none of `spec`'s output files (the caller's: they depend on its front-end). Throws
-/// InvalidArgument when `inputs` gives neither a device nor a registry, no teacher for a replay, or no hand
-/// maker when the simulated writer writes, or a part of `inputs` out of range; DeviceNotFound; and what
-/// `run_trial` throws.
+/// Runs the whole trial `trial` on `scene` (laid out from `trial->spec.characters` by the caller, who knows
+/// where characters come from), taken as it is: nothing of it is validated again down to the renderer, and
+/// nothing in `inputs` replaces a part of it. The device is `inputs.device` (the one the trial was built
+/// for), else the simulated device of `trial->simulated_device`'s physics, else `spec.device` created from
+/// `inputs.registry` (then the trial must have been built for that device's figures, as `run_trial_spec`
+/// builds it). Asks `inputs.hand_maker` for the simulated writer's hand when it writes, runs `run_trial`,
+/// lets the hand maker mark the trace, and scores the trace. A replay's teacher samples (`inputs.teacher`,
+/// a runtime input) are checked with the options they join. Writes none of the specification's output
+/// files (the caller's: they depend on its front-end). Throws InvalidArgument when `inputs` gives no device
+/// to run on, no teacher for a replay or teacher samples out of range, or no hand maker when the simulated
+/// writer writes; DeviceNotFound; and what `run_trial` throws.
+[[nodiscard]] TrialRun run_whole_trial(const Checked<WholeTrial>& trial, const Scene& scene,
+                                       const TrialRunInputs& inputs = {});
+
+/// A thin wrapper of `run_whole_trial` for a trial of the specification's defaults: creates the device
+/// (unless `inputs.device` is given), builds the whole trial of the checked `spec` for its figures
+/// (`build_whole_trial(spec, device.info())`, the one builder) and runs it. `spec` was checked once by its
+/// front-end (`Checked<TrialSpec>::check`, or the parsers of trial_spec.hpp). Throws what
+/// `build_whole_trial` and `run_whole_trial` throw, and InvalidArgument when `inputs` gives neither a device
+/// nor a registry.
 [[nodiscard]] TrialRun run_trial_spec(const Checked<TrialSpec>& spec, const Scene& scene,
                                       const TrialRunInputs& inputs = {});
 
