@@ -466,7 +466,6 @@ class ReportCases(Case):
     # link keeps pointing where it did"), and report's tables do so too, while the same page says a set is
     # written in its folders only. Which promise gives way (refuse a link in a set's folder, or document that a
     # set's file follows it) is a decision about the file writer, not a small fix.
-    @unittest.expectedFailure
     def test_a_link_planted_in_the_table_folder_writes_nothing_outside_it(self):
         # docs/cli.md: a set of files (report) "needs no folder but those its files are in ... writes in /tmp/t
         # and beside ~/r.html only". A trials.csv that is a link to a file elsewhere must leave that file alone.
