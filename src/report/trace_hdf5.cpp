@@ -548,7 +548,6 @@ class TraceFileReader {
       refuse(source_, std::string("column '") + name + "' cannot be read (damaged or of another type)");
   }
 
-  // A measured column: integers over 10^decimals, or doubles; every value finite when `finite`.
   // A measured column: integers over 10^`decimals` (the version's, which the column's attribute repeats for
   // other readers), or doubles; every value finite when `finite`.
   // Its attributes say the same to other readers (h5py divides by 10 ** decimals): `unit` must be `unit`, and
