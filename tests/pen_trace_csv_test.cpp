@@ -137,7 +137,19 @@ TEST_CASE("Malformed traces name the source, line and column", "[pen_trace_csv]"
   CHECK_THROWS_WITH(parse_pen_trace_csv("t,x,y,pen,z\n", "a.csv", p), Catch::Contains("both"));
   CHECK_THROWS_WITH(parse_pen_trace_csv("t,x,x,y,pen\n", "a.csv", p), Catch::Contains("twice"));
   CHECK_THROWS_WITH(parse_pen_trace_csv("# only a comment\n", "a.csv", p), Catch::Contains("no header"));
-  CHECK_THROWS_AS(parse_pen_trace_csv("t,x,y,pen\n0,\"1\",0,1\n", "a.csv", p), DataError);
+  // A field in double quotes (RFC 4180, as spreadsheets write every field) is the text between them; a quote
+  // that does not enclose its field, or one inside it, stays and is refused.
+  const auto quoted = parse_pen_trace_csv("\"t\",\"x\",\"y\",\"pen\"\n\"0\",\"0.001\",0,\"1\"\n", "a.csv", p);
+  const auto plain = parse_pen_trace_csv("t,x,y,pen\n0,0.001,0,1\n", "a.csv", p);
+  REQUIRE(quoted.size() == 1);
+  REQUIRE(plain.size() == 1);
+  CHECK(quoted[0].position_m == plain[0].position_m);
+  CHECK(quoted[0].pen_down);
+  CHECK_THROWS_WITH(parse_pen_trace_csv("t,x,y,pen\n0,\"1,0,1\n", "a.csv", p),
+                    Catch::Contains("a.csv:2") && Catch::Contains("column 2 (x)"));
+  CHECK_THROWS_WITH(parse_pen_trace_csv("t,x,y,pen\n0,\"1\"2\",0,1\n", "a.csv", p),
+                    Catch::Contains("a.csv:2") && Catch::Contains("column 2 (x)"));
+  CHECK_THROWS_WITH(parse_pen_trace_csv("\"t,x,y,pen\n0,0,0,1\n", "a.csv", p), Catch::Contains("'t'"));
   // Header only: an empty trace.
   CHECK(parse_pen_trace_csv("t,x,y,pen\n", "a.csv", p).empty());
 }

@@ -210,9 +210,14 @@ class Study:
         fx_n, fy_n, fz_n [N], state ("SS", "AS", "CS", "WS"), stroke, element (positions in the scene's arrays,
         0-based), attempt (1-based, 0 outside any; traces of older folders may lack it) and rewritten (1: part
         of an attempt written again later). `trial` is a row of `trials` or its index
-        label. Raises KeyError for an unknown label, FileNotFoundError when the trace is gone, DataError naming
+        label. Raises TypeError naming `trial` for None or a value that cannot be a label (a list, a dict,
+        a bool), KeyError for an unknown label, FileNotFoundError when the trace is gone, DataError naming
         the file of a damaged trace (and the line of an older CSV trace: another header, a field that is not a
         finite number)."""
+        if not hasattr(trial, "trace_file"):
+            if trial is None or isinstance(trial, bool) or not isinstance(trial, collections.abc.Hashable):
+                raise TypeError(f"Study.samples: trial: expected a row of trials or its index label, got "
+                                f"{type(trial).__name__} {trial!r}")
         row = self.trials.loc[trial] if not hasattr(trial, "trace_file") else trial
         expected = row.get("trace_sha256", "")
         return _read_trace(row["trace_file"], expected if isinstance(expected, str) else "")

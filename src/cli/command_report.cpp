@@ -88,12 +88,12 @@ int run_report(const ReportCommand& command) {
   // Every file of the session folders read (saved trial records among them) is an input: --out replaces none.
   FilePlan files;
   for (const std::string& folder : command.folders) add_saved_sessions(files, "DIR", folder);
-  files.output("--out", command.out);
+  files.set_output("--out", command.out);
   const fs::path tables_folder(command.csv);
   if (!command.csv.empty()) {
     files.existing_output_folder("--csv", command.csv);
-    files.output("--csv", (tables_folder / "trials.csv").string());
-    files.output("--csv", (tables_folder / "strokes.csv").string());
+    files.set_output("--csv", (tables_folder / "trials.csv").string());
+    files.set_output("--csv", (tables_folder / "strokes.csv").string());
   }
   std::vector<fs::path> roots(command.folders.begin(), command.folders.end());
   const auto elapsed = [&start] {
@@ -126,7 +126,7 @@ int run_report(const ReportCommand& command) {
     for (const ReportedSession& s : study.sessions) {
       pages.push_back(index_path.parent_path() /
                       session_page_path(index_name, s.shown.subject, s.shown.session));
-      files.output("--out", pages.back().string());
+      files.set_output("--out", pages.back().string());
     }
     PagesWriter writer(study, pages, "../../" + index_name);
     writer.files = &report_files;
@@ -153,14 +153,16 @@ int run_report(const ReportCommand& command) {
     const std::string index = study_index_html(study.index, index_name);
     report_files.add(index_path, index);
     char line[512];
-    std::snprintf(line, sizeof line, "%zu sessions, %zu trials, %zu pages in %s (%.1f MB)", study.sessions.size(),
-                  writer.trials.load(), pages.size(), pages_folder.string().c_str(),
+    std::snprintf(line, sizeof line, "%zu sessions, %zu trials, %zu pages in %s (%.1f MB)",
+                  study.sessions.size(), writer.trials.load(), pages.size(), pages_folder.string().c_str(),
                   static_cast<double>(writer.bytes.load() + index.size()) / 1e6);
     pages_line = line;
   }
   report_files.commit();
-  if (!tables_line.empty()) std::printf("%s: %s, %.1f s\n", command.csv.c_str(), tables_line.c_str(), elapsed());
-  if (!pages_line.empty()) std::printf("%s: %s, %.1f s\n", command.out.c_str(), pages_line.c_str(), elapsed());
+  if (!tables_line.empty())
+    std::printf("%s: %s, %.1f s\n", command.csv.c_str(), tables_line.c_str(), elapsed());
+  if (!pages_line.empty())
+    std::printf("%s: %s, %.1f s\n", command.out.c_str(), pages_line.c_str(), elapsed());
   return 0;
 }
 

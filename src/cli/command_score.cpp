@@ -5,6 +5,7 @@
 #include <string>
 
 #include "calligraphy/analysis/writing_metrics.hpp"
+#include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/report/pen_trace_csv.hpp"
 #include "calligraphy/report/score_report.hpp"
@@ -39,7 +40,16 @@ int run_score(const ScoreCommand& command) {
   // written.
   std::vector<Character> models;
   const CharacterSource source(command.library);
-  for (const char32_t c : chars) models.push_back(source.load(c));
+  // A character the user named that the library lacks is the command's input, as one of a protocol is:
+  // wrong usage (exit 2, docs/cli.md); one the library has but cannot read stays a data error (exit 1).
+  for (const char32_t c : chars) {
+    try {
+      models.push_back(source.load(c));
+    } catch (const CharacterNotFound& e) {
+      std::string message("--character: ");
+      throw UsageError(message.append(e.what()));
+    }
+  }
   const Scene scene = Scene::lay_out(models);
   const PlacedCharacter& character = scene.characters.front();
   TerminalProgress progress("reading " + command.trace);  // on stderr, only when it is a terminal

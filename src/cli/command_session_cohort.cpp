@@ -39,8 +39,8 @@ int run_session_cohort(const SessionCohortCommand& command) {
   add_library_inputs(files, command.library);
   const std::filesystem::path tables_folder(command.csv);
   files.existing_output_folder("--csv", command.csv);
-  files.output("--csv", (tables_folder / "trials.csv").string());
-  files.output("--csv", (tables_folder / "strokes.csv").string());
+  files.set_output("--csv", (tables_folder / "trials.csv").string());
+  files.set_output("--csv", (tables_folder / "strokes.csv").string());
 
   const LoadedProtocol protocol = load_study_protocol(command.protocol);
   const CharacterSource characters(command.library);

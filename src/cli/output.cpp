@@ -100,7 +100,8 @@ int finish_standard_output(int status, const std::string& command) {
   if (flushed && !std::ferror(stdout) && std::cout.good()) return status;
   if (status != 0) return status;  // the failure was reported already
   print_error_line(command, "error",
-                   std::string("standard output: cannot write") + (error ? ": " : "") + (error ? std::strerror(error) : ""));
+                   std::string("standard output: cannot write") + (error ? ": " : "") +
+                       (error ? std::strerror(error) : ""));
   return 1;
 }
 
@@ -246,6 +247,16 @@ void FilePlan::output(const std::string& what, const std::string& path) {
   if (!in_output_folder || fs::exists(folder, error)) require_writable_folder(what, path, folder);
   outputs_.push_back({what, path, identity});
   note_planned(path);
+}
+
+void FilePlan::set_output(const std::string& what, const std::string& path) {
+  output(what, path);
+  struct stat status {};
+  if (!path.empty() && path != "-" && ::lstat(path.c_str(), &status) == 0 && S_ISLNK(status.st_mode)) {
+    throw UsageError(named(what, path) +
+                     " is a symbolic link: the files of a set are written only in their own folders, never "
+                     "through a link; remove it, nothing written");
+  }
 }
 
 void FilePlan::output_folder(const std::string& what, const std::string& path) {

@@ -69,6 +69,10 @@ class FilePlan {
   void input_folder(const std::string& what, const std::string& path);
   /// A file the command writes (write_output). Throws as the class comment says.
   void output(const std::string& what, const std::string& path);
+  /// A file of a set the command writes (OutputSet): checked as `output`, and in addition refused when it is
+  /// a symbolic link (UsageError, exit 2, naming the option and path), since a set is written only in its
+  /// own folders, never through a link (AtomicFileSet).
+  void set_output(const std::string& what, const std::string& path);
   /// A folder the command creates files or folders in: it must be a writable folder, or not exist yet
   /// with a writable folder as its nearest existing ancestor. Throws DataError naming `what` and the path.
   /// Outputs given after it may lie in it, or in subfolders of it, before they exist: the command makes them.

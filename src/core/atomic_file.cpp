@@ -674,9 +674,19 @@ AtomicFileSet::~AtomicFileSet() = default;  // uncommitted temporaries are remov
 
 void AtomicFileSet::add(const fs::path& path, std::string_view content) {
   if (path.empty()) throw DataError("cannot write a file with an empty name");
-  const fs::path target = written_path(path);
+  // A file of a set is written only in its own folder: a symbolic link in a member's place is never
+  // followed (it may lead anywhere, e.g. out of a tables folder onto a file of the system) and is refused
+  // before anything of the set is replaced. A hard-linked member needs no rule: it is replaced by rename,
+  // which gives the name a new file and leaves the file its other names share as it was.
+  const fs::path& target = path;
   struct stat status {};
   bool exists = false;
+  if (::lstat(target.c_str(), &status) == 0 && S_ISLNK(status.st_mode)) {
+    throw DataError(
+        path.string() +
+        ": is a symbolic link: a file of a set is written only in its own folder, never through a "
+        "link (nothing written; remove the link or write the set elsewhere)");
+  }
   if (::stat(target.c_str(), &status) == 0) {
     if (S_ISDIR(status.st_mode)) fail(path, "cannot write", EISDIR);
     if (!S_ISREG(status.st_mode)) {  // a device or FIFO: nothing to replace, written last as it is

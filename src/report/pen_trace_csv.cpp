@@ -27,16 +27,25 @@ std::string_view trimmed(std::string_view s) {
   return s;
 }
 
-// The first `wanted` fields of `line`, trimmed, into `fields` (kept between lines, so that a line allocates
-// nothing); returns how many fields the line has in all, the rest counted rather than split: a trace has
-// millions of lines and a reader needs a few of its columns.
+// A field as RFC 4180 allows it to be written, in double quotes ("t", "0.001", as spreadsheet programs write
+// every field): the text between them, when they enclose it and it holds no quote of its own. Any other
+// field is as it is (a quote left in a number or a name is then refused as such).
+std::string_view unquoted(std::string_view s) {
+  if (s.size() >= 2 && s.front() == '"' && s.back() == '"' && s.substr(1, s.size() - 2).find('"') == s.npos)
+    return trimmed(s.substr(1, s.size() - 2));
+  return s;
+}
+
+// The first `wanted` fields of `line`, trimmed and unquoted, into `fields` (kept between lines, so that a
+// line allocates nothing); returns how many fields the line has in all, the rest counted rather than split: a
+// trace has millions of lines and a reader needs a few of its columns.
 std::size_t split_fields(std::string_view line, std::size_t wanted, std::vector<std::string_view>& fields) {
   fields.clear();
   const char* start = line.data();
   const char* const end = start + line.size();
   for (const char* at = start;; ++at) {
     if (at != end && *at != ',') continue;
-    fields.push_back(trimmed(std::string_view(start, static_cast<std::size_t>(at - start))));
+    fields.push_back(unquoted(trimmed(std::string_view(start, static_cast<std::size_t>(at - start)))));
     if (at == end) return fields.size();
     start = at + 1;
     if (fields.size() == wanted) return wanted + 1 + static_cast<std::size_t>(std::count(start, end, ','));

@@ -302,6 +302,102 @@ std::size_t dataset_length(hid_t file, const char* name, const std::string& sour
   return static_cast<std::size_t>(dims[0]);
 }
 
+// ---- attributes ----
+//
+// Read only after the user block's CRC-32 has matched (check_user_block), so that the header messages they
+// are decoded from are the bytes a writer made, not accidental damage; each is opened, its dataspace and type
+// checked (one value, of the class the writer gives it, of bounded size) before H5Aread, which then reads it
+// with its own type into a buffer of that size: HDF5 converts nothing a file describes.
+
+// How an attribute is named in messages: "attribute /version", "column 'x': attribute /x/unit".
+std::string attribute_path(const char* column, const char* name) {
+  std::string path;
+  if (column != nullptr) path.append("column '").append(column).append("': ");
+  path.append("attribute /");
+  if (column != nullptr) path.append(column).append("/");
+  return path.append(name);
+}
+
+// The open attribute `name` of `object`, one value (a scalar dataspace) of class `expected` and at most
+// `max_bytes` bytes; `bytes` is set to its size. Refuses naming the attribute when it is missing or other.
+Handle open_attribute(hid_t object, const char* name, const std::string& where, H5T_class_t expected,
+                      std::size_t max_bytes, std::size_t& bytes, const std::string& source) {
+  const htri_t exists = H5Aexists(object, name);
+  if (exists == 0) refuse(source, where + " is missing (this version writes it)");
+  Handle attribute(exists > 0 ? H5Aopen(object, name, H5P_DEFAULT) : H5I_INVALID_HID, H5Aclose);
+  if (!attribute.ok()) refuse(source, where + " cannot be read (damaged)");
+  Handle space(H5Aget_space(attribute.get()), H5Sclose);
+  if (!space.ok() || H5Sget_simple_extent_type(space.get()) != H5S_SCALAR)
+    refuse(source, where + " is not a single value");
+  Handle type(H5Aget_type(attribute.get()), H5Tclose);
+  const char* const kind = expected == H5T_STRING ? "a fixed-length string" : "an integer";
+  if (!type.ok() || H5Tget_class(type.get()) != expected ||
+      (expected == H5T_STRING && H5Tis_variable_str(type.get()) != 0))
+    refuse(source, where + " is not " + kind + " (this version writes one)");
+  bytes = H5Tget_size(type.get());
+  if (bytes == 0 || bytes > max_bytes) {
+    refuse(source,
+           where + " is " + kind + " of " + std::to_string(bytes) + " bytes, more than this version writes");
+  }
+  return attribute;
+}
+
+// A fixed-length string attribute (at most 64 bytes), trailing NULs dropped.
+std::string string_attribute(hid_t object, const char* name, const std::string& where,
+                             const std::string& source) {
+  std::size_t bytes = 0;
+  Handle attribute = open_attribute(object, name, where, H5T_STRING, 64, bytes, source);
+  Handle type(H5Aget_type(attribute.get()), H5Tclose);
+  std::array<char, 64> text{};
+  if (!type.ok() || H5Aread(attribute.get(), type.get(), text.data()) < 0)
+    refuse(source, where + " cannot be read (damaged)");
+  std::string value(text.data(), bytes);
+  while (!value.empty() && value.back() == '\0') value.pop_back();
+  return value;
+}
+
+// An integer attribute of 1, 2, 4 or 8 bytes, signed or not, either byte order, as its decimal text: read
+// with its own type (no conversion) and decoded here.
+std::string integer_attribute(hid_t object, const char* name, const std::string& where,
+                              const std::string& source) {
+  std::size_t bytes = 0;
+  Handle attribute = open_attribute(object, name, where, H5T_INTEGER, 8, bytes, source);
+  Handle type(H5Aget_type(attribute.get()), H5Tclose);
+  std::array<unsigned char, 8> raw{};
+  const H5T_order_t order = type.ok() ? H5Tget_order(type.get()) : H5T_ORDER_ERROR;
+  const H5T_sign_t sign = type.ok() ? H5Tget_sign(type.get()) : H5T_SGN_ERROR;
+  if ((bytes != 1 && bytes != 2 && bytes != 4 && bytes != 8) ||
+      (order != H5T_ORDER_LE && order != H5T_ORDER_BE) || (sign != H5T_SGN_NONE && sign != H5T_SGN_2) ||
+      H5Tget_precision(type.get()) != 8 * bytes || H5Tget_offset(type.get()) != 0)
+    refuse(source, where + " is not an integer of 1, 2, 4 or 8 bytes");
+  if (H5Aread(attribute.get(), type.get(), raw.data()) < 0)
+    refuse(source, where + " cannot be read (damaged)");
+  std::uint64_t value = 0;
+  for (std::size_t i = 0; i < bytes; ++i) {
+    const std::size_t at = order == H5T_ORDER_LE ? bytes - 1 - i : i;  // most significant byte first
+    value = (value << 8) | raw[at];
+  }
+  const bool negative = sign == H5T_SGN_2 && (value >> (8 * bytes - 1)) != 0;
+  if (!negative) return std::to_string(value);
+  const std::uint64_t magnitude = bytes == 8 ? ~value + 1 : (std::uint64_t{1} << (8 * bytes)) - value;
+  std::string text(1, '-');  // built by appends: GCC 12 warns wrongly on "-" + std::string
+  return text.append(std::to_string(magnitude));
+}
+
+// Refuses the file unless `got` is `expected` (each as its text: a string quoted, a number as it is).
+void require_attribute(const std::string& where, const std::string& got, const std::string& expected,
+                       bool quoted, const std::string& source) {
+  if (got == expected) return;
+  const auto shown = [quoted](const std::string& text) {
+    if (!quoted) return text;
+    std::string q("\"");
+    return q.append(text).append("\"");
+  };
+  std::string what(where);
+  what.append(" is ").append(shown(got)).append(", this version writes ").append(shown(expected));
+  refuse(source, what);
+}
+
 // A dataset's chunks read raw (H5Dread_chunk) and decoded here: inflated by libdeflate (the same zlib
 // stream, RFC 1950, that HDF5's deflate filter writes, at about three times zlib's speed) and unshuffled.
 // HDF5's own pipeline would do the same under its global lock; this way the decoding of one file runs
@@ -452,17 +548,31 @@ class TraceFileReader {
       refuse(source_, std::string("column '") + name + "' cannot be read (damaged or of another type)");
   }
 
-  // A measured column: integers over 10^decimals, or doubles; every value finite when `finite`.
   // A measured column: integers over 10^`decimals` (the version's, which the column's attribute repeats for
   // other readers), or doubles; every value finite when `finite`.
-  std::vector<double> measured(const char* name, int decimals, bool finite) {
+  // Its attributes say the same to other readers (h5py divides by 10 ** decimals): `unit` must be `unit`, and
+  // `decimals` `decimals` on an integer column and absent on a column of doubles, or the file is refused.
+  std::vector<double> measured(const char* name, const char* unit, int decimals, bool finite) {
     Handle dataset = open(name, {H5T_STD_I32LE, H5T_STD_I64LE, H5T_IEEE_F64LE});
     Handle type(H5Dget_type(dataset.get()), H5Tclose);
+    const bool integers = H5Tget_class(type.get()) == H5T_INTEGER;
+    const std::string unit_path = attribute_path(name, "unit");
+    require_attribute(unit_path, string_attribute(dataset.get(), "unit", unit_path, source_), unit, true,
+                      source_);
+    const std::string decimals_path = attribute_path(name, "decimals");
+    if (integers) {
+      require_attribute(decimals_path, integer_attribute(dataset.get(), "decimals", decimals_path, source_),
+                        std::to_string(decimals), false, source_);
+    } else if (H5Aexists(dataset.get(), "decimals") != 0) {
+      refuse(source_, decimals_path +
+                          " is on a column of doubles, where this version writes none (the values are not "
+                          "scaled)");
+    }
     // The integer (exact in a double) over an exact power of ten, one correctly rounded division: the value
     // the CSV's text of the same digits parses to.
     static constexpr double kPowers[] = {1e0, 1e1, 1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
                                          1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15};  // each exact
-    const double power = H5Tget_class(type.get()) == H5T_INTEGER ? kPowers[decimals] : 1.0;
+    const double power = integers ? kPowers[decimals] : 1.0;
     std::vector<double> values(samples_);
     if (!direct_.read_measured(dataset.get(), type.get(), samples_, power, values.data())) {
       read(dataset, name, H5T_NATIVE_DOUBLE, values.data());
@@ -531,10 +641,25 @@ TraceColumns parse_trace_hdf5(std::string_view bytes, const std::string& source,
   Handle file(H5Fopen(image_name().c_str(), H5F_ACC_RDONLY, access.get()), H5Fclose);
   if (!file.ok()) refuse(source, "HDF5 cannot open it (damaged)");
   // What the file is, its version and so its layout, are in the header checked above. HDF5's attributes (the
-  // root's format, version and samples, a column's unit and decimals) say the same to other readers and are
-  // never read here: decoding an attribute message is where HDF5 1.10 crashes on a damaged header, and a
-  // file that reads must not depend on them. The samples are the time column's length.
+  // root's format, version and samples, a column's unit and decimals) say the same to other readers, which
+  // read the values by them (docs/python.md): each must be what this version writes, or the file is refused
+  // naming it, so that no file reads as one thing here and as another there. They are decoded only now that
+  // the CRC-32 has matched (accidental damage to a header is where HDF5 1.10 crashed), and each is checked
+  // before it is read (above: open_attribute).
+  const hid_t root = file.get();
+  const std::string format_path = attribute_path(nullptr, "format");
+  require_attribute(format_path, string_attribute(root, "format", format_path, source),
+                    std::string(kMagic.substr(0, kMagic.size() - 1)), true, source);
+  const std::string version_path = attribute_path(nullptr, "version");
+  require_attribute(version_path, integer_attribute(root, "version", version_path, source),
+                    std::to_string(kVersion), false, source);
+  // The samples are the time column's length, which the root's `samples` repeats.
   const std::size_t samples = dataset_length(file.get(), "t", source);
+  const std::string declared = integer_attribute(root, "samples", attribute_path(nullptr, "samples"), source);
+  if (declared != std::to_string(samples)) {
+    refuse(source, "attribute /samples is " + declared + ", but the time column holds " +
+                       std::to_string(samples) + " samples");
+  }
   // Bounded before any column is allocated: by what the file's bytes could hold (deflate inflates at most
   // 1032-fold, a sample takes at least 4 bytes of the time column) and by kMaxTraceSamples.
   if (samples > kMaxTraceSamples || samples / 1032 > bytes.size() / 4) {
@@ -545,14 +670,14 @@ TraceColumns parse_trace_hdf5(std::string_view bytes, const std::string& source,
   }
   TraceFileReader in(file.get(), samples, source);
   TraceColumns c;
-  c.time_s = in.measured("t", kTraceTimeDecimals, true);
-  c.x_m = in.measured("x", kTracePositionDecimals, true);
-  c.y_m = in.measured("y", kTracePositionDecimals, true);
-  c.z_m = in.measured("z", kTracePositionDecimals, true);
-  c.fx_n = in.measured("fx", kTraceForceDecimals, false);
-  c.fy_n = in.measured("fy", kTraceForceDecimals, false);
+  c.time_s = in.measured("t", "s", kTraceTimeDecimals, true);
+  c.x_m = in.measured("x", "m", kTracePositionDecimals, true);
+  c.y_m = in.measured("y", "m", kTracePositionDecimals, true);
+  c.z_m = in.measured("z", "m", kTracePositionDecimals, true);
+  c.fx_n = in.measured("fx", "N", kTraceForceDecimals, false);
+  c.fy_n = in.measured("fy", "N", kTraceForceDecimals, false);
   if (columns == TraceColumnSet::pen) return c;
-  c.fz_n = in.measured("fz", kTraceForceDecimals, false);
+  c.fz_n = in.measured("fz", "N", kTraceForceDecimals, false);
   c.state = in.states();
   c.stroke = in.whole<std::uint32_t>("stroke", H5T_STD_U32LE, H5T_NATIVE_UINT32);
   c.element = in.whole<std::uint32_t>("element", H5T_STD_U32LE, H5T_NATIVE_UINT32);

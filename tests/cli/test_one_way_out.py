@@ -299,6 +299,30 @@ class OneWayOut(unittest.TestCase):
         self.assert_one_error(result, 2, "index.html", "session.json")
         self.assertEqual(digest(manifest), before)
 
+    def test_study_report_through_a_link_planted_in_its_folder_writes_nothing_outside_it(self):
+        # A set of files is written only in its own folders (docs/cli.md, "Outputs"): a link in the report
+        # folder to a file elsewhere is refused, naming it, and the file it names is left alone.
+        found = subprocess.run([sys.executable, "-c", "import pandas, calligraphy.study_report"], cwd=self.cwd,
+                               capture_output=True, timeout=TIMEOUT_S)
+        if found.returncode != 0:  # sanitizer builds have no Python module; the report needs pandas
+            self.skipTest(f"no Python module or no pandas: {found.stderr.decode().strip().splitlines()[-1:]}")
+        outside = self.cwd / "outside"
+        outside.mkdir()
+        victim = outside / "precious.txt"
+        victim.write_text("keep me\n")
+        (self.cwd / "report").mkdir()
+        os.symlink(victim, self.cwd / "report" / "index.html")
+        result = subprocess.run([sys.executable, "-m", "calligraphy.study_report", str(self.session.parent.parent),
+                                 "--out", "report"], cwd=self.cwd, capture_output=True, timeout=TIMEOUT_S)
+        message = result.stderr.decode(errors="replace")
+        self.assertEqual(result.returncode, 1, message)
+        self.assertEqual(len(message.strip().splitlines()), 1, message)
+        self.assertIn("index.html", message)
+        self.assertIn("symbolic link", message)
+        self.assertEqual(victim.read_text(), "keep me\n")
+        self.assertEqual(sorted(p.name for p in outside.iterdir()), ["precious.txt"])
+        self.assertTrue((self.cwd / "report" / "index.html").is_symlink())
+
     # --- the journal of a set (report --csv, study_report) ---------------------------------------------------
 
     def killed_between_renames(self, tables):

@@ -318,7 +318,12 @@ def test_a_small_trace_declaring_more_samples_than_any_trial_is_refused_unread(c
 
     h5py = pytest.importorskip("h5py")
     body = tmp_path / "body.h5"
+    numpy = __import__("numpy")
     with h5py.File(body, "w", userblock_size=512) as forged:
+        # The root's attributes as the writer makes them (the reader checks them), declaring that many.
+        forged.attrs["format"] = numpy.bytes_(b"calligraphy-trace")
+        forged.attrs["version"] = numpy.int32(1)
+        forged.attrs["samples"] = numpy.uint64(samples)
         for column in ("t", "x", "y", "z", "fx", "fy", "fz"):
             forged.create_dataset(column, shape=(samples,), dtype="<i8", chunks=(65536,), compression="gzip")
         # Some bytes that do not compress, so that the file is large enough to hold that many samples at the

@@ -78,6 +78,11 @@ struct FileContent {
 ///    A set needs no folder but its targets' own (in which `add` already made the temporaries); a stop
 ///    signal (guard_output_files) that comes between the first and the last rename ends the process once
 ///    the set is whole.
+///  - a set is written only in its own folders, never through a link: a target that is a symbolic link
+///    (dangling or not) is refused by `add` (DataError naming it) before anything of the set is replaced,
+///    unlike `write_file_atomically`, which writes the file one link names; a link planted after `add` is
+///    replaced by the rename, its target untouched. A target with other hard links is replaced by rename
+///    too: the name gets the new file, and the file its other names share is left as it was.
 ///  - destroyed without `commit`: the temporaries are removed and no target changes.
 /// Throws DataError naming the file at fault (as `write_file_atomically`), StateError for `add` after
 /// `commit` or a second `commit`. A device or FIFO among the targets is written in place after the renames.

@@ -18,9 +18,13 @@
 /// any HDF5 reader decodes them). The file's first 512 bytes are an HDF5 user block that readers skip; it
 /// holds "calligraphy-trace" and the CRC-32 (ISO 3309, as zlib and gzip compute it) and length of the rest,
 /// which this library checks before HDF5 parses anything: a damaged or truncated file is refused by name,
-/// never handed to HDF5. The header's version fixes the layout and the decimals, so this library reads no
-/// HDF5 attribute (they are for other readers) and only the exact column types above. A file whose CRC-32
-/// was made to match a changed HDF5 structure reaches HDF5's parser, which (1.10.8) may still crash on it.
+/// never handed to HDF5. The header's version fixes the layout and the decimals; the HDF5 attributes say the
+/// same to other readers (which scale by them), and once the CRC-32 has matched each is checked (one value,
+/// of the class and bounded size written) and must be what this version writes, or the file is refused
+/// naming it (DataError: "T.trace.h5: column 'x': attribute /x/decimals is 3, this version writes 7"), so no
+/// file reads one way here and another in h5py. Only the exact column types above are read. A file whose
+/// CRC-32 was made to match a changed HDF5 structure reaches HDF5's parser, which (1.10.8) may still crash on
+/// it.
 #include <cstdint>
 #include <filesystem>
 #include <string>
