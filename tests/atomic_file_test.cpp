@@ -410,16 +410,19 @@ TEST_CASE("a set is written only in its own folder: a link in a member's place i
   plant(victim, "keep me\n");
   plant(tables / "strokes.csv", "old strokes\n");
   SECTION("a symbolic link, to a file or dangling, is refused naming it before anything is replaced") {
-    const fs::path target = GENERATE_COPY(victim, outside / "not-there.txt");
-    fs::create_symlink(target, tables / "trials.csv");
-    const FileContent next[] = {{tables / "strokes.csv", "new strokes\n"}, {tables / "trials.csv", "new\n"}};
-    CHECK_THROWS_WITH(write_files_atomically(next),
-                      Catch::Contains((tables / "trials.csv").string()) && Catch::Contains("symbolic link"));
-    CHECK(contents(victim) == "keep me\n");
-    CHECK_FALSE(fs::exists(outside / "not-there.txt"));
-    CHECK(contents(tables / "strokes.csv") == "old strokes\n");
-    CHECK(fs::is_symlink(tables / "trials.csv"));
-    CHECK(names_in(tables) == std::vector<std::string>{"strokes.csv", "trials.csv"});
+    for (const fs::path& target : {victim, outside / "not-there.txt"}) {
+      INFO("the link points at " << target.string());
+      fs::remove(tables / "trials.csv");
+      fs::create_symlink(target, tables / "trials.csv");
+      const FileContent next[] = {{tables / "strokes.csv", "new strokes\n"}, {tables / "trials.csv", "new\n"}};
+      CHECK_THROWS_WITH(write_files_atomically(next),
+                        Catch::Contains((tables / "trials.csv").string()) && Catch::Contains("symbolic link"));
+      CHECK(contents(victim) == "keep me\n");
+      CHECK_FALSE(fs::exists(outside / "not-there.txt"));
+      CHECK(contents(tables / "strokes.csv") == "old strokes\n");
+      CHECK(fs::is_symlink(tables / "trials.csv"));
+      CHECK(names_in(tables) == std::vector<std::string>{"strokes.csv", "trials.csv"});
+    }
   }
   SECTION("a member hard-linked to a file elsewhere gets the new file; the other name keeps the old one") {
     fs::create_hard_link(victim, tables / "trials.csv");
