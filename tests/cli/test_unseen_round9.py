@@ -221,6 +221,31 @@ class OutputSets(unittest.TestCase):
 
 @unittest.skipUnless(CLI, "CALLIGRAPHY_CLI not set")
 @unittest.skipIf(SANITIZED, "a study of two subjects: left to the Release run")
+class StudyReportFolders(unittest.TestCase):
+    """Python's study report (`python3 -m calligraphy.study_report STUDY --out OUT`) whose own `tables/`
+    folder is a symbolic link to a sibling folder: the set's files would leave OUT through it."""
+
+    def test_tables_folder_that_is_a_link(self):
+        if cg is None:
+            self.skipTest("the Python package is not on PYTHONPATH")
+        base = Shared.get()
+        tmp = Path(tempfile.mkdtemp(prefix="case-", dir=base))
+        (tmp / "elsewhere").mkdir()
+        (tmp / "elsewhere" / "mine.txt").write_bytes(b"mine\n")
+        (tmp / "paper").mkdir()
+        os.symlink("../elsewhere", tmp / "paper" / "tables")
+        r = subprocess.run([sys.executable, "-m", "calligraphy.study_report", str(base / "study"), "--out", "paper"],
+                           cwd=tmp, stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=120, env=ENV)
+        lines = error_lines(r)
+        self.assertEqual(r.returncode, 1, lines)
+        self.assertEqual(len(lines), 1, lines)
+        self.assertIn("paper/tables", lines[0])
+        self.assertEqual(sorted(p.name for p in (tmp / "elsewhere").iterdir()), ["mine.txt"])
+        self.assertEqual(sorted(p.name for p in (tmp / "paper").iterdir()), ["tables"])
+
+
+@unittest.skipUnless(CLI, "CALLIGRAPHY_CLI not set")
+@unittest.skipIf(SANITIZED, "a study of two subjects: left to the Release run")
 class SwappedTrace(unittest.TestCase):
     """One trial's trace copied over another's inside a session folder."""
 
