@@ -227,9 +227,9 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
   // their pointer, before a device is looked up: a simulated writer's profile on a person's trial, and the
   // physics of a simulated device on another device.
   if (r.writer && r.spec.writer == TrialWriter::person)
-    json_detail::fail(source, reader.pointer("writer"),
-                      "a simulated writer's profile for a trial a person writes (/trial/writer 'person'); "
-                      "expected null");
+    json_detail::fail(source, reader.pointer("trial") + "/writer",
+                      "'person', but the record holds a simulated writer's profile (/writer, null for a "
+                      "person)");
   if (r.simulated_device && r.spec.device != "simulated") {
     std::string message = "simulated device physics for the device '";
     message.append(r.spec.device).append("' (/trial/device; only for 'simulated'); expected null");

@@ -123,7 +123,8 @@ class RecordReRun(unittest.TestCase):
         rec = self.record()
         rec["specification"]["trial"]["device"] = "openhaptics"
         rec["specification"]["trial"]["writer"] = "person"
-        line = self.refused(rec, "/specification/writer")
+        line = self.refused(rec, "/specification/trial/writer")
+        self.assertIn("profile", line)
         self.assertNotIn("libHD", line)  # the content is refused, no device library was looked for
 
     @heavy
