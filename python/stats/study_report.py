@@ -956,6 +956,13 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
     data = _phase_trials(kept, phase)
     out = pathlib.Path(out_dir)
     figures, tables = out / "figures", out / "tables"
+    for folder in (figures, tables):
+        # The report's own subfolders are part of its set: one that is a symbolic link would carry the set's
+        # files out of out_dir, as a link in a file's place would (refused by the file set), so it is refused.
+        if folder.is_symlink():
+            raise OSError(errno.ELOOP, f"{folder}: is a symbolic link: the report's files are written only in "
+                          "its own folders, never through a link (nothing written; remove the link or write the "
+                          "report elsewhere)")
     for folder in (out, figures, tables):
         _make_folder(folder)
     per_trial_link = _relative_link(per_trial_page, out) if per_trial_page is not None else None

@@ -223,6 +223,18 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
     json_detail::fail(source, reader.pointer("teacher_sha256"),
                       "names a teacher, but the trial is not a replay");
   r.teacher_sha256 = std::move(parts.teacher_sha256);
+  // The parts a trial's builder takes only for some trials are refused here, as content of the record at
+  // their pointer, before a device is looked up: a simulated writer's profile on a person's trial, and the
+  // physics of a simulated device on another device.
+  if (r.writer && r.spec.writer == TrialWriter::person)
+    json_detail::fail(source, reader.pointer("trial") + "/writer",
+                      "'person', but the record holds a simulated writer's profile (/writer, null for a "
+                      "person)");
+  if (r.simulated_device && r.spec.device != "simulated") {
+    std::string message = "simulated device physics for the device '";
+    message.append(r.spec.device).append("' (/trial/device; only for 'simulated'); expected null");
+    json_detail::fail(source, reader.pointer("simulated_device"), message);
+  }
   r.defaulted = std::move(read.defaulted);
   return r;
 }
