@@ -55,8 +55,37 @@ int close_checked(int& fd) {
 }
 
 // A device, FIFO or terminal: written as it is; there is no file to replace.
+// How long a FIFO may wait for a process to read it: an output is never a hang, and a reader started beside
+// the writer (`cat FIFO & calligraphy ... --csv FIFO`) has this long to open it.
+constexpr int kFifoReaderWaitMs = 10000;
+
+// A FIFO opened for writing without waiting (O_NONBLOCK: ENXIO while no process has it open to read), tried
+// again every 20 ms until a reader comes or kFifoReaderWaitMs pass; then writes block as they do on any pipe.
+int open_fifo_for_writing(const fs::path& path) {
+  for (int waited_ms = 0;; waited_ms += 20) {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+    if (fd >= 0) {
+      const int flags = ::fcntl(fd, F_GETFL);
+      if (flags < 0 || ::fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0) {
+        const int error = errno;
+        ::close(fd);
+        fail(path, "cannot open for writing", error);
+      }
+      return fd;
+    }
+    if (errno != ENXIO) fail(path, "cannot open for writing", errno);
+    if (waited_ms >= kFifoReaderWaitMs) {
+      throw DataError(path.string() + ": cannot write: a FIFO that no process opened for reading within " +
+                      std::to_string(kFifoReaderWaitMs / 1000) + " s");
+    }
+    ::usleep(20000);
+  }
+}
+
 void write_in_place(const fs::path& path, std::string_view content) {
-  int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC | O_NOCTTY);
+  struct stat status {};
+  const bool fifo = ::stat(path.c_str(), &status) == 0 && S_ISFIFO(status.st_mode);
+  int fd = fifo ? open_fifo_for_writing(path) : ::open(path.c_str(), O_WRONLY | O_CLOEXEC | O_NOCTTY);
   if (fd < 0) fail(path, "cannot open for writing", errno);
   const int write_error = write_all(fd, content);
   const int close_error = close_checked(fd);

@@ -219,6 +219,18 @@ class OutputSets(unittest.TestCase):
         self.assertTrue(fifo.is_fifo(), "the FIFO was replaced by a file")
         self.assertEqual(sorted(p.name for p in (self.tmp / "tables").iterdir()), ["strokes.csv", "trials.csv"])
 
+    @heavy
+    def test_report_fifo_no_process_reads_is_an_error_not_a_hang(self):
+        fifo = self.tmp / "tables" / "strokes.csv"
+        os.mkfifo(fifo)
+        r = run(["report", self.base / "study", "--csv", "tables"], self.tmp, timeout=60)  # waits 10 s
+        lines = error_lines(r)
+        self.assertEqual(r.returncode, 1, lines)
+        self.assertEqual(len(lines), 1, lines)
+        self.assertIn("strokes.csv", lines[0])
+        self.assertIn("no process opened for reading", lines[0])
+        self.assertTrue(fifo.is_fifo(), "the FIFO was replaced by a file")
+
 
 @unittest.skipUnless(CLI, "CALLIGRAPHY_CLI not set")
 @unittest.skipIf(SANITIZED, "a study of two subjects: left to the Release run")
