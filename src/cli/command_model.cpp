@@ -27,7 +27,7 @@ int run_model(const ModelCommand& command) {
   FilePlan files;
   add_library_inputs(files, command.library);
   files.output("--svg", command.svg);
-  const Character character = CharacterSource(command.library).load(chars[0]);
+  const Character character = CharacterSource(command.library).load_named(chars[0], "CHAR");
   if (!command.svg.empty()) write_output(command.svg, model_svg(character));
   if (command.json) {
     write_standard_output(model_json(character));

@@ -40,16 +40,7 @@ int run_score(const ScoreCommand& command) {
   // written.
   std::vector<Character> models;
   const CharacterSource source(command.library);
-  // A character the user named that the library lacks is the command's input, as one of a protocol is:
-  // wrong usage (exit 2, docs/cli.md); one the library has but cannot read stays a data error (exit 1).
-  for (const char32_t c : chars) {
-    try {
-      models.push_back(source.load(c));
-    } catch (const CharacterNotFound& e) {
-      std::string message("--character: ");
-      throw UsageError(message.append(e.what()));
-    }
-  }
+  for (const char32_t c : chars) models.push_back(source.load_named(c, "--character"));
   const Scene scene = Scene::lay_out(models);
   const PlacedCharacter& character = scene.characters.front();
   TerminalProgress progress("reading " + command.trace);  // on stderr, only when it is a terminal

@@ -150,7 +150,7 @@ int run_train(const TrainCommand& command, DeviceRegistry& devices) {
   const CharacterLibrary outlines = library_from(command.library);
   for (const char32_t c : chars) {
     trainer::TrainerCharacter character;
-    character.model = source.load(c);
+    character.model = source.load_named(c, "CHARS");
     character.utf8 = encode_utf8(c);
     try {
       character.outlines = outlines.load_outlines(c);

@@ -282,7 +282,17 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
   std::map<char32_t, std::size_t> loaded;  // a character repeated in CHARS is read and fitted once
   for (char32_t c : chars) {
     const auto [at, added] = loaded.try_emplace(c, characters.size());
-    characters.push_back(added ? source.load(c) : characters[at->second]);
+    if (!added) {
+      characters.push_back(characters[at->second]);
+    } else if (!recorded) {
+      characters.push_back(source.load_named(c, "CHARS"));
+    } else {
+      try {  // a record's character the library lacks is named as every bad value of it is (exit 2)
+        characters.push_back(source.load(c));
+      } catch (const CharacterNotFound& e) {
+        throw InputError(command.spec_file + ": /specification/trial/characters: " + e.what());
+      }
+    }
   }
   const Scene scene = Scene::lay_out(characters, recorded ? recorded->layout : SceneLayout{});
   // A signal while the characters were read: nothing recorded yet, no device opened, no file written.

@@ -48,6 +48,15 @@ Character CharacterSource::load(char32_t code_point) const {
   }
 }
 
+Character CharacterSource::load_named(char32_t code_point, const std::string& named_by) const {
+  try {
+    return load(code_point);
+  } catch (const CharacterNotFound& e) {
+    std::string message = named_by;
+    throw UsageError(message.append(": ").append(e.what()));
+  }
+}
+
 bool CharacterSource::contains(char32_t code_point) const {
   return store_ ? store_->contains(code_point) : library_.contains(code_point);
 }

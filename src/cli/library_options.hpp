@@ -32,6 +32,10 @@ class CharacterSource {
   /// The character's model; throws CharacterNotFound (for the embedded set naming --data and --store)
   /// or DataError.
   [[nodiscard]] Character load(char32_t code_point) const;
+  /// The model of a character the user named (`named_by`: "CHARS", "--character", "--spec FILE"): as `load`,
+  /// but one the library lacks is the user's input, a UsageError (exit 2) starting with `named_by`, as a
+  /// protocol's is; one the library has but cannot read stays a DataError (exit 1).
+  [[nodiscard]] Character load_named(char32_t code_point, const std::string& named_by) const;
   /// True when the character is there.
   [[nodiscard]] bool contains(char32_t code_point) const;
   /// Every character there, sorted by code point (DataError for a folder without character files).

@@ -320,12 +320,24 @@ class CharacterStatuses(unittest.TestCase):
                         continue
                     self.assertEqual(len(lines), 1, lines)
                     self.assertIn(code, lines[0])
-                    # The table: 2 for `score --character` (naming the option); the others a library error.
-                    if name == "score":
-                        self.assertEqual(r.returncode, 2, lines)
-                        self.assertIn("--character", lines[0])
-                    else:
-                        self.assertIn(r.returncode, (1, 2), lines)
+                    # The table: wrong usage, naming the argument that gave it, as a protocol's is.
+                    self.assertEqual(r.returncode, 2, lines)
+                    self.assertIn("--character" if name == "score" else "CHAR", lines[0])
+            # A trial record whose characters were edited to one the library lacks: named at its pointer.
+            record = base / f"lacking-{code}.record.json"
+            if not record.exists():
+                made = run(["trial", SHI, "--json", record.name], base)
+                self.assertEqual(made.returncode, 0, made.stderr)
+                document = json.loads(record.read_text(encoding="utf-8"))
+                document["specification"]["trial"]["characters"] = SHI + text.decode()
+                record.write_text(json.dumps(document, ensure_ascii=False), encoding="utf-8")
+            r = run(["trial", "--spec", record.name, "--json", "again.json"], base)
+            lines = error_lines(r)
+            with self.subTest(text=label, command="trial --spec"):
+                self.assertEqual(r.returncode, 2, lines)
+                self.assertEqual(len(lines), 1, lines)
+                self.assertIn(f"{record.name}: /specification/trial/characters", lines[0])
+                self.assertIn(code, lines[0])
             protocol = copy.deepcopy(PROTOCOL)
             protocol["test"]["characters"] = [SHI + text.decode()]
             path = base / f"lacking-{code}.json"

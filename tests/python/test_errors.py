@@ -107,7 +107,7 @@ def test_simulated_device_bad_input():
 def test_cli_adds_its_own_flag_hint(cli):
     # The library's message is neutral; the command line names its options.
     run = subprocess.run([cli, "model", "龘"], capture_output=True, text=True)
-    assert run.returncode == 1
+    assert run.returncode == 2  # a character the user names that the library lacks: wrong usage
     assert "U+9F98" in run.stderr and "--data" in run.stderr and "CharacterLibrary" not in run.stderr
 
 
