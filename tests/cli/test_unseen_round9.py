@@ -63,6 +63,9 @@ SIMULATED_DEVICE = {"moving_mass_kg": 0.05, "damping_n_s_per_m": 0.5, "encoder_r
                     "initial_position_m": [0, 0, 0.01]}
 
 
+# What `train` says in a build without the trainer window (the sanitizer stage builds none).
+WITHOUT_WINDOW = b"built without the trainer window"
+
 class Shared:
     """Two trial records (fixed guidance and fading) with the first one's CSV, and a study of two subjects."""
     folder = None
@@ -303,6 +306,8 @@ class CharacterStatuses(unittest.TestCase):
                 with self.subTest(text=label, command=name):
                     r = run(args, base)
                     lines = error_lines(r)
+                    if WITHOUT_WINDOW in r.stderr:  # the sanitizer stage's build: `train` only says so
+                        continue
                     self.assertEqual(r.returncode, 2, lines)
                     self.assertEqual(len(lines), 1, lines)
 
@@ -315,6 +320,8 @@ class CharacterStatuses(unittest.TestCase):
                 with self.subTest(text=label, command=name):
                     r = run(args, base)
                     lines = error_lines(r)
+                    if WITHOUT_WINDOW in r.stderr:
+                        continue
                     if name == "characters":  # named on its list, not an error
                         self.assertEqual(r.returncode, 0, lines)
                         continue
