@@ -13,9 +13,12 @@
 #include <cstring>
 #include <initializer_list>
 #include <limits>
+#include <optional>
+#include <string>
 #include <system_error>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/report/trace_columns.hpp"
 #include "calligraphy/report/trial_report.hpp"
 #include "core/whole_file.hpp"
 
@@ -23,6 +26,8 @@ namespace calligraphy {
 namespace {
 
 constexpr std::string_view kMagic = "calligraphy-trace\n";
+// The root's `format` attribute: the user block's first line, for readers of the HDF5 alone.
+constexpr std::string_view kFormat = kMagic.substr(0, kMagic.size() - 1);
 constexpr int kVersion = 1;
 // HDF5 looks for its superblock at 0, 512, 1024, ...: the smallest user block is 512 bytes.
 constexpr std::size_t kUserBlockBytes = 512;
@@ -129,8 +134,15 @@ bool scaled_integer(double value, int decimals, std::int64_t& out) {
   return true;
 }
 
-void write_scaled_column(hid_t file, const char* name, const char* unit, int decimals,
-                         const std::vector<TrialSample>& trace, double (*get)(const TrialSample&)) {
+// The unit of the measured column the trace files name `file_name` ("t", "x", "fx"), from the one table of
+// a trace's columns (trace_columns.hpp): what its `unit` attribute says.
+std::string unit_of(const char* file_name) {
+  const std::optional<TraceColumnInfo> column = trace_column(file_name);
+  return column ? std::string(column->unit) : std::string();
+}
+
+void write_scaled_column(hid_t file, const char* name, int decimals, const std::vector<TrialSample>& trace,
+                         double (*get)(const TrialSample&)) {
   std::vector<std::int64_t> integers(trace.size());
   bool exact = true;
   bool fits_32 = true;
@@ -151,7 +163,7 @@ void write_scaled_column(hid_t file, const char* name, const char* unit, int dec
     dataset = write_column(file, name, H5T_STD_I64LE, H5T_NATIVE_INT64, integers.data(), integers.size());
   }
   Handle closer(dataset, H5Dclose);
-  write_string_attribute(dataset, "unit", unit);
+  write_string_attribute(dataset, "unit", unit_of(name));
   if (exact) write_number_attribute(dataset, "decimals", H5T_STD_I32LE, H5T_NATIVE_INT, decimals);
 }
 
@@ -193,23 +205,22 @@ std::string trial_trace_hdf5(const std::vector<TrialSample>& trace) {
   Handle file(H5Fcreate(image_name().c_str(), H5F_ACC_TRUNC, create.get(), access.get()), H5Fclose);
   if (!file.ok()) throw DataError("trace file: HDF5 cannot make an in-memory file");
   const hid_t root = file.get();
-  write_string_attribute(root, "format", "calligraphy-trace");
+  write_string_attribute(root, "format", kFormat);
   write_number_attribute(root, "version", H5T_STD_I32LE, H5T_NATIVE_INT, kVersion);
   write_number_attribute(root, "samples", H5T_STD_U64LE, H5T_NATIVE_UINT64, std::uint64_t{trace.size()});
 
-  write_scaled_column(root, "t", "s", kTraceTimeDecimals, trace,
-                      [](const TrialSample& s) { return s.time_s; });
-  write_scaled_column(root, "x", "m", kTracePositionDecimals, trace,
+  write_scaled_column(root, "t", kTraceTimeDecimals, trace, [](const TrialSample& s) { return s.time_s; });
+  write_scaled_column(root, "x", kTracePositionDecimals, trace,
                       [](const TrialSample& s) { return s.position_m.x(); });
-  write_scaled_column(root, "y", "m", kTracePositionDecimals, trace,
+  write_scaled_column(root, "y", kTracePositionDecimals, trace,
                       [](const TrialSample& s) { return s.position_m.y(); });
-  write_scaled_column(root, "z", "m", kTracePositionDecimals, trace,
+  write_scaled_column(root, "z", kTracePositionDecimals, trace,
                       [](const TrialSample& s) { return s.position_m.z(); });
-  write_scaled_column(root, "fx", "N", kTraceForceDecimals, trace,
+  write_scaled_column(root, "fx", kTraceForceDecimals, trace,
                       [](const TrialSample& s) { return s.force_n.x(); });
-  write_scaled_column(root, "fy", "N", kTraceForceDecimals, trace,
+  write_scaled_column(root, "fy", kTraceForceDecimals, trace,
                       [](const TrialSample& s) { return s.force_n.y(); });
-  write_scaled_column(root, "fz", "N", kTraceForceDecimals, trace,
+  write_scaled_column(root, "fz", kTraceForceDecimals, trace,
                       [](const TrialSample& s) { return s.force_n.z(); });
 
   const std::size_t n = trace.size();
@@ -550,15 +561,16 @@ class TraceFileReader {
 
   // A measured column: integers over 10^`decimals` (the version's, which the column's attribute repeats for
   // other readers), or doubles; every value finite when `finite`.
-  // Its attributes say the same to other readers (h5py divides by 10 ** decimals): `unit` must be `unit`, and
-  // `decimals` `decimals` on an integer column and absent on a column of doubles, or the file is refused.
-  std::vector<double> measured(const char* name, const char* unit, int decimals, bool finite) {
+  // Its attributes say the same to other readers (h5py divides by 10 ** decimals): `unit` must be its unit in
+  // the table of a trace's columns, and `decimals` `decimals` on an integer column and absent on a column of
+  // doubles, or the file is refused.
+  std::vector<double> measured(const char* name, int decimals, bool finite) {
     Handle dataset = open(name, {H5T_STD_I32LE, H5T_STD_I64LE, H5T_IEEE_F64LE});
     Handle type(H5Dget_type(dataset.get()), H5Tclose);
     const bool integers = H5Tget_class(type.get()) == H5T_INTEGER;
     const std::string unit_path = attribute_path(name, "unit");
-    require_attribute(unit_path, string_attribute(dataset.get(), "unit", unit_path, source_), unit, true,
-                      source_);
+    require_attribute(unit_path, string_attribute(dataset.get(), "unit", unit_path, source_), unit_of(name),
+                      true, source_);
     const std::string decimals_path = attribute_path(name, "decimals");
     if (integers) {
       require_attribute(decimals_path, integer_attribute(dataset.get(), "decimals", decimals_path, source_),
@@ -648,8 +660,8 @@ TraceColumns parse_trace_hdf5(std::string_view bytes, const std::string& source,
   // before it is read (above: open_attribute).
   const hid_t root = file.get();
   const std::string format_path = attribute_path(nullptr, "format");
-  require_attribute(format_path, string_attribute(root, "format", format_path, source),
-                    std::string(kMagic.substr(0, kMagic.size() - 1)), true, source);
+  require_attribute(format_path, string_attribute(root, "format", format_path, source), std::string(kFormat),
+                    true, source);
   const std::string version_path = attribute_path(nullptr, "version");
   require_attribute(version_path, integer_attribute(root, "version", version_path, source),
                     std::to_string(kVersion), false, source);
@@ -670,14 +682,14 @@ TraceColumns parse_trace_hdf5(std::string_view bytes, const std::string& source,
   }
   TraceFileReader in(file.get(), samples, source);
   TraceColumns c;
-  c.time_s = in.measured("t", "s", kTraceTimeDecimals, true);
-  c.x_m = in.measured("x", "m", kTracePositionDecimals, true);
-  c.y_m = in.measured("y", "m", kTracePositionDecimals, true);
-  c.z_m = in.measured("z", "m", kTracePositionDecimals, true);
-  c.fx_n = in.measured("fx", "N", kTraceForceDecimals, false);
-  c.fy_n = in.measured("fy", "N", kTraceForceDecimals, false);
+  c.time_s = in.measured("t", kTraceTimeDecimals, true);
+  c.x_m = in.measured("x", kTracePositionDecimals, true);
+  c.y_m = in.measured("y", kTracePositionDecimals, true);
+  c.z_m = in.measured("z", kTracePositionDecimals, true);
+  c.fx_n = in.measured("fx", kTraceForceDecimals, false);
+  c.fy_n = in.measured("fy", kTraceForceDecimals, false);
   if (columns == TraceColumnSet::pen) return c;
-  c.fz_n = in.measured("fz", "N", kTraceForceDecimals, false);
+  c.fz_n = in.measured("fz", kTraceForceDecimals, false);
   c.state = in.states();
   c.stroke = in.whole<std::uint32_t>("stroke", H5T_STD_U32LE, H5T_NATIVE_UINT32);
   c.element = in.whole<std::uint32_t>("element", H5T_STD_U32LE, H5T_NATIVE_UINT32);

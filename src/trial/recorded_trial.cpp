@@ -268,9 +268,9 @@ TeacherFile read_recorded_teacher(const RecordedTrial& recorded, const std::file
   return {parse_teacher_recording(bytes, path.string()), sha256};
 }
 
-Checked<WholeTrial> recorded_whole_trial(const RecordedTrial& recorded, const Checked<TrialSpec>& spec,
-                                         const DeviceInfo& device) {
-  return build_whole_trial(spec, device,
+Checked<WholeTrial> recorded_whole_trial(const RecordedTrial& recorded, const Checked<TrialSpec>& spec) {
+  // The record's force law is given whole: the device's figures fit no default stiffness of it.
+  return build_whole_trial(spec, DeviceInfo{},
                            {.force_law = recorded.force_law,
                             .safety = recorded.safety,
                             .passivity = recorded.passivity,

@@ -1,6 +1,7 @@
 #include "calligraphy/trial/trial_spec_runner.hpp"
 
 #include <memory>
+#include <string>
 #include <utility>
 #include <variant>
 
@@ -42,6 +43,16 @@ void require_teacher(const TrialSpec& spec, const TrialRunInputs& inputs) {
         (spec.teacher.empty() ? std::string("a teacher's recording") : spec.teacher) +
         " by its front-end (read_teacher_recording)");
   }
+}
+
+// The device `spec.device` made by `inputs.registry`, for a caller (`who`) that gives none to run on.
+std::unique_ptr<HapticDevice> registry_device(const TrialSpec& spec, const TrialRunInputs& inputs,
+                                              const char* who) {
+  if (inputs.registry == nullptr) {
+    throw InvalidArgument(std::string(who) + ": no device and no registry to create \"" + spec.device +
+                          "\" from (TrialRunInputs::device, TrialRunInputs::registry)");
+  }
+  return inputs.registry->create(spec.device);
 }
 
 }  // namespace
@@ -96,11 +107,7 @@ TrialRun run_whole_trial(const Checked<WholeTrial>& checked, const Scene& scene,
     device = created.get();
   }
   if (device == nullptr) {
-    if (inputs.registry == nullptr) {
-      throw InvalidArgument("run_whole_trial: no device and no registry to create \"" + spec.device +
-                            "\" from (TrialRunInputs::device, TrialRunInputs::registry)");
-    }
-    created = inputs.registry->create(spec.device);
+    created = registry_device(spec, inputs, "run_whole_trial");
     device = created.get();
   }
   run.device = device->info();
@@ -144,11 +151,7 @@ TrialRun run_trial_spec(const Checked<TrialSpec>& spec, const Scene& scene, cons
   std::unique_ptr<HapticDevice> created;
   TrialRunInputs with_device = inputs;
   if (with_device.device == nullptr) {
-    if (inputs.registry == nullptr) {
-      throw InvalidArgument("run_trial_spec: no device and no registry to create \"" + spec->device +
-                            "\" from (TrialRunInputs::device, TrialRunInputs::registry)");
-    }
-    created = inputs.registry->create(spec->device);
+    created = registry_device(*spec, inputs, "run_trial_spec");
     with_device.device = created.get();
   }
   // The specification's defaults on this device, through the one builder.

@@ -129,11 +129,10 @@ struct TeacherFile {
 /// The whole trial of `recorded` as it runs again, checked: the one builder (`build_whole_trial`) given
 /// `spec` (`recorded.spec` as the caller checked it, `Checked<TrialSpec>::check`, its output files and a
 /// replay's teacher file the caller's) and the record's force law, safety chain, passivity controller,
-/// writer profile and simulated device physics; `device` the figures of the device it runs on (not read:
-/// the force law is the record's). Throws InvalidArgument naming the part at fault (`build_whole_trial`).
+/// writer profile and simulated device physics (no figure of a device is read: the force law is the
+/// record's). Throws InvalidArgument naming the part at fault (`build_whole_trial`).
 [[nodiscard]] Checked<WholeTrial> recorded_whole_trial(const RecordedTrial& recorded,
-                                                       const Checked<TrialSpec>& spec,
-                                                       const DeviceInfo& device = {});
+                                                       const Checked<TrialSpec>& spec);
 
 /// Runs `recorded` again on `scene` (laid out by the caller with `recorded.layout`) with `inputs` (the
 /// registry, a stop flag, a replay's teacher samples, and, for a record the simulated writer wrote
