@@ -291,6 +291,15 @@ TEST_CASE("What is not a recorded trial is refused naming the file and the place
              Catch::Contains("/writer/noise_fraction"));
   CHECK_THAT(refusal(edited([](auto& d) { d["trial"]["rate_hz"] = 5.0; })), Catch::Contains("rate"));
   CHECK_THAT(refusal(edited([](auto& d) { d["passivity"]["surprise"] = 1; })), Catch::Contains("surprise"));
+  // A simulated writer's record without its profile would re-run with another writer's.
+  CHECK_THAT(refusal(edited([](auto& d) {
+               d["trial"]["writer"] = "simulated";
+               d["writer"] = nullptr;
+             })),
+             Catch::Contains("r.json: /writer") && Catch::Contains("simulated"));
+  // A safety peak past its table's range: a typing error, not a limit.
+  CHECK_THAT(refusal(edited([](auto& d) { d["safety"]["max_force_n"] = 1e308; })),
+             Catch::Contains("/safety/max_force_n"));
   // Inside a trial record, the pointers name the record's member.
   const std::string record =
       "{\"version\": 2, \"specification\": " + edited([](auto& d) { d["safety"]["max_force_n"] = -1.0; }) +

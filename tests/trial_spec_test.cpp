@@ -383,6 +383,13 @@ TEST_CASE("the one builder refuses a part out of range naming the part, before a
   safety.max_force_change_n_per_tick = -0.5;
   CHECK_THAT(error_of([&] { (void)build_whole_trial(checked, figures, {.safety = safety}); }),
              Catch::StartsWith("safety: "));
+  // A low-pass at or above the loop's Nyquist frequency (500 Hz at 1 kHz) filters nothing it samples.
+  SafetyChainParameters aliased;
+  aliased.low_pass_cutoff_hz = 0.5 * spec.rate_hz;
+  CHECK_THAT(error_of([&] { (void)build_whole_trial(checked, figures, {.safety = aliased}); }),
+             Catch::StartsWith("safety: low_pass_cutoff_hz") && Catch::Contains("half the servo rate"));
+  aliased.low_pass_cutoff_hz = 0.49 * spec.rate_hz;
+  CHECK_NOTHROW(build_whole_trial(checked, figures, {.safety = aliased}));
   PassivityParameters passivity;
   passivity.enabled = true;
   passivity.max_damping_n_s_per_m = -2.0;

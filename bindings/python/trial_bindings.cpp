@@ -407,6 +407,16 @@ RecordedTrial read_record_py(const py::object& record) {
     const std::string text = py::module_::import("json").attr("dumps")(record).cast<std::string>();
     return read_recorded_trial(text, "record");
   }
+  if (py::isinstance<py::str>(record)) {
+    // A record's JSON text passed for its path: say so, rather than naming the text as a missing file.
+    const std::string text = record.cast<std::string>();
+    const std::size_t first = text.find_first_not_of(" \t\r\n");
+    std::error_code no_file;  // a text too long for a path is not a file either
+    if (first != std::string::npos && (text[first] == '{' || text[first] == '[') &&
+        !std::filesystem::exists(std::filesystem::path(text), no_file))
+      throw py::type_error(
+          "record: a record's JSON text, not a path: give json.loads(text) (a dict) or the record's path");
+  }
   if (py::isinstance<py::str>(record) || py::isinstance(record, py::module_::import("os").attr("PathLike")))
     return read_study_recorded_trial(convert_named<std::filesystem::path>(record, "record").string());
   throw_type_error("record", "a dict (TrialResult.metrics, a trial record) or a record's path", record);
@@ -602,7 +612,7 @@ TeacherRecording or a list of TeacherSample), which records name but do not hold
 Raises DataError naming the record and the JSON pointer of a value at fault, a record without a
 specification (written before records held one) or of another version; InvalidArgument when the
 characters placed are not the recorded ones (other character data), or a replay without its teacher;
-CharacterNotFound; TypeError for a record of another type.)");
+CharacterNotFound; TypeError for a record of another type or its JSON text given as a path.)");
   m.def(
       "check_trial_record", &check_trial_record_py, py::arg("record"),
       R"(Checks the trial a record states, as rerun_trial and `calligraphy trial --spec RECORD --check` check

@@ -28,12 +28,17 @@ using SafetyField = ParameterField<SafetyChainParameters>;
 using S = SafetyChainParameters;
 constexpr ParameterRange kNonNegative{};
 constexpr ParameterRange kPositive{.low_open = true};
+// An order of magnitude above the peak force of every device this library knows (the Phantom Desktop's
+// 7.9 N is the largest): a larger limit is a typing error, not a limit.
+constexpr ParameterRange kForce{.high = 100.0};
+// Under the Nyquist frequency of the fastest servo loop (100 kHz); WholeTrial also holds it under its own.
+constexpr ParameterRange kCutoff{.high = 50000.0, .high_open = true};
 
 // In declaration order; a stage at 0 is off, except the peak force and the time constant.
 constexpr std::array kSafetyFields{
-    SafetyField{"max_force_n", "N", kNonNegative,
+    SafetyField{"max_force_n", "N", kForce,
                 "peak clamp; 0 = the device's max force (the renderer fills it in)", &S::max_force_n},
-    SafetyField{"max_continuous_force_n", "N", kNonNegative,
+    SafetyField{"max_continuous_force_n", "N", kForce,
                 "continuous-force limit; 0 = the device's under a renderer, off in a bare chain",
                 &S::max_continuous_force_n},
     SafetyField{"continuous_time_constant_s", "s", kPositive, "tau of the RMS (thermal) force estimate",
@@ -42,7 +47,7 @@ constexpr std::array kSafetyFields{
                 &S::start_ramp_n_per_s},
     SafetyField{"max_force_change_n_per_tick", "N", kNonNegative, "per-tick force change limit; 0 = off",
                 &S::max_force_change_n_per_tick},
-    SafetyField{"low_pass_cutoff_hz", "Hz", kNonNegative, "first-order low-pass cutoff; 0 = off",
+    SafetyField{"low_pass_cutoff_hz", "Hz", kCutoff, "first-order low-pass cutoff; 0 = off",
                 &S::low_pass_cutoff_hz},
 };
 

@@ -230,6 +230,10 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
     json_detail::fail(source, reader.pointer("trial") + "/writer",
                       "'person', but the record holds a simulated writer's profile (/writer, null for a "
                       "person)");
+  if (!r.writer && r.spec.writer == TrialWriter::simulated)
+    json_detail::fail(source, reader.pointer("writer"),
+                      "null, but the trial's writer is 'simulated' (/trial/writer): a simulated writer's "
+                      "record holds the profile it wrote with");
   if (r.simulated_device && r.spec.device != "simulated") {
     std::string message = "simulated device physics for the device '";
     message.append(r.spec.device).append("' (/trial/device; only for 'simulated'); expected null");

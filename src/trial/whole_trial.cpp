@@ -5,6 +5,7 @@
 #include <utility>
 #include <variant>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
@@ -93,7 +94,18 @@ void WholeTrial::validate() const {
     if (!(force_law.acceptance == spec.acceptance))
       throw InvalidArgument("its acceptance is not the specification's (acceptance)");
   });
-  part("safety", [&] { safety.validate(); });
+  part("safety", [&] {
+    safety.validate();
+    // A first-order low-pass at or above the loop's Nyquist frequency filters nothing it can sample.
+    if (safety.low_pass_cutoff_hz >= 0.5 * spec.rate_hz) {
+      std::string message = "low_pass_cutoff_hz = ";
+      message.append(shortest_decimal(safety.low_pass_cutoff_hz))
+          .append(" Hz must be under half the servo rate (rate_hz / 2 = ")
+          .append(shortest_decimal(0.5 * spec.rate_hz))
+          .append(" Hz); 0 = off");
+      throw InvalidArgument(message);
+    }
+  });
   part("passivity", [&] { passivity.validate(); });
   if (writer) {
     part("writer", [&] {

@@ -68,3 +68,9 @@ def test_what_is_not_a_record_is_refused():
     spec["version"] = 7
     with pytest.raises(calligraphy.DataError, match="/version"):
         calligraphy.rerun_trial(spec)
+    # A record's JSON text is not a path: it is named as such, not echoed back as a missing file.
+    spec["version"] = 6
+    with pytest.raises(TypeError, match="JSON text, not a path"):
+        calligraphy.rerun_trial(json.dumps(spec))
+    with pytest.raises(TypeError, match="JSON text, not a path"):
+        calligraphy.check_trial_record("  " + json.dumps(spec))
