@@ -112,13 +112,14 @@ TEST_CASE("Another hand's strokes (KanjiVG) written by a position-only pen are a
   // No dead end: with the assisted credit every character is completed.
   CHECK(m.characters_completed == n);
   CHECK(m.strokes_unassisted + m.strokes_assisted == m.strokes);
-  // What the rule reaches on the held-out half (docs/stroke-acceptance.md): 98.3 % of strokes and 89 % of
-  // characters without assistance. Short of the goals (99 % and 97 %): the misses are dots and ticks whose
-  // KanjiVG lines cover the middle of the median, as little of it as a half stroke does (see the docs).
+  // What the rule reaches on the held-out half (docs/stroke-acceptance.md): 99.05 % of strokes and 93 % of
+  // characters without assistance. Short of the characters' goal (97 %): the misses are dots and ticks whose
+  // KanjiVG lines cover less of the median than the centred rule asks, or are not centred on it (see the
+  // docs).
   const double strokes = share(m.strokes_unassisted, m.strokes);
   const double whole = share(m.characters_unassisted, n);
-  CHECK(strokes >= 0.98 - slack(0.98, m.strokes));
-  CHECK(whole >= 0.88 - slack(0.88, n));
+  CHECK(strokes >= 0.99 - slack(0.99, m.strokes));
+  CHECK(whole >= 0.92 - slack(0.92, n));
   // Negatives made from the same lines: reversed, another stroke, the next stroke and a shift of exactly
   // 8 mm are refused as on the medians; half, shifted by 4-8 mm and scribble are credited more often than
   // on the medians (halves of 3-6 mm strokes, shifts of a line itself up to 4 mm off; docs).

@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "calligraphy/collision/active_stroke.hpp"
@@ -200,6 +201,7 @@ TEST_CASE(
   const RecordedTrial v4 = read_recorded_trial(v4_json.dump(), "v4.json");
   StrokeAcceptance as_v4 = first.options.force.acceptance;
   as_v4.use_version_4_end_gaps();
+  as_v4.use_version_6_coverage();
   CHECK(v4.force_law.acceptance == as_v4);
   CHECK(v4.force_law.acceptance.end_gap_m == 0.0);
   CHECK(recorded.force_law.acceptance.end_gap_m == StrokeAcceptance{}.end_gap_m);
@@ -346,7 +348,26 @@ TEST_CASE(
   for (const ParameterField<StrokeAcceptance>& field : ParameterTable<StrokeAcceptance>::fields())
     v5["trial"].erase(std::string(field.name));
   const RecordedTrial earlier = read_recorded_trial(v5.dump(), "v5.json");
-  CHECK(earlier.spec.acceptance == recorded.force_law.acceptance);
+  StrokeAcceptance as_v5 = recorded.force_law.acceptance;
+  as_v5.use_version_6_coverage();  // records before version 7 ran without the centred rule
+  CHECK(earlier.spec.acceptance == as_v5);
+  CHECK(earlier.force_law.acceptance == as_v5);
   CHECK(earlier.spec.acceptance.assist_after_misses == 2.0);
   CHECK(earlier.defaulted.empty());
+
+  // A version-6 record, written before the centred rule: it runs without it, in its specification and its
+  // force law alike, and the rule's other fields take their defaults (inert with the rule off).
+  nlohmann::json v6 = document;
+  v6["version"] = 6;
+  for (const ParameterField<StrokeAcceptance>& field : ParameterTable<StrokeAcceptance>::fields()) {
+    if (!std::string_view(field.name).starts_with("centred_")) continue;
+    v6["trial"].erase(std::string(field.name));
+    v6["force_law"]["acceptance"].erase(std::string(field.name));
+  }
+  const RecordedTrial sixth = read_recorded_trial(v6.dump(), "v6.json");
+  CHECK(sixth.spec.acceptance == as_v5);
+  CHECK(sixth.force_law.acceptance == as_v5);
+  CHECK(sixth.defaulted.size() == 6);  // balance, shortest and longest, in the trial and the force law
+  for (const std::string& pointer : sixth.defaulted)
+    CHECK(pointer.find("centred_coverage") == std::string::npos);
 }

@@ -163,6 +163,10 @@ void bind_collision(py::module_& m) {
       .field(&StrokeAcceptance::assist_after_misses)
       .field(&StrokeAcceptance::end_gap_m)
       .field(&StrokeAcceptance::end_gap_fraction)
+      .field(&StrokeAcceptance::centred_coverage_fraction)
+      .field(&StrokeAcceptance::centred_balance_fraction)
+      .field(&StrokeAcceptance::centred_min_length_m)
+      .field(&StrokeAcceptance::centred_max_length_m)
       .finish();
 
   py::enum_<StrokeRefusal>(m, "StrokeRefusal",

@@ -75,6 +75,21 @@ constexpr std::array kAcceptanceFields{
         "end_gap_fraction", "", ParameterRange{.low = 0.0, .high = 1.0, .high_open = true},
         "the end gap's floor as a fraction of the stroke's length, the smaller applying",
         &StrokeAcceptance::end_gap_fraction},
+    // Added with version 7 of a trial record; older records run with use_version_6_coverage().
+    ParameterField<StrokeAcceptance>{
+        "centred_coverage_fraction", "", ParameterRange{.low = 0.0, .high = 1.0, .high_open = true},
+        "least share of a dot or short tick a path centred on it covers to write it, 0 for no such rule",
+        &StrokeAcceptance::centred_coverage_fraction},
+    ParameterField<StrokeAcceptance>{
+        "centred_balance_fraction", "", ParameterRange{.low = 0.0, .high = 1.0},
+        "most the gaps a centred path leaves at the two ends may differ by, as a fraction of the length",
+        &StrokeAcceptance::centred_balance_fraction},
+    ParameterField<StrokeAcceptance>{"centred_min_length_m", "m", ParameterRange{.low = 0.0, .high = 0.1},
+                                     "shortest stroke the centred rule applies to",
+                                     &StrokeAcceptance::centred_min_length_m},
+    ParameterField<StrokeAcceptance>{"centred_max_length_m", "m", ParameterRange{.low = 0.0, .high = 0.1},
+                                     "longest stroke the centred rule applies to",
+                                     &StrokeAcceptance::centred_max_length_m},
 };
 
 }  // namespace
@@ -105,6 +120,17 @@ double StrokeAcceptance::allowed_end_gap_m(double length_m) const noexcept {
       {allowed_shortfall_m(length_m), displacement_m, std::min(end_gap_m, end_gap_fraction * length_m)});
 }
 
+bool StrokeAcceptance::centred_cover(double length_m, double way_along_m, double start_gap_m,
+                                     double finish_gap_m) const noexcept {
+  if (!(centred_coverage_fraction > 0.0) || length_m < centred_min_length_m ||
+      length_m > centred_max_length_m)
+    return false;
+  const double end_gap_limit = allowed_end_gap_m(length_m);
+  return way_along_m >= centred_coverage_fraction * length_m && start_gap_m <= end_gap_limit &&
+         finish_gap_m <= end_gap_limit &&
+         std::abs(start_gap_m - finish_gap_m) <= centred_balance_fraction * length_m;
+}
+
 double StrokeAcceptance::allowed_mean_deviation_m(double length_m) const noexcept {
   return std::min(mean_deviation_m + deviation_per_length * length_m, mean_deviation_cap_m);
 }
@@ -117,6 +143,7 @@ void StrokeAcceptance::use_fixed_tolerances() noexcept {
   reference_character_size_m = 0.0;
   assist_after_misses = 0.0;
   use_version_4_end_gaps();
+  use_version_6_coverage();
 }
 
 StrokeAcceptance StrokeAcceptance::for_character_size(double character_size_m) const noexcept {
@@ -127,7 +154,8 @@ StrokeAcceptance StrokeAcceptance::for_character_size(double character_size_m) c
        {&StrokeAcceptance::corridor_m, &StrokeAcceptance::mean_deviation_m, &StrokeAcceptance::shortfall_m,
         &StrokeAcceptance::displacement_m, &StrokeAcceptance::lookahead_m,
         &StrokeAcceptance::follow_through_m, &StrokeAcceptance::shortfall_cap_m,
-        &StrokeAcceptance::mean_deviation_cap_m, &StrokeAcceptance::end_gap_m}) {
+        &StrokeAcceptance::mean_deviation_cap_m, &StrokeAcceptance::end_gap_m,
+        &StrokeAcceptance::centred_min_length_m, &StrokeAcceptance::centred_max_length_m}) {
     out.*length *= k;
   }
   return out;
@@ -278,8 +306,10 @@ bool StrokeProgressTracker::written() const noexcept {
   const double end_gap_limit = acceptance_.allowed_end_gap_m(length);
   const double start_gap = entry_arc_m_ - line.start_arc_m;
   const double end_gap = line.element_end_arc_m.back() - progress_m_;
-  return way_along_m() >= length - shortfall && start_gap <= end_gap_limit && end_gap <= end_gap_limit &&
-         mean_deviation_m() <= acceptance_.allowed_mean_deviation_m(length);
+  if (mean_deviation_m() > acceptance_.allowed_mean_deviation_m(length)) return false;
+  const double way = way_along_m();
+  return (way >= length - shortfall && start_gap <= end_gap_limit && end_gap <= end_gap_limit) ||
+         acceptance_.centred_cover(length, way, start_gap, end_gap);
 }
 
 std::size_t StrokeProgressTracker::element_index() const noexcept {

@@ -30,7 +30,8 @@ const Schema& SchemaOf<StrokeAcceptance>::get() {
   // The fields after the eighth came with version 4 of a trial record: an older record lacks them and
   // runs with the fixed tolerances it ran with (StrokeAcceptance::use_fixed_tolerances, recorded_trial.cpp).
   // The end gap's floor (the last two) came with version 5: a version-4 record runs without it
-  // (StrokeAcceptance::use_version_4_end_gaps).
+  // (StrokeAcceptance::use_version_4_end_gaps). The centred rule (the last four) came with version 7: an
+  // older record runs without it (StrokeAcceptance::use_version_6_coverage).
   static const std::vector<SchemaField> fields = [] {
     std::vector<SchemaField> out = table_fields<StrokeAcceptance>();
     for (SchemaField& field : out) {  // the miss counts are whole numbers (StrokeAcceptance::validate)
@@ -42,7 +43,8 @@ const Schema& SchemaOf<StrokeAcceptance>::get() {
     }
     for (std::size_t i = 8; i < out.size(); ++i) {
       const bool end_gap = out[i].name == "end_gap_m" || out[i].name == "end_gap_fraction";
-      out[i] = since(end_gap ? 5 : 4, out[i]);
+      const bool centred = out[i].name.starts_with("centred_");
+      out[i] = since(centred ? 7 : end_gap ? 5 : 4, out[i]);
     }
     return out;
   }();

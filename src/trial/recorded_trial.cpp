@@ -179,6 +179,14 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
   // Before version 5 either end of a stroke could be left unwritten by no more than its shortfall or
   // displacement: no floor of the end gap.
   if (version < 5) r.force_law.acceptance.use_version_4_end_gaps();
+  // Before version 7 no path centred on a dot was written by covering less of it than the shortfall allows:
+  // the rule is off, as it ran (not its default, so not listed as defaulted).
+  if (version < 7) {
+    r.force_law.acceptance.use_version_6_coverage();
+    r.spec.acceptance.use_version_6_coverage();
+    std::erase_if(read.defaulted,
+                  [](const std::string& pointer) { return pointer.ends_with("/centred_coverage_fraction"); });
+  }
   // Before version 6 the specification did not state the acceptance: it is the one the force law ran with,
   // not a default (its fields are not listed as defaulted).
   if (version < 6) {

@@ -92,7 +92,8 @@ std::vector<SchemaField> acceptance_fields() {
     } else if (entries[i].member == &StrokeAcceptance::assist_after_misses) {
       make_count_field<&StrokeAcceptance::assist_after_misses>(f);
     }
-    out.push_back(since(6, f));
+    // The specification states the acceptance since version 6 of a record; the centred rule came with 7.
+    out.push_back(since(f.name.starts_with("centred_") ? 7 : 6, f));
   }
   return out;
 }

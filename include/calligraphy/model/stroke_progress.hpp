@@ -105,6 +105,25 @@ struct StrokeAcceptance {
   /// The same floor as a fraction of the stroke's length, the smaller applying, dimensionless: a half
   /// stroke leaves one end unwritten by half the stroke (0.5), so 0.4 keeps it refused on a dot.
   double end_gap_fraction = 0.4;
+  /// A path centred on a dot or a short tick may cover less of it (a rule beside the shortfall's, added in
+  /// version 7 of a trial record): the data's medians run to the tips of the ink, and the ink of a dot
+  /// reaches past the pen's path at both ends by about the brush's radius, a large part of a short stroke;
+  /// another hand's centre lines (KanjiVG's, drawn as a pen's path) cover the middle 46-63 % of such
+  /// medians. A path is written by this rule when the stroke's length L is in [`centred_min_length_m`,
+  /// `centred_max_length_m`], its way along is at least this fraction of L, the gaps it leaves at the two
+  /// ends differ by at most `centred_balance_fraction` L, each within the end gap allowed, and its mean
+  /// deviation within the limit. A half stroke leaves one end whole and the other half unwritten: not
+  /// centred. Chosen on the tuning half of the KanjiVG characters (docs/stroke-acceptance.md). 0: no such
+  /// rule (records before version 7).
+  double centred_coverage_fraction = 0.55;
+  /// Most the gaps a centred path leaves at the two ends may differ by, as a fraction of L.
+  double centred_balance_fraction = 0.1;
+  /// Shortest stroke the centred rule applies to [m]: below it a half stroke copied up to 2.2 mm along
+  /// lands on the middle as often as a person's dot (docs/stroke-acceptance.md).
+  double centred_min_length_m = 0.008;
+  /// Longest stroke the centred rule applies to [m]: beyond it the brush's radius is a small part of the
+  /// stroke, and the end-point scatter's rule alone applies. Below `centred_min_length_m`: no stroke.
+  double centred_max_length_m = 0.02;
   /// The character size the lengths above are for [m]: in a character of another size
   /// (`SceneLayout::character_size_m`) every length scales by size / this. 0: lengths are absolute
   /// (records before version 4).
@@ -125,6 +144,12 @@ struct StrokeAcceptance {
   void use_fixed_tolerances() noexcept;
   /// The rule as records of version 4 ran it: no floor of the end gap (`end_gap_m` 0).
   void use_version_4_end_gaps() noexcept { end_gap_m = 0.0; }
+  /// The rule as records of versions 4 to 6 ran it: no centred coverage (`centred_coverage_fraction` 0).
+  void use_version_6_coverage() noexcept { centred_coverage_fraction = 0.0; }
+  /// True when a path that leaves `start_gap_m` and `finish_gap_m` [m] of a stroke of `length_m` unwritten,
+  /// with `way_along_m` along it, is centred on it and covers enough of it (`centred_coverage_fraction`).
+  [[nodiscard]] bool centred_cover(double length_m, double way_along_m, double start_gap_m,
+                                   double finish_gap_m) const noexcept;
   /// This acceptance for a character of side `character_size_m` [m]: every length scaled by size /
   /// `reference_character_size_m` (unchanged when that is 0).
   [[nodiscard]] StrokeAcceptance for_character_size(double character_size_m) const noexcept;
@@ -132,9 +157,9 @@ struct StrokeAcceptance {
   [[nodiscard]] double allowed_mean_deviation_m(double length_m) const noexcept;
 
   /// Throws InvalidArgument naming the field when a value is outside its range
-  /// (`ParameterTable<StrokeAcceptance>`: each length in (0, 0.1] m (`end_gap_m` [0, 0.1]), the fractions in
-  /// (0, 1) and [0, 1), the gain ratio
-  /// in [1, 100], the miss counts in [0, 1000]) or a miss count is not a whole number.
+  /// (`ParameterTable<StrokeAcceptance>`: each length in (0, 0.1] m (`end_gap_m` and the centred rule's
+  /// [0, 0.1]), the fractions in (0, 1) and [0, 1), the gain ratio in [1, 100], the miss counts in
+  /// [0, 1000]), or a miss count is not a whole number.
   void validate() const;
   /// The most a stroke of `length_m` may be written short by [m]: min(`shortfall_fraction` L,
   /// `shortfall_m` + `shortfall_per_length` L, `shortfall_cap_m`).
