@@ -853,12 +853,27 @@ class Python(Case):
                  ((p, 1), {"profile": 3}, TypeError), ((p, 1), {"profile": "expert"}, ValueError),
                  ((p, 1), {"learning": "two_state"}, ValueError), ((p, 1), {"individual_differences": 1}, TypeError),
                  ((p, 1), {"individual_differences": "yes"}, TypeError), ((123, 1), {}, TypeError),
-                 ((str(self.tmp), 1), {}, cg.Error), ((str(self.tmp / "missing.json"), 1), {}, cg.Error)]
+                 ((str(self.tmp), 1), {}, cg.Error), ((str(self.tmp / "missing.json"), 1), {}, cg.Error),
+                 ((p, 1), {"batch_size": 0}, ValueError), ((p, 1), {"batch_size": 1.5}, (TypeError, ValueError)),
+                 ((p, 1), {"client": 3}, TypeError), ((p, 1), {"client": "tcp://localhost:1"}, TypeError)]
         for args, kwargs, kind in cases:
             with self.subTest(args=args[1:], kwargs=kwargs):
                 with self.assertRaises(kind) as caught:
                     cohort.simulate(*args, progress=False, **kwargs)
                 self.assertTrue(str(caught.exception))
+
+    def test_cohort_on_an_executor_is_the_cohort_on_threads(self):
+        """docs/python.md: any concurrent.futures.Executor runs the batches as a Dask client would, and the
+        tables do not depend on the threads, workers or batches."""
+        import calligraphy.cohort as cohort
+        from concurrent.futures import ThreadPoolExecutor
+        p = str(self.write(tiny()))
+        threads = cohort.simulate(p, 2, progress=False, workers=1)
+        with ThreadPoolExecutor(max_workers=2) as pool:
+            executor = cohort.simulate(p, 2, progress=False, client=pool, batch_size=1)
+        self.assertEqual(threads.trials.drop(columns=["start_utc"]).to_csv(),
+                         executor.trials.drop(columns=["start_utc"]).to_csv())
+        self.assertEqual(threads.strokes.to_csv(), executor.strokes.to_csv())
 
     def test_samples_of_a_cohort_trial_say_there_is_no_trace(self):
         import calligraphy.cohort as cohort
