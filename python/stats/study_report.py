@@ -972,6 +972,8 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
     names = [out / "index.html"] + [tables / f"{name}.csv" for name in _TABLE_NAMES]
     names += [figures / f"{kind}_{_file_name(value)}.{ext}" for value in values for kind in ("phase", "learning")
               for ext in ("svg", "png")]
+    # A link onto a file the report reads is named as that first (exit 2 from the command line).
+    _refuse_outputs_on_inputs(names, study.trials["trace_file"] if "trace_file" in study.trials else ())
     for path in names:
         if path.is_symlink():
             raise OSError(f"{path}: is a symbolic link: a file of a set is written only in its own "
