@@ -8,6 +8,7 @@
 // for arguments of several types (ArrayLike: numpy-convertible, shown as numpy.typing.ArrayLike).
 #include <pybind11/pybind11.h>
 
+#include <filesystem>
 #include <limits>
 #include <optional>
 #include <string>
@@ -160,6 +161,14 @@ T convert_named(py::handle value, const std::string& name) {
       if (PyUnicode_Check(value.ptr())) {
         throw InvalidArgument(name + ": " + short_repr(value) +
                               " is not valid Unicode text (a lone surrogate has no UTF-8 encoding)");
+      }
+    }
+    if constexpr (std::is_same_v<T, std::filesystem::path>) {
+      // A str or path-like that the file system cannot take ("a\0b": a NUL byte) is a wrong value, as
+      // os.fspath and open() say, not a value of another type.
+      if (PyUnicode_Check(value.ptr()) || py::hasattr(value, "__fspath__")) {
+        throw InvalidArgument(name + ": " + short_repr(value) +
+                              " is not a file name (a NUL character, or text the file system cannot encode)");
       }
     }
     throw_type_error(name, python_type_name<T>(), value);

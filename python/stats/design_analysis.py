@@ -490,11 +490,15 @@ def _paired_rows(data: pandas.DataFrame, value: str, design: StudyDesign) -> lis
             rows.append(_row(**base, comparison=f"{level} - {design.control}", note=f"not computed: {error}"))
             continue
         g_se = math.sqrt(1.0 / c.n_subjects + c.g_av ** 2 / (2.0 * c.n_subjects)) if math.isfinite(c.g_av) else math.nan
+        # Differences that do not vary (an outcome the same in every trial) leave t undefined: the row says why.
+        note = "" if math.isfinite(c.t) else ("not tested: every subject's difference is the same (no variance), "
+                                              "so there is no t statistic")
         rows.append(_row(**base, comparison=f"{level} - {design.control}",
                          test="paired t-test on subject means (scipy.stats.ttest_rel); Hedges' g_av",
                          n=c.n_subjects, df=float(c.df), statistic=float(c.t), p=float(c.p),
                          estimate=float(c.mean_difference), ci95_low=float(c.ci95_low), ci95_high=float(c.ci95_high),
-                         g=float(c.g_av), g_ci95_low=c.g_av - 1.96 * g_se, g_ci95_high=c.g_av + 1.96 * g_se))
+                         g=float(c.g_av), g_ci95_low=c.g_av - 1.96 * g_se, g_ci95_high=c.g_av + 1.96 * g_se,
+                         note=note))
     return rows
 
 

@@ -16,7 +16,8 @@
 #                                              @@calligraphy-reply ID error MESSAGE
 #                                            where ID is the request's (decimal) and FILES and MESSAGE are hex.
 #                                            Other lines (a package's chatter) carry no marker and are ignored.
-# FOLDER holds data.csv (UTF-8) and levels.csv (factor, level: each factor's levels in order, reference
+# FOLDER holds data.csv (UTF-8; an empty field is a missing value), types.csv (column, type: "number" or
+# "text", each column of data.csv) and levels.csv (factor, level: each factor's levels in order, reference
 # first); a fit writes fixed.csv, random.csv, anova.csv (one F test per term) and fit.csv (key, value) there
 # (a fit that did not converge or is singular says so in fit.csv). When the first factor of levels.csv (the
 # compared one) has three or more levels and is a term of the model, pairs.csv holds every pairwise contrast
@@ -30,10 +31,18 @@ has_emmeans <- requireNamespace("emmeans", quietly = TRUE)
 
 fit_model <- function(folder, formula_text, ddf) {
   model_formula <- stats::as.formula(formula_text)
+  # Only an empty field is missing, and a column of text stays text: a condition called "NA", "TRUE" or "T"
+  # or subjects called "1" and "01" are levels as written, never R's missing value, a logical or one number.
+  classes <- NA
+  if (file.exists(file.path(folder, "types.csv"))) {
+    types <- utils::read.csv(file.path(folder, "types.csv"), encoding = "UTF-8", stringsAsFactors = FALSE,
+                             colClasses = "character", na.strings = character(0))
+    classes <- stats::setNames(ifelse(types$type == "number", "numeric", "character"), types$column)
+  }
   data <- utils::read.csv(file.path(folder, "data.csv"), encoding = "UTF-8", stringsAsFactors = FALSE,
-                          check.names = FALSE)
+                          check.names = FALSE, colClasses = classes, na.strings = "")
   levels_table <- utils::read.csv(file.path(folder, "levels.csv"), encoding = "UTF-8", stringsAsFactors = FALSE,
-                                  colClasses = "character")
+                                  colClasses = "character", na.strings = character(0))
   for (factor_name in unique(levels_table$factor)) {
     ordered_levels <- levels_table$level[levels_table$factor == factor_name]
     # An unordered factor gets R's default treatment coding, the first level (the control) the reference: each

@@ -376,6 +376,12 @@ def lmer(frame: "pandas.DataFrame", formula: str, factors: typing.Mapping[str, t
     rscript = _check_r()
     with tempfile.TemporaryDirectory(prefix="calligraphy-lmer-") as folder:
         frame.to_csv(os.path.join(folder, "data.csv"), index=False, encoding="utf-8")
+        # R is told which columns are text, so that a level spelt like a number, a logical or R's NA stays text.
+        numeric = pandas.api.types.is_numeric_dtype
+        types = ["number" if numeric(frame[c]) and not pandas.api.types.is_bool_dtype(frame[c]) else "text"
+                 for c in frame.columns]
+        pandas.DataFrame({"column": [str(c) for c in frame.columns], "type": types}).to_csv(
+            os.path.join(folder, "types.csv"), index=False, encoding="utf-8")
         levels = [{"factor": name, "level": str(level)} for name, values in factors.items() for level in values]
         pandas.DataFrame(levels, columns=["factor", "level"]).to_csv(os.path.join(folder, "levels.csv"),
                                                                     index=False, encoding="utf-8")

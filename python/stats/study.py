@@ -211,7 +211,8 @@ class Study:
         0-based), attempt (1-based, 0 outside any; traces of older folders may lack it) and rewritten (1: part
         of an attempt written again later). `trial` is a row of `trials` or its index
         label. Raises TypeError naming `trial` for None or a value that cannot be a label (a list, a dict,
-        a bool), KeyError for an unknown label, FileNotFoundError when the trace is gone, DataError naming
+        a bool), KeyError for an unknown label, FileNotFoundError when the trace is gone, DataError for a
+        trial without a trace file (a cohort simulated in memory) and naming
         the file of a damaged trace (and the line of an older CSV trace: another header, a field that is not a
         finite number)."""
         if not hasattr(trial, "trace_file"):
@@ -219,8 +220,14 @@ class Study:
                 raise TypeError(f"Study.samples: trial: expected a row of trials or its index label, got "
                                 f"{type(trial).__name__} {trial!r}")
         row = self.trials.loc[trial] if not hasattr(trial, "trace_file") else trial
+        path = row["trace_file"]
+        if not isinstance(path, str) or not path:
+            # A cohort simulated in memory (calligraphy.cohort.simulate) keeps no trace.
+            raise _native.DataError(f"Study.samples: trial {row.get('trial', '?')} of session "
+                                    f"{row.get('session', '?')} has no trace file (a cohort simulated in memory "
+                                    "keeps no traces; run the protocol with calligraphy session run for them)")
         expected = row.get("trace_sha256", "")
-        return _read_trace(row["trace_file"], expected if isinstance(expected, str) else "")
+        return _read_trace(path, expected if isinstance(expected, str) else "")
 
     def iter_samples(self) -> typing.Iterator[tuple[typing.Any, "pandas.DataFrame"]]:
         """(index label, samples) for every trial in turn, one trace in memory at a time."""

@@ -898,6 +898,10 @@ def _relative_link(target: PathLike, out_dir: pathlib.Path) -> str:
     return urllib.parse.quote(pathlib.PurePath(relative).as_posix())
 
 
+# The tables a report may write (tables/NAME.csv), each only for the designs that have it.
+_TABLE_NAMES = ("phase_means", "questions", "exclusions", "retention", "summary", "statistics")
+
+
 def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Optional[str] = None,
                  values: typing.Sequence[str] = ("total_time_s", "mean_deviation_m"),
                  per_trial_page: typing.Optional[PathLike] = None, reference: typing.Optional[str] = None,
@@ -963,6 +967,17 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
             raise OSError(errno.ELOOP, f"{folder}: is a symbolic link: the report's files are written only in "
                           "its own folders, never through a link (nothing written; remove the link or write the "
                           "report elsewhere)")
+    # A file of the set that is a symbolic link is refused before any work (docs/cli.md, "Outputs"): the set's
+    # writer refuses it too, but only after every fit and figure.
+    names = [out / "index.html"] + [tables / f"{name}.csv" for name in _TABLE_NAMES]
+    names += [figures / f"{kind}_{_file_name(value)}.{ext}" for value in values for kind in ("phase", "learning")
+              for ext in ("svg", "png")]
+    # A link onto a file the report reads is named as that first (exit 2 from the command line).
+    _refuse_outputs_on_inputs(names, study.trials["trace_file"] if "trace_file" in study.trials else ())
+    for path in names:
+        if path.is_symlink():
+            raise OSError(f"{path}: is a symbolic link: a file of a set is written only in its own "
+                          "folder, never through a link (nothing written; remove the link or write the set elsewhere)")
     for folder in (out, figures, tables):
         _make_folder(folder)
     per_trial_link = _relative_link(per_trial_page, out) if per_trial_page is not None else None

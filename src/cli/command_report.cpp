@@ -121,11 +121,12 @@ int run_report(const ReportCommand& command) {
     const std::string index_name = index_path.filename().string();
     // The pages are outputs too: none may be a file the command reads.
     const fs::path pages_folder = index_path.parent_path() / session_pages_folder(index_name);
-    files.output_folder("--out", pages_folder.string());
+    files.set_output_folder("--out", pages_folder.string());
     std::vector<fs::path> pages;
     for (const ReportedSession& s : study.sessions) {
       pages.push_back(index_path.parent_path() /
                       session_page_path(index_name, s.shown.subject, s.shown.session));
+      files.set_output_folder("--out", pages.back().parent_path().string());
       files.set_output("--out", pages.back().string());
     }
     PagesWriter writer(study, pages, "../../" + index_name);

@@ -320,9 +320,19 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
       throw UsageError(std::string("--subject: ") + e.what());
     }
   } else {
+    // The id names a folder under --out: one that is not a label is the option's value refused.
+    if (!is_subject_id(command.subject)) {
+      throw UsageError("--subject '" + command.subject + "': expected 1 to 64 letters, digits, '_' or '-'");
+    }
     const std::size_t number = command.subject_number_option->count() > 0
                                    ? static_cast<std::size_t>(command.subject_number)
                                    : trailing_number(command.subject);
+    if (number == 0 && resolved.protocol.crossover_phase() != nullptr) {
+      throw UsageError(
+          "--subject " + command.subject +
+          ": the crossover phase counterbalances by the subject's number (1, 2, ...), and this id "
+          "ends in none or in 0; give --subject-number N");
+    }
     subjects.push_back({command.subject, number});
   }
   std::vector<std::string> again;  // subjects of this run whose series is begun under --out

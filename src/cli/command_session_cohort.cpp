@@ -10,6 +10,7 @@
 
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/study/cohort.hpp"
+#include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/study_tables.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
@@ -43,6 +44,16 @@ int run_session_cohort(const SessionCohortCommand& command) {
   files.set_output("--csv", (tables_folder / "strokes.csv").string());
 
   const LoadedProtocol protocol = load_study_protocol(command.protocol);
+  // A replay's teacher is recorded into a session folder, which a cohort has not: the protocol's content is
+  // refused as a design this command cannot run, naming the condition's mode.
+  for (std::size_t i = 0; i < protocol.protocol.conditions.size(); ++i) {
+    const StudyCondition& condition = protocol.protocol.conditions[i];
+    if (!replays_teacher(condition)) continue;
+    throw ProtocolError(protocol.path.string() + ": /conditions/" + std::to_string(i) +
+                        "/mode: the condition '" + condition.name +
+                        "' replays a teacher, which is kept in a session folder; a simulated cohort runs "
+                        "without one (run it with calligraphy session run)");
+  }
   const CharacterSource characters(command.library);
   require_characters(protocol, characters);
   const LoadedProtocol resolved = resolved_protocol(protocol, characters);

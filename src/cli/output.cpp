@@ -275,6 +275,18 @@ void FilePlan::output_folder(const std::string& what, const std::string& path) {
   output_folders_.push_back(fs::absolute(path).lexically_normal());
 }
 
+void FilePlan::set_output_folder(const std::string& what, const std::string& path) {
+  if (path.empty()) return;
+  struct stat status {};
+  if (::lstat(path.c_str(), &status) == 0 && S_ISLNK(status.st_mode)) {
+    throw UsageError(
+        named(what, path) +
+        " is a symbolic link: the folders a set makes are written only in place, never through a "
+        "link; remove it, nothing written");
+  }
+  output_folder(what, path);
+}
+
 void FilePlan::existing_output_folder(const std::string& what, const std::string& path) {
   if (path.empty()) return;
   require_writable_folder(what, path, fs::path(path));

@@ -77,6 +77,10 @@ class FilePlan {
   /// with a writable folder as its nearest existing ancestor. Throws DataError naming `what` and the path.
   /// Outputs given after it may lie in it, or in subfolders of it, before they exist: the command makes them.
   void output_folder(const std::string& what, const std::string& path);
+  /// A folder a set makes for its files (report's NAME_files/ and its subjects' folders): as output_folder,
+  /// and a symbolic link in its place is refused (UsageError naming `what` and the path), as a set's file is,
+  /// so a link planted there cannot carry the set's files out of it.
+  void set_output_folder(const std::string& what, const std::string& path);
   /// An existing folder the command writes new files into (e.g. screenshots): it must exist and be
   /// writable. Throws DataError naming `what` and the path.
   void existing_output_folder(const std::string& what, const std::string& path);

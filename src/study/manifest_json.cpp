@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <iterator>
+#include <set>
 #include <unordered_set>
 
 #include "calligraphy/core/errors.hpp"
@@ -243,12 +244,36 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
     return std::any_of(conditions.begin(), conditions.end(),
                        [&](const StudyCondition& c) { return c.name == condition; });
   };
+  // Only the protocol's items can be written: its phases' strings, its sets' and a transfer choice's
+  // candidates (chosen when the session was made).
+  std::set<std::u32string> items;
+  for (const ProtocolPhase& phase : manifest.protocol.protocol.phases) {
+    items.insert(phase.items.begin(), phase.items.end());
+    if (phase.choice) items.insert(phase.choice->candidates.begin(), phase.choice->candidates.end());
+  }
+  for (const ItemSet& set : manifest.protocol.protocol.item_sets)
+    items.insert(set.items.begin(), set.items.end());
   for (std::size_t i = 0; i < read.plan.size(); ++i) {
     const std::string at = json_detail::child_pointer("/plan", i);
     PlannedTrial trial = planned_trial_from(read.plan[i], missing, at, source, i);
     if (!known(trial.condition))
       json_detail::fail(source, json_detail::child_pointer(at, "condition"),
                         "not a condition of the protocol");
+    if (!items.contains(trial.characters)) {
+      json_detail::fail(
+          source, json_detail::child_pointer(at, "characters"),
+          "not an item of the protocol copy, got " + json_detail::describe(json(read.plan[i].characters)));
+    }
+    // Every reader finds a planned trial's files by the stem its values make; a `file` naming another one
+    // (edited) would send a program reading session.json elsewhere.
+    const std::string stem = SessionFolder::trial_stem(trial);
+    if (!defaulted(missing, json_detail::child_pointer(at, "file")) && read.plan[i].file != stem) {
+      json_detail::fail(source, json_detail::child_pointer(at, "file"),
+                        "expected \"" + stem +
+                            "\" (the stem of its index, phase, condition, repetition and "
+                            "characters), got " +
+                            json_detail::describe(json(read.plan[i].file)));
+    }
     if (!trial.trained_condition.empty() && !known(trial.trained_condition)) {
       json_detail::fail(source, json_detail::child_pointer(at, "trained_condition"),
                         "not a condition of the protocol");

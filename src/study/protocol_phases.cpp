@@ -126,6 +126,11 @@ void check_crossover(const json_detail::ObjectReader& reader, const StudyProtoco
 ProtocolPhase read_phase(const json& value, const std::string& pointer, const std::string& source,
                          const StudyProtocol& protocol) {
   json_detail::ObjectReader reader(value, pointer, source);
+  // A key of two that exclude each other, given null, is named as null rather than as the other one missing.
+  for (const char* key : {"condition", "conditions", "characters", "sets"}) {
+    if (value.is_object() && value.contains(key) && value.at(key).is_null())
+      json_detail::fail(source, reader.pointer(key), "null is not a value (leave the key out)");
+  }
   ProtocolPhase phase;
   phase.pointer = pointer;
   // The settings through their schema (SchemaOf<ProtocolPhase>: spellings and ranges written once).

@@ -74,7 +74,7 @@ def simulate(protocol: PathLike, subjects: int, *, profile: str = "novice", lear
     progress: a tqdm bar over the batches on an executor (when tqdm is installed).
 
     Raises TypeError or ValueError for a bad argument (subjects beyond 1..100000 or workers beyond 1..1024, the
-    CLI's bounds), InvalidArgument for a bad profile or learning, a
+    CLI's bounds; a client that is neither a distributed.Client nor an Executor), InvalidArgument for a bad profile or learning, a
     protocol with a replay condition (its teacher lives in a session folder) or a transfer choice that
     cannot be made; DataError naming the protocol file when it cannot be read; CharacterNotFound for a
     character the source lacks; ImportError without pandas. A simulated subject is a model, not a person.
@@ -88,6 +88,9 @@ def simulate(protocol: PathLike, subjects: int, *, profile: str = "novice", lear
     for name, value in (("profile", profile), ("learning", learning)):
         if not isinstance(value, str):
             raise TypeError(f"{name}: expected a str, got {type(value).__name__} {value!r}")
+    if client is not None and not (hasattr(client, "get_executor") or callable(getattr(client, "submit", None))):
+        raise TypeError(f"client: expected a distributed.Client or a concurrent.futures.Executor, got "
+                        f"{type(client).__name__} {client!r}")
     # Checked whoever runs the subjects, so that a value is refused the same with and without a client.
     if batch_size is not None and (isinstance(batch_size, bool) or not isinstance(batch_size, int) or batch_size < 1):
         raise ValueError(f"batch_size: expected an int >= 1, got {batch_size!r}")
