@@ -209,6 +209,20 @@ class TrialSpecRecords(Base):
         line = self.assert_one_error(result, 2)
         self.assertTrue("--max-duration" in line or "--rate" in line, line)
 
+    def test_a_layout_the_scene_cannot_take(self):
+        # In the schema's range, a layout must run: a zero start radius, spacing or size, and a paper 1e308 m
+        # up, are refused by --check naming the pointer (exit 2), as the run would refuse them.
+        for field, value in (("start_radius_m", 0.0), ("spacing_m", 0.0), ("character_size_m", 0.0),
+                             ("paper_z_m", 1e308), ("centre_m", [1e308, 0.0])):
+            with self.subTest(field=field):
+                record = self.record()
+                record["specification"]["scene"]["layout"][field] = value
+                (self.dir / "layout.json").write_text(json.dumps(record))
+                for extra in (["--check"], ["--json", "out.json"]):
+                    result = run(["trial", "--spec", "layout.json", *extra], self.dir)
+                    self.assert_one_error(result, 2, "layout.json", f"/specification/scene/layout/{field}")
+        self.assert_listing(self.dir, ["layout.json"])
+
     def test_characters_empty_and_past_the_scene_limit(self):
         record = self.record()
         record["specification"]["trial"]["characters"] = ""
@@ -287,6 +301,35 @@ class TrialTeachers(Base):
                 self.assert_one_error(result, (1, 2), name)
                 self.assertFalse((self.dir / "out.json").exists())
 
+    def test_a_replay_record_that_drops_or_moves_its_teacher(self):
+        self.copy("teacher.json")
+        made = run(["trial", SHI, "--guidance-mode", "replay", "--teacher", "teacher.json", "--json", "rep.json"],
+                   self.dir)
+        self.assertEqual(made.returncode, 0, made.stderr)
+        record = json.loads((self.dir / "rep.json").read_text())
+        self.assertEqual(len(record["specification"]["teacher_sha256"]), 64)
+        # The binding dropped: a record naming its teacher's file without the SHA-256 would re-run on any file of
+        # that name, which the record's binding exists to prevent.
+        dropped = json.loads(json.dumps(record))
+        dropped["specification"]["teacher_sha256"] = ""
+        (self.dir / "dropped.json").write_text(json.dumps(dropped))
+        for extra in (["--check"], ["--json", "out.json"]):
+            result = run(["trial", "--spec", "dropped.json", *extra], self.dir)
+            self.assert_one_error(result, 2, "dropped.json", "/specification/teacher_sha256")
+        # The teacher renamed to the record itself: another recording, named with both SHA-256.
+        moved = json.loads(json.dumps(record))
+        moved["specification"]["trial"]["teacher"] = "rep.json"
+        (self.dir / "moved.json").write_text(json.dumps(moved))
+        result = run(["trial", "--spec", "moved.json", "--json", "out.json"], self.dir)
+        self.assert_one_error(result, 1, "rep.json", record["specification"]["teacher_sha256"])
+        # A teacher given to a record that is no replay.
+        result = run(["trial", "--spec", "rep.json", "--teacher", "teacher.json", "--json", "out.json"], self.dir)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.copy("r.json")
+        result = run(["trial", "--spec", "r.json", "--teacher", "teacher.json", "--json", "out2.json"], self.dir)
+        self.assert_one_error(result, 2, "--teacher")
+        self.assertFalse((self.dir / "out2.json").exists())
+
     def test_a_teacher_fifo_does_not_hang(self):
         os.mkfifo(self.dir / "teacher.json")
         result = run(["trial", SHI, "--guidance-mode", "replay", "--teacher", "teacher.json"], self.dir,
@@ -344,6 +387,24 @@ class TrialOutputs(Base):
             subprocess.run(["chattr", "-i", str(locked)])
         self.assert_listing(self.dir, ["locked"])
         self.assert_listing(locked, [])
+
+    def test_links_as_outputs_relative_chains_and_loops(self):
+        (self.dir / "out").mkdir()
+        (self.dir / "real").mkdir()
+        os.symlink("../real/x.svg", self.dir / "out" / "link.svg")  # relative to the link's own folder
+        result = run(["model", SHI, "--svg", "out/link.svg"], self.dir)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertTrue((self.dir / "out" / "link.svg").is_symlink())
+        self.assertIn("</svg>", (self.dir / "real" / "x.svg").read_text())
+        self.assert_listing(self.dir / "out", ["link.svg"])
+        os.symlink("self.svg", self.dir / "self.svg")
+        for index in range(1, 42):
+            os.symlink(f"c{index + 1}", self.dir / f"c{index}")
+        for name in ("self.svg", "c1"):
+            with self.subTest(output=name):
+                result = run(["model", SHI, "--svg", name], self.dir, timeout=HANG_S)
+                self.assert_one_error(result, (1, 2), "--svg", name)
+        self.assertFalse((self.dir / "c42").exists())
 
     def test_an_output_through_a_dangling_folder_link_and_a_bad_name(self):
         os.symlink("nowhere", self.dir / "gone")
@@ -681,15 +742,21 @@ class CurriculumSchemaBenchTrain(Base):
                 self.assertLess(time.monotonic() - started, 5)
 
     def test_bench_markdown_keeps_the_rest_of_a_document(self):
-        document = self.dir / "notes.md"
-        document.write_text("# My notes\n\nKeep this paragraph.\n")
-        result = run(["bench", "nearest", "--queries", "1", "--markdown", "notes.md"], self.dir)
-        if result.returncode == 0:
-            self.assertIn("Keep this paragraph.", document.read_text())
-        else:
-            self.assert_one_error(result, (1, 2), "notes.md")
-            self.assertEqual(document.read_text(), "# My notes\n\nKeep this paragraph.\n")
-        self.assert_listing(self.dir, ["notes.md"])
+        # Another text, and a section begun but never ended (cut by hand): the rest of the document is kept.
+        texts = {"notes.md": "# My notes\n\nKeep this paragraph.\n",
+                 "cut.md": "# Notes\n<!-- BEGIN generated by `calligraphy bench jumps` -->\nold\n\nKeep this tail.\n"}
+        for name, text in texts.items():
+            with self.subTest(document=name):
+                document = self.dir / name
+                document.write_text(text)
+                result = run(["bench", "jumps", "--seeds", "1", "--chars", SHI, "--markdown", name], self.dir)
+                if result.returncode == 0:
+                    self.assertIn(text.splitlines()[-1], document.read_text())
+                    self.assertIn("| exact |", document.read_text())
+                else:
+                    self.assert_one_error(result, (1, 2), name)
+                    self.assertEqual(document.read_text(), text)
+        self.assert_listing(self.dir, list(texts))
 
     def test_train_bad_options_without_a_display(self):
         kinds = strict_json(run(["devices", "--json"], self.dir).stdout.decode())["kinds"]
@@ -746,9 +813,14 @@ class PythonSurfaces(Base):
         def properties(ref):
             return defs[ref.split("/")[-1]]["properties"]
 
+        # Every part but the safety chain, whose upper bounds are being settled apart.
         groups = {"trial": properties(schema["properties"]["trial"]["$ref"]),
                   "passivity": properties(schema["properties"]["passivity"]["$ref"]),
-                  "force_law/acceptance": properties("#/$defs/StrokeAcceptance")}
+                  "force_law": properties("#/$defs/ForceLawParameters"),
+                  "force_law/acceptance": properties("#/$defs/StrokeAcceptance"),
+                  "force_law/nearest": properties("#/$defs/NearestPointOptions"),
+                  "scene/layout": properties("#/$defs/SceneLayout"),
+                  "writer": properties("#/$defs/WriterProfile")}
         tried = 0
         for group, props in groups.items():
             for field, spec in props.items():
@@ -761,7 +833,7 @@ class PythonSurfaces(Base):
                 if "minimum" in spec:
                     low = spec["minimum"]
                     bad.append(low - 1 if integer else (low - max(abs(low) * 1e-6, 1e-9)))
-                if "maximum" in spec:
+                if "maximum" in spec and spec["maximum"] < 1e308:
                     high = spec["maximum"]
                     bad.append(high + 1 if integer else 1e308)
                 if "exclusiveMaximum" in spec:
@@ -779,7 +851,11 @@ class PythonSurfaces(Base):
                             cg.check_trial_record(forged)
                         self.assertIn(f"/specification/{group}/{field}", str(caught.exception))
                         tried += 1
-        self.assertGreater(tried, 30)
+        self.assertGreater(tried, 60)
+        # What the schema takes, the layout takes: the largest box margin it allows runs.
+        forged = json.loads(json.dumps(record))
+        forged["specification"]["scene"]["layout"]["box_margin_m"] = 1e308
+        cg.check_trial_record(forged)
 
     def test_rerun_trial_with_values_of_another_type(self):
         record = self.record()
