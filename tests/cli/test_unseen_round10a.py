@@ -147,15 +147,13 @@ class Base(unittest.TestCase):
 class TrialSpecRecords(Base):
     """`trial --spec RECORD`: the record forged, made a FIFO or a device, or given beside options it excludes."""
 
-    def test_spec_excludes_the_options_that_state_a_trial(self):
+    def test_spec_beside_other_options_and_as_an_output(self):
         self.copy("r.json")
         for extra in (["--record", "x.json"], ["--seed", "3"], ["--rate", "500"], ["--guidance", "off"]):
             with self.subTest(extra=extra):
                 result = run(["trial", "--spec", "r.json", *extra], self.dir)
                 self.assert_one_error(result, 2, extra[0])
         self.assert_listing(self.dir, ["r.json"])
-
-    def test_spec_as_a_hard_link_of_an_output(self):
         record = self.copy("r.json")
         before = record.read_bytes()
         os.link(record, self.dir / "again.json")
@@ -178,7 +176,7 @@ class TrialSpecRecords(Base):
                      preexec_fn=address_space_limit)
         self.assert_one_error(result, (1, 2), "/dev/zero")
 
-    def test_seed_at_and_past_two_to_the_sixty_four(self):
+    def test_numbers_at_the_ends_of_their_kinds_in_a_record(self):
         record = self.record()
         record["specification"]["trial"]["seed"] = 18446744073709551615
         (self.dir / "top.json").write_text(json.dumps(record))
@@ -188,8 +186,6 @@ class TrialSpecRecords(Base):
         (self.dir / "past.json").write_text(text)
         result = run(["trial", "--spec", "past.json", "--check"], self.dir)
         self.assert_one_error(result, 2, "past.json", "/specification/trial/seed")
-
-    def test_a_number_beyond_a_double_in_the_record(self):
         text = (self.shared / "r.json").read_text()
         self.assertEqual(text.count('"max_duration_s": 300.0'), 1)
         (self.dir / "big.json").write_text(text.replace('"max_duration_s": 300.0', '"max_duration_s": 1e400'))
@@ -242,7 +238,7 @@ class TrialSpecRecords(Base):
 class TrialOptions(Base):
     """`trial CHARS` with option values at and past their ranges, and options that cannot go together."""
 
-    def test_writer_param_spellings(self):
+    def test_writer_param_and_max_duration_spellings(self):
         for value in ("bias_offset_m=nan", "bias_offset_m=inf", "bias_offset_m=1e308", "bias_offset_m=",
                       "bias_offset_m", "=0.001", "bias_offset_m=0.001=2", "bias_offset_m= 0.001"):
             with self.subTest(value=value):
@@ -250,6 +246,12 @@ class TrialOptions(Base):
                 line = self.assert_one_error(result, 2)
                 self.assertTrue("--writer-param" in line or "bias_offset_m" in line, line)
         self.assert_listing(self.dir, [])
+        for value in ("-0", "0", "1e308", "86400.001", "", "5s"):
+            with self.subTest(value=value):
+                result = run(["trial", SHI, "--max-duration", value, "--check"], self.dir)
+                self.assert_one_error(result, 2, "--max-duration")
+        result = run(["trial", SHI, "--max-duration", "86400", "--rate", "100", "--check"], self.dir)
+        self.assertEqual(result.returncode, 0, result.stderr)
 
     def test_options_that_cannot_go_together(self):
         cases = [
@@ -266,24 +268,19 @@ class TrialOptions(Base):
                 self.assert_one_error(result, 2, needle)
         self.assert_listing(self.dir, [])
 
-    def test_max_duration_at_and_past_its_range(self):
-        for value in ("-0", "0", "1e308", "86400.001", "", "5s"):
-            with self.subTest(value=value):
-                result = run(["trial", SHI, "--max-duration", value, "--check"], self.dir)
-                self.assert_one_error(result, 2, "--max-duration")
-        result = run(["trial", SHI, "--max-duration", "86400", "--rate", "100", "--check"], self.dir)
-        self.assertEqual(result.returncode, 0, result.stderr)
-
-
 class TrialTeachers(Base):
     """A replay's `--teacher`: a trial record in its place, a forged recording, a FIFO."""
 
-    def test_a_trial_record_as_teacher(self):
+    def test_a_trial_record_and_a_fifo_as_teacher(self):
         self.copy("r.json")
         result = run(["trial", SHI, "--guidance-mode", "replay", "--teacher", "r.json", "--json", "out.json"],
                      self.dir)
         self.assert_one_error(result, (1, 2), "r.json")
         self.assertFalse((self.dir / "out.json").exists())
+        os.mkfifo(self.dir / "teacher.json")
+        result = run(["trial", SHI, "--guidance-mode", "replay", "--teacher", "teacher.json"], self.dir,
+                     timeout=HANG_S)
+        self.assert_one_error(result, (1, 2), "teacher.json")
 
     def test_forged_teacher_recordings(self):
         teacher = json.loads((self.shared / "teacher.json").read_text())
@@ -329,13 +326,6 @@ class TrialTeachers(Base):
         result = run(["trial", "--spec", "r.json", "--teacher", "teacher.json", "--json", "out2.json"], self.dir)
         self.assert_one_error(result, 2, "--teacher")
         self.assertFalse((self.dir / "out2.json").exists())
-
-    def test_a_teacher_fifo_does_not_hang(self):
-        os.mkfifo(self.dir / "teacher.json")
-        result = run(["trial", SHI, "--guidance-mode", "replay", "--teacher", "teacher.json"], self.dir,
-                     timeout=HANG_S)
-        self.assert_one_error(result, (1, 2), "teacher.json")
-
 
 class TrialOutputs(Base):
     """Where `trial` writes: a refused `--record`, a closed standard output, a file size limit, folders that
@@ -485,15 +475,13 @@ class ScoreCommand(Base):
         else:
             self.assert_one_error(result, 1, "far.csv")
 
-    def test_pen_values_other_than_zero_and_one(self):
+    def test_rows_refused_at_their_line(self):
         for value in ("2", "0.5", "-1", "", "yes"):
             with self.subTest(value=value):
                 (self.dir / "pen.csv").write_text(self.HEADER + "0,0,0,0\n0.001,0,0," + value + "\n")
                 result = run(["score", "pen.csv", "--character", SHI, "--json", "out.json"], self.dir)
                 self.assert_one_error(result, 1, "pen.csv:3")
                 self.assertFalse((self.dir / "out.json").exists())
-
-    def test_a_quoted_field_holding_a_comma(self):
         (self.dir / "q.csv").write_text('"t","x","y","z"\n"0","0","0","0.01"\n"0,001","0","0","0"\n')
         result = run(["score", "q.csv", "--character", SHI], self.dir)
         self.assert_one_error(result, 1, "q.csv:3")
@@ -520,26 +508,22 @@ class ModelStrokesCharacters(Base):
     """`model`, `strokes` and `characters`: `-` with a `--json` flag, one character, a broken pipe, stores
     that are no store."""
 
-    def test_dash_beside_a_json_flag(self):
+    def test_dash_beside_a_json_flag_and_one_character(self):
         result = run(["model", SHI, "--json", "--svg", "-"], self.dir)
         self.assert_one_error(result, 2, "--svg")
         result = run(["strokes", "--json", "--markdown", "-"], self.dir)
         self.assert_one_error(result, 2, "--markdown")
-
-    def test_model_svg_to_standard_output_is_the_svg_alone(self):
-        result = run(["model", SHI, "--svg", "-"], self.dir)
-        self.assertEqual(result.returncode, 0, result.stderr)
-        text = result.stdout.decode().strip()
-        self.assertTrue(text.startswith("<?xml") or text.startswith("<svg"), text[:80])
-        self.assertTrue(text.endswith("</svg>"), text[-80:])
-
-    def test_model_takes_one_character(self):
         for chars in (SHI + "人", "", " "):
             with self.subTest(chars=chars):
                 result = run(["model", chars], self.dir)
                 self.assert_one_error(result, 2)
 
-    def test_characters_and_strokes_into_a_closed_pipe(self):
+    def test_standard_output_alone_and_closed(self):
+        result = run(["model", SHI, "--svg", "-"], self.dir)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        text = result.stdout.decode().strip()
+        self.assertTrue(text.startswith("<?xml") or text.startswith("<svg"), text[:80])
+        self.assertTrue(text.endswith("</svg>"), text[-80:])
         for args in (["characters", "--strokes", "2"], ["strokes", "--markdown", "-"]):
             with self.subTest(args=args):
                 process = subprocess.Popen([CLI, *args], cwd=self.dir, stdout=subprocess.PIPE,
@@ -664,7 +648,7 @@ class DevicesCommand(Base):
     """`devices` and devices named: a driver library that is garbage, a regular file as a hidraw device, a flag
     given a value."""
 
-    def test_a_garbage_driver_library(self):
+    def test_a_garbage_driver_library_and_a_flag_given_false(self):
         garbage = self.dir / "libHD.so"
         garbage.write_bytes(b"\x7fELF" + os.urandom(4000))
         env = dict(ENV, CALLIGRAPHY_LIBHD=str(garbage))
@@ -675,6 +659,13 @@ class DevicesCommand(Base):
         result = run(["trial", SHI, "--device", "openhaptics", "--json", "out.json"], self.dir, env=env)
         self.assert_one_error(result, 1, str(garbage))
         self.assert_listing(self.dir, ["libHD.so"])
+        result = run(["devices", "--json=false"], self.dir)
+        self.assert_one_error(result, 2, "--json")
+        result = run(["devices", "--json=true"], self.dir)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        strict_json(result.stdout.decode())
+        result = run(["devices", "simulated"], self.dir)
+        self.assert_one_error(result, 2)
 
     def test_a_regular_file_as_a_hidraw_device_is_not_written(self):
         plain = self.dir / "plain.bin"
@@ -685,16 +676,6 @@ class DevicesCommand(Base):
                 self.assert_one_error(result, (1, 2))
         self.assertEqual(plain.read_bytes(), b"keep me\n")
         self.assert_listing(self.dir, ["plain.bin"])
-
-    def test_a_flag_given_false_and_a_stray_argument(self):
-        result = run(["devices", "--json=false"], self.dir)
-        self.assert_one_error(result, 2, "--json")
-        result = run(["devices", "--json=true"], self.dir)
-        self.assertEqual(result.returncode, 0, result.stderr)
-        strict_json(result.stdout.decode())
-        result = run(["devices", "simulated"], self.dir)
-        self.assert_one_error(result, 2)
-
 
 class CurriculumSchemaBenchTrain(Base):
     """`curriculum`'s inputs, `schema`'s names, `bench`'s and `train`'s options."""
@@ -719,14 +700,12 @@ class CurriculumSchemaBenchTrain(Base):
         proposed = [item["character"] for item in strict_json(result.stdout.decode())]
         self.assertNotIn(SHI, proposed)  # it has written it
 
-    def test_schema_names(self):
+    def test_schema_names_and_bench_options_past_their_ranges(self):
         for args in (["schema", "nope"], ["schema", "record", "--markdown=1"], ["schema", "record", "extra"],
                      ["schema", "Record"]):
             with self.subTest(args=args):
                 result = run(args, self.dir)
                 self.assert_one_error(result, 2)
-
-    def test_bench_options_past_their_ranges(self):
         cases = [["loop", "--priority", "0", "--realtime", "enforce"], ["loop", "--rate", "10001"],
                  ["loop", "--cpu", "1024"], ["loop", "--cpu", "-2"], ["loop", "--seconds", "0"],
                  ["loop", "--seconds", "nan"], ["loop", "--priority", "100"],
@@ -780,7 +759,7 @@ class PythonSurfaces(Base):
     """The Python functions of the same surfaces: readers given FIFOs, the record checker at every field's
     bounds, scoring pen values, trial bounds, teachers written and read."""
 
-    def test_readers_given_a_fifo_do_not_hang(self):
+    def test_readers_given_a_fifo_or_values_of_another_type(self):
         os.mkfifo(self.dir / "fifo")
         script = (
             "import json, sys, calligraphy as cg\n"
@@ -804,6 +783,19 @@ class PythonSurfaces(Base):
             with self.subTest(function=name):
                 self.assertIsInstance(what, list, what)
                 self.assertNotEqual(what[0], "TypeError", what)
+        record = self.record()
+        for value in ("7", 1.5, -1, None, 2 ** 64, [0]):
+            with self.subTest(seed=value):
+                forged = json.loads(json.dumps(record))
+                forged["specification"]["trial"]["seed"] = value
+                with self.assertRaises((cg.DataError, TypeError)) as caught:
+                    cg.rerun_trial(forged)
+                self.assertIn("/specification/trial/seed", str(caught.exception))
+        for value in (42, 4.5, ["r.json"]):
+            with self.subTest(record=value):
+                with self.assertRaises(TypeError) as caught:
+                    cg.rerun_trial(value)
+                self.assertIn("record", str(caught.exception))
 
     def test_check_trial_record_at_every_numeric_bound_of_the_schema(self):
         schema = strict_json(run(["schema", "record"], self.dir).stdout.decode())
@@ -857,33 +849,7 @@ class PythonSurfaces(Base):
         forged["specification"]["scene"]["layout"]["box_margin_m"] = 1e308
         cg.check_trial_record(forged)
 
-    def test_rerun_trial_with_values_of_another_type(self):
-        record = self.record()
-        for value in ("7", 1.5, -1, None, 2 ** 64, [0]):
-            with self.subTest(seed=value):
-                forged = json.loads(json.dumps(record))
-                forged["specification"]["trial"]["seed"] = value
-                with self.assertRaises((cg.DataError, TypeError)) as caught:
-                    cg.rerun_trial(forged)
-                self.assertIn("/specification/trial/seed", str(caught.exception))
-        for value in (42, 4.5, ["r.json"]):
-            with self.subTest(record=value):
-                with self.assertRaises(TypeError) as caught:
-                    cg.rerun_trial(value)
-                self.assertIn("record", str(caught.exception))
-
-    def test_score_pen_values_other_than_zero_and_one(self):
-        t = [0.0, 0.001, 0.002]
-        for pen in ([0, 2, 0], [0, 0.5, 0], [0, -1, 0]):
-            with self.subTest(pen=pen):
-                with self.assertRaises((cg.InvalidArgument, cg.DataError)) as caught:
-                    cg.score({"t": t, "x": [0.0] * 3, "y": [0.0] * 3, "pen": pen}, SHI)
-                self.assertIn("pen", str(caught.exception))
-        with self.assertRaises((cg.InvalidArgument, cg.DataError)) as caught:  # no inf or NaN in the score
-            cg.score({"t": t, "x": [0.0, 1e308, 0.0], "y": [0.0] * 3, "pen": [1, 1, 1]}, SHI)
-        self.assertIn("sample 1", str(caught.exception))
-
-    def test_simulate_trial_at_and_past_its_bounds(self):
+    def test_simulate_trial_and_score_past_their_bounds(self):
         cases = [({"rate_hz": 99.999}, "rate_hz"), ({"rate_hz": float("nan")}, "rate_hz"),
                  ({"max_duration_s": -0.0}, "max_duration_s"), ({"max_duration_s": 1e308}, "max_duration_s"),
                  ({"hint_after_misses": 1001}, "hint_after_misses"),
@@ -893,6 +859,15 @@ class PythonSurfaces(Base):
                 with self.assertRaises((cg.InvalidArgument, TypeError)) as caught:
                     cg.simulate_trial(SHI, keep_trace=False, **kwargs)
                 self.assertIn(name, str(caught.exception))
+        t = [0.0, 0.001, 0.002]
+        for pen in ([0, 2, 0], [0, 0.5, 0], [0, -1, 0]):
+            with self.subTest(pen=pen):
+                with self.assertRaises((cg.InvalidArgument, cg.DataError)) as caught:
+                    cg.score({"t": t, "x": [0.0] * 3, "y": [0.0] * 3, "pen": pen}, SHI)
+                self.assertIn("pen", str(caught.exception))
+        with self.assertRaises((cg.InvalidArgument, cg.DataError)) as caught:  # no inf or NaN in the score
+            cg.score({"t": t, "x": [0.0, 1e308, 0.0], "y": [0.0] * 3, "pen": [1, 1, 1]}, SHI)
+        self.assertIn("sample 1", str(caught.exception))
 
     def test_record_teacher_outputs(self):
         trial = cg.simulate_trial(SHI, writer="skilled")
