@@ -222,15 +222,6 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
   if (!parts.teacher_sha256.empty() && !(r.spec.guidance && r.spec.guidance_mode == GuidanceMode::replay))
     json_detail::fail(source, reader.pointer("teacher_sha256"),
                       "names a teacher, but the trial is not a replay");
-  // Since version 4 a replay that read its teacher from a file (/trial/teacher) names the file's SHA-256,
-  // which the re-run checks the file against; a record naming the file without it would re-run on any file of
-  // that name (a replay given its teacher as samples names no file and no SHA-256).
-  if (version >= 4 && parts.teacher_sha256.empty() && r.spec.guidance &&
-      r.spec.guidance_mode == GuidanceMode::replay && !r.spec.teacher.empty()) {
-    json_detail::fail(source, reader.pointer("teacher_sha256"),
-                      "\"\", but the replay read its teacher from the file /trial/teacher names (" +
-                          r.spec.teacher + "): a record since version 4 binds that file by its SHA-256");
-  }
   r.teacher_sha256 = std::move(parts.teacher_sha256);
   // The parts a trial's builder takes only for some trials are refused here, as content of the record at
   // their pointer, before a device is looked up: a simulated writer's profile on a person's trial, and the
