@@ -424,8 +424,10 @@ void bind_scene(py::module_& m) {
       .field("character_size_m", &SceneLayout::character_size_m,
              "side of each character's data box on paper [m], > 0")
       .field("spacing_m", &SceneLayout::spacing_m, "centre-to-centre distance in the row [m], > 0")
-      .field("centre_m", &SceneLayout::centre_m, "centre of the row on the paper [m].")
-      .field("paper_z_m", &SceneLayout::paper_z_m, "z0, height of the paper plane in device space [m]")
+      .field("centre_m", &SceneLayout::centre_m,
+             "centre of the row on the paper [m], each coordinate in [-1, 1]")
+      .field("paper_z_m", &SceneLayout::paper_z_m,
+             "z0, height of the paper plane in device space [m], in [-1, 1]")
       .field("box_margin_m", &SceneLayout::box_margin_m,
              "bounding-box margin around the strokes (Fig. 5) [m], >= 0")
       .field("start_radius_m", &SceneLayout::start_radius_m,

@@ -1,7 +1,9 @@
 #include "calligraphy/model/scene.hpp"
 
+#include <cmath>
 #include <string>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
@@ -27,13 +29,31 @@ void check_scene_size(std::size_t count, const std::string& what) {
 
 Scene Scene::lay_out(const std::vector<Character>& characters, const SceneLayout& layout) {
   check_scene_size(characters.size(), "Scene::lay_out");
-  if (!(layout.character_size_m > 0.0) || !(layout.spacing_m > 0.0) || !(layout.start_radius_m > 0.0) ||
-      !(layout.box_margin_m >= 0.0) || !layout.centre_m.allFinite() || !std::isfinite(layout.paper_z_m)) {
-    throw InvalidArgument("SceneLayout out of range: character size " +
-                          std::to_string(layout.character_size_m) + " m, spacing " +
-                          std::to_string(layout.spacing_m) + " m, start radius " +
-                          std::to_string(layout.start_radius_m) + " m");
+  // Each field by its name, in its range (SchemaOf<SceneLayout> states the same ranges for a trial record).
+  const auto refuse = [](const char* field, double value, const char* range) {
+    throw InvalidArgument(std::string("SceneLayout.")
+                              .append(field)
+                              .append(" = ")
+                              .append(shortest_decimal(value))
+                              .append(" m is out of range: expected ")
+                              .append(range));
+  };
+  if (!(layout.character_size_m > 0.0 && std::isfinite(layout.character_size_m))) {
+    refuse("character_size_m", layout.character_size_m, "a finite length > 0 m");
   }
+  if (!(layout.spacing_m > 0.0 && std::isfinite(layout.spacing_m))) {
+    refuse("spacing_m", layout.spacing_m, "a finite length > 0 m");
+  }
+  if (!(layout.start_radius_m > 0.0 && std::isfinite(layout.start_radius_m))) {
+    refuse("start_radius_m", layout.start_radius_m, "a finite length > 0 m");
+  }
+  if (!(layout.box_margin_m >= 0.0 && std::isfinite(layout.box_margin_m))) {
+    refuse("box_margin_m", layout.box_margin_m, "a finite length >= 0 m");
+  }
+  for (const double c : {layout.centre_m.x(), layout.centre_m.y()}) {
+    if (!(std::abs(c) <= kMaxLayoutOffsetM)) refuse("centre_m", c, "each coordinate in [-1, 1] m");
+  }
+  if (!(std::abs(layout.paper_z_m) <= kMaxLayoutOffsetM)) refuse("paper_z_m", layout.paper_z_m, "[-1, 1] m");
   Scene scene;
   scene.layout = layout;
   const double n = static_cast<double>(characters.size());

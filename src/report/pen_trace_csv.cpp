@@ -278,6 +278,12 @@ class Reader {
     const Vec2 xy(number(fields, c.x), number(fields, c.y));
     s.position_m = options_.units == TraceUnits::data ? placement_.to_paper(xy) : xy;
     if (!s.position_m.allFinite()) fail(c.x, fields[c.x], "not finite once converted to metres");
+    // Scoring measures every sample in the character's data units too: a position too far away to be one
+    // there (1e308 m) is refused here, at its line, rather than by the scorer without the file's name.
+    if (const Vec2 data = placement_.to_data(s.position_m); !data.allFinite()) {
+      const std::size_t far = std::isfinite(data.x()) ? c.y : c.x;
+      fail(far, fields[far], "too far from the character to convert to its data units");
+    }
     if (c.pen) {
       const std::string_view pen = fields[*c.pen];
       if (pen != "0" && pen != "1") fail(*c.pen, pen, "pen must be 1 (down) or 0 (up)");
@@ -372,6 +378,9 @@ void for_each_trace_hdf5_row(const TraceColumns& c, const std::string& source, c
     const Vec2 xy(c.x_m[i], c.y_m[i]);
     s.position_m = options.units == TraceUnits::data ? placement.to_paper(xy) : xy;
     if (!s.position_m.allFinite()) fail(i, "position not finite once converted to metres");
+    if (!placement.to_data(s.position_m).allFinite()) {
+      fail(i, "position too far from the character to convert to its data units");
+    }
     s.pen_down = c.z_m[i] - options.paper_z_m <= options.contact_threshold_m;
     if (s.pen_down && (i == 0 || !was_down) && ++segments > options.max_pen_down_segments) {
       fail(i, "more than " + std::to_string(options.max_pen_down_segments) +

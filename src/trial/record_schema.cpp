@@ -11,6 +11,8 @@ namespace {
 constexpr double kLargest = std::numeric_limits<double>::max();
 constexpr ParameterRange kAnyNumber{.low = -kLargest, .high = kLargest};
 constexpr ParameterRange kNonNegative{.low = 0.0, .high = kLargest};
+constexpr ParameterRange kPositive{.low = 0.0, .high = kLargest, .low_open = true};
+constexpr ParameterRange kWithinReach{.low = -kMaxLayoutOffsetM, .high = kMaxLayoutOffsetM};
 
 }  // namespace
 
@@ -160,18 +162,18 @@ const Schema& SchemaOf<SimulatedDeviceParameters>::get() {
 const Schema& SchemaOf<SceneLayout>::get() {
   using L = SceneLayout;
   static const std::vector<SchemaField> fields{
-      number_field<&L::character_size_m>("character_size_m", kNonNegative,
+      number_field<&L::character_size_m>("character_size_m", kPositive,
                                          {.unit = "m", .doc = "side of each character's data box on paper"}),
-      number_field<&L::spacing_m>("spacing_m", kNonNegative,
+      number_field<&L::spacing_m>("spacing_m", kPositive,
                                   {.unit = "m", .doc = "centre-to-centre distance in the row"}),
-      number_array_field<&L::centre_m, 2>("centre_m", kAnyNumber,
+      number_array_field<&L::centre_m, 2>("centre_m", kWithinReach,
                                           {.unit = "m", .doc = "centre of the row on the paper"}),
-      number_field<&L::paper_z_m>("paper_z_m", kAnyNumber,
+      number_field<&L::paper_z_m>("paper_z_m", kWithinReach,
                                   {.unit = "m", .doc = "z0, height of the paper plane in device space"}),
       number_field<&L::box_margin_m>("box_margin_m", kNonNegative,
                                      {.unit = "m", .doc = "bounding box margin around the strokes (Fig. 5)"}),
       number_field<&L::start_radius_m>(
-          "start_radius_m", kNonNegative,
+          "start_radius_m", kPositive,
           {.unit = "m", .doc = "radius of the start-point neighbourhood (Fig. 5, Table 1)"}),
   };
   static const Schema schema{.name = "SceneLayout",

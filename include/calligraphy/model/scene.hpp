@@ -72,6 +72,11 @@ struct PlacedCharacter {
 /// is refused up front (Scene::lay_out; front ends check the count before loading the characters).
 inline constexpr std::size_t kMaxSceneCharacters = 1000;
 
+/// The farthest the row's centre and the paper's height may lie from the device's origin [m]: farther than
+/// any haptic device reaches, and near enough that every position of a trial stays a finite number (a paper
+/// at 1e308 m made the simulated pen's position overflow).
+inline constexpr double kMaxLayoutOffsetM = 1.0;
+
 /// Throws InvalidArgument "<what>: N characters, more than a scene's limit of kMaxSceneCharacters" when
 /// `count` > kMaxSceneCharacters.
 void check_scene_size(std::size_t count, const std::string& what);
