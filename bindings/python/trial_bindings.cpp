@@ -7,10 +7,12 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "arguments.hpp"
@@ -402,8 +404,43 @@ PyTrialResult run_trial_py(
 // The trial a record states (a TrialResult's metrics, a trial record as a dict, or a record's file), run
 // again as it ran.
 // The record `record` names (a dict or a path), read and checked by the one reader (recorded_trial.hpp).
+// The JSON pointer and value of the first float of `value` that JSON cannot hold (nan, inf): a dict holding
+// one is refused naming that value, as the reader names a value out of its range, rather than as JSON text
+// the caller never wrote, cut at a byte offset of it.
+std::optional<std::pair<std::string, std::string>> non_finite_value(const py::handle& value,
+                                                                    const std::string& pointer) {
+  if (py::isinstance<py::float_>(value)) {
+    if (std::isfinite(value.cast<double>())) return std::nullopt;
+    return std::make_pair(pointer, py::repr(value).cast<std::string>());
+  }
+  const auto child = [&](const std::string& name) {
+    std::string at = pointer;
+    at.append("/");
+    for (const char c : name) at.append(c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c));  // RFC 6901
+    return at;
+  };
+  if (py::isinstance<py::dict>(value)) {
+    for (const auto& [key, item] : value.cast<py::dict>()) {
+      auto found = non_finite_value(item, child(py::str(key).cast<std::string>()));
+      if (found) return found;
+    }
+  } else if (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value)) {
+    std::size_t i = 0;
+    for (const py::handle item : value) {
+      auto found = non_finite_value(item, child(std::to_string(i++)));
+      if (found) return found;
+    }
+  }
+  return std::nullopt;
+}
+
 RecordedTrial read_record_py(const py::object& record) {
   if (py::isinstance<py::dict>(record)) {
+    if (const auto found = non_finite_value(record, "")) {
+      std::string message = "record: ";
+      message.append(found->first).append(": expected a finite number, got ").append(found->second);
+      throw DataError(message);
+    }
     const std::string text = py::module_::import("json").attr("dumps")(record).cast<std::string>();
     return read_recorded_trial(text, "record");
   }
