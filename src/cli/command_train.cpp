@@ -41,7 +41,8 @@ struct TrainCommand {
   std::string screenshot;
   double exit_after_s = 0.0;
   std::int64_t watchdog_ms = 0;
-  const CLI::Option* watchdog_option = nullptr;  // given on the command line when its count() > 0
+  const CLI::Option* watchdog_option = nullptr;       // given on the command line when its count() > 0
+  const CLI::Option* guidance_gain_option = nullptr;  // given on the command line when its count() > 0
   bool quiz = false;
   bool engineer = false;
   bool no_demo = false;
@@ -84,6 +85,15 @@ std::pair<int, int> window_size(const std::string& text) {
 }
 
 int run_train(const TrainCommand& command, DeviceRegistry& devices) {
+  // Combinations of options before any file is read: a quiz has no guidance, so nothing that sets one.
+  if (command.quiz && command.guidance_mode != "fixed")
+    throw UsageError("--quiz: a quiz has no guidance; drop --guidance-mode " + command.guidance_mode);
+  if (command.quiz && !command.teacher.empty()) {
+    std::string message = "--quiz: a quiz has no guidance; drop --teacher ";
+    throw UsageError(message.append(command.teacher));
+  }
+  if (command.quiz && command.guidance_gain_option->count() > 0)
+    throw UsageError("--quiz: a quiz has no guidance; drop --guidance-gain");
   check_train_files(command);
   trainer::register_trainer_devices(devices);
   const std::u32string chars = characters_from(command.characters, "CHARS");
@@ -116,8 +126,6 @@ int run_train(const TrainCommand& command, DeviceRegistry& devices) {
   options.acceptance.hint_after_misses = static_cast<double>(command.hint_after);
   options.acceptance.assist_after_misses = static_cast<double>(command.assist_after);
   options.quiz_screenshots = command.quiz_screenshots;
-  if (command.quiz && command.guidance_mode != "fixed")
-    throw UsageError("--quiz: a quiz has no guidance; drop --guidance-mode " + command.guidance_mode);
   options.guidance_mode = *guidance_mode_from_string(command.guidance_mode);
   options.guidance_gain = command.guidance_gain;
   options.record = command.record;
@@ -193,9 +201,10 @@ void add_train_command(CLI::App& root, Commands& commands, DeviceRegistry& devic
              "how guidance acts (docs/force-rendering.md): the paper's fixed fixture, faded trial by trial "
              "from the mean deviation, along a teacher's recording, only beyond a band that adapts trial by "
              "trial, a gentle push off the stroke, or a target pacing the stroke (M cycles it)");
-  add_number(*app, "--guidance-gain", command->guidance_gain, "G",
-             "fading: the first trial's gain, faded after each trial", "a number in [0, 1]",
-             [](double g) { return g >= 0.0 && g <= 1.0; });
+  command->guidance_gain_option =
+      add_number(*app, "--guidance-gain", command->guidance_gain, "G",
+                 "fading: the first trial's gain, faded after each trial", "a number in [0, 1]",
+                 [](double g) { return g >= 0.0 && g <= 1.0; });
   add_input_path(*app, "--teacher", command->teacher, "FILE",
                  "replay: the teacher's recording (JSON, from --record)", "none");
   add_output_path(*app, "--record", command->record,

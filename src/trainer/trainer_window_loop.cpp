@@ -51,9 +51,11 @@ TrainerApp::TrainerApp(const TrainerOptions& options, DeviceInfo device_info, bo
 }
 
 int TrainerApp::run() {
-  if (practice_) practice_->open_practice_folder();
   set_display_lost_ending([this] { end_after_lost_display(); });
   open_window();
+  // The session folder only once the window is open: a display that cannot be opened leaves no session
+  // that started and never stopped.
+  if (practice_) practice_->open_practice_folder();
   layout_.emplace(session_ ? 1 : options_.characters.size(), options_.width_px, options_.height_px,
                   kPanelWidthPx);
   if (session_) art_.resize(1);

@@ -25,6 +25,7 @@ import functools
 import itertools
 import math
 import multiprocessing
+import numbers
 import os
 import typing
 
@@ -66,6 +67,7 @@ _MAX_DEFAULT_BATCH = 32
 # Bounds of a sweep, checked before any list is built: trials (a million is hours of simulation and the
 # largest table kept in memory) and local workers (as `session cohort --jobs`).
 MAX_SWEEP_TRIALS = 1_000_000
+_MAX_SEED = 2 ** 64 - 1  # a seed is a 64-bit unsigned integer (simulate_trial, `trial --seed`)
 MAX_WORKERS = 1024
 # Default batches per worker, so that a slow batch at the end does not leave the other workers idle.
 _BATCHES_PER_WORKER = 4
@@ -137,6 +139,17 @@ def _writer_profile(writer: typing.Any) -> WriterProfile:
     raise ValueError(f"writer: expected 'novice', 'skilled' or a WriterProfile, got {writer!r}")
 
 
+def _check_trial_argument_type(name: str, argument: str, value: typing.Any) -> None:
+    """The type simulate_trial takes for a trial argument, checked before any trial runs (its range is the
+    trial's to check: a value out of range becomes that trial's error row)."""
+    if argument == "guidance":
+        if not isinstance(value, bool):
+            raise TypeError(f"grid['{name}']: expected bool, got {type(value).__name__} {value!r}")
+    elif argument in ("rate_hz", "max_duration_s"):
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):
+            raise TypeError(f"grid['{name}']: expected a number, got {type(value).__name__} {value!r}")
+
+
 def _trial_arguments(parameters: typing.Iterable[tuple[str, typing.Any]]) -> dict[str, typing.Any]:
     """simulate_trial's keyword arguments for one combination of grid values. Raises what the parameter
     classes raise for a value out of range (ValueError) or of the wrong type (TypeError), naming it."""
@@ -148,6 +161,7 @@ def _trial_arguments(parameters: typing.Iterable[tuple[str, typing.Any]]) -> dic
     for name, value in parameters:
         target = catalogue[name]
         if target[0] == "trial":
+            _check_trial_argument_type(name, target[1], value)
             arguments[target[1]] = value
         elif target[0] == "writer":
             writer_fields[target[1]] = value
@@ -243,8 +257,8 @@ def _seed_list(seeds: typing.Any) -> list[int]:
     if not values:
         raise ValueError("seeds: no seeds")
     for seed in values:
-        if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
-            raise ValueError(f"seeds: expected ints >= 0, got {seed!r}")
+        if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0 or seed > _MAX_SEED:
+            raise ValueError(f"seeds: expected ints in 0..{_MAX_SEED} (0..2**64-1), got {seed!r}")
     return values
 
 

@@ -54,6 +54,9 @@ def _text_font(text: str) -> dict:
 
 def _axes(ax, figsize):
     if ax is not None:
+        import matplotlib.axes
+        if not isinstance(ax, matplotlib.axes.Axes):
+            raise TypeError(f"ax: expected matplotlib Axes, got {type(ax).__name__} {ax!r}")
         return ax
     _, ax = _pyplot().subplots(figsize=figsize)
     return ax
@@ -68,6 +71,10 @@ def _runs(mask: np.ndarray):
 
 
 def _require_trace(result: TrialResult, what: str):
+    from ._calligraphy import TrialResult as _TrialResult
+    if not isinstance(result, _TrialResult):
+        raise TypeError(f"calligraphy.plot.{what}: result: expected a TrialResult (simulate_trial, run_trial), "
+                        f"got {type(result).__name__}")
     if np.asarray(result.time_s).size == 0:
         raise ValueError(f"calligraphy.plot.{what}: the result has no trace; run simulate_trial with "
                          "keep_trace=True")

@@ -5,6 +5,7 @@
 #include <cstdlib>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/printable_text.hpp"
 #include "devices/openhaptics/hd_probe.hpp"
 #include "devices/shared_library_check.hpp"
 
@@ -48,11 +49,18 @@ std::shared_ptr<const HdLibrary> HdLibrary::load(const std::string& configuratio
     const bool named_by_user = explicit_path != nullptr && path == explicit_path;
     // A library the user named and that is refused is an error, never replaced by another libHD found
     // on the search path: the session would run on a driver nobody chose.
+    // The path and the loader's words about it are quoted as printable text: a path from the environment
+    // may hold a line break or an escape sequence, and the reason is printed as a line of `devices`.
     const auto refuse = [&](const std::string& problem) {
-      if (named_by_user)
-        throw DeviceUnavailable("OpenHaptics: CALLIGRAPHY_LIBHD=" + path + " cannot be used: " + problem +
-                                "; set it to the full path of a working libHD.so, or unset it");
-      tried += "\n  " + path + ": " + problem;
+      if (named_by_user) {
+        std::string message = "OpenHaptics: CALLIGRAPHY_LIBHD=";
+        message.append(printable_one_line(path))
+            .append(" cannot be used: ")
+            .append(printable_one_line(problem));
+        message.append("; set it to the full path of a working libHD.so, or unset it");
+        throw DeviceUnavailable(message);
+      }
+      tried.append("\n  ").append(printable_one_line(path)).append(": ").append(printable_one_line(problem));
     };
     // A path is checked before any process maps it (a truncated file raises SIGBUS, a FIFO blocks), then
     // loaded and its device initialised in a probe process: only a driver that neither crashes, hangs nor
