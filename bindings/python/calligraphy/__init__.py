@@ -42,6 +42,10 @@ old paths ``calligraphy.statistics`` and so on are the same modules. See docs/py
 
 import typing as _typing
 
+# numpy is imported here, not first inside a call that returns an array: an import that a Ctrl-C interrupts
+# half way leaves a module without its names for the rest of the process.
+import numpy as _numpy  # noqa: F401
+
 from ._calligraphy import (  # noqa: F401
     __version__,
     TYPICAL_STROKES,
