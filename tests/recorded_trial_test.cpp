@@ -13,6 +13,8 @@
 #include <nlohmann/json.hpp>
 #include <random>
 #include <string>
+#include <string_view>
+#include <tuple>
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
@@ -300,6 +302,29 @@ TEST_CASE("What is not a recorded trial is refused naming the file and the place
   // A safety peak past its table's range: a typing error, not a limit.
   CHECK_THAT(refusal(edited([](auto& d) { d["safety"]["max_force_n"] = 1e308; })),
              Catch::Contains("/safety/max_force_n"));
+  // Lengths, times and tolerances have finite bounds: the largest double is a typing error, refused by
+  // pointer; the bound itself is taken.
+  for (const auto& [part, field, bound] :
+       {std::tuple{"scene/layout", "box_margin_m", 0.1}, std::tuple{"scene/layout", "start_radius_m", 0.1},
+        std::tuple{"scene/layout", "character_size_m", 1.0}, std::tuple{"scene/layout", "spacing_m", 1.0},
+        std::tuple{"force_law/nearest", "tolerance", 1e-3},
+        std::tuple{"force_law", "constraint_radius_m", 0.1},
+        std::tuple{"force_law", "contact_hysteresis_m", 0.1},
+        std::tuple{"force_law", "off_stroke_travel_m", 0.1}, std::tuple{"force_law", "crossfade_s", 10.0},
+        std::tuple{"force_law", "paper_fade_s", 10.0},
+        std::tuple{"safety", "continuous_time_constant_s", 86400.0}}) {
+    const std::string pointer = "/" + std::string(part) + "/" + field;
+    const bool radius = std::string_view(field) == "constraint_radius_m";
+    INFO(pointer);
+    const auto set = [&](double value) {
+      return edited([&](nlohmann::json& d) {
+        d[nlohmann::json::json_pointer(pointer)] = value;
+        if (radius) d["force_law"]["constraint_taper_m"] = 0.0;  // at most R_res
+      });
+    };
+    CHECK_THAT(refusal(set(1e308)), Catch::Contains("r.json: " + pointer));
+    CHECK_NOTHROW((void)read_recorded_trial(set(bound), "r.json"));
+  }
   // Inside a trial record, the pointers name the record's member.
   const std::string record =
       "{\"version\": 2, \"specification\": " + edited([](auto& d) { d["safety"]["max_force_n"] = -1.0; }) +

@@ -853,7 +853,9 @@ class PythonSurfaces(Base):
         self.assertGreater(tried, 60)
         # What the schema takes, the layout takes: the largest box margin it allows runs.
         forged = json.loads(json.dumps(record))
-        forged["specification"]["scene"]["layout"]["box_margin_m"] = 1e308
+        largest = properties("#/$defs/SceneLayout")["box_margin_m"]["maximum"]
+        self.assertLess(largest, 1e308)  # a finite bound, not the largest double
+        forged["specification"]["scene"]["layout"]["box_margin_m"] = largest
         cg.check_trial_record(forged)
 
     def test_simulate_trial_and_score_past_their_bounds(self):
