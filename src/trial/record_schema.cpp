@@ -216,7 +216,8 @@ const Schema& SchemaOf<trial_detail::RecordDocument>::get() {
       since(4, string_field<&R::teacher_sha256>(
                    "teacher_sha256",
                    {.doc = "lower-case hex SHA-256 of the teacher's recording a replay ran on, "
-                           "checked when it is re-run; empty: no file was read",
+                           "checked when it is re-run; required when the replay names its file "
+                           "(/trial/teacher); empty: no file was read (a teacher given as samples)",
                     .source = "FIPS 180-4"})),
   };
   static const Schema schema{.name = "RecordedTrial",

@@ -307,7 +307,6 @@ class TrialTeachers(Base):
         self.assertEqual(len(record["specification"]["teacher_sha256"]), 64)
         return record
 
-    @unittest.expectedFailure  # recorded_trial() (C++ API) writes "" beside a named teacher: its writers need the SHA first
     def test_a_replay_record_that_drops_its_teacher_binding(self):
         # A record naming its teacher's file without the SHA-256 re-runs on any file of that name, which the
         # binding exists to prevent (docs/cli.md, "Re-running a trial").
