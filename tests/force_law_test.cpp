@@ -4,10 +4,12 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <tuple>
 #include <type_traits>
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/render/safety_chain.hpp"
 
 using namespace calligraphy;
 
@@ -129,7 +131,7 @@ TEST_CASE("Each parameter table holds its defaults, and validation refuses just 
 TEST_CASE("A parameter's error names the field, its value with the unit and the range", "[force]") {
   ForceLawParameters p;
   p.constraint_radius_m = 0.0;
-  CHECK_THROWS_WITH(p.validate(), "ForceLawParameters.constraint_radius_m = 0 m must be finite and > 0 m");
+  CHECK_THROWS_WITH(p.validate(), "ForceLawParameters.constraint_radius_m = 0 m must be in (0, 0.1] m");
   p = {};
   p.guidance_law = FadingGuidance{.gain = 1.5};
   CHECK_THROWS_WITH(p.validate(), "FadingGuidance.gain = 1.5 must be in [0, 1]");
@@ -138,4 +140,32 @@ TEST_CASE("A parameter's error names the field, its value with the unit and the 
                     Catch::Contains("TimingGuidance.max_lead_m") && Catch::Contains("0.006] m"));
   CHECK(parameter_field(&ForceLawParameters::friction_stick_speed_m_s).description() ==
         "stick band of the friction, viscous below it [m/s], > 0 m/s");
+}
+
+TEST_CASE("The force law's lengths, fade times and nearest-point tolerance have finite bounds", "[force]") {
+  for (const auto& [field, name, bound] :
+       {std::tuple{&ForceLawParameters::constraint_radius_m, "constraint_radius_m", 0.1},
+        std::tuple{&ForceLawParameters::contact_hysteresis_m, "contact_hysteresis_m", 0.1},
+        std::tuple{&ForceLawParameters::off_stroke_travel_m, "off_stroke_travel_m", 0.1},
+        std::tuple{&ForceLawParameters::constraint_taper_m, "constraint_taper_m", 0.1},
+        std::tuple{&ForceLawParameters::crossfade_s, "crossfade_s", 10.0},
+        std::tuple{&ForceLawParameters::paper_fade_s, "paper_fade_s", 10.0}}) {
+    INFO(name);
+    ForceLawParameters p;
+    p.constraint_radius_m = 0.1;  // the taper may reach it
+    p.*field = bound;
+    CHECK_NOTHROW(p.validate());
+    p.*field = 1e308;
+    CHECK_THROWS_WITH(p.validate(), Catch::Contains(name));
+  }
+  ForceLawParameters p;
+  p.nearest.tolerance = 1e-3;
+  CHECK_NOTHROW(p.validate());
+  p.nearest.tolerance = 1e308;
+  CHECK_THROWS_WITH(p.validate(), Catch::Contains("nearest.tolerance") && Catch::Contains("(0, 0.001]"));
+  SafetyChainParameters safety;
+  safety.continuous_time_constant_s = 86400.0;
+  CHECK_NOTHROW(safety.validate());
+  safety.continuous_time_constant_s = 1e308;
+  CHECK_THROWS_WITH(safety.validate(), Catch::Contains("continuous_time_constant_s"));
 }

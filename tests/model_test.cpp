@@ -1,14 +1,16 @@
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <tuple>
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/model/fitting.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
-#include "calligraphy/core/unicode.hpp"
 
 using namespace calligraphy;
 
@@ -138,4 +140,23 @@ TEST_CASE("A scene holds at most kMaxSceneCharacters characters", "[model]") {
                     Catch::Contains("1001 characters") && Catch::Contains("limit of 1000"));
   CHECK_NOTHROW(check_scene_size(kMaxSceneCharacters, "CHARS"));
   CHECK_THROWS_WITH(check_scene_size(100000, "CHARS"), Catch::StartsWith("CHARS: 100000 characters"));
+}
+
+TEST_CASE("A scene's layout lengths have finite bounds", "[model]") {
+  const std::vector<Character> one{CharacterLibrary::embedded().load(U'十')};
+  const auto laid_out = [&](double SceneLayout::*field, double value) {
+    SceneLayout layout;
+    layout.*field = value;
+    return Scene::lay_out(one, layout);
+  };
+  for (const auto& [field, name, bound] :
+       {std::tuple{&SceneLayout::box_margin_m, "box_margin_m", kMaxLayoutMarginM},
+        std::tuple{&SceneLayout::start_radius_m, "start_radius_m", kMaxLayoutMarginM},
+        std::tuple{&SceneLayout::character_size_m, "character_size_m", kMaxLayoutSizeM},
+        std::tuple{&SceneLayout::spacing_m, "spacing_m", kMaxLayoutSizeM}}) {
+    INFO(name);
+    CHECK_NOTHROW(laid_out(field, bound));
+    CHECK_THROWS_WITH(laid_out(field, 1e308), Catch::Contains(name) && Catch::Contains("out of range"));
+    CHECK_THROWS_AS(laid_out(field, std::nextafter(bound, 1.0e9)), InvalidArgument);
+  }
 }

@@ -13,6 +13,8 @@
 #include <nlohmann/json.hpp>
 #include <random>
 #include <string>
+#include <string_view>
+#include <tuple>
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
@@ -62,7 +64,10 @@ RecordedTrial random_recorded_trial(std::mt19937_64& random, GuidanceMode mode) 
   r.spec.max_duration_s = 1.0 + std::uniform_real_distribution<double>(0.0, 100.0)(random);
   r.spec.writer_profile = "foreign";
   r.spec.writer_parameters = {{"hesitation_s", 0.25}};
-  if (mode == GuidanceMode::replay) r.spec.teacher = "teacher.json";
+  if (mode == GuidanceMode::replay) {
+    r.spec.teacher = "teacher.json";
+    r.teacher_sha256 = std::string(64, 'b');  // the file it read, as a replay's writer states it
+  }
   randomise(r.force_law, random);
   r.force_law.constraint_taper_m = r.force_law.constraint_radius_m * 0.5;  // a cross-field rule
   r.force_law.guidance_law = default_guidance_law(mode);
@@ -229,6 +234,43 @@ TEST_CASE("A record with a part out of range is refused by the builder, naming i
   CHECK(rerun.result.trace.size() == ran.result.trace.size());
 }
 
+TEST_CASE("A replay naming its teacher's file states the file's SHA-256, written and read",
+          "[recorded_trial]") {
+  std::mt19937_64 random(11);
+  RecordedTrial replay = random_recorded_trial(random, GuidanceMode::replay);
+  const std::string good = recorded_trial_json(replay);
+  nlohmann::json document = nlohmann::json::parse(good);
+  document["teacher_sha256"] = "";
+  // Read: refused at its pointer, from version 4 (which introduced it); older records named none.
+  CHECK_THAT(error_of([&] { (void)read_recorded_trial(document.dump(), "r.json"); }),
+             Catch::Contains("r.json: /teacher_sha256") && Catch::Contains("teacher.json"));
+  document["version"] = 3;
+  document.erase("teacher_sha256");
+  CHECK_NOTHROW((void)read_recorded_trial(document.dump(), "r.json"));
+  // A teacher given as samples names no file: nothing to bind.
+  document = nlohmann::json::parse(good);
+  document["teacher_sha256"] = "";
+  document["trial"]["teacher"] = "";
+  CHECK_NOTHROW((void)read_recorded_trial(document.dump(), "r.json"));
+
+  // Written: recorded_trial() takes the SHA-256 of the file the replay read, and refuses to write without it.
+  const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'十')});
+  TrialSpec spec;
+  spec.characters = "十";
+  spec.guidance_mode = GuidanceMode::replay;
+  spec.teacher = "teacher.json";
+  TrialOptions ran;
+  ran.force.guidance_law = ReplayGuidance{};
+  CHECK_THROWS_WITH((void)recorded_trial(spec, ran, nullptr, scene),
+                    Catch::Contains("teacher.json") && Catch::Contains("SHA-256"));
+  CHECK_THROWS_AS((void)recorded_trial(spec, ran, nullptr, scene, "not a sha"), InvalidArgument);
+  const std::string sha(64, 'c');
+  CHECK(recorded_trial(spec, ran, nullptr, scene, sha).teacher_sha256 == sha);
+  spec.teacher.clear();  // samples
+  CHECK(recorded_trial(spec, ran, nullptr, scene).teacher_sha256.empty());
+  CHECK_THROWS_AS((void)recorded_trial(spec, ran, nullptr, scene, sha), InvalidArgument);
+}
+
 TEST_CASE("A record run on other characters is refused", "[recorded_trial]") {
   const Scene ten = Scene::lay_out({CharacterLibrary::embedded().load(U'十')});
   const Scene person = Scene::lay_out({CharacterLibrary::embedded().load(U'人')});
@@ -300,6 +342,29 @@ TEST_CASE("What is not a recorded trial is refused naming the file and the place
   // A safety peak past its table's range: a typing error, not a limit.
   CHECK_THAT(refusal(edited([](auto& d) { d["safety"]["max_force_n"] = 1e308; })),
              Catch::Contains("/safety/max_force_n"));
+  // Lengths, times and tolerances have finite bounds: the largest double is a typing error, refused by
+  // pointer; the bound itself is taken.
+  for (const auto& [part, field, bound] :
+       {std::tuple{"scene/layout", "box_margin_m", 0.1}, std::tuple{"scene/layout", "start_radius_m", 0.1},
+        std::tuple{"scene/layout", "character_size_m", 1.0}, std::tuple{"scene/layout", "spacing_m", 1.0},
+        std::tuple{"force_law/nearest", "tolerance", 1e-3},
+        std::tuple{"force_law", "constraint_radius_m", 0.1},
+        std::tuple{"force_law", "contact_hysteresis_m", 0.1},
+        std::tuple{"force_law", "off_stroke_travel_m", 0.1}, std::tuple{"force_law", "crossfade_s", 10.0},
+        std::tuple{"force_law", "paper_fade_s", 10.0},
+        std::tuple{"safety", "continuous_time_constant_s", 86400.0}}) {
+    const std::string pointer = "/" + std::string(part) + "/" + field;
+    const bool radius = std::string_view(field) == "constraint_radius_m";
+    INFO(pointer);
+    const auto set = [&](double value) {
+      return edited([&](nlohmann::json& d) {
+        d[nlohmann::json::json_pointer(pointer)] = value;
+        if (radius) d["force_law"]["constraint_taper_m"] = 0.0;  // at most R_res
+      });
+    };
+    CHECK_THAT(refusal(set(1e308)), Catch::Contains("r.json: " + pointer));
+    CHECK_NOTHROW((void)read_recorded_trial(set(bound), "r.json"));
+  }
   // Inside a trial record, the pointers name the record's member.
   const std::string record =
       "{\"version\": 2, \"specification\": " + edited([](auto& d) { d["safety"]["max_force_n"] = -1.0; }) +

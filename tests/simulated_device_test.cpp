@@ -70,3 +70,11 @@ TEST_CASE("The simulated device refuses a step that would run its clock past 2^6
   CHECK_THROWS_AS(d.advance(4.7e9), InvalidArgument);  // 149 years
   CHECK(d.time() == 1.0);
 }
+
+TEST_CASE("The simulated device starts within a layout's reach", "[device]") {
+  SimulatedDeviceParameters p;
+  p.initial_position_m = Vec3(1.0, -1.0, 0.5);
+  CHECK_NOTHROW(p.validate());
+  p.initial_position_m = Vec3(0.0, 1e308, 0.0);
+  CHECK_THROWS_WITH(p.validate(), Catch::Contains("initial_position_m") && Catch::Contains("[-1, 1] m"));
+}

@@ -422,16 +422,16 @@ void bind_scene(py::module_& m) {
       "x right, y away from the writer (paper Figs. 5 and 30).",
       [](const SceneLayout& layout) { static_cast<void>(Scene::lay_out({}, layout)); })
       .field("character_size_m", &SceneLayout::character_size_m,
-             "side of each character's data box on paper [m], > 0")
-      .field("spacing_m", &SceneLayout::spacing_m, "centre-to-centre distance in the row [m], > 0")
+             "side of each character's data box on paper [m], in (0, 1]")
+      .field("spacing_m", &SceneLayout::spacing_m, "centre-to-centre distance in the row [m], in (0, 1]")
       .field("centre_m", &SceneLayout::centre_m,
              "centre of the row on the paper [m], each coordinate in [-1, 1]")
       .field("paper_z_m", &SceneLayout::paper_z_m,
              "z0, height of the paper plane in device space [m], in [-1, 1]")
       .field("box_margin_m", &SceneLayout::box_margin_m,
-             "bounding-box margin around the strokes (Fig. 5) [m], >= 0")
+             "bounding-box margin around the strokes (Fig. 5) [m], in [0, 0.1]")
       .field("start_radius_m", &SceneLayout::start_radius_m,
-             "radius of the start-point neighbourhood (Fig. 5, Table 1) [m], > 0")
+             "radius of the start-point neighbourhood (Fig. 5, Table 1) [m], in (0, 0.1]")
       .finish();
 
   py::class_<PlacedStroke>(m, "PlacedStroke", "A stroke placed on the paper, in metres.")

@@ -119,7 +119,7 @@ void bind_simulated_device(py::module_& m) {
       .field("physics_rate_hz", &SimulatedDeviceParameters::physics_rate_hz,
              "least physics rate [Hz], in [1e3, 1e8]")
       .field("initial_position_m", &SimulatedDeviceParameters::initial_position_m,
-             "where the stylus starts [m].")
+             "where the stylus starts [m], each coordinate in [-1, 1]")
       .field("info", &SimulatedDeviceParameters::info, "the DeviceInfo it reports (Phantom Desktop figures)")
       .finish();
 

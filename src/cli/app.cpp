@@ -142,8 +142,9 @@ CLI::Option* add_unsigned(CLI::App& app, const std::string& name, std::uint64_t&
 
 CLI::Option* add_number(CLI::App& app, const std::string& name, double& target, const std::string& value_name,
                         const std::string& description, const std::string& expectation,
-                        std::function<bool(double)> valid) {
-  return add_single(app, name, value_name, description, shortest_decimal(target),
+                        std::function<bool(double)> valid, const std::string& default_text) {
+  return add_single(app, name, value_name, description,
+                    default_text.empty() ? shortest_decimal(target) : default_text,
                     [=, &target](const std::string& text) {
                       double value = 0.0;
                       if (!parse_number(text, value) || !valid(value)) invalid(name, expectation, text);

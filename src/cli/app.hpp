@@ -60,10 +60,11 @@ CLI::Option* add_integer(CLI::App& app, const std::string& name, std::int64_t& t
 /// An unsigned 64-bit integer, parsed exactly (e.g. a seed up to 18446744073709551615).
 CLI::Option* add_unsigned(CLI::App& app, const std::string& name, std::uint64_t& target,
                           const std::string& value_name, const std::string& description);
-/// A finite decimal number for which `valid` holds; `expectation` says what is valid ("a number > 0").
+/// A finite decimal number for which `valid` holds; `expectation` says what is valid ("a number > 0"). The
+/// default shown is `target`, or `default_text` when given ("none" for an option without a default).
 CLI::Option* add_number(CLI::App& app, const std::string& name, double& target, const std::string& value_name,
                         const std::string& description, const std::string& expectation,
-                        std::function<bool(double)> valid);
+                        std::function<bool(double)> valid, const std::string& default_text = "");
 /// A comma-separated list of finite numbers for which `valid` holds.
 CLI::Option* add_number_list(CLI::App& app, const std::string& name, std::vector<double>& target,
                              const std::string& value_name, const std::string& description,

@@ -38,15 +38,22 @@ int run_acceptance(const AcceptanceCommand& command) {
   add_library_inputs(files, command.library);
   if (!command.kanjivg.empty()) files.input_folder("--kanjivg", command.kanjivg);
   files.output("--markdown", command.markdown);
+  const bool to_document = !command.markdown.empty() && command.markdown != "-";
+  const char* begin_marker = command.kanjivg.empty() ? kAcceptanceGeneratedBegin : kOtherHandGeneratedBegin;
+  if (to_document) {  // refused before the measurement, not after it
+    check_generated_section(read_file_for_update(command.markdown).value_or(std::string()), begin_marker,
+                            command.markdown);
+  }
   const CharacterLibrary library = library_from(command.library);
   const auto count = static_cast<std::size_t>(command.characters);
-  std::string invocation = "calligraphy bench acceptance --data DATA";
+  // The command as run, its paths as placeholders.
+  std::string invocation = "calligraphy bench acceptance";
+  if (!command.library.data_folder.empty()) invocation += " --data DATA";
   if (!command.kanjivg.empty()) invocation += " --kanjivg KANJIVG";
   if (!command.markdown.empty()) invocation += " --markdown " + command.markdown;
   invocation +=
       " --characters " + std::to_string(command.characters) + " --seed " + std::to_string(command.seed);
   std::string section;
-  const char* begin_marker = kAcceptanceGeneratedBegin;
   if (!command.kanjivg.empty()) {
     // Another hand's strokes: the characters KanjiVG and the library share with as many strokes, in the
     // same order and form, from the half asked for (both: each half, the tuning one first).
@@ -60,7 +67,6 @@ int run_acceptance(const AcceptanceCommand& command) {
     std::vector<KanjivgHalf> halves;
     if (command.half != "held-out") halves.push_back(KanjivgHalf::tuning);
     if (command.half != "tuning") halves.push_back(KanjivgHalf::held_out);
-    begin_marker = kOtherHandGeneratedBegin;
     section = std::string(begin_marker) + "\n";
     for (const KanjivgHalf half : halves) {
       const double tolerance_m = command.form_tolerance_mm / 1000.0;
@@ -96,12 +102,13 @@ int run_acceptance(const AcceptanceCommand& command) {
     section = std::string(begin_marker) + "\n" + acceptance_markdown(measurement, invocation) +
               kGeneratedEnd + "\n";
   }
-  if (command.markdown.empty() || command.markdown == "-") {
+  if (!to_document) {
     write_standard_output(section);
     return 0;
   }
   const std::string document = read_file_for_update(command.markdown).value_or(std::string());
-  write_output(command.markdown, replace_generated_section(document, section, begin_marker));
+  write_output(command.markdown,
+               replace_generated_section(document, section, begin_marker, command.markdown));
   write_standard_output("wrote the table to " + command.markdown + "\n");
   return 0;
 }

@@ -17,13 +17,21 @@
 namespace calligraphy::cli {
 namespace {
 
+std::string document_at(const std::string& path) {
+  return path == "-" ? std::string() : read_file_for_update(path).value_or(std::string());
+}
+
+// Before any measurement: a document whose generated section (`marker`) has no end is refused.
+void check_document(const std::string& path, const char* marker) {
+  if (!path.empty()) check_generated_section(document_at(path), marker, path);
+}
+
 // The document at `path` with its generated sections replaced, or the sections alone.
 std::string updated_document(const std::string& path, const std::string& section, const char* marker,
                              const std::string& jumps_section = {}) {
-  std::string document = path == "-" ? std::string() : read_file_for_update(path).value_or(std::string());
-  document = replace_generated_section(document, section, marker);
+  std::string document = replace_generated_section(document_at(path), section, marker, path);
   if (!jumps_section.empty())
-    document = replace_generated_section(document, jumps_section, kJumpsGeneratedBegin);
+    document = replace_generated_section(document, jumps_section, kJumpsGeneratedBegin, path);
   return document;
 }
 
@@ -50,6 +58,8 @@ int run_nearest(const NearestCommand& command) {
   require_one_standard_output({{"--json", command.json}, {"--markdown -", command.markdown == "-"}});
   FilePlan files;  // the document is read and its generated section replaced: it is the one output
   files.output("--markdown", command.markdown);
+  check_document(command.markdown, kGeneratedBegin);
+  check_document(command.markdown, kJumpsGeneratedBegin);
   MeasurementSettings settings;
   settings.queries = static_cast<int>(command.queries);
   settings.seed = command.seed;
@@ -83,6 +93,7 @@ int run_jumps(const JumpsCommand& command) {
   require_one_standard_output({{"--json", command.json}, {"--markdown -", command.markdown == "-"}});
   FilePlan files;
   files.output("--markdown", command.markdown);
+  check_document(command.markdown, kJumpsGeneratedBegin);
   JumpSettings settings;
   settings.seeds.clear();
   for (std::int64_t seed = 1; seed <= command.seeds; ++seed)

@@ -53,7 +53,7 @@ struct BuildCommand {
   std::string medians = "on";
 };
 
-int run_build(const BuildCommand& command) {
+int run_build(const BuildCommand& command, bool verbose) {
   const std::filesystem::path folder = corpus_folder(command.fit);
   FilePlan files;
   files.input_folder("--data", folder.string());
@@ -68,7 +68,7 @@ int run_build(const BuildCommand& command) {
 
   const auto start = Clock::now();
   const CorpusFit fit =
-      fit_corpus(library, fit_options, static_cast<unsigned>(command.fit.threads), "fitting");
+      fit_corpus(library, fit_options, static_cast<unsigned>(command.fit.threads), "fitting", verbose);
   if (fit.characters.empty()) {  // a store of nothing would replace an earlier store with nothing
     throw DataError(folder.string() + ": none of its " + std::to_string(fit.failures.size()) +
                     " character files could be modelled, so " + command.out + " is not written; the first: " +
@@ -93,6 +93,8 @@ int run_stats(const StatsCommand& command) {
   const CorpusStore store = CorpusStore::open(command.store);
   const CorpusStoreStats stats = corpus_store_stats(store);
   write_standard_output(command.json ? corpus_stats_json(store, stats) : corpus_stats_text(store, stats));
+  // The statistics on standard output (the JSON lists the errors too); each bad record an error line.
+  for (const std::string& error : stats.errors) print_error_line("calligraphy corpus stats", "error", error);
   return stats.errors.empty() ? 0 : 1;
 }
 
@@ -102,15 +104,15 @@ struct FidelityCommand {
   std::string markdown;
 };
 
-int run_fidelity(const FidelityCommand& command) {
+int run_fidelity(const FidelityCommand& command, bool verbose) {
   const std::filesystem::path folder = corpus_folder(command.fit);
   FilePlan files;
   files.input_folder("--data", folder.string());
   files.output("--markdown", command.markdown);
   const CharacterLibrary library = CharacterLibrary::from_directory(folder);
   const int steps = std::stoi(command.fit.steps);
-  const std::vector<FidelityRow> rows =
-      measure_corpus_fidelity(library, command.tolerances, steps, static_cast<unsigned>(command.fit.threads));
+  const std::vector<FidelityRow> rows = measure_corpus_fidelity(
+      library, command.tolerances, steps, static_cast<unsigned>(command.fit.threads), verbose);
   const std::string table = corpus_fidelity_markdown(rows, steps);
   write_standard_output(table);
   if (!command.markdown.empty() && command.markdown != "-") write_output(command.markdown, table);
@@ -125,7 +127,7 @@ void add_corpus_build_command(CLI::App& corpus, Commands& commands) {
   auto command = std::make_shared<BuildCommand>();
   CLI::App* app =
       commands.add(corpus, "build", "Model every character of hanzi-writer-data into a compact store",
-                   [command] { return run_build(*command); });
+                   [command, &commands] { return run_build(*command, commands.verbose()); });
   required(add_output_path(*app, "--out", command->out, "the store to write", StandardOutput::refused));
   add_number(*app, "--tolerance", command->tolerance, "UNITS",
              "largest deviation of the fitted elements from the median [data units, 1024 per character]",
@@ -149,7 +151,7 @@ void add_corpus_fidelity_command(CLI::App& corpus, Commands& commands) {
   auto command = std::make_shared<FidelityCommand>();
   CLI::App* app = commands.add(
       corpus, "fidelity", "Elements, bytes and deviation from the medians per fitting tolerance (Markdown)",
-      [command] { return run_fidelity(*command); });
+      [command, &commands] { return run_fidelity(*command, commands.verbose()); });
   add_number_list(*app, "--tolerances", command->tolerances, "LIST",
                   "fitting tolerances to compare [data units]", "numbers > 0", positive);
   add_output_path(*app, "--markdown", command->markdown, "also write the table (printed anyway) to a file",

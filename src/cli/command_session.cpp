@@ -554,9 +554,10 @@ void add_display_options(CLI::App& app, SessionDisplay& display) {
   add_output_path(app, "--screenshot", display.screenshot,
                   "window: write it as PNG after the last planned trial's outcome, or at exit",
                   StandardOutput::refused);
-  add_number(app, "--exit-after", display.exit_after_s, "SECONDS",
-             "window, unattended: trials start by themselves; quit after this long [s] or at the end",
-             "a number of seconds > 0", [](double s) { return s > 0.0 && s <= 86400.0; });
+  add_number(
+      app, "--exit-after", display.exit_after_s, "SECONDS",
+      "window, unattended: trials start by themselves; quit after this long [s, (0, 86400]] or at the end",
+      "a number of seconds in (0, 86400]", [](double s) { return s > 0.0 && s <= 86400.0; }, "none");
   add_flag(app, "--engineer", display.engineer,
            "window: the engineer's panel (interaction state, ticks, elements, pen and force); without it the "
            "learner's view (docs/trainer.md)");

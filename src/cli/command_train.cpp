@@ -246,9 +246,10 @@ void add_train_command(CLI::App& root, Commands& commands, DeviceRegistry& devic
   add_flag(*app, "--no-demo", command->no_demo,
            "start writing at once: no stroke-order demonstration before each character's first trial (D "
            "still demonstrates)");
-  add_number(*app, "--exit-after", command->exit_after_s, "SECONDS",
-             "unattended: quit after this long [s], or once every character had its trial",
-             "a number of seconds > 0", [](double s) { return s > 0.0 && s <= 86400.0; });
+  add_number(
+      *app, "--exit-after", command->exit_after_s, "SECONDS",
+      "unattended: quit after this long [s, (0, 86400]], or once every character had its trial",
+      "a number of seconds in (0, 86400]", [](double s) { return s > 0.0 && s <= 86400.0; }, "none");
   command->watchdog_option = add_integer(
       *app, "--watchdog-ms", command->watchdog_ms, "MS",
       "end the trial when the device holds one force longer than this [ms]; 0: off (mouse, mouse-hand and "

@@ -318,8 +318,8 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
   }
   TrialResult& result = run.result;
   TrialDescription description = describe(spec, run, *writing, device);
-  RecordedTrial ran = recorded_trial(spec, run, *writing, scene);
-  ran.teacher_sha256 = teacher_sha256;  // the replay's teacher, bound to the record
+  // The replay's teacher, bound to the record by the SHA-256 of the file read.
+  const RecordedTrial ran = recorded_trial(spec, run, *writing, scene, teacher_sha256);
   description.specification_json = recorded_trial_json(ran);
   const int signal = StopSignals::received();
   if (result.end == TrialEnd::interrupted && result.abort_reason.empty() && signal != 0) {

@@ -49,8 +49,11 @@ void SimulatedDeviceParameters::validate() const {
     out_of_range("physics_substeps", physics_substeps, "an integer in [1, 10000]");
   if (!within(physics_rate_hz, 1e3, 1e8))
     out_of_range("physics_rate_hz", physics_rate_hz, "in [1e3, 1e8] Hz");
-  if (!initial_position_m.allFinite())
-    throw InvalidArgument("SimulatedDeviceParameters.initial_position_m must be finite");
+  // As far as a scene's layout may lie from the device's origin (kMaxLayoutOffsetM, scene.hpp): farther than
+  // any haptic device reaches.
+  if (!(initial_position_m.array().abs() <= 1.0).all())
+    throw InvalidArgument(
+        "SimulatedDeviceParameters.initial_position_m must be finite, each coordinate in [-1, 1] m");
   if (!(info.max_force_n > 0.0) || !std::isfinite(info.max_force_n))
     out_of_range("info.max_force_n", info.max_force_n, "> 0 N and finite");
 }

@@ -5,11 +5,11 @@
 #include <sstream>
 
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/model/corpus_store.hpp"
-#include "calligraphy/model/scene.hpp"
 #include "calligraphy/core/unicode.hpp"
-#include "eval/corpus_fit.hpp"
+#include "calligraphy/model/corpus_store.hpp"
 #include "calligraphy/model/polyline.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "eval/corpus_fit.hpp"
 
 namespace calligraphy::cli {
 namespace {
@@ -39,11 +39,12 @@ void measure_stroke(const Stroke& fitted, const Stroke& stored, StrokeDeviation&
   }
 }
 
-FidelityRow measure_tolerance(const CharacterLibrary& library, double tolerance, int steps,
-                              unsigned threads) {
+FidelityRow measure_tolerance(const CharacterLibrary& library, double tolerance, int steps, unsigned threads,
+                              bool log_progress) {
   FitOptions options;
   options.tolerance = tolerance;
-  const CorpusFit fit = fit_corpus(library, options, threads, "tolerance " + format("%g", tolerance));
+  const CorpusFit fit =
+      fit_corpus(library, options, threads, "tolerance " + format("%g", tolerance), log_progress);
   const auto bytes = encode_corpus_store(fit.characters, {steps, tolerance});
   const CorpusStore store = CorpusStore::from_bytes(bytes, "memory");
   FidelityRow row;
@@ -93,13 +94,13 @@ double share_percent(std::size_t part, std::size_t whole) {
 
 std::vector<FidelityRow> measure_corpus_fidelity(const CharacterLibrary& library,
                                                  const std::vector<double>& tolerances, int steps_per_unit,
-                                                 unsigned threads) {
+                                                 unsigned threads, bool log_progress) {
   if (tolerances.empty()) throw InvalidArgument("corpus fidelity: no tolerance given");
   std::vector<FidelityRow> rows;
   for (double tolerance : tolerances) {
     if (!(tolerance > 0.0))
       throw InvalidArgument("corpus fidelity: tolerance " + format("%g", tolerance) + " is not > 0");
-    rows.push_back(measure_tolerance(library, tolerance, steps_per_unit, threads));
+    rows.push_back(measure_tolerance(library, tolerance, steps_per_unit, threads, log_progress));
   }
   return rows;
 }

@@ -42,9 +42,10 @@ struct FidelityRow {
 
 /// Fits, stores and measures the corpus at each tolerance (> 0) with `steps_per_unit` quantisation.
 /// Throws InvalidArgument for no or non-positive tolerances, and what fitting and encoding throw.
+/// `log_progress`: as fit_corpus's.
 std::vector<FidelityRow> measure_corpus_fidelity(const CharacterLibrary& library,
                                                  const std::vector<double>& tolerances, int steps_per_unit,
-                                                 unsigned threads);
+                                                 unsigned threads, bool log_progress);
 
 /// The Markdown table of the rows, with a closing line on the corpus and the units.
 std::string corpus_fidelity_markdown(const std::vector<FidelityRow>& rows, int steps_per_unit);

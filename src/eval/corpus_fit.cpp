@@ -21,11 +21,12 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// A bar redrawn in place on a terminal; elsewhere (a log, CI) one line per 10 %.
+// A bar redrawn in place on a terminal; elsewhere (a log, CI) one line per 10 % when asked for
+// (`log_lines`), else nothing.
 class ProgressBar {
  public:
-  ProgressBar(std::string label, std::size_t total)
-      : label_(std::move(label)), total_(total), tty_(::isatty(STDERR_FILENO) != 0) {}
+  ProgressBar(std::string label, std::size_t total, bool log_lines)
+      : label_(std::move(label)), total_(total), tty_(::isatty(STDERR_FILENO) != 0), log_lines_(log_lines) {}
   void show(std::size_t done) {
     if (tty_) {
       constexpr int kWidth = 40;
@@ -33,7 +34,7 @@ class ProgressBar {
       std::fprintf(stderr, "\r%s [%.*s%*s] %zu/%zu", label_.c_str(), filled,
                    "########################################", kWidth - filled, "", done, total_);
       if (done == total_) std::fputc('\n', stderr);
-    } else {
+    } else if (log_lines_) {
       const std::size_t tenth = total_ ? 10 * done / total_ : 10;
       if (tenth > last_tenth_ || (done == total_ && !finished_)) {
         std::fprintf(stderr, "%s: %zu/%zu\n", label_.c_str(), done, total_);
@@ -47,6 +48,7 @@ class ProgressBar {
   std::string label_;
   std::size_t total_;
   bool tty_;
+  bool log_lines_;
   std::size_t last_tenth_ = 0;
   bool finished_ = false;
 };
@@ -77,7 +79,7 @@ std::optional<std::filesystem::path> complete_fetched_corpus_folder() {
 unsigned default_corpus_threads() { return std::max(1u, std::thread::hardware_concurrency()); }
 
 CorpusFit fit_corpus(const CharacterLibrary& library, const FitOptions& options, unsigned threads,
-                     const std::string& label) {
+                     const std::string& label, bool log_progress) {
   const auto start = Clock::now();
   const std::vector<char32_t> code_points = library.characters();
   std::vector<Character> fitted(code_points.size());
@@ -119,7 +121,7 @@ CorpusFit fit_corpus(const CharacterLibrary& library, const FitOptions& options,
   };
   std::vector<std::thread> pool;
   for (unsigned t = 0; t < threads; ++t) pool.emplace_back(work);
-  ProgressBar bar(label, code_points.size());
+  ProgressBar bar(label, code_points.size(), log_progress);
   while (done < code_points.size()) {
     bar.show(done);
     std::this_thread::sleep_for(std::chrono::milliseconds(100));

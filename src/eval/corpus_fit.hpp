@@ -34,8 +34,9 @@ std::filesystem::path fetched_corpus_folder();
 std::optional<std::filesystem::path> complete_fetched_corpus_folder();
 /// std::thread::hardware_concurrency(), at least 1.
 unsigned default_corpus_threads();
-/// Fits every character of the folder. `label` prefixes the progress bar.
+/// Fits every character of the folder. `label` prefixes the progress bar, drawn on stderr when it is a
+/// terminal; elsewhere one line per 10 % with `log_progress`, else none.
 CorpusFit fit_corpus(const CharacterLibrary& library, const FitOptions& options, unsigned threads,
-                     const std::string& label);
+                     const std::string& label, bool log_progress);
 
 }  // namespace calligraphy::cli

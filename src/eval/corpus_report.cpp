@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <nlohmann/json.hpp>
 
-#include "calligraphy/model/typical_strokes.hpp"
 #include "calligraphy/core/unicode.hpp"
+#include "calligraphy/model/typical_strokes.hpp"
 #include "report/appendf.hpp"
 
 namespace calligraphy::cli {
@@ -81,7 +81,6 @@ std::string corpus_stats_text(const CorpusStore& store, const CorpusStoreStats& 
   appendf(out, "  fit tolerance       %.3g data units; quantisation 1/%d unit (max error %.3f units)\n",
           info.fit_tolerance, info.steps_per_unit, info.max_quantisation_error());
   appendf(out, "  checksums           %s\n", checksums.c_str());
-  for (const auto& e : stats.errors) appendf(out, "    %s\n", e.c_str());
   out += "  typical strokes:\n";
   for (const auto& [id, count] : stats.strokes_by_typical_id) {
     appendf(

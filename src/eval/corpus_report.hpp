@@ -24,7 +24,7 @@ std::string corpus_build_text(const std::string& store_name, const std::string& 
 /// bytes, bytes_per_character, fit_tolerance, steps_per_unit, checksums_ok, errors,
 /// typical_stroke_histogram), newline-terminated.
 std::string corpus_stats_json(const CorpusStore& store, const CorpusStoreStats& stats);
-/// The same for people.
+/// The same for people, with the number of bad records (their errors are the caller's to print).
 std::string corpus_stats_text(const CorpusStore& store, const CorpusStoreStats& stats);
 
 }  // namespace calligraphy::cli

@@ -6,6 +6,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "calligraphy/core/errors.hpp"
+
 namespace calligraphy::cli {
 
 namespace {
@@ -158,13 +160,28 @@ std::string nearest_point_markdown(const NearestPointMeasurement& measurement,
   return out.str();
 }
 
-std::string replace_generated_section(const std::string& document, const std::string& section,
-                                      const char* begin_marker) {
+void check_generated_section(const std::string& document, const char* begin_marker,
+                             const std::string& document_name) {
   const auto begin = document.find(begin_marker);
-  const auto end = begin == std::string::npos ? std::string::npos : document.find(kGeneratedEnd, begin);
-  if (end == std::string::npos) {
+  if (begin != std::string::npos && document.find(kGeneratedEnd, begin) == std::string::npos) {
+    std::string message = document_name;
+    message.append(": has the marker ")
+        .append(begin_marker)
+        .append(" but no ")
+        .append(kGeneratedEnd)
+        .append(" after it; add the end marker where the generated section ends (nothing was written)");
+    throw InputError(message);
+  }
+}
+
+std::string replace_generated_section(const std::string& document, const std::string& section,
+                                      const char* begin_marker, const std::string& document_name) {
+  check_generated_section(document, begin_marker, document_name);
+  const auto begin = document.find(begin_marker);
+  if (begin == std::string::npos) {
     return document + (document.empty() || document.back() == '\n' ? "" : "\n") + section;
   }
+  const auto end = document.find(kGeneratedEnd, begin);
   auto after = end + std::string(kGeneratedEnd).size();
   if (after < document.size() && document[after] == '\n') ++after;
   return document.substr(0, begin) + section + document.substr(after);

@@ -38,17 +38,17 @@ Scene Scene::lay_out(const std::vector<Character>& characters, const SceneLayout
                               .append(" m is out of range: expected ")
                               .append(range));
   };
-  if (!(layout.character_size_m > 0.0 && std::isfinite(layout.character_size_m))) {
-    refuse("character_size_m", layout.character_size_m, "a finite length > 0 m");
+  if (!(layout.character_size_m > 0.0 && layout.character_size_m <= kMaxLayoutSizeM)) {
+    refuse("character_size_m", layout.character_size_m, "a length in (0, 1] m");
   }
-  if (!(layout.spacing_m > 0.0 && std::isfinite(layout.spacing_m))) {
-    refuse("spacing_m", layout.spacing_m, "a finite length > 0 m");
+  if (!(layout.spacing_m > 0.0 && layout.spacing_m <= kMaxLayoutSizeM)) {
+    refuse("spacing_m", layout.spacing_m, "a length in (0, 1] m");
   }
-  if (!(layout.start_radius_m > 0.0 && std::isfinite(layout.start_radius_m))) {
-    refuse("start_radius_m", layout.start_radius_m, "a finite length > 0 m");
+  if (!(layout.start_radius_m > 0.0 && layout.start_radius_m <= kMaxLayoutMarginM)) {
+    refuse("start_radius_m", layout.start_radius_m, "a length in (0, 0.1] m");
   }
-  if (!(layout.box_margin_m >= 0.0 && std::isfinite(layout.box_margin_m))) {
-    refuse("box_margin_m", layout.box_margin_m, "a finite length >= 0 m");
+  if (!(layout.box_margin_m >= 0.0 && layout.box_margin_m <= kMaxLayoutMarginM)) {
+    refuse("box_margin_m", layout.box_margin_m, "a length in [0, 0.1] m");
   }
   for (const double c : {layout.centre_m.x(), layout.centre_m.y()}) {
     if (!(std::abs(c) <= kMaxLayoutOffsetM)) refuse("centre_m", c, "each coordinate in [-1, 1] m");

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
@@ -15,6 +16,14 @@ using Field = ParameterField<ForceLawParameters>;
 using P = ForceLawParameters;
 constexpr ParameterRange kNonNegative{};
 constexpr ParameterRange kPositive{.low_open = true};
+// The force law's lengths: at most 0.1 m, more than the side of a character (60 mm, SceneLayout) and about
+// twenty times the paper's constraint radius (a few mm, section 4.3): a larger one is a typing error, and a
+// bound keeps every product with a stiffness finite.
+constexpr ParameterRange kLength{.high = 0.1};
+constexpr ParameterRange kPositiveLength{.high = 0.1, .low_open = true};
+// Its fade times: at most 10 s, longer than a stroke of a 60 mm character takes to write, so a longer fade
+// never completes within the stroke it starts on.
+constexpr ParameterRange kFadeTime{.high = 10.0};
 
 // In declaration order; the docs say what the value is, the header says why.
 constexpr std::array kFields{
@@ -22,20 +31,20 @@ constexpr std::array kFields{
           &P::guidance_stiffness_n_per_m},
     Field{"paper_stiffness_n_per_m", "N/m", kNonNegative, "K_en, stiffness of the virtual paper (eq. 9)",
           &P::paper_stiffness_n_per_m},
-    Field{"constraint_radius_m", "m", kPositive,
+    Field{"constraint_radius_m", "m", kPositiveLength,
           "R_res, radius of the constraint space around the active element (section 4.3)",
           &P::constraint_radius_m},
     Field{"resistance_damping_n_s_per_m", "N s/m", kNonNegative,
           "damping against writing backwards along the active element (Fig. 4)",
           &P::resistance_damping_n_s_per_m},
-    Field{"contact_hysteresis_m", "m", kNonNegative,
+    Field{"contact_hysteresis_m", "m", kLength,
           "height above the paper at which a touching tip counts as lifted (section 6)",
           &P::contact_hysteresis_m},
     Field{"off_stroke_force_n", "N", kNonNegative,
           "friction against writing away from the active stroke in CS; 0 = the paper's CS",
           &P::off_stroke_force_n},
-    Field{"off_stroke_travel_m", "m", kPositive, "travel before the off-stroke friction reaches its force",
-          &P::off_stroke_travel_m},
+    Field{"off_stroke_travel_m", "m", kPositiveLength,
+          "travel before the off-stroke friction reaches its force", &P::off_stroke_travel_m},
     Field{"off_stroke_damping_n_s_per_m", "N s/m", kNonNegative,
           "damping of motion away from the active element in WS outside R_res",
           &P::off_stroke_damping_n_s_per_m},
@@ -43,13 +52,13 @@ constexpr std::array kFields{
           &P::off_stroke_speed_m_s},
     Field{"off_stroke_velocity_cutoff_hz", "Hz", kPositive,
           "low-pass on the velocity the off-stroke damping reads", &P::off_stroke_velocity_cutoff_hz},
-    Field{"constraint_taper_m", "m", kNonNegative,
+    Field{"constraint_taper_m", "m", kLength,
           "band at R_res over which F_et tapers to zero, at most R_res; 0 = the paper's step",
           &P::constraint_taper_m},
-    Field{"crossfade_s", "s", kNonNegative,
+    Field{"crossfade_s", "s", kFadeTime,
           "cross-fade time of the in-plane force when the active element or state changes; 0 = off",
           &P::crossfade_s},
-    Field{"paper_fade_s", "s", kNonNegative,
+    Field{"paper_fade_s", "s", kFadeTime,
           "fade time of the paper force when it starts or stops pushing (AS <-> CS); 0 = off",
           &P::paper_fade_s},
     Field{"paper_damping_n_s_per_m", "N s/m", kNonNegative,
@@ -77,6 +86,10 @@ void ForceLawParameters::validate() const {
   if (constraint_taper_m > constraint_radius_m) {
     throw InvalidArgument("ForceLawParameters.constraint_taper_m = " + std::to_string(constraint_taper_m) +
                           " must not exceed constraint_radius_m = " + std::to_string(constraint_radius_m));
+  }
+  if (!(nearest.tolerance > 0.0 && nearest.tolerance <= kMaxForceLawNearestTolerance)) {
+    throw InvalidArgument("ForceLawParameters.nearest.tolerance = " + shortest_decimal(nearest.tolerance) +
+                          " is out of range: expected (0, 0.001]");
   }
 }
 

@@ -27,12 +27,14 @@ namespace {
 using SafetyField = ParameterField<SafetyChainParameters>;
 using S = SafetyChainParameters;
 constexpr ParameterRange kNonNegative{};
-constexpr ParameterRange kPositive{.low_open = true};
 // An order of magnitude above the peak force of every device this library knows (the Phantom Desktop's
 // 7.9 N is the largest): a larger limit is a typing error, not a limit.
 constexpr ParameterRange kForce{.high = 100.0};
 // Under the Nyquist frequency of the fastest servo loop (100 kHz); WholeTrial also holds it under its own.
 constexpr ParameterRange kCutoff{.high = 50000.0, .high_open = true};
+// The RMS estimate's time constant: at most a day, the longest trial (TrialSpec::max_duration_s); a slower
+// estimate never moves within a trial.
+constexpr ParameterRange kTimeConstant{.high = 86400.0, .low_open = true};
 
 // In declaration order; a stage at 0 is off, except the peak force and the time constant.
 constexpr std::array kSafetyFields{
@@ -41,7 +43,7 @@ constexpr std::array kSafetyFields{
     SafetyField{"max_continuous_force_n", "N", kForce,
                 "continuous-force limit; 0 = the device's under a renderer, off in a bare chain",
                 &S::max_continuous_force_n},
-    SafetyField{"continuous_time_constant_s", "s", kPositive, "tau of the RMS (thermal) force estimate",
+    SafetyField{"continuous_time_constant_s", "s", kTimeConstant, "tau of the RMS (thermal) force estimate",
                 &S::continuous_time_constant_s},
     SafetyField{"start_ramp_n_per_s", "N/s", kNonNegative, "force ramp after start or reset; 0 = off",
                 &S::start_ramp_n_per_s},

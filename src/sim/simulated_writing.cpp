@@ -63,8 +63,9 @@ void SimulatedWriting::after_trial(TrialResult& result) {
 }
 
 RecordedTrial recorded_trial(const TrialSpec& spec, const TrialRun& run, const SimulatedWriting& writing,
-                             const Scene& scene) {
-  return recorded_trial(spec, run.options, run.simulated_writer ? &writing.profile() : nullptr, scene);
+                             const Scene& scene, const std::string& teacher_sha256) {
+  return recorded_trial(spec, run.options, run.simulated_writer ? &writing.profile() : nullptr, scene,
+                        teacher_sha256);
 }
 
 SimulatedWriting recorded_writing(const RecordedTrial& recorded) {

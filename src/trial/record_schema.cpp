@@ -1,6 +1,5 @@
 #include "trial/record_schema.hpp"
 
-#include <limits>
 #include <vector>
 
 #include "calligraphy/trial/recorded_trial.hpp"
@@ -8,11 +7,13 @@
 namespace calligraphy {
 namespace {
 
-constexpr double kLargest = std::numeric_limits<double>::max();
-constexpr ParameterRange kAnyNumber{.low = -kLargest, .high = kLargest};
-constexpr ParameterRange kNonNegative{.low = 0.0, .high = kLargest};
-constexpr ParameterRange kPositive{.low = 0.0, .high = kLargest, .low_open = true};
 constexpr ParameterRange kWithinReach{.low = -kMaxLayoutOffsetM, .high = kMaxLayoutOffsetM};
+constexpr ParameterRange kLayoutSize{.low = 0.0, .high = kMaxLayoutSizeM, .low_open = true};
+constexpr ParameterRange kLayoutMargin{.low = 0.0, .high = kMaxLayoutMarginM};
+constexpr ParameterRange kLayoutRadius{.low = 0.0, .high = kMaxLayoutMarginM, .low_open = true};
+// The nearest-point search's tolerance, as ForceLawParameters::validate bounds it.
+constexpr ParameterRange kNearestTolerance{
+    .low = 0.0, .high = kMaxForceLawNearestTolerance, .low_open = true};
 
 }  // namespace
 
@@ -66,7 +67,7 @@ const Schema& SchemaOf<NearestPointOptions>::get() {
   static const std::vector<SchemaField> fields{
       enum_field<&NearestPointOptions::method>("method", {.doc = "the nearest-point search"}),
       number_field<&NearestPointOptions::tolerance>(
-          "tolerance", {.low = 0.0, .high = kLargest, .low_open = true},
+          "tolerance", kNearestTolerance,
           {.doc = "tolerance of the parameter search (exact: in t; subdivision: the paper's e, in m)"}),
       integer_field<&NearestPointOptions::newton_starts>("newton_starts", 1, 1000,
                                                          {.doc = "newton: number of starts"}),
@@ -148,7 +149,7 @@ const Schema& SchemaOf<SimulatedDeviceParameters>::get() {
                                           {.doc = "least number of integration steps per servo tick"}),
       number_field<&P::physics_rate_hz>("physics_rate_hz", {.low = 1e3, .high = 1e8},
                                         {.unit = "Hz", .doc = "least physics rate"}),
-      number_array_field<&P::initial_position_m, 3>("initial_position_m", kAnyNumber,
+      number_array_field<&P::initial_position_m, 3>("initial_position_m", kWithinReach,
                                                     {.unit = "m", .doc = "where the stylus starts"}),
   };
   static const Schema schema{.name = "SimulatedDeviceParameters",
@@ -162,18 +163,18 @@ const Schema& SchemaOf<SimulatedDeviceParameters>::get() {
 const Schema& SchemaOf<SceneLayout>::get() {
   using L = SceneLayout;
   static const std::vector<SchemaField> fields{
-      number_field<&L::character_size_m>("character_size_m", kPositive,
+      number_field<&L::character_size_m>("character_size_m", kLayoutSize,
                                          {.unit = "m", .doc = "side of each character's data box on paper"}),
-      number_field<&L::spacing_m>("spacing_m", kPositive,
+      number_field<&L::spacing_m>("spacing_m", kLayoutSize,
                                   {.unit = "m", .doc = "centre-to-centre distance in the row"}),
       number_array_field<&L::centre_m, 2>("centre_m", kWithinReach,
                                           {.unit = "m", .doc = "centre of the row on the paper"}),
       number_field<&L::paper_z_m>("paper_z_m", kWithinReach,
                                   {.unit = "m", .doc = "z0, height of the paper plane in device space"}),
-      number_field<&L::box_margin_m>("box_margin_m", kNonNegative,
+      number_field<&L::box_margin_m>("box_margin_m", kLayoutMargin,
                                      {.unit = "m", .doc = "bounding box margin around the strokes (Fig. 5)"}),
       number_field<&L::start_radius_m>(
-          "start_radius_m", kPositive,
+          "start_radius_m", kLayoutRadius,
           {.unit = "m", .doc = "radius of the start-point neighbourhood (Fig. 5, Table 1)"}),
   };
   static const Schema schema{.name = "SceneLayout",
@@ -215,7 +216,8 @@ const Schema& SchemaOf<trial_detail::RecordDocument>::get() {
       since(4, string_field<&R::teacher_sha256>(
                    "teacher_sha256",
                    {.doc = "lower-case hex SHA-256 of the teacher's recording a replay ran on, "
-                           "checked when it is re-run; empty: no file was read",
+                           "checked when it is re-run; required when the replay names its file "
+                           "(/trial/teacher); empty: no file was read (a teacher given as samples)",
                     .source = "FIPS 180-4"})),
   };
   static const Schema schema{.name = "RecordedTrial",

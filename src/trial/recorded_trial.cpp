@@ -44,8 +44,24 @@ void append_bits(std::string& bytes, double value) {
 }  // namespace
 
 RecordedTrial recorded_trial(const TrialSpec& spec, const TrialOptions& ran, const WriterProfile* writer,
-                             const Scene& scene) {
+                             const Scene& scene, const std::string& teacher_sha256) {
+  // A replay that read its teacher's file is bound to that file by its SHA-256 (read_recorded_trial refuses
+  // the record otherwise); a teacher given as samples names no file.
+  const bool names_teacher_file =
+      spec.guidance && spec.guidance_mode == GuidanceMode::replay && !spec.teacher.empty();
+  if (names_teacher_file && teacher_sha256.empty()) {
+    throw InvalidArgument("recorded_trial: the replay names its teacher's recording (spec.teacher " +
+                          spec.teacher +
+                          "): give that file's SHA-256 (teacher_sha256, read_recorded_teacher)");
+  }
+  if (!teacher_sha256.empty() &&
+      (!names_teacher_file || teacher_sha256.size() != 64 ||
+       teacher_sha256.find_first_not_of("0123456789abcdef") != std::string::npos)) {
+    throw InvalidArgument("recorded_trial: teacher_sha256 '" + teacher_sha256 +
+                          "' is not 64 lower-case hex digits of a teacher's file the replay names");
+  }
   RecordedTrial recorded;
+  recorded.teacher_sha256 = teacher_sha256;
   recorded.spec = spec;
   recorded.spec.json_file.clear();
   recorded.spec.csv_file.clear();
@@ -230,6 +246,14 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
   if (!parts.teacher_sha256.empty() && !(r.spec.guidance && r.spec.guidance_mode == GuidanceMode::replay))
     json_detail::fail(source, reader.pointer("teacher_sha256"),
                       "names a teacher, but the trial is not a replay");
+  // Since version 4 a replay that names its teacher's file states that file's SHA-256: without it the record
+  // would re-run on whatever file has the name. (A teacher given as samples names no file.)
+  if (version >= 4 && parts.teacher_sha256.empty() && r.spec.guidance &&
+      r.spec.guidance_mode == GuidanceMode::replay && !r.spec.teacher.empty()) {
+    json_detail::fail(source, reader.pointer("teacher_sha256"),
+                      "\"\", but the replay names its teacher's recording (/trial/teacher " + r.spec.teacher +
+                          "): a record of version 4 or later states that file's SHA-256");
+  }
   r.teacher_sha256 = std::move(parts.teacher_sha256);
   // The parts a trial's builder takes only for some trials are refused here, as content of the record at
   // their pointer, before a device is looked up: a simulated writer's profile on a person's trial, and the

@@ -119,3 +119,6 @@ def test_values_and_arguments_are_checked_before_running():
         sweep("口", {}, [0], workers=10**6, progress=False)
     with pytest.raises(calligraphy.DataError, match="no-such-folder"):
         sweep("口", {}, [0], data="no-such-folder", progress=False)
+    # A client that is neither a distributed.Client nor an Executor is named, not an AttributeError.
+    with pytest.raises(TypeError, match="client: expected a distributed.Client or a concurrent.futures.Executor, got int 3"):
+        sweep("口", {}, [0], client=3, progress=False)

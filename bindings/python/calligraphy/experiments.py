@@ -379,12 +379,16 @@ def sweep(characters: typing.Union[str, typing.Sequence[str], None],
     missing), e.g. "CharacterNotFound: ...".
 
     Raises ValueError for an unknown grid name (listing the valid ones), an empty value list or a
-    value out of range, more than MAX_SWEEP_TRIALS (1,000,000) trials or workers beyond 1..MAX_WORKERS (1024), TypeError for a value of the wrong type (both before any trial runs),
+    value out of range, more than MAX_SWEEP_TRIALS (1,000,000) trials or workers beyond 1..MAX_WORKERS (1024), TypeError for a value of the wrong type or a client that is
+    neither a distributed.Client nor a concurrent.futures.Executor (all before any trial runs),
     DataError when the store or folder cannot be opened, ImportError without pandas.
     """
     from .frames import _pandas
 
     pandas = _pandas()  # first: an ImportError saying how to install it, before any trial runs
+    if client is not None and not (isinstance(client, concurrent.futures.Executor) or hasattr(client, "get_executor")):
+        raise TypeError(f"client: expected a distributed.Client or a concurrent.futures.Executor, got "
+                        f"{type(client).__name__} {client!r}")
     axes = _resolve(grid)
     source = _source(store, data)
     labels = _character_labels(characters, _library(source))

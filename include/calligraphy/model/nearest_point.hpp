@@ -50,6 +50,12 @@ struct EnumTable<NearestPointMethod> {
   }};
 };
 
+/// The coarsest `NearestPointOptions::tolerance` a force law (and a trial record) takes: 1e-3, a thousandth
+/// of the parameter range for `exact` (in t) and 1 mm for `subdivision` (the paper's e, in m), coarser than
+/// any search is meant to stop (the default is 1e-12; docs/nearest-point.md). `nearest_point` itself takes
+/// any finite tolerance > 0.
+inline constexpr double kMaxForceLawNearestTolerance = 1e-3;
+
 /// Options of `nearest_point`. Lengths are in the element's units (m for a placed element).
 struct NearestPointOptions {
   NearestPointMethod method = NearestPointMethod::exact;

@@ -76,6 +76,13 @@ inline constexpr std::size_t kMaxSceneCharacters = 1000;
 /// any haptic device reaches, and near enough that every position of a trial stays a finite number (a paper
 /// at 1e308 m made the simulated pen's position overflow).
 inline constexpr double kMaxLayoutOffsetM = 1.0;
+/// The largest side of a character's box and centre-to-centre spacing [m]: the same reach
+/// (kMaxLayoutOffsetM).
+inline constexpr double kMaxLayoutSizeM = kMaxLayoutOffsetM;
+/// The largest bounding-box margin and start-point radius [m]: 0.1 m, more than the side of a character
+/// (60 mm by default) and twenty times the paper's start neighbourhood (5 mm, Fig. 5): a larger one is a
+/// typing error.
+inline constexpr double kMaxLayoutMarginM = 0.1;
 
 /// Throws InvalidArgument "<what>: N characters, more than a scene's limit of kMaxSceneCharacters" when
 /// `count` > kMaxSceneCharacters.

@@ -51,9 +51,10 @@ class SimulatedWriting final : public TrialHandMaker {
 };
 
 /// What `run` ran for `spec` on `scene` (trial/recorded_trial.hpp), written (when the simulated writer
-/// wrote) by `writing`.
+/// wrote) by `writing`; `teacher_sha256` as the other overload's.
 [[nodiscard]] RecordedTrial recorded_trial(const TrialSpec& spec, const TrialRun& run,
-                                           const SimulatedWriting& writing, const Scene& scene);
+                                           const SimulatedWriting& writing, const Scene& scene,
+                                           const std::string& teacher_sha256 = {});
 
 /// The simulated writer of `recorded` as it wrote (`RecordedTrial::writer`, its traits and what it had
 /// learned folded in): `rerun_trial`'s hand maker for a record the simulated writer wrote. Throws

@@ -86,9 +86,14 @@ struct RecordedTrial : WholeTrial {
 [[nodiscard]] const Schema& recorded_trial_schema();
 
 /// What ran for `spec` on `scene` with the options `ran` (TrialRun::options) and, when the simulated writer
-/// wrote, its profile `writer` (nullptr: a person).
+/// wrote, its profile `writer` (nullptr: a person). `teacher_sha256`: the SHA-256 of the teacher's recording
+/// file a replay read (`read_recorded_teacher`'s), required when `spec` is a replay naming that file
+/// (`spec.teacher`; a reader refuses such a record without it); empty when the teacher was given as
+/// samples. Throws InvalidArgument for a replay naming its teacher's file without its SHA-256, or a SHA-256
+/// that is not 64 lower-case hex digits or is given for a trial that read no teacher's file.
 [[nodiscard]] RecordedTrial recorded_trial(const TrialSpec& spec, const TrialOptions& ran,
-                                           const WriterProfile* writer, const Scene& scene);
+                                           const WriterProfile* writer, const Scene& scene,
+                                           const std::string& teacher_sha256 = {});
 
 /// Lower-case hex SHA-256 (FIPS 180-4) of the placed characters: each character's code point and, stroke by
 /// stroke, its typical stroke ID, attraction factors and elements' control points [m] (bit patterns): equal
