@@ -24,4 +24,8 @@ std::string sha256_hex(std::string_view bytes) {
   return lower_hex(std::span<const unsigned char>(digest.data(), length));
 }
 
+bool is_sha256_hex(std::string_view text) noexcept {
+  return text.size() == 64 && text.find_first_not_of("0123456789abcdef") == std::string_view::npos;
+}
+
 }  // namespace calligraphy

@@ -1,6 +1,5 @@
 #include "calligraphy/model/scene.hpp"
 
-#include <cmath>
 #include <string>
 
 #include "calligraphy/core/decimal_number.hpp"
@@ -29,31 +28,24 @@ void check_scene_size(std::size_t count, const std::string& what) {
 
 Scene Scene::lay_out(const std::vector<Character>& characters, const SceneLayout& layout) {
   check_scene_size(characters.size(), "Scene::lay_out");
-  // Each field by its name, in its range (SchemaOf<SceneLayout> states the same ranges for a trial record).
-  const auto refuse = [](const char* field, double value, const char* range) {
+  // Each field by its name, in its range (the ranges SchemaOf<SceneLayout> states for a trial record).
+  const auto check = [](const char* field, double value, const ParameterRange& range, const char* what) {
+    if (range.contains(value)) return;
     throw InvalidArgument(std::string("SceneLayout.")
                               .append(field)
                               .append(" = ")
                               .append(shortest_decimal(value))
                               .append(" m is out of range: expected ")
-                              .append(range));
+                              .append(what)
+                              .append(range.text("m")));
   };
-  if (!(layout.character_size_m > 0.0 && layout.character_size_m <= kMaxLayoutSizeM)) {
-    refuse("character_size_m", layout.character_size_m, "a length in (0, 1] m");
-  }
-  if (!(layout.spacing_m > 0.0 && layout.spacing_m <= kMaxLayoutSizeM)) {
-    refuse("spacing_m", layout.spacing_m, "a length in (0, 1] m");
-  }
-  if (!(layout.start_radius_m > 0.0 && layout.start_radius_m <= kMaxLayoutMarginM)) {
-    refuse("start_radius_m", layout.start_radius_m, "a length in (0, 0.1] m");
-  }
-  if (!(layout.box_margin_m >= 0.0 && layout.box_margin_m <= kMaxLayoutMarginM)) {
-    refuse("box_margin_m", layout.box_margin_m, "a length in [0, 0.1] m");
-  }
-  for (const double c : {layout.centre_m.x(), layout.centre_m.y()}) {
-    if (!(std::abs(c) <= kMaxLayoutOffsetM)) refuse("centre_m", c, "each coordinate in [-1, 1] m");
-  }
-  if (!(std::abs(layout.paper_z_m) <= kMaxLayoutOffsetM)) refuse("paper_z_m", layout.paper_z_m, "[-1, 1] m");
+  check("character_size_m", layout.character_size_m, kLayoutSizeRange, "a length ");
+  check("spacing_m", layout.spacing_m, kLayoutSizeRange, "a length ");
+  check("start_radius_m", layout.start_radius_m, kLayoutRadiusRange, "a length ");
+  check("box_margin_m", layout.box_margin_m, kLayoutMarginRange, "a length ");
+  for (const double c : {layout.centre_m.x(), layout.centre_m.y()})
+    check("centre_m", c, kLayoutOffsetRange, "each coordinate ");
+  check("paper_z_m", layout.paper_z_m, kLayoutOffsetRange, "");
   Scene scene;
   scene.layout = layout;
   const double n = static_cast<double>(characters.size());

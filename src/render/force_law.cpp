@@ -87,9 +87,9 @@ void ForceLawParameters::validate() const {
     throw InvalidArgument("ForceLawParameters.constraint_taper_m = " + std::to_string(constraint_taper_m) +
                           " must not exceed constraint_radius_m = " + std::to_string(constraint_radius_m));
   }
-  if (!(nearest.tolerance > 0.0 && nearest.tolerance <= kMaxForceLawNearestTolerance)) {
+  if (!kForceLawNearestToleranceRange.contains(nearest.tolerance)) {
     throw InvalidArgument("ForceLawParameters.nearest.tolerance = " + shortest_decimal(nearest.tolerance) +
-                          " is out of range: expected (0, 0.001]");
+                          " is out of range: expected " + kForceLawNearestToleranceRange.text());
   }
 }
 

@@ -5,17 +5,6 @@
 #include "calligraphy/trial/recorded_trial.hpp"
 
 namespace calligraphy {
-namespace {
-
-constexpr ParameterRange kWithinReach{.low = -kMaxLayoutOffsetM, .high = kMaxLayoutOffsetM};
-constexpr ParameterRange kLayoutSize{.low = 0.0, .high = kMaxLayoutSizeM, .low_open = true};
-constexpr ParameterRange kLayoutMargin{.low = 0.0, .high = kMaxLayoutMarginM};
-constexpr ParameterRange kLayoutRadius{.low = 0.0, .high = kMaxLayoutMarginM, .low_open = true};
-// The nearest-point search's tolerance, as ForceLawParameters::validate bounds it.
-constexpr ParameterRange kNearestTolerance{
-    .low = 0.0, .high = kMaxForceLawNearestTolerance, .low_open = true};
-
-}  // namespace
 
 const Schema& SchemaOf<FixedGuidance>::get() { return table_schema<FixedGuidance>("the paper's fixture"); }
 const Schema& SchemaOf<FadingGuidance>::get() { return table_schema<FadingGuidance>("fading guidance"); }
@@ -67,7 +56,7 @@ const Schema& SchemaOf<NearestPointOptions>::get() {
   static const std::vector<SchemaField> fields{
       enum_field<&NearestPointOptions::method>("method", {.doc = "the nearest-point search"}),
       number_field<&NearestPointOptions::tolerance>(
-          "tolerance", kNearestTolerance,
+          "tolerance", kForceLawNearestToleranceRange,
           {.doc = "tolerance of the parameter search (exact: in t; subdivision: the paper's e, in m)"}),
       integer_field<&NearestPointOptions::newton_starts>("newton_starts", 1, 1000,
                                                          {.doc = "newton: number of starts"}),
@@ -149,7 +138,7 @@ const Schema& SchemaOf<SimulatedDeviceParameters>::get() {
                                           {.doc = "least number of integration steps per servo tick"}),
       number_field<&P::physics_rate_hz>("physics_rate_hz", {.low = 1e3, .high = 1e8},
                                         {.unit = "Hz", .doc = "least physics rate"}),
-      number_array_field<&P::initial_position_m, 3>("initial_position_m", kWithinReach,
+      number_array_field<&P::initial_position_m, 3>("initial_position_m", kLayoutOffsetRange,
                                                     {.unit = "m", .doc = "where the stylus starts"}),
   };
   static const Schema schema{.name = "SimulatedDeviceParameters",
@@ -163,18 +152,18 @@ const Schema& SchemaOf<SimulatedDeviceParameters>::get() {
 const Schema& SchemaOf<SceneLayout>::get() {
   using L = SceneLayout;
   static const std::vector<SchemaField> fields{
-      number_field<&L::character_size_m>("character_size_m", kLayoutSize,
+      number_field<&L::character_size_m>("character_size_m", kLayoutSizeRange,
                                          {.unit = "m", .doc = "side of each character's data box on paper"}),
-      number_field<&L::spacing_m>("spacing_m", kLayoutSize,
+      number_field<&L::spacing_m>("spacing_m", kLayoutSizeRange,
                                   {.unit = "m", .doc = "centre-to-centre distance in the row"}),
-      number_array_field<&L::centre_m, 2>("centre_m", kWithinReach,
+      number_array_field<&L::centre_m, 2>("centre_m", kLayoutOffsetRange,
                                           {.unit = "m", .doc = "centre of the row on the paper"}),
-      number_field<&L::paper_z_m>("paper_z_m", kWithinReach,
+      number_field<&L::paper_z_m>("paper_z_m", kLayoutOffsetRange,
                                   {.unit = "m", .doc = "z0, height of the paper plane in device space"}),
-      number_field<&L::box_margin_m>("box_margin_m", kLayoutMargin,
+      number_field<&L::box_margin_m>("box_margin_m", kLayoutMarginRange,
                                      {.unit = "m", .doc = "bounding box margin around the strokes (Fig. 5)"}),
       number_field<&L::start_radius_m>(
-          "start_radius_m", kLayoutRadius,
+          "start_radius_m", kLayoutRadiusRange,
           {.unit = "m", .doc = "radius of the start-point neighbourhood (Fig. 5, Table 1)"}),
   };
   static const Schema schema{.name = "SceneLayout",

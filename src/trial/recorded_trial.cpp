@@ -41,22 +41,24 @@ void append_bits(std::string& bytes, double value) {
   for (int shift = 0; shift < 64; shift += 8) bytes.push_back(static_cast<char>((bits >> shift) & 0xFF));
 }
 
+// A replay that names its teacher's recording file: the record binds it by the file's SHA-256. (A teacher
+// given as samples names no file.)
+bool names_teacher_file(const TrialSpec& spec) noexcept {
+  return spec.guidance && spec.guidance_mode == GuidanceMode::replay && !spec.teacher.empty();
+}
+
 }  // namespace
 
 RecordedTrial recorded_trial(const TrialSpec& spec, const TrialOptions& ran, const WriterProfile* writer,
                              const Scene& scene, const std::string& teacher_sha256) {
-  // A replay that read its teacher's file is bound to that file by its SHA-256 (read_recorded_trial refuses
-  // the record otherwise); a teacher given as samples names no file.
-  const bool names_teacher_file =
-      spec.guidance && spec.guidance_mode == GuidanceMode::replay && !spec.teacher.empty();
-  if (names_teacher_file && teacher_sha256.empty()) {
+  // read_recorded_trial refuses a replay naming its teacher's file without the file's SHA-256.
+  const bool names_file = names_teacher_file(spec);
+  if (names_file && teacher_sha256.empty()) {
     throw InvalidArgument("recorded_trial: the replay names its teacher's recording (spec.teacher " +
                           spec.teacher +
                           "): give that file's SHA-256 (teacher_sha256, read_recorded_teacher)");
   }
-  if (!teacher_sha256.empty() &&
-      (!names_teacher_file || teacher_sha256.size() != 64 ||
-       teacher_sha256.find_first_not_of("0123456789abcdef") != std::string::npos)) {
+  if (!teacher_sha256.empty() && (!names_file || !is_sha256_hex(teacher_sha256))) {
     throw InvalidArgument("recorded_trial: teacher_sha256 '" + teacher_sha256 +
                           "' is not 64 lower-case hex digits of a teacher's file the replay names");
   }
@@ -237,9 +239,7 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
   r.layout = parts.scene.layout;
   r.scene_sha256 = std::move(parts.scene.sha256);
   r.library_version = std::move(parts.library_version);
-  if (!parts.teacher_sha256.empty() &&
-      (parts.teacher_sha256.size() != 64 ||
-       parts.teacher_sha256.find_first_not_of("0123456789abcdef") != std::string::npos)) {
+  if (!parts.teacher_sha256.empty() && !is_sha256_hex(parts.teacher_sha256)) {
     json_detail::fail(source, reader.pointer("teacher_sha256"),
                       "expected 64 lower-case hex digits (a SHA-256) or \"\"");
   }
@@ -247,9 +247,8 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
     json_detail::fail(source, reader.pointer("teacher_sha256"),
                       "names a teacher, but the trial is not a replay");
   // Since version 4 a replay that names its teacher's file states that file's SHA-256: without it the record
-  // would re-run on whatever file has the name. (A teacher given as samples names no file.)
-  if (version >= 4 && parts.teacher_sha256.empty() && r.spec.guidance &&
-      r.spec.guidance_mode == GuidanceMode::replay && !r.spec.teacher.empty()) {
+  // would re-run on whatever file has the name.
+  if (version >= 4 && parts.teacher_sha256.empty() && names_teacher_file(r.spec)) {
     json_detail::fail(source, reader.pointer("teacher_sha256"),
                       "\"\", but the replay names its teacher's recording (/trial/teacher " + r.spec.teacher +
                           "): a record of version 4 or later states that file's SHA-256");

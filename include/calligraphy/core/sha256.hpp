@@ -11,4 +11,7 @@ namespace calligraphy {
 /// Lower-case hex SHA-256 of `bytes` (FIPS 180-4).
 [[nodiscard]] std::string sha256_hex(std::string_view bytes);
 
+/// True when `text` is a digest as sha256_hex writes it: 64 lower-case hex digits.
+[[nodiscard]] bool is_sha256_hex(std::string_view text) noexcept;
+
 }  // namespace calligraphy

@@ -55,6 +55,10 @@ struct EnumTable<NearestPointMethod> {
 /// any search is meant to stop (the default is 1e-12; docs/nearest-point.md). `nearest_point` itself takes
 /// any finite tolerance > 0.
 inline constexpr double kMaxForceLawNearestTolerance = 1e-3;
+/// That tolerance's range, (0, kMaxForceLawNearestTolerance]: ForceLawParameters::validate checks it and a
+/// trial record's schema states it.
+inline constexpr ParameterRange kForceLawNearestToleranceRange{
+    .low = 0.0, .high = kMaxForceLawNearestTolerance, .low_open = true};
 
 /// Options of `nearest_point`. Lengths are in the element's units (m for a placed element).
 struct NearestPointOptions {

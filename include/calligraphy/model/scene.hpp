@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "calligraphy/core/parameter_table.hpp"
 #include "calligraphy/model/character.hpp"
 
 namespace calligraphy {
@@ -83,6 +84,15 @@ inline constexpr double kMaxLayoutSizeM = kMaxLayoutOffsetM;
 /// (60 mm by default) and twenty times the paper's start neighbourhood (5 mm, Fig. 5): a larger one is a
 /// typing error.
 inline constexpr double kMaxLayoutMarginM = 0.1;
+/// The ranges of SceneLayout's fields [m], as Scene::lay_out checks them and a trial record's schema states
+/// them: a character's side and the spacing in (0, kMaxLayoutSizeM], the box margin in [0,
+/// kMaxLayoutMarginM], the start radius in (0, kMaxLayoutMarginM], each coordinate of the row's centre and
+/// the paper's height in
+/// [-kMaxLayoutOffsetM, kMaxLayoutOffsetM].
+inline constexpr ParameterRange kLayoutSizeRange{.low = 0.0, .high = kMaxLayoutSizeM, .low_open = true};
+inline constexpr ParameterRange kLayoutMarginRange{.low = 0.0, .high = kMaxLayoutMarginM};
+inline constexpr ParameterRange kLayoutRadiusRange{.low = 0.0, .high = kMaxLayoutMarginM, .low_open = true};
+inline constexpr ParameterRange kLayoutOffsetRange{.low = -kMaxLayoutOffsetM, .high = kMaxLayoutOffsetM};
 
 /// Throws InvalidArgument "<what>: N characters, more than a scene's limit of kMaxSceneCharacters" when
 /// `count` > kMaxSceneCharacters.
