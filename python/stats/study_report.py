@@ -969,7 +969,8 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
                           "report elsewhere)")
     # A file of the set that is a symbolic link is refused before any work (docs/cli.md, "Outputs"): the set's
     # writer refuses it too, but only after every fit and figure.
-    names = [out / "index.html"] + [tables / f"{name}.csv" for name in _TABLE_NAMES]
+    table_file = {name: tables / f"{name}.csv" for name in _TABLE_NAMES}  # the one list of the set's tables
+    names = [out / "index.html", *table_file.values()]
     names += [figures / f"{kind}_{_file_name(value)}.{ext}" for value in values for kind in ("phase", "learning")
               for ext in ("svg", "png")]
     # A link onto a file the report reads is named as that first (exit 2 from the command line).
@@ -1023,19 +1024,19 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
                 f"{'group' if design.kind == 'between-subjects' else 'condition'} the mean over subjects "
                 "with its 95 % t interval (n = subjects). Left: all characters; then each character. One y axis for "
                 "all panels.</figcaption></figure>\n")
-    files[tables / "phase_means.csv"] = pandas.concat(all_means, ignore_index=True).to_csv(index=False)
-    files[tables / "questions.csv"] = pandas.concat(all_questions, ignore_index=True).to_csv(index=False)
-    files[tables / "exclusions.csv"] = exclusions.to_csv(index=False)
+    files[table_file["phase_means"]] = pandas.concat(all_means, ignore_index=True).to_csv(index=False)
+    files[table_file["questions"]] = pandas.concat(all_questions, ignore_index=True).to_csv(index=False)
+    files[table_file["exclusions"]] = exclusions.to_csv(index=False)
     if all_ratios:
-        files[tables / "retention.csv"] = pandas.concat(all_ratios, ignore_index=True).to_csv(index=False)
+        files[table_file["retention"]] = pandas.concat(all_ratios, ignore_index=True).to_csv(index=False)
     table5_html = ""
     statistics_html = ""
     if within and not data.empty:
         table5s = [_table5(data, value) for value in values]
         statistics_tables = [_statistics(data, value, design.control) for value in values]
-        files[tables / "summary.csv"] = pandas.DataFrame(
+        files[table_file["summary"]] = pandas.DataFrame(
             [row for t in table5s for row in _summary_rows(t)]).to_csv(index=False)
-        files[tables / "statistics.csv"] = pandas.concat(statistics_tables, ignore_index=True).to_csv(index=False)
+        files[table_file["statistics"]] = pandas.concat(statistics_tables, ignore_index=True).to_csv(index=False)
         table5_html = ("<section id=\"table5\">\n<h2>Means per subject and character (after Table 5)</h2>\n"
                        "<div class=\"table5s\">\n" + "".join(_table5_html(t, phase) for t in table5s) + "</div>\n"
                        "</section>\n")

@@ -86,14 +86,20 @@ std::pair<int, int> window_size(const std::string& text) {
 
 int run_train(const TrainCommand& command, DeviceRegistry& devices) {
   // Combinations of options before any file is read: a quiz has no guidance, so nothing that sets one.
-  if (command.quiz && command.guidance_mode != "fixed")
-    throw UsageError("--quiz: a quiz has no guidance; drop --guidance-mode " + command.guidance_mode);
-  if (command.quiz && !command.teacher.empty()) {
-    std::string message = "--quiz: a quiz has no guidance; drop --teacher ";
-    throw UsageError(message.append(command.teacher));
+  if (command.quiz) {
+    std::string guidance_set;  // the first option given that sets guidance
+    if (command.guidance_mode != "fixed") {
+      guidance_set.append("--guidance-mode ").append(command.guidance_mode);
+    } else if (!command.teacher.empty()) {
+      guidance_set.append("--teacher ").append(command.teacher);
+    } else if (command.guidance_gain_option->count() > 0) {
+      guidance_set.append("--guidance-gain");
+    }
+    if (!guidance_set.empty()) {
+      std::string message = "--quiz: a quiz has no guidance; drop ";
+      throw UsageError(message.append(guidance_set));
+    }
   }
-  if (command.quiz && command.guidance_gain_option->count() > 0)
-    throw UsageError("--quiz: a quiz has no guidance; drop --guidance-gain");
   check_train_files(command);
   trainer::register_trainer_devices(devices);
   const std::u32string chars = characters_from(command.characters, "CHARS");
