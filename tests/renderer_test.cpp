@@ -170,6 +170,21 @@ TEST_CASE("Renderer: non-finite input gives zero force, never NaN", "[renderer]"
   CHECK(out.force_n.isZero());
 }
 
+TEST_CASE("Renderer: a reading beyond any device's reach is rejected like a non-finite one", "[renderer]") {
+  const Scene scene = two_stroke_scene();
+  Renderer r(scene, ForceLawParameters{}, simulated_phantom_desktop_info());
+  DeviceState s = at(scene, {210, 600}, -0.001);
+  const auto near = r.tick(s);
+  CHECK_FALSE(near.input_rejected);
+  // A garbled driver value: finite, but no pen on a desk.
+  s.position_m.y() = 1e304;
+  const auto far = r.tick(s);
+  CHECK(far.input_rejected);
+  CHECK(far.force_n.isZero());
+  s.position_m.y() = -2.0 * kMaxDeviceReadingM;
+  CHECK(r.tick(s).input_rejected);
+}
+
 TEST_CASE("Renderer: guidance off keeps the paper and the tracking but no in-plane force", "[renderer]") {
   const Scene scene = two_stroke_scene();
   ForceLawParameters p;

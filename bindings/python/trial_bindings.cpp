@@ -72,11 +72,11 @@ PyTrialResult to_python(const TrialResult& result, py::dict metrics, py::object 
   auto time = new_array({n});
   auto position = new_array({n, 3});
   auto force = new_array({n, 3});
-  py::array_t<std::uint8_t> state({n});
-  py::array_t<std::int64_t> stroke({n});
-  py::array_t<std::int64_t> element({n});
-  py::array_t<std::int64_t> attempt({n});
-  py::array_t<std::uint8_t> rewritten({n});
+  py::array_t<std::uint8_t> state(n);
+  py::array_t<std::int64_t> stroke(n);
+  py::array_t<std::int64_t> element(n);
+  py::array_t<std::int64_t> attempt(n);
+  py::array_t<std::uint8_t> rewritten(n);
   auto tw = time.mutable_unchecked<1>();
   auto pw = position.mutable_unchecked<2>();
   auto fw = force.mutable_unchecked<2>();

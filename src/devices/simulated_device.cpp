@@ -49,9 +49,8 @@ void SimulatedDeviceParameters::validate() const {
     out_of_range("physics_substeps", physics_substeps, "an integer in [1, 10000]");
   if (!within(physics_rate_hz, 1e3, 1e8))
     out_of_range("physics_rate_hz", physics_rate_hz, "in [1e3, 1e8] Hz");
-  // As far as a scene's layout may lie from the device's origin (kMaxLayoutOffsetM, scene.hpp): farther than
-  // any haptic device reaches.
-  if (!(initial_position_m.array().abs() <= 1.0).all())
+  // Within a haptic device's reach, as a scene's layout is (kDeviceReachM).
+  if (!(initial_position_m.array().abs() <= kDeviceReachM).all())
     throw InvalidArgument(
         "SimulatedDeviceParameters.initial_position_m must be finite, each coordinate in [-1, 1] m");
   if (!(info.max_force_n > 0.0) || !std::isfinite(info.max_force_n))

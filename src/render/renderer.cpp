@@ -219,7 +219,8 @@ Vec2 Renderer::guidance_force(const DeviceState& device, RenderOutput& out, bool
 
 RenderOutput Renderer::tick(const DeviceState& device) noexcept {
   RenderOutput out;
-  if (!device.position_m.allFinite() || !device.velocity_m_s.allFinite()) {
+  // `!(|x| <= limit)` is also true of NaN.
+  if (!(device.position_m.array().abs() <= kMaxDeviceReadingM).all() || !device.velocity_m_s.allFinite()) {
     out.input_rejected = true;
     command(Vec3::Constant(std::numeric_limits<double>::quiet_NaN()), out);
     return out;

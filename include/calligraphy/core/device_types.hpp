@@ -11,6 +11,17 @@
 
 namespace calligraphy {
 
+/// The farthest a haptic device's tip reaches from its origin along any axis [m]: the Phantom models'
+/// workspaces are at most 0.12 m in radius (Premium 1.5; CHAI3D's per-model values, phantom_models.hpp),
+/// so 1 m bounds every desktop device with a margin. A scene's layout lies within it (kMaxLayoutOffsetM,
+/// scene.hpp), a simulated pen starts within it, and the renderer takes a reading beyond kMaxDeviceReadingM
+/// for a fault.
+inline constexpr double kDeviceReachM = 1.0;
+/// The largest coordinate of a device reading the renderer uses [m]: ten times the reach, so a scene at the
+/// edge of the reach (a character up to 1 m wide, its row 1 m away) is still rendered; a reading beyond it
+/// (a garbled driver value, 1e304 m) gives zero force, as a non-finite one does (`input_rejected`).
+inline constexpr double kMaxDeviceReadingM = 10.0 * kDeviceReachM;
+
 /// What a device can do, in SI units (after CHAI3D's cHapticDeviceInfo).
 struct DeviceInfo {
   std::string model;                    ///< e.g. "Phantom Desktop (simulated)"

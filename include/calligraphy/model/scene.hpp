@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "calligraphy/core/device_types.hpp"
 #include "calligraphy/core/parameter_table.hpp"
 #include "calligraphy/model/character.hpp"
 
@@ -76,7 +77,7 @@ inline constexpr std::size_t kMaxSceneCharacters = 1000;
 /// The farthest the row's centre and the paper's height may lie from the device's origin [m]: farther than
 /// any haptic device reaches, and near enough that every position of a trial stays a finite number (a paper
 /// at 1e308 m made the simulated pen's position overflow).
-inline constexpr double kMaxLayoutOffsetM = 1.0;
+inline constexpr double kMaxLayoutOffsetM = kDeviceReachM;
 /// The largest side of a character's box and centre-to-centre spacing [m]: the same reach
 /// (kMaxLayoutOffsetM).
 inline constexpr double kMaxLayoutSizeM = kMaxLayoutOffsetM;

@@ -51,10 +51,11 @@ struct RenderOutput {
   /// The abandoned stroke was refused for the `assist_after_misses`-th time (StrokeAcceptance): credited
   /// as assisted, not written; the next stroke is active.
   bool stroke_assisted = false;
-  std::uint32_t misses = 0;     ///< refused attempts at the active stroke (after this tick)
-  bool hint_shown = false;      ///< the active stroke is to be shown as a hint (misses >= hint_after_misses)
-  bool input_rejected = false;  ///< the device state was not finite: zero force
-  bool force_error = false;     ///< the force law gave a non-finite force: zero force
+  std::uint32_t misses = 0;  ///< refused attempts at the active stroke (after this tick)
+  bool hint_shown = false;   ///< the active stroke is to be shown as a hint (misses >= hint_after_misses)
+  /// The device state was not finite, or a coordinate lay beyond kMaxDeviceReadingM: zero force.
+  bool input_rejected = false;
+  bool force_error = false;                  ///< the force law gave a non-finite force: zero force
   std::uint8_t limits = safety_none;         ///< SafetyLimit bits: which safety stages acted
   double passivity_damping_n_s_per_m = 0.0;  ///< damper added by the passivity controller [N s/m]
 };
