@@ -267,6 +267,14 @@ class TrialOutputs(Case):
         self.assertEqual((self.tmp / "j.json").read_bytes(), (self.base / "a.json").read_bytes())
         self.assertEqual(listing(self.tmp), ["c.csv", "j.json"], "a temporary was left")
 
+    def test_record_of_an_unfinished_trial_keeps_the_earlier_file(self):
+        (self.tmp / "t.json").write_text("earlier\n")
+        r = run(["trial", SHI, "--max-duration", "0.5", "--record", "t.json", "--json", "j.json"], self.tmp)
+        lines = self.failed_write(r, "--record", "t.json")
+        self.assertEqual((self.tmp / "t.json").read_text(), "earlier\n")
+        self.assertEqual(json.loads((self.tmp / "j.json").read_text())["end_reason"], "time_limit")
+        self.assertEqual(listing(self.tmp), ["j.json", "t.json"])
+
     @heavy
     def test_sigterm_twice_keeps_every_output_whole(self):
         (self.tmp / "j.json").write_text("{}\n")
@@ -541,6 +549,26 @@ class CorpusBenchTrainOutputs(Case):
         self.assertEqual(store.read_bytes(), before)
         self.assertEqual(listing(self.tmp), ["store.clg"])
 
+    @heavy
+    def test_corpus_build_two_writers_at_once_leave_one_whole_store(self):
+        data = self.base / "data"
+        refs = []
+        for medians in ("on", "off"):
+            r = run(["corpus", "build", "--data", data, "--out", f"ref-{medians}.clg", "--medians", medians,
+                     "--threads", "1"], self.tmp)
+            self.assertEqual(r.returncode, 0, error_lines(r))
+            refs.append((self.tmp / f"ref-{medians}.clg").read_bytes())
+        self.assertNotEqual(refs[0], refs[1])
+        for _ in range(3):
+            procs = [subprocess.Popen([CLI, "corpus", "build", "--data", str(data), "--out", "same.clg", "--medians",
+                                       medians, "--threads", "1"], cwd=self.tmp, stdout=subprocess.DEVNULL,
+                                      stderr=subprocess.PIPE, env=ENV) for medians in ("on", "off")]
+            for p in procs:
+                p.communicate(timeout=TIMEOUT_S)
+                self.assertEqual(p.returncode, 0)
+            self.assertIn((self.tmp / "same.clg").read_bytes(), refs)
+            self.assertEqual(listing(self.tmp), ["ref-off.clg", "ref-on.clg", "same.clg"])
+
     def test_corpus_validate_outputs_onto_the_cnchar_file_or_each_other(self):
         cnchar = self.tmp / "cnchar.order.min.js"
         cnchar.write_text("/* not cnchar */\n")
@@ -658,7 +686,7 @@ class PythonTeacher(unittest.TestCase):
 # ------------------------------------------------------------------------------------------------ numbers
 NUMERIC_PLACEHOLDERS = {"N", "N/M", "G", "M", "M/S", "HZ", "MS", "S", "X", "UNITS", "SECONDS", "P", "MM"}
 GENERIC = ["nan", "inf", "-inf", "1e308", "0x10", " 1", "1 ", "", "1e", "\u0663", "-0"]
-ROTATE = 3  # generic values per option at least, rotating through GENERIC so that each command tries them all
+ROTATE = 2  # generic values per option at least, rotating through GENERIC so that each command tries them all
 
 # Bounds docs/cli.md gives where `--help` states none: (lower, lower included, upper, upper included, integer)
 DOC_BOUNDS = {
@@ -842,6 +870,30 @@ class NumberSweep(unittest.TestCase):
                 self.assertEqual(r.returncode, 2, lines)
                 self.assertIn("--window", lines[0])
 
+    def test_writer_parameters_and_typical_stroke_ids(self):
+        # the keys from the program's own list (an unknown key names them), each given a hostile spelling
+        r = run(["trial", SHI, "--check", "--writer-param", "nokey=1"], self.tmp)
+        self.assertEqual(r.returncode, 2)
+        keys = error_lines(r)[0].split("known: ")[1].split(", ")
+        self.assertGreater(len(keys), 10)
+        hostile = ["nan", "inf", "-inf", "1e308", "0x10", " 1", "1 ", "", "1e", "\u0663", "1=2"]
+        for index, key in enumerate(keys):
+            value = hostile[index % len(hostile)]
+            with self.subTest(key=key, value=value):
+                r = run(["trial", SHI, "--check", "--writer-param", f"{key}={value}"], self.tmp)
+                lines = error_lines(r)
+                self.assertEqual(r.returncode, 2, lines)
+                self.assertEqual(len(lines), 1, lines)
+                self.assertIn("--writer-param", lines[0])
+                self.assertIn(key, lines[0])
+        for value in ("0", "40", "-0", "0x10", " 1", "1 ", "\u0663", "", "+1", "1e1"):
+            with self.subTest(option="--typical", value=value):
+                r = run(["characters", "--typical", value], self.tmp)
+                lines = error_lines(r)
+                self.assertEqual(r.returncode, 2, lines)
+                self.assertEqual(len(lines), 1, lines)
+                self.assertIn("--typical", lines[0])
+
     def test_characters_and_curriculum(self):
         self.sweep("characters", lambda option: ["--text", SHI], (0,))
         self.sweep("curriculum", lambda option: [str(self.tmp / "empty"), "--subject", "S1", "--from", SHI],
@@ -893,6 +945,40 @@ class HelpDefaults(Case):
                 self.assertEqual(len(keys), 1, (option, keys))
                 self.assertAlmostEqual(fields[keys[0]], float(m.group(1)) * scale, delta=1e-12,
                                        msg=f"{option}: help default {m.group(1)}, record {keys[0]}={fields[keys[0]]}")
+
+    def test_help_defaults_agree_with_the_tables_of_docs_cli(self):
+        """Each option's numeric default in docs/cli.md's tables is the one its `--help` shows."""
+        command, rows = None, {}
+        for line in (SOURCE / "docs" / "cli.md").read_text(encoding="utf-8").splitlines():
+            m = re.match(r"^## ([a-z]+)\s*$", line)
+            if m:
+                command = m.group(1)
+            m = re.match(r"^`calligraphy ([a-z]+)(?: ([a-z]+))?", line)
+            if m:
+                command = " ".join(w for w in m.groups() if w)
+            m = re.match(r"^\| `(--[\w-]+)`[^|]*\| [^|]* \| ([^|]*) \|", line)
+            if m and command and not command.startswith(("session", "report")):
+                rows.setdefault(command, {})[m.group(1)] = m.group(2).strip().strip("`")
+        compared = 0
+        for command, table in rows.items():
+            r = run([*command.split(), "--help"], self.tmp)
+            self.assertEqual(r.returncode, 0, command)
+            helped, current = {}, None
+            for line in r.stdout.decode().splitlines():
+                m = re.match(r"^  (--[\w-]+)(?: \S+)?\s*(.*)$", line)
+                if m:
+                    current = m.group(1)
+                    helped[current] = m.group(2)
+                elif current and line.startswith("       "):
+                    helped[current] += " " + line.strip()
+            for option, documented in table.items():
+                m = re.search(r"\(default: ([-\d.e]+)\)\s*$", helped.get(option, ""))
+                if not m or not re.fullmatch(r"-?[\d.]+(e-?\d+)?", documented):
+                    continue
+                compared += 1
+                with self.subTest(command=command, option=option):
+                    self.assertEqual(float(documented), float(m.group(1)))
+        self.assertGreater(compared, 15)
 
     def test_trial_values_at_their_bounds_are_taken_exactly(self):
         args, wanted = ["trial", SHI], {}
