@@ -57,6 +57,25 @@ TEST_CASE("write_file_atomically keeps permission bits and symbolic links", "[at
   CHECK((status.st_mode & 07777) == 0640);
 }
 
+TEST_CASE("a target with the longest name a file system takes is written, alone or in a set",
+          "[atomic_file]") {
+  // NAME_MAX is 255 bytes: the temporary's and the earlier file's second names beside it must fit too.
+  TemporaryFolder folder;
+  const std::string longest(255, 'a');
+  std::string multibyte(207, 'b');  // then 3-byte characters, one of them where the name is cut
+  for (int i = 0; i < 16; ++i) multibyte += "\xe6\xb0\xb8";
+  for (const std::string& name : {longest, multibyte}) {
+    const fs::path target = folder.path / name;
+    write_file_atomically(target, std::string_view("first\n"));
+    write_file_atomically(target, std::string_view("second\n"));
+    CHECK(contents(target) == "second\n");
+    const FileContent set[] = {{target, "third\n"}, {folder.path / "short.csv", "x\n"}};
+    write_files_atomically(set);
+    CHECK(contents(target) == "third\n");
+  }
+  CHECK(folder.names() == std::vector<std::string>{longest, multibyte, "short.csv"});
+}
+
 TEST_CASE("a dangling symbolic link is kept and the file it names is created", "[atomic_file]") {
   TemporaryFolder folder;
   fs::create_directory(folder.path / "out");
@@ -414,9 +433,10 @@ TEST_CASE("a set is written only in its own folder: a link in a member's place i
       INFO("the link points at " << target.string());
       fs::remove(tables / "trials.csv");
       fs::create_symlink(target, tables / "trials.csv");
-      const FileContent next[] = {{tables / "strokes.csv", "new strokes\n"}, {tables / "trials.csv", "new\n"}};
-      CHECK_THROWS_WITH(write_files_atomically(next),
-                        Catch::Contains((tables / "trials.csv").string()) && Catch::Contains("symbolic link"));
+      const FileContent next[] = {{tables / "strokes.csv", "new strokes\n"},
+                                  {tables / "trials.csv", "new\n"}};
+      CHECK_THROWS_WITH(write_files_atomically(next), Catch::Contains((tables / "trials.csv").string()) &&
+                                                          Catch::Contains("symbolic link"));
       CHECK(contents(victim) == "keep me\n");
       CHECK_FALSE(fs::exists(outside / "not-there.txt"));
       CHECK(contents(tables / "strokes.csv") == "old strokes\n");

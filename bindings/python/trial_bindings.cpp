@@ -293,7 +293,7 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   options.validate();
   simulation.validate();
   if (!(options.rate_hz * options.max_duration_s <= kMaxTrialTicks)) {
-    throw InvalidArgument(fmt::format("max_duration_s: {} s at {} Hz is more than 10^7 servo ticks",
+    throw InvalidArgument(fmt::format("max_duration_s: {} s at rate_hz {} Hz is more than 10^7 servo ticks",
                                       options.max_duration_s, options.rate_hz));
   }
 

@@ -124,7 +124,11 @@ CLI::Option* add_integer(CLI::App& app, const std::string& name, std::int64_t& t
   const std::string shown = default_text.empty() ? std::to_string(target) : default_text;
   return add_single(app, name, value_name, description, shown, [=, &target](const std::string& text) {
     std::int64_t value = 0;
-    if (!parse_integer(text, value) || value < minimum || value > maximum) invalid(name, expectation, text);
+    // Decimal digits only (docs/cli.md, "Numbers"): a sign only where a negative number is allowed, so a
+    // count that starts at 0 refuses '-0' as it refuses '-1'.
+    const bool sign_allowed = minimum < 0 || !text.starts_with('-');
+    if (!sign_allowed || !parse_integer(text, value) || value < minimum || value > maximum)
+      invalid(name, expectation, text);
     target = value;
   });
 }

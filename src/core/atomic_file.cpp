@@ -167,6 +167,26 @@ class RenamesUnderWay {
   }
 };
 
+// ".NAME" and `mark`: how a temporary's or a second name's file name beside `target` starts
+// (".NAME.tmp-PID-N",
+// ".NAME.kept-PID-N"). A file name is at most NAME_MAX (255) bytes, so a NAME that leaves no room for the
+// mark and "PID-N" is cut (at the start of a UTF-8 character): a target with the longest name the file system
+// takes gets a temporary it takes too. Its writer, its journal's reader and the removal of a dead writer's
+// files all use this one prefix.
+std::string sibling_prefix(const fs::path& target, std::string_view mark) {
+  constexpr std::size_t kSuffixRoom = 2 * 20 + 1;  // "PID-N": two 64-bit numbers in decimal and the '-'
+  std::string name = target.filename().string();
+  const std::size_t room = NAME_MAX - 1 - mark.size() - kSuffixRoom;
+  if (name.size() > room) {
+    std::size_t cut = room;
+    while (cut > 0 && (static_cast<unsigned char>(name[cut]) & 0xC0U) == 0x80U) --cut;
+    name.resize(cut);
+  }
+  std::string prefix(1, '.');  // built by appends: GCC 12 warns wrongly on a + chain
+  prefix.append(name).append(mark);
+  return prefix;
+}
+
 // The temporary file beside the target, removed on destruction unless committed.
 class TemporaryFile {
  public:
@@ -175,8 +195,8 @@ class TemporaryFile {
     static std::atomic<unsigned> counter{0};
     const fs::path folder = target.parent_path().empty() ? fs::path(".") : target.parent_path();
     for (int attempt = 0; attempt < 100; ++attempt) {
-      std::string name(1, '.');  // hidden, beside the target; built by appends (GCC 12 warns on a + chain)
-      name.append(target.filename().string()).append(".tmp-").append(std::to_string(::getpid()));
+      std::string name = sibling_prefix(target, ".tmp-");  // hidden, beside the target
+      name.append(std::to_string(::getpid()));
       name.append("-").append(std::to_string(counter.fetch_add(1)));
       path_ = folder / name;
       fd_ =
@@ -353,8 +373,8 @@ class SetReplacement {
       : targets_(targets), existed_(existed), kept_(targets.size()), temporaries_(targets.size()) {
     for (std::size_t i = 0; i < targets.size(); ++i) {
       if (!existed[i]) continue;
-      std::string name(1, '.');  // built by appends: GCC 12 warns wrongly on a + chain
-      name.append(targets[i].filename().string()).append(".kept-").append(unique_suffix());
+      std::string name = sibling_prefix(targets[i], ".kept-");
+      name.append(unique_suffix());
       kept_[i] = folder_of(targets[i]) / name;
       // A file system without hard links (FAT) keeps no second name: that file alone cannot be put back.
       if (::link(targets[i].c_str(), kept_[i].c_str()) != 0) kept_[i].clear();
@@ -475,8 +495,7 @@ void remove_dead_writers_files(const fs::path& folder) {
 // Removes the temporaries of `target` that a killed writer left beside it (".NAME.tmp-PID-N", its process
 // gone): a writer killed by SIGKILL cannot remove its own.
 void remove_dead_writers_temporaries(const fs::path& target) {
-  std::string prefix(1, '.');  // built by appends: GCC 12 warns wrongly on a + chain
-  prefix.append(target.filename().string()).append(".tmp-");
+  const std::string prefix = sibling_prefix(target, ".tmp-");
   std::error_code error;
   std::vector<fs::path> dead;
   for (fs::directory_iterator entry(folder_of(target), error), end; !error && entry != end;
@@ -504,8 +523,7 @@ struct JournalEntry {
 
 // A name of a file in the target's folder, of the form this writer gives it (".NAME" + mark + "...").
 bool sibling_name(const std::string& name, const fs::path& target, const char* mark) {
-  std::string prefix(1, '.');  // built by appends: GCC 12 warns wrongly on a + chain
-  prefix.append(target.filename().string()).append(mark);
+  const std::string prefix = sibling_prefix(target, mark);
   return name.size() > prefix.size() && name.starts_with(prefix) && name.find('/') == std::string::npos;
 }
 

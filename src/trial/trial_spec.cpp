@@ -198,12 +198,12 @@ const std::vector<SchemaField>& spec_fields() {
                       "in whole milliseconds; 0: off",
                .option = "--watchdog-ms",
                .option_value_name = "MS"})),
-      number_field<&TrialSpec::max_duration_s>("max_duration_s",
-                                               {.low = 0.0, .high = kMaxTrialDurationS, .low_open = true},
-                                               {.unit = "s",
-                                                .doc = "the trial ends after this much time",
-                                                .option = "--max-duration",
-                                                .option_value_name = "S"}),
+      number_field<&TrialSpec::max_duration_s>(
+          "max_duration_s", {.low = 0.0, .high = kMaxTrialDurationS, .low_open = true},
+          {.unit = "s",
+           .doc = "the trial ends after this much time; at most 10^7 servo ticks (max_duration_s x rate_hz)",
+           .option = "--max-duration",
+           .option_value_name = "S"}),
       string_field<&TrialSpec::json_file>("json_file",
                                           {.doc = "write the metrics as JSON ('-': standard output)",
                                            .option = "--json",
@@ -445,8 +445,8 @@ void TrialSpec::validate(TeacherSource teacher_from) const {
   }
   // A trace longer than this would not fit a trial's memory (one sample per tick).
   if (rate_hz * max_duration_s > kMaxTrialTicks) {
-    refuse("max_duration_s", number_text(max_duration_s) + " s at " + number_text(rate_hz) +
-                                 " Hz is more than 10^7 servo ticks");
+    refuse("max_duration_s", number_text(max_duration_s) + " s at " + field_label("rate_hz") + " " +
+                                 number_text(rate_hz) + " Hz is more than 10^7 servo ticks");
   }
   // Outputs on one file are the front-end's to find (after resolving links: the CLI's file plan).
   if (record_file == "-")
