@@ -292,10 +292,6 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
     options.force.acceptance.assist_after_misses = take(*a.assist_after_misses, "assist_after_misses");
   options.validate();
   simulation.validate();
-  if (!(options.rate_hz * options.max_duration_s <= kMaxTrialTicks)) {
-    throw InvalidArgument(fmt::format("max_duration_s: {} s at rate_hz {} Hz is more than 10^7 servo ticks",
-                                      options.max_duration_s, options.rate_hz));
-  }
 
   // The trial specification of these arguments, made a whole trial by its one builder and run by its one
   // runner (whole_trial.hpp, trial_spec_runner.hpp), as `calligraphy trial` runs its options. What a

@@ -213,9 +213,10 @@ void add_saved_sessions(FilePlan& plan, const std::string& what, const std::stri
 void FilePlan::output(const std::string& what, const std::string& path) {
   if (path.empty() || path == "-") return;
   const Identity identity = identify_file(what, path);
-  if (identity.folder || (!identity.exists && (path.back() == '/' || fs::path(path).filename() == ".." ||
-                                               fs::path(path).filename() == "."))) {
-    throw DataError(named(what, path) + ": is a folder, not a file");
+  if (identity.folder) throw DataError(named(what, path) + ": is a folder, not a file");
+  if (!identity.exists && (path.back() == '/' || fs::path(path).filename() == ".." ||
+                           fs::path(path).filename() == ".")) {
+    throw DataError(named(what, path) + ": names a folder (it ends in '/', '.' or '..'), not a file");
   }
   if (identity.exists && !identity.regular) {  // a device or FIFO: written in place, never replaced
     note_planned(path);
