@@ -18,6 +18,7 @@
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/study/cohort.hpp"
 #include "calligraphy/study/protocol.hpp"
+#include "calligraphy/study/schedule.hpp"
 #include "calligraphy/study/session_folder.hpp"
 #include "calligraphy/study/session_runner.hpp"
 #include "calligraphy/study/session_series.hpp"
@@ -333,6 +334,18 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
           ": the crossover phase counterbalances by the subject's number (1, 2, ...), and this id "
           "ends in none or in 0; give --subject-number N");
     }
+    if (number == 0) {
+      // A design that assigns groups or orders by number cannot place a subject without one: the id the user
+      // gave is the value at fault (exit 2), found before any folder is made.
+      try {
+        for (int session = 1; session <= sessions; ++session)
+          static_cast<void>(plan_session(resolved.protocol, {command.subject, 0}, session));
+      } catch (const InvalidArgument& e) {
+        throw UsageError(
+            "--subject " + command.subject + ": " + e.what() +
+            "; this id ends in none or in 0 (or in more than 9 digits): give --subject-number N");
+      }
+    }
     subjects.push_back({command.subject, number});
   }
   std::vector<std::string> again;  // subjects of this run whose series is begun under --out
@@ -583,7 +596,7 @@ void add_session_commands(CLI::App& root, Commands& commands, DeviceRegistry& de
                   1000000000, "the digits ending --subject");
   add_integer(
       *app, "--subjects", run->subjects, "N",
-      "run N simulated subjects ID01..IDN, numbered 1..N, one session each (needs --writer simulated)", 0,
+      "run N simulated subjects ID01..IDN, numbered 1..N, one session each (needs --writer simulated)", 1,
       1000, "none");
   add_text(*app, "--device", run->device, "NAME", "the device, by its name in `calligraphy devices`");
   add_writer_option(*app, run->writer,

@@ -407,7 +407,6 @@ class Sessions(unittest.TestCase):
         self.assertEqual(result.returncode, 0, text(result))
         return sessions_of(self.dir / out)
 
-    @unittest.expectedFailure  # --subjects 0 was taken as no --subjects: one subject ran
     def test_subjects_zero_is_refused_not_taken_as_none(self):
         # `--subjects N (0-1000)`: zero subjects is either nothing run or a usage error naming --subjects; it must
         # never run a subject the option did not ask for.
@@ -417,7 +416,6 @@ class Sessions(unittest.TestCase):
         self.assertEqual(result.returncode, 2, text(result))
         self.assertIn("--subjects", error_lines(result)[0])
 
-    @unittest.expectedFailure  # a subject number the design cannot assign was a runtime failure (exit 1)
     def test_a_subject_number_no_group_can_take_is_a_usage_error(self):
         # The digits ending the id are its number; 0 (or digits past any integer) assigns no group: the value the
         # user gave is wrong, exit 2 naming it, nothing written.
