@@ -536,6 +536,8 @@ int resume_session(const SessionResumeCommand& command, DeviceRegistry& devices)
   SessionFolder session = SessionFolder::open(command.folder);
   // A session of another study, copied into this study folder, is not this study's to go on with.
   StudyIdentity::check(StudyIdentity::read(study_root), study_root, session.path(), session.manifest());
+  // A folder renamed since its first trial was saved: its records name the old id (the folder's name).
+  session.check_records_name_this_session();
   require_characters(session.manifest().protocol, CharacterSource(command.library));
   if (!session.next_unsaved()) {
     std::printf("%s: every trial of %s is saved already\n", session.manifest().setup.subject.id.c_str(),
