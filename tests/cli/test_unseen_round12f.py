@@ -205,7 +205,6 @@ class Protocols(unittest.TestCase):
         self.assertIn("p.json: " + pointer, lines[0])
         self.assertEqual(result.stdout, b"")
 
-    @unittest.expectedFailure  # a string listed twice was planned twice as repetition 1 of its condition
     def test_a_character_listed_twice_is_refused_or_counted_as_its_next_repetition(self):
         # docs/experiments.md: `repetition` counts how often a string was written in that condition (1-based).
         # Listing 十 twice in one phase, in the paper's `test` or in one item set must not give two trials both
