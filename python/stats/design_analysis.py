@@ -255,6 +255,13 @@ class ExclusionPolicy:
 
     keep_end_reasons: typing.Optional[tuple[str, ...]] = ("completed",)
 
+    def __post_init__(self) -> None:
+        reasons = self.keep_end_reasons
+        # One text is one end reason's name, never its letters (which would exclude every trial).
+        if reasons is not None and (isinstance(reasons, (str, bytes)) or not all(isinstance(r, str) for r in reasons)):
+            raise TypeError(f"keep_end_reasons: expected a sequence of end reasons (e.g. ('completed',)) or None, "
+                            f"got {reasons!r}")
+
     def sentence(self) -> str:
         if self.keep_end_reasons is None:
             return "Every trial is analysed, however it ended."

@@ -327,6 +327,12 @@ def _read_answer(folder: str, formula: str, files: typing.Mapping[str, int]) -> 
     return tables
 
 
+def _r_backquoted(name: str) -> str:
+    """The text R's deparse() puts between backquotes for a non-syntactic name."""
+    escapes = {"\\": "\\\\", "`": "\\`", "\n": "\\n", "\t": "\\t", "\r": "\\r"}
+    return "".join(escapes.get(character, character) for character in name)
+
+
 def _check_r() -> str:
     rscript = shutil.which("Rscript")
     if rscript is None:
@@ -340,7 +346,8 @@ def _check_r() -> str:
                 [rscript, "--vanilla", "-e",
                  "for (p in c('lme4','lmerTest','pbkrtest')) if (!requireNamespace(p, quietly=TRUE)) "
                  "{cat(p); quit(status=3)}"],
-                capture_output=True, text=True, timeout=120,
+                # Any bytes R prints (a Latin-1 locale's message) are read, never an exception of their own.
+                capture_output=True, text=True, encoding="utf-8", errors="replace", timeout=120,
                 preexec_fn=_keep_with_parent if os.name == "posix" else None)
         except subprocess.TimeoutExpired as error:
             raise RUnavailable(f"Rscript did not answer within {error.timeout:g} s when asked for lme4, "
@@ -360,8 +367,9 @@ def lmer(frame: "pandas.DataFrame", formula: str, factors: typing.Mapping[str, t
     """Fits ``formula`` (lme4 syntax, e.g. ``outcome ~ group + (1 | subject) + (1 | item)``) to ``frame`` by
     REML and tests the fixed effects with ``ddf`` degrees of freedom ('Satterthwaite' or 'Kenward-Roger').
 
-    frame: a pandas DataFrame with the formula's columns (names that are R identifiers); rows with a missing
-    outcome must be dropped by the caller. factors: for each categorical column, its levels in order, the
+    frame: a pandas DataFrame with the formula's columns (a name that is no R identifier, with a space or a
+    line break, is written in backquotes in the formula); rows with a missing outcome must be dropped by the
+    caller. factors: for each categorical column, its levels in order, the
     reference (the control) first; those columns are R factors with treatment coding. Returns an
     ``LmerFit``. Raises ValueError for an unknown ``ddf`` or an empty frame; RUnavailable without R and its
     packages; RuntimeError naming R's message when lme4 cannot fit it (e.g. a factor with one level);
@@ -393,6 +401,9 @@ def lmer(frame: "pandas.DataFrame", formula: str, factors: typing.Mapping[str, t
     for name, values in factors.items():
         for level in list(values)[1:]:
             owners[f"{name}{level}"] = (name, str(level))
+            # R names the term of a factor whose name is not syntactic (a space, a line break) by the name in
+            # backquotes, escaped as deparse() escapes it.
+            owners[f"`{_r_backquoted(str(name))}`{level}"] = (name, str(level))
     fixed.insert(1, "factor", [owners.get(term, ("", ""))[0] for term in fixed["term"]])
     fixed.insert(2, "level", [owners.get(term, ("", ""))[1] for term in fixed["term"]])
     variances = {str(group): float(variance) for group, variance in zip(random["group"], random["variance"])}

@@ -952,6 +952,9 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
         raise ValueError("write_report: out_dir is empty; name the report folder")
     design = design_analysis.study_design(trials, reference)
     trials = design_analysis.ordered(trials, design)
+    if isinstance(keep_end_reasons, (str, bytes)):
+        raise TypeError(f"write_report: keep_end_reasons must be a sequence of end reasons (e.g. ('completed',)) "
+                        f"or None, got {keep_end_reasons!r}")
     policy = design_analysis.ExclusionPolicy(None if keep_end_reasons is None else tuple(keep_end_reasons))
     if policy.keep_end_reasons is not None and "end_reason" not in trials.columns:
         policy = design_analysis.ExclusionPolicy(None)
@@ -1193,10 +1196,19 @@ def main(argv: typing.Optional[typing.Sequence[str]] = None) -> int:
     if os.path.exists(arguments.out) and not os.path.isdir(arguments.out):
         parser.error(f"argument --out: {arguments.out} exists and is not a folder")
 
+    started = time.monotonic()
+    try:
+        return _run_main(arguments, keep, started)
+    except KeyboardInterrupt:
+        # Ctrl-C: one line and 130, as the command line; R ends with this process.
+        print("calligraphy.study_report: stopped by SIGINT (Ctrl-C)", file=sys.stderr)
+        return 130
+
+
+def _run_main(arguments: argparse.Namespace, keep: typing.Optional[tuple[str, ...]], started: float) -> int:
     from ._native import DataError
     from .design_analysis import UnknownReference
 
-    started = time.monotonic()
     try:
         study = _study.load(arguments.folders)
         index = write_report(study, arguments.out, title=arguments.title, per_trial_page=arguments.per_trial_page,

@@ -18,6 +18,7 @@
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/study/cohort.hpp"
 #include "calligraphy/study/protocol.hpp"
+#include "calligraphy/study/schedule.hpp"
 #include "calligraphy/study/session_folder.hpp"
 #include "calligraphy/study/session_runner.hpp"
 #include "calligraphy/study/session_series.hpp"
@@ -333,6 +334,18 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
           ": the crossover phase counterbalances by the subject's number (1, 2, ...), and this id "
           "ends in none or in 0; give --subject-number N");
     }
+    if (number == 0) {
+      // A design that assigns groups or orders by number cannot place a subject without one: the id the user
+      // gave is the value at fault (exit 2), found before any folder is made.
+      try {
+        for (int session = 1; session <= sessions; ++session)
+          static_cast<void>(plan_session(resolved.protocol, {command.subject, 0}, session));
+      } catch (const InvalidArgument& e) {
+        throw UsageError(
+            "--subject " + command.subject + ": " + e.what() +
+            "; this id ends in none or in 0 (or in more than 9 digits): give --subject-number N");
+      }
+    }
     subjects.push_back({command.subject, number});
   }
   std::vector<std::string> again;  // subjects of this run whose series is begun under --out
@@ -523,6 +536,8 @@ int resume_session(const SessionResumeCommand& command, DeviceRegistry& devices)
   SessionFolder session = SessionFolder::open(command.folder);
   // A session of another study, copied into this study folder, is not this study's to go on with.
   StudyIdentity::check(StudyIdentity::read(study_root), study_root, session.path(), session.manifest());
+  // A folder renamed since its first trial was saved: its records name the old id (the folder's name).
+  session.check_records_name_this_session();
   require_characters(session.manifest().protocol, CharacterSource(command.library));
   if (!session.next_unsaved()) {
     std::printf("%s: every trial of %s is saved already\n", session.manifest().setup.subject.id.c_str(),
@@ -583,7 +598,7 @@ void add_session_commands(CLI::App& root, Commands& commands, DeviceRegistry& de
                   1000000000, "the digits ending --subject");
   add_integer(
       *app, "--subjects", run->subjects, "N",
-      "run N simulated subjects ID01..IDN, numbered 1..N, one session each (needs --writer simulated)", 0,
+      "run N simulated subjects ID01..IDN, numbered 1..N, one session each (needs --writer simulated)", 1,
       1000, "none");
   add_text(*app, "--device", run->device, "NAME", "the device, by its name in `calligraphy devices`");
   add_writer_option(*app, run->writer,

@@ -496,8 +496,43 @@ LoadedProtocol protocol_from_text(std::string text, const std::filesystem::path&
   return loaded;
 }
 
+namespace {
+
+// An item listed twice in one list would be written twice as the first repetition of its condition
+// (`repetition` counts the writings of a string in a condition); `repetitions` writes it again. Checked for a
+// protocol file a run is planned from, not for the protocol copy of a session folder made before the check.
+void refuse_repeated_items(const StudyProtocol& protocol, const std::string& source) {
+  const auto check = [&](const std::vector<std::u32string>& items, const std::string& characters) {
+    for (std::size_t k = 1; k < items.size(); ++k) {
+      for (std::size_t first = 0; first < k; ++first) {
+        if (items[first] != items[k]) continue;
+        json_detail::fail(source, json_detail::child_pointer(characters, k),
+                          "\"" + encode_utf8(items[k]) + "\" is listed twice (also at " +
+                              json_detail::child_pointer(characters, first) +
+                              "): give it once and write it again with \"repetitions\"");
+      }
+    }
+  };
+  for (const ProtocolPhase& phase : protocol.phases) {
+    if (phase.sets.empty()) check(phase.items, json_detail::child_pointer(phase.pointer, "characters"));
+  }
+  for (std::size_t i = 0; i < protocol.item_sets.size(); ++i) {
+    check(protocol.item_sets[i].items,
+          json_detail::child_pointer(json_detail::child_pointer("/item_sets", i), "characters"));
+  }
+}
+
+}  // namespace
+
 LoadedProtocol load_study_protocol(const std::filesystem::path& path) {
-  return protocol_from_text(study_detail::read_small_file(path, kMaxProtocolBytes, "study protocol"), path);
+  LoadedProtocol loaded =
+      protocol_from_text(study_detail::read_small_file(path, kMaxProtocolBytes, "study protocol"), path);
+  try {
+    refuse_repeated_items(loaded.protocol, path.string());
+  } catch (const DataError& e) {  // the protocol's content, refused as the parser refuses it
+    throw ProtocolError(e.what());
+  }
+  return loaded;
 }
 
 }  // namespace calligraphy

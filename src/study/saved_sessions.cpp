@@ -82,6 +82,27 @@ void check_records_planned(const fs::path& folder, const SessionManifest& manife
   }
 }
 
+void check_records_name_the_folder(const fs::path& folder, const SessionManifest& manifest) {
+  // A session's id is its folder's name, and each record names it: a folder renamed since its first trial
+  // was saved is refused before a resume saves records under the new name beside those of the old one.
+  for (const PlannedTrial& trial : manifest.plan) {
+    const fs::path record = SessionLayout::record(folder, trial);
+    std::error_code missing;
+    if (!fs::exists(record, missing)) continue;
+    const nlohmann::json document = read_trial_record(record);
+    const auto session = document.find("session");
+    if (session != document.end() && session->is_string() && *session != manifest.session_id) {
+      json_detail::fail(
+          record.string(), "/session",
+          "names the session '" + session->get<std::string>() + "', but its session folder is " +
+              folder.string() +
+              " (a session's id is its folder's name): the folder was renamed; rename it back to " +
+              session->get<std::string>());
+    }
+    break;  // the first saved record tells the session's id
+  }
+}
+
 SessionManifest read_previous_session(const fs::path& folder, const SessionManifest& manifest) {
   const PreviousSession& link = manifest.previous.value();
   const fs::path before = folder.parent_path() / link.session_id;

@@ -39,6 +39,10 @@ void refuse_session_links(const std::filesystem::path& folder);
 /// the record and the session.json's /plan.
 void check_records_planned(const std::filesystem::path& folder, const SessionManifest& manifest);
 
+/// The saved records name the session by `manifest.session_id`, the folder's name: a DataError naming the
+/// first saved record's /session when the folder was renamed since it was saved.
+void check_records_name_the_folder(const std::filesystem::path& folder, const SessionManifest& manifest);
+
 /// The manifest of the session that `manifest` (the session in `folder`) follows, from the folder beside it.
 /// Throws DataError naming the file when it cannot be read or its session.json is not the one the link
 /// recorded (another SHA-256: replaced or edited).

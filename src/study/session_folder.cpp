@@ -25,6 +25,7 @@
 #include "calligraphy/trial/options.hpp"
 #include "calligraphy/trial/writer_profile.hpp"
 #include "core/json_reader.hpp"
+#include "core/whole_file.hpp"
 #include "report/compressed_text.hpp"
 #include "study/manifest_json.hpp"
 #include "study/names.hpp"
@@ -62,6 +63,9 @@ void write_all(int fd, std::string_view bytes, const fs::path& path) {
   }
 }
 
+// The most a session log is copied whole to be made a folder's own (below): far above any session's.
+constexpr std::uintmax_t kMaxLogBytes = std::uintmax_t{1} << 30;
+
 // Opens (creating it) the log for appending and takes its exclusive lock.
 int open_locked_log(const fs::path& log_path) {
   // O_NOFOLLOW: a link planted under the log's name is refused, not followed (the log is the session's own
@@ -81,6 +85,22 @@ int open_locked_log(const fs::path& log_path) {
                        ": the session is open in another process (its log is locked)");
     }
     fail_errno(log_path, "cannot lock the session log", error);
+  }
+  // A log with other hard links (a study copied with `cp -l`) is another folder's file too: appending would
+  // write this session's events into the other copy. It becomes this folder's own first (copied whole under
+  // a temporary name and renamed over its name; the other names keep the earlier file), then is locked again.
+  struct stat status {};
+  if (::fstat(fd, &status) == 0 && S_ISREG(status.st_mode) && status.st_nlink > 1) {
+    std::string text;
+    try {
+      text = read_regular_file(log_path, kMaxLogBytes);
+      write_file_atomically(log_path.string(), text);
+    } catch (...) {
+      ::close(fd);
+      throw;
+    }
+    ::close(fd);
+    return open_locked_log(log_path);
   }
   return fd;
 }
@@ -478,7 +498,10 @@ SessionFolder SessionFolder::open(const fs::path& folder) {
   } catch (const DataError& e) {
     throw InputError(e.what());
   }
-  manifest.session_id = folder.filename().string();
+  // The id is the folder's own name, also when DIR was given through a symbolic link of another name.
+  std::error_code unresolved;
+  const fs::path resolved = fs::weakly_canonical(folder, unresolved);
+  manifest.session_id = (unresolved ? folder : resolved).filename().string();
   if (manifest.session_id.empty()) manifest.session_id = folder.parent_path().filename().string();
   // Trials are saved only into the session's own folders: one that is a symbolic link (or not a folder)
   // would take the records, traces and the removal of leftovers somewhere else.
@@ -601,6 +624,10 @@ fs::path SessionFolder::save_attempt(const PlannedTrial& trial,
     if (link_error != EEXIST) fail_errno(json_path, "cannot keep the attempt", link_error);
   }
   throw DataError(folder.string() + ": too many attempts of trial " + trial_stem(trial));
+}
+
+void SessionFolder::check_records_name_this_session() const {
+  study_detail::check_records_name_the_folder(path_, manifest_);
 }
 
 void SessionFolder::check_writable() const {

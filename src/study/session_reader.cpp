@@ -106,6 +106,45 @@ void check_trace_is_the_records(const json_detail::JsonView& record, const fs::p
   }
 }
 
+// A record under a session's trials/ is that session's: it names the session's subject and id (the folder's
+// name) and, for a simulated writer, the session's writer profile. A record copied in from another study's
+// session of the same stem, or a session folder renamed (its id is its name), is refused naming the record's
+// key, rather than reported under labels that are not its own.
+void check_record_is_the_sessions(const json& document, const std::string& source,
+                                  const SessionManifest& manifest) {
+  const json_detail::JsonView record(document, "", source);
+  const auto differs = [&](const char* key, const std::string& expected, const std::string& what) {
+    if (!record.has(key)) return;
+    const std::string named = record.string_or(key, "");
+    if (named != expected) {
+      json_detail::fail(source, std::string("/") + key,
+                        "names " + what + " '" + named + "', but the record lies in the session folder of '" +
+                            expected + "' (" + manifest.session_id +
+                            "): a record copied in from another session, or the session folder renamed (its "
+                            "name is its id); put it back where it was saved");
+    }
+  };
+  differs("subject", manifest.setup.subject.id, "the subject");
+  differs("session", manifest.session_id, "the session");
+  const json_detail::JsonView writer = record.object("writer");
+  const std::string kind = writer.string_or("kind", "");
+  if (!kind.empty() && kind != manifest.setup.writer) {
+    json_detail::fail(source, "/writer/kind",
+                      "is '" + kind + "', but the session " + manifest.session_id + " was written by a " +
+                          manifest.setup.writer +
+                          " writer: a record copied in from another session; put it back where it was saved");
+  }
+  const std::string profile = writer.object("profile").string_or("name", "");
+  if (kind == "simulated" && !profile.empty() && !manifest.setup.writer_profile.empty() &&
+      profile != manifest.setup.writer_profile) {
+    json_detail::fail(
+        source, "/writer/profile/name",
+        "is '" + profile + "', but the session " + manifest.session_id + " ran the simulated writer '" +
+            manifest.setup.writer_profile +
+            "': a record copied in from another study's session; put it back where it was saved");
+  }
+}
+
 // The tidy tables' rows of the saved trial whose record `document` was read from `json_file`: the one
 // reading of a record into rows, for the tables alone and beside the pages.
 void append_trial_rows(const json& document, const fs::path& json_file, const SessionManifest& manifest,
@@ -122,6 +161,7 @@ ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifes
                        StudyTables* rows) {
   const std::string source = json_file.string();
   const json document = study_detail::read_trial_record(json_file);
+  check_record_is_the_sessions(document, source, manifest);
   const json_detail::JsonView record(document, "", source);
   // the tidy tables' rows from the same parse of the record
   if (rows != nullptr) append_trial_rows(document, json_file, manifest, plan, *rows);
@@ -307,7 +347,9 @@ void read_session_rows(const ReportedSession& session, StudyTables& rows) {
   for (const PlannedTrial& plan : session.manifest.plan) {
     if (!is_saved(session.folder, plan)) continue;  // not saved (yet): a running session can be read
     const fs::path json_file = trial_record_file(session.folder, plan);
-    append_trial_rows(study_detail::read_trial_record(json_file), json_file, session.manifest, plan, rows);
+    const json document = study_detail::read_trial_record(json_file);
+    check_record_is_the_sessions(document, json_file.string(), session.manifest);
+    append_trial_rows(document, json_file, session.manifest, plan, rows);
   }
 }
 

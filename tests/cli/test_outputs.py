@@ -226,7 +226,9 @@ class Protocols(OutputTestCase):
         def edit(document):
             document["conditions"] = [{"name": f"c{i:02d}", "mode": "vision"} for i in range(26)]
             document["practice"]["condition"] = "c00"
-            document["test"].update({"characters": ["大"] * 1000, "conditions": [f"c{i:02d}" for i in range(26)],
+            # 1000 distinct strings (an item is listed once): rows of 大, 人 and 口, 7 characters each.
+            strings = ["".join("大人口"[(n // 3 ** k) % 3] for k in range(7)) for n in range(1000)]
+            document["test"].update({"characters": strings, "conditions": [f"c{i:02d}" for i in range(26)],
                                      "repetitions": 1000})
             document["order"]["conditions"] = "fixed"
         protocol = self.protocol("huge.json", edit)

@@ -173,7 +173,9 @@ class Protocols(Case):
         doc["conditions"] = conditions
         self.plan_refused(doc, "/conditions")
         for count, ok in ((1000, True), (1001, False)):
-            doc = tiny(test={"characters": [SHI] * count, "conditions": ["v"], "repetitions": 1})
+            # distinct strings (a string is listed once): rows of 7 of 十, 人 and 口
+            strings = ["".join((SHI, "人", "口")[(n // 3 ** k) % 3] for k in range(7)) for n in range(count)]
+            doc = tiny(test={"characters": strings, "conditions": ["v"], "repetitions": 1})
             if ok:
                 self.plan_ok(doc)
             else:

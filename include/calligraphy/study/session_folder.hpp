@@ -242,6 +242,11 @@ class SessionFolder {
   /// naming the folder or file.
   void check_writable() const;
 
+  /// Checks that the saved records name this session by its id, the folder's name: a folder renamed since
+  /// its first trial was saved is a DataError naming that record's /session, before a resume saves records
+  /// under the new name beside those of the old one.
+  void check_records_name_this_session() const;
+
   /// Appends {"time_utc": ..., "event": EVENT, ...details} as one line to log.jsonl and fsyncs it.
   /// `details_json` is a JSON object (its members are added) or empty. Throws InvalidArgument when it is
   /// not an object, DataError naming the log when the write or fsync fails.
