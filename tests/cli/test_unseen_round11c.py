@@ -25,10 +25,11 @@ import time
 import unittest
 from pathlib import Path
 
+from outsider import SANITIZED, sanitized_subset
+
 CLI = os.environ.get("CALLIGRAPHY_CLI", "")
 STAND_IN = os.environ.get("CALLIGRAPHY_HD_STAND_IN", "")
 TIMEOUT_S = 60
-SANITIZED = os.environ.get("CALLIGRAPHY_SANITIZED") == "1"
 YI = "一"
 
 heavy = unittest.skipIf(SANITIZED, "several runs of the program: left to the Release run")
@@ -697,19 +698,7 @@ SANITIZED_CASES = {"test_window_sizes_past_the_range_and_mis_spelt", "test_quiz_
                    "test_sweep_values_are_checked_before_any_trial_runs"}
 
 
-def load_tests(loader, tests, pattern):  # noqa: ARG001 - unittest's protocol
-    if not SANITIZED:
-        return tests
-    chosen = unittest.TestSuite()
-
-    def walk(suite):
-        for item in suite:
-            if isinstance(item, unittest.TestSuite):
-                walk(item)
-            elif getattr(item, "_testMethodName", "") in SANITIZED_CASES:
-                chosen.addTest(item)
-    walk(tests)
-    return chosen
+load_tests = sanitized_subset(SANITIZED_CASES)
 
 
 if __name__ == "__main__":

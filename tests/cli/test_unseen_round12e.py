@@ -37,11 +37,12 @@ import time
 import unittest
 from pathlib import Path
 
+from outsider import SANITIZED, sanitized_subset
+
 CLI = os.environ.get("CALLIGRAPHY_CLI", "")
 SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 SAMPLE = SOURCE / "tests" / "data" / "hanzi-writer-sample"
 TIMEOUT_S = 60
-SANITIZED = os.environ.get("CALLIGRAPHY_SANITIZED") == "1"
 SHI = "十"
 YI = "一"
 
@@ -1019,19 +1020,7 @@ SANITIZED_CASES = {"test_two_outputs_spelled_with_dot_and_double_slash_are_one_f
                    "test_characters_and_curriculum"}
 
 
-def load_tests(loader, tests, pattern):
-    if not SANITIZED:
-        return tests
-    chosen = unittest.TestSuite()
-
-    def walk(suite):
-        for test in suite:
-            if isinstance(test, unittest.TestSuite):
-                walk(test)
-            elif getattr(test, "_testMethodName", "") in SANITIZED_CASES:
-                chosen.addTest(test)
-    walk(tests)
-    return chosen
+load_tests = sanitized_subset(SANITIZED_CASES)
 
 
 if __name__ == "__main__":
