@@ -222,7 +222,14 @@ class _RServer:
                 self.process.wait(timeout=5)
             except (OSError, subprocess.TimeoutExpired):
                 self.process.kill()
-                self.process.wait()
+        self.process.wait()
+        # The pipes too, whether it ended by itself or was killed: none is left for the collector to find.
+        for pipe in (self.process.stdin, self.process.stdout):
+            if pipe is not None:
+                try:
+                    pipe.close()
+                except OSError:
+                    pass
         self.log.close()
 
 

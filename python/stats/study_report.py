@@ -902,6 +902,11 @@ def _relative_link(target: PathLike, out_dir: pathlib.Path) -> str:
 _TABLE_NAMES = ("phase_means", "questions", "exclusions", "retention", "summary", "statistics")
 
 
+# The mixed models' denominator degrees of freedom (lmerTest's ddf): Satterthwaite (1946) or Kenward & Roger
+# (1997).
+_DDF_METHODS = ("Satterthwaite", "Kenward-Roger")
+
+
 def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Optional[str] = None,
                  values: typing.Sequence[str] = ("total_time_s", "mean_deviation_m"),
                  per_trial_page: typing.Optional[PathLike] = None, reference: typing.Optional[str] = None,
@@ -933,7 +938,7 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
     tables/statistics.csv (``statistics.statistics_table``). docs/experiments.md lists every column.
 
     Raises TypeError when `study` has no trials DataFrame; ValueError naming a missing or non-numeric column,
-    an unknown reference or an empty `out_dir`; OutputOnInput (a ValueError) naming both files when a file it
+    an unknown reference, a `ddf` not in ('Satterthwaite', 'Kenward-Roger') or an empty `out_dir`; OutputOnInput (a ValueError) naming both files when a file it
     would write is a file of a session folder it reads (through a symbolic or hard link), before anything is
     written; OSError naming a file or folder that could not be written; ImportError without pandas, matplotlib, SciPy or statsmodels. Without R (lme4, lmerTest) the mixed
     models' rows say "not computed" and name the packages.
@@ -955,6 +960,8 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
     if isinstance(keep_end_reasons, (str, bytes)):
         raise TypeError(f"write_report: keep_end_reasons must be a sequence of end reasons (e.g. ('completed',)) "
                         f"or None, got {keep_end_reasons!r}")
+    if ddf not in _DDF_METHODS:
+        raise ValueError(f"write_report: ddf must be one of {', '.join(_DDF_METHODS)}, got {ddf!r}")
     policy = design_analysis.ExclusionPolicy(None if keep_end_reasons is None else tuple(keep_end_reasons))
     if policy.keep_end_reasons is not None and "end_reason" not in trials.columns:
         policy = design_analysis.ExclusionPolicy(None)
@@ -1180,7 +1187,7 @@ def main(argv: typing.Optional[typing.Sequence[str]] = None) -> int:
     parser.add_argument("--analyse", metavar="END_REASONS", default="completed",
                         help="the trials analysed, by how they ended: a comma-separated list of end reasons, or "
                              "'all' (default: completed)")
-    parser.add_argument("--ddf", choices=("Satterthwaite", "Kenward-Roger"), default="Satterthwaite",
+    parser.add_argument("--ddf", choices=_DDF_METHODS, default="Satterthwaite",
                         help="the mixed models' degrees of freedom (default: Satterthwaite)")
     arguments = parser.parse_args(argv)
     if arguments.title is not None and not arguments.title.strip():

@@ -759,6 +759,15 @@ class PythonStudy(unittest.TestCase):
             rows = list(csv.DictReader(stream))
         self.assertGreater(sum(int(row["kept"]) for row in rows), 0, "every trial excluded")
 
+    def test_an_unknown_ddf_is_refused_before_anything_is_written(self):
+        import calligraphy.study_report as report
+        out = self.work / "wald"
+        for ddf in ("Wald", "satterthwaite", ""):
+            with self.subTest(ddf=ddf), self.assertRaises(ValueError) as caught:
+                report.write_report(self.study, str(out), values=("mean_deviation_m",), ddf=ddf)
+            self.assertIn("write_report: ddf", str(caught.exception))
+            self.assertFalse(out.exists(), "written before the argument was checked")
+
     def test_load_of_nothing_or_of_the_wrong_type_names_the_argument(self):
         empty = self.work / "empty"
         empty.mkdir(exist_ok=True)
