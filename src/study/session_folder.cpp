@@ -662,6 +662,23 @@ bool names_a_session(const fs::path& folder) {
   return ::lstat(SessionLayout::manifest(folder).c_str(), &status) == 0;
 }
 
+// Whether `folder` (followed if it is a link) is a session folder or holds one within three levels, links
+// inside it not followed.
+bool holds_sessions(const fs::path& folder) {
+  if (names_a_session(folder)) return true;
+  std::error_code error;
+  fs::recursive_directory_iterator it(folder, fs::directory_options::skip_permission_denied, error);
+  for (; !error && it != fs::recursive_directory_iterator(); it.increment(error)) {
+    if (it->is_symlink(error) || !it->is_directory(error)) {
+      it.disable_recursion_pending();
+      continue;
+    }
+    if (names_a_session(it->path())) return true;
+    if (it.depth() >= 2) it.disable_recursion_pending();
+  }
+  return false;
+}
+
 }  // namespace
 
 std::vector<fs::path> find_session_folders(const fs::path& root) {
@@ -678,7 +695,13 @@ std::vector<fs::path> find_session_folders(const fs::path& root) {
   for (; it != fs::recursive_directory_iterator(); it.increment(error)) {
     if (error) throw DataError(root.string() + ": cannot list the folder: " + error.message());
     if (it->is_symlink(error)) {
+      // A study's sessions are its own, as a session's files are: a link to a session or subject folder
+      // would be reported as part of this study, or skipped and the subject silently lost, so it is named.
       it.disable_recursion_pending();
+      if (fs::is_directory(it->path(), error) && holds_sessions(it->path())) {
+        throw DataError(it->path().string() +
+                        ": is a symbolic link to session folders; a study's folders are its own (copy them in)");
+      }
       continue;
     }
     if (!it->is_directory(error)) continue;

@@ -670,12 +670,20 @@ class Reports(unittest.TestCase):
         (self.dir / "study" / "S01" / "loop").symlink_to("..")
         (self.dir / "study" / "S09").symlink_to(self.dir / "other" / "S01")
         result = run(["report", "study", "--csv", "."], self.dir, timeout=30)
-        if result.returncode == 0:
-            rows = read_rows(self.dir / "trials.csv")
-            self.assertEqual(len(rows), 3, "a session counted twice, or one of another study taken")
-        else:
-            self.assertEqual(result.returncode, 1, text(result))
-            self.assertEqual(len(error_lines(result)), 1)
+        # Neither taken nor skipped in silence (a subject lost): each link to session folders is named.
+        self.assertEqual(result.returncode, 1, text(result))
+        self.assertEqual(len(error_lines(result)), 1)
+        self.assertIn("symbolic link", error_lines(result)[0])
+        (self.dir / "study" / "S01" / "loop").unlink()
+        result = run(["report", "study", "--csv", "."], self.dir, timeout=30)
+        self.assertEqual(result.returncode, 1, text(result))
+        self.assertIn("S09", error_lines(result)[0])
+        (self.dir / "study" / "S09").unlink()
+        (self.dir / "empty").mkdir()
+        (self.dir / "study" / "notes").symlink_to(self.dir / "empty")
+        result = run(["report", "study", "--csv", "."], self.dir, timeout=30)
+        self.assertEqual(result.returncode, 0, text(result))
+        self.assertEqual(len(read_rows(self.dir / "trials.csv")), 3, "a link to a folder of no session is skipped")
         # A copy of a session beside it is refused naming both (docs/experiments.md).
         shutil.copytree(session, session.with_name("copy"), symlinks=True)
         result = run(["report", "study", "--csv", "."], self.dir)
