@@ -463,8 +463,9 @@ ServoLoop::~ServoLoop() { stop(); }
 // runs its time-based parts (fades, filters, a replay) at the wrong speed, which no measurement after the run
 // could tell from a loaded machine.
 void ServoLoop::Impl::check_rates(const DeviceServoClock* device_clock) const {
-  const auto differ = [](double a, double b) { return std::abs(a - b) > 1e-6 * b; };
-  const bool says_rate = callback_rate_hz > 0.0;
+  // Written so that a NaN rate differs from every rate (a NaN compares false either way round).
+  const auto differ = [](double a, double b) { return !(std::abs(a - b) <= 1e-6 * std::abs(b)); };
+  const bool says_rate = callback_rate_hz != 0.0;  // 0: it does not say; any other value is checked
   if (device_clock != nullptr) {
     const double clock_hz = device_clock->servo_rate_hz();
     if (says_rate && differ(callback_rate_hz, clock_hz)) {

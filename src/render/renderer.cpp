@@ -219,8 +219,10 @@ Vec2 Renderer::guidance_force(const DeviceState& device, RenderOutput& out, bool
 
 RenderOutput Renderer::tick(const DeviceState& device) noexcept {
   RenderOutput out;
-  // `!(|x| <= limit)` is also true of NaN.
-  if (!(device.position_m.array().abs() <= kMaxDeviceReadingM).all() || !device.velocity_m_s.allFinite()) {
+  // `!(|x| <= limit)` is also true of NaN. The time stamp is part of the reading (the fades' and the
+  // timing guidance's clock).
+  if (!(device.position_m.array().abs() <= kMaxDeviceReadingM).all() || !device.velocity_m_s.allFinite() ||
+      !std::isfinite(device.time_s)) {
     out.input_rejected = true;
     command(Vec3::Constant(std::numeric_limits<double>::quiet_NaN()), out);
     return out;

@@ -21,6 +21,16 @@ void TrialOptions::validate() const {
   if (!(max_duration_s > 0.0) || !std::isfinite(max_duration_s)) {
     throw InvalidArgument("TrialOptions.max_duration_s = " + std::to_string(max_duration_s) + " must be > 0");
   }
+  // The trace is held in memory, one sample a tick (reserved up front in real time): a duration of 1e308 s
+  // would be refused by the allocator, not by its field.
+  if (max_duration_s * rate_hz > kMaxTrialTicks) {
+    std::string message = "TrialOptions.max_duration_s = ";
+    message.append(std::to_string(max_duration_s))
+        .append(" s at ")
+        .append(detail::rate_text(rate_hz))
+        .append(" is more than a trial's limit of 10^7 ticks (kMaxTrialTicks)");
+    throw InvalidArgument(message);
+  }
   force.validate();
   passivity.validate();
   ServoLoopOptions paced = loop;

@@ -30,12 +30,16 @@ void TrialRecorder::record(const DeviceState& state, const RenderOutput& out) {
   last_state_ = out.state;
 
   const std::size_t index = ticks_++;
+  // A reading the renderer rejected (not finite, or beyond any device's reach) is no position of the pen:
+  // it is recorded at the last accepted one, and it is no tick of writing (no deviation is measured to it).
+  if (!out.input_rejected) last_position_ = state.position_m;
   if (keep_trace_) {
-    trace_.push_back({state.time_s, state.position_m, out.force_n, out.state, current_, out.element});
+    trace_.push_back({state.time_s, last_position_, out.force_n, out.state, current_, out.element});
   }
   if (current_ >= metrics_.per_stroke.size()) return;
   StrokeMetrics& m = metrics_.per_stroke[current_];
-  const bool writing_this = out.state == InteractionState::writing || out.stroke_completed;
+  const bool writing_this =
+      !out.input_rejected && (out.state == InteractionState::writing || out.stroke_completed);
   if (out.state_changed && out.state == InteractionState::writing) {  // a new attempt starts
     attempt_ = {};
     attempt_.start_time = state.time_s;

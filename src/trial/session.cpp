@@ -4,6 +4,7 @@
 #include <cmath>
 #include <utility>
 
+#include "calligraphy/core/errors.hpp"
 #include "core/library_log.hpp"
 #include "core/rate_text.hpp"
 
@@ -55,12 +56,20 @@ void TrialSession::attach_display(DisplayChannel* channel) {
 void TrialSession::reserve_trace() { recorder_.reserve(max_ticks_); }
 
 ServoCommand TrialSession::step(const DeviceState& device_state) noexcept {
-  // One time base for every device: the trial's clock starts at its first tick, whatever the device's
-  // clock counts from (the simulated device from open(), OpenHaptics from the machine's boot).
-  if (ticks_ == 0) device_origin_s_ = device_state.time_s;
+  // One time base for every device: the trial's clock starts at its first tick with a finite time stamp,
+  // whatever the device's clock counts from (the simulated device from open(), OpenHaptics from the
+  // machine's boot).
+  if (!origin_set_ && std::isfinite(device_state.time_s)) {
+    device_origin_s_ = device_state.time_s;
+    origin_set_ = true;
+  }
   DeviceState state = device_state;
-  state.time_s = device_state.time_s - device_origin_s_;
-  last_output_ = renderer_.tick(state);
+  state.time_s = origin_set_ ? device_state.time_s - device_origin_s_ : device_state.time_s;
+  last_output_ = renderer_.tick(state);  // a non-finite time stamp is a rejected reading: zero force
+  // The recorded clock never runs backwards nor leaves the numbers: a device clock that stepped back, or a
+  // garbled (non-finite) stamp, is recorded at the previous tick's time, so that the trace stays one the
+  // trace readers take (times that do not decrease, all finite) and the metrics' times are not negative.
+  if (!(state.time_s >= last_time_s_) || !std::isfinite(state.time_s)) state.time_s = last_time_s_;
   recorder_.record(state, last_output_);
   ++ticks_;
   if (display_) display_->publish_tick(ticks_, state, last_output_, recorder_.metrics());
@@ -69,6 +78,9 @@ ServoCommand TrialSession::step(const DeviceState& device_state) noexcept {
 }
 
 TrialResult TrialSession::finish(TrialEnd end, std::string reason, double end_time_s) {
+  if (spent_)
+    throw StateError("TrialSession::finish: called again; a session is spent after its first finish");
+  spent_ = true;
   const double trial_end_s = end_time_s < 0.0 ? last_time_s_ : end_time_s - device_origin_s_;
   recorder_.finish(trial_end_s);
   if (display_) display_->publish_end(end, trial_end_s);

@@ -53,7 +53,8 @@ struct RenderOutput {
   bool stroke_assisted = false;
   std::uint32_t misses = 0;  ///< refused attempts at the active stroke (after this tick)
   bool hint_shown = false;   ///< the active stroke is to be shown as a hint (misses >= hint_after_misses)
-  /// The device state was not finite, or a coordinate lay beyond kMaxDeviceReadingM: zero force.
+  /// The device state (position, velocity, time stamp) was not finite, or a coordinate lay beyond
+  /// kMaxDeviceReadingM: zero force.
   bool input_rejected = false;
   bool force_error = false;                  ///< the force law gave a non-finite force: zero force
   std::uint8_t limits = safety_none;         ///< SafetyLimit bits: which safety stages acted

@@ -56,8 +56,9 @@ struct TrialOptions {
   /// Real-time pacing: realtime mode, priority, CPU, stale-force and stall bounds. Its `rate_hz` is
   /// ignored: the trial's `rate_hz` is used.
   ServoLoopOptions loop{};
-  double max_duration_s = 300.0;  ///< the trial ends after this much device time [s]
-  bool keep_trace = true;         ///< keep one `TrialSample` per tick in the result
+  /// The trial ends after this much device time [s]: > 0, and at most kMaxTrialTicks ticks at `rate_hz`.
+  double max_duration_s = 300.0;
+  bool keep_trace = true;  ///< keep one `TrialSample` per tick in the result
   /// Polled by the thread that runs the trial (never the servo thread): once per tick in lock-step,
   /// every millisecond in real time. Returning true ends the trial at the next tick with
   /// `TrialEnd::interrupted` (zero force, forces disabled, every recorded tick kept). May be empty.

@@ -16,8 +16,10 @@ namespace calligraphy {
 /// One servo tick of the trace.
 struct TrialSample {
   double time_s = 0.0;
-  Vec3 position_m = Vec3::Zero();  ///< HIP as read from the device [m]
-  Vec3 force_n = Vec3::Zero();     ///< commanded force [N]
+  /// HIP as read from the device [m]; for a reading the renderer rejected (`RenderOutput::input_rejected`:
+  /// not finite, or beyond kMaxDeviceReadingM) the last accepted one (the origin before any).
+  Vec3 position_m = Vec3::Zero();
+  Vec3 force_n = Vec3::Zero();  ///< commanded force [N]
   InteractionState state = InteractionState::separation;
   std::size_t stroke = 0;   ///< active stroke, counted over the whole scene (0-based)
   std::size_t element = 0;  ///< active element within it
@@ -106,6 +108,7 @@ class TrialRecorder {
   std::size_t ticks_ = 0;  // ticks recorded: the next sample's index in the trace
   Attempt attempt_;
   Vec3 last_force_ = Vec3::Zero();
+  Vec3 last_position_ = Vec3::Zero();  // the last reading the renderer accepted
   bool first_ = true;
   InteractionState last_state_ = InteractionState::separation;
   double pooled_sum_ = 0.0;

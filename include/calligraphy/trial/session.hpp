@@ -68,7 +68,9 @@ class TrialSession {
   /// One servo tick: renders the force for `state` and records the tick. `stop` is set when every
   /// stroke is written or the time limit is reached. Servo path: no lock, log or exception, and no
   /// allocation after `reserve_trace()`. Times: the trial's clock starts at 0 with the first tick;
-  /// `state.time_s` is on the device's clock (any origin) and only its differences are used.
+  /// `state.time_s` is on the device's clock (any origin) and only its differences are used. A stamp that is
+  /// not finite gives zero force (a rejected reading); it and a stamp before the previous one are recorded at
+  /// the previous tick's time (the recorded clock never runs backwards).
   ServoCommand step(const DeviceState& state) noexcept;
 
   /// The session as a `ServoLoop`'s callback: `ServoLoop loop(device, session.servo_callback(), options)`.
@@ -95,7 +97,8 @@ class TrialSession {
 
   /// Closes the metrics at `end_time_s` (when the trial ended, on the device's clock as the states
   /// stepped; the last tick's time when negative) and returns the recording with how it ended. `reason` is
-  /// kept as `abort_reason`. Call once, after the loop stopped stepping; the session is spent after it. With
+  /// kept as `abort_reason`. Call once, after the loop stopped stepping; the session is spent after it (a
+  /// second call throws StateError). With
   /// a display attached it pushes the `trial_ended` event. When the device's clock says the ticks came more
   /// than 10 % off `rate_hz` (over 100 ticks or more: `TrialResult::device_tick_rate_hz`), logs a warning
   /// with the measured rate: late ticks (load on the machine) when they came slower on a rate-checked loop
@@ -115,6 +118,8 @@ class TrialSession {
   double last_time_s_ = 0.0;      // the trial's clock: 0 at the first tick
   double device_origin_s_ = 0.0;  // the device's time stamp of the first tick
   bool rate_checked_ = false;     // stepped by a ServoLoop that checked the rates at start (servo_callback)
+  bool origin_set_ = false;       // device_origin_s_ holds a finite time stamp
+  bool spent_ = false;            // finish() was called
 };
 
 }  // namespace calligraphy
