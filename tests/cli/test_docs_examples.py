@@ -23,6 +23,7 @@ CALLIGRAPHY_DOCS_EXAMPLES_ONLY=README.md,python.md restricts the run to some doc
 """
 
 import glob
+import hashlib
 import json
 import resource
 import os
@@ -148,6 +149,43 @@ def substitute(step):
     if "corpus build" not in step:
         step = re.sub(r"--store corpus\.clg\b", "--store " + BUNDLED_STORE, step)
     return step
+
+
+# A study step run already in another document, the same command on the same input, is not run again: its
+# output folder is copied from that run (the examples of docs/experiments.md and docs/learning-study.md make
+# the same study and report). Keyed by the command and a digest of its study folder (the output left out).
+STUDY_STEP = re.compile(r"calligraphy session run .*--out (?P<out>\S+)|-m calligraphy\.study_report (?P<study>\S+) .*--out (?P<rout>\S+)")
+_STUDY_CACHE = {}
+
+
+def _digest(path, leave_out):
+    if not os.path.exists(path):
+        return "absent"
+    h = hashlib.sha256()
+    for root, dirs, files in os.walk(path):
+        dirs.sort()
+        for name in sorted(files):
+            p = os.path.join(root, name)
+            if p == leave_out or p.startswith(leave_out + os.sep):
+                continue
+            h.update(os.path.relpath(p, path).encode() + b"\0")
+            with open(p, "rb") as f:
+                h.update(f.read())
+    return h.hexdigest()
+
+
+def study_key(command, folder):
+    """(key, output folder) of a study step, or None."""
+    m = STUDY_STEP.search(command)
+    if not m:
+        return None
+    if m.group("out"):
+        out = os.path.join(folder, m.group("out"))
+        if os.path.exists(out):    # a second run into a study: depends on what is there, never cached
+            return None
+        return (command, "absent"), out
+    out = os.path.join(folder, m.group("rout"))
+    return (command, _digest(os.path.join(folder, m.group("study")), out)), out
 
 
 _SQUARES = {}
@@ -377,20 +415,25 @@ PY_SKIP = [
 ]
 
 PY_RUNNER = r'''
-import json, sys, traceback, io, contextlib
+import json, sys, traceback, io, contextlib, os
 blocks = json.load(open(sys.argv[1]))
 ns = {"__name__": "__main__"}
+def cpu():
+    t = os.times()
+    return t.user + t.system + t.children_user + t.children_system
 for b in blocks:
+    start = cpu()
     buf = io.StringIO()
     try:
         with contextlib.redirect_stdout(buf):
             for part in (b["fixture"], b["code"], b["check"]):
                 if part:
                     exec(compile(part, b["name"], "exec"), ns)
-        print(json.dumps({"name": b["name"], "ok": True, "out": buf.getvalue()[-2000:]}), flush=True)
+        print(json.dumps({"name": b["name"], "ok": True, "out": buf.getvalue()[-2000:], "cpu": cpu() - start}),
+              flush=True)
     except BaseException:
         print(json.dumps({"name": b["name"], "ok": False, "out": buf.getvalue()[-2000:],
-                          "error": traceback.format_exc()[-3000:]}), flush=True)
+                          "error": traceback.format_exc()[-3000:], "cpu": cpu() - start}), flush=True)
 '''
 
 
@@ -408,6 +451,8 @@ class DocsExamples(unittest.TestCase):
 
     @classmethod
     def tearDownClass(cls):
+        if cls._cache_dir:
+            shutil.rmtree(cls._cache_dir, True)
         t = cls.tally
         print("\nblocks found: %d (shell %d, Python %d, other %d); shell steps %d: run %d, skipped %d; "
               "Python blocks run %d, skipped %d" % (t["blocks"], t["shell"], t["python"], t["other"], t["steps"],
@@ -415,9 +460,17 @@ class DocsExamples(unittest.TestCase):
               file=sys.stderr)
         for s in cls.skips:
             print("  skipped %s" % s, file=sys.stderr)
-        print("CPU of the examples: %.1f s; the largest:" % sum(c for c, _ in cls.costs), file=sys.stderr)
-        for cost, what in sorted(cls.costs, reverse=True)[:8]:
+        print("CPU of the examples: %.1f s; the largest:" % sum(c for c, w in cls.costs if not w.startswith(" ")), file=sys.stderr)
+        for cost, what in sorted(cls.costs, reverse=True)[:12]:
             print("  %5.1f s %s" % (cost, what), file=sys.stderr)
+
+    _cache_dir = None
+
+    @classmethod
+    def cache_dir(cls):
+        if cls._cache_dir is None:
+            cls._cache_dir = tempfile.mkdtemp(prefix="docs-examples-studies-")
+        return cls._cache_dir
 
     def folder_for(self, doc):
         folder = tempfile.mkdtemp(prefix="docs-examples-")
@@ -459,10 +512,21 @@ class DocsExamples(unittest.TestCase):
                     self.tally["run"] += 1
                     script = "\n".join(variables + [one_run])
                     with self.subTest(doc=doc, line=line, step=one):
-                        before = _children_cpu()
-                        proc = subprocess.run(["bash", "-c", script], cwd=folder, env=env, capture_output=True,
-                                              text=True, timeout=300)
-                        self.costs.append((_children_cpu() - before, "%s:%d `%s`" % (doc, line, one_run)))
+                        keyed = study_key(one_run, folder)
+                        if keyed and keyed[0] in _STUDY_CACHE:
+                            copy, proc, where = _STUDY_CACHE[keyed[0]]
+                            shutil.copytree(copy, keyed[1])
+                            self.skips.append("%s:%d `%s`: not run again, its output copied from the same "
+                                              "command on the same input at %s" % (doc, line, one, where))
+                        else:
+                            before = _children_cpu()
+                            proc = subprocess.run(["bash", "-c", script], cwd=folder, env=env, capture_output=True,
+                                                  text=True, timeout=300)
+                            self.costs.append((_children_cpu() - before, "%s:%d `%s`" % (doc, line, one_run)))
+                            if keyed and proc.returncode == 0 and os.path.isdir(keyed[1]):
+                                copy = os.path.join(self.cache_dir(), str(len(_STUDY_CACHE)))
+                                shutil.copytree(keyed[1], copy)
+                                _STUDY_CACHE[keyed[0]] = (copy, proc, "%s:%d" % (doc, line))
                         expected = EXPECTED_STATUS.get(one, 0)
                         self.assertEqual(proc.returncode, expected,
                                          "%s:%d `%s` exit %d\n%s" % (doc, line, one, proc.returncode, proc.stderr[-3000:]))
@@ -500,6 +564,7 @@ class DocsExamples(unittest.TestCase):
         results = [json.loads(l) for l in proc.stdout.splitlines() if l.startswith("{")]
         self.assertEqual(len(results), len(payload), proc.stderr[-3000:])
         for r in results:
+            self.costs.append((r.get("cpu", 0.0), "  of which the Python block " + r["name"]))
             with self.subTest(block=r["name"]):
                 self.assertTrue(r["ok"], "%s raised:\n%s" % (r["name"], r.get("error", "")))
 
