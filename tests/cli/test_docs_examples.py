@@ -314,7 +314,27 @@ def check_study_report(t, out, folder, out_dir):
     t.assertTrue(os.path.isfile(os.path.join(folder, out_dir, "index.html")), out_dir + "/index.html")
 
 
+def _stroke_rows(out):
+    """(number, character) of each row of the per-stroke table a trial prints (strokes numbered from 1)."""
+    return [(int(m.group(1)), m.group(2)) for m in re.finditer(r"^\s+(\d+)\s+(\S)\s+[A-Z]", out, re.M)]
+
+
+def check_trial_table(t, out, folder):
+    # README: "table per stroke and in total"; strokes are numbered from 1 where people read them.
+    t.assertEqual(_stroke_rows(out), [(i, "永") for i in range(1, 6)], "one row per stroke of 永, from 1")
+    t.assertRegex(out, r"(?m)^\s+mean deviation\s+[0-9.]+ mm$", "and the totals, in millimetres for people")
+
+
+def check_group_order(t, out, folder):
+    # README: "a character group, written left to right": 口's strokes, then 九's.
+    chars = [c for _, c in _stroke_rows(out)]
+    t.assertTrue(chars and set(chars) == {"口", "九"}, chars)
+    t.assertEqual(chars, sorted(chars, key="口九".index), "口 written before 九")
+
+
 CHECKS = [   # (pattern on the step as written, check(test, stdout, folder))
+    (re.compile(r"calligraphy trial 永\s*$"), check_trial_table),
+    (re.compile(r"calligraphy trial 口九 --writer-profile skilled\s*$"), check_group_order),
     (re.compile(r"calligraphy strokes\s*$"), check_strokes),
     (re.compile(r"calligraphy model 永 --json\s*$"), check_json_stdout),
     (re.compile(r"calligraphy devices --json"), check_devices),
