@@ -34,6 +34,7 @@ import subprocess
 import sys
 import tempfile
 import unittest
+from xml.etree import ElementTree
 
 SOURCE = os.environ.get("CALLIGRAPHY_SOURCE_DIR", os.path.dirname(os.path.dirname(os.path.dirname(
     os.path.abspath(__file__)))))
@@ -250,6 +251,35 @@ def _nonempty(path):
     return os.path.isfile(path) and os.path.getsize(path) > 0
 
 
+def check_output_kind(t, path):
+    """An output named .json is JSON, .svg an SVG document, .csv a table with a header; a folder is not
+    looked into further."""
+    if not os.path.isfile(path):
+        return
+    if path.endswith(".json"):
+        with open(path, encoding="utf-8") as f:
+            json.load(f)
+    elif path.endswith(".svg"):
+        root = ElementTree.parse(path).getroot()
+        t.assertTrue(root.tag.endswith("svg"), path + ": not an SVG document")
+    elif path.endswith(".csv"):
+        with open(path, encoding="utf-8") as f:
+            header = f.readline()
+        t.assertRegex(header, r"^[A-Za-z_][\w ,]*$", path + ": no header line")
+
+
+def check_characters_listed(t, out, folder, strokes, typical_id):
+    """`characters --strokes N --typical ACRONYM`: each character listed has N strokes, one of them that one."""
+    listed = sorted(set(re.findall(r"[\u2e80-\u2fdf\u3400-\u9fff\uf900-\ufaff]", out)))
+    t.assertTrue(listed, "characters listed")
+    code = ("import calligraphy as cg, sys\nlib = cg.CharacterLibrary.default()\nbad = []\n"
+            "for c in sys.argv[1]:\n    ids = list(lib.load(c).typical_stroke_ids)\n"
+            "    if len(ids) != %d or %d not in ids: bad.append((c, ids))\nprint(bad)\n" % (strokes, typical_id))
+    proc = subprocess.run([PYTHON, "-c", code, "".join(listed)], capture_output=True, text=True, timeout=120,
+                          env=dict(os.environ, PYTHONPATH=PYTHONPATH))
+    t.assertEqual(proc.stdout.strip(), "[]", proc.stderr[-2000:])
+
+
 def _typical_acronyms():
     with open(os.path.join(SOURCE, "docs", "typical-strokes.md"), encoding="utf-8") as f:
         return [m.group(2) for m in re.finditer(r"^\| (\d+) \| ([A-Z][A-Z0-9]*) \|", f.read(), re.M)]
@@ -333,6 +363,8 @@ def check_group_order(t, out, folder):
 
 
 CHECKS = [   # (pattern on the step as written, check(test, stdout, folder))
+    (re.compile(r"characters --typical HZG --strokes 4"), lambda t, o, f: check_characters_listed(t, o, f, 4, 10)),
+    (re.compile(r"characters --strokes 5 --typical HZG"), lambda t, o, f: check_characters_listed(t, o, f, 5, 10)),
     (re.compile(r"calligraphy trial 永\s*$"), check_trial_table),
     (re.compile(r"calligraphy trial 口九 --writer-profile skilled\s*$"), check_group_order),
     (re.compile(r"calligraphy strokes\s*$"), check_strokes),
@@ -555,6 +587,7 @@ class DocsExamples(unittest.TestCase):
                         for out in output_paths(one_run):
                             self.assertTrue(_nonempty(os.path.join(folder, out)),
                                             "%s:%d `%s`: %s not made or empty" % (doc, line, one, out))
+                            check_output_kind(self, os.path.join(folder, out))
                         for pattern, check in CHECKS:
                             if pattern.search(one):
                                 check(self, proc.stdout, folder)
