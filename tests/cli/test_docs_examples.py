@@ -387,7 +387,7 @@ CHECKS = [   # (pattern on the step as written, check(test, stdout, folder))
 # Exit statuses the text beside a step states (none yet: every example is documented to succeed).
 EXPECTED_STATUS = {}
 
-ERROR_LINE = re.compile(r"^(?:error|Error|ERROR|calligraphy: error)\b|Traceback \(most recent call last\)", re.M)
+ERROR_LINE = re.compile(r"^(?:error|Error|ERROR|calligraphy[\w .-]*: error)\b|Traceback \(most recent call last\)", re.M)
 
 # Inputs a Python block's reader supplies (names a fragment uses without making them), given before it runs.
 # Keyed by a line of the block. Made with the library itself where a file is needed.
@@ -616,6 +616,8 @@ class DocsExamples(unittest.TestCase):
         self.costs.append((_children_cpu() - before, "%s: %d Python blocks" % (doc, len(payload))))
         results = [json.loads(l) for l in proc.stdout.splitlines() if l.startswith("{")]
         self.assertEqual(len(results), len(payload), proc.stderr[-3000:])
+        self.assertIsNone(ERROR_LINE.search(proc.stderr), "%s's Python blocks printed an error\n%s" % (
+            doc, proc.stderr[-3000:]))
         for r in results:
             self.costs.append((r.get("cpu", 0.0), "  of which the Python block " + r["name"]))
             with self.subTest(block=r["name"]):
