@@ -119,6 +119,25 @@ int register_temporary(const fs::path& path) noexcept {
   return -1;
 }
 
+// Holds the stop signals back while it lives (this thread): a temporary created and not yet registered
+// would be left behind by a signal that came between the two; one held back is handled when it ends, with
+// the temporary registered.
+class StopSignalsHeld {
+ public:
+  StopSignalsHeld() noexcept {
+    sigset_t held;
+    sigemptyset(&held);
+    for (const int signal : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&held, signal);
+    pthread_sigmask(SIG_BLOCK, &held, &before_);
+  }
+  StopSignalsHeld(const StopSignalsHeld&) = delete;
+  StopSignalsHeld& operator=(const StopSignalsHeld&) = delete;
+  ~StopSignalsHeld() { pthread_sigmask(SIG_SETMASK, &before_, nullptr); }
+
+ private:
+  sigset_t before_{};
+};
+
 void release_temporary(int slot) noexcept {
   if (slot >= 0) temporary_slots[slot].state.store(0);
 }
@@ -194,6 +213,7 @@ class TemporaryFile {
       : reported_(reported) {
     static std::atomic<unsigned> counter{0};
     const fs::path folder = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+    const StopSignalsHeld held;  // from the file's creation to its registration
     for (int attempt = 0; attempt < 100; ++attempt) {
       std::string name = sibling_prefix(target, ".tmp-");  // hidden, beside the target
       name.append(std::to_string(::getpid()));

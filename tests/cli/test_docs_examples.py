@@ -19,7 +19,8 @@ itself where it can (FIXTURES): `DIR` is the character data folder, a study is a
 must exit 0 (or what the text beside it says), print no traceback and no error line, make the files it names
 as outputs (non-empty), and hold what the docs state about its output (CHECKS).
 
-CALLIGRAPHY_DOCS_EXAMPLES_ONLY=README.md,python.md restricts the run to some documents (for working on them).
+CALLIGRAPHY_DOCS_EXAMPLES_ONLY=README.md,python.md restricts the run to some documents (for working on them);
+CALLIGRAPHY_DOCS_EXAMPLES_ALL=1 also runs the LONG_DOCUMENTS, skipped otherwise to keep the suite's budget.
 """
 
 import glob
@@ -642,10 +643,23 @@ class DocsExamples(unittest.TestCase):
             self.run_python(doc, python_blocks, folder, env)
 
 
+# Documents whose examples run whole studies or cohorts for most of a minute of CPU each: run when
+# CALLIGRAPHY_DOCS_EXAMPLES_ALL=1 (docs/testing.md, the long sweeps), skipped visibly otherwise, so that the
+# suite keeps its time budget. Their commands are the ones the other documents' studies run, on more subjects.
+LONG_DOCUMENTS = {
+    os.path.join("docs", "learning-study.md"): "two crossover studies of 4 subjects and their paper, about 45 s of CPU",
+    os.path.join("docs", "experiments.md"): "a learning study of 3 subjects and its paper, about 30 s of CPU",
+    os.path.join("docs", "python.md"): "a cohort of 14 simulated subjects, sweeps and statistics, about 45 s of CPU",
+}
+ALL = os.environ.get("CALLIGRAPHY_DOCS_EXAMPLES_ALL") == "1"
+
+
 def _make_test(doc):
     def test(self):
         self.run_document(doc)
     test.__doc__ = "every example of %s, run as written" % doc
+    if doc in LONG_DOCUMENTS and not ALL:
+        return unittest.skip("%s (CALLIGRAPHY_DOCS_EXAMPLES_ALL=1 runs it)" % LONG_DOCUMENTS[doc])(test)
     return test
 
 
