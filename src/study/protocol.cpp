@@ -279,8 +279,8 @@ void read_trial_settings(json_detail::ObjectReader& reader, StudyProtocol& proto
                            reader.source(), {}, unused);
   // Checked here, so that a session is refused before its folder is made, naming the protocol's fields
   // rather than the trial runner's options.
-  const double ticks = protocol.trial.max_duration_s * protocol.trial.rate_hz;
-  if (ticks > kMaxTrialTicks) {
+  if (exceeds_trial_ticks(protocol.trial.max_duration_s, protocol.trial.rate_hz)) {
+    const double ticks = protocol.trial.max_duration_s * protocol.trial.rate_hz;
     std::ostringstream message;
     message << protocol.trial.max_duration_s << " s at " << protocol.trial.rate_hz << " Hz ("
             << json_detail::child_pointer(at, "rate_hz") << ") is " << std::llround(ticks)

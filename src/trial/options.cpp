@@ -23,7 +23,7 @@ void TrialOptions::validate() const {
   }
   // The trace is held in memory, one sample a tick (reserved up front in real time): a duration of 1e308 s
   // would be refused by the allocator, not by its field.
-  if (max_duration_s * rate_hz > kMaxTrialTicks) {
+  if (exceeds_trial_ticks(max_duration_s, rate_hz)) {
     std::string message = "TrialOptions.max_duration_s = ";
     message.append(std::to_string(max_duration_s))
         .append(" s at ")

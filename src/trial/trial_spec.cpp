@@ -444,7 +444,7 @@ void TrialSpec::validate(TeacherSource teacher_from) const {
     refuse("watchdog_s", "applies to real-time pacing only (lock-step has no wall clock to bound)");
   }
   // A trace longer than this would not fit a trial's memory (one sample per tick).
-  if (rate_hz * max_duration_s > kMaxTrialTicks) {
+  if (exceeds_trial_ticks(max_duration_s, rate_hz)) {
     refuse("max_duration_s", number_text(max_duration_s) + " s at " + field_label("rate_hz") + " " +
                                  number_text(rate_hz) + " Hz is more than 10^7 servo ticks");
   }

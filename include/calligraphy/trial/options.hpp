@@ -15,9 +15,14 @@
 namespace calligraphy {
 
 /// The most servo ticks a trial may last (max_duration_s x rate_hz): its trace, one sample a tick, is held
-/// in memory. A trial specification (TrialSpec::validate) and Python refuse more; a protocol is refused at
-/// reading.
+/// in memory. TrialOptions::validate, a trial specification (TrialSpec::validate, which Python's checks use)
+/// and a protocol's trial settings (at reading) refuse more, each naming its own fields.
 inline constexpr double kMaxTrialTicks = 1e7;
+/// Whether a trial of `max_duration_s` [s] at `rate_hz` [Hz] has more ticks than kMaxTrialTicks: the one test
+/// every reader of the two fields applies. NaN gives false; the fields' own ranges refuse it.
+[[nodiscard]] constexpr bool exceeds_trial_ticks(double max_duration_s, double rate_hz) noexcept {
+  return max_duration_s * rate_hz > kMaxTrialTicks;
+}
 /// The longest a trial may be stated to last [s] (one day): `TrialSpec::max_duration_s` is in (0, this].
 inline constexpr double kMaxTrialDurationS = 86400.0;
 
