@@ -662,21 +662,48 @@ bool names_a_session(const fs::path& folder) {
   return ::lstat(SessionLayout::manifest(folder).c_str(), &status) == 0;
 }
 
-// Whether `folder` (followed if it is a link) is a session folder or holds one within three levels, links
-// inside it not followed.
-bool holds_sessions(const fs::path& folder) {
-  if (names_a_session(folder)) return true;
+// Walks the folders under `root` (not `root` itself), links not followed, to three levels: a session folder
+// found goes to `on_session` and is not entered, a symbolic link goes to `on_link`, and a run's partial
+// folder is skipped. A callback that returns true ends the walk. A folder that cannot be listed throws
+// DataError when `strict`, and ends the walk otherwise. The one walk of a study's tree: finding its sessions
+// and telling whether a link leads to some.
+template <class OnSession, class OnLink>
+void walk_session_tree(const fs::path& root, bool strict, OnSession on_session, OnLink on_link) {
   std::error_code error;
-  fs::recursive_directory_iterator it(folder, fs::directory_options::skip_permission_denied, error);
-  for (; !error && it != fs::recursive_directory_iterator(); it.increment(error)) {
-    if (it->is_symlink(error) || !it->is_directory(error)) {
+  const auto listing_failed = [&] {
+    if (strict) throw DataError(root.string() + ": cannot list the folder: " + error.message());
+    return true;
+  };
+  fs::recursive_directory_iterator it(root, fs::directory_options::skip_permission_denied, error);
+  if (error && listing_failed()) return;
+  for (; it != fs::recursive_directory_iterator(); it.increment(error)) {
+    if (error && listing_failed()) return;
+    if (it->is_symlink(error)) {
+      it.disable_recursion_pending();
+      if (on_link(it->path())) return;
+      continue;
+    }
+    if (!it->is_directory(error)) continue;
+    if (is_partial_session_folder(it->path())) {  // a run's folder not made yet, or a killed run's
       it.disable_recursion_pending();
       continue;
     }
-    if (names_a_session(it->path())) return true;
-    if (it.depth() >= 2) it.disable_recursion_pending();
+    if (names_a_session(it->path())) {
+      it.disable_recursion_pending();
+      if (on_session(it->path())) return;
+    } else if (it.depth() >= 3) {
+      it.disable_recursion_pending();
+    }
   }
-  return false;
+}
+
+// Whether `folder` (followed if it is a link) is a session folder or holds one, links inside it not followed.
+bool holds_sessions(const fs::path& folder) {
+  if (names_a_session(folder)) return true;
+  bool found = false;
+  walk_session_tree(
+      folder, false, [&](const fs::path&) { return found = true; }, [](const fs::path&) { return false; });
+  return found;
 }
 
 }  // namespace
@@ -690,32 +717,23 @@ std::vector<fs::path> find_session_folders(const fs::path& root) {
     return {root};
   }
   std::vector<fs::path> found;
-  fs::recursive_directory_iterator it(root, fs::directory_options::skip_permission_denied, error);
-  if (error) throw DataError(root.string() + ": cannot list the folder: " + error.message());
-  for (; it != fs::recursive_directory_iterator(); it.increment(error)) {
-    if (error) throw DataError(root.string() + ": cannot list the folder: " + error.message());
-    if (it->is_symlink(error)) {
-      // A study's sessions are its own, as a session's files are: a link to a session or subject folder
-      // would be reported as part of this study, or skipped and the subject silently lost, so it is named.
-      it.disable_recursion_pending();
-      if (fs::is_directory(it->path(), error) && holds_sessions(it->path())) {
-        throw DataError(it->path().string() +
-                        ": is a symbolic link to session folders; a study's folders are its own (copy them in)");
-      }
-      continue;
-    }
-    if (!it->is_directory(error)) continue;
-    if (is_partial_session_folder(it->path())) {  // a run's folder not made yet, or a killed run's
-      it.disable_recursion_pending();
-      continue;
-    }
-    if (names_a_session(it->path())) {
-      found.push_back(it->path());
-      it.disable_recursion_pending();
-    } else if (it.depth() >= 3) {
-      it.disable_recursion_pending();
-    }
-  }
+  walk_session_tree(
+      root, true,
+      [&](const fs::path& folder) {
+        found.push_back(folder);
+        return false;
+      },
+      [](const fs::path& link) {
+        // A study's sessions are its own, as a session's files are: a link to a session or subject folder
+        // would be reported as part of this study, or skipped and the subject silently lost, so it is named.
+        std::error_code ignored;
+        if (fs::is_directory(link, ignored) && holds_sessions(link)) {
+          throw DataError(
+              link.string() +
+              ": is a symbolic link to session folders; a study's folders are its own (copy them in)");
+        }
+        return false;
+      });
   std::sort(found.begin(), found.end());
   return found;
 }
