@@ -619,6 +619,21 @@ TEST_CASE("unseen12g: a callback that says NaN Hz, or 0.5 Hz off, is refused at 
   }
 }
 
+TEST_CASE("unseen12g: a callback that names no place for its rate is still told which rate to change",
+          "[unseen12g]") {
+  AppDevice device;
+  device.open();
+  const auto plain = [](const DeviceState&, double) { return ServoCommand{}; };
+  for (const char* name : {static_cast<const char*>(nullptr), ""}) {
+    RatedServoCallback<decltype(plain)> rated{plain, 500.0, name};
+    ServoLoop loop(device, rated);
+    const std::string message = message_of<InvalidArgument>([&] { loop.start(); });
+    CHECK_THAT(message, Contains("the callback's servo_rate_hz()"));
+    CHECK_THAT(message, !Contains("(),"));  // the old message: "built for 500 Hz (), but ..."
+    CHECK_FALSE(loop.running());
+  }
+}
+
 TEST_CASE(
     "unseen12g: a device clock at NaN or 0 Hz, or whose attach throws, refuses the start with forces off",
     "[unseen12g]") {

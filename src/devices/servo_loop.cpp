@@ -454,7 +454,9 @@ ServoLoop::ServoLoop(HapticDevice& device, Prepared prepared, const ServoLoopOpt
   impl_ = std::make_unique<Impl>(device, std::move(prepared.callback), options);
   impl_->after_write = std::move(after_write);
   impl_->callback_rate_hz = prepared.rate_hz;
-  impl_->callback_rate_name = prepared.rate_name != nullptr ? prepared.rate_name : "";
+  // A callback that names no place for its rate (nullptr or "") is still told which rate to change.
+  const bool named = prepared.rate_name != nullptr && *prepared.rate_name != '\0';
+  impl_->callback_rate_name = named ? prepared.rate_name : "the callback's servo_rate_hz()";
 }
 
 ServoLoop::~ServoLoop() { stop(); }

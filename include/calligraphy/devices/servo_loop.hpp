@@ -128,7 +128,7 @@ template <typename Callback>
 struct RatedServoCallback {
   Callback callback;
   double rate_hz = 0.0;        ///< the rate the callback was built for [Hz]
-  const char* rate_name = "";  ///< where that rate was set (a static string)
+  const char* rate_name = "";  ///< where that rate was set (a static string; nullptr or "": not said)
   ServoCommand operator()(const DeviceState& state, double dt_s) { return callback(state, dt_s); }
   [[nodiscard]] double servo_rate_hz() const noexcept { return rate_hz; }
   [[nodiscard]] const char* servo_rate_name() const noexcept { return rate_name; }
