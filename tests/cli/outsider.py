@@ -1,12 +1,34 @@
-"""What the rounds of hostile cases written from the documentation alone (test_unseen_round*.py) share.
+"""What the rounds of hostile cases written from the documentation alone (test_unseen_round*.py) share: the
+program they run (CALLIGRAPHY_CLI), its environment without a device library or a display, one way to run it,
+and the lines of its error output.
 
 Under the sanitizers (CALLIGRAPHY_SANITIZED=1, set by tests/CMakeLists.txt's add_outsider_round) each case is
 a run of the program about ten times slower, so a round runs only the few cases it names there.
 """
 import os
+import subprocess
 import unittest
 
 SANITIZED = os.environ.get("CALLIGRAPHY_SANITIZED") == "1"
+CLI = os.environ.get("CALLIGRAPHY_CLI", "")
+TIMEOUT_S = 60
+# No real device library, no display: what a command checks before it opens either shows as its exit status.
+ENV = {k: v for k, v in os.environ.items()
+       if not k.startswith("CALLIGRAPHY_LIBHD") and k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+
+
+def run(args, cwd, timeout=TIMEOUT_S, env=None, **kw):
+    """The program with `args` (text or bytes) in `cwd`, its output and errors captured, no standard input."""
+    arguments = [a if isinstance(a, bytes) else str(a) for a in args]
+    kw.setdefault("stdout", subprocess.PIPE)
+    kw.setdefault("stderr", subprocess.PIPE)
+    kw.setdefault("stdin", subprocess.DEVNULL)
+    return subprocess.run([CLI, *arguments], cwd=cwd, timeout=timeout, env=ENV if env is None else env, **kw)
+
+
+def error_lines(result):
+    """The lines the run wrote to its standard error, the blank ones at its two ends left out."""
+    return result.stderr.decode("utf-8", "replace").strip().splitlines()
 
 
 def sanitized_subset(names):

@@ -28,10 +28,10 @@ import time
 import unittest
 from pathlib import Path
 
-CLI = os.environ.get("CALLIGRAPHY_CLI", "")
+from outsider import CLI, ENV, TIMEOUT_S, error_lines, run
+
 SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 DATA = SOURCE / "data" / "hanzi-writer-data"
-TIMEOUT_S = 60
 HANG_S = 25  # a read that waits for a writer that never comes must end well before this
 SANITIZED = os.environ.get("CALLIGRAPHY_SANITIZED") == "1"
 SHI = "十"
@@ -44,21 +44,6 @@ except ImportError:  # pragma: no cover - a build without the Python bindings
     cg = None
 
 needs_python = unittest.skipIf(cg is None, "the Python package is not on PYTHONPATH")
-
-# No real device library, no display: a device named is refused for what it is, `train` runs headless.
-ENV = {k: v for k, v in os.environ.items()
-       if not k.startswith("CALLIGRAPHY_LIBHD") and k not in ("DISPLAY", "WAYLAND_DISPLAY")}
-
-
-def run(args, cwd, timeout=TIMEOUT_S, env=None, stdin=subprocess.DEVNULL, preexec_fn=None):
-    arguments = [a if isinstance(a, bytes) else str(a) for a in args]
-    return subprocess.run([CLI, *arguments], cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                          stdin=stdin, timeout=timeout, env=env if env is not None else ENV,
-                          preexec_fn=preexec_fn)
-
-
-def lines(result):
-    return [line for line in result.stderr.decode("utf-8", "replace").splitlines() if line.strip()]
 
 
 def strict_json(text):
@@ -133,7 +118,7 @@ class Base(unittest.TestCase):
         self.assertIn(result.returncode, statuses, text)
         self.assertNotIn("Traceback", text)
         self.assertNotIn("terminate called", text)
-        got = lines(result)
+        got = error_lines(result)
         self.assertEqual(len(got), 1, f"expected one error line, got {got!r}")
         self.assertIn("error", got[0])
         for needle in needles:
@@ -365,8 +350,8 @@ class TrialOutputs(Base):
         result = run(["trial", SHI, "--seed", "1", "--record", "teacher.json"], self.dir,
                      preexec_fn=file_size_limit(64 * 1024))
         self.assertEqual(result.returncode, 1, result.stderr)
-        errors = [line for line in lines(result) if "error" in line]
-        self.assertEqual(len(errors), 1, lines(result))
+        errors = [line for line in error_lines(result) if "error" in line]
+        self.assertEqual(len(errors), 1, error_lines(result))
         self.assertIn("teacher.json", errors[0])
         self.assertEqual(teacher.read_bytes(), before)
         self.assert_listing(self.dir, ["teacher.json"])
@@ -612,8 +597,8 @@ class CorpusCommands(Base):
         result = run(["corpus", "build", "--data", "data", "--out", "s.clg"], self.dir,
                      preexec_fn=file_size_limit(512))
         self.assertEqual(result.returncode, 1, result.stderr)
-        errors = [line for line in lines(result) if "error" in line]
-        self.assertEqual(len(errors), 1, lines(result))
+        errors = [line for line in error_lines(result) if "error" in line]
+        self.assertEqual(len(errors), 1, error_lines(result))
         self.assertIn("s.clg", errors[0])
         self.assertEqual((self.dir / "s.clg").read_bytes(), b"earlier store\n")
         self.assert_listing(self.dir, ["data", "s.clg"])

@@ -28,8 +28,8 @@ import time
 import unittest
 from pathlib import Path
 
-CLI = os.environ.get("CALLIGRAPHY_CLI", "")
-TIMEOUT_S = 60
+from outsider import CLI, ENV, TIMEOUT_S, error_lines, run
+
 SANITIZED = os.environ.get("CALLIGRAPHY_SANITIZED") == "1"
 SHI, REN, KOU = "十", "人", "口"
 
@@ -43,19 +43,6 @@ except ImportError:  # pragma: no cover - a build without the Python bindings
     cg_study = None
 
 needs_python = unittest.skipIf(cg is None, "the Python package is not on PYTHONPATH")
-
-ENV = {k: v for k, v in os.environ.items()
-       if not k.startswith("CALLIGRAPHY_LIBHD") and k not in ("DISPLAY", "WAYLAND_DISPLAY")}
-
-
-def run(args, cwd, timeout=TIMEOUT_S, env=None):
-    arguments = [a if isinstance(a, bytes) else str(a) for a in args]
-    return subprocess.run([CLI, *arguments], cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                          timeout=timeout, env=env or ENV)
-
-
-def error_lines(result):
-    return result.stderr.decode("utf-8", "replace").strip().splitlines()
 
 
 def tree(folder):

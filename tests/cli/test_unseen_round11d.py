@@ -27,9 +27,9 @@ import tempfile
 import unittest
 from pathlib import Path
 
-CLI = os.environ.get("CALLIGRAPHY_CLI", "")
+from outsider import CLI, ENV, TIMEOUT_S, error_lines, run
+
 SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
-TIMEOUT_S = 60
 SANITIZED = os.environ.get("CALLIGRAPHY_SANITIZED") == "1"
 SHI = "十"
 
@@ -43,8 +43,6 @@ except ImportError:  # pragma: no cover - a build without the Python bindings
     cg_study = None
 needs_python = unittest.skipIf(cg is None, "the Python bindings are not on PYTHONPATH")
 
-ENV = {k: v for k, v in os.environ.items()
-       if not k.startswith("CALLIGRAPHY_LIBHD") and k not in ("DISPLAY", "WAYLAND_DISPLAY")}
 
 # Fields whose documented maximum is the largest double: known, handled elsewhere.
 KNOWN_MAX_DOUBLE = ("box_margin_m", "tolerance")
@@ -53,12 +51,6 @@ MB50 = 50 * 1024 * 1024
 # Peak resident memory allowed for refusing a 50 MB file: the file may be read a block at a time or once, never
 # blown up into a DOM of GBs.
 RSS_BOUND_KB = 400 * 1024
-
-
-def run(args, cwd, timeout=TIMEOUT_S):
-    arguments = [a if isinstance(a, bytes) else str(a) for a in args]
-    return subprocess.run([CLI, *arguments], cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                          timeout=timeout, env=ENV)
 
 
 def run_rss(args, cwd):
@@ -71,10 +63,6 @@ def run_rss(args, cwd):
     own = [l for l in lines if l.startswith("calligraphy")]
     r = subprocess.CompletedProcess(r.args, r.returncode, r.stdout, "\n".join(own).encode())
     return r, rss[0] if rss else 0
-
-
-def error_lines(result):
-    return [l for l in result.stderr.decode("utf-8", "replace").strip().splitlines() if l.strip()]
 
 
 # What runs under the sanitizers (CALLIGRAPHY_SANITIZED=1): five cases, one run of the program or a few each.

@@ -37,12 +37,10 @@ import time
 import unittest
 from pathlib import Path
 
-from outsider import SANITIZED, sanitized_subset
+from outsider import CLI, ENV, SANITIZED, TIMEOUT_S, error_lines, run, sanitized_subset
 
-CLI = os.environ.get("CALLIGRAPHY_CLI", "")
 SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 SAMPLE = SOURCE / "tests" / "data" / "hanzi-writer-sample"
-TIMEOUT_S = 60
 SHI = "十"
 YI = "一"
 
@@ -52,17 +50,6 @@ try:
     import calligraphy as cg
 except ImportError:  # pragma: no cover - a build without the Python bindings
     cg = None
-
-# No real device library, no display: `train` cannot open its window here, so every check it makes before
-# the window shows as its own exit status.
-ENV = {k: v for k, v in os.environ.items()
-       if not k.startswith("CALLIGRAPHY_LIBHD") and k not in ("DISPLAY", "WAYLAND_DISPLAY")}
-
-
-def run(args, cwd, timeout=TIMEOUT_S, **kw):
-    arguments = [a if isinstance(a, bytes) else str(a) for a in args]
-    kw.setdefault("stdout", subprocess.PIPE)
-    return subprocess.run([CLI, *arguments], cwd=cwd, stderr=subprocess.PIPE, timeout=timeout, env=ENV, **kw)
 
 
 def run_closed_stdout(args, cwd):
@@ -79,10 +66,6 @@ def run_file_limit(args, cwd, limit_bytes):
     def limit():
         resource.setrlimit(resource.RLIMIT_FSIZE, (limit_bytes, limit_bytes))
     return run(args, cwd, preexec_fn=limit)
-
-
-def error_lines(result):
-    return result.stderr.decode("utf-8", "replace").strip().splitlines()
 
 
 def listing(folder):

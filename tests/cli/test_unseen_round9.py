@@ -23,8 +23,8 @@ import threading
 import unittest
 from pathlib import Path
 
-CLI = os.environ.get("CALLIGRAPHY_CLI", "")
-TIMEOUT_S = 60
+from outsider import CLI, ENV, TIMEOUT_S, error_lines, run
+
 SANITIZED = os.environ.get("CALLIGRAPHY_SANITIZED") == "1"
 SHI = "十"
 
@@ -36,22 +36,6 @@ try:
 except ImportError:  # pragma: no cover - a build without the Python bindings
     cg = None
     cg_study = None
-
-# Every variable that could point the program at a real device library is left out: a record naming a
-# hardware device must be refused for its content before any device is looked for.
-# `train` runs without a display here.
-ENV = {k: v for k, v in os.environ.items()
-       if not k.startswith("CALLIGRAPHY_LIBHD") and k not in ("DISPLAY", "WAYLAND_DISPLAY")}
-
-
-def run(args, cwd, timeout=TIMEOUT_S):
-    arguments = [a if isinstance(a, bytes) else str(a) for a in args]
-    return subprocess.run([CLI, *arguments], cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                          timeout=timeout, env=ENV)
-
-
-def error_lines(result):
-    return result.stderr.decode("utf-8", "replace").strip().splitlines()
 
 
 PROTOCOL = {"name": "p9", "conditions": [{"name": "h", "mode": "haptic"}, {"name": "v", "mode": "vision"}],
