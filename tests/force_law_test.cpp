@@ -59,6 +59,17 @@ TEST_CASE("Force-law parameters are validated", "[force]") {
   CHECK_THROWS_WITH(p.validate(), Catch::Contains("guidance_stiffness_n_per_m"));
 }
 
+TEST_CASE("An error names a number in its shortest form, not in six fixed decimals", "[force]") {
+  // Printed as %f, a taper of 1e300 m was a 301-digit number and a radius of 1e-9 m read "0.000000".
+  ForceLawParameters p;
+  p.constraint_taper_m = 1e300;
+  CHECK_THROWS_WITH(p.validate(), Catch::Contains("constraint_taper_m = 1e+300 m must be in"));
+  p = {};
+  p.constraint_radius_m = 1e-9;
+  p.constraint_taper_m = 2e-9;
+  CHECK_THROWS_WITH(p.validate(), Catch::Contains("= 2e-09 must not exceed constraint_radius_m = 1e-09"));
+}
+
 namespace {
 
 // What validates `object`: the force-law parameters holding it when it is a guidance law (a replay with a

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "calligraphy/analysis/metrics.hpp"
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/nearest_point.hpp"
 
@@ -11,7 +12,7 @@ namespace calligraphy {
 namespace {
 
 std::string point_text(const Vec2& p) {
-  return "(" + std::to_string(p.x()) + ", " + std::to_string(p.y()) + ")";
+  return "(" + shortest_decimal(p.x()) + ", " + shortest_decimal(p.y()) + ")";
 }
 
 }  // namespace
@@ -26,14 +27,14 @@ double deviation_from_stroke_m(std::span<const StrokeElement> reference_m, const
 
 DeviationPool::DeviationPool(double tube_radius_m) : tube_radius_m_(tube_radius_m) {
   if (!std::isfinite(tube_radius_m) || tube_radius_m < 0.0) {
-    throw InvalidArgument("DeviationPool: tube radius " + std::to_string(tube_radius_m) +
+    throw InvalidArgument("DeviationPool: tube radius " + shortest_decimal(tube_radius_m) +
                           " m is not a finite length >= 0");
   }
 }
 
 void DeviationPool::add(double deviation_m) {
   if (!std::isfinite(deviation_m) || deviation_m < 0.0) {
-    throw InvalidArgument("DeviationPool::add: deviation " + std::to_string(deviation_m) +
+    throw InvalidArgument("DeviationPool::add: deviation " + shortest_decimal(deviation_m) +
                           " m is not a finite length >= 0");
   }
   ++count_;
@@ -45,8 +46,8 @@ void DeviationPool::add(double deviation_m) {
 
 void DeviationPool::merge(const DeviationPool& other) {
   if (other.tube_radius_m_ != tube_radius_m_) {
-    throw InvalidArgument("DeviationPool::merge: tube radii differ (" + std::to_string(tube_radius_m_) +
-                          " m and " + std::to_string(other.tube_radius_m_) + " m)");
+    throw InvalidArgument("DeviationPool::merge: tube radii differ (" + shortest_decimal(tube_radius_m_) +
+                          " m and " + shortest_decimal(other.tube_radius_m_) + " m)");
   }
   count_ += other.count_;
   outside_ += other.outside_;
@@ -81,8 +82,8 @@ DeviationSummary pool_deviation_summaries(std::span<const DeviationSummary> part
       throw InvalidArgument("pool_deviation_summaries: summary " + std::to_string(i) + " has no sample");
     if (part.tube_radius_m != pooled.tube_radius_m) {
       throw InvalidArgument("pool_deviation_summaries: summary " + std::to_string(i) + " has tube radius " +
-                            std::to_string(part.tube_radius_m) + " m, the first " +
-                            std::to_string(pooled.tube_radius_m) + " m");
+                            shortest_decimal(part.tube_radius_m) + " m, the first " +
+                            shortest_decimal(pooled.tube_radius_m) + " m");
     }
     const double n = static_cast<double>(part.samples);
     pooled.samples += part.samples;

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 
 namespace calligraphy::trial_detail {
@@ -30,10 +31,10 @@ void require_bounded_cells(std::size_t rows, std::size_t columns, const char* fu
 void require_valid_options(const KinematicsOptions& options) {
   if (!std::isfinite(options.low_pass_cutoff_hz) || options.low_pass_cutoff_hz < 0.0) {
     throw InvalidArgument("KinematicsOptions: low-pass cut-off " +
-                          std::to_string(options.low_pass_cutoff_hz) + " Hz is not finite and >= 0");
+                          shortest_decimal(options.low_pass_cutoff_hz) + " Hz is not finite and >= 0");
   }
   if (!(options.peak_prominence > 0.0 && options.peak_prominence < 1.0)) {
-    throw InvalidArgument("KinematicsOptions: peak prominence " + std::to_string(options.peak_prominence) +
+    throw InvalidArgument("KinematicsOptions: peak prominence " + shortest_decimal(options.peak_prominence) +
                           " is outside (0, 1)");
   }
   if (options.max_grid_points < 16) {
@@ -45,7 +46,7 @@ void require_valid_options(const KinematicsOptions& options) {
 void require_valid_options(const CurveComparisonOptions& options) {
   if (!std::isfinite(options.reference_step_m) || options.reference_step_m <= 0.0) {
     throw InvalidArgument("CurveComparisonOptions: reference step " +
-                          std::to_string(options.reference_step_m) + " m is not a finite length > 0");
+                          shortest_decimal(options.reference_step_m) + " m is not a finite length > 0");
   }
   if (options.max_points < 2 || options.max_points > 4096) {
     throw InvalidArgument("CurveComparisonOptions: max_points " + std::to_string(options.max_points) +
@@ -55,7 +56,7 @@ void require_valid_options(const CurveComparisonOptions& options) {
 
 void require_valid_options(const MetricsOptions& options) {
   if (!std::isfinite(options.tube_radius_m) || options.tube_radius_m < 0.0) {
-    throw InvalidArgument("MetricsOptions: tube radius " + std::to_string(options.tube_radius_m) +
+    throw InvalidArgument("MetricsOptions: tube radius " + shortest_decimal(options.tube_radius_m) +
                           " m is not a finite length >= 0");
   }
   require_valid_options(options.curves);

@@ -6,6 +6,7 @@
 
 #include "analysis/input_checks.hpp"
 #include "calligraphy/analysis/metrics.hpp"
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
@@ -25,7 +26,7 @@ void check_samples(std::span<const double> times_s, std::span<const Vec2> positi
     }
     if (i > 0 && times_s[i] < times_s[i - 1]) {
       throw InvalidArgument("stroke_kinematics: time goes backwards at sample " + std::to_string(i) + " (" +
-                            std::to_string(times_s[i]) + " s after " + std::to_string(times_s[i - 1]) +
+                            shortest_decimal(times_s[i]) + " s after " + shortest_decimal(times_s[i - 1]) +
                             " s)");
     }
   }

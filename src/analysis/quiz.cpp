@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "analysis/segmentation.hpp"
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/parameter_table.hpp"
 
@@ -15,7 +16,7 @@ void QuizOptions::validate() const {
   acceptance.validate();
   if (!std::isfinite(start_radius_m) || !(start_radius_m > 0.0)) {
     throw InvalidArgument("QuizOptions::start_radius_m must be finite and > 0, got " +
-                          std::to_string(start_radius_m));
+                          shortest_decimal(start_radius_m));
   }
   const ParameterRange range = parameter_field(&StrokeAcceptance::hint_after_misses).range;
   if (hint_after_misses && !range.contains(static_cast<double>(*hint_after_misses))) {
@@ -120,7 +121,8 @@ std::vector<QuizEvent> QuizSession::feed(const PenSample& sample) {
   }
   if (index > 0 && sample.time_s < last_time_s_) {
     throw InvalidArgument("quiz: pen sample " + std::to_string(index) + " goes back in time (" +
-                          std::to_string(sample.time_s) + " s after " + std::to_string(last_time_s_) + " s)");
+                          shortest_decimal(sample.time_s) + " s after " + shortest_decimal(last_time_s_) +
+                          " s)");
   }
   ++samples_fed_;
   last_time_s_ = sample.time_s;

@@ -6,6 +6,7 @@
 #include "analysis/curve_distances.hpp"
 #include "analysis/input_checks.hpp"
 #include "calligraphy/analysis/metrics.hpp"
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
@@ -57,7 +58,7 @@ std::vector<Vec2> reference_polyline_m(std::span<const StrokeElement> reference_
                                        std::size_t max_points) {
   if (reference_m.empty()) throw InvalidArgument("reference_polyline_m: the reference stroke has no element");
   if (!std::isfinite(step_m) || step_m <= 0.0) {
-    throw InvalidArgument("reference_polyline_m: step " + std::to_string(step_m) +
+    throw InvalidArgument("reference_polyline_m: step " + shortest_decimal(step_m) +
                           " m is not a finite length > 0");
   }
   if (max_points < 2)

@@ -10,6 +10,7 @@
 #include "analysis/input_checks.hpp"
 #include "analysis/segment_metrics.hpp"
 #include "analysis/segmentation.hpp"
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
@@ -24,12 +25,12 @@ std::string character_name(char32_t code_point) {
 void check_options(const ScoreOptions& options) {
   options.acceptance.validate();
   if (!std::isfinite(options.start_radius_m) || !(options.start_radius_m > 0.0)) {
-    throw InvalidArgument("ScoreOptions: start_radius_m " + std::to_string(options.start_radius_m) +
+    throw InvalidArgument("ScoreOptions: start_radius_m " + shortest_decimal(options.start_radius_m) +
                           " m is not finite and > 0");
   }
   if (!std::isfinite(options.min_segment_length_m) || options.min_segment_length_m < 0.0) {
     throw InvalidArgument("ScoreOptions: minimum segment length " +
-                          std::to_string(options.min_segment_length_m) + " m is not finite and >= 0");
+                          shortest_decimal(options.min_segment_length_m) + " m is not finite and >= 0");
   }
   if (options.max_segments == 0) throw InvalidArgument("ScoreOptions: max_segments is 0");
   trial_detail::require_valid_options(options.metrics);

@@ -5,6 +5,7 @@
 #include <limits>
 #include <string>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
@@ -17,7 +18,7 @@ void validate_pen_trace(std::span<const PenSample> trace) {
     }
     if (i > 0 && s.time_s < trace[i - 1].time_s) {
       throw InvalidArgument("pen trace: time goes backwards at sample " + std::to_string(i) + " (" +
-                            std::to_string(s.time_s) + " s after " + std::to_string(trace[i - 1].time_s) +
+                            shortest_decimal(s.time_s) + " s after " + shortest_decimal(trace[i - 1].time_s) +
                             " s)");
     }
   }

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
@@ -29,7 +30,7 @@ void check_attempt_arguments(const char* function, std::span<const Vec2> path, d
     }
   }
   if (!(start_radius_m > 0.0) || !std::isfinite(start_radius_m)) {
-    throw InvalidArgument(std::string(function) + ": start radius " + std::to_string(start_radius_m) +
+    throw InvalidArgument(std::string(function) + ": start radius " + shortest_decimal(start_radius_m) +
                           " m must be > 0");
   }
   acceptance.validate();

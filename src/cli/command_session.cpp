@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/study/cohort.hpp"
 #include "calligraphy/study/protocol.hpp"
@@ -491,7 +492,7 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
           previous->delay = "overridden";
         } else {
           throw StateError(subjects[i].id + ": session " + std::to_string(series.next) + " of " +
-                           protocol.protocol.name + " is due " + std::to_string(previous->delay_s) +
+                           protocol.protocol.name + " is due " + shortest_decimal(previous->delay_s) +
                            " s after session " + std::to_string(series.next - 1) + " ended (" +
                            previous->ended_utc + "); " +
                            std::to_string(static_cast<long long>(previous->delay_s - previous->elapsed_s)) +

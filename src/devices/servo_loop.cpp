@@ -13,6 +13,7 @@
 #include <exception>
 #include <thread>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/servo_rate.hpp"
 #include "calligraphy/devices/device_servo_clock.hpp"
 #include "core/library_log.hpp"
@@ -132,11 +133,11 @@ void ServoLoopOptions::validate() const {
                           " must be -1 or a CPU index below " + std::to_string(CPU_SETSIZE));
   }
   if (!(max_force_age_s > 0.0 && max_force_age_s <= kMaxForceAgeLimitS)) {
-    throw InvalidArgument("ServoLoopOptions.max_force_age_s = " + std::to_string(max_force_age_s) +
+    throw InvalidArgument("ServoLoopOptions.max_force_age_s = " + shortest_decimal(max_force_age_s) +
                           " must be in (0, 1] s");
   }
   if (!(stall_timeout_s >= 0.0 && stall_timeout_s <= kMaxStallTimeoutS)) {
-    throw InvalidArgument("ServoLoopOptions.stall_timeout_s = " + std::to_string(stall_timeout_s) +
+    throw InvalidArgument("ServoLoopOptions.stall_timeout_s = " + shortest_decimal(stall_timeout_s) +
                           " must be in [0, 60] s (0: no stall bound)");
   }
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <system_error>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/corpus_store.hpp"
@@ -116,7 +117,7 @@ CharacterData CharacterLibrary::load_data(char32_t cp) const {
 
 CharacterOutlines CharacterLibrary::load_outlines(char32_t cp, double tolerance) const {
   if (!(tolerance > 0.0)) {
-    throw InvalidArgument("load_outlines: tolerance " + std::to_string(tolerance) +
+    throw InvalidArgument("load_outlines: tolerance " + shortest_decimal(tolerance) +
                           " must be > 0 data units");
   }
   if (from_bundled_store(cp)) {

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "calligraphy/core/atomic_file.hpp"
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/corpus_store.hpp"
@@ -49,7 +50,8 @@ class RecordEncoder {
     const auto q = [&](double v) {
       const double scaled = std::round(v * steps_);
       if (!std::isfinite(scaled) || std::abs(scaled) > static_cast<double>(kMaxCoordinate)) {
-        fail("stroke " + std::to_string(stroke + 1) + ": coordinate " + std::to_string(v) + " out of range");
+        fail("stroke " + std::to_string(stroke + 1) + ": coordinate " + shortest_decimal(v) +
+             " out of range");
       }
       return static_cast<std::int64_t>(scaled);
     };
@@ -165,7 +167,7 @@ class RecordEncoder {
       for (const Vec2& p : median) {
         for (double v : {p.x(), p.y()}) {
           if (!std::isfinite(v) || std::abs(v) > static_cast<double>(kMaxMedianCoordinate))
-            fail(where + ": coordinate " + std::to_string(v) + " out of range");
+            fail(where + ": coordinate " + shortest_decimal(v) + " out of range");
           out_.put(double_bits(v), 64);
         }
       }
@@ -176,7 +178,7 @@ class RecordEncoder {
       const auto round = [&](double v) {
         const double r = std::round(v * static_cast<double>(1 << shift));
         if (!std::isfinite(r) || std::abs(r) > static_cast<double>(kMaxMedianCoordinate))
-          fail(where + ": coordinate " + std::to_string(v) + " out of range");
+          fail(where + ": coordinate " + shortest_decimal(v) + " out of range");
         return static_cast<std::int64_t>(r);
       };
       points.push_back({round(p.x()), round(p.y())});

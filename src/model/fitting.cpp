@@ -11,10 +11,11 @@
 #include <numbers>
 #include <string>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/polyline.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
 #include "model/corner_search.hpp"
-#include "calligraphy/model/polyline.hpp"
 
 namespace calligraphy {
 namespace {
@@ -182,9 +183,9 @@ double stroke_deviation(std::span<const Vec2> pts, std::span<const std::size_t> 
 void check_options(const FitOptions& o) {
   if (!(o.tolerance > 0.0) || !(o.corner_angle_deg > 0.0) || !(o.corner_window > 0.0) ||
       !(o.hook_trim_length >= 0.0) || o.max_degree < 2 || o.max_degree > kMaxElementDegree) {
-    throw InvalidArgument("FitOptions out of range: tolerance " + std::to_string(o.tolerance) +
-                          ", corner angle " + std::to_string(o.corner_angle_deg) + ", window " +
-                          std::to_string(o.corner_window) + ", max degree " + std::to_string(o.max_degree) +
+    throw InvalidArgument("FitOptions out of range: tolerance " + shortest_decimal(o.tolerance) +
+                          ", corner angle " + shortest_decimal(o.corner_angle_deg) + ", window " +
+                          shortest_decimal(o.corner_window) + ", max degree " + std::to_string(o.max_degree) +
                           " (2-4)");
   }
 }
@@ -195,7 +196,8 @@ FittedStroke fit_stroke(std::span<const Vec2> median, const FitOptions& options)
   check_options(options);
   if (median.empty()) throw InvalidArgument("fit_stroke: empty median");
   for (std::size_t i = 0; i < median.size(); ++i) {
-    if (!median[i].allFinite()) throw InvalidArgument("fit_stroke: median point " + std::to_string(i) + " is not finite");
+    if (!median[i].allFinite())
+      throw InvalidArgument("fit_stroke: median point " + std::to_string(i) + " is not finite");
     if (median[i].cwiseAbs().maxCoeff() > kMaxFitCoordinate) {
       throw InvalidArgument("fit_stroke: median point " + std::to_string(i) +
                             " is beyond +-1e150 (lengths would overflow)");

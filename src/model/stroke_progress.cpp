@@ -6,6 +6,7 @@
 #include <limits>
 #include <string>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
@@ -105,7 +106,7 @@ void StrokeAcceptance::validate() const {
       throw InvalidArgument(
           "StrokeAcceptance." +
           std::string(count == hint_after_misses ? "hint_after_misses" : "assist_after_misses") + " = " +
-          std::to_string(count) + " must be a whole number");
+          shortest_decimal(count) + " must be a whole number");
     }
   }
 }

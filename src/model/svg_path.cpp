@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/model/stroke_outline.hpp"
@@ -202,14 +203,14 @@ class PathParser {
 
 std::vector<OutlinePolygon> parse_svg_path(std::string_view path, double tolerance) {
   if (!(tolerance > 0.0) || !std::isfinite(tolerance)) {
-    throw InvalidArgument("parse_svg_path: tolerance " + std::to_string(tolerance) + " must be > 0");
+    throw InvalidArgument("parse_svg_path: tolerance " + shortest_decimal(tolerance) + " must be > 0");
   }
   return PathParser(path, tolerance, true).parse();
 }
 
 std::vector<std::vector<Vec2>> parse_svg_polylines(std::string_view path, double tolerance) {
   if (!(tolerance > 0.0) || !std::isfinite(tolerance)) {
-    throw InvalidArgument("parse_svg_polylines: tolerance " + std::to_string(tolerance) + " must be > 0");
+    throw InvalidArgument("parse_svg_polylines: tolerance " + shortest_decimal(tolerance) + " must be > 0");
   }
   return PathParser(path, tolerance, false).parse();
 }

@@ -84,8 +84,8 @@ void ForceLawParameters::validate() const {
   // A replay's or timing target's attraction point must stay within R_res of the pen.
   validate_guidance_law(guidance_law, constraint_radius_m);
   if (constraint_taper_m > constraint_radius_m) {
-    throw InvalidArgument("ForceLawParameters.constraint_taper_m = " + std::to_string(constraint_taper_m) +
-                          " must not exceed constraint_radius_m = " + std::to_string(constraint_radius_m));
+    throw InvalidArgument("ForceLawParameters.constraint_taper_m = " + shortest_decimal(constraint_taper_m) +
+                          " must not exceed constraint_radius_m = " + shortest_decimal(constraint_radius_m));
   }
   if (!kForceLawNearestToleranceRange.contains(nearest.tolerance)) {
     throw InvalidArgument("ForceLawParameters.nearest.tolerance = " + shortest_decimal(nearest.tolerance) +

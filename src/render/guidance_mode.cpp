@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
@@ -84,8 +85,8 @@ void validate_teacher_trajectory(std::span<const TeacherSample> samples) {
     }
     if (i > 0 && samples[i].time_s < samples[i - 1].time_s) {
       throw InvalidArgument("teacher trajectory: sample " + std::to_string(i) + " at " +
-                            std::to_string(samples[i].time_s) + " s comes before the previous sample at " +
-                            std::to_string(samples[i - 1].time_s) + " s");
+                            shortest_decimal(samples[i].time_s) + " s comes before the previous sample at " +
+                            shortest_decimal(samples[i - 1].time_s) + " s");
     }
   }
 }
@@ -95,10 +96,10 @@ void FadingRule::validate() const { check_parameters(*this); }
 double next_guidance_gain(double gain, double error_m, const FadingRule& rule) {
   rule.validate();
   if (!(gain >= 0.0 && gain <= 1.0)) {
-    throw InvalidArgument("next_guidance_gain: gain = " + std::to_string(gain) + " must be in [0, 1]");
+    throw InvalidArgument("next_guidance_gain: gain = " + shortest_decimal(gain) + " must be in [0, 1]");
   }
   if (!(error_m >= 0.0) || !std::isfinite(error_m)) {
-    throw InvalidArgument("next_guidance_gain: error_m = " + std::to_string(error_m) +
+    throw InvalidArgument("next_guidance_gain: error_m = " + shortest_decimal(error_m) +
                           " must be finite and >= 0");
   }
   return std::clamp(rule.forgetting_factor * gain + rule.error_gain_per_m * error_m, 0.0, 1.0);
@@ -108,7 +109,7 @@ namespace {
 
 void check_length(double value, const char* name, bool positive) {
   if (!std::isfinite(value) || value < 0.0 || (positive && value == 0.0)) {
-    throw InvalidArgument(std::string(name) + " = " + std::to_string(value) +
+    throw InvalidArgument(std::string(name) + " = " + shortest_decimal(value) +
                           (positive ? " must be finite and > 0" : " must be finite and >= 0"));
   }
 }
@@ -118,8 +119,8 @@ void check_length(double value, const char* name, bool positive) {
 void AssistBandRule::validate() const {
   check_parameters(*this);
   if (max_band_m < min_band_m) {
-    throw InvalidArgument("AssistBandRule.max_band_m = " + std::to_string(max_band_m) +
-                          " must be >= min_band_m = " + std::to_string(min_band_m));
+    throw InvalidArgument("AssistBandRule.max_band_m = " + shortest_decimal(max_band_m) +
+                          " must be >= min_band_m = " + shortest_decimal(min_band_m));
   }
 }
 

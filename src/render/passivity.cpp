@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "core/rate_text.hpp"
 
@@ -14,7 +15,7 @@ double colgate_stiffness_bound(double device_damping_n_s_per_m, double rate_hz,
                                double virtual_damping_n_s_per_m) {
   if (!std::isfinite(device_damping_n_s_per_m) || device_damping_n_s_per_m < 0.0) {
     throw InvalidArgument("colgate_stiffness_bound: device damping " +
-                          std::to_string(device_damping_n_s_per_m) + " N s/m must be finite and >= 0");
+                          shortest_decimal(device_damping_n_s_per_m) + " N s/m must be finite and >= 0");
   }
   if (!std::isfinite(rate_hz) || !(rate_hz > 0.0)) {
     throw InvalidArgument("colgate_stiffness_bound: rate " + detail::rate_text(rate_hz) +
@@ -22,7 +23,7 @@ double colgate_stiffness_bound(double device_damping_n_s_per_m, double rate_hz,
   }
   if (!std::isfinite(virtual_damping_n_s_per_m) || virtual_damping_n_s_per_m < 0.0) {
     throw InvalidArgument("colgate_stiffness_bound: virtual damping " +
-                          std::to_string(virtual_damping_n_s_per_m) + " N s/m must be finite and >= 0");
+                          shortest_decimal(virtual_damping_n_s_per_m) + " N s/m must be finite and >= 0");
   }
   return std::max(0.0, 2.0 * (device_damping_n_s_per_m - virtual_damping_n_s_per_m) * rate_hz);
 }

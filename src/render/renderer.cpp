@@ -7,6 +7,7 @@
 #include <string>
 
 #include "calligraphy/collision/constraint_space.hpp"
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/servo_rate.hpp"
 #include "core/library_log.hpp"
@@ -46,7 +47,7 @@ SafetyChainParameters chain_parameters(const RendererOptions& options, const Dev
 const DeviceInfo& checked(const DeviceInfo& device) {
   if (!(device.max_force_n > 0.0) || !std::isfinite(device.max_force_n)) {
     throw InvalidArgument("Renderer: device '" + device.model + "' max_force_n = " +
-                          std::to_string(device.max_force_n) + " must be finite and > 0");
+                          shortest_decimal(device.max_force_n) + " must be finite and > 0");
   }
   return device;
 }
@@ -104,7 +105,7 @@ Renderer::Renderer(const Scene& scene, const Checked<ForceLawParameters>& parame
   }
   const double b_device = device.intrinsic_damping_n_s_per_m;
   if (!std::isfinite(b_device) || b_device < 0.0) {
-    throw InvalidArgument("DeviceInfo.intrinsic_damping_n_s_per_m = " + std::to_string(b_device) +
+    throw InvalidArgument("DeviceInfo.intrinsic_damping_n_s_per_m = " + shortest_decimal(b_device) +
                           " must be finite and >= 0");
   }
   if (b_device > 0.0) {

@@ -6,6 +6,7 @@
 #include <numbers>
 #include <string>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "core/rate_text.hpp"
 
@@ -64,8 +65,8 @@ void SafetyChainParameters::validate() const {
   check_parameters(*this);
   if (max_force_n > 0.0 && max_continuous_force_n > max_force_n) {
     throw InvalidArgument(
-        "SafetyChainParameters.max_continuous_force_n = " + std::to_string(max_continuous_force_n) +
-        " must not exceed max_force_n = " + std::to_string(max_force_n));
+        "SafetyChainParameters.max_continuous_force_n = " + shortest_decimal(max_continuous_force_n) +
+        " must not exceed max_force_n = " + shortest_decimal(max_force_n));
   }
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
@@ -22,7 +23,7 @@ double minimum_jerk(double u) noexcept {
 
 TimingTarget::TimingTarget(const Scene& scene, double mean_speed_m_s) {
   if (!(mean_speed_m_s > 0.0) || !std::isfinite(mean_speed_m_s)) {
-    throw InvalidArgument("TimingTarget: mean_speed_m_s = " + std::to_string(mean_speed_m_s) +
+    throw InvalidArgument("TimingTarget: mean_speed_m_s = " + shortest_decimal(mean_speed_m_s) +
                           " must be finite and > 0");
   }
   for (const PlacedCharacter& character : scene.characters) {

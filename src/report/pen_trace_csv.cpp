@@ -99,7 +99,7 @@ class Reader {
     }
     if (samples_ > 0 && current.sample.time_s < previous_.time_s) {
       fail(columns_->t, fields[columns_->t],
-           "time goes backwards (previous sample at " + std::to_string(previous_.time_s) + " s)");
+           "time goes backwards (previous sample at " + shortest_decimal(previous_.time_s) + " s)");
     }
     ++samples_;
     previous_ = current.sample;
@@ -325,10 +325,10 @@ std::size_t count_lines(std::string_view text) {
 void check_options(const PenTraceCsvOptions& options, const Placement& placement) {
   if (!std::isfinite(options.contact_threshold_m)) {
     throw InvalidArgument("PenTraceCsvOptions: contact threshold " +
-                          std::to_string(options.contact_threshold_m) + " m is not finite");
+                          shortest_decimal(options.contact_threshold_m) + " m is not finite");
   }
   if (!std::isfinite(options.paper_z_m)) {
-    throw InvalidArgument("PenTraceCsvOptions: paper height " + std::to_string(options.paper_z_m) +
+    throw InvalidArgument("PenTraceCsvOptions: paper height " + shortest_decimal(options.paper_z_m) +
                           " m is not finite");
   }
   if (options.max_file_bytes == 0) throw InvalidArgument("PenTraceCsvOptions: max_file_bytes is 0");
@@ -339,7 +339,8 @@ void check_options(const PenTraceCsvOptions& options, const Placement& placement
   if (options.units == TraceUnits::data &&
       (!placement.origin_m.allFinite() || !std::isfinite(placement.metres_per_unit) ||
        !(placement.metres_per_unit > 0.0))) {
-    throw InvalidArgument("parse_pen_trace_csv: the placement (" + std::to_string(placement.metres_per_unit) +
+    throw InvalidArgument("parse_pen_trace_csv: the placement (" +
+                          shortest_decimal(placement.metres_per_unit) +
                           " m per unit) cannot convert data units to metres");
   }
 }
@@ -373,7 +374,7 @@ void for_each_trace_hdf5_row(const TraceColumns& c, const std::string& source, c
   for (std::size_t i = 0; i < c.size(); ++i) {
     const bool was_down = s.pen_down;
     if (i > 0 && c.time_s[i] < s.time_s)
-      fail(i, "time goes backwards (previous sample at " + std::to_string(s.time_s) + " s)");
+      fail(i, "time goes backwards (previous sample at " + shortest_decimal(s.time_s) + " s)");
     s.time_s = c.time_s[i];
     const Vec2 xy(c.x_m[i], c.y_m[i]);
     s.position_m = options.units == TraceUnits::data ? placement.to_paper(xy) : xy;

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
@@ -31,7 +32,7 @@ double retention_scaled(double retention, double factor) { return 1.0 - (1.0 - r
 
 void check_factor(double value, const char* name) {
   if (!std::isfinite(value) || !(value > 0.0)) {
-    throw InvalidArgument(std::string("SubjectTraits.") + name + " = " + std::to_string(value) +
+    throw InvalidArgument(std::string("SubjectTraits.") + name + " = " + shortest_decimal(value) +
                           " must be finite and > 0");
   }
 }

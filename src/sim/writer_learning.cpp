@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
@@ -33,7 +34,7 @@ RepetitionOutcome RepetitionOutcome::from_log(const WriterLog& log, double guida
 
 void RepetitionOutcome::validate() const {
   if (!(guidance_share >= 0.0 && guidance_share <= 1.0)) {
-    throw InvalidArgument("RepetitionOutcome.guidance_share = " + std::to_string(guidance_share) +
+    throw InvalidArgument("RepetitionOutcome.guidance_share = " + shortest_decimal(guidance_share) +
                           " must be in [0, 1]");
   }
   if (refused_out_of_order > out_of_order_attempts || refused_backwards > backwards_attempts) {

@@ -7,6 +7,7 @@
 #include <string>
 #include <utility>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
@@ -43,7 +44,7 @@ double blend(double own, double skilled, double skill) { return own + (skilled -
 
 void check_skill(double skill, const char* name) {
   if (!(skill >= 0.0 && skill <= 1.0)) {
-    throw InvalidArgument(std::string("learned_profile: ") + name + " skill " + std::to_string(skill) +
+    throw InvalidArgument(std::string("learned_profile: ") + name + " skill " + shortest_decimal(skill) +
                           " outside [0, 1]");
   }
 }
@@ -86,11 +87,11 @@ void TwoStateRates::validate() const {
   check_parameters(*this);
   // The rules between fields: the slow state retains more and learns less than the fast one.
   if (!(slow_retention > fast_retention)) {
-    throw InvalidArgument("TwoStateRates.slow_retention = " + std::to_string(slow_retention) +
+    throw InvalidArgument("TwoStateRates.slow_retention = " + shortest_decimal(slow_retention) +
                           " must be in (fast_retention, 1)");
   }
   if (!(slow_learning < fast_learning)) {
-    throw InvalidArgument("TwoStateRates.slow_learning = " + std::to_string(slow_learning) +
+    throw InvalidArgument("TwoStateRates.slow_learning = " + shortest_decimal(slow_learning) +
                           " must be in (0, fast_learning)");
   }
 }
@@ -100,14 +101,14 @@ double SkillMemory::skill() const noexcept { return std::clamp(fast + slow, 0.0,
 double guidance_assistance_share(double gain, double guidance_stiffness_n_per_m,
                                  double hand_stiffness_n_per_m) {
   if (!(gain >= 0.0 && gain <= 1.0)) {
-    throw InvalidArgument("guidance gain " + std::to_string(gain) + " outside [0, 1]");
+    throw InvalidArgument("guidance gain " + shortest_decimal(gain) + " outside [0, 1]");
   }
   if (!(guidance_stiffness_n_per_m >= 0.0) || !std::isfinite(guidance_stiffness_n_per_m)) {
-    throw InvalidArgument("guidance stiffness " + std::to_string(guidance_stiffness_n_per_m) +
+    throw InvalidArgument("guidance stiffness " + shortest_decimal(guidance_stiffness_n_per_m) +
                           " N/m must be finite and >= 0");
   }
   if (!(hand_stiffness_n_per_m > 0.0) || !std::isfinite(hand_stiffness_n_per_m)) {
-    throw InvalidArgument("hand stiffness " + std::to_string(hand_stiffness_n_per_m) +
+    throw InvalidArgument("hand stiffness " + shortest_decimal(hand_stiffness_n_per_m) +
                           " N/m must be finite and > 0");
   }
   const double guide = gain * guidance_stiffness_n_per_m;
@@ -119,14 +120,15 @@ void practise(WriterMemory& memory, const std::vector<int>& typical_ids, const s
   rates.validate();
   for (const auto& [name, share] : {std::pair{"shape", shares.shape}, std::pair{"timing", shares.timing}}) {
     if (!(share >= kMinAssistanceShare && share <= 1.0)) {
-      throw InvalidArgument(std::string("practise: ") + name + " assistance share " + std::to_string(share) +
-                            " outside [" + std::to_string(kMinAssistanceShare) + ", 1]");
+      throw InvalidArgument(std::string("practise: ") + name + " assistance share " +
+                            shortest_decimal(share) + " outside [" + shortest_decimal(kMinAssistanceShare) +
+                            ", 1]");
     }
   }
   // x(n+1) = A x(n) + B e(n), e(n) from the skill before the trial; a stroke type written k times learns k
   // times from that error.
   if (!(shares.timing_demonstration >= 0.0 && shares.timing_demonstration <= 1.0)) {
-    throw InvalidArgument("practise: timing demonstration " + std::to_string(shares.timing_demonstration) +
+    throw InvalidArgument("practise: timing demonstration " + shortest_decimal(shares.timing_demonstration) +
                           " outside [0, 1]");
   }
   std::map<int, double> shape_errors;

@@ -5,6 +5,7 @@
 #include <limits>
 #include <string>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
@@ -51,13 +52,13 @@ AssistanceShares guidance_shares(const ForceLawParameters& force, double hand_st
   force.validate();
   const double k = hand_stiffness_n_per_m;
   if (!(k > 0.0) || !std::isfinite(k)) {
-    throw InvalidArgument("guidance_shares: hand stiffness " + std::to_string(k) +
+    throw InvalidArgument("guidance_shares: hand stiffness " + shortest_decimal(k) +
                           " N/m must be finite and > 0");
   }
   const double e = mean_deviation_m;
   const bool written = !std::isnan(e);
   if (written && (!(e >= 0.0) || !std::isfinite(e))) {
-    throw InvalidArgument("guidance_shares: mean deviation " + std::to_string(e) +
+    throw InvalidArgument("guidance_shares: mean deviation " + shortest_decimal(e) +
                           " m must be finite and >= 0");
   }
   if (!force.guidance) return {};

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/servo_rate.hpp"
 #include "core/rate_text.hpp"
@@ -19,13 +20,14 @@ void TrialOptions::validate() const {
                           servo_rate_range_text(real_time) + (real_time ? " in real time" : ""));
   }
   if (!(max_duration_s > 0.0) || !std::isfinite(max_duration_s)) {
-    throw InvalidArgument("TrialOptions.max_duration_s = " + std::to_string(max_duration_s) + " must be > 0");
+    throw InvalidArgument("TrialOptions.max_duration_s = " + shortest_decimal(max_duration_s) +
+                          " must be > 0");
   }
   // The trace is held in memory, one sample a tick (reserved up front in real time): a duration of 1e308 s
   // would be refused by the allocator, not by its field.
   if (exceeds_trial_ticks(max_duration_s, rate_hz)) {
     std::string message = "TrialOptions.max_duration_s = ";
-    message.append(std::to_string(max_duration_s))
+    message.append(shortest_decimal(max_duration_s))
         .append(" s at ")
         .append(detail::rate_text(rate_hz))
         .append(" is more than a trial's limit of 10^7 ticks (kMaxTrialTicks)");

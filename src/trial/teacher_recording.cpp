@@ -3,6 +3,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "core/json_document.hpp"
 #include "core/whole_file.hpp"
@@ -116,7 +117,7 @@ TeacherRecording parse_teacher_recording(std::string_view json_text, const std::
   recording.samples.reserve(t.size());
   for (std::size_t i = 0; i < t.size(); ++i) {
     if (i > 0 && t[i] < t[i - 1]) {
-      fail(source, "/samples/t_s/" + std::to_string(i) + ": time " + std::to_string(t[i]) +
+      fail(source, "/samples/t_s/" + std::to_string(i) + ": time " + shortest_decimal(t[i]) +
                        " s is below the previous one");
     }
     recording.samples.push_back({t[i], Vec3(x[i], y[i], z[i])});

@@ -192,7 +192,7 @@ void set_writer_parameter(WriterProfile& profile, std::string_view key, double v
   WriterProfile changed = profile;
   if (key == kAttemptsKey) {
     if (!std::isfinite(value) || value != std::floor(value) || std::abs(value) > 1e9) {
-      throw InvalidArgument("writer parameter max_attempts_per_stroke = " + std::to_string(value) +
+      throw InvalidArgument("writer parameter max_attempts_per_stroke = " + shortest_decimal(value) +
                             " must be a whole number");
     }
     changed.max_attempts_per_stroke = static_cast<int>(value);

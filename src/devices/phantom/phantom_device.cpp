@@ -1,13 +1,13 @@
 #include "devices/phantom/phantom_device.hpp"
 
-#include "core/library_log.hpp"
-
 #include <string>
 #include <utility>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/force_limits.hpp"
 #include "calligraphy/devices/phantom_models.hpp"
+#include "core/library_log.hpp"
 
 namespace calligraphy::phantom {
 namespace {
@@ -38,7 +38,7 @@ PhantomDeviceConfig validated(PhantomDeviceConfig config) {
 
 std::string describe(const PhantomFaultRecord& record) {
   if (record.fault == DeviceFault::none) return {};
-  std::string text = "at " + std::to_string(record.time_s) + " s";
+  std::string text = "at " + shortest_decimal(record.time_s) + " s";
   if (record.bad_reads > 0) {
     text +=
         "; " + std::to_string(record.bad_reads) + " reads in a row without a valid status packet, the last ";
@@ -74,7 +74,8 @@ PhantomDevice::PhantomDevice(std::unique_ptr<devices::ByteTransport> transport, 
 PhantomDevice::~PhantomDevice() { close(); }
 
 void PhantomDevice::log_start_up() const {
-  calligraphy::detail::library_log().info("Phantom: opening {} on {}", config_.info.model, transport_->description());
+  calligraphy::detail::library_log().info("Phantom: opening {} on {}", config_.info.model,
+                                          transport_->description());
   calligraphy::detail::library_log().info(
       "Phantom: verified (by tests, against published sources): the packet codec against the FireWire Omni "
       "field list of raw_omni / phantom-drivers (field order and byte order are this library's choice, see "
@@ -110,15 +111,17 @@ void PhantomDevice::open() {
   if (is_calibrated()) {
     calligraphy::detail::library_log().info("Phantom: homed from the inkwell (docked bit set)");
   } else {
-    calligraphy::detail::library_log().warn("Phantom: not calibrated: put the stylus in the inkwell and call calibrate()");
+    calligraphy::detail::library_log().warn(
+        "Phantom: not calibrated: put the stylus in the inkwell and call calibrate()");
   }
 }
 
 void PhantomDevice::close() noexcept {
   if (fault_record_.fault != DeviceFault::none) {
     try {  // the servo path kept the fault as plain data; it is worded here, off the servo thread
-      calligraphy::detail::library_log().warn("Phantom: last fault: {} ({}): {}", device_fault_name(fault_record_.fault),
-                   describe(fault_record_), to_string(fault_record_.fault));
+      calligraphy::detail::library_log().warn("Phantom: last fault: {} ({}): {}",
+                                              device_fault_name(fault_record_.fault), describe(fault_record_),
+                                              to_string(fault_record_.fault));
     } catch (...) {
       // Logging must not turn close() into a throwing call.
     }
