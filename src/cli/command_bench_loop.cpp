@@ -5,7 +5,9 @@
 #include <memory>
 #include <string>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/servo_rate.hpp"
+#include "calligraphy/trial/options.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 #include "cli/output.hpp"
@@ -49,7 +51,15 @@ int run_loop(const LoopCommand& command) {
   // The stall bound in periods; off by default so that the whole run is measured (the worst lateness shows
   // in wake_latency_us_max and longest_stall).
   loop.stall_timeout_s = static_cast<double>(command.watchdog_periods) / loop.rate_hz;
-  if (!command.trial.empty()) settings.trial_characters = characters_from(command.trial, "--trial");
+  if (!command.trial.empty()) {
+    // The trial holds its trace in memory: named by the options given, not by the trial runner's field.
+    if (exceeds_trial_ticks(command.seconds, command.rate_hz)) {
+      throw UsageError("--seconds " + shortest_decimal(command.seconds) + " at --rate " +
+                       shortest_decimal(command.rate_hz) +
+                       " is more than 10^7 servo ticks, a trial's limit (--trial)");
+    }
+    settings.trial_characters = characters_from(command.trial, "--trial");
+  }
   // A stop signal ends the run early; its statistics are still printed.
   const StopSignals stop_signals;
   settings.should_stop = StopSignals::stop_requested();
@@ -73,8 +83,11 @@ void add_bench_loop_command(CLI::App& bench, Commands& commands) {
   add_number(*app, "--rate", command->rate_hz, "HZ", "servo rate [Hz]",
              "a rate in " + servo_rate_range_text(true),
              [](double hz) { return servo_rate_allowed(hz, true); });
-  add_number(*app, "--seconds", command->seconds, "S", "how long to run; the trial's time limit [s]",
-             "a number of seconds > 0", [](double s) { return s > 0.0; });
+  // A day at most, as a trial (kMaxTrialDurationS): the run's end is a clock reading that must not overflow.
+  add_number(
+      *app, "--seconds", command->seconds, "S",
+      "how long to run; the trial's time limit [s, (0, 86400]]; with --trial, at most 10^7 ticks at --rate",
+      "a number of seconds in (0, 86400]", [](double s) { return s > 0.0 && s <= kMaxTrialDurationS; });
   add_choice(
       *app, "--realtime", command->realtime, {"enforce", "ignore", "off"},
       "enforce: fail unless every realtime setting is obtained; ignore: try them; off: a plain thread");

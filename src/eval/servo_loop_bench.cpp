@@ -6,11 +6,12 @@
 #include <thread>
 #include <vector>
 
-#include "calligraphy/sim/simulated_hand.hpp"
-#include "calligraphy/model/scene.hpp"
-#include "calligraphy/devices/simulated_device.hpp"
-#include "calligraphy/trial/trial.hpp"
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/unicode.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
+#include "calligraphy/model/scene.hpp"
+#include "calligraphy/sim/simulated_hand.hpp"
+#include "calligraphy/trial/trial.hpp"
 #include "report/appendf.hpp"
 
 namespace calligraphy::cli {
@@ -117,7 +118,8 @@ std::string loop_bench_json(const LoopBenchResult& result, const LoopBenchSettin
 std::string loop_bench_text(const LoopBenchResult& result, const LoopBenchSettings& settings) {
   const ServoLoopStats& s = result.stats;
   std::string out;
-  appendf(out, "servo loop at %.0f Hz for %.1f s\n", s.rate_hz, settings.seconds);
+  out += "servo loop at " + shortest_decimal(s.rate_hz) + " Hz for " + shortest_decimal(settings.seconds) +
+         " s\n";
   appendf(out, "  ticks                  %llu\n", static_cast<unsigned long long>(s.ticks));
   appendf(out, "  missed_deadlines       %llu (skipped periods %llu)\n",
           static_cast<unsigned long long>(s.missed_deadlines),

@@ -166,6 +166,11 @@ class StrictOptions(CliTestCase):
         self.assert_usage_error(["trial", "乙", "--rate", "nan"], "--rate")
         self.assert_usage_error(["trial", "乙", "--pacing", "real-time", "--watchdog-ms", "1.5"], "--watchdog-ms")
         self.assert_usage_error(["bench", "loop", "--cpu", "-2"], "--cpu")
+        # The run's end is a clock reading: 1e308 s would overflow it (and ran until stopped).
+        self.assert_usage_error(["bench", "loop", "--seconds", "1e308"], "--seconds")
+        self.assert_usage_error(["bench", "loop", "--seconds", "86400.5"], "--seconds")
+        # With a trial, its 10^7-tick limit, named by the options given.
+        self.assert_usage_error(["bench", "loop", "--trial", "乙", "--seconds", "20000"], "--seconds")
 
     def test_negative_integer_where_allowed(self):
         result = self.run_cli("bench", "loop", "--seconds", "0.05", "--cpu", "-1", "--realtime", "off", "--json")

@@ -692,7 +692,7 @@ DOC_BOUNDS = {
     ("bench tick", "--passes"): (1, True, 1000, True, True),
     ("bench tick", "--rate"): (100, True, 100000, True, False),
     ("bench loop", "--rate"): (100, True, 10000, True, False),
-    ("bench loop", "--seconds"): (0, False, None, False, False),
+    ("bench loop", "--seconds"): (0, False, 86400, True, False),
     ("bench loop", "--priority"): (0, True, 99, True, True),
     ("bench loop", "--cpu"): (-1, True, 1023, True, True),
     ("bench loop", "--watchdog-periods"): (0, True, 10 ** 6, True, True),
