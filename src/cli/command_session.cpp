@@ -259,6 +259,9 @@ std::vector<std::string> split_profiles(const std::string& text) {
 }
 
 int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
+  // From the start: a signal while the study's folders and files are made is seen before the first trial,
+  // and a file being written is finished, not cut (docs/cli.md, "session run | resume").
+  install_stop_handlers();
 #ifdef CALLIGRAPHY_WITH_TRAINER
   if (command.display.display == "window") trainer::register_trainer_devices(devices);  // mouse, mouse-hand
 #endif
@@ -438,7 +441,6 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
   std::fputs(session_plan_text(resolved, subjects, study).c_str(), stderr);
   std::fflush(stderr);
 
-  install_stop_handlers();
   TerminalHost host;
   std::shared_ptr<CharacterSource> source;
   const SessionRunOptions options = run_options(devices, command.library, person ? &host : nullptr, source);
@@ -446,7 +448,12 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
     // The subject's series: a simulated subject writes every remaining session in a row (the delays taken
     // as passed), a person the next one, when its delay has passed.
     while (true) {
-      if (stop_requested()) return 128 + stop_signal();
+      if (stop_requested()) {
+        print_error_line("calligraphy session run", "error",
+                         subjects[i].id + ": stopped by " + signal_name(stop_signal()) +
+                             " before its session began; nothing written for it");
+        return 128 + stop_signal();
+      }
       // Held until this session is written: another run of the subject waits, then sees it.
       std::optional<SeriesLock> lock;
       {
@@ -513,6 +520,7 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
 }
 
 int resume_session(const SessionResumeCommand& command, DeviceRegistry& devices) {
+  install_stop_handlers();  // from the start, as `session run`
 #ifdef CALLIGRAPHY_WITH_TRAINER
   if (command.display.display == "window") trainer::register_trainer_devices(devices);
 #endif
@@ -547,7 +555,6 @@ int resume_session(const SessionResumeCommand& command, DeviceRegistry& devices)
   }
   check_not_followed(session);
   session.check_writable();  // before the first trial: a folder no trial could be saved in
-  install_stop_handlers();
   TerminalHost host;
   std::shared_ptr<CharacterSource> source;
   SessionRunOptions options = run_options(
