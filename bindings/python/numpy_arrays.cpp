@@ -48,6 +48,11 @@ void check_real_numbers(py::handle object, const std::string& name) {
     throw InvalidArgument(name + " holds " + std::string(py::str(array.dtype())) +
                           " values, not real numbers");
   }
+  if (kind == 'm' || kind == 'M') {  // cast to float64 as counts of their unit: nanoseconds for pandas' times
+    throw InvalidArgument(
+        name + " holds " + std::string(py::str(array.dtype())) +
+        " values, not real numbers (give times in seconds, e.g. Series.dt.total_seconds())");
+  }
   if (kind == 'O') {
     for (const py::handle item : array.attr("ravel")()) {
       if (PyUnicode_Check(item.ptr()) || PyBytes_Check(item.ptr()) || PyComplex_Check(item.ptr())) {

@@ -27,8 +27,9 @@ py::array_t<double> to_array(const Vec3& v);
 py::array_t<double> read_only(py::array_t<double> array);
 
 /// InvalidArgument "<name> holds <dtype> values, not real numbers" for what numpy's forcecast to float64
-/// would misread: complex numbers (their real part taken) and text (parsed as numbers), as a numpy array of
-/// strings or an object array (a pandas column of str) holding any. Nothing for anything else: the
+/// would misread: complex numbers (their real part taken), text (parsed as numbers), as a numpy array of
+/// strings or an object array (a pandas column of str) holding any, and times and dates (counts of their
+/// unit: a pandas Timedelta column in nanoseconds). Nothing for anything else: the
 /// conversion itself says what else is wrong.
 void check_real_numbers(py::handle object, const std::string& name);
 

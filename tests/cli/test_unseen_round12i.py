@@ -323,6 +323,22 @@ class ScoreFrames(Case):
             self.assertEqual(status, 0, "the CLI refused what Python scored: %s" % lines)
             self.assert_same_record(without(got, "trace", "samples"), without(record, "trace", "samples"))
 
+    def test_times_as_timedeltas_or_dates_are_refused_naming_the_column(self):
+        # pandas' own time types (pd.to_timedelta(t, unit="s"), a time stamp per sample) cast to float64 as
+        # nanoseconds: read so, the trace would last a billion times longer. Refused naming the column, as
+        # `score` refuses any column that is no real numbers; in seconds as floats, the same trace.
+        frame = self.frame()
+        since_start = pd.to_timedelta(frame["t_s"], unit="s")
+        for name, times in (("timedelta", since_start), ("datetime", pd.Timestamp("2026-11-27") + since_start)):
+            with self.subTest(times=name):
+                with self.assertRaises(ValueError) as caught:
+                    cg.score(frame.assign(t_s=times), SHI)
+                self.assertIn("'t_s'", str(caught.exception))
+        seconds = frame.assign(t_s=since_start.dt.total_seconds())
+        self.assert_same_record(without(cg.score(seconds, SHI), "trace"), without(cg.score(frame, SHI), "trace"))
+        self.assert_named(cg.InvalidArgument, "distance_m", cg.constraint_taper,
+                          np.array([1, 2], dtype="m8[ms]"), 0.002, 0.001)
+
     def test_categorical_and_text_pen_columns(self):
         columns = pen_columns(self.shared)
         expected = cg.score(columns, SHI)
