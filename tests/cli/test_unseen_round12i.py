@@ -807,7 +807,8 @@ class Concurrency(Case):
         with concurrent.futures.ThreadPoolExecutor(max_workers=2) as pool:
             expected = sweep([SHI, "é"], grid, 1, client=pool, progress=False)
         with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None,
-                                      silence_logs=logging.ERROR) as cluster, distributed.Client(cluster) as client:
+                                      silence_logs=logging.ERROR, local_directory=str(self.tmp)) as cluster, \
+                distributed.Client(cluster) as client:
             table = sweep([SHI, "é"], grid, 1, client=client, progress=False)
         pd.testing.assert_frame_equal(table, expected)
         self.assertEqual(table["error"].notna().sum(), 2)
