@@ -155,6 +155,10 @@ T convert_named(py::handle value, const std::string& name) {
   } catch (const py::cast_error&) {
     if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
       if (PyLong_Check(value.ptr())) throw_out_of_range<T>(name, value);
+      // A numpy integer (numpy.int64(-1) from numpy.arange) is an int out of range as well, not a value of
+      // another type (numpy.bool_ and numpy's floats are no numbers.Integral).
+      if (py::isinstance(value, py::module_::import("numbers").attr("Integral")))
+        throw_out_of_range<T>(name, py::int_(py::reinterpret_borrow<py::object>(value)));
     }
     if constexpr (std::is_same_v<T, std::string>) {
       // A str that UTF-8 cannot encode ('\ud800', a lone surrogate) is of the right type and a wrong value.

@@ -40,12 +40,35 @@ py::array_t<double> read_only(py::array_t<double> array) {
   return array;
 }
 
+void check_real_numbers(py::handle object, const std::string& name) {
+  const py::array array = py::array::ensure(object);
+  if (!array) return;
+  const char kind = array.dtype().kind();
+  if (kind == 'c' || kind == 'U' || kind == 'S') {
+    throw InvalidArgument(name + " holds " + std::string(py::str(array.dtype())) +
+                          " values, not real numbers");
+  }
+  if (kind == 'm' || kind == 'M') {  // cast to float64 as counts of their unit: nanoseconds for pandas' times
+    throw InvalidArgument(
+        name + " holds " + std::string(py::str(array.dtype())) +
+        " values, not real numbers (give times in seconds, e.g. Series.dt.total_seconds())");
+  }
+  if (kind == 'O') {
+    for (const py::handle item : array.attr("ravel")()) {
+      if (PyUnicode_Check(item.ptr()) || PyBytes_Check(item.ptr()) || PyComplex_Check(item.ptr())) {
+        throw InvalidArgument(name + " holds " + short_repr(item) + ", not a real number");
+      }
+    }
+  }
+}
+
 namespace {
 
 Array to_float_array(py::handle object, const std::string& name) {
   if (py::isinstance<py::str>(object) || py::isinstance<py::bytes>(object) || object.is_none()) {
     throw_type_error(name, "an array of numbers", object);
   }
+  check_real_numbers(object, name);
   Array array = Array::ensure(object);
   if (!array) {
     PyErr_Clear();

@@ -26,6 +26,13 @@ py::array_t<double> to_array(const Vec3& v);
 /// change nothing, so it must not look as if it did).
 py::array_t<double> read_only(py::array_t<double> array);
 
+/// InvalidArgument "<name> holds <dtype> values, not real numbers" for what numpy's forcecast to float64
+/// would misread: complex numbers (their real part taken), text (parsed as numbers), as a numpy array of
+/// strings or an object array (a pandas column of str) holding any, and times and dates (counts of their
+/// unit: a pandas Timedelta column in nanoseconds). Nothing for anything else: the
+/// conversion itself says what else is wrong.
+void check_real_numbers(py::handle object, const std::string& name);
+
 /// Vectors of length `dim`: shape (dim,) is one vector, (N, dim) are N of them.
 struct Vectors {
   Array array;

@@ -24,6 +24,7 @@
 #include "calligraphy/report/score_report.hpp"
 #include "calligraphy/report/trace_columns.hpp"
 #include "character_source.hpp"
+#include "numpy_arrays.hpp"
 #include "report_bindings.hpp"
 
 namespace calligraphy::python {
@@ -36,14 +37,9 @@ Column column(const py::object& columns, const char* key) {
   Column values;
   try {
     const py::object given = columns[py::str(key)];
-    // forcecast takes a complex column's real part (numpy's ComplexWarning aside) and parses text: refused
-    // instead, as neither is a column of real numbers.
-    const py::array as_array = py::array::ensure(given);
-    if (as_array && (as_array.dtype().kind() == 'c' || as_array.dtype().kind() == 'U' ||
-                     as_array.dtype().kind() == 'S')) {
-      throw InvalidArgument(std::string("trace: column '") + key + "' holds " +
-                            std::string(py::str(as_array.dtype())) + " values, not real numbers");
-    }
+    // forcecast takes a complex column's real part (numpy's ComplexWarning aside) and parses text ("1" in a
+    // pandas column of str): refused instead, as neither is a column of real numbers.
+    check_real_numbers(given, std::string("trace: column '") + key + "'");
     values = Column::ensure(given);
   } catch (const py::error_already_set&) {
     values = Column();
@@ -62,10 +58,18 @@ bool has_column(const py::object& columns, const char* key) {
 // its unit ("t_s", as the library's DataFrames name it: trace_columns.hpp) or its file name; "time_s", the
 // name TrialResult.to_dataframe gave the time before, is read for one more version with a note. Empty when
 // none is there.
+// A column given under both names ("x" and "x_m") is refused, as a CSV header naming it twice is
+// (pen_trace_csv.hpp): a reader would otherwise take one of the two without a word.
 std::string column_key(const py::object& columns, const char* file_name) {
   const std::optional<TraceColumnInfo> info = trace_column(file_name);
-  if (info && has_column(columns, std::string(info->name).c_str())) return std::string(info->name);
-  if (has_column(columns, file_name)) return file_name;
+  const bool by_name = info && has_column(columns, std::string(info->name).c_str());
+  const bool by_file_name = has_column(columns, file_name);
+  if (by_name && by_file_name) {
+    throw InvalidArgument(std::string("trace: column '") + file_name + "' is given twice, as '" + file_name +
+                          "' and as '" + std::string(info->name) + "'");
+  }
+  if (by_name) return std::string(info->name);
+  if (by_file_name) return file_name;
   if (std::string_view(file_name) == "t" && has_column(columns, "time_s")) {
     if (PyErr_WarnEx(PyExc_DeprecationWarning,
                      "trace: column 'time_s' is named 't_s' now (read for one more version)", 1) != 0)
@@ -79,7 +83,10 @@ std::string column_key(const py::object& columns, const char* file_name) {
 // its file name or its name with its unit (t_s, x_m, y_m, z_m).
 std::vector<PenSample> samples_from_columns(const py::object& columns, TraceUnits units,
                                             const Placement& placement, double contact_threshold_m) {
-  if (!py::hasattr(columns, "__getitem__") || !py::hasattr(columns, "__contains__")) {
+  // A numpy array has both, but `"t" in array` compares its elements with "t": it is no mapping of columns
+  // (a structured array's fields included).
+  if (!py::hasattr(columns, "__getitem__") || !py::hasattr(columns, "__contains__") ||
+      py::isinstance<py::array>(columns)) {
     throw py::type_error(
         "trace: expected a CSV file's path or a mapping of columns (a dict of arrays, a "
         "pandas DataFrame) with t, x, y and pen or z (or t_s, x_m, y_m, z_m)");

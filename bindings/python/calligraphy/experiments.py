@@ -107,6 +107,15 @@ def parameter_names() -> list[str]:
     return [name for name in _catalogue() if not name.startswith(("force_law.", "writer."))]
 
 
+def _plain(value: typing.Any) -> typing.Any:
+    """A numpy scalar (numpy.int64 from numpy.arange, numpy.float64 from numpy.linspace, numpy.bool_ from a
+    boolean array) as the Python number or bool it holds, as simulate_trial and the parameter classes take
+    it; any other value as it is."""
+    if type(value).__module__ == "numpy" and getattr(value, "ndim", None) == 0 and hasattr(value, "item"):
+        return value.item()
+    return value
+
+
 def _resolve(grid: typing.Mapping[str, typing.Iterable[typing.Any]]) -> list[tuple[str, list[typing.Any]]]:
     if not isinstance(grid, typing.Mapping):
         raise TypeError(f"grid: expected a dict of parameter name -> list of values, got {type(grid).__name__}")
@@ -122,7 +131,7 @@ def _resolve(grid: typing.Mapping[str, typing.Iterable[typing.Any]]) -> list[tup
         targets[catalogue[name]] = name
         if isinstance(values, (str, bytes)) or not isinstance(values, typing.Iterable):
             raise TypeError(f"grid['{name}']: expected a list of values, got {type(values).__name__}")
-        values = list(values)
+        values = [_plain(value) for value in values]
         if not values:
             raise ValueError(f"grid['{name}']: no values")
         resolved.append((name, values))
@@ -247,13 +256,14 @@ def _character_labels(characters: typing.Any, library: CharacterLibrary) -> list
 
 
 def _seed_list(seeds: typing.Any) -> list[int]:
+    seeds = _plain(seeds)
     if isinstance(seeds, int) and not isinstance(seeds, bool):
         if seeds < 1 or seeds > MAX_SWEEP_TRIALS:
             raise ValueError(f"seeds: expected a count in 1..{MAX_SWEEP_TRIALS} or a list of seeds, got {seeds}")
         return list(range(seeds))
     if isinstance(seeds, (str, bytes)) or not isinstance(seeds, collections.abc.Iterable):
         raise TypeError(f"seeds: expected a count (int) or a list of seeds, got {type(seeds).__name__} {seeds!r}")
-    values = list(seeds)
+    values = [_plain(seed) for seed in seeds]
     if not values:
         raise ValueError("seeds: no seeds")
     for seed in values:
@@ -373,7 +383,7 @@ def sweep(characters: typing.Union[str, typing.Sequence[str], None],
         every core this process may run on); ignored with a client.
 
     Columns: 'character', 'seed', one per grid name (its values as given), the scalar metrics of
-    `calligraphy trial --json` not already among them (deviations in mm, times in s, forces in N,
+    `calligraphy trial --json` not already among them (deviations in m, times in s, forces in N,
     'completed_in_order', 'end_reason', ...), 'attempts_total' (attempts summed over the strokes)
     and 'error': None, or the text of the exception a failed trial raised (its metrics are then
     missing), e.g. "CharacterNotFound: ...".

@@ -68,10 +68,8 @@ def loads(text: str) -> Metrics:
 _FRAME_CLASS = None
 
 
-def metric_frame(frame):
-    """``frame`` (a pandas.DataFrame with metric columns) as a DataFrame that still reads an old millimetre
-    column (``frame["mean_deviation_mm"]``, ``frame.mean_deviation_mm``) with a DeprecationWarning naming the
-    new column; its columns are the one names."""
+def _frame_class():
+    """The DataFrame class of ``metric_frame``, made on first use (pandas is imported only then)."""
     global _FRAME_CLASS
     if _FRAME_CLASS is None:
         import pandas
@@ -96,5 +94,22 @@ def metric_frame(frame):
                     return self[name]
                 return pandas.DataFrame.__getattr__(self, name)
 
+        # Pickled by name as calligraphy.metrics.MetricFrame (DataFrame.to_pickle, process pools, Dask): the
+        # module's __getattr__ below gives the class to pickle, making it when it is not made yet.
+        MetricFrame.__module__ = __name__
+        MetricFrame.__qualname__ = "MetricFrame"
         _FRAME_CLASS = MetricFrame
-    return _FRAME_CLASS(frame)
+    return _FRAME_CLASS
+
+
+def metric_frame(frame):
+    """``frame`` (a pandas.DataFrame with metric columns) as a DataFrame that still reads an old millimetre
+    column (``frame["mean_deviation_mm"]``, ``frame.mean_deviation_mm``) with a DeprecationWarning naming the
+    new column; its columns are the one names. It pickles (``to_pickle``) and unpickles as such."""
+    return _frame_class()(frame)
+
+
+def __getattr__(name: str) -> Any:
+    if name == "MetricFrame":
+        return _frame_class()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

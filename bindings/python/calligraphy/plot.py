@@ -177,6 +177,7 @@ def forces(result: TrialResult, ax: matplotlib.axes.Axes | None = None, *, compo
                     va="bottom", fontsize=8, **_text_font(name))
     ax.set_xlabel("time [s]")
     ax.set_ylabel("force in the paper plane [N]")
-    ax.set_xlim(time[0], time[-1])
+    if time[-1] > time[0]:  # a trial of one tick has no span to show
+        ax.set_xlim(time[0], time[-1])
     ax.legend(loc="upper right", fontsize=8)
     return ax
