@@ -652,9 +652,11 @@ TEST_CASE("unseen12j: typical strokes, the Table-3 view and classification at th
   CHECK(table.feature_point_indices.size() == 3);
 }
 
+// The range of angles is (-180, 180]; a test name with an unmatched bracket would break CTest's list of
+// names.
 TEST_CASE(
-    "unseen12j: polyline helpers keep their documented ranges: angles in (-180, 180], no points for a bad "
-    "step",
+    "unseen12j: polyline helpers keep their documented ranges: angles above -180 up to 180, no points for a "
+    "bad step",
     "[unseen12j]") {
   for (const double step : {0.0, -0.0, -1.0, kNaN})
     CHECK(resample(std::vector<Vec2>{Vec2(0, 0), Vec2(1, 0)}, step).empty());
