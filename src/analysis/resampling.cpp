@@ -29,6 +29,12 @@ std::vector<Vec2> resample_by_arc_length(std::span<const Vec2> polyline, std::si
     throw InvalidArgument("resample_by_arc_length: count " + std::to_string(count) + " is below 2");
   double total = 0.0;
   for (std::size_t i = 1; i < polyline.size(); ++i) total += (polyline[i] - polyline[i - 1]).norm();
+  // Finite points can be farther apart than a double reaches (1e308 m apart): no point of such a polyline can
+  // be placed by its arc length.
+  if (!std::isfinite(total))
+    throw InvalidArgument(
+        "resample_by_arc_length: the polyline's length overflows a double (its points are "
+        "too far apart to measure)");
   std::vector<Vec2> out;
   out.reserve(count);
   out.push_back(polyline.front());

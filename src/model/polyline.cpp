@@ -8,7 +8,9 @@
 
 namespace calligraphy {
 
-double direction_deg(const Vec2& v) { return std::atan2(v.y(), v.x()) * 180.0 / std::numbers::pi; }
+// atan2 gives -pi for a vector pointing left with a y of -0 or below the smallest double's reach: -180, which
+// is 180 in the documented range.
+double direction_deg(const Vec2& v) { return wrap_deg(std::atan2(v.y(), v.x()) * 180.0 / std::numbers::pi); }
 
 double wrap_deg(double a) {
   a = std::fmod(a, 360.0);

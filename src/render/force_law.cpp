@@ -7,6 +7,7 @@
 
 #include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/force_limits.hpp"
 
 namespace calligraphy {
 
@@ -139,10 +140,9 @@ Vec2 off_stroke_resistance(const Vec2& velocity_m_s, double damping_n_s_per_m,
   return -damping_n_s_per_m * u * u * (3.0 - 2.0 * u) * velocity_m_s;
 }
 
+// The devices' clamp: a finite force whose squared magnitude overflows (1e308 N) is scaled, never zeroed.
 Vec3 clamp_force(const Vec3& force_n, double max_force_n) noexcept {
-  if (!force_n.allFinite() || !(max_force_n > 0.0)) return Vec3::Zero();
-  const double magnitude = force_n.norm();
-  return magnitude > max_force_n ? Vec3(force_n * (max_force_n / magnitude)) : force_n;
+  return clamp_force_magnitude(force_n, max_force_n);
 }
 
 }  // namespace calligraphy

@@ -1,7 +1,10 @@
 #include "calligraphy/render/guidance_schedule.hpp"
 
+#include <cmath>
 #include <limits>
 #include <variant>
+
+#include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
 
@@ -36,6 +39,13 @@ RepetitionGuidance GuidanceSchedule::next(const RepetitionGuidance& previous,
                                           : assist_rule.min_band_m;
       break;
     case AdaptiveGuidance::skill_adaptive:
+      // skill_adaptive_mode reads NaN as "no stroke written"; here that is nullopt, so a NaN given is
+      // refused.
+      if (mean_deviation_m && std::isnan(*mean_deviation_m)) {
+        throw InvalidArgument(
+            "GuidanceSchedule::next: mean_deviation_m = nan must be finite and >= 0 (no stroke written: "
+            "none)");
+      }
       following.mode = skill_adaptive_mode(
           mean_deviation_m ? *mean_deviation_m : std::numeric_limits<double>::quiet_NaN(), skill_rule);
       break;

@@ -59,6 +59,7 @@ void RendererOptions::validate() const {
     throw InvalidArgument("RendererOptions.rate_hz = " + detail::rate_text(rate_hz) + " must be in " +
                           servo_rate_range_text(false));
   }
+  check_low_pass_cutoff(safety.low_pass_cutoff_hz, rate_hz);
   passivity.validate();
 }
 

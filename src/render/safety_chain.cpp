@@ -70,6 +70,18 @@ void SafetyChainParameters::validate() const {
   }
 }
 
+void check_low_pass_cutoff(double low_pass_cutoff_hz, double rate_hz) {
+  // A first-order low-pass at or above the loop's Nyquist frequency filters nothing it can sample.
+  if (low_pass_cutoff_hz > 0.0 && low_pass_cutoff_hz >= 0.5 * rate_hz) {
+    std::string message = "low_pass_cutoff_hz = ";
+    message.append(shortest_decimal(low_pass_cutoff_hz))
+        .append(" Hz must be under half the servo rate (rate_hz / 2 = ")
+        .append(shortest_decimal(0.5 * rate_hz))
+        .append(" Hz); 0 = off");
+    throw InvalidArgument(message);
+  }
+}
+
 SafetyChain::SafetyChain(const SafetyChainParameters& parameters, double rate_hz) : parameters_(parameters) {
   parameters_.validate();
   if (!(parameters_.max_force_n > 0.0)) {  // 0 stands for the device's peak, which only a renderer knows
@@ -79,6 +91,7 @@ SafetyChain::SafetyChain(const SafetyChainParameters& parameters, double rate_hz
   if (!std::isfinite(rate_hz) || !(rate_hz > 0.0)) {
     throw InvalidArgument("SafetyChain: rate_hz = " + detail::rate_text(rate_hz) + " must be finite and > 0");
   }
+  check_low_pass_cutoff(parameters_.low_pass_cutoff_hz, rate_hz);
   period_s_ = 1.0 / rate_hz;
   low_pass_alpha_ = parameters_.low_pass_cutoff_hz > 0.0
                         ? 1.0 - std::exp(-2.0 * std::numbers::pi * parameters_.low_pass_cutoff_hz * period_s_)

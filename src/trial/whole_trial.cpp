@@ -5,7 +5,6 @@
 #include <utility>
 #include <variant>
 
-#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 
 namespace calligraphy {
@@ -96,15 +95,7 @@ void WholeTrial::validate() const {
   });
   part("safety", [&] {
     safety.validate();
-    // A first-order low-pass at or above the loop's Nyquist frequency filters nothing it can sample.
-    if (safety.low_pass_cutoff_hz >= 0.5 * spec.rate_hz) {
-      std::string message = "low_pass_cutoff_hz = ";
-      message.append(shortest_decimal(safety.low_pass_cutoff_hz))
-          .append(" Hz must be under half the servo rate (rate_hz / 2 = ")
-          .append(shortest_decimal(0.5 * spec.rate_hz))
-          .append(" Hz); 0 = off");
-      throw InvalidArgument(message);
-    }
+    check_low_pass_cutoff(safety.low_pass_cutoff_hz, spec.rate_hz);
   });
   part("passivity", [&] { passivity.validate(); });
   if (writer) {

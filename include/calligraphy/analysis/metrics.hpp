@@ -85,7 +85,7 @@ double dtw_mean_distance(std::span<const Vec2> a, std::span<const Vec2> b);
 
 /// `count` points equally spaced by arc length along the polyline, both ends included (a polyline of
 /// zero length gives `count` copies of its first point). Throws InvalidArgument for an empty polyline,
-/// a non-finite point or count < 2.
+/// a non-finite point, a length beyond a double's range (points 1e308 m apart) or count < 2.
 std::vector<Vec2> resample_by_arc_length(std::span<const Vec2> polyline, std::size_t count);
 
 /// The reference stroke as a polyline equally spaced by arc length: every element is first split into

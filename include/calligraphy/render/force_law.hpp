@@ -136,7 +136,9 @@ struct ParameterTable<ForceLawParameters> {
 [[nodiscard]] Vec2 off_stroke_resistance(const Vec2& velocity_m_s, double damping_n_s_per_m,
                                          double threshold_speed_m_s) noexcept;
 
-/// Scales `force` down to at most `max_force_n`, keeping its direction; a non-finite force gives zero.
+/// Scales `force` down to at most `max_force_n`, keeping its direction; a non-finite force or a non-positive
+/// limit gives zero, and a finite force of any size (1e308 N) is scaled, never zeroed (clamp_force_magnitude,
+/// core/force_limits.hpp).
 [[nodiscard]] Vec3 clamp_force(const Vec3& force_n, double max_force_n) noexcept;
 
 }  // namespace calligraphy

@@ -127,7 +127,7 @@ struct SkillAdaptiveRule {
 
 /// The mode of the next repetition from the error of the previous one [m] >= 0 (NaN: no stroke written,
 /// the least skilled): `fixed` when the error is at or above the threshold, else `error_amplification`.
-/// Throws InvalidArgument for a negative error or a bad rule.
+/// Throws InvalidArgument for a negative or infinite error or a bad rule.
 [[nodiscard]] GuidanceMode skill_adaptive_mode(double previous_error_m, const SkillAdaptiveRule& rule = {});
 
 // Each rule's table (parameter_table.hpp): the one definition of its fields' ranges, which its validate(),

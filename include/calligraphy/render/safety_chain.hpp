@@ -41,6 +41,12 @@ struct SafetyChainParameters {
   void validate() const;
 };
 
+/// Throws InvalidArgument "low_pass_cutoff_hz = F Hz must be under half the servo rate (rate_hz / 2 = R Hz);
+/// 0 = off" when the low-pass is on at or above the Nyquist frequency of a loop at `rate_hz` [Hz] (a
+/// first-order low-pass there filters nothing the loop samples). The one check of that rule: `SafetyChain`,
+/// `RendererOptions::validate` and a whole trial's safety part (trial/whole_trial.hpp) apply it.
+void check_low_pass_cutoff(double low_pass_cutoff_hz, double rate_hz);
+
 /// The fields of SafetyChainParameters (parameter_table.hpp): the one definition of their units and ranges.
 template <>
 struct ParameterTable<SafetyChainParameters> {
@@ -67,7 +73,8 @@ struct SafetyResult {
 
 class SafetyChain {
  public:
-  /// `rate_hz`: servo rate [Hz], > 0. Throws InvalidArgument for bad parameters or rate.
+  /// `rate_hz`: servo rate [Hz], > 0. Throws InvalidArgument for bad parameters or rate, and a low-pass on at
+  /// or above half the rate (check_low_pass_cutoff).
   SafetyChain(const SafetyChainParameters& parameters, double rate_hz);
 
   /// One tick: the force law's force in [N], the force to command out.
