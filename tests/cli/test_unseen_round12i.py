@@ -39,11 +39,9 @@ import unittest
 import warnings
 from pathlib import Path
 
-from outsider import sanitized_subset
+from outsider import CLI, TIMEOUT_S, error_lines, run, sanitized_subset
 
-CLI = os.environ.get("CALLIGRAPHY_CLI", "")
 SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
-TIMEOUT_S = 120
 SHI = "十"
 YI = "一"
 
@@ -62,15 +60,6 @@ except ImportError:  # pragma: no cover
 needs_python = unittest.skipIf(cg is None, "the calligraphy Python package (PYTHONPATH) or numpy is missing")
 needs_pandas = unittest.skipIf(pd is None, "pandas is not installed")
 needs_cli = unittest.skipUnless(CLI, "CALLIGRAPHY_CLI not set")
-
-
-def run(args, cwd):
-    return subprocess.run([CLI, *[str(a) for a in args]], cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                          timeout=TIMEOUT_S)
-
-
-def error_lines(result):
-    return result.stderr.decode("utf-8", "replace").strip().splitlines()
 
 
 class Shared:
