@@ -105,7 +105,11 @@ class Learner(unittest.TestCase):
     def key(self, *keys):
         xdo("windowfocus", "--sync", self.window)
         for k in keys:
-            xdo("key", "--window", self.window, k)
+            sent = subprocess.run(["xdotool", "key", "--window", self.window, k], capture_output=True, text=True)
+            if sent.returncode != 0:  # the window is gone: the program must have ended
+                time.sleep(0.5)
+                self.fail(f"key {k}: no window ({sent.stderr.strip()}); the program's status "
+                          f"{self.trainer.process.poll()}:\n" + self.trainer.errors())
 
     def quit_and_wait(self, key="q", status=0):
         self.key(key)
@@ -198,6 +202,19 @@ class Keys(Learner):
         self.assertEqual(saved(self.folder / "out"), [])
         self.assertEqual(attempts(self.folder / "out"), [], "no trial ran: no attempt to keep")
         self.assertNotRegex(err, r"trial \d")
+
+    def test_n_during_the_demonstration_goes_to_the_next_character_once_it_ends(self):
+        """docs/trainer.md: N during a demonstration goes to the next character once it ends; that character's
+        first trial is preceded by its own demonstration, and 一 gets no trial meanwhile."""
+        self.start("一十", "--device", "mouse", "--session", "out")
+        self.ready(2)
+        self.trainer.wait_for("demonstrating the stroke order of 一")
+        self.key("n")
+        self.trainer.wait_for("demonstrating the stroke order of 十", timeout=10)
+        time.sleep(0.3)
+        err = self.quit_and_wait()
+        self.assertNotRegex(err, r"trial \d+ 一", "一 had no trial: N went on to 十")
+        self.assertEqual(attempts(self.folder / "out") + saved(self.folder / "out"), [], err)
 
     def test_d_during_the_demonstration_skips_it_and_the_trial_starts(self):
         self.start("十", "--device", "mouse", "--session", "out")
@@ -324,8 +341,48 @@ class Keys(Learner):
         self.assertIn(attempt.name, err, "the trial's line names the attempt kept")
 
 
+def is_button(r, g, b):  # the panel's buttons, ImGui's light style over the panel's grey
+    return abs(r - 170) <= 8 and abs(g - 204) <= 8 and abs(b - 244) <= 8
+
+
+def panel_buttons(image):
+    """The centres of the panel's buttons, left to right: the runs of button colour along the row that has
+    the most of it in the window's right half."""
+    rows = [(sum(is_button(*image.pixel(x, y)) for x in range(image.width // 2, image.width)), y)
+            for y in range(image.height)]
+    count, y = max(rows)
+    runs, start = [], None
+    for x in range(image.width // 2, image.width + 1):
+        inside = x < image.width and is_button(*image.pixel(x, y))
+        if inside and start is None:
+            start = x
+        elif not inside and start is not None:
+            if x - start > 20:
+                runs.append(((start + x) / 2, y))
+            start = None
+    return runs
+
+
 class Pointer(Learner):
     """The button and the pointer as a learner's hand moves them."""
+
+    def test_the_panel_buttons_clicked_with_the_mouse_write_no_stroke(self):
+        """The panel's buttons do what D, R and N do; a click on them is not a pen-down on the paper."""
+        self.start("十", "--device", "mouse", "--no-demo", "--session", "out")
+        self.ready()
+        time.sleep(0.6)
+        buttons = panel_buttons(DISPLAY.window_image(self.window))
+        self.assertEqual(len(buttons), 3, buttons)
+        demonstrate, restart, _ = buttons
+        xdo("mousemove", "--window", self.window, round(restart[0]), round(restart[1]), "click", "1")
+        self.trainer.wait_for("trial 1 十: interrupted by R")
+        time.sleep(0.6)
+        xdo("mousemove", "--window", self.window, round(demonstrate[0]), round(demonstrate[1]), "click", "1")
+        self.trainer.wait_for("trial 2 十: interrupted by D (demonstration)")
+        self.trainer.wait_for("demonstrating the stroke order of 十")
+        err = self.quit_and_wait()
+        self.assertNotIn("not written", err, "a click on a button taken as a stroke attempt")
+        self.assertEqual(len(attempts(self.folder / "out")), 2, err)
 
     def test_pressed_inside_released_outside_then_written_completes(self):
         self.start("一", "--device", "mouse", "--no-demo", "--session", "out", "--exit-after", "60")
