@@ -339,7 +339,9 @@ void learner_panel(const PanelInput& input) {
           view->hint && view->hint->character == s.character && view->hint->stroke == s.stroke;
       if (!s.finished && !view->ended)
         ImGui::TextWrapped(hinted ? "Start at the red circle; the stroke to write is the light blue one."
-                                  : "Start at the red circle; the stroke to write is the darker yellow one.");
+                           : input.outlined
+                               ? "Start at the red circle; the stroke to write is the darker yellow one."
+                               : "Start at the red circle and follow the blue line from there.");
     }
     if (view->feedback && !view->quiz) {
       ImGui::Spacing();

@@ -38,6 +38,9 @@ struct PanelInput {
   /// A demonstration runs: the stroke being drawn (1-based) and the character's strokes.
   std::optional<std::pair<std::size_t, std::size_t>> demonstrating;
   bool practice_buttons = false;  ///< `train`: the demonstrate, restart and next buttons
+  /// The character shown has its stroke outlines (a character of the bundled store has none: only its blue
+  /// reference is drawn, so no stroke is yellow).
+  bool outlined = true;
 };
 
 /// What a button of the panel asked for this frame.

@@ -100,9 +100,9 @@ void PracticeController::begin_demonstration(std::size_t character) {
     lengths_m.push_back(stroke.median_m.size() > 1 ? polyline_length(stroke.median_m) : stroke.length_m());
   demo.schedule = DemoSchedule(std::move(lengths_m), DemoPace{});
   demo.started = Clock::now();
-  std::fprintf(stderr, "calligraphy train: demonstrating the stroke order of %s (%zu strokes, %.1f s)\n",
+  std::fprintf(stderr, "calligraphy train: demonstrating the stroke order of %s (%zu stroke%s, %.1f s)\n",
                options_.characters[character].utf8.c_str(), demo.schedule.strokes(),
-               demo.schedule.duration_s());
+               demo.schedule.strokes() == 1 ? "" : "s", demo.schedule.duration_s());
   demo_ = std::move(demo);
   demonstrated_[character] = true;
   advance_at_.reset();
@@ -297,8 +297,9 @@ void PracticeController::finish_trial(QuizLog& quiz_log) {
     log_stop("device_fault");
   }
   const bool last = view.character + 1 == options_.characters.size();
-  if (last) last_character_ended_ = true;                     // after the last character's last stroke
-  if (unattended() && pending_ != NextAction::demonstrate) {  // a demonstration asked for comes first
+  if (last) last_character_ended_ = true;  // after the last character's last stroke
+  // A key's request (D, R, N) comes first: the run goes on with the trial it asked for.
+  if (unattended() && pending_ == NextAction::none) {
     if (last) {
       close_window_ = true;
     } else {
@@ -448,7 +449,10 @@ std::span<const std::string> PracticeController::characters_utf8(const TrialView
 }
 
 void PracticeController::fill_panel(PanelInput& panel) const {
-  if (view_) panel.character = options_.characters[view_->character].utf8;
+  if (view_) {
+    panel.character = options_.characters[view_->character].utf8;
+    panel.outlined = !options_.characters[view_->character].outlines.strokes.empty();
+  }
   panel.next_guidance = guidance_;
   panel.next_mode = to_string(guidance_mode_);
   panel.next_gain = guidance_gain_;

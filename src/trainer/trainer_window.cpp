@@ -141,6 +141,11 @@ void TrainerApp::close_window() {
 void TrainerApp::render(bool take_screenshot) {
   ImGui_ImplOpenGL3_NewFrame();
   ImGui_ImplGlfw_NewFrame();
+  // A window destroyed by another client since the loop looked: GLFW's size query just failed (the X error
+  // handler recorded it) and left the size undefined, which ImGui::NewFrame asserts on. Nothing to draw; the
+  // loop ends the trial as after any X error.
+  const ImVec2 size = ImGui::GetIO().DisplaySize;
+  if (x11_error_seen() || !(size.x >= 0.0f && size.y >= 0.0f)) return;
   ImGui::NewFrame();
   const Scene& scene = practice_ ? practice_->scene() : session_->scene();
   const TrialView* view = trial_view();
