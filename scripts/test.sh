@@ -105,6 +105,7 @@ end_stage
 
 begin_stage "Layering and docs checks"
 python3 scripts/check-layering.py .
+python3 scripts/check-test-names.py .
 bash scripts/check-docs.sh
 end_stage
 
