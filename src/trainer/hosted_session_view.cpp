@@ -128,8 +128,16 @@ void HostedSessionView::fill_panel(PanelInput& panel) const {
   const SessionView& s = state_;
   const SessionSetup& setup = link_.manifest->setup;
   std::string characters;
-  for (const char32_t c : s.trial.characters) characters += characters_[index_of_.at(c)].utf8;
+  // The panel names the outline's colour only when every character of the trial is drawn with one (a
+  // character from the bundled store has none: its strokes are followed along their lines).
+  bool outlined = true;
+  for (const char32_t c : s.trial.characters) {
+    const TrainerCharacter& character = characters_[index_of_.at(c)];
+    characters += character.utf8;
+    outlined = outlined && !character.outlines.strokes.empty();
+  }
   panel.character = characters;
+  panel.outlined = outlined;
   char line[256];
   std::snprintf(line, sizeof line, "Session %s, subject %s\ntrial %zu of %zu (%s), condition %s: %s",
                 link_.manifest->protocol.protocol.name.c_str(), setup.subject.id.c_str(), s.trial.index + 1,
