@@ -128,13 +128,12 @@ void HostedSessionView::fill_panel(PanelInput& panel) const {
   const SessionView& s = state_;
   const SessionSetup& setup = link_.manifest->setup;
   std::string characters;
-  // The panel names the outline's colour only when every character of the trial is drawn with one (a
-  // character from the bundled store has none: its strokes are followed along their lines).
+  // The panel names the outline's colour only when every character of the trial is drawn with one.
   bool outlined = true;
   for (const char32_t c : s.trial.characters) {
     const TrainerCharacter& character = characters_[index_of_.at(c)];
     characters += character.utf8;
-    outlined = outlined && !character.outlines.strokes.empty();
+    outlined = outlined && character.outlined();
   }
   panel.character = characters;
   panel.outlined = outlined;

@@ -451,7 +451,7 @@ std::span<const std::string> PracticeController::characters_utf8(const TrialView
 void PracticeController::fill_panel(PanelInput& panel) const {
   if (view_) {
     panel.character = options_.characters[view_->character].utf8;
-    panel.outlined = !options_.characters[view_->character].outlines.strokes.empty();
+    panel.outlined = options_.characters[view_->character].outlined();
   }
   panel.next_guidance = guidance_;
   panel.next_mode = to_string(guidance_mode_);

@@ -20,6 +20,8 @@ struct TrainerCharacter {
   Character model;
   CharacterOutlines outlines;
   std::string utf8;
+  /// Whether it is drawn with its outline: a character from the bundled store has none (only its line).
+  [[nodiscard]] bool outlined() const noexcept { return !outlines.strokes.empty(); }
 };
 
 struct TrainerOptions {
@@ -35,7 +37,8 @@ struct TrainerOptions {
   GuidanceMode guidance_mode = GuidanceMode::fixed;  ///< how guidance attracts (M cycles it)
   double guidance_gain = 1.0;          ///< the fading mode's first gain in [0, 1]; faded after each trial
   std::vector<TeacherSample> teacher;  ///< replay: the teacher's pen (one character, its recording)
-  /// A quiz (analysis/quiz.hpp): guidance off, each stroke judged live by the stroke matcher as the pen lifts.
+  /// A quiz (analysis/quiz.hpp): guidance off, each stroke judged live by the stroke matcher as the pen
+  /// lifts.
   bool quiz = false;
   /// Hint after N misses, backwards accepted or not. The trainer sets the acceptance and start radius to its
   /// trials' (the renderer's tolerances and the scene's start neighbourhood), so that quiz and renderer
