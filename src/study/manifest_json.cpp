@@ -7,6 +7,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
+#include "calligraphy/trial/writer_profile.hpp"
 #include "core/json_reader.hpp"
 #include "core/schema_json.hpp"
 #include "study/manifest_schema.hpp"
@@ -199,8 +200,13 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
   }
   manifest.setup.subject.number = static_cast<std::size_t>(read.subject.number);
   manifest.setup.device = read.device;
-  manifest.setup.writer = read.writer;
+  manifest.setup.writer = std::string(enum_spelling(read.writer));
   manifest.setup.writer_profile = read.writer_profile;
+  try {  // as check_setup refuses it when a session is made
+    (void)writer_profile(manifest.setup.writer_profile);
+  } catch (const InvalidArgument& error) {
+    json_detail::fail(source, "/writer_profile", error.what());
+  }
   manifest.setup.writer_seed = read.writer_seed;
   manifest.setup.writer_learning = std::string(enum_spelling(read.writer_learning));
   manifest.setup.individual_differences = read.individual_differences;

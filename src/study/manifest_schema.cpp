@@ -127,7 +127,7 @@ const Schema& SchemaOf<study_detail::ManifestDocument>::get() {
           "session_number", 1, 20, {.doc = "which of the protocol's sessions this one is (1-based)"})),
       omissible(string_field<&D::group>("group", {.doc = "the subject's group; \"\" within subjects"})),
       string_field<&D::device>("device", {.doc = "the device's name in the device registry"}),
-      string_field<&D::writer>("writer", {.doc = "\"simulated\" or \"human\""}),
+      enum_field<&D::writer>("writer", {.doc = "who wrote the trials"}),
       string_field<&D::writer_profile>("writer_profile", {.doc = "the simulated writer's profile"}),
       omissible(unsigned_field<&D::writer_seed>("writer_seed", {.doc = "the simulated subject's seed"})),
       omissible(enum_field<&D::writer_learning>("writer_learning",

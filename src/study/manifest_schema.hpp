@@ -21,6 +21,9 @@ namespace study_detail {
 inline constexpr const char* kSessionFormat = "calligraphy-study-session";
 inline constexpr std::int64_t kSessionVersion = 2;
 
+/// Who wrote a session's trials (SessionSetup::writer).
+enum class WriterKind { simulated, human };
+
 /// How a simulated subject learns from trial to trial (SessionSetup::writer_learning).
 enum class WriterLearning { none, two_state };
 
@@ -63,7 +66,7 @@ struct ManifestDocument {
   std::int64_t session_number = 1;
   std::string group;
   std::string device;
-  std::string writer;
+  WriterKind writer = WriterKind::simulated;
   std::string writer_profile;
   std::uint64_t writer_seed = 0;
   WriterLearning writer_learning = WriterLearning::none;
@@ -77,6 +80,15 @@ struct ManifestDocument {
 };
 
 }  // namespace study_detail
+
+template <>
+struct EnumTable<study_detail::WriterKind> {
+  static constexpr std::string_view name = "WriterKind";
+  static constexpr std::array<EnumEntry<study_detail::WriterKind>, 2> entries{{
+      {study_detail::WriterKind::simulated, "simulated", "the simulated writer of writer_profile"},
+      {study_detail::WriterKind::human, "human", "a person at the device"},
+  }};
+};
 
 template <>
 struct EnumTable<study_detail::WriterLearning> {

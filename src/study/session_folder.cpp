@@ -28,6 +28,7 @@
 #include "core/whole_file.hpp"
 #include "report/compressed_text.hpp"
 #include "study/manifest_json.hpp"
+#include "study/manifest_schema.hpp"
 #include "study/names.hpp"
 #include "study/saved_sessions.hpp"
 
@@ -175,14 +176,18 @@ void check_setup(const SessionSetup& setup) {
     throw InvalidArgument("subject id '" + setup.subject.id +
                           "': expected 1 to 64 letters, digits, '_' or '-'");
   }
-  if (setup.writer != "simulated" && setup.writer != "human") {
-    throw InvalidArgument("writer '" + setup.writer + "': expected 'simulated' or 'human'");
+  using study_detail::WriterKind;
+  using study_detail::WriterLearning;
+  if (!enum_from_spelling<WriterKind>(setup.writer)) {
+    throw InvalidArgument("writer '" + setup.writer + "': expected " +
+                          join_spellings(enum_spellings<WriterKind>(), " or ", "'"));
   }
   (void)writer_profile(setup.writer_profile);  // InvalidArgument naming it and the known profiles
   (void)parse_trial_pacing(setup.pacing, "session setup");  // InvalidArgument naming the spellings
   if (setup.device.empty()) throw InvalidArgument("session setup: the device name is empty");
-  if (setup.writer_learning != "none" && setup.writer_learning != "two-state") {
-    throw InvalidArgument("writer learning '" + setup.writer_learning + "': expected 'none' or 'two-state'");
+  if (!enum_from_spelling<WriterLearning>(setup.writer_learning)) {
+    throw InvalidArgument("writer learning '" + setup.writer_learning + "': expected " +
+                          join_spellings(enum_spellings<WriterLearning>(), " or ", "'"));
   }
   if (setup.writer_learning != "none" && setup.writer != "simulated") {
     throw InvalidArgument("writer learning '" + setup.writer_learning +

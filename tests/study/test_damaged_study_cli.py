@@ -179,6 +179,17 @@ class DamagedStudyTest(unittest.TestCase):
                 self.assertLess(len(result.stderr), 3000)
         manifest.write_text(json.dumps(original), encoding="utf-8")
 
+    def test_an_unknown_writer_or_profile_in_a_session_manifest_names_the_manifest(self):
+        manifest = self.first_session() / "session.json"
+        original = json.loads(manifest.read_text(encoding="utf-8"))
+        for key, wrong in (("writer", "x"), ("writer", "person"), ("writer_profile", "x")):
+            with self.subTest(key=key, wrong=wrong):
+                manifest.write_text(json.dumps(dict(original, **{key: wrong})), encoding="utf-8")
+                result = self.run_cli("report", "S", "--csv", ".")
+                self.assert_data_error(result, "session.json", f"{key} = {wrong!r}")
+                self.assertIn(f"/{key}", result.stderr.decode())
+        manifest.write_text(json.dumps(original), encoding="utf-8")
+
     def test_every_wrong_value_of_a_session_manifest_is_a_data_error_naming_the_file(self):
         manifest = self.first_session() / "session.json"
         for what, damaged in self.damaged_copies(manifest):
