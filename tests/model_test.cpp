@@ -11,6 +11,7 @@
 #include "calligraphy/model/fitting.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
+#include "parameter_table_walk.hpp"
 
 using namespace calligraphy;
 
@@ -159,4 +160,13 @@ TEST_CASE("A scene's layout lengths have finite bounds", "[model]") {
     CHECK_THROWS_WITH(laid_out(field, 1e308), Catch::Contains(name) && Catch::Contains("out of range"));
     CHECK_THROWS_AS(laid_out(field, std::nextafter(bound, 1.0e9)), InvalidArgument);
   }
+}
+
+TEST_CASE("FitOptions' table: defaults in range, each bound refused by name", "[model]") {
+  const std::vector<Vec2> median{Vec2(0, 0), Vec2(100, 0), Vec2(100, 100)};
+  check_table_through<FitOptions>([&](const FitOptions& options) { (void)fit_stroke(median, options); });
+  FitOptions degree;
+  degree.max_degree = kMaxElementDegree + 1;
+  CHECK_THROWS_WITH(fit_stroke(median, degree),
+                    Catch::Contains("FitOptions.max_degree = 5 must be in [2, 4]"));
 }

@@ -2,8 +2,9 @@
 #include <cmath>
 #include <vector>
 
-#include "calligraphy/core/errors.hpp"
 #include "calligraphy/analysis/metrics.hpp"
+#include "calligraphy/core/errors.hpp"
+#include "parameter_table_walk.hpp"
 
 using namespace calligraphy;
 
@@ -210,4 +211,26 @@ TEST_CASE("Kinematics reject bad samples, naming the index", "[metrics]") {
   KinematicsOptions bad;
   bad.peak_prominence = 0.0;
   CHECK_THROWS_AS(stroke_kinematics(t, p, bad), InvalidArgument);
+}
+
+TEST_CASE("The metrics' option tables: defaults in range, each bound refused by name", "[metrics]") {
+  const std::vector<StrokeElement> reference{StrokeElement::line(Vec2(0, 0), Vec2(0.03, 0))};
+  std::vector<double> t;
+  std::vector<Vec2> p;
+  minimum_jerk(0.03, 0.6, 200.0, t, p);
+  check_table_through<CurveComparisonOptions>(
+      [&](const CurveComparisonOptions& options) { (void)compare_curves(p, reference, options); });
+  check_table_through<KinematicsOptions>(
+      [&](const KinematicsOptions& options) { (void)stroke_kinematics(t, p, options); });
+  check_table_through<MetricsOptions>(
+      [&](const MetricsOptions& options) { (void)stroke_writing_metrics(t, p, reference, options); });
+  // The counts beside the tables, named the same way.
+  CurveComparisonOptions one_point;
+  one_point.max_points = 1;
+  CHECK_THROWS_WITH(compare_curves(p, reference, one_point),
+                    Catch::Contains("CurveComparisonOptions.max_points = 1"));
+  KinematicsOptions small_grid;
+  small_grid.max_grid_points = 15;
+  CHECK_THROWS_WITH(stroke_kinematics(t, p, small_grid),
+                    Catch::Contains("KinematicsOptions.max_grid_points = 15"));
 }

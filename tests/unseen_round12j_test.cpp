@@ -618,7 +618,7 @@ TEST_CASE("unseen12j: fit_stroke on one point, duplicate points, no point, NaN, 
   FitOptions bad;
   bad.max_degree = 5;
   CHECK_REFUSED(InvalidArgument, fit_stroke(std::vector<Vec2>{Vec2(0, 0), Vec2(100, 0)}, bad),
-                "max degree 5");
+                "FitOptions.max_degree = 5");
   bad = FitOptions{};
   bad.tolerance = kNaN;
   CHECK_REFUSED(InvalidArgument, fit_stroke(std::vector<Vec2>{Vec2(0, 0), Vec2(100, 0)}, bad), "tolerance");
@@ -1463,7 +1463,8 @@ TEST_CASE(
   }
   CurveComparisonOptions nan_step;
   nan_step.reference_step_m = kNaN;
-  CHECK_REFUSED(InvalidArgument, compare_curves(beside, reference, nan_step), "reference step nan");
+  CHECK_REFUSED(InvalidArgument, compare_curves(beside, reference, nan_step),
+                "CurveComparisonOptions.reference_step_m = nan");
   CHECK_REFUSED(InvalidArgument, compare_curves(std::vector<Vec2>{}, reference), "");
   CHECK_REFUSED(InvalidArgument, compare_curves(beside, std::vector<StrokeElement>{}), "");
   CHECK_REFUSED(InvalidArgument, compare_curves(std::vector<Vec2>{Vec2(kNaN, 0)}, reference), "");
@@ -1499,10 +1500,14 @@ TEST_CASE(
     set(options);
     CHECK_REFUSED(InvalidArgument, stroke_kinematics(t2, p2, options), field);
   };
-  refused_option([](KinematicsOptions& o) { o.low_pass_cutoff_hz = -1.0; }, "low-pass cut-off -1");
-  refused_option([](KinematicsOptions& o) { o.low_pass_cutoff_hz = kNaN; }, "low-pass cut-off nan");
-  refused_option([](KinematicsOptions& o) { o.peak_prominence = 0.0; }, "peak prominence 0");
-  refused_option([](KinematicsOptions& o) { o.peak_prominence = 1.0; }, "peak prominence 1");
+  refused_option([](KinematicsOptions& o) { o.low_pass_cutoff_hz = -1.0; },
+                 "KinematicsOptions.low_pass_cutoff_hz = -1");
+  refused_option([](KinematicsOptions& o) { o.low_pass_cutoff_hz = kNaN; },
+                 "KinematicsOptions.low_pass_cutoff_hz = nan");
+  refused_option([](KinematicsOptions& o) { o.peak_prominence = 0.0; },
+                 "KinematicsOptions.peak_prominence = 0");
+  refused_option([](KinematicsOptions& o) { o.peak_prominence = 1.0; },
+                 "KinematicsOptions.peak_prominence = 1");
   refused_option([](KinematicsOptions& o) { o.max_grid_points = 15; }, "max_grid_points");
   // A minimum-jerk movement of 30 mm in 0.6 s at 1 kHz, unfiltered: 18.91 (docs/metrics.md), one peak.
   std::vector<double> times;

@@ -29,36 +29,23 @@ void require_bounded_cells(std::size_t rows, std::size_t columns, const char* fu
 }
 
 void require_valid_options(const KinematicsOptions& options) {
-  if (!std::isfinite(options.low_pass_cutoff_hz) || options.low_pass_cutoff_hz < 0.0) {
-    throw InvalidArgument("KinematicsOptions: low-pass cut-off " +
-                          shortest_decimal(options.low_pass_cutoff_hz) + " Hz is not finite and >= 0");
-  }
-  if (!(options.peak_prominence > 0.0 && options.peak_prominence < 1.0)) {
-    throw InvalidArgument("KinematicsOptions: peak prominence " + shortest_decimal(options.peak_prominence) +
-                          " is outside (0, 1)");
-  }
+  check_parameters(options);
   if (options.max_grid_points < 16) {
-    throw InvalidArgument("KinematicsOptions: max_grid_points " + std::to_string(options.max_grid_points) +
-                          " is below 16");
+    throw InvalidArgument("KinematicsOptions.max_grid_points = " + std::to_string(options.max_grid_points) +
+                          " must be >= 16");
   }
 }
 
 void require_valid_options(const CurveComparisonOptions& options) {
-  if (!std::isfinite(options.reference_step_m) || options.reference_step_m <= 0.0) {
-    throw InvalidArgument("CurveComparisonOptions: reference step " +
-                          shortest_decimal(options.reference_step_m) + " m is not a finite length > 0");
-  }
+  check_parameters(options);
   if (options.max_points < 2 || options.max_points > 4096) {
-    throw InvalidArgument("CurveComparisonOptions: max_points " + std::to_string(options.max_points) +
-                          " is outside 2..4096");
+    throw InvalidArgument("CurveComparisonOptions.max_points = " + std::to_string(options.max_points) +
+                          " must be in [2, 4096]");
   }
 }
 
 void require_valid_options(const MetricsOptions& options) {
-  if (!std::isfinite(options.tube_radius_m) || options.tube_radius_m < 0.0) {
-    throw InvalidArgument("MetricsOptions: tube radius " + shortest_decimal(options.tube_radius_m) +
-                          " m is not a finite length >= 0");
-  }
+  check_parameters(options);
   require_valid_options(options.curves);
   require_valid_options(options.kinematics);
 }

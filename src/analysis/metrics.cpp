@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "analysis/input_checks.hpp"
 #include "analysis/segment_metrics.hpp"
 #include "calligraphy/core/errors.hpp"
 
@@ -27,6 +28,7 @@ StrokeWritingMetrics stroke_writing_metrics(std::span<const double> times_s,
     throw InvalidArgument("stroke_writing_metrics: " + std::to_string(times_s.size()) + " times but " +
                           std::to_string(positions_m.size()) + " positions");
   }
+  trial_detail::require_valid_options(options);  // every option named by its table before any work
   return trial_detail::stroke_writing_metrics(stroke_kinematics(times_s, positions_m, options.kinematics),
                                               positions_m, reference_m, options, reference_reversed);
 }

@@ -181,16 +181,32 @@ double stroke_deviation(std::span<const Vec2> pts, std::span<const std::size_t> 
 }
 
 void check_options(const FitOptions& o) {
-  if (!(o.tolerance > 0.0) || !(o.corner_angle_deg > 0.0) || !(o.corner_window > 0.0) ||
-      !(o.hook_trim_length >= 0.0) || o.max_degree < 2 || o.max_degree > kMaxElementDegree) {
-    throw InvalidArgument("FitOptions out of range: tolerance " + shortest_decimal(o.tolerance) +
-                          ", corner angle " + shortest_decimal(o.corner_angle_deg) + ", window " +
-                          shortest_decimal(o.corner_window) + ", max degree " + std::to_string(o.max_degree) +
-                          " (2-4)");
+  check_parameters(o);
+  if (o.max_degree < 2 || o.max_degree > kMaxElementDegree) {
+    throw InvalidArgument("FitOptions.max_degree = " + std::to_string(o.max_degree) + " must be in [2, " +
+                          std::to_string(kMaxElementDegree) + "]");
   }
 }
 
+using FitField = ParameterField<FitOptions>;
+constexpr ParameterRange kPositiveLength{.low_open = true};
+
+constexpr std::array kFitFields{
+    FitField{"tolerance", "", kPositiveLength,
+             "largest deviation of the elements from the median, in data units", &FitOptions::tolerance},
+    FitField{"corner_angle_deg", "deg", ParameterRange{.low = 0.0, .high = 180.0, .low_open = true},
+             "least turn within the corner window that makes a corner", &FitOptions::corner_angle_deg},
+    FitField{"corner_window", "", kPositiveLength, "arc length over which turning is summed, in data units",
+             &FitOptions::corner_window},
+    FitField{"hook_trim_length", "", ParameterRange{},
+             "longest end segment trimmed as a brush hook, in data units", &FitOptions::hook_trim_length},
+};
+
 }  // namespace
+
+std::span<const ParameterField<FitOptions>> ParameterTable<FitOptions>::fields() noexcept {
+  return kFitFields;
+}
 
 FittedStroke fit_stroke(std::span<const Vec2> median, const FitOptions& options) {
   check_options(options);

@@ -7,8 +7,10 @@
 #include <cstddef>
 #include <optional>
 #include <span>
+#include <string_view>
 #include <vector>
 
+#include "calligraphy/core/parameter_table.hpp"
 #include "calligraphy/model/element.hpp"
 
 namespace calligraphy {
@@ -98,9 +100,18 @@ std::vector<Vec2> reference_polyline_m(std::span<const StrokeElement> reference_
 inline constexpr int kReferenceChordsPerElement = 128;
 
 /// How written samples are compared with the reference curve.
+/// `reference_step_m` is in its table (`ParameterTable<CurveComparisonOptions>`); `max_points`, a count, is
+/// checked beside it.
 struct CurveComparisonOptions {
-  double reference_step_m = 0.25e-3;  ///< arc-length step of the resampled reference [m]
+  double reference_step_m = 0.25e-3;  ///< arc-length step of the resampled reference [m], > 0
   std::size_t max_points = 2000;      ///< most points per curve, 2..4096 (bounds the O(n m) work)
+};
+
+/// The numeric fields of CurveComparisonOptions but the count `max_points` (parameter_table.hpp).
+template <>
+struct ParameterTable<CurveComparisonOptions> {
+  static constexpr std::string_view name = "CurveComparisonOptions";
+  [[nodiscard]] static std::span<const ParameterField<CurveComparisonOptions>> fields() noexcept;
 };
 
 /// Discrete Frechet and DTW distances [m] of written samples to a reference curve.
@@ -120,7 +131,8 @@ CurveDistances compare_curves(std::span<const Vec2> samples_m, std::span<const S
 
 // ---- Kinematics ------------------------------------------------------------------------------
 
-/// How speed and jerk are estimated from samples.
+/// How speed and jerk are estimated from samples. The two real-valued fields are in their table
+/// (`ParameterTable<KinematicsOptions>`); `max_grid_points`, a count, is checked beside it.
 struct KinematicsOptions {
   /// Cut-off of the low-pass filter applied to the positions before differentiating [Hz]: a Gaussian
   /// whose gain is 1/sqrt(2) at this frequency (sigma = 0.1325 / cutoff s). Pen-tip movement in
@@ -132,6 +144,13 @@ struct KinematicsOptions {
   double peak_prominence = 0.1;
   /// Most points of the uniform time grid the samples are interpolated on (bounds the work). >= 16.
   std::size_t max_grid_points = 1'000'000;
+};
+
+/// The numeric fields of KinematicsOptions but the count `max_grid_points` (parameter_table.hpp).
+template <>
+struct ParameterTable<KinematicsOptions> {
+  static constexpr std::string_view name = "KinematicsOptions";
+  [[nodiscard]] static std::span<const ParameterField<KinematicsOptions>> fields() noexcept;
 };
 
 /// Kinematics of one stroke (one pen-down segment).
@@ -165,6 +184,13 @@ struct MetricsOptions {
   double tube_radius_m = 2e-3;
   CurveComparisonOptions curves{};
   KinematicsOptions kinematics{};
+};
+
+/// The numeric field of MetricsOptions itself, `tube_radius_m` (parameter_table.hpp).
+template <>
+struct ParameterTable<MetricsOptions> {
+  static constexpr std::string_view name = "MetricsOptions";
+  [[nodiscard]] static std::span<const ParameterField<MetricsOptions>> fields() noexcept;
 };
 
 /// All metrics of one written stroke against its reference.

@@ -4,13 +4,17 @@
 /// points at corners, LSEs where straight, Bezier CSEs where bent, and a typical-stroke ID.
 /// All lengths are in the data's units (the 1024 box).
 #include <span>
+#include <string_view>
 #include <vector>
 
+#include "calligraphy/core/parameter_table.hpp"
 #include "calligraphy/model/character.hpp"
 
 namespace calligraphy {
 
-/// Parameters of `fit_stroke`. Lengths in data units (1024 per character box).
+/// Parameters of `fit_stroke`. Lengths in data units (1024 per character box). The real-valued fields are
+/// in their table (`ParameterTable<FitOptions>`: each finite, the lengths and the angle > 0, the hook trim
+/// >= 0, the angle at most 180 degrees); `max_degree` is checked beside it.
 struct FitOptions {
   /// Max deviation of the fitted elements from the (trimmed) median. Governs the trade between
   /// the number of elements and fidelity.
@@ -29,6 +33,13 @@ struct FitOptions {
   int max_degree = 3;
 };
 
+/// The real-valued fields of FitOptions (parameter_table.hpp).
+template <>
+struct ParameterTable<FitOptions> {
+  static constexpr std::string_view name = "FitOptions";
+  [[nodiscard]] static std::span<const ParameterField<FitOptions>> fields() noexcept;
+};
+
 /// A piece of a stroke between two corners: the unit of classification.
 struct StrokePiece {
   double start_direction_deg = 0.0;  ///< direction of motion at the piece's start, y-up degrees
@@ -43,8 +54,8 @@ struct StrokePiece {
 
 /// Result of fitting one median.
 struct FittedStroke {
-  Stroke stroke;                     ///< elements, attraction factors, typical ID, median
-  std::vector<StrokePiece> pieces;   ///< corner-to-corner pieces
+  Stroke stroke;                    ///< elements, attraction factors, typical ID, median
+  std::vector<StrokePiece> pieces;  ///< corner-to-corner pieces
   /// Max distance from the (trimmed) median's points to the elements [data units]. Exact for medians of
   /// up to 64 points (all of hanzi-writer-data); for longer ones, when the exact value would cost more
   /// than 64 point-segment distances per point and curve sample (a median overlapping itself many
