@@ -40,6 +40,17 @@ def xdotool(*args):
     return subprocess.run(["xdotool", *map(str, args)], check=True, capture_output=True, text=True).stdout
 
 
+def press_quit(window, trainer, key="q"):
+    """Q (or Esc) to the window. xdotool sends the press, then the release: the program may close the window
+    in between, and the release then fails (BadWindow). That is accepted only once the program has ended."""
+    sent = subprocess.run(["xdotool", "key", "--window", str(window), key], capture_output=True, text=True)
+    if sent.returncode != 0:
+        try:
+            trainer.process.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            raise AssertionError(f"key {key}: {sent.stderr.strip()}, and the program still runs") from None
+
+
 class Box:
     """A `box <index> <char> x= y= size=` line: the data box in window pixels, y down."""
 
@@ -550,7 +561,7 @@ class TrainerTest(unittest.TestCase):
         time.sleep(0.3)
         window = trainer.window()
         xdotool("windowfocus", "--sync", window)
-        xdotool("key", "--window", window, "q")  # the screenshot shows the window as the exit came
+        press_quit(window, trainer)  # the screenshot shows the window as the exit came
         self.assertEqual(trainer.wait(timeout=30), 0, trainer.errors())
         picture = pathlib.Path(self.folder) / "refused.png"
         keep_artifact(picture)
@@ -591,7 +602,7 @@ class TrainerTest(unittest.TestCase):
         corner = box.data_to_px((980, 880))  # the pointer off the strokes, for the picture
         xdotool("mousemove", "--window", window, round(corner[0]), round(corner[1]))
         xdotool("windowfocus", "--sync", window)
-        xdotool("key", "--window", window, "q")
+        press_quit(window, trainer)
         self.assertEqual(trainer.wait(timeout=30), 0, trainer.errors())
         keep_artifact(pathlib.Path(self.folder) / "hint.png")
         panel = text.read_text(encoding="utf-8")
@@ -750,7 +761,7 @@ class TrainerTest(unittest.TestCase):
         def press_q(trainer):
             window = trainer.window()
             xdotool("windowfocus", "--sync", window)
-            xdotool("key", "--window", window, "q")
+            press_quit(window, trainer)
         self.ended_mid_trial(press_q)
 
     def test_sigterm_mid_trial_keeps_the_data(self):
@@ -871,7 +882,7 @@ class PeopleOutputTest(unittest.TestCase):
         time.sleep(1.2)
         window = self.trainer.window()
         xdotool("windowfocus", "--sync", window)
-        xdotool("key", "--window", window, "q")
+        press_quit(window, self.trainer)
         self.assertEqual(self.trainer.wait(timeout=30), 0, self.trainer.errors())
         self.assertNotIn("trial 1", self.trainer.errors(), "a trial ran during the demonstration")
         self.assertEqual(self.trainer.output(), "")
@@ -900,7 +911,7 @@ class PeopleOutputTest(unittest.TestCase):
         xdotool("key", "--window", window, "d")
         self.trainer.wait_for("trial 1 十: interrupted by D (demonstration)")
         self.trainer.wait_for("calligraphy train: demonstrating the stroke order of 十")
-        xdotool("key", "--window", window, "q")
+        press_quit(window, self.trainer)
         self.assertEqual(self.trainer.wait(timeout=30), 0, self.trainer.errors())
         keep_artifact(pathlib.Path(self.folder) / "demo.png")
         panel = text.read_text(encoding="utf-8")
