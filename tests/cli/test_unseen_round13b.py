@@ -25,6 +25,7 @@ CALLIGRAPHY_SANITIZED=1 takes five cases.
 """
 import json
 import os
+import pwd
 import resource
 import shutil
 import signal
@@ -654,14 +655,33 @@ class ModelSvg(Base):
         self.assertEqual(ElementTree.fromstring(got["bytes"]).tag.rsplit("}", 1)[-1], "svg")
         self.assertTrue(fifo.is_fifo())
 
+    def as_a_user_who_is_not_root(self):
+        """The command prefix that runs the program as a user who is not root: none when this process is not
+        root, else nobody through setpriv or runuser. Skips, saying why, when neither can run the program."""
+        if os.geteuid() != 0:
+            return []
+        try:
+            nobody = pwd.getpwnam("nobody")
+        except KeyError:
+            self.skipTest("running as root, and there is no user nobody to run as")
+        tried = []
+        for prefix in (["setpriv", f"--reuid={nobody.pw_uid}", f"--regid={nobody.pw_gid}", "--clear-groups"],
+                       ["runuser", "-u", "nobody", "--"]):
+            if shutil.which(prefix[0]) is None:
+                tried.append(f"{prefix[0]}: not installed")
+                continue
+            probe = subprocess.run([*prefix, CLI, "--version"], capture_output=True, timeout=TIMEOUT_S, cwd="/")
+            if probe.returncode == 0:
+                return prefix
+            tried.append(f"{prefix[0]}: {probe.stderr.decode(errors='replace').strip()[:200]}")
+        self.skipTest("running as root, and cannot run the program as nobody (" + "; ".join(tried) + ")")
+
     def test_model_svg_into_a_folder_its_user_cannot_write(self):
-        if os.geteuid() == 0 and not shutil.which("setpriv"):
-            self.skipTest("running as root and setpriv is missing: a folder's mode does not stop root")
+        prefix = self.as_a_user_who_is_not_root()
         locked = self.dir / "locked"
         locked.mkdir()
         locked.chmod(0o555)
         self.dir.chmod(0o755)
-        prefix = ["setpriv", "--reuid=65534", "--regid=65534", "--clear-groups"] if os.geteuid() == 0 else []
         result = subprocess.run([*prefix, CLI, "model", SHI, "--svg", str(locked / "m.svg")], cwd="/",
                                 env=ENV, stdin=subprocess.DEVNULL, capture_output=True, timeout=TIMEOUT_S)
         self.assert_one_error(result, 1, "--svg", str(locked))
