@@ -249,6 +249,29 @@ TEST_CASE("A folder without character files is an error naming the folder", "[va
   std::filesystem::remove_all(dir);
 }
 
+TEST_CASE("A file with outlines has one per median, and a name of white space or a control is no character's",
+          "[validation]") {
+  const std::string two = R"([[[0,0],[9,9]],[[0,9],[9,0]]])";
+  CHECK(parse_hanzi_writer_json(R"({"strokes":["M 0 0 Z","M 1 1 Z"],"medians":)" + two + "}", U'一', "a.json")
+            .medians.size() == 2);
+  CHECK(parse_hanzi_writer_json(R"({"medians":)" + two + "}", U'一', "b.json").medians.size() == 2);
+  CHECK_THAT(refusal(R"({"strokes":["M 0 0 Z"],"medians":)" + two + "}"),
+             Catch::Contains("/strokes") && Catch::Contains("1 stroke outlines for 2 medians"));
+  CHECK_THAT(refusal(R"({"medians":)" + two + R"(,"strokes":["M 0 0 Z","M 1 1 Z","M 2 2 Z"]})"),
+             Catch::Contains("3 stroke outlines for 2 medians"));
+
+  const auto dir = scratch_folder("names");
+  for (const char* name : {"永.json", " .json", "\x1b.json", "\t.json", "\u3000.json", "\u00a0.json"})
+    std::ofstream(dir / name) << "{}";
+  const auto library = CharacterLibrary::from_directory(dir);
+  CHECK(library.characters() == std::vector<char32_t>{U'永'});
+  CHECK(library.contains(U'永'));
+  CHECK_FALSE(library.contains(U' '));
+  CHECK_FALSE(library.contains(U'\x1b'));
+  CHECK_FALSE(library.contains(U'\u3000'));
+  std::filesystem::remove_all(dir);
+}
+
 TEST_CASE("Far coordinates fit with corner-search work bounded by the number of points", "[validation]") {
   // The corner search used to step its window by 4 units from 0 to the arc length: 1e17 never
   // advanced (4 is below the rounding of 1e17) and 1e9 took seconds.

@@ -59,6 +59,8 @@ int run_loop(const LoopCommand& command) {
                        " is more than 10^7 servo ticks, a trial's limit (--trial)");
     }
     settings.trial_characters = characters_from(command.trial, "--trial");
+    const CharacterSource source(command.library);
+    for (const char32_t c : settings.trial_characters) (void)source.load_named(c, "--trial");
   }
   // A stop signal ends the run early; its statistics are still printed.
   const StopSignals stop_signals;

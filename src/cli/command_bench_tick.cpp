@@ -25,6 +25,8 @@ int run_tick(const TickCommand& command) {
   settings.characters = characters_from(command.chars, "--chars");
   settings.passes = static_cast<int>(command.passes);
   settings.rate_hz = command.rate_hz;
+  const CharacterSource source(command.library);
+  for (const char32_t c : settings.characters) (void)source.load_named(c, "--chars");
   const TickCost cost = measure_tick_cost(library_from(command.library), settings);
   write_standard_output(command.json ? tick_cost_json(cost) : tick_cost_text(cost));
   return 0;

@@ -67,15 +67,6 @@ std::string code_point_text(char32_t c) {
   return text;
 }
 
-// White space as Unicode's White_Space property lists it (PropList.txt, Unicode 15.0): tabs and line ends,
-// the spaces of every width (U+00A0 no-break, U+2000-U+200A, U+3000 ideographic), the line and paragraph
-// separators. A text pasted from a page or a document holds any of them between its characters.
-bool is_white_space(char32_t c) {
-  return (c >= U'\x0009' && c <= U'\x000D') || c == U' ' || c == U'\x0085' || c == U'\x00A0' ||
-         c == U'\x1680' || (c >= U'\x2000' && c <= U'\x200A') || c == U'\x2028' || c == U'\x2029' ||
-         c == U'\x202F' || c == U'\x205F' || c == U'\x3000';
-}
-
 struct Listed {
   char32_t code_point = 0;
   std::vector<int> typical_ids;

@@ -81,7 +81,13 @@ int run_build(const BuildCommand& command, bool verbose) {
   const CorpusBuildTimes times{seconds_since(start), seconds_since(write_start)};
   write_standard_output(
       corpus_build_text(command.out, library.description(), fit, store_options, bytes.size(), times));
-  return fit.failures.empty() ? 0 : 1;
+  if (fit.failures.empty()) return 0;
+  // The exit status 1 said in the command's error line, as every failure is: how many, and the first.
+  print_error_line(
+      "calligraphy corpus build", "error",
+      std::to_string(fit.failures.size()) + " of the character files could not be modelled (" + command.out +
+          " holds the others; each is listed on standard output), the first: " + fit.failures.front().reason);
+  return 1;
 }
 
 struct StatsCommand {

@@ -8,12 +8,12 @@
 #include <string>
 #include <vector>
 
+#include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
 #include "calligraphy/study/curriculum.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 #include "cli/output.hpp"
-#include "calligraphy/core/unicode.hpp"
 
 namespace calligraphy::cli {
 namespace {
@@ -58,7 +58,7 @@ int run_curriculum(const CurriculumCommand& command) {
   const CharacterSource source(command.library);
   const auto typical_ids = [&source](char32_t c) {
     std::vector<int> ids;
-    for (const Stroke& stroke : source.load(c).strokes) ids.push_back(stroke.typical_id);
+    for (const Stroke& stroke : source.load_named(c, "--from").strokes) ids.push_back(stroke.typical_id);
     return ids;
   };
   const std::vector<ProposedCharacter> proposed =

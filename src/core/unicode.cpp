@@ -86,4 +86,15 @@ std::string describe_character(char32_t cp) {
   return glyph + "(" + code + ")";
 }
 
+bool is_white_space(char32_t c) {
+  return (c >= U'\x0009' && c <= U'\x000D') || c == U' ' || c == U'\x0085' || c == U'\x00A0' ||
+         c == U'\x1680' || (c >= U'\x2000' && c <= U'\x200A') || c == U'\x2028' || c == U'\x2029' ||
+         c == U'\x202F' || c == U'\x205F' || c == U'\x3000';
+}
+
+bool names_a_character(char32_t c) {
+  const bool control = c < U'\x0020' || (c >= U'\x007F' && c <= U'\x009F');
+  return !control && !is_white_space(c);
+}
+
 }  // namespace calligraphy

@@ -94,6 +94,7 @@ CharacterLibrary CharacterLibrary::from_directory(const std::filesystem::path& f
 bool CharacterLibrary::contains(char32_t cp) const {
   if (folder_.empty())
     return find_embedded(cp) != nullptr || (bundled_store_ && CorpusStore::bundled().contains(cp));
+  if (!names_a_character(cp)) return false;  // " .json", a control character's: not a character file
   std::error_code ec;
   return std::filesystem::is_regular_file(folder_ / (encode_utf8(cp) + ".json"), ec);
 }
@@ -179,7 +180,7 @@ std::vector<char32_t> CharacterLibrary::characters() const {
       if (path.extension() != ".json") continue;
       try {
         const std::u32string name = decode_utf8(path.stem().string());
-        if (name.size() == 1) out.push_back(name[0]);
+        if (name.size() == 1 && names_a_character(name[0])) out.push_back(name[0]);
       } catch (const InvalidArgument&) {
         // Not a character file (package.json, an odd name): skip.
       }

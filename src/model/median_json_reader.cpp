@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "calligraphy/model/character_library.hpp"
 
@@ -16,7 +17,7 @@ namespace calligraphy::detail {
 namespace {
 
 // What a value is, from where it stands in the document.
-enum class Role : std::uint8_t { root, medians, median, point, coordinate, skipped };
+enum class Role : std::uint8_t { root, medians, median, point, coordinate, outlines, skipped };
 
 struct Frame {
   Role role = Role::skipped;
@@ -108,6 +109,9 @@ class MediansHandler {
         medians_.push_back(std::move(median_));
         median_.clear();
         break;
+      case Role::outlines:  // counted only: one outline per median (the outline reader reads them)
+        outline_count_ = frame.count;
+        break;
       case Role::point:
         if (frame.count != 2) {
           return fail(path(), "expected a point [x, y] of two numbers, got " + std::to_string(frame.count));
@@ -132,6 +136,12 @@ class MediansHandler {
 
   void finish() {
     if (!result_.where.empty()) return;
+    if (outline_count_ && *outline_count_ != medians_.size()) {
+      fail("/strokes", std::to_string(*outline_count_) + " stroke outlines for " +
+                           std::to_string(medians_.size()) +
+                           " medians: a character file has one outline per median");
+      return;
+    }
     result_.medians = std::move(medians_);
     result_.ok = true;
   }
@@ -149,6 +159,7 @@ class MediansHandler {
     const Frame& frame = frames_.back();
     switch (frame.role) {
       case Role::root:
+        if (frame.key == "strokes") return Role::outlines;
         return frame.key == "medians" ? Role::medians : Role::skipped;
       case Role::medians:
         return Role::median;
@@ -237,6 +248,7 @@ class MediansHandler {
         if (frames_.back().count >= 2)
           return fail(next_path(), "expected a point [x, y] of two numbers, got more");
         break;
+      case Role::outlines:
       case Role::skipped:
         break;
     }
@@ -281,7 +293,8 @@ class MediansHandler {
   std::string_view text_;
   std::vector<Frame> frames_;
   bool seen_medians_ = false;
-  std::size_t points_ = 0;  // in all medians so far
+  std::optional<std::size_t> outline_count_;  // the root's "strokes" array, when it has one
+  std::size_t points_ = 0;                    // in all medians so far
   std::vector<std::vector<Vec2>> medians_;
   std::vector<Vec2> median_;
   Vec2 point_ = Vec2::Zero();
