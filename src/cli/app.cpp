@@ -122,7 +122,10 @@ CLI::Option* add_integer(CLI::App& app, const std::string& name, std::int64_t& t
   const std::string expectation =
       "an integer in [" + std::to_string(minimum) + ", " + std::to_string(maximum) + "]";
   const std::string shown = default_text.empty() ? std::to_string(target) : default_text;
-  return add_single(app, name, value_name, description, shown, [=, &target](const std::string& text) {
+  // The range in the help as the schema's integer options write it ("0..1000"), so that no option's
+  // bounds are found only by trying them.
+  const std::string ranged = description + ", " + std::to_string(minimum) + ".." + std::to_string(maximum);
+  return add_single(app, name, value_name, ranged, shown, [=, &target](const std::string& text) {
     std::int64_t value = 0;
     // Decimal digits only (docs/cli.md, "Numbers"): a sign only where a negative number is allowed, so a
     // count that starts at 0 refuses '-0' as it refuses '-1'.
