@@ -138,7 +138,7 @@ CLI::Option* add_integer(CLI::App& app, const std::string& name, std::int64_t& t
 
 CLI::Option* add_unsigned(CLI::App& app, const std::string& name, std::uint64_t& target,
                           const std::string& value_name, const std::string& description) {
-  return add_single(app, name, value_name, description, std::to_string(target),
+  return add_single(app, name, value_name, description + ", 0..18446744073709551615", std::to_string(target),
                     [=, &target](const std::string& text) {
                       std::uint64_t value = 0;
                       if (!parse_integer(text, value))

@@ -216,7 +216,7 @@ void add_train_command(CLI::App& root, Commands& commands, DeviceRegistry& devic
   add_output_path(*app, "--record", command->record,
                   "write each completed trial here as a teacher's recording (JSON), replacing the last",
                   StandardOutput::refused);
-  add_unsigned(*app, "--seed", command->seed, "N", "seed of the simulated writer (a 64-bit integer)");
+  add_unsigned(*app, "--seed", command->seed, "N", "seed of the simulated writer");
   add_library_options(*app, command->library, true);
   add_output_folder(
       *app, "--session", command->session,

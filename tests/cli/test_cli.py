@@ -88,6 +88,9 @@ class HelpAndVersion(CliTestCase):
                     # An option taking a value ("--seed N ...") shows its default or that it is required.
                     if re.match(r"--[a-z-]+ [A-Z]", entry):
                         self.assertRegex(entry, r"\((default: .+|required)\)", f"{command}: {entry}")
+                    # A count ("--jobs N") states the integers it takes.
+                    if re.match(r"--[a-z-]+ N(?![/A-Za-z])", entry):
+                        self.assertRegex(entry, r"-?\d+\.\.\d+|in [\[(]", f"{command}: {entry}")
 
     def test_an_option_without_a_default_says_none_once(self):
         # --exit-after has no default (docs/cli.md): its help says so, once, with its range.
