@@ -5,17 +5,19 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <cstddef>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "bindings.hpp"
-#include "calligraphy/model/nearest_point.hpp"
 #include "calligraphy/analysis/stroke_matcher.hpp"
-#include "calligraphy/model/stroke_progress.hpp"
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/nearest_point.hpp"
 #include "calligraphy/model/scene.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 #include "model_bindings.hpp"
 #include "numpy_arrays.hpp"
 #include "parameter_class.hpp"
@@ -56,6 +58,15 @@ py::tuple nearest_point_py(const ElementLike& element_object, const ArrayLike& p
   options.newton_iterations = take(newton_iterations, "newton_iterations");
   check_options(options, "");
   const Vectors p = as_vectors(point.object, 2, "point");
+  // Named by the argument and row here; the library's own message names its C++ parameter.
+  for (py::ssize_t i = 0; i < p.count; ++i) {
+    const Vec2 v = p.vec2(i);
+    if (!(std::abs(v.x()) <= kMaxNearestPointCoordinate && std::abs(v.y()) <= kMaxNearestPointCoordinate)) {
+      throw InvalidArgument(std::string(p.single ? "point" : "point[" + std::to_string(i) + "]") + " = (" +
+                            shortest_decimal(v.x()) + ", " + shortest_decimal(v.y()) +
+                            ") is not finite or exceeds 1e150 in magnitude");
+    }
+  }
   if (p.single) {
     const NearestPoint r = nearest_point(element, p.vec2(0), options);
     return py::make_tuple(r.t, to_array(r.foot), r.distance);

@@ -16,7 +16,7 @@ namespace calligraphy {
 namespace {
 
 // Above this magnitude squared distances could overflow a double.
-constexpr double kMaxCoordinate = 1e150;
+constexpr double kMaxCoordinate = kMaxNearestPointCoordinate;
 
 std::string format_number(double value) {
   char buffer[32];

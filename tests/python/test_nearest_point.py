@@ -92,3 +92,13 @@ def test_control_point_array_and_line_element():
     element = calligraphy.StrokeElement(cp)
     assert element.kind == "line" and element.degree == 1
     assert calligraphy.nearest_point(element, [0.005, 0.003])[2] == pytest.approx(0.003)
+
+
+def test_a_point_that_is_not_finite_is_named_by_the_argument_and_its_row():
+    line = [[0.0, 0.0], [1.0, 0.0]]
+    with pytest.raises(ValueError, match=r"^point = \(nan, 0\) is not finite"):
+        calligraphy.nearest_point(line, [float("nan"), 0.0])
+    with pytest.raises(ValueError, match=r"^point\[1\] = \(2e\+150, 1\)"):
+        calligraphy.nearest_point(line, [[0.0, 0.0], [2e150, 1.0]])
+    t, foot, distance = calligraphy.nearest_point(line, [1e150, 0.0])  # the bound itself is taken
+    assert t == 1.0 and distance == pytest.approx(1e150)

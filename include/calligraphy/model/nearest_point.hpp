@@ -83,11 +83,14 @@ struct NearestPoint {
   double distance = 0.0;
 };
 
+/// Largest |x| or |y| of a point or control point `nearest_point` accepts: squared distances stay finite.
+inline constexpr double kMaxNearestPointCoordinate = 1e150;
+
 /// Nearest point on `element` to `p` (element units, m for a placed element).
 /// Throws InvalidArgument when `p` or a control point is not finite or has a magnitude above 1e150
-/// (squared distances would overflow), when the element's degree is not 1..4, or when the options
-/// are out of range (tolerance not finite or <= 0, starts or iterations < 1). Among equally near
-/// points the one with the smallest t is returned. Allocation-free.
+/// (kMaxNearestPointCoordinate; squared distances would overflow), when the element's degree is not 1..4, or
+/// when the options are out of range (tolerance not finite or <= 0, starts or iterations < 1). Among equally
+/// near points the one with the smallest t is returned. Allocation-free.
 NearestPoint nearest_point(const StrokeElement& element, const Vec2& p,
                            const NearestPointOptions& options = {});
 
