@@ -820,6 +820,19 @@ class TraceAndUnits(Case):
                 if c["unit"]:
                     self.assertTrue(c["name"].endswith("_" + c["unit"].lower()), c)
 
+    def test_a_devices_limits_are_one_object_in_devices_records_and_python(self):
+        # `calligraphy devices --json` gives each device's `info` (its limits in SI units); a trial record's
+        # `device.info` is "every DeviceInfo field in SI units" (docs/experiments.md), and Python's
+        # `list_devices()` is the same listing (docs/cli.md). One device, one set of names and values.
+        listing = json.loads(out(run(["devices", "--json"], self.tmp)))
+        info = next(d for d in listing["devices"] if d["name"] == "simulated")["info"]
+        name, record, _ = OneTrial.first_trial(self)
+        self.assertEqual(record["device"]["name"], "simulated")
+        self.assertEqual(info, record["device"]["info"])
+        if cg is not None:
+            python = next(d for d in cg.list_devices().devices if d.name == "simulated").info.to_dict()
+            self.assertEqual(json.loads(json.dumps(python)), info)
+
     def test_score_takes_the_units_docs_metrics_spells(self):
         # docs/metrics.md, "Trace CSV": "Units of `x`, `y`: ..." names the values of `score --units` and of
         # Python's `units=`.
