@@ -750,6 +750,23 @@ class OneTrial(Case):
         self.assertEqual(sorted({p["block"] for p in plan}), [1, 2])
         self.assertEqual(sorted({p["item"] for p in plan}), [1, 2])
 
+    def test_a_cohort_in_memory_gives_the_tables_of_the_session(self):
+        # `session cohort --help`: "no session folders; the same trials as session run". Its tables have the
+        # report's columns and, for the same subject of the same protocol, the same values in every column but
+        # those that name a folder, a file or a wall-clock time.
+        (self.tmp / "co").mkdir()
+        r = run(["session", "cohort", Shared.folder / "p.json", "--subjects", "1", "--csv", "co"], self.tmp)
+        self.assertTrue(ok(r), error_lines(r))
+        for table, rows in (("trials.csv", self.s.trials_csv), ("strokes.csv", self.s.strokes_csv)):
+            text = (self.tmp / "co" / table).read_text()
+            self.assertEqual(text.splitlines()[0], (Shared.folder / "tables" / table).read_text().splitlines()[0])
+            cohort = list(csv.DictReader(io.StringIO(text)))
+            self.assertEqual(len(cohort), len(rows), table)
+            for mine, theirs in zip(cohort, rows):
+                differing = {k for k in mine if mine[k] != theirs[k]}
+                self.assertLessEqual(differing, {"session", "start_utc", "trace_file", "trace_sha256"},
+                                     (table, {k: (mine[k], theirs[k]) for k in differing}))
+
     def test_times_are_rounded_to_whole_nanoseconds_on_every_surface(self):
         # docs/metrics.md: "The times (writing, in-air, total, ...) are rounded to whole nanoseconds ... rounded,
         # n ticks of 1 ms read n ms". A stroke's writing time `time_s` (t_(N-1) - t_0) is such a time.
@@ -832,6 +849,30 @@ class TraceAndUnits(Case):
         if cg is not None:
             python = next(d for d in cg.list_devices().devices if d.name == "simulated").info.to_dict()
             self.assertEqual(json.loads(json.dumps(python)), info)
+
+    def test_a_typical_stroke_is_named_alike_by_strokes_model_and_python(self):
+        # `strokes --json`, `model --json` and Python's TYPICAL_STROKES (docs/python.md: `name` is `name_zh`
+        # there) give each of the 39 strokes one id, acronym, name, pinyin and code point; the JSON writes the
+        # code point as U+XXXX, Python the character itself.
+        table = json.loads(out(run(["strokes", "--json"], self.tmp)))
+        self.assertEqual([t["id"] for t in table], list(range(1, 40)))
+        by_id = {t["id"]: t for t in table}
+        model = json.loads(out(run(["model", SHI, "--json"], self.tmp)))
+        for stroke in model["strokes"]:
+            t = by_id[stroke["typical_id"]]
+            self.assertEqual((stroke["acronym"], stroke["name"], stroke["pinyin"], stroke["unicode"]),
+                             (t["acronym"], t["name"], t["pinyin"], t["unicode"]))
+        if cg is None:
+            return
+        self.assertEqual(len(cg.TYPICAL_STROKES), 39)
+        for p in cg.TYPICAL_STROKES:
+            t = by_id[p.id]
+            with self.subTest(id=p.id):
+                self.assertEqual((p.acronym, p.name_zh, p.pinyin, p.compound),
+                                 (t["acronym"], t["name"], t["pinyin"], t["compound"]))
+                self.assertEqual(f"U+{ord(p.unicode):04X}" if p.unicode else None,
+                                 t["unicode"] if t["unicode"] not in ("", "-") else None)
+                self.assertEqual(cg.typical_stroke(p.acronym).id, p.id)
 
     def test_score_takes_the_units_docs_metrics_spells(self):
         # docs/metrics.md, "Trace CSV": "Units of `x`, `y`: ..." names the values of `score --units` and of
