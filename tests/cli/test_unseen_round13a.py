@@ -38,7 +38,7 @@ import unittest
 import warnings
 from pathlib import Path
 
-from outsider import CLI, SANITIZED, error_lines, run, sanitized_subset
+from outsider import error_lines, run, sanitized_subset
 
 SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 SHI = "十"
