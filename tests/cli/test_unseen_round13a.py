@@ -508,6 +508,31 @@ class Spellings(Case):
         listed = re.search(r'metrics\["end_reason"\]\s*#\s*([\w, ]+)', python_md).group(1)
         self.assertEqual({w.strip() for w in listed.split(",")}, END_REASONS)
 
+    def test_a_pen_down_that_never_reached_the_stroke_due_has_no_distance_from_it(self):
+        # docs/metrics.md: a segment's verdict gives "the refused or accepted pen-down's mean distance from the
+        # stroke due as `mean_deviation_m`"; docs/cli.md: "A value that does not exist is `null` (`-` in the
+        # table), never 0". 十 written 30 mm to the right never comes near the start of a stroke: no distance
+        # was measured, so none is given, in the JSON, Python or the table ("0.0 mm off" would be false).
+        rows = list(csv.DictReader(open(self.s.folder / "t.csv", encoding="utf-8")))
+        lines = [",".join(rows[0].keys())]
+        for row in rows:
+            lines.append(",".join(dict(row, x=repr(float(row["x"]) + 0.03)).values()))
+        (self.tmp / "shifted.csv").write_text("\n".join(lines) + "\n")
+        r = run(["score", "shifted.csv", "--character", SHI, "--json", "-"], self.tmp)
+        self.assertTrue(ok(r), error_lines(r))
+        results = [json.loads(out(r))]
+        if cg is not None:
+            results.append(cg.score(str(self.tmp / "shifted.csv"), SHI))
+        for result in results:
+            verdicts = [s["verdict"] for s in result["per_character"][0]["segments"] if s["verdict"]]
+            self.assertTrue(verdicts)
+            for v in verdicts:
+                self.assertEqual((v["accepted"], v["refusal"]), (False, "wrong_place"))
+                self.assertIsNone(v["mean_deviation_m"], v)
+        table = out(run(["score", "shifted.csv", "--character", SHI], self.tmp))
+        self.assertIn("refused: wrong place", table)
+        self.assertNotIn("0.0 mm off", table)
+
     def test_refusals_are_spelt_alike_by_score_python_and_the_quiz(self):
         # A trace of 十 written with its two strokes swapped: the first pen-down is refused as `wrong_order`.
         rows = list(csv.DictReader(open(self.s.folder / "t.csv", encoding="utf-8")))
