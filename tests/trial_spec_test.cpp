@@ -232,10 +232,12 @@ TEST_CASE("a specification's errors name the field in both its forms") {
   bad = spec;
   bad.writer_profile = "";
   fails_naming(bad, "writer_profile (--writer-profile): no profile named");
-  // The profile's name and its settings are the simulated writer's to check, naming the same fields.
+  // The profile is one of the known ones, refused where the specification is checked (so a record naming
+  // another is refused as the option is); its settings are the simulated writer's to check, naming the same
+  // fields.
   bad = spec;
   bad.writer_profile = "expert";
-  CHECK_NOTHROW(bad.validate());
+  fails_naming(bad, "writer_profile (--writer-profile): unknown writer profile 'expert'");
   CHECK_THAT(error_of([&] { (void)writer_profile_of(bad); }),
              Catch::Contains("writer_profile (--writer-profile)") && Catch::Contains("expert"));
   CHECK_THAT(error_of([&] { SimulatedWriting refused(bad); }),

@@ -201,6 +201,9 @@ void bind_collision(py::module_& m) {
       .def_readonly("matched_stroke", &StrokeMatch::matched_stroke,
                     "for wrong_order and wrong_stroke the index of the stroke the path writes instead; "
                     "otherwise the expected stroke's index")
+      .def_readonly("entered", &StrokeMatch::entered,
+                    "the path came within the start radius of the expected stroke's start; when not, "
+                    "covered_fraction and mean_deviation_m are 0 and measure nothing")
       .def_readonly("covered_fraction", &StrokeMatch::covered_fraction,
                     "the pen's way along the expected stroke / its length, in [0, 1]")
       .def_readonly("mean_deviation_m", &StrokeMatch::mean_deviation_m,
@@ -224,8 +227,9 @@ it. A refusal is named by trying the path on the character's other strokes and r
 path_m: array-like (N, 2), N >= 1, points on the paper in writing order [m], at any spacing (read as
         straight lines between them).
 acceptance: a StrokeAcceptance (default: the C++ defaults, as ForceLawParameters().acceptance).
-Returns a StrokeMatch: accepted (bool), refusal (StrokeRefusal), matched_stroke (int),
-covered_fraction (float, in [0, 1]), mean_deviation_m (float) [m]. The GIL is released while matching.
+Returns a StrokeMatch: accepted (bool), refusal (StrokeRefusal), matched_stroke (int), entered (bool: the
+path came near the expected stroke's start), covered_fraction (float, in [0, 1]), mean_deviation_m (float)
+[m] (both 0, measuring nothing, when not entered; `score` then gives the verdict's mean_deviation_m None). The GIL is released while matching.
 Raises IndexError naming character_index or stroke_index out of range, InvalidArgument (a ValueError)
 naming path_m for another shape, no points or a point that is not finite, TypeError naming the argument
 for a value of the wrong type.)");

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "analysis/durations.hpp"
 #include "analysis/input_checks.hpp"
 #include "calligraphy/analysis/metrics.hpp"
 #include "calligraphy/core/decimal_number.hpp"
@@ -117,10 +118,15 @@ StrokeKinematics stroke_kinematics(std::span<const double> times_s, std::span<co
   trial_detail::require_valid_options(options);
   check_samples(times_s, positions_m);
   StrokeKinematics k;
-  k.writing_time_s = times_s.back() - times_s.front();
+  // The samples' span as the grid and the jerk take it; the writing time reported is that span in whole
+  // nanoseconds, as every time of the metrics record is (docs/metrics.md), so n ticks of 1 ms read n ms (a
+  // span under half a nanosecond is kept as it is).
+  const double span_s = times_s.back() - times_s.front();
+  if (!(span_s > 0.0)) throw InvalidArgument("stroke_kinematics: the samples span no time");
+  const double rounded_s = analysis::whole_nanoseconds(span_s);
+  k.writing_time_s = rounded_s > 0.0 ? rounded_s : span_s;
   for (std::size_t i = 1; i < positions_m.size(); ++i)
     k.path_length_m += (positions_m[i] - positions_m[i - 1]).norm();
-  if (!(k.writing_time_s > 0.0)) throw InvalidArgument("stroke_kinematics: the samples span no time");
   if (!(k.path_length_m > 0.0)) throw InvalidArgument("stroke_kinematics: the pen does not move");
   k.mean_speed_m_per_s = k.path_length_m / k.writing_time_s;
 
@@ -131,12 +137,12 @@ StrokeKinematics stroke_kinematics(std::span<const double> times_s, std::span<co
   // sampling interval and at max_grid_points (the step grows instead), which bounds the work by the
   // number of samples whatever the timestamps.
   const double sample_count = static_cast<double>(times_s.size());
-  double step_s = k.writing_time_s / (sample_count - 1.0);
+  double step_s = span_s / (sample_count - 1.0);
   if (filtered) step_s = std::clamp(step_s, sigma_s / 16.0, sigma_s / 4.0);
-  const double needed = std::max(1.0, std::ceil(k.writing_time_s / step_s));
+  const double needed = std::max(1.0, std::ceil(span_s / step_s));
   const double intervals = std::min({needed, static_cast<double>(options.max_grid_points - 1),
                                      kGridPointsPerInterval * (sample_count - 1.0)});
-  if (intervals < needed) step_s = k.writing_time_s / intervals;
+  if (intervals < needed) step_s = span_s / intervals;
   // The grid covers [t0, t0 + intervals * step], at least the samples' span; later points hold the end.
   const auto count = static_cast<std::size_t>(intervals) + 1;
   // Rest before and after: as far as the kernel spreads the movement, plus the stencils' reach.
@@ -157,7 +163,7 @@ StrokeKinematics stroke_kinematics(std::span<const double> times_s, std::span<co
     const Vec2 jerk = (grid[i + 2] - 2.0 * grid[i + 1] + 2.0 * grid[i - 1] - grid[i - 2]) / h3;
     jerk_squared_integral += jerk.squaredNorm() * step_s;
   }
-  const double t = k.writing_time_s;
+  const double t = span_s;
   k.normalised_jerk =
       std::sqrt(0.5 * jerk_squared_integral * std::pow(t, 5) / (k.path_length_m * k.path_length_m));
   return k;

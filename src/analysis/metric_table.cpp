@@ -268,7 +268,7 @@ const MetricInfo kMetrics[] = {
     {.name = "time_s",
      .unit = "s",
      .doc = "writing time of the segment matched to the stroke",
-     .definition = "t_(N-1) - t_0",
+     .definition = "t_(N-1) - t_0, rounded to whole nanoseconds",
      .levels = kStroke,
      .of_stroke =
          [](const StrokeScore& s) {

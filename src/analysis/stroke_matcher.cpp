@@ -104,6 +104,7 @@ StrokeMatch match_stroke(const PlacedCharacter& character, std::size_t expected,
   const StrokeAttempt own = attempt(stroke, path_m, start_radius_m, acceptance);
   StrokeMatch match;
   match.matched_stroke = expected;
+  match.entered = own.entered;
   match.covered_fraction = own.covered_fraction;
   match.mean_deviation_m = own.mean_deviation_m;
   if (own.written) {

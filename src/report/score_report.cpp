@@ -46,12 +46,14 @@ nlohmann::json segments_json(const CharacterScore& score) {
     nlohmann::json verdict = nullptr;
     if (s.verdict) {
       const StrokeMatch& v = *s.verdict;
-      verdict = {{"expected_stroke", expected},
-                 {"accepted", v.accepted},
-                 {"refusal", to_string(v.refusal)},
-                 {"matched_stroke", v.matched_stroke},
-                 {"covered_fraction", v.covered_fraction},
-                 {"mean_deviation_m", v.mean_deviation_m}};
+      verdict = {
+          {"expected_stroke", expected},
+          {"accepted", v.accepted},
+          {"refusal", to_string(v.refusal)},
+          {"matched_stroke", v.matched_stroke},
+          {"covered_fraction", v.covered_fraction},
+          // No distance was measured from a stroke the pen never came near the start of.
+          {"mean_deviation_m", v.entered ? nlohmann::json(v.mean_deviation_m) : nlohmann::json(nullptr)}};
       if (v.accepted) ++expected;
     }
     out.push_back({{"begin", s.begin},
@@ -76,7 +78,8 @@ struct StrokeVerdict {
   enum class State { not_written, accepted, refused } state = State::not_written;
   StrokeRefusal refusal = StrokeRefusal::none;
   std::size_t due = 0;            // the stroke due when it was refused (0-based)
-  double deviation_m = 0.0;       // the refused pen-down's mean distance from the stroke that was due
+  bool entered = false;           // the refused pen-down came near the start of the stroke that was due
+  double deviation_m = 0.0;       // its mean distance from that stroke, when it did
   double covered_fraction = 0.0;  // how far along the stroke that was due it went
 };
 
@@ -88,7 +91,7 @@ std::vector<StrokeVerdict> stroke_verdicts(const CharacterScore& score) {
     const StrokeMatch& match = *segment.verdict;
     if (match.accepted) {
       if (due < verdicts.size())
-        verdicts[due] = {StrokeVerdict::State::accepted, StrokeRefusal::none, due, 0.0, 1.0};
+        verdicts[due] = {StrokeVerdict::State::accepted, StrokeRefusal::none, due, true, 0.0, 1.0};
       ++due;
       continue;
     }
@@ -96,8 +99,8 @@ std::vector<StrokeVerdict> stroke_verdicts(const CharacterScore& score) {
         match.refusal == StrokeRefusal::wrong_order || match.refusal == StrokeRefusal::wrong_stroke;
     const std::size_t about = other_stroke ? match.matched_stroke : due;
     if (about >= verdicts.size() || verdicts[about].state == StrokeVerdict::State::accepted) continue;
-    verdicts[about] = {StrokeVerdict::State::refused, match.refusal, due, match.mean_deviation_m,
-                       match.covered_fraction};
+    verdicts[about] = {StrokeVerdict::State::refused, match.refusal,         due, match.entered,
+                       match.mean_deviation_m,        match.covered_fraction};
   }
   return verdicts;
 }
@@ -134,6 +137,7 @@ std::string verdict_text(const StrokeVerdict& v, std::size_t stroke) {
                     v.deviation_m * 1e3);
       return why + text;
     default:
+      if (!v.entered) return why + " (never near its start)";
       std::snprintf(text, sizeof text, " (%.1f mm off)", v.deviation_m * 1e3);
       return why + text;
   }

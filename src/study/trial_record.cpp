@@ -11,6 +11,7 @@
 #include "calligraphy/model/typical_strokes.hpp"
 #include "calligraphy/report/pen_trace_csv.hpp"
 #include "core/schema_json.hpp"
+#include "report/device_info_object.hpp"
 #include "report/trial_outcome.hpp"
 #include "study/manifest_json.hpp"
 #include "study/remembered_writer.hpp"
@@ -24,7 +25,6 @@ namespace {
 using nlohmann::json;
 
 json vec(const Vec2& v) { return json::array({v.x(), v.y()}); }
-json vec(const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
 
 const char* method_name(NearestPointMethod method) {
   switch (method) {
@@ -104,18 +104,6 @@ json renderer_json(const TrialOptions& o) {
             {"lock_memory", o.loop.lock_memory},
             {"max_force_age_s", o.loop.max_force_age_s},
             {"stall_timeout_s", o.loop.stall_timeout_s}}}};
-}
-
-json device_info_json(const DeviceInfo& d) {
-  return {{"model", d.model},
-          {"manufacturer", d.manufacturer},
-          {"max_force_n", d.max_force_n},
-          {"max_continuous_force_n", d.max_continuous_force_n},
-          {"max_stiffness_n_per_m", d.max_stiffness_n_per_m},
-          {"max_damping_n_s_per_m", d.max_damping_n_s_per_m},
-          {"intrinsic_damping_n_s_per_m", d.intrinsic_damping_n_s_per_m},
-          {"workspace_radius_m", d.workspace_radius_m},
-          {"workspace_size_m", vec(d.workspace_size_m)}};
 }
 
 json writer_json(const TrialRecordContext& c) {
@@ -301,7 +289,7 @@ nlohmann::json trial_record(const TrialRecordContext& c, const Scene& scene, con
                    {"device",
                     {{"name", c.device_name},
                      {"hardware", c.hardware},
-                     {"info", device_info_json(c.device_info)},
+                     {"info", report_detail::device_info_object(c.device_info)},
                      {"time_at_start_s", result.device_time_at_start_s}}},
                    {"writer", writer_json(c)},
                    {"force_law", force_law_json(c.options->force)},

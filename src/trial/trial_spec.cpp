@@ -16,6 +16,7 @@
 #include "calligraphy/core/servo_rate.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/scene.hpp"
+#include "calligraphy/trial/writer_profile.hpp"
 #include "core/json_reader.hpp"
 #include "core/schema_json.hpp"
 #include "trial/trial_spec_object.hpp"
@@ -426,9 +427,17 @@ void TrialSpec::validate(TeacherSource teacher_from) const {
   if (writer == TrialWriter::person && !writer_parameters.empty()) {
     refuse("writer_parameters", "apply to the simulated writer, not to a person (writer 'person')");
   }
-  // The profile's name and its settings' keys and ranges are the simulated writer's to check (sim's
-  // writer_profile_of, when it is made); here, only what any writer needs.
+  // The profile is one of the known ones (`writer_profile`, the one list the options and Python take), so a
+  // record naming another is refused as the option is, not run under a name no writer has. Its settings' keys
+  // and ranges are the simulated writer's to check (sim's writer_profile_of, when it is made).
   if (writer_profile.empty()) refuse("writer_profile", "no profile named");
+  std::string unknown_profile;
+  try {
+    (void)calligraphy::writer_profile(writer_profile);
+  } catch (const InvalidArgument& error) {
+    unknown_profile = error.what();
+  }
+  if (!unknown_profile.empty()) refuse("writer_profile", unknown_profile);
   for (const WriterSetting& setting : writer_parameters) {
     if (setting.key.empty() || !std::isfinite(setting.value))
       refuse("writer_parameters", "'" + writer_setting_text(setting) + "' is not a key and a finite number");

@@ -8,8 +8,8 @@
 #include <cstddef>
 #include <span>
 
-#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/model/scene.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 
 namespace calligraphy {
 
@@ -20,6 +20,9 @@ struct StrokeMatch {
   /// For wrong_order and wrong_stroke: the stroke of the character the path writes instead (index);
   /// otherwise the expected stroke.
   std::size_t matched_stroke = 0;
+  /// The path came within the start radius of the expected stroke's start (WS); when not, the two figures
+  /// below are 0 and measure nothing (the report gives no distance then).
+  bool entered = false;
   double covered_fraction = 0.0;  ///< the pen's way along the expected stroke / its length, in [0, 1]
   double mean_deviation_m = 0.0;  ///< mean distance of the path from the expected stroke [m]
 };
