@@ -125,6 +125,14 @@ def restore(pristine, work):
     shutil.copytree(pristine, work, symlinks=True)
 
 
+def default_stop_signals():
+    """In the child before exec: SIGINT, SIGTERM and SIGHUP at their default disposition. A test started in the
+    background of a shell (`ctest ... &`) inherits SIGINT ignored, and the program leaves an ignored stop signal
+    ignored (as nohup asks), so the signal raised at a step would not stop it."""
+    for number in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        signal.signal(number, signal.SIG_DFL)
+
+
 def leftovers(folder):
     return sorted(str(path.relative_to(folder)) for path in folder.rglob("*")
                   if any(mark in path.name for mark in LEFTOVER_MARKS))
@@ -164,7 +172,8 @@ class FaultInjection(unittest.TestCase):
             environment.update(LD_PRELOAD=SHIM, CALLIGRAPHY_FAULT_UNDER=str(cwd / "out"), **fault)
         program = [CLI] if arguments[0] != PYTHON_WRITER else [sys.executable, "-c", PYTHON_WRITER_CODE]
         return subprocess.run([*program, *map(str, arguments[1:] if program[0] != CLI else arguments)], cwd=cwd,
-                              capture_output=True, env=environment, timeout=TIMEOUT_S)
+                              capture_output=True, env=environment, timeout=TIMEOUT_S,
+                              preexec_fn=default_stop_signals)
 
     def sweep(self, arguments_for, signals=False, files=2, repeated_step_stride=1):
         """Every fault at every step of `arguments_for(study)` writing over the output of the one-subject
