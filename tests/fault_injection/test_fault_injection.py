@@ -586,10 +586,16 @@ class FaultInjection(unittest.TestCase):
               f"({', '.join(f'{kind} {counts[kind]}' for kind in KINDS)})", flush=True)
 
     def test_cohort_tables(self):
-        """`session cohort` replacing its tables of one subject with those of two."""
+        """`session cohort` replacing its tables of one subject with those of two, each subject writing one trial:
+        the two tables are written in the same steps whatever their rows (every run simulates its cohort again)."""
+        protocol = json.loads(self.protocol.read_text(encoding="utf-8"))
+        protocol["phases"] = protocol["phases"][:1]
+        one_trial = Path(self.scratch.name) / "one-trial.json"
+        one_trial.write_text(json.dumps(protocol, ensure_ascii=False), encoding="utf-8")
+
         def cohort(study):
             subjects = "1" if study == self.one_subject / "study" else "2"
-            return ["session", "cohort", self.protocol, "--subjects", subjects, "--csv", "out", "--jobs", "1"]
+            return ["session", "cohort", one_trial, "--subjects", subjects, "--csv", "out", "--jobs", "1"]
         self.sweep(cohort)
 
 
