@@ -4,6 +4,7 @@ the subjects alike it is singular. Needs R with lmerTest (Debian r-cran-lmertest
 it. The same subject draws the same traits from the CLI and from calligraphy.cohort.simulate."""
 
 import functools
+import json
 import pathlib
 import shutil
 import subprocess
@@ -73,7 +74,15 @@ def test_a_pilot_has_a_subject_variance_only_when_subjects_differ(cli, tmp_path,
 
 
 def test_the_cli_and_python_draw_the_same_subjects(cli, tmp_path):
-    protocol = PROTOCOLS / "retention-transfer.json"
+    # retention-transfer with its training once per character: both days and every phase, each subject's traits
+    # on every row (14 a subject instead of 23), drawn from the subject's id whatever the trials.
+    document = json.loads((PROTOCOLS / "retention-transfer.json").read_text(encoding="utf-8"))
+    training = next(phase for phase in document["phases"] if phase["phase"] == "training")
+    assert training["repetitions"] == 4
+    training["repetitions"] = 1
+    protocol = tmp_path / "protocol" / "retention-transfer.json"
+    protocol.parent.mkdir()
+    protocol.write_text(json.dumps(document, ensure_ascii=False), encoding="utf-8")
     subprocess.run([cli, "session", "cohort", str(protocol), "--subjects", "3", "--writer-profile", "novice",
                     "--csv", str(tmp_path)], check=True, capture_output=True)
     from_cli = pandas.read_csv(tmp_path / "trials.csv", float_precision="round_trip")
