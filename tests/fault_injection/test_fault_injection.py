@@ -23,6 +23,7 @@ appeared) completes the session without rewriting a saved trial or leaving a tem
 import hashlib
 import json
 import os
+import random
 import shutil
 import signal
 import subprocess
@@ -92,15 +93,28 @@ def snapshot(folder):
 # file) and every call of the other kinds, which change what a folder holds; CALLIGRAPHY_FAULT_EVERY_CALL=1
 # takes every call of every kind (docs/testing.md).
 REPEATED_STEP_STRIDE = 1 if os.environ.get("CALLIGRAPHY_FAULT_EVERY_CALL") == "1" else 3
+# The Python report's writer is the binding's door to the one writer of sets that the `report` sweeps take at
+# every step; each of its runs starts an interpreter and imports the package (a tenth of a second of CPU).
+# Its sweep takes, of each kind of more than three calls, every third call from an offset drawn per kind with
+# CALLIGRAPHY_TEST_SEED (random when unset, printed), so that every call is swept by some seed, and every call
+# of the other kinds; CALLIGRAPHY_FAULT_EVERY_CALL=1 takes every call.
+SAMPLED_STRIDE = 1 if os.environ.get("CALLIGRAPHY_FAULT_EVERY_CALL") == "1" else 3
+SEED = int(os.environ.get("CALLIGRAPHY_TEST_SEED") or random.SystemRandom().randrange(1 << 32))
 
 
-def every_fault(counts, repeated_step_stride=1):
+def every_fault(counts, repeated_step_stride=1, sampled_stride=1):
     """(kind, N, kill, the shim's environment) for every N of every kind counted (every `repeated_step_stride`th
-    write and fsync, and the last), failing and killed, the errno taken in turn from ERRNOS."""
+    write and fsync, and the last; with `sampled_stride` > 1, every `sampled_stride`th call of each kind with
+    more calls than that, from an offset drawn per kind from SEED, instead), failing and killed, the errno taken
+    in turn from ERRNOS."""
     tried = 0
     for kind in KINDS:
-        stride = repeated_step_stride if kind in ("write", "fsync") else 1
-        calls = sorted(set(range(1, counts[kind] + 1, stride)) | ({counts[kind]} if counts[kind] else set()))
+        if sampled_stride > 1 and counts[kind] > sampled_stride:
+            offset = random.Random(f"{SEED}:{kind}").randrange(sampled_stride)
+            calls = list(range(1 + offset, counts[kind] + 1, sampled_stride))
+        else:
+            stride = repeated_step_stride if kind in ("write", "fsync") else 1
+            calls = sorted(set(range(1, counts[kind] + 1, stride)) | ({counts[kind]} if counts[kind] else set()))
         for n in calls:
             for kill in (False, True):
                 yield kind, n, kill, {"CALLIGRAPHY_FAULT_CALL": kind, "CALLIGRAPHY_FAULT_AT": str(n),
@@ -123,6 +137,14 @@ def restore(pristine, work):
     program itself), hidden files and all."""
     shutil.rmtree(work, ignore_errors=True)
     shutil.copytree(pristine, work, symlinks=True)
+
+
+def default_stop_signals():
+    """In the child before exec: SIGINT, SIGTERM and SIGHUP at their default disposition. A test started in the
+    background of a shell (`ctest ... &`) inherits SIGINT ignored, and the program leaves an ignored stop signal
+    ignored (as nohup asks), so the signal raised at a step would not stop it."""
+    for number in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        signal.signal(number, signal.SIG_DFL)
 
 
 def leftovers(folder):
@@ -164,9 +186,10 @@ class FaultInjection(unittest.TestCase):
             environment.update(LD_PRELOAD=SHIM, CALLIGRAPHY_FAULT_UNDER=str(cwd / "out"), **fault)
         program = [CLI] if arguments[0] != PYTHON_WRITER else [sys.executable, "-c", PYTHON_WRITER_CODE]
         return subprocess.run([*program, *map(str, arguments[1:] if program[0] != CLI else arguments)], cwd=cwd,
-                              capture_output=True, env=environment, timeout=TIMEOUT_S)
+                              capture_output=True, env=environment, timeout=TIMEOUT_S,
+                              preexec_fn=default_stop_signals)
 
-    def sweep(self, arguments_for, signals=False, files=2, repeated_step_stride=1):
+    def sweep(self, arguments_for, signals=False, files=2, repeated_step_stride=1, sampled_stride=1):
         """Every fault at every step of `arguments_for(study)` writing over the output of the one-subject
         study with the output of the two-subject study (every `repeated_step_stride`th write and fsync);
         with `signals`, also SIGTERM, SIGINT or SIGHUP (in turn) raised at every step, after which the run
@@ -211,7 +234,7 @@ class FaultInjection(unittest.TestCase):
         self.assertGreaterEqual(counts["rename"], files, counts)  # the set's files are renamed into place
         self.assertGreaterEqual(counts["fsync"], files, counts)
         tried = 0
-        for kind, n, kill, fault in every_fault(counts, repeated_step_stride):
+        for kind, n, kill, fault in every_fault(counts, repeated_step_stride, sampled_stride):
             with self.subTest(kind=kind, n=n, errno=fault["CALLIGRAPHY_FAULT_ERRNO"], kill=kill):
                 self.assertEqual(fresh(), earlier)
                 result = self.run_cli(arguments_for(self.two_subjects / "study"), work, fault)
@@ -248,6 +271,8 @@ class FaultInjection(unittest.TestCase):
                     self.assertEqual(leftovers(work / "out"), [], f"left behind by {name} at {kind} {n}")
                 tried += 1
         every = "" if repeated_step_stride == 1 else f", every {repeated_step_stride}th write and fsync"
+        if sampled_stride > 1:
+            every = f", every {sampled_stride}th call of each kind from offsets of CALLIGRAPHY_TEST_SEED={SEED}"
         print(f"{' '.join(map(str, arguments_for(Path('STUDY'))))}: {tried} faults at every step{every} "
               f"({', '.join(f'{kind} {counts[kind]}' for kind in KINDS)})", flush=True)
         shutil.rmtree(pristine)
@@ -260,7 +285,9 @@ class FaultInjection(unittest.TestCase):
                    repeated_step_stride=REPEATED_STEP_STRIDE)
 
     def test_python_report_set(self):
-        self.sweep(lambda study: [PYTHON_WRITER, study], repeated_step_stride=REPEATED_STEP_STRIDE)
+        print(f"python-report-writer: every {SAMPLED_STRIDE} call of each kind, CALLIGRAPHY_TEST_SEED={SEED}",
+              flush=True)  # before the sweep: a failure's subTest names its kind and N, this its draw
+        self.sweep(lambda study: [PYTHON_WRITER, study], sampled_stride=SAMPLED_STRIDE)
 
     def test_report_tables_alone(self):
         self.sweep(lambda study: ["report", study, "--csv", "out"], signals=True)
@@ -559,10 +586,16 @@ class FaultInjection(unittest.TestCase):
               f"({', '.join(f'{kind} {counts[kind]}' for kind in KINDS)})", flush=True)
 
     def test_cohort_tables(self):
-        """`session cohort` replacing its tables of one subject with those of two."""
+        """`session cohort` replacing its tables of one subject with those of two, each subject writing one trial:
+        the two tables are written in the same steps whatever their rows (every run simulates its cohort again)."""
+        protocol = json.loads(self.protocol.read_text(encoding="utf-8"))
+        protocol["phases"] = protocol["phases"][:1]
+        one_trial = Path(self.scratch.name) / "one-trial.json"
+        one_trial.write_text(json.dumps(protocol, ensure_ascii=False), encoding="utf-8")
+
         def cohort(study):
             subjects = "1" if study == self.one_subject / "study" else "2"
-            return ["session", "cohort", self.protocol, "--subjects", subjects, "--csv", "out", "--jobs", "1"]
+            return ["session", "cohort", one_trial, "--subjects", subjects, "--csv", "out", "--jobs", "1"]
         self.sweep(cohort)
 
 

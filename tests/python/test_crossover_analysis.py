@@ -260,13 +260,22 @@ def test_retention_ratios_are_per_condition_on_its_own_sets():
 
 @needs_r
 def test_a_crossover_run_by_session_run_gets_a_page_that_states_its_design(cli, tmp_path):
-    """The example protocol, 4 simulated subjects (one full rotation), through session run and the page."""
+    """The example protocol, 4 simulated subjects (one full rotation), through session run and the page; its
+    training once per character instead of 4 times (what is checked is the design the page states: sequences,
+    sets, periods, conditions and phases, none of which the repetitions change)."""
+    import json
     import pathlib
     import re
 
     from calligraphy import study, study_report
 
-    protocol = pathlib.Path(__file__).resolve().parents[2] / "examples" / "protocols" / "crossover.json"
+    example = pathlib.Path(__file__).resolve().parents[2] / "examples" / "protocols" / "crossover.json"
+    protocol_json = json.loads(example.read_text(encoding="utf-8"))
+    training = next(phase for phase in protocol_json["phases"] if phase["phase"] == "training")
+    assert training["repetitions"] == 4
+    training["repetitions"] = 1
+    protocol = tmp_path / "crossover.json"
+    protocol.write_text(json.dumps(protocol_json, ensure_ascii=False), encoding="utf-8")
     subprocess.run([cli, "session", "run", str(protocol), "--writer", "simulated", "--subjects", "4", "--out",
                     str(tmp_path / "xo")], check=True, capture_output=True, timeout=600)
     loaded = study.load(tmp_path / "xo")

@@ -5,9 +5,10 @@ Also: the same data in metres and in millimetres give the same rows, without lme
 documented reduction of a singular fit in a between-subjects design; the item set as a term of a crossover whose
 sets rotate, and the reason when they do not."""
 
-import io
+import atexit
 import math
 import os
+import select
 import shutil
 import subprocess
 import tempfile
@@ -78,36 +79,87 @@ def crossover3_study(seed, subjects=18, effect_m=(0.0, -0.4e-3, -0.9e-3), groups
     return pandas.DataFrame(rows)
 
 
+# One Rscript answers every pairs request of a run (lmerTest and emmeans load once, about 1.4 s of CPU each
+# time): a request is a line of tab-separated arguments, the answer written to the file it names, then "done".
 _R_EMMEANS = r"""
 suppressPackageStartupMessages({library(lmerTest); library(emmeans)})
-arguments <- commandArgs(trailingOnly = TRUE)
-d <- read.csv(arguments[1], encoding = "UTF-8")
-levels <- strsplit(arguments[3], ",", fixed = TRUE)[[1]]
-d[[arguments[4]]] <- factor(d[[arguments[4]]], levels = levels)
-for (f in c("period", "item_set", "group", "subject", "item")) if (f %in% names(d)) d[[f]] <- factor(d[[f]])
-if (arguments[5] == "lm") fit <- lm(as.formula(arguments[2]), data = d) else
-  fit <- lmer(as.formula(arguments[2]), data = d, REML = TRUE)
-means <- emmeans(fit, arguments[4], lmer.df = arguments[6])
-raw <- as.data.frame(summary(pairs(means, reverse = TRUE, adjust = "none")))
-holm <- as.data.frame(summary(pairs(means, reverse = TRUE, adjust = "holm")))
-write.csv(data.frame(estimate = raw$estimate, df = raw$df, p = raw$p.value, p_holm = holm$p.value), stdout(),
-          row.names = FALSE)
+requests <- file("stdin")
+open(requests)
+while (length(line <- readLines(requests, n = 1)) > 0) {
+  arguments <- strsplit(line, "\t", fixed = TRUE)[[1]]
+  d <- read.csv(arguments[1], encoding = "UTF-8")
+  levels <- strsplit(arguments[3], ",", fixed = TRUE)[[1]]
+  d[[arguments[4]]] <- factor(d[[arguments[4]]], levels = levels)
+  for (f in c("period", "item_set", "group", "subject", "item")) if (f %in% names(d)) d[[f]] <- factor(d[[f]])
+  if (arguments[5] == "lm") fit <- lm(as.formula(arguments[2]), data = d) else
+    fit <- lmer(as.formula(arguments[2]), data = d, REML = TRUE)
+  means <- emmeans(fit, arguments[4], lmer.df = arguments[6])
+  raw <- as.data.frame(summary(pairs(means, reverse = TRUE, adjust = "none")))
+  holm <- as.data.frame(summary(pairs(means, reverse = TRUE, adjust = "holm")))
+  write.csv(data.frame(estimate = raw$estimate, df = raw$df, p = raw$p.value, p_holm = holm$p.value),
+            arguments[7], row.names = FALSE)
+  cat("done\n")
+  flush(stdout())
+}
 """
+_R_PAIRS = []  # the running Rscript and its folder, started by the first request
+
+
+def _r_pairs_process():
+    if _R_PAIRS and _R_PAIRS[0][0].poll() is None:
+        return _R_PAIRS[0]
+    _close_r_pairs()
+    folder = tempfile.TemporaryDirectory(prefix="calligraphy-emmeans-")
+    script = os.path.join(folder.name, "r.R")
+    with open(script, "w", encoding="utf-8") as out:
+        out.write(_R_EMMEANS)
+    process = subprocess.Popen([shutil.which("Rscript"), "--vanilla", script], stdin=subprocess.PIPE,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    _R_PAIRS.append((process, folder))
+    return _R_PAIRS[0]
+
+
+def _close_r_pairs():
+    while _R_PAIRS:
+        process, folder = _R_PAIRS.pop()
+        if process.poll() is None:
+            process.stdin.close()
+            try:
+                process.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                process.wait()
+        process.stdout.close()
+        process.stderr.close()
+        folder.cleanup()
+
+
+atexit.register(_close_r_pairs)
 
 
 def r_pairs(frame, formula, factor, levels, kind="lmer", ddf="Satterthwaite"):
     """R's every pairwise contrast (later - earlier, in ``levels``' order) of ``factor`` in ``formula`` fitted
     to ``frame`` (the outcome in mm), raw and Holm-adjusted."""
-    with tempfile.TemporaryDirectory() as folder:
-        frame.to_csv(os.path.join(folder, "d.csv"), index=False, encoding="utf-8")
-        with open(os.path.join(folder, "r.R"), "w", encoding="utf-8") as script:
-            script.write(_R_EMMEANS)
-        run = subprocess.run([shutil.which("Rscript"), "--vanilla", os.path.join(folder, "r.R"),
-                              os.path.join(folder, "d.csv"), formula, ",".join(levels), factor, kind,
-                              "kenward-roger" if ddf == "Kenward-Roger" else "satterthwaite"],
-                             capture_output=True, text=True, timeout=300)
-    assert run.returncode == 0, run.stderr
-    return pandas.read_csv(io.StringIO(run.stdout))
+    process, folder = _r_pairs_process()
+    data, answer = (os.path.join(folder.name, name) for name in ("d.csv", "answer.csv"))
+    frame.to_csv(data, index=False, encoding="utf-8")
+    request = (data, formula, ",".join(levels), factor, kind,
+               "kenward-roger" if ddf == "Kenward-Roger" else "satterthwaite", answer)
+    assert not any("\t" in part or "\n" in part for part in request), request
+    process.stdin.write("\t".join(request) + "\n")
+    process.stdin.flush()
+    ready, _, _ = select.select([process.stdout], [], [], 300)
+    # "" when R ended on an error (its message is on standard error); nothing within 300 s is a hang
+    reply = process.stdout.readline() if ready else "(nothing within 300 s)"
+    if reply != "done\n":
+        _R_PAIRS.clear()
+        process.kill()
+        error = process.communicate()[1]
+        folder.cleanup()
+        pytest.fail(f"Rscript answered {reply!r}: {error}")
+    answer_frame = pandas.read_csv(answer)
+    os.unlink(answer)
+    return answer_frame
 
 
 def assert_matches_r(ours, reference, levels, check):

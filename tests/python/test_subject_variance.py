@@ -3,6 +3,8 @@ intercept per subject and per character, has a subject variance that is not zero
 the subjects alike it is singular. Needs R with lmerTest (Debian r-cran-lmertest): skipped, saying so, without
 it. The same subject draws the same traits from the CLI and from calligraphy.cohort.simulate."""
 
+import functools
+import json
 import pathlib
 import shutil
 import subprocess
@@ -15,20 +17,24 @@ pandas = pytest.importorskip("pandas")
 
 PROTOCOLS = pathlib.Path(__file__).resolve().parents[2] / "examples" / "protocols"
 
-# The mixed model of the study report: mean deviation by group, random intercepts for subject and characters.
+# The mixed model of the study report: mean deviation by group, random intercepts for subject and characters;
+# each table given is fitted on its own, one line each, in one R process (R and lmerTest load once).
 FIT = r"""
 suppressMessages(library(lmerTest))
-d <- read.csv(commandArgs(trailingOnly = TRUE)[1])
-d <- d[!is.na(d$mean_deviation_m), ]
-d$group[is.na(d$group) | d$group == ""] <- "all"
-f <- if (length(unique(d$group)) > 1) mean_deviation_m ~ group + (1|subject) + (1|characters) else
-  mean_deviation_m ~ 1 + (1|subject) + (1|characters)
-fit <- suppressMessages(suppressWarnings(lmer(f, data = d)))
-vc <- as.data.frame(VarCorr(fit))
-cat(isSingular(fit), vc$sdcor[vc$grp == "subject"], "\n")
+for (path in commandArgs(trailingOnly = TRUE)) {
+  d <- read.csv(path)
+  d <- d[!is.na(d$mean_deviation_m), ]
+  d$group[is.na(d$group) | d$group == ""] <- "all"
+  f <- if (length(unique(d$group)) > 1) mean_deviation_m ~ group + (1|subject) + (1|characters) else
+    mean_deviation_m ~ 1 + (1|subject) + (1|characters)
+  fit <- suppressMessages(suppressWarnings(lmer(f, data = d)))
+  vc <- as.data.frame(VarCorr(fit))
+  cat(isSingular(fit), vc$sdcor[vc$grp == "subject"], "\n")
+}
 """
 
 
+@functools.lru_cache(maxsize=None)  # one probe per run (a skip is raised again, not cached)
 def _rscript():
     rscript = shutil.which("Rscript")
     if rscript is None:
@@ -40,33 +46,43 @@ def _rscript():
     return rscript
 
 
-def _fit(rscript, trials_csv, tmp_path):
+def _fit(rscript, trials_csvs, tmp_path):
+    """[(singular, the subject's SD)] of each table, in order."""
     script = tmp_path / "fit.R"
     script.write_text(FIT, encoding="utf-8")
-    out = subprocess.run([rscript, str(script), str(trials_csv)], capture_output=True, text=True, check=True)
-    singular, subject_sd = out.stdout.split()
-    return singular == "TRUE", float(subject_sd)
+    out = subprocess.run([rscript, str(script), *map(str, trials_csvs)], capture_output=True, text=True,
+                         check=True)
+    lines = out.stdout.splitlines()
+    assert len(lines) == len(trials_csvs), out.stdout
+    return [(singular == "TRUE", float(subject_sd)) for singular, subject_sd in map(str.split, lines)]
 
 
 @pytest.mark.parametrize("profile", ["foreign", "novice"])
 def test_a_pilot_has_a_subject_variance_only_when_subjects_differ(cli, tmp_path, profile):
     rscript = _rscript()
-    results = {}
+    tables = {}
     for differences in ("on", "off"):
-        tables = tmp_path / differences
-        tables.mkdir()
+        tables[differences] = tmp_path / differences
+        tables[differences].mkdir()
         subprocess.run([cli, "session", "cohort", str(PROTOCOLS / "retention-transfer.json"), "--subjects", "15",
                         "--writer-profile", profile, "--individual-differences", differences, "--jobs", "2",
-                        "--csv", str(tables)], check=True, capture_output=True)
-        results[differences] = _fit(rscript, tables / "trials.csv", tmp_path)
-    singular_on, subject_sd_on = results["on"]
-    singular_off, subject_sd_off = results["off"]
+                        "--csv", str(tables[differences])], check=True, capture_output=True)
+    (singular_on, subject_sd_on), (singular_off, subject_sd_off) = _fit(
+        rscript, [tables["on"] / "trials.csv", tables["off"] / "trials.csv"], tmp_path)
     assert not singular_on and subject_sd_on > 1e-4  # metres: a tenth of a millimetre at least
     assert singular_off and subject_sd_off < 1e-6  # lme4 puts it at the boundary (0 or round-off)
 
 
 def test_the_cli_and_python_draw_the_same_subjects(cli, tmp_path):
-    protocol = PROTOCOLS / "retention-transfer.json"
+    # retention-transfer with its training once per character: both days and every phase, each subject's traits
+    # on every row (14 a subject instead of 23), drawn from the subject's id whatever the trials.
+    document = json.loads((PROTOCOLS / "retention-transfer.json").read_text(encoding="utf-8"))
+    training = next(phase for phase in document["phases"] if phase["phase"] == "training")
+    assert training["repetitions"] == 4
+    training["repetitions"] = 1
+    protocol = tmp_path / "protocol" / "retention-transfer.json"
+    protocol.parent.mkdir()
+    protocol.write_text(json.dumps(document, ensure_ascii=False), encoding="utf-8")
     subprocess.run([cli, "session", "cohort", str(protocol), "--subjects", "3", "--writer-profile", "novice",
                     "--csv", str(tmp_path)], check=True, capture_output=True)
     from_cli = pandas.read_csv(tmp_path / "trials.csv", float_precision="round_trip")

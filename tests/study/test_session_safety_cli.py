@@ -178,8 +178,9 @@ class SessionSafetyTest(unittest.TestCase):
     def test_a_disk_filled_mid_session_keeps_the_saved_trials_and_resumes(self):
         disk = self.mount_tmpfs("disk", "48m")
         # Many short lock-step trials: the run is still writing when the disk fills (it is stopped after two
-        # are saved). Under the sanitizers a trial takes ten times as long, so fewer do: the resume runs them all.
-        repetitions = 20 if os.environ.get("CALLIGRAPHY_SANITIZED") else 100
+        # are saved; 200 trials of under 20 ms leave it over three seconds, against the poll's 10 ms). Under the
+        # sanitizers a trial takes ten times as long, so fewer do: the resume runs them all.
+        repetitions = 20 if os.environ.get("CALLIGRAPHY_SANITIZED") else 50
         self.write_protocol(dict(SMALL, name="fill", test=dict(SMALL["test"], repetitions=repetitions)))
         process = subprocess.Popen([CLI, "session", "run", "p.json", "--subject", "P1", "--out", disk / "out"],
                                    cwd=self.cwd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
