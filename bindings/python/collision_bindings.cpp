@@ -210,8 +210,9 @@ void bind_collision(py::module_& m) {
                     "mean distance of the path from the expected stroke's centre line [m]")
       .def("__repr__", [](const StrokeMatch& s) {
         return std::string("<StrokeMatch ") + (s.accepted ? "accepted" : to_string(s.refusal)) + ", stroke " +
-               std::to_string(s.matched_stroke) + ", covered " + std::to_string(s.covered_fraction) +
-               ", mean deviation " + std::to_string(s.mean_deviation_m) + " m>";
+               std::to_string(s.matched_stroke) + ", covered " + shortest_decimal(s.covered_fraction) +
+               (s.entered ? ", mean deviation " + shortest_decimal(s.mean_deviation_m) + " m>"
+                          : ", never entered>");
       });
 
   m.def("match_stroke", &match_stroke_py, py::arg("scene"), py::arg("character_index"),

@@ -16,6 +16,7 @@
 #include "arguments.hpp"
 #include "bindings.hpp"
 #include "calligraphy/analysis/writing_metrics.hpp"
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/scene.hpp"
@@ -159,7 +160,7 @@ py::dict score_py(const py::object& trace, const py::object& character, const st
     model = source.load(one_character(convert_named<std::string>(character, "character"), "character"));
   }
   if (!std::isfinite(start_radius_m) || !(start_radius_m > 0.0))
-    throw InvalidArgument("start_radius_m: " + std::to_string(start_radius_m) + " m is not finite and > 0");
+    throw InvalidArgument("start_radius_m: " + shortest_decimal(start_radius_m) + " m is not finite and > 0");
   SceneLayout layout;
   layout.start_radius_m = start_radius_m;
   const Scene scene = Scene::lay_out({model}, layout);

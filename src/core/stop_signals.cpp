@@ -37,8 +37,14 @@ StopSignals::StopSignals() {
   sigemptyset(&action.sa_mask);
   for (int signal : kStopSignals) sigaddset(&action.sa_mask, signal);  // one handler at a time
   action.sa_flags = SA_RESTART;
-  for (std::size_t i = 0; i < std::size(kStopSignals); ++i)
-    sigaction(kStopSignals[i], &action, &saved.stop[i]);
+  for (std::size_t i = 0; i < std::size(kStopSignals); ++i) {
+    sigaction(kStopSignals[i], nullptr, &saved.stop[i]);
+    // An ignored SIGHUP was ignored on purpose (nohup: keep running when the terminal closes), so it stays
+    // ignored. SIGINT and SIGTERM are caught whatever they were: a background job's ignored SIGINT only
+    // keeps the terminal's Ctrl-C away, and a stop asked for by kill must still end a trial cleanly.
+    if (kStopSignals[i] == SIGHUP && saved.stop[i].sa_handler == SIG_IGN) continue;
+    sigaction(kStopSignals[i], &action, nullptr);
+  }
   struct sigaction ignore {};
   ignore.sa_handler = SIG_IGN;
   sigemptyset(&ignore.sa_mask);

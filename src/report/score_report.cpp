@@ -217,7 +217,7 @@ void append_character_table(std::string& out, const CharacterScore& score) {
   appendf(out, "  Frechet (worst stroke)     %s mm\n", fixed(t.frechet_m, 1e3, "%.3f").c_str());
   appendf(out, "  DTW (mean)                 %s mm\n", fixed(t.dtw_m, 1e3, "%.3f").c_str());
   appendf(out, "  pen lifts                  %zu\n", t.pen_lifts);
-  appendf(out, "  time                       %.2f s (writing %.2f s, in the air %.2f s)\n", t.total_time_s,
+  appendf(out, "  time                       %.2f s (pen down %.2f s, in the air %.2f s)\n", t.total_time_s,
           t.writing_time_s, t.in_air_time_s);
   appendf(out, "  mean speed                 %s m/s\n", fixed(t.mean_speed_m_per_s, 1.0, "%.4f").c_str());
   appendf(out, "  velocity peaks             %d\n", t.velocity_peaks);

@@ -272,11 +272,21 @@ def read_trace(path):
 class Signals(HostileTestCase):
     """A trial stopped by SIGINT or SIGTERM writes every recorded tick, then exits 128 + the signal."""
 
-    def stop_trial(self, args, sig, after_s=1.5, twice=False):
+    def stop_trial(self, args, sig, after_s=1.5, twice=False, ignored=(), before=None):
+        """`trial ARGS` stopped by `sig` after `after_s`; `ignored` signals are ignored in the program from its
+        start (as `nohup` ignores SIGHUP), and `before` is sent first, half a second earlier."""
+        def ignore():
+            for each in ignored:
+                signal.signal(each, signal.SIG_IGN)
         process = subprocess.Popen([CLI, "trial", *args], cwd=self.cwd, stdout=subprocess.PIPE,
-                                   stderr=subprocess.PIPE)
+                                   stderr=subprocess.PIPE, preexec_fn=ignore)
         try:
-            time.sleep(after_s)
+            if before is not None:
+                time.sleep(after_s - 0.5)
+                process.send_signal(before)
+                time.sleep(0.5)
+            else:
+                time.sleep(after_s)
             if process.poll() is not None:
                 self.fail(f"the trial ended (status {process.returncode}) before the signal: "
                           f"{process.communicate()[1].decode(errors='replace')}")
@@ -332,6 +342,14 @@ class Signals(HostileTestCase):
 
     def test_sigint_real_time(self):
         self.real_time(signal.SIGINT)
+
+    def test_a_sighup_ignored_from_the_start_stays_ignored_and_sigterm_still_stops(self):
+        # nohup: the trial goes on through the hangup (it is still running half a second after it), and
+        # a SIGTERM ignored from the start (as no shell does) is still a stop asked for.
+        doc, _ = self.stop_trial([YONG, "--pacing", "real-time", "--json", "trial.json", "--csv", "trace.csv"],
+                                 signal.SIGTERM, after_s=2.0, ignored=(signal.SIGHUP, signal.SIGTERM),
+                                 before=signal.SIGHUP)
+        self.assertIn("SIGTERM", doc["abort_reason"])
 
     def test_sigterm_real_time(self):
         self.real_time(signal.SIGTERM)

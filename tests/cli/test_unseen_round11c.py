@@ -68,6 +68,12 @@ def python_run(code, cwd, timeout=TIMEOUT_S):
                           stderr=subprocess.PIPE, timeout=timeout, env=env)
 
 
+def default_sighup():
+    """SIGHUP at its default in the program, whatever this suite runs under: an ignored SIGHUP stays ignored
+    (nohup), and these cases send one."""
+    signal.signal(signal.SIGHUP, signal.SIG_DFL)
+
+
 class Case(unittest.TestCase):
     def setUp(self):
         if not CLI:
@@ -287,7 +293,7 @@ class Devices(Case):
         env = dict(ENV, CALLIGRAPHY_LIBHD=STAND_IN)
         process = subprocess.Popen([CLI, "trial", YI, "--device", "openhaptics", "--json", "t.json", "--csv",
                                     "t.csv"], cwd=self.dir, env=env, stdout=subprocess.PIPE,
-                                   stderr=subprocess.PIPE)
+                                   stderr=subprocess.PIPE, preexec_fn=default_sighup)
         time.sleep(1.0)
         process.send_signal(signal.SIGHUP)
         out, err = process.communicate(timeout=30)
@@ -662,7 +668,8 @@ class Window(unittest.TestCase):
         self.addCleanup(shutil.rmtree, folder, True)
         process = subprocess.Popen(
             [CLI, "train", "永", "--device", "mouse", "--window", "800x500", "--session", "s", "--subject", "d1"],
-            cwd=folder, env=dict(ENV, DISPLAY=self.display), stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+            cwd=folder, env=dict(ENV, DISPLAY=self.display), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+            preexec_fn=default_sighup)
         deadline = time.monotonic() + 30
         seen = b""
         try:

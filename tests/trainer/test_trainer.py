@@ -1152,8 +1152,10 @@ class EndingTest(unittest.TestCase):
         return self.display
 
     def start(self, command, environment=None):
+        # SIGHUP at its default whatever this suite runs under (an ignored one stays ignored, as under nohup).
         self.process = subprocess.Popen([CLI, *command], stdout=self.stdout, stderr=self.stderr, cwd=self.folder,
-                                        env=boxes_environment(environment))
+                                        env=boxes_environment(environment),
+                                        preexec_fn=lambda: signal.signal(signal.SIGHUP, signal.SIG_DFL))
 
     def first_box(self, timeout=30):
         return box_lines(self.folder, self.process, "the program", timeout)[0]
