@@ -31,6 +31,25 @@ def error_lines(result):
     return result.stderr.decode("utf-8", "replace").strip().splitlines()
 
 
+class OneErrorLine:
+    """A mixin for unittest.TestCase: `assert_one_error` holds a run to the documented error output."""
+
+    def assert_one_error(self, result, status, *needles):
+        """The run ended with `status` (or one of a tuple of them) and wrote one error line holding each of
+        `needles`: no traceback, no C++ runtime's abort text. Returns the line."""
+        text = result.stderr.decode("utf-8", "replace")
+        statuses = status if isinstance(status, tuple) else (status,)
+        self.assertIn(result.returncode, statuses, text)
+        self.assertNotIn("Traceback", text)
+        self.assertNotIn("terminate called", text)
+        got = error_lines(result)
+        self.assertEqual(len(got), 1, f"expected one error line, got {got!r}")
+        self.assertIn("error", got[0])
+        for needle in needles:
+            self.assertIn(needle, got[0])
+        return got[0]
+
+
 def sanitized_subset(names):
     """A `load_tests` (unittest's protocol) that keeps every case, or under the sanitizers only the test
     methods named in `names`."""

@@ -28,7 +28,7 @@ import time
 import unittest
 from pathlib import Path
 
-from outsider import CLI, ENV, TIMEOUT_S, error_lines, run
+from outsider import CLI, ENV, TIMEOUT_S, OneErrorLine, error_lines, run
 
 SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 DATA = SOURCE / "data" / "hanzi-writer-data"
@@ -94,7 +94,7 @@ def tearDownModule():
         shutil.rmtree(SHARED["dir"], ignore_errors=True)
 
 
-class Base(unittest.TestCase):
+class Base(OneErrorLine, unittest.TestCase):
     def setUp(self):
         if SANITIZED and self._testMethodName not in SANITIZED_CASES:
             self.skipTest("a small subset under the sanitizers")
@@ -111,19 +111,6 @@ class Base(unittest.TestCase):
 
     def record(self):
         return json.loads((self.shared / "r.json").read_text())
-
-    def assert_one_error(self, result, status, *needles):
-        text = result.stderr.decode("utf-8", "replace")
-        statuses = status if isinstance(status, tuple) else (status,)
-        self.assertIn(result.returncode, statuses, text)
-        self.assertNotIn("Traceback", text)
-        self.assertNotIn("terminate called", text)
-        got = error_lines(result)
-        self.assertEqual(len(got), 1, f"expected one error line, got {got!r}")
-        self.assertIn("error", got[0])
-        for needle in needles:
-            self.assertIn(needle, got[0])
-        return got[0]
 
     def assert_listing(self, folder, names):
         self.assertEqual(sorted(p.name for p in Path(folder).iterdir()), sorted(names))

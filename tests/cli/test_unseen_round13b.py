@@ -38,7 +38,7 @@ import xml.etree.ElementTree as ElementTree
 import zlib
 from pathlib import Path
 
-from outsider import CLI, ENV, SANITIZED, TIMEOUT_S, error_lines, run, sanitized_subset
+from outsider import CLI, ENV, SANITIZED, TIMEOUT_S, OneErrorLine, error_lines, run, sanitized_subset
 
 SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 SAMPLE = SOURCE / "data" / "hanzi-writer-data"
@@ -131,24 +131,11 @@ def tearDownModule():
         shutil.rmtree(SHARED["dir"], ignore_errors=True)
 
 
-class Base(unittest.TestCase):
+class Base(OneErrorLine, unittest.TestCase):
     def setUp(self):
         self.shared = SHARED["dir"]
         self.dir = Path(tempfile.mkdtemp(prefix="r13b-"))
         self.addCleanup(shutil.rmtree, self.dir, True)
-
-    def assert_one_error(self, result, status, *needles):
-        text = result.stderr.decode("utf-8", "replace")
-        statuses = status if isinstance(status, tuple) else (status,)
-        self.assertIn(result.returncode, statuses, text)
-        self.assertNotIn("Traceback", text)
-        self.assertNotIn("terminate called", text)
-        got = error_lines(result)
-        self.assertEqual(len(got), 1, f"expected one error line, got {got!r}")
-        self.assertIn("error", got[0])
-        for needle in needles:
-            self.assertIn(needle, got[0])
-        return got[0]
 
     def assert_no_temporary(self, folder):
         left = [p.name for p in Path(folder).iterdir() if ".tmp-" in p.name]
