@@ -19,6 +19,7 @@ replaced, and from Python the documented exception, never a crash.
 CALLIGRAPHY_CLI names the program, CALLIGRAPHY_SOURCE_DIR the source tree (its hanzi-writer-data sample).
 CALLIGRAPHY_SANITIZED=1 takes five cases.
 """
+import gzip
 import json
 import os
 import shutil
@@ -75,7 +76,7 @@ def setUpModule():
     made = run(["schema", "record"], d)
     assert made.returncode == 0, made.stderr
     (d / "schema.json").write_bytes(made.stdout)
-    subprocess.run(["gzip", "-k", str(d / "trace.csv")], check=True)
+    (d / "trace.csv.gz").write_bytes(gzip.compress((d / "trace.csv").read_bytes()))
     shutil.copyfile(SAMPLE / f"{SHI}.json", d / "char.json")
     for kind, name in (("record", "record.json"), ("csv", "trace.csv"), ("gz", "trace.csv.gz"),
                        ("svg", "drawing.svg"), ("teacher", "teacher.json"), ("protocol", "protocol.json"),
@@ -106,8 +107,7 @@ class Case(unittest.TestCase):
         return lines[0]
 
     def work(self):
-        w = Path(tempfile.mkdtemp(prefix="case-", dir=F["dir"]))
-        return w
+        return Path(tempfile.mkdtemp(prefix="case-", dir=F["dir"]))
 
     def nothing_written(self, folder, before):
         self.assertEqual(sorted(p.name for p in Path(folder).iterdir()), before)
@@ -132,6 +132,23 @@ class TestTrialInputs(Case):
         w = self.work()
         r = run(["trial", "--spec", F["record.csv"], "--check"], w)
         self.assertEqual(r.returncode, 0, error_lines(r))
+
+    def test_a_study_record_and_a_teacher_named_csv_are_read_by_content(self):
+        """A session's trial record is a trial record (`--check` valid), and a teacher recording named .csv
+        guides the replay as under its own name: the same trial."""
+        w = self.work()
+        r = run(["trial", "--spec", F["study_record"], "--check"], w)
+        self.assertEqual(r.returncode, 0, error_lines(r))
+        shutil.copyfile(F["teacher"], w / "teacher.csv")
+        runs = []
+        for teacher in (F["teacher"], w / "teacher.csv"):
+            r = run(["trial", YI, "--guidance-mode", "replay", "--teacher", teacher, "--max-duration", "6",
+                     "--json", "-"], w)
+            self.assertEqual(r.returncode, 0, error_lines(r))
+            runs.append(json.loads(r.stdout))
+        for key in ("mean_deviation_m", "strokes_accepted", "trial_time_s", "pen_down_time_s"):
+            self.assertEqual(runs[0][key], runs[1][key], key)
+        self.assertEqual(runs[0]["specification"]["teacher_sha256"], runs[1]["specification"]["teacher_sha256"])
 
     def test_check_given_other_kinds(self):
         w = self.work()
@@ -165,9 +182,17 @@ class TestTraceReaders(Case):
                 self.refused(r, 1, F[kind], kind)
                 self.nothing_written(w, [])
 
+    def test_score_of_a_gzipped_record_is_refused_naming_it(self):
+        """A gzip is decompressed by its first bytes; what it holds must still be a trace (exit 1, one line)."""
+        w = self.work()
+        (w / "record.json.gz").write_bytes(gzip.compress(F["record"].read_bytes()))
+        r = run(["score", "record.json.gz", "--character", YI, "--json", "out.json"], w)
+        self.refused(r, 1, "record.json.gz", "gzip of a record")
+        self.nothing_written(w, ["record.json.gz"])
+
     def test_score_reads_every_trace_kind_alike_whatever_its_name(self):
-        """The CSV, its gzip and the HDF5 trace under their names and under misleading ones score alike, or a
-        misnamed one is refused naming it: never another score."""
+        """The CSV, its gzip and the HDF5 trace score alike under their own names and under misleading ones
+        (a CSV named .trace.h5, an HDF5 named .json): each is read by its content."""
         w = self.work()
         scores = {}
         for kind in ("csv", "gz", "csv.h5"):
@@ -304,6 +329,13 @@ class TestCharacterSources(Case):
                 self.refused(r, 1, F[kind], kind)
                 self.nothing_written(w, [])
 
+    def test_corpus_stats_given_every_other_kind(self):
+        """corpus stats of a file that is no store: exit 1, one line naming it."""
+        w = self.work()
+        for kind in ("record", "gz", "trace.h5", "csv", "char"):
+            with self.subTest(kind=kind):
+                self.refused(run(["corpus", "stats", F[kind]], w), 1, F[kind], kind)
+
     def test_data_folder_of_other_kinds_named_as_characters(self):
         """A --data folder whose 十.json is a trial record, a teacher or a protocol: the character the library
         has but cannot read is exit 1 naming its file."""
@@ -383,6 +415,8 @@ print(json.dumps(out))
         shutil.copytree(F["dir"] / "study", copy)
         session = copy / F["session"].relative_to(F["dir"] / "study")
         shutil.copyfile(F["protocol"], session / "session.json")
+        (w / "hw").mkdir()
+        shutil.copyfile(F["gz"], w / "hw" / f"{SHI}.json")
         code = f"""
 import json, calligraphy as cg, calligraphy.study as st
 import pandas as pd
@@ -396,14 +430,18 @@ attempt("score-table", lambda: cg.score(pd.read_csv({str(F["tables"])!r}), "一"
 attempt("score-record", lambda: cg.score({str(F["record"])!r}, "一"))
 attempt("score-record.csv", lambda: cg.score({str(F["record.csv"])!r}, "一"))
 attempt("study.load", lambda: st.load({str(copy)!r}))
+attempt("from_hanzi_writer", lambda: cg.CharacterLibrary.from_hanzi_writer({str(w / "hw")!r}).load("十"))
 print(json.dumps(out))
 """
         got = {what: (kind, message) for what, kind, message in self.python(code)}
         self.assertEqual(got["score-table"][0], "InvalidArgument", got["score-table"])
         for what, name in (("score-record", "record.json"), ("score-record.csv", "record-named.csv"),
-                           ("study.load", "session.json")):
+                           ("study.load", "session.json"), ("from_hanzi_writer", f"{SHI}.json")):
             self.assertEqual(got[what][0], "DataError", got[what])
             self.assertIn(name, got[what][1], got[what])
+            for text in INTERNAL:
+                self.assertNotIn(text, got[what][1])
+        self.assertIn("gzip", got["from_hanzi_writer"][1])
 
 
 if __name__ == "__main__":
