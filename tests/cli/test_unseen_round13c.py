@@ -309,6 +309,25 @@ class TestStudyReaders(Case):
         self.refused(r, 1, target.name, "csv as h5")
         self.assertFalse((w / "r.html").exists())
 
+    def test_folders_of_other_kinds_given_for_a_session_or_a_study(self):
+        """session resume of the study folder, a subject's folder or a tables folder, and report and
+        curriculum of a folder of tables or report pages: one line naming the folder and what it lacks (exit 1,
+        a missing file), nothing written."""
+        w = self.work()
+        shutil.copytree(F["dir"] / "tables", w / "tables")
+        shutil.copytree(F["dir"] / "report_files", w / "pages")
+        before = sorted(p.name for p in w.iterdir())
+        for folder in (F["dir"] / "study", F["dir"] / "study" / "S1", w / "tables"):
+            with self.subTest(resume=folder.name):
+                line = self.refused(run(["session", "resume", folder], w), 1, folder, "resume")
+                self.assertIn("session.json", line)
+        for folder in ("tables", "pages"):
+            with self.subTest(report=folder):
+                self.refused(run(["report", folder, "--out", "r.html"], w), 1, folder, "report")
+                self.refused(run(["curriculum", folder, "--subject", "S1", "--from", SHI], w), 1, folder,
+                             "curriculum")
+        self.nothing_written(w, before)
+
     def test_curriculum_with_a_trial_record_of_another_kind(self):
         w, copy, session = self.copied_session()
         target = session / "trials" / F["study_record"].name
