@@ -166,9 +166,25 @@ class TestTrialInputs(Case):
                 r = run(["trial", YI, "--guidance-mode", "replay", "--teacher", F[kind], "--json", "out.json",
                          "--max-duration", "1"], w)
                 line = self.refused(r, 1, F[kind], kind)
-                if kind in SAYS:
-                    self.assertIn(SAYS[kind], line)
+                self.assertIn(SAYS.get(kind, "not a teacher's recording"), line)
                 self.nothing_written(w, [])
+
+    def test_session_run_replay_teacher_of_every_other_kind(self):
+        """docs/cli.md, "Teachers": a teacher that is no teacher's recording is refused naming the condition and
+        the file (exit 1: data), and no folder is made."""
+        w = self.work()
+        for kind in ("record", "protocol", "csv", "trace.h5", "gz", "char"):
+            with self.subTest(kind=kind):
+                shutil.copyfile(F[kind], w / "teacher-file")
+                protocol = {"name": "rp", "conditions": [{"name": "echo", "mode": "replay",
+                                                          "teachers": {YI: "teacher-file"}}],
+                            "test": {"characters": [YI], "conditions": ["echo"], "repetitions": 1}}
+                (w / "rp.json").write_text(json.dumps(protocol, ensure_ascii=False), encoding="utf-8")
+                r = run(["session", "run", "rp.json", "--subject", "S1", "--out", "out"], w)
+                line = self.refused(r, 1, "teacher-file", kind)
+                self.assertIn("'echo'", line)
+                self.assertIn(SAYS.get(kind, "not a teacher's recording"), line)
+                self.nothing_written(w, ["rp.json", "teacher-file"])
 
 
 class TestTraceReaders(Case):
