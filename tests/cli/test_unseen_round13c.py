@@ -444,7 +444,9 @@ print(json.dumps(out))
 
     def test_python_score_of_the_wrong_table_and_study_load_of_a_foreign_folder(self):
         """score of the trials table (no t/x/y) is InvalidArgument naming a column; score of a record's path
-        a DataError naming it; study.load of a study whose session.json is a protocol a DataError naming it."""
+        a DataError naming it; study.load of a study whose session.json is a protocol, Study.samples of a trial
+        whose .trace.h5 is a CSV and a hanzi-writer folder whose character file is a gzip: DataError naming the
+        file."""
         w = self.work()
         copy = w / "study"
         shutil.copytree(F["dir"] / "study", copy)
@@ -452,6 +454,10 @@ print(json.dumps(out))
         shutil.copyfile(F["protocol"], session / "session.json")
         (w / "hw").mkdir()
         shutil.copyfile(F["gz"], w / "hw" / f"{SHI}.json")
+        other = w / "other"  # the study whose trace is the trial's CSV under the .trace.h5 name
+        shutil.copytree(F["dir"] / "study", other)
+        trace = other / F["trace.h5"].relative_to(F["dir"] / "study")
+        shutil.copyfile(F["csv"], trace)
         code = f"""
 import json, calligraphy as cg, calligraphy.study as st
 import pandas as pd
@@ -465,13 +471,18 @@ attempt("score-table", lambda: cg.score(pd.read_csv({str(F["tables"])!r}), "一"
 attempt("score-record", lambda: cg.score({str(F["record"])!r}, "一"))
 attempt("score-record.csv", lambda: cg.score({str(F["record.csv"])!r}, "一"))
 attempt("study.load", lambda: st.load({str(copy)!r}))
+def samples():
+    other = st.load({str(other)!r})
+    other.samples(0)
+attempt("samples", samples)
 attempt("from_hanzi_writer", lambda: cg.CharacterLibrary.from_hanzi_writer({str(w / "hw")!r}).load("十"))
 print(json.dumps(out))
 """
         got = {what: (kind, message) for what, kind, message in self.python(code)}
         self.assertEqual(got["score-table"][0], "InvalidArgument", got["score-table"])
         for what, name in (("score-record", "record.json"), ("score-record.csv", "record-named.csv"),
-                           ("study.load", "session.json"), ("from_hanzi_writer", f"{SHI}.json")):
+                           ("study.load", "session.json"), ("from_hanzi_writer", f"{SHI}.json"),
+                           ("samples", trace.name)):
             self.assertEqual(got[what][0], "DataError", got[what])
             self.assertIn(name, got[what][1], got[what])
             for text in INTERNAL:
