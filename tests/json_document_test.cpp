@@ -81,6 +81,7 @@ TEST_CASE("a file of another kind given to a JSON reader is named for what it is
   CHECK(error_of("tru").find("json.exception") == std::string::npos);
   CHECK(json_detail::non_json_kind(R"({"a": "x,y"})").empty());
   CHECK(json_detail::non_json_kind("[1, 2").empty());
+  CHECK(json_detail::non_json_kind("// a comment, then\n{}").empty());
   CHECK(json_detail::parser_reason("[json.exception.out_of_range.406] number overflow parsing '1e999'") ==
         "number overflow parsing '1e999'");
 }

@@ -1,6 +1,7 @@
 #include "core/json_document.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <functional>
 #include <optional>
 #include <string>
@@ -149,9 +150,14 @@ std::string non_json_kind(std::string_view text) {
   if (rest.front() == '<') return "markup (an SVG drawing, an HTML page or XML)";
   std::string_view line = rest.substr(0, rest.find('\n'));
   if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-  const bool csv_line = rest.front() == '"' ? line.find("\",\"") != std::string_view::npos
-                                            : line.find(',') != std::string_view::npos;
-  if (rest.front() != '{' && rest.front() != '[' && csv_line) {
+  // A CSV header starts with a column's name (a letter, a digit, '_' or a quoted name) and has a comma: not a
+  // comment ("// a, b") or a stray character before a JSON object.
+  const auto first_char = static_cast<unsigned char>(rest.front());
+  const bool csv_line = rest.front() == '"'
+                            ? line.find("\",\"") != std::string_view::npos
+                            : (std::isalnum(first_char) != 0 || rest.front() == '_' || first_char >= 0x80) &&
+                                  line.find(',') != std::string_view::npos;
+  if (csv_line) {
     constexpr std::size_t kShown = 60;
     std::size_t cut = std::min(line.size(), kShown);
     while (cut < line.size() && cut > 0 && (static_cast<unsigned char>(line[cut]) & 0xC0) == 0x80) --cut;
