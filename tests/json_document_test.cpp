@@ -56,3 +56,32 @@ TEST_CASE("a key given twice in one object is refused by its pointer", "[json]")
   CHECK(error_of(R"({"x": {"x": 1}, "y": [{"x": 1}, {"x": 2}]})").empty());
   CHECK(error_of(R"([{"k": 1}, {"k": 1}])").empty());
 }
+
+TEST_CASE("a file of another kind given to a JSON reader is named for what it is", "[json]") {
+  // The parser's own exception tag never reaches the message.
+  CHECK(error_of("t,x,y,z,fx\n0,0,0,0,0\n") ==
+        "doc.json: not a JSON document: it is CSV text (its first line: t,x,y,z,fx)");
+  CHECK(error_of("\xEF\xBB\xBF\"t\",\"x\"\r\n") ==
+        "doc.json: not a JSON document: it is CSV text (its first line: \"t\",\"x\")");
+  CHECK(error_of("calligraphy-trace\nversion 1\n")
+            .starts_with("doc.json: not a JSON document: it is a calligraphy "
+                         "trace file"));
+  CHECK(error_of(std::string("\x1f\x8b\x08\x00", 4)).find("gzip-compressed data") != std::string::npos);
+  CHECK(error_of("CLGSTORE\x01").find("a corpus store") != std::string::npos);
+  CHECK(error_of("\x89HDF\r\n\x1a\n").find("an HDF5 file") != std::string::npos);
+  CHECK(error_of("<svg xmlns=\"http://www.w3.org/2000/svg\">").find("markup") != std::string::npos);
+  CHECK(error_of(std::string("ab\0cd", 5)).find("binary data") != std::string::npos);
+  const std::string long_line = "a" + std::string(100, ',');
+  CHECK(error_of(long_line).ends_with(",...)"));
+  // JSON that is only malformed keeps the byte and the reason, without the tag.
+  const std::string cut = error_of(R"({"a": 1,)");
+  CHECK(cut.starts_with("doc.json: not valid JSON at byte 9: "));
+  CHECK(cut.find("json.exception") == std::string::npos);
+  CHECK(cut.find("parse error at") == std::string::npos);
+  CHECK(error_of("tru").find("json.exception") == std::string::npos);
+  CHECK(json_detail::non_json_kind(R"({"a": "x,y"})").empty());
+  CHECK(json_detail::non_json_kind("[1, 2").empty());
+  CHECK(json_detail::non_json_kind("// a comment, then\n{}").empty());
+  CHECK(json_detail::parser_reason("[json.exception.out_of_range.406] number overflow parsing '1e999'") ==
+        "number overflow parsing '1e999'");
+}

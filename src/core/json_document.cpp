@@ -1,5 +1,7 @@
 #include "core/json_document.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <functional>
 #include <optional>
 #include <string>
@@ -128,6 +130,56 @@ class DuplicateKeys : public nlohmann::json_sax<nlohmann::json> {
 
 }  // namespace
 
+std::string non_json_kind(std::string_view text) {
+  const auto starts = [&text](std::string_view prefix) { return text.substr(0, prefix.size()) == prefix; };
+  // The binary kinds by their signatures: the trace file (report/trace_hdf5.cpp), gzip (RFC 1952), the
+  // corpus store (model/corpus_store_format.hpp) and HDF5 (its format specification, "Superblock").
+  if (starts("calligraphy-trace\n")) return "a calligraphy trace file (a session's .trace.h5)";
+  if (starts("\x1f\x8b")) return "gzip-compressed data";
+  if (starts("CLGSTORE")) return "a corpus store (corpus build)";
+  if (starts("\x89HDF\r\n\x1a\n")) return "an HDF5 file";
+  std::string_view rest = text;
+  if (rest.substr(0, 3) == "\xEF\xBB\xBF") rest.remove_prefix(3);  // a UTF-8 byte-order mark
+  const std::size_t first = rest.find_first_not_of(" \t\r\n");
+  if (first == std::string_view::npos) return {};
+  rest.remove_prefix(first);
+  for (const char c : rest.substr(0, 64)) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte < 0x20 && c != '\t' && c != '\r' && c != '\n') return "binary data";
+  }
+  if (rest.front() == '<') return "markup (an SVG drawing, an HTML page or XML)";
+  std::string_view line = rest.substr(0, rest.find('\n'));
+  if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+  // A CSV header starts with a column's name (a letter, a digit, '_' or a quoted name) and has a comma: not a
+  // comment ("// a, b") or a stray character before a JSON object.
+  const auto first_char = static_cast<unsigned char>(rest.front());
+  const bool csv_line = rest.front() == '"'
+                            ? line.find("\",\"") != std::string_view::npos
+                            : (std::isalnum(first_char) != 0 || rest.front() == '_' || first_char >= 0x80) &&
+                                  line.find(',') != std::string_view::npos;
+  if (csv_line) {
+    constexpr std::size_t kShown = 60;
+    std::size_t cut = std::min(line.size(), kShown);
+    while (cut < line.size() && cut > 0 && (static_cast<unsigned char>(line[cut]) & 0xC0) == 0x80) --cut;
+    return "CSV text (its first line: " + std::string(line.substr(0, cut)) +
+           (cut < line.size() ? "...)" : ")");
+  }
+  return {};
+}
+
+std::string parser_reason(const std::string& what) {
+  std::string reason = what;
+  if (reason.starts_with("[json.exception.")) {
+    if (const std::size_t bracket = reason.find("] "); bracket != std::string::npos)
+      reason.erase(0, bracket + 2);
+  }
+  // "parse error at line 1, column 2: syntax error ...": the position is the reader's to state.
+  if (reason.starts_with("parse error")) {
+    if (const std::size_t colon = reason.find(": "); colon != std::string::npos) reason.erase(0, colon + 2);
+  }
+  return reason;
+}
+
 nlohmann::json parse_json_document(std::string_view text, const std::string& source) {
   // The plain parser first: linear in the text. A parser with a callback is not (nlohmann/json 3.11's
   // callback parser scans an object's parent for a discarded value at every object's end, so an array of n
@@ -149,13 +201,15 @@ nlohmann::json parse_json_document(std::string_view text, const std::string& sou
   try {
     return nlohmann::json::parse(text.begin(), text.end(), std::ref(tracker));
   } catch (const nlohmann::json::parse_error& e) {
-    throw DataError(source + ": not valid JSON at byte " + std::to_string(e.byte) + ": " + e.what());
+    if (const std::string kind = non_json_kind(text); !kind.empty())
+      throw DataError(source + ": not a JSON document: it is " + kind);
+    throw DataError(source + ": not valid JSON at byte " + std::to_string(e.byte) + ": " +
+                    parser_reason(e.what()));
   } catch (const nlohmann::json::exception& e) {
     // A number beyond a double's range (1e999): the parser's only error without a byte offset.
     const std::string pointer = tracker.pointer();
-    std::string reason = e.what();  // "[json.exception.out_of_range.406] number overflow parsing '1e999'"
-    if (const std::size_t bracket = reason.find("] "); bracket != std::string::npos)
-      reason.erase(0, bracket + 2);
+    // "[json.exception.out_of_range.406] number overflow parsing '1e999'"
+    const std::string reason = parser_reason(e.what());
     throw DataError(source + ": " + (pointer.empty() ? "/" : pointer) +
                     ": not a finite number (beyond the range of a double): " + reason);
   }

@@ -13,4 +13,15 @@ namespace calligraphy::json_detail {
 /// double's range (1e999, -1e400), which the parser refuses without a byte offset.
 nlohmann::json parse_json_document(std::string_view text, const std::string& source);
 
+/// What `text` is, by its first bytes, when it cannot be a JSON document at all: another kind of file the
+/// program writes or reads (a trace, a gzip, a corpus store, an HDF5 file, an SVG drawing or HTML page, CSV
+/// text) or "binary data"; empty when it begins as JSON may. So that a file given to the wrong reader is
+/// named for what it is ("r.csv: not a JSON document: it is CSV text ..."), not by the parser's words for its
+/// first byte.
+std::string non_json_kind(std::string_view text);
+
+/// nlohmann/json's message for an error without its "[json.exception.parse_error.101] parse error at line 1,
+/// column 2: " prefix, which names the parser's own exception (the reader states where).
+std::string parser_reason(const std::string& what);
+
 }  // namespace calligraphy::json_detail

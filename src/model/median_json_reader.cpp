@@ -12,6 +12,7 @@
 #include <optional>
 
 #include "calligraphy/model/character_library.hpp"
+#include "core/json_document.hpp"
 
 namespace calligraphy::detail {
 namespace {
@@ -128,10 +129,14 @@ class MediansHandler {
   bool parse_error(std::size_t position, const std::string& /*last_token*/,
                    const nlohmann::detail::exception& e) {
     if (e.id == 406) {  // out_of_range.406: a number beyond double's range, such as 1e400
-      return fail(next_path(), "number out of range (" + shortened(e.what(), kMaxParserMessage) + ")");
+      return fail(next_path(), "number out of range (" +
+                                   shortened(json_detail::parser_reason(e.what()), kMaxParserMessage) + ")");
     }
-    return fail("line:column " + line_column(position) + " (at " + next_path() + ")",
-                "malformed JSON (" + shortened(e.what(), kMaxParserMessage) + ")");
+    if (const std::string kind = json_detail::non_json_kind(text_); !kind.empty())
+      return fail("/", "not a JSON document: it is " + kind);
+    return fail(
+        "line:column " + line_column(position) + " (at " + next_path() + ")",
+        "malformed JSON (" + shortened(json_detail::parser_reason(e.what()), kMaxParserMessage) + ")");
   }
 
   void finish() {

@@ -273,9 +273,16 @@ void check_protocol_teachers(const LoadedProtocol& protocol) {
   for (const StudyCondition& condition : protocol.protocol.conditions) {
     for (const auto& [characters, given] : condition.teachers) {
       const std::filesystem::path source = protocol.path.parent_path() / given;
-      const std::string text =
-          study_detail::read_small_file(source, kMaxTeacherRecordingBytes, "teacher's recording");
-      (void)study_detail::checked_teacher(text, source.string(), condition, given, characters);
+      try {
+        const std::string text =
+            study_detail::read_small_file(source, kMaxTeacherRecordingBytes, "teacher's recording");
+        (void)study_detail::checked_teacher(text, source.string(), condition, given, characters);
+      } catch (const InvalidArgument&) {
+        throw;  // names the condition and the teacher already
+      } catch (const DataError& e) {
+        // The file cannot be read or is no teacher's recording: the condition that names it, then the file.
+        throw DataError("condition '" + condition.name + "': " + e.what());
+      }
     }
   }
 }

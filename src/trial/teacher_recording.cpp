@@ -86,8 +86,15 @@ std::string teacher_recording_json(const TeacherRecording& recording) {
 TeacherRecording parse_teacher_recording(std::string_view json_text, const std::string& source) {
   const nlohmann::json document = json_detail::parse_json_document(json_text, source);
   if (!document.is_object()) fail(source, "expected a JSON object");
-  const nlohmann::json& format = member(document, "format", source, "/");
-  if (format != kFormat) fail(source, std::string("/format: expected \"") + kFormat + "\"");
+  // Another kind of JSON document (a trial record, a protocol, a session.json) has no such format: say so
+  // rather than name the first key it lacks.
+  const auto format = document.find("format");
+  if (format == document.end() || *format != kFormat) {
+    fail(source, std::string("/format: ") +
+                     (format == document.end() ? "missing" : "not \"" + std::string(kFormat) + "\"") +
+                     ": not a teacher's recording (one has format \"" + kFormat +
+                     "\", as trial --record writes it)");
+  }
   const nlohmann::json& version = member(document, "version", source, "/");
   if (version != kVersion) fail(source, "/version: expected " + std::to_string(kVersion));
 
