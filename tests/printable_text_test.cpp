@@ -6,6 +6,8 @@
 #include <span>
 #include <string>
 
+#include "calligraphy/core/unicode.hpp"
+
 using calligraphy::printable_one_line;
 
 namespace {
@@ -25,8 +27,10 @@ TEST_CASE("line breaks, tabs and terminal escapes are shown escaped, on one line
   CHECK(printable_one_line(std::string("nul\0byte", 8)) == "nul\\x00byte");
   CHECK(printable_one_line("del\x7f") == "del\\x7f");
   // C1 controls (U+009B is a one-code CSI on some terminals) and the Unicode line separators.
-  CHECK(printable_one_line("a\xc2\x9b" "b") == "a\\u009bb");
-  CHECK(printable_one_line("a\xe2\x80\xa8" "b") == "a\\u2028b");
+  CHECK(printable_one_line("a\xc2\x9b"
+                           "b") == "a\\u009bb");
+  CHECK(printable_one_line("a\xe2\x80\xa8"
+                           "b") == "a\\u2028b");
 }
 
 TEST_CASE("Chinese text and other printable characters are kept as they are", "[printable]") {
@@ -35,10 +39,11 @@ TEST_CASE("Chinese text and other printable characters are kept as they are", "[
 }
 
 TEST_CASE("bytes that are not UTF-8 are shown as hexadecimal, one at a time", "[printable]") {
-  CHECK(printable_one_line("a\xff" "b") == "a\\xffb");
-  CHECK(printable_one_line("\xe6\xb0") == "\\xe6\\xb0");          // a cut three-byte sequence
-  CHECK(printable_one_line("\xc0\xaf") == "\\xc0\\xaf");          // an overlong '/'
-  CHECK(printable_one_line("\xed\xa0\x80") == "\\xed\\xa0\\x80");  // a UTF-16 surrogate
+  CHECK(printable_one_line("a\xff"
+                           "b") == "a\\xffb");
+  CHECK(printable_one_line("\xe6\xb0") == "\\xe6\\xb0");                    // a cut three-byte sequence
+  CHECK(printable_one_line("\xc0\xaf") == "\\xc0\\xaf");                    // an overlong '/'
+  CHECK(printable_one_line("\xed\xa0\x80") == "\\xed\\xa0\\x80");           // a UTF-16 surrogate
   CHECK(printable_one_line("\xf4\x90\x80\x80") == "\\xf4\\x90\\x80\\x80");  // above U+10FFFF
 }
 
@@ -55,7 +60,8 @@ TEST_CASE("a long message is cut at a character boundary and says how much was c
   CHECK(kept.size() % 5 == 0);
   CHECK(kept.substr(0, 5) == "永\\n");
   const std::size_t kept_source_bytes = kept.size() / 5 * 4;
-  CHECK(line.substr(note) == " ... (" + std::to_string(long_text.size() - kept_source_bytes) + " more bytes)");
+  CHECK(line.substr(note) ==
+        " ... (" + std::to_string(long_text.size() - kept_source_bytes) + " more bytes)");
   // Text within the bound is not cut.
   CHECK(printable_one_line(std::string(100, 'a'), 100) == std::string(100, 'a'));
 }
@@ -73,4 +79,17 @@ TEST_CASE("lower_hex writes two lower-case digits a byte, most significant first
   const unsigned char bytes[] = {0x00, 0x0f, 0xa0, 0xff, 0x5c};
   CHECK(calligraphy::lower_hex(bytes) == "000fa0ff5c");
   CHECK(calligraphy::lower_hex(std::span<const unsigned char>()).empty());
+}
+
+TEST_CASE("a character file's name is a written character: no white space, control or format character",
+          "[printable]") {
+  for (const char32_t c : {U'永', U'一', U'A', U'\u3400', U'\U00020000'})
+    CHECK(calligraphy::names_a_character(c));
+  // Controls, white space of every width, and Unicode's format characters (Cf), which print as nothing or
+  // turn the rest of a line around (U+202E).
+  for (const char32_t c : {U'\x00', U'\x1b', U'\x7f', U'\x85', U' ', U'\t', U'\u00a0', U'\u3000', U'\u00ad',
+                           U'\u200b', U'\u200f', U'\u202e', U'\u2066', U'\ufeff', U'\U000e0001'}) {
+    INFO(static_cast<unsigned>(c));
+    CHECK_FALSE(calligraphy::names_a_character(c));
+  }
 }

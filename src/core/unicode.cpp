@@ -1,6 +1,7 @@
 #include "calligraphy/core/unicode.hpp"
 
 #include <cstdio>
+#include <utility>
 
 #include "calligraphy/core/errors.hpp"
 
@@ -92,9 +93,28 @@ bool is_white_space(char32_t c) {
          c == U'\x202F' || c == U'\x205F' || c == U'\x3000';
 }
 
+namespace {
+
+// Unicode's format characters, general category Cf (DerivedGeneralCategory.txt, Unicode 15.0): invisible,
+// and some (U+202E, right-to-left override) turn the text printed after them around.
+bool is_format_character(char32_t c) {
+  constexpr std::pair<char32_t, char32_t> kFormat[] = {
+      {0x00AD, 0x00AD},   {0x0600, 0x0605},   {0x061C, 0x061C},   {0x06DD, 0x06DD},   {0x070F, 0x070F},
+      {0x0890, 0x0891},   {0x08E2, 0x08E2},   {0x180E, 0x180E},   {0x200B, 0x200F},   {0x202A, 0x202E},
+      {0x2060, 0x2064},   {0x2066, 0x206F},   {0xFEFF, 0xFEFF},   {0xFFF9, 0xFFFB},   {0x110BD, 0x110BD},
+      {0x110CD, 0x110CD}, {0x13430, 0x1343F}, {0x1BCA0, 0x1BCA3}, {0x1D173, 0x1D17A}, {0xE0001, 0xE0001},
+      {0xE0020, 0xE007F}};
+  for (const auto& [first, last] : kFormat) {
+    if (c >= first && c <= last) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 bool names_a_character(char32_t c) {
   const bool control = c < U'\x0020' || (c >= U'\x007F' && c <= U'\x009F');
-  return !control && !is_white_space(c);
+  return !control && !is_white_space(c) && !is_format_character(c);
 }
 
 }  // namespace calligraphy

@@ -18,9 +18,10 @@ std::string describe_character(char32_t code_point);
 /// the spaces of every width (U+00A0 no-break, U+2000-U+200A, U+3000 ideographic), the line and paragraph
 /// separators. A text pasted from a page or a document holds any of them between its characters.
 bool is_white_space(char32_t code_point);
-/// True for a code point that can name a written character: not white space (above) and not a control
-/// character (U+0000-U+001F, U+007F-U+009F). A data folder's file named by anything else is not a
-/// character's.
+/// True for a code point that can name a written character: not white space (above), not a control
+/// character (U+0000-U+001F, U+007F-U+009F) and not a format character (Unicode's category Cf: U+200B
+/// zero width space, U+202E right-to-left override, U+FEFF, ...). A data folder's file named by anything
+/// else is not a character's.
 bool names_a_character(char32_t code_point);
 
 }  // namespace calligraphy
