@@ -89,9 +89,10 @@ def box_lines(folder, process, who, timeout=30):
     raise AssertionError("no box line within %s s" % timeout)
 
 
-def program_window(pid, tool=None, timeout=10):
+def program_window(pid, tool=None, timeout=30):
     """The window of the program with process id `pid`: searched by its pid as well as its title, so that the
-    window of a program that has just ended (still listed for a moment by the X server) is never taken."""
+    window of a program that has just ended (still listed for a moment by the X server) is never taken. As long
+    as the character boxes are waited for: a first window on a loaded machine took more than 10 s."""
     tool = tool or xdotool
     deadline = time.time() + timeout
     while True:
