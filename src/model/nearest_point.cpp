@@ -15,9 +15,6 @@ namespace calligraphy {
 
 namespace {
 
-// Above this magnitude squared distances could overflow a double.
-constexpr double kMaxCoordinate = kMaxNearestPointCoordinate;
-
 std::string format_number(double value) {
   char buffer[32];
   std::snprintf(buffer, sizeof buffer, "%.17g", value);
@@ -31,8 +28,8 @@ std::string format_point(const Vec2& v) {
 }
 
 bool usable_point(const Vec2& v) {
-  return std::isfinite(v.x()) && std::isfinite(v.y()) && std::abs(v.x()) <= kMaxCoordinate &&
-         std::abs(v.y()) <= kMaxCoordinate;
+  return std::isfinite(v.x()) && std::isfinite(v.y()) && std::abs(v.x()) <= kMaxNearestPointCoordinate &&
+         std::abs(v.y()) <= kMaxNearestPointCoordinate;
 }
 
 // Messages are built only on failure: the success path must not allocate.

@@ -277,10 +277,9 @@ void check_protocol_teachers(const LoadedProtocol& protocol) {
         const std::string text =
             study_detail::read_small_file(source, kMaxTeacherRecordingBytes, "teacher's recording");
         (void)study_detail::checked_teacher(text, source.string(), condition, given, characters);
-      } catch (const InvalidArgument&) {
-        throw;  // names the condition and the teacher already
       } catch (const DataError& e) {
         // The file cannot be read or is no teacher's recording: the condition that names it, then the file.
+        // (checked_teacher's InvalidArgument names the condition and the teacher already.)
         throw DataError("condition '" + condition.name + "': " + e.what());
       }
     }

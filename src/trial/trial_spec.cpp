@@ -431,13 +431,11 @@ void TrialSpec::validate(TeacherSource teacher_from) const {
   // record naming another is refused as the option is, not run under a name no writer has. Its settings' keys
   // and ranges are the simulated writer's to check (sim's writer_profile_of, when it is made).
   if (writer_profile.empty()) refuse("writer_profile", "no profile named");
-  std::string unknown_profile;
   try {
     (void)calligraphy::writer_profile(writer_profile);
   } catch (const InvalidArgument& error) {
-    unknown_profile = error.what();
+    refuse("writer_profile", error.what());
   }
-  if (!unknown_profile.empty()) refuse("writer_profile", unknown_profile);
   for (const WriterSetting& setting : writer_parameters) {
     if (setting.key.empty() || !std::isfinite(setting.value))
       refuse("writer_parameters", "'" + writer_setting_text(setting) + "' is not a key and a finite number");
