@@ -27,6 +27,8 @@
 #include "calligraphy/trial/whole_trial.hpp"
 #include "calligraphy/trial/writer_profile.hpp"
 #include "probe_device.hpp"
+#include "study/manifest_json.hpp"
+#include "study/saved_sessions.hpp"
 #include "study/trial_guidance.hpp"
 #include "study_test_devices.hpp"
 #include "temp_folder.hpp"
@@ -860,4 +862,38 @@ TEST_CASE("a condition's force law reaches the trial record through the one buil
     ++compared;
   }
   CHECK(compared == plan.size());
+}
+
+TEST_CASE(
+    "a person writing is spelt person in session.json and its records, and older files' human reads as "
+    "person",
+    "[study][session]") {
+  TempFolder temp;
+  SessionSetup setup = simulated("S07");
+  setup.writer = "person";
+  SessionFolder session = SessionFolder::create(temp.path / "S07", setup, small_protocol());
+  nlohmann::json document = nlohmann::json::parse(read(session.path() / "session.json"));
+  CHECK(document["writer"] == "person");
+  CHECK(document["version"] == 3);
+  CHECK(study_detail::manifest_from_json(document.dump(2), "session.json").setup.writer == "person");
+
+  // Versions 1 and 2 said "human": read as "person". Version 3 refuses it as any other unknown spelling.
+  document["writer"] = "human";
+  CHECK_THROWS_WITH(study_detail::manifest_from_json(document.dump(2), "session.json"),
+                    Catch::StartsWith("session.json: /writer: ") && Catch::Contains("\"person\""));
+  document["version"] = 2;
+  CHECK(study_detail::manifest_from_json(document.dump(2), "session.json").setup.writer == "person");
+
+  // A trial record of version 2 says "human" as well; every reader of records sees "person".
+  const auto record_with = [&](int version, const char* kind) {
+    const fs::path file = temp.path / ("record-" + std::to_string(version) + ".json");
+    std::ofstream(file) << nlohmann::json{{"format", study_detail::kTrialRecordFormat},
+                                          {"version", version},
+                                          {"writer", {{"kind", kind}, {"subject", "S07"}}}}
+                               .dump();
+    return study_detail::read_trial_record(file)["writer"]["kind"].get<std::string>();
+  };
+  CHECK(record_with(2, "human") == "person");
+  CHECK(record_with(3, "person") == "person");
+  CHECK(record_with(3, "human") == "human");  // left for the record's reader to refuse against its session
 }

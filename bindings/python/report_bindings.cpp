@@ -239,7 +239,8 @@ order: a list of dicts with ``name`` (its SI unit in it, as the library's DataFr
       "simulate_trial(..., teacher=recording). It guides only the characters it was recorded on, laid out "
       "the same way.")
       .def_readonly("characters", &TeacherRecording::characters, "the scene's characters, left to right")
-      .def_readonly("writer", &TeacherRecording::writer, "who wrote it, 'human' or the writer's profile")
+      .def_readonly("writer", &TeacherRecording::writer,
+                    "who wrote it, 'person' or the simulated writer's profile")
       .def_readonly("device", &TeacherRecording::device, "registry name of the device it was written on")
       .def_readonly("rate_hz", &TeacherRecording::rate_hz, "servo rate it was recorded at [Hz]")
       .def_readonly("library_version", &TeacherRecording::library_version,

@@ -348,7 +348,7 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   TrialDescription description;
   description.characters = label;
   description.guidance = options.force.guidance;
-  description.writer = simulation.writer.name.empty() ? "custom" : simulation.writer.name;
+  description.writer = "simulated";
   description.seed = simulation.seed;
   description.rate_hz = options.rate_hz;
   if (!device_name.empty()) description.device = device_name;
@@ -359,7 +359,7 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
     description.teacher_characters =
         label;  // a recording was checked against them; samples are taken as given
   }
-  description.writer_profile = description.writer;
+  description.writer_profile = simulation.writer.name.empty() ? "custom" : simulation.writer.name;
   if (a.writer_params && !a.writer_params->object.is_none()) {
     for (const auto& [key, value] : a.writer_params->object.cast<py::dict>()) {
       description.writer_parameters.push_back(py::str(key).cast<std::string>() + "=" +
@@ -492,7 +492,7 @@ PyTrialResult rerun_trial_py(const py::object& record,
   TrialDescription description;
   description.characters = recorded.spec.characters;
   description.guidance = recorded.spec.guidance;
-  description.writer = run.simulated_writer ? writing.profile().name : "human";
+  description.writer = run.simulated_writer ? "simulated" : "person";
   description.seed = recorded.spec.seed;
   description.rate_hz = recorded.spec.rate_hz;
   description.device = recorded.spec.device;
@@ -524,10 +524,13 @@ TeacherRecording record_teacher_py(const PyTrialResult& result, const std::optio
     sample.position_m = Vec3(position(i, 0), position(i, 1), position(i, 2));
   }
   const py::dict& m = result.metrics;
+  // The recording's writer is the simulated writer's profile, or "person" (teacher_recording.hpp).
+  const std::string writer = m.contains("writer_profile") ? m["writer_profile"].cast<std::string>()
+                                                          : m["writer"].cast<std::string>();
   TeacherRecording recording;
   try {
     recording =
-        teacher_recording_from_trace(m["character"].cast<std::string>(), m["writer"].cast<std::string>(),
+        teacher_recording_from_trace(m["character"].cast<std::string>(), writer,
                                      m["device"].cast<std::string>(), m["rate_hz"].cast<double>(), trace);
   } catch (const InvalidArgument& e) {
     throw InvalidArgument(std::string("result: ") + e.what());

@@ -128,7 +128,7 @@ SessionRunOptions run_options(const DeviceRegistry& devices, const LibraryOption
 #ifdef CALLIGRAPHY_WITH_TRAINER
 // A person's session goes to the trainer window unless --display terminal.
 bool in_window(const SessionDisplay& display, const std::string& writer) {
-  return writer == "human" && display.display == "window";
+  return writer == kPersonWriter && display.display == "window";
 }
 #endif
 
@@ -272,9 +272,8 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
   if (command.subjects > 0 && command.writer == kPersonWriter) {
     throw UsageError("--subjects: simulated subjects need --writer simulated");
   }
-  // The session folder's format calls a person "human" (SessionSetup::writer).
-  const bool person = writer_for_device(command.writer, *device) == kPersonWriter;
-  const std::string writer = person ? "human" : "simulated";
+  const std::string writer = writer_for_device(command.writer, *device);
+  const bool person = writer == kPersonWriter;
   if (person && command.learning_option->count() > 0 && command.writer_learning != "none") {
     throw UsageError("--writer-learning models the simulated writer, not a person (--writer person)");
   }
@@ -558,7 +557,7 @@ int resume_session(const SessionResumeCommand& command, DeviceRegistry& devices)
   TerminalHost host;
   std::shared_ptr<CharacterSource> source;
   SessionRunOptions options = run_options(
-      devices, command.library, session.manifest().setup.writer == "human" ? &host : nullptr, source);
+      devices, command.library, session.manifest().setup.writer == kPersonWriter ? &host : nullptr, source);
   if (!command.pacing.empty()) {
     options.pacing = parse_trial_pacing(command.pacing, "--pacing");
   }

@@ -127,9 +127,9 @@ Checked<TrialSpec> spec_from(const TrialCommand& command) {
 // What the trial's JSON and table say of it: the specification and the device it ran on.
 TrialDescription describe(const TrialSpec& spec, const TrialRun& run, const SimulatedWriting& writing,
                           const DeviceListing& device) {
-  // The report calls a person "human"; the simulated writer by its profile.
+  // Who wrote it, spelt as the specification's `writer`; the simulated writer's profile beside it.
   TrialDescription description{
-      spec.characters,  spec.guidance, run.simulated_writer ? spec.writer_profile : "human",
+      spec.characters,  spec.guidance, run.simulated_writer ? kSimulatedWriter : kPersonWriter,
       spec.seed,        spec.rate_hz,  device.name,
       device.info.model};
   description.guidance_mode = spec.guidance_mode;
@@ -199,7 +199,9 @@ bool write_teacher_recording(const TrialSpec& spec, const TrialDescription& desc
   }
   try {
     const TeacherRecording recording = teacher_recording_from_trace(
-        description.characters, description.writer, description.device, description.rate_hz, result.trace);
+        description.characters,
+        description.writer_profile.empty() ? kPersonWriter : description.writer_profile, description.device,
+        description.rate_hz, result.trace);
     write_output(spec.record_file, teacher_recording_json(recording));
     return true;
   } catch (const Error& e) {

@@ -73,10 +73,11 @@ void print_trial_table(const TrialDescription& d, const Scene& scene, const Tria
     std::snprintf(guidance, sizeof guidance, "%s", to_string(d.guidance_mode));
   }
   std::printf(
-      "Trial %s: guidance %s, %s writer, seed %llu, %.0f Hz, device %s (%s); strokes numbered from 1 "
+      "Trial %s: guidance %s, writer %s, seed %llu, %.0f Hz, device %s (%s); strokes numbered from 1 "
       "here, from 0 in the JSON\n",
-      d.characters.c_str(), guidance, d.writer.c_str(), static_cast<unsigned long long>(d.seed), d.rate_hz,
-      d.device.c_str(), d.device_model.c_str());
+      d.characters.c_str(), guidance,
+      (d.writer_profile.empty() ? d.writer : d.writer + " (" + d.writer_profile + ")").c_str(),
+      static_cast<unsigned long long>(d.seed), d.rate_hz, d.device.c_str(), d.device_model.c_str());
   std::printf("\n  %-6s %-5s %-6s %-4s %9s %9s %11s %9s %9s %8s %9s\n", "stroke", "char", "type", "ID",
               "mean[mm]", "max[mm]", "Frechet[mm]", "DTW[mm]", "time[s]", "attempts", "completed");
   // Strokes numbered over the scene; a person reads them from 1 (the files count from 0, as the renderer

@@ -17,12 +17,13 @@ namespace calligraphy {
 namespace study_detail {
 
 /// The format name and the newest version of session.json. Version 2 counts a planned trial's block and
-/// item from 1, as its index and repetition; version 1 (older folders) counted them from 0.
+/// item from 1, as its index and repetition; version 1 (older folders) counted them from 0. Version 3 calls a
+/// person writing `person`, as the trial's specification and the options do; versions 1 and 2 said `human`.
 inline constexpr const char* kSessionFormat = "calligraphy-study-session";
-inline constexpr std::int64_t kSessionVersion = 2;
+inline constexpr std::int64_t kSessionVersion = 3;
 
 /// Who wrote a session's trials (SessionSetup::writer).
-enum class WriterKind { simulated, human };
+enum class WriterKind { simulated, person };
 
 /// How a simulated subject learns from trial to trial (SessionSetup::writer_learning).
 enum class WriterLearning { none, two_state };
@@ -86,7 +87,7 @@ struct EnumTable<study_detail::WriterKind> {
   static constexpr std::string_view name = "WriterKind";
   static constexpr std::array<EnumEntry<study_detail::WriterKind>, 2> entries{{
       {study_detail::WriterKind::simulated, "simulated", "the simulated writer of writer_profile"},
-      {study_detail::WriterKind::human, "human", "a person at the device"},
+      {study_detail::WriterKind::person, "person", "a person at the device"},
   }};
 };
 

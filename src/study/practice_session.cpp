@@ -49,7 +49,7 @@ SessionFolder create_folder(const PracticeSetup& setup) {
   SessionSetup session;
   session.subject = {setup.subject, trailing_number(setup.subject)};
   session.device = setup.device;
-  session.writer = setup.simulated_writer ? "simulated" : "human";
+  session.writer = setup.simulated_writer ? "simulated" : "person";
   session.writer_profile = setup.writer_profile;
   session.writer_seed = setup.writer_seed;
   session.pacing = "real-time";

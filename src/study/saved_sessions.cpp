@@ -156,6 +156,10 @@ nlohmann::json read_trial_record(const fs::path& json_file) {
                                ? " (written by a newer calligraphy: read it with that version)"
                                : ""));
   }
+  // Versions 1 and 2 called a person writing "human": every reader sees version 3's "person".
+  if (version->get<std::int64_t>() < 3 && record.contains("writer") && record["writer"].is_object() &&
+      record["writer"].value("kind", nlohmann::json()) == "human")
+    record["writer"]["kind"] = "person";
   return record;
 }
 

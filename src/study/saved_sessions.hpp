@@ -66,9 +66,10 @@ class DistinctSessions {
 };
 
 /// The format name and the newest version of a saved trial's record (trial_record.cpp writes it; version 1
-/// counted a trial's block and item from 0).
+/// counted a trial's block and item from 0; versions 1 and 2 called a person writing `human`, read as
+/// `person`).
 inline constexpr const char* kTrialRecordFormat = "calligraphy-study-trial";
-inline constexpr std::int64_t kTrialRecordVersion = 2;
+inline constexpr std::int64_t kTrialRecordVersion = 3;
 
 /// The record of a saved trial, its format and version checked, read without following a link
 /// (read_session_file): every reader of a session's records reads them through this. Throws DataError naming

@@ -214,7 +214,7 @@ ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifes
 std::string session_line(const SessionManifest& m, const fs::path& folder, std::size_t saved) {
   std::string writer = m.setup.writer == "simulated" ? "simulated writer (" + m.setup.writer_profile +
                                                            ", learning " + m.setup.writer_learning + ")"
-                                                     : "human";
+                                                     : "person";
   return folder.string() + ", protocol " + m.protocol.protocol.name + " (sha256 " +
          m.protocol.sha256.substr(0, 12) + "), session " + std::to_string(m.setup.session_number) +
          ", device " + m.setup.device + ", " + writer + ", " + std::to_string(saved) + " of " +

@@ -107,7 +107,7 @@ json renderer_json(const TrialOptions& o) {
 }
 
 json writer_json(const TrialRecordContext& c) {
-  if (!c.simulated_writer) return {{"kind", "human"}, {"subject", c.session->setup.subject.id}};
+  if (!c.simulated_writer) return {{"kind", "person"}, {"subject", c.session->setup.subject.id}};
   const WriterProfile& w = c.simulation.writer;
   json writer = {{"kind", "simulated"},
                  {"seed", c.simulation.seed},

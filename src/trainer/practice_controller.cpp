@@ -417,7 +417,7 @@ void PracticeController::save_recording(TrialView& view, const TrialResult& resu
   try {
     const TeacherRecording recording =
         teacher_recording_from_trace(options_.characters[view.character].utf8,
-                                     options_.simulated_writer ? options_.writer_profile : "human",
+                                     options_.simulated_writer ? options_.writer_profile : "person",
                                      options_.device, trial_options_.rate_hz, result.trace);
     write_file_atomically(options_.record, teacher_recording_json(recording));
     std::fprintf(stderr, "calligraphy train: teacher recording %s (%zu samples)\n", options_.record.c_str(),

@@ -594,7 +594,7 @@ class GuidanceModesAndWriters(CliTestCase):
 
     def test_foreign_writer_runs_and_is_recorded(self):
         metrics = self.trial_json("十", "--writer-profile", "foreign", "--seed", "2")
-        self.assertEqual(metrics["writer"], "foreign")
+        self.assertEqual(metrics["writer"], "simulated")  # who wrote it, spelt as --writer
         self.assertEqual(metrics["writer_profile"], "foreign")
         self.assertEqual(metrics["guidance_mode"], "fixed")
         self.assertGreater(metrics["total_time_s"], 0.0)
@@ -719,7 +719,7 @@ class OneCommandLine(CliTestCase):
         self.assertEqual(self.trial_json("十", "--writer", "auto", "--seed", "1"), self.trial_json("十", "--seed", "1"))
         # The new spellings: the simulated writer with a profile; a person cannot hold the simulated device.
         metrics = self.trial_json("十", "--writer", "simulated", "--writer-profile", "skilled", "--seed", "1")
-        self.assertEqual((metrics["writer"], metrics["writer_profile"]), ("skilled", "skilled"))
+        self.assertEqual((metrics["writer"], metrics["writer_profile"]), ("simulated", "skilled"))
         self.assertEqual(metrics, self.trial_json("十", "--writer-profile", "skilled", "--seed", "1"))
         for device in ("simulated", "emulated-phantom"):
             message = self.assert_usage_error(["trial", "十", "--device", device, "--writer", "person"], "--writer")

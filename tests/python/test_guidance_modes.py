@@ -19,7 +19,7 @@ def trial(**kwargs):
 def test_writer_by_name(name):
     result = trial(writer=name)
     assert result.writer == getattr(calligraphy.WriterProfile, name)()
-    assert result.metrics["writer"] == name
+    assert (result.metrics["writer"], result.metrics["writer_profile"]) == ("simulated", name)
 
 
 def test_unknown_writer_name_is_named():

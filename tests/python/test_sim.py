@@ -21,7 +21,7 @@ def test_a_custom_writer_changes_the_trial_and_is_named():
                                                          scale_error=0.0, tremor_amplitude_n=0.0)
     result = calligraphy.simulate_trial("九", writer=steady, seed=4, guidance=False, keep_trace=False)
     novice = calligraphy.simulate_trial("九", writer="novice", seed=4, guidance=False, keep_trace=False)
-    assert result.metrics["writer"] == "steady"
+    assert (result.metrics["writer"], result.metrics["writer_profile"]) == ("simulated", "steady")
     # Without the systematic bias the unguided writer stays closer to the reference.
     assert result.metrics["mean_deviation_m"] < novice.metrics["mean_deviation_m"]
 

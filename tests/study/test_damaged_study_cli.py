@@ -146,7 +146,7 @@ class DamagedStudyTest(unittest.TestCase):
         subject = original["subject"]
         readers = (["report", "S", "--csv", "."], ["report", "S", "--out", "r.html"],
                    ["curriculum", "S", "--subject", subject, "--from", "永十"])
-        for version in (3, 99, 0, -1, "2", 2.5, None):
+        for version in (4, 99, 0, -1, "2", 2.5, None):
             with self.subTest(version=version):
                 document = dict(original)
                 if version is None:
@@ -182,7 +182,7 @@ class DamagedStudyTest(unittest.TestCase):
     def test_an_unknown_writer_or_profile_in_a_session_manifest_names_the_manifest(self):
         manifest = self.first_session() / "session.json"
         original = json.loads(manifest.read_text(encoding="utf-8"))
-        for key, wrong in (("writer", "x"), ("writer", "person"), ("writer_profile", "x")):
+        for key, wrong in (("writer", "x"), ("writer", "human"), ("writer_profile", "x")):
             with self.subTest(key=key, wrong=wrong):
                 manifest.write_text(json.dumps(dict(original, **{key: wrong})), encoding="utf-8")
                 result = self.run_cli("report", "S", "--csv", ".")

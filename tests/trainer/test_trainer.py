@@ -1021,7 +1021,7 @@ class SessionWindowTest(unittest.TestCase):
         self.assertNotRegex(self.errors(), r"\bnan\b")
         for record in (first, second):
             self.assertEqual(record["device"]["name"], "mouse-hand")
-            self.assertEqual(record["writer"]["kind"], "human")
+            self.assertEqual(record["writer"]["kind"], "person")
             self.assertEqual(record["renderer"]["loop"]["stall_timeout_s"], 0.0)  # no motors: no stall bound
         log = [json.loads(l) for l in (self.session_folder() / "log.jsonl").read_text().splitlines()]
         self.assertIn("session_completed", [e["event"] for e in log])

@@ -12,7 +12,7 @@ namespace calligraphy {
 struct TrialDescription {
   std::string characters;  // UTF-8
   bool guidance = true;
-  std::string writer;
+  std::string writer;  ///< who wrote it: "simulated" or "person" (TrialSpec::writer's spelling)
   std::uint64_t seed = 0;
   double rate_hz = 1000.0;
   std::string device = "simulated";  // registry name

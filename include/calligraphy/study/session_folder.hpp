@@ -45,7 +45,7 @@ struct LibraryBuild {
 struct SessionSetup {
   SubjectAssignment subject;
   std::string device = "simulated";       ///< the device's name in the device registry
-  std::string writer = "simulated";       ///< "simulated" (a simulated writer moves the device) or "human"
+  std::string writer = "simulated";       ///< "simulated" (a simulated writer moves the device) or "person"
   std::string writer_profile = "novice";  ///< the simulated writer's profile (`writer_profile`): "novice",
                                           ///< "skilled" or "foreign"
   std::uint64_t writer_seed = 0;          ///< the simulated subject's seed (see `subject_seed`)

@@ -43,7 +43,7 @@ struct TrialRow {
   std::optional<int> period;
   /// The condition the item is or was trained under in the crossover, on every phase's row; "" when none.
   std::string trained_condition;
-  std::string writer;  ///< "simulated" or "human"
+  std::string writer;  ///< "simulated" or "person"
   /// A simulated writer's profile ("novice", "skilled", "foreign") and learning model ("none", "two-state");
   /// "" for a person.
   std::string writer_profile;

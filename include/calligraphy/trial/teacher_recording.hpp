@@ -25,7 +25,7 @@ namespace calligraphy {
 
 struct TeacherRecording {
   std::string characters;  ///< UTF-8, the scene's characters left to right
-  std::string writer;      ///< "human", or the simulated writer's profile
+  std::string writer;      ///< "person", or the simulated writer's profile
   std::string device;      ///< registry name of the device it was written on
   double rate_hz = 1000.0;
   std::string library_version;  ///< of the library that recorded it (empty when unknown)
