@@ -396,6 +396,13 @@ class Components(Base):
                                        'message(STATUS "found=${calligraphy_FOUND}")'))
         self.assertEqual(done.returncode, 0, done.stderr.decode())
         self.assertIn("found=0", done.stdout.decode())
+        done = configure(self.tmp / "src3", self.tmp / "b3", self.full,
+                         probe_project("find_package(calligraphy REQUIRED COMPONENTS haptics "
+                                       "OPTIONAL_COMPONENTS quaternion_usb)",
+                                       'message(STATUS "found=${calligraphy_FOUND} '
+                                       'why=${calligraphy_NOT_FOUND_MESSAGE}.")'))
+        self.assertEqual(done.returncode, 0, done.stderr.decode())
+        self.assertIn("found=1 why=.", done.stdout.decode())
 
 
 class CMakePackage(Base):
