@@ -1,13 +1,14 @@
 """Packs the built Python package (``<build>/python/calligraphy``: the extension, the pure-Python modules,
-the subpackage calligraphy.stats with its R script, the type stubs) into a wheel (PEP 427) with setuptools
-and wheel (Debian python3-setuptools, python3-wheel), so that it installs into any environment of the same
-interpreter version with ``pip install --no-index calligraphy-*.whl``: a virtual environment among them.
+the subpackage calligraphy.stats with its R script, the type stubs, the licences in calligraphy/licences)
+into a wheel (PEP 427) with setuptools and wheel (Debian python3-setuptools, python3-wheel), so that it
+installs into any environment of the same interpreter version with ``pip install --no-index
+calligraphy-*.whl``: a virtual environment among them.
 
     python3 make_wheel.py --package BUILD/python/calligraphy --version 0.1.0 --out DIR
 
 Prints the wheel's path. The extension was built for this interpreter's ABI (the wheel's tag says which) and
-links Debian 12's libspdlog and libfmt at run time: the wheel is for Debian 12 machines, not manylinux.
-Exit status 0, or 1 with a message naming what is missing.
+links Debian 12's libraries at run time (docs/python.md, "Install"): the wheel is for Debian 12 machines, not
+manylinux. Exit status 0, or 1 with a message naming what is missing.
 """
 
 import argparse
@@ -58,7 +59,8 @@ def main() -> int:
                 name="calligraphy", version=arguments.version,
                 description="Haptic training of Chinese handwriting (Wang, Zhang & Yao 2006, Virtual Reality 9)",
                 packages=["calligraphy", "calligraphy.stats"],
-                package_data={"calligraphy": ["*.so", "*.pyi", "py.typed"], "calligraphy.stats": ["*.R"]},
+                package_data={"calligraphy": ["*.so", "*.pyi", "py.typed", "licences/*"],
+                              "calligraphy.stats": ["*.R"]},
                 python_requires=f"=={sys.version_info.major}.{sys.version_info.minor}.*",
                 install_requires=["numpy"],
                 extras_require={"tables": ["pandas"], "figures": ["matplotlib"],

@@ -1,8 +1,9 @@
 """The wheel installs into a virtual environment and imports from there: packs the build's package
 (bindings/python/make_wheel.py), makes a venv of the build interpreter with its site packages (numpy,
 pandas from Debian), `pip install --no-index` the wheel, and in the venv's interpreter imports calligraphy
-from the venv, runs a trial of 十, finds the R script of the mixed models beside the package, and runs binding
-tests (VENV_TESTS) with the venv's interpreter on the installed package. Then checks
+from the venv, runs a trial of 十, finds the R script of the mixed models beside the package and the licences
+in it (calligraphy/licences, byte for byte), and runs binding tests (VENV_TESTS) with the venv's interpreter
+on the installed package. Then checks
 that a venv without numpy refuses the wheel naming numpy, offline. Exit 0 or 1 (77: venv or pip missing).
 
     python3 check_wheel.py --build BUILD --version 0.1.0
@@ -64,6 +65,11 @@ def main() -> int:
         location, script, strokes = probe.stdout.split("\n")[:3]
         assert pathlib.Path(location).is_relative_to(env.resolve()), location  # the venv's, not Debian's copy
         assert script == "True" and strokes == "2 2", probe.stdout
+        # The licences of the code and of the character data compiled into the extension go with it.
+        licences = pathlib.Path(location).parent / "licences"
+        for name, source in (("LICENSE", "LICENSE"), ("ARPHICPL.TXT", "data/corpus/ARPHICPL.TXT"),
+                             ("NOTICE.md", "data/corpus/NOTICE.md")):
+            assert (licences / name).read_bytes() == (SOURCE / source).read_bytes(), name
         # The binding tests that need no build tree, run by the venv's interpreter on the installed package
         # (conftest.py checks that `calligraphy` comes from the venv, not from a build or Debian's folders).
         tested = run([env / "bin/python", "-m", "pytest", "-q", "-p", "no:cacheprovider",
