@@ -111,6 +111,18 @@ namespace fs = std::filesystem;
 
 std::string named(const std::string& what, const std::string& path) { return what + " " + path; }
 
+// A relative path is resolved against the working directory, which may have been removed under the process
+// (getcwd fails): an error naming the option and the path, as a missing folder is.
+fs::path absolute_path(const std::string& what, const std::string& path, const fs::path& relative) {
+  std::error_code error;
+  fs::path absolute = fs::absolute(relative, error);
+  if (error) {
+    throw DataError(named(what, path) +
+                    ": cannot resolve it against the working directory: " + error.message());
+  }
+  return absolute;
+}
+
 bool same_file(const FilePlan::Identity& a, const FilePlan::Identity& b) {
   if (a.exists != b.exists) return false;
   return a.exists ? a.device == b.device && a.inode == b.inode : a.path == b.path;
@@ -166,7 +178,7 @@ FilePlan::Identity identify_file(const std::string& what, const std::string& pat
     throw DataError(named(what, path) + ": cannot examine: " + std::strerror(errno));
   }
   FilePlan::Identity identity;  // not there yet: the resolved folder and the name
-  const fs::path absolute = fs::absolute(target);
+  const fs::path absolute = absolute_path(what, path, target);
   std::error_code error;
   const fs::path folder = fs::weakly_canonical(absolute.parent_path(), error);
   identity.path = ((error ? absolute.parent_path() : folder) / absolute.filename()).string();
@@ -214,8 +226,8 @@ void FilePlan::output(const std::string& what, const std::string& path) {
   if (path.empty() || path == "-") return;
   const Identity identity = identify_file(what, path);
   if (identity.folder) throw DataError(named(what, path) + ": is a folder, not a file");
-  if (!identity.exists && (path.back() == '/' || fs::path(path).filename() == ".." ||
-                           fs::path(path).filename() == ".")) {
+  if (!identity.exists &&
+      (path.back() == '/' || fs::path(path).filename() == ".." || fs::path(path).filename() == ".")) {
     throw DataError(named(what, path) + ": names a folder (it ends in '/', '.' or '..'), not a file");
   }
   if (identity.exists && !identity.regular) {  // a device or FIFO: written in place, never replaced
@@ -262,18 +274,19 @@ void FilePlan::set_output(const std::string& what, const std::string& path) {
 
 void FilePlan::output_folder(const std::string& what, const std::string& path) {
   if (path.empty()) return;
-  fs::path folder = fs::absolute(path);
+  const fs::path absolute = absolute_path(what, path, path);
+  fs::path folder = absolute;
   struct stat status {};
   while (::stat(folder.c_str(), &status) != 0) {  // the nearest folder that exists is the one written in
     if (errno != ENOENT) throw DataError(named(what, path) + ": cannot examine: " + std::strerror(errno));
     if (folder == folder.root_path()) break;
     folder = folder.parent_path();
   }
-  if (folder == fs::absolute(path) && !S_ISDIR(status.st_mode)) {
+  if (folder == absolute && !S_ISDIR(status.st_mode)) {
     throw DataError(named(what, path) + ": is not a folder");
   }
   require_writable_folder(what, path, folder);
-  output_folders_.push_back(fs::absolute(path).lexically_normal());
+  output_folders_.push_back(absolute.lexically_normal());
 }
 
 void FilePlan::set_output_folder(const std::string& what, const std::string& path) {

@@ -23,6 +23,7 @@ extern "C" void record_stop_signal(int signal) {
 struct SavedDispositions {
   struct sigaction stop[std::size(kStopSignals)];
   struct sigaction pipe;
+  sigset_t mask;
 };
 SavedDispositions saved;
 std::atomic<bool> installed_flag{false};
@@ -37,6 +38,8 @@ StopSignals::StopSignals() {
   sigemptyset(&action.sa_mask);
   for (int signal : kStopSignals) sigaddset(&action.sa_mask, signal);  // one handler at a time
   action.sa_flags = SA_RESTART;
+  sigset_t caught;
+  sigemptyset(&caught);
   for (std::size_t i = 0; i < std::size(kStopSignals); ++i) {
     sigaction(kStopSignals[i], nullptr, &saved.stop[i]);
     // An ignored SIGHUP was ignored on purpose (nohup: keep running when the terminal closes), so it stays
@@ -44,7 +47,11 @@ StopSignals::StopSignals() {
     // keeps the terminal's Ctrl-C away, and a stop asked for by kill must still end a trial cleanly.
     if (kStopSignals[i] == SIGHUP && saved.stop[i].sa_handler == SIG_IGN) continue;
     sigaction(kStopSignals[i], &action, nullptr);
+    sigaddset(&caught, kStopSignals[i]);
   }
+  // The same for a signal blocked when the process started (a parent's sigprocmask is inherited through
+  // exec): it would stay pending and never stop anything. One sent before, pending, is delivered now.
+  pthread_sigmask(SIG_UNBLOCK, &caught, &saved.mask);
   struct sigaction ignore {};
   ignore.sa_handler = SIG_IGN;
   sigemptyset(&ignore.sa_mask);
@@ -57,6 +64,7 @@ StopSignals::~StopSignals() {
   if (received() == 0) {
     for (std::size_t i = 0; i < std::size(kStopSignals); ++i)
       sigaction(kStopSignals[i], &saved.stop[i], nullptr);
+    pthread_sigmask(SIG_SETMASK, &saved.mask, nullptr);
   }
   sigaction(SIGPIPE, &saved.pipe, nullptr);
   installed_flag.store(false);

@@ -58,8 +58,10 @@ class ProgressBar {
 std::filesystem::path fetched_corpus_folder() {
   const char* xdg = std::getenv("XDG_CACHE_HOME");
   const char* home = std::getenv("HOME");
+  // The XDG base directory specification: $XDG_CACHE_HOME only when it is an absolute path (an empty or
+  // relative one is ignored), else $HOME/.cache.
   std::filesystem::path cache;
-  if (xdg != nullptr && *xdg != '\0') {
+  if (xdg != nullptr && std::filesystem::path(xdg).is_absolute()) {
     cache = xdg;
   } else if (home != nullptr) {
     cache = std::filesystem::path(home) / ".cache";

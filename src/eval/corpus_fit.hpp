@@ -27,7 +27,7 @@ struct CorpusFit {
   double fit_cpu_s = 0.0;         ///< summed over threads
 };
 
-/// The folder scripts/fetch-hanzi-writer-data.sh fills ($XDG_CACHE_HOME, else ~/.cache, then
+/// The folder scripts/fetch-hanzi-writer-data.sh fills ($XDG_CACHE_HOME when absolute, else ~/.cache, then
 /// calligraphy/hanzi-writer-data-2.0.1), whether or not it has been filled.
 std::filesystem::path fetched_corpus_folder();
 /// `fetched_corpus_folder()` when the fetch completed (its `.complete` marker exists), else nullopt.

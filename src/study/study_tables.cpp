@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cstdio>
+#include <charconv>
 #include <exception>
 #include <iterator>
 #include <mutex>
@@ -172,10 +172,12 @@ std::string field(const std::string& text) {
   return quoted + "\"";
 }
 
+// printf's %.17g in the C locale whatever the process's locale is: a Python program that called
+// locale.setlocale(LC_ALL, "de_DE.UTF-8") would otherwise get decimal commas inside comma-separated fields.
 std::string field(double value) {
   char text[32];
-  std::snprintf(text, sizeof text, "%.17g", value);
-  return text;
+  return std::string(text,
+                     std::to_chars(text, text + sizeof text, value, std::chars_format::general, 17).ptr);
 }
 
 std::string field(const std::optional<double>& value) { return value ? field(*value) : std::string(); }

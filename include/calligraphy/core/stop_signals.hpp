@@ -11,14 +11,14 @@
 namespace calligraphy {
 
 /// While it lives, SIGINT, SIGTERM and SIGHUP are caught (sigaction with SA_RESTART, so that interrupted
-/// reads and writes resume), except a SIGHUP that was ignored when it was made (`nohup`: the command goes
-/// on when its terminal closes), and SIGPIPE is ignored (a closed standard output becomes a write error that
-/// is reported, not a death before the files are written). Every later stop signal is recorded as well,
-/// so a second Ctrl-C while the files are written cannot lose them; SIGKILL and SIGQUIT still end the
-/// process. The previous dispositions are restored on destruction, except after a stop was received:
-/// then further stop signals stay caught (and change nothing) until the process exits, so that a second
-/// Ctrl-C during the shutdown cannot change how it ends. One at a time per process: the
-/// constructor throws StateError when another one lives (see `installed`).
+/// reads and writes resume) and unblocked in the thread that made it, except a SIGHUP that was ignored when
+/// it was made (`nohup`: the command goes on when its terminal closes), and SIGPIPE is ignored (a closed
+/// standard output becomes a write error that is reported, not a death before the files are written). Every
+/// later stop signal is recorded as well, so a second Ctrl-C while the files are written cannot lose them;
+/// SIGKILL and SIGQUIT still end the process. The previous dispositions and signal mask are restored on
+/// destruction, except after a stop was received: then further stop signals stay caught (and change nothing)
+/// until the process exits, so that a second Ctrl-C during the shutdown cannot change how it ends. One at a
+/// time per process: the constructor throws StateError when another one lives (see `installed`).
 class StopSignals {
  public:
   StopSignals();
