@@ -1,0 +1,1068 @@
+#!/usr/bin/env python3
+"""Round 14C: every number the program reports about a trial or a study, recomputed independently from the
+definitions of docs/metrics.md, docs/experiments.md, docs/cli.md and the statistics' docstrings, with numpy,
+from the raw trace and never from the library. Run by CTest as `cli_unseen_round14c_tests`.
+
+Traces made by hand with a known geometry on 一 and 十 (whose models are straight elements: `model --json`):
+the stroke's parallel curve 2 mm to its side at a constant 50 mm/s, the same with a pause with the pen down,
+with a lift mid-stroke, written twice, backwards, with irregular time stamps, minimum-jerk movements, an
+ignored blip, a pen height at the contact threshold; each `score`d (JSON and table, metres and data units,
+Python's `score` of a mapping) and every reported number held to its closed form or to a brute-force
+deviation, discrete Frechet distance and DTW written here. One simulated trial's `--json` held to its own
+`--csv` (segments from the pen's height, times, path, forces, state changes, deviations). One tiny study
+(`session run` of 4 subjects, `report --csv`, `trace` of a saved trial, `session cohort`): the tables' rows
+against the records, the times against the traces, the statistics' means, SDs, intervals and paired t against
+numpy.
+
+Each case asserts the documented value; tolerances are those a trace file's precision gives (times 1 us,
+lengths 0.1 um) or the documented discretisation. CALLIGRAPHY_CLI names the program, PYTHONPATH its Python
+module. CALLIGRAPHY_SANITIZED=1 takes five cases.
+"""
+import csv
+import io
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import unittest
+from decimal import Decimal
+from pathlib import Path
+
+import numpy as np
+
+from outsider import SANITIZED, run, sanitized_subset
+
+load_tests = sanitized_subset({"test_offset_line_deviations_are_two_millimetres",
+                               "test_offset_line_path_time_and_speed",
+                               "test_frechet_matches_a_brute_force",
+                               "test_trial_times_and_path_from_its_own_csv",
+                               "test_trials_table_rows_are_the_records"})
+
+YI, SHI = "一", "十"
+SCALE = 0.06 / 1024  # the default layout: 60 mm per 1024-unit box, centred on the paper's origin
+CONTACT_M = 0.0005
+YI_MEDIAN = [[121, 393], [193, 372], [417, 402], [827, 434], [920, 401]]  # hanzi-writer-data 2.0.1's 一
+STEP_M = 0.00025  # the reference's arc-length spacing for Frechet and DTW (docs/metrics.md, "Resampling")
+SHARED = {}
+
+
+# ---- geometry, independent of the library ------------------------------------------------------------
+
+def to_metres(data_points):
+    """hanzi-writer-data units (y up) to paper metres: (x - 512, y - 388) x 60 mm / 1024 (docs/trainer.md)."""
+    p = np.asarray(data_points, float)
+    return np.c_[(p[:, 0] - 512.0) * SCALE, (p[:, 1] - 388.0) * SCALE]
+
+
+def to_data(metres):
+    p = np.asarray(metres, float)
+    return np.c_[p[:, 0] / SCALE + 512.0, p[:, 1] / SCALE + 388.0]
+
+
+def model_polylines(char, cwd):
+    """Each stroke's elements from `model --json` (all straight for 一 and 十) as a polyline in metres."""
+    result = run(["model", char, "--json"], cwd)
+    assert result.returncode == 0, result.stderr
+    lines = []
+    for stroke in json.loads(result.stdout)["strokes"]:
+        points = []
+        for element in stroke["elements"]:
+            assert element["degree"] == 1, "the closed forms here need straight elements"
+            a, b = element["control_points"]
+            if not points:
+                points.append(a)
+            points.append(b)
+        lines.append(to_metres(points))
+    return lines
+
+
+def point_segment_distances(points, a, b):
+    d = b - a
+    s = np.clip(((points - a) @ d) / (d @ d), 0.0, 1.0)
+    return np.linalg.norm(points - (a + s[:, None] * d), axis=1)
+
+
+def deviations(points, polyline):
+    """d_i = min over elements of the distance to the element (exact for straight elements)."""
+    return np.min([point_segment_distances(points, a, b) for a, b in zip(polyline[:-1], polyline[1:])], axis=0)
+
+
+def chord_length(points):
+    return float(np.sum(np.linalg.norm(np.diff(points, axis=0), axis=1)))
+
+
+def resample_by_arc_length(polyline, step=STEP_M, max_points=2000):
+    """Equal arc-length spacing of at most `step` and at most `max_points` points, both ends kept."""
+    lengths = np.linalg.norm(np.diff(polyline, axis=0), axis=1)
+    cumulative = np.r_[0.0, np.cumsum(lengths)]
+    total = cumulative[-1]
+    count = min(max_points, int(math.ceil(total / step - 1e-12)) + 1)
+    s = np.linspace(0.0, total, count)
+    return np.c_[np.interp(s, cumulative, polyline[:, 0]), np.interp(s, cumulative, polyline[:, 1])]
+
+
+def drop_repeats(points):
+    keep = np.r_[True, np.any(np.diff(points, axis=0) != 0.0, axis=1)]
+    return points[keep]
+
+
+def brute_frechet(p, q):
+    """Eiter & Mannila's recurrence, the whole table."""
+    dist = np.linalg.norm(p[:, None, :] - q[None, :, :], axis=2)
+    n, m = dist.shape
+    c = np.empty((n, m))
+    for i in range(n):
+        for j in range(m):
+            if i == 0 and j == 0:
+                best = -np.inf
+            elif i == 0:
+                best = c[0, j - 1]
+            elif j == 0:
+                best = c[i - 1, 0]
+            else:
+                best = min(c[i - 1, j], c[i - 1, j - 1], c[i, j - 1])
+            c[i, j] = max(best, dist[i, j])
+    return float(c[-1, -1])
+
+
+def brute_dtw(p, q):
+    """Sakoe & Chiba with steps (1,0), (0,1), (1,1): D(n-1, m-1) / K, K the pairs on the optimal path."""
+    dist = np.linalg.norm(p[:, None, :] - q[None, :, :], axis=2)
+    n, m = dist.shape
+    cost = np.full((n + 1, m + 1), np.inf)
+    pairs = np.zeros((n + 1, m + 1))
+    cost[0, 0] = 0.0
+    for i in range(1, n + 1):
+        for j in range(1, m + 1):
+            options = ((cost[i - 1, j - 1], pairs[i - 1, j - 1]), (cost[i - 1, j], pairs[i - 1, j]),
+                       (cost[i, j - 1], pairs[i, j - 1]))
+            best = min(options, key=lambda o: o[0])
+            cost[i, j] = dist[i - 1, j - 1] + best[0]
+            pairs[i, j] = best[1] + 1
+    return float(cost[n, m] / pairs[n, m]), int(pairs[n, m])
+
+
+def parallel_curve(polyline, offset, spacing):
+    """Points at arc-length `spacing` on the curve `offset` metres to the left of the polyline: every point
+    is exactly |offset| from it (offset lines cut at their crossing on the inner side of a corner, an arc
+    round the corner on the outer side)."""
+    pieces = []
+    for a, b in zip(polyline[:-1], polyline[1:]):
+        d = (b - a) / np.linalg.norm(b - a)
+        normal = np.array([-d[1], d[0]])
+        pieces.append((a + offset * normal, b + offset * normal))
+    dense = [pieces[0][0]]
+    for k in range(len(pieces) - 1):
+        (a1, b1), (a2, b2) = pieces[k], pieces[k + 1]
+        corner = polyline[k + 1]
+        matrix = np.array([b1 - a1, a2 - b2]).T
+        inner = False
+        if abs(np.linalg.det(matrix)) > 1e-18:
+            s, u = np.linalg.solve(matrix, a2 - a1)
+            inner = 0.0 < s < 1.0 and 0.0 < u < 1.0
+        if inner:  # the two offset lines cross
+            dense.append(a1 + s * (b1 - a1))
+        else:  # an arc of radius |offset| round the corner
+            angle1 = math.atan2(b1[1] - corner[1], b1[0] - corner[0])
+            angle2 = math.atan2(a2[1] - corner[1], a2[0] - corner[0])
+            sweep = (angle2 - angle1 + math.pi) % (2 * math.pi) - math.pi
+            dense.extend(corner + abs(offset) * np.array([math.cos(angle1 + sweep * f), math.sin(angle1 + sweep * f)])
+                         for f in np.linspace(0.0, 1.0, 513))
+    dense.append(pieces[-1][1])
+    return resample_by_arc_length(drop_repeats(np.array(dense)), spacing, max_points=10 ** 6)
+
+
+def kinematics(t, xy, cutoff_hz=10.0):
+    """Velocity peaks and normalised jerk as docs/metrics.md defines them: a Gaussian low-pass of
+    sigma = sqrt(ln 2) / (2 pi f_c) truncated at 4 sigma, on a uniform grid of step the mean sampling interval
+    clamped to [sigma/16, sigma/4] from the first sample on (past the last, the pen rests there), extended
+    before and after by the pen resting as far as the kernel reaches plus 3 points; speed and jerk by the
+    documented differences; peaks by 10 % hysteresis."""
+    t = np.asarray(t, float)
+    xy = np.asarray(xy, float)
+    sigma = math.sqrt(math.log(2.0)) / (2.0 * math.pi * cutoff_hz)
+    h = min(max((t[-1] - t[0]) / (len(t) - 1), sigma / 16.0), sigma / 4.0)
+    grid = t[0] + np.arange(int(math.ceil((t[-1] - t[0]) / h)) + 1) * h
+    y = np.c_[np.interp(grid, t, xy[:, 0]), np.interp(grid, t, xy[:, 1])]
+    reach = int(math.ceil(4.0 * sigma / h))
+    y = np.r_[np.repeat(y[:1], reach + 3, 0), y, np.repeat(y[-1:], reach + 3, 0)]
+    weights = np.exp(-0.5 * (np.arange(-reach, reach + 1) * h / sigma) ** 2)
+    weights /= weights.sum()
+    padded = np.r_[np.repeat(y[:1], reach, 0), y, np.repeat(y[-1:], reach, 0)]
+    f = np.c_[np.convolve(padded[:, 0], weights, "valid"), np.convolve(padded[:, 1], weights, "valid")]
+    speed = np.linalg.norm(f[2:] - f[:-2], axis=1) / (2.0 * h)
+    jerk = (f[4:] - 2.0 * f[3:-1] + 2.0 * f[1:-3] - f[:-4]) / (2.0 * h ** 3)
+    integral = float(np.sum(jerk ** 2) * h)
+    duration = t[-1] - t[0]
+    length = chord_length(xy)
+    threshold = 0.1 * float(np.max(speed))
+    peaks, high, trough, top = 0, False, speed[0], 0.0
+    for v in speed:
+        if not high:
+            trough = min(trough, v)
+            if v - trough >= threshold:
+                high, top = True, v
+        else:
+            top = max(top, v)
+            if top - v >= threshold:
+                peaks, high, trough = peaks + 1, False, v
+    return peaks + (1 if high else 0), math.sqrt(0.5 * integral * duration ** 5 / length ** 2)
+
+
+def min_jerk(a, b, duration, rate):
+    """Flash & Hogan's minimum-jerk movement from a to b in `duration` seconds sampled at `rate` Hz."""
+    count = int(round(duration * rate)) + 1
+    tau = np.linspace(0.0, 1.0, count)
+    s = 10 * tau ** 3 - 15 * tau ** 4 + 6 * tau ** 5
+    return tau * duration, a + s[:, None] * (b - a)
+
+
+# ---- traces and the program -------------------------------------------------------------------------
+
+def write_trace(path, t, xy, pen=None, z=None, decimals=9):
+    """A CSV trace: `t` in s to 1 us, x and y to `decimals`, `pen` (1/0) or `z` [m]."""
+    with open(path, "w", encoding="utf-8") as out:
+        out.write("t,x,y," + ("z" if z is not None else "pen") + "\n")
+        last = z if z is not None else (pen if pen is not None else np.ones(len(t), int))
+        for ti, (x, y), v in zip(t, xy, last):
+            third = repr(float(v)) if z is not None else str(int(v))
+            out.write(f"{ti if isinstance(ti, str) else format(ti, '.6f')},{x:.{decimals}f},{y:.{decimals}f},{third}\n")
+    return path
+
+
+def read_trace(path):
+    """The written trace back as the program reads it (the printed precision is the data)."""
+    with open(path, encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    return rows
+
+
+def score(trace, char, cwd, *extra):
+    result = run(["score", str(trace), "--character", char, "--json", "-", *extra], cwd)
+    assert result.returncode == 0, result.stderr.decode()
+    return json.loads(result.stdout)
+
+
+def score_table(trace, char, cwd):
+    result = run(["score", str(trace), "--character", char], cwd)
+    assert result.returncode == 0, result.stderr.decode()
+    return result.stdout.decode()
+
+
+def constant_speed_trace(polyline, offset, speed=0.05, rate=100.0):
+    """The parallel curve `offset` from the stroke, at `speed` m/s sampled at `rate` Hz."""
+    xy = parallel_curve(polyline, offset, speed / rate)
+    t = np.arange(len(xy)) / rate
+    return t, xy
+
+
+def times_of(t):
+    return [format(v, ".6f") for v in t]
+
+
+def pen_segments(down):
+    """Maximal runs of pen-down samples as (first index, last index)."""
+    runs = []
+    start = None
+    for i, d in enumerate(down):
+        if d and start is None:
+            start = i
+        if not d and start is not None:
+            runs.append((start, i - 1))
+            start = None
+    if start is not None:
+        runs.append((start, len(down) - 1))
+    return runs
+
+
+def ns(value):
+    """A time rounded to whole nanoseconds, as the docs round every reported time."""
+    return round(float(value) * 1e9) / 1e9
+
+
+def setUpModule():
+    SHARED["tmp"] = tempfile.TemporaryDirectory(prefix="round14c-")
+    root = Path(SHARED["tmp"].name)
+    SHARED["root"] = root
+    SHARED["yi"] = model_polylines(YI, root)[0]
+    SHARED["shi"] = model_polylines(SHI, root)
+    t, xy = constant_speed_trace(SHARED["yi"], 0.002)
+    SHARED["offset"] = (t, xy)
+    write_trace(root / "offset.csv", times_of(t), xy)
+    SHARED["offset_score"] = score(root / "offset.csv", YI, root)
+
+
+def tearDownModule():
+    SHARED["tmp"].cleanup()
+
+
+class Base(unittest.TestCase):
+    maxDiff = None
+
+    def setUp(self):
+        self.root = SHARED["root"]
+        self.yi = SHARED["yi"]
+
+    def only_stroke(self, record, char_index=0, stroke=0):
+        return record["per_character"][char_index]["per_stroke"][stroke]
+
+    def close(self, got, expected, tol, what):
+        self.assertIsNotNone(got, f"{what}: null, expected {expected!r}")
+        self.assertLessEqual(abs(got - expected), tol, f"{what}: got {got!r}, expected {expected!r}")
+
+
+# ---- traces made by hand, scored --------------------------------------------------------------------
+
+class HandMadeTraces(Base):
+
+    def test_offset_line_deviations_are_two_millimetres(self):
+        t, xy = SHARED["offset"]
+        mine = deviations(xy, self.yi)
+        self.assertLess(float(np.max(np.abs(mine - 0.002))), 1e-8, "the test's own curve is 2 mm off")
+        record = SHARED["offset_score"]
+        stroke = self.only_stroke(record)
+        for level, values in (("scene", record), ("stroke", stroke), ("character", record["per_character"][0])):
+            self.close(values["mean_deviation_m"], float(np.mean(mine)), 2e-9, f"{level} mean_deviation_m")
+            self.close(values["max_deviation_m"], float(np.max(mine)), 2e-9, f"{level} max_deviation_m")
+            self.close(values["rms_deviation_m"], float(np.sqrt(np.mean(mine ** 2))), 2e-9,
+                       f"{level} rms_deviation_m")
+        self.assertEqual(record["strokes_written"], 1)
+        self.assertEqual(record["strokes_total"], 1)
+        self.assertTrue(record["completed_in_order"])
+
+    def test_offset_line_path_time_and_speed(self):
+        t, xy = SHARED["offset"]
+        record = SHARED["offset_score"]
+        stroke = self.only_stroke(record)
+        character = record["per_character"][0]
+        written = np.array([[float(r["x"]), float(r["y"])] for r in read_trace(self.root / "offset.csv")])
+        length = chord_length(written)
+        duration = ns(Decimal(times_of(t)[-1]) - Decimal(times_of(t)[0]))
+        self.close(stroke["path_length_m"], length, 1e-9, "per_stroke path_length_m")
+        self.close(character["path_length_m"], length, 1e-9, "per_character path_length_m")
+        self.assertEqual(stroke["time_s"], duration)
+        self.assertEqual(record["pen_down_time_s"], duration)
+        self.assertEqual(record["total_time_s"], duration)
+        self.assertEqual(character["in_air_time_s"], 0.0)
+        self.assertEqual(character["pen_lifts"], 0)
+        self.close(stroke["mean_speed_m_s"], length / duration, 1e-9, "per_stroke mean_speed_m_s")
+        self.close(character["mean_speed_m_s"], length / duration, 1e-9, "per_character mean_speed_m_s")
+        self.close(stroke["mean_speed_m_s"], 0.05, 0.05 * 0.01, "the constant 50 mm/s")
+        self.assertEqual(stroke["outside_tube_share"], float(np.mean(deviations(written, self.yi) > 0.002)))
+
+    def test_constant_speed_has_one_velocity_peak(self):
+        record = SHARED["offset_score"]
+        self.assertEqual(self.only_stroke(record)["velocity_peaks"], 1)
+        self.assertEqual(record["velocity_peaks"], 1)
+
+    def test_frechet_matches_a_brute_force(self):
+        t, xy = SHARED["offset"]
+        written = drop_repeats(np.array([[float(r["x"]), float(r["y"])] for r in read_trace(self.root / "offset.csv")]))
+        expected = brute_frechet(written, resample_by_arc_length(self.yi))
+        record = SHARED["offset_score"]
+        self.close(self.only_stroke(record)["frechet_m"], expected, 1e-8, "frechet_m against the brute force")
+        self.assertEqual(record["frechet_m"], self.only_stroke(record)["frechet_m"])
+        # docs/metrics.md: delta_dF <= d_max + step/2 with d_max the largest deviation (2 mm here)
+        self.assertLessEqual(record["frechet_m"], 0.002 + STEP_M / 2 + 1e-9)
+        self.assertGreaterEqual(record["frechet_m"], 0.002 - 1e-9)
+
+    def test_dtw_matches_a_brute_force(self):
+        written = drop_repeats(np.array([[float(r["x"]), float(r["y"])] for r in read_trace(self.root / "offset.csv")]))
+        reference = resample_by_arc_length(self.yi)
+        expected, pairs = brute_dtw(written, reference)
+        self.assertTrue(max(len(written), len(reference)) <= pairs <= len(written) + len(reference) - 1)
+        record = SHARED["offset_score"]
+        self.close(self.only_stroke(record)["dtw_m"], expected, 1e-8, "dtw_m against the brute force")
+        self.assertEqual(record["dtw_m"], self.only_stroke(record)["dtw_m"])
+
+    def test_tube_share_counts_samples_beyond_two_millimetres(self):
+        t, near = constant_speed_trace(self.yi, 0.0015)
+        _, far = constant_speed_trace(self.yi, 0.0025)
+        half = len(near) // 2
+        xy = np.r_[near[:half], far[half:]]
+        path = write_trace(self.root / "tube.csv", times_of(t[:len(xy)]), xy)
+        record = score(path, YI, self.root)
+        mine = deviations(np.array([[float(r["x"]), float(r["y"])] for r in read_trace(path)]), self.yi)
+        stroke = self.only_stroke(record)
+        self.assertEqual(stroke["outside_tube_share"], float(np.sum(mine > 0.002)) / len(mine))
+        self.close(stroke["mean_deviation_m"], float(np.mean(mine)), 2e-9, "mean over the two halves")
+        self.close(stroke["max_deviation_m"], float(np.max(mine)), 2e-9, "max over the two halves")
+
+    def test_data_units_give_the_same_numbers(self):
+        t, xy = SHARED["offset"]
+        path = write_trace(self.root / "offset-data.csv", times_of(t), to_data(xy), decimals=6)
+        record = score(path, YI, self.root, "--units", "data")
+        metres = SHARED["offset_score"]
+        for key in ("mean_deviation_m", "max_deviation_m", "rms_deviation_m", "frechet_m", "dtw_m"):
+            self.close(record[key], metres[key], 1e-8, key)
+        self.close(self.only_stroke(record)["path_length_m"], self.only_stroke(metres)["path_length_m"], 1e-7,
+                   "path_length_m")
+        self.assertEqual(record["total_time_s"], metres["total_time_s"])
+        self.assertEqual(record["units"], "data")
+
+    def test_pause_with_the_pen_down_counts_in_the_writing_time(self):
+        t, xy = SHARED["offset"]
+        middle = len(xy) // 2
+        pause = 40  # 0.4 s at 100 Hz, the pen resting on the paper
+        xy2 = np.r_[xy[:middle], np.repeat(xy[middle:middle + 1], pause, axis=0), xy[middle:]]
+        t2 = np.arange(len(xy2)) / 100.0
+        path = write_trace(self.root / "pause.csv", times_of(t2), xy2)
+        record = score(path, YI, self.root)
+        stroke = self.only_stroke(record)
+        written = np.array([[float(r["x"]), float(r["y"])] for r in read_trace(path)])
+        duration = ns(Decimal(times_of(t2)[-1]))
+        self.assertEqual(stroke["time_s"], duration)
+        self.assertEqual(record["pen_down_time_s"], duration)
+        self.close(stroke["path_length_m"], chord_length(written), 1e-9, "path_length_m")
+        self.close(stroke["mean_speed_m_s"], chord_length(written) / duration, 1e-9, "mean speed over the pause")
+        self.assertEqual(stroke["velocity_peaks"], 2, "the speed falls to 0 and rises again: two peaks")
+        # the repeated samples count in the deviation (N samples) and are dropped for Frechet and DTW
+        self.close(stroke["mean_deviation_m"], float(np.mean(deviations(written, self.yi))), 2e-9, "mean")
+        offset = self.only_stroke(SHARED["offset_score"])
+        self.close(stroke["frechet_m"], offset["frechet_m"], 1e-12, "Frechet without the repeats")
+        self.close(stroke["dtw_m"], offset["dtw_m"], 1e-12, "DTW without the repeats")
+
+    def test_lift_mid_stroke_times_and_segments(self):
+        t, xy = SHARED["offset"]
+        cut = int(len(xy) * 0.6)
+        pen = np.ones(len(xy), int)
+        pen[cut:cut + 20] = 0  # 0.2 s in the air
+        path = write_trace(self.root / "lift.csv", times_of(t), xy, pen=pen)
+        record = score(path, YI, self.root)
+        character = record["per_character"][0]
+        runs = pen_segments(pen == 1)
+        self.assertEqual(len(runs), 2)
+        tt = [Decimal(v) for v in times_of(t)]
+        writing = sum(ns(tt[b] - tt[a]) for a, b in runs)
+        in_air = ns(tt[runs[1][0]] - tt[runs[0][1]])
+        self.assertEqual(character["pen_lifts"], 1)
+        self.close(character["in_air_time_s"], in_air, 1e-12, "in_air_time_s")
+        self.close(record["pen_down_time_s"], writing, 1e-12, "pen_down_time_s")
+        self.close(record["total_time_s"], ns(tt[runs[1][1]] - tt[runs[0][0]]), 1e-12, "total_time_s")
+        self.close(record["total_time_s"], writing + in_air, 1e-12, "total = writing + in the air")
+        written = np.array([[float(r["x"]), float(r["y"])] for r in read_trace(path)])
+        path_down = sum(chord_length(written[a:b + 1]) for a, b in runs)
+        self.close(character["path_length_m"], path_down, 1e-9, "pen-down path over both segments")
+        self.close(character["mean_speed_m_s"], path_down / writing, 1e-9, "path / writing time")
+        self.assertEqual([(s["begin"], s["end"]) for s in character["segments"]], [(a, b + 1) for a, b in runs],
+                         "begin the first sample, end one past the last (0-based)")
+        for stroke in character["per_stroke"]:
+            if stroke["written"]:
+                seg = [s for s in character["segments"] if s["matched_stroke"] == stroke["index"]][0]
+                a, b = [r for r in runs if r[0] == seg["begin"]][0]
+                self.assertEqual(stroke["time_s"], ns(tt[b] - tt[a]))
+                self.close(stroke["path_length_m"], chord_length(written[a:b + 1]), 1e-9, "the matched run's path")
+            else:
+                self.assertIsNone(stroke["mean_deviation_m"])
+                self.assertIsNone(stroke["time_s"])
+
+    def test_stroke_written_twice_matches_the_closer_copy(self):
+        t, far = constant_speed_trace(self.yi, 0.002)
+        _, near = constant_speed_trace(self.yi, -0.001)
+        count = min(len(far), len(near))
+        xy = np.r_[far[:count], near[:count]]
+        pen = np.r_[np.ones(count, int), np.ones(count, int)]
+        tt = np.r_[t[:count], t[:count] + t[count - 1] + 0.3]
+        pen[count - 1] = 0  # the lift between the two copies
+        path = write_trace(self.root / "twice.csv", times_of(tt), xy, pen=pen)
+        record = score(path, YI, self.root)
+        character = record["per_character"][0]
+        stroke = self.only_stroke(record)
+        self.assertEqual(record["strokes_written"], 1)
+        self.assertEqual(record["unmatched_segments"], 1)
+        self.assertEqual(record["strokes_accepted"], 1)
+        self.assertEqual(sum(record["refusals"].values()), 0)
+        self.assertEqual([s["matched_stroke"] for s in character["segments"]], [None, 0])
+        self.assertEqual(character_verdicts(record)[0], "accepted", "the first copy is accepted in turn")
+        self.assertIsNone(character["segments"][1]["verdict"], "no verdict once every stroke is accepted")
+        written = np.array([[float(r["x"]), float(r["y"])] for r in read_trace(path)])
+        second = written[count:]
+        self.close(stroke["mean_deviation_m"], float(np.mean(deviations(second, self.yi))), 2e-9, "the near copy")
+        self.assertEqual(stroke["time_s"], ns(Decimal(times_of(tt)[-1]) - Decimal(times_of(tt)[count])))
+        self.close(character["path_length_m"], chord_length(written[:count - 1]) + chord_length(second), 1e-9,
+                   "both copies' pen-down path")
+        # velocity peaks: a sum over scored segments; jerk: a mean over them (two copies of one movement)
+        self.assertEqual(record["velocity_peaks"], 2)
+        self.close(record["normalised_jerk"], stroke["normalised_jerk"], stroke["normalised_jerk"] * 0.05,
+                   "mean jerk of two copies of one movement")
+
+    def test_irregular_time_stamps_read_in_whole_nanoseconds(self):
+        t, xy = SHARED["offset"]
+        rng = np.random.default_rng(14)
+        steps = rng.choice([0.0007, 0.001, 0.0013, 0.0171], size=len(xy) - 1)
+        stamps = np.r_[13.075, 13.075 + np.cumsum(steps)]
+        text = [format(v, ".4f") for v in stamps]
+        path = write_trace(self.root / "irregular.csv", text, xy)
+        record = score(path, YI, self.root)
+        exact = Decimal(text[-1]) - Decimal(text[0])
+        self.assertEqual(record["total_time_s"], float(exact), "the exact decimal difference")
+        self.assertEqual(record["pen_down_time_s"], float(exact))
+        self.assertEqual(self.only_stroke(record)["time_s"], float(exact))
+        written = np.array([[float(r["x"]), float(r["y"])] for r in read_trace(path)])
+        self.close(self.only_stroke(record)["mean_speed_m_s"], chord_length(written) / float(exact), 1e-9,
+                   "L / T with irregular steps")
+
+    def test_minimum_jerk_gives_the_documented_normalised_jerk(self):
+        # docs/metrics.md's table (L = 30 mm, 10 Hz filter): 0.6 s at 1 kHz 17.76, at 100 Hz 17.69;
+        # 1.5 s at 1 kHz 18.49; one velocity peak each
+        a = self.yi[1] + np.array([0.002, 0.0])
+        direction = (self.yi[2] - self.yi[1]) / np.linalg.norm(self.yi[2] - self.yi[1])
+        b = a + 0.030 * direction
+        for duration, rate, documented in ((0.6, 1000, 17.76), (0.6, 100, 17.69), (1.5, 1000, 18.49)):
+            with self.subTest(duration=duration, rate=rate):
+                t, xy = min_jerk(a, b, duration, rate)
+                path = write_trace(self.root / f"minjerk-{duration}-{rate}.csv", times_of(t), xy)
+                record = score(path, YI, self.root)
+                self.close(record["normalised_jerk"], documented, 0.006, "normalised_jerk")
+                self.assertEqual(record["velocity_peaks"], 1)
+                self.close(record["per_character"][0]["path_length_m"], 0.030, 1e-8, "L = 30 mm")
+
+    def test_an_ignored_blip_counts_in_the_times_but_not_the_fluency(self):
+        t, xy = SHARED["offset"]
+        blip = np.array([xy[0] + [0.0, 0.010], xy[0] + [0.0002, 0.010]])
+        xy2 = np.r_[blip, xy[:1] + [0, 0.01], xy]
+        pen = np.r_[1, 1, 0, np.ones(len(xy), int)]
+        t2 = np.arange(len(xy2)) / 100.0
+        path = write_trace(self.root / "blip.csv", times_of(t2), xy2, pen=pen)
+        record = score(path, YI, self.root)
+        character = record["per_character"][0]
+        self.assertEqual(character["ignored_segments"], 1)
+        self.assertEqual(character["pen_lifts"], 1)
+        self.assertTrue(character["segments"][0]["ignored"])
+        self.assertIsNone(character["segments"][0]["verdict"])
+        tt = [Decimal(v) for v in times_of(t2)]
+        self.assertEqual(record["total_time_s"], ns(tt[-1] - tt[0]))
+        self.close(record["pen_down_time_s"], ns(tt[1] - tt[0]) + ns(tt[-1] - tt[3]), 1e-12, "both segments")
+        self.close(character["in_air_time_s"], ns(tt[3] - tt[1]), 1e-12, "the gap after the blip")
+        self.assertEqual(record["velocity_peaks"], 1, "the ignored blip has no fluency")
+        self.assertEqual(record["normalised_jerk"], self.only_stroke(record)["normalised_jerk"])
+        offset = self.only_stroke(SHARED["offset_score"])
+        for key in ("mean_deviation_m", "frechet_m", "dtw_m", "time_s", "path_length_m"):
+            self.assertEqual(self.only_stroke(record)[key], offset[key], key)
+
+    def test_pen_height_at_the_contact_threshold(self):
+        t, xy = SHARED["offset"]
+        z = np.zeros(len(xy))
+        cut = len(xy) // 2
+        z[cut - 5:cut] = CONTACT_M  # still down at exactly 0.5 mm
+        z[cut:cut + 5] = 0.00050001  # up just above it
+        path = write_trace(self.root / "z.csv", times_of(t), xy, z=z)
+        record = score(path, YI, self.root)
+        runs = pen_segments(z <= CONTACT_M)
+        character = record["per_character"][0]
+        self.assertEqual(character["pen_lifts"], len(runs) - 1)
+        self.assertEqual([s["begin"] for s in character["segments"]], [a for a, _ in runs])
+        tt = [Decimal(v) for v in times_of(t)]
+        self.close(record["pen_down_time_s"], sum(ns(tt[b] - tt[a]) for a, b in runs), 1e-12, "pen_down_time_s")
+
+    def test_reference_itself_and_one_millimetre_beside(self):
+        # docs/metrics.md: the reference sampled densely scores Frechet <= 0.125 mm, 1 mm beside it 1-1.125 mm
+        for offset, low, high in ((0.0, 0.0, STEP_M / 2), (0.001, 0.001, 0.001 + STEP_M / 2)):
+            with self.subTest(offset=offset):
+                if offset:
+                    t, xy = constant_speed_trace(self.yi, offset, 0.05, 1000.0)
+                else:
+                    xy = resample_by_arc_length(self.yi, 0.00005, 10 ** 6)
+                    t = np.arange(len(xy)) / 1000.0
+                path = write_trace(self.root / f"beside-{offset}.csv", times_of(t), xy)
+                frechet = score(path, YI, self.root)["frechet_m"]
+                self.assertGreaterEqual(frechet, low - 1e-9)
+                self.assertLessEqual(frechet, high + 1e-9)
+
+    def test_backwards_stroke_measured_against_the_reversed_reference(self):
+        t, xy = SHARED["offset"]
+        path = write_trace(self.root / "backwards.csv", times_of(t), xy[::-1])
+        record = score(path, YI, self.root)
+        stroke = self.only_stroke(record)
+        self.assertTrue(stroke["backwards"])
+        self.assertEqual(record["backwards_strokes"], 1)
+        written = drop_repeats(np.array([[float(r["x"]), float(r["y"])] for r in read_trace(path)]))
+        reference = resample_by_arc_length(self.yi)[::-1]
+        self.close(stroke["frechet_m"], brute_frechet(written, reference), 1e-8, "Frechet against the reversed")
+        self.close(stroke["dtw_m"], brute_dtw(written, reference)[0], 1e-8, "DTW against the reversed")
+        self.close(stroke["mean_deviation_m"], 0.002, 1e-8, "mean deviation")
+        self.assertEqual(character_verdicts(record), ["backwards"])
+
+    def test_shi_strokes_swapped_give_one_order_error(self):
+        first, second = SHARED["shi"]
+        t1, xy1 = constant_speed_trace(second, 0.0)
+        t2, xy2 = constant_speed_trace(first, 0.0)
+        gap = 0.25
+        t = np.r_[t1, t2 + t1[-1] + gap]
+        xy = np.r_[xy1, xy2]
+        pen = np.ones(len(xy), int)
+        pen[len(xy1) - 1] = 0
+        path = write_trace(self.root / "swapped.csv", times_of(t), xy, pen=pen)
+        record = score(path, SHI, self.root)
+        self.assertEqual(record["strokes_written"], 2)
+        self.assertEqual(record["order_errors"], 1)
+        self.assertFalse(record["completed_in_order"])
+        self.assertFalse(record["per_character"][0]["strokes_in_order"])
+        self.assertEqual(character_verdicts(record)[0], "wrong_order")
+        self.assertEqual(record["per_character"][0]["segments"][0]["matched_stroke"], 1)
+
+    def test_pooled_totals_over_two_strokes(self):
+        first, second = SHARED["shi"]
+        t1, xy1 = constant_speed_trace(first, 0.0005, 0.05)
+        t2, xy2 = constant_speed_trace(second, -0.0015, 0.03)  # slower: more samples
+        t = np.r_[t1, t2 + t1[-1] + 0.3]
+        xy = np.r_[xy1, xy2]
+        pen = np.ones(len(xy), int)
+        pen[len(xy1) - 1] = 0
+        path = write_trace(self.root / "pooled.csv", times_of(t), xy, pen=pen)
+        SHARED["pooled_path"] = path
+        record = score(path, SHI, self.root)
+        SHARED["pooled"] = record
+        written = np.array([[float(r["x"]), float(r["y"])] for r in read_trace(path)])
+        d1 = deviations(written[:len(xy1) - 1], first)
+        d2 = deviations(written[len(xy1):], second)
+        pooled = np.r_[d1, d2]
+        strokes = record["per_character"][0]["per_stroke"]
+        self.close(strokes[0]["mean_deviation_m"], float(np.mean(d1)), 2e-9, "stroke 0 mean")
+        self.close(strokes[1]["mean_deviation_m"], float(np.mean(d2)), 2e-9, "stroke 1 mean")
+        self.close(record["mean_deviation_m"], float(np.mean(pooled)), 2e-9, "pooled mean, weighted by samples")
+        self.close(record["rms_deviation_m"], float(np.sqrt(np.mean(pooled ** 2))), 2e-9, "pooled RMS")
+        self.close(record["max_deviation_m"], float(np.max(pooled)), 2e-9, "max of maxima")
+        self.assertEqual(record["frechet_m"], max(s["frechet_m"] for s in strokes))
+        weights = np.array([len(d1), len(d2)], float)
+        self.close(record["dtw_m"], float(np.dot(weights, [s["dtw_m"] for s in strokes]) / weights.sum()), 1e-12,
+                   "DTW weighted by sample counts")
+        self.assertEqual(record["velocity_peaks"], sum(s["velocity_peaks"] for s in strokes))
+        self.close(record["normalised_jerk"], float(np.mean([s["normalised_jerk"] for s in strokes])), 1e-9,
+                   "mean jerk over scored segments")
+        self.assertEqual([s["index"] for s in strokes], [0, 1])
+
+    def test_score_table_numbers_strokes_from_one_in_millimetres(self):
+        if "pooled" not in SHARED:
+            self.test_pooled_totals_over_two_strokes()
+        record = SHARED["pooled"]
+        table = score_table(SHARED["pooled_path"], SHI, self.root)
+        strokes = record["per_character"][0]["per_stroke"]
+        rows = [line.split() for line in table.splitlines() if re.match(r"^\s+[12]\s+[A-Z]+\s", line)]
+        self.assertEqual([r[0] for r in rows], ["1", "2"], table)
+        for row, stroke in zip(rows, strokes):
+            mean, top, frechet, dtw, seconds = (float(v) for v in row[3:8])
+            self.assertEqual(mean, round(stroke["mean_deviation_m"] * 1000, 2), row)
+            self.assertEqual(top, round(stroke["max_deviation_m"] * 1000, 2), row)
+            self.assertEqual(frechet, round(stroke["frechet_m"] * 1000, 2), row)
+            self.assertEqual(dtw, round(stroke["dtw_m"] * 1000, 2), row)
+            self.assertEqual(seconds, round(stroke["time_s"], 2), row)
+        total = re.search(r"mean deviation\s+([0-9.]+) mm", table)
+        self.assertEqual(float(total.group(1)), round(record["mean_deviation_m"] * 1000, 3), table)
+        lifts = re.search(r"pen lifts\s+(\d+)", table)
+        self.assertEqual(int(lifts.group(1)), record["per_character"][0]["pen_lifts"])
+        peaks = re.search(r"velocity peaks\s+(\d+)", table)
+        self.assertEqual(int(peaks.group(1)), record["velocity_peaks"])
+
+    def test_python_score_of_a_mapping_gives_the_closed_forms(self):
+        try:
+            import calligraphy
+        except ImportError as error:  # pragma: no cover - the module is built with the tests
+            self.skipTest(f"no calligraphy module: {error}")
+        rows = read_trace(self.root / "offset.csv")
+        columns = {"t": np.array([float(r["t"]) for r in rows]), "x": np.array([float(r["x"]) for r in rows]),
+                   "y": np.array([float(r["y"]) for r in rows]), "pen": np.array([int(r["pen"]) for r in rows])}
+        record = calligraphy.score(columns, YI)
+        written = np.c_[columns["x"], columns["y"]]
+        mine = deviations(written, self.yi)
+        self.close(record["mean_deviation_m"], float(np.mean(mine)), 2e-9, "Python mean_deviation_m")
+        self.close(record["per_character"][0]["path_length_m"], chord_length(written), 1e-9, "Python path")
+        self.assertEqual(record["total_time_s"], ns(Decimal(rows[-1]["t"]) - Decimal(rows[0]["t"])))
+        self.assertEqual(record["per_character"][0]["per_stroke"][0]["index"], 0)
+
+
+    def test_velocity_peaks_and_jerk_of_hand_made_traces_recomputed(self):
+        makers = {"pause": self.test_pause_with_the_pen_down_counts_in_the_writing_time,
+                  "irregular": self.test_irregular_time_stamps_read_in_whole_nanoseconds,
+                  "minjerk-0.6-100": self.test_minimum_jerk_gives_the_documented_normalised_jerk,
+                  "pooled": self.test_pooled_totals_over_two_strokes,
+                  "twice": self.test_stroke_written_twice_matches_the_closer_copy}
+        for name, char in (("offset", YI), ("pause", YI), ("irregular", YI), ("minjerk-0.6-100", YI),
+                           ("pooled", SHI), ("twice", YI)):
+            with self.subTest(trace=name):
+                path = self.root / f"{name}.csv"
+                if not path.exists():
+                    makers[name]()  # the case that makes the trace, when this one runs alone
+                rows = read_trace(path)
+                t = np.array([float(r["t"]) for r in rows])
+                xy = np.array([[float(r["x"]), float(r["y"])] for r in rows])
+                down = np.array([r["pen"] == "1" for r in rows])
+                record = score(path, char, self.root)
+                results = [kinematics(t[a:b + 1], xy[a:b + 1]) for a, b in pen_segments(down)]
+                self.assertEqual(record["velocity_peaks"], sum(p for p, _ in results))
+                self.close(record["normalised_jerk"], float(np.mean([j for _, j in results])),
+                           1e-9 * record["normalised_jerk"], "normalised_jerk")
+
+    def test_verdict_distance_is_the_path_mean_from_the_median(self):
+        # docs/stroke-acceptance.md: the verdict's mean distance is from the centre line, the data's median
+        # (一's median has a fifth point the model's elements leave out), over the pen's path
+        median = to_metres(YI_MEDIAN)
+        written = np.array([[float(r["x"]), float(r["y"])] for r in read_trace(self.root / "offset.csv")])
+        d = deviations(written, median)
+        steps = np.linalg.norm(np.diff(written, axis=0), axis=1)
+        along_path = float(np.sum(steps * (d[1:] + d[:-1]) / 2) / np.sum(steps))
+        verdict = SHARED["offset_score"]["per_character"][0]["segments"][0]["verdict"]
+        self.assertTrue(verdict["accepted"])
+        self.assertEqual(verdict["expected_stroke"], 0)
+        self.close(verdict["mean_deviation_m"], along_path, 1e-6, "the verdict's mean distance")
+        self.assertGreater(abs(verdict["mean_deviation_m"] - SHARED["offset_score"]["mean_deviation_m"]), 1e-5,
+                           "the median is not the elements: the two distances differ")
+
+def character_verdicts(record):
+    out = []
+    for segment in record["per_character"][0]["segments"]:
+        verdict = segment["verdict"]
+        if verdict is None:
+            out.append(None)
+        else:
+            out.append("accepted" if verdict["accepted"] else verdict["refusal"])
+    return out
+
+
+# ---- one simulated trial: its JSON against its own CSV ----------------------------------------------
+
+class TrialNumbers(Base):
+
+    @classmethod
+    def setUpClass(cls):
+        root = SHARED["root"]
+        result = run(["trial", SHI, "--max-duration", "6", "--seed", "3", "--json", "trial.json",
+                      "--csv", "trial.csv"], root)
+        assert result.returncode in (0, 1), result.stderr
+        cls.record = json.loads((root / "trial.json").read_text(encoding="utf-8"))
+        cls.rows = read_trace(root / "trial.csv")
+        cls.table = result.stdout.decode()
+        cls.t = [Decimal(r["t"]) for r in cls.rows]
+        cls.xy = np.array([[float(r["x"]), float(r["y"])] for r in cls.rows])
+        cls.z = np.array([float(r["z"]) for r in cls.rows])
+        cls.runs = pen_segments(cls.z <= CONTACT_M)
+
+    def test_trial_times_and_path_from_its_own_csv(self):
+        record, runs, t = self.record, self.runs, self.t
+        self.assertGreater(len(runs), 0, "the simulated writer touched the paper")
+        character = record["per_character"][0]
+        self.assertEqual([s["begin"] for s in character["segments"]], [a for a, _ in runs])
+        self.assertEqual(character["pen_lifts"], len(runs) - 1)
+        self.close(record["total_time_s"], ns(t[runs[-1][1]] - t[runs[0][0]]), 1e-9, "total_time_s")
+        self.close(record["pen_down_time_s"], sum(ns(t[b] - t[a]) for a, b in runs), 1e-9, "pen_down_time_s")
+        self.close(character["in_air_time_s"], sum(ns(t[c] - t[b]) for (_, b), (c, _) in zip(runs, runs[1:])),
+                   1e-9, "in_air_time_s")
+        path = sum(chord_length(self.xy[a:b + 1]) for a, b in runs)
+        self.close(character["path_length_m"], path, 1e-6 * max(path, 1e-3), "path_length_m")
+
+    def test_trial_fluency_recomputed_from_its_csv(self):
+        character = self.record["per_character"][0]
+        t = np.array([float(v) for v in self.t])
+        totals = []
+        for segment in character["segments"]:
+            if segment["ignored"]:
+                continue
+            a, b = segment["begin"], segment["end"]
+            peaks, jerk = kinematics(t[a:b], self.xy[a:b])
+            totals.append((peaks, jerk))
+            if segment["matched_stroke"] is not None:
+                stroke = character["per_stroke"][segment["matched_stroke"]]
+                self.assertEqual(stroke["velocity_peaks"], peaks)
+                self.close(stroke["normalised_jerk"], jerk, 1e-9 * jerk, "the stroke's normalised_jerk")
+        self.assertEqual(self.record["velocity_peaks"], sum(p for p, _ in totals))
+        self.close(self.record["normalised_jerk"], float(np.mean([j for _, j in totals])),
+                   1e-9 * self.record["normalised_jerk"], "normalised_jerk, the mean over scored segments")
+        self.close(character["mean_speed_m_s"], character["path_length_m"] / character["pen_down_time_s"], 1e-12,
+                   "path / writing time")
+
+    def test_trial_forces_and_state_changes_from_its_csv(self):
+        force = np.array([[float(r["fx"]), float(r["fy"]), float(r["fz"])] for r in self.rows])
+        magnitude = np.linalg.norm(force, axis=1)
+        self.close(self.record["max_force_n"], float(np.max(magnitude)), 2e-4, "max_force_n (0.1 mN in the CSV)")
+        steps = np.linalg.norm(np.diff(np.r_[np.zeros((1, 3)), force], axis=0), axis=1)
+        steps_inside = np.linalg.norm(np.diff(force, axis=0), axis=1)
+        self.assertTrue(abs(self.record["max_force_step_n"] - float(np.max(steps_inside))) <= 3e-4
+                        or abs(self.record["max_force_step_n"] - float(np.max(steps))) <= 3e-4,
+                        f"max_force_step_n {self.record['max_force_step_n']} vs {np.max(steps_inside)}")
+        states = [r["state"] for r in self.rows]
+        changes = sum(1 for a, b in zip(states, states[1:]) if a != b)
+        self.assertEqual(self.record["state_transitions"], changes)
+
+    def test_trial_renderer_counts_and_time(self):
+        record = self.record
+        renderer = record["renderer_strokes"]
+        self.assertEqual([s["index"] for s in renderer], list(range(len(renderer))))
+        self.assertEqual(record["strokes_completed"], sum(1 for s in renderer if s["completed"] and not s["assisted"]))
+        self.assertEqual(record["strokes_assisted"], sum(1 for s in renderer if s["assisted"]))
+        self.assertEqual(record["strokes_total"], len(renderer))
+        ticks = len(self.rows)
+        end = ticks / record["rate_hz"]
+        if record["end_reason"] == "time_limit":
+            self.close(record["trial_time_s"], end, 1e-9, "trial_time_s at the time limit")
+        else:
+            self.assertLessEqual(record["trial_time_s"], end + 1e-9)
+        self.assertEqual(record["strokes_written"],
+                         sum(1 for s in record["per_character"][0]["per_stroke"] if s["written"]))
+
+    def test_trial_deviation_of_each_written_stroke_from_the_csv(self):
+        character = self.record["per_character"][0]
+        checked = 0
+        for segment in character["segments"]:
+            if segment["matched_stroke"] is None:
+                continue
+            a, b = [r for r in self.runs if r[0] == segment["begin"]][0]
+            stroke = character["per_stroke"][segment["matched_stroke"]]
+            polyline = SHARED["shi"][segment["matched_stroke"]]
+            mine = deviations(self.xy[a:b + 1], polyline)
+            self.close(stroke["mean_deviation_m"], float(np.mean(mine)), 2e-7, "mean from the CSV")
+            self.close(stroke["max_deviation_m"], float(np.max(mine)), 2e-7, "max from the CSV")
+            self.assertEqual(stroke["time_s"], ns(self.t[b] - self.t[a]))
+            checked += 1
+        self.assertEqual(checked, self.record["strokes_written"])
+
+    def test_score_of_the_trial_csv_gives_the_trial_metrics(self):
+        scored = score(self.root / "trial.csv", SHI, self.root)
+        for key in ("strokes_total", "strokes_written", "strokes_accepted", "order_errors", "backwards_strokes",
+                    "unmatched_segments", "completed_in_order", "velocity_peaks", "total_time_s",
+                    "pen_down_time_s"):
+            self.assertEqual(scored[key], self.record[key], key)
+        for key in ("mean_deviation_m", "max_deviation_m", "rms_deviation_m", "frechet_m", "dtw_m",
+                    "normalised_jerk"):
+            if self.record[key] is None:
+                self.assertIsNone(scored[key], key)
+            else:
+                self.close(scored[key], self.record[key], 1e-6 * max(abs(self.record[key]), 1e-3), key)
+
+    def test_trial_table_numbers_strokes_from_one(self):
+        rows = [line.split() for line in self.table.splitlines() if re.match(r"^\s+[12]\s+十\s", line)]
+        self.assertEqual([r[0] for r in rows], ["1", "2"], self.table)
+        for row, stroke in zip(rows, self.record["per_character"][0]["per_stroke"]):
+            if stroke["mean_deviation_m"] is None:
+                self.assertEqual(row[4], "-", row)
+            else:
+                self.assertEqual(float(row[4]), round(stroke["mean_deviation_m"] * 1000, 2), row)
+                self.assertEqual(float(row[8]), round(stroke["time_s"], 2), row)
+
+
+# ---- one tiny study ---------------------------------------------------------------------------------
+
+PROTOCOL = {"name": "r14c", "conditions": [{"name": "V", "mode": "vision"}, {"name": "H", "mode": "haptic"}],
+            "test": {"characters": [YI, SHI], "conditions": ["V", "H"], "repetitions": 2},
+            "trial": {"max_duration_s": 4}}
+SUBJECTS = 4
+T975 = {1: 12.706204736174698, 2: 4.302652729749464, 3: 3.182446305284263, 4: 2.7764451051977987}
+
+
+def read_table(path):
+    with open(path, encoding="utf-8", newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def number(text):
+    return float("nan") if text == "" else float(text)
+
+
+class StudyNumbers(Base):
+
+    @classmethod
+    def setUpClass(cls):
+        root = SHARED["root"] / "study"
+        root.mkdir()
+        (root / "p.json").write_text(json.dumps(PROTOCOL, ensure_ascii=False), encoding="utf-8")
+        (root / "tables").mkdir()
+        (root / "cohort").mkdir()
+        for args in (["session", "run", "p.json", "--subjects", str(SUBJECTS), "--out", "st"],
+                     ["report", "st", "--csv", "tables"],
+                     ["session", "cohort", "p.json", "--subjects", str(SUBJECTS), "--csv", "cohort", "--jobs", "1"]):
+            result = run(args, root)
+            assert result.returncode == 0, (args, result.stderr)
+        cls.study = root
+        cls.trials = read_table(root / "tables" / "trials.csv")
+        cls.strokes = read_table(root / "tables" / "strokes.csv")
+        cls.records = {}
+        for path in sorted(root.glob("st/*/*/trials/*.json")):
+            cls.records[(path.parts[-4], int(path.name[:3]))] = (path, json.loads(path.read_text(encoding="utf-8")))
+
+    def test_trials_table_rows_are_the_records(self):
+        self.assertEqual(len(self.trials), SUBJECTS * 8)
+        self.assertEqual(len(self.records), SUBJECTS * 8)
+        metric_columns = ["completed_in_order", "strokes_total", "strokes_written", "strokes_accepted",
+                          "strokes_assisted", "order_errors", "backwards_strokes", "unmatched_segments",
+                          "mean_deviation_m", "max_deviation_m", "rms_deviation_m", "frechet_m", "dtw_m",
+                          "total_time_s", "pen_down_time_s", "velocity_peaks", "normalised_jerk"]
+        for row in self.trials:
+            path, record = self.records[(row["subject"], int(row["trial"]))]
+            found = self.find_metrics(record)
+            for column in metric_columns:
+                value = found[column]
+                if value is None:
+                    self.assertEqual(row[column], "", (path.name, column))
+                elif isinstance(value, bool):
+                    self.assertEqual(row[column], "true" if value else "false", (path.name, column))
+                else:
+                    self.assertEqual(float(row[column]), float(value), (path.name, column))
+            # the file name's NNN-phase-condition-rN
+            number_, phase, condition, repetition = path.name.split("-")[:4]
+            self.assertEqual(int(row["trial"]), int(number_))
+            self.assertEqual((row["phase"], row["condition"]), (phase, condition))
+            self.assertEqual(row["repetition"], repetition[1:])
+
+    def find_metrics(self, record):
+        """The one metrics record's keys wherever the record holds them (top level or under a key)."""
+        if "mean_deviation_m" in record:
+            return record
+        for value in record.values():
+            if isinstance(value, dict) and "mean_deviation_m" in value and "strokes_total" in value:
+                return value
+        raise AssertionError(f"no metrics in the record: {sorted(record)}")
+
+    def test_numbering_blocks_items_and_labels(self):
+        for subject in {r["subject"] for r in self.trials}:
+            rows = sorted((r for r in self.trials if r["subject"] == subject), key=lambda r: int(r["trial"]))
+            self.assertEqual([int(r["trial"]) for r in rows], list(range(1, 9)))
+            self.assertEqual([r["condition"] for r in rows], ["V"] * 4 + ["H"] * 4)
+            self.assertEqual([int(r["block"]) for r in rows], [1] * 4 + [2] * 4)
+            self.assertEqual([r["mode"] for r in rows], ["vision"] * 4 + ["haptic"] * 4)
+            self.assertEqual([r["characters"] for r in rows], [YI, SHI] * 4)
+            self.assertEqual([int(r["item"]) for r in rows], [1, 2] * 4)
+            self.assertEqual([int(r["repetition"]) for r in rows], [1, 1, 2, 2] * 2)
+            self.assertTrue(all(r["group"] == "" and r["phase"] == "test" for r in rows))
+            self.assertTrue(all(r["session_number"] == "1" for r in rows))
+
+    def test_strokes_table_rows_are_the_per_stroke_records(self):
+        expected = sum(int(r["strokes_total"]) for r in self.trials)
+        self.assertEqual(len(self.strokes), expected)
+        for row in self.strokes:
+            _, record = self.records[(row["subject"], int(row["trial"]))]
+            metrics = self.find_metrics(record)
+            character = metrics["per_character"][int(row["character"]) - 1]
+            stroke = character["per_stroke"][int(row["stroke"]) - 1]
+            self.assertEqual(stroke["index"], int(row["stroke"]) - 1)
+            self.assertEqual(row["character_text"], character["character"])
+            self.assertEqual(row["written"], "true" if stroke["written"] else "false")
+            for column in ("mean_deviation_m", "max_deviation_m", "rms_deviation_m", "frechet_m", "dtw_m",
+                           "time_s", "path_length_m"):
+                if stroke[column] is None:
+                    self.assertEqual(row[column], "", column)
+                else:
+                    self.assertEqual(float(row[column]), float(stroke[column]), column)
+            # the pen-downs whose verdict names this stroke (the one written as, or the one due), those refused
+            # and the last refusal's reason
+            judged = [s["verdict"] for s in character["segments"]
+                      if s["verdict"] is not None and s["verdict"]["matched_stroke"] == stroke["index"]]
+            refused = [v for v in judged if not v["accepted"]]
+            self.assertEqual(int(row["segments"]), len(judged), row)
+            self.assertEqual(int(row["refused_segments"]), len(refused), row)
+            self.assertEqual(row["refusal"], refused[-1]["refusal"] if refused else "", row)
+
+    def test_saved_traces_give_the_tables_times(self):
+        checked = 0
+        for row in self.trials[:4]:
+            trace = self.study / row["trace_file"] if not os.path.isabs(row["trace_file"]) else Path(row["trace_file"])
+            if not trace.exists():
+                trace = Path(row["trace_file"])
+            result = run(["trace", str(trace)], self.study)
+            self.assertEqual(result.returncode, 0, result.stderr)
+            rows = list(csv.DictReader(io.StringIO(result.stdout.decode())))
+            t = [Decimal(r["t"]) for r in rows]
+            z = np.array([float(r["z"]) for r in rows])
+            xy = np.array([[float(r["x"]), float(r["y"])] for r in rows])
+            runs = pen_segments(z <= CONTACT_M)
+            if not runs:
+                self.assertEqual(row["total_time_s"], "")
+                continue
+            self.close(float(row["total_time_s"]), ns(t[runs[-1][1]] - t[runs[0][0]]), 1e-9, "total_time_s")
+            self.close(float(row["pen_down_time_s"]), sum(ns(t[b] - t[a]) for a, b in runs), 1e-9, "pen_down_time_s")
+            _, record = self.records[(row["subject"], int(row["trial"]))]
+            metrics = self.find_metrics(record)
+            character = metrics["per_character"][0]
+            for segment in character["segments"]:
+                if segment["matched_stroke"] is None:
+                    continue
+                a, b = [r for r in runs if r[0] == segment["begin"]][0]
+                srow = [s for s in self.strokes if s["subject"] == row["subject"] and s["trial"] == row["trial"]
+                        and int(s["stroke"]) == segment["matched_stroke"] + 1][0]
+                self.close(float(srow["path_length_m"]), chord_length(xy[a:b + 1]), 1e-6, "strokes.csv path")
+                self.close(float(srow["time_s"]), ns(t[b] - t[a]), 1e-9, "strokes.csv time_s")
+            checked += 1
+        self.assertGreater(checked, 0)
+
+    def test_cohort_tables_are_the_session_tables(self):
+        cohort = read_table(self.study / "cohort" / "trials.csv")
+        self.assertEqual(len(cohort), len(self.trials))
+        key = lambda r: (r["subject"], int(r["trial"]))  # noqa: E731
+        left = {key(r): r for r in self.trials}
+        skip = {"session", "start_utc", "trace_file", "trace_sha256"}
+        for row in cohort:
+            mine = left[key(row)]
+            self.assertEqual(row["session"], f"r14c-{row['subject']}-s1")
+            self.assertEqual(row["start_utc"], "")
+            self.assertEqual(row["trace_file"], "")
+            for column, value in row.items():
+                if column not in skip:
+                    self.assertEqual(value, mine[column], (key(row), column))
+        cohort_strokes = read_table(self.study / "cohort" / "strokes.csv")
+        self.assertEqual(len(cohort_strokes), len(self.strokes))
+
+    def frame(self):
+        import pandas
+        frame = pandas.DataFrame(self.trials)
+        for column in ("mean_deviation_m", "total_time_s"):
+            frame[column] = [number(v) for v in frame[column]]
+        frame["repetition"] = frame["repetition"].astype(int)
+        return frame
+
+    def subject_means(self, value, condition):
+        out = {}
+        for subject in sorted({r["subject"] for r in self.trials}):
+            values = [number(r[value]) for r in self.trials if r["subject"] == subject and r["condition"] == condition]
+            values = [v for v in values if not math.isnan(v)]
+            out[subject] = float(np.mean(values))
+        return out
+
+    def test_describe_by_subject_against_numpy(self):
+        try:
+            from calligraphy.statistics import describe
+            import pandas  # noqa: F401
+        except ImportError as error:  # pragma: no cover
+            self.skipTest(f"no pandas: {error}")
+        table = describe(self.frame(), "total_time_s", by="condition", unit="subject")
+        for condition in ("H", "V"):
+            means = np.array(list(self.subject_means("total_time_s", condition).values()))
+            row = table[table.condition == condition].iloc[0]
+            n = len(means)
+            sd = float(np.std(means, ddof=1))
+            self.assertEqual(int(row["n"]), n)
+            self.close(float(row["mean"]), float(np.mean(means)), 1e-12, "mean of subject means")
+            self.close(float(row["sd"]), sd, 1e-12, "SD over subjects")
+            self.close(float(row["sem"]), sd / math.sqrt(n), 1e-12, "sem")
+            self.close(float(row["ci95_low"]), float(np.mean(means)) - T975[n - 1] * sd / math.sqrt(n), 1e-9, "low")
+            self.close(float(row["ci95_high"]), float(np.mean(means)) + T975[n - 1] * sd / math.sqrt(n), 1e-9, "high")
+
+    def test_paired_comparison_against_numpy(self):
+        try:
+            from calligraphy.statistics import paired_comparison
+            import pandas  # noqa: F401
+        except ImportError as error:  # pragma: no cover
+            self.skipTest(f"no pandas: {error}")
+        a = self.subject_means("mean_deviation_m", "H")
+        b = self.subject_means("mean_deviation_m", "V")
+        diff = np.array([a[s] - b[s] for s in sorted(a)])
+        n = len(diff)
+        sd = float(np.std(diff, ddof=1))
+        result = paired_comparison(self.frame(), "mean_deviation_m", "H", "V")
+        self.assertEqual(result.n_subjects, n)
+        self.assertEqual(result.df, n - 1)
+        self.close(result.mean_difference, float(np.mean(diff)), 1e-15, "mean difference a - b")
+        self.close(result.sd_difference, sd, 1e-15, "sd of the differences")
+        self.close(result.t, float(np.mean(diff)) / (sd / math.sqrt(n)), 1e-9 * abs(result.t) + 1e-12, "t")
+        self.close(result.ci95_low, float(np.mean(diff)) - T975[n - 1] * sd / math.sqrt(n), 1e-12, "low")
+        self.close(result.ci95_high, float(np.mean(diff)) + T975[n - 1] * sd / math.sqrt(n), 1e-12, "high")
+        self.close(result.d_z, float(np.mean(diff)) / sd, 1e-9, "d_z")
+        sds = [float(np.std(list(m.values()), ddof=1)) for m in (a, b)]
+        d_av = float(np.mean(diff)) / float(np.mean(sds))
+        self.close(result.d_av, d_av, 1e-9, "d_av")
+        self.close(result.g_av, d_av * (1 - 3 / (4 * (n - 1) - 1)), 1e-9, "g_av")
+        self.close(result.mean_a, float(np.mean(list(a.values()))), 1e-15, "mean_a")
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
