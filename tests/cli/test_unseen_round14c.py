@@ -109,40 +109,60 @@ def drop_repeats(points):
     return points[keep]
 
 
+def _diagonals(p, q):
+    """The cells (i, j) of the n x m table by anti-diagonals k = i + j: each diagonal's i and distances."""
+    n, m = len(p), len(q)
+    for k in range(n + m - 1):
+        i = np.arange(max(0, k - m + 1), min(k, n - 1) + 1)
+        yield k, i, np.linalg.norm(p[i] - q[k - i], axis=1)
+
+
 def brute_frechet(p, q):
-    """Eiter & Mannila's recurrence, the whole table."""
-    dist = np.linalg.norm(p[:, None, :] - q[None, :, :], axis=2)
-    n, m = dist.shape
-    c = np.empty((n, m))
-    for i in range(n):
-        for j in range(m):
-            if i == 0 and j == 0:
-                best = -np.inf
-            elif i == 0:
-                best = c[0, j - 1]
-            elif j == 0:
-                best = c[i - 1, 0]
-            else:
-                best = min(c[i - 1, j], c[i - 1, j - 1], c[i, j - 1])
-            c[i, j] = max(best, dist[i, j])
-    return float(c[-1, -1])
+    """Eiter & Mannila's recurrence over the whole table (by anti-diagonals, so numpy does each one)."""
+    n = len(p)
+    prev2 = np.full(n, np.inf)
+    prev1 = np.full(n, np.inf)
+    for k, i, dist in _diagonals(p, q):
+        up = np.r_[np.inf, prev1[:-1]]  # c(i-1, j)
+        diag = np.r_[np.inf, prev2[:-1]]  # c(i-1, j-1)
+        best = np.minimum(np.minimum(up, diag), prev1)[i]  # prev1[i] is c(i, j-1)
+        if k == 0:
+            best = np.array([-np.inf])
+        row = np.full(n, np.inf)
+        row[i] = np.maximum(best, dist)
+        prev2, prev1 = prev1, row
+    return float(prev1[n - 1])
 
 
 def brute_dtw(p, q):
     """Sakoe & Chiba with steps (1,0), (0,1), (1,1): D(n-1, m-1) / K, K the pairs on the optimal path."""
-    dist = np.linalg.norm(p[:, None, :] - q[None, :, :], axis=2)
-    n, m = dist.shape
-    cost = np.full((n + 1, m + 1), np.inf)
-    pairs = np.zeros((n + 1, m + 1))
-    cost[0, 0] = 0.0
-    for i in range(1, n + 1):
-        for j in range(1, m + 1):
-            options = ((cost[i - 1, j - 1], pairs[i - 1, j - 1]), (cost[i - 1, j], pairs[i - 1, j]),
-                       (cost[i, j - 1], pairs[i, j - 1]))
-            best = min(options, key=lambda o: o[0])
-            cost[i, j] = dist[i - 1, j - 1] + best[0]
-            pairs[i, j] = best[1] + 1
-    return float(cost[n, m] / pairs[n, m]), int(pairs[n, m])
+    n = len(p)
+    cost2, cost1 = np.full(n, np.inf), np.full(n, np.inf)
+    pairs2, pairs1 = np.zeros(n), np.zeros(n)
+    for k, i, dist in _diagonals(p, q):
+        options = np.array([np.r_[np.inf, cost2[:-1]][i], np.r_[np.inf, cost1[:-1]][i], cost1[i]])
+        counts = np.array([np.r_[0, pairs2[:-1]][i], np.r_[0, pairs1[:-1]][i], pairs1[i]])
+        choice = np.argmin(options, axis=0)
+        best = options[choice, np.arange(len(i))]
+        count = counts[choice, np.arange(len(i))]
+        if k == 0:
+            best, count = np.zeros(1), np.zeros(1)
+        cost, pairs = np.full(n, np.inf), np.zeros(n)
+        cost[i] = best + dist
+        pairs[i] = count + 1
+        cost2, cost1, pairs2, pairs1 = cost1, cost, pairs1, pairs
+    return float(cost1[n - 1] / pairs1[n - 1]), int(pairs1[n - 1])
+
+
+def written_for_curves(points, max_points=2000):
+    """The written samples as Frechet and DTW take them: repeats dropped, above `max_points` replaced by
+    `max_points` points equally spaced by arc length."""
+    points = drop_repeats(np.asarray(points, float))
+    if len(points) <= max_points:
+        return points
+    lengths = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    s = np.linspace(0.0, lengths[-1], max_points)
+    return np.c_[np.interp(s, lengths, points[:, 0]), np.interp(s, lengths, points[:, 1])]
 
 
 def parallel_curve(polyline, offset, spacing):
@@ -657,6 +677,96 @@ class HandMadeTraces(Base):
         peaks = re.search(r"velocity peaks\s+(\d+)", table)
         self.assertEqual(int(peaks.group(1)), record["velocity_peaks"])
 
+    def test_stroke_ended_short_frechet_reaches_the_reference_end(self):
+        # a stroke left 9 mm short (the shortfall allowed on 一 is 13 mm): Frechet couples the reference's end
+        # with a written point, so it is at least the distance from that end to the nearest written point
+        t, xy = SHARED["offset"]
+        lengths = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))]
+        keep = lengths <= lengths[-1] - 0.009
+        path = write_trace(self.root / "short.csv", times_of(t[keep]), xy[keep])
+        record = score(path, YI, self.root)
+        stroke = self.only_stroke(record)
+        self.assertTrue(stroke["written"], "9 mm short is within the shortfall allowed")
+        written = drop_repeats(np.array([[float(r["x"]), float(r["y"])] for r in read_trace(path)]))
+        reference = resample_by_arc_length(self.yi)
+        self.close(stroke["frechet_m"], brute_frechet(written, reference), 1e-8, "Frechet of the short stroke")
+        self.close(stroke["dtw_m"], brute_dtw(written, reference)[0], 1e-8, "DTW of the short stroke")
+        gap = float(np.min(np.linalg.norm(written - self.yi[-1], axis=1)))
+        self.assertGreaterEqual(stroke["frechet_m"], gap - 1e-9)
+        self.assertGreater(stroke["frechet_m"], 0.008, "the unwritten end shows in the worst case")
+        self.close(stroke["max_deviation_m"], 0.002, 1e-8, "the deviation does not see the unwritten end")
+
+    def test_two_characters_pool_over_the_scene(self):
+        # a row of two: centres 66 mm apart about the origin (SceneLayout: spacing_m, centre_m)
+        yi = self.yi + np.array([-0.033, 0.0])
+        shi = [line + np.array([0.033, 0.0]) for line in SHARED["shi"]]
+        pieces = [constant_speed_trace(yi, 0.001), constant_speed_trace(shi[0], -0.0005),
+                  constant_speed_trace(shi[1], 0.0015, 0.03)]
+        t_all, xy_all, pen_all, begin = [], [], [], 0.0
+        for t, xy in pieces:
+            t_all.append(t + begin)
+            xy_all.append(xy)
+            pen = np.ones(len(xy), int)
+            pen[-1] = 0
+            pen_all.append(pen)
+            begin += t[-1] + 0.25
+        t, xy, pen = np.concatenate(t_all), np.concatenate(xy_all), np.concatenate(pen_all)
+        path = write_trace(self.root / "row.csv", times_of(t), xy, pen=pen)
+        record = score(path, YI + SHI, self.root)
+        self.assertEqual(record["strokes_total"], 3)
+        self.assertEqual(record["strokes_written"], 3)
+        self.assertTrue(record["completed_in_order"])
+        written = np.array([[float(r["x"]), float(r["y"])] for r in read_trace(path)])
+        runs = pen_segments(pen == 1)
+        d = [deviations(written[a:b + 1], line) for (a, b), line in zip(runs, [yi, *shi])]
+        pooled = np.concatenate(d)
+        self.close(record["mean_deviation_m"], float(np.mean(pooled)), 2e-9, "scene mean over every sample")
+        self.close(record["rms_deviation_m"], float(np.sqrt(np.mean(pooled ** 2))), 2e-9, "scene RMS")
+        self.close(record["max_deviation_m"], float(np.max(pooled)), 2e-9, "scene max")
+        self.close(record["per_character"][0]["mean_deviation_m"], float(np.mean(d[0])), 2e-9, "一's mean")
+        self.close(record["per_character"][1]["mean_deviation_m"], float(np.mean(np.r_[d[1], d[2]])), 2e-9,
+                   "十's mean")
+        tt = [Decimal(v) for v in times_of(t)]
+        self.assertEqual(record["total_time_s"], ns(tt[runs[-1][1]] - tt[runs[0][0]]))
+        self.close(record["pen_down_time_s"], sum(ns(tt[b] - tt[a]) for a, b in runs), 1e-12, "pen down")
+        self.assertEqual(record["per_character"][1]["total_time_s"], ns(tt[runs[2][1]] - tt[runs[1][0]]))
+        self.assertEqual(record["velocity_peaks"],
+                         sum(kinematics(t[a:b + 1], written[a:b + 1])[0] for a, b in runs))
+
+    def test_score_table_verdicts_add_up_to_the_strokes(self):
+        if not (self.root / "swapped.csv").exists():
+            self.test_shi_strokes_swapped_give_one_order_error()
+        table = score_table(self.root / "swapped.csv", SHI, self.root)
+        record = score(self.root / "swapped.csv", SHI, self.root)
+
+        def count(label):
+            found = re.search(rf"^\s*{label}\s+(\d+)", table, re.M)
+            self.assertIsNotNone(found, f"{label!r} in {table}")
+            return int(found.group(1))
+        accepted, refused, missing = count("strokes accepted"), count("strokes refused"), count("strokes not written")
+        self.assertEqual(accepted + refused + missing, record["strokes_total"], table)
+        self.assertEqual(accepted, record["strokes_accepted"], table)
+        self.assertEqual(count("pen-downs refused"), sum(record["refusals"].values()), table)
+        self.assertEqual(count("strokes matched"), record["strokes_written"], table)
+        verdicts = [line.split(None, 3)[-1] for line in table.splitlines() if re.match(r"^\s+[12]\s+[A-Z]+\s", line)]
+        self.assertEqual(len(verdicts), 2, table)
+        self.assertIn("refused: wrong order", " ".join(verdicts), table)
+
+    def test_long_written_stroke_is_resampled_to_two_thousand_points(self):
+        # 3,000-odd samples at 1 kHz and 15 mm/s: above 2000 the written points are replaced by 2000 equally
+        # spaced by arc length (docs/metrics.md, "Resampling")
+        t, xy = constant_speed_trace(self.yi, 0.0012, 0.015, 1000.0)
+        self.assertGreater(len(xy), 2000)
+        path = write_trace(self.root / "long.csv", times_of(t), xy)
+        record = score(path, YI, self.root)
+        stroke = self.only_stroke(record)
+        written = written_for_curves([[float(r["x"]), float(r["y"])] for r in read_trace(path)])
+        self.assertEqual(len(written), 2000)
+        reference = resample_by_arc_length(self.yi)
+        self.close(stroke["frechet_m"], brute_frechet(written, reference), 1e-8, "Frechet of 2000 points")
+        self.close(stroke["dtw_m"], brute_dtw(written, reference)[0], 1e-8, "DTW of 2000 points")
+        self.close(stroke["mean_deviation_m"], 0.0012, 1e-8, "every raw sample in the deviation")
+
     def test_python_score_of_a_mapping_gives_the_closed_forms(self):
         try:
             import calligraphy
@@ -739,6 +849,11 @@ class TrialNumbers(Base):
         cls.xy = np.array([[float(r["x"]), float(r["y"])] for r in cls.rows])
         cls.z = np.array([float(r["z"]) for r in cls.rows])
         cls.runs = pen_segments(cls.z <= CONTACT_M)
+        result = run(["trial", SHI, "--max-duration", "10", "--seed", "1", "--json", "done.json",
+                      "--csv", "done.csv"], root)
+        assert result.returncode == 0, result.stderr
+        cls.done = json.loads((root / "done.json").read_text(encoding="utf-8"))
+        cls.done_rows = read_trace(root / "done.csv")
 
     def test_trial_times_and_path_from_its_own_csv(self):
         record, runs, t = self.record, self.runs, self.t
@@ -772,6 +887,29 @@ class TrialNumbers(Base):
                    1e-9 * self.record["normalised_jerk"], "normalised_jerk, the mean over scored segments")
         self.close(character["mean_speed_m_s"], character["path_length_m"] / character["pen_down_time_s"], 1e-12,
                    "path / writing time")
+
+    def test_completed_trial_time_and_attempts_from_its_csv(self):
+        record, rows = self.done, self.done_rows
+        self.assertEqual(record["end_reason"], "completed")
+        self.assertEqual(record["trial_time_s"], ns(Decimal(rows[-1]["t"])), "the tick the last stroke completed")
+        for stroke in record["renderer_strokes"]:
+            attempts = {int(r["attempt"]) for r in rows if int(r["stroke"]) == stroke["index"]}
+            self.assertEqual(stroke["attempts"], max(attempts), stroke)
+        self.assertEqual(record["strokes_completed"], 2)
+        self.assertTrue(record["completed_in_order"])
+
+    def test_trial_frechet_and_dtw_of_each_written_stroke_from_the_csv(self):
+        character = self.record["per_character"][0]
+        for segment in character["segments"]:
+            if segment["matched_stroke"] is None:
+                continue
+            stroke = character["per_stroke"][segment["matched_stroke"]]
+            written = written_for_curves(self.xy[segment["begin"]:segment["end"]])
+            reference = resample_by_arc_length(SHARED["shi"][segment["matched_stroke"]])
+            if segment["backwards"]:
+                reference = reference[::-1]
+            self.close(stroke["frechet_m"], brute_frechet(written, reference), 1e-6, "Frechet from the CSV")
+            self.close(stroke["dtw_m"], brute_dtw(written, reference)[0], 1e-6, "DTW from the CSV")
 
     def test_trial_forces_and_state_changes_from_its_csv(self):
         force = np.array([[float(r["fx"]), float(r["fy"]), float(r["fz"])] for r in self.rows])
@@ -985,6 +1123,32 @@ class StudyNumbers(Base):
             checked += 1
         self.assertGreater(checked, 0)
 
+    def test_per_trial_pages_show_the_tables_values(self):
+        import html as html_module
+        result = run(["report", "st", "--out", "pages.html"], self.study)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        shown = {}
+        for page in sorted((self.study / "pages_files").glob("*/*.html")):
+            text = page.read_text(encoding="utf-8")
+            for article in re.finditer(r'<article[^>]* id="trial-([^"]+)-(\d+)".*?</article>', text, re.S):
+                body = re.sub(r"<svg.*?</svg>|<figcaption.*?</figcaption>", "", article.group(0), flags=re.S)
+                words = " ".join(html_module.unescape(re.sub(r"<[^>]+>", " ", body)).split())
+                shown[(article.group(1), int(article.group(2)))] = words
+        self.assertEqual(len(shown), len(self.trials))
+
+        def mm(value):
+            return "\u2013" if value == "" else f"{float(value) * 1000:.2f}"
+        for row in self.trials:
+            words = shown[(row["session"], int(row["trial"]))]
+            expected = (f"{float(row['total_time_s']):.1f} s \u00b7 deviation {mm(row['mean_deviation_m'])} mm "
+                        f"\u00b7 Fr\u00e9chet {mm(row['frechet_m'])} mm \u00b7 DTW {mm(row['dtw_m'])} mm "
+                        f"\u00b7 order errors {row['order_errors']} \u00b7 backwards {row['backwards_strokes']}")
+            self.assertIn(expected, words)
+            self.assertIn(f"#{int(row['trial'])} {row['characters']} {row['phase']} {row['condition']} "
+                          f"block {row['block']}, item {row['item']}, r{row['repetition']}", words)
+            self.assertEqual(row["end_reason"] in words.split(" \u00b7 ")[-1], row["end_reason"] != "completed",
+                             words)
+
     def test_cohort_tables_are_the_session_tables(self):
         cohort = read_table(self.study / "cohort" / "trials.csv")
         self.assertEqual(len(cohort), len(self.trials))
@@ -1001,6 +1165,12 @@ class StudyNumbers(Base):
                     self.assertEqual(value, mine[column], (key(row), column))
         cohort_strokes = read_table(self.study / "cohort" / "strokes.csv")
         self.assertEqual(len(cohort_strokes), len(self.strokes))
+        stroke_key = lambda r: (r["subject"], int(r["trial"]), int(r["character"]), int(r["stroke"]))  # noqa: E731
+        sessions = {stroke_key(r): r for r in self.strokes}
+        for row in cohort_strokes:
+            for column, value in row.items():
+                if column != "session":
+                    self.assertEqual(value, sessions[stroke_key(row)][column], (stroke_key(row), column))
 
     def frame(self):
         import pandas
@@ -1062,6 +1232,88 @@ class StudyNumbers(Base):
         self.close(result.d_av, d_av, 1e-9, "d_av")
         self.close(result.g_av, d_av * (1 - 3 / (4 * (n - 1) - 1)), 1e-9, "g_av")
         self.close(result.mean_a, float(np.mean(list(a.values()))), 1e-15, "mean_a")
+
+
+BETWEEN = {"name": "r14cb",
+           "conditions": [{"name": "unguided", "mode": "vision"}, {"name": "fixture", "mode": "haptic"}],
+           "phases": [{"phase": "pre-test", "condition": "unguided", "characters": [YI, SHI]},
+                      {"phase": "training", "conditions": ["unguided", "fixture"],
+                       "assignment": "between-subjects", "characters": [YI, SHI], "repetitions": 2},
+                      {"phase": "post-test", "condition": "unguided", "characters": [YI, SHI]}],
+           "trial": {"max_duration_s": 4}}
+
+
+class BetweenSubjectsNumbers(Base):
+    """A cohort of six in a pre-test, training between subjects, post-test design: the labels and the learning
+    statistics against numpy."""
+
+    @classmethod
+    def setUpClass(cls):
+        root = SHARED["root"] / "between"
+        root.mkdir()
+        (root / "p.json").write_text(json.dumps(BETWEEN, ensure_ascii=False), encoding="utf-8")
+        (root / "tables").mkdir()
+        result = run(["session", "cohort", "p.json", "--subjects", "6", "--csv", "tables", "--jobs", "1"], root)
+        assert result.returncode == 0, result.stderr
+        cls.trials = read_table(root / "tables" / "trials.csv")
+
+    def test_groups_phases_blocks_and_items(self):
+        self.assertEqual(len(self.trials), 6 * 8)
+        for n in range(1, 7):
+            subject = f"S{n:02d}"
+            rows = sorted((r for r in self.trials if r["subject"] == subject), key=lambda r: int(r["trial"]))
+            group = ["unguided", "fixture"][(n - 1) % 2]  # subject n writes the ((n - 1) mod k)-th condition
+            self.assertEqual({r["group"] for r in rows}, {group}, subject)
+            self.assertEqual([r["phase"] for r in rows], ["pre-test"] * 2 + ["training"] * 4 + ["post-test"] * 2)
+            self.assertEqual([r["condition"] for r in rows], ["unguided"] * 2 + [group] * 4 + ["unguided"] * 2)
+            self.assertEqual([int(r["block"]) for r in rows], [1, 1, 2, 2, 2, 2, 3, 3])
+            self.assertEqual([int(r["trial"]) for r in rows], list(range(1, 9)))
+            self.assertEqual([int(r["item"]) for r in rows], [1, 2] * 4)
+            self.assertEqual([int(r["repetition"]) for r in rows], [1, 1, 1, 1, 2, 2, 1, 1])
+
+    def means(self, value, phase):
+        out = {}
+        for r in self.trials:
+            if r["phase"] == phase and r[value] != "":
+                out.setdefault(r["subject"], []).append(float(r[value]))
+        return {k: float(np.mean(v)) for k, v in out.items()}
+
+    def test_learning_and_group_comparison_against_numpy(self):
+        try:
+            import pandas
+            from calligraphy.statistics import group_comparison, learning
+            from scipy import stats
+        except ImportError as error:  # pragma: no cover
+            self.skipTest(f"no pandas or scipy: {error}")
+        frame = pandas.DataFrame(self.trials)
+        frame["total_time_s"] = [number(v) for v in frame["total_time_s"]]
+        frame["repetition"] = frame["repetition"].astype(int)
+        table = learning(frame, "total_time_s", pre="pre-test", post="post-test")
+        pre, post = self.means("total_time_s", "pre-test"), self.means("total_time_s", "post-test")
+        for _, row in table.iterrows():
+            subject = row["subject"]
+            self.close(row["pre"], pre[subject], 1e-12, f"{subject} pre")
+            self.close(row["post"], post[subject], 1e-12, f"{subject} post")
+            self.close(row["gain"], pre[subject] - post[subject], 1e-12, f"{subject} gain = pre - post")
+            self.close(row["relative_gain"], (pre[subject] - post[subject]) / pre[subject], 1e-12, "gain / pre")
+            self.assertEqual(row["group"], ["unguided", "fixture"][(int(subject[1:]) - 1) % 2])
+        result = group_comparison(table, "gain", "fixture", "unguided")
+        a = np.array([pre[s] - post[s] for s in pre if int(s[1:]) % 2 == 0])
+        b = np.array([pre[s] - post[s] for s in pre if int(s[1:]) % 2 == 1])
+        va, vb = np.var(a, ddof=1) / len(a), np.var(b, ddof=1) / len(b)
+        df = (va + vb) ** 2 / (va ** 2 / (len(a) - 1) + vb ** 2 / (len(b) - 1))
+        diff = float(np.mean(a) - np.mean(b))
+        half = float(stats.t.ppf(0.975, df) * math.sqrt(va + vb))
+        pooled = math.sqrt(((len(a) - 1) * np.var(a, ddof=1) + (len(b) - 1) * np.var(b, ddof=1)) /
+                           (len(a) + len(b) - 2))
+        self.assertEqual((result.n_a, result.n_b), (len(a), len(b)))
+        self.close(result.mean_difference, diff, 1e-12, "mean difference a - b")
+        self.close(result.df, df, 1e-9, "Welch-Satterthwaite df")
+        self.close(result.t, diff / math.sqrt(va + vb), 1e-9, "Welch t")
+        self.close(result.ci95_low, diff - half, 1e-9, "Welch interval, low")
+        self.close(result.ci95_high, diff + half, 1e-9, "Welch interval, high")
+        self.close(result.g, diff / pooled * (1 - 3 / (4 * (len(a) + len(b)) - 9)), 1e-9, "Hedges' g")
+        self.close(result.sd_a, float(np.std(a, ddof=1)), 1e-12, "sd_a")
 
 
 if __name__ == "__main__":
