@@ -806,6 +806,32 @@ class HandMadeTraces(Base):
                 self.close(record["normalised_jerk"], float(np.mean([j for _, j in results])),
                            1e-9 * record["normalised_jerk"], "normalised_jerk")
 
+    def test_python_trial_on_a_raised_paper_scores_as_the_trial_did(self):
+        # a row centred 10 mm right and 5 mm down on paper 20 mm above the device's origin: the trace's z is the
+        # device's, the pen down within 0.5 mm of the paper (docs/metrics.md); score(trace, scene) places and
+        # measures it as the trial did
+        try:
+            import calligraphy
+        except ImportError as error:  # pragma: no cover - the module is built with the tests
+            self.skipTest(f"no calligraphy module: {error}")
+        scene = calligraphy.Scene(YI, layout=calligraphy.SceneLayout(paper_z_m=0.02, centre_m=[0.01, -0.005]))
+        result = calligraphy.simulate_trial(scene, max_duration_s=4, seed=0)
+        t = np.asarray(result.time_s, float)
+        position = np.asarray(result.position_m, float)
+        runs = pen_segments(position[:, 2] - 0.02 <= CONTACT_M)
+        self.assertGreater(len(runs), 0)
+        total = ns(t[runs[-1][1]] - t[runs[0][0]])
+        down = sum(ns(t[b] - t[a]) for a, b in runs)
+        for name, record in (("the trial's metrics", result.metrics),
+                             ("score of its trace", calligraphy.score(result.to_dataframe(), result.scene))):
+            with self.subTest(name):
+                self.close(record["total_time_s"], total, 1e-9, "total_time_s")
+                self.close(record["pen_down_time_s"], down, 1e-9, "pen_down_time_s")
+                self.assertEqual(record["strokes_written"], 1)
+                segment = [s for s in record["per_character"][0]["segments"] if s["matched_stroke"] == 0][0]
+                mine = deviations(position[segment["begin"]:segment["end"], :2], self.yi + np.array([0.01, -0.005]))
+                self.close(record["mean_deviation_m"], float(np.mean(mine)), 2e-9, "mean deviation")
+
     def test_verdict_distance_is_the_path_mean_from_the_median(self):
         # docs/stroke-acceptance.md: the verdict's mean distance is from the centre line, the data's median
         # (一's median has a fifth point the model's elements leave out), over the pen's path
