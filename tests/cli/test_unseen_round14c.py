@@ -525,6 +525,21 @@ class HandMadeTraces(Base):
         self.close(self.only_stroke(record)["mean_speed_m_s"], chord_length(written) / float(exact), 1e-9,
                    "L / T with irregular steps")
 
+    def test_large_clock_times_within_the_documented_resolution(self):
+        # docs/metrics.md: exact to the nanosecond below about 10^6 s, within about 0.25 us at the Unix time
+        t, xy = SHARED["offset"]
+        ticks = len(xy) - 1
+        for start, tolerance in (("1000000", 0.0), ("1764201600", 2.5e-7)):
+            with self.subTest(start=start):
+                text = [f"{start}.{i * 10:03d}" if i < 100 else f"{int(start) + i // 100}.{(i % 100) * 10:03d}"
+                        for i in range(len(xy))]
+                path = write_trace(self.root / f"clock-{start}.csv", text, xy)
+                record = score(path, YI, self.root)
+                exact = float(Decimal(text[-1]) - Decimal(text[0]))
+                self.assertEqual(exact, round(ticks * 0.01, 9))
+                for value in (record["total_time_s"], record["pen_down_time_s"], self.only_stroke(record)["time_s"]):
+                    self.assertLessEqual(abs(value - exact), tolerance, (start, value, exact))
+
     def test_minimum_jerk_gives_the_documented_normalised_jerk(self):
         # docs/metrics.md's table (L = 30 mm, 10 Hz filter): 0.6 s at 1 kHz 17.76, at 100 Hz 17.69;
         # 1.5 s at 1 kHz 18.49; one velocity peak each
