@@ -21,6 +21,7 @@ lengths 0.1 um) or the documented discretisation. CALLIGRAPHY_CLI names the prog
 module. CALLIGRAPHY_SANITIZED=1 takes five cases.
 """
 import csv
+import hashlib
 import io
 import json
 import math
@@ -1045,11 +1046,13 @@ class StudyNumbers(Base):
         (root / "p.json").write_text(json.dumps(PROTOCOL, ensure_ascii=False), encoding="utf-8")
         (root / "tables").mkdir()
         (root / "cohort").mkdir()
+        cls.printed = []
         for args in (["session", "run", "p.json", "--subjects", str(SUBJECTS), "--out", "st"],
                      ["report", "st", "--csv", "tables"],
                      ["session", "cohort", "p.json", "--subjects", str(SUBJECTS), "--csv", "cohort", "--jobs", "1"]):
             result = run(args, root)
             assert result.returncode == 0, (args, result.stderr)
+            cls.printed.append(result.stdout.decode())
         cls.study = root
         cls.trials = read_table(root / "tables" / "trials.csv")
         cls.strokes = read_table(root / "tables" / "strokes.csv")
@@ -1075,6 +1078,13 @@ class StudyNumbers(Base):
                     self.assertEqual(row[column], "true" if value else "false", (path.name, column))
                 else:
                     self.assertEqual(float(row[column]), float(value), (path.name, column))
+            self.assertEqual(row["end_reason"], record["end_reason"], path.name)
+            self.assertEqual(number(row["legibility_top1"]), float(record["legibility"]["top1"]), path.name)
+            self.assertEqual(number(row["legibility_top5"]), float(record["legibility"]["top5"]), path.name)
+            self.assertEqual(int(row["strokes_given_up"]), record["writer"]["log"]["strokes_given_up"], path.name)
+            trace = path.parent / record["files"]["trace"]
+            self.assertEqual(row["trace_sha256"], hashlib.sha256(trace.read_bytes()).hexdigest(), path.name)
+            self.assertEqual(Path(row["trace_file"]).name, trace.name)
             # the file name's NNN-phase-condition-rN
             number_, phase, condition, repetition = path.name.split("-")[:4]
             self.assertEqual(int(row["trial"]), int(number_))
@@ -1142,9 +1152,17 @@ class StudyNumbers(Base):
             z = np.array([float(r["z"]) for r in rows])
             xy = np.array([[float(r["x"]), float(r["y"])] for r in rows])
             runs = pen_segments(z <= CONTACT_M)
+            _, record = self.records[(row["subject"], int(row["trial"]))]
+            self.assertEqual(record["samples"], len(rows), "the record's samples are the trace's rows")
             if not runs:
                 self.assertEqual(row["total_time_s"], "")
                 continue
+            scored = score(trace, row["characters"], self.study)
+            for key in ("total_time_s", "pen_down_time_s", "strokes_written", "velocity_peaks"):
+                self.assertEqual(scored[key], float(row[key]) if "." in row[key] else int(row[key]), key)
+            for key in ("mean_deviation_m", "frechet_m", "dtw_m", "normalised_jerk"):
+                if row[key] != "":
+                    self.close(scored[key], float(row[key]), 1e-6 * abs(float(row[key])), f"score of the .trace.h5: {key}")
             self.close(float(row["total_time_s"]), ns(t[runs[-1][1]] - t[runs[0][0]]), 1e-9, "total_time_s")
             self.close(float(row["pen_down_time_s"]), sum(ns(t[b] - t[a]) for a, b in runs), 1e-9, "pen_down_time_s")
             _, record = self.records[(row["subject"], int(row["trial"]))]
@@ -1186,6 +1204,16 @@ class StudyNumbers(Base):
                           f"block {row['block']}, item {row['item']}, r{row['repetition']}", words)
             self.assertEqual(row["end_reason"] in words.split(" \u00b7 ")[-1], row["end_reason"] != "completed",
                              words)
+
+    def test_printed_counts_are_the_tables(self):
+        session_run, report, cohort = self.printed
+        for subject in range(1, SUBJECTS + 1):
+            line = [x for x in session_run.splitlines() if x.startswith(f"S{subject:02d}:")]
+            self.assertEqual(len(line), 1, session_run)
+            self.assertIn("8 of 8 trials saved", line[0])
+        self.assertIn(f"trials.csv ({len(self.trials)} rows), strokes.csv ({len(self.strokes)} rows)", report)
+        self.assertIn(f"{SUBJECTS} subjects, {len(self.trials)} trials on 1 threads", cohort.replace("thread ", "threads "))
+        self.assertIn(f"trials.csv ({len(self.trials)} rows), strokes.csv ({len(self.strokes)} rows)", cohort)
 
     def test_cohort_tables_are_the_session_tables(self):
         cohort = read_table(self.study / "cohort" / "trials.csv")
