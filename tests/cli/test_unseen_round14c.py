@@ -199,13 +199,15 @@ def parallel_curve(polyline, offset, spacing):
 def kinematics(t, xy, cutoff_hz=10.0):
     """Velocity peaks and normalised jerk as docs/metrics.md defines them: a Gaussian low-pass of
     sigma = sqrt(ln 2) / (2 pi f_c) truncated at 4 sigma, on a uniform grid of step the mean sampling interval
-    clamped to [sigma/16, sigma/4] from the first sample on (past the last, the pen rests there), extended
+    clamped to [sigma/16, sigma/4] but at most 16 grid points per sampling interval, from the first sample on
+    (past the last, the pen rests there), extended
     before and after by the pen resting as far as the kernel reaches plus 3 points; speed and jerk by the
     documented differences; peaks by 10 % hysteresis."""
     t = np.asarray(t, float)
     xy = np.asarray(xy, float)
     sigma = math.sqrt(math.log(2.0)) / (2.0 * math.pi * cutoff_hz)
-    h = min(max((t[-1] - t[0]) / (len(t) - 1), sigma / 16.0), sigma / 4.0)
+    mean_interval = (t[-1] - t[0]) / (len(t) - 1)
+    h = max(min(max(mean_interval, sigma / 16.0), sigma / 4.0), mean_interval / 16.0)
     grid = t[0] + np.arange(int(math.ceil((t[-1] - t[0]) / h)) + 1) * h
     y = np.c_[np.interp(grid, t, xy[:, 0]), np.interp(grid, t, xy[:, 1])]
     reach = int(math.ceil(4.0 * sigma / h))
@@ -806,8 +808,11 @@ class HandMadeTraces(Base):
                   "minjerk-0.6-100": self.test_minimum_jerk_gives_the_documented_normalised_jerk,
                   "pooled": self.test_pooled_totals_over_two_strokes,
                   "twice": self.test_stroke_written_twice_matches_the_closer_copy}
+        for rate in (10.0, 15.0):  # a tablet's sparse samples: at most 16 grid points per sampling interval
+            t, xy = constant_speed_trace(self.yi, 0.001, 0.02, rate)
+            write_trace(self.root / f"sparse-{rate:g}.csv", times_of(t), xy)
         for name, char in (("offset", YI), ("pause", YI), ("irregular", YI), ("minjerk-0.6-100", YI),
-                           ("pooled", SHI), ("twice", YI)):
+                           ("pooled", SHI), ("twice", YI), ("sparse-10", YI), ("sparse-15", YI)):
             with self.subTest(trace=name):
                 path = self.root / f"{name}.csv"
                 if not path.exists():
