@@ -900,6 +900,7 @@ class TrialNumbers(Base):
                       "--csv", "done.csv"], root)
         assert result.returncode == 0, result.stderr
         cls.done = json.loads((root / "done.json").read_text(encoding="utf-8"))
+        cls.done_table = result.stdout.decode()
         cls.done_rows = read_trace(root / "done.csv")
 
     def test_trial_times_and_path_from_its_own_csv(self):
@@ -957,6 +958,38 @@ class TrialNumbers(Base):
                 reference = reference[::-1]
             self.close(stroke["frechet_m"], brute_frechet(written, reference), 1e-6, "Frechet from the CSV")
             self.close(stroke["dtw_m"], brute_dtw(written, reference)[0], 1e-6, "DTW from the CSV")
+
+    def test_tables_totals_are_the_json_rounded(self):
+        record = self.done
+        score_record = score(self.root / "done.csv", SHI, self.root)
+        score_text = score_table(self.root / "done.csv", SHI, self.root)
+        character = score_record["per_character"][0]
+
+        def value(text, label, pattern=r"([0-9.]+)"):
+            found = re.search(rf"^\s*{re.escape(label)}\s+{pattern}", text, re.M)
+            self.assertIsNotNone(found, f"{label!r} in {text}")
+            return found.groups() if found.re.groups > 1 else found.group(1)
+        for text in (self.done_table, score_text):
+            self.assertEqual(value(text, "mean deviation"), f"{record['mean_deviation_m'] * 1000:.3f}")
+            self.assertEqual(value(text, "max deviation"), f"{record['max_deviation_m'] * 1000:.3f}")
+            self.assertEqual(value(text, "Frechet (worst stroke)"), f"{record['frechet_m'] * 1000:.3f}")
+            self.assertEqual(value(text, "DTW (mean)"), f"{record['dtw_m'] * 1000:.3f}")
+        self.assertEqual(value(self.done_table, "time", r"([0-9.]+) s \(pen down ([0-9.]+) s\)"),
+                         (f"{record['total_time_s']:.2f}", f"{record['pen_down_time_s']:.2f}"))
+        self.assertEqual(value(self.done_table, "trial time"), f"{record['trial_time_s']:.2f}")
+        self.assertEqual(value(self.done_table, "state transitions"), str(record["state_transitions"]))
+        self.assertEqual(value(self.done_table, "max |F|"), f"{record['max_force_n']:.3f}")
+        self.assertEqual(value(self.done_table, "max per-tick |dF|"), f"{record['max_force_step_n']:.3f}")
+        self.assertEqual(value(score_text, "RMS deviation"), f"{record['rms_deviation_m'] * 1000:.3f}")
+        self.assertEqual(value(score_text, "time", r"([0-9.]+) s \(pen down ([0-9.]+) s, in the air ([0-9.]+) s\)"),
+                         (f"{record['total_time_s']:.2f}", f"{record['pen_down_time_s']:.2f}",
+                          f"{character['in_air_time_s']:.2f}"))
+        self.assertEqual(float(value(score_text, "mean speed")), float(f"{character['mean_speed_m_s']:.4f}"))
+        self.assertEqual(value(score_text, "pen lifts"), str(character["pen_lifts"]))
+        self.assertEqual(value(score_text, "velocity peaks"), str(record["velocity_peaks"]))
+        self.assertEqual(value(score_text, "normalised jerk"), f"{record['normalised_jerk']:.1f}")
+        self.assertEqual(value(score_text, "pen-downs unmatched", r"(\d+), too short to score (\d+)"),
+                         (str(character["unmatched_segments"]), str(character["ignored_segments"])))
 
     def test_trial_forces_and_state_changes_from_its_csv(self):
         force = np.array([[float(r["fx"]), float(r["fy"]), float(r["fz"])] for r in self.rows])
@@ -1248,6 +1281,7 @@ class StudyNumbers(Base):
         frame = pandas.DataFrame(self.trials)
         for column in ("mean_deviation_m", "total_time_s"):
             frame[column] = [number(v) for v in frame[column]]
+        frame["mean_deviation_m"] = frame["mean_deviation_m"].astype(float)
         frame["repetition"] = frame["repetition"].astype(int)
         return frame
 
@@ -1265,7 +1299,22 @@ class StudyNumbers(Base):
             import pandas  # noqa: F401
         except ImportError as error:  # pragma: no cover
             self.skipTest(f"no pandas: {error}")
-        table = describe(self.frame(), "total_time_s", by="condition", unit="subject")
+        frame = self.frame()
+        deviation = describe(frame, "mean_deviation_m", by="condition", unit="subject")
+        for condition in ("H", "V"):
+            rows = [r for r in self.trials if r["condition"] == condition]
+            means = np.array(list(self.subject_means("mean_deviation_m", condition).values()))
+            row = deviation[deviation.condition == condition].iloc[0]
+            self.assertEqual(int(row["n_missing"]), sum(1 for r in rows if r["mean_deviation_m"] == ""))
+            self.assertEqual(int(row["n"]), len(means))
+            self.close(float(row["mean"]), float(np.mean(means)), 1e-15, "mean of subject means, NaN trials left out")
+            by_trial = describe(frame, "mean_deviation_m", by="condition", unit="trial")
+            values = np.array([float(r["mean_deviation_m"]) for r in rows if r["mean_deviation_m"] != ""])
+            row = by_trial[by_trial.condition == condition].iloc[0]
+            self.assertEqual(int(row["n"]), len(values))
+            self.close(float(row["mean"]), float(np.mean(values)), 1e-15, "mean over trials")
+            self.close(float(row["sd"]), float(np.std(values, ddof=1)), 1e-15, "SD over trials")
+        table = describe(frame, "total_time_s", by="condition", unit="subject")
         for condition in ("H", "V"):
             means = np.array(list(self.subject_means("total_time_s", condition).values()))
             row = table[table.condition == condition].iloc[0]
