@@ -902,6 +902,11 @@ class TrialNumbers(Base):
         cls.done = json.loads((root / "done.json").read_text(encoding="utf-8"))
         cls.done_table = result.stdout.decode()
         cls.done_rows = read_trace(root / "done.csv")
+        result = run(["trial", SHI, "--guidance", "off", "--max-duration", "30", "--assist-after-misses", "1",
+                      "--writer-param", "backwards_probability=1", "--json", "assisted.json", "--csv",
+                      "assisted.csv"], root)
+        assert result.returncode == 0, result.stderr
+        cls.assisted = json.loads((root / "assisted.json").read_text(encoding="utf-8"))
 
     def test_trial_times_and_path_from_its_own_csv(self):
         record, runs, t = self.record, self.runs, self.t
@@ -990,6 +995,37 @@ class TrialNumbers(Base):
         self.assertEqual(value(score_text, "normalised jerk"), f"{record['normalised_jerk']:.1f}")
         self.assertEqual(value(score_text, "pen-downs unmatched", r"(\d+), too short to score (\d+)"),
                          (str(character["unmatched_segments"]), str(character["ignored_segments"])))
+
+    def test_strokes_written_backwards_then_assisted(self):
+        # every stroke written from its end, refused, and credited as assisted after one miss: the renderer took
+        # none (strokes_completed 0, strokes_assisted 2); the trace wrote both, backwards (docs/metrics.md)
+        record = self.assisted
+        self.assertEqual(record["end_reason"], "completed")
+        renderer = record["renderer_strokes"]
+        self.assertEqual(record["strokes_assisted"], sum(1 for s in renderer if s["assisted"]))
+        self.assertEqual(record["strokes_completed"], sum(1 for s in renderer if s["completed"] and not s["assisted"]))
+        self.assertEqual((record["strokes_assisted"], record["strokes_completed"], record["strokes_accepted"]),
+                         (2, 0, 0))
+        strokes = record["per_character"][0]["per_stroke"]
+        self.assertEqual(record["strokes_written"], sum(1 for s in strokes if s["written"]))
+        self.assertEqual(record["backwards_strokes"], sum(1 for s in strokes if s["backwards"]))
+        self.assertEqual(record["completed_in_order"],
+                         record["strokes_written"] == record["strokes_total"] and record["order_errors"] == 0)
+        self.assertEqual((record["strokes_written"], record["backwards_strokes"], record["completed_in_order"]),
+                         (2, 2, True), "both strokes were written, backwards (docs/stroke-acceptance.md)")
+        self.assertEqual(sum(record["refusals"].values()),
+                         sum(1 for s in record["per_character"][0]["segments"]
+                             if s["verdict"] is not None and not s["verdict"]["accepted"]))
+        rows = read_trace(self.root / "assisted.csv")
+        xy = np.array([[float(r["x"]), float(r["y"])] for r in rows])
+        for segment in record["per_character"][0]["segments"]:
+            if segment["matched_stroke"] is not None:
+                stroke = strokes[segment["matched_stroke"]]
+                mine = deviations(xy[segment["begin"]:segment["end"]], SHARED["shi"][segment["matched_stroke"]])
+                self.close(stroke["mean_deviation_m"], float(np.mean(mine)), 2e-7, "a backwards stroke's deviation")
+        scored = score(self.root / "assisted.csv", SHI, self.root)
+        for key in ("strokes_written", "backwards_strokes", "completed_in_order", "strokes_accepted", "refusals"):
+            self.assertEqual(scored[key], record[key], key)
 
     def test_trial_forces_and_state_changes_from_its_csv(self):
         force = np.array([[float(r["fx"]), float(r["fy"]), float(r["fz"])] for r in self.rows])
