@@ -1395,7 +1395,9 @@ BETWEEN = {"name": "r14cb",
            "phases": [{"phase": "pre-test", "condition": "unguided", "characters": [YI, SHI]},
                       {"phase": "training", "conditions": ["unguided", "fixture"],
                        "assignment": "between-subjects", "characters": [YI, SHI], "repetitions": 2},
-                      {"phase": "post-test", "condition": "unguided", "characters": [YI, SHI]}],
+                      {"phase": "post-test", "condition": "unguided", "characters": [YI, SHI]},
+                      {"phase": "retention", "condition": "unguided", "characters": [YI, SHI], "session": 2,
+                       "delay_s": 86400}],
            "trial": {"max_duration_s": 4}}
 
 
@@ -1414,10 +1416,15 @@ class BetweenSubjectsNumbers(Base):
         cls.trials = read_table(root / "tables" / "trials.csv")
 
     def test_groups_phases_blocks_and_items(self):
-        self.assertEqual(len(self.trials), 6 * 8)
+        self.assertEqual(len(self.trials), 6 * 10)
         for n in range(1, 7):
             subject = f"S{n:02d}"
-            rows = sorted((r for r in self.trials if r["subject"] == subject), key=lambda r: int(r["trial"]))
+            later = [r for r in self.trials if r["subject"] == subject and r["session_number"] == "2"]
+            self.assertEqual([(r["phase"], r["block"], r["trial"], r["group"], r["session"]) for r in later],
+                             [("retention", "1", "1", ["unguided", "fixture"][(n - 1) % 2], f"r14cb-{subject}-s2"),
+                              ("retention", "1", "2", ["unguided", "fixture"][(n - 1) % 2], f"r14cb-{subject}-s2")])
+            rows = sorted((r for r in self.trials if r["subject"] == subject and r["session_number"] == "1"),
+                          key=lambda r: int(r["trial"]))
             group = ["unguided", "fixture"][(n - 1) % 2]  # subject n writes the ((n - 1) mod k)-th condition
             self.assertEqual({r["group"] for r in rows}, {group}, subject)
             self.assertEqual([r["phase"] for r in rows], ["pre-test"] * 2 + ["training"] * 4 + ["post-test"] * 2)
@@ -1444,15 +1451,33 @@ class BetweenSubjectsNumbers(Base):
         frame = pandas.DataFrame(self.trials)
         frame["total_time_s"] = [number(v) for v in frame["total_time_s"]]
         frame["repetition"] = frame["repetition"].astype(int)
-        table = learning(frame, "total_time_s", pre="pre-test", post="post-test")
+        table = learning(frame, "total_time_s", pre="pre-test", post="post-test", retention="retention")
         pre, post = self.means("total_time_s", "pre-test"), self.means("total_time_s", "post-test")
+        kept = self.means("total_time_s", "retention")
         for _, row in table.iterrows():
             subject = row["subject"]
             self.close(row["pre"], pre[subject], 1e-12, f"{subject} pre")
             self.close(row["post"], post[subject], 1e-12, f"{subject} post")
             self.close(row["gain"], pre[subject] - post[subject], 1e-12, f"{subject} gain = pre - post")
             self.close(row["relative_gain"], (pre[subject] - post[subject]) / pre[subject], 1e-12, "gain / pre")
+            self.close(row["retention"], kept[subject], 1e-12, f"{subject} retention")
             self.assertEqual(row["group"], ["unguided", "fixture"][(int(subject[1:]) - 1) % 2])
+            gain = pre[subject] - post[subject]
+            if gain >= 0.05 * pre[subject]:  # min_relative_gain: a ratio only over a gain of 5 % of the pre-test
+                self.close(row["retention_ratio"], (pre[subject] - kept[subject]) / gain, 1e-9, "retention ratio")
+            else:
+                self.assertTrue(math.isnan(row["retention_ratio"]), (subject, gain, row["retention_ratio"]))
+        ratios = 0
+        for _, row in learning(frame, "total_time_s", pre="pre-test", post="post-test", retention="retention",
+                               min_relative_gain=0.0).iterrows():
+            gain = pre[row["subject"]] - post[row["subject"]]
+            if gain > 0:
+                ratios += 1
+                self.close(row["retention_ratio"], (pre[row["subject"]] - kept[row["subject"]]) / gain, 1e-9,
+                           "retention ratio = (pre - retention) / (pre - post)")
+            else:
+                self.assertTrue(math.isnan(row["retention_ratio"]), (row["subject"], gain))
+        self.assertGreater(ratios, 0, "some subject gained")
         result = group_comparison(table, "gain", "fixture", "unguided")
         a = np.array([pre[s] - post[s] for s in pre if int(s[1:]) % 2 == 0])
         b = np.array([pre[s] - post[s] for s in pre if int(s[1:]) % 2 == 1])
