@@ -1556,5 +1556,84 @@ class BetweenSubjectsNumbers(Base):
         self.close(result.sd_a, float(np.std(a, ddof=1)), 1e-12, "sd_a")
 
 
+QUIZ = {"name": "r14cq", "conditions": [{"name": "Q", "mode": "quiz"}],
+        "test": {"characters": [YI, SHI, "人"], "conditions": ["Q"], "repetitions": 2},
+        "trial": {"max_duration_s": 6}}
+
+
+class QuizNumbers(Base):
+    """A quiz condition's record: the quiz fed the recorded trace judges each pen lift by the matcher that gives
+    the metrics record's verdicts, so its events, misses and accepted strokes are those verdicts."""
+
+    @classmethod
+    def setUpClass(cls):
+        root = SHARED["root"] / "quiz"
+        root.mkdir()
+        (root / "p.json").write_text(json.dumps(QUIZ, ensure_ascii=False), encoding="utf-8")
+        result = run(["session", "run", "p.json", "--subjects", "2", "--out", "st", "--writer-profile", "foreign"],
+                     root)
+        assert result.returncode == 0, result.stderr
+        cls.root_ = root
+        cls.records = [(path, json.loads(path.read_text(encoding="utf-8")))
+                       for path in sorted(root.glob("st/*/*/trials/*.json"))]
+
+    def test_quiz_events_are_the_segments_verdicts(self):
+        self.assertEqual(len(self.records), 12)
+        misses_seen = 0
+        for path, record in self.records:
+            quiz = record["quiz"]
+            rows = None
+            self.assertEqual(quiz["misses"], sum(record["refusals"].values()), path.name)
+            self.assertEqual(quiz["strokes_accepted"], record["strokes_accepted"], path.name)
+            misses_seen += quiz["misses"]
+            for character, judged in zip(record["per_character"], quiz["characters"]):
+                self.assertEqual(judged["character"], character["character"])
+                events = [e for e in judged["events"] if e["kind"] in ("stroke_accepted", "stroke_missed", "too_short")]
+                expected, misses, total = [], {}, 0
+                for segment in character["segments"]:
+                    verdict = segment["verdict"]
+                    if segment["ignored"]:
+                        kind, refusal, stroke = "too_short", "none", None
+                    elif verdict is None:
+                        break  # every stroke accepted: the quiz is over
+                    elif verdict["accepted"]:
+                        kind, refusal, stroke = "stroke_accepted", "none", verdict["expected_stroke"]
+                    else:
+                        kind, refusal, stroke = "stroke_missed", verdict["refusal"], verdict["expected_stroke"]
+                        misses[stroke] = misses.get(stroke, 0) + 1
+                        total += 1
+                    expected.append((kind, refusal, segment["end"] - segment["begin"], total, segment["end"] - 1,
+                                     misses.get(stroke, 0) if kind == "stroke_missed" else None))
+                if rows is None:
+                    trace = path.parent / record["files"]["trace"]
+                    result = run(["trace", str(trace)], self.root_)
+                    rows = list(csv.DictReader(io.StringIO(result.stdout.decode())))
+                got = [(e["kind"], e["refusal"], e["samples"], e["total_misses"], e["time_s"],
+                        e["misses_on_stroke"] if e["kind"] == "stroke_missed" else None) for e in events]
+                self.assertEqual(len(got), len(expected), (path.name, got, expected))
+                for g, x in zip(got, expected):
+                    self.assertEqual(g[:4], x[:4], path.name)
+                    self.assertEqual(g[4], ns(Decimal(rows[x[4]]["t"])), (path.name, "the lift's time"))
+                    self.assertEqual(g[5], x[5], path.name)
+                hints = [e for e in judged["events"] if e["kind"] == "hint"]
+                self.assertEqual(len(hints), sum(max(0, m - quiz["hint_after_misses"] + 1) for m in misses.values()))
+        self.assertGreater(misses_seen, 0, "the foreign writer misses some strokes")
+
+    def test_pages_show_the_quiz_misses(self):
+        import html as html_module
+        result = run(["report", "st", "--out", "pages.html"], self.root_)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        shown = {}
+        for page in (self.root_ / "pages_files").glob("*/*.html"):
+            for article in re.finditer(r'<article[^>]* id="trial-([^"]+)-(\d+)".*?</article>',
+                                       page.read_text(encoding="utf-8"), re.S):
+                body = re.sub(r"<svg.*?</svg>|<figcaption.*?</figcaption>", "", article.group(0), flags=re.S)
+                shown[(article.group(1), int(article.group(2)))] = " ".join(
+                    html_module.unescape(re.sub(r"<[^>]+>", " ", body)).split())
+        for path, record in self.records:
+            words = shown[(record["session"], int(path.name[:3]))]
+            self.assertIn(f"quiz misses {record['quiz']['misses']}", words)
+
+
 if __name__ == "__main__":
     unittest.main(verbosity=2)
