@@ -1295,7 +1295,8 @@ class StudyNumbers(Base):
                 self.assertEqual(scored[key], float(row[key]) if "." in row[key] else int(row[key]), key)
             for key in ("mean_deviation_m", "frechet_m", "dtw_m", "normalised_jerk"):
                 if row[key] != "":
-                    self.close(scored[key], float(row[key]), 1e-6 * abs(float(row[key])), f"score of the .trace.h5: {key}")
+                    self.close(scored[key], float(row[key]), 1e-6 * abs(float(row[key])),
+                               f"score of the .trace.h5: {key}")
             self.close(float(row["total_time_s"]), ns(t[runs[-1][1]] - t[runs[0][0]]), 1e-9, "total_time_s")
             self.close(float(row["pen_down_time_s"]), sum(ns(t[b] - t[a]) for a, b in runs), 1e-9, "pen_down_time_s")
             _, record = self.records[(row["subject"], int(row["trial"]))]
@@ -1345,7 +1346,8 @@ class StudyNumbers(Base):
             self.assertEqual(len(line), 1, session_run)
             self.assertIn("8 of 8 trials saved", line[0])
         self.assertIn(f"trials.csv ({len(self.trials)} rows), strokes.csv ({len(self.strokes)} rows)", report)
-        self.assertIn(f"{SUBJECTS} subjects, {len(self.trials)} trials on 1 threads", cohort.replace("thread ", "threads "))
+        self.assertIn(f"{SUBJECTS} subjects, {len(self.trials)} trials on 1 threads",
+                      cohort.replace("thread ", "threads "))
         self.assertIn(f"trials.csv ({len(self.trials)} rows), strokes.csv ({len(self.strokes)} rows)", cohort)
 
     def test_cohort_tables_are_the_session_tables(self):
@@ -1633,6 +1635,48 @@ class QuizNumbers(Base):
         for path, record in self.records:
             words = shown[(record["session"], int(path.name[:3]))]
             self.assertIn(f"quiz misses {record['quiz']['misses']}", words)
+
+
+CROSSOVER = {"name": "r14cx",
+             "conditions": [{"name": "unguided", "mode": "vision"}, {"name": "fixture", "mode": "haptic"}],
+             "item_sets": [{"name": "set1", "characters": [YI]}, {"name": "set2", "characters": [SHI]}],
+             "phases": [{"phase": "pre-test", "condition": "unguided", "sets": ["set1", "set2"]},
+                        {"phase": "training", "conditions": ["unguided", "fixture"], "assignment": "crossover",
+                         "sets": ["set1", "set2"]},
+                        {"phase": "post-test", "condition": "unguided", "sets": ["set1", "set2"]}],
+             "trial": {"max_duration_s": 3}}
+
+
+class CrossoverLabels(Base):
+
+    def test_crossover_labels_follow_the_documented_rule(self):
+        root = SHARED["root"] / "crossover"
+        root.mkdir()
+        (root / "p.json").write_text(json.dumps(CROSSOVER, ensure_ascii=False), encoding="utf-8")
+        (root / "tables").mkdir()
+        result = run(["session", "cohort", "p.json", "--subjects", "4", "--csv", "tables", "--jobs", "1"], root)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        trials = read_table(root / "tables" / "trials.csv")
+        conditions, sets, items = ["unguided", "fixture"], ["set1", "set2"], {"set1": YI, "set2": SHI}
+        square = [[0, 1], [1, 0]]  # the balanced Latin square of two conditions: rows = k = 2
+        for n in range(1, 5):
+            row = square[(n - 1) % 2]
+            rotation = ((n - 1) // 2) % 2
+            set_of = {i: sets[(i + rotation) % 2] for i in range(2)}  # listed condition i trains set (i + q) mod k
+            period_of_set = {set_of[c]: p + 1 for p, c in enumerate(row)}
+            condition_of_set = {set_of[i]: conditions[i] for i in range(2)}
+            sequence = "".join("AB"[c] for c in row)
+            rows = sorted((r for r in trials if r["subject"] == f"S{n:02d}"), key=lambda r: int(r["trial"]))
+            self.assertEqual(len(rows), 6)
+            for r in rows:
+                item_set = [name for name, char in items.items() if char == r["characters"]][0]
+                self.assertEqual((r["item_set"], r["sequence"], int(r["period"]), r["trained_condition"]),
+                                 (item_set, sequence, period_of_set[item_set], condition_of_set[item_set]),
+                                 (n, r["phase"], r["characters"]))
+                self.assertEqual(int(r["item"]), sets.index(item_set) + 1)
+            training = [r for r in rows if r["phase"] == "training"]
+            self.assertEqual([(r["condition"], r["item_set"], r["block"]) for r in training],
+                             [(conditions[c], set_of[c], str(2 + p)) for p, c in enumerate(row)])
 
 
 if __name__ == "__main__":
