@@ -14,7 +14,8 @@ state changes, attempts, deviations, fluency); a Python trial on a raised paper 
 One tiny study (`session run` of 4 subjects, `report --csv` and `--out`, `trace` of its saved trials, `session
 cohort`): the tables' rows against the records, the times against the traces, the per-trial pages, the
 statistics' means, SDs, intervals and paired t against numpy; a between-subjects cohort's groups and learning
-statistics.
+statistics; a crossover cohort's labels against the documented rule; a quiz condition's events against the
+record's verdicts and its trace.
 
 Each case asserts the documented value; tolerances are those a trace file's precision gives (times 1 us,
 lengths 0.1 um) or the documented discretisation. CALLIGRAPHY_CLI names the program, PYTHONPATH its Python
