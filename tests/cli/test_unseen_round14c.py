@@ -1250,6 +1250,10 @@ class StudyNumbers(Base):
     def test_strokes_table_rows_are_the_per_stroke_records(self):
         expected = sum(int(r["strokes_total"]) for r in self.trials)
         self.assertEqual(len(self.strokes), expected)
+        typical = {}
+        for char in (YI, SHI):
+            result = run(["model", char, "--json"], self.study)
+            typical[char] = [stroke["typical_id"] for stroke in json.loads(result.stdout)["strokes"]]
         for row in self.strokes:
             _, record = self.records[(row["subject"], int(row["trial"]))]
             metrics = self.find_metrics(record)
@@ -1258,6 +1262,8 @@ class StudyNumbers(Base):
             self.assertEqual(stroke["index"], int(row["stroke"]) - 1)
             self.assertEqual(row["character_text"], character["character"])
             self.assertEqual(row["written"], "true" if stroke["written"] else "false")
+            self.assertEqual(row["backwards"], "true" if stroke["backwards"] else "false")
+            self.assertEqual(int(row["typical_id"]), typical[row["character_text"]][int(row["stroke"]) - 1])
             for column in ("mean_deviation_m", "max_deviation_m", "rms_deviation_m", "frechet_m", "dtw_m",
                            "time_s", "path_length_m"):
                 if stroke[column] is None:
