@@ -83,7 +83,8 @@ std::string column_key(const py::object& columns, const char* file_name) {
 // The samples of a mapping with columns t, x, y and pen (1/0) or z [m] (pen_trace_csv.hpp's columns), each by
 // its file name or its name with its unit (t_s, x_m, y_m, z_m).
 std::vector<PenSample> samples_from_columns(const py::object& columns, TraceUnits units,
-                                            const Placement& placement, double contact_threshold_m) {
+                                            const Placement& placement, double contact_threshold_m,
+                                            double paper_z_m) {
   // A numpy array has both, but `"t" in array` compares its elements with "t": it is no mapping of columns
   // (a structured array's fields included).
   if (!py::hasattr(columns, "__getitem__") || !py::hasattr(columns, "__contains__") ||
@@ -139,7 +140,7 @@ std::vector<PenSample> samples_from_columns(const py::object& columns, TraceUnit
     PenSample& sample = samples[static_cast<std::size_t>(i)];
     sample.time_s = t.at(i);
     sample.position_m = units == TraceUnits::data ? placement.to_paper(position) : position;
-    sample.pen_down = pen_column ? c == 1.0 : c <= contact_threshold_m;
+    sample.pen_down = pen_column ? c == 1.0 : c - paper_z_m <= contact_threshold_m;
   }
   return samples;
 }
@@ -152,19 +153,34 @@ py::dict score_py(const py::object& trace, const py::object& character, const st
     throw InvalidArgument("units: '" + units_name +
                           "' is neither 'm' (metres) nor 'data' (the 1024-unit box)");
   const TraceUnits units = parse_trace_units(units_name == "m" ? "metres" : units_name);
-  Character model;
-  if (py::isinstance<Character>(character)) {
-    model = character.cast<Character>();
-  } else {
-    const CharacterSource source = library ? take(*library, "library") : CharacterSource::embedded();
-    model = source.load(one_character(convert_named<std::string>(character, "character"), "character"));
-  }
   if (!std::isfinite(start_radius_m) || !(start_radius_m > 0.0))
     throw InvalidArgument("start_radius_m: " + shortest_decimal(start_radius_m) + " m is not finite and > 0");
-  SceneLayout layout;
-  layout.start_radius_m = start_radius_m;
-  const Scene scene = Scene::lay_out({model}, layout);
+  // A Scene (the one a trial was written on, TrialResult.scene) is scored as it was laid out: its row, size,
+  // start radius and paper height, which a `z` column is measured from, as the trial measured it.
+  Scene scene;
+  if (py::isinstance<Scene>(character)) {
+    scene = character.cast<Scene>();
+    if (scene.characters.empty()) throw InvalidArgument("character: the scene has no character");
+    if (units == TraceUnits::data && scene.characters.size() != 1) {
+      throw InvalidArgument(
+          "units: 'data' takes one character (data units are one character's); the scene has " +
+          std::to_string(scene.characters.size()));
+    }
+  } else {
+    Character model;
+    if (py::isinstance<Character>(character)) {
+      model = character.cast<Character>();
+    } else {
+      const CharacterSource source = library ? take(*library, "library") : CharacterSource::embedded();
+      model = source.load(one_character(convert_named<std::string>(character, "character"), "character"));
+    }
+    SceneLayout layout;
+    layout.start_radius_m = start_radius_m;
+    scene = Scene::lay_out({model}, layout);
+  }
   const PlacedCharacter& placed = scene.characters.front();
+  std::string characters;
+  for (const PlacedCharacter& c : scene.characters) characters += encode_utf8(c.code_point);
 
   std::vector<PenSample> samples;
   std::string trace_name = "<columns>";
@@ -176,17 +192,19 @@ py::dict score_py(const py::object& trace, const py::object& character, const st
     PenTraceCsvOptions options;
     options.units = units;
     options.contact_threshold_m = contact_threshold_m;
+    options.paper_z_m = scene.layout.paper_z_m;
     samples = read_pen_trace_csv(trace_name, placed.placement, options);
   } else {
     if (!std::isfinite(contact_threshold_m))
       throw InvalidArgument("contact_threshold_m: not a finite number");
-    samples = samples_from_columns(trace, units, placed.placement, contact_threshold_m);
+    samples =
+        samples_from_columns(trace, units, placed.placement, contact_threshold_m, scene.layout.paper_z_m);
   }
   ScoreOptions options;
   if (acceptance) options.acceptance = take(*acceptance, "acceptance");
   const WritingMetrics metrics = writing_metrics(scene, samples, options);
-  const ScoreDescription description{encode_utf8(placed.code_point), trace_name,
-                                     units == TraceUnits::data ? "data" : "m", samples.size()};
+  const ScoreDescription description{characters, trace_name, units == TraceUnits::data ? "data" : "m",
+                                     samples.size()};
   return metrics_from_json(score_json(description, metrics));
 }
 
@@ -207,8 +225,12 @@ trace: the path of a CSV file (header t, x, y and pen or z; other columns ignore
        reads as it is), or a mapping of columns (a dict of 1-D arrays, a pandas DataFrame) with `t` [s],
        `x`, `y` and `pen` (1 on paper, 0 lifted) or `z` [m] (on paper when z <= contact_threshold_m).
 character: a str of one character (loaded from `library`, default the embedded set) or a Character,
-           laid out as `simulate_trial` places it.
-units: 'm' (metres on the paper plane of that placement) or 'data' (the 1024-unit box, y up).
+           laid out as `simulate_trial` places it; or a Scene (a row of characters, or a trial's
+           `TrialResult.scene`), scored as it is laid out: its placement, its start radius (not
+           `start_radius_m`) and its paper height, which `z` is measured from (on paper when
+           z - paper_z_m <= contact_threshold_m), so that a trial's trace scores as the trial did.
+units: 'm' (metres on the paper plane of that placement) or 'data' (the 1024-unit box, y up; one
+       character only).
 acceptance: a StrokeAcceptance (default: the C++ defaults, the renderer's).
 start_radius_m: radius of the start neighbourhood a segment must enter a stroke in [m], > 0 (default the
                 scene's, 0.005).

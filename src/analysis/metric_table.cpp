@@ -323,7 +323,8 @@ const MetricInfo kMetrics[] = {
      .levels = kRun},
     {.name = "strokes_assisted",
      .kind = MetricKind::count,
-     .doc = "strokes credited as assisted after `assist_after_misses` refused attempts (not written)",
+     .doc = "strokes credited as assisted after `assist_after_misses` refused attempts (not taken by the "
+            "renderer)",
      .definition = "`TrialMetrics::strokes_assisted`",
      .levels = kRun,
      .trials_column = 5,
