@@ -10,6 +10,8 @@
 // object keeps its previous value.
 #include <pybind11/pybind11.h>
 
+#include <cmath>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -121,7 +123,36 @@ class ParameterClass {
   ParameterClass& field(double S::*member) {
     const ParameterField<S>& entry = parameter_field(member);
     // The tables' names are string literals: data() is null-terminated and lives as long as the program.
+    if (entry.whole_number) return count_field(entry.name.data(), member, entry.description());
     return field(entry.name.data(), member, entry.description());
+  }
+
+  /// Adds field `name`, a count the C++ struct keeps as a double (ParameterField::whole_number), as an int:
+  /// read as an int, set with an int (a float is refused, as for every int argument), checked whole.
+  ParameterClass& count_field(const char* name, double S::*member, const std::string& doc) {
+    Field f;
+    f.name = name;
+    f.type = python_type_name<std::int64_t>();
+    const std::string qualified = name_ + "." + name;
+    auto shared = shared_;
+    const auto value = [member](const S& s) { return static_cast<std::int64_t>(std::llround(s.*member)); };
+    f.set = [member, qualified](S& s, py::handle v) {
+      s.*member = static_cast<double>(convert_named<std::int64_t>(v, qualified));
+    };
+    f.repr = [value](const S& s) { return std::to_string(value(s)); };
+    f.to_python = [value](const S& s) { return py::object(py::int_(value(s))); };
+    f.equal = [member](const S& a, const S& b) { return a.*member == b.*member; };
+    cls_.def_property(
+        name, [value](const S& s) { return value(s); },
+        [member, qualified, shared](S& s, const PyArgument<std::int64_t>& v) {
+          S copy = s;
+          copy.*member = static_cast<double>(take(v, qualified));
+          shared->validate(copy);
+          s = copy;
+        },
+        doc.c_str());
+    shared_->fields.push_back(std::move(f));
+    return *this;
   }
 
   /// Adds field `name` holding one of several parameter classes bound before (a std::variant of them, e.g.

@@ -167,21 +167,21 @@ TrialRun run_interruptible(TrialRunInputs& inputs, Trial&& trial) {
 // One description of the arguments simulate_trial and run_trial share, in their Python order after each
 // function's own leading arguments: X(C++ type, Python name, default). It makes the TrialArguments
 // fields, the C++ parameters and the py::arg list of both functions.
-#define CALLIGRAPHY_TRIAL_ARGUMENTS(X)                                    \
-  X(Annotated<WriterTag>, writer, "novice")                               \
-  X(PyArgument<bool>, guidance, true)                                     \
-  X(PyArgument<double>, rate_hz, 1000.0)                                  \
-  X(PyArgument<std::uint64_t>, seed, 0)                                   \
-  X(std::optional<PyArgument<CharacterSource>>, library, py::none())      \
-  X(std::optional<PyArgument<ForceLawParameters>>, force_law, py::none()) \
-  X(PyArgument<double>, max_duration_s, 300.0)                            \
-  X(PyArgument<bool>, keep_trace, true)                                   \
-  X(std::optional<Annotated<WriterParamsTag>>, writer_params, py::none()) \
-  X(std::optional<PyArgument<GuidanceMode>>, guidance_mode, py::none())   \
-  X(std::optional<PyArgument<double>>, guidance_gain, py::none())         \
-  X(std::optional<Annotated<TeacherTag>>, teacher, py::none())            \
-  X(std::optional<PyArgument<double>>, hint_after_misses, py::none())     \
-  X(std::optional<PyArgument<double>>, assist_after_misses, py::none())
+#define CALLIGRAPHY_TRIAL_ARGUMENTS(X)                                      \
+  X(Annotated<WriterTag>, writer, "novice")                                 \
+  X(PyArgument<bool>, guidance, true)                                       \
+  X(PyArgument<double>, rate_hz, 1000.0)                                    \
+  X(PyArgument<std::uint64_t>, seed, 0)                                     \
+  X(std::optional<PyArgument<CharacterSource>>, library, py::none())        \
+  X(std::optional<PyArgument<ForceLawParameters>>, force_law, py::none())   \
+  X(PyArgument<double>, max_duration_s, 300.0)                              \
+  X(PyArgument<bool>, keep_trace, true)                                     \
+  X(std::optional<Annotated<WriterParamsTag>>, writer_params, py::none())   \
+  X(std::optional<PyArgument<GuidanceMode>>, guidance_mode, py::none())     \
+  X(std::optional<PyArgument<double>>, guidance_gain, py::none())           \
+  X(std::optional<Annotated<TeacherTag>>, teacher, py::none())              \
+  X(std::optional<PyArgument<std::int64_t>>, hint_after_misses, py::none()) \
+  X(std::optional<PyArgument<std::int64_t>>, assist_after_misses, py::none())
 
 #define CALLIGRAPHY_TRIAL_FIELD(type, name, default_value) type name;
 #define CALLIGRAPHY_TRIAL_PARAMETER(type, name, default_value) , const type& name
@@ -287,9 +287,11 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   apply_guidance(a, label, options.force);
   // The stroke acceptance's miss counts, the specification's fields of the same names, over force_law's.
   if (a.hint_after_misses)
-    options.force.acceptance.hint_after_misses = take(*a.hint_after_misses, "hint_after_misses");
+    options.force.acceptance.hint_after_misses =
+        static_cast<double>(take(*a.hint_after_misses, "hint_after_misses"));
   if (a.assist_after_misses)
-    options.force.acceptance.assist_after_misses = take(*a.assist_after_misses, "assist_after_misses");
+    options.force.acceptance.assist_after_misses =
+        static_cast<double>(take(*a.assist_after_misses, "assist_after_misses"));
   options.validate();
   simulation.validate();
 
@@ -612,7 +614,7 @@ teacher: a TeacherRecording of the same characters (record_teacher) or a list of
 rate_hz: servo rate [Hz], 100..100000. seed: int >= 0. max_duration_s: simulated time limit [s],
 > 0, at most 10^7 ticks (rate_hz * max_duration_s).
 hint_after_misses, assist_after_misses: refused attempts at a stroke after which it is shown as a hint,
-and after which it is demonstrated and credited as assisted (whole numbers in [0, 1000], 0: never; None
+and after which it is demonstrated and credited as assisted (ints in 0..1000, 0: never; None
 keeps force_law's acceptance's, 3 and 5 by default), as `calligraphy trial --hint-after-misses N
 --assist-after-misses N` (docs/stroke-acceptance.md).
 force_law: ForceLawParameters (its guidance fields are replaced by the arguments given). device:

@@ -42,6 +42,12 @@ void check_parameter(std::string_view qualified_name, double value, std::string_
                         " must be " + (std::isinf(range.high) ? "finite and " : "") + range.text(unit));
 }
 
+void check_whole_parameter(std::string_view qualified_name, double value) {
+  if (value == std::floor(value)) return;
+  throw InvalidArgument(std::string(qualified_name) + " = " + shortest_decimal(value) +
+                        " must be a whole number");
+}
+
 void throw_parameter_not_in_table(std::string_view struct_name) {
   throw InvalidArgument(std::string(struct_name) + ": no table entry for this member");
 }

@@ -91,6 +91,18 @@ std::string SchemaField::range_text() const {
   }
 }
 
+std::int64_t SchemaField::integer_value(const void* object) const {
+  return get_integer != nullptr ? get_integer(object) : std::llround(get_number(*this, object, 0));
+}
+
+void SchemaField::set_integer_value(void* object, std::int64_t value) const {
+  if (set_integer != nullptr) {
+    set_integer(object, value);
+  } else {
+    set_number(*this, object, 0, static_cast<double>(value));
+  }
+}
+
 std::string SchemaField::description() const {
   std::string out(doc);
   if (!unit.empty()) out += " [" + std::string(unit) + "]";
@@ -121,7 +133,7 @@ void check_field(const Schema& schema, const SchemaField& field, const void* obj
       break;
     case FieldKind::integer:
       if (!field.integer_unsigned) {
-        const std::int64_t value = field.get_integer(object);
+        const std::int64_t value = field.integer_value(object);
         if (value < field.integer_low || value > field.integer_high) {
           throw InvalidArgument(qualified + " = " + std::to_string(value) + " must be in " +
                                 integer_range_text(field));
@@ -171,7 +183,7 @@ void set_field_from_text(const SchemaField& field, void* object, std::string_vie
       const std::optional<std::int64_t> value = parse_whole<std::int64_t>(text);
       if (!value || *value < field.integer_low || *value > field.integer_high)
         throw InvalidArgument(quoted(text) + " is not an integer in " + integer_range_text(field));
-      field.set_integer(object, *value);
+      field.set_integer_value(object, *value);
       return;
     }
     case FieldKind::boolean:
@@ -208,7 +220,7 @@ std::string field_text(const SchemaField& field, const void* object) {
       return shortest_decimal(field.get_number(field, object, 0) * field.option_factor);
     case FieldKind::integer:
       return field.integer_unsigned ? std::to_string(field.get_unsigned(object))
-                                    : std::to_string(field.get_integer(object));
+                                    : std::to_string(field.integer_value(object));
     case FieldKind::boolean:
       return field.get_boolean(object) ? "on" : "off";
     case FieldKind::enumeration:

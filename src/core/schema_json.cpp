@@ -26,7 +26,7 @@ ordered_json value_json(const SchemaField& field, const void* object) {
     }
     case FieldKind::integer:
       if (field.integer_unsigned) return field.get_unsigned(object);
-      return field.get_integer(object);
+      return field.integer_value(object);
     case FieldKind::boolean:
       return field.get_boolean(object);
     case FieldKind::enumeration:
@@ -95,7 +95,7 @@ void read_value(const SchemaField& field, const std::string& owner, void* object
         field.set_unsigned(object, json_detail::as_unsigned(value, pointer, source));
         return;
       }
-      field.set_integer(
+      field.set_integer_value(
           object, json_detail::as_integer(value, pointer, source, field.integer_low, field.integer_high));
       return;
     case FieldKind::boolean:

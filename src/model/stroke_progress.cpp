@@ -62,11 +62,11 @@ constexpr std::array kAcceptanceFields{
     ParameterField<StrokeAcceptance>{
         "hint_after_misses", "", ParameterRange{.low = 0.0, .high = 1000.0},
         "refused attempts at a stroke after which it is shown as a hint, 0 never",
-        &StrokeAcceptance::hint_after_misses},
+        &StrokeAcceptance::hint_after_misses, true},
     ParameterField<StrokeAcceptance>{
         "assist_after_misses", "", ParameterRange{.low = 0.0, .high = 1000.0},
         "refused attempts at a stroke after which it is demonstrated and credited assisted, 0 never",
-        &StrokeAcceptance::assist_after_misses},
+        &StrokeAcceptance::assist_after_misses, true},
     // Added with version 5 of a trial record; older records run with use_version_4_end_gaps().
     ParameterField<StrokeAcceptance>{"end_gap_m", "m", ParameterRange{.low = 0.0, .high = 0.1},
                                      "least either end may be left unwritten by on a stroke long enough, 0 "
@@ -100,15 +100,7 @@ std::span<const ParameterField<StrokeAcceptance>> ParameterTable<StrokeAcceptanc
 }
 
 void StrokeAcceptance::validate() const {
-  check_parameters(*this);
-  for (const double count : {hint_after_misses, assist_after_misses}) {
-    if (count != std::floor(count)) {
-      throw InvalidArgument(
-          "StrokeAcceptance." +
-          std::string(count == hint_after_misses ? "hint_after_misses" : "assist_after_misses") + " = " +
-          shortest_decimal(count) + " must be a whole number");
-    }
-  }
+  check_parameters(*this);  // the miss counts whole numbers too (ParameterField::whole_number)
 }
 
 double StrokeAcceptance::allowed_shortfall_m(double length_m) const noexcept {

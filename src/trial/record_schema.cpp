@@ -26,13 +26,6 @@ const Schema& SchemaOf<StrokeAcceptance>::get() {
   // older record runs without it (StrokeAcceptance::use_version_6_coverage).
   static const std::vector<SchemaField> fields = [] {
     std::vector<SchemaField> out = table_fields<StrokeAcceptance>();
-    for (SchemaField& field : out) {  // the miss counts are whole numbers (StrokeAcceptance::validate)
-      if (field.name == "hint_after_misses") {
-        field = whole_number_field<&StrokeAcceptance::hint_after_misses>(field);
-      } else if (field.name == "assist_after_misses") {
-        field = whole_number_field<&StrokeAcceptance::assist_after_misses>(field);
-      }
-    }
     for (std::size_t i = 8; i < out.size(); ++i) {
       const bool end_gap = out[i].name == "end_gap_m" || out[i].name == "end_gap_fraction";
       const bool centred = out[i].name.starts_with("centred_");

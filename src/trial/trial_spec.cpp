@@ -45,19 +45,6 @@ const std::vector<SchemaField>& writer_setting_fields() {
   return fields;
 }
 
-// A miss count of the acceptance (a double in its table, a whole number by its rule) as an integer field of
-// the specification, so that its JSON Schema says "integer" as the protocol's quiz count does.
-template <double StrokeAcceptance::*Member>
-void make_count_field(SchemaField& field) {
-  make_whole_number_kind(field);
-  field.get_integer = [](const void* o) -> std::int64_t {
-    return std::llround(static_cast<const TrialSpec*>(o)->acceptance.*Member);
-  };
-  field.set_integer = [](void* o, std::int64_t v) {
-    static_cast<TrialSpec*>(o)->acceptance.*Member = static_cast<double>(v);
-  };
-}
-
 // The stroke acceptance's fields as fields of the specification (TrialSpec::acceptance), one per entry of
 // StrokeAcceptance's table, in its order: the key, unit, range and doc are the table's (the one definition; a
 // field added to the table is a field of the specification), the option the key dashed with a length's "_m"
@@ -88,11 +75,7 @@ std::vector<SchemaField> acceptance_fields() {
       static_cast<TrialSpec*>(o)->acceptance.*
           (ParameterTable<StrokeAcceptance>::fields()[self.table_slot].member) = v;
     };
-    if (entries[i].member == &StrokeAcceptance::hint_after_misses) {
-      make_count_field<&StrokeAcceptance::hint_after_misses>(f);
-    } else if (entries[i].member == &StrokeAcceptance::assist_after_misses) {
-      make_count_field<&StrokeAcceptance::assist_after_misses>(f);
-    }
+    if (entries[i].whole_number) make_whole_number_kind(f);  // the miss counts
     // The specification states the acceptance since version 6 of a record; the centred rule came with 7.
     out.push_back(since(f.name.starts_with("centred_") ? 7 : 6, f));
   }

@@ -289,7 +289,7 @@ class SchemaAgainstOptions(Case):
                          0.02)
 
     def test_whole_numbers_are_whole_on_every_surface(self):
-        # hint_after_misses is an integer 0..1000 in the schema; Python's signature says a float.
+        # hint_after_misses is an integer 0..1000 in the schema, and an int in Python (a float is a TypeError).
         self.assertEqual(self.fields["hint_after_misses"]["kind"], "integer")
         self.assert_refused(run(["trial", YI, "--hint-after-misses", "3.5", "--check"], self.tmp),
                             "--hint-after-misses")
@@ -300,12 +300,14 @@ class SchemaAgainstOptions(Case):
                             "--hint-after-misses")
         if cg is None:
             return
-        with self.assertRaises(cg.InvalidArgument) as caught:
-            cg.simulate_trial(YI, hint_after_misses=3.5, max_duration_s=0.01)
-        self.assertIn("hint_after_misses", str(caught.exception))
+        for fraction in (3.5, 7.0):
+            with self.assertRaises(TypeError) as caught:
+                cg.simulate_trial(YI, hint_after_misses=fraction, max_duration_s=0.01)
+            self.assertIn("hint_after_misses", str(caught.exception))
         with self.assertRaises(cg.InvalidArgument):
             cg.simulate_trial(YI, hint_after_misses=1001, max_duration_s=0.01)
-        recorded = cg.simulate_trial(YI, hint_after_misses=7.0, max_duration_s=0.01).metrics
+        self.assertIs(type(cg.StrokeAcceptance().hint_after_misses), int)
+        recorded = cg.simulate_trial(YI, hint_after_misses=7, max_duration_s=0.01).metrics
         value = recorded["specification"]["trial"]["hint_after_misses"]
         self.assertEqual((value, type(value)), (7, int))
 

@@ -118,6 +118,12 @@ def cases(scene):
         "RepetitionOutcome.refused_backwards": lambda v: c.RepetitionOutcome(refused_backwards=v),
         "SimulatedDeviceParameters.physics_substeps": lambda v: c.SimulatedDeviceParameters(physics_substeps=v),
         "WriterProfile.max_attempts_per_stroke": lambda v: c.WriterProfile(max_attempts_per_stroke=v),
+        "StrokeAcceptance.hint_after_misses": lambda v: c.StrokeAcceptance(hint_after_misses=v),
+        "StrokeAcceptance.assist_after_misses": lambda v: c.StrokeAcceptance(assist_after_misses=v),
+        "simulate_trial.hint_after_misses": lambda v: c.simulate_trial("一", hint_after_misses=v),
+        "simulate_trial.assist_after_misses": lambda v: c.simulate_trial("一", assist_after_misses=v),
+        "run_trial.hint_after_misses": lambda v: c.run_trial("一", hint_after_misses=v),
+        "run_trial.assist_after_misses": lambda v: c.run_trial("一", assist_after_misses=v),
     }
 
 

@@ -42,6 +42,8 @@ def _pairs(schema):
 
 
 def _past(prop):
+    if prop.get("type") == "integer":  # a count: the next whole number past each bound
+        return [prop[bound] + step for bound, step in (("minimum", -1), ("maximum", 1)) if bound in prop]
     out = []
     if "minimum" in prop:
         out.append(math.nextafter(prop["minimum"], -math.inf))

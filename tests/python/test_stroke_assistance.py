@@ -41,8 +41,18 @@ def test_the_keywords_override_the_force_laws_acceptance():
     assert attempts(missing_trial(force_law=force, assist_after_misses=3)) == [(3, True), (3, True)]
 
 
-@pytest.mark.parametrize("keyword, value", [("assist_after_misses", 1001), ("assist_after_misses", 2.5),
-                                            ("hint_after_misses", -1)])
-def test_a_count_out_of_range_or_not_whole_is_refused_by_name(keyword, value):
+@pytest.mark.parametrize("keyword, value", [("assist_after_misses", 1001), ("hint_after_misses", -1)])
+def test_a_count_out_of_range_is_refused_by_name(keyword, value):
     with pytest.raises(calligraphy.InvalidArgument, match=keyword):
         missing_trial(**{keyword: value})
+
+
+@pytest.mark.parametrize("keyword, value", [("assist_after_misses", 2.5), ("hint_after_misses", 3.0)])
+def test_a_count_is_an_int(keyword, value):
+    # A count is an int in Python, as the schema's "integer" and every other count argument: a float is a
+    # TypeError naming it, a whole one too (as range(3.0) is).
+    with pytest.raises(TypeError, match=keyword):
+        missing_trial(**{keyword: value})
+    with pytest.raises(TypeError, match=keyword):
+        calligraphy.StrokeAcceptance(**{keyword: value})
+    assert type(getattr(calligraphy.StrokeAcceptance(), keyword)) is int

@@ -7,6 +7,7 @@
 /// protocol read their values against the same entries, and Python's documentation of the fields is read
 /// from it (docs/force-rendering.md, "Parameter tables"). Defaults stay the struct's own member
 /// initialisers. In `core` because structs of every layer from `model` up have one.
+#include <cmath>
 #include <limits>
 #include <span>
 #include <string>
@@ -39,6 +40,9 @@ struct ParameterField {
   /// "words:" at the start of a property's documentation as its type).
   std::string_view doc;
   double S::*member;  ///< where the value lives
+  /// A count kept as a double (a number of misses): only whole numbers are accepted, and the schema, the
+  /// JSON Schema, the options and Python give it as an integer.
+  bool whole_number = false;
 
   /// The field's default: the struct's own member initialiser.
   [[nodiscard]] double default_value() const { return S{}.*member; }
@@ -61,18 +65,24 @@ struct ParameterTable;
 void check_parameter(std::string_view qualified_name, double value, std::string_view unit,
                      const ParameterRange& range);
 
+/// Throws InvalidArgument "Struct.field = value must be a whole number" unless `value` is one.
+void check_whole_parameter(std::string_view qualified_name, double value);
+
 /// Throws InvalidArgument: `struct_name`'s table has no entry for a member it was asked about.
 [[noreturn]] void throw_parameter_not_in_table(std::string_view struct_name);
 
 /// Checks every field of `object` against its table, in table order; throws InvalidArgument naming the
-/// first field out of range (check_parameter). Cross-field rules are the struct's own, after this.
+/// first field out of range (check_parameter) or, for a count, not a whole number. Cross-field rules are
+/// the struct's own, after this.
 template <typename S>
 void check_parameters(const S& object) {
   for (const ParameterField<S>& field : ParameterTable<S>::fields()) {
+    const double value = object.*field.member;
     // The name is built only for an error: a profile is checked for every trial a study plans.
-    if (field.range.contains(object.*field.member)) continue;
-    check_parameter(std::string(ParameterTable<S>::name) + "." + std::string(field.name),
-                    object.*field.member, field.unit, field.range);
+    if (field.range.contains(value) && (!field.whole_number || value == std::floor(value))) continue;
+    const std::string name = std::string(ParameterTable<S>::name) + "." + std::string(field.name);
+    check_parameter(name, value, field.unit, field.range);
+    check_whole_parameter(name, value);
   }
 }
 

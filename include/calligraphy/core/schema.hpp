@@ -175,6 +175,12 @@ struct SchemaField {
   void* (*list_append)(void* object) = nullptr;  ///< a default element at the end
   void (*list_clear)(void* object) = nullptr;
 
+  /// integer, signed: the value, through `get_integer`, or through `get_number` for a count a ParameterTable
+  /// keeps as a double (make_whole_number_kind).
+  [[nodiscard]] std::int64_t integer_value(const void* object) const;
+  /// integer, signed: sets the value, through `set_integer` or `set_number` as `integer_value` reads it.
+  void set_integer_value(void* object, std::int64_t value) const;
+
   /// "doc [unit], range" for help and docs: "servo rate [Hz], in [100, 100000] Hz".
   [[nodiscard]] std::string description() const;
   /// The range as text ("in [0, 1]", "0..18446744073709551615", "fixed|fading"); empty for strings and
@@ -362,27 +368,15 @@ template <auto Member>
   return f;
 }
 
-/// `field`, a double member that holds whole numbers only (a count a ParameterTable keeps as a double), as an
-/// integer field over the whole numbers of its range: its JSON Schema then says "integer", as a count's does.
-/// `field` (a number field) made an integer field over the whole numbers of its range, without accessors:
-/// the caller sets `get_integer` and `set_integer`.
+/// `field`, a number field of a double member that holds whole numbers only (a count a ParameterTable keeps
+/// as a double, ParameterField::whole_number), made an integer field over the whole numbers of its range: its
+/// JSON Schema then says "integer", as a count's does. Its number accessors stay and are read through
+/// SchemaField::integer_value.
 inline void make_whole_number_kind(SchemaField& field) {
   field.kind = FieldKind::integer;
   field.integer_low = static_cast<std::int64_t>(std::ceil(field.range.low));
   field.integer_high = static_cast<std::int64_t>(std::floor(field.range.high));
   field.range = {};
-  field.get_number = nullptr;
-  field.set_number = nullptr;
-}
-
-template <auto Member>
-[[nodiscard]] SchemaField whole_number_field(SchemaField field) {
-  make_whole_number_kind(field);
-  field.get_integer = [](const void* o) -> std::int64_t {
-    return std::llround(schema_detail::cref<Member>(o));
-  };
-  field.set_integer = [](void* o, std::int64_t v) { schema_detail::ref<Member>(o) = static_cast<double>(v); };
-  return field;
 }
 
 /// A std::uint64_t member taking every value (a seed).
@@ -580,6 +574,7 @@ template <typename S>
     f.set_number = [](const SchemaField& self, void* o, std::size_t, double v) {
       static_cast<S*>(o)->*(ParameterTable<S>::fields()[self.table_slot].member) = v;
     };
+    if (entries[i].whole_number) make_whole_number_kind(f);
     out.push_back(f);
   }
   return out;
