@@ -100,6 +100,26 @@ TEST_CASE("A z column sets pen contact by the threshold", "[pen_trace_csv]") {
   CHECK_FALSE(parse_pen_trace_csv(text, "inline", test_placement(), strict)[0].pen_down);
 }
 
+TEST_CASE("A pen column takes the number 1 or 0 however another program spells it", "[pen_trace_csv]") {
+  // numpy.savetxt writes 1.000000000000000000e+00, pandas a float column's 1.0: the numbers 1 and 0.
+  const auto samples = parse_pen_trace_csv(
+      "t,x,y,pen\n0,0,0,1.0\n0.001,0,0,0.0\n0.002,0,0,1.000000000000000000e+00\n0.003,0,0,0e0\n0.004,0,0,-"
+      "0\n",
+      "spellings.csv", test_placement());
+  REQUIRE(samples.size() == 5);
+  CHECK(samples[0].pen_down);
+  CHECK_FALSE(samples[1].pen_down);
+  CHECK(samples[2].pen_down);
+  CHECK_FALSE(samples[3].pen_down);
+  CHECK_FALSE(samples[4].pen_down);
+  for (const char* value : {"0.5", "1.0000001", "2e0", "nan", "inf", "true", "0x1", ""}) {
+    INFO(value);
+    CHECK_THROWS_WITH(
+        parse_pen_trace_csv(std::string("t,x,y,pen\n0,0,0,") + value + "\n", "odd.csv", test_placement()),
+        Catch::Contains("odd.csv:2") && Catch::Contains("pen must be 1 (down) or 0 (up)"));
+  }
+}
+
 TEST_CASE("Data units are converted with the placement", "[pen_trace_csv]") {
   PenTraceCsvOptions options;
   options.units = TraceUnits::data;

@@ -105,6 +105,12 @@ std::vector<PenSample> samples_from_columns(const py::object& columns, TraceUnit
   const bool pen_column = has_column(columns, "pen");
   const std::string z_key = column_key(columns, "z");
   if (!pen_column && z_key.empty()) throw InvalidArgument("trace: no column 'pen' or 'z' (or 'z_m')");
+  // As a CSV header with both is refused (pen_trace_csv.cpp): which of two contacts to believe is not
+  // guessed.
+  if (pen_column && !z_key.empty()) {
+    throw InvalidArgument("trace: both a 'pen' and a '" + z_key +
+                          "' column; give one, so that pen contact is unambiguous");
+  }
   const Column t = column(columns, keys[0].c_str()), x = column(columns, keys[1].c_str()),
                y = column(columns, keys[2].c_str());
   const Column contact = column(columns, pen_column ? "pen" : z_key.c_str());

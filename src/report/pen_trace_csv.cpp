@@ -285,9 +285,12 @@ class Reader {
       fail(far, fields[far], "too far from the character to convert to its data units");
     }
     if (c.pen) {
+      // The number 1 or 0 however a program spells it: numpy.savetxt writes 1.000000000000000000e+00 and
+      // pandas a float column's 1.0, which Python's score takes from the same columns.
       const std::string_view pen = fields[*c.pen];
-      if (pen != "0" && pen != "1") fail(*c.pen, pen, "pen must be 1 (down) or 0 (up)");
-      s.pen_down = pen == "1";
+      const std::optional<double> value = pen == "1" ? 1.0 : pen == "0" ? 0.0 : parse_finite_double(pen);
+      if (!value || (*value != 0.0 && *value != 1.0)) fail(*c.pen, pen, "pen must be 1 (down) or 0 (up)");
+      s.pen_down = *value == 1.0;
     } else {
       s.pen_down = number(fields, *c.z) - options_.paper_z_m <= options_.contact_threshold_m;
     }
