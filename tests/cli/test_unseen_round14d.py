@@ -367,6 +367,57 @@ class Round14D(OneErrorLine, unittest.TestCase):
         else:
             self.assert_one_error(result, 1, "padded.csv.gz")
 
+    def test_numpy_savetxt_trace_scores_as_its_canonical_text(self):
+        # numpy.savetxt writes every column as `%.18e`: the pen as 1.000000000000000000e+00, the number 1.
+        import numpy
+        path = self.dir / "savetxt.csv"
+        numpy.savetxt(path, numpy.array(CANONICAL[SHI][0], dtype=float), delimiter=",", header="t,x,y,pen",
+                      comments="")
+        self.assertSameSpatial(self.score_file(path, SHI), SHI)
+
+    def test_pandas_to_csv_of_a_float_pen_with_its_index_scores_alike(self):
+        # A frame whose pen column became float (1.0, 0.0), written with its unnamed index column first.
+        if pandas is None:
+            self.skipTest("pandas is not installed")
+        frame = pandas.DataFrame(CANONICAL[REN][0], columns=["t", "x", "y", "pen"]).astype(float)
+        path = self.dir / "frame.csv"
+        frame.to_csv(path)
+        self.assertSameSpatial(self.score_file(path, REN), REN)
+        if calligraphy is not None:  # the frame as columns and as its CSV: one score
+            self.assertEqual(spatial(calligraphy.score(frame, REN)), spatial(calligraphy.score(str(path), REN)))
+
+    def test_pen_spelt_otherwise_than_zero_or_one_is_still_refused(self):
+        for value in ("0.5", "1.0000001", "2e0", "nan", "0x1", "1.", "+1"):
+            with self.subTest(value=value):
+                text = csv_text(CANONICAL[SHI][0][:3], pen=lambda p, v=value: v)
+                path = self.write("odd-pen.csv", text)
+                if value in ("1.", "+1"):  # a number 1 however spelt: read as 1, or refused as any other
+                    result = run(["score", path, "--character", SHI], self.dir)
+                    if result.returncode == 0:
+                        continue
+                    self.assert_one_error(result, 1, "odd-pen.csv:2", "pen")
+                else:
+                    self.assert_one_error(run(["score", path, "--character", SHI], self.dir), 1,
+                                          "odd-pen.csv:2", "pen")
+
+    def test_height_below_the_paper_and_unit_named_columns_are_pen_down(self):
+        # A haptic logger's z: the pen pressed 2 mm into the paper (negative), lifted 1 cm; columns named as
+        # Python's frames name them (t_s, x_m, y_m, z_m).
+        lines = ["t_s,x_m,y_m,z_m"]
+        lines += [f"{t!r},{x!r},{y!r},{-0.002 if p else 0.01}" for t, x, y, p in CANONICAL[SHI][0]]
+        score = self.score_file(self.write("pressed.csv", "\n".join(lines) + "\n"), SHI)
+        self.assertSameSpatial(score, SHI)
+
+    def test_cut_second_gzip_member_is_refused_naming_the_file(self):
+        # A logger killed while appending its second chunk: the file ends inside a member.
+        text = csv_text(CANONICAL[SHI][0]).encode()
+        cut = text.index(b"\n", len(text) // 2) + 1
+        second = gzip.compress(text[cut:])
+        path = self.write("killed.csv.gz", gzip.compress(text[:cut]) + second[:len(second) // 2])
+        self.assert_one_error(run(["score", path, "--character", SHI, "--json", self.dir / "k.json"],
+                                  self.dir), 1, "killed.csv.gz")
+        self.assertFalse((self.dir / "k.json").exists())
+
     def test_pen_never_down_scores_nothing_written(self):
         rows = [(t, x, y, 0) for t, x, y, _ in CANONICAL[SHI][0]]
         score = self.score_file(self.write("hover.csv", csv_text(rows)), SHI)
@@ -427,6 +478,18 @@ class PythonTraces(unittest.TestCase):
             calligraphy.score({"t": c["t"], "x": c["x"], "y": c["y"], "pen": c["p"]}, SHI)
         self.assertIn("t", str(caught.exception))
         self.assertIn("50", str(caught.exception))
+
+    def test_pen_and_z_columns_together_are_refused_as_the_csv_header_is(self):
+        # A logger's frame with both a pen flag and a height that disagree (z 1 cm up where pen says down):
+        # `calligraphy score` refuses such a CSV's header; the same columns must not be scored by either.
+        c = self.columns
+        z = self.np.full(len(c["t"]), 0.01)
+        for key in ("z", "z_m"):
+            with self.subTest(key=key):
+                with self.assertRaises(calligraphy.InvalidArgument) as caught:
+                    calligraphy.score({"t": c["t"], "x": c["x"], "y": c["y"], "pen": c["p"], key: z}, SHI)
+                self.assertIn("pen", str(caught.exception))
+                self.assertIn(key, str(caught.exception))
 
     def test_unit_suffixed_millimetre_columns_are_refused_not_read_as_metres(self):
         c = self.columns
@@ -602,6 +665,31 @@ class CharacterData(OneErrorLine, unittest.TestCase):
         self.assertEqual(result.returncode, 0, result.stderr)
         self.assertEqual(json.loads(result.stdout)["strokes_accepted"], 0)
 
+    def test_character_file_with_a_byte_order_mark_or_in_utf16(self):
+        # Saved by a Windows editor: UTF-8 with a byte-order mark (read alike, as the docs say of the JSON files a
+        # person edits, or refused naming the file) and UTF-16 (refused naming the file).
+        text = json.dumps(hanzi_writer_document(REN), ensure_ascii=False)
+        reference = self.model_json(REN, "--data", SAMPLE)
+        folder = self.folder("bom", {f"{REN}.json": "\ufeff" + text})
+        result = run(["model", REN, "--json", "--data", folder], self.dir)
+        if result.returncode == 0:
+            self.assertEqual(self.strip_source(json.loads(result.stdout)), self.strip_source(reference))
+        else:
+            self.assert_one_error(result, 1, f"{REN}.json")
+        folder = self.folder("utf16", {f"{REN}.json": text.encode("utf-16")})
+        self.assert_one_error(run(["model", REN, "--data", folder], self.dir), 1, f"{REN}.json")
+
+    def test_trial_of_an_extension_b_character_keeps_it_in_its_record(self):
+        folder = self.folder("extb-trial", {f"{EXT_B}.json": hanzi_writer_document(SHI)})
+        record = self.dir / "r.json"
+        result = run(["trial", EXT_B, "--data", folder, "--writer", "simulated", "--max-duration", "30",
+                      "--json", record], self.dir)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        document = json.loads(record.read_text(encoding="utf-8"))
+        self.assertEqual(document["specification"]["trial"]["characters"], EXT_B)
+        check = run(["trial", "--spec", record, "--check", "--data", folder], self.dir)
+        self.assertEqual(check.returncode, 0, check.stderr)
+
     @unittest.skipIf(calligraphy is None, "the Python module is not on PYTHONPATH")
     def test_python_library_of_other_sets(self):
         folder = self.folder("py", {f"{EXT_B}.json": hanzi_writer_document(SHI),
@@ -615,6 +703,8 @@ class CharacterData(OneErrorLine, unittest.TestCase):
         self.assertIn(EXT_B, character.source)
         with self.assertRaises(calligraphy.CharacterNotFound):
             lib.load(SHI)
+        trace = {k: [r[i] for r in hand_trace(SHI)] for i, k in enumerate(("t", "x", "y", "pen"))}
+        self.assertEqual(spatial(calligraphy.score(trace, EXT_B, library=lib)), spatial(calligraphy.score(trace, SHI)))
 
 
 if __name__ == "__main__":
