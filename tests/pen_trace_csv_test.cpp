@@ -120,6 +120,15 @@ TEST_CASE("A pen column takes the number 1 or 0 however another program spells i
   }
 }
 
+TEST_CASE("UTF-16 text and lines ending in CR alone are refused saying so", "[pen_trace_csv]") {
+  CHECK_THROWS_WITH(parse_pen_trace_csv(std::string("\xFF\xFEt\0,\0x\0", 8), "excel.txt", test_placement()),
+                    Catch::Contains("excel.txt:1") && Catch::Contains("UTF-16"));
+  CHECK_THROWS_WITH(parse_pen_trace_csv("t,x,y,pen\r0,0,0,1\r0.001,0,0,1\r", "mac.csv", test_placement()),
+                    Catch::Contains("mac.csv:1") && Catch::Contains("CR alone"));
+  // A UTF-8 byte-order mark and CR LF are still read.
+  CHECK(parse_pen_trace_csv("\xEF\xBB\xBFt,x,y,pen\r\n0,0,0,1\r\n", "bom.csv", test_placement()).size() == 1);
+}
+
 TEST_CASE("Data units are converted with the placement", "[pen_trace_csv]") {
   PenTraceCsvOptions options;
   options.units = TraceUnits::data;

@@ -83,6 +83,14 @@ class Reader {
     const std::size_t count = split_fields(line, columns_ ? columns_->used : fields_.max_size(), fields_);
     const std::vector<std::string_view>& fields = fields_;
     if (!columns_) {
+      // Text of other programs that would be refused for a column it seems to lack or to name twice: Excel's
+      // "Unicode text" (UTF-16) and lines ending in CR alone (classic Mac OS's "CSV (Macintosh)").
+      if (line_number_ == 1 && (line.starts_with("\xFF\xFE") || line.starts_with("\xFE\xFF")))
+        fail("UTF-16 text (its byte-order mark): a trace is UTF-8 text, save it as UTF-8 CSV");
+      if (line.find('\r') != std::string_view::npos)
+        fail(
+            "a carriage return within the header line: lines ending in CR alone are not read (end them in LF "
+            "or CR LF)");
       header_.assign(fields.begin(), fields.end());
       columns_ = header(fields);
       return;

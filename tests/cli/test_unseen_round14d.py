@@ -301,6 +301,16 @@ class Round14D(OneErrorLine, unittest.TestCase):
         else:
             self.assert_one_error(result, 1, "tabs.tsv")
 
+    def test_excel_unicode_text_is_refused_saying_utf16(self):
+        # Excel's "Unicode Text (*.txt)": UTF-16 with its byte-order mark, tab-separated.
+        path = self.write("unicode.txt", csv_text(CANONICAL[SHI][0], sep="\t").encode("utf-16"))
+        self.assert_one_error(run(["score", path, "--character", SHI], self.dir), 1, "unicode.txt:1", "UTF-16")
+
+    def test_lines_ending_in_cr_alone_are_refused_saying_so(self):
+        # Classic Mac OS's "CSV (Macintosh)": every line ends in CR alone, so the file is one line of text.
+        path = self.write("mac.csv", csv_text(CANONICAL[SHI][0], newline="\r"))
+        self.assert_one_error(run(["score", path, "--character", SHI], self.dir), 1, "mac.csv:1", "CR alone")
+
     def test_spreadsheet_encodings_together_change_nothing(self):
         # Excel's "CSV UTF-8": a byte-order mark, CR LF, columns reordered, a comment, blank and trailing lines.
         rows = CANONICAL[REN][0]
