@@ -303,6 +303,20 @@ class Round14D(OneErrorLine, unittest.TestCase):
         path = self.write("mac.csv", csv_text(CANONICAL[SHI][0], newline="\r"))
         self.assert_one_error(run(["score", path, "--character", SHI], self.dir), 1, "mac.csv:1", "CR alone")
 
+    def test_iso_8601_time_stamps_are_refused_naming_line_and_column(self):
+        # A logger writing dates, not seconds: refused at its first row, never read as a number of something.
+        lines = ["t,x,y,pen"] + [f"2026-11-27T20:00:{i / 200:06.3f}Z,{x!r},{y!r},{p}"
+                                 for i, (_, x, y, p) in enumerate(CANONICAL[SHI][0][:5])]
+        path = self.write("iso.csv", "\n".join(lines) + "\n")
+        line = self.assert_one_error(run(["score", path, "--character", SHI], self.dir), 1, "iso.csv:2",
+                                     "column 1 (t)")
+        self.assertIn("2026-11-27T20:00:00.000Z", line)
+
+    def test_a_space_after_each_comma_changes_nothing(self):
+        # `t, x, y, pen` and `0.005, -0.02, ...`, as many loggers and hand-written files space their fields.
+        self.assertSameSpatial(self.score_file(self.write("spaced.csv", csv_text(CANONICAL[SHI][0], sep=", ")),
+                                               SHI), SHI)
+
     def test_spreadsheet_encodings_together_change_nothing(self):
         # Excel's "CSV UTF-8": a byte-order mark, CR LF, columns reordered, a comment, blank and trailing lines.
         rows = CANONICAL[REN][0]
@@ -557,6 +571,21 @@ class CharacterData(OneErrorLine, unittest.TestCase):
         self.assert_one_error(run(["corpus", "build", "--data", folder, "--out", out, "--threads", "1"],
                                   self.dir), 1, "mmah")
         self.assertFalse(out.exists())
+
+    def test_graphics_txt_given_as_the_data_folder_is_refused_naming_it(self):
+        # Make Me a Hanzi's one file given where a folder is taken: `model`, `corpus build` and Python alike.
+        document = hanzi_writer_document(SHI)
+        graphics = self.dir / "graphics.txt"
+        graphics.write_text(json.dumps({"character": SHI, **document}, ensure_ascii=False) + "\n", encoding="utf-8")
+        self.assert_one_error(run(["model", SHI, "--data", graphics], self.dir), 1, "graphics.txt", "folder")
+        out = self.dir / "g.clg"
+        self.assert_one_error(run(["corpus", "build", "--data", graphics, "--out", out], self.dir), 1,
+                              "graphics.txt", "folder")
+        self.assertFalse(out.exists())
+        if calligraphy is not None:
+            with self.assertRaises(calligraphy.DataError) as caught:
+                calligraphy.CharacterLibrary.from_hanzi_writer(graphics)
+            self.assertIn("graphics.txt", str(caught.exception))
 
     def test_graphics_txt_named_as_a_character_is_refused_naming_the_file(self):
         lines = [json.dumps({"character": c, "strokes": hanzi_writer_document(c)["strokes"],
