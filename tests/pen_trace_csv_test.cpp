@@ -542,10 +542,10 @@ TEST_CASE("A trace's bytes read whole give the rows its file gives, in each of i
   const TemporaryFile hdf5(trial_trace_hdf5(trace), "trace.trace.h5");
   const TemporaryFile gzip("", "trace.csv.gz");
   write_gzip(gzip.path, csv);
-  // Two gzip members one after the other (as `cat a.gz b.gz` makes): one text, as zlib's file reader reads
-  // it.
+  // Two gzip members one after the other (as `cat a.gz b.gz` makes): one text, as gunzip reads it.
   const TemporaryFile members("", "members.csv.gz");
   write_gzip(members.path, csv.substr(0, csv.size() / 2));
+  const std::size_t second_member = file_bytes(members.path).size();  // where the second member starts
   {
     const TemporaryFile second("", "second.gz");
     write_gzip(second.path, csv.substr(csv.size() / 2));
@@ -577,6 +577,23 @@ TEST_CASE("A trace's bytes read whole give the rows its file gives, in each of i
                     Catch::Contains("the trace") && Catch::Contains("gzip"));
   const std::string h5 = file_bytes(hdf5.path);
   CHECK_THROWS_WITH(rows_of_bytes(h5.substr(0, h5.size() - 100), options), Catch::Contains("the trace"));
+  // Bytes after the last member that start no other (a chunk whose header is damaged, plain text appended,
+  // padding) would be left out without a word: refused from a file and from bytes alike, naming where.
+  const std::string two = file_bytes(members.path);
+  REQUIRE(two.substr(second_member, 2) == "\x1f\x8b");
+  std::string flipped = two;
+  flipped[second_member] = '\x1e';
+  for (const std::string& damaged :
+       {flipped, compressed + "0.5,0,0,1\n", compressed + std::string(512, '\0'), compressed + "\x1f"}) {
+    const std::size_t at = damaged == flipped ? second_member : compressed.size();
+    const std::string where = "at byte " + std::to_string(at) + ", after its last member";
+    CHECK_THROWS_WITH(rows_of_bytes(damaged, options),
+                      Catch::Contains("the trace") && Catch::Contains(where));
+    const TemporaryFile file(damaged, "damaged.csv.gz");
+    CHECK_THROWS_WITH(rows_of_file(file.path, options),
+                      Catch::Contains("damaged.csv.gz") && Catch::Contains(where) &&
+                          Catch::Contains(std::to_string(damaged.size() - at) + " bytes"));
+  }
   PenTraceCsvOptions small = options;
   small.max_file_bytes = compressed.size() + 1;  // the gzip file is under it, its text is not
   REQUIRE(csv.size() > small.max_file_bytes);

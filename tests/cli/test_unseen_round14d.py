@@ -367,16 +367,29 @@ class Round14D(OneErrorLine, unittest.TestCase):
         self.assertEqual(score["samples"], len(CANONICAL[SHI][0]))
         self.assertSameSpatial(score, SHI)
 
-    def test_gzip_with_trailing_garbage_is_refused_naming_the_file(self):
-        # A gzip stream followed by bytes that are no gzip member (a logger's padding): gunzip warns "trailing
-        # garbage ignored"; the trace must not be scored as if whole without a word, nor the bytes read as CSV.
+    def test_bytes_after_the_gzip_data_are_refused_naming_where(self):
+        # After the last member, bytes that start no other: a logger's zero padding, plain rows appended with
+        # `>>`, a second chunk whose first byte was damaged. gunzip says "trailing garbage ignored"; a score
+        # that left them out would be a silent score of part of the trace, so each is refused (exit 1, nothing
+        # written), naming the file and the byte where they start.
         text = csv_text(CANONICAL[SHI][0]).encode()
-        path = self.write("padded.csv.gz", gzip.compress(text) + b"\0" * 512)
-        result = run(["score", path, "--character", SHI, "--json", "-"], self.dir)
-        if result.returncode == 0:
-            self.assertSameSpatial(json.loads(result.stdout), SHI)
-        else:
-            self.assert_one_error(result, 1, "padded.csv.gz")
+        cut = text.index(b"\n", len(text) // 2) + 1
+        first, second = gzip.compress(text[:cut]), bytearray(gzip.compress(text[cut:]))
+        second[0] ^= 0x01
+        whole = gzip.compress(text)
+        for name, data, at in (("padded.csv.gz", whole + b"\0" * 512, len(whole)),
+                               ("appended.csv.gz", whole + text[cut:], len(whole)),
+                               ("damaged.csv.gz", first + bytes(second), len(first))):
+            with self.subTest(name=name):
+                path = self.write(name, data)
+                out = self.dir / "out.json"
+                self.assert_one_error(run(["score", path, "--character", SHI, "--json", out], self.dir), 1,
+                                      name, f"at byte {at}")
+                self.assertFalse(out.exists())
+        if calligraphy is not None:
+            with self.assertRaises(calligraphy.DataError) as caught:
+                calligraphy.score(str(self.dir / "damaged.csv.gz"), SHI)
+            self.assertIn(f"at byte {len(first)}", str(caught.exception))
 
     def test_numpy_savetxt_trace_scores_as_its_canonical_text(self):
         # numpy.savetxt writes every column as `%.18e`: the pen as 1.000000000000000000e+00, the number 1.
