@@ -100,6 +100,35 @@ TEST_CASE("A z column sets pen contact by the threshold", "[pen_trace_csv]") {
   CHECK_FALSE(parse_pen_trace_csv(text, "inline", test_placement(), strict)[0].pen_down);
 }
 
+TEST_CASE("A pen column takes the number 1 or 0 however another program spells it", "[pen_trace_csv]") {
+  // numpy.savetxt writes 1.000000000000000000e+00, pandas a float column's 1.0: the numbers 1 and 0.
+  const auto samples = parse_pen_trace_csv(
+      "t,x,y,pen\n0,0,0,1.0\n0.001,0,0,0.0\n0.002,0,0,1.000000000000000000e+00\n0.003,0,0,0e0\n0.004,0,0,-"
+      "0\n",
+      "spellings.csv", test_placement());
+  REQUIRE(samples.size() == 5);
+  CHECK(samples[0].pen_down);
+  CHECK_FALSE(samples[1].pen_down);
+  CHECK(samples[2].pen_down);
+  CHECK_FALSE(samples[3].pen_down);
+  CHECK_FALSE(samples[4].pen_down);
+  for (const char* value : {"0.5", "1.0000001", "2e0", "nan", "inf", "true", "0x1", ""}) {
+    INFO(value);
+    CHECK_THROWS_WITH(
+        parse_pen_trace_csv(std::string("t,x,y,pen\n0,0,0,") + value + "\n", "odd.csv", test_placement()),
+        Catch::Contains("odd.csv:2") && Catch::Contains("pen must be 1 (down) or 0 (up)"));
+  }
+}
+
+TEST_CASE("UTF-16 text and lines ending in CR alone are refused saying so", "[pen_trace_csv]") {
+  CHECK_THROWS_WITH(parse_pen_trace_csv(std::string("\xFF\xFEt\0,\0x\0", 8), "excel.txt", test_placement()),
+                    Catch::Contains("excel.txt:1") && Catch::Contains("UTF-16"));
+  CHECK_THROWS_WITH(parse_pen_trace_csv("t,x,y,pen\r0,0,0,1\r0.001,0,0,1\r", "mac.csv", test_placement()),
+                    Catch::Contains("mac.csv:1") && Catch::Contains("CR alone"));
+  // A UTF-8 byte-order mark and CR LF are still read.
+  CHECK(parse_pen_trace_csv("\xEF\xBB\xBFt,x,y,pen\r\n0,0,0,1\r\n", "bom.csv", test_placement()).size() == 1);
+}
+
 TEST_CASE("Data units are converted with the placement", "[pen_trace_csv]") {
   PenTraceCsvOptions options;
   options.units = TraceUnits::data;
@@ -513,10 +542,10 @@ TEST_CASE("A trace's bytes read whole give the rows its file gives, in each of i
   const TemporaryFile hdf5(trial_trace_hdf5(trace), "trace.trace.h5");
   const TemporaryFile gzip("", "trace.csv.gz");
   write_gzip(gzip.path, csv);
-  // Two gzip members one after the other (as `cat a.gz b.gz` makes): one text, as zlib's file reader reads
-  // it.
+  // Two gzip members one after the other (as `cat a.gz b.gz` makes): one text, as gunzip reads it.
   const TemporaryFile members("", "members.csv.gz");
   write_gzip(members.path, csv.substr(0, csv.size() / 2));
+  const std::size_t second_member = file_bytes(members.path).size();  // where the second member starts
   {
     const TemporaryFile second("", "second.gz");
     write_gzip(second.path, csv.substr(csv.size() / 2));
@@ -548,6 +577,23 @@ TEST_CASE("A trace's bytes read whole give the rows its file gives, in each of i
                     Catch::Contains("the trace") && Catch::Contains("gzip"));
   const std::string h5 = file_bytes(hdf5.path);
   CHECK_THROWS_WITH(rows_of_bytes(h5.substr(0, h5.size() - 100), options), Catch::Contains("the trace"));
+  // Bytes after the last member that start no other (a chunk whose header is damaged, plain text appended,
+  // padding) would be left out without a word: refused from a file and from bytes alike, naming where.
+  const std::string two = file_bytes(members.path);
+  REQUIRE(two.substr(second_member, 2) == "\x1f\x8b");
+  std::string flipped = two;
+  flipped[second_member] = '\x1e';
+  for (const std::string& damaged :
+       {flipped, compressed + "0.5,0,0,1\n", compressed + std::string(512, '\0'), compressed + "\x1f"}) {
+    const std::size_t at = damaged == flipped ? second_member : compressed.size();
+    const std::string where = "at byte " + std::to_string(at) + ", after its last member";
+    CHECK_THROWS_WITH(rows_of_bytes(damaged, options),
+                      Catch::Contains("the trace") && Catch::Contains(where));
+    const TemporaryFile file(damaged, "damaged.csv.gz");
+    CHECK_THROWS_WITH(rows_of_file(file.path, options),
+                      Catch::Contains("damaged.csv.gz") && Catch::Contains(where) &&
+                          Catch::Contains(std::to_string(damaged.size() - at) + " bytes"));
+  }
   PenTraceCsvOptions small = options;
   small.max_file_bytes = compressed.size() + 1;  // the gzip file is under it, its text is not
   REQUIRE(csv.size() > small.max_file_bytes);

@@ -105,6 +105,12 @@ std::vector<PenSample> samples_from_columns(const py::object& columns, TraceUnit
   const bool pen_column = has_column(columns, "pen");
   const std::string z_key = column_key(columns, "z");
   if (!pen_column && z_key.empty()) throw InvalidArgument("trace: no column 'pen' or 'z' (or 'z_m')");
+  // As a CSV header with both is refused (pen_trace_csv.cpp): which of two contacts to believe is not
+  // guessed.
+  if (pen_column && !z_key.empty()) {
+    throw InvalidArgument("trace: both a 'pen' and a '" + z_key +
+                          "' column; give one, so that pen contact is unambiguous");
+  }
   const Column t = column(columns, keys[0].c_str()), x = column(columns, keys[1].c_str()),
                y = column(columns, keys[2].c_str());
   const Column contact = column(columns, pen_column ? "pen" : z_key.c_str());
@@ -223,7 +229,7 @@ direction errors are found, and each segment gets the verdict the renderer would
 
 trace: the path of a CSV file (header t, x, y and pen or z; other columns ignored: `trial --csv` output
        reads as it is), or a mapping of columns (a dict of 1-D arrays, a pandas DataFrame) with `t` [s],
-       `x`, `y` and `pen` (1 on paper, 0 lifted) or `z` [m] (on paper when z <= contact_threshold_m).
+       `x`, `y` and `pen` (1 on paper, 0 lifted) or `z` [m] (on paper when z <= contact_threshold_m), not both.
 character: a str of one character (loaded from `library`, default the embedded set) or a Character,
            laid out as `simulate_trial` places it; or a Scene (a row of characters, or a trial's
            `TrialResult.scene`), scored as it is laid out: its placement, its start radius (not

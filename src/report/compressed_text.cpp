@@ -3,7 +3,11 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <climits>
+#include <cstdio>
+#include <cstring>
+#include <vector>
 
 #include "calligraphy/core/errors.hpp"
 #include "core/whole_file.hpp"
@@ -11,9 +15,54 @@
 namespace calligraphy {
 namespace {
 
-gzFile handle(void* file) { return static_cast<gzFile>(file); }
+bool starts_gzip(const unsigned char* bytes, std::size_t size) {
+  return size >= 2 && bytes[0] == 0x1f && bytes[1] == 0x8b;
+}
+
+// Bytes after the last member that start no other member: gunzip's "trailing garbage", refused.
+DataError bytes_after_gzip(const std::string& source, std::uintmax_t offset, std::uintmax_t count) {
+  return DataError(source + ": cannot be read (gzip: " + std::to_string(count) + " bytes at byte " +
+                   std::to_string(offset) + ", after its last member, start no gzip member)");
+}
 
 }  // namespace
+
+struct TextFileReader::State {
+  std::FILE* file = nullptr;
+  bool gzip = false;
+  bool done = false;  // a gzip file's last member has ended at the end of the file
+  z_stream stream{};
+  bool inflating = false;            // `stream` initialised
+  std::vector<unsigned char> input;  // read from the file; [used, filled) not yet taken
+  std::size_t used = 0, filled = 0;
+  std::uintmax_t read_from_file = 0;  // bytes in all
+  bool end_of_file = false;
+
+  State() = default;
+  State(const State&) = delete;
+  State& operator=(const State&) = delete;
+  ~State() {
+    if (inflating) inflateEnd(&stream);
+    if (file != nullptr) std::fclose(file);
+  }
+
+  // At least `want` bytes not yet taken, unless the file ends first.
+  void refill(const std::string& name, std::size_t want) {
+    if (filled - used >= want || end_of_file) return;
+    std::memmove(input.data(), input.data() + used, filled - used);
+    filled -= used;
+    used = 0;
+    while (filled < want && !end_of_file) {
+      const std::size_t got = std::fread(input.data() + filled, 1, input.size() - filled, file);
+      filled += got;
+      read_from_file += got;
+      if (got == 0) {
+        if (std::ferror(file) != 0) throw DataError(name + ": cannot be read (" + std::strerror(errno) + ")");
+        end_of_file = true;
+      }
+    }
+  }
+};
 
 std::string gzip_text(std::string_view text) {
   z_stream stream{};
@@ -47,6 +96,7 @@ std::string gunzip_text(std::string_view bytes, const std::string& source, std::
   }
   std::string text;
   constexpr std::size_t kBlockBytes = std::size_t{1} << 18;
+  const std::size_t size = bytes.size();
   while (is_gzip(bytes)) {  // one gzip member a turn
     z_stream stream{};
     if (inflateInit2(&stream, 15 + 16) != Z_OK)
@@ -81,41 +131,78 @@ std::string gunzip_text(std::string_view bytes, const std::string& source, std::
     bytes.remove_prefix(bytes.size() - stream.avail_in);
     inflateEnd(&stream);
   }
+  if (!bytes.empty()) throw bytes_after_gzip(source, size - bytes.size(), bytes.size());
   return text;
 }
 
 TextFileReader::TextFileReader(const std::filesystem::path& file, std::uintmax_t max_file_bytes,
                                std::uintmax_t max_text_bytes)
-    : name_(file.string()), max_text_bytes_(max_text_bytes) {
+    : name_(file.string()), state_(std::make_unique<State>()), max_text_bytes_(max_text_bytes) {
   file_bytes_ = regular_file_size(file, max_file_bytes);
-  file_ = gzopen(name_.c_str(), "rb");  // reads a file that is not gzip as it is (zlib.h, gzopen)
-  if (file_ == nullptr) throw DataError(name_ + ": cannot be opened");
-  gzbuffer(handle(file_), 256 * 1024);
+  State& s = *state_;
+  s.file = std::fopen(name_.c_str(), "rb");
+  if (s.file == nullptr) throw DataError(name_ + ": cannot be opened");
+  s.input.resize(256 * 1024);
+  s.refill(name_, 2);
+  s.gzip = starts_gzip(s.input.data(), s.filled);
+  if (s.gzip) {
+    // 15 window bits + 16: a gzip member (zlib.h, inflateInit2); inflateReset for each further one.
+    if (inflateInit2(&s.stream, 15 + 16) != Z_OK)
+      throw DataError(name_ + ": cannot be read (gzip: out of memory)");
+    s.inflating = true;
+  }
 }
 
-TextFileReader::~TextFileReader() {
-  if (file_ != nullptr) gzclose_r(handle(file_));
-}
+TextFileReader::~TextFileReader() = default;
 
 std::size_t TextFileReader::read(char* out, std::size_t size) {
-  const int got = gzread(handle(file_), out, static_cast<unsigned>(std::min<std::size_t>(size, INT_MAX)));
-  int error = Z_OK;
-  const char* message = gzerror(handle(file_), &error);
-  // A gzip stream cut short reads to its end, then reports Z_BUF_ERROR ("unexpected end of file").
-  if (got < 0 || (error != Z_OK && error != Z_STREAM_END)) {
-    throw DataError(name_ + ": cannot be read (" + (gzdirect(handle(file_)) ? "" : "gzip: ") + message + ")");
+  State& s = *state_;
+  size = std::min<std::size_t>(size, UINT_MAX);
+  std::size_t got = 0;
+  if (!s.gzip) {
+    s.refill(name_, 1);
+    got = std::min(size, s.filled - s.used);
+    std::memcpy(out, s.input.data() + s.used, got);
+    s.used += got;
+  }
+  while (s.gzip && got == 0 && !s.done && size > 0) {
+    s.refill(name_, 1);
+    s.stream.next_in = s.input.data() + s.used;
+    s.stream.avail_in = static_cast<uInt>(s.filled - s.used);
+    s.stream.next_out = reinterpret_cast<Bytef*>(out);
+    s.stream.avail_out = static_cast<uInt>(size);
+    const int result = inflate(&s.stream, Z_NO_FLUSH);
+    s.used = s.filled - s.stream.avail_in;
+    got = size - s.stream.avail_out;
+    if (result == Z_STREAM_END) {
+      // A member ended: another may follow (RFC 1952, 2.2: `cat a.gz b.gz`), or the file ends here.
+      s.refill(name_, 2);
+      const std::size_t left = s.filled - s.used;
+      if (left == 0) {
+        s.done = true;
+      } else if (starts_gzip(s.input.data() + s.used, left)) {
+        inflateReset(&s.stream);
+      } else {
+        const std::uintmax_t offset = s.read_from_file - left;
+        throw bytes_after_gzip(name_, offset, file_bytes_ > offset ? file_bytes_ - offset : left);
+      }
+    } else if (result == Z_BUF_ERROR) {  // no progress: the file ended inside a member
+      throw DataError(name_ + ": cannot be read (gzip: unexpected end of file)");
+    } else if (result != Z_OK) {
+      throw DataError(name_ + ": cannot be read (gzip: " +
+                      (s.stream.msg != nullptr ? s.stream.msg : "damaged stream") + ")");
+    }
   }
   text_bytes_ += static_cast<std::uintmax_t>(got);
   if (text_bytes_ > max_text_bytes_) {
     throw DataError(name_ + ": more than " + std::to_string(max_text_bytes_) +
                     " bytes of text, the limit (the rest is not read)");
   }
-  return static_cast<std::size_t>(got);
+  return got;
 }
 
 std::uintmax_t TextFileReader::file_offset() const {
-  const z_off_t offset = gzoffset(handle(file_));
-  return offset < 0 ? 0 : static_cast<std::uintmax_t>(offset);
+  return state_->read_from_file - (state_->filled - state_->used);
 }
 
 void for_each_line(TextFileReader& reader, const std::string& source, std::size_t max_line_bytes,

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <string>
 #include <string_view>
 
@@ -14,16 +15,18 @@ namespace calligraphy {
 /// Throws DataError when zlib fails (out of memory).
 [[nodiscard]] std::string gzip_text(std::string_view text);
 
-/// The text of gzip `bytes` (RFC 1952; members one after another are one text, as `gzread` reads them, and
-/// bytes after the last member that start no other are ignored, as it ignores them), or `bytes` as they are
-/// when they do not start as gzip (1f 8b). For a file already read whole: the same text as TextFileReader
+/// The text of gzip `bytes` (RFC 1952; members one after another are one text, as gunzip reads them), or
+/// `bytes` as they are when they do not start as gzip (1f 8b). Bytes after a member that start no other are
+/// refused (gunzip's "trailing garbage"): a damaged or plain-text chunk appended to a trace would otherwise
+/// be left out without a word. For a file already read whole: the same text as TextFileReader
 /// gives. Throws DataError naming `source` for a damaged or truncated stream, or text longer than
 /// `max_text_bytes` (refused as soon as the inflated text passes it).
 [[nodiscard]] std::string gunzip_text(std::string_view bytes, const std::string& source,
                                       std::uintmax_t max_text_bytes);
 
 /// A text file read a block at a time, decompressed on the way when it is gzip (by its first two bytes,
-/// 1f 8b), as it is otherwise. Memory holds one block, never the file.
+/// 1f 8b; every member, and nothing after the last one, as gunzip_text), as it is otherwise. Memory holds
+/// one block, never the file.
 class TextFileReader {
  public:
   /// Opens `file`. Throws DataError naming it when it does not exist, is not a regular file, is larger
@@ -35,8 +38,8 @@ class TextFileReader {
   TextFileReader& operator=(const TextFileReader&) = delete;
 
   /// Up to `size` bytes of text into `out`; 0 at the end of the text. Throws DataError naming the file for
-  /// a damaged or truncated gzip stream, a read error, or text longer than `max_text_bytes` (a small
-  /// file that decompresses to more is refused, not read).
+  /// a damaged or truncated gzip stream, bytes after its last member, a read error, or text longer than
+  /// `max_text_bytes` (a small file that decompresses to more is refused, not read).
   std::size_t read(char* out, std::size_t size);
 
   [[nodiscard]] std::uintmax_t file_bytes() const { return file_bytes_; }  ///< its size on disk
@@ -44,8 +47,9 @@ class TextFileReader {
   [[nodiscard]] std::uintmax_t file_offset() const;
 
  private:
+  struct State;  // the open file, its unread bytes and the inflater (compressed_text.cpp)
   std::string name_;
-  void* file_ = nullptr;  // gzFile
+  std::unique_ptr<State> state_;
   std::uintmax_t file_bytes_ = 0;
   std::uintmax_t max_text_bytes_ = 0;
   std::uintmax_t text_bytes_ = 0;

@@ -83,6 +83,14 @@ class Reader {
     const std::size_t count = split_fields(line, columns_ ? columns_->used : fields_.max_size(), fields_);
     const std::vector<std::string_view>& fields = fields_;
     if (!columns_) {
+      // Text of other programs that would be refused for a column it seems to lack or to name twice: Excel's
+      // "Unicode text" (UTF-16) and lines ending in CR alone (classic Mac OS's "CSV (Macintosh)").
+      if (line_number_ == 1 && (line.starts_with("\xFF\xFE") || line.starts_with("\xFE\xFF")))
+        fail("UTF-16 text (its byte-order mark): a trace is UTF-8 text, save it as UTF-8 CSV");
+      if (line.find('\r') != std::string_view::npos)
+        fail(
+            "a carriage return within the header line: lines ending in CR alone are not read (end them in LF "
+            "or CR LF)");
       header_.assign(fields.begin(), fields.end());
       columns_ = header(fields);
       return;
@@ -285,9 +293,12 @@ class Reader {
       fail(far, fields[far], "too far from the character to convert to its data units");
     }
     if (c.pen) {
+      // The number 1 or 0 however a program spells it: numpy.savetxt writes 1.000000000000000000e+00 and
+      // pandas a float column's 1.0, which Python's score takes from the same columns.
       const std::string_view pen = fields[*c.pen];
-      if (pen != "0" && pen != "1") fail(*c.pen, pen, "pen must be 1 (down) or 0 (up)");
-      s.pen_down = pen == "1";
+      const std::optional<double> value = pen == "1" ? 1.0 : pen == "0" ? 0.0 : parse_finite_double(pen);
+      if (!value || (*value != 0.0 && *value != 1.0)) fail(*c.pen, pen, "pen must be 1 (down) or 0 (up)");
+      s.pen_down = *value == 1.0;
     } else {
       s.pen_down = number(fields, *c.z) - options_.paper_z_m <= options_.contact_threshold_m;
     }
