@@ -140,7 +140,7 @@ void add_bench_acceptance_command(CLI::App& bench, Commands& commands) {
              "a number in (0, 60]", [](double v) { return v > 0.0 && v <= 60.0; });
   add_integer(*app, "--characters", command->characters, "N",
               "characters drawn at random (not the embedded ones)", 1, 100000);
-  add_unsigned(*app, "--seed", command->seed, "S", "seed of the draw and the paths");
+  add_unsigned(*app, "--seed", command->seed, "N", "seed of the draw and the paths");
 }
 
 }  // namespace calligraphy::cli
