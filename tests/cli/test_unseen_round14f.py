@@ -378,6 +378,13 @@ class UsageErrors(unittest.TestCase, OneErrorLine):
                 self.assert_one_error(result, 2, "unknown option", needle)
                 self.assertEqual(result.stdout, b"")
 
+    def test_a_value_that_is_an_option_and_a_flags_own_value(self):
+        result = run(["trial", "一", "--json", "--seed", "3"], cwd="/tmp")
+        self.assert_one_error(result, 2, "--json", "'--seed'")
+        result = run(["devices", "--json=true"], cwd="/")
+        self.assertEqual(result.returncode, 0, result.stderr)
+        self.assertIn("kinds", json.loads(result.stdout))
+
     def test_old_writer_values_say_what_to_write_instead(self):
         result = run(["trial", "一", "--writer", "novice"], cwd="/")
         self.assert_one_error(result, 2, "--writer novice", "--writer-profile novice")
@@ -505,6 +512,49 @@ class Summaries(unittest.TestCase, OneErrorLine):
         self.assertEqual(len(refusals), 1)
         self.assertEqual(refusals[-1]["refusal"], "wrong_place")
         self.assertAlmostEqual(float(match.group(1)), refusals[-1]["mean_deviation_m"] * 1000, delta=0.051)
+
+    def test_a_stroke_written_out_of_turn_names_the_stroke_due_from_1(self):
+        folder, _ = shared_trial("written")
+        # 十's two strokes from its trace, the second written first, a pen lift of 0.1 s after each.
+        lines = (Path(folder) / "written.csv").read_text().splitlines()
+        header = lines[0].split(",")
+        t, x, y, z = (header.index(name) for name in ("t", "x", "y", "z"))
+        segments, current = [], []
+        for line in lines[1:]:
+            cells = line.split(",")
+            if float(cells[z]) <= 0.0005:
+                current.append(cells)
+            elif current:
+                segments.append(current)
+                current = []
+        if current:
+            segments.append(current)
+        first, second = sorted(sorted(segments, key=len)[-2:], key=lambda segment: float(segment[0][t]))
+        rows = ["t,x,y,pen"]
+        for segment in (second, first):
+            rows += [f"{cells[x]},{cells[y]},1" for cells in segment]
+            rows += [f"{segment[-1][x]},{segment[-1][y]},0"] * 100
+        rows[1:] = [f"{tick / 1000:.3f},{row}" for tick, row in enumerate(rows[1:])]
+        (Path(folder) / "swapped.csv").write_text("\n".join(rows) + "\n")
+        result = run(["score", "swapped.csv", "--character", "十", "--json", "swapped.json"], cwd=folder)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        verdicts = [" ".join(row[8:]) for row in table_rows(result.stdout.decode())]
+        self.assertEqual(verdicts, ["accepted", "refused: wrong order (written while stroke 1 was due)"])
+        segments = json.loads((Path(folder) / "swapped.json").read_text())["per_character"][0]["segments"]
+        refused = [s["verdict"] for s in segments if s["verdict"] and not s["verdict"]["accepted"]]
+        self.assertEqual([(v["refusal"], v["expected_stroke"], v["matched_stroke"]) for v in refused],
+                         [("wrong_order", 0, 1)])
+
+    def test_check_prints_one_line_and_writes_nothing(self):
+        with tempfile.TemporaryDirectory() as folder:
+            result = run(["trial", "一", "--check", "--json", "t.json", "--csv", "t.csv"], cwd=folder)
+            self.assertEqual(result.returncode, 0, result.stderr)
+            self.assertEqual(len(result.stdout.decode().strip().splitlines()), 1, result.stdout)
+            self.assertEqual(result.stderr, b"")
+            self.assertEqual(os.listdir(folder), [])
+            result = run(["trial", "一", "--check", "--rate", "99"], cwd=folder)
+            self.assert_one_error(result, 2, "--rate", "99")
+            self.assertEqual(result.stdout, b"")
 
     def test_json_to_standard_output_carries_the_document_alone(self):
         result = run(["trial", "一", "--max-duration", "0.05", "--json", "-"], cwd="/")
