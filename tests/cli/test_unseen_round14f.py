@@ -196,6 +196,40 @@ class Help(unittest.TestCase):
                 self.assertEqual(table_options(sections[command]) - shown, set(),
                                  f"{command}: in docs/cli.md's table, not in --help")
 
+    def test_documented_ranges_are_the_helps(self):
+        # docs/cli.md's tables give each number's range ("0..1", ">= 0", "(0, 86400]"); the help gives it
+        # from the specification's schema. A bound one states and the other leaves out is a value one accepts
+        # and the other refuses.
+        def bounds(text):
+            text = text.replace("2^64-1", "18446744073709551615").replace("10^8", "100000000")
+            text = text.replace("10^6", "1000000")
+            match = re.search(r"[\[(](-?[\d.]+), (-?[\d.]+)[\])]", text) or \
+                re.search(r"(?<![\w.])(-?[\d.]+)\.\.(\d[\d.]*)", text)
+            if match:  # (low, high, whether the low bound is open)
+                return float(match.group(1)), float(match.group(2)), match.group(0).startswith("(")
+            match = re.search(r"(>=?) (-?[\d.]+)", text)
+            return (float(match.group(2)), None, match.group(1) == ">") if match else None
+
+        checked = 0
+        for command, section in docs_sections().items():
+            if command in COMMANDS:
+                checked += self.ranges_agree(command, section, bounds)
+        self.assertGreater(checked, 15)
+
+    def ranges_agree(self, command, section, bounds):
+        text = help_text(command)
+        checked = 0
+        for line in section.splitlines():
+            cells = [cell.strip() for cell in re.split(r"(?<!\\)\|", line.strip().strip("|"))]
+            names = re.findall(r"`(--[a-z0-9-]+)`", cells[0]) if line.startswith("| `--") else []
+            if len(names) != 1 or bounds(cells[1]) is None:
+                continue
+            shown = next(entry for entry in text.split("\n  --")[1:] if entry.startswith(names[0][2:] + " "))
+            with self.subTest(command=command, option=names[0], documented=cells[1]):
+                self.assertEqual(bounds(cells[1]), bounds(shown.split("(default:")[0]), shown)
+                checked += 1
+        return checked
+
     def test_each_option_states_its_default_once_and_dash_once(self):
         for command in COMMANDS:
             text = help_text(command)
