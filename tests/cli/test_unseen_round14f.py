@@ -659,6 +659,65 @@ class Outputs(unittest.TestCase, OneErrorLine):
         self.assertIn("\\x1b (U+001B)", text)
 
 
+PROTOCOL = {"name": "tiny", "conditions": [{"name": "fixture", "mode": "haptic"}],
+            "test": {"characters": ["一"], "conditions": ["fixture"], "repetitions": 2},
+            "trial": {"max_duration_s": 10}}
+SESSION_LINE = r"^(S\d+): (\d+) of (\d+) trials saved \((\d+) now, (\d+) attempts kept\) in (\S+), \d+\.\d s$"
+
+
+class Sessions(unittest.TestCase):
+    """`session run` and `resume`: one line per session on standard output, the plan and the stop on standard
+    error, each naming its command."""
+
+    def test_session_run_prints_one_line_per_session_and_its_plan_on_standard_error(self):
+        with tempfile.TemporaryDirectory() as folder:
+            (Path(folder) / "p.json").write_text(json.dumps(PROTOCOL, ensure_ascii=False))
+            result = run(["session", "run", "p.json", "--subjects", "2", "--out", "study"], cwd=folder)
+            self.assertEqual(result.returncode, 0, result.stderr)
+            lines = result.stdout.decode().splitlines()
+            self.assertEqual(len(lines), 2, lines)
+            for number, line in enumerate(lines, 1):
+                match = re.match(SESSION_LINE, line)
+                self.assertTrue(match, line)
+                subject, saved, planned, now, attempts, path = match.groups()
+                self.assertEqual((subject, saved, planned, now, attempts), (f"S0{number}", "2", "2", "2", "0"))
+                self.assertEqual(len(list((Path(folder) / path / "trials").glob("*.json"))), 2)
+            err = result.stderr.decode()
+            self.assertIn("plan of tiny", err)
+            self.assertIn("items 一", err)
+            self.assertNotIn("error", err)
+            self.assertNotIn("warning", err)
+
+    def test_a_session_stopped_by_sigint_names_its_command_the_signal_and_the_resume(self):
+        with tempfile.TemporaryDirectory() as folder:
+            (Path(folder) / "p.json").write_text(json.dumps(PROTOCOL, ensure_ascii=False))
+            process = subprocess.Popen([CLI, "session", "run", "p.json", "--subject", "S01", "--out", "study",
+                                        "--pacing", "real-time"], cwd=folder, env=ENV, stdin=subprocess.DEVNULL,
+                                       stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+            deadline = time.monotonic() + 20
+            while time.monotonic() < deadline and not any(
+                    b"trial_started" in log.read_bytes() for log in Path(folder).glob("study/S01/*/log.jsonl")):
+                time.sleep(0.05)
+            time.sleep(0.3)
+            process.send_signal(signal.SIGINT)
+            out, err = process.communicate(timeout=30)
+            self.assertEqual(process.returncode, 130, err)
+            match = re.match(SESSION_LINE, out.decode().strip())
+            self.assertTrue(match, out)
+            subject, saved, planned, now, attempts, path = match.groups()
+            self.assertEqual((saved, planned, now, attempts), ("0", "2", "0", "1"))
+            self.assertEqual(len(list((Path(folder) / path / "trials" / "attempts").glob("*.json"))), 1)
+            last = err.decode().strip().splitlines()[-1]
+            self.assertEqual(last, f"calligraphy session run: stopped by SIGINT; resume with: "
+                                   f"calligraphy session resume {path}")
+            result = run(["session", "resume", path, "--pacing", "lock-step"], cwd=folder)
+            self.assertEqual(result.returncode, 0, result.stderr)
+            match = re.match(SESSION_LINE, result.stdout.decode().strip())
+            self.assertTrue(match, result.stdout)
+            # Every trial saved now; the attempt the stop kept was kept by the run, not by this resume.
+            self.assertEqual(match.groups()[1:5], ("2", "2", "2", "0"))
+
+
 class Log(unittest.TestCase):
     """The library's log: on standard error as the command's own lines, info only with --verbose."""
 
