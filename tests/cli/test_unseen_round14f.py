@@ -780,8 +780,13 @@ class Devices(unittest.TestCase, OneErrorLine):
     def test_a_device_no_command_takes_says_which_commands_do(self):
         result = run(["trial", "一", "--device", "mouse-hand"], cwd="/")
         self.assert_one_error(result, 2, "--device mouse-hand", "train", "session run")
-        result = run(["trial", "一", "--device", "nosuch"], cwd="/")
-        self.assert_one_error(result, 2, "'nosuch'", "simulated", "emulated-phantom")
+        for command in (["trial", "一"], ["train", "一"], ["session", "run", "p.json", "--out", "o"]):
+            with self.subTest(command=command[:2]), tempfile.TemporaryDirectory() as folder:
+                (Path(folder) / "p.json").write_text(json.dumps(PROTOCOL, ensure_ascii=False))
+                result = run([*command, "--device", "nosuch"], cwd=folder)
+                self.assertEqual(os.listdir(folder), ["p.json"])
+                line = self.assert_one_error(result, 2, "--device", "'nosuch'", "simulated", "emulated-phantom")
+                self.assertEqual(line.count("nosuch"), 1, line)  # the name once, then the devices there are
 
 
 class Names(unittest.TestCase, OneErrorLine):
