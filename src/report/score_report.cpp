@@ -237,7 +237,9 @@ std::string score_table(const ScoreDescription& d, const WritingMetrics& metrics
   appendf(out,
           "Score of %s against %s (%zu samples, x and y in %s; strokes numbered from 1 here, from 0 in the "
           "JSON)\n",
-          d.trace.c_str(), d.character.c_str(), d.samples, d.units.c_str());
+          d.trace.c_str(), d.character.c_str(), d.samples,
+          // `--units data`: the character's 1024-unit data box, named as a unit for a person.
+          d.units == "data" ? "data units (1024 per character)" : d.units.c_str());
   VerdictCounts all;
   for (const CharacterScore& score : metrics.characters) {
     if (metrics.characters.size() > 1) appendf(out, "\n%s\n", encode_utf8(score.code_point).c_str());

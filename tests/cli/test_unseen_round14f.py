@@ -652,6 +652,15 @@ class Outputs(unittest.TestCase, OneErrorLine):
             self.assertEqual(summary_value(text, "mean deviation"), "-")
             self.assertIsNone(json.loads((Path(folder) / "up.json").read_text())["mean_deviation_m"])
 
+    def test_score_header_names_the_units_of_its_trace(self):
+        with tempfile.TemporaryDirectory() as folder:
+            (Path(folder) / "d.csv").write_text("t,x,y,pen\n0,100,500,1\n0.5,500,500,1\n1,900,500,1\n")
+            for units, needle in (("data", "x and y in data units (1024 per character)"), ("m", "x and y in m;")):
+                with self.subTest(units=units):
+                    result = run(["score", "d.csv", "--character", "一", "--units", units], cwd=folder)
+                    self.assertEqual(result.returncode, 0, result.stderr)
+                    self.assertIn(needle, result.stdout.decode().splitlines()[0])
+
     def test_characters_of_a_text_show_a_control_character_printable(self):
         result = run(["characters", "--text", "一\x1b"], cwd="/")
         text = result.stdout.decode() + result.stderr.decode()
