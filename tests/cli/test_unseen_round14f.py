@@ -6,7 +6,8 @@ one-line summaries of `trial` and `score`, `devices`, and the library's log on s
 as `cli_unseen_round14f_tests`.
 
 Each help is held to docs/cli.md: every option of a command's help is in the command's section and every
-option of its table in its help, one default stated once, a value naming a file read `FILE`, the top-level
+option of its tables in its help, with the same range, one default and one meaning of `-` stated once, a
+number's unit in brackets, a value naming a file read `FILE`, one value name per option name, the top-level
 help listing every command the docs describe, `--version` anywhere. Every option of every command given a
 wrong value (an enumeration a name it lacks, a number `nan` and past its range, a flag a value): exit 2,
 exactly one line on standard error naming the command and the option, nothing on standard output, nothing
@@ -14,10 +15,11 @@ written; a misspelt command, subcommand and option name the near one. The summar
 (strokes numbered from 1, millimetres, one verdict per stroke) against the JSON of the same run, for a
 trial that wrote every stroke, one whose strokes were credited as assisted, one stopped by its time limit at
 0.05 s and one stopped by SIGINT after 0.3 s (no "nan", the counts and the time of the JSON); `score`'s
-verdicts and the distance of a refused pen-down against its JSON; `train` without a display; the library's
-info lines only with `--verbose`, on standard error in the command's own form; `devices` listing every kind
-with the commands that take it, in text and `--json`, as docs/cli.md's table; messages naming a character by
-itself and its code point.
+verdicts, the distance of a refused pen-down and the stroke that was due against its JSON, its units;
+`session run`'s line per session and its stop by SIGINT; `train` without a display; the library's info lines
+only with `--verbose`, on standard error in the command's own form; `devices` listing every kind with the
+commands that take it, in text and `--json`, as docs/cli.md's table, and an unknown device named once;
+messages naming a character by itself and its code point, a file name quoted on one line.
 
 CALLIGRAPHY_CLI names the program, CALLIGRAPHY_SOURCE_DIR the source tree (its docs). CALLIGRAPHY_SANITIZED=1
 takes five cases.
