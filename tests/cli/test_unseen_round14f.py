@@ -182,6 +182,25 @@ class Help(unittest.TestCase):
             got = set(re.findall(r"^  ([a-z]+)\s", help_text(group), flags=re.M))
             self.assertEqual(got, subs, group)
 
+    def test_every_command_the_docs_quote_is_one(self):
+        # `calligraphy WORD [SUB]` in README.md and docs/*.md: WORD a command of the help, SUB one of its
+        # group's; `trail`, docs/cli.md's example of a mistyped command, the one exception.
+        top = set(re.findall(r"^  ([a-z]+)\s", run(["--help"], cwd="/").stdout.decode(), flags=re.M))
+        groups = {group: set(re.findall(r"^  ([a-z]+)\s", help_text(group), flags=re.M))
+                  for group in ("corpus", "bench", "session")}
+        quoted = set()
+        for document in [SOURCE / "README.md", *sorted((SOURCE / "docs").glob("*.md"))]:
+            text = document.read_text(encoding="utf-8")
+            quoted |= set(re.findall(r"`calligraphy ([a-z]+)(?:\s+([a-z]+))?", text))
+        self.assertGreater(len(quoted), 20)
+        for word, sub in quoted:
+            with self.subTest(command=f"{word} {sub}".strip()):
+                if word == "trail":
+                    continue
+                self.assertIn(word, top)
+                if word in groups:
+                    self.assertIn(sub, groups[word])
+
     def test_every_help_option_is_in_its_commands_section_of_the_docs(self):
         sections = docs_sections()
         for command in COMMANDS:
