@@ -205,12 +205,13 @@ int report_run(std::string_view command, const SessionFolder& session, const Ses
     return 1;
   }
   if (!result.complete()) {
-    const int signal = stop_signal();
-    const std::string line = std::string(command) + ": stopped" +
-                             (signal != 0 ? std::string(" by ") + signal_name(signal) : std::string()) +
-                             "; " + resume + "\n";
+    const int stopped_by = stop_signal();
+    const std::string line =
+        std::string(command) + ": stopped" +
+        (stopped_by != 0 ? std::string(" by ") + signal_name(stopped_by) : std::string()) + "; " + resume +
+        "\n";
     std::fputs(line.c_str(), stderr);
-    return signal != 0 ? 128 + signal : 1;
+    return stopped_by != 0 ? 128 + stopped_by : 1;
   }
   return 0;
 }
