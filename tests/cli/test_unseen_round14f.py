@@ -440,6 +440,18 @@ class UsageErrors(unittest.TestCase, OneErrorLine):
         self.assertEqual(result.returncode, 0, result.stderr)
         self.assertIn("kinds", json.loads(result.stdout))
 
+    def test_options_that_cannot_go_together_name_the_one_that_does_not_apply(self):
+        # docs/cli.md's trial table: each of these "is a usage error" beside the other option.
+        for bad, needle in ((["--writer", "person", "--device", "simulated"], "a person cannot hold the device"),
+                            (["--guidance", "off", "--guidance-stiffness", "300"], "--guidance-stiffness"),
+                            (["--guidance-gain", "0.5"], "--guidance-gain"),
+                            (["--guidance-mode", "fading", "--assist-band", "0.002"], "--assist-band"),
+                            (["--pacing", "lock-step", "--watchdog-ms", "10"], "--watchdog-ms")):
+            with self.subTest(bad=bad), tempfile.TemporaryDirectory() as folder:
+                result = run(["trial", "一", "--json", "t.json", *bad], cwd=folder)
+                self.assert_one_error(result, 2, "calligraphy trial: error:", needle)
+                self.assertEqual(os.listdir(folder), [])
+
     def test_old_writer_values_say_what_to_write_instead(self):
         result = run(["trial", "一", "--writer", "novice"], cwd="/")
         self.assert_one_error(result, 2, "--writer novice", "--writer-profile novice")
