@@ -516,6 +516,11 @@ class Summaries(unittest.TestCase, OneErrorLine):
             process = subprocess.Popen([CLI, "trial", "十", "--pacing", "real-time", "--json", "s.json"], cwd=folder,
                                        env=ENV, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                                        stderr=subprocess.PIPE)
+            # The real-time trial runs its servo loop on a thread of its own: once it is there the trial runs
+            # (a signal before would stop a trial that never started); then 0.3 s of it.
+            deadline = time.monotonic() + 20
+            while time.monotonic() < deadline and len(os.listdir(f"/proc/{process.pid}/task")) < 2:
+                time.sleep(0.01)
             time.sleep(0.3)
             process.send_signal(signal.SIGINT)
             out, err = process.communicate(timeout=30)
