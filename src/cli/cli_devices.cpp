@@ -25,7 +25,8 @@ DeviceListing find_cli_device(const DeviceRegistry& devices, const char* option,
                        ": the pointer devices are taken by commands with the trainer window (train, session "
                        "run); `calligraphy devices` lists the commands that take each device");
     }
-    throw UsageError(std::string(option) + ": unknown device '" + name + "': " + e.what());
+    // The registry's message names the device and the ones there are: said once.
+    throw UsageError(std::string(option) + ": " + e.what());
   }
 }
 

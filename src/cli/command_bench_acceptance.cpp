@@ -134,13 +134,14 @@ void add_bench_acceptance_command(CLI::App& bench, Commands& commands) {
   add_choice(*app, "--half", command->half, {"tuning", "held-out", "both"},
              "with --kanjivg: which half of the shared characters (split by a hash of the code point): the "
              "one the rule's tolerances were tuned on, the one held out from tuning, or each in turn");
-  add_number(*app, "--form-tolerance-mm", command->form_tolerance_mm, "MM",
-             "with --kanjivg: the same form: each KanjiVG line within this discrete Frechet distance of its "
-             "median [mm, 60 mm box]; wider admits more characters, and lines farther from the medians",
-             "a number in (0, 60]", [](double v) { return v > 0.0 && v <= 60.0; });
+  add_number(
+      *app, "--form-tolerance-mm", command->form_tolerance_mm, "MM",
+      "with --kanjivg: the same form: each KanjiVG line within this discrete Frechet distance of its "
+      "median [mm, 60 mm box], in (0, 60]; wider admits more characters, and lines farther from the medians",
+      "a number in (0, 60]", [](double v) { return v > 0.0 && v <= 60.0; });
   add_integer(*app, "--characters", command->characters, "N",
               "characters drawn at random (not the embedded ones)", 1, 100000);
-  add_unsigned(*app, "--seed", command->seed, "S", "seed of the draw and the paths");
+  add_unsigned(*app, "--seed", command->seed, "N", "seed of the draw and the paths");
 }
 
 }  // namespace calligraphy::cli

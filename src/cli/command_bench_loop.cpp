@@ -82,7 +82,7 @@ void add_bench_loop_command(CLI::App& bench, Commands& commands) {
   CLI::App* app =
       commands.add(bench, "loop", "Period jitter and missed deadlines of the real-time servo loop",
                    [command] { return run_loop(*command); });
-  add_number(*app, "--rate", command->rate_hz, "HZ", "servo rate [Hz]",
+  add_number(*app, "--rate", command->rate_hz, "HZ", "servo rate [Hz], in " + servo_rate_range_text(true),
              "a rate in " + servo_rate_range_text(true),
              [](double hz) { return servo_rate_allowed(hz, true); });
   // A day at most, as a trial (kMaxTrialDurationS): the run's end is a clock reading that must not overflow.

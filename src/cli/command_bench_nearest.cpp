@@ -124,7 +124,7 @@ void add_bench_nearest_command(CLI::App& bench, Commands& commands) {
                   "replace the generated sections (nearest point and jumps) of this Markdown document",
                   StandardOutput::allowed);
   add_integer(*app, "--queries", command->queries, "N", "queries per scenario and degree", 1, 100000000);
-  add_unsigned(*app, "--seed", command->seed, "S", "seed of the random scenarios");
+  add_unsigned(*app, "--seed", command->seed, "N", "seed of the random scenarios");
 }
 
 void add_bench_jumps_command(CLI::App& bench, Commands& commands) {

@@ -42,7 +42,7 @@ void add_bench_tick_command(CLI::App& bench, Commands& commands) {
   add_flag(*app, "--json", command->json, "print the result as JSON");
   add_text(*app, "--chars", command->chars, "CHARS", "the characters whose trials are replayed (UTF-8)");
   add_integer(*app, "--passes", command->passes, "N", "replays of each recorded trial", 1, 1000);
-  add_number(*app, "--rate", command->rate_hz, "HZ", "servo rate [Hz]",
+  add_number(*app, "--rate", command->rate_hz, "HZ", "servo rate [Hz], in " + servo_rate_range_text(false),
              "a rate in " + servo_rate_range_text(false),
              [](double hz) { return servo_rate_allowed(hz, false); });
   add_library_options(*app, command->library, false);

@@ -136,7 +136,7 @@ void add_corpus_build_command(CLI::App& corpus, Commands& commands) {
                    [command, &commands] { return run_build(*command, commands.verbose()); });
   required(add_output_path(*app, "--out", command->out, "the store to write", StandardOutput::refused));
   add_number(*app, "--tolerance", command->tolerance, "UNITS",
-             "largest deviation of the fitted elements from the median [data units, 1024 per character]",
+             "largest deviation of the fitted elements from the median [data units, 1024 per character], > 0",
              "a number of data units > 0", positive);
   add_choice(*app, "--medians", command->medians, {"on", "off"},
              "store the strokes' medians too (format 1.1; off: a 1.0 store of the models only)");
@@ -159,7 +159,7 @@ void add_corpus_fidelity_command(CLI::App& corpus, Commands& commands) {
       corpus, "fidelity", "Elements, bytes and deviation from the medians per fitting tolerance (Markdown)",
       [command, &commands] { return run_fidelity(*command, commands.verbose()); });
   add_number_list(*app, "--tolerances", command->tolerances, "LIST",
-                  "fitting tolerances to compare [data units]", "numbers > 0", positive);
+                  "fitting tolerances to compare [data units], each > 0", "numbers > 0", positive);
   add_output_path(*app, "--markdown", command->markdown, "also write the table (printed anyway) to a file",
                   StandardOutput::allowed);
   add_fit_options(*app, command->fit);

@@ -11,6 +11,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -186,30 +187,31 @@ SessionRunResult run_resumable(SessionFolder& session, const SessionRunOptions& 
 }
 
 // Prints one line per session; returns the exit status: 0 when complete, 128 + the signal when stopped
-// by one, 1 after a device fault.
-int report_run(const SessionFolder& session, const SessionRunResult& result, double seconds) {
+// by one, 1 after a device fault. `command` ("calligraphy session run" or "... resume") names the command in
+// the line on standard error, as its other lines do.
+int report_run(std::string_view command, const SessionFolder& session, const SessionRunResult& result,
+               double seconds) {
   std::printf("%s: %zu of %zu trials saved (%zu now, %zu attempts kept) in %s, %.1f s\n",
               session.manifest().setup.subject.id.c_str(), result.saved_before + result.saved_now,
               result.planned, result.saved_now, result.attempts_kept, session.path().c_str(), seconds);
   std::fflush(stdout);
+  const std::string resume = "resume with: calligraphy session resume " + session.path().string();
   if (result.save_failed) {
-    print_error_line("calligraphy session", "error",
-                     result.failure +
-                         "; every trial saved before is kept; resume with: calligraphy session resume " +
-                         session.path().string());
+    print_error_line(command, "error", result.failure + "; every trial saved before is kept; " + resume);
     return 1;
   }
   if (result.device_failed) {
-    std::fprintf(
-        stderr,
-        "calligraphy session: error: the device failed (%s); resume with: calligraphy session resume %s\n",
-        result.failure.c_str(), session.path().c_str());
+    print_error_line(command, "error", "the device failed (" + result.failure + "); " + resume);
     return 1;
   }
   if (!result.complete()) {
-    std::fprintf(stderr, "calligraphy session: stopped; resume with: calligraphy session resume %s\n",
-                 session.path().c_str());
-    return stop_signal() != 0 ? 128 + stop_signal() : 1;
+    const int stopped_by = stop_signal();
+    const std::string line =
+        std::string(command) + ": stopped" +
+        (stopped_by != 0 ? std::string(" by ") + signal_name(stopped_by) : std::string()) + "; " + resume +
+        "\n";
+    std::fputs(line.c_str(), stderr);
+    return stopped_by != 0 ? 128 + stopped_by : 1;
   }
   return 0;
 }
@@ -510,7 +512,7 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
       const auto start = std::chrono::steady_clock::now();
       const SessionRunResult result = run_resumable(session, options, command.display, command.library);
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      const int status = report_run(session, result, seconds);
+      const int status = report_run("calligraphy session run", session, result, seconds);
       if (status != 0) return status;
       if (person || sessions == 1) break;
     }
@@ -563,7 +565,7 @@ int resume_session(const SessionResumeCommand& command, DeviceRegistry& devices)
   }
   const auto start = std::chrono::steady_clock::now();
   const SessionRunResult result = run_resumable(session, options, command.display, command.library);
-  return report_run(session, result,
+  return report_run("calligraphy session resume", session, result,
                     std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
 }
 

@@ -33,8 +33,8 @@ void add_trace_command(CLI::App& root, Commands& commands) {
   CLI::App* app = commands.add(root, "trace",
                                "Write a saved trial's trace (.trace.h5) as CSV, the columns of trial --csv",
                                [command] { return run_trace(*command); });
-  app->add_option("TRACE", command->trace, "the trace file (HDF5: a session folder's trials/STEM.trace.h5)")
-      ->required();
+  add_positional(*app, "TRACE", command->trace,
+                 "the trace file (HDF5: a session folder's trials/STEM.trace.h5)", "FILE");
   with_default(add_output_path(*app, "--csv", command->csv, "write the CSV here", StandardOutput::allowed),
                "standard output");
 }

@@ -209,7 +209,7 @@ void add_train_command(CLI::App& root, Commands& commands, DeviceRegistry& devic
              "trial, a gentle push off the stroke, or a target pacing the stroke (M cycles it)");
   command->guidance_gain_option =
       add_number(*app, "--guidance-gain", command->guidance_gain, "G",
-                 "fading: the first trial's gain, faded after each trial", "a number in [0, 1]",
+                 "fading: the first trial's gain, faded after each trial, in [0, 1]", "a number in [0, 1]",
                  [](double g) { return g >= 0.0 && g <= 1.0; });
   add_input_path(*app, "--teacher", command->teacher, "FILE",
                  "replay: the teacher's recording (JSON, from --record)", "none");

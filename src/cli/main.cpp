@@ -103,8 +103,10 @@ int main(int argc, char** argv) {
     } catch (const CLI::ParseError& e) {
       const auto [name, deepest] = given_command(root);
       std::string message = e.what();
-      // A group given without its subcommand: its help shows what it offers.
-      if (deepest->get_require_subcommand_min() > 0 && deepest->get_subcommands().empty()) {
+      // A group given without its subcommand: its help shows what it offers. A group given a word that is
+      // none of its commands (`calligraphy trail`) is the one error line below, naming the near ones.
+      if (deepest->get_require_subcommand_min() > 0 && deepest->get_subcommands().empty() &&
+          deepest->remaining().empty()) {
         const auto parent_end = name.rfind(' ');
         std::fputs(deepest->help(parent_end == std::string::npos ? "" : name.substr(0, parent_end)).c_str(),
                    stderr);

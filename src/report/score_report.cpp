@@ -21,6 +21,12 @@ std::string fixed(const std::optional<double>& value, double scale, const char* 
   return text;
 }
 
+// A summary's quantity with its unit, or "-" alone when there is none (as `trial`'s summary gives it): a
+// person reads "-" as no value, never as one of "- mm".
+std::string fixed(const std::optional<double>& value, double scale, const char* pattern, const char* unit) {
+  return value ? fixed(value, scale, pattern) + " " + unit : "-";
+}
+
 nlohmann::json stroke_json(const StrokeScore& stroke) {
   nlohmann::json out = {{"index", stroke.index}, {"typical_id", stroke.typical_id}};
   report_detail::add_metrics(out, metric_level_stroke, stroke);
@@ -208,18 +214,18 @@ void append_character_table(std::string& out, const CharacterScore& score) {
           score.ignored_segments);
   appendf(out, "  strokes matched            %zu  (the deviations and times below are theirs)\n",
           score.strokes_written);
-  appendf(out, "  mean deviation             %s mm\n",
-          fixed(deviation(&DeviationSummary::mean_m), 1e3, "%.3f").c_str());
-  appendf(out, "  max deviation              %s mm\n",
-          fixed(deviation(&DeviationSummary::max_m), 1e3, "%.3f").c_str());
-  appendf(out, "  RMS deviation              %s mm\n",
-          fixed(deviation(&DeviationSummary::rms_m), 1e3, "%.3f").c_str());
-  appendf(out, "  Frechet (worst stroke)     %s mm\n", fixed(t.frechet_m, 1e3, "%.3f").c_str());
-  appendf(out, "  DTW (mean)                 %s mm\n", fixed(t.dtw_m, 1e3, "%.3f").c_str());
+  appendf(out, "  mean deviation             %s\n",
+          fixed(deviation(&DeviationSummary::mean_m), 1e3, "%.3f", "mm").c_str());
+  appendf(out, "  max deviation              %s\n",
+          fixed(deviation(&DeviationSummary::max_m), 1e3, "%.3f", "mm").c_str());
+  appendf(out, "  RMS deviation              %s\n",
+          fixed(deviation(&DeviationSummary::rms_m), 1e3, "%.3f", "mm").c_str());
+  appendf(out, "  Frechet (worst stroke)     %s\n", fixed(t.frechet_m, 1e3, "%.3f", "mm").c_str());
+  appendf(out, "  DTW (mean)                 %s\n", fixed(t.dtw_m, 1e3, "%.3f", "mm").c_str());
   appendf(out, "  pen lifts                  %zu\n", t.pen_lifts);
   appendf(out, "  time                       %.2f s (pen down %.2f s, in the air %.2f s)\n", t.total_time_s,
           t.writing_time_s, t.in_air_time_s);
-  appendf(out, "  mean speed                 %s m/s\n", fixed(t.mean_speed_m_per_s, 1.0, "%.4f").c_str());
+  appendf(out, "  mean speed                 %s\n", fixed(t.mean_speed_m_per_s, 1.0, "%.4f", "m/s").c_str());
   appendf(out, "  velocity peaks             %d\n", t.velocity_peaks);
   appendf(out, "  normalised jerk            %s\n", fixed(t.normalised_jerk, 1.0, "%.1f").c_str());
 }
@@ -231,7 +237,9 @@ std::string score_table(const ScoreDescription& d, const WritingMetrics& metrics
   appendf(out,
           "Score of %s against %s (%zu samples, x and y in %s; strokes numbered from 1 here, from 0 in the "
           "JSON)\n",
-          d.trace.c_str(), d.character.c_str(), d.samples, d.units.c_str());
+          d.trace.c_str(), d.character.c_str(), d.samples,
+          // `--units data`: the character's 1024-unit data box, named as a unit for a person.
+          d.units == "data" ? "data units (1024 per character)" : d.units.c_str());
   VerdictCounts all;
   for (const CharacterScore& score : metrics.characters) {
     if (metrics.characters.size() > 1) appendf(out, "\n%s\n", encode_utf8(score.code_point).c_str());
@@ -239,17 +247,17 @@ std::string score_table(const ScoreDescription& d, const WritingMetrics& metrics
     all.add(stroke_verdicts(score));
   }
   if (metrics.characters.size() > 1) {
-    const auto mm = [](const std::optional<double>& v) { return fixed(v, 1e3, "%.3f"); };
+    const auto mm = [](const std::optional<double>& v) { return fixed(v, 1e3, "%.3f", "mm"); };
     appendf(out, "\nAll %zu characters\n", metrics.characters.size());
     append_verdict_counts(out, all);
     appendf(out, "  pen-downs refused          %zu%s\n", metrics.refusals.total(),
             by_reason(metrics.refusals).c_str());
     appendf(out, "  strokes matched            %zu  (the deviations and times below are theirs)\n",
             metrics.strokes_written);
-    appendf(out, "  mean deviation             %s mm\n",
+    appendf(out, "  mean deviation             %s\n",
             mm(metrics.deviation ? std::optional<double>(metrics.deviation->mean_m) : std::nullopt).c_str());
-    appendf(out, "  Frechet (worst stroke)     %s mm\n", mm(metrics.frechet_m).c_str());
-    appendf(out, "  DTW (mean)                 %s mm\n", mm(metrics.dtw_m).c_str());
+    appendf(out, "  Frechet (worst stroke)     %s\n", mm(metrics.frechet_m).c_str());
+    appendf(out, "  DTW (mean)                 %s\n", mm(metrics.dtw_m).c_str());
     appendf(out, "  time                       %.2f s (pen down %.2f s)\n", metrics.total_time_s,
             metrics.pen_down_time_s);
   }

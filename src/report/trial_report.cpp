@@ -106,8 +106,11 @@ void print_trial_table(const TrialDescription& d, const Scene& scene, const Tria
       writing.deviation ? std::optional<double>(writing.deviation->mean_m) : std::nullopt;
   const std::optional<double> max =
       writing.deviation ? std::optional<double>(writing.deviation->max_m) : std::nullopt;
-  std::printf("\n  strokes completed in order  %zu / %zu%s\n", m.strokes_completed, m.strokes_total,
-              m.completed_in_order ? "" : "  (incomplete)");
+  // The renderer's count (`strokes_completed` of the JSON); the trial is incomplete only when a stroke was
+  // neither taken nor credited as assisted. Whether the trace wrote every stroke in order is the writing's
+  // `completed_in_order`, judged again below ("accepted in turn").
+  std::printf("\n  strokes completed          %zu / %zu%s\n", m.strokes_completed, m.strokes_total,
+              m.strokes_completed + m.strokes_assisted < m.strokes_total ? "  (incomplete)" : "");
   if (m.strokes_assisted > 0) std::printf("  strokes assisted           %zu\n", m.strokes_assisted);
   std::printf("  accepted in turn           %zu / %zu (order errors %zu, backwards %zu)\n",
               writing.strokes_accepted, writing.strokes_total, writing.order_errors,

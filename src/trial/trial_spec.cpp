@@ -188,19 +188,16 @@ const std::vector<SchemaField>& spec_fields() {
            .doc = "the trial ends after this much time; at most 10^7 servo ticks (max_duration_s x rate_hz)",
            .option = "--max-duration",
            .option_value_name = "S"}),
-      string_field<&TrialSpec::json_file>("json_file",
-                                          {.doc = "write the metrics as JSON ('-': standard output)",
-                                           .option = "--json",
-                                           .option_value_name = "FILE"}),
+      string_field<&TrialSpec::json_file>(
+          "json_file", {.doc = "write the metrics as JSON", .option = "--json", .option_value_name = "FILE"}),
       string_field<&TrialSpec::csv_file>(
           "csv_file", {.doc = "write the trace (t,x,y,z,fx,fy,fz,state,stroke,element,attempt,rewritten; "
-                              "s, m, N) as CSV ('-': standard output)",
+                              "s, m, N) as CSV",
                        .option = "--csv",
                        .option_value_name = "FILE"}),
-      string_field<&TrialSpec::svg_file>(
-          "svg_file", {.doc = "draw the reference and the pen trace as SVG ('-': standard output)",
-                       .option = "--svg",
-                       .option_value_name = "FILE"}),
+      string_field<&TrialSpec::svg_file>("svg_file", {.doc = "draw the reference and the pen trace as SVG",
+                                                      .option = "--svg",
+                                                      .option_value_name = "FILE"}),
       string_field<&TrialSpec::record_file>(
           "record_file",
           {.doc = "write the trial as a teacher's recording for --guidance-mode replay (a trial "
