@@ -129,6 +129,18 @@ TEST_CASE("UTF-16 text and lines ending in CR alone are refused saying so", "[pe
   CHECK(parse_pen_trace_csv("\xEF\xBB\xBFt,x,y,pen\r\n0,0,0,1\r\n", "bom.csv", test_placement()).size() == 1);
 }
 
+TEST_CASE("A JSON document or markup in a trace's place is named as what it is", "[pen_trace_csv]") {
+  // A trial record (trial --json), one line or pretty-printed, with a byte-order mark; an SVG drawing.
+  for (const char* text :
+       {"{\"character\": \"一\", \"t\": 1}\n", "{\n  \"t\": 1\n}\n", "\xEF\xBB\xBF [1, 2]\n"}) {
+    CHECK_THROWS_WITH(parse_pen_trace_csv(text, "record.csv", test_placement()),
+                      Catch::StartsWith("record.csv:1: a JSON document, not a trace"));
+  }
+  CHECK_THROWS_WITH(
+      parse_pen_trace_csv("<svg xmlns=\"http://www.w3.org/2000/svg\">\n", "t.csv", test_placement()),
+      Catch::StartsWith("t.csv:1: markup"));
+}
+
 TEST_CASE("Data units are converted with the placement", "[pen_trace_csv]") {
   PenTraceCsvOptions options;
   options.units = TraceUnits::data;

@@ -313,11 +313,18 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
       spec.amplification_gain = amplify->gain;
     if (const auto* timing = std::get_if<TimingGuidance>(&law)) spec.timing_speed_m_s = timing->speed_m_s;
   }
-  // The profile it starts from, by name, when it is one of the named ones (the record states it; the
-  // profile itself, with writer_params applied, is an input below).
+  // The profile it starts from, by name when it is one of the named ones (else the specification's default),
+  // and the settings that make it the profile given (writer_params, or a WriterProfile of other values): the
+  // specification alone then states the writer that wrote, as `--writer-profile` and `--writer-param` do.
+  // The profile itself is also an input below, and the record keeps it whole.
   const std::string& profile_name = simulation.writer.name;
   if (profile_name == "novice" || profile_name == "skilled" || profile_name == "foreign")
     spec.writer_profile = profile_name;
+  const WriterProfile base = writer_profile(spec.writer_profile);
+  for (const std::string& key : writer_parameter_names()) {
+    const double value = writer_parameter(simulation.writer, key);
+    if (value != writer_parameter(base, key)) spec.writer_parameters.push_back({key, value});
+  }
   spec.seed = simulation.seed;
   spec.rate_hz = options.rate_hz;
   spec.pacing = options.pacing;

@@ -87,6 +87,17 @@ class Reader {
       // "Unicode text" (UTF-16) and lines ending in CR alone (classic Mac OS's "CSV (Macintosh)").
       if (line_number_ == 1 && (line.starts_with("\xFF\xFE") || line.starts_with("\xFE\xFF")))
         fail("UTF-16 text (its byte-order mark): a trace is UTF-8 text, save it as UTF-8 CSV");
+      // Another file of the program given in a trace's place (a trial's --json record, a protocol): say what
+      // it is, not that it lacks a column.
+      if (line_number_ == 1) {
+        std::string_view start = line.starts_with("\xEF\xBB\xBF") ? line.substr(3) : line;
+        start.remove_prefix(std::min(start.find_first_not_of(" \t"), start.size()));
+        if (start.starts_with('{') || start.starts_with('['))
+          fail(
+              "a JSON document, not a trace (a trial's trace is its --csv file, or `calligraphy trace` of a "
+              "session's .trace.h5)");
+        if (start.starts_with('<')) fail("markup (an SVG drawing, an HTML page or XML), not a trace");
+      }
       if (line.find('\r') != std::string_view::npos)
         fail(
             "a carriage return within the header line: lines ending in CR alone are not read (end them in LF "

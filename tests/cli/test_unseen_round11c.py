@@ -318,8 +318,9 @@ class PythonTrials(unittest.TestCase):
     def test_miss_counts_and_gain_at_and_past_their_ranges(self):
         st = cg.simulate_trial
         self.assert_named(TypeError, "hint_after_misses", st, YI, hint_after_misses=True, keep_trace=False)
-        self.assert_named(cg.InvalidArgument, "hint_after_misses", st, YI, hint_after_misses=1.5)
-        self.assert_named(cg.InvalidArgument, "hint_after_misses", st, YI, hint_after_misses=float("nan"))
+        # A count is an int (docs/python.md): a float, whole or not, is a TypeError naming it.
+        self.assert_named(TypeError, "hint_after_misses", st, YI, hint_after_misses=1.5)
+        self.assert_named(TypeError, "hint_after_misses", st, YI, hint_after_misses=float("nan"))
         self.assert_named(cg.InvalidArgument, "assist_after_misses", st, YI, assist_after_misses=1001)
         self.assert_named(cg.InvalidArgument, "guidance_gain", st, YI, guidance_gain=0.5)
         self.assert_named(cg.InvalidArgument, "gain", st, YI, guidance_mode="fading", guidance_gain=float("nan"))

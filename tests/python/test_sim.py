@@ -24,6 +24,19 @@ def test_a_custom_writer_changes_the_trial_and_is_named():
     assert (result.metrics["writer"], result.metrics["writer_profile"]) == ("simulated", "steady")
     # Without the systematic bias the unguided writer stays closer to the reference.
     assert result.metrics["mean_deviation_m"] < novice.metrics["mean_deviation_m"]
+    # The specification states it as the command line would: the named profile it starts from and the
+    # settings that make it the profile that wrote (its name aside), so the specification alone runs it.
+    trial = result.metrics["specification"]["trial"]
+    settings = {s["key"]: s["value"] for s in trial["writer_parameters"]}
+    assert trial["writer_profile"] == "novice"
+    assert settings == {"bias_offset_m": 0.0, "stroke_jitter_m": 0.0, "scale_error": 0.0, "tremor_amplitude_n": 0.0}
+    assert calligraphy.writer_profile("novice", settings).replace(name="steady") == steady
+    # A named profile with writer_params is stated the same way; the profile alone states no setting.
+    skilled = calligraphy.simulate_trial("九", writer="skilled", writer_params={"bias_offset_m": 0.001}, seed=4,
+                                         max_duration_s=0.01, keep_trace=False).metrics["specification"]["trial"]
+    assert (skilled["writer_profile"], skilled["writer_parameters"]) == (
+        "skilled", [{"key": "bias_offset_m", "value": 0.001}])
+    assert novice.metrics["specification"]["trial"]["writer_parameters"] == []
 
 
 def test_device_parameters_reach_the_trial():
