@@ -253,11 +253,11 @@ ForceLawParameters too_stiff() {
   return parameters;
 }
 
-// Restores the library's log as the tests found it.
+// Gives the library's log back to spdlog at the level the test program's main sets (errors only).
 struct LogRestorer {
   ~LogRestorer() {
     set_log_handler({});
-    set_log_level(LogLevel::info);
+    set_log_level(LogLevel::error);
   }
 };
 
@@ -535,7 +535,6 @@ TEST_CASE("unseen14e: handlers and levels changed from many threads while a loop
       set_log_level(LogLevel::off);
     }
   });
-  set_log_level(LogLevel::info);
   REQUIRE(eventually([&] { return ticks.load() >= 100; }));
   CHECK_FALSE(loop.stop());
   CHECK(loop.stats().forces_withheld >= 1);
@@ -1043,4 +1042,71 @@ TEST_CASE("unseen14e: the loop thread never allocates while its ticks run late, 
   } else {
     SUCCEED("malloc belongs to the sanitizer here");
   }
+}
+
+TEST_CASE(
+    "unseen14e: a display thread draining a tiny trace queue while the loop ticks loses no point unseen",
+    "[unseen14e]") {
+  const Scene& scene = cross_scene();
+  Stylus stylus;
+  stylus.open();
+  DisplayChannelOptions queues;
+  queues.trace_capacity = 4;  // far smaller than the ticks between two drains: most points are dropped
+  queues.event_capacity = 4;
+  DisplayChannel channel(queues);
+  TrialOptions options;
+  options.max_duration_s = 0.3;
+  options.display = &channel;
+  TrialSession session(scene, stylus.info(), options);
+  session.reserve_trace();
+  ServoLoop loop(stylus, session.servo_callback(), relaxed_loop());
+  std::atomic<bool> draining{true};
+  std::uint64_t received = 0;
+  std::uint64_t out_of_order = 0;
+  std::thread display([&] {
+    std::uint64_t last = 0;
+    auto drain = [&] {
+      for (TracePoint point; channel.poll_trace(point);) {
+        ++received;
+        if (point.tick <= last) ++out_of_order;
+        last = point.tick;
+      }
+    };
+    while (draining.load()) {
+      drain();
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));  // a slow display frame
+    }
+    drain();
+  });
+  loop.start();
+  CHECK_NOTHROW(loop.wait());
+  draining.store(false);
+  display.join();
+  const TrialResult result = session.finish(TrialEnd::time_limit);
+  REQUIRE(result.trace.size() == 300);
+  CHECK(out_of_order == 0);
+  CHECK(channel.dropped_trace_points() > 0);
+  CHECK(received + channel.dropped_trace_points() == 300);  // every point either drawn or counted as dropped
+}
+
+TEST_CASE(
+    "unseen14e: a device registry moved while in use keeps its backends in the new one, and the "
+    "moved-from one takes a new value",
+    "[unseen14e]") {
+  DeviceRegistry registry;
+  register_simulated_device(registry);
+  const std::unique_ptr<HapticDevice> before = registry.create("simulated");
+  DeviceRegistry moved = std::move(registry);
+  CHECK(moved.backend_names() == std::vector<std::string>{"simulated"});
+  const std::unique_ptr<HapticDevice> after = moved.create("simulated");
+  REQUIRE(after != nullptr);
+  CHECK(after->info().model == before->info().model);
+  registry = DeviceRegistry{};  // the moved-from registry given a fresh value works as a new one
+  CHECK(registry.backend_names().empty());
+  CHECK_THROWS_AS(registry.create("simulated"), DeviceNotFound);
+  register_simulated_device(registry);
+  CHECK(registry.create("simulated") != nullptr);
+  DeviceRegistry& alias = moved;
+  moved = std::move(alias);  // self-move-assignment: the header promises nothing of the value, only no crash
+  CHECK_NOTHROW(moved.backend_names());
 }
