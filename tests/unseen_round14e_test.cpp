@@ -35,6 +35,7 @@
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/render/renderer.hpp"
 #include "calligraphy/trial/display.hpp"
+#include "calligraphy/trial/runner.hpp"
 #include "calligraphy/trial/session.hpp"
 
 namespace {
@@ -1109,4 +1110,37 @@ TEST_CASE(
   DeviceRegistry& alias = moved;
   moved = std::move(alias);  // self-move-assignment: the header promises nothing of the value, only no crash
   CHECK_NOTHROW(moved.backend_names());
+}
+
+TEST_CASE("unseen14e: two real-time trials at once, each interrupted from the main thread, keep every tick",
+          "[unseen14e]") {
+  const Scene& scene = cross_scene();
+  std::array<Stylus, 2> styluses;
+  std::array<std::atomic<bool>, 2> interrupt{};
+  std::array<TrialResult, 2> results;
+  std::vector<std::thread> trials;
+  for (std::size_t i = 0; i < 2; ++i) {
+    trials.emplace_back([&, i] {
+      TrialOptions options;
+      options.max_duration_s = 30.0;
+      options.loop = relaxed_loop();
+      options.should_stop = [&, i] { return interrupt[i].load(); };
+      results[i] = run_trial(styluses[i], scene, options);
+    });
+  }
+  REQUIRE(eventually([&] { return styluses[0].reads.load() >= 30 && styluses[1].reads.load() >= 30; }));
+  interrupt[0].store(true);
+  REQUIRE(eventually([&] { return styluses[1].reads.load() >= 60; }));
+  interrupt[1].store(true);
+  for (std::thread& trial : trials) trial.join();
+  for (std::size_t i = 0; i < 2; ++i) {
+    INFO("trial " << i);
+    CHECK(results[i].end == TrialEnd::interrupted);
+    CHECK(results[i].aborted);
+    CHECK(results[i].trace.size() == styluses[i].reads.load());  // every tick read was recorded
+    CHECK(results[i].trace.size() >= 30);
+    CHECK(styluses[i].last_force_norm.load() == 0.0);
+    CHECK_FALSE(styluses[i].forces_enabled());
+    CHECK_FALSE(styluses[i].is_open());
+  }
 }
