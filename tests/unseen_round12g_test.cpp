@@ -50,18 +50,14 @@
 #include "temp_folder.hpp"
 
 // Allocation count of the threads that ask for it (the servo path's promise: no allocation after
-// reserve_trace). Interposed only where the sanitizers do not own malloc.
+// reserve_trace): allocation_count.hpp, interposed only where the sanitizers do not own malloc.
+#include "allocation_count.hpp"
 #if !defined(CALLIGRAPHY_TEST_SANITIZED) && defined(__GLIBC__)
 #define UNSEEN12G_COUNTS_ALLOCATIONS 1
 namespace {
-thread_local bool g_counted = false;
-std::atomic<long> g_allocations{0};
+using calligraphy::testing::count_this_thread;
+using calligraphy::testing::counted_allocations;
 }  // namespace
-extern "C" void* __libc_malloc(std::size_t size);
-extern "C" void* malloc(std::size_t size) {
-  if (g_counted) g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_malloc(size);
-}
 #endif
 
 namespace {
@@ -844,8 +840,8 @@ TEST_CASE("unseen12g: step never allocates after reserve_trace, with a display a
   const auto& points = scene.characters.front().strokes.front().centre_line.points_m;
   long allocations = -1;
   std::thread servo([&] {
-    g_counted = true;
-    const long before = g_allocations.load();
+    count_this_thread = true;
+    const long before = counted_allocations.load();
     DeviceState state;
     for (int i = 0; i < 2500; ++i) {
       const double s = std::min(1.0, i / 1500.0);
@@ -855,8 +851,8 @@ TEST_CASE("unseen12g: step never allocates after reserve_trace, with a display a
       state.time_s = 0.001 * i;
       if (session.step(state).stop) break;
     }
-    allocations = g_allocations.load() - before;
-    g_counted = false;
+    allocations = counted_allocations.load() - before;
+    count_this_thread = false;
   });
   servo.join();
   CHECK(allocations == 0);

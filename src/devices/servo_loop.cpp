@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstring>
 #include <exception>
+#include <mutex>
 #include <thread>
 
 #include "calligraphy/core/decimal_number.hpp"
@@ -179,6 +180,12 @@ struct ServoLoop::Impl {
   double callback_rate_hz = 0.0;  // the rate the callback was built for; 0: it does not say
   std::string callback_rate_name;
   std::thread thread;
+  // The loop thread's id while it runs (empty otherwise): how stop() knows it is called from the callback
+  // without reading `thread`, which another thread's join may be writing.
+  std::atomic<std::thread::id> loop_thread_id{};
+  // Held by whoever starts the run or ends it (joins the thread, detaches the clock, stops the log drain):
+  // stop() and wait() may be called from several threads at once, and only one may join.
+  std::mutex control;
   // The device driver's servo thread while a run is attached to it; set and cleared by the controlling
   // thread, read by running() from any thread.
   std::atomic<DeviceServoClock*> clock{nullptr};
@@ -494,6 +501,7 @@ void ServoLoop::Impl::check_rates(const DeviceServoClock* device_clock) const {
 
 void ServoLoop::start() {
   Impl& m = *impl_;
+  const std::lock_guard control(m.control);
   if (m.running.load(std::memory_order_acquire))
     throw StateError("ServoLoop::start: the loop is already running");
   if (m.thread.joinable()) m.thread.join();              // the previous run ended by itself
@@ -545,9 +553,11 @@ void ServoLoop::start() {
     return;
   }
   m.thread = std::thread([&m] {
+    m.loop_thread_id.store(std::this_thread::get_id(), std::memory_order_release);
     devices::apply_thread_realtime(m.options, m.realtime);
     const bool failed = m.options.realtime == RealtimeMode::enforce && !m.realtime.problems.empty();
     if (failed) {
+      m.loop_thread_id.store(std::thread::id{}, std::memory_order_release);
       m.running.store(false, std::memory_order_release);
       m.startup.store(2, std::memory_order_release);
       m.startup.notify_one();
@@ -557,6 +567,7 @@ void ServoLoop::start() {
     m.startup.store(1, std::memory_order_release);
     m.startup.notify_one();
     m.run_thread();
+    m.loop_thread_id.store(std::thread::id{}, std::memory_order_release);
   });
   m.startup.wait(0, std::memory_order_acquire);
   if (m.startup.load(std::memory_order_acquire) == 2) {
@@ -580,9 +591,11 @@ void ServoLoop::start() {
 LoopFault ServoLoop::stop() noexcept {
   Impl& m = *impl_;
   m.stop_requested.store(true, std::memory_order_release);
-  if (m.thread.get_id() == std::this_thread::get_id() ||
+  if (m.loop_thread_id.load(std::memory_order_acquire) == std::this_thread::get_id() ||
       (m.clock.load() != nullptr && m.frame_thread.load() == std::this_thread::get_id()))
     return {};  // called from the callback: stops after this tick
+  // Another thread may be in stop() or wait() too: it ends the run, and this call then finds it ended.
+  const std::lock_guard control(m.control);
   if (m.thread.joinable()) m.thread.join();
   if (m.clock.load() != nullptr) m.stop_device_clock();
   m.log_drain.stop();
@@ -597,10 +610,13 @@ LoopFault ServoLoop::stop() noexcept {
 
 void ServoLoop::wait() {
   Impl& m = *impl_;
+  const std::lock_guard control(m.control);  // as stop(): one thread ends the run
   if (m.thread.joinable()) m.thread.join();
   if (m.clock.load() != nullptr) {
-    // The driver ends the run in one of its frames; a driver that stopped calling is a stall.
-    while (m.running.load(std::memory_order_acquire) && !m.clock_went_silent()) {
+    // The driver ends the run in one of its frames; a driver that stopped calling is a stall. A stop()
+    // from another thread (waiting for this lock) ends the run here.
+    while (m.running.load(std::memory_order_acquire) && !m.clock_went_silent() &&
+           !m.stop_requested.load(std::memory_order_acquire)) {
       std::this_thread::sleep_for(std::chrono::microseconds(500));
     }
     m.stop_device_clock();

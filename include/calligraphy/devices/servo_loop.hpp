@@ -278,8 +278,9 @@ class ServoLoop {
   /// Asks the loop to stop, waits for the thread to end (or for the device clock's next frame, then
   /// detaches from it; a clock that stopped calling is detached after 100 ms) and returns the fault that
   /// ended the run, if any (none when it was stopped or ended by its callback). Forces are zero and disabled
-  /// on return. Never throws; does nothing when not started. Called from the callback it only requests the
-  /// stop (the callback should return `ServoCommand::stop` instead).
+  /// on return. Never throws; does nothing when not started. Any thread, also several at once and while
+  /// another waits in `wait()` (which then returns as for a run stopped). Called from the callback it only
+  /// requests the stop (the callback should return `ServoCommand::stop` instead).
   LoopFault stop() noexcept;
   /// Waits until the loop ends by itself (its callback asked to stop, or a fault) and joins it; then
   /// throws the fault: for a device fault `throw_device_fault(code, device.info().model)`

@@ -28,14 +28,14 @@
 #include <cstdint>
 #include <vector>
 
-#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/core/device_types.hpp"
+#include "calligraphy/core/seqlock.hpp"
+#include "calligraphy/core/spsc_queue.hpp"
 #include "calligraphy/model/scene.hpp"
+#include "calligraphy/model/stroke_progress.hpp"
 #include "calligraphy/render/renderer.hpp"
 #include "calligraphy/trial/recorder.hpp"
 #include "calligraphy/trial/result.hpp"
-#include "calligraphy/core/seqlock.hpp"
-#include "calligraphy/core/spsc_queue.hpp"
 
 namespace calligraphy {
 
@@ -54,8 +54,10 @@ struct DisplayPoint3 {
 /// The display's view of one servo tick. Device coordinates: x right, y away from the writer, z up out
 /// of the paper, in metres.
 struct DisplaySnapshot {
-  std::uint64_t tick = 0;         ///< ticks stepped so far (0: nothing published yet)
-  double time_s = 0.0;            ///< the device time of the tick [s]
+  std::uint64_t tick = 0;  ///< ticks stepped so far (0: nothing published yet)
+  /// The tick's time [s] as the publisher was given it: from a `TrialSession`, the trial's clock (device
+  /// time since the trial's first tick, so 0 at tick 1), not the device's own time stamp.
+  double time_s = 0.0;
   std::int64_t published_ns = 0;  ///< std::chrono::steady_clock time of publishing [ns], for latency
   InteractionState state = InteractionState::separation;  ///< SS, AS, CS or WS (Table 1)
   bool finished = false;                                  ///< every stroke of the scene is written
@@ -67,9 +69,9 @@ struct DisplaySnapshot {
   std::uint32_t strokes_completed = 0;
   std::uint32_t strokes_total = 0;
   std::uint32_t misses = 0;  ///< refused attempts on the active stroke
-  bool hint_shown = false;  ///< the active stroke is shown as a hint (misses >= hint_after_misses)
-  DisplayPoint2 hint_m;  ///< the active stroke's start, where the red ellipse goes [m]
-  DisplayPoint3 hip_m;   ///< haptic interface point, as read from the device [m]
+  bool hint_shown = false;   ///< the active stroke is shown as a hint (misses >= hint_after_misses)
+  DisplayPoint2 hint_m;      ///< the active stroke's start, where the red ellipse goes [m]
+  DisplayPoint3 hip_m;       ///< haptic interface point, as read from the device [m]
   /// Virtual pen tip: the HIP projected onto the paper when it is below the paper, else the HIP [m]
   /// (section 4.2: the VTP stays on the surface the HIP penetrates).
   DisplayPoint3 vtp_m;
@@ -80,7 +82,7 @@ struct DisplaySnapshot {
 enum class DisplayEventKind : std::uint8_t {
   stroke_completed,     ///< the last feature point of a stroke was written; its metrics are set
   stroke_abandoned,     ///< the pen left the paper in WS unwritten (4.3.3); `refusal` says why
-  stroke_assisted,  ///< the stroke was demonstrated and credited after assist_after_misses misses
+  stroke_assisted,      ///< the stroke was demonstrated and credited after assist_after_misses misses
   character_completed,  ///< the last stroke of a character was written
   trial_ended,          ///< `TrialSession::finish` was called; `end` says how
 };
@@ -92,7 +94,7 @@ enum class DisplayEventKind : std::uint8_t {
 struct DisplayEvent {
   DisplayEventKind kind = DisplayEventKind::stroke_completed;
   std::uint64_t tick = 0;               ///< the tick it happened at (1-based, as `DisplaySnapshot::tick`)
-  double time_s = 0.0;                  ///< device time [s]
+  double time_s = 0.0;                  ///< the tick's time [s], on the clock of `DisplaySnapshot::time_s`
   std::uint32_t character = 0;          ///< the character it concerns
   std::uint32_t stroke = 0;             ///< the stroke within that character (stroke events)
   std::uint32_t stroke_index = 0;       ///< the stroke counted over the scene (stroke events)
@@ -111,7 +113,7 @@ struct DisplayEvent {
 /// The pen at one tick, for drawing its trajectory.
 struct TracePoint {
   std::uint64_t tick = 0;
-  double time_s = 0.0;  ///< [s]
+  double time_s = 0.0;  ///< the tick's time [s], on the clock of `DisplaySnapshot::time_s`
   DisplayPoint3 hip_m;  ///< [m]
   InteractionState state = InteractionState::separation;
   /// The stroke over the scene the point belongs to: the active one, or the one this tick completed.
