@@ -53,7 +53,9 @@ std::vector<DeviceKind> device_kinds(const DeviceRegistry& devices) {
       {"phantom-usb:BUS-ADDRESS", "phantom-usb", "person", kEveryCommand, "a Phantom over libusb"},
   };
 #ifndef CALLIGRAPHY_WITH_TRAINER
+  // No window: `train` takes no device, and the pointer kinds no command.
   for (DeviceKind& kind : kinds) {
+    std::erase(kind.commands, "train");
     if (kind.backend == "mouse" || kind.backend == "mouse-hand") {
       kind.commands.clear();
       kind.what += " (not in this build: no trainer window)";

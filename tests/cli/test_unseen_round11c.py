@@ -264,9 +264,11 @@ class Devices(Case):
             "phantom-usb:BUS-ADDRESS": ("person", ["trial", "train", "session run"]),
         }
         self.assertEqual(set(kinds), set(table))
+        # A build without the trainer window lists no kind for train, and the pointer kinds with no command.
+        windowless = not kinds["mouse"]["commands"]
         for name, (writer, commands) in table.items():
-            if not kinds[name]["commands"] and name.startswith("mouse"):
-                continue  # a build without the trainer window lists the pointer kinds with no command
+            if windowless:
+                commands = [] if name.startswith("mouse") else [c for c in commands if c != "train"]
             self.assertEqual(kinds[name]["writer"], writer, name)
             self.assertEqual(sorted(kinds[name]["commands"]), sorted(commands), name)
         names = [d["name"] for d in survey["devices"]]

@@ -813,16 +813,21 @@ class Devices(unittest.TestCase, OneErrorLine):
         kinds = {kind["name"].split(":")[0]: kind for kind in json.loads(listing.stdout)["kinds"]}
         self.assertEqual(set(kinds), self.KINDS)
         text = run(["devices"], cwd="/").stdout.decode().split("Kinds of device", 1)[1]
+        # docs/cli.md: "In a build without the trainer window no kind lists `train`, and the pointer kinds are
+        # listed with no command" (the sanitizer builds have no window).
+        windowless = any("not in this build" in kind["what"] for kind in kinds.values())
         for name, (writer, commands) in documented.items():
             with self.subTest(kind=name):
+                if windowless:
+                    commands = [] if name in ("mouse", "mouse-hand") else [c for c in commands if c != "train"]
                 self.assertEqual(kinds[name]["writer"], writer)
                 self.assertEqual(sorted(kinds[name]["commands"]), commands)
                 line = next(line for line in text.splitlines() if line.split() and
                             line.split()[0].split(":")[0] == name)
                 self.assertEqual(line.split()[1], writer, line)
                 columns = re.split(r"\s{2,}", line.strip())
-                listed = columns[2]
-                self.assertEqual(sorted(c.strip() for c in listed.split(",")), commands, line)
+                listed = [] if columns[2] == "none" else [c.strip() for c in columns[2].split(",")]
+                self.assertEqual(sorted(listed), commands, line)
 
     def test_a_device_no_command_takes_says_which_commands_do(self):
         result = run(["trial", "一", "--device", "mouse-hand"], cwd="/")
@@ -832,6 +837,8 @@ class Devices(unittest.TestCase, OneErrorLine):
                 (Path(folder) / "p.json").write_text(json.dumps(PROTOCOL, ensure_ascii=False))
                 result = run([*command, "--device", "nosuch"], cwd=folder)
                 self.assertEqual(os.listdir(folder), ["p.json"])
+                if command[0] == "train" and b"built without the trainer window" in result.stderr:
+                    continue  # the sanitizer builds: train says only that (exit 1), before any option
                 line = self.assert_one_error(result, 2, "--device", "'nosuch'", "simulated", "emulated-phantom")
                 self.assertEqual(line.count("nosuch"), 1, line)  # the name once, then the devices there are
 
