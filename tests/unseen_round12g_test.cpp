@@ -52,6 +52,7 @@
 // Allocation count of the threads that ask for it (the servo path's promise: no allocation after
 // reserve_trace): allocation_count.hpp, interposed only where the sanitizers do not own malloc.
 #include "allocation_count.hpp"
+#include "application_stylus.hpp"
 #if !defined(CALLIGRAPHY_TEST_SANITIZED) && defined(__GLIBC__)
 #define UNSEEN12G_COUNTS_ALLOCATIONS 1
 namespace {
@@ -93,15 +94,8 @@ double now_s() {
 // contract says; the counters the test reads while a loop runs are atomics.
 class AppDevice : public HapticDevice {
  public:
-  AppDevice() {
-    info_.model = "app stylus";
+  AppDevice() : info_(testing::application_stylus_info("app stylus")) {
     info_.manufacturer = "an application";
-    info_.max_force_n = 3.0;
-    info_.max_continuous_force_n = 1.0;
-    info_.max_stiffness_n_per_m = 1000.0;
-    info_.max_damping_n_s_per_m = 5.0;
-    info_.workspace_radius_m = 0.08;
-    info_.workspace_size_m = Vec3(0.16, 0.12, 0.12);
   }
   const DeviceInfo& info() const override { return info_; }
   void open() override {

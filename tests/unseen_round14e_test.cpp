@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "allocation_count.hpp"
+#include "application_stylus.hpp"
 #include "calligraphy/collision/active_stroke.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/logging.hpp"
@@ -158,15 +159,7 @@ bool same_scene(const Scene& a, const Scene& b) {
 // contract); what the test reads meanwhile is atomic.
 class Stylus final : public HapticDevice {
  public:
-  Stylus() {
-    info_.model = "round 14E stylus";
-    info_.max_force_n = 3.0;
-    info_.max_continuous_force_n = 1.0;
-    info_.max_stiffness_n_per_m = 1000.0;
-    info_.max_damping_n_s_per_m = 5.0;
-    info_.workspace_radius_m = 0.08;
-    info_.workspace_size_m = Vec3(0.16, 0.12, 0.12);
-  }
+  Stylus() : info_(testing::application_stylus_info("round 14E stylus")) {}
   const DeviceInfo& info() const override { return info_; }
   void open() override { open_ = true; }
   void close() noexcept override {
