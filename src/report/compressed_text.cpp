@@ -7,6 +7,7 @@
 #include <climits>
 #include <cstdio>
 #include <cstring>
+#include <utility>
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
@@ -28,12 +29,13 @@ DataError bytes_after_gzip(const std::string& source, std::uintmax_t offset, std
 }  // namespace
 
 struct TextFileReader::State {
-  std::FILE* file = nullptr;
+  std::FILE* file = nullptr;  // null: the bytes were given in memory, `input` points at them
   bool gzip = false;
   bool done = false;  // a gzip file's last member has ended at the end of the file
   z_stream stream{};
-  bool inflating = false;            // `stream` initialised
-  std::vector<unsigned char> input;  // read from the file; [used, filled) not yet taken
+  bool inflating = false;                // `stream` initialised
+  std::vector<unsigned char> buffer;     // a file's bytes as read
+  const unsigned char* input = nullptr;  // `buffer`, or the bytes given; [used, filled) not yet taken
   std::size_t used = 0, filled = 0;
   std::uintmax_t read_from_file = 0;  // bytes in all
   bool end_of_file = false;
@@ -46,14 +48,14 @@ struct TextFileReader::State {
     if (file != nullptr) std::fclose(file);
   }
 
-  // At least `want` bytes not yet taken, unless the file ends first.
+  // At least `want` bytes not yet taken, unless the file ends first (bytes given in memory have ended).
   void refill(const std::string& name, std::size_t want) {
     if (filled - used >= want || end_of_file) return;
-    std::memmove(input.data(), input.data() + used, filled - used);
+    std::memmove(buffer.data(), buffer.data() + used, filled - used);
     filled -= used;
     used = 0;
     while (filled < want && !end_of_file) {
-      const std::size_t got = std::fread(input.data() + filled, 1, input.size() - filled, file);
+      const std::size_t got = std::fread(buffer.data() + filled, 1, buffer.size() - filled, file);
       filled += got;
       read_from_file += got;
       if (got == 0) {
@@ -86,53 +88,16 @@ std::string gzip_text(std::string_view text) {
 }
 
 std::string gunzip_text(std::string_view bytes, const std::string& source, std::uintmax_t max_text_bytes) {
-  const auto is_gzip = [](std::string_view b) { return b.size() >= 2 && b[0] == '\x1f' && b[1] == '\x8b'; };
-  if (!is_gzip(bytes)) {
-    if (bytes.size() > max_text_bytes) {
-      throw DataError(source + ": more than " + std::to_string(max_text_bytes) +
-                      " bytes of text, the limit (the rest is not read)");
-    }
-    return std::string(bytes);
-  }
+  TextFileReader reader(bytes, source, max_text_bytes);
   std::string text;
   constexpr std::size_t kBlockBytes = std::size_t{1} << 18;
-  const std::size_t size = bytes.size();
-  while (is_gzip(bytes)) {  // one gzip member a turn
-    z_stream stream{};
-    if (inflateInit2(&stream, 15 + 16) != Z_OK)
-      throw DataError(source + ": cannot be read (gzip: out of memory)");
-    stream.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(bytes.data()));
-    stream.avail_in = static_cast<uInt>(std::min<std::size_t>(bytes.size(), UINT_MAX));
-    int result = Z_OK;
-    while (result != Z_STREAM_END) {
-      const std::size_t kept = text.size();
-      text.resize(kept + kBlockBytes);
-      stream.next_out = reinterpret_cast<Bytef*>(text.data() + kept);
-      stream.avail_out = static_cast<uInt>(kBlockBytes);
-      result = inflate(&stream, Z_NO_FLUSH);
-      text.resize(kept + kBlockBytes - stream.avail_out);
-      const bool stuck =
-          result == Z_BUF_ERROR || (result == Z_OK && stream.avail_in == 0 && stream.avail_out != 0);
-      if (result != Z_OK && result != Z_STREAM_END && !stuck) {
-        const std::string message = stream.msg != nullptr ? stream.msg : "damaged stream";
-        inflateEnd(&stream);
-        throw DataError(source + ": cannot be read (gzip: " + message + ")");
-      }
-      if (stuck) {  // the input ended inside the member
-        inflateEnd(&stream);
-        throw DataError(source + ": cannot be read (gzip: unexpected end of file)");
-      }
-      if (text.size() > max_text_bytes) {
-        inflateEnd(&stream);
-        throw DataError(source + ": more than " + std::to_string(max_text_bytes) +
-                        " bytes of text, the limit (the rest is not read)");
-      }
-    }
-    bytes.remove_prefix(bytes.size() - stream.avail_in);
-    inflateEnd(&stream);
+  while (true) {
+    const std::size_t kept = text.size();
+    text.resize(kept + kBlockBytes);
+    const std::size_t got = reader.read(text.data() + kept, kBlockBytes);
+    text.resize(kept + got);
+    if (got == 0) return text;
   }
-  if (!bytes.empty()) throw bytes_after_gzip(source, size - bytes.size(), bytes.size());
-  return text;
 }
 
 TextFileReader::TextFileReader(const std::filesystem::path& file, std::uintmax_t max_file_bytes,
@@ -142,9 +107,26 @@ TextFileReader::TextFileReader(const std::filesystem::path& file, std::uintmax_t
   State& s = *state_;
   s.file = std::fopen(name_.c_str(), "rb");
   if (s.file == nullptr) throw DataError(name_ + ": cannot be opened");
-  s.input.resize(256 * 1024);
+  s.buffer.resize(256 * 1024);
+  s.input = s.buffer.data();
   s.refill(name_, 2);
-  s.gzip = starts_gzip(s.input.data(), s.filled);
+  start();
+}
+
+TextFileReader::TextFileReader(std::string_view bytes, std::string source, std::uintmax_t max_text_bytes)
+    : name_(std::move(source)), state_(std::make_unique<State>()), max_text_bytes_(max_text_bytes) {
+  file_bytes_ = bytes.size();
+  State& s = *state_;
+  s.input = reinterpret_cast<const unsigned char*>(bytes.data());
+  s.filled = bytes.size();
+  s.read_from_file = bytes.size();
+  s.end_of_file = true;
+  start();
+}
+
+void TextFileReader::start() {
+  State& s = *state_;
+  s.gzip = starts_gzip(s.input, s.filled);
   if (s.gzip) {
     // 15 window bits + 16: a gzip member (zlib.h, inflateInit2); inflateReset for each further one.
     if (inflateInit2(&s.stream, 15 + 16) != Z_OK)
@@ -162,13 +144,13 @@ std::size_t TextFileReader::read(char* out, std::size_t size) {
   if (!s.gzip) {
     s.refill(name_, 1);
     got = std::min(size, s.filled - s.used);
-    std::memcpy(out, s.input.data() + s.used, got);
+    std::memcpy(out, s.input + s.used, got);
     s.used += got;
   }
   while (s.gzip && got == 0 && !s.done && size > 0) {
     s.refill(name_, 1);
-    s.stream.next_in = s.input.data() + s.used;
-    s.stream.avail_in = static_cast<uInt>(s.filled - s.used);
+    s.stream.next_in = const_cast<Bytef*>(s.input + s.used);  // zlib's next_in is not const (zlib.h)
+    s.stream.avail_in = static_cast<uInt>(std::min<std::size_t>(s.filled - s.used, UINT_MAX));
     s.stream.next_out = reinterpret_cast<Bytef*>(out);
     s.stream.avail_out = static_cast<uInt>(size);
     const int result = inflate(&s.stream, Z_NO_FLUSH);
@@ -180,7 +162,7 @@ std::size_t TextFileReader::read(char* out, std::size_t size) {
       const std::size_t left = s.filled - s.used;
       if (left == 0) {
         s.done = true;
-      } else if (starts_gzip(s.input.data() + s.used, left)) {
+      } else if (starts_gzip(s.input + s.used, left)) {
         inflateReset(&s.stream);
       } else {
         const std::uintmax_t offset = s.read_from_file - left;

@@ -33,6 +33,9 @@ class TextFileReader {
   /// than `max_file_bytes` on disk or cannot be opened.
   TextFileReader(const std::filesystem::path& file, std::uintmax_t max_file_bytes,
                  std::uintmax_t max_text_bytes);
+  /// Reads `bytes` already in memory (not copied: they outlive the reader), named `source` in errors;
+  /// gunzip_text reads through this.
+  TextFileReader(std::string_view bytes, std::string source, std::uintmax_t max_text_bytes);
   ~TextFileReader();
   TextFileReader(const TextFileReader&) = delete;
   TextFileReader& operator=(const TextFileReader&) = delete;
@@ -47,6 +50,7 @@ class TextFileReader {
   [[nodiscard]] std::uintmax_t file_offset() const;
 
  private:
+  void start();  // after the first bytes are in: gzip or not, and the inflater for gzip
   struct State;  // the open file, its unread bytes and the inflater (compressed_text.cpp)
   std::string name_;
   std::unique_ptr<State> state_;
