@@ -64,7 +64,7 @@ StudyTables through_folders(const std::filesystem::path& root, const LoadedProto
       setup.individual_differences = cohort.individual_differences;
       setup.session_number = number;
       std::optional<PreviousSession> previous = session_series(root, subject.id, protocol).previous;
-      if (previous) previous->delay = "simulated";
+      if (previous) previous->delay = SessionDelay::simulated;
       SessionFolder session = SessionFolder::create(root, setup, protocol, previous);
       REQUIRE(run_session(session, study_test::run_options()).complete());
     }
@@ -173,7 +173,7 @@ TEST_CASE("a cohort's threads change none of its rows", "[study][cohort]") {
   LoadedProtocol protocol = two_day_protocol(kSmall);
   const std::vector<SubjectAssignment> subjects = numbered_subjects(3);
   CohortSetup setup;
-  setup.writer_learning = "none";
+  setup.writer_learning = WriterLearning::none;
   std::size_t reported = 0;
   const StudyTables one =
       simulate_cohort(protocol, subjects, setup, 1, [&](std::size_t done) { reported = done; });
@@ -199,7 +199,7 @@ TEST_CASE("a cohort refuses what it cannot run, naming it", "[study][cohort]") {
   CHECK_THROWS_WITH(simulate_subject(two_day_protocol(), {"S01", 1}, bad),
                     Catch::Contains("CohortSetup.writer_profile"));
   bad = {};
-  bad.writer_learning = "three-state";
+  bad.writer_learning = static_cast<WriterLearning>(7);  // outside the table
   CHECK_THROWS_WITH(simulate_subject(two_day_protocol(), {"S01", 1}, bad),
                     Catch::Contains("CohortSetup.writer_learning"));
   CHECK_THROWS_AS(simulate_cohort(two_day_protocol(), numbered_subjects(1), {}, 0), InvalidArgument);

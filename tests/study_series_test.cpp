@@ -88,7 +88,7 @@ TEST_CASE("a predecessor that ended after now is recorded as measured and read b
   CHECK(series.previous->session_sha256.size() == 64);
 
   PreviousSession previous = *series.previous;
-  previous.delay = "overridden";
+  previous.delay = SessionDelay::overridden;
   setup.session_number = 2;
   fs::path second_folder;
   {

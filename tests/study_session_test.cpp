@@ -701,7 +701,7 @@ TEST_CASE("a protocol over two days: sessions linked, the delay recorded, groups
   CHECK_FALSE(series.due());
 
   PreviousSession previous = *series.previous;
-  previous.delay = "simulated";
+  previous.delay = SessionDelay::simulated;
   setup.session_number = 2;
   fs::path second_folder;
   {
@@ -713,7 +713,7 @@ TEST_CASE("a protocol over two days: sessions linked, the delay recorded, groups
   const SessionFolder reopened = SessionFolder::open(second_folder);
   REQUIRE(reopened.manifest().previous);
   CHECK(reopened.manifest().previous->session_id == first_id);
-  CHECK(reopened.manifest().previous->delay == "simulated");
+  CHECK(reopened.manifest().previous->delay == SessionDelay::simulated);
   CHECK(reopened.manifest().setup.session_number == 2);
   series = session_series(temp.path, "S1", protocol);
   CHECK(series.next == 3);
@@ -744,7 +744,7 @@ TEST_CASE("a learning simulated subject writes with what it learned, the same af
   // Both days of subject L1 under `root`; the first day stopped after `stop_after` trials and resumed.
   const auto run_days = [&protocol](const fs::path& root, std::size_t stop_after) {
     SessionSetup setup = simulated("L1");
-    setup.writer_learning = "two-state";
+    setup.writer_learning = WriterLearning::two_state;
     setup.individual_differences = false;  // compared with the novice profile's own fields below
     fs::path first_folder;
     {
@@ -763,7 +763,7 @@ TEST_CASE("a learning simulated subject writes with what it learned, the same af
     const SessionSeries series = session_series(root, "L1", protocol);
     REQUIRE(series.previous);
     PreviousSession previous = *series.previous;
-    previous.delay = "simulated";
+    previous.delay = SessionDelay::simulated;
     setup.session_number = 2;
     SessionFolder second = SessionFolder::create(root, setup, protocol, previous);
     REQUIRE(run_session(second, study_test::run_options()).complete());
@@ -805,7 +805,7 @@ TEST_CASE("a learning subject's guidance takes shape and timing apart: the fixtu
             "trial": {"max_duration_s": 40}})",
                            "apart.json");
     SessionSetup setup = simulated("A1");
-    setup.writer_learning = "two-state";
+    setup.writer_learning = WriterLearning::two_state;
     SessionFolder session = SessionFolder::create(temp.path, setup, protocol);
     REQUIRE(run_session(session, study_test::run_options()).complete());
     const TrialRow last = read_study_tables({temp.path}).trials.back();
@@ -870,19 +870,21 @@ TEST_CASE(
     "[study][session]") {
   TempFolder temp;
   SessionSetup setup = simulated("S07");
-  setup.writer = "person";
+  setup.writer = TrialWriter::person;
   SessionFolder session = SessionFolder::create(temp.path / "S07", setup, small_protocol());
   nlohmann::json document = nlohmann::json::parse(read(session.path() / "session.json"));
   CHECK(document["writer"] == "person");
   CHECK(document["version"] == 3);
-  CHECK(study_detail::manifest_from_json(document.dump(2), "session.json").setup.writer == "person");
+  CHECK(study_detail::manifest_from_json(document.dump(2), "session.json").setup.writer ==
+        TrialWriter::person);
 
   // Versions 1 and 2 said "human": read as "person". Version 3 refuses it as any other unknown spelling.
   document["writer"] = "human";
   CHECK_THROWS_WITH(study_detail::manifest_from_json(document.dump(2), "session.json"),
                     Catch::StartsWith("session.json: /writer: ") && Catch::Contains("\"person\""));
   document["version"] = 2;
-  CHECK(study_detail::manifest_from_json(document.dump(2), "session.json").setup.writer == "person");
+  CHECK(study_detail::manifest_from_json(document.dump(2), "session.json").setup.writer ==
+        TrialWriter::person);
 
   // A trial record of version 2 says "human" as well; every reader of records sees "person".
   const auto record_with = [&](int version, const char* kind) {

@@ -2038,7 +2038,7 @@ TEST_CASE("unseen12j: cohorts of no, one and too many subjects, and the guidance
   })",
                                                      "tiny.json");
   CohortSetup setup;
-  setup.writer_learning = "none";
+  setup.writer_learning = WriterLearning::none;
   setup.individual_differences = false;
   setup.load_character = [](char32_t c) { return embedded_character(c); };
   CHECK_REFUSED(InvalidArgument, simulate_cohort(protocol, one, setup, 0), "");

@@ -28,6 +28,16 @@ TEST_CASE("The named profiles are valid and differ as described", "[writer]") {
   CHECK_THROWS_WITH(writer_profile("expert"), Catch::Contains("expert") && Catch::Contains("foreign"));
 }
 
+TEST_CASE("Every name of the profile list is a profile of that name, and an unknown one lists them all",
+          "[writer]") {
+  const auto names = writer_profile_names();
+  REQUIRE(names.size() == 3);
+  for (const std::string_view name : names) {
+    CHECK(writer_profile(name).name == name);
+    CHECK_THROWS_WITH(writer_profile(std::string(name) + "x"), Catch::Contains(std::string(name)));
+  }
+}
+
 TEST_CASE("validate names the field that is out of range", "[writer]") {
   WriterProfile p;
   p.writing_speed_m_s = -0.01;

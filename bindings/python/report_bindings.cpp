@@ -184,7 +184,11 @@ order: a list of dicts with ``name`` (its SI unit in it, as the library's DataFr
         for (const auto& [id, number] : subjects) assigned.push_back({id, number});
         CohortSetup setup;
         setup.writer_profile = profile;
-        setup.writer_learning = learning;
+        try {
+          setup.writer_learning = parse_enum<WriterLearning>(learning);
+        } catch (const InvalidArgument& e) {
+          throw InvalidArgument(std::string("CohortSetup.writer_learning: ") + e.what());
+        }
         setup.individual_differences = individual_differences;
         setup.load_character = load;
         StudyTables tables;

@@ -6,6 +6,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -318,8 +319,8 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   // specification alone then states the writer that wrote, as `--writer-profile` and `--writer-param` do.
   // The profile itself is also an input below, and the record keeps it whole.
   const std::string& profile_name = simulation.writer.name;
-  if (profile_name == "novice" || profile_name == "skilled" || profile_name == "foreign")
-    spec.writer_profile = profile_name;
+  const auto named = writer_profile_names();
+  if (std::find(named.begin(), named.end(), profile_name) != named.end()) spec.writer_profile = profile_name;
   const WriterProfile base = writer_profile(spec.writer_profile);
   for (const std::string& key : writer_parameter_names()) {
     const double value = writer_parameter(simulation.writer, key);

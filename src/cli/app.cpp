@@ -183,6 +183,10 @@ CLI::Option* add_number_list(CLI::App& app, const std::string& name, std::vector
   });
 }
 
+std::vector<std::string> name_choices(std::span<const std::string_view> names) {
+  return {names.begin(), names.end()};
+}
+
 CLI::Option* add_choice(CLI::App& app, const std::string& name, std::string& target,
                         const std::vector<std::string>& choices, const std::string& description,
                         const std::string& default_text, const std::map<std::string, std::string>& retired) {

@@ -128,8 +128,8 @@ SessionRunOptions run_options(const DeviceRegistry& devices, const LibraryOption
 
 #ifdef CALLIGRAPHY_WITH_TRAINER
 // A person's session goes to the trainer window unless --display terminal.
-bool in_window(const SessionDisplay& display, const std::string& writer) {
-  return writer == kPersonWriter && display.display == "window";
+bool in_window(const SessionDisplay& display, TrialWriter writer) {
+  return writer == TrialWriter::person && display.display == "window";
 }
 #endif
 
@@ -274,8 +274,8 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
   if (command.subjects > 0 && command.writer == kPersonWriter) {
     throw UsageError("--subjects: simulated subjects need --writer simulated");
   }
-  const std::string writer = writer_for_device(command.writer, *device);
-  const bool person = writer == kPersonWriter;
+  const TrialWriter writer = writer_for_device(command.writer, *device);
+  const bool person = writer == TrialWriter::person;
   if (person && command.learning_option->count() > 0 && command.writer_learning != "none") {
     throw UsageError("--writer-learning models the simulated writer, not a person (--writer person)");
   }
@@ -378,9 +378,10 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
     setup.writer = writer;
     setup.writer_profile = profiles[i % profiles.size()];
     setup.writer_seed = subject_seed(setup.subject.id);
-    setup.writer_learning = person ? "none" : command.writer_learning;
+    setup.writer_learning =
+        person ? WriterLearning::none : parse_enum<WriterLearning>(command.writer_learning);
     setup.individual_differences = !person && command.individual_differences == "on";
-    setup.pacing = command.pacing;
+    setup.pacing = parse_enum<TrialPacing>(command.pacing);
     setup.session_number = session_number;
     return setup;
   };
@@ -495,9 +496,9 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
       }
       if (previous && !series.due()) {
         if (!person) {
-          previous->delay = "simulated";
+          previous->delay = SessionDelay::simulated;
         } else if (command.ignore_delay) {
-          previous->delay = "overridden";
+          previous->delay = SessionDelay::overridden;
         } else {
           throw StateError(subjects[i].id + ": session " + std::to_string(series.next) + " of " +
                            protocol.protocol.name + " is due " + shortest_decimal(previous->delay_s) +
@@ -558,8 +559,9 @@ int resume_session(const SessionResumeCommand& command, DeviceRegistry& devices)
   session.check_writable();  // before the first trial: a folder no trial could be saved in
   TerminalHost host;
   std::shared_ptr<CharacterSource> source;
-  SessionRunOptions options = run_options(
-      devices, command.library, session.manifest().setup.writer == kPersonWriter ? &host : nullptr, source);
+  SessionRunOptions options =
+      run_options(devices, command.library,
+                  session.manifest().setup.writer == TrialWriter::person ? &host : nullptr, source);
   if (!command.pacing.empty()) {
     options.pacing = parse_trial_pacing(command.pacing, "--pacing");
   }
@@ -619,14 +621,14 @@ void add_session_commands(CLI::App& root, Commands& commands, DeviceRegistry& de
       "the simulated writer's profile, novice, skilled or foreign; a comma-separated list is used by subject "
       "in turn");
   run->learning_option = add_choice(
-      *app, "--writer-learning", run->writer_learning, {"none", "two-state"},
+      *app, "--writer-learning", run->writer_learning, enum_choices<WriterLearning>(),
       "how a simulated subject learns: none (every trial from its profile) or two-state (a memory per "
       "typical stroke and character that practice builds and time between sessions thins; docs/writer.md), "
       "as `session cohort`; a person's session records none");
   add_choice(*app, "--individual-differences", run->individual_differences, {"on", "off"},
              "on: each simulated subject draws its own baseline skill, motor noise and learning rates from "
              "its id (docs/writer.md); off: every subject is the profile itself");
-  add_choice(*app, "--pacing", run->pacing, {"auto", "lock-step", "real-time"},
+  add_choice(*app, "--pacing", run->pacing, enum_choices<TrialPacing>(),
              "auto: lock-step for a simulated writer, real time for a person; real-time paces a simulated "
              "writer by the wall clock");
   required(
@@ -651,7 +653,7 @@ void add_session_commands(CLI::App& root, Commands& commands, DeviceRegistry& de
                    [resume, &devices] { return resume_session(*resume, devices); });
   add_positional(*resume_app, "DIR", resume->folder, "the session folder (the one holding session.json)",
                  "DIR");
-  add_choice(*resume_app, "--pacing", resume->pacing, {"auto", "lock-step", "real-time"},
+  add_choice(*resume_app, "--pacing", resume->pacing, enum_choices<TrialPacing>(),
              "overrides the pacing the session was started with", "the session's own pacing");
   add_library_options(*resume_app, resume->library, true);
   add_display_options(*resume_app, resume->display);

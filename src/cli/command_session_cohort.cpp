@@ -12,6 +12,7 @@
 #include "calligraphy/study/cohort.hpp"
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/study_tables.hpp"
+#include "calligraphy/trial/writer_profile.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 #include "cli/output.hpp"
@@ -59,7 +60,7 @@ int run_session_cohort(const SessionCohortCommand& command) {
   const LoadedProtocol resolved = resolved_protocol(protocol, characters);
   CohortSetup setup;
   setup.writer_profile = command.writer_profile;
-  setup.writer_learning = command.writer_learning;
+  setup.writer_learning = parse_enum<WriterLearning>(command.writer_learning);
   setup.individual_differences = command.individual_differences == "on";
   setup.load_character = [&characters](char32_t c) { return characters.load(c); };
   std::vector<SubjectAssignment> subjects;
@@ -104,9 +105,9 @@ void add_session_cohort_command(CLI::App& session, Commands& commands) {
                        "simulated subjects PREFIX01..PREFIXN, numbered 1..N", 1,
                        static_cast<long long>(kMaxCohortSubjects)));
   add_text(*app, "--subject", command->prefix, "PREFIX", "the prefix of the subjects' ids");
-  add_choice(*app, "--writer-profile", command->writer_profile, {"novice", "skilled", "foreign"},
+  add_choice(*app, "--writer-profile", command->writer_profile, name_choices(writer_profile_names()),
              "the simulated subjects' profile");
-  add_choice(*app, "--writer-learning", command->writer_learning, {"none", "two-state"},
+  add_choice(*app, "--writer-learning", command->writer_learning, enum_choices<WriterLearning>(),
              "how a subject learns: none (every trial from its profile) or two-state (docs/writer.md)");
   add_choice(*app, "--individual-differences", command->individual_differences, {"on", "off"},
              "on: each subject draws its own baseline skill, motor noise and learning rates from its id "

@@ -104,26 +104,13 @@ int run_train(const TrainCommand& command, DeviceRegistry& devices) {
   trainer::register_trainer_devices(devices);
   const std::u32string chars = characters_from(command.characters, "CHARS");
   trainer::TrainerOptions options;
-  options.simulated_writer = command.writer == "simulated";
-  options.device = !command.device.empty()    ? command.device
-                   : options.simulated_writer ? "simulated"
-                                              : "mouse-hand";
+  const bool simulated_writer = command.writer == kSimulatedWriter;
+  options.device = !command.device.empty() ? command.device : simulated_writer ? "simulated" : "mouse-hand";
   options.registry = &devices;  // the command line's devices, the mouse ones included
-  {  // a simulated writer moves only a device with a hand port; a person moves any other
-    const bool hand_port =
-        find_cli_device(devices, "--device", options.device).capabilities.moved_by_simulated_hand;
-    if (options.simulated_writer && !hand_port) {
-      throw UsageError(
-          "--writer simulated needs a device a simulated writer can move (simulated, "
-          "emulated-phantom), not '" +
-          options.device + "'");
-    }
-    if (!options.simulated_writer && hand_port) {
-      throw UsageError(
-          "--device " + options.device +
-          " is moved by the simulated writer: add --writer simulated, or use mouse or mouse-hand");
-    }
-  }
+  // A simulated writer moves only a device with a hand port; a person moves any other.
+  options.simulated_writer =
+      writer_for_device(command.writer, find_cli_device(devices, "--device", options.device)) ==
+      TrialWriter::simulated;
   options.guidance = command.guidance == "on";
   options.quiz = command.quiz;
   options.engineer = command.engineer;
@@ -199,8 +186,10 @@ void add_train_command(CLI::App& root, Commands& commands, DeviceRegistry& devic
            "the device: mouse, mouse-hand (docs/devices.md), a haptic device, or simulated with --writer "
            "simulated",
            "mouse-hand; simulated with --writer simulated");
-  add_choice(*app, "--writer", command->writer, {"person", "simulated"},
-             "who writes: a person, or the simulated writer live on the simulated device (a demonstration)");
+  add_writer_option(
+      *app, command->writer,
+      "who writes: a person, or the simulated writer live on the simulated device (a demonstration)",
+      "person");
   add_choice(*app, "--guidance", command->guidance, {"on", "off"},
              "guiding force towards the stroke (G toggles)");
   add_choice(*app, "--guidance-mode", command->guidance_mode, guidance_mode_choices(),

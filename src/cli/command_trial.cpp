@@ -383,7 +383,7 @@ void add_trial_command(CLI::App& root, Commands& commands, DeviceRegistry& devic
   add_input_path(*app, "--teacher", command->spec.teacher, "FILE", spec_help("teacher"), "none");
   add_writer_option(*app, command->writer, spec_help("writer"),
                     "simulated on a simulated or emulated device, person on hardware", true);
-  add_choice(*app, "--writer-profile", command->writer_profile, {"novice", "skilled", "foreign"},
+  add_choice(*app, "--writer-profile", command->writer_profile, name_choices(writer_profile_names()),
              spec_help("writer_profile"));
   add_repeated_text(*app, "--writer-param", command->writer_parameters, "KEY=VALUE",
                     spec_help("writer_parameters") + " (repeatable)");

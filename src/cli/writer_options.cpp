@@ -34,20 +34,22 @@ bool simulated_writer_moves(const DeviceListing& device) {
   return device.capabilities.moved_by_simulated_hand;
 }
 
-std::string writer_for_device(const std::string& given, const DeviceListing& device) {
+TrialWriter writer_for_device(const std::string& given, const DeviceListing& device) {
   const bool simulated_device = simulated_writer_moves(device);
-  if (given.empty()) return simulated_device ? kSimulatedWriter : kPersonWriter;
+  if (given.empty()) return simulated_device ? TrialWriter::simulated : TrialWriter::person;
   if (given == kSimulatedWriter && !simulated_device) {
-    throw UsageError("--writer simulated: the device '" + device.name +
+    throw UsageError("--writer simulated with --device " + device.name + ": the device '" + device.name +
                      "' is moved by a person (--writer person); the simulated writer moves simulated and "
                      "emulated-phantom");
   }
   if (given == kPersonWriter && simulated_device) {
-    throw UsageError("--writer person: a person cannot hold the device '" + device.name +
+    throw UsageError("--writer person with --device " + device.name + ": a person cannot hold the device '" +
+                     device.name +
                      "', the simulated writer moves it (--writer simulated); a person writes on a haptic "
-                     "device of `calligraphy devices`, or with the mouse in `calligraphy train`");
+                     "device of `calligraphy devices`, or with the mouse in `calligraphy train` (mouse, "
+                     "mouse-hand)");
   }
-  return given;
+  return given == kSimulatedWriter ? TrialWriter::simulated : TrialWriter::person;
 }
 
 std::vector<std::string> guidance_mode_choices() {

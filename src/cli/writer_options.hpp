@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "calligraphy/devices/device_registry.hpp"
+#include "calligraphy/trial/trial_spec.hpp"
 #include "cli/app.hpp"
 
 namespace calligraphy::cli {
@@ -26,9 +27,9 @@ CLI::Option* add_writer_option(CLI::App& app, std::string& target, const std::st
 bool simulated_writer_moves(const DeviceListing& device);
 
 /// Who writes on `device`: `given` ("person", "simulated", or "" for the device's own: the simulated
-/// writer on a device it moves, a person on any other). Throws UsageError naming --writer when that writer
-/// cannot move the device.
-std::string writer_for_device(const std::string& given, const DeviceListing& device);
+/// writer on a device it moves, a person on any other), never `automatic`. Throws UsageError naming
+/// --writer when that writer cannot move the device.
+TrialWriter writer_for_device(const std::string& given, const DeviceListing& device);
 
 /// Every guidance mode's name (`guidance_modes`, render/guidance_mode.hpp), for --guidance-mode.
 std::vector<std::string> guidance_mode_choices();

@@ -46,12 +46,12 @@ SessionManifest cohort_manifest(const LoadedProtocol& protocol, const SubjectAss
   manifest.session_id = protocol.protocol.name + "-" + subject.id + "-s" + std::to_string(number);
   manifest.setup.subject = subject;
   manifest.setup.device = kCohortDevice;
-  manifest.setup.writer = "simulated";
+  manifest.setup.writer = TrialWriter::simulated;
   manifest.setup.writer_profile = setup.writer_profile;
   manifest.setup.writer_seed = subject_seed(subject.id);
   manifest.setup.writer_learning = setup.writer_learning;
   manifest.setup.individual_differences = setup.individual_differences;
-  manifest.setup.pacing = "lock-step";
+  manifest.setup.pacing = TrialPacing::lock_step;
   manifest.setup.session_number = number;
   manifest.protocol = protocol;
   manifest.plan = plan_session(protocol.protocol, subject, number);
@@ -83,7 +83,7 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
     guidance = study_detail::repetition_guidance(condition, previous, previous_record, source);
   }
   TrialSpec spec = study_trial_spec(manifest, condition, trial, guidance.guidance);
-  const bool learning = manifest.setup.writer_learning == "two-state";
+  const bool learning = manifest.setup.writer_learning == WriterLearning::two_state;
   std::optional<WriterSkills> skills;
   if (learning)
     skills = study_detail::learn_into(spec, memory, study_detail::subject_profile(manifest.setup), scene,
@@ -140,9 +140,9 @@ void CohortSetup::validate() const {
   } catch (const InvalidArgument& e) {
     throw InvalidArgument(std::string("CohortSetup.writer_profile: ") + e.what());
   }
-  if (writer_learning != "none" && writer_learning != "two-state") {
-    throw InvalidArgument("CohortSetup.writer_learning '" + writer_learning +
-                          "': expected 'none' or 'two-state'");
+  if (enum_spelling(writer_learning) == "?") {  // a value cast from outside the table
+    throw InvalidArgument("CohortSetup.writer_learning: expected " +
+                          join_spellings(enum_spellings<WriterLearning>(), " or ", "'"));
   }
 }
 

@@ -151,12 +151,12 @@ std::string manifest_to_json(const SessionManifest& manifest) {
                    {"session_number", setup.session_number},
                    {"group", manifest.group},
                    {"device", setup.device},
-                   {"writer", setup.writer},
+                   {"writer", std::string(enum_spelling(setup.writer))},
                    {"writer_profile", setup.writer_profile},
                    {"writer_seed", setup.writer_seed},
-                   {"writer_learning", setup.writer_learning},
+                   {"writer_learning", std::string(enum_spelling(setup.writer_learning))},
                    {"individual_differences", setup.individual_differences},
-                   {"pacing", setup.pacing},
+                   {"pacing", std::string(enum_spelling(setup.pacing))},
                    {"library", library_build_json(manifest.library)},
                    {"protocol",
                     {{"name", manifest.protocol.protocol.name},
@@ -170,7 +170,7 @@ std::string manifest_to_json(const SessionManifest& manifest) {
                                     {"ended_utc", p.ended_utc},
                                     {"delay_s", p.delay_s},
                                     {"elapsed_s", p.elapsed_s},
-                                    {"delay", p.delay}};
+                                    {"delay", std::string(enum_spelling(p.delay))}};
     if (!p.session_sha256.empty()) document["previous_session"]["session_sha256"] = p.session_sha256;
   }
   if (!manifest.study_id.empty()) document["study_id"] = manifest.study_id;
@@ -209,7 +209,7 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
   }
   manifest.setup.subject.number = static_cast<std::size_t>(read.subject.number);
   manifest.setup.device = read.device;
-  manifest.setup.writer = std::string(enum_spelling(read.writer));
+  manifest.setup.writer = read.writer == WriterKind::person ? TrialWriter::person : TrialWriter::simulated;
   manifest.setup.writer_profile = read.writer_profile;
   try {  // as check_setup refuses it when a session is made
     (void)writer_profile(manifest.setup.writer_profile);
@@ -217,9 +217,9 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
     json_detail::fail(source, "/writer_profile", error.what());
   }
   manifest.setup.writer_seed = read.writer_seed;
-  manifest.setup.writer_learning = std::string(enum_spelling(read.writer_learning));
+  manifest.setup.writer_learning = read.writer_learning;
   manifest.setup.individual_differences = read.individual_differences;
-  manifest.setup.pacing = to_string(read.pacing);
+  manifest.setup.pacing = read.pacing;
   manifest.setup.session_number = static_cast<int>(read.session_number);
   manifest.group = read.group;
   manifest.study_id = read.study_id;
@@ -229,13 +229,7 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
         "expected 32 lower-case hex digits, got " + json_detail::describe(json(manifest.study_id)));
   }
   if (!defaulted(missing, "/previous_session")) {
-    const PreviousSession& p = read.previous_session;
-    if (p.delay != "waited" && p.delay != "simulated" && p.delay != "overridden") {
-      json_detail::fail(source, "/previous_session/delay",
-                        "expected \"waited\", \"simulated\" or \"overridden\", got " +
-                            json_detail::describe(json(p.delay)));
-    }
-    manifest.previous = p;
+    manifest.previous = read.previous_session;
   }
   if (manifest.previous.has_value() != (manifest.setup.session_number > 1)) {
     json_detail::fail(source, "/previous_session", "expected exactly for a session after the first");
@@ -303,9 +297,9 @@ std::string session_created_details(const SessionManifest& manifest) {
   return json{{"subject", setup.subject.id},
               {"subject_number", setup.subject.number},
               {"device", setup.device},
-              {"writer", setup.writer},
+              {"writer", std::string(enum_spelling(setup.writer))},
               {"writer_profile", setup.writer_profile},
-              {"writer_learning", setup.writer_learning},
+              {"writer_learning", std::string(enum_spelling(setup.writer_learning))},
               {"individual_differences", setup.individual_differences},
               {"protocol", manifest.protocol.protocol.name},
               {"protocol_sha256", manifest.protocol.sha256},

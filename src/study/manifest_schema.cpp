@@ -98,7 +98,7 @@ const Schema& SchemaOf<PreviousSession>::get() {
       // Any finite time: a clock that differs between the sessions is recorded as it was measured.
       number_field<&P::elapsed_s>("elapsed_s", {.low = -1e15, .high = 1e15},
                                   {.unit = "s", .doc = "from ended_utc to this session's creation"}),
-      string_field<&P::delay>("delay", {.doc = "\"waited\", \"simulated\" or \"overridden\""}),
+      enum_field<&P::delay>("delay", {.doc = "how the protocol's delay before this session was kept"}),
       omissible(string_field<&P::session_sha256>(
           "session_sha256", {.doc = "lower-case hex SHA-256 of its session.json when this session was made; "
                                     "absent in sessions made before it was recorded",
@@ -179,7 +179,6 @@ std::string session_manifest_json_schema_text() {
   planned["sequence"]["pattern"] = "^[A-Z]{1,26}$";
   root["$defs"]["SessionSubject"]["properties"]["id"]["pattern"] = "^[A-Za-z0-9_-]{1,64}$";
   root["properties"]["study_id"]["pattern"] = "^[0-9a-f]{32}$";
-  root["$defs"]["PreviousSession"]["properties"]["delay"]["enum"] = {"waited", "simulated", "overridden"};
   root["if"] = {{"properties", {{"version", {{"const", 1}}}}}, {"required", {"version"}}};
   root["then"] = {{"properties", {{"plan", {{"items", {{"properties", from_zero}}}}}}}};
   root["else"] = {{"properties", {{"plan", {{"items", {{"properties", from_one}}}}}}}};

@@ -25,9 +25,6 @@ inline constexpr std::int64_t kSessionVersion = 3;
 /// Who wrote a session's trials (SessionSetup::writer).
 enum class WriterKind { simulated, person };
 
-/// How a simulated subject learns from trial to trial (SessionSetup::writer_learning).
-enum class WriterLearning { none, two_state };
-
 struct ManifestSubject {
   std::string id;
   std::int64_t number = 0;
@@ -88,16 +85,6 @@ struct EnumTable<study_detail::WriterKind> {
   static constexpr std::array<EnumEntry<study_detail::WriterKind>, 2> entries{{
       {study_detail::WriterKind::simulated, "simulated", "the simulated writer of writer_profile"},
       {study_detail::WriterKind::person, "person", "a person at the device"},
-  }};
-};
-
-template <>
-struct EnumTable<study_detail::WriterLearning> {
-  static constexpr std::string_view name = "WriterLearning";
-  static constexpr std::array<EnumEntry<study_detail::WriterLearning>, 2> entries{{
-      {study_detail::WriterLearning::none, "none", "each trial written from the subject's profile"},
-      {study_detail::WriterLearning::two_state, "two-state",
-       "a memory per typical stroke and character, rebuilt from the saved trials"},
   }};
 };
 

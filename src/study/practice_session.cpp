@@ -49,10 +49,10 @@ SessionFolder create_folder(const PracticeSetup& setup) {
   SessionSetup session;
   session.subject = {setup.subject, trailing_number(setup.subject)};
   session.device = setup.device;
-  session.writer = setup.simulated_writer ? "simulated" : "person";
+  session.writer = setup.simulated_writer ? TrialWriter::simulated : TrialWriter::person;
   session.writer_profile = setup.writer_profile;
   session.writer_seed = setup.writer_seed;
-  session.pacing = "real-time";
+  session.pacing = TrialPacing::real_time;
   return SessionFolder::create(setup.root, session, practice_protocol(setup));
 }
 

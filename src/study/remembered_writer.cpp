@@ -40,7 +40,7 @@ void remember(WriterMemory& memory, const fs::path& folder, const SessionManifes
 }  // namespace
 
 SubjectTraits subject_traits(const SessionSetup& setup) {
-  if (setup.writer != "simulated" || !setup.individual_differences) return SubjectTraits{};
+  if (setup.writer != TrialWriter::simulated || !setup.individual_differences) return SubjectTraits{};
   return draw_subject_traits(setup.writer_seed);
 }
 

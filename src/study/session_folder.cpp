@@ -176,21 +176,13 @@ void check_setup(const SessionSetup& setup) {
     throw InvalidArgument("subject id '" + setup.subject.id +
                           "': expected 1 to 64 letters, digits, '_' or '-'");
   }
-  using study_detail::WriterKind;
-  using study_detail::WriterLearning;
-  if (!enum_from_spelling<WriterKind>(setup.writer)) {
-    throw InvalidArgument("writer '" + setup.writer + "': expected " +
-                          join_spellings(enum_spellings<WriterKind>(), " or ", "'"));
+  if (setup.writer == TrialWriter::automatic) {
+    throw InvalidArgument("writer 'auto': a session's writer is 'simulated' or 'person'");
   }
   (void)writer_profile(setup.writer_profile);  // InvalidArgument naming it and the known profiles
-  (void)parse_trial_pacing(setup.pacing, "session setup");  // InvalidArgument naming the spellings
   if (setup.device.empty()) throw InvalidArgument("session setup: the device name is empty");
-  if (!enum_from_spelling<WriterLearning>(setup.writer_learning)) {
-    throw InvalidArgument("writer learning '" + setup.writer_learning + "': expected " +
-                          join_spellings(enum_spellings<WriterLearning>(), " or ", "'"));
-  }
-  if (setup.writer_learning != "none" && setup.writer != "simulated") {
-    throw InvalidArgument("writer learning '" + setup.writer_learning +
+  if (setup.writer_learning != WriterLearning::none && setup.writer != TrialWriter::simulated) {
+    throw InvalidArgument("writer learning '" + std::string(enum_spelling(setup.writer_learning)) +
                           "' models a simulated writer, not a person");
   }
 }
@@ -277,7 +269,7 @@ void check_session_manifest_size(const SessionSetup& setup, const LoadedProtocol
     previous->session_id = protocol.protocol.name + "-" + setup.subject.id + "-YYYYMMDD-HHMMSS-1000";
     previous->ended_utc = utc_now_iso8601();
     previous->session_sha256 = std::string(64, '0');
-    previous->delay = "overridden";
+    previous->delay = SessionDelay::overridden;
   }
   (void)manifest_text(make_manifest(setup, protocol, previous));
 }

@@ -128,10 +128,11 @@ void check_record_is_the_sessions(const json& document, const std::string& sourc
   differs("session", manifest.session_id, "the session");
   const json_detail::JsonView writer = record.object("writer");
   const std::string kind = writer.string_or("kind", "");
-  if (!kind.empty() && kind != manifest.setup.writer) {
+  const std::string session_writer(enum_spelling(manifest.setup.writer));
+  if (!kind.empty() && kind != session_writer) {
     json_detail::fail(source, "/writer/kind",
                       "is '" + kind + "', but the session " + manifest.session_id + " was written by a " +
-                          manifest.setup.writer +
+                          session_writer +
                           " writer: a record copied in from another session; put it back where it was saved");
   }
   const std::string profile = writer.object("profile").string_or("name", "");
@@ -212,9 +213,10 @@ ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifes
 }
 
 std::string session_line(const SessionManifest& m, const fs::path& folder, std::size_t saved) {
-  std::string writer = m.setup.writer == "simulated" ? "simulated writer (" + m.setup.writer_profile +
-                                                           ", learning " + m.setup.writer_learning + ")"
-                                                     : "person";
+  const std::string writer = m.setup.writer == TrialWriter::simulated
+                                 ? "simulated writer (" + m.setup.writer_profile + ", learning " +
+                                       std::string(enum_spelling(m.setup.writer_learning)) + ")"
+                                 : "person";
   return folder.string() + ", protocol " + m.protocol.protocol.name + " (sha256 " +
          m.protocol.sha256.substr(0, 12) + "), session " + std::to_string(m.setup.session_number) +
          ", device " + m.setup.device + ", " + writer + ", " + std::to_string(saved) + " of " +
@@ -311,7 +313,8 @@ StudyReportSessions list_report_sessions(const std::vector<fs::path>& roots) {
     }
     protocols.insert(manifest.protocol.sha256);
     protocol_names.insert(manifest.protocol.protocol.name);
-    if (manifest.setup.writer == "simulated") learning.insert(manifest.setup.writer_learning);
+    if (manifest.setup.writer == TrialWriter::simulated)
+      learning.insert(std::string(enum_spelling(manifest.setup.writer_learning)));
     ReportSession shown;
     shown.subject = manifest.setup.subject.id;
     shown.session = manifest.session_id;

@@ -52,9 +52,9 @@ void check_plan(const SessionManifest& session, const DeviceListing& device) {
     if (replays_teacher(condition)) continue;
     (void)study_trial_options(session, condition, trial);
   }
-  if (session.setup.writer == "simulated" && device.capabilities.hardware) {
+  if (session.setup.writer == TrialWriter::simulated && device.capabilities.hardware) {
     throw InvalidArgument("device '" + device.name +
-                          "' is moved by a person: a simulated writer cannot write on it (writer 'human')");
+                          "' is moved by a person: a simulated writer cannot write on it (writer 'person')");
   }
 }
 
@@ -136,8 +136,8 @@ TrialSpec study_trial_spec(const SessionManifest& session, const StudyCondition&
         },
         law);
   }
-  const bool simulated = session.setup.writer == "simulated";
-  spec.writer = simulated ? TrialWriter::simulated : TrialWriter::person;
+  const bool simulated = session.setup.writer == TrialWriter::simulated;
+  spec.writer = session.setup.writer;
   if (simulated) {
     spec.writer_profile = session.setup.writer_profile;
     // The subject's own baseline skill and motor noise (its traits); a learning subject's learned fields
@@ -153,7 +153,7 @@ TrialSpec study_trial_spec(const SessionManifest& session, const StudyCondition&
   const StudyProtocol& protocol = session.protocol.protocol;
   spec.rate_hz = protocol.trial.rate_hz;
   spec.max_duration_s = protocol.trial.max_duration_s;
-  spec.pacing = parse_trial_pacing(session.setup.pacing, "session pacing");
+  spec.pacing = session.setup.pacing;
   return spec;
 }
 
@@ -179,9 +179,9 @@ class SessionRun {
         registry_(registry),
         manifest_(session.manifest()),
         listing_(registry.find(manifest_.setup.device)),  // only its backend is scanned
-        simulated_writer_(manifest_.setup.writer == "simulated"),
+        simulated_writer_(manifest_.setup.writer == TrialWriter::simulated),
         // A learning simulated subject remembers its saved trials, of this session and the ones before it.
-        learning_(simulated_writer_ && manifest_.setup.writer_learning == "two-state"),
+        learning_(simulated_writer_ && manifest_.setup.writer_learning == WriterLearning::two_state),
         standard_(CharacterLibrary::standard()) {
     check_plan(manifest_, listing_);
   }

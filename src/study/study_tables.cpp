@@ -128,10 +128,10 @@ TrialRow study_detail::trial_row(const json& document, const std::string& source
   row.sequence = plan.sequence;
   if (plan.period > 0) row.period = plan.period;
   row.trained_condition = plan.trained_condition;
-  row.writer = manifest.setup.writer;
-  if (row.writer == "simulated") {
+  row.writer = enum_spelling(manifest.setup.writer);
+  if (manifest.setup.writer == TrialWriter::simulated) {
     row.writer_profile = manifest.setup.writer_profile;
-    row.writer_learning = manifest.setup.writer_learning;
+    row.writer_learning = enum_spelling(manifest.setup.writer_learning);
   }
   row.end_reason = record.string_or("end_reason", "");
   row.start_utc = record.string_or("start_time_utc", "");

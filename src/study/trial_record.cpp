@@ -153,7 +153,7 @@ json writer_json(const TrialRecordContext& c) {
                      {"strokes_given_up", c.writer_log->strokes_given_up}};
   }
   if (c.writer_skills) {
-    writer["memory"] = {{"model", c.session->setup.writer_learning},
+    writer["memory"] = {{"model", std::string(enum_spelling(c.session->setup.writer_learning))},
                         {"shape_skill", c.writer_skills->shape},
                         {"order_skill", c.writer_skills->order},
                         {"timing_skill", c.writer_skills->timing}};

@@ -7,6 +7,7 @@
 
 #include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/schema.hpp"
 
 namespace calligraphy {
 namespace {
@@ -166,12 +167,28 @@ void WriterProfile::validate() const {
   }
 }
 
+namespace {
+struct NamedProfile {
+  std::string_view name;
+  WriterProfile (*make)();
+};
+constexpr std::array<NamedProfile, 3> kNamedProfiles{{
+    {"novice", &WriterProfile::novice},
+    {"skilled", &WriterProfile::skilled},
+    {"foreign", &WriterProfile::foreign},
+}};
+constexpr std::array<std::string_view, kNamedProfiles.size()> kProfileNames{
+    kNamedProfiles[0].name, kNamedProfiles[1].name, kNamedProfiles[2].name};
+}  // namespace
+
+std::span<const std::string_view> writer_profile_names() noexcept { return kProfileNames; }
+
 WriterProfile writer_profile(std::string_view name) {
-  if (name == "novice") return WriterProfile::novice();
-  if (name == "skilled") return WriterProfile::skilled();
-  if (name == "foreign") return WriterProfile::foreign();
+  for (const NamedProfile& profile : kNamedProfiles) {
+    if (profile.name == name) return profile.make();
+  }
   throw InvalidArgument("unknown writer profile '" + std::string(name) +
-                        "'; known: novice, skilled, foreign");
+                        "'; known: " + join_spellings(kProfileNames, ", "));
 }
 
 std::vector<std::string> writer_parameter_names() {

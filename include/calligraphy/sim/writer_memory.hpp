@@ -19,9 +19,11 @@
 /// & Smith 2008, J Neurophysiol 100:2948). The skills move a profile from the writer's own towards the
 /// skilled writer's. Deterministic: the same trials give the same memory, so a resumed session rebuilds it
 /// from its records.
+#include <array>
 #include <cstdint>
 #include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "calligraphy/core/parameter_table.hpp"
@@ -29,6 +31,21 @@
 #include "calligraphy/trial/writer_profile.hpp"
 
 namespace calligraphy {
+
+/// How a simulated writer learns from trial to trial: not at all (each trial written from its profile) or by
+/// the two-state memory of this header. One spelling everywhere (EnumTable): the CLI's `--writer-learning`,
+/// session.json, the study tables and Python.
+enum class WriterLearning : std::uint8_t { none, two_state };
+
+template <>
+struct EnumTable<WriterLearning> {
+  static constexpr std::string_view name = "WriterLearning";
+  static constexpr std::array<EnumEntry<WriterLearning>, 2> entries{{
+      {WriterLearning::none, "none", "each trial written from the subject's profile"},
+      {WriterLearning::two_state, "two-state",
+       "a memory per typical stroke and character, rebuilt from the saved trials"},
+  }};
+};
 
 /// The retention factors A and learning rates B of the two-state model, per trial. Defaults: the values
 /// Smith, Ghazizadeh & Shadmehr (2006) simulate force-field adaptation with. Ranges:

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "calligraphy/model/character.hpp"
+#include "calligraphy/sim/writer_memory.hpp"
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/schedule.hpp"
 #include "calligraphy/study/study_tables.hpp"
@@ -24,9 +25,9 @@ namespace calligraphy {
 struct CohortSetup {
   /// The simulated writer's profile (`writer_profile`): "novice", "skilled" or "foreign".
   std::string writer_profile = "novice";
-  /// "none" (every trial from the profile) or "two-state" (the learning memory,
+  /// `none` (every trial from the profile) or `two_state` (the learning memory,
   /// SessionSetup::writer_learning).
-  std::string writer_learning = "two-state";
+  WriterLearning writer_learning = WriterLearning::two_state;
   /// Whether the subjects differ from one another (SessionSetup::individual_differences, sim/
   /// subject_traits.hpp); false: every subject is the profile itself.
   bool individual_differences = true;

@@ -13,6 +13,7 @@
 /// fsync'ed temporary file, which fails rather than replace an existing file; the CSV and SVG beside it
 /// are written first with `write_file_atomically`. The log is locked (flock) while a process works on the
 /// session, so two runners cannot write one session. Format of every file: docs/experiments.md.
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -22,9 +23,11 @@
 #include <string_view>
 #include <vector>
 
+#include "calligraphy/sim/writer_memory.hpp"
 #include "calligraphy/study/protocol.hpp"
 #include "calligraphy/study/schedule.hpp"
 #include "calligraphy/trial/recorded_trial.hpp"
+#include "calligraphy/trial/trial_spec.hpp"
 
 namespace calligraphy {
 
@@ -44,34 +47,51 @@ struct LibraryBuild {
 /// How a session is run: kept in session.json so that a resumed session runs the same way.
 struct SessionSetup {
   SubjectAssignment subject;
-  std::string device = "simulated";       ///< the device's name in the device registry
-  std::string writer = "simulated";       ///< "simulated" (a simulated writer moves the device) or "person"
+  std::string device = "simulated";  ///< the device's name in the device registry
+  /// Who writes: `simulated` (a simulated writer moves the device) or `person`; a session is never
+  /// `automatic` (`create` refuses it: the CLI resolves it from the device before).
+  TrialWriter writer = TrialWriter::simulated;
   std::string writer_profile = "novice";  ///< the simulated writer's profile (`writer_profile`): "novice",
                                           ///< "skilled" or "foreign"
   std::uint64_t writer_seed = 0;          ///< the simulated subject's seed (see `subject_seed`)
-  /// How a simulated subject learns from trial to trial: "none" (each trial from its profile) or "two-state"
+  /// How a simulated subject learns from trial to trial: `none` (each trial from its profile) or `two_state`
   /// (a memory per typical stroke and character, sim/writer_memory.hpp, rebuilt from the saved trials of
-  /// this session and the ones before it).
-  std::string writer_learning = "none";
+  /// this session and the ones before it); a person's session is `none`.
+  WriterLearning writer_learning = WriterLearning::none;
   /// Whether a simulated subject differs from the others of its profile (sim/subject_traits.hpp: its own
   /// baseline skill, motor noise and learning rates, drawn from `writer_seed`); false: every subject is the
   /// profile itself. Sessions made before subjects differed read as false.
   bool individual_differences = true;
-  std::string pacing = "auto";  ///< "auto", "lock-step" or "real-time" (TrialPacing)
+  TrialPacing pacing = TrialPacing::automatic;
   /// 1-based: which of the protocol's sessions (ProtocolPhase::session) this one is.
   int session_number = 1;
 };
 
+/// How the protocol's delay before a session was kept.
+enum class SessionDelay : std::uint8_t {
+  waited,      ///< elapsed_s >= delay_s
+  simulated,   ///< a simulated writer: the delay is taken as passed, not waited
+  overridden,  ///< started early on the experimenter's request, or after a session whose end lies in the
+               ///< future by this computer's clock (`elapsed_s` then negative, recorded as measured)
+};
+
+template <>
+struct EnumTable<SessionDelay> {
+  static constexpr std::string_view name = "SessionDelay";
+  static constexpr std::array<EnumEntry<SessionDelay>, 3> entries{{
+      {SessionDelay::waited, "waited", "the delay had passed"},
+      {SessionDelay::simulated, "simulated", "a simulated writer: the delay taken as passed"},
+      {SessionDelay::overridden, "overridden", "started early on the experimenter's request"},
+  }};
+};
+
 /// The session before this one in a subject's series of sessions of one protocol (session_series.hpp).
 struct PreviousSession {
-  std::string session_id;  ///< its folder's name, beside this one in the subject's folder
-  std::string ended_utc;   ///< when its last trial ended (ISO 8601)
-  double delay_s = 0.0;    ///< the protocol's delay before this session [s]
-  double elapsed_s = 0.0;  ///< from `ended_utc` to this session's creation [s]
-  /// "waited" (elapsed_s >= delay_s), "simulated" (a simulated writer: the delay is taken as passed, not
-  /// waited) or "overridden" (started early on the experimenter's request, or after a session whose end
-  /// lies in the future by this computer's clock: `elapsed_s` is then negative, recorded as measured).
-  std::string delay = "waited";
+  std::string session_id;                     ///< its folder's name, beside this one in the subject's folder
+  std::string ended_utc;                      ///< when its last trial ended (ISO 8601)
+  double delay_s = 0.0;                       ///< the protocol's delay before this session [s]
+  double elapsed_s = 0.0;                     ///< from `ended_utc` to this session's creation [s]
+  SessionDelay delay = SessionDelay::waited;  ///< how the delay was kept
   /// Lower-case hex SHA-256 of its session.json when this session was made: the content id that tells the
   /// previous session from another one of the same name. Empty for sessions made before it was recorded.
   std::string session_sha256;

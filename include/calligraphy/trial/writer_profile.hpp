@@ -101,8 +101,12 @@ struct ParameterTable<WriterProfile> {
   [[nodiscard]] static std::span<const ParameterField<WriterProfile>> fields() noexcept;
 };
 
-/// The profile called `name`: "novice", "skilled" or "foreign". Throws InvalidArgument naming the
-/// unknown name and the known ones.
+/// The names of the named profiles, "novice", "skilled" and "foreign": the one list the CLI's
+/// `--writer-profile`, specifications, session.json and Python take.
+[[nodiscard]] std::span<const std::string_view> writer_profile_names() noexcept;
+
+/// The profile called `name`, one of `writer_profile_names()`. Throws InvalidArgument naming the unknown
+/// name and the known ones.
 [[nodiscard]] WriterProfile writer_profile(std::string_view name);
 
 /// Names of the numeric fields `set_writer_parameter` knows, in declaration order.
