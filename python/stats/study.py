@@ -163,9 +163,9 @@ def _read_table(text: str, numeric: tuple[str, ...], booleans: tuple[str, ...]) 
     frame = pd.read_csv(io.StringIO(text), keep_default_na=False, na_values={c: [""] for c in numeric},
                         float_precision="round_trip",
                         dtype={**{c: "float64" for c in numeric}, "trace_sha256": str})
-    for column in booleans:  # pandas may have read "true"/"false" as booleans already
+    for column in booleans:  # pandas reads "TRUE"/"FALSE" as booleans, but not a column of no row
         if frame[column].dtype != bool:
-            frame[column] = frame[column].astype(str) == "true"
+            frame[column] = frame[column].astype(str) == "TRUE"
     for column in numeric:  # counts and indices without a gap are integers
         if column in _FLOAT_COLUMNS:
             continue
