@@ -9,7 +9,8 @@ One tiny study in setUpClass: a between-subjects protocol of two sessions on 一
 of two groups, post-test; a retention test a day later), `session run` of 3 simulated subjects, `report --csv`,
 `session cohort --csv` of the same protocol and of one subject, `calligraphy.study.load` and
 `calligraphy.cohort.simulate`, a study whose sessions saved no trial yet, a cohort whose protocol and conditions
-are named `NA` and `null`, and one saved trace through `calligraphy trace`. Every table is read once by one
+are named `NA` and `null`, a crossover cohort (item sets, sequences, periods), a cohort writing a row of two
+characters, and one saved trace through `calligraphy trace`. Every table is read once by one
 `Rscript` process (skipped visibly without Rscript), the way docs/learning-study.md reads them, and by pandas.
 Each case checks a documented promise: each table's key unique, every foreign key in its parent table and no
 row missing against the records; every column documented and every documented column there, with its type,
@@ -56,6 +57,17 @@ ODD = {"name": "NA",
        "conditions": [{"name": "NA", "mode": "vision"}, {"name": "null", "mode": "haptic"}],
        "test": {"characters": [YI], "conditions": ["NA", "null"], "repetitions": 1},
        "trial": {"max_duration_s": 2}}
+# A crossover of two sets (item_set, sequence, period and trained_condition filled) and a row of two characters.
+CROSSOVER = {"name": "xo15d",
+             "conditions": [{"name": "unguided", "mode": "vision"}, {"name": "amplify", "mode": "error-amplification"}],
+             "item_sets": [{"name": "set1", "characters": [YI]}, {"name": "set2", "characters": [SHI]}],
+             "phases": [{"phase": "pre-test", "condition": "unguided", "sets": ["set1", "set2"]},
+                        {"phase": "training", "conditions": ["unguided", "amplify"], "assignment": "crossover",
+                         "sets": ["set1", "set2"], "repetitions": 1},
+                        {"phase": "post-test", "condition": "unguided", "sets": ["set1", "set2"]}],
+             "trial": {"max_duration_s": 2}}
+ROW = {"name": "row15d", "conditions": [{"name": "V", "mode": "vision"}],
+       "test": {"characters": [YI + SHI], "conditions": ["V"], "repetitions": 1}, "trial": {"max_duration_s": 3}}
 PHASES = {"practice", "test", "pre-test", "training", "post-test", "retention", "transfer"}
 REFUSALS = {"too_short", "backwards", "wrong_place", "wrong_stroke", "wrong_order"}
 # Columns that are text (labels, names, times as text); every other column is a number, a count or a flag.
@@ -215,13 +227,17 @@ def build(root):
     """The study, its tables, its cohorts and every reader's view of them, made once."""
     (root / "p.json").write_text(json.dumps(PROTOCOL, ensure_ascii=False), encoding="utf-8")
     (root / "odd.json").write_text(json.dumps(ODD), encoding="utf-8")
-    for folder in ("tables", "cohort", "one", "zero", "odd", "empty", "empty-tables", "r"):
+    (root / "xo.json").write_text(json.dumps(CROSSOVER, ensure_ascii=False), encoding="utf-8")
+    (root / "row.json").write_text(json.dumps(ROW, ensure_ascii=False), encoding="utf-8")
+    for folder in ("tables", "cohort", "one", "zero", "odd", "xo", "row", "empty", "empty-tables", "r"):
         (root / folder).mkdir()
     cli(["session", "run", "p.json", "--subjects", str(SUBJECTS), "--out", "st"], root)
     cli(["report", str(root / "st"), "--csv", "tables"], root)  # the path study.load is given below
     cli(["session", "cohort", "p.json", "--subjects", str(SUBJECTS), "--csv", "cohort", "--jobs", "1"], root)
     cli(["session", "cohort", "p.json", "--subjects", "1", "--csv", "one", "--jobs", "1"], root)
     cli(["session", "cohort", "odd.json", "--subjects", "2", "--csv", "odd", "--jobs", "1"], root)
+    cli(["session", "cohort", "xo.json", "--subjects", "2", "--csv", "xo", "--jobs", "1"], root)
+    cli(["session", "cohort", "row.json", "--subjects", "2", "--csv", "row", "--jobs", "1"], root)
     # A study whose one session saved no trial yet: its session folder with the plan and no record.
     first = sorted((root / "st" / "S01").iterdir())[0]
     stopped = root / "st0" / "S01" / first.name
@@ -250,6 +266,8 @@ def build(root):
               "otrials": root / "one" / "trials.csv", "ostrokes": root / "one" / "strokes.csv",
               "ztrials": root / "zero" / "trials.csv", "zstrokes": root / "zero" / "strokes.csv",
               "xtrials": root / "odd" / "trials.csv", "xstrokes": root / "odd" / "strokes.csv",
+              "ktrials": root / "xo" / "trials.csv", "kstrokes": root / "xo" / "strokes.csv",
+              "wtrials": root / "row" / "trials.csv", "wstrokes": root / "row" / "strokes.csv",
               "trace": root / "trace.csv"}
     SHARED["tables"] = tables
     SHARED["r"] = None
@@ -281,6 +299,8 @@ def build(root):
     SHARED["study0"] = calligraphy.study.load(str(root / "st0"))
     SHARED["simulated"] = calligraphy.cohort.simulate(str(root / "p.json"), SUBJECTS, workers=1, progress=False)
     SHARED["odd_simulated"] = calligraphy.cohort.simulate(str(root / "odd.json"), 2, workers=1, progress=False)
+    SHARED["xo_simulated"] = calligraphy.cohort.simulate(str(root / "xo.json"), 2, workers=1, progress=False)
+    SHARED["row_simulated"] = calligraphy.cohort.simulate(str(root / "row.json"), 2, workers=1, progress=False)
     SHARED["metric_table"] = calligraphy.metric_table()
     SHARED["pandas"] = {label: pandas_read(path) for label, path in tables.items() if label != "trace"}
 
@@ -572,6 +592,33 @@ class Tables(Base):
         self.assertEqual(set(map(str, odd.trials["protocol"])), {"NA"})
         self.assert_one_frame("odd trials", self.r("xtrials"), SHARED["pandas"]["xtrials"], odd.trials)
         self.assert_one_frame("odd strokes", self.r("xstrokes"), SHARED["pandas"]["xstrokes"], odd.strokes)
+
+    def test_a_crossover_labels_read_alike(self):
+        self.python()
+        xo = SHARED["xo_simulated"]
+        self.assert_one_frame("crossover trials", self.r("ktrials"), SHARED["pandas"]["ktrials"], xo.trials)
+        self.assert_strokes_belong(self.tables["ktrials"], self.tables["kstrokes"])
+        table = self.r("ktrials")
+        self.assertEqual(table.classes["period"], "integer")  # 1-based periods, every row filled here
+        self.assertEqual(str(xo.trials["period"].dtype), "float64")  # documented: a float in Python
+        for name in ("item_set", "sequence", "trained_condition"):
+            self.assertEqual(table.classes[name], "character", name)
+        self.assertEqual({row["sequence"] for row in table.rows}, {"AB", "BA"})
+        self.assertEqual({row["item_set"] for row in table.rows}, {"set1", "set2"})
+        self.assertEqual({row["trained_condition"] for row in table.rows}, {"unguided", "amplify"})
+
+    def test_a_row_of_two_characters_numbers_its_characters_and_shares(self):
+        self.python()
+        row = SHARED["row_simulated"]
+        strokes = self.assert_strokes_belong(self.tables["wtrials"], self.tables["wstrokes"])
+        self.assertEqual(sorted({(int(r["character"]), r["character_text"]) for r in strokes}), [(1, YI), (2, SHI)])
+        self.assert_one_frame("row trials", self.r("wtrials"), SHARED["pandas"]["wtrials"], row.trials)
+        self.assert_one_frame("row strokes", self.r("wstrokes"), SHARED["pandas"]["wstrokes"], row.strokes)
+        for name in ("legibility_top1", "legibility_top5"):  # shares of the row's two characters
+            self.assertEqual(str(row.trials[name].dtype), "float64", name)
+            for value in row.trials[name]:
+                self.assertIn(value, (0.0, 0.5, 1.0), name)
+            self.assertIn(self.r("wtrials").classes[name], ("numeric", "integer"), name)
 
     def test_one_reading_in_every_example_of_the_docs(self):
         self.assertEqual(len(set(SHARED["r_arguments"])), 1, SHARED["r_arguments"])
