@@ -48,9 +48,16 @@ _NUMERIC_TRIAL_COLUMNS = (
        "subject_fast_learning_per_trial", "subject_slow_learning_per_trial", "subject_fast_retention_per_trial",
        "subject_slow_retention_per_trial", "strokes_given_up", "legibility_top1", "legibility_top5"))
 _BOOLEAN_TRIAL_COLUMNS = _metric_columns("trials", ("flag",))
-# Numeric columns kept float64 even without a gap: a crossover period is NaN where the item's set is not
-# trained, and one dtype in every study spares an analysis a column whose type follows the data.
-_FLOAT_COLUMNS = ("period",)
+# Numeric columns kept float64 even without a gap, in a study of no trial too: a crossover period is NaN where
+# the item's set is not trained, every metric number (the metric table's kind), the skills, traits and
+# legibility shares are real numbers; one dtype in every study spares an analysis a column whose type follows
+# the data.
+_FLOAT_COLUMNS = (
+    ("period", "shape_skill", "order_skill", "timing_skill", "subject_writing_speed_factor",
+     "subject_spatial_error_factor", "subject_error_rate_factor", "subject_motor_noise_factor",
+     "subject_fast_learning_per_trial", "subject_slow_learning_per_trial", "subject_fast_retention_per_trial",
+     "subject_slow_retention_per_trial", "legibility_top1", "legibility_top5")
+    + _metric_columns("trials", ("number",)) + _metric_columns("strokes", ("number",)))
 _NUMERIC_STROKE_COLUMNS = (
     ("trial", "character", "stroke", "typical_id", "segments", "refused_segments")
     + _metric_columns("strokes", ("number", "count")))
@@ -163,9 +170,9 @@ def _read_table(text: str, numeric: tuple[str, ...], booleans: tuple[str, ...]) 
     frame = pd.read_csv(io.StringIO(text), keep_default_na=False, na_values={c: [""] for c in numeric},
                         float_precision="round_trip",
                         dtype={**{c: "float64" for c in numeric}, "trace_sha256": str})
-    for column in booleans:  # pandas may have read "true"/"false" as booleans already
+    for column in booleans:  # pandas reads "TRUE"/"FALSE" as booleans, but not a column of no row
         if frame[column].dtype != bool:
-            frame[column] = frame[column].astype(str) == "true"
+            frame[column] = frame[column].astype(str) == "TRUE"
     for column in numeric:  # counts and indices without a gap are integers
         if column in _FLOAT_COLUMNS:
             continue

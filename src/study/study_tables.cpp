@@ -184,7 +184,9 @@ std::string field(const std::optional<double>& value) { return value ? field(*va
 std::string field(const std::optional<int>& value) { return value ? std::to_string(*value) : std::string(); }
 std::string field(std::size_t value) { return std::to_string(value); }
 std::string field(int value) { return std::to_string(value); }
-std::string field(bool value) { return value ? "true" : "false"; }
+// A flag as R's logical literals, which R's read.csv reads as logical and pandas' read_csv as bool (R reads
+// "true"/"false" as text).
+std::string field(bool value) { return value ? "TRUE" : "FALSE"; }
 std::string field(std::int64_t value) { return std::to_string(value); }
 
 // A metric's value as the field of its kind: a number as a double, a count, a flag; empty when null.

@@ -1209,7 +1209,7 @@ class StudyNumbers(Base):
                 if value is None:
                     self.assertEqual(row[column], "", (path.name, column))
                 elif isinstance(value, bool):
-                    self.assertEqual(row[column], "true" if value else "false", (path.name, column))
+                    self.assertEqual(row[column], "TRUE" if value else "FALSE", (path.name, column))
                 else:
                     self.assertEqual(float(row[column]), float(value), (path.name, column))
             self.assertEqual(row["end_reason"], record["end_reason"], path.name)
@@ -1261,8 +1261,8 @@ class StudyNumbers(Base):
             stroke = character["per_stroke"][int(row["stroke"]) - 1]
             self.assertEqual(stroke["index"], int(row["stroke"]) - 1)
             self.assertEqual(row["character_text"], character["character"])
-            self.assertEqual(row["written"], "true" if stroke["written"] else "false")
-            self.assertEqual(row["backwards"], "true" if stroke["backwards"] else "false")
+            self.assertEqual(row["written"], "TRUE" if stroke["written"] else "FALSE")
+            self.assertEqual(row["backwards"], "TRUE" if stroke["backwards"] else "FALSE")
             self.assertEqual(int(row["typical_id"]), typical[row["character_text"]][int(row["stroke"]) - 1])
             for column in ("mean_deviation_m", "max_deviation_m", "rms_deviation_m", "frechet_m", "dtw_m",
                            "time_s", "path_length_m"):
