@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/devices/device_registry.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/model/scene.hpp"
@@ -74,6 +75,18 @@ RecordedTrial recorded_from(const TrialCommand& command) {
     print_error_line("calligraphy trial", "note",
                      "--spec " + command.spec_file + ": " + pointer +
                          " is not in this earlier version of the record; it takes its default");
+  }
+  // The fields the record's version fixes run as that version ran: said with the value taken, and a value
+  // the record gives in their place is said to be left unused.
+  for (const RecordedTrial::VersionRule& rule : recorded.version_rules) {
+    const std::string taken = shortest_decimal(rule.taken);
+    const std::string as_ran = "records of version " + std::to_string(rule.version) + " ran with " + taken;
+    print_error_line("calligraphy trial", "note",
+                     "--spec " + command.spec_file + ": " + rule.pointer +
+                         (rule.given ? " is " + shortest_decimal(*rule.given) + " in the record, but " +
+                                           as_ran + "; it takes " + taken
+                                     : " is not in this earlier version of the record; it takes " + taken +
+                                           ", as " + as_ran));
   }
   if (!command.spec.teacher.empty()) {
     if (recorded.spec.guidance_mode != GuidanceMode::replay) {

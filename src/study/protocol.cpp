@@ -248,7 +248,7 @@ StudyCondition read_condition(const json& value, const std::string& pointer, con
 void read_order(json_detail::ObjectReader& reader, StudyProtocol& protocol) {
   const json* value = reader.optional("order");
   if (!value) return;
-  // Through its schema (protocol_order_schema: the enumerations' one spelling each); null keeps the default.
+  // Through its schema (protocol_order_schema: the enumerations' one spelling each).
   json_detail::ObjectReader order(*value, reader.pointer("order"), reader.source());
   // The seed: every value of a std::uint64_t, also in exponent form when exact (1e3), as the schema reads it.
   for (const char* key : {"conditions", "characters", "seed"})
@@ -364,6 +364,9 @@ namespace {
 
 StudyProtocol read_protocol_document(std::string_view json_text, const std::string& source) {
   const json document = json_detail::parse_json(json_text, source);
+  // A key at the root given null is refused as a condition's is: its schema takes no null, and leaving the
+  // key out is how its default is asked for.
+  refuse_null_members(document, "", source);
   json_detail::ObjectReader root(document, "", source);
   StudyProtocol protocol;
   const std::string format = root.string_or("format", kFormat);

@@ -165,12 +165,22 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
     json_detail::fail(source, reader.pointer("format"),
                       "format '" + format + "' is not '" + std::string(kRecordedTrialFormat) + "'");
   }
-  const std::int64_t version = reader.integer("version", 0, std::numeric_limits<std::int64_t>::max());
-  if (version < kOldestRecordedTrialVersion || version > kRecordedTrialVersion) {
+  const std::string versions_read =
+      std::to_string(kOldestRecordedTrialVersion) + " to " + std::to_string(kRecordedTrialVersion);
+  std::int64_t version = 0;
+  try {
+    version = reader.integer("version", 0, std::numeric_limits<std::int64_t>::max());
+  } catch (const DataError&) {
+    if (!object->is_object() || !object->contains("version")) throw;  // missing: named as such
+    // Text, null, a fraction, a negative or a 65-bit number is no version: say which this library reads.
     json_detail::fail(source, reader.pointer("version"),
-                      "version " + std::to_string(version) + " is not one this library reads (" +
-                          std::to_string(kOldestRecordedTrialVersion) + " to " +
-                          std::to_string(kRecordedTrialVersion) + ")");
+                      "expected a version this library reads (" + versions_read + "), got " +
+                          json_detail::describe((*object)["version"]));
+  }
+  if (version < kOldestRecordedTrialVersion || version > kRecordedTrialVersion) {
+    json_detail::fail(
+        source, reader.pointer("version"),
+        "version " + std::to_string(version) + " is not one this library reads (" + versions_read + ")");
   }
   // Every part is required, read by the record's one schema (record_schema.hpp): a value out of its field's
   // range, null, an unknown key or a missing part is refused naming its pointer; a field added in a later
@@ -191,6 +201,8 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
     json_detail::fail(source, reader.pointer("trial"), e.what());
   }
   r.force_law = std::move(parts.force_law);
+  const StrokeAcceptance law_as_read = r.force_law.acceptance;
+  const StrokeAcceptance spec_as_read = r.spec.acceptance;
   // Before version 4 a stroke's tolerances did not grow with its length or scale with the character, and
   // no stroke was credited as assisted: an older record runs again as it ran.
   if (version < 4) r.force_law.acceptance.use_fixed_tolerances();
@@ -198,13 +210,30 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
   // displacement: no floor of the end gap.
   if (version < 5) r.force_law.acceptance.use_version_4_end_gaps();
   // Before version 7 no path centred on a dot was written by covering less of it than the shortfall allows:
-  // the rule is off, as it ran (not its default, so not listed as defaulted).
+  // the rule is off, as it ran.
   if (version < 7) {
     r.force_law.acceptance.use_version_6_coverage();
     r.spec.acceptance.use_version_6_coverage();
-    std::erase_if(read.defaulted,
-                  [](const std::string& pointer) { return pointer.ends_with("/centred_coverage_fraction"); });
   }
+  // A field those rules set takes the version's value, not its default and not another value the record
+  // gives: each is listed with the value it takes (RecordedTrial::version_rules), never as defaulted. Before
+  // version 6 the specification's acceptance is the force law's (below), so only the force law's are listed.
+  const auto list_rules = [&](const std::string& at_acceptance, const StrokeAcceptance& as_read,
+                              const StrokeAcceptance& runs) {
+    for (const ParameterField<StrokeAcceptance>& field : ParameterTable<StrokeAcceptance>::fields()) {
+      if (as_read.*field.member == runs.*field.member) continue;
+      std::string pointer = json_detail::child_pointer(at_acceptance, std::string(field.name));
+      const bool left_out = std::erase(read.defaulted, pointer) > 0;
+      r.version_rules.push_back(
+          {.pointer = std::move(pointer),
+           .taken = runs.*field.member,
+           .given = left_out ? std::nullopt : std::optional<double>(as_read.*field.member),
+           .version = static_cast<int>(version)});
+    }
+  };
+  list_rules(json_detail::child_pointer(reader.pointer("force_law"), "acceptance"), law_as_read,
+             r.force_law.acceptance);
+  if (version >= 6) list_rules(reader.pointer("trial"), spec_as_read, r.spec.acceptance);
   // Before version 6 the specification did not state the acceptance: it is the one the force law ran with,
   // not a default (its fields are not listed as defaulted).
   if (version < 6) {
@@ -265,6 +294,18 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
     json_detail::fail(source, reader.pointer("writer"),
                       "null, but the trial's writer is 'simulated' (/trial/writer): a simulated writer's "
                       "record holds the profile it wrote with");
+  // The settings are the writer's own keys, as --writer-param and Python take them: the re-run writes with
+  // the recorded profile (/writer) and never applies them, so an unknown key would otherwise pass unread.
+  for (std::size_t i = 0; i < r.spec.writer_parameters.size(); ++i) {
+    try {
+      (void)writer_parameter(*r.writer, r.spec.writer_parameters[i].key);
+    } catch (const InvalidArgument& e) {
+      json_detail::fail(source,
+                        json_detail::child_pointer(
+                            json_detail::child_pointer(reader.pointer("trial"), "writer_parameters"), i),
+                        e.what());
+    }
+  }
   if (r.simulated_device && r.spec.device != "simulated") {
     std::string message = "simulated device physics for the device '";
     message.append(r.spec.device).append("' (/trial/device; only for 'simulated'); expected null");

@@ -78,6 +78,18 @@ struct RecordedTrial : WholeTrial {
   /// Read from a record of an earlier version: the JSON pointers of fields added since, which took their
   /// documented defaults (empty for a record written by this version). Not written.
   std::vector<std::string> defaulted;
+  /// A field of the stroke acceptance whose value the record's version fixes (fixed tolerances and no
+  /// assisted credit before version 4, no end-gap floor before 5, no centred rule before 7), the record
+  /// leaving it out (`given` empty) or giving another value: the value it runs with, as that version ran.
+  struct VersionRule {
+    std::string pointer;          ///< the field's JSON pointer in the record
+    double taken = 0.0;           ///< the value it runs with
+    std::optional<double> given;  ///< the value the record gave; empty when it left the field out
+    int version = 0;              ///< the record's version
+  };
+  /// Read from a record of an earlier version: each acceptance field its version's rule set, in table order
+  /// (empty for a record written by this version). Not written.
+  std::vector<VersionRule> version_rules;
 };
 
 /// The schema of the specification object a trial record holds (format, version, trial, force_law, safety,
