@@ -409,7 +409,7 @@ PY_FIXTURES = {
         "velocity_m_s = np.array([0.05, 0.0])\ntangent = np.array([1.0, 0.0])\nnormal_force_n = 1.0\n"
         "distance_m = 0.002\nforces_n = np.array([10.0, 0.0, 0.0])\n",
     "out = renderer.tick(cg.DeviceState(":
-        "x, y, z = 0.0, 0.0, 0.01\nvx, vy, vz = 0.0, 0.0, 0.0\nt = 0.0\n",
+        "x, y, z = 0.0, 0.0, 0.01\nvx, vy, vz = 0.0, 0.0, 0.0\nt_s = 0.0\n",
     # docs/experiments.md reads "study" before its shell block makes one: the study its first block made (S).
     "# a `session run --out` folder, a session folder, or a list":
         "import shutil as _s\n_s.copytree('S', 'study')\n",
