@@ -268,7 +268,21 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
   if (command.display.display == "window") trainer::register_trainer_devices(devices);  // mouse, mouse-hand
 #endif
   const LoadedProtocol protocol = load_study_protocol(command.protocol);
-  const DeviceListing found_device = find_cli_device(devices, "--device", command.device);
+  const DeviceListing found_device = [&] {
+    try {
+      return find_cli_device(devices, "--device", command.device);
+    } catch (const DeviceUnavailable&) {
+      // The writer is checked against the kind of device, known whether or not the device can be used now:
+      // a pairing it cannot have is the usage error it is (exit 2) before a device that cannot be used (1).
+      if (const std::optional<bool> simulated_hand = kind_moved_by_simulated_hand(devices, command.device)) {
+        DeviceListing kind;
+        kind.name = command.device;
+        kind.capabilities.moved_by_simulated_hand = *simulated_hand;
+        (void)writer_for_device(command.writer, kind);
+      }
+      throw;
+    }
+  }();
   const DeviceListing* device = &found_device;
   // Simulated subjects rule out a person before the device is looked at.
   if (command.subjects > 0 && command.writer == kPersonWriter) {
