@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -104,8 +105,12 @@ class TerminalHost final : public SessionHost {
     }
   }
   void after_trial(const PlannedTrial& trial, const TrialOutcome& outcome) override {
-    std::fprintf(stderr, "trial %zu: %s, %.1f s, mean deviation %.2f mm%s\n", trial.index + 1,
-                 outcome.end_reason.c_str(), outcome.time_s, outcome.mean_deviation_mm,
+    // A trial that wrote no stroke has no deviation: "-", as in every table, never "nan".
+    char deviation[32] = "-";
+    if (std::isfinite(outcome.mean_deviation_mm))
+      std::snprintf(deviation, sizeof deviation, "%.2f mm", outcome.mean_deviation_mm);
+    std::fprintf(stderr, "trial %zu: %s, %.1f s, mean deviation %s%s\n", trial.index + 1,
+                 outcome.end_reason.c_str(), outcome.time_s, deviation,
                  outcome.saved ? "" : " (kept as an attempt)");
   }
 };
