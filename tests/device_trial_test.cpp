@@ -196,10 +196,11 @@ TEST_CASE("A disconnect mid-trial aborts it with forces zeroed and the recording
   CHECK(result.abort_reason.find("unplugged") != std::string::npos);
   // Every tick before the failed read is kept and readable.
   REQUIRE(result.trace.size() == kUnplugAt - 1);
-  // The trial's clock starts at its first tick (the emulator's own clock reads 1 ms there).
+  // The trial's clock starts at its first tick (the emulator's own clock reads 2 ms there: the status
+  // packet that opened it and the first tick's, each stamped when it arrived).
   CHECK(result.trace.front().time_s == 0.0);
   CHECK(result.trace.back().time_s == Approx(0.001 * (kUnplugAt - 2)).margin(1e-9));
-  CHECK(result.device_time_at_start_s == Approx(0.001).margin(1e-12));
+  CHECK(result.device_time_at_start_s == Approx(0.002).margin(1e-12));
   bool wrote = false;
   for (const auto& sample : result.trace) {
     REQUIRE(sample.position_m.allFinite());

@@ -16,62 +16,6 @@
 namespace calligraphy::cli {
 namespace {
 
-// What a kind of device is and which commands take it with --device. The commands are those that open a
-// device by name: `trial`, `train` and `session run` (`session resume` goes on on the session's device).
-struct DeviceKind {
-  std::string name;     // what --device takes, or its pattern ("phantom-hid:PATH")
-  std::string backend;  // the registry backend that makes it (the window adds "mouse" and "mouse-hand")
-  std::string writer;   // who writes with it: "simulated" or "person"
-  std::vector<std::string> commands;
-  std::string what;
-};
-
-const std::vector<std::string> kEveryCommand = {"trial", "train", "session run"};
-
-std::vector<DeviceKind> device_kinds(const DeviceRegistry& devices) {
-  std::vector<DeviceKind> kinds = {
-      {"simulated", "simulated", "simulated", kEveryCommand,
-       "the simulated device, moved by the simulated writer (train: --writer simulated)"},
-      {"emulated-phantom", "emulated-phantom", "simulated", kEveryCommand,
-       "the Phantom emulator behind the real Phantom driver, moved by the simulated writer (train: --writer "
-       "simulated)"},
-      {"mouse",
-       "mouse",
-       "person",
-       {"train", "session run"},
-       "the pointer is the pen (no force), in the trainer window"},
-      {"mouse-hand",
-       "mouse-hand",
-       "person",
-       {"train", "session run"},
-       "the pointer through a simulated hand on a simulated Phantom Desktop: guidance pulls, in the trainer "
-       "window"},
-      {"openhaptics", "openhaptics", "person", kEveryCommand,
-       "the default OpenHaptics device (a Phantom through libHD.so)"},
-      {"phantom-hid:PATH", "phantom-hid", "person", kEveryCommand,
-       "a Phantom over hidraw (PATH: /dev/hidrawN)"},
-      {"phantom-usb:BUS-ADDRESS", "phantom-usb", "person", kEveryCommand, "a Phantom over libusb"},
-  };
-#ifndef CALLIGRAPHY_WITH_TRAINER
-  // No window: `train` takes no device, and the pointer kinds no command.
-  for (DeviceKind& kind : kinds) {
-    std::erase(kind.commands, "train");
-    if (kind.backend == "mouse" || kind.backend == "mouse-hand") {
-      kind.commands.clear();
-      kind.what += " (not in this build: no trainer window)";
-    }
-  }
-#endif
-  // A backend registered besides these (an application's own) is a device a person holds.
-  for (const std::string& backend : devices.backend_names()) {
-    bool known = false;
-    for (const DeviceKind& kind : kinds) known = known || kind.backend == backend;
-    if (!known)
-      kinds.push_back({backend, backend, "person", kEveryCommand, "a device of the backend " + backend});
-  }
-  return kinds;
-}
-
 std::string joined(const std::vector<std::string>& items) {
   std::string text;
   for (const std::string& item : items) text += (text.empty() ? "" : ", ") + item;

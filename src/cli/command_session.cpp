@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -104,8 +105,12 @@ class TerminalHost final : public SessionHost {
     }
   }
   void after_trial(const PlannedTrial& trial, const TrialOutcome& outcome) override {
-    std::fprintf(stderr, "trial %zu: %s, %.1f s, mean deviation %.2f mm%s\n", trial.index + 1,
-                 outcome.end_reason.c_str(), outcome.time_s, outcome.mean_deviation_mm,
+    // A trial that wrote no stroke has no deviation: "-", as in every table, never "nan".
+    char deviation[32] = "-";
+    if (std::isfinite(outcome.mean_deviation_mm))
+      std::snprintf(deviation, sizeof deviation, "%.2f mm", outcome.mean_deviation_mm);
+    std::fprintf(stderr, "trial %zu: %s, %.1f s, mean deviation %s%s\n", trial.index + 1,
+                 outcome.end_reason.c_str(), outcome.time_s, deviation,
                  outcome.saved ? "" : " (kept as an attempt)");
   }
 };
@@ -268,7 +273,21 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
   if (command.display.display == "window") trainer::register_trainer_devices(devices);  // mouse, mouse-hand
 #endif
   const LoadedProtocol protocol = load_study_protocol(command.protocol);
-  const DeviceListing found_device = find_cli_device(devices, "--device", command.device);
+  const DeviceListing found_device = [&] {
+    try {
+      return find_cli_device(devices, "--device", command.device);
+    } catch (const DeviceUnavailable&) {
+      // The writer is checked against the kind of device, known whether or not the device can be used now:
+      // a pairing it cannot have is the usage error it is (exit 2) before a device that cannot be used (1).
+      if (const std::optional<bool> simulated_hand = kind_moved_by_simulated_hand(devices, command.device)) {
+        DeviceListing kind;
+        kind.name = command.device;
+        kind.capabilities.moved_by_simulated_hand = *simulated_hand;
+        (void)writer_for_device(command.writer, kind);
+      }
+      throw;
+    }
+  }();
   const DeviceListing* device = &found_device;
   // Simulated subjects rule out a person before the device is looked at.
   if (command.subjects > 0 && command.writer == kPersonWriter) {

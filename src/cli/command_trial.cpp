@@ -243,15 +243,39 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
   const Checked<TrialSpec> checked = recorded ? checked_spec(command, *recorded) : spec_from(command);
   const TrialSpec& spec = *checked;
   const std::u32string chars = characters_from(spec.characters, "CHARS");
-  const DeviceListing device = find_cli_device(devices, "--device", spec.device);
-  bool simulated = false;
-  try {
-    simulated = simulated_writer_writes(spec, simulated_writer_moves(device));
-  } catch (const InvalidArgument& e) {
-    // A record's writer that cannot hold its device is named as every bad value of it is (exit 2).
-    if (recorded) throw InputError(command.spec_file + ": /specification/trial/writer: " + e.what());
-    throw UsageError(e.what());
-  }
+  // Who writes and how the ticks are paced are checked against the kind of device (simulated writer or
+  // person), which is known whether or not the device can be used now: a pairing the device cannot have is
+  // a usage error (a record's: at its JSON pointer, exit 2) before a device that cannot be used (exit 1).
+  const auto writer_on = [&](bool simulated_hand) {
+    bool simulated_writer = false;
+    try {
+      simulated_writer = simulated_writer_writes(spec, simulated_hand);
+    } catch (const InvalidArgument& e) {
+      if (recorded) throw InputError(command.spec_file + ": /specification/trial/writer: " + e.what());
+      throw UsageError(e.what());
+    }
+    if (spec.pacing == TrialPacing::lock_step && !simulated_hand) {
+      const std::string reason = "lock-step needs a device the simulated writer moves; '" + spec.device +
+                                 "' is moved by a person, in real time";
+      if (recorded) throw InputError(command.spec_file + ": /specification/trial/pacing: " + reason);
+      throw UsageError("--pacing lock-step: " + reason + " (--pacing real-time or auto)");
+    }
+    return simulated_writer;
+  };
+  const DeviceListing device = [&] {
+    try {
+      return find_cli_device(devices, recorded ? "" : "--device", spec.device);
+    } catch (const DeviceUnavailable&) {
+      if (const std::optional<bool> simulated_hand = kind_moved_by_simulated_hand(devices, spec.device))
+        writer_on(*simulated_hand);
+      throw;
+    } catch (const UsageError& e) {
+      // A record's device is named as every bad value of it is (exit 2).
+      if (recorded) throw InputError(command.spec_file + ": /specification/trial/device: " + e.what());
+      throw;
+    }
+  }();
+  const bool simulated = writer_on(simulated_writer_moves(device));
   // A profile or its settings describe the simulated writer: with a person writing they would be ignored.
   if (!simulated && command.app->count("--writer-profile") > 0) {
     throw UsageError("--writer-profile applies to the simulated writer, not to a person (--writer person)");

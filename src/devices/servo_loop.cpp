@@ -441,8 +441,15 @@ void ServoLoop::Impl::stop_device_clock() noexcept {
   clock.load(std::memory_order_acquire)->detach();  // no frame runs after this returns
   clock.store(nullptr, std::memory_order_release);
   if (running.load(std::memory_order_acquire)) {
-    const double silent_ms =
-        static_cast<double>(monotonic_ns() - last_frame_ns.load(std::memory_order_relaxed)) * 1e-6;
+    const std::int64_t silent_ns = monotonic_ns() - last_frame_ns.load(std::memory_order_relaxed);
+    const double silent_ms = static_cast<double>(silent_ns) * 1e-6;
+    // The device held the last frame's force all the while the driver did not call: a stall like one
+    // between two ticks (the time beyond one period), counted in the statistics the run reports.
+    const std::int64_t stall = silent_ns - options.period_ns();
+    if (stall > run.longest_stall) {
+      run.longest_stall = stall;
+      longest_stall_ns.store(stall, std::memory_order_relaxed);
+    }
     if (options.stall_timeout_s > 0.0 && silent_ms > options.stall_timeout_s * 1e3 &&
         fault_kind.load(std::memory_order_acquire) == 0) {
       record_fault(LoopFaultKind::watchdog, kStallFaultMessage, run.tick, silent_ms);

@@ -347,7 +347,6 @@ class SessionRun {
     context.trial = &trial;
     context.condition = &condition;
     context.device_name = manifest_.setup.device;
-    context.device_info = device->info();
     context.hardware = listing_.capabilities.hardware;
     context.simulated_writer = simulated_writer_;
     context.guidance = study_detail::guidance_record_json(condition, prepared.guidance);
@@ -355,6 +354,7 @@ class SessionRun {
     context.start_utc = utc_now_iso8601();
     const auto wall_start = std::chrono::steady_clock::now();
     TrialRun run = run_whole_trial(whole, prepared.scene, inputs);
+    context.device_info = run.device;  // as it ran: a device that reads its limits on opening knows them now
     if (run.result.end == TrialEnd::interrupted && run.result.abort_reason.empty())
       run.result.abort_reason = "stopped by " + stop_reason(options_);
     context.wall_time_s =

@@ -137,6 +137,9 @@ TrialRun run_whole_trial(const Checked<WholeTrial>& checked, const Scene& scene,
   std::unique_ptr<TrialHand> hand;
   if (run.simulated_writer) hand = inputs.hand_maker->make_hand(*device, scene, spec.seed);
   run.result = run_trial(*device, scene, options, hand.get());
+  // The figures of the device as it ran: a device that reads its limits when it is opened (OpenHaptics)
+  // knows them only now.
+  run.device = device->info();
   run.options = *options;
   if (hand) inputs.hand_maker->after_trial(run.result);  // the hand has let go (run_trial), and still is
   hand.reset();                                          // before the device goes

@@ -64,7 +64,7 @@ struct TrialRunInputs {
 struct TrialRun {
   TrialResult result;
   TrialOptions options;           ///< the options the trial ran with (should_stop and display cleared)
-  DeviceInfo device;              ///< the device's figures
+  DeviceInfo device;              ///< the device's figures as it ran (read when it was opened)
   bool simulated_writer = false;  ///< the simulated writer wrote (the hand maker's hand; else a person)
   WritingMetrics metrics;         ///< the one metrics record of the trace (writing_metrics.hpp)
 };

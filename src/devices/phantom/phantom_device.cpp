@@ -101,7 +101,7 @@ void PhantomDevice::open() {
   fault_record_ = PhantomFaultRecord{};
   DeviceFault fault = send_command(CommandPacket{});  // forces off before anything else
   // receive_status gives up after max_consecutive_bad_packets bad reads.
-  for (bool valid = false; fault == DeviceFault::none && !valid;) fault = receive_status(now_s(), valid);
+  for (bool valid = false; fault == DeviceFault::none && !valid;) fault = receive_status(valid);
   if (fault != DeviceFault::none) {
     record(fault);
     open_ = false;
@@ -150,7 +150,7 @@ void PhantomDevice::close() noexcept {
 void PhantomDevice::calibrate() {
   if (!open_) throw DeviceError("Phantom: calibrate() on a device that is not open");
   for (bool valid = false; !valid;) {
-    if (const DeviceFault fault = receive_status(now_s(), valid); fault != DeviceFault::none)
+    if (const DeviceFault fault = receive_status(valid); fault != DeviceFault::none)
       throw_fault(record(fault));
   }
   if (!last_status_.docked) {
@@ -194,7 +194,7 @@ DeviceFault PhantomDevice::read_state(DeviceState& state) noexcept {
     return record(DeviceFault::watchdog);
   }
   bool valid = false;
-  if (const DeviceFault fault = receive_status(now, valid); fault != DeviceFault::none) return record(fault);
+  if (const DeviceFault fault = receive_status(valid); fault != DeviceFault::none) return record(fault);
   state = state_;  // a fresh state, or the previous one after a rejected or missing packet
   return DeviceFault::none;
 }
@@ -260,7 +260,7 @@ SafetyEventCounts PhantomDevice::safety_events() const noexcept {
   return counts;
 }
 
-DeviceFault PhantomDevice::receive_status(double now, bool& valid) noexcept {
+DeviceFault PhantomDevice::receive_status(bool& valid) noexcept {
   valid = false;
   std::size_t received = 0;
   if (const DeviceFault fault = transport_->read(receive_buffer_, config_.packet_timeout, received);
@@ -293,7 +293,9 @@ DeviceFault PhantomDevice::receive_status(double now, bool& valid) noexcept {
     if (gap != 0 && gap < 0x8000) counters_.lost_packets.fetch_add(gap, std::memory_order_relaxed);
   }
   if (status.docked && !is_calibrated()) home_at_inkwell(status);
-  apply_status(status, now);
+  // Stamped when it arrived: the state it carries is the device's after the read (the emulator integrates
+  // one tick per status packet), so its time and the velocity's differences are those of that state.
+  apply_status(status, now_s());
   valid = true;
   return DeviceFault::none;
 }

@@ -152,9 +152,10 @@ class PhantomDevice final : public HapticDevice {
   };
 
   double now_s() const noexcept { return config_.clock(); }
-  /// Reads once; on a valid packet updates the state and sets `valid`. Returns `link_lost` or
-  /// `not_open` (transport) or `no_valid_status` (too many bad reads in a row): the link is then lost.
-  [[nodiscard]] DeviceFault receive_status(double now_s, bool& valid) noexcept;
+  /// Reads once; on a valid packet updates the state, stamped with the clock when it arrived, and sets
+  /// `valid`. Returns `link_lost` or `not_open` (transport) or `no_valid_status` (too many bad reads in a
+  /// row): the link is then lost.
+  [[nodiscard]] DeviceFault receive_status(bool& valid) noexcept;
   void count_rejected(PacketError error) noexcept;
   void apply_status(const StatusPacket& status, double now_s) noexcept;
   void home_at_inkwell(const StatusPacket& status) noexcept;
