@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -133,7 +134,7 @@ CorpusFit fit_corpus(const CharacterLibrary& library, const FitOptions& options,
   bar.show(code_points.size());
 
   CorpusFit result;
-  result.threads = threads;
+  result.threads = std::max<unsigned>(1, static_cast<unsigned>(pool.started()));  // those that ran
   for (std::size_t k = 0; k < code_points.size(); ++k) {
     if (errors[k].empty()) {
       result.characters.push_back(std::move(fitted[k]));
