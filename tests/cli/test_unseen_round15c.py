@@ -369,18 +369,27 @@ class NoProcesses(Case):
             self.skipTest("becoming nobody needs root")
 
     def test_commands_with_threads_when_no_thread_can_start(self):
-        (self.dir / "t").mkdir(mode=0o777)
-        os.chmod(self.dir / "t", 0o777)
-        runs = {"corpus build": ["corpus", "build", "--data", self.base / "data", "--out", self.dir / "c.clg",
-                                 "--threads", "2"],
-                "report": ["report", self.base / "st", "--csv", self.dir / "t", "--jobs", "2"],
-                "real-time trial": ["trial", *REAL_TIME, "--json", self.dir / "a.json"]}
-        for name, args in runs.items():
+        for folder in ("t", "c"):
+            (self.dir / folder).mkdir()
+            os.chmod(self.dir / folder, 0o777)
+        # Each command and the file its success writes.
+        runs = {"corpus build": (["corpus", "build", "--data", self.base / "data", "--out", self.dir / "c.clg",
+                                  "--threads", "2"], self.dir / "c.clg"),
+                "report": (["report", self.base / "st", "--csv", self.dir / "t", "--jobs", "2"],
+                           self.dir / "t" / "trials.csv"),
+                "session cohort": (["session", "cohort", self.base / "p.json", "--subjects", "2", "--jobs", "2",
+                                    "--csv", self.dir / "c"], self.dir / "c" / "trials.csv"),
+                "real-time trial": (["trial", *REAL_TIME, "--json", self.dir / "a.json"], self.dir / "a.json")}
+        for name, (args, output) in runs.items():
             with self.subTest(command=name):
                 result = self.cli(*args, preexec_fn=nobody_without_processes)
-                if result.returncode != 0:
+                if result.returncode == 0:
+                    self.assertTrue(output.is_file(), output)
+                else:
                     self.assert_clean_failure(result, "thread")
+                    self.assertFalse(output.exists())
                 self.assert_no_leftovers()
+        self.assertEqual((self.dir / "t" / "trials.csv").read_bytes(), Shared.tables["st"][0])
 
     def test_study_report_when_r_cannot_start(self):
         # matplotlib builds its font cache on a thread of its own the first time: the cache is made (or copied)
