@@ -128,7 +128,8 @@ int run_report(const ReportCommand& command) {
   };
   // Everything this run writes (the tables, the pages, the index) is one set: replaced together at the end,
   // or, on any failure, none of it, the earlier report and tables left whole.
-  // Declared before the set: on a failure the set's temporaries in the page folders go first, then the folders.
+  // Declared before the set: on a failure the set's temporaries in the page folders go first, then the
+  // folders.
   MadeFolders page_folders;
   OutputSet report_files;
   std::string tables_line;
