@@ -140,6 +140,11 @@ class Shared:
         cls.base = base
 
 
+def tearDownModule():  # noqa: N802 - unittest's name
+    if Shared.dir is not None:
+        shutil.rmtree(Shared.dir, ignore_errors=True)
+
+
 class Case(OneErrorLine, unittest.TestCase):
     @classmethod
     def setUpClass(cls):
