@@ -107,8 +107,9 @@ void configure_root(CLI::App& root) {
   root.footer(
       "Exit status: 0 success; 1 a library or I/O error, an aborted trial, or a failed check; 2 wrong usage; "
       "3 an internal error; 4 the trainer window lost its display (the running trial kept); 128 + N stopped "
-      "by signal N (130 SIGINT, 143 SIGTERM, 129 SIGHUP). Every output file is written whole or not at all; "
-      "'-' as an output file means standard output. docs/cli.md describes every command.");
+      "by signal N (130 SIGINT, 143 SIGTERM, 129 SIGHUP, 138 SIGUSR1, 140 SIGUSR2, 152 SIGXCPU). Every "
+      "output file is written whole or not at all; '-' as an output file means standard output. docs/cli.md "
+      "describes every command.");
 }
 
 CLI::Option* add_flag(CLI::App& app, const std::string& name, bool& target, const std::string& description) {

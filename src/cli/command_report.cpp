@@ -2,6 +2,8 @@
 // sessions (study/session_reader.hpp, report/study_report_html.hpp): an index page and one page per session
 // in trials_files/SUBJECT/SESSION.html; and the study as tidy tables (study/study_tables.hpp):
 // TABLES/trials.csv and TABLES/strokes.csv.
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -22,6 +24,7 @@
 #include "calligraphy/study/study_tables.hpp"
 #include "cli/commands.hpp"
 #include "cli/output.hpp"
+#include "core/worker_threads.hpp"
 
 namespace calligraphy::cli {
 namespace fs = std::filesystem;
@@ -36,6 +39,34 @@ struct ReportCommand {
 
 // Each session's page, built as its trials are read and written whole (the temporary of its file in the
 // report's set) before the next session is read: memory holds one session's page and one trial per thread.
+// The folders a report makes for its pages (FILE_files/ and a folder per subject), made before the pages are
+// read; unless keep() is called, each one made is removed again (rmdir: only while empty, as nothing was
+// written in it), so a report that fails leaves no folder of its own, as it leaves no file.
+class MadeFolders {
+ public:
+  MadeFolders() = default;
+  MadeFolders(const MadeFolders&) = delete;
+  MadeFolders& operator=(const MadeFolders&) = delete;
+  ~MadeFolders() {
+    if (kept_) return;
+    for (auto folder = made_.rbegin(); folder != made_.rend(); ++folder) ::rmdir(folder->c_str());
+  }
+
+  void make(const fs::path& folder) {
+    std::error_code error;
+    if (folder.empty() || fs::is_directory(folder, error)) return;
+    make(folder.parent_path());
+    if (!fs::create_directory(folder, error) && error)
+      throw DataError(folder.string() + ": cannot create the folder: " + error.message());
+    made_.push_back(folder);
+  }
+  void keep() noexcept { kept_ = true; }
+
+ private:
+  std::vector<fs::path> made_;
+  bool kept_ = false;
+};
+
 // With `tables`, each session's rows of the tidy tables are read from the same parse of its records.
 class PagesWriter {
  public:
@@ -68,10 +99,6 @@ class PagesWriter {
         trials += page.trials();
         const std::string text = page.finish();
         bytes += text.size();
-        std::error_code error;
-        fs::create_directories(pages[i].parent_path(), error);
-        if (error)
-          throw DataError(pages[i].parent_path().string() + ": cannot create the folder: " + error.message());
         files->add(pages[i], text);
       } catch (...) {
         const std::lock_guard lock(error_mutex);
@@ -101,6 +128,9 @@ int run_report(const ReportCommand& command) {
   };
   // Everything this run writes (the tables, the pages, the index) is one set: replaced together at the end,
   // or, on any failure, none of it, the earlier report and tables left whole.
+  // Declared before the set: on a failure the set's temporaries in the page folders go first, then the
+  // folders.
+  MadeFolders page_folders;
   OutputSet report_files;
   std::string tables_line;
   const auto add_tables = [&](const StudyTables& tables) {
@@ -129,6 +159,7 @@ int run_report(const ReportCommand& command) {
       files.set_output_folder("--out", pages.back().parent_path().string());
       files.set_output("--out", pages.back().string());
     }
+    for (const fs::path& page : pages) page_folders.make(page.parent_path());
     PagesWriter writer(study, pages, "../../" + index_name);
     writer.files = &report_files;
     std::vector<StudyTables> session_tables(command.csv.empty() ? 0 : study.sessions.size());
@@ -137,10 +168,9 @@ int run_report(const ReportCommand& command) {
     const std::size_t threads =
         std::min<std::size_t>(command.jobs > 0 ? static_cast<std::size_t>(command.jobs) : cores,
                               std::max<std::size_t>(1, pages.size()));
-    std::vector<std::thread> pool;
-    for (std::size_t t = 1; t < threads; ++t) pool.emplace_back([&writer] { writer.work(); });
+    WorkerThreads pool(threads - 1, [&writer] { writer.work(); });
     writer.work();
-    for (std::thread& thread : pool) thread.join();
+    pool.join();
     if (writer.failure) std::rethrow_exception(writer.failure);
     if (!command.csv.empty()) {  // the sessions' rows in the sessions' order, as read_study_tables gives them
       StudyTables tables;
@@ -160,6 +190,7 @@ int run_report(const ReportCommand& command) {
     pages_line = line;
   }
   report_files.commit();
+  page_folders.keep();
   if (!tables_line.empty())
     std::printf("%s: %s, %.1f s\n", command.csv.c_str(), tables_line.c_str(), elapsed());
   if (!pages_line.empty())

@@ -2,8 +2,10 @@
 // corpus store, benchmarks. docs/cli.md describes every command.
 #include <cstdio>
 #include <exception>
+#include <new>
 #include <string>
 #include <string_view>
+#include <system_error>
 
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
@@ -144,6 +146,20 @@ int main(int argc, char** argv) {
   } catch (const calligraphy::Error& e) {
     print_error(given_command(root).first, e.what());
     status = 1;
+  } catch (const std::bad_alloc&) {  // a limit on the address space (ulimit -v) or no memory left
+    print_error(given_command(root).first, "out of memory (the memory this process may use is used up)");
+    status = 1;
+  } catch (const std::system_error& e) {
+    if (e.code() != std::errc::resource_unavailable_try_again) {
+      print_error_line(given_command(root).first, "internal error", e.what());
+      status = 3;
+    } else {  // std::thread's refusal: RLIMIT_NPROC, or no memory for a thread's stack
+      print_error(given_command(root).first,
+                  std::string("cannot start a thread: ") + e.code().message() +
+                      " (the threads this user may run, RLIMIT_NPROC, or the memory of a thread's stack are "
+                      "used up)");
+      status = 1;
+    }
   } catch (const std::exception& e) {
     print_error_line(given_command(root).first, "internal error", e.what());
     status = 3;

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/stop_signals.hpp"
 
 namespace calligraphy {
 namespace {
@@ -127,7 +128,7 @@ class StopSignalsHeld {
   StopSignalsHeld() noexcept {
     sigset_t held;
     sigemptyset(&held);
-    for (const int signal : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&held, signal);
+    for (const int signal : stop_signal_numbers()) sigaddset(&held, signal);
     pthread_sigmask(SIG_BLOCK, &held, &before_);
   }
   StopSignalsHeld(const StopSignalsHeld&) = delete;
@@ -825,9 +826,9 @@ void guard_output_files() noexcept {
   struct sigaction cleanup {};
   cleanup.sa_handler = remove_temporaries_then_die;
   sigemptyset(&cleanup.sa_mask);
-  for (const int signal : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&cleanup.sa_mask, signal);
+  for (const int signal : stop_signal_numbers()) sigaddset(&cleanup.sa_mask, signal);
   cleanup.sa_flags = SA_RESTART;
-  for (const int signal : {SIGINT, SIGTERM, SIGHUP}) {
+  for (const int signal : stop_signal_numbers()) {
     struct sigaction current {};
     if (sigaction(signal, nullptr, &current) == 0 && current.sa_handler == SIG_DFL) {
       sigaction(signal, &cleanup, nullptr);

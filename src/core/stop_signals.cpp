@@ -13,7 +13,9 @@ namespace {
 std::atomic<int> received_signal{0};
 static_assert(std::atomic<int>::is_always_lock_free);
 
-constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
+// SIGUSR1 and SIGUSR2 (what a batch scheduler sends before it ends a job) and SIGXCPU (the soft CPU time
+// limit reached, RLIMIT_CPU) would end the process before any file is written as well.
+constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGUSR1, SIGUSR2, SIGXCPU};
 
 extern "C" void record_stop_signal(int signal) {
   int none = 0;
@@ -43,9 +45,11 @@ StopSignals::StopSignals() {
   for (std::size_t i = 0; i < std::size(kStopSignals); ++i) {
     sigaction(kStopSignals[i], nullptr, &saved.stop[i]);
     // An ignored SIGHUP was ignored on purpose (nohup: keep running when the terminal closes), so it stays
-    // ignored. SIGINT and SIGTERM are caught whatever they were: a background job's ignored SIGINT only
-    // keeps the terminal's Ctrl-C away, and a stop asked for by kill must still end a trial cleanly.
-    if (kStopSignals[i] == SIGHUP && saved.stop[i].sa_handler == SIG_IGN) continue;
+    // ignored, as do SIGUSR1, SIGUSR2 and SIGXCPU ignored by the parent. SIGINT and SIGTERM are caught
+    // whatever they were: a background job's ignored SIGINT only keeps the terminal's Ctrl-C away, and a
+    // stop asked for by kill must still end a trial cleanly.
+    const bool always = kStopSignals[i] == SIGINT || kStopSignals[i] == SIGTERM;
+    if (!always && saved.stop[i].sa_handler == SIG_IGN) continue;
     sigaction(kStopSignals[i], &action, nullptr);
     sigaddset(&caught, kStopSignals[i]);
   }
@@ -70,6 +74,8 @@ StopSignals::~StopSignals() {
   installed_flag.store(false);
 }
 
+std::span<const int> stop_signal_numbers() noexcept { return kStopSignals; }
+
 bool StopSignals::installed() noexcept { return installed_flag.load(); }
 
 int StopSignals::received() noexcept { return received_signal.load(std::memory_order_relaxed); }
@@ -86,6 +92,12 @@ const char* signal_name(int signal) noexcept {
       return "SIGTERM";
     case SIGHUP:
       return "SIGHUP";
+    case SIGUSR1:
+      return "SIGUSR1";
+    case SIGUSR2:
+      return "SIGUSR2";
+    case SIGXCPU:
+      return "SIGXCPU";
     default:
       return "a signal";
   }

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <exception>
 #include <mutex>
+#include <system_error>
 #include <thread>
 
 #include "calligraphy/core/decimal_number.hpp"
@@ -534,9 +535,26 @@ void ServoLoop::start() {
 
   m.stop_requested.store(false, std::memory_order_relaxed);
   m.running.store(true, std::memory_order_release);
+  // A thread the system will not start (the threads this user may run, RLIMIT_NPROC, or the memory of its
+  // stack used up) ends the start as any refusal does: not running, forces off, one error naming the cause.
+  const auto refuse_thread = [&m](const std::system_error& e) {
+    m.running.store(false, std::memory_order_release);
+    m.log_drain.stop();
+    try {
+      m.device.enable_forces(false);
+    } catch (...) {
+    }
+    throw Error(
+        std::string("ServoLoop::start: cannot start a thread: ") + e.code().message() +
+        " (the threads this user may run, RLIMIT_NPROC, or the memory of a thread's stack are used up)");
+  };
   // The library's logger is registered on first use; do it here, before the drain thread logs.
   static_cast<void>(calligraphy::detail::library_log());
-  m.log_drain.start(m.log_queue, log_sink);
+  try {
+    m.log_drain.start(m.log_queue, log_sink);
+  } catch (const std::system_error& e) {
+    refuse_thread(e);
+  }
   if (device_clock != nullptr) {
     // The driver's thread ticks: its priority and CPU are the driver's to set, not the loop's.
     m.begin_run();
@@ -559,23 +577,27 @@ void ServoLoop::start() {
         m.options.rate_hz, m.realtime.memory_locked ? "yes" : "no");
     return;
   }
-  m.thread = std::thread([&m] {
-    m.loop_thread_id.store(std::this_thread::get_id(), std::memory_order_release);
-    devices::apply_thread_realtime(m.options, m.realtime);
-    const bool failed = m.options.realtime == RealtimeMode::enforce && !m.realtime.problems.empty();
-    if (failed) {
-      m.loop_thread_id.store(std::thread::id{}, std::memory_order_release);
-      m.running.store(false, std::memory_order_release);
-      m.startup.store(2, std::memory_order_release);
+  try {
+    m.thread = std::thread([&m] {
+      m.loop_thread_id.store(std::this_thread::get_id(), std::memory_order_release);
+      devices::apply_thread_realtime(m.options, m.realtime);
+      const bool failed = m.options.realtime == RealtimeMode::enforce && !m.realtime.problems.empty();
+      if (failed) {
+        m.loop_thread_id.store(std::thread::id{}, std::memory_order_release);
+        m.running.store(false, std::memory_order_release);
+        m.startup.store(2, std::memory_order_release);
+        m.startup.notify_one();
+        return;
+      }
+      devices::prefault_stack();
+      m.startup.store(1, std::memory_order_release);
       m.startup.notify_one();
-      return;
-    }
-    devices::prefault_stack();
-    m.startup.store(1, std::memory_order_release);
-    m.startup.notify_one();
-    m.run_thread();
-    m.loop_thread_id.store(std::thread::id{}, std::memory_order_release);
-  });
+      m.run_thread();
+      m.loop_thread_id.store(std::thread::id{}, std::memory_order_release);
+    });
+  } catch (const std::system_error& e) {
+    refuse_thread(e);
+  }
   m.startup.wait(0, std::memory_order_acquire);
   if (m.startup.load(std::memory_order_acquire) == 2) {
     m.thread.join();

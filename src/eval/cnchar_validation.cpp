@@ -2,13 +2,15 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cstdio>
 #include <ostream>
 #include <thread>
 
 #include "calligraphy/core/errors.hpp"
-#include "calligraphy/model/typical_strokes.hpp"
 #include "calligraphy/core/unicode.hpp"
+#include "calligraphy/model/typical_strokes.hpp"
+#include "core/worker_threads.hpp"
 
 namespace calligraphy::cli {
 namespace {
@@ -165,8 +167,9 @@ CncharValidation validate_against_cnchar(const CharacterLibrary& library,
   };
   const std::vector<std::pair<char32_t, std::string>> items(labels.begin(), labels.end());
   std::vector<Outcome> outcomes(items.size());
-  const auto work = [&](std::size_t begin, std::size_t step) {
-    for (std::size_t k = begin; k < items.size(); k += step) {
+  std::atomic<std::size_t> next{0};
+  const auto work = [&] {
+    for (std::size_t k = next++; k < items.size(); k = next++) {
       const auto& [cp, letters] = items[k];
       if (!library.contains(cp)) continue;
       const CharacterData data = library.load_data(cp);
@@ -182,11 +185,9 @@ CncharValidation validate_against_cnchar(const CharacterLibrary& library,
       }
     }
   };
-  threads = std::max(1u, threads);
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work, t, threads);
-  work(0, threads);
-  for (auto& t : pool) t.join();
+  WorkerThreads pool(std::max(1u, threads) - 1, work);
+  work();
+  pool.join();
 
   CncharValidation result;
   result.labelled = items.size();

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -11,6 +12,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
+#include "core/worker_threads.hpp"
 
 namespace calligraphy::cli {
 namespace {
@@ -121,18 +123,18 @@ CorpusFit fit_corpus(const CharacterLibrary& library, const FitOptions& options,
     read_parse += my_read;
     fit += my_fit;
   };
-  std::vector<std::thread> pool;
-  for (unsigned t = 0; t < threads; ++t) pool.emplace_back(work);
+  WorkerThreads pool(threads, work);
+  if (pool.started() == 0) work();  // no thread could be started: the characters are fitted here
   ProgressBar bar(label, code_points.size(), log_progress);
   while (done < code_points.size()) {
     bar.show(done);
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
-  for (auto& t : pool) t.join();
+  pool.join();
   bar.show(code_points.size());
 
   CorpusFit result;
-  result.threads = threads;
+  result.threads = std::max<unsigned>(1, static_cast<unsigned>(pool.started()));  // those that ran
   for (std::size_t k = 0; k < code_points.size(); ++k) {
     if (errors[k].empty()) {
       result.characters.push_back(std::move(fitted[k]));

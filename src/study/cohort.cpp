@@ -23,6 +23,7 @@
 #include "calligraphy/trial/quiz_trace.hpp"
 #include "calligraphy/trial/trial_spec_runner.hpp"
 #include "calligraphy/trial/writer_profile.hpp"
+#include "core/worker_threads.hpp"
 #include "study/names.hpp"
 #include "study/remembered_writer.hpp"
 #include "study/trial_guidance.hpp"
@@ -251,10 +252,9 @@ StudyTables simulate_cohort(const LoadedProtocol& protocol, const std::vector<Su
     }
   };
   const unsigned count = static_cast<unsigned>(std::min<std::size_t>(threads, subjects.size()));
-  std::vector<std::thread> workers;
-  for (unsigned t = 1; t < count; ++t) workers.emplace_back(work);
+  WorkerThreads workers(count > 0 ? count - 1 : 0, work);
   work();
-  for (std::thread& worker : workers) worker.join();
+  workers.join();
   if (first_error) std::rethrow_exception(first_error);
 
   StudyTables tables;

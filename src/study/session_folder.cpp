@@ -348,8 +348,15 @@ SessionFolder SessionFolder::create(const fs::path& root, const SessionSetup& se
   int fd = -1;
   const auto abandon = [&building, &fd] {
     if (fd >= 0) ::close(fd);
-    std::error_code ignored;
-    fs::remove_all(building, ignored);
+    // What was made is removed by name first: listing the folder needs a file descriptor for each level,
+    // which a process at its limit (RLIMIT_NOFILE, the very failure being undone) may not have.
+    ::unlink(SessionLayout::log(building).c_str());
+    ::rmdir(SessionLayout::trials(building).c_str());
+    ::unlink(SessionLayout::manifest(building).c_str());
+    if (::rmdir(building.c_str()) != 0) {
+      std::error_code ignored;
+      fs::remove_all(building, ignored);
+    }
   };
   try {
     write_file_atomically(SessionLayout::manifest(building), text);
@@ -692,6 +699,9 @@ void walk_session_tree(const fs::path& root, bool strict, OnSession on_session, 
       it.disable_recursion_pending();
     }
   }
+  // An increment that fails (a subfolder that cannot be opened: no file descriptor left, EMFILE) ends the
+  // iteration with `error` set: the folders not listed are not "no session there".
+  if (error) listing_failed();
 }
 
 // Whether `folder` (followed if it is a link) is a session folder or holds one, links inside it not followed.

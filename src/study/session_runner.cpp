@@ -391,8 +391,14 @@ class SessionRun {
     outcome.mean_deviation_mm = writing.deviation ? writing.deviation->mean_m * 1e3 : std::nan("");
     json details = trial_details(trial);
     details["end_reason"] = outcome.end_reason;
-    // The trace's bytes first: the record names them by their SHA-256.
-    const std::string trace = trial_trace_hdf5(trial_result.trace);
+    // The trace's bytes first: the record names them by their SHA-256. Its image made in memory may fail
+    // as a write does (HDF5 out of memory): the trial is then one that could not be saved, named as such.
+    std::string trace;
+    try {
+      trace = trial_trace_hdf5(trial_result.trace);
+    } catch (const DataError& e) {
+      return save_failed(trial, e, outcome);
+    }
     context.trace_sha256 = sha256_hex(trace);
     if (keep_as_trial) {
       const std::string record = study_detail::trial_record_json(context, scene, trial_result, writing,

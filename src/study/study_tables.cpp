@@ -15,6 +15,7 @@
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/study/session_reader.hpp"
 #include "core/json_reader.hpp"
+#include "core/worker_threads.hpp"
 #include "study/names.hpp"
 #include "study/record_metrics.hpp"
 #include "study/trial_row.hpp"
@@ -256,10 +257,9 @@ StudyTables read_study_tables(const std::vector<fs::path>& roots, unsigned threa
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   const std::size_t count =
       std::min<std::size_t>(threads > 0 ? threads : cores, std::max<std::size_t>(1, sessions.size()));
-  std::vector<std::thread> pool;
-  for (std::size_t t = 1; t < count; ++t) pool.emplace_back(work);
+  WorkerThreads pool(count - 1, work);
   work();
-  for (std::thread& thread : pool) thread.join();
+  pool.join();
   if (failure) std::rethrow_exception(failure);
   StudyTables tables;
   for (StudyTables& session : rows) {

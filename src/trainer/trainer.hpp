@@ -69,12 +69,12 @@ struct TrainerOptions {
   std::string library_version;
 };
 
-/// Runs the trainer until the window is closed, Q or Esc is pressed, SIGINT, SIGTERM or SIGHUP arrives, the
-/// device fails, or (with exit_after_s) the time runs out or every character had its trial. Prints the
-/// character boxes to stdout first, a measurement summary to stderr last. Returns 0, 1 when a trial ended
-/// with a device fault or could not be saved, 128 + N after stop signal N. A lost display ends the process
-/// with kDisplayLostStatus (4, x11_errors.hpp) once the running trial is saved. Throws Error
-/// (InvalidArgument, DeviceNotFound, ...) when it cannot start (no display, a bad option).
+/// Runs the trainer until the window is closed, Q or Esc is pressed, a stop signal (SIGINT, SIGTERM, SIGHUP,
+/// SIGUSR1, SIGUSR2, SIGXCPU) arrives, the device fails, or (with exit_after_s) the time runs out or every
+/// character had its trial. Prints the character boxes to stdout first, a measurement summary to stderr last.
+/// Returns 0, 1 when a trial ended with a device fault or could not be saved, 128 + N after stop signal N. A
+/// lost display ends the process with kDisplayLostStatus (4, x11_errors.hpp) once the running trial is saved.
+/// Throws Error (InvalidArgument, DeviceNotFound, ...) when it cannot start (no display, a bad option).
 int run_trainer(const TrainerOptions& options);
 
 /// A study session in the window: `calligraphy session run` on a device a person moves.

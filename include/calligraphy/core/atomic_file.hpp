@@ -107,10 +107,10 @@ class AtomicFileSet {
 ///  - SIGXFSZ is ignored, so a write over the file size limit (RLIMIT_FSIZE, `ulimit -f`) fails with EFBIG,
 ///    which the writers report (DataError naming the file) after removing their temporary;
 ///  - SIGPIPE is ignored, so a closed pipe is the write error EPIPE, reported, not a silent death;
-///  - SIGINT, SIGTERM and SIGHUP, where they are at their default action, first remove every temporary
-///    file the writers of this file have open, then end the process as the default action would (a set
-///    between its renames is finished first). A program that catches them itself (StopSignals, while it
-///    lives) is not changed. Never throws.
+///  - the stop signals (stop_signals.hpp: SIGINT, SIGTERM, SIGHUP, SIGUSR1, SIGUSR2, SIGXCPU), where they are
+///    at their default action, first remove every temporary file the writers of this file have open, then
+///    end the process as the default action would (a set between its renames is finished first). A program
+///    that catches them itself (StopSignals, while it lives) is not changed. Never throws.
 void guard_output_files() noexcept;
 
 /// The files of `files` as one `AtomicFileSet`, committed.

@@ -272,8 +272,9 @@ class ServoLoop {
   /// settings on it and returns once they are applied. Throws RealtimeError (mode `enforce`, with the
   /// reason), DeviceError (the device is not open, or from `enable_forces` or the clock's attach),
   /// InvalidArgument (`rate_hz`, or the rate the callback was built for, differs from the device clock's rate
-  /// or from each other: both named), or StateError when the loop is already running. A loop that ended
-  /// (stopped by its callback, by `stop()` or by a fault) can be started again.
+  /// or from each other: both named), Error when its thread or the log's cannot be started (RLIMIT_NPROC, no
+  /// memory for a stack: not running then, forces disabled), or StateError when the loop is already running.
+  /// A loop that ended (stopped by its callback, by `stop()` or by a fault) can be started again.
   void start();
   /// Asks the loop to stop, waits for the thread to end (or for the device clock's next frame, then
   /// detaches from it; a clock that stopped calling is detached after 100 ms) and returns the fault that

@@ -59,7 +59,8 @@ inline constexpr std::size_t kMaxCohortSubjects = 100000;
 [[nodiscard]] StudyTables simulate_subject(const LoadedProtocol& protocol, const SubjectAssignment& subject,
                                            const CohortSetup& setup);
 
-/// `simulate_subject` for every subject, on `threads` >= 1 threads (each subject on one thread, in turn),
+/// `simulate_subject` for every subject, on `threads` >= 1 threads (each subject on one thread, in turn;
+/// the calling thread is one, and a thread the system will not start is done without: RLIMIT_NPROC),
 /// the rows in the order of `subjects`. The characters of the protocol are loaded once, before any trial.
 /// `progress`, when given, is called after each subject with the number done (from the worker threads, one
 /// call at a time). The first error of any subject is thrown once every thread has stopped; no subject
