@@ -118,7 +118,7 @@ void bind_element(py::module_& m) {
 
 const TypicalStroke& typical_stroke_by_key(py::handle key) {
   if (py::isinstance<py::str>(key)) {
-    const std::string acronym = key.cast<std::string>();
+    const std::string acronym = convert_named<std::string>(key, "key");  // a lone surrogate: a wrong value
     if (const auto id = typical_stroke_id(acronym)) return typical_stroke(*id);
     std::string known;
     for (const TypicalStroke& t : typical_strokes()) {
