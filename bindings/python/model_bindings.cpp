@@ -9,6 +9,7 @@
 
 #include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "bindings.hpp"
@@ -330,7 +331,14 @@ void bind_library(py::module_& m) {
       .def("__contains__",
            [](const CharacterSource& lib, const py::object& c) {
              if (!py::isinstance<py::str>(c)) return false;
-             const std::u32string chars = decode_utf8(c.cast<std::string>());
+             // A str UTF-8 cannot encode (a lone surrogate) names no character: not in any library.
+             Py_ssize_t size = 0;
+             const char* utf8 = PyUnicode_AsUTF8AndSize(c.ptr(), &size);
+             if (utf8 == nullptr) {
+               PyErr_Clear();
+               return false;
+             }
+             const std::u32string chars = decode_utf8(std::string_view(utf8, static_cast<std::size_t>(size)));
              return chars.size() == 1 && lib.contains(chars[0]);
            })
       .def(

@@ -301,6 +301,8 @@ class Round15E(unittest.TestCase):
             "writer_params key": lambda: cg.writer_profile("novice", {"\ud800": 1.0}),
             "units": lambda: cg.score(columns, "一", units="\ud800"),
             "characters": lambda: cg.Scene("\ud800"),
+            "record": lambda: cg.rerun_trial("\ud800"),
+            "record key": lambda: cg.check_trial_record({"\ud800": 1}),
         }
         for name, call in calls.items():
             with self.subTest(argument=name):
@@ -309,6 +311,9 @@ class Round15E(unittest.TestCase):
         with self.subTest(argument="simulate_trial writer"):
             self.raised(cg.InvalidArgument, lambda: cg.simulate_trial("一", writer="\ud800", max_duration_s=0.05),
                         "writer")
+        # Membership asks, it does not refuse: a str that names no character is not in the library.
+        self.assertNotIn("\ud800", cg.CharacterLibrary.default())
+        self.assertIn("一", cg.CharacterLibrary.default())
         cg.set_log_level("warning")
 
     def test_score_arguments_of_another_type_are_type_errors_naming_them(self):
