@@ -91,13 +91,14 @@ void set_log_level(const Annotated<LogLevelTag>& level) {
   const py::object logging = py::module_::import("logging");
   int value = 0;
   if (py::isinstance<py::str>(level.object)) {
-    std::string name = level.object.cast<std::string>();
+    const std::string given = convert_named<std::string>(level.object, "level");  // a lone surrogate: a value
+    std::string name = given;
     for (char& c : name) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
     const py::object number = logging.attr("getLevelName")(name);  // "DEBUG" -> 10; unknown -> "Level X"
     if (!py::isinstance<py::int_>(number)) {
       throw InvalidArgument(
-          "level: expected a logging level name (DEBUG, INFO, WARNING, ERROR, CRITICAL), got '" +
-          level.object.cast<std::string>() + "'");
+          "level: expected a logging level name (DEBUG, INFO, WARNING, ERROR, CRITICAL), got '" + given +
+          "'");
     }
     value = number.cast<int>();
   } else if (PyLong_Check(level.object.ptr()) && !PyBool_Check(level.object.ptr())) {

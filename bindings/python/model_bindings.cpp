@@ -9,6 +9,7 @@
 
 #include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "bindings.hpp"
@@ -118,7 +119,7 @@ void bind_element(py::module_& m) {
 
 const TypicalStroke& typical_stroke_by_key(py::handle key) {
   if (py::isinstance<py::str>(key)) {
-    const std::string acronym = key.cast<std::string>();
+    const std::string acronym = convert_named<std::string>(key, "key");  // a lone surrogate: a wrong value
     if (const auto id = typical_stroke_id(acronym)) return typical_stroke(*id);
     std::string known;
     for (const TypicalStroke& t : typical_strokes()) {
@@ -330,7 +331,14 @@ void bind_library(py::module_& m) {
       .def("__contains__",
            [](const CharacterSource& lib, const py::object& c) {
              if (!py::isinstance<py::str>(c)) return false;
-             const std::u32string chars = decode_utf8(c.cast<std::string>());
+             // A str UTF-8 cannot encode (a lone surrogate) names no character: not in any library.
+             Py_ssize_t size = 0;
+             const char* utf8 = PyUnicode_AsUTF8AndSize(c.ptr(), &size);
+             if (utf8 == nullptr) {
+               PyErr_Clear();
+               return false;
+             }
+             const std::u32string chars = decode_utf8(std::string_view(utf8, static_cast<std::size_t>(size)));
              return chars.size() == 1 && lib.contains(chars[0]);
            })
       .def(

@@ -151,9 +151,17 @@ std::vector<PenSample> samples_from_columns(const py::object& columns, TraceUnit
   return samples;
 }
 
-py::dict score_py(const py::object& trace, const py::object& character, const std::string& units_name,
-                  const std::optional<PyArgument<CharacterSource>>& library, double contact_threshold_m,
-                  const std::optional<PyArgument<StrokeAcceptance>>& acceptance, double start_radius_m) {
+py::dict score_py(const py::object& trace, const py::object& character,
+                  const PyArgument<std::string>& units_arg,
+                  const std::optional<PyArgument<CharacterSource>>& library,
+                  const PyArgument<double>& contact_threshold_arg,
+                  const std::optional<PyArgument<StrokeAcceptance>>& acceptance,
+                  const PyArgument<double>& start_radius_arg) {
+  // Each argument converted by name: a value of another type is a TypeError naming it, a lone surrogate an
+  // InvalidArgument (arguments.hpp), never pybind11's "incompatible function arguments".
+  const std::string units_name = take(units_arg, "units");
+  const double contact_threshold_m = take(contact_threshold_arg, "contact_threshold_m");
+  const double start_radius_m = take(start_radius_arg, "start_radius_m");
   // The spellings this function documents and the command line's --units takes: "m" or "data".
   if (units_name != "m" && units_name != "data")
     throw InvalidArgument("units: '" + units_name +

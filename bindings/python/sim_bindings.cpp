@@ -167,8 +167,9 @@ void bind_simulated_device(py::module_& m) {
           "enable_forces",
           [](SimulatedDevice& d, const PyArgument<bool>& on) { d.enable_forces(take(on, "enabled")); },
           py::arg("enabled"), "Forces on or off (off: the commanded force is not applied).")
-      .def_property_readonly("forces_enabled", &SimulatedDevice::forces_enabled)
-      .def_property_readonly("is_open", &SimulatedDevice::is_open)
+      .def_property_readonly("forces_enabled", &SimulatedDevice::forces_enabled,
+                             "True while commanded forces are applied (enable_forces; True when made)")
+      .def_property_readonly("is_open", &SimulatedDevice::is_open, "True between open() and close()")
       .def("close", &SimulatedDevice::close, "Forces off and closed.")
       .def("open", &SimulatedDevice::open, "Opens it again after close().")
       .def_property_readonly("info", &SimulatedDevice::info, "its DeviceInfo")

@@ -427,7 +427,7 @@ std::optional<std::pair<std::string, std::string>> non_finite_value(const py::ha
   };
   if (py::isinstance<py::dict>(value)) {
     for (const auto& [key, item] : value.cast<py::dict>()) {
-      auto found = non_finite_value(item, child(py::str(key).cast<std::string>()));
+      auto found = non_finite_value(item, child(convert_named<std::string>(py::str(key), "record key")));
       if (found) return found;
     }
   } else if (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value)) {
@@ -452,7 +452,7 @@ RecordedTrial read_record_py(const py::object& record) {
   }
   if (py::isinstance<py::str>(record)) {
     // A record's JSON text passed for its path: say so, rather than naming the text as a missing file.
-    const std::string text = record.cast<std::string>();
+    const std::string text = convert_named<std::string>(record, "record");  // a lone surrogate: a wrong value
     const std::size_t first = text.find_first_not_of(" \t\r\n");
     std::error_code no_file;  // a text too long for a path is not a file either
     if (first != std::string::npos && (text[first] == '{' || text[first] == '[') &&

@@ -11,8 +11,9 @@ WriterProfile writer_with_settings(const py::object& writer, const py::object& p
   if (py::isinstance<WriterProfile>(writer)) {
     profile = writer.cast<WriterProfile>();
   } else if (py::isinstance<py::str>(writer)) {
+    const std::string name = convert_named<std::string>(writer, "writer");  // a lone surrogate: a wrong value
     try {
-      profile = writer_profile(writer.cast<std::string>());
+      profile = writer_profile(name);
     } catch (const InvalidArgument& e) {
       throw InvalidArgument(std::string("writer: ") + e.what());
     }
@@ -25,7 +26,7 @@ WriterProfile writer_with_settings(const py::object& writer, const py::object& p
   for (const py::handle item : params.attr("items")()) {
     const py::tuple pair = py::reinterpret_borrow<py::tuple>(item);
     if (!py::isinstance<py::str>(pair[0])) throw_type_error("writer_params key", "str", pair[0]);
-    const std::string key = pair[0].cast<std::string>();
+    const std::string key = convert_named<std::string>(pair[0], "writer_params key");
     const std::string name = "writer_params['" + key + "']";
     const double value = convert_named<double>(pair[1], name);
     try {

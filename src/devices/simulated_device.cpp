@@ -65,7 +65,7 @@ SimulatedDevice::SimulatedDevice(const SimulatedDeviceParameters& parameters)
   parameters_.info.intrinsic_damping_n_s_per_m = parameters_.damping_n_s_per_m;  // the simulation's truth
 }
 
-void SimulatedDevice::open() {
+void SimulatedDevice::open() noexcept {
   if (open_) return;
   open_ = true;
   // DeviceState::time_s counts from open(); a velocity differenced across the re-open would span the gap.

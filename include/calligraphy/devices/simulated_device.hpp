@@ -77,7 +77,7 @@ class SimulatedDevice final : public HandDrivenDevice {
   [[nodiscard]] const DeviceInfo& info() const override { return parameters_.info; }
   /// Opens the device: its clock restarts at 0 s and its velocity filter afresh (the first read reports
   /// zero velocity); the stylus stays where it is. Opening an open device changes nothing. Never throws.
-  void open() override;
+  void open() noexcept override;
   void close() noexcept override;
   [[nodiscard]] bool is_open() const override { return open_; }
   void enable_forces(bool enabled) override;
