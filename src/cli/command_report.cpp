@@ -19,12 +19,12 @@
 
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/worker_threads.hpp"
 #include "calligraphy/report/study_report_html.hpp"
 #include "calligraphy/study/session_reader.hpp"
 #include "calligraphy/study/study_tables.hpp"
 #include "cli/commands.hpp"
 #include "cli/output.hpp"
-#include "core/worker_threads.hpp"
 
 namespace calligraphy::cli {
 namespace fs = std::filesystem;

@@ -12,7 +12,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
-#include "core/worker_threads.hpp"
+#include "calligraphy/core/worker_threads.hpp"
 
 namespace calligraphy::cli {
 namespace {

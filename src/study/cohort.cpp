@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/worker_threads.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/model/scene.hpp"
@@ -23,7 +24,6 @@
 #include "calligraphy/trial/quiz_trace.hpp"
 #include "calligraphy/trial/trial_spec_runner.hpp"
 #include "calligraphy/trial/writer_profile.hpp"
-#include "core/worker_threads.hpp"
 #include "study/names.hpp"
 #include "study/remembered_writer.hpp"
 #include "study/trial_guidance.hpp"

@@ -13,9 +13,9 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
+#include "calligraphy/core/worker_threads.hpp"
 #include "calligraphy/study/session_reader.hpp"
 #include "core/json_reader.hpp"
-#include "core/worker_threads.hpp"
 #include "study/names.hpp"
 #include "study/record_metrics.hpp"
 #include "study/trial_row.hpp"

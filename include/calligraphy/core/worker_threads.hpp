@@ -1,5 +1,7 @@
 #pragma once
-// Worker threads that share one task's items, for a machine that may not give them. Internal.
+/// \file worker_threads.hpp
+/// Worker threads that share one task's items, for a machine that may not give them (a limit on the threads
+/// this user may run, RLIMIT_NPROC, or on memory): the work goes on with the threads that started.
 #include <cstddef>
 #include <functional>
 #include <system_error>
