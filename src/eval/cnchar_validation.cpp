@@ -4,13 +4,15 @@
 #include <array>
 #include <atomic>
 #include <cstdio>
+#include <exception>
+#include <mutex>
 #include <ostream>
 #include <thread>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
+#include "calligraphy/core/worker_threads.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
-#include "core/worker_threads.hpp"
 
 namespace calligraphy::cli {
 namespace {
@@ -168,7 +170,7 @@ CncharValidation validate_against_cnchar(const CharacterLibrary& library,
   const std::vector<std::pair<char32_t, std::string>> items(labels.begin(), labels.end());
   std::vector<Outcome> outcomes(items.size());
   std::atomic<std::size_t> next{0};
-  const auto work = [&] {
+  const auto take_characters = [&] {
     for (std::size_t k = next++; k < items.size(); k = next++) {
       const auto& [cp, letters] = items[k];
       if (!library.contains(cp)) continue;
@@ -185,9 +187,23 @@ CncharValidation validate_against_cnchar(const CharacterLibrary& library,
       }
     }
   };
+  // A character whose data cannot be read ends the validation with that error, from whichever thread met it
+  // first; the others stop at their next character (an exception leaving a thread would end the process).
+  std::mutex failure_mutex;
+  std::exception_ptr failure;
+  const auto work = [&] {
+    try {
+      take_characters();
+    } catch (...) {
+      const std::lock_guard<std::mutex> lock(failure_mutex);
+      if (!failure) failure = std::current_exception();
+      next = items.size();
+    }
+  };
   WorkerThreads pool(std::max(1u, threads) - 1, work);
   work();
   pool.join();
+  if (failure) std::rethrow_exception(failure);
 
   CncharValidation result;
   result.labelled = items.size();
