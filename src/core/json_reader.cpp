@@ -81,9 +81,13 @@ constexpr double kLargestExactInteger = 9007199254740992.0;
 [[noreturn]] void fail_integer(const nlohmann::json& value, const std::string& pointer,
                                const std::string& source, const std::string& range) {
   std::string message = "expected an integer in " + range + ", got " + describe(value);
-  if (value.is_number_float() && std::isfinite(value.get<double>()) &&
-      std::floor(value.get<double>()) == value.get<double>() &&
-      std::fabs(value.get<double>()) >= kLargestExactInteger) {
+  const bool whole_float = value.is_number_float() && std::isfinite(value.get<double>()) &&
+                           std::floor(value.get<double>()) == value.get<double>();
+  // Digits alone read as an integer up to 2^64; a whole float below that was written with an exponent or a
+  // fraction, one from 2^64 on may be digits alone, past every 64-bit integer.
+  if (whole_float && std::fabs(value.get<double>()) >= 18446744073709551616.0) {
+    message += " (beyond every 64-bit integer)";
+  } else if (whole_float && std::fabs(value.get<double>()) >= kLargestExactInteger) {
     message +=
         " (written with an exponent or a fraction: above 2^53 = 9007199254740992 write it in digits, "
         "as such a number may have been rounded)";
