@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/study/cohort.hpp"
@@ -62,6 +63,8 @@ SubjectShown show_subject(const StudyProtocol& protocol, const SubjectAssignment
 
 // "1 h 02 min 05 s", "3 min 20 s", "45 s".
 std::string duration_text(double seconds) {
+  // Under ten seconds as given (a trial of 0.3 s is not one of "0 s"); above, in whole seconds.
+  if (seconds < 10.0) return shortest_decimal(seconds) + " s";
   const auto total = static_cast<long long>(seconds + 0.5);
   char text[64];
   if (total >= 3600) {
