@@ -226,7 +226,8 @@ def skip_reason(example):
         (r"--kanjivg", "KanjiVG data (the network)"),
         (r"strace ", "a measurement of the test suite"),
         (r"/usr/bin/time ", "a measurement of the test suite"),
-        (r"\$\(scripts/fetch-hanzi-writer-data\.sh\)|\$data", None),
+        # The fetched data, and the store an example before builds from it.
+        (r"\$\(scripts/fetch-hanzi-writer-data\.sh\)|\$data|--store corpus\.clg", None),
     ]
     for pattern, reason in rules:
         if re.search(pattern, t):
