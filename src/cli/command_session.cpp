@@ -435,6 +435,11 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
       check_writable_folder(existing, trial_files_bytes(resolved.protocol.trial));
   }
 
+#ifdef CALLIGRAPHY_WITH_TRAINER
+  // and a person's session in the window without a display to open it on (no session folder left behind).
+  if (in_window(command.display, writer)) trainer::check_display();
+#endif
+
   // One run into a study folder at a time: the lock is held until this run ends. Another run that was here
   // before it, or ended since the checks above, is seen by checking again under the lock.
   const StudyRunLock study_lock(command.out,

@@ -77,6 +77,11 @@ struct TrainerOptions {
 /// Throws Error (InvalidArgument, DeviceNotFound, ...) when it cannot start (no display, a bad option).
 int run_trainer(const TrainerOptions& options);
 
+/// Throws Error ("cannot open a window: ... DISPLAY is '...'") when no window can be opened because there is
+/// no X display (GLFW cannot initialise), as `run_trainer` and `run_trainer_session` would: a caller refuses
+/// before it makes anything (a session's folder).
+void check_display();
+
 /// A study session in the window: `calligraphy session run` on a device a person moves.
 struct TrainerSessionOptions {
   SessionFolder* session = nullptr;  ///< the session to run (its unsaved trials)

@@ -23,6 +23,7 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "trainer/screenshot.hpp"
+#include "trainer/trainer.hpp"
 #include "trainer/x11_errors.hpp"
 
 namespace calligraphy::trainer {
@@ -61,7 +62,21 @@ void record_key(GLFWwindow* /*window*/, int key, int /*scancode*/, int action, i
   if (action == GLFW_PRESS && pending_keys != nullptr) pending_keys->push_back(key);
 }
 
+// "cannot open a window: GLFW could not initialise (no X display? ...)": the one line for a display that is
+// not there, from open_window and check_display alike.
+std::string no_display_message() {
+  std::string message = "cannot open a window: GLFW could not initialise (no X display? DISPLAY is '";
+  message.append(std::getenv("DISPLAY") ? std::getenv("DISPLAY") : "").append("'; try xvfb-run)");
+  return message;
+}
+
 }  // namespace
+
+void check_display() {
+  glfwSetErrorCallback(nullptr);  // the refusal below is the one line
+  if (glfwInit() == GLFW_FALSE) throw Error(no_display_message());
+  glfwTerminate();
+}
 
 void TrainerApp::open_window() {
   std::string start_error;
@@ -77,11 +92,7 @@ void TrainerApp::open_window() {
     if (!start_error.empty()) text.append(" (").append(start_error).append(")");
     return text;
   };
-  if (glfwInit() == GLFW_FALSE) {
-    std::string message = "cannot open a window: GLFW could not initialise (no X display? DISPLAY is '";
-    message.append(std::getenv("DISPLAY") ? std::getenv("DISPLAY") : "").append("'; try xvfb-run)");
-    throw Error(message + said());
-  }
+  if (glfwInit() == GLFW_FALSE) throw Error(no_display_message() + said());
   install_x11_error_handler();
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
