@@ -1,6 +1,7 @@
 // `calligraphy session cohort PROTOCOL --subjects N --csv DIR`: N simulated subjects through every session
 // of a protocol in memory (study/cohort.hpp), on every core, without session folders; the study's tidy
 // tables (trials.csv, strokes.csv) are written at the end, as `report --csv` writes them for folders.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -83,10 +84,12 @@ int run_session_cohort(const SessionCohortCommand& command) {
   table_files.add(tables_folder / "strokes.csv", strokes_text);
   table_files.commit();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // The threads simulate_cohort runs: one per subject at most.
+  const std::size_t used = std::min<std::size_t>(threads, subjects.size());
   std::printf(
-      "%s: %zu subjects, %zu trials on %u threads in %.1f s: trials.csv (%zu rows), strokes.csv (%zu rows)\n",
-      command.csv.c_str(), subjects.size(), tables.trials.size(), threads, seconds, tables.trials.size(),
-      tables.strokes.size());
+      "%s: %zu subjects, %zu trials on %zu %s in %.1f s: trials.csv (%zu rows), strokes.csv (%zu rows)\n",
+      command.csv.c_str(), subjects.size(), tables.trials.size(), used, used == 1 ? "thread" : "threads",
+      seconds, tables.trials.size(), tables.strokes.size());
   return 0;
 }
 

@@ -688,6 +688,13 @@ class Sets(Case):
         self.refused(r, 2, "replay")
         self.assertEqual(list((self.tmp / "t").iterdir()), [])
 
+    def test_cohort_names_the_threads_it_ran(self):
+        # One subject is simulated on one thread whatever --jobs asks for; the summary says so.
+        (self.tmp / "t").mkdir()
+        r = run(["session", "cohort", self.write(tiny()), "--subjects", "1", "--jobs", "4", "--csv", "t"], self.tmp)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn(b" on 1 thread in ", r.stdout)
+
     @heavy
     def test_two_cohorts_into_one_folder_at_once_leave_one_pair(self):
         p = self.write(tiny())
