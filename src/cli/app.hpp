@@ -78,14 +78,13 @@ CLI::Option* add_choice(CLI::App& app, const std::string& name, std::string& tar
                         const std::vector<std::string>& choices, const std::string& description,
                         const std::string& default_text = "",
                         const std::map<std::string, std::string>& retired = {});
+/// A list of names (`writer_profile_names()`) as `add_choice` takes them.
+std::vector<std::string> name_choices(std::span<const std::string_view> names);
 /// Every spelling of enumeration `E` (its EnumTable, core/schema.hpp), as `add_choice` takes them.
 template <typename E>
 std::vector<std::string> enum_choices() {
-  const auto spellings = enum_spellings<E>();
-  return {spellings.begin(), spellings.end()};
+  return name_choices(enum_spellings<E>());
 }
-/// The same of a list of names (`writer_profile_names()`).
-std::vector<std::string> name_choices(std::span<const std::string_view> names);
 /// Free text (characters, a device name). `default_text` describes the default when `target` is empty.
 CLI::Option* add_text(CLI::App& app, const std::string& name, std::string& target,
                       const std::string& value_name, const std::string& description,

@@ -279,12 +279,8 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
     } catch (const DeviceUnavailable&) {
       // The writer is checked against the kind of device, known whether or not the device can be used now:
       // a pairing it cannot have is the usage error it is (exit 2) before a device that cannot be used (1).
-      if (const std::optional<bool> simulated_hand = kind_moved_by_simulated_hand(devices, command.device)) {
-        DeviceListing kind;
-        kind.name = command.device;
-        kind.capabilities.moved_by_simulated_hand = *simulated_hand;
-        (void)writer_for_device(command.writer, kind);
-      }
+      if (const std::optional<bool> simulated_hand = kind_moved_by_simulated_hand(devices, command.device))
+        (void)writer_for_device(command.writer, command.device, *simulated_hand);
       throw;
     }
   }();

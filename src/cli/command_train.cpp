@@ -192,7 +192,7 @@ void add_train_command(CLI::App& root, Commands& commands, DeviceRegistry& devic
       "person");
   add_choice(*app, "--guidance", command->guidance, {"on", "off"},
              "guiding force towards the stroke (G toggles)");
-  add_choice(*app, "--guidance-mode", command->guidance_mode, guidance_mode_choices(),
+  add_choice(*app, "--guidance-mode", command->guidance_mode, enum_choices<GuidanceMode>(),
              "how guidance acts (docs/force-rendering.md): the paper's fixed fixture, faded trial by trial "
              "from the mean deviation, along a teacher's recording, only beyond a band that adapts trial by "
              "trial, a gentle push off the stroke, or a target pacing the stroke (M cycles it)");

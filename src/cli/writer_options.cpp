@@ -3,7 +3,6 @@
 #include <map>
 
 #include "calligraphy/devices/hand_port.hpp"
-#include "calligraphy/render/guidance_mode.hpp"
 #include "calligraphy/trial/trial_spec.hpp"
 #include "cli/cli_devices.hpp"
 
@@ -35,27 +34,25 @@ bool simulated_writer_moves(const DeviceListing& device) {
 }
 
 TrialWriter writer_for_device(const std::string& given, const DeviceListing& device) {
-  const bool simulated_device = simulated_writer_moves(device);
-  if (given.empty()) return simulated_device ? TrialWriter::simulated : TrialWriter::person;
-  if (given == kSimulatedWriter && !simulated_device) {
-    throw UsageError("--writer simulated with --device " + device.name + ": the device '" + device.name +
+  return writer_for_device(given, device.name, simulated_writer_moves(device));
+}
+
+TrialWriter writer_for_device(const std::string& given, const std::string& device_name,
+                              bool moved_by_simulated_hand) {
+  if (given.empty()) return moved_by_simulated_hand ? TrialWriter::simulated : TrialWriter::person;
+  if (given == kSimulatedWriter && !moved_by_simulated_hand) {
+    throw UsageError("--writer simulated with --device " + device_name + ": the device '" + device_name +
                      "' is moved by a person (--writer person); the simulated writer moves simulated and "
                      "emulated-phantom");
   }
-  if (given == kPersonWriter && simulated_device) {
-    throw UsageError("--writer person with --device " + device.name + ": a person cannot hold the device '" +
-                     device.name +
+  if (given == kPersonWriter && moved_by_simulated_hand) {
+    throw UsageError("--writer person with --device " + device_name + ": a person cannot hold the device '" +
+                     device_name +
                      "', the simulated writer moves it (--writer simulated); a person writes on a haptic "
                      "device of `calligraphy devices`, or with the mouse in `calligraphy train` (mouse, "
                      "mouse-hand)");
   }
   return given == kSimulatedWriter ? TrialWriter::simulated : TrialWriter::person;
-}
-
-std::vector<std::string> guidance_mode_choices() {
-  std::vector<std::string> names;
-  for (const GuidanceMode mode : guidance_modes()) names.emplace_back(to_string(mode));
-  return names;
 }
 
 }  // namespace calligraphy::cli

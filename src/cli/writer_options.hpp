@@ -30,8 +30,9 @@ bool simulated_writer_moves(const DeviceListing& device);
 /// writer on a device it moves, a person on any other), never `automatic`. Throws UsageError naming
 /// --writer when that writer cannot move the device.
 TrialWriter writer_for_device(const std::string& given, const DeviceListing& device);
-
-/// Every guidance mode's name (`guidance_modes`, render/guidance_mode.hpp), for --guidance-mode.
-std::vector<std::string> guidance_mode_choices();
+/// The same for the device called `device_name` whose kind the simulated writer moves or not
+/// (`kind_moved_by_simulated_hand`): a writer it cannot have is refused also while the device cannot be used.
+TrialWriter writer_for_device(const std::string& given, const std::string& device_name,
+                              bool moved_by_simulated_hand);
 
 }  // namespace calligraphy::cli
