@@ -5,10 +5,10 @@
 #include <chrono>
 #include <string>
 
-#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/report/trial_report.hpp"
+#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/testing/emulated_phantom.hpp"
 #include "calligraphy/trial/trial.hpp"
 #include "testing/phantom_emulator.hpp"
@@ -227,7 +227,8 @@ TEST_CASE("The reports of an aborted trial say so and keep what was recorded", "
   CHECK(result.device_fault == DeviceFault::link_lost);
   const TrialDescription description{
       "口", true, "novice", 0, 1000.0, "emulated-phantom", device.info().model};
-  const std::string json = trial_json(description, result, trial_writing_metrics(scene, result, StrokeAcceptance{}));
+  const std::string json =
+      trial_json(description, result, trial_writing_metrics(scene, result, StrokeAcceptance{}));
   CHECK(json.find("\"aborted\": true") != std::string::npos);
   CHECK(json.find("unplugged") != std::string::npos);
   CHECK(json.find("\"device\": \"emulated-phantom\"") != std::string::npos);
