@@ -13,11 +13,11 @@
 
 #include "bindings.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/render/force_law.hpp"
 #include "calligraphy/render/guidance_law.hpp"
 #include "calligraphy/render/interaction_state.hpp"
 #include "calligraphy/render/renderer.hpp"
-#include "calligraphy/devices/simulated_device.hpp"
 #include "log_forwarding.hpp"
 #include "numpy_arrays.hpp"
 #include "parameter_class.hpp"
@@ -481,16 +481,17 @@ void bind_renderer(py::module_& m) {
             return std::make_unique<Renderer>(
                 scene.object.cast<const Scene&>(),
                 force_law ? take(*force_law, "force_law") : ForceLawParameters{},
-                device ? take(*device, "device") : simulated_phantom_desktop_info(),
+                device ? take(*device, "device") : SimulatedDevice{}.info(),
                 options ? take(*options, "options") : RendererOptions{});
           }),
           py::arg("scene"), py::arg("force_law") = py::none(), py::arg("device") = py::none(),
           py::arg("options") = py::none(), py::keep_alive<1, 2>(), py::call_guard<ForwardLog>(),
           "scene: the Scene to render. force_law: ForceLawParameters (default the C++ defaults). device: the "
-          "DeviceInfo whose limits the safety chain takes (default the simulated Phantom Desktop's). "
-          "options: "
-          "RendererOptions. Raises InvalidArgument (a ValueError) for values out of range or a device with "
-          "max_force_n <= 0; logs a warning when a stiffness exceeds the device's stable maximum.")
+          "DeviceInfo whose limits the safety chain takes and whose intrinsic damping sets the passivity "
+          "bound (default the simulated Phantom Desktop's as SimulatedDevice().info reports it, with its "
+          "own damping, 0.5 N s/m). options: RendererOptions. Raises InvalidArgument (a ValueError) for "
+          "values out of range or a device with max_force_n <= 0; logs a warning when a stiffness exceeds "
+          "the device's stable maximum or Colgate's bound 2 (b - B) / T.")
       .def(
           "tick",
           [](Renderer& r, const PyArgument<DeviceState>& state) { return r.tick(take(state, "state")); },

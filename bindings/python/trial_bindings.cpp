@@ -616,8 +616,9 @@ characters: a str of one or more characters (loaded from `library`, default the 
             a Character, a sequence of Characters (written left to right), or a Scene.
 writer: 'novice', 'skilled', 'foreign' or a WriterProfile; writer_params: {'key': value} set on it
 by name (writer_parameter_names(), docs/writer.md). guidance: in-plane guidance on or off (the paper
-force stays). guidance_mode: 'fixed' (eq. 8), 'fading' (eq. 8 times guidance_gain in [0, 1]) or
-'replay' (follow `teacher` in time); None keeps force_law's, or 'replay' when a teacher is given.
+force stays). guidance_mode: 'fixed' (eq. 8), 'fading' (eq. 8 times guidance_gain in [0, 1]),
+'replay' (follow `teacher` in time), 'assist-as-needed', 'error-amplification' or 'timing'
+(docs/force-rendering.md, "Guidance modes"); None keeps force_law's, or 'replay' when a teacher is given.
 teacher: a TeacherRecording of the same characters (record_teacher) or a list of TeacherSample.
 rate_hz: servo rate [Hz], 100..100000. seed: int >= 0. max_duration_s: simulated time limit [s],
 > 0, at most 10^7 ticks (rate_hz * max_duration_s).

@@ -11,7 +11,8 @@ import calligraphy
 
 @pytest.fixture
 def stiff_paper():
-    # Above the simulated device's stable stiffness: the renderer logs a warning (not per tick).
+    # Above the simulated device's stable stiffness and its passivity bound 2 b / T (b = 0.5 N s/m, the default
+    # device's own damping): the renderer logs two warnings at construction (not per tick).
     return calligraphy.ForceLawParameters(paper_stiffness_n_per_m=5000.0)
 
 
@@ -26,9 +27,9 @@ def test_cpp_warnings_reach_python_logging(caplog, stiff_paper):
     caplog.set_level(logging.DEBUG, logger="calligraphy")
     calligraphy.Renderer(calligraphy.Scene("九"), stiff_paper)
     records = [r for r in caplog.records if r.name == "calligraphy"]
-    assert len(records) == 1
-    assert records[0].levelno == logging.WARNING
-    assert "5000" in records[0].getMessage() and "stable maximum" in records[0].getMessage()
+    assert len(records) == 2
+    assert all(r.levelno == logging.WARNING and "5000" in r.getMessage() for r in records)
+    assert "stable maximum" in records[0].getMessage() and "passivity bound" in records[1].getMessage()
 
 
 def test_set_log_level_filters_on_the_cpp_side(caplog, stiff_paper):
@@ -40,7 +41,7 @@ def test_set_log_level_filters_on_the_cpp_side(caplog, stiff_paper):
     assert not [r for r in caplog.records if r.name == "calligraphy"]
     calligraphy.set_log_level("warning")
     calligraphy.Renderer(calligraphy.Scene("九"), stiff_paper)
-    assert len([r for r in caplog.records if r.name == "calligraphy"]) == 1
+    assert len([r for r in caplog.records if r.name == "calligraphy"]) == 2
 
 
 def test_set_log_level_rejects_unknown_levels():
