@@ -168,7 +168,7 @@ def yi():
 
 def write_yi(pen, stroke, offset, speed=0.04, stop_before_end=0.0, z=-0.001):
     """Touch down at 一's start and write along its median with `offset` to the left; the ticks of the pass."""
-    positions, velocities = along(stroke.median_m, speed, offset=offset, z=z,
+    positions, velocities = along(stroke.median_m, speed, offset=offset, z=z, rate=1.0 / pen.period,
                                   stop=float(np.sum(np.hypot(*np.diff(stroke.median_m, axis=0).T))) - stop_before_end)
     pen.touch_down(positions[0][:2], z)
     return pen.go(positions, velocities)
@@ -192,10 +192,10 @@ def middle_ticks(pen, ticks, elements, margin=R_RES + 0.0005):
 class ForceLawByHand(unittest.TestCase):
     """A Renderer ticked along 一 (and 口), every force held to the documented law computed here."""
 
-    def paper_pen(self, law=None, safety=None, **law_fields):
+    def paper_pen(self, law=None, safety=None, rate=RATE, **law_fields):
         scene, stroke, elements = yi()
         law = law or cg.ForceLawParameters(**{**PAPER_LAW, **law_fields})
-        return Pen(scene, law, safety or no_chain()), stroke, elements
+        return Pen(scene, law, safety or no_chain(), rate=rate), stroke, elements
 
     def expected_eq8(self, pen, ticks, elements, gain=1.0):
         a, b = elements[1]
@@ -475,23 +475,24 @@ class ForceLawByHand(unittest.TestCase):
 
     def test_leaving_the_constraint_space_cross_fades_by_a_smoothstep(self):
         crossfade = 0.05
-        pen, stroke, elements = self.paper_pen(crossfade_s=crossfade)
-        ticks = write_yi(pen, stroke, 0.0, stop_before_end=0.025)
-        a, b = elements[1]
-        normal = np.array([-(b - a)[1], (b - a)[0]]) / np.linalg.norm(b - a)
-        foot = foot_on_segment(pen.pos[ticks[-1]][:2], a, b)[0]
-        inside, outside = foot + 0.003 * normal, foot + 0.0075 * normal
-        steady = pen.hold((inside[0], inside[1], -0.001), 80)
-        f0 = pen.force(steady)[-1]
-        np.testing.assert_allclose(f0[:2], -K_ET * 0.003 * normal, atol=1e-9)
-        fade = pen.hold((outside[0], outside[1], -0.001), 100)
-        f = pen.force(fade)[:, :2]
-        n = int(round(crossfade * RATE))
-        best = min(np.max(np.abs(f - np.outer(1.0 - smoothstep((np.arange(100) + shift) / n), f0[:2])))
-                   for shift in (0, 1))
-        self.assertLess(best, 1e-9, "F = F0 (1 - smoothstep(t / crossfade_s)), from the value at the switch")
-        self.assertTrue(np.all(f[n + 1:] == 0.0))
-        self.assertTrue(np.all(np.abs(f[: n - 2]) > 0.0), "not cut short")
+        for rate in (RATE, 4000.0):  # a time, not a count of ticks: 50 ticks at 1 kHz, 200 at 4 kHz
+            pen, stroke, elements = self.paper_pen(crossfade_s=crossfade, rate=rate)
+            ticks = write_yi(pen, stroke, 0.0, stop_before_end=0.025)
+            a, b = elements[1]
+            normal = np.array([-(b - a)[1], (b - a)[0]]) / np.linalg.norm(b - a)
+            foot = foot_on_segment(pen.pos[ticks[-1]][:2], a, b)[0]
+            inside, outside = foot + 0.003 * normal, foot + 0.0075 * normal
+            steady = pen.hold((inside[0], inside[1], -0.001), 80)
+            f0 = pen.force(steady)[-1]
+            np.testing.assert_allclose(f0[:2], -K_ET * 0.003 * normal, atol=1e-9)
+            n = int(round(crossfade * rate))
+            fade = pen.hold((outside[0], outside[1], -0.001), 2 * n)
+            f = pen.force(fade)[:, :2]
+            best = min(np.max(np.abs(f - np.outer(1.0 - smoothstep((np.arange(2 * n) + shift) / n), f0[:2])))
+                       for shift in (0, 1))
+            self.assertLess(best, 1e-9, f"F = F0 (1 - smoothstep(t / crossfade_s)) from the switch, at {rate} Hz")
+            self.assertTrue(np.all(f[n + 1:] == 0.0), rate)
+            self.assertTrue(np.all(np.abs(f[: n - 2]) > 0.0), f"not cut short at {rate} Hz")
 
     def test_paper_force_fades_in_linearly_on_a_tip_already_below(self):
         fade = 0.2
@@ -598,6 +599,22 @@ class ForceLawByHand(unittest.TestCase):
         rising = fz[fz < 2.4 - 1e-9]
         self.assertGreater(len(rising), 100, "2.4 N at 20 N/s takes 120 ms")
         np.testing.assert_allclose(np.diff(rising[1:]), ramp * T, atol=1e-9)
+
+    def test_reset_restarts_the_ramp_from_zero(self):
+        ramp = 20.0
+        scene, _, _ = yi()
+        pen = Pen(scene, cg.ForceLawParameters(**PAPER_LAW), cg.SafetyChainParameters(start_ramp_n_per_s=ramp))
+        pen.touch_down(IN_BOX, -0.003)
+        held = pen.hold((*IN_BOX, -0.003), 300)
+        self.assertAlmostEqual(pen.out[held[-1]].force_n[2], 2.4, delta=1e-12)
+        pen.renderer.reset()  # with the pen pressed in: the documented drop to the ramp, never a push
+        again = pen.hold((*IN_BOX, -0.003), 200)
+        fz = pen.force(again)[:, 2]
+        elapsed = (np.arange(len(fz)) + 1) * T
+        self.assertTrue(np.all(fz <= ramp * elapsed + 1e-12), "abs(F) <= rate x time since reset()")
+        self.assertTrue(np.all(np.abs(np.diff(fz)) <= 0.25 + 1e-12), "after the reset tick, the per-tick limit")
+        self.assertAlmostEqual(float(fz[-1]), 2.4, delta=1e-12)
+        self.assertEqual(pen.out[again[0]].state, cg.InteractionState.calibration)
 
     def test_low_pass_is_the_documented_first_order_filter(self):
         cutoff = 40.0
