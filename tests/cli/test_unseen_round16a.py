@@ -335,6 +335,23 @@ class ForceLawByHand(unittest.TestCase):
                 np.testing.assert_allclose(at_rest[:2], 0.0, atol=1e-12, err_msg=mode)
                 np.testing.assert_allclose(backwards[:2], 15.0 * 0.05 * t, rtol=0, atol=1e-9, err_msg=mode)
 
+    def test_a_pen_exactly_on_the_element_gives_no_nan_in_any_mode(self):
+        # d = 0: assist-as-needed's (X_S - X_p) / d with a band of 0 is 0 / 0 unless the law guards it
+        laws = {"fixed": cg.FixedGuidance(), "assist-as-needed, band 0": cg.AssistAsNeededGuidance(band_m=0.0),
+                "error-amplification": cg.ErrorAmplificationGuidance(), "timing": cg.TimingGuidance()}
+        for name, guidance_law in laws.items():
+            pen, stroke, elements = self.paper_pen(law=cg.ForceLawParameters(**PAPER_LAW, guidance_law=guidance_law))
+            write_yi(pen, stroke, 0.0, stop_before_end=0.025)
+            a, b = elements[1]
+            for u in (0.4, 0.45, 0.5):
+                on = a + u * (b - a)
+                out = pen.tick((on[0], on[1], -0.001))
+                self.assertFalse(out.force_error, name)
+                self.assertTrue(np.all(np.isfinite(out.force_n)), name)
+                self.assertAlmostEqual(out.force_n[2], 0.8, delta=1e-12, msg=name)  # the paper's force kept
+                if name != "timing":
+                    np.testing.assert_allclose(out.force_n[:2], 0.0, atol=1e-12, err_msg=name)
+
     def test_no_guidance_outside_the_constraint_space(self):
         pen, stroke, elements = self.paper_pen()
         ticks = write_yi(pen, stroke, 0.0, stop_before_end=0.025)
