@@ -7,8 +7,8 @@ One tiny within-subjects study in setUpModule (3 simulated subjects, 一 and 十
 condition, a protocol description full of markup), its `report --out --csv` and the Python study report
 (`python3 -m calligraphy.study_report`, no Rscript on PATH: the mixed models' rows say why); a study of characters
 named `<`, `&`, `"`, `'` and a right-to-left mark (a hanzi-writer-data folder of their files); a study of one trial
-that wrote nothing; a session that saved no trial; an empty folder; an output named with a space, `#`, `&` and
-`?`. Each case checks a documented promise: pages well formed (python3's html.parser held to balanced tags, every
+that wrote nothing; a session that saved no trial; an empty folder; an output named with a space, `#`, `&`, `?`
+and `%20`; session.json edited to names of markup. Each case checks a documented promise: pages well formed (python3's html.parser held to balanced tags, every
 inline and file SVG parsed by xml.etree), UTF-8 declared, a title, no script and nothing loaded from outside the
 output folder, every local link and image there (fragments too), an accessible name on every figure, header
 cells on every table; the pages' numbers those of the tidy tables within their printed rounding, in the units
@@ -461,6 +461,34 @@ class NamesAndFigures(OneErrorLine, unittest.TestCase):
             ET.fromstring(svg)
         self.assertEqual({tag for tag, _ in page.starts} & {"img", "script", "iframe"}, set())
 
+    def test_session_json_edited_to_names_of_markup_is_refused_or_shown_as_text(self):
+        """A subject id of markup is refused at its JSON pointer (its alphabet, docs/cli.md), nothing written; a
+        group edited to markup is shown as text on the index."""
+        import json
+        for key in ("subject", "group"):
+            study = self.root / f"edited-{key}"
+            shutil.copytree(self.root / "study", study)
+            session = sorted(study.glob("S01/*/session.json"))[0]
+            document = json.loads(session.read_text(encoding="utf-8"))
+            if key == "subject":
+                document["subject"]["id"] = "<b>S</b>&\""
+            else:
+                document["group"] = "<i>g</i>&\""
+            session.write_text(json.dumps(document, ensure_ascii=False), encoding="utf-8")
+            site = self.root / f"edited-{key}-site"
+            site.mkdir()
+            result = run(["report", study, "--out", site / "t.html", "--jobs", "1"], self.root)
+            if key == "subject":
+                self.assert_one_error(result, 1, "session.json", "/subject/id")
+                self.assertEqual(list(site.iterdir()), [])
+                continue
+            self.assertEqual(result.returncode, 0, result.stderr)
+            page, text = read_page(site / "t.html")
+            self.assertEqual(page.errors, [])
+            self.assertNotIn("<i>", text)
+            cells = [c[1] for t in page.tables for row in t["rows"] for c in row]
+            self.assertIn("<i>g</i>&\"", cells)
+
     def test_protocol_description_never_becomes_markup(self):
         for path in trial_pages(SHARED["root"] / "site", "trials.html") + [self.root / "site/paper/index.html"]:
             page, text = read_page(path)
@@ -632,6 +660,23 @@ class StudyReport(OneErrorLine, unittest.TestCase):
             inside = goal.is_relative_to(self.paper.resolve())
             self.assertTrue(inside or goal == per_trial or goal.is_relative_to(per_trial_files),
                             f"{target} leaves the report's folder and is no per-trial page")
+            if parts.fragment:
+                self.assertIn(parts.fragment, read_page(goal)[0].ids, target)
+
+    def test_study_report_links_a_per_trial_page_named_with_space_hash_ampersand_and_percent(self):
+        odd = self.root / "odd site" / SHARED["odd_name"]
+        result = study_report(["study", "--out", "odd-paper", "--per-trial-page", odd, "--analyse", "all"], self.root)
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
+        index = self.root / "odd-paper" / "index.html"
+        page, _ = read_page(index)
+        outside = [t for _, t in page.links if "odd" in t]
+        self.assertGreater(len(outside), 3 * 4, outside)
+        for target in outside:
+            parts = urlsplit(target)
+            self.assertEqual((parts.scheme, parts.netloc, parts.query), ("", "", ""), target)
+            goal = (index.parent / unquote(parts.path)).resolve()
+            self.assertTrue(goal.is_file(), f"{target} names nothing")
+            self.assertTrue(goal == odd.resolve() or goal.parent.parent.name == odd.name[:-5] + "_files", target)
             if parts.fragment:
                 self.assertIn(parts.fragment, read_page(goal)[0].ids, target)
 
