@@ -3,18 +3,18 @@
 read them, from the docs alone (docs/cli.md "report" and "model", docs/experiments.md "The per-trial pages" and
 "A report for a paper", docs/python.md). Run by CTest as `cli_unseen_round16f_tests`.
 
-One tiny within-subjects study in setUpModule (3 simulated subjects, 一 and 十 under a vision and a haptic
-condition, a protocol description full of markup), its `report --out --csv` and the Python study report
-(`python3 -m calligraphy.study_report`, no Rscript on PATH: the mixed models' rows say why); a study of characters
-named `<`, `&`, `"`, `'` and a right-to-left mark (a hanzi-writer-data folder of their files); a study of one trial
-that wrote nothing; a session that saved no trial; an empty folder; an output named with a space, `#`, `&`, `?`
-and `%20`; session.json edited to names of markup. Each case checks a documented promise: pages well formed (python3's html.parser held to balanced tags, every
-inline and file SVG parsed by xml.etree), UTF-8 declared, a title, no script and nothing loaded from outside the
-output folder, every local link and image there (fragments too), an accessible name on every figure, header
-cells on every table; the pages' numbers those of the tidy tables within their printed rounding, in the units
-the docs give, strokes numbered from 1, no `nan`, `inf` or `None` and no empty cell without a word why; names
-shown as text; PNG figures that open, at 150 dpi, not blank; axes named with units; a report run again over
-itself giving the same set and nothing else, the study folder unchanged.
+One tiny within-subjects study in setUpModule (3 simulated subjects, 一 and 十 under a vision and a haptic condition,
+a protocol description full of markup), its `report --out --csv` and the Python study report (`python3 -m
+calligraphy.study_report`, no Rscript on PATH: the mixed models' rows say why); a study of characters named `<`,
+`&`, `"`, `'` and a right-to-left mark (a hanzi-writer-data folder of their files); a study of one trial that wrote
+nothing; a session that saved no trial; an empty folder; an output named with a space, `#`, `&`, `?` and `%20`;
+session.json edited to names of markup. Each case checks a documented promise: pages well formed (python3's
+html.parser held to balanced tags, every inline and file SVG parsed by xml.etree), UTF-8 declared, a title, no
+script and nothing loaded from outside the output folder, every local link and image there (fragments too), an
+accessible name on every figure, header cells on every table; the pages' numbers those of the tidy tables within
+their printed rounding, in the units the docs give, strokes numbered from 1, no `nan`, `inf` or `None` and no empty
+cell without a word why; names shown as text; PNG figures that open, at 150 dpi, not blank; axes named with units; a
+report run again over itself giving the same set and nothing else, the study folder unchanged.
 
 CALLIGRAPHY_CLI names the program, PYTHONPATH its Python module, CALLIGRAPHY_SOURCE_DIR the sources (docs/ and
 the sample character data). CALLIGRAPHY_SANITIZED=1 takes five cases.
