@@ -430,7 +430,9 @@ def learning_figure(trials: "pandas.DataFrame", value: str, phase: typing.Option
             ax.set_xlabel("repetition")
             if repetitions:
                 ax.set_xlim(repetitions[0] - 0.4, repetitions[-1] + 0.4)
-            ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+            # Whole repetitions even when there are few: without min_n_ticks=1 the locator gives up on integers
+            # for a range holding one (a single repetition got ticks 0.64, 0.72, ... 1.36).
+            ax.xaxis.set_major_locator(MaxNLocator(integer=True, min_n_ticks=1))
             ax.yaxis.set_major_locator(MaxNLocator(nbins=5, steps=[1, 2, 2.5, 5, 10]))
             ax.grid(axis="y", color="#dddddd", lw=0.6)
             ax.spines[["top", "right"]].set_visible(False)
@@ -709,8 +711,11 @@ def phase_figure(means: "pandas.DataFrame", value: str, design: "design_analysis
         ax.yaxis.set_major_locator(MaxNLocator(nbins=5, steps=[1, 2, 2.5, 5, 10]))
         ax.grid(axis="y", color="#dddddd", lw=0.6)
         ax.spines[["top", "right"]].set_visible(False)
-        ax.legend(title=_factor_name(design), fontsize=8, title_fontsize=8,
-                  frameon=False, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+        if conditions:
+            ax.legend(title=_factor_name(design), fontsize=8, title_fontsize=8,
+                      frameon=False, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+        else:  # no trial analysed: the figure says so rather than showing empty axes
+            ax.text(0.5, 0.5, "no trial analysed", transform=ax.transAxes, ha="center", va="center", color="#555555")
     return figure
 
 
@@ -858,6 +863,9 @@ def _questions_html(questions: "pandas.DataFrame", value: str, factor: str = "co
                    f"<td>{_e(row['apa'] or '–')}</td>"
                    f"<td class=\"num\">{_e(_p_value(row['p_holm']))}</td><td class=\"num\">{difference}</td>"
                    f"<td class=\"test\">{_e(note)}</td></tr>\n")
+    if questions.empty:
+        out.append(f"<tr class=\"not-tested\"><td colspan=\"7\">none: no two {_e(factor)}s with analysed trials "
+                   "to compare</td></tr>\n")
     out.append("</tbody></table>\n")
     return "".join(out)
 
@@ -879,6 +887,8 @@ def _phase_means_html(means: "pandas.DataFrame", value: str, design: "design_ana
                        f"{_fixed(cell['sd'] * display.scale, display.decimals)} <span class=\"n\">({int(cell['n'])})"
                        "</span></td>")
         body.append("<tr>" + "".join(row) + "</tr>\n")
+    if not body:
+        body.append("<tr><td>none: no trial analysed</td></tr>\n")
     return (f"<table class=\"phase-means\" data-value=\"{_e(value)}\"><caption>{_e(display.label.capitalize())}{_e(unit)}"
             f": mean &plusmn; SD over subjects (n subjects)</caption><thead><tr><th>phase</th>{head}</tr></thead>"
             f"<tbody>\n{''.join(body)}</tbody></table>\n")
@@ -1086,8 +1096,8 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
                 "<section id=\"phases\">\n<h2>Means by phase</h2>\n", *means_html,
                 f"<p>{_e(transfer)}</p>\n" if transfer else "", "</section>\n",
                 table5_html, statistics_html,
-                "<section id=\"learning\">\n<h2>Learning curves</h2>\n", *learning_html, "</section>\n"
-                if learning_html else "",
+                *(["<section id=\"learning\">\n<h2>Learning curves</h2>\n", *learning_html, "</section>\n"]
+                  if learning_html else []),
                 _subjects_html(trials, values, per_trial_link),
                 "</body></html>\n"]
         index = out / "index.html"

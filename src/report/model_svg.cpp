@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "calligraphy/core/unicode.hpp"
+#include "report/markup_escape.hpp"
 
 namespace calligraphy {
 namespace {
@@ -51,7 +52,7 @@ std::string model_svg(const Character& character) {
   svg += "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
   svg +=
       "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 1024 1024\" width=\"512\" height=\"512\">\n";
-  svg += "<title>Model of " + describe_character(character.code_point) + "</title>\n";
+  svg += "<title>Model of " + escape_markup(describe_character(character.code_point)) + "</title>\n";
   svg +=
       "<style>.median{fill:none;stroke:#ccc;stroke-width:24;stroke-linecap:round;stroke-linejoin:round}"
       ".element{fill:none;stroke:#000;stroke-width:4}"

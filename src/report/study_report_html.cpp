@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "report/appendf.hpp"
+#include "report/markup_escape.hpp"
 
 namespace calligraphy {
 namespace {
@@ -21,33 +22,6 @@ namespace {
 // condition in the protocol's order.
 constexpr std::array<const char*, 7> kConditionColours{"#0072B2", "#E69F00", "#009E73", "#CC79A7",
                                                        "#56B4E9", "#D55E00", "#000000"};
-
-std::string escape(const std::string& text) {
-  std::string out;
-  out.reserve(text.size());
-  for (const char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&#39;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
 
 std::string number(double value, int decimals) {
   if (!std::isfinite(value)) return "&ndash;";
@@ -114,9 +88,9 @@ void append_trajectory_figure(std::string& out, const ReportTrial& trial) {
   };
   appendf(out,
           "<figure class=\"trajectory\"><svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" "
-          "height=\"%.0f\" viewBox=\"0 0 %.1f %.1f\" role=\"img\"><rect width=\"100%%\" height=\"100%%\" "
-          "fill=\"#fff\"/>\n",
-          width_px, height_px, width_px, height_px);
+          "height=\"%.0f\" viewBox=\"0 0 %.1f %.1f\" role=\"img\"><title>Trial %zu, %s: trajectory over the "
+          "reference</title><rect width=\"100%%\" height=\"100%%\" fill=\"#fff\"/>\n",
+          width_px, height_px, width_px, height_px, trial.index, escape_markup(trial.characters).c_str());
   for (const auto& stroke : trial.reference_m) {
     out +=
         "<polyline fill=\"none\" stroke=\"#3060d0\" stroke-opacity=\"0.6\" stroke-width=\"5\" "
@@ -167,10 +141,12 @@ void append_force_figure(std::string& out, const ReportTrial& trial) {
   f_max = f_max > 0.0 ? f_max * 1.1 : 1.0;
   const auto x_of = [&](double t) { return kLeft + (t - t0) / (t1 - t0) * plot_w; };
   const auto y_of = [&](double f) { return kTop + plot_h * (1.0 - f / f_max); };
-  appendf(out,
-          "<figure class=\"force\"><svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
-          "viewBox=\"0 0 %.0f %.0f\" role=\"img\"><rect width=\"100%%\" height=\"100%%\" fill=\"#fff\"/>\n",
-          kWidth, kHeight, kWidth, kHeight);
+  appendf(
+      out,
+      "<figure class=\"force\"><svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
+      "viewBox=\"0 0 %.0f %.0f\" role=\"img\"><title>Trial %zu, %s: in-plane force over time</title><rect "
+      "width=\"100%%\" height=\"100%%\" fill=\"#fff\"/>\n",
+      kWidth, kHeight, kWidth, kHeight, trial.index, escape_markup(trial.characters).c_str());
   for (const ReportStrokeSpan& s : trial.strokes) {
     appendf(
         out,
@@ -220,12 +196,13 @@ void append_trial(std::string& out, const std::vector<std::string>& conditions, 
           "<article class=\"trial\" id=\"%s\" data-subject=\"%s\" data-condition=\"%s\" "
           "data-phase=\"%s\">\n<h4><a href=\"#%s\">#%zu</a> <span class=\"glyph\">%s</span> %s <span "
           "style=\"color:%s\">%s</span> block %zu, item %zu, r%d</h4>\n",
-          escape(trial_anchor(trial.session, trial.index)).c_str(), escape(trial.subject).c_str(),
-          escape(trial.condition).c_str(), escape(trial.phase).c_str(),
-          escape(href(trial_anchor(trial.session, trial.index))).c_str(), trial.index,
-          escape(trial.characters).c_str(), escape(trial.phase).c_str(),
-          colour_of(conditions, trial.condition), escape(trial.condition).c_str(), trial.block, trial.item,
-          trial.repetition);
+          escape_markup(trial_anchor(trial.session, trial.index)).c_str(),
+          escape_markup(trial.subject).c_str(), escape_markup(trial.condition).c_str(),
+          escape_markup(trial.phase).c_str(),
+          escape_markup(href(trial_anchor(trial.session, trial.index))).c_str(), trial.index,
+          escape_markup(trial.characters).c_str(), escape_markup(trial.phase).c_str(),
+          colour_of(conditions, trial.condition), escape_markup(trial.condition).c_str(), trial.block,
+          trial.item, trial.repetition);
   appendf(
       out,
       "<p class=\"metrics\">%s s &middot; deviation %s mm &middot; Fr&eacute;chet %s mm &middot; DTW %s mm "
@@ -235,7 +212,7 @@ void append_trial(std::string& out, const std::vector<std::string>& conditions, 
       trial.dtw_m ? number(*trial.dtw_m * 1e3, 2).c_str() : "&ndash;", trial.order_errors,
       trial.backwards_strokes);
   if (trial.quiz_misses) appendf(out, " &middot; quiz misses %d", *trial.quiz_misses);
-  if (!trial.completed) appendf(out, " &middot; <b>%s</b>", escape(trial.end_reason).c_str());
+  if (!trial.completed) appendf(out, " &middot; <b>%s</b>", escape_markup(trial.end_reason).c_str());
   out += "</p>\n<div class=\"figures\">\n";
   append_trajectory_figure(out, trial);
   append_force_figure(out, trial);
@@ -259,7 +236,7 @@ article.trial:target{border-color:#0072B2;box-shadow:0 0 0 2px #0072B2}
 )";
 
 void append_head(std::string& out, const std::string& title) {
-  out += "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" + escape(title) +
+  out += "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" + escape_markup(title) +
          "</title>\n" + kStyle + "</head><body>\n";
 }
 
@@ -283,7 +260,7 @@ std::string session_page_path(const std::string& index_name, const std::string& 
 std::string study_index_html(const StudyReportIndex& index, const std::string& index_name) {
   std::string out;
   append_head(out, index.title);
-  out += "<h1>" + escape(index.title) + "</h1>\n";
+  out += "<h1>" + escape_markup(index.title) + "</h1>\n";
   std::size_t saved = 0;
   for (const ReportSession& s : index.sessions) saved += s.saved;
   appendf(out,
@@ -291,7 +268,7 @@ std::string study_index_html(const StudyReportIndex& index, const std::string& i
           "its force over time and its own values. The study's summaries and statistics are the study "
           "report's (<code>python3 -m calligraphy.study_report</code>).</p>\n",
           index.sessions.size(), saved);
-  for (const std::string& note : index.notes) out += "<p class=\"note\">" + escape(note) + "</p>\n";
+  for (const std::string& note : index.notes) out += "<p class=\"note\">" + escape_markup(note) + "</p>\n";
   out +=
       "<table class=\"sessions\">\n<tr><th>Subject</th><th>Group</th><th>Session</th><th>Trials saved</th>"
       "<th>Details</th></tr>\n";
@@ -299,9 +276,10 @@ std::string study_index_html(const StudyReportIndex& index, const std::string& i
     appendf(out,
             "<tr><td>%s</td><td>%s</td><td><a href=\"%s\">%s</a></td><td class=\"num\">%zu of "
             "%zu</td><td>%s</td></tr>\n",
-            escape(s.subject).c_str(), escape(s.group).c_str(),
-            escape(href(session_page_path(index_name, s.subject, s.session))).c_str(),
-            escape(s.session).c_str(), s.saved, s.planned, escape(s.description).c_str());
+            escape_markup(s.subject).c_str(),
+            s.group.empty() ? "none (no between-subjects phase)" : escape_markup(s.group).c_str(),
+            escape_markup(href(session_page_path(index_name, s.subject, s.session))).c_str(),
+            escape_markup(s.session).c_str(), s.saved, s.planned, escape_markup(s.description).c_str());
   }
   out += "</table>\n</body></html>\n";
   return out;
@@ -311,9 +289,10 @@ SessionPageHtml::SessionPageHtml(const ReportSession& session, const std::string
                                  const std::string& index_href)
     : conditions_(session.conditions) {
   append_head(out_, title + ": " + session.session);
-  out_ += "<p><a href=\"" + escape(href(index_href)) + "\">" + escape(title) + "</a></p>\n<h1>Subject " +
-          escape(session.subject) + " &mdash; " + escape(session.session) + "</h1>\n<p>" +
-          escape(session.description) + "</p>\n<div class=\"trials\">\n";
+  out_ += "<p><a href=\"" + escape_markup(href(index_href)) + "\">" + escape_markup(title) +
+          "</a></p>\n<h1>Subject " + escape_markup(session.subject) + " &mdash; " +
+          escape_markup(session.session) + "</h1>\n<p>" + escape_markup(session.description) +
+          "</p>\n<div class=\"trials\">\n";
 }
 
 void SessionPageHtml::add(const ReportTrial& trial) {
