@@ -365,8 +365,8 @@ def _training_rows(data: pandas.DataFrame, value: str, design: StudyDesign, ddf:
                               "item": rows_of["characters"].astype(str).to_numpy()})
     levels = [c for c in design.conditions if c in set(frame["factor"])]
     if len(levels) < 2 or design.control not in levels or frame["subject"].nunique() < 3:
-        return [_row(**base, comparison=f"{column}", note="not computed: fewer than 2 conditions with values "
-                     "or fewer than 3 subjects")]
+        return design_models.not_computed_rows(base, design.conditions, design.control, "not computed: fewer than "
+                                               "2 conditions with values or fewer than 3 subjects")
     # The documented reduction (design_models.fit_reduced): within subjects the slope's compound-symmetry form
     # is an intercept per subject and one per subject and condition.
     terms = ["(1 | subject)"] + (["(1 | subject:factor)"] if within else []) + items
@@ -374,7 +374,7 @@ def _training_rows(data: pandas.DataFrame, value: str, design: StudyDesign, ddf:
         fit, dropped = design_models.fit_reduced(frame, ["factor"], {"factor": levels}, ddf, terms,
                                                  ([subject_term] + items) if within else None, units)
     except RuntimeError as error:  # RUnavailable among them: R or its packages missing
-        return [_row(**base, comparison=column, note=f"not computed: {error}")]
+        return design_models.not_computed_rows(base, design.conditions, design.control, f"not computed: {error}")
     # One fit: whether it is a test, its note, subjects per level and subject means hold for every row.
     trusted = fit.trustworthy
     base["model"] = fit.formula.replace("outcome", value, 1).replace("factor", column)
@@ -432,8 +432,8 @@ def _ancova_rows(data: pandas.DataFrame, value: str, design: StudyDesign, phase:
                               "group": groups.reindex(subjects).to_numpy()})
     levels = [g for g in design.conditions if g in set(frame["group"])]
     if design.control not in levels or len(levels) < 2 or len(frame) < len(levels) + 2:
-        return [_row(**base, comparison="group", note=f"not computed: {len(frame)} subjects with a pre-test and a "
-                     f"{phase} value in {len(levels)} group(s)")]
+        return design_models.not_computed_rows(base, design.conditions, design.control, f"not computed: {len(frame)} "
+                                               f"subjects with a pre-test and a {phase} value in {len(levels)} group(s)")
     frame["group"] = pandas.Categorical(frame["group"], categories=levels)
     # In the unit that brings the phase's SD between 1 and 10 (as the mixed models are fitted): OLS is the same
     # in any unit, but sums of squares of an outcome near 1e-300 or 1e300 leave a double's range.
@@ -447,10 +447,9 @@ def _ancova_rows(data: pandas.DataFrame, value: str, design: StudyDesign, phase:
     spread = float(((frame["post"] - frame["post"].mean()) ** 2).sum())
     residual = float(fit.ssr)
     if not math.isfinite(residual) or residual <= max(rounding, 1e-12 * spread):
-        return [_row(**base, comparison="group",
-                     note=f"not computed: the {phase} means leave no residual variance "
-                          + ("(the outcome is the same for every subject)" if spread <= rounding
-                             else "(the model fits them exactly)"))]
+        return design_models.not_computed_rows(
+            base, design.conditions, design.control, f"not computed: the {phase} means leave no residual variance "
+            + ("(the outcome is the same for every subject)" if spread <= rounding else "(the model fits them exactly)"))
     interval = fit.conf_int(alpha=statistics.ALPHA)
     rows = []
     for k, level in enumerate(levels[1:], start=1):

@@ -284,6 +284,21 @@ def fit_note(fit: "mixed_models.LmerFit", dropped: list[str], units: Units, name
     return note
 
 
+def planned_comparisons(levels: list[str], control: str) -> list[str]:
+    """The comparisons a family holds, as its rows name them: each level against the control
+    ('level - control'), then every other pair 'later - earlier' in the levels' order (``pair_rows``)."""
+    others = [level for level in levels if level != control]
+    pairs = [f"{b} - {a}" for i, a in enumerate(others) for b in others[i + 1:]]
+    return [f"{level} - {control}" for level in others] + pairs
+
+
+def not_computed_rows(base: dict, levels: list[str], control: str, note: str, **kw) -> list[dict]:
+    """One row per planned comparison of ``levels`` (``planned_comparisons``), each with the same note: why
+    none was computed. The rows name the contrasts a reader looks for, not only the factor."""
+    return [row(**base, comparison=comparison, note=note, **kw)
+            for comparison in planned_comparisons(levels, control)]
+
+
 def pair_rows(fit: "mixed_models.LmerFit", levels: list[str], control: typing.Optional[str], base: dict, note: str,
               counts: typing.Callable[[str, str], int],
               g: typing.Optional[typing.Callable[[float, str, str], tuple[float, float, float]]] = None
