@@ -676,6 +676,25 @@ emit("ha.p", ha$p.value)
                 self.assertNotIn("nan", s.note, (label, s.note))
                 self.assertNotIn("not", s.note, (label, s.note))
 
+    def test_tiny_and_huge_outcomes_give_the_same_means_and_retention(self):
+        """The page's phase means (over subject means, SD and t interval) and retention ratios of the same data at
+        1e-300 and 1e300 m: those of the data in m, that many times smaller or larger; never an SD of 0 or inf."""
+        from calligraphy import statistics
+        base = self.frames["between"]
+        design = self.da.study_design(base)
+        means = statistics.describe(base, VALUE, by=("phase", "group"), unit="subject")
+        ratios = self.da.retention_ratios(base, VALUE, design)
+        for label, factor in (("tiny", 1e-300), ("huge", 1e300)):
+            frame = self.frames[label]
+            scaled = statistics.describe(frame, VALUE, by=("phase", "group"), unit="subject")
+            for column in ("mean", "sd", "sem", "ci95_low", "ci95_high"):
+                self.assertTrue(np_allclose(scaled[column] / factor, means[column], rtol=1e-12), (label, column))
+            got = self.da.retention_ratios(frame, VALUE, design)
+            for column in ("gain", "gain_ci95_low", "gain_ci95_high"):
+                self.assertTrue(np_allclose(got[column] / factor, ratios[column], rtol=1e-12), (label, column))
+            self.assertTrue(np_allclose(got.retention_ratio, ratios.retention_ratio, rtol=1e-12), label)
+            self.assertEqual(list(got.note), list(ratios.note), label)
+
     # ---- what a number is ---------------------------------------------------------------------------------------
     def test_every_row_is_a_well_formed_result(self):
         """Across every scenario: p and Holm in [0, 1], Holm never below p, intervals holding their estimate,
@@ -902,9 +921,9 @@ emit("ha.p", ha$p.value)
             self.assertEqual(int(r["n"]), len(subjects))
 
 
-def np_allclose(a, b):
+def np_allclose(a, b, rtol=1e-12):
     import numpy as np
-    return bool(np.allclose(np.asarray(a, dtype=float), np.asarray(b, dtype=float), rtol=1e-12, atol=0,
+    return bool(np.allclose(np.asarray(a, dtype=float), np.asarray(b, dtype=float), rtol=rtol, atol=0,
                             equal_nan=True))
 
 
