@@ -189,12 +189,13 @@ def _fit_rows(frame: "pandas.DataFrame", fixed: list[str], base: dict, design: "
     fixed = fixed + sets
     model = f"{value} ~ " + " + ".join(fixed)
     if design.control not in levels or len(levels) < 2 or frame["subject"].nunique() < 3:
-        return [_row(**base, model=model, comparison="condition",
-                     note="not computed: fewer than 2 conditions with values or fewer than 3 subjects")]
+        return design_models.not_computed_rows(base, design.conditions, design.control, "not computed: fewer than 2 "
+                                               "conditions with values or fewer than 3 subjects", model=model)
     try:
         fit, dropped = _fit(frame, fixed, factors, ddf, units)
     except RuntimeError as error:  # RUnavailable among them: R or its packages missing
-        return [_row(**base, model=model, comparison="condition", note=f"not computed: {error}")]
+        return design_models.not_computed_rows(base, design.conditions, design.control, f"not computed: {error}",
+                                               model=model)
     model = fit.formula.replace("outcome", value, 1)
     trusted = fit.trustworthy
     note = design_models.fit_note(fit, dropped, units)

@@ -365,8 +365,8 @@ def _training_rows(data: pandas.DataFrame, value: str, design: StudyDesign, ddf:
                               "item": rows_of["characters"].astype(str).to_numpy()})
     levels = [c for c in design.conditions if c in set(frame["factor"])]
     if len(levels) < 2 or design.control not in levels or frame["subject"].nunique() < 3:
-        return [_row(**base, comparison=f"{column}", note="not computed: fewer than 2 conditions with values "
-                     "or fewer than 3 subjects")]
+        return design_models.not_computed_rows(base, design.conditions, design.control, "not computed: fewer than "
+                                               "2 conditions with values or fewer than 3 subjects")
     # The documented reduction (design_models.fit_reduced): within subjects the slope's compound-symmetry form
     # is an intercept per subject and one per subject and condition.
     terms = ["(1 | subject)"] + (["(1 | subject:factor)"] if within else []) + items
@@ -374,7 +374,7 @@ def _training_rows(data: pandas.DataFrame, value: str, design: StudyDesign, ddf:
         fit, dropped = design_models.fit_reduced(frame, ["factor"], {"factor": levels}, ddf, terms,
                                                  ([subject_term] + items) if within else None, units)
     except RuntimeError as error:  # RUnavailable among them: R or its packages missing
-        return [_row(**base, comparison=column, note=f"not computed: {error}")]
+        return design_models.not_computed_rows(base, design.conditions, design.control, f"not computed: {error}")
     # One fit: whether it is a test, its note, subjects per level and subject means hold for every row.
     trusted = fit.trustworthy
     base["model"] = fit.formula.replace("outcome", value, 1).replace("factor", column)
@@ -385,13 +385,15 @@ def _training_rows(data: pandas.DataFrame, value: str, design: StudyDesign, ddf:
     note = design_models.fit_note(fit, [d.replace("factor", column) for d in dropped], units, name)
     counts = frame.groupby("factor")["subject"].nunique()
     subject_means = frame.groupby(["factor", "subject"])["outcome"].mean()
+    factor = design_models.outcome_factor(frame["outcome"])
     rows = []
 
     def g_between(estimate: float, level: str, control: str) -> tuple[float, float, float]:
         if design.kind != "between-subjects":
             return math.nan, math.nan, math.nan
-        a, b = subject_means.loc[level], subject_means.loc[control]
-        return _hedges_g_interval(estimate, float(a.std(ddof=1)), float(b.std(ddof=1)), len(a), len(b))
+        # In the fit's unit (design_models.outcome_factor): g has none, and SDs near 1e-300 would underflow.
+        a, b = subject_means.loc[level] * factor, subject_means.loc[control] * factor
+        return _hedges_g_interval(estimate * factor, float(a.std(ddof=1)), float(b.std(ddof=1)), len(a), len(b))
 
     test = f"linear mixed model (REML), lme4 {fit.ddf} t ({fit.versions})"
     for effect in fit.fixed.itertuples(index=False):
@@ -430,9 +432,13 @@ def _ancova_rows(data: pandas.DataFrame, value: str, design: StudyDesign, phase:
                               "group": groups.reindex(subjects).to_numpy()})
     levels = [g for g in design.conditions if g in set(frame["group"])]
     if design.control not in levels or len(levels) < 2 or len(frame) < len(levels) + 2:
-        return [_row(**base, comparison="group", note=f"not computed: {len(frame)} subjects with a pre-test and a "
-                     f"{phase} value in {len(levels)} group(s)")]
+        return design_models.not_computed_rows(base, design.conditions, design.control, f"not computed: {len(frame)} "
+                                               f"subjects with a pre-test and a {phase} value in {len(levels)} group(s)")
     frame["group"] = pandas.Categorical(frame["group"], categories=levels)
+    # In the unit that brings the phase's SD between 1 and 10 (as the mixed models are fitted): OLS is the same
+    # in any unit, but sums of squares of an outcome near 1e-300 or 1e300 leave a double's range.
+    factor = design_models.outcome_factor(frame["post"])
+    frame["post"], frame["pre"] = frame["post"] * factor, frame["pre"] * factor
     fit = smf.ols("post ~ pre + C(group, Treatment(reference=0))", data=frame).fit()
     # No residual variance (every subject's mean the same, or fitted exactly): t and p would be 0/0 or x/0,
     # numbers that are no test. R's lm warns of "essentially perfect fit" in the same case.
@@ -441,10 +447,9 @@ def _ancova_rows(data: pandas.DataFrame, value: str, design: StudyDesign, phase:
     spread = float(((frame["post"] - frame["post"].mean()) ** 2).sum())
     residual = float(fit.ssr)
     if not math.isfinite(residual) or residual <= max(rounding, 1e-12 * spread):
-        return [_row(**base, comparison="group",
-                     note=f"not computed: the {phase} means leave no residual variance "
-                          + ("(the outcome is the same for every subject)" if spread <= rounding
-                             else "(the model fits them exactly)"))]
+        return design_models.not_computed_rows(
+            base, design.conditions, design.control, f"not computed: the {phase} means leave no residual variance "
+            + ("(the outcome is the same for every subject)" if spread <= rounding else "(the model fits them exactly)"))
     interval = fit.conf_int(alpha=statistics.ALPHA)
     rows = []
     for k, level in enumerate(levels[1:], start=1):
@@ -456,8 +461,9 @@ def _ancova_rows(data: pandas.DataFrame, value: str, design: StudyDesign, phase:
         rows.append(_row(**base, comparison=f"{level} - {design.control}",
                          test="ANCOVA (OLS on subject means, statsmodels); t of the adjusted difference",
                          n=len(a) + len(b), df=float(fit.df_resid), statistic=float(fit.tvalues[name]),
-                         p=float(fit.pvalues[name]), estimate=estimate, ci95_low=float(interval.loc[name, 0]),
-                         ci95_high=float(interval.loc[name, 1]), g=g, g_ci95_low=g_low, g_ci95_high=g_high,
+                         p=float(fit.pvalues[name]), estimate=estimate / factor,
+                         ci95_low=float(interval.loc[name, 0]) / factor,
+                         ci95_high=float(interval.loc[name, 1]) / factor, g=g, g_ci95_low=g_low, g_ci95_high=g_high,
                          note=f"pre-test slope {float(fit.params['pre']):.3g}; n per group "
                               + ", ".join(f"{lv} {int((frame['group'] == lv).sum())}" for lv in levels)))
     # With three or more groups every other pair: the difference of their adjusted means (the contrast of
@@ -477,8 +483,9 @@ def _ancova_rows(data: pandas.DataFrame, value: str, design: StudyDesign, phase:
             rows.append(_row(**base, comparison=f"{later} - {earlier}",
                              test="ANCOVA (OLS on subject means, statsmodels); t of the contrast of adjusted means",
                              n=len(a) + len(b), df=float(fit.df_resid), statistic=float(np.squeeze(contrast.tvalue)),
-                             p=float(np.squeeze(contrast.pvalue)), estimate=estimate, ci95_low=low, ci95_high=high,
-                             g=g, g_ci95_low=g_low, g_ci95_high=g_high, note=rows[0]["note"]))
+                             p=float(np.squeeze(contrast.pvalue)), estimate=estimate / factor, ci95_low=low / factor,
+                             ci95_high=high / factor, g=g, g_ci95_low=g_low, g_ci95_high=g_high,
+                             note=rows[0]["note"]))
     return rows
 
 

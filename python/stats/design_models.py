@@ -24,6 +24,8 @@ import dataclasses
 import math
 import typing
 
+import numpy as np
+
 from . import mixed_models, statistics
 
 if typing.TYPE_CHECKING:  # pragma: no cover
@@ -71,6 +73,11 @@ def hedges_g_interval(difference: float, sd_a: float, sd_b: float, n_a: int, n_b
     (Hedges & Olkin 1985, eq. 5.14)."""
     if n_a < 2 or n_b < 2:
         return math.nan, math.nan, math.nan
+    # g has no unit: in the SDs' own size, so that an outcome near 1e300 (or 1e-300) squares to no overflow
+    # (or 0) on the way.
+    size = max(abs(sd_a), abs(sd_b))
+    if math.isfinite(size) and size > 0:
+        difference, sd_a, sd_b = difference / size, sd_a / size, sd_b / size
     g = statistics._hedges_g(difference, sd_a ** 2, sd_b ** 2, n_a, n_b)
     if not math.isfinite(g):
         return math.nan, math.nan, math.nan
@@ -168,13 +175,20 @@ class StudyDesign:
 # ---------------------------------------------------------------------------------------------- fitting
 
 
-def outcome_factor(frame: "pandas.DataFrame") -> float:
-    """The power of ten that brings the outcome's SD between 1 and 10 (1 for a constant outcome): the unit R
-    fits in. The same data in metres and in millimetres get the same scaled numbers."""
-    sd = float(frame["outcome"].std(ddof=1)) if len(frame) > 1 else math.nan
+def outcome_factor(values: "pandas.Series") -> float:
+    """The power of ten that brings the SD of ``values`` (an outcome) between 1 and 10 (1 for a constant
+    outcome): the unit R fits in and the ANCOVA is computed in. The same data in metres and in millimetres get
+    the same scaled numbers, and so do data near 1e-300 or 1e300, whose squares leave the range of a double:
+    the SD is taken of the values divided by their largest size. The power stays within a double's range."""
+    values = np.asarray(values, dtype=float)
+    values = values[np.isfinite(values)]
+    size = float(np.max(np.abs(values))) if len(values) > 1 else 0.0
+    if size <= 0:
+        return 1.0
+    sd = float(np.std(values / size, ddof=1)) * size
     if not math.isfinite(sd) or sd <= 0:
         return 1.0
-    return 10.0 ** (-math.floor(math.log10(sd)))
+    return 10.0 ** min(max(-math.floor(math.log10(sd)), -307), 307)
 
 
 # Columns in the outcome's unit: scaled with it.
@@ -185,7 +199,7 @@ def lmer_scaled(frame: "pandas.DataFrame", formula: str, factors: dict, ddf: str
     """``mixed_models.lmer`` on ``frame`` with the outcome (and ``pre``) in the unit of ``outcome_factor``, its
     results converted back to the outcome's unit: estimates, SEs and intervals of every fixed effect but a
     covariate in the outcome's unit (whose slope has no unit), variances, the pairwise contrasts."""
-    factor = outcome_factor(frame)
+    factor = outcome_factor(frame["outcome"])
     # Rounded to 10 decimals (SD 1 to 10: 11 or more significant digits): the same data in two units give R
     # the same numbers, not numbers that differ in the last bit and a fit that ends on the other side of a
     # convergence tolerance.
@@ -202,7 +216,7 @@ def lmer_scaled(frame: "pandas.DataFrame", formula: str, factors: dict, ddf: str
         pairs = pairs.copy()
         for column in ("estimate", "std_error", "ci95_low", "ci95_high"):
             pairs[column] = pairs[column] / factor
-    variances = {k: v / factor ** 2 for k, v in fit.variances.items()}
+    variances = {k: v / factor / factor for k, v in fit.variances.items()}
     return dataclasses.replace(fit, fixed=fixed, pairs=pairs, variances=variances)
 
 
@@ -268,6 +282,21 @@ def fit_note(fit: "mixed_models.LmerFit", dropped: list[str], units: Units, name
     if fit.trustworthy and fit.messages.strip():
         note += "; lme4 said: " + fit.messages.strip()
     return note
+
+
+def planned_comparisons(levels: list[str], control: str) -> list[str]:
+    """The comparisons a family holds, as its rows name them: each level against the control
+    ('level - control'), then every other pair 'later - earlier' in the levels' order (``pair_rows``)."""
+    others = [level for level in levels if level != control]
+    pairs = [f"{b} - {a}" for i, a in enumerate(others) for b in others[i + 1:]]
+    return [f"{level} - {control}" for level in others] + pairs
+
+
+def not_computed_rows(base: dict, levels: list[str], control: str, note: str, **kw) -> list[dict]:
+    """One row per planned comparison of ``levels`` (``planned_comparisons``), each with the same note: why
+    none was computed. The rows name the contrasts a reader looks for, not only the factor."""
+    return [row(**base, comparison=comparison, note=note, **kw)
+            for comparison in planned_comparisons(levels, control)]
 
 
 def pair_rows(fit: "mixed_models.LmerFit", levels: list[str], control: typing.Optional[str], base: dict, note: str,

@@ -178,6 +178,27 @@ def _column_names(columns: str | typing.Sequence[str], argument: str, caller: st
 RETENTION_COLUMNS = ["group", "n", "gain", "gain_ci95_low", "gain_ci95_high", "retention_ratio", "note"]
 
 
+def _power_of_two(values) -> float:
+    """A power of two that brings the largest finite size among ``values`` into [0.5, 1). Sums of squares of
+    values near 1e-300 or 1e300 then stay within a double's range; a power of two scales exactly, so any other
+    data give the same result to the bit."""
+    sizes = np.abs(np.asarray(values, dtype=float))
+    sizes = sizes[np.isfinite(sizes)]
+    largest = float(sizes.max()) if sizes.size else 0.0
+    if not largest > 0:
+        return 1.0
+    return math.ldexp(1.0, min(max(-math.frexp(largest)[1], -1000), 1000))
+
+
+def sample_sd(values) -> float:
+    """The sample standard deviation (n - 1) of ``values`` (NaN skipped in a pandas Series, as its ``std``),
+    taken at the scale of ``_power_of_two``: an outcome near 1e-300 does not read as constant nor one near 1e300
+    as infinitely spread."""
+    scale = _power_of_two(values)
+    scaled = values * scale if hasattr(values, "std") else np.asarray(values, dtype=float) * scale
+    return float(scaled.std(ddof=1)) / scale
+
+
 def retention_row(group: str, pre, post, retention, too_few: str, whose_gain: str) -> dict:
     """One row of a retention-ratio table (columns RETENTION_COLUMNS) from per-subject means of the same
     subjects [n] (errors and times: lower is better): the gain pre - post with its 95 % t interval, and
@@ -189,7 +210,7 @@ def retention_row(group: str, pre, post, retention, too_few: str, whose_gain: st
     gains = pre - post
     n = len(gains)
     low, high = _t_interval(np.array([gains.mean() if n else math.nan]),
-                            np.array([gains.std(ddof=1) if n > 1 else math.nan]), np.array([n]))
+                            np.array([sample_sd(gains) if n > 1 else math.nan]), np.array([n]))
     ratio, note = math.nan, ""
     if n < 2:
         note = too_few
@@ -260,7 +281,11 @@ def describe(trials: pandas.DataFrame, value: str, by: str | typing.Sequence[str
     units = data[~missing]
     if unit == "subject":
         units = units.groupby([*keys, "subject"], observed=True, sort=True)[value].mean().reset_index()
-    summary = units.groupby(keys, observed=True, sort=True)[value].agg(["count", "mean", "std"])
+    # At the scale of _power_of_two (exact): values near 1e-300 or 1e300 keep their spread.
+    scale = _power_of_two(units[value])
+    summary = units.assign(**{value: units[value] * scale}).groupby(keys, observed=True, sort=True)[value].agg(
+        ["count", "mean", "std"])
+    summary[["mean", "std"]] = summary[["mean", "std"]] / scale
     summary = summary.reindex(n_missing.index)  # groups whose every trial is NaN keep a row with n = 0
     n = summary["count"].fillna(0).astype(int).to_numpy()
     sd = np.where(n >= 2, summary["std"].to_numpy(dtype=float), np.nan)

@@ -487,6 +487,14 @@ def _quantity_text(text: str, value: str, display: _Display) -> str:
     return text.replace(f" of {value}", "").replace(value, display.label).strip()
 
 
+def _table_csv(table: "pandas.DataFrame") -> str:
+    """A table's CSV text, its count of subjects ``n`` written as a whole number (``6``, not ``6.0``; empty where
+    a row has none), as the tidy tables of ``calligraphy report --csv`` write counts."""
+    if "n" in table.columns and table["n"].dtype.kind == "f":
+        table = table.assign(n=table["n"].astype("Int64"))
+    return table.to_csv(index=False)
+
+
 def _scaled_effect(row: dict, value: str) -> bool:
     """Whether a statistics row's effect is in the value's unit (a mean or difference), not d_z or power."""
     return f"[{value}]" in str(row.get("effect_name", ""))
@@ -1059,11 +1067,11 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
                     f"{'group' if design.kind == 'between-subjects' else 'condition'} the mean over subjects "
                     "with its 95 % t interval (n = subjects). Left: all characters; then each character. One y axis for "
                     "all panels.</figcaption></figure>\n")
-        files[table_file["phase_means"]] = pandas.concat(all_means, ignore_index=True).to_csv(index=False)
-        files[table_file["questions"]] = pandas.concat(all_questions, ignore_index=True).to_csv(index=False)
-        files[table_file["exclusions"]] = exclusions.to_csv(index=False)
+        files[table_file["phase_means"]] = _table_csv(pandas.concat(all_means, ignore_index=True))
+        files[table_file["questions"]] = _table_csv(pandas.concat(all_questions, ignore_index=True))
+        files[table_file["exclusions"]] = _table_csv(exclusions)
         if all_ratios:
-            files[table_file["retention"]] = pandas.concat(all_ratios, ignore_index=True).to_csv(index=False)
+            files[table_file["retention"]] = _table_csv(pandas.concat(all_ratios, ignore_index=True))
         table5_html = ""
         statistics_html = ""
         if within and not data.empty:

@@ -137,9 +137,10 @@ def test_an_ancova_with_no_residual_variance_is_not_computed():
         trials.loc[post, "mean_deviation_m"] = make({"pre": trials.loc[post, "subject"].map(pre)})
         questions = design_analysis.design_questions(trials, "mean_deviation_m")
         rows = questions[(questions.phase == "post-test") & questions.question.str.contains("ANCOVA")]
-        assert len(rows) == 1 and rows.iloc[0]["note"].startswith("not computed: the post-test means leave no "
-                                                                  "residual variance")
-        assert math.isnan(rows.iloc[0]["p"])
+        # One row per comparison of the family (each group against the control, the other pair), each saying why.
+        assert list(rows.comparison) == [f"{g} - {GROUPS[0]}" for g in GROUPS[1:]] + [f"{GROUPS[2]} - {GROUPS[1]}"]
+        assert rows.note.str.startswith("not computed: the post-test means leave no residual variance").all()
+        assert rows.p.isna().all()
 
 
 @needs_r
@@ -246,5 +247,6 @@ def test_without_r_the_mixed_model_is_not_computed_and_says_why(monkeypatch):
     monkeypatch.setattr(mixed_models, "_R_CHECKED", [])
     questions = design_analysis.design_questions(between_study(10), "mean_deviation_m")
     training = questions[questions.phase == "training"]
-    assert len(training) == 1 and training.note.iloc[0].startswith("not computed: Rscript is not installed")
+    assert list(training.comparison) == [f"{g} - {GROUPS[0]}" for g in GROUPS[1:]] + [f"{GROUPS[2]} - {GROUPS[1]}"]
+    assert training.note.str.startswith("not computed: Rscript is not installed").all() and training.p.isna().all()
     assert questions[questions.phase == "post-test"].p.notna().all()  # the ANCOVA needs no R
