@@ -35,11 +35,6 @@ py::array_t<double> to_array(const Vec3& v) {
   return out;
 }
 
-py::array_t<double> read_only(py::array_t<double> array) {
-  py::detail::array_proxy(array.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
-  return array;
-}
-
 void check_real_numbers(py::handle object, const std::string& name) {
   const py::array array = py::array::ensure(object);
   if (!array) return;
