@@ -34,7 +34,8 @@ py::array_t<T> read_only(py::array_t<T> array) {
 /// InvalidArgument "<name> holds <dtype> values, not real numbers" for what numpy's forcecast to float64
 /// would misread: complex numbers (their real part taken), text (parsed as numbers), as a numpy array of
 /// strings or an object array (a pandas column of str) holding any, and times and dates (counts of their
-/// unit: a pandas Timedelta column in nanoseconds). Nothing for anything else: the
+/// unit: a pandas Timedelta column in nanoseconds), and a numpy.ma masked array with a value masked (read as
+/// the number under its mask). Nothing for anything else: the
 /// conversion itself says what else is wrong.
 void check_real_numbers(py::handle object, const std::string& name);
 
