@@ -479,10 +479,11 @@ void bind_scene(py::module_& m) {
           "(len(elements) - 1,) float64, where each corner between elements lies along centre_line_m: arc "
           "length from its first point [m], non-decreasing")
       .def_property_readonly(
-          "start_m", [](const PlacedStroke& s) { return to_array(s.start()); },
+          "start_m", [](const PlacedStroke& s) { return read_only(to_array(s.start())); },
           "(2,) float64, start point [m]")
       .def_property_readonly(
-          "end_m", [](const PlacedStroke& s) { return to_array(s.end()); }, "(2,) float64, end point [m]")
+          "end_m", [](const PlacedStroke& s) { return read_only(to_array(s.end())); },
+          "(2,) float64, end point [m]")
       .def_property_readonly("length_m", &PlacedStroke::length_m, "arc length of its elements [m]")
       .def("__repr__", [](const PlacedStroke& s) {
         return "<PlacedStroke " + std::string(typical_stroke(s.typical_id).acronym) + ", " +

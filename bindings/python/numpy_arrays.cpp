@@ -35,12 +35,19 @@ py::array_t<double> to_array(const Vec3& v) {
   return out;
 }
 
-py::array_t<double> read_only(py::array_t<double> array) {
-  py::detail::array_proxy(array.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
-  return array;
-}
-
 void check_real_numbers(py::handle object, const std::string& name) {
+  // numpy.ma: converted to float64, a masked array is its data, the values under the mask too.
+  if (py::hasattr(object, "mask")) {
+    const py::module_ ma = py::module_::import("numpy.ma");
+    if (py::isinstance(object, ma.attr("MaskedArray"))) {
+      const py::object mask = ma.attr("getmaskarray")(object);
+      if (mask.attr("any")().cast<bool>()) {
+        throw InvalidArgument(name + " holds " + std::to_string(mask.attr("sum")().cast<long long>()) +
+                              " masked value(s) (numpy.ma), which would be read as the numbers under the "
+                              "mask: fill them (.filled(numpy.nan)) or leave them out");
+      }
+    }
+  }
   const py::array array = py::array::ensure(object);
   if (!array) return;
   const char kind = array.dtype().kind();

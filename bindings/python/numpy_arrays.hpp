@@ -23,13 +23,19 @@ py::array_t<double> points_to_array(const std::vector<Vec2>& points);
 py::array_t<double> to_array(const Vec2& v);
 py::array_t<double> to_array(const Vec3& v);
 /// The same array, made read-only (for values copied out of a C++ object: writing to them would
-/// change nothing, so it must not look as if it did).
-py::array_t<double> read_only(py::array_t<double> array);
+/// change nothing, so it must not look as if it did; and for what an object holds that its other values
+/// were made from, as a trial's trace its metrics: writing to it would part the two).
+template <typename T>
+py::array_t<T> read_only(py::array_t<T> array) {
+  py::detail::array_proxy(array.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  return array;
+}
 
 /// InvalidArgument "<name> holds <dtype> values, not real numbers" for what numpy's forcecast to float64
 /// would misread: complex numbers (their real part taken), text (parsed as numbers), as a numpy array of
 /// strings or an object array (a pandas column of str) holding any, and times and dates (counts of their
-/// unit: a pandas Timedelta column in nanoseconds). Nothing for anything else: the
+/// unit: a pandas Timedelta column in nanoseconds), and a numpy.ma masked array with a value masked (read as
+/// the number under its mask). Nothing for anything else: the
 /// conversion itself says what else is wrong.
 void check_real_numbers(py::handle object, const std::string& name);
 

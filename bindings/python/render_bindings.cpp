@@ -52,7 +52,7 @@ void bind_guidance(py::module_& m) {
            "time_s [s]; position_m, 3 floats, the pen in the device frame [m]")
       .def_readonly("time_s", &TeacherSample::time_s, "time [s]")
       .def_property_readonly(
-          "position_m", [](const TeacherSample& t) { return to_array(t.position_m); },
+          "position_m", [](const TeacherSample& t) { return read_only(to_array(t.position_m)); },
           "(3,) float64, the pen in the device frame [m]")
       .def("__repr__", [](const TeacherSample& t) {
         return "TeacherSample(time_s=" + std::to_string(t.time_s) + ", position_m=[" +
@@ -425,7 +425,7 @@ void bind_renderer(py::module_& m) {
 
   py::class_<RenderOutput>(m, "RenderOutput", "Everything one Renderer.tick decided.")
       .def_property_readonly(
-          "force_n", [](const RenderOutput& o) { return to_array(o.force_n); },
+          "force_n", [](const RenderOutput& o) { return read_only(to_array(o.force_n)); },
           "(3,) float64, the command for the device [N]: finite, within the safety chain's limits")
       .def_readonly("state", &RenderOutput::state, "the InteractionState after this tick")
       .def_readonly("state_changed", &RenderOutput::state_changed, "the state changed this tick")
@@ -436,7 +436,7 @@ void bind_renderer(py::module_& m) {
       .def_readonly("in_constraint_space", &RenderOutput::in_constraint_space,
                     "the tip is inside R_res of the active element")
       .def_property_readonly(
-          "foot_m", [](const RenderOutput& o) { return to_array(o.foot_m); },
+          "foot_m", [](const RenderOutput& o) { return read_only(to_array(o.foot_m)); },
           "(2,) float64, the foot point X_S on the active element (WS only) [m]")
       .def_readonly("stroke_completed", &RenderOutput::stroke_completed,
                     "this tick wrote the last feature point of a stroke")

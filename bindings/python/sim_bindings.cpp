@@ -174,13 +174,14 @@ void bind_simulated_device(py::module_& m) {
       .def("open", &SimulatedDevice::open, "Opens it again after close().")
       .def_property_readonly("info", &SimulatedDevice::info, "its DeviceInfo")
       .def_property_readonly(
-          "true_position_m", [](const SimulatedDevice& d) { return to_array(d.true_position()); },
+          "true_position_m", [](const SimulatedDevice& d) { return read_only(to_array(d.true_position())); },
           "(3,) float64, the unquantised position [m]")
       .def_property_readonly(
-          "true_velocity_m_s", [](const SimulatedDevice& d) { return to_array(d.true_velocity()); },
+          "true_velocity_m_s",
+          [](const SimulatedDevice& d) { return read_only(to_array(d.true_velocity())); },
           "(3,) float64, the velocity [m/s]")
       .def_property_readonly(
-          "applied_force_n", [](const SimulatedDevice& d) { return to_array(d.applied_force()); },
+          "applied_force_n", [](const SimulatedDevice& d) { return read_only(to_array(d.applied_force())); },
           "(3,) float64, the force applied after saturation [N]")
       .def_property_readonly("time_s", &SimulatedDevice::time, "device time [s]");
 }

@@ -108,15 +108,16 @@ PyTrialResult to_python(const TrialResult& result, py::dict metrics, py::object 
     rw(i, 0) = n > 0 ? static_cast<std::int64_t>(m.trace_begin) : 0;
     rw(i, 1) = n > 0 ? static_cast<std::int64_t>(m.trace_end) : 0;
   }
-  return PyTrialResult{time,
-                       position,
-                       force,
-                       state,
-                       stroke,
-                       element,
-                       attempt,
-                       rewritten,
-                       ranges,
+  // Read-only: the metrics, the record and a teacher recorded from it are the trace as it was written.
+  return PyTrialResult{read_only(time),
+                       read_only(position),
+                       read_only(force),
+                       read_only(state),
+                       read_only(stroke),
+                       read_only(element),
+                       read_only(attempt),
+                       read_only(rewritten),
+                       read_only(ranges),
                        std::move(metrics),
                        std::move(scene),
                        {},
