@@ -7,15 +7,16 @@ as `cli_unseen_round16b_tests`.
 
 One trace of 十 is made with numpy from the data's medians (each stroke a minimum-jerk movement along its
 median, 0.8 s a stroke, 0.3 s of pen-up movement between), then transformed: written in data units, its clock
-moved by 1e3 and 1e9 s or slowed twice, resampled at 60, 120, 1000 and 4000 Hz, every sample or some written
+moved by -1e3, 1e3 and 1e9 s or slowed twice, resampled at 60, 120, 1000 and 4000 Hz, every sample or some written
 twice, its pen-up samples thinned or removed; the character laid out in a box of half and twice the size and
 elsewhere on raised paper (Python's `Scene`), as the second of a row; a stroke reversed, written twice, another
-stroke's path given for it, the character mirrored; `model` against Python in every layout. Simulated trials of
-一: the same seed twice, other seeds, other servo rates, a record replayed at 250 Hz with the largest seed,
-Python against the command line. A tiny study's `report --csv` twice, on 1 and 3 threads, of a copy, of the
+stroke's path given for it, the character mirrored; `model` against Python in every layout, the character's
+data file against the embedded character. Simulated trials of 一: the same seed twice, other seeds, other servo
+rates, a record replayed at 250 Hz with the largest seed, Python against the command line, a trial without its
+trace kept. A tiny study's `report --csv` twice, on 1 and 3 threads, of a copy, of the
 folder renamed, of its sessions listed in another order and of a session folder named with a trailing slash,
-`.` or a link; its trials run again from their records against `trace` of their saved traces; `session cohort`
-on 1 and 2 threads.
+`.` or a link; its trials run again from their records against `trace` of their saved traces, a saved trace
+scored as HDF5 and as its CSV; `session cohort` on 1 and 2 threads.
 
 Each case asserts the documented relation: the same verdicts, the same numbers to the last bit or within the
 bound the definition gives (the discrete Frechet distance is a pseudo-metric: resampling a path moves it by at
@@ -624,6 +625,22 @@ class Round16B(unittest.TestCase):
         self.assertTrue(np.array_equal(again.position_m, result.position_m))
         self.assertTrue(np.array_equal(again.time_s, result.time_s))
 
+    @needs_python
+    def test_a_trial_without_its_trace_kept_has_the_same_metrics(self):
+        # keep_trace=False: "empty arrays; the metrics are still taken from the trace" (docs/python.md)
+        kept = calligraphy.simulate_trial(YI, writer="skilled", seed=11, max_duration_s=6.0,
+                                          library=calligraphy.CharacterLibrary.default())
+        dropped = calligraphy.simulate_trial(YI, writer="skilled", seed=11, max_duration_s=6.0, keep_trace=False,
+                                             library=calligraphy.CharacterLibrary.default())
+        self.assertEqual(len(dropped.time_s), 0)
+        self.assertEqual(dict(dropped.metrics), dict(kept.metrics))
+
+    def test_the_character_from_its_data_file_scores_as_the_embedded_one(self):
+        path = self.dir / "base.csv"
+        got = self.score_file(path, SHI, "--data", SAMPLE)
+        self.assertEqual({k: v for k, v in got.items() if k != "trace"},
+                         {k: v for k, v in self.base_score.items() if k != "trace"})
+
     # -- a study's tables ----------------------------------------------------------------------------------
 
     @classmethod
@@ -677,6 +694,17 @@ class Round16B(unittest.TestCase):
             saved = run(["trace", record.with_name(record.stem + ".trace.h5"), "--csv", "-"], self.dir)
             self.assertEqual(saved.returncode, 0, saved.stderr.decode())
             self.assertEqual(again.read_bytes(), saved.stdout, record)
+
+    def test_a_saved_trace_scores_alike_as_hdf5_and_as_its_csv(self):
+        # `score` reads a session's .trace.h5 by its columns; `trace` writes it as the CSV `trial --csv` writes
+        study = self.study()
+        trace = sorted(study.glob("S01/*/trials/*.trace.h5"))[0]
+        exported = self.dir / "exported.csv"
+        self.assertEqual(run(["trace", trace, "--csv", exported], self.dir).returncode, 0)
+        from_h5 = self.score_file(trace, YI)
+        from_csv = self.score_file(exported, YI)
+        self.assertEqual({k: v for k, v in from_h5.items() if k != "trace"},
+                         {k: v for k, v in from_csv.items() if k != "trace"})
 
     def test_report_of_a_copy_differs_only_in_the_trace_paths(self):
         self.study()
