@@ -2,6 +2,7 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <set>
 
 #include "calligraphy/core/errors.hpp"
@@ -20,6 +21,7 @@ std::vector<fs::path> session_folders_under(const std::vector<fs::path>& roots) 
   for (const fs::path& root : roots) {
     for (fs::path& folder : find_session_folders(root)) folders.push_back(std::move(folder));
   }
+  std::sort(folders.begin(), folders.end());
   if (folders.empty()) {
     // The first few folders given, and how many more: a shell glob may give thousands.
     constexpr std::size_t kNamed = 3;
@@ -34,11 +36,25 @@ std::vector<fs::path> session_folders_under(const std::vector<fs::path>& roots) 
   return folders;
 }
 
+fs::path named_folder(const fs::path& folder) {
+  std::error_code error;
+  const fs::path resolved = fs::weakly_canonical(folder, error);
+  if (!error) return resolved;
+  const fs::path absolute = fs::absolute(folder, error);
+  return (error ? folder : absolute).lexically_normal();
+}
+
+std::string session_folder_id(const fs::path& folder) {
+  fs::path named = named_folder(folder);
+  if (named.filename().empty()) named = named.parent_path();  // "S/x/" made normal keeps its last separator
+  return named.filename().string();
+}
+
 SessionManifest read_session_manifest(const fs::path& folder) {
   const fs::path path = SessionLayout::manifest(folder);
   SessionManifest manifest = manifest_from_json(
       read_session_file(path, kMaxSessionManifestBytes, "session manifest"), path.string());
-  manifest.session_id = folder.filename().string();
+  manifest.session_id = session_folder_id(folder);
   check_records_planned(folder, manifest);
   return manifest;
 }
@@ -105,7 +121,7 @@ void check_records_name_the_folder(const fs::path& folder, const SessionManifest
 
 SessionManifest read_previous_session(const fs::path& folder, const SessionManifest& manifest) {
   const PreviousSession& link = manifest.previous.value();
-  const fs::path before = folder.parent_path() / link.session_id;
+  const fs::path before = named_folder(folder).parent_path() / link.session_id;
   const fs::path path = SessionLayout::manifest(before);
   const std::string text = read_session_file(path, kMaxSessionManifestBytes, "session manifest");
   if (!link.session_sha256.empty() && sha256_hex(text) != link.session_sha256) {

@@ -17,13 +17,21 @@ namespace calligraphy::study_detail {
 /// kMaxSessionManifestBytes, session_folder.hpp).
 inline constexpr std::uintmax_t kMaxRecordBytes = kMaxRecordedTrialBytes;
 
-/// The session folders under `roots` (each a session folder or a folder holding some), sorted by path within
-/// each root. Throws DataError naming the roots when there is none.
+/// The session folders under `roots` (each a session folder or a folder holding some), sorted by path over
+/// all the roots: the same folders in the same order whatever the order the roots are given in. Throws
+/// DataError naming the roots when there is none.
 std::vector<std::filesystem::path> session_folders_under(const std::vector<std::filesystem::path>& roots);
 
-/// The manifest of the session folder `folder`, its `session_id` the folder's name, its saved records checked
-/// against its plan (check_records_planned), read without following a link (read_session_file). Throws
-/// DataError naming the file (and JSON pointer) when it cannot be read.
+/// The folder as named by its own name: its links resolved ("S/x/", "S/x/.", "." inside x and a symbolic
+/// link to x are x), or, when it cannot be resolved, its absolute path made lexically normal.
+std::filesystem::path named_folder(const std::filesystem::path& folder);
+
+/// A session's id: its folder's own name (named_folder), whatever spelling of the folder a reader was given.
+std::string session_folder_id(const std::filesystem::path& folder);
+
+/// The manifest of the session folder `folder`, its `session_id` the folder's name (session_folder_id), its
+/// saved records checked against its plan (check_records_planned), read without following a link
+/// (read_session_file). Throws DataError naming the file (and JSON pointer) when it cannot be read.
 SessionManifest read_session_manifest(const std::filesystem::path& folder);
 
 /// Refuses a file of the session folder `folder` that is a symbolic link (session.json, log.jsonl, trials/,

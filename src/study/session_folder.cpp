@@ -151,13 +151,6 @@ void remove_dead_partial_folders(const fs::path& subject_folder) {
   }
 }
 
-// The folder as named by its own name ("S/x/" and "S/x/." are x).
-fs::path named_folder(const fs::path& folder) {
-  std::error_code error;
-  const fs::path resolved = fs::weakly_canonical(folder, error);
-  return error ? folder.lexically_normal() : resolved;
-}
-
 // rename(2) that fails with EEXIST rather than replace an (empty) folder of that name.
 int rename_no_replace(const fs::path& from, const fs::path& to) {
   if (::renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_NOREPLACE) == 0) return 0;
@@ -481,7 +474,8 @@ fs::path SessionLayout::record(const fs::path& folder, const PlannedTrial& trial
 }
 
 SessionFolder SessionFolder::open(const fs::path& folder) {
-  if (is_partial_session_folder(named_folder(folder))) throw DataError(folder.string() + ": " + kPartialNote);
+  if (is_partial_session_folder(study_detail::named_folder(folder)))
+    throw DataError(folder.string() + ": " + kPartialNote);
   const fs::path manifest_path = SessionLayout::manifest(folder);
   // A file of the folder that is a symbolic link is refused as its content would be (InputError): a
   // session's files are its own, and nothing is read or written through a link.
@@ -503,10 +497,7 @@ SessionFolder SessionFolder::open(const fs::path& folder) {
     throw InputError(e.what());
   }
   // The id is the folder's own name, also when DIR was given through a symbolic link of another name.
-  std::error_code unresolved;
-  const fs::path resolved = fs::weakly_canonical(folder, unresolved);
-  manifest.session_id = (unresolved ? folder : resolved).filename().string();
-  if (manifest.session_id.empty()) manifest.session_id = folder.parent_path().filename().string();
+  manifest.session_id = study_detail::session_folder_id(folder);
   // Trials are saved only into the session's own folders: one that is a symbolic link (or not a folder)
   // would take the records, traces and the removal of leftovers somewhere else.
   for (const fs::path& own :
@@ -720,7 +711,8 @@ std::vector<fs::path> find_session_folders(const fs::path& root) {
   if (!fs::is_directory(root, error))
     throw DataError(root.string() + ": not a folder (expected session folders)");
   if (names_a_session(root)) {
-    if (is_partial_session_folder(named_folder(root))) throw DataError(root.string() + ": " + kPartialNote);
+    if (is_partial_session_folder(study_detail::named_folder(root)))
+      throw DataError(root.string() + ": " + kPartialNote);
     return {root};
   }
   std::vector<fs::path> found;
