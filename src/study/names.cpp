@@ -166,6 +166,11 @@ double utc_seconds_of(std::string_view iso8601, const std::string& source, std::
   }
 }
 
+std::filesystem::path beside_session(const std::filesystem::path& folder, const std::string& name) {
+  const std::filesystem::path parent = (folder / "..").lexically_normal();
+  return parent == "." ? std::filesystem::path(name) : parent / name;
+}
+
 std::uint64_t fnv1a_64(std::string_view text) {
   std::uint64_t hash = 0xcbf29ce484222325ULL;  // offset basis
   for (const char c : text) {

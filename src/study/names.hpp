@@ -35,6 +35,10 @@ double utc_seconds(std::string_view iso8601);
 /// one that is not such a time is an InputError naming `source` and `pointer` (json_detail::fail).
 double utc_seconds_of(std::string_view iso8601, const std::string& source, std::string_view pointer);
 
+/// The session folder `name` beside the session folder `folder` (its subject's folder), also when `folder` is
+/// given as ".", "..", or with a trailing '/' (whose parent_path is not the subject's folder).
+std::filesystem::path beside_session(const std::filesystem::path& folder, const std::string& name);
+
 /// 64-bit FNV-1a of `text` (Fowler, Noll & Vo; IETF draft-eastlake-fnv): a stable seed from a name.
 std::uint64_t fnv1a_64(std::string_view text);
 /// SplitMix64's finaliser (Steele, Lea & Flood 2014, "Fast splittable pseudorandom number generators",

@@ -105,7 +105,7 @@ void check_records_name_the_folder(const fs::path& folder, const SessionManifest
 
 SessionManifest read_previous_session(const fs::path& folder, const SessionManifest& manifest) {
   const PreviousSession& link = manifest.previous.value();
-  const fs::path before = folder.parent_path() / link.session_id;
+  const fs::path before = beside_session(folder, link.session_id);
   const fs::path path = SessionLayout::manifest(before);
   const std::string text = read_session_file(path, kMaxSessionManifestBytes, "session manifest");
   if (!link.session_sha256.empty() && sha256_hex(text) != link.session_sha256) {
