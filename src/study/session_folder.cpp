@@ -106,13 +106,11 @@ int open_locked_log(const fs::path& log_path) {
   return fd;
 }
 
-std::string folder_timestamp() {
-  const std::time_t now = std::time(nullptr);
-  std::tm utc{};
-  gmtime_r(&now, &utc);
-  char text[32];
-  std::strftime(text, sizeof text, "%Y%m%d-%H%M%S", &utc);
-  return text;
+// "YYYYMMDD-HHMMSS" of the session's created_utc ("YYYY-MM-DDTHH:MM:SS.mmmZ", utc_now_iso8601): the folder
+// is named by the second its session.json says it was made, not by a later reading of the clock.
+std::string folder_timestamp(const std::string& created_utc) {
+  return created_utc.substr(0, 4) + created_utc.substr(5, 2) + created_utc.substr(8, 2) + "-" +
+         created_utc.substr(11, 2) + created_utc.substr(14, 2) + created_utc.substr(17, 2);
 }
 
 // "PID.HOST" of this process: whose a temporary session folder is, so that only a dead run's is removed.
@@ -338,7 +336,8 @@ SessionFolder SessionFolder::create(const fs::path& root, const SessionSetup& se
   remove_dead_partial_folders(subject_folder);
   // The session id names the protocol, the subject and the second it began, so ids are keys across
   // subjects (two subjects started in the same second differ) and sort by time within a subject.
-  const std::string base = protocol.protocol.name + "-" + setup.subject.id + "-" + folder_timestamp();
+  const std::string base =
+      protocol.protocol.name + "-" + setup.subject.id + "-" + folder_timestamp(manifest.created_utc);
   // The folder is made whole under a temporary name beside its own, session.json first, then renamed: a run
   // killed at any moment leaves no session folder or one with its session.json, and at worst a temporary
   // that readers skip and the next run removes.
