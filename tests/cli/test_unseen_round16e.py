@@ -301,6 +301,18 @@ class Zones(Base):
                         for r in records(f))
         self.assertEqual(sorted(row["start_utc"] for row in rows), starts)
 
+    def test_report_pages_are_the_same_in_every_zone(self):
+        pages = {}
+        for zone in ("UTC", "Pacific/Kiritimati", "Nowhere/Atlantis"):
+            out = self.cwd / zone.replace("/", "-")
+            out.mkdir()
+            result = run(["report", SHARED["sim"], "--out", out / "index.html"], self.cwd, env=zone_env(zone))
+            self.assertEqual(result.returncode, 0, result.stderr.decode())
+            pages[zone] = {p.relative_to(out): p.read_bytes() for p in sorted(out.rglob("*")) if p.is_file()}
+        self.assertGreaterEqual(len(pages["UTC"]), 3)
+        for zone, files in pages.items():
+            self.assertEqual(files, pages["UTC"], zone)
+
     def test_python_reads_the_same_dates_in_every_zone(self):
         try:
             import calligraphy.study as study
