@@ -46,6 +46,11 @@ ZONES = ("UTC", "Asia/Shanghai", "America/St_Johns", "Pacific/Kiritimati", "Nowh
 ISO_UTC = re.compile(r"^\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d\.\d{3}Z$")
 SHARED = {}
 RATE_HZ = 1000
+# Two readings of the clock a run makes apart (the series' elapsed time and session.json's created_utc; a
+# trial's UTC stamps and its wall time): close, but a loaded machine or a sanitizer may put a pause between
+# them. A time zone or a change of clocks misread is 1,800 s or more.
+CLOCK_S = 2.0
+STAMPS_S = 0.02
 
 
 def protocol(name, sessions=2, max_duration_s=0.3, delay_s=86400):
@@ -217,7 +222,7 @@ class Base(OneErrorLine, unittest.TestCase):
         link = manifest["previous_session"]
         self.assertEqual(link["ended_utc"], ended)
         expected = seconds(manifest["created_utc"]) - seconds(ended)
-        self.assertAlmostEqual(link["elapsed_s"], expected, delta=0.05, msg=link)
+        self.assertAlmostEqual(link["elapsed_s"], expected, delta=CLOCK_S, msg=link)
         # A simulated subject's delay is recorded, not waited: `simulated`, or `waited` when it had passed.
         self.assertEqual(link["delay"], "waited" if link["elapsed_s"] >= link["delay_s"] else "simulated", link)
         return link
@@ -285,7 +290,7 @@ class Zones(Base):
         self.assertEqual(link["delay_s"], 86400)
         self.assertGreaterEqual(link["elapsed_s"], 0)
         self.assertAlmostEqual(link["elapsed_s"], seconds(second["created_utc"]) - seconds(link["ended_utc"]),
-                               delta=0.05)
+                               delta=CLOCK_S)
 
     def test_report_tables_are_the_same_in_every_zone(self):
         tables = {}
@@ -452,7 +457,7 @@ class MovedClock(Base):
                     if result.returncode == 0:
                         manifest = self.link_of(study)
                         elapsed = manifest["previous_session"]["elapsed_s"]
-                        self.assertAlmostEqual(elapsed, seconds(manifest["created_utc"]) - seconds(utc), delta=0.05)
+                        self.assertAlmostEqual(elapsed, seconds(manifest["created_utc"]) - seconds(utc), delta=CLOCK_S)
                         outcomes.add("read")
                     else:
                         self.assert_refusal(result, 1, last.name, "/end_time_utc")
@@ -520,7 +525,7 @@ class Person(Base):
         manifest = self.link_of(study, "P01")
         link = manifest["previous_session"]
         self.assertEqual((link["ended_utc"], link["delay"], link["delay_s"]), (text, "waited", 86400))
-        self.assertAlmostEqual(link["elapsed_s"], seconds(manifest["created_utc"]) - seconds(text), delta=0.05)
+        self.assertAlmostEqual(link["elapsed_s"], seconds(manifest["created_utc"]) - seconds(text), delta=CLOCK_S)
         self.assertGreater(link["elapsed_s"], 86400)
 
     def test_a_person_after_a_session_ending_in_2038_is_refused_naming_the_record(self):
@@ -539,7 +544,7 @@ class Person(Base):
         link = manifest["previous_session"]
         self.assertEqual((link["ended_utc"], link["delay"]), ("2028-02-29T12:00:00.000Z", "overridden"))
         self.assertAlmostEqual(link["elapsed_s"], seconds(manifest["created_utc"]) - seconds(link["ended_utc"]),
-                               delta=0.05)
+                               delta=CLOCK_S)
         self.assertLess(link["elapsed_s"], 0)
 
     def test_a_persons_trial_lasts_its_device_time_in_wall_time_and_utc_stamps(self):
@@ -547,9 +552,9 @@ class Person(Base):
         session = sessions_of(person_study(), "P01")[1]
         document = read_json(records(session)[-1])
         self.assertLessEqual(document["trial_time_s"], 0.05 + 1.0 / RATE_HZ)
-        self.assertAlmostEqual(document["wall_time_s"], document["trial_time_s"], delta=0.03)
+        self.assertAlmostEqual(document["wall_time_s"], document["trial_time_s"], delta=0.05)
         span = seconds(document["end_time_utc"]) - seconds(document["start_time_utc"])
-        self.assertAlmostEqual(span, document["wall_time_s"], delta=0.0025)
+        self.assertAlmostEqual(span, document["wall_time_s"], delta=STAMPS_S)
 
 
 class Durations(Base):
@@ -611,7 +616,7 @@ class Durations(Base):
                 document = read_json(record)
                 span = seconds(document["end_time_utc"]) - seconds(document["start_time_utc"])
                 self.assertGreaterEqual(document["wall_time_s"], 0)
-                self.assertAlmostEqual(span, document["wall_time_s"], delta=0.0025, msg=record.name)
+                self.assertAlmostEqual(span, document["wall_time_s"], delta=STAMPS_S, msg=record.name)
                 self.assertAlmostEqual(document["trial_time_s"], 0.3, delta=1.0 / RATE_HZ + 1e-9)
 
     def test_times_are_whole_nanoseconds(self):
