@@ -8,6 +8,7 @@
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/study/guidance_share.hpp"
 #include "core/json_reader.hpp"
+#include "study/names.hpp"
 #include "study/record_metrics.hpp"
 #include "study/saved_sessions.hpp"
 
@@ -30,7 +31,7 @@ void practise_session(WriterMemory& memory, const fs::path& folder, const Sessio
 
 void remember(WriterMemory& memory, const fs::path& folder, const SessionManifest& manifest, int depth) {
   if (manifest.previous && depth < 20) {
-    const fs::path before = folder.parent_path() / manifest.previous->session_id;
+    const fs::path before = beside_session(folder, manifest.previous->session_id);
     remember(memory, before, read_previous_session(folder, manifest), depth + 1);
     consolidate(memory);  // hours or days between the sessions
   }

@@ -38,16 +38,19 @@ std::vector<fs::path> session_folders_under(const std::vector<fs::path>& roots) 
 
 fs::path named_folder(const fs::path& folder) {
   std::error_code error;
-  const fs::path resolved = fs::weakly_canonical(folder, error);
-  if (!error) return resolved;
-  const fs::path absolute = fs::absolute(folder, error);
-  return (error ? folder : absolute).lexically_normal();
+  fs::path named = fs::weakly_canonical(folder, error);
+  if (error) {
+    const fs::path absolute = fs::absolute(folder, error);
+    named = (error ? folder : absolute).lexically_normal();
+  }
+  if (named.filename().empty()) named = named.parent_path();  // "S/x/" made normal keeps its last separator
+  return named;
 }
 
-std::string session_folder_id(const fs::path& folder) {
-  fs::path named = named_folder(folder);
-  if (named.filename().empty()) named = named.parent_path();  // "S/x/" made normal keeps its last separator
-  return named.filename().string();
+std::string session_folder_id(const fs::path& folder) { return named_folder(folder).filename().string(); }
+
+fs::path beside_session(const fs::path& folder, const std::string& name) {
+  return named_folder(folder).parent_path() / name;
 }
 
 SessionManifest read_session_manifest(const fs::path& folder) {
@@ -121,7 +124,7 @@ void check_records_name_the_folder(const fs::path& folder, const SessionManifest
 
 SessionManifest read_previous_session(const fs::path& folder, const SessionManifest& manifest) {
   const PreviousSession& link = manifest.previous.value();
-  const fs::path before = named_folder(folder).parent_path() / link.session_id;
+  const fs::path before = beside_session(folder, link.session_id);
   const fs::path path = SessionLayout::manifest(before);
   const std::string text = read_session_file(path, kMaxSessionManifestBytes, "session manifest");
   if (!link.session_sha256.empty() && sha256_hex(text) != link.session_sha256) {

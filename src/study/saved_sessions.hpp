@@ -23,8 +23,13 @@ inline constexpr std::uintmax_t kMaxRecordBytes = kMaxRecordedTrialBytes;
 std::vector<std::filesystem::path> session_folders_under(const std::vector<std::filesystem::path>& roots);
 
 /// The folder as named by its own name: its links resolved ("S/x/", "S/x/.", "." inside x and a symbolic
-/// link to x are x), or, when it cannot be resolved, its absolute path made lexically normal.
+/// link to x are x), or, when it cannot be resolved, its absolute path made lexically normal; never with a
+/// trailing separator.
 std::filesystem::path named_folder(const std::filesystem::path& folder);
+
+/// The session folder `name` beside the session folder `folder` (in its subject's folder), however `folder`
+/// is spelt: ".", "..", with a trailing '/', or through a symbolic link (named_folder).
+std::filesystem::path beside_session(const std::filesystem::path& folder, const std::string& name);
 
 /// A session's id: its folder's own name (named_folder), whatever spelling of the folder a reader was given.
 std::string session_folder_id(const std::filesystem::path& folder);

@@ -174,12 +174,8 @@ SessionSeries session_series(const fs::path& root, const std::string& subject_id
                             "again, so resume cannot)");
     }
     previous.ended_utc = view.string_or("end_time_utc", "");
-    double ended_s = 0.0;
-    try {
-      ended_s = study_detail::utc_seconds(previous.ended_utc);
-    } catch (const InvalidArgument& e) {
-      json_detail::fail(last_record.string(), "/end_time_utc", e.what());
-    }
+    const double ended_s =
+        study_detail::utc_seconds_of(previous.ended_utc, last_record.string(), "/end_time_utc");
     for (const ProtocolPhase& phase : protocol.protocol.phases) {
       if (phase.session == number + 1) {
         previous.delay_s = phase.delay_s;

@@ -291,8 +291,8 @@ inline constexpr const char* kPartialNote =
 [[nodiscard]] bool is_partial_session_folder(const std::filesystem::path& folder);
 
 /// The session folders under `root`: `root` itself when it holds a session.json, else every folder below it
-/// (at most 4 levels deep) that does, sorted by path; temporary folders (`is_partial_session_folder`) are
-/// skipped. Throws DataError when `root` is not a folder or is a temporary one.
+/// (at most 4 levels deep) that does, by path, digits as numbers (-2 before -10); temporary folders
+/// (`is_partial_session_folder`) skipped. Throws DataError when `root` is not a folder or a temporary one.
 [[nodiscard]] std::vector<std::filesystem::path> find_session_folders(const std::filesystem::path& root);
 
 /// The trial record file `path` as `read_recorded_trial_file` reads it (trial/recorded_trial.hpp), and for a
