@@ -997,8 +997,6 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
     if policy.keep_end_reasons is not None and "end_reason" not in trials.columns:
         policy = design_analysis.ExclusionPolicy(None)
     kept, exclusions = design_analysis.apply_exclusions(trials, policy)
-    phase = design.compared_phase
-    data = _phase_trials(kept, phase)
     out = pathlib.Path(out_dir)
     figures, tables = out / "figures", out / "tables"
     for folder in (figures, tables):
@@ -1024,98 +1022,115 @@ def write_report(study: "_study.Study", out_dir: PathLike, *, title: typing.Opti
     try:
         for folder in (out, figures, tables):
             _make_folder(folder, made)
-        per_trial_link = _relative_link(per_trial_page, out) if per_trial_page is not None else None
-        protocols = [str(p) for p in _levels(trials["protocol"])] if "protocol" in trials else []
-        title = title or f"Study report: {', '.join(protocols) or 'study'}"
-        within = design.kind == "within-subjects"
-
-        files: dict[pathlib.Path, typing.Union[bytes, str]] = {}  # written together at the end, the page last
-        summary_html, question_html, means_html, learning_html = [], [], [], []
-        all_means, all_questions, all_ratios = [], [], []
-        for value in values:
-            display = _display(value)
-            means = _phase_means(kept, value, design)
-            all_means.append(means)
-            stem = f"phase_{_file_name(value)}"
-            figure = phase_figure(means, value, design)
-            _save_figure(figure, figures, stem, files)
-            width_px = round(figure.get_figwidth() * 96)
-            summary_html.append(
-                f"<figure><img src=\"figures/{_e(stem)}.svg\" width=\"{width_px}\" alt=\"{_e(display.label.capitalize())} "
-                f"by phase and {_factor_name(design)}\"><figcaption>{_e(display.label.capitalize())} by phase and "
-                f"{_factor_name(design)}: {_interval_words(design)} (each subject's analysed trials averaged first; "
-                "n = subjects).</figcaption></figure>\n")
-            questions = design_analysis.design_questions(trials, value, design, policy=policy, ddf=ddf,
-                                                         scale=display.scale, display_unit=display.unit)
-            all_questions.append(questions)
-            question_html.append(_questions_html(questions, value, _factor_name(design)))
-            means_html.append(_phase_means_html(means, value, design))
-            ratios = design_analysis.retention_ratios(trials, value, design, policy)
-            if not ratios.empty:
-                all_ratios.append(ratios.assign(value=value, unit=_si_unit(value)))
-                means_html.append(_retention_html(ratios, _factor_name(design), display))
-            if phase is not None and not data.empty:
-                stem = f"learning_{_file_name(value)}"
-                figure = learning_figure(data, value, phase=None,
-                                         legend_title="group" if design.kind == "between-subjects" else "condition")
-                _save_figure(figure, figures, stem, files)
-                width_px = round(figure.get_figwidth() * 96)
-                learning_html.append(
-                    f"<figure><img src=\"figures/{_e(stem)}.svg\" width=\"{width_px}\" "
-                    f"alt=\"Learning curves of {_e(display.label)}\"><figcaption>{_e(display.label.capitalize())} over "
-                    f"repetitions in {_e(phase)} (counted from 1): per "
-                    f"{'group' if design.kind == 'between-subjects' else 'condition'} the mean over subjects "
-                    "with its 95 % t interval (n = subjects). Left: all characters; then each character. One y axis for "
-                    "all panels.</figcaption></figure>\n")
-        files[table_file["phase_means"]] = _table_csv(pandas.concat(all_means, ignore_index=True))
-        files[table_file["questions"]] = _table_csv(pandas.concat(all_questions, ignore_index=True))
-        files[table_file["exclusions"]] = _table_csv(exclusions)
-        if all_ratios:
-            files[table_file["retention"]] = _table_csv(pandas.concat(all_ratios, ignore_index=True))
-        table5_html = ""
-        statistics_html = ""
-        if within and not data.empty:
-            table5s = [_table5(data, value) for value in values]
-            statistics_tables = [_statistics(data, value, design.control) for value in values]
-            files[table_file["summary"]] = pandas.DataFrame(
-                [row for t in table5s for row in _summary_rows(t)]).to_csv(index=False)
-            files[table_file["statistics"]] = pandas.concat(statistics_tables, ignore_index=True).to_csv(index=False)
-            table5_html = ("<section id=\"table5\">\n<h2>Means per subject and character (after Table 5)</h2>\n"
-                           "<div class=\"table5s\">\n" + "".join(_table5_html(t, phase) for t in table5s) + "</div>\n"
-                           "</section>\n")
-            statistics_html = ("<section id=\"statistics\">\n<h2>Paired statistics of the " + _e(phase) + " trials</h2>\n"
-                               "<p class=\"files\">Over subjects: each subject's trials are averaged per condition. n "
-                               "counts subjects (trials for the mixed model); effects are in the unit shown, d_z and g_av "
-                               "standardized; p two-sided, not adjusted (the adjusted ones are above). The power and "
-                               "the subjects for 80 % power take the observed d_z as true" + _power_basis(trials)
-                               + ".</p>\n"
-                               + "".join(_statistics_html(t, v, phase) for t, v in zip(statistics_tables, values))
-                               + "</section>\n")
-        transfer = design_analysis.transfer_baseline(kept, design)
-        page = ["<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
-                "<meta name=\"viewport\" content=\"width=device-width\">"
-                f"<title>{_e(title)}</title>\n{_STYLE}</head><body>\n",
-                _header_html(trials, title, design, per_trial_link, tables, files),
-                _words_html(design), _protocol_html(trials, design),
-                _exclusions_html(exclusions, policy),
-                "<section id=\"summary\">\n<h2>Summary</h2>\n<div class=\"figures\">\n", *summary_html, "</div>\n</section>\n",
-                "<section id=\"questions\">\n<h2>The design's questions</h2>\n<p class=\"files\">",
-                _e(_methods_sentence(design, ddf, pandas.concat(all_questions, ignore_index=True))), "</p>\n", *question_html, "</section>\n",
-                "<section id=\"phases\">\n<h2>Means by phase</h2>\n", *means_html,
-                f"<p>{_e(transfer)}</p>\n" if transfer else "", "</section>\n",
-                table5_html, statistics_html,
-                *(["<section id=\"learning\">\n<h2>Learning curves</h2>\n", *learning_html, "</section>\n"]
-                  if learning_html else []),
-                _subjects_html(trials, values, per_trial_link),
-                "</body></html>\n"]
-        index = out / "index.html"
-        files[index] = "".join(page)
+        files = _report_set(trials, kept, exclusions, design, policy, values, title=title, out=out,
+                            table_file=table_file, per_trial_page=per_trial_page, ddf=ddf)
         _refuse_outputs_on_inputs(files, study.trials["trace_file"] if "trace_file" in study.trials else ())
         _write_together(files)
     except BaseException:
         _remove_made_folders(made)
         raise
-    return index
+    return out / "index.html"
+
+
+def _report_set(trials: "pandas.DataFrame", kept: "pandas.DataFrame", exclusions: "pandas.DataFrame",
+                design: "design_analysis.StudyDesign", policy: "design_analysis.ExclusionPolicy",
+                values: typing.Sequence[str], *, title: typing.Optional[str], out: pathlib.Path,
+                table_file: dict[str, pathlib.Path], per_trial_page: typing.Optional[PathLike],
+                ddf: str) -> dict[pathlib.Path, typing.Union[bytes, str]]:
+    """The files of `write_report`'s set, made in memory (nothing written): its page, figures and tables, by path
+    under `out`, the page last."""
+    from . import design_analysis
+
+    pandas = _pandas()
+    figures, tables = out / "figures", out / "tables"
+    phase = design.compared_phase
+    data = _phase_trials(kept, phase)
+    per_trial_link = _relative_link(per_trial_page, out) if per_trial_page is not None else None
+    protocols = [str(p) for p in _levels(trials["protocol"])] if "protocol" in trials else []
+    title = title or f"Study report: {', '.join(protocols) or 'study'}"
+    within = design.kind == "within-subjects"
+
+    files: dict[pathlib.Path, typing.Union[bytes, str]] = {}  # written together at the end, the page last
+    summary_html, question_html, means_html, learning_html = [], [], [], []
+    all_means, all_questions, all_ratios = [], [], []
+    for value in values:
+        display = _display(value)
+        means = _phase_means(kept, value, design)
+        all_means.append(means)
+        stem = f"phase_{_file_name(value)}"
+        figure = phase_figure(means, value, design)
+        _save_figure(figure, figures, stem, files)
+        width_px = round(figure.get_figwidth() * 96)
+        summary_html.append(
+            f"<figure><img src=\"figures/{_e(stem)}.svg\" width=\"{width_px}\" alt=\"{_e(display.label.capitalize())} "
+            f"by phase and {_factor_name(design)}\"><figcaption>{_e(display.label.capitalize())} by phase and "
+            f"{_factor_name(design)}: {_interval_words(design)} (each subject's analysed trials averaged first; "
+            "n = subjects).</figcaption></figure>\n")
+        questions = design_analysis.design_questions(trials, value, design, policy=policy, ddf=ddf,
+                                                     scale=display.scale, display_unit=display.unit)
+        all_questions.append(questions)
+        question_html.append(_questions_html(questions, value, _factor_name(design)))
+        means_html.append(_phase_means_html(means, value, design))
+        ratios = design_analysis.retention_ratios(trials, value, design, policy)
+        if not ratios.empty:
+            all_ratios.append(ratios.assign(value=value, unit=_si_unit(value)))
+            means_html.append(_retention_html(ratios, _factor_name(design), display))
+        if phase is not None and not data.empty:
+            stem = f"learning_{_file_name(value)}"
+            figure = learning_figure(data, value, phase=None,
+                                     legend_title="group" if design.kind == "between-subjects" else "condition")
+            _save_figure(figure, figures, stem, files)
+            width_px = round(figure.get_figwidth() * 96)
+            learning_html.append(
+                f"<figure><img src=\"figures/{_e(stem)}.svg\" width=\"{width_px}\" "
+                f"alt=\"Learning curves of {_e(display.label)}\"><figcaption>{_e(display.label.capitalize())} over "
+                f"repetitions in {_e(phase)} (counted from 1): per "
+                f"{'group' if design.kind == 'between-subjects' else 'condition'} the mean over subjects "
+                "with its 95 % t interval (n = subjects). Left: all characters; then each character. One y axis for "
+                "all panels.</figcaption></figure>\n")
+    files[table_file["phase_means"]] = _table_csv(pandas.concat(all_means, ignore_index=True))
+    files[table_file["questions"]] = _table_csv(pandas.concat(all_questions, ignore_index=True))
+    files[table_file["exclusions"]] = _table_csv(exclusions)
+    if all_ratios:
+        files[table_file["retention"]] = _table_csv(pandas.concat(all_ratios, ignore_index=True))
+    table5_html = ""
+    statistics_html = ""
+    if within and not data.empty:
+        table5s = [_table5(data, value) for value in values]
+        statistics_tables = [_statistics(data, value, design.control) for value in values]
+        files[table_file["summary"]] = pandas.DataFrame(
+            [row for t in table5s for row in _summary_rows(t)]).to_csv(index=False)
+        files[table_file["statistics"]] = pandas.concat(statistics_tables, ignore_index=True).to_csv(index=False)
+        table5_html = ("<section id=\"table5\">\n<h2>Means per subject and character (after Table 5)</h2>\n"
+                       "<div class=\"table5s\">\n" + "".join(_table5_html(t, phase) for t in table5s) + "</div>\n"
+                       "</section>\n")
+        statistics_html = ("<section id=\"statistics\">\n<h2>Paired statistics of the " + _e(phase) + " trials</h2>\n"
+                           "<p class=\"files\">Over subjects: each subject's trials are averaged per condition. n "
+                           "counts subjects (trials for the mixed model); effects are in the unit shown, d_z and g_av "
+                           "standardized; p two-sided, not adjusted (the adjusted ones are above). The power and "
+                           "the subjects for 80 % power take the observed d_z as true" + _power_basis(trials)
+                           + ".</p>\n"
+                           + "".join(_statistics_html(t, v, phase) for t, v in zip(statistics_tables, values))
+                           + "</section>\n")
+    transfer = design_analysis.transfer_baseline(kept, design)
+    page = ["<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+            "<meta name=\"viewport\" content=\"width=device-width\">"
+            f"<title>{_e(title)}</title>\n{_STYLE}</head><body>\n",
+            _header_html(trials, title, design, per_trial_link, tables, files),
+            _words_html(design), _protocol_html(trials, design),
+            _exclusions_html(exclusions, policy),
+            "<section id=\"summary\">\n<h2>Summary</h2>\n<div class=\"figures\">\n", *summary_html, "</div>\n</section>\n",
+            "<section id=\"questions\">\n<h2>The design's questions</h2>\n<p class=\"files\">",
+            _e(_methods_sentence(design, ddf, pandas.concat(all_questions, ignore_index=True))), "</p>\n", *question_html, "</section>\n",
+            "<section id=\"phases\">\n<h2>Means by phase</h2>\n", *means_html,
+            f"<p>{_e(transfer)}</p>\n" if transfer else "", "</section>\n",
+            table5_html, statistics_html,
+            *(["<section id=\"learning\">\n<h2>Learning curves</h2>\n", *learning_html, "</section>\n"]
+              if learning_html else []),
+            _subjects_html(trials, values, per_trial_link),
+            "</body></html>\n"]
+    files[out / "index.html"] = "".join(page)
+    return files
 
 
 def _power_basis(trials: "pandas.DataFrame") -> str:

@@ -8,12 +8,9 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
-#include <exception>
 #include <iterator>
 #include <memory>
-#include <mutex>
 #include <string>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -77,35 +74,21 @@ class PagesWriter {
   const StudyReportSessions& study;
   const std::vector<fs::path>& pages;
   std::string index_href_from_page;
-  std::atomic<std::size_t> next{0};
-  std::atomic<bool> failed{false};
-  std::mutex error_mutex;
-  std::exception_ptr failure;
   std::atomic<std::size_t> trials{0};
   std::atomic<std::uintmax_t> bytes{0};
   std::vector<StudyTables>* tables = nullptr;  // one per session, when the tables are wanted too
   OutputSet* files = nullptr;                  // the report's files, replaced together at the end
 
-  void work() {
-    while (!failed) {
-      const std::size_t i = next++;
-      if (i >= study.sessions.size()) return;
-      try {
-        const ReportedSession& session = study.sessions[i];
-        SessionPageHtml page(session.shown, study.index.title, index_href_from_page);
-        read_session_trials(
-            session, [&page](const ReportTrial& trial) { page.add(trial); },
-            tables != nullptr ? &(*tables)[i] : nullptr);
-        trials += page.trials();
-        const std::string text = page.finish();
-        bytes += text.size();
-        files->add(pages[i], text);
-      } catch (...) {
-        const std::lock_guard lock(error_mutex);
-        if (!failure) failure = std::current_exception();
-        failed = true;
-      }
-    }
+  void write_page(std::size_t i) {
+    const ReportedSession& session = study.sessions[i];
+    SessionPageHtml page(session.shown, study.index.title, index_href_from_page);
+    read_session_trials(
+        session, [&page](const ReportTrial& trial) { page.add(trial); },
+        tables != nullptr ? &(*tables)[i] : nullptr);
+    trials += page.trials();
+    const std::string text = page.finish();
+    bytes += text.size();
+    files->add(pages[i], text);
   }
 };
 
@@ -164,14 +147,8 @@ int run_report(const ReportCommand& command) {
     writer.files = &report_files;
     std::vector<StudyTables> session_tables(command.csv.empty() ? 0 : study.sessions.size());
     if (!command.csv.empty()) writer.tables = &session_tables;
-    const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
-    const std::size_t threads =
-        std::min<std::size_t>(command.jobs > 0 ? static_cast<std::size_t>(command.jobs) : cores,
-                              std::max<std::size_t>(1, pages.size()));
-    WorkerThreads pool(threads - 1, [&writer] { writer.work(); });
-    writer.work();
-    pool.join();
-    if (writer.failure) std::rethrow_exception(writer.failure);
+    for_each_item(study.sessions.size(), static_cast<std::size_t>(command.jobs),
+                  [&writer](std::size_t i) { writer.write_page(i); });
     if (!command.csv.empty()) {  // the sessions' rows in the sessions' order, as read_study_tables gives them
       StudyTables tables;
       for (StudyTables& rows : session_tables) {

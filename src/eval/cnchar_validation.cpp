@@ -2,12 +2,8 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cstdio>
-#include <exception>
-#include <mutex>
 #include <ostream>
-#include <thread>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
@@ -169,41 +165,22 @@ CncharValidation validate_against_cnchar(const CharacterLibrary& library,
   };
   const std::vector<std::pair<char32_t, std::string>> items(labels.begin(), labels.end());
   std::vector<Outcome> outcomes(items.size());
-  std::atomic<std::size_t> next{0};
-  const auto take_characters = [&] {
-    for (std::size_t k = next++; k < items.size(); k = next++) {
-      const auto& [cp, letters] = items[k];
-      if (!library.contains(cp)) continue;
-      const CharacterData data = library.load_data(cp);
-      if (data.medians.size() != letters.size()) {
-        outcomes[k].status = Outcome::count_mismatch;
-        continue;
-      }
-      outcomes[k].status = Outcome::compared;
-      for (const auto& median : data.medians) {
-        const FittedStroke f = fit_stroke(median, options);
-        outcomes[k].ids.push_back(f.stroke.typical_id);
-        outcomes[k].pieces.push_back(f.pieces);
-      }
+  // A character whose data cannot be read ends the validation with that error (the first in order).
+  for_each_item(items.size(), std::max(1u, threads), [&](std::size_t k) {
+    const auto& [cp, letters] = items[k];
+    if (!library.contains(cp)) return;
+    const CharacterData data = library.load_data(cp);
+    if (data.medians.size() != letters.size()) {
+      outcomes[k].status = Outcome::count_mismatch;
+      return;
     }
-  };
-  // A character whose data cannot be read ends the validation with that error, from whichever thread met it
-  // first; the others stop at their next character (an exception leaving a thread would end the process).
-  std::mutex failure_mutex;
-  std::exception_ptr failure;
-  const auto work = [&] {
-    try {
-      take_characters();
-    } catch (...) {
-      const std::lock_guard<std::mutex> lock(failure_mutex);
-      if (!failure) failure = std::current_exception();
-      next = items.size();
+    outcomes[k].status = Outcome::compared;
+    for (const auto& median : data.medians) {
+      const FittedStroke f = fit_stroke(median, options);
+      outcomes[k].ids.push_back(f.stroke.typical_id);
+      outcomes[k].pieces.push_back(f.pieces);
     }
-  };
-  WorkerThreads pool(std::max(1u, threads) - 1, work);
-  work();
-  pool.join();
-  if (failure) std::rethrow_exception(failure);
+  });
 
   CncharValidation result;
   result.labelled = items.size();

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
 #include <mutex>
 #include <thread>
 
@@ -91,7 +92,9 @@ CorpusFit fit_corpus(const CharacterLibrary& library, const FitOptions& options,
   std::vector<std::string> errors(code_points.size());
   std::atomic<std::size_t> next{0};
   std::atomic<std::size_t> done{0};
-  std::mutex timing_mutex;
+  std::mutex timing_mutex;  // guards the timings and `fatal`
+  std::exception_ptr fatal;
+  std::atomic<bool> failed{false};
   double read_parse = 0.0;
   double fit = 0.0;
 
@@ -114,8 +117,17 @@ CorpusFit fit_corpus(const CharacterLibrary& library, const FitOptions& options,
         }
         my_fit += seconds_since(t1);
         my_read += std::chrono::duration<double>(t1 - t0).count();
-      } catch (const std::exception& e) {  // reported per character below, never fatal for the run
+      } catch (const DataError& e) {  // the character's data: reported per character below, never fatal
         errors[k] = e.what();
+      } catch (const InvalidArgument& e) {  // a median the fitter cannot take: as the data's
+        errors[k] = e.what();
+      } catch (...) {
+        // The machine's refusal (no memory, no file descriptor: Error, bad_alloc), not the data's: the run
+        // fails whole, since a store without the characters it could not read would replace a good one.
+        const std::lock_guard lock(timing_mutex);
+        if (!fatal) fatal = std::current_exception();
+        next = code_points.size();
+        failed = true;
       }
       ++done;
     }
@@ -126,11 +138,12 @@ CorpusFit fit_corpus(const CharacterLibrary& library, const FitOptions& options,
   WorkerThreads pool(threads, work);
   if (pool.started() == 0) work();  // no thread could be started: the characters are fitted here
   ProgressBar bar(label, code_points.size(), log_progress);
-  while (done < code_points.size()) {
+  while (done < code_points.size() && !failed) {
     bar.show(done);
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
   pool.join();
+  if (fatal) std::rethrow_exception(fatal);
   bar.show(code_points.size());
 
   CorpusFit result;

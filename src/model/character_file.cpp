@@ -45,6 +45,12 @@ std::string read_character_file(const std::filesystem::path& path, char32_t code
     if (error == ENOENT || error == ENOTDIR) {
       throw CharacterNotFound("character " + describe_character(code_point) + " not found: no file " + name);
     }
+    if (error == EMFILE || error == ENFILE || error == ENOMEM) {
+      // The machine's limit (the open files this process or the system may have, or memory), not the file's
+      // fault: an Error, which a reader that skips a bad character file does not take for one.
+      throw Error(name + ": cannot open (" + std::strerror(error) +
+                  "): the files this process may open, or its memory, are used up; the file was not read");
+    }
     throw refuse(std::string("cannot open (") + std::strerror(error) + ")");
   }
   struct stat info {};

@@ -1,16 +1,13 @@
 #include "calligraphy/study/cohort.hpp"
 
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <exception>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <thread>
 #include <utility>
 
 #include "calligraphy/core/errors.hpp"
@@ -229,33 +226,14 @@ StudyTables simulate_cohort(const LoadedProtocol& protocol, const std::vector<Su
   shared.load_character = [&characters](char32_t c) { return characters.at(c); };
 
   std::vector<StudyTables> per_subject(subjects.size());
-  std::atomic<std::size_t> next{0};
-  std::atomic<bool> failed{false};
-  std::mutex mutex;  // guards first_error, done and the progress callback
-  std::exception_ptr first_error;
+  std::mutex progress_mutex;  // one progress call at a time
   std::size_t done = 0;
-  const auto work = [&] {
-    while (!failed.load()) {
-      const std::size_t i = next.fetch_add(1);
-      if (i >= subjects.size()) return;
-      try {
-        per_subject[i] = simulate_subject(protocol, subjects[i], shared);
-      } catch (...) {
-        const std::lock_guard<std::mutex> lock(mutex);
-        if (!first_error) first_error = std::current_exception();
-        failed.store(true);
-        return;
-      }
-      const std::lock_guard<std::mutex> lock(mutex);
-      ++done;
-      if (progress) progress(done);
-    }
-  };
-  const unsigned count = static_cast<unsigned>(std::min<std::size_t>(threads, subjects.size()));
-  WorkerThreads workers(count > 0 ? count - 1 : 0, work);
-  work();
-  workers.join();
-  if (first_error) std::rethrow_exception(first_error);
+  for_each_item(subjects.size(), threads, [&](std::size_t i) {
+    per_subject[i] = simulate_subject(protocol, subjects[i], shared);
+    const std::lock_guard<std::mutex> lock(progress_mutex);
+    ++done;
+    if (progress) progress(done);
+  });
 
   StudyTables tables;
   for (StudyTables& subject : per_subject) {

@@ -146,6 +146,38 @@ void check_record_is_the_sessions(const json& document, const std::string& sourc
   }
 }
 
+// A record under a session's trials/ is the trial of the plan its file name gives: its own plan entry
+// (`trial`: index and file stem) and characters are that trial's. A record copied over another trial's of
+// the same session (its trace too, so that the checksums agree) is refused naming the record's key, rather
+// than reported with one character's strokes under another's label.
+void check_record_is_the_plans(const json& document, const std::string& source, const PlannedTrial& plan) {
+  const json_detail::JsonView record(document, "", source);
+  const std::string stem = SessionFolder::trial_stem(plan);
+  const auto copied = [&](const std::string& pointer, const std::string& named, const std::string& planned) {
+    json_detail::fail(source, pointer,
+                      "is " + named + ", but the record is saved as " + stem + ", trial " +
+                          std::to_string(plan.index + 1) + " of the session's plan (" + planned +
+                          "): a record copied from another trial; put it back where it was saved");
+  };
+  std::string characters;
+  for (const char32_t c : plan.characters) characters += encode_utf8(c);
+  if (record.has("characters")) {
+    const std::string named = record.string_or("characters", "");
+    if (named != characters) copied("/characters", "'" + named + "'", "characters '" + characters + "'");
+  }
+  if (!record.has("trial")) return;
+  const json_detail::JsonView trial = record.object("trial");
+  if (trial.has("index")) {
+    const std::int64_t index = trial.integer_or("index", 0, 0, std::int64_t{1} << 40);
+    if (index != static_cast<std::int64_t>(plan.index) + 1)
+      copied("/trial/index", std::to_string(index), "index " + std::to_string(plan.index + 1));
+  }
+  if (trial.has("file")) {
+    const std::string file = trial.string_or("file", "");
+    if (file != stem) copied("/trial/file", "'" + file + "'", "file '" + stem + "'");
+  }
+}
+
 // The tidy tables' rows of the saved trial whose record `document` was read from `json_file`: the one
 // reading of a record into rows, for the tables alone and beside the pages.
 void append_trial_rows(const json& document, const fs::path& json_file, const SessionManifest& manifest,
@@ -163,6 +195,7 @@ ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifes
   const std::string source = json_file.string();
   const json document = study_detail::read_trial_record(json_file);
   check_record_is_the_sessions(document, source, manifest);
+  check_record_is_the_plans(document, source, plan);
   const json_detail::JsonView record(document, "", source);
   // the tidy tables' rows from the same parse of the record
   if (rows != nullptr) append_trial_rows(document, json_file, manifest, plan, *rows);
@@ -352,6 +385,7 @@ void read_session_rows(const ReportedSession& session, StudyTables& rows) {
     const fs::path json_file = trial_record_file(session.folder, plan);
     const json document = study_detail::read_trial_record(json_file);
     check_record_is_the_sessions(document, json_file.string(), session.manifest);
+    check_record_is_the_plans(document, json_file.string(), plan);
     append_trial_rows(document, json_file, session.manifest, plan, rows);
   }
 }

@@ -1,13 +1,9 @@
 #include "calligraphy/study/study_tables.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <charconv>
-#include <exception>
 #include <iterator>
-#include <mutex>
 #include <nlohmann/json.hpp>
-#include <thread>
 #include <type_traits>
 #include <variant>
 
@@ -233,34 +229,8 @@ StudyTables read_study_tables(const std::vector<fs::path>& roots, unsigned threa
   // each into its own rows, joined in the sessions' order.
   const std::vector<ReportedSession> sessions = list_report_sessions(roots).sessions;
   std::vector<StudyTables> rows(sessions.size());
-  std::atomic<std::size_t> next{0};
-  std::atomic<bool> failed{false};
-  std::mutex failure_mutex;
-  std::exception_ptr failure;
-  std::size_t failed_session = 0;
-  const auto work = [&] {
-    for (std::size_t i = next++; i < sessions.size() && !failed; i = next++) {
-      try {
-        read_session_rows(sessions[i], rows[i]);
-      } catch (...) {
-        const std::lock_guard lock(failure_mutex);
-        // The first session in order that failed, as reading them in turn would name it: sessions are taken
-        // in order and each one taken is read to its end, so every earlier one is read.
-        if (!failure || i < failed_session) {
-          failure = std::current_exception();
-          failed_session = i;
-        }
-        failed = true;
-      }
-    }
-  };
-  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
-  const std::size_t count =
-      std::min<std::size_t>(threads > 0 ? threads : cores, std::max<std::size_t>(1, sessions.size()));
-  WorkerThreads pool(count - 1, work);
-  work();
-  pool.join();
-  if (failure) std::rethrow_exception(failure);
+  // An error names the first session in order that failed, as reading them in turn would.
+  for_each_item(sessions.size(), threads, [&](std::size_t i) { read_session_rows(sessions[i], rows[i]); });
   StudyTables tables;
   for (StudyTables& session : rows) {
     std::move(session.trials.begin(), session.trials.end(), std::back_inserter(tables.trials));

@@ -807,6 +807,25 @@ class Sets(Case):
         self.refused(r, 1, s1.name)
         self.assertFalse((self.tmp / "t" / "trials.csv").exists())
 
+    def test_report_of_a_record_copied_over_another_trial_of_its_session(self):
+        # The record and its trace of trial 1 copied over trial 2's (the same character in the other condition):
+        # the checksums agree, the session is the same; the record is still another trial's.
+        st = self.copy_study()
+        first, second = sorted(sessions(st)[0].glob("trials/*.json"))[:2]
+        for ext in (".json", ".trace.h5"):
+            shutil.copy(str(first)[:-len(".json")] + ext, str(second)[:-len(".json")] + ext)
+        (self.tmp / "t").mkdir()
+        r = run(["report", "st", "--csv", "t"], self.tmp)
+        self.refused(r, 1, second.name, "/trial/index", "copied from another trial")
+        self.assertFalse((self.tmp / "t" / "trials.csv").exists())
+        (self.tmp / "page").mkdir()
+        r = run(["report", "st", "--out", "page/index.html"], self.tmp)
+        self.refused(r, 1, second.name, "/trial/index")
+        self.assertEqual(list((self.tmp / "page").iterdir()), [])
+        if cg is not None:
+            with self.assertRaisesRegex(cg.DataError, "/trial/index"):
+                cg_study.load(str(st))
+
     def test_report_of_a_record_with_numbers_no_double_holds(self):
         st = self.copy_study()
         record = sorted(sessions(st)[0].glob("trials/*.json"))[0]

@@ -45,4 +45,13 @@ class WorkerThreads {
   std::vector<std::thread> threads_;
 };
 
+/// Runs `task(i)` for every i in [0, count) on up to `threads` threads (0: one a hardware thread; never more
+/// than `count`), the calling thread one of them; a thread the system will not start is done without, as
+/// WorkerThreads. Items are taken in increasing order and each one taken runs to its end. Once an item has
+/// thrown no further item starts, and when every thread has stopped the exception of the lowest-numbered item
+/// that threw is rethrown: every item before it was taken and ran, so it is the error a run in turn would
+/// meet first, whatever the threads. Returns the number of threads that ran (at least 1).
+std::size_t for_each_item(std::size_t count, std::size_t threads,
+                          const std::function<void(std::size_t)>& task);
+
 }  // namespace calligraphy

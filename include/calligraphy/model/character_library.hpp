@@ -72,7 +72,9 @@ class CharacterLibrary {
   /// True when the character is available.
   [[nodiscard]] bool contains(char32_t code_point) const;
   /// The raw medians (for a character of the bundled store, its stored medians). Throws
-  /// CharacterNotFound (naming the character and where it looked) or DataError.
+  /// CharacterNotFound (naming the character and where it looked) or DataError; Error (not a DataError)
+  /// naming the file when the system will not open it for want of resources (EMFILE, ENFILE, ENOMEM: the
+  /// data is not at fault).
   [[nodiscard]] CharacterData load_data(char32_t code_point) const;
   /// The fitted model (elements, feature points, typical IDs). A character of the bundled store is the
   /// stored model, fitted when the store was built (`options` do not apply to it). Throws as `load_data`.
