@@ -205,3 +205,25 @@ TEST_CASE("Renderer: the force never exceeds the device maximum", "[renderer]") 
   const auto out = r.tick(at(scene, {300, 500}, -0.01));  // 10 mm deep: 8 N asked
   CHECK(out.force_n.norm() == Approx(0.5));
 }
+
+TEST_CASE("Renderer: a peak or continuous force given above the device's is taken as the device's",
+          "[renderer]") {
+  const Scene scene = two_stroke_scene();
+  DeviceInfo weak = simulated_phantom_desktop_info();
+  weak.max_force_n = 0.5;
+  weak.max_continuous_force_n = 0.4;
+  RendererOptions options = no_ramp_no_rate_limit();
+  options.safety.max_force_n = 20.0;  // within the chain's own range (100 N), far above this device
+  Renderer r(scene, unsmoothed(), weak, options);
+  const auto out = r.tick(at(scene, {300, 500}, -0.01));  // 10 mm deep: 8 N asked
+  CHECK(out.force_n.norm() == Approx(0.5));
+  CHECK(r.safety_chain().parameters().max_force_n == 0.5);
+  CHECK(r.safety_chain().parameters().max_continuous_force_n == 0.4);
+
+  options.safety.max_force_n = 0.3;  // one below the device's is kept, and the continuous force under it
+  options.safety.max_continuous_force_n = 5.0;
+  Renderer lower(scene, unsmoothed(), weak, options);
+  CHECK(lower.tick(at(scene, {300, 500}, -0.01)).force_n.norm() == Approx(0.3));
+  CHECK(lower.safety_chain().parameters().max_force_n == 0.3);
+  CHECK(lower.safety_chain().parameters().max_continuous_force_n == 0.3);
+}

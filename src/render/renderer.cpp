@@ -35,12 +35,19 @@ double corner_slack(const ActiveStroke& active, const Vec2& tip, double radius_m
   return smoothstep((radius_m - d) / (0.5 * radius_m));
 }
 
-// The safety chain's parameters with the device's peak and continuous force filled in.
+// The safety chain's parameters with the device's peak and continuous force filled in, and a peak or
+// continuous force given above the device's taken as the device's: the chain never commands (and the trace
+// never records) a force the device cannot give, which its driver would clamp unseen.
 SafetyChainParameters chain_parameters(const RendererOptions& options, const DeviceInfo& device) {
   SafetyChainParameters p = options.safety;
-  if (p.max_force_n == 0.0) p.max_force_n = device.max_force_n;
-  if (p.max_continuous_force_n == 0.0)
-    p.max_continuous_force_n = std::min(device.max_continuous_force_n, p.max_force_n);
+  p.max_force_n = p.max_force_n == 0.0 ? device.max_force_n : std::min(p.max_force_n, device.max_force_n);
+  double continuous = p.max_continuous_force_n;
+  if (continuous == 0.0) {
+    continuous = device.max_continuous_force_n;  // the device's (0, unknown: the stage is off)
+  } else if (device.max_continuous_force_n > 0.0) {
+    continuous = std::min(continuous, device.max_continuous_force_n);
+  }
+  p.max_continuous_force_n = std::min(continuous, p.max_force_n);
   return p;
 }
 

@@ -27,7 +27,8 @@ namespace calligraphy {
 /// How the renderer is run: the servo rate and the stages after the force law.
 struct RendererOptions {
   double rate_hz = 1000.0;  ///< servo rate [Hz], in [100, 100000]
-  /// Safety chain. `max_force_n` and `max_continuous_force_n` left at 0 take the device's figures.
+  /// Safety chain. `max_force_n` and `max_continuous_force_n` left at 0 take the device's figures; one given
+  /// above the device's is taken as the device's (never more than the device can give).
   SafetyChainParameters safety{};
   PassivityParameters passivity{};  ///< Hannaford-Ryu observer and controller (off by default)
   /// Throws InvalidArgument naming the field when a value is out of range.
