@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
+#include "core/utc_time.hpp"
 
 namespace calligraphy {
 namespace {
@@ -42,6 +43,7 @@ struct Sample {
   bool on = true;
   Colour colour = Colour::red;
   std::string name = "x";
+  std::string when_utc = "2024-05-01T12:34:56.789Z";
   Inner inner;
   std::vector<Inner> list;
   std::array<double, 2> point_m{0.0, 0.0};
@@ -124,6 +126,7 @@ struct SchemaOf<Sample> {
         boolean_field<&Sample::on>("on", {.doc = "a switch", .option = "--on"}),
         enum_field<&Sample::colour>("colour", {.doc = "a colour", .option = "--colour"}),
         string_field<&Sample::name>("name", {.doc = "a name", .option = "--name"}),
+        string_field<&Sample::when_utc>("when_utc", {.doc = "a time", .format = StringFormat::utc_time}),
         object_field<&Sample::inner>("inner", {.doc = "a nested struct"}),
         object_list_field<&Sample::list>("list", {.doc = "a list of them"}),
         number_array_field<&Sample::point_m, 2>("point_m", {.low = -1.0, .high = 1.0},
@@ -163,6 +166,7 @@ Sample everything_set() {
   s.on = false;
   s.colour = Colour::light_blue;
   s.name = "名字";
+  s.when_utc = "2028-02-29T23:59:60Z";
   s.inner.width_m = 1.0;
   s.list = {Inner{0.1}, Inner{0.2}};
   s.point_m = {-1.0, 0.1 + 0.2};
@@ -211,6 +215,16 @@ TEST_CASE("The schema's JSON reader refuses, naming the source and the pointer",
   CHECK_THAT(refusal(R"({"point_m": [0]})"), Catch::Contains("/point_m") && Catch::Contains("2 numbers"));
   CHECK_THAT(refusal(R"({"shape": {"kind": "triangle"}})"), Catch::Contains("/shape/kind"));
   CHECK_THAT(refusal(R"({"shape": {"kind": "circle", "side_m": 1}})"), Catch::Contains("/shape/side_m"));
+  // A time of the calendar in UTC, as the program writes it: another form, a zone, or a day the calendar
+  // lacks is refused at its pointer, never read as another day.
+  for (const char* wrong :
+       {"yesterday", "2027-02-29T12:00:00Z", "2026-04-31T00:00:00Z", "2026-11-28T24:00:01Z",
+        "2026-11-28T01:45:43+08:00", "2026-11-28T01:45:43", "2026-11-28 01:45:43Z", ""}) {
+    CHECK_THAT(refusal(R"({"when_utc": ")" + std::string(wrong) + R"("})"),
+               Catch::Contains("s.json: /when_utc") && Catch::Contains("is not a UTC time"));
+  }
+  CHECK(schema_from_json<Sample>(R"({"when_utc": "1970-01-01T00:00:00Z"})", "s.json").when_utc ==
+        "1970-01-01T00:00:00Z");
   CHECK_THAT(refusal(R"({"name": "forbidden"})"),
              Catch::Contains("s.json: /") && Catch::Contains("refused by a rule"));
   CHECK_THAT(refusal(R"([1])"), Catch::Contains("s.json: /") && Catch::Contains("an object"));
@@ -337,7 +351,11 @@ TEST_CASE("The JSON Schema and the docs' table come from the same fields", "[sch
   CHECK_THAT(rate["description"].get<std::string>(), Catch::Contains("[Hz]"));
   CHECK(schema["$defs"]["Inner"]["properties"]["width_m"]["exclusiveMinimum"] == 0.0);
   CHECK(schema["properties"]["colour"]["enum"] == nlohmann::json{"red", "light-blue"});
-  CHECK(schema["properties"]["colour"]["title"] == "Colour");  // the enumeration's table names it
+  CHECK(schema["properties"]["colour"]["title"] == "Colour");
+  CHECK(schema["properties"]["when_utc"]["format"] == "date-time");
+  CHECK(schema["properties"]["when_utc"]["pattern"] == std::string(kUtcTimePattern));
+  CHECK(!schema["properties"]["when_utc"].contains("default"));
+  CHECK(!schema["properties"]["name"].contains("format"));  // the enumeration's table names it
   CHECK(schema["properties"]["shape"]["title"] == "Shape");
   CHECK(schema["properties"]["seed"]["maximum"].get<std::uint64_t>() == 18446744073709551615ULL);
   CHECK(schema["properties"]["shape"]["oneOf"].size() == 2);

@@ -7,6 +7,7 @@
 
 #include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "core/utc_time.hpp"
 
 namespace calligraphy {
 namespace {
@@ -162,6 +163,10 @@ void check_schema(const Schema& schema, const void* object) {
   if (schema.check_rules != nullptr) schema.check_rules(object);
 }
 
+void SchemaField::check_string(std::string_view text) const {
+  if (string_format == StringFormat::utc_time) (void)utc_seconds(text);
+}
+
 void set_field_from_text(const SchemaField& field, void* object, std::string_view text) {
   switch (field.kind) {
     case FieldKind::number: {
@@ -206,6 +211,7 @@ void set_field_from_text(const SchemaField& field, void* object, std::string_vie
       throw_not_a_spelling(text, spellings);
     }
     case FieldKind::string:
+      field.check_string(text);
       field.set_string(object, std::string(text));
       return;
     default:

@@ -8,6 +8,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/schema.hpp"
 #include "core/json_reader.hpp"
+#include "core/utc_time.hpp"
 
 namespace calligraphy {
 namespace {
@@ -117,9 +118,16 @@ void read_value(const SchemaField& field, const std::string& owner, void* object
       expect(false, choices);
       return;
     }
-    case FieldKind::string:
-      field.set_string(object, json_detail::as_string(value, pointer, source));
+    case FieldKind::string: {
+      std::string text = json_detail::as_string(value, pointer, source);
+      try {
+        field.check_string(text);
+      } catch (const InvalidArgument& e) {
+        json_detail::fail(source, pointer, e.what());
+      }
+      field.set_string(object, std::move(text));
       return;
+    }
     case FieldKind::object: {
       if (field.nullable && value.is_null()) {
         field.reset_object(object);
@@ -253,6 +261,10 @@ ordered_json field_schema(const SchemaField& field, const void* defaults, ordere
     }
     case FieldKind::string:
       out = {{"type", "string"}};
+      if (field.string_format == StringFormat::utc_time) {
+        out["format"] = "date-time";  // RFC 3339's, narrowed by the pattern to UTC with a Z
+        out["pattern"] = std::string(kUtcTimePattern);
+      }
       break;
     case FieldKind::object:
       out = {{"$ref", def_reference(*field.nested(), defs, all_required)}};
@@ -281,8 +293,9 @@ ordered_json field_schema(const SchemaField& field, const void* defaults, ordere
       break;
   }
   out["description"] = describe_field(field);
+  // A time has no default a document could take (the struct's is empty, no time): none is stated.
   if (field.kind != FieldKind::object_list && field.kind != FieldKind::variant &&
-      (field.kind != FieldKind::object || field.nullable))
+      (field.kind != FieldKind::object || field.nullable) && field.string_format == StringFormat::any)
     out["default"] = value_json(field, defaults);
   if (field.kind == FieldKind::object_list) out["default"] = ordered_json::array();
   return out;

@@ -234,11 +234,6 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
   if (manifest.previous.has_value() != (manifest.setup.session_number > 1)) {
     json_detail::fail(source, "/previous_session", "expected exactly for a session after the first");
   }
-  // The dates are times of the calendar in UTC, as utc_now_iso8601 writes them: one forged or mistyped is
-  // named here, not compared as text (a session found twice is told by created_utc) or copied on.
-  (void)utc_seconds_of(manifest.created_utc, source, "/created_utc");
-  if (manifest.previous)
-    (void)utc_seconds_of(manifest.previous->ended_utc, source, "/previous_session/ended_utc");
   manifest.library = read.library;
   try {
     manifest.protocol = protocol_from_text(std::move(read.protocol.text), read.protocol.path);

@@ -92,7 +92,8 @@ const Schema& SchemaOf<PreviousSession>::get() {
   using P = PreviousSession;
   static const std::vector<SchemaField> fields{
       string_field<&P::session_id>("session_id", {.doc = "its folder's name, beside this one"}),
-      string_field<&P::ended_utc>("ended_utc", {.doc = "when its last trial ended (ISO 8601, UTC)"}),
+      string_field<&P::ended_utc>("ended_utc", {.doc = "when its last trial ended (ISO 8601, UTC)",
+                                                .format = StringFormat::utc_time}),
       number_field<&P::delay_s>("delay_s", {.low = 0.0, .high = 1e9},
                                 {.unit = "s", .doc = "the protocol's delay before this session"}),
       // Any finite time: a clock that differs between the sessions is recorded as it was measured.
@@ -121,7 +122,8 @@ const Schema& SchemaOf<study_detail::ManifestDocument>::get() {
       string_field<&D::format>("format", {.doc = "\"calligraphy-study-session\""}),
       integer_field<&D::version>("version", 1, study_detail::kSessionVersion,
                                  {.doc = "the format's version"}),
-      string_field<&D::created_utc>("created_utc", {.doc = "when the session was made (ISO 8601, UTC)"}),
+      string_field<&D::created_utc>("created_utc", {.doc = "when the session was made (ISO 8601, UTC)",
+                                                    .format = StringFormat::utc_time}),
       object_field<&D::subject>("subject", {.doc = "the subject"}),
       omissible(integer_field<&D::session_number>(
           "session_number", 1, 20, {.doc = "which of the protocol's sessions this one is (1-based)"})),

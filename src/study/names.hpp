@@ -28,11 +28,9 @@ std::string read_session_file(const std::filesystem::path& path, std::uintmax_t 
 /// "PATH: is a symbolic link; a session's files are its own: ...".
 std::string session_file_link_message(const std::filesystem::path& path);
 
-/// Seconds since 1970-01-01T00:00:00Z of a time `utc_now_iso8601` wrote ("2024-05-01T12:34:56.789Z"; the
-/// fraction optional). Throws InvalidArgument quoting the text when it is not such a time.
-double utc_seconds(std::string_view iso8601);
-/// utc_seconds of a file's value at a JSON pointer (a record's /end_time_utc, session.json's /created_utc):
-/// one that is not such a time is an InputError naming `source` and `pointer` (json_detail::fail).
+/// utc_seconds (core/utc_time.hpp) of a file's value at a JSON pointer (a record's /end_time_utc,
+/// session.json's /created_utc): one that is not such a time is an InputError naming `source` and `pointer`
+/// (json_detail::fail).
 double utc_seconds_of(std::string_view iso8601, const std::string& source, std::string_view pointer);
 
 /// 64-bit FNV-1a of `text` (Fowler, Noll & Vo; IETF draft-eastlake-fnv): a stable seed from a name.

@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <map>
 #include <thread>
@@ -16,6 +17,7 @@
 #include "calligraphy/study/schedule.hpp"
 #include "calligraphy/study/session_folder.hpp"
 #include "core/json_reader.hpp"
+#include "core/utc_time.hpp"
 #include "study/names.hpp"
 #include "study/saved_sessions.hpp"
 
@@ -182,8 +184,10 @@ SessionSeries session_series(const fs::path& root, const std::string& subject_id
         break;
       }
     }
-    // Negative when the previous session's clock was ahead of this one's: recorded as measured.
-    previous.elapsed_s = study_detail::utc_seconds(utc_now_iso8601()) - ended_s;
+    // Negative when the previous session's clock was ahead of this one's: recorded as measured. Rounded to
+    // the microsecond: the two times are doubles near 1.8e9 s, whose difference carries their rounding (0.006
+    // s would read 0.006000041961669922), far under the clock strings' millisecond.
+    previous.elapsed_s = std::round((utc_seconds(utc_now_iso8601()) - ended_s) * 1e6) / 1e6;
     series.previous = std::move(previous);
     series.previous_record = last_record;
   }

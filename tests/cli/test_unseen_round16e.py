@@ -223,6 +223,8 @@ class Base(OneErrorLine, unittest.TestCase):
         self.assertEqual(link["ended_utc"], ended)
         expected = seconds(manifest["created_utc"]) - seconds(ended)
         self.assertAlmostEqual(link["elapsed_s"], expected, delta=CLOCK_S, msg=link)
+        # The difference of two clock readings, to the microsecond: never the rounding of two doubles near 1.8e9 s.
+        self.assertEqual(link["elapsed_s"], round(link["elapsed_s"], 6), link)
         # A simulated subject's delay is recorded, not waited: `simulated`, or `waited` when it had passed.
         self.assertEqual(link["delay"], "waited" if link["elapsed_s"] >= link["delay_s"] else "simulated", link)
         return link

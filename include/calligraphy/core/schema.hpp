@@ -104,6 +104,12 @@ enum class FieldKind : std::uint8_t {
   variant,       ///< one of several structs, named by an enumeration in member `variant_tag` (a std::variant)
 };
 
+/// What a string field's text must be, beyond UTF-8.
+enum class StringFormat : std::uint8_t {
+  any,       ///< any text
+  utc_time,  ///< a time of the calendar in UTC, "2024-05-01T12:34:56.789Z" (ISO 8601, the fraction optional)
+};
+
 /// The JSON name of a kind: "number", "integer", "boolean", "enumeration", "string", "object", ...
 [[nodiscard]] std::string_view to_string(FieldKind kind) noexcept;
 
@@ -126,6 +132,7 @@ struct SchemaField {
   const Schema* (*nested)() = nullptr;  ///< object, object_list: the nested struct's schema
   std::span<const std::string_view> (*spellings)() = nullptr;  ///< enumeration: spellings in table order
   std::string_view enum_name = {};  ///< enumeration, variant: the enumeration's name ("GuidanceMode")
+  StringFormat string_format = StringFormat::any;  ///< string: what its text must be
   /// object: std::optional of the struct; JSON null when empty
   bool nullable = false;
   /// variant: the key naming the alternative ("mode"), spelled by the enumeration `spellings`, whose i-th
@@ -180,6 +187,10 @@ struct SchemaField {
   [[nodiscard]] std::int64_t integer_value(const void* object) const;
   /// integer, signed: sets the value, through `set_integer` or `set_number` as `integer_value` reads it.
   void set_integer_value(void* object, std::int64_t value) const;
+
+  /// string: throws InvalidArgument quoting `text` and saying what it must be when it is not of the field's
+  /// `string_format` (a StringFormat::utc_time that is no time of the calendar in UTC).
+  void check_string(std::string_view text) const;
 
   /// "doc [unit], range" for help and docs: "servo rate [Hz], in [100, 100000] Hz".
   [[nodiscard]] std::string description() const;
@@ -333,6 +344,7 @@ struct FieldText {
   std::string_view option = {};
   std::string_view option_value_name = {};
   std::string_view source = {};
+  StringFormat format = StringFormat::any;  ///< a string field's
 };
 
 template <auto Member>
@@ -433,6 +445,7 @@ template <auto Member>
 [[nodiscard]] constexpr SchemaField string_field(std::string_view name, FieldText text) {
   SchemaField f{
       .name = name, .kind = FieldKind::string, .unit = text.unit, .doc = text.doc, .source = text.source};
+  f.string_format = text.format;
   f.option = text.option;
   f.option_value_name = text.option_value_name;
   f.get_string = [](const void* o) -> const std::string& { return schema_detail::cref<Member>(o); };
