@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <iterator>
+#include <optional>
 #include <set>
 #include <unordered_set>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
+#include "calligraphy/study/schedule.hpp"
 #include "calligraphy/trial/writer_profile.hpp"
 #include "core/json_reader.hpp"
 #include "core/schema_json.hpp"
@@ -246,6 +248,23 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
   }
   if (manifest.protocol.protocol.name != read.protocol.name)
     json_detail::fail(source, "/protocol/name", "not the name in the protocol copy");
+  // The group is the one the protocol copy assigns the subject (its number): a group edited in (or markup
+  // put there) would be reported as the subject's. A folder from before groups were kept may lack it.
+  if (!defaulted(missing, "/group")) {
+    std::optional<std::string> assigned;
+    try {
+      assigned = subject_group(manifest.protocol.protocol, manifest.setup.subject);
+    } catch (const InvalidArgument&) {  // a subject number the order cannot place: refused where it is read
+    }
+    if (assigned && *assigned != manifest.group) {
+      json_detail::fail(source, "/group",
+                        "is " + json_detail::describe(json(manifest.group)) +
+                            ", but the protocol copy puts subject " +
+                            std::to_string(manifest.setup.subject.number) + " in " +
+                            (assigned->empty() ? std::string("no group (every phase is within subjects)")
+                                               : "the group '" + *assigned + "'"));
+    }
+  }
   if (read.plan.empty()) json_detail::fail(source, "/plan", "expected a list of planned trials, got none");
   // Only conditions of the protocol can run, or have trained an item.
   const auto known = [&](const std::string& condition) {
