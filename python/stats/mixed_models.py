@@ -85,7 +85,9 @@ class LmerFit:
         if self.singular:
             problems.append(f"singular fit (a variance estimated at 0 or a correlation at +-1: {variances})")
         if not self.converged:
-            problems.append("did not converge: " + self.messages)
+            # lme4's messages break their lines ("very large eigenvalue\n - Rescale variables?"): one line in a
+            # table's cell and a page's sentence.
+            problems.append("did not converge: " + " ".join(self.messages.split()))
         return ("not tested: " + "; ".join(problems)) if problems else f"variances: {variances}"
 
 

@@ -74,3 +74,14 @@ def test_a_forked_child_fits_with_its_own_process():
     assert child.exitcode == 0
     assert queue.get(timeout=5) == pytest.approx(parent, rel=1e-12)
     assert estimate(mixed_models.lmer(frame(), FORMULA, {"condition": ["a", "b"]})) == pytest.approx(parent)
+
+
+def test_a_fits_note_is_one_line_whatever_lme4_writes():
+    fit = mixed_models.LmerFit(formula=FORMULA, ddf="Satterthwaite", fixed=pandas.DataFrame(),
+                               terms=pandas.DataFrame(), variances={}, singular=False, converged=False,
+                               messages="Model is nearly unidentifiable: very large eigenvalue\n - Rescale variables?",
+                               n_observations=0, versions="")
+    note = fit.note("subject 0.1")
+    assert "\n" not in note
+    assert note == ("not tested: did not converge: Model is nearly unidentifiable: very large eigenvalue - Rescale "
+                    "variables?")
