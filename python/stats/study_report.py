@@ -158,6 +158,11 @@ def _integer(x: typing.Any) -> str:
     return str(int(x)) if _finite(x) else "–"
 
 
+def _count(n: int, noun: str) -> str:
+    """"1 trial", "2 trials": a count with its noun in the number it takes."""
+    return f"{n} {noun}{'' if n == 1 else 's'}"
+
+
 def _e(text: typing.Any) -> str:
     return html.escape(str(text), quote=True)
 
@@ -507,10 +512,10 @@ def _header_html(trials: "pandas.DataFrame", title: str, design: "design_analysi
     subjects = trials["subject"].nunique()
     sessions = trials["session"].nunique() if "session" in trials else None
     facts = [f"Protocol{'s' if len(protocols) != 1 else ''} <b>{_e(', '.join(protocols) or 'unnamed')}</b>",
-             f"{subjects} subject{'s' if subjects != 1 else ''}"]
+             _count(subjects, "subject")]
     if sessions is not None:
-        facts.append(f"{sessions} session{'s' if sessions != 1 else ''}")
-    facts.append(f"{len(trials)} trials")
+        facts.append(_count(sessions, "session"))
+    facts.append(_count(len(trials), "trial"))
     parts = [f"<header>\n<h1>{_e(title)}</h1>\n<p class=\"lead\">{' &middot; '.join(facts)}</p>\n",
              f"<p>{_e(design.sentence())}</p>\n"]
     sentence = _subjects_sentence(trials)
@@ -627,8 +632,8 @@ def _subjects_html(trials: "pandas.DataFrame", values: typing.Sequence[str], per
         if "trial" in rows:
             rows = rows.sort_values([c for c in ("session", "trial") if c in rows.columns], kind="stable")
         sessions = rows["session"].nunique() if "session" in rows else 1
-        out.append(f"<details id=\"subject-{_e(_file_name(str(subject)))}\"><summary>{_e(subject)}: {len(rows)} trials"
-                   f" in {sessions} session{'s' if sessions != 1 else ''}</summary>\n<table class=\"subject-trials\">"
+        out.append(f"<details id=\"subject-{_e(_file_name(str(subject)))}\"><summary>{_e(subject)}: {_count(len(rows), 'trial')}"
+                   f" in {_count(sessions, 'session')}</summary>\n<table class=\"subject-trials\">"
                    "<thead><tr>")
         headings = {"trial": "trial #", "repetition": "repetition", "end_reason": "end"}
         out += [f"<th>{_e(headings.get(c, c))}</th>" for c in columns]

@@ -264,10 +264,10 @@ std::string study_index_html(const StudyReportIndex& index, const std::string& i
   std::size_t saved = 0;
   for (const ReportSession& s : index.sessions) saved += s.saved;
   appendf(out,
-          "<p>%zu sessions, %zu trials: one page per session, each trial's trajectory over the reference, "
+          "<p>%zu session%s, %zu trial%s: one page per session, each trial's trajectory over the reference, "
           "its force over time and its own values. The study's summaries and statistics are the study "
           "report's (<code>python3 -m calligraphy.study_report</code>).</p>\n",
-          index.sessions.size(), saved);
+          index.sessions.size(), index.sessions.size() == 1 ? "" : "s", saved, saved == 1 ? "" : "s");
   for (const std::string& note : index.notes) out += "<p class=\"note\">" + escape_markup(note) + "</p>\n";
   out +=
       "<table class=\"sessions\">\n<tr><th>Subject</th><th>Group</th><th>Session</th><th>Trials saved</th>"
