@@ -814,10 +814,14 @@ class Threads(unittest.TestCase):
             rate = (count[0] - first) / 0.05
             share = {}
             for name, call in calls.items():
-                before, started = count[0], time.monotonic()
-                call()
-                took = time.monotonic() - started
-                share[name] = (count[0] - before) / (rate * took)
+                # The best of three tries: on a loaded machine (the other core busy with another test) a call
+                # that releases the GIL may still find the spinner waiting for a core once; one holding it
+                # never lets it run, however often it is tried.
+                for _ in range(1 if name == control else 3):
+                    before, started = count[0], time.monotonic()
+                    call()
+                    took = time.monotonic() - started
+                    share[name] = max(share.get(name, 0.0), (count[0] - before) / (rate * took))
         finally:
             stop.set()
             spinner.join()
