@@ -39,27 +39,13 @@ import unittest
 import warnings
 from pathlib import Path
 
-from outsider import CLI, TIMEOUT_S, error_lines, run, sanitized_subset
+from outsider import TIMEOUT_S, error_lines, run, sanitized_subset
+from outsider_python import cg, needs_cli, needs_pandas, needs_python, np, pd
 
 SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 SHI = "十"
 YI = "一"
 
-try:
-    import numpy as np
-    import calligraphy as cg
-except ImportError:  # pragma: no cover - a build without the Python bindings
-    np = None
-    cg = None
-
-try:
-    import pandas as pd
-except ImportError:  # pragma: no cover
-    pd = None
-
-needs_python = unittest.skipIf(cg is None, "the calligraphy Python package (PYTHONPATH) or numpy is missing")
-needs_pandas = unittest.skipIf(pd is None, "pandas is not installed")
-needs_cli = unittest.skipUnless(CLI, "CALLIGRAPHY_CLI not set")
 
 
 class Shared:

@@ -45,21 +45,10 @@ import unittest
 from pathlib import Path
 
 from outsider import CLI, TIMEOUT_S, sanitized_subset
+from outsider_python import cg, needs_cli, needs_pandas, needs_python, np, pd
 
 SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 YI, SHI = "一", "十"
-
-try:
-    import numpy as np
-    import calligraphy as cg
-except ImportError:  # pragma: no cover - a build without the Python bindings
-    np = None
-    cg = None
-
-try:
-    import pandas as pd
-except ImportError:  # pragma: no cover
-    pd = None
 
 try:
     import dask
@@ -67,9 +56,6 @@ try:
 except ImportError:  # pragma: no cover
     dask = None
 
-needs_python = unittest.skipIf(cg is None, "the calligraphy Python package (PYTHONPATH) or numpy is missing")
-needs_pandas = unittest.skipIf(pd is None, "pandas is not installed")
-needs_cli = unittest.skipUnless(CLI, "CALLIGRAPHY_CLI not set")
 
 load_tests = sanitized_subset({"test_force_functions_of_every_numeric_dtype_and_byte_order",
                                "test_masked_arrays_are_their_data_or_refused_naming_the_argument",
