@@ -485,6 +485,14 @@ summary{cursor:pointer;font-weight:600}details table{margin:.4em 0}
 """
 
 
+def _figure_html(figure: "matplotlib.figure.Figure", stem: str, alt: str, caption: str) -> str:
+    """A saved figure (figures/STEM.svg) on the page at its own width, with its alternative text and caption
+    (plain text, escaped here)."""
+    width_px = round(figure.get_figwidth() * 96)
+    return (f"<figure><img src=\"figures/{_e(stem)}.svg\" width=\"{width_px}\" alt=\"{_e(alt)}\"><figcaption>"
+            f"{_e(caption)}</figcaption></figure>\n")
+
+
 def _quantity_text(text: str, value: str, display: _Display) -> str:
     """A statistics_table label for a table whose caption names the value: '[value]' -> '[unit]', and
     'mean of value' -> 'mean'."""
@@ -1065,12 +1073,10 @@ def _report_set(trials: "pandas.DataFrame", kept: "pandas.DataFrame", exclusions
         stem = f"phase_{_file_name(value)}"
         figure = phase_figure(means, value, design)
         _save_figure(figure, figures, stem, files)
-        width_px = round(figure.get_figwidth() * 96)
-        summary_html.append(
-            f"<figure><img src=\"figures/{_e(stem)}.svg\" width=\"{width_px}\" alt=\"{_e(display.label.capitalize())} "
-            f"by phase and {_factor_name(design)}\"><figcaption>{_e(display.label.capitalize())} by phase and "
-            f"{_factor_name(design)}: {_interval_words(design)} (each subject's analysed trials averaged first; "
-            "n = subjects).</figcaption></figure>\n")
+        summary_html.append(_figure_html(
+            figure, stem, f"{display.label.capitalize()} by phase and {_factor_name(design)}",
+            f"{display.label.capitalize()} by phase and {_factor_name(design)}: {_interval_words(design)} (each "
+            "subject's analysed trials averaged first; n = subjects)."))
         questions = design_analysis.design_questions(trials, value, design, policy=policy, ddf=ddf,
                                                      scale=display.scale, display_unit=display.unit)
         all_questions.append(questions)
@@ -1085,14 +1091,12 @@ def _report_set(trials: "pandas.DataFrame", kept: "pandas.DataFrame", exclusions
             figure = learning_figure(data, value, phase=None,
                                      legend_title="group" if design.kind == "between-subjects" else "condition")
             _save_figure(figure, figures, stem, files)
-            width_px = round(figure.get_figwidth() * 96)
-            learning_html.append(
-                f"<figure><img src=\"figures/{_e(stem)}.svg\" width=\"{width_px}\" "
-                f"alt=\"Learning curves of {_e(display.label)}\"><figcaption>{_e(display.label.capitalize())} over "
-                f"repetitions in {_e(phase)} (counted from 1): per "
-                f"{'group' if design.kind == 'between-subjects' else 'condition'} the mean over subjects "
-                "with its 95 % t interval (n = subjects). Left: all characters; then each character. One y axis for "
-                "all panels.</figcaption></figure>\n")
+            learning_html.append(_figure_html(
+                figure, stem, f"Learning curves of {display.label}",
+                f"{display.label.capitalize()} over repetitions in {phase} (counted from 1): per "
+                f"{'group' if design.kind == 'between-subjects' else 'condition'} the mean over subjects with its "
+                "95 % t interval (n = subjects). Left: all characters; then each character. One y axis for all "
+                "panels."))
     files[table_file["phase_means"]] = _table_csv(pandas.concat(all_means, ignore_index=True))
     files[table_file["questions"]] = _table_csv(pandas.concat(all_questions, ignore_index=True))
     files[table_file["exclusions"]] = _table_csv(exclusions)

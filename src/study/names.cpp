@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -111,6 +112,42 @@ double utc_seconds_of(std::string_view iso8601, const std::string& source, std::
   } catch (const InvalidArgument& e) {
     json_detail::fail(source, std::string(pointer), e.what());
   }
+}
+
+// Names in order with each run of digits read as a number, so that a subject's sessions come in the order
+// they began: the second's "-2" ... "-10" suffixes too (made in one second; "-10" sorts before "-2" as text).
+bool natural_less(const std::string& x, const std::string& y) {
+  const auto digit = [](char c) { return c >= '0' && c <= '9'; };
+  std::size_t i = 0, j = 0;
+  while (i < x.size() && j < y.size()) {
+    if (digit(x[i]) && digit(y[j])) {
+      std::size_t end_i = i, end_j = j;
+      while (end_i < x.size() && digit(x[end_i])) ++end_i;
+      while (end_j < y.size() && digit(y[end_j])) ++end_j;
+      std::size_t zi = i, zj = j;  // leading zeros do not count toward the value
+      while (zi + 1 < end_i && x[zi] == '0') ++zi;
+      while (zj + 1 < end_j && y[zj] == '0') ++zj;
+      const std::string_view u(x.data() + zi, end_i - zi), v(y.data() + zj, end_j - zj);
+      if (u.size() != v.size()) return u.size() < v.size();
+      if (u != v) return u < v;
+      if (end_i - i != end_j - j) return end_i - i < end_j - j;
+      i = end_i;
+      j = end_j;
+    } else {
+      if (x[i] != y[j]) return static_cast<unsigned char>(x[i]) < static_cast<unsigned char>(y[j]);
+      ++i;
+      ++j;
+    }
+  }
+  return x.size() - i < y.size() - j;
+}
+
+// Paths element by element in natural_less order of their names.
+bool session_path_less(const std::filesystem::path& a, const std::filesystem::path& b) {
+  return std::lexicographical_compare(a.begin(), a.end(), b.begin(), b.end(),
+                                      [](const std::filesystem::path& x, const std::filesystem::path& y) {
+                                        return natural_less(x.native(), y.native());
+                                      });
 }
 
 std::uint64_t fnv1a_64(std::string_view text) {

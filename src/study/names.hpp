@@ -33,6 +33,11 @@ std::string session_file_link_message(const std::filesystem::path& path);
 /// (json_detail::fail).
 double utc_seconds_of(std::string_view iso8601, const std::string& source, std::string_view pointer);
 
+/// Names in order with each run of digits read as a number ("S-2" before "S-10"), leading zeros aside.
+bool natural_less(const std::string& x, const std::string& y);
+/// Paths element by element in natural_less order of their names: session folders in the order they began.
+bool session_path_less(const std::filesystem::path& a, const std::filesystem::path& b);
+
 /// 64-bit FNV-1a of `text` (Fowler, Noll & Vo; IETF draft-eastlake-fnv): a stable seed from a name.
 std::uint64_t fnv1a_64(std::string_view text);
 /// SplitMix64's finaliser (Steele, Lea & Flood 2014, "Fast splittable pseudorandom number generators",

@@ -21,7 +21,7 @@ std::vector<fs::path> session_folders_under(const std::vector<fs::path>& roots) 
   for (const fs::path& root : roots) {
     for (fs::path& folder : find_session_folders(root)) folders.push_back(std::move(folder));
   }
-  std::sort(folders.begin(), folders.end());
+  std::sort(folders.begin(), folders.end(), session_path_less);  // as find_session_folders orders them
   if (folders.empty()) {
     // The first few folders given, and how many more: a shell glob may give thousands.
     constexpr std::size_t kNamed = 3;

@@ -694,41 +694,6 @@ void walk_session_tree(const fs::path& root, bool strict, OnSession on_session, 
   if (error) listing_failed();
 }
 
-// Names in order with each run of digits read as a number, so that a subject's sessions come in the order
-// they began: the second's "-2" ... "-10" suffixes too (made in one second; "-10" sorts before "-2" as text).
-bool natural_less(const std::string& x, const std::string& y) {
-  const auto digit = [](char c) { return c >= '0' && c <= '9'; };
-  std::size_t i = 0, j = 0;
-  while (i < x.size() && j < y.size()) {
-    if (digit(x[i]) && digit(y[j])) {
-      std::size_t end_i = i, end_j = j;
-      while (end_i < x.size() && digit(x[end_i])) ++end_i;
-      while (end_j < y.size() && digit(y[end_j])) ++end_j;
-      std::size_t zi = i, zj = j;  // leading zeros do not count toward the value
-      while (zi + 1 < end_i && x[zi] == '0') ++zi;
-      while (zj + 1 < end_j && y[zj] == '0') ++zj;
-      const std::string_view u(x.data() + zi, end_i - zi), v(y.data() + zj, end_j - zj);
-      if (u.size() != v.size()) return u.size() < v.size();
-      if (u != v) return u < v;
-      if (end_i - i != end_j - j) return end_i - i < end_j - j;
-      i = end_i;
-      j = end_j;
-    } else {
-      if (x[i] != y[j]) return static_cast<unsigned char>(x[i]) < static_cast<unsigned char>(y[j]);
-      ++i;
-      ++j;
-    }
-  }
-  return x.size() - i < y.size() - j;
-}
-
-// Paths element by element in natural_less order of their names.
-bool session_path_less(const fs::path& a, const fs::path& b) {
-  return std::lexicographical_compare(
-      a.begin(), a.end(), b.begin(), b.end(),
-      [](const fs::path& x, const fs::path& y) { return natural_less(x.native(), y.native()); });
-}
-
 // Whether `folder` (followed if it is a link) is a session folder or holds one, links inside it not followed.
 bool holds_sessions(const fs::path& folder) {
   if (names_a_session(folder)) return true;
@@ -767,7 +732,7 @@ std::vector<fs::path> find_session_folders(const fs::path& root) {
         }
         return false;
       });
-  std::sort(found.begin(), found.end(), session_path_less);
+  std::sort(found.begin(), found.end(), study_detail::session_path_less);
   return found;
 }
 

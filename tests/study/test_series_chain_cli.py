@@ -88,8 +88,10 @@ class SeriesChainTest(unittest.TestCase):
         self.assertEqual(done.returncode, 0, done.stderr.decode())
         sessions = self.sessions()
         manifest = sessions[1] / "session.json"
-        manifest.write_text(manifest.read_text(encoding="utf-8").replace('"group": ""', '"group": "  "'),
-                            encoding="utf-8")
+        # Another file of the same content (a key's spacing changed): a group edited in would be refused as such.
+        text = manifest.read_text(encoding="utf-8")
+        self.assertIn('"group": ""', text)
+        manifest.write_text(text.replace('"group": ""', '"group":""'), encoding="utf-8")
         result = self.run_subject()
         self.assert_refused(result, "/previous_session/session_sha256", str(manifest.relative_to(self.cwd)))
 
@@ -101,8 +103,10 @@ class SeriesChainTest(unittest.TestCase):
         for record in (sessions[2] / "trials").glob("*.json"):
             record.unlink()  # unsaved again: the resume writes it with the memory of session 1
         manifest = sessions[1] / "session.json"
-        manifest.write_text(manifest.read_text(encoding="utf-8").replace('"group": ""', '"group": "  "'),
-                            encoding="utf-8")
+        # Another file of the same content (a key's spacing changed): a group edited in would be refused as such.
+        text = manifest.read_text(encoding="utf-8")
+        self.assertIn('"group": ""', text)
+        manifest.write_text(text.replace('"group": ""', '"group":""'), encoding="utf-8")
         resumed = self.run_cli("session", "resume", sessions[2])
         self.assert_refused(resumed, "/previous_session/session_sha256", str(manifest.relative_to(self.cwd)))
 
