@@ -40,7 +40,8 @@ import warnings
 from pathlib import Path
 
 from outsider import TIMEOUT_S, error_lines, run, sanitized_subset
-from outsider_python import cg, needs_cli, needs_pandas, needs_python, np, pd
+from outsider_python import (SharedTrial, cg, needs_cli, needs_pandas, needs_python, np, pd,
+                             remove_shared_trial)
 
 SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 SHI = "十"
@@ -48,24 +49,11 @@ YI = "一"
 
 
 
-class Shared:
-    """One trial of 十 (seed 1) from Python with its trace, its columns and a temporary folder."""
-    folder = None
-
-    @classmethod
-    def get(cls):
-        if cls.folder is None:
-            cls.folder = Path(tempfile.mkdtemp(prefix="unseen12i-"))
-            cls.trial = cg.simulate_trial(SHI, seed=1)
-            p = cls.trial.position_m
-            cls.columns = {"t": cls.trial.time_s, "x": p[:, 0], "y": p[:, 1], "z": p[:, 2]}
-            cls.reference = cg.score(cls.columns, SHI)
-        return cls
+Shared = SharedTrial  # one trial of 十 (seed 1), made once
 
 
 def tearDownModule():
-    if Shared.folder is not None:
-        shutil.rmtree(Shared.folder, ignore_errors=True)
+    remove_shared_trial()
 
 
 def without(record, *keys):

@@ -37,7 +37,6 @@ import pickle
 import shutil
 import subprocess
 import sys
-import tempfile
 import textwrap
 import threading
 import time
@@ -45,7 +44,8 @@ import unittest
 from pathlib import Path
 
 from outsider import CLI, TIMEOUT_S, sanitized_subset
-from outsider_python import cg, needs_cli, needs_pandas, needs_python, np, pd
+from outsider_python import (SharedTrial, cg, needs_cli, needs_pandas, needs_python, np, pd,
+                             remove_shared_trial)
 
 SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 YI, SHI = "一", "十"
@@ -64,24 +64,11 @@ load_tests = sanitized_subset({"test_force_functions_of_every_numeric_dtype_and_
                                "test_every_value_type_copies_and_pickles_or_refuses_by_name"})
 
 
-class Shared:
-    """One trial of 十 (seed 1), its columns and score, made once; a temporary folder."""
-    folder = None
-
-    @classmethod
-    def get(cls):
-        if cls.folder is None:
-            cls.folder = Path(tempfile.mkdtemp(prefix="unseen16d-"))
-            cls.trial = cg.simulate_trial(SHI, seed=1)
-            p = cls.trial.position_m
-            cls.columns = {"t": cls.trial.time_s, "x": p[:, 0], "y": p[:, 1], "z": p[:, 2]}
-            cls.reference = cg.score(cls.columns, SHI)
-        return cls
+Shared = SharedTrial  # one trial of 十 (seed 1), made once
 
 
 def tearDownModule():
-    if Shared.folder is not None:
-        shutil.rmtree(Shared.folder, ignore_errors=True)
+    remove_shared_trial()
 
 
 def python(code, timeout=TIMEOUT_S, env=None):
