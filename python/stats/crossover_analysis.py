@@ -188,9 +188,9 @@ def _fit_rows(frame: "pandas.DataFrame", fixed: list[str], base: dict, design: "
     sets, no_set = _set_terms(frame, fixed)
     fixed = fixed + sets
     model = f"{value} ~ " + " + ".join(fixed)
-    if design.control not in levels or len(levels) < 2 or frame["subject"].nunique() < 3:
-        return design_models.not_computed_rows(base, design.conditions, design.control, "not computed: fewer than 2 "
-                                               "conditions with values or fewer than 3 subjects", model=model)
+    too_few = design_models.too_few_to_fit(levels, design.control, frame["subject"].nunique())
+    if too_few:
+        return design_models.not_computed_rows(base, design.conditions, design.control, too_few, model=model)
     try:
         fit, dropped = _fit(frame, fixed, factors, ddf, units)
     except RuntimeError as error:  # RUnavailable among them: R or its packages missing

@@ -364,9 +364,9 @@ def _training_rows(data: pandas.DataFrame, value: str, design: StudyDesign, ddf:
                               "subject": rows_of["subject"].astype(str).to_numpy(),
                               "item": rows_of["characters"].astype(str).to_numpy()})
     levels = [c for c in design.conditions if c in set(frame["factor"])]
-    if len(levels) < 2 or design.control not in levels or frame["subject"].nunique() < 3:
-        return design_models.not_computed_rows(base, design.conditions, design.control, "not computed: fewer than "
-                                               "2 conditions with values or fewer than 3 subjects")
+    too_few = design_models.too_few_to_fit(levels, design.control, frame["subject"].nunique())
+    if too_few:
+        return design_models.not_computed_rows(base, design.conditions, design.control, too_few)
     # The documented reduction (design_models.fit_reduced): within subjects the slope's compound-symmetry form
     # is an intercept per subject and one per subject and condition.
     terms = ["(1 | subject)"] + (["(1 | subject:factor)"] if within else []) + items

@@ -292,6 +292,18 @@ def planned_comparisons(levels: list[str], control: str) -> list[str]:
     return [f"{level} - {control}" for level in others] + pairs
 
 
+def too_few_to_fit(levels: typing.Sequence[str], control: str, subjects: int) -> typing.Optional[str]:
+    """Why a mixed model of ``levels`` (the conditions or groups with values) against ``control`` over ``subjects``
+    cannot be fitted, naming what is short ("not computed: ..."); None when it can be."""
+    if control not in levels:
+        return f"not computed: the control '{control}' has no values"
+    if len(levels) < 2:
+        return "not computed: only one condition has values (a comparison needs 2)"
+    if subjects < 3:
+        return f"not computed: {subjects} subject{'' if subjects == 1 else 's'} with values (the model needs at least 3)"
+    return None
+
+
 def not_computed_rows(base: dict, levels: list[str], control: str, note: str, **kw) -> list[dict]:
     """One row per planned comparison of ``levels`` (``planned_comparisons``), each with the same note: why
     none was computed. The rows name the contrasts a reader looks for, not only the factor."""

@@ -250,3 +250,16 @@ def test_without_r_the_mixed_model_is_not_computed_and_says_why(monkeypatch):
     assert list(training.comparison) == [f"{g} - {GROUPS[0]}" for g in GROUPS[1:]] + [f"{GROUPS[2]} - {GROUPS[1]}"]
     assert training.note.str.startswith("not computed: Rscript is not installed").all() and training.p.isna().all()
     assert questions[questions.phase == "post-test"].p.notna().all()  # the ANCOVA needs no R
+
+
+def test_a_model_not_fitted_for_too_few_values_says_what_is_short():
+    from calligraphy import design_models
+    assert design_models.too_few_to_fit(["unguided", "fixture"], "unguided", 3) is None
+    assert design_models.too_few_to_fit(["unguided", "fixture"], "unguided", 2) == (
+        "not computed: 2 subjects with values (the model needs at least 3)")
+    assert design_models.too_few_to_fit(["unguided", "fixture"], "unguided", 1) == (
+        "not computed: 1 subject with values (the model needs at least 3)")
+    assert design_models.too_few_to_fit(["unguided"], "unguided", 8) == (
+        "not computed: only one condition has values (a comparison needs 2)")
+    assert design_models.too_few_to_fit(["fixture"], "unguided", 8) == (
+        "not computed: the control 'unguided' has no values")
