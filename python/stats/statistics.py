@@ -328,7 +328,8 @@ class PairedComparison:
     ``scipy.stats.wilcoxon``; NaN when every difference is 0); ``d_z`` = mean difference / sd of the
     differences, ``d_av`` = mean difference / mean of the two conditions' sds (Lakens 2013, eqs. 6 and 10),
     ``g_av`` = d_av x (1 - 3 / (4 df - 1)), Hedges' small-sample correction with the paired test's df
-    (Hedges 1981; Lakens 2013's eq. 4 is the same with df = n1 + n2 - 2); ``power``, the power of
+    (Hedges 1981; Lakens 2013's eq. 4 is the same with df = n1 + n2 - 2; NaN with 2 subjects, whose df of 1
+    makes the correction 0); ``power``, the power of
     a two-sided paired t-test at alpha .05 with n subjects for an effect of |d_z|, and
     ``n_for_80_percent_power``, the subjects such a test needs for power 0.8 at that effect, rounded up
     (Cohen 1988, ``statsmodels.stats.power.TTestPower``; NaN when d_z is 0 or undefined); ``test`` and
@@ -481,8 +482,9 @@ def paired_comparison(trials: pandas.DataFrame, value: str, a: typing.Any, b: ty
     d_z = mean_difference / sd_difference if sd_difference > 0 else math.nan
     sd_average = (np.std(x, ddof=1) + np.std(y, ddof=1)) / 2.0
     d_av = mean_difference / sd_average if sd_average > 0 else math.nan
-    # Hedges' approximation of the bias correction, with the paired test's df (Hedges 1981).
-    g_av = d_av * (1.0 - 3.0 / (4.0 * df - 1.0))
+    # Hedges' approximation of the bias correction, with the paired test's df (Hedges 1981). At df = 1 (two
+    # subjects) the correction is 0, exactly as the exact one is: a g of 0 beside any d would be no estimate.
+    g_av = d_av * (1.0 - 3.0 / (4.0 * df - 1.0)) if df >= 2 else math.nan
     power = needed = math.nan
     if math.isfinite(d_z) and d_z != 0:
         power = _power(TTestPower(), abs(d_z), n)

@@ -3,6 +3,7 @@ statsmodels computed independently, intervals cover, the mixed model recovers a 
 input is named."""
 
 import itertools
+import math
 import subprocess
 import sys
 import warnings
@@ -139,6 +140,9 @@ def test_effect_sizes_on_constructed_differences():
     # Hedges' correction shrinks the estimate by 3 / (4 df - 1), df = n - 1.
     assert result.g_av == pytest.approx(d_av * (1 - 3 / (4 * (n - 1) - 1)), rel=1e-9)
     assert abs(result.g_av) < abs(result.d_av)
+    # Two subjects (df = 1): the correction is 0, so no g is given beside the d.
+    two = statistics.paired_comparison(one_trial_per_condition(a_values[:2], b_values[:2]), VALUE, "a", "b")
+    assert math.isfinite(two.d_av) and math.isnan(two.g_av)
 
 
 def test_power_and_the_subjects_needed_for_80_percent():
