@@ -520,12 +520,13 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
         } else if (command.ignore_delay) {
           previous->delay = SessionDelay::overridden;
         } else {
-          throw StateError(subjects[i].id + ": session " + std::to_string(series.next) + " of " +
-                           protocol.protocol.name + " is due " + shortest_decimal(previous->delay_s) +
-                           " s after session " + std::to_string(series.next - 1) + " ended (" +
-                           previous->ended_utc + "); " +
-                           std::to_string(static_cast<long long>(previous->delay_s - previous->elapsed_s)) +
-                           " s to go. --ignore-delay starts it now (recorded as overridden)");
+          throw StateError(
+              subjects[i].id + ": session " + std::to_string(series.next) + " of " + protocol.protocol.name +
+              " is due " + shortest_decimal(previous->delay_s) + " s after session " +
+              std::to_string(series.next - 1) + " ended (" + previous->ended_utc + "); " +
+              // rounded up: "0 s to go" of a session not yet due would say it is
+              std::to_string(static_cast<long long>(std::ceil(previous->delay_s - previous->elapsed_s))) +
+              " s to go. --ignore-delay starts it now (recorded as overridden)");
         }
       }
       SessionFolder session =
