@@ -178,6 +178,16 @@ void check_record_is_the_plans(const json& document, const std::string& source, 
   }
 }
 
+// The saved record `json_file` of the session's trial `plan`, read and checked to be that trial's: its
+// session's (check_record_is_the_sessions) and its plan's (check_record_is_the_plans).
+json read_sessions_record(const fs::path& json_file, const SessionManifest& manifest,
+                          const PlannedTrial& plan) {
+  json document = study_detail::read_trial_record(json_file);
+  check_record_is_the_sessions(document, json_file.string(), manifest);
+  check_record_is_the_plans(document, json_file.string(), plan);
+  return document;
+}
+
 // The tidy tables' rows of the saved trial whose record `document` was read from `json_file`: the one
 // reading of a record into rows, for the tables alone and beside the pages.
 void append_trial_rows(const json& document, const fs::path& json_file, const SessionManifest& manifest,
@@ -193,9 +203,7 @@ void append_trial_rows(const json& document, const fs::path& json_file, const Se
 ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifest, const PlannedTrial& plan,
                        StudyTables* rows) {
   const std::string source = json_file.string();
-  const json document = study_detail::read_trial_record(json_file);
-  check_record_is_the_sessions(document, source, manifest);
-  check_record_is_the_plans(document, source, plan);
+  const json document = read_sessions_record(json_file, manifest, plan);
   const json_detail::JsonView record(document, "", source);
   // the tidy tables' rows from the same parse of the record
   if (rows != nullptr) append_trial_rows(document, json_file, manifest, plan, *rows);
@@ -383,9 +391,7 @@ void read_session_rows(const ReportedSession& session, StudyTables& rows) {
   for (const PlannedTrial& plan : session.manifest.plan) {
     if (!is_saved(session.folder, plan)) continue;  // not saved (yet): a running session can be read
     const fs::path json_file = trial_record_file(session.folder, plan);
-    const json document = study_detail::read_trial_record(json_file);
-    check_record_is_the_sessions(document, json_file.string(), session.manifest);
-    check_record_is_the_plans(document, json_file.string(), plan);
+    const json document = read_sessions_record(json_file, session.manifest, plan);
     append_trial_rows(document, json_file, session.manifest, plan, rows);
   }
 }
