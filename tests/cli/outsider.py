@@ -67,3 +67,18 @@ def sanitized_subset(names):
         walk(tests)
         return chosen
     return load_tests
+
+
+def strip_comment(line):
+    """A shell line without its trailing `# comment` (a `#` outside quotes at the start or after a space), and
+    the comment; a line with none as it is, right-stripped, and ""."""
+    quote = None
+    for i, ch in enumerate(line):
+        if quote:
+            if ch == quote:
+                quote = None
+        elif ch in "'\"":
+            quote = ch
+        elif ch == "#" and (i == 0 or line[i - 1] in " \t"):
+            return line[:i].rstrip(), line[i + 1:].strip()
+    return line.rstrip(), ""

@@ -37,6 +37,8 @@ import tempfile
 import unittest
 from xml.etree import ElementTree
 
+from outsider import strip_comment
+
 SOURCE = os.environ.get("CALLIGRAPHY_SOURCE_DIR", os.path.dirname(os.path.dirname(os.path.dirname(
     os.path.abspath(__file__)))))
 CLI = os.environ.get("CALLIGRAPHY_CLI", "")
@@ -84,19 +86,6 @@ def logical_lines(text):
         current = ""
     return out
 
-
-def strip_comment(line):
-    """The command without its trailing `# ...` remark (a `#` outside quotes after a space)."""
-    quote = None
-    for i, ch in enumerate(line):
-        if quote:
-            if ch == quote:
-                quote = None
-        elif ch in "'\"":
-            quote = ch
-        elif ch == "#" and i > 0 and line[i - 1] in " \t":
-            return line[:i].rstrip(), line[i + 1:].strip()
-    return line, ""
 
 
 def extract(doc):

@@ -46,7 +46,7 @@ import unittest
 import contextlib
 from pathlib import Path
 
-from outsider import CLI, SANITIZED, sanitized_subset
+from outsider import CLI, SANITIZED, sanitized_subset, strip_comment
 
 SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 PYTHONPATH = os.environ.get("PYTHONPATH", "").split(os.pathsep)[0]
@@ -77,19 +77,6 @@ class Example:
         first = self.text.strip().splitlines()[0] if self.text.strip() else ""
         return f"{self.doc}:{self.line} [{self.kind}] {first[:110]}"
 
-
-def strip_comment(line):
-    """A shell line without its trailing `# comment` (outside quotes), and the comment."""
-    quote = None
-    for i, ch in enumerate(line):
-        if quote:
-            if ch == quote:
-                quote = None
-        elif ch in "'\"":
-            quote = ch
-        elif ch == "#" and (i == 0 or line[i - 1] in " \t"):
-            return line[:i].rstrip(), line[i + 1:].strip()
-    return line.rstrip(), ""
 
 
 def comment_run(lines, index):
