@@ -783,9 +783,9 @@ class Threads(unittest.TestCase):
         spinner = threading.Thread(target=spin)
         spinner.start()
         try:
-            first = count[0]
-            time.sleep(0.05)  # the spinner alone: its rate of Python steps
-            rate = (count[0] - first) / 0.05
+            first, started = count[0], time.monotonic()
+            time.sleep(0.1)  # the spinner alone: its rate of Python steps
+            rate = (count[0] - first) / (time.monotonic() - started)
             share = {}
             for name, call in calls.items():
                 # The best of three tries: on a loaded machine (the other core busy with another test) a call
@@ -803,9 +803,13 @@ class Threads(unittest.TestCase):
         # in the switch intervals (5 ms) at the call's two ends; released, it runs on the other core or between
         # the call's ticks. The control, a call that holds the GIL, shows that the measure tells the two apart.
         # (match_stroke, also documented to release it, takes under a millisecond: too short to tell.)
-        self.assertLess(share.pop(control), 0.12, "the control kept its pace: the measure cannot tell")
+        # The spinner's pace is measured once, over 0.1 s, so on a loaded machine every share may come out high
+        # by the same factor: the control is judged against the calls, not against a fixed figure.
+        held = share.pop(control)
         for name, kept in share.items():
             self.assertGreater(kept, 0.2, f"{name}: the spinning thread kept {kept:.0%} of its pace")
+            self.assertLess(held, kept / 3, f"the control kept {held:.0%} of its pace, {name} {kept:.0%}: "
+                            "the measure cannot tell the two apart")
 
 
 # --- Dask ------------------------------------------------------------------------------------------------------
