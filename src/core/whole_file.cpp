@@ -1,8 +1,13 @@
 #include "core/whole_file.hpp"
 
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
-#include <fstream>
+#include <array>
+#include <cerrno>
+#include <cstring>
+#include <memory>
 
 #include "calligraphy/core/errors.hpp"
 
@@ -25,13 +30,28 @@ std::uintmax_t regular_file_size(const std::filesystem::path& path, std::uintmax
 
 std::string read_regular_file(const std::filesystem::path& path, std::uintmax_t max_bytes) {
   const std::string name = path.string();
-  const std::uintmax_t size = regular_file_size(path, max_bytes);
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw DataError(name + ": cannot be opened");
-  std::string text(static_cast<std::size_t>(size), '\0');
-  in.read(text.data(), static_cast<std::streamsize>(size));
-  if (static_cast<std::uintmax_t>(in.gcount()) != size) throw DataError(name + ": could not be read whole");
-  return text;
+  (void)regular_file_size(path, max_bytes);
+  // O_NONBLOCK: a FIFO put in the file's place since the check above is refused below, never waited on.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) throw DataError(name + ": cannot be opened (" + std::strerror(errno) + ")");
+  const std::unique_ptr<const int, void (*)(const int*)> closer(&fd, [](const int* f) { ::close(*f); });
+  struct stat status {};
+  if (::fstat(fd, &status) != 0 || !S_ISREG(status.st_mode)) throw DataError(name + ": not a regular file");
+  // Read to its end, not to the size stat(2) gave: a /proc file says 0 bytes and has content, and a file
+  // that grows or shrinks meanwhile is read as it then is; never more than max_bytes.
+  std::string text;
+  std::array<char, 65536> buffer{};
+  for (;;) {
+    const ssize_t got = ::read(fd, buffer.data(), buffer.size());
+    if (got < 0 && errno == EINTR) continue;
+    if (got < 0) throw DataError(name + ": could not be read whole (" + std::strerror(errno) + ")");
+    if (got == 0) return text;
+    if (text.size() + static_cast<std::size_t>(got) > max_bytes) {
+      throw DataError(name + ": more bytes than the limit of " + std::to_string(max_bytes) +
+                      " (it grew while it was read)");
+    }
+    text.append(buffer.data(), static_cast<std::size_t>(got));
+  }
 }
 
 const char* file_kind(mode_t mode) noexcept {

@@ -12,8 +12,9 @@ namespace calligraphy {
 /// it does not exist, is not a regular file, or is larger than `max_bytes`.
 [[nodiscard]] std::uintmax_t regular_file_size(const std::filesystem::path& path, std::uintmax_t max_bytes);
 
-/// The bytes of the regular file `path`. Throws DataError naming the path when it does not exist, is not a
-/// regular file (a device or FIFO is never read), is larger than `max_bytes`, or cannot be read whole.
+/// The bytes of the regular file `path`, read to its end (a /proc file, whose size stat(2) gives as 0, too).
+/// Throws DataError naming the path when it does not exist, is not a regular file (a device or FIFO is never
+/// read), is larger than `max_bytes` (or grows past it while read), or cannot be read whole.
 [[nodiscard]] std::string read_regular_file(const std::filesystem::path& path, std::uintmax_t max_bytes);
 
 /// What a file that is not regular is, for messages: "a directory", "a FIFO", "a character device", ...
