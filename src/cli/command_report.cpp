@@ -99,6 +99,16 @@ int run_report(const ReportCommand& command) {
   FilePlan files;
   for (const std::string& folder : command.folders) add_saved_sessions(files, "DIR", folder);
   files.set_output("--out", command.out);
+  if (!command.out.empty()) {
+    // The pages go in NAME_files/ beside the index page: beside a device or FIFO, written in place, that
+    // would be a folder in /dev (`--out /dev/null`). So, as '-', it is refused: the pages need a folder.
+    const FilePlan::Identity index = identify_file("--out", command.out);
+    if (index.exists && !index.regular && !index.folder) {
+      throw UsageError("--out " + command.out +
+                       ": not a regular file (a device, FIFO or socket): the session pages go in a folder "
+                       "beside the index page; give a file name");
+    }
+  }
   const fs::path tables_folder(command.csv);
   if (!command.csv.empty()) {
     files.existing_output_folder("--csv", command.csv);
