@@ -10,22 +10,21 @@ middling ones. For each: `model` as text, JSON and SVG (its stroke count and typ
 strokes numbered from 1 for people, every typical stroke one of the documented 39), `trial --json` (the simulated
 writer writes every stroke, in order), `score` of the trial's own trace (every stroke accepted, the trial's
 metrics), Python's `CharacterLibrary.default().load` (the model's numbers, the store's medians) and `simulate_trial`
-(the command line's metrics). `characters` by stroke counts at 0, 1, the listing's maximum, past it, 255 and 256;
-by every documented spelling of every typical stroke and by names that are none; by a text with duplicates, white
-space, Latin letters, punctuation and the odd characters below (named once each, with its code point, exit 0).
-What a person types where a character is expected (`model`, `trial`, `score --character`, a protocol's test
-characters through `session plan`, Python's `load`, `Scene` and `simulate_trial`): two characters, nothing, a
-space, an ideographic space, a kana, a Hangul syllable and its jamo (NFD), U+20000, the Kangxi radical U+2F00
-beside 一, the compatibility ideograph U+F900 beside 豈 U+8C48, 永 with the variation selector U+FE00, a combining
-acute accent, a fullwidth digit, a lone surrogate (Python) and bytes that are no UTF-8 (the command line): each one
-error line naming the character and its code point (or the bytes), the documented status, nothing written, never
-another character's strokes.
+(the command line's metrics); three of them through `session run` (each record its character's, its trace scored).
+`characters` by stroke counts at 0, 1, the listing's maximum, past it, 255 and 256; by every typical stroke, spelt
+in turn each documented way, and by names that are none; by a text with duplicates, white space, Latin letters,
+punctuation and the odd characters below (named once each, with its code point, exit 0). What a person types where a
+character is expected (`model`, `trial`, `score --character`, a protocol's test characters through `session plan`,
+Python's `load`, `Scene` and `simulate_trial`): two characters, nothing, a space, an ideographic space, a kana, a
+Hangul syllable and its jamo (NFD), U+20000, the Kangxi radical U+2F00 beside 一, the compatibility ideograph U+F900
+beside 豈 U+8C48, 永 with the variation selector U+FE00, a combining acute accent, a fullwidth digit, a lone surrogate
+(Python) and bytes that are no UTF-8 (the command line): each one error line naming the character and its code point
+(or the bytes), the documented status, nothing written, never another character's strokes.
 
 CALLIGRAPHY_CLI names the program, PYTHONPATH its Python module, CALLIGRAPHY_SOURCE_DIR the sources.
 CALLIGRAPHY_SANITIZED=1 takes five cases.
 """
 import json
-import math
 import os
 import random
 import re
@@ -503,7 +502,7 @@ class Protocols(unittest.TestCase, OneErrorLine):
         path = SHARED["root"] / name
         path.write_text(json.dumps({"name": "r17b", "conditions": [{"name": "V", "mode": "vision"}],
                                     "test": {"characters": characters, "conditions": ["V"], "repetitions": 1},
-                                    "trial": {"max_duration_s": 5}}, ensure_ascii=False), encoding="utf-8")
+                                    "trial": {"max_duration_s": 120}}, ensure_ascii=False), encoding="utf-8")
         return name
 
     def test_session_plan_of_random_corpus_characters(self):
@@ -513,6 +512,25 @@ class Protocols(unittest.TestCase, OneErrorLine):
         items = [item for session in plan["subjects"][0]["sessions"] for phase in session["phases"]
                  for item in phase["items"]]
         self.assertEqual(sorted(items), sorted(picks))
+
+    def test_session_run_writes_random_corpus_characters(self):
+        # docs/experiments.md: each trial saved as trials/STEM.json and STEM.trace.h5, STEM ending in the
+        # character's code point (`U6C38`); `score STEM.trace.h5 --character C` scores it again.
+        picks, rows = SHARED["picks"][:3], SHARED["rows"]
+        name = self.protocol("run.json", picks)
+        cli(["session", "run", name, "--writer", "simulated", "--subjects", "1", "--out", "run-study"])
+        records = sorted((SHARED["root"] / "run-study").glob("S01/*/trials/*.json"))
+        self.assertEqual(len(records), len(picks))
+        for path, ch in zip(records, picks):
+            record = json.loads(path.read_text(encoding="utf-8"))
+            self.assertTrue(path.stem.endswith(f"-U{ord(ch):04X}"), path.name)
+            self.assertEqual(record["characters"], ch)
+            self.assertEqual((record["end_reason"], record["strokes_completed"], record["strokes_assisted"]),
+                             ("completed", rows[ch]["strokes"], 0), path.name)
+            self.assertEqual([s["typical_id"] for s in record["per_stroke"]], rows[ch]["typical_ids"])
+            trace = path.with_name(path.stem + ".trace.h5")
+            score = json.loads(cli(["score", str(trace), "--character", ch, "--json", "-"]).stdout)
+            self.assertEqual(score["strokes_accepted"], rows[ch]["strokes"], path.name)
 
     def test_session_plan_names_an_odd_character_at_its_pointer(self):
         for ch, cp in ODD + [("永\ufe00", "U+FE00")]:
