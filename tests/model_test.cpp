@@ -131,6 +131,16 @@ TEST_CASE("UTF-8 round trip and malformed input", "[model]") {
   CHECK(encode_utf8(U'永') == "永");
   CHECK_THROWS_AS(decode_utf8("\xE6\xB0"), InvalidArgument);
   CHECK_THROWS_AS(decode_utf8("\xC0\x80"), InvalidArgument);
+  // The message shows the bytes at fault, from the sequence's first byte through the one that broke it.
+  CHECK_THROWS_WITH(decode_utf8("a\xE6\xB0"), "malformed UTF-8 at byte 1 (\\xe6\\xb0): truncated sequence");
+  CHECK_THROWS_WITH(decode_utf8("\xE6\xB0"
+                                "b"),
+                    Catch::Contains("(\\xe6\\xb0\\x62): invalid continuation byte"));
+  CHECK_THROWS_WITH(decode_utf8("\xED\xA0\x80"),
+                    Catch::Contains("(\\xed\\xa0\\x80): not a Unicode scalar value"));
+  CHECK_THROWS_WITH(decode_utf8("\xFF"), Catch::Contains("(\\xff): invalid lead byte"));
+  CHECK(describe_characters(U"永\uFE00") == "永 (U+6C38), \uFE00 (U+FE00)");
+  CHECK(describe_characters(U"一二三", 2) == "一 (U+4E00), 二 (U+4E8C), ... (1 more)");
 }
 
 TEST_CASE("A scene holds at most kMaxSceneCharacters characters", "[model]") {

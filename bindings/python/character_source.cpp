@@ -57,8 +57,9 @@ std::string CharacterSource::description() const {
 char32_t one_character(const std::string& text, const std::string& name) {
   const std::u32string chars = decode_utf8(text);
   if (chars.size() != 1) {
-    throw InvalidArgument(name + ": expected exactly one character, got " + std::to_string(chars.size()) +
-                          " in '" + text + "'");
+    throw InvalidArgument(
+        name + ": expected exactly one character, got " + std::to_string(chars.size()) +
+        (chars.empty() ? std::string(" (an empty string)") : ": " + describe_characters(chars)));
   }
   return chars[0];
 }

@@ -256,7 +256,8 @@ void bind_character(py::module_& m) {
           "(len(elements) + 1, 2) float64, data units: the element joints")
       .def_property_readonly(
           "median", [](const Stroke& s) { return read_only(points_to_array(s.median)); },
-          "(M, 2) float64, data units: the source median polyline (empty for a corpus store's character)")
+          "(M, 2) float64, data units: the source median polyline (also from the bundled store and any "
+          "format 1.1 corpus store; empty only for a character of a format 1.0 store)")
       .def("__repr__", [](const Stroke& s) {
         return "<Stroke " + std::string(typical_stroke(s.typical_id).acronym) + " (" +
                std::to_string(s.typical_id) + "), " + std::to_string(s.elements.size()) + " element(s)>";

@@ -4,6 +4,7 @@
 #include <memory>
 #include <string>
 
+#include "calligraphy/core/unicode.hpp"
 #include "calligraphy/report/model_report.hpp"
 #include "calligraphy/report/model_svg.hpp"
 #include "cli/commands.hpp"
@@ -23,7 +24,10 @@ struct ModelCommand {
 int run_model(const ModelCommand& command) {
   require_one_standard_output({{"--json", command.json}, {"--svg -", command.svg == "-"}});
   const std::u32string chars = characters_from(command.character, "CHAR");
-  if (chars.size() != 1) throw UsageError("CHAR: expects one character, got " + std::to_string(chars.size()));
+  if (chars.size() != 1) {
+    throw UsageError("CHAR: expects one character, got " + std::to_string(chars.size()) + ": " +
+                     describe_characters(chars));
+  }
   FilePlan files;
   add_library_inputs(files, command.library);
   files.output("--svg", command.svg);

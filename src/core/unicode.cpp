@@ -10,8 +10,17 @@ namespace calligraphy {
 std::u32string decode_utf8(std::string_view text) {
   std::u32string out;
   std::size_t i = 0;
-  const auto fail = [&](const char* what) {
-    throw InvalidArgument("malformed UTF-8 at byte " + std::to_string(i) + ": " + what);
+  // The message shows the bytes at fault as `\xHH` (docs/cli.md: bytes that are not UTF-8 are printed so),
+  // from the sequence's first byte through the one that broke it, so that a person sees what was typed or
+  // pasted.
+  const auto fail = [&](const char* what, std::size_t length) {
+    std::string bytes;
+    for (std::size_t k = i; k < i + length && k < text.size(); ++k) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02x", static_cast<unsigned>(static_cast<unsigned char>(text[k])));
+      bytes += hex;
+    }
+    throw InvalidArgument("malformed UTF-8 at byte " + std::to_string(i) + " (" + bytes + "): " + what);
   };
   while (i < text.size()) {
     const auto lead = static_cast<unsigned char>(text[i]);
@@ -29,17 +38,19 @@ std::u32string decode_utf8(std::string_view text) {
       extra = 3;
       cp = lead & 0x07;
     } else {
-      fail("invalid lead byte");
+      fail("invalid lead byte", 1);
     }
-    if (i + static_cast<std::size_t>(extra) >= text.size() && extra > 0) fail("truncated sequence");
+    if (i + static_cast<std::size_t>(extra) >= text.size() && extra > 0)
+      fail("truncated sequence", text.size() - i);
     for (int k = 1; k <= extra; ++k) {
       const auto c = static_cast<unsigned char>(text[i + static_cast<std::size_t>(k)]);
-      if ((c & 0xC0) != 0x80) fail("invalid continuation byte");
+      if ((c & 0xC0) != 0x80) fail("invalid continuation byte", static_cast<std::size_t>(k) + 1);
       cp = (cp << 6) | (c & 0x3F);
     }
     static constexpr char32_t kMinimum[4] = {0, 0x80, 0x800, 0x10000};
-    if (cp < kMinimum[extra]) fail("overlong encoding");
-    if (cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) fail("not a Unicode scalar value");
+    if (cp < kMinimum[extra]) fail("overlong encoding", static_cast<std::size_t>(extra) + 1);
+    if (cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF))
+      fail("not a Unicode scalar value", static_cast<std::size_t>(extra) + 1);
     out.push_back(cp);
     i += static_cast<std::size_t>(extra) + 1;
   }
@@ -85,6 +96,17 @@ std::string describe_character(char32_t cp) {
   } catch (const InvalidArgument&) {
   }
   return glyph + "(" + code + ")";
+}
+
+std::string describe_characters(const std::u32string& text, std::size_t max_characters) {
+  std::string out;
+  for (std::size_t k = 0; k < text.size() && k < max_characters; ++k) {
+    if (k > 0) out += ", ";
+    out += describe_character(text[k]);
+  }
+  if (text.size() > max_characters)
+    out += ", ... (" + std::to_string(text.size() - max_characters) + " more)";
+  return out;
 }
 
 bool is_white_space(char32_t c) {
