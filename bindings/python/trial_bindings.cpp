@@ -307,7 +307,11 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   spec.device = device_name.empty() ? std::string("simulated") : device_name;
   spec.guidance = options.force.guidance;
   const GuidanceLaw& law = options.force.guidance_law;
-  if (spec.guidance) spec.guidance_mode = mode_of(law);
+  // The mode the caller asked for (guidance_mode=, or a teacher's replay) is stated even with guidance off,
+  // so that the specification's one check refuses the contradiction as `trial --guidance off --guidance-mode`
+  // is refused, rather than the trial running unguided under a record that says 'fixed'.
+  const bool mode_asked = a.guidance_mode || (a.teacher && !a.teacher->object.is_none());
+  if (spec.guidance || mode_asked) spec.guidance_mode = mode_of(law);
   if (spec.guidance) {
     if (const auto* fading = std::get_if<FadingGuidance>(&law)) spec.guidance_gain = fading->gain;
     if (const auto* assist = std::get_if<AssistAsNeededGuidance>(&law)) spec.assist_band_m = assist->band_m;
