@@ -672,8 +672,8 @@ it, without running it: every field in its range (the one schema, `calligraphy s
 contradiction refused. record: as rerun_trial takes it. Returns the record's specification as the library
 writes it back (a dict: "format", "version", "trial", "force_law", ...; enumerations by their one spelling),
 which check_trial_record and rerun_trial take again. Raises DataError naming the record and the JSON pointer
-of a value at fault; InvalidArgument naming the field of a contradiction; TypeError for a record of another
-type.)");
+of a value at fault (of another type or out of its range) and of a contradiction between fields, with the
+field; TypeError for a record of another type.)");
   m.def("record_teacher", &record_teacher_py, py::arg("result"), py::arg("path") = py::none(),
         R"(A teacher's recording of a trial (teacher_recording_from_trace,
 include/calligraphy/trial/teacher_recording.hpp): the pen's times [s] and positions [m] of every tick,
