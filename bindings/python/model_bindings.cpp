@@ -524,7 +524,7 @@ void bind_scene(py::module_& m) {
              return Scene::lay_out(characters_from(characters.object, source, "characters"), chosen);
            }),
            py::arg("characters"), py::arg("layout") = py::none(), py::arg("library") = py::none(),
-           "characters: a str of one or more characters (loaded from `library`, default the embedded set), a "
+           "characters: a str of one or more characters (loaded from `library`, default every character), a "
            "Character or a sequence of Characters. layout: a SceneLayout (default: 60 mm characters, 66 mm "
            "apart, centred at the origin, paper at z = 0). Raises CharacterNotFound (a KeyError), "
            "InvalidArgument (a ValueError), TypeError naming the argument.")

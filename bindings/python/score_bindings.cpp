@@ -238,7 +238,7 @@ direction errors are found, and each segment gets the verdict the renderer would
 trace: the path of a CSV file (header t, x, y and pen or z; other columns ignored: `trial --csv` output
        reads as it is), or a mapping of columns (a dict of 1-D arrays, a pandas DataFrame) with `t` [s],
        `x`, `y` and `pen` (1 on paper, 0 lifted) or `z` [m] (on paper when z <= contact_threshold_m), not both.
-character: a str of one character (loaded from `library`, default the embedded set) or a Character,
+character: a str of one character (loaded from `library`, default every character) or a Character,
            laid out as `simulate_trial` places it; or a Scene (a row of characters, or a trial's
            `TrialResult.scene`), scored as it is laid out: its placement, its start radius (not
            `start_radius_m`) and its paper height, which `z` is measured from (on paper when

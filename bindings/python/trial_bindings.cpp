@@ -617,7 +617,7 @@ void bind_trial(py::module_& m) {
 as `calligraphy trial` does (run_simulated_trial, include/calligraphy/trial/trial.hpp).
 Deterministic for a seed; the GIL is released while it runs.
 
-characters: a str of one or more characters (loaded from `library`, default the embedded set),
+characters: a str of one or more characters (loaded from `library`, default every character),
             a Character, a sequence of Characters (written left to right), or a Scene.
 writer: 'novice', 'skilled', 'foreign' or a WriterProfile; writer_params: {'key': value} set on it
 by name (writer_parameter_names(), docs/writer.md). guidance: in-plane guidance on or off (the paper
@@ -656,7 +656,7 @@ LookupError) naming the devices there are, InvalidArgument, RealtimeError, Commu
         R"(Runs again the trial a record states (include/calligraphy/trial/recorded_trial.hpp): its whole
 specification, the force law with its guidance law's values, the safety chain, the passivity controller,
 the simulated writer's profile and seed and a simulated device's physics, on the characters of `library`
-(default the embedded set) laid out as recorded. On the simulated device the trace is the same bit for bit.
+(default every character) laid out as recorded. On the simulated device the trace is the same bit for bit.
 
 record: a TrialResult's `metrics` (simulate_trial, run_trial), a trial record read as a dict (`calligraphy
 trial --json`, a study session's trials/*.json), or the path of such a file. teacher: a replay's teacher (a
