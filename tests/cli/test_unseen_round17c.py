@@ -17,8 +17,9 @@ compared one trial and one record across the two; this one takes what they left:
   `check_trial_record` at the same JSON pointer; a protocol naming a missing character, planned and simulated.
 - the same names: `schema metrics` and `metric_table()`, `schema specification` and the keywords and defaults
   of `simulate_trial` and the options of `trial --help`, the CSV header and `trace_columns()`, `characters
-  --json` and `CharacterLibrary.default()`, `model --json` and a `Character`, `devices --json` and
-  `list_devices()`.
+  --json` and `CharacterLibrary.default()`, `model --json` and a `Character`, `strokes --json` and
+  `TYPICAL_STROKES` (every name `characters --typical` takes, `typical_stroke` takes), `devices --json` and
+  `list_devices()`, a `--data` folder and `CharacterLibrary.from_hanzi_writer` of it.
 
 CALLIGRAPHY_CLI names the program; CALLIGRAPHY_SOURCE_DIR the source tree; the built Python package is found on
 PYTHONPATH. CALLIGRAPHY_SANITIZED=1 takes a small subset.
@@ -28,6 +29,7 @@ import csv
 import io
 import json
 import math
+import os
 import shutil
 import sys
 import tempfile
@@ -528,7 +530,7 @@ class ScoreTwins(unittest.TestCase, OneErrorLine):
 
 @needs_cli
 @needs_python
-class NameTwins(unittest.TestCase):
+class NameTwins(unittest.TestCase, OneErrorLine):
     """The names, units, defaults and listings both sides print from one table."""
 
     def test_schema_metrics_is_the_metric_table(self):
@@ -626,6 +628,66 @@ class NameTwins(unittest.TestCase):
                 self.assertEqual(e_json["kind"], e.kind)
                 self.assertEqual(e_json["degree"], e.degree)
                 self.assertEqual(e_json["control_points"], e.control_points.tolist())
+
+    def test_strokes_json_is_the_typical_stroke_table(self):
+        table = cli_json(self, "strokes", "--json")
+        self.assertEqual(len(table), len(cg.TYPICAL_STROKES))
+        for entry, stroke in zip(table, cg.TYPICAL_STROKES):
+            with self.subTest(stroke=entry["acronym"]):
+                self.assertEqual(stroke, cg.typical_stroke(entry["id"]))
+                # the stroke character: the JSON gives its code point, Python the character (None for neither)
+                code_point = f"U+{ord(stroke.unicode):04X}" if stroke.unicode else None
+                self.assertEqual((entry["id"], entry["acronym"], entry["name"], entry["pinyin"], entry["unicode"],
+                                  entry["compound"], entry["corner_attraction"], entry["default_attraction"]),
+                                 (stroke.id, stroke.acronym, stroke.name_zh, stroke.pinyin, code_point,
+                                  stroke.compound, stroke.corner_attraction, stroke.default_attraction))
+                # every name `characters --typical` takes, Python's typical_stroke takes
+                names = [entry["acronym"].lower(), entry["name"]] + ([stroke.unicode] if stroke.unicode else [])
+                for name in names:
+                    if stroke.id % 8 == 2:  # the command line for a sample of five strokes (a run each)
+                        result = run(["characters", "--typical", name, "--text", SHI], FOLDER)
+                        self.assertEqual(result.returncode, 0, result.stderr.decode())
+                    self.assertEqual(cg.typical_stroke(name), stroke)
+                self.assertEqual(len(entry["template"]), len(stroke.pieces))
+                for piece_json, piece in zip(entry["template"], stroke.pieces):
+                    # no upper bound: JSON's null, Python's inf
+                    self.assertEqual({k: getattr(piece, k) for k in piece_json},
+                                     {k: math.inf if k == "max_length" and v is None else v
+                                      for k, v in piece_json.items()})
+        # an ID past the table: a usage error on one side, InvalidArgument on the other, both naming 40
+        result = run(["characters", "--typical", "40"], FOLDER)
+        self.assertEqual(result.returncode, 2, result.stderr.decode())
+        self.assertIn("--typical", result.stderr.decode())
+        with self.assertRaises(cg.InvalidArgument) as caught:
+            cg.typical_stroke(40)
+        self.assertIn("40", str(caught.exception))
+
+    def test_a_data_folder_is_read_alike(self):
+        # A hanzi-writer-data folder with 十 as it is, 人 cut short and no 一: 十 written to the same numbers,
+        # 人 refused naming its file (status 1: the library has it but cannot read it), 一 not found (status 2).
+        source = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
+        folder = FOLDER / "hanzi-writer-data"
+        folder.mkdir()
+        shutil.copy(source / "data" / "hanzi-writer-data" / f"{SHI}.json", folder)
+        whole = (source / "data" / "hanzi-writer-data" / "人.json").read_bytes()
+        (folder / "人.json").write_bytes(whole[: len(whole) // 2])
+        lib = cg.CharacterLibrary.from_hanzi_writer(str(folder))
+        result = run(["trial", SHI, "--data", str(folder), "--seed", str(SEED), "--max-duration", DURATION,
+                      "--json", "-"], FOLDER)
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
+        py = json.loads(json.dumps(cg.simulate_trial(SHI, library=lib, seed=SEED, max_duration_s=float(DURATION),
+                                                     keep_trace=False).metrics))
+        cli = json.loads(result.stdout)
+        same_numbers(self, without(cli, "device_time_at_start_s"), without(py, "device_time_at_start_s"))
+        self.assert_one_error(run(["trial", "人", "--data", str(folder), "--max-duration", "1"], FOLDER), 1,
+                              "人.json")
+        with self.assertRaises(cg.DataError) as caught:
+            cg.simulate_trial("人", library=lib, max_duration_s=1.0, keep_trace=False)
+        self.assertNotIsInstance(caught.exception, cg.CharacterNotFound)
+        self.assertIn("人.json", str(caught.exception))
+        self.assert_one_error(run(["trial", YI, "--data", str(folder), "--max-duration", "1"], FOLDER), 2, YI)
+        with self.assertRaises(cg.CharacterNotFound):
+            cg.simulate_trial(YI, library=lib, max_duration_s=1.0, keep_trace=False)
 
     def test_devices_json_is_list_devices(self):
         cli = cli_json(self, "devices", "--json")
