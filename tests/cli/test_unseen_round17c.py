@@ -775,6 +775,24 @@ class StudyTwins(unittest.TestCase, OneErrorLine):
         self.assertEqual(py["trace"], "<columns>")
         same_numbers(self, {k: cli[k] for k in py if k != "trace"}, without(py, "trace"))
 
+    def test_a_saved_record_rerun_by_python_and_the_command_line_is_its_trace(self):
+        # The session's record run again: by trial --spec, the CSV `trace` writes of the saved .trace.h5, byte
+        # for byte; by rerun_trial, the positions study.samples reads, to the trace's 0.1 um, exactly.
+        record = sorted((self.dir / "study").rglob("trials/*.json"))[0]
+        trace = record.with_name(record.name[: -len(".json")] + ".trace.h5")
+        saved = run(["trace", str(trace), "--csv", "from-trace.csv"], self.dir)
+        again = run(["trial", "--spec", str(record), "--csv", "from-spec.csv"], self.dir)
+        self.assertEqual((saved.returncode, again.returncode), (0, 0), again.stderr.decode())
+        self.assertEqual((self.dir / "from-trace.csv").read_bytes(), (self.dir / "from-spec.csv").read_bytes())
+        r = cg.rerun_trial(str(record))
+        samples = dict(self.study.iter_samples())
+        matching = [f for f in samples.values() if len(f) == len(r.time_s)
+                    and np.array_equal(np.round(r.position_m[:, 0] * 1e7) / 1e7, f["x_m"].to_numpy())]
+        self.assertEqual(len(matching), 1)
+        for axis, column in enumerate(("x_m", "y_m", "z_m")):
+            self.assertTrue(np.array_equal(np.round(r.position_m[:, axis] * 1e7) / 1e7, matching[0][column]),
+                            column)
+
     def test_session_cohort_and_cohort_simulate_give_one_table(self):
         import calligraphy.cohort
         out = self.dir / "cohort"
@@ -792,6 +810,45 @@ class StudyTwins(unittest.TestCase, OneErrorLine):
                 self.assertTrue(np.array_equal(a.astype(float), b.astype(float), equal_nan=True), column)
             else:
                 self.assertEqual([str(x) for x in a], [str(x) for x in b], column)
+
+    def test_a_plan_a_run_and_a_simulated_cohort_assign_alike(self):
+        # Between-subjects groups by subject number and a transfer choice from the library: session plan --json,
+        # the tables of session run's folders (study.load) and cohort.simulate's, row for row but for the
+        # session's id, its start time and the trace file (docs/python.md, "Simulated cohorts").
+        import calligraphy.cohort
+        import calligraphy.study
+        protocol = {"format": "calligraphy-study-protocol", "version": 1, "name": "between",
+                    "conditions": [{"name": "unguided", "mode": "vision"}, {"name": "fixture", "mode": "haptic"}],
+                    "phases": [{"phase": "pre-test", "condition": "unguided", "characters": [YI]},
+                               {"phase": "training", "conditions": ["unguided", "fixture"],
+                                "assignment": "between-subjects", "characters": [YI], "repetitions": 1},
+                               {"phase": "transfer", "condition": "unguided", "session": 2, "delay_s": 60,
+                                "characters": {"choose": 1, "from": [SHI, "大", "人", "二"]}}],
+                    "trial": {"max_duration_s": 4}}
+        (self.dir / "between.json").write_text(json.dumps(protocol), encoding="utf-8")
+        plan = cli_json(self, "session", "plan", str(self.dir / "between.json"), "--subjects", "3", "--json")
+        run_result = run(["session", "run", "between.json", "--subjects", "3", "--out", "between-study"], self.dir)
+        self.assertEqual(run_result.returncode, 0, run_result.stderr.decode())
+        ran = calligraphy.study.load(str(self.dir / "between-study")).trials
+        simulated = calligraphy.cohort.simulate(str(self.dir / "between.json"), 3, workers=1, progress=False).trials
+        planned = [(s["id"], s["group"], phase["phase"], block["condition"], "".join(phase["items"]))
+                   for s in plan["subjects"] for session in s["sessions"] for phase in session["phases"]
+                   for block in phase["blocks"]]
+        for name, table in (("session run", ran), ("cohort.simulate", simulated)):
+            with self.subTest(source=name):
+                rows = [(r.subject, str(r.group), str(r.phase), str(r.condition), r.characters)
+                        for r in table.itertuples()]
+                self.assertEqual(rows, planned)
+        self.assertEqual(list(ran.columns), list(simulated.columns))
+        for column in ran.columns:
+            if column in ("session", "start_utc", "trace_file", "trace_sha256"):  # no trace in memory
+                continue
+            a, b = ran[column], simulated[column]
+            if pd.api.types.is_float_dtype(b):
+                self.assertTrue(np.array_equal(a.to_numpy(float), b.to_numpy(float), equal_nan=True), column)
+            else:
+                self.assertEqual([None if pd.isna(x) else str(x) for x in a],
+                                 [None if pd.isna(x) else str(x) for x in b], column)
 
     def test_subjects_past_their_bounds_refused_by_both(self):
         for n in ("0", "100001"):
