@@ -482,6 +482,16 @@ class ScoreTwins(unittest.TestCase, OneErrorLine):
         py = json.loads(json.dumps(cg.score(str(FOLDER / "row.csv"), cg.Scene(SHI + YI))))
         same_numbers(self, {k: cli[k] for k in py}, py)
         self.assertEqual(len(py["per_character"]), 2)
+        # the characters as text, as --character takes them: the same row
+        as_text = json.loads(json.dumps(cg.score(str(FOLDER / "row.csv"), SHI + YI)))
+        same_numbers(self, as_text, py)
+        # data units are one character's: two refused by both, naming the units
+        self.assert_one_error(run(["score", "row.csv", "--character", SHI + YI, "--units", "data"], FOLDER), 2,
+                              "--units")
+        for character in (SHI + YI, cg.Scene(SHI + YI)):
+            with self.assertRaises(cg.InvalidArgument) as caught:
+                cg.score(str(FOLDER / "row.csv"), character, units="data")
+            self.assertIn("units", str(caught.exception))
 
     def test_an_unknown_unit_is_refused_by_both_naming_it(self):
         shared = Shared.get(self)
