@@ -262,8 +262,9 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   options.pacing = pacing;
   if (a.force_law) options.force = take(*a.force_law, "force_law");
   SimulationOptions simulation;
-  simulation.writer =
-      writer_with_settings(a.writer.object, a.writer_params ? a.writer_params->object : py::none());
+  std::vector<WriterSetting> given_settings;  // writer_params as given, stated as --writer-param states them
+  simulation.writer = writer_with_settings(
+      a.writer.object, a.writer_params ? a.writer_params->object : py::none(), &given_settings);
   options.rate_hz = take(a.rate_hz, "rate_hz");
   simulation.seed = take(a.seed, "seed");
   options.max_duration_s = take(a.max_duration_s, "max_duration_s");
@@ -323,14 +324,19 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   // and the settings that make it the profile given (writer_params, or a WriterProfile of other values): the
   // specification alone then states the writer that wrote, as `--writer-profile` and `--writer-param` do.
   // The profile itself is also an input below, and the record keeps it whole.
+  // A WriterProfile's own differences from its named profile come first, then writer_params as given, in
+  // turn (a setting equal to the profile's value too), as `--writer-param` states them: the same request
+  // makes the same record on both sides.
   const std::string& profile_name = simulation.writer.name;
   const auto named = writer_profile_names();
   if (std::find(named.begin(), named.end(), profile_name) != named.end()) spec.writer_profile = profile_name;
   const WriterProfile base = writer_profile(spec.writer_profile);
+  const WriterProfile before_params = writer_with_settings(a.writer.object, py::none());
   for (const std::string& key : writer_parameter_names()) {
-    const double value = writer_parameter(simulation.writer, key);
+    const double value = writer_parameter(before_params, key);
     if (value != writer_parameter(base, key)) spec.writer_parameters.push_back({key, value});
   }
+  spec.writer_parameters.insert(spec.writer_parameters.end(), given_settings.begin(), given_settings.end());
   spec.seed = simulation.seed;
   spec.rate_hz = options.rate_hz;
   spec.pacing = options.pacing;
@@ -375,12 +381,9 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
         label;  // a recording was checked against them; samples are taken as given
   }
   description.writer_profile = simulation.writer.name.empty() ? "custom" : simulation.writer.name;
-  if (a.writer_params && !a.writer_params->object.is_none()) {
-    for (const auto& [key, value] : a.writer_params->object.cast<py::dict>()) {
-      description.writer_parameters.push_back(py::str(key).cast<std::string>() + "=" +
-                                              py::repr(value).cast<std::string>());
-    }
-  }
+  // writer_params as `--writer-param` prints them: "key=value", the value in its shortest digits
+  for (const WriterSetting& setting : given_settings)
+    description.writer_parameters.push_back(writer_setting_text(setting));
   // The whole specification that ran, with a simulated device's own physics: rerun_trial runs it again.
   RecordedTrial recorded = recorded_trial(spec, run, writing, scene);
   // Only physics of the caller's own: without `device=` the simulated device is the registry's.
