@@ -322,13 +322,17 @@ class TrialTwins(unittest.TestCase, OneErrorLine):
                 with self.assertRaises(kind) as caught:
                     cg.simulate_trial(SHI, writer_params={"learning_rate": value}, keep_trace=False)
                 self.assertIn("writer_params['learning_rate']", str(caught.exception))
-        # a denormal is a number like any other: the same setting recorded on both sides
-        cli = self.cli_record("--writer-param", "learning_rate=1e-320", "--max-duration", "1")
-        py = json.loads(json.dumps(self.python_trial(writer_params={"learning_rate": 1e-320},
-                                                     max_duration_s=1.0).metrics))
-        self.assertEqual(cli["specification"]["trial"]["writer_parameters"],
-                         [{"key": "learning_rate", "value": 1e-320}])
-        same_numbers(self, without(cli, "device_time_at_start_s"), without(py, "device_time_at_start_s"))
+        # a denormal, -0, the profile's own value, two settings in an order: the same record on both sides
+        default = cg.writer_profile("novice").bias_offset_m
+        for settings in ({"learning_rate": 1e-320}, {"learning_rate": -0.0}, {"bias_offset_m": default},
+                         {"learning_rate": 0.3, "bias_offset_m": 0.001}):
+            with self.subTest(settings=settings):
+                args = [a for k, v in settings.items() for a in ("--writer-param", f"{k}={v!r}")]
+                cli = self.cli_record(*args, "--max-duration", "1")
+                py = json.loads(json.dumps(self.python_trial(writer_params=settings, max_duration_s=1.0).metrics))
+                self.assertEqual(cli["specification"]["trial"]["writer_parameters"],
+                                 [{"key": k, "value": v} for k, v in settings.items()])
+                same_numbers(self, without(cli, "device_time_at_start_s"), without(py, "device_time_at_start_s"))
         # the tick limit: both name the duration
         self.assert_one_error(run(["trial", SHI, "--rate", "100000", "--max-duration", "100.001", "--check"],
                                   FOLDER), 2, "--max-duration", "--rate")
