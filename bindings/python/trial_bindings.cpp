@@ -645,9 +645,10 @@ of the wrong type.)");
         py::arg("pacing") = "auto" CALLIGRAPHY_TRIAL_ARGUMENTS(CALLIGRAPHY_TRIAL_PY_ARG),
         py::call_guard<ForwardLog>(),
         R"(Runs a whole guided writing trial on the device called `device` in list_devices(), as
-`calligraphy trial --device NAME` does (run_trial, include/calligraphy/trial/runner.hpp): 'simulated' and
-'emulated-phantom' are moved by the simulated `writer`; a hardware device is moved by a person and runs in
-real time on the servo loop's own thread. The GIL is released while it runs; Ctrl-C ends the trial at
+`calligraphy trial --device NAME` does (run_trial, include/calligraphy/trial/runner.hpp): 'simulated' is
+moved by the simulated `writer` (the command line's Phantom emulator, 'emulated-phantom', is not among the
+module's devices); a hardware device is moved by a person and runs in real time on the servo loop's own
+thread. The GIL is released while it runs; Ctrl-C ends the trial at
 the next tick (forces off, the device closed) and raises KeyboardInterrupt.
 
 pacing: 'auto' (lock-step for a device a simulated writer moves, real time otherwise), 'lock-step' or
