@@ -719,6 +719,11 @@ class NameTwins(unittest.TestCase, OneErrorLine):
                 self.assertEqual({k: (list(v) if isinstance(v, (tuple, list)) else v) for k, v in info.items()},
                                  {k: entry["info"][k] for k in info})
                 self.assertEqual(set(entry["info"]), set(info))
+        # the one device the command line has and the module has not: its Phantom emulator (docs/python.md)
+        self.assertEqual(set(by_name) - {d.name for d in survey.devices}, {"emulated-phantom"})
+        with self.assertRaises(cg.DeviceNotFound) as caught:
+            cg.run_trial(SHI, device="emulated-phantom", max_duration_s=0.01, keep_trace=False)
+        self.assertIn("simulated", str(caught.exception))
 
 
 PROTOCOL = {"format": "calligraphy-study-protocol", "version": 1, "name": "twins",
