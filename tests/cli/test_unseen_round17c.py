@@ -53,6 +53,11 @@ load_tests = sanitized_subset({"test_trial_json_is_simulate_trial_metrics_defaul
                                "test_schema_metrics_is_the_metric_table",
                                "test_trace_csv_header_is_trace_columns"})
 
+try:
+    import jsonschema
+except ImportError:  # pragma: no cover
+    jsonschema = None
+
 FOLDER = None
 
 
@@ -561,6 +566,23 @@ class NameTwins(unittest.TestCase, OneErrorLine):
                 self.assertIn(f"[{m['unit']}]", prop["description"], name)
         # and every key a trial's metrics dict has at its top level that the table names is one of them
         self.assertTrue(set(table) <= set(Shared.get(self).record))
+
+    @unittest.skipIf(jsonschema is None, "jsonschema is not installed")
+    def test_what_python_writes_is_valid_against_the_command_lines_schemas(self):
+        # A record, its specification written back, its trial part and its metrics from Python, and a score of
+        # columns, each valid against `calligraphy schema record|specification|metrics`.
+        record_schema = cli_json(self, "schema", "record")
+        r = cg.simulate_trial(SHI, seed=SEED, max_duration_s=5.0, keep_trace=False, guidance_mode="timing",
+                              writer_params={"learning_rate": 0.3})
+        jsonschema.validate(r.metrics["specification"], record_schema)
+        jsonschema.validate(cg.check_trial_record(r.metrics), record_schema)
+        jsonschema.validate(r.metrics["specification"]["trial"], cli_json(self, "schema", "specification"))
+        metrics_schema = cli_json(self, "schema", "metrics")
+        jsonschema.validate(json.loads(json.dumps(r.metrics)), metrics_schema)
+        jsonschema.validate(json.loads(json.dumps(Shared.get(self).record)), metrics_schema)
+        columns = {"t": [0.0, 0.001], "x": [0.0, 0.0], "y": [0.0, 0.0], "pen": [1, 1]}
+        jsonschema.validate(json.loads(json.dumps(cg.score({k: np.array(v) for k, v in columns.items()}, SHI))),
+                            metrics_schema)
 
     def test_specification_defaults_are_simulate_trials_defaults(self):
         schema = cli_json(self, "schema", "specification")
