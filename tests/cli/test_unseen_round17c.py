@@ -777,20 +777,20 @@ class StudyTwins(unittest.TestCase, OneErrorLine):
         tables.mkdir()
         result = run(["report", "study", "--csv", "tables"], self.dir)
         self.assertEqual(result.returncode, 0, result.stderr.decode())
-        trials = pd.read_csv(tables / "trials.csv", float_precision="round_trip")
-        loaded = self.study.trials
-        self.assertEqual(list(trials.columns), list(loaded.columns))
-        self.assertEqual(len(trials), len(loaded))
-        for column in trials.columns:
-            if column == "trace_file":
-                continue
-            a, b = trials[column], loaded[column]
-            if pd.api.types.is_numeric_dtype(b) and not pd.api.types.is_bool_dtype(b):
-                self.assertTrue(np.allclose(a.astype(float), b.astype(float), rtol=0, atol=0, equal_nan=True),
-                                column)
-            else:
-                self.assertEqual([str(x) if not pd.isna(x) else "" for x in a],
-                                 [str(x) if not pd.isna(x) else "" for x in b], column)
+        for name, loaded in (("trials", self.study.trials), ("strokes", self.study.strokes)):
+            written = pd.read_csv(tables / f"{name}.csv", float_precision="round_trip")
+            self.assertEqual(list(written.columns), list(loaded.columns), name)
+            self.assertEqual(len(written), len(loaded), name)
+            for column in written.columns:
+                if column == "trace_file":  # the path as reached from the folder given, which differs here
+                    continue
+                a, b = written[column], loaded[column]
+                if pd.api.types.is_numeric_dtype(b) and not pd.api.types.is_bool_dtype(b):
+                    self.assertTrue(np.array_equal(a.to_numpy(float), b.to_numpy(float), equal_nan=True),
+                                    f"{name}.{column}")
+                else:
+                    self.assertEqual([str(x) if not pd.isna(x) else "" for x in a],
+                                     [str(x) if not pd.isna(x) else "" for x in b], f"{name}.{column}")
 
     def test_a_saved_trace_reads_alike_through_trace_score_and_samples(self):
         import calligraphy.study
