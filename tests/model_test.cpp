@@ -24,6 +24,23 @@ TEST_CASE("39 typical strokes with stable IDs", "[model]") {
   CHECK_THROWS_AS(typical_stroke(40), InvalidArgument);
 }
 
+TEST_CASE("A typical stroke by what a person calls it: acronym in any case, Chinese name, stroke character",
+          "[model]") {
+  CHECK(typical_stroke_id_by_name("HZG") == 10);
+  CHECK(typical_stroke_id_by_name("hzg") == 10);
+  CHECK(typical_stroke_id_by_name("hZg") == 10);
+  CHECK(typical_stroke_id_by_name("横折钩") == 10);
+  CHECK(typical_stroke_id_by_name("\u31C6") == 10);
+  CHECK_FALSE(typical_stroke_id_by_name("10").has_value());  // an ID is a number, read by the caller
+  CHECK_FALSE(typical_stroke_id_by_name("").has_value());
+  CHECK_FALSE(typical_stroke_id_by_name("HZGX").has_value());
+  CHECK_FALSE(typical_stroke_id("hzg").has_value());  // the data's acronyms are exact
+  for (const TypicalStroke& t : typical_strokes()) {
+    CHECK(typical_stroke_id_by_name(t.acronym) == t.id);
+    CHECK(typical_stroke_id_by_name(t.name_zh) == t.id);
+  }
+}
+
 TEST_CASE("Fitting: a straight median is one LSE, a corner makes a feature point", "[model]") {
   const std::vector<Vec2> straight = {{100, 500}, {300, 502}, {600, 500}};
   auto f = fit_stroke(straight);

@@ -120,13 +120,13 @@ void bind_element(py::module_& m) {
 const TypicalStroke& typical_stroke_by_key(py::handle key) {
   if (py::isinstance<py::str>(key)) {
     const std::string acronym = convert_named<std::string>(key, "key");  // a lone surrogate: a wrong value
-    if (const auto id = typical_stroke_id(acronym)) return typical_stroke(*id);
+    if (const auto id = typical_stroke_id_by_name(acronym)) return typical_stroke(*id);
     std::string known;
     for (const TypicalStroke& t : typical_strokes()) {
       if (!known.empty()) known += ", ";
       known += t.acronym;
     }
-    throw InvalidArgument("typical_stroke: no typical stroke has the acronym '" + acronym +
+    throw InvalidArgument("key: no typical stroke has the acronym, name or stroke character '" + acronym +
                           "'; acronyms: " + known);
   }
   if (PyIndex_Check(key.ptr()) && !PyBool_Check(key.ptr())) {
@@ -224,9 +224,10 @@ void bind_typical_strokes(py::module_& m) {
       "typical_stroke",
       [](const Annotated<TypicalStrokeKeyTag>& key) { return &typical_stroke_by_key(key.object); },
       py::arg("key"), py::return_value_policy::reference,
-      "The typical stroke with this ID (int, 1..39) or acronym (str, e.g. 'HZG'), as in "
-      "include/calligraphy/model/typical_strokes.hpp. Raises InvalidArgument (a ValueError) naming an "
-      "unknown ID or acronym, TypeError for another type.");
+      "The typical stroke with this ID (int, 1..39) or name (str): its acronym in any case ('HZG', 'hzg'), "
+      "Chinese name ('横折钩') or CJK stroke character ('㇆'), as `calligraphy strokes` lists them and "
+      "`calligraphy characters --typical` takes them (include/calligraphy/model/typical_strokes.hpp). Raises "
+      "InvalidArgument (a ValueError) naming an unknown ID or name, TypeError for another type.");
 }
 
 void bind_character(py::module_& m) {
@@ -525,7 +526,7 @@ void bind_scene(py::module_& m) {
              return Scene::lay_out(characters_from(characters.object, source, "characters"), chosen);
            }),
            py::arg("characters"), py::arg("layout") = py::none(), py::arg("library") = py::none(),
-           "characters: a str of one or more characters (loaded from `library`, default the embedded set), a "
+           "characters: a str of one or more characters (loaded from `library`, default every character), a "
            "Character or a sequence of Characters. layout: a SceneLayout (default: 60 mm characters, 66 mm "
            "apart, centred at the origin, paper at z = 0). Raises CharacterNotFound (a KeyError), "
            "InvalidArgument (a ValueError), TypeError naming the argument.")

@@ -25,6 +25,7 @@
 #include "calligraphy/report/score_report.hpp"
 #include "calligraphy/report/trace_columns.hpp"
 #include "character_source.hpp"
+#include "model_bindings.hpp"
 #include "numpy_arrays.hpp"
 #include "report_bindings.hpp"
 
@@ -181,16 +182,17 @@ py::dict score_py(const py::object& trace, const py::object& character,
           std::to_string(scene.characters.size()));
     }
   } else {
-    Character model;
-    if (py::isinstance<Character>(character)) {
-      model = character.cast<Character>();
-    } else {
-      const CharacterSource source = library ? take(*library, "library") : CharacterSource::embedded();
-      model = source.load(one_character(convert_named<std::string>(character, "character"), "character"));
+    // One or more characters, a row laid out as simulate_trial lays it out, as `score --character CHARS`.
+    const CharacterSource source = library ? take(*library, "library") : CharacterSource::embedded();
+    const std::vector<Character> models = characters_from(character, source, "character");
+    if (units == TraceUnits::data && models.size() != 1) {
+      throw InvalidArgument(
+          "units: 'data' takes one character (data units are one character's); character has " +
+          std::to_string(models.size()));
     }
     SceneLayout layout;
     layout.start_radius_m = start_radius_m;
-    scene = Scene::lay_out({model}, layout);
+    scene = Scene::lay_out(models, layout);
   }
   const PlacedCharacter& placed = scene.characters.front();
   std::string characters;
@@ -238,8 +240,9 @@ direction errors are found, and each segment gets the verdict the renderer would
 trace: the path of a CSV file (header t, x, y and pen or z; other columns ignored: `trial --csv` output
        reads as it is), or a mapping of columns (a dict of 1-D arrays, a pandas DataFrame) with `t` [s],
        `x`, `y` and `pen` (1 on paper, 0 lifted) or `z` [m] (on paper when z <= contact_threshold_m), not both.
-character: a str of one character (loaded from `library`, default the embedded set) or a Character,
-           laid out as `simulate_trial` places it; or a Scene (a row of characters, or a trial's
+character: a str of one or more characters (loaded from `library`, default every character), a Character
+           or a sequence of them, laid out as `simulate_trial` places them (a row, as `calligraphy score
+           --character CHARS` places it); or a Scene (a row of characters, or a trial's
            `TrialResult.scene`), scored as it is laid out: its placement, its start radius (not
            `start_radius_m`) and its paper height, which `z` is measured from (on paper when
            z - paper_z_m <= contact_threshold_m), so that a trial's trace scores as the trial did.

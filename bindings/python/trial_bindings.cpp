@@ -262,8 +262,9 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   options.pacing = pacing;
   if (a.force_law) options.force = take(*a.force_law, "force_law");
   SimulationOptions simulation;
-  simulation.writer =
-      writer_with_settings(a.writer.object, a.writer_params ? a.writer_params->object : py::none());
+  std::vector<WriterSetting> given_settings;  // writer_params as given, stated as --writer-param states them
+  simulation.writer = writer_with_settings(
+      a.writer.object, a.writer_params ? a.writer_params->object : py::none(), &given_settings);
   options.rate_hz = take(a.rate_hz, "rate_hz");
   simulation.seed = take(a.seed, "seed");
   options.max_duration_s = take(a.max_duration_s, "max_duration_s");
@@ -307,7 +308,11 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   spec.device = device_name.empty() ? std::string("simulated") : device_name;
   spec.guidance = options.force.guidance;
   const GuidanceLaw& law = options.force.guidance_law;
-  if (spec.guidance) spec.guidance_mode = mode_of(law);
+  // The mode the caller asked for (guidance_mode=, or a teacher's replay) is stated even with guidance off,
+  // so that the specification's one check refuses the contradiction as `trial --guidance off --guidance-mode`
+  // is refused, rather than the trial running unguided under a record that says 'fixed'.
+  const bool mode_asked = a.guidance_mode || (a.teacher && !a.teacher->object.is_none());
+  if (spec.guidance || mode_asked) spec.guidance_mode = mode_of(law);
   if (spec.guidance) {
     if (const auto* fading = std::get_if<FadingGuidance>(&law)) spec.guidance_gain = fading->gain;
     if (const auto* assist = std::get_if<AssistAsNeededGuidance>(&law)) spec.assist_band_m = assist->band_m;
@@ -319,14 +324,19 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   // and the settings that make it the profile given (writer_params, or a WriterProfile of other values): the
   // specification alone then states the writer that wrote, as `--writer-profile` and `--writer-param` do.
   // The profile itself is also an input below, and the record keeps it whole.
+  // A WriterProfile's own differences from its named profile come first, then writer_params as given, in
+  // turn (a setting equal to the profile's value too), as `--writer-param` states them: the same request
+  // makes the same record on both sides.
   const std::string& profile_name = simulation.writer.name;
   const auto named = writer_profile_names();
   if (std::find(named.begin(), named.end(), profile_name) != named.end()) spec.writer_profile = profile_name;
   const WriterProfile base = writer_profile(spec.writer_profile);
+  const WriterProfile before_params = writer_with_settings(a.writer.object, py::none());
   for (const std::string& key : writer_parameter_names()) {
-    const double value = writer_parameter(simulation.writer, key);
+    const double value = writer_parameter(before_params, key);
     if (value != writer_parameter(base, key)) spec.writer_parameters.push_back({key, value});
   }
+  spec.writer_parameters.insert(spec.writer_parameters.end(), given_settings.begin(), given_settings.end());
   spec.seed = simulation.seed;
   spec.rate_hz = options.rate_hz;
   spec.pacing = options.pacing;
@@ -371,12 +381,9 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
         label;  // a recording was checked against them; samples are taken as given
   }
   description.writer_profile = simulation.writer.name.empty() ? "custom" : simulation.writer.name;
-  if (a.writer_params && !a.writer_params->object.is_none()) {
-    for (const auto& [key, value] : a.writer_params->object.cast<py::dict>()) {
-      description.writer_parameters.push_back(py::str(key).cast<std::string>() + "=" +
-                                              py::repr(value).cast<std::string>());
-    }
-  }
+  // writer_params as `--writer-param` prints them: "key=value", the value in its shortest digits
+  for (const WriterSetting& setting : given_settings)
+    description.writer_parameters.push_back(writer_setting_text(setting));
   // The whole specification that ran, with a simulated device's own physics: rerun_trial runs it again.
   RecordedTrial recorded = recorded_trial(spec, run, writing, scene);
   // Only physics of the caller's own: without `device=` the simulated device is the registry's.
@@ -613,7 +620,7 @@ void bind_trial(py::module_& m) {
 as `calligraphy trial` does (run_simulated_trial, include/calligraphy/trial/trial.hpp).
 Deterministic for a seed; the GIL is released while it runs.
 
-characters: a str of one or more characters (loaded from `library`, default the embedded set),
+characters: a str of one or more characters (loaded from `library`, default every character),
             a Character, a sequence of Characters (written left to right), or a Scene.
 writer: 'novice', 'skilled', 'foreign' or a WriterProfile; writer_params: {'key': value} set on it
 by name (writer_parameter_names(), docs/writer.md). guidance: in-plane guidance on or off (the paper
@@ -638,9 +645,10 @@ of the wrong type.)");
         py::arg("pacing") = "auto" CALLIGRAPHY_TRIAL_ARGUMENTS(CALLIGRAPHY_TRIAL_PY_ARG),
         py::call_guard<ForwardLog>(),
         R"(Runs a whole guided writing trial on the device called `device` in list_devices(), as
-`calligraphy trial --device NAME` does (run_trial, include/calligraphy/trial/runner.hpp): 'simulated' and
-'emulated-phantom' are moved by the simulated `writer`; a hardware device is moved by a person and runs in
-real time on the servo loop's own thread. The GIL is released while it runs; Ctrl-C ends the trial at
+`calligraphy trial --device NAME` does (run_trial, include/calligraphy/trial/runner.hpp): 'simulated' is
+moved by the simulated `writer` (the command line's Phantom emulator, 'emulated-phantom', is not among the
+module's devices); a hardware device is moved by a person and runs in real time on the servo loop's own
+thread. The GIL is released while it runs; Ctrl-C ends the trial at
 the next tick (forces off, the device closed) and raises KeyboardInterrupt.
 
 pacing: 'auto' (lock-step for a device a simulated writer moves, real time otherwise), 'lock-step' or
@@ -652,7 +660,7 @@ LookupError) naming the devices there are, InvalidArgument, RealtimeError, Commu
         R"(Runs again the trial a record states (include/calligraphy/trial/recorded_trial.hpp): its whole
 specification, the force law with its guidance law's values, the safety chain, the passivity controller,
 the simulated writer's profile and seed and a simulated device's physics, on the characters of `library`
-(default the embedded set) laid out as recorded. On the simulated device the trace is the same bit for bit.
+(default every character) laid out as recorded. On the simulated device the trace is the same bit for bit.
 
 record: a TrialResult's `metrics` (simulate_trial, run_trial), a trial record read as a dict (`calligraphy
 trial --json`, a study session's trials/*.json), or the path of such a file. teacher: a replay's teacher (a
@@ -668,8 +676,8 @@ it, without running it: every field in its range (the one schema, `calligraphy s
 contradiction refused. record: as rerun_trial takes it. Returns the record's specification as the library
 writes it back (a dict: "format", "version", "trial", "force_law", ...; enumerations by their one spelling),
 which check_trial_record and rerun_trial take again. Raises DataError naming the record and the JSON pointer
-of a value at fault; InvalidArgument naming the field of a contradiction; TypeError for a record of another
-type.)");
+of a value at fault (of another type or out of its range) and of a contradiction between fields, with the
+field; TypeError for a record of another type.)");
   m.def("record_teacher", &record_teacher_py, py::arg("result"), py::arg("path") = py::none(),
         R"(A teacher's recording of a trial (teacher_recording_from_trace,
 include/calligraphy/trial/teacher_recording.hpp): the pen's times [s] and positions [m] of every tick,

@@ -6,7 +6,8 @@
 
 namespace calligraphy::python {
 
-WriterProfile writer_with_settings(const py::object& writer, const py::object& params) {
+WriterProfile writer_with_settings(const py::object& writer, const py::object& params,
+                                   std::vector<WriterSetting>* given) {
   WriterProfile profile;
   if (py::isinstance<WriterProfile>(writer)) {
     profile = writer.cast<WriterProfile>();
@@ -34,6 +35,7 @@ WriterProfile writer_with_settings(const py::object& writer, const py::object& p
     } catch (const InvalidArgument& e) {
       throw InvalidArgument(name + ": " + e.what());
     }
+    if (given != nullptr) given->push_back({key, value});
   }
   return profile;
 }

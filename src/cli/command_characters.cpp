@@ -45,12 +45,9 @@ int typical_id_from(const std::string& value) {
                        ": a typical stroke ID is 1-39 (calligraphy strokes lists them)");
     return id;
   }
+  if (const auto id = typical_stroke_id_by_name(value)) return *id;
   std::vector<std::string> acronyms;
-  for (const TypicalStroke& t : typical_strokes()) {
-    const std::string own = t.unicode != 0 ? encode_utf8(t.unicode) : std::string();
-    if (upper(value) == t.acronym || value == t.name_zh || (!own.empty() && value == own)) return t.id;
-    acronyms.emplace_back(t.acronym);
-  }
+  for (const TypicalStroke& t : typical_strokes()) acronyms.emplace_back(t.acronym);
   std::string message = "--typical " + value +
                         ": no typical stroke has this ID (1-39), acronym (HZG), name (横折钩) or stroke "
                         "character (calligraphy strokes lists them)";

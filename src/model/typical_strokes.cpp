@@ -5,11 +5,13 @@
 #include "calligraphy/model/typical_strokes.hpp"
 
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <limits>
 #include <string>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/unicode.hpp"
 
 namespace calligraphy {
 namespace {
@@ -131,6 +133,16 @@ const TypicalStroke& typical_stroke(int id) {
 std::optional<int> typical_stroke_id(std::string_view acronym) {
   for (const auto& t : kTable) {
     if (t.acronym == acronym) return t.id;
+  }
+  return std::nullopt;
+}
+
+std::optional<int> typical_stroke_id_by_name(std::string_view name) {
+  std::string upper(name);
+  for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  for (const auto& t : kTable) {
+    if (upper == t.acronym || name == t.name_zh || (t.unicode != 0 && name == encode_utf8(t.unicode)))
+      return t.id;
   }
   return std::nullopt;
 }

@@ -68,5 +68,10 @@ std::span<const TypicalStroke> typical_strokes();
 const TypicalStroke& typical_stroke(int id);
 /// Looks up an acronym ("HZG"); empty when unknown.
 std::optional<int> typical_stroke_id(std::string_view acronym);
+/// Looks up what a person calls a typical stroke, as `calligraphy strokes` lists it: its acronym in any case
+/// ("HZG", "hzg"), its Chinese name ("横折钩") or its CJK stroke character ("㇆"); empty when none. The one
+/// reading of `calligraphy characters --typical` and Python's `typical_stroke(key)` (an ID is a number
+/// there).
+std::optional<int> typical_stroke_id_by_name(std::string_view name);
 
 }  // namespace calligraphy
