@@ -801,10 +801,12 @@ class Round17D(unittest.TestCase):
     # ---- a trial's own verdicts ---------------------------------------------------------------------------
 
     def test_trial_strokes_completed_are_the_score_of_its_trace(self):
-        """A simulated trial of 十: each stroke the renderer completed (`renderer_strokes`) is one a verdict of
-        its own trace accepted with that stroke due (`segments`), and `strokes_accepted` counts them."""
-        result = run(["trial", "十", "--writer-profile", "skilled", "--seed", "3", "--max-duration", "6",
-                      "--json", "t.json", "--csv", "t.csv"], self.dir)
+        """A simulated trial of 十 by a novice writing 4.5 mm off its copy, stopped at 6 s: each stroke the
+        renderer completed (`renderer_strokes`) is one a verdict of its own trace accepted with that stroke due
+        (`segments`), `strokes_accepted` counts them, and a stroke it tried and did not complete has a refused
+        verdict with it due."""
+        result = run(["trial", "十", "--writer-profile", "novice", "--seed", "3", "--max-duration", "6",
+                      "--writer-param", "bias_offset_m=0.0045", "--json", "t.json", "--csv", "t.csv"], self.dir)
         self.assertIn(result.returncode, (0, 1), result.stderr)
         record = json.loads((self.dir / "t.json").read_text(encoding="utf-8"))
         completed = [s["index"] for s in record["renderer_strokes"] if s["completed"]]
@@ -812,6 +814,11 @@ class Round17D(unittest.TestCase):
         self.assertEqual(completed, accepted)
         self.assertEqual(record["strokes_completed"], len(completed))
         self.assertEqual(record["strokes_accepted"], len(accepted))
+        refused = {v["expected_stroke"] for v in segment_verdicts(record) if v and not v["accepted"]}
+        tried = [s["index"] for s in record["renderer_strokes"] if s["attempts"] and not s["completed"]]
+        self.assertTrue(tried, record["renderer_strokes"])  # the case has a refusal to tell
+        for index in tried:
+            self.assertIn(index, refused, f"stroke {index + 1} tried and not completed, no refusal with it due")
         scored = run(["score", "t.csv", "--character", "十", "--json", "-"], self.dir)
         self.assertEqual(scored.returncode, 0, scored.stderr)
         again = segment_verdicts(json.loads(scored.stdout))
