@@ -406,6 +406,10 @@ class Round17D(unittest.TestCase):
         self.assertEqual(verdict["refusal"], "too_short")
         self.assertLess(verdict["mean_deviation_m"], 0.1 * MM)
         self.assertAlmostEqual(verdict["covered_fraction"], (L - 18 * MM) / L, delta=0.03)
+        share = re.search(r"\((\d+) % of it, ([\d.]+) mm off\)", row)
+        self.assertIsNotNone(share, row)
+        self.assertAlmostEqual(int(share.group(1)) / 100, (L - 18 * MM) / L, delta=0.03, msg=row)
+        self.assertEqual(share.group(2), f"{verdict['mean_deviation_m'] / MM:.1f}")
         self.assert_counts_add_up(score, table, 1)
 
     @needs_python
