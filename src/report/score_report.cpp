@@ -78,8 +78,9 @@ namespace {
 
 // One verdict per reference stroke, from the renderer's verdicts on the pen-downs in writing order: accepted
 // when a pen-down was accepted as it; else refused, by the last refusal about it (a wrong order or a wrong
-// stroke is about the stroke the pen wrote; any other refusal about the stroke that was due); else not
-// written.
+// stroke is about the stroke the pen wrote, and so is a refused pen-down that wrote a later stroke from its
+// end, so that such a stroke is not called not written; any other refusal about the stroke that was due);
+// else not written.
 struct StrokeVerdict {
   enum class State { not_written, accepted, refused } state = State::not_written;
   StrokeRefusal refusal = StrokeRefusal::none;
@@ -87,6 +88,7 @@ struct StrokeVerdict {
   bool entered = false;           // the refused pen-down came near the start of the stroke that was due
   double deviation_m = 0.0;       // its mean distance from that stroke, when it did
   double covered_fraction = 0.0;  // how far along the stroke that was due it went
+  bool out_of_turn = false;       // the pen-down wrote this stroke from its end while another was due
 };
 
 std::vector<StrokeVerdict> stroke_verdicts(const CharacterScore& score) {
@@ -103,10 +105,17 @@ std::vector<StrokeVerdict> stroke_verdicts(const CharacterScore& score) {
     }
     const bool other_stroke =
         match.refusal == StrokeRefusal::wrong_order || match.refusal == StrokeRefusal::wrong_stroke;
-    const std::size_t about = other_stroke ? match.matched_stroke : due;
+    // A pen-down refused while one stroke was due that wrote a later one from its end (the assignment matched
+    // it backwards: a later stroke written backwards is `wrong_place`) is about the stroke it wrote.
+    const bool out_of_turn = !other_stroke && segment.backwards && segment.matched_stroke &&
+                             *segment.matched_stroke != due && *segment.matched_stroke < verdicts.size() &&
+                             verdicts[*segment.matched_stroke].state != StrokeVerdict::State::accepted;
+    const std::size_t about = other_stroke  ? match.matched_stroke
+                              : out_of_turn ? *segment.matched_stroke
+                                            : due;
     if (about >= verdicts.size() || verdicts[about].state == StrokeVerdict::State::accepted) continue;
-    verdicts[about] = {StrokeVerdict::State::refused, match.refusal,         due, match.entered,
-                       match.mean_deviation_m,        match.covered_fraction};
+    verdicts[about] = {StrokeVerdict::State::refused, match.refusal,          due,        match.entered,
+                       match.mean_deviation_m,        match.covered_fraction, out_of_turn};
   }
   return verdicts;
 }
@@ -130,6 +139,10 @@ std::string verdict_text(const StrokeVerdict& v, std::size_t stroke) {
       break;
   }
   const std::string why = "refused: " + reason_words(v.refusal);
+  if (v.out_of_turn) {
+    std::snprintf(text, sizeof text, " (written backwards while stroke %zu was due)", v.due + 1);
+    return why + text;
+  }
   switch (v.refusal) {
     case StrokeRefusal::wrong_order:
       std::snprintf(text, sizeof text, " (written while stroke %zu was due)", v.due + 1);
@@ -190,7 +203,8 @@ void append_character_table(std::string& out, const CharacterScore& score) {
     const auto& m = s.metrics;
     const auto mm = [&](auto member) { return m ? std::optional<double>(member(*m)) : std::nullopt; };
     std::string verdict = verdict_text(verdicts[s.index], s.index);
-    if (s.backwards && verdicts[s.index].refusal != StrokeRefusal::backwards)
+    if (s.backwards && verdicts[s.index].refusal != StrokeRefusal::backwards &&
+        !verdicts[s.index].out_of_turn)
       verdict += "; matched backwards";
     appendf(out, "  %-6zu %-6s %-4d %9s %9s %11s %9s %9s  %s\n", s.index + 1,
             std::string(typical_stroke(s.typical_id).acronym).c_str(), s.typical_id,
