@@ -197,3 +197,40 @@ TEST_CASE("a square no study reaches is said, and a mixed design's sequences alt
   CHECK(counterbalancing(crossover(2), subjects(5)).reachable());
   CHECK_THAT(counterbalancing(crossover(2), subjects(5)).warning(), Catch::StartsWith("N=5 does not fill"));
 }
+
+TEST_CASE("a within-subjects order beside between-subjects groups gives every group every order",
+          "[study][balance]") {
+  // Two groups beside tests in a Latin-square order of two conditions (and the same in ABBA): counted by
+  // number alone, every subject of a group would write one order.
+  for (const std::string order : {"latin_square", "abba"}) {
+    const StudyProtocol protocol = parse_study_protocol(
+        R"({"name": "gw", "conditions": [{"name": "A", "mode": "vision"}, {"name": "B", "mode": "haptic"}],
+            "phases": [{"phase": "pre-test", "conditions": ["A", "B"], "characters": ["十"], "repetitions": 2},
+                       {"phase": "training", "conditions": ["A", "B"], "assignment": "between-subjects",
+                        "characters": ["十"]}],
+            "order": {"conditions": ")" +
+            order + R"("}})",
+        "gw.json");
+    CAPTURE(order);
+    const std::size_t square = counterbalancing_square(protocol);
+    CHECK(square == 4);
+    std::map<std::pair<std::string, std::string>, int> cells;
+    for (std::size_t n = 1; n <= 2 * square; ++n) {
+      const SubjectAssignment subject{subject_id(n), n};
+      const std::vector<std::string> blocks = block_conditions(protocol, protocol.phases.front(), subject);
+      ++cells[{subject_group(protocol, subject), blocks.front()}];
+    }
+    CHECK(cells.size() == 4);  // (group, first condition): A A, A B, B A, B B
+    for (const auto& [cell, count] : cells) CHECK(count == 2);
+    // Without groups the order is the number's, as before: subject 1 the listed order, subject 2 the other.
+    const StudyProtocol alone = parse_study_protocol(
+        R"({"name": "w", "conditions": [{"name": "A", "mode": "vision"}, {"name": "B", "mode": "haptic"}],
+            "test": {"characters": ["十"], "conditions": ["A", "B"], "repetitions": 2},
+            "order": {"conditions": ")" +
+            order + R"("}})",
+        "w.json");
+    CHECK(block_conditions(alone, alone.phases.back(), {subject_id(1), 1}).front() == "A");
+    CHECK(block_conditions(alone, alone.phases.back(), {subject_id(2), 2}).front() == "B");
+    CHECK(counterbalancing_square(alone) == 2);
+  }
+}

@@ -214,7 +214,9 @@ std::string session_plan_json(const LoadedProtocol& loaded, std::span<const Subj
         phase["items"] = items;
         phase["item_sets"] = planned.phase->item_sets;
         phase["repetitions"] = planned.phase->repetitions;
-        phase["first_trial"] = planned.first_trial;
+        // 1-based, the `index` of the phase's first trial in session.json's plan: a study's indices count
+        // from 1 wherever it shows them.
+        phase["first_trial"] = planned.first_trial + 1;
         phase["trials"] = planned.trials;
         phases.push_back(phase);
       }

@@ -137,6 +137,17 @@ std::size_t between_subjects_cycle(const StudyProtocol& protocol) {
   return cycle;
 }
 
+// The 0-based cell from which whatever else is assigned by number (a crossover's sequence and rotation, a
+// within-subjects phase's Latin square row or ABBA direction) is taken: m = j + g, g = (n - 1) mod G the
+// subject's group and j = (n - 1) / G its place in the group, G the between-subjects cycle (n - 1 when there
+// are no groups). A cyclic Latin square of groups by subjects within the group: every group gets every row
+// over its own first subjects, and consecutive subjects consecutive cells. Counted over all subjects alone
+// (m = n - 1), two groups beside two orders would coincide: every subject of a group in one order.
+std::size_t assignment_cell(const StudyProtocol& protocol, std::size_t number) {
+  const std::size_t cycle = between_subjects_cycle(protocol);
+  return (number - 1) / cycle + (number - 1) % cycle;
+}
+
 }  // namespace
 
 CrossoverAssignment crossover_assignment(const StudyProtocol& protocol, const SubjectAssignment& subject) {
@@ -159,14 +170,11 @@ CrossoverAssignment crossover_assignment(const StudyProtocol& protocol, const Su
   // after each other one, equally often. The rotation, advanced once per full set of rows, moves every
   // condition over every set, so that condition and set are balanced every rows x k subjects.
   const std::size_t rows = k % 2 == 0 ? k : 2 * k;
-  // In a mixed design the groups of the between-subjects phases take turns by number, g = (n - 1) mod G, and
-  // j = (n - 1) / G counts the subject within its group. The cell m = j + g (a cyclic Latin square of groups
-  // by subjects within the group) gives every group every sequence and rotation over its first rows x k
-  // subjects, and consecutive subjects consecutive cells, so that the sequences stay balanced over all
-  // subjects too: counted over all subjects alone, group and sequence could coincide (two groups, two
-  // sequences); counted within the group alone (m = j), G subjects in a row would share one sequence.
-  const std::size_t cycle = between_subjects_cycle(protocol);
-  const std::size_t cell = (subject.number - 1) / cycle + (subject.number - 1) % cycle;
+  // In a mixed design the cell m = j + g (`assignment_cell`) gives every group every sequence and rotation
+  // over its first rows x k subjects, and consecutive subjects consecutive cells, so that the sequences stay
+  // balanced over all subjects too; counted within the group alone (m = j), G subjects in a row would share
+  // one sequence.
+  const std::size_t cell = assignment_cell(protocol, subject.number);
   const std::size_t row = cell % rows;
   out.rotation = (cell / rows) % k;
   const std::vector<std::size_t> order = williams_row(k, row);
@@ -228,12 +236,15 @@ std::vector<std::string> block_conditions(const StudyProtocol& protocol, const P
       break;
     case ConditionOrder::latin_square: {
       const std::size_t rows = n % 2 == 0 ? n : 2 * n;
-      for (const std::size_t k : williams_row(n, (subject.number - 1) % rows)) blocks.push_back(listed[k]);
+      // By the subject's cell, so that beside between-subjects groups every group gets every row.
+      const std::size_t row = assignment_cell(protocol, subject.number) % rows;
+      for (const std::size_t k : williams_row(n, row)) blocks.push_back(listed[k]);
       break;
     }
     case ConditionOrder::abba: {
       std::vector<std::string> first = listed;
-      if (subject.number % 2 == 0) std::reverse(first.begin(), first.end());
+      // Odd cells (even numbers without groups) reverse: every group gets both directions.
+      if (assignment_cell(protocol, subject.number) % 2 == 1) std::reverse(first.begin(), first.end());
       blocks = first;
       blocks.insert(blocks.end(), first.rbegin(), first.rend());
       break;
@@ -366,9 +377,9 @@ std::size_t counterbalancing_square(const StudyProtocol& protocol) {
     if (phase.assignment == ConditionAssignment::crossover) {
       square = std::lcm(square, groups * rows * n);  // counted within the group (crossover_assignment)
     } else if (n > 1 && protocol.condition_order == ConditionOrder::latin_square) {
-      square = std::lcm(square, rows);
+      square = std::lcm(square, groups * rows);  // every group every row (block_conditions)
     } else if (n > 1 && protocol.condition_order == ConditionOrder::abba) {
-      square = std::lcm(square, std::size_t{2});
+      square = std::lcm(square, groups * 2);
     }
   }
   return square;

@@ -115,7 +115,8 @@ class DesignsCliTest(StudyCliTest):
                 self.assertEqual(len(records), len(trials), where)
                 # The plan's blocks, phase by phase, are the conditions of the trials that ran.
                 for phase in shown["phases"]:
-                    ran = trials[phase["first_trial"]:phase["first_trial"] + phase["trials"]]
+                    ran = trials[phase["first_trial"] - 1:phase["first_trial"] - 1 + phase["trials"]]
+                    self.assertEqual(ran[0]["index"], phase["first_trial"], where)
                     self.assertEqual({t["phase"] for t in ran}, {phase["phase"]}, where)
                     blocks = []
                     for t in ran:

@@ -52,10 +52,14 @@ struct SubjectAssignment {
 /// 2:149-168: every condition follows every other equally often; n rows for an even number n of conditions,
 /// 2n for odd n); `abba`: the listed order then its reverse for odd numbers, the reversed order then the
 /// listed one for even numbers; `random`: a Fisher-Yates shuffle seeded from the protocol's seed and the
-/// subject id. Between subjects, the one condition of the subject's group: the (number - 1) mod n-th listed
-/// (groups balanced in turn), or under a `random` order a seeded draw. A crossover phase: its conditions in
-/// the subject's period order (`crossover_assignment`), whatever the protocol's order. Throws InvalidArgument
-/// naming the subject when the id is not a label, or when the order or the groups need a number and it is 0.
+/// subject id. Beside between-subjects phases (groups in turn by number), the row and the direction come from
+/// the subject's cell m = j + g instead of number - 1 (g = (number - 1) mod G its group, j = (number - 1) / G
+/// its place in the group, G as `crossover_assignment`), so that every group gets every row and both
+/// directions and the order is not the group. Between subjects, the one condition of the subject's group: the
+/// (number - 1) mod n-th listed (groups balanced in turn), or under a `random` order a seeded draw. A
+/// crossover phase: its conditions in the subject's period order (`crossover_assignment`), whatever the
+/// protocol's order. Throws InvalidArgument naming the subject when the id is not a label, or when the order
+/// or the groups need a number and it is 0.
 [[nodiscard]] std::vector<std::string> block_conditions(const StudyProtocol& protocol,
                                                         const ProtocolPhase& phase,
                                                         const SubjectAssignment& subject);
@@ -136,8 +140,9 @@ struct PlannedPhase {
 /// Subjects after which every assignment the protocol makes by subject number repeats (a full
 /// counterbalancing square): the least common multiple of the between-subjects groups' cycle G (the lcm of
 /// those phases' condition counts; 1 under a random order), the crossover's G x rows x k
-/// (`crossover_assignment`), and, for within-subjects phases of two or more conditions, the Latin square's
-/// rows (`latin_square`: n for even n, 2n for odd n) or 2 (`abba`). 1 when nothing is assigned by number.
+/// (`crossover_assignment`), and, for within-subjects phases of two or more conditions, G x the Latin
+/// square's rows (`latin_square`: n for even n, 2n for odd n) or G x 2 (`abba`): every group gets every order
+/// (`block_conditions`). 1 when nothing is assigned by number.
 [[nodiscard]] std::size_t counterbalancing_square(const StudyProtocol& protocol);
 
 /// One factor a protocol counterbalances, and how many of some subjects are at each of its levels.
