@@ -45,6 +45,7 @@ void read_all(std::span<const std::uint8_t> bytes) {
     for (char32_t cp : store.characters()) {
       try {
         (void)store.load(cp);
+        (void)store.load_outline_paths(cp);
       } catch (const calligraphy::DataError&) {
         // A bad record must not stop the others from being tried.
       }

@@ -44,12 +44,14 @@ std::vector<char32_t> random_store_characters(std::size_t count) {
 
 }  // namespace
 
-TEST_CASE("The bundled store holds every hanzi-writer-data character with its medians", "[store][bundled]") {
+TEST_CASE("The bundled store holds every hanzi-writer-data character with its medians and outlines",
+          "[store][bundled]") {
   const CorpusStore& store = CorpusStore::bundled();
   CHECK(store.size() == 9574);
   CHECK(store.info().version_major == 1);
-  CHECK(store.info().version_minor == 1);
+  CHECK(store.info().version_minor == 2);
   CHECK(store.info().medians);
+  CHECK(store.info().outlines);
   CHECK(store.info().steps_per_unit == CorpusStoreOptions{}.steps_per_unit);
   CHECK(store.name() == "bundled:hanzi-writer-data-2.0.1.clg");
   CHECK(std::string(CorpusStore::bundled_sha256()).size() == 64);
@@ -89,8 +91,20 @@ TEST_CASE("The standard set loads characters beyond the embedded ones from the b
     // A scene follows the medians, as for an embedded character (docs/stroke-acceptance.md).
     const Scene scene = Scene::lay_out({character});
     for (const auto& placed : scene.characters[0].strokes) CHECK(placed.median_m.size() >= 2);
-    CHECK_THROWS_WITH(standard.load_outlines(c),
-                      Catch::Contains("bundled:hanzi-writer-data-2.0.1.clg") && Catch::Contains("outlines"));
+    // Drawn as Hanzi Writer draws it: one filled outline per stroke, around that stroke's median.
+    const CharacterOutlines outlines = standard.load_outlines(c);
+    CHECK(outlines.source.find("bundled:hanzi-writer-data-2.0.1.clg#") == 0);
+    REQUIRE(outlines.strokes.size() == character.strokes.size());
+    for (std::size_t s = 0; s < outlines.strokes.size(); ++s) {
+      INFO("stroke " << s + 1);
+      REQUIRE_FALSE(outlines.strokes[s].empty());
+      const auto inside = [&](const Vec2& p) {
+        return std::any_of(outlines.strokes[s].begin(), outlines.strokes[s].end(),
+                           [&](const OutlinePolygon& polygon) { return polygon_contains(polygon, p); });
+      };
+      const std::vector<Vec2>& median = character.strokes[s].median;
+      CHECK(inside(median[median.size() / 2]));
+    }
   }
   // An embedded character is still fitted from its JSON file, with its outlines.
   CHECK(standard.load(U'永').source == embedded.load(U'永').source);
@@ -134,8 +148,10 @@ TEST_CASE("A copy of the store file truncated or damaged is refused naming the f
   std::filesystem::remove(path);
 }
 
-TEST_CASE("The bundled store's medians are hanzi-writer-data's, exactly, for every character of the package",
-          "[store][bundled]") {
+TEST_CASE(
+    "The bundled store's medians and outlines are hanzi-writer-data's, exactly, for every character of the "
+    "package",
+    "[store][bundled]") {
   // The whole package where scripts/test.sh fetched it, else the sample in tests/data (said on stdout).
   const CharacterLibrary package = CharacterLibrary::from_directory(testing::corpus_folder());
   const CorpusStore& store = CorpusStore::bundled();
@@ -149,6 +165,14 @@ TEST_CASE("The bundled store's medians are hanzi-writer-data's, exactly, for eve
     REQUIRE(stored.strokes.size() == data.medians.size());
     for (std::size_t s = 0; s < data.medians.size(); ++s) {
       if (stored.strokes[s].median != data.medians[s]) FAIL("stroke " << s + 1 << ": the median differs");
+    }
+    // The outlines: the same numbers as the file's paths (compact or as text), so the same polygons.
+    const std::vector<std::string> paths = package.load_outline_paths(c);
+    const std::vector<std::string> stored_paths = store.load_outline_paths(c);
+    REQUIRE(stored_paths.size() == paths.size());
+    for (std::size_t s = 0; s < paths.size(); ++s) {
+      if (parse_svg_path(stored_paths[s]) != parse_svg_path(paths[s]))
+        FAIL("stroke " << s + 1 << ": the outline differs");
     }
     ++compared;
   }

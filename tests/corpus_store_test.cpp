@@ -7,6 +7,7 @@
 #include <map>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
@@ -26,6 +27,23 @@ std::vector<Character> embedded_characters() {
 std::vector<Character> small_set() {
   const CharacterLibrary library = CharacterLibrary::embedded();
   return {library.load(U'永'), library.load(U'十')};
+}
+
+// Each character's outline paths as its embedded file gives them.
+std::vector<std::vector<std::string>> outline_paths(const std::vector<Character>& characters) {
+  const CharacterLibrary library = CharacterLibrary::embedded();
+  std::vector<std::vector<std::string>> paths;
+  for (const Character& c : characters) paths.push_back(library.load_outline_paths(c.code_point));
+  return paths;
+}
+
+// Every load of every character and its outlines either succeeds or throws DataError.
+void open_and_load_outlines(std::span<const std::uint8_t> bytes) {
+  const CorpusStore store = CorpusStore::from_bytes(bytes, "test");
+  for (char32_t cp : store.characters()) {
+    (void)store.load(cp);
+    (void)store.load_outline_paths(cp);
+  }
 }
 
 std::filesystem::path temp_path(const std::string& name) {
@@ -148,9 +166,90 @@ TEST_CASE("Store medians: exact in any unit, every count coded, bounds refused",
   CHECK_THROWS_WITH(encode_corpus_store(std::vector{bad}), Catch::Contains("16383"));
 }
 
+TEST_CASE("Store outlines: the same numbers back, compact or as text, and none where none were given",
+          "[store]") {
+  const std::vector<Character> characters = embedded_characters();
+  const std::vector<std::vector<std::string>> paths = outline_paths(characters);
+  const auto bytes = encode_corpus_store(characters, {}, paths);
+  const CorpusStore store = CorpusStore::from_bytes(bytes, "memory");
+  CHECK(store.info().version_minor == 2);
+  CHECK(store.info().outlines);
+  CHECK(store.info().medians);
+  // hanzi-writer-data's paths are absolute commands in whole units: stored compactly, far below their text.
+  std::size_t text_bytes = 0;
+  for (const auto& character : paths) {
+    for (const std::string& path : character) text_bytes += path.size();
+  }
+  CHECK(bytes.size() - encode_corpus_store(characters).size() < text_bytes / 2);
+  for (std::size_t i = 0; i < characters.size(); ++i) {
+    INFO(describe_character(characters[i].code_point));
+    const std::vector<std::string> back = store.load_outline_paths(characters[i].code_point);
+    REQUIRE(back.size() == paths[i].size());
+    for (std::size_t s = 0; s < back.size(); ++s)
+      CHECK(parse_svg_path(back[s]) == parse_svg_path(paths[i][s]));
+  }
+
+  // Paths not in the compact form (relative commands, S, decimals, an exponent, implicit repetition, two
+  // subpaths, a '+') come back as their text; a character without outlines has none.
+  Character shi = CharacterLibrary::embedded().load(U'十');
+  Character yong = CharacterLibrary::embedded().load(U'永');
+  Character ren = CharacterLibrary::embedded().load(U'人');
+  const std::vector<std::string> odd = {"m 10 20 l 30 0 l 0 30 z", "M +1.5 2 L 40 2 L 40 40.25 Z"};
+  REQUIRE(yong.strokes.size() == 5);
+  const std::vector<std::string> more = {
+      "M 0 0 C 10 0 20 10 20 20 S 30 40 0 40 Z", "M 0 0 L 1e2 0 L 100 100 Z", "M 0 0 L 50 0 50 50 Z",
+      "M 0 0 L 9 0 L 9 9 Z M 20 20 L 30 20 L 30 30 Z", "M 0 0 L -100000 0 L 0 100000 Z"};
+  const std::vector<std::vector<std::string>> forged = {odd, more, {}};
+  const CorpusStore forged_store = CorpusStore::from_bytes(
+      encode_corpus_store(std::vector<Character>{shi, yong, ren}, {}, forged), "forged");
+  CHECK(forged_store.load_outline_paths(U'十') == odd);
+  const std::vector<std::string> back = forged_store.load_outline_paths(U'永');
+  REQUIRE(back.size() == more.size());
+  for (std::size_t s = 0; s < back.size(); ++s) CHECK(parse_svg_path(back[s]) == parse_svg_path(more[s]));
+  CHECK(back.back() == "M 0 0 L -100000 0 L 0 100000 Z");  // compact: whole units within the bound
+  CHECK(forged_store.load_outline_paths(U'人').empty());
+
+  // Asked not to, or given none, the writer writes a 1.1 store, which has none to give.
+  CorpusStoreOptions options;
+  options.outlines = false;
+  for (const auto& without :
+       {encode_corpus_store(characters, options, paths), encode_corpus_store(characters)}) {
+    const CorpusStore plain = CorpusStore::from_bytes(without, "plain");
+    CHECK(plain.info().version_minor == 1);
+    CHECK_FALSE(plain.info().outlines);
+    CHECK(plain.load_outline_paths(U'永').empty());
+  }
+  // What it cannot store is refused, naming the character.
+  CHECK_THROWS_AS(encode_corpus_store(characters, {}, std::vector<std::vector<std::string>>(2)),
+                  InvalidArgument);
+  CHECK_THROWS_WITH(encode_corpus_store(std::vector<Character>{shi}, {},
+                                        std::vector<std::vector<std::string>>{{"M 0 0 L 1 1 L 0 1 Z"}}),
+                    Catch::Contains("U+5341") && Catch::Contains("1 outlines for 2 strokes"));
+  CHECK_THROWS_WITH(encode_corpus_store(std::vector<Character>{shi}, {},
+                                        std::vector<std::vector<std::string>>{
+                                            {std::string(1 << 20, ' '), "M 0 0 L 1 1 L 0 1 Z"}}),
+                    Catch::Contains("1,048,575"));
+}
+
+TEST_CASE("Store with outlines cut at every byte or with any byte changed is a DataError", "[store]") {
+  const std::vector<Character> set = small_set();
+  const auto bytes = encode_corpus_store(set, {}, outline_paths(set));
+  for (std::size_t n = 0; n < bytes.size(); ++n) {
+    INFO("truncated to " << n << " of " << bytes.size() << " bytes");
+    CHECK_THROWS_AS(open_and_load_outlines(std::span(bytes).first(n)), DataError);
+  }
+  CHECK_NOTHROW(open_and_load_outlines(bytes));
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    auto corrupted = bytes;
+    corrupted[i] ^= 0x10;
+    INFO("byte " << i);
+    CHECK_THROWS_AS(open_and_load_outlines(corrupted), DataError);
+  }
+}
+
 TEST_CASE("Store with an unknown header flag is refused naming the file and the offset", "[store]") {
   auto bytes = encode_corpus_store(small_set());
-  store::put_u32(bytes.data() + store::kOffFlags, store::kFlagMedians | 2u);
+  store::put_u32(bytes.data() + store::kOffFlags, store::kFlagMedians | 4u);
   store::put_u32(bytes.data() + store::kOffHeaderCrc,
                  store::crc32(std::span(bytes).first(store::kOffHeaderCrc)));
   CHECK_THROWS_WITH(CorpusStore::from_bytes(bytes, "flags.clg"),

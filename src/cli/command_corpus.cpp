@@ -51,7 +51,23 @@ struct BuildCommand {
   std::string out;
   double tolerance = FitOptions{}.tolerance;
   std::string medians = "on";
+  std::string outlines = "on";
 };
+
+// Each character's outline paths as its file gives them, in the order of `characters`; none for a file
+// without a readable `strokes` array (the character is still stored, drawn without outlines).
+std::vector<std::vector<std::string>> outline_paths(const CharacterLibrary& library,
+                                                    const std::vector<Character>& characters) {
+  std::vector<std::vector<std::string>> paths(characters.size());
+  for (std::size_t i = 0; i < characters.size(); ++i) {
+    try {
+      paths[i] = library.load_outline_paths(characters[i].code_point);
+      if (paths[i].size() != characters[i].strokes.size()) paths[i].clear();
+    } catch (const DataError&) {
+    }
+  }
+  return paths;
+}
 
 int run_build(const BuildCommand& command, bool verbose) {
   const std::filesystem::path folder = corpus_folder(command.fit);
@@ -65,6 +81,7 @@ int run_build(const BuildCommand& command, bool verbose) {
   store_options.steps_per_unit = std::stoi(command.fit.steps);
   store_options.fit_tolerance = fit_options.tolerance;
   store_options.medians = command.medians == "on";
+  store_options.outlines = command.outlines == "on";
 
   const auto start = Clock::now();
   const CorpusFit fit =
@@ -76,7 +93,10 @@ int run_build(const BuildCommand& command, bool verbose) {
   }
   const auto write_start = Clock::now();
   // Encoded in memory and then written whole: an earlier store survives any failure to write this one.
-  const std::vector<std::uint8_t> bytes = encode_corpus_store(fit.characters, store_options);
+  const std::vector<std::vector<std::string>> outlines = store_options.outlines
+                                                             ? outline_paths(library, fit.characters)
+                                                             : std::vector<std::vector<std::string>>{};
+  const std::vector<std::uint8_t> bytes = encode_corpus_store(fit.characters, store_options, outlines);
   write_output(command.out, bytes);
   const CorpusBuildTimes times{seconds_since(start), seconds_since(write_start)};
   write_standard_output(
@@ -140,6 +160,9 @@ void add_corpus_build_command(CLI::App& corpus, Commands& commands) {
              "a number of data units > 0", positive);
   add_choice(*app, "--medians", command->medians, {"on", "off"},
              "store the strokes' medians too (format 1.1; off: a 1.0 store of the models only)");
+  add_choice(
+      *app, "--outlines", command->outlines, {"on", "off"},
+      "store the strokes' outlines too, for drawing (format 1.2; off: none, the window draws the medians)");
   add_fit_options(*app, command->fit);
 }
 

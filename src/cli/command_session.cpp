@@ -148,20 +148,15 @@ SessionRunResult run_one(SessionFolder& session, const SessionRunOptions& option
     window.run = options;
     window.run.host = nullptr;
     const auto source = std::make_shared<CharacterSource>(library);
-    const auto outlines = std::make_shared<CharacterLibrary>(library_from(library));
-    // The bundled store holds no outlines by design (docs/corpus.md): only a folder or store the user named
-    // is expected to have them.
-    const bool outlines_expected = !library.data_folder.empty() || !library.store_file.empty();
-    window.load_character = [source, outlines, outlines_expected](char32_t c) {
+    window.load_character = [source](char32_t c) {
       trainer::TrainerCharacter character;
       character.model = source->load(c);
       character.utf8 = encode_utf8(c);
       try {
-        character.outlines = outlines->load_outlines(c);
-      } catch (const DataError& e) {  // drawn without outlines
-        if (outlines_expected)
-          print_error_line("calligraphy session", "warning",
-                           "no stroke outlines for " + character.utf8 + ": " + e.what());
+        character.outlines = source->load_outlines(c);
+      } catch (const DataError& e) {  // e.g. a store built with `--outlines off`: drawn without outlines
+        print_error_line("calligraphy session", "warning",
+                         "no stroke outlines for " + character.utf8 + ": " + e.what());
       }
       return character;
     };

@@ -148,19 +148,15 @@ int run_train(const TrainCommand& command, DeviceRegistry& devices) {
     options.watchdog_s = static_cast<double>(command.watchdog_ms) / 1000.0;
   options.library_version = CALLIGRAPHY_VERSION;
   const CharacterSource source(command.library);
-  const CharacterLibrary outlines = library_from(command.library);
   for (const char32_t c : chars) {
     trainer::TrainerCharacter character;
     character.model = source.load_named(c, "CHARS");
     character.utf8 = encode_utf8(c);
     try {
-      character.outlines = outlines.load_outlines(c);
-    } catch (const DataError& e) {  // e.g. a store without the data folder: drawn without outlines
-      // The bundled store holds no outlines by design (docs/corpus.md): only a folder or store the user named
-      // is expected to have them.
-      if (!command.library.data_folder.empty() || !command.library.store_file.empty())
-        print_error_line("calligraphy train", "warning",
-                         "no stroke outlines for " + character.utf8 + ": " + e.what());
+      character.outlines = source.load_outlines(c);
+    } catch (const DataError& e) {  // e.g. a store built with `--outlines off`: drawn without outlines
+      print_error_line("calligraphy train", "warning",
+                       "no stroke outlines for " + character.utf8 + ": " + e.what());
     }
     options.characters.push_back(std::move(character));
   }

@@ -36,6 +36,9 @@ class CharacterSource {
   /// but one the library lacks is the user's input, a UsageError (exit 2) starting with `named_by`, as a
   /// protocol's is; one the library has but cannot read stays a DataError (exit 1).
   [[nodiscard]] Character load_named(char32_t code_point, const std::string& named_by) const;
+  /// The character's stroke outlines, for drawing (from the store named, else the library). Throws
+  /// DataError when there are none (a store built with `corpus build --outlines off`) or as `load`.
+  [[nodiscard]] CharacterOutlines load_outlines(char32_t code_point) const;
   /// True when the character is there.
   [[nodiscard]] bool contains(char32_t code_point) const;
   /// Every character there, sorted by code point (DataError for a folder without character files).

@@ -51,6 +51,7 @@ std::string corpus_stats_json(const CorpusStore& store, const CorpusStoreStats& 
       {"file", store.name()},
       {"format_version", std::to_string(info.version_major) + "." + std::to_string(info.version_minor)},
       {"medians", info.medians},
+      {"outlines", info.outlines},
       {"characters", info.character_count},
       {"strokes", stats.strokes},
       {"elements", stats.elements},
@@ -71,7 +72,9 @@ std::string corpus_stats_text(const CorpusStore& store, const CorpusStoreStats& 
   std::string out;
   appendf(out, "corpus store %s\n", store.name().c_str());
   appendf(out, "  format version      %d.%d (%s)\n", info.version_major, info.version_minor,
-          info.medians ? "models and medians" : "models only, no medians");
+          info.outlines  ? (info.medians ? "models, medians and outlines" : "models and outlines")
+          : info.medians ? "models and medians"
+                         : "models only, no medians");
   appendf(out, "  characters          %zu\n", info.character_count);
   appendf(out, "  strokes             %zu\n", stats.strokes);
   appendf(out, "  elements            %zu (%.2f per stroke)\n", stats.elements,

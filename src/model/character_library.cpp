@@ -116,41 +116,36 @@ CharacterData CharacterLibrary::load_data(char32_t cp) const {
   return parse_hanzi_writer_json(document.text, cp, document.source);
 }
 
-CharacterOutlines CharacterLibrary::load_outlines(char32_t cp, double tolerance) const {
-  if (!(tolerance > 0.0)) {
-    throw InvalidArgument("load_outlines: tolerance " + shortest_decimal(tolerance) +
-                          " must be > 0 data units");
-  }
+std::vector<std::string> CharacterLibrary::load_outline_paths(char32_t cp) const {
+  return outline_paths(cp).paths;
+}
+
+CharacterLibrary::OutlinePaths CharacterLibrary::outline_paths(char32_t cp) const {
   if (from_bundled_store(cp)) {
     const CorpusStore& store = CorpusStore::bundled();
-    if (!store.contains(cp)) (void)store.load(cp);  // CharacterNotFound naming the character and the store
-    throw DataError(store.name() + ": character " + describe_character(cp) +
-                    ": no stroke outlines (the corpus store holds the models and medians; the outlines are "
-                    "in the hanzi-writer-data package, scripts/fetch-hanzi-writer-data.sh)");
+    OutlinePaths found{store.load_outline_paths(cp), store.name() + "#" + describe_character(cp)};
+    if (found.paths.empty()) {
+      throw DataError(store.name() + ": character " + describe_character(cp) +
+                      ": no stroke outlines (a store built without them, `corpus build --outlines off`)");
+    }
+    return found;
   }
   const Document document = read_document(folder_, cp);
   if (document.text.size() > kMaxCharacterFileBytes) {
     fail(document.source, cp, "/", "document larger than a character file may be");
   }
-  const detail::OutlineJsonResult read = detail::read_outlines_json(document.text);
+  detail::OutlineJsonResult read = detail::read_outlines_json(document.text);
   if (!read.ok) fail(document.source, cp, read.where, read.what);
-  CharacterOutlines outlines;
-  outlines.code_point = cp;
-  outlines.source = document.source;
-  std::size_t vertices = 0;
-  for (std::size_t i = 0; i < read.paths.size(); ++i) {
-    try {
-      outlines.strokes.push_back(parse_svg_path(read.paths[i], tolerance));
-    } catch (const DataError& e) {
-      fail(document.source, cp, "/strokes/" + std::to_string(i), e.what());
-    }
-    for (const OutlinePolygon& polygon : outlines.strokes.back()) vertices += polygon.size();
-    if (vertices > kMaxOutlineVertices) {
-      fail(document.source, cp, "/strokes/" + std::to_string(i),
-           "more than " + std::to_string(kMaxOutlineVertices) + " outline vertices in all strokes");
-    }
+  return {std::move(read.paths), document.source};
+}
+
+CharacterOutlines CharacterLibrary::load_outlines(char32_t cp, double tolerance) const {
+  if (!(tolerance > 0.0)) {
+    throw InvalidArgument("load_outlines: tolerance " + shortest_decimal(tolerance) +
+                          " must be > 0 data units");
   }
-  return outlines;
+  const OutlinePaths found = outline_paths(cp);
+  return outlines_from_paths(cp, found.paths, found.source, tolerance);
 }
 
 Character CharacterLibrary::load(char32_t cp, const FitOptions& options) const {
@@ -207,6 +202,27 @@ std::string CharacterLibrary::description() const {
     return "embedded default (" + embedded + " characters)";
   }
   return folder_.string();
+}
+
+CharacterOutlines outlines_from_paths(char32_t cp, std::span<const std::string> paths,
+                                      const std::string& source, double tolerance) {
+  CharacterOutlines outlines;
+  outlines.code_point = cp;
+  outlines.source = source;
+  std::size_t vertices = 0;
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    try {
+      outlines.strokes.push_back(parse_svg_path(paths[i], tolerance));
+    } catch (const DataError& e) {
+      fail(source, cp, "/strokes/" + std::to_string(i), e.what());
+    }
+    for (const OutlinePolygon& polygon : outlines.strokes.back()) vertices += polygon.size();
+    if (vertices > kMaxOutlineVertices) {
+      fail(source, cp, "/strokes/" + std::to_string(i),
+           "more than " + std::to_string(kMaxOutlineVertices) + " outline vertices in all strokes");
+    }
+  }
+  return outlines;
 }
 
 }  // namespace calligraphy

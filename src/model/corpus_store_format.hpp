@@ -12,15 +12,17 @@ namespace calligraphy::store {
 inline constexpr std::array<std::uint8_t, 8> kMagic = {'C', 'L', 'G', 'S', 'T', 'O', 'R', 'E'};
 inline constexpr std::uint16_t kVersionMajor = 1;  // readers reject another major version
 // Minor 0: the models only. Minor 1: header flag kFlagMedians may be set (the records then end with the
-// strokes' medians). Readers accept any minor and refuse flags they do not know.
+// strokes' medians). Minor 2: header flag kFlagOutlines may be set (the records then end with the strokes'
+// outlines). Readers accept any minor and refuse flags they do not know.
+inline constexpr std::uint16_t kVersionMinorWithOutlines = 2;
 inline constexpr std::uint16_t kVersionMinor = 1;
 inline constexpr std::uint16_t kVersionMinorWithoutMedians = 0;
 inline constexpr std::size_t kHeaderBytes = 64;
 inline constexpr std::size_t kTypicalStrokeCount = 39;
 // Two float64 per typical ID: the default attraction factor, then the corner attraction factor.
 inline constexpr std::size_t kDefaultsBytes = 16 * kTypicalStrokeCount;
-inline constexpr std::size_t kIndexEntryBytes = 12;                     // code point, offset, CRC
-inline constexpr std::int64_t kMaxCoordinate = std::int64_t{1} << 23;   // quantised |x|
+inline constexpr std::size_t kIndexEntryBytes = 12;                    // code point, offset, CRC
+inline constexpr std::int64_t kMaxCoordinate = std::int64_t{1} << 23;  // quantised |x|
 
 // Header field offsets.
 inline constexpr std::size_t kOffVersionMajor = 8, kOffVersionMinor = 10, kOffHeaderSize = 12, kOffCount = 16,
@@ -29,7 +31,25 @@ inline constexpr std::size_t kOffVersionMajor = 8, kOffVersionMinor = 10, kOffHe
 
 // Header flags (u32 at kOffFlags).
 inline constexpr std::uint32_t kFlagMedians = 1;  // every record ends with its strokes' medians (minor 1)
-inline constexpr std::uint32_t kKnownFlags = kFlagMedians;
+inline constexpr std::uint32_t kFlagOutlines =
+    2;  // then with its strokes' outlines, if it has them (minor 2)
+inline constexpr std::uint32_t kKnownFlags = kFlagMedians | kFlagOutlines;
+// Outlines (SVG path data, one path per stroke): one bit, the character has them; then per stroke one bit,
+// the path as text (1: a length of kOutlineTextLengthBits and the bytes) or compact (0): a command count in
+// 7 bits (127: 16 bits follow), each command in 3 bits (kOutlineCommands), and the commands' points as whole
+// data units, the first absolute, the others from the point before, x and y each in its own width.
+inline constexpr char kOutlineCommands[] = {'M', 'L', 'Q', 'C', 'Z'};
+inline constexpr int kOutlineCommandBits = 3;
+inline constexpr std::uint64_t kOutlineCountEscape = 127;
+inline constexpr int kOutlineCountBits = 7;
+inline constexpr int kOutlineCountExtensionBits = 16;
+inline constexpr int kOutlineTextLengthBits = 20;
+inline constexpr std::int64_t kMaxOutlineCoordinate =
+    100'000;  // |x| of a compact point, as kMaxDataCoordinate
+/// Points a compact outline command takes (M, L, Q, C, Z).
+inline constexpr int outline_command_points(char command) {
+  return command == 'Q' ? 2 : command == 'C' ? 3 : command == 'Z' ? 0 : 1;
+}
 // Median points: a count of points per stroke in 5 bits; 31 means a 14-bit count follows.
 inline constexpr std::uint64_t kMedianCountEscape = 31;
 inline constexpr int kMedianCountExtensionBits = 14;

@@ -16,6 +16,7 @@
 #include "calligraphy/model/corpus_store.hpp"
 #include "model/bundled_corpus_store.hpp"
 #include "model/corpus_store_format.hpp"
+#include "model/corpus_store_outlines.hpp"
 
 namespace calligraphy {
 
@@ -69,7 +70,8 @@ struct CorpusStore::Data {
   }
 
   void validate();
-  [[nodiscard]] Character decode(std::size_t k) const;
+  /// The character; its outlines' paths into `outlines` when not null (they are checked either way).
+  [[nodiscard]] Character decode(std::size_t k, std::vector<std::string>* outlines = nullptr) const;
 };
 
 void CorpusStore::Data::validate() {
@@ -89,6 +91,7 @@ void CorpusStore::Data::validate() {
   const std::uint32_t flags = get_u32(bytes + kOffFlags);
   if ((flags & ~kKnownFlags) != 0) fail(kOffFlags, "unknown flags");
   info.medians = (flags & kFlagMedians) != 0;
+  info.outlines = (flags & kFlagOutlines) != 0;
   info.character_count = get_u32(bytes + kOffCount);
   info.steps_per_unit = static_cast<int>(get_u32(bytes + kOffSteps));
   const int s = info.steps_per_unit;
@@ -136,7 +139,7 @@ void CorpusStore::Data::validate() {
   }
 }
 
-Character CorpusStore::Data::decode(std::size_t k) const {
+Character CorpusStore::Data::decode(std::size_t k, std::vector<std::string>* outlines) const {
   const char32_t cp = code_point_at(k);
   const std::size_t begin = record_begin(k);
   const std::span<const std::uint8_t> record(records + begin, record_end(k) - begin);
@@ -259,6 +262,10 @@ Character CorpusStore::Data::decode(std::size_t k) const {
       }
     }
   }
+  if (info.outlines) {
+    std::vector<std::string> paths = decode_outlines(in, stroke_count, outlines != nullptr, bad);
+    if (outlines != nullptr) *outlines = std::move(paths);
+  }
   // The writer pads the last byte with zero bits and writes nothing after.
   std::uint64_t padding = 0;
   if (in.remaining() >= 8 || !in.get(static_cast<int>(in.remaining()), padding) || padding != 0) {
@@ -351,6 +358,14 @@ Character CorpusStore::load(char32_t cp) const {
   const std::size_t k = data_->find(cp);
   if (k == data_->info.character_count) not_found(data_->name, cp, k);
   return data_->decode(k);
+}
+
+std::vector<std::string> CorpusStore::load_outline_paths(char32_t cp) const {
+  const std::size_t k = data_->find(cp);
+  if (k == data_->info.character_count) not_found(data_->name, cp, k);
+  std::vector<std::string> paths;
+  (void)data_->decode(k, &paths);
+  return paths;
 }
 
 CorpusStoreStats corpus_store_stats(const CorpusStore& store) {

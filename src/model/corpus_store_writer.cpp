@@ -11,6 +11,7 @@
 #include "calligraphy/model/corpus_store.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
 #include "model/corpus_store_format.hpp"
+#include "model/corpus_store_outlines.hpp"
 
 namespace calligraphy {
 namespace {
@@ -25,8 +26,8 @@ struct QPoint {
 
 class RecordEncoder {
  public:
-  RecordEncoder(const Character& character, int steps, bool medians)
-      : character_(character), steps_(steps), medians_(medians) {}
+  RecordEncoder(const Character& character, int steps, bool medians, const std::vector<std::string>* outlines)
+      : character_(character), steps_(steps), medians_(medians), outlines_(outlines) {}
 
   std::vector<std::uint8_t> encode() {
     const auto& strokes = character_.strokes;
@@ -36,6 +37,9 @@ class RecordEncoder {
     for (std::size_t s = 0; s < strokes.size(); ++s) encode_stroke(s);
     if (medians_) {
       for (std::size_t s = 0; s < strokes.size(); ++s) encode_median(s);
+    }
+    if (outlines_ != nullptr) {
+      encode_outlines(out_, *outlines_, strokes.size(), [this](const std::string& what) { fail(what); });
     }
     return out_.take();
   }
@@ -208,6 +212,7 @@ class RecordEncoder {
   const Character& character_;
   int steps_;
   bool medians_;
+  const std::vector<std::string>* outlines_;  // null: the store holds no outlines
   BitWriter out_;
   QPoint previous_;
   std::vector<QPoint> median_origins_;
@@ -217,6 +222,12 @@ class RecordEncoder {
 
 std::vector<std::uint8_t> encode_corpus_store(std::span<const Character> characters,
                                               const CorpusStoreOptions& options) {
+  return encode_corpus_store(characters, options, {});
+}
+
+std::vector<std::uint8_t> encode_corpus_store(std::span<const Character> characters,
+                                              const CorpusStoreOptions& options,
+                                              std::span<const std::vector<std::string>> outline_paths) {
   const int steps = options.steps_per_unit;
   if (steps != 1 && steps != 2 && steps != 4 && steps != 8 && steps != 16) {
     throw InvalidArgument("corpus store: steps_per_unit must be 1, 2, 4, 8 or 16, got " +
@@ -225,13 +236,22 @@ std::vector<std::uint8_t> encode_corpus_store(std::span<const Character> charact
   if (!(options.fit_tolerance >= 0.0) || !std::isfinite(options.fit_tolerance)) {
     throw InvalidArgument("corpus store: fit_tolerance must be finite and >= 0");
   }
-  std::vector<const Character*> sorted;
-  for (const Character& c : characters) sorted.push_back(&c);
-  std::sort(sorted.begin(), sorted.end(), [](auto* a, auto* b) { return a->code_point < b->code_point; });
+  if (!outline_paths.empty() && outline_paths.size() != characters.size()) {
+    throw InvalidArgument("corpus store: " + std::to_string(outline_paths.size()) + " outline lists for " +
+                          std::to_string(characters.size()) + " characters");
+  }
+  // Outlines are stored when asked for and some character has them.
+  const bool outlines = options.outlines && std::any_of(outline_paths.begin(), outline_paths.end(),
+                                                        [](const auto& paths) { return !paths.empty(); });
+  std::vector<std::size_t> sorted(characters.size());
+  for (std::size_t i = 0; i < sorted.size(); ++i) sorted[i] = i;
+  std::sort(sorted.begin(), sorted.end(), [&](std::size_t a, std::size_t b) {
+    return characters[a].code_point < characters[b].code_point;
+  });
   for (std::size_t i = 1; i < sorted.size(); ++i) {
-    if (sorted[i]->code_point == sorted[i - 1]->code_point) {
-      throw InvalidArgument("corpus store: character " + describe_character(sorted[i]->code_point) +
-                            " given twice");
+    if (characters[sorted[i]].code_point == characters[sorted[i - 1]].code_point) {
+      throw InvalidArgument("corpus store: character " +
+                            describe_character(characters[sorted[i]].code_point) + " given twice");
     }
   }
 
@@ -239,11 +259,12 @@ std::vector<std::uint8_t> encode_corpus_store(std::span<const Character> charact
   const std::size_t records_offset = index_offset + kIndexEntryBytes * sorted.size();
   std::vector<std::uint8_t> file(records_offset, 0);
   for (std::size_t k = 0; k < sorted.size(); ++k) {
-    const Character* c = sorted[k];
+    const Character* c = &characters[sorted[k]];
     if (c->code_point > 0x10FFFF) throw InvalidArgument("corpus store: code point out of Unicode range");
     const std::size_t offset = file.size() - records_offset;
     if (offset > 0xFFFFFFFFu) throw InvalidArgument("corpus store: records exceed 4 GiB");
-    const std::vector<std::uint8_t> record = RecordEncoder(*c, steps, options.medians).encode();
+    const std::vector<std::uint8_t> record =
+        RecordEncoder(*c, steps, options.medians, outlines ? &outline_paths[sorted[k]] : nullptr).encode();
     file.insert(file.end(), record.begin(), record.end());
     std::uint8_t* entry = file.data() + index_offset + kIndexEntryBytes * k;
     put_u32(entry, static_cast<std::uint32_t>(c->code_point));
@@ -254,12 +275,14 @@ std::vector<std::uint8_t> encode_corpus_store(std::span<const Character> charact
   std::uint8_t* h = file.data();
   std::copy(kMagic.begin(), kMagic.end(), h);
   put_u16(h + kOffVersionMajor, kVersionMajor);
-  put_u16(h + kOffVersionMinor, options.medians ? kVersionMinor : kVersionMinorWithoutMedians);
+  put_u16(h + kOffVersionMinor, outlines          ? kVersionMinorWithOutlines
+                                : options.medians ? kVersionMinor
+                                                  : kVersionMinorWithoutMedians);
   put_u32(h + kOffHeaderSize, static_cast<std::uint32_t>(kHeaderBytes));
   put_u32(h + kOffCount, static_cast<std::uint32_t>(sorted.size()));
   put_u32(h + kOffSteps, static_cast<std::uint32_t>(steps));
   put_u32(h + kOffTolerance, float_bits(static_cast<float>(options.fit_tolerance)));
-  put_u32(h + kOffFlags, options.medians ? kFlagMedians : 0u);
+  put_u32(h + kOffFlags, (options.medians ? kFlagMedians : 0u) | (outlines ? kFlagOutlines : 0u));
   put_u64(h + kOffIndex, index_offset);
   put_u64(h + kOffRecords, records_offset);
   put_u64(h + kOffRecordsSize, file.size() - records_offset);
@@ -275,9 +298,15 @@ std::vector<std::uint8_t> encode_corpus_store(std::span<const Character> charact
 
 void write_corpus_store(const std::filesystem::path& path, std::span<const Character> characters,
                         const CorpusStoreOptions& options) {
+  write_corpus_store(path, characters, options, {});
+}
+
+void write_corpus_store(const std::filesystem::path& path, std::span<const Character> characters,
+                        const CorpusStoreOptions& options,
+                        std::span<const std::vector<std::string>> outline_paths) {
   // Encoded whole before the file is touched, then written as every output is: an earlier store survives
   // any failure, and no temporary file is left behind.
-  write_file_atomically(path, encode_corpus_store(characters, options));
+  write_file_atomically(path, encode_corpus_store(characters, options, outline_paths));
 }
 
 }  // namespace calligraphy

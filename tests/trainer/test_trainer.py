@@ -1030,9 +1030,9 @@ class SessionWindowTest(unittest.TestCase):
         self.assertGreater(fraction([near(image, box.data_to_px(p), 6, is_blue) for p in inner]), 0.9)
         self.assertGreater(fraction([near(image, box.data_to_px(p), 15, is_yellow) for p in inner]), 0.9)
 
-    def test_a_bundled_character_in_a_session_is_not_called_yellow(self):
-        """一 without --data comes from the bundled store, which holds no outlines: the session's learner panel
-        sends the person along the blue line, not to a yellow outline the window does not draw."""
+    def test_a_bundled_character_in_a_session_is_drawn_with_its_outline(self):
+        """一 without --data comes from the bundled store, which holds every character's outlines: the session's
+        learner panel sends the person to the stroke's yellow outline, as for an embedded character."""
         text = self.folder / "panel.txt"
         self.process = subprocess.Popen(
             [CLI, "session", "run", "tiny.json", "--subject", "S01", "--device", "mouse-hand", "--writer", "person",
@@ -1042,8 +1042,8 @@ class SessionWindowTest(unittest.TestCase):
         # Stopped by --exit-after during its first trial: the session is left to resume (exit 1).
         self.assertIn(self.process.wait(timeout=120), (0, 1), self.errors())
         panel = text.read_text(encoding="utf-8")
-        self.assertIn("follow the blue line", panel, panel)
-        self.assertNotIn("yellow", panel, panel)
+        self.assertIn("the darker yellow one", panel, panel)
+        self.assertNotIn("no stroke outlines", self.errors())
 
     def test_sigint_ends_the_session_keeping_the_running_trial_as_an_attempt(self):
         self.run_session()  # attended: the first trial waits for Space

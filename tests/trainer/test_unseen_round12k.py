@@ -610,10 +610,30 @@ class Characters(Learner):
         err = self.finish()
         self.assertRegex(err, r"trial 1 乘: .*no stroke written")
 
-    def test_a_character_without_outlines_is_not_called_yellow(self):
-        """一 comes from the bundled store, which holds no outlines: only its blue reference is drawn, so the
-        learner's panel must not send them to "the darker yellow one" that the window does not show."""
+    def test_a_character_of_the_bundled_store_is_drawn_with_its_outline(self):
+        """一 comes from the bundled store, which holds every character's outlines (docs/corpus.md): its stroke
+        is filled in yellow, as an embedded character's is, and the panel sends the learner to it."""
         self.start("一", "--device", "mouse", "--no-demo", panel=True)
+        (box,) = self.ready()
+        time.sleep(0.8)
+        image = DISPLAY.window_image(self.window)
+        self.quit_and_wait()
+        inside = [(x, y) for x in range(int(box.x), int(box.x + box.size), 3)
+                  for y in range(int(box.y), int(box.y + box.size), 3)]
+        self.assertGreater(sum(is_yellow(*image.pixel(x, y)) for x, y in inside), 100, "the outline filled yellow")
+        panel = self.panel()
+        self.assertIn("Stroke 1 of 1", panel)
+        self.assertIn("darker yellow", panel, panel)
+
+    def test_a_character_without_outlines_is_not_called_yellow(self):
+        """A store built without outlines (`corpus build --outlines off`, docs/cli.md): only the blue reference
+        is drawn, so the learner's panel must not send them to "the darker yellow one" the window does not show,
+        and the program says, once, that it has no outlines."""
+        store = self.folder / "plain.clg"
+        built = subprocess.run([CLI, "corpus", "build", "--data", str(EMBEDDED), "--out", str(store), "--outlines",
+                                "off", "--threads", "1"], capture_output=True, timeout=60)
+        self.assertEqual(built.returncode, 0, built.stderr)
+        self.start("十", "--store", str(store), "--device", "mouse", "--no-demo", panel=True)
         (box,) = self.ready()
         time.sleep(0.8)
         image = DISPLAY.window_image(self.window)
@@ -622,9 +642,12 @@ class Characters(Learner):
                   for y in range(int(box.y), int(box.y + box.size), 3)]
         self.assertFalse(any(is_yellow(*image.pixel(x, y)) for x, y in inside), "no outline drawn yellow")
         panel = self.panel()
-        self.assertIn("Stroke 1 of 1", panel)
+        self.assertIn("Stroke 1 of 2", panel)
         self.assertNotIn("yellow", panel, panel)
         self.assertIn("follow the blue line", panel)
+        warnings = [line for line in self.trainer.errors().splitlines() if "no stroke outlines" in line]
+        self.assertEqual(len(warnings), 1, self.trainer.errors())
+        self.assertIn("十", warnings[0])
 
     def test_a_character_in_no_set_is_named_and_no_window_opens(self):
         folder = self.folder / "out"

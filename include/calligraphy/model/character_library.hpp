@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -61,8 +62,7 @@ class CharacterLibrary {
   /// set, and every other character of hanzi-writer-data 2.0.1 (9,574 in all) from the corpus store
   /// compiled into the library (`CorpusStore::bundled()`). An embedded character is fitted from its JSON
   /// file as `embedded()` does; another is loaded from the store as fitted when the store was built
-  /// (elements within its quantisation, the medians exact). A store character has no outlines
-  /// (`load_outlines` throws DataError saying so). Nothing is read from disk.
+  /// (elements within its quantisation, the medians and the outlines exact). Nothing is read from disk.
   static CharacterLibrary standard();
   /// A folder of `<char>.json` files. Throws DataError when the folder does not exist. Only regular
   /// files of at most kMaxCharacterFileBytes are read (a FIFO or a device named like a character file
@@ -84,6 +84,9 @@ class CharacterLibrary {
   /// `load_data`, DataError naming the source, the character and the JSON pointer (/strokes/2) when the
   /// file has no such array or a path does not parse, and InvalidArgument when tolerance is not > 0.
   [[nodiscard]] CharacterOutlines load_outlines(char32_t code_point, double tolerance = 1.0) const;
+  /// The outlines as their SVG path data, one per stroke in stroke order (hanzi-writer-data's `strokes`;
+  /// for a character of the bundled store, the stored paths). Throws as `load_outlines`.
+  [[nodiscard]] std::vector<std::string> load_outline_paths(char32_t code_point) const;
   /// Every available character, sorted by code point. Throws DataError naming the folder when a folder
   /// holds no `<char>.json` file or cannot be listed.
   [[nodiscard]] std::vector<char32_t> characters() const;
@@ -93,9 +96,22 @@ class CharacterLibrary {
 
  private:
   [[nodiscard]] bool from_bundled_store(char32_t code_point) const;
+  struct OutlinePaths {
+    std::vector<std::string> paths;
+    std::string source;  // where they were read, for errors and CharacterOutlines::source
+  };
+  [[nodiscard]] OutlinePaths outline_paths(char32_t code_point) const;
 
   std::filesystem::path folder_;  // empty: embedded
   bool bundled_store_ = false;    // embedded, then the bundled corpus store (standard())
 };
+
+/// A character's outlines from its strokes' SVG path data (one path per stroke, in stroke order), each
+/// flattened within `tolerance` data units by `parse_svg_path`; `source` names where the paths were read.
+/// Throws DataError naming `source`, the character and the JSON pointer (/strokes/2) of a path that does not
+/// parse or past which the polygons hold more than kMaxOutlineVertices vertices in all; InvalidArgument for
+/// a tolerance not > 0.
+[[nodiscard]] CharacterOutlines outlines_from_paths(char32_t code_point, std::span<const std::string> paths,
+                                                    const std::string& source, double tolerance = 1.0);
 
 }  // namespace calligraphy

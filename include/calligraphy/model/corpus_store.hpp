@@ -10,8 +10,10 @@
 /// feature points (exact float64; a stroke whose factors all equal its typical stroke's default
 /// stores none) and, in a 1.1 store written with `CorpusStoreOptions::medians` (the default), the
 /// source medians, exactly, which stroke acceptance and scoring follow
-/// (docs/stroke-acceptance.md). A 1.0 store has no medians: a loaded `Stroke::median` is then empty
-/// and the centre line is the elements (`StrokeCentreLine`). `Character::source` is
+/// (docs/stroke-acceptance.md); in a 1.2 store (`CorpusStoreOptions::outlines`, the default, when the
+/// outlines are given) also the strokes' outlines for drawing (`load_outline_paths`). A 1.0 store has no
+/// medians: a loaded `Stroke::median` is then empty and the centre line is the elements (`StrokeCentreLine`).
+/// `Character::source` is
 /// "<store path>#<char> (U+XXXX)". Fidelity of the models against the medians is measured when the
 /// store is built (`calligraphy corpus fidelity`, docs/corpus.md).
 #include <cstdint>
@@ -39,13 +41,21 @@ struct CorpusStoreOptions {
   /// quarter units), else as float64 coordinates (2 strokes of hanzi-writer-data): format 1.1 with the
   /// medians flag. False writes a 1.0 store of the models only, which every 1.x reader reads.
   bool medians = true;
+  /// Also store each stroke's outline (hanzi-writer-data's `strokes`: SVG path data, for drawing) where
+  /// `encode_corpus_store` is given them: format 1.2 with the outlines flag. A path of absolute M, L, Q, C
+  /// and Z commands, one subpath, whole data units within +-1e5 (every path of hanzi-writer-data 2.0.1 but
+  /// those of 70 coordinates with decimals) is delta-coded; any other is kept as its text. Either way
+  /// `CorpusStore::load_outline_paths` gives back the same numbers, so the outlines flatten to the same
+  /// polygons as from the JSON file.
+  bool outlines = true;
 };
 
 /// What a store's header says, plus sizes.
 struct CorpusStoreInfo {
   int version_major = 0;
   int version_minor = 0;
-  bool medians = false;  ///< the records hold the strokes' medians (format 1.1, header flag 1)
+  bool medians = false;   ///< the records hold the strokes' medians (format 1.1, header flag 1)
+  bool outlines = false;  ///< the records hold the strokes' outlines where known (format 1.2, header flag 2)
   std::size_t character_count = 0;
   int steps_per_unit = 0;
   double fit_tolerance = 0.0;  ///< data units, as recorded by the writer
@@ -65,6 +75,14 @@ struct CorpusStoreInfo {
 /// quarter units and as float64), a median of more than 16,383 points, or bad options.
 std::vector<std::uint8_t> encode_corpus_store(std::span<const Character> characters,
                                               const CorpusStoreOptions& options = {});
+/// The same with each character's outlines: `outline_paths[i]` is `characters[i]`'s, one SVG path per
+/// stroke in stroke order, or empty when it has none (`CharacterLibrary::load_outline_paths`); the whole
+/// span empty for none at all. Also throws InvalidArgument when the span's size is neither 0 nor the
+/// characters', a character's list is neither empty nor one path per stroke, or a path kept as text is
+/// longer than 1,048,575 bytes.
+std::vector<std::uint8_t> encode_corpus_store(std::span<const Character> characters,
+                                              const CorpusStoreOptions& options,
+                                              std::span<const std::vector<std::string>> outline_paths);
 
 /// Writes `encode_corpus_store(characters, options)` to `path` with `write_file_atomically`
 /// (calligraphy/core/atomic_file.hpp): a temporary file in the same folder, fsync'ed and renamed into
@@ -72,6 +90,10 @@ std::vector<std::uint8_t> encode_corpus_store(std::span<const Character> charact
 /// Throws as `encode_corpus_store`, and DataError naming the path when it cannot be written.
 void write_corpus_store(const std::filesystem::path& path, std::span<const Character> characters,
                         const CorpusStoreOptions& options = {});
+/// The same with each character's outlines, as `encode_corpus_store` takes them.
+void write_corpus_store(const std::filesystem::path& path, std::span<const Character> characters,
+                        const CorpusStoreOptions& options,
+                        std::span<const std::vector<std::string>> outline_paths);
 
 /// A read-only store. Cheap to copy (the mapping is shared); thread-safe for concurrent `load`s.
 class CorpusStore {
@@ -84,12 +106,12 @@ class CorpusStore {
   /// The same over a copy of `bytes` (tests, fuzzing); `name` stands for the file in errors.
   static CorpusStore from_bytes(std::span<const std::uint8_t> bytes, const std::string& name);
   /// The store compiled into the library: every character of hanzi-writer-data 2.0.1 (9,574) fitted by
-  /// `calligraphy corpus build` at the default tolerance and quantisation, with the medians (format
-  /// 1.1), from data/corpus/hanzi-writer-data-2.0.1.clg (Arphic Public License: data/corpus/ARPHICPL.TXT
-  /// and NOTICE.md, installed under share/calligraphy/corpus). Checked when first asked for (header,
-  /// index and their checksums; each record when loaded, as `open`), then shared, without a copy. Its
-  /// `name()` is "bundled:hanzi-writer-data-2.0.1.clg". Throws DataError as `open` if the compiled-in
-  /// bytes fail the checks.
+  /// `calligraphy corpus build` at the default tolerance and quantisation, with the medians and the
+  /// outlines (format 1.2), from data/corpus/hanzi-writer-data-2.0.1.clg (Arphic Public License:
+  /// data/corpus/ARPHICPL.TXT and NOTICE.md, installed under share/calligraphy/corpus). Checked when first
+  /// asked for (header, index and their checksums; each record when loaded, as `open`), then shared, without
+  /// a copy. Its `name()` is "bundled:hanzi-writer-data-2.0.1.clg". Throws DataError as `open` if the
+  /// compiled-in bytes fail the checks.
   static const CorpusStore& bundled();
   /// SHA-256 of the bundled store's file, lower-case hex (64 characters).
   static const char* bundled_sha256();
@@ -106,6 +128,10 @@ class CorpusStore {
   /// read bounds-checked. Throws CharacterNotFound (naming the character and the file) or DataError
   /// (naming the file, the character, the record's offset and what is wrong).
   [[nodiscard]] Character load(char32_t code_point) const;
+  /// The character's stroke outlines as SVG path data, one per stroke in stroke order, as written
+  /// (`CorpusStoreOptions::outlines`); empty when the store (format 1.0 or 1.1) or the character has none.
+  /// Throws as `load`.
+  [[nodiscard]] std::vector<std::string> load_outline_paths(char32_t code_point) const;
   /// The file's name as used in messages.
   [[nodiscard]] const std::string& name() const;
 
