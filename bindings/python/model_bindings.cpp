@@ -366,11 +366,12 @@ void bind_library(py::module_& m) {
             d["max_quantisation_error"] = i.max_quantisation_error();
             d["file_bytes"] = i.file_bytes;
             d["medians"] = i.medians;
+            d["outlines"] = i.outlines;
             return {d};
           },
           "For a corpus store, its header as a dict (version, character_count, steps_per_unit, "
-          "fit_tolerance and max_quantisation_error in data units, file_bytes, medians: whether it holds "
-          "the strokes' medians); else None.")
+          "fit_tolerance and max_quantisation_error in data units, file_bytes, medians and outlines: whether "
+          "it holds the strokes' medians and their outlines, docs/corpus.md); else None.")
       .def("__repr__",
            [](const CharacterSource& lib) { return "<CharacterLibrary " + lib.description() + ">"; });
 }

@@ -121,7 +121,7 @@ def test_from_store_matches_the_fitted_characters(store_path):
     assert len(store) == len(library)
     info = store.store_info
     assert info["character_count"] == len(library)
-    assert info["version"] == "1.1" and info["medians"]
+    assert info["version"] == "1.2" and info["medians"] and info["outlines"]
     assert library.store_info is None
     for ch in ("永", "我"):
         stored, fitted = store.load(ch), library.load(ch)
