@@ -678,13 +678,14 @@ class CorpusStores(Base):
             self.assertEqual(made.returncode, 0, made.stderr.decode())
             self.assertEqual((self.cwd / f"s{threads}.clg").read_bytes(), (self.shared / "store.clg").read_bytes())
         for name in ("a.clg", "b.clg"):  # a 1.0 store, of the models only
-            made = run(["corpus", "build", "--data", "hw", "--out", name, "--medians", "off"], self.cwd)
+            made = run(["corpus", "build", "--data", "hw", "--out", name, "--medians", "off", "--outlines", "off"],
+                       self.cwd)
             self.assertEqual(made.returncode, 0, made.stderr.decode())
         self.assertEqual((self.cwd / "a.clg").read_bytes(), (self.cwd / "b.clg").read_bytes())
         header = struct.unpack_from(self.HEADER_FIELDS, (self.cwd / "a.clg").read_bytes())
         self.assertEqual(header[:3], (b"CLGSTORE", 1, 0))
         header = struct.unpack_from(self.HEADER_FIELDS, (self.cwd / "s1.clg").read_bytes())
-        self.assertEqual((header[1], header[2], header[7] & 1), (1, 1, 1))
+        self.assertEqual((header[1], header[2], header[7] & 3), (1, 2, 3))  # 1.2: medians and outlines
 
     def test_store_of_a_later_minor_version_reads_as_its_own(self):
         own = self.model(self.shared / "store.clg")
@@ -703,7 +704,7 @@ class CorpusStores(Base):
                 refused = run(command, self.cwd)
                 self.assert_one_error(refused, 1, name, "offset 8", f"{major}.", "1.x")
                 self.assertFalse((self.cwd / "out.json").exists())
-        name = self.forge("flags.clg", flags=3)
+        name = self.forge("flags.clg", flags=4)
         self.assert_one_error(self.model(name), 1, name, "offset 28", "flags")
 
 
