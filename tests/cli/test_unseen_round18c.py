@@ -324,7 +324,8 @@ class StubsAgainstRuntime(unittest.TestCase):
             "writer_parameter_names": cg.writer_parameter_names(), "typical_stroke": cg.typical_stroke(1),
             "writer_profile": cg.writer_profile("novice"), "is_positive": cg.is_positive("median"),
             "trace_applies": cg.trace_applies(scene, 0, 0, "median"),
-            "person_trace": cg.person_trace(scene, 0, 0, "median"), "match_stroke": cg.match_stroke(scene, 0, 0, median),
+            "person_trace": cg.person_trace(scene, 0, 0, "median"),
+            "match_stroke": cg.match_stroke(scene, 0, 0, median),
             "next_guidance_gain": cg.next_guidance_gain(0.5, 0.001),
             "paper_force": cg.paper_force(-0.001, 0.0, 800.0), "clamp_force": cg.clamp_force([1.0, 0, 0], 0.5),
             "constraint_taper": cg.constraint_taper(0.001, 0.005, 0.002),
@@ -373,7 +374,8 @@ class StubsAgainstRuntime(unittest.TestCase):
                                      "z": r.position_m[:, 2]}, "十")
             band: float = cg.next_assist_band(0.001, 0.002, cg.AssistBandRule())
             mode: cg.GuidanceMode = cg.skill_adaptive_mode(0.003)
-            print(type(match).__name__, positive, type(fading).__name__, len(again.time_s) > 0, 0.0 <= g <= 1.0, mode.name)
+            print(type(match).__name__, positive, type(fading).__name__, len(again.time_s) > 0, 0.0 <= g <= 1.0,
+                  mode.name)
             ''')
         with tempfile.TemporaryDirectory(prefix="round18c-mypy-") as folder:
             path = Path(folder) / "use.py"
@@ -640,7 +642,8 @@ class DocumentedShapes(unittest.TestCase):
 @needs_python
 class DocumentedErrors(unittest.TestCase):
     def test_exception_classes_are_the_documented_table(self):
-        table = {"Error": (Exception,), "InvalidArgument": (cg.Error, ValueError), "DataError": (cg.Error, RuntimeError),
+        table = {"Error": (Exception,), "InvalidArgument": (cg.Error, ValueError),
+                 "DataError": (cg.Error, RuntimeError),
                  "CharacterNotFound": (KeyError, cg.DataError), "DeviceError": (cg.Error, RuntimeError),
                  "DeviceNotFound": (LookupError, cg.DeviceError), "DeviceUnavailable": (cg.DeviceError,),
                  "CommunicationError": (ConnectionError, cg.DeviceError), "SafetyFault": (cg.DeviceError,),
