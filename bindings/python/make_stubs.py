@@ -16,7 +16,10 @@ its docstrings. Where it cannot, this script completes its output from the same 
   type; the type of the getter's signature is used instead;
 * `numpy.ndarray[numpy.float64]` (pybind11's spelling) becomes `numpy.typing.NDArray[numpy.float64]`;
 * `__hash__ = None` and the import of pandas (which has no type information) get the `type: ignore`
-  comments typeshed uses.
+  comments typeshed uses;
+* an enum argument takes a member or its spelling (docs/python.md, "Errors"): each parameter typed by an
+  enum is `Union[Enum, str]`, and each field holding one an `_EnumField[Enum]`, a descriptor of the stubs
+  alone that reads as the member and takes either on assignment (`law.nearest.method = "newton"`).
 
 The result must parse as Python; the script fails otherwise.
 """
@@ -121,6 +124,40 @@ def fix_class(lines, cls):
     return out
 
 
+ENUM_FIELD = '''
+_E = TypeVar("_E")
+
+class _EnumField(Generic[_E]):  # the stubs' own: an enum field, read as the member, set by member or spelling
+    @overload
+    def __get__(self, instance: None, owner: Any) -> _EnumField[_E]: ...
+    @overload
+    def __get__(self, instance: object, owner: Any) -> _E: ...
+    def __set__(self, instance: object, value: Union[_E, str]) -> None: ...
+'''
+
+
+def spelled_enums(stub, module):
+    """Types every enum parameter as the member or its spelling and every enum field as an `_EnumField`."""
+    enums = sorted(name for name, value in vars(module).items()
+                   if inspect.isclass(value) and "__members__" in dir(value) and not name.startswith("_"))
+    alternation = "|".join(enums)
+    enum = re.compile(r"(?<![\w.])((?:" + re.escape(PREFIX) + r")?(?:" + alternation + r"))(?![\w\[])")
+    out = []
+    for line in stub.splitlines():
+        function = re.match(r"(\s*def \w+\()(.*)(\) -> .*)$", line)
+        field = re.match(r"(    \w+): (" + alternation + r")$", line)
+        if function:
+            line = function.group(1) + enum.sub(r"Union[\1, str]", function.group(2)) + function.group(3)
+        elif field:
+            line = f"{field.group(1)}: _EnumField[{field.group(2)}]"
+        out.append(line)
+    text = "\n".join(out) + "\n"
+    if "_EnumField[" in text:
+        first_class = re.search(r"^class ", text, flags=re.MULTILINE).start()
+        text = text[:first_class] + ENUM_FIELD.lstrip("\n") + "\n" + text[first_class:]
+    return text
+
+
 def fix(text, module):
     lines = text.splitlines()
     out, i = [], 0
@@ -140,6 +177,7 @@ def fix(text, module):
         i = end
     result = "\n".join(out) + "\n"
     result = re.sub(r"numpy\.ndarray\[(numpy\.\w+)\]", r"numpy.typing.NDArray[\1]", result)
+    result = spelled_enums(result, module)
     # Unhashable classes, written as typeshed does.
     result = result.replace("    __hash__: ClassVar[None] = ...\n", "    __hash__: ClassVar[None]  # type: ignore[assignment]\n")
     result = with_imports(result)
@@ -159,7 +197,8 @@ def with_imports(stub):
         typing_line = 0
     imported = set(lines[typing_line][len("from typing import "):].split(", "))
     body = "\n".join(lines[typing_line + 1:])
-    for name in ("Any", "ClassVar", "Dict", "List", "Optional", "Sequence", "Tuple", "Union"):
+    for name in ("Any", "ClassVar", "Dict", "Generic", "List", "Mapping", "Optional", "Sequence", "Tuple",
+                 "TypeVar", "Union", "overload"):
         if re.search(r"\b" + name + r"\b", body):
             imported.add(name)
     lines[typing_line] = "from typing import " + ", ".join(sorted(imported))

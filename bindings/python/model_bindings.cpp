@@ -80,12 +80,14 @@ void bind_element(py::module_& m) {
       "A stroke element (paper section 3.2): an LSE (kind 'line', degree 1) or a CSE (kind 'bezier', "
       "degree 2..4), in the units of its control points (data units for a Character's, m for a "
       "Scene's).")
-      .def(py::init(
-               [](const ArrayLike& points) { return element_from_points(points.object, "control_points"); }),
-           py::arg("control_points"),
-           "From control points, array-like of shape (n, 2) with n in 2..5: 2 points make a line, 3..5 a "
-           "Bezier curve. Raises InvalidArgument (a ValueError) otherwise or when a point is not finite, "
-           "TypeError when it is not numbers.")
+      .def(
+          py::init(
+              [](const ArrayLike& points) { return element_from_points(points.object, "control_points"); }),
+          py::arg("control_points"),
+          "From control points, array-like of shape (n, 2) with n in 2..5: 2 points make a line, 3..5 a "
+          "Bezier curve. Raises InvalidArgument (a ValueError) naming control_points otherwise, when a point "
+          "is not finite or when the array holds no real numbers (text, complex), TypeError naming it for a "
+          "value that is no array (None, a str).")
       .def_property_readonly("kind", &kind_name, "'line' (LSE) or 'bezier' (CSE)")
       .def_readonly("degree", &StrokeElement::degree, "1 for a line, 2..4 for a Bezier curve")
       .def_property_readonly(
@@ -319,7 +321,9 @@ void bind_library(py::module_& m) {
           py::arg("path"),
           "A binary corpus store of fitted characters (include/calligraphy/model/corpus_store.hpp, "
           "docs/corpus.md; made by `calligraphy corpus build`), memory-mapped: each character is decoded "
-          "when loaded. Its Strokes have no median. Raises DataError (a RuntimeError) naming the file and "
+          "when loaded. Its Strokes have their data's medians (a store of format 1.1 or later; one of format "
+          "1.0, `corpus build --medians off`, has none: Stroke.median is (0, 2)). Raises DataError (a "
+          "RuntimeError) naming the file and "
           "offset for a missing, truncated, corrupted or foreign file.")
       .def(
           "load",

@@ -302,7 +302,7 @@ seed: int in 0..2**64-1, seeds the std::mt19937_64 the path is drawn from: the s
 Returns an (N, 2) float64 array, points on the paper in writing order [m], for match_stroke.
 Raises IndexError naming character_index or stroke_index out of range; InvalidArgument (a ValueError)
 naming `kind` or `seed` for an unknown name or a seed out of range, or when the kind does not apply to
-the stroke (trace_applies) or the stroke has no median (a corpus store's character); TypeError naming
+the stroke (trace_applies) or the stroke has no median (a corpus store of format 1.0); TypeError naming
 the argument for a value of the wrong type.)");
 }
 
