@@ -356,6 +356,19 @@ class Round18D(unittest.TestCase):
         self.assertGreater(f[-100:].min(), CONTINUOUS_N - 0.05)  # at it, not below
 
     @need_stand_in
+    def test_the_trace_of_a_garbled_trial_scores_as_the_trial_did(self):
+        # docs/cli.md: `score` reads a trial's CSV as it is and gives the trial's metrics to its precision; the
+        # refused readings are no positions in it, so the pen-down time is the trial's and nothing is NaN
+        result, record, rows, where = self.cli_trial("inf", self.garbled("inf"))
+        self.assertIsNotNone(rows, result.stderr.decode())
+        scored = run(["score", "t.csv", "--character", YI, "--json", "-"], cwd=where)
+        self.assertEqual(scored.returncode, 0, scored.stderr.decode())
+        metrics = strict_json(scored.stdout.decode())
+        self.assertAlmostEqual(metrics["pen_down_time_s"], record["pen_down_time_s"], delta=2e-6)
+        self.assertEqual(metrics["samples"], len(rows))  # every tick, the refused ones too
+        self.assertEqual(metrics["strokes_accepted"], record["strokes_completed"])
+
+    @need_stand_in
     def test_the_record_of_a_garbled_trial_is_valid_for_its_re_run(self):
         result, record, rows, where = self.cli_trial("nan", self.garbled("nan"))
         self.assertIsNotNone(record, result.stderr.decode())
