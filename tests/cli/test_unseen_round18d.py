@@ -160,6 +160,7 @@ SCENARIOS = textwrap.dedent("""
     results["buttons"] = scenario(lambda: (hd.hd_stand_in_set_buttons(3), hd.hd_stand_in_set_docked(1)))
     results["full"] = scenario(lambda: hd.hd_stand_in_inject(3, 0, 1000))
     results["dead_from_start"] = scenario(lambda: hd.hd_stand_in_inject(1, 0, 0))
+    results["force_limit_once"] = scenario(lambda: hd.hd_stand_in_inject(2, 200, 0))
     hd.hd_stand_in_set_clock_offset.argtypes = [ctypes.c_double]
     hd.hd_stand_in_wait_ticks.argtypes = [ctypes.c_long, ctypes.c_double]
 
@@ -410,6 +411,21 @@ class Round18D(unittest.TestCase):
             self.assertEqual(got["end_reason"], "device_fault")
             self.assertEqual(got["loop"]["ticks"], got["ticks"])
             self.assertLess(got["ticks"], 5)
+
+    def test_a_force_limit_tripped_once_ends_the_trial_and_no_force_follows(self):
+        # docs/devices.md: HD_EXCEEDED_MAX_FORCE in the servo path is `safety_limit`, ending the trial
+        # `device_fault`; the driver re-enables nothing by itself and the backend commands nothing after it
+        got = self.stand_in_results()["force_limit_once"]
+        self.assertNotIn("error", got)
+        self.assertEqual(got["end_reason"], "device_fault")
+        self.assertIn("safety limit", got["abort_reason"])
+        self.assertEqual(got["loop"]["ticks"], got["ticks"])
+        self.assertLess(got["ticks"], 210)
+        after = [f for f in got["frames"] if f["tick"] > 200]
+        self.assertTrue(after)
+        self.assertFalse([f for f in after if any(f["force_out"])])
+        self.assertFalse([f for f in after if f["set"] and any(f["force_set"])])
+        self.released(got)
 
     def test_late_frames_under_the_watchdog_are_counted_and_the_trial_goes_on_for_its_ticks(self):
         got = self.stand_in_results()["late"]
