@@ -185,7 +185,9 @@ const std::vector<SchemaField>& spec_fields() {
       number_field<&TrialSpec::max_duration_s>(
           "max_duration_s", {.low = 0.0, .high = kMaxTrialDurationS, .low_open = true},
           {.unit = "s",
-           .doc = "the trial ends after this much time; at most 10^7 servo ticks (max_duration_s x rate_hz)",
+           .doc =
+               "the trial ends after max_duration_s x rate_hz servo ticks (late real-time ticks make it last "
+               "longer by the clock); at most 10^7 ticks",
            .option = "--max-duration",
            .option_value_name = "S"}),
       string_field<&TrialSpec::json_file>(

@@ -117,9 +117,6 @@ int hd_stand_in_set_path(const double* t_s, const double* xyz_mm, size_t n) {
     for (size_t i = 0; i < n; ++i) {
       if (!std::isfinite(t[i]) || (i > 0 && t[i] < t[i - 1])) return -1;
     }
-    for (double x : xyz) {
-      if (!std::isfinite(x)) return -1;
-    }
   }
   {
     std::lock_guard<std::mutex> lock(L.state_mu);

@@ -96,7 +96,8 @@ void hd_stand_in_set_strict_one_frame(int on);               /* 1: a second fram
 
 /* ---- the hand ---- */
 int hd_stand_in_set_path(const double* t_s, const double* xyz_mm, size_t n);            /* n points,
-                       xyz_mm = n*3 values; t non-decreasing; n = 0 clears (pen at origin). 0 or -1 */
+                       xyz_mm = n*3 values (NaN or +-inf allowed: a garbled reading, held over
+                       its segment); t finite, non-decreasing; n = 0 clears (pen at origin). 0 or -1 */
 void hd_stand_in_set_square_wave(int axis, double amplitude_mm, int half_period_ticks); /*
             adds 0 for half_period ticks, then +amplitude for half_period ticks, ...;
             counted from the first tick after the call; amplitude 0 or half_period <= 0 off */

@@ -39,7 +39,9 @@ void sleep_until_or_stop(std::int64_t deadline_ns) {
 }
 
 // Hand position at time t (s) along the path: linear interpolation, held at
-// both ends. Caller holds state_mu.
+// both ends. A coordinate that is not finite at either end of its segment is
+// the segment's first point's, held (a garbled reading is played as given,
+// never turned into another by the interpolation). Caller holds state_mu.
 Vec3 path_position(const Lib& L, double t) {
   const std::size_t n = L.path_t.size();
   if (n == 0) return {0.0, 0.0, 0.0};
@@ -62,7 +64,11 @@ Vec3 path_position(const Lib& L, double t) {
   const double a = span > 0.0 ? (t - L.path_t[lo]) / span : 1.0;
   const Vec3 p0 = point(lo);
   const Vec3 p1 = point(hi);
-  return {p0[0] + a * (p1[0] - p0[0]), p0[1] + a * (p1[1] - p0[1]), p0[2] + a * (p1[2] - p0[2])};
+  Vec3 p{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    p[i] = std::isfinite(p0[i]) && std::isfinite(p1[i]) ? p0[i] + a * (p1[i] - p0[i]) : p0[i];
+  }
+  return p;
 }
 
 struct TickInputs {

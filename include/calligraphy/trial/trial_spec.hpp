@@ -75,7 +75,7 @@ struct TrialSpec {
   RealtimeMode realtime = RealtimeMode::ignore;  ///< real time: require SCHED_FIFO, pinning, locked memory
   /// real time: longest stall [s] in [0, kMaxStallTimeoutS], whole milliseconds; 0 off
   double watchdog_s = ServoLoopOptions{}.stall_timeout_s;
-  double max_duration_s = 300.0;  ///< the trial ends after this much time [s], (0, kMaxTrialDurationS]
+  double max_duration_s = 300.0;  ///< ends after max_duration_s x rate_hz ticks [s], (0, kMaxTrialDurationS]
   /// When a stroke counts as written, and the counts of refused attempts after which it is hinted and
   /// assisted (`hint_after_misses`, `assist_after_misses`): every field of StrokeAcceptance's table is a
   /// field of the specification of the same key, its option the key dashed (a length's "_m" dropped:
