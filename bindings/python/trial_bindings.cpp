@@ -257,7 +257,8 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
                        const Annotated<TrialCharactersTag>& characters, const TrialArguments& a,
                        const std::optional<PyArgument<SimulatedDeviceParameters>>& device,
                        const std::optional<PyArgument<SafetyChainParameters>>& safety,
-                       const std::optional<PyArgument<PassivityParameters>>& passivity) {
+                       const std::optional<PyArgument<PassivityParameters>>& passivity,
+                       const std::optional<PyArgument<double>>& watchdog_s = std::nullopt) {
   TrialOptions options;
   options.pacing = pacing;
   if (a.force_law) options.force = take(*a.force_law, "force_law");
@@ -342,6 +343,8 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   spec.pacing = options.pacing;
   spec.max_duration_s = options.max_duration_s;
   spec.acceptance = options.force.acceptance;
+  // The stall bound `trial --watchdog-ms` sets; the specification's one check refuses it in lock-step.
+  if (watchdog_s) spec.watchdog_s = take(*watchdog_s, "watchdog_s");
   // A replay's teacher is given as samples (TrialRunInputs::teacher), below.
   const auto checked = calligraphy::Checked<TrialSpec>::check(
       spec, spec.guidance_mode == GuidanceMode::replay ? TeacherSource::samples : TeacherSource::file);
@@ -407,12 +410,13 @@ PyTrialResult simulate_trial_py(const Annotated<TrialCharactersTag>& characters
 
 PyTrialResult run_trial_py(
     const Annotated<TrialCharactersTag>& characters, const PyArgument<std::string>& device,
-    const PyArgument<std::string>& pacing CALLIGRAPHY_TRIAL_ARGUMENTS(CALLIGRAPHY_TRIAL_PARAMETER)) {
+    const PyArgument<std::string>& pacing CALLIGRAPHY_TRIAL_ARGUMENTS(CALLIGRAPHY_TRIAL_PARAMETER),
+    const std::optional<PyArgument<double>>& watchdog_s) {
   const TrialArguments arguments{CALLIGRAPHY_TRIAL_ARGUMENTS(CALLIGRAPHY_TRIAL_VALUE)};
   const std::string name = take(device, "device");
   if (name.empty()) throw InvalidArgument("device: a device name of list_devices() is needed");
   const TrialPacing chosen = parse_trial_pacing(take(pacing, "pacing"));
-  return trial_py(name, chosen, characters, arguments, std::nullopt, std::nullopt, std::nullopt);
+  return trial_py(name, chosen, characters, arguments, std::nullopt, std::nullopt, std::nullopt, watchdog_s);
 }
 
 // The trial a record states (a TrialResult's metrics, a trial record as a dict, or a record's file), run
@@ -643,7 +647,7 @@ a teacher of other characters or replay without a teacher; TypeError naming the 
 of the wrong type.)");
   m.def("run_trial", &run_trial_py, py::arg("characters"), py::arg("device") = "simulated",
         py::arg("pacing") = "auto" CALLIGRAPHY_TRIAL_ARGUMENTS(CALLIGRAPHY_TRIAL_PY_ARG),
-        py::call_guard<ForwardLog>(),
+        py::arg("watchdog_s") = py::none(), py::call_guard<ForwardLog>(),
         R"(Runs a whole guided writing trial on the device called `device` in list_devices(), as
 `calligraphy trial --device NAME` does (run_trial, include/calligraphy/trial/runner.hpp): 'simulated' is
 moved by the simulated `writer` (the command line's Phantom emulator, 'emulated-phantom', is not among the
@@ -652,7 +656,10 @@ thread. The GIL is released while it runs; Ctrl-C ends the trial at
 the next tick (forces off, the device closed) and raises KeyboardInterrupt.
 
 pacing: 'auto' (lock-step for a device a simulated writer moves, real time otherwise), 'lock-step' or
-'real-time' (the spellings of `calligraphy trial --pacing` and of protocols). rate_hz: servo rate [Hz] (at most 10000 in real time). The other arguments as for
+'real-time' (the spellings of `calligraphy trial --pacing` and of protocols). rate_hz: servo rate [Hz] (at most 10000 in real time).
+watchdog_s: the real-time loop's stall bound [s], a whole number of milliseconds in [0, 60] (0: off), the
+specification's `watchdog_s` (`calligraphy trial --watchdog-ms`); None: 0.05, the Phantom's own command
+watchdog; refused with lock-step pacing. The other arguments as for
 simulate_trial. Returns a TrialResult whose metrics carry `end_reason`. Raises DeviceNotFound (a
 LookupError) naming the devices there are, InvalidArgument, RealtimeError, CommunicationError.)");
   m.def("rerun_trial", &rerun_trial_py, py::arg("record"), py::arg("library") = py::none(),

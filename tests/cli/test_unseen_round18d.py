@@ -138,7 +138,9 @@ SCENARIOS = textwrap.dedent("""
         setup()
         got = {}
         try:
-            r = cg.run_trial("一", device="openhaptics", max_duration_s=duration, **kw)
+            # A stall bound far above the injected ones (docs/python.md, watchdog_s): a loaded machine that
+            # holds the stand-in's scheduler back for 50 ms must not end a trial that tests something else.
+            r = cg.run_trial("一", device="openhaptics", max_duration_s=duration, watchdog_s=5.0, **kw)
         except Exception as e:
             got["error"] = [type(e).__name__, [c.__name__ for c in type(e).__mro__], str(e)]
         else:
@@ -436,7 +438,7 @@ class Round18D(unittest.TestCase):
         # replaces the loop's own late-tick check), counted in longest_stall_ms and the period jitter
         self.assertGreaterEqual(got["loop"]["longest_stall_ms"], 15.0)
         self.assertGreaterEqual(got["loop"]["period_jitter_us_max"], 15000.0)
-        self.assertLess(got["loop"]["longest_stall_ms"], 50.0)
+        self.assertLess(got["loop"]["longest_stall_ms"], 5000.0)  # under the stall bound given
         gaps = np.diff(got["time"])
         self.assertGreaterEqual((gaps > 0.015).sum(), 3)  # the trial's clock shows the leaps
         self.assertTrue((gaps > 0).all())  # and never goes back

@@ -43,3 +43,14 @@ def test_every_error_class_of_the_library_is_there():
     assert issubclass(calligraphy.RealtimeError, calligraphy.DeviceError)
     assert issubclass(calligraphy.StateError, calligraphy.Error)
     assert issubclass(calligraphy.StateError, RuntimeError)
+
+
+def test_run_trial_takes_the_specifications_watchdog():
+    # watchdog_s is the specification's field (`calligraphy trial --watchdog-ms`): stated in the record,
+    # refused in lock-step (no wall clock to bound) and off a whole millisecond, naming it.
+    result = calligraphy.run_trial("一", device="simulated", pacing="real-time", max_duration_s=0.05,
+                                   watchdog_s=0.2)
+    assert calligraphy.check_trial_record(result.metrics)["trial"]["watchdog_s"] == 0.2
+    for pacing, seconds in (("lock-step", 1.0), ("real-time", 0.0125), ("real-time", -1.0)):
+        with pytest.raises(calligraphy.InvalidArgument, match="watchdog_s"):
+            calligraphy.run_trial("一", device="simulated", pacing=pacing, max_duration_s=0.05, watchdog_s=seconds)
