@@ -413,6 +413,35 @@ class Session(unittest.TestCase, OneErrorLine):
         self.assertEqual(redone["end_reason"], "completed")
 
 
+    def test_resume_goes_on_with_the_data_the_session_ran_with(self):
+        # The bundled corpus has 十 too, with two strokes: a session of the user's one-stroke 十 resumed without
+        # its --store (or with another folder) would write another shape of 十 into the same session. It is
+        # refused naming the saved record and the character, nothing written; with the same data it goes on.
+        protocol = SHARED["root"] / "ten-protocol.json"
+        protocol.write_text(json.dumps({"name": "ten", "conditions": [{"name": "V", "mode": "vision"}],
+                                        "test": {"characters": ["十"], "conditions": ["V"], "repetitions": 2},
+                                        "trial": {"max_duration_s": 20}}, ensure_ascii=False), encoding="utf-8")
+        study = SHARED["root"] / "ten-study"
+        store = SHARED["root"] / "own.clg"
+        cli(["session", "run", protocol, "--subjects", "1", "--out", study, "--store", store])
+        session = next(study.glob("S01/ten-*"))
+        first, last = sorted(session.glob("trials/*.json"))
+        for f in session.glob(f"trials/{last.stem}*"):
+            f.unlink()
+        moved = write_folder(SHARED["root"] / "moved", {"十": {"strokes": [box(110, 100, 170, 900)],
+                                                              "medians": [[[140, 880], [140, 500], [140, 120]]]}})
+        for option in ([], ["--data", moved]):
+            refused = cli(["session", "resume", session, *option], ok=False)
+            self.assert_one_error(refused, 1, first.name, "十")
+            self.assertFalse(any(session.glob(f"trials/{last.stem}*")))
+        # The user's folder gives the same 十 as the store (whole units, a line: nothing quantised away).
+        cli(["session", "resume", session, "--data", SHARED["own"]])
+        redone = json.loads(last.read_text(encoding="utf-8"))
+        self.assertEqual(redone["strokes_total"], 1)
+        self.assertEqual(redone["specification"]["scene"]["sha256"],
+                         json.loads(first.read_text(encoding="utf-8"))["specification"]["scene"]["sha256"])
+
+
 class Bounds(unittest.TestCase, OneErrorLine):
     """Medians and outlines at and past the documented bounds in a user's file (docs/corpus.md)."""
 
