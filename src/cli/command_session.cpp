@@ -543,8 +543,9 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
 // Other data (a session run with --store or --data, resumed without it, or with another folder or store) is
 // refused naming the record and the character, before the first trial: one session, one shape per character.
 void require_same_characters(const SessionFolder& session, const CharacterSource& source) {
+  std::set<std::u32string> checked;  // one saved record per item: its characters are placed alike in each
   for (const PlannedTrial& trial : session.plan()) {
-    if (!session.is_saved(trial)) continue;
+    if (!session.is_saved(trial) || !checked.insert(trial.characters).second) continue;
     const std::string path = session.trial_file(trial, "json").string();
     const RecordedTrial recorded = read_recorded_trial_file(path);
     if (recorded.scene_sha256.empty()) continue;  // a record that states no placed characters
