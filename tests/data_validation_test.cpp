@@ -259,6 +259,14 @@ TEST_CASE("A file with outlines has one per median, and a name of white space or
              Catch::Contains("/strokes") && Catch::Contains("1 stroke outlines for 2 medians"));
   CHECK_THAT(refusal(R"({"medians":)" + two + R"(,"strokes":["M 0 0 Z","M 1 1 Z","M 2 2 Z"]})"),
              Catch::Contains("3 stroke outlines for 2 medians"));
+  // An outline path as long as a store keeps as text (1,048,575 bytes) is read; one byte more is refused at
+  // its pointer, so that corpus build lists the file instead of failing to write the whole store.
+  const std::string at_bound = "M 0 0 Z" + std::string(1'048'575 - 7, ' ');
+  CHECK(parse_hanzi_writer_json(R"({"strokes":["M 0 0 Z",")" + at_bound + R"("],"medians":)" + two + "}",
+                                U'一', "c.json")
+            .medians.size() == 2);
+  CHECK_THAT(refusal(R"({"strokes":["M 0 0 Z",")" + at_bound + R"( "],"medians":)" + two + "}"),
+             Catch::Contains("/strokes/1") && Catch::Contains("outline path of 1048576 bytes"));
 
   const auto dir = scratch_folder("names");
   for (const char* name : {"永.json", " .json", "\x1b.json", "\t.json", "\u3000.json", "\u00a0.json"})

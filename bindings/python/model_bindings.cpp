@@ -324,6 +324,8 @@ void bind_library(py::module_& m) {
           "when loaded. Its Strokes have their data's medians (a store of format 1.1 or later; one of format "
           "1.0, `corpus build --medians off`, has none: Stroke.median is (0, 2)). Raises DataError (a "
           "RuntimeError) naming the file and "
+          "when loaded. Its Strokes have their data's medians (a store built with `--medians off` has "
+          "none: Stroke.median is then (0, 2)). Raises DataError (a RuntimeError) naming the file and "
           "offset for a missing, truncated, corrupted or foreign file.")
       .def(
           "load",

@@ -25,6 +25,7 @@
 #include "calligraphy/study/session_folder.hpp"
 #include "calligraphy/study/session_runner.hpp"
 #include "calligraphy/study/session_series.hpp"
+#include "calligraphy/trial/recorded_trial.hpp"
 #include "calligraphy/trial/writer_profile.hpp"
 #include "cli/cli_devices.hpp"
 #include "cli/commands.hpp"
@@ -537,6 +538,29 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
   return 0;
 }
 
+// The characters a resumed session goes on with are the ones its saved trials were written with: each saved
+// record's placed characters (scene SHA-256) against the same characters loaded now and placed as recorded.
+// Other data (a session run with --store or --data, resumed without it, or with another folder or store) is
+// refused naming the record and the character, before the first trial: one session, one shape per character.
+void require_same_characters(const SessionFolder& session, const CharacterSource& source) {
+  std::set<std::u32string> checked;  // one saved record per item: its characters are placed alike in each
+  for (const PlannedTrial& trial : session.plan()) {
+    if (!session.is_saved(trial) || !checked.insert(trial.characters).second) continue;
+    const std::string path = session.trial_file(trial, "json").string();
+    const RecordedTrial recorded = read_recorded_trial_file(path);
+    if (recorded.scene_sha256.empty()) continue;  // a record that states no placed characters
+    std::vector<Character> characters;
+    for (const char32_t c : trial.characters) characters.push_back(source.load(c));
+    if (scene_sha256(Scene::lay_out(characters, recorded.layout)) == recorded.scene_sha256) continue;
+    throw DataError(
+        path + ": " + encode_utf8(trial.characters) +
+        " was written with other character data "
+        "than --data or --store give now (scene SHA-256 " +
+        recorded.scene_sha256.substr(0, 12) +
+        "... in the record); resume with the option the session ran with; nothing was run or written");
+  }
+}
+
 int resume_session(const SessionResumeCommand& command, DeviceRegistry& devices) {
   install_stop_handlers();  // from the start, as `session run`
 #ifdef CALLIGRAPHY_WITH_TRAINER
@@ -572,6 +596,7 @@ int resume_session(const SessionResumeCommand& command, DeviceRegistry& devices)
     return 0;
   }
   check_not_followed(session);
+  require_same_characters(session, CharacterSource(command.library));
   session.check_writable();  // before the first trial: a folder no trial could be saved in
   TerminalHost host;
   std::shared_ptr<CharacterSource> source;

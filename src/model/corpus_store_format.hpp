@@ -2,6 +2,7 @@
 // Internal: constants, CRC-32 and bit streams of the corpus store format (docs/corpus.md).
 #include <algorithm>
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <span>
@@ -44,6 +45,9 @@ inline constexpr std::uint64_t kOutlineCountEscape = 127;
 inline constexpr int kOutlineCountBits = 7;
 inline constexpr int kOutlineCountExtensionBits = 16;
 inline constexpr int kOutlineTextLengthBits = 20;
+/// Longest SVG path of one stroke's outline kept as text (length:20), bytes; the character-data readers
+/// refuse a longer entry of `strokes`, so that every character a folder gives can be stored.
+inline constexpr std::size_t kMaxOutlinePathBytes = (std::size_t{1} << kOutlineTextLengthBits) - 1;
 inline constexpr std::int64_t kMaxOutlineCoordinate =
     100'000;  // |x| of a compact point, as kMaxDataCoordinate
 /// Points a compact outline command takes (M, L, Q, C, Z).

@@ -67,7 +67,7 @@ void encode_outlines(BitWriter& out, const std::vector<std::string>& paths, std:
     const std::optional<CompactPath> compact = compact_form(paths[s]);
     out.put(compact ? 0 : 1, 1);
     if (!compact) {
-      if (paths[s].size() >= (std::size_t{1} << kOutlineTextLengthBits))
+      if (paths[s].size() > kMaxOutlinePathBytes)
         fail("stroke " + std::to_string(s + 1) + ": outline path of " + std::to_string(paths[s].size()) +
              " bytes (at most 1,048,575)");
       out.put(paths[s].size(), kOutlineTextLengthBits);

@@ -13,6 +13,7 @@
 
 #include "calligraphy/model/character_library.hpp"
 #include "core/json_document.hpp"
+#include "model/corpus_store_format.hpp"
 
 namespace calligraphy::detail {
 namespace {
@@ -70,7 +71,17 @@ class MediansHandler {
 
   bool null() { return scalar("null"); }
   bool boolean(bool /*value*/) { return scalar("a boolean"); }
-  bool string(json::string_t& /*value*/) { return scalar("a string"); }
+  bool string(json::string_t& value) {
+    // A stroke's outline path (the outline reader reads it): bounded here, where every character file is
+    // read first, so that a character whose outline no store can hold is refused at the door, named, rather
+    // than stop a whole corpus build when the store is written.
+    if (!frames_.empty() && frames_.back().role == Role::outlines &&
+        value.size() > store::kMaxOutlinePathBytes) {
+      return fail(next_path(), "outline path of " + std::to_string(value.size()) + " bytes, more than " +
+                                   std::to_string(store::kMaxOutlinePathBytes));
+    }
+    return scalar("a string");
+  }
   bool binary(json::binary_t& /*value*/) { return scalar("binary data"); }
   bool number_integer(json::number_integer_t value) { return number(static_cast<double>(value)); }
   bool number_unsigned(json::number_unsigned_t value) { return number(static_cast<double>(value)); }

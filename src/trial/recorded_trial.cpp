@@ -358,10 +358,10 @@ TrialRun rerun_trial(const RecordedTrial& recorded, const Checked<TrialSpec>& sp
                      TrialRunInputs inputs) {
   const std::string here = scene_sha256(scene);
   if (here != recorded.scene_sha256) {
-    throw InvalidArgument("the characters placed here are not the recorded ones (scene SHA-256 " +
-                          here.substr(0, 12) + "... against the record's " +
-                          recorded.scene_sha256.substr(0, 12) +
-                          "...): other character data (--corpus, --store) or another layout");
+    throw InvalidArgument(
+        "the characters placed here are not the recorded ones (scene SHA-256 " + here.substr(0, 12) +
+        "... against the record's " + recorded.scene_sha256.substr(0, 12) +
+        "...): other character data (another --data or --store; in Python, library=) or another layout");
   }
   if (recorded.writer && inputs.hand_maker == nullptr) {
     throw InvalidArgument(
