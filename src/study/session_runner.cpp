@@ -301,8 +301,14 @@ class SessionRun {
     study_detail::PreparedGuidance guidance;
     if (study_detail::adapts_by_repetition(condition))
       guidance = study_detail::repetition_guidance(session_, condition, trial);
-    if (replays_teacher(condition))
-      guidance = study_detail::replay_guidance(session_, condition, trial, scene);
+    if (replays_teacher(condition)) {
+      try {
+        guidance = study_detail::replay_guidance(session_, condition, trial, scene);
+      } catch (const Error& e) {  // a teacher that cannot be read or recorded: logged as a character is
+        log_failure(trial, e, "teacher_not_loaded");
+        throw;
+      }
+    }
     TrialSpec spec = study_trial_spec(manifest_, condition, trial, guidance.guidance);
     if (options_.pacing) spec.pacing = *options_.pacing;
     if (!simulated_writer_ && spec.pacing != TrialPacing::lock_step)  // a person, in real time

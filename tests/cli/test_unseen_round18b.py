@@ -530,6 +530,38 @@ class Round18B(OneErrorLine, unittest.TestCase):
         self.assertTrue((session / "log.jsonl").read_bytes().startswith(before))
         self.assertNotIn("session_resumed", kinds)
 
+    def test_a_replay_teacher_is_logged_and_so_is_one_that_cannot_be_recorded(self):
+        """A replay condition without teachers: the runner records 一's teacher (teacher_saved once, before its
+        first trial, with the SHA-256 of the copy in teachers/ that the records name); 十's simulated teacher
+        cannot write its two strokes in 4 s, which ends the run (exit 1, one error line) and is logged as a
+        trial that could not be run: trial_failed with the error, then session_stopped with its reason."""
+        protocol = self.tmp / "replay.json"
+        protocol.write_text(json.dumps({"name": "r18b", "conditions": [{"name": "R", "mode": "replay"}],
+                                        "test": {"characters": [YI, SHI], "conditions": ["R"], "repetitions": 2},
+                                        "trial": {"max_duration_s": 4}}, ensure_ascii=False), encoding="utf-8")
+        done = run(["session", "run", protocol, "--subjects", "1", "--out", self.tmp / "replay", *RUN], cwd=self.tmp)
+        # The plan `session run` prints on standard error comes first; then one error line.
+        self.assertEqual(done.returncode, 1, done.stderr)
+        lines = error_lines(done)
+        self.assertEqual([line for line in lines if "error" in line], lines[-1:])
+        self.assertRegex(lines[-1], rf"^calligraphy session run: error: .*teacher.*{SHI}")
+        (session,) = sessions_under(self.tmp / "replay")
+        log = read_log(session)
+        kinds = [kind(e) for e in log]
+        self.assertEqual(kinds, ["session_created", "session_started", "teacher_saved", "trial_started",
+                                 "trial_saved", "trial_failed", "session_stopped"])
+        teacher = log[2]
+        self.assertEqual((teacher["condition"], teacher["characters"], teacher["source"]), ("R", YI, "recorded"))
+        self.assertEqual(teacher["sha256"], hashlib.sha256((session / teacher["file"]).read_bytes()).hexdigest())
+        (record,) = records(session).values()
+        self.assertEqual(record["guidance"]["teacher"]["sha256"], teacher["sha256"])
+        self.assertEqual(record["guidance"]["teacher"]["file"], teacher["file"])
+        failed, stopped = log[-2], log[-1]
+        self.assertEqual((trial_number(failed), failed["characters"]), (2, SHI))
+        self.assertIn("teacher", failed["error"])
+        self.assertEqual((stopped["reason"], stopped["saved_trials"], stopped["planned"]),
+                         ("teacher_not_loaded", 1, 4))
+
     # -- a run killed between two appends of the log -------------------------------------------------------------
     def killed_between(self, name, last_line, trials_kept=4):
         """A lock-step session of the four trials of 十, then its files as a run killed right after writing
