@@ -11,8 +11,9 @@ attempt; a resume logged once as one; `session_completed` last and once), sessio
 `previous_session`, the trial records' times and end reasons against the log's, and `report --csv` and
 `calligraphy.study.load` against the log. The runs: a two-session study (rests, a within-session delay, a
 retention session a day later) written straight through lock-step, and sessions in real time stopped by SIGINT,
-SIGTERM (at the first trial), SIGHUP and SIGKILL at a chosen trial and resumed lock-step, one of them stopped
-again during its resume.
+SIGTERM (at the first trial), SIGHUP, SIGUSR1 and SIGKILL at a chosen trial and resumed lock-step, one of them
+stopped again during its resume; logs as a run killed between two appends leaves them; a replay condition whose
+teacher is recorded, and one whose teacher cannot be.
 
 CALLIGRAPHY_CLI names the program, PYTHONPATH its Python module. CALLIGRAPHY_SANITIZED=1 takes five cases.
 """
