@@ -563,6 +563,44 @@ class Round18B(OneErrorLine, unittest.TestCase):
         self.assertEqual((stopped["reason"], stopped["saved_trials"], stopped["planned"]),
                          ("teacher_not_loaded", 1, 4))
 
+    def test_a_learning_subjects_skills_are_logged_as_recorded_and_rebuilt_on_resume(self):
+        """A learning simulated subject (two-state): each trial_started carries the skills the record's
+        writer memory and the tables give; a run killed after its first save and resumed logs the same skills
+        for the trials it runs again as the run straight through did."""
+        protocol = self.tmp / "learning.json"
+        protocol.write_text(json.dumps({"name": "l18b", "conditions": [{"name": "U", "mode": "vision"}],
+                                        "test": {"characters": [YI], "conditions": ["U"], "repetitions": 3},
+                                        "trial": {"max_duration_s": 0.4}}, ensure_ascii=False), encoding="utf-8")
+        out = self.tmp / "learning"
+        done = run(["session", "run", protocol, "--subjects", "1", "--out", out, "--writer", "simulated",
+                    "--writer-learning", "two-state"], cwd=self.tmp)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        (session,) = sessions_under(out)
+        skills = ("shape_skill", "order_skill", "timing_skill")
+
+        def logged(log):
+            return {trial_number(e): tuple(e[k] for k in skills) for e in log if kind(e) == "trial_started"}
+        straight = logged(read_log(session))
+        self.assertEqual(sorted(straight), [1, 2, 3])
+        self.assertGreater(straight[3][0], straight[1][0])
+        saved = records(session)
+        for p in manifest(session)["plan"]:
+            memory = saved[p["file"]]["writer"]["memory"]
+            self.assertEqual(tuple(memory[k] for k in skills), straight[p["index"]], p["file"])
+        from calligraphy import study
+        for _, row in study.load(str(out)).trials.iterrows():
+            self.assertEqual(tuple(row[k] for k in skills), straight[int(row.trial)])
+        # Killed after trial 1's trial_saved (line 3): trials 2 and 3 unsaved; resumed.
+        log = session / "log.jsonl"
+        log.write_text("".join(log.read_text(encoding="utf-8").splitlines(keepends=True)[:4]), encoding="utf-8")
+        for p in manifest(session)["plan"][1:]:
+            for path in (session / "trials").glob(p["file"] + ".*"):
+                path.unlink()
+        self.assertEqual(resume(self.tmp, session).returncode, 0)
+        after = read_log(session)
+        resumed = next(i for i, e in enumerate(after) if kind(e) == "session_resumed")
+        self.assertEqual(logged(after[resumed:]), {2: straight[2], 3: straight[3]})
+
     # -- a run killed between two appends of the log -------------------------------------------------------------
     def killed_between(self, name, last_line, trials_kept=4):
         """A lock-step session of the four trials of 十, then its files as a run killed right after writing
