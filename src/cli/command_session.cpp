@@ -591,6 +591,8 @@ int resume_session(const SessionResumeCommand& command, DeviceRegistry& devices)
   session.check_records_name_this_session();
   require_characters(session.manifest().protocol, CharacterSource(command.library));
   if (!session.next_unsaved()) {
+    // A run killed after its last save and before it logged the end: the log is completed, once.
+    (void)complete_session_log(session);
     std::printf("%s: every trial of %s is saved already\n", session.manifest().setup.subject.id.c_str(),
                 session.path().c_str());
     return 0;

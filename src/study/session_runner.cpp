@@ -10,6 +10,7 @@
 #include <string>
 #include <type_traits>
 #include <variant>
+#include <vector>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/parameter_table.hpp"
@@ -27,6 +28,7 @@
 #include "calligraphy/trial/writer_profile.hpp"
 #include "study/names.hpp"
 #include "study/remembered_writer.hpp"
+#include "study/saved_sessions.hpp"
 #include "study/trial_guidance.hpp"
 #include "study/trial_record.hpp"
 
@@ -64,29 +66,42 @@ json trial_details(const PlannedTrial& trial) {
           {"repetition", trial.repetition}, {"file", SessionFolder::trial_stem(trial)}};
 }
 
-// Trials saved by a run that crashed before it could log them get their "trial_saved" line now, marked
-// recovered, so that the log names every saved trial once.
-void log_unlogged_saves(SessionFolder& session) {
+// The events of the session's log, in order; a line torn by a crash names nothing and is left out.
+std::vector<json> logged_events(const SessionFolder& session) {
   const std::filesystem::path log_path = SessionLayout::log(session.path());
   const std::string text =
       study_detail::read_session_file(log_path, std::uintmax_t{256} << 20, "session log");
-  std::set<std::string> logged;
+  std::vector<json> events;
   std::size_t begin = 0;
   while (begin < text.size()) {
     std::size_t end = text.find('\n', begin);
     if (end == std::string::npos) end = text.size();
     try {
-      const json line = json::parse(text.begin() + static_cast<std::ptrdiff_t>(begin),
-                                    text.begin() + static_cast<std::ptrdiff_t>(end));
-      if (line.value("event", "") == "trial_saved") logged.insert(line.value("file", ""));
+      json line = json::parse(text.begin() + static_cast<std::ptrdiff_t>(begin),
+                              text.begin() + static_cast<std::ptrdiff_t>(end));
+      if (line.is_object()) events.push_back(std::move(line));
     } catch (const json::exception&) {
       // a line torn by a crash: it names nothing
     }
     begin = end + 1;
   }
+  return events;
+}
+
+// Trials saved by a run that crashed before it could log them get their "trial_saved" line now, marked
+// recovered, with what their record says (end_reason, time_s) as a trial_saved line has, so that the log
+// names every saved trial once.
+void log_unlogged_saves(SessionFolder& session) {
+  std::set<std::string> logged;
+  for (const json& event : logged_events(session)) {
+    if (event.value("event", "") == "trial_saved") logged.insert(event.value("file", ""));
+  }
   for (const PlannedTrial& trial : session.plan()) {
     if (!session.is_saved(trial) || logged.count(SessionFolder::trial_stem(trial)) > 0) continue;
+    const json record = study_detail::read_trial_record(session.trial_file(trial, "json"));
     json details = trial_details(trial);
+    details["end_reason"] = record.at("end_reason");
+    details["time_s"] = record.at("total_time_s");
     details["recovered"] = true;
     session.log("trial_saved", details.dump());
   }
@@ -286,8 +301,14 @@ class SessionRun {
     study_detail::PreparedGuidance guidance;
     if (study_detail::adapts_by_repetition(condition))
       guidance = study_detail::repetition_guidance(session_, condition, trial);
-    if (replays_teacher(condition))
-      guidance = study_detail::replay_guidance(session_, condition, trial, scene);
+    if (replays_teacher(condition)) {
+      try {
+        guidance = study_detail::replay_guidance(session_, condition, trial, scene);
+      } catch (const Error& e) {  // a teacher that cannot be read or recorded: logged as a character is
+        log_failure(trial, e, "teacher_not_loaded");
+        throw;
+      }
+    }
     TrialSpec spec = study_trial_spec(manifest_, condition, trial, guidance.guidance);
     if (options_.pacing) spec.pacing = *options_.pacing;
     if (!simulated_writer_ && spec.pacing != TrialPacing::lock_step)  // a person, in real time
@@ -510,6 +531,19 @@ SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& ru
         session.manifest().setup.device + "\" from");
   }
   return SessionRun(session, run_options, *run_options.registry).run();
+}
+
+bool complete_session_log(SessionFolder& session) {
+  if (session.next_unsaved()) return false;
+  const std::vector<json> events = logged_events(session);
+  if (!events.empty() && events.back().value("event", "") == "session_completed") return false;
+  const std::size_t saved = session.saved_count();
+  log_unlogged_saves(session);
+  session.log(
+      "session_resumed",
+      json{{"saved_trials", saved}, {"next_trial", nullptr}, {"library", library_build().version}}.dump());
+  session.log("session_completed", json{{"trials", session.plan().size()}}.dump());
+  return true;
 }
 
 }  // namespace calligraphy

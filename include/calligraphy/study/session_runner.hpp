@@ -143,4 +143,12 @@ struct TrialGuidance {
 /// cannot be saved ends the run with `save_failed`; what was saved before stays saved.
 SessionRunResult run_session(SessionFolder& session, const SessionRunOptions& options);
 
+/// The end of the log of a session whose every planned trial is saved but whose log does not end with
+/// `session_completed`: a run killed (or stopped) after its last trial's record was saved, before it logged
+/// the save or the end. Logs what `run_session` on it would: each saved trial the log does not name
+/// (`trial_saved`, marked `recovered`), `session_resumed` and `session_completed`; returns true. A session
+/// with a trial unsaved, or whose log ends with `session_completed`, is left as it is (false). Throws
+/// DataError naming the log or a record that cannot be read, or the log when it cannot be written.
+bool complete_session_log(SessionFolder& session);
+
 }  // namespace calligraphy
