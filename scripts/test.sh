@@ -132,35 +132,34 @@ end_stage
 # bools, returns and calls through a wrong function type are still checked.
 # Built with clang: its instrumented files compile in 70-100 % of GCC's time, and this build is the stage's
 # longest path. (The Release and ThreadSanitizer stages stay on GCC, so both compilers keep building.)
-# -Wno-tsan: GCC warns that TSan does not model atomic_thread_fence (the OpenHaptics seqlock uses it);
-# the seqlock's fields are atomics, so no race is hidden. Only the servo-loop test program (with the
-# OpenHaptics stand-in it loads) and the modules it links are built, at -O1, without debug information
-# (a report's stack names the functions, as the ASan stage's do).
-# The ThreadSanitizer build follows the ASan build in the same background job, beside the Release tests'
-# last minutes (the ASan build ends about two minutes before them), not beside the ASan tests: at idle
-# priority it still slowed those by 40 % (284 s against 201 s alone, 2026-11-28), and their stage waits on them.
-start_background "AddressSanitizer + UndefinedBehaviorSanitizer: build (clang), then the ThreadSanitizer build" "
+start_background "AddressSanitizer + UndefinedBehaviorSanitizer: build (clang)" "
   cmake -S . -B build-asan -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG='-O1 -g0' \
     -DCALLIGRAPHY_SANITIZE=address,undefined -DCALLIGRAPHY_NO_SANITIZE=alignment,object-size,pointer-overflow,null \
     -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_BENCH=OFF \
     -DCALLIGRAPHY_BUILD_TESTS=ON -DCALLIGRAPHY_BUILD_EXAMPLES=ON -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_TRAINER=OFF \
     -DCALLIGRAPHY_BUILD_FUZZERS=ON -DCALLIGRAPHY_TEST_PYTHONPATH=$PWD/build/python \
     -DCALLIGRAPHY_TEST_PYTHON_HD_STAND_IN=$PWD/build/lib/hd_stand_in/libHD.so >/dev/null &&
-  cmake --build build-asan -j $jobs &&
-  cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO='-O1 -g0' \
-    -DCALLIGRAPHY_SANITIZE=thread -DCALLIGRAPHY_BUILD_TESTS=ON \
-    -DCMAKE_CXX_FLAGS=-Wno-tsan -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_TOOLS=OFF \
-    -DCALLIGRAPHY_BUILD_BENCH=OFF -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_EXAMPLES=OFF >/dev/null &&
-  cmake --build build-tsan -j $jobs --target calligraphy_servo_tests"
+  cmake --build build-asan -j $jobs"
 begin_stage "Release tests"
 run_ctest build
 end_stage
 wait_background
 python3 scripts/build-times.py build-asan
 
+# -Wno-tsan: GCC warns that TSan does not model atomic_thread_fence (the OpenHaptics seqlock uses it);
+# the seqlock's fields are atomics, so no race is hidden. Only the servo-loop test program (with the
+# OpenHaptics stand-in it loads) and the modules it links are built, at -O1, without debug information
+# (a report's stack names the functions, as the ASan stage's do), beside the sanitizer tests.
+start_background "ThreadSanitizer build" "
+  cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO='-O1 -g0' \
+    -DCALLIGRAPHY_SANITIZE=thread -DCALLIGRAPHY_BUILD_TESTS=ON \
+    -DCMAKE_CXX_FLAGS=-Wno-tsan -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_TOOLS=OFF \
+    -DCALLIGRAPHY_BUILD_BENCH=OFF -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_EXAMPLES=OFF >/dev/null &&
+  cmake --build build-tsan -j $jobs --target calligraphy_servo_tests"
 begin_stage "AddressSanitizer + UndefinedBehaviorSanitizer: tests"
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 run_ctest build-asan -E "study_report_chromium"
 end_stage
+wait_background
 
 begin_stage "ThreadSanitizer: the servo loop, its log queue and the OpenHaptics stand-in"
 TSAN_OPTIONS=halt_on_error=1 build-tsan/bin/calligraphy_servo_tests "[servo],[log_queue]"
