@@ -32,8 +32,8 @@ inline constexpr std::size_t kOffVersionMajor = 8, kOffVersionMinor = 10, kOffHe
 
 // Header flags (u32 at kOffFlags).
 inline constexpr std::uint32_t kFlagMedians = 1;  // every record ends with its strokes' medians (minor 1)
-inline constexpr std::uint32_t kFlagOutlines =
-    2;  // then with its strokes' outlines, if it has them (minor 2)
+// Then with its strokes' outlines, where it has them (minor 2).
+inline constexpr std::uint32_t kFlagOutlines = 2;
 inline constexpr std::uint32_t kKnownFlags = kFlagMedians | kFlagOutlines;
 // Outlines (SVG path data, one path per stroke): one bit, the character has them; then per stroke one bit,
 // the path as text (1: a length of kOutlineTextLengthBits and the bytes) or compact (0): a command count in
@@ -48,8 +48,6 @@ inline constexpr int kOutlineTextLengthBits = 20;
 /// Longest SVG path of one stroke's outline kept as text (length:20), bytes; the character-data readers
 /// refuse a longer entry of `strokes`, so that every character a folder gives can be stored.
 inline constexpr std::size_t kMaxOutlinePathBytes = (std::size_t{1} << kOutlineTextLengthBits) - 1;
-inline constexpr std::int64_t kMaxOutlineCoordinate =
-    100'000;  // |x| of a compact point, as kMaxDataCoordinate
 /// Points a compact outline command takes (M, L, Q, C, Z).
 inline constexpr int outline_command_points(char command) {
   return command == 'Q' ? 2 : command == 'C' ? 3 : command == 'Z' ? 0 : 1;

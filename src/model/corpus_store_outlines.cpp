@@ -7,11 +7,16 @@
 #include <charconv>
 #include <optional>
 
+#include "calligraphy/model/character_library.hpp"
+
 namespace calligraphy::store {
 namespace {
 
+// |x| of a compact point: the bound every outline path's coordinates are held to (parse_svg_path).
+constexpr auto kMaxOutlineCoordinate = static_cast<std::int64_t>(kMaxDataCoordinate);
+
 struct CompactPath {
-  std::vector<char> commands;
+  std::vector<std::uint64_t> codes;       // each command's index in kOutlineCommands
   std::vector<std::int64_t> coordinates;  // x, y, x, y, ...
 };
 
@@ -26,8 +31,8 @@ std::optional<CompactPath> compact_form(const std::string& path) {
     const char command = path[at++];
     const char* known = std::find(std::begin(kOutlineCommands), std::end(kOutlineCommands), command);
     if (known == std::end(kOutlineCommands)) return std::nullopt;
-    if (compact.commands.empty() != (command == 'M')) return std::nullopt;  // one M, first
-    compact.commands.push_back(command);
+    if (compact.codes.empty() != (command == 'M')) return std::nullopt;  // one M, first
+    compact.codes.push_back(static_cast<std::uint64_t>(known - std::begin(kOutlineCommands)));
     for (int i = 0; i < 2 * outline_command_points(command); ++i) {
       skip();
       std::int64_t value = 0;
@@ -42,7 +47,7 @@ std::optional<CompactPath> compact_form(const std::string& path) {
       compact.coordinates.push_back(value);
     }
   }
-  if (compact.commands.empty() || compact.commands.size() >= (std::size_t{1} << kOutlineCountExtensionBits))
+  if (compact.codes.empty() || compact.codes.size() >= (std::size_t{1} << kOutlineCountExtensionBits))
     return std::nullopt;
   return compact;
 }
@@ -74,18 +79,14 @@ void encode_outlines(BitWriter& out, const std::vector<std::string>& paths, std:
       for (const char c : paths[s]) out.put(static_cast<unsigned char>(c), 8);
       continue;
     }
-    const std::size_t count = compact->commands.size();
+    const std::size_t count = compact->codes.size();
     if (count < kOutlineCountEscape) {
       out.put(count, kOutlineCountBits);
     } else {
       out.put(kOutlineCountEscape, kOutlineCountBits);
       out.put(count, kOutlineCountExtensionBits);
     }
-    for (const char command : compact->commands) {
-      const auto code = std::find(std::begin(kOutlineCommands), std::end(kOutlineCommands), command) -
-                        std::begin(kOutlineCommands);
-      out.put(static_cast<std::uint64_t>(code), kOutlineCommandBits);
-    }
+    for (const std::uint64_t code : compact->codes) out.put(code, kOutlineCommandBits);
     const std::vector<std::int64_t>& xy = compact->coordinates;  // at least the M's point
     const int start_width = std::max(bit_width(zigzag(xy[0])), bit_width(zigzag(xy[1])));
     out.put(static_cast<std::uint64_t>(start_width), 5);

@@ -10,7 +10,7 @@
 namespace calligraphy::store {
 
 /// Appends a character's outlines: `paths` empty (none) or one SVG path per stroke. A path of absolute
-/// M, L, Q, C and Z, each with its own letter, and whole numbers within kMaxOutlineCoordinate is stored
+/// M, L, Q, C and Z, each with its own letter, and whole numbers within kMaxDataCoordinate is stored
 /// compactly; any other path as its text. `fail` throws, given what is wrong.
 void encode_outlines(BitWriter& out, const std::vector<std::string>& paths, std::size_t stroke_count,
                      const std::function<void(const std::string&)>& fail);
