@@ -90,10 +90,10 @@ std::vector<json> logged_events(const SessionFolder& session) {
 
 // Trials saved by a run that crashed before it could log them get their "trial_saved" line now, marked
 // recovered, with what their record says (end_reason, time_s) as a trial_saved line has, so that the log
-// names every saved trial once.
-void log_unlogged_saves(SessionFolder& session) {
+// names every saved trial once. `events` are the log's (logged_events).
+void log_unlogged_saves(SessionFolder& session, const std::vector<json>& events) {
   std::set<std::string> logged;
-  for (const json& event : logged_events(session)) {
+  for (const json& event : events) {
     if (event.value("event", "") == "trial_saved") logged.insert(event.value("file", ""));
   }
   for (const PlannedTrial& trial : session.plan()) {
@@ -230,7 +230,7 @@ class SessionRun {
     result_.planned = session_.plan().size();
     result_.saved_before = session_.saved_count();
     const std::optional<std::size_t> first = session_.next_unsaved();
-    if (result_.saved_before > 0) log_unlogged_saves(session_);
+    if (result_.saved_before > 0) log_unlogged_saves(session_, logged_events(session_));
     session_.log(result_.saved_before == 0 ? "session_started" : "session_resumed",
                  json{{"saved_trials", result_.saved_before},
                       {"next_trial", first ? json(*first + 1) : json(nullptr)},
@@ -538,7 +538,7 @@ bool complete_session_log(SessionFolder& session) {
   const std::vector<json> events = logged_events(session);
   if (!events.empty() && events.back().value("event", "") == "session_completed") return false;
   const std::size_t saved = session.saved_count();
-  log_unlogged_saves(session);
+  log_unlogged_saves(session, events);
   session.log(
       "session_resumed",
       json{{"saved_trials", saved}, {"next_trial", nullptr}, {"library", library_build().version}}.dump());
