@@ -40,12 +40,8 @@ CharacterSource::CharacterSource(const LibraryOptions& options) : library_(Chara
 
 CharacterOutlines CharacterSource::load_outlines(char32_t code_point) const {
   if (!store_) return library_.load_outlines(code_point);
-  const std::vector<std::string> paths = store_->load_outline_paths(code_point);
-  const std::string source = store_->name() + "#" + describe_character(code_point);
-  if (paths.empty()) {
-    throw DataError(source + ": no stroke outlines (a store built with `corpus build --outlines off`)");
-  }
-  return outlines_from_paths(code_point, paths, source);
+  return outlines_from_paths(code_point, store_outline_paths(*store_, code_point),
+                             store_->name() + "#" + describe_character(code_point));
 }
 
 Character CharacterSource::load(char32_t code_point) const {

@@ -123,12 +123,7 @@ std::vector<std::string> CharacterLibrary::load_outline_paths(char32_t cp) const
 CharacterLibrary::OutlinePaths CharacterLibrary::outline_paths(char32_t cp) const {
   if (from_bundled_store(cp)) {
     const CorpusStore& store = CorpusStore::bundled();
-    OutlinePaths found{store.load_outline_paths(cp), store.name() + "#" + describe_character(cp)};
-    if (found.paths.empty()) {
-      throw DataError(store.name() + ": character " + describe_character(cp) +
-                      ": no stroke outlines (a store built without them, `corpus build --outlines off`)");
-    }
-    return found;
+    return {store_outline_paths(store, cp), store.name() + "#" + describe_character(cp)};
   }
   const Document document = read_document(folder_, cp);
   if (document.text.size() > kMaxCharacterFileBytes) {
@@ -202,6 +197,15 @@ std::string CharacterLibrary::description() const {
     return "embedded default (" + embedded + " characters)";
   }
   return folder_.string();
+}
+
+std::vector<std::string> store_outline_paths(const CorpusStore& store, char32_t cp) {
+  std::vector<std::string> paths = store.load_outline_paths(cp);
+  if (paths.empty()) {
+    throw DataError(store.name() + ": character " + describe_character(cp) +
+                    ": no stroke outlines (a store built without them, `corpus build --outlines off`)");
+  }
+  return paths;
 }
 
 CharacterOutlines outlines_from_paths(char32_t cp, std::span<const std::string> paths,

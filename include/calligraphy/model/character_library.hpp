@@ -106,6 +106,13 @@ class CharacterLibrary {
   bool bundled_store_ = false;    // embedded, then the bundled corpus store (standard())
 };
 
+class CorpusStore;
+
+/// A corpus store's outline paths of the character (`CorpusStore::load_outline_paths`), one per stroke.
+/// Throws as `CorpusStore::load`, and DataError naming the store and the character when it holds none (a
+/// store of format 1.0 or 1.1, or built with `corpus build --outlines off`).
+[[nodiscard]] std::vector<std::string> store_outline_paths(const CorpusStore& store, char32_t code_point);
+
 /// A character's outlines from its strokes' SVG path data (one path per stroke, in stroke order), each
 /// flattened within `tolerance` data units by `parse_svg_path`; `source` names where the paths were read.
 /// Throws DataError naming `source`, the character and the JSON pointer (/strokes/2) of a path that does not
