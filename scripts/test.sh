@@ -110,7 +110,10 @@ bash scripts/check-docs.sh
 end_stage
 
 begin_stage "Release build, warnings as errors"
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON \
+# Every build here is fresh and never edited: each library module is compiled as one unit
+# (CALLIGRAPHY_UNITY_BATCH_SIZE=0), in about 40 % of its files' time apart (docs/testing.md, "Build time").
+unity="-DCALLIGRAPHY_UNITY_BATCH_SIZE=0"
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON $unity \
   -DCALLIGRAPHY_BUILD_PYTHON=ON -DCALLIGRAPHY_BUILD_TESTS=ON -DCALLIGRAPHY_BUILD_BENCH=ON \
   -DCALLIGRAPHY_BUILD_EXAMPLES=ON >/dev/null
 cmake --build build -j "$jobs"
@@ -133,7 +136,7 @@ end_stage
 # Built with clang: its instrumented files compile in 70-100 % of GCC's time, and this build is the stage's
 # longest path. (The Release and ThreadSanitizer stages stay on GCC, so both compilers keep building.)
 start_background "AddressSanitizer + UndefinedBehaviorSanitizer: build (clang)" "
-  cmake -S . -B build-asan -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG='-O1 -g0' \
+  cmake -S . -B build-asan -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG='-O1 -g0' $unity \
     -DCALLIGRAPHY_SANITIZE=address,undefined -DCALLIGRAPHY_NO_SANITIZE=alignment,object-size,pointer-overflow,null \
     -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_BENCH=OFF \
     -DCALLIGRAPHY_BUILD_TESTS=ON -DCALLIGRAPHY_BUILD_EXAMPLES=ON -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_TRAINER=OFF \
@@ -151,7 +154,7 @@ python3 scripts/build-times.py build-asan
 # OpenHaptics stand-in it loads) and the modules it links are built, at -O1, without debug information
 # (a report's stack names the functions, as the ASan stage's do), beside the sanitizer tests.
 start_background "ThreadSanitizer build" "
-  cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO='-O1 -g0' \
+  cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO='-O1 -g0' $unity \
     -DCALLIGRAPHY_SANITIZE=thread -DCALLIGRAPHY_BUILD_TESTS=ON \
     -DCMAKE_CXX_FLAGS=-Wno-tsan -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_TOOLS=OFF \
     -DCALLIGRAPHY_BUILD_BENCH=OFF -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_EXAMPLES=OFF >/dev/null &&

@@ -9,17 +9,14 @@ namespace calligraphy {
 
 namespace {
 
-constexpr ParameterRange kPositive{.low_open = true};
-constexpr ParameterRange kNonNegative{};
-
 constexpr std::array kCurveFields{
-    ParameterField<CurveComparisonOptions>{"reference_step_m", "m", kPositive,
+    ParameterField<CurveComparisonOptions>{"reference_step_m", "m", kPositiveRange,
                                            "arc-length step of the resampled reference curve",
                                            &CurveComparisonOptions::reference_step_m},
 };
 
 constexpr std::array kKinematicsFields{
-    ParameterField<KinematicsOptions>{"low_pass_cutoff_hz", "Hz", kNonNegative,
+    ParameterField<KinematicsOptions>{"low_pass_cutoff_hz", "Hz", kNonNegativeRange,
                                       "cut-off of the Gaussian low-pass filter on the positions, 0 for none",
                                       &KinematicsOptions::low_pass_cutoff_hz},
     ParameterField<KinematicsOptions>{
@@ -29,7 +26,7 @@ constexpr std::array kKinematicsFields{
 };
 
 constexpr std::array kMetricsFields{
-    ParameterField<MetricsOptions>{"tube_radius_m", "m", kNonNegative,
+    ParameterField<MetricsOptions>{"tube_radius_m", "m", kNonNegativeRange,
                                    "radius of the tolerance tube around the reference stroke",
                                    &MetricsOptions::tube_radius_m},
 };

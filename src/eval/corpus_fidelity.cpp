@@ -10,15 +10,10 @@
 #include "calligraphy/model/polyline.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "eval/corpus_fit.hpp"
+#include "eval/report_numbers.hpp"
 
 namespace calligraphy::cli {
 namespace {
-
-std::string format(const char* pattern, double value) {
-  char text[64];
-  std::snprintf(text, sizeof text, pattern, value);
-  return text;
-}
 
 void measure_stroke(const Stroke& fitted, const Stroke& stored, StrokeDeviation& d) {
   std::vector<Vec2> curve;
@@ -44,7 +39,7 @@ FidelityRow measure_tolerance(const CharacterLibrary& library, double tolerance,
   FitOptions options;
   options.tolerance = tolerance;
   const CorpusFit fit =
-      fit_corpus(library, options, threads, "tolerance " + format("%g", tolerance), log_progress);
+      fit_corpus(library, options, threads, "tolerance " + format_number("%g", tolerance), log_progress);
   const auto bytes = encode_corpus_store(fit.characters, {steps, tolerance});
   const CorpusStore store = CorpusStore::from_bytes(bytes, "memory");
   FidelityRow row;
@@ -99,7 +94,7 @@ std::vector<FidelityRow> measure_corpus_fidelity(const CharacterLibrary& library
   std::vector<FidelityRow> rows;
   for (double tolerance : tolerances) {
     if (!(tolerance > 0.0))
-      throw InvalidArgument("corpus fidelity: tolerance " + format("%g", tolerance) + " is not > 0");
+      throw InvalidArgument("corpus fidelity: tolerance " + format_number("%g", tolerance) + " is not > 0");
     rows.push_back(measure_tolerance(library, tolerance, steps_per_unit, threads, log_progress));
   }
   return rows;
@@ -117,25 +112,26 @@ std::string corpus_fidelity_markdown(const std::vector<FidelityRow>& rows, int s
   for (const auto& r : rows) {
     const double mean =
         r.after.samples_kept ? r.after.sum_kept / static_cast<double>(r.after.samples_kept) : 0.0;
-    md << "| " << format("%g", r.tolerance) << " | " << format("%.2f", r.elements_per_stroke) << " | "
-       << r.bytes << " | "
-       << format("%.1f",
-                 static_cast<double>(r.bytes) / static_cast<double>(std::max<std::size_t>(1, r.characters)))
-       << " | " << format("%.2f", r.after.max_kept) << " | " << format("%.3f", r.after.max_kept * mm_per_unit)
-       << " | " << format("%.2f", mean) << " | " << format("%.3f", mean * mm_per_unit) << " | "
-       << format("%.2f", r.max_before) << " | " << format("%.1f", r.after.max_all) << " | "
-       << r.strokes_beyond << " (" << format("%.2f", share_percent(r.strokes_beyond, r.strokes)) << " %) | "
+    md << "| " << format_number("%g", r.tolerance) << " | " << format_number("%.2f", r.elements_per_stroke)
+       << " | " << r.bytes << " | "
+       << format_number("%.1f", static_cast<double>(r.bytes) /
+                                    static_cast<double>(std::max<std::size_t>(1, r.characters)))
+       << " | " << format_number("%.2f", r.after.max_kept) << " | "
+       << format_number("%.3f", r.after.max_kept * mm_per_unit) << " | " << format_number("%.2f", mean)
+       << " | " << format_number("%.3f", mean * mm_per_unit) << " | " << format_number("%.2f", r.max_before)
+       << " | " << format_number("%.1f", r.after.max_all) << " | " << r.strokes_beyond << " ("
+       << format_number("%.2f", share_percent(r.strokes_beyond, r.strokes)) << " %) | "
        << encode_utf8(r.worst_character) << " stroke " << r.worst_stroke << " | "
-       << format("%.2f", r.fitter_max) << " | " << r.fitter_beyond << " ("
-       << format("%.2f", share_percent(r.fitter_beyond, r.strokes)) << " %) | "
-       << format("%.2f", r.fit_wall_s) << " (" << r.threads << ") | " << format("%.2f", r.fit_cpu_s)
-       << " |\n";
+       << format_number("%.2f", r.fitter_max) << " | " << r.fitter_beyond << " ("
+       << format_number("%.2f", share_percent(r.fitter_beyond, r.strokes)) << " %) | "
+       << format_number("%.2f", r.fit_wall_s) << " (" << r.threads << ") | "
+       << format_number("%.2f", r.fit_cpu_s) << " |\n";
   }
   if (!rows.empty()) {
     md << "\n"
        << rows.front().characters << " characters (" << rows.front().failures
        << " not modelled), quantisation 1/" << steps_per_unit << " data unit; mm at the default layout ("
-       << format("%.0f", 1000.0 * SceneLayout{}.character_size_m) << " mm per 1024 units).\n";
+       << format_number("%.0f", 1000.0 * SceneLayout{}.character_size_m) << " mm per 1024 units).\n";
   }
   return md.str();
 }

@@ -9,6 +9,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "eval/lib2geom_nearest.hpp"
 #include "eval/nearest_point_reference.hpp"
+#include "eval/report_numbers.hpp"
 
 namespace calligraphy::cli {
 
@@ -27,12 +28,6 @@ NearestPointOptions options_for(NearestPointMethod method, const StrokeElement& 
     options.tolerance = length > 0.0 ? 1e-12 * length : 1e-12;
   }
   return options;
-}
-
-double percentile(std::vector<double> values, double fraction) {
-  std::sort(values.begin(), values.end());
-  const auto rank = static_cast<std::size_t>(std::ceil(fraction * static_cast<double>(values.size())));
-  return values[std::clamp<std::size_t>(rank, 1, values.size()) - 1];
 }
 
 // Time per call of `distance_of(i)`, `repeats` calls timed together.
@@ -80,9 +75,10 @@ NearestPointRow measure_solver(NearestPointRow row, const std::vector<NearestPoi
   for (std::size_t i = 0; i < queries.size(); ++i) {
     if (!failed[i]) times.push_back(time_query(distance_of, i, repeats, sink));
   }
+  std::sort(times.begin(), times.end());
   if (!times.empty()) {
-    row.ns_median = percentile(times, 0.5);
-    row.ns_p99 = percentile(times, 0.99);
+    row.ns_median = nearest_rank(times, 0.5);
+    row.ns_p99 = nearest_rank(times, 0.99);
   }
   return row;
 }

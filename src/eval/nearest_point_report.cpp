@@ -7,16 +7,11 @@
 #include <sstream>
 
 #include "calligraphy/core/errors.hpp"
+#include "eval/report_numbers.hpp"
 
 namespace calligraphy::cli {
 
 namespace {
-
-std::string format(const char* pattern, double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, pattern, value);
-  return buffer;
-}
 
 std::string cpu_model() {
   std::ifstream cpuinfo("/proc/cpuinfo");
@@ -73,19 +68,20 @@ std::string lib2geom_comparison(const NearestPointMeasurement& measurement) {
     failed += row.failed_queries;
     const double time_ratio = row.ns_median / exact->ns_median;
     time_ratios.push_back(time_ratio);
-    table << "| " << row.degree << " | " << row.scenario << " | " << format("%.0f", exact->ns_median) << " | "
-          << format("%.0f", row.ns_median) << " | " << format("%.2f", time_ratio) << " | "
-          << format("%.3g", exact->max_error_m) << " | " << format("%.3g", row.max_error_m) << " | "
-          << (exact->max_error_m > 0.0 ? format("%.3g", row.max_error_m / exact->max_error_m)
+    table << "| " << row.degree << " | " << row.scenario << " | " << format_number("%.0f", exact->ns_median)
+          << " | " << format_number("%.0f", row.ns_median) << " | " << format_number("%.2f", time_ratio)
+          << " | " << format_number("%.3g", exact->max_error_m) << " | "
+          << format_number("%.3g", row.max_error_m) << " | "
+          << (exact->max_error_m > 0.0 ? format_number("%.3g", row.max_error_m / exact->max_error_m)
                                        : std::string("-"))
-          << " | " << format("%.2f %%", 100.0 * row.frac_off_0p1mm) << " |\n";
+          << " | " << format_number("%.2f %%", 100.0 * row.frac_off_0p1mm) << " |\n";
   }
   if (time_ratios.empty()) return {};
   std::sort(time_ratios.begin(), time_ratios.end());
   out << table.str() << "\nTime ratio over the " << time_ratios.size()
-      << " scenario and degree pairs: median " << format("%.2f", time_ratios[time_ratios.size() / 2])
-      << ", from " << format("%.2f", time_ratios.front()) << " to " << format("%.2f", time_ratios.back())
-      << ".";
+      << " scenario and degree pairs: median " << format_number("%.2f", time_ratios[time_ratios.size() / 2])
+      << ", from " << format_number("%.2f", time_ratios.front()) << " to "
+      << format_number("%.2f", time_ratios.back()) << ".";
   if (failed > 0)
     out << " " << kLib2geomMethod << " threw on " << failed << " queries (counted as infinite errors).";
   out << "\n";
@@ -141,10 +137,10 @@ std::string nearest_point_markdown(const NearestPointMeasurement& measurement,
       continue;
     }
     out << "| " << row.method << " | " << row.degree << " | " << row.scenario << " | " << row.queries << " | "
-        << format("%.0f", row.ns_median) << " | " << format("%.0f", row.ns_p99) << " | "
-        << format("%.3g", row.max_error_m) << " | " << format("%.3g", row.mean_error_m) << " | "
-        << format("%.2f %%", 100.0 * row.frac_off_0p1mm) << " | "
-        << (row.max_error_over_length ? format("%.3g", *row.max_error_over_length) : std::string("-"))
+        << format_number("%.0f", row.ns_median) << " | " << format_number("%.0f", row.ns_p99) << " | "
+        << format_number("%.3g", row.max_error_m) << " | " << format_number("%.3g", row.mean_error_m) << " | "
+        << format_number("%.2f %%", 100.0 * row.frac_off_0p1mm) << " | "
+        << (row.max_error_over_length ? format_number("%.3g", *row.max_error_over_length) : std::string("-"))
         << " |\n";
   }
   out << lib2geom_comparison(measurement);
@@ -153,7 +149,8 @@ std::string nearest_point_markdown(const NearestPointMeasurement& measurement,
         << "`: the input rounded to float first, max distance error in m):\n\n";
     out << "| input | degree | max error (m) |\n|---|---:|---:|\n";
     for (const PrecisionRow& row : measurement.precision) {
-      out << "| " << row.input << " | " << row.degree << " | " << format("%.3g", row.max_error_m) << " |\n";
+      out << "| " << row.input << " | " << row.degree << " | " << format_number("%.3g", row.max_error_m)
+          << " |\n";
     }
   }
   out << "\n" << kGeneratedEnd << "\n";

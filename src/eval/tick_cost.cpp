@@ -8,11 +8,12 @@
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/unicode.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/render/renderer.hpp"
-#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/sim/simulated_writer.hpp"
-#include "calligraphy/core/unicode.hpp"
+#include "eval/report_numbers.hpp"
 
 namespace calligraphy::cli {
 namespace {
@@ -43,12 +44,6 @@ std::vector<DeviceState> record_states(const Scene& scene, double rate_hz, doubl
     device.advance(dt);
   }
   return states;
-}
-
-double percentile(const std::vector<double>& sorted, double p) {
-  if (sorted.empty()) return 0.0;
-  const auto index = static_cast<std::size_t>(std::ceil(p * static_cast<double>(sorted.size()))) - 1;
-  return sorted[std::min(index, sorted.size() - 1)];
 }
 
 double nanoseconds(Clock::time_point start, Clock::time_point stop) {
@@ -94,11 +89,11 @@ TickCost measure_tick_cost(const CharacterLibrary& library, const TickCostSettin
   for (double v : ns) sum += v;
   cost.ticks = ns.size();
   cost.ns_mean = ns.empty() ? 0.0 : sum / static_cast<double>(ns.size());
-  cost.ns_median = percentile(ns, 0.5);
-  cost.ns_p99 = percentile(ns, 0.99);
-  cost.ns_p999 = percentile(ns, 0.999);
+  cost.ns_median = nearest_rank(ns, 0.5);
+  cost.ns_p99 = nearest_rank(ns, 0.99);
+  cost.ns_p999 = nearest_rank(ns, 0.999);
   cost.ns_max = ns.empty() ? 0.0 : ns.back();
-  cost.clock_overhead_ns_median = percentile(overhead, 0.5);
+  cost.clock_overhead_ns_median = nearest_rank(overhead, 0.5);
   return cost;
 }
 

@@ -17,10 +17,9 @@ namespace calligraphy {
 namespace {
 
 using P = StrokePieceTemplate;
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 constexpr P piece(double start, double end, double start_tol, double end_tol, bool hook = false,
-                  double min_length = 0.0, double max_length = kInf) {
+                  double min_length = 0.0, double max_length = std::numeric_limits<double>::infinity()) {
   return piece_template(start, end, start_tol, end_tol, hook, min_length, max_length);
 }
 constexpr P piece(double start, double end, double tol = 20.0) { return piece(start, end, tol, tol); }

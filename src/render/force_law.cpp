@@ -15,8 +15,6 @@ namespace {
 
 using Field = ParameterField<ForceLawParameters>;
 using P = ForceLawParameters;
-constexpr ParameterRange kNonNegative{};
-constexpr ParameterRange kPositive{.low_open = true};
 // The force law's lengths: at most 0.1 m, more than the side of a character (60 mm, SceneLayout) and about
 // twenty times the paper's constraint radius (a few mm, section 4.3): a larger one is a typing error, and a
 // bound keeps every product with a stiffness finite.
@@ -28,30 +26,30 @@ constexpr ParameterRange kFadeTime{.high = 10.0};
 
 // In declaration order; the docs say what the value is, the header says why.
 constexpr std::array kFields{
-    Field{"guidance_stiffness_n_per_m", "N/m", kNonNegative, "K_et per unit attraction factor (eq. 8)",
+    Field{"guidance_stiffness_n_per_m", "N/m", kNonNegativeRange, "K_et per unit attraction factor (eq. 8)",
           &P::guidance_stiffness_n_per_m},
-    Field{"paper_stiffness_n_per_m", "N/m", kNonNegative, "K_en, stiffness of the virtual paper (eq. 9)",
+    Field{"paper_stiffness_n_per_m", "N/m", kNonNegativeRange, "K_en, stiffness of the virtual paper (eq. 9)",
           &P::paper_stiffness_n_per_m},
     Field{"constraint_radius_m", "m", kPositiveLength,
           "R_res, radius of the constraint space around the active element (section 4.3)",
           &P::constraint_radius_m},
-    Field{"resistance_damping_n_s_per_m", "N s/m", kNonNegative,
+    Field{"resistance_damping_n_s_per_m", "N s/m", kNonNegativeRange,
           "damping against writing backwards along the active element (Fig. 4)",
           &P::resistance_damping_n_s_per_m},
     Field{"contact_hysteresis_m", "m", kLength,
           "height above the paper at which a touching tip counts as lifted (section 6)",
           &P::contact_hysteresis_m},
-    Field{"off_stroke_force_n", "N", kNonNegative,
+    Field{"off_stroke_force_n", "N", kNonNegativeRange,
           "friction against writing away from the active stroke in CS; 0 = the paper's CS",
           &P::off_stroke_force_n},
     Field{"off_stroke_travel_m", "m", kPositiveLength,
           "travel before the off-stroke friction reaches its force", &P::off_stroke_travel_m},
-    Field{"off_stroke_damping_n_s_per_m", "N s/m", kNonNegative,
+    Field{"off_stroke_damping_n_s_per_m", "N s/m", kNonNegativeRange,
           "damping of motion away from the active element in WS outside R_res",
           &P::off_stroke_damping_n_s_per_m},
-    Field{"off_stroke_speed_m_s", "m/s", kPositive, "speed below which that damping fades out",
+    Field{"off_stroke_speed_m_s", "m/s", kPositiveRange, "speed below which that damping fades out",
           &P::off_stroke_speed_m_s},
-    Field{"off_stroke_velocity_cutoff_hz", "Hz", kPositive,
+    Field{"off_stroke_velocity_cutoff_hz", "Hz", kPositiveRange,
           "low-pass on the velocity the off-stroke damping reads", &P::off_stroke_velocity_cutoff_hz},
     Field{"constraint_taper_m", "m", kLength,
           "band at R_res over which F_et tapers to zero, at most R_res; 0 = the paper's step",
@@ -62,14 +60,14 @@ constexpr std::array kFields{
     Field{"paper_fade_s", "s", kFadeTime,
           "fade time of the paper force when it starts or stops pushing (AS <-> CS); 0 = off",
           &P::paper_fade_s},
-    Field{"paper_damping_n_s_per_m", "N s/m", kNonNegative,
+    Field{"paper_damping_n_s_per_m", "N s/m", kNonNegativeRange,
           "damping of the paper on inward motion only; 0 = off", &P::paper_damping_n_s_per_m},
-    Field{"max_foot_speed_m_s", "m/s", kPositive, "highest speed of the rendered attraction target X_S",
+    Field{"max_foot_speed_m_s", "m/s", kPositiveRange, "highest speed of the rendered attraction target X_S",
           &P::max_foot_speed_m_s},
-    Field{"friction_coefficient", "", kNonNegative,
+    Field{"friction_coefficient", "", kNonNegativeRange,
           "Coulomb friction coefficient mu of the paper (not in the paper), dimensionless",
           &P::friction_coefficient},
-    Field{"friction_stick_speed_m_s", "m/s", kPositive, "stick band of the friction, viscous below it",
+    Field{"friction_stick_speed_m_s", "m/s", kPositiveRange, "stick band of the friction, viscous below it",
           &P::friction_stick_speed_m_s},
 };
 

@@ -31,12 +31,11 @@ double colgate_stiffness_bound(double device_damping_n_s_per_m, double rate_hz,
 namespace {
 
 using PassivityField = ParameterField<PassivityParameters>;
-constexpr ParameterRange kPositive{.low_open = true};
 
 constexpr std::array kPassivityFields{
-    PassivityField{"max_damping_n_s_per_m", "N s/m", kPositive, "cap on the variable damper alpha",
+    PassivityField{"max_damping_n_s_per_m", "N s/m", kPositiveRange, "cap on the variable damper alpha",
                    &PassivityParameters::max_damping_n_s_per_m},
-    PassivityField{"min_speed_m_s", "m/s", kPositive, "speed below which no damping is added",
+    PassivityField{"min_speed_m_s", "m/s", kPositiveRange, "speed below which no damping is added",
                    &PassivityParameters::min_speed_m_s},
 };
 

@@ -27,7 +27,6 @@ namespace {
 
 using SafetyField = ParameterField<SafetyChainParameters>;
 using S = SafetyChainParameters;
-constexpr ParameterRange kNonNegative{};
 // An order of magnitude above the peak force of every device this library knows (the Phantom Desktop's
 // 7.9 N is the largest): a larger limit is a typing error, not a limit.
 constexpr ParameterRange kForce{.high = 100.0};
@@ -46,9 +45,9 @@ constexpr std::array kSafetyFields{
                 &S::max_continuous_force_n},
     SafetyField{"continuous_time_constant_s", "s", kTimeConstant, "tau of the RMS (thermal) force estimate",
                 &S::continuous_time_constant_s},
-    SafetyField{"start_ramp_n_per_s", "N/s", kNonNegative, "force ramp after start or reset; 0 = off",
+    SafetyField{"start_ramp_n_per_s", "N/s", kNonNegativeRange, "force ramp after start or reset; 0 = off",
                 &S::start_ramp_n_per_s},
-    SafetyField{"max_force_change_n_per_tick", "N", kNonNegative, "per-tick force change limit; 0 = off",
+    SafetyField{"max_force_change_n_per_tick", "N", kNonNegativeRange, "per-tick force change limit; 0 = off",
                 &S::max_force_change_n_per_tick},
     SafetyField{"low_pass_cutoff_hz", "Hz", kCutoff, "first-order low-pass cutoff; 0 = off",
                 &S::low_pass_cutoff_hz},

@@ -19,8 +19,6 @@ constexpr double kCornerTurn_deg = 70.0;
 // against the medians (docs/stroke-acceptance.md) end short by at most 12 % of a short stroke.
 constexpr double kMostShortShare = 0.12;
 
-Vec3 on_plane(const Vec2& p, double z) { return Vec3(p.x(), p.y(), z); }
-
 // The writer's copy of the seen stroke: its legs, biased, the last one ending where the pen lifts.
 struct StrokeCopy {
   std::vector<Polyline> legs;  // at least one, each of at least two points [m]

@@ -17,8 +17,6 @@ constexpr double kMidLiftHold_s = 0.1;      // and how long the pen stays up
 constexpr double kStrayDistance_m = 0.004;  // a touch outside the box lands this far outside it
 constexpr double kStrayLength_m = 0.004;    // and slides this far along it
 
-Vec3 on_plane(const Vec2& p, double z) { return Vec3(p.x(), p.y(), z); }
-
 }  // namespace
 
 Vec2 WriterErrorInjector::draw_character_offset(std::mt19937_64& rng) const {

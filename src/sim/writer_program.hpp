@@ -61,6 +61,9 @@ struct Segment {
   [[nodiscard]] static double minimum_jerk_slope(double phase);
 };
 
+/// The point `p` of the writing plane at height `z` [m].
+inline Vec3 on_plane(const Vec2& p, double z) { return Vec3(p.x(), p.y(), z); }
+
 /// A segment through `path` lasting max(minimum_s, length / speed_m_s) at speed factor 1.
 Segment make_segment(SegmentKind kind, std::vector<Vec3> path, double speed_m_s, double minimum_s);
 

@@ -30,6 +30,10 @@ struct ParameterRange {
   [[nodiscard]] std::string text(std::string_view unit = {}) const;
 };
 
+/// The ranges most fields share: any finite value >= 0, and any finite value > 0.
+inline constexpr ParameterRange kNonNegativeRange{};
+inline constexpr ParameterRange kPositiveRange{.low_open = true};
+
 /// One numeric field of parameter struct `S`.
 template <typename S>
 struct ParameterField {

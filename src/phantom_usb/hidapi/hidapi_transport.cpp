@@ -22,7 +22,7 @@ std::string narrow(const wchar_t* text) {
   return out;
 }
 
-int to_milliseconds(std::chrono::microseconds timeout) noexcept {
+int hid_timeout_ms(std::chrono::microseconds timeout) noexcept {
   return static_cast<int>(std::max<std::int64_t>(1, (timeout.count() + 999) / 1000));
 }
 
@@ -92,7 +92,7 @@ DeviceFault HidapiTransport::read(std::span<std::uint8_t> buffer, std::chrono::m
                                   std::size_t& received) noexcept {
   received = 0;
   if (device_ == nullptr) return DeviceFault::not_open;
-  const int count = hid_read_timeout(device_, buffer.data(), buffer.size(), to_milliseconds(timeout));
+  const int count = hid_read_timeout(device_, buffer.data(), buffer.size(), hid_timeout_ms(timeout));
   if (count < 0) return DeviceFault::link_lost;  // unplugged?
   received = static_cast<std::size_t>(count);
   return DeviceFault::none;

@@ -12,7 +12,7 @@
 namespace calligraphy::phantom {
 namespace {
 
-unsigned int to_milliseconds(std::chrono::microseconds timeout) noexcept {
+unsigned int libusb_timeout_ms(std::chrono::microseconds timeout) noexcept {
   return static_cast<unsigned int>(std::max<std::int64_t>(1, (timeout.count() + 999) / 1000));
 }
 
@@ -143,7 +143,7 @@ DeviceFault LibusbTransport::write(std::span<const std::uint8_t> packet,
   std::copy(packet.begin(), packet.end(), out_buffer_.begin());
   int sent = 0;
   const int rc = libusb_bulk_transfer(handle_, endpoint_out_, out_buffer_.data(),
-                                      static_cast<int>(packet.size()), &sent, to_milliseconds(timeout));
+                                      static_cast<int>(packet.size()), &sent, libusb_timeout_ms(timeout));
   // Unplugged (LIBUSB_ERROR_NO_DEVICE), any other failure, or a short write.
   if (rc != 0 || sent != static_cast<int>(packet.size())) return DeviceFault::link_lost;
   return DeviceFault::none;
@@ -155,7 +155,7 @@ DeviceFault LibusbTransport::read(std::span<std::uint8_t> buffer, std::chrono::m
   if (handle_ == nullptr) return DeviceFault::not_open;
   int count = 0;
   const int rc = libusb_bulk_transfer(handle_, endpoint_in_, buffer.data(), static_cast<int>(buffer.size()),
-                                      &count, to_milliseconds(timeout));
+                                      &count, libusb_timeout_ms(timeout));
   if (rc == 0 || rc == LIBUSB_ERROR_TIMEOUT) {
     received = static_cast<std::size_t>(count);
     return DeviceFault::none;
