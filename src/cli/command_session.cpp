@@ -192,9 +192,10 @@ SessionRunResult run_resumable(SessionFolder& session, const SessionRunOptions& 
 // the line on standard error, as its other lines do.
 int report_run(std::string_view command, const SessionFolder& session, const SessionRunResult& result,
                double seconds) {
-  std::printf("%s: %zu of %zu trials saved (%zu now, %zu attempts kept) in %s, %.1f s\n",
+  std::printf("%s: %zu of %zu trials saved (%zu now, %zu %s kept) in %s, %.1f s\n",
               session.manifest().setup.subject.id.c_str(), result.saved_before + result.saved_now,
-              result.planned, result.saved_now, result.attempts_kept, session.path().c_str(), seconds);
+              result.planned, result.saved_now, result.attempts_kept,
+              result.attempts_kept == 1 ? "attempt" : "attempts", session.path().c_str(), seconds);
   std::fflush(stdout);
   const std::string resume = "resume with: calligraphy session resume " + session.path().string();
   if (result.save_failed) {

@@ -1,6 +1,7 @@
 // `calligraphy session plan PROTOCOL --subjects N [--json]`: what `session run` would run, subject by
 // subject, and how N subjects fill the protocol's counterbalancing, without running or writing anything.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -63,8 +64,9 @@ SubjectShown show_subject(const StudyProtocol& protocol, const SubjectAssignment
 
 // "1 h 02 min 05 s", "3 min 20 s", "45 s".
 std::string duration_text(double seconds) {
-  // Under ten seconds as given (a trial of 0.3 s is not one of "0 s"); above, in whole seconds.
-  if (seconds < 10.0) return shortest_decimal(seconds) + " s";
+  // Under ten seconds to the microsecond (a trial of 0.3 s is not one of "0 s", and three of them are 0.9 s,
+  // not their sum's 0.8999999999999999 s); above, in whole seconds.
+  if (seconds < 10.0) return shortest_decimal(std::round(seconds * 1e6) / 1e6) + " s";
   const auto total = static_cast<long long>(seconds + 0.5);
   char text[64];
   if (total >= 3600) {

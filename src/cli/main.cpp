@@ -2,7 +2,11 @@
 // corpus store, benchmarks. docs/cli.md describes every command.
 #include <cstdio>
 #include <exception>
+#include <functional>
+#include <memory>
+#include <mutex>
 #include <new>
+#include <set>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -38,9 +42,20 @@ void print_error(const std::string& command, const std::string& message) {
 // The library's log as the command's own lines on standard error, one line each in the error lines' form:
 // "calligraphy trial: warning: Phantom: ...". Its errors (a servo loop's watchdog) are warnings of the
 // command, which says itself how it ended; info lines only with --verbose. Standard output carries reports.
+// A warning said word for word before is not said again: each trial of a session builds its renderer, and a
+// stiffness above the device's passivity bound was said once per trial.
 void show_library_log(const std::string& command, bool verbose) {
-  calligraphy::set_log_handler([command](calligraphy::LogLevel level, std::string_view message) {
+  struct Said {
+    std::mutex mutex;  // the handler may be called from the corpus fitter's threads
+    std::set<std::string, std::less<>> warnings;
+  };
+  auto said = std::make_shared<Said>();
+  calligraphy::set_log_handler([command, said](calligraphy::LogLevel level, std::string_view message) {
     using calligraphy::LogLevel;
+    if (level >= LogLevel::warning) {
+      const std::lock_guard<std::mutex> lock(said->mutex);
+      if (!said->warnings.emplace(message).second) return;
+    }
     const char* kind = level >= LogLevel::warning ? "warning" : level == LogLevel::info ? "info" : "debug";
     print_error_line(command, kind, message);
   });

@@ -797,6 +797,24 @@ class OneCommandLine(CliTestCase):
         for args in runs:
             self.assertEqual(self.warnings(*args), [], args)
 
+    def test_a_warning_repeated_by_every_trial_of_a_session_is_said_once(self):
+        # At 100 Hz the default stiffnesses are above the simulated device's passivity bound, and each trial's
+        # renderer says so: the session's standard error says it once (docs/cli.md), a trial alone once too.
+        protocol = dict(ONE_TRIAL_PROTOCOL, trial={"max_duration_s": 0.3, "rate_hz": 100})
+        protocol["test"] = dict(protocol["test"], characters=["一"], repetitions=3)
+        (self.cwd / "p100.json").write_text(json.dumps(protocol, ensure_ascii=False), encoding="utf-8")
+        result = self.run_cli("session", "run", "p100.json", "--subject", "S01", "--out", "s100")
+        self.assertIn("3 of 3 trials saved", result.stdout.decode(), result.stderr.decode())
+        lines = result.stderr.decode().splitlines()
+        # The plan's total of three 0.3 s trials is 0.9 s, not the sum's 0.8999999999999999 s.
+        self.assertIn("  session 1: 3 trials, at most 0.9 s (0 s of rests)", lines)
+        said = [line for line in lines if "passivity bound" in line]
+        # The paper's and the guidance's stiffness: two warnings, each said once, not once per trial.
+        self.assertEqual(len(said), 2, lines)
+        self.assertEqual(len(set(said)), 2, lines)
+        for line, stiffness in zip(said, ("paper stiffness", "guidance stiffness")):
+            self.assertTrue(line.startswith(f"calligraphy session run: warning: {stiffness} "), line)
+
     def test_the_emulated_phantom_runs_within_its_stiffness(self):
         # The force law's default paper stiffness (800 N/m) is above the Phantom Omni's stable 700 N/m: the
         # commands cap it at the device's limit instead of warning about their own default.

@@ -719,7 +719,7 @@ class Outputs(unittest.TestCase, OneErrorLine):
 PROTOCOL = {"name": "tiny", "conditions": [{"name": "fixture", "mode": "haptic"}],
             "test": {"characters": ["一"], "conditions": ["fixture"], "repetitions": 2},
             "trial": {"max_duration_s": 10}}
-SESSION_LINE = r"^(S\d+): (\d+) of (\d+) trials saved \((\d+) now, (\d+) attempts kept\) in (\S+), \d+\.\d s$"
+SESSION_LINE = r"^(S\d+): (\d+) of (\d+) trials saved \((\d+) now, (\d+) attempts? kept\) in (\S+), \d+\.\d s$"
 
 
 class Sessions(unittest.TestCase):
