@@ -18,6 +18,7 @@ import csv
 import hashlib
 import html.parser
 import json
+import math
 import os
 import shutil
 import subprocess
@@ -45,8 +46,8 @@ PROTOCOL = {"name": "-r19b_NA", "description": DESCRIPTION,
             "trial": {"max_duration_s": 3}}
 RUN = ["--writer", "simulated", "--writer-learning", "none"]
 TRACE_HEADER = "t,x,y,z,fx,fy,fz,state,stroke,element,attempt,rewritten"
-# A folder name a lab could be given: a comma, a quote, a line break, a leading `=`, a tab and an `@`.
-HOSTILE_DIR = '=cmd,"x"\n;\t@y'
+# A folder name a lab could be given: a comma, a quote, markup, a line break, a leading `=`, a tab and an `@`.
+HOSTILE_DIR = '=cmd,"x"<i>&amp;\n;\t@y'
 SHARED = {}
 
 
@@ -451,6 +452,48 @@ class Study(unittest.TestCase, OneErrorLine):
             self.assertTrue((self.tmp / a["trace_file"]).is_file())
         self.assertEqual(raw.count(b"\n"), len(copied) * (1 + HOSTILE_DIR.count("\n")) + 1)
 
+    def test_pages_of_the_copy_in_a_hostile_folder_are_whole(self):
+        copy = self.tmp / "copy-for-pages" / HOSTILE_DIR
+        shutil.copytree(self.tmp / "st", copy)
+        site = self.tmp / "copy-for-pages" / "site"
+        site.mkdir()
+        r = run(["report", HOSTILE_DIR, "--out", "site/index.html"], copy.parent)
+        self.assertEqual(r.returncode, 0, r.stderr.decode())
+        pages = [site / "index.html", *sorted((site / "index_files").rglob("*.html"))]
+        self.assertEqual(len(pages), 3)
+        for path in pages:
+            with self.subTest(page=path.name):
+                page = parse_page(path)
+                self.assertEqual((page.errors, page.stack), ([], []))
+                self.assertNotIn("i", page.tags)
+                for link in page.links:
+                    target = local_target(path, link)
+                    if target is not None:
+                        self.assertTrue(target.is_file(), link)
+
+    def test_a_trial_that_wrote_nothing_is_absent_in_every_reader(self):
+        import pandas
+        from calligraphy import study
+        d = Path(tempfile.mkdtemp(dir=self.tmp))
+        p = dict(PROTOCOL, name="none19b", test={"characters": [YI], "conditions": ["007"], "repetitions": 1},
+                 trial={"max_duration_s": 0.01})
+        (d / "p.json").write_text(json.dumps(p, ensure_ascii=False), encoding="utf-8")
+        r = run(["session", "run", "p.json", *RUN, "--subject", "N1", "--out", "o"], d)
+        self.assertEqual(r.returncode, 0, r.stderr.decode())
+        (d / "t").mkdir()
+        r = run(["report", "o", "--csv", "t"], d)
+        self.assertEqual(r.returncode, 0, r.stderr.decode())
+        (record,) = records(d / "o").values()
+        self.assertIsNone(record["mean_deviation_m"])
+        (row,) = read_rows(d / "t" / "trials.csv")
+        self.assertEqual(row["mean_deviation_m"], "")
+        self.assertEqual(row["condition"], "007")
+        read = pandas.read_csv(d / "t" / "trials.csv", **documented_pandas_options())
+        loaded = study.load(str(d / "o")).trials
+        for frame in (read, loaded):
+            self.assertTrue(math.isnan(frame["mean_deviation_m"][0]))
+            self.assertEqual(frame["condition"][0], "007")
+
     def test_flags_and_absent_values_as_documented(self):
         rows = read_rows(self.tmp / "tables-a" / "trials.csv")
         for row in rows:
@@ -496,6 +539,26 @@ class Study(unittest.TestCase, OneErrorLine):
             for column in ("mean_deviation_m", "max_deviation_m", "frechet_m", "dtw_m", "pen_down_time_s"):
                 if row[column] != "":
                     self.assertIn(float(row[column]), found, column)
+
+    def test_session_plan_json_is_strict_and_names_as_written(self):
+        r = run(["session", "plan", "p.json", "--subjects", "2", "--subject", "Z_-", "--json"], self.tmp)
+        self.assertEqual(r.returncode, 0, r.stderr.decode())
+        plan = strict_json(r.stdout.decode("utf-8"))
+        self.assertEqual(plan["protocol"], "-r19b_NA")
+        self.assertEqual([s["id"] for s in plan["subjects"]], ["Z_-01", "Z_-02"])
+        self.assertIn('"007"', r.stdout.decode("utf-8"))
+        self.assertIn('"1e5"', r.stdout.decode("utf-8"))
+
+    def test_session_cohort_tables_keep_the_labels(self):
+        import pandas
+        (self.tmp / "cohort").mkdir()
+        r = run(["session", "cohort", "p.json", "--subjects", "1", "--subject", "Z_-", "--csv", "cohort"], self.tmp)
+        self.assertEqual(r.returncode, 0, r.stderr.decode())
+        rows = read_rows(self.tmp / "cohort" / "trials.csv")
+        self.assertEqual([row["condition"] for row in rows], ["007", "007", "1e5", "1e5"])
+        read = pandas.read_csv(self.tmp / "cohort" / "trials.csv", **documented_pandas_options())
+        self.assertEqual(list(read["condition"]), ["007", "007", "1e5", "1e5"])
+        self.assertEqual(set(read["protocol"]), {"-r19b_NA"})
 
     # -- traces ---------------------------------------------------------------------------------------------
     def test_trace_csv_header_and_units(self):
@@ -585,14 +648,26 @@ class Study(unittest.TestCase, OneErrorLine):
         page = parse_page(self.tmp / "paper" / "index.html")
         text = "".join(page.text)
         for label in ("007", "1e5", "-r19b_NA"):
-            self.assertIn(label, text)
+            self.assertTrue(label in text, f"{label} is not on the page")
         for guess in ("7.0", "100000"):
-            self.assertNotIn(guess, text)
+            self.assertFalse(guess in text, f"{guess} is on the page")
         for table in sorted((self.tmp / "paper" / "tables").glob("*.csv")):
             with self.subTest(table=table.name):
                 content = table.read_text(encoding="utf-8")
                 self.assertNotIn(",7.0,", content)
                 self.assertNotIn("100000.0", content)
+
+    def test_study_report_tables_are_whole_rows(self):
+        tables = sorted((self.tmp / "paper" / "tables").glob("*.csv"))
+        self.assertTrue(tables)
+        for table in tables:
+            with self.subTest(table=table.name):
+                with open(table, newline="", encoding="utf-8") as f:
+                    rows = list(csv.reader(f))
+                self.assertTrue(all(len(row) == len(rows[0]) for row in rows), table.name)
+                for row in rows[1:]:
+                    for value in row:
+                        self.assertNotIn(value.lower(), ("nan", "inf", "-inf", "none"))
 
     def test_study_report_is_whole_when_moved_with_its_study_pages(self):
         moved = self.tmp / "moved-all"
