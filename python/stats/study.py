@@ -166,10 +166,13 @@ def _pandas() -> typing.Any:
 
 def _read_table(text: str, numeric: tuple[str, ...], booleans: tuple[str, ...]) -> "pandas.DataFrame":
     pd = _pandas()
+    # Every column that is not a number or a flag is text: a label of its alphabet that reads as a number
+    # (a condition `007` or `1e5`, a subject `0012`) keeps its spelling, as the records write it.
+    header = text.partition("\n")[0].rstrip("\r").split(",")
+    labels = {c: str for c in header if c not in numeric and c not in booleans}
     # round_trip: every double as the C++ side wrote it (the default parser may differ in the last bit).
     frame = pd.read_csv(io.StringIO(text), keep_default_na=False, na_values={c: [""] for c in numeric},
-                        float_precision="round_trip",
-                        dtype={**{c: "float64" for c in numeric}, "trace_sha256": str})
+                        float_precision="round_trip", dtype={**labels, **{c: "float64" for c in numeric}})
     for column in booleans:  # pandas reads "TRUE"/"FALSE" as booleans, but not a column of no row
         if frame[column].dtype != bool:
             frame[column] = frame[column].astype(str) == "TRUE"
