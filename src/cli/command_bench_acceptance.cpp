@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "calligraphy/core/atomic_file.hpp"
 #include "cli/commands.hpp"
@@ -31,9 +32,19 @@ struct AcceptanceCommand {
   double form_tolerance_mm = kSameFormFrechet_m * 1000.0;
   std::int64_t characters = 500;
   std::uint64_t seed = 1;
+  // The options that only mean something with --kanjivg: given without it, a usage error.
+  std::vector<const CLI::Option*> kanjivg_only;
 };
 
 int run_acceptance(const AcceptanceCommand& command) {
+  if (command.kanjivg.empty()) {
+    for (const CLI::Option* option : command.kanjivg_only) {
+      if (option->count() > 0) {
+        throw UsageError(option->get_name() +
+                         ": only with --kanjivg (the library's own medians have no other hand's strokes)");
+      }
+    }
+  }
   FilePlan files;  // the document is read and its generated section replaced: it is the one output
   add_library_inputs(files, command.library);
   if (!command.kanjivg.empty()) files.input_folder("--kanjivg", command.kanjivg);
@@ -127,18 +138,19 @@ void add_bench_acceptance_command(CLI::App& bench, Commands& commands) {
                  "another hand's strokes: KanjiVG's SVG files (the folder scripts/fetch-kanjivg.sh prints), "
                  "written by a position-only pen on the characters both data sets have with as many strokes",
                  "the library's own medians, as labelled person-like paths");
-  add_integer(
+  command->kanjivg_only.push_back(add_integer(
       *app, "--assist-after-misses", command->assist_after_misses, "N",
       "with --kanjivg: refusals of a stroke before it is credited assisted, as in the trial (0: never)", 0,
-      1000);
-  add_choice(*app, "--half", command->half, {"tuning", "held-out", "both"},
-             "with --kanjivg: which half of the shared characters (split by a hash of the code point): the "
-             "one the rule's tolerances were tuned on, the one held out from tuning, or each in turn");
-  add_number(
+      1000));
+  command->kanjivg_only.push_back(add_choice(
+      *app, "--half", command->half, {"tuning", "held-out", "both"},
+      "with --kanjivg: which half of the shared characters (split by a hash of the code point): the "
+      "one the rule's tolerances were tuned on, the one held out from tuning, or each in turn"));
+  command->kanjivg_only.push_back(add_number(
       *app, "--form-tolerance-mm", command->form_tolerance_mm, "MM",
       "with --kanjivg: the same form: each KanjiVG line within this discrete Frechet distance of its "
       "median [mm, 60 mm box], in (0, 60]; wider admits more characters, and lines farther from the medians",
-      "a number in (0, 60]", [](double v) { return v > 0.0 && v <= 60.0; });
+      "a number in (0, 60]", [](double v) { return v > 0.0 && v <= 60.0; }));
   add_integer(*app, "--characters", command->characters, "N",
               "characters drawn at random (not the embedded ones)", 1, 100000);
   add_unsigned(*app, "--seed", command->seed, "N", "seed of the draw and the paths");

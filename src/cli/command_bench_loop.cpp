@@ -7,6 +7,7 @@
 
 #include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/servo_rate.hpp"
+#include "calligraphy/devices/servo_loop.hpp"
 #include "calligraphy/trial/options.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
@@ -51,6 +52,12 @@ int run_loop(const LoopCommand& command) {
   // The stall bound in periods; off by default so that the whole run is measured (the worst lateness shows
   // in wake_latency_us_max and longest_stall).
   loop.stall_timeout_s = static_cast<double>(command.watchdog_periods) / loop.rate_hz;
+  if (loop.stall_timeout_s > kMaxStallTimeoutS) {  // named by the options given, not by the loop's field
+    throw UsageError("--watchdog-periods " + std::to_string(command.watchdog_periods) + " at --rate " +
+                     shortest_decimal(command.rate_hz) + " is a stall of " +
+                     shortest_decimal(loop.stall_timeout_s) + " s, more than the loop's bound of " +
+                     shortest_decimal(kMaxStallTimeoutS) + " s");
+  }
   if (!command.trial.empty()) {
     // The trial holds its trace in memory: named by the options given, not by the trial runner's field.
     if (exceeds_trial_ticks(command.seconds, command.rate_hz)) {
@@ -96,8 +103,11 @@ void add_bench_loop_command(CLI::App& bench, Commands& commands) {
   add_integer(*app, "--priority", command->priority, "P", "SCHED_FIFO priority of the loop thread; 0: none",
               0, 99);
   add_integer(*app, "--cpu", command->cpu, "N", "pin the loop thread to this CPU; -1: no pinning", -1, 1023);
-  add_integer(*app, "--watchdog-periods", command->watchdog_periods, "N",
-              "end the run when the device holds one force longer than N periods; 0: off", 0, 1000000);
+  add_integer(
+      *app, "--watchdog-periods", command->watchdog_periods, "N",
+      "end the run when the device holds one force longer than N periods (at most 60 s of them at --rate); "
+      "0: off",
+      0, 1000000);
   add_text(*app, "--trial", command->trial, "CHARS", "run a real-time simulated trial of these characters",
            "none: the free loop, the simulated device held by a spring");
   add_library_options(*app, command->library, false);

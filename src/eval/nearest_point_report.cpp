@@ -5,6 +5,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string_view>
 
 #include "calligraphy/core/errors.hpp"
 #include "eval/report_numbers.hpp"
@@ -160,14 +161,18 @@ std::string nearest_point_markdown(const NearestPointMeasurement& measurement,
 void check_generated_section(const std::string& document, const char* begin_marker,
                              const std::string& document_name) {
   const auto begin = document.find(begin_marker);
-  if (begin != std::string::npos && document.find(kGeneratedEnd, begin) == std::string::npos) {
-    std::string message = document_name;
-    message.append(": has the marker ")
-        .append(begin_marker)
-        .append(" but no ")
-        .append(kGeneratedEnd)
-        .append(" after it; add the end marker where the generated section ends (nothing was written)");
-    throw InputError(message);
+  if (begin == std::string::npos) return;
+  const std::string marker(begin_marker);
+  const auto refuse = [&](const std::string& what) {
+    throw InputError(document_name + ": has the marker " + marker + what + " (nothing was written)");
+  };
+  if (document.find(kGeneratedEnd, begin) == std::string::npos) {
+    refuse(std::string(" but no ") + kGeneratedEnd +
+           " after it; add the end marker where the generated section ends");
+  }
+  // Two sections of one kind: replacing one would leave the other stale in the same document.
+  if (document.find(marker, begin + marker.size()) != std::string::npos) {
+    refuse(" twice; keep one generated section of it");
   }
 }
 
@@ -178,10 +183,12 @@ std::string replace_generated_section(const std::string& document, const std::st
   if (begin == std::string::npos) {
     return document + (document.empty() || document.back() == '\n' ? "" : "\n") + section;
   }
-  const auto end = document.find(kGeneratedEnd, begin);
-  auto after = end + std::string(kGeneratedEnd).size();
-  if (after < document.size() && document[after] == '\n') ++after;
-  return document.substr(0, begin) + section + document.substr(after);
+  // The markers and what is between them are replaced; every byte after the end marker (its line's
+  // ending, LF or CR LF, included) is kept as it was.
+  const auto end = document.find(kGeneratedEnd, begin) + std::string(kGeneratedEnd).size();
+  const std::string_view generated =
+      std::string_view(section).substr(0, section.ends_with('\n') ? section.size() - 1 : section.size());
+  return document.substr(0, begin).append(generated).append(document, end);
 }
 
 }  // namespace calligraphy::cli
