@@ -18,7 +18,6 @@ left, later readers accept the result.
 CALLIGRAPHY_CLI names the program, PYTHONPATH its Python module. CALLIGRAPHY_SANITIZED=1 takes five cases.
 """
 import csv
-import io
 import json
 import os
 import re
@@ -55,7 +54,8 @@ def protocol(name):
 
 def race(commands, cwd, kill=None, timeout=60):
     """Start every command (an argv) at once: each waits in a shell reading one pipe (its standard input, then
-    /dev/null for the command) that the parent closes when all are started. `kill` = (index, seconds): SIGKILL that one so long after the release. CompletedProcess each."""
+    /dev/null for the command) that the parent closes when all are started. `kill` = (index, seconds): SIGKILL
+    that one so long after the release. A CompletedProcess each, with its `pid`."""
     r, w = os.pipe()
     procs = []
     try:
