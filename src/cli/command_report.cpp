@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <iterator>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
@@ -38,7 +39,8 @@ struct ReportCommand {
 // report's set) before the next session is read: memory holds one session's page and one trial per thread.
 // The folders a report makes for its pages (FILE_files/ and a folder per subject), made before the pages are
 // read; unless keep() is called, each one made is removed again (rmdir: only while empty, as nothing was
-// written in it), so a report that fails leaves no folder of its own, as it leaves no file.
+// written in it), so a report that fails leaves no folder of its own, as it leaves no file. A folder that
+// another process made first is not this report's, and is left to it.
 class MadeFolders {
  public:
   MadeFolders() = default;
@@ -49,17 +51,32 @@ class MadeFolders {
     for (auto folder = made_.rbegin(); folder != made_.rend(); ++folder) ::rmdir(folder->c_str());
   }
 
+  // Thread-safe: the pages' threads make their folders again when they are gone (write_page).
   void make(const fs::path& folder) {
-    std::error_code error;
-    if (folder.empty() || fs::is_directory(folder, error)) return;
-    make(folder.parent_path());
-    if (!fs::create_directory(folder, error) && error)
-      throw DataError(folder.string() + ": cannot create the folder: " + error.message());
-    made_.push_back(folder);
+    const std::lock_guard<std::mutex> hold(mutex_);
+    make_locked(folder);
   }
   void keep() noexcept { kept_ = true; }
 
  private:
+  // A parent removed between its check and the folder's creation (by another report that failed, as in
+  // write_page) is made again.
+  void make_locked(const fs::path& folder) {
+    for (int attempt = 1;; ++attempt) {
+      std::error_code error;
+      if (folder.empty() || fs::is_directory(folder, error)) return;
+      make_locked(folder.parent_path());
+      if (fs::create_directory(folder, error)) {
+        made_.push_back(folder);
+        return;
+      }
+      if (!error) return;  // made by another process meanwhile: not this report's
+      if (attempt == 3 || error != std::errc::no_such_file_or_directory)
+        throw DataError(folder.string() + ": cannot create the folder: " + error.message());
+    }
+  }
+
+  std::mutex mutex_;
   std::vector<fs::path> made_;
   bool kept_ = false;
 };
@@ -78,6 +95,7 @@ class PagesWriter {
   std::atomic<std::uintmax_t> bytes{0};
   std::vector<StudyTables>* tables = nullptr;  // one per session, when the tables are wanted too
   OutputSet* files = nullptr;                  // the report's files, replaced together at the end
+  MadeFolders* folders = nullptr;              // the pages' folders
 
   void write_page(std::size_t i) {
     const ReportedSession& session = study.sessions[i];
@@ -88,7 +106,19 @@ class PagesWriter {
     trials += page.trials();
     const std::string text = page.finish();
     bytes += text.size();
-    files->add(pages[i], text);
+    // Another report into the same folder that failed removes the page folders it made while they are empty,
+    // which may be before this report's first page is in one of them: a folder gone is made again.
+    const fs::path folder = pages[i].parent_path();
+    for (int attempt = 1;; ++attempt) {
+      folders->make(folder);
+      try {
+        files->add(pages[i], text);
+        return;
+      } catch (const DataError&) {
+        std::error_code error;
+        if (attempt == 3 || fs::is_directory(folder, error)) throw;
+      }
+    }
   }
 };
 
@@ -155,6 +185,7 @@ int run_report(const ReportCommand& command) {
     for (const fs::path& page : pages) page_folders.make(page.parent_path());
     PagesWriter writer(study, pages, "../../" + index_name);
     writer.files = &report_files;
+    writer.folders = &page_folders;
     std::vector<StudyTables> session_tables(command.csv.empty() ? 0 : study.sessions.size());
     if (!command.csv.empty()) writer.tables = &session_tables;
     for_each_item(study.sessions.size(), static_cast<std::size_t>(command.jobs),
