@@ -231,13 +231,20 @@ def _refuse_outputs_on_inputs(outputs: typing.Iterable[pathlib.Path], trace_file
 def _make_folder(folder: pathlib.Path, made: list[pathlib.Path]) -> None:
     """Makes `folder` (and its parents) and checks that files can be made in it, before the report's work: the
     set of files is written with a journal in each of its folders, and needs no other folder. Each folder it
-    makes is appended to `made`, parents first."""
-    missing = [f for f in (folder, *folder.parents) if not f.exists()]
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError as error:
-        raise OSError(error.errno, f"cannot create the folder {folder}: {error.strerror or error}") from error
-    made.extend(reversed(missing))
+    makes is appended to `made`, parents first; one that another process made meanwhile is not (a report
+    writing beside this one into the same folder keeps it when this one fails)."""
+    for level in (*reversed(folder.parents), folder):
+        if level.is_dir():
+            continue
+        try:
+            os.mkdir(level)
+        except FileExistsError:
+            if level.is_dir():
+                continue  # made by another process between the check and the mkdir: not this report's
+            raise OSError(errno.EEXIST, f"cannot create the folder {folder}: {level} is a file") from None
+        except OSError as error:
+            raise OSError(error.errno, f"cannot create the folder {folder}: {error.strerror or error}") from error
+        made.append(level)
     if not os.access(folder, os.W_OK | os.X_OK):
         raise OSError(errno.EACCES, f"cannot write in the folder {folder}: {os.strerror(errno.EACCES)}")
 

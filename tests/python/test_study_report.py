@@ -143,6 +143,28 @@ def report(study, tmp_path_factory):
     return index, parse(index.read_text(encoding="utf-8"))
 
 
+def test_a_report_claims_only_the_folders_it_made(tmp_path, monkeypatch):
+    # Two reports into one new folder: the one that fails removes the folders it made, never one the other made
+    # between its check and its mkdir (as if the other report had made `out` first).
+    made = []
+    real_mkdir = os.mkdir
+
+    def raced_mkdir(path, *args, **kwargs):
+        if Path(path).name == "out":
+            real_mkdir(path, *args, **kwargs)  # the other report, just before this one
+        return real_mkdir(path, *args, **kwargs)
+
+    monkeypatch.setattr(study_report.os, "mkdir", raced_mkdir)
+    study_report._make_folder(tmp_path / "top" / "out" / "figures", made)
+    assert made == [tmp_path / "top", tmp_path / "top" / "out" / "figures"]
+    study_report._remove_made_folders(made)
+    assert (tmp_path / "top" / "out").is_dir() and not (tmp_path / "top" / "out" / "figures").exists()
+    monkeypatch.undo()
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(OSError, match="cannot create the folder .*file/sub: .*file is a file"):
+        study_report._make_folder(tmp_path / "file" / "sub", [])
+
+
 def test_importing_the_module_imports_none_of_its_libraries():
     code = ("import sys, calligraphy.study_report; "
             "print(sorted(m for m in ('pandas', 'matplotlib', 'scipy', 'statsmodels') if m in sys.modules))")
