@@ -218,8 +218,8 @@ class Study:
     def samples(self, trial: typing.Union[int, "pandas.Series"]) -> "pandas.DataFrame":
         """One trial's trace, read now: a DataFrame of N ticks with t_s [s], x_m, y_m, z_m [m] (device frame),
         fx_n, fy_n, fz_n [N], state ("SS", "AS", "CS", "WS"), stroke, element (positions in the scene's arrays,
-        0-based), attempt (1-based, 0 outside any; traces of older folders may lack it) and rewritten (1: part
-        of an attempt written again later). `trial` is a row of `trials` or its index
+        0-based), attempt (1-based, 0 outside any) and rewritten (1: part of an attempt written again later;
+        a trace of an older folder, saved before them, lacks both columns). `trial` is a row of `trials` or its index
         label. Raises TypeError naming `trial` for None or a value that cannot be a label (a list, a dict,
         a bool), KeyError for an unknown label, FileNotFoundError when the trace is gone, DataError for a
         trial without a trace file (a cohort simulated in memory) and naming
