@@ -99,6 +99,8 @@ int run_jumps(const JumpsCommand& command) {
   for (std::int64_t seed = 1; seed <= command.seeds; ++seed)
     settings.seeds.push_back(static_cast<std::uint64_t>(seed));
   if (!command.chars.empty()) settings.characters = characters_from(command.chars, "--chars");
+  const CharacterSource source(LibraryOptions{});  // the standard set, as the measurement reads it
+  for (const char32_t c : settings.characters) (void)source.load_named(c, "--chars");
   const JumpMeasurement measurement = measure_foot_jumps(settings);
 
   std::string invocation = "calligraphy bench jumps";

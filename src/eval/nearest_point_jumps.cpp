@@ -94,10 +94,11 @@ void replay(const PlacedCharacter& character, std::uint64_t seed, const std::vec
 JumpMeasurement measure_foot_jumps(const JumpSettings& settings) {
   JumpMeasurement measurement;
   measurement.settings = settings;
-  const CharacterLibrary library = CharacterLibrary::embedded();
+  // Any character of the standard set (the embedded ones, then the bundled corpus); by default the embedded.
+  const CharacterLibrary library = CharacterLibrary::standard();
   std::u32string characters = settings.characters;
   if (characters.empty()) {
-    for (const char32_t c : library.characters()) characters.push_back(c);
+    for (const char32_t c : CharacterLibrary::embedded().characters()) characters.push_back(c);
   }
   measurement.characters = characters.size();
 

@@ -11,7 +11,7 @@
 namespace calligraphy::cli {
 
 struct JumpSettings {
-  std::u32string characters;  ///< empty: every embedded character
+  std::u32string characters;  ///< any of CharacterLibrary::standard(); empty: every embedded character
   std::vector<std::uint64_t> seeds{1, 2, 3};
   std::vector<bool> guidance{true, false};  ///< trials with guidance on, and off (larger deviations)
   double threshold_m = 1e-3;                ///< a foot-point move above this between ticks is a jump [m]
