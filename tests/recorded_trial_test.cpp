@@ -287,6 +287,39 @@ TEST_CASE("A record run on other characters is refused", "[recorded_trial]") {
              Catch::Contains("not the recorded ones") && Catch::Contains("SHA-256"));
 }
 
+TEST_CASE("The characters' SHA-256 covers their medians, and a record of the models alone still matches",
+          "[recorded_trial]") {
+  const Scene ten = Scene::lay_out({CharacterLibrary::embedded().load(U'十')});
+  Scene models_only = ten;
+  for (PlacedStroke& stroke : models_only.characters.front().strokes) stroke.median_m.clear();
+  Scene moved_median = ten;
+  moved_median.characters.front().strokes.back().median_m.back().x() += 1e-9;
+  // Another median, or none, is other character data: progress is measured along it.
+  CHECK(scene_sha256(models_only) != scene_sha256(ten));
+  CHECK(scene_sha256(moved_median) != scene_sha256(ten));
+  CHECK_FALSE(scene_is_recorded_one(models_only, scene_sha256(ten)));
+  CHECK_FALSE(scene_is_recorded_one(ten, scene_sha256(models_only)));
+  // The models' SHA-256 alone, as records stated it before, matches the same models with medians or without.
+  CHECK(scene_models_sha256(models_only) == scene_models_sha256(ten));
+  CHECK(scene_is_recorded_one(ten, scene_models_sha256(ten)));
+  CHECK(scene_is_recorded_one(models_only, scene_models_sha256(ten)));
+  const Scene person = Scene::lay_out({CharacterLibrary::embedded().load(U'人')});
+  CHECK_FALSE(scene_is_recorded_one(person, scene_models_sha256(ten)));
+
+  TrialSpec spec;
+  spec.characters = "十";
+  spec.max_duration_s = 1.0;
+  RecordedTrial recorded = recorded_trial(spec, TrialOptions{}, nullptr, ten);
+  CHECK_THAT(error_of([&] {
+               (void)rerun_trial(recorded, Checked<TrialSpec>::check(recorded.spec), models_only,
+                                 study_test::trial_inputs());
+             }),
+             Catch::Contains("not the recorded ones"));
+  recorded.scene_sha256 = scene_models_sha256(ten);
+  CHECK_NOTHROW(rerun_trial(recorded, Checked<TrialSpec>::check(recorded.spec), models_only,
+                            study_test::trial_inputs()));
+}
+
 TEST_CASE("What is not a recorded trial is refused naming the file and the place", "[recorded_trial]") {
   std::mt19937_64 random(7);
   const std::string good = recorded_trial_json(random_recorded_trial(random, GuidanceMode::fixed));

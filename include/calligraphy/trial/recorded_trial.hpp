@@ -108,9 +108,16 @@ struct RecordedTrial : WholeTrial {
                                            const std::string& teacher_sha256 = {});
 
 /// Lower-case hex SHA-256 (FIPS 180-4) of the placed characters: each character's code point and, stroke by
-/// stroke, its typical stroke ID, attraction factors and elements' control points [m] (bit patterns): equal
-/// for equal character data and layout, whatever the data's source.
+/// stroke, its typical stroke ID, attraction factors, elements' control points [m] and median [m] (its
+/// point count, 0 for none, then its points; bit patterns): equal for equal character data and layout,
+/// whatever the data's source.
 [[nodiscard]] std::string scene_sha256(const Scene& scene);
+/// The SHA-256 records stated before it covered the medians: `scene_sha256` without them.
+[[nodiscard]] std::string scene_models_sha256(const Scene& scene);
+/// True when `recorded_sha256` (a record's `scene.sha256`) is `scene_sha256(scene)`, or, for a record
+/// written before the SHA-256 covered the medians, `scene_models_sha256(scene)`: such a record cannot tell
+/// characters with medians from the same models without them.
+[[nodiscard]] bool scene_is_recorded_one(const Scene& scene, const std::string& recorded_sha256);
 
 /// `recorded` as a JSON object (2-space indent): "format", "version", "trial" (trial_spec_json's keys),
 /// "force_law", "safety", "passivity", "writer" (null for a person), "simulated_device" (null: the
