@@ -290,6 +290,13 @@ class Circumstances(unittest.TestCase, OneErrorLine):
         one = self.session_run("first", there)
         two = self.session_run("second 第二", there, env_with(TZ="Pacific/Chatham", LC_ALL="C", HOME=None))
         self.assert_sessions_alike(one, two)
+        if shutil.which("taskset"):  # and on one core at nice 19
+            argv = ["taskset", "-c", "0", "nice", "-n", "19", CLI, "session", "run", "p.json", "--subject", "S01",
+                    *SIM, "--out", "third"]
+            r = subprocess.run(argv, cwd=there, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               stdin=subprocess.DEVNULL, timeout=60)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assert_sessions_alike(one, sessions(there / "third")[0])
 
     def test_two_sessions_tables_differ_in_session_times_and_trace_paths_only(self):
         there = self.folder("tables-")
@@ -614,6 +621,37 @@ class Circumstances(unittest.TestCase, OneErrorLine):
         for key in ("end_reason", "strokes_completed", "total_time_s", "pen_down_time_s", "max_force_n",
                     "mean_deviation_m", "seed", "specification"):
             self.assertEqual(again.metrics[key], want[key], key)
+
+    def test_python_replay_record_reruns_on_the_command_line_with_its_teacher_given(self):
+        import calligraphy as cg
+        teacher = cg.TeacherRecording.load(str(self.base / "t.json"))
+        result = cg.simulate_trial(YI, seed=int(SEED), max_duration_s=2.0, teacher=teacher)
+        there = self.folder("python-replay-")
+        (there / "py.json").write_text(json.dumps(result.metrics))
+        # Its teacher was given as samples: the record names no file, so the command line needs --teacher.
+        r = run(["trial", "--spec", "py.json", "--csv", "x.csv"], there)
+        self.assert_one_error(r, 2, "--teacher")
+        self.assertFalse((there / "x.csv").exists())
+        _, got = self.rerun("py.json", there, None, "--teacher", self.base / "t.json")
+        self.assertEqual(got, self.r_csv, "Python's replay re-run by the command line is not the CLI's replay")
+
+    def test_cli_replay_record_reruns_in_python_reading_the_teacher_it_names(self):
+        import calligraphy as cg
+        rows = list(csv.DictReader(io.StringIO(self.r_csv.decode())))
+        old = os.getcwd()
+        try:
+            os.chdir(self.base)   # the record's relative teacher name, read from the working folder
+            again = cg.rerun_trial("r.json")
+            os.chdir(self.root)   # from elsewhere it is not there: named
+            with self.assertRaises(cg.DataError) as refused:
+                cg.rerun_trial(str(self.base / "r.json"))
+        finally:
+            os.chdir(old)
+        self.assertIn("t.json", str(refused.exception))
+        self.assertEqual(len(rows), len(again.time_s))
+        for i in (0, len(rows) // 2, len(rows) - 1):
+            for axis, key in enumerate("xyz"):
+                self.assertAlmostEqual(float(rows[i][key]), float(again.position_m[i][axis]), delta=0.6e-7)
 
     # ---- what must differ ----
 
