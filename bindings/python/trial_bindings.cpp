@@ -29,6 +29,7 @@
 #include "calligraphy/sim/simulated_writing.hpp"
 #include "calligraphy/study/session_folder.hpp"
 #include "calligraphy/trial/recorded_trial.hpp"
+#include "calligraphy/trial/teacher_recording.hpp"
 #include "calligraphy/trial/trial.hpp"
 #include "calligraphy/trial/trial_spec_runner.hpp"
 #include "character_source.hpp"
@@ -498,13 +499,21 @@ PyTrialResult rerun_trial_py(const py::object& record,
   inputs.registry = &python_device_registry();
   inputs.host_process = true;
   if (recorded.spec.guidance_mode == GuidanceMode::replay && recorded.spec.guidance) {
-    if (!teacher) {
+    if (teacher) {
+      inputs.teacher = teacher_samples(teacher->object, recorded.spec.characters);
+      recorded.spec.teacher.clear();  // the samples are the teacher
+    } else if (!recorded.spec.teacher.empty()) {
+      // The file the record names (a session's kept teacher, or the --teacher of `calligraphy trial`), read
+      // and bound by its SHA-256 as `trial --spec` reads it.
+      TeacherFile file = read_recorded_teacher(recorded, recorded.spec.teacher);
+      require_teacher_for(file.recording, recorded.spec.characters);
+      inputs.teacher = std::move(file.recording.samples);
+      recorded.spec.teacher.clear();  // its samples are the teacher now, as a teacher= given
+    } else {
       throw InvalidArgument(
-          "teacher: the record's trial is a replay; give its teacher (a TeacherRecording or a "
-          "list of TeacherSample)");
+          "teacher: the record's trial is a replay and names no teacher's file; give its teacher (a "
+          "TeacherRecording or a list of TeacherSample)");
     }
-    inputs.teacher = teacher_samples(teacher->object, recorded.spec.characters);
-    recorded.spec.teacher.clear();  // the samples are the teacher
   }
   const auto checked = calligraphy::Checked<TrialSpec>::check(
       recorded.spec, inputs.teacher.empty() ? TeacherSource::file : TeacherSource::samples);
@@ -671,10 +680,14 @@ the simulated writer's profile and seed and a simulated device's physics, on the
 
 record: a TrialResult's `metrics` (simulate_trial, run_trial), a trial record read as a dict (`calligraphy
 trial --json`, a study session's trials/*.json), or the path of such a file. teacher: a replay's teacher (a
-TeacherRecording or a list of TeacherSample), which records name but do not hold. Returns a TrialResult.
-Raises DataError naming the record and the JSON pointer of a value at fault, a record without a
-specification (written before records held one) or of another version; InvalidArgument when the
-characters placed are not the recorded ones (other character data), or a replay without its teacher;
+TeacherRecording or a list of TeacherSample), which records name but do not hold; without it, the file the
+record names is read as `calligraphy trial --spec` reads it (a session's record: the teacher kept in its
+session folder; a `trial --json` record: its --teacher, a relative name from the working folder). Returns a
+TrialResult. Raises DataError naming the record and the JSON pointer of a value at fault, a record without a
+specification (written before records held one) or of another version, or a teacher's file that cannot be
+read or is not the recording the replay ran on (naming it and both SHA-256); InvalidArgument when the
+characters placed are not the recorded ones (other character data), or a replay naming no teacher's file
+given none;
 CharacterNotFound; TypeError for a record of another type or its JSON text given as a path.)");
   m.def(
       "check_trial_record", &check_trial_record_py, py::arg("record"),

@@ -191,8 +191,11 @@ RecordedTrial read_study_recorded_trial(const std::string& path) {
   if (recorded.spec.guidance && recorded.spec.guidance_mode == GuidanceMode::replay &&
       recorded.spec.teacher.empty()) {
     // A session's replay ran on the teacher kept in its folder (trials/ is beside teachers/): the record
-    // names the file and its SHA-256 under /guidance/teacher (trial_guidance.hpp); taken when it is still the
-    // same. The record was read whole above: a damaged one was refused there.
+    // names the file and its SHA-256 under /guidance/teacher (trial_guidance.hpp). That file is the teacher,
+    // bound by that SHA-256 as a replay's teacher file is (`teacher_sha256`, read_recorded_teacher): one
+    // edited or replaced since is refused naming it and both SHA-256, and a recording given instead
+    // (--teacher, Python's teacher=) must be the one it ran on. The record was read whole above: a damaged
+    // one was refused there.
     nlohmann::json document =
         json_detail::parse_json(read_regular_file(path, study_detail::kMaxRecordBytes), path);
     nlohmann::json* teacher = document.contains("guidance") && document["guidance"].is_object() &&
@@ -200,14 +203,12 @@ RecordedTrial read_study_recorded_trial(const std::string& path) {
                                       document["guidance"]["teacher"].is_object()
                                   ? &document["guidance"]["teacher"]
                                   : nullptr;
-    if (teacher != nullptr && (*teacher)["file"].is_string() && (*teacher)["sha256"].is_string()) {
-      const std::filesystem::path file =
-          std::filesystem::path(path).parent_path().parent_path() / (*teacher)["file"].get<std::string>();
-      std::error_code error;
-      if (std::filesystem::is_regular_file(file, error) &&
-          sha256_hex(read_regular_file(file, kMaxTeacherRecordingBytes)) ==
-              (*teacher)["sha256"].get<std::string>())
-        recorded.spec.teacher = file.string();
+    if (teacher != nullptr && (*teacher)["file"].is_string() && (*teacher)["sha256"].is_string() &&
+        is_sha256_hex((*teacher)["sha256"].get<std::string>())) {
+      recorded.spec.teacher =
+          (std::filesystem::path(path).parent_path().parent_path() / (*teacher)["file"].get<std::string>())
+              .string();
+      recorded.teacher_sha256 = (*teacher)["sha256"].get<std::string>();
     }
   }
   return recorded;

@@ -297,9 +297,10 @@ inline constexpr const char* kPartialNote =
 
 /// The trial record file `path` as `read_recorded_trial_file` reads it (trial/recorded_trial.hpp), and for a
 /// study session's replay, which ran on the teacher kept in its session folder (trials/ is beside
-/// teachers/), that file as its teacher (`spec.teacher`) when it is still there with the SHA-256 the record
-/// gives (/guidance/teacher). What `calligraphy trial --spec` and Python's `rerun_trial` read. Throws what
-/// `read_recorded_trial_file` throws.
+/// teachers/), that file as its teacher (`spec.teacher`) bound by the SHA-256 the record gives
+/// (/guidance/teacher) as `teacher_sha256`: `read_recorded_teacher` then refuses it, or a recording given
+/// instead, when it is another file, naming it and both SHA-256. What `calligraphy trial --spec` and Python's
+/// `rerun_trial` read. Throws what `read_recorded_trial_file` throws.
 [[nodiscard]] RecordedTrial read_study_recorded_trial(const std::string& path);
 
 }  // namespace calligraphy
