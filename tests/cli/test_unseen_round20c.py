@@ -7,8 +7,8 @@ stopped a single `simulate_trial`; this one takes the other long calls and Pytho
 - Ctrl-C (SIGINT) during a cohort on the module's C++ threads and on an executor, a real-time `run_trial`, a
   renderer loop, `study.load` at any moment, a study report and an R fit; SIGTERM to a process inside an R fit:
   raised promptly, no thread or R child left, nothing half-written, the objects usable after.
-- threads: trials, cohorts, a shared teacher, errors and log messages from several threads at once, the GIL
-  released where the docs say it is (a cohort on threads, `match_stroke`).
+- threads: trials, cohorts, scores, a shared teacher, teachers saved to one path, errors and log messages from
+  several threads at once, the GIL released where the docs say it is (a cohort on threads, `match_stroke`).
 - `os.fork()` after the module has run threads (a cohort, a real-time trial, an R process) and while another
   thread is inside a trial; `ProcessPoolExecutor` with the fork and spawn start methods as a cohort's client.
 - objects after `close()`, at `atexit` and in `__del__` as the interpreter ends, after a refused call, and Python
@@ -471,6 +471,29 @@ class Threads(Base):
         finally:
             logger.removeHandler(handler)
 
+    def test_score_from_four_threads_on_shared_columns_gives_the_serial_dict(self):
+        trial = cg.simulate_trial(SHI, seed=2, max_duration_s=6.0)
+        p = trial.position_m
+        columns = {"t": trial.time_s, "x": p[:, 0], "y": p[:, 1], "z": p[:, 2]}
+        serial = json.dumps(cg.score(columns, SHI), sort_keys=True)
+        got = self.run_threads([lambda: cg.score(columns, SHI)] * 2 + [lambda: cg.score(columns, trial.scene)] * 2)
+        for kind, result in got:
+            self.assertEqual(kind, "ok", result)
+            self.assertEqual(json.dumps(result, sort_keys=True), serial)
+
+    def test_teachers_saved_from_three_threads_to_one_path_leave_one_whole_teacher(self):
+        path = self.root / "shared-teacher.json"
+        trials = [cg.simulate_trial(YI, seed=s, writer="skilled", max_duration_s=4.0) for s in range(3)]
+        texts = {cg.record_teacher(t).to_json() for t in trials}
+        self.assertEqual(len(texts), 3)
+        for _ in range(2):
+            got = self.run_threads([lambda t=t: cg.record_teacher(t, str(path)) for t in trials] +
+                                   [lambda t=t: cg.record_teacher(t).save(str(path)) for t in trials])
+            self.assertTrue(all(kind == "ok" for kind, _ in got), got)
+            self.assertIn(cg.TeacherRecording.load(str(path)).to_json(), texts)
+        self.assertEqual(sorted(f.name for f in self.root.iterdir() if f.name.startswith("shared-teacher")),
+                         ["shared-teacher.json"])
+
     def gil_free_share(self, call):
         """How many times a pure-Python thread counts while `call` runs, against while it sleeps as long."""
         counts = []
@@ -716,6 +739,23 @@ class Lifecycle(Base):
         np.testing.assert_array_equal(a.true_position_m, b.true_position_m)
         np.testing.assert_array_equal(a.applied_force_n, b.applied_force_n)
         self.assertEqual(a.time_s, b.time_s)
+
+    def test_a_warning_raised_as_an_error_inside_a_with_block_leaves_the_objects_usable(self):
+        # docs/python.md, "Errors": an old enum spelling is read with a DeprecationWarning; under
+        # warnings.simplefilter("error") that warning is raised, in the middle of a call or an assignment.
+        import warnings
+        law = cg.ForceLawParameters()
+        before = law.to_dict()
+        expected = cg.simulate_trial(YI, guidance_mode="assist-as-needed", max_duration_s=2.0, keep_trace=False)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            with self.assertRaises(DeprecationWarning):
+                cg.simulate_trial(YI, guidance_mode="assist_as_needed", max_duration_s=2.0)
+            with self.assertRaises(DeprecationWarning):
+                law.guidance_law = cg.default_guidance_law("error_amplification")
+        self.assertEqual(law.to_dict(), before)
+        again = cg.simulate_trial(YI, guidance_mode="assist-as-needed", max_duration_s=2.0, keep_trace=False)
+        self.assertEqual(json.dumps(again.metrics, sort_keys=True), json.dumps(expected.metrics, sort_keys=True))
 
     def test_objects_at_atexit_and_in_del_as_the_interpreter_ends(self):
         out = self.root / "atexit-teacher.json"
