@@ -200,7 +200,7 @@ order: a list of dicts with ``name`` (its SI unit in it, as the library's DataFr
         try {
           py::gil_scoped_release release;  // minutes of simulation
           tables = simulate_cohort(protocol, assigned, setup, threads);
-        } catch (const StateError&) {
+        } catch (...) {  // a trial stopped by the signal (StateError), or another thread's error meanwhile
           poll.raise_if_interrupted();
           throw;
         }
