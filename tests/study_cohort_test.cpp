@@ -3,6 +3,7 @@
 // trial and stroke by stroke, over two sessions, every adaptive schedule and a between-subjects design; its
 // threads change nothing; and what it cannot do (a replay, a bad setup) is refused by name.
 #include <algorithm>
+#include <atomic>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <optional>
@@ -185,6 +186,26 @@ TEST_CASE("a cohort's threads change none of its rows", "[study][cohort]") {
     CHECK_FALSE(one.trials[i].shape_skill.has_value());  // no memory without learning
   }
   CHECK(trials_csv(one) == trials_csv(three));
+}
+
+TEST_CASE("a cohort asked to stop ends its running trials and starts no subject more", "[study][cohort]") {
+  LoadedProtocol protocol = two_day_protocol(kSmall);
+  const std::vector<SubjectAssignment> subjects = numbered_subjects(6);
+  CohortSetup setup;
+  setup.writer_learning = WriterLearning::none;
+  std::atomic<int> polls{0};
+  // Stops at the 200th tick of the first trial polled, from whichever of the two threads gets there.
+  setup.should_stop = [&polls] { return polls.fetch_add(1) >= 200; };
+  std::size_t done = 0;
+  CHECK_THROWS_WITH(simulate_cohort(protocol, subjects, setup, 2, [&](std::size_t n) { done = n; }),
+                    Catch::Contains("interrupted") && Catch::Contains("was not kept"));
+  CHECK(done == 0);  // no subject of several trials each was finished
+  CHECK_THROWS_AS(simulate_subject(protocol, subjects[0], setup), StateError);
+  setup.should_stop = [] { return false; };  // a poll that never stops changes nothing
+  CohortSetup plain;
+  plain.writer_learning = WriterLearning::none;
+  CHECK(trials_csv(simulate_cohort(protocol, {subjects[0]}, setup)) ==
+        trials_csv(simulate_cohort(protocol, {subjects[0]}, plain)));
 }
 
 TEST_CASE("a cohort refuses what it cannot run, naming it", "[study][cohort]") {

@@ -138,6 +138,12 @@ T convert_named(py::handle value, const std::string& name) {
       return members[value].template cast<T>();
     }
   }
+  if constexpr (std::is_same_v<T, std::filesystem::path>) {
+    // A path-like object: its own __fspath__, whose exception (if it raises) is the caller's to see, never
+    // read as a file name refused.
+    if (!PyUnicode_Check(value.ptr()) && !PyBytes_Check(value.ptr()) && py::hasattr(value, "__fspath__"))
+      return convert_named<T>(py::module_::import("os").attr("fspath")(value), name);
+  }
   try {
     if constexpr (std::is_enum_v<T>) {
       // TraceKind(-1) makes an instance that is no member: refused, as an unknown name is.

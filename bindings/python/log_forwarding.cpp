@@ -117,16 +117,25 @@ void forward_queued_log() noexcept {
   std::size_t dropped = 0;
   std::deque<QueuedMessage> messages = log_queue().take(dropped);
   if (messages.empty() && dropped == 0) return;
-  try {
-    const py::object logger = py::module_::import("logging").attr("getLogger")("calligraphy");
-    if (dropped > 0) {
-      logger.attr("warning")("%d log messages of the C++ library were dropped (queue full)", dropped);
+  // Each message on its own: a handler or filter that raises for one is reported as Python reports an
+  // exception it cannot raise (sys.unraisablehook), and the messages after it are still forwarded.
+  const auto forward = [](const auto& send) noexcept {
+    try {
+      send();
+    } catch (py::error_already_set& e) {
+      e.discard_as_unraisable("calligraphy: forwarding the C++ log to Python's logging");
+    } catch (...) {  // nothing may escape a destructor
     }
-    for (const QueuedMessage& m : messages) logger.attr("log")(m.python_level, "%s", m.text);
-  } catch (py::error_already_set& e) {
-    e.discard_as_unraisable("calligraphy: forwarding the C++ log to Python's logging");
-  } catch (...) {  // nothing may escape a destructor
+  };
+  py::object logger;
+  forward([&] { logger = py::module_::import("logging").attr("getLogger")("calligraphy"); });
+  if (!logger) return;
+  if (dropped > 0) {
+    forward([&] {
+      logger.attr("warning")("%d log messages of the C++ library were dropped (queue full)", dropped);
+    });
   }
+  for (const QueuedMessage& m : messages) forward([&] { logger.attr("log")(m.python_level, "%s", m.text); });
 }
 
 void bind_logging(py::module_& m) {

@@ -26,6 +26,7 @@
 #include "calligraphy/study/transfer_set.hpp"
 #include "calligraphy/trial/teacher_recording.hpp"
 #include "character_source.hpp"
+#include "signal_poll.hpp"
 
 namespace calligraphy::python {
 
@@ -191,10 +192,17 @@ order: a list of dicts with ``name`` (its SI unit in it, as the library's DataFr
         }
         setup.individual_differences = individual_differences;
         setup.load_character = load;
+        // Ctrl-C: the calling thread (one of the cohort's) runs Python's signal handlers every 50 ms; a
+        // KeyboardInterrupt stops every trial at its next tick and is raised once every thread has stopped.
+        SignalPoll poll;
+        setup.should_stop = [&poll] { return poll.interrupted(); };
         StudyTables tables;
-        {
+        try {
           py::gil_scoped_release release;  // minutes of simulation
           tables = simulate_cohort(protocol, assigned, setup, threads);
+        } catch (...) {  // a trial stopped by the signal (StateError), or another thread's error meanwhile
+          poll.raise_if_interrupted();
+          throw;
         }
         return py::make_tuple(trials_csv(tables), strokes_csv(tables));
       },

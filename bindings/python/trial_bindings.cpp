@@ -37,6 +37,7 @@
 #include "model_bindings.hpp"
 #include "numpy_arrays.hpp"
 #include "report_bindings.hpp"
+#include "signal_poll.hpp"
 #include "writer_settings.hpp"
 
 namespace calligraphy::python {
@@ -124,32 +125,6 @@ PyTrialResult to_python(const TrialResult& result, py::dict metrics, py::object 
                        {},
                        {}};
 }
-
-// Polls Python's signal handlers from a thread that does not hold the GIL, at most every 50 ms.
-class SignalPoll {
- public:
-  bool interrupted() {
-    if (interrupted_) return true;
-    const auto now = std::chrono::steady_clock::now();
-    if (now - last_ < std::chrono::milliseconds(50)) return false;
-    last_ = now;
-    py::gil_scoped_acquire acquire;
-    if (PyErr_CheckSignals() != 0) {
-      error_ = std::make_unique<py::error_already_set>();  // keeps the exception until it is raised
-      interrupted_ = true;
-    }
-    return interrupted_;
-  }
-  // With the GIL held: raises what a signal handler raised during the trial.
-  void raise_if_interrupted() {
-    if (error_) throw std::move(*error_);
-  }
-
- private:
-  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
-  bool interrupted_ = false;
-  std::unique_ptr<py::error_already_set> error_;
-};
 
 // Runs `trial` (which runs with `inputs`) without the GIL. Ctrl-C: every 50 ms of wall clock the runner's
 // thread takes the GIL and lets Python run its signal handlers; a KeyboardInterrupt (or any exception a

@@ -71,7 +71,7 @@ void refuse_replay(const StudyProtocol& protocol) {
 // One trial as a session folder would save it: its record (trial_record.hpp), kept in memory.
 json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& trial,
                          const StudyCondition& condition, const Scene& scene, WriterMemory& memory,
-                         const json* previous_record) {
+                         const json* previous_record, const std::function<bool()>& should_stop) {
   const std::string source = manifest.setup.subject.id + ", session " +
                              std::to_string(manifest.setup.session_number) + ", trial " +
                              std::to_string(trial.index + 1);
@@ -91,6 +91,7 @@ json cohort_trial_record(const SessionManifest& manifest, const PlannedTrial& tr
   const auto device = std::make_unique<SimulatedDevice>();
   TrialRunInputs inputs;
   inputs.device = device.get();
+  inputs.should_stop = should_stop;
   const auto checked = Checked<TrialSpec>::check(std::move(spec), study_teacher_source(condition));
   const Checked<WholeTrial> whole =
       study_detail::study_whole_trial(condition, guidance.guidance, checked, device->info());
@@ -190,8 +191,9 @@ StudyTables simulate_subject(const LoadedProtocol& protocol, const SubjectAssign
       for (const char32_t c : trial.characters) models.push_back(character(c));
       const Scene scene = Scene::lay_out(models);
       const PlannedTrial* previous = study_detail::previous_repetition(manifest.plan, trial);
-      records[trial.index] = cohort_trial_record(manifest, trial, condition, scene, memory,
-                                                 previous ? &records[previous->index] : nullptr);
+      records[trial.index] =
+          cohort_trial_record(manifest, trial, condition, scene, memory,
+                              previous ? &records[previous->index] : nullptr, setup.should_stop);
       tables.trials.push_back(study_detail::trial_row(records[trial.index], manifest.setup.subject.id,
                                                       manifest, trial, tables.strokes));
     }

@@ -34,6 +34,11 @@ struct CohortSetup {
   /// Loads a character's model; empty: the standard set (CharacterLibrary::standard(): every
   /// hanzi-writer-data character). Called from one thread at a time.
   std::function<Character(char32_t)> load_character;
+  /// Asks the cohort to stop (Ctrl-C in Python); empty: never. Polled by every trial's ticks from every
+  /// worker thread at once (TrialRunInputs::should_stop), so it must be thread-safe. Once it returns true,
+  /// each running trial ends `interrupted` at its next tick, no subject starts, and `simulate_subject` and
+  /// `simulate_cohort` throw StateError naming the subject and trial it stopped.
+  std::function<bool()> should_stop;
   /// Throws InvalidArgument naming the field for an unknown profile or learning.
   void validate() const;
 };
