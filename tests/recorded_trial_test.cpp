@@ -309,15 +309,21 @@ TEST_CASE("The characters' SHA-256 covers their medians, and a record of the mod
   TrialSpec spec;
   spec.characters = "十";
   spec.max_duration_s = 1.0;
-  RecordedTrial recorded = recorded_trial(spec, TrialOptions{}, nullptr, ten);
+  spec.seed = 3;
+  SimulatedWriting writing(spec);
+  const TrialRun first = run_whole_trial(build_whole_trial(Checked<TrialSpec>::check(spec), DeviceInfo{}, {}),
+                                         ten, study_test::trial_inputs(&writing));
+  RecordedTrial recorded = recorded_trial(spec, first, writing, ten);
+  SimulatedWriting again = recorded_writing(recorded);
   CHECK_THAT(error_of([&] {
                (void)rerun_trial(recorded, Checked<TrialSpec>::check(recorded.spec), models_only,
-                                 study_test::trial_inputs());
+                                 study_test::trial_inputs(&again));
              }),
              Catch::Contains("not the recorded ones"));
-  recorded.scene_sha256 = scene_models_sha256(ten);
+  recorded.scene_sha256 = scene_models_sha256(ten);  // as a record written before stated it
+  SimulatedWriting once_more = recorded_writing(recorded);
   CHECK_NOTHROW(rerun_trial(recorded, Checked<TrialSpec>::check(recorded.spec), models_only,
-                            study_test::trial_inputs()));
+                            study_test::trial_inputs(&once_more)));
 }
 
 TEST_CASE("What is not a recorded trial is refused naming the file and the place", "[recorded_trial]") {

@@ -74,7 +74,7 @@ int run_nearest(const NearestCommand& command) {
     // The jump measurement of `bench nearest`: seeds S, S + 1, S + 2 on every embedded character.
     JumpSettings jump_settings;
     jump_settings.seeds = {settings.seed, settings.seed + 1, settings.seed + 2};
-    const JumpMeasurement jumps = measure_foot_jumps(jump_settings);
+    const JumpMeasurement jumps = measure_foot_jumps(CharacterLibrary::standard(), jump_settings);
     write_output(command.markdown, updated_document(command.markdown, section, kGeneratedBegin,
                                                     foot_jumps_markdown(jumps, invocation)));
   }
@@ -87,11 +87,13 @@ struct JumpsCommand {
   std::string markdown;
   std::int64_t seeds = 3;
   std::string chars;
+  LibraryOptions library;
 };
 
 int run_jumps(const JumpsCommand& command) {
   require_one_standard_output({{"--json", command.json}, {"--markdown -", command.markdown == "-"}});
   FilePlan files;
+  add_library_inputs(files, command.library);
   files.output("--markdown", command.markdown);
   check_document(command.markdown, kJumpsGeneratedBegin);
   JumpSettings settings;
@@ -99,14 +101,15 @@ int run_jumps(const JumpsCommand& command) {
   for (std::int64_t seed = 1; seed <= command.seeds; ++seed)
     settings.seeds.push_back(static_cast<std::uint64_t>(seed));
   if (!command.chars.empty()) settings.characters = characters_from(command.chars, "--chars");
-  const CharacterSource source(LibraryOptions{});  // the standard set, as the measurement reads it
+  const CharacterSource source(command.library);
   for (const char32_t c : settings.characters) (void)source.load_named(c, "--chars");
-  const JumpMeasurement measurement = measure_foot_jumps(settings);
+  const JumpMeasurement measurement = measure_foot_jumps(library_from(command.library), settings);
 
   std::string invocation = "calligraphy bench jumps";
   if (!command.markdown.empty()) invocation += " --markdown " + command.markdown;
   invocation += " --seeds " + std::to_string(command.seeds);
   if (!command.chars.empty()) invocation += " --chars " + command.chars;
+  if (!command.library.data_folder.empty()) invocation += " --data DATA";
   const std::string section = foot_jumps_markdown(measurement, invocation);
   if (!command.markdown.empty()) {
     write_output(command.markdown, updated_document(command.markdown, section, kJumpsGeneratedBegin));
@@ -140,6 +143,7 @@ void add_bench_jumps_command(CLI::App& bench, Commands& commands) {
   add_integer(*app, "--seeds", command->seeds, "N", "trials per character, seeds 1..N", 1, 1000000);
   add_text(*app, "--chars", command->chars, "CHARS", "the characters to write (UTF-8)",
            "every embedded character");
+  add_library_options(*app, command->library, false);
 }
 
 }  // namespace calligraphy::cli

@@ -11,6 +11,7 @@ void add_library_options(CLI::App& app, LibraryOptions& options, bool with_store
       app, "--data", options.data_folder, "DIR",
       "read characters from this hanzi-writer-data folder (one JSON file each)",
       "the embedded characters, then the bundled corpus store (every hanzi-writer-data character)");
+  options.store_offered = with_store;
   if (with_store) {
     CLI::Option* store =
         add_input_path(app, "--store", options.store_file, "FILE",
@@ -29,7 +30,8 @@ CharacterLibrary library_from(const LibraryOptions& options) {
   return CharacterLibrary::standard();
 }
 
-CharacterSource::CharacterSource(const LibraryOptions& options) : library_(CharacterLibrary::standard()) {
+CharacterSource::CharacterSource(const LibraryOptions& options)
+    : library_(CharacterLibrary::standard()), store_offered_(options.store_offered) {
   if (!options.store_file.empty()) {
     store_ = CorpusStore::open(options.store_file);
   } else {
@@ -50,7 +52,8 @@ Character CharacterSource::load(char32_t code_point) const {
   try {
     return library_.load(code_point);
   } catch (const CharacterNotFound& e) {  // the library's message is neutral; the flags are ours
-    throw CharacterNotFound(std::string(e.what()) + ": pass --data DIR or --store FILE");
+    throw CharacterNotFound(std::string(e.what()) +
+                            (store_offered_ ? ": pass --data DIR or --store FILE" : ": pass --data DIR"));
   }
 }
 

@@ -14,8 +14,9 @@ namespace calligraphy::cli {
 class FilePlan;
 
 struct LibraryOptions {
-  std::string data_folder;  ///< --data DIR; empty: CharacterLibrary::standard()
-  std::string store_file;   ///< --store FILE; empty: none
+  std::string data_folder;     ///< --data DIR; empty: CharacterLibrary::standard()
+  std::string store_file;      ///< --store FILE; empty: none
+  bool store_offered = false;  ///< the command has --store (add_library_options), so a hint may name it
 };
 
 /// Adds --data DIR and, when `with_store`, --store FILE (the two exclude each other).
@@ -50,6 +51,7 @@ class CharacterSource {
   std::optional<CorpusStore> store_;
   CharacterLibrary library_;
   bool embedded_ = false;  // the standard set: a missing character gets the --data/--store hint
+  bool store_offered_ = false;
 };
 
 /// Registers --store FILE and --data DIR (every file in it) as inputs of `plan`: no output may replace them.

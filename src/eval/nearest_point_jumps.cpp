@@ -91,11 +91,9 @@ void replay(const PlacedCharacter& character, std::uint64_t seed, const std::vec
 
 }  // namespace
 
-JumpMeasurement measure_foot_jumps(const JumpSettings& settings) {
+JumpMeasurement measure_foot_jumps(const CharacterLibrary& library, const JumpSettings& settings) {
   JumpMeasurement measurement;
   measurement.settings = settings;
-  // Any character of the standard set (the embedded ones, then the bundled corpus); by default the embedded.
-  const CharacterLibrary library = CharacterLibrary::standard();
   std::u32string characters = settings.characters;
   if (characters.empty()) {
     for (const char32_t c : CharacterLibrary::embedded().characters()) characters.push_back(c);

@@ -8,10 +8,12 @@
 #include <string>
 #include <vector>
 
+#include "calligraphy/model/character_library.hpp"
+
 namespace calligraphy::cli {
 
 struct JumpSettings {
-  std::u32string characters;  ///< any of CharacterLibrary::standard(); empty: every embedded character
+  std::u32string characters;  ///< empty: every embedded character
   std::vector<std::uint64_t> seeds{1, 2, 3};
   std::vector<bool> guidance{true, false};  ///< trials with guidance on, and off (larger deviations)
   double threshold_m = 1e-3;                ///< a foot-point move above this between ticks is a jump [m]
@@ -43,8 +45,9 @@ struct JumpMeasurement {
   std::vector<JumpRow> rows;
 };
 
-/// Runs the trials and the replays. Deterministic for the settings.
-JumpMeasurement measure_foot_jumps(const JumpSettings& settings);
+/// Runs the trials and the replays on the characters of `library` the settings name (by default every
+/// embedded character). Deterministic for the library and the settings.
+JumpMeasurement measure_foot_jumps(const CharacterLibrary& library, const JumpSettings& settings);
 
 /// A JSON array of objects: method, guidance, strokes, ws_ticks, jumps, jumps_at_element_switch,
 /// jumps_per_stroke, frac_strokes_with_jump, max_jump_m.

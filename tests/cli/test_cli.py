@@ -385,6 +385,27 @@ class NothingLost(CliTestCase):
         self.assertEqual(again.returncode, 0)
         self.assertEqual(document.read_text().count("<!-- BEGIN generated"), 1)  # replaced, not appended
 
+    def test_bench_jumps_takes_any_character_of_its_library_and_names_only_options_it_has(self):
+        # 丁 is in the bundled corpus, not the embedded set; the advice for one it lacks names --data alone,
+        # the library option bench jumps and bench tick have (not --store).
+        result = self.run_cli("bench", "jumps", "--seeds", "1", "--chars", "丁", "--json")
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
+        self.assertEqual({row["guidance"] for row in json.loads(result.stdout)}, {True, False})
+        for command in (["bench", "jumps", "--seeds", "1"], ["bench", "tick"]):
+            with self.subTest(command=command):
+                result = self.run_cli(*command, "--chars", "\U00020000")
+                self.assertEqual(result.returncode, 2)
+                line = result.stderr.decode().strip()
+                self.assertIn("--chars", line)
+                self.assertIn("--data DIR", line)
+                self.assertNotIn("--store", line)
+        data = self.cwd / "data"
+        data.mkdir()
+        (data / "乙.json").write_text(json.dumps({"strokes": [], "medians": []}))
+        result = self.run_cli("bench", "jumps", "--seeds", "1", "--chars", "丁", "--data", data)
+        self.assertEqual(result.returncode, 2, result.stderr.decode())
+        self.assertIn("--chars", result.stderr.decode())
+
     def test_markdown_header_states_the_command_as_run(self):
         document = self.cwd / "doc.md"
         result = self.run_cli("bench", "acceptance", "--characters", "2", "--markdown", document)
