@@ -44,6 +44,7 @@ class CountingHand final : public HandModel {
 TEST_CASE("advance(100 s) under 1 N gives the damped mass's analytic displacement", "[simulated_device]") {
   const SimulatedDeviceParameters p = free_parameters(0.2, 0.5);  // the defaults: tau = 0.4 s
   SimulatedDevice d(p);
+  d.open();
   CHECK(d.write_force(Vec3(1.0, 0.0, 0.0)) == DeviceFault::none);
   d.advance(100.0);
   const double expected =
@@ -63,6 +64,7 @@ TEST_CASE("advance(100 s) under 1 N gives the damped mass's analytic displacemen
 TEST_CASE("Without damping a long step follows x = F t^2 / (2 m)", "[simulated_device]") {
   const SimulatedDeviceParameters p = free_parameters(0.2, 0.0);
   SimulatedDevice d(p);
+  d.open();
   CHECK(d.write_force(Vec3(0.0, 0.0, -1.0)) == DeviceFault::none);
   d.advance(100.0);
   CHECK(d.true_position().z() == Approx(-1.0 * 100.0 * 100.0 / (2.0 * p.moving_mass_kg)).epsilon(1e-6));
@@ -72,6 +74,7 @@ TEST_CASE("Without damping a long step follows x = F t^2 / (2 m)", "[simulated_d
 TEST_CASE("A heavily damped light device stays finite and reaches F / b", "[simulated_device]") {
   const SimulatedDeviceParameters p = free_parameters(1e-3, 1e3);  // tau = 1 us, a thousandth of a servo tick
   SimulatedDevice d(p);
+  d.open();
   CHECK(d.write_force(Vec3(1.0, 0.0, 0.0)) == DeviceFault::none);
   for (int i = 0; i < 1000; ++i) d.advance(1e-3);
   CHECK(d.true_position().allFinite());
@@ -93,6 +96,7 @@ TEST_CASE("A light device held by a stiff hand settles where the hand and the fo
   const Vec3 target(0.01, 0.0, 0.0);
   testing::ImpedanceHand hand = testing::stiff_hand(target);  // 600 N/m, 8 N s/m
   d.attach_hand(&hand);
+  d.open();
   CHECK(d.write_force(Vec3(-1.2, 0.0, 0.0)) == DeviceFault::none);
   // Overdamped: settles with the time constant (b + b_hand) / k = 0.18 s; 4 s is 22 of them.
   for (int i = 0; i < 4000; ++i) d.advance(1e-3);
@@ -137,6 +141,7 @@ TEST_CASE("The substep is no longer than 1 / physics_rate_hz nor m / b, and the 
 TEST_CASE("advance refuses a negative or non-finite step and leaves the device as it was",
           "[simulated_device]") {
   SimulatedDevice d;
+  d.open();
   CHECK(d.write_force(Vec3(1.0, 0.0, 0.0)) == DeviceFault::none);
   d.advance(1e-3);
   const Vec3 position = d.true_position();

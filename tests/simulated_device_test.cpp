@@ -12,6 +12,7 @@ TEST_CASE("A free simulated device accelerates as F = m a under a held force", "
   p.encoder_resolution_m = 0.0;
   p.initial_position_m = Vec3::Zero();
   SimulatedDevice d(p);
+  d.open();
   CHECK(d.write_force(Vec3(0.5, 0.0, 0.0)) == DeviceFault::none);
   for (int i = 0; i < 100; ++i) d.advance(1e-3);
   // x = F t^2 / (2 m) at t = 0.1 s; semi-implicit Euler's error is h / t = 0.1 ms / 100 ms = 0.1 %.
@@ -21,13 +22,14 @@ TEST_CASE("A free simulated device accelerates as F = m a under a held force", "
 
 TEST_CASE("The simulated device saturates and quantises like a real one", "[device]") {
   SimulatedDevice d;
+  d.open();
   CHECK(d.write_force(Vec3(0.0, 30.0, 40.0)) == DeviceFault::none);
   CHECK(d.applied_force().norm() == Approx(simulated_phantom_desktop_info().max_force_n));
   d.enable_forces(false);
   CHECK(d.write_force(Vec3(1.0, 0.0, 0.0)) == DeviceFault::none);
   CHECK(d.applied_force().isZero());
   DeviceState state;
-  CHECK(d.read_state(state) == DeviceFault::none);  // the simulated device never faults
+  CHECK(d.read_state(state) == DeviceFault::none);  // an open simulated device never faults
   const double q = SimulatedDeviceParameters{}.encoder_resolution_m;
   CHECK(std::abs(state.position_m.x() / q - std::round(state.position_m.x() / q)) < 1e-6);
   SimulatedDeviceParameters bad;
@@ -62,6 +64,46 @@ TEST_CASE("The simulated device's clock reads 0 at open() and counts whole ticks
   for (int i = 0; i < 250; ++i) d.advance(1e-3);
   CHECK(d.read_state(state) == DeviceFault::none);
   CHECK(state.time_s == 0.25);
+}
+
+TEST_CASE("A simulated device not open reads and writes nothing: not_open and zero force", "[device]") {
+  SimulatedDeviceParameters p;
+  p.damping_n_s_per_m = 0.0;
+  p.encoder_resolution_m = 0.0;
+  p.initial_position_m = Vec3::Zero();
+  SimulatedDevice d(p);
+  DeviceState state;
+  state.time_s = 42.0;
+  // Before open(): as every device, a link fault, the state untouched and no force applied.
+  CHECK(d.read_state(state) == DeviceFault::not_open);
+  CHECK(state.time_s == 42.0);
+  CHECK(d.write_force(Vec3(1.0, 0.0, 0.0)) == DeviceFault::not_open);
+  CHECK(d.applied_force().isZero());
+  d.advance(1e-2);
+  CHECK(d.true_position().isZero());
+  CHECK(is_link_fault(DeviceFault::not_open));
+
+  d.open();
+  CHECK(d.write_force(Vec3(1.0, 0.0, 0.0)) == DeviceFault::none);
+  CHECK(d.applied_force().x() == 1.0);
+  d.advance(1e-2);
+  d.close();  // zero force: the stylus keeps only its momentum
+  CHECK(d.applied_force().isZero());
+  const Vec3 velocity = d.true_velocity();
+  CHECK(d.write_force(Vec3(1.0, 0.0, 0.0)) == DeviceFault::not_open);
+  CHECK(d.applied_force().isZero());
+  d.advance(1e-2);
+  CHECK(velocity.x() > 0.0);
+  CHECK(d.true_velocity() == velocity);  // no force acted: undamped, it coasts
+  CHECK(d.read_state(state) == DeviceFault::not_open);
+  CHECK(state.time_s == 42.0);
+
+  d.open();  // open again: reads and writes work, the force acts
+  CHECK(d.read_state(state) == DeviceFault::none);
+  CHECK(state.time_s == 0.0);
+  CHECK(d.write_force(Vec3(1.0, 0.0, 0.0)) == DeviceFault::none);
+  d.advance(1e-2);
+  CHECK(d.true_velocity().x() == Approx(2.0 * 1e-2 / p.moving_mass_kg));  // 10 ms under 1 N, twice
 }
 
 TEST_CASE("The simulated device refuses a step that would run its clock past 2^62 ns", "[device]") {

@@ -7,9 +7,9 @@
 #include <vector>
 
 #include "calligraphy/analysis/score.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/render/renderer.hpp"
-#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/sim/simulated_writer.hpp"
 #include "calligraphy/trial/trial.hpp"
 
@@ -73,7 +73,7 @@ inline WriterTrial run_writer_trial(const Scene& scene, const WriterTrialOptions
   double end_time = 0.0;
   for (long k = 0; k < ticks; ++k) {
     DeviceState state;
-    if (device.read_state(state) != DeviceFault::none) break;  // the simulated device never faults
+    if (device.read_state(state) != DeviceFault::none) break;  // an open simulated device never faults
     const RenderOutput out = renderer.tick(state);
     if (device.write_force(out.force_n) != DeviceFault::none) break;
     recorder.record(state, out);

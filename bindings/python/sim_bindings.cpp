@@ -147,7 +147,7 @@ void bind_simulated_device(py::module_& m) {
             return state;
           },
           "The DeviceState: position quantised to the encoder [m], low-passed velocity [m/s], time [s]. "
-          "A device fault raises CommunicationError or SafetyFault (the simulated device has none).")
+          "A device fault raises CommunicationError (not_open once closed: the state is not read).")
       .def(
           "write_force",
           [](SimulatedDevice& d, const ArrayLike& force) {
@@ -157,7 +157,7 @@ void bind_simulated_device(py::module_& m) {
           },
           py::arg("force_n"),
           "Commands a force (3,) [N], held until the next command, saturated at info.max_force_n. A device "
-          "fault raises CommunicationError or SafetyFault (the simulated device has none).")
+          "fault raises CommunicationError (not_open once closed: zero force is applied).")
       .def(
           "advance", [](SimulatedDevice& d, const PyArgument<double>& dt) { d.advance(take(dt, "dt_s")); },
           py::arg("dt_s"),
@@ -170,7 +170,9 @@ void bind_simulated_device(py::module_& m) {
       .def_property_readonly("forces_enabled", &SimulatedDevice::forces_enabled,
                              "True while commanded forces are applied (enable_forces; True when made)")
       .def_property_readonly("is_open", &SimulatedDevice::is_open, "True between open() and close()")
-      .def("close", &SimulatedDevice::close, "Forces off and closed.")
+      .def("close", &SimulatedDevice::close,
+           "Zero force and closed: read_state and write_force then raise CommunicationError (not_open) "
+           "until open().")
       .def("open", &SimulatedDevice::open, "Opens it again after close().")
       .def_property_readonly("info", &SimulatedDevice::info, "its DeviceInfo")
       .def_property_readonly(

@@ -88,6 +88,10 @@ void SimulatedDevice::enable_forces(bool enabled) {
 }
 
 DeviceFault SimulatedDevice::write_force(const Vec3& force_n) noexcept {
+  if (!open_) {  // as every device: nothing reaches a closed device (close() left the force at zero)
+    force_ = Vec3::Zero();
+    return DeviceFault::not_open;
+  }
   force_ = forces_enabled_ ? clamp_force_magnitude(force_n, parameters_.info.max_force_n) : Vec3::Zero();
   written_since_read_ = read_since_advance_;
   return DeviceFault::none;
@@ -186,6 +190,7 @@ void SimulatedDevice::integrate_exactly(double duration_s, double start_s) {
 }
 
 DeviceFault SimulatedDevice::read_state(DeviceState& state) noexcept {
+  if (!open_) return DeviceFault::not_open;  // `state` untouched, as on every device
   // A held pen read, commanded and read again with no advance() between: the program forgot to let time
   // pass, and the pen would sit still while the hand "writes". Refused, so it cannot go unnoticed.
   if (hand_ != nullptr && read_since_advance_ && written_since_read_) {

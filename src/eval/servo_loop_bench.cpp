@@ -28,7 +28,7 @@ ServoLoopStats run_free_loop(const ServoLoopOptions& options, double seconds,
       device,
       [&](const DeviceState& state, double) {
         const Vec3 force = -200.0 * (state.position_m - home) - 2.0 * state.velocity_m_s;  // [N/m], [N s/m]
-        // Written here too, so that the step below acts under it (the simulated device has no faults).
+        // Written here too, so that the step below acts under it (an open simulated device has no faults).
         if (device.write_force(force) != DeviceFault::none) return ServoCommand{Vec3::Zero(), true};
         device.advance(period_s);
         return ServoCommand{force, false};

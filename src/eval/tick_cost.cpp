@@ -34,7 +34,7 @@ std::vector<DeviceState> record_states(const Scene& scene, double rate_hz, doubl
   const auto ticks = static_cast<std::size_t>(max_duration_s * rate_hz);
   for (std::size_t k = 0; k < ticks; ++k) {
     DeviceState state;
-    if (device.read_state(state) != DeviceFault::none) break;  // the simulated device has no faults
+    if (device.read_state(state) != DeviceFault::none) break;  // an open simulated device has no faults
     states.push_back(state);
     const RenderOutput out = renderer.tick(state);
     if (device.write_force(out.force_n) != DeviceFault::none) break;

@@ -98,8 +98,8 @@ class MouseHandDevice final : public HapticDevice {
   [[nodiscard]] bool is_open() const override { return device_.is_open(); }
   void enable_forces(bool enabled) override { device_.enable_forces(enabled); }
   [[nodiscard]] bool forces_enabled() const override { return device_.forces_enabled(); }
-  // Servo path: the simulated device never faults. `advance` throws only for a negative or non-finite
-  // step, which the clamp rules out.
+  // Servo path: the simulated device faults only when not open. `advance` throws only for a negative or
+  // non-finite step, which the clamp rules out.
   [[nodiscard]] DeviceFault read_state(DeviceState& state) noexcept override {
     const double now_s = steady_seconds();
     // A stalled thread does not make the physics jump: at most 50 ms are integrated at once.
@@ -192,7 +192,8 @@ PointerInput& pointer_input() {
 void register_pointer_devices(DeviceRegistry& registry) {
   if (!registered(registry, "mouse")) {
     registry.register_device(
-        "mouse", mouse_info(), [] { return std::make_unique<MouseDevice>(mouse_info()); }, DeviceCapabilities{},
+        "mouse", mouse_info(), [] { return std::make_unique<MouseDevice>(mouse_info()); },
+        DeviceCapabilities{},
         "the window's pointer on the paper plane; left button = pen on the paper; no force output "
         "(calligraphy train only)");
   }

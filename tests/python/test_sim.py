@@ -89,6 +89,24 @@ def test_simulated_device_open_close_and_forces():
     assert not device.is_open
 
 
+def test_a_closed_simulated_device_faults_not_open_and_applies_no_force():
+    # As every device: reading or writing a closed one is the link fault not_open, and no force acts.
+    parameters = calligraphy.SimulatedDeviceParameters(damping_n_s_per_m=0.0, encoder_resolution_m=0.0)
+    device = calligraphy.SimulatedDevice(parameters)
+    device.close()
+    for call in (lambda: device.write_force([1.0, 0.0, 0.0]), device.read_state):
+        with pytest.raises(calligraphy.CommunicationError, match="not open"):
+            call()
+    device.advance(0.05)
+    np.testing.assert_array_equal(device.applied_force_n, [0.0, 0.0, 0.0])
+    np.testing.assert_array_equal(device.true_velocity_m_s, [0.0, 0.0, 0.0])
+    np.testing.assert_array_equal(device.true_position_m, parameters.initial_position_m)
+    device.open()  # open again: the force acts
+    device.write_force([1.0, 0.0, 0.0])
+    device.advance(0.05)
+    assert device.read_state().position_m[0] > 0.0
+
+
 def test_simulate_trial_releases_the_gil():
     # With the GIL held for the whole trial, this thread could run only before and after it: a couple of
     # 1 ms sleeps. Released, it keeps running while the trial runs.

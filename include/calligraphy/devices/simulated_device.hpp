@@ -78,17 +78,20 @@ class SimulatedDevice final : public HandDrivenDevice {
   /// Opens the device: its clock restarts at 0 s and its velocity filter afresh (the first read reports
   /// zero velocity); the stylus stays where it is. Opening an open device changes nothing. Never throws.
   void open() noexcept override;
+  /// Closes the device: zero force, and reads and writes return `DeviceFault::not_open` until `open()`.
   void close() noexcept override;
   [[nodiscard]] bool is_open() const override { return open_; }
   void enable_forces(bool enabled) override;
   [[nodiscard]] bool forces_enabled() const override { return forces_enabled_; }
-  /// `DeviceFault::none` (also before open(), for tests and tools), except one misuse: with a hand attached,
-  /// a read that follows a read and a `write_force` with no `advance` between them returns
-  /// `DeviceFault::not_advanced` and turns forces off (the program forgot to let time pass: the pen would
-  /// stay at rest while the hand writes). The tick order is read_state, write_force, advance(dt_s).
+  /// `DeviceFault::none`, except `DeviceFault::not_open` before `open()` and after `close()` (`state` is left
+  /// untouched), and one misuse: with a hand attached, a read that follows a read and a `write_force` with
+  /// no `advance` between them returns `DeviceFault::not_advanced` and turns forces off (the program forgot
+  /// to let time pass: the pen would stay at rest while the hand writes). The tick order is read_state,
+  /// write_force, advance(dt_s).
   [[nodiscard]] DeviceFault read_state(DeviceState& state) noexcept override;
-  /// Never faults: always `DeviceFault::none`. Saturates at info().max_force_n keeping the direction;
-  /// a non-finite force, or any force while forces are disabled, applies zero force.
+  /// `DeviceFault::none`, or `DeviceFault::not_open` before `open()` and after `close()`: zero force is then
+  /// applied (the stylus moves only under the hand and its own momentum). Saturates at info().max_force_n
+  /// keeping the direction; a non-finite force, or any force while forces are disabled, applies zero force.
   [[nodiscard]] DeviceFault write_force(const Vec3& force_n) noexcept override;
 
   /// The unquantised position and velocity, for tests [m], [m/s].
