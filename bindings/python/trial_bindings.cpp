@@ -480,7 +480,8 @@ PyTrialResult rerun_trial_py(const py::object& record,
     } else if (!recorded.spec.teacher.empty()) {
       // The file the record names (a session's kept teacher, or the --teacher of `calligraphy trial`), read
       // and bound by its SHA-256 as `trial --spec` reads it.
-      TeacherFile file = read_recorded_teacher(recorded, recorded.spec.teacher);
+      TeacherFile file =
+          read_record_named_teacher(recorded, "record", "teacher=read_teacher_recording(FILE)");
       require_teacher_for(file.recording, recorded.spec.characters);
       inputs.teacher = std::move(file.recording.samples);
       recorded.spec.teacher.clear();  // its samples are the teacher now, as a teacher= given

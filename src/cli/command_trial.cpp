@@ -160,10 +160,13 @@ TrialDescription describe(const TrialSpec& spec, const TrialRun& run, const Simu
 
 // A replay's teacher: the recording --teacher (or the record) names, of these characters and, for a record
 // that names its teacher's SHA-256, that recording; `sha256` is set to its file's.
-std::vector<TeacherSample> teacher_samples(const TrialSpec& spec,
+std::vector<TeacherSample> teacher_samples(const TrialCommand& command, const TrialSpec& spec,
                                            const std::optional<RecordedTrial>& recorded,
                                            std::string& sha256) {
-  TeacherFile teacher = read_recorded_teacher(recorded ? *recorded : RecordedTrial{}, spec.teacher);
+  TeacherFile teacher =
+      recorded && command.spec.teacher.empty()
+          ? read_record_named_teacher(*recorded, "--spec " + command.spec_file, "--teacher FILE")
+          : read_recorded_teacher(recorded ? *recorded : RecordedTrial{}, spec.teacher);
   try {
     require_teacher_for(teacher.recording, spec.characters);
   } catch (const InvalidArgument& e) {
@@ -360,7 +363,7 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
   std::string teacher_sha256;
   try {
     if (spec.guidance && spec.guidance_mode == GuidanceMode::replay)
-      inputs.teacher = teacher_samples(spec, recorded, teacher_sha256);
+      inputs.teacher = teacher_samples(command, spec, recorded, teacher_sha256);
     run = recorded ? rerun_trial(*recorded, checked, scene, inputs) : run_trial_spec(checked, scene, inputs);
   } catch (const InvalidArgument& e) {
     if (!recorded) throw;

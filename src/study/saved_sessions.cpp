@@ -209,6 +209,7 @@ RecordedTrial read_study_recorded_trial(const std::string& path) {
           (std::filesystem::path(path).parent_path().parent_path() / (*teacher)["file"].get<std::string>())
               .string();
       recorded.teacher_sha256 = (*teacher)["sha256"].get<std::string>();
+      recorded.teacher_kept_by_session = true;
     }
   }
   return recorded;

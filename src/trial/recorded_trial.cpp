@@ -366,6 +366,21 @@ TeacherFile read_recorded_teacher(const RecordedTrial& recorded, const std::file
   return {parse_teacher_recording(bytes, path.string()), sha256};
 }
 
+TeacherFile read_record_named_teacher(const RecordedTrial& recorded, std::string_view source,
+                                      std::string_view give) {
+  const std::filesystem::path path = recorded.spec.teacher;
+  std::error_code error;
+  if (!std::filesystem::exists(std::filesystem::symlink_status(path, error))) {
+    throw DataError(std::string(source) + ": the replay's teacher " + path.string() +
+                    (recorded.teacher_kept_by_session
+                         ? " (the copy its session kept beside the record's folder)"
+                         : " (as --teacher was given when it ran; a relative name is read from the working "
+                           "folder)") +
+                    ": no such file; give " + std::string(give) + ", the teacher's recording it ran on");
+  }
+  return read_recorded_teacher(recorded, path);
+}
+
 Checked<WholeTrial> recorded_whole_trial(const RecordedTrial& recorded, const Checked<TrialSpec>& spec) {
   // The record's force law is given whole: the device's figures fit no default stiffness of it.
   return build_whole_trial(spec, DeviceInfo{},

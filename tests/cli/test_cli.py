@@ -669,6 +669,29 @@ class GuidanceModesAndWriters(CliTestCase):
         self.assertIn("teacher.json", other.stderr.decode())
         self.assertIn("人", other.stderr.decode())
 
+    def test_a_replay_record_run_from_another_folder_names_its_teacher_and_what_to_give(self):
+        # The record names its teacher as --teacher was given, relative to the folder it ran in.
+        self.assertEqual(self.run_cli("trial", "十", "--writer-profile", "skilled", "--record",
+                                      "teacher.json").returncode, 0)
+        self.assertEqual(self.run_cli("trial", "十", "--guidance-mode", "replay", "--teacher", "teacher.json",
+                                      "--json", "replay.json").returncode, 0)
+        elsewhere = self.cwd / "elsewhere"
+        elsewhere.mkdir()
+        refused = subprocess.run([CLI, "trial", "--spec", "../replay.json", "--json", "again.json"], cwd=elsewhere,
+                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=120)
+        message = refused.stderr.decode()
+        self.assertEqual(refused.returncode, 1, message)  # a missing file: docs/cli.md's status 1
+        self.assertEqual(len(message.splitlines()), 1, message)
+        self.assertIn("--spec ../replay.json: the replay's teacher teacher.json (as --teacher was given when it "
+                      "ran", message)
+        self.assertIn("no such file; give --teacher FILE", message)
+        self.assertEqual(list(elsewhere.iterdir()), [])  # nothing written
+        given = subprocess.run([CLI, "trial", "--spec", "../replay.json", "--teacher", "../teacher.json", "--json",
+                                "again.json"], cwd=elsewhere, stderr=subprocess.PIPE, timeout=120)
+        self.assertEqual(given.returncode, 0, given.stderr.decode())
+        self.assertEqual(json.loads((elsewhere / "again.json").read_text(encoding="utf-8"))["teacher"]["file"],
+                         "../teacher.json")
+
     def test_record_refused_for_a_trial_not_completed_in_order(self):
         # A writer who gives up on the first attempt at a stroke out of order cannot teach the order.
         result = self.run_cli("trial", "永", "--writer-profile", "foreign", "--seed", "1", "--writer-param",

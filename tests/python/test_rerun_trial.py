@@ -1,4 +1,5 @@
 """rerun_trial: a trial's metrics hold its whole specification, which runs it again bit for bit."""
+import hashlib
 import json
 
 import numpy as np
@@ -75,3 +76,23 @@ def test_what_is_not_a_record_is_refused():
         calligraphy.rerun_trial(json.dumps(spec))
     with pytest.raises(TypeError, match="JSON text, not a path"):
         calligraphy.check_trial_record("  " + json.dumps(spec))
+
+
+def test_a_replay_record_run_from_another_folder_says_its_teacher_is_the_one_it_names(tmp_path, monkeypatch):
+    # A record names its teacher's file as --teacher was given, relative to the folder it ran in; from
+    # another folder the file is not there: the DataError says it is the record's teacher and what to give.
+    monkeypatch.chdir(tmp_path)
+    teacher = calligraphy.record_teacher(calligraphy.simulate_trial("十", writer="skilled"), "teacher.json")
+    record = calligraphy.simulate_trial("十", teacher=teacher, keep_trace=False).metrics
+    record["specification"]["trial"]["teacher"] = "teacher.json"  # as `calligraphy trial --teacher` names it
+    record["specification"]["teacher_sha256"] = hashlib.sha256((tmp_path / "teacher.json").read_bytes()).hexdigest()
+    here = calligraphy.rerun_trial(record)  # from the folder it names its teacher in
+    (tmp_path / "elsewhere").mkdir()
+    monkeypatch.chdir(tmp_path / "elsewhere")
+    with pytest.raises(calligraphy.DataError) as refused:
+        calligraphy.rerun_trial(record)
+    message = str(refused.value)
+    assert "the replay's teacher teacher.json (as --teacher was given when it ran" in message
+    assert "no such file" in message and "give teacher=" in message
+    again = calligraphy.rerun_trial(record, teacher=teacher)
+    assert again.metrics["mean_deviation_m"] == here.metrics["mean_deviation_m"]

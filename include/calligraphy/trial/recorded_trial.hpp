@@ -90,6 +90,9 @@ struct RecordedTrial : WholeTrial {
   /// Read from a record of an earlier version: each acceptance field its version's rule set, in table order
   /// (empty for a record written by this version). Not written.
   std::vector<VersionRule> version_rules;
+  /// `spec.teacher` is the copy of the teacher a session kept in its folder, found from the record's own
+  /// place (`read_study_recorded_trial`), rather than the file named as `--teacher` was given. Not written.
+  bool teacher_kept_by_session = false;
 };
 
 /// The schema of the specification object a trial record holds (format, version, trial, force_law, safety,
@@ -152,6 +155,13 @@ struct TeacherFile {
 /// another recording, and what `read_teacher_recording` throws.
 [[nodiscard]] TeacherFile read_recorded_teacher(const RecordedTrial& recorded,
                                                 const std::filesystem::path& path);
+
+/// `read_recorded_teacher` of the file the record itself names (`recorded.spec.teacher`), for a re-run given
+/// no other. A file not there is refused with a DataError `<source>: the replay's teacher <file> (<where the
+/// name comes from>): no such file; give <give>, ...`: the name as `--teacher` was given when the trial ran
+/// (a relative name is read from the working folder), or the copy its session kept.
+[[nodiscard]] TeacherFile read_record_named_teacher(const RecordedTrial& recorded, std::string_view source,
+                                                    std::string_view give);
 
 /// The whole trial of `recorded` as it runs again, checked: the one builder (`build_whole_trial`) given
 /// `spec` (`recorded.spec` as the caller checked it, `Checked<TrialSpec>::check`, its output files and a
