@@ -408,7 +408,8 @@ class Circumstances(unittest.TestCase, OneErrorLine):
         kept.unlink()
         (elsewhere / "again.csv").unlink()
         r = run(["trial", "--spec", record, "--csv", "again.csv"], elsewhere)
-        self.assert_one_error(r, 1, kept.name)
+        self.assert_one_error(r, 1, kept.name, "the replay's teacher", "the copy its session kept",
+                              "give --teacher FILE")
         self.assertFalse((elsewhere / "again.csv").exists())
 
     def test_replay_session_record_reruns_in_python_from_another_folder_with_its_kept_teacher(self):
