@@ -370,7 +370,8 @@ TeacherFile read_record_named_teacher(const RecordedTrial& recorded, std::string
                                       std::string_view give) {
   const std::filesystem::path path = recorded.spec.teacher;
   std::error_code error;
-  if (!std::filesystem::exists(std::filesystem::symlink_status(path, error))) {
+  // Not there as `read_recorded_teacher` would find it (a dangling link included): say whose file it is.
+  if (const auto status = std::filesystem::status(path, error); error || !std::filesystem::exists(status)) {
     throw DataError(std::string(source) + ": the replay's teacher " + path.string() +
                     (recorded.teacher_kept_by_session
                          ? " (the copy its session kept beside the record's folder)"
