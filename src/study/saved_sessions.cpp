@@ -207,10 +207,11 @@ RecordedTrial read_study_recorded_trial(const std::string& path) {
   // Read whole, as read_recorded_trial_file reads: what is refused now is the record's content, the input
   // the command was given. A study's record (a format of its own beside its specification; a `trial --json`
   // record states none) is checked as every reader of a session's records checks it.
+  const std::string text = read_regular_file(path, study_detail::kMaxRecordBytes);
   nlohmann::json document;
   RecordedTrial recorded;
   try {
-    document = json_detail::parse_json(read_regular_file(path, study_detail::kMaxRecordBytes), path);
+    document = json_detail::parse_json(text, path);
     if (document.is_object() && document.contains("specification") && document.contains("format"))
       recorded = *study_detail::check_trial_record(document, path);
     else
