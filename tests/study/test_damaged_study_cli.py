@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """Damaged study files through the program, run by CTest as `study_damaged_cli`: every value of a trial
 record, a session manifest and a protocol replaced by one of another type or beyond a double's range gives
-the data error (exit 1) naming the file, never an internal error (exit 3); a trial that wrote no stroke is
+the data error (exit 1) naming the file, never an internal error (exit 3); a record whose specification
+`trial --spec` refuses is refused by every reader naming the record and the pointer, and `trial --spec` of a
+study's record checks its own format and version; a trial that wrote no stroke is
 shown on the report page; subnormal option values are finite; the cohort's tables are replaced together or
 not at all, also when the cohort is killed.
 
@@ -187,8 +189,8 @@ class DamagedStudyTest(unittest.TestCase):
 
     def test_a_record_whose_specification_cannot_run_again_is_refused_by_every_reader(self):
         """The study's readers read a record's specification through `trial --spec`'s one reader: a field that
-        reader refuses is refused by the report's tables and page and by the curriculum too (exit 1, one line
-        naming the record and the pointer); the untouched study reports the same tables byte for byte."""
+        reader refuses is refused by the report's tables and page, the curriculum and `session resume` too (exit 1,
+        one line naming the record and the pointer); the untouched study reports the same tables byte for byte."""
         record = sorted((self.first_session() / "trials").glob("*.json"))[0]
         text = record.read_text(encoding="utf-8")
         original = json.loads(text)
@@ -196,7 +198,8 @@ class DamagedStudyTest(unittest.TestCase):
         self.assertEqual(self.run_cli("report", "S", "--csv", "before").returncode, 0)
         before = {p.name: p.read_bytes() for p in (self.cwd / "before").iterdir()}
         readers = (["report", "S", "--csv", "."], ["report", "S", "--out", "r.html"],
-                   ["curriculum", "S", "--subject", original["subject"], "--from", "十"])
+                   ["curriculum", "S", "--subject", original["subject"], "--from", "十"],
+                   ["session", "resume", self.first_session()])
         for pointer, value in self.FORGED_SPECIFICATIONS:
             with self.subTest(pointer=pointer, value=value):
                 record.write_text(json.dumps(self.forge(original, pointer, value)), encoding="utf-8")
@@ -205,6 +208,9 @@ class DamagedStudyTest(unittest.TestCase):
                     self.assert_one_line(self.run_cli(*command), 1, record.name, pointer)
                 self.assertFalse((self.cwd / "r.html").exists())
         record.write_text(text, encoding="utf-8")
+        for command in readers[2:]:
+            result = self.run_cli(*command)
+            self.assertEqual(result.returncode, 0, result.stderr.decode())
         (self.cwd / "after").mkdir()
         self.assertEqual(self.run_cli("report", "S", "--csv", "after").returncode, 0)
         self.assertEqual({p.name: p.read_bytes() for p in (self.cwd / "after").iterdir()}, before)
