@@ -271,7 +271,8 @@ def load(paths: typing.Union[PathLike, typing.Sequence[PathLike]]) -> Study:
     session manifests and trial records are read, never the traces. ``phase`` is an ordered categorical in
     the protocol's order and ``condition`` and ``group`` categoricals with the control (the condition without
     guidance, ``calligraphy.design_analysis.study_design``) first. Raises DataError naming the file (and
-    JSON pointer) for a path without a session folder or a damaged record, and naming the subject and both
+    JSON pointer) for a path without a session folder or a damaged record (its ``specification`` included, read as
+    ``rerun_trial`` and ``calligraphy trial --spec`` read it), and naming the subject and both
     folders for a subject's session of one number found twice (a session run twice: its trials are not
     pooled), naming session.json and /study_id for a session of another study (copied in from another study
     folder: its study_id is not the folder's, docs/experiments.md "Phases"), ValueError for no path or an empty one,

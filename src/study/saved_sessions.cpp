@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <optional>
 #include <set>
 
 #include "calligraphy/core/errors.hpp"
@@ -12,6 +13,7 @@
 #include "core/whole_file.hpp"
 #include "study/manifest_json.hpp"
 #include "study/names.hpp"
+#include "trial/recorded_trial_object.hpp"
 
 namespace calligraphy::study_detail {
 namespace fs = std::filesystem;
@@ -157,10 +159,13 @@ bool DistinctSessions::add(const fs::path& folder, const SessionManifest& manife
                   "): a copy; remove one so that its trials are not counted twice");
 }
 
-nlohmann::json read_trial_record(const fs::path& json_file) {
-  const std::string source = json_file.string();
-  nlohmann::json record =
-      json_detail::parse_json(read_session_file(json_file, kMaxRecordBytes, "trial record (JSON)"), source);
+namespace {
+
+// The record's own format and version (a study's trial record, kTrialRecordFormat) and the specification
+// that ran, read by its one reader (read_recorded_trial's, as `trial --spec` reads it): a record whose trial
+// could not be run again is refused naming its pointer. Returns that specification (none in a record written
+// before records held one).
+std::optional<RecordedTrial> check_trial_record(const nlohmann::json& record, const std::string& source) {
   if (!record.is_object() || !record.contains("format") || record["format"] != kTrialRecordFormat) {
     json_detail::fail(source, "/format", std::string("expected \"") + kTrialRecordFormat + "\"");
   }
@@ -175,6 +180,18 @@ nlohmann::json read_trial_record(const fs::path& json_file) {
                                ? " (written by a newer calligraphy: read it with that version)"
                                : ""));
   }
+  if (!record.contains("specification")) return std::nullopt;
+  return trial_detail::read_recorded_document(record, source);
+}
+
+}  // namespace
+
+nlohmann::json read_trial_record(const fs::path& json_file) {
+  const std::string source = json_file.string();
+  nlohmann::json record =
+      json_detail::parse_json(read_session_file(json_file, kMaxRecordBytes, "trial record (JSON)"), source);
+  (void)check_trial_record(record, source);
+  const auto version = record.find("version");
   // Versions 1 and 2 called a person writing "human": every reader sees version 3's "person".
   if (version->get<std::int64_t>() < 3 && record.contains("writer") && record["writer"].is_object() &&
       record["writer"].value("kind", nlohmann::json()) == "human")
@@ -187,17 +204,30 @@ nlohmann::json read_trial_record(const fs::path& json_file) {
 namespace calligraphy {
 
 RecordedTrial read_study_recorded_trial(const std::string& path) {
-  RecordedTrial recorded = read_recorded_trial_file(path);
+  // Read whole, as read_recorded_trial_file reads: what is refused now is the record's content, the input
+  // the command was given. A study's record (a format of its own beside its specification; a `trial --json`
+  // record states none) is checked as every reader of a session's records checks it.
+  const std::string text = read_regular_file(path, study_detail::kMaxRecordBytes);
+  nlohmann::json document;
+  RecordedTrial recorded;
+  try {
+    document = json_detail::parse_json(text, path);
+    if (document.is_object() && document.contains("specification") && document.contains("format"))
+      recorded = *study_detail::check_trial_record(document, path);
+    else
+      recorded = trial_detail::read_recorded_document(document, path);
+  } catch (const InputError&) {
+    throw;
+  } catch (const DataError& e) {
+    throw InputError(e.what());
+  }
   if (recorded.spec.guidance && recorded.spec.guidance_mode == GuidanceMode::replay &&
       recorded.spec.teacher.empty()) {
     // A session's replay ran on the teacher kept in its folder (trials/ is beside teachers/): the record
     // names the file and its SHA-256 under /guidance/teacher (trial_guidance.hpp). That file is the teacher,
     // bound by that SHA-256 as a replay's teacher file is (`teacher_sha256`, read_recorded_teacher): one
     // edited or replaced since is refused naming it and both SHA-256, and a recording given instead
-    // (--teacher, Python's teacher=) must be the one it ran on. The record was read whole above: a damaged
-    // one was refused there.
-    nlohmann::json document =
-        json_detail::parse_json(read_regular_file(path, study_detail::kMaxRecordBytes), path);
+    // (--teacher, Python's teacher=) must be the one it ran on.
     nlohmann::json* teacher = document.contains("guidance") && document["guidance"].is_object() &&
                                       document["guidance"].contains("teacher") &&
                                       document["guidance"]["teacher"].is_object()

@@ -1,5 +1,6 @@
 #include "calligraphy/trial/recorded_trial.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cstdint>
 #include <filesystem>
@@ -160,7 +161,7 @@ std::string recorded_trial_json(const RecordedTrial& r) {
   return trial_detail::recorded_trial_object(r).dump(2) + "\n";
 }
 
-namespace {
+namespace trial_detail {
 
 RecordedTrial read_recorded_document(const json& document, const std::string& source) {
   std::string at;  // the specification object's pointer in the document
@@ -207,9 +208,21 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
   // Every part is required, read by the record's one schema (record_schema.hpp): a value out of its field's
   // range, null, an unknown key or a missing part is refused naming its pointer; a field added in a later
   // version than the record's takes its default, and the record says which (RecordedTrial::defaulted).
-  json normalized = *object;
-  if (normalized.contains("trial"))
-    trial_detail::type_writer_settings(normalized["trial"], reader.pointer("trial"), source);
+  // Only a record whose writer settings are "key=value" text (version 1) is read from a typed copy: a study's
+  // readers read every record's specification, and copying it is as dear as reading it.
+  const auto text_settings = [](const json& part) {
+    const auto trial = part.find("trial");
+    if (trial == part.end() || !trial->is_object()) return false;
+    const auto settings = trial->find("writer_parameters");
+    return settings != trial->end() && settings->is_array() &&
+           std::any_of(settings->begin(), settings->end(), [](const json& item) { return item.is_string(); });
+  };
+  json typed;
+  if (object->is_object() && text_settings(*object)) {
+    typed = *object;
+    trial_detail::type_writer_settings(typed["trial"], reader.pointer("trial"), source);
+  }
+  const json& normalized = typed.is_null() ? *object : typed;
   trial_detail::RecordDocument parts;
   SchemaReadResult read;
   schema_detail::from_json(recorded_trial_schema(), &parts, normalized, at, source,
@@ -337,17 +350,17 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
   return r;
 }
 
-}  // namespace
+}  // namespace trial_detail
 
 RecordedTrial read_recorded_trial(std::string_view text, const std::string& source) {
-  return read_recorded_document(json_detail::parse_json(text, source), source);
+  return trial_detail::read_recorded_document(json_detail::parse_json(text, source), source);
 }
 
 RecordedTrial read_recorded_trial_file(const std::string& path) {
   const std::string text = read_regular_file(path, kMaxRecordedTrialBytes);
   // Read whole: what is refused now is the record's content, the input the command was given.
   try {
-    return read_recorded_document(json_detail::parse_json(text, path), path);
+    return trial_detail::read_recorded_document(json_detail::parse_json(text, path), path);
   } catch (const InputError&) {
     throw;
   } catch (const DataError& e) {

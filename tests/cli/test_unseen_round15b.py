@@ -575,8 +575,10 @@ class SessionFolders(Base):
         def person(document):
             document["version"] = 2
             document["writer"] = {"kind": "human"}
+            # A person's specification as trial --spec reads it: no simulated writer's profile or settings.
             document["specification"]["writer"] = None
             document["specification"]["trial"]["writer"] = "person"
+            document["specification"]["trial"]["writer_parameters"] = []
 
         folder, _ = self.study(manifest, person, drop_second=True)
         rows = self.tables(folder)

@@ -156,6 +156,30 @@ def test_a_damaged_record_is_a_data_error_naming_the_file_and_pointer(study_fold
     record.write_text(text, encoding="utf-8")
 
 
+def test_a_record_whose_specification_cannot_run_again_is_a_data_error_naming_the_pointer(study_folder, tmp_path):
+    """study.load reads a record's specification as `trial --spec` does (one reader): a field it refuses is a
+    DataError naming the record and the pointer; the untouched copy loads the same tables."""
+    import shutil
+
+    copy = tmp_path / "study"
+    shutil.copytree(study_folder / "study", copy)
+    before = calligraphy.study.load(copy)
+    record = sorted(copy.glob("S01/*/trials/*.json"))[0]
+    text = record.read_text(encoding="utf-8")
+    for part, key, value in [(None, "version", 8), ("force_law", "crossfade_s", -1.0),
+                             ("trial", "max_duration_s", "20")]:
+        document = json.loads(text)
+        (document["specification"] if part is None else document["specification"][part])[key] = value
+        record.write_text(json.dumps(document), encoding="utf-8")
+        pointer = "/specification/" + (key if part is None else f"{part}/{key}")
+        with pytest.raises(calligraphy.DataError, match=f"{record.name}: {pointer}:"):
+            calligraphy.study.load(copy)
+    record.write_text(text, encoding="utf-8")
+    after = calligraphy.study.load(copy)
+    pd.testing.assert_frame_equal(after.trials, before.trials)
+    pd.testing.assert_frame_equal(after.strokes, before.strokes)
+
+
 def test_a_damaged_trace_is_a_data_error_naming_the_file_and_line(cli, study_folder, tmp_path):
     import shutil
 

@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """Damaged study files through the program, run by CTest as `study_damaged_cli`: every value of a trial
 record, a session manifest and a protocol replaced by one of another type or beyond a double's range gives
-the data error (exit 1) naming the file, never an internal error (exit 3); a trial that wrote no stroke is
+the data error (exit 1) naming the file, never an internal error (exit 3); a record whose specification
+`trial --spec` refuses is refused by every reader naming the record and the pointer, and `trial --spec` of a
+study's record checks its own format and version; a trial that wrote no stroke is
 shown on the report page; subnormal option values are finite; the cohort's tables are replaced together or
 not at all, also when the cohort is killed.
 
@@ -162,6 +164,72 @@ class DamagedStudyTest(unittest.TestCase):
         for command in readers:
             result = self.run_cli(*command)
             self.assertEqual(result.returncode, 0, result.stderr.decode())
+
+    # One field of a record's specification forged as `trial --spec RECORD --check` refuses it: (pointer, value).
+    FORGED_SPECIFICATIONS = (("/specification/version", 8), ("/specification/force_law/crossfade_s", -1.0),
+                             ("/specification/trial/max_duration_s", "20"))
+
+    def forge(self, document, pointer, value):
+        """A copy of `document` with the member at the JSON `pointer` set to `value`."""
+        forged = json.loads(json.dumps(document))
+        *path, last = pointer.strip("/").split("/")
+        parent = forged
+        for step in path:
+            parent = parent[step]
+        parent[last] = value
+        return forged
+
+    def assert_one_line(self, result, status, *needles):
+        stderr = result.stderr.decode()
+        self.assertEqual(result.returncode, status, stderr)
+        self.assertNotIn("internal error", stderr)
+        self.assertEqual(len(stderr.strip().splitlines()), 1, stderr)
+        for needle in needles:
+            self.assertIn(needle, stderr)
+
+    def test_a_record_whose_specification_cannot_run_again_is_refused_by_every_reader(self):
+        """The study's readers read a record's specification through `trial --spec`'s one reader: a field that
+        reader refuses is refused by the report's tables and page, the curriculum and `session resume` too (exit 1,
+        one line naming the record and the pointer); the untouched study reports the same tables byte for byte."""
+        record = sorted((self.first_session() / "trials").glob("*.json"))[0]
+        text = record.read_text(encoding="utf-8")
+        original = json.loads(text)
+        (self.cwd / "before").mkdir()
+        self.assertEqual(self.run_cli("report", "S", "--csv", "before").returncode, 0)
+        before = {p.name: p.read_bytes() for p in (self.cwd / "before").iterdir()}
+        readers = (["report", "S", "--csv", "."], ["report", "S", "--out", "r.html"],
+                   ["curriculum", "S", "--subject", original["subject"], "--from", "十"],
+                   ["session", "resume", self.first_session()])
+        for pointer, value in self.FORGED_SPECIFICATIONS:
+            with self.subTest(pointer=pointer, value=value):
+                record.write_text(json.dumps(self.forge(original, pointer, value)), encoding="utf-8")
+                self.assert_one_line(self.run_cli("trial", "--spec", record, "--check"), 2, record.name, pointer)
+                for command in readers:
+                    self.assert_one_line(self.run_cli(*command), 1, record.name, pointer)
+                self.assertFalse((self.cwd / "r.html").exists())
+        record.write_text(text, encoding="utf-8")
+        for command in readers[2:]:
+            result = self.run_cli(*command)
+            self.assertEqual(result.returncode, 0, result.stderr.decode())
+        (self.cwd / "after").mkdir()
+        self.assertEqual(self.run_cli("report", "S", "--csv", "after").returncode, 0)
+        self.assertEqual({p.name: p.read_bytes() for p in (self.cwd / "after").iterdir()}, before)
+
+    def test_trial_spec_of_a_study_record_checks_the_records_own_format_and_version(self):
+        """`trial --spec` of a study's record reads its top-level format and version as the study's readers do:
+        another format or a version they do not read is refused (exit 2, one line naming the record and the
+        pointer); the record as written is a valid specification."""
+        record = sorted((self.first_session() / "trials").glob("*.json"))[0]
+        original = json.loads(record.read_text(encoding="utf-8"))
+        for pointer, value in (("/format", "calligraphy-session"), ("/format", 5), ("/version", 4),
+                               ("/version", 0), ("/version", "3")):
+            with self.subTest(pointer=pointer, value=value):
+                record.write_text(json.dumps(self.forge(original, pointer, value)), encoding="utf-8")
+                self.assert_one_line(self.run_cli("trial", "--spec", record, "--check"), 2, record.name, pointer)
+                self.assertEqual(self.run_cli("report", "S", "--csv", ".").returncode, 1)
+        record.write_text(json.dumps(original), encoding="utf-8")
+        result = self.run_cli("trial", "--spec", record, "--check")
+        self.assertEqual(result.returncode, 0, result.stderr.decode())
 
     def test_a_huge_or_odd_subject_id_is_refused_before_it_reaches_a_table(self):
         manifest = self.first_session() / "session.json"
