@@ -26,6 +26,16 @@ def run(args, cwd, timeout=TIMEOUT_S, env=None, **kw):
     return subprocess.run([CLI, *arguments], cwd=cwd, timeout=timeout, env=ENV if env is None else env, **kw)
 
 
+def run_ok(args, cwd, ok=True):
+    """As `run`; with `ok`, a run that did not exit 0 raises AssertionError naming the command, its status and
+    its standard error."""
+    result = run(args, cwd)
+    if ok and result.returncode != 0:
+        raise AssertionError(f"calligraphy {' '.join(map(str, args))}: {result.returncode}\n"
+                             f"{result.stderr.decode('utf-8', 'replace')}")
+    return result
+
+
 def error_lines(result):
     """The lines the run wrote to its standard error, the blank ones at its two ends left out."""
     return result.stderr.decode("utf-8", "replace").strip().splitlines()

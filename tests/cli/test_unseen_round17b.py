@@ -35,7 +35,7 @@ import unittest
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from outsider import OneErrorLine, run, sanitized_subset
+from outsider import OneErrorLine, run, run_ok, sanitized_subset
 
 load_tests = sanitized_subset({"test_model_text_of_random_characters_agrees_with_the_listing",
                                "test_kangxi_radical_is_refused_never_read_as_its_twin",
@@ -60,11 +60,7 @@ TEXT_SUFFIXES = {".md", ".py", ".cpp", ".hpp", ".h", ".json", ".txt", ".csv", ".
 
 
 def cli(args, cwd=None, ok=True):
-    result = run(args, cwd or SHARED["root"])
-    if ok and result.returncode != 0:
-        raise AssertionError(f"calligraphy {' '.join(map(str, args))}: {result.returncode}\n"
-                             f"{result.stderr.decode('utf-8', 'replace')}")
-    return result
+    return run_ok(args, cwd or SHARED["root"], ok)
 
 
 def cjk_named_in_the_sources():

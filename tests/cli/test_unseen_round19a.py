@@ -29,7 +29,7 @@ import time
 import unittest
 from pathlib import Path
 
-from outsider import CLI, ENV, OneErrorLine, error_lines, run, sanitized_subset
+from outsider import CLI, ENV, OneErrorLine, error_lines, run, run_ok, sanitized_subset
 
 load_tests = sanitized_subset({"test_end_marker_before_begin_is_refused_untouched",
                                "test_acceptance_rows_add_up_to_the_paths",
@@ -54,11 +54,7 @@ SHI = {"strokes": ["M 100 500 L 900 500 L 900 540 L 100 540 Z", "M 480 100 L 520
 
 
 def cli(args, cwd=None, ok=True):
-    result = run(args, cwd or SHARED["root"])
-    if ok and result.returncode != 0:
-        raise AssertionError(f"calligraphy {' '.join(map(str, args))}: {result.returncode}\n"
-                             f"{result.stderr.decode('utf-8', 'replace')}")
-    return result
+    return run_ok(args, cwd or SHARED["root"], ok)
 
 
 def temporaries(folder):
