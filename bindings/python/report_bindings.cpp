@@ -214,8 +214,18 @@ order: a list of dicts with ``name`` (its SI unit in it, as the library's DataFr
       "strokes) of their tidy tables. calligraphy.cohort.simulate wraps it.");
   m.def(
       "_propose_characters",
-      [](const py::list& roots, const std::string& subject, const std::string& candidates, std::size_t count,
+      [](const py::list& roots, const PyArgument<std::string>& subject_object,
+         const PyArgument<std::string>& candidates_object, const PyArgument<long long>& count_object,
          const CharacterSource& library) {
+        const std::string subject = take(subject_object, "subject");
+        const std::string candidates = take(candidates_object, "candidates");
+        // Refused as the command refuses --count and an empty --from.
+        const long long count = take(count_object, "count");
+        if (count < 1 || count > static_cast<long long>(kMaxProposedCharacters)) {
+          throw InvalidArgument("count: " + std::to_string(count) + " is outside 1.." +
+                                std::to_string(kMaxProposedCharacters));
+        }
+        if (candidates.empty()) throw InvalidArgument("candidates: give the characters to choose from");
         std::vector<std::filesystem::path> paths;
         for (const py::handle root : roots) {
           paths.push_back(
@@ -230,7 +240,7 @@ order: a list of dicts with ``name`` (its SI unit in it, as the library's DataFr
         py::list out;
         for (const ProposedCharacter& p :
              propose_characters(typical_stroke_record(tables, subject), written_characters(tables, subject),
-                                decode_utf8(candidates), count, typical_ids)) {
+                                decode_utf8(candidates), static_cast<std::size_t>(count), typical_ids)) {
           py::dict row;
           row["character"] = encode_utf8(p.character);
           row["new_strokes"] = p.new_strokes;

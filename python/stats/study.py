@@ -297,9 +297,11 @@ def propose_characters(paths: typing.Union[PathLike, typing.Sequence[PathLike]],
     (2 each) and that it writes worst (1 each: a mean deviation above the median of its typical strokes),
     ties to fewer strokes; characters it has written are not proposed (include/calligraphy/study/
     curriculum.hpp; the same as ``calligraphy curriculum``). Returns up to `count` dicts: character,
-    new_strokes and weak_strokes (typical-stroke IDs). library: a calligraphy.CharacterLibrary for the
-    candidates (default: the embedded characters). Raises InvalidArgument for a subject without saved
-    trials, CharacterNotFound for a candidate the library lacks, DataError for a damaged record."""
+    new_strokes and weak_strokes (typical-stroke IDs). count: 1..1000, as the command's --count. library: a
+    calligraphy.CharacterLibrary for the candidates (default: CharacterLibrary.default(), every
+    hanzi-writer-data character, as the command). Raises InvalidArgument for a subject without saved
+    trials, a count outside 1..1000, candidates empty or not Unicode text (a lone surrogate),
+    CharacterNotFound for a candidate the library lacks, DataError for a damaged record."""
     if library is None:
         library = _native.CharacterLibrary.default()
     return _native._propose_characters(_folder_paths(paths, "propose_characters"), subject, candidates, count,

@@ -99,7 +99,8 @@ void add_curriculum_command(CLI::App& root, Commands& commands) {
       ->type_name("DIR");
   required(add_text(*app, "--subject", command->subject, "ID", "the learner's subject id"));
   required(add_text(*app, "--from", command->candidates, "CHARS", "the characters to choose from (UTF-8)"));
-  add_integer(*app, "--count", command->count, "N", "characters to propose", 1, 1000);
+  add_integer(*app, "--count", command->count, "N", "characters to propose", 1,
+              static_cast<std::int64_t>(kMaxProposedCharacters));
   add_flag(*app, "--json", command->json, "print the proposal as JSON");
   add_library_options(*app, command->library, true);
 }

@@ -25,6 +25,9 @@ struct TypicalStrokeRecord {
 [[nodiscard]] std::vector<TypicalStrokeRecord> typical_stroke_record(const StudyTables& tables,
                                                                      const std::string& subject);
 
+/// The most characters one proposal of `calligraphy curriculum --count` or Python's propose_characters holds.
+inline constexpr std::size_t kMaxProposedCharacters = 1000;
+
 /// One character proposed, and why.
 struct ProposedCharacter {
   char32_t character = 0;
@@ -37,7 +40,8 @@ struct ProposedCharacter {
 /// of the learner's typical strokes) to what the characters chosen so far cover, ties to fewer strokes, then
 /// to the earlier candidate; candidates that add nothing are not proposed. A candidate the learner has
 /// written is not proposed. `typical_ids` gives a candidate's typical strokes, one per stroke. Throws what
-/// `typical_ids` throws.
+/// `typical_ids` throws. A `count` of 0 or no candidates propose nothing; the command and the Python module
+/// refuse both (count in 1..kMaxProposedCharacters).
 [[nodiscard]] std::vector<ProposedCharacter> propose_characters(
     const std::vector<TypicalStrokeRecord>& record, const std::u32string& written_characters,
     const std::u32string& candidates, std::size_t count,
