@@ -387,6 +387,32 @@ class Round21C(unittest.TestCase, OneErrorLine):
         blank = self.listed("--text", " \t\u3000\u00a0\u2029")
         self.assertEqual((blank["count"], blank["characters"], blank["not_found"]), (0, [], []))
 
+    def test_option_syntax_of_both_commands(self):
+        # docs/cli.md "Option syntax", "Numbers": a value option once, flags without a value, whole decimal
+        # numbers, no option where a value belongs, --data and --store not together.
+        base = ["curriculum", "sb", "--subject", "S01", "--from", "二"]
+        refused = [(base + ["--count", "2", "--count", "3"], "--count"),
+                   (base + ["--subject", "S02"], "--subject"),
+                   (base + ["--json=yes"], "--json"),
+                   (base + ["--count=0x10"], "--count"),
+                   (base + ["--count", "1e3"], "--count"),
+                   (["curriculum", "sb", "--subject", "S01", "--from", "-一"], "--from"),
+                   (base + ["--data", "sb", "--store", "x.bin"], "--store"),
+                   (["characters", "--strokes", "2", "--strokes", "3"], "--strokes"),
+                   (["characters", "--strokes", "+2"], "--strokes"),
+                   (["characters", "--text", "-一"], "--text"),
+                   (["characters", "--data", "sb", "--store", "x.bin"], "--store")]
+        for args, name in refused:
+            with self.subTest(args=args):
+                self.assert_one_error(run(args, self.tmp), 2, name)
+        self.assertEqual(self.proposal("sb", "S01", "大二", "--count=1", "--json=true"),
+                         self.proposal("sb", "S01", "大二", "--count", "1"))
+        self.assertEqual(self.listed("--typical=hzg", "--strokes=4")["characters"],
+                         self.listed("--typical", "10", "--strokes", "4")["characters"])
+        for args in (base + ["--store", "missing.bin"], ["characters", "--store", "missing.bin"]):
+            with self.subTest(args=args):
+                self.assert_one_error(run(args, self.tmp), 1, "missing.bin")
+
     def test_table_and_json_count_the_same(self):
         for args in (["--strokes", "3"], ["--typical", "HZG"], ["--text", "十一人口abc"]):
             with self.subTest(args=args):
