@@ -270,33 +270,39 @@ int run_sessions(const SessionRunCommand& command, DeviceRegistry& devices) {
   if (command.display.display == "window") trainer::register_trainer_devices(devices);  // mouse, mouse-hand
 #endif
   const LoadedProtocol protocol = load_study_protocol(command.protocol);
+  // Simulated subjects rule out a person before the device is looked at.
+  if (command.subjects > 0 && command.writer == kPersonWriter) {
+    throw UsageError("--subjects: simulated subjects need --writer simulated");
+  }
+  // What only the simulated writer takes, refused with a person writing.
+  const auto check_writer = [&](TrialWriter writer) {
+    const bool person = writer == TrialWriter::person;
+    if (person && command.learning_option->count() > 0 && command.writer_learning != "none") {
+      throw UsageError("--writer-learning models the simulated writer, not a person (--writer person)");
+    }
+    if (person && command.profile_option->count() > 0) {
+      throw UsageError("--writer-profile applies to the simulated writer, not to a person (--writer person)");
+    }
+    if (command.subjects > 0 && person) {
+      throw UsageError("--subjects: simulated subjects need --writer simulated");
+    }
+    return writer;
+  };
   const DeviceListing found_device = [&] {
     try {
       return find_cli_device(devices, "--device", command.device);
     } catch (const DeviceUnavailable&) {
       // The writer is checked against the kind of device, known whether or not the device can be used now:
-      // a pairing it cannot have is the usage error it is (exit 2) before a device that cannot be used (1).
+      // a pairing it cannot have, or an option a person's session does not take, is the usage error it is
+      // (exit 2) before a device that cannot be used (1).
       if (const std::optional<bool> simulated_hand = kind_moved_by_simulated_hand(devices, command.device))
-        (void)writer_for_device(command.writer, command.device, *simulated_hand);
+        (void)check_writer(writer_for_device(command.writer, command.device, *simulated_hand));
       throw;
     }
   }();
   const DeviceListing* device = &found_device;
-  // Simulated subjects rule out a person before the device is looked at.
-  if (command.subjects > 0 && command.writer == kPersonWriter) {
-    throw UsageError("--subjects: simulated subjects need --writer simulated");
-  }
-  const TrialWriter writer = writer_for_device(command.writer, *device);
+  const TrialWriter writer = check_writer(writer_for_device(command.writer, *device));
   const bool person = writer == TrialWriter::person;
-  if (person && command.learning_option->count() > 0 && command.writer_learning != "none") {
-    throw UsageError("--writer-learning models the simulated writer, not a person (--writer person)");
-  }
-  if (person && command.profile_option->count() > 0) {
-    throw UsageError("--writer-profile applies to the simulated writer, not to a person (--writer person)");
-  }
-  if (command.subjects > 0 && person) {
-    throw UsageError("--subjects: simulated subjects need --writer simulated");
-  }
   if (command.subjects == 0 && command.subject.empty()) {
     throw UsageError("--subject: required (or --subjects N with --writer simulated)");
   }

@@ -263,29 +263,37 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
       if (recorded) throw InputError(command.spec_file + ": /specification/trial/pacing: " + reason);
       throw UsageError("--pacing lock-step: " + reason + " (--pacing real-time or auto)");
     }
+    // A profile or its settings describe the simulated writer: with a person writing they would be ignored.
+    if (!simulated_writer && command.app->count("--writer-profile") > 0) {
+      throw UsageError("--writer-profile applies to the simulated writer, not to a person (--writer person)");
+    }
+    if (!simulated_writer && !spec.writer_parameters.empty()) {
+      throw UsageError("--writer-param applies to the simulated writer, not to a person (--writer person)");
+    }
     return simulated_writer;
   };
-  const DeviceListing device = [&] {
+  // --check needs only the kind of device, not the device: a trial stated for a device that cannot be used
+  // now (not plugged in on this computer) is still a valid statement.
+  bool simulated_hand = false;
+  const std::optional<DeviceListing> device = [&]() -> std::optional<DeviceListing> {
     try {
-      return find_cli_device(devices, recorded ? "" : "--device", spec.device);
+      DeviceListing found = find_cli_device(devices, recorded ? "" : "--device", spec.device);
+      simulated_hand = simulated_writer_moves(found);
+      return found;
     } catch (const DeviceUnavailable&) {
-      if (const std::optional<bool> simulated_hand = kind_moved_by_simulated_hand(devices, spec.device))
-        writer_on(*simulated_hand);
-      throw;
+      const std::optional<bool> kind = kind_moved_by_simulated_hand(devices, spec.device);
+      if (!kind) throw;
+      writer_on(*kind);
+      if (!command.check) throw;
+      simulated_hand = *kind;
+      return std::nullopt;
     } catch (const UsageError& e) {
       // A record's device is named as every bad value of it is (exit 2).
       if (recorded) throw InputError(command.spec_file + ": /specification/trial/device: " + e.what());
       throw;
     }
   }();
-  const bool simulated = writer_on(simulated_writer_moves(device));
-  // A profile or its settings describe the simulated writer: with a person writing they would be ignored.
-  if (!simulated && command.app->count("--writer-profile") > 0) {
-    throw UsageError("--writer-profile applies to the simulated writer, not to a person (--writer person)");
-  }
-  if (!simulated && !spec.writer_parameters.empty()) {
-    throw UsageError("--writer-param applies to the simulated writer, not to a person (--writer person)");
-  }
+  (void)writer_on(simulated_hand);
   // The simulated writer, its profile and settings checked here (a record's writer as it wrote).
   const auto writing = [&] {
     try {
@@ -296,8 +304,10 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
     }
   }();
   // Lock-step pacing has no wall clock, so no stall can be bounded: the option would be ignored.
-  const bool real_time = spec.pacing == TrialPacing::real_time ||
-                         (spec.pacing == TrialPacing::automatic && device.capabilities.hardware);
+  // A device of a person's kind is hardware, paced in real time (docs/cli.md, "trial": --pacing auto).
+  const bool hardware = device ? device->capabilities.hardware : !simulated_hand;
+  const bool real_time =
+      spec.pacing == TrialPacing::real_time || (spec.pacing == TrialPacing::automatic && hardware);
   if (command.app->count("--watchdog-ms") > 0 && !real_time) {
     throw UsageError(
         "--watchdog-ms applies to real-time pacing only (--pacing real-time, or a hardware device)");
@@ -370,7 +380,7 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
     throw DataError("--spec " + command.spec_file + ": " + e.what());  // e.g. other character data
   }
   TrialResult& result = run.result;
-  TrialDescription description = describe(spec, run, *writing, device);
+  TrialDescription description = describe(spec, run, *writing, *device);
   // The replay's teacher, bound to the record by the SHA-256 of the file read.
   const RecordedTrial ran = recorded_trial(spec, run, *writing, scene, teacher_sha256);
   description.specification_json = recorded_trial_json(ran);
