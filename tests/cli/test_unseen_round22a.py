@@ -64,6 +64,8 @@ The promises (docs/cli.md unless said; "status" is the exit status):
 | 47 | train | `--window`, `--quiz` with guidance, `--quiz-screenshots` missing, `--exit-after 0`: before any window | train |
 | 48 | characters, schema, trial | an unknown `--typical` names the close acronyms; an unknown document; a scene over 1,000 characters: 1 | characters; schema; Pen traces |
 | 49 | report | `--out` onto a session folder's file: 2 | report |
+| 50 | session run, report | a protocol edited under its name: 1 naming both SHA-256; report of two protocols of one name, or of one session twice: 1, nothing written | session run; report |
+| 51 | score | more than 10,000 pen-down segments: 1 at `TRACE:LINE` of the first one too many | Pen traces |
 
 CALLIGRAPHY_CLI names the program, PYTHONPATH its Python module. CALLIGRAPHY_SANITIZED=1 takes five cases.
 """
@@ -755,6 +757,39 @@ class Round22A(unittest.TestCase, OneErrorLine):
         for name in ("session.json", "log.jsonl"):
             with self.subTest(name=name):
                 self.refused(["report", "study", "--out", str(self.session / name)], 2, "--out", name)
+
+    def test_one_protocol_name_for_two_protocols_is_refused(self):
+        work = self.scratch("edited")
+        shutil.copytree(self.tmp / "study", work / "study", symlinks=True)
+        (work / "p.json").write_text(json.dumps(protocol("p", "一", 4)), encoding="utf-8")  # edited since
+        before = tree(work)
+        r = run(["session", "run", "p.json", "--subject", "S02", "--out", "study", *SIM], work)
+        self.assert_one_error(r, 1, "p.json", "'p'", self.session.name, "SHA-256")
+        self.assertEqual(r.stdout, b"")
+        self.assertEqual(tree(work), before)
+        # Its sessions run into another folder, then reported together with the first study's: nothing written.
+        run_ok(["session", "run", "p.json", "--subject", "S02", "--out", "other", *SIM], work)
+        shutil.copytree(work / "study", work / "again", symlinks=True)  # the same session twice
+        (work / "tables").mkdir()
+        for dirs, needles in ((["study", "other"], ["session.json", "SHA-256"]),
+                              (["study", "again"], ["S01", "twice"])):
+            with self.subTest(dirs=dirs):
+                before = tree(work)
+                r = run(["report", *dirs, "--csv", "tables", "--out", "r.html"], work)
+                self.assert_one_error(r, 1, *needles)
+                self.assertEqual(tree(work), before)
+
+    def test_a_trace_of_more_than_ten_thousand_segments_is_refused_at_its_line(self):
+        work = self.scratch("segments")
+        lines = ["t,x,y,pen"]
+        for i in range(10001):
+            lines += [f"{2 * i / 1000:.3f},0,0,1", f"{(2 * i + 1) / 1000:.3f},0,0,0"]
+        (work / "seg.csv").write_text("\n".join(lines) + "\n", encoding="utf-8")
+        before = tree(work)
+        r = run(["score", "seg.csv", "--character", "一", "--json", "s.json"], work)
+        self.assert_one_error(r, 1, "seg.csv:20002", "10000")
+        self.assertEqual(r.stdout, b"")
+        self.assertEqual(tree(work), before)
 
     # --- 45: Python -----------------------------------------------------------------------------------------
 
