@@ -120,6 +120,22 @@ TEST_CASE("a target that is not a regular file is written in place and checked",
   CHECK(folder.names().empty());
 }
 
+TEST_CASE("a pipe reached through /proc/self/fd, as /dev/stdout reaches one, is written in place",
+          "[atomic_file]") {
+  // The link /proc/self/fd/N of a pipe reads `pipe:[INODE]`, no file name: followed by hand it would name a
+  // missing file in /proc/self/fd, to be created there.
+  int ends[2] = {-1, -1};
+  REQUIRE(::pipe(ends) == 0);
+  const std::filesystem::path through = "/proc/self/fd/" + std::to_string(ends[1]);
+  CHECK(written_path(through) == through);
+  CHECK_NOTHROW(write_file_atomically(through, std::string_view("t,x\n")));
+  ::close(ends[1]);
+  char got[16] = {};
+  CHECK(::read(ends[0], got, sizeof got) == 4);
+  CHECK(std::string(got) == "t,x\n");
+  ::close(ends[0]);
+}
+
 TEST_CASE("write_file_exclusively creates a file whole and never replaces anything", "[atomic_file]") {
   TemporaryFolder folder;
   const fs::path target = folder.path / "identity.json";

@@ -653,6 +653,12 @@ void complete_interrupted_sets(const std::vector<SetFolder>& folders) {
 }  // namespace
 
 fs::path written_path(const fs::path& path) {
+  // What the kernel reaches through the path's links and is not a regular file (a device, a FIFO, or the
+  // pipe, socket or terminal behind /dev/stdout, whose /proc/self/fd link reads `pipe:[N]`, no file name) is
+  // written in place through the path itself: its links are not followed one by one into a name that is no
+  // file, where a dangling link's target would then be created.
+  struct stat reached {};
+  if (::stat(path.c_str(), &reached) == 0 && !S_ISREG(reached.st_mode)) return path;
   fs::path current = path;
   for (int links = 0; links <= 40; ++links) {
     struct stat status {};

@@ -43,7 +43,8 @@ void write_file_atomically(const std::filesystem::path& path, std::string_view c
 [[nodiscard]] bool write_file_exclusively(const std::filesystem::path& path, std::string_view content);
 
 /// The path a write to `path` replaces or creates: symbolic links followed one by one (a relative target
-/// read from the link's folder), a dangling link to the path it names, any other path as it is. Throws
+/// read from the link's folder), a dangling link to the path it names, any other path as it is; a path that
+/// reaches something other than a regular file (a device, a FIFO, /dev/stdout on a pipe) as it is. Throws
 /// DataError naming `path` when a link cannot be read or there are more than 40 links in a chain (ELOOP).
 [[nodiscard]] std::filesystem::path written_path(const std::filesystem::path& path);
 
