@@ -5,6 +5,7 @@
 // for it. The same for a field added to a struct's schema: `where to add` of docs/architecture.md.
 #include "calligraphy/analysis/metric_table.hpp"
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -136,6 +137,7 @@ TEST_CASE("every run-level metric has the renderer's value in a trial's record",
   run.max_force_n = 1.25;
   run.max_force_step_n = 0.5;
   run.state_transitions = 7;
+  run.readings_rejected = 4;
   std::set<std::string> seen;
   for (const MetricInfo& info : metric_table()) {
     const MetricValue value = report_detail::run_metric_value(info, run);
@@ -144,7 +146,11 @@ TEST_CASE("every run-level metric has the renderer's value in a trial's record",
     if (info.at(metric_level_run)) seen.emplace(info.name);
   }
   CHECK(seen == std::set<std::string>{"strokes_completed", "strokes_assisted", "trial_time_s", "max_force_n",
-                                      "max_force_step_n", "state_transitions"});
+                                      "max_force_step_n", "state_transitions", "readings_rejected"});
+  const auto rejected = std::find_if(metric_table().begin(), metric_table().end(),
+                                     [](const MetricInfo& info) { return info.name == "readings_rejected"; });
+  REQUIRE(rejected != metric_table().end());
+  CHECK(std::get<std::int64_t>(report_detail::run_metric_value(*rejected, run)) == 4);
 }
 
 // ---- where to add: a metric, a struct's field

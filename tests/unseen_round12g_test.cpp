@@ -758,6 +758,8 @@ TEST_CASE("unseen12g: step() on NaN, infinite and 1e304 m readings gives exactly
   }
   CHECK(std::isfinite(result.metrics.max_force_n));
   CHECK(std::isfinite(result.metrics.max_force_step_n));
+  // Each rejected reading counted, and only those: the denormal, -0 and edge readings were taken.
+  CHECK(result.metrics.readings_rejected == garbled.size() + 1);
 }
 
 TEST_CASE("unseen12g: a NaN, infinite or 1e308 device time stamp gives zero force and a finite trace",

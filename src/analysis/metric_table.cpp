@@ -350,6 +350,14 @@ const MetricInfo kMetrics[] = {
      .definition = "`TrialMetrics::state_transitions`",
      .source = "Wang, Zhang & Yao 2006",
      .levels = kRun},
+    {.name = "readings_rejected",
+     .kind = MetricKind::count,
+     .doc =
+         "ticks whose device reading was no pen (not finite, or beyond 10 m): zero force, the last accepted "
+         "position kept in the trace",
+     .definition = "`TrialMetrics::readings_rejected`: ticks with `RenderOutput::input_rejected`",
+     .levels = kRun,
+     .if_missing = MetricMissing::zero},
 };
 
 std::string_view kind_text(MetricKind kind) {

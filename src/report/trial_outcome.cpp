@@ -13,6 +13,7 @@ MetricValue run_metric_value(const MetricInfo& info, const TrialMetrics& m) {
   if (info.name == "max_force_n") return MetricValue(m.max_force_n);
   if (info.name == "max_force_step_n") return MetricValue(m.max_force_step_n);
   if (info.name == "state_transitions") return count(m.state_transitions);
+  if (info.name == "readings_rejected") return count(m.readings_rejected);
   return std::monostate{};
 }
 

@@ -130,6 +130,7 @@ void print_trial_table(const TrialDescription& d, const Scene& scene, const Tria
   std::printf("  state transitions          %zu\n", m.state_transitions);
   std::printf("  max |F|                    %.3f N\n", m.max_force_n);
   std::printf("  max per-tick |dF|          %.3f N\n", m.max_force_step_n);
+  if (m.readings_rejected > 0) std::printf("  readings rejected          %zu\n", m.readings_rejected);
   if (result.loop) print_loop_statistics(*result.loop);
   if (result.aborted) {
     std::printf("\n  ABORTED after %.3f s (%s)%s%s\n", m.time_s, to_string(result.end),

@@ -32,7 +32,11 @@ void TrialRecorder::record(const DeviceState& state, const RenderOutput& out) {
   const std::size_t index = ticks_++;
   // A reading the renderer rejected (not finite, or beyond any device's reach) is no position of the pen:
   // it is recorded at the last accepted one, and it is no tick of writing (no deviation is measured to it).
-  if (!out.input_rejected) last_position_ = state.position_m;
+  if (out.input_rejected) {
+    ++metrics_.readings_rejected;
+  } else {
+    last_position_ = state.position_m;
+  }
   if (keep_trace_) {
     trace_.push_back({state.time_s, last_position_, out.force_n, out.state, current_, out.element});
   }

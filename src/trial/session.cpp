@@ -91,6 +91,14 @@ TrialResult TrialSession::finish(TrialEnd end, std::string reason, double end_ti
   result.aborted = end != TrialEnd::completed;
   result.abort_reason = std::move(reason);
   result.device_time_at_start_s = device_origin_s_;
+  if (result.metrics.readings_rejected > 0) {
+    // Such ticks look like a pen held still with no force in the trace: say so once, after the loop.
+    calligraphy::detail::library_log().warn(
+        "trial: {} of {} device readings were no pen (not finite, or beyond 10 m) and were rejected: zero "
+        "force "
+        "on those ticks, the last accepted position kept (readings_rejected)",
+        result.metrics.readings_rejected, ticks_);
+  }
   if (ticks_ >= 2 && last_time_s_ > 0.0) {
     result.device_tick_rate_hz = static_cast<double>(ticks_ - 1) / last_time_s_;
     const double ratio = result.device_tick_rate_hz / options_.rate_hz;

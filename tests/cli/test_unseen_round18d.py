@@ -267,6 +267,8 @@ class Round18D(unittest.TestCase):
         self.assertEqual(positions, {("-0.01", "0", "-0.004")})  # the last accepted reading, never the garbled
         steps = np.linalg.norm(np.diff(f, axis=0), axis=1)
         self.assertAlmostEqual(record["max_force_step_n"], steps.max(), delta=2e-4)  # the step to zero counted
+        # and the record counts those ticks: a run of zero force at a held position is no pen held still
+        self.assertEqual(record["readings_rejected"], longest[1] - longest[0])
 
     # ---- the command line on the stand-in, its hand garbled -----------------------------------------------
     def garbled(self, value):

@@ -68,6 +68,10 @@ struct TrialMetrics {
   double max_force_n = 0.0;               ///< max |F| commanded
   double max_force_step_n = 0.0;          ///< max |F(k) - F(k-1)| between consecutive ticks
   std::size_t state_transitions = 0;
+  /// Ticks whose device reading the renderer rejected (`RenderOutput::input_rejected`: not finite, or a
+  /// coordinate beyond kMaxDeviceReadingM): each commanded zero force and is kept at the last accepted
+  /// position, so the trace alone cannot show them.
+  std::size_t readings_rejected = 0;
   std::vector<StrokeMetrics> per_stroke;
 };
 
