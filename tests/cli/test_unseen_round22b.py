@@ -194,6 +194,18 @@ class Round22B(unittest.TestCase, OneErrorLine):
         self.assertEqual({r["protocol"] for r in got}, {"life"})
         self.assertEqual([r for r in got if r["subject"] != "S03"], rows(self.tables["A"][1]))
 
+    def test_protocol_moved_and_renamed_unchanged_is_the_same_design(self):
+        # The same bytes from another folder under another file name: the same SHA-256, so the same design.
+        w = self.case()
+        (w / "protocols").mkdir()
+        (w / "p.json").rename(w / "protocols" / "life-2026.json")
+        run_ok(["session", "run", "protocols/life-2026.json", "--subjects", "1", "--new-subjects", "--out", "A",
+                *SIM], w)
+        _, trials, _ = self.report_csv(w, "A")
+        got = rows(trials)
+        self.assertEqual([r["subject"] for r in got], ["S01", "S01", "S02", "S02", "S03", "S03"])
+        self.assertEqual({r["protocol"] for r in got}, {"life"})
+
     def test_new_version_under_a_new_name_is_reported_apart(self):
         w = self.case()
         write_json(w / "p5.json", protocol(name="life-v2", stiffness=150.0, characters=("一", "十")))
@@ -372,6 +384,22 @@ class Round22B(unittest.TestCase, OneErrorLine):
         got = rows(trials)
         self.assertEqual(len(got), 4)
         self.assertEqual({r["subject"] for r in got if r["session"] == s.name}, {"S01"})
+
+    def test_session_given_as_dot_or_through_a_link_is_read_as_its_studys(self):
+        # "a session folder may be given by any name that reaches it": its study is the folder it lies in.
+        w = self.case()
+        s = self.session_of(w / "A", "S01")
+        expect = [r for r in rows(self.tables["A"][1]) if r["subject"] == "S01"]
+        for r in expect:
+            r.pop("trace_file")
+        (w / "elsewhere").mkdir()
+        (w / "elsewhere" / "link").symlink_to(s)
+        for cwd, name in ((s, "."), (w / "elsewhere", "link"), (w / "elsewhere", "link/")):
+            _, trials, _ = self.report_csv(cwd, name)
+            got = rows(trials)
+            for r in got:
+                r.pop("trace_file")
+            self.assertEqual(got, expect, name)
 
     # --- two machines ------------------------------------------------------------------------------------------
 
