@@ -137,11 +137,15 @@ class Round22B(unittest.TestCase, OneErrorLine):
             assert os.listdir(out) == [], os.listdir(out)
         return (result, *texts)
 
-    def case(self):
-        """A copy of the pristine folder (studies, protocols) for one case."""
+    def case(self, *studies):
+        """A copy of the pristine folder's protocols and of the studies named (A when none) for one case."""
         Round22B.count += 1
         where = self.tmp / f"case{Round22B.count}"
-        shutil.copytree(self.pristine, where, symlinks=True)
+        for protocol_file in ("p.json", "days.json", "mb/p.json", "amended/p.json"):
+            (where / protocol_file).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(self.pristine / protocol_file, where / protocol_file)
+        for study in studies or ("A",):
+            shutil.copytree(self.pristine / study, where / study, symlinks=True)
         return where
 
     def session_of(self, study, subject):
@@ -223,7 +227,7 @@ class Round22B(unittest.TestCase, OneErrorLine):
             self.assertEqual(data["protocol"]["sha256"], v2_sha if data["subject"] == "V01" else v1_sha, rec)
 
     def test_report_of_two_versions_of_one_name_is_refused_naming_both(self):
-        w = self.case()
+        w = self.case("A", "C")
         before = tree(w)
         (r, trials, strokes) = self.report_csv(w, "A", "C", ok=False)
         line = self.assert_one_error(r, 1, sha256(w / "p.json"), sha256(w / "amended" / "p.json"))
@@ -240,7 +244,7 @@ class Round22B(unittest.TestCase, OneErrorLine):
     def test_study_load_of_two_versions_of_one_name_is_refused(self):
         import calligraphy
         import calligraphy.study
-        w = self.case()
+        w = self.case("A", "C")
         with self.assertRaises(calligraphy.DataError) as caught:
             calligraphy.study.load([str(w / "A"), str(w / "C")])
         message = str(caught.exception)
@@ -289,7 +293,7 @@ class Round22B(unittest.TestCase, OneErrorLine):
         self.assertEqual(self.report_csv(w, "A")[1:], self.tables["A"][1:])
 
     def test_day_one_deleted_stops_the_series_naming_what_to_put_back(self):
-        w = self.case()
+        w = self.case("D")
         day1, day2 = sessions(w / "D", "S01")
         shutil.rmtree(day1)
         before = tree(w / "D")
@@ -303,7 +307,7 @@ class Round22B(unittest.TestCase, OneErrorLine):
                              [(day2.name, "2", "retention")])
 
     def test_day_two_deleted_is_written_again_after_day_one(self):
-        w = self.case()
+        w = self.case("D")
         day1, day2 = sessions(w / "D", "S01")
         shutil.rmtree(day2)
         run_ok(["session", "run", "days.json", "--subject", "S01", "--out", "D", *SIM], w)
@@ -365,7 +369,7 @@ class Round22B(unittest.TestCase, OneErrorLine):
         self.assert_one_error(result, 1, s.name + "-renamed", "/session")
 
     def test_session_moved_into_another_study_is_refused_naming_study_id(self):
-        w = self.case()
+        w = self.case("A", "B")
         s = self.session_of(w / "A", "S02")
         (w / "B" / "S02").mkdir()
         s.rename(w / "B" / "S02" / s.name)
@@ -404,7 +408,7 @@ class Round22B(unittest.TestCase, OneErrorLine):
     # --- two machines ------------------------------------------------------------------------------------------
 
     def test_two_machines_with_the_same_subject_ids_are_refused_naming_subject_and_both(self):
-        w = self.case()
+        w = self.case("A", "Bs")
         before = tree(w)
         result, _, _ = self.report_csv(w, "A", "Bs", ok=False)
         line = self.assert_one_error(result, 1, "S01")
@@ -413,7 +417,7 @@ class Round22B(unittest.TestCase, OneErrorLine):
         self.assertEqual(tree(w), before)
 
     def test_two_machines_with_other_prefixes_count_every_trial_once(self):
-        w = self.case()
+        w = self.case("A", "B")
         before = tree(w)
         _, trials, strokes = self.report_csv(w, "A", "B")
         _, trials2, strokes2 = self.report_csv(w, "B", "A")
@@ -424,7 +428,7 @@ class Round22B(unittest.TestCase, OneErrorLine):
         self.assertEqual(tree(w), before)
 
     def test_session_copied_in_from_the_other_machine_is_refused_naming_study_id(self):
-        w = self.case()
+        w = self.case("A", "B")
         shutil.copytree(w / "B" / "T01", w / "A" / "T01")
         copied = self.session_of(w / "A", "T01")
         result, _, _ = self.report_csv(w, "A", ok=False)
@@ -433,7 +437,7 @@ class Round22B(unittest.TestCase, OneErrorLine):
 
     def test_whole_other_study_copied_over_the_identity_is_refused(self):
         # `cp -r B/. A/`: the other machine's identity replaces this one's; A's own sessions are then strangers.
-        w = self.case()
+        w = self.case("A", "B")
         subprocess.run(["cp", "-r", f"{w / 'B'}/.", str(w / "A")], check=True)
         self.assertEqual(sha256(w / "A" / ".calligraphy-study.json"), sha256(w / "B" / ".calligraphy-study.json"))
         result, _, _ = self.report_csv(w, "A", ok=False)
@@ -441,7 +445,7 @@ class Round22B(unittest.TestCase, OneErrorLine):
         self.assertTrue("S01" in line or "S02" in line, line)
 
     def test_same_subject_from_the_other_machine_copied_beside_it_is_refused(self):
-        w = self.case()
+        w = self.case("A", "Bs")
         theirs = self.session_of(w / "Bs", "S01")
         shutil.copytree(theirs, w / "A" / "S01" / theirs.name)
         result, _, _ = self.report_csv(w, "A", ok=False)
@@ -451,7 +455,7 @@ class Round22B(unittest.TestCase, OneErrorLine):
 
     def test_study_load_of_two_machines_is_the_report(self):
         import calligraphy.study
-        w = self.case()
+        w = self.case("A", "B")
         study = calligraphy.study.load([str(w / "B"), str(w / "A")])
         _, trials, _ = self.report_csv(w, str(w / "A"), str(w / "B"))
         expect = rows(trials)
@@ -549,7 +553,7 @@ class Round22B(unittest.TestCase, OneErrorLine):
 
     def test_session_copied_into_a_study_made_before_identities_is_refused(self):
         # A study folder of an earlier build (no identity file, no study_id) and a session of this one copied in.
-        w = self.case()
+        w = self.case("A", "B")
         (w / "B" / ".calligraphy-study.json").unlink()
         for manifest in (w / "B").rglob("session.json"):
             doc = json.loads(manifest.read_text(encoding="utf-8"))
@@ -594,7 +598,7 @@ class Round22B(unittest.TestCase, OneErrorLine):
         self.assertIn("twice", line)
 
     def test_days_protocol_amended_before_the_second_day_is_refused_naming_the_first(self):
-        w = self.case()
+        w = self.case("D")
         day1, day2 = sessions(w / "D", "S01")
         shutil.rmtree(day2)
         amended = json.loads(json.dumps(DAYS))
@@ -607,7 +611,7 @@ class Round22B(unittest.TestCase, OneErrorLine):
         self.assertEqual(tree(w / "D"), before)
 
     def test_two_machines_pages_index_every_session_once(self):
-        w = self.case()
+        w = self.case("A", "B")
         before = tree(w)
         run_ok(["report", "A", "B", "--out", "pages.html"], w)
         index = (w / "pages.html").read_text(encoding="utf-8")
