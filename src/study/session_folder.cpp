@@ -431,7 +431,16 @@ std::string StudyIdentity::obtain(const fs::path& root) {
 
 void StudyIdentity::check(const std::optional<std::string>& root_id, const fs::path& root,
                           const fs::path& folder, const SessionManifest& manifest) {
-  if (!root_id || manifest.study_id.empty() || manifest.study_id == *root_id) return;
+  if (manifest.study_id.empty() || manifest.study_id == root_id) return;
+  if (!root_id) {
+    // Its study folder made an identity with its first session and this folder has none: the session came
+    // from elsewhere (into a folder made before identities, or one copied without its hidden file).
+    json_detail::fail(SessionLayout::manifest(folder).string(), "/study_id",
+                      "this session belongs to study " + manifest.study_id + ", but " + root.string() +
+                          " has no study identity (" + (root / kFileName).string() +
+                          "): copied in from another study folder? move it back to the study it was run in, "
+                          "or restore that file");
+  }
   json_detail::fail(SessionLayout::manifest(folder).string(), "/study_id",
                     "this session belongs to study " + manifest.study_id + ", not to the study of " +
                         root.string() + " (" + *root_id + ", " + (root / kFileName).string() +

@@ -302,27 +302,17 @@ StudyReportSessions list_report_sessions(const std::vector<fs::path>& roots) {
   // Each subject's session of each number of each protocol, so that a session run twice (two folders of one
   // subject's session 1) is refused rather than pooled as one subject's trials.
   std::map<std::string, fs::path> by_session;
-  // Each study folder's identity (ROOT of ROOT/SUBJECT/SESSION), and without one the first session's id
-  // found there: a session copied in from another study folder is not pooled with this study's.
-  std::map<fs::path, std::pair<std::optional<std::string>, fs::path>> studies;
+  // Each study folder's identity (ROOT of ROOT/SUBJECT/SESSION): a session copied in from another study
+  // folder is not pooled with this study's.
+  std::map<fs::path, std::optional<std::string>> studies;
   for (const fs::path& folder : folders) {
     SessionManifest manifest = study_detail::read_session_manifest(folder);
     if (!distinct.add(folder, manifest)) continue;
-    const fs::path root = folder.parent_path().parent_path();
+    // The study folder the session lies in, by its own name (a session given as `.` or through a link).
+    const fs::path root = study_detail::named_folder(folder).parent_path().parent_path();
     auto study = studies.find(root);
-    if (study == studies.end())
-      study = studies.emplace(root, std::pair{StudyIdentity::read(root), fs::path()}).first;
-    auto& [study_id, first_with_id] = study->second;
-    if (!study_id && !manifest.study_id.empty()) {
-      study_id = manifest.study_id;
-      first_with_id = folder;
-    } else if (!first_with_id.empty() && !manifest.study_id.empty() && manifest.study_id != *study_id) {
-      json_detail::fail(SessionLayout::manifest(folder).string(), "/study_id",
-                        "this session belongs to study " + manifest.study_id + ", but " +
-                            first_with_id.string() + " beside it to study " + *study_id +
-                            ": sessions of two studies in one study folder would be pooled as one; move the "
-                            "copied one back to the study it was run in");
-    }
+    if (study == studies.end()) study = studies.emplace(root, StudyIdentity::read(root)).first;
+    const std::optional<std::string>& study_id = study->second;
     StudyIdentity::check(study_id, root, folder, manifest);
     // The trainer's free practice saves a session 1 on every run: those are not one design's sessions.
     if (manifest.protocol.path != "calligraphy-train") {

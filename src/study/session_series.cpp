@@ -105,15 +105,6 @@ SessionSeries session_series(const fs::path& root, const std::string& subject_id
     for (const fs::path& folder : find_session_folders(subject_folder)) {
       SessionManifest manifest = study_detail::read_session_manifest(folder);
       if (manifest.protocol.sha256 != protocol.sha256) continue;
-      if (!study_id && !manifest.study_id.empty()) {
-        // Its study folder made an identity with its first session: this one has none, so the session
-        // came from elsewhere (or the identity was removed); the next session would take a new one.
-        json_detail::fail((SessionLayout::manifest(folder)).string(), "/study_id",
-                          "this session belongs to study " + manifest.study_id + ", but " + root.string() +
-                              " has no study identity (" + (root / StudyIdentity::kFileName).string() +
-                              "): copied in from another study folder? move it back to the study it was run "
-                              "in, or restore that file");
-      }
       StudyIdentity::check(study_id, root, folder, manifest);
       if (manifest.setup.subject.id != subject_id) {
         json_detail::fail((SessionLayout::manifest(folder)).string(), "/subject/id",

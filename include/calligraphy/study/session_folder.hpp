@@ -143,9 +143,10 @@ struct StudyIdentity {
   /// DataError as `read`, and naming the file when it cannot be written.
   [[nodiscard]] static std::string obtain(const std::filesystem::path& root);
   /// Refuses the session in `folder` (its session.json read as `manifest`) when it names another study than
-  /// `root_id`, the id of the study folder it lies in: copied in from another study folder. A session
-  /// without an id (made before studies had one) and a folder without one are accepted. Throws DataError
-  /// naming the session.json, its /study_id and both ids.
+  /// `root_id`, the id of the study folder it lies in: copied in from another study folder; also when it
+  /// names one and the folder has none (copied into a folder made before identities, or the folder's
+  /// identity file lost). A session without an id (made before studies had one) is accepted. Throws
+  /// DataError naming the session.json, its /study_id and the ids, or the missing identity file.
   static void check(const std::optional<std::string>& root_id, const std::filesystem::path& root,
                     const std::filesystem::path& folder, const SessionManifest& manifest);
 };
