@@ -167,6 +167,28 @@ class Round23A(unittest.TestCase, OneErrorLine):
         self.assert_one_error(result, 1, path.name, "'x'", "outside")
         self.assertEqual(result.stdout, b"")
 
+    def test_time_and_stroke_columns_outside_the_file_are_refused_naming_each(self):
+        # The time column (read first, for the samples) in external storage beside the trace, and `stroke` (an
+        # integer column of the scene's indices) an external link to a file beside it.
+        d = self.folder()
+        (d / "t.bin").write_bytes(np.asarray(self.data["t"][0], dtype="<i4").tobytes())
+        with h5py.File(d / "outside.h5", "w") as g:
+            g.create_dataset("stroke", data=self.data["stroke"][0])
+
+        def time_outside(f, name, data, dtype):
+            if name == "t":
+                return f.create_dataset("t", shape=data.shape, dtype=dtype,
+                                        external=[("t.bin", 0, len(data) * 4)])
+            return None
+
+        def stroke_outside(f, name, data, dtype):
+            if name == "stroke":
+                f["stroke"] = h5py.ExternalLink("outside.h5", "/stroke")
+                return False
+            return None
+        self.assert_refused(self.build(d / "t.trace.h5", time_outside), "'t'", "outside")
+        self.assert_refused(self.build(d / "s.trace.h5", stroke_outside), "'stroke'", "outside")
+
     def test_external_raw_storage_naming_etc_passwd_reads_nothing_of_it(self):
         d = self.folder()
         size = min(os.path.getsize("/etc/passwd"), self.n * 4) // 4 * 4
