@@ -339,6 +339,20 @@ Handle open_column(hid_t file, const char* name, const std::string& source) {
     refuse(source, column + " keeps its values in HDF5 external storage, outside the trace file (which " +
                        "its CRC-32 and SHA-256 do not cover)");
   }
+  // Samples never written read as the fill value, which HDF5 leaves undefined (the reader's buffer as it was)
+  // when the dataset has none or is never to be filled: such a column holds no values to read.
+  H5D_fill_time_t fill_time = H5D_FILL_TIME_IFSET;
+  H5D_fill_value_t fill_value = H5D_FILL_VALUE_DEFAULT;
+  H5D_space_status_t allocated = H5D_SPACE_STATUS_ERROR;
+  if (H5Pget_fill_time(create.get(), &fill_time) < 0 ||
+      H5Pfill_value_defined(create.get(), &fill_value) < 0 ||
+      H5Dget_space_status(dataset.get(), &allocated) < 0)
+    refuse(source, column + " cannot be read (damaged)");
+  if ((fill_time == H5D_FILL_TIME_NEVER || fill_value == H5D_FILL_VALUE_UNDEFINED) &&
+      allocated != H5D_SPACE_STATUS_ALLOCATED) {
+    refuse(source, column + " has samples that were never written and that HDF5 does not fill (their " +
+                       "values are undefined)");
+  }
   // Another program's filters are read through HDF5's pipeline; one this HDF5 lacks is named by its number
   // (its name is the file's text), not reported as damage.
   const int filters = H5Pget_nfilters(create.get());

@@ -73,7 +73,8 @@ enum class TraceColumnSet {
 /// newer version, more than kMaxTraceSamples samples (or more than its bytes could hold), a missing or
 /// mistyped column, columns of different lengths, a column whose values are outside the file (an external
 /// link, a virtual dataset, HDF5 external storage: no other file is opened) or stored through a filter this
-/// HDF5 lacks, a non-finite time or position, a state beyond WS, a `rewritten` beyond 1.
+/// HDF5 lacks, samples never written that HDF5 does not fill (undefined), a non-finite time or position, a
+/// state beyond WS, a `rewritten` beyond 1.
 [[nodiscard]] TraceColumns read_trace_hdf5(const std::filesystem::path& file,
                                            std::uintmax_t max_file_bytes = std::uintmax_t{256} << 20,
                                            TraceColumnSet columns = TraceColumnSet::all);
