@@ -524,6 +524,46 @@ class Round23A(unittest.TestCase, OneErrorLine):
         self.assertEqual(result.returncode, 0, result.stderr)
         self.assertEqual(self.x_column(result.stdout), [0.1234567] * self.n)
 
+    def test_chunks_never_written_in_the_librarys_own_filters_read_as_h5py_reads_them(self):
+        # The layout the library writes (chunks, shuffle, deflate) with only the first chunk of `x` written: the
+        # others were never stored, and read as the fill value, by h5py and by the program alike.
+        d = self.folder()
+
+        def column(f, name, data, dtype):
+            if name == "x":
+                made = f.create_dataset("x", shape=data.shape, dtype=dtype, chunks=(100,), compression="gzip",
+                                        shuffle=True, fillvalue=7654321)
+                made[:100] = data[:100]
+                return made
+            return None
+        path = self.build(d / "fc.trace.h5", column)
+        result = self.trace(path)
+        self.assertEqual(result.returncode, 0, result.stderr)
+        expected = [float(f"{v / 1e7:.7f}") for v in self.data["x"][0][:100]] + [0.7654321] * (self.n - 100)
+        self.assertEqual(self.x_column(result.stdout), expected)
+
+    def test_chunks_never_written_and_never_filled_are_refused(self):
+        # Fill time "never": the chunks of `x` after its first were never written and HDF5 leaves their values
+        # undefined (a reader's buffer as it was: h5py's read_direct and [()] differ). In the library's own
+        # filters and unfiltered, refused naming the column rather than read as some value.
+        d = self.folder()
+        for filtered in (True, False):
+            def column(f, name, data, dtype):
+                if name != "x":
+                    return None
+                dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
+                dcpl.set_chunk((100,))
+                dcpl.set_fill_time(h5py.h5d.FILL_TIME_NEVER)
+                if filtered:
+                    dcpl.set_shuffle()
+                    dcpl.set_deflate(6)
+                made = h5py.Dataset(h5py.h5d.create(f.id, b"x", h5py.h5t.STD_I32LE,
+                                                    h5py.h5s.create_simple((len(data),)), dcpl=dcpl))
+                made[:100] = data[:100]
+                return made
+            path = self.build(d / f"nf{int(filtered)}.trace.h5", column)
+            self.assert_refused(path, "'x'", "never written")
+
     def test_compact_and_contiguous_storage_read_as_the_programs_own(self):
         d = self.folder()
 
