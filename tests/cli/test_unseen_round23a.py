@@ -640,6 +640,26 @@ class Round23A(unittest.TestCase, OneErrorLine):
             return made
         self.assert_refused(self.build(d / "rf.trace.h5", self.typed("x", make)), "'x'")
 
+    def test_a_big_endian_column_reads_as_h5py_reads_it_or_is_refused_naming_it(self):
+        # `x` as big-endian int32 (what h5py writes for numpy's '>i4'): the same values to h5py; read as them
+        # or refused naming the column, never read byte-swapped.
+        d = self.folder()
+
+        def make(f, data):
+            return f.create_dataset("x", data=data.astype(">i4"), dtype=">i4", chunks=(len(data),))
+        path = self.build(d / "be.trace.h5", self.typed("x", make))
+        result = self.trace(path)
+        if result.returncode == 0:
+            self.assertEqual(result.stdout, self.csv)
+        else:
+            self.assert_one_error(result, 1, path.name, "'x'")
+
+    def test_an_empty_dataspace_column_is_refused_naming_it(self):
+        # `x` with HDF5's null dataspace (no elements, not even zero of them: h5py.Empty).
+        d = self.folder()
+        empty = self.typed("x", lambda f, data: f.create_dataset("x", data=h5py.Empty("<i4")))
+        self.assert_refused(self.build(d / "em.trace.h5", empty), "'x'")
+
     # --- 5. another tool's whole file -----------------------------------------------------------------------
 
     def test_a_user_block_of_1024_bytes_is_read_or_refused_in_one_line(self):
