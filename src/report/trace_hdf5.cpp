@@ -300,11 +300,81 @@ void check_user_block(std::string_view bytes, const std::string& source) {
   if (crc32_of(rest) != crc) refuse(source, "damaged (its CRC-32 does not match its contents)");
 }
 
+// HDF5 calls this before it follows an external link (to a dataset in another file): refused, and noted, so
+// that no file but the trace is ever opened (a path the link names may be a FIFO, which open(2) waits on).
+herr_t refuse_external_link(const char* /*parent_file*/, const char* /*parent_group*/,
+                            const char* /*child_file*/, const char* /*child_object*/,
+                            unsigned* /*access_flags*/, hid_t /*access*/, void* refused) {
+  *static_cast<bool*>(refused) = true;
+  return -1;
+}
+
+// The dataset `name` of a trace file, opened so that its values come from the file's own bytes, which the
+// header's CRC-32 and a record's SHA-256 cover: a column that is an external link (or a soft link reaching
+// one), a virtual dataset (its values mapped from other files) or kept in HDF5's external storage (raw bytes
+// in files named by the dataset) is refused naming it, before HDF5 opens anything else. A link inside the
+// file (hard or soft) is the dataset it names, as every HDF5 reader reads it. Refuses a missing column.
+Handle open_column(hid_t file, const char* name, const std::string& source) {
+  const std::string column = std::string("column '") + name + "'";
+  if (H5Lexists(file, name, H5P_DEFAULT) <= 0) refuse(source, "no " + column);
+  H5L_info_t link{};
+  if (H5Lget_info(file, name, &link, H5P_DEFAULT) < 0) refuse(source, "no " + column);
+  bool external_link = link.type == H5L_TYPE_EXTERNAL;
+  Handle access(H5Pcreate(H5P_DATASET_ACCESS), H5Pclose);
+  if (!access.ok() || H5Pset_elink_cb(access.get(), refuse_external_link, &external_link) < 0)
+    refuse(source, "HDF5 cannot open " + column + " (out of memory?)");
+  Handle dataset(external_link ? H5I_INVALID_HID : H5Dopen2(file, name, access.get()), H5Dclose);
+  if (external_link) {
+    refuse(source, column + " is a link to a dataset in another file, outside the trace file (whose CRC-32 " +
+                       "and SHA-256 do not cover it)");
+  }
+  if (!dataset.ok()) refuse(source, column + " is not a dataset");
+  Handle create(H5Dget_create_plist(dataset.get()), H5Pclose);
+  if (!create.ok()) refuse(source, column + " cannot be read (damaged)");
+  if (H5Pget_layout(create.get()) == H5D_VIRTUAL) {
+    refuse(source, column + " is a virtual dataset, its values mapped from outside the trace file (which " +
+                       "its CRC-32 and SHA-256 do not cover)");
+  }
+  if (H5Pget_external_count(create.get()) != 0) {
+    refuse(source, column + " keeps its values in HDF5 external storage, outside the trace file (which " +
+                       "its CRC-32 and SHA-256 do not cover)");
+  }
+  // Samples never written read as the fill value, which HDF5 leaves undefined (the reader's buffer as it was)
+  // when the dataset has none or is never to be filled: such a column holds no values to read.
+  H5D_fill_time_t fill_time = H5D_FILL_TIME_IFSET;
+  H5D_fill_value_t fill_value = H5D_FILL_VALUE_DEFAULT;
+  H5D_space_status_t allocated = H5D_SPACE_STATUS_ERROR;
+  if (H5Pget_fill_time(create.get(), &fill_time) < 0 ||
+      H5Pfill_value_defined(create.get(), &fill_value) < 0 ||
+      H5Dget_space_status(dataset.get(), &allocated) < 0)
+    refuse(source, column + " cannot be read (damaged)");
+  if ((fill_time == H5D_FILL_TIME_NEVER || fill_value == H5D_FILL_VALUE_UNDEFINED) &&
+      allocated != H5D_SPACE_STATUS_ALLOCATED) {
+    refuse(source, column + " has samples that were never written and that HDF5 does not fill (their " +
+                       "values are undefined)");
+  }
+  // Another program's filters are read through HDF5's pipeline; one this HDF5 lacks is named by its number
+  // (its name is the file's text), not reported as damage.
+  const int filters = H5Pget_nfilters(create.get());
+  for (int i = 0; i < filters; ++i) {
+    unsigned flags = 0;
+    std::size_t values = 0;
+    unsigned int filter_info = 0;
+    const H5Z_filter_t filter = H5Pget_filter2(create.get(), static_cast<unsigned>(i), &flags, &values,
+                                               nullptr, 0, nullptr, &filter_info);
+    if (filter < 0) refuse(source, column + " cannot be read (damaged)");
+    if (H5Zfilter_avail(filter) <= 0) {
+      refuse(source, column + " is stored through HDF5 filter " + std::to_string(filter) +
+                         ", which this program's HDF5 does not have");
+    }
+  }
+  return dataset;
+}
+
 // The length of the one-dimensional dataset `name`, at most 2^40 (a damaged size is refused, never
 // allocated).
 std::size_t dataset_length(hid_t file, const char* name, const std::string& source) {
-  Handle dataset(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose);
-  if (!dataset.ok()) refuse(source, std::string("no column '") + name + "'");
+  Handle dataset = open_column(file, name, source);
   Handle space(H5Dget_space(dataset.get()), H5Sclose);
   hsize_t dims[1] = {0};
   if (!space.ok() || H5Sget_simple_extent_ndims(space.get()) != 1 ||
@@ -535,11 +605,7 @@ class TraceFileReader {
   // A dataset of `samples_` elements stored as one of `types` exactly: only the types this library writes are
   // read, so HDF5 never converts from a type a damaged file describes.
   Handle open(const char* name, std::initializer_list<hid_t> types) const {
-    Handle dataset(H5Dopen2(file_, name, H5P_DEFAULT), H5Dclose);
-    if (!dataset.ok()) {
-      if (H5Lexists(file_, name, H5P_DEFAULT) <= 0) refuse(source_, std::string("no column '") + name + "'");
-      refuse(source_, std::string("column '") + name + "' is not a dataset");
-    }
+    Handle dataset = open_column(file_, name, source_);
     Handle space(H5Dget_space(dataset.get()), H5Sclose);
     hsize_t dims[1] = {0};
     if (!space.ok() || H5Sget_simple_extent_ndims(space.get()) != 1 ||

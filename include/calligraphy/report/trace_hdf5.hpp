@@ -71,8 +71,10 @@ enum class TraceColumnSet {
 /// Reads every column of a trace file. Refuses, with DataError naming `file`: a missing file, one over
 /// `max_file_bytes`, one that is not a calligraphy trace, a damaged or cut file (its CRC-32 or length), a
 /// newer version, more than kMaxTraceSamples samples (or more than its bytes could hold), a missing or
-/// mistyped column, columns of different lengths, a non-finite time or
-/// position, a state beyond WS, a `rewritten` beyond 1.
+/// mistyped column, columns of different lengths, a column whose values are outside the file (an external
+/// link, a virtual dataset, HDF5 external storage: no other file is opened) or stored through a filter this
+/// HDF5 lacks, samples never written that HDF5 does not fill (undefined), a non-finite time or position, a
+/// state beyond WS, a `rewritten` beyond 1.
 [[nodiscard]] TraceColumns read_trace_hdf5(const std::filesystem::path& file,
                                            std::uintmax_t max_file_bytes = std::uintmax_t{256} << 20,
                                            TraceColumnSet columns = TraceColumnSet::all);
