@@ -505,6 +505,14 @@ class VocabularyTest(unittest.TestCase):
             for spelling in prop["enum"]:
                 context, refusals = self.context_for([option, spelling])
                 runs = context is not None
+                path = self.cwd / "spelling.json"
+                if runs:
+                    path.unlink(missing_ok=True)
+                    ran = self.run_cli("trial", CHARS, *context[0], option, spelling, "--max-duration",
+                                       _number_text(SHORT_S), "--json", path.name)
+                    if not path.exists() and ran.returncode == 1 and b"cannot be used now" in ran.stderr:
+                        # `trial --check` needs only the device's kind: a person's device is not attached here.
+                        runs, context = False, None
                 if context is None:
                     # No trial here takes it (a person needs a hardware device that is not attached): the
                     # option still knows the spelling, and a record states it.
@@ -527,10 +535,6 @@ class VocabularyTest(unittest.TestCase):
                 record = self.record_in(self.contexts[0])
                 record["specification"]["trial"][key] = spelling
                 if runs:
-                    path = self.cwd / "spelling.json"
-                    path.unlink(missing_ok=True)
-                    ran = self.run_cli("trial", CHARS, *context[0], option, spelling, "--max-duration",
-                                       _number_text(SHORT_S), "--json", path.name)
                     self.assertTrue(path.exists(), f"{option} {spelling}: exit {ran.returncode}, "
                                                    f"{ran.stderr.decode().strip()}")
                     record = json.loads(path.read_text(encoding="utf-8"))
