@@ -227,6 +227,24 @@ except calligraphy.InvalidArgument as e:
         self.assert_one_error(bounded(["session", "plan", "p.json", "--subjects", "1"], d), 2, "p.json",
                               "1,000,001", "1,000,000")
 
+    def test_a_latin_square_of_the_most_conditions_for_the_most_subjects_is_planned(self):
+        # 26 conditions (the most) in a Latin square, 1,000 subjects (the most `--subjects` takes).
+        d = self.folder("square")
+        p = protocol("square", ["一"], conditions=26, order={"conditions": "latin_square"})
+        (d / "p.json").write_text(json.dumps(p), encoding="ascii")
+        result = bounded(["session", "plan", "p.json", "--subjects", "1000", "--json"], d)
+        self.assert_processed(result)
+        subjects = json.loads(result.stdout)["subjects"]
+        self.assertEqual(len(subjects), 1000)
+        self.assertEqual(len({s["id"] for s in subjects}), 1000)
+        names = sorted(f"C{i}" for i in range(26))
+        orders = set()
+        for s in subjects:
+            blocks = [b["condition"] for b in s["sessions"][0]["phases"][0]["blocks"]]
+            self.assertEqual(sorted(blocks), names)
+            orders.add(tuple(blocks))
+        self.assertEqual(len(orders), 26)  # the square's 26 rows, each subject on one
+
     def test_a_session_of_the_most_trials_is_refused_by_its_manifest_size_before_any_folder(self):
         # 1,000,000 planned trials (the limit) need about 250 MB of session.json, more than the 64 MiB every
         # reader takes: refused naming the session, its trials and its size, before anything is made.
