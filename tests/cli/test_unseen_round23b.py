@@ -98,7 +98,7 @@ class Round23B(unittest.TestCase, OneErrorLine):
         self.assertEqual(len(score["per_character"][0]["segments"]), 1)
 
     def test_the_most_segments_of_three_samples_are_each_scored(self):
-        # 10,000 pen-downs (the limit) of three samples along 十's first stroke: each tried on every stroke.
+        # 10,000 pen-downs (the limit) of three samples across 十 near its first stroke: each tried on every stroke.
         d = self.folder("segments")
         rows = []
         for s in range(10_000):
