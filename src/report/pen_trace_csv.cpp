@@ -6,7 +6,9 @@
 #include <cstring>
 #include <fstream>
 #include <optional>
+#include <string_view>
 #include <system_error>
+#include <unordered_set>
 #include <utility>
 
 #include "calligraphy/core/decimal_number.hpp"
@@ -231,12 +233,12 @@ class Reader {
       const std::optional<TraceColumnInfo> info = trace_column(name);
       return info ? info->file_name : name;
     };
+    // The names seen, by their file name: a header may have a hundred thousand columns.
+    std::unordered_set<std::string_view> seen;
     for (std::size_t i = 0; i < names.size(); ++i) {
       const std::string_view name = file_name(names[i]);
-      for (std::size_t j = 0; j < i; ++j) {
-        if (!names[i].empty() && name == file_name(names[j]))
-          fail("column name '" + printable_one_line(names[i], 200) + "' appears twice");
-      }
+      if (!names[i].empty() && !seen.insert(name).second)
+        fail("column name '" + printable_one_line(names[i], 200) + "' appears twice");
       if (name == "t") t = i;
       if (name == "x") x = i;
       if (name == "y") y = i;

@@ -13,6 +13,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/worker_threads.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
+#include "calligraphy/legibility/legibility.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/sim/simulated_writing.hpp"
@@ -227,6 +228,10 @@ StudyTables simulate_cohort(const LoadedProtocol& protocol, const std::vector<Su
   CohortSetup shared = setup;
   shared.load_character = [&characters](char32_t c) { return characters.at(c); };
 
+  // The recogniser of every trial's legibility opens its model (some 27 MB) once, on first use: here, before
+  // the threads map their stacks. Opened by the first thread after up to 1,024 stacks had used up an
+  // address-space limit, zinnia's failing allocation ended the process instead of being caught.
+  (void)legibility_available();
   std::vector<StudyTables> per_subject(subjects.size());
   std::mutex progress_mutex;  // one progress call at a time
   std::size_t done = 0;

@@ -4,6 +4,7 @@
 #include <iterator>
 #include <optional>
 #include <set>
+#include <string_view>
 #include <unordered_set>
 
 #include "calligraphy/core/errors.hpp"
@@ -142,9 +143,15 @@ json planned_trial_json(const PlannedTrial& trial) {
   return out;
 }
 
-std::string manifest_to_json(const SessionManifest& manifest) {
-  json plan = json::array();
-  for (const PlannedTrial& trial : manifest.plan) plan.push_back(planned_trial_json(trial));
+namespace {
+
+// Gives `sink` session.json's text in pieces, in order, while it returns true: the document without its plan,
+// dumped as nlohmann dumps it (keys sorted, two spaces), with each planned trial's object dumped on its own
+// and indented as it would be in place; returns the planned trials given. A plan of a million trials is never
+// one JSON tree: its tree took gigabytes, and freeing it under an address-space limit could fail inside
+// nlohmann's destructor, which ends the process.
+template <class Sink>
+std::size_t write_manifest(const SessionManifest& manifest, Sink&& sink) {
   const SessionSetup& setup = manifest.setup;
   json document = {{"format", kSessionFormat},
                    {"version", kSessionVersion},
@@ -165,7 +172,7 @@ std::string manifest_to_json(const SessionManifest& manifest) {
                      {"path", manifest.protocol.path.string()},
                      {"sha256", manifest.protocol.sha256},
                      {"text", manifest.protocol.text}}},
-                   {"plan", plan}};
+                   {"plan", json::array()}};
   if (manifest.previous) {
     const PreviousSession& p = *manifest.previous;
     document["previous_session"] = {{"session_id", p.session_id},
@@ -176,7 +183,49 @@ std::string manifest_to_json(const SessionManifest& manifest) {
     if (!p.session_sha256.empty()) document["previous_session"]["session_sha256"] = p.session_sha256;
   }
   if (!manifest.study_id.empty()) document["study_id"] = manifest.study_id;
-  return document.dump(2) + "\n";
+  const std::string text = document.dump(2) + "\n";
+  // The empty plan as dumped: a top-level key starts a line after two spaces; a string value holds no line
+  // break (dumped as \n), so this is the plan's key and nothing inside a value.
+  constexpr std::string_view empty_plan = "\n  \"plan\": []";
+  const std::size_t at = text.find(empty_plan);
+  if (at == std::string::npos || manifest.plan.empty()) {
+    sink(std::string_view(text));
+    return 0;
+  }
+  const std::size_t open = at + empty_plan.size() - 1;  // the ']' of "[]"
+  if (!sink(std::string_view(text).substr(0, open))) return 0;
+  std::string item;
+  for (std::size_t i = 0; i < manifest.plan.size(); ++i) {
+    const std::string dumped = planned_trial_json(manifest.plan[i]).dump(2);
+    item.assign(i == 0 ? "\n    " : ",\n    ");
+    for (const char c : dumped) {
+      item += c;
+      if (c == '\n') item += "    ";
+    }
+    if (!sink(std::string_view(item))) return i + 1;
+  }
+  if (sink(std::string_view("\n  "))) sink(std::string_view(text).substr(open));
+  return manifest.plan.size();
+}
+
+}  // namespace
+
+std::string manifest_to_json(const SessionManifest& manifest) {
+  std::string text;
+  write_manifest(manifest, [&](std::string_view piece) {
+    text += piece;
+    return true;
+  });
+  return text;
+}
+
+ManifestSize manifest_json_bytes(const SessionManifest& manifest, std::size_t limit) {
+  ManifestSize size;
+  size.trials = write_manifest(manifest, [&](std::string_view piece) {
+    size.bytes += piece.size();
+    return size.bytes <= limit;
+  });
+  return size;
 }
 
 SessionManifest manifest_from_json(std::string_view text, const std::string& source) {

@@ -1,5 +1,6 @@
 #pragma once
 // session.json and log lines as JSON (format: docs/experiments.md). Internal.
+#include <cstddef>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
@@ -9,6 +10,13 @@
 namespace calligraphy::study_detail {
 
 std::string manifest_to_json(const SessionManifest& manifest);
+/// The size of manifest_to_json's text, counted without holding the text or its plan as one JSON tree.
+struct ManifestSize {
+  std::size_t bytes = 0;   // the whole text's, or once past the limit, the bytes counted so far
+  std::size_t trials = 0;  // the planned trials counted: the first of them takes `bytes` past the limit
+};
+/// Counts the bytes of manifest_to_json's text, stopping at the planned trial that takes them past `limit`.
+ManifestSize manifest_json_bytes(const SessionManifest& manifest, std::size_t limit);
 /// Throws DataError naming `source` and the JSON pointer of a missing or bad value, or a protocol copy
 /// whose SHA-256 is not the one recorded.
 SessionManifest manifest_from_json(std::string_view text, const std::string& source);

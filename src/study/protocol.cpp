@@ -445,17 +445,29 @@ StudyProtocol parse_study_protocol(std::string_view json_text, const std::string
 
 std::uint64_t planned_trial_count(const StudyProtocol& protocol) noexcept {
   // Each factor is at most 1,000 (strings, repetitions) or 26 (conditions), and phases at most 20: no
-  // overflow.
-  std::map<int, std::uint64_t> per_session;
-  for (const ProtocolPhase& phase : protocol.phases) {
+  // overflow. Nothing is allocated (a map of the sessions' counts threw std::bad_alloc out of this noexcept
+  // function when the memory was used up, which ends the process): each session's phases are summed from its
+  // first phase, at most 20 x 20 steps.
+  const std::vector<ProtocolPhase>& phases = protocol.phases;
+  const auto trials = [](const ProtocolPhase& phase) {
     // Between subjects a subject writes one condition; in a crossover each set is written in one.
     const std::uint64_t conditions =
         phase.assignment == ConditionAssignment::within_subjects ? phase.conditions.size() : std::uint64_t{1};
-    per_session[phase.session] += static_cast<std::uint64_t>(phase.item_count()) * conditions *
-                                  static_cast<std::uint64_t>(std::max(phase.repetitions, 0));
-  }
+    return static_cast<std::uint64_t>(phase.item_count()) * conditions *
+           static_cast<std::uint64_t>(std::max(phase.repetitions, 0));
+  };
   std::uint64_t largest = 0;
-  for (const auto& [session, count] : per_session) largest = std::max(largest, count);
+  for (std::size_t i = 0; i < phases.size(); ++i) {
+    const int session = phases[i].session;
+    const auto first = std::find_if(phases.begin(), phases.begin() + static_cast<std::ptrdiff_t>(i),
+                                    [session](const ProtocolPhase& p) { return p.session == session; });
+    if (first != phases.begin() + static_cast<std::ptrdiff_t>(i)) continue;  // summed at its first phase
+    std::uint64_t count = 0;
+    for (std::size_t j = i; j < phases.size(); ++j) {
+      if (phases[j].session == session) count += trials(phases[j]);
+    }
+    largest = std::max(largest, count);
+  }
   return largest;
 }
 

@@ -191,21 +191,27 @@ SessionManifest make_manifest(const SessionSetup& setup, const LoadedProtocol& p
   return manifest;
 }
 
-// session.json's text, refused when a reader would refuse it (kMaxSessionManifestBytes).
-std::string manifest_text(const SessionManifest& manifest) {
-  std::string text = study_detail::manifest_to_json(manifest);
-  if (text.size() > kMaxSessionManifestBytes) {
-    char size[32];
-    std::snprintf(size, sizeof size, "%.1f MiB", static_cast<double>(text.size()) / (1 << 20));
+// Refuses a session.json a reader would refuse (kMaxSessionManifestBytes), counted without building it and
+// only up to the limit: a plan of a million trials is refused at the quarter of it that fills the limit.
+void check_manifest_size(const SessionManifest& manifest) {
+  const study_detail::ManifestSize size =
+      study_detail::manifest_json_bytes(manifest, kMaxSessionManifestBytes);
+  if (size.bytes > kMaxSessionManifestBytes) {
     throw DataError(
         manifest.protocol.path.string() + ": session " + std::to_string(manifest.setup.session_number) +
         " of subject " + manifest.setup.subject.id + " plans " + std::to_string(manifest.plan.size()) +
-        " trials, a session.json of " + size + ", more than the " +
-        std::to_string(kMaxSessionManifestBytes >> 20) +
-        " MiB a session's reader takes: fewer characters, conditions or repetitions a session, or "
-        "the phases over more sessions");
+        " trials, more than the " + std::to_string(kMaxSessionManifestBytes >> 20) +
+        " MiB of session.json a session's reader takes (" +
+        (size.trials > 0 ? "its first " + std::to_string(size.trials - 1) + " trials fill it"
+                         : "its protocol alone fills it") +
+        "): fewer characters, conditions or repetitions a session, or the phases over more sessions");
   }
-  return text;
+}
+
+// session.json's text, refused when a reader would refuse it.
+std::string manifest_text(const SessionManifest& manifest) {
+  check_manifest_size(manifest);
+  return study_detail::manifest_to_json(manifest);
 }
 
 }  // namespace
@@ -262,7 +268,7 @@ void check_session_manifest_size(const SessionSetup& setup, const LoadedProtocol
     previous->session_sha256 = std::string(64, '0');
     previous->delay = SessionDelay::overridden;
   }
-  (void)manifest_text(make_manifest(setup, protocol, previous));
+  check_manifest_size(make_manifest(setup, protocol, previous));
 }
 
 std::uint64_t subject_seed(std::string_view subject_id) {
@@ -318,7 +324,7 @@ SessionFolder SessionFolder::create(const fs::path& root, const SessionSetup& se
         (previous ? "the first session has no previous one" : "a later session needs the previous one"));
   }
   SessionManifest manifest = make_manifest(setup, protocol, previous);
-  (void)manifest_text(manifest);  // refused before any folder is made
+  check_manifest_size(manifest);  // refused before any folder is made
   // The study folder's identity, made by its first session; a later session of the subject's series
   // follows only a session of the same study (session_series).
   manifest.study_id = StudyIdentity::obtain(root);

@@ -4,6 +4,7 @@
 /// this user may run, RLIMIT_NPROC, or on memory): the work goes on with the threads that started.
 #include <cstddef>
 #include <functional>
+#include <new>
 #include <system_error>
 #include <thread>
 #include <utility>
@@ -13,10 +14,10 @@ namespace calligraphy {
 
 /// Up to `count` threads each running `work`, joined by join() or the destructor (also when the caller's own
 /// share of the work throws). A thread the system will not start (std::system_error: the threads this user
-/// may run, RLIMIT_NPROC, or the memory of a thread's stack used up) is not started and no error: the work
-/// is meant to take its items from a shared counter, so the threads that did start, and the calling thread,
-/// do them all. started() says how many run; a caller that does no share of the work itself runs `work` on
-/// its own thread when it is 0.
+/// may run, RLIMIT_NPROC, or the memory of a thread's stack used up; std::bad_alloc: no memory for its
+/// state) is not started and no error: the work is meant to take its items from a shared counter, so the
+/// threads that did start, and the calling thread, do them all. started() says how many run; a caller that
+/// does no share of the work itself runs `work` on its own thread when it is 0.
 class WorkerThreads {
  public:
   WorkerThreads(std::size_t count, const std::function<void()>& work) {
@@ -26,6 +27,10 @@ class WorkerThreads {
         threads_.emplace_back(work);
       } catch (const std::system_error&) {
         break;  // none more will start either
+      } catch (const std::bad_alloc&) {
+        // No memory for the thread's state (a copy of `work`): as a stack that cannot be mapped. Leaving the
+        // constructor would destroy the threads already started unjoined, which ends the process.
+        break;
       }
     }
   }
