@@ -899,3 +899,30 @@ TEST_CASE(
   CHECK(record_with(3, "person") == "person");
   CHECK(record_with(3, "human") == "human");  // left for the record's reader to refuse against its session
 }
+
+TEST_CASE("session.json, written a planned trial at a time, is the JSON library's own dump of its document",
+          "[study][session]") {
+  // The writer never holds the plan as one JSON tree (a plan of a million trials took gigabytes): its text
+  // must still be exactly what dumping the whole document gives, so that readers and SHA-256s see one format.
+  TempFolder temp;
+  SessionFolder first = SessionFolder::create(temp.path, simulated("J1"), small_protocol());
+  const std::string text = read(SessionLayout::manifest(first.path()));
+  REQUIRE(first.plan().size() == 3);
+  CHECK(nlohmann::json::parse(text).dump(2) + "\n" == text);
+  CHECK(study_detail::manifest_to_json(first.manifest()) == text);
+  // Counted without building it: the whole text's bytes, and past a limit the trial that takes it there.
+  const study_detail::ManifestSize whole = study_detail::manifest_json_bytes(first.manifest(), text.size());
+  CHECK(whole.bytes == text.size());
+  CHECK(whole.trials == 3);
+  const std::size_t before_plan = text.find("\"plan\": [") + 9;
+  const study_detail::ManifestSize cut =
+      study_detail::manifest_json_bytes(first.manifest(), before_plan + 10);
+  CHECK(cut.bytes > before_plan + 10);
+  CHECK(cut.trials == 1);
+  // An empty plan is the document as it is.
+  SessionManifest empty = first.manifest();
+  empty.plan.clear();
+  nlohmann::json document = nlohmann::json::parse(text);
+  document["plan"] = nlohmann::json::array();
+  CHECK(study_detail::manifest_to_json(empty) == document.dump(2) + "\n");
+}

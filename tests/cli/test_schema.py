@@ -711,6 +711,8 @@ class SessionSchemaTest(unittest.TestCase):
         folder = Path(tempfile.mkdtemp(dir=self.cwd))
         session = folder / "study" / self.manifests[0].parent.relative_to(self.cwd / "study")
         shutil.copytree(self.manifests[0].parent, session)
+        # with its study's identity: a session naming a study in a folder without one is refused by every reader
+        shutil.copy2(self.cwd / "study" / ".calligraphy-study.json", folder / "study")
         sorted(session.glob("trials/*.json"))[-1].unlink()
         (session / "session.json").write_text(json.dumps(document, ensure_ascii=False, indent=2) + "\n",
                                               encoding="utf-8")
