@@ -158,6 +158,9 @@ TEST_CASE("UTF-8 round trip and malformed input", "[model]") {
   CHECK_THROWS_WITH(decode_utf8("\xFF"), Catch::Contains("(\\xff): invalid lead byte"));
   CHECK(describe_characters(U"永\uFE00") == "永 (U+6C38), \uFE00 (U+FE00)");
   CHECK(describe_characters(U"一二三", 2) == "一 (U+4E00), 二 (U+4E8C), ... (1 more)");
+  // A NUL would cut the message short wherever it passes through a C string (an exception's what()).
+  CHECK(describe_character(U'\0') == "(U+0000)");
+  CHECK(describe_characters(std::u32string(U"\0一", 2)) == "(U+0000), 一 (U+4E00)");
 }
 
 TEST_CASE("A scene holds at most kMaxSceneCharacters characters", "[model]") {

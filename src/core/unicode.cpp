@@ -91,8 +91,10 @@ std::string describe_character(char32_t cp) {
   char code[16];
   std::snprintf(code, sizeof code, "U+%04X", static_cast<unsigned>(cp));
   std::string glyph;
+  // U+0000 (a JSON string's "\u0000") is named by its code point alone: its byte would end the text of every
+  // exception and C string the message passes through, cutting the name off before it.
   try {
-    glyph = encode_utf8(cp) + " ";
+    if (cp != 0) glyph = encode_utf8(cp) + " ";
   } catch (const InvalidArgument&) {
   }
   return glyph + "(" + code + ")";
