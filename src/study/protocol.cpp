@@ -202,8 +202,9 @@ StudyCondition read_condition(const json& value, const std::string& pointer, con
   StudyCondition condition;
   condition.name = reader.string("name");
   if (!study_detail::is_label(condition.name, study_detail::kMaxLabelLength)) {
-    json_detail::fail(source, reader.pointer("name"),
-                      "expected 1 to 32 letters, digits, '_' or '-', got \"" + condition.name + "\"");
+    json_detail::fail(
+        source, reader.pointer("name"),
+        "expected 1 to 32 letters, digits, '_' or '-', got " + study_detail::in_quotes(condition.name));
   }
   // The mode's condition with the parameters' defaults (SchemaOf<StudyCondition>: condition_from_mode).
   read_member(reader, SchemaOf<StudyCondition>::get(), "mode", &condition, true);
@@ -376,8 +377,9 @@ StudyProtocol read_protocol_document(std::string_view json_text, const std::stri
   root.integer_or("version", 1, 1, 1);
   protocol.name = root.string("name");
   if (!study_detail::is_label(protocol.name, study_detail::kMaxProtocolNameLength)) {
-    json_detail::fail(source, "/name",
-                      "expected 1 to 64 letters, digits, '_' or '-', got \"" + protocol.name + "\"");
+    json_detail::fail(
+        source, "/name",
+        "expected 1 to 64 letters, digits, '_' or '-', got " + study_detail::in_quotes(protocol.name));
   }
   protocol.description = root.string_or("description", "");
 

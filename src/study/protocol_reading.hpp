@@ -100,14 +100,11 @@ inline void read_member(json_detail::ObjectReader& reader, const Schema& schema,
   schema_detail::read_field(schema, *field, object, *value, reader.pointer(key), reader.source());
 }
 
-/// `text` in double quotes, for messages ("\"x\" is trained"); not `quoted`, which argument-dependent lookup
-/// would confuse with std::quoted. Appended, not concatenated: GCC 12 warns
-/// falsely on "x" + string (-Wrestrict).
+/// `text` as a JSON string, for messages ("\"x\" is trained"): a quote, a backslash or a control character
+/// is escaped as the protocol file spells it (`"V\u0000"`), so that a NUL cannot cut the message short;
+/// not `quoted`, which argument-dependent lookup would confuse with std::quoted.
 inline std::string in_quotes(const std::string& text) {
-  std::string out = "\"";
-  out += text;
-  out += '"';
-  return out;
+  return nlohmann::json(text).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 /// A list of 1 to kMaxItems strings of 1 to kMaxCharactersPerItem characters each, none a space or control
