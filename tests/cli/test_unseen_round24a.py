@@ -15,7 +15,9 @@ are used where installed; a case that needs one that is missing is skipped, sayi
 """
 import copy
 import gzip
+import hashlib
 import json
+import os
 import shutil
 import subprocess
 import tempfile
@@ -193,6 +195,23 @@ write.csv(d, args[7], row.names = FALSE)
             self.skipTest("R with jsonlite is not installed")
         self.assert_same_trial(self.r_dir / "r.json")
 
+    @unittest.skipUnless(tool("jq"), "jq is not installed")
+    def test_teacher_through_jq_replays_the_same_but_is_not_the_recording_a_record_names(self):
+        # A teacher's recording rewritten by jq holds the same samples: a replay of it writes the same trace. A
+        # replay's record names its teacher by the SHA-256 of the file's bytes, so its re-run refuses the
+        # rewritten file, naming it and both SHA-256, rather than run on a teacher it cannot vouch for.
+        d = self.folder()
+        run_ok(["trial", "一", "--writer-profile", "skilled", "--max-duration", "5", "--record", "t.json"], d)
+        replay = ["trial", "一", "--guidance-mode", "replay", "--max-duration", "2", "--seed", SEED]
+        run_ok([*replay, "--teacher", "t.json", "--json", "rep.json", "--csv", "rep.csv"], d, ok=False)
+        jq(["--tab", "-S", "."], d / "t.json", d / "tq.json")
+        run_ok([*replay, "--teacher", "tq.json", "--csv", "again.csv"], d, ok=False)
+        self.assertEqual((d / "again.csv").read_bytes(), (d / "rep.csv").read_bytes())
+        result = run(["trial", "--spec", "rep.json", "--teacher", "tq.json", "--csv", "spec.csv"], d)
+        digest = hashlib.sha256((d / "t.json").read_bytes()).hexdigest()
+        self.assert_one_error(result, 1, "tq.json", digest, "teacher_sha256")
+        self.assertFalse((d / "spec.csv").exists())
+
     def test_seed_past_2_53_kept_by_python_json_reruns_the_same(self):
         # Python's json reads integers exactly: a record of a seed past 2^53 written again by it is the trial.
         d = self.folder()
@@ -368,6 +387,30 @@ write.csv(d, args[7], row.names = FALSE)
                         encoding="utf-8")
         self.assert_one_error(run(["session", "plan", path, "--subjects", "1"], path.parent), 2, "p.json",
                               "/name", "twice")
+
+    def test_character_data_through_jq_and_python_is_the_same_character(self):
+        # A hanzi-writer-data file rewritten (jq -a, Python's ensure_ascii and indent) is the same character:
+        # the record's SHA-256 of the characters matches, so it re-runs to the same trace, and scores the same.
+        source = Path(os.environ.get("CALLIGRAPHY_CORPUS_DIR",
+                                     Path.home() / ".cache/calligraphy/hanzi-writer-data-2.0.1")) / "一.json"
+        if not source.is_file() or not tool("jq"):
+            self.skipTest("CALLIGRAPHY_CORPUS_DIR (hanzi-writer-data 2.0.1) or jq is not there")
+        for form in ("jq", "python"):
+            with self.subTest(form=form):
+                d = self.folder()
+                (d / "data").mkdir()
+                if form == "jq":
+                    jq(["-a", "."], source, d / "data" / "一.json")
+                else:
+                    text = json.dumps(json.loads(source.read_text(encoding="utf-8")), indent=3)
+                    (d / "data" / "一.json").write_text(text, encoding="utf-8")
+                run(["trial", "--spec", self.tmp / "r.json", "--data", "data", "--csv", "again.csv"], d)
+                self.assertEqual((d / "again.csv").read_bytes(), self.csv)
+                result = run_ok(["score", self.tmp / "r.csv", "--character", "一", "--data", "data", "--json", "-"],
+                                d)
+                score = json.loads(result.stdout)
+                score.pop("trace")
+                self.assertEqual(score, self.score)
 
     # --- 4. a session's files written again ----------------------------------------------------------------
 
