@@ -25,6 +25,7 @@
 #include "calligraphy/render/guidance_law.hpp"
 #include "calligraphy/render/passivity.hpp"
 #include "calligraphy/render/safety_chain.hpp"
+#include "calligraphy/report/rerun_check.hpp"
 #include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/sim/simulated_writing.hpp"
 #include "calligraphy/study/session_folder.hpp"
@@ -496,6 +497,12 @@ PyTrialResult rerun_trial_py(const py::object& record,
   SimulatedWriting writing = recorded_writing(recorded);
   inputs.hand_maker = &writing;
   TrialRun run = run_interruptible(inputs, [&] { return rerun_trial(recorded, checked, scene, inputs); });
+  // A record changed since it was written runs as another trial: said as a RuntimeWarning, never silently.
+  if (const std::vector<std::string> differences = rerun_differences(recorded, run.result);
+      !differences.empty()) {
+    if (PyErr_WarnEx(PyExc_RuntimeWarning, rerun_differences_text(recorded, differences).c_str(), 1) < 0)
+      throw py::error_already_set();
+  }
   TrialDescription description;
   description.characters = recorded.spec.characters;
   description.guidance = recorded.spec.guidance;
@@ -664,7 +671,9 @@ specification (written before records held one) or of another version, or a teac
 read or is not the recording the replay ran on (naming it and both SHA-256); InvalidArgument when the
 characters placed are not the recorded ones (other character data), or a replay naming no teacher's file
 given none;
-CharacterNotFound; TypeError for a record of another type or its JSON text given as a path.)");
+CharacterNotFound; TypeError for a record of another type or its JSON text given as a path. Warns
+(RuntimeWarning) when a simulated writer's re-run gives other figures than the run the record states: the
+record changed since it was written (a seed past 2^53 rounded by a tool), or another library.)");
   m.def(
       "check_trial_record", &check_trial_record_py, py::arg("record"),
       R"(Checks the trial a record states, as rerun_trial and `calligraphy trial --spec RECORD --check` check

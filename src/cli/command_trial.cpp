@@ -17,6 +17,7 @@
 #include "calligraphy/devices/device_registry.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/model/scene.hpp"
+#include "calligraphy/report/rerun_check.hpp"
 #include "calligraphy/report/trial_report.hpp"
 #include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/sim/simulated_writing.hpp"
@@ -380,6 +381,13 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
     throw DataError("--spec " + command.spec_file + ": " + e.what());  // e.g. other character data
   }
   TrialResult& result = run.result;
+  // A record changed since it was written runs as another trial: never silently.
+  if (recorded) {
+    if (const std::vector<std::string> differences = rerun_differences(*recorded, result);
+        !differences.empty())
+      print_error_line("calligraphy trial", "warning",
+                       "--spec " + command.spec_file + ": " + rerun_differences_text(*recorded, differences));
+  }
   TrialDescription description = describe(spec, run, *writing, *device);
   // The replay's teacher, bound to the record by the SHA-256 of the file read.
   const RecordedTrial ran = recorded_trial(spec, run, *writing, scene, teacher_sha256);

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <utility>
 
+#include "calligraphy/analysis/metric_table.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/sha256.hpp"
 #include "core/json_reader.hpp"
@@ -318,6 +319,17 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
                           "): a record of version 4 or later states that file's SHA-256");
   }
   r.teacher_sha256 = std::move(parts.teacher_sha256);
+  // A whole record states what its run gave beside its specification: kept for the re-run to compare.
+  if (!at.empty()) {
+    const auto keep = [&](std::string_view name) {
+      const auto value = document.find(std::string(name));
+      if (value != document.end()) r.recorded_outcome.emplace_back(std::string(name), value->dump());
+    };
+    keep("end_reason");
+    for (const MetricInfo& info : metric_table()) {
+      if (info.at(metric_level_run)) keep(info.name);
+    }
+  }
   // The parts a trial's builder takes only for some trials are refused here, as content of the record at
   // their pointer, before a device is looked up: a simulated writer's profile on a person's trial, and the
   // physics of a simulated device on another device.

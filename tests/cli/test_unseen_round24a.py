@@ -20,11 +20,12 @@ import json
 import os
 import shutil
 import subprocess
+import sys
 import tempfile
 import unittest
 from pathlib import Path
 
-from outsider import OneErrorLine, run, run_ok, sanitized_subset
+from outsider import ENV, OneErrorLine, run, run_ok, sanitized_subset
 
 load_tests = sanitized_subset({"test_record_through_jq_reruns_to_the_same_trace",
                                "test_record_through_node_reruns_to_the_same_trace",
@@ -223,6 +224,49 @@ write.csv(d, args[7], row.names = FALSE)
         (d / "py.json").write_text(json.dumps(record, indent=1, sort_keys=True), encoding="utf-8")
         run(["trial", "--spec", "py.json", "--csv", "again.csv"], d)
         self.assertEqual((d / "again.csv").read_bytes(), (d / "big.csv").read_bytes())
+
+    def test_seed_past_2_53_rounded_as_jq_and_node_do_reruns_saying_it_is_another_trial(self):
+        # jq 1.6 and Node read numbers as doubles and write 12345678901234568 back for 12345678901234567: a
+        # valid seed, so the record re-runs as another trial. The re-run compares what it gave with what the
+        # record says its run gave, and says so in one warning line (and Python in a RuntimeWarning).
+        d = self.folder()
+        run(["trial", "一", "--max-duration", "3", "--seed", BIG_SEED, "--json", "big.json", "--csv", "big.csv"], d)
+        record = json.loads((d / "big.json").read_text(encoding="utf-8"))
+        same = run(["trial", "--spec", "big.json", "--csv", "same.csv"], d)
+        self.assertEqual((d / "same.csv").read_bytes(), (d / "big.csv").read_bytes())
+        self.assertNotIn(b"warning", same.stderr)  # the record as written: no word
+        rounded = json.dumps(record, indent=2).replace(f'"seed": {BIG_SEED}', f'"seed": {BIG_SEED + 1}')
+        self.assertNotEqual(rounded, json.dumps(record, indent=2))
+        (d / "rounded.json").write_text(rounded, encoding="utf-8")
+        if tool("jq"):  # what jq itself writes, where it rounds (jq 1.6; 1.7 keeps the digits)
+            jq(["."], d / "big.json", d / "jq.json")
+        for name in ("rounded.json", "jq.json"):
+            if not (d / name).exists():
+                continue
+            again = run(["trial", "--spec", name, "--csv", "again.csv"], d)
+            written = (d / "again.csv").read_bytes()
+            if written == (d / "big.csv").read_bytes():
+                self.assertNotIn(b"warning", again.stderr, name)  # this jq kept the seed
+                continue
+            warnings_said = [line for line in again.stderr.decode().splitlines() if ": warning: " in line]
+            self.assertEqual(len(warnings_said), 1, again.stderr)
+            self.assertIn(f"--spec {name}", warnings_said[0])
+            self.assertIn("the re-run differs from the run the record states", warnings_said[0])
+            self.assertIn("2^53", warnings_said[0])
+        # Python's rerun_trial says it as a RuntimeWarning.
+        probe = ("import warnings, calligraphy\n"
+                 "with warnings.catch_warnings(record=True) as caught:\n"
+                 "    warnings.simplefilter('always')\n"
+                 "    calligraphy.rerun_trial('rounded.json')\n"
+                 "    calligraphy.rerun_trial('big.json')\n"
+                 "print([(w.category.__name__, str(w.message)[:49]) for w in caught])\n")
+        said = subprocess.run([sys.executable, "-c", probe], cwd=d, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, env=ENV, timeout=120)
+        if said.returncode != 0 and b"No module named 'calligraphy'" in said.stderr:
+            return  # a build without the Python module
+        self.assertEqual(said.returncode, 0, said.stderr)
+        self.assertEqual(said.stdout.decode().strip(),
+                         "[('RuntimeWarning', 'the re-run differs from the run the record states')]")
 
     def test_seed_written_with_an_exponent_is_refused_naming_it(self):
         # R's and a spreadsheet's way of writing a large integer: 1.23456789012346e+16.

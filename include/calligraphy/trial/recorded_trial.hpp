@@ -16,6 +16,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "calligraphy/core/schema.hpp"
@@ -93,6 +94,11 @@ struct RecordedTrial : WholeTrial {
   /// `spec.teacher` is the copy of the teacher a session kept in its folder, found from the record's own
   /// place (`read_study_recorded_trial`), rather than the file named as `--teacher` was given. Not written.
   bool teacher_kept_by_session = false;
+  /// What a whole record (`trial --json`, a study's trial record) says its run gave: `end_reason` and each
+  /// run-level figure of the metric table it states (analysis/metric_table.hpp), by name, as the record's
+  /// JSON text of the value; empty for a specification alone. A re-run compares them (report's
+  /// `rerun_differences`). Not written.
+  std::vector<std::pair<std::string, std::string>> recorded_outcome;
 };
 
 /// The schema of the specification object a trial record holds (format, version, trial, force_law, safety,
