@@ -525,7 +525,9 @@ class Summaries(unittest.TestCase, OneErrorLine):
             process.send_signal(signal.SIGINT)
             out, err = process.communicate(timeout=30)
             self.assertEqual(process.returncode, 130, err)
-            lines = err.decode().strip().splitlines()
+            # One line says why it stopped; a real-time loop on a loaded machine may warn of a late tick besides.
+            lines = [line for line in err.decode().strip().splitlines()
+                     if not line.startswith("calligraphy trial: warning: servo loop: tick ")]
             self.assertEqual(len(lines), 1, lines)
             self.assertIn("SIGINT", lines[0])
             self.assertTrue(lines[0].startswith("calligraphy trial:"), lines[0])
