@@ -926,3 +926,22 @@ TEST_CASE("session.json, written a planned trial at a time, is the JSON library'
   document["plan"] = nlohmann::json::array();
   CHECK(study_detail::manifest_to_json(empty) == document.dump(2) + "\n");
 }
+
+TEST_CASE("a subject's seed rounded to a double by a tool that re-saved session.json is named, not run",
+          "[study][session]") {
+  TempFolder temp;
+  SessionFolder session = SessionFolder::create(temp.path / "S07", simulated("S07"), small_protocol());
+  nlohmann::json document = nlohmann::json::parse(read(session.path() / "session.json"));
+  const std::uint64_t seed = subject_seed("S07");
+  REQUIRE(seed > (std::uint64_t{1} << 53));  // else no double-reading tool could change it
+  const auto rounded = static_cast<std::uint64_t>(static_cast<double>(seed));
+  REQUIRE(rounded != seed);
+  CHECK(study_detail::manifest_from_json(document.dump(2), "session.json").setup.writer_seed == seed);
+  document["writer_seed"] = rounded;
+  CHECK_THROWS_WITH(study_detail::manifest_from_json(document.dump(2), "session.json"),
+                    Catch::StartsWith("session.json: /writer_seed: is " + std::to_string(rounded)) &&
+                        Catch::Contains("put back " + std::to_string(seed)));
+  // Another seed altogether (a session made with its own seed) is read as it is.
+  document["writer_seed"] = 12345;
+  CHECK(study_detail::manifest_from_json(document.dump(2), "session.json").setup.writer_seed == 12345);
+}

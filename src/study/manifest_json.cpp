@@ -10,6 +10,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/study/schedule.hpp"
+#include "calligraphy/study/session_folder.hpp"
 #include "calligraphy/trial/writer_profile.hpp"
 #include "core/json_reader.hpp"
 #include "core/schema_json.hpp"
@@ -268,6 +269,18 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
     json_detail::fail(source, "/writer_profile", error.what());
   }
   manifest.setup.writer_seed = read.writer_seed;
+  // The subject's seed (subject_seed) lies past 2^53; a tool that holds JSON numbers as doubles (Node's
+  // JSON.parse, jq 1.6) writes it back rounded, and the session's later trials would be another writer's.
+  // Such a rounding of the subject's own seed is named here rather than run.
+  const std::uint64_t own_seed = subject_seed(manifest.setup.subject.id);
+  if (read.writer_seed != own_seed &&
+      static_cast<double>(read.writer_seed) == static_cast<double>(own_seed)) {
+    json_detail::fail(source, "/writer_seed",
+                      "is " + std::to_string(read.writer_seed) + ": the seed of subject '" +
+                          manifest.setup.subject.id + "' (" + std::to_string(own_seed) +
+                          ") rounded to a double by a tool that re-saved the file; put back " +
+                          std::to_string(own_seed));
+  }
   manifest.setup.writer_learning = read.writer_learning;
   manifest.setup.individual_differences = read.individual_differences;
   manifest.setup.pacing = read.pacing;
