@@ -17,7 +17,15 @@ std::uintmax_t regular_file_size(const std::filesystem::path& path, std::uintmax
   const std::string name = path.string();
   std::error_code error;
   const auto status = std::filesystem::status(path, error);
-  if (error || !std::filesystem::exists(status)) throw DataError(name + ": no such file");
+  if (error || !std::filesystem::exists(status)) {
+    // `-` means standard output for an output; an input is never standard input (it must be a regular file).
+    if (name == "-") {
+      throw DataError(
+          "-: no such file (standard input is not read: every input is a regular file; save it to one "
+          "first)");
+    }
+    throw DataError(name + ": no such file");
+  }
   if (!std::filesystem::is_regular_file(status)) throw DataError(name + ": not a regular file");
   const std::uintmax_t size = std::filesystem::file_size(path, error);
   if (error) throw DataError(name + ": cannot read its size (" + error.message() + ")");

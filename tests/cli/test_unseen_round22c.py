@@ -219,7 +219,7 @@ class Round22C(unittest.TestCase, OneErrorLine):
         self.assert_one_error(r, 2, "--spec", "'-'")
         with open(self.tmp / "t.csv", "rb") as trace:
             r = run(["score", "-", "--character", "一"], self.tmp, stdin=trace)
-        self.assert_one_error(r, 1, "-: no such file")
+        self.assert_one_error(r, 1, "-: no such file", "standard input is not read")
 
     def test_protocol_by_process_substitution_is_refused_naming_it(self):
         # docs/cli.md "Protocols": a FIFO in the protocol's place is refused before it is read (exit 1).
