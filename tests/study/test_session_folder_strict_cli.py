@@ -116,6 +116,31 @@ class SessionJsonContent(Readers):
         study, session = self.forged(edit)
         self.every_reader_refuses(study, session, ("session.json", "/plan/1/condition"))
 
+    def test_the_subjects_seed_rounded_to_a_double_is_refused_by_every_reader(self):
+        # What Node's JSON.parse/stringify or jq 1.6 write back for a seed past 2^53: a valid seed, but not the
+        # one the session's saved trials were run with; the message names the seed to put back.
+        def edit(doc):
+            seed = doc["writer_seed"]
+            self.assertGreater(seed, 2 ** 53)
+            doc["writer_seed"] = int(float(seed))
+            self.assertNotEqual(doc["writer_seed"], seed)
+            edit.seed = seed
+        study, session = self.forged(edit)
+        self.every_reader_refuses(study, session, ("session.json", "/writer_seed", f"put back {edit.seed}"))
+
+    def test_a_session_moved_into_another_subjects_folder_is_refused_by_every_reader(self):
+        # ROOT/SUBJECT/SESSION: a session of one subject under another's folder would be reported under its
+        # own subject from there, and the series of either subject would not find it.
+        study, session = self.unfinished()
+        own = session.parent.name
+        other = study / (own + "x")
+        other.mkdir()
+        moved = other / session.name
+        session.rename(moved)
+        # Where the session lies is not its content: a data error (1) for `session resume` too.
+        self.every_reader_refuses(study, moved, ("session.json", "/subject/id", "move it back to"),
+                                  resume_status=1)
+
 
 class Links(Readers):
     """Files of the folder that are links."""

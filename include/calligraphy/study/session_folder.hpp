@@ -145,8 +145,9 @@ struct StudyIdentity {
   /// Refuses the session in `folder` (its session.json read as `manifest`) when it names another study than
   /// `root_id`, the id of the study folder it lies in: copied in from another study folder; also when it
   /// names one and the folder has none (copied into a folder made before identities, or the folder's
-  /// identity file lost). A session without an id (made before studies had one) is accepted. Throws
-  /// DataError naming the session.json, its /study_id and the ids, or the missing identity file.
+  /// identity file lost), and when it is this study's but lies in another subject's folder than its own
+  /// (ROOT/SUBJECT/). A session without an id (made before studies had one) is accepted. Throws DataError
+  /// naming the session.json, its /study_id and the ids, or the missing identity file, or its /subject/id.
   static void check(const std::optional<std::string>& root_id, const std::filesystem::path& root,
                     const std::filesystem::path& folder, const SessionManifest& manifest);
 };
