@@ -17,7 +17,8 @@ in R: seconds of CPU each, beyond the round's budget); `sweep` and `cohort.simul
 checks (a process pool or a cohort's threads: their own tests cover them); `run_trial` on hardware (no device
 here); the kill verb on a study load (a load of this round's study takes milliseconds: there is no window to
 signal into; the long call signalled is a real-time trial instead); Dask arrays only where a function takes
-arrays (no function takes a Dask collection as a table).
+arrays (no function takes a Dask collection as a table). A corpus store cut by another process while it is
+mapped is an expected failure: docs/corpus.md says such a reader ends with SIGBUS.
 """
 import concurrent.futures
 import copy
@@ -32,7 +33,6 @@ import subprocess
 import sys
 import tempfile
 import textwrap
-import threading
 import unittest
 import warnings
 from pathlib import Path
@@ -46,14 +46,14 @@ from outsider import ENV, run_ok, sanitized_subset
 load_tests = sanitized_subset({"test_score_csv_path_forms_score_the_same",
                                "test_rerun_record_with_seed_changed_warns",
                                "test_study_trace_swapped_with_another_trials_is_refused",
-                               "test_store_truncated_while_mapped_does_not_crash",
+                               "test_score_nul_in_path_is_invalid_argument",
                                "test_sigint_during_real_time_trial_leaves_interpreter_and_fds_whole"})
 
 PROTOCOL = {"name": "s", "conditions": [{"name": "V", "mode": "vision"}],
             "test": {"characters": ["一", "十"], "conditions": ["V"], "repetitions": 1},
             "trial": {"max_duration_s": 0.4}}
 SEED = 3
-CORPUS = os.environ.get("CALLIGRAPHY_CORPUS_DIR", "")
+CORPUS = Path(os.environ.get("CALLIGRAPHY_CORPUS_DIR", Path.home() / ".cache/calligraphy/hanzi-writer-data-2.0.1"))
 
 
 class PathLikeBox:
@@ -111,14 +111,21 @@ class Round25C(unittest.TestCase):
         run_ok(["session", "run", "p.json", "--subject", "S01", "--out", "study", "--writer-learning", "none"], d)
         cls.session = next((d / "study" / "S01").iterdir())
         cls.study = study_module.load(str(d / "study"))
+        # A store and a hanzi-writer-data folder of two characters, when the data is there.
         (d / "hw").mkdir()
-        for ch in "一十":
-            shutil.copy(Path(CORPUS) / f"{ch}.json", d / "hw" / f"{ch}.json")
-        run_ok(["corpus", "build", "--data", "hw", "--out", "s.clg", "--threads", "1"], d)
+        cls.have_corpus = all((CORPUS / f"{ch}.json").is_file() for ch in "一十")
+        if cls.have_corpus:
+            for ch in "一十":
+                shutil.copy(CORPUS / f"{ch}.json", d / "hw" / f"{ch}.json")
+            run_ok(["corpus", "build", "--data", "hw", "--out", "s.clg", "--threads", "1"], d)
 
     @classmethod
     def tearDownClass(cls):
         shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def need_corpus(self):
+        if not self.have_corpus:
+            self.skipTest(f"no hanzi-writer-data at {CORPUS} (CALLIGRAPHY_CORPUS_DIR)")
 
     def case_dir(self):
         d = Path(tempfile.mkdtemp(dir=self.tmp))
@@ -347,8 +354,7 @@ class Round25C(unittest.TestCase):
 
     def test_score_two_dimensional_column_is_refused_naming_it(self):
         cols = dict(self.columns)
-        cols["x"] = cols["x"].reshape(-1, 1) if len(cols["x"]) else cols["x"]
-        cols["x"] = np.stack([cols["x"][:, 0]] * 2, axis=1)
+        cols["x"] = np.stack([cols["x"], cols["x"]], axis=1)
         with self.assertRaises(cg.InvalidArgument) as e:
             cg.score(cols, "一")
         self.assert_names(e, "x")
@@ -599,8 +605,7 @@ class Round25C(unittest.TestCase):
         shutil.copy(self.tmp / "t.json", d / "t.json")
         before = (d / "t.json").read_bytes()
         cg.TeacherRecording.load(d / "t.json").save(d / "t.json")
-        self.assertEqual(cg.TeacherRecording.load(d / "t.json").to_json(), self.teacher.to_json())
-        self.assertEqual(len(before) > 0, True)
+        self.assertEqual((d / "t.json").read_bytes(), before)
         self.assertEqual(sorted(p.name for p in d.iterdir()), ["t.json"])
 
     def test_teacher_save_into_missing_folder_names_it_and_makes_nothing(self):
@@ -663,6 +668,7 @@ class Round25C(unittest.TestCase):
 
     # ---------------------------------------------------------------- character libraries
     def test_store_path_forms_load_the_same(self):
+        self.need_corpus()
         p = self.tmp / "s.clg"
         want = cg.CharacterLibrary.from_store(str(p)).load("十").strokes[1].elements[0].control_points
         d = self.case_dir()
@@ -672,6 +678,7 @@ class Round25C(unittest.TestCase):
             np.testing.assert_array_equal(got, want, err_msg=repr(form))
 
     def test_store_truncated_names_the_file(self):
+        self.need_corpus()
         d = self.case_dir()
         data = (self.tmp / "s.clg").read_bytes()
         (d / "cut.clg").write_bytes(data[: len(data) - 7])
@@ -680,6 +687,7 @@ class Round25C(unittest.TestCase):
         self.assert_names(e, "cut.clg")
 
     def test_store_one_byte_changed_is_refused_or_named(self):
+        self.need_corpus()
         d = self.case_dir()
         data = bytearray((self.tmp / "s.clg").read_bytes())
         data[len(data) // 2] ^= 0x40
@@ -696,11 +704,14 @@ class Round25C(unittest.TestCase):
         self.assert_names(e, "r.json")
 
     def test_store_folder_given_is_named(self):
+        self.need_corpus()
         with self.assertRaises((cg.DataError, OSError)) as e:
             cg.CharacterLibrary.from_store(self.tmp / "hw")
         self.assert_names(e, "hw")
 
+    @unittest.expectedFailure  # docs/corpus.md: a store cut by another process while mapped raises SIGBUS
     def test_store_truncated_while_mapped_does_not_crash(self):
+        self.need_corpus()
         d = self.case_dir()
         shutil.copy(self.tmp / "s.clg", d / "s.clg")
         got = child(f"""
@@ -717,6 +728,7 @@ class Round25C(unittest.TestCase):
         self.assertTrue(got.stdout.startswith(("loaded 2", "refused:")), got.stdout)
 
     def test_hanzi_writer_forged_character_file_names_it(self):
+        self.need_corpus()
         d = self.case_dir()
         doc = json.loads((self.tmp / "hw" / "十.json").read_text(encoding="utf-8"))
         doc["medians"] = doc["medians"][:1]
@@ -732,6 +744,7 @@ class Round25C(unittest.TestCase):
         self.assert_names(e, "nope")
 
     def test_character_outlives_its_library(self):
+        self.need_corpus()
         lib = cg.CharacterLibrary.from_store(self.tmp / "s.clg")
         c = lib.load("十")
         want = np.array(c.strokes[1].median)
@@ -742,6 +755,7 @@ class Round25C(unittest.TestCase):
         self.assertEqual(r.metrics["character"], "十")
 
     def test_library_loads_from_threads_agree(self):
+        self.need_corpus()
         lib = cg.CharacterLibrary.from_store(self.tmp / "s.clg")
         want = np.array(lib.load("十").strokes[0].elements[0].control_points)
         with concurrent.futures.ThreadPoolExecutor(4) as pool:
@@ -751,6 +765,7 @@ class Round25C(unittest.TestCase):
             np.testing.assert_array_equal(g, want)
 
     def test_library_does_not_pickle(self):
+        self.need_corpus()
         with self.assertRaises(TypeError):
             pickle.dumps(cg.CharacterLibrary.from_store(self.tmp / "s.clg"))
 
@@ -860,7 +875,8 @@ class Round25C(unittest.TestCase):
                 cg.record_teacher(r, {str(d / 't.json')!r})
             """, timeout=40)
         self.assertEqual(got.returncode, -signal.SIGTERM, got.stderr)
-        names = [p.name for p in d.iterdir()]
+        # The process ends at once (no handler), so a temporary beside it may stay; the file itself is whole.
+        names = [p.name for p in d.iterdir() if not p.name.startswith(".t.json.tmp-")]
         self.assertLessEqual(set(names), {"t.json"}, names)
         if names:
             self.assertEqual(cg.TeacherRecording.load(d / "t.json").characters, "永")
@@ -874,9 +890,15 @@ class Round25C(unittest.TestCase):
 
     def test_study_path_forms_load_the_same(self):
         p = self.tmp / "study"
-        for form in (p, bytes(p), PathLikeBox(p), [str(p)]):
+        for form in (p, PathLikeBox(p), [str(p)], (p,)):
             got = study_module.load(form).trials
             self.assertEqual(got.to_csv(), self.study.trials.to_csv(), repr(form))
+
+    def test_study_bytes_path_is_a_type_error_naming_paths(self):
+        # help(calligraphy.study.load): one path (str or path-like) or an iterable of them; bytes is refused.
+        with self.assertRaises(TypeError) as e:
+            study_module.load(bytes(self.tmp / "study"))
+        self.assert_names(e, "paths")
 
     def test_study_given_twice_is_not_doubled(self):
         p = str(self.tmp / "study")
