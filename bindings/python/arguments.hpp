@@ -143,6 +143,10 @@ T convert_named(py::handle value, const std::string& name) {
     // read as a file name refused.
     if (!PyUnicode_Check(value.ptr()) && !PyBytes_Check(value.ptr()) && py::hasattr(value, "__fspath__"))
       return convert_named<T>(py::module_::import("os").attr("fspath")(value), name);
+    // A bytes path as open() reads it (os.fsdecode), so that a NUL byte in it is refused as in a str rather
+    // than cutting the name short.
+    if (PyBytes_Check(value.ptr()))
+      return convert_named<T>(py::module_::import("os").attr("fsdecode")(value), name);
   }
   try {
     if constexpr (std::is_enum_v<T>) {

@@ -87,9 +87,10 @@ std::vector<PenSample> samples_from_columns(const py::object& columns, TraceUnit
                                             const Placement& placement, double contact_threshold_m,
                                             double paper_z_m) {
   // A numpy array has both, but `"t" in array` compares its elements with "t": it is no mapping of columns
-  // (a structured array's fields included).
+  // (a structured array's fields included); nor is a list or tuple (of paths, of arrays), which has both too.
   if (!py::hasattr(columns, "__getitem__") || !py::hasattr(columns, "__contains__") ||
-      py::isinstance<py::array>(columns)) {
+      py::isinstance<py::array>(columns) || py::isinstance<py::list>(columns) ||
+      py::isinstance<py::tuple>(columns)) {
     throw py::type_error(
         "trace: expected a CSV file's path or a mapping of columns (a dict of arrays, a "
         "pandas DataFrame) with t, x, y and pen or z (or t_s, x_m, y_m, z_m)");
@@ -142,6 +143,15 @@ std::vector<PenSample> samples_from_columns(const py::object& columns, TraceUnit
     }
     if (!pen_column && !std::isfinite(c)) {
       throw InvalidArgument("trace: sample " + std::to_string(i) + ": z is not a finite number");
+    }
+    // Named by its column, as a CSV trace's field is named (the segmentation would only say "a sample").
+    const std::array<std::pair<const std::string*, double>, 3> values{
+        {{&keys[0], t.at(i)}, {&keys[1], x.at(i)}, {&keys[2], y.at(i)}}};
+    for (const auto& [key, value] : values) {
+      if (!std::isfinite(value)) {
+        throw InvalidArgument("trace: sample " + std::to_string(i) + ": column '" + *key +
+                              "' is not a finite number");
+      }
     }
     const Vec2 position(x.at(i), y.at(i));
     PenSample& sample = samples[static_cast<std::size_t>(i)];
@@ -203,8 +213,9 @@ py::dict score_py(const py::object& trace, const py::object& character,
   const py::module_ os = py::module_::import("os");
   if (py::isinstance<py::str>(trace) || py::isinstance<py::bytes>(trace) ||
       py::isinstance(trace, os.attr("PathLike"))) {
-    // A path as str, bytes or path-like object (os.fsdecode: the file system's encoding, as open() reads it).
-    trace_name = py::str(os.attr("fsdecode")(trace));
+    // A path as str, bytes or path-like object (the file system's encoding, as open() reads it); a NUL in it
+    // is an InvalidArgument naming `trace`, never a shorter name read.
+    trace_name = convert_named<std::filesystem::path>(trace, "trace").string();
     PenTraceCsvOptions options;
     options.units = units;
     options.contact_threshold_m = contact_threshold_m;

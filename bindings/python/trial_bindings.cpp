@@ -449,7 +449,8 @@ RecordedTrial read_record_py(const py::object& record) {
       throw py::type_error(
           "record: a record's JSON text, not a path: give json.loads(text) (a dict) or the record's path");
   }
-  if (py::isinstance<py::str>(record) || py::isinstance(record, py::module_::import("os").attr("PathLike")))
+  if (py::isinstance<py::str>(record) || py::isinstance<py::bytes>(record) ||
+      py::isinstance(record, py::module_::import("os").attr("PathLike")))
     return read_study_recorded_trial(convert_named<std::filesystem::path>(record, "record").string());
   throw_type_error("record", "a dict (TrialResult.metrics, a trial record) or a record's path", record);
 }
