@@ -298,12 +298,12 @@ class Learner(unittest.TestCase):
         cls.char = corpus_character(3)
         cls.medians = medians(cls.char)
         cls.looks = {}
-        trainer = Trainer(cls.dir, cls.char, "--device", "mouse", "--session", "out", "--exit-after", "60",
+        trainer = Trainer(cls.dir, cls.char, "--device", "mouse", "--session", "out", "--exit-after", "40",
                           "--screenshot", "end.png", panel=cls.dir / "panel.txt")
         cls.trainer = trainer
         try:
             cls.write(trainer)
-            cls.status = trainer.process.wait(timeout=60)
+            cls.status = trainer.process.wait(timeout=50)
         finally:
             trainer.kill()
         cls.stderr = trainer.errors()
@@ -321,7 +321,10 @@ class Learner(unittest.TestCase):
         def px(point):
             return round(bx + point[0] / 1024 * size), round(by + (900 - point[1]) / 1024 * size)
 
-        def stroke(path, pause_s=0.02, steps=12):
+        def stroke(path, pause_s=0.02, steps=None):
+            # The pointer moves as a hand moves it, about 2 mm a step, unless a number of steps is given.
+            length_mm = sum(math.dist(a, b) for a, b in zip(path, path[1:])) / MM
+            steps = steps or max(4, math.ceil(length_mm / 2))
             points = [px(p) for p in along(path, [i / steps for i in range(steps + 1)])]
             trainer.xdotool("mousemove", "--window", window, *points[0])
             time.sleep(0.1)  # the hand settles at the start before it presses
@@ -371,7 +374,7 @@ class Learner(unittest.TestCase):
         stroke(backwards)
         look("assisted")
         stroke(along(second, [i / 10 for i in range(6)]))  # the pen lifted half way
-        stroke(second, pause_s=0.06)                       # slowly
+        stroke(second, pause_s=0.08)                       # slowly
         stroke(third, pause_s=0.0, steps=6)                # very fast: six moves, about 15 mm each
         stroke(third)                                      # again at a pointer's pace, if that was refused
 
@@ -525,6 +528,48 @@ class Ending(unittest.TestCase):
         self.assertEqual(len(attempts), 2, (attempts, errors))
         self.assertEqual([json.loads(p.read_text(encoding="utf-8"))["end_reason"] for p in attempts],
                          ["interrupted", "interrupted"])
+
+
+    def test_a_stroke_8_mm_above_is_told_so_in_millimetres(self):
+        """Stroke 1 of a two-stroke corpus character written whole but 8 mm above its place: the panel says
+        "Stroke 1: started 8 mm above the start" (docs/trainer.md, the feedback table), and `score` of the kept
+        trace refuses that pen-down as a wrong place too."""
+        need_window()
+        folder = Path(tempfile.mkdtemp(dir=SHARED["dir"]))
+        char = corpus_character(2)
+        first = medians(char)[0]
+        trainer = Trainer(folder, char, "--device", "mouse", "--session", "out", "--exit-after", "4",
+                          "--screenshot", "shot.png", panel=folder / "panel.txt")
+        try:
+            bx, by, size = trainer.box()
+            window = trainer.window()
+            path = [(bx + x / 1024 * size, by + (900 - y - 8 * MM) / 1024 * size)
+                    for x, y in along(first, [i / 30 for i in range(31)])]  # 2 mm steps on 60 mm
+            time.sleep(0.3)
+            trainer.xdotool("mousemove", "--window", window, round(path[0][0]), round(path[0][1]))
+            time.sleep(0.1)
+            trainer.xdotool("mousedown", 1)
+            for x, y in path[1:]:
+                time.sleep(0.02)
+                trainer.xdotool("mousemove", "--window", window, round(x), round(y))
+            time.sleep(0.05)
+            trainer.xdotool("mouseup", 1)
+            self.assertEqual(trainer.process.wait(timeout=30), 0, trainer.errors())
+        finally:
+            trainer.kill()
+        keep_artifact(folder / "shot.png")
+        panel = (folder / "panel.txt").read_text(encoding="utf-8")
+        found = re.search(r"Stroke 1: started (\d+) mm (left of|right of|above|below)( and .*)? the start",
+                          panel)
+        self.assertIsNotNone(found, panel)
+        self.assertEqual(found.group(2), "above", panel)
+        self.assertIsNone(found.group(3), panel)
+        self.assertLessEqual(abs(int(found.group(1)) - 8), 1, panel)
+        (trace,) = folder.glob("out/anonymous/train-*/trials/attempts/*.trace.h5")
+        run_ok(["score", trace, "--character", char, "--json", folder / "s.json"], folder)
+        score = json.loads((folder / "s.json").read_text(encoding="utf-8"))
+        verdicts = [s["verdict"] for s in score["per_character"][0]["segments"] if not s.get("ignored")]
+        self.assertEqual([v["refusal"] for v in verdicts], ["wrong_place"], verdicts)
 
 
 if __name__ == "__main__":
