@@ -31,7 +31,7 @@ import time
 import unittest
 from pathlib import Path
 
-from outsider import CLI, ENV, run, run_ok, sanitized_subset
+from outsider import CLI, ENV, run_ok, sanitized_subset
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "trainer"))
 from png import read_png, read_xwd, write_png  # noqa: E402
@@ -452,29 +452,40 @@ class Learner(unittest.TestCase):
         self.assertEqual(f"{shot.width}x{shot.height}", WINDOW)
 
 
-class Ending(unittest.TestCase):
-    def test_two_windows_at_once_one_stopped_by_sigint_keep_both_attempts(self):
-        """Two learners start `train` at once into one --session folder: the one stopped by SIGINT exits 130
-        and says it wrote no stroke; the other ends by --exit-after with 0; both attempts are kept, neither
-        replacing the other, each saying what stopped it."""
+class ShortSessions(unittest.TestCase):
+    """Short sessions in the window, each of its own."""
+
+    def test_three_windows_at_once_stopped_three_ways_keep_every_attempt(self):
+        """Three learners start `train` at once into one --session folder: the one stopped by SIGINT exits 130
+        and says it wrote no stroke, the one whose window is closed exits 0 saying it was interrupted, the
+        third ends by --exit-after with 0; the three attempts are kept, none replacing another, each saying
+        what stopped it."""
         need_window()
         folder = Path(tempfile.mkdtemp(dir=SHARED["dir"]))
         char = corpus_character(4)
         a = Trainer(folder, char, "--device", "mouse", "--session", "out", "--no-demo", "--exit-after", "3")
         b = Trainer(folder, char, "--device", "mouse", "--session", "out", "--no-demo", "--exit-after", "30")
+        c = Trainer(folder, char, "--device", "mouse", "--session", "out", "--no-demo", "--exit-after", "30")
         try:
             a.box()
             b.box()
+            c.box()
             time.sleep(0.5)
             b.process.send_signal(signal.SIGINT)
+            c.xdotool("windowclose", c.window())  # the third learner closes the window
             self.assertEqual(b.process.wait(timeout=30), 130, b.errors())
             self.assertEqual(a.process.wait(timeout=30), 0, a.errors())
+            self.assertEqual(c.process.wait(timeout=30), 0, c.errors())
         finally:
             a.kill()
             b.kill()
-        self.assertEqual((a.output(), b.output()), (b"", b""))
+            c.kill()
+        self.assertEqual((a.output(), b.output(), c.output()), (b"", b"", b""))
         attempts = sorted(folder.glob("out/anonymous/train-*/trials/attempts/*.json"))
-        self.assertEqual(len(attempts), 2, (attempts, a.errors(), b.errors()))
+        self.assertEqual(len(attempts), 3, (attempts, a.errors(), b.errors(), c.errors()))
+        (line,) = [l for l in c.errors().splitlines() if l.startswith(f"calligraphy train: trial 1 {char}:")]
+        self.assertIn("interrupted", line)
+        self.assertIn("no stroke written", line)
         reasons = sorted(json.loads(p.read_text(encoding="utf-8")).get("abort_reason") or "" for p in attempts)
         self.assertIn("stopped by SIGINT", reasons, reasons)
         (line,) = [l for l in b.errors().splitlines() if l.startswith(f"calligraphy train: trial 1 {char}:")]
@@ -521,7 +532,7 @@ class Ending(unittest.TestCase):
         seconds = float(re.search(re.escape(announced) + r"([\d.]+) s\)", errors).group(1))
         self.assertLess(elapsed, 2 * seconds, "both demonstrations were skipped")
         self.assertEqual(trainer.output(), b"")
-        lines = [l for l in errors.splitlines() if l.startswith(f"calligraphy train: trial ")]
+        lines = [l for l in errors.splitlines() if l.startswith("calligraphy train: trial ")]
         self.assertEqual(len(lines), 2, errors)
         self.assertIn("interrupted by D (demonstration)", lines[0])
         attempts = sorted(folder.glob("out/anonymous/train-*/trials/attempts/*.json"))
@@ -570,6 +581,33 @@ class Ending(unittest.TestCase):
         score = json.loads((folder / "s.json").read_text(encoding="utf-8"))
         verdicts = [s["verdict"] for s in score["per_character"][0]["segments"] if not s.get("ignored")]
         self.assertEqual([v["refusal"] for v in verdicts], ["wrong_place"], verdicts)
+
+    def test_the_engineers_table_numbers_and_names_strokes_as_model_the_record_and_score_do(self):
+        """The simulated writer writes a two-stroke corpus character in the engineer's view: its per-stroke
+        table numbers the strokes 1 and 2 with `model`'s typical strokes, and each row's mean deviation is the
+        saved record's and `score`'s of the saved trace for that stroke (to the table's 0.01 mm)."""
+        need_window()
+        folder = Path(tempfile.mkdtemp(dir=SHARED["dir"]))
+        char = corpus_character(2, seed=2025)
+        trainer = Trainer(folder, char, "--writer", "simulated", "--engineer", "--session", "out",
+                          "--exit-after", "30", "--screenshot", "shot.png", panel=folder / "panel.txt")
+        try:
+            self.assertEqual(trainer.process.wait(timeout=60), 0, trainer.errors())
+        finally:
+            trainer.kill()
+        keep_artifact(folder / "shot.png")
+        panel = (folder / "panel.txt").read_text(encoding="utf-8")
+        rows = re.findall(r"^\| (\d+) (\S+) \| (\d+\.\d\d) \| (\d+\.\d\d) \| (\d+\.\d\d) \| (\d+) \|$", panel, re.M)
+        model = run_ok(["model", char], folder).stdout.decode("utf-8")
+        acronyms = re.findall(r"^  stroke \d+: ID \d+ (\S+) ", model, re.M)
+        self.assertEqual([(r[0], r[1]) for r in rows], [("1", acronyms[0]), ("2", acronyms[1])], panel)
+        (record_path,) = folder.glob("out/anonymous/train-*/trials/*.json")
+        record = json.loads(record_path.read_text(encoding="utf-8"))
+        run_ok(["score", record_path.with_suffix(".trace.h5"), "--character", char, "--json", "s.json"], folder)
+        score = json.loads((folder / "s.json").read_text(encoding="utf-8"))
+        for row, kept, scored in zip(rows, record["per_character"][0]["per_stroke"], score["per_character"][0]["per_stroke"]):
+            self.assertAlmostEqual(float(row[2]), kept["mean_deviation_m"] * 1e3, delta=0.006, msg=panel)
+            self.assertAlmostEqual(float(row[2]), scored["mean_deviation_m"] * 1e3, delta=0.006, msg=panel)
 
 
 if __name__ == "__main__":
