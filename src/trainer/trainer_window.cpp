@@ -62,6 +62,17 @@ void record_key(GLFWwindow* /*window*/, int key, int /*scancode*/, int action, i
   if (action == GLFW_PRESS && pending_keys != nullptr) pending_keys->push_back(key);
 }
 
+// The size --window asked for: the layout, the printed boxes and the screenshot are for it. GLFW_RESIZABLE
+// only asks a window manager to keep it; without one (Xvfb, or a client such as `xdotool windowsize`) the
+// window can be resized all the same, so its size callback puts the asked size back.
+int asked_width_px = 0;
+int asked_height_px = 0;
+void keep_asked_size(GLFWwindow* window, int width_px, int height_px) {
+  if (asked_width_px > 0 && (width_px != asked_width_px || height_px != asked_height_px)) {
+    glfwSetWindowSize(window, asked_width_px, asked_height_px);
+  }
+}
+
 // "cannot open a window: GLFW could not initialise (no X display? ...)": the one line for a display that is
 // not there, from open_window and check_display alike.
 std::string no_display_message() {
@@ -112,6 +123,9 @@ void TrainerApp::open_window() {
   glfwSwapInterval(1);
   pending_keys = &keys_;
   glfwSetKeyCallback(window_, record_key);  // before ImGui's, which calls it in turn
+  asked_width_px = options_.width_px;
+  asked_height_px = options_.height_px;
+  glfwSetWindowSizeCallback(window_, keep_asked_size);
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
   ImGuiIO& io = ImGui::GetIO();
@@ -147,6 +161,8 @@ void TrainerApp::close_window() {
   if (!x11_error_seen()) glfwDestroyWindow(window_);
   glfwTerminate();
   pending_keys = nullptr;
+  asked_width_px = 0;
+  asked_height_px = 0;
 }
 
 void TrainerApp::render(bool take_screenshot) {
