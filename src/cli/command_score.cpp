@@ -26,8 +26,8 @@ struct ScoreCommand {
 };
 
 int run_score(const ScoreCommand& command) {
-  // before any character is loaded (docs/cli.md)
-  const std::u32string chars = scene_characters_from(command.character, "--character");
+  const std::u32string chars = characters_from(command.character, "--character");
+  check_scene_size(chars.size(), "--character");  // before any character is loaded (docs/cli.md)
   if (chars.size() != 1 && command.units == "data") {
     throw UsageError("--character: --units data takes one character (data units are one character's); got " +
                      std::to_string(chars.size()));

@@ -240,7 +240,9 @@ int run_trial(const TrialCommand& command, const DeviceRegistry& devices) {
     throw UsageError("CHARS is required (or --spec RECORD)");
   }
   // Before any character is loaded.
-  (void)scene_characters_from(recorded ? recorded->spec.characters : command.spec.characters, "CHARS");
+  check_scene_size(
+      characters_from(recorded ? recorded->spec.characters : command.spec.characters, "CHARS").size(),
+      "CHARS");
   // Checked once, here; the runner and the renderer take it as it is.
   const Checked<TrialSpec> checked = recorded ? checked_spec(command, *recorded) : spec_from(command);
   const TrialSpec& spec = *checked;

@@ -2,7 +2,6 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
-#include "calligraphy/model/scene.hpp"
 #include "cli/output.hpp"
 
 namespace calligraphy::cli {
@@ -89,16 +88,6 @@ std::u32string characters_from(const std::string& text, const std::string& what)
     throw UsageError(what + ": " + e.what());
   }
   if (chars.empty()) throw UsageError(what + ": no character given");
-  return chars;
-}
-
-std::u32string scene_characters_from(const std::string& text, const std::string& what) {
-  std::u32string chars = characters_from(text, what);
-  try {
-    check_scene_size(chars.size(), what);
-  } catch (const InvalidArgument& e) {
-    throw UsageError(e.what());
-  }
   return chars;
 }
 

@@ -61,8 +61,4 @@ void add_library_inputs(FilePlan& plan, const LibraryOptions& options);
 /// empty or not UTF-8.
 std::u32string characters_from(const std::string& text, const std::string& what);
 
-/// As characters_from, for a text laid out as one scene: more than kMaxSceneCharacters
-/// (calligraphy/model/scene.hpp) is a UsageError naming `what` too, checked before any character is loaded.
-std::u32string scene_characters_from(const std::string& text, const std::string& what);
-
 }  // namespace calligraphy::cli
