@@ -25,14 +25,15 @@ character file under `--data`) and every file they write (`trial --json|--csv|--
 Each case expects the documented outcome, or one error line naming the file (and the JSON pointer, line or
 option) with the documented exit status; never a crash, a traceback, a silent wrong result or a file lost.
 
-Cells left out, and why: `devices` and `schema` read and write no file (standard output only, which earlier
-rounds hold to /dev/full, closed pipes and SIGPIPE); `characters` writes no file, so only its `--store` input
-row is here; `train --check` does not exist (`trial --check` is tried on a forged record instead); kill and
-race on inputs other than the record (a teacher, a store, a character file are read whole before the trial, as
-the record is, so one race stands for them); fill on inputs whose limits earlier rounds hold (the 256 MiB trace
-and 1,000,000 samples: round 23B; a record's nesting: round 23B); SIGKILL leaves a temporary by design (the
-docs name no cleanup after it), so only the target is checked then; mislabel on outputs (an output is what the
-command makes; its kind is not read); `bench acceptance` only with `--characters 2`, its cheap form.
+Cells left out, and why: `devices` and `schema` read and write no file (standard output only, which
+tests/cli/test_unseen_round_cli.py holds to /dev/full, closed pipes and SIGPIPE); `characters` writes no file,
+so only its `--store` input row is here; `train --check` does not exist (`trial --check` is tried on a forged
+record instead); kill on inputs, and race on inputs other than the record and the score's trace (a teacher, a
+store, a character file are read whole before any work, as those two are, so their race stands for them); fill
+on inputs whose limits other tests hold (the 256 MiB trace, 1,000,000 samples and a record's nesting:
+tests/cli/test_unseen_round23b.py); after SIGKILL only the target is checked (the docs name no cleanup of a
+temporary then); mislabel on outputs (an output is what the command makes; its kind is not read); `bench
+acceptance` only with `--characters 2`, its cheap form.
 
 CALLIGRAPHY_CLI names the program. CALLIGRAPHY_SANITIZED=1 takes five cases.
 """
@@ -82,6 +83,24 @@ def pen_trace(segments, samples_per_segment=2):
         lines.append(f"{t / 1000:.3f},-0.02,0.001,0")
         t += 1
     return ("\n".join(lines) + "\n").encode()
+
+
+SWAPPER = """import os, sys, time
+folder, first, second, target, stop = sys.argv[1:4] + [sys.argv[4], float(sys.argv[5])]
+texts = [open(os.path.join(folder, name), "rb").read() for name in (first, second)]
+i = 0
+while time.time() < stop:
+    with open(os.path.join(folder, "swap.tmp"), "wb") as f:
+        f.write(texts[i % 2])
+    os.rename(os.path.join(folder, "swap.tmp"), os.path.join(folder, target))
+    i += 1
+"""
+
+
+def swapping(folder, first, second, target, seconds):
+    """A process that puts `first` and `second` in turn at `target` by rename(2) for `seconds`."""
+    return subprocess.Popen(["/usr/bin/python3", "-c", SWAPPER, str(folder), first, second, target,
+                             str(time.time() + seconds)])
 
 
 class Round25A(unittest.TestCase, OneErrorLine):
@@ -290,15 +309,7 @@ class Round25A(unittest.TestCase, OneErrorLine):
         run_ok(["trial", "--spec", "other.json", "--csv", "other.csv"], self.d, ok=False)
         other_csv = (self.d / "other.csv").read_bytes()
         (self.d / "one.json").write_bytes(self.record)
-        swapper = subprocess.Popen(
-            ["/usr/bin/python3", "-c",
-             "import os, sys, time\n"
-             "d, stop = sys.argv[1], float(sys.argv[2])\n"
-             "a, b = open(d + '/one.json', 'rb').read(), open(d + '/other.json', 'rb').read()\n"
-             "i = 0\n"
-             "while time.time() < stop:\n"
-             "    open(d + '/n.tmp', 'wb').write(a if i % 2 else b); os.rename(d + '/n.tmp', d + '/live.json'); i += 1\n",
-             str(self.d), str(time.time() + 0.4)])
+        swapper = swapping(self.d, "other.json", "one.json", "live.json", 0.4)
         try:
             time.sleep(0.05)
             for _ in range(4):  # the swapper renames for 0.4 s: each run reads while it does
@@ -516,15 +527,7 @@ class Round25A(unittest.TestCase, OneErrorLine):
         run_ok(["trial", "一", "--writer-profile", "skilled", "--seed", "9", "--max-duration", "3",
                 "--csv", "other.csv"], self.d)
         other = self.score_json("other.csv")["per_character"]
-        swapper = subprocess.Popen(
-            ["/usr/bin/python3", "-c",
-             "import os, sys, time\n"
-             "d, stop = sys.argv[1], float(sys.argv[2])\n"
-             "a, b = open(d + '/r.csv', 'rb').read(), open(d + '/other.csv', 'rb').read()\n"
-             "i = 0\n"
-             "while time.time() < stop:\n"
-             "    open(d + '/n.tmp', 'wb').write(a if i % 2 else b); os.rename(d + '/n.tmp', d + '/live.csv'); i += 1\n",
-             str(self.d), str(time.time() + 0.35)])
+        swapper = swapping(self.d, "other.csv", "r.csv", "live.csv", 0.35)
         try:
             time.sleep(0.05)
             for _ in range(4):  # the swapper renames for 0.35 s: each run reads while it does
