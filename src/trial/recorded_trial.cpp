@@ -233,6 +233,8 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
   try {
     // A replay whose teacher was given as samples (a session's, kept in its folder) names no file.
     r.spec.validate(r.spec.teacher.empty() ? TeacherSource::samples : TeacherSource::file);
+  } catch (const InvalidTrialSpecField& e) {
+    json_detail::fail(source, json_detail::child_pointer(reader.pointer("trial"), e.key()), e.what());
   } catch (const InvalidArgument& e) {
     json_detail::fail(source, reader.pointer("trial"), e.what());
   }

@@ -250,7 +250,7 @@ std::string field_label(std::string_view key) {
 }
 
 [[noreturn]] void refuse(std::string_view key, const std::string& message) {
-  throw InvalidArgument(field_label(key) + ": " + message);
+  throw InvalidTrialSpecField(std::string(key), field_label(key) + ": " + message);
 }
 
 std::string number_text(double value) { return shortest_decimal(value); }
@@ -357,10 +357,9 @@ void TrialSpec::validate(TeacherSource teacher_from) const {
     refuse("characters", e.what());
   }
   if (decoded.empty()) refuse("characters", "no character to write");
-  try {
-    check_scene_size(decoded.size(), "characters");
-  } catch (const InvalidArgument& e) {
-    refuse("characters", e.what());
+  if (decoded.size() > kMaxSceneCharacters) {
+    refuse("characters", std::to_string(decoded.size()) + " characters, more than a scene's limit of " +
+                             std::to_string(kMaxSceneCharacters));
   }
   if (device.empty()) refuse("device", "no device named");
   // Every field in its range (the schema's, from the laws' tables), the error naming both its forms.

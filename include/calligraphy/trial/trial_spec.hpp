@@ -14,9 +14,11 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "calligraphy/core/checked.hpp"
+#include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/schema.hpp"
 #include "calligraphy/devices/servo_loop.hpp"
 #include "calligraphy/model/stroke_progress.hpp"
@@ -26,6 +28,18 @@
 #include "calligraphy/trial/writer_setting.hpp"
 
 namespace calligraphy {
+
+/// What TrialSpec::validate throws for a field at fault: its message names the field's JSON key and option,
+/// and `key()` is that key, so that a reader of a record names the field's JSON pointer.
+class InvalidTrialSpecField : public InvalidArgument {
+ public:
+  InvalidTrialSpecField(std::string key, const std::string& message)
+      : InvalidArgument(message), key_(std::move(key)) {}
+  [[nodiscard]] const std::string& key() const { return key_; }
+
+ private:
+  std::string key_;
+};
 
 /// Who writes: the device's own writer (the simulated writer on a device it can move, a person on any
 /// other), a person, or the simulated writer. Spelled "auto", "person", "simulated".
@@ -86,16 +100,16 @@ struct TrialSpec {
   std::string svg_file;     ///< the reference and the trace as SVG
   std::string record_file;  ///< the trial as a teacher's recording (only "" or a file)
 
-  /// Throws InvalidArgument naming the field (its JSON key and its option) when a value is out of range or
-  /// two fields contradict each other: characters empty or over 1,000, a guidance mode or gain without the
-  /// guidance it needs, a replay without a teacher or a teacher without a replay, a profile or settings for a
-  /// person, an empty profile name or a setting without a key, a rate outside the pacing's range, more than
-  /// 10^7 ticks, a teacher's recording on standard output, an acceptance StrokeAcceptance::validate refuses
-  /// (a miss count that is not a whole number). The profile's name and its settings' keys and ranges are the
-  /// simulated writer's to check (sim's `writer_profile_of`); outputs on one file are the front-end's to
-  /// refuse (it resolves links: the CLI's file plan). `teacher_from`: where a replay's teacher comes from,
-  /// the file `teacher` (required then; its front-end reads it) or samples the runner is given with no file
-  /// named (`teacher` must then be empty: nothing would read it).
+  /// Throws InvalidTrialSpecField (an InvalidArgument) naming the field (its JSON key and its option) when a
+  /// value is out of range or two fields contradict each other: characters empty or over 1,000, a guidance
+  /// mode or gain without the guidance it needs, a replay without a teacher or a teacher without a replay, a
+  /// profile or settings for a person, an empty profile name or a setting without a key, a rate outside the
+  /// pacing's range, more than 10^7 ticks, a teacher's recording on standard output, an acceptance
+  /// StrokeAcceptance::validate refuses (a miss count that is not a whole number). The profile's name and its
+  /// settings' keys and ranges are the simulated writer's to check (sim's `writer_profile_of`); outputs on
+  /// one file are the front-end's to refuse (it resolves links: the CLI's file plan). `teacher_from`: where a
+  /// replay's teacher comes from, the file `teacher` (required then; its front-end reads it) or samples the
+  /// runner is given with no file named (`teacher` must then be empty: nothing would read it).
   void validate(TeacherSource teacher_from = TeacherSource::file) const;
 
   bool operator==(const TrialSpec&) const = default;
