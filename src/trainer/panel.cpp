@@ -302,6 +302,10 @@ void learner_summary(const TrialView& view) {
   const bool complete = view.end == TrialEnd::completed;
   ImGui::TextColored(complete ? kGood : kBad, "%s: %zu of %zu strokes in order",
                      complete ? "Done" : "Stopped", m.strokes_completed, m.strokes_total);
+  // An assisted stroke was shown and counted, not written: said apart, so "2 of 3" is not a riddle.
+  if (m.strokes_assisted > 0) {
+    ImGui::Text("%zu shown and counted as assisted", m.strokes_assisted);
+  }
   if (m.mean_deviation_m) {
     ImGui::Text("%.1f mm off on average, %.1f s", *m.mean_deviation_m * 1e3, m.time_s);
   } else {

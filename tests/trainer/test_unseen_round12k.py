@@ -528,6 +528,8 @@ class HintsAndCredit(Learner):
         self.assertEqual((record["strokes_assisted"], record["strokes_written"]), (1, 0))
         self.assertTrue(record["per_stroke"][0]["assisted"])
         self.assertIn("Stroke 1 shown and counted as assisted", self.panel())
+        # The summary says it apart from the strokes written: "0 of 1 strokes in order" alone is a riddle.
+        self.assertIn("\n1 shown and counted as assisted", self.panel())
         self.assertNotIn("Here is stroke", self.panel(), "--hint-after-misses 0: never a hint")
         (line,) = [l for n, c, l in self.trial_lines(err)]
         self.assertNotIn("mean deviation", line, "no deviation of a stroke never written: " + line)
