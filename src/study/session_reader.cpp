@@ -165,8 +165,30 @@ void check_record_is_the_plans(const json& document, const std::string& source, 
     const std::string named = record.string_or("characters", "");
     if (named != characters) copied("/characters", "'" + named + "'", "characters '" + characters + "'");
   }
+  // Its labels too: a record of one condition edited to another's would be read under the plan's condition
+  // with the other's mode and values.
+  const std::string phase = to_string(plan.phase);
+  const auto same_labels = [&](const json_detail::JsonView& view, const std::string& at) {
+    if (view.has("condition")) {
+      const std::string named = view.string_or("condition", "");
+      if (named != plan.condition)
+        copied(at + "/condition", "'" + named + "'", "condition '" + plan.condition + "'");
+    }
+    if (view.has("phase")) {
+      const std::string named = view.string_or("phase", "");
+      if (named != phase) copied(at + "/phase", "'" + named + "'", "phase '" + phase + "'");
+    }
+    if (view.has("repetition")) {
+      const std::int64_t repetition = view.integer_or("repetition", 0, 0, std::int64_t{1} << 40);
+      if (repetition != plan.repetition)
+        copied(at + "/repetition", std::to_string(repetition),
+               "repetition " + std::to_string(plan.repetition));
+    }
+  };
+  same_labels(record, "");
   if (!record.has("trial")) return;
   const json_detail::JsonView trial = record.object("trial");
+  same_labels(trial, "/trial");
   if (trial.has("index")) {
     const std::int64_t index = trial.integer_or("index", 0, 0, std::int64_t{1} << 40);
     if (index != static_cast<std::int64_t>(plan.index) + 1)
