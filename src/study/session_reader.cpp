@@ -207,6 +207,19 @@ json read_sessions_record(const fs::path& json_file, const SessionManifest& mani
   json document = study_detail::read_trial_record(json_file);
   check_record_is_the_sessions(document, json_file.string(), manifest);
   check_record_is_the_plans(document, json_file.string(), plan);
+  // Its mode is its condition's in the session's protocol copy: the tables' `mode` column is read from it.
+  const json_detail::JsonView record(document, "", json_file.string());
+  for (const StudyCondition& condition : manifest.protocol.protocol.conditions) {
+    if (condition.name != plan.condition || !record.has("mode")) continue;
+    const std::string mode = to_string(condition_mode(condition));
+    const std::string named = record.string_or("mode", "");
+    if (named != mode) {
+      json_detail::fail(json_file.string(), "/mode",
+                        "is '" + named + "', but the condition " + plan.condition +
+                            " of the session's protocol is '" + mode +
+                            "': a record edited or copied from another trial; put it back as it was saved");
+    }
+  }
   return document;
 }
 
