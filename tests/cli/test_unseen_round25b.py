@@ -234,6 +234,12 @@ class Round25B(unittest.TestCase, OneErrorLine):
         self.edit_json(rec, lambda d: d.update(condition="H", mode="haptic"))
         self.refused_by_report(w, rec.name)
 
+    def test_record_of_another_mode_is_refused_naming_it(self):
+        w = self.fresh()
+        rec = self.records(self.session(w))[0]  # 001-test-V-...: vision
+        self.edit_json(rec, lambda d: d.update(mode="haptic"))
+        self.refused_by_report(w, rec.name, "/mode")
+
     def test_record_of_another_trial_index_is_refused_naming_it(self):
         w = self.fresh()
         rec = self.records(self.session(w))[0]
