@@ -598,6 +598,10 @@ int resume_session(const SessionResumeCommand& command, DeviceRegistry& devices)
   session.check_records_name_this_session();
   require_characters(session.manifest().protocol, CharacterSource(command.library));
   if (!session.next_unsaved()) {
+    // "Every trial is saved" is said only of records a reader takes: each is read as the trials of a
+    // resume are, so a damaged one (cut, emptied) is named now rather than by the next reader of the study.
+    for (const PlannedTrial& trial : session.plan())
+      (void)read_recorded_trial_file(session.trial_file(trial, "json").string());
     // A run killed after its last save and before it logged the end: the log is completed, once.
     (void)complete_session_log(session);
     std::printf("%s: every trial of %s is saved already\n", session.manifest().setup.subject.id.c_str(),

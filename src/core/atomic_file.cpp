@@ -652,6 +652,8 @@ void complete_interrupted_sets(const std::vector<SetFolder>& folders) {
 
 }  // namespace
 
+void remove_dead_temporaries_of(const fs::path& path) { remove_dead_writers_temporaries(path); }
+
 fs::path written_path(const fs::path& path) {
   // What the kernel reaches through the path's links and is not a regular file (a device, a FIFO, or the
   // pipe, socket or terminal behind /dev/stdout, whose /proc/self/fd link reads `pipe:[N]`, no file name) is

@@ -414,7 +414,11 @@ std::optional<std::string> StudyIdentity::read(const fs::path& root) {
 }
 
 std::string StudyIdentity::obtain(const fs::path& root) {
-  if (std::optional<std::string> id = read(root)) return *std::move(id);
+  if (std::optional<std::string> id = read(root)) {
+    // What a run killed as it made the identity left, once another run had made it.
+    remove_dead_temporaries_of(root / kFileName);
+    return *std::move(id);
+  }
   make_folder(root);
   unsigned char bytes[16] = {};
   std::size_t got = 0;

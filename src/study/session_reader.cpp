@@ -165,8 +165,30 @@ void check_record_is_the_plans(const json& document, const std::string& source, 
     const std::string named = record.string_or("characters", "");
     if (named != characters) copied("/characters", "'" + named + "'", "characters '" + characters + "'");
   }
+  // Its labels too: a record of one condition edited to another's would be read under the plan's condition
+  // with the other's mode and values.
+  const std::string phase = to_string(plan.phase);
+  const auto same_labels = [&](const json_detail::JsonView& view, const std::string& at) {
+    if (view.has("condition")) {
+      const std::string named = view.string_or("condition", "");
+      if (named != plan.condition)
+        copied(at + "/condition", "'" + named + "'", "condition '" + plan.condition + "'");
+    }
+    if (view.has("phase")) {
+      const std::string named = view.string_or("phase", "");
+      if (named != phase) copied(at + "/phase", "'" + named + "'", "phase '" + phase + "'");
+    }
+    if (view.has("repetition")) {
+      const std::int64_t repetition = view.integer_or("repetition", 0, 0, std::int64_t{1} << 40);
+      if (repetition != plan.repetition)
+        copied(at + "/repetition", std::to_string(repetition),
+               "repetition " + std::to_string(plan.repetition));
+    }
+  };
+  same_labels(record, "");
   if (!record.has("trial")) return;
   const json_detail::JsonView trial = record.object("trial");
+  same_labels(trial, "/trial");
   if (trial.has("index")) {
     const std::int64_t index = trial.integer_or("index", 0, 0, std::int64_t{1} << 40);
     if (index != static_cast<std::int64_t>(plan.index) + 1)
@@ -185,6 +207,19 @@ json read_sessions_record(const fs::path& json_file, const SessionManifest& mani
   json document = study_detail::read_trial_record(json_file);
   check_record_is_the_sessions(document, json_file.string(), manifest);
   check_record_is_the_plans(document, json_file.string(), plan);
+  // Its mode is its condition's in the session's protocol copy: the tables' `mode` column is read from it.
+  const json_detail::JsonView record(document, "", json_file.string());
+  for (const StudyCondition& condition : manifest.protocol.protocol.conditions) {
+    if (condition.name != plan.condition || !record.has("mode")) continue;
+    const std::string mode = to_string(condition_mode(condition));
+    const std::string named = record.string_or("mode", "");
+    if (named != mode) {
+      json_detail::fail(json_file.string(), "/mode",
+                        "is '" + named + "', but the condition " + plan.condition +
+                            " of the session's protocol is '" + mode +
+                            "': a record edited or copied from another trial; put it back as it was saved");
+    }
+  }
   return document;
 }
 

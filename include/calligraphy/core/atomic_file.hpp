@@ -42,6 +42,11 @@ void write_file_atomically(const std::filesystem::path& path, std::string_view c
 /// (the folder is missing or read-only, the disk is full): a failed write is an error, and leaves no file.
 [[nodiscard]] bool write_file_exclusively(const std::filesystem::path& path, std::string_view content);
 
+/// Removes the named temporaries that killed writers of `path` left beside it (".NAME.tmp-PID-N", their
+/// process gone), as the writers above do before they write: for a caller that finds `path` made and writes
+/// nothing.
+void remove_dead_temporaries_of(const std::filesystem::path& path);
+
 /// The path a write to `path` replaces or creates: symbolic links followed one by one (a relative target
 /// read from the link's folder), a dangling link to the path it names, any other path as it is; a path that
 /// reaches something other than a regular file (a device, a FIFO, /dev/stdout on a pipe) as it is. Throws
