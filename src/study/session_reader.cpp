@@ -185,10 +185,11 @@ void check_record_is_the_plans(const json& document, const std::string& source, 
                "repetition " + std::to_string(plan.repetition));
     }
   };
-  same_labels(record, "");
-  if (!record.has("trial")) return;
+  if (!record.has("trial")) {
+    same_labels(record, "");
+    return;
+  }
   const json_detail::JsonView trial = record.object("trial");
-  same_labels(trial, "/trial");
   if (trial.has("index")) {
     const std::int64_t index = trial.integer_or("index", 0, 0, std::int64_t{1} << 40);
     if (index != static_cast<std::int64_t>(plan.index) + 1)
@@ -198,6 +199,9 @@ void check_record_is_the_plans(const json& document, const std::string& source, 
     const std::string file = trial.string_or("file", "");
     if (file != stem) copied("/trial/file", "'" + file + "'", "file '" + stem + "'");
   }
+  // After the plan entry: a record copied over another trial is named by its index first.
+  same_labels(record, "");
+  same_labels(trial, "/trial");
 }
 
 // The saved record `json_file` of the session's trial `plan`, read and checked to be that trial's: its

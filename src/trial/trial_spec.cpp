@@ -250,6 +250,11 @@ std::string field_label(std::string_view key) {
 }
 
 [[noreturn]] void refuse(std::string_view key, const std::string& message) {
+  throw InvalidArgument(field_label(key) + ": " + message);
+}
+
+// TrialSpec::validate's refusals carry the field's key, so that a record's reader names its JSON pointer.
+[[noreturn]] void refuse_field(std::string_view key, const std::string& message) {
   throw InvalidTrialSpecField(std::string(key), field_label(key) + ": " + message);
 }
 
@@ -354,21 +359,21 @@ void TrialSpec::validate(TeacherSource teacher_from) const {
   try {
     decoded = decode_utf8(characters);
   } catch (const Error& e) {
-    refuse("characters", e.what());
+    refuse_field("characters", e.what());
   }
-  if (decoded.empty()) refuse("characters", "no character to write");
+  if (decoded.empty()) refuse_field("characters", "no character to write");
   if (decoded.size() > kMaxSceneCharacters) {
-    refuse("characters", std::to_string(decoded.size()) + " characters, more than a scene's limit of " +
-                             std::to_string(kMaxSceneCharacters));
+    refuse_field("characters", std::to_string(decoded.size()) + " characters, more than a scene's limit of " +
+                                   std::to_string(kMaxSceneCharacters));
   }
-  if (device.empty()) refuse("device", "no device named");
+  if (device.empty()) refuse_field("device", "no device named");
   // Every field in its range (the schema's, from the laws' tables), the error naming both its forms.
   const Schema& schema = SchemaOf<TrialSpec>::get();
   for (const SchemaField& field : schema.fields) {
     try {
       check_field(schema, field, this);
     } catch (const InvalidArgument& e) {
-      refuse(field.name, e.what());
+      refuse_field(field.name, e.what());
     }
   }
   // The acceptance's rules beyond its fields' ranges (a miss count is a whole number), named by the field.
@@ -379,66 +384,67 @@ void TrialSpec::validate(TeacherSource teacher_from) const {
     for (const ParameterField<StrokeAcceptance>& entry : ParameterTable<StrokeAcceptance>::fields()) {
       std::string named = ".";
       named.append(entry.name).append(" ");
-      if (what.find(named) != std::string::npos) refuse(entry.name, what);
+      if (what.find(named) != std::string::npos) refuse_field(entry.name, what);
     }
     throw InvalidArgument(std::string("trial specification: ").append(what));
   }
   if (!guidance && guidance_mode != GuidanceMode::fixed) {
-    refuse("guidance_mode", std::string("'") + calligraphy::to_string(guidance_mode) +
-                                "' needs guidance on (guidance is off)");
+    refuse_field("guidance_mode", std::string("'") + calligraphy::to_string(guidance_mode) +
+                                      "' needs guidance on (guidance is off)");
   }
   // Each mode's own parameter: in its law's range, and stated only with its mode (a value nothing reads is
   // a mistake). The teacher is checked below, where it comes from matters.
   for (const ConditionalField& field : kConditionalFields) {
     if (field.name != "teacher" && field.stated(*this) && !field.applies(*this))
-      refuse(field.name, field.when);
+      refuse_field(field.name, field.when);
   }
   if (guidance_mode == GuidanceMode::replay && teacher.empty() && teacher_from == TeacherSource::file) {
-    refuse("teacher", "required with guidance mode 'replay' (a recording made with --record)");
+    refuse_field("teacher", "required with guidance mode 'replay' (a recording made with --record)");
   }
   if (!teacher.empty() && teacher_from == TeacherSource::samples) {
-    refuse("teacher", "the teacher is given as samples; the file would not be read");
+    refuse_field("teacher", "the teacher is given as samples; the file would not be read");
   }
   if (!teacher.empty() && guidance_mode != GuidanceMode::replay) {
-    refuse("teacher", "applies to guidance mode 'replay' only");
+    refuse_field("teacher", "applies to guidance mode 'replay' only");
   }
   if (writer == TrialWriter::person && writer_profile != TrialSpec{}.writer_profile) {
-    refuse("writer_profile", "applies to the simulated writer, not to a person (writer 'person')");
+    refuse_field("writer_profile", "applies to the simulated writer, not to a person (writer 'person')");
   }
   if (writer == TrialWriter::person && !writer_parameters.empty()) {
-    refuse("writer_parameters", "apply to the simulated writer, not to a person (writer 'person')");
+    refuse_field("writer_parameters", "apply to the simulated writer, not to a person (writer 'person')");
   }
   // The profile is one of the known ones (`writer_profile`, the one list the options and Python take), so a
   // record naming another is refused as the option is, not run under a name no writer has. Its settings' keys
   // and ranges are the simulated writer's to check (sim's writer_profile_of, when it is made).
-  if (writer_profile.empty()) refuse("writer_profile", "no profile named");
+  if (writer_profile.empty()) refuse_field("writer_profile", "no profile named");
   try {
     (void)calligraphy::writer_profile(writer_profile);
   } catch (const InvalidArgument& error) {
-    refuse("writer_profile", error.what());
+    refuse_field("writer_profile", error.what());
   }
   for (const WriterSetting& setting : writer_parameters) {
     if (setting.key.empty() || !std::isfinite(setting.value))
-      refuse("writer_parameters", "'" + writer_setting_text(setting) + "' is not a key and a finite number");
+      refuse_field("writer_parameters",
+                   "'" + writer_setting_text(setting) + "' is not a key and a finite number");
   }
   const bool real_time = pacing == TrialPacing::real_time;
   if (!servo_rate_allowed(rate_hz, real_time)) {
-    refuse("rate_hz", number_text(rate_hz) + " Hz is outside " + servo_rate_range_text(real_time) +
-                          (real_time ? " (real-time pacing)" : ""));
+    refuse_field("rate_hz", number_text(rate_hz) + " Hz is outside " + servo_rate_range_text(real_time) +
+                                (real_time ? " (real-time pacing)" : ""));
   }
   if (watchdog_s != static_cast<double>(std::llround(watchdog_s * 1000.0)) / 1000.0)
-    refuse("watchdog_s", number_text(watchdog_s) + " s is not a whole number of milliseconds");
+    refuse_field("watchdog_s", number_text(watchdog_s) + " s is not a whole number of milliseconds");
   if (pacing == TrialPacing::lock_step && watchdog_s != TrialSpec{}.watchdog_s) {
-    refuse("watchdog_s", "applies to real-time pacing only (lock-step has no wall clock to bound)");
+    refuse_field("watchdog_s", "applies to real-time pacing only (lock-step has no wall clock to bound)");
   }
   // A trace longer than this would not fit a trial's memory (one sample per tick).
   if (exceeds_trial_ticks(max_duration_s, rate_hz)) {
-    refuse("max_duration_s", number_text(max_duration_s) + " s at " + field_label("rate_hz") + " " +
-                                 number_text(rate_hz) + " Hz is more than 10^7 servo ticks");
+    refuse_field("max_duration_s", number_text(max_duration_s) + " s at " + field_label("rate_hz") + " " +
+                                       number_text(rate_hz) + " Hz is more than 10^7 servo ticks");
   }
   // Outputs on one file are the front-end's to find (after resolving links: the CLI's file plan).
   if (record_file == "-")
-    refuse("record_file", "a teacher's recording goes to a file, not to standard output");
+    refuse_field("record_file", "a teacher's recording goes to a file, not to standard output");
 }
 
 Checked<TrialSpec> trial_spec_from_args(std::span<const std::string> args) {
