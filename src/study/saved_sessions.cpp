@@ -49,6 +49,14 @@ fs::path named_folder(const fs::path& folder) {
   return named;
 }
 
+void check_session_in_subject_folder(const fs::path& root, const fs::path& folder,
+                                     const std::string& subject_folder, const SessionManifest& manifest) {
+  if (subject_folder == manifest.setup.subject.id) return;
+  json_detail::fail(SessionLayout::manifest(folder).string(), "/subject/id",
+                    "a session of subject '" + manifest.setup.subject.id + "' in the folder of '" +
+                        subject_folder + "': move it back to " + (root / manifest.setup.subject.id).string());
+}
+
 std::string session_folder_id(const fs::path& folder) { return named_folder(folder).filename().string(); }
 
 fs::path beside_session(const fs::path& folder, const std::string& name) {

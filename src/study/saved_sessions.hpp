@@ -34,6 +34,14 @@ std::filesystem::path beside_session(const std::filesystem::path& folder, const 
 /// A session's id: its folder's own name (named_folder), whatever spelling of the folder a reader was given.
 std::string session_folder_id(const std::filesystem::path& folder);
 
+/// Refuses the session in `folder` (of the study folder `root`) whose subject is not `subject_folder`, the
+/// name of the subject's folder it lies in: a study's sessions lie in ROOT/SUBJECT/ (SessionFolder::create),
+/// and one moved into another subject's folder would be read under its own subject from there while that
+/// subject's series would not find it. Throws DataError naming the session.json's /subject/id and where it
+/// belongs.
+void check_session_in_subject_folder(const std::filesystem::path& root, const std::filesystem::path& folder,
+                                     const std::string& subject_folder, const SessionManifest& manifest);
+
 /// The manifest of the session folder `folder`, its `session_id` the folder's name (session_folder_id), its
 /// saved records checked against its plan (check_records_planned), read without following a link
 /// (read_session_file). Throws DataError naming the file (and JSON pointer) when it cannot be read.

@@ -443,15 +443,9 @@ void StudyIdentity::check(const std::optional<std::string>& root_id, const fs::p
                           const fs::path& folder, const SessionManifest& manifest) {
   if (manifest.study_id.empty()) return;
   if (manifest.study_id == root_id) {
-    // A study's sessions lie in ROOT/SUBJECT/ (SessionFolder::create): one moved into another subject's
-    // folder would be read under its own subject from there, and a series would not find it.
-    const std::string subject_folder = study_detail::named_folder(folder).parent_path().filename().string();
-    if (subject_folder != manifest.setup.subject.id) {
-      json_detail::fail(SessionLayout::manifest(folder).string(), "/subject/id",
-                        "a session of subject '" + manifest.setup.subject.id + "' in the folder of '" +
-                            subject_folder + "': move it back to " +
-                            (root / manifest.setup.subject.id).string());
-    }
+    // However the reader spelt the folder ("S/x/.", a link): its subject folder's own name.
+    study_detail::check_session_in_subject_folder(
+        root, folder, study_detail::named_folder(folder).parent_path().filename().string(), manifest);
     return;
   }
   if (!root_id) {

@@ -106,12 +106,7 @@ SessionSeries session_series(const fs::path& root, const std::string& subject_id
       SessionManifest manifest = study_detail::read_session_manifest(folder);
       if (manifest.protocol.sha256 != protocol.sha256) continue;
       StudyIdentity::check(study_id, root, folder, manifest);
-      if (manifest.setup.subject.id != subject_id) {
-        json_detail::fail((SessionLayout::manifest(folder)).string(), "/subject/id",
-                          "a session of subject '" + manifest.setup.subject.id + "' in the folder of '" +
-                              subject_id + "': move it back to " +
-                              (root / manifest.setup.subject.id).string());
-      }
+      study_detail::check_session_in_subject_folder(root, folder, subject_id, manifest);
       const int number = manifest.setup.session_number;
       const auto known = by_number.find(number);
       if (known == by_number.end() || known->second.second.created_utc <= manifest.created_utc) {
