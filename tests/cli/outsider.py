@@ -6,6 +6,8 @@ Under the sanitizers (CALLIGRAPHY_SANITIZED=1, set by tests/CMakeLists.txt's add
 a run of the program about ten times slower, so a round runs only the few cases it names there.
 """
 import os
+import select
+import shutil
 import subprocess
 import unittest
 
@@ -15,6 +17,37 @@ TIMEOUT_S = 60
 # No real device library, no display: what a command checks before it opens either shows as its exit status.
 ENV = {k: v for k, v in os.environ.items()
        if not k.startswith("CALLIGRAPHY_LIBHD") and k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+
+
+def start_own_x_server(screen="1024x768x24", framebuffer_dir=None, wait_s=20):
+    """An X server of the caller's own (Xvfb -displayfd: the display number it picks, so that runs in parallel
+    never share one), or None where Xvfb is missing or does not start within `wait_s`. Returns (process,
+    ":N"); with `framebuffer_dir` its screen is kept there as the file Xvfb_screen0 (XWD) to read what is
+    shown. The caller ends the process."""
+    if shutil.which("Xvfb") is None:
+        return None
+    command = ["Xvfb", "-displayfd", "", "-screen", "0", screen, "-nolisten", "tcp"]
+    if framebuffer_dir is not None:
+        command += ["-fbdir", str(framebuffer_dir)]
+    read_end, write_end = os.pipe()
+    command[2] = str(write_end)
+    process = subprocess.Popen(command, pass_fds=(write_end,), stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+    os.close(write_end)
+    number = b""
+    try:
+        while not number.endswith(b"\n") and select.select([read_end], [], [], wait_s)[0]:
+            chunk = os.read(read_end, 16)
+            if not chunk:
+                break
+            number += chunk
+    finally:
+        os.close(read_end)
+    if not number.strip():
+        process.kill()
+        process.wait()
+        return None
+    return process, ":" + number.decode().strip()
 
 
 def run(args, cwd, timeout=TIMEOUT_S, env=None, **kw):

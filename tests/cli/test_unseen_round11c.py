@@ -25,7 +25,7 @@ import time
 import unittest
 from pathlib import Path
 
-from outsider import SANITIZED, sanitized_subset
+from outsider import SANITIZED, sanitized_subset, start_own_x_server
 
 CLI = os.environ.get("CALLIGRAPHY_CLI", "")
 STAND_IN = os.environ.get("CALLIGRAPHY_HD_STAND_IN", "")
@@ -563,24 +563,7 @@ def window_available():
 
 def start_xvfb():
     """An X server of the test's own (`-displayfd`), so that the program's exit status is its own."""
-    read_end, write_end = os.pipe()
-    server = subprocess.Popen(["Xvfb", "-displayfd", str(write_end), "-screen", "0", "1024x768x24", "-nolisten",
-                               "tcp"], pass_fds=(write_end,), stdout=subprocess.DEVNULL,
-                              stderr=subprocess.DEVNULL)
-    os.close(write_end)
-    number = b""
-    deadline = time.monotonic() + 20
-    while time.monotonic() < deadline and not number.endswith(b"\n"):
-        chunk = os.read(read_end, 16)
-        if not chunk:
-            break
-        number += chunk
-    os.close(read_end)
-    if not number.strip():
-        server.kill()
-        server.wait()
-        return None, None
-    return server, ":" + number.decode().strip()
+    return start_own_x_server("1024x768x24") or (None, None)
 
 
 def stop_xvfb(server):

@@ -34,7 +34,7 @@ import time
 import unittest
 from pathlib import Path
 
-from outsider import ENV, OneErrorLine, error_lines, run, sanitized_subset
+from outsider import ENV, OneErrorLine, error_lines, run, sanitized_subset, start_own_x_server
 
 load_tests = sanitized_subset({"test_session_folder_is_named_by_the_utc_second_in_every_zone",
                                "test_a_day_that_does_not_exist_is_refused_naming_the_record",
@@ -113,22 +113,11 @@ def forge_end(session, value):
 
 def start_xvfb():
     """An X server of the round's own, or None where there is none to start."""
-    xvfb = shutil.which("Xvfb")
-    if xvfb is None:
+    started = start_own_x_server("800x600x24")
+    if started is None:
         return None
-    read_end, write_end = os.pipe()
-    process = subprocess.Popen([xvfb, "-displayfd", str(write_end), "-screen", "0", "800x600x24", "-nolisten",
-                                "tcp"], pass_fds=(write_end,), stdout=subprocess.DEVNULL,
-                               stderr=subprocess.DEVNULL)
-    os.close(write_end)
-    with os.fdopen(read_end) as pipe:
-        number = pipe.readline().strip()
-    if not number:
-        process.kill()
-        process.wait()
-        return None
-    SHARED["xvfb"] = process
-    return f":{number}"
+    SHARED["xvfb"], display = started
+    return display
 
 
 def setUpModule():  # noqa: N802 - unittest's name

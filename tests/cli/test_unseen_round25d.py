@@ -31,7 +31,7 @@ import time
 import unittest
 from pathlib import Path
 
-from outsider import CLI, ENV, run_ok, sanitized_subset
+from outsider import CLI, ENV, run_ok, sanitized_subset, start_own_x_server
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "trainer"))
 from png import read_png, read_xwd, write_png  # noqa: E402
@@ -205,19 +205,11 @@ def start_xvfb():
         return None
     fb = SHARED["dir"] / "fb"
     fb.mkdir()
-    read_end, write_end = os.pipe()
-    process = subprocess.Popen(["Xvfb", "-displayfd", str(write_end), "-screen", "0", "1024x640x24", "-nolisten",
-                                "tcp", "-fbdir", str(fb)], pass_fds=(write_end,), stdout=subprocess.DEVNULL,
-                               stderr=subprocess.DEVNULL)
-    os.close(write_end)
-    with os.fdopen(read_end) as pipe:
-        number = pipe.readline().strip()
-    if not number:
-        process.kill()
-        process.wait()
+    started = start_own_x_server("1024x640x24", framebuffer_dir=fb)
+    if started is None:
         return None
+    process, SHARED["display"] = started
     SHARED["xvfb"] = process
-    SHARED["display"] = f":{number}"
     return SHARED["display"]
 
 
