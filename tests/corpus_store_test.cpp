@@ -285,6 +285,19 @@ TEST_CASE("Store lookup of present and absent characters", "[store]") {
   std::filesystem::remove(path);
 }
 
+TEST_CASE("A store cut or replaced by another program after it was opened loads as it was", "[store]") {
+  // Read whole when opened: a mapping of a file cut under it would end the process (SIGBUS) at the next load.
+  const auto path = temp_path("cut_after_open.clg");
+  write_corpus_store(path, small_set());
+  const CorpusStore store = CorpusStore::open(path);
+  const std::size_t yong_strokes = store.load(U'永').strokes.size();
+  std::filesystem::resize_file(path, 0);
+  CHECK(store.load(U'永').strokes.size() == yong_strokes);
+  CHECK(store.load(U'十').strokes.size() == 2);
+  std::filesystem::remove(path);
+  CHECK(store.characters() == std::vector<char32_t>{U'十', U'永'});
+}
+
 TEST_CASE("Store writer rejects what it cannot encode", "[store]") {
   const auto set = small_set();
   CHECK_THROWS_AS(encode_corpus_store(set, {3, 10.0}), InvalidArgument);

@@ -320,9 +320,10 @@ void bind_library(py::module_& m) {
           },
           py::arg("path"),
           "A binary corpus store of fitted characters (include/calligraphy/model/corpus_store.hpp, "
-          "docs/corpus.md; made by `calligraphy corpus build`), memory-mapped: each character is decoded "
-          "when loaded. Its Strokes have their data's medians (a store built with `--medians off` has "
-          "none: Stroke.median is then (0, 2)). Raises DataError (a RuntimeError) naming the file and "
+          "docs/corpus.md; made by `calligraphy corpus build`), read whole when opened: each character "
+          "is decoded when loaded. Its Strokes have their data's medians (a store built with "
+          "`--medians off` has none: Stroke.median is then (0, 2)). Raises DataError (a RuntimeError) "
+          "naming the file and "
           "offset for a missing, truncated, corrupted or foreign file.")
       .def(
           "load",

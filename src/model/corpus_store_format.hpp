@@ -10,6 +10,10 @@
 
 namespace calligraphy::store {
 
+/// The largest file read as a store: its index addresses records at 32-bit offsets, so a longer file cannot
+/// be a valid one (the whole corpus is a few megabytes).
+inline constexpr std::size_t kMaxCorpusStoreBytes = std::size_t{1} << 32;
+
 inline constexpr std::array<std::uint8_t, 8> kMagic = {'C', 'L', 'G', 'S', 'T', 'O', 'R', 'E'};
 inline constexpr std::uint16_t kVersionMajor = 1;  // readers reject another major version
 // Minor 0: the models only. Minor 1: header flag kFlagMedians may be set (the records then end with the

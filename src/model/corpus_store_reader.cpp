@@ -1,7 +1,6 @@
 // Reads the corpus store (docs/corpus.md) through a read-only memory mapping. Every offset and size is
 // checked against the file before it is used; every failure is a DataError naming the file and offset.
 #include <fcntl.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -26,8 +25,7 @@ struct CorpusStore::Data {
   std::string name;
   const std::uint8_t* bytes = nullptr;
   std::size_t size = 0;
-  void* mapping = nullptr;          // from mmap, unmapped on destruction
-  std::vector<std::uint8_t> owned;  // from_bytes
+  std::vector<std::uint8_t> owned;  // the store's bytes, read whole (open) or copied (from_bytes)
   CorpusStoreInfo info;
   const std::uint8_t* index = nullptr;
   const std::uint8_t* records = nullptr;
@@ -37,9 +35,7 @@ struct CorpusStore::Data {
   Data() = default;
   Data(const Data&) = delete;
   Data& operator=(const Data&) = delete;
-  ~Data() {
-    if (mapping != nullptr) munmap(mapping, size);
-  }
+  ~Data() = default;
 
   [[noreturn]] void fail(std::size_t offset, const std::string& what) const {
     throw DataError(name + ": offset " + std::to_string(offset) + ": " + what);
@@ -289,16 +285,39 @@ CorpusStore CorpusStore::open(const std::filesystem::path& path) {
     ::close(fd);
     throw DataError(data->name + ": not a regular file");
   }
-  data->size = static_cast<std::size_t>(st.st_size);
-  if (data->size > 0) {
-    void* m = ::mmap(nullptr, data->size, PROT_READ, MAP_PRIVATE, fd, 0);
-    if (m == MAP_FAILED) {
-      ::close(fd);
-      throw DataError(data->name + ": cannot map the corpus store (" + std::strerror(errno) + ")");
-    }
-    data->mapping = m;
-    data->bytes = static_cast<const std::uint8_t*>(m);
+  // Read whole, not mapped: a file truncated by another process while mapped would end the process with
+  // SIGBUS at the next access, and a store is a few megabytes. Read to its end, whatever stat said.
+  if (static_cast<std::uintmax_t>(st.st_size) > kMaxCorpusStoreBytes) {
+    ::close(fd);
+    throw DataError(data->name + ": larger than a corpus store may be (" +
+                    std::to_string(kMaxCorpusStoreBytes) + " bytes)");
   }
+  std::vector<std::uint8_t>& bytes = data->owned;
+  bytes.resize(static_cast<std::size_t>(std::max<off_t>(st.st_size, 0)) + 1);
+  std::size_t filled = 0;
+  for (;;) {
+    if (filled == bytes.size()) {
+      if (bytes.size() > kMaxCorpusStoreBytes) {
+        ::close(fd);
+        throw DataError(data->name + ": larger than a corpus store may be (" +
+                        std::to_string(kMaxCorpusStoreBytes) + " bytes)");
+      }
+      bytes.resize(bytes.size() * 2);
+    }
+    const ssize_t got = ::read(fd, bytes.data() + filled, bytes.size() - filled);
+    if (got < 0 && errno == EINTR) continue;
+    if (got < 0) {
+      const int error = errno;
+      ::close(fd);
+      throw DataError(data->name + ": cannot read the corpus store (" + std::strerror(error) + ")");
+    }
+    if (got == 0) break;
+    filled += static_cast<std::size_t>(got);
+  }
+  bytes.resize(filled);
+  bytes.shrink_to_fit();
+  data->bytes = bytes.data();
+  data->size = bytes.size();
   ::close(fd);
   data->validate();
   return CorpusStore(std::move(data));

@@ -191,7 +191,7 @@ def _trial_arguments(parameters: typing.Iterable[tuple[str, typing.Any]]) -> dic
 
 @functools.lru_cache(maxsize=4)
 def _library(source: _Source) -> CharacterLibrary:
-    """The character source, opened once per process (a store is memory-mapped, a folder read lazily)."""
+    """The character source, opened once per process (a store is read whole, a folder lazily)."""
     kind, path = source
     if kind == "store":
         return CharacterLibrary.from_store(path)

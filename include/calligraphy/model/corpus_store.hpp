@@ -95,13 +95,13 @@ void write_corpus_store(const std::filesystem::path& path, std::span<const Chara
                         const CorpusStoreOptions& options,
                         std::span<const std::vector<std::string>> outline_paths);
 
-/// A read-only store. Cheap to copy (the mapping is shared); thread-safe for concurrent `load`s.
+/// A read-only store. Cheap to copy (its bytes are shared); thread-safe for concurrent `load`s.
 class CorpusStore {
  public:
-  /// Memory-maps the file (POSIX mmap) and validates the header, the sizes, the index and its checksum.
-  /// Records are checked when loaded. Throws DataError naming the file and the offset at fault for a
-  /// missing, truncated, corrupted or foreign file. Do not modify the file while it is open: a file
-  /// truncated under a live mapping raises SIGBUS on access, which no reader can prevent.
+  /// Reads the file whole (a store is a few megabytes) and validates the header, the sizes, the index and its
+  /// checksum. Records are checked when loaded. Throws DataError naming the file and the offset at fault for
+  /// a missing, truncated, corrupted or foreign file, or one larger than 4 GiB (the format's offsets are
+  /// 32-bit). The file may change or go once opened: the store keeps what was read.
   static CorpusStore open(const std::filesystem::path& path);
   /// The same over a copy of `bytes` (tests, fuzzing); `name` stands for the file in errors.
   static CorpusStore from_bytes(std::span<const std::uint8_t> bytes, const std::string& name);
