@@ -364,8 +364,11 @@ PanelAction draw_panel(const WindowLayout& layout, double panel_width_px, const 
   ImGui::SetNextWindowPos(ImVec2(static_cast<float>(layout.area_width_px()), 0));
   ImGui::SetNextWindowSize(
       ImVec2(static_cast<float>(panel_width_px), static_cast<float>(layout.height_px())));
+  // A scroll bar where the panel is taller than a small window (the engineer's tables at 800x480): its
+  // buttons and lines are never cut off out of reach.
   ImGui::Begin("trainer", nullptr,
-               ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
+               ImGuiWindowFlags_NoTitleBar | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse |
+                   ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
                    ImGuiWindowFlags_NoBringToFrontOnFocus);
   if (!input.session.empty()) {
     ImGui::TextWrapped("%s", input.session.c_str());
@@ -401,7 +404,9 @@ PanelAction draw_panel(const WindowLayout& layout, double panel_width_px, const 
   }
   if (!input.status.empty()) ImGui::TextWrapped("%s", input.status.c_str());
   if (input.engineer) {
-    ImGui::SetCursorPosY(static_cast<float>(layout.height_px()) - 30.0f);
+    // At the foot of the panel where there is room below the rest, else after it (never over it).
+    const float foot = static_cast<float>(layout.height_px()) - 30.0f;
+    if (ImGui::GetCursorPosY() < foot) ImGui::SetCursorPosY(foot);
     ImGui::TextDisabled("%.0f frames/s", input.frame_rate_hz);
   }
   ImGui::End();
