@@ -360,3 +360,44 @@ TEST_CASE("A trace with more pen-down segments than the limit is refused before 
   CHECK_THROWS_WITH(score_trace(yong, trace.samples, options), Catch::Contains("max_segments"));
   CHECK(ScoreOptions{}.max_segments == kMaxScoredSegments);
 }
+
+TEST_CASE("A stroke refused assist_after_misses times is credited assisted and the next is judged", "[score]") {
+  // As the renderer credits it (ActiveStroke::lift): the strokes after it are judged as a trial judged them,
+  // not refused as written out of order.
+  const PlacedCharacter& yong = scene_of(U'永').characters.front();
+  const auto trace_with_misses = [&](int misses) {
+    TraceBuilder trace;
+    for (int k = 0; k < misses; ++k) trace.write(stroke_points(yong.strokes[0], 0.05e-3, 8e-3));
+    for (std::size_t s = 1; s < yong.strokes.size(); ++s) trace.write(stroke_points(yong.strokes[s], 0.05e-3));
+    return trace;
+  };
+  const TraceBuilder five = trace_with_misses(5);
+
+  const CharacterScore credited = score_trace(yong, five.samples);  // the default: 5
+  CHECK(credited.strokes_assisted == 1);
+  CHECK(credited.strokes[0].assisted);
+  CHECK_FALSE(credited.strokes[1].assisted);
+  CHECK(credited.strokes_accepted == yong.strokes.size() - 1);
+  CHECK(credited.refusals.total() == 5);
+  CHECK(credited.refusals.wrong_order == 0);
+  CHECK(credited.segments[4].assists_due);
+  CHECK_FALSE(credited.segments[3].assists_due);
+
+  ScoreOptions never;
+  never.acceptance.assist_after_misses = 0.0;
+  const CharacterScore uncredited = score_trace(yong, five.samples, never);
+  CHECK(uncredited.strokes_assisted == 0);
+  CHECK_FALSE(uncredited.strokes[0].assisted);
+  CHECK(uncredited.strokes_accepted == 0);
+  CHECK(uncredited.refusals.total() == 5 + yong.strokes.size() - 1);
+
+  // Four misses are not enough at the default; at 3 the fourth and fifth are judged against stroke 2.
+  CHECK(score_trace(yong, trace_with_misses(4).samples).strokes_assisted == 0);
+  ScoreOptions three;
+  three.acceptance.assist_after_misses = 3.0;
+  const CharacterScore early = score_trace(yong, five.samples, three);
+  CHECK(early.strokes_assisted == 1);
+  CHECK(early.segments[2].assists_due);
+  CHECK(early.strokes_accepted == yong.strokes.size() - 1);
+  CHECK(early.refusals.total() == 5);
+}

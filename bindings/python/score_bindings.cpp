@@ -263,10 +263,11 @@ acceptance: a StrokeAcceptance (default: the C++ defaults, the renderer's).
 start_radius_m: radius of the start neighbourhood a segment must enter a stroke in [m], > 0 (default the
                 scene's, 0.005).
 Returns a dict with the keys of `calligraphy score --json` (order_errors, backwards_strokes,
-mean_deviation_m, frechet_m, dtw_m [m], strokes_accepted, refusals: {reason: count}, ..., and per character
-under per_character its per_stroke and segments: one dict per pen-down segment with begin/end sample
-indices (0-based, end exclusive), matched_stroke and a verdict dict (accepted, refusal name,
-expected_stroke, matched_stroke) or None); stroke numbers are 0-based, as per_stroke's index and
+mean_deviation_m, frechet_m, dtw_m [m], strokes_accepted, strokes_assisted, refusals: {reason: count},
+..., and per character under per_character its per_stroke (assisted: credited after
+acceptance.assist_after_misses refusals while due, as the renderer credits it) and segments: one dict per
+pen-down segment with begin/end sample indices (0-based, end exclusive), matched_stroke and a verdict dict
+(accepted, refusal name, expected_stroke, matched_stroke, assists_due) or None); stroke numbers are 0-based, as per_stroke's index and
 Scene(...).characters[0].strokes; a value that does not exist is None.
 Raises DataError (file unreadable, bad row: naming line and column), InvalidArgument (a bad column,
 sample or option, naming it), CharacterNotFound, TypeError.)");

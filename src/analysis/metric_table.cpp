@@ -128,6 +128,12 @@ const MetricInfo kMetrics[] = {
      .definition = "the assignment gave the stroke a segment",
      .levels = kStroke,
      .of_stroke = [](const StrokeScore& s) { return MetricValue(s.written); }},
+    {.name = "assisted",
+     .kind = MetricKind::flag,
+     .doc = "credited assisted in turn after `assist_after_misses` refused attempts while it was due",
+     .definition = "`StrokeScore::assisted` (`score_trace`, as the renderer credits it)",
+     .levels = kStroke,
+     .of_stroke = [](const StrokeScore& s) { return MetricValue(s.assisted); }},
     {.name = "backwards",
      .kind = MetricKind::flag,
      .doc = "the stroke was written from its end to its start",
@@ -325,8 +331,12 @@ const MetricInfo kMetrics[] = {
      .kind = MetricKind::count,
      .doc = "strokes credited as assisted after `assist_after_misses` refused attempts (not taken by the "
             "renderer)",
-     .definition = "`TrialMetrics::strokes_assisted`",
-     .levels = kRun,
+     .definition =
+         "a run's: `TrialMetrics::strokes_assisted`; a scored trace's: strokes credited in turn after "
+         "`assist_after_misses` refused verdicts (`score_trace`)",
+     .levels = kScene | kCharacter | kRun,
+     .of_scene = [](const WritingMetrics& m) { return count(m.strokes_assisted); },
+     .of_character = [](const CharacterScore& c) { return count(c.strokes_assisted); },
      .trials_column = 5,
      .if_missing = MetricMissing::zero},
     {.name = "trial_time_s",

@@ -193,18 +193,32 @@ CharacterScore score_trace(const PlacedCharacter& character, std::span<const Pen
     positions.push_back(std::move(p));
   }
 
-  // The renderer's verdict on each segment in sequence: the stroke expected advances with each acceptance.
+  // The renderer's verdict on each segment in sequence: the stroke expected advances with each acceptance,
+  // and after assist_after_misses refusals of it, as the renderer demonstrates and credits it
+  // (ActiveStroke::lift; Hanzi Writer's markStrokeCorrectAfterMisses).
   const std::size_t strokes = character.strokes.size();
+  const double assist_after = options.acceptance.assist_after_misses;
   std::size_t expected = 0;
+  double misses = 0.0;
   for (std::size_t w = 0; w < scored.size() && expected < strokes; ++w) {
     const StrokeMatch verdict =
         match_stroke(character, expected, positions[w], options.start_radius_m, options.acceptance);
-    score.segments[scored[w]].verdict = verdict;
+    WrittenSegment& segment = score.segments[scored[w]];
+    segment.verdict = verdict;
     if (verdict.accepted) {
       ++expected;
       ++score.strokes_accepted;
-    } else {
-      score.refusals.add(verdict.refusal);
+      misses = 0.0;
+      continue;
+    }
+    score.refusals.add(verdict.refusal);
+    misses += 1.0;
+    if (assist_after > 0.0 && misses >= assist_after) {
+      segment.assists_due = true;
+      score.strokes[expected].assisted = true;
+      ++score.strokes_assisted;
+      ++expected;
+      misses = 0.0;
     }
   }
 

@@ -14,6 +14,7 @@ void add_totals(WritingMetrics& metrics, const CharacterScore& score) {
   metrics.strokes_total += score.strokes.size();
   metrics.strokes_written += score.strokes_written;
   metrics.strokes_accepted += score.strokes_accepted;
+  metrics.strokes_assisted += score.strokes_assisted;
   metrics.order_errors += score.order_errors;
   metrics.backwards_strokes += score.backwards_strokes;
   metrics.unmatched_segments += score.unmatched_strokes;

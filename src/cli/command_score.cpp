@@ -6,6 +6,7 @@
 
 #include "calligraphy/analysis/writing_metrics.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/parameter_table.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/report/pen_trace_csv.hpp"
 #include "calligraphy/report/score_report.hpp"
@@ -22,6 +23,8 @@ struct ScoreCommand {
   std::string character;
   std::string units = "m";
   std::string json;
+  // The renderer's assisted credit, so that the verdicts in turn follow a trial's (StrokeAcceptance).
+  std::int64_t assist_after = static_cast<std::int64_t>(StrokeAcceptance{}.assist_after_misses);
   LibraryOptions library;
 };
 
@@ -50,6 +53,7 @@ int run_score(const ScoreCommand& command) {
   const std::vector<PenSample> trace = read_pen_trace_csv(command.trace, character.placement, options);
   progress.relabel("scoring " + command.trace);
   ScoreOptions score_options;
+  score_options.acceptance.assist_after_misses = static_cast<double>(command.assist_after);
   score_options.progress = [&progress](std::size_t matched, std::size_t total) {
     progress.update(matched, total, "segments");
   };
@@ -78,6 +82,11 @@ void add_score_command(CLI::App& root, Commands& commands) {
   add_choice(*app, "--units", command->units, {"m", "data"},
              "units of x and y: metres on the paper as `trial` places the character, or the character's "
              "1024-unit data box (y up)");
+  const ParameterRange assist_range = parameter_field(&StrokeAcceptance::assist_after_misses).range;
+  add_integer(*app, "--assist-after-misses", command->assist_after, "N",
+              "credit a stroke as assisted after N refused pen-downs while it is due, as a trial and the "
+              "trainer do, and judge the next; 0: never (the stroke acceptance's assist_after_misses)",
+              static_cast<std::int64_t>(assist_range.low), static_cast<std::int64_t>(assist_range.high));
   add_output_path(*app, "--json", command->json, "write the score as JSON", StandardOutput::allowed);
   add_library_options(*app, command->library, true);
 }

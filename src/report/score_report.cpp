@@ -59,8 +59,10 @@ nlohmann::json segments_json(const CharacterScore& score) {
           {"matched_stroke", v.matched_stroke},
           {"covered_fraction", v.covered_fraction},
           // No distance was measured from a stroke the pen never came near the start of.
-          {"mean_deviation_m", v.entered ? nlohmann::json(v.mean_deviation_m) : nlohmann::json(nullptr)}};
-      if (v.accepted) ++expected;
+          {"mean_deviation_m", v.entered ? nlohmann::json(v.mean_deviation_m) : nlohmann::json(nullptr)},
+          // The stroke due was credited assisted after this refusal (assist_after_misses): the next is due.
+          {"assists_due", s.assists_due}};
+      if (v.accepted || s.assists_due) ++expected;
     }
     out.push_back({{"begin", s.begin},
                    {"end", s.end},
@@ -77,12 +79,14 @@ nlohmann::json segments_json(const CharacterScore& score) {
 namespace {
 
 // One verdict per reference stroke, from the renderer's verdicts on the pen-downs in writing order: accepted
-// when a pen-down was accepted as it; else refused, by the last refusal about it (a wrong order or a wrong
+// when a pen-down was accepted as it; assisted when it was credited after assist_after_misses refusals while
+// it was due (the renderer's credit, so that the strokes after it are judged as the renderer judged them);
+// else refused, by the last refusal about it (a wrong order or a wrong
 // stroke is about the stroke the pen wrote, and so is a refused pen-down that wrote a later stroke from its
 // end, so that such a stroke is not called not written; any other refusal about the stroke that was due);
 // else not written.
 struct StrokeVerdict {
-  enum class State { not_written, accepted, refused } state = State::not_written;
+  enum class State { not_written, accepted, assisted, refused } state = State::not_written;
   StrokeRefusal refusal = StrokeRefusal::none;
   std::size_t due = 0;            // the stroke due when it was refused (0-based)
   bool entered = false;           // the refused pen-down came near the start of the stroke that was due
@@ -103,6 +107,15 @@ std::vector<StrokeVerdict> stroke_verdicts(const CharacterScore& score) {
       ++due;
       continue;
     }
+    if (segment.assists_due) {
+      // Its last refusal, as for a refused stroke, and the credit: what was off stays said.
+      if (due < verdicts.size()) {
+        verdicts[due] = {StrokeVerdict::State::assisted, match.refusal,         due, match.entered,
+                         match.mean_deviation_m,         match.covered_fraction};
+      }
+      ++due;
+      continue;
+    }
     const bool other_stroke =
         match.refusal == StrokeRefusal::wrong_order || match.refusal == StrokeRefusal::wrong_stroke;
     // A pen-down refused while one stroke was due that wrote a later one from its end (the assignment matched
@@ -113,7 +126,9 @@ std::vector<StrokeVerdict> stroke_verdicts(const CharacterScore& score) {
     const std::size_t about = other_stroke  ? match.matched_stroke
                               : out_of_turn ? *segment.matched_stroke
                                             : due;
-    if (about >= verdicts.size() || verdicts[about].state == StrokeVerdict::State::accepted) continue;
+    if (about >= verdicts.size() || verdicts[about].state == StrokeVerdict::State::accepted ||
+        verdicts[about].state == StrokeVerdict::State::assisted)
+      continue;
     verdicts[about] = {StrokeVerdict::State::refused, match.refusal,          due,        match.entered,
                        match.mean_deviation_m,        match.covered_fraction, out_of_turn};
   }
@@ -135,6 +150,12 @@ std::string verdict_text(const StrokeVerdict& v, std::size_t stroke) {
       return "accepted";
     case StrokeVerdict::State::not_written:
       return "not written";
+    case StrokeVerdict::State::assisted:
+      // Credited, not written: the last refusal says what was off.
+      if (!v.entered) return "assisted (last refused: " + reason_words(v.refusal) + ", never near its start)";
+      std::snprintf(text, sizeof text, "assisted (last refused: %s, %.1f mm off)",
+                    reason_words(v.refusal).c_str(), v.deviation_m * 1e3);
+      return text;
     case StrokeVerdict::State::refused:
       break;
   }
@@ -162,17 +183,19 @@ std::string verdict_text(const StrokeVerdict& v, std::size_t stroke) {
   }
 }
 
-// The verdicts' counts: accepted, refused (by reason), not written; they add up to the strokes.
+// The verdicts' counts: accepted, assisted, refused (by reason), not written; they add up to the strokes.
 struct VerdictCounts {
   std::size_t strokes = 0;
   std::size_t accepted = 0;
   std::size_t not_written = 0;
+  std::size_t assisted = 0;
   RefusalCounts refused;
   void add(const std::vector<StrokeVerdict>& verdicts) {
     for (const StrokeVerdict& v : verdicts) {
       ++strokes;
       if (v.state == StrokeVerdict::State::accepted) ++accepted;
       if (v.state == StrokeVerdict::State::not_written) ++not_written;
+      if (v.state == StrokeVerdict::State::assisted) ++assisted;
       if (v.state == StrokeVerdict::State::refused) refused.add(v.refusal);
     }
   }
@@ -190,6 +213,12 @@ std::string by_reason(const RefusalCounts& counts) {
 void append_verdict_counts(std::string& out, const VerdictCounts& c) {
   appendf(out, "  strokes accepted           %zu of %zu  (in turn, as the renderer judges each pen lift)\n",
           c.accepted, c.strokes);
+  if (c.assisted > 0) {
+    appendf(
+        out,
+        "  strokes assisted           %zu  (credited after the refusals the renderer allows, not written)\n",
+        c.assisted);
+  }
   appendf(out, "  strokes refused            %zu%s\n", c.refused.total(), by_reason(c.refused).c_str());
   appendf(out, "  strokes not written        %zu\n", c.not_written);
 }

@@ -97,6 +97,36 @@ def test_acceptance_and_start_radius_decide_the_verdicts():
         calligraphy.score(beside, "木", leniency=1.0)
 
 
+def joined(*traces):
+    """The traces one after another, each starting 0.2 s after the one before ends."""
+    out = {k: [] for k in ("t", "x", "y", "pen")}
+    start = 0.0
+    for trace in traces:
+        for k in ("x", "y", "pen"):
+            out[k].append(trace[k])
+        out["t"].append(trace["t"] + start)
+        start = out["t"][-1][-1] + 0.2
+    return {k: np.concatenate(v) for k, v in out.items()}
+
+
+def test_a_stroke_refused_often_enough_is_credited_assisted_as_the_renderer_credits_it():
+    missed = [reference_trace("木", offset_m=0.008, order=[0]) for _ in range(5)]  # 8 mm beside the first stroke
+    trace = joined(*missed, reference_trace("木", order=[1, 2, 3]))
+    credited = calligraphy.score(trace, "木")  # the renderer's default: credited after 5 refusals
+    assert credited["strokes_assisted"] == 1
+    assert credited["strokes_accepted"] == 3
+    assert credited["refusals"]["wrong_order"] == 0
+    character = credited["per_character"][0]
+    assert [s["assisted"] for s in character["per_stroke"]] == [True, False, False, False]
+    verdicts = [s["verdict"] for s in character["segments"]]
+    assert [v["assists_due"] for v in verdicts] == [False] * 4 + [True] + [False] * 3
+    assert [v["expected_stroke"] for v in verdicts] == [0] * 5 + [1, 2, 3]
+    never = calligraphy.score(trace, "木", acceptance=calligraphy.StrokeAcceptance(assist_after_misses=0))
+    assert never["strokes_assisted"] == 0
+    assert never["strokes_accepted"] == 0
+    assert never["refusals"]["wrong_order"] == 3
+
+
 def test_dataframe_and_csv_give_the_dict_result(tmp_path):
     pandas = pytest.importorskip("pandas")
     columns = reference_trace("大", offset_m=0.0005)

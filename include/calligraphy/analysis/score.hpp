@@ -11,9 +11,9 @@
 #include <span>
 #include <vector>
 
+#include "calligraphy/analysis/metrics.hpp"
 #include "calligraphy/analysis/stroke_matcher.hpp"
 #include "calligraphy/model/scene.hpp"
-#include "calligraphy/analysis/metrics.hpp"
 
 namespace calligraphy {
 
@@ -45,9 +45,13 @@ struct WrittenSegment {
   std::optional<StrokeKinematics> kinematics;  ///< every segment not ignored
   /// The verdict the renderer (and the quiz) would give this segment in sequence:
   /// `match_stroke(character, expected, its path, start_radius_m, acceptance)`, where `expected` is 0 for
-  /// the first segment judged and goes up by one after each accepted verdict. Absent for an ignored
-  /// segment and once every stroke has been accepted.
+  /// the first segment judged and goes up by one after each accepted verdict and after each stroke credited
+  /// assisted (`assists_due`). Absent for an ignored segment and once every stroke has been accepted or
+  /// credited.
   std::optional<StrokeMatch> verdict;
+  /// This refused verdict was the `acceptance.assist_after_misses`-th on the stroke due: that stroke is then
+  /// credited assisted, as the renderer demonstrates and credits it (StrokeAcceptance), and the next is due.
+  bool assists_due = false;
 };
 
 /// The most pen-down segments one scored trace may have (ScoreOptions::max_segments): a character has at
@@ -77,7 +81,10 @@ struct ScoreOptions {
 struct StrokeScore {
   std::size_t index = 0;  ///< in the character's stroke order, 0-based
   int typical_id = 0;
-  bool written = false;                ///< a written segment was matched to it
+  bool written = false;  ///< a written segment was matched to it
+  /// Credited assisted in turn: refused `acceptance.assist_after_misses` times while it was due
+  /// (WrittenSegment::assists_due), as the renderer credits it; such a stroke may still be `written` later.
+  bool assisted = false;
   std::optional<std::size_t> segment;  ///< index into CharacterScore::segments
   bool backwards = false;              ///< written from its end to its start
   /// Metrics of the matched segment against this stroke (for a backwards stroke, Frechet and DTW are taken
@@ -118,6 +125,9 @@ struct CharacterScore {
   /// Segment verdicts accepted (WrittenSegment::verdict): the strokes the renderer would have completed in
   /// turn, writing the trace with the pen.
   std::size_t strokes_accepted = 0;
+  /// Strokes credited assisted in turn (StrokeScore::assisted): the renderer's assisted credit, never
+  /// counted as accepted. 0 when `acceptance.assist_after_misses` is 0.
+  std::size_t strokes_assisted = 0;
   RefusalCounts refusals;  ///< segment verdicts refused, by reason
   CharacterWritingMetrics totals;
 };

@@ -21,6 +21,8 @@ struct WritingMetrics {
   std::size_t strokes_written = 0;         ///< reference strokes matched to a written segment
   /// Segments accepted in turn: the strokes the renderer (and the quiz) would have completed.
   std::size_t strokes_accepted = 0;
+  /// Strokes credited assisted in turn (CharacterScore::strokes_assisted), summed over characters.
+  std::size_t strokes_assisted = 0;
   std::size_t order_errors = 0;        ///< inversions of the writing order, summed over characters
   std::size_t backwards_strokes = 0;   ///< matched segments written from the stroke's end
   std::size_t unmatched_segments = 0;  ///< scored segments matched to no reference stroke
