@@ -351,6 +351,9 @@ RenderOutput Renderer::tick(const DeviceState& device) noexcept {
     force = passivity_.apply(device.position_m, device.velocity_m_s, chain_.last_output(), force);
     out.passivity_damping_n_s_per_m = passivity_.damping_n_s_per_m();
   }
+  // Every stroke written: nothing is left to guide, and the paper's force goes too (docs/force-rendering.md);
+  // the safety chain takes the force down to zero at its per-tick rate.
+  if (active_.finished()) force = Vec3::Zero();
   out.force_error = !force.allFinite();
   command(force, out);
   return out;
