@@ -242,6 +242,7 @@ RenderOutput Renderer::tick(const DeviceState& device) noexcept {
   const std::size_t stroke_before = active_.stroke_index();
   const std::size_t element_before = active_.element_index();
   const InteractionState state_before = state_;
+  const bool finished_before = active_.finished();
 
   StateInputs inputs;
   const double release_z =
@@ -351,6 +352,10 @@ RenderOutput Renderer::tick(const DeviceState& device) noexcept {
     force = passivity_.apply(device.position_m, device.velocity_m_s, chain_.last_output(), force);
     out.passivity_damping_n_s_per_m = passivity_.damping_n_s_per_m();
   }
+  // Every stroke written by an earlier tick: nothing is left to guide, and the paper's force goes too
+  // (docs/force-rendering.md); the safety chain takes the force down to zero at its per-tick rate. The tick
+  // that wrote the last stroke keeps its force, the last of the trial.
+  if (finished_before) force = Vec3::Zero();
   out.force_error = !force.allFinite();
   command(force, out);
   return out;

@@ -13,10 +13,17 @@
 namespace calligraphy {
 namespace {
 
-// Shortens `v` to at most `limit`, keeping its direction; true when it did.
+// Shortens `v` to at most `limit`, keeping its direction; true when it did. A finite force beyond 1e154 N has
+// a squared norm that overflows: its direction is then taken from the vector scaled by its largest component,
+// so that it is clamped, not zeroed.
 bool shorten(Vec3& v, double limit) noexcept {
   const double n = v.norm();
   if (n <= limit) return false;
+  if (std::isinf(n) && v.allFinite()) {
+    const Vec3 direction = v / v.cwiseAbs().maxCoeff();
+    v = direction * (limit / direction.norm());
+    return true;
+  }
   v *= n > 0.0 ? limit / n : 0.0;
   return true;
 }

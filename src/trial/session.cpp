@@ -56,6 +56,9 @@ void TrialSession::attach_display(DisplayChannel* channel) {
 void TrialSession::reserve_trace() { recorder_.reserve(max_ticks_); }
 
 ServoCommand TrialSession::step(const DeviceState& device_state) noexcept {
+  // Past the time limit the trial is over (a loop that went on after `stop`): nothing is recorded, so the
+  // trace stays within what reserve_trace() allocated and what kMaxTrialTicks bounds, and the force is zero.
+  if (ticks_ >= max_ticks_) return ServoCommand{Vec3::Zero(), true};
   // One time base for every device: the trial's clock starts at its first tick with a finite time stamp,
   // whatever the device's clock counts from (the simulated device from open(), OpenHaptics from the
   // machine's boot).

@@ -66,7 +66,8 @@ class TrialSession {
   void attach_display(DisplayChannel* channel);
 
   /// One servo tick: renders the force for `state` and records the tick. `stop` is set when every
-  /// stroke is written or the time limit is reached. Servo path: no lock, log or exception, and no
+  /// stroke is written or the time limit is reached; a step past the time limit (a loop that went on) records
+  /// nothing and commands zero force, with `stop` set. Servo path: no lock, log or exception, and no
   /// allocation after `reserve_trace()`. Times: the trial's clock starts at 0 with the first tick;
   /// `state.time_s` is on the device's clock (any origin) and only its differences are used. A stamp that is
   /// not finite gives zero force (a rejected reading); it and a stamp before the previous one are recorded at
