@@ -203,16 +203,17 @@ int run_report(const ReportCommand& command) {
     report_files.add(index_path, index);
     char line[512];
     std::snprintf(line, sizeof line, "%zu sessions, %zu trials, %zu pages in %s (%.1f MB)",
-                  study.sessions.size(), writer.trials.load(), pages.size(), pages_folder.string().c_str(),
+                  study.sessions.size(), writer.trials.load(), pages.size(),
+                  printable_name(pages_folder.string()).c_str(),
                   static_cast<double>(writer.bytes.load() + index.size()) / 1e6);
     pages_line = line;
   }
   report_files.commit();
   page_folders.keep();
   if (!tables_line.empty())
-    std::printf("%s: %s, %.1f s\n", command.csv.c_str(), tables_line.c_str(), elapsed());
+    std::printf("%s: %s, %.1f s\n", printable_name(command.csv).c_str(), tables_line.c_str(), elapsed());
   if (!pages_line.empty())
-    std::printf("%s: %s, %.1f s\n", command.out.c_str(), pages_line.c_str(), elapsed());
+    std::printf("%s: %s, %.1f s\n", printable_name(command.out).c_str(), pages_line.c_str(), elapsed());
   return 0;
 }
 

@@ -195,9 +195,11 @@ int report_run(std::string_view command, const SessionFolder& session, const Ses
   std::printf("%s: %zu of %zu trials saved (%zu now, %zu %s kept) in %s, %.1f s\n",
               session.manifest().setup.subject.id.c_str(), result.saved_before + result.saved_now,
               result.planned, result.saved_now, result.attempts_kept,
-              result.attempts_kept == 1 ? "attempt" : "attempts", session.path().c_str(), seconds);
+              result.attempts_kept == 1 ? "attempt" : "attempts",
+              printable_name(session.path().string()).c_str(), seconds);
   std::fflush(stdout);
-  const std::string resume = "resume with: calligraphy session resume " + session.path().string();
+  const std::string resume =
+      "resume with: calligraphy session resume " + printable_name(session.path().string());
   if (result.save_failed) {
     print_error_line(command, "error", result.failure + "; every trial saved before is kept; " + resume);
     return 1;

@@ -88,8 +88,8 @@ int run_session_cohort(const SessionCohortCommand& command) {
   const std::size_t used = std::min<std::size_t>(threads, subjects.size());
   std::printf(
       "%s: %zu subjects, %zu trials on %zu %s in %.1f s: trials.csv (%zu rows), strokes.csv (%zu rows)\n",
-      command.csv.c_str(), subjects.size(), tables.trials.size(), used, used == 1 ? "thread" : "threads",
-      seconds, tables.trials.size(), tables.strokes.size());
+      printable_name(command.csv).c_str(), subjects.size(), tables.trials.size(), used,
+      used == 1 ? "thread" : "threads", seconds, tables.trials.size(), tables.strokes.size());
   return 0;
 }
 

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <mutex>
 #include <set>
 
@@ -90,6 +91,10 @@ void print_error_line(std::string_view command, std::string_view kind, std::stri
   const std::string line = printable_one_line(command, 200) + ": " + printable_one_line(kind, 100) + ": " +
                            printable_one_line(message) + "\n";
   std::fputs(line.c_str(), stderr);
+}
+
+std::string printable_name(std::string_view text) {
+  return printable_one_line(text, std::numeric_limits<std::size_t>::max() / 2);
 }
 
 int finish_standard_output(int status, const std::string& command) {

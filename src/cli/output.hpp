@@ -46,6 +46,11 @@ std::string read_input_file(const std::string& path, const std::string& what);
 /// (docs/cli.md, "Errors").
 void print_error_line(std::string_view command, std::string_view kind, std::string_view message);
 
+/// `text` (a path the user gave, a folder made of it) as printable text, never cut: for the lines a command
+/// prints about what it did, so that a line break or an escape sequence in a name keeps the line one line and
+/// cannot act on the terminal (printable_one_line).
+std::string printable_name(std::string_view text);
+
 /// Flushes standard output and checks that everything written to it arrived; prints a one-line error
 /// and returns 1 (or `status` when that is already an error) when not. What main() returns.
 int finish_standard_output(int status, const std::string& command);

@@ -1,7 +1,9 @@
 #pragma once
 // Progress of a long step on the terminal: "\r<label> 42%" on stderr, only when stderr is a terminal (never
 // into a redirected log or a pipe), first shown after half a second and at most ten times a second; the
-// line is cleared when the step ends. CALLIGRAPHY_PROGRESS_AFTER_S (seconds) changes the half second.
+// line is cleared when the step ends (by spaces on a dumb terminal, TERM=dumb, which shows escapes as text).
+// The label is printed as printable text, so a file name cannot act on the terminal.
+// CALLIGRAPHY_PROGRESS_AFTER_S (seconds) changes the half second.
 #include <chrono>
 #include <cstddef>
 #include <string>
@@ -25,6 +27,8 @@ class TerminalProgress {
   void clear();
 
   bool enabled_ = false;
+  bool escapes_ = true;
+  std::size_t shown_bytes_ = 0;
   bool shown_ = false;
   std::string label_;
   std::chrono::steady_clock::duration first_shown_after_;

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "calligraphy/core/printable_text.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
 #include "report/appendf.hpp"
@@ -280,7 +281,8 @@ std::string score_table(const ScoreDescription& d, const WritingMetrics& metrics
   appendf(out,
           "Score of %s against %s (%zu samples, x and y in %s; strokes numbered from 1 here, from 0 in the "
           "JSON)\n",
-          d.trace.c_str(), d.character.c_str(), d.samples,
+          // The file's name as printable text: an escape sequence in it cannot act on the terminal.
+          printable_one_line(d.trace).c_str(), d.character.c_str(), d.samples,
           // `--units data`: the character's 1024-unit data box, named as a unit for a person.
           d.units == "data" ? "data units (1024 per character)" : d.units.c_str());
   VerdictCounts all;
