@@ -753,6 +753,41 @@ class Journals(Case):
         self.assertEqual((tables / "notes.txt").read_text(), "the user's notes\n")
         self.assertEqual((tables / "trials.csv").read_text(), "earlier trials.csv\n")
 
+    def test_journal_naming_one_file_twice_leaves_a_whole_set(self):
+        tables = self.tables()
+        pid = dead_pid()
+        for n in (0, 1):
+            (tables / f".trials.csv.tmp-{pid}-{n}").write_text(f"forged {n}\n")
+        journal = self.plant(tables, [("trials.csv", f".trials.csv.kept-{pid}-{n}", f".trials.csv.tmp-{pid}-{n}")
+                                      for n in (0, 1)], pid=pid)
+        result = self.report("--csv", "tables")
+        if result.returncode == 0:
+            self.assertEqual(tree(tables), self.fresh)
+        else:
+            self.assert_refused_and_left(result, journal)
+            self.assertEqual((tables / "trials.csv").read_text(), "earlier trials.csv\n")
+
+    def test_journal_naming_no_file_leaves_a_whole_set(self):
+        tables = self.tables()
+        journal = self.plant(tables, [])
+        result = self.report("--csv", "tables")
+        if result.returncode == 0:
+            self.assertEqual(tree(tables), self.fresh)
+        else:
+            self.assert_refused_and_left(result, journal)
+
+    def test_journal_whose_temporary_is_a_hard_link_to_a_file_outside_leaves_that_file(self):
+        tables = self.tables()
+        outside, before = self.outside()
+        pid = dead_pid()
+        os.link(outside / "victim.csv", tables / f".trials.csv.tmp-{pid}-0")
+        self.plant(tables, [("trials.csv", f".trials.csv.kept-{pid}-0", f".trials.csv.tmp-{pid}-0")], pid=pid)
+        result = self.report("--csv", "tables")
+        self.assertIn(result.returncode, (0, 1), result.stderr.decode())
+        if result.returncode == 0:
+            self.assertEqual(tree(tables), self.fresh)
+        self.assertEqual(tree(outside), before, "the file outside changed through its hard link")
+
     def test_huge_journal_is_refused_without_reading_it_all(self):
         tables = self.tables()
         journal = tables / f"{JOURNAL_PREFIX}{dead_pid()}-9.journal"
