@@ -201,6 +201,11 @@ while True:
     elif kind == "twice":
         reply(number, sizes)
         reply(number, {"fixed.csv": 1, "random.csv": 1, "anova.csv": 1, "fit.csv": 1})
+    elif kind == "error":
+        say(f"@@calligraphy-reply {number} error {m['message'].encode().hex()}\n")
+    elif kind == "raw":  # a reply line as the mode spells it, NUMBER standing for the request's number
+        say(m["line"].replace("NUMBER", number) + "\n")
+        sys.exit(0)
     elif kind == "garbage":
         say(b"\x00\xff\xfe garbage \x80\n@@calligraphy-reply\n@@calligraphy-reply x ok zz\n\xc3\x28\n")
         sys.exit(0)
@@ -426,11 +431,39 @@ class RServing(unittest.TestCase):
         self.assertEqual(fit.fixed.set_index("term").loc["(Intercept)", "estimate"], 42.5)
         self.assert_good_fit()  # not the second reply to the request before it
 
-    def test_r_answering_a_p_above_one_fails_the_fit_alone(self):
-        self.assert_spoils_this_fit_only(kind="good", p=1.5)
+    def test_r_answering_a_p_outside_zero_and_one_fails_the_fit_alone(self):
+        for p in (1.5, -0.1, "Inf"):
+            with self.subTest(p=p):
+                self.assert_spoils_this_fit_only(kind="good", p=p)
 
-    def test_r_answering_a_negative_variance_fails_the_fit_alone(self):
-        self.assert_spoils_this_fit_only(kind="good", variance=-0.375)
+    def test_r_answering_a_negative_or_infinite_variance_fails_the_fit_alone(self):
+        for variance in (-0.375, "NaN", "Inf"):
+            with self.subTest(variance=variance):
+                self.assert_spoils_this_fit_only(kind="good", variance=variance)
+
+    def test_r_whose_reply_is_malformed_fails_the_fit_alone(self):
+        ok = ";".join(["fixed.csv=339", "random.csv=76", "anova.csv=99", "fit.csv=211"]).encode().hex()
+        lines = {"another status": f"@@calligraphy-reply NUMBER maybe {ok}",
+                 "an odd hex field": f"@@calligraphy-reply NUMBER ok {ok[:-1]}",
+                 "four fields": f"@@calligraphy-reply NUMBER ok {ok} {ok}",
+                 "a number spelt 0N": f"@@calligraphy-reply 0NUMBER ok {ok}",
+                 "no field": "@@calligraphy-reply NUMBER ok"}
+        for name, line in lines.items():
+            with self.subTest(reply=name):
+                self.assert_spoils_this_fit_only(kind="raw", line=line)
+
+    def test_r_that_cannot_fit_says_why_in_one_line_and_the_next_fit_is_answered(self):
+        """lme4 refusing a model is R's answer, not a broken R: a RuntimeError naming R's message (on one line,
+        as a table's cell holds it), never taken for R unavailable."""
+        self.assert_good_fit()
+        self.fake.set(kind="error", message="Error: grouping factors must have > 1 sampled level\n<b>x</b>")
+        with self.assertRaises(RuntimeError) as caught:
+            self.fit()
+        self.assertNotIsInstance(caught.exception, mixed_models.RUnavailable)
+        message = str(caught.exception)
+        self.assertIn("grouping factors must have > 1 sampled level", message)
+        self.assertNotIn("\n", message)
+        self.assert_good_fit()
 
     def test_r_answering_a_negative_covariance_is_taken_at_its_word(self):
         """A covariance of two random effects may be negative (lmer_fit.R names its row "GROUP cov A B"):
