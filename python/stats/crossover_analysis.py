@@ -215,6 +215,7 @@ def _fit_rows(frame: "pandas.DataFrame", fixed: list[str], base: dict, design: "
             estimate=float(effect.estimate), ci95_low=float(effect.ci95_low) if trusted else math.nan,
             ci95_high=float(effect.ci95_high) if trusted else math.nan, g=g, g_ci95_low=g_low, g_ci95_high=g_high,
             note=note))
+    rows += design_models.absent_effect_rows(fit, "condition", levels, design.control, base, model=model)
     return rows + design_models.pair_rows(
         fit, levels, design.control, {**base, "model": model}, note,
         lambda a, b: int(frame.loc[frame["condition"].isin([a, b]), "subject"].nunique()),

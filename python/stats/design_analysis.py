@@ -408,6 +408,7 @@ def _training_rows(data: pandas.DataFrame, value: str, design: StudyDesign, ddf:
             ci95_low=float(effect.ci95_low) if trusted else math.nan,
             ci95_high=float(effect.ci95_high) if trusted else math.nan, g=g, g_ci95_low=g_low, g_ci95_high=g_high,
             note=note))
+    rows += design_models.absent_effect_rows(fit, "factor", levels, design.control, base)
     return rows + design_models.pair_rows(
         fit, levels, design.control, base, note,
         lambda a, b: int(frame.loc[frame["factor"].isin([a, b]), "subject"].nunique()), g_between)

@@ -311,6 +311,17 @@ def not_computed_rows(base: dict, levels: list[str], control: str, note: str, **
             for comparison in planned_comparisons(levels, control)]
 
 
+def absent_effect_rows(fit: "mixed_models.LmerFit", factor: str, levels: list[str], control: str, base: dict,
+                       **kw) -> list[dict]:
+    """A "not computed" row for each level against the control that R's fit has no fixed effect for (lme4
+    drops the column of a level it cannot tell apart from the others, a rank-deficient design), so that no
+    planned comparison leaves the table without a word."""
+    present = set(fit.fixed.loc[fit.fixed["factor"] == factor, "level"])
+    return [row(**base, comparison=f"{level} - {control}", note=f"not computed: R's fit has no fixed effect for "
+                f"{level} (lme4 drops a level it cannot estimate)", **kw)
+            for level in levels if level != control and level not in present]
+
+
 def pair_rows(fit: "mixed_models.LmerFit", levels: list[str], control: typing.Optional[str], base: dict, note: str,
               counts: typing.Callable[[str, str], int],
               g: typing.Optional[typing.Callable[[float, str, str], tuple[float, float, float]]] = None

@@ -17,7 +17,9 @@ signal too.
 from __future__ import annotations
 
 import atexit
+import csv
 import dataclasses
+import io
 import os
 import pathlib
 import shutil
@@ -35,6 +37,8 @@ __all__ = ["LmerFit", "RAnswerError", "RUnavailable", "lmer", "r_available"]
 _SCRIPT = pathlib.Path(__file__).with_name("lmer_fit.R")
 # A fit of a few thousand trials takes seconds; a hung R is stopped instead of hanging a report.
 _TIMEOUT_S = 600.0
+# A reply is a few hundred bytes; a package's chatter is lines of text. A longer line is no answer.
+_LONGEST_LINE_BYTES = 64 << 20
 
 
 class RUnavailable(RuntimeError):
@@ -105,10 +109,11 @@ _R_CHECKED: list[bool] = []
 
 class RAnswerError(RUnavailable):
     """R could not answer one fit as a whole: it ended, hung past the timeout, or answered with something
-    other than its one framed reply and the result files that reply names (missing, cut, not UTF-8, or
-    columns that are not the script's). Like ``RUnavailable`` the fit is "not computed": a caller never
-    takes it for lme4 refusing a model, and so never reduces the model because of it. The next fit gets a
-    new R process."""
+    other than its one framed reply and the result files that reply names (missing, cut, not UTF-8,
+    columns that are not the script's, or numbers no fit gives: an infinite estimate, a negative variance, a
+    p outside [0, 1]). Like ``RUnavailable`` the fit is "not computed": a caller never takes it for lme4
+    refusing a model, and so never reduces the model because of it. The R that spoilt it is ended with every
+    process it started, and the next fit gets a new R process."""
 
 
 def _hex(text: str) -> str:
@@ -116,13 +121,14 @@ def _hex(text: str) -> str:
 
 
 def _keep_with_parent() -> None:  # pragma: no cover - runs in the child between fork and exec
-    """Linux: the child gets SIGTERM when the thread that started it ends, so R never outlives a Python
-    killed by a signal (prctl PR_SET_PDEATHSIG). Elsewhere R ends when its standard input closes."""
+    """Linux: the child gets SIGKILL when the thread that started it ends, so R never outlives a Python
+    killed by a signal (prctl PR_SET_PDEATHSIG), not even an R that ignores SIGTERM. Elsewhere R ends when its
+    standard input closes."""
     import ctypes
     import signal
 
     try:
-        ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGTERM), 0, 0, 0)
+        ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGKILL), 0, 0, 0)
     except (OSError, AttributeError):
         pass
 
@@ -148,7 +154,8 @@ class _RServer:
             try:
                 started.append(subprocess.Popen(
                     [rscript, "--vanilla", str(_SCRIPT), "--serve"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                    stderr=self.log, bufsize=0, preexec_fn=_keep_with_parent if os.name == "posix" else None))
+                    stderr=self.log, bufsize=0, preexec_fn=_keep_with_parent if os.name == "posix" else None,
+                    start_new_session=os.name == "posix"))
             except OSError as error:
                 started.append(error)
             ready.set()
@@ -200,21 +207,44 @@ class _RServer:
 
         assert self.process.stdout is not None
         descriptor = self.process.stdout.fileno()
+        pending = bytearray(self.unread)
+        searched = 0  # the line break is looked for in what came since, so a long line costs its length once
         with selectors.DefaultSelector() as selector:
             selector.register(descriptor, selectors.EVENT_READ)
-            while b"\n" not in self.unread:
-                if not selector.select(max(0.0, deadline - time.monotonic())):
-                    raise TimeoutError
-                chunk = os.read(descriptor, 65536)
+            while (end := pending.find(b"\n", searched)) < 0:
+                searched = len(pending)
+                if searched > _LONGEST_LINE_BYTES:
+                    raise ValueError(f"a line of more than {_LONGEST_LINE_BYTES} bytes")
+                # In slices, so that an R that ended while a child of its still holds the pipe open is seen
+                # to have ended (its output read first), not waited on until the time-out.
+                ended = self.process.poll() is not None
+                if not selector.select(0.0 if ended else min(0.5, max(0.0, deadline - time.monotonic()))):
+                    if ended:
+                        raise EOFError(self.stderr_tail())
+                    if time.monotonic() >= deadline:
+                        raise TimeoutError
+                    continue
+                chunk = os.read(descriptor, 1 << 20)
                 if not chunk:
                     raise EOFError(self.stderr_tail())
-                self.unread += chunk
-        line, _, self.unread = self.unread.partition(b"\n")
+                pending += chunk
+        line, self.unread = bytes(pending[:end]), bytes(pending[end + 1:])
         return line.decode("utf-8", errors="replace").rstrip("\r")
 
     def stderr_tail(self) -> str:
         self.log.seek(0)
         return " ".join(self.log.read().split())[-600:]
+
+    def kill(self) -> None:
+        """R and whatever it started (its process group) ended at once."""
+        if os.name == "posix":
+            import signal
+
+            try:
+                os.killpg(self.process.pid, signal.SIGKILL)
+            except OSError:
+                pass
+        self.process.kill()
 
     def close(self) -> None:
         if self.running():
@@ -223,7 +253,8 @@ class _RServer:
                 self.process.stdin.close()
                 self.process.wait(timeout=5)
             except (OSError, subprocess.TimeoutExpired):
-                self.process.kill()
+                pass
+        self.kill()  # also a child R left behind, which would hold the pipes open
         self.process.wait()
         # The pipes too, whether it ended by itself or was killed: none is left for the collector to find.
         for pipe in (self.process.stdin, self.process.stdout):
@@ -250,24 +281,31 @@ def _close_server() -> None:
 atexit.register(_close_server)
 
 
-def _fit_in_r(rscript: str, folder: str, formula: str, ddf: str) -> dict[str, int]:
-    """Has the process's R server fit the model in ``folder`` and returns the result files its reply names,
-    with their sizes in bytes. Raises RuntimeError naming the formula and R's message when lme4 cannot fit
-    it; RAnswerError when R hangs past the timeout, ends or answers out of protocol (the server is then
-    stopped, and the next fit starts another)."""
+def _fit_in_r(rscript: str, folder: str, formula: str, ddf: str) -> dict[str, "pandas.DataFrame"]:
+    """Has the process's R server fit the model in ``folder`` and returns the result tables its reply names,
+    each checked whole (``_read_answer``). Raises RuntimeError naming the formula and R's message when lme4
+    cannot fit it; RAnswerError when R hangs past the timeout, ends, answers out of protocol or with result
+    files that are not whole (the server is then stopped, and the next fit starts another)."""
     one_line = " ".join(formula.split())
     with _SERVER_LOCK:
         if _SERVER and (_SERVER[0].pid != os.getpid() or not _SERVER[0].running()):
-            _SERVER.pop()  # a parent's (after fork) or one that ended: start another
+            ended = _SERVER.pop()  # a parent's (after fork) or one that ended: start another
+            if ended.pid == os.getpid():
+                ended.close()  # and end what the one that ended left running
         if not _SERVER:
             _SERVER.append(_RServer(rscript))
         server = _SERVER[0]
         try:
             status, text = server.fit(folder, formula, ddf, _TIMEOUT_S)
-        except (TimeoutError, EOFError, OSError, ValueError) as error:
+            if status != "ok":
+                raise RuntimeError(f"lmer: R could not fit {one_line}: {' '.join(text.split())[-600:]}")
+            return _read_answer(folder, formula, _named_files(text, one_line))
+        except (TimeoutError, EOFError, OSError, ValueError, RAnswerError) as error:
             _SERVER.pop()
-            server.process.kill()
+            server.kill()
             server.close()
+            if isinstance(error, RAnswerError):
+                raise
             if isinstance(error, TimeoutError):
                 why = f"did not finish fitting {one_line} in {_TIMEOUT_S:.0f} s"
             elif isinstance(error, ValueError):
@@ -275,12 +313,14 @@ def _fit_in_r(rscript: str, folder: str, formula: str, ddf: str) -> dict[str, in
             else:
                 why = f"ended while fitting {one_line}: {error}"
             raise RAnswerError("lmer: R " + why) from error
-    if status != "ok":
-        raise RuntimeError(f"lmer: R could not fit {one_line}: {' '.join(text.split())[-600:]}")
+
+
+def _named_files(text: str, one_line: str) -> dict[str, int]:
+    """The result files an 'ok' reply names, with their sizes in bytes."""
     files: dict[str, int] = {}
     for entry in text.split(";"):
         name, _, size = entry.partition("=")
-        if not size.isdigit():
+        if not (size.isascii() and size.isdigit()):
             raise RAnswerError(f"lmer: R answered the fit of {one_line} with an unreadable file list {text[:200]!r}")
         files[name] = int(size)
     return files
@@ -317,13 +357,16 @@ def _read_answer(folder: str, formula: str, files: typing.Mapping[str, int]) -> 
                 problem = f"{size} bytes where R's reply says {files[name]}"
             else:
                 with open(path, encoding="utf-8", errors="strict") as stream:
-                    table = pandas.read_csv(stream, dtype={"fit.csv": str, "pairs.csv": {"contrast": str}}.get(name),
-                                            keep_default_na=name != "fit.csv")
+                    text = stream.read()
+                table = pandas.read_csv(io.StringIO(text), dtype={"fit.csv": str, "pairs.csv": {"contrast": str}}.get(
+                    name), keep_default_na=name != "fit.csv")
                 if tuple(table.columns) != columns:
                     problem = f"columns {list(table.columns)} where {list(columns)} belong"
                 elif name != "fit.csv" and len(table) and any(not pandas.api.types.is_numeric_dtype(table[c])
                                                for c in columns[1:]):
                     problem = "a value that is not a number"
+                else:
+                    problem = _cut_row(text, len(columns)) or _impossible_number(name, table)
                 tables[name] = table
         except FileNotFoundError:
             problem = "missing"
@@ -334,6 +377,55 @@ def _read_answer(folder: str, formula: str, files: typing.Mapping[str, int]) -> 
         if problem is not None:
             raise RAnswerError(f"lmer: R's answer to the fit of {one_line} is not whole: {name} {problem}")
     return tables
+
+
+def _cut_row(text: str, width: int) -> typing.Optional[str]:
+    """What shows a result file cut at its size (R's write.csv ends every row, the last too, with a line
+    break, and gives every row every column), or None."""
+    if text and not text.endswith("\n"):
+        return "cut: no line break at its end"
+    for number, row in enumerate(csv.reader(io.StringIO(text)), start=1):
+        if len(row) != width:
+            return f"cut: row {number} has {len(row)} fields where {width} belong"
+    return None
+
+
+# The numbers no fit of finite data gives: an infinite or missing estimate or variance, a negative standard
+# error, variance, F or degrees of freedom, a p outside [0, 1]. (A missing df, t, F or p is R's NA, which a
+# fit may give; random.csv's rows named "GROUP cov A B" are covariances, which may be negative.)
+_NUMBER_RULES = {
+    "fixed.csv": {"finite": ("estimate",), "not_infinite": ("std_error", "ci95_low", "ci95_high"),
+                  "non_negative": ("std_error", "df"), "probability": ("p",)},
+    # emmeans gives NA for a contrast it cannot estimate
+    "pairs.csv": {"not_infinite": ("estimate", "std_error", "ci95_low", "ci95_high"),
+                  "non_negative": ("std_error", "df"), "probability": ("p", "p_holm")},
+    "random.csv": {"finite": ("variance",), "non_negative": ("variance",)},
+    "anova.csv": {"non_negative": ("num_df", "den_df", "f"), "probability": ("p",)},
+}
+
+
+def _impossible_number(name: str, table: "pandas.DataFrame") -> typing.Optional[str]:
+    """The first number of ``table`` (result file ``name``) no fit gives, named by column and row, or None."""
+    import numpy
+
+    rules = _NUMBER_RULES.get(name, {})
+    checks = {
+        "finite": lambda v: numpy.isfinite(v),
+        "not_infinite": lambda v: ~numpy.isinf(v),
+        "non_negative": lambda v: numpy.isnan(v) | (v >= 0),
+        "probability": lambda v: numpy.isnan(v) | ((v >= 0) & (v <= 1)),
+    }
+    words = {"finite": "not a finite number", "not_infinite": "infinite", "non_negative": "negative",
+             "probability": "outside [0, 1]"}
+    covariance = (table["group"].astype(str).str.contains(" cov ", regex=False).to_numpy() if name == "random.csv"
+                  else numpy.zeros(len(table), dtype=bool))
+    for rule, columns in rules.items():
+        for column in columns:
+            values = table[column].to_numpy(dtype=float)
+            bad = numpy.flatnonzero(~checks[rule](values) & ~(covariance & (rule == "non_negative")))
+            if bad.size:
+                return f"{column} {values[bad[0]]!r} in row {bad[0] + 2} is {words[rule]}"
+    return None
 
 
 def _r_backquoted(name: str) -> str:
@@ -402,7 +494,7 @@ def lmer(frame: "pandas.DataFrame", formula: str, factors: typing.Mapping[str, t
         levels = [{"factor": name, "level": str(level)} for name, values in factors.items() for level in values]
         pandas.DataFrame(levels, columns=["factor", "level"]).to_csv(os.path.join(folder, "levels.csv"),
                                                                     index=False, encoding="utf-8")
-        answer = _read_answer(folder, formula, _fit_in_r(rscript, folder, formula, ddf))
+        answer = _fit_in_r(rscript, folder, formula, ddf)
     fixed, random, terms = answer["fixed.csv"], answer["random.csv"], answer["anova.csv"]
     info = dict(answer["fit.csv"].itertuples(index=False, name=None))
     pairs = answer.get("pairs.csv")
