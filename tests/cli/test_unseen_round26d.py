@@ -972,6 +972,191 @@ class Round26D(unittest.TestCase, OneErrorLine):
         for key in self.session_schema["required"]:
             self.assertNotIn(key, optional)
 
+    def assert_keys_named(self, document, named, where, extra=()):
+        """Every key of `document`, at every depth of objects and lists of objects, is one `named`."""
+        def walk(value, path):
+            if isinstance(value, dict):
+                for key, inner in value.items():
+                    with self.subTest(where=where, key=f"{path}/{key}"):
+                        self.assertTrue(key in named or key in extra, f"{where}: {path}/{key} is in no docs")
+                    walk(inner, f"{path}/{key}")
+            elif isinstance(value, list):
+                for inner in value[:2]:
+                    walk(inner, path + "/N")
+        walk(document, "")
+
+    def test_session_plan_json_keys_are_the_docs_list(self):
+        plan = json.loads(run_ok(["session", "plan", "p.json", "--subjects", "1", "--json"], self.tmp).stdout)
+        text = section(DOCS / "cli.md", "## session plan")
+        named = set(re.findall(r"`(\w+)`", text))
+        self.assert_keys_named(plan, named, "session plan --json")
+        first = plan["subjects"][0]["sessions"][0]["phases"][0]
+        self.assertEqual(first["first_trial"], 1, "1-based: the index of the phase's first trial in the plan")
+
+    def test_devices_json_keys_are_the_docs_list_and_pythons(self):
+        listing = json.loads(run_ok(["devices", "--json"], self.tmp).stdout)
+        text = section(DOCS / "cli.md", "## devices")
+        named = set(re.findall(r"`(\w+)`", text))
+        self.assert_keys_named(listing, named, "devices --json")
+        info = next(d for d in listing["devices"] if d["name"] == "simulated")["info"]
+        for key, value in info.items():
+            if isinstance(value, float):
+                self.assertRegex(key, r"_(n|m|n_per_m|n_s_per_m)$", "a number's key carries its unit")
+        if cg is not None:
+            python = next(d for d in cg.list_devices().devices if d.name == "simulated").info.to_dict()
+            self.assertEqual(sorted(python), sorted(info))
+
+    def test_characters_json_keys_and_numbers_are_the_docs_and_the_models(self):
+        listing = json.loads(run_ok(["characters", "--text", "十口x", "--json"], self.tmp).stdout)
+        text = section(DOCS / "cli.md", "## characters")
+        m = re.search(r"`--json` prints an object: (.*?)Exit status", text, re.S)
+        named = set(re.findall(r"`(\w+)`", m.group(1)))
+        self.assertEqual(named, {"library", "count", "characters", "character", "code_point", "strokes",
+                                 "typical_ids", "typical_strokes", "not_found"})
+        self.assert_keys_named(listing, named, "characters --json")
+        for entry in listing["characters"]:
+            model = self.models[entry["character"]]["strokes"]
+            self.assertEqual(entry["code_point"], f"U+{ord(entry['character']):04X}")
+            self.assertEqual(entry["typical_ids"], [s["typical_id"] for s in model])
+            self.assertEqual(entry["typical_strokes"], [s["acronym"] for s in model])
+            self.assertEqual(entry["strokes"], len(model))
+        self.assertEqual(listing["count"], 2)
+
+    def cohort_tables(self):
+        """`session cohort` of the protocol with its defaults, once."""
+        if not (self.tmp / "C" / "trials.csv").exists():
+            (self.tmp / "C").mkdir(exist_ok=True)
+            run_ok(["session", "cohort", "p.json", "--subjects", "1", "--csv", "C"], self.tmp)
+        return self.tmp / "C"
+
+    def test_python_cohort_defaults_are_the_commands(self):
+        # docs/python.md: simulate(..., profile="novice", learning="two-state", individual_differences=True,
+        # prefix="S"), the defaults of `session cohort`'s --writer-profile, --writer-learning,
+        # --individual-differences and --subject: the same subjects give the same rows.
+        self.need_python()
+        import calligraphy.cohort
+        folder = self.cohort_tables()
+        study = calligraphy.cohort.simulate(str(self.tmp / "p.json"), 1, progress=False)
+        rows = list(csv.DictReader(io.StringIO((folder / "trials.csv").read_text(encoding="utf-8"))))
+        frame = study.trials
+        self.assertEqual(list(frame.columns), self.trials_header)
+        self.assertEqual(list(frame["subject"]), [r["subject"] for r in rows])
+        for key in ("mean_deviation_m", "total_time_s", "shape_skill", "subject_motor_noise_factor"):
+            with self.subTest(key=key):
+                self.assertEqual([float(v) for v in frame[key]], [float(r[key]) for r in rows])
+        self.assertEqual(set(frame["writer_learning"]), {"two-state"})
+        self.assertEqual(set(frame["writer_profile"]), {"novice"})
+
+    def test_cohort_and_report_tables_have_one_header(self):
+        self.cohort_tables()
+        for name, header in (("trials.csv", self.trials_header), ("strokes.csv", self.strokes_header)):
+            with self.subTest(table=name):
+                text = (self.tmp / "C" / name).read_text(encoding="utf-8")
+                self.assertEqual(text.splitlines()[0].split(","), header)
+        rows = list(csv.DictReader(io.StringIO((self.tmp / "C" / "trials.csv").read_text(encoding="utf-8"))))
+        self.assertEqual([int(r["trial"]) for r in rows], [1, 2, 3, 4])
+        self.assertEqual({r["session"] for r in rows}, {"vocab-S01-s1"})
+
+    def test_log_events_and_fields_are_the_docs_table(self):
+        text = section(DOCS / "experiments.md", "## Sessions")
+        table = {ticked(r[0])[0]: set(re.findall(r"`(\w+)`", r[2])) for r in markdown_rows(text)
+                 if r and ticked(r[0]) and len(r) == 3}
+        self.assertIn("trial_saved", table)
+        trial_fields = {"trial", "phase", "condition", "characters", "repetition", "file"}
+        records = {p.name.split("-")[0]: json.loads(p.read_text(encoding="utf-8"))
+                   for p in (self.session_dir / "trials").glob("*.json")}
+        lines = (self.session_dir / "log.jsonl").read_text(encoding="utf-8").splitlines()
+        for line in lines:
+            entry = json.loads(line)
+            event = entry["event"]
+            with self.subTest(event=event):
+                self.assertIn(event, table)
+                allowed = table[event] | {"event", "time_utc"} | (trial_fields if event.startswith("trial_")
+                                                                  else set())
+                self.assertEqual(set(entry) - allowed, set(), event)
+                if event == "trial_saved":
+                    # `time_s`: the record's `total_time_s`, in s; `trial` 1-based, the NNN of its file.
+                    record = records[f"{entry['trial']:03d}"]
+                    self.assertEqual(entry["time_s"], record["total_time_s"])
+                    self.assertTrue(entry["file"].startswith(f"{entry['trial']:03d}-"))
+        self.assertEqual(json.loads(lines[-1])["event"], "session_completed")
+
+    def test_rate_and_duration_count_ticks_in_hz_and_seconds(self):
+        out = self.cli("trial", "十", "--rate", "500", "--max-duration", "0.05", "--csv", "r500.csv", "--json",
+                       "r500.json")
+        self.assertEqual(out.returncode, 1, "a trial at its time limit ended early")
+        record = json.loads((self.tmp / "r500.json").read_text(encoding="utf-8"))
+        rows = list(csv.DictReader(io.StringIO((self.tmp / "r500.csv").read_text(encoding="utf-8"))))
+        # --max-duration x --rate servo ticks: 0.05 s x 500 Hz = 25 ticks, 2 ms apart, from t = 0.
+        self.assertEqual(len(rows), 25)
+        self.assertEqual([float(r["t"]) for r in rows[:2]], [0.0, 0.002])
+        self.assertEqual((record["rate_hz"], record["end_reason"]), (500, "time_limit"))
+        self.assertAlmostEqual(record["trial_time_s"], 0.05, delta=1e-9)
+        trial = record["specification"]["trial"]
+        self.assertEqual((trial["rate_hz"], trial["max_duration_s"]), (500, 0.05))
+
+    def test_writer_settings_are_one_text_from_option_and_python(self):
+        out = self.tmp / "param.json"
+        self.cli("trial", "十", "--writer-param", "bias_offset_m=0.004", "--max-duration", "0.05", "--json", out.name)
+        record = json.loads(out.read_text(encoding="utf-8"))
+        self.assertEqual(record["writer_parameters"], ["bias_offset_m=0.004"])
+        stated = record["specification"]["trial"]["writer_parameters"]
+        self.assertEqual(len(stated), 1)
+        if cg is not None:
+            r = cg.simulate_trial("十", writer_params={"bias_offset_m": 0.004}, max_duration_s=0.05,
+                                  keep_trace=False)
+            self.assertEqual(r.metrics["writer_parameters"], record["writer_parameters"])
+            self.assertEqual(r.metrics["specification"]["trial"]["writer_parameters"], stated)
+            self.assertEqual(r.metrics["specification"]["writer"], record["specification"]["writer"])
+
+    def test_a_trace_in_data_units_scores_in_metres(self):
+        self.need_python()
+        scene = cg.Scene("十")
+        placement = scene.characters[0].placement
+        lines = ["t,x,y,z"]
+        for r in self.trace:
+            x, y = placement.to_data([float(r["x"]), float(r["y"])])
+            lines.append(f"{r['t']},{x!r},{y!r},{r['z']}")
+        (self.tmp / "data-units.csv").write_text("\n".join(lines) + "\n", encoding="utf-8")
+        in_data = json.loads(run_ok(["score", "data-units.csv", "--character", "十", "--units", "data", "--json",
+                                     "-"], self.tmp).stdout)
+        self.assertEqual(in_data["units"], "data")
+        for key in ("mean_deviation_m", "max_deviation_m", "frechet_m", "dtw_m", "total_time_s"):
+            with self.subTest(key=key):
+                # Lengths stay metres on the paper whatever the trace's units.
+                self.assertAlmostEqual(in_data[key], self.score[key], delta=1e-7)
+        by_python = cg.score(str(self.tmp / "data-units.csv"), "十", units="data")
+        self.assertAlmostEqual(by_python["mean_deviation_m"], self.score["mean_deviation_m"], delta=1e-7)
+
+    def test_a_protocols_trial_settings_reach_plan_session_and_records(self):
+        # The protocol's `trial.max_duration_s` (30 here) and `trial.rate_hz` (left out: the schema's default)
+        # are the plan's, each study record's specification and each record's renderer figures, in s and Hz.
+        schema = {ticked(r[0])[0]: r for r in markdown_rows(run_ok(["schema", "protocol", "--markdown"],
+                                                                    self.tmp).stdout.decode()) if ticked(r[0])}
+        rate = float(schema["rate_hz"][4].strip("`"))
+        plan = json.loads(run_ok(["session", "plan", "p.json", "--subjects", "1", "--json"], self.tmp).stdout)
+        self.assertEqual(plan["trial_max_duration_s"], PROTOCOL["trial"]["max_duration_s"])
+        session = plan["subjects"][0]["sessions"][0]
+        self.assertEqual(session["max_duration_s"], session["trials"] * PROTOCOL["trial"]["max_duration_s"])
+        for path in sorted((self.session_dir / "trials").glob("*.json")):
+            with self.subTest(record=path.name):
+                trial = json.loads(path.read_text(encoding="utf-8"))["specification"]["trial"]
+                self.assertEqual((trial["max_duration_s"], trial["rate_hz"]),
+                                 (PROTOCOL["trial"]["max_duration_s"], rate))
+                self.assertEqual(trial["pacing"], "lock-step")
+
+    def test_python_frames_number_strokes_as_the_trace_and_the_record(self):
+        # Python counts from 0 (docs/python.md): the per-stroke frame's `stroke` is the trace's `stroke`
+        # column and the record's `renderer_strokes[].index`, the same stroke by the same number.
+        self.need_python()
+        r = self.python_trial()
+        frame = r.per_stroke_dataframe()
+        self.assertEqual(frame.index.name, "stroke")
+        self.assertEqual(list(frame.index), [s["index"] for s in r.metrics["renderer_strokes"]])
+        self.assertEqual(list(frame["typical_id"]), [s["typical_id"] for s in r.metrics["renderer_strokes"]])
+        self.assertEqual(sorted(set(int(v) for v in r.stroke)), list(frame.index))
+        self.assertEqual(list(frame["typical_id"]), [s["typical_id"] for s in self.models["十"]["strokes"]])
+
 
 if __name__ == "__main__":
     unittest.main()
