@@ -437,6 +437,8 @@ class Round26D(unittest.TestCase, OneErrorLine):
             with self.subTest(option=option):
                 ends = re.findall(r"(?:in \[|, )?(\d+(?:\.\d+)?)(?:\.\.|, |\])", self.trial_help[option][1])
                 self.assertTrue(ends, self.trial_help[option][1])
+                self.assertEqual(ends[:2], re.findall(r"(?:in \[|, )?(\d+(?:\.\d+)?)(?:\.\.|, |\])",
+                                                      train_help[option][1])[:2], "the two helps' ranges")
                 extra = ["--guidance-mode", "fading"] if option == "--guidance-gain" else []
                 for command in ("trial", "train"):
                     line = self.assert_one_error(self.cli(command, "十", *extra, f"{option}={past}", "--check"), 2,
@@ -1156,6 +1158,40 @@ class Round26D(unittest.TestCase, OneErrorLine):
         self.assertEqual(list(frame["typical_id"]), [s["typical_id"] for s in r.metrics["renderer_strokes"]])
         self.assertEqual(sorted(set(int(v) for v in r.stroke)), list(frame.index))
         self.assertEqual(list(frame["typical_id"]), [s["typical_id"] for s in self.models["十"]["strokes"]])
+
+    def test_a_protocols_enumerations_are_the_docs_lists(self):
+        schema = json.loads(run_ok(["schema", "protocol"], self.tmp).stdout)
+        found = {}
+
+        def walk(value, path):
+            if isinstance(value, dict):
+                if "enum" in value:
+                    found[path.rsplit("/", 1)[-1] if "/order/" not in path else "order." + path.rsplit("/", 1)[-1]] \
+                        = value["enum"]
+                for key, inner in value.items():
+                    walk(inner, f"{path}/{key}")
+            elif isinstance(value, list):
+                for inner in value:
+                    walk(inner, path)
+        walk(schema, "")
+        text = section(DOCS / "experiments.md", "## Protocol files")
+        rows = {ticked(r[0])[0]: r for r in markdown_rows(text) if r and ticked(r[0])}
+        phases = section(DOCS / "experiments.md", "### Phases: pre-test, training, post-test, retention, transfer")
+        phase_rows = {ticked(r[0])[0]: r for r in markdown_rows(phases) if r and ticked(r[0])}
+        documented = {"mode": [ticked(r[0])[0] for r in markdown_rows(text) if len(r) == 3 and ticked(r[0])
+                               and r[0] != "`format`" and not ticked(r[0])[0].startswith(("test", "order"))],
+                      "order.conditions": ticked(rows["order.conditions"][1]),
+                      "order.characters": ticked(rows["order.characters"][1]),
+                      "phase": ticked(phase_rows["phase"][1]),
+                      "assignment": ticked(phase_rows["assignment"][1])}
+        for key, spellings in documented.items():
+            with self.subTest(enum=key):
+                self.assertIn(key, found)
+                self.assertEqual(sorted(found[key]), sorted(spellings))
+        # What a session writes is spelt so: trials.csv's `mode` and `phase`.
+        for row in self.trials_csv:
+            self.assertIn(row["mode"], found["mode"])
+            self.assertIn(row["phase"], found["phase"])
 
 
 if __name__ == "__main__":
