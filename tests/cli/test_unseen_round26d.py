@@ -453,7 +453,8 @@ class Round26D(unittest.TestCase, OneErrorLine):
                 protocol["conditions"][0]["mode"] = wrong
                 path = self.tmp / f"mode-{wrong}.json"
                 path.write_text(json.dumps(protocol, ensure_ascii=False), encoding="utf-8")
-                self.assert_one_error(self.cli("session", "plan", path.name, "--subjects", "1"), 2, "/conditions/0/mode")
+                self.assert_one_error(self.cli("session", "plan", path.name, "--subjects", "1"), 2,
+                                      "/conditions/0/mode")
 
     def test_python_reads_a_member_name_with_a_warning_and_records_the_spelling(self):
         self.need_python()
@@ -655,13 +656,13 @@ class Round26D(unittest.TestCase, OneErrorLine):
         self.assertIn(columns, self.spec_schema["properties"]["csv_file"]["description"])
         self.assertIn(columns, (DOCS / "experiments.md").read_text(encoding="utf-8"))
         if cg is not None:
-            names = [c["file_name"] if isinstance(c, dict) else getattr(c, "file_name", None) for c in cg.trace_columns()]
+            names = [c["file_name"] for c in cg.trace_columns()]
             self.assertEqual(",".join(names), columns)
 
     def test_python_frame_columns_are_the_trace_tables_names(self):
         self.need_python()
         frame = self.python_trial().to_dataframe()
-        named = [c["name"] if isinstance(c, dict) else getattr(c, "name") for c in cg.trace_columns()]
+        named = [c["name"] for c in cg.trace_columns()]
         self.assertEqual(list(frame.columns), named)
         self.assertEqual(named[:7], ["t_s", "x_m", "y_m", "z_m", "fx_n", "fy_n", "fz_n"])
         self.assertTrue((frame["t_s"].to_numpy() == self.python_trial().time_s).all())
