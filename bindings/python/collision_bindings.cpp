@@ -15,6 +15,7 @@
 #include "calligraphy/analysis/stroke_matcher.hpp"
 #include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/parameter_table.hpp"
 #include "calligraphy/model/nearest_point.hpp"
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/model/stroke_progress.hpp"
@@ -40,6 +41,13 @@ void check_options(const NearestPointOptions& o, const std::string& prefix) {
     throw InvalidArgument(prefix + "newton_iterations = " + std::to_string(o.newton_iterations) +
                           " must be in 1.." + std::to_string(kMaxNewtonCount));
   }
+}
+
+// The class NearestPointOptions is a force law's `nearest` (its only use), so its tolerance has the force
+// law's range, the one a trial record's schema states; nearest_point's own `tolerance=` takes any > 0.
+void check_class_options(const NearestPointOptions& o) {
+  check_options(o, "NearestPointOptions.");
+  check_parameter("NearestPointOptions.tolerance", o.tolerance, "", kForceLawNearestToleranceRange);
 }
 
 StrokeElement element_from(py::handle object) {
@@ -135,15 +143,14 @@ void bind_collision(py::module_& m) {
       .value("subdivision", NearestPointMethod::subdivision,
              "the paper's greedy subdivision (section 4.3.2); no guarantee, kept to reproduce the paper");
 
-  ParameterClass<NearestPointOptions>(
-      m, "NearestPointOptions",
-      "Options of nearest_point and of the renderer's foot-point search. "
-      "Lengths are in the element's units (m for a placed element).",
-      [](const NearestPointOptions& o) { check_options(o, "NearestPointOptions."); })
+  ParameterClass<NearestPointOptions>(m, "NearestPointOptions",
+                                      "Options of nearest_point and of the renderer's foot-point search. "
+                                      "Lengths are in the element's units (m for a placed element).",
+                                      check_class_options)
       .field("method", &NearestPointOptions::method, "a NearestPointMethod (or its name)")
       .field("tolerance", &NearestPointOptions::tolerance,
              "'exact': parameter interval (dimensionless, in t); 'subdivision': the paper's e, a length "
-             "(element units). Finite, > 0")
+             "(element units). In (0, 0.001], a force law's range")
       .field("newton_starts", &NearestPointOptions::newton_starts, "'newton' only: starts, 1..1000")
       .field("newton_iterations", &NearestPointOptions::newton_iterations,
              "'newton' only: iterations per start, 1..1000")

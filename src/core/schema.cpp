@@ -192,9 +192,11 @@ void set_field_from_text(const SchemaField& field, void* object, std::string_vie
       return;
     }
     case FieldKind::boolean:
-      if (text == "on" || text == "true") {
+      // The command line's words only, as every on|off option takes them (`train --guidance true` is
+      // refused too); JSON's true and false are the record's form, not text.
+      if (text == "on") {
         field.set_boolean(object, true);
-      } else if (text == "off" || text == "false") {
+      } else if (text == "off") {
         field.set_boolean(object, false);
       } else {
         throw InvalidArgument(quoted(text) + " is not one of 'on', 'off'");

@@ -231,9 +231,9 @@ void check_schema(const S& object) {
 
 /// Sets field `field` of `object` from its text as the command line spells it: a number (in the option's
 /// unit when it has one), an integer (decimal digits, a leading '-' only where negatives are allowed; "-0"
-/// is refused), "on"/"off" or "true"/"false", an enumeration's spelling, or text. Throws InvalidArgument
-/// "'text' is not ..." naming the accepted values; the range check is `check_schema`'s (an integer out of
-/// its range is refused here, as it has no other form).
+/// is refused), "on"/"off" (as every on|off option), an enumeration's spelling, or text. Throws
+/// InvalidArgument "'text' is not ..." naming the accepted values; the range check is `check_schema`'s (an
+/// integer out of its range is refused here, as it has no other form).
 void set_field_from_text(const SchemaField& field, void* object, std::string_view text);
 /// The field's value as the command line spells it (numbers in shortest round-trip form, in the option's
 /// unit). For scalar kinds only (InvalidArgument otherwise).
