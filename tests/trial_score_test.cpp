@@ -391,8 +391,14 @@ TEST_CASE("A stroke refused assist_after_misses times is credited assisted and t
   CHECK(uncredited.strokes_accepted == 0);
   CHECK(uncredited.refusals.total() == 5 + yong.strokes.size() - 1);
 
-  // Four misses are not enough at the default; at 3 the fourth and fifth are judged against stroke 2.
-  CHECK(score_trace(yong, trace_with_misses(4).samples).strokes_assisted == 0);
+  // After four misses the second stroke, written while the first is due, is the fifth refusal: the first is
+  // credited, and the second is due when the third is written (refused in turn, as the renderer refuses it).
+  const CharacterScore four = score_trace(yong, trace_with_misses(4).samples);
+  CHECK(four.strokes_assisted == 1);
+  CHECK(four.segments[4].assists_due);
+  CHECK(four.strokes_accepted == 0);
+  CHECK(four.refusals.wrong_order == yong.strokes.size() - 1);
+  // At 3 the fourth and fifth misses are judged against the second stroke.
   ScoreOptions three;
   three.acceptance.assist_after_misses = 3.0;
   const CharacterScore early = score_trace(yong, five.samples, three);

@@ -1083,9 +1083,11 @@ class TrialNumbers(Base):
                 stroke = strokes[segment["matched_stroke"]]
                 mine = deviations(xy[segment["begin"]:segment["end"]], SHARED["shi"][segment["matched_stroke"]])
                 self.close(stroke["mean_deviation_m"], float(np.mean(mine)), 2e-7, "a backwards stroke's deviation")
-        scored = score(self.root / "assisted.csv", SHI, self.root)
+        # Scored with the trial's assisted credit (after one miss), the verdicts in turn are the trial's.
+        scored = score(self.root / "assisted.csv", SHI, self.root, "--assist-after-misses", "1")
         for key in ("strokes_written", "backwards_strokes", "completed_in_order", "strokes_accepted", "refusals"):
             self.assertEqual(scored[key], record[key], key)
+        self.assertEqual(scored["strokes_assisted"], 2)
 
     def test_trial_forces_and_state_changes_from_its_csv(self):
         force = np.array([[float(r["fx"]), float(r["fy"]), float(r["fz"])] for r in self.rows])

@@ -83,7 +83,8 @@ def per_stroke_dataframe(result: TrialResult) -> pandas.DataFrame:
 
     Columns: ``character`` (str), ``acronym`` of its typical stroke, ``typical_id`` (1..39),
     then every stroke-level metric of the metric table (``calligraphy.metric_table()``, docs/metrics.md) under
-    its name, in SI units: ``written`` and ``backwards`` (bool), ``mean_deviation_m``, ``max_deviation_m``,
+    its name, in SI units: ``written``, ``assisted`` (credited after ``assist_after_misses`` refusals, as the
+    renderer credits it) and ``backwards`` (bool), ``mean_deviation_m``, ``max_deviation_m``,
     ``rms_deviation_m``, ``outside_tube_share``, ``frechet_m``, ``dtw_m``, ``path_length_m`` [m], ``time_s``
     [s] (its pen-down writing time), ``mean_speed_m_s``, ``velocity_peaks``, ``normalised_jerk`` (None for a
     stroke not written; the old ``*_mm`` columns still read, in mm, with a DeprecationWarning), then

@@ -6,7 +6,9 @@
 /// ignores a segment: analysis/score.hpp) is neither. Every other run is judged by the stroke matcher,
 /// `match_stroke(character, expected, run, start_radius_m, acceptance)` (analysis/stroke_matcher.hpp):
 /// the renderer's rule, so that the quiz, the renderer and `score_trace`'s segment verdicts agree on the
-/// same trace (docs/stroke-acceptance.md). A run refused as backwards is a miss reported as backwards, or
+/// same trace (docs/stroke-acceptance.md) until a stroke is credited assisted: the quiz gives no such credit
+/// (its stroke stays expected, with a hint after each further miss), the renderer and `score_trace` do after
+/// `assist_after_misses` misses. A run refused as backwards is a miss reported as backwards, or
 /// accepted (still reported as backwards) with `accept_backwards`. After `hint_after_misses` misses on
 /// one stroke, and after each further miss, a hint event asks to show the expected stroke. Not for the
 /// servo thread: judging takes up to milliseconds per pen lift. On the model and the stroke matcher only:
