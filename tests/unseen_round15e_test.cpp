@@ -49,28 +49,13 @@
 #include "calligraphy/trial/trial_spec.hpp"
 #include "calligraphy/trial/writer_profile.hpp"
 #include "temp_folder.hpp"
+#include "thrown_exactly.hpp"
 
 using namespace calligraphy;
+using calligraphy::testing::has;
+using calligraphy::testing::thrown_exactly;
 
 namespace {
-
-// The message of the exception `call` throws, which must be of type E exactly (a CharacterNotFound is not
-// accepted where the comment says DataError, nor the reverse). Fails the test when nothing or another type
-// is thrown.
-template <typename E, typename F>
-std::string thrown_exactly(F&& call) {
-  try {
-    call();
-  } catch (const std::exception& error) {
-    INFO("thrown: " << typeid(error).name() << ": " << error.what());
-    CHECK(typeid(error) == typeid(E));
-    return error.what();
-  }
-  FAIL("nothing was thrown");
-  return {};
-}
-
-bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 // The first character of `library` for which `pick` holds (the test does not guess the embedded set).
 char32_t first_character(const std::vector<char32_t>& characters, const std::function<bool(char32_t)>& pick) {

@@ -49,8 +49,11 @@
 #include "calligraphy/trial/session.hpp"
 #include "calligraphy/trial/teacher_recording.hpp"
 #include "temp_folder.hpp"
+#include "thrown_exactly.hpp"
 
 using namespace calligraphy;
+using calligraphy::testing::has;
+using calligraphy::testing::thrown_exactly;
 using calligraphy::testing::count_this_thread;
 using calligraphy::testing::counted_allocations;
 using calligraphy::testing::kCountsAllocations;
@@ -61,21 +64,6 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // The per-tick change limit of the default safety chain [N per tick] (safety_chain.hpp), with rounding room.
 constexpr double kStepLimitN = 0.25 + 1e-9;
-
-template <typename E, typename F>
-std::string thrown_exactly(F&& call) {
-  try {
-    call();
-  } catch (const std::exception& error) {
-    INFO("thrown: " << typeid(error).name() << ": " << error.what());
-    CHECK(typeid(error) == typeid(E));
-    return error.what();
-  }
-  FAIL("nothing was thrown");
-  return {};
-}
-
-bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 const Scene& cross_scene() {
   static const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'十')});
