@@ -89,10 +89,11 @@ def box_lines(folder, process, who, timeout=30):
     raise AssertionError("no box line within %s s" % timeout)
 
 
-def program_window(pid, tool=None, timeout=30):
+def program_window(pid, tool=None, timeout=60, process=None):
     """The window of the program with process id `pid`: searched by its pid as well as its title, so that the
-    window of a program that has just ended (still listed for a moment by the X server) is never taken. As long
-    as the character boxes are waited for: a first window on a loaded machine took more than 10 s."""
+    window of a program that has just ended (still listed for a moment by the X server) is never taken. A first
+    window on a loaded machine took more than 30 s (llvmpipe beside a sanitizer build); with `process`, a
+    program that ended before its window showed fails at once, with its status."""
     tool = tool or xdotool
     deadline = time.time() + timeout
     while True:
@@ -102,6 +103,8 @@ def program_window(pid, tool=None, timeout=30):
             found = []
         if found:
             return found[-1]
+        if process is not None and process.poll() is not None:
+            raise AssertionError(f"process {pid} ended with status {process.returncode} and no window of it is shown")
         if time.time() > deadline:
             raise AssertionError(f"no window of process {pid} within {timeout} s")
         time.sleep(0.1)
@@ -126,7 +129,7 @@ class Trainer:
         return box_lines(self.folder, self.process, "the trainer", timeout)
 
     def window(self):
-        return program_window(self.process.pid)
+        return program_window(self.process.pid, process=self.process)
 
     def wait(self, timeout=120):
         return self.process.wait(timeout=timeout)
