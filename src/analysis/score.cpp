@@ -205,6 +205,7 @@ CharacterScore score_trace(const PlacedCharacter& character, std::span<const Pen
         match_stroke(character, expected, positions[w], options.start_radius_m, options.acceptance);
     WrittenSegment& segment = score.segments[scored[w]];
     segment.verdict = verdict;
+    segment.due_stroke = expected;
     if (verdict.accepted) {
       ++expected;
       ++score.strokes_accepted;

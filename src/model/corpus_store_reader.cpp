@@ -1,9 +1,5 @@
-// Reads the corpus store (docs/corpus.md) through a read-only memory mapping. Every offset and size is
+// Reads the corpus store (docs/corpus.md), read whole into memory. Every offset and size is
 // checked against the file before it is used; every failure is a DataError naming the file and offset.
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -13,6 +9,7 @@
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/corpus_store.hpp"
+#include "core/whole_file.hpp"
 #include "model/bundled_corpus_store.hpp"
 #include "model/corpus_store_format.hpp"
 #include "model/corpus_store_outlines.hpp"
@@ -25,7 +22,7 @@ struct CorpusStore::Data {
   std::string name;
   const std::uint8_t* bytes = nullptr;
   std::size_t size = 0;
-  std::vector<std::uint8_t> owned;  // the store's bytes, read whole (open) or copied (from_bytes)
+  std::string owned;  // the store's bytes, read whole (open) or copied (from_bytes)
   CorpusStoreInfo info;
   const std::uint8_t* index = nullptr;
   const std::uint8_t* records = nullptr;
@@ -277,48 +274,11 @@ double CorpusStoreInfo::max_quantisation_error() const {
 CorpusStore CorpusStore::open(const std::filesystem::path& path) {
   auto data = std::make_shared<Data>();
   data->name = path.string();
-  // O_NONBLOCK: opening a FIFO for reading would otherwise wait for a writer (it is then refused below).
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
-  if (fd < 0) throw DataError(data->name + ": cannot open the corpus store (" + std::strerror(errno) + ")");
-  struct stat st {};
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-    ::close(fd);
-    throw DataError(data->name + ": not a regular file");
-  }
   // Read whole, not mapped: a file truncated by another process while mapped would end the process with
-  // SIGBUS at the next access, and a store is a few megabytes. Read to its end, whatever stat said.
-  if (static_cast<std::uintmax_t>(st.st_size) > kMaxCorpusStoreBytes) {
-    ::close(fd);
-    throw DataError(data->name + ": larger than a corpus store may be (" +
-                    std::to_string(kMaxCorpusStoreBytes) + " bytes)");
-  }
-  std::vector<std::uint8_t>& bytes = data->owned;
-  bytes.resize(static_cast<std::size_t>(std::max<off_t>(st.st_size, 0)) + 1);
-  std::size_t filled = 0;
-  for (;;) {
-    if (filled == bytes.size()) {
-      if (bytes.size() > kMaxCorpusStoreBytes) {
-        ::close(fd);
-        throw DataError(data->name + ": larger than a corpus store may be (" +
-                        std::to_string(kMaxCorpusStoreBytes) + " bytes)");
-      }
-      bytes.resize(bytes.size() * 2);
-    }
-    const ssize_t got = ::read(fd, bytes.data() + filled, bytes.size() - filled);
-    if (got < 0 && errno == EINTR) continue;
-    if (got < 0) {
-      const int error = errno;
-      ::close(fd);
-      throw DataError(data->name + ": cannot read the corpus store (" + std::strerror(error) + ")");
-    }
-    if (got == 0) break;
-    filled += static_cast<std::size_t>(got);
-  }
-  bytes.resize(filled);
-  bytes.shrink_to_fit();
-  data->bytes = bytes.data();
-  data->size = bytes.size();
-  ::close(fd);
+  // SIGBUS at the next access, and a store is a few megabytes. A FIFO or device is refused unread.
+  data->owned = read_regular_file(path, kMaxCorpusStoreBytes);
+  data->bytes = reinterpret_cast<const std::uint8_t*>(data->owned.data());
+  data->size = data->owned.size();
   data->validate();
   return CorpusStore(std::move(data));
 }
@@ -326,8 +286,8 @@ CorpusStore CorpusStore::open(const std::filesystem::path& path) {
 CorpusStore CorpusStore::from_bytes(std::span<const std::uint8_t> bytes, const std::string& name) {
   auto data = std::make_shared<Data>();
   data->name = name;
-  data->owned.assign(bytes.begin(), bytes.end());
-  data->bytes = data->owned.data();
+  data->owned.assign(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  data->bytes = reinterpret_cast<const std::uint8_t*>(data->owned.data());
   data->size = data->owned.size();
   data->validate();
   return CorpusStore(std::move(data));

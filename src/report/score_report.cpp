@@ -48,13 +48,12 @@ nlohmann::json refusals_json(const RefusalCounts& counts) {
 // sequence; sample indices (begin inclusive, end exclusive) and strokes 0-based.
 nlohmann::json segments_json(const CharacterScore& score) {
   nlohmann::json out = nlohmann::json::array();
-  std::size_t expected = 0;  // the stroke each verdict judged against: the verdicts accepted before it
   for (const WrittenSegment& s : score.segments) {
     nlohmann::json verdict = nullptr;
     if (s.verdict) {
       const StrokeMatch& v = *s.verdict;
       verdict = {
-          {"expected_stroke", expected},
+          {"expected_stroke", s.due_stroke},
           {"accepted", v.accepted},
           {"refusal", to_string(v.refusal)},
           {"matched_stroke", v.matched_stroke},
@@ -63,7 +62,6 @@ nlohmann::json segments_json(const CharacterScore& score) {
           {"mean_deviation_m", v.entered ? nlohmann::json(v.mean_deviation_m) : nlohmann::json(nullptr)},
           // The stroke due was credited assisted after this refusal (assist_after_misses): the next is due.
           {"assists_due", s.assists_due}};
-      if (v.accepted || s.assists_due) ++expected;
     }
     out.push_back({{"begin", s.begin},
                    {"end", s.end},
@@ -98,14 +96,13 @@ struct StrokeVerdict {
 
 std::vector<StrokeVerdict> stroke_verdicts(const CharacterScore& score) {
   std::vector<StrokeVerdict> verdicts(score.strokes.size());
-  std::size_t due = 0;
   for (const WrittenSegment& segment : score.segments) {
     if (!segment.verdict) continue;
     const StrokeMatch& match = *segment.verdict;
+    const std::size_t due = segment.due_stroke;  // score_trace's, which counts the credits once
     if (match.accepted) {
       if (due < verdicts.size())
         verdicts[due] = {StrokeVerdict::State::accepted, StrokeRefusal::none, due, true, 0.0, 1.0};
-      ++due;
       continue;
     }
     if (segment.assists_due) {
@@ -114,7 +111,6 @@ std::vector<StrokeVerdict> stroke_verdicts(const CharacterScore& score) {
         verdicts[due] = {StrokeVerdict::State::assisted, match.refusal,         due, match.entered,
                          match.mean_deviation_m,         match.covered_fraction};
       }
-      ++due;
       continue;
     }
     const bool other_stroke =

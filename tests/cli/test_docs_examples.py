@@ -533,6 +533,11 @@ class DocsExamples(unittest.TestCase):
         env["PATH"] = path_dir + os.pathsep + env.get("PATH", "")
         env["PYTHONPATH"] = os.path.join(folder, "build", "python")
         env["MPLBACKEND"] = "Agg"   # no display: a figure is drawn, not shown
+        # An example run without its output option writes under the temporary folder (tempfile.mkdtemp):
+        # one of this test's own, removed with it.
+        scratch = tempfile.mkdtemp(prefix="docs-examples-tmp-")
+        self.addCleanup(shutil.rmtree, scratch, True)
+        env["TMPDIR"] = scratch
         env.pop("DISPLAY", None)
         return folder, env
 

@@ -42,6 +42,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
 import unittest
 import contextlib
 from pathlib import Path
@@ -376,6 +377,12 @@ EXIT_STATUS = {  # examples the docs give as refused, with the status the docs g
 }
 
 
+def cpu_seconds():
+    """This process's and its waited-for children's processor time [s]."""
+    usage = [resource.getrusage(who) for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)]
+    return sum(u.ru_utime + u.ru_stime for u in usage)
+
+
 class Round15A(unittest.TestCase):
     maxDiff = None
 
@@ -383,8 +390,7 @@ class Round15A(unittest.TestCase):
         if name in LONG_DOCUMENTS and not ALL:
             self.skipTest(f"{name}: {LONG_DOCUMENTS[name]}; run with CALLIGRAPHY_DOCS_EXAMPLES_ALL=1")
         doc = SOURCE / name
-        self.cpu_before = sum(u.ru_utime + u.ru_stime for u in (resource.getrusage(resource.RUSAGE_SELF),
-                                                                resource.getrusage(resource.RUSAGE_CHILDREN)))
+        self.cpu_before = cpu_seconds()
         examples = extract(doc)
         if not examples:
             self.skipTest(f"{name}: no runnable example")
@@ -399,6 +405,9 @@ class Round15A(unittest.TestCase):
         env["PYTHONPATH"] = str(folder / "build" / "python")
         env["MPLBACKEND"] = "Agg"
         env["XDG_CACHE_HOME"] = str(Path(tmp) / "cache")
+        # An example run without its output option writes under the temporary folder: this round's own.
+        (Path(tmp) / "tmp").mkdir()
+        env["TMPDIR"] = str(Path(tmp) / "tmp")
         self.env = env
         namespace = {"__name__": "__docs__"}
         self.trial_outputs = {}  # a trial's --csv trace: its --json record
@@ -416,13 +425,15 @@ class Round15A(unittest.TestCase):
                 continue
             print(f"RUN  {example}" + (f"  (cheaper: {change})" if change else ""), file=sys.stderr)
             ran += 1
+            started = time.monotonic(), cpu_seconds()
             with self.subTest(example=str(example)):
                 if example.kind == "python":
                     self.run_python(example, text, folder, namespace)
                 else:
                     self.run_shell(example, text, folder, env)
-        usage = [resource.getrusage(who) for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)]
-        cpu = sum(u.ru_utime + u.ru_stime for u in usage) - self.cpu_before
+            print(f"     {time.monotonic() - started[0]:.1f} s wall, {cpu_seconds() - started[1]:.1f} s of CPU",
+                  file=sys.stderr)
+        cpu = cpu_seconds() - self.cpu_before
         print(f"{name}: {ran} examples run of {len(examples)} ({cpu:.1f} s of CPU)", file=sys.stderr)
 
     # -- shell -------------------------------------------------------------------------------------------------

@@ -49,6 +49,8 @@ struct WrittenSegment {
   /// assisted (`assists_due`). Absent for an ignored segment and once every stroke has been accepted or
   /// credited.
   std::optional<StrokeMatch> verdict;
+  /// The stroke the verdict judged, `expected` above (0-based); 0 without a verdict.
+  std::size_t due_stroke = 0;
   /// This refused verdict was the `acceptance.assist_after_misses`-th on the stroke due: that stroke is then
   /// credited assisted, as the renderer demonstrates and credits it (StrokeAcceptance), and the next is due.
   bool assists_due = false;
