@@ -145,12 +145,13 @@ def _condition_order(trials: pandas.DataFrame, column: str, reference: typing.Op
 def _crossover_parts(trials: pandas.DataFrame, compared: pandas.DataFrame) -> typing.Optional[dict]:
     """The crossover's sequences, periods, item sets, condition-set pairing and sequence letters when the
     compared phase's trials name the period and the condition their set is trained under (the tables'
-    ``period`` and ``trained_condition``) and every subject trains two or more conditions; else None."""
+    ``period`` and ``trained_condition``) and a subject trains two or more conditions; else None."""
     if compared.empty or not {"period", "trained_condition", "sequence", "item_set"} <= set(compared.columns):
         return None
     period = compared["period"].astype(float)
     named = compared[(period >= 1) & (compared["trained_condition"].astype(str).replace({"nan": ""}) != "")]
-    if named.empty or (named.groupby("subject", observed=True)["condition"].nunique() < 2).any():
+    # A subject who stopped before a later period trained one condition: still a crossover's subject.
+    if named.empty or (named.groupby("subject", observed=True)["condition"].nunique() < 2).all():
         return None
     named = named.assign(period=named["period"].astype(float).astype(int), subject=named["subject"].astype(str),
                          condition=named["condition"].astype(str), item_set=named["item_set"].astype(str),
@@ -364,7 +365,8 @@ def _training_rows(data: pandas.DataFrame, value: str, design: StudyDesign, ddf:
                               "subject": rows_of["subject"].astype(str).to_numpy(),
                               "item": rows_of["characters"].astype(str).to_numpy()})
     levels = [c for c in design.conditions if c in set(frame["factor"])]
-    too_few = design_models.too_few_to_fit(levels, design.control, frame["subject"].nunique())
+    too_few = design_models.too_few_to_fit(levels, design.control, frame["subject"].nunique(),
+                                           between=design.kind == "between-subjects")
     if too_few:
         return design_models.not_computed_rows(base, design.conditions, design.control, too_few)
     # The documented reduction (design_models.fit_reduced): within subjects the slope's compound-symmetry form
@@ -409,9 +411,11 @@ def _training_rows(data: pandas.DataFrame, value: str, design: StudyDesign, ddf:
             ci95_high=float(effect.ci95_high) if trusted else math.nan, g=g, g_ci95_low=g_low, g_ci95_high=g_high,
             note=note))
     rows += design_models.absent_effect_rows(fit, "factor", levels, design.control, base)
-    return rows + design_models.pair_rows(
+    rows += design_models.pair_rows(
         fit, levels, design.control, base, note,
         lambda a, b: int(frame.loc[frame["factor"].isin([a, b]), "subject"].nunique()), g_between)
+    return design_models.with_absent_levels(rows, base, list(design.conditions), levels, design.control,
+                                            f"in {phase} (after the exclusions)")
 
 
 # ---------------------------------------------------------------------------------------------- after training
@@ -441,6 +445,13 @@ def _ancova_rows(data: pandas.DataFrame, value: str, design: StudyDesign, phase:
     factor = design_models.outcome_factor(frame["post"])
     frame["post"], frame["pre"] = frame["post"] * factor, frame["pre"] * factor
     fit = smf.ols("post ~ pre + C(group, Treatment(reference=0))", data=frame).fit()
+    # A pre-test mean that the groups determine (the same within each group) leaves the adjusted difference
+    # unidentified: OLS's pseudo-inverse would still give a number, one of infinitely many.
+    rank = int(np.linalg.matrix_rank(fit.model.exog))
+    if rank < fit.model.exog.shape[1]:
+        return design_models.not_computed_rows(
+            base, design.conditions, design.control, f"not computed: the pre-test mean is collinear with the groups "
+            f"(the model's {fit.model.exog.shape[1]} columns have rank {rank}), so no adjusted difference is defined")
     # No residual variance (every subject's mean the same, or fitted exactly): t and p would be 0/0 or x/0,
     # numbers that are no test. R's lm warns of "essentially perfect fit" in the same case.
     # Rounding leaves ~1e-16 of the values' size where the exact answer is 0: below a part in 1e9 is none.
@@ -487,7 +498,8 @@ def _ancova_rows(data: pandas.DataFrame, value: str, design: StudyDesign, phase:
                              p=float(np.squeeze(contrast.pvalue)), estimate=estimate / factor, ci95_low=low / factor,
                              ci95_high=high / factor, g=g, g_ci95_low=g_low, g_ci95_high=g_high,
                              note=rows[0]["note"]))
-    return rows
+    return design_models.with_absent_levels(rows, base, list(design.conditions), levels, design.control,
+                                            f"with a pre-test and a {phase} value (after the exclusions)")
 
 
 def _paired_rows(data: pandas.DataFrame, value: str, design: StudyDesign) -> list[dict]:

@@ -11,9 +11,9 @@ the fitting of a linear mixed model the way every design fits it:
   random structure first; a fit that is singular (a variance at 0 or a correlation at +-1) or that did not
   converge is refitted with the slope's compound-symmetry form where there is a slope, then, while still
   singular or not converged, without the random term of the smallest variance; a term lme4 refuses (as many
-  random effects as observations) is dropped in turn (Matuschek, Kliegl, Vasishth, Baayen & Bates 2017, J Mem
-  Lang 94:305; Barr, Levy, Scheepers & Tily 2013, J Mem Lang 68:255). Each row shows the formula fitted and
-  names what was reduced.
+  random effects as observations; the one its error names) is dropped in turn (Matuschek, Kliegl, Vasishth,
+  Baayen & Bates 2017, J Mem Lang 94:305; Barr, Levy, Scheepers & Tily 2013, J Mem Lang 68:255). Each row
+  shows the formula fitted and names what was reduced.
 * every pairwise contrast of the compared factor when it has three or more levels (R's emmeans: estimated
   marginal means, the model's df method), beside the comparisons with the control.
 """
@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 import typing
 
 import numpy as np
@@ -256,10 +257,15 @@ def fit_reduced(frame: "pandas.DataFrame", fixed: list[str], factors: dict, ddf:
             fit = lmer_scaled(frame, formula + " + ".join(terms), factors, ddf)
         except mixed_models.RUnavailable:
             raise
-        except RuntimeError:
+        except RuntimeError as error:
             if len(terms) == 1:
                 raise
-            refused = terms[1]  # the subject's intercept last
+            # lme4 names the grouping factors it refuses ("... (problems: subject)"): that term goes, the
+            # subject's intercept last of those named; naming none, the items' before the subject's.
+            named = re.search(r"\(problems: ([^)]*)\)", str(error))
+            problems = {p.strip() for p in named.group(1).split(",")} if named else set()
+            candidates = [t for t in terms[1:] + terms[:1] if _group(t) in problems] or terms[1:]
+            refused = candidates[0]
             terms.remove(refused)
             dropped.append(f"{refused}, which lme4 could not fit")
             continue
@@ -284,23 +290,54 @@ def fit_note(fit: "mixed_models.LmerFit", dropped: list[str], units: Units, name
     return note
 
 
+def planned_pairs(levels: list[str], control: str) -> list[tuple[str, str]]:
+    """The comparisons a family holds as (later, earlier): each level against the control, then every other
+    pair in the levels' order (``pair_rows``)."""
+    others = [level for level in levels if level != control]
+    return [(level, control) for level in others] + [(b, a) for i, a in enumerate(others) for b in others[i + 1:]]
+
+
 def planned_comparisons(levels: list[str], control: str) -> list[str]:
     """The comparisons a family holds, as its rows name them: each level against the control
     ('level - control'), then every other pair 'later - earlier' in the levels' order (``pair_rows``)."""
-    others = [level for level in levels if level != control]
-    pairs = [f"{b} - {a}" for i, a in enumerate(others) for b in others[i + 1:]]
-    return [f"{level} - {control}" for level in others] + pairs
+    return [f"{b} - {a}" for b, a in planned_pairs(levels, control)]
 
 
-def too_few_to_fit(levels: typing.Sequence[str], control: str, subjects: int) -> typing.Optional[str]:
+def with_absent_levels(rows: list[dict], base: dict, levels: list[str], present: typing.Collection[str],
+                       control: str, where: str) -> list[dict]:
+    """``rows`` and a "not computed" row for each planned comparison (``planned_pairs``) of a level without
+    values ``where`` (every trial excluded, every value missing), in the planned order: a group that lost
+    every trial is a finding, not a row that silently leaves the table."""
+    have = {r["comparison"]: r for r in rows}
+    out = []
+    for later, earlier in planned_pairs(levels, control):
+        comparison = f"{later} - {earlier}"
+        if comparison in have:
+            out.append(have.pop(comparison))
+            continue
+        absent = [level for level in (later, earlier) if level not in present]
+        if absent:
+            out.append(row(**base, comparison=comparison,
+                           note=f"not computed: no values of {' or '.join(absent)} {where}"))
+    return out + list(have.values())
+
+
+def too_few_to_fit(levels: typing.Sequence[str], control: str, subjects: int, between: bool = False
+                   ) -> typing.Optional[str]:
     """Why a mixed model of ``levels`` (the conditions or groups with values) against ``control`` over ``subjects``
-    cannot be fitted, naming what is short ("not computed: ..."); None when it can be."""
+    cannot be fitted, naming what is short ("not computed: ..."); None when it can be. ``between``: each subject
+    in one level (groups), so the levels need more subjects than levels."""
     if control not in levels:
         return f"not computed: the control '{control}' has no values"
     if len(levels) < 2:
         return "not computed: only one condition has values (a comparison needs 2)"
     if subjects < 3:
         return f"not computed: {subjects} subject{'' if subjects == 1 else 's'} with values (the model needs at least 3)"
+    if between and subjects <= len(levels):
+        # Each subject in one group: the groups' difference is tested against the subjects' spread, which
+        # needs more subjects than groups; the trials' spread would make a test of the trials, not of people.
+        return (f"not computed: {subjects} subjects in {len(levels)} groups (a between-subjects comparison needs more "
+                "subjects than groups)")
     return None
 
 
