@@ -2,6 +2,7 @@
 after the acceptance's assist_after_misses misses the quiz's stroke_assisted event follows the miss, the next
 stroke is expected, and the record counts the credit apart from the strokes written; with 0 never."""
 import json
+import re
 import subprocess
 
 import pytest
@@ -16,11 +17,16 @@ PROTOCOL = {
 
 
 @pytest.fixture(scope="module")
-def records(cli, tmp_path_factory):
+def folder(cli, tmp_path_factory):
     folder = tmp_path_factory.mktemp("quiz")
     (folder / "p.json").write_text(json.dumps(PROTOCOL, ensure_ascii=False), encoding="utf-8")
     subprocess.run([cli, "session", "run", "p.json", "--subjects", "2", "--writer-profile", "foreign", "--out",
                     "st"], cwd=folder, check=True, capture_output=True)
+    return folder
+
+
+@pytest.fixture(scope="module")
+def records(folder):
     return [json.loads(p.read_text(encoding="utf-8")) for p in sorted(folder.glob("st/*/*/trials/*.json"))]
 
 
@@ -54,3 +60,11 @@ def test_the_quiz_credits_as_the_score_and_counts_the_credit_apart(records):
         credited[record["condition"]] += quiz["strokes_assisted"]
     assert credited["Q1"] > 0
     assert credited["Q0"] == 0
+
+
+def test_the_pages_show_the_quizs_assisted_strokes(cli, folder, records):
+    subprocess.run([cli, "report", "st", "--out", "index.html"], cwd=folder, check=True, capture_output=True)
+    pages = "".join(p.read_text(encoding="utf-8") for p in folder.glob("index_files/*/*.html"))
+    shown = [int(n) for n in re.findall(r"quiz strokes assisted (\d+)", pages)]
+    assert sorted(shown) == sorted(r["quiz"]["strokes_assisted"] for r in records if r["quiz"]["strokes_assisted"])
+    assert shown
