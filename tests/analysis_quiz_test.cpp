@@ -1,11 +1,12 @@
 // QuizSession on hand-made pen traces over 十 (horizontal, then vertical) and 口.
 #include <catch2/catch.hpp>
+#include <string>
 #include <vector>
 
 #include "calligraphy/analysis/metrics.hpp"
+#include "calligraphy/analysis/quiz.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/character_library.hpp"
-#include "calligraphy/analysis/quiz.hpp"
 #include "embedded_scenes.hpp"
 
 using namespace calligraphy;
@@ -123,6 +124,112 @@ TEST_CASE("quiz hints after the stroke acceptance's hint_after_misses unless an 
   CHECK_THROWS_AS(options.validate(), InvalidArgument);
   options.hint_after_misses = -1;
   CHECK_THROWS_AS(options.validate(), InvalidArgument);
+}
+
+namespace {
+
+std::vector<QuizEvent::Kind> kinds(const std::vector<QuizEvent>& events) {
+  std::vector<QuizEvent::Kind> out;
+  for (const QuizEvent& e : events) out.push_back(e.kind);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE(
+    "quiz credits a stroke assisted after the acceptance's assist_after_misses misses, then expects the next",
+    "[analysis][quiz]") {
+  using K = QuizEvent::Kind;
+  const PlacedCharacter& shi = character_of(U'十');
+  // The default: a hint after 3 misses and after the 4th, the credit after the 5th (StrokeAcceptance), no
+  // hint beside it: the stroke is shown as assisted instead.
+  REQUIRE(QuizOptions{}.assist_after() == 5);
+  REQUIRE(QuizOptions{}.hint_after() == 3);
+  Writer writer{QuizSession(shi)};
+  const std::vector<std::vector<K>> expected = {{K::stroke_missed},
+                                                {K::stroke_missed},
+                                                {K::stroke_missed, K::hint},
+                                                {K::stroke_missed, K::hint},
+                                                {K::stroke_missed, K::stroke_assisted}};
+  std::vector<QuizEvent> fifth;
+  for (std::size_t miss = 0; miss < expected.size(); ++miss) {
+    INFO("miss " << miss + 1);
+    const std::vector<QuizEvent> events = writer.write(stroke_points(shi.strokes[1]));  // out of order
+    CHECK(kinds(events) == expected[miss]);
+    CHECK(events.front().misses_on_stroke == static_cast<int>(miss) + 1);
+    CHECK(events.front().refusal == StrokeRefusal::wrong_order);
+    if (miss + 1 < expected.size()) CHECK(writer.quiz.current_stroke() == 0);
+    fifth = events;
+  }
+  REQUIRE(fifth.size() == 2);
+  const QuizEvent& credit = fifth[1];
+  CHECK(credit.stroke == 0);
+  CHECK(credit.misses_on_stroke == 5);  // the misses that earned it, as Hanzi Writer's onCorrectStroke
+  CHECK(credit.total_misses == 5);
+  CHECK(credit.refusal == StrokeRefusal::none);
+  CHECK_FALSE(credit.written_stroke);
+  CHECK(credit.time_s == fifth[0].time_s);
+  CHECK(writer.quiz.current_stroke() == 1);
+  CHECK(writer.quiz.misses_on_stroke() == 0);
+  CHECK(writer.quiz.strokes_assisted() == 1);
+  CHECK_FALSE(writer.quiz.complete());
+  // The next stroke written is accepted in its turn, and completes the character.
+  const std::vector<QuizEvent> next = writer.write(stroke_points(shi.strokes[1]));
+  CHECK(kinds(next) == std::vector<K>{K::stroke_accepted, K::character_completed});
+  CHECK(next[0].stroke == 1);
+  CHECK(next[0].total_misses == 5);
+  CHECK(writer.quiz.complete());
+  CHECK(writer.quiz.events().size() == 1 + 1 + 2 + 2 + 2 + 2);
+
+  // At 3 the credit replaces the hint that would come with the 3rd miss.
+  QuizOptions three;
+  three.acceptance.assist_after_misses = 3;
+  Writer sooner{QuizSession(shi, three)};
+  CHECK(kinds(sooner.write(stroke_points(shi.strokes[1]))) == std::vector<K>{K::stroke_missed});
+  CHECK(kinds(sooner.write(stroke_points(shi.strokes[1]))) == std::vector<K>{K::stroke_missed});
+  CHECK(kinds(sooner.write(stroke_points(shi.strokes[1]))) ==
+        std::vector<K>{K::stroke_missed, K::stroke_assisted});
+  CHECK(sooner.quiz.current_stroke() == 1);
+  // A hint overridden to come sooner still comes before the credit.
+  three.hint_after_misses = 2;
+  Writer hinted{QuizSession(shi, three)};
+  CHECK(kinds(hinted.write(stroke_points(shi.strokes[1]))) == std::vector<K>{K::stroke_missed});
+  CHECK(kinds(hinted.write(stroke_points(shi.strokes[1]))) == std::vector<K>{K::stroke_missed, K::hint});
+  CHECK(kinds(hinted.write(stroke_points(shi.strokes[1]))) ==
+        std::vector<K>{K::stroke_missed, K::stroke_assisted});
+
+  // At 0 never: the stroke stays expected, hinted after each miss from the 3rd.
+  QuizOptions never;
+  never.acceptance.assist_after_misses = 0;
+  Writer stuck{QuizSession(shi, never)};
+  for (int miss = 1; miss <= 12; ++miss) {
+    const std::vector<QuizEvent> events = stuck.write(stroke_points(shi.strokes[1]));
+    CHECK_FALSE(has(events, K::stroke_assisted));
+    CHECK(has(events, K::hint) == (miss >= 3));
+  }
+  CHECK(stuck.quiz.current_stroke() == 0);
+  CHECK(stuck.quiz.strokes_assisted() == 0);
+  CHECK(stuck.quiz.total_misses() == 12);
+}
+
+TEST_CASE("quiz completes the character when its last stroke is credited assisted", "[analysis][quiz]") {
+  using K = QuizEvent::Kind;
+  const PlacedCharacter& shi = character_of(U'十');
+  QuizOptions options;
+  options.acceptance.assist_after_misses = 2;
+  Writer writer{QuizSession(shi, options)};
+  CHECK(kinds(writer.write(stroke_points(shi.strokes[0]))) == std::vector<K>{K::stroke_accepted});
+  // The horizontal again where the vertical is expected: missed twice, then credited and complete.
+  CHECK(kinds(writer.write(stroke_points(shi.strokes[0]))) == std::vector<K>{K::stroke_missed});
+  const std::vector<QuizEvent> last = writer.write(stroke_points(shi.strokes[0]));
+  CHECK(kinds(last) == std::vector<K>{K::stroke_missed, K::stroke_assisted, K::character_completed});
+  CHECK(last[1].stroke == 1);
+  CHECK(last[2].stroke == 1);
+  CHECK(last[2].total_misses == 2);
+  CHECK(writer.quiz.complete());
+  CHECK(writer.quiz.strokes_assisted() == 1);
+  CHECK(writer.write(stroke_points(shi.strokes[1])).empty());  // nothing more is judged
+  CHECK(std::string(to_string(K::stroke_assisted)) == "stroke_assisted");
 }
 
 TEST_CASE("quiz reports a stroke written backwards and accepts it only when asked to", "[analysis][quiz]") {

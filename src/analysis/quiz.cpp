@@ -37,6 +37,8 @@ const char* to_string(QuizEvent::Kind kind) noexcept {
       return "character_completed";
     case QuizEvent::Kind::too_short:
       return "too_short";
+    case QuizEvent::Kind::stroke_assisted:
+      return "stroke_assisted";
   }
   return "unknown";
 }
@@ -78,18 +80,24 @@ std::vector<QuizEvent> QuizSession::judge_segment() {
         match_stroke(character_, current_, path, options_.start_radius_m, options_.acceptance);
     event.backwards = match.refusal == StrokeRefusal::backwards;
     const bool accepted = match.accepted || (event.backwards && options_.accept_backwards);
-    if (accepted) {
-      event.kind = QuizEvent::Kind::stroke_accepted;
+    // The expected stroke is done when written, or credited assisted after this miss made
+    // `assist_after_misses` misses on it (ActiveStroke::lift, score_trace): the next is expected.
+    const auto next_stroke = [&](const QuizEvent& last) {
       misses_on_stroke_ = 0;
       ++current_;
-      event.total_misses = total_misses_;
-      out.push_back(event);
       if (complete()) {
-        QuizEvent done = event;
+        QuizEvent done = last;
         done.kind = QuizEvent::Kind::character_completed;
         done.backwards = false;
+        done.misses_on_stroke = 0;
         out.push_back(done);
       }
+    };
+    if (accepted) {
+      event.kind = QuizEvent::Kind::stroke_accepted;
+      event.total_misses = total_misses_;
+      out.push_back(event);
+      next_stroke(event);
     } else {
       event.kind = QuizEvent::Kind::stroke_missed;
       event.refusal = match.refusal;
@@ -98,13 +106,20 @@ std::vector<QuizEvent> QuizSession::judge_segment() {
       event.misses_on_stroke = ++misses_on_stroke_;
       event.total_misses = ++total_misses_;
       out.push_back(event);
-      if (const int hint_after = options_.hint_after(); hint_after > 0 && misses_on_stroke_ >= hint_after) {
-        QuizEvent hint = event;
-        hint.kind = QuizEvent::Kind::hint;
-        hint.backwards = false;
-        hint.refusal = StrokeRefusal::none;
-        hint.written_stroke.reset();
-        out.push_back(hint);
+      QuizEvent shown = event;  // a hint or the assisted credit: the expected stroke shown
+      shown.backwards = false;
+      shown.refusal = StrokeRefusal::none;
+      shown.written_stroke.reset();
+      if (const int assist_after = options_.assist_after();
+          assist_after > 0 && misses_on_stroke_ >= assist_after) {
+        shown.kind = QuizEvent::Kind::stroke_assisted;
+        ++strokes_assisted_;
+        out.push_back(shown);
+        next_stroke(shown);
+      } else if (const int hint_after = options_.hint_after();
+                 hint_after > 0 && misses_on_stroke_ >= hint_after) {
+        shown.kind = QuizEvent::Kind::hint;
+        out.push_back(shown);
       }
     }
   }

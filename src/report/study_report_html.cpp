@@ -212,6 +212,7 @@ void append_trial(std::string& out, const std::vector<std::string>& conditions, 
       trial.dtw_m ? number(*trial.dtw_m * 1e3, 2).c_str() : "&ndash;", trial.order_errors,
       trial.backwards_strokes);
   if (trial.quiz_misses) appendf(out, " &middot; quiz misses %d", *trial.quiz_misses);
+  if (trial.quiz_assisted > 0) appendf(out, " &middot; quiz strokes assisted %d", trial.quiz_assisted);
   if (!trial.completed) appendf(out, " &middot; <b>%s</b>", escape_markup(trial.end_reason).c_str());
   out += "</p>\n<div class=\"figures\">\n";
   append_trajectory_figure(out, trial);

@@ -277,8 +277,12 @@ ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifes
   trial.order_errors = static_cast<std::size_t>(record.number("order_errors", 0.0, 1e12));
   trial.backwards_strokes = static_cast<std::size_t>(record.number("backwards_strokes", 0.0, 1e12));
   trial.completed = trial.end_reason == "completed";
-  if (record.has("quiz"))
-    trial.quiz_misses = static_cast<int>(record.object("quiz").integer_or("misses", 0, 0, 1 << 30));
+  if (record.has("quiz")) {
+    const json_detail::JsonView quiz = record.object("quiz");
+    trial.quiz_misses = static_cast<int>(quiz.integer_or("misses", 0, 0, 1 << 30));
+    // Absent before the quiz credited strokes assisted: none were.
+    trial.quiz_assisted = static_cast<int>(quiz.integer_or("strokes_assisted", 0, 0, 1 << 30));
+  }
   read_scene(record, trial);
   const json_detail::JsonView per_stroke = record.array("per_stroke");
   for (std::size_t i = 0; i < per_stroke.size(); ++i) {

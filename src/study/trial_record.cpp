@@ -315,7 +315,7 @@ nlohmann::json trial_record(const TrialRecordContext& c, const Scene& scene, con
   if (quiz) {
     json characters = json::array();
     int misses = 0;
-    std::size_t accepted = 0, hints = 0, quiz_backwards = 0;
+    std::size_t accepted = 0, assisted = 0, hints = 0, quiz_backwards = 0;
     for (std::size_t i = 0; i < quiz->size(); ++i) {
       json events = json::array();
       for (const QuizEvent& e : (*quiz)[i]) {
@@ -330,6 +330,7 @@ nlohmann::json trial_record(const TrialRecordContext& c, const Scene& scene, con
         if (e.written_stroke) event["written_stroke"] = *e.written_stroke;
         events.push_back(event);
         accepted += e.kind == QuizEvent::Kind::stroke_accepted ? 1 : 0;
+        assisted += e.kind == QuizEvent::Kind::stroke_assisted ? 1 : 0;
         hints += e.kind == QuizEvent::Kind::hint ? 1 : 0;
         quiz_backwards += e.backwards ? 1 : 0;
         misses += e.kind == QuizEvent::Kind::stroke_missed ? 1 : 0;
@@ -340,8 +341,10 @@ nlohmann::json trial_record(const TrialRecordContext& c, const Scene& scene, con
     document["quiz"] = {{"acceptance", acceptance_json(q.acceptance)},
                         {"start_radius_m", q.start_radius_m},
                         {"hint_after_misses", q.hint_after()},
+                        {"assist_after_misses", q.assist_after()},
                         {"accept_backwards", q.accept_backwards},
                         {"strokes_accepted", accepted},
+                        {"strokes_assisted", assisted},
                         {"misses", misses},
                         {"hints", hints},
                         {"backwards", quiz_backwards},

@@ -18,6 +18,7 @@ LiveQuiz::LiveQuiz(const Scene& scene, const QuizOptions& options) : paper_z_m_(
   std::size_t first = 0;
   for (const PlacedCharacter& c : scene.characters) {
     sessions_.emplace_back(c, options);
+    assisted_.emplace_back(c.strokes.size(), false);
     first_stroke_.push_back(first);
     first += c.strokes.size();
   }
@@ -54,6 +55,11 @@ void LiveQuiz::take(std::size_t character, const std::vector<QuizEvent>& events,
       case QuizEvent::Kind::hint:
         hinted_[character] = e.stroke;
         break;
+      case QuizEvent::Kind::stroke_assisted:
+        hinted_[character].reset();
+        assisted_[character][e.stroke] = true;
+        last_assisted_ = Assisted{character, e.stroke, std::chrono::steady_clock::now()};
+        break;
       case QuizEvent::Kind::character_completed:
         break;
     }
@@ -84,6 +90,10 @@ std::vector<std::pair<std::size_t, QuizEvent>> LiveQuiz::finish() {
   open_run_.clear();
   finished_ = true;
   return out;
+}
+
+bool LiveQuiz::assisted(std::size_t character, std::size_t stroke) const noexcept {
+  return character < assisted_.size() && stroke < assisted_[character].size() && assisted_[character][stroke];
 }
 
 bool LiveQuiz::complete() const noexcept {

@@ -1,7 +1,7 @@
 #pragma once
-// The quiz judged live in the window (analysis/quiz.hpp: the stroke matcher, as the renderer judges): the pen's
-// positions arrive on the window thread through the display channel's trace queue, one `QuizSession` per
-// character of the trial's scene judges each stroke the moment the pen lifts, and the window shows the
+// The quiz judged live in the window (analysis/quiz.hpp: the stroke matcher, as the renderer judges): the
+// pen's positions arrive on the window thread through the display channel's trace queue, one `QuizSession`
+// per character of the trial's scene judges each stroke the moment the pen lifts, and the window shows the
 // verdicts at once. Never on the servo thread: a judgement takes up to milliseconds.
 //
 // The samples are the ones the saved record judges after the trial (quiz_characters): the
@@ -17,8 +17,8 @@
 #include <utility>
 #include <vector>
 
-#include "calligraphy/model/scene.hpp"
 #include "calligraphy/analysis/quiz.hpp"
+#include "calligraphy/model/scene.hpp"
 #include "calligraphy/trial/display.hpp"
 
 namespace calligraphy::trainer {
@@ -49,7 +49,18 @@ class LiveQuiz {
   /// The pen-down run being written (for drawing), and the character it is routed to.
   [[nodiscard]] const std::vector<Vec2>& open_run() const noexcept { return open_run_; }
   [[nodiscard]] const std::vector<QuizInk>& inks() const noexcept { return inks_; }
-  /// The stroke to highlight per character (after a hint event, until that stroke is accepted).
+  /// A stroke the quiz credited assisted (stroke_assisted): shown drawn once from `at` in the
+  /// demonstration's ink, as a trial's assisted stroke is (TrialView::assisted), then kept filled so.
+  struct Assisted {
+    std::size_t character = 0;
+    std::size_t stroke = 0;  ///< within that character
+    std::chrono::steady_clock::time_point at;
+  };
+  /// The last stroke credited assisted, of any character; empty before the first.
+  [[nodiscard]] const std::optional<Assisted>& last_assisted() const noexcept { return last_assisted_; }
+  /// Whether `stroke` of `character` was credited assisted (not written).
+  [[nodiscard]] bool assisted(std::size_t character, std::size_t stroke) const noexcept;
+  /// The stroke to highlight per character (after a hint event, until that stroke is accepted or assisted).
   [[nodiscard]] const std::vector<std::optional<std::size_t>>& hinted() const noexcept { return hinted_; }
   /// The last judged stroke was written from its end to its start, per character.
   [[nodiscard]] const std::vector<bool>& last_backwards() const noexcept { return last_backwards_; }
@@ -60,7 +71,7 @@ class LiveQuiz {
     return last_event_;
   }
   [[nodiscard]] bool finished() const noexcept { return finished_; }
-  /// Every stroke of every character accepted: the quiz, and so its trial, is complete.
+  /// Every stroke of every character accepted or assisted: the quiz, and so its trial, is complete.
   [[nodiscard]] bool complete() const noexcept;
   [[nodiscard]] std::uint64_t dropped_points() const noexcept { return dropped_points_; }
 
@@ -76,6 +87,8 @@ class LiveQuiz {
   std::size_t open_character_ = 0;
   std::vector<QuizInk> inks_;
   std::vector<std::optional<std::size_t>> hinted_;
+  std::vector<std::vector<bool>> assisted_;  // per character, per stroke
+  std::optional<Assisted> last_assisted_;
   std::vector<bool> last_backwards_;
   std::vector<StrokeRefusal> last_refusal_;
   std::optional<std::pair<std::size_t, QuizEvent>> last_event_;

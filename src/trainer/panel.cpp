@@ -87,6 +87,7 @@ void results_table(const TrialView& view) {
 
 const ImVec4 kGood(0.1f, 0.55f, 0.15f, 1);
 const ImVec4 kBad(0.8f, 0.1f, 0.1f, 1);
+const ImVec4 kHintText(0.35f, 0.35f, 0.9f, 1);  // a stroke shown: hinted, or assisted
 
 // The last refused attempt, until the pen touches the paper again: what it did, large, and what to do.
 void refusal(const TrialView& view, const PanelInput& input) {
@@ -103,8 +104,8 @@ void refusal(const TrialView& view, const PanelInput& input) {
 }
 
 // The quiz's state: per character, stroke k of n and the misses; the last verdict, why a stroke was missed
-// (in the learner's words, as a refused stroke), the hint, and "complete, M misses" once every stroke is
-// accepted.
+// (in the learner's words, as a refused stroke), the hint, a stroke shown and counted as assisted, and
+// "complete, M misses" (", K strokes assisted") once every stroke is accepted or assisted.
 void quiz_state(const TrialView& view, const PanelInput& input) {
   const LiveQuiz& quiz = *view.quiz;
   ImGui::Text("Quiz: write each stroke in order");
@@ -114,9 +115,14 @@ void quiz_state(const TrialView& view, const PanelInput& input) {
     const std::string label = quiz.sessions().size() > 1 ? "character " + std::to_string(c + 1) + ": " : "";
     if (input.large_font != nullptr) ImGui::PushFont(input.large_font);
     if (session.complete()) {
-      ImGui::TextColored(
-          kGood, "%scomplete, %s", label.c_str(),
-          count_of(static_cast<std::size_t>(session.total_misses()), "miss", "misses").c_str());
+      // Assisted strokes said apart: shown and counted, not written.
+      const std::string assisted =
+          session.strokes_assisted() > 0
+              ? ", " + count_of(session.strokes_assisted(), "stroke", "strokes") + " assisted"
+              : "";
+      ImGui::TextColored(kGood, "%scomplete, %s%s", label.c_str(),
+                         count_of(static_cast<std::size_t>(session.total_misses()), "miss", "misses").c_str(),
+                         assisted.c_str());
     } else {
       ImGui::Text("%sstroke %zu of %zu", label.c_str(), session.current_stroke() + 1, n);
     }
@@ -124,15 +130,21 @@ void quiz_state(const TrialView& view, const PanelInput& input) {
     if (!session.complete()) {
       ImGui::Text("misses on this stroke %d, in all %d", session.misses_on_stroke(), session.total_misses());
     }
-    if (quiz.hinted()[c])
-      ImGui::TextColored(ImVec4(0.35f, 0.35f, 0.9f, 1), "hint: stroke %zu shown", *quiz.hinted()[c] + 1);
+    if (quiz.hinted()[c]) ImGui::TextColored(kHintText, "hint: stroke %zu shown", *quiz.hinted()[c] + 1);
   }
   if (const auto& last = quiz.last_event()) {
     const QuizEvent& e = last->second;
     switch (e.kind) {
       case QuizEvent::Kind::stroke_accepted:
       case QuizEvent::Kind::character_completed:
-        ImGui::TextColored(kGood, "stroke %zu accepted", e.stroke + 1);
+        if (quiz.assisted(last->first, e.stroke)) {  // completed by an assisted stroke
+          ImGui::TextColored(kHintText, "stroke %zu shown and counted as assisted", e.stroke + 1);
+        } else {
+          ImGui::TextColored(kGood, "stroke %zu accepted", e.stroke + 1);
+        }
+        break;
+      case QuizEvent::Kind::stroke_assisted:
+        ImGui::TextColored(kHintText, "stroke %zu shown and counted as assisted", e.stroke + 1);
         break;
       case QuizEvent::Kind::stroke_missed:
       case QuizEvent::Kind::hint:

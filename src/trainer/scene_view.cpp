@@ -128,12 +128,14 @@ CharacterArt prepare_art(const TrainerCharacter& character) {
 
 namespace {
 
-// A stroke's colour in a quiz: accepted, hinted, or the plain outline; per character of the row.
+// A stroke's colour in a quiz: accepted, assisted (in the demonstration's ink, as a trial's assisted stroke
+// stays), hinted, or the plain outline; per character of the row.
 ImU32 quiz_fill(const TrialView& view, std::size_t row_character, std::size_t stroke) {
   const std::size_t q = view.whole_row ? row_character : 0;
   if (!view.whole_row && row_character != view.character) return kOutline;
   if (q >= view.quiz->sessions().size()) return kOutline;
-  if (stroke < view.quiz->sessions()[q].current_stroke()) return kQuizAccepted;
+  if (stroke < view.quiz->sessions()[q].current_stroke())
+    return view.quiz->assisted(q, stroke) ? kDemoInk : kQuizAccepted;
   if (view.quiz->hinted()[q] == stroke) return kQuizHint;
   return kOutline;
 }
@@ -291,7 +293,8 @@ void draw_demonstration(ImDrawList& draw, const WindowLayout& layout, const std:
 
 // Over a running trial: a stroke the trial demonstrated and credited (drawn once at the demonstration's pace,
 // then kept filled), and the active stroke's hint after misses (drawn once in the hint colour, then kept as
-// the outline in that colour with its median).
+// the outline in that colour with its median). Over a quiz: the last stroke the quiz credited assisted, drawn
+// once so (its fill is the quiz's, quiz_fill).
 void draw_shown_strokes(ImDrawList& draw, const WindowLayout& layout, const std::vector<CharacterArt>& art,
                         const TrialView& view) {
   if (view.scene == nullptr) return;
@@ -314,6 +317,13 @@ void draw_shown_strokes(ImDrawList& draw, const WindowLayout& layout, const std:
     if (number && !stroke.median_m.empty())
       draw_number(draw, to_screen(stroke.median_m.front()), shown.stroke + 1);
   };
+  if (view.quiz) {  // the quiz's own assisted credit; the renderer's events are not the quiz's verdicts
+    if (const auto& a = view.quiz->last_assisted()) {
+      draw_once({static_cast<std::uint32_t>(a->character), static_cast<std::uint32_t>(a->stroke), a->at},
+                kDemoInk, true);
+    }
+    return;
+  }
   if (view.assisted) draw_once(*view.assisted, kDemoInk, true);
   const DisplaySnapshot& s = view.snapshot;
   if (view.hint && !s.finished && view.hint->character == s.character && view.hint->stroke == s.stroke) {
@@ -374,7 +384,7 @@ void draw_scene(ImDrawList& draw, const WindowLayout& layout, const std::vector<
     draw_demonstration(draw, layout, art, *demo);
     return;
   }
-  if (view != nullptr && !quiz) draw_shown_strokes(draw, layout, art, *view);
+  if (view != nullptr) draw_shown_strokes(draw, layout, art, *view);
   for (std::size_t c = 0; c < art.size() && !quiz; ++c) {
     for (const std::vector<Vec2>& stroke : art[c].reference) {
       std::vector<ImVec2> points;

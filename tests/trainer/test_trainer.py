@@ -446,6 +446,43 @@ class TrainerTest(unittest.TestCase):
         # Hanzi Writer's quiz shows no reference and no start of the next stroke.
         self.assertEqual(fraction([near(missed, box.data_to_px(p), 4, is_blue) for p in inner]), 0.0)
 
+    def test_the_quiz_credits_a_stroke_assisted_live(self):
+        # After --assist-after-misses misses the quiz shows the stroke and credits it (Hanzi Writer's
+        # markStrokeCorrectAfterMisses): one miss on 一's only stroke completes the quiz.
+        shots = pathlib.Path(self.folder) / "shots"
+        shots.mkdir()
+        trainer = self.start("一", "--device", "mouse", "--data", SAMPLE, "--quiz", "--assist-after-misses", "1",
+                             "--session", "out", "--quiz-screenshots", "shots", "--exit-after", "60")
+        (box,) = trainer.boxes()
+        window = trainer.window()
+        median = medians("一", SAMPLE)[0]
+        backwards = [box.data_to_px(p) for p in along(median, [i / 12 for i in range(13)])][::-1]
+        time.sleep(0.5)
+        self.write_with_the_mouse(window, backwards, trainer=trainer)
+        self.assertEqual(trainer.wait(), 0, trainer.errors())
+        errors = trainer.errors()
+        self.assertIn("quiz 一 stroke 1: stroke_missed (misses 1 on the stroke, 1 in all, backwards)", errors)
+        self.assertIn("quiz 一 stroke 1: stroke_assisted (misses 1 on the stroke, 1 in all)", errors)
+        self.assertIn("quiz 一 complete, 1 miss\n", errors)
+        self.assertIn("quiz: 1 live verdict, the same as in the saved record", errors)
+
+        (record_path,) = saved_trials(pathlib.Path(self.folder) / "out")
+        record = json.loads(record_path.read_text(encoding="utf-8"))
+        self.assertEqual(record["end_reason"], "completed")
+        quiz = record["quiz"]
+        self.assertEqual((quiz["assist_after_misses"], quiz["acceptance"]["assist_after_misses"]), (1, 1))
+        self.assertEqual((quiz["strokes_accepted"], quiz["strokes_assisted"], quiz["misses"]), (0, 1, 1))
+        events = quiz["characters"][0]["events"]
+        self.assertEqual([e["kind"] for e in events], ["stroke_missed", "stroke_assisted", "character_completed"])
+        self.assertEqual([e["stroke"] for e in events], [0, 0, 0])
+
+        # The assisted stroke filled in the demonstration's ink, as a trial's assisted stroke; not accepted.
+        inner = along(median, [i / 20 for i in range(2, 19)])
+        shown = read_png(shots / "quiz-01-stroke_missed.png")
+        self.assertGreater(fraction([near(shown, box.data_to_px(p), 4, is_demo_ink) for p in inner]), 0.9,
+                           "the assisted stroke in the demonstration's ink")
+        self.assertEqual(fraction([near(shown, box.data_to_px(p), 4, is_accepted) for p in inner]), 0.0)
+
     def test_the_quiz_options_need_quiz(self):
         with tempfile.TemporaryDirectory() as folder:
             result = subprocess.run([CLI, "train", "一", "--quiz-screenshots", folder], capture_output=True,

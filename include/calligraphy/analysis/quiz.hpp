@@ -6,13 +6,15 @@
 /// ignores a segment: analysis/score.hpp) is neither. Every other run is judged by the stroke matcher,
 /// `match_stroke(character, expected, run, start_radius_m, acceptance)` (analysis/stroke_matcher.hpp):
 /// the renderer's rule, so that the quiz, the renderer and `score_trace`'s segment verdicts agree on the
-/// same trace (docs/stroke-acceptance.md) until a stroke is credited assisted: the quiz gives no such credit
-/// (its stroke stays expected, with a hint after each further miss), the renderer and `score_trace` do after
-/// `assist_after_misses` misses. A run refused as backwards is a miss reported as backwards, or
-/// accepted (still reported as backwards) with `accept_backwards`. After `hint_after_misses` misses on
-/// one stroke, and after each further miss, a hint event asks to show the expected stroke. Not for the
-/// servo thread: judging takes up to milliseconds per pen lift. On the model and the stroke matcher only:
-/// a trial's trace is judged through `quiz_characters` (trial/quiz_trace.hpp).
+/// same trace (docs/stroke-acceptance.md), assisted credit included: after the acceptance's
+/// `assist_after_misses` misses on one stroke (0: never), that stroke is credited assisted, as the renderer
+/// (`ActiveStroke::lift`) and `score_trace` (`StrokeScore::assisted`) credit it and as Hanzi Writer's
+/// `markStrokeCorrectAfterMisses` marks it correct: shown, not written, and the next stroke is expected. A
+/// run refused as backwards is a miss reported as backwards, or accepted (still reported as backwards) with
+/// `accept_backwards`. After `hint_after_misses` misses on one stroke, and after each further miss but the
+/// one that credits it, a hint event asks to show the expected stroke. Not for the servo thread: judging
+/// takes up to milliseconds per pen lift. On the model and the stroke matcher only: a trial's trace is
+/// judged through `quiz_characters` (trial/quiz_trace.hpp).
 #include <cstddef>
 #include <optional>
 #include <span>
@@ -44,6 +46,10 @@ struct QuizOptions {
   [[nodiscard]] int hint_after() const noexcept {
     return hint_after_misses ? *hint_after_misses : static_cast<int>(acceptance.hint_after_misses);
   }
+  /// The misses on one stroke after which the quiz credits it assisted (0: never): the acceptance's
+  /// `assist_after_misses`, the renderer's and `score_trace`'s count, with no override of the quiz's own
+  /// (a protocol sets it as `quiz.acceptance.assist_after_misses`).
+  [[nodiscard]] int assist_after() const noexcept { return static_cast<int>(acceptance.assist_after_misses); }
   /// A stroke written from its end to its start is accepted (and still reported as backwards).
   bool accept_backwards = false;
   /// Throws InvalidArgument naming the field when a value is out of range.
@@ -56,16 +62,21 @@ struct QuizEvent {
     stroke_accepted,      ///< the written stroke is the expected one: show it, expect the next
     stroke_missed,        ///< not the expected stroke: `refusal` says why
     hint,                 ///< show the expected stroke (after enough misses)
-    character_completed,  ///< every stroke accepted
+    character_completed,  ///< every stroke accepted or assisted
     too_short,            ///< a touch or a dot too short to judge: neither accepted nor a miss
+    /// After the miss that made `assist_after_misses` misses on the expected stroke: that stroke is shown
+    /// (demonstrated) and credited assisted, not written; the next is expected. Follows its stroke_missed.
+    stroke_assisted,
   };
   Kind kind = Kind::stroke_missed;
-  std::size_t stroke = 0;    ///< the expected stroke, 0-based in the character's stroke order
-  bool backwards = false;    ///< the written stroke writes the expected one from its end to its start
-  int misses_on_stroke = 0;  ///< misses on `stroke` so far (0 after it is accepted)
-  int total_misses = 0;      ///< misses on the whole character so far
-  double time_s = 0.0;       ///< time of the last pen-down sample of the judged stroke [s]
-  std::size_t samples = 0;   ///< pen-down samples of the judged stroke
+  std::size_t stroke = 0;  ///< the expected stroke, 0-based in the character's stroke order
+  bool backwards = false;  ///< the written stroke writes the expected one from its end to its start
+  /// Misses on `stroke` so far: 0 after it is accepted; the misses that earned the credit with
+  /// stroke_assisted (as Hanzi Writer's onCorrectStroke gives them).
+  int misses_on_stroke = 0;
+  int total_misses = 0;     ///< misses on the whole character so far
+  double time_s = 0.0;      ///< time of the last pen-down sample of the judged stroke [s]
+  std::size_t samples = 0;  ///< pen-down samples of the judged stroke
   /// Why the stroke matcher refused the written stroke (stroke_missed); none otherwise, also for a
   /// backwards stroke accepted with `accept_backwards`.
   StrokeRefusal refusal = StrokeRefusal::none;
@@ -74,7 +85,7 @@ struct QuizEvent {
   std::optional<std::size_t> written_stroke;
 };
 
-/// "stroke_accepted", "stroke_missed", "hint", "character_completed", "too_short".
+/// "stroke_accepted", "stroke_missed", "hint", "character_completed", "too_short", "stroke_assisted".
 [[nodiscard]] const char* to_string(QuizEvent::Kind kind) noexcept;
 
 /// One character's quiz.
@@ -96,6 +107,8 @@ class QuizSession {
   [[nodiscard]] bool complete() const noexcept { return current_ >= character_.strokes.size(); }
   [[nodiscard]] int misses_on_stroke() const noexcept { return misses_on_stroke_; }
   [[nodiscard]] int total_misses() const noexcept { return total_misses_; }
+  /// Strokes credited assisted so far (stroke_assisted events).
+  [[nodiscard]] std::size_t strokes_assisted() const noexcept { return strokes_assisted_; }
   /// Every event so far, in order.
   [[nodiscard]] const std::vector<QuizEvent>& events() const noexcept { return events_; }
   [[nodiscard]] const PlacedCharacter& character() const noexcept { return character_; }
@@ -109,6 +122,7 @@ class QuizSession {
   std::size_t current_ = 0;
   int misses_on_stroke_ = 0;
   int total_misses_ = 0;
+  std::size_t strokes_assisted_ = 0;
   std::size_t samples_fed_ = 0;
   double last_time_s_ = 0.0;
   std::vector<QuizEvent> events_;

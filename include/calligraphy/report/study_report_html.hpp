@@ -57,6 +57,8 @@ struct ReportTrial {
   std::size_t backwards_strokes = 0;
   bool completed = false;
   std::optional<int> quiz_misses;  ///< quiz conditions: strokes missed
+  /// Quiz conditions: strokes the quiz credited assisted (0 in records written before it did).
+  int quiz_assisted = 0;
 };
 
 /// One session as the index lists it and its page heads it.
