@@ -54,7 +54,7 @@ QuizSession::QuizSession(PlacedCharacter character, const QuizOptions& options)
   }
 }
 
-std::vector<QuizEvent> QuizSession::judge_segment() {
+std::vector<QuizEvent> QuizSession::judge_segment(bool lifted) {
   std::vector<QuizEvent> out;
   if (segment_.empty() || complete()) {
     segment_.clear();
@@ -103,7 +103,10 @@ std::vector<QuizEvent> QuizSession::judge_segment() {
       event.refusal = match.refusal;
       // Another stroke written (a wrong_stroke that set off along the expected one and left it names none).
       if (match.matched_stroke != current_) event.written_stroke = match.matched_stroke;
-      event.misses_on_stroke = ++misses_on_stroke_;
+      // A run the input ends in (finish) is missed but earns no hint or credit, as in score_trace: the
+      // renderer judges an attempt at its lift.
+      if (lifted) ++misses_on_stroke_;
+      event.misses_on_stroke = misses_on_stroke_;
       event.total_misses = ++total_misses_;
       out.push_back(event);
       QuizEvent shown = event;  // a hint or the assisted credit: the expected stroke shown
@@ -146,10 +149,10 @@ std::vector<QuizEvent> QuizSession::feed(const PenSample& sample) {
     segment_.push_back(sample);
     return {};
   }
-  return judge_segment();
+  return judge_segment(true);
 }
 
-std::vector<QuizEvent> QuizSession::finish() { return judge_segment(); }
+std::vector<QuizEvent> QuizSession::finish() { return judge_segment(false); }
 
 std::vector<QuizEvent> quiz_character(const PlacedCharacter& character, std::span<const PenSample> samples,
                                       const QuizOptions& options) {

@@ -194,8 +194,9 @@ CharacterScore score_trace(const PlacedCharacter& character, std::span<const Pen
   }
 
   // The renderer's verdict on each segment in sequence: the stroke expected advances with each acceptance,
-  // and after assist_after_misses refusals of it, as the renderer demonstrates and credits it
-  // (ActiveStroke::lift; Hanzi Writer's markStrokeCorrectAfterMisses).
+  // and after assist_after_misses misses of it, as the renderer demonstrates and credits it
+  // (ActiveStroke::lift; Hanzi Writer's markStrokeCorrectAfterMisses). A miss is a refused pen-down ended
+  // by a lift: one the trace ends in is refused but no miss (the renderer judges an attempt at its lift).
   const std::size_t strokes = character.strokes.size();
   const double assist_after = options.acceptance.assist_after_misses;
   std::size_t expected = 0;
@@ -213,6 +214,8 @@ CharacterScore score_trace(const PlacedCharacter& character, std::span<const Pen
       continue;
     }
     score.refusals.add(verdict.refusal);
+    const bool lifted = segment.end < trace.size();
+    if (!lifted) continue;
     misses += 1.0;
     if (assist_after > 0.0 && misses >= assist_after) {
       segment.assists_due = true;

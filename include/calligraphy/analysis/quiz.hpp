@@ -9,8 +9,9 @@
 /// same trace (docs/stroke-acceptance.md), assisted credit included: after the acceptance's
 /// `assist_after_misses` misses on one stroke (0: never), that stroke is credited assisted, as the renderer
 /// (`ActiveStroke::lift`) and `score_trace` (`StrokeScore::assisted`) credit it and as Hanzi Writer's
-/// `markStrokeCorrectAfterMisses` marks it correct: shown, not written, and the next stroke is expected. A
-/// run refused as backwards is a miss reported as backwards, or accepted (still reported as backwards) with
+/// `markStrokeCorrectAfterMisses` marks it correct: shown, not written, and the next stroke is expected.
+/// A run `finish` judges (the input ended with the pen down) is missed but counts towards no hint or
+/// credit. A run refused as backwards is a miss reported as backwards, or accepted (still reported as backwards) with
 /// `accept_backwards`. After `hint_after_misses` misses on one stroke, and after each further miss but the
 /// one that credits it, a hint event asks to show the expected stroke. Not for the servo thread: judging
 /// takes up to milliseconds per pen lift. On the model and the stroke matcher only: a trial's trace is
@@ -71,10 +72,10 @@ struct QuizEvent {
   Kind kind = Kind::stroke_missed;
   std::size_t stroke = 0;  ///< the expected stroke, 0-based in the character's stroke order
   bool backwards = false;  ///< the written stroke writes the expected one from its end to its start
-  /// Misses on `stroke` so far: 0 after it is accepted; the misses that earned the credit with
-  /// stroke_assisted (as Hanzi Writer's onCorrectStroke gives them).
+  /// Misses on `stroke` so far (not the one `finish` judges): 0 after it is accepted; the misses that
+  /// earned the credit with stroke_assisted (as Hanzi Writer's onCorrectStroke gives them).
   int misses_on_stroke = 0;
-  int total_misses = 0;     ///< misses on the whole character so far
+  int total_misses = 0;     ///< every miss on the whole character so far
   double time_s = 0.0;      ///< time of the last pen-down sample of the judged stroke [s]
   std::size_t samples = 0;  ///< pen-down samples of the judged stroke
   /// Why the stroke matcher refused the written stroke (stroke_missed); none otherwise, also for a
@@ -100,7 +101,8 @@ class QuizSession {
   /// character is completed are ignored. Throws InvalidArgument naming the sample (counted from 0) when
   /// its time or position is not finite or its time is below the previous sample's.
   std::vector<QuizEvent> feed(const PenSample& sample);
-  /// Judges a pen-down run still open (the input ended with the pen down); returns its events.
+  /// Judges a pen-down run still open (the input ended with the pen down); returns its events. Not lifted,
+  /// it can be accepted or missed, never counted towards a hint or the assisted credit.
   std::vector<QuizEvent> finish();
 
   [[nodiscard]] std::size_t current_stroke() const noexcept { return current_; }
@@ -114,7 +116,7 @@ class QuizSession {
   [[nodiscard]] const PlacedCharacter& character() const noexcept { return character_; }
 
  private:
-  std::vector<QuizEvent> judge_segment();
+  std::vector<QuizEvent> judge_segment(bool lifted);
 
   PlacedCharacter character_;
   QuizOptions options_;

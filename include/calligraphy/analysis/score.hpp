@@ -51,8 +51,9 @@ struct WrittenSegment {
   std::optional<StrokeMatch> verdict;
   /// The stroke the verdict judged, `expected` above (0-based); 0 without a verdict.
   std::size_t due_stroke = 0;
-  /// This refused verdict was the `acceptance.assist_after_misses`-th on the stroke due: that stroke is then
-  /// credited assisted, as the renderer demonstrates and credits it (StrokeAcceptance), and the next is due.
+  /// This refused verdict was the `acceptance.assist_after_misses`-th miss on the stroke due: that stroke is
+  /// then credited assisted, as the renderer demonstrates and credits it (StrokeAcceptance), and the next is
+  /// due. A miss is a refused verdict on a segment the pen lifted from (not one the trace ends in).
   bool assists_due = false;
 };
 
