@@ -195,7 +195,9 @@ CharacterScore score_trace(const PlacedCharacter& character, std::span<const Pen
 
   // The renderer's verdict on each segment in sequence: the stroke expected advances with each acceptance,
   // and after assist_after_misses refusals of it, as the renderer demonstrates and credits it
-  // (ActiveStroke::lift; Hanzi Writer's markStrokeCorrectAfterMisses).
+  // (ActiveStroke::lift; Hanzi Writer's markStrokeCorrectAfterMisses). The renderer counts a miss at a lift
+  // in WS only: a pen-down that never came within the start radius of the stroke due (8 mm beside it, an
+  // earlier stroke written again) is refused but is no attempt at that stroke.
   const std::size_t strokes = character.strokes.size();
   const double assist_after = options.acceptance.assist_after_misses;
   std::size_t expected = 0;
@@ -212,6 +214,7 @@ CharacterScore score_trace(const PlacedCharacter& character, std::span<const Pen
       continue;
     }
     score.refusals.add(verdict.refusal);
+    if (!verdict.entered) continue;
     misses += 1.0;
     if (assist_after > 0.0 && misses >= assist_after) {
       segment.assists_due = true;

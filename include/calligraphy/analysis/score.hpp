@@ -49,8 +49,9 @@ struct WrittenSegment {
   /// assisted (`assists_due`). Absent for an ignored segment and once every stroke has been accepted or
   /// credited.
   std::optional<StrokeMatch> verdict;
-  /// This refused verdict was the `acceptance.assist_after_misses`-th on the stroke due: that stroke is then
-  /// credited assisted, as the renderer demonstrates and credits it (StrokeAcceptance), and the next is due.
+  /// This refused verdict was the `acceptance.assist_after_misses`-th on the stroke due of those that came
+  /// within the start radius of its start (the renderer's misses: lifts in WS): that stroke is then credited
+  /// assisted, as the renderer demonstrates and credits it (StrokeAcceptance), and the next is due.
   bool assists_due = false;
 };
 
