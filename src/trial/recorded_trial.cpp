@@ -278,8 +278,8 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
   // field, naming the force law's.
   if (version >= 6) {
     for (const ParameterField<StrokeAcceptance>& field : ParameterTable<StrokeAcceptance>::fields()) {
-      const double stated = r.spec.acceptance.*field.member;
-      const double ran = r.force_law.acceptance.*field.member;
+      const double stated = r.spec.acceptance.*field.member + 0.0;  // -0 is said as 0
+      const double ran = r.force_law.acceptance.*field.member + 0.0;
       if (stated == ran) continue;
       const std::string law_pointer = json_detail::child_pointer(
           json_detail::child_pointer(reader.pointer("force_law"), "acceptance"), std::string(field.name));
