@@ -64,12 +64,14 @@ def along(median, offset=(0.0, 0.0), fraction=1.0, n=400):
 
 
 def pen_path(characters, plan):
-    """The ticks (t, x, y, z) of a pen writing `plan`, a list of (character, stroke, offset, fraction), each
-    pen-down set down and lifted straight up, the pen carried through the air between them, 1 kHz."""
+    """The ticks (t, x, y, z) of a pen writing `plan`, a list of (character, stroke, offset, fraction; a
+    negative fraction: from the stroke's end), each pen-down set down and lifted straight up, the pen carried
+    through the air between them, 1 kHz."""
     scene = cg.Scene(characters)
     points, here = [], None
     for c, k, offset, fraction in plan:
-        p = along(scene.characters[c].strokes[k].median_m, offset, fraction)
+        median = np.asarray(scene.characters[c].strokes[k].median_m)
+        p = along(median if fraction > 0 else median[::-1], offset, abs(fraction))
         if here is not None:
             points += [(*(here * (1 - a) + p[0] * a), HOVER_M) for a in np.linspace(0, 1, 200)]
         points += [(*p[0], HOVER_M * (1 - a) + DOWN_M * a) for a in np.linspace(0, 1, 50)]
@@ -311,6 +313,21 @@ class Round27A(unittest.TestCase, OneErrorLine):
         self.assertEqual(scored["strokes_assisted"], 1)
         self.assertEqual(scored["strokes_accepted"], 4)
 
+    def test_strokes_written_backwards_until_credited_are_written_and_in_order(self):
+        # docs/stroke-acceptance.md: every stroke written backwards and then credited assisted has
+        # strokes_written = strokes_total and is completed_in_order, with strokes_accepted 0.
+        ticks = pen_path("十", [(0, 0, (0.0, 0.0), -1.0)] * 5 + [(0, 1, (0.0, 0.0), -1.0)] * 5)
+        write_trace(self.tmp / "backwards.csv", ticks)
+        scored = self.score("backwards.csv")
+        self.assertEqual(self.assisted(scored), [True, True])
+        self.assertEqual(scored["refusals"]["backwards"], 10)
+        self.assertEqual((scored["strokes_written"], scored["strokes_accepted"]), (2, 0))
+        self.assertEqual(scored["backwards_strokes"], 2)
+        self.assertTrue(scored["completed_in_order"])
+        # The renderer counts each as a lift in WS (the pen ends at the start) and credits both.
+        _, assisted, completed = renderer_story("十", ticks, 3, 5)
+        self.assertEqual((assisted, completed), ([0, 1], []))
+
     # ---- the renderer's own credit on the same trace -----------------------------------------------------
     def test_renderer_and_score_credit_the_same_stroke(self):
         lifts, assisted, completed = renderer_story("十", self.ticks["half", 5], 3, 5)
@@ -424,7 +441,9 @@ class Round27A(unittest.TestCase, OneErrorLine):
         for pointer in ("/specification/trial/assist_after_misses", "/specification/trial/hint_after_misses",
                         "/specification/force_law/acceptance/assist_after_misses",
                         "/specification/force_law/acceptance/hint_after_misses"):
-            for value in (1001, -1, 2.5, "2", None, True):
+            # Every kind of wrong value at one pointer, one past the range and one not whole at the others.
+            values = (1001, -1, 2.5, "2", None, True) if pointer.endswith("trial/assist_after_misses") else (1001, 2.5)
+            for value in values:
                 with self.subTest(pointer=pointer, value=value):
                     def change(r, pointer=pointer, value=value):
                         *parents, key = pointer.strip("/").split("/")
