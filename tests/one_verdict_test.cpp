@@ -1,8 +1,7 @@
 // One stroke matcher decides acceptance everywhere: a pen trace of person-like paths (sim/person_traces.hpp),
 // written stroke after stroke with the pen lifted between them, gets the same verdict and the same refusal
 // for every pen-down run from score_trace's segment verdicts, from a QuizSession fed the same samples, and
-// from match_stroke called on each run in turn, and the same assisted credit from score_trace and the quiz at
-// the default `assist_after_misses` as without it. And score_trace, whose one-to-one matching is built on the
+// from match_stroke called on each run in turn. And score_trace, whose one-to-one matching is built on the
 // same pairwise test (attempt_stroke), finds the order and direction of the strokes written.
 #include <algorithm>
 #include <catch2/catch.hpp>
@@ -51,49 +50,47 @@ std::vector<std::vector<Vec2>> runs_of_kind(const PlacedCharacter& c, TraceKind 
   return runs;
 }
 
-// A verdict on a run, or the assisted credit that follows the miss that earned it.
-bool judged_or_credited(QuizEvent::Kind kind) {
+bool judged(QuizEvent::Kind kind) {
   return kind == QuizEvent::Kind::stroke_accepted || kind == QuizEvent::Kind::stroke_missed ||
-         kind == QuizEvent::Kind::too_short || kind == QuizEvent::Kind::stroke_assisted;
+         kind == QuizEvent::Kind::too_short;
 }
 
 }  // namespace
 
 TEST_CASE("The score and the quiz give match_stroke's verdict and refusal for every pen-down run",
           "[score][quiz]") {
-  // Without the assisted credit, and with the default one (the renderer's, StrokeAcceptance).
-  const double assist_after = GENERATE(0.0, StrokeAcceptance{}.assist_after_misses);
   std::mt19937_64 random(20260611);
-  std::size_t accepted = 0, refused = 0, runs_judged = 0, assisted = 0;
+  std::size_t accepted = 0, refused = 0, runs_judged = 0;
   std::set<StrokeRefusal> reasons;
   for (const char32_t code_point : {U'十', U'口', U'人', U'永', U'我'}) {
     const PlacedCharacter& c = character_of(code_point);
     for (const TraceKind kind : kTraceKinds) {
       const std::vector<PenSample> trace = pen_trace(runs_of_kind(c, kind, random));
       INFO("character U+" << std::hex << static_cast<unsigned>(code_point) << std::dec << ", paths "
-                          << to_string(kind) << ", assist_after_misses " << assist_after);
-      ScoreOptions score_options;
-      score_options.acceptance.assist_after_misses = assist_after;
-      const CharacterScore score = score_trace(c, trace, score_options);
+                          << to_string(kind));
+      // Read without the assisted credit: the quiz counts its misses as Hanzi Writer does (every mismatch),
+      // the score as the renderer does (attempts begun in WS), so their credits part where a pen-down never
+      // comes near the expected stroke's start (quiz.hpp). The quiz's credit is held in
+      // analysis_quiz_test.cpp, the score's to the renderer's in trial_score_test.cpp.
+      ScoreOptions without_credit;
+      without_credit.acceptance.assist_after_misses = 0.0;
+      const CharacterScore score = score_trace(c, trace, without_credit);
 
-      QuizOptions quiz_options;
-      quiz_options.acceptance = score_options.acceptance;
-      QuizSession quiz(c, quiz_options);
+      QuizSession quiz(c);
       for (const PenSample& s : trace) quiz.feed(s);
       quiz.finish();
       std::vector<QuizEvent> events;
       for (const QuizEvent& e : quiz.events()) {
-        if (judged_or_credited(e.kind)) events.push_back(e);
+        if (judged(e.kind)) events.push_back(e);
       }
 
-      // The renderer's reading, run by run: the expected stroke advances with each acceptance, and with
-      // each assisted credit.
+      // The renderer's reading, run by run: the expected stroke advances with each acceptance.
       std::size_t expected = 0;
       std::size_t next_event = 0;
       for (std::size_t k = 0; k < score.segments.size(); ++k) {
         const WrittenSegment& segment = score.segments[k];
         INFO("run " << k << ", stroke " << expected << " expected");
-        if (expected == c.strokes.size()) {  // every stroke accepted or assisted: nothing more is judged
+        if (expected == c.strokes.size()) {  // every stroke accepted: nothing more is judged
           CHECK_FALSE(segment.verdict);
           continue;
         }
@@ -129,39 +126,20 @@ TEST_CASE("The score and the quiz give match_stroke's verdict and refusal for ev
           ++refused;
           reasons.insert(direct.refusal);
         }
-        // The credit: score_trace's after this refusal exactly when the quiz's follows its miss.
-        const bool quiz_credits =
-            next_event < events.size() && events[next_event].kind == QuizEvent::Kind::stroke_assisted;
-        CHECK(quiz_credits == segment.assists_due);
-        if (quiz_credits) {
-          CHECK(events[next_event].stroke == expected);
-          CHECK(events[next_event].misses_on_stroke == static_cast<int>(assist_after));
-          CHECK(score.strokes[expected].assisted);
-          ++next_event;
-          ++expected;
-          ++assisted;
-        }
       }
       CHECK(next_event == events.size());  // every run the quiz judged is a segment of the score
-      CHECK(score.strokes_accepted + score.strokes_assisted == expected);
+      CHECK(score.strokes_accepted == expected);
       CHECK(quiz.current_stroke() == expected);
-      CHECK(quiz.strokes_assisted() == score.strokes_assisted);
-      CHECK(quiz.complete() == (expected == c.strokes.size()));
       const auto with_verdict = std::count_if(score.segments.begin(), score.segments.end(),
                                               [](const WrittenSegment& s) { return s.verdict.has_value(); });
       CHECK(score.refusals.total() + score.strokes_accepted == static_cast<std::size_t>(with_verdict));
     }
   }
-  // The agreement is on verdicts of every sort, not only on easy acceptances, and on the credit too.
+  // The agreement is on verdicts of every sort, not only on easy acceptances.
   CHECK(runs_judged > 150);
   CHECK(accepted > 50);
   CHECK(refused > 50);
   CHECK(reasons.size() >= 4);
-  if (assist_after > 0.0) {
-    CHECK(assisted > 0);
-  } else {
-    CHECK(assisted == 0);
-  }
 }
 
 TEST_CASE("score_trace finds the order and direction of person-like strokes", "[score]") {

@@ -85,6 +85,7 @@ RecordedTrial random_recorded_trial(std::mt19937_64& random, GuidanceMode mode) 
     r.spec.guidance_gain = fading->gain;
   r.force_law.acceptance.corridor_m = 0.0071234567890123;
   r.force_law.acceptance.shortfall_fraction = 0.41;
+  r.spec.acceptance = r.force_law.acceptance;  // a record states the acceptance its force law ran with
   r.force_law.nearest.method = NearestPointMethod::newton;
   r.force_law.nearest.newton_starts = 5;
   randomise(r.safety, random);

@@ -363,11 +363,12 @@ TEST_CASE("A trace with more pen-down segments than the limit is refused before 
 
 TEST_CASE("A stroke refused assist_after_misses times is credited assisted and the next is judged", "[score]") {
   // As the renderer credits it (ActiveStroke::lift): the strokes after it are judged as a trial judged them,
-  // not refused as written out of order.
+  // not refused as written out of order. A miss is a refused pen-down that came within the start radius of
+  // the stroke due (the renderer's lift in WS): here the first stroke 4 mm beside itself.
   const PlacedCharacter& yong = scene_of(U'永').characters.front();
-  const auto trace_with_misses = [&](int misses) {
+  const auto trace_with_misses = [&](int misses, double offset_m = 4e-3) {
     TraceBuilder trace;
-    for (int k = 0; k < misses; ++k) trace.write(stroke_points(yong.strokes[0], 0.05e-3, 8e-3));
+    for (int k = 0; k < misses; ++k) trace.write(stroke_points(yong.strokes[0], 0.05e-3, offset_m));
     for (std::size_t s = 1; s < yong.strokes.size(); ++s) trace.write(stroke_points(yong.strokes[s], 0.05e-3));
     return trace;
   };
@@ -391,13 +392,17 @@ TEST_CASE("A stroke refused assist_after_misses times is credited assisted and t
   CHECK(uncredited.strokes_accepted == 0);
   CHECK(uncredited.refusals.total() == 5 + yong.strokes.size() - 1);
 
-  // After four misses the second stroke, written while the first is due, is the fifth refusal: the first is
-  // credited, and the second is due when the third is written (refused in turn, as the renderer refuses it).
+  // After four misses the later strokes, written while the first is due, begin far from its start: refused
+  // as written out of order, but no attempt at the first, which the renderer would not credit either.
   const CharacterScore four = score_trace(yong, trace_with_misses(4).samples);
-  CHECK(four.strokes_assisted == 1);
-  CHECK(four.segments[4].assists_due);
+  CHECK(four.strokes_assisted == 0);
+  CHECK_FALSE(four.segments[4].assists_due);
   CHECK(four.strokes_accepted == 0);
   CHECK(four.refusals.wrong_order == yong.strokes.size() - 1);
+  // Five pen-downs 8 mm beside the first stroke never come within its start radius: refused, never a miss.
+  const CharacterScore far = score_trace(yong, trace_with_misses(5, 8e-3).samples);
+  CHECK(far.strokes_assisted == 0);
+  CHECK(far.refusals.wrong_place == 5);
   // At 3 the fourth and fifth misses are judged against the second stroke.
   ScoreOptions three;
   three.acceptance.assist_after_misses = 3.0;

@@ -209,7 +209,7 @@ class Study:
     strokes: one row per reference stroke of each saved trial (subject, session, trial, phase, condition,
         character (1-based in the trial), character_text, stroke (1-based in its character), typical_id,
         written, backwards, segments, refused_segments, refusal, the per-stroke deviations [m], time_s [s],
-        path_length_m [m]).
+        path_length_m [m], assisted).
     """
 
     trials: "pandas.DataFrame"

@@ -133,7 +133,9 @@ const MetricInfo kMetrics[] = {
      .doc = "credited assisted in turn after `assist_after_misses` refused attempts while it was due",
      .definition = "`StrokeScore::assisted` (`score_trace`, as the renderer credits it)",
      .levels = kStroke,
-     .of_stroke = [](const StrokeScore& s) { return MetricValue(s.assisted); }},
+     .of_stroke = [](const StrokeScore& s) { return MetricValue(s.assisted); },
+     .strokes_column = 8,
+     .if_missing = MetricMissing::zero},
     {.name = "backwards",
      .kind = MetricKind::flag,
      .doc = "the stroke was written from its end to its start",
@@ -333,7 +335,8 @@ const MetricInfo kMetrics[] = {
             "renderer)",
      .definition =
          "a run's: `TrialMetrics::strokes_assisted`; a scored trace's: strokes credited in turn after "
-         "`assist_after_misses` refused verdicts (`score_trace`)",
+         "`assist_after_misses` refused verdicts of pen-downs that came within the start radius of the "
+         "stroke's start, the renderer's misses (`score_trace`)",
      .levels = kScene | kCharacter | kRun,
      .of_scene = [](const WritingMetrics& m) { return count(m.strokes_assisted); },
      .of_character = [](const CharacterScore& c) { return count(c.strokes_assisted); },

@@ -103,8 +103,9 @@ std::vector<QuizEvent> QuizSession::judge_segment(bool lifted) {
       event.refusal = match.refusal;
       // Another stroke written (a wrong_stroke that set off along the expected one and left it names none).
       if (match.matched_stroke != current_) event.written_stroke = match.matched_stroke;
-      // A run the input ends in (finish) is missed but earns no hint or credit, as in score_trace: the
-      // renderer judges an attempt at its lift.
+      // Every mismatch lifted is a miss on the expected stroke, as Hanzi Writer counts them (not the run
+      // `finish` judges, which was never lifted). The renderer and score_trace count only attempts begun in
+      // the stroke's start neighbourhood (WS): see quiz.hpp.
       if (lifted) ++misses_on_stroke_;
       event.misses_on_stroke = misses_on_stroke_;
       event.total_misses = ++total_misses_;

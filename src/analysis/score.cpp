@@ -195,8 +195,9 @@ CharacterScore score_trace(const PlacedCharacter& character, std::span<const Pen
 
   // The renderer's verdict on each segment in sequence: the stroke expected advances with each acceptance,
   // and after assist_after_misses misses of it, as the renderer demonstrates and credits it
-  // (ActiveStroke::lift; Hanzi Writer's markStrokeCorrectAfterMisses). A miss is a refused pen-down ended
-  // by a lift: one the trace ends in is refused but no miss (the renderer judges an attempt at its lift).
+  // (ActiveStroke::lift; Hanzi Writer's markStrokeCorrectAfterMisses). The renderer counts a miss at a lift
+  // in WS only: a pen-down that never came within the start radius of the stroke due (8 mm beside it, an
+  // earlier stroke written again), or one the trace ends in before a lift, is refused but no miss.
   const std::size_t strokes = character.strokes.size();
   const double assist_after = options.acceptance.assist_after_misses;
   std::size_t expected = 0;
@@ -215,7 +216,7 @@ CharacterScore score_trace(const PlacedCharacter& character, std::span<const Pen
     }
     score.refusals.add(verdict.refusal);
     const bool lifted = segment.end < trace.size();
-    if (!lifted) continue;
+    if (!verdict.entered || !lifted) continue;
     misses += 1.0;
     if (assist_after > 0.0 && misses >= assist_after) {
       segment.assists_due = true;

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "calligraphy/analysis/metric_table.hpp"
+#include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/sha256.hpp"
 #include "core/json_reader.hpp"
@@ -272,6 +273,22 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
   list_rules(json_detail::child_pointer(reader.pointer("force_law"), "acceptance"), law_as_read,
              r.force_law.acceptance);
   if (version >= 6) list_rules(reader.pointer("trial"), spec_as_read, r.spec.acceptance);
+  // Since version 6 the specification states the acceptance its force law ran with: a field that differs
+  // (a record edited in one place) leaves no way to tell which ran, so it is refused at the specification's
+  // field, naming the force law's.
+  if (version >= 6) {
+    for (const ParameterField<StrokeAcceptance>& field : ParameterTable<StrokeAcceptance>::fields()) {
+      const double stated = r.spec.acceptance.*field.member + 0.0;  // -0 is said as 0
+      const double ran = r.force_law.acceptance.*field.member + 0.0;
+      if (stated == ran) continue;
+      const std::string law_pointer = json_detail::child_pointer(
+          json_detail::child_pointer(reader.pointer("force_law"), "acceptance"), std::string(field.name));
+      json_detail::fail(source, json_detail::child_pointer(reader.pointer("trial"), std::string(field.name)),
+                        shortest_decimal(stated) + ", but the force law's acceptance states " +
+                            shortest_decimal(ran) + " (" + law_pointer +
+                            "): a record states the acceptance its trial ran with in both, the same");
+    }
+  }
   // Before version 6 the specification did not state the acceptance: it is the one the force law ran with,
   // not a default (its fields are not listed as defaulted).
   if (version < 6) {

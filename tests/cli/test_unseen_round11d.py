@@ -348,9 +348,15 @@ class RecordSweepPython(Base):
         return [(p, n) for p, n in numeric_leaves(schema, schema, spec, "/specification")
                 if p.rsplit("/", 1)[-1] not in KNOWN_MAX_DOUBLE]
 
-    def check(self, pointer, value):
+    def check(self, pointer, value, both_places=False):
         doc = copy.deepcopy(Shared.record)
         set_at(doc, pointer, value)
+        # A record states its stroke acceptance in its specification and in its force law, the same in both: a
+        # value taken at its bound is given in both places, or it is refused as a contradiction between them.
+        field = pointer.rsplit("/", 1)[-1]
+        acceptance = doc["specification"]["force_law"]["acceptance"]
+        if both_places and field in acceptance and field in doc["specification"]["trial"]:
+            acceptance[field] = doc["specification"]["trial"][field] = value
         try:
             cg.check_trial_record(doc)
         except (cg.DataError, cg.InvalidArgument, TypeError) as e:
@@ -363,7 +369,7 @@ class RecordSweepPython(Base):
         wrong = []
         for pointer, node in leaves:
             for value, taken in bound_cases(node):
-                e = self.check(pointer, value)
+                e = self.check(pointer, value, both_places=taken)
                 # A field that applies to another mode or pacing only, or whose value contradicts another
                 # field's (86,400 s at 1,000 Hz: more than 10^7 ticks), is refused naming its own pointer and
                 # the rule or the other field: that is no refusal of the value at its bound.

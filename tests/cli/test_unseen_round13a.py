@@ -670,7 +670,7 @@ class MetricTable(Case):
             self.assertEqual(header[start:end + 1], trials)
         for name in header[start:end + 1]:
             self.assertIn(name, self.by_name)
-        start, end = self.s.strokes_header.index("mean_deviation_m"), self.s.strokes_header.index("path_length_m")
+        start, end = self.s.strokes_header.index("mean_deviation_m"), self.s.strokes_header.index("assisted")
         if strokes is not None:
             self.assertEqual(self.s.strokes_header[start:end + 1], strokes)
         for name in self.s.strokes_header[start:end + 1]:

@@ -850,12 +850,12 @@ class Round26D(unittest.TestCase, OneErrorLine):
 
     def test_table_metric_columns_follow_the_metric_table(self):
         # docs/experiments.md: the metric columns are `completed_in_order` to `normalised_jerk` in trials.csv
-        # and `mean_deviation_m` to `path_length_m` in strokes.csv.
+        # and `mean_deviation_m` to `assisted` in strokes.csv.
         levels = self.metric_levels()
         trials = self.trials_header
         metric_columns = trials[trials.index("completed_in_order"):trials.index("normalised_jerk") + 1]
         strokes = self.strokes_header
-        stroke_columns = strokes[strokes.index("mean_deviation_m"):strokes.index("path_length_m") + 1]
+        stroke_columns = strokes[strokes.index("mean_deviation_m"):strokes.index("assisted") + 1]
         for name in metric_columns:
             self.assertTrue({"scene", "run"} & set(levels[name][2]), name)
         for name in stroke_columns:

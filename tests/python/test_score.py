@@ -110,7 +110,9 @@ def joined(*traces):
 
 
 def test_a_stroke_refused_often_enough_is_credited_assisted_as_the_renderer_credits_it():
-    missed = [reference_trace("木", offset_m=0.008, order=[0]) for _ in range(5)]  # 8 mm beside the first stroke
+    # 4 mm beside the first stroke: within its start radius (an attempt at it, as the renderer counts a lift in
+    # WS), beyond the mean deviation allowed.
+    missed = [reference_trace("木", offset_m=0.004, order=[0]) for _ in range(5)]
     trace = joined(*missed, reference_trace("木", order=[1, 2, 3]))
     credited = calligraphy.score(trace, "木")  # the renderer's default: credited after 5 refusals
     assert credited["strokes_assisted"] == 1
@@ -125,6 +127,12 @@ def test_a_stroke_refused_often_enough_is_credited_assisted_as_the_renderer_cred
     assert never["strokes_assisted"] == 0
     assert never["strokes_accepted"] == 0
     assert never["refusals"]["wrong_order"] == 3
+    # 8 mm beside it the pen never comes within the start radius: refused, but no attempt at the stroke.
+    far = joined(*[reference_trace("木", offset_m=0.008, order=[0]) for _ in range(5)],
+                 reference_trace("木", order=[1, 2, 3]))
+    apart = calligraphy.score(far, "木")
+    assert apart["strokes_assisted"] == 0
+    assert apart["refusals"]["wrong_place"] == 5
 
 
 def test_dataframe_and_csv_give_the_dict_result(tmp_path):

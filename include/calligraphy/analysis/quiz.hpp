@@ -6,12 +6,14 @@
 /// ignores a segment: analysis/score.hpp) is neither. Every other run is judged by the stroke matcher,
 /// `match_stroke(character, expected, run, start_radius_m, acceptance)` (analysis/stroke_matcher.hpp):
 /// the renderer's rule, so that the quiz, the renderer and `score_trace`'s segment verdicts agree on the
-/// same trace (docs/stroke-acceptance.md), assisted credit included: after the acceptance's
-/// `assist_after_misses` misses on one stroke (0: never), that stroke is credited assisted, as the renderer
-/// (`ActiveStroke::lift`) and `score_trace` (`StrokeScore::assisted`) credit it and as Hanzi Writer's
-/// `markStrokeCorrectAfterMisses` marks it correct: shown, not written, and the next stroke is expected.
-/// A run `finish` judges (the input ended with the pen down) is missed but counts towards no hint or
-/// credit. A run refused as backwards is a miss reported as backwards, or accepted (still reported as backwards) with
+/// same trace (docs/stroke-acceptance.md). After the acceptance's `assist_after_misses` misses on one stroke
+/// (0: never), that stroke is credited assisted, as Hanzi Writer's `markStrokeCorrectAfterMisses` marks it
+/// correct: shown, not written, and the next stroke is expected. The quiz counts its misses as Hanzi Writer
+/// does: every mismatch lifted (not the run `finish` judges). The renderer (`ActiveStroke::lift`) and
+/// `score_trace` count only attempts begun within the start radius of the stroke's start (WS), so where a
+/// trace has pen-downs that never come near the expected stroke's start (another stroke out of turn, a
+/// stroke 8 mm off) the quiz hints and credits sooner than they do; otherwise its credits are theirs. A run
+/// refused as backwards is a miss reported as backwards, or accepted (still reported as backwards) with
 /// `accept_backwards`. After `hint_after_misses` misses on one stroke, and after each further miss but the
 /// one that credits it, a hint event asks to show the expected stroke. Not for the servo thread: judging
 /// takes up to milliseconds per pen lift. On the model and the stroke matcher only: a trial's trace is
@@ -72,7 +74,7 @@ struct QuizEvent {
   Kind kind = Kind::stroke_missed;
   std::size_t stroke = 0;  ///< the expected stroke, 0-based in the character's stroke order
   bool backwards = false;  ///< the written stroke writes the expected one from its end to its start
-  /// Misses on `stroke` so far (not the one `finish` judges): 0 after it is accepted; the misses that
+  /// Misses on `stroke` so far (not the run `finish` judges): 0 after it is accepted; the misses that
   /// earned the credit with stroke_assisted (as Hanzi Writer's onCorrectStroke gives them).
   int misses_on_stroke = 0;
   int total_misses = 0;     ///< every miss on the whole character so far

@@ -53,7 +53,8 @@ struct WrittenSegment {
   std::size_t due_stroke = 0;
   /// This refused verdict was the `acceptance.assist_after_misses`-th miss on the stroke due: that stroke is
   /// then credited assisted, as the renderer demonstrates and credits it (StrokeAcceptance), and the next is
-  /// due. A miss is a refused verdict on a segment the pen lifted from (not one the trace ends in).
+  /// due. A miss is the renderer's: a refused verdict that came within the start radius of the due stroke's
+  /// start (a lift in WS), on a segment the pen was lifted from (not one the trace ends in).
   bool assists_due = false;
 };
 
