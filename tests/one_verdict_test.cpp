@@ -76,7 +76,9 @@ TEST_CASE("The score and the quiz give match_stroke's verdict and refusal for ev
       without_credit.acceptance.assist_after_misses = 0.0;
       const CharacterScore score = score_trace(c, trace, without_credit);
 
-      QuizSession quiz(c);
+      QuizOptions quiz_options;
+      quiz_options.acceptance = without_credit.acceptance;
+      QuizSession quiz(c, quiz_options);
       for (const PenSample& s : trace) quiz.feed(s);
       quiz.finish();
       std::vector<QuizEvent> events;

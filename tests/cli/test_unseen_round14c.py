@@ -1600,6 +1600,10 @@ class QuizNumbers(Base):
             for character, judged in zip(record["per_character"], quiz["characters"]):
                 self.assertEqual(judged["character"], character["character"])
                 events = [e for e in judged["events"] if e["kind"] in ("stroke_accepted", "stroke_missed", "too_short")]
+                if rows is None:
+                    trace = path.parent / record["files"]["trace"]
+                    result = run(["trace", str(trace)], self.root_)
+                    rows = list(csv.DictReader(io.StringIO(result.stdout.decode())))
                 expected, misses, total = [], {}, 0
                 for segment in character["segments"]:
                     verdict = segment["verdict"]
@@ -1611,14 +1615,12 @@ class QuizNumbers(Base):
                         kind, refusal, stroke = "stroke_accepted", "none", verdict["expected_stroke"]
                     else:
                         kind, refusal, stroke = "stroke_missed", verdict["refusal"], verdict["expected_stroke"]
-                        misses[stroke] = misses.get(stroke, 0) + 1
+                        # A run the trace ends in, never lifted, is missed but no miss on its stroke (quiz.hpp).
+                        if segment["end"] < len(rows):
+                            misses[stroke] = misses.get(stroke, 0) + 1
                         total += 1
                     expected.append((kind, refusal, segment["end"] - segment["begin"], total, segment["end"] - 1,
                                      misses.get(stroke, 0) if kind == "stroke_missed" else None))
-                if rows is None:
-                    trace = path.parent / record["files"]["trace"]
-                    result = run(["trace", str(trace)], self.root_)
-                    rows = list(csv.DictReader(io.StringIO(result.stdout.decode())))
                 got = [(e["kind"], e["refusal"], e["samples"], e["total_misses"], e["time_s"],
                         e["misses_on_stroke"] if e["kind"] == "stroke_missed" else None) for e in events]
                 self.assertEqual(len(got), len(expected), (path.name, got, expected))
