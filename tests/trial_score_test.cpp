@@ -5,9 +5,9 @@
 #include <utility>
 #include <vector>
 
+#include "calligraphy/analysis/score.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/character_library.hpp"
-#include "calligraphy/analysis/score.hpp"
 #include "embedded_scenes.hpp"
 
 using namespace calligraphy;
@@ -361,7 +361,8 @@ TEST_CASE("A trace with more pen-down segments than the limit is refused before 
   CHECK(ScoreOptions{}.max_segments == kMaxScoredSegments);
 }
 
-TEST_CASE("A stroke refused assist_after_misses times is credited assisted and the next is judged", "[score]") {
+TEST_CASE("A stroke refused assist_after_misses times is credited assisted and the next is judged",
+          "[score]") {
   // As the renderer credits it (ActiveStroke::lift): the strokes after it are judged as a trial judged them,
   // not refused as written out of order. A miss is a refused pen-down that came within the start radius of
   // the stroke due (the renderer's lift in WS): here the first stroke 4 mm beside itself.
@@ -369,7 +370,8 @@ TEST_CASE("A stroke refused assist_after_misses times is credited assisted and t
   const auto trace_with_misses = [&](int misses, double offset_m = 4e-3) {
     TraceBuilder trace;
     for (int k = 0; k < misses; ++k) trace.write(stroke_points(yong.strokes[0], 0.05e-3, offset_m));
-    for (std::size_t s = 1; s < yong.strokes.size(); ++s) trace.write(stroke_points(yong.strokes[s], 0.05e-3));
+    for (std::size_t s = 1; s < yong.strokes.size(); ++s)
+      trace.write(stroke_points(yong.strokes[s], 0.05e-3));
     return trace;
   };
   const TraceBuilder five = trace_with_misses(5);
