@@ -407,7 +407,7 @@ class Tables(Base):
         for path, key, first, last in ((self.tables["trials"], "trials_column", "completed_in_order",
                                         "normalised_jerk"),
                                        (self.tables["strokes"], "strokes_column", "mean_deviation_m",
-                                        "path_length_m")):
+                                        "assisted")):
             header = read_table(path)[0]
             placed = [m["name"] for m in sorted((m for m in table if m[key] > 0), key=lambda m: m[key])]
             self.assertEqual(header[header.index(first):header.index(last) + 1], placed, path.name)
@@ -549,14 +549,15 @@ class Tables(Base):
                 want = None if want is None else ("n", float(want))
                 self.assertEqual(r_cell(row[name], trials_r.classes[name]), want, f"R trials {i} {name}")
                 self.assertEqual(canonical(trials_p[name].iloc[i]), want, f"pandas trials {i} {name}")
-        stroke_names = [m["name"] for m in SHARED["metric_table"] if m["strokes_column"] > 0]
+        stroke_metrics = [m for m in SHARED["metric_table"] if m["strokes_column"] > 0]
         for i, row in enumerate(strokes_r.rows):
             record = self.records[(row["subject"], row["session"], int(row["trial"]))]
             stroke = record["per_character"][int(row["character"]) - 1]["per_stroke"][int(row["stroke"]) - 1]
             self.assertEqual(stroke["index"], int(row["stroke"]) - 1)
-            for name in stroke_names:
-                want = stroke.get(name)
-                want = None if want is None else ("n", float(want))
+            for metric in stroke_metrics:
+                name = metric["name"]
+                want = stroke.get(name)  # a flag (a stroke's assisted credit) is a logical, every other a number
+                want = None if want is None else ("b", bool(want)) if metric["kind"] == "flag" else ("n", float(want))
                 self.assertEqual(r_cell(row[name], strokes_r.classes[name]), want, f"R strokes {i} {name}")
                 self.assertEqual(canonical(strokes_p[name].iloc[i]), want, f"pandas strokes {i} {name}")
 
