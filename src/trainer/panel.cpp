@@ -120,11 +120,14 @@ void quiz_state(const TrialView& view, const PanelInput& input) {
           session.strokes_assisted() > 0
               ? ", " + count_of(session.strokes_assisted(), "stroke", "strokes") + " assisted"
               : "";
-      ImGui::TextColored(kGood, "%scomplete, %s%s", label.c_str(),
+      // Wrapped: in the large font this line is wider than the panel at 800 px.
+      ImGui::PushStyleColor(ImGuiCol_Text, kGood);
+      ImGui::TextWrapped("%scomplete, %s%s", label.c_str(),
                          count_of(static_cast<std::size_t>(session.total_misses()), "miss", "misses").c_str(),
                          assisted.c_str());
+      ImGui::PopStyleColor();
     } else {
-      ImGui::Text("%sstroke %zu of %zu", label.c_str(), session.current_stroke() + 1, n);
+      ImGui::TextWrapped("%sstroke %zu of %zu", label.c_str(), session.current_stroke() + 1, n);
     }
     if (input.large_font != nullptr) ImGui::PopFont();
     if (!session.complete()) {
