@@ -139,15 +139,13 @@ void quiz_state(const TrialView& view, const PanelInput& input) {
     const QuizEvent& e = last->second;
     switch (e.kind) {
       case QuizEvent::Kind::stroke_accepted:
-      case QuizEvent::Kind::character_completed:
-        if (quiz.assisted(last->first, e.stroke)) {  // completed by an assisted stroke
+      case QuizEvent::Kind::stroke_assisted:
+      case QuizEvent::Kind::character_completed:  // by the last stroke, accepted or assisted
+        if (quiz.assisted(last->first, e.stroke)) {
           ImGui::TextColored(kHintText, "stroke %zu shown and counted as assisted", e.stroke + 1);
         } else {
           ImGui::TextColored(kGood, "stroke %zu accepted", e.stroke + 1);
         }
-        break;
-      case QuizEvent::Kind::stroke_assisted:
-        ImGui::TextColored(kHintText, "stroke %zu shown and counted as assisted", e.stroke + 1);
         break;
       case QuizEvent::Kind::stroke_missed:
       case QuizEvent::Kind::hint:
