@@ -60,7 +60,7 @@ bool judged(QuizEvent::Kind kind) {
 TEST_CASE("The score and the quiz give match_stroke's verdict and refusal for every pen-down run",
           "[score][quiz]") {
   std::mt19937_64 random(20260611);
-  std::size_t accepted = 0, refused = 0, runs_judged = 0;
+  std::size_t accepted = 0, refused = 0, runs_judged = 0, assisted = 0;
   std::set<StrokeRefusal> reasons;
   for (const char32_t code_point : {U'十', U'口', U'人', U'永', U'我'}) {
     const PlacedCharacter& c = character_of(code_point);
@@ -68,16 +68,13 @@ TEST_CASE("The score and the quiz give match_stroke's verdict and refusal for ev
       const std::vector<PenSample> trace = pen_trace(runs_of_kind(c, kind, random));
       INFO("character U+" << std::hex << static_cast<unsigned>(code_point) << std::dec << ", paths "
                           << to_string(kind));
-      // Read without the assisted credit: the quiz counts its misses as Hanzi Writer does (every mismatch),
-      // the score as the renderer does (attempts begun in WS), so their credits part where a pen-down never
-      // comes near the expected stroke's start (quiz.hpp). The quiz's credit is held in
-      // analysis_quiz_test.cpp, the score's to the renderer's in trial_score_test.cpp.
-      ScoreOptions without_credit;
-      without_credit.acceptance.assist_after_misses = 0.0;
-      const CharacterScore score = score_trace(c, trace, without_credit);
+      // At the default credit: the quiz counts every mismatch lifted as a miss (Hanzi Writer), the score
+      // as the renderer does (StrokeAcceptance::counts_as_miss: any refused pen-down that moved), the same.
+      const ScoreOptions with_credit;
+      const CharacterScore score = score_trace(c, trace, with_credit);
 
       QuizOptions quiz_options;
-      quiz_options.acceptance = without_credit.acceptance;
+      quiz_options.acceptance = with_credit.acceptance;
       QuizSession quiz(c, quiz_options);
       for (const PenSample& s : trace) quiz.feed(s);
       quiz.finish();
@@ -86,9 +83,12 @@ TEST_CASE("The score and the quiz give match_stroke's verdict and refusal for ev
         if (judged(e.kind)) events.push_back(e);
       }
 
-      // The renderer's reading, run by run: the expected stroke advances with each acceptance.
+      // The renderer's reading, run by run: the expected stroke advances with each acceptance, and with
+      // each credit after assist_after_misses misses of it.
       std::size_t expected = 0;
       std::size_t next_event = 0;
+      std::size_t misses = 0;
+      std::size_t credited = 0;
       for (std::size_t k = 0; k < score.segments.size(); ++k) {
         const WrittenSegment& segment = score.segments[k];
         INFO("run " << k << ", stroke " << expected << " expected");
@@ -124,14 +124,28 @@ TEST_CASE("The score and the quiz give match_stroke's verdict and refusal for ev
         if (direct.accepted) {
           ++expected;
           ++accepted;
+          misses = 0;
         } else {
           ++refused;
           reasons.insert(direct.refusal);
+          const bool lifted = segment.end < trace.size();
+          misses += lifted ? 1 : 0;
+          CHECK(static_cast<std::size_t>(event.misses_on_stroke) == misses);
+          if (static_cast<double>(misses) >= with_credit.acceptance.assist_after_misses) {
+            CHECK(segment.assists_due);
+            CHECK(score.strokes[expected].assisted);
+            ++expected;
+            ++credited;
+            misses = 0;
+          }
         }
       }
       CHECK(next_event == events.size());  // every run the quiz judged is a segment of the score
-      CHECK(score.strokes_accepted == expected);
+      CHECK(score.strokes_accepted + score.strokes_assisted == expected);
+      CHECK(score.strokes_assisted == credited);
+      CHECK(quiz.strokes_assisted() == credited);
       CHECK(quiz.current_stroke() == expected);
+      assisted += credited;
       const auto with_verdict = std::count_if(score.segments.begin(), score.segments.end(),
                                               [](const WrittenSegment& s) { return s.verdict.has_value(); });
       CHECK(score.refusals.total() + score.strokes_accepted == static_cast<std::size_t>(with_verdict));
@@ -142,6 +156,7 @@ TEST_CASE("The score and the quiz give match_stroke's verdict and refusal for ev
   CHECK(accepted > 50);
   CHECK(refused > 50);
   CHECK(reasons.size() >= 4);
+  CHECK(assisted > 0);  // and on the credit, where runs of a negative kind leave a stroke refused five times
 }
 
 TEST_CASE("score_trace finds the order and direction of person-like strokes", "[score]") {

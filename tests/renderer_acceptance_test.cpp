@@ -7,11 +7,12 @@
 #include <iostream>
 #include <random>
 
+#include "calligraphy/analysis/score.hpp"
 #include "calligraphy/analysis/stroke_matcher.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/model/character_library.hpp"
 #include "calligraphy/render/renderer.hpp"
 #include "calligraphy/sim/person_traces.hpp"
-#include "calligraphy/devices/simulated_device.hpp"
 #include "corpus_folder.hpp"
 #include "eval/stroke_acceptance.hpp"
 #include "test_sizing.hpp"
@@ -30,12 +31,15 @@ constexpr double kUp_m = 0.005;
 struct Pen {
   Renderer& renderer;
   double time_s = 0.0;
+  std::vector<PenSample>* trace = nullptr;  // when set, every tick as a pen trace (score.hpp's contact rule)
 
   RenderOutput at(const Vec2& p, double z, const Vec2& velocity) {
     DeviceState s;
     s.time_s = time_s;
     s.position_m = Vec3(p.x(), p.y(), z);
     s.velocity_m_s = Vec3(velocity.x(), velocity.y(), 0.0);
+    if (trace != nullptr)
+      trace->push_back({time_s, p, z - renderer.scene().layout.paper_z_m <= kPenContactThresholdM});
     time_s += kPeriod_s;
     return renderer.tick(s);
   }
@@ -123,4 +127,77 @@ TEST_CASE("The renderer and the stroke matcher give the same verdict on person-l
   // a path right at a threshold may fall either side.
   CHECK(static_cast<double>(agree) >= 0.995 * static_cast<double>(paths));
   CHECK(accepted > paths / 3);  // both verdicts occur: the agreement is not vacuous
+}
+
+namespace {
+
+// `path` moved `offset_m` across its own chord (to its left).
+std::vector<Vec2> moved_across(const std::vector<Vec2>& path, double offset_m) {
+  const Vec2 chord = (path.back() - path.front()).normalized();
+  const Vec2 across(-chord.y(), chord.x());
+  std::vector<Vec2> out;
+  for (const Vec2& p : path) out.push_back(p + offset_m * across);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE(
+    "A pen-down that never comes near the stroke's start is a miss: hinted after three, credited after five, "
+    "as the score counts it",
+    "[stroke_progress][renderer][stroke_assistance]") {
+  // A learner with a mouse, whom nothing draws to the start, writes each stroke 8 mm beside itself: never
+  // within the 5 mm start radius, so never WS. Each pen-down is a miss all the same (no dead end).
+  const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'十')});
+  const PlacedCharacter& shi = scene.characters[0];
+  Renderer renderer(scene, no_guidance(), simulated_phantom_desktop_info());
+  std::vector<PenSample> trace;
+  Pen pen{renderer, 0.0, &trace};
+  const std::vector<Vec2> off = moved_across(shi.strokes[0].median_m, 0.008);
+  REQUIRE((off.front() - shi.strokes[0].start()).norm() > scene.layout.start_radius_m);
+  for (std::uint32_t miss = 1; miss <= 4; ++miss) {
+    const RenderOutput out = pen.write(off);
+    CHECK(out.missed_off_start);
+    CHECK_FALSE(out.stroke_abandoned);  // nothing was begun in WS
+    CHECK(out.refusal == StrokeRefusal::wrong_place);
+    CHECK(out.misses == miss);
+    CHECK(out.hint_shown == (miss >= 3));
+    CHECK(out.stroke == 0);
+  }
+  // A touch that barely moves (0.5 mm) and a pen resting outside the box are no attempts.
+  const Vec2 inside = shi.bounding_box.center();
+  CHECK_FALSE(pen.write({inside, inside + Vec2(0.0005, 0.0)}).missed_off_start);
+  const Vec2 outside = shi.bounding_box.max() + Vec2(0.01, 0.01);
+  CHECK_FALSE(pen.write({outside, outside + Vec2(0.01, 0.0)}).missed_off_start);
+  CHECK(renderer.active().misses() == 4);
+  const RenderOutput fifth = pen.write(off);
+  CHECK(fifth.missed_off_start);
+  CHECK(fifth.stroke_assisted);
+  CHECK(fifth.stroke == 1);
+  CHECK(fifth.misses == 0);
+  CHECK(pen.write(shi.strokes[1].median_m).stroke_completed);
+  CHECK(renderer.active().finished());
+  CHECK(renderer.active().strokes_assisted() == 1);
+  CHECK(renderer.active().strokes_written() == 1);
+
+  // The score of the same ticks credits the same stroke, judging the pen-downs the renderer counted.
+  const CharacterScore score = score_trace(shi, trace);
+  CHECK(score.strokes_assisted == 1);
+  CHECK(score.strokes[0].assisted);
+  CHECK_FALSE(score.strokes[1].assisted);
+  CHECK(score.strokes_accepted == 1);
+  CHECK(score.ignored_segments == 1);  // the touch
+
+  // As records before version 8 ran (a miss only at a lift in WS): the same pen-downs are never misses.
+  ForceLawParameters version_7 = no_guidance();
+  version_7.acceptance.use_version_7_misses();
+  Renderer old(scene, version_7, simulated_phantom_desktop_info());
+  Pen old_pen{old};
+  for (int k = 0; k < 6; ++k) {
+    const RenderOutput out = old_pen.write(off);
+    CHECK_FALSE(out.missed_off_start);
+    CHECK(out.misses == 0);
+    CHECK_FALSE(out.stroke_assisted);
+  }
+  CHECK(old.active().stroke_index() == 0);
 }

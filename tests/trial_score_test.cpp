@@ -364,8 +364,8 @@ TEST_CASE("A trace with more pen-down segments than the limit is refused before 
 TEST_CASE("A stroke refused assist_after_misses times is credited assisted and the next is judged",
           "[score]") {
   // As the renderer credits it (ActiveStroke::lift): the strokes after it are judged as a trial judged them,
-  // not refused as written out of order. A miss is a refused pen-down that came within the start radius of
-  // the stroke due (the renderer's lift in WS): here the first stroke 4 mm beside itself.
+  // not refused as written out of order. A miss is a refused pen-down lifted (StrokeAcceptance::
+  // counts_as_miss): here the first stroke 4 mm beside itself.
   const PlacedCharacter& yong = scene_of(U'永').characters.front();
   const auto trace_with_misses = [&](int misses, double offset_m = 4e-3) {
     TraceBuilder trace;
@@ -395,16 +395,34 @@ TEST_CASE("A stroke refused assist_after_misses times is credited assisted and t
   CHECK(uncredited.refusals.total() == 5 + yong.strokes.size() - 1);
 
   // After four misses the later strokes, written while the first is due, begin far from its start: refused
-  // as written out of order, but no attempt at the first, which the renderer would not credit either.
+  // as written out of order, and each a miss, as Hanzi Writer counts every stroke drawn that does not match:
+  // the second stroke is the first's fifth miss and credits it, and the rest are misses of the second.
   const CharacterScore four = score_trace(yong, trace_with_misses(4).samples);
-  CHECK(four.strokes_assisted == 0);
-  CHECK_FALSE(four.segments[4].assists_due);
+  CHECK(four.strokes_assisted == 1);
+  CHECK(four.strokes[0].assisted);
+  CHECK(four.segments[4].assists_due);
+  CHECK_FALSE(four.segments[5].assists_due);
   CHECK(four.strokes_accepted == 0);
   CHECK(four.refusals.wrong_order == yong.strokes.size() - 1);
-  // Five pen-downs 8 mm beside the first stroke never come within its start radius: refused, never a miss.
+  // Records before version 8 counted a lift in WS only: no attempt at the first, no credit.
+  ScoreOptions lift_in_ws_only;
+  lift_in_ws_only.acceptance.use_version_7_misses();
+  const CharacterScore four_v7 = score_trace(yong, trace_with_misses(4).samples, lift_in_ws_only);
+  CHECK(four_v7.strokes_assisted == 0);
+  CHECK_FALSE(four_v7.segments[4].assists_due);
+  CHECK(four_v7.refusals.wrong_order == yong.strokes.size() - 1);
+  // Five pen-downs 8 mm beside the first stroke never come within its start radius: refused, and misses all
+  // the same (no dead end), so the fifth credits it; as records before version 8 counted (a lift in WS
+  // only), never a miss.
   const CharacterScore far = score_trace(yong, trace_with_misses(5, 8e-3).samples);
-  CHECK(far.strokes_assisted == 0);
+  CHECK(far.strokes_assisted == 1);
+  CHECK(far.strokes[0].assisted);
+  CHECK(far.segments[4].assists_due);
   CHECK(far.refusals.wrong_place == 5);
+  CHECK(far.strokes_accepted == yong.strokes.size() - 1);
+  const CharacterScore far_v7 = score_trace(yong, trace_with_misses(5, 8e-3).samples, lift_in_ws_only);
+  CHECK(far_v7.strokes_assisted == 0);
+  CHECK(far_v7.refusals.wrong_place == 5);
   // At 3 the fourth and fifth misses are judged against the second stroke.
   ScoreOptions three;
   three.acceptance.assist_after_misses = 3.0;

@@ -1114,16 +1114,17 @@ TEST_CASE("unseen12g: hostile record texts are refused as DataError naming the s
     text.replace(at, from.size(), to);
     return text;
   };
+  const std::string version = "\"version\": " + std::to_string(kRecordedTrialVersion);
   const std::vector<std::string> bad{
       "",
       "null",
       "[]",
       "{}",
       good.substr(0, good.size() / 2),
-      replaced("\"version\": 7", "\"version\": 8"),
-      replaced("\"version\": 7", "\"version\": 0"),
-      replaced("\"version\": 7", "\"version\": 7.5"),
-      replaced("\"version\": 7", "\"version\": 1e999"),
+      replaced(version, "\"version\": " + std::to_string(kRecordedTrialVersion + 1)),
+      replaced(version, "\"version\": 0"),
+      replaced(version, "\"version\": 7.5"),
+      replaced(version, "\"version\": 1e999"),
       replaced("\"calligraphy-trial-specification\"", "\"calligraphy-trial-spec\""),
       replaced("\"format\"", "\"surprise\": 1, \"format\""),
       replaced("\"rate_hz\": 1000", "\"rate_hz\": NaN"),

@@ -185,6 +185,7 @@ void bind_collision(py::module_& m) {
       .field(&StrokeAcceptance::centred_balance_fraction)
       .field(&StrokeAcceptance::centred_min_length_m)
       .field(&StrokeAcceptance::centred_max_length_m)
+      .field(&StrokeAcceptance::miss_min_path_m)
       .finish();
 
   py::enum_<StrokeRefusal>(m, "StrokeRefusal",

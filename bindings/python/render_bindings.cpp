@@ -445,6 +445,9 @@ void bind_renderer(py::module_& m) {
       .def_readonly("stroke_assisted", &RenderOutput::stroke_assisted,
                     "the abandoned stroke was refused assist_after_misses times: credited as assisted, the "
                     "next stroke is active")
+      .def_readonly("missed_off_start", &RenderOutput::missed_off_start,
+                    "the pen was lifted from a pen-down that never entered WS, counted as a miss "
+                    "(StrokeAcceptance.miss_min_path_m)")
       .def_readonly("misses", &RenderOutput::misses, "refused attempts at the active stroke")
       .def_readonly("hint_shown", &RenderOutput::hint_shown,
                     "the active stroke is to be shown as a hint (misses >= hint_after_misses)")

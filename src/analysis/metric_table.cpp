@@ -335,8 +335,8 @@ const MetricInfo kMetrics[] = {
             "renderer)",
      .definition =
          "a run's: `TrialMetrics::strokes_assisted`; a scored trace's: strokes credited in turn after "
-         "`assist_after_misses` refused verdicts of pen-downs that came within the start radius of the "
-         "stroke's start, the renderer's misses (`score_trace`)",
+         "`assist_after_misses` refused verdicts of pen-downs that count as the renderer's misses "
+         "(`StrokeAcceptance::counts_as_miss`, `score_trace`)",
      .levels = kScene | kCharacter | kRun,
      .of_scene = [](const WritingMetrics& m) { return count(m.strokes_assisted); },
      .of_character = [](const CharacterScore& c) { return count(c.strokes_assisted); },

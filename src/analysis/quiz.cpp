@@ -104,8 +104,8 @@ std::vector<QuizEvent> QuizSession::judge_segment(bool lifted) {
       // Another stroke written (a wrong_stroke that set off along the expected one and left it names none).
       if (match.matched_stroke != current_) event.written_stroke = match.matched_stroke;
       // Every mismatch lifted is a miss on the expected stroke, as Hanzi Writer counts them (not the run
-      // `finish` judges, which was never lifted). The renderer and score_trace count only attempts begun in
-      // the stroke's start neighbourhood (WS): see quiz.hpp.
+      // `finish` judges, which was never lifted); the renderer and score_trace count the same at the
+      // default acceptance (StrokeAcceptance::counts_as_miss; see quiz.hpp).
       if (lifted) ++misses_on_stroke_;
       event.misses_on_stroke = misses_on_stroke_;
       event.total_misses = ++total_misses_;

@@ -195,9 +195,10 @@ CharacterScore score_trace(const PlacedCharacter& character, std::span<const Pen
 
   // The renderer's verdict on each segment in sequence: the stroke expected advances with each acceptance,
   // and after assist_after_misses misses of it, as the renderer demonstrates and credits it
-  // (ActiveStroke::lift; Hanzi Writer's markStrokeCorrectAfterMisses). The renderer counts a miss at a lift
-  // in WS only: a pen-down that never came within the start radius of the stroke due (8 mm beside it, an
-  // earlier stroke written again), or one the trace ends in before a lift, is refused but no miss.
+  // (ActiveStroke::lift; Hanzi Writer's markStrokeCorrectAfterMisses). A refused pen-down is a miss as the
+  // renderer counts it (StrokeAcceptance::counts_as_miss): any that moved far enough in the box (with
+  // `miss_min_path_m` 0, as records before version 8 ran, a lift in WS only); one the trace ends in before a
+  // lift is refused but no miss (the renderer judges an attempt at its lift).
   const std::size_t strokes = character.strokes.size();
   const double assist_after = options.acceptance.assist_after_misses;
   std::size_t expected = 0;
@@ -216,7 +217,13 @@ CharacterScore score_trace(const PlacedCharacter& character, std::span<const Pen
     }
     score.refusals.add(verdict.refusal);
     const bool lifted = segment.end < trace.size();
-    if (!verdict.entered || !lifted) continue;
+    RefusedPenDown pen_down{.entered_ws = verdict.entered, .samples = positions[w].size()};
+    for (std::size_t i = 0; i < positions[w].size(); ++i) {
+      if (i > 0) pen_down.path_m += (positions[w][i] - positions[w][i - 1]).norm();
+      pen_down.in_character_box =
+          pen_down.in_character_box || character.bounding_box.contains(positions[w][i]);
+    }
+    if (!lifted || !options.acceptance.counts_as_miss(pen_down)) continue;
     misses += 1.0;
     if (assist_after > 0.0 && misses >= assist_after) {
       segment.assists_due = true;

@@ -60,7 +60,7 @@ StrokeProgress ActiveStroke::advance(const Vec2& tip_m) noexcept {
   return progress;
 }
 
-StrokeProgress ActiveStroke::lift() noexcept {
+StrokeProgress ActiveStroke::lift(bool counts_as_miss) noexcept {
   StrokeProgress progress;
   if (stroke() == nullptr || !attempt_open_) return progress;
   attempt_open_ = false;
@@ -73,6 +73,19 @@ StrokeProgress ActiveStroke::lift() noexcept {
     return progress;
   }
   element_ = 0;  // the stroke's feature points are loaded again (section 4.3.3)
+  if (counts_as_miss) count_miss(progress);
+  return progress;
+}
+
+StrokeProgress ActiveStroke::miss() noexcept {
+  StrokeProgress progress;
+  if (stroke() == nullptr) return progress;
+  progress.refusal = StrokeRefusal::wrong_place;
+  count_miss(progress);
+  return progress;
+}
+
+void ActiveStroke::count_miss(StrokeProgress& progress) noexcept {
   ++misses_;
   const double assist = acceptance_.assist_after_misses;
   if (assist > 0.0 && static_cast<double>(misses_) >= assist) {
@@ -81,7 +94,6 @@ StrokeProgress ActiveStroke::lift() noexcept {
     ++assisted_;
     next_stroke();
   }
-  return progress;
 }
 
 bool ActiveStroke::hint_shown() const noexcept {

@@ -91,6 +91,11 @@ constexpr std::array kAcceptanceFields{
     ParameterField<StrokeAcceptance>{"centred_max_length_m", "m", ParameterRange{.low = 0.0, .high = 0.1},
                                      "longest stroke the centred rule applies to",
                                      &StrokeAcceptance::centred_max_length_m},
+    // Added with version 8 of a trial record; older records run with use_version_7_misses().
+    ParameterField<StrokeAcceptance>{"miss_min_path_m", "m", ParameterRange{.low = 0.0, .high = 0.1},
+                                     "least path of a refused pen-down for it to count as a miss wherever it "
+                                     "was, 0 for a lift in WS only",
+                                     &StrokeAcceptance::miss_min_path_m},
 };
 
 }  // namespace
@@ -124,6 +129,12 @@ bool StrokeAcceptance::centred_cover(double length_m, double way_along_m, double
          std::abs(start_gap_m - finish_gap_m) <= centred_balance_fraction * length_m;
 }
 
+bool StrokeAcceptance::counts_as_miss(const RefusedPenDown& pen_down) const noexcept {
+  if (!(miss_min_path_m > 0.0)) return pen_down.entered_ws;  // before version 8: every lift in WS, no other
+  return (pen_down.entered_ws || pen_down.in_character_box) && pen_down.samples >= kMinMissSamples &&
+         pen_down.path_m > 0.0 && pen_down.path_m >= miss_min_path_m;
+}
+
 double StrokeAcceptance::allowed_mean_deviation_m(double length_m) const noexcept {
   return std::min(mean_deviation_m + deviation_per_length * length_m, mean_deviation_cap_m);
 }
@@ -137,6 +148,7 @@ void StrokeAcceptance::use_fixed_tolerances() noexcept {
   assist_after_misses = 0.0;
   use_version_4_end_gaps();
   use_version_6_coverage();
+  use_version_7_misses();
 }
 
 StrokeAcceptance StrokeAcceptance::for_character_size(double character_size_m) const noexcept {

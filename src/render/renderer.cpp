@@ -150,6 +150,7 @@ void Renderer::reset() noexcept {
   writing_since_s_ = 0.0;
   off_stroke_velocity_ = Vec2::Zero();
   anchor_valid_ = false;
+  contact_ = PenDown{};
 }
 
 // F_et (eq. 8) with the taper at R_res and a rate-limited foot point, plus the resistance force, for
@@ -253,14 +254,38 @@ RenderOutput Renderer::tick(const DeviceState& device) noexcept {
     inputs.in_start_neighbourhood = (tip - s->start()).norm() <= scene_->layout.start_radius_m;
   }
   InteractionState next = next_state(state_, inputs);
+  // The pen-down as a whole, from touch-down to lift: its path decides whether a refusal is a miss.
+  if (next != InteractionState::separation) {
+    if (state_ == InteractionState::separation) contact_ = PenDown{.last_tip_m = tip};
+    contact_.path_m += (tip - contact_.last_tip_m).norm();
+    contact_.last_tip_m = tip;
+    ++contact_.ticks;
+    contact_.reached_writing = contact_.reached_writing || next == InteractionState::writing;
+    contact_.in_character_box = contact_.in_character_box || inputs.inside_box;
+  }
+  const auto pen_down = [&](bool entered_ws) {
+    return RefusedPenDown{.entered_ws = entered_ws,
+                          .in_character_box = contact_.in_character_box,
+                          .path_m = contact_.path_m,
+                          .samples = contact_.ticks};
+  };
   if (state_ == InteractionState::writing && next == InteractionState::separation) {
     // Lifting in WS ends the attempt: written when it reached the end neighbourhood, else abandoned and
     // the stroke's feature points reloaded (section 4.3.3).
-    const StrokeProgress lifted = active_.lift();
+    const StrokeProgress lifted = active_.lift(active_.acceptance().counts_as_miss(pen_down(true)));
     out.stroke_completed = lifted.stroke_completed;
     out.stroke_abandoned = !lifted.stroke_completed;
     out.refusal = lifted.refusal;
     out.stroke_assisted = lifted.stroke_assisted;
+  } else if (state_ != InteractionState::separation && next == InteractionState::separation &&
+             !contact_.reached_writing && !active_.finished() &&
+             active_.acceptance().counts_as_miss(pen_down(false))) {
+    // A pen-down that never came near the stroke's start (written beside it, or another stroke) is a miss
+    // too, so that a learner who never finds the start is hinted and credited (no dead end).
+    const StrokeProgress missed = active_.miss();
+    out.missed_off_start = true;
+    out.refusal = missed.refusal;
+    out.stroke_assisted = missed.stroke_assisted;
   }
   if (next == InteractionState::writing) {
     if (state_ != InteractionState::writing) active_.begin(tip);

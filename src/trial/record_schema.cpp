@@ -18,19 +18,24 @@ const Schema& SchemaOf<ErrorAmplificationGuidance>::get() {
   return table_schema<ErrorAmplificationGuidance>("error amplification");
 }
 const Schema& SchemaOf<TimingGuidance>::get() { return table_schema<TimingGuidance>("timing guidance"); }
+int trial_detail::acceptance_field_version(std::string_view name) {
+  if (name == "miss_min_path_m") return 8;
+  if (name.starts_with("centred_")) return 7;
+  if (name == "end_gap_m" || name == "end_gap_fraction") return 5;
+  return 4;
+}
+
 const Schema& SchemaOf<StrokeAcceptance>::get() {
   // The fields after the eighth came with version 4 of a trial record: an older record lacks them and
   // runs with the fixed tolerances it ran with (StrokeAcceptance::use_fixed_tolerances, recorded_trial.cpp).
   // The end gap's floor (the last two) came with version 5: a version-4 record runs without it
   // (StrokeAcceptance::use_version_4_end_gaps). The centred rule (the last four) came with version 7: an
-  // older record runs without it (StrokeAcceptance::use_version_6_coverage).
+  // older record runs without it (StrokeAcceptance::use_version_6_coverage). The miss's least path came with
+  // version 8 (StrokeAcceptance::use_version_7_misses).
   static const std::vector<SchemaField> fields = [] {
     std::vector<SchemaField> out = table_fields<StrokeAcceptance>();
-    for (std::size_t i = 8; i < out.size(); ++i) {
-      const bool end_gap = out[i].name == "end_gap_m" || out[i].name == "end_gap_fraction";
-      const bool centred = out[i].name.starts_with("centred_");
-      out[i] = since(centred ? 7 : end_gap ? 5 : 4, out[i]);
-    }
+    for (std::size_t i = 8; i < out.size(); ++i)
+      out[i] = since(trial_detail::acceptance_field_version(out[i].name), out[i]);
     return out;
   }();
   static const Schema schema{.name = ParameterTable<StrokeAcceptance>::name,

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "calligraphy/core/schema.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
@@ -39,6 +40,11 @@ struct RecordDocument {
   std::string library_version;
   std::string teacher_sha256;  ///< a replay's teacher recording's SHA-256; empty: none read
 };
+
+/// The first version of a trial record whose force law's acceptance has the StrokeAcceptance field `name`
+/// (4 for the fields after the eighth, 5 for the end gap's floor, 7 for the centred rule, 8 for the miss's
+/// least path); an older record runs without it (recorded_trial.cpp).
+[[nodiscard]] int acceptance_field_version(std::string_view name);
 
 }  // namespace trial_detail
 

@@ -254,6 +254,12 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
     r.force_law.acceptance.use_version_6_coverage();
     r.spec.acceptance.use_version_6_coverage();
   }
+  // Before version 8 a refused pen-down was a miss only when lifted in WS: one that never came near the
+  // stroke's start was no miss, as it ran.
+  if (version < 8) {
+    r.force_law.acceptance.use_version_7_misses();
+    r.spec.acceptance.use_version_7_misses();
+  }
   // A field those rules set takes the version's value, not its default and not another value the record
   // gives: each is listed with the value it takes (RecordedTrial::version_rules), never as defaulted. Before
   // version 6 the specification's acceptance is the force law's (below), so only the force law's are listed.

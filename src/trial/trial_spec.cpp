@@ -19,6 +19,7 @@
 #include "calligraphy/trial/writer_profile.hpp"
 #include "core/json_reader.hpp"
 #include "core/schema_json.hpp"
+#include "trial/record_schema.hpp"
 #include "trial/trial_spec_object.hpp"
 
 namespace calligraphy {
@@ -76,8 +77,8 @@ std::vector<SchemaField> acceptance_fields() {
           (ParameterTable<StrokeAcceptance>::fields()[self.table_slot].member) = v;
     };
     if (entries[i].whole_number) make_whole_number_kind(f);  // the miss counts
-    // The specification states the acceptance since version 6 of a record; the centred rule came with 7.
-    out.push_back(since(f.name.starts_with("centred_") ? 7 : 6, f));
+    // The specification states the acceptance since version 6 of a record; later fields since their own.
+    out.push_back(since(std::max(6, trial_detail::acceptance_field_version(f.name)), f));
   }
   return out;
 }

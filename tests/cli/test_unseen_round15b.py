@@ -39,7 +39,7 @@ from outsider import OneErrorLine, error_lines, run, sanitized_subset
 SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 SAMPLE = SOURCE / "data" / "hanzi-writer-data"
 YI, SHI = "一", "十"
-SPEC_VERSION = 7  # docs/cli.md: `calligraphy-trial-specification`, version 7
+SPEC_VERSION = 8  # docs/cli.md: `calligraphy-trial-specification`, version 8
 
 load_tests = sanitized_subset({"test_record_run_again_is_the_record_byte_for_byte",
                                "test_version_4_record_runs_without_the_end_gap_floor",
@@ -99,17 +99,19 @@ def tearDownModule():
 
 
 def record():
-    """The whole `trial --json` document of 一 (version 7)."""
+    """The whole `trial --json` document of 一 (version 8)."""
     return json.loads((SHARED["dir"] / "one.json").read_text(encoding="utf-8"))
 
 
 def older(version, document=None):
-    """A version-`version` record made by hand from a version-7 one, from what docs/cli.md and
+    """A version-`version` record made by hand from a version-8 one, from what docs/cli.md and
     docs/stroke-acceptance.md say each earlier version lacked or spelt otherwise."""
     whole = copy.deepcopy(document if document is not None else record())
     spec = whole["specification"]
     spec["version"] = version
     trial, acceptance = spec["trial"], spec["force_law"]["acceptance"]
+    if version < 8:  # version 7: written before a pen-down off the stroke's start counted as a miss
+        del trial["miss_min_path_m"], acceptance["miss_min_path_m"]
     if version < 7:  # version 6: written before the centred rule and the three fields after it
         for key in CENTRED:
             del trial[key], acceptance[key]
@@ -183,7 +185,7 @@ class Base(OneErrorLine, unittest.TestCase):
 
     def assert_notes_true(self, result, name, whole, ran, *, exempt=()):
         """Every field the forged record lacks is named by a note (but those in `exempt`), and every note says
-        what the field took: "its default" only where the re-run's value is the default (version 7's)."""
+        what the field took: "its default" only where the re-run's value is the default (version 8's)."""
         said = notes(result, name)
         defaults = record()["specification"]
         for pointer in pointers_absent(whole):
@@ -212,6 +214,16 @@ class TrialRecordVersions(Base):
         result = run(["trial", "--spec", "again.json", "--json", "third.json"], self.cwd)
         self.assertEqual(result.returncode, 0, result.stderr.decode())
         self.assertEqual((self.cwd / "third.json").read_bytes(), (self.shared / "one.json").read_bytes())
+
+    def test_version_7_record_counts_a_miss_only_at_a_lift_in_ws(self):
+        whole = older(7)
+        result, ran = self.rerun("v7.json", whole)
+        spec = ran["specification"]
+        self.assertEqual(spec["version"], SPEC_VERSION)  # written back in this version, as it ran
+        self.assertEqual(spec["trial"]["miss_min_path_m"], 0)
+        self.assertEqual(spec["force_law"]["acceptance"]["miss_min_path_m"], 0)
+        self.assertEqual(spec["trial"]["centred_coverage_fraction"], 0.55)  # version 7 had the centred rule
+        self.assert_notes_true(result, "v7.json", whole, ran)
 
     def test_version_6_record_runs_without_the_centred_rule(self):
         whole = older(6)

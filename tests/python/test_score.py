@@ -110,8 +110,7 @@ def joined(*traces):
 
 
 def test_a_stroke_refused_often_enough_is_credited_assisted_as_the_renderer_credits_it():
-    # 4 mm beside the first stroke: within its start radius (an attempt at it, as the renderer counts a lift in
-    # WS), beyond the mean deviation allowed.
+    # 4 mm beside the first stroke: within its start radius, beyond the mean deviation allowed.
     missed = [reference_trace("木", offset_m=0.004, order=[0]) for _ in range(5)]
     trace = joined(*missed, reference_trace("木", order=[1, 2, 3]))
     credited = calligraphy.score(trace, "木")  # the renderer's default: credited after 5 refusals
@@ -127,12 +126,18 @@ def test_a_stroke_refused_often_enough_is_credited_assisted_as_the_renderer_cred
     assert never["strokes_assisted"] == 0
     assert never["strokes_accepted"] == 0
     assert never["refusals"]["wrong_order"] == 3
-    # 8 mm beside it the pen never comes within the start radius: refused, but no attempt at the stroke.
+    # 8 mm beside it the pen never comes within the start radius: refused, and each a miss all the same (no
+    # dead end): credited after the fifth, as the renderer credits it.
     far = joined(*[reference_trace("木", offset_m=0.008, order=[0]) for _ in range(5)],
                  reference_trace("木", order=[1, 2, 3]))
     apart = calligraphy.score(far, "木")
-    assert apart["strokes_assisted"] == 0
+    assert apart["strokes_assisted"] == 1
+    assert apart["strokes_accepted"] == 3
     assert apart["refusals"]["wrong_place"] == 5
+    # As records before version 8 counted misses (a lift in WS only): no attempt at the stroke, no credit.
+    in_ws_only = calligraphy.score(far, "木", acceptance=calligraphy.StrokeAcceptance(miss_min_path_m=0))
+    assert in_ws_only["strokes_assisted"] == 0
+    assert in_ws_only["refusals"]["wrong_place"] == 5
 
 
 def test_dataframe_and_csv_give_the_dict_result(tmp_path):

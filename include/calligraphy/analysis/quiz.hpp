@@ -9,10 +9,11 @@
 /// same trace (docs/stroke-acceptance.md). After the acceptance's `assist_after_misses` misses on one stroke
 /// (0: never), that stroke is credited assisted, as Hanzi Writer's `markStrokeCorrectAfterMisses` marks it
 /// correct: shown, not written, and the next stroke is expected. The quiz counts its misses as Hanzi Writer
-/// does: every mismatch lifted (not the run `finish` judges). The renderer (`ActiveStroke::lift`) and
-/// `score_trace` count only attempts begun within the start radius of the stroke's start (WS), so where a
-/// trace has pen-downs that never come near the expected stroke's start (another stroke out of turn, a
-/// stroke 8 mm off) the quiz hints and credits sooner than they do; otherwise its credits are theirs. A run
+/// does: every mismatch lifted (not the run `finish` judges). The renderer and `score_trace` count the same
+/// misses on pen-downs that touch the character's box (StrokeAcceptance::counts_as_miss), none outside it;
+/// with the acceptance's `miss_min_path_m` 0 (records before version 8) they count only attempts begun
+/// within the start radius of the stroke's start (WS), and the quiz hints and credits sooner where
+/// pen-downs never come near it (a stroke 8 mm off). A run
 /// refused as backwards is a miss reported as backwards, or accepted (still reported as backwards) with
 /// `accept_backwards`. After `hint_after_misses` misses on one stroke, and after each further miss but the
 /// one that credits it, a hint event asks to show the expected stroke. Not for the servo thread: judging

@@ -53,8 +53,10 @@ struct WrittenSegment {
   std::size_t due_stroke = 0;
   /// This refused verdict was the `acceptance.assist_after_misses`-th miss on the stroke due: that stroke is
   /// then credited assisted, as the renderer demonstrates and credits it (StrokeAcceptance), and the next is
-  /// due. A miss is the renderer's: a refused verdict that came within the start radius of the due stroke's
-  /// start (a lift in WS), on a segment the pen was lifted from (not one the trace ends in).
+  /// due. A miss is the renderer's (StrokeAcceptance::counts_as_miss): a refused verdict of a segment the pen
+  /// was lifted from (not one the trace ends in) that touched the character's box, near the due stroke's
+  /// start or not (with `miss_min_path_m` 0, as records before version 8 ran, only one that came within the
+  /// start radius of its start: a lift in WS).
   bool assists_due = false;
 };
 
@@ -71,8 +73,11 @@ struct ScoreOptions {
   /// Radius of the start neighbourhood a segment must enter a stroke in [m]: the scene's
   /// (SceneLayout::start_radius_m). Finite, > 0.
   double start_radius_m = SceneLayout{}.start_radius_m;
-  std::size_t min_segment_samples = 3;  ///< a segment with fewer samples is ignored
-  double min_segment_length_m = 1e-3;   ///< a segment with a shorter pen-down path is ignored [m]
+  /// A segment with fewer samples is ignored (the fewest a miss has, kMinMissSamples).
+  std::size_t min_segment_samples = kMinMissSamples;
+  /// A segment with a shorter pen-down path is ignored [m] (the least path of a miss,
+  /// StrokeAcceptance::miss_min_path_m).
+  double min_segment_length_m = StrokeAcceptance{}.miss_min_path_m;
   MetricsOptions metrics{};
   /// A trace with more pen-down segments (ignored ones included) is refused before any is matched. > 0.
   std::size_t max_segments = kMaxScoredSegments;

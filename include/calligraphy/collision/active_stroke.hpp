@@ -39,10 +39,14 @@ class ActiveStroke {
   /// nothing outside an attempt.
   StrokeProgress advance(const Vec2& tip_m) noexcept;
   /// Pen lifted in WS: the stroke is written when the attempt meets the tolerances (short of the end or
-  /// past it); otherwise its feature points are loaded again (section 4.3.3), `refusal` says why and the
-  /// refusal counts as a miss; at `assist_after_misses` misses the stroke is credited as assisted and the
-  /// next stroke is active.
-  StrokeProgress lift() noexcept;
+  /// past it); otherwise its feature points are loaded again (section 4.3.3), `refusal` says why and, when
+  /// `counts_as_miss` (StrokeAcceptance::counts_as_miss of the pen-down), the refusal counts as a miss; at
+  /// `assist_after_misses` misses the stroke is credited as assisted and the next stroke is active.
+  StrokeProgress lift(bool counts_as_miss = true) noexcept;
+  /// A pen-down that never came near the active stroke's start (never WS) was lifted, and counts as a miss
+  /// (StrokeAcceptance::counts_as_miss): `refusal` wrong_place; the hint and the assisted credit follow
+  /// the misses as after `lift`. Does nothing once finished.
+  StrokeProgress miss() noexcept;
 
   [[nodiscard]] bool finished() const noexcept { return character_ >= scene_->characters.size(); }
   /// Indices of the active character, its stroke, and the active element; meaningless once finished.
@@ -68,7 +72,8 @@ class ActiveStroke {
   [[nodiscard]] const StrokeAcceptance& acceptance() const noexcept { return acceptance_; }
 
  private:
-  void next_stroke() noexcept;  // the active stroke is done (written or assisted)
+  void next_stroke() noexcept;                         // the active stroke is done (written or assisted)
+  void count_miss(StrokeProgress& progress) noexcept;  // a refused pen-down: maybe credited assisted
 
   const Scene* scene_;
   StrokeAcceptance acceptance_;

@@ -36,6 +36,15 @@
 
 namespace calligraphy {
 
+/// A pen-down refused at its lift, as the renderer (servo ticks) and the score (trace samples) see it:
+/// whether it is a miss (StrokeAcceptance::counts_as_miss).
+struct RefusedPenDown {
+  bool entered_ws = false;        ///< it came within the start radius of the stroke due's start (WS)
+  bool in_character_box = false;  ///< it touched the paper inside the character's box
+  double path_m = 0.0;            ///< its path from touch-down to lift [m]
+  std::size_t samples = 0;        ///< its samples on the paper
+};
+
 /// Tolerances of stroke acceptance, SI units. Defaults for a 60 mm character box from how far people's
 /// strokes lie from hanzi-writer-data's medians: hand-drawn centre lines of an independent data set,
 /// aligned to the medians, have a discrete Frechet distance of median 2.3 mm, 95th percentile 3.4 mm,
@@ -138,6 +147,15 @@ struct StrokeAcceptance {
   /// Writer's `markStrokeCorrectAfterMisses`. 5: two more tries after the hint, so that a stroke refused
   /// on 1 % of attempts is almost never assisted (1e-10) while a learner never stays stuck.
   double assist_after_misses = 5.0;
+  /// Least pen path of a refused pen-down for it to count as a miss [m] (a rule added in version 8 of a
+  /// trial record): every pen-down refused at its lift counts, whether or not it came near the stroke's
+  /// start (WS) but touched the character's box, as Hanzi Writer counts every stroke drawn on it that does
+  /// not match; a touch that barely moves (shorter than this, or fewer than kMinMissSamples samples) is no
+  /// attempt. The same threshold as the
+  /// score's ignored pen-downs (ScoreOptions::min_segment_length_m). Not scaled with the character: it is
+  /// the pen's jitter, not the stroke's size. 0: only a lift in WS is a miss, however short (records
+  /// before version 8), so that a stroke written a start radius or more away is never hinted or credited.
+  double miss_min_path_m = 0.001;
 
   /// The values of the fields above as records before version 4 ran them: no growth with the stroke's
   /// length, no cap, no scaling with the character size, no assisted credit, no floor of the end gap.
@@ -146,6 +164,13 @@ struct StrokeAcceptance {
   void use_version_4_end_gaps() noexcept { end_gap_m = 0.0; }
   /// The rule as records of versions 4 to 6 ran it: no centred coverage (`centred_coverage_fraction` 0).
   void use_version_6_coverage() noexcept { centred_coverage_fraction = 0.0; }
+  /// The misses as records before version 8 counted them: a lift in WS only (`miss_min_path_m` 0).
+  void use_version_7_misses() noexcept { miss_min_path_m = 0.0; }
+  /// True when `pen_down`, refused at its lift, counts as a miss of the stroke due: with `miss_min_path_m`
+  /// > 0, one that entered WS or touched the character's box, with a path of at least `miss_min_path_m`
+  /// over at least kMinMissSamples samples (a pen resting outside the box is no attempt at the character);
+  /// with 0, one that entered WS.
+  [[nodiscard]] bool counts_as_miss(const RefusedPenDown& pen_down) const noexcept;
   /// True when a path that leaves `start_gap_m` and `finish_gap_m` [m] of a stroke of `length_m` unwritten,
   /// with `way_along_m` along it, is centred on it and covers enough of it (`centred_coverage_fraction`).
   [[nodiscard]] bool centred_cover(double length_m, double way_along_m, double start_gap_m,
@@ -169,6 +194,10 @@ struct StrokeAcceptance {
   [[nodiscard]] double allowed_end_gap_m(double length_m) const noexcept;
   bool operator==(const StrokeAcceptance&) const = default;
 };
+
+/// Fewest samples a pen-down has for its refusal to count as a miss (StrokeAcceptance::counts_as_miss), and
+/// for the score to judge it at all (ScoreOptions::min_segment_samples): two samples are a touch, not a path.
+inline constexpr std::size_t kMinMissSamples = 3;
 
 /// The fields of StrokeAcceptance (parameter_table.hpp): the one definition of their units and ranges, which
 /// its validate(), a protocol's "acceptance" and a trial record read. A length beyond 0.1 m, more than the

@@ -52,6 +52,10 @@ struct RenderOutput {
   /// The abandoned stroke was refused for the `assist_after_misses`-th time (StrokeAcceptance): credited
   /// as assisted, not written; the next stroke is active.
   bool stroke_assisted = false;
+  /// The pen was lifted from a pen-down that never entered WS (it never came near the active stroke's start)
+  /// and that counts as a miss (StrokeAcceptance::counts_as_miss): `refusal` wrong_place, `misses` one more,
+  /// or the stroke credited assisted.
+  bool missed_off_start = false;
   std::uint32_t misses = 0;  ///< refused attempts at the active stroke (after this tick)
   bool hint_shown = false;   ///< the active stroke is to be shown as a hint (misses >= hint_after_misses)
   /// The device state (position, velocity, time stamp) was not finite, or a coordinate lay beyond
@@ -122,6 +126,17 @@ class Renderer {
   Vec2 off_stroke_anchor_ = Vec2::Zero();    // adhesion point of the off-stroke friction in CS
   bool anchor_valid_ = false;
   double off_stroke_alpha_ = 1.0;  // its filter coefficient per tick
+  // The pen-down under way, from the touch-down: its path and ticks, whether it entered WS (or wrote a
+  // stroke) and touched the active character's box; a refusal at its lift is a miss by
+  // StrokeAcceptance::counts_as_miss.
+  struct PenDown {
+    Vec2 last_tip_m = Vec2::Zero();
+    double path_m = 0.0;
+    std::size_t ticks = 0;
+    bool reached_writing = false;
+    bool in_character_box = false;
+  };
+  PenDown contact_;
   // Smoothing state.
   Vec2 rendered_foot_ = Vec2::Zero();  // attraction target, rate-limited towards the tracked foot
   bool foot_valid_ = false;
