@@ -371,7 +371,6 @@ void draw_scene(ImDrawList& draw, const WindowLayout& layout, const std::vector<
     draw_quiz_ink(draw, layout, *view);
   } else if (view !=
              nullptr) {  // the trace under the reference, so that both stay visible where they overlap
-    if (view->refused) draw_ink(draw, layout, *view, view->refused->points_m, kRefused);
     for (const TraceSegment& segment : view->segments) {
       std::vector<ImVec2> points;
       for (const Vec2& p : segment.points_m) points.push_back(im(trial_to_screen(layout, *view, p)));
@@ -385,6 +384,10 @@ void draw_scene(ImDrawList& draw, const WindowLayout& layout, const std::vector<
     return;
   }
   if (view != nullptr) draw_shown_strokes(draw, layout, art, *view);
+  // The last refused attempt over the hint that its misses brought (a learner sees both where the pen went
+  // and the stroke to write), under the reference.
+  if (view != nullptr && !quiz && view->refused)
+    draw_ink(draw, layout, *view, view->refused->points_m, kRefused);
   for (std::size_t c = 0; c < art.size() && !quiz; ++c) {
     for (const std::vector<Vec2>& stroke : art[c].reference) {
       std::vector<ImVec2> points;

@@ -749,6 +749,40 @@ class TrainerTest(unittest.TestCase):
         acceptance = record["force_law"]["acceptance"]
         self.assertEqual((acceptance["hint_after_misses"], acceptance["assist_after_misses"]), (1, 2))
 
+    def test_a_stroke_never_started_at_its_start_is_credited_after_the_misses(self):
+        """`train 十 --assist-after-misses 3` on the mouse, whose pen nothing draws to the start: stroke 1
+        written 8 mm beside itself never comes within the 5 mm start radius (no WS), and each pen-down is a
+        miss all the same (docs/stroke-acceptance.md, "No dead end"): at the third it is credited assisted and
+        stroke 2, written, completes the trial."""
+        trainer = self.start("十", "--device", "mouse", "--no-demo", "--session", "out", "--exit-after", "60",
+                             "--hint-after-misses", "2", "--assist-after-misses", "3")
+        (box,) = trainer.boxes()
+        hand = trainer.hand(box, seed=7)
+        across, down = medians("十")
+        off = 0.008 / CHARACTER_SIZE_M * 1024  # 8 mm in data units, across the horizontal stroke
+        beside = [(x, y + off) for x, y in across]
+        said = "十 stroke 1 not written: wrong place"
+        time.sleep(0.5)
+        for count in (1, 2, 3):
+            hand.write([box.data_to_px(p) for p in beside])
+            deadline = time.time() + 20
+            while trainer.errors().count(said) < count:
+                self.assertLess(time.time(), deadline, f"no miss {count}:\n" + trainer.errors())
+                self.assertIsNone(trainer.process.poll(), trainer.errors())
+                time.sleep(0.05)
+        time.sleep(1.0)
+        hand.write([box.data_to_px(p) for p in down])
+        self.assertEqual(trainer.wait(timeout=30), 0, trainer.errors())
+        self.assertEqual(trainer.errors().count("judged from the pen-down path"), 3, trainer.errors())
+        (record_path,) = saved_trials(pathlib.Path(self.folder) / "out")
+        record = json.loads(record_path.read_text(encoding="utf-8"))
+        self.assertEqual(record["end_reason"], "completed")
+        self.assertEqual((record["strokes_assisted"], record["strokes_completed"]), (1, 1))
+        first, second = record["per_stroke"]
+        self.assertTrue(first["assisted"])
+        self.assertEqual(first["attempts"], 0, "never in WS: every miss was a pen-down off its start")
+        self.assertTrue(second["completed"])
+
     def test_a_quiz_ends_completed_once_every_stroke_is_accepted(self):
         # 一 written along its median: the quiz accepts it as the renderer completes it (one stroke matcher,
         # the renderer's tolerances), and the trial ends at once. On mouse-hand, where the pen landing on the
@@ -1319,7 +1353,7 @@ GROUPS = {
     "stop_signals": ("EndingTest",),
     "openhaptics": ("test_a_haptic_device_writes_yong_through_the_stand_in_libhd",),
     "hint_assist": ("test_misses_bring_the_hint", "test_the_panel_names_the_hinted_stroke",
-                    "test_the_miss_counts_given_to_train"),
+                    "test_the_miss_counts_given_to_train", "test_a_stroke_never_started_at_its_start"),
 }
 
 
