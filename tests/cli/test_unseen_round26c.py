@@ -128,8 +128,9 @@ class Case(OneErrorLine, unittest.TestCase):
 
 
 # ---------------------------------------------------------------------------------------------------------
-# (1) The R process. The fake R below is a Python script named Rscript. Its first call (`Rscript --vanilla -e
-# ...`, which asks whether lme4, lmerTest and pbkrtest load) exits 0; the serving one (`lmer_fit.R --serve`)
+# (1) The R process. The fake R below is a Python script named Rscript, started as `lmer_fit.R --serve`. Its
+# first frame says whether lme4, lmerTest and pbkrtest load (`@@calligraphy-ready ok`, or `missing HEX(name)`
+# and an end, as the mode's "start" says; "hang" never says); then it
 # reads its requests one line each, `@@calligraphy-request N HEX(folder) HEX(formula) HEX(ddf)`, and answers as
 # the file MODE in its state folder says at that request: `good` writes the result files a real lme4 wrote for
 # the frame below (its intercept set to the mode's) and replies `@@calligraphy-reply N ok HEX(name=size;...)`;
@@ -145,11 +146,14 @@ def mode():
     with open(os.path.join(state, "mode")) as f:
         return json.load(f)
 m = mode()
-if "--serve" not in sys.argv:  # the first R: are lme4, lmerTest and pbkrtest there?
-    if m.get("probe") == "hang":
-        signal.signal(signal.SIGTERM, signal.SIG_IGN)
-        time.sleep(300)
-    sys.exit(0)
+# The first frame: do lme4, lmerTest and pbkrtest load?
+if m.get("start") == "hang":
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    time.sleep(300)
+elif m.get("start") == "missing":
+    os.write(1, f"@@calligraphy-ready missing {m['package'].encode().hex()}\n".encode())
+    sys.exit(3)
+os.write(1, b"@@calligraphy-ready ok\n")
 RESULTS = {
     "fixed.csv": '"term","estimate","std_error","df","t","p","ci95_low","ci95_high"\n'
                  '"(Intercept)",INTERCEPT,0.412918926065332,2.6516661721289,0.596265998603122,P,'
@@ -547,6 +551,22 @@ class RServing(unittest.TestCase):
         self.assertIn("Rscript is not installed", str(caught.exception))
         self.assert_good_fit()
 
+    def test_r_whose_first_frame_names_a_missing_package_is_r_not_installed_in_one_line(self):
+        """The serving R says at its start that pbkrtest does not load: RUnavailable (not a spoilt fit) naming
+        the package and its Debian name, that R ended, and the next R, whose packages load, answers."""
+        self.assert_good_fit()
+        self.fake.set(kind="exit")  # the serving R ends: the next fit starts one, which lacks the package
+        with self.assertRaises(mixed_models.RAnswerError):
+            self.fit()
+        self.fake.set(kind="good", start="missing", package="pbkrtest")
+        with self.assertRaises(mixed_models.RUnavailable) as caught:
+            self.fit()
+        self.assertNotIsInstance(caught.exception, mixed_models.RAnswerError)
+        self.assertEqual(str(caught.exception),
+                         "R's package pbkrtest is not installed (Debian: apt-get install r-cran-pbkrtest)")
+        self.fake.assert_none_alive(self)
+        self.assert_good_fit()
+
     def test_an_rscript_that_is_not_executable_is_r_not_installed(self):
         def make(path):
             shutil.copy(self.fake.script, path)
@@ -600,7 +620,7 @@ class RProcessLife(unittest.TestCase):
         self.fake.set(**mode)
         process = self.child()
         deadline = time.monotonic() + 20
-        stage = "--serve" if mode.get("kind") == "hang" else "-e"
+        stage = "--serve"  # one R both checks its packages and serves
         while True:
             started = [p for p in self.fake.pids() if alive(p)]
             if any(stage.encode() in Path(f"/proc/{p}/cmdline").read_bytes() for p in started if alive(p)):
@@ -627,7 +647,7 @@ class RProcessLife(unittest.TestCase):
         self.stopped(signal.SIGTERM, kind="hang", ignore_sigterm=True)
 
     def test_the_first_r_that_never_answers_is_stopped_with_python(self):
-        self.stopped(signal.SIGTERM, kind="good", probe="hang")
+        self.stopped(signal.SIGTERM, kind="good", start="hang")
 
 
 # ---------------------------------------------------------------------------------------------------------

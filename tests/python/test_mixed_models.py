@@ -1,9 +1,11 @@
-"""calligraphy.mixed_models' one R process: a failed fit is an error naming the formula and R's message and
-leaves the process serving; a hung fit is stopped at the timeout and the next fit gets a new process; a forked
-child fits with its own process; every answer is the one-shot script's."""
+"""calligraphy.mixed_models' one R process: started once, its first frame the package check; a failed fit is an
+error naming the formula and R's message and leaves the process serving; a hung fit is stopped at the timeout
+and the next fit gets a new process; a forked child fits with its own process; every answer is the one-shot
+script's."""
 
 import multiprocessing
 import os
+import shlex
 import shutil
 import subprocess
 import tempfile
@@ -29,6 +31,25 @@ def frame(seed=1, subjects=8):
 
 def estimate(fit):
     return float(fit.fixed.set_index("term").loc["conditionb", "estimate"])
+
+
+def test_one_r_start_checks_the_packages_and_serves_every_fit(tmp_path, monkeypatch):
+    """With no R running, r_available() and two fits start R once (a stand-in Rscript on PATH logs each start,
+    then runs the real one): the serving R's first frame is the package check."""
+    log = tmp_path / "starts"
+    wrapper = tmp_path / "bin" / "Rscript"
+    wrapper.parent.mkdir()
+    wrapper.write_text(f'#!/bin/sh\necho "$*" >> {shlex.quote(str(log))}\n'
+                       f'exec {shlex.quote(shutil.which("Rscript"))} "$@"\n')
+    wrapper.chmod(0o755)
+    monkeypatch.setenv("PATH", f"{wrapper.parent}{os.pathsep}{os.environ['PATH']}")
+    mixed_models._close_server()
+    assert mixed_models.r_available()
+    first = mixed_models.lmer(frame(), FORMULA, {"condition": ["a", "b"]})
+    second = mixed_models.lmer(frame(seed=2), FORMULA, {"condition": ["a", "b"]})
+    assert estimate(first) != estimate(second)  # two fits, each of its own data
+    starts = log.read_text().splitlines()
+    assert len(starts) == 1 and starts[0].endswith("lmer_fit.R --serve"), starts
 
 
 def test_the_served_fit_is_the_one_shot_scripts():
