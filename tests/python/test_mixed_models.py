@@ -8,7 +8,9 @@ import os
 import shlex
 import shutil
 import subprocess
+import sys
 import tempfile
+import textwrap
 
 import numpy as np
 import pandas
@@ -33,21 +35,32 @@ def estimate(fit):
     return float(fit.fixed.set_index("term").loc["conditionb", "estimate"])
 
 
-def test_one_r_start_checks_the_packages_and_serves_every_fit(tmp_path, monkeypatch):
-    """With no R running, r_available() and two fits start R once (a stand-in Rscript on PATH logs each start,
-    then runs the real one): the serving R's first frame is the package check."""
+def test_one_r_start_checks_the_packages_and_serves_every_fit(tmp_path):
+    """A Python process that asks r_available() and fits twice starts R once (a stand-in Rscript on PATH logs
+    each start, then runs the real one): the serving R's first frame is the package check. A process of its own,
+    as this one has R running and its check done already."""
     log = tmp_path / "starts"
     wrapper = tmp_path / "bin" / "Rscript"
     wrapper.parent.mkdir()
     wrapper.write_text(f'#!/bin/sh\necho "$*" >> {shlex.quote(str(log))}\n'
                        f'exec {shlex.quote(shutil.which("Rscript"))} "$@"\n')
     wrapper.chmod(0o755)
-    monkeypatch.setenv("PATH", f"{wrapper.parent}{os.pathsep}{os.environ['PATH']}")
-    mixed_models._close_server()
-    assert mixed_models.r_available()
-    first = mixed_models.lmer(frame(), FORMULA, {"condition": ["a", "b"]})
-    second = mixed_models.lmer(frame(seed=2), FORMULA, {"condition": ["a", "b"]})
-    assert estimate(first) != estimate(second)  # two fits, each of its own data
+    code = textwrap.dedent(f"""\
+        import pandas
+        from calligraphy import mixed_models
+        assert mixed_models.r_available()
+        for seed in (1, 2):
+            frame = pandas.read_csv({str(tmp_path / "frame")!r} + str(seed) + ".csv")
+            fit = mixed_models.lmer(frame, {FORMULA!r}, {{"condition": ["a", "b"]}})
+            print(fit.fixed.set_index("term").loc["conditionb", "estimate"])
+        """)
+    for seed in (1, 2):
+        frame(seed=seed).to_csv(tmp_path / f"frame{seed}.csv", index=False)
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300,
+                          env=dict(os.environ, PATH=f"{wrapper.parent}{os.pathsep}{os.environ['PATH']}"))
+    assert done.returncode == 0, done.stderr[-2000:]
+    estimates = [float(line) for line in done.stdout.split()]
+    assert len(estimates) == 2 and estimates[0] != estimates[1]  # two fits, each of its own data
     starts = log.read_text().splitlines()
     assert len(starts) == 1 and starts[0].endswith("lmer_fit.R --serve"), starts
 
