@@ -145,6 +145,7 @@ class _RServer:
 
     _REPLY = "@@calligraphy-reply "
     _READY = "@@calligraphy-ready "
+    process: subprocess.Popen
 
     def __init__(self, rscript: str) -> None:
         """Starts R and waits for its first frame. Raises RUnavailable when Rscript cannot be run, names a package
@@ -163,22 +164,30 @@ class _RServer:
                     [rscript, "--vanilla", str(_SCRIPT), "--serve"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                     stderr=self.log, bufsize=0, preexec_fn=_keep_with_parent if os.name == "posix" else None,
                     start_new_session=os.name == "posix"))
-            except OSError as error:
+            except (OSError, subprocess.SubprocessError) as error:  # the latter: the child's set-up failed
                 started.append(error)
-            ready.set()
+            finally:
+                ready.set()  # whatever happened, the caller is not left waiting
             if isinstance(started[0], subprocess.Popen):
                 started[0].wait()
 
         try:
-            threading.Thread(target=keep, name="calligraphy-r", daemon=True).start()
-        except RuntimeError as error:  # no thread to be had (a process limit): no process either
-            started.append(OSError(str(error)))
-            ready.set()
-        ready.wait()
-        if isinstance(started[0], OSError):
+            try:
+                threading.Thread(target=keep, name="calligraphy-r", daemon=True).start()
+            except RuntimeError as error:  # no thread to be had (a process limit): no process either
+                started.append(OSError(str(error)))
+                ready.set()
+            ready.wait()
+        except BaseException:  # a Ctrl-C while R is being started: that R is ended, not left to this process's end
+            if ready.wait(30) and started and isinstance(started[0], subprocess.Popen):
+                self.process = started[0]
+                self.kill()
+                self.close()
+            raise
+        if not isinstance(started[0], subprocess.Popen):
             self.log.close()
             raise RUnavailable(f"Rscript could not be run: {started[0]}")
-        self.process: subprocess.Popen = started[0]
+        self.process = started[0]
         try:
             self._wait_ready(time.monotonic() + _START_TIMEOUT_S)
         except BaseException:  # also a Ctrl-C while R loads its packages: no R is left behind

@@ -208,6 +208,21 @@ def test_an_r_silent_at_its_start_is_stopped_and_named(fake_r, tmp_path, monkeyp
     assert not running(r_pid_of(tmp_path))
 
 
+def test_an_r_whose_start_fails_before_it_runs_is_r_unavailable_not_a_wait(fake_r, monkeypatch):
+    """The child's set-up between fork and exec failing (subprocess's SubprocessError, not an OSError) is
+    "Rscript could not be run", at once."""
+    fake_r("twice")
+
+    def broken():
+        raise ValueError("no prctl here")
+
+    monkeypatch.setattr(mixed_models, "_keep_with_parent", broken)
+    started = time.monotonic()
+    with pytest.raises(mixed_models.RUnavailable, match="^Rscript could not be run: "):
+        mixed_models.lmer(frame(), FORMULA, FACTORS)
+    assert time.monotonic() - started < 30
+
+
 def test_line_breaks_and_tabs_in_a_formula_are_one_request(fake_r):
     fake_r("formula")
     formula = "outcome ~ condition\n  +\t(1 | subject)\n"
