@@ -4,13 +4,14 @@ report for a paper", docs/python.md "The design's questions", docs/architecture.
 
 (1) The R process. A fake `Rscript` first on PATH (a small Python script in a temporary folder) misbehaves as a
 peer can: garbage, a reply twice, half a reply then its end, Latin-1 and UTF-16, a huge length, a long line, NaN,
-infinities, p > 1 and negative variances, a megabyte on standard error, an exit at once, not executable, a
-folder, a child that holds the pipe, no answer with SIGTERM ignored. `calligraphy.mixed_models.lmer` runs in
-this process against it: the fit alone fails (`RAnswerError` naming why, within seconds), every R started has
-ended, and the next fit is the fake's again; and in a Python of its own stopped by SIGTERM or SIGINT while R
-hangs (the serving R and the first R, which asks for the packages): no R outlives it, no traceback. The
-smallest study with a mixed model (three simulated subjects) asked its questions with its first R broken: that
-row alone is "not computed". No real R is needed: the fake answers as lme4 did once for the frame below.
+infinities, p > 1 and negative variances, a megabyte on standard error, an exit at once, not executable, a folder,
+a child that holds the pipe, no answer with SIGTERM ignored, a first frame naming a missing package.
+`calligraphy.mixed_models.lmer` runs in this process against it: the fit alone fails (`RAnswerError` naming why,
+within seconds), every R started has ended, and the next fit is the fake's again; and in a Python of its own
+stopped by SIGTERM or SIGINT while R hangs (fitting, or before its first frame, which says whether the packages
+load): no R outlives it, no traceback. The smallest study with a mixed model (three simulated subjects) asked its
+questions with its first R broken: that row alone is "not computed". No real R is needed: the fake answers as lme4
+did once for the frame below.
 
 (2) The journals of a set (`report --csv/--out`). A journal is what a run killed between two renames leaves
 (here killed by strace's fault injection, skipped saying so without strace); its form (a header with the
