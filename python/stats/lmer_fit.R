@@ -15,6 +15,11 @@
 #                                                                                   the result files written)
 #                                              @@calligraphy-reply ID error MESSAGE
 #                                            where ID is the request's (decimal) and FILES and MESSAGE are hex.
+#                                            Before any request R says whether the packages a fit needs load,
+#                                            in its first frame (so that one R start both checks and serves):
+#                                              @@calligraphy-ready ok
+#                                              @@calligraphy-ready missing PACKAGE  (hex; R then ends, status 3)
+#                                            naming the first of lme4, lmerTest and pbkrtest that does not load.
 #                                            Other lines (a package's chatter) carry no marker and are ignored.
 # FOLDER holds data.csv (UTF-8; an empty field is a missing value), types.csv (column, type: "number" or
 # "text", each column of data.csv) and levels.csv (factor, level: each factor's levels in order, reference
@@ -23,6 +28,20 @@
 # compared one) has three or more levels and is a term of the model, pairs.csv holds every pairwise contrast
 # of its estimated marginal means (emmeans, Lenth 2024; the same df method), later level - earlier level, with
 # p raw and Holm-adjusted among them; fit.csv's "pairs" says why there are none.
+arguments <- commandArgs(trailingOnly = TRUE)
+serving <- length(arguments) == 1 && arguments[1] == "--serve"
+if (serving) {
+  # Loading is the check (an install missing one of its own dependencies does not load), and library() below
+  # then attaches the namespaces already loaded: the check costs this R no second load.
+  for (package in c("lme4", "lmerTest", "pbkrtest")) {
+    if (!suppressPackageStartupMessages(requireNamespace(package, quietly = TRUE))) {
+      cat("@@calligraphy-ready missing ",
+          paste(as.character(charToRaw(enc2utf8(package))), collapse = ""), "\n", sep = "")
+      flush(stdout())
+      quit(save = "no", status = 3)
+    }
+  }
+}
 suppressPackageStartupMessages({
   library(lme4)
   library(lmerTest)
@@ -137,8 +156,9 @@ hex_to_text <- function(hex) {
   text
 }
 
-arguments <- commandArgs(trailingOnly = TRUE)
-if (length(arguments) == 1 && arguments[1] == "--serve") {
+if (serving) {
+  cat("@@calligraphy-ready ok\n")
+  flush(stdout())
   requests <- file("stdin", open = "r")
   repeat {
     line <- readLines(requests, n = 1, encoding = "UTF-8")

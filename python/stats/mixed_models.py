@@ -5,7 +5,9 @@ Christensen 2017, J Stat Softw 82(13)): Satterthwaite (1946) by default, Kenward
 
 ``lmer(frame, formula, factors)`` writes ``frame`` to a temporary folder and has R fit it with the package's
 ``lmer_fit.R``; nothing is re-implemented in Python. One R process per Python process serves every fit (loading
-lme4 takes longer than most fits), started on the first and ended at exit. R and its packages come from Debian:
+lme4 takes longer than most fits), started on the first (or by ``r_available``) and ended at exit; its first
+frame says whether lme4, lmerTest and pbkrtest load, so R is started once, not once more to ask. R and its
+packages come from Debian:
 ``apt-get install r-base-core r-cran-lme4 r-cran-lmertest r-cran-pbkrtest`` (scripts/install-deps.sh).
 Without them ``lmer`` raises ``RUnavailable``, which callers report as "not computed" and never replace
 with a large-sample Wald test. R speaks a framed protocol (each request and reply one line of hex fields
@@ -22,6 +24,7 @@ import dataclasses
 import io
 import os
 import pathlib
+import re
 import shutil
 import subprocess
 import tempfile
@@ -37,6 +40,8 @@ __all__ = ["LmerFit", "RAnswerError", "RUnavailable", "lmer", "r_available"]
 _SCRIPT = pathlib.Path(__file__).with_name("lmer_fit.R")
 # A fit of a few thousand trials takes seconds; a hung R is stopped instead of hanging a report.
 _TIMEOUT_S = 600.0
+# Loading lme4, lmerTest and pbkrtest takes seconds; an R silent for longer at its start counts as not installed.
+_START_TIMEOUT_S = 120.0
 # A reply is a few hundred bytes; a package's chatter is lines of text. A longer line is no answer.
 _LONGEST_LINE_BYTES = 64 << 20
 
@@ -96,15 +101,13 @@ class LmerFit:
 
 
 def r_available() -> bool:
-    """Whether Rscript with lme4, lmerTest and pbkrtest can be run here."""
+    """Whether Rscript with lme4, lmerTest and pbkrtest can be run here. Asking starts the process's serving R
+    (when none runs), which then serves the fits that follow."""
     try:
         _check_r()
     except RUnavailable:
         return False
     return True
-
-
-_R_CHECKED: list[bool] = []
 
 
 class RAnswerError(RUnavailable):
@@ -141,8 +144,13 @@ class _RServer:
     thread asked for the first fit."""
 
     _REPLY = "@@calligraphy-reply "
+    _READY = "@@calligraphy-ready "
+    process: subprocess.Popen
 
     def __init__(self, rscript: str) -> None:
+        """Starts R and waits for its first frame. Raises RUnavailable when Rscript cannot be run, names a package
+        that does not load, or ends, says something else or stays silent (``_START_TIMEOUT_S``) before that
+        frame; the R is then ended."""
         self.pid = os.getpid()
         self.log = tempfile.TemporaryFile(mode="w+", encoding="utf-8", errors="replace")
         self.requests = 0
@@ -156,17 +164,69 @@ class _RServer:
                     [rscript, "--vanilla", str(_SCRIPT), "--serve"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                     stderr=self.log, bufsize=0, preexec_fn=_keep_with_parent if os.name == "posix" else None,
                     start_new_session=os.name == "posix"))
-            except OSError as error:
+            except (OSError, subprocess.SubprocessError) as error:  # the latter: the child's set-up failed
                 started.append(error)
-            ready.set()
+            finally:
+                ready.set()  # whatever happened, the caller is not left waiting
             if isinstance(started[0], subprocess.Popen):
                 started[0].wait()
 
-        threading.Thread(target=keep, name="calligraphy-r", daemon=True).start()
-        ready.wait()
-        if isinstance(started[0], OSError):
-            raise RAnswerError(f"lmer: R could not be started: {started[0]}")
-        self.process: subprocess.Popen = started[0]
+        try:
+            try:
+                threading.Thread(target=keep, name="calligraphy-r", daemon=True).start()
+            except RuntimeError as error:  # no thread to be had (a process limit): no process either
+                started.append(OSError(str(error)))
+                ready.set()
+            ready.wait()
+        except BaseException:  # a Ctrl-C while R is being started: that R is ended, not left to this process's end
+            if ready.wait(30) and started and isinstance(started[0], subprocess.Popen):
+                self.process = started[0]
+                self.kill()
+                self.close()
+            raise
+        if not isinstance(started[0], subprocess.Popen):
+            self.log.close()
+            raise RUnavailable(f"Rscript could not be run: {started[0]}")
+        self.process = started[0]
+        try:
+            self._wait_ready(time.monotonic() + _START_TIMEOUT_S)
+        except BaseException:  # also a Ctrl-C while R loads its packages: no R is left behind
+            self.kill()
+            self.close()
+            raise
+
+    def _wait_ready(self, deadline: float) -> None:
+        """R's first frame (lmer_fit.R): 'ok', or the first of lme4, lmerTest and pbkrtest that does not load."""
+        asked = "lme4, lmerTest and pbkrtest"
+        while True:
+            try:
+                line = self._line(deadline)
+            except TimeoutError:
+                raise RUnavailable(f"Rscript did not answer within {_START_TIMEOUT_S:g} s when asked for "
+                                   f"{asked}") from None
+            except EOFError as error:  # its standard error, if it wrote any, says why
+                raise RUnavailable(f"Rscript ended before saying whether {asked} load"
+                                   + (f": {error}" if str(error) else "")) from None
+            except ValueError as error:
+                raise RUnavailable(f"Rscript answered the question whether {asked} load out of protocol: "
+                                   f"{error}") from None
+            if not line.startswith(self._READY):
+                continue  # a package's or a profile's chatter
+            fields = line[len(self._READY):].split(" ")
+            if fields == ["ok"]:
+                return
+            missing = None
+            if len(fields) == 2 and fields[0] == "missing":
+                try:
+                    missing = bytes.fromhex(fields[1]).decode("ascii")
+                except (ValueError, UnicodeDecodeError):
+                    pass
+            # R's package names are letters, digits and dots; anything else is no name to print.
+            if missing is None or not re.fullmatch(r"[A-Za-z][A-Za-z0-9.]*", missing):
+                raise RUnavailable(f"Rscript answered the question whether {asked} load out of protocol: "
+                                   f"{line[:200]!r}")
+            raise RUnavailable(f"R's package {missing} is not installed (Debian: apt-get install "
+                               f"r-cran-{missing.lower()})")
 
     def running(self) -> bool:
         return self.process.returncode is None and self.process.poll() is None
@@ -281,20 +341,27 @@ def _close_server() -> None:
 atexit.register(_close_server)
 
 
+def _serving(rscript: str) -> _RServer:
+    """This process's R server, started (its packages checked by its first frame) when none runs. Called with
+    ``_SERVER_LOCK`` held. Raises RUnavailable as ``_RServer`` does."""
+    if _SERVER and (_SERVER[0].pid != os.getpid() or not _SERVER[0].running()):
+        ended = _SERVER.pop()  # a parent's (after fork) or one that ended: start another
+        if ended.pid == os.getpid():
+            ended.close()  # and end what the one that ended left running
+    if not _SERVER:
+        _SERVER.append(_RServer(rscript))
+    return _SERVER[0]
+
+
 def _fit_in_r(rscript: str, folder: str, formula: str, ddf: str) -> dict[str, "pandas.DataFrame"]:
     """Has the process's R server fit the model in ``folder`` and returns the result tables its reply names,
     each checked whole (``_read_answer``). Raises RuntimeError naming the formula and R's message when lme4
     cannot fit it; RAnswerError when R hangs past the timeout, ends, answers out of protocol or with result
-    files that are not whole (the server is then stopped, and the next fit starts another)."""
+    files that are not whole (the server is then stopped, and the next fit starts another); RUnavailable when
+    the R started for it says a package is missing (``_RServer``)."""
     one_line = " ".join(formula.split())
     with _SERVER_LOCK:
-        if _SERVER and (_SERVER[0].pid != os.getpid() or not _SERVER[0].running()):
-            ended = _SERVER.pop()  # a parent's (after fork) or one that ended: start another
-            if ended.pid == os.getpid():
-                ended.close()  # and end what the one that ended left running
-        if not _SERVER:
-            _SERVER.append(_RServer(rscript))
-        server = _SERVER[0]
+        server = _serving(rscript)
         try:
             status, text = server.fit(folder, formula, ddf, _TIMEOUT_S)
             if status != "ok":
@@ -435,31 +502,15 @@ def _r_backquoted(name: str) -> str:
 
 
 def _check_r() -> str:
+    """The Rscript on PATH, once this process's serving R has said in its first frame that lme4, lmerTest and
+    pbkrtest load (started here when none runs: one R start both checks and serves). Raises RUnavailable
+    naming what is missing."""
     rscript = shutil.which("Rscript")
     if rscript is None:
         raise RUnavailable("Rscript is not installed (Debian: apt-get install r-base-core r-cran-lme4 "
                            "r-cran-lmertest r-cran-pbkrtest)")
-    if not _R_CHECKED:
-        # Kept with this process as the serving R is: a Python stopped by a signal while R loads its packages
-        # (a second or more) leaves no R behind.
-        try:
-            probe = subprocess.run(
-                [rscript, "--vanilla", "-e",
-                 "for (p in c('lme4','lmerTest','pbkrtest')) if (!requireNamespace(p, quietly=TRUE)) "
-                 "{cat(p); quit(status=3)}"],
-                # Any bytes R prints (a Latin-1 locale's message) are read, never an exception of their own.
-                capture_output=True, text=True, encoding="utf-8", errors="replace", timeout=120,
-                preexec_fn=_keep_with_parent if os.name == "posix" else None)
-        except subprocess.TimeoutExpired as error:
-            raise RUnavailable(f"Rscript did not answer within {error.timeout:g} s when asked for lme4, "
-                               "lmerTest and pbkrtest") from None
-        except OSError as error:
-            raise RUnavailable(f"Rscript could not be run: {error}") from None
-        if probe.returncode != 0:
-            missing = probe.stdout.strip() or "lme4/lmerTest/pbkrtest"
-            raise RUnavailable(f"R's package {missing} is not installed (Debian: apt-get install "
-                               f"r-cran-{missing.lower()})")
-        _R_CHECKED.append(True)
+    with _SERVER_LOCK:
+        _serving(rscript)
     return rscript
 
 

@@ -148,6 +148,33 @@ def process_group_members(sid):
     return members
 
 
+def descendants(pid):
+    """Every process below pid by parent links, while they run: the serving R starts a session of its own, so
+    the session id alone does not find it."""
+    parents = {}
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                parents[int(entry)] = int(Path(f"/proc/{entry}/stat").read_text().rsplit(")", 1)[1].split()[1])
+            except OSError:
+                continue
+    found, frontier = [], [pid]
+    while frontier:
+        below = frontier.pop()
+        children = [child for child, parent in parents.items() if parent == below]
+        found += children
+        frontier += children
+    return found
+
+
+def running(pid):
+    """pid exists and has not ended (a zombie has)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
 def command_of(pid):
     try:
         return Path(f"/proc/{pid}/comm").read_text().strip()
@@ -838,26 +865,38 @@ class StudyReportProcess(unittest.TestCase):
                                    start_new_session=True)
         self.addCleanup(reap_session, process.pid)
         deadline = time.monotonic() + TIMEOUT_S
-        while time.monotonic() < deadline:  # until the R it started is there (the stand-in's `sleep`)
-            if any(command_of(pid) == "sleep" for pid in process_group_members(process.pid)):
+        while True:  # until the R it started is there (the stand-in's `sleep`)
+            self.r_pids = [pid for pid in set(process_group_members(process.pid) + descendants(process.pid))
+                           if command_of(pid) == "sleep"]
+            if self.r_pids:
                 break
             if process.poll() is not None:
                 self.fail("the report ended before it started R: " + process.stderr.read().decode())
+            if time.monotonic() > deadline:
+                process.kill()
+                self.fail(f"no R was started within {TIMEOUT_S} s")
             time.sleep(0.05)
+        self.addCleanup(lambda pids=self.r_pids: [os.kill(p, signal.SIGKILL) for p in pids if running(p)])
         return process
+
+    def assert_no_r_left(self, process):
+        """Neither the R found at the start nor anything else of the Python process's session runs."""
+        deadline = time.monotonic() + 5
+        while ((process_group_members(process.pid) or any(running(p) for p in self.r_pids))
+               and time.monotonic() < deadline):
+            time.sleep(0.05)
+        self.assertEqual(process_group_members(process.pid), [], "a process outlived the Python process")
+        self.assertEqual([p for p in self.r_pids if running(p)], [], "an R outlived the Python process")
 
     @heavy
     def test_sigkill_of_the_python_process_ends_its_r(self):
-        # The first R (asked whether lme4 is there) of a fit, as every report starts it.
+        # The first R of a fit (still loading its packages, which it never says it did), as every report starts it.
         fit = ("import pandas; from calligraphy import mixed_models; mixed_models.lmer(pandas.DataFrame("
                "{'y': [1.0, 2.0, 3.0], 'subject': ['a', 'b', 'c']}), 'y ~ 1 + (1 | subject)', {})")
         process = self.start(self.work / "killed", self.slow, [sys.executable, "-c", fit])
         process.kill()
         process.communicate(timeout=TIMEOUT_S)
-        deadline = time.monotonic() + 5
-        while process_group_members(process.pid) and time.monotonic() < deadline:
-            time.sleep(0.05)
-        self.assertEqual(process_group_members(process.pid), [], "an R outlived the Python process")
+        self.assert_no_r_left(process)
 
     @heavy
     def test_ctrl_c_while_r_is_slow_is_one_line_and_leaves_nothing(self):
@@ -868,10 +907,7 @@ class StudyReportProcess(unittest.TestCase):
         self.assertIn(process.returncode, (130, -signal.SIGINT), stderr)
         self.assertNotIn(b"Traceback", stderr)
         self.assertLessEqual(len(stderr.decode().strip().splitlines()), 1, stderr)
-        deadline = time.monotonic() + 5
-        while process_group_members(process.pid) and time.monotonic() < deadline:
-            time.sleep(0.05)
-        self.assertEqual(process_group_members(process.pid), [], "an R outlived the Python process")
+        self.assert_no_r_left(process)
         self.assertEqual(leftovers(out) if out.exists() else [], [])
 
     def test_usage_errors_name_the_option_before_any_work(self):

@@ -4,13 +4,14 @@ report for a paper", docs/python.md "The design's questions", docs/architecture.
 
 (1) The R process. A fake `Rscript` first on PATH (a small Python script in a temporary folder) misbehaves as a
 peer can: garbage, a reply twice, half a reply then its end, Latin-1 and UTF-16, a huge length, a long line, NaN,
-infinities, p > 1 and negative variances, a megabyte on standard error, an exit at once, not executable, a
-folder, a child that holds the pipe, no answer with SIGTERM ignored. `calligraphy.mixed_models.lmer` runs in
-this process against it: the fit alone fails (`RAnswerError` naming why, within seconds), every R started has
-ended, and the next fit is the fake's again; and in a Python of its own stopped by SIGTERM or SIGINT while R
-hangs (the serving R and the first R, which asks for the packages): no R outlives it, no traceback. The
-smallest study with a mixed model (three simulated subjects) asked its questions with its first R broken: that
-row alone is "not computed". No real R is needed: the fake answers as lme4 did once for the frame below.
+infinities, p > 1 and negative variances, a megabyte on standard error, an exit at once, not executable, a folder,
+a child that holds the pipe, no answer with SIGTERM ignored, a first frame naming a missing package.
+`calligraphy.mixed_models.lmer` runs in this process against it: the fit alone fails (`RAnswerError` naming why,
+within seconds), every R started has ended, and the next fit is the fake's again; and in a Python of its own
+stopped by SIGTERM or SIGINT while R hangs (fitting, or before its first frame, which says whether the packages
+load): no R outlives it, no traceback. The smallest study with a mixed model (three simulated subjects) asked its
+questions with its first R broken: that row alone is "not computed". No real R is needed: the fake answers as lme4
+did once for the frame below.
 
 (2) The journals of a set (`report --csv/--out`). A journal is what a run killed between two renames leaves
 (here killed by strace's fault injection, skipped saying so without strace); its form (a header with the
@@ -128,8 +129,9 @@ class Case(OneErrorLine, unittest.TestCase):
 
 
 # ---------------------------------------------------------------------------------------------------------
-# (1) The R process. The fake R below is a Python script named Rscript. Its first call (`Rscript --vanilla -e
-# ...`, which asks whether lme4, lmerTest and pbkrtest load) exits 0; the serving one (`lmer_fit.R --serve`)
+# (1) The R process. The fake R below is a Python script named Rscript, started as `lmer_fit.R --serve`. Its
+# first frame says whether lme4, lmerTest and pbkrtest load (`@@calligraphy-ready ok`, or `missing HEX(name)`
+# and an end, as the mode's "start" says; "hang" never says); then it
 # reads its requests one line each, `@@calligraphy-request N HEX(folder) HEX(formula) HEX(ddf)`, and answers as
 # the file MODE in its state folder says at that request: `good` writes the result files a real lme4 wrote for
 # the frame below (its intercept set to the mode's) and replies `@@calligraphy-reply N ok HEX(name=size;...)`;
@@ -145,11 +147,14 @@ def mode():
     with open(os.path.join(state, "mode")) as f:
         return json.load(f)
 m = mode()
-if "--serve" not in sys.argv:  # the first R: are lme4, lmerTest and pbkrtest there?
-    if m.get("probe") == "hang":
-        signal.signal(signal.SIGTERM, signal.SIG_IGN)
-        time.sleep(300)
-    sys.exit(0)
+# The first frame: do lme4, lmerTest and pbkrtest load?
+if m.get("start") == "hang":
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    time.sleep(300)
+elif m.get("start") == "missing":
+    os.write(1, f"@@calligraphy-ready missing {m['package'].encode().hex()}\n".encode())
+    sys.exit(3)
+os.write(1, b"@@calligraphy-ready ok\n")
 RESULTS = {
     "fixed.csv": '"term","estimate","std_error","df","t","p","ci95_low","ci95_high"\n'
                  '"(Intercept)",INTERCEPT,0.412918926065332,2.6516661721289,0.596265998603122,P,'
@@ -547,6 +552,22 @@ class RServing(unittest.TestCase):
         self.assertIn("Rscript is not installed", str(caught.exception))
         self.assert_good_fit()
 
+    def test_r_whose_first_frame_names_a_missing_package_is_r_not_installed_in_one_line(self):
+        """The serving R says at its start that pbkrtest does not load: RUnavailable (not a spoilt fit) naming
+        the package and its Debian name, that R ended, and the next R, whose packages load, answers."""
+        self.assert_good_fit()
+        self.fake.set(kind="exit")  # the serving R ends: the next fit starts one, which lacks the package
+        with self.assertRaises(mixed_models.RAnswerError):
+            self.fit()
+        self.fake.set(kind="good", start="missing", package="pbkrtest")
+        with self.assertRaises(mixed_models.RUnavailable) as caught:
+            self.fit()
+        self.assertNotIsInstance(caught.exception, mixed_models.RAnswerError)
+        self.assertEqual(str(caught.exception),
+                         "R's package pbkrtest is not installed (Debian: apt-get install r-cran-pbkrtest)")
+        self.fake.assert_none_alive(self)
+        self.assert_good_fit()
+
     def test_an_rscript_that_is_not_executable_is_r_not_installed(self):
         def make(path):
             shutil.copy(self.fake.script, path)
@@ -600,7 +621,7 @@ class RProcessLife(unittest.TestCase):
         self.fake.set(**mode)
         process = self.child()
         deadline = time.monotonic() + 20
-        stage = "--serve" if mode.get("kind") == "hang" else "-e"
+        stage = "--serve"  # one R both checks its packages and serves
         while True:
             started = [p for p in self.fake.pids() if alive(p)]
             if any(stage.encode() in Path(f"/proc/{p}/cmdline").read_bytes() for p in started if alive(p)):
@@ -627,7 +648,7 @@ class RProcessLife(unittest.TestCase):
         self.stopped(signal.SIGTERM, kind="hang", ignore_sigterm=True)
 
     def test_the_first_r_that_never_answers_is_stopped_with_python(self):
-        self.stopped(signal.SIGTERM, kind="good", probe="hang")
+        self.stopped(signal.SIGTERM, kind="good", start="hang")
 
 
 # ---------------------------------------------------------------------------------------------------------

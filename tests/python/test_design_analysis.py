@@ -244,7 +244,6 @@ def test_apa_sentences():
 
 def test_without_r_the_mixed_model_is_not_computed_and_says_why(monkeypatch):
     monkeypatch.setattr(mixed_models.shutil, "which", lambda name: None)
-    monkeypatch.setattr(mixed_models, "_R_CHECKED", [])
     questions = design_analysis.design_questions(between_study(10), "mean_deviation_m")
     training = questions[questions.phase == "training"]
     assert list(training.comparison) == [f"{g} - {GROUPS[0]}" for g in GROUPS[1:]] + [f"{GROUPS[2]} - {GROUPS[1]}"]

@@ -1,12 +1,16 @@
-"""calligraphy.mixed_models' one R process: a failed fit is an error naming the formula and R's message and
-leaves the process serving; a hung fit is stopped at the timeout and the next fit gets a new process; a forked
-child fits with its own process; every answer is the one-shot script's."""
+"""calligraphy.mixed_models' one R process: started once, its first frame the package check; a failed fit is an
+error naming the formula and R's message and leaves the process serving; a hung fit is stopped at the timeout
+and the next fit gets a new process; a forked child fits with its own process; every answer is the one-shot
+script's."""
 
 import multiprocessing
 import os
+import shlex
 import shutil
 import subprocess
+import sys
 import tempfile
+import textwrap
 
 import numpy as np
 import pandas
@@ -29,6 +33,36 @@ def frame(seed=1, subjects=8):
 
 def estimate(fit):
     return float(fit.fixed.set_index("term").loc["conditionb", "estimate"])
+
+
+def test_one_r_start_checks_the_packages_and_serves_every_fit(tmp_path):
+    """A Python process that asks r_available() and fits twice starts R once (a stand-in Rscript on PATH logs
+    each start, then runs the real one): the serving R's first frame is the package check. A process of its own,
+    as this one has R running and its check done already."""
+    log = tmp_path / "starts"
+    wrapper = tmp_path / "bin" / "Rscript"
+    wrapper.parent.mkdir()
+    wrapper.write_text(f'#!/bin/sh\necho "$*" >> {shlex.quote(str(log))}\n'
+                       f'exec {shlex.quote(shutil.which("Rscript"))} "$@"\n')
+    wrapper.chmod(0o755)
+    code = textwrap.dedent(f"""\
+        import pandas
+        from calligraphy import mixed_models
+        assert mixed_models.r_available()
+        for seed in (1, 2):
+            frame = pandas.read_csv({str(tmp_path / "frame")!r} + str(seed) + ".csv")
+            fit = mixed_models.lmer(frame, {FORMULA!r}, {{"condition": ["a", "b"]}})
+            print(fit.fixed.set_index("term").loc["conditionb", "estimate"])
+        """)
+    for seed in (1, 2):
+        frame(seed=seed).to_csv(tmp_path / f"frame{seed}.csv", index=False)
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300,
+                          env=dict(os.environ, PATH=f"{wrapper.parent}{os.pathsep}{os.environ['PATH']}"))
+    assert done.returncode == 0, done.stderr[-2000:]
+    estimates = [float(line) for line in done.stdout.split()]
+    assert len(estimates) == 2 and estimates[0] != estimates[1]  # two fits, each of its own data
+    starts = log.read_text().splitlines()
+    assert len(starts) == 1 and starts[0].endswith("lmer_fit.R --serve"), starts
 
 
 def test_the_served_fit_is_the_one_shot_scripts():

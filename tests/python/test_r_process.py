@@ -1,6 +1,7 @@
 """The R process behind calligraphy.mixed_models, attacked: a formula with line breaks or tabs is one request;
 an R that answers without its result files, in Latin-1, cut short, twice, out of protocol or not at all spoils
-only that fit (RAnswerError, "not computed" in a report) and the next fit gets a working R; R ends with a
+only that fit (RAnswerError, "not computed" in a report) and the next fit gets a working R; an R whose first
+frame names a missing package, that ends or stays silent before it, is R unavailable in one line; R ends with a
 Python killed by SIGTERM. A stand-in Rscript on PATH plays the broken R; the real R is used where it is
 installed."""
 
@@ -20,17 +21,34 @@ from calligraphy import design_analysis, mixed_models
 FORMULA = "outcome ~ condition + (1 | subject)"
 FACTORS = {"condition": ["a", "b"]}
 
-# Plays `Rscript --vanilla lmer_fit.R --serve` as the mode in CALLIGRAPHY_FAKE_R says. It answers the probe
-# (`Rscript --vanilla -e ...`) as an R with every package would. Its files hold the request's number as the
-# estimate, so a test sees which request an answer belongs to.
+# Plays `Rscript --vanilla lmer_fit.R --serve` as the mode in CALLIGRAPHY_FAKE_R says. Its first frame says
+# every package loads, but in the modes "start-*": no package, another's name, a broken frame, silence, or an
+# end before it. Its files hold the request's number as the estimate, so a test sees which request an answer
+# belongs to.
 FAKE_RSCRIPT = textwrap.dedent("""\
     #!/usr/bin/python3
     import os, sys, time
-    if "-e" in sys.argv:
-        sys.exit(0)
     mode = os.environ["CALLIGRAPHY_FAKE_R"]
     with open(os.environ["CALLIGRAPHY_FAKE_R_PID"], "w") as stream:
         stream.write(str(os.getpid()))
+    # A Latin-1 locale's chatter before the first frame, as R's own messages there are.
+    sys.stdout.buffer.write("Chargement requis : Matrix (d\u00e9j\u00e0)\\n".encode("latin-1"))
+    sys.stdout.flush()
+    if mode == "start-missing":
+        print("@@calligraphy-ready missing " + "lmerTest".encode().hex(), flush=True)
+        sys.exit(3)
+    elif mode == "start-odd-name":
+        print("@@calligraphy-ready missing " + "lme4; rm -rf /".encode().hex(), flush=True)
+        sys.exit(3)
+    elif mode == "start-garbage":
+        print("@@calligraphy-ready perhaps", flush=True)
+        time.sleep(600)
+    elif mode == "start-hang":
+        time.sleep(600)
+    elif mode == "start-die":
+        sys.stderr.write("Error: R could not load its base package\\n")
+        sys.exit(2)
+    print("@@calligraphy-ready ok", flush=True)
 
     def files(folder, number, encoding="utf-8", note="ok"):
         tables = {
@@ -96,7 +114,6 @@ def fake_r(tmp_path, monkeypatch):
     monkeypatch.setenv("PATH", f"{script.parent}{os.pathsep}{os.environ['PATH']}")
     monkeypatch.setenv("CALLIGRAPHY_FAKE_R_PID", str(tmp_path / "r.pid"))
     mixed_models._close_server()
-    monkeypatch.setattr(mixed_models, "_R_CHECKED", [])
 
     def mode(name):
         mixed_models._close_server()  # a new mode needs a new process
@@ -147,6 +164,65 @@ def test_a_hung_r_is_stopped_and_named(fake_r, monkeypatch):
         mixed_models.lmer(frame(), FORMULA, FACTORS)
 
 
+def test_a_missing_package_is_r_unavailable_in_one_line(fake_r, tmp_path):
+    """R's first frame names the package that does not load: the fit raises RUnavailable saying which and how to
+    install it (no fit was spoilt, so not RAnswerError), r_available() is False, and that R has ended."""
+    fake_r("start-missing")
+    with pytest.raises(mixed_models.RUnavailable) as caught:
+        mixed_models.lmer(frame(), FORMULA, FACTORS)
+    assert not isinstance(caught.value, mixed_models.RAnswerError)
+    assert str(caught.value) == "R's package lmerTest is not installed (Debian: apt-get install r-cran-lmertest)"
+    assert not running(r_pid_of(tmp_path))
+    assert not mixed_models.r_available()
+    fake_r("twice")
+    assert intercept(mixed_models.lmer(frame(), FORMULA, FACTORS)) == 1.0
+
+
+@pytest.mark.parametrize("mode, message", [
+    ("start-die", "Rscript ended before saying whether lme4, lmerTest and pbkrtest load: Error: R could not load "
+                  "its base package"),
+    ("start-garbage", "Rscript answered the question whether lme4, lmerTest and pbkrtest load out of protocol: "
+                      "'@@calligraphy-ready perhaps'"),
+    ("start-odd-name", "Rscript answered the question whether lme4, lmerTest and pbkrtest load out of protocol"),
+])
+def test_an_r_that_ends_or_garbles_its_first_frame_is_r_unavailable(fake_r, tmp_path, mode, message):
+    fake_r(mode)
+    with pytest.raises(mixed_models.RUnavailable) as caught:
+        mixed_models.lmer(frame(), FORMULA, FACTORS)
+    assert str(caught.value).startswith(message) and "\n" not in str(caught.value), str(caught.value)
+    assert not running(r_pid_of(tmp_path)), "the R that garbled its first frame was left running"
+    fake_r("twice")
+    assert intercept(mixed_models.lmer(frame(), FORMULA, FACTORS)) == 1.0
+
+
+def test_an_r_silent_at_its_start_is_stopped_and_named(fake_r, tmp_path, monkeypatch):
+    """An R that never says whether its packages load counts as R not installed after _START_TIMEOUT_S, ended;
+    the fit's own time-out is not what stops it."""
+    fake_r("start-hang")
+    monkeypatch.setattr(mixed_models, "_START_TIMEOUT_S", 0.5)
+    started = time.monotonic()
+    with pytest.raises(mixed_models.RUnavailable) as caught:
+        mixed_models.lmer(frame(), FORMULA, FACTORS)
+    assert time.monotonic() - started < 30
+    assert str(caught.value) == "Rscript did not answer within 0.5 s when asked for lme4, lmerTest and pbkrtest"
+    assert not running(r_pid_of(tmp_path))
+
+
+def test_an_r_whose_start_fails_before_it_runs_is_r_unavailable_not_a_wait(fake_r, monkeypatch):
+    """The child's set-up between fork and exec failing (subprocess's SubprocessError, not an OSError) is
+    "Rscript could not be run", at once."""
+    fake_r("twice")
+
+    def broken():
+        raise ValueError("no prctl here")
+
+    monkeypatch.setattr(mixed_models, "_keep_with_parent", broken)
+    started = time.monotonic()
+    with pytest.raises(mixed_models.RUnavailable, match="^Rscript could not be run: "):
+        mixed_models.lmer(frame(), FORMULA, FACTORS)
+    assert time.monotonic() - started < 30
+
+
 def test_line_breaks_and_tabs_in_a_formula_are_one_request(fake_r):
     fake_r("formula")
     formula = "outcome ~ condition\n  +\t(1 | subject)\n"
@@ -194,8 +270,7 @@ def test_r_ends_with_a_python_killed_by_sigterm(fake_r, tmp_path, in_thread):
                                    "outcome": [1.0, 2.0, 1.5, 2.5]}})
         fit = lambda: mixed_models.lmer(frame, "outcome ~ condition + (1 | subject)", {{"condition": ["a", "b"]}})
         if {in_thread}:
-            worker = threading.Thread(target=lambda: mixed_models._SERVER or mixed_models._SERVER.append(
-                mixed_models._RServer(mixed_models._check_r())))
+            worker = threading.Thread(target=mixed_models.r_available)  # starts the serving R
             worker.start()
             worker.join()
         fit()
@@ -216,9 +291,12 @@ def test_r_ends_with_a_python_killed_by_sigterm(fake_r, tmp_path, in_thread):
             python.kill()
 
 
-@pytest.mark.skipif(not mixed_models.r_available(), reason="R with lme4, lmerTest and pbkrtest is not installed")
 def test_real_r_fits_a_formula_written_over_lines_as_on_one():
-    mixed_models._close_server()
+    mixed_models._close_server()  # no stand-in left serving
+    # Asked here, not when the file is collected: the R that answers is the one that serves the fits below
+    # (the stand-ins' cases end any R running before them).
+    if not mixed_models.r_available():
+        pytest.skip("R with lme4, lmerTest and pbkrtest is not installed")
     one_line = mixed_models.lmer(frame(subjects=8), FORMULA, FACTORS)
     over_lines = mixed_models.lmer(frame(subjects=8), "outcome ~ condition +\n\t(1 | subject)", FACTORS)
     estimate = lambda fit: float(fit.fixed.set_index("term").loc["conditionb", "estimate"])
