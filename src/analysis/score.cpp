@@ -217,12 +217,12 @@ CharacterScore score_trace(const PlacedCharacter& character, std::span<const Pen
     }
     score.refusals.add(verdict.refusal);
     const bool lifted = segment.end < trace.size();
-    RefusedPenDown pen_down{.entered_ws = verdict.entered, .samples = positions[w].size()};
-    for (std::size_t i = 0; i < positions[w].size(); ++i) {
-      if (i > 0) pen_down.path_m += (positions[w][i] - positions[w][i - 1]).norm();
-      pen_down.in_character_box =
-          pen_down.in_character_box || character.bounding_box.contains(positions[w][i]);
-    }
+    const RefusedPenDown pen_down{
+        .entered_ws = verdict.entered,
+        .in_character_box = std::any_of(positions[w].begin(), positions[w].end(),
+                                        [&](const Vec2& p) { return character.bounding_box.contains(p); }),
+        .path_m = segment.kinematics->path_length_m,
+        .samples = positions[w].size()};
     if (!lifted || !options.acceptance.counts_as_miss(pen_down)) continue;
     misses += 1.0;
     if (assist_after > 0.0 && misses >= assist_after) {

@@ -132,7 +132,7 @@ bool StrokeAcceptance::centred_cover(double length_m, double way_along_m, double
 bool StrokeAcceptance::counts_as_miss(const RefusedPenDown& pen_down) const noexcept {
   if (!(miss_min_path_m > 0.0)) return pen_down.entered_ws;  // before version 8: every lift in WS, no other
   return (pen_down.entered_ws || pen_down.in_character_box) && pen_down.samples >= kMinMissSamples &&
-         pen_down.path_m > 0.0 && pen_down.path_m >= miss_min_path_m;
+         pen_down.path_m >= miss_min_path_m;
 }
 
 double StrokeAcceptance::allowed_mean_deviation_m(double length_m) const noexcept {

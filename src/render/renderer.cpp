@@ -150,7 +150,8 @@ void Renderer::reset() noexcept {
   writing_since_s_ = 0.0;
   off_stroke_velocity_ = Vec2::Zero();
   anchor_valid_ = false;
-  contact_ = PenDown{};
+  contact_ = RefusedPenDown{};
+  contact_tip_m_ = Vec2::Zero();
 }
 
 // F_et (eq. 8) with the taper at R_res and a rate-limited foot point, plus the resistance force, for
@@ -256,30 +257,26 @@ RenderOutput Renderer::tick(const DeviceState& device) noexcept {
   InteractionState next = next_state(state_, inputs);
   // The pen-down as a whole, from touch-down to lift: its path decides whether a refusal is a miss.
   if (next != InteractionState::separation) {
-    if (state_ == InteractionState::separation) contact_ = PenDown{.last_tip_m = tip};
-    contact_.path_m += (tip - contact_.last_tip_m).norm();
-    contact_.last_tip_m = tip;
-    ++contact_.ticks;
-    contact_.reached_writing = contact_.reached_writing || next == InteractionState::writing;
+    if (state_ == InteractionState::separation) {
+      contact_ = RefusedPenDown{};
+      contact_tip_m_ = tip;
+    }
+    contact_.path_m += (tip - contact_tip_m_).norm();
+    contact_tip_m_ = tip;
+    ++contact_.samples;
+    contact_.entered_ws = contact_.entered_ws || next == InteractionState::writing;
     contact_.in_character_box = contact_.in_character_box || inputs.inside_box;
   }
-  const auto pen_down = [&](bool entered_ws) {
-    return RefusedPenDown{.entered_ws = entered_ws,
-                          .in_character_box = contact_.in_character_box,
-                          .path_m = contact_.path_m,
-                          .samples = contact_.ticks};
-  };
   if (state_ == InteractionState::writing && next == InteractionState::separation) {
     // Lifting in WS ends the attempt: written when it reached the end neighbourhood, else abandoned and
     // the stroke's feature points reloaded (section 4.3.3).
-    const StrokeProgress lifted = active_.lift(active_.acceptance().counts_as_miss(pen_down(true)));
+    const StrokeProgress lifted = active_.lift(active_.acceptance().counts_as_miss(contact_));
     out.stroke_completed = lifted.stroke_completed;
     out.stroke_abandoned = !lifted.stroke_completed;
     out.refusal = lifted.refusal;
     out.stroke_assisted = lifted.stroke_assisted;
   } else if (state_ != InteractionState::separation && next == InteractionState::separation &&
-             !contact_.reached_writing && !active_.finished() &&
-             active_.acceptance().counts_as_miss(pen_down(false))) {
+             !contact_.entered_ws && !active_.finished() && active_.acceptance().counts_as_miss(contact_)) {
     // A pen-down that never came near the stroke's start (written beside it, or another stroke) is a miss
     // too, so that a learner who never finds the start is hinted and credited (no dead end).
     const StrokeProgress missed = active_.miss();

@@ -126,17 +126,10 @@ class Renderer {
   Vec2 off_stroke_anchor_ = Vec2::Zero();    // adhesion point of the off-stroke friction in CS
   bool anchor_valid_ = false;
   double off_stroke_alpha_ = 1.0;  // its filter coefficient per tick
-  // The pen-down under way, from the touch-down: its path and ticks, whether it entered WS (or wrote a
-  // stroke) and touched the active character's box; a refusal at its lift is a miss by
-  // StrokeAcceptance::counts_as_miss.
-  struct PenDown {
-    Vec2 last_tip_m = Vec2::Zero();
-    double path_m = 0.0;
-    std::size_t ticks = 0;
-    bool reached_writing = false;
-    bool in_character_box = false;
-  };
-  PenDown contact_;
+  // The pen-down under way, from the touch-down (its samples are ticks; entered WS also when it wrote a
+  // stroke without a lift): a refusal at its lift is a miss by StrokeAcceptance::counts_as_miss.
+  RefusedPenDown contact_;
+  Vec2 contact_tip_m_ = Vec2::Zero();  // where the pen-down's path reached last tick
   // Smoothing state.
   Vec2 rendered_foot_ = Vec2::Zero();  // attraction target, rate-limited towards the tracked foot
   bool foot_valid_ = false;
