@@ -216,10 +216,13 @@ def _fit_rows(frame: "pandas.DataFrame", fixed: list[str], base: dict, design: "
             ci95_high=float(effect.ci95_high) if trusted else math.nan, g=g, g_ci95_low=g_low, g_ci95_high=g_high,
             note=note))
     rows += design_models.absent_effect_rows(fit, "condition", levels, design.control, base, model=model)
-    return rows + design_models.pair_rows(
+    rows += design_models.pair_rows(
         fit, levels, design.control, {**base, "model": model}, note,
         lambda a, b: int(frame.loc[frame["condition"].isin([a, b]), "subject"].nunique()),
         lambda d, later, earlier: _g_av(d, frame[frame["condition"].isin([later, earlier])], later, earlier))
+    # A condition with no trial left keeps its comparisons, each saying so, as between and within subjects.
+    return design_models.with_absent_levels(rows, {**base, "model": model}, list(design.conditions), levels,
+                                            design.control, f"in {base['phase']} (after the exclusions)")
 
 
 def _family(value: str, phase: typing.Optional[str]) -> str:

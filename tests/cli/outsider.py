@@ -10,6 +10,7 @@ import select
 import shutil
 import subprocess
 import unittest
+from pathlib import Path
 
 SANITIZED = os.environ.get("CALLIGRAPHY_SANITIZED") == "1"
 CLI = os.environ.get("CALLIGRAPHY_CLI", "")
@@ -125,3 +126,30 @@ def strip_comment(line):
         elif ch == "#" and (i == 0 or line[i - 1] in " \t"):
             return line[:i].rstrip(), line[i + 1:].strip()
     return line.rstrip(), ""
+
+
+def descendants(pid):
+    """Every process below `pid`, by the parent ids of /proc, while they run (a process that starts a session
+    of its own, as the serving R does, is found by its parent, not by the session id)."""
+    children = {}
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                fields = Path(f"/proc/{entry}/stat").read_text().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            children.setdefault(int(fields[1]), []).append(int(entry))
+    found, stack = [], [pid]
+    while stack:
+        for child in children.get(stack.pop(), []):
+            found.append(child)
+            stack.append(child)
+    return found
+
+
+def running(pid):
+    """`pid` exists and has not ended (a zombie has)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False

@@ -30,6 +30,8 @@ import time
 import unittest
 from pathlib import Path
 
+from outsider import descendants, running
+
 CLI = os.environ.get("CALLIGRAPHY_CLI", "")
 TIMEOUT_S = 60
 SANITIZED = os.environ.get("CALLIGRAPHY_SANITIZED") == "1"
@@ -146,33 +148,6 @@ def process_group_members(sid):
         if int(stat[3]) == sid:  # the session id: every process the started one made, reparented or not
             members.append(int(entry))
     return members
-
-
-def descendants(pid):
-    """Every process below pid by parent links, while they run: the serving R starts a session of its own, so
-    the session id alone does not find it."""
-    parents = {}
-    for entry in os.listdir("/proc"):
-        if entry.isdigit():
-            try:
-                parents[int(entry)] = int(Path(f"/proc/{entry}/stat").read_text().rsplit(")", 1)[1].split()[1])
-            except OSError:
-                continue
-    found, frontier = [], [pid]
-    while frontier:
-        below = frontier.pop()
-        children = [child for child, parent in parents.items() if parent == below]
-        found += children
-        frontier += children
-    return found
-
-
-def running(pid):
-    """pid exists and has not ended (a zombie has)."""
-    try:
-        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
-    except OSError:
-        return False
 
 
 def command_of(pid):

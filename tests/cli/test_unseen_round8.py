@@ -27,6 +27,8 @@ import unittest
 import zlib
 from pathlib import Path
 
+from outsider import descendants, running
+
 CLI = os.environ.get("CALLIGRAPHY_CLI", "")
 TIMEOUT_S = 60
 SANITIZED = os.environ.get("CALLIGRAPHY_SANITIZED") == "1"
@@ -739,31 +741,6 @@ if __name__ == "__main__":
     print(os.getpid(), flush=True)
     sweep("永我九心", {"guidance": [True, False]}, seeds=500, workers=2, progress=False)
 """
-
-
-def descendants(pid):
-    """Every process below `pid`, by the parent ids of /proc."""
-    children = {}
-    for entry in os.listdir("/proc"):
-        if entry.isdigit():
-            try:
-                fields = Path(f"/proc/{entry}/stat").read_text().rsplit(")", 1)[1].split()
-            except OSError:
-                continue
-            children.setdefault(int(fields[1]), []).append(int(entry))
-    found, stack = [], [pid]
-    while stack:
-        for child in children.get(stack.pop(), []):
-            found.append(child)
-            stack.append(child)
-    return found
-
-
-def running(pid):
-    try:
-        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
-    except OSError:
-        return False
 
 
 @unittest.skipIf(cg is None, "the Python package is not on PYTHONPATH")

@@ -356,3 +356,52 @@ def test_a_mixed_design_has_its_group_in_every_model_and_tests_the_interaction()
     assert interaction["statistic"] == pytest.approx(f, rel=1e-5)
     assert interaction["df"] == pytest.approx(den_df, rel=1e-4)
     assert interaction["p"] == pytest.approx(p, rel=1e-4)
+
+
+def three_condition_crossover(seed, subjects=12):
+    """Three conditions in a Latin square (sequences ABC, BCA, CAB), each trained on its own set of three
+    characters, the sets rotated across subjects: a pre-test on every set, training by period, a post-test on
+    every set by the condition it trained."""
+    rng = np.random.default_rng(seed)
+    conditions = ("unguided", "amplify", "fixture")
+    sets = {"a": ("十", "人", "口"), "b": ("山", "中", "日"), "c": ("土", "八", "二")}
+    rows = []
+    for number in range(subjects):
+        order = [(number + k) % 3 for k in range(3)]
+        rotation = (number // 3) % 3
+        set_of = {conditions[c]: list(sets)[(c + rotation) % 3] for c in range(3)}
+        period_of = {conditions[c]: p + 1 for p, c in enumerate(order)}
+        skill = rng.normal(0.0, 0.5e-3)
+        trial = 0
+        for phase in ("pre-test", "training", "post-test"):
+            for condition in conditions:
+                if phase == "training":
+                    condition = conditions[order[conditions.index(condition)]]  # in the period's order
+                for character in sets[set_of[condition]]:
+                    trial += 1
+                    rows.append({"subject": f"S{number + 1:02d}", "session_number": 1, "block": trial, "trial": trial,
+                                 "phase": phase, "condition": condition if phase == "training" else "unguided",
+                                 "mode": "vision", "characters": character, "repetition": 1,
+                                 "item_set": set_of[condition], "sequence": "".join("ABC"[c] for c in order),
+                                 "period": float(period_of[condition]), "trained_condition": condition, "group": "",
+                                 "end_reason": "completed",
+                                 "mean_deviation_m": 3e-3 + skill + rng.normal(0.0, 0.4e-3)})
+    return pandas.DataFrame(rows)
+
+
+@needs_r
+def test_a_condition_with_no_trial_left_keeps_its_comparisons_saying_so():
+    """Every training trial of one of three conditions given up: the other two are still compared, and each
+    planned comparison of the missing one keeps its row, saying it has no values, as between subjects."""
+    trials = three_condition_crossover(5)
+    design = design_analysis.study_design(trials)
+    assert design.kind == "crossover" and list(design.conditions) == ["unguided", "amplify", "fixture"]
+    lost = (trials["phase"] == "training") & (trials["trained_condition"] == "fixture")
+    trials.loc[lost, "end_reason"] = "given_up"
+    questions = design_analysis.design_questions(trials, "mean_deviation_m", design)
+    training = questions[(questions["family"] == "mean_deviation_m, training")].set_index("comparison")
+    assert list(training.index) == ["amplify - unguided", "fixture - unguided", "fixture - amplify"]
+    assert math.isfinite(training.loc["amplify - unguided", "p"])
+    for comparison in ("fixture - unguided", "fixture - amplify"):
+        assert training.loc[comparison, "note"] == "not computed: no values of fixture in training (after the exclusions)"
+        assert math.isnan(training.loc[comparison, "p"])
