@@ -38,7 +38,7 @@ Outcome outcome(const Scene& scene, const WriterTrialOptions& options) {
   Outcome o;
   REQUIRE(score.totals.deviation.has_value());
   o.deviation_m = score.totals.deviation->mean_m;
-  o.time_s = score.totals.total_time_s;
+  o.time_s = score.totals.total_time_s.value_or(0.0);
   o.order_errors = score.order_errors;
   o.backwards = score.backwards_strokes;
   o.in_order = trial.metrics.completed_in_order;

@@ -26,7 +26,7 @@ Figures figures(const Scene& scene, const WriterTrialOptions& options) {
   const CharacterScore score = score_trace(scene.characters[0], pen);
   Figures f;
   f.deviation_mm = score.totals.deviation ? score.totals.deviation->mean_m * 1e3 : -1.0;
-  f.time_s = score.totals.total_time_s;
+  f.time_s = score.totals.total_time_s.value_or(0.0);
   f.order_errors = score.order_errors;
   f.backwards = score.backwards_strokes;
   f.in_order = trial.metrics.completed_in_order;

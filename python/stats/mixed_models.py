@@ -24,7 +24,6 @@ import dataclasses
 import io
 import os
 import pathlib
-import re
 import shutil
 import subprocess
 import tempfile
@@ -197,6 +196,7 @@ class _RServer:
 
     def _wait_ready(self, deadline: float) -> None:
         """R's first frame (lmer_fit.R): 'ok', or the first of lme4, lmerTest and pbkrtest that does not load."""
+        packages = ("lme4", "lmerTest", "pbkrtest")
         asked = "lme4, lmerTest and pbkrtest"
         while True:
             try:
@@ -221,8 +221,8 @@ class _RServer:
                     missing = bytes.fromhex(fields[1]).decode("ascii")
                 except (ValueError, UnicodeDecodeError):
                     pass
-            # R's package names are letters, digits and dots; anything else is no name to print.
-            if missing is None or not re.fullmatch(r"[A-Za-z][A-Za-z0-9.]*", missing):
+            # Only a package it was asked about: the frame names one of the three, never what to install.
+            if missing not in packages:
                 raise RUnavailable(f"Rscript answered the question whether {asked} load out of protocol: "
                                    f"{line[:200]!r}")
             raise RUnavailable(f"R's package {missing} is not installed (Debian: apt-get install "

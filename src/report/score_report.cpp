@@ -263,8 +263,8 @@ void append_character_table(std::string& out, const CharacterScore& score) {
   appendf(out, "  Frechet (worst stroke)     %s\n", fixed(t.frechet_m, 1e3, "%.3f", "mm").c_str());
   appendf(out, "  DTW (mean)                 %s\n", fixed(t.dtw_m, 1e3, "%.3f", "mm").c_str());
   appendf(out, "  pen lifts                  %zu\n", t.pen_lifts);
-  appendf(out, "  time                       %.2f s (pen down %.2f s, in the air %.2f s)\n", t.total_time_s,
-          t.writing_time_s, t.in_air_time_s);
+  appendf(out, "  time                       %s (pen down %.2f s, in the air %.2f s)\n",
+          fixed(t.total_time_s, 1.0, "%.2f", "s").c_str(), t.writing_time_s, t.in_air_time_s);
   appendf(out, "  mean speed                 %s\n", fixed(t.mean_speed_m_per_s, 1.0, "%.4f", "m/s").c_str());
   appendf(out, "  velocity peaks             %d\n", t.velocity_peaks);
   appendf(out, "  normalised jerk            %s\n", fixed(t.normalised_jerk, 1.0, "%.1f").c_str());
@@ -299,8 +299,8 @@ std::string score_table(const ScoreDescription& d, const WritingMetrics& metrics
             mm(metrics.deviation ? std::optional<double>(metrics.deviation->mean_m) : std::nullopt).c_str());
     appendf(out, "  Frechet (worst stroke)     %s\n", mm(metrics.frechet_m).c_str());
     appendf(out, "  DTW (mean)                 %s\n", mm(metrics.dtw_m).c_str());
-    appendf(out, "  time                       %.2f s (pen down %.2f s)\n", metrics.total_time_s,
-            metrics.pen_down_time_s);
+    appendf(out, "  time                       %s (pen down %.2f s)\n",
+            fixed(metrics.total_time_s, 1.0, "%.2f", "s").c_str(), metrics.pen_down_time_s);
   }
   return out;
 }

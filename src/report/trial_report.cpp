@@ -1,5 +1,6 @@
 #include "calligraphy/report/trial_report.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -80,8 +81,8 @@ void print_trial_table(const TrialDescription& d, const Scene& scene, const Tria
       static_cast<unsigned long long>(d.seed), d.rate_hz, d.device.c_str(), d.device_model.c_str());
   std::printf("\n  %-6s %-5s %-6s %-4s %9s %9s %11s %9s %9s %8s %9s\n", "stroke", "char", "type", "ID",
               "mean[mm]", "max[mm]", "Frechet[mm]", "DTW[mm]", "time[s]", "attempts", "completed");
-  // Strokes numbered over the scene; a person reads them from 1 (the files count from 0, as the renderer
-  // does).
+  // Strokes numbered within their character from 1, as `score` and the trainer number them (the files count
+  // from 0, as the renderer does); the renderer's per-stroke figures are over the scene.
   std::size_t scene_stroke = 0;
   for (const CharacterScore& character : writing.characters) {
     for (const StrokeScore& s : character.strokes) {
@@ -90,7 +91,7 @@ void print_trial_table(const TrialDescription& d, const Scene& scene, const Tria
       const StrokeMetrics* live = scene_stroke < m.per_stroke.size() ? &m.per_stroke[scene_stroke] : nullptr;
       char time_text[32] = "-";
       if (w) std::snprintf(time_text, sizeof time_text, "%.2f", w->kinematics.writing_time_s);
-      std::printf("  %-6zu %-5s %-6s %-4d %9s %9s %11s %9s %9s %8d %9s\n", scene_stroke + 1,
+      std::printf("  %-6zu %-5s %-6s %-4d %9s %9s %11s %9s %9s %8d %9s\n", s.index + 1,
                   encode_utf8(character.code_point).c_str(),
                   std::string(typical_stroke(s.typical_id).acronym).c_str(), s.typical_id,
                   millimetres(value([](auto& x) { return x.deviation.mean_m; }), 2).c_str(),
@@ -115,6 +116,12 @@ void print_trial_table(const TrialDescription& d, const Scene& scene, const Tria
   std::printf("  accepted in turn           %zu / %zu (order errors %zu, backwards %zu)\n",
               writing.strokes_accepted, writing.strokes_total, writing.order_errors,
               writing.backwards_strokes);
+  // A trial stopped with the pen down: the scoring judges that last pen-down at the trace's end, as if lifted
+  // there, where the renderer, which judges at a lift, gave it no verdict (docs/metrics.md).
+  const bool judged_at_end = std::any_of(writing.characters.begin(), writing.characters.end(), [&](const auto& c) {
+    return !c.segments.empty() && c.segments.back().end == result.trace.size() && c.segments.back().verdict;
+  });
+  if (judged_at_end) std::printf("                             (the last pen-down judged at the trial's end, not lifted)\n");
   // "-" without a unit: nothing was written, so there is no deviation to give.
   std::printf("  mean deviation             %s%s\n", millimetres(mean, 3).c_str(), mean ? " mm" : "");
   std::printf("  max deviation              %s%s\n", millimetres(max, 3).c_str(), max ? " mm" : "");
@@ -124,8 +131,10 @@ void print_trial_table(const TrialDescription& d, const Scene& scene, const Tria
               writing.dtw_m ? " mm" : "");
   // Named as `score` names the same trace's times: the total (first to last pen-down sample), then the
   // pen-down time, which docs/metrics.md calls the writing time.
-  std::printf("  time                       %.2f s (pen down %.2f s)\n", writing.total_time_s,
-              writing.pen_down_time_s);
+  // "-": the pen never touched, so there is no first or last pen-down sample to time.
+  char total_text[32] = "-";
+  if (writing.total_time_s) std::snprintf(total_text, sizeof total_text, "%.2f s", *writing.total_time_s);
+  std::printf("  time                       %s (pen down %.2f s)\n", total_text, writing.pen_down_time_s);
   std::printf("  trial time                 %.2f s\n", m.time_s);
   std::printf("  state transitions          %zu\n", m.state_transitions);
   std::printf("  max |F|                    %.3f N\n", m.max_force_n);

@@ -269,8 +269,8 @@ ReportTrial read_trial(const fs::path& json_file, const SessionManifest& manifes
   trial.block = plan.block + 1;
   trial.item = plan.item + 1;
   trial.repetition = plan.repetition;
-  trial.time_total_s = record.number("total_time_s", -1e12, 1e12);
   // null for a trial in which no stroke was written (the time ran out first): shown as such, not refused
+  trial.time_total_s = study_detail::record_metric(record, "total_time_s").value_or(std::nan(""));
   trial.mean_deviation_m = study_detail::record_metric(record, "mean_deviation_m").value_or(std::nan(""));
   trial.frechet_m = study_detail::record_metric(record, "frechet_m");
   trial.dtw_m = study_detail::record_metric(record, "dtw_m");

@@ -408,7 +408,7 @@ class SessionRun {
         trial_result.end == TrialEnd::gave_up || trial_result.end == TrialEnd::writer_finished;
     TrialOutcome outcome;
     outcome.end_reason = to_string(trial_result.end);
-    outcome.time_s = writing.total_time_s;
+    outcome.time_s = writing.total_time_s.value_or(std::nan(""));
     outcome.mean_deviation_mm = writing.deviation ? writing.deviation->mean_m * 1e3 : std::nan("");
     json details = trial_details(trial);
     details["end_reason"] = outcome.end_reason;

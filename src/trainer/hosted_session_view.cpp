@@ -65,7 +65,7 @@ void HostedSessionView::follow(QuizLog& quiz_log,
   if (s.outcome && !view_->have_result) {
     view_->have_result = true;
     view_->ended = true;
-    view_->metrics.time_s = s.outcome->time_s;
+    view_->metrics.time_s = std::isnan(s.outcome->time_s) ? 0.0 : s.outcome->time_s;  // nothing written: 0 s
     view_->metrics.strokes_completed = view_->snapshot.strokes_completed;
     view_->metrics.strokes_total = view_->snapshot.strokes_total;
     if (std::isfinite(s.outcome->mean_deviation_mm))

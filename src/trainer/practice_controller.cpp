@@ -269,7 +269,7 @@ void PracticeController::finish_trial(QuizLog& quiz_log) {
       writing.deviation ? std::optional<double>(writing.deviation->mean_m) : std::nullopt;
   view.metrics.max_deviation_m =
       writing.deviation ? std::optional<double>(writing.deviation->max_m) : std::nullopt;
-  view.metrics.time_s = writing.total_time_s;
+  view.metrics.time_s = writing.total_time_s.value_or(0.0);
   view.end_reason = result.abort_reason;
   if (result.end == TrialEnd::device_fault || result.end == TrialEnd::watchdog) failed_ = true;
   adapt_guidance(view);

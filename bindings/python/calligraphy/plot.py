@@ -130,8 +130,9 @@ def trial(result: TrialResult, scene: Scene | None = None, ax: matplotlib.axes.A
     ax.set_ylabel("y [mm]")
     m = result.metrics
     deviation = "-" if m["mean_deviation_m"] is None else f"{m['mean_deviation_m'] * 1e3:.2f} mm"
+    time = "-" if m["total_time_s"] is None else f"{m['total_time_s']:.1f} s"  # None: the pen never touched
     title = (f"{m['character']}: {m['strokes_completed']}/{m['strokes_total']} strokes, mean deviation "
-             f"{deviation}, {m['total_time_s']:.1f} s")
+             f"{deviation}, {time}")
     ax.set_title(title, **_text_font(title))
     return ax
 

@@ -33,7 +33,8 @@ struct WritingMetrics {
   std::optional<DeviationSummary> deviation;
   std::optional<double> frechet_m;  ///< max over matched strokes [m]
   std::optional<double> dtw_m;      ///< mean over matched strokes weighted by their sample counts [m]
-  double total_time_s = 0.0;        ///< first pen-down sample to last pen-down sample [s]
+  /// First pen-down sample to last pen-down sample [s]; absent when the pen never touched (no such time).
+  std::optional<double> total_time_s;
   double pen_down_time_s = 0.0;     ///< sum over pen-down segments of t_last - t_first [s]
   int velocity_peaks = 0;           ///< fluency: velocity peaks summed over scored segments
   /// Fluency: normalised jerk (dimensionless) averaged over scored segments; absent without one.

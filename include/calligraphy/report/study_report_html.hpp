@@ -49,7 +49,7 @@ struct ReportTrial {
   std::vector<bool> pen_down;                  ///< the tip touched the paper
   std::vector<double> in_plane_force_n;        ///< |(Fx, Fy)| commanded [N]
   std::vector<ReportStrokeSpan> strokes;
-  double time_total_s = 0.0;        ///< the trial's writing time [s]
+  double time_total_s = 0.0;        ///< the trial's writing time [s]; NaN when the pen never touched
   double mean_deviation_m = 0.0;    ///< the trial's mean deviation [m]; NaN when it wrote no stroke
   std::optional<double> frechet_m;  ///< [m]
   std::optional<double> dtw_m;      ///< [m]

@@ -29,7 +29,7 @@ namespace calligraphy {
 struct TrialOutcome {
   std::string end_reason;          ///< TrialEnd as text
   bool saved = false;              ///< saved as the trial (else kept as an attempt)
-  double time_s = 0.0;             ///< writing time, first to last pen-down sample [s] (total_time_s)
+  double time_s = 0.0;             ///< first to last pen-down sample [s] (total_time_s); NaN: the pen never touched
   double mean_deviation_mm = 0.0;  ///< NaN when no stroke was written
   std::string json_file;           ///< the saved trial's or the attempt's JSON
 };
