@@ -152,6 +152,11 @@ const nlohmann::json* ObjectReader::optional(const std::string& key) {
   return found->is_null() ? nullptr : &*found;
 }
 
+bool ObjectReader::is_null(const std::string& key) const {
+  const auto found = value_.find(key);
+  return found != value_.end() && found->is_null();
+}
+
 void ObjectReader::finish() const {
   for (const auto& item : value_.items()) {
     if (read_.count(item.key()) == 0) fail(source_, pointer(item.key()), "unknown key");

@@ -31,6 +31,8 @@ class ObjectReader {
   const nlohmann::json& required(const std::string& key);
   /// The member, or nullptr when it is missing (or null).
   const nlohmann::json* optional(const std::string& key);
+  /// Member `key` is given as null.
+  [[nodiscard]] bool is_null(const std::string& key) const;
   /// The pointer of member `key`.
   [[nodiscard]] std::string pointer(const std::string& key) const;
   [[nodiscard]] const std::string& pointer() const { return pointer_; }

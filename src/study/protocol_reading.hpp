@@ -95,6 +95,11 @@ Enum choice(json_detail::ObjectReader& reader, const std::string& key, const std
 inline void read_member(json_detail::ObjectReader& reader, const Schema& schema, const std::string& key,
                         void* object, bool required = false) {
   const SchemaField* field = schema.field(key);
+  // A key given null is refused naming it (docs/experiments.md, "Protocol files"): null is no value, and
+  // leaving the key out is how its default is asked for.
+  if (reader.is_null(key)) {
+    json_detail::fail(reader.source(), reader.pointer(key), "null is not a value (leave the key out for its default)");
+  }
   const nlohmann::json* value = required ? &reader.required(key) : reader.optional(key);
   if (field == nullptr || value == nullptr) return;
   schema_detail::read_field(schema, *field, object, *value, reader.pointer(key), reader.source());

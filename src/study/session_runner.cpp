@@ -227,6 +227,9 @@ class SessionRun {
   void begin() {
     // Refused before the first trial rather than found when a trial cannot be saved.
     session_.check_writable();
+    // The series' chain checked (a day before edited or replaced is refused) before the log is written to:
+    // a refused run writes nothing.
+    if (learning_) memory_ = study_detail::remembered(session_);
     result_.planned = session_.plan().size();
     result_.saved_before = session_.saved_count();
     const std::optional<std::size_t> first = session_.next_unsaved();
@@ -236,7 +239,6 @@ class SessionRun {
                       {"next_trial", first ? json(*first + 1) : json(nullptr)},
                       {"library", library_build().version}}
                      .dump());
-    if (learning_) memory_ = study_detail::remembered(session_);
   }
 
   // The break before `trial` (logged; waited for with a person); false when the run is to stop.
