@@ -66,7 +66,7 @@ Run run_trial(const Scene& scene, const WriterProfile& profile, bool guidance, s
   run.seed = seed;
   run.deviation_mm = score.totals.deviation ? score.totals.deviation->mean_m * 1e3 : std::nan("");
   run.renderer_deviation_mm = result.metrics.mean_deviation_m.value_or(std::nan("")) * 1e3;
-  run.time_s = score.totals.total_time_s;
+  run.time_s = score.totals.total_time_s.value_or(std::nan(""));  // NaN: the pen never touched
   run.order_errors = score.order_errors;
   run.backwards = score.backwards_strokes;
   run.in_order = result.metrics.completed_in_order;
