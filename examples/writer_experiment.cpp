@@ -9,10 +9,10 @@
 // characters are every N-th code point of the CJK Unified Ideographs block (U+4E00-U+9FFF) in the
 // folder, leaving out the embedded set, up to --count. Novice and foreign profiles, seeds 1..S.
 #include <algorithm>
+#include <calligraphy/analysis/score.hpp>
 #include <calligraphy/model/character_library.hpp>
 #include <calligraphy/model/scene.hpp>
 #include <calligraphy/sim/simulated_hand.hpp>
-#include <calligraphy/analysis/score.hpp>
 #include <calligraphy/trial/trial.hpp>
 #include <cmath>
 #include <cstdio>

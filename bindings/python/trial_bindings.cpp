@@ -626,7 +626,7 @@ force stays). guidance_mode: 'fixed' (eq. 8), 'fading' (eq. 8 times guidance_gai
 (docs/force-rendering.md, "Guidance modes"); None keeps force_law's, or 'replay' when a teacher is given.
 teacher: a TeacherRecording of the same characters (record_teacher) or a list of TeacherSample.
 rate_hz: servo rate [Hz], 100..100000. seed: int >= 0. max_duration_s: simulated time limit [s],
-> 0, at most 10^7 ticks (rate_hz * max_duration_s).
+> 0, at most 86400 s (a day) and 10^7 ticks (rate_hz * max_duration_s).
 hint_after_misses, assist_after_misses: refused attempts at a stroke after which it is shown as a hint,
 and after which it is demonstrated and credited as assisted (ints in 0..1000, 0: never; None
 keeps force_law's acceptance's, 3 and 5 by default), as `calligraphy trial --hint-after-misses N

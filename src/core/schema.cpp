@@ -7,6 +7,7 @@
 
 #include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/sha256.hpp"
 #include "core/utc_time.hpp"
 
 namespace calligraphy {
@@ -165,6 +166,8 @@ void check_schema(const Schema& schema, const void* object) {
 
 void SchemaField::check_string(std::string_view text) const {
   if (string_format == StringFormat::utc_time) (void)utc_seconds(text);
+  if (string_format == StringFormat::sha256 && !text.empty() && !is_sha256_hex(text))
+    throw InvalidArgument("expected 64 lower-case hex digits (a SHA-256) or \"\"");
 }
 
 void set_field_from_text(const SchemaField& field, void* object, std::string_view text) {

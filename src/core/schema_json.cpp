@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/schema.hpp"
@@ -217,6 +218,38 @@ ordered_json struct_schema(const Schema& schema, ordered_json& defs, bool all_re
   return out;
 }
 
+// The versions in which fields were added anywhere in `schema` (SchemaField::since_version), through its
+// objects and lists of objects; `seen` guards a struct met inside itself.
+void added_versions(const Schema& schema, std::set<int>& versions, std::set<const Schema*>& seen) {
+  if (!seen.insert(&schema).second) return;
+  for (const SchemaField& field : schema.fields) {
+    if (field.since_version > 0 && !field.omissible) versions.insert(field.since_version);
+    if (field.kind == FieldKind::object || field.kind == FieldKind::object_list)
+      added_versions(*field.nested(), versions, seen);
+  }
+}
+
+// What a document of `version` or later must hold that an older one may lack: the fields added in `version`
+// where they are, as a JSON Schema (`required` at each level, `properties` down to it); empty when none.
+ordered_json added_in(const Schema& schema, int version, std::set<const Schema*>& path) {
+  ordered_json out = ordered_json::object();
+  if (!path.insert(&schema).second) return out;
+  ordered_json required = ordered_json::array();
+  ordered_json properties = ordered_json::object();
+  for (const SchemaField& field : schema.fields) {
+    if (field.since_version == version && !field.omissible) required.push_back(std::string(field.name));
+    if (field.kind != FieldKind::object && field.kind != FieldKind::object_list) continue;
+    ordered_json nested = added_in(*field.nested(), version, path);
+    if (nested.empty()) continue;
+    properties[std::string(field.name)] =
+        field.kind == FieldKind::object ? nested : ordered_json{{"items", std::move(nested)}};
+  }
+  path.erase(&schema);
+  if (!required.empty()) out["required"] = std::move(required);
+  if (!properties.empty()) out["properties"] = std::move(properties);
+  return out;
+}
+
 std::string def_reference(const Schema& schema, ordered_json& defs, bool all_required) {
   const std::string name(schema.name);
   if (!defs.contains(name)) {
@@ -265,6 +298,8 @@ ordered_json field_schema(const SchemaField& field, const void* defaults, ordere
         out["format"] = "date-time";  // RFC 3339's, narrowed by the pattern to UTC with a Z
         out["pattern"] = std::string(kUtcTimePattern);
       }
+      if (field.string_format == StringFormat::sha256) out["pattern"] = "^([0-9a-f]{64})?$";
+      if (field.string_format == StringFormat::constant) out["const"] = value_json(field, defaults);
       break;
     case FieldKind::object:
       out = {{"$ref", def_reference(*field.nested(), defs, all_required)}};
@@ -354,6 +389,11 @@ void from_json(const Schema& schema, void* object, const json& document, const s
       json_detail::fail(source, at,
                         "null is not a value (" + owner + "." + key + ": " + field.description() + ")");
     }
+    if (field.string_format == StringFormat::constant && schema.defaults != nullptr) {
+      const std::string& expected = field.get_string(schema.defaults());
+      if (!found->is_string() || found->get_ref<const std::string&>() != expected)
+        json_detail::fail(source, at, "expected \"" + expected + "\", got " + json_detail::describe(*found));
+    }
     read_value(field, owner, object, *found, at, source, options, result);
   }
   if (schema.check_rules != nullptr) {
@@ -387,6 +427,23 @@ std::string json_schema_text(const Schema& schema, std::string_view id, std::str
                        {"title", std::string(title)}};
   ordered_json body = struct_schema(schema, defs, all_required);
   for (auto& [key, value] : body.items()) root[key] = value;
+  // A document that holds every field (a record) holds those its version has: one condition on the root's
+  // `version` per version that added fields, requiring them where they are, as the reader does
+  // (SchemaReadOptions::version).
+  if (all_required && schema.field("version") != nullptr) {
+    std::set<int> versions;
+    std::set<const Schema*> seen;
+    added_versions(schema, versions, seen);
+    ordered_json conditions = ordered_json::array();
+    for (const int version : versions) {
+      std::set<const Schema*> path;
+      conditions.push_back({{"if",
+                             {{"properties", {{"version", {{"minimum", version}}}}},
+                              {"required", ordered_json::array({"version"})}}},
+                            {"then", added_in(schema, version, path)}});
+    }
+    if (!conditions.empty()) root["allOf"] = std::move(conditions);
+  }
   if (!defs.empty()) root["$defs"] = std::move(defs);
   return root.dump(2) + "\n";
 }

@@ -9,8 +9,9 @@ namespace calligraphy {
 
 double utc_seconds(std::string_view iso8601) {
   // YYYY-MM-DDTHH:MM:SS, an optional fraction of one or more digits, then Z: a time of the calendar (a day
-  // its month has, 2028-02-29 but not 2027-02-29; hours 00-23, minutes 00-59, seconds 00-60 with a leap
-  // second), never normalised into another (timegm would read 2027-02-29 as 2027-03-01).
+  // its month has, 2028-02-29 but not 2027-02-29; hours 00-23, minutes 00-59, seconds 00-59, or 60 as a leap
+  // second at 23:59 of a month's last day), never normalised into another (timegm would read 2027-02-29 as
+  // 2027-03-01).
   const auto fail = [&iso8601]() -> double {
     throw InvalidArgument(
         "'" + std::string(iso8601) +
@@ -51,6 +52,10 @@ double utc_seconds(std::string_view iso8601) {
       hour > 23 || minute > 59 || second > 60) {
     return fail();
   }
+  // A leap second is the last second of a month's last day, 23:59:60 (RFC 3339, section 5.7): second 60 at
+  // any other time is a time the calendar lacks.
+  const int last_day = kDays[month - 1] + (month == 2 && leap ? 1 : 0);
+  if (second == 60 && (day != last_day || hour != 23 || minute != 59)) return fail();
   std::tm utc{};
   utc.tm_year = year - 1900;
   utc.tm_mon = month - 1;

@@ -118,10 +118,13 @@ void print_trial_table(const TrialDescription& d, const Scene& scene, const Tria
               writing.backwards_strokes);
   // A trial stopped with the pen down: the scoring judges that last pen-down at the trace's end, as if lifted
   // there, where the renderer, which judges at a lift, gave it no verdict (docs/metrics.md).
-  const bool judged_at_end = std::any_of(writing.characters.begin(), writing.characters.end(), [&](const auto& c) {
-    return !c.segments.empty() && c.segments.back().end == result.trace.size() && c.segments.back().verdict;
-  });
-  if (judged_at_end) std::printf("                             (the last pen-down judged at the trial's end, not lifted)\n");
+  const bool judged_at_end =
+      std::any_of(writing.characters.begin(), writing.characters.end(), [&](const auto& c) {
+        return !c.segments.empty() && c.segments.back().end == result.trace.size() &&
+               c.segments.back().verdict;
+      });
+  if (judged_at_end)
+    std::printf("                             (the last pen-down judged at the trial's end, not lifted)\n");
   // "-" without a unit: nothing was written, so there is no deviation to give.
   std::printf("  mean deviation             %s%s\n", millimetres(mean, 3).c_str(), mean ? " mm" : "");
   std::printf("  max deviation              %s%s\n", millimetres(max, 3).c_str(), max ? " mm" : "");

@@ -98,7 +98,8 @@ inline void read_member(json_detail::ObjectReader& reader, const Schema& schema,
   // A key given null is refused naming it (docs/experiments.md, "Protocol files"): null is no value, and
   // leaving the key out is how its default is asked for.
   if (reader.is_null(key)) {
-    json_detail::fail(reader.source(), reader.pointer(key), "null is not a value (leave the key out for its default)");
+    json_detail::fail(reader.source(), reader.pointer(key),
+                      "null is not a value (leave the key out for its default)");
   }
   const nlohmann::json* value = required ? &reader.required(key) : reader.optional(key);
   if (field == nullptr || value == nullptr) return;

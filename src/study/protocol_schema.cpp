@@ -304,14 +304,14 @@ ordered_json phase_schema() {
                               {"uniqueItems", true},
                               {"items", label_schema(study_detail::kMaxLabelLength, "a condition's name")}};
   properties["assignment"] = schema_property(settings, "assignment");
+  ordered_json choice = object_schema(
+      {{"choose", integer_schema(1, static_cast<std::int64_t>(study_detail::kMaxItems), "characters chosen")},
+       {"from", items_schema("single characters to choose from, in order of preference")}},
+      "characters chosen when a session is made");
+  choice["required"] = ordered_json::array({"choose", "from"});  // as the reader requires both
   properties["characters"] = {
       {"description", "the strings written, or (transfer) a choice by typical-stroke coverage"},
-      {"oneOf",
-       {items_schema("each string written in one trial"),
-        object_schema({{"choose", integer_schema(1, static_cast<std::int64_t>(study_detail::kMaxItems),
-                                                 "characters chosen")},
-                       {"from", items_schema("single characters to choose from, in order of preference")}},
-                      "characters chosen when a session is made")}}};
+      {"oneOf", {items_schema("each string written in one trial"), std::move(choice)}}};
   properties["sets"] = {{"type", "array"},
                         {"description", "names of item sets whose items the phase writes"},
                         {"minItems", 1},

@@ -175,7 +175,8 @@ const Schema& SchemaOf<trial_detail::RecordedScene>::get() {
   using S = trial_detail::RecordedScene;
   static const std::vector<SchemaField> fields{
       object_field<&S::layout>("layout", {.doc = "where the characters were placed"}),
-      string_field<&S::sha256>("sha256", {.doc = "SHA-256 of the placed characters (hex)"}),
+      string_field<&S::sha256>(
+          "sha256", {.doc = "SHA-256 of the placed characters (hex)", .format = StringFormat::sha256}),
   };
   static const Schema schema{.name = "RecordedScene",
                              .doc = "the scene the trial ran on",
@@ -187,7 +188,7 @@ const Schema& SchemaOf<trial_detail::RecordedScene>::get() {
 const Schema& SchemaOf<trial_detail::RecordDocument>::get() {
   using R = trial_detail::RecordDocument;
   static const std::vector<SchemaField> fields{
-      string_field<&R::format>("format", {.doc = "\"calligraphy-trial-specification\""}),
+      string_field<&R::format>("format", {.doc = "the format's name", .format = StringFormat::constant}),
       integer_field<&R::version>("version", kOldestRecordedTrialVersion, kRecordedTrialVersion,
                                  {.doc = "the format's version"}),
       object_field<&R::trial>("trial", {.doc = "the trial as stated, its outputs cleared"}),
@@ -205,7 +206,8 @@ const Schema& SchemaOf<trial_detail::RecordDocument>::get() {
                    {.doc = "lower-case hex SHA-256 of the teacher's recording a replay ran on, "
                            "checked when it is re-run; required when the replay names its file "
                            "(/trial/teacher); empty: no file was read (a teacher given as samples)",
-                    .source = "FIPS 180-4"})),
+                    .source = "FIPS 180-4",
+                    .format = StringFormat::sha256})),
   };
   static const Schema schema{.name = "RecordedTrial",
                              .doc = "a trial as it ran, whole: what `calligraphy trial --spec` runs again",

@@ -13,6 +13,7 @@
 #include "calligraphy/render/force_law.hpp"
 #include "calligraphy/render/passivity.hpp"
 #include "calligraphy/render/safety_chain.hpp"
+#include "calligraphy/trial/recorded_trial.hpp"
 #include "calligraphy/trial/trial_spec.hpp"
 #include "calligraphy/trial/writer_profile.hpp"
 
@@ -28,8 +29,8 @@ struct RecordedScene {
 
 /// The specification object of a trial record as its JSON lays it out.
 struct RecordDocument {
-  std::string format;
-  std::int64_t version = 0;
+  std::string format = std::string(kRecordedTrialFormat);  // the schema's constant and default
+  std::int64_t version = kRecordedTrialVersion;
   TrialSpec trial;
   ForceLawParameters force_law;
   SafetyChainParameters safety;

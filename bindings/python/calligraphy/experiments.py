@@ -248,6 +248,9 @@ def _character_labels(characters: typing.Any, library: CharacterLibrary) -> list
         return list(library.characters())
     if isinstance(characters, str):
         return list(characters)
+    if isinstance(characters, (bytes, bytearray)) or not isinstance(characters, collections.abc.Iterable):
+        raise TypeError(f"characters: expected a str or a list of non-empty str, got "
+                        f"{type(characters).__name__} {characters!r}")
     labels = list(characters)
     for label in labels:
         if not isinstance(label, str) or not label:
@@ -267,7 +270,10 @@ def _seed_list(seeds: typing.Any) -> list[int]:
     if not values:
         raise ValueError("seeds: no seeds")
     for seed in values:
-        if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0 or seed > _MAX_SEED:
+        if not isinstance(seed, int) or isinstance(seed, bool):  # 1.5, "1", True: of the wrong type
+            raise TypeError(f"seeds: expected ints in 0..{_MAX_SEED} (0..2**64-1), got {type(seed).__name__} "
+                            f"{seed!r}")
+        if seed < 0 or seed > _MAX_SEED:
             raise ValueError(f"seeds: expected ints in 0..{_MAX_SEED} (0..2**64-1), got {seed!r}")
     return values
 

@@ -224,7 +224,7 @@ struct CharacterWritingMetrics {
   double in_air_time_s = 0.0;       ///< sum of the gaps: t_first(next segment) - t_last(segment) [s]
   /// First pen-down sample to last pen-down sample = writing + in air [s]; absent without a pen-down.
   std::optional<double> total_time_s;
-  double path_length_m = 0.0;       ///< pen-down path length, all segments [m]
+  double path_length_m = 0.0;                ///< pen-down path length, all segments [m]
   std::optional<double> mean_speed_m_per_s;  ///< path_length_m / writing_time_s, absent for zero time
   int velocity_peaks = 0;                    ///< sum over the scored segments
   std::optional<double> normalised_jerk;     ///< mean over the scored segments

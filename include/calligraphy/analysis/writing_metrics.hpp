@@ -35,8 +35,8 @@ struct WritingMetrics {
   std::optional<double> dtw_m;      ///< mean over matched strokes weighted by their sample counts [m]
   /// First pen-down sample to last pen-down sample [s]; absent when the pen never touched (no such time).
   std::optional<double> total_time_s;
-  double pen_down_time_s = 0.0;     ///< sum over pen-down segments of t_last - t_first [s]
-  int velocity_peaks = 0;           ///< fluency: velocity peaks summed over scored segments
+  double pen_down_time_s = 0.0;  ///< sum over pen-down segments of t_last - t_first [s]
+  int velocity_peaks = 0;        ///< fluency: velocity peaks summed over scored segments
   /// Fluency: normalised jerk (dimensionless) averaged over scored segments; absent without one.
   std::optional<double> normalised_jerk;
 };

@@ -108,6 +108,8 @@ enum class FieldKind : std::uint8_t {
 enum class StringFormat : std::uint8_t {
   any,       ///< any text
   utc_time,  ///< a time of the calendar in UTC, "2024-05-01T12:34:56.789Z" (ISO 8601, the fraction optional)
+  sha256,    ///< a SHA-256 as 64 lower-case hex digits (FIPS 180-4), or empty: none
+  constant,  ///< the field's default and nothing else: a format's name, which a reader checks first
 };
 
 /// The JSON name of a kind: "number", "integer", "boolean", "enumeration", "string", "object", ...

@@ -27,9 +27,9 @@ namespace calligraphy {
 
 /// What a saved trial came to, for the host.
 struct TrialOutcome {
-  std::string end_reason;          ///< TrialEnd as text
-  bool saved = false;              ///< saved as the trial (else kept as an attempt)
-  double time_s = 0.0;             ///< first to last pen-down sample [s] (total_time_s); NaN: the pen never touched
+  std::string end_reason;  ///< TrialEnd as text
+  bool saved = false;      ///< saved as the trial (else kept as an attempt)
+  double time_s = 0.0;     ///< first to last pen-down sample [s] (total_time_s); NaN: the pen never touched
   double mean_deviation_mm = 0.0;  ///< NaN when no stroke was written
   std::string json_file;           ///< the saved trial's or the attempt's JSON
 };
