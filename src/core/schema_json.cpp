@@ -330,7 +330,7 @@ ordered_json field_schema(const SchemaField& field, const void* defaults, ordere
   out["description"] = describe_field(field);
   // A time has no default a document could take (the struct's is empty, no time): none is stated.
   if (field.kind != FieldKind::object_list && field.kind != FieldKind::variant &&
-      (field.kind != FieldKind::object || field.nullable) && field.string_format == StringFormat::any)
+      (field.kind != FieldKind::object || field.nullable) && field.string_format != StringFormat::utc_time)
     out["default"] = value_json(field, defaults);
   if (field.kind == FieldKind::object_list) out["default"] = ordered_json::array();
   return out;

@@ -411,7 +411,7 @@ TeacherFile read_recorded_teacher(const RecordedTrial& recorded, const std::file
   if (!recorded.teacher_sha256.empty() && sha256 != recorded.teacher_sha256) {
     throw DataError(path.string() + ": SHA-256 " + sha256 +
                     ", but the replay ran on a teacher's recording of SHA-256 " + recorded.teacher_sha256 +
-                    " (as the record names it): give the recording it ran on (--teacher)");
+                    " (the record's teacher_sha256): give the recording it ran on (--teacher)");
   }
   return {parse_teacher_recording(bytes, path.string()), sha256};
 }
