@@ -475,6 +475,12 @@ PyTrialResult rerun_trial_py(const py::object& record,
   TrialRunInputs inputs;
   inputs.registry = &python_device_registry();
   inputs.host_process = true;
+  if (teacher && !(recorded.spec.guidance_mode == GuidanceMode::replay && recorded.spec.guidance)) {
+    // As `trial --spec RECORD --teacher FILE` refuses it: a teacher given to a trial that replays none.
+    throw InvalidArgument(
+        "teacher: the record's trial is not a replay (guidance " +
+        std::string(recorded.spec.guidance ? to_string(recorded.spec.guidance_mode) : "off") + ")");
+  }
   if (recorded.spec.guidance_mode == GuidanceMode::replay && recorded.spec.guidance) {
     if (teacher) {
       inputs.teacher = teacher_samples(teacher->object, recorded.spec.characters);
@@ -670,8 +676,8 @@ session folder; a `trial --json` record: its --teacher, a relative name from the
 TrialResult. Raises DataError naming the record and the JSON pointer of a value at fault, a record without a
 specification (written before records held one) or of another version, or a teacher's file that cannot be
 read or is not the recording the replay ran on (naming it and both SHA-256); InvalidArgument when the
-characters placed are not the recorded ones (other character data), or a replay naming no teacher's file
-given none;
+characters placed are not the recorded ones (other character data), a replay naming no teacher's file
+given none, or a teacher given to a trial that is not a replay (as `trial --spec RECORD --teacher FILE`);
 CharacterNotFound; TypeError for a record of another type or its JSON text given as a path. Warns
 (RuntimeWarning) when a simulated writer's re-run gives other figures than the run the record states: the
 record changed since it was written (a seed past 2^53 rounded by a tool), or another library.)");

@@ -510,7 +510,14 @@ def _paired_rows(data: pandas.DataFrame, value: str, design: StudyDesign) -> lis
             "model": "subject means per condition", "question": f"{phase}: condition against the control "
             "(paired, within subjects)"}
     rows = []
+    present = set(rows_of.loc[rows_of[value].notna(), "condition"].astype(str))
     for level in design.conditions[1:]:
+        absent = [c for c in (level, design.control) if c not in present]
+        if absent:  # every trial excluded or missing: said as the models say it, not as the helper's error
+            rows.append(_row(**base, comparison=f"{level} - {design.control}",
+                             note=f"not computed: no values of {' or '.join(absent)} in {phase} (after the "
+                                  "exclusions)"))
+            continue
         try:
             c = statistics.paired_comparison(rows_of, value, level, design.control, by="condition")
         except ValueError as error:

@@ -322,6 +322,31 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
           "its guidance is not the specification's (/trial/guidance, /trial/guidance_mode)");
     }
   });
+  // The guidance mode's own value is stated in the specification and in the force law's guidance_law, which
+  // the renderer ran: a record edited in one place leaves no way to tell which ran, so it is refused at the
+  // specification's field, naming the force law's (a value the record leaves out is the law's, not stated).
+  if (r.spec.guidance) {
+    const auto same = [&](const char* field, double stated, const char* law_field, double ran) {
+      const std::string at = json_detail::child_pointer(reader.pointer("trial"), field);
+      if (stated + 0.0 == ran + 0.0 ||
+          std::find(read.defaulted.begin(), read.defaulted.end(), at) != read.defaulted.end())
+        return;
+      const std::string law_pointer = json_detail::child_pointer(
+          json_detail::child_pointer(reader.pointer("force_law"), "guidance_law"), law_field);
+      json_detail::fail(source, at,
+                        shortest_decimal(stated) + ", but the force law's guidance states " +
+                            shortest_decimal(ran) + " (" + law_pointer +
+                            "): a record states the value its trial ran with in both, the same");
+    };
+    if (const auto* fading = std::get_if<FadingGuidance>(&r.force_law.guidance_law))
+      same("guidance_gain", r.spec.guidance_gain, "gain", fading->gain);
+    if (const auto* band = std::get_if<AssistAsNeededGuidance>(&r.force_law.guidance_law))
+      same("assist_band_m", r.spec.assist_band_m, "band_m", band->band_m);
+    if (const auto* amplified = std::get_if<ErrorAmplificationGuidance>(&r.force_law.guidance_law))
+      same("amplification_gain", r.spec.amplification_gain, "gain", amplified->gain);
+    if (const auto* timing = std::get_if<TimingGuidance>(&r.force_law.guidance_law))
+      same("timing_speed_m_s", r.spec.timing_speed_m_s, "speed_m_s", timing->speed_m_s);
+  }
   r.safety = parts.safety;
   r.passivity = parts.passivity;
   r.writer = std::move(parts.writer);

@@ -316,26 +316,31 @@ class Round28I(unittest.TestCase, OneErrorLine):
             self.assertEqual(int(row["excluded_time_limit"]), sum(r["end_reason"] == "time_limit" for r in mine))
 
     def test_exclusions_table_has_the_documented_columns(self):
-        # docs/experiments.md: "`tables/exclusions.csv` | phase x group (or condition) | `phase`, `group`,
-        # `trials`, `kept`, `excluded_<end_reason>`".
+        # First run: a finding (the docs listed a `group` column, the table of this study without groups has
+        # `condition`). docs/experiments.md now says: "`phase`, `group` (`condition` in a design without
+        # groups), `trials`, `kept`, `excluded_<end_reason>`".
         with open(self.paper / "tables/exclusions.csv", encoding="utf-8") as f:
             header = f.readline().strip().split(",")
-        self.assertEqual(header[:4], ["phase", "group", "trials", "kept"])
+        self.assertEqual(header[:4], ["phase", "condition", "trials", "kept"])
         self.assertTrue(all(h.startswith("excluded_") for h in header[4:]), header)
 
-    def test_means_over_subjects_count_every_subject_with_analysed_trials(self):
-        # "each subject's analysed trials are averaged first, the SD is over subjects, and n counts subjects";
-        # "means by phase: mean +- SD over subjects (n subjects) per phase and group" (phase_means.csv), and
-        # "a number appears once, with one definition" (the Table-5 summary row too).
+    def test_means_over_subjects_count_the_subjects_their_definition_names(self):
+        # "each subject's analysed trials are averaged first, the SD is over subjects, and n counts subjects".
+        # First run: a finding (phase_means.csv gave haptic over 3 subjects where summary.csv gave it over 4,
+        # and the docs said only "over subjects"). docs/experiments.md now says: within subjects the means by
+        # phase are "over the subjects with analysed trials in every condition of the phase ... (n says how
+        # many; the Table-5 summary below is over every subject)".
         for value in VALUES:
             means = subject_means(self.trials, value)
+            complete = {s for s, _ in means if all((s, c) in means for c in CONDITIONS)}
             for c in CONDITIONS:
-                per_subject = [m for (s, cc), m in sorted(means.items()) if cc == c]
-                want = (len(per_subject), statistics.fmean(per_subject), statistics.stdev(per_subject))
+                every = [m for (s, cc), m in sorted(means.items()) if cc == c]
+                both = [m for (s, cc), m in sorted(means.items()) if cc == c and s in complete]
                 row = next(r for r in self.phase_means if r["value"] == value and r["condition"] == c)
                 total = next(r for r in self.summary if r["quantity"] == value and r["condition"] == c
                              and r["row"] == "mean over subjects")
-                for name, got in (("phase_means.csv", row), ("summary.csv", total)):
+                for name, got, per_subject in (("phase_means.csv", row, both), ("summary.csv", total, every)):
+                    want = (len(per_subject), statistics.fmean(per_subject), statistics.stdev(per_subject))
                     with self.subTest(value=value, condition=c, table=name):
                         self.assertEqual(int(got["n"]), want[0])
                         self.assertAlmostEqual(float(got["mean"]) / want[1], 1.0, places=12)
@@ -484,20 +489,30 @@ class Round28I(unittest.TestCase, OneErrorLine):
         self.assertEqual(tree_digest(self.tmp / "study", skip=("S01", "S02", "S03", "S04", "paper")),
                          self.pages_before)
 
-    def test_report_with_no_trial_analysed_says_none_in_every_table_of_means_and_questions(self):
-        # "A study with no trial analysed ... still gets its page: the completion count says so, each table of
-        # means and of questions has one row saying `none` and why, each summary figure says "no trial
-        # analysed" on its empty axes, and the learning curves are left out."
+    def test_report_with_no_trial_analysed_says_none_and_not_computed_in_its_tables(self):
+        # First run: a finding (the docs said each table of questions had one row saying `none`; the page kept a
+        # row per comparison, one of them "not computed: paired_comparison: condition 'haptic' is not in
+        # trials' 'condition' column; present: ", a helper's error). The docs now say: "each table of means has
+        # one row saying `none` and why, each table of questions keeps a row per comparison it would have
+        # held, each saying "not computed" and why"; the paired check says which condition has no values.
         d = self.tmp / "none"
         page = Path(self.none_index).read_text(encoding="utf-8")
         self.assertIn("Completion: 0 of 16 trials analysed", page)
         for value in VALUES:
-            for css in ("phase-means", "questions"):
-                with self.subTest(value=value, table=css):
-                    body = table_bodies(page, css, value)
-                    self.assertIsNotNone(body)
-                    self.assertEqual(len(body), 1, body)
-                    self.assertIn("none", " ".join(cells(body[0])))
+            with self.subTest(value=value, table="phase-means"):
+                body = table_bodies(page, "phase-means", value)
+                self.assertIsNotNone(body)
+                self.assertEqual(len(body), 1, body)
+                self.assertIn("none", " ".join(cells(body[0])))
+            with self.subTest(value=value, table="questions"):
+                body = table_bodies(page, "questions", value)
+                self.assertIsNotNone(body)
+                self.assertGreaterEqual(len(body), 1, body)
+                for row in body:
+                    text = " ".join(cells(row))
+                    self.assertIn("not computed", text)
+                    self.assertNotIn("present:", text, "a helper's error, not the page's words")
+                self.assertTrue(any("no values of" in " ".join(cells(row)) for row in body), body)
             self.assertIn("no trial analysed", (d / f"figures/phase_{value}.svg").read_text(encoding="utf-8"))
             self.assertFalse((d / f"figures/learning_{value}.svg").exists())
         self.assertNotIn('id="learning"', page)
