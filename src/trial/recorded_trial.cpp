@@ -327,13 +327,13 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
   // specification's field, naming the force law's (a value the record leaves out is the law's, not stated).
   if (r.spec.guidance) {
     const auto same = [&](const char* field, double stated, const char* law_field, double ran) {
-      const std::string at = json_detail::child_pointer(reader.pointer("trial"), field);
+      const std::string stated_at = json_detail::child_pointer(reader.pointer("trial"), field);
       if (stated + 0.0 == ran + 0.0 ||
-          std::find(read.defaulted.begin(), read.defaulted.end(), at) != read.defaulted.end())
+          std::find(read.defaulted.begin(), read.defaulted.end(), stated_at) != read.defaulted.end())
         return;
       const std::string law_pointer = json_detail::child_pointer(
           json_detail::child_pointer(reader.pointer("force_law"), "guidance_law"), law_field);
-      json_detail::fail(source, at,
+      json_detail::fail(source, stated_at,
                         shortest_decimal(stated) + ", but the force law's guidance states " +
                             shortest_decimal(ran) + " (" + law_pointer +
                             "): a record states the value its trial ran with in both, the same");
