@@ -16,7 +16,6 @@ CALLIGRAPHY_CLI names the program; PYTHONPATH the built Python package. CALLIGRA
 import csv
 import io
 import json
-import math
 import shutil
 import tempfile
 import unittest
@@ -27,9 +26,19 @@ from outsider import OneErrorLine, run, run_ok, sanitized_subset
 
 try:
     import numpy as np
+    import outsider_pen
     import calligraphy as cg
 except ImportError:  # reported by setUpClass: every case needs the traces numpy and the package draw
     np = cg = None
+
+
+def along(median, offset=(0.0, 0.0), fraction=1.0, n=400):
+    """`n` points along a median [m] (outsider_pen.along, this round's density)."""
+    return outsider_pen.along(median, offset, fraction, n)
+
+
+def write_trace(path, ticks):
+    outsider_pen.write_trace(path, ticks)
 
 load_tests = sanitized_subset({"test_score_credits_at_exactly_the_count_and_judges_on",
                                "test_score_count_past_its_range_is_one_error_naming_the_option",
@@ -55,14 +64,6 @@ COUNT_KEYS = ("strokes_total", "strokes_written", "strokes_accepted", "strokes_a
               "order_errors", "backwards_strokes", "unmatched_segments", "refusals")
 
 
-def along(median, offset=(0.0, 0.0), fraction=1.0, n=400):
-    """`n` points equally spaced along a median [m], moved by `offset`, cut at `fraction` of its length."""
-    m = np.asarray(median, dtype=float) + np.asarray(offset)
-    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(m, axis=0), axis=1))])
-    u = np.linspace(0.0, s[-1] * fraction, n)
-    return np.column_stack([np.interp(u, s, m[:, 0]), np.interp(u, s, m[:, 1])])
-
-
 def pen_path(characters, plan):
     """The ticks (t, x, y, z) of a pen writing `plan`, a list of (character, stroke, offset, fraction; a
     negative fraction: from the stroke's end), each pen-down set down and lifted straight up, the pen carried
@@ -80,13 +81,6 @@ def pen_path(characters, plan):
         here = p[-1]
     xyz = np.array(points)
     return np.column_stack([np.arange(len(xyz)) / RATE_HZ, xyz])
-
-
-def write_trace(path, ticks):
-    with open(path, "w", encoding="utf-8") as f:
-        f.write("t,x,y,z\n")
-        for t, x, y, z in ticks:
-            f.write(f"{t:.6f},{x:.7f},{y:.7f},{z:.7f}\n")
 
 
 def misses_then_right(kind, n):

@@ -36,9 +36,19 @@ from outsider import OneErrorLine, error_lines, run, run_ok, sanitized_subset
 
 try:
     import numpy as np
+    import outsider_pen
     import calligraphy as cg
 except ImportError:  # reported by setUpClass: every case needs the traces numpy and the package draw
     np = cg = None
+
+
+def along(median, offset=(0.0, 0.0), fraction=1.0, n=150):
+    """`n` points along a median [m] (outsider_pen.along, this round's density)."""
+    return outsider_pen.along(median, offset, fraction, n)
+
+
+def write_trace(path, ticks):
+    outsider_pen.write_trace(path, ticks)
 
 load_tests = sanitized_subset({"test_score_and_renderer_count_a_pen_down_8mm_beside_the_stroke",
                                "test_score_and_renderer_count_no_pen_down_wholly_outside_the_box",
@@ -59,14 +69,6 @@ OFF_WRITER = ["--guidance", "off", "--writer-param", "bias_offset_m=0.01", "--wr
               "stroke_jitter_m=0", "--hint-after-misses", "1", "--assist-after-misses", "2"]
 TRIAL_POINTER = "/specification/trial/miss_min_path_m"
 LAW_POINTER = "/specification/force_law/acceptance/miss_min_path_m"
-
-
-def along(median, offset=(0.0, 0.0), fraction=1.0, n=150):
-    """`n` points equally spaced along a median [m], moved by `offset` [m], cut at `fraction` of its length."""
-    m = np.asarray(median, dtype=float) + np.asarray(offset)
-    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(m, axis=0), axis=1))])
-    u = np.linspace(0.0, s[-1] * fraction, n)
-    return np.column_stack([np.interp(u, s, m[:, 0]), np.interp(u, s, m[:, 1])])
 
 
 def segment(a_mm, b_mm, n):
@@ -108,13 +110,6 @@ def hovering(ticks, down_downs):
             ticks[j, 3] = 0.0003
             j += 1
     return ticks
-
-
-def write_trace(path, ticks):
-    with open(path, "w", encoding="utf-8") as f:
-        f.write("t,x,y,z\n")
-        for t, x, y, z in ticks:
-            f.write(f"{t:.6f},{x:.7f},{y:.7f},{z:.7f}\n")
 
 
 def columns(ticks):

@@ -35,9 +35,19 @@ from outsider import CLI, ENV, OneErrorLine, run, run_ok, sanitized_subset
 
 try:
     import numpy as np
+    import outsider_pen
     import calligraphy as cg
 except ImportError:  # reported by setUpClass: the traces need numpy and the package's medians
     np = cg = None
+
+
+def along(median, offset=(0.0, 0.0), fraction=1.0, n=300):
+    """`n` points along a median [m] (outsider_pen.along, this round's density)."""
+    return outsider_pen.along(median, offset, fraction, n)
+
+
+def write_trace(path, ticks):
+    outsider_pen.write_trace(path, ticks)
 
 load_tests = sanitized_subset({"test_score_table_and_json_agree_on_a_stroke_written_4_mm_off",
                                "test_score_table_and_json_agree_on_strokes_written_out_of_order",
@@ -70,14 +80,6 @@ COMMANDS = [[], ["trial"], ["train"], ["score"], ["trace"], ["model"], ["strokes
             ["session", "plan"], ["session", "cohort"], ["report"], ["curriculum"]]
 
 
-def along(median, offset=(0.0, 0.0), fraction=1.0, n=300):
-    """`n` points equally spaced along a median [m], moved by `offset`, cut at `fraction` of its length."""
-    m = np.asarray(median, dtype=float) + np.asarray(offset)
-    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(m, axis=0), axis=1))])
-    u = np.linspace(0.0, s[-1] * fraction, n)
-    return np.column_stack([np.interp(u, s, m[:, 0]), np.interp(u, s, m[:, 1])])
-
-
 def pen_path(medians, plan):
     """Ticks (t, x, y, z) at 1 kHz of a pen writing `plan`, a list of (stroke, offset [m], fraction; a negative
     fraction: from the stroke's end), each pen-down set down and lifted straight up, carried through the air."""
@@ -93,13 +95,6 @@ def pen_path(medians, plan):
         here = p[-1]
     xyz = np.array(points)
     return np.column_stack([np.arange(len(xyz)) / RATE_HZ, xyz])
-
-
-def write_trace(path, ticks):
-    with open(path, "w", encoding="utf-8") as f:
-        f.write("t,x,y,z\n")
-        for t, x, y, z in ticks:
-            f.write(f"{t:.6f},{x:.7f},{y:.7f},{z:.7f}\n")
 
 
 def distance_to_polyline(points, polyline):
