@@ -110,9 +110,11 @@ class TerminalHost final : public SessionHost {
     char deviation[32] = "-";
     if (std::isfinite(outcome.mean_deviation_mm))
       std::snprintf(deviation, sizeof deviation, "%.2f mm", outcome.mean_deviation_mm);
-    std::fprintf(stderr, "trial %zu: %s, %.1f s, mean deviation %s%s\n", trial.index + 1,
-                 outcome.end_reason.c_str(), outcome.time_s, deviation,
-                 outcome.saved ? "" : " (kept as an attempt)");
+    // No writing time when the pen never touched: "-", as in the tables.
+    char time[32] = "-";
+    if (std::isfinite(outcome.time_s)) std::snprintf(time, sizeof time, "%.1f s", outcome.time_s);
+    std::fprintf(stderr, "trial %zu: %s, %s, mean deviation %s%s\n", trial.index + 1,
+                 outcome.end_reason.c_str(), time, deviation, outcome.saved ? "" : " (kept as an attempt)");
   }
 };
 

@@ -80,9 +80,11 @@ void HostedSessionView::follow(QuizLog& quiz_log,
     char deviation[64] = "no stroke written";
     if (std::isfinite(s.outcome->mean_deviation_mm))
       std::snprintf(deviation, sizeof deviation, "mean deviation %.2f mm", s.outcome->mean_deviation_mm);
-    std::fprintf(stderr, "calligraphy session: trial %zu/%zu %s: %s after %.1f s, %s; %s %s\n",
-                 s.trial.index + 1, s.total, s.trial.condition.c_str(), s.outcome->end_reason.c_str(),
-                 s.outcome->time_s, deviation,
+    // The writing time, first to last pen-down: none when the pen never touched.
+    char time[48] = "the pen never touched";
+    if (std::isfinite(s.outcome->time_s)) std::snprintf(time, sizeof time, "after %.1f s", s.outcome->time_s);
+    std::fprintf(stderr, "calligraphy session: trial %zu/%zu %s: %s %s, %s; %s %s\n", s.trial.index + 1,
+                 s.total, s.trial.condition.c_str(), s.outcome->end_reason.c_str(), time, deviation,
                  s.outcome->saved ? "saved as" : "kept as an attempt:", file.filename().c_str());
     if (s.trial.index + 1 == s.total) last_trial_ended_ = true;
   }
