@@ -81,8 +81,15 @@ RecordedTrial random_recorded_trial(std::mt19937_64& random, GuidanceMode mode) 
         }
       },
       r.force_law.guidance_law);
+  // A record states its mode's value in the specification and in the force law, the same.
   if (auto* fading = std::get_if<FadingGuidance>(&r.force_law.guidance_law))
     r.spec.guidance_gain = fading->gain;
+  if (auto* band = std::get_if<AssistAsNeededGuidance>(&r.force_law.guidance_law))
+    r.spec.assist_band_m = band->band_m;
+  if (auto* amplified = std::get_if<ErrorAmplificationGuidance>(&r.force_law.guidance_law))
+    r.spec.amplification_gain = amplified->gain;
+  if (auto* timing = std::get_if<TimingGuidance>(&r.force_law.guidance_law))
+    r.spec.timing_speed_m_s = timing->speed_m_s;
   r.force_law.acceptance.corridor_m = 0.0071234567890123;
   r.force_law.acceptance.shortfall_fraction = 0.41;
   r.spec.acceptance = r.force_law.acceptance;  // a record states the acceptance its force law ran with

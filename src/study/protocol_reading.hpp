@@ -97,7 +97,7 @@ inline void read_member(json_detail::ObjectReader& reader, const Schema& schema,
   const SchemaField* field = schema.field(key);
   // A key given null is refused naming it (docs/experiments.md, "Protocol files"): null is no value, and
   // leaving the key out is how its default is asked for.
-  if (reader.is_null(key)) {
+  if (!required && reader.is_null(key)) {  // a required key's null is named by its type below
     json_detail::fail(reader.source(), reader.pointer(key),
                       "null is not a value (leave the key out for its default)");
   }

@@ -333,6 +333,12 @@ class VocabularyTest(unittest.TestCase):
             acceptance = record["specification"]["force_law"]["acceptance"]
             if key in acceptance:  # a record states the acceptance its trial ran with in both places
                 acceptance[key] = value
+            # ... and its guidance mode's own value too, in the force law's guidance_law under its own name
+            law = record["specification"]["force_law"].get("guidance_law", {})
+            law_key = {"guidance_gain": "gain", "assist_band_m": "band_m", "amplification_gain": "gain",
+                       "timing_speed_m_s": "speed_m_s"}.get(key)
+            if law_key in law:
+                law[law_key] = value
             if key == "max_duration_s":
                 record["specification"]["trial"]["rate_hz"] = rate["minimum"]
             pointer = f"/specification/trial/{key}"
