@@ -212,12 +212,12 @@ json read_sessions_record(const fs::path& json_file, const SessionManifest& mani
   json document = study_detail::read_trial_record(json_file);
   check_record_is_the_sessions(document, json_file.string(), manifest);
   check_record_is_the_plans(document, json_file.string(), plan);
+  const json_detail::JsonView record(document, "", json_file.string());
   // A record bound to its trace (files.trace_sha256) names its own: the trace beside it of its own stem, so
   // that another trial's trace, hashed right, is not drawn and analysed under this trial's labels.
-  const json_detail::JsonView files(document, "", json_file.string());
-  if (files.object("files").has("trace") && files.object("files").has("trace_sha256")) {
+  if (record.object("files").has("trace") && record.object("files").has("trace_sha256")) {
     const std::string own = SessionFolder::trial_stem(plan) + ".trace.h5";
-    const std::string named = trace_file_name(files);
+    const std::string named = trace_file_name(record);
     if (named != own) {
       json_detail::fail(json_file.string(), "/files/trace",
                         "names the trace '" + named + "', another trial's: this trial's is '" + own +
@@ -225,7 +225,6 @@ json read_sessions_record(const fs::path& json_file, const SessionManifest& mani
     }
   }
   // Its mode is its condition's in the session's protocol copy: the tables' `mode` column is read from it.
-  const json_detail::JsonView record(document, "", json_file.string());
   for (const StudyCondition& condition : manifest.protocol.protocol.conditions) {
     if (condition.name != plan.condition || !record.has("mode")) continue;
     const std::string mode = to_string(condition_mode(condition));
