@@ -515,8 +515,7 @@ def _paired_rows(data: pandas.DataFrame, value: str, design: StudyDesign) -> lis
         absent = [c for c in (level, design.control) if c not in present]
         if absent:  # every trial excluded or missing: said as the models say it, not as the helper's error
             rows.append(_row(**base, comparison=f"{level} - {design.control}",
-                             note=f"not computed: no values of {' or '.join(absent)} in {phase} (after the "
-                                  "exclusions)"))
+                             note=design_models.no_values_note(absent, f"in {phase} (after the exclusions)")))
             continue
         try:
             c = statistics.paired_comparison(rows_of, value, level, design.control, by="condition")

@@ -303,6 +303,12 @@ def planned_comparisons(levels: list[str], control: str) -> list[str]:
     return [f"{b} - {a}" for b, a in planned_pairs(levels, control)]
 
 
+def no_values_note(absent: typing.Sequence[str], where: str) -> str:
+    """Why a comparison of levels without values ``where`` (every trial excluded, every value missing) has no
+    numbers: the one wording of the models' rows and the paired check's."""
+    return f"not computed: no values of {' or '.join(absent)} {where}"
+
+
 def with_absent_levels(rows: list[dict], base: dict, levels: list[str], present: typing.Collection[str],
                        control: str, where: str) -> list[dict]:
     """``rows`` and a "not computed" row for each planned comparison (``planned_pairs``) of a level without
@@ -317,8 +323,7 @@ def with_absent_levels(rows: list[dict], base: dict, levels: list[str], present:
             continue
         absent = [level for level in (later, earlier) if level not in present]
         if absent:
-            out.append(row(**base, comparison=comparison,
-                           note=f"not computed: no values of {' or '.join(absent)} {where}"))
+            out.append(row(**base, comparison=comparison, note=no_values_note(absent, where)))
     return out + list(have.values())
 
 
