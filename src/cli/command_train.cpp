@@ -66,7 +66,6 @@ void check_train_files(const TrainCommand& command) {
   files.existing_output_folder("--quiz-screenshots", command.quiz_screenshots);
 }
 
-#ifdef CALLIGRAPHY_WITH_TRAINER
 // "WxH" in pixels, each in [min, 8192].
 std::pair<int, int> window_size(const std::string& text) {
   const auto x = text.find('x');
@@ -84,7 +83,9 @@ std::pair<int, int> window_size(const std::string& text) {
   return {width, height};
 }
 
-int run_train(const TrainCommand& command, DeviceRegistry& devices) {
+// Every usage and file check of the command, before anything opens, in a build without the window too:
+// wrong options are reported as such (exit 2) wherever the command exists.
+void check_train_options(const TrainCommand& command) {
   // Combinations of options before any file is read: a quiz has no guidance, so nothing that sets one.
   if (command.quiz) {
     std::string guidance_set;  // the first option given that sets guidance
@@ -100,7 +101,19 @@ int run_train(const TrainCommand& command, DeviceRegistry& devices) {
       throw UsageError(message.append(guidance_set));
     }
   }
+  if (guidance_mode_from_string(command.guidance_mode) == GuidanceMode::replay && command.teacher.empty())
+    throw UsageError("--guidance-mode replay: needs --teacher FILE (a recording made with --record)");
+  if (!is_subject_id(command.subject)) {
+    throw UsageError("--subject: '" + command.subject +
+                     "' must be 1-64 characters of A-Z a-z 0-9 _ - (it names the session folder)");
+  }
+  window_size(command.window);
   check_train_files(command);
+}
+
+#ifdef CALLIGRAPHY_WITH_TRAINER
+int run_train(const TrainCommand& command, DeviceRegistry& devices) {
+  check_train_options(command);
   trainer::register_trainer_devices(devices);
   const std::u32string chars = characters_from(command.characters, "CHARS");
   trainer::TrainerOptions options;
@@ -122,8 +135,6 @@ int run_train(const TrainCommand& command, DeviceRegistry& devices) {
   options.guidance_mode = *guidance_mode_from_string(command.guidance_mode);
   options.guidance_gain = command.guidance_gain;
   options.record = command.record;
-  if (options.guidance_mode == GuidanceMode::replay && command.teacher.empty())
-    throw UsageError("--guidance-mode replay: needs --teacher FILE (a recording made with --record)");
   if (!command.teacher.empty()) {
     const TeacherRecording teacher = read_teacher_recording(command.teacher);
     try {
@@ -137,10 +148,6 @@ int run_train(const TrainCommand& command, DeviceRegistry& devices) {
   options.seed = command.seed;
   options.session_dir = command.session;
   options.subject = command.subject;
-  if (!is_subject_id(command.subject)) {
-    throw UsageError("--subject: '" + command.subject +
-                     "' must be 1-64 characters of A-Z a-z 0-9 _ - (it names the session folder)");
-  }
   std::tie(options.width_px, options.height_px) = window_size(command.window);
   options.screenshot = command.screenshot;
   options.exit_after_s = command.exit_after_s;
@@ -164,7 +171,7 @@ int run_train(const TrainCommand& command, DeviceRegistry& devices) {
 }
 #else
 int run_train(const TrainCommand& command, DeviceRegistry&) {
-  check_train_files(command);  // wrong options are reported as such in this build too
+  check_train_options(command);
   throw Error(
       "this calligraphy was built without the trainer window (CALLIGRAPHY_BUILD_TRAINER=OFF; it needs GLFW 3 "
       "and Dear ImGui: libglfw3-dev libimgui-dev)");

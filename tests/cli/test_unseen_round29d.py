@@ -61,7 +61,7 @@ except ImportError:
 load_tests = sanitized_subset({"test_window_size_outside_800x480_to_8192x8192_is_one_usage_error",
                                "test_exit_after_outside_0_to_86400_is_one_usage_error",
                                "test_quiz_with_a_guidance_option_is_refused_before_any_file_is_read",
-                               "test_unknown_device_is_a_usage_error_naming_it",
+                               "test_screenshot_in_a_missing_folder_is_refused_naming_the_option",
                                "test_no_display_exits_1_and_leaves_no_session_folder"})
 
 HAVE_X = shutil.which("Xvfb") is not None and shutil.which("xdotool") is not None
