@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include "calligraphy/analysis/writing_metrics.hpp"
 #include "calligraphy/core/errors.hpp"
@@ -10,6 +11,7 @@
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/report/pen_trace_csv.hpp"
 #include "calligraphy/report/score_report.hpp"
+#include "calligraphy/trial/trial_spec.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 #include "cli/output.hpp"
@@ -18,13 +20,20 @@
 namespace calligraphy::cli {
 namespace {
 
+bool is_acceptance_field(std::string_view name) {
+  for (const ParameterField<StrokeAcceptance>& entry : ParameterTable<StrokeAcceptance>::fields())
+    if (entry.name == name) return true;
+  return false;
+}
+
 struct ScoreCommand {
   std::string trace;
   std::string character;
   std::string units = "m";
   std::string json;
-  // The renderer's assisted credit, so that the verdicts in turn follow a trial's (StrokeAcceptance).
-  std::int64_t assist_after = static_cast<std::int64_t>(StrokeAcceptance{}.assist_after_misses);
+  // Only its stroke acceptance is read: set by the options `trial` has for it, so that a trial's CSV scored
+  // with the trial's options credits the strokes the trial credited.
+  TrialSpec spec;
   LibraryOptions library;
 };
 
@@ -53,7 +62,7 @@ int run_score(const ScoreCommand& command) {
   const std::vector<PenSample> trace = read_pen_trace_csv(command.trace, character.placement, options);
   progress.relabel("scoring " + command.trace);
   ScoreOptions score_options;
-  score_options.acceptance.assist_after_misses = static_cast<double>(command.assist_after);
+  score_options.acceptance = command.spec.acceptance;
   score_options.progress = [&progress](std::size_t matched, std::size_t total) {
     progress.update(matched, total, "segments");
   };
@@ -82,11 +91,12 @@ void add_score_command(CLI::App& root, Commands& commands) {
   add_choice(*app, "--units", command->units, {"m", "data"},
              "units of x and y: metres on the paper as `trial` places the character, or the character's "
              "1024-unit data box (y up)");
-  const ParameterRange assist_range = parameter_field(&StrokeAcceptance::assist_after_misses).range;
-  add_integer(*app, "--assist-after-misses", command->assist_after, "N",
-              "credit a stroke as assisted after N refused pen-downs while it is due, as a trial and the "
-              "trainer do, and judge the next; 0: never (the stroke acceptance's assist_after_misses)",
-              static_cast<std::int64_t>(assist_range.low), static_cast<std::int64_t>(assist_range.high));
+  // Every field of the stroke acceptance, with the option, unit, range and default `trial` gives it (the
+  // trial specification's schema): the miss counts, the corridor, the deviation, the shortfall and the rest.
+  const TrialSpec defaults;
+  for (const SchemaField& field : SchemaOf<TrialSpec>::get().fields) {
+    if (is_acceptance_field(field.name)) add_schema_option(*app, field, &command->spec, &defaults);
+  }
   add_output_path(*app, "--json", command->json, "write the score as JSON", StandardOutput::allowed);
   add_library_options(*app, command->library, true);
 }

@@ -962,12 +962,13 @@ class Round29B(unittest.TestCase, OneErrorLine):
     STRICT = ["--guidance", "off", "--mean-deviation", "0.0001", "--mean-deviation-cap", "0.0001",
               "--assist-after-misses", "2"]
 
-    def trial_and_its_score(self, name, options, assist):
-        """A simulated trial of 十 with `options` (run once), its record and `score` of its CSV."""
+    def trial_and_its_score(self, name, options, assist, *acceptance):
+        """A simulated trial of 十 with `options` (run once), its record and `score` of its CSV with the stroke
+        acceptance's options `acceptance`."""
         if not (self.tmp / f"{name}.json").exists():
             run_ok(["trial", "十", *options, "--json", f"{name}.json", "--csv", f"{name}.csv"], self.tmp)
         trial = json.loads((self.tmp / f"{name}.json").read_text(encoding="utf-8"))
-        record, _ = self.score(name, "--assist-after-misses", assist, chars="十")
+        record, _ = self.score(name, "--assist-after-misses", assist, *acceptance, chars="十")
         return trial, record
 
     def test_a_trials_csv_scored_gives_the_trials_verdicts(self):
@@ -979,9 +980,9 @@ class Round29B(unittest.TestCase, OneErrorLine):
 
     def test_a_strict_trials_csv_scored_gives_the_trials_verdicts(self):
         # The same trial, judged with a mean deviation of 0.1 mm (`trial --mean-deviation`): docs/cli.md
-        # promises `score`'s values for its CSV, and `score` takes the trial's assist count; it has no option
-        # for the other tolerances.
-        trial, record = self.trial_and_its_score("strict", self.STRICT, "2")
+        # promises `score`'s values for its CSV, scored with the trial's stroke acceptance options (found here
+        # first: `score` had only the assist count, so it judged with the default tolerances).
+        trial, record = self.trial_and_its_score("strict", self.STRICT, "2", *self.STRICT[2:6])
         for key in ("strokes_written", "strokes_accepted", "refusals", "unmatched_segments"):
             self.assertEqual(trial[key], record[key], key)
 
