@@ -84,9 +84,10 @@ int run_build(const BuildCommand& command, bool verbose) {
   store_options.outlines = command.outlines == "on";
 
   const auto start = Clock::now();
-  const CorpusFit fit =
+  CorpusFit fit =
       fit_corpus(library, fit_options, static_cast<unsigned>(command.fit.threads), "fitting", verbose);
-  if (fit.characters.empty()) {  // a store of nothing would replace an earlier store with nothing
+  drop_unstorable(fit, store_options);  // listed as not modelled; the store holds the others
+  if (fit.characters.empty()) {         // a store of nothing would replace an earlier store with nothing
     throw DataError(folder.string() + ": none of its " + std::to_string(fit.failures.size()) +
                     " character files could be modelled, so " + command.out + " is not written; the first: " +
                     (fit.failures.empty() ? std::string("none") : fit.failures.front().reason));

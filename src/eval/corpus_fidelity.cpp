@@ -38,9 +38,11 @@ FidelityRow measure_tolerance(const CharacterLibrary& library, double tolerance,
                               bool log_progress) {
   FitOptions options;
   options.tolerance = tolerance;
-  const CorpusFit fit =
+  CorpusFit fit =
       fit_corpus(library, options, threads, "tolerance " + format_number("%g", tolerance), log_progress);
-  const auto bytes = encode_corpus_store(fit.characters, {steps, tolerance});
+  const CorpusStoreOptions store_options{steps, tolerance};
+  drop_unstorable(fit, store_options);  // counted with the characters not modelled
+  const auto bytes = encode_corpus_store(fit.characters, store_options);
   const CorpusStore store = CorpusStore::from_bytes(bytes, "memory");
   FidelityRow row;
   row.tolerance = tolerance;

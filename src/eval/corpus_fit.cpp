@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <exception>
 #include <mutex>
+#include <span>
 #include <thread>
 
 #include "calligraphy/core/errors.hpp"
@@ -160,6 +161,28 @@ CorpusFit fit_corpus(const CharacterLibrary& library, const FitOptions& options,
   result.read_parse_cpu_s = read_parse;
   result.fit_cpu_s = fit;
   return result;
+}
+
+void drop_unstorable(CorpusFit& fit, const CorpusStoreOptions& options) {
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < fit.characters.size(); ++k) {
+    try {
+      encode_corpus_store(std::span(&fit.characters[k], 1), options);
+    } catch (const InvalidArgument& e) {
+      fit.failures.push_back({fit.characters[k].code_point, e.what()});
+      continue;
+    }
+    if (kept != k) {
+      fit.characters[kept] = std::move(fit.characters[k]);
+      fit.fitter_deviation[kept] = std::move(fit.fitter_deviation[k]);
+    }
+    ++kept;
+  }
+  fit.characters.resize(kept);
+  fit.fitter_deviation.resize(kept);
+  std::stable_sort(
+      fit.failures.begin(), fit.failures.end(),
+      [](const CorpusFitFailure& a, const CorpusFitFailure& b) { return a.code_point < b.code_point; });
 }
 
 }  // namespace calligraphy::cli

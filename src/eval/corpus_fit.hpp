@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "calligraphy/model/character_library.hpp"
+#include "calligraphy/model/corpus_store.hpp"
 
 namespace calligraphy::cli {
 
@@ -38,5 +39,10 @@ unsigned default_corpus_threads();
 /// terminal; elsewhere one line per 10 % with `log_progress`, else none.
 CorpusFit fit_corpus(const CharacterLibrary& library, const FitOptions& options, unsigned threads,
                      const std::string& label, bool log_progress);
+/// Moves each fitted character that a store of `options` cannot hold (`encode_corpus_store` refuses it
+/// alone: a stroke fitted with more than 270 elements, a coordinate beyond the store's range) from
+/// `fit.characters` to `fit.failures` with the store's reason, so that the store holds the others and the
+/// character is listed as the others that could not be modelled are. Failures stay in code point order.
+void drop_unstorable(CorpusFit& fit, const CorpusStoreOptions& options);
 
 }  // namespace calligraphy::cli
