@@ -39,7 +39,8 @@ struct ReportCommand {
 // report's set) before the next session is read: memory holds one session's page and one trial per thread.
 // The folders a report makes for its pages (FILE_files/ and a folder per subject), made before the pages are
 // read; unless keep() is called, each one made is removed again (rmdir: only while empty, as nothing was
-// written in it), so a report that fails leaves no folder of its own, as it leaves no file. A folder that
+// written in it), so a report that fails leaves no folder of its own, as it leaves no file; a stop signal
+// removes them too (register_made_folder). A folder that
 // another process made first is not this report's, and is left to it.
 class MadeFolders {
  public:
@@ -47,8 +48,10 @@ class MadeFolders {
   MadeFolders(const MadeFolders&) = delete;
   MadeFolders& operator=(const MadeFolders&) = delete;
   ~MadeFolders() {
-    if (kept_) return;
-    for (auto folder = made_.rbegin(); folder != made_.rend(); ++folder) ::rmdir(folder->c_str());
+    for (auto made = made_.rbegin(); made != made_.rend(); ++made) {
+      if (!kept_) ::rmdir(made->folder.c_str());
+      release_made_folder(made->signal_slot);
+    }
   }
 
   // Thread-safe: the pages' threads make their folders again when they are gone (write_page).
@@ -66,18 +69,25 @@ class MadeFolders {
       std::error_code error;
       if (folder.empty() || fs::is_directory(folder, error)) return;
       make_locked(folder.parent_path());
+      // Registered before it exists, so that a stop signal at any moment removes it (guard_output_files).
+      const int signal_slot = register_made_folder(folder);
       if (fs::create_directory(folder, error)) {
-        made_.push_back(folder);
+        made_.push_back({folder, signal_slot});
         return;
       }
+      release_made_folder(signal_slot);
       if (!error) return;  // made by another process meanwhile: not this report's
       if (attempt == 3 || error != std::errc::no_such_file_or_directory)
         throw DataError(folder.string() + ": cannot create the folder: " + error.message());
     }
   }
 
+  struct Made {
+    fs::path folder;
+    int signal_slot = -1;  // its registration for the stop signals' removal
+  };
   std::mutex mutex_;
-  std::vector<fs::path> made_;
+  std::vector<Made> made_;
   bool kept_ = false;
 };
 

@@ -17,6 +17,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <string>
 #include <system_error>
 #include <utility>
@@ -107,14 +108,14 @@ std::atomic<int> committing_sets{0};  // sets between their first and last renam
 std::atomic<int> deferred_signal{0};  // the stop signal that came during a set's renames
 std::atomic<bool> signals_guarded{false};
 
-int register_temporary(const fs::path& path) noexcept {
+int claim_slot(std::span<TemporarySlot> slots, const fs::path& path) noexcept {
   const std::string& text = path.native();
   if (text.size() >= PATH_MAX) return -1;
-  for (int i = 0; i < static_cast<int>(std::size(temporary_slots)); ++i) {
+  for (int i = 0; i < static_cast<int>(slots.size()); ++i) {
     int free_slot = 0;
-    if (!temporary_slots[i].state.compare_exchange_strong(free_slot, 1)) continue;
-    std::memcpy(temporary_slots[i].path, text.c_str(), text.size() + 1);
-    temporary_slots[i].state.store(2);
+    if (!slots[static_cast<std::size_t>(i)].state.compare_exchange_strong(free_slot, 1)) continue;
+    std::memcpy(slots[static_cast<std::size_t>(i)].path, text.c_str(), text.size() + 1);
+    slots[static_cast<std::size_t>(i)].state.store(2);
     return i;
   }
   return -1;
@@ -139,14 +140,27 @@ class StopSignalsHeld {
   sigset_t before_{};
 };
 
+int register_temporary(const fs::path& path) noexcept { return claim_slot(temporary_slots, path); }
+
 void release_temporary(int slot) noexcept {
   if (slot >= 0) temporary_slots[slot].state.store(0);
 }
 
-// Async-signal-safe: unlink(2) of every live temporary.
+// The folders commands made for their outputs (register_made_folder), in slots as the temporaries'.
+TemporarySlot made_folder_slots[256];
+
+// Async-signal-safe: unlink(2) of every live temporary, then rmdir(2) of every made folder still empty. A
+// folder is emptied only by its subfolders' removal, so each pass removes one level more: a made folder is at
+// most a few levels below another (a report's NAME_files/SUBJECT/), and eight passes outlast any nesting
+// here.
 void remove_live_temporaries() noexcept {
   for (TemporarySlot& slot : temporary_slots) {
     if (slot.state.load() == 2) ::unlink(slot.path);
+  }
+  for (int pass = 0; pass < 8; ++pass) {
+    for (TemporarySlot& slot : made_folder_slots) {
+      if (slot.state.load() == 2) ::rmdir(slot.path);
+    }
   }
 }
 
@@ -653,6 +667,12 @@ void complete_interrupted_sets(const std::vector<SetFolder>& folders) {
 }  // namespace
 
 void remove_dead_temporaries_of(const fs::path& path) { remove_dead_writers_temporaries(path); }
+
+int register_made_folder(const fs::path& folder) noexcept { return claim_slot(made_folder_slots, folder); }
+
+void release_made_folder(int slot) noexcept {
+  if (slot >= 0) made_folder_slots[slot].state.store(0);
+}
 
 fs::path written_path(const fs::path& path) {
   // What the kernel reaches through the path's links and is not a regular file (a device, a FIFO, or the

@@ -119,6 +119,15 @@ class AtomicFileSet {
 ///    that catches them itself (StopSignals, while it lives) is not changed. Never throws.
 void guard_output_files() noexcept;
 
+/// A folder a command made for its outputs (a report's page folders), removed by a stop signal that ends the
+/// process while it is registered, after the temporaries (guard_output_files: rmdir(2), so only while empty,
+/// deepest first): a command stopped leaves no folder of its own, as a command that fails removes the folders
+/// it made. Returns the registration's slot, or -1 when it cannot be held (a path of PATH_MAX bytes or more,
+/// or 256 folders registered at once: that folder is then left by a signal). Never throws, never allocates.
+int register_made_folder(const std::filesystem::path& folder) noexcept;
+/// Ends the registration `slot` of `register_made_folder` (-1: none), once the folder is kept or removed.
+void release_made_folder(int slot) noexcept;
+
 /// The files of `files` as one `AtomicFileSet`, committed.
 void write_files_atomically(std::span<const FileContent> files);
 
