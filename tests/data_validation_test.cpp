@@ -52,7 +52,7 @@ std::string hostile_refusal(const std::string& name) {
   return refusal(read_text(path), path.string());
 }
 
-std::filesystem::path scratch_folder(const std::string& name) {
+std::filesystem::path validation_scratch_folder(const std::string& name) {
   auto dir = std::filesystem::temp_directory_path() / ("calligraphy-validation-" + name);
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
@@ -195,7 +195,7 @@ TEST_CASE("The bounds of character data are inclusive, one past them is refused"
 }
 
 TEST_CASE("A folder refuses files that are not regular or too large, without blocking", "[validation]") {
-  const auto dir = scratch_folder("files");
+  const auto dir = validation_scratch_folder("files");
   const auto library = CharacterLibrary::from_directory(dir);
   const auto fifo = dir / "一.json";
   REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
@@ -228,7 +228,7 @@ TEST_CASE("A folder refuses files that are not regular or too large, without blo
 
 TEST_CASE("A rejection through the folder names the file and 1e400 is a DataError, not an internal error",
           "[validation]") {
-  const auto dir = scratch_folder("named");
+  const auto dir = validation_scratch_folder("named");
   std::filesystem::copy_file(kHostile / "number_out_of_range_1e400.json", dir / "一.json");
   const auto library = CharacterLibrary::from_directory(dir);
   CHECK_THROWS_AS(library.load(U'一'), DataError);
@@ -238,7 +238,7 @@ TEST_CASE("A rejection through the folder names the file and 1e400 is a DataErro
 }
 
 TEST_CASE("A folder without character files is an error naming the folder", "[validation]") {
-  const auto dir = scratch_folder("empty");
+  const auto dir = validation_scratch_folder("empty");
   CHECK_THROWS_AS(CharacterLibrary::from_directory(dir).characters(), DataError);
   CHECK_THROWS_WITH(CharacterLibrary::from_directory(dir).characters(), Catch::Contains(dir.string()));
   std::ofstream(dir / "package.json") << "{}";  // not a character file
@@ -268,7 +268,7 @@ TEST_CASE("A file with outlines has one per median, and a name of white space or
   CHECK_THAT(refusal(R"({"strokes":["M 0 0 Z",")" + at_bound + R"( "],"medians":)" + two + "}"),
              Catch::Contains("/strokes/1") && Catch::Contains("outline path of 1048576 bytes"));
 
-  const auto dir = scratch_folder("names");
+  const auto dir = validation_scratch_folder("names");
   for (const char* name : {"永.json", " .json", "\x1b.json", "\t.json", "\u3000.json", "\u00a0.json"})
     std::ofstream(dir / name) << "{}";
   const auto library = CharacterLibrary::from_directory(dir);

@@ -11,18 +11,13 @@
 #include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/testing/emulated_phantom.hpp"
 #include "calligraphy/trial/trial.hpp"
+#include "embedded_scenes.hpp"
 #include "testing/phantom_emulator.hpp"
 
 using namespace calligraphy;
 using phantom::EmulatedPhantomDevice;
 
 namespace {
-
-Scene scene_of(const std::u32string& chars) {
-  std::vector<Character> characters;
-  for (char32_t c : chars) characters.push_back(CharacterLibrary::embedded().load(c));
-  return Scene::lay_out(characters);
-}
 
 // The registry's emulated Phantom: powered on in the inkwell, lifted out after 50 ms.
 phantom::EmulatorParameters undocking_emulator(const phantom::PhantomDeviceConfig& config) {
@@ -106,7 +101,7 @@ class FaultingDevice final : public HapticDevice {
 
 TEST_CASE("A trial of 永 runs end to end on the emulated Phantom through the PhantomDevice path",
           "[device-trial][phantom]") {
-  const Scene scene = scene_of(U"永");
+  const Scene scene = calligraphy::testing::scene_of_text(U"永");
   EmulatedPhantomDevice device(phantom::phantom_omni_config(),
                                undocking_emulator(phantom::phantom_omni_config()));
   const TrialResult result = run_trial(device, scene, TrialOptions{}, SimulationOptions{});
@@ -135,7 +130,7 @@ TEST_CASE("Lock-step trials on the emulated Phantom are deterministic for a seed
           "[device-trial][phantom]") {
   DeviceRegistry registry;
   calligraphy::testing::register_emulated_phantom(registry);
-  const Scene scene = scene_of(U"口");
+  const Scene scene = calligraphy::testing::scene_of_text(U"口");
   TrialOptions options;
   options.keep_trace = false;
   SimulationOptions simulation;
@@ -151,7 +146,7 @@ TEST_CASE("The CLI's runner takes a registry name, an unknown name lists the dev
           "[device-trial][registry]") {
   DeviceRegistry registry = standard_device_registry();
   calligraphy::testing::register_emulated_phantom(registry);
-  const Scene scene = scene_of(U"口");
+  const Scene scene = calligraphy::testing::scene_of_text(U"口");
   TrialOptions options;
   options.keep_trace = false;
   const TrialResult result = run_trial(registry, "emulated-phantom", scene, options);
@@ -169,7 +164,7 @@ TEST_CASE("The CLI's runner takes a registry name, an unknown name lists the dev
 }
 
 TEST_CASE("The simulated device runs the same loop as run_simulated_trial", "[device-trial]") {
-  const Scene scene = scene_of(U"九");
+  const Scene scene = calligraphy::testing::scene_of_text(U"九");
   const TrialOptions options;
   SimulationOptions simulation;
   simulation.seed = 2;
@@ -184,7 +179,7 @@ TEST_CASE("The simulated device runs the same loop as run_simulated_trial", "[de
 
 TEST_CASE("A disconnect mid-trial aborts it with forces zeroed and the recording kept",
           "[device-trial][phantom]") {
-  const Scene scene = scene_of(U"永");
+  const Scene scene = calligraphy::testing::scene_of_text(U"永");
   constexpr int kUnplugAt = 3000;  // 3 s in: the first stroke is being written
   UnpluggedPhantom device(kUnplugAt);
   const TrialResult result = run_trial(device, scene, TrialOptions{}, SimulationOptions{});
@@ -219,7 +214,7 @@ TEST_CASE("A disconnect mid-trial aborts it with forces zeroed and the recording
 }
 
 TEST_CASE("The reports of an aborted trial say so and keep what was recorded", "[device-trial][phantom]") {
-  const Scene scene = scene_of(U"口");
+  const Scene scene = calligraphy::testing::scene_of_text(U"口");
   UnpluggedPhantom device(1500);
   TrialOptions options;
   const TrialResult result = run_trial(device, scene, options, SimulationOptions{});
@@ -240,7 +235,7 @@ TEST_CASE("The reports of an aborted trial say so and keep what was recorded", "
 
 TEST_CASE("A safety fault aborts a trial on the servo loop, ticks are paced by absolute deadlines",
           "[device-trial]") {
-  const Scene scene = scene_of(U"口");
+  const Scene scene = calligraphy::testing::scene_of_text(U"口");
   FaultingDevice device(40);
   TrialOptions options;
   const auto start = std::chrono::steady_clock::now();
@@ -266,7 +261,9 @@ TEST_CASE("A device that cannot calibrate refuses the trial and is closed", "[de
   auto parameters = phantom::emulator_matching(config);
   parameters.start_docked = false;  // never in the inkwell: encoders cannot be homed
   EmulatedPhantomDevice device(config, parameters);
-  CHECK_THROWS_AS(run_trial(device, scene_of(U"口"), TrialOptions{}, SimulationOptions{}), CalibrationNeeded);
+  CHECK_THROWS_AS(
+      run_trial(device, calligraphy::testing::scene_of_text(U"口"), TrialOptions{}, SimulationOptions{}),
+      CalibrationNeeded);
   CHECK_FALSE(device.is_open());
   CHECK_FALSE(device.emulator().forces_active());
 }
@@ -274,7 +271,9 @@ TEST_CASE("A device that cannot calibrate refuses the trial and is closed", "[de
 TEST_CASE("A device without a usable force limit is refused after open() and closed again",
           "[device-trial]") {
   FaultingDevice device(1000, 0.0);
-  CHECK_THROWS_AS(run_trial(device, scene_of(U"口"), TrialOptions{}, SimulationOptions{}), InvalidArgument);
+  CHECK_THROWS_AS(
+      run_trial(device, calligraphy::testing::scene_of_text(U"口"), TrialOptions{}, SimulationOptions{}),
+      InvalidArgument);
   CHECK(device.reads == 0);
   CHECK(device.closes == 1);
   CHECK_FALSE(device.is_open());

@@ -1,7 +1,6 @@
 // The servo-to-display channel: the seqlock never hands out a torn value while another thread writes,
 // the SPSC queue keeps order and counts what it refuses, and a trial publishes what the display needs
 // (snapshots, trace, the stroke and trial events), also while a display thread reads concurrently.
-#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/trial/display.hpp"
 
 #include <atomic>
@@ -12,17 +11,13 @@
 
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/model/character_library.hpp"
+#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/trial/trial.hpp"
+#include "embedded_scenes.hpp"
 
 using namespace calligraphy;
 
 namespace {
-
-Scene scene_of(std::u32string chars) {
-  std::vector<Character> characters;
-  for (char32_t c : chars) characters.push_back(CharacterLibrary::embedded().load(c));
-  return Scene::lay_out(characters);
-}
 
 // Every field derived from one counter, so a torn copy shows as fields that disagree.
 struct Stamped {
@@ -126,7 +121,7 @@ TEST_CASE("Display channel options out of range are refused by name", "[display]
 }
 
 TEST_CASE("A lock-step trial publishes each tick, its trace, and its stroke events in order", "[display]") {
-  const Scene scene = scene_of(U"十人");
+  const Scene scene = calligraphy::testing::scene_of_text(U"十人");
   DisplayChannelOptions channel_options;
   channel_options.trace_capacity = std::size_t{1} << 20;
   DisplayChannel channel(channel_options);
@@ -189,7 +184,7 @@ TEST_CASE("A lock-step trial publishes each tick, its trace, and its stroke even
 }
 
 TEST_CASE("Lifting the pen while writing publishes the abandoned stroke and why", "[display]") {
-  const Scene scene = scene_of(U"十");
+  const Scene scene = calligraphy::testing::scene_of_text(U"十");
   DisplayChannel channel;
   TrialSession session(scene, simulated_phantom_desktop_info(), TrialOptions{});
   session.attach_display(&channel);
@@ -229,7 +224,7 @@ TEST_CASE("Lifting the pen while writing publishes the abandoned stroke and why"
 }
 
 TEST_CASE("A display thread reads a real-time trial while it runs and sees whole snapshots", "[display]") {
-  const Scene scene = scene_of(U"人");
+  const Scene scene = calligraphy::testing::scene_of_text(U"人");
   DisplayChannel channel;
   TrialOptions options;
   options.pacing = TrialPacing::real_time;

@@ -4,10 +4,11 @@
 #include <thread>
 #include <vector>
 
-using namespace calligraphy::devices;
+// Named in full: the servo programs are built a few files to a unit, where calligraphy has a SpscQueue
+// and a LogLevel of its own.
 
 TEST_CASE("The SPSC queue returns records in the order they were pushed", "[log_queue][servo]") {
-  SpscQueue<int, 8> queue;
+  calligraphy::devices::SpscQueue<int, 8> queue;
   int out = -1;
   CHECK_FALSE(queue.try_pop(out));
   for (int round = 0; round < 5; ++round) {  // several laps around the ring
@@ -23,7 +24,7 @@ TEST_CASE("The SPSC queue returns records in the order they were pushed", "[log_
 }
 
 TEST_CASE("A full SPSC queue drops the newest record and counts it", "[log_queue][servo]") {
-  SpscQueue<int, 4> queue;
+  calligraphy::devices::SpscQueue<int, 4> queue;
   for (int i = 0; i < 4; ++i) REQUIRE(queue.try_push(i));
   CHECK_FALSE(queue.try_push(99));
   CHECK_FALSE(queue.try_push(100));
@@ -38,7 +39,7 @@ TEST_CASE("A full SPSC queue drops the newest record and counts it", "[log_queue
 }
 
 TEST_CASE("One producer and one consumer thread pass every record in order", "[log_queue][servo]") {
-  SpscQueue<std::uint64_t, 64> queue;
+  calligraphy::devices::SpscQueue<std::uint64_t, 64> queue;
   constexpr std::uint64_t kCount = 50000;
   std::thread producer([&] {
     for (std::uint64_t i = 0; i < kCount;) {
@@ -67,13 +68,14 @@ TEST_CASE("One producer and one consumer thread pass every record in order", "[l
 
 TEST_CASE("The log drain hands every record to the sink in order, also those left at stop",
           "[log_queue][servo]") {
-  LogQueue queue;
+  calligraphy::devices::LogQueue queue;
   std::vector<std::uint64_t> seen;  // touched only by the drain thread until stop() joins it
-  LogDrain drain;
+  calligraphy::devices::LogDrain drain;
   drain.start(
-      queue, [&](const LogRecord& r) { seen.push_back(r.count); }, std::chrono::milliseconds(1));
+      queue, [&](const calligraphy::devices::LogRecord& r) { seen.push_back(r.count); },
+      std::chrono::milliseconds(1));
   for (std::uint64_t i = 0; i < 1000; ++i) {
-    LogRecord r;
+    calligraphy::devices::LogRecord r;
     r.code = 7;
     r.count = i;
     r.set_text("a message longer than nothing");
@@ -85,7 +87,7 @@ TEST_CASE("The log drain hands every record to the sink in order, also those lef
 }
 
 TEST_CASE("A log record truncates a long text and keeps it NUL-terminated", "[log_queue][servo]") {
-  LogRecord r;
+  calligraphy::devices::LogRecord r;
   const std::string long_text(500, 'x');
   r.set_text(long_text.c_str());
   CHECK(std::string(r.text.data()) == std::string(r.text.size() - 1, 'x'));

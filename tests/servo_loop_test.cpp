@@ -2,7 +2,6 @@
 // real-time trial on the simulated device (late ticks and stalls: servo_loop_stall_test.cpp). Timing is
 // asserted only as loose properties (tick counts within 20 %), never as benchmarks; `calligraphy bench
 // loop` measures jitter.
-#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/devices/servo_loop.hpp"
 
 #include <dirent.h>
@@ -13,10 +12,12 @@
 #include <stdexcept>
 #include <thread>
 
-#include "calligraphy/model/character_library.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/trial/trial.hpp"
 #include "devices/latency_histogram.hpp"
+#include "embedded_scenes.hpp"
 #include "probe_device.hpp"
 
 using namespace calligraphy;
@@ -56,12 +57,6 @@ std::size_t settled_thread_count(std::size_t expected) {
   for (int i = 0; i < 100 && thread_count() != expected; ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   return thread_count();
-}
-
-Scene scene_of(const std::u32string& chars) {
-  std::vector<Character> characters;
-  for (char32_t c : chars) characters.push_back(CharacterLibrary::embedded().load(c));
-  return Scene::lay_out(characters);
 }
 
 }  // namespace
@@ -276,7 +271,8 @@ TEST_CASE("The loop's defaults change nothing process-wide: no SCHED_FIFO, no lo
   device.open();
   ServoLoopOptions defaults;
   defaults.stall_timeout_s = 0.0;  // a loaded test machine may stall; not what this test is about
-  ServoLoop loop(device, [](const DeviceState&, double) { return ServoCommand{}; }, defaults);
+  ServoLoop loop(
+      device, [](const DeviceState&, double) { return ServoCommand{}; }, defaults);
   loop.start();
   std::this_thread::sleep_for(std::chrono::milliseconds(20));
   loop.stop();
@@ -311,7 +307,7 @@ TEST_CASE("Enforced realtime that cannot be had fails at start with the reason",
 }
 
 TEST_CASE("A real-time trial on the simulated device records the lock-step trial's trace", "[servo]") {
-  const Scene scene = scene_of(U"口");
+  const Scene scene = testing::embedded_scene(U'口');
   TrialOptions trial;
   trial.max_duration_s = 2.5;  // about the first stroke of 口 (a whole trial would take 6 s of wall clock)
   SimulationOptions skilled;
@@ -344,7 +340,7 @@ TEST_CASE("A real-time trial on the simulated device records the lock-step trial
 }
 
 TEST_CASE("A device fault during a real-time trial keeps the recording and reports the fault", "[servo]") {
-  const Scene scene = scene_of(U"口");
+  const Scene scene = testing::embedded_scene(U'口');
   ProbeDevice device(/*fail_on_read=*/300);
   TrialOptions options;
   options.pacing = TrialPacing::real_time;
@@ -364,7 +360,7 @@ TEST_CASE("A device fault during a real-time trial keeps the recording and repor
 }
 
 TEST_CASE("Start, stop and restart under a running trial leave no thread behind", "[servo]") {
-  const Scene scene = scene_of(U"口");
+  const Scene scene = testing::embedded_scene(U'口');
   SimulatedDevice device;
   SimulatedWriter writer(scene, WriterProfile::skilled(), 0);
   Renderer renderer(scene, ForceLawParameters{}, device.info());

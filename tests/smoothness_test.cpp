@@ -8,13 +8,14 @@
 #include <utility>
 #include <vector>
 
-#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy//model/character_library.hpp"
 #include "calligraphy/collision/constraint_space.hpp"
+#include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/render/force_law.hpp"
 #include "calligraphy/render/renderer.hpp"
-#include "calligraphy/devices/simulated_device.hpp"
+#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/trial/trial.hpp"
+#include "embedded_scenes.hpp"
 #include "test_sizing.hpp"
 
 using namespace calligraphy;
@@ -23,8 +24,6 @@ namespace {
 
 // 20 characters of the embedded set: turns (横折, 竖折), hooks (竖钩, 弯钩, 卧钩), crossings.
 const std::u32string kCharacters = U"永我九乙也书之力母马弓心水长东为电风写凸";
-
-Scene scene_of(char32_t c) { return Scene::lay_out({CharacterLibrary::embedded().load(c)}); }
 
 std::string utf8(char32_t c) {
   std::string s;
@@ -47,7 +46,7 @@ struct StepFigures {
 
 // A guided novice of seed `seed` writes `c` with `options`.
 StepFigures trial_steps(char32_t c, const TrialOptions& options, std::uint64_t seed) {
-  const Scene scene = scene_of(c);
+  const Scene scene = calligraphy::testing::embedded_scene(c);
   SimulationOptions novice;
   novice.writer = WriterProfile::novice();
   novice.seed = seed;
@@ -130,7 +129,7 @@ double corner_max_step(const ForceLawParameters& force) {
 
 // 20 characters x 2 seeds in Release; under the sanitizers 6 of those 40 trials drawn at random
 // (tests/test_sizing.hpp).
-constexpr std::size_t kSanitizedTrials = 6;
+constexpr std::size_t kSanitizedSmoothnessTrials = 6;
 
 TEST_CASE("Through full guided trials on 20 characters the per-tick force change stays within the limit",
           "[smoothness][safety]") {
@@ -139,7 +138,7 @@ TEST_CASE("Through full guided trials on 20 characters the per-tick force change
     for (const std::uint64_t seed : {1u, 2u}) trials.emplace_back(c, seed);
   }
   for (const auto& [c, seed] :
-       calligraphy::testing::sanitizer_subset(trials, kSanitizedTrials, "character x seed")) {
+       calligraphy::testing::sanitizer_subset(trials, kSanitizedSmoothnessTrials, "character x seed")) {
     TrialOptions options = guided();
     options.keep_trace = true;
     const StepFigures chain = trial_steps(c, options, seed);

@@ -21,6 +21,7 @@
 #include "study/manifest_json.hpp"
 #include "study_test_devices.hpp"
 #include "temp_folder.hpp"
+#include "temporary_files.hpp"
 
 using namespace calligraphy;
 using protocol_checks::check_error;
@@ -65,13 +66,6 @@ std::vector<PlannedTrial> whole_plan(const StudyProtocol& protocol, std::size_t 
     for (PlannedTrial& t : plan_session(protocol, {subject_id(number), number}, session)) trials.push_back(t);
   }
   return trials;
-}
-
-std::string read_text(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
 }
 
 }  // namespace
@@ -324,7 +318,7 @@ TEST_CASE("crossover protocol: session.json keeps each trial's set and crossover
   SessionSetup setup;
   setup.subject = {"S3", 3};
   SessionFolder session = SessionFolder::create(temp.path / "S3", setup, protocol);
-  const std::string text = read_text(session.path() / "session.json");
+  const std::string text = calligraphy::testing_files::contents(session.path() / "session.json");
   nlohmann::json document = nlohmann::json::parse(text);
   const nlohmann::json& first = document["plan"][0];  // pre-test on 十 of s1, trained second under B
   CHECK(first["item_set"] == "s1");
@@ -374,7 +368,7 @@ TEST_CASE("crossover protocol: session.json keeps each trial's set and crossover
   SessionFolder plain_session = SessionFolder::create(temp.path / "S1", setup, plain);
   // Parsed into a variable: a range-for over a member of a temporary would read it after its end.
   const nlohmann::json plain_manifest =
-      nlohmann::json::parse(read_text(plain_session.path() / "session.json"));
+      nlohmann::json::parse(calligraphy::testing_files::contents(plain_session.path() / "session.json"));
   for (const nlohmann::json& entry : plain_manifest["plan"]) {
     for (const char* key : {"item_set", "sequence", "period", "trained_condition"})
       CHECK_FALSE(entry.contains(key));

@@ -2,29 +2,22 @@
 // the loop statistics kept, an interrupt, the time limit, a writer that gives up.
 #include <catch2/catch.hpp>
 
-#include "calligraphy/model/character_library.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
+#include "calligraphy/model/character_library.hpp"
 #include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/sim/simulated_writer.hpp"
 #include "calligraphy/trial/trial.hpp"
+#include "embedded_scenes.hpp"
 #include "probe_device.hpp"
 
 using namespace calligraphy;
 
 using test::ProbeDevice;
 
-namespace {
-
-Scene scene_of(std::u32string chars) {
-  std::vector<Character> characters;
-  for (char32_t c : chars) characters.push_back(CharacterLibrary::embedded().load(c));
-  return Scene::lay_out(characters);
-}
-
-}  // namespace
+namespace {}  // namespace
 
 TEST_CASE("A session stepped from the application's own loop records the runner's trial", "[trial]") {
-  const Scene scene = scene_of(U"九");
+  const Scene scene = testing::embedded_scene(U'九');
   TrialOptions options;
   SimulationOptions simulation;
   simulation.seed = 3;
@@ -57,7 +50,7 @@ TEST_CASE("A session stepped from the application's own loop records the runner'
 }
 
 TEST_CASE("Every tick writes the force once, lock-step and in real time", "[trial][servo]") {
-  const Scene scene = scene_of(U"乙");
+  const Scene scene = testing::embedded_scene(U'乙');
   for (const TrialPacing pacing : {TrialPacing::lock_step, TrialPacing::real_time}) {
     ProbeDevice device;
     TrialOptions options;
@@ -82,7 +75,7 @@ TEST_CASE("Every tick writes the force once, lock-step and in real time", "[tria
 }
 
 TEST_CASE("should_stop ends a trial as interrupted with the ticks kept", "[trial][servo]") {
-  const Scene scene = scene_of(U"永");
+  const Scene scene = testing::embedded_scene(U'永');
   for (const TrialPacing pacing : {TrialPacing::lock_step, TrialPacing::real_time}) {
     TrialOptions options;
     options.pacing = pacing;
@@ -127,7 +120,7 @@ class QuittingHand final : public TrialHand {
 
 TEST_CASE("A writer that stops early ends the trial as writer_finished, a hand that quits as gave_up",
           "[trial]") {
-  const Scene scene = scene_of(U"口");
+  const Scene scene = testing::embedded_scene(U'口');
   TrialOptions options;
   options.rate_hz = 100.0;  // too coarse a tick for this writer: the display takes none of its strokes
   options.force.acceptance.assist_after_misses = 0;  // no stroke credited as assisted

@@ -88,7 +88,7 @@ TrialSpec random_spec(std::mt19937_64& random) {
   return spec;
 }
 
-std::string error_of(const std::function<void()>& call) {
+std::string spec_error_of(const std::function<void()>& call) {
   try {
     call();
   } catch (const Error& e) {
@@ -154,12 +154,12 @@ TEST_CASE("the writer's settings are numbers in the JSON, and a record's older \
       "old.json");
   CHECK(older.writer_parameters ==
         std::vector<WriterSetting>{{"bias_offset_m", 0.004}, {"stroke_jitter_m", 1e-5}});
-  CHECK_THAT(error_of([] {
+  CHECK_THAT(spec_error_of([] {
                (void)*trial_spec_from_json(
                    R"({"characters": "十", "writer_parameters": [{"key": "bias_offset_m"}]})", "s.json");
              }),
              Catch::Contains("s.json: /writer_parameters/0") && Catch::Contains("value"));
-  CHECK_THAT(error_of([] {
+  CHECK_THAT(spec_error_of([] {
                (void)*trial_spec_from_json(R"({"characters": "十", "writer_parameters": ["bias_offset_m"]})",
                                            "s.json");
              }),
@@ -186,7 +186,7 @@ TEST_CASE("a specification's errors name the field in both its forms") {
   TrialSpec spec;
   spec.characters = "永";
   const auto fails_naming = [](TrialSpec bad, const std::string& expected) {
-    const std::string message = error_of([&] { bad.validate(); });
+    const std::string message = spec_error_of([&] { bad.validate(); });
     INFO(message);
     CHECK(message.find(expected) != std::string::npos);
   };
@@ -238,17 +238,17 @@ TEST_CASE("a specification's errors name the field in both its forms") {
   bad = spec;
   bad.writer_profile = "expert";
   fails_naming(bad, "writer_profile (--writer-profile): unknown writer profile 'expert'");
-  CHECK_THAT(error_of([&] { (void)writer_profile_of(bad); }),
+  CHECK_THAT(spec_error_of([&] { (void)writer_profile_of(bad); }),
              Catch::Contains("writer_profile (--writer-profile)") && Catch::Contains("expert"));
-  CHECK_THAT(error_of([&] { SimulatedWriting refused(bad); }),
+  CHECK_THAT(spec_error_of([&] { SimulatedWriting refused(bad); }),
              Catch::Contains("writer_profile (--writer-profile)"));
   bad = spec;
   bad.writer_parameters = {{"no_such_key", 1.0}};
-  CHECK_THAT(error_of([&] { (void)writer_profile_of(bad); }),
+  CHECK_THAT(spec_error_of([&] { (void)writer_profile_of(bad); }),
              Catch::Contains("writer_parameters (--writer-param): 'no_such_key=1'") &&
                  Catch::Contains("known: hand_stiffness_n_per_m"));
   bad.writer_parameters = {{"bias_offset_m", -1.0}};
-  CHECK_THAT(error_of([&] { (void)writer_profile_of(bad); }),
+  CHECK_THAT(spec_error_of([&] { (void)writer_profile_of(bad); }),
              Catch::Contains("writer_parameters (--writer-param): 'bias_offset_m=-1'"));
   bad = spec;
   bad.pacing = TrialPacing::real_time;
@@ -262,25 +262,27 @@ TEST_CASE("a specification's errors name the field in both its forms") {
   fails_naming(bad, "record_file (--record)");
 
   CHECK_THAT(
-      error_of([] {
+      spec_error_of([] {
         (void)*trial_spec_from_args(std::vector<std::string>{"永", "--pacing", "lock_step"});
       }),
       Catch::Contains("pacing (--pacing): 'lock_step' is not one of 'auto', 'lock-step', 'real-time'"));
-  CHECK_THAT(error_of([] {
+  CHECK_THAT(spec_error_of([] {
                (void)*trial_spec_from_args(std::vector<std::string>{"永", "--guidence", "on"});
              }),
              Catch::Contains("no field '--guidence'"));
-  CHECK_THAT(error_of([] {
+  CHECK_THAT(spec_error_of([] {
                (void)*trial_spec_from_args(std::vector<std::string>{"永", "--seed"});
              }),
              Catch::Contains("--seed: needs a value"));
-  CHECK_THAT(error_of([] { (void)*trial_spec_from_json(R"({"characters": "永", "sede": 3})", "s.json"); }),
-             Catch::Contains("s.json") && Catch::Contains("sede"));
-  CHECK_THAT(error_of([] { (void)*trial_spec_from_json(R"({"characters": "永", "seed": -3})", "s.json"); }),
-             Catch::Contains("s.json: /seed"));
   CHECK_THAT(
-      error_of([] { (void)*trial_spec_from_json(R"({"characters": "永", "guidance": "on"})", "s.json"); }),
-      Catch::Contains("s.json: /guidance: expected true or false"));
+      spec_error_of([] { (void)*trial_spec_from_json(R"({"characters": "永", "sede": 3})", "s.json"); }),
+      Catch::Contains("s.json") && Catch::Contains("sede"));
+  CHECK_THAT(
+      spec_error_of([] { (void)*trial_spec_from_json(R"({"characters": "永", "seed": -3})", "s.json"); }),
+      Catch::Contains("s.json: /seed"));
+  CHECK_THAT(spec_error_of(
+                 [] { (void)*trial_spec_from_json(R"({"characters": "永", "guidance": "on"})", "s.json"); }),
+             Catch::Contains("s.json: /guidance: expected true or false"));
 }
 
 TEST_CASE("the runner of a specification gives the simulated writer to the trial as its hand") {
@@ -298,7 +300,7 @@ TEST_CASE("the runner of a specification gives the simulated writer to the trial
   CHECK(std::any_of(run.result.trace.begin(), run.result.trace.end(),
                     [](const TrialSample& sample) { return sample.attempt > 0; }));
   // Without a hand maker, the runner names what is missing instead of running no writer.
-  CHECK_THAT(error_of([&] {
+  CHECK_THAT(spec_error_of([&] {
                (void)run_trial_spec(Checked<TrialSpec>::check(spec), scene, study_test::trial_inputs());
              }),
              Catch::Contains("no hand maker") && Catch::Contains("TrialRunInputs::hand_maker"));
@@ -312,7 +314,7 @@ TEST_CASE("the runner of a specification gives the simulated writer to the trial
 
   TrialSpec person = spec;
   person.writer = TrialWriter::person;
-  CHECK_THAT(error_of([&] {
+  CHECK_THAT(spec_error_of([&] {
                (void)run_trial_spec(Checked<TrialSpec>::check(person), scene, study_test::trial_inputs());
              }),
              Catch::Contains("writer (--writer): 'person'"));
@@ -322,7 +324,7 @@ TEST_CASE("the runner of a specification gives the simulated writer to the trial
       run_trial_spec(Checked<TrialSpec>::check(nowhere), scene, study_test::trial_inputs(&writing)),
       DeviceNotFound);
   // The library makes no registry of its own: the caller passes one, or a device.
-  CHECK_THAT(error_of([&] { (void)run_trial_spec(Checked<TrialSpec>::check(spec), scene); }),
+  CHECK_THAT(spec_error_of([&] { (void)run_trial_spec(Checked<TrialSpec>::check(spec), scene); }),
              Catch::Contains("no device and no registry to create \"simulated\""));
 }
 
@@ -366,7 +368,7 @@ TEST_CASE("the runner runs the whole trial its one builder made, with a force la
   CHECK(run.options.force.acceptance == force.acceptance);
   CHECK_FALSE(run.options.loop.lock_memory);
   force.guidance_law = FadingGuidance{.gain = 0.5};
-  CHECK_THAT(error_of([&] { (void)build_whole_trial(checked, DeviceInfo{}, {.force_law = force}); }),
+  CHECK_THAT(spec_error_of([&] { (void)build_whole_trial(checked, DeviceInfo{}, {.force_law = force}); }),
              Catch::Contains("force_law: its guidance (fading) is not the specification's (fixed)"));
 }
 
@@ -379,27 +381,27 @@ TEST_CASE("the one builder refuses a part out of range naming the part, before a
   const DeviceInfo figures;  // the builder is given figures only: it can open no device
   ForceLawParameters force;
   force.guidance_stiffness_n_per_m = -1.0;
-  CHECK_THAT(error_of([&] { (void)build_whole_trial(checked, figures, {.force_law = force}); }),
+  CHECK_THAT(spec_error_of([&] { (void)build_whole_trial(checked, figures, {.force_law = force}); }),
              Catch::StartsWith("force_law: "));
   SafetyChainParameters safety;
   safety.max_force_change_n_per_tick = -0.5;
-  CHECK_THAT(error_of([&] { (void)build_whole_trial(checked, figures, {.safety = safety}); }),
+  CHECK_THAT(spec_error_of([&] { (void)build_whole_trial(checked, figures, {.safety = safety}); }),
              Catch::StartsWith("safety: "));
   // A low-pass at or above the loop's Nyquist frequency (500 Hz at 1 kHz) filters nothing it samples.
   SafetyChainParameters aliased;
   aliased.low_pass_cutoff_hz = 0.5 * spec.rate_hz;
-  CHECK_THAT(error_of([&] { (void)build_whole_trial(checked, figures, {.safety = aliased}); }),
+  CHECK_THAT(spec_error_of([&] { (void)build_whole_trial(checked, figures, {.safety = aliased}); }),
              Catch::StartsWith("safety: low_pass_cutoff_hz") && Catch::Contains("half the servo rate"));
   aliased.low_pass_cutoff_hz = 0.49 * spec.rate_hz;
   CHECK_NOTHROW(build_whole_trial(checked, figures, {.safety = aliased}));
   PassivityParameters passivity;
   passivity.enabled = true;
   passivity.max_damping_n_s_per_m = -2.0;
-  CHECK_THAT(error_of([&] { (void)build_whole_trial(checked, figures, {.passivity = passivity}); }),
+  CHECK_THAT(spec_error_of([&] { (void)build_whole_trial(checked, figures, {.passivity = passivity}); }),
              Catch::StartsWith("passivity: "));
-  CHECK_THAT(error_of([&] { (void)build_whole_trial(checked, figures, {.writer = WriterProfile{}}); }),
+  CHECK_THAT(spec_error_of([&] { (void)build_whole_trial(checked, figures, {.writer = WriterProfile{}}); }),
              Catch::StartsWith("writer: ") && Catch::Contains("a person writes"));
-  CHECK_THAT(error_of([&] {
+  CHECK_THAT(spec_error_of([&] {
                (void)build_whole_trial(checked, figures, {.simulated_device = SimulatedDeviceParameters{}});
              }),
              Catch::StartsWith("simulated_device: ") && Catch::Contains("emulated-phantom"));
@@ -490,12 +492,12 @@ TEST_CASE("a specification reaches the runner checked: it takes no unchecked one
   spec.characters = "十";
   spec.guidance_mode = GuidanceMode::fading;
   spec.guidance_gain = 1.5;
-  CHECK_THAT(error_of([&] { (void)Checked<TrialSpec>::check(spec); }), Catch::Contains("guidance_gain"));
+  CHECK_THAT(spec_error_of([&] { (void)Checked<TrialSpec>::check(spec); }), Catch::Contains("guidance_gain"));
   // A checked replay runs on one teacher: its file or the caller's samples, named when neither is there.
   spec.guidance_gain = 1.0;
   spec.guidance_mode = GuidanceMode::replay;
   const auto replay = Checked<TrialSpec>::check(spec, TeacherSource::samples);
   const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'十')});
-  CHECK_THAT(error_of([&] { (void)run_trial_spec(replay, scene, study_test::trial_inputs()); }),
+  CHECK_THAT(spec_error_of([&] { (void)run_trial_spec(replay, scene, study_test::trial_inputs()); }),
              Catch::Contains("teacher (--teacher): a replay runs on the teacher's samples"));
 }

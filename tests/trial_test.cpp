@@ -1,23 +1,18 @@
-#include "calligraphy/sim/simulated_hand.hpp"
 #include "calligraphy/trial/trial.hpp"
 
 #include <catch2/catch.hpp>
 
-#include "calligraphy/model/character_library.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
+#include "calligraphy/model/character_library.hpp"
+#include "calligraphy/sim/simulated_hand.hpp"
+#include "embedded_scenes.hpp"
 
 using namespace calligraphy;
 
-namespace {
-Scene scene_of(std::u32string chars) {
-  std::vector<Character> characters;
-  for (char32_t c : chars) characters.push_back(CharacterLibrary::embedded().load(c));
-  return Scene::lay_out(characters);
-}
-}  // namespace
+namespace {}  // namespace
 
 TEST_CASE("A guided trial on 永 completes every stroke in order", "[trial]") {
-  const Scene scene = scene_of(U"永");
+  const Scene scene = calligraphy::testing::scene_of_text(U"永");
   TrialOptions options;
   const TrialResult result = run_simulated_trial(scene, options);
   CHECK(result.metrics.strokes_total == 5);
@@ -29,7 +24,7 @@ TEST_CASE("A guided trial on 永 completes every stroke in order", "[trial]") {
 
 TEST_CASE("For the same seeded novice, guidance lowers the mean deviation", "[trial]") {
   for (const char32_t c : std::u32string(U"永我九")) {
-    const Scene scene = scene_of(std::u32string(1, c));
+    const Scene scene = calligraphy::testing::scene_of_text(std::u32string(1, c));
     for (std::uint64_t seed : {0u, 7u}) {
       TrialOptions on;
       on.keep_trace = false;
@@ -47,7 +42,7 @@ TEST_CASE("For the same seeded novice, guidance lowers the mean deviation", "[tr
 }
 
 TEST_CASE("Trials are deterministic for a seed and differ across seeds", "[trial]") {
-  const Scene scene = scene_of(U"口");
+  const Scene scene = calligraphy::testing::scene_of_text(U"口");
   const TrialOptions a;
   SimulationOptions simulation;
   simulation.seed = 3;
@@ -60,7 +55,7 @@ TEST_CASE("Trials are deterministic for a seed and differ across seeds", "[trial
 }
 
 TEST_CASE("A character group is written one character after another", "[trial]") {
-  const Scene scene = scene_of(U"口九");
+  const Scene scene = calligraphy::testing::scene_of_text(U"口九");
   REQUIRE(scene.characters.size() == 2);
   CHECK(scene.characters[0].bounding_box.max().x() < scene.characters[1].bounding_box.min().x());
   const auto result = run_simulated_trial(scene, TrialOptions{});

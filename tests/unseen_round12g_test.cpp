@@ -53,6 +53,10 @@
 // reserve_trace): allocation_count.hpp, interposed only where the sanitizers do not own malloc.
 #include "allocation_count.hpp"
 #include "application_stylus.hpp"
+#include "embedded_scenes.hpp"
+#include "special_values.hpp"
+
+using calligraphy::testing::cross_scene;
 #if !defined(CALLIGRAPHY_TEST_SANITIZED) && defined(__GLIBC__)
 #define UNSEEN12G_COUNTS_ALLOCATIONS 1
 namespace {
@@ -66,19 +70,14 @@ namespace {
 using namespace calligraphy;
 using Catch::Matchers::Contains;
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kDenormal = std::numeric_limits<double>::denorm_min();
+using calligraphy::testing::kDenormal;
+using calligraphy::testing::kInf;
+using calligraphy::testing::kNaN;
 
 const Scene& one_stroke_scene() {
   static const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'乙')});
   return scene;
 }
-const Scene& cross_scene() {
-  static const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'十')});
-  return scene;
-}
-
 // A point on the first stroke's start, `depth_m` into the paper.
 Vec3 stroke_start(const Scene& scene, double depth_m) {
   const Vec2& start = scene.characters.front().strokes.front().centre_line.points_m.front();

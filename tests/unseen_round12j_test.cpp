@@ -73,6 +73,7 @@
 #include "calligraphy/trial/recorder.hpp"
 #include "calligraphy/trial/result.hpp"
 #include "calligraphy/trial/teacher_recording.hpp"
+#include "special_values.hpp"
 #include "temp_folder.hpp"
 
 namespace {
@@ -81,9 +82,9 @@ using namespace calligraphy;
 using Catch::Matchers::Contains;
 using Catch::Matchers::StartsWith;
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kDenormal = std::numeric_limits<double>::denorm_min();
+using calligraphy::testing::kDenormal;
+using calligraphy::testing::kInf;
+using calligraphy::testing::kNaN;
 
 // What `f` threw: "[thrown] MESSAGE" for an E, "[another exception] ..." for any other exception, "[nothing
 // thrown]" otherwise, so that a check names what came instead.

@@ -38,6 +38,9 @@
 #include "calligraphy/trial/display.hpp"
 #include "calligraphy/trial/runner.hpp"
 #include "calligraphy/trial/session.hpp"
+#include "embedded_scenes.hpp"
+
+using calligraphy::testing::cross_scene;
 
 namespace {
 
@@ -45,11 +48,6 @@ using namespace calligraphy;
 using Catch::Matchers::Contains;
 
 constexpr int kThreads = 4;
-
-const Scene& cross_scene() {
-  static const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'十')});
-  return scene;
-}
 
 // Runs `work(i)` on kThreads threads started together (they wait for each other before working).
 template <typename Work>

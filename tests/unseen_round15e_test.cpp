@@ -49,6 +49,7 @@
 #include "calligraphy/trial/trial_spec.hpp"
 #include "calligraphy/trial/writer_profile.hpp"
 #include "temp_folder.hpp"
+#include "temporary_files.hpp"
 #include "thrown_exactly.hpp"
 
 using namespace calligraphy;
@@ -64,11 +65,6 @@ char32_t first_character(const std::vector<char32_t>& characters, const std::fun
   }
   FAIL("no character fits");
   return 0;
-}
-
-std::string read_text(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 void write_text(const std::filesystem::path& path, const std::string& text) {
@@ -210,7 +206,7 @@ TEST_CASE("unseen15e: the atomic writers name the path and the system's reason, 
   AtomicFileSet set;
   set.add(folder.path / "one.txt", "one");
   set.commit();
-  CHECK(read_text(folder.path / "one.txt") == "one");
+  CHECK(calligraphy::testing_files::contents(folder.path / "one.txt") == "one");
   (void)thrown_exactly<StateError>([&] { set.add(folder.path / "two.txt", "two"); });
   (void)thrown_exactly<StateError>([&] { set.commit(); });
   CHECK_FALSE(std::filesystem::exists(folder.path / "two.txt"));

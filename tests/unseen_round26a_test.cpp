@@ -48,27 +48,27 @@
 #include "calligraphy/trial/display.hpp"
 #include "calligraphy/trial/session.hpp"
 #include "calligraphy/trial/teacher_recording.hpp"
+#include "embedded_scenes.hpp"
+#include "special_values.hpp"
 #include "temp_folder.hpp"
 #include "thrown_exactly.hpp"
 
+using calligraphy::testing::cross_scene;
+#include "temporary_files.hpp"
+
 using namespace calligraphy;
-using calligraphy::testing::has;
-using calligraphy::testing::thrown_exactly;
 using calligraphy::testing::count_this_thread;
 using calligraphy::testing::counted_allocations;
+using calligraphy::testing::has;
 using calligraphy::testing::kCountsAllocations;
+using calligraphy::testing::thrown_exactly;
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using calligraphy::testing::kInf;
+using calligraphy::testing::kNaN;
 // The per-tick change limit of the default safety chain [N per tick] (safety_chain.hpp), with rounding room.
 constexpr double kStepLimitN = 0.25 + 1e-9;
-
-const Scene& cross_scene() {
-  static const Scene scene = Scene::lay_out({CharacterLibrary::embedded().load(U'十')});
-  return scene;
-}
 
 DeviceInfo desktop() { return simulated_phantom_desktop_info(); }
 
@@ -278,11 +278,6 @@ struct LogCapture {
     return found;
   }
 };
-
-std::string read_text(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
 
 std::vector<std::string> names_in(const std::filesystem::path& folder) {
   std::vector<std::string> names;
@@ -1073,7 +1068,7 @@ TEST_CASE("unseen26a: a file size limit mid-write keeps the earlier record whole
   REQUIRE(WIFEXITED(status));
   CHECK(WEXITSTATUS(status) == 0);
   CHECK(has(message, file.string()));
-  CHECK(read_text(file) == "earlier\n");
+  CHECK(calligraphy::testing_files::contents(file) == "earlier\n");
   CHECK(names_in(folder.path) == std::vector<std::string>{"trial.json"});
 }
 
@@ -1098,12 +1093,12 @@ TEST_CASE("unseen26a: a record written through a link replaces the file it names
   std::filesystem::create_symlink("real.json", link);
   write_file_atomically(link, "new");
   CHECK(std::filesystem::is_symlink(link));
-  CHECK(read_text(target) == "new");
+  CHECK(calligraphy::testing_files::contents(target) == "new");
   const auto dangling = folder.path / "dangling.json";
   std::filesystem::create_symlink("made.json", dangling);
   write_file_atomically(dangling, "made");
   CHECK(std::filesystem::is_symlink(dangling));
-  CHECK(read_text(folder.path / "made.json") == "made");
+  CHECK(calligraphy::testing_files::contents(folder.path / "made.json") == "made");
   const auto loop = folder.path / "loop.json";
   std::filesystem::create_symlink("loop.json", loop);
   CHECK(has(thrown_exactly<DataError>([&] { write_file_atomically(loop, "x"); }), loop.string()));
@@ -1122,8 +1117,8 @@ TEST_CASE("unseen26a: a set with a link among its targets is refused by name and
     const auto link = folder.path / "b.json";
     CHECK(has(thrown_exactly<DataError>([&] { set.add(link, "b1"); }), link.string()));
   }
-  CHECK(read_text(folder.path / "a.json") == "a0");
-  CHECK(read_text(folder.path / "elsewhere.json") == "e0");
+  CHECK(calligraphy::testing_files::contents(folder.path / "a.json") == "a0");
+  CHECK(calligraphy::testing_files::contents(folder.path / "elsewhere.json") == "e0");
   CHECK(names_in(folder.path) == std::vector<std::string>{"a.json", "b.json", "elsewhere.json"});
 }
 
@@ -1133,7 +1128,7 @@ TEST_CASE("unseen26a: an exclusive record made twice keeps the first, a folder i
   const auto file = folder.path / "001.json";
   CHECK(write_file_exclusively(file, "first"));
   CHECK_FALSE(write_file_exclusively(file, "second"));
-  CHECK(read_text(file) == "first");
+  CHECK(calligraphy::testing_files::contents(file) == "first");
   const auto in_the_way = folder.path / "trace.h5";
   std::filesystem::create_directory(in_the_way);
   CHECK(has(thrown_exactly<DataError>([&] { write_file_atomically(in_the_way, "x"); }), in_the_way.string()));
