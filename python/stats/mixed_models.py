@@ -154,6 +154,9 @@ class _RServer:
         self.log = tempfile.TemporaryFile(mode="w+", encoding="utf-8", errors="replace")
         self.requests = 0
         self.unread = b""  # what R wrote after the last line taken
+        # Request folders left while R may still write in them (a Ctrl-C during a fit), by request number:
+        # removed once R has answered that request, or has ended.
+        self.abandoned: dict[int, str] = {}
         started: list[typing.Any] = []
         ready = threading.Event()
 
@@ -250,8 +253,10 @@ class _RServer:
             fields = line[len(self._REPLY):].split(" ")
             if fields[0] != number:
                 if fields[0].isdigit() and int(fields[0]) < self.requests:
+                    self._remove_abandoned(int(fields[0]))  # R is done with that request's folder
                     continue  # a second reply to an earlier request: that request was already answered
                 raise ValueError(f"a reply to request {fields[0]!r}, not {number}")
+            self._remove_abandoned(self.requests - 1)  # R answers in order: every earlier request is done
             if len(fields) != 3 or fields[1] not in ("ok", "error"):
                 raise ValueError(f"a reply that is not 'ok' or 'error' with one field: {line[:200]!r}")
             try:
@@ -295,6 +300,15 @@ class _RServer:
         self.log.seek(0)
         return " ".join(self.log.read().split())[-600:]
 
+    def abandon(self, folder: str) -> None:
+        """Leaves the folder of the last request to be removed once R is done with it (its answer read, or R
+        ended): a fit stopped by a Ctrl-C, whose R goes on and may still write its answer there."""
+        self.abandoned[self.requests] = folder
+
+    def _remove_abandoned(self, up_to: int) -> None:
+        for number in [n for n in self.abandoned if n <= up_to]:
+            shutil.rmtree(self.abandoned.pop(number), ignore_errors=True)
+
     def kill(self) -> None:
         """R and whatever it started (its process group) ended at once."""
         if os.name == "posix":
@@ -316,6 +330,7 @@ class _RServer:
                 pass
         self.kill()  # also a child R left behind, which would hold the pipes open
         self.process.wait()
+        self._remove_abandoned(self.requests)
         # The pipes too, whether it ended by itself or was killed: none is left for the collector to find.
         for pipe in (self.process.stdin, self.process.stdout):
             if pipe is not None:
@@ -358,28 +373,48 @@ def _fit_in_r(rscript: str, folder: str, formula: str, ddf: str) -> dict[str, "p
     each checked whole (``_read_answer``). Raises RuntimeError naming the formula and R's message when lme4
     cannot fit it; RAnswerError when R hangs past the timeout, ends, answers out of protocol or with result
     files that are not whole (the server is then stopped, and the next fit starts another); RUnavailable when
-    the R started for it says a package is missing (``_RServer``)."""
+    the R started for it says a package is missing (``_RServer``). Removes ``folder`` when it returns or
+    raises; after a Ctrl-C (any exception that is not an Exception) while R works on it, the server removes
+    it once R has answered or ended, so that the folder is never removed while R writes in it."""
     one_line = " ".join(formula.split())
-    with _SERVER_LOCK:
-        server = _serving(rscript)
-        try:
-            status, text = server.fit(folder, formula, ddf, _TIMEOUT_S)
-            if status != "ok":
-                raise RuntimeError(f"lmer: R could not fit {one_line}: {' '.join(text.split())[-600:]}")
-            return _read_answer(folder, formula, _named_files(text, one_line))
-        except (TimeoutError, EOFError, OSError, ValueError, RAnswerError) as error:
-            _SERVER.pop()
-            server.kill()
-            server.close()
-            if isinstance(error, RAnswerError):
+    left_to_server = False
+    try:
+        with _SERVER_LOCK:
+            server = _serving(rscript)
+            try:
+                return _answer_of_r(server, folder, formula, ddf, one_line)
+            except BaseException as error:
+                # A Ctrl-C: R goes on with the request and writes its answer in the folder. (On an Exception
+                # the server was stopped where R cannot go on, _answer_of_r, or R answered already.)
+                if not isinstance(error, Exception) and server.running():
+                    server.abandon(folder)
+                    left_to_server = True
                 raise
-            if isinstance(error, TimeoutError):
-                why = f"did not finish fitting {one_line} in {_TIMEOUT_S:.0f} s"
-            elif isinstance(error, ValueError):
-                why = f"answered the fit of {one_line} out of protocol: {error}"
-            else:
-                why = f"ended while fitting {one_line}: {error}"
-            raise RAnswerError("lmer: R " + why) from error
+    finally:
+        if not left_to_server:
+            shutil.rmtree(folder, ignore_errors=True)
+
+
+def _answer_of_r(server: _RServer, folder: str, formula: str, ddf: str, one_line: str) -> dict:
+    """`_fit_in_r`'s request to a running server, under the server lock."""
+    try:
+        status, text = server.fit(folder, formula, ddf, _TIMEOUT_S)
+        if status != "ok":
+            raise RuntimeError(f"lmer: R could not fit {one_line}: {' '.join(text.split())[-600:]}")
+        return _read_answer(folder, formula, _named_files(text, one_line))
+    except (TimeoutError, EOFError, OSError, ValueError, RAnswerError) as error:
+        _SERVER.pop()
+        server.kill()
+        server.close()
+        if isinstance(error, RAnswerError):
+            raise
+        if isinstance(error, TimeoutError):
+            why = f"did not finish fitting {one_line} in {_TIMEOUT_S:.0f} s"
+        elif isinstance(error, ValueError):
+            why = f"answered the fit of {one_line} out of protocol: {error}"
+        else:
+            why = f"ended while fitting {one_line}: {error}"
+        raise RAnswerError("lmer: R " + why) from error
 
 
 def _named_files(text: str, one_line: str) -> dict[str, int]:
@@ -534,7 +569,8 @@ def lmer(frame: "pandas.DataFrame", formula: str, factors: typing.Mapping[str, t
     if frame.empty:
         raise ValueError("lmer: the frame has no rows")
     rscript = _check_r()
-    with tempfile.TemporaryDirectory(prefix="calligraphy-lmer-") as folder:
+    folder = tempfile.mkdtemp(prefix="calligraphy-lmer-")
+    try:  # the folder is _fit_in_r's to remove once it is called
         frame.to_csv(os.path.join(folder, "data.csv"), index=False, encoding="utf-8")
         # R is told which columns are text, so that a level spelt like a number, a logical or R's NA stays text.
         numeric = pandas.api.types.is_numeric_dtype
@@ -545,7 +581,10 @@ def lmer(frame: "pandas.DataFrame", formula: str, factors: typing.Mapping[str, t
         levels = [{"factor": name, "level": str(level)} for name, values in factors.items() for level in values]
         pandas.DataFrame(levels, columns=["factor", "level"]).to_csv(os.path.join(folder, "levels.csv"),
                                                                     index=False, encoding="utf-8")
-        answer = _fit_in_r(rscript, folder, formula, ddf)
+    except BaseException:
+        shutil.rmtree(folder, ignore_errors=True)
+        raise
+    answer = _fit_in_r(rscript, folder, formula, ddf)
     fixed, random, terms = answer["fixed.csv"], answer["random.csv"], answer["anova.csv"]
     info = dict(answer["fit.csv"].itertuples(index=False, name=None))
     pairs = answer.get("pairs.csv")
