@@ -595,8 +595,10 @@ class CorpusCommands(Base):
         process.send_signal(signal.SIGTERM)
         process.communicate(timeout=TIMEOUT_S)
         self.assert_listing(self.dir, ["data", "s.clg"])
-        if process.returncode != 0:
-            self.assertEqual((self.dir / "s.clg").read_bytes(), b"earlier store\n")
+        if process.returncode != 0 and (self.dir / "s.clg").read_bytes() != b"earlier store\n":
+            # The signal came after the store was renamed into place (the build is quick): the run ends by the
+            # signal with the new store whole, never a part of it.
+            self.assertEqual(run(["characters", "--store", "s.clg"], self.dir).returncode, 0)
 
     def test_numbers_past_their_ranges(self):
         self.data(("十",))
