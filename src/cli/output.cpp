@@ -177,16 +177,16 @@ FilePlan::Identity identify_file(const std::string& what, const std::string& pat
   } catch (const DataError& e) {
     throw DataError(what + " " + e.what());
   }
-  // A relative input or output once the working directory was removed is refused, as docs/cli.md says:
-  // the kernel may still resolve "../x" from the removed folder, but no path can name what was read.
-  if (target.is_relative()) absolute_path(what, path, target);
+  // Resolved first: a relative input or output once the working directory was removed is refused, as
+  // docs/cli.md says (the kernel may still resolve "../x" from the removed folder, but no path can name what
+  // was read).
+  const fs::path absolute = absolute_path(what, path, target);
   struct stat status {};
   if (::stat(target.c_str(), &status) == 0) return identity_of(status, target);
   if (errno != ENOENT && errno != ENOTDIR) {
     throw DataError(named(what, path) + ": cannot examine: " + std::strerror(errno));
   }
   FilePlan::Identity identity;  // not there yet: the resolved folder and the name
-  const fs::path absolute = absolute_path(what, path, target);
   std::error_code error;
   const fs::path folder = fs::weakly_canonical(absolute.parent_path(), error);
   identity.path = ((error ? absolute.parent_path() : folder) / absolute.filename()).string();
