@@ -296,6 +296,21 @@ TEST_CASE("No NaN leaves a query, whatever the method and options", "[nearest_po
   check_well_formed({"huge", huge, Vec2(0, -1e150)}, calligraphy::nearest_point(huge, Vec2(0, -1e150)));
   const StrokeElement denormal = make({{0, 0}, {4e-320, 0}, {0, 4e-320}});
   check_well_formed({"subnormal", denormal, Vec2(1, 1)}, calligraphy::nearest_point(denormal, Vec2(1, 1)));
+  // The element and the query all subnormal: the local frame's scale 2^-exponent would overflow.
+  const double tiny = std::numeric_limits<double>::denorm_min();
+  for (const StrokeElement& element :
+       {make({{tiny, 0}, {0, tiny}}), make({{tiny, 0}, {0, tiny}, {4e-320, 4e-320}})}) {
+    for (const NearestPointMethod method :
+         {NearestPointMethod::exact, NearestPointMethod::newton, NearestPointMethod::subdivision}) {
+      const auto found = calligraphy::nearest_point(element, Vec2(0, 0), with_method(method));
+      check_well_formed({"all subnormal", element, Vec2(0, 0)}, found);
+      // exact: no farther than the start, up to the subnormal grid's rounding (hypot: the squared norm of a
+      // subnormal vector underflows to 0). Subdivision stops at its absolute tolerance, far above this
+      // element.
+      if (method == NearestPointMethod::exact)
+        CHECK(found.distance <= std::hypot(element.control[0].x(), element.control[0].y()) + 4 * tiny);
+    }
+  }
 }
 
 TEST_CASE("NaN, infinite or out-of-range input is rejected with InvalidArgument naming it",

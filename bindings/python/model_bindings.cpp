@@ -32,7 +32,12 @@ StrokeElement element_from_points(py::handle object, const std::string& name) {
                           " point(s)");
   }
   std::vector<Vec2> points;
-  for (py::ssize_t i = 0; i < v.count; ++i) points.push_back(v.vec2(i));
+  for (py::ssize_t i = 0; i < v.count; ++i) {
+    points.push_back(v.vec2(i));
+    // Named as Python names it (the argument and the row), not as the C++ constructor would.
+    if (!points.back().allFinite())
+      throw InvalidArgument(name + ": point " + std::to_string(i) + " is not finite");
+  }
   if (points.size() == 2) return StrokeElement::line(points[0], points[1]);
   return StrokeElement::bezier(points.data(), static_cast<int>(points.size()));
 }

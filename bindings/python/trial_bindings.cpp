@@ -330,6 +330,16 @@ PyTrialResult trial_py(const std::string& device_name, TrialPacing pacing,
   std::unique_ptr<HapticDevice> trial_device = device_name.empty()
                                                    ? std::make_unique<SimulatedDevice>(simulation.device)
                                                    : python_device_registry().create(device_name);
+  // Auto pacing is lock-step on a device the simulated writer moves, and lock-step has no wall clock to
+  // bound: a stall bound given there is refused, as `trial --watchdog-ms` is (the record would be invalid).
+  const bool lock_step = spec.pacing == TrialPacing::lock_step ||
+                         (spec.pacing == TrialPacing::automatic && trial_device->hand_port() != nullptr);
+  if (watchdog_s && lock_step) {
+    throw InvalidArgument(
+        "watchdog_s: applies to real-time pacing only (pacing='real-time' or a hardware "
+        "device); '" +
+        trial_device->info().model + "' runs lock-step, with no wall clock to bound");
+  }
   TrialRunInputs inputs;
   inputs.device = trial_device.get();
   inputs.host_process = true;  // the interpreter is the application: no memory locking, no SCHED_FIFO

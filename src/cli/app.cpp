@@ -216,7 +216,9 @@ CLI::Option* add_schema_option(CLI::App& app, const SchemaField& field, void* ob
   ParameterRange range = field.range;  // in the option's unit
   range.low *= field.option_factor;
   range.high *= field.option_factor;
-  if (field.kind == FieldKind::number) {
+  if (field.kind == FieldKind::number && field.option_whole) {
+    description += ", " + whole_option_range_text(field);  // as the integer options write theirs
+  } else if (field.kind == FieldKind::number) {
     description += ", " + range.text(unit);
   } else if (field.kind == FieldKind::integer) {
     description += ", " + field.range_text();

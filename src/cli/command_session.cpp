@@ -598,14 +598,16 @@ int resume_session(const SessionResumeCommand& command, DeviceRegistry& devices)
   SessionFolder session = SessionFolder::open(command.folder);
   // A session of another study, copied into this study folder, is not this study's to go on with.
   StudyIdentity::check(StudyIdentity::read(study_root), study_root, session.path(), session.manifest());
+  // Each saved record read as `trial --spec` reads it, whether trials are left or not: one cut or emptied
+  // since is the folder's content refused (InputError, exit 2), named now rather than by the next reader of
+  // the study, and never called saved.
+  for (const PlannedTrial& trial : session.plan()) {
+    if (session.is_saved(trial)) (void)read_recorded_trial_file(session.trial_file(trial, "json").string());
+  }
   // A folder renamed since its first trial was saved: its records name the old id (the folder's name).
   session.check_records_name_this_session();
   require_characters(session.manifest().protocol, CharacterSource(command.library));
   if (!session.next_unsaved()) {
-    // "Every trial is saved" is said only of records a reader takes: each is read as the trials of a
-    // resume are, so a damaged one (cut, emptied) is named now rather than by the next reader of the study.
-    for (const PlannedTrial& trial : session.plan())
-      (void)read_recorded_trial_file(session.trial_file(trial, "json").string());
     // A run killed after its last save and before it logged the end: the log is completed, once.
     (void)complete_session_log(session);
     std::printf("%s: every trial of %s is saved already\n", session.manifest().setup.subject.id.c_str(),

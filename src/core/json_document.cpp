@@ -138,6 +138,7 @@ std::string non_json_kind(std::string_view text) {
   if (starts("\x1f\x8b")) return "gzip-compressed data";
   if (starts("CLGSTORE")) return "a corpus store (corpus build)";
   if (starts("\x89HDF\r\n\x1a\n")) return "an HDF5 file";
+  if (text.empty()) return "empty (0 bytes)";  // "at byte 1" would name a byte it does not have
   std::string_view rest = text;
   if (rest.substr(0, 3) == "\xEF\xBB\xBF") rest.remove_prefix(3);  // a UTF-8 byte-order mark
   const std::size_t first = rest.find_first_not_of(" \t\r\n");

@@ -25,6 +25,19 @@ std::string integer_range_text(const SchemaField& field) {
   return std::to_string(field.integer_low) + ".." + std::to_string(field.integer_high);
 }
 
+}  // namespace
+
+std::string whole_option_range_text(const SchemaField& field) {
+  const double low = field.range.low * field.option_factor;
+  const double high = field.range.high * field.option_factor;
+  const auto first = static_cast<std::int64_t>(field.range.low_open ? std::floor(low) + 1.0 : std::ceil(low));
+  const auto last =
+      static_cast<std::int64_t>(field.range.high_open ? std::ceil(high) - 1.0 : std::floor(high));
+  return std::to_string(first) + ".." + std::to_string(last);
+}
+
+namespace {
+
 // A whole number as the command line writes it: digits, '-' first only for a negative value; no '+', no
 // spaces, no "-0" (which would say a sign the value does not have).
 template <typename T>
@@ -173,6 +186,16 @@ void SchemaField::check_string(std::string_view text) const {
 void set_field_from_text(const SchemaField& field, void* object, std::string_view text) {
   switch (field.kind) {
     case FieldKind::number: {
+      if (field.option_whole) {
+        const std::string range = whole_option_range_text(field);
+        const std::optional<std::int64_t> whole = parse_whole<std::int64_t>(text);
+        const double value = whole ? static_cast<double>(*whole) / field.option_factor : 0.0;
+        if (!whole || !field.range.contains(value))
+          throw InvalidArgument(quoted(text) + " is not a whole number of " + std::string(field.option_unit) +
+                                " in " + range);
+        field.set_number(field, object, 0, value);
+        return;
+      }
       const std::optional<double> value = parse_finite_double(text);
       // '+400', ' 400' and '0x190' are numbers to some readers: say which spelling is read.
       if (!value)

@@ -22,12 +22,19 @@ LocalCurve to_local(const StrokeElement& element, const Vec2& p) noexcept {
   int exponent = 0;
   if (extent > 0.0) std::frexp(extent, &exponent);  // extent = m * 2^exponent, m in [0.5, 1)
   curve.scale = std::ldexp(1.0, exponent);
-  const double inverse_scale = std::ldexp(1.0, -exponent);
+  // 2^-exponent overflows for an extent below 2^-1022 (subnormal): such an extent is scaled by ldexp, which
+  // is exact for each coordinate; every other extent by one multiplication.
+  const bool subnormal_extent = exponent < -1021;
+  const double inverse_scale = subnormal_extent ? 0.0 : std::ldexp(1.0, -exponent);
+  const auto to_unit = [&](const Vec2& v) {
+    return subnormal_extent ? Vec2(std::ldexp(v.x(), -exponent), std::ldexp(v.y(), -exponent))
+                            : Vec2(v * inverse_scale);
+  };
   for (int i = 0; i <= element.degree; ++i) {
     const auto index = static_cast<std::size_t>(i);
-    curve.q[index] = (element.control[index] - curve.origin) * inverse_scale;
+    curve.q[index] = to_unit(element.control[index] - curve.origin);
   }
-  curve.p = (p - curve.origin) * inverse_scale;
+  curve.p = to_unit(p - curve.origin);
   return curve;
 }
 

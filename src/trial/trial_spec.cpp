@@ -18,6 +18,7 @@
 #include "calligraphy/model/scene.hpp"
 #include "calligraphy/trial/writer_profile.hpp"
 #include "core/json_reader.hpp"
+#include "core/rate_text.hpp"
 #include "core/schema_json.hpp"
 #include "trial/record_schema.hpp"
 #include "trial/trial_spec_object.hpp"
@@ -174,7 +175,7 @@ const std::vector<SchemaField>& spec_fields() {
           "realtime", {.doc = "real-time pacing: fail unless SCHED_FIFO, CPU pinning and locked memory are "
                               "obtained (enforce)",
                        .option = "--realtime"}),
-      option_in(
+      option_in_whole(
           "ms", 1000.0,
           number_field<&TrialSpec::watchdog_s>(
               "watchdog_s", {.low = 0.0, .high = kMaxStallTimeoutS},
@@ -430,7 +431,7 @@ void TrialSpec::validate(TeacherSource teacher_from) const {
   }
   const bool real_time = pacing == TrialPacing::real_time;
   if (!servo_rate_allowed(rate_hz, real_time)) {
-    refuse_field("rate_hz", number_text(rate_hz) + " Hz is outside " + servo_rate_range_text(real_time) +
+    refuse_field("rate_hz", detail::rate_text(rate_hz) + " is outside " + servo_rate_range_text(real_time) +
                                 (real_time ? " (real-time pacing)" : ""));
   }
   if (watchdog_s != static_cast<double>(std::llround(watchdog_s * 1000.0)) / 1000.0)
@@ -441,7 +442,7 @@ void TrialSpec::validate(TeacherSource teacher_from) const {
   // A trace longer than this would not fit a trial's memory (one sample per tick).
   if (exceeds_trial_ticks(max_duration_s, rate_hz)) {
     refuse_field("max_duration_s", number_text(max_duration_s) + " s at " + field_label("rate_hz") + " " +
-                                       number_text(rate_hz) + " Hz is more than 10^7 servo ticks");
+                                       detail::rate_text(rate_hz) + " is more than 10^7 servo ticks");
   }
   // Outputs on one file are the front-end's to find (after resolving links: the CLI's file plan).
   if (record_file == "-")

@@ -148,6 +148,9 @@ struct SchemaField {
   std::string_view option_value_name = {};
   std::string_view option_unit = {};
   double option_factor = 1.0;
+  /// The option takes whole numbers of `option_unit` only ("--watchdog-ms 20", not "20.5" or "1e3"): the
+  /// command line's integer syntax, for a field the documents hold as a real number in another unit.
+  bool option_whole = false;
   /// A document of a version older than this may lack the field, which then takes its default (a field
   /// added since); 0: the field was always there.
   int since_version = 0;
@@ -571,6 +574,17 @@ template <auto Member, std::size_t N>
   field.option_factor = factor;
   return field;
 }
+
+/// The command line gives the field as a whole number of another unit (integer syntax, "0..60000" in help):
+/// option value = field value x `factor`.
+[[nodiscard]] constexpr SchemaField option_in_whole(std::string_view unit, double factor, SchemaField field) {
+  field = option_in(unit, factor, field);
+  field.option_whole = true;
+  return field;
+}
+
+/// An `option_in_whole` field's range as whole numbers of its option's unit ("0..60000").
+[[nodiscard]] std::string whole_option_range_text(const SchemaField& field);
 
 /// The numeric fields of a struct's ParameterTable as schema fields, in table order: the table stays the one
 /// definition of their ranges.
