@@ -126,12 +126,17 @@ def _finite_outcome(trials: pandas.DataFrame, value: str, caller: str) -> pandas
     if not pandas.api.types.is_numeric_dtype(trials[value]) or pandas.api.types.is_bool_dtype(trials[value]):
         raise TypeError(f"{caller}: column {value!r} must be numeric (an outcome in SI units), "
                         f"it has dtype {trials[value].dtype}")
-    infinite = np.isinf(trials[value].to_numpy(dtype=float))
-    if not infinite.any():
+    # As float64, pandas' missing value (pd.NA of a nullable column: Float64, Int64, convert_dtypes) as NaN,
+    # so that every statistic and fit reads one kind of number and one kind of missing.
+    numbers = trials[value].to_numpy(dtype=float, na_value=np.nan)
+    infinite = np.isinf(numbers)
+    if infinite.any():
+        warnings.warn(f"{caller}: column {value!r} holds {int(infinite.sum())} infinite value(s); they are counted "
+                      "as missing (like NaN)", NonFiniteValueWarning, stacklevel=3)
+        numbers = np.where(infinite, np.nan, numbers)
+    elif trials[value].dtype == np.float64:
         return trials
-    warnings.warn(f"{caller}: column {value!r} holds {int(infinite.sum())} infinite value(s); they are counted "
-                  "as missing (like NaN)", NonFiniteValueWarning, stacklevel=3)
-    return trials.assign(**{value: trials[value].where(~infinite, np.nan)})
+    return trials.assign(**{value: pandas.Series(numbers, index=trials.index)})
 
 
 def _levels(column: pandas.Series) -> list[typing.Any]:
@@ -278,6 +283,8 @@ def describe(trials: pandas.DataFrame, value: str, by: str | typing.Sequence[str
     data = trials[list(dict.fromkeys(needed))].assign(**({everything: 0} if not by else {}))
     missing = data[value].isna()
     n_missing = missing.groupby([data[k] for k in keys], observed=True, sort=True).sum()
+    if not by:  # the whole table is one group, also when it has no rows: one row in all, with n = 0
+        n_missing = n_missing.reindex(pandas.Index([0], name=everything), fill_value=0)
     units = data[~missing]
     if unit == "subject":
         units = units.groupby([*keys, "subject"], observed=True, sort=True)[value].mean().reset_index()

@@ -211,8 +211,13 @@ nlohmann::json parse_json_document(std::string_view text, const std::string& sou
     const std::string pointer = tracker.pointer();
     // "[json.exception.out_of_range.406] number overflow parsing '1e999'"
     const std::string reason = parser_reason(e.what());
-    throw DataError(source + ": " + (pointer.empty() ? "/" : pointer) +
-                    ": not a finite number (beyond the range of a double): " + reason);
+    const std::size_t open = reason.find('\'');
+    const std::size_t close = open == std::string::npos ? open : reason.find('\'', open + 1);
+    const std::string literal =
+        close == std::string::npos ? std::string() : reason.substr(open + 1, close - open - 1);
+    throw NumberOverflow(source + ": " + (pointer.empty() ? "/" : pointer) +
+                             ": not a finite number (beyond the range of a double): " + reason,
+                         pointer.empty() ? "/" : pointer, literal);
   }
 }
 

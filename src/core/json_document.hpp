@@ -6,11 +6,27 @@
 #include <string>
 #include <string_view>
 
+#include "calligraphy/core/errors.hpp"
+
 namespace calligraphy::json_detail {
+
+/// The DataError of a number beyond a double's range, with its JSON pointer and its text ("1e999"), for a
+/// reader that knows what the value there means (a record's version) and can say what it expected.
+class NumberOverflow : public DataError {
+ public:
+  NumberOverflow(const std::string& message, std::string pointer, std::string literal)
+      : DataError(message), pointer_(std::move(pointer)), literal_(std::move(literal)) {}
+  [[nodiscard]] const std::string& pointer() const noexcept { return pointer_; }
+  [[nodiscard]] const std::string& literal() const noexcept { return literal_; }
+
+ private:
+  std::string pointer_;
+  std::string literal_;
+};
 
 /// The document `text`. Throws DataError "SOURCE: not valid JSON at byte N: ..." for malformed JSON, and
 /// "SOURCE: POINTER: not a finite number: ..." (the JSON pointer of the value) for a number beyond a
-/// double's range (1e999, -1e400), which the parser refuses without a byte offset.
+/// double's range (1e999, -1e400), which the parser refuses without a byte offset (a NumberOverflow).
 nlohmann::json parse_json_document(std::string_view text, const std::string& source);
 
 /// What `text` is, by its first bytes, when it cannot be a JSON document at all: another kind of file the

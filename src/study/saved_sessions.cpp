@@ -219,7 +219,7 @@ RecordedTrial read_study_recorded_trial(const std::string& path) {
   nlohmann::json document;
   RecordedTrial recorded;
   try {
-    document = json_detail::parse_json(text, path);
+    document = trial_detail::parse_record_text(text, path);
     if (document.is_object() && document.contains("specification") && document.contains("format"))
       recorded = *study_detail::check_trial_record(document, path);
     else

@@ -13,6 +13,7 @@
 #include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
 #include "calligraphy/core/sha256.hpp"
+#include "core/json_document.hpp"
 #include "core/json_reader.hpp"
 #include "core/schema_json.hpp"
 #include "core/whole_file.hpp"
@@ -220,7 +221,7 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
            std::any_of(settings->begin(), settings->end(), [](const json& item) { return item.is_string(); });
   };
   json typed;
-  if (object->is_object() && text_settings(*object)) {
+  if (version == 1 && object->is_object() && text_settings(*object)) {
     typed = *object;
     trial_detail::type_writer_settings(typed["trial"], reader.pointer("trial"), source);
   }
@@ -412,17 +413,30 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
   return r;
 }
 
+json parse_record_text(std::string_view text, const std::string& source) {
+  try {
+    return json_detail::parse_json(text, source);
+  } catch (const json_detail::NumberOverflow& e) {
+    // Only the specification's own: a study record's top-level version reads other numbers.
+    if (e.pointer() != "/specification/version") throw;
+    json_detail::fail(source, e.pointer(),
+                      "version " + e.literal() + " is not one this library reads (" +
+                          std::to_string(kOldestRecordedTrialVersion) + " to " +
+                          std::to_string(kRecordedTrialVersion) + ")");
+  }
+}
+
 }  // namespace trial_detail
 
 RecordedTrial read_recorded_trial(std::string_view text, const std::string& source) {
-  return trial_detail::read_recorded_document(json_detail::parse_json(text, source), source);
+  return trial_detail::read_recorded_document(trial_detail::parse_record_text(text, source), source);
 }
 
 RecordedTrial read_recorded_trial_file(const std::string& path) {
   const std::string text = read_regular_file(path, kMaxRecordedTrialBytes);
   // Read whole: what is refused now is the record's content, the input the command was given.
   try {
-    return trial_detail::read_recorded_document(json_detail::parse_json(text, path), path);
+    return trial_detail::read_recorded_document(trial_detail::parse_record_text(text, path), path);
   } catch (const InputError&) {
     throw;
   } catch (const DataError& e) {
