@@ -276,6 +276,8 @@ class SessionSafetyTest(unittest.TestCase):
         _, stderr = resumed.communicate(timeout=300)
         self.assertEqual(resumed.returncode, 128 + signal.SIGTERM, stderr.decode())
 
+    @unittest.skipIf(os.environ.get("CALLIGRAPHY_SANITIZED"),
+                     "a plan of 300,000 trials sized takes 14 s under the sanitizers; the Release run sizes it")
     def test_a_manifest_larger_than_its_readers_take_is_refused_before_any_folder(self):
         # 300,000 planned trials, within the 1,000,000 a session may plan: a session.json of some 75 MB.
         strings = ["十", "人", "口", "大", "山", "日", "木", "中", "天", "千", "十人", "人十", "口十", "十口", "大人"]
