@@ -14,10 +14,12 @@ Steps that chain run in order in the one folder of their document; the Python bl
 namespace, as in one interpreter session.
 
 A shell step (a logical line, or one part of an `a && b` chain) is skipped only by one of the rules of SKIP
-below, and the test prints each skip with its rule. Inputs the reader supplies are given, made by the program
-itself where it can (FIXTURES): `DIR` is the character data folder, a study is a session run. Each step run
-must exit 0 (or what the text beside it says), print no traceback and no error line, make the files it names
-as outputs (non-empty), and hold what the docs state about its output (CHECKS).
+below, or as run by round 15A (RUN_BY_ROUND15A: the README's study, cohort and Table 5, the very commands round
+15A runs with this test's checks and more), and the test prints each skip with its rule. Inputs the reader
+supplies are given, made by the program itself where it can (FIXTURES): `DIR` is the character data folder, a
+study is a session run. Each step run must exit 0 (or what the text beside it says), print no traceback and no
+error line, make the files it names as outputs (non-empty), and hold what the docs state about its output
+(CHECKS).
 
 CALLIGRAPHY_DOCS_EXAMPLES_ONLY=README.md,python.md restricts the run to some documents (for working on them);
 CALLIGRAPHY_DOCS_EXAMPLES_ALL=1 also runs the LONG_DOCUMENTS, skipped otherwise to keep the suite's budget.
@@ -38,6 +40,7 @@ import unittest
 from xml.etree import ElementTree
 
 from outsider import strip_comment
+import test_unseen_round15a as round15a   # what round 15A runs of each document: its extraction, skips and caps
 
 SOURCE = os.environ.get("CALLIGRAPHY_SOURCE_DIR", os.path.dirname(os.path.dirname(os.path.dirname(
     os.path.abspath(__file__)))))
@@ -213,6 +216,38 @@ def cap_python(code, folder, env):
         square = counterbalancing_square(m.group(2), folder, env)
         return m.group(1) + str(min(int(m.group(3)), 2 * square if square else int(m.group(3))))
     return re.sub(r'(cohort\.simulate\("([^"]+)", )(\d+)', repl, code)
+
+
+# The README's study (`session run`, `report`, `study_report`), its cohort and Table 5 are most of this test's CPU,
+# and round 15A (tests/cli/test_unseen_round15a.py, CTest cli_unseen_round15a_tests, registered wherever this test
+# is, with the same program, module and sources) runs each of them as well: the same command after the same cap, in
+# a folder laid out as here, in the document's order (a study's `session run` that another document runs the same
+# way, made once and copied), held to all this test holds them to (exit status 0, no error line on either stream,
+# each output it names made, non-empty and of its kind, the study report's index.html, Table 5's table of 永我九心) and
+# more (a line and a folder per subject, trials.csv and strokes.csv). Such a step is not run twice: it is skipped
+# here, naming round 15A, where round 15A runs that very command in this configuration (not skipped by its rules,
+# with its Python module, not under the sanitizers, its document not one it leaves to
+# CALLIGRAPHY_DOCS_EXAMPLES_ALL).
+RUN_BY_ROUND15A = {"README.md": re.compile(r"calligraphy (?:session run|session cohort|report) |"
+                                           r"calligraphy\.study_report |examples/python/table5\.py")}
+_ROUND15A_COMMANDS = {}
+
+
+def run_by_round15a(doc, command):
+    """Whether round 15A runs this command, as this test would run it, of this document."""
+    steps = RUN_BY_ROUND15A.get(doc)
+    if not steps or not steps.search(command) or round15a.SANITIZED or not round15a.PYTHONPATH or (
+            doc in round15a.LONG_DOCUMENTS and not round15a.ALL):
+        return False
+    if doc not in _ROUND15A_COMMANDS:
+        commands = set()
+        for example in round15a.extract(round15a.SOURCE / doc):
+            if example.kind != "sh" or round15a.skip_reason(example):
+                continue
+            text = round15a.cheaper(example.text)[0]
+            commands.update(" ".join(part.split()) for part in (text or "").split("&&"))
+        _ROUND15A_COMMANDS[doc] = commands
+    return " ".join(command.split()) in _ROUND15A_COMMANDS[doc]
 
 
 def skip_rule(step):
@@ -555,6 +590,11 @@ class DocsExamples(unittest.TestCase):
                     one_run = cap(substitute(one), folder, env)
                     if re.match(r"^\w+=\S+$", one_run):    # an assignment the later lines use
                         variables.append(one_run)
+                        continue
+                    if run_by_round15a(doc, one_run):
+                        self.tally["skipped"] += 1
+                        self.skips.append("%s:%d `%s`: round15a (run as `%s` by round 15A, cli_unseen_round15a_tests,"
+                                          " with this test's checks and more)" % (doc, line, one, one_run))
                         continue
                     self.tally["run"] += 1
                     script = "\n".join(variables + [one_run])

@@ -13,25 +13,34 @@ order, so that a later one finds the files an earlier one made; its Python block
 What each example is held to, from the docs (docs/cli.md "Conventions" and "Exit statuses", the text beside it):
 - its exit status: 0, or the status the docs give the example (`calligraphy trail 永`: a usage error, 2);
 - standard error: no error line and no traceback (the library's warnings are allowed, docs/cli.md "The
-  library's log"), and never a log line on standard output;
+  library's log"), and never a log line or an error line on standard output;
 - standard output: a document alone where an output is `-` or the command takes `--json` as a flag (it parses);
 - the files: every file or folder it makes or changes is one it names (an output option's value, `mkdir`'s
   folder, a name in a Python block's text) or a companion its docs name (`report --out X.html`'s `X_files`),
-  and no temporary is left; a document the example regenerates (`--markdown docs/X.md`) is unchanged;
+  and no temporary is left; a document the example regenerates (`--markdown docs/X.md`) is unchanged; each
+  output option's file or folder is made and not empty, a .json one JSON, a .svg one SVG, a .csv one a table
+  with a header line;
 - what the text beside it says of its output: a comment `again.csv == out.csv`, the 39 typical strokes, a
   table per stroke, a session per subject, keys in SI units, a Python expression's value or shape given in its
-  comment (`yong.typical_stroke_ids  # [4, 10, 8, 3, 5]`), and the numbers a document quotes from a run of the
-  example (docs/python.md's Table 5) within their printed rounding.
+  comment (`yong.typical_stroke_ids  # [4, 10, 8, 3, 5]`), Table 5's table of its four characters, and the
+  numbers a document quotes from a run of the example (docs/python.md's Table 5) within their printed rounding.
+(test_docs_examples.py leaves the README's study, cohort and Table 5 to this round, which holds them to all of
+its checks of them.)
 
 An example is skipped only by a named rule, printed with it: a build or install step, a haptic device or a
 person, the trainer window, the network (npm, cnchar), a benchmark or fuzzing campaign (their output is a
 timing), R. Where the docs' example would cost more than this round's budget (a cohort of 70 simulated
-subjects, 15 subjects of a study, 8 seeds of every trial of Table 5 beside the README's 4), it runs with a
-smaller count of its own option, said in the printed line; a store built from the whole data set is the
-bundled one (docs/corpus.md: data/corpus is that build). CALLIGRAPHY_CORPUS_DIR names the fetched
-hanzi-writer-data package where an example fetches it.
+subjects, 15 subjects of a study, 8 seeds of every trial of Table 5 beside the README's 4, 4 seeds of a sweep,
+the corpus sweep's 58 characters), it runs with a smaller count of its own option, said in the printed line; a
+real-time trial, which lasts as long as its writing (永 about 14 s), writes the one-stroke 一 (about 4 s) with the
+same options; a store built from the whole data set is the bundled one (docs/corpus.md: data/corpus is that
+build). A simulated study's `session run` that several documents (and a Python example's input) run alike, on
+the same protocol, runs once: the later ones get a copy of its study and its output, said in the printed line.
+CALLIGRAPHY_CORPUS_DIR names the fetched hanzi-writer-data package where an example fetches it.
 """
 import ast
+import atexit
+import hashlib
 import io
 import resource
 import json
@@ -46,6 +55,7 @@ import time
 import unittest
 import contextlib
 from pathlib import Path
+from xml.etree import ElementTree
 
 from outsider import CLI, SANITIZED, sanitized_subset, strip_comment
 
@@ -261,6 +271,20 @@ def cheaper(text):
     if re.search(r"cohort\.simulate\([^)]*\b70\b", text):
         text = re.sub(r"(cohort\.simulate\([^,]+, )70\b", r"\g<1>12", text)
         changes.append("70 subjects -> 12, two or more in each group it compares")
+    # A real-time trial lasts as long as its writing (永 about 14 s, 口 9 s): the one-stroke 一 (4 s) is paced
+    # by the same loop with the same options.
+    m = re.search(r"calligraphy trial ([\u3400-\u9fff]+) [^\n&|;]*--pacing real-time", text)
+    if m and m.group(1) != "一":
+        text = text[:m.start(1)] + "一" + text[m.end(1):]
+        changes.append(f"{m.group(1)} -> 一: a real-time trial lasts as long as its writing")
+    # A sweep's seeds are alike (each a trial per character and grid point): one seed, every character and
+    # grid point as written.
+    cap(r"(\bsweep\([^)\n]*\bseeds=)(\d+)", 1, "the sweep's seeds")
+    # The corpus sweep of every embedded character on the local pool: its own --limit, 4 characters (8 trials,
+    # guidance off and on, work for each worker), the table, the summary and the figure as written.
+    if re.search(r"examples/python/corpus_sweep\.py\s*$", text):
+        text = text.rstrip() + " --limit 4"
+        changes.append("the 58 embedded characters -> --limit 4")
     for placeholder, value in PYTHON_PLACEHOLDERS.items():
         if placeholder in text:
             text = text.replace(placeholder, value)
@@ -355,6 +379,65 @@ def covered(path, names):
 # ---------------------------------------------------------------------------------------------------------------
 # What the text beside an example says of its output.
 
+# An error line on either stream (what test_docs_examples.py holds the same examples to).
+ERROR_LINE = re.compile(r"^(?:error|Error|ERROR|calligraphy[\w .-]*: error)\b|Traceback \(most recent call last\)",
+                        re.M)
+
+
+def option_outputs(text):
+    """The values of the output options of the example's commands (`--json`, `--svg`, `--csv`, `--out`,
+    `--record`, `--markdown`) and of its redirections (`> FILE`): files and folders it makes, never empty."""
+    outs = []
+    for command in re.split(r"&&|;|\n", text):
+        try:
+            words = shlex.split(command, comments=True)
+        except ValueError:
+            continue
+        for k, w in enumerate(words[:-1]):
+            if w in ("--json", "--svg", "--csv", "--out", "--record", "--markdown", ">") and not words[
+                    k + 1].startswith(("-", "/dev/")):
+                outs.append(words[k + 1])
+    return outs
+
+
+def nonempty(path):
+    return any(path.iterdir()) if path.is_dir() else path.is_file() and path.stat().st_size > 0
+
+
+# A simulated study's `session run` alone (the same command in several documents, and the study a Python
+# example reads): run once in this process, and where the same command runs again on the same protocol with
+# its output folder absent, its study copied and its exit status and output given again, so that each
+# document's checks read the one run's outputs.
+STUDY_RUN = re.compile(r"build/bin/calligraphy session run (\S+\.json) --writer simulated --subjects \d+ --out (\S+)")
+_STUDIES = {}  # (command, protocol's SHA-256) -> (result, copy of its study, where it ran)
+_STUDY_COPIES = []
+
+
+def run_bash(text, folder, env, where):
+    """`bash -c` the text in the folder (pipefail, no standard input, output captured)."""
+    m = STUDY_RUN.fullmatch(text.strip())
+    key = None
+    if m and (folder / m.group(1)).is_file() and not os.path.lexists(folder / m.group(2)):
+        key = (text.strip(), hashlib.sha256((folder / m.group(1)).read_bytes()).hexdigest())
+        if key in _STUDIES:
+            result, copy, first = _STUDIES[key]
+            shutil.copytree(copy, folder / m.group(2), symlinks=True)
+            print(f"     (not run again: the study and output of the same command on the same protocol at {first})",
+                  file=sys.stderr)
+            return result
+    result = subprocess.run(["bash", "-c", "set -o pipefail\n" + text], cwd=folder, env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
+                            timeout=TIMEOUT_S)
+    if key and result.returncode == 0 and (folder / m.group(2)).is_dir():
+        if not _STUDY_COPIES:
+            _STUDY_COPIES.append(tempfile.mkdtemp(prefix="r15a-studies-"))
+            atexit.register(shutil.rmtree, _STUDY_COPIES[0], True)
+        copy = Path(_STUDY_COPIES[0]) / str(len(_STUDIES))
+        shutil.copytree(folder / m.group(2), copy, symlinks=True)
+        _STUDIES[key] = (result, copy, where)
+    return result
+
+
 def stdout_is_one_document(text):
     for command in re.split(r"&&|\n", text):
         words = command.split()
@@ -443,9 +526,7 @@ class Round15A(unittest.TestCase):
             text = text.replace('"$(bash scripts/fetch-hanzi-writer-data.sh)"', shlex.quote(CORPUS_DIR))
         before = snapshot(folder)
         docs_before = {p: p.read_bytes() for p in (folder / "docs").glob("*.md")}
-        result = subprocess.run(["bash", "-c", "set -o pipefail\n" + text], cwd=folder, env=env,
-                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
-                                timeout=TIMEOUT_S)
+        result = run_bash(text, folder, env, f"{example.doc}:{example.line}")
         out = result.stdout.decode("utf-8", "replace")
         err = result.stderr.decode("utf-8", "replace")
         expected = next((s for p, s in EXIT_STATUS.items() if re.search(p, text)), 0)
@@ -453,6 +534,8 @@ class Round15A(unittest.TestCase):
         self.assertNotIn("Traceback", err, f"{example}\n{err[-2000:]}")
         if expected == 0:
             self.assertNotRegex(err, r"(?m)^calligraphy [\w ]+: error:|^Error|^error", f"{example}\n{err[-2000:]}")
+            self.assertIsNone(ERROR_LINE.search(out), f"{example}: an error line on standard output\n{out[-2000:]}")
+            self.assertIsNone(ERROR_LINE.search(err), f"{example}: an error line\n{err[-2000:]}")
         self.assertNotRegex(out, r"(?m)^calligraphy [\w ]+: (warning|info|error):|\[(info|warning)\]",
                             f"{example}: the library's log on standard output")
         kind = stdout_is_one_document(text)
@@ -464,6 +547,10 @@ class Round15A(unittest.TestCase):
         elif kind == "svg" and expected == 0:
             self.assertRegex(out.lstrip(), r"^(<\?xml|<svg)", f"{example}: standard output is not an SVG alone")
         self.check_files(example, text, folder, before)
+        if expected == 0:
+            for name in option_outputs(text):
+                self.assertTrue(nonempty(folder / name), f"{example}: {name} not made or empty")
+                self.check_output_kind(example, folder / name)
         for path, data in docs_before.items():
             self.assertEqual(path.read_bytes(), data, f"{example}: regenerated {path.name} differs from the document")
         self.check_said(example, text, folder, out, err)
@@ -479,6 +566,21 @@ class Round15A(unittest.TestCase):
         for name in names:
             if example.kind != "python" and not name.startswith("-") and not name.endswith("_files"):
                 self.assertTrue((folder / name).exists(), f"{example}: {name} was not written")
+
+    def check_output_kind(self, example, path):
+        """An output named .json is JSON, .svg an SVG document, .csv a table with a header line."""
+        if not path.is_file():
+            return
+        if path.suffix == ".json":
+            try:
+                json.loads(path.read_text(encoding="utf-8"))
+            except ValueError as e:
+                self.fail(f"{example}: {path.name} is not JSON ({e})")
+        elif path.suffix == ".svg":
+            self.assertTrue(ElementTree.parse(path).getroot().tag.endswith("svg"), f"{example}: {path.name}")
+        elif path.suffix == ".csv":
+            with path.open(encoding="utf-8") as f:
+                self.assertRegex(f.readline(), r"^[A-Za-z_][\w ,]*$", f"{example}: {path.name} has no header line")
 
     def check_said(self, example, text, folder, out, err):
         """What the text beside the example says of its output."""
@@ -521,6 +623,11 @@ class Round15A(unittest.TestCase):
         if m:
             value = float(out.strip())
             self.assertTrue(0 < value < 0.005, f"{example}: {value} is not a deviation in metres")
+        if "examples/python/table5.py" in text:
+            # (a) the table of the paper's four characters, with and without guidance, whatever the seeds
+            self.assertIn("dev off [mm]", out, f"{example}: no Table 5\n{out[-2000:]}")
+            for char in "永我九心":
+                self.assertIn(char, out, f"{example}: no row of {char}")
         if "table5.py --seeds 8" in text:
             self.check_table5(example, out)
         if "corpus stats" in text and "--json" in text:
@@ -591,8 +698,9 @@ class Round15A(unittest.TestCase):
             if re.search(rf"load\(\"{name}\"\)|load\('{name}'\)", text + FREE_NAMES["trials"]) and not (
                     folder / name).exists():
                 print(f"     (the study {name!r} it reads: {command})", file=sys.stderr)
-                subprocess.run(["bash", "-c", command], cwd=folder, env=self.env, check=True, timeout=TIMEOUT_S,
-                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                made = run_bash(command, folder, self.env, f"{example.doc}:{example.line}")
+                if made.returncode != 0:
+                    raise subprocess.CalledProcessError(made.returncode, command, made.stdout, made.stderr)
         where = folder
         for literal in re.findall(r"\"([\w.-]+\.(?:h5|json))\"", text):
             if not (folder / literal).exists():  # a file of a study made earlier, read where it lies
