@@ -5,8 +5,10 @@ factors); Hills-Armitage equal to R's t.test on half period differences; one tes
 Holm family; n counted as subjects; a planted effect recovered, a planted null not found more often than
 chance would allow in one seed."""
 
+import atexit
 import math
 import os
+import select
 import shutil
 import subprocess
 import tempfile
@@ -75,9 +77,80 @@ def crossover_study(seed, subjects=16, effect_m=-0.4e-3, period_m=-0.2e-3, subje
     return pandas.DataFrame(rows)
 
 
+# The test's own R, apart from calligraphy.mixed_models: one Rscript runs every reference script of a run, each in
+# an environment of its own given `arguments` (lmerTest loads once, about 1.7 s of CPU each time): a request is a
+# line of tab-separated arguments, the script's path first, its answer written to the file it names, then "done".
+_R_RUNNER = r"""
+suppressPackageStartupMessages(library(lmerTest))
+requests <- file("stdin")
+open(requests)
+while (length(line <- readLines(requests, n = 1)) > 0) {
+  request <- strsplit(line, "\t", fixed = TRUE)[[1]]
+  script <- new.env(parent = globalenv())
+  assign("arguments", request[-1], envir = script)
+  sys.source(request[1], envir = script)
+  cat("done\n")
+  flush(stdout())
+}
+"""
+_R_RUNNING = []  # the running Rscript and its folder, started by the first request
+
+
+def _r_runner():
+    if _R_RUNNING and _R_RUNNING[0][0].poll() is None:
+        return _R_RUNNING[0]
+    _close_r_runner()
+    folder = tempfile.TemporaryDirectory(prefix="calligraphy-crossover-r-")
+    script = os.path.join(folder.name, "runner.R")
+    with open(script, "w", encoding="utf-8") as out:
+        out.write(_R_RUNNER)
+    process = subprocess.Popen([shutil.which("Rscript"), "--vanilla", script], stdin=subprocess.PIPE,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    _R_RUNNING.append((process, folder))
+    return _R_RUNNING[0]
+
+
+def _close_r_runner():
+    while _R_RUNNING:
+        process, folder = _R_RUNNING.pop()
+        if process.poll() is None:
+            process.stdin.close()
+            try:
+                process.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                process.wait()
+        process.stdout.close()
+        process.stderr.close()
+        folder.cleanup()
+
+
+atexit.register(_close_r_runner)
+
+
+def run_r(code, *arguments):
+    """Runs the R code `code` with its variable `arguments` (strings) in the test's one Rscript."""
+    process, folder = _r_runner()
+    with tempfile.NamedTemporaryFile("w", encoding="utf-8", suffix=".R", dir=folder.name, delete=False) as script:
+        script.write(code)
+    request = (script.name, *map(str, arguments))
+    assert not any("\t" in part or "\n" in part for part in request), request
+    process.stdin.write("\t".join(request) + "\n")
+    process.stdin.flush()
+    ready, _, _ = select.select([process.stdout], [], [], 300)
+    # "" when R ended on an error (its message is on standard error); nothing within 300 s is a hang
+    reply = process.stdout.readline() if ready else "(nothing within 300 s)"
+    os.unlink(script.name)
+    if reply != "done\n":
+        _R_RUNNING.clear()
+        process.kill()
+        error = process.communicate()[1]
+        folder.cleanup()
+        pytest.fail(f"Rscript answered {reply!r}: {error}")
+
+
 _R_REFERENCE = r"""
 suppressPackageStartupMessages(library(lmerTest))
-arguments <- commandArgs(trailingOnly = TRUE)
 trials <- read.csv(arguments[1], encoding = "UTF-8")
 models <- read.csv(arguments[2], encoding = "UTF-8", stringsAsFactors = FALSE)
 trials <- subset(trials, end_reason == "completed")
@@ -128,11 +201,8 @@ def _r_reference(trials, rows):
         models = pandas.DataFrame({"phase": rows["phase"],
                                    "formula": [m.replace("mean_deviation_m", "outcome", 1) for m in rows["model"]]})
         models.to_csv(os.path.join(folder, "models.csv"), index=False, encoding="utf-8")
-        with open(os.path.join(folder, "reference.R"), "w", encoding="utf-8") as script:
-            script.write(_R_REFERENCE)
-        subprocess.run([shutil.which("Rscript"), "--vanilla", os.path.join(folder, "reference.R"),
-                        os.path.join(folder, "trials.csv"), os.path.join(folder, "models.csv"),
-                        os.path.join(folder, "out.csv")], check=True, capture_output=True, timeout=300)
+        run_r(_R_REFERENCE, os.path.join(folder, "trials.csv"), os.path.join(folder, "models.csv"),
+              os.path.join(folder, "out.csv"))
         return pandas.read_csv(os.path.join(folder, "out.csv"))
 
 
@@ -349,10 +419,11 @@ def test_a_mixed_design_has_its_group_in_every_model_and_tests_the_interaction()
             "d$condition <- factor(d$condition, levels = c('unguided', 'amplify')); d$period <- factor(d$period)\n"
             "d$group <- factor(d$group, levels = c('early', 'late'))\n"
             f"fit <- lmer({interaction['model'].replace('mean_deviation_m', 'outcome', 1)}, data = d)\n"
-            "a <- anova(fit)['condition:group', ]; cat(a[['F value']], a[['DenDF']], a[['Pr(>F)']])\n")
-        run = subprocess.run([shutil.which("Rscript"), "--vanilla", "-e", script], capture_output=True, text=True,
-                             check=True, timeout=300)
-    f, den_df, p = (float(x) for x in run.stdout.split())
+            "a <- anova(fit)['condition:group', ]\n"
+            "cat(a[['F value']], a[['DenDF']], a[['Pr(>F)']], file = arguments[1])\n")
+        run_r(script, os.path.join(folder, "answer.txt"))
+        with open(os.path.join(folder, "answer.txt"), encoding="utf-8") as answer:
+            f, den_df, p = (float(x) for x in answer.read().split())
     assert interaction["statistic"] == pytest.approx(f, rel=1e-5)
     assert interaction["df"] == pytest.approx(den_df, rel=1e-4)
     assert interaction["p"] == pytest.approx(p, rel=1e-4)
