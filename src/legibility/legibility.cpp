@@ -18,10 +18,16 @@
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/trial/result.hpp"
 #include "core/library_log.hpp"
-#include "core/whole_file.hpp"
 
 #ifdef CALLIGRAPHY_WITH_ZINNIA
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <zinnia.h>
+
+#include <cerrno>
+#include <string_view>
 #endif
 
 namespace calligraphy {
@@ -36,9 +42,14 @@ constexpr double kDataTopY = 900.0;
 struct Recogniser {
   zinnia_recognizer_t* recogniser = nullptr;
   std::string model;
+  // The model file mapped read-only: checked, then given to zinnia, which keeps pointers into it. One mapping
+  // (zinnia_recognizer_open would map the file again), no copy of its 26 MB into memory of the process's own.
+  void* mapped = MAP_FAILED;
+  std::size_t mapped_bytes = 0;
   std::mutex mutex;  // zinnia's classify is not documented as thread-safe
   ~Recogniser() {
     if (recogniser != nullptr) zinnia_recognizer_destroy(recogniser);
+    if (mapped != MAP_FAILED) ::munmap(mapped, mapped_bytes);
   }
 };
 
@@ -54,9 +65,9 @@ std::string model_file() {
 // Why a zinnia model file cannot be used, "" when its layout is whole. zinnia trusts the file: a damaged
 // count makes it allocate gigabytes (std::bad_alloc) and a damaged length read past the end. Its layout
 // (zinnia 0.06, recognizer.cpp): a magic number, a version, the number of characters, then per character a
-// 16-byte name, a float bias and (int index, float weight) pairs, the last of index -1. Walked here, bounded by the
-// file's size, before zinnia sees it.
-std::string model_damage(const std::string& bytes) {
+// 16-byte name, a float bias and (int index, float weight) pairs, the last of index -1. Walked here, bounded
+// by the file's size, before zinnia sees it.
+std::string model_damage(std::string_view bytes) {
   const auto word = [&](std::size_t at) {
     std::int32_t value = 0;
     std::memcpy(&value, bytes.data() + at, sizeof value);
@@ -78,8 +89,32 @@ std::string model_damage(const std::string& bytes) {
       if (index < 0) return "damaged: a feature index " + std::to_string(index);
     }
   }
-  if (at != bytes.size()) return "damaged: " + std::to_string(bytes.size() - at) + " bytes after its last character";
+  if (at != bytes.size())
+    return "damaged: " + std::to_string(bytes.size() - at) + " bytes after its last character";
   return "";
+}
+
+// `file` mapped into `into` (a regular file of 1 byte to kMaxModelBytes, read-only); why not, "" when mapped.
+std::string map_model(const std::string& file, Recogniser& into) {
+  const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return std::string("cannot open it: ") + std::strerror(errno);
+  struct stat status {};
+  std::string problem;
+  if (::fstat(fd, &status) != 0) {
+    problem = std::string("cannot read its size: ") + std::strerror(errno);
+  } else if (!S_ISREG(status.st_mode)) {
+    problem = "not a regular file";
+  } else if (status.st_size == 0) {
+    problem = model_damage({});  // no bytes to map: not a model, as any file without its magic number
+  } else if (static_cast<std::uintmax_t>(status.st_size) > kMaxModelBytes) {
+    problem = std::to_string(status.st_size) + " bytes, outside 1 to " + std::to_string(kMaxModelBytes);
+  } else {
+    into.mapped_bytes = static_cast<std::size_t>(status.st_size);
+    into.mapped = ::mmap(nullptr, into.mapped_bytes, PROT_READ, MAP_PRIVATE, fd, 0);
+    if (into.mapped == MAP_FAILED) problem = std::string("cannot map it: ") + std::strerror(errno);
+  }
+  ::close(fd);
+  return problem;
 }
 
 // Opened once, on first use; nullptr when the model cannot be opened, said once in the library's log.
@@ -90,11 +125,15 @@ Recogniser* recogniser() {
     if (!std::filesystem::is_regular_file(file, error)) return nullptr;  // none installed: not a fault
     std::string problem;
     try {
-      problem = model_damage(read_regular_file(file, kMaxModelBytes));
+      auto made = std::make_unique<Recogniser>();
+      problem = map_model(file, *made);
+      if (problem.empty())
+        problem = model_damage(std::string_view(static_cast<const char*>(made->mapped), made->mapped_bytes));
       if (problem.empty()) {
-        auto made = std::make_unique<Recogniser>();
         made->recogniser = zinnia_recognizer_new();
-        if (made->recogniser != nullptr && zinnia_recognizer_open(made->recogniser, file.c_str()) != 0) {
+        if (made->recogniser != nullptr &&
+            zinnia_recognizer_open_from_ptr(made->recogniser, static_cast<const char*>(made->mapped),
+                                            made->mapped_bytes) != 0) {
           made->model = file;
           return made;
         }
@@ -103,9 +142,10 @@ Recogniser* recogniser() {
     } catch (const std::exception& e) {  // unreadable, over the bound, or zinnia's own allocation failing
       problem = e.what();
     }
-    detail::library_log().warn("legibility: the recogniser's model {} cannot be used ({}); trials are kept without "
-                       "legibility",
-                       file, problem);
+    detail::library_log().warn(
+        "legibility: the recogniser's model {} cannot be used ({}); trials are kept without "
+        "legibility",
+        file, problem);
     return nullptr;
   }();
   return shared.get();
