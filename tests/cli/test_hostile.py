@@ -32,13 +32,21 @@ HOSTILE = SOURCE / "tests" / "data" / "hostile"
 YONG = "永"  # U+6C38, in the embedded set
 YONG_CODE = "U+6C38"
 TIMEOUT_S = 120  # a hang (reading a FIFO, /dev/zero) fails the case instead of blocking CTest
+SANITIZED = os.environ.get("CALLIGRAPHY_SANITIZED") == "1"  # the program runs about ten times slower there
+
+
+def scratch_parent():
+    """Where each case works: /dev/shm when it is a writable folder (tmpfs), else the default temporary folder.
+    Nothing here depends on the file system; on a disk, removing a case's 3,000 folders took 9 s of waiting."""
+    shm = Path("/dev/shm")
+    return str(shm) if shm.is_dir() and os.access(shm, os.W_OK | os.X_OK) else None
 
 
 class HostileTestCase(unittest.TestCase):
     def setUp(self):
         if not CLI or not Path(CLI).exists():
             self.fail(f"CALLIGRAPHY_CLI={CLI!r} is not the calligraphy program: run these tests through ctest")
-        self.folder = tempfile.TemporaryDirectory(prefix="calligraphy-hostile-")
+        self.folder = tempfile.TemporaryDirectory(prefix="calligraphy-hostile-", dir=scratch_parent())
         self.cwd = Path(self.folder.name)
 
     def tearDown(self):
@@ -264,16 +272,65 @@ class HonestResults(HostileTestCase):
 
 
 def read_trace(path):
-    with open(path, newline="") as f:
-        rows = list(csv.reader(f))
-    return rows[0], rows[1:]
+    """A trace CSV's header, its number of rows and its first and last rows. The program writes one row of
+    numbers per line (nothing quoted), so rows are lines: counted, and only the first and last parsed."""
+    lines = Path(path).read_text().splitlines()
+    header, rows = next(csv.reader(lines[:1])), lines[1:]
+    first, last = next(csv.reader(rows[:1]), None), next(csv.reader(rows[-1:]), None)
+    return header, len(rows), first, last
+
+
+def cpu_seconds(pid):
+    """The user and system time process `pid` has used so far (/proc/PID/stat), or None once it is gone."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return None
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def threads(pid):
+    """The number of threads of process `pid` (/proc/PID/status), or None once it is gone."""
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return None
+    return int(next(line.split()[1] for line in status.splitlines() if line.startswith("Threads:")))
 
 
 class Signals(HostileTestCase):
-    """A trial stopped by SIGINT or SIGTERM writes every recorded tick, then exits 128 + the signal."""
+    """A trial stopped by SIGINT or SIGTERM writes every recorded tick, then exits 128 + the signal.
 
-    def stop_trial(self, args, sig, after_s=1.5, twice=False, ignored=(), before=None):
-        """`trial ARGS` stopped by `sig` after `after_s`; `ignored` signals are ignored in the program from its
+    The signal comes once the trial runs (a signal before the program has set its handlers ends it by its
+    default action, one while it reads the characters ends it with nothing written), found by polling every
+    10 ms instead of a fixed wait: a real-time trial runs once its device's servo loop has a thread of its own
+    (at most REAL_TIME_START_S, the fixed wait this replaces), then REAL_TIME_RUN_S more to record ticks; a
+    lock-step trial, which ticks as fast as it can, once it has used LOCK_STEP_CPU_S of CPU (its characters are
+    read in about a hundredth of a second: some 250,000 ticks at 10 kHz in Release), whatever the load."""
+
+    REAL_TIME_START_S = 1.5
+    REAL_TIME_RUN_S = 0.3
+    LOCK_STEP_CPU_S = 1.5 if SANITIZED else 0.15
+
+    def wait_until_running(self, process, lock_step=False):
+        """Polls `process` until its trial runs (see the class); returns early when it has ended."""
+        started = time.monotonic()
+        if lock_step:
+            while time.monotonic() - started < TIMEOUT_S:
+                used = cpu_seconds(process.pid)
+                if used is None or used >= self.LOCK_STEP_CPU_S or process.poll() is not None:
+                    return
+                time.sleep(0.01)
+            return
+        while time.monotonic() - started < self.REAL_TIME_START_S:
+            count = threads(process.pid)
+            if count is None or count > 1 or process.poll() is not None:
+                break
+            time.sleep(0.01)
+        time.sleep(self.REAL_TIME_RUN_S)
+
+    def stop_trial(self, args, sig, lock_step=False, twice=False, ignored=(), before=None):
+        """`trial ARGS` stopped by `sig` once it runs; `ignored` signals are ignored in the program from its
         start (as `nohup` ignores SIGHUP), and `before` is sent first, half a second earlier."""
         def ignore():
             for each in ignored:
@@ -281,12 +338,10 @@ class Signals(HostileTestCase):
         process = subprocess.Popen([CLI, "trial", *args], cwd=self.cwd, stdout=subprocess.PIPE,
                                    stderr=subprocess.PIPE, preexec_fn=ignore)
         try:
+            self.wait_until_running(process, lock_step)
             if before is not None:
-                time.sleep(after_s - 0.5)
                 process.send_signal(before)
                 time.sleep(0.5)
-            else:
-                time.sleep(after_s)
             if process.poll() is not None:
                 self.fail(f"the trial ended (status {process.returncode}) before the signal: "
                           f"{process.communicate()[1].decode(errors='replace')}")
@@ -313,18 +368,18 @@ class Signals(HostileTestCase):
         self.assertTrue(doc["aborted"])
         self.assertIn(name, doc["abort_reason"])
         self.assertLess(doc["strokes_completed"], doc["strokes_total"])
-        header, rows = read_trace(self.cwd / "trace.csv")
+        header, rows, first, last = read_trace(self.cwd / "trace.csv")
         self.assertEqual(header[0], "t")
-        self.assertGreater(len(rows), 0)
+        self.assertGreater(rows, 0)
         # The last tick recorded is the last row (times written to 1 us).
-        self.assertAlmostEqual(float(rows[-1][0]), doc["trial_time_s"], delta=1e-6)
+        self.assertAlmostEqual(float(last[0]), doc["trial_time_s"], delta=1e-6)
         self.assertEqual(sorted(p.name for p in self.cwd.iterdir()), ["trace.csv", "trial.json"])  # no temporary
-        return doc, rows
+        return doc, rows, first
 
     def real_time(self, sig):
-        doc, rows = self.stop_trial([YONG, "--pacing", "real-time", "--json", "trial.json", "--csv", "trace.csv"],
-                                    sig)
-        self.assertEqual(len(rows), doc["loop"]["ticks"])  # one row per tick of the servo loop
+        doc, rows, _ = self.stop_trial([YONG, "--pacing", "real-time", "--json", "trial.json", "--csv",
+                                        "trace.csv"], sig)
+        self.assertEqual(rows, doc["loop"]["ticks"])  # one row per tick of the servo loop
         for key in ("late_ticks", "forces_withheld", "longest_stall_ms", "period_jitter_us_p99"):
             self.assertIn(key, doc["loop"])
 
@@ -334,11 +389,11 @@ class Signals(HostileTestCase):
         rate_hz = 10000
         args = [YONG * 20, "--pacing", "lock-step", "--rate", str(rate_hz), "--json", "trial.json", "--csv",
                 "trace.csv"]
-        doc, rows = self.stop_trial(args, sig, twice=twice)
+        doc, rows, first = self.stop_trial(args, sig, lock_step=True, twice=twice)
         self.assertNotIn("loop", doc)
         # Ticks from t = 0 one period apart, up to the time the JSON gives: none missing.
-        self.assertEqual(len(rows), round(doc["trial_time_s"] * rate_hz) + 1)
-        self.assertEqual(float(rows[0][0]), 0.0)
+        self.assertEqual(rows, round(doc["trial_time_s"] * rate_hz) + 1)
+        self.assertEqual(float(first[0]), 0.0)
 
     def test_sigint_real_time(self):
         self.real_time(signal.SIGINT)
@@ -346,9 +401,8 @@ class Signals(HostileTestCase):
     def test_a_sighup_ignored_from_the_start_stays_ignored_and_sigterm_still_stops(self):
         # nohup: the trial goes on through the hangup (it is still running half a second after it), and
         # a SIGTERM ignored from the start (as no shell does) is still a stop asked for.
-        doc, _ = self.stop_trial([YONG, "--pacing", "real-time", "--json", "trial.json", "--csv", "trace.csv"],
-                                 signal.SIGTERM, after_s=2.0, ignored=(signal.SIGHUP, signal.SIGTERM),
-                                 before=signal.SIGHUP)
+        doc, _, _ = self.stop_trial([YONG, "--pacing", "real-time", "--json", "trial.json", "--csv", "trace.csv"],
+                                    signal.SIGTERM, ignored=(signal.SIGHUP, signal.SIGTERM), before=signal.SIGHUP)
         self.assertIn("SIGTERM", doc["abort_reason"])
 
     def test_sigterm_real_time(self):
@@ -363,7 +417,7 @@ class Signals(HostileTestCase):
     def test_bench_loop_trial(self):
         process = subprocess.Popen([CLI, "bench", "loop", "--trial", YONG, "--json"], cwd=self.cwd,
                                    stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-        time.sleep(1.5)
+        self.wait_until_running(process)  # a real-time servo loop, as a real-time trial's
         self.assertIsNone(process.poll())
         process.send_signal(signal.SIGINT)
         stdout, stderr = process.communicate(timeout=TIMEOUT_S)
@@ -464,9 +518,11 @@ class HostileSizes(HostileTestCase):
         return process.returncode, stdout, shown.decode(errors="replace")
 
     def test_progress_of_a_long_score_on_a_terminal_only(self):
-        # One pen-down zig-zag of a million samples (the limit, 30 MB): a second or more to read and score.
-        # Under the sanitizers a fifth of it takes as long (the program runs ten times slower there).
-        samples = 200_000 if os.environ.get("CALLIGRAPHY_SANITIZED") == "1" else 1_000_000
+        # One pen-down zig-zag of 200,000 samples (6 MB): the progress is shown from the start (run_on_terminal),
+        # whatever the score's length (a trace past the limit of a million samples is read by
+        # test_too_many_samples_are_refused_while_reading). Under the sanitizers a fifth of it (the program runs
+        # ten times slower there).
+        samples = 40_000 if SANITIZED else 200_000
         rows = "".join(f"{i * 1e-3:.3f},{0.0002 * (i % 100) - 0.01:.4f},{0.0001 * (i % 37):.4f},1\n"
                        for i in range(samples))
         (self.cwd / "long.csv").write_text("t,x,y,pen\n" + rows)

@@ -183,6 +183,7 @@ class VocabularyTest(unittest.TestCase):
             raise AssertionError(made.stderr.decode())
         cls.contexts = cls.make_contexts()
         cls.records = {}
+        cls.found_contexts = {}
 
     @classmethod
     def tearDownClass(cls):
@@ -259,7 +260,15 @@ class VocabularyTest(unittest.TestCase):
     def context_for(self, arguments):
         """The first context in which `arguments` pass `trial --check` (None when there is none), and the
         refusals met on the way. A context setting the option `arguments` set gives only its other arguments
-        (a replay's teacher)."""
+        (a replay's teacher). Looked for once per `arguments`: every bound of a field asks for the context of
+        its option at its default, which the same runs of `trial --check` answer."""
+        key = tuple(arguments)
+        if key not in self.found_contexts:
+            self.found_contexts[key] = self.look_for_context(arguments)
+        context, refusals = self.found_contexts[key]
+        return copy.deepcopy(context), list(refusals)
+
+    def look_for_context(self, arguments):
         refusals = []
         for context in self.contexts:
             given = list(context[0])

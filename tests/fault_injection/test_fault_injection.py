@@ -48,23 +48,45 @@ SIGNALS = ("TERM", "INT", "HUP")  # the stop signals raised at a step (fault_shi
 # The Python side: study_report's writer of its set of files (the library's AtomicFileSet), given a study
 # folder whose files it writes, scaled, into out/ (a report's page, tables and figures stand in).
 PYTHON_WRITER = "python-report-writer"
-PYTHON_WRITER_CODE = """
+PYTHON_WRITER_FUNCTION = """
 import pathlib, sys
 from calligraphy import study_report
-source = pathlib.Path(sys.argv[1])
-files = {}
-for path in sorted(source.rglob("*.json")):
-    relative = path.relative_to(source)
-    target = pathlib.Path("out") / ("figures" if len(files) % 2 else "tables") / (relative.stem + ".txt")
-    files[target] = path.read_bytes()
-(pathlib.Path("out") / "figures").mkdir(exist_ok=True)
-(pathlib.Path("out") / "tables").mkdir(exist_ok=True)
-files[pathlib.Path("out") / "index.html"] = ("<p>" + str(len(files)) + " files</p>").encode()
-try:
-    study_report._write_together(files)
-except OSError as error:
-    print(f"study_report: error: {error}", file=sys.stderr)
-    sys.exit(1)
+
+def write_set(source):
+    \"\"\"(exit status, standard error) of writing the set made from `source` into out/.\"\"\"
+    files = {}
+    for path in sorted(source.rglob("*.json")):
+        relative = path.relative_to(source)
+        target = pathlib.Path("out") / ("figures" if len(files) % 2 else "tables") / (relative.stem + ".txt")
+        files[target] = path.read_bytes()
+    (pathlib.Path("out") / "figures").mkdir(exist_ok=True)
+    (pathlib.Path("out") / "tables").mkdir(exist_ok=True)
+    files[pathlib.Path("out") / "index.html"] = ("<p>" + str(len(files)) + " files</p>").encode()
+    try:
+        study_report._write_together(files)
+    except OSError as error:
+        return 1, f"study_report: error: {error}\\n"
+    return 0, ""
+"""
+# A run of the writer: an interpreter of its own, as each fault needs (the shim is loaded when it starts).
+PYTHON_WRITER_CODE = PYTHON_WRITER_FUNCTION + """
+status, message = write_set(pathlib.Path(sys.argv[1]))
+sys.stderr.write(message)
+sys.exit(status)
+"""
+# The runs without a fault (the sets written first, the clean run after every fault): the same function in one
+# interpreter that imported the package once, given the folder to work in and the study, one JSON line each;
+# it answers [exit status, standard error] (an exception other than OSError: status 1 and its traceback).
+PYTHON_WRITER_SERVER_CODE = PYTHON_WRITER_FUNCTION + """
+import json, os, traceback
+for line in sys.stdin:
+    cwd, source = json.loads(line)
+    os.chdir(cwd)
+    try:
+        answer = write_set(pathlib.Path(source))
+    except Exception:
+        answer = 1, traceback.format_exc()
+    print(json.dumps(answer), flush=True)
 """
 
 
@@ -123,6 +145,24 @@ def every_fault(counts, repeated_step_stride=1, sampled_stride=1):
                 tried += 1
 
 
+# The trials the sweeps run (the studies made first, the sessions, the cohort, a record run again) are trials of 一,
+# the shortest character, and their records carry no legibility: CALLIGRAPHY_ZINNIA_MODEL names no file, so the
+# recogniser's model (26 MB, read and walked by every process that makes a trial record: about half of such a
+# run's CPU) is not loaded, as in a build without zinnia (docs/writer.md). The model is read from outside the
+# folder the shim watches; what is swept is how the outputs are written, whatever they hold.
+CHARACTER = "一"
+NO_RECOGNISER_MODEL = {"CALLIGRAPHY_ZINNIA_MODEL": "/nonexistent/calligraphy-fault-sweeps.model"}
+
+
+def protocol_of(phases):
+    """tests/study's two-session protocol (its phases on 十), cut to its first `phases` phases, on CHARACTER."""
+    protocol = two_session_protocol("faults")
+    protocol["phases"] = protocol["phases"][:phases]
+    for phase in protocol["phases"]:
+        phase["characters"] = [CHARACTER]
+    return protocol
+
+
 def scratch_parent():
     """Where the sweeps work: /dev/shm when it is a writable folder (tmpfs), else the default temporary folder.
     Every fsync the program makes is still called, counted and faulted by the shim; on tmpfs it returns at
@@ -160,34 +200,56 @@ class FaultInjection(unittest.TestCase):
             raise unittest.SkipTest("run through ctest: CALLIGRAPHY_CLI and CALLIGRAPHY_FAULT_SHIM name the "
                                     "program and the shim")
         cls.scratch = tempfile.TemporaryDirectory(prefix="calligraphy-faults-", dir=scratch_parent())
+        cls.python_writer = None  # started by the first run of the Python writer without a fault
         root = Path(cls.scratch.name)
-        protocol = two_session_protocol("faults")
-        protocol["phases"] = protocol["phases"][:3]  # one session
-        (root / "p.json").write_text(json.dumps(protocol, ensure_ascii=False), encoding="utf-8")
+        # The studies whose reports are swept: one session of one trial per subject. The report's set is its
+        # tables, its index and a page per session whatever a session holds; the Python writer's set is a file
+        # per JSON file of the study (5, and the index, for two subjects).
+        (root / "p.json").write_text(json.dumps(protocol_of(1), ensure_ascii=False), encoding="utf-8")
         cls.protocol = root / "p.json"
         # The sessions swept: two trials (one saved before a fault, one after; a third saves the same way).
-        protocol["phases"] = protocol["phases"][:2]
-        (root / "session.json").write_text(json.dumps(protocol, ensure_ascii=False), encoding="utf-8")
+        (root / "session.json").write_text(json.dumps(protocol_of(2), ensure_ascii=False), encoding="utf-8")
         cls.session_protocol = root / "session.json"
         cls.one_subject = root / "one"
         cls.two_subjects = root / "two"
         for folder, subjects in ((cls.one_subject, "1"), (cls.two_subjects, "2")):
             done = subprocess.run([CLI, "session", "run", cls.protocol, "--writer", "simulated", "--subjects",
-                                   subjects, "--out", folder / "study"], capture_output=True, timeout=TIMEOUT_S)
+                                   subjects, "--out", folder / "study"], capture_output=True, timeout=TIMEOUT_S,
+                                  env=dict(os.environ, **NO_RECOGNISER_MODEL))
             assert done.returncode == 0, done.stderr.decode()
 
     @classmethod
     def tearDownClass(cls):
+        if cls.python_writer is not None:
+            cls.python_writer.stdin.close()
+            cls.python_writer.wait(timeout=TIMEOUT_S)
+            cls.python_writer.stdout.close()
         cls.scratch.cleanup()
 
     def run_cli(self, arguments, cwd, fault=None):
-        environment = dict(os.environ)
+        environment = dict(os.environ, **NO_RECOGNISER_MODEL)
         if fault is not None:
             environment.update(LD_PRELOAD=SHIM, CALLIGRAPHY_FAULT_UNDER=str(cwd / "out"), **fault)
+        elif arguments[0] == PYTHON_WRITER:
+            return self.run_python_writer(arguments, cwd, environment)
         program = [CLI] if arguments[0] != PYTHON_WRITER else [sys.executable, "-c", PYTHON_WRITER_CODE]
         return subprocess.run([*program, *map(str, arguments[1:] if program[0] != CLI else arguments)], cwd=cwd,
                               capture_output=True, env=environment, timeout=TIMEOUT_S,
                               preexec_fn=default_stop_signals)
+
+    def run_python_writer(self, arguments, cwd, environment):
+        """The Python writer without a fault: write_set in the interpreter that serves those runs (an
+        interpreter and the package's import less per run; each fault still runs in an interpreter of its own)."""
+        cls = type(self)
+        if cls.python_writer is None:
+            cls.python_writer = subprocess.Popen([sys.executable, "-c", PYTHON_WRITER_SERVER_CODE], env=environment,
+                                                 stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        cls.python_writer.stdin.write(json.dumps([str(cwd), str(arguments[1])]) + "\n")
+        cls.python_writer.stdin.flush()
+        answer = cls.python_writer.stdout.readline()
+        self.assertTrue(answer, f"the Python writer's server ended (status {cls.python_writer.poll()})")
+        status, stderr = json.loads(answer)
+        return subprocess.CompletedProcess(arguments, status, b"", stderr.encode())
 
     def sweep(self, arguments_for, signals=False, files=2, repeated_step_stride=1, sampled_stride=1):
         """Every fault at every step of `arguments_for(study)` writing over the output of the one-subject
