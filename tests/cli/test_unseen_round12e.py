@@ -703,9 +703,19 @@ DOC_BOUNDS = {
 }
 
 
+HELP = {}
+
+
+def help_of(command):
+    """The run of `command --help`, made once for every case that reads it."""
+    if command not in HELP:
+        HELP[command] = run([*command.split(), "--help"], ".")
+    return HELP[command]
+
+
 def numeric_options(command):
     """(option, placeholder, help text) of each option of `command` whose value is a number."""
-    r = run([*command.split(), "--help"], ".")
+    r = help_of(command)
     assert r.returncode == 0, r.stderr
     options, current = [], None
     for line in r.stdout.decode().splitlines():
@@ -945,7 +955,7 @@ class HelpDefaults(Case):
                 rows.setdefault(command, {})[m.group(1)] = m.group(2).strip().strip("`")
         compared = 0
         for command, table in rows.items():
-            r = run([*command.split(), "--help"], self.tmp)
+            r = help_of(command)
             self.assertEqual(r.returncode, 0, command)
             helped, current = {}, None
             for line in r.stdout.decode().splitlines():

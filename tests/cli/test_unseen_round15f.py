@@ -87,6 +87,20 @@ def start(args, cwd, env=None):
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
 
 
+def in_trial(process, after):
+    """Waits until the real-time trial of `process` runs (its servo loop is a thread of its own: the process has
+    more than one, polled every 10 ms for at most 20 s), then `after` seconds of the trial."""
+    deadline = time.monotonic() + 20
+    while time.monotonic() < deadline and process.poll() is None:
+        try:
+            if len(os.listdir(f"/proc/{process.pid}/task")) >= 2:
+                break
+        except OSError:
+            break
+        time.sleep(0.01)
+    time.sleep(after)
+
+
 class Round15F(OneErrorLine, unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -354,10 +368,10 @@ class Round15F(OneErrorLine, unittest.TestCase):
                                   "watchdog_s")
 
     # ---- stalls ---------------------------------------------------------------------------------------------
-    def stalled(self, where, device, extra, stop_at=0.4, stop_for=0.2, seconds="1.5"):
+    def stalled(self, where, device, extra, stop_at=0.2, stop_for=0.2, seconds="1.5"):
         process = start(["trial", YI, "--device", device, "--pacing", "real-time", "--max-duration", seconds,
                          "--json", "t.json", "--csv", "t.csv", *extra], cwd=where)
-        time.sleep(stop_at)
+        in_trial(process, stop_at)  # stopped `stop_at` s into the trial, for `stop_for` s
         process.send_signal(signal.SIGSTOP)
         time.sleep(stop_for)
         process.send_signal(signal.SIGCONT)
@@ -522,11 +536,11 @@ class Round15F(OneErrorLine, unittest.TestCase):
         self.assertGreaterEqual(out["loop"]["longest_stall_ms"], 50)
 
     # ---- signals --------------------------------------------------------------------------------------------
-    def interrupted(self, device, sig, env=None, after=0.8):
+    def interrupted(self, device, sig, env=None, after=0.3):
         where = self.folder()
         process = start(["trial", YI, "--device", device, "--pacing", "real-time", "--max-duration", "3",
                          "--json", "t.json", "--csv", "t.csv"], cwd=where, env=env)
-        time.sleep(after)
+        in_trial(process, after)  # `sig` `after` s into the trial
         process.send_signal(sig)
         _, err = process.communicate(timeout=TIMEOUT_S)
         self.assertEqual(process.returncode, 128 + sig, err)
@@ -579,9 +593,13 @@ class Round15F(OneErrorLine, unittest.TestCase):
         os.mkfifo(where / "trace.csv")
         process = start(["trial", YI, "--device", "emulated-phantom", "--pacing", "real-time", "--max-duration",
                          "3", "--json", "t.json", "--csv", "trace.csv"], cwd=where)
-        time.sleep(0.6)
+        in_trial(process, 0.3)
         process.send_signal(signal.SIGINT)
-        time.sleep(0.5)
+        # The record is written first; then the CSV waits for a reader of the FIFO (polled, then 0.1 s into it).
+        deadline = time.monotonic() + 5
+        while time.monotonic() < deadline and not (where / "t.json").exists():
+            time.sleep(0.01)
+        time.sleep(0.1)
         process.send_signal(signal.SIGTERM)
         with open(where / "trace.csv", newline="") as fifo:
             rows = list(csv.reader(fifo))[1:]
