@@ -146,12 +146,8 @@ def every_fault(counts, repeated_step_stride=1, sampled_stride=1):
 
 
 # The trials the sweeps run (the studies made first, the sessions, the cohort, a record run again) are trials of 一,
-# the shortest character, and their records carry no legibility: CALLIGRAPHY_ZINNIA_MODEL names no file, so the
-# recogniser's model (26 MB, read and walked by every process that makes a trial record: about half of such a
-# run's CPU) is not loaded, as in a build without zinnia (docs/writer.md). The model is read from outside the
-# folder the shim watches; what is swept is how the outputs are written, whatever they hold.
+# the shortest character: what is swept is how the outputs are written, whatever they hold.
 CHARACTER = "一"
-NO_RECOGNISER_MODEL = {"CALLIGRAPHY_ZINNIA_MODEL": "/nonexistent/calligraphy-fault-sweeps.model"}
 
 
 def protocol_of(phases):
@@ -215,7 +211,7 @@ class FaultInjection(unittest.TestCase):
         for folder, subjects in ((cls.one_subject, "1"), (cls.two_subjects, "2")):
             done = subprocess.run([CLI, "session", "run", cls.protocol, "--writer", "simulated", "--subjects",
                                    subjects, "--out", folder / "study"], capture_output=True, timeout=TIMEOUT_S,
-                                  env=dict(os.environ, **NO_RECOGNISER_MODEL))
+                                  env=dict(os.environ))
             assert done.returncode == 0, done.stderr.decode()
 
     @classmethod
@@ -227,7 +223,7 @@ class FaultInjection(unittest.TestCase):
         cls.scratch.cleanup()
 
     def run_cli(self, arguments, cwd, fault=None):
-        environment = dict(os.environ, **NO_RECOGNISER_MODEL)
+        environment = dict(os.environ)
         if fault is not None:
             environment.update(LD_PRELOAD=SHIM, CALLIGRAPHY_FAULT_UNDER=str(cwd / "out"), **fault)
         elif arguments[0] == PYTHON_WRITER:
