@@ -1,6 +1,9 @@
 // hd_stand_in_scheduler.cpp - the servo thread of the stand-in libHD.so:
 // tick timing, hand playback, injected faults, callback scheduling and the
 // per-tick frame log.
+#include <pthread.h>
+#include <sched.h>
+
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -248,6 +251,12 @@ void end_tick() {
 
 void servo_main() {
   tl_on_servo = true;
+  // HDAPI runs its servo loop in a thread of its own at high priority (OpenHaptics Programmer's Guide):
+  // the stand-in asks for SCHED_FIFO where the process may have it (root, CAP_SYS_NICE) and ticks at normal
+  // priority where not, so that other work on a busy machine delays its ticks no more than the driver's.
+  sched_param priority{};
+  priority.sched_priority = sched_get_priority_min(SCHED_FIFO) + 10;
+  (void)pthread_setschedparam(pthread_self(), SCHED_FIFO, &priority);
   Lib& L = lib();
   Servo& S = L.servo;
   std::int64_t deadline = mono_ns();
