@@ -251,6 +251,8 @@ void set_field_from_text(const SchemaField& field, void* object, std::string_vie
 std::string field_text(const SchemaField& field, const void* object) {
   switch (field.kind) {
     case FieldKind::number:
+      if (field.option_whole)  // 0.007 s x 1000 is 7.000000000000001: the whole number it stands for
+        return std::to_string(std::llround(field.get_number(field, object, 0) * field.option_factor));
       return shortest_decimal(field.get_number(field, object, 0) * field.option_factor);
     case FieldKind::integer:
       return field.integer_unsigned ? std::to_string(field.get_unsigned(object))
