@@ -95,10 +95,12 @@ class Case(unittest.TestCase):
         self.tmp = Path(tempfile.mkdtemp(prefix="unseen10b-"))
 
     def tearDown(self):
-        for p in self.tmp.rglob("*"):
-            if not p.is_symlink() and p.is_file():
-                subprocess.run(["chattr", "-i", str(p)], stderr=subprocess.DEVNULL, stdout=subprocess.DEVNULL)
         shutil.rmtree(self.tmp, ignore_errors=True)
+        if self.tmp.exists():  # a file a case left immutable (chattr +i): made mutable again, then removed
+            for p in self.tmp.rglob("*"):
+                if not p.is_symlink() and p.is_file():
+                    subprocess.run(["chattr", "-i", str(p)], stderr=subprocess.DEVNULL, stdout=subprocess.DEVNULL)
+            shutil.rmtree(self.tmp, ignore_errors=True)
 
     def write(self, doc, name="p.json"):
         path = self.tmp / name

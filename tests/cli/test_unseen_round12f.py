@@ -186,6 +186,35 @@ class Shared:
             cls.folder = None
 
 
+class Made:
+    """Complete studies of one simulated subject (`session run --subjects 1`), each protocol's run once: a case
+    that stops, edits, moves or resumes such a study works on a copy of it (the same files; none of them names
+    the folder it is in)."""
+    folder = None
+    studies = {}
+
+    @classmethod
+    def copy(cls, name, document, target):
+        """The session folders of a copy, at `target`, of the study of `document` (run under `name`)."""
+        if name not in cls.studies:
+            if cls.folder is None:
+                cls.folder = Path(tempfile.mkdtemp(prefix="round12f-made-"))
+            write_json(cls.folder / f"{name}.json", document)
+            result = run(["session", "run", f"{name}.json", "--writer", "simulated", "--subjects", "1", "--out",
+                          name], cls.folder)
+            assert result.returncode == 0, text(result)
+            cls.studies[name] = cls.folder / name
+        shutil.copytree(cls.studies[name], target, symlinks=True)
+        return sessions_of(target)
+
+    @classmethod
+    def remove(cls):
+        if cls.folder is not None:
+            shutil.rmtree(cls.folder, ignore_errors=True)
+            cls.folder = None
+            cls.studies = {}
+
+
 @unittest.skipUnless(CLI, "CALLIGRAPHY_CLI is not set")
 class Protocols(unittest.TestCase):
     """Every design's protocol read by `session plan` (nothing runs, nothing is written)."""
@@ -405,11 +434,10 @@ class Sessions(unittest.TestCase):
     def tearDown(self):
         shutil.rmtree(self.dir, ignore_errors=True)
 
-    def complete(self, protocol="w.json", out="study", *extra):
-        result = run(["session", "run", protocol, "--writer", "simulated", "--subjects", "1", "--out", out, *extra],
-                     self.dir)
-        self.assertEqual(result.returncode, 0, text(result))
-        return sessions_of(self.dir / out)
+    def complete(self, protocol="w.json", out="study"):
+        """The sessions of a complete study of one subject of `protocol` (w.json or r.json) at `out`: a copy of
+        the one run for every case."""
+        return Made.copy(protocol[:-len(".json")], {"w.json": WITHIN, "r.json": DAYS}[protocol], self.dir / out)
 
     def test_subjects_zero_is_refused_not_taken_as_none(self):
         # `--subjects N (0-1000)`: zero subjects is either nothing run or a usage error naming --subjects; it must
@@ -647,9 +675,12 @@ class Reports(unittest.TestCase):
     def tearDown(self):
         shutil.rmtree(self.dir, ignore_errors=True)
 
-    def make(self, out, *extra):
-        result = run(["session", "run", "b.json", "--writer", "simulated", "--subjects", "1", "--out", out, *extra],
-                     self.dir)
+    def make(self, out, fresh=False):
+        """The session of a complete study of one subject of b.json at `out`: a copy of the one run for every
+        case or, `fresh`, a run of its own (a study of its own id)."""
+        if not fresh:
+            return Made.copy("b", BETWEEN, self.dir / out)[0]
+        result = run(["session", "run", "b.json", "--writer", "simulated", "--subjects", "1", "--out", out], self.dir)
         self.assertEqual(result.returncode, 0, text(result))
         return sessions_of(self.dir / out)[0]
 
@@ -668,7 +699,7 @@ class Reports(unittest.TestCase):
 
     def test_links_in_the_study_neither_loop_nor_count_a_session_twice(self):
         session = self.make("study")
-        self.make("other")
+        self.make("other", fresh=True)
         (self.dir / "study" / "S01" / "loop").symlink_to("..")
         (self.dir / "study" / "S09").symlink_to(self.dir / "other" / "S01")
         result = run(["report", "study", "--csv", "."], self.dir, timeout=30)
@@ -933,6 +964,7 @@ class RealR(unittest.TestCase):
 
 def tearDownModule():
     Shared.remove()
+    Made.remove()
 
 
 if __name__ == "__main__":

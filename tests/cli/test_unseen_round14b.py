@@ -142,6 +142,33 @@ def strict_json(data):
     return json.loads(data, parse_constant=refuse)
 
 
+def wait_until(process, ready, settle_s=0.1):
+    """Polls every 10 ms (never past TIMEOUT_S) until `ready()` or the end of `process`, then waits `settle_s`
+    more."""
+    deadline = time.monotonic() + TIMEOUT_S
+    while process.poll() is None and time.monotonic() < deadline:
+        if ready():
+            time.sleep(settle_s)
+            return
+        time.sleep(0.01)
+
+
+def wait_for_trial(process):
+    """Waits until `process` runs a trial, then a tenth of a second more: a trial's servo loop runs on threads of
+    its own (with the log's drain), so the process has more than one thread from its first tick to its last.
+    Without /proc, a second's wait."""
+    if not os.path.isdir("/proc/self/task"):
+        time.sleep(1.0)
+        return
+
+    def threads():
+        try:
+            return len(os.listdir(f"/proc/{process.pid}/task"))
+        except OSError:
+            return 0
+    wait_until(process, lambda: threads() > 1)
+
+
 class Case(OneErrorLine, unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -672,7 +699,7 @@ class Signals(Case):
                                    stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
                                    preexec_fn=lambda: signal.pthread_sigmask(signal.SIG_BLOCK, {sig}))
         try:
-            time.sleep(1.0)
+            wait_for_trial(process)
             self.assertIsNone(process.poll(), "the trial ended before the signal")
             process.send_signal(sig)
             _, stderr = process.communicate(timeout=6)
@@ -696,14 +723,14 @@ class Signals(Case):
 
     def test_sigterm_blocked_from_the_start_still_stops_a_session(self):
         # `session run`: "SIGINT or SIGTERM stops it after keeping the running trial (exit status 128 + the
-        # signal)" (its --help); the 40 trials take about 2 s of CPU, the signal comes after 0.7 s.
+        # signal)" (its --help); the 40 trials take about 2 s of CPU, the signal comes once the first is saved.
         (self.dir / "l.json").write_text(json.dumps(LONG, ensure_ascii=False), encoding="utf-8")
         process = subprocess.Popen([CLI, "session", "run", "l.json", "--writer", "simulated", "--subject", "S01",
                                     "--out", "study"], cwd=self.dir, env=C_ENV, stdout=subprocess.PIPE,
                                    stderr=subprocess.PIPE, stdin=subprocess.DEVNULL,
                                    preexec_fn=lambda: signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM}))
         try:
-            time.sleep(0.7)
+            wait_until(process, lambda: any(self.dir.glob("study/S01/*/trials/*.json")), settle_s=0.05)
             self.assertIsNone(process.poll(), "the session ended before the signal")
             process.send_signal(signal.SIGTERM)
             _, stderr = process.communicate(timeout=TIMEOUT_S)

@@ -103,6 +103,24 @@ def csv_rows(path):
     return Path(path).read_text(encoding="utf-8").strip().splitlines()[1:]
 
 
+def wait_for_trial(process, ticks_s=0.1):
+    """Waits until `process` runs a trial, then `ticks_s` more: a trial's servo loop runs on threads of its
+    own (with the log's drain), so the process has more than one thread from its first tick to its last.
+    Without /proc, a second's wait as before. Polled every 10 ms, never past TIMEOUT_S."""
+    if not os.path.isdir("/proc/self/task"):
+        time.sleep(1.0)
+        return
+    deadline = time.monotonic() + TIMEOUT_S
+    while process.poll() is None and time.monotonic() < deadline:
+        try:
+            if len(os.listdir(f"/proc/{process.pid}/task")) > 1:
+                time.sleep(ticks_s)
+                return
+        except OSError:
+            return
+        time.sleep(0.01)
+
+
 class Shared:
     """Made once: a trial's CSV trace and its gzip, their score; two tiny studies and their tables; a data
     folder of two characters."""
@@ -444,12 +462,12 @@ class Signals(Case):
     """docs/cli.md, "Stopping a trial": SIGINT, SIGTERM and SIGHUP stop a running trial at its next tick with
     zero force, every recorded tick written, exit 128 + N; SIGKILL and SIGQUIT still end the program."""
 
-    def real_time(self, sig, after=1.0, extra=(), pause=None):
+    def real_time(self, sig, extra=(), pause=None):
         process = subprocess.Popen([CLI, "trial", *REAL_TIME, *extra, "--json", "b.json", "--csv", "b.csv"],
                                    cwd=self.dir, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                    stdin=subprocess.DEVNULL, preexec_fn=no_core)
         try:
-            time.sleep(after)
+            wait_for_trial(process)
             self.assertIsNone(process.poll(), "the trial ended before the signal")
             if pause is not None:
                 process.send_signal(signal.SIGSTOP)
@@ -474,8 +492,8 @@ class Signals(Case):
     def stops_cleanly(self, sig):
         status, stdout, stderr = self.real_time(sig)
         self.assertEqual(status, 128 + sig, stderr)
-        # The trial (about 3.8 s) runs when the signal comes after 1 s; on a machine so loaded that it had not
-        # started, "a signal before the trial started opens no device and writes nothing" (docs/cli.md).
+        # The trial (about 3.8 s) runs when the signal comes a tenth of a second after its servo loop started;
+        # had it not started, "a signal before the trial started opens no device and writes nothing" (docs/cli.md).
         if not (self.dir / "b.json").exists():
             self.assertEqual(sorted(p.name for p in self.dir.iterdir()), [])
             return
@@ -504,8 +522,8 @@ class Signals(Case):
         self.assertEqual(sorted(p.name for p in self.dir.iterdir()), [])
 
     def test_sigstop_longer_than_the_watchdog_ends_the_trial_safely(self):
-        # A stopped process holds the device's last force: after 1 s the 50 ms watchdog ends the trial with
-        # zero force, exit 1 (ended early), every tick written.
+        # A stopped process holds the device's last force: after 1 s stopped the 50 ms watchdog ends the trial
+        # with zero force, exit 1 (ended early), every tick written.
         status, _, stderr = self.real_time(None, pause=1.0)
         self.assertEqual(status, 1, stderr)
         record = self.assert_every_tick_kept("watchdog")
@@ -515,7 +533,11 @@ class Signals(Case):
         self.assertIn("watchdog", errors[0])
 
     def test_sigstop_without_a_watchdog_resumes_the_trial(self):
-        status, _, stderr = self.real_time(None, pause=1.0, extra=("--watchdog-ms", "0"))
+        # Stopped 0.3 s, six times the default watchdog's 50 ms: with --watchdog-ms 0 the trial goes on to its
+        # end, written by a quick writer (docs/writer.md: about 1.4 s of writing rather than 3.8 s).
+        quick = ("--writer-profile", "skilled", "--writer-param", "writing_speed_m_s=0.1", "--writer-param",
+                 "travel_speed_m_s=0.3")
+        status, _, stderr = self.real_time(None, pause=0.3, extra=("--watchdog-ms", "0", *quick))
         self.assertEqual(status, 0, stderr)
         self.assert_every_tick_kept("completed")
 
@@ -529,7 +551,7 @@ class Signals(Case):
     def test_sighup_during_a_real_time_session_then_resume(self):
         process = self.session()
         try:
-            time.sleep(1.0)
+            wait_for_trial(process)  # its first trial running
             self.assertIsNone(process.poll(), "the session ended before the signal")
             process.send_signal(signal.SIGHUP)
             _, stderr = process.communicate(timeout=TIMEOUT_S)
@@ -559,7 +581,7 @@ class Signals(Case):
         try:
             time.sleep(0.05)
             process.send_signal(signal.SIGSTOP)
-            time.sleep(0.5)
+            time.sleep(0.2)
             process.send_signal(signal.SIGCONT)
             _, stderr = process.communicate(timeout=TIMEOUT_S)
         finally:
@@ -615,7 +637,7 @@ class StandardStreams(Case):
         process = self.big_output()
         got = bytearray()
         try:
-            time.sleep(0.5)  # the pipe is full; the program waits for its reader
+            time.sleep(0.2)  # the pipe is full; the program waits for its reader
             while chunk := process.stdout.read1(256 << 10):
                 got += chunk
                 time.sleep(0.02)
@@ -631,7 +653,7 @@ class StandardStreams(Case):
         process = self.big_output()
         try:
             process.stdout.read(4096)
-            time.sleep(1.0)
+            time.sleep(0.5)  # the whole output, unread, takes under 0.2 s to write
             self.assertIsNone(process.poll(), "the program did not wait for its reader")
             process.stdout.close()
             process.wait(timeout=10)
