@@ -139,7 +139,13 @@ class Round30D(unittest.TestCase, OneErrorLine):
     # ---- devices -----------------------------------------------------------------------------------------
     def test_devices_lists_every_documented_kind_with_its_writer_and_commands(self):
         kinds = {k["name"]: (k["writer"], k["commands"]) for k in self.survey["kinds"]}
-        self.assertEqual(kinds, KINDS)
+        expected = KINDS
+        # docs/cli.md: "In a build without the trainer window no kind lists `train`, and the pointer kinds are
+        # listed with no command" (the sanitizer builds have no window; such a kind says "not in this build").
+        if any("not in this build" in k.get("what", "") for k in self.survey["kinds"]):
+            expected = {name: (writer, [] if name in ("mouse", "mouse-hand") else [c for c in commands if c != "train"])
+                        for name, (writer, commands) in KINDS.items()}
+        self.assertEqual(kinds, expected)
         self.assertIn("No haptic hardware attached.", self.survey_text)
         self.assertFalse(self.survey["any_hardware"])
         for name in KINDS:
