@@ -160,16 +160,76 @@ end_stage
 wait_background
 python3 scripts/build-times.py build-asan
 
+# The install and projects of another's built against it with find_package(calligraphy): made from the Release
+# build in the background beside the ASan tests, after the TSan build (below), so that their compiles take the
+# time the sanitizer tests leave (the OpenHaptics stand-in's waits, the window-less rounds); their programs run
+# afterwards in a stage of their own (run_consumers), at normal priority, as two of them tick a servo loop.
+install_and_build_consumers() {
+  rm -rf build/stage build/consumer build/consumer-haptics build/consumer-emulator
+  touch build/install-started
+  cmake --install build --prefix build/stage >/dev/null
+  # A staging install writes only under its prefix (no .pth into another interpreter's site-packages).
+  bash tests/consumer/check_install_prefix.sh build build/stage build/install-started
+  # Only Eigen3 may be found: a find_dependency of anything else in the installed package fails the configure.
+  cmake --no-warn-unused-cli -S tests/consumer -B build/consumer -G Ninja \
+    -DCMAKE_PREFIX_PATH="$PWD/build/stage" \
+    -DCMAKE_DISABLE_FIND_PACKAGE_spdlog=ON -DCMAKE_DISABLE_FIND_PACKAGE_fmt=ON \
+    -DCMAKE_DISABLE_FIND_PACKAGE_nlohmann_json=ON -DCMAKE_DISABLE_FIND_PACKAGE_ZLIB=ON \
+    -DCMAKE_DISABLE_FIND_PACKAGE_OpenSSL=ON -DCMAKE_DISABLE_FIND_PACKAGE_Threads=ON >/dev/null
+  cmake --build build/consumer
+  # A haptic application: only the haptics component, its examples built and run, and their link lines free
+  # of libssl and the USB libraries; log_redirect takes the library's log through a handler and a spdlog logger
+  # of its own (spdlog's headers from the system, its package not found) and silences it; rerun_record reads a
+  # record of `calligraphy trial --json` and runs it again. The haptics package links OpenSSL's libcrypto (a
+  # record names its scene and a replay's teacher by SHA-256) by its library name, so OpenSSL's package is
+  # still never looked for.
+  cmake --no-warn-unused-cli -S tests/consumer/haptics -B build/consumer-haptics -G Ninja \
+    -DCMAKE_PREFIX_PATH="$PWD/build/stage" \
+    -DCMAKE_DISABLE_FIND_PACKAGE_spdlog=ON -DCMAKE_DISABLE_FIND_PACKAGE_fmt=ON \
+    -DCMAKE_DISABLE_FIND_PACKAGE_OpenSSL=ON >/dev/null
+  cmake --build build/consumer-haptics
+  bash tests/consumer/check_link_line.sh build/consumer-haptics build/consumer-haptics/own_loop \
+    build/consumer-haptics/custom_device_loop build/consumer-haptics/log_redirect build/consumer-haptics/rerun_record
+  # The USB transports and the emulator are components of their own: absent from the plain install above,
+  # installed when asked for by name, and then found by an application's tests that name the emulator.
+  if find build/stage -name 'libcalligraphy_phantom_usb.a' -o -name 'libcalligraphy_testing.a' | grep -q .; then
+    echo "the plain install carries the USB transports or the emulator, which were not asked for" >&2
+    exit 1
+  fi
+  cmake --install build --prefix build/stage --component testing >/dev/null
+  cmake --install build --prefix build/stage --component phantom_usb >/dev/null
+  cmake --no-warn-unused-cli -S tests/consumer/emulator -B build/consumer-emulator -G Ninja \
+    -DCMAKE_PREFIX_PATH="$PWD/build/stage" \
+    -DCMAKE_DISABLE_FIND_PACKAGE_spdlog=ON -DCMAKE_DISABLE_FIND_PACKAGE_fmt=ON \
+    -DCMAKE_DISABLE_FIND_PACKAGE_OpenSSL=ON >/dev/null
+  cmake --build build/consumer-emulator
+}
+export -f install_and_build_consumers
+
+# The programs install_and_build_consumers built: each runs against the installed package and exits 0.
+run_consumers() {
+  build/consumer/consumer
+  build/consumer-haptics/bundled_store "$PWD/build/stage"
+  build/consumer-haptics/own_loop
+  build/consumer-haptics/custom_device_loop
+  build/consumer-haptics/log_redirect
+  build/bin/calligraphy trial 十 --seed 3 --json build/consumer-haptics/record.json >/dev/null
+  build/consumer-haptics/rerun_record build/consumer-haptics/record.json
+  build/consumer-emulator/emulated_phantom
+}
+
 # -Wno-tsan: GCC warns that TSan does not model atomic_thread_fence (the OpenHaptics seqlock uses it);
 # the seqlock's fields are atomics, so no race is hidden. Only the servo-loop test program (with the
 # OpenHaptics stand-in it loads) and the modules it links are built, at -O1, without debug information
 # (a report's stack names the functions, as the ASan stage's do), beside the sanitizer tests.
-start_background "ThreadSanitizer build" "
+start_background "ThreadSanitizer build, then the install and the projects built with find_package(calligraphy)" "
+  set -euo pipefail
   cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO='-O1 -g0' $unity \
     -DCALLIGRAPHY_SANITIZE=thread -DCALLIGRAPHY_BUILD_TESTS=ON \
     -DCMAKE_CXX_FLAGS=-Wno-tsan -DCALLIGRAPHY_WARNINGS_AS_ERRORS=ON -DCALLIGRAPHY_BUILD_TOOLS=OFF \
     -DCALLIGRAPHY_BUILD_BENCH=OFF -DCALLIGRAPHY_BUILD_PYTHON=OFF -DCALLIGRAPHY_BUILD_EXAMPLES=OFF >/dev/null &&
-  cmake --build build-tsan -j $jobs --target calligraphy_servo_tests"
+  cmake --build build-tsan -j $jobs --target calligraphy_servo_tests
+  install_and_build_consumers"
 begin_stage "AddressSanitizer + UndefinedBehaviorSanitizer: tests"
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 run_ctest build-asan -E "study_report_chromium"
 end_stage
@@ -187,52 +247,8 @@ build-asan/bin/character_data_fuzzer -runs=0 data/hanzi-writer-data tests/data/h
 build-asan/bin/corpus_store_fuzzer -runs=0 fuzz/seeds tests/data/store_regressions
 end_stage
 
-begin_stage "install + find_package(calligraphy) from another project"
-rm -rf build/stage build/consumer build/consumer-haptics build/consumer-emulator
-touch build/install-started
-cmake --install build --prefix build/stage >/dev/null
-# A staging install writes only under its prefix (no .pth into another interpreter's site-packages).
-bash tests/consumer/check_install_prefix.sh build build/stage build/install-started
-# Only Eigen3 may be found: a find_dependency of anything else in the installed package fails the configure.
-cmake --no-warn-unused-cli -S tests/consumer -B build/consumer -G Ninja \
-  -DCMAKE_PREFIX_PATH="$PWD/build/stage" \
-  -DCMAKE_DISABLE_FIND_PACKAGE_spdlog=ON -DCMAKE_DISABLE_FIND_PACKAGE_fmt=ON \
-  -DCMAKE_DISABLE_FIND_PACKAGE_nlohmann_json=ON -DCMAKE_DISABLE_FIND_PACKAGE_ZLIB=ON \
-  -DCMAKE_DISABLE_FIND_PACKAGE_OpenSSL=ON -DCMAKE_DISABLE_FIND_PACKAGE_Threads=ON >/dev/null
-cmake --build build/consumer
-build/consumer/consumer
-# A haptic application: only the haptics component, its examples built and run, and their link lines free
-# of libssl and the USB libraries; log_redirect takes the library's log through a handler and a spdlog logger
-# of its own (spdlog's headers from the system, its package not found) and silences it; rerun_record reads a
-# record of `calligraphy trial --json` and runs it again. The haptics package links OpenSSL's libcrypto (a
-# record names its scene and a replay's teacher by SHA-256) by its library name, so OpenSSL's package is
-# still never looked for.
-cmake --no-warn-unused-cli -S tests/consumer/haptics -B build/consumer-haptics -G Ninja \
-  -DCMAKE_PREFIX_PATH="$PWD/build/stage" \
-  -DCMAKE_DISABLE_FIND_PACKAGE_spdlog=ON -DCMAKE_DISABLE_FIND_PACKAGE_fmt=ON \
-  -DCMAKE_DISABLE_FIND_PACKAGE_OpenSSL=ON >/dev/null
-cmake --build build/consumer-haptics
-bash tests/consumer/check_link_line.sh build/consumer-haptics build/consumer-haptics/own_loop \
-  build/consumer-haptics/custom_device_loop build/consumer-haptics/log_redirect build/consumer-haptics/rerun_record
-build/consumer-haptics/bundled_store "$PWD/build/stage"
-build/consumer-haptics/own_loop
-build/consumer-haptics/custom_device_loop
-build/consumer-haptics/log_redirect
-build/bin/calligraphy trial 十 --seed 3 --json build/consumer-haptics/record.json >/dev/null
-build/consumer-haptics/rerun_record build/consumer-haptics/record.json
-# The USB transports and the emulator are components of their own: absent from the plain install above,
-# installed when asked for by name, and then found by an application's tests that name the emulator.
-if find build/stage -name 'libcalligraphy_phantom_usb.a' -o -name 'libcalligraphy_testing.a' | grep -q .; then
-  echo "the plain install carries the USB transports or the emulator, which were not asked for" >&2
-  exit 1
-fi
-cmake --install build --prefix build/stage --component testing >/dev/null
-cmake --install build --prefix build/stage --component phantom_usb >/dev/null
-cmake --no-warn-unused-cli -S tests/consumer/emulator -B build/consumer-emulator -G Ninja \
-  -DCMAKE_PREFIX_PATH="$PWD/build/stage" \
-  -DCMAKE_DISABLE_FIND_PACKAGE_spdlog=ON -DCMAKE_DISABLE_FIND_PACKAGE_fmt=ON \
-  -DCMAKE_DISABLE_FIND_PACKAGE_OpenSSL=ON >/dev/null
-cmake --build build/consumer-emulator
-build/consumer-emulator/emulated_phantom
+begin_stage "install + find_package(calligraphy) from another project: its programs run"
+run_consumers
 end_stage
+
 echo "== all tests passed"
