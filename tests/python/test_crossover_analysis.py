@@ -5,11 +5,9 @@ factors); Hills-Armitage equal to R's t.test on half period differences; one tes
 Holm family; n counted as subjects; a planted effect recovered, a planted null not found more often than
 chance would allow in one seed."""
 
-import atexit
 import math
 import os
 import select
-import shutil
 import subprocess
 import tempfile
 
@@ -18,6 +16,7 @@ import pandas
 import pytest
 
 from calligraphy import design_analysis, mixed_models
+from persistent_rscript import PersistentRscript
 
 needs_r = pytest.mark.skipif(not mixed_models.r_available(), reason="R with lme4, lmerTest and pbkrtest is not "
                              "installed (Debian: r-base-core r-cran-lme4 r-cran-lmertest r-cran-pbkrtest)")
@@ -93,44 +92,12 @@ while (length(line <- readLines(requests, n = 1)) > 0) {
   flush(stdout())
 }
 """
-_R_RUNNING = []  # the running Rscript and its folder, started by the first request
-
-
-def _r_runner():
-    if _R_RUNNING and _R_RUNNING[0][0].poll() is None:
-        return _R_RUNNING[0]
-    _close_r_runner()
-    folder = tempfile.TemporaryDirectory(prefix="calligraphy-crossover-r-")
-    script = os.path.join(folder.name, "runner.R")
-    with open(script, "w", encoding="utf-8") as out:
-        out.write(_R_RUNNER)
-    process = subprocess.Popen([shutil.which("Rscript"), "--vanilla", script], stdin=subprocess.PIPE,
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    _R_RUNNING.append((process, folder))
-    return _R_RUNNING[0]
-
-
-def _close_r_runner():
-    while _R_RUNNING:
-        process, folder = _R_RUNNING.pop()
-        if process.poll() is None:
-            process.stdin.close()
-            try:
-                process.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                process.kill()
-                process.wait()
-        process.stdout.close()
-        process.stderr.close()
-        folder.cleanup()
-
-
-atexit.register(_close_r_runner)
+_R_PROCESS = PersistentRscript(_R_RUNNER, "calligraphy-crossover-r-")
 
 
 def run_r(code, *arguments):
     """Runs the R code `code` with its variable `arguments` (strings) in the test's one Rscript."""
-    process, folder = _r_runner()
+    process, folder = _R_PROCESS.running()
     with tempfile.NamedTemporaryFile("w", encoding="utf-8", suffix=".R", dir=folder.name, delete=False) as script:
         script.write(code)
     request = (script.name, *map(str, arguments))
@@ -142,10 +109,7 @@ def run_r(code, *arguments):
     reply = process.stdout.readline() if ready else "(nothing within 300 s)"
     os.unlink(script.name)
     if reply != "done\n":
-        _R_RUNNING.clear()
-        process.kill()
-        error = process.communicate()[1]
-        folder.cleanup()
+        error = _R_PROCESS.abandon()
         pytest.fail(f"Rscript answered {reply!r}: {error}")
 
 

@@ -5,13 +5,9 @@ Also: the same data in metres and in millimetres give the same rows, without lme
 documented reduction of a singular fit in a between-subjects design; the item set as a term of a crossover whose
 sets rotate, and the reason when they do not."""
 
-import atexit
 import math
 import os
 import select
-import shutil
-import subprocess
-import tempfile
 
 import numpy as np
 import pandas
@@ -20,6 +16,7 @@ import pytest
 from calligraphy import design_analysis, design_models, mixed_models
 
 from test_design_analysis import GROUPS, between_study
+from persistent_rscript import PersistentRscript
 
 needs_r = pytest.mark.skipif(not mixed_models.r_available(), reason="R with lme4, lmerTest and pbkrtest is not "
                              "installed (Debian: r-base-core r-cran-lme4 r-cran-lmertest r-cran-pbkrtest)")
@@ -102,45 +99,13 @@ while (length(line <- readLines(requests, n = 1)) > 0) {
   flush(stdout())
 }
 """
-_R_PAIRS = []  # the running Rscript and its folder, started by the first request
-
-
-def _r_pairs_process():
-    if _R_PAIRS and _R_PAIRS[0][0].poll() is None:
-        return _R_PAIRS[0]
-    _close_r_pairs()
-    folder = tempfile.TemporaryDirectory(prefix="calligraphy-emmeans-")
-    script = os.path.join(folder.name, "r.R")
-    with open(script, "w", encoding="utf-8") as out:
-        out.write(_R_EMMEANS)
-    process = subprocess.Popen([shutil.which("Rscript"), "--vanilla", script], stdin=subprocess.PIPE,
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    _R_PAIRS.append((process, folder))
-    return _R_PAIRS[0]
-
-
-def _close_r_pairs():
-    while _R_PAIRS:
-        process, folder = _R_PAIRS.pop()
-        if process.poll() is None:
-            process.stdin.close()
-            try:
-                process.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                process.kill()
-                process.wait()
-        process.stdout.close()
-        process.stderr.close()
-        folder.cleanup()
-
-
-atexit.register(_close_r_pairs)
+_R_PROCESS = PersistentRscript(_R_EMMEANS, "calligraphy-emmeans-")
 
 
 def r_pairs(frame, formula, factor, levels, kind="lmer", ddf="Satterthwaite"):
     """R's every pairwise contrast (later - earlier, in ``levels``' order) of ``factor`` in ``formula`` fitted
     to ``frame`` (the outcome in mm), raw and Holm-adjusted."""
-    process, folder = _r_pairs_process()
+    process, folder = _R_PROCESS.running()
     data, answer = (os.path.join(folder.name, name) for name in ("d.csv", "answer.csv"))
     frame.to_csv(data, index=False, encoding="utf-8")
     request = (data, formula, ",".join(levels), factor, kind,
@@ -152,10 +117,7 @@ def r_pairs(frame, formula, factor, levels, kind="lmer", ddf="Satterthwaite"):
     # "" when R ended on an error (its message is on standard error); nothing within 300 s is a hang
     reply = process.stdout.readline() if ready else "(nothing within 300 s)"
     if reply != "done\n":
-        _R_PAIRS.clear()
-        process.kill()
-        error = process.communicate()[1]
-        folder.cleanup()
+        error = _R_PROCESS.abandon()
         pytest.fail(f"Rscript answered {reply!r}: {error}")
     answer_frame = pandas.read_csv(answer)
     os.unlink(answer)
