@@ -113,6 +113,21 @@ def sanitized_subset(names):
     return load_tests
 
 
+def last_case(tests, name):
+    """`tests` as one flat suite with the test method `name` moved to its end, and whether that case is in it: a
+    case that waits on a clock runs last, beside what the others started."""
+    cases, last = [], []
+
+    def walk(suite):
+        for item in suite:
+            if isinstance(item, unittest.TestSuite):
+                walk(item)
+            else:
+                (last if getattr(item, "_testMethodName", "") == name else cases).append(item)
+    walk(tests)
+    return unittest.TestSuite(cases + last), bool(last)
+
+
 def strip_comment(line):
     """A shell line without its trailing `# comment` (a `#` outside quotes at the start or after a space), and
     the comment; a line with none as it is, right-stripped, and ""."""

@@ -32,7 +32,7 @@ import time
 import unittest
 from pathlib import Path
 
-from outsider import ENV, OneErrorLine, error_lines, run, sanitized_subset
+from outsider import ENV, OneErrorLine, error_lines, last_case, run, sanitized_subset
 
 run_sanitized_subset = sanitized_subset({"test_score_of_a_fifo_no_one_writes_to_is_refused_without_waiting",
                                         "test_score_of_endless_devices_is_refused_at_once",
@@ -47,17 +47,8 @@ WAITING_CASE = "test_a_fifo_no_one_reads_as_an_output_fails_after_the_stated_wai
 
 def load_tests(loader, tests, pattern):
     """The cases sanitized_subset keeps, the one that waits last (see WAITING_CASE)."""
-    cases, waiting = [], []
-
-    def walk(suite):
-        for item in suite:
-            if isinstance(item, unittest.TestSuite):
-                walk(item)
-            else:
-                (waiting if getattr(item, "_testMethodName", "") == WAITING_CASE else cases).append(item)
-    walk(run_sanitized_subset(loader, tests, pattern))
-    SHARED["start_waiting_early"] = bool(waiting)
-    return unittest.TestSuite(cases + waiting)
+    suite, SHARED["start_waiting_early"] = last_case(run_sanitized_subset(loader, tests, pattern), WAITING_CASE)
+    return suite
 
 SOURCE = Path(os.environ.get("CALLIGRAPHY_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 SAMPLE = SOURCE / "tests" / "data" / "hanzi-writer-sample"

@@ -23,7 +23,7 @@ import threading
 import unittest
 from pathlib import Path
 
-from outsider import CLI, ENV, TIMEOUT_S, error_lines, run
+from outsider import CLI, ENV, error_lines, last_case, run
 
 SANITIZED = os.environ.get("CALLIGRAPHY_SANITIZED") == "1"
 SHI = "十"
@@ -107,17 +107,9 @@ class ReportOntoUnreadFifo:
 
 def load_tests(loader, tests, pattern):  # noqa: ARG001 - unittest's protocol
     """Every case, the one that waits last (see WAITING_CASE)."""
-    cases, waiting = [], []
-
-    def walk(suite):
-        for item in suite:
-            if isinstance(item, unittest.TestSuite):
-                walk(item)
-            else:
-                (waiting if getattr(item, "_testMethodName", "") == WAITING_CASE else cases).append(item)
-    walk(tests)
-    WAITING["early"] = bool(waiting) and not SANITIZED
-    return unittest.TestSuite(cases + waiting)
+    suite, waits = last_case(tests, WAITING_CASE)
+    WAITING["early"] = waits and not SANITIZED
+    return suite
 
 
 def tearDownModule():
