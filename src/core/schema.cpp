@@ -187,12 +187,11 @@ void set_field_from_text(const SchemaField& field, void* object, std::string_vie
   switch (field.kind) {
     case FieldKind::number: {
       if (field.option_whole) {
-        const std::string range = whole_option_range_text(field);
         const std::optional<std::int64_t> whole = parse_whole<std::int64_t>(text);
         const double value = whole ? static_cast<double>(*whole) / field.option_factor : 0.0;
         if (!whole || !field.range.contains(value))
           throw InvalidArgument(quoted(text) + " is not a whole number of " + std::string(field.option_unit) +
-                                " in " + range);
+                                " in " + whole_option_range_text(field));
         field.set_number(field, object, 0, value);
         return;
       }
