@@ -96,7 +96,8 @@ std::string model_damage(std::string_view bytes) {
 
 // `file` mapped into `into` (a regular file of 1 byte to kMaxModelBytes, read-only); why not, "" when mapped.
 std::string map_model(const std::string& file, Recogniser& into) {
-  const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
+  // O_NONBLOCK: a FIFO put in the file's place since it was found regular is refused below, never waited on.
+  const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0) return std::string("cannot open it: ") + std::strerror(errno);
   struct stat status {};
   std::string problem;
