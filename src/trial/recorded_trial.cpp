@@ -166,6 +166,15 @@ std::string recorded_trial_json(const RecordedTrial& r) {
 
 namespace trial_detail {
 
+namespace {
+
+// The versions a record's specification may have, as its errors name them ("1 to 8").
+std::string versions_read_text() {
+  return std::to_string(kOldestRecordedTrialVersion) + " to " + std::to_string(kRecordedTrialVersion);
+}
+
+}  // namespace
+
 RecordedTrial read_recorded_document(const json& document, const std::string& source) {
   std::string at;  // the specification object's pointer in the document
   const json* object = &document;
@@ -191,8 +200,7 @@ RecordedTrial read_recorded_document(const json& document, const std::string& so
     json_detail::fail(source, reader.pointer("format"),
                       "format '" + format + "' is not '" + std::string(kRecordedTrialFormat) + "'");
   }
-  const std::string versions_read =
-      std::to_string(kOldestRecordedTrialVersion) + " to " + std::to_string(kRecordedTrialVersion);
+  const std::string versions_read = versions_read_text();
   std::int64_t version = 0;
   try {
     version = reader.integer("version", 0, std::numeric_limits<std::int64_t>::max());
@@ -419,10 +427,9 @@ json parse_record_text(std::string_view text, const std::string& source) {
   } catch (const json_detail::NumberOverflow& e) {
     // Only the specification's own: a study record's top-level version reads other numbers.
     if (e.pointer() != "/specification/version") throw;
-    json_detail::fail(source, e.pointer(),
-                      "version " + e.literal() + " is not one this library reads (" +
-                          std::to_string(kOldestRecordedTrialVersion) + " to " +
-                          std::to_string(kRecordedTrialVersion) + ")");
+    json_detail::fail(
+        source, e.pointer(),
+        "version " + e.literal() + " is not one this library reads (" + versions_read_text() + ")");
   }
 }
 
