@@ -7,8 +7,8 @@
 #include <limits>
 #include <random>
 
-#include "calligraphy/model/nearest_point.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/model/nearest_point.hpp"
 #include "eval/nearest_point_measurement.hpp"
 #include "eval/nearest_point_report.hpp"
 #include "eval/nearest_point_scenarios.hpp"
@@ -42,6 +42,19 @@ TEST_CASE("Lib2geomCurve keeps the element's curve and parameter", "[lib2geom]")
       CHECK(answer.distance <= exact.distance + 1e-12);
     }
   }
+}
+
+// A build configured with lib2geom must load its module from beside the test program, as the installed
+// program does from beside itself: otherwise the cases above would silently take the "not built" branch.
+TEST_CASE("A build with lib2geom loads its module", "[lib2geom]") {
+#ifdef CALLIGRAPHY_TEST_EXPECT_LIB2GEOM
+  CAPTURE(cli::lib2geom_missing());
+  CHECK(lib2geom_built());
+  CHECK(cli::lib2geom_missing().empty());
+#else
+  CHECK_FALSE(lib2geom_built());
+  CHECK_THAT(cli::lib2geom_missing(), Contains("no lib2geom"));
+#endif
 }
 
 TEST_CASE("Lib2geomCurve rejects a bad element or query point", "[lib2geom]") {

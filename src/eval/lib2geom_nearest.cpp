@@ -1,21 +1,15 @@
 #include "eval/lib2geom_nearest.hpp"
 
-#include <cmath>
-#include <string>
-
-#include "calligraphy/core/errors.hpp"
-
-#ifdef CALLIGRAPHY_WITH_LIB2GEOM
-#include <2geom/bezier-curve.h>
-#include <2geom/bezier.h>
-#include <2geom/curve.h>
-#include <2geom/d2.h>
-#include <2geom/exception.h>
-#include <2geom/point.h>
+#include <dlfcn.h>
 
 #include <array>
-#include <vector>
-#endif
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <system_error>
+
+#include "calligraphy/core/errors.hpp"
+#include "eval/lib2geom_module/lib2geom_module.hpp"
 
 namespace calligraphy::cli {
 
@@ -37,84 +31,95 @@ void require_element(const StrokeElement& element) {
   }
 }
 
-}  // namespace
-
-#ifdef CALLIGRAPHY_WITH_LIB2GEOM
-
-// A Bezier curve of any order in lib2geom is D2<Bezier>, one Bernstein polynomial per axis, whose
-// coefficients are the control points' coordinates: no change of basis, so nothing is rounded.
-// BezierCurve::nearestTime, which Geom::nearest_time(Point, Curve) calls, roots the Bernstein
-// product (B - P) . B' and compares the roots with both ends.
-struct Lib2geomCurve::Curve {
-  Geom::BezierCurve bezier;
+// The module that calls lib2geom, loaded once, on first use, from beside the program: build and install
+// put it at CALLIGRAPHY_LIB2GEOM_MODULE_DIR relative to the directory of the running executable.
+struct Lib2geomModule {
+  calligraphy_lib2geom_curve_new_fn curve_new = nullptr;
+  calligraphy_lib2geom_curve_delete_fn curve_delete = nullptr;
+  calligraphy_lib2geom_nearest_fn nearest = nullptr;
+  std::string missing;  ///< why it is not loaded; empty when loaded
 };
 
-namespace {
-
-// |B(t) - P| from the control points taken relative to P, as lib2geom compares its candidates (it
-// subtracts P from the curve first): the distance then carries no rounding of global coordinates, and
-// the error measured is that of lib2geom's t. De Casteljau on at most five points, no allocation.
-double distance_at(const Geom::BezierCurve& curve, const Geom::Point& p, double t) {
-  std::array<Geom::Point, kMaxElementDegree + 1> relative;
-  const unsigned order = curve.order();
-  for (unsigned i = 0; i <= order; ++i) relative[i] = curve.controlPoint(i) - p;
-  for (unsigned level = 1; level <= order; ++level) {
-    for (unsigned i = 0; i + level <= order; ++i) relative[i] = (1.0 - t) * relative[i] + t * relative[i + 1];
+Lib2geomModule load_module() {
+  Lib2geomModule module;
+#ifdef CALLIGRAPHY_LIB2GEOM_MODULE_DIR
+  std::error_code error;
+  const std::filesystem::path program = std::filesystem::read_symlink("/proc/self/exe", error);
+  if (error) {
+    module.missing = "the running program's path is unknown (/proc/self/exe: " + error.message() + ")";
+    return module;
   }
-  return Geom::L2(relative[0]);
+  const std::filesystem::path file =
+      program.parent_path() / CALLIGRAPHY_LIB2GEOM_MODULE_DIR / CALLIGRAPHY_LIB2GEOM_MODULE_FILE;
+  void* handle = ::dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (handle == nullptr) {
+    const char* why = ::dlerror();
+    module.missing = "its module does not load (" + std::string(why != nullptr ? why : file.string()) + ")";
+    return module;
+  }
+  module.curve_new =
+      reinterpret_cast<calligraphy_lib2geom_curve_new_fn>(::dlsym(handle, "calligraphy_lib2geom_curve_new"));
+  module.curve_delete = reinterpret_cast<calligraphy_lib2geom_curve_delete_fn>(
+      ::dlsym(handle, "calligraphy_lib2geom_curve_delete"));
+  module.nearest =
+      reinterpret_cast<calligraphy_lib2geom_nearest_fn>(::dlsym(handle, "calligraphy_lib2geom_nearest"));
+  if (module.curve_new == nullptr || module.curve_delete == nullptr || module.nearest == nullptr) {
+    module.missing = "its module " + file.string() + " lacks a function";
+  }
+#else
+  module.missing = "this build has no lib2geom (install lib2geom-dev and configure again)";
+#endif
+  return module;
+}
+
+const Lib2geomModule& lib2geom_module() {
+  static const Lib2geomModule module = load_module();
+  return module;
 }
 
 }  // namespace
 
-bool lib2geom_built() { return true; }
+bool lib2geom_built() { return lib2geom_module().missing.empty(); }
+
+std::string lib2geom_missing() { return lib2geom_module().missing; }
+
+struct Lib2geomCurve::Curve {
+  void* curve = nullptr;
+  ~Curve() { lib2geom_module().curve_delete(curve); }
+};
 
 Lib2geomCurve::Lib2geomCurve(const StrokeElement& element) {
   require_element(element);
+  if (!lib2geom_built()) throw Error("lib2geom nearest point: " + lib2geom_missing());
   // Bernstein coefficients per axis are the control points' coordinates.
-  std::vector<Geom::Coord> x;
-  std::vector<Geom::Coord> y;
+  std::array<double, kMaxElementDegree + 1> x{};
+  std::array<double, kMaxElementDegree + 1> y{};
   for (int i = 0; i <= element.degree; ++i) {
-    const Vec2& control = element.control[static_cast<std::size_t>(i)];
-    x.push_back(control.x());
-    y.push_back(control.y());
+    x[static_cast<std::size_t>(i)] = element.control[static_cast<std::size_t>(i)].x();
+    y[static_cast<std::size_t>(i)] = element.control[static_cast<std::size_t>(i)].y();
   }
-  curve_ = std::make_unique<Curve>(
-      Curve{Geom::BezierCurve(Geom::D2<Geom::Bezier>(Geom::Bezier(x), Geom::Bezier(y)))});
+  std::array<char, 256> message{};
+  void* curve =
+      lib2geom_module().curve_new(x.data(), y.data(), element.degree + 1, message.data(), message.size());
+  if (curve == nullptr) throw Error(std::string("lib2geom nearest point: ") + message.data());
+  curve_ = std::make_unique<Curve>();
+  curve_->curve = curve;
 }
 
 NearestPoint Lib2geomCurve::nearest(const Vec2& p) const {
   require_finite(p, "the query point");
-  const Geom::Point query(p.x(), p.y());
-  NearestPoint result;
-  try {
-    result.t = Geom::nearest_time(query, curve_->bezier);
-  } catch (const Geom::Exception& e) {
-    throw Error(std::string("lib2geom nearest point: Geom::nearest_time threw: ") + e.what());
+  std::array<double, 4> out{};
+  std::array<char, 256> message{};
+  if (lib2geom_module().nearest(curve_->curve, p.x(), p.y(), out.data(), message.data(), message.size()) !=
+      0) {
+    throw Error(std::string("lib2geom nearest point: Geom::nearest_time threw: ") + message.data());
   }
-  const Geom::Point foot = curve_->bezier.pointAt(result.t);
-  result.foot = Vec2(foot.x(), foot.y());
-  result.distance = distance_at(curve_->bezier, query, result.t);
+  NearestPoint result;
+  result.t = out[0];
+  result.foot = Vec2(out[1], out[2]);
+  result.distance = out[3];
   return result;
 }
-
-#else
-
-struct Lib2geomCurve::Curve {};
-
-bool lib2geom_built() { return false; }
-
-Lib2geomCurve::Lib2geomCurve(const StrokeElement& element) {
-  require_element(element);
-  throw Error(
-      "lib2geom nearest point: this build has no lib2geom (install lib2geom-dev and configure again)");
-}
-
-NearestPoint Lib2geomCurve::nearest(const Vec2& p) const {
-  require_finite(p, "the query point");
-  throw Error("lib2geom nearest point: this build has no lib2geom");
-}
-
-#endif
 
 Lib2geomCurve::~Lib2geomCurve() = default;
 Lib2geomCurve::Lib2geomCurve(Lib2geomCurve&&) noexcept = default;

@@ -1,17 +1,22 @@
 #pragma once
 // lib2geom's nearest point (Geom::nearest_time, lib2geom 1.2, https://gitlab.com/inkscape/lib2geom) on
 // our stroke elements, as a further column of `calligraphy bench nearest`. lib2geom is optional at
-// configure time (CALLIGRAPHY_WITH_LIB2GEOM); without it `lib2geom_built()` is false and
-// `Lib2geomCurve` throws.
+// configure time; it is called from a module loaded on first use (lib2geom_module/), so that its 30 shared
+// libraries load only for this column. Without the module `lib2geom_built()` is false and `Lib2geomCurve`
+// throws.
 #include <memory>
+#include <string>
 
-#include "calligraphy/model/nearest_point.hpp"
 #include "calligraphy/model/element.hpp"
+#include "calligraphy/model/nearest_point.hpp"
 
 namespace calligraphy::cli {
 
-/// Whether this build links lib2geom.
+/// Whether this build has lib2geom's module and it loads (loaded by the first call).
 bool lib2geom_built();
+
+/// Why lib2geom is not available ("this build has no lib2geom ...", the loader's message); empty when it is.
+std::string lib2geom_missing();
 
 /// One stroke element converted once to a Geom::BezierCurve with the same control points in the same
 /// coordinates (Bernstein form, so the curve and its parameter t in [0, 1] are the element's own),
@@ -19,7 +24,7 @@ bool lib2geom_built();
 class Lib2geomCurve {
  public:
   /// Throws InvalidArgument when the degree is not 1..4 or a control point is not finite, Error when
-  /// this build has no lib2geom.
+  /// lib2geom is not available (lib2geom_missing()).
   explicit Lib2geomCurve(const StrokeElement& element);
   ~Lib2geomCurve();
   Lib2geomCurve(Lib2geomCurve&&) noexcept;

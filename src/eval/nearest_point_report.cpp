@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "calligraphy/core/errors.hpp"
+#include "eval/lib2geom_nearest.hpp"
 #include "eval/report_numbers.hpp"
 
 namespace calligraphy::cli {
@@ -62,8 +63,7 @@ std::string lib2geom_comparison(const NearestPointMeasurement& measurement) {
   table << "|---:|---|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const NearestPointRow& row : measurement.rows) {
     if (row.method != kLib2geomMethod) continue;
-    if (!row.built)
-      return out.str() + kLib2geomMethod + std::string(": not built (this build has no lib2geom)\n");
+    if (!row.built) return out.str() + kLib2geomMethod + ": not built (" + lib2geom_missing() + ")\n";
     const NearestPointRow* exact = find_row(measurement, "exact", row.degree, row.scenario);
     if (exact == nullptr) continue;
     failed += row.failed_queries;
