@@ -120,8 +120,7 @@ CLI::Option* add_flag(CLI::App& app, const std::string& name, bool& target, cons
 CLI::Option* add_integer(CLI::App& app, const std::string& name, std::int64_t& target,
                          const std::string& value_name, const std::string& description, std::int64_t minimum,
                          std::int64_t maximum, const std::string& default_text) {
-  const std::string expectation =
-      "an integer in [" + std::to_string(minimum) + ", " + std::to_string(maximum) + "]";
+  const std::string expectation = "an integer in " + std::to_string(minimum) + ".." + std::to_string(maximum);
   const std::string shown = default_text.empty() ? std::to_string(target) : default_text;
   // The range in the help as the schema's integer options write it ("0..1000"), so that no option's
   // bounds are found only by trying them.
@@ -143,7 +142,7 @@ CLI::Option* add_unsigned(CLI::App& app, const std::string& name, std::uint64_t&
                     [=, &target](const std::string& text) {
                       std::uint64_t value = 0;
                       if (!parse_integer(text, value))
-                        invalid(name, "an integer in [0, 18446744073709551615]", text);
+                        invalid(name, "an integer in 0..18446744073709551615", text);
                       target = value;
                     });
 }

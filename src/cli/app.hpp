@@ -54,7 +54,7 @@ void configure_root(CLI::App& root);
 /// A flag (no value).
 CLI::Option* add_flag(CLI::App& app, const std::string& name, bool& target, const std::string& description);
 
-/// An integer in [minimum, maximum], decimal digits only (a leading '-' for a negative one). The default
+/// An integer in minimum..maximum, decimal digits only (a leading '-' for a negative one). The default
 /// shown is `target`, or `default_text` when given.
 CLI::Option* add_integer(CLI::App& app, const std::string& name, std::int64_t& target,
                          const std::string& value_name, const std::string& description, std::int64_t minimum,

@@ -76,8 +76,9 @@ namespace {
 // may already have been rounded when it was read, so it is not taken for the integer it seems to be.
 constexpr double kLargestExactInteger = 9007199254740992.0;
 
-// "expected an integer in [minimum, maximum], got VALUE", saying why when the value is in the range but
-// not an integer the file states exactly (a fraction or an exponent beyond 2^53: 1e19).
+// "expected an integer in minimum..maximum, got VALUE" (the range as the schema's tables and the options
+// write it), saying why when the value is in the range but not an integer the file states exactly (a fraction
+// or an exponent beyond 2^53: 1e19).
 [[noreturn]] void fail_integer(const nlohmann::json& value, const std::string& pointer,
                                const std::string& source, const std::string& range) {
   std::string message = "expected an integer in " + range + ", got " + describe(value);
@@ -105,8 +106,7 @@ bool is_exact_integral_float(const nlohmann::json& value) {
 
 std::int64_t as_integer(const nlohmann::json& value, const std::string& pointer, const std::string& source,
                         std::int64_t minimum, std::int64_t maximum) {
-  std::string range = "[";
-  range.append(std::to_string(minimum)).append(", ").append(std::to_string(maximum)).append("]");
+  const std::string range = std::to_string(minimum) + ".." + std::to_string(maximum);
   if (!value.is_number_integer() && !is_exact_integral_float(value))
     fail_integer(value, pointer, source, range);
   if (value.is_number_unsigned() &&
@@ -121,7 +121,7 @@ std::int64_t as_integer(const nlohmann::json& value, const std::string& pointer,
 
 std::uint64_t as_unsigned(const nlohmann::json& value, const std::string& pointer,
                           const std::string& source) {
-  static const std::string kRange = "[0, 18446744073709551615]";
+  static const std::string kRange = "0..18446744073709551615";
   if (value.is_number_unsigned()) return value.get<std::uint64_t>();
   if (value.is_number_integer() && value.get<std::int64_t>() >= 0) return value.get<std::uint64_t>();
   if (is_exact_integral_float(value) && value.get<double>() >= 0.0)

@@ -46,7 +46,7 @@ void SimulatedDeviceParameters::validate() const {
   if (!(velocity_cutoff_hz > 0.0 && velocity_cutoff_hz <= 1e6))
     out_of_range("velocity_cutoff_hz", velocity_cutoff_hz, "in (0, 1e6] Hz");
   if (physics_substeps < 1 || physics_substeps > 10000)
-    out_of_range("physics_substeps", physics_substeps, "an integer in [1, 10000]");
+    out_of_range("physics_substeps", physics_substeps, "an integer in 1..10000");
   if (!within(physics_rate_hz, 1e3, 1e8))
     out_of_range("physics_rate_hz", physics_rate_hz, "in [1e3, 1e8] Hz");
   // Within a haptic device's reach, as a scene's layout is (kDeviceReachM).

@@ -100,8 +100,8 @@ void count_from_one(json& document, const std::string& source) {
         *value = value->get<std::uint64_t>() + 1;
       } else {
         json_detail::fail(source, json_detail::child_pointer(json_detail::child_pointer("/plan", i), key),
-                          "expected an integer in [0, " + std::to_string(kMaxPlannedTrials - 1) +
-                              "] (version 1 counts from 0), got " + json_detail::describe(*value));
+                          "expected an integer in 0.." + std::to_string(kMaxPlannedTrials - 1) +
+                              " (version 1 counts from 0), got " + json_detail::describe(*value));
       }
     }
   }
