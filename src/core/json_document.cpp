@@ -185,6 +185,11 @@ nlohmann::json parse_json_document(std::string_view text, const std::string& sou
   // The plain parser first: linear in the text. A parser with a callback is not (nlohmann/json 3.11's
   // callback parser scans an object's parent for a discarded value at every object's end, so an array of n
   // objects, a session plan, takes n^2 steps); it runs only to name where a document that failed fails.
+  // JSON text never holds a NUL byte; the parser would take one for the end of its input and drop the rest.
+  if (const std::size_t nul = text.find('\0'); nul != std::string_view::npos) {
+    throw DataError(source + ": not valid JSON at byte " + std::to_string(nul + 1) +
+                    ": a NUL byte, which JSON text never holds");
+  }
   try {
     nlohmann::json document = nlohmann::json::parse(text.begin(), text.end());
     DuplicateKeys keys;

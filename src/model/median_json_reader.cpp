@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <set>
 
 #include "calligraphy/model/character_library.hpp"
 #include "core/json_document.hpp"
@@ -24,9 +25,10 @@ enum class Role : std::uint8_t { root, medians, median, point, coordinate, outli
 struct Frame {
   Role role = Role::skipped;
   bool is_array = false;
-  std::size_t count = 0;  // values seen so far in an array
-  std::string segment;    // this container's name in its parent (JSON pointer segment, escaped)
-  std::string key;        // the key read last in an object
+  std::size_t count = 0;       // values seen so far in an array
+  std::string segment;         // this container's name in its parent (JSON pointer segment, escaped)
+  std::string key;             // the key read last in an object
+  std::set<std::string> keys;  // every key of an object so far: one given twice is refused, as elsewhere
 };
 
 // Keys are free text of any length; an error names at most this many bytes of one.
@@ -90,10 +92,9 @@ class MediansHandler {
   bool start_object(std::size_t /*size*/) { return open(false, "an object"); }
   bool key(json::string_t& name) {
     frames_.back().key = name;
-    if (frames_.back().role == Role::root && name == "medians") {
-      if (seen_medians_) return fail(next_path(), "duplicate key");
-      seen_medians_ = true;
-    }
+    // Any key given twice (a reader would take one of the two without a word), ignored ones included.
+    if (!frames_.back().keys.insert(name).second) return fail(next_path(), "duplicate key");
+    if (frames_.back().role == Role::root && name == "medians") seen_medians_ = true;
     return true;
   }
   bool end_object() {
@@ -163,6 +164,12 @@ class MediansHandler {
   }
 
   void set_text(std::string_view text) { text_ = text; }
+
+  // JSON text never holds a NUL byte; the parser would take one for the end of its input and drop the rest.
+  void nul_byte(std::size_t offset) {
+    fail("line:column " + line_column(offset + 1),
+         "malformed JSON (a NUL byte, which JSON text never holds)");
+  }
 
  private:
   static bool has_two_distinct_points(const std::vector<Vec2>& median) {
@@ -322,6 +329,10 @@ MedianJsonResult read_medians_json(std::string_view json) {
   MedianJsonResult result;
   MediansHandler handler(result);
   handler.set_text(json);
+  if (const std::size_t nul = json.find('\0'); nul != std::string_view::npos) {
+    handler.nul_byte(nul);
+    return result;
+  }
   const bool parsed = nlohmann::json::sax_parse(json.begin(), json.end(), &handler);
   if (parsed) {
     handler.finish();

@@ -124,6 +124,12 @@ class OutlinesHandler {
 OutlineJsonResult read_outlines_json(std::string_view json) {
   OutlineJsonResult result;
   OutlinesHandler handler(result);
+  // JSON text never holds a NUL byte; the parser would take one for the end of its input and drop the rest.
+  if (const std::size_t nul = json.find('\0'); nul != std::string_view::npos) {
+    result.where = "byte " + std::to_string(nul + 1);
+    result.what = "malformed JSON (a NUL byte, which JSON text never holds)";
+    return result;
+  }
   if (nlohmann::json::sax_parse(json.begin(), json.end(), &handler)) {
     handler.finish();
   } else if (result.where.empty()) {
