@@ -17,6 +17,10 @@ std::uintmax_t regular_file_size(const std::filesystem::path& path, std::uintmax
   const std::string name = path.string();
   std::error_code error;
   const auto status = std::filesystem::status(path, error);
+  if (error && error.value() == ELOOP) {
+    // A link that leads back to itself exists: it is not a missing file.
+    throw DataError(name + ": cannot resolve the symbolic link: " + std::strerror(ELOOP));
+  }
   if (error || !std::filesystem::exists(status)) {
     // `-` means standard output for an output; an input is never standard input (it must be a regular file).
     if (name == "-") {
