@@ -67,8 +67,9 @@ class RecordEncoder {
     const std::string where = "stroke " + std::to_string(s + 1);
     if (stroke.typical_id < 1 || stroke.typical_id > 39) fail(where + ": typical ID out of range 1-39");
     const std::size_t n = stroke.elements.size();
-    if (n == 0 || n > 15 + 255)
-      fail(where + ": " + std::to_string(n) + " elements, where a store's record holds 1-270");
+    // count:4 holds 1..15 elements, count 15 and count_extension:8 16..271 (docs/corpus.md, "Record").
+    if (n == 0 || n > 16 + 255)
+      fail(where + ": " + std::to_string(n) + " elements, where a store's record holds 1-271");
     if (stroke.attraction_factors.size() != n + 1)
       fail(where + ": needs one attraction factor per feature point");
 
