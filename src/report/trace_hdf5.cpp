@@ -494,6 +494,7 @@ class DirectChunks {
   // `out` (`samples` values) as doubles: integers over `power` (1 for a float column); `type` is the
   // dataset's.
   bool read_measured(hid_t dataset, hid_t type, std::size_t samples, double power, double* out) {
+    damaged_chunk_.reset();
     const bool i32 = H5Tequal(type, H5T_STD_I32LE) > 0;
     const bool i64 = !i32 && H5Tequal(type, H5T_STD_I64LE) > 0;
     const bool f64 = !i32 && !i64 && H5Tequal(type, H5T_IEEE_F64LE) > 0;
@@ -519,8 +520,14 @@ class DirectChunks {
     return true;
   }
 
+  // The first sample of a chunk in this library's layout whose stream does not inflate to exactly the chunk's
+  // bytes (cut short, two streams, damaged), from the last read that returned false; HDF5's own deflate
+  // filter would hand on such a chunk with its missing samples undefined, so the file is refused instead.
+  [[nodiscard]] std::optional<std::size_t> damaged_chunk() const { return damaged_chunk_; }
+
   // `samples` elements of `element` bytes each, little-endian as stored, into `out`.
   bool read_bytes(hid_t dataset, std::size_t samples, std::size_t element, unsigned char* out) {
+    damaged_chunk_.reset();
     if (inflater_ == nullptr || samples == 0 || std::endian::native != std::endian::little) return false;
     hsize_t chunk_samples = 0;
     if (!shuffled_deflate_chunks(dataset, chunk_samples)) return false;
@@ -541,8 +548,10 @@ class DirectChunks {
       std::size_t inflated = 0;
       if (libdeflate_zlib_decompress(inflater_, compressed_.data(), compressed_.size(), raw_.data(),
                                      chunk_bytes, &inflated) != LIBDEFLATE_SUCCESS ||
-          inflated != chunk_bytes)
+          inflated != chunk_bytes) {
+        damaged_chunk_ = static_cast<std::size_t>(first);
         return false;
+      }
       const std::size_t count =
           std::min<std::size_t>(static_cast<std::size_t>(chunk_samples), samples - first);
       if (element == 1) {
@@ -595,6 +604,7 @@ class DirectChunks {
 
   libdeflate_decompressor* inflater_;
   std::vector<unsigned char> compressed_, raw_, plain_, values_;
+  std::optional<std::size_t> damaged_chunk_;
 };
 
 class TraceFileReader {
@@ -620,7 +630,14 @@ class TraceFileReader {
     return dataset;
   }
 
+  // Read by HDF5 when the direct read did not: refused when the direct read found a damaged chunk.
   void read(const Handle& dataset, const char* name, hid_t memory_type, void* out) const {
+    if (const std::optional<std::size_t> first = direct_.damaged_chunk()) {
+      refuse(source_,
+             std::string("column '") + name + "': its chunk from sample " + std::to_string(*first + 1) +
+                 " does not inflate to the chunk's size (damaged, cut or forged: its samples would be "
+                 "undefined)");
+    }
     if (samples_ > 0 && H5Dread(dataset.get(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out) < 0)
       refuse(source_, std::string("column '") + name + "' cannot be read (damaged or of another type)");
   }
