@@ -37,7 +37,7 @@ import unittest
 import zlib
 from pathlib import Path
 
-from outsider import CLI, ENV, OneErrorLine, error_lines, run, run_ok, sanitized_subset
+from outsider import CLI, ENV, OneErrorLine, run, run_ok, sanitized_subset
 
 try:
     import numpy as np
@@ -654,7 +654,7 @@ class Round32A(unittest.TestCase, OneErrorLine):
         d = self.folder()
         (d / name).write_bytes(b"\0" * 1024)
         result = run(["trace", name, "--csv", "out.csv"], d)
-        line = self.assert_one_error(result, 1, "bad\\nname\\x1b[31m.trace.h5")
+        self.assert_one_error(result, 1, "bad\\nname\\x1b[31m.trace.h5")
         self.assertNotIn("\x1b", result.stderr.decode("utf-8", "replace"))
         self.assertEqual(sorted(os.listdir(d)), [name])
 
