@@ -129,7 +129,7 @@ TEST_CASE("an integer in range but written in exponent form is refused saying wh
   };
   // 1e19 is below 2^64 - 1: the message must not merely repeat the range it is in.
   check_error(with_seed("1e19"), "/order/seed", "write it in digits");
-  check_error(with_seed("-1"), "/order/seed", "[0, 18446744073709551615], got -1");
+  check_error(with_seed("-1"), "/order/seed", "0..18446744073709551615, got -1");
   check_error(with_seed("2.5"), "/order/seed", "got 2.5");
   // An exact integer in exponent form below 2^53 is that integer; the full range in digits is read.
   CHECK(parse_study_protocol(with_seed("1e3"), "p.json").seed == 1000);
@@ -406,7 +406,7 @@ TEST_CASE("a quiz condition's acceptance is checked naming the key, and leniency
   check_error(with_quiz(R"({"acceptance": {"hint_after_misses": 2.5}})"),
               "/conditions/0/quiz/acceptance/hint_after_misses", "integer");
   check_error(with_quiz(R"({"acceptance": {"assist_after_misses": 1001}})"),
-              "/conditions/0/quiz/acceptance/assist_after_misses", "[0, 1000]");
+              "/conditions/0/quiz/acceptance/assist_after_misses", "0..1000");
   // Every key a trial record writes is read.
   const StudyProtocol p = parse_study_protocol(
       with_quiz(R"({"acceptance": {"corridor_m": 0.007, "mean_deviation_m": 0.0035, "shortfall_m": 0.005,
@@ -449,9 +449,9 @@ TEST_CASE("a quiz condition's hint is its acceptance's hint_after_misses unless 
            R"(}], "test": {"characters": ["大"], "conditions": ["A"], "repetitions": 1}})";
   };
   check_error(with_quiz(R"({"hint_after_misses": )" + std::to_string(high + 1) + "}"),
-              "/conditions/0/quiz/hint_after_misses", "[0, 1000]");
+              "/conditions/0/quiz/hint_after_misses", "0..1000");
   check_error(with_quiz(R"({"acceptance": {"hint_after_misses": )" + std::to_string(high + 1) + "}}"),
-              "/conditions/0/quiz/acceptance/hint_after_misses", "[0, 1000]");
+              "/conditions/0/quiz/acceptance/hint_after_misses", "0..1000");
 }
 
 TEST_CASE("a balanced Latin square: each condition once per row, every ordered pair equally often",

@@ -186,7 +186,10 @@ nlohmann::json parse_json_document(std::string_view text, const std::string& sou
   // callback parser scans an object's parent for a discarded value at every object's end, so an array of n
   // objects, a session plan, takes n^2 steps); it runs only to name where a document that failed fails.
   // JSON text never holds a NUL byte; the parser would take one for the end of its input and drop the rest.
+  // A file of another kind (gzip, a trace, a store) holds some: it is named for what it is.
   if (const std::size_t nul = text.find('\0'); nul != std::string_view::npos) {
+    if (const std::string kind = non_json_kind(text); !kind.empty())
+      throw DataError(source + ": not a JSON document: it is " + kind);
     throw DataError(source + ": not valid JSON at byte " + std::to_string(nul + 1) +
                     ": a NUL byte, which JSON text never holds");
   }

@@ -167,6 +167,10 @@ class MediansHandler {
 
   // JSON text never holds a NUL byte; the parser would take one for the end of its input and drop the rest.
   void nul_byte(std::size_t offset) {
+    if (const std::string kind = json_detail::non_json_kind(text_); !kind.empty()) {
+      fail("/", "not a JSON document: it is " + kind);
+      return;
+    }
     fail("line:column " + line_column(offset + 1),
          "malformed JSON (a NUL byte, which JSON text never holds)");
   }

@@ -681,11 +681,12 @@ class Build(Offline):
         self.assertFalse((self.tmp / "file.clg").exists())
 
     def test_character_of_more_elements_than_a_record_holds_is_listed_and_the_store_holds_the_others(self):
-        # a median of 272 points zig-zagging 120 units (within every bound of the loader: at most 10,000 points)
-        # that the fitter models as 271 elements; a straight one beside it
+        # a median of 273 points zig-zagging 120 units (within every bound of the loader: at most 10,000 points)
+        # that the fitter models as 272 elements, one more than a record's count and its extension hold
+        # (docs/corpus.md, "Record": 15 + 1 + 255); a straight one beside it
         folder = self.tmp / "zigzag"
         folder.mkdir()
-        zigzag = [[100 + i * 800 / 271, 500 + (60 if i % 2 else -60)] for i in range(272)]
+        zigzag = [[100 + i * 800 / 272, 500 + (60 if i % 2 else -60)] for i in range(273)]
         (folder / "乙.json").write_text(json.dumps({"strokes": ["M 0 0 L 10 10 Z"], "medians": [zigzag]}))
         (folder / "一.json").write_text(json.dumps({"strokes": ["M 0 0 L 10 10 Z"],
                                                     "medians": [[[100, 500], [900, 500]]]}))
