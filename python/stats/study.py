@@ -279,13 +279,18 @@ def load(paths: typing.Union[PathLike, typing.Sequence[PathLike]]) -> Study:
     TypeError naming `paths` for anything but a path (str or path-like) or an iterable of them, ImportError without
     pandas."""
     roots = _folder_paths(paths, "load")
-    trials_text, strokes_text = _native._study_tables_csv(roots)
+    return _tidy_study(*_native._study_tables_csv(roots))
+
+
+def _tidy_study(trials_text: str, strokes_text: str) -> Study:
+    """The `Study` of the trials and strokes tables' CSV texts (as ``calligraphy report --csv`` writes them):
+    typed columns, and the design's order, not the alphabet's: phases as the protocol runs them, the control
+    condition first. What `load` returns, and `calligraphy.cohort.simulate` for subjects run in memory."""
     trials = _read_table(trials_text, _NUMERIC_TRIAL_COLUMNS, _BOOLEAN_TRIAL_COLUMNS)
     strokes = _read_table(strokes_text, _NUMERIC_STROKE_COLUMNS, _BOOLEAN_STROKE_COLUMNS)
     if not trials.empty:
         from . import design_analysis
 
-        # The design's order, not the alphabet's: phases as the protocol runs them, the control condition first.
         trials = design_analysis.ordered(trials, design_analysis.study_design(trials))
     return Study(trials=trials, strokes=strokes)
 

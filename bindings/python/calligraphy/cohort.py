@@ -122,7 +122,4 @@ def simulate(protocol: PathLike, subjects: int, *, profile: str = "novice", lear
                 bar.close()
         trials_text = texts[0][0] + "".join(_body(trials) for trials, _ in texts[1:])
         strokes_text = texts[0][1] + "".join(_body(strokes) for _, strokes in texts[1:])
-    return _study.Study(trials=_study._read_table(trials_text, _study._NUMERIC_TRIAL_COLUMNS,
-                                                  _study._BOOLEAN_TRIAL_COLUMNS),
-                        strokes=_study._read_table(strokes_text, _study._NUMERIC_STROKE_COLUMNS,
-                                                   _study._BOOLEAN_STROKE_COLUMNS))
+    return _study._tidy_study(trials_text, strokes_text)
