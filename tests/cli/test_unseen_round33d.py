@@ -35,8 +35,7 @@ import calligraphy.statistics
 import calligraphy.study
 
 try:
-    import dask  # noqa: F401 - the brief: Dask first
-    import distributed
+    import distributed  # Dask's scheduler, which imports Dask
 except ImportError:
     distributed = None
 try:
