@@ -277,8 +277,15 @@ class Reader {
     return c;
   }
 
+  // A leading '+', as C's printf("%+f") writes a number, before the number it signs (never before a sign).
+  static std::string_view unsigned_part(std::string_view field) {
+    if (field.size() > 1 && field.front() == '+' && field[1] != '+' && field[1] != '-')
+      field.remove_prefix(1);
+    return field;
+  }
+
   double number(const std::vector<std::string_view>& fields, std::size_t column) const {
-    const std::string_view field = fields[column];
+    const std::string_view field = unsigned_part(fields[column]);
     // A plain decimal (a trial's trace has millions) read where it stands, to the same value as
     // parse_finite_double gives but without the round trip through its optional, which costs as much again.
     double plain = 0.0;
@@ -286,7 +293,8 @@ class Reader {
     if (!field.empty() && parse_plain_decimal(field.data(), end, plain) == end) return plain;
     const std::optional<double> value = parse_finite_double(field);
     if (!value)
-      fail(column, field, "not a number (a finite decimal within the range of a double is expected)");
+      fail(column, fields[column],
+           "not a number (a finite decimal within the range of a double is expected)");
     return *value;
   }
 
@@ -309,7 +317,9 @@ class Reader {
       // The number 1 or 0 however a program spells it: numpy.savetxt writes 1.000000000000000000e+00 and
       // pandas a float column's 1.0, which Python's score takes from the same columns.
       const std::string_view pen = fields[*c.pen];
-      const std::optional<double> value = pen == "1" ? 1.0 : pen == "0" ? 0.0 : parse_finite_double(pen);
+      const std::optional<double> value = pen == "1"   ? 1.0
+                                          : pen == "0" ? 0.0
+                                                       : parse_finite_double(unsigned_part(pen));
       if (!value || (*value != 0.0 && *value != 1.0)) fail(*c.pen, pen, "pen must be 1 (down) or 0 (up)");
       s.pen_down = *value == 1.0;
     } else {
@@ -344,6 +354,14 @@ std::size_t count_lines(std::string_view text) {
     lines += block;
   }
   return lines;
+}
+
+// An unfinished line that is a comment ('#' after blanks) cut after its '#': the reader skips the line
+// whatever follows, so a comment of any length holds no more memory than that.
+void keep_comment_mark(std::string& unfinished) {
+  const std::size_t at = unfinished.find_first_not_of(" \t");
+  if (at != std::string::npos && unfinished[at] == '#' && unfinished.size() > at + 1)
+    unfinished.resize(at + 1);
 }
 
 void check_options(const PenTraceCsvOptions& options, const Placement& placement) {
@@ -465,8 +483,11 @@ void for_each_pen_trace_row(const std::filesystem::path& file, const Placement& 
     const std::size_t got = in.read(buffer.data() + kept, kBlockBytes);
     buffer.resize(kept + got);
     if (got == 0) break;
-    const std::size_t rest = reader.lines(buffer, offset, size);
-    buffer.erase(0, rest);
+    // A block that ends no line adds to the unfinished one, which is not scanned again (a long line would
+    // be scanned at every block, in time growing with its square).
+    if (std::memchr(buffer.data() + kept, '\n', got) != nullptr)
+      buffer.erase(0, reader.lines(buffer, offset, size));
+    keep_comment_mark(buffer);
   }
   if (!buffer.empty()) reader.line(buffer);
   reader.finish(size);
