@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "calligraphy/core/json_text.hpp"
 #include "calligraphy/core/printable_text.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
@@ -119,7 +120,7 @@ int run_characters(const CharactersCommand& command) {
                                 {"count", listed.size()},
                                 {"characters", characters},
                                 {"not_found", missing}};
-    write_standard_output(out.dump(2) + "\n");
+    write_standard_output(json_text(out, 2) + "\n");
     return 0;
   }
   std::string table = "char  code point  strokes  typical strokes\n";

@@ -1,6 +1,8 @@
 // `calligraphy corpus validate --cnchar FILE [--data DIR] [--markdown FILE] [--json] [--threads N]`:
 // per-stroke agreement of the typical-stroke classification with cnchar-order's letters
 // (docs/classification.md is this command's --markdown output).
+#include <fmt/printf.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -9,11 +11,11 @@
 #include <thread>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/json_text.hpp"
 #include "cli/commands.hpp"
 #include "cli/library_options.hpp"
 #include "cli/output.hpp"
 #include "eval/cnchar_validation.hpp"
-#include <fmt/printf.h>
 
 namespace calligraphy::cli {
 namespace {
@@ -35,10 +37,10 @@ std::string summary_text(const CncharValidation& result, const std::string& data
       "compared %zu characters (%zu strokes); skipped %zu not in the data, %zu with other stroke counts\n",
       result.compared, result.strokes, result.missing, result.count_mismatch.size());
   out += fmt::sprintf("per-stroke agreement %.2f %% (%zu of %zu); characters fully agreeing %.2f %%\n",
-          100.0 * result.agreement(), result.agreeing, result.strokes,
-          result.compared ? 100.0 * static_cast<double>(result.characters_all_agree) /
-                                static_cast<double>(result.compared)
-                          : 0.0);
+                      100.0 * result.agreement(), result.agreeing, result.strokes,
+                      result.compared ? 100.0 * static_cast<double>(result.characters_all_agree) /
+                                            static_cast<double>(result.compared)
+                                      : 0.0);
   out += fmt::sprintf("fit and classify: %.2f s on %u thread(s)\n", seconds, threads);
   return out;
 }
@@ -78,7 +80,7 @@ int run_validate(const ValidateCommand& command) {
                                    "cnchar-order 3.2.6 (" + std::to_string(labels.size()) + " characters)"));
   }
   if (command.json) {
-    write_standard_output(cnchar_validation_json(result).dump(2) + "\n");
+    write_standard_output(json_text(cnchar_validation_json(result), 2) + "\n");
   } else if (command.markdown != "-") {
     write_standard_output(summary_text(result, data_description, seconds, threads));
   }

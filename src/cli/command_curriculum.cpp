@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "calligraphy/core/json_text.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
 #include "calligraphy/study/curriculum.hpp"
@@ -71,7 +72,7 @@ int run_curriculum(const CurriculumCommand& command) {
                      {"new_strokes", p.new_strokes},
                      {"weak_strokes", p.weak_strokes}});
     }
-    std::printf("%s\n", out.dump(2).c_str());
+    std::printf("%s\n", json_text(out, 2).c_str());
     return 0;
   }
   std::printf("%s: %zu of %zu typical strokes written; next:\n", command.subject.c_str(),

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "calligraphy/core/json_text.hpp"
 #include "calligraphy/devices/device_registry.hpp"
 #include "calligraphy/report/device_survey_json.hpp"
 #include "cli/cli_devices.hpp"
@@ -45,7 +46,7 @@ std::string survey_and_kinds_json(const DeviceSurvey& survey, const std::vector<
                     {"what", kind.what}});
   }
   document["kinds"] = std::move(list);
-  return document.dump(2) + "\n";
+  return json_text(document, 2) + "\n";
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 
 #include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/json_text.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/study/cohort.hpp"
 #include "cli/commands.hpp"
@@ -241,7 +242,7 @@ std::string session_plan_json(const LoadedProtocol& loaded, std::span<const Subj
                          {"filled", balance.filled()},  {"reachable", balance.reachable()},
                          {"drawn", balance.drawn},      {"factors", factors},
                          {"warning", balance.warning()}};
-  return document.dump(2) + "\n";
+  return json_text(document, 2) + "\n";
 }
 
 namespace {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <nlohmann/json.hpp>
 
+#include "calligraphy/core/json_text.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
 #include "report/appendf.hpp"
@@ -62,7 +63,7 @@ std::string corpus_stats_json(const CorpusStore& store, const CorpusStoreStats& 
       {"checksums_ok", stats.errors.empty()},
       {"errors", stats.errors},
       {"typical_stroke_histogram", histogram}};
-  return doc.dump(2) + "\n";
+  return json_text(doc, 2) + "\n";
 }
 
 std::string corpus_stats_text(const CorpusStore& store, const CorpusStoreStats& stats) {

@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "calligraphy/core/json_text.hpp"
 #include "report/device_info_object.hpp"
 
 namespace calligraphy {
@@ -33,7 +34,7 @@ std::string device_survey_json(const DeviceSurvey& survey) {
   }
   const nlohmann::json doc = {
       {"devices", devices}, {"notes", survey.notes}, {"any_hardware", survey.any_hardware()}};
-  return doc.dump(2) + "\n";
+  return json_text(doc, 2) + "\n";
 }
 
 }  // namespace calligraphy

@@ -3,8 +3,9 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
-#include "calligraphy/model/typical_strokes.hpp"
+#include "calligraphy/core/json_text.hpp"
 #include "calligraphy/core/unicode.hpp"
+#include "calligraphy/model/typical_strokes.hpp"
 #include "report/appendf.hpp"
 
 namespace calligraphy {
@@ -56,7 +57,7 @@ std::string model_json(const Character& character) {
       {"character", encode_utf8(character.code_point)}, {"typical_strokes", character.strokes.size()},
       {"typical_stroke_ids", table.typical_stroke_ids}, {"control_points", table.control_points.size()},
       {"feature_points", table.feature_point_count()},  {"strokes", strokes}};
-  return doc.dump(2) + "\n";
+  return json_text(doc, 2) + "\n";
 }
 
 std::string model_text(const Character& character) {

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "calligraphy/core/json_text.hpp"
 #include "calligraphy/core/printable_text.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
@@ -331,14 +332,14 @@ nlohmann::json report_detail::writing_metrics_object(const WritingMetrics& m) {
 }
 
 std::string writing_metrics_json(const WritingMetrics& metrics) {
-  return report_detail::writing_metrics_object(metrics).dump(2) + "\n";
+  return json_text(report_detail::writing_metrics_object(metrics), 2) + "\n";
 }
 
 std::string score_json(const ScoreDescription& d, const WritingMetrics& metrics) {
   nlohmann::json doc = {
       {"character", d.character}, {"trace", d.trace}, {"units", d.units}, {"samples", d.samples}};
   doc.update(report_detail::writing_metrics_object(metrics));
-  return doc.dump(2) + "\n";
+  return json_text(doc, 2) + "\n";
 }
 
 }  // namespace calligraphy

@@ -11,6 +11,7 @@
 
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/json_text.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/model/polyline.hpp"
 #include "calligraphy/model/typical_strokes.hpp"
@@ -174,7 +175,7 @@ std::string trial_json(const TrialDescription& d, const TrialResult& result, con
   if (!d.writer_parameters.empty()) doc["writer_parameters"] = d.writer_parameters;
   // Made by its one writer above this module: parsed whole (a JSON number reads back to the same double).
   if (!d.specification_json.empty()) doc["specification"] = nlohmann::json::parse(d.specification_json);
-  return doc.dump(2) + "\n";
+  return json_text(doc, 2) + "\n";
 }
 
 std::string trial_svg(const Scene& scene, const TrialResult& result) {

@@ -4,8 +4,9 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
-#include "calligraphy/model/typical_strokes.hpp"
+#include "calligraphy/core/json_text.hpp"
 #include "calligraphy/core/unicode.hpp"
+#include "calligraphy/model/typical_strokes.hpp"
 
 namespace calligraphy {
 namespace {
@@ -132,7 +133,7 @@ std::string typical_strokes_json() {
                     {"default_attraction", t.default_attraction},
                     {"corner_attraction", t.corner_attraction}});
   }
-  return list.dump(2);
+  return json_text(list, 2);
 }
 
 }  // namespace calligraphy

@@ -8,6 +8,7 @@
 #include <unordered_set>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/json_text.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/study/schedule.hpp"
 #include "calligraphy/study/session_folder.hpp"
@@ -184,7 +185,7 @@ std::size_t write_manifest(const SessionManifest& manifest, Sink&& sink) {
     if (!p.session_sha256.empty()) document["previous_session"]["session_sha256"] = p.session_sha256;
   }
   if (!manifest.study_id.empty()) document["study_id"] = manifest.study_id;
-  const std::string text = document.dump(2) + "\n";
+  const std::string text = json_text(document, 2) + "\n";
   // The empty plan as dumped: a top-level key starts a line after two spaces; a string value holds no line
   // break (dumped as \n), so this is the plan's key and nothing inside a value.
   constexpr std::string_view empty_plan = "\n  \"plan\": []";
@@ -197,7 +198,7 @@ std::size_t write_manifest(const SessionManifest& manifest, Sink&& sink) {
   if (!sink(std::string_view(text).substr(0, open))) return 0;
   std::string item;
   for (std::size_t i = 0; i < manifest.plan.size(); ++i) {
-    const std::string dumped = planned_trial_json(manifest.plan[i]).dump(2);
+    const std::string dumped = json_text(planned_trial_json(manifest.plan[i]), 2);
     item.assign(i == 0 ? "\n    " : ",\n    ");
     for (const char c : dumped) {
       item += c;
@@ -375,19 +376,18 @@ SessionManifest manifest_from_json(std::string_view text, const std::string& sou
 
 std::string session_created_details(const SessionManifest& manifest) {
   const SessionSetup& setup = manifest.setup;
-  return json{{"subject", setup.subject.id},
-              {"subject_number", setup.subject.number},
-              {"device", setup.device},
-              {"writer", std::string(enum_spelling(setup.writer))},
-              {"writer_profile", setup.writer_profile},
-              {"writer_learning", std::string(enum_spelling(setup.writer_learning))},
-              {"individual_differences", setup.individual_differences},
-              {"protocol", manifest.protocol.protocol.name},
-              {"protocol_sha256", manifest.protocol.sha256},
-              {"session_number", setup.session_number},
-              {"group", manifest.group},
-              {"trials_planned", manifest.plan.size()}}
-      .dump();
+  return json_text(json{{"subject", setup.subject.id},
+                        {"subject_number", setup.subject.number},
+                        {"device", setup.device},
+                        {"writer", std::string(enum_spelling(setup.writer))},
+                        {"writer_profile", setup.writer_profile},
+                        {"writer_learning", std::string(enum_spelling(setup.writer_learning))},
+                        {"individual_differences", setup.individual_differences},
+                        {"protocol", manifest.protocol.protocol.name},
+                        {"protocol_sha256", manifest.protocol.sha256},
+                        {"session_number", setup.session_number},
+                        {"group", manifest.group},
+                        {"trials_planned", manifest.plan.size()}});
 }
 
 std::string log_line(const std::string& time_utc, std::string_view event, std::string_view details_json) {
@@ -404,7 +404,7 @@ std::string log_line(const std::string& time_utc, std::string_view event, std::s
       if (item.key() != "time_utc" && item.key() != "event") line[item.key()] = item.value();
     }
   }
-  return line.dump() + "\n";
+  return json_text(line) + "\n";
 }
 
 }  // namespace calligraphy::study_detail

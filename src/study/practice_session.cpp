@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "calligraphy/core/json_text.hpp"
 #include "calligraphy/core/sha256.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/report/trace_hdf5.hpp"
@@ -42,7 +43,7 @@ LoadedProtocol practice_protocol(const PracticeSetup& setup) {
         {{"name", kAmplificationCondition}, {"mode", "error-amplification"}},
         {{"name", kTimingCondition}, {"mode", "timing"}}}},
       {"test", {{"characters", items}, {"conditions", {setup.first_condition}}, {"repetitions", 1}}}};
-  return protocol_from_text(protocol.dump(2) + "\n", "calligraphy-train");
+  return protocol_from_text(json_text(protocol, 2) + "\n", "calligraphy-train");
 }
 
 SessionFolder create_folder(const PracticeSetup& setup) {
@@ -109,7 +110,7 @@ std::pair<std::filesystem::path, bool> PracticeSession::save(const PracticeTrial
     const std::string record =
         study_detail::trial_record_json(context, scene, result, writing, quiz.empty() ? nullptr : &quiz);
     folder_.save_trial(planned, record, trace, trial_svg(scene, result));
-    folder_.log("trial_saved", details.dump());
+    folder_.log("trial_saved", json_text(details));
     return {folder_.trial_file(planned, "json"), true};
   }
   context.svg_file.clear();
@@ -119,7 +120,7 @@ std::pair<std::filesystem::path, bool> PracticeSession::save(const PracticeTrial
   };
   const std::filesystem::path kept = folder_.save_attempt(planned, record, trace);
   details["abort_reason"] = result.abort_reason;
-  folder_.log(result.end == TrialEnd::interrupted ? "trial_interrupted" : "trial_failed", details.dump());
+  folder_.log(result.end == TrialEnd::interrupted ? "trial_interrupted" : "trial_failed", json_text(details));
   return {kept, false};
 }
 

@@ -247,16 +247,6 @@ void append_trial_rows(const json& document, const fs::path& json_file, const Se
   TrialRow row = study_detail::trial_row(document, source, manifest, plan, rows.strokes);
   const json_detail::JsonView record(document, "", source);
   row.trace_file = json_file.parent_path() / trace_file_name(record);
-  // The tables are UTF-8 text (R, pandas and Python's strings read them so): a folder given by a path with a
-  // byte that is not UTF-8 is named (as printable text, which Python's message can hold too), not written
-  // into them as a column no reader can decode.
-  try {
-    decode_utf8(row.trace_file.string());
-  } catch (const InvalidArgument& error) {
-    throw DataError(printable_one_line(row.trace_file.string()) +
-                    ": the trace's path cannot go into the tables, which are UTF-8 text: " + error.what() +
-                    "; give the study folder by a path in UTF-8 (a relative one, or rename it)");
-  }
   row.trace_sha256 = record.object("files").string_or("trace_sha256", "");
   rows.trials.push_back(std::move(row));
 }

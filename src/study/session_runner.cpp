@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/json_text.hpp"
 #include "calligraphy/core/parameter_table.hpp"
 #include "calligraphy/core/sha256.hpp"
 #include "calligraphy/core/unicode.hpp"
@@ -103,7 +104,7 @@ void log_unlogged_saves(SessionFolder& session, const std::vector<json>& events)
     details["end_reason"] = record.at("end_reason");
     details["time_s"] = record.at("total_time_s");
     details["recovered"] = true;
-    session.log("trial_saved", details.dump());
+    session.log("trial_saved", json_text(details));
   }
 }
 
@@ -268,7 +269,7 @@ class SessionRun {
   void log_failure(const PlannedTrial& trial, const Error& e, const char* reason) {
     json details = trial_details(trial);
     details["error"] = e.what();
-    session_.log("trial_failed", details.dump());
+    session_.log("trial_failed", json_text(details));
     session_.log("session_stopped", json{{"saved_trials", result_.saved_before + result_.saved_now},
                                          {"planned", result_.planned},
                                          {"reason", reason}}
@@ -357,7 +358,7 @@ class SessionRun {
     const StudyCondition& condition = manifest_.protocol.protocol.condition(trial.condition);
     PreparedTrial prepared = prepare(trial, condition);
     std::unique_ptr<HapticDevice> device = create_device(trial);
-    session_.log("trial_started", prepared.started.dump());
+    session_.log("trial_started", json_text(prepared.started));
     // The simulated subject, with its traits and what it learned (the specification's writer part).
     SimulatedWriting writing(*prepared.spec);
     const Checked<WholeTrial> whole =
@@ -439,7 +440,7 @@ class SessionRun {
       outcome.saved = true;
       outcome.json_file = session_.trial_file(trial, "json").string();
       details["time_s"] = outcome.time_s;
-      session_.log("trial_saved", details.dump());
+      session_.log("trial_saved", json_text(details));
       ++result_.saved_now;
     } else {
       context.svg_file.clear();
@@ -460,10 +461,10 @@ class SessionRun {
       ++result_.attempts_kept;
       if (trial_result.end == TrialEnd::interrupted) {
         details["reason"] = stop_reason(options_);
-        session_.log("trial_interrupted", details.dump());
+        session_.log("trial_interrupted", json_text(details));
         result_.interrupted = true;
       } else {
-        session_.log("trial_failed", details.dump());
+        session_.log("trial_failed", json_text(details));
         result_.device_failed = true;
         result_.failure = trial_result.abort_reason;
       }
@@ -480,7 +481,7 @@ class SessionRun {
     json details = trial_details(trial);
     details["error"] = e.what();
     try {
-      session_.log("trial_failed", details.dump());
+      session_.log("trial_failed", json_text(details));
     } catch (const DataError&) {  // the same full disk: the failure is reported by the result
     }
     return outcome;

@@ -8,6 +8,7 @@
 #include <variant>
 
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/printable_text.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/core/worker_threads.hpp"
 #include "calligraphy/study/session_reader.hpp"
@@ -253,6 +254,17 @@ std::string trials_csv(const StudyTables& tables, std::span<const MetricInfo> me
       "learning_per_trial,subject_fast_retention_per_trial,subject_slow_retention_per_trial,strokes_given_"
       "up,legibility_top1,legibility_top5,trace_file,trace_sha256\n";
   for (const TrialRow& r : tables.trials) {
+    // The tables are UTF-8 text (R, pandas and Python's strings read them so): a folder given by a path with
+    // a byte that is not UTF-8 is named (as printable text, which Python's message can hold too), not written
+    // into them as a column no reader can decode. Only the text is refused: the rows in memory (curriculum's)
+    // need no path.
+    try {
+      decode_utf8(r.trace_file.string());
+    } catch (const InvalidArgument& error) {
+      throw DataError(printable_one_line(r.trace_file.string()) +
+                      ": the trace's path cannot go into the tables, which are UTF-8 text: " + error.what() +
+                      "; give the study folder by a path in UTF-8 (a relative one, or rename it)");
+    }
     out += field(r.subject);
     fields(out, r.session, r.protocol, r.session_number, r.group, r.phase, r.block, r.condition, r.mode,
            r.characters, r.trial, r.item, r.repetition, r.item_set, r.sequence, r.period, r.trained_condition,

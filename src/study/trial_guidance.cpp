@@ -6,6 +6,7 @@
 
 #include "calligraphy/core/atomic_file.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/json_text.hpp"
 #include "calligraphy/core/sha256.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
@@ -183,12 +184,11 @@ PreparedGuidance replay_guidance(SessionFolder& session, const StudyCondition& c
     }
     fs::create_directories(path.parent_path(), error);
     write_file_atomically(path, text);
-    session.log("teacher_saved", json{{"condition", condition.name},
-                                      {"characters", encode_utf8(trial.characters)},
-                                      {"file", prepared.teacher_file},
-                                      {"source", prepared.teacher_source},
-                                      {"sha256", sha256_hex(text)}}
-                                     .dump());
+    session.log("teacher_saved", json_text(json{{"condition", condition.name},
+                                                {"characters", encode_utf8(trial.characters)},
+                                                {"file", prepared.teacher_file},
+                                                {"source", prepared.teacher_source},
+                                                {"sha256", sha256_hex(text)}}));
   }
   // The session's own copy: read without following a link, as every file of a session folder.
   const std::string text = read_session_file(path, kMaxTeacherRecordingBytes, "teacher's recording");

@@ -4,6 +4,7 @@
 #include <array>
 #include <nlohmann/json.hpp>
 
+#include "calligraphy/core/json_text.hpp"
 #include "calligraphy/core/unicode.hpp"
 #include "calligraphy/devices/simulated_device.hpp"
 #include "calligraphy/legibility/legibility.hpp"
@@ -356,7 +357,7 @@ nlohmann::json trial_record(const TrialRecordContext& c, const Scene& scene, con
 std::string trial_record_json(const TrialRecordContext& context, const Scene& scene,
                               const TrialResult& result, const WritingMetrics& writing,
                               const std::vector<std::vector<QuizEvent>>* quiz) {
-  return trial_record(context, scene, result, writing, quiz).dump(2) + "\n";
+  return json_text(trial_record(context, scene, result, writing, quiz), 2) + "\n";
 }
 
 }  // namespace calligraphy::study_detail

@@ -12,6 +12,7 @@
 #include "calligraphy/analysis/metric_table.hpp"
 #include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/json_text.hpp"
 #include "calligraphy/core/sha256.hpp"
 #include "core/json_document.hpp"
 #include "core/json_reader.hpp"
@@ -161,7 +162,7 @@ nlohmann::json recorded_trial_object(const RecordedTrial& r) {
 const Schema& recorded_trial_schema() { return SchemaOf<trial_detail::RecordDocument>::get(); }
 
 std::string recorded_trial_json(const RecordedTrial& r) {
-  return trial_detail::recorded_trial_object(r).dump(2) + "\n";
+  return json_text(trial_detail::recorded_trial_object(r), 2) + "\n";
 }
 
 namespace trial_detail {

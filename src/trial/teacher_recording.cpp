@@ -5,6 +5,7 @@
 
 #include "calligraphy/core/decimal_number.hpp"
 #include "calligraphy/core/errors.hpp"
+#include "calligraphy/core/json_text.hpp"
 #include "core/json_document.hpp"
 #include "core/whole_file.hpp"
 
@@ -80,7 +81,7 @@ std::string teacher_recording_json(const TeacherRecording& recording) {
                                    {"rate_hz", recording.rate_hz},
                                    {"library_version", recording.library_version},
                                    {"samples", {{"t_s", t}, {"x_m", x}, {"y_m", y}, {"z_m", z}}}};
-  return document.dump() + "\n";
+  return json_text(document) + "\n";
 }
 
 TeacherRecording parse_teacher_recording(std::string_view json_text, const std::string& source) {

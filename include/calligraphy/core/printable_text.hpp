@@ -22,6 +22,11 @@ inline constexpr std::size_t kMaxMessageBytes = 2000;
 /// Never throws but std::bad_alloc.
 std::string printable_one_line(std::string_view text, std::size_t max_bytes = kMaxMessageBytes);
 
+/// `text` with each byte that is not part of valid UTF-8 written as the text `\xHH` (lower-case hex, as
+/// printable_one_line writes it), everything else kept as it is (line breaks and controls too): how a name in
+/// another encoding goes into UTF-8 text such as JSON (json_text.hpp). Valid UTF-8 comes back unchanged.
+[[nodiscard]] std::string valid_utf8_text(std::string_view text);
+
 /// `bytes` as lower-case hexadecimal text, two digits a byte, most significant first ({0x0f, 0xa0} ->
 /// "0fa0"): how a SHA-256 and a study folder's id are written.
 [[nodiscard]] std::string lower_hex(std::span<const unsigned char> bytes);
