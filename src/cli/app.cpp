@@ -275,6 +275,12 @@ CLI::Option* add_input_path(CLI::App& app, const std::string& name, std::string&
                             const std::string& value_name, const std::string& description,
                             const std::string& default_text) {
   return add_single(app, name, value_name, description, default_text, [=, &target](const std::string& text) {
+    // `-` is standard output for an output; for an input it is refused here, saying so, as the readers say
+    // it of a `-` given as an argument.
+    if (text == "-") {
+      throw CLI::ValidationError(name,
+                                 "expects a " + value_name + " name, got '-' (standard input is not read)");
+    }
     require_not_option_like(name, text, "a " + value_name + " name");
     target = text;
   });
